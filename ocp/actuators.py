@@ -1,0 +1,89 @@
+"""Actuator commands and the actuator model that turns a command into what is applied.
+
+A controller returns a :class:`Command`; the simulator's :class:`ActuatorModel` enforces the
+hardware: failed wheels give nothing, each wheel's torque and momentum stay within their limits
+over the coming zero-order-hold interval, and dipoles and torquer torques are clipped per axis.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ocp.spacecraft import Spacecraft
+
+Array = NDArray[np.float64]
+
+
+@dataclass
+class Command:
+    """What a controller asks of the actuators.
+
+    Attributes
+    ----------
+    wheel_torque : (n_w,) N m, motor torques ``g`` (``ḣ_w = g``, the body feels ``−A g``).
+    dipole : (3,) A m², magnetorquer dipole in body axes.
+    torque : (3,) N m, ideal torquer torque in body axes.
+    Any may be ``None`` (nothing asked of that actuator).
+    """
+
+    wheel_torque: Array | None = None
+    dipole: Array | None = None
+    torque: Array | None = None
+
+
+@dataclass
+class Measurement:
+    """What the controller sees at a sample: time (s), attitude, body rate (rad/s), wheel momenta
+    (N m s) and the magnetometer reading in body axes (T; ``None`` without a field model)."""
+
+    t: float
+    q: Array
+    omega: Array
+    wheel_momentum: Array
+    field_body: Array | None = None
+
+
+class ActuatorModel:
+    """Saturation and failures of a spacecraft's actuators, for a zero-order hold of ``dt``."""
+
+    def __init__(self, spacecraft: Spacecraft, slices: dict[str, slice], nu: int):
+        self.spacecraft = spacecraft
+        self.slices = slices
+        self.nu = nu
+        wheels = spacecraft.wheels
+        if wheels is not None:
+            self._wheel_mask = wheels.working.astype(float)
+            self._wheel_limit = wheels.max_torque
+            self._momentum_limit = wheels.max_momentum
+        self._dipole_limit = None if spacecraft.magnetorquers is None else spacecraft.magnetorquers.max_dipole
+        self._torquer_limit = None if spacecraft.torquers is None else spacecraft.torquers.max_torque
+
+    def apply(self, command: Command, wheel_momentum: Array, dt: float) -> tuple[Array, bool]:
+        """Applied control vector ``u`` for the model, and whether any actuator is at its limit.
+
+        The wheel torque is clipped to ``[−g_max, g_max]`` and further so that ``h_w + g dt``
+        stays within ``±h_max`` (``ḣ_w = g`` is constant over the hold, so this is exact).
+        """
+        u = np.zeros(self.nu)
+        saturated = False
+        if "wheels" in self.slices and command.wheel_torque is not None:
+            g = np.asarray(command.wheel_torque, dtype=float) * self._wheel_mask
+            low = np.maximum(-self._wheel_limit, (-self._momentum_limit - wheel_momentum) / dt)
+            high = np.minimum(self._wheel_limit, (self._momentum_limit - wheel_momentum) / dt)
+            high = np.maximum(high, low)  # a wheel already beyond its limit may only come back
+            applied = np.clip(g, low, high)
+            saturated |= bool(np.any(np.abs(applied - g) > 1e-12 * np.maximum(1.0, np.abs(g))))
+            saturated |= bool(np.any(np.abs(applied) >= self._wheel_limit * (1 - 1e-12)))
+            u[self.slices["wheels"]] = applied
+        for name, value, limit in (
+            ("dipole", command.dipole, self._dipole_limit),
+            ("torquers", command.torque, self._torquer_limit),
+        ):
+            if name in self.slices and value is not None:
+                value = np.asarray(value, dtype=float)
+                applied = np.clip(value, -limit, limit)
+                saturated |= bool(np.any(np.abs(value) >= limit * (1 - 1e-12)))
+                u[self.slices[name]] = applied
+        return u, saturated

@@ -1,0 +1,131 @@
+"""The assembled symbolic model ``ẋ = f(x, u, t, p)`` of a spacecraft in its environment.
+
+State ``x = [q (4), ω (3), h_w (n_w)]``: scalar-first attitude quaternion (body to inertial),
+body rate w.r.t. inertial in body axes (rad/s), wheel spin momenta (N m s).
+Control ``u = [g (n_w), m (3), τ_t (3)]`` with only the blocks of the actuators present:
+wheel motor torques (N m, ``ḣ_w = g``), magnetorquer dipole (A m², body axes), torquer torques
+(N m, body axes). Parameter ``p`` (3): the constant disturbance torque in body axes (N m); its
+default value is the environment's, and passing it lets one built model serve many runs.
+
+Dynamics (ARCHITECTURE.md): ``I ω̇ = −ω × (I ω + A h_w) − A g + m × B_B + τ_t + τ_gg + p``.
+"""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from ocp import quat, quat_casadi as qc
+from ocp.environment import Environment, gravity_gradient_torque
+from ocp.spacecraft import Spacecraft
+
+
+class AttitudeModel:
+    """Symbolic model of one spacecraft in one environment.
+
+    Attributes
+    ----------
+    rhs : casadi.Function ``(x, u, t, p) -> xdot``.
+    body_torque : casadi.Function ``(x, u, t) -> tau``: the actuators' torque on the body
+        (``−A g + m × B_B + τ_t``), N m, body axes.
+    environment_torque : casadi.Function ``(x, t, p) -> tau``: gravity gradient plus disturbance.
+    field_body : casadi.Function ``(x, t) -> b`` (T, body axes), or ``None`` without a field model.
+    control_slices : dict mapping ``"wheels"``, ``"dipole"``, ``"torquers"`` to slices of ``u``.
+    """
+
+    def __init__(self, spacecraft: Spacecraft, environment: Environment | None = None):
+        self.spacecraft = spacecraft
+        self.environment = environment if environment is not None else Environment()
+        self.n_wheels = spacecraft.n_wheels
+        self.nx = 7 + self.n_wheels
+        self.control_slices: dict[str, slice] = {}
+        offset = 0
+        for name, present, size in (
+            ("wheels", spacecraft.wheels is not None, self.n_wheels),
+            ("dipole", spacecraft.magnetorquers is not None, 3),
+            ("torquers", spacecraft.torquers is not None, 3),
+        ):
+            if present:
+                self.control_slices[name] = slice(offset, offset + size)
+                offset += size
+        self.nu = offset
+        self._build()
+
+    @property
+    def default_parameters(self) -> NDArray:
+        """Default ``p``: the environment's constant disturbance torque."""
+        return np.asarray(self.environment.disturbance_torque, dtype=float)
+
+    def split_state(self, x):
+        """``(q, ω, h_w)`` parts of a state vector (symbolic or numeric column)."""
+        return x[0:4], x[4:7], x[7:self.nx]
+
+    def magnetic_field_body(self, q, t):
+        """Field in body axes (T) as an expression, or ``None`` without a field model."""
+        env = self.environment
+        if env.magnetic_field is None:
+            return None
+        field_inertial = env.magnetic_field.field_inertial(env.orbit.position(t), t)
+        return ca.mtimes(qc.rotation_matrix(q).T, field_inertial)
+
+    def actuator_torque(self, x, u, t):
+        """Body torque of the actuators (expression): ``−A g + m × B_B + τ_t``."""
+        q = x[0:4]
+        torque = ca.MX.zeros(3, 1) if isinstance(x, ca.MX) else ca.SX.zeros(3, 1)
+        if "wheels" in self.control_slices:
+            torque -= ca.mtimes(ca.DM(self.spacecraft.wheel_axes), u[self.control_slices["wheels"]])
+        if "dipole" in self.control_slices:
+            field_body = self.magnetic_field_body(q, t)
+            if field_body is not None:
+                torque += ca.cross(u[self.control_slices["dipole"]], field_body)
+        if "torquers" in self.control_slices:
+            torque += u[self.control_slices["torquers"]]
+        return torque
+
+    def external_torque(self, x, t, p):
+        """Environment torque (expression): gravity gradient plus the disturbance ``p``."""
+        env = self.environment
+        torque = p
+        if env.gravity_gradient:
+            torque = torque + gravity_gradient_torque(
+                x[0:4], env.orbit.position(t), self.spacecraft.inertia, env.orbit.mu
+            )
+        return torque
+
+    def dynamics(self, x, u, t, p):
+        """``ẋ`` as an expression on SX or MX symbols."""
+        q, omega, h_w = self.split_state(x)
+        inertia = ca.DM(self.spacecraft.inertia)
+        axes = ca.DM(self.spacecraft.wheel_axes)
+        momentum = ca.mtimes(inertia, omega)
+        if self.n_wheels:
+            momentum += ca.mtimes(axes, h_w)
+        torque = self.actuator_torque(x, u, t) + self.external_torque(x, t, p)
+        omega_dot = ca.solve(inertia, -ca.cross(omega, momentum) + torque)
+        parts = [qc.kinematics(q, omega), omega_dot]
+        if self.n_wheels:
+            parts.append(u[self.control_slices["wheels"]])
+        return ca.vertcat(*parts)
+
+    def _build(self) -> None:
+        x = ca.SX.sym("x", self.nx)
+        u = ca.SX.sym("u", self.nu)
+        t = ca.SX.sym("t")
+        p = ca.SX.sym("p", 3)
+        self.rhs = ca.Function("f", [x, u, t, p], [self.dynamics(x, u, t, p)], ["x", "u", "t", "p"], ["xdot"])
+        self.body_torque = ca.Function(
+            "body_torque", [x, u, t], [self.actuator_torque(x, u, t)], ["x", "u", "t"], ["tau"]
+        )
+        self.environment_torque = ca.Function(
+            "environment_torque", [x, t, p], [self.external_torque(x, t, p)], ["x", "t", "p"], ["tau"]
+        )
+        field_body = self.magnetic_field_body(x[0:4], t)
+        self.field_body = None if field_body is None else ca.Function(
+            "field_body", [x, t], [field_body], ["x", "t"], ["b"]
+        )
+
+    def inertial_momentum(self, x: NDArray) -> NDArray:
+        """Total inertial angular momentum ``R(q)(I ω + A h_w)`` (N m s) for states ``(..., nx)``."""
+        x = np.asarray(x, dtype=float)
+        body = x[..., 4:7] @ self.spacecraft.inertia.T + x[..., 7:self.nx] @ self.spacecraft.wheel_axes.T
+        return quat.rotate(x[..., 0:4], body)
