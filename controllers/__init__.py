@@ -1,0 +1,11 @@
+"""Feedback controllers. ``CONTROLLERS`` maps registry names to controller classes."""
+from controllers.augmented_quaternion_feedback import AugmentedQuaternionFeedback
+from controllers.base import Controller, gain_matrix
+from controllers.eigenaxis_pd import EigenaxisPD
+from controllers.none import NoControl
+
+CONTROLLERS: dict[str, type[Controller]] = {
+    cls.name: cls for cls in (AugmentedQuaternionFeedback, EigenaxisPD, NoControl)
+}
+
+__all__ = ["AugmentedQuaternionFeedback", "CONTROLLERS", "Controller", "EigenaxisPD", "NoControl", "gain_matrix"]

@@ -1,0 +1,92 @@
+"""Controller contract and the mapping of a body torque onto the actuators.
+
+A controller computes, at each sample, a :class:`~ocp.actuators.Command`. Laws written for the
+rigid body ``I ω̇ = −ω × I ω + u`` compute ``u`` and call :meth:`Controller.allocate`, which maps it
+to the actuators as ARCHITECTURE.md states: wheels take ``τ_w = u + ω × A h_w`` through
+``g = −A⁺ τ_w`` (working wheels only); what the wheels cannot give (fewer than three independent
+axes) goes to the torquers if there are any, else to the magnetorquers as
+``m = B × τ / |B|²`` (the component of τ perpendicular to B). Without wheels the torquers take
+``u``, else the magnetorquers.
+"""
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import Any, ClassVar, Mapping
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ocp import Command, Measurement, Spacecraft
+from ocp.options import parse_options
+
+Array = NDArray[np.float64]
+
+
+class Controller(ABC):
+    """Base class of every feedback law.
+
+    Contract
+    --------
+    * ``name`` is the registry key; ``Options`` a dataclass of the law's options with defaults.
+    * ``reset(spacecraft, sample_time, target=None)`` clears any state before a run; ``target``
+      is ``(q_f, ω_f or None)``, used in regulation mode and by regulators.
+    * ``__call__(t, measurement, reference)`` returns the :class:`Command` for the coming sample;
+      ``reference`` is a ``planners.Reference`` or ``None`` (regulation to the target).
+    * Saturation is the simulator's actuator model's job, not the controller's.
+    """
+
+    name: ClassVar[str]
+
+    @dataclass(frozen=True)
+    class Options:
+        pass
+
+    def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
+        self.options = parse_options(self.Options, options, path)
+        self.spacecraft: Spacecraft | None = None
+        self.sample_time = 0.0
+        self.target: tuple[Array, Array | None] | None = None
+
+    def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
+        """Prepare for a run of ``spacecraft`` sampled every ``sample_time`` seconds."""
+        self.spacecraft = spacecraft
+        self.sample_time = sample_time
+        self.target = target
+        wheels = spacecraft.wheels
+        self._working_axes = None
+        if wheels is not None and np.any(wheels.working):
+            self._working_axes = wheels.axes * wheels.working
+            self._wheel_pinv = np.linalg.pinv(self._working_axes)
+
+    @abstractmethod
+    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
+        """The command for the sample starting at ``t`` (s)."""
+
+    def allocate(self, torque: Array, measurement: Measurement) -> Command:
+        """Map a rigid-body control torque ``u`` (N m, body axes) to the actuators."""
+        spacecraft = self.spacecraft
+        command = Command()
+        residual = np.asarray(torque, dtype=float)
+        if self._working_axes is not None:
+            wheel_torque = residual + np.cross(measurement.omega, spacecraft.wheel_axes @ measurement.wheel_momentum)
+            command.wheel_torque = -self._wheel_pinv @ wheel_torque
+            residual = wheel_torque + self._working_axes @ command.wheel_torque
+            if np.linalg.norm(residual) <= 1e-12 * max(np.linalg.norm(wheel_torque), 1e-300):
+                return command
+        if spacecraft.torquers is not None:
+            command.torque = residual
+        elif spacecraft.magnetorquers is not None and measurement.field_body is not None:
+            field = measurement.field_body
+            command.dipole = np.cross(field, residual) / max(float(field @ field), 1e-30)
+        return command
+
+
+def gain_matrix(gain: float | list[list[float]], inertia: Array) -> Array:
+    """A scalar gain times the inertia (the spin paper's choice), or a full 3x3 gain matrix."""
+    if isinstance(gain, (int, float)):
+        return float(gain) * inertia
+    matrix = np.asarray(gain, dtype=float)
+    if matrix.shape != (3, 3):
+        raise ValueError(f"a gain matrix must be 3x3, got shape {matrix.shape}")
+    return matrix

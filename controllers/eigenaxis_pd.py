@@ -1,0 +1,28 @@
+"""Eigenaxis PD regulator (nano paper eq. 39; Wie, Weiss & Arapostathis 1989).
+
+``u = −K q_e − C ω_e + ω × J ω`` towards the manoeuvre's target ``(q_f, ω_f)``, whatever the
+reference: the law itself produces the eigenaxis slew. With ``K = k J`` and ``C = c J`` a rest-to-rest
+slew stays on the eigenaxis, because ``q_e`` and ``ω`` remain parallel.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from controllers.augmented_quaternion_feedback import AugmentedQuaternionFeedback
+from ocp import Command, Measurement
+
+
+class EigenaxisPD(AugmentedQuaternionFeedback):
+    """Regulates to the target; a reference, if any, is ignored."""
+
+    name = "eigenaxis_pd"
+
+    @dataclass(frozen=True)
+    class Options:
+        kp: float | list[list[float]] = 0.06
+        kd: float | list[list[float]] = 0.48
+        feedforward: bool = False  # eq. 39 has none; kept so the parent's law is reused as is
+
+    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
+        return self.allocate(self.body_torque(t, measurement, None), measurement)

@@ -1,0 +1,16 @@
+"""No actuation: free motion under the environment (how the model is checked against others)."""
+from __future__ import annotations
+
+from typing import Any
+
+from controllers.base import Controller
+from ocp import Command, Measurement
+
+
+class NoControl(Controller):
+    """Commands nothing."""
+
+    name = "none"
+
+    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
+        return Command()

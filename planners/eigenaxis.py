@@ -1,0 +1,172 @@
+"""Eigenaxis slew: rotation about the fixed Euler axis of ``q0* ⊗ qf``, with three angle profiles.
+
+* ``smooth``: quintic θ(t) over the scenario's T with zero angular acceleration at both ends and
+  the boundary rates projected on the axis (rest-to-rest when they are zero).
+* ``trapezoidal``: bang-coast-bang over the scenario's T, rest to rest, with the largest
+  acceleration the torque bounds allow; ``infeasible`` if T is shorter than the minimum time.
+* ``min_time``: the fastest bang-coast-bang under the torque and optional rate bounds.
+
+The body rate is ``ω = e θ̇`` and the feed-forward torque the inverse dynamics
+``I ω̇ + ω × I ω = I e θ̈ + θ̇² e × I e``; the second term is not zero off a principal axis, so the
+acceleration ``α`` is chosen with the coast rate ``w`` such that every axis respects its bound:
+``|(I e)_i| α + w² |(e × I e)_i| <= u_i``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
+from ocp import quat
+from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference,
+                           ReferenceSample, inverse_dynamics_torque)
+
+
+class AngleProfile:
+    """θ(t), θ̇(t), θ̈(t) of a rotation about a fixed axis."""
+
+    def __call__(self, t: Array) -> tuple[Array, Array, Array]:
+        raise NotImplementedError
+
+
+class QuinticProfile(AngleProfile):
+    """θ(0)=0, θ(T)=Θ, θ̇(0)=w0, θ̇(T)=wT, θ̈(0)=θ̈(T)=0."""
+
+    def __init__(self, angle: float, duration: float, rate0: float, rate_end: float):
+        T = duration
+        rows = [[1, 0, 0, 0, 0, 0], [0, 1, 0, 0, 0, 0], [0, 0, 2, 0, 0, 0],
+                [1, T, T**2, T**3, T**4, T**5], [0, 1, 2 * T, 3 * T**2, 4 * T**3, 5 * T**4],
+                [0, 0, 2, 6 * T, 12 * T**2, 20 * T**3]]
+        coefficients = np.linalg.solve(np.array(rows, float), [0, rate0, 0, angle, rate_end, 0])
+        self.position = np.polynomial.Polynomial(coefficients)
+        self.rate = self.position.deriv()
+        self.acceleration = self.rate.deriv()
+
+    def __call__(self, t: Array) -> tuple[Array, Array, Array]:
+        return self.position(t), self.rate(t), self.acceleration(t)
+
+
+class BangCoastBangProfile(AngleProfile):
+    """Accelerate at α to the coast rate w, coast, decelerate at α to rest."""
+
+    def __init__(self, angle: float, acceleration: float, coast_rate: float):
+        self.alpha = acceleration
+        self.rate_max = coast_rate
+        self.ramp = coast_rate / acceleration
+        self.coast = max(angle / coast_rate - self.ramp, 0.0) if coast_rate > 0 else 0.0
+        self.angle = angle
+        self.duration = 2 * self.ramp + self.coast
+
+    def __call__(self, t: Array) -> tuple[Array, Array, Array]:
+        a, w, ramp = self.alpha, self.rate_max, self.ramp
+        late = np.maximum(self.duration - t, 0.0)
+        accelerating, decelerating = t < ramp, t > ramp + self.coast
+        position = np.where(accelerating, 0.5 * a * t**2,
+                            np.where(decelerating, self.angle - 0.5 * a * late**2, 0.5 * a * ramp**2 + w * (t - ramp)))
+        rate = np.where(accelerating, a * t, np.where(decelerating, a * late, w))
+        acceleration = np.where(accelerating, a, np.where(decelerating, -a, 0.0))
+        return position, rate, acceleration
+
+
+class EigenaxisReference(Reference):
+    """``q(t) = q0 ⊗ [cos θ/2, e sin θ/2]``, ``ω = e θ̇`` (body axes)."""
+
+    def __init__(self, q0: Array, axis: Array, profile: AngleProfile, duration: float, inertia: Array, message: str):
+        super().__init__("eigenaxis", duration, inertia, message=message)
+        self.q0, self.axis, self.profile = q0, axis, profile
+
+    def _evaluate(self, t: Array) -> ReferenceSample:
+        angle, rate, acceleration = self.profile(t)
+        q = quat.product(self.q0, quat.from_axis_angle(self.axis, angle))
+        omega = rate[:, None] * self.axis
+        omega_dot = acceleration[:, None] * self.axis
+        return ReferenceSample(q, omega, omega_dot, inverse_dynamics_torque(self.inertia, omega, omega_dot))
+
+
+class EigenaxisPlanner(Planner):
+    """Eigenaxis slew planner; see the module docstring for the profiles."""
+
+    name = "eigenaxis"
+
+    @dataclass(frozen=True)
+    class Options:
+        profile: Literal["smooth", "trapezoidal", "min_time"] = "smooth"
+        max_rate: float | None = None       # rad/s about the axis; default: the problem's max_rate
+        torque_fraction: float = 1.0        # share of the actuator bound the bang profiles may use
+
+        def __post_init__(self) -> None:
+            if not 0 < self.torque_fraction <= 1:
+                raise ValueError(f"torque_fraction must be in (0, 1], got {self.torque_fraction}")
+            if self.max_rate is not None and not self.max_rate > 0:
+                raise ValueError(f"max_rate must be positive, got {self.max_rate}")
+
+    def _plan(self, problem: ManeuverProblem) -> Reference:
+        rotvec = quat.to_rotation_vector(quat.error(problem.qf, problem.q0))
+        angle = float(np.linalg.norm(rotvec))
+        axis = rotvec / angle if angle > 1e-12 else np.array([1.0, 0.0, 0.0])
+        inertia = problem.spacecraft.inertia
+        if self.options.profile == "smooth":
+            rate_end = 0.0 if problem.omegaf is None else float(axis @ problem.omegaf)
+            profile = QuinticProfile(angle, problem.duration, float(axis @ problem.omega0), rate_end)
+            return EigenaxisReference(problem.q0, axis, profile, problem.duration, inertia,
+                                      f"quintic, {np.rad2deg(angle):.2f} deg about {np.round(axis, 4).tolist()}")
+        max_rate = self.options.max_rate if self.options.max_rate is not None else problem.max_rate
+        bounds = self.options.torque_fraction * problem.torque_limit
+        accel_axis = inertia @ axis
+        gyro = np.abs(np.cross(axis, accel_axis))
+
+        def acceleration(coast_rate: float) -> float:
+            """Largest α with every axis within its bound while coasting at ``coast_rate``."""
+            margin = bounds - coast_rate**2 * gyro
+            active = np.abs(accel_axis) > 1e-12 * np.max(np.abs(accel_axis))
+            if np.any(margin < 0) or np.any(margin[active] <= 0):
+                return 0.0
+            return float(np.min(margin[active] / np.abs(accel_axis[active])))
+
+        if angle < 1e-12:
+            profile = BangCoastBangProfile(0.0, 1.0, 0.0)
+            return EigenaxisReference(problem.q0, axis, profile, problem.duration if self.options.profile
+                                      == "trapezoidal" else 0.0, inertia, "no rotation needed")
+        if acceleration(0.0) <= 0:
+            return FailedReference(self.name, f"the actuators give no torque about the axis {axis.round(4).tolist()}",
+                                   "infeasible")
+        rate_cap = max_rate if max_rate is not None else np.inf
+        if np.any(gyro > 0):
+            rate_cap = min(rate_cap, float(np.sqrt(np.min(bounds[gyro > 0] / gyro[gyro > 0]))))
+
+        def slew_time(coast_rate: float) -> float:
+            alpha = acceleration(coast_rate)
+            if alpha <= 0:
+                return np.inf
+            return angle / coast_rate + coast_rate / alpha if coast_rate**2 / alpha <= angle else 2 * np.sqrt(angle / alpha)
+
+        # With no gyroscopic term the optimum is the triangle w = sqrt(Θ α); else a bounded 1-D search.
+        peak = np.sqrt(angle * acceleration(0.0))
+        if np.all(gyro == 0) or not np.isfinite(rate_cap):
+            best_rate = min(peak, rate_cap)
+        else:
+            found = minimize_scalar(slew_time, bounds=(1e-9 * peak, min(peak, rate_cap)), method="bounded",
+                                    options={"xatol": 1e-12 * peak})
+            best_rate = float(found.x)
+        best_rate = min(best_rate, np.sqrt(angle * acceleration(best_rate)))  # a triangle never coasts faster
+        minimum_time = slew_time(best_rate)
+        if self.options.profile == "min_time":
+            profile = BangCoastBangProfile(angle, acceleration(best_rate), best_rate)
+            return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,
+                                      f"minimum time {profile.duration:.3f} s, coast rate {best_rate:.4g} rad/s")
+        if problem.duration < minimum_time * (1 - 1e-12):
+            return FailedReference(self.name, f"T = {problem.duration:g} s is shorter than the minimum "
+                                   f"bang-coast-bang time {minimum_time:.4g} s under the torque bounds", "infeasible")
+        # Fixed T: the slowest coast rate w with w (T − w/α(w)) = Θ.
+        def covered(w: float) -> float:
+            alpha = acceleration(w)
+            return w * (problem.duration - w / alpha) - angle if alpha > 0 else -angle
+
+        coast_rate = brentq(covered, 1e-15, best_rate, xtol=1e-15) if covered(best_rate) > 0 else best_rate
+        profile = BangCoastBangProfile(angle, acceleration(coast_rate), coast_rate)
+        profile.coast = problem.duration - 2 * profile.ramp  # exact T despite root tolerance
+        profile.duration = problem.duration
+        return EigenaxisReference(problem.q0, axis, profile, problem.duration, inertia,
+                                  f"bang-coast-bang, coast rate {coast_rate:.4g} rad/s")

@@ -1,0 +1,92 @@
+"""``slewbench`` command line: run, validate, list.
+
+Exit status: 0 when the run completed (a failed planner is a row, not an error), 2 for a bad
+scenario file, 1 for an internal error.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+import traceback
+from pathlib import Path
+
+from controllers import CONTROLLERS
+from planners import PLANNERS
+from scenarios.loader import load
+from scenarios.runner import run
+from scenarios.yaml_node import ScenarioError
+
+EXIT_OK, EXIT_INTERNAL, EXIT_BAD_SCENARIO = 0, 1, 2
+
+
+def _first_doc_line(cls) -> str:
+    import sys as _sys
+    doc = (_sys.modules[cls.__module__].__doc__ or cls.__doc__ or "").strip()
+    return doc.splitlines()[0] if doc else ""
+
+
+def command_list(_: argparse.Namespace) -> int:
+    print("planners:")
+    for name, cls in PLANNERS.items():
+        print(f"  {name:32s} {_first_doc_line(cls)}")
+    print("controllers:")
+    for name, cls in CONTROLLERS.items():
+        print(f"  {name:32s} {_first_doc_line(cls)}")
+    return EXIT_OK
+
+
+def command_validate(args: argparse.Namespace) -> int:
+    scenario = load(args.file)
+    print(f"{args.file}: valid scenario {scenario.name!r} with {len(scenario.planners)} planner(s) "
+          f"and controller {scenario.controller.name!r}")
+    return EXIT_OK
+
+
+def command_run(args: argparse.Namespace) -> int:
+    scenario = load(args.file)
+    out = Path(args.out) if args.out else Path("results") / scenario.name
+    start = time.perf_counter()
+    results = run(scenario, progress=lambda line: print(line, flush=True))
+    print()
+    print(results.to_terminal())
+    results.write(out, plots=not args.no_plots)
+    print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
+          f"{'' if args.no_plots else ', PNG plots'}) in {time.perf_counter() - start:.2f} s")
+    return EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="slewbench", description="Spacecraft attitude manoeuvre planning workbench")
+    commands = parser.add_subparsers(dest="command", required=True)
+    run_parser = commands.add_parser("run", help="plan, simulate and score every planner of a scenario")
+    run_parser.add_argument("file", help="scenario YAML file")
+    run_parser.add_argument("--out", help="output directory (default: results/<scenario name>)")
+    run_parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    run_parser.set_defaults(handler=command_run)
+    validate_parser = commands.add_parser("validate", help="check a scenario file")
+    validate_parser.add_argument("file")
+    validate_parser.set_defaults(handler=command_validate)
+    list_parser = commands.add_parser("list", help="registered planners and controllers")
+    list_parser.set_defaults(handler=command_list)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.handler(args)
+    except ScenarioError as error:
+        print(f"slewbench: error in scenario: {error}", file=sys.stderr)
+        return EXIT_BAD_SCENARIO
+    except KeyboardInterrupt:
+        print("slewbench: interrupted; no output was written", file=sys.stderr)
+        return EXIT_INTERNAL
+    except Exception:
+        traceback.print_exc()
+        print("slewbench: internal error (this is a bug; please report it with the scenario file)", file=sys.stderr)
+        return EXIT_INTERNAL
+
+
+if __name__ == "__main__":
+    sys.exit(main())

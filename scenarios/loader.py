@@ -1,0 +1,260 @@
+"""Scenario YAML schema (ARCHITECTURE.md, "Scenario YAML") and the :class:`Scenario` it builds.
+
+Every error is a :class:`~scenarios.yaml_node.ScenarioError` naming the YAML path and what was
+expected. Degrees (``*_deg``) and kilometres (``*_km``) are converted to SI here, and so are
+scalar-last quaternions (``maneuver.quaternion_order: scalar_last``), so that nothing inside the
+code sees the papers' conventions.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from controllers import CONTROLLERS
+from ocp import (CircularOrbit, Environment, Magnetorquers, ModelError, ReactionWheels, SensorNoise,
+                 Spacecraft, TiltedDipole, Torquers, quat)
+from ocp.options import OptionsError
+from planners import PLANNERS, ManeuverProblem
+from scenarios.yaml_node import Node, ScenarioError, read_yaml
+
+
+@dataclass
+class PlannerSpec:
+    """One planner row: registry ``name``, table ``label`` and its parsed options."""
+
+    name: str
+    label: str
+    options: Any
+
+
+@dataclass
+class ControllerSpec:
+    name: str
+    options: Any
+
+
+@dataclass
+class SimulationSpec:
+    """Closed-loop settings: sample time (s), window (s, ``None``: the manoeuvre's, or the
+    reference's if longer), errors applied to the true initial state (rad, rad/s), noise."""
+
+    sample_time: float = 1.0
+    duration: float | None = None
+    initial_attitude_error: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    initial_rate_error: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    noise: SensorNoise = field(default_factory=SensorNoise)
+    integrator: str = "rk4"
+    max_step: float = 0.05
+    settling_tolerance_deg: float = 0.5
+
+
+@dataclass
+class Scenario:
+    """A parsed, validated scenario."""
+
+    name: str
+    problem: ManeuverProblem
+    planners: list[PlannerSpec]
+    controller: ControllerSpec
+    simulation: SimulationSpec
+    source: Path | None = None
+
+    @property
+    def true_initial_state(self) -> np.ndarray:
+        """The simulated initial state: the manoeuvre's with the configured errors applied."""
+        p = self.problem
+        q0 = quat.product(p.q0, quat.from_rotation_vector(self.simulation.initial_attitude_error))
+        return np.concatenate([q0, p.omega0 + self.simulation.initial_rate_error, p.wheel_momentum0])
+
+
+def _model_part(node: Node, build: Callable[..., Any], **kwargs: Any) -> Any:
+    """Call a model constructor, turning its ModelError into a ScenarioError at ``node.path``."""
+    try:
+        return build(**kwargs)
+    except ModelError as error:
+        raise ScenarioError(f"{node.path}.{error.field}" if node.path else error.field, str(error)) from None
+
+
+def _limits(node: Node, key: str) -> Any:
+    child = node.get(key, None)
+    return None if child.is_null() else child.vector(allow_scalar=True)
+
+
+def parse_spacecraft(node: Node) -> Spacecraft:
+    node.mapping()
+    inertia_node = node.get("inertia", required=True)
+    inertia = inertia_node.value
+    if isinstance(inertia, list) and inertia and all(isinstance(row, list) for row in inertia):
+        inertia = np.array([Node(row, f"{inertia_node.path}[{i}]").vector(3) for i, row in enumerate(inertia)])
+    else:
+        inertia = inertia_node.vector(3)
+    wheels_node = node.get("wheels", {})
+    wheels = None
+    if not wheels_node.is_null():
+        wheels_node.mapping()
+        axes = wheels_node.get("axes", None)
+        axes = np.eye(3) if axes.is_null() else np.array([row.vector(3) for row in axes.items()]).T
+        failed = [item.integer() for item in wheels_node.get("failed", []).items()]
+        wheels = _model_part(
+            wheels_node, ReactionWheels, axes=axes, max_torque=_limits(wheels_node, "max_torque"),
+            max_momentum=_limits(wheels_node, "max_momentum"), spin_inertia=_limits(wheels_node, "spin_inertia"),
+            failed=tuple(failed),
+        )
+        wheels_node.finish()
+    magnetorquers = torquers = None
+    mtq = node.get("magnetorquers", None)
+    if not mtq.is_null():
+        magnetorquers = _model_part(mtq.mapping(), Magnetorquers, max_dipole=_limits(mtq, "max_dipole"))
+        mtq.finish()
+    trq = node.get("torquers", None)
+    if not trq.is_null():
+        torquers = _model_part(trq.mapping(), Torquers, max_torque=_limits(trq, "max_torque"))
+        trq.finish()
+    spacecraft = _model_part(node, Spacecraft, inertia=inertia, wheels=wheels, magnetorquers=magnetorquers,
+                             torquers=torquers)
+    node.finish()
+    return spacecraft
+
+
+def parse_environment(orbit_node: Node, node: Node) -> Environment:
+    orbit = None
+    if not orbit_node.is_null():
+        orbit_node.mapping()
+        orbit = _model_part(
+            orbit_node, CircularOrbit,
+            altitude=orbit_node.get("altitude_km", required=True).number() * 1e3,
+            inclination=np.deg2rad(orbit_node.get("inclination_deg", 0.0).number()),
+            raan=np.deg2rad(orbit_node.get("raan_deg", 0.0).number()),
+            arg_latitude=np.deg2rad(orbit_node.get("arg_latitude_deg", 0.0).number()),
+        )
+        orbit_node.finish()
+    node = node if not node.is_null() else Node({}, node.path)
+    node.mapping()
+    field_node = node.get("magnetic_field", None)
+    magnetic_field = None
+    if not field_node.is_null():
+        if isinstance(field_node.value, str):
+            field_node.string(("tilted_dipole", "none"))
+            magnetic_field = TiltedDipole()
+        else:
+            field_node.mapping()
+            field_node.get("model", "tilted_dipole").string(("tilted_dipole",))
+            defaults = TiltedDipole()
+            magnetic_field = TiltedDipole(
+                strength=field_node.get("strength", defaults.strength).number(positive=True),
+                tilt=np.deg2rad(field_node.get("tilt_deg", np.rad2deg(defaults.tilt)).number()),
+                pole_longitude=np.deg2rad(field_node.get("pole_longitude_deg", np.rad2deg(defaults.pole_longitude)).number()),
+                greenwich_angle=np.deg2rad(field_node.get("greenwich_angle_deg", 0.0).number()),
+            )
+            field_node.finish()
+    environment = _model_part(
+        node, Environment, orbit=orbit,
+        gravity_gradient=node.get("gravity_gradient", False).boolean(),
+        magnetic_field=magnetic_field,
+        disturbance_torque=node.get("disturbance_torque", [0.0, 0.0, 0.0]).vector(3),
+    )
+    node.finish()
+    return environment
+
+
+def parse_problem(node: Node, spacecraft: Spacecraft, environment: Environment) -> ManeuverProblem:
+    node.mapping()
+    order = node.get("quaternion_order", "scalar_first").string(("scalar_first", "scalar_last"))
+
+    def attitude(parent: Node) -> np.ndarray:
+        q = parent.get("q", required=True).quaternion()
+        return quat.from_scalar_last(q) if order == "scalar_last" else q
+
+    initial = node.get("initial", required=True).mapping()
+    final = node.get("final", required=True).mapping()
+    momentum = initial.get("wheel_momentum", None).optional_vector(spacecraft.n_wheels)
+    problem = ManeuverProblem(
+        spacecraft=spacecraft, environment=environment,
+        q0=attitude(initial), omega0=initial.get("omega", [0.0, 0.0, 0.0]).vector(3),
+        qf=attitude(final), omegaf=final.get("omega", None).optional_vector(3),
+        duration=node.get("duration", required=True).number(positive=True),
+        wheel_momentum0=momentum, max_rate=node.get("max_rate", None).optional_number(positive=True),
+    )
+    for part in (initial, final, node):
+        part.finish()
+    return problem
+
+
+def parse_planners(node: Node) -> list[PlannerSpec]:
+    specs, labels = [], set()
+    for item in node.items():
+        item.mapping()
+        name = item.get("name", required=True).string()
+        if name not in PLANNERS:
+            raise ScenarioError(f"{item.path}.name", f"unknown planner {name!r}; registered: {sorted(PLANNERS)}")
+        label = item.get("label", name).string()
+        if label in labels:
+            raise ScenarioError(f"{item.path}.label", f"duplicate label {label!r}; give each row its own label")
+        labels.add(label)
+        options = item.get("options", {})
+        try:
+            planner_options = PLANNERS[name](options.value, path=options.path).options
+        except OptionsError as error:
+            raise ScenarioError(error.path, error.message) from None
+        item.finish()
+        specs.append(PlannerSpec(name, label, planner_options))
+    return specs
+
+
+def parse_controller(node: Node) -> ControllerSpec:
+    node.mapping()
+    name = node.get("name", required=True).string()
+    if name not in CONTROLLERS:
+        raise ScenarioError(f"{node.path}.name", f"unknown controller {name!r}; registered: {sorted(CONTROLLERS)}")
+    options = node.get("options", {})
+    try:
+        controller_options = CONTROLLERS[name](options.value, path=options.path).options
+    except OptionsError as error:
+        raise ScenarioError(error.path, error.message) from None
+    node.finish()
+    return ControllerSpec(name, controller_options)
+
+
+def parse_simulation(node: Node) -> SimulationSpec:
+    node = node if not node.is_null() else Node({}, node.path)
+    node.mapping()
+    noise = node.get("sensor_noise", {}).mapping()
+    spec = SimulationSpec(
+        sample_time=node.get("sample_time", 1.0).number(positive=True),
+        duration=node.get("duration", None).optional_number(positive=True),
+        initial_attitude_error=np.deg2rad(node.get("initial_attitude_error_deg", [0.0, 0.0, 0.0]).vector(3)),
+        initial_rate_error=node.get("initial_rate_error", [0.0, 0.0, 0.0]).vector(3),
+        noise=SensorNoise(
+            attitude_std=np.deg2rad(noise.get("attitude_deg", 0.0).number(non_negative=True)),
+            rate_std=noise.get("rate", 0.0).number(non_negative=True),
+            seed=noise.get("seed", 0).integer(),
+        ),
+        integrator=node.get("integrator", "rk4").string(("rk4", "cvodes")),
+        max_step=node.get("max_step", 0.05).number(positive=True),
+        settling_tolerance_deg=node.get("settling_tolerance_deg", 0.5).number(positive=True),
+    )
+    noise.finish()
+    node.finish()
+    return spec
+
+
+def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
+    """Build a :class:`Scenario` from parsed YAML data."""
+    root = Node(data).mapping()
+    name = root.get("name", required=True).string()
+    spacecraft = parse_spacecraft(root.get("spacecraft", required=True))
+    environment = parse_environment(root.get("orbit", None), root.get("environment", {}))
+    problem = parse_problem(root.get("maneuver", required=True), spacecraft, environment)
+    planners = parse_planners(root.get("planners", required=True))
+    controller = parse_controller(root.get("controller", required=True))
+    simulation = parse_simulation(root.get("simulation", {}))
+    root.finish()
+    return Scenario(name, problem, planners, controller, simulation, source)
+
+
+def load(path: str | Path) -> Scenario:
+    """Read and validate a scenario file."""
+    return parse_scenario(read_yaml(path), Path(path))

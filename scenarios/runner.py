@@ -1,0 +1,128 @@
+"""Run a scenario: plan with every planner, track each reference in closed loop, score both.
+
+:func:`run` returns :class:`RunResults`, whose rows carry the metrics, the reference and the
+simulation, and which render to JSON, CSV and Markdown (see :mod:`scenarios.tables`).
+"""
+from __future__ import annotations
+
+import time
+import traceback
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from controllers import CONTROLLERS
+from ocp import SimulationError, SimulationResult, Simulator, metrics_from_reference, metrics_from_simulation
+from planners import PLANNERS, FailedReference, Reference
+from scenarios.loader import Scenario
+
+
+@dataclass
+class Row:
+    """One planner (or, in regulation mode, the controller alone) and its scores."""
+
+    label: str
+    planner: str | None
+    status: str
+    message: str
+    plan_time_s: float | None
+    reference_metrics: dict[str, Any] | None
+    closed_loop_metrics: dict[str, Any] | None
+    reference: Reference | None = field(default=None, repr=False)
+    simulation: SimulationResult | None = field(default=None, repr=False)
+    simulate_time_s: float = 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        """The row as ARCHITECTURE.md's ``results.json`` writes it."""
+        return {"label": self.label, "planner": self.planner, "status": self.status, "message": self.message,
+                "plan_time_s": self.plan_time_s, "reference": self.reference_metrics,
+                "closed_loop": self.closed_loop_metrics}
+
+
+@dataclass
+class RunResults:
+    """Rows of a scenario run. ``to_json``, ``to_csv``, ``to_markdown``, ``to_dataframe`` and
+    ``write`` render them (implemented in :mod:`scenarios.tables` and :mod:`scenarios.outputs`)."""
+
+    scenario: Scenario
+    rows: list[Row]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"scenario": self.scenario.name, "rows": [row.to_dict() for row in self.rows]}
+
+    def to_json(self) -> str:
+        from scenarios.tables import to_json
+        return to_json(self)
+
+    def to_csv(self) -> str:
+        from scenarios.tables import to_csv
+        return to_csv(self)
+
+    def to_markdown(self) -> str:
+        from scenarios.tables import to_markdown
+        return to_markdown(self)
+
+    def to_terminal(self) -> str:
+        from scenarios.tables import to_terminal
+        return to_terminal(self)
+
+    def to_dataframe(self):
+        """A pandas DataFrame of the CSV table (needs pandas installed)."""
+        from scenarios.tables import to_dataframe
+        return to_dataframe(self)
+
+    def write(self, directory, plots: bool = True) -> None:
+        """Write results.json/csv/md, time series and plots into ``directory`` atomically."""
+        from scenarios.outputs import write_results
+        write_results(self, directory, plots=plots)
+
+
+def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | None, row: Row) -> None:
+    problem = scenario.problem
+    duration = scenario.simulation.duration or max(problem.duration, reference.duration if reference else 0.0)
+    controller = CONTROLLERS[scenario.controller.name](scenario.controller.options)
+    start = time.perf_counter()
+    try:
+        result = simulator.run(controller, scenario.true_initial_state, duration, reference=reference,
+                               target=(problem.qf, problem.omegaf), noise=scenario.simulation.noise)
+    except SimulationError as error:
+        row.status, row.message = "failed", f"simulation: {error}"
+        return
+    finally:
+        row.simulate_time_s = time.perf_counter() - start
+    row.simulation = result
+    row.closed_loop_metrics = metrics_from_simulation(
+        result, problem.qf, problem.omegaf, reference=reference, plan_time_s=row.plan_time_s,
+        duration_s=reference.duration if reference else None,
+        settling_tolerance_deg=scenario.simulation.settling_tolerance_deg)
+
+
+def run(scenario: Scenario, progress: Callable[[str], None] | None = None) -> RunResults:
+    """Plan, simulate and score every planner of ``scenario``; ``progress`` receives a line per row."""
+    say = progress or (lambda line: None)
+    spec = scenario.simulation
+    simulator = Simulator(scenario.problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step)
+    rows = []
+    if not scenario.planners:
+        row = Row(scenario.controller.name, None, "ok", "regulation to the target", None, None, None)
+        _simulate(scenario, simulator, None, row)
+        say(f"[1/1] {row.label}: {row.status} (simulated in {row.simulate_time_s:.2f} s)")
+        return RunResults(scenario, [row])
+    for index, planner_spec in enumerate(scenario.planners, start=1):
+        planner = PLANNERS[planner_spec.name](planner_spec.options)
+        try:
+            reference = planner.plan(scenario.problem)
+        except Exception as error:  # a planner bug must not lose the other rows
+            traceback.print_exc()
+            reference = FailedReference(planner_spec.name, f"planner raised {type(error).__name__}: {error}")
+        row = Row(planner_spec.label, planner_spec.name, reference.status, reference.message,
+                  reference.plan_time_s, None, None, reference)
+        if reference.ok:
+            row.reference_metrics = metrics_from_reference(
+                reference, scenario.problem.qf, scenario.problem.omegaf,
+                settling_tolerance_deg=spec.settling_tolerance_deg)
+            _simulate(scenario, simulator, reference, row)
+        say(f"[{index}/{len(scenario.planners)}] {row.label}: {row.status} "
+            f"(planned in {row.plan_time_s * 1e3:.1f} ms, simulated in {row.simulate_time_s:.2f} s)"
+            + (f" - {row.message}" if row.status != "ok" else ""))
+        rows.append(row)
+    return RunResults(scenario, rows)

@@ -1,0 +1,162 @@
+"""Reading YAML with errors that name the path (``planners[1].options.weight``).
+
+:func:`read_yaml` parses with a loader that also reads numbers such as ``6e5`` (YAML 1.1 reads them
+as strings). :class:`Node` wraps a parsed value with its path; typed accessors raise
+:class:`ScenarioError` naming the path and what was expected, and :meth:`Node.finish` rejects
+keys that were never read.
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any, Iterator
+
+import numpy as np
+import yaml
+
+
+class ScenarioError(ValueError):
+    """A scenario file is wrong; ``path`` is where, ``message`` what was expected."""
+
+    def __init__(self, path: str, message: str):
+        super().__init__(f"{path}: {message}" if path else message)
+        self.path = path
+        self.message = message
+
+
+class _Loader(yaml.SafeLoader):
+    """SafeLoader that also reads exponent numbers without a dot or exponent sign (``6e5``),
+    which YAML 1.1 leaves as strings and YAML 1.2 reads as floats."""
+
+
+_Loader.yaml_implicit_resolvers = {key: list(value) for key, value in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+_EXPONENT_FLOAT = re.compile(r"^[-+]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[eE][-+]?[0-9]+$")
+for _first in "-+0123456789.":
+    _Loader.yaml_implicit_resolvers.setdefault(_first, []).insert(0, ("tag:yaml.org,2002:float", _EXPONENT_FLOAT))
+
+
+def read_yaml(path: str | Path) -> Any:
+    """Parse a YAML file; a missing file or text that is not YAML is a :class:`ScenarioError`."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ScenarioError("", f"scenario file not found: {path}") from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise ScenarioError("", f"cannot read {path}: {error}") from None
+    try:
+        return yaml.load(text, Loader=_Loader)
+    except yaml.YAMLError as error:
+        where = getattr(error, "problem_mark", None)
+        line = f" (line {where.line + 1}, column {where.column + 1})" if where else ""
+        raise ScenarioError("", f"{path} is not valid YAML{line}: {getattr(error, 'problem', error)}") from None
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+class Node:
+    """A YAML value with its path."""
+
+    def __init__(self, value: Any, path: str = ""):
+        self.value = value
+        self.path = path
+        self._read: set[str] = set()
+
+    def error(self, message: str) -> ScenarioError:
+        return ScenarioError(self.path or "(top level)", message)
+
+    def _child_path(self, key: str | int) -> str:
+        if isinstance(key, int):
+            return f"{self.path}[{key}]"
+        return f"{self.path}.{key}" if self.path else key
+
+    def mapping(self) -> "Node":
+        if not isinstance(self.value, dict):
+            raise self.error(f"expected a mapping, got {type(self.value).__name__}")
+        return self
+
+    def __contains__(self, key: str) -> bool:
+        return isinstance(self.value, dict) and key in self.value and self.value[key] is not None
+
+    def get(self, key: str, default: Any = ..., required: bool = False) -> "Node":
+        """Child node; a missing key gives ``default`` (or an error if ``required``)."""
+        self.mapping()
+        self._read.add(key)
+        if key not in self.value:
+            if required or default is ...:
+                raise ScenarioError(self._child_path(key), "required key is missing")
+            return Node(default, self._child_path(key))
+        return Node(self.value[key], self._child_path(key))
+
+    def finish(self) -> None:
+        """Reject keys that were not read."""
+        if isinstance(self.value, dict):
+            for key in self.value:
+                if key not in self._read:
+                    raise ScenarioError(self._child_path(key), f"unknown key; expected one of {sorted(self._read)}")
+
+    def items(self) -> Iterator["Node"]:
+        if not isinstance(self.value, list):
+            raise self.error(f"expected a list, got {type(self.value).__name__}")
+        return (Node(item, self._child_path(i)) for i, item in enumerate(self.value))
+
+    def is_null(self) -> bool:
+        return self.value is None or (isinstance(self.value, str) and self.value.lower() == "none")
+
+    def number(self, positive: bool = False, non_negative: bool = False) -> float:
+        if not _is_number(self.value) or not np.isfinite(self.value):
+            raise self.error(f"expected a number, got {self.value!r}")
+        if positive and not self.value > 0:
+            raise self.error(f"expected a positive number, got {self.value!r}")
+        if non_negative and self.value < 0:
+            raise self.error(f"expected a non-negative number, got {self.value!r}")
+        return float(self.value)
+
+    def optional_number(self, **checks: bool) -> float | None:
+        return None if self.is_null() else self.number(**checks)
+
+    def integer(self) -> int:
+        if not isinstance(self.value, int) or isinstance(self.value, bool):
+            raise self.error(f"expected an integer, got {self.value!r}")
+        return self.value
+
+    def boolean(self) -> bool:
+        if not isinstance(self.value, bool):
+            raise self.error(f"expected true or false, got {self.value!r}")
+        return self.value
+
+    def string(self, choices: tuple[str, ...] | None = None) -> str:
+        if not isinstance(self.value, str):
+            raise self.error(f"expected a string, got {self.value!r}")
+        if choices is not None and self.value not in choices:
+            raise self.error(f"expected one of {list(choices)}, got {self.value!r}")
+        return self.value
+
+    def vector(self, size: int | None = None, allow_scalar: bool = False) -> np.ndarray:
+        """A list of numbers (of ``size`` entries); a scalar if ``allow_scalar``."""
+        if allow_scalar and _is_number(self.value):
+            return np.asarray(self.number())
+        if not isinstance(self.value, list) or not all(_is_number(v) for v in self.value):
+            expected = f"a list of {size} numbers" if size else "a list of numbers"
+            raise self.error(f"expected {expected}{' or a number' if allow_scalar else ''}, got {self.value!r}")
+        if size is not None and len(self.value) != size:
+            raise self.error(f"expected {size} numbers, got {len(self.value)}")
+        array = np.asarray(self.value, dtype=float)
+        if not np.all(np.isfinite(array)):
+            raise self.error("expected finite numbers")
+        return array
+
+    def optional_vector(self, size: int | None = None) -> np.ndarray | None:
+        return None if self.is_null() else self.vector(size)
+
+    def quaternion(self) -> np.ndarray:
+        """A unit quaternion; normalised if close to unit norm, an error if zero or far from it."""
+        q = self.vector(4)
+        norm = float(np.linalg.norm(q))
+        if norm == 0.0:
+            raise self.error("a quaternion cannot be zero")
+        if abs(norm - 1.0) > 1e-2:
+            raise self.error(f"a quaternion must have unit norm (got norm {norm:.6g}; tolerance 1e-2)")
+        return q / norm
