@@ -11,19 +11,18 @@ axes) goes to the torquers if there are any, else to the magnetorquers as
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
-from typing import Any, ClassVar, Mapping
+from typing import Any, Mapping
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ocp import Command, Measurement, Spacecraft
-from ocp.options import parse_options
+from ocp.options import Configurable
 
 Array = NDArray[np.float64]
 
 
-class Controller(ABC):
+class Controller(Configurable, ABC):
     """Base class of every feedback law.
 
     Contract
@@ -36,14 +35,8 @@ class Controller(ABC):
     * Saturation is the simulator's actuator model's job, not the controller's.
     """
 
-    name: ClassVar[str]
-
-    @dataclass(frozen=True)
-    class Options:
-        pass
-
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
-        self.options = parse_options(self.Options, options, path)
+        super().__init__(options, path)
         self.spacecraft: Spacecraft | None = None
         self.sample_time = 0.0
         self.target: tuple[Array, Array | None] | None = None

@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import types
 import typing
-from typing import Any, Literal, Mapping, TypeVar, Union
+from typing import Any, ClassVar, Literal, Mapping, TypeVar, Union
 
 T = TypeVar("T")
 
@@ -108,3 +108,17 @@ def parse_options(options_class: type[T], values: Mapping[str, Any] | T | None, 
         return options_class(**kwargs)
     except ValueError as error:  # __post_init__ checks of ranges
         raise OptionsError(path, str(error)) from None
+
+
+class Configurable:
+    """Base of registered components (planners, controllers): a registry ``name`` and a frozen
+    dataclass ``Options`` whose typed fields, with defaults, are the component's options."""
+
+    name: ClassVar[str]
+
+    @dataclasses.dataclass(frozen=True)
+    class Options:
+        pass
+
+    def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
+        self.options = parse_options(self.Options, options, path)

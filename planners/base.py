@@ -10,13 +10,13 @@ import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any, ClassVar, Mapping, NamedTuple
+from typing import Any, Mapping, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp import AttitudeModel, Environment, Spacecraft, quat
-from ocp.options import parse_options
+from ocp.options import Configurable
 
 Array = NDArray[np.float64]
 STATUSES = ("ok", "failed", "infeasible")
@@ -166,7 +166,7 @@ def inverse_dynamics_torque(inertia: Array, omega: Array, omega_dot: Array) -> A
     return omega_dot @ inertia.T + np.cross(omega, omega @ inertia.T)
 
 
-class Planner(ABC):
+class Planner(Configurable, ABC):
     """Base class of every planner.
 
     Contract
@@ -178,15 +178,6 @@ class Planner(ABC):
       ``status="failed"`` or ``"infeasible"`` and a message; ``plan`` does not raise for it.
     * Planners never read YAML and never simulate.
     """
-
-    name: ClassVar[str]
-
-    @dataclass(frozen=True)
-    class Options:
-        pass
-
-    def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
-        self.options = parse_options(self.Options, options, path)
 
     def plan(self, problem: ManeuverProblem) -> Reference:
         """Plan the manoeuvre; the wall time goes into ``reference.plan_time_s``."""

@@ -183,39 +183,36 @@ def parse_problem(node: Node, spacecraft: Spacecraft, environment: Environment) 
     return problem
 
 
+def _registered(node: Node, registry: dict[str, type], kind: str) -> tuple[str, Any]:
+    """``name`` and parsed ``options`` of a registry entry (planner or controller) at ``node``."""
+    name = node.get("name", required=True).string()
+    if name not in registry:
+        raise ScenarioError(f"{node.path}.name", f"unknown {kind} {name!r}; registered: {sorted(registry)}")
+    options = node.get("options", {})
+    try:
+        return name, registry[name](options.value, path=options.path).options
+    except OptionsError as error:
+        raise ScenarioError(error.path, error.message) from None
+
+
 def parse_planners(node: Node) -> list[PlannerSpec]:
     specs, labels = [], set()
     for item in node.items():
         item.mapping()
-        name = item.get("name", required=True).string()
-        if name not in PLANNERS:
-            raise ScenarioError(f"{item.path}.name", f"unknown planner {name!r}; registered: {sorted(PLANNERS)}")
+        name, options = _registered(item, PLANNERS, "planner")
         label = item.get("label", name).string()
         if label in labels:
             raise ScenarioError(f"{item.path}.label", f"duplicate label {label!r}; give each row its own label")
         labels.add(label)
-        options = item.get("options", {})
-        try:
-            planner_options = PLANNERS[name](options.value, path=options.path).options
-        except OptionsError as error:
-            raise ScenarioError(error.path, error.message) from None
         item.finish()
-        specs.append(PlannerSpec(name, label, planner_options))
+        specs.append(PlannerSpec(name, label, options))
     return specs
 
 
 def parse_controller(node: Node) -> ControllerSpec:
-    node.mapping()
-    name = node.get("name", required=True).string()
-    if name not in CONTROLLERS:
-        raise ScenarioError(f"{node.path}.name", f"unknown controller {name!r}; registered: {sorted(CONTROLLERS)}")
-    options = node.get("options", {})
-    try:
-        controller_options = CONTROLLERS[name](options.value, path=options.path).options
-    except OptionsError as error:
-        raise ScenarioError(error.path, error.message) from None
+    name, options = _registered(node.mapping(), CONTROLLERS, "controller")
     node.finish()
-    return ControllerSpec(name, controller_options)
+    return ControllerSpec(name, options)
 
 
 def parse_simulation(node: Node) -> SimulationSpec:
