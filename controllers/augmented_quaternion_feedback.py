@@ -3,7 +3,8 @@
 ``u = −K q_e − C ω_e + ω × I ω + I ω̇*``, with ``q_e`` the vector part of ``q* ⊗ q`` (sign chosen
 so that its scalar part is non-negative), ``ω_e = ω − ω*`` (eq. 39), ``K = k_p I``, ``C = k_d I``
 for scalar gains (or full matrices). The wheel-momentum term of nano eq. 40, ``ω × h``, enters
-through the allocation ``τ_w = u + ω × A h_w``. With it the closed loop obeys
+through the allocation ``τ_w = u + ω × A h_w`` (see ``Controller.allocate``, which also
+corrects the held gyroscopic term to mid-sample). With it the closed loop obeys
 ``ω̇_e = −I⁻¹(K q_e + C ω_e)`` and the Lyapunov function of the spin paper's appendix
 (eq. 42-43), ``V = 2 k_p (1 − q_e0) + ½ ω_eᵀ ω_e``, has ``V̇ = −k_d ω_eᵀ ω_e`` for scalar gains.
 """
@@ -28,9 +29,11 @@ class AugmentedQuaternionFeedback(Controller):
         kp: float | list[list[float]] = 0.06       # 1/s² times inertia (spin paper "medium" gains)
         kd: float | list[list[float]] = 0.48       # 1/s times inertia
         feedforward: bool = True                    # the I ω̇* term of eq. 38
+        hold_compensation: bool = True              # gyroscopic term at mid-sample (Controller.allocate)
 
     def reset(self, spacecraft, sample_time, target=None) -> None:
         super().reset(spacecraft, sample_time, target)
+        self.hold_compensation = self.options.hold_compensation
         self.stiffness = gain_matrix(self.options.kp, spacecraft.inertia)
         self.damping = gain_matrix(self.options.kd, spacecraft.inertia)
 

@@ -6,7 +6,9 @@ to the actuators as ARCHITECTURE.md states: wheels take ``τ_w = u + ω × A h_w
 ``g = −A⁺ τ_w`` (working wheels only); what the wheels cannot give (fewer than three independent
 axes) goes to the torquers if there are any, else to the magnetorquers as
 ``m = B × τ / |B|²`` (the component of τ perpendicular to B). Without wheels the torquers take
-``u``, else the magnetorquers.
+``u``, else the magnetorquers. With ``hold_compensation`` the gyroscopic term is taken at
+mid-sample (see :meth:`Controller._gyroscopic_drift`), which removes the first-order lag of the
+zero-order hold when the body carries a large momentum (spinning spacecraft, loaded wheels).
 """
 from __future__ import annotations
 
@@ -35,6 +37,9 @@ class Controller(Configurable, ABC):
     * Saturation is the simulator's actuator model's job, not the controller's.
     """
 
+    hold_compensation: bool = True
+    """Correct the held gyroscopic term to mid-sample in :meth:`allocate`."""
+
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
         super().__init__(options, path)
         self.spacecraft: Spacecraft | None = None
@@ -56,11 +61,21 @@ class Controller(Configurable, ABC):
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
         """The command for the sample starting at ``t`` (s)."""
 
+    def _gyroscopic_drift(self, measurement: Measurement) -> Array:
+        """Mid-sample correction of the held gyroscopic term ``ω × H`` (``H = I ω + A h_w``, the
+        total body momentum): without external torque ``H`` turns in body axes as ``Ḣ = −ω × H``,
+        whatever the wheels exchange, so over the hold ``ω × H`` drifts by ``−dt/2 ω × (ω × H)``."""
+        omega = measurement.omega
+        momentum = self.spacecraft.inertia @ omega + self.spacecraft.wheel_axes @ measurement.wheel_momentum
+        return -0.5 * self.sample_time * np.cross(omega, np.cross(omega, momentum))
+
     def allocate(self, torque: Array, measurement: Measurement) -> Command:
         """Map a rigid-body control torque ``u`` (N m, body axes) to the actuators."""
         spacecraft = self.spacecraft
         command = Command()
         residual = np.asarray(torque, dtype=float)
+        if self.hold_compensation:
+            residual = residual + self._gyroscopic_drift(measurement)
         if self._working_axes is not None:
             wheel_torque = residual + np.cross(measurement.omega, spacecraft.wheel_axes @ measurement.wheel_momentum)
             command.wheel_torque = -self._wheel_pinv @ wheel_torque

@@ -23,6 +23,7 @@ class EigenaxisPD(AugmentedQuaternionFeedback):
         kp: float | list[list[float]] = 0.06
         kd: float | list[list[float]] = 0.48
         feedforward: bool = False  # eq. 39 has none; kept so the parent's law is reused as is
+        hold_compensation: bool = True
 
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
         return self.allocate(self.body_torque(t, measurement, None), measurement)

@@ -2,9 +2,10 @@
 from planners.base import (FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
 from planners.eigenaxis import EigenaxisPlanner
+from planners.spin_extremal import SpinExtremalPlanner
 
 PLANNERS: dict[str, type[Planner]] = {
-    cls.name: cls for cls in (EigenaxisPlanner,)
+    cls.name: cls for cls in (EigenaxisPlanner, SpinExtremalPlanner)
 }
 
 __all__ = ["FailedReference", "ManeuverProblem", "PLANNERS", "Planner", "Reference", "ReferenceSample",

@@ -22,6 +22,17 @@ class WheelPD:
         return Command(wheel_torque=-u)
 
 
+def finite_difference_torque(reference, inertia, t, h=1e-3):
+    """Inverse dynamics from the attitude alone: ω = 2 vec(q* ⊗ q̇), ω̇ by central differences."""
+    def omega(times):
+        q_dot = (reference.q(times + h) - reference.q(times - h)) / (2 * h)
+        return 2 * quat.product(quat.conjugate(reference.q(times)), q_dot)[:, 1:]
+
+    w = omega(t)
+    w_dot = (omega(t + h) - omega(t - h)) / (2 * h)
+    return w, w_dot @ inertia.T + np.cross(w, w @ inertia.T)
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(20261123)

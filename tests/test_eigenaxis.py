@@ -4,6 +4,7 @@ import pytest
 
 from ocp import ReactionWheels, Spacecraft, Torquers, quat
 from planners import PLANNERS, ManeuverProblem
+from tests.conftest import finite_difference_torque
 
 PROFILES = ("smooth", "trapezoidal", "min_time")
 
@@ -12,17 +13,6 @@ def non_principal_spacecraft(rng, max_torque=0.1):
     moments = rng.uniform(8.0, 20.0, 3)
     rotation = quat.rotation_matrix(quat.random_unit(rng))
     return Spacecraft(rotation @ np.diag(moments) @ rotation.T, wheels=ReactionWheels.from_body_axes(max_torque=max_torque))
-
-
-def finite_difference_torque(reference, inertia, t, h=1e-3):
-    """Inverse dynamics from the attitude alone: ω = 2 vec(q* ⊗ q̇), ω̇ by central differences."""
-    def omega(times):
-        q_dot = (reference.q(times + h) - reference.q(times - h)) / (2 * h)
-        return 2 * quat.product(quat.conjugate(reference.q(times)), q_dot)[:, 1:]
-
-    w = omega(t)
-    w_dot = (omega(t + h) - omega(t - h)) / (2 * h)
-    return w, w_dot @ inertia.T + np.cross(w, w @ inertia.T)
 
 
 @pytest.mark.parametrize("profile", PROFILES)

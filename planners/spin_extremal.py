@@ -1,0 +1,201 @@
+"""Closed-form spin-stabilized extremals (Biggs & Horri, Theorem 1) with parameter optimisation.
+
+Extremals of ``½∫(Ω2² + Ω3²) dt`` with the roll rate held at ``v``:
+``ω*(t) = [v, r sin θ, r cos θ]``, ``θ = (v + c) t + β``. The attitude from ``q*(0) = 1`` is
+
+    q*(t) = E1(−β) ⊗ exp(t [−c, 0, r] / 2) ⊗ E1(θ(t)),   E1(φ) = [cos φ/2, sin φ/2, 0, 0],
+
+because in the frame turning with θ about the roll axis the rate is the constant ``[−c, 0, r]``
+(norm ``K = √(r² + c²)``). Expanded, ``q0, q1`` carry the coefficients ``(K − c)`` with
+``cos((c + K + v) t/2)`` and ``(K + c)`` with ``cos((c − K + v) t/2)``: eq. 11 prints them swapped
+(invisible for the paper's c ≈ 0); ``q2, q3`` are eq. 11 with the + sign. Any initial attitude is
+reached by ``q(t) = q0 ⊗ q*(t)``. The feed-forward torque is eq. 31 (checked against inverse dynamics).
+
+The parameters ``(r, c, β)`` minimise ``J = J1 + k J2`` (eq. 34) with IPOPT:
+``J1 = min(‖q(T) − q_f‖², ‖q(T) + q_f‖²)`` (eq. 30 made invariant to ``q_f ~ −q_f``) and ``J2 = ∫‖u‖² dt`` in closed form (eq. 33 corrected:
+its ``u2`` factor must be ``(α − v δ2)`` as in eq. 31, and its first term's brackets are misplaced).
+A vectorised multi-start over branches of ``K T``, over ``β`` and over ``c`` seeds IPOPT.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import casadi as ca
+import numpy as np
+
+from ocp import quat
+from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample)
+
+
+def extremal_quaternion(t, v, r, c, beta, math=np):
+    """``q*(t)`` from the identity (scalar first); ``math`` is ``numpy`` or ``casadi``."""
+    K = math.sqrt(r**2 + c**2)
+    fast, slow = (c + K + v) * t / 2, (c - K + v) * t / 2
+    spin = (v + c) * t / 2 + beta
+    nutation = r / K * math.sin(K * t / 2)
+    return ((K - c) * math.cos(fast) + (K + c) * math.cos(slow)) / (2 * K), \
+        ((K - c) * math.sin(fast) + (K + c) * math.sin(slow)) / (2 * K), \
+        nutation * math.sin(spin), nutation * math.cos(spin)
+
+
+def attitude_cost(q_end: Array, target: Array) -> Array:
+    """Eq. 30 invariant to the double cover: ``min(‖q − q_f‖², ‖q + q_f‖²)`` over the last axis."""
+    return np.minimum(np.sum((q_end - target) ** 2, axis=-1), np.sum((q_end + target) ** 2, axis=-1))
+
+
+def extremal_torque(t, v, r, c, beta, moments):
+    """Eq. 31: body torque (N m) that makes a principal-axis body follow ``ω*``; rows per time."""
+    I1, I2, I3 = moments
+    d1, d2, d3 = (I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3
+    alpha = v + c
+    theta = alpha * t + beta
+    return np.stack([-0.5 * I1 * r**2 * np.sin(2 * theta) * d1,
+                     I2 * r * np.cos(theta) * (alpha - v * d2),
+                     -I3 * r * np.sin(theta) * (alpha + v * d3)], axis=-1)
+
+
+def _sin_ratio(x, duration, math):
+    """``sin(x T)/x`` with its limit ``T`` at ``x = 0`` (series below 1e-4 relative)."""
+    small = (x * duration) ** 2 < 1e-8
+    if math is np:
+        return np.where(small, duration, np.sin(x * duration) / np.where(small, 1.0, x))
+    return ca.if_else(small, duration * (1 - (x * duration) ** 2 / 6), ca.sin(x * duration) / x)
+
+
+def energy_cost(v, r, c, beta, duration, moments, math=np):
+    """``J2 = ∫₀ᵀ ‖u‖² dt`` in closed form for the torque of eq. 31 (N² m² s)."""
+    I1, I2, I3 = moments
+    d1, d2, d3 = (I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3
+    alpha = v + c
+    cos2 = math.cos(alpha * duration + 2 * beta) * _sin_ratio(alpha, duration, math)        # ∫ cos 2θ
+    cos4 = math.cos(2 * alpha * duration + 4 * beta) * _sin_ratio(2 * alpha, duration, math)  # ∫ cos 4θ
+    return (0.125 * (I1 * d1) ** 2 * r**4 * (duration - cos4)
+            + 0.5 * I2**2 * r**2 * (alpha - v * d2) ** 2 * (duration + cos2)
+            + 0.5 * I3**2 * r**2 * (alpha + v * d3) ** 2 * (duration - cos2))
+
+
+# IPOPT statuses taken as converged; at a zero-cost optimum (k = 0, target reached) IPOPT
+# reports the search direction as too small, which is convergence, not failure.
+CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level", "Search_Direction_Becomes_Too_Small")
+
+
+@lru_cache(maxsize=None)
+def _solver() -> ca.Function:
+    """IPOPT on (r, c, β) with parameters [v, T, I1, I2, I3, q_target (4), k]; built once."""
+    x = ca.SX.sym("x", 3)
+    p = ca.SX.sym("p", 10)
+    r, c, beta = x[0], x[1], x[2]
+    v, duration, moments, target, weight = p[0], p[1], (p[2], p[3], p[4]), p[5:9], p[9]
+    q_end = ca.vertcat(*extremal_quaternion(duration, v, r, c, beta, math=ca))
+    j1 = ca.fmin(ca.sumsqr(q_end - target), ca.sumsqr(q_end + target))
+    j2 = energy_cost(v, r, c, beta, duration, moments, math=ca)
+    # Unbounded: (−r, β + π) is the same extremal, so r >= 0 is restored afterwards instead of
+    # being a bound whose barrier would cost IPOPT iterations. J1 is written as eq. 30's sum of
+    # squares: the equal 2 − 2|q·q_f| cancels at the optimum and leaves IPOPT a noisy gradient.
+    options = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-12,
+               "ipopt.max_iter": 200}
+    solver = ca.nlpsol("spin_extremal", "ipopt", {"x": x, "p": p, "f": j1 + weight * j2}, options)
+    return solver
+
+
+@dataclass(frozen=True)
+class SpinParameters:
+    r: float
+    c: float
+    beta: float
+
+
+class SpinExtremalReference(Reference):
+    """``q(t) = q0 ⊗ q*(t)``, ``ω = ω*(t)``, torque of eq. 31."""
+
+    def __init__(self, q0: Array, v: float, params: SpinParameters, duration: float, moments: Array,
+                 message: str, stats: dict):
+        super().__init__("spin_extremal", duration, np.diag(moments), message=message, stats=stats)
+        self.q0, self.v, self.params, self.moments = q0, v, params, moments
+
+    def _evaluate(self, t: Array) -> ReferenceSample:
+        r, c, beta = self.params.r, self.params.c, self.params.beta
+        q_star = np.stack(extremal_quaternion(t, self.v, r, c, beta), axis=-1)
+        theta = (self.v + c) * t + beta
+        omega = np.stack([np.full_like(t, self.v), r * np.sin(theta), r * np.cos(theta)], axis=-1)
+        rate = (self.v + c) * r
+        omega_dot = np.stack([np.zeros_like(t), rate * np.cos(theta), -rate * np.sin(theta)], axis=-1)
+        return ReferenceSample(quat.product(self.q0, q_star), omega, omega_dot,
+                               extremal_torque(t, self.v, r, c, beta, self.moments))
+
+
+class SpinExtremalPlanner(Planner):
+    """Spin-stabilized extremal planner (Biggs & Horri); needs a principal-axis inertia."""
+
+    name = "spin_extremal"
+
+    @dataclass(frozen=True)
+    class Options:
+        weight: float = 0.0                        # k of J = J1 + k J2 (1/(N² m² s))
+        spin_rate: float | None = None             # v (rad/s); default: the initial roll rate ω0[0]
+        parameters: list[float] | None = None      # fixed [r, c, β] (rad/s, rad/s, rad): no optimisation
+        starts: int = 3                            # multi-start candidates polished by IPOPT
+
+        def __post_init__(self) -> None:
+            if self.weight < 0:
+                raise ValueError(f"weight must be non-negative, got {self.weight}")
+            if self.parameters is not None and len(self.parameters) != 3:
+                raise ValueError(f"parameters must be [r, c, beta], got {self.parameters}")
+            if self.starts < 1:
+                raise ValueError(f"starts must be at least 1, got {self.starts}")
+
+    def _plan(self, problem: ManeuverProblem) -> Reference:
+        if not problem.spacecraft.is_principal:
+            return FailedReference(self.name, "the spin extremals need a principal-axis (diagonal) inertia; "
+                                   "rotate the problem into principal axes first")
+        moments = np.diag(problem.spacecraft.inertia).copy()
+        v = float(problem.omega0[0]) if self.options.spin_rate is None else self.options.spin_rate
+        T = problem.duration
+        target = quat.product(quat.conjugate(problem.q0), problem.qf)
+        if self.options.parameters is not None:
+            params = SpinParameters(*self.options.parameters)
+            stats = {"fixed_parameters": True}
+        else:
+            params, stats = self._optimise(v, T, moments, target)
+            if params is None:
+                return FailedReference(self.name, stats["message"], stats=stats)
+        q_end = np.array(extremal_quaternion(T, v, params.r, params.c, params.beta))
+        stats.update(r=params.r, c=params.c, beta=params.beta, spin_rate=v, weight=self.options.weight,
+                     J1=float(attitude_cost(q_end, target)),
+                     J2=float(energy_cost(v, params.r, params.c, params.beta, T, moments)))
+        message = (f"r={params.r:.6g} c={params.c:.4g} beta={params.beta:.6g}; "
+                   f"J1={stats['J1']:.3g} J2={stats['J2']:.4g}")
+        return SpinExtremalReference(problem.q0, v, params, T, moments, message, stats)
+
+    def _seeds(self, v: float, T: float, moments: Array, target: Array) -> Array:
+        """Best distinct starts of a grid over K T branches, c and β (vectorised evaluation)."""
+        base = np.pi / T
+        r, c, beta = np.meshgrid(base * np.array([0.5, 1.0, 2.0, 3.0, 5.0]),
+                                 base * np.array([0.0, -1.0, 1.0, -2.0, 2.0, -4.0, 4.0]),
+                                 np.linspace(-np.pi, np.pi, 12, endpoint=False), indexing="ij")
+        r, c, beta = r.ravel(), c.ravel(), beta.ravel()
+        q_end = np.stack(extremal_quaternion(T, v, r, c, beta), axis=-1)
+        cost = attitude_cost(q_end, target) + self.options.weight * energy_cost(v, r, c, beta, T, moments)
+        return np.column_stack([r, c, beta])[np.argsort(cost)[: self.options.starts]]
+
+    def _optimise(self, v: float, T: float, moments: Array, target: Array):
+        solver = _solver()
+        parameters = np.r_[v, T, moments, target, self.options.weight]
+        best, best_cost, iterations, statuses = None, np.inf, 0, []
+        for seed in self._seeds(v, T, moments, target):
+            solution = solver(x0=seed, p=parameters)
+            stats = solver.stats()
+            iterations += stats["iter_count"]
+            statuses.append(stats["return_status"])
+            cost = float(solution["f"])
+            if stats["return_status"] in CONVERGED and cost < best_cost:
+                best, best_cost = solution["x"].full().ravel(), cost
+        stats = {"ipopt_status": statuses, "iterations": iterations, "objective": best_cost}
+        if best is None:
+            stats["message"] = f"IPOPT did not converge from any start: {sorted(set(statuses))}"
+            return None, stats
+        r, c, beta = (float(v) for v in best)
+        if r < 0:
+            r, beta = -r, beta + np.pi
+        return SpinParameters(r, c, float(np.mod(beta + np.pi, 2 * np.pi) - np.pi)), stats
