@@ -39,6 +39,14 @@ def extremal_quaternion(t, v, r, c, beta, math=np):
         nutation * math.sin(spin), nutation * math.cos(spin)
 
 
+def torque_amplitudes(v: float, r: float, c: float, moments: Array) -> Array:
+    """Per-axis amplitudes (N m) of eq. 31: ``[½ I1 |δ1| r², I2 r |α − v δ2|, I3 r |α + v δ3|]``."""
+    I1, I2, I3 = moments
+    alpha = v + c
+    return np.array([0.5 * abs(I2 - I3) * r**2, I2 * r * abs(alpha - v * (I3 - I1) / I2),
+                     I3 * r * abs(alpha + v * (I1 - I2) / I3)])
+
+
 def attitude_cost(q_end: Array, target: Array) -> Array:
     """Eq. 30 invariant to the double cover: ``min(‖q − q_f‖², ‖q + q_f‖²)`` over the last axis."""
     return np.minimum(np.sum((q_end - target) ** 2, axis=-1), np.sum((q_end + target) ** 2, axis=-1))
@@ -164,8 +172,10 @@ class SpinExtremalPlanner(Planner):
         stats.update(r=params.r, c=params.c, beta=params.beta, spin_rate=v, weight=self.options.weight,
                      J1=float(attitude_cost(q_end, target)),
                      J2=float(energy_cost(v, params.r, params.c, params.beta, T, moments)))
-        message = (f"r={params.r:.6g} c={params.c:.4g} beta={params.beta:.6g}; "
-                   f"J1={stats['J1']:.3g} J2={stats['J2']:.4g}")
+        amplitudes = torque_amplitudes(v, params.r, params.c, moments)
+        stats["torque_amplitudes"] = amplitudes.tolist()
+        message = (f"r={params.r:.6g} c={params.c:.4g} beta={params.beta:.6g}; J1={stats['J1']:.3g} "
+                   f"J2={stats['J2']:.4g}; torque amplitudes {np.array2string(amplitudes, precision=4)} N m")
         return SpinExtremalReference(problem.q0, v, params, T, moments, message, stats)
 
     def _seeds(self, v: float, T: float, moments: Array, target: Array) -> Array:
