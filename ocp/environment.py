@@ -79,6 +79,12 @@ class CircularOrbit:
         r = self.position(t)
         return -r / ca.norm_2(r)
 
+    def function(self) -> ca.Function:
+        """``casadi.Function`` ``(t) -> (position, velocity, nadir)`` in inertial axes (m, m/s, unit)."""
+        t = ca.SX.sym("t")
+        return ca.Function("orbit", [t], [self.position(t), self.velocity(t), self.nadir(t)], ["t"],
+                           ["position", "velocity", "nadir"])
+
     def lvlh_matrix(self, t):
         """Columns: LVLH axes in inertial axes (x along-track, y = −orbit normal, z nadir)."""
         z = self.nadir(t)
@@ -116,6 +122,11 @@ class TiltedDipole:
         angle = self.greenwich_angle + self.earth_rate * t + self.pole_longitude
         st = np.sin(self.tilt)
         return -ca.vertcat(st * ca.cos(angle), st * ca.sin(angle), np.cos(self.tilt))
+
+    def function(self) -> ca.Function:
+        """``casadi.Function`` ``(position, t) -> b``: the field (T) in inertial axes."""
+        position, t = ca.SX.sym("position", 3), ca.SX.sym("t")
+        return ca.Function("dipole_field", [position, t], [self.field_inertial(position, t)], ["position", "t"], ["b"])
 
     def field_inertial(self, position, t):
         """Field vector (T) in inertial axes at inertial ``position`` (m) and time ``t``."""

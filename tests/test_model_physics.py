@@ -111,6 +111,20 @@ def _rotation_taking_x_to(axis):
     return quat.from_axis_angle(cross / np.linalg.norm(cross), np.arccos(np.dot(axis, x)))
 
 
+def test_orbit_function_is_circular_at_the_mean_motion():
+    orbit = CircularOrbit(altitude=600e3, inclination=np.deg2rad(97.79), raan=0.5, arg_latitude=0.2)
+    evaluate = orbit.function()
+    for t in (0.0, 1000.0, 5000.0):
+        out = evaluate(t=t)
+        r, v, nadir = (out[k].full().ravel() for k in ("position", "velocity", "nadir"))
+        assert np.linalg.norm(r) == pytest.approx(orbit.radius, rel=1e-12)
+        assert np.linalg.norm(v) == pytest.approx(np.sqrt(MU_EARTH / orbit.radius), rel=1e-12)
+        assert abs(r @ v) < 1e-6 * orbit.radius and np.allclose(nadir, -r / orbit.radius)
+    # 600 km: mean motion 1.083e-3 rad/s and period 5801 s (nano-spacecraft paper, section III).
+    assert orbit.mean_motion == pytest.approx(1.083e-3, rel=1e-3)
+    assert 2 * np.pi / orbit.mean_motion == pytest.approx(5801.06, rel=1e-3)
+
+
 def test_pitch_libration_frequency_matches_linear_theory():
     # x along-track, y orbit normal (LVLH: minus the orbit angular momentum), z nadir.
     inertia = np.array([2.0, 2.5, 1.0])
@@ -140,7 +154,7 @@ def test_pitch_libration_frequency_matches_linear_theory():
 
 
 def dipole_field(dipole, position, t):
-    return np.array(ca.DM(dipole.field_inertial(position, t))).ravel()
+    return dipole.function()(position=position, t=t)["b"].full().ravel()
 
 
 def test_dipole_magnitude_on_equator_and_poles_at_600_km(rng):
