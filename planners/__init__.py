@@ -2,10 +2,11 @@
 from planners.base import (FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
 from planners.eigenaxis import EigenaxisPlanner
+from planners.natural_motion import NaturalMotionPlanner
 from planners.spin_extremal import SpinExtremalPlanner
 
 PLANNERS: dict[str, type[Planner]] = {
-    cls.name: cls for cls in (EigenaxisPlanner, SpinExtremalPlanner)
+    cls.name: cls for cls in (EigenaxisPlanner, NaturalMotionPlanner, SpinExtremalPlanner)
 }
 
 __all__ = ["FailedReference", "ManeuverProblem", "PLANNERS", "Planner", "Reference", "ReferenceSample",

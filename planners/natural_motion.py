@@ -1,0 +1,256 @@
+"""Natural motions (nano-spacecraft paper, section IV): torque-free arcs of the spacecraft itself,
+shot from the initial attitude to the target, then brought to rest.
+
+* Axisymmetric body (two equal moments): ``ω`` in closed form (eq. 17-24); the attitude from the
+  Lax-pair reduction (eq. 25-37), which is the closed form of :mod:`planners.spin_extremal` with the
+  roll rate ``v = ω_s`` and spin offset ``λ − ω_s``, ``λ = ω_s (J − J_s)/J``, about the symmetry axis
+  (eq. 17-18 print ``β = (J1 − J)/J``, the opposite sign; Euler's equations and eq. 34 agree with ours).
+* Asymmetric body: ``ω`` with Jacobi elliptic functions (Landau & Lifshitz §37) in both polhode
+  regimes; the attitude by DOP853 integration of the kinematics (rtol 1e-12) with that ``ω``.
+* Shooting: IPOPT finds ``ω(0)`` with ``vec(q_f* ⊗ q(T_arc)) = 0`` (3 equations) minimising the
+  momentum ``‖I ω(0)‖²`` to spin up (the same is removed at the stop), over several starts.
+  For the asymmetric body ``q(T_arc)`` comes from an RK4 CasADi graph; the result is checked with
+  the elliptic solution.
+* The arc lasts ``T − stop_time``; then ``stop: step`` sets the rate reference to zero (the paper's
+  last 10 s of 110 s), or ``stop: smooth`` decelerates along the final body rate with a cubic
+  (the shooting then targets the attitude after the stop). The feed-forward torque is zero on the
+  arc; spin-up and stopping are paid for by the closed loop.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Literal
+
+import casadi as ca
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.special import ellipj, ellipkinc
+
+from ocp import quat
+from ocp import quat_casadi as qc
+from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
+                           inverse_dynamics_torque)
+from planners.spin_extremal import extremal_quaternion
+
+
+def symmetry_axis(moments: Array, rtol: float = 1e-9) -> int | None:
+    """Index of the distinct moment of an axisymmetric body (0 for a sphere), else ``None``."""
+    for axis in range(3):
+        others = np.delete(moments, axis)
+        if abs(others[0] - others[1]) <= rtol * np.max(moments):
+            return axis
+    return None
+
+
+def _cyclic(axis: int) -> Array:
+    """Cyclic axis order putting ``axis`` first (a proper rotation of the axes)."""
+    return np.roll(np.arange(3), -axis)
+
+
+def symmetric_motion(t: Array, omega0: Array, moments: Array, axis: int, math=np):
+    """Rates (N, 3) and attitude relative to t = 0 (N, 4) of an axisymmetric body (closed form)."""
+    order = _cyclic(axis)
+    w = [omega0[i] for i in order]
+    spin, J_s, J = w[0], moments[axis], moments[order[1]]
+    lam = spin * (J - J_s) / J  # eq. 17 prints (J1 − J)/J: a sign typo (its eq. 34 has J − J1)
+    r = math.sqrt(w[1] ** 2 + w[2] ** 2)
+    delta = math.arctan2(w[1], w[2]) if math is np else ca.atan2(w[1], w[2])
+    q_rel = extremal_quaternion(t, spin, r, lam - spin, delta, math=math)
+    theta = lam * t + delta
+    permuted = [spin + 0 * t, r * math.sin(theta), r * math.cos(theta)]
+    rates, vector = [None] * 3, [None] * 3
+    for k, i in enumerate(order):
+        rates[i], vector[i] = permuted[k], q_rel[1 + k]
+    return rates, [q_rel[0]] + vector
+
+
+def asymmetric_rates(t: Array, omega0: Array, moments: Array) -> Array:
+    """Torque-free rates (N, 3) of an asymmetric body with Jacobi elliptic functions."""
+    order = np.argsort(moments)
+    I, w0 = moments[order], omega0[order]
+    h2, e2 = np.sum((I * w0) ** 2), np.sum(I * w0**2)
+    a, b, c = (0, 1, 2) if h2 >= e2 * I[1] else (2, 1, 0)  # polhode about the major / minor axis
+    Ia, Ib, Ic = I[a], I[b], I[c]
+    amp_a = np.sqrt(max((e2 * Ic - h2) / (Ia * (Ic - Ia)), 0.0))
+    amp_b = np.sqrt(max((e2 * Ic - h2) / (Ib * (Ic - Ib)), 0.0))
+    amp_c = np.sqrt(max((h2 - e2 * Ia) / (Ic * (Ic - Ia)), 0.0))
+    rate = np.sqrt((Ic - Ib) * (h2 - e2 * Ia) / (Ia * Ib * Ic))
+    m = min((Ib - Ia) * (e2 * Ic - h2) / ((Ic - Ib) * (h2 - e2 * Ia)), 1.0)
+    sign_c = 1.0 if w0[c] >= 0 else -1.0
+    parity = np.linalg.det(np.eye(3)[order])  # an odd sort reverses the Euler equations
+    phase = ellipkinc(np.arctan2(w0[b] / amp_b if amp_b > 0 else 0.0, w0[a] / amp_a if amp_a > 0 else 1.0), m)
+    sn, cn, dn, _ = ellipj(sign_c * parity * rate * np.asarray(t, dtype=float) + phase, m)
+    sorted_rates = np.empty(np.shape(t) + (3,))
+    sorted_rates[..., a], sorted_rates[..., b], sorted_rates[..., c] = amp_a * cn, amp_b * sn, sign_c * amp_c * dn
+    rates = np.empty_like(sorted_rates)
+    rates[..., order] = sorted_rates
+    return rates
+
+
+def euler_rhs(moments):
+    """Torque-free Euler equations as a function of rates (works on NumPy and CasADi)."""
+    I1, I2, I3 = moments
+    return lambda w: [(I2 - I3) / I1 * w[1] * w[2], (I3 - I1) / I2 * w[2] * w[0], (I1 - I2) / I3 * w[0] * w[1]]
+
+
+class NaturalMotionReference(Reference):
+    """Torque-free arc on ``[0, arc]`` from ``q0`` with ``ω(0) = omega0``, then the stop."""
+
+    def __init__(self, q0, omega0, moments, arc, duration, stop, message, stats):
+        super().__init__("natural_motion", duration, np.diag(moments), message=message, stats=stats)
+        self.q0, self.omega0, self.moments, self.arc, self.stop = q0, omega0, moments, arc, stop
+        self.axis = symmetry_axis(moments)
+        if self.axis is None:
+            solution = solve_ivp(lambda s, q: quat.kinematics(q, asymmetric_rates(s, omega0, moments)), (0, arc),
+                                 quat.IDENTITY, method="DOP853", rtol=1e-12, atol=1e-13, dense_output=True)
+            self._relative = lambda t: quat.normalize(solution.sol(t).T)
+        q_end, self.omega_end = self._arc(np.array([arc]))
+        self.q_end, self.omega_end = q_end[0], self.omega_end[0]
+
+    def _arc(self, t: Array) -> tuple[Array, Array]:
+        if self.axis is not None:
+            rates, q_rel = symmetric_motion(t, self.omega0, self.moments, self.axis)
+            return quat.product(self.q0, np.stack(q_rel, axis=-1)), np.stack(rates, axis=-1)
+        return quat.product(self.q0, self._relative(t)), asymmetric_rates(t, self.omega0, self.moments)
+
+    def _evaluate(self, t: Array) -> ReferenceSample:
+        q, omega = self._arc(np.minimum(t, self.arc))
+        omega_dot = np.stack(euler_rhs(self.moments)(omega.T), axis=-1)
+        after = t > self.arc
+        if np.any(after):
+            stop_time = self.duration - self.arc
+            if self.stop == "smooth" and stop_time > 0:
+                s = (t[after] - self.arc) / stop_time
+                profile, rate = 1 - 3 * s**2 + 2 * s**3, (-6 * s + 6 * s**2) / stop_time
+                angle = stop_time * (s - s**3 + 0.5 * s**4)  # ∫ profile dt
+                q[after] = quat.product(self.q_end, quat.from_rotation_vector(angle[:, None] * self.omega_end))
+                omega[after] = profile[:, None] * self.omega_end
+                omega_dot[after] = rate[:, None] * self.omega_end
+            else:
+                q[after], omega[after], omega_dot[after] = self.q_end, 0.0, 0.0
+        torque = np.zeros_like(omega)
+        torque[after] = inverse_dynamics_torque(self.inertia, omega[after], omega_dot[after])
+        return ReferenceSample(q, omega, omega_dot, torque)
+
+
+class NaturalMotionPlanner(Planner):
+    """Natural-motion planner for any principal-axis inertia."""
+
+    name = "natural_motion"
+
+    @dataclass(frozen=True)
+    class Options:
+        stop_time: float = 10.0                     # s at the end of T spent stopping
+        stop: Literal["step", "smooth"] = "step"    # rate reference to zero at once (paper) or a cubic
+        rk4_steps: int = 60                         # RK4 steps of the asymmetric shooting (refined x4 as needed)
+        starts: int = 3                             # IPOPT starts (short, long way round, perturbed)
+
+        def __post_init__(self) -> None:
+            if self.stop_time < 0:
+                raise ValueError(f"stop_time must be non-negative, got {self.stop_time}")
+
+    def _plan(self, problem: ManeuverProblem) -> Reference:
+        if not problem.spacecraft.is_principal:
+            return FailedReference(self.name, "natural motions need a principal-axis (diagonal) inertia")
+        arc = problem.duration - self.options.stop_time
+        if arc <= 0:
+            return FailedReference(self.name, f"stop_time {self.options.stop_time} s leaves no arc in T = "
+                                   f"{problem.duration} s", "infeasible")
+        moments = np.diag(problem.spacecraft.inertia).copy()
+        solution = self._shoot(problem, moments, arc)
+        if isinstance(solution, Reference):
+            return solution
+        omega0, stats = solution
+        steps = self.options.rk4_steps
+        while True:
+            reference = NaturalMotionReference(problem.q0, omega0, moments, arc, problem.duration,
+                                               self.options.stop, "", stats)
+            error = np.rad2deg(quat.error_angle(reference.q(problem.duration), problem.qf))
+            if symmetry_axis(moments) is not None or error <= 1e-6 or steps >= 16 * self.options.rk4_steps:
+                break
+            steps *= 4  # the RK4 graph was too coarse for this arc: polish from the found ω(0)
+            refined = self._shoot(problem, moments, arc, steps, seeds=[omega0])
+            if isinstance(refined, Reference):
+                break
+            omega0, stats = refined
+        stats["rk4_steps"] = steps if symmetry_axis(moments) is None else None
+        reference.stats = stats
+        stats.update(omega0=omega0.tolist(), final_error_deg=float(error))
+        reference.message = (f"natural arc from ω0 = {np.array2string(omega0, precision=5)} rad/s over "
+                             f"{arc:g} s, stop '{self.options.stop}', final error {error:.2g} deg")
+        if error > 1e-3:
+            return FailedReference(self.name, f"shooting converged but the exact arc misses the target by "
+                                   f"{error:.3g} deg (raise rk4_steps)", stats=stats)
+        return reference
+
+    def _shoot(self, problem: ManeuverProblem, moments: Array, arc: float, steps: int | None = None,
+               seeds: list[Array] | None = None):
+        solver = _shooting_solver(symmetry_axis(moments), self.options.stop, steps or self.options.rk4_steps)
+        target = quat.product(quat.conjugate(problem.q0), problem.qf)
+        parameters = np.r_[moments, target, arc, problem.duration - arc]
+        rotvec = quat.to_rotation_vector(target)
+        angle = np.linalg.norm(rotvec)
+        axis_vec = rotvec / angle if angle > 1e-12 else np.array([1.0, 0.0, 0.0])
+        if seeds is None:
+            rng = np.random.default_rng(0)
+            seeds = [rotvec / arc, (angle - 2 * np.pi) * axis_vec / arc]
+            seeds += [rotvec / arc + rng.normal(0, 0.3 * angle / arc + 1e-3, 3) for _ in range(self.options.starts - 2)]
+        best, best_cost, statuses = None, np.inf, []
+        for seed in seeds[: self.options.starts]:
+            result = solver(x0=seed, p=parameters, lbg=0, ubg=0)
+            statuses.append(solver.stats()["return_status"])
+            violation = float(np.max(np.abs(result["g"].full())))
+            if violation < 1e-9 and float(result["f"]) < best_cost:
+                best, best_cost = result["x"].full().ravel(), float(result["f"])
+        stats = {"ipopt_status": statuses, "momentum_sq": best_cost}
+        if best is None:
+            return FailedReference(self.name, f"shooting did not reach the target from any start: {statuses}",
+                                   stats=stats)
+        return best, stats
+
+
+@lru_cache(maxsize=None)
+def _shooting_solver(axis: int | None, stop: str, rk4_steps: int) -> ca.Function:
+    """IPOPT on ω(0) with parameters [I1, I2, I3, q_target (4), arc, stop_time]; built once per
+    structure (symmetry axis or none, stop law, RK4 steps)."""
+    omega0 = ca.SX.sym("omega0", 3)
+    p = ca.SX.sym("p", 9)
+    moments, target, arc, stop_time = [p[0], p[1], p[2]], p[3:7], p[7], p[8]
+    if axis is not None:
+        rates, q_rel = symmetric_motion(arc, [omega0[i] for i in range(3)], moments, axis, math=ca)
+        q_rel, omega_end = ca.vertcat(*q_rel), ca.vertcat(*rates)
+    else:
+        q_rel, omega_end = _rk4_arc(omega0, moments, arc, rk4_steps)
+    if stop == "smooth":
+        q_rel = qc.product(q_rel, qc.from_rotation_vector(omega_end * stop_time / 2))
+    miss = qc.product(qc.conjugate(target), q_rel)[1:]
+    momentum = ca.sumsqr(ca.vertcat(*moments) * omega0)
+    # A start that needs more than 15 iterations is heading for a poor, high-momentum optimum (the
+    # long way round took 115 iterations to a 4e4 times larger objective): cut it short.
+    options = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-12,
+               "ipopt.constr_viol_tol": 1e-13, "ipopt.max_iter": 15}
+    return ca.nlpsol("natural_motion", "ipopt", {"x": omega0, "p": p, "f": momentum, "g": miss}, options)
+
+
+def _rk4_arc(omega0, moments, arc, steps: int):
+    """Attitude (relative to t = 0) and rate after ``arc`` seconds of torque-free motion, RK4."""
+    state = ca.SX.sym("state", 7)
+    params = ca.SX.sym("params", 4)  # I1, I2, I3, step length
+    euler = euler_rhs([params[0], params[1], params[2]])
+    h = params[3]
+
+    def rhs(x):
+        q, w = x[:4], x[4:]
+        return ca.vertcat(0.5 * qc.product(q, ca.vertcat(0, w)), *euler([w[0], w[1], w[2]]))
+
+    k1 = rhs(state)
+    k2 = rhs(state + h / 2 * k1)
+    k3 = rhs(state + h / 2 * k2)
+    k4 = rhs(state + h * k3)
+    step = ca.Function("rk4", [state, params], [state + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)])
+    final = ca.vertcat(1, 0, 0, 0, omega0)
+    step_params = ca.vertcat(*moments, arc / steps)
+    for _ in range(steps):
+        final = step(final, step_params)
+    return final[:4] / ca.norm_2(final[:4]), final[4:]
