@@ -229,7 +229,7 @@ def _shooting_solver(axis: int | None, stop: str, rk4_steps: int) -> ca.Function
     # A start that needs more than 15 iterations is heading for a poor, high-momentum optimum (the
     # long way round took 115 iterations to a 4e4 times larger objective): cut it short.
     options = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-12,
-               "ipopt.constr_viol_tol": 1e-13, "ipopt.max_iter": 15}
+               "ipopt.constr_viol_tol": 1e-13, "ipopt.max_iter": 15, "show_eval_warnings": False}
     return ca.nlpsol("natural_motion", "ipopt", {"x": omega0, "p": p, "f": momentum, "g": miss}, options)
 
 
