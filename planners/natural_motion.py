@@ -27,7 +27,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.special import ellipj, ellipkinc
 
-from ocp import quat
+from ocp import Spacecraft, quat
 from ocp import quat_casadi as qc
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
@@ -134,8 +134,22 @@ class NaturalMotionReference(Reference):
         return ReferenceSample(q, omega, omega_dot, torque)
 
 
+class RotatedReference(Reference):
+    """A reference planned in principal axes, expressed in body axes (``v_B = V v_P``)."""
+
+    def __init__(self, inner: Reference, axes: Array, q_body_to_principal: Array):
+        super().__init__(inner.planner, inner.duration, axes @ inner.inertia @ axes.T, inner.status,
+                         inner.message + " (planned in principal axes)", inner.stats)
+        self.inner, self.axes, self.q_rotation = inner, axes, q_body_to_principal
+
+    def _evaluate(self, t: Array) -> ReferenceSample:
+        sample = self.inner.sample(t)
+        return ReferenceSample(quat.product(sample.q, self.q_rotation), sample.omega @ self.axes.T,
+                               sample.omega_dot @ self.axes.T, sample.torque @ self.axes.T)
+
+
 class NaturalMotionPlanner(Planner):
-    """Natural-motion planner for any principal-axis inertia."""
+    """Natural-motion planner for any valid inertia (planned in its principal axes)."""
 
     name = "natural_motion"
 
@@ -152,7 +166,16 @@ class NaturalMotionPlanner(Planner):
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         if not problem.spacecraft.is_principal:
-            return FailedReference(self.name, "natural motions need a principal-axis (diagonal) inertia")
+            # Plan in principal axes (columns of V, a proper rotation) and map the reference back.
+            moments, axes = np.linalg.eigh(problem.spacecraft.inertia)
+            axes[:, 2] *= np.linalg.det(axes)
+            q_body_to_principal = quat.from_rotation_matrix(axes.T)  # v_P = Vᵀ v_B
+            principal = ManeuverProblem(
+                Spacecraft(moments), quat.product(problem.q0, quat.conjugate(q_body_to_principal)),
+                axes.T @ problem.omega0, quat.product(problem.qf, quat.conjugate(q_body_to_principal)),
+                problem.duration, None if problem.omegaf is None else axes.T @ problem.omegaf)
+            reference = self._plan(principal)
+            return reference if not reference.ok else RotatedReference(reference, axes, q_body_to_principal)
         arc = problem.duration - self.options.stop_time
         if arc <= 0:
             return FailedReference(self.name, f"stop_time {self.options.stop_time} s leaves no arc in T = "

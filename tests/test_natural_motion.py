@@ -88,3 +88,26 @@ def test_tracked_natural_motion_of_an_asymmetric_body_ends_at_the_target():
         reference=reference, target=(problem.qf, problem.omegaf))
     metrics = metrics_from_simulation(simulation, problem.qf, problem.omegaf, reference=reference)
     assert metrics["final_error_deg"] < 0.5
+
+
+def test_non_principal_inertia_is_planned_in_principal_axes(rng):
+    moments = np.array([0.02, 0.05, 0.04])
+    rotation = quat.rotation_matrix(quat.random_unit(rng))
+    inertia = rotation @ np.diag(moments) @ rotation.T
+    spacecraft = Spacecraft(inertia, wheels=ReactionWheels.from_body_axes())
+    problem = ManeuverProblem(spacecraft, quat.random_unit(rng), np.zeros(3), quat.random_unit(rng), 110.0,
+                              omegaf=np.zeros(3))
+    reference = PLANNERS["natural_motion"]().plan(problem)
+    assert reference.status == "ok", reference.message
+    assert np.rad2deg(quat.error_angle(reference.q(110.0), problem.qf)) < 1e-3
+    # On the arc the body moves freely with its full inertia: integrate I ω̇ = −ω × I ω in body axes.
+    arc = np.linspace(0, 100.0, 201)
+
+    def rhs(_, y):
+        w = y[4:]
+        return np.r_[quat.kinematics(y[:4], w), np.linalg.solve(inertia, -np.cross(w, inertia @ w))]
+
+    truth = solve_ivp(rhs, (0, 100.0), np.r_[problem.q0, reference.omega(0.0)], method="DOP853", rtol=1e-13,
+                      atol=1e-14, t_eval=arc)
+    assert np.max(quat.error_angle(reference.q(arc), truth.y[:4].T)) < 1e-8
+    np.testing.assert_allclose(reference.omega(arc), truth.y[4:].T, atol=1e-10)
