@@ -34,7 +34,8 @@ def _describe(annotation: Any) -> str:
         return "null"
     if origin is list:
         inner = typing.get_args(annotation)[0]
-        return "a list of numbers" if inner is float else "a matrix (list of lists of numbers)"
+        return {float: "a list of numbers", str: "a list of names", dict: "a list of mappings"}.get(
+            inner, "a matrix (list of lists of numbers)")
     return {float: "a number", int: "an integer", bool: "true or false", str: "a string"}.get(annotation, str(annotation))
 
 
@@ -71,6 +72,10 @@ def _convert(value: Any, annotation: Any) -> Any:
     if annotation is str:
         if isinstance(value, str):
             return value
+        raise TypeError
+    if annotation is dict:
+        if isinstance(value, Mapping):
+            return dict(value)
         raise TypeError
     if origin is list:
         if not isinstance(value, (list, tuple)):

@@ -1,12 +1,13 @@
 """Reference-motion planners. ``PLANNERS`` maps registry names to planner classes."""
 from planners.base import (FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
+from planners.collocation import CollocationPlanner
 from planners.eigenaxis import EigenaxisPlanner
 from planners.natural_motion import NaturalMotionPlanner
 from planners.spin_extremal import SpinExtremalPlanner
 
 PLANNERS: dict[str, type[Planner]] = {
-    cls.name: cls for cls in (EigenaxisPlanner, NaturalMotionPlanner, SpinExtremalPlanner)
+    cls.name: cls for cls in (CollocationPlanner, EigenaxisPlanner, NaturalMotionPlanner, SpinExtremalPlanner)
 }
 
 __all__ = ["FailedReference", "ManeuverProblem", "PLANNERS", "Planner", "Reference", "ReferenceSample",

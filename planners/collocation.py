@@ -1,0 +1,175 @@
+"""Direct optimal control on the full model (IPOPT): the workbench's numerical reference.
+
+Objectives: ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt (slack variables),
+``min_time`` (free T, the scenario's T is the upper bound), and ``weighted``
+(``energy_weight``, ``l1_weight``, ``time_weight``). τ is the actuators' body torque.
+Constraints: actuator bounds (wheel torques, dipoles, torquers), wheel momentum bounds, a body-rate
+bound ``max_rate`` (per axis), fixed or free final rate, keep-out / keep-in cones.
+The transcription (``collocation``: Legendre-Gauss-Radau, or ``multiple_shooting``) is injected from
+:data:`ocp.transcription.TRANSCRIPTIONS`; the NLP is built once per problem structure and cached
+on the model. Starts: the reference of the ``warm_start`` planner, the ``seed_planners``, and
+``multistart`` random perturbations of the warm start; the best converged optimum is kept.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+import casadi as ca
+import numpy as np
+
+from ocp import quat
+from ocp.transcription import TRANSCRIPTIONS, Cone, OptimalControlProblem
+from planners.base import FailedReference, ManeuverProblem, Planner, Reference
+from planners.collocation_reference import CollocationReference, seed_vector
+
+CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+INFEASIBLE = ("Infeasible_Problem_Detected", "Restoration_Failed")
+
+
+def parse_cone(spec: dict, keep_out: bool, margin: float = 0.0) -> Cone:
+    """A :class:`Cone` from ``{boresight, direction, angle_deg}``, tightened by ``margin`` (rad)."""
+    keys = {"boresight", "direction", "angle_deg"}
+    if set(spec) != keys:
+        raise ValueError(f"a cone needs exactly {sorted(keys)}, got {sorted(spec)}")
+    boresight = np.asarray(spec["boresight"], dtype=float)
+    direction = np.asarray(spec["direction"], dtype=float)
+    if boresight.shape != (3,) or direction.shape != (3,) or not np.linalg.norm(boresight) or not np.linalg.norm(direction):
+        raise ValueError("cone boresight and direction must be non-zero 3-vectors")
+    angle = float(np.deg2rad(spec["angle_deg"])) + (margin if keep_out else -margin)
+    return Cone(tuple(boresight / np.linalg.norm(boresight)), tuple(direction / np.linalg.norm(direction)),
+                angle, keep_out)
+
+
+class CollocationPlanner(Planner):
+    """Direct optimal control planner (see the module docstring)."""
+
+    name = "collocation"
+
+    @dataclass(frozen=True)
+    class Options:
+        objective: Literal["min_energy", "min_l1", "min_time", "weighted"] = "min_energy"
+        intervals: int = 50
+        degree: int = 3
+        transcription: Literal["collocation", "multiple_shooting"] = "collocation"
+        warm_start: str = "eigenaxis"            # registered planner whose reference seeds the NLP
+        seed_planners: list[str] = field(default_factory=list)
+        multistart: int = 0                      # extra starts: random perturbations of the warm start
+        energy_weight: float = 1.0               # for objective "weighted"
+        l1_weight: float = 0.0
+        time_weight: float = 0.0
+        max_rate: float | None = None            # rad/s, per body axis
+        keep_out: list[dict] = field(default_factory=list)  # {boresight, direction, angle_deg}
+        keep_in: list[dict] = field(default_factory=list)
+        cone_margin_deg: float = 0.01            # cones are imposed this much tighter, so that they
+                                                 # hold between the points where they are imposed
+        tolerance: float = 1e-10
+        max_iterations: int = 500
+
+        def __post_init__(self) -> None:
+            if self.intervals < 1 or not 1 <= self.degree <= 9:
+                raise ValueError("intervals must be >= 1 and degree in 1..9")
+            for spec in self.keep_out:
+                parse_cone(spec, True)
+            for spec in self.keep_in:
+                parse_cone(spec, False)
+
+    def _ocp(self, problem: ManeuverProblem) -> OptimalControlProblem:
+        o = self.options
+        weights = {"min_energy": (1.0, 0.0, 0.0), "min_l1": (0.0, 1.0, 0.0), "min_time": (0.0, 0.0, 1.0),
+                   "weighted": (o.energy_weight, o.l1_weight, o.time_weight)}[o.objective]
+        margin = np.deg2rad(o.cone_margin_deg)
+        cones = tuple(parse_cone(c, True, margin) for c in o.keep_out) + tuple(parse_cone(c, False, margin) for c in o.keep_in)
+        return OptimalControlProblem(problem.model, *weights, free_time=weights[2] > 0,
+                                     fixed_final_rate=problem.omegaf is not None, cones=cones)
+
+    def _nlp(self, problem: ManeuverProblem, ocp: OptimalControlProblem):
+        o = self.options
+        key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
+               o.transcription, o.intervals, o.degree, o.tolerance, o.max_iterations)
+        cache = problem.model.__dict__.setdefault("_nlp_cache", {})
+        if key not in cache:
+            transcription = TRANSCRIPTIONS[o.transcription](o.intervals, *([o.degree] if o.transcription == "collocation" else []))
+            options = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": o.tolerance,
+                       "ipopt.max_iter": o.max_iterations, "show_eval_warnings": False}
+            cache[key] = (transcription, transcription.build(ocp, options))
+        return cache[key]
+
+    def _bounds(self, problem: ManeuverProblem, nlp, duration: float):
+        """lbx/ubx in the layout of the decision vector."""
+        spacecraft, model = problem.spacecraft, problem.model
+        x_low, x_high = np.full(model.nx, -np.inf), np.full(model.nx, np.inf)
+        x_low[0:4], x_high[0:4] = -1.5, 1.5
+        if self.options.max_rate is not None:
+            x_low[4:7], x_high[4:7] = -self.options.max_rate, self.options.max_rate
+        u_low, u_high = np.full(model.nu, -np.inf), np.full(model.nu, np.inf)
+        slices = model.control_slices
+        if spacecraft.wheels is not None:
+            x_low[7:], x_high[7:] = -spacecraft.wheels.max_momentum, spacecraft.wheels.max_momentum
+            limit = np.where(spacecraft.wheels.working, spacecraft.wheels.max_torque, 0.0)
+            u_low[slices["wheels"]], u_high[slices["wheels"]] = -limit, limit
+        if "dipole" in slices:
+            u_low[slices["dipole"]], u_high[slices["dipole"]] = -spacecraft.magnetorquers.max_dipole, spacecraft.magnetorquers.max_dipole
+        if "torquers" in slices:
+            u_low[slices["torquers"]], u_high[slices["torquers"]] = -spacecraft.torquers.max_torque, spacecraft.torquers.max_torque
+        n_blocks, _, x_points = nlp.layout["X"]
+        _, _, u_points = nlp.layout["U"]
+        low = [np.tile(x_low, n_blocks * x_points), np.tile(u_low, n_blocks * u_points), np.zeros(nlp.layout["S"])]
+        high = [np.tile(x_high, n_blocks * x_points), np.tile(u_high, n_blocks * u_points), np.full(nlp.layout["S"], np.inf)]
+        if self.options.transcription == "collocation":
+            low.append(x_low), high.append(x_high)
+        if nlp.layout["free_time"]:
+            low.append([1e-3 * duration]), high.append([duration])
+        return np.concatenate(low), np.concatenate(high)
+
+    def _starts(self, problem: ManeuverProblem) -> list[Reference]:
+        from planners import PLANNERS
+
+        names = [self.options.warm_start] + list(self.options.seed_planners)
+        starts = []
+        for name in names:
+            if name not in PLANNERS or name == self.name:
+                raise ValueError(f"warm_start / seed_planners: unknown planner {name!r}; registered: {sorted(PLANNERS)}")
+            options = {"profile": "min_time"} if name == "eigenaxis" and self.options.objective == "min_time" else None
+            reference = PLANNERS[name](options).plan(problem)
+            if reference.ok:
+                starts.append(reference)
+        return starts
+
+    def _plan(self, problem: ManeuverProblem) -> Reference:
+        ocp = self._ocp(problem)
+        transcription, nlp = self._nlp(problem, ocp)
+        starts = self._starts(problem)
+        if not starts:
+            return FailedReference(self.name, f"no start: the warm-start planner {self.options.warm_start!r} failed")
+        disturbance = problem.model.default_parameters
+        omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf
+        params = np.concatenate([problem.initial_state, problem.qf, omegaf, [problem.duration], disturbance])
+        lbx, ubx = self._bounds(problem, nlp, problem.duration)
+        rng = np.random.default_rng(0)
+        guesses = [seed_vector(problem, transcription, nlp, ref) for ref in starts]
+        spread = 0.05 * (np.abs(guesses[0]) + 1e-3)
+        guesses += [guesses[0] + rng.normal(0, 1, guesses[0].size) * spread for _ in range(self.options.multistart)]
+        best, best_cost, statuses, iterations = None, np.inf, [], 0
+        for guess in guesses:
+            result = nlp.solver(x0=np.clip(guess, lbx, ubx), p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg)
+            stats = nlp.solver.stats()
+            statuses.append(stats["return_status"])
+            iterations += stats["iter_count"]
+            if stats["return_status"] in CONVERGED and float(result["f"]) < best_cost:
+                best, best_cost = result["x"], float(result["f"])
+        stats = {"ipopt_status": statuses, "iterations": iterations, "objective": best_cost,
+                 "transcription": transcription.name, "intervals": self.options.intervals}
+        if best is None:
+            status = "infeasible" if all(s in INFEASIBLE for s in statuses) else "failed"
+            return FailedReference(self.name, f"IPOPT did not converge from any start: {sorted(set(statuses))}",
+                                   status, stats=stats)
+        T, nodes, states, controls = (v.full() for v in nlp.unpack(best, params))
+        T = T.item()
+        reference = CollocationReference(problem, transcription, T, states, controls, stats)
+        norm_error = float(np.max(np.abs(np.linalg.norm(states[0:4], axis=0) - 1)))
+        stats.update(duration=T, max_quaternion_norm_error=norm_error,
+                     cones=[(c.boresight, c.direction, c.angle, c.keep_out) for c in ocp.cones])
+        reference.message = (f"{self.options.objective} by {transcription.name} (N={self.options.intervals}): "
+                             f"objective {best_cost:.6g}, T = {T:.4g} s, IPOPT {statuses}")
+        return reference
