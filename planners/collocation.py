@@ -168,7 +168,7 @@ class CollocationPlanner(Planner):
         T = T.item()
         reference = CollocationReference(problem, transcription, T, states, controls, stats)
         norm_error = float(np.max(np.abs(np.linalg.norm(states[0:4], axis=0) - 1)))
-        stats.update(duration=T, max_quaternion_norm_error=norm_error,
+        reference.stats.update(duration=T, max_quaternion_norm_error=norm_error,
                      cones=[(c.boresight, c.direction, c.angle, c.keep_out) for c in ocp.cones])
         reference.message = (f"{self.options.objective} by {transcription.name} (N={self.options.intervals}): "
                              f"objective {best_cost:.6g}, T = {T:.4g} s, IPOPT {statuses}")

@@ -60,6 +60,29 @@ def plot_row(row, target_q, path: Path) -> None:
     plt.close(fig)
 
 
+def plot_cones(row, path: Path) -> None:
+    """Angle between each constrained boresight and its direction, closed loop and reference,
+    against the cone's limit (the planner's stats carry the cones as imposed, margin included)."""
+    cones = row.reference.stats.get("cones", [])
+    sim = row.simulation
+    fig, axes = plt.subplots(len(cones), 1, figsize=(9, 3.2 * len(cones)), squeeze=False)
+    reference_q = row.reference.q(sim.t)
+    for axis, (boresight, direction, angle, keep_out) in zip(axes[:, 0], cones):
+        for q, style, label in ((sim.q, "-", "closed loop"), (reference_q, "--", "reference")):
+            pointing = quat.rotate(q, np.asarray(boresight))
+            separation = np.rad2deg(np.arccos(np.clip(pointing @ np.asarray(direction), -1, 1)))
+            axis.plot(sim.t, separation, style, label=label)
+        axis.axhline(np.rad2deg(angle), color="r", lw=1, label=("keep-out" if keep_out else "keep-in") + " limit")
+        axis.set_ylabel("boresight to direction (deg)")
+        axis.grid(alpha=0.3)
+        axis.legend(fontsize=8)
+    axes[-1, 0].set_xlabel("time (s)")
+    fig.suptitle(f"{row.label}: pointing constraints")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 def plot_overlay(results, path: Path) -> None:
     target_q = results.scenario.problem.qf
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
@@ -87,4 +110,6 @@ def write_plots(results, directory: Path) -> None:
     for row in results.rows:
         if row.simulation is not None:
             plot_row(row, target_q, directory / f"{safe_name(row.label)}.png")
+            if row.reference is not None and row.reference.stats.get("cones"):
+                plot_cones(row, directory / f"{safe_name(row.label)}_cones.png")
     plot_overlay(results, directory / "comparison.png")
