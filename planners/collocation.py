@@ -67,8 +67,14 @@ class CollocationPlanner(Planner):
         max_iterations: int = 500
 
         def __post_init__(self) -> None:
+            from planners import PLANNERS  # the registry is complete once options are parsed
+
             if self.intervals < 1 or not 1 <= self.degree <= 9:
                 raise ValueError("intervals must be >= 1 and degree in 1..9")
+            for name in [self.warm_start, *self.seed_planners]:
+                if name not in PLANNERS or name == "collocation":
+                    raise ValueError(f"warm_start / seed_planners: {name!r} is not another registered planner; "
+                                     f"expected one of {sorted(set(PLANNERS) - {'collocation'})}")
             for spec in self.keep_out:
                 parse_cone(spec, True)
             for spec in self.keep_in:
@@ -125,11 +131,8 @@ class CollocationPlanner(Planner):
     def _starts(self, problem: ManeuverProblem) -> list[Reference]:
         from planners import PLANNERS
 
-        names = [self.options.warm_start] + list(self.options.seed_planners)
         starts = []
-        for name in names:
-            if name not in PLANNERS or name == self.name:
-                raise ValueError(f"warm_start / seed_planners: unknown planner {name!r}; registered: {sorted(PLANNERS)}")
+        for name in [self.options.warm_start, *self.options.seed_planners]:
             options = {"profile": "min_time"} if name == "eigenaxis" and self.options.objective == "min_time" else None
             reference = PLANNERS[name](options).plan(problem)
             if reference.ok:

@@ -81,6 +81,9 @@ BAD_INPUTS = {
     "controller gain type": (lambda d: d["controller"]["options"].update(kp=[1, 2]), "controller.options.kp",
                              "expected a number or a matrix"),
     "missing key": (lambda d: d.pop("maneuver"), "maneuver", "required"),
+    "unknown warm start": (lambda d: d["planners"].append({"name": "collocation", "label": "c",
+                                                           "options": {"warm_start": "magic"}}),
+                           "planners[2].options", "not another registered planner"),
 }
 
 
