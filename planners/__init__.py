@@ -2,12 +2,13 @@
 from planners.base import (FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
 from planners.collocation import CollocationPlanner
+from planners.costate_tpbvp import CostateTPBVPPlanner
 from planners.eigenaxis import EigenaxisPlanner
 from planners.natural_motion import NaturalMotionPlanner
 from planners.spin_extremal import SpinExtremalPlanner
 
 PLANNERS: dict[str, type[Planner]] = {
-    cls.name: cls for cls in (CollocationPlanner, EigenaxisPlanner, NaturalMotionPlanner, SpinExtremalPlanner)
+    cls.name: cls for cls in (CollocationPlanner, CostateTPBVPPlanner, EigenaxisPlanner, NaturalMotionPlanner, SpinExtremalPlanner)
 }
 
 __all__ = ["FailedReference", "ManeuverProblem", "PLANNERS", "Planner", "Reference", "ReferenceSample",

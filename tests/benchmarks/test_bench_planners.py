@@ -32,3 +32,15 @@ def test_natural_motion_nano_case(benchmark, moments):
     planner.plan(problem)  # builds the IPOPT solver once
     reference = benchmark(planner.plan, problem)
     assert reference.status == "ok"
+
+
+def test_costate_tpbvp_min_energy(benchmark):
+    # Issue 7 target: a TPBVP solve in at most 2 s. Full inertia, gravity gradient, rest to rest.
+    from ocp import CircularOrbit, Environment, Torquers, quat
+
+    environment = Environment(CircularOrbit(500e3, 0.9), gravity_gradient=True)
+    spacecraft = Spacecraft([[10.0, 0.5, 0.2], [0.5, 8.0, 0.3], [0.2, 0.3, 6.0]], torquers=Torquers(10.0))
+    problem = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.normalize([0.3, 0.5, -0.6, 0.4]), 120.0,
+                              omegaf=np.zeros(3), environment=environment)
+    reference = benchmark(PLANNERS["costate_tpbvp"]().plan, problem)
+    assert reference.status == "ok"
