@@ -5,10 +5,11 @@ from planners.collocation import CollocationPlanner
 from planners.costate_tpbvp import CostateTPBVPPlanner
 from planners.eigenaxis import EigenaxisPlanner
 from planners.natural_motion import NaturalMotionPlanner
+from planners.shape_polynomial import ShapePolynomialPlanner
 from planners.spin_extremal import SpinExtremalPlanner
 
 PLANNERS: dict[str, type[Planner]] = {
-    cls.name: cls for cls in (CollocationPlanner, CostateTPBVPPlanner, EigenaxisPlanner, NaturalMotionPlanner, SpinExtremalPlanner)
+    cls.name: cls for cls in (CollocationPlanner, CostateTPBVPPlanner, EigenaxisPlanner, NaturalMotionPlanner, ShapePolynomialPlanner, SpinExtremalPlanner)
 }
 
 __all__ = ["FailedReference", "ManeuverProblem", "PLANNERS", "Planner", "Reference", "ReferenceSample",

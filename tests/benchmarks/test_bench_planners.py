@@ -44,3 +44,17 @@ def test_costate_tpbvp_min_energy(benchmark):
                               omegaf=np.zeros(3), environment=environment)
     reference = benchmark(PLANNERS["costate_tpbvp"]().plan, problem)
     assert reference.status == "ok"
+
+
+def test_shape_polynomial_vepa_case(benchmark):
+    # Issue 7 target: shape-based planning (all N = 1..6) in at most 50 ms.
+    from ocp import Torquers, quat
+
+    spacecraft = Spacecraft([2.27293, 3.27331, 1.5], torquers=Torquers(1.0))
+    problem = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3),
+                              quat.from_scalar_last([0.2068, 0.2518, 0.1682, 0.9303]), 1000.0,
+                              omegaf=np.zeros(3), max_rate=0.001)
+    planner = PLANNERS["shape_polynomial"]()
+    planner.plan(problem)  # builds the six IPOPT solvers once
+    reference = benchmark(planner.plan, problem)
+    assert reference.status == "ok"

@@ -1,0 +1,172 @@
+"""Shape-based quaternion polynomials (Vepa, section 7, after Caubet & Biggs), eq. 52-54.
+
+With τ = t/t_f each component is a cubic Hermite polynomial matching ``q(0), q(1)`` and the boundary
+rates, plus ``N`` free shapes ``e_ij [(j−4) τ² − (j−3) τ³ + τ^(j−1)]``, ``j = 5 … N+4``, which vanish
+with zero slope at both ends (eq. 52), so every choice of coefficients meets the boundary
+conditions exactly. The polynomial ``p(τ)`` is normalised, ``q = p/‖p‖``, which keeps the reference
+unit and leaves the boundary values unchanged. The coefficients minimise (``cost``):
+
+* ``path``: ``∫₀¹ ‖dq/dτ‖² dτ`` (our reading of eq. 53, whose integrand is garbled in the text; the
+  smooth form of the path length, minimised by constant-speed geodesics), or
+* ``torque``: ``∫ ‖I ω̇ + ω × I ω‖² dt`` over the scenario's duration.
+
+``ω = 2 vec(q* ⊗ q̇)`` (eq. 54 in our convention). With ``duration: rate_limit`` the time is the
+shortest that keeps ``‖ω‖ <= max_rate`` (the paper's choice): ``t_f = max_τ ‖ω_τ‖ / max_rate``;
+the planner tries ``N = 1 … max_terms`` and keeps the shortest ``t_f`` (or the lowest cost).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Literal
+
+import casadi as ca
+import numpy as np
+
+from ocp import quat
+from ocp import quat_casadi as qc
+from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
+                           inverse_dynamics_torque)
+
+QUADRATURE_POINTS = 41
+
+
+def shape_basis(tau, terms: int, math=np):
+    """Hermite basis (4 functions) and the ``terms`` free shapes of eq. 52 at ``tau``, with τ-derivatives."""
+    h = [2 * tau**3 - 3 * tau**2 + 1, tau**3 - 2 * tau**2 + tau, -2 * tau**3 + 3 * tau**2, tau**3 - tau**2]
+    dh = [6 * tau**2 - 6 * tau, 3 * tau**2 - 4 * tau + 1, -6 * tau**2 + 6 * tau, 3 * tau**2 - 2 * tau]
+    free = [(j - 4) * tau**2 - (j - 3) * tau**3 + tau ** (j - 1) for j in range(5, terms + 5)]
+    dfree = [2 * (j - 4) * tau - 3 * (j - 3) * tau**2 + (j - 1) * tau ** (j - 2) for j in range(5, terms + 5)]
+    return h + free, dh + dfree
+
+
+def polynomial(tau, q0, q1, slope0, slope1, coefficients, terms: int, math=np):
+    """``q(τ)`` normalised and ``dq/dτ`` (coefficients: 4 x terms). NumPy: ``tau`` a row of times,
+    the other vectors columns (4, 1); results (4, m). CasADi: one scalar τ."""
+    basis, dbasis = shape_basis(tau, terms, math)
+    p = basis[0] * q0 + basis[1] * slope0 + basis[2] * q1 + basis[3] * slope1
+    dp = dbasis[0] * q0 + dbasis[1] * slope0 + dbasis[2] * q1 + dbasis[3] * slope1
+    for k in range(terms):
+        p = p + basis[4 + k] * coefficients[:, k:k + 1]
+        dp = dp + dbasis[4 + k] * coefficients[:, k:k + 1]
+    if math is np:  # columns are times
+        norm = np.linalg.norm(p, axis=0)
+        q = p / norm
+        return q, (dp - q * np.sum(q * dp, axis=0)) / norm
+    norm = ca.norm_2(p)
+    q = p / norm
+    return q, (dp - q * ca.dot(q, dp)) / norm
+
+
+@lru_cache(maxsize=None)
+def _solver(terms: int, cost: str) -> ca.Function:
+    """IPOPT on the 4 x terms coefficients; parameters [q0, q1, slope0, slope1, I (9), T]."""
+    e = ca.SX.sym("e", 4, terms)
+    p = ca.SX.sym("p", 26)
+    q0, q1, s0, s1 = p[0:4], p[4:8], p[8:12], p[12:16]
+    inertia, duration = ca.reshape(p[16:25], 3, 3), p[25]
+    taus = np.linspace(0, 1, QUADRATURE_POINTS)
+    weights = np.full(QUADRATURE_POINTS, 1.0 / (QUADRATURE_POINTS - 1))
+    weights[[0, -1]] /= 2
+    total = 0
+    rates, norms = [], []
+    for tau, w in zip(taus, weights):
+        q, dq = polynomial(tau, q0, q1, s0, s1, e, terms, math=ca)
+        basis, _ = shape_basis(tau, terms, ca)
+        raw = basis[0] * q0 + basis[1] * s0 + basis[2] * q1 + basis[3] * s1 + sum(basis[4 + k] * e[:, k] for k in range(terms))
+        norms.append(ca.sumsqr(raw))
+        if cost == "path":
+            total += w * ca.sumsqr(dq)
+        rates.append(2 * qc.product(qc.conjugate(q), dq)[1:4] / duration)
+    if cost == "torque":
+        h = 1.0 / (QUADRATURE_POINTS - 1)
+        for k, (tau, w) in enumerate(zip(taus, weights)):
+            rate_dot = (rates[min(k + 1, len(rates) - 1)] - rates[max(k - 1, 0)]) / ((2 if 0 < k < len(rates) - 1 else 1) * h * duration)
+            torque = ca.mtimes(inertia, rate_dot) + ca.cross(rates[k], ca.mtimes(inertia, rates[k]))
+            total += w * duration * ca.sumsqr(torque)
+    # The cost only shapes the path (the boundary conditions hold exactly for any coefficients),
+    # so a loose tolerance is enough.
+    options = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-7,
+               "ipopt.max_iter": 100}
+    # Keep the raw polynomial near the unit sphere: through the normalisation, a polynomial whose
+    # norm blows up could turn between quadrature points where the cost does not see it.
+    return ca.nlpsol(f"shape_{terms}_{cost}", "ipopt",
+                     {"x": ca.vec(e), "p": p, "f": total, "g": ca.vertcat(*norms)}, options)
+
+
+class ShapeReference(Reference):
+    """Normalised polynomial attitude; rate and acceleration by eq. 54, torque by inverse dynamics."""
+
+    def __init__(self, q0, q1, slope0, slope1, coefficients, terms, duration, inertia, message, stats):
+        super().__init__("shape_polynomial", duration, inertia, message=message, stats=stats)
+        self.args = (q0, q1, slope0, slope1, coefficients, terms)
+
+    def _rate(self, tau: Array) -> tuple[Array, Array]:
+        q, dq = polynomial(tau[None, :], *(np.asarray(a)[:, None] if i < 4 else a for i, a in enumerate(self.args)))
+        return q.T, 2 * quat.product(quat.conjugate(q.T), dq.T)[:, 1:] / self.duration
+
+    def _evaluate(self, t: Array) -> ReferenceSample:
+        tau = t / self.duration
+        q, omega = self._rate(tau)
+        step = 1e-5
+        omega_dot = (self._rate(np.minimum(tau + step, 1))[1] - self._rate(np.maximum(tau - step, 0))[1]) / (
+            (np.minimum(tau + step, 1) - np.maximum(tau - step, 0))[:, None] * self.duration)
+        return ReferenceSample(q, omega, omega_dot, inverse_dynamics_torque(self.inertia, omega, omega_dot))
+
+
+class ShapePolynomialPlanner(Planner):
+    """Shape-based quaternion polynomial planner (see the module docstring)."""
+
+    name = "shape_polynomial"
+
+    @dataclass(frozen=True)
+    class Options:
+        terms: int | None = None                                    # N; None tries 1..max_terms
+        max_terms: int = 6
+        cost: Literal["path", "torque"] = "path"
+        duration: Literal["rate_limit", "scenario"] = "rate_limit"
+        max_rate: float | None = None                               # rad/s; default: the problem's max_rate
+
+        def __post_init__(self) -> None:
+            if self.terms is not None and not 1 <= self.terms <= 12:
+                raise ValueError(f"terms must be in 1..12, got {self.terms}")
+
+    def _plan(self, problem: ManeuverProblem) -> Reference:
+        o = self.options
+        max_rate = o.max_rate if o.max_rate is not None else problem.max_rate
+        if o.duration == "rate_limit" and max_rate is None:
+            return FailedReference(self.name, "duration: rate_limit needs max_rate (option or maneuver.max_rate)")
+        omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf
+        rest_to_rest = not np.any(problem.omega0) and not np.any(omegaf)
+        if o.duration == "rate_limit" and not rest_to_rest:
+            return FailedReference(self.name, "duration: rate_limit is for rest-to-rest slews; use duration: scenario")
+        q0 = problem.q0
+        q1 = problem.qf if problem.qf @ q0 >= 0 else -problem.qf  # the shorter way round
+        T = problem.duration
+        slope0, slope1 = T * quat.kinematics(q0, problem.omega0), T * quat.kinematics(q1, omegaf)
+        params = np.concatenate([q0, q1, slope0, slope1, problem.spacecraft.inertia.ravel(order="F"), [T]])
+        best, previous = None, np.zeros((4, 0))
+        candidates = [o.terms] if o.terms is not None else range(1, o.max_terms + 1)
+        for terms in candidates:
+            solver = _solver(terms, o.cost)
+            seed = np.zeros((4, terms))
+            seed[:, :min(terms, previous.shape[1])] = previous[:, :terms]  # N − 1 terms seed N
+            result = solver(x0=seed.T.ravel(), p=params, lbg=0.5, ubg=2.0)
+            status = solver.stats()["return_status"]
+            if status not in ("Solve_Succeeded", "Solved_To_Acceptable_Level"):
+                continue
+            coefficients = result["x"].full().reshape(terms, 4).T
+            previous = coefficients
+            probe = ShapeReference(q0, q1, slope0, slope1, coefficients, terms, 1.0, problem.spacecraft.inertia, "", {})
+            peak = float(np.max(np.linalg.norm(probe._rate(np.linspace(0, 1, 2001))[1], axis=1)))  # per unit τ
+            duration = peak / max_rate if o.duration == "rate_limit" else T
+            score = duration if o.duration == "rate_limit" else float(result["f"])
+            if best is None or score < best[0]:
+                best = (score, terms, coefficients, duration, float(result["f"]))
+        if best is None:
+            return FailedReference(self.name, "IPOPT did not converge for any number of shape terms")
+        _, terms, coefficients, duration, cost = best
+        stats = {"terms": terms, "cost": cost, "duration": duration}
+        message = f"N = {terms}, t_f = {duration:.4g} s, {o.cost} cost {cost:.4g}"
+        return ShapeReference(q0, q1, slope0, slope1, coefficients, terms, duration, problem.spacecraft.inertia,
+                              message, stats)
