@@ -6,6 +6,7 @@ scenario file, 1 for an internal error.
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import time
 import traceback
@@ -21,9 +22,11 @@ EXIT_OK, EXIT_INTERNAL, EXIT_BAD_SCENARIO = 0, 1, 2
 
 
 def _first_doc_line(cls) -> str:
-    import sys as _sys
-    doc = (_sys.modules[cls.__module__].__doc__ or cls.__doc__ or "").strip()
-    return doc.splitlines()[0] if doc else ""
+    """The first sentence of the module's docstring (the class's if the module has none)."""
+    doc = (sys.modules[cls.__module__].__doc__ or cls.__doc__ or "").strip()
+    paragraph = " ".join(doc.split("\n\n")[0].split())
+    sentence = re.match(r"(.+?[.:])\s+(?=[A-Z*`])", paragraph)  # not at "eq. 38"
+    return (sentence.group(1) if sentence else paragraph).rstrip(".:")
 
 
 def command_list(_: argparse.Namespace) -> int:
