@@ -7,8 +7,8 @@ Constraints: actuator bounds (wheel torques, dipoles, torquers), wheel momentum 
 bound ``max_rate`` (per axis), fixed or free final rate, keep-out / keep-in cones.
 The transcription (``collocation``: Legendre-Gauss-Radau, or ``multiple_shooting``) is injected from
 :data:`ocp.transcription.TRANSCRIPTIONS`; the NLP is built once per problem structure and cached
-on the model. Starts: the reference of the ``warm_start`` planner, the ``seed_planners``, and
-``multistart`` random perturbations of the warm start; the best converged optimum is kept.
+on the model. Starts: the reference of the ``warm_start`` planner (or, with ``multistart`` > 0, that many randomly
+perturbed copies of it) and the ``seed_planners``; the best converged optimum is kept.
 """
 from __future__ import annotations
 
@@ -54,7 +54,8 @@ class CollocationPlanner(Planner):
         transcription: Literal["collocation", "multiple_shooting"] = "collocation"
         warm_start: str = "eigenaxis"            # registered planner whose reference seeds the NLP
         seed_planners: list[str] = field(default_factory=list)
-        multistart: int = 0                      # extra starts: random perturbations of the warm start
+        multistart: int = 0                      # > 0: try this many randomly perturbed copies of the warm
+                                                 # start (1 %, then 5 %) instead of the warm start itself
         energy_weight: float = 1.0               # for objective "weighted"
         l1_weight: float = 0.0
         time_weight: float = 0.0
@@ -151,8 +152,14 @@ class CollocationPlanner(Planner):
         lbx, ubx = self._bounds(problem, nlp, problem.duration)
         rng = np.random.default_rng(0)
         guesses = [seed_vector(problem, transcription, nlp, ref) for ref in starts]
-        spread = 0.05 * (np.abs(guesses[0]) + 1e-3)
-        guesses += [guesses[0] + rng.normal(0, 1, guesses[0].size) * spread for _ in range(self.options.multistart)]
+        if self.options.multistart:
+            # A warm start can sit exactly on a stationary point (the eigenaxis slew is one for minimum
+            # time on a symmetric body: 179 IPOPT iterations to the poorer 15.85 s there, against ~45
+            # from any perturbed copy to 14.50 s). Perturbed copies cover it and escape such points.
+            warm = guesses.pop(0)
+            scale = np.abs(warm) + 1e-3
+            guesses = [warm + rng.normal(0, 1, warm.size) * scale * (0.01 if k == 0 else 0.05)
+                       for k in range(self.options.multistart)] + guesses
         best, best_cost, statuses, iterations = None, np.inf, [], 0
         for guess in guesses:
             result = nlp.solver(x0=np.clip(guess, lbx, ubx), p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg)
