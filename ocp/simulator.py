@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from ocp import quat
 from ocp.actuators import ActuatorModel, Command, Measurement
 from ocp.fast_call import BufferedFunction
+from ocp.integration import rk4_step
 from ocp.model import AttitudeModel
 
 Array = NDArray[np.float64]
@@ -129,12 +130,7 @@ class Simulator:
             h = dt / substeps
             x_next = x
             for k in range(substeps):
-                tk = t + k * h
-                k1 = model.rhs(x_next, u, tk, p)
-                k2 = model.rhs(x_next + h / 2 * k1, u, tk + h / 2, p)
-                k3 = model.rhs(x_next + h / 2 * k2, u, tk + h / 2, p)
-                k4 = model.rhs(x_next + h * k3, u, tk + h, p)
-                x_next = x_next + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+                x_next = rk4_step(lambda state, time: model.rhs(state, u, time, p), x_next, t + k * h, h)
             return ca.Function("zoh_step", [x, u, t, dt, p], [x_next], ["x", "u", "t", "dt", "p"], ["x_next"])
         # CVODES on normalised time s in [0, 1]: dx/ds = dt f(x, u, t + s dt, p).
         s = ca.SX.sym("s")

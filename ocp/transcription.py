@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ocp import quat_casadi as qc
+from ocp.integration import rk4_step
 from ocp.model import AttitudeModel
 
 Array = NDArray[np.float64]
@@ -199,22 +200,15 @@ class MultipleShooting(Transcription):
         t_start, h_interval, dist = ca.SX.sym("t0"), ca.SX.sym("h"), ca.SX.sym("d", 3)
         h = h_interval / M
 
-        def augmented(state, control, t):
-            return ca.vertcat(model.dynamics(state, control, t, dist), problem.stage_cost(state, control, t))
+        def augmented(state, t):
+            fraction = (t - t_start) / h_interval  # piecewise-linear control across the interval
+            control = (1 - fraction) * u0 + fraction * u1
+            return ca.vertcat(model.dynamics(state[:nx], control, t, dist),
+                              problem.stage_cost(state[:nx], control, t))
 
         state = ca.vertcat(x, 0)
         for m in range(M):
-            t0 = t_start + h * m
-
-            def control(s):
-                fraction = (m + s) / M
-                return (1 - fraction) * u0 + fraction * u1
-
-            k1 = augmented(state[:nx], control(0), t0)
-            k2 = augmented(state[:nx] + h / 2 * k1[:nx], control(0.5), t0 + h / 2)
-            k3 = augmented(state[:nx] + h / 2 * k2[:nx], control(0.5), t0 + h / 2)
-            k4 = augmented(state[:nx] + h * k3[:nx], control(1), t0 + h)
-            state = state + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            state = rk4_step(augmented, state, t_start + h * m, h)
         interval = ca.Function("interval", [x, u0, u1, t_start, h_interval, dist], [state[:nx], state[nx]])
         shots = interval.map(N)
 

@@ -15,10 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
-import casadi as ca
 import numpy as np
 
-from ocp import quat
 from ocp.transcription import TRANSCRIPTIONS, Cone, OptimalControlProblem
 from planners.base import FailedReference, ManeuverProblem, Planner, Reference
 from planners.collocation_reference import CollocationReference, seed_vector
@@ -53,6 +51,7 @@ class CollocationPlanner(Planner):
         degree: int = 3
         transcription: Literal["collocation", "multiple_shooting"] = "collocation"
         warm_start: str = "eigenaxis"            # registered planner whose reference seeds the NLP
+        warm_start_options: dict = field(default_factory=dict)  # its options, e.g. {profile: min_time}
         seed_planners: list[str] = field(default_factory=list)
         multistart: int = 0                      # > 0: try this many randomly perturbed copies of the warm
                                                  # start (1 %, then 5 %) instead of the warm start itself
@@ -76,6 +75,11 @@ class CollocationPlanner(Planner):
                 if name not in PLANNERS or name == "collocation":
                     raise ValueError(f"warm_start / seed_planners: {name!r} is not another registered planner; "
                                      f"expected one of {sorted(set(PLANNERS) - {'collocation'})}")
+            PLANNERS[self.warm_start](self.warm_start_options, path="warm_start_options")  # raises if invalid
+            if self.transcription == "multiple_shooting" and (self.keep_out or self.keep_in or self.objective == "min_l1"
+                                                              or (self.objective == "weighted" and self.l1_weight)):
+                raise ValueError("multiple_shooting supports energy and time objectives without cones; "
+                                 "use transcription: collocation for L1 costs and keep-out / keep-in cones")
             for spec in self.keep_out:
                 parse_cone(spec, True)
             for spec in self.keep_in:
@@ -133,8 +137,9 @@ class CollocationPlanner(Planner):
         from planners import PLANNERS
 
         starts = []
-        for name in [self.options.warm_start, *self.options.seed_planners]:
-            options = {"profile": "min_time"} if name == "eigenaxis" and self.options.objective == "min_time" else None
+        requested = [(self.options.warm_start, self.options.warm_start_options)]
+        requested += [(name, None) for name in self.options.seed_planners]
+        for name, options in requested:
             reference = PLANNERS[name](options).plan(problem)
             if reference.ok:
                 starts.append(reference)

@@ -26,7 +26,6 @@ import numpy as np
 from scipy.integrate import solve_bvp
 
 from ocp import quat
-from ocp import quat_casadi as qc
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample)
 
 

@@ -29,6 +29,7 @@ from scipy.special import ellipj, ellipkinc
 
 from ocp import Spacecraft, quat
 from ocp import quat_casadi as qc
+from ocp.integration import rk4_step
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
 from planners.spin_extremal import extremal_quaternion
@@ -263,15 +264,11 @@ def _rk4_arc(omega0, moments, arc, steps: int):
     euler = euler_rhs([params[0], params[1], params[2]])
     h = params[3]
 
-    def rhs(x):
+    def rhs(x, _):
         q, w = x[:4], x[4:]
         return ca.vertcat(0.5 * qc.product(q, ca.vertcat(0, w)), *euler([w[0], w[1], w[2]]))
 
-    k1 = rhs(state)
-    k2 = rhs(state + h / 2 * k1)
-    k3 = rhs(state + h / 2 * k2)
-    k4 = rhs(state + h * k3)
-    step = ca.Function("rk4", [state, params], [state + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)])
+    step = ca.Function("rk4", [state, params], [rk4_step(rhs, state, 0, h)])
     final = ca.vertcat(1, 0, 0, 0, omega0)
     step_params = ca.vertcat(*moments, arc / steps)
     for _ in range(steps):

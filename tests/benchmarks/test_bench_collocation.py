@@ -21,7 +21,7 @@ CASES = {
     "min_time_3axis_multistart": (
         lambda: ManeuverProblem(Spacecraft([10.0, 10.0, 10.0], torquers=Torquers(0.5)), quat.IDENTITY, np.zeros(3),
                                 quat.normalize([0.0, 1.0, 0.0, 0.0]), 60.0, omegaf=np.zeros(3)),
-        {"objective": "min_time", "intervals": 40, "multistart": 4}),
+        {"objective": "min_time", "intervals": 40, "multistart": 4, "warm_start_options": {"profile": "min_time"}}),
     "spin_paper_case": (
         lambda: ManeuverProblem(Spacecraft([19.5, 19.0, 12.6], torquers=Torquers(0.1)), [1, 0, 0, 0], [0.2, 0, 0],
                                 [0, 0, 1, 0], 200.0),
