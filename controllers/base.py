@@ -34,17 +34,26 @@ class Controller(Configurable, ABC):
       is ``(q_f, ω_f or None)``, used in regulation mode and by regulators.
     * ``__call__(t, measurement, reference)`` returns the :class:`Command` for the coming sample;
       ``reference`` is a ``planners.Reference`` or ``None`` (regulation to the target).
+    * ``needs_reference``: the law cannot regulate (``reference=None``) and raises ``ValueError``
+      there; the scenario loader rejects regulation mode for it.
+    * ``planner_error(name, options)`` says why the law cannot track references of that planner
+      (``None`` if it can); the scenario loader reports it. Most laws track any reference.
     * Saturation is the simulator's actuator model's job, not the controller's.
     """
 
     hold_compensation: bool = True
     """Correct the held gyroscopic term to mid-sample in :meth:`allocate`."""
+    needs_reference: bool = False
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
         super().__init__(options, path)
         self.spacecraft: Spacecraft | None = None
         self.sample_time = 0.0
         self.target: tuple[Array, Array | None] | None = None
+
+    def planner_error(self, planner: str, options: Any) -> str | None:
+        """Why this law cannot track the references of ``planner`` with ``options``, or ``None``."""
+        return None
 
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
         """Prepare for a run of ``spacecraft`` sampled every ``sample_time`` seconds."""

@@ -32,7 +32,11 @@ class BufferedFunction:
             self._buffer.set_res(i, memoryview(array))
 
     def __call__(self, *args: ArrayLike | float) -> NDArray[np.float64]:
+        return self.all_outputs(*args)[0]
+
+    def all_outputs(self, *args: ArrayLike | float) -> list[NDArray[np.float64]]:
+        """Every output, flat (column-major for matrices), overwritten by the next call."""
         for target, value in zip(self._inputs, args):
             target[:] = value
         self._evaluate()
-        return self._outputs[0]
+        return self._outputs

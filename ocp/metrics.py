@@ -32,7 +32,7 @@ def compute_metrics(
     q: ArrayLike,
     omega: ArrayLike,
     torque: ArrayLike,
-    target_q: ArrayLike,
+    target_q: ArrayLike | None,
     target_omega: ArrayLike | None = None,
     reference_q: ArrayLike | None = None,
     wheel_momentum: ArrayLike | None = None,
@@ -48,7 +48,7 @@ def compute_metrics(
     q, omega : (N+1, 4), (N+1, 3) attitude and body rate (rad/s) at ``t``.
     torque : (N, 3) body torque held over each interval (zero-order hold, closed loop), or
         (N+1, 3) torque samples at ``t`` (a reference; integrated with trapezoids). N m.
-    target_q, target_omega : the manoeuvre's final attitude and rate (``None``: free rate).
+    target_q, target_omega : the manoeuvre's final attitude and rate (``None``: free).
     reference_q : (N+1, 4) reference attitude at ``t`` for the tracking errors (closed loop).
     wheel_momentum : (N+1, n_w) N m s; saturated : (N,) bool per sample.
 
@@ -60,9 +60,11 @@ def compute_metrics(
     q = np.asarray(q, dtype=float)
     torque = np.asarray(torque, dtype=float)
     norms = np.linalg.norm(torque, axis=1)
-    error_to_target = np.rad2deg(quat.error_angle(q, target_q))
-    above = np.nonzero(error_to_target > settling_tolerance_deg)[0]
-    if above.size == 0:
+    error_to_target = None if target_q is None else np.rad2deg(quat.error_angle(q, target_q))
+    above = None if target_q is None else np.nonzero(error_to_target > settling_tolerance_deg)[0]
+    if above is None:
+        settling = None  # free final attitude
+    elif above.size == 0:
         settling = 0.0
     elif above[-1] == t.size - 1:
         settling = None  # not settled by the end of the window
@@ -73,7 +75,7 @@ def compute_metrics(
         "int_u": float(_integrate(t, norms)),
         "int_abs_u": [float(v) for v in _integrate(t, np.abs(torque))],
         "peak_u": float(np.max(np.abs(torque))) if torque.size else 0.0,
-        "final_error_deg": float(error_to_target[-1]),
+        "final_error_deg": None if error_to_target is None else float(error_to_target[-1]),
         "final_rate_error": None if target_omega is None
         else float(np.linalg.norm(np.asarray(omega)[-1] - np.asarray(target_omega, dtype=float))),
         "rms_error_deg": None,
@@ -95,7 +97,7 @@ def compute_metrics(
 
 def metrics_from_simulation(
     result: Any,
-    target_q: ArrayLike,
+    target_q: ArrayLike | None,
     target_omega: ArrayLike | None = None,
     reference: Any = None,
     plan_time_s: float | None = None,
@@ -115,7 +117,7 @@ def metrics_from_simulation(
 
 def metrics_from_reference(
     reference: Any,
-    target_q: ArrayLike,
+    target_q: ArrayLike | None,
     target_omega: ArrayLike | None = None,
     points: int = 2001,
     settling_tolerance_deg: float = DEFAULT_SETTLING_TOLERANCE_DEG,

@@ -30,7 +30,8 @@ class ManeuverProblem:
     ----------
     spacecraft, environment : the model.
     q0, omega0 : initial attitude (scalar first, body to inertial) and body rate (rad/s).
-    qf, omegaf : target attitude and rate; ``omegaf=None`` leaves the final rate free.
+    qf, omegaf : target attitude and rate; ``None`` leaves the final attitude or rate free (a
+        free attitude only suits planners that say so in :meth:`Planner.problem_error`).
     duration : s, manoeuvre time T (an initial guess or bound for minimum-time planners).
     wheel_momentum0 : (n_w,) N m s, initial wheel momenta (default zero).
     max_rate : rad/s, optional bound on the body rate norm for planners that honour it.
@@ -39,7 +40,7 @@ class ManeuverProblem:
     spacecraft: Spacecraft
     q0: Array
     omega0: Array
-    qf: Array
+    qf: Array | None
     duration: float
     omegaf: Array | None = None
     environment: Environment = field(default_factory=Environment)
@@ -48,7 +49,8 @@ class ManeuverProblem:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "q0", quat.normalize(np.asarray(self.q0, dtype=float)))
-        object.__setattr__(self, "qf", quat.normalize(np.asarray(self.qf, dtype=float)))
+        if self.qf is not None:
+            object.__setattr__(self, "qf", quat.normalize(np.asarray(self.qf, dtype=float)))
         object.__setattr__(self, "omega0", np.asarray(self.omega0, dtype=float))
         if self.omegaf is not None:
             object.__setattr__(self, "omegaf", np.asarray(self.omegaf, dtype=float))
@@ -176,13 +178,23 @@ class Planner(Configurable, ABC):
     * ``plan(problem)`` returns a :class:`Reference` and sets its ``plan_time_s``. A numerical
       failure (no convergence, infeasible bounds) is returned as a reference with
       ``status="failed"`` or ``"infeasible"`` and a message; ``plan`` does not raise for it.
+    * ``problem_error(problem)`` says, cheaply, why the planner cannot take a problem (``None``
+      if it can); the scenario loader reports it against the planner's YAML entry and ``plan``
+      returns it as a failed reference. By default a planner needs a target attitude.
     * Planners never read YAML and never simulate.
     """
+
+    def problem_error(self, problem: ManeuverProblem) -> str | None:
+        """Why this planner cannot plan ``problem``, or ``None``."""
+        if problem.qf is None:
+            return f"planner {self.name} needs a target attitude (maneuver.final.q)"
+        return None
 
     def plan(self, problem: ManeuverProblem) -> Reference:
         """Plan the manoeuvre; the wall time goes into ``reference.plan_time_s``."""
         start = time.perf_counter()
-        reference = self._plan(problem)
+        error = self.problem_error(problem)
+        reference = FailedReference(self.name, error) if error else self._plan(problem)
         reference.plan_time_s = time.perf_counter() - start
         return reference
 

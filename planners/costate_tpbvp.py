@@ -1,105 +1,135 @@
 """Indirect optimal control: the states and co-states of Pontryagin's principle as a two-point
 boundary-value problem (Vepa, sections 3 and 6), solved with ``scipy.integrate.solve_bvp``.
 
-Implemented form, ``objective: min_energy``: minimise ``½∫‖u‖² dt`` with
-``I ω̇ = −ω × I ω + u + τ_gg(q, t)`` and ``q̇ = ½ Ω(ω) q``. Then ``u = −I⁻¹ λ_ω`` and, with
-``Ξ(q)`` from ``q̇ = ½ Ξ(q) ω``,
+Problem forms (``objective``; the Hamiltonian systems are in :mod:`planners.costate_systems`):
 
-    λ̇_q = −½ Ω(ω)ᵀ λ_q − (∂τ_gg/∂q)ᵀ I⁻¹ λ_ω
-    λ̇_ω = −½ Ξ(q)ᵀ λ_q + ([ω×] I − [(I ω)×])ᵀ I⁻¹ λ_ω
+* ``min_energy``: ``min ½∫‖M_c‖² dt`` for any rest-to-rest or rate-to-rate slew in the scenario's
+  time, ``M_c = −I⁻¹λ_ω``. Cross-checked against the collocation planner.
+* ``rate_acquisition``: reach the target rate ``ω_f`` steering a torque of fixed size,
+  ``M_c = diag(τ) W u``, ``u = −Gᵀλ_ω/‖Gᵀλ_ω‖`` (eq. 21, 34); the attitude is free.
+* ``attitude_acquisition``: reach ``q_f`` with the rate as the control, ``ω = ω_max u`` (eq. 44, 50).
 
-(written out here; the gravity-gradient Jacobian comes from CasADi; a test checks the whole right
-side against ``−∂H/∂x`` by automatic differentiation). Boundary conditions: ``x(0)`` fixed;
-``vec(q_f* ⊗ q(T)) = 0`` and ``λ_q(T)·q(T) = 0`` (the scaling symmetry of the quaternion makes a
-fourth attitude condition redundant; this fixes the gauge instead); ``ω(T) = ω_f``, or
-``λ_ω(T) = 0`` when the final rate is free. Torque bounds are not imposed (unconstrained form).
-A cold start uses the eigenaxis slew, and continuation walks the target from ``q0`` to ``q_f``
-along the slerp, each solve seeding the next.
+The steering forms solve for the minimum time (``final_time: minimum``, default) or, with
+``final_time: fixed``, minimise the paper's terminal cost at ``t_f = T`` with its transversality
+conditions (eq. 36-38, 51). Gravity gradient enters whenever the scenario has it (eq. 5-8, orbit
+frame from the scenario's orbit). A cold start (eigenaxis slew or straight-line rates) is walked to
+the target by continuation, each solve seeding the next. Torque bounds are not imposed.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Callable, Literal
 
-import casadi as ca
 import numpy as np
 from scipy.integrate import solve_bvp
 
-from ocp import quat
-from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample)
+from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample
+from planners.costate_systems import (AttitudeAcquisitionSystem, HamiltonianSystem, MinimumEnergySystem,
+                                      RateAcquisitionSystem)
 
 
-def omega_matrix(omega):
-    """``Ω(ω)`` with ``q̇ = ½ Ω(ω) q`` (scalar first, ω in body axes)."""
-    w1, w2, w3 = omega[0], omega[1], omega[2]
-    return ca.vertcat(ca.horzcat(0, -w1, -w2, -w3), ca.horzcat(w1, 0, w3, -w2),
-                      ca.horzcat(w2, -w3, 0, w1), ca.horzcat(w3, w2, -w1, 0))
+def _min_energy(problem: ManeuverProblem, o, build: bool = True) -> HamiltonianSystem | str | None:
+    if problem.qf is None:
+        return "objective min_energy needs a target attitude (maneuver.final.q)"
+    if o.final_time == "minimum":
+        return "objective min_energy has a fixed final time (final_time: fixed)"
+    return MinimumEnergySystem(problem, problem.duration) if build else None
 
 
-def xi_matrix(q):
-    """``Ξ(q)`` with ``q̇ = ½ Ξ(q) ω``."""
-    q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
-    return ca.vertcat(ca.horzcat(-q1, -q2, -q3), ca.horzcat(q0, -q3, q2),
-                      ca.horzcat(q3, q0, -q1), ca.horzcat(-q2, q1, q0))
+def _rate_acquisition(problem: ManeuverProblem, o, build: bool = True) -> HamiltonianSystem | str | None:
+    if problem.omegaf is None:
+        return "objective rate_acquisition needs a target rate (maneuver.final.omega)"
+    torque = np.asarray(o.steering_torque if o.steering_torque is not None else problem.torque_limit, dtype=float)
+    if torque.shape != (3,) or not np.all(np.isfinite(torque) & (torque > 0)):
+        return (f"objective rate_acquisition needs a finite positive torque on every axis, got {torque}; "
+                "give the actuators limits or set options.steering_torque (N m per axis)")
+    if not build:
+        return None
+    return RateAcquisitionSystem(problem, problem.duration, torque, np.diag(o.weighting), o.terminal_weight,
+                                 o.final_time != "fixed")
 
 
-def skew(v):
-    return ca.vertcat(ca.horzcat(0, -v[2], v[1]), ca.horzcat(v[2], 0, -v[0]), ca.horzcat(-v[1], v[0], 0))
+def _attitude_acquisition(problem: ManeuverProblem, o, build: bool = True) -> HamiltonianSystem | str | None:
+    max_rate = o.max_rate if o.max_rate is not None else problem.max_rate
+    if max_rate is None:
+        return "objective attitude_acquisition needs a rate bound (options.max_rate or maneuver.max_rate)"
+    if problem.qf is None:
+        return "objective attitude_acquisition needs a target attitude (maneuver.final.q)"
+    if not build:
+        return None
+    return AttitudeAcquisitionSystem(problem, problem.duration, max_rate, o.terminal_weight, o.final_time != "fixed")
 
 
-class MinimumEnergySystem:
-    """The Hamiltonian system of the minimum-energy problem for one spacecraft and environment."""
-
-    def __init__(self, problem: ManeuverProblem):
-        model = problem.model
-        inertia = ca.DM(problem.spacecraft.inertia)
-        inverse = ca.DM(np.linalg.inv(problem.spacecraft.inertia))
-        t, x, lam = ca.SX.sym("t"), ca.SX.sym("x", 7), ca.SX.sym("lam", 7)
-        q, omega, lam_q, lam_w = x[0:4], x[4:7], lam[0:4], lam[4:7]
-        state = ca.vertcat(x, ca.SX.zeros(model.n_wheels))
-        gravity = model.external_torque(state, t, ca.DM(model.default_parameters))
-        u = -ca.mtimes(inverse, lam_w)
-        q_dot = 0.5 * ca.mtimes(omega_matrix(omega), q)
-        momentum = ca.mtimes(inertia, omega)
-        omega_dot = ca.mtimes(inverse, -ca.cross(omega, momentum) + u + gravity)
-        gyro_jacobian = ca.mtimes(skew(omega), inertia) - skew(momentum)  # ∂(ω × I ω)/∂ω
-        lam_q_dot = -0.5 * ca.mtimes(omega_matrix(omega).T, lam_q) \
-            - ca.mtimes(ca.jacobian(gravity, q).T, ca.mtimes(inverse, lam_w))
-        lam_w_dot = -0.5 * ca.mtimes(xi_matrix(q).T, lam_q) + ca.mtimes(gyro_jacobian.T, ca.mtimes(inverse, lam_w))
-        y = ca.vertcat(x, lam)
-        rhs = ca.vertcat(q_dot, omega_dot, lam_q_dot, lam_w_dot)
-        hamiltonian = 0.5 * ca.sumsqr(u) + ca.dot(lam_q, q_dot) + ca.dot(lam_w, omega_dot)
-        self.rhs = ca.Function("hamiltonian_rhs", [t, y], [rhs])
-        self.rhs_jacobian = ca.Function("hamiltonian_jac", [t, y], [ca.jacobian(rhs, y)])
-        self.hamiltonian = ca.Function("hamiltonian", [t, y], [hamiltonian])
-        self.control = ca.Function("control", [y], [u])
-        self.gravity = ca.Function("gravity", [t, y], [gravity])
-        self._mapped: dict[int, tuple[ca.Function, ca.Function]] = {}
-
-    def vectorised(self, t: Array, y: Array) -> tuple[Array, Array]:
-        """Right side (14, m) and its Jacobian (14, 14, m) at the columns of ``y``."""
-        m = t.size
-        if m not in self._mapped:
-            self._mapped[m] = (self.rhs.map(m), self.rhs_jacobian.map(m))
-        rhs, jac = self._mapped[m]
-        jacobian = jac(t, y).full().reshape(14, m, 14).transpose(0, 2, 1)
-        return rhs(t, y).full(), jacobian
+# objective -> builder(problem, options, build=True): the system, or the reason it cannot be built
+# (with build=False only the reason, or None: a cheap check for scenario loading).
+FORMS: dict[str, Callable[..., HamiltonianSystem | str | None]] = {
+    "min_energy": _min_energy,
+    "rate_acquisition": _rate_acquisition,
+    "attitude_acquisition": _attitude_acquisition,
+}
 
 
 class CostateReference(Reference):
-    """States from ``solve_bvp``'s C¹ cubic interpolant; torque ``u + τ_gg`` from the co-states."""
+    """States and co-states from ``solve_bvp``'s C¹ interpolant on ``[0, t_f]``."""
 
-    def __init__(self, system: MinimumEnergySystem, solution, duration: float, inertia: Array, message: str,
-                 stats: dict):
-        super().__init__("costate_tpbvp", duration, inertia, message=message, stats=stats)
+    def __init__(self, system: HamiltonianSystem, solution, duration: float, message: str, stats: dict):
+        super().__init__("costate_tpbvp", duration, system.inertia, message=message, stats=stats)
         self.system, self.solution = system, solution
 
+    def state_and_costate(self, t) -> tuple[Array, Array]:
+        """``x`` and ``λ`` at times ``t`` (clipped to ``[0, t_f]``), rows per time."""
+        y = self.solution.sol(np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration) / self.duration)
+        n = self.system.n_state
+        return y[:n].T, y[n:].T
+
     def _evaluate(self, t: Array) -> ReferenceSample:
-        y = self.solution.sol(t)
-        rhs, _ = self.system.vectorised(t, y)
-        control = self.system.control.map(t.size)(y).full()
-        gravity = self.system.gravity.map(t.size)(t, y).full()
-        return ReferenceSample(quat.normalize(y[0:4].T), y[4:7].T, rhs[4:7].T, (control + gravity).T)
+        return self.system.sample(t, self.solution.sol(t / self.duration), self.duration)
+
+
+def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, max_nodes: int,
+          guess: tuple[float, Array, Array] | None = None, min_step: float = 1e-3):
+    """Solve the TPBVP of ``system`` by adaptive continuation, starting with steps of ``1/steps``.
+
+    A failed stage is retried with half the step; a successful one lengthens the next by half.
+    Each solution is resampled on ``nodes`` points before it seeds the next stage (``solve_bvp``
+    only ever adds nodes). Returns ``(solution, t_f, stages, None)`` or ``(None, None, stages,
+    message)``. ``guess`` replaces the system's own cold start (tests use it to start far away).
+    """
+    free = system.free_final_time
+    t_f = 0.0
+
+    def fun(s, y, p=None):
+        time = system.final_time(p) if free else t_f
+        return time * system.evaluate(s * time, y, derivatives=False)[0]
+
+    def fun_jac(s, y, p=None):
+        time = system.final_time(p) if free else t_f
+        f, jac, f_t = system.evaluate(s * time, y)
+        if not free:
+            return time * jac
+        return time * jac, (f + time * s * f_t)[:, None, :]
+
+    done, step, stages, start, solution = 0.0, 1.0 / steps if system.continued else 1.0, 0, guess, None
+    while done < 1.0:
+        fraction = min(1.0, done + step)
+        t_f, s, y = start if start is not None else system.guess(nodes, fraction)
+        bc = system.boundary(fraction)
+        final = fraction == 1.0  # intermediate stages only seed the next: loose and small
+        trial = solve_bvp(fun, bc if free else (lambda ya, yb: bc(ya, yb)), s, y, p=[t_f] if free else None,
+                          fun_jac=fun_jac, tol=tolerance if final else max(tolerance, 1e-5),
+                          max_nodes=max_nodes if final else min(max_nodes, 10 * nodes))
+        stages += 1
+        if trial.status == 0 and (not free or trial.p[0] > 0):
+            solution, done, step = trial, fraction, 1.5 * step
+            t_f = float(trial.p[0]) if free else t_f
+            mesh = np.linspace(0.0, 1.0, nodes)
+            start = (t_f, mesh, trial.sol(mesh))
+            continue
+        step /= 2
+        if step < min_step:
+            detail = trial.message if trial.status != 0 else f"non-positive t_f = {trial.p[0]:.4g} s"
+            return None, None, stages, f"solve_bvp failed at continuation fraction {fraction:.3f}: {detail}"
+    return solution, t_f, stages, None
 
 
 class CostateTPBVPPlanner(Planner):
@@ -109,56 +139,47 @@ class CostateTPBVPPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
-        objective: Literal["min_energy"] = "min_energy"
-        continuation_steps: int = 3          # targets along the slerp from q0 to qf, the last one qf
-        nodes: int = 60                      # initial mesh
-        tolerance: float = 1e-8              # solve_bvp residual tolerance
-        max_nodes: int = 20000
+        objective: Literal["min_energy", "rate_acquisition", "attitude_acquisition"] = "min_energy"
+        final_time: Literal["minimum", "fixed"] | None = None   # steering forms: default minimum
+        weighting: list[float] = (1.0, 1.0, 1.0)                 # diagonal of W (eq. 34)
+        steering_torque: list[float] | None = None              # N m per axis; default the actuator limits
+        terminal_weight: float = 100.0                           # Q_f = terminal_weight · I (final_time: fixed)
+        max_rate: float | None = None                            # rad/s; default maneuver.max_rate
+        continuation_steps: int = 3                              # first step 1/continuation_steps, then adaptive
+        nodes: int = 60                                          # mesh each stage starts from
+        tolerance: float = 1e-8                                  # solve_bvp residual tolerance
+        max_nodes: int = 5000
 
         def __post_init__(self) -> None:
             if self.continuation_steps < 1 or self.nodes < 5:
                 raise ValueError("continuation_steps must be >= 1 and nodes >= 5")
+            if len(self.weighting) != 3 or min(self.weighting) <= 0:
+                raise ValueError(f"weighting must be 3 positive numbers, got {list(self.weighting)}")
+            if self.terminal_weight <= 0:
+                raise ValueError("terminal_weight must be positive")
+
+    def problem_error(self, problem: ManeuverProblem) -> str | None:
+        return FORMS[self.options.objective](problem, self.options, build=False)
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
-        system = MinimumEnergySystem(problem)
-        T = problem.duration
-        t = np.linspace(0.0, T, self.options.nodes)
-        from planners.eigenaxis import EigenaxisPlanner
+        o = self.options
+        system = FORMS[o.objective](problem, o)
+        if isinstance(system, str):
+            return FailedReference(self.name, system)
+        solution, t_f, stages, failure = solve(system, o.nodes, o.continuation_steps, o.tolerance, o.max_nodes)
+        if failure:
+            return FailedReference(self.name, f"{o.objective}: {failure}")
+        stats = {"objective_form": o.objective, "t_f": t_f, "nodes": int(solution.x.size),
+                 "max_rms_residual": float(np.max(solution.rms_residuals)), "continuation_stages": stages}
+        if system.torque_control:
+            fine = np.linspace(0.0, t_f, 4001)
+            reference = CostateReference(system, solution, t_f, "", {})
+            control = reference.sample(fine).torque - system.environment_torque(fine, reference.state_and_costate(fine)[0].T).T
+            stats["int_u2"] = float(np.trapezoid(np.sum(control**2, axis=1), fine))
+        reference = CostateReference(system, solution, t_f, "", stats)
+        timing = "minimum time" if system.free_final_time else "fixed time"
+        reference.message = (f"{o.objective} ({timing}) t_f = {t_f:.6g} s"
+                             + (f", ∫‖M_c‖² = {stats['int_u2']:.6g}" if "int_u2" in stats else "")
+                             + f" on {solution.x.size} nodes (solve_bvp)")
+        return reference
 
-        guess_reference = EigenaxisPlanner().plan(problem)
-        sample = guess_reference.sample(t)
-        gravity = system.gravity.map(t.size)(t, np.vstack([sample.q.T, sample.omega.T, np.zeros((7, t.size))])).full()
-        control = sample.torque.T - gravity
-        y = np.vstack([sample.q.T, sample.omega.T, np.zeros((4, t.size)),
-                       -problem.spacecraft.inertia @ control])
-        x0 = problem.initial_state[:7]
-        omegaf = problem.omegaf
-
-        def residual_for(target):
-            def bc(ya, yb):
-                final_rate = yb[4:7] - omegaf if omegaf is not None else yb[11:14]
-                miss = quat.product(quat.conjugate(target), yb[0:4])[1:]
-                return np.concatenate([ya[0:7] - x0, miss, [yb[7:11] @ yb[0:4]], final_rate])
-            return bc
-
-        def fun(s, ys):
-            return system.vectorised(s, ys)[0]
-
-        def fun_jac(s, ys):
-            return system.vectorised(s, ys)[1]
-
-        steps, solution = self.options.continuation_steps, None
-        for fraction in np.linspace(1.0 / steps, 1.0, steps):
-            target = quat.slerp(problem.q0, problem.qf, fraction)
-            solution = solve_bvp(fun, residual_for(target), t, y, fun_jac=fun_jac, tol=self.options.tolerance,
-                                 max_nodes=self.options.max_nodes)
-            if solution.status != 0:
-                return FailedReference(self.name, f"solve_bvp failed at continuation fraction {fraction:.2f}: "
-                                       f"{solution.message}", stats={"nodes": solution.x.size})
-            t, y = solution.x, solution.y
-        fine = np.linspace(0, T, 4001)
-        energy = float(np.trapezoid(np.sum(system.control.map(fine.size)(solution.sol(fine)).full() ** 2, axis=0), fine))
-        stats = {"int_u2": energy, "nodes": int(t.size), "rms_residual": float(np.max(solution.rms_residuals)),
-                 "continuation_steps": steps}
-        message = f"min-energy TPBVP: ∫‖u‖² = {energy:.6g} N² m² s on {t.size} nodes (solve_bvp)"
-        return CostateReference(system, solution, T, problem.spacecraft.inertia, message, stats)

@@ -28,7 +28,8 @@ from ocp import quat_casadi as qc
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
 
-QUADRATURE_POINTS = 41
+QUADRATURE_POINTS = 41  # uniform grid of the torque cost
+GAUSS_POINTS = 16       # Gauss-Legendre points of the path cost (exact for degree 31)
 
 
 def shape_basis(tau, terms: int, math=np):
@@ -65,9 +66,13 @@ def _solver(terms: int, cost: str) -> ca.Function:
     p = ca.SX.sym("p", 26)
     q0, q1, s0, s1 = p[0:4], p[4:8], p[8:12], p[12:16]
     inertia, duration = ca.reshape(p[16:25], 3, 3), p[25]
-    taus = np.linspace(0, 1, QUADRATURE_POINTS)
-    weights = np.full(QUADRATURE_POINTS, 1.0 / (QUADRATURE_POINTS - 1))
-    weights[[0, -1]] /= 2
+    if cost == "path":  # Gauss-Legendre: the integrand is smooth, so few points are exact enough
+        nodes, gauss_weights = np.polynomial.legendre.leggauss(GAUSS_POINTS)
+        taus, weights = 0.5 * (nodes + 1), 0.5 * gauss_weights
+    else:  # a uniform grid, on which the torque's rate derivative is differenced
+        taus = np.linspace(0, 1, QUADRATURE_POINTS)
+        weights = np.full(QUADRATURE_POINTS, 1.0 / (QUADRATURE_POINTS - 1))
+        weights[[0, -1]] /= 2
     total = 0
     rates, norms = [], []
     for tau, w in zip(taus, weights):

@@ -164,8 +164,11 @@ def parse_problem(node: Node, spacecraft: Spacecraft, environment: Environment) 
     node.mapping()
     order = node.get("quaternion_order", "scalar_first").string(("scalar_first", "scalar_last"))
 
-    def attitude(parent: Node) -> np.ndarray:
-        q = parent.get("q", required=True).quaternion()
+    def attitude(parent: Node, free: bool = False) -> np.ndarray | None:
+        node = parent.get("q", required=True)
+        if free and node.is_null():  # final attitude written as null: free
+            return None
+        q = node.quaternion()
         return quat.from_scalar_last(q) if order == "scalar_last" else q
 
     initial = node.get("initial", required=True).mapping()
@@ -174,7 +177,7 @@ def parse_problem(node: Node, spacecraft: Spacecraft, environment: Environment) 
     problem = ManeuverProblem(
         spacecraft=spacecraft, environment=environment,
         q0=attitude(initial), omega0=initial.get("omega", [0.0, 0.0, 0.0]).vector(3),
-        qf=attitude(final), omegaf=final.get("omega", None).optional_vector(3),
+        qf=attitude(final, free=True), omegaf=final.get("omega", None).optional_vector(3),
         duration=node.get("duration", required=True).number(positive=True),
         wheel_momentum0=momentum, max_rate=node.get("max_rate", None).optional_number(positive=True),
     )
@@ -238,6 +241,24 @@ def parse_simulation(node: Node) -> SimulationSpec:
     return spec
 
 
+def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
+                        controller: ControllerSpec) -> None:
+    """What each planner and the controller say they cannot take, reported at their YAML entries."""
+    for index, spec in enumerate(planners):
+        error = PLANNERS[spec.name](spec.options).problem_error(problem)
+        if error:
+            raise ScenarioError(f"planners[{index}]", error)
+    if not planners and problem.qf is None:
+        raise ScenarioError("maneuver.final.q", "regulation (no planners) needs a target attitude")
+    law = CONTROLLERS[controller.name](controller.options)
+    if not planners and law.needs_reference:
+        raise ScenarioError("controller.name", f"controller {controller.name} tracks a reference; give planners")
+    for index, spec in enumerate(planners):
+        error = law.planner_error(spec.name, spec.options)
+        if error:
+            raise ScenarioError("controller.name", f"{error} (planners[{index}] is {spec.name!r})")
+
+
 def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     """Build a :class:`Scenario` from parsed YAML data."""
     root = Node(data).mapping()
@@ -249,6 +270,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     controller = parse_controller(root.get("controller", required=True))
     simulation = parse_simulation(root.get("simulation", {}))
     root.finish()
+    check_compatibility(problem, planners, controller)
     return Scenario(name, problem, planners, controller, simulation, source)
 
 

@@ -37,8 +37,9 @@ def plot_row(row, target_q, path: Path) -> None:
         axes[2].plot(t, sim.q[:, i], color=AXIS_COLORS[i], label=f"q{i}")
         if ref is not None:
             axes[2].plot(t, ref.q[:, i], "--", color=AXIS_COLORS[i], lw=1)
-    to_target = np.rad2deg(quat.error_angle(sim.q, target_q))
-    axes[3].semilogy(t, np.maximum(to_target, 1e-9), color="k", label="to target")
+    if target_q is not None:
+        to_target = np.rad2deg(quat.error_angle(sim.q, target_q))
+        axes[3].semilogy(t, np.maximum(to_target, 1e-9), color="k", label="to target")
     if ref is not None:
         axes[3].semilogy(t, np.maximum(np.rad2deg(quat.error_angle(sim.q, ref.q)), 1e-9), color="tab:orange",
                          label="to reference")
@@ -84,7 +85,8 @@ def plot_cones(row, path: Path) -> None:
 
 
 def plot_overlay(results, path: Path) -> None:
-    target_q = results.scenario.problem.qf
+    """Torque norm, and the error to the target attitude (to the target rate when the attitude is free)."""
+    target_q, target_omega = results.scenario.problem.qf, results.scenario.problem.omegaf
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
     for row in results.rows:
         if row.simulation is None:
@@ -92,9 +94,11 @@ def plot_overlay(results, path: Path) -> None:
         sim = row.simulation
         norm = np.linalg.norm(sim.applied_torque, axis=1)
         top.step(sim.t, np.r_[norm, norm[-1]], where="post", label=row.label)
-        bottom.semilogy(sim.t, np.maximum(np.rad2deg(quat.error_angle(sim.q, target_q)), 1e-9), label=row.label)
+        error = (np.rad2deg(quat.error_angle(sim.q, target_q)) if target_q is not None
+                 else np.linalg.norm(sim.omega - target_omega, axis=1))
+        bottom.semilogy(sim.t, np.maximum(error, 1e-9), label=row.label)
     top.set_ylabel("‖u‖ (N m)")
-    bottom.set_ylabel("error to target (deg)")
+    bottom.set_ylabel("error to target (deg)" if target_q is not None else "‖ω − ω_f‖ (rad/s)")
     bottom.set_xlabel("time (s)")
     for axis in (top, bottom):
         axis.grid(alpha=0.3)

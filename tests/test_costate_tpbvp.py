@@ -1,34 +1,57 @@
-"""Indirect minimum-energy planner: co-states against automatic differentiation, and the optimum
-against the direct collocation planner (the cross-method oracle)."""
+"""Indirect (co-state) planner, every problem form: co-states against automatic differentiation,
+minimum energy against the collocation planner, minimum-time rate acquisition against closed
+forms and a direct transcription, attitude acquisition against the geodesic."""
 import casadi as ca
 import numpy as np
 import pytest
 
-from ocp import CircularOrbit, Environment, Spacecraft, Torquers, quat
+from ocp import CircularOrbit, Environment, Simulator, Spacecraft, Torquers, quat
+from ocp.actuators import Command
+from ocp.integration import rk4_step
 from planners import PLANNERS, ManeuverProblem
-from planners.costate_tpbvp import MinimumEnergySystem
+from planners.costate_systems import AttitudeAcquisitionSystem, MinimumEnergySystem, RateAcquisitionSystem
+from planners.costate_tpbvp import solve
 
 INERTIA = [[10.0, 0.5, 0.2], [0.5, 8.0, 0.3], [0.2, 0.3, 6.0]]
+GRAVITY = Environment(CircularOrbit(500e3, 0.9), gravity_gradient=True)
 
 
-def problem(gravity_gradient=False):
-    environment = Environment(CircularOrbit(500e3, 0.9), gravity_gradient=True) if gravity_gradient else Environment()
-    spacecraft = Spacecraft(INERTIA, torquers=Torquers(10.0))  # bounds far away: the unconstrained optimum
-    return ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.normalize([0.3, 0.5, -0.6, 0.4]), 120.0,
-                           omegaf=np.zeros(3), environment=environment)
+def problem(gravity_gradient=False, inertia=INERTIA, **changes):
+    spacecraft = Spacecraft(inertia, torquers=Torquers(10.0))  # bounds far away: the unconstrained optimum
+    arguments = dict(q0=quat.IDENTITY, omega0=np.zeros(3), qf=quat.normalize([0.3, 0.5, -0.6, 0.4]),
+                     duration=120.0, omegaf=np.zeros(3), environment=GRAVITY if gravity_gradient else Environment())
+    arguments.update(changes)
+    return ManeuverProblem(spacecraft, **arguments)
 
 
-def test_costate_equations_are_minus_the_gradient_of_the_hamiltonian(rng):
-    system = MinimumEnergySystem(problem(gravity_gradient=True))
-    t, y = ca.SX.sym("t"), ca.SX.sym("y", 14)
-    gradient = ca.Function("dH", [t, y], [ca.gradient(system.hamiltonian(t, y), y)])
+STEERING_TORQUE, WEIGHTING = np.array([0.3, 0.5, 0.4]), np.diag([0.24, 0.9, 1.0])
+SYSTEMS = {
+    "min_energy": lambda p: MinimumEnergySystem(p, p.duration),
+    "rate_acquisition, minimum time": lambda p: RateAcquisitionSystem(p, p.duration, STEERING_TORQUE, WEIGHTING, 100.0, True),
+    "rate_acquisition, fixed time": lambda p: RateAcquisitionSystem(p, p.duration, STEERING_TORQUE, WEIGHTING, 100.0, False),
+    "attitude_acquisition": lambda p: AttitudeAcquisitionSystem(p, p.duration, 1e-3, 100.0, True),
+}
+
+
+@pytest.mark.parametrize("form", SYSTEMS)
+def test_costate_equations_are_minus_the_gradient_of_the_hamiltonian(form, rng):
+    system = SYSTEMS[form](problem(gravity_gradient=True, omega0=np.array([0.01, -0.02, 0.03]), omegaf=np.ones(3)))
+    n = system.n_state
+    t, y, u = ca.SX.sym("t"), ca.SX.sym("y", 2 * n), ca.SX.sym("u", 3)
+    gradient = ca.Function("dH", [t, y, u], [ca.gradient(system.hamiltonian(t, y, u), y)])
     for _ in range(20):
-        point = np.r_[quat.random_unit(rng), rng.normal(0, 0.1, 3), rng.normal(0, 1, 7)]
+        point = np.r_[quat.random_unit(rng), rng.normal(0, 0.1, n - 4), rng.normal(0, 1, n)]
         time = rng.uniform(0, 5000)
+        optimal = system.control(point).full().ravel()
         rhs = system.rhs(time, point).full().ravel()
-        dh = gradient(time, point).full().ravel()
-        np.testing.assert_allclose(rhs[7:], -dh[:7], rtol=1e-10, atol=1e-14)   # λ̇ = −∂H/∂x
-        np.testing.assert_allclose(rhs[:7], dh[7:], rtol=1e-10, atol=1e-14)    # ẋ = ∂H/∂λ
+        dh = gradient(time, point, optimal).full().ravel()
+        np.testing.assert_allclose(rhs[n:], -dh[:n], rtol=1e-10, atol=1e-12)   # λ̇ = −∂H/∂x
+        np.testing.assert_allclose(rhs[:n], dh[n:], rtol=1e-10, atol=1e-12)    # ẋ = ∂H/∂λ
+        # u* minimises H: over the unit sphere for the steering forms, everywhere for min energy.
+        h_optimal = float(system.hamiltonian(time, point, optimal))
+        for trial in rng.normal(size=(50, 3)):
+            trial = trial / np.linalg.norm(trial) if form != "min_energy" else optimal + trial
+            assert float(system.hamiltonian(time, point, trial)) >= h_optimal - 1e-12
 
 
 @pytest.mark.parametrize("gravity_gradient", [False, True])
@@ -41,3 +64,150 @@ def test_indirect_and_direct_minimum_energy_agree(gravity_gradient):
     assert np.rad2deg(quat.error_angle(indirect.q(120.0), case.qf)) < 1e-6
     t = np.linspace(0, 120, 61)
     assert np.max(quat.error_angle(indirect.q(t), direct.q(t))) < np.deg2rad(0.01)
+
+
+def perturbed_guess(system, rng, scale=0.3):
+    """The system's own start, with t_f and the co-states disturbed, so the solver has work to do."""
+    t_f, s, y = system.guess(40, 1.0)
+    y = y.copy()
+    y[system.n_state:] *= 1 + scale * rng.normal(size=(system.n_state, 1))
+    return t_f * (1 + scale), s, y
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_minimum_time_rate_acquisition_on_a_spherical_body_is_the_straight_line(seed):
+    # Without gyroscopic or gravity torque ω̇ = G u, ‖u‖ = 1: the reachable set at t is ω0 + t G B,
+    # so the minimum time is ‖G⁻¹ Δω‖ and ω runs straight at constant speed.
+    rng = np.random.default_rng(seed)
+    case = problem(inertia=np.eye(3) * rng.uniform(1, 5), omega0=rng.normal(0, 0.1, 3), omegaf=rng.normal(0, 0.3, 3))
+    torque, weighting = rng.uniform(0.1, 1.0, 3), np.diag(rng.uniform(0.2, 1.0, 3))
+    system = RateAcquisitionSystem(case, case.duration, torque, weighting, 100.0, True)
+    solution, t_f, _, failure = solve(system, 40, 1, 1e-8, 5000, guess=perturbed_guess(system, rng))
+    assert failure is None, failure
+    steering = np.linalg.solve(case.spacecraft.inertia, np.diag(torque) @ weighting)
+    assert t_f == pytest.approx(np.linalg.norm(np.linalg.solve(steering, case.omegaf - case.omega0)), rel=1e-7)
+    s = np.linspace(0, 1, 11)
+    line = case.omega0[:, None] + s * (case.omegaf - case.omega0)[:, None]
+    np.testing.assert_allclose(solution.sol(s)[4:7], line, atol=1e-7)
+
+
+def direct_minimum_time(case, torque_map, intervals=80):
+    """Minimum-time rate acquisition by multiple shooting (RK4, IPOPT), written here on the model's
+    right-hand side: an independent second method for the indirect solution."""
+    model, p = case.model, case.model.default_parameters
+    opti = ca.Opti()
+    X, U, T = opti.variable(7, intervals + 1), opti.variable(3, intervals), opti.variable()
+    h = T / intervals
+    for k in range(intervals):
+        step = rk4_step(lambda x, t: model.rhs(x, ca.mtimes(ca.DM(torque_map), U[:, k]), t, p), X[:, k], k * h, h)
+        opti.subject_to(X[:, k + 1] == step)
+        opti.subject_to(ca.sumsqr(U[:, k]) <= 1)
+    opti.subject_to(X[:, 0] == case.initial_state[:7])
+    opti.subject_to(X[4:7, -1] == case.omegaf)
+    opti.subject_to(T >= 0.1)
+    opti.minimize(T)
+    s = np.linspace(0, 1, intervals + 1)
+    opti.set_initial(X[0:4, :], np.repeat(case.q0[:, None], intervals + 1, axis=1))
+    opti.set_initial(X[4:7, :], case.omega0[:, None] + s * (case.omegaf - case.omega0)[:, None])
+    opti.set_initial(U, np.repeat([[0.5], [0.5], [0.5]], intervals, axis=1))
+    opti.set_initial(T, 5.0)
+    opti.solver("ipopt", {"print_time": False}, {"print_level": 0, "sb": "yes", "tol": 1e-10})
+    return float(opti.solve().value(T))
+
+
+@pytest.mark.parametrize("seed", [4, 5])
+def test_minimum_time_rate_acquisition_matches_a_direct_method_and_replays(seed):
+    rng = np.random.default_rng(seed)
+    principal = rng.uniform(2.0, 4.0, 3)
+    rotation = quat.rotation_matrix(quat.random_unit(rng))
+    case = problem(gravity_gradient=True, inertia=rotation @ np.diag(principal) @ rotation.T,
+                   omegaf=rng.uniform(-0.6, 0.6, 3), duration=5.0)
+    planner = PLANNERS["costate_tpbvp"]({"objective": "rate_acquisition", "steering_torque": [0.3, 0.5, 0.4],
+                                          "weighting": [0.24, 0.9, 1.0]})
+    reference = planner.plan(case)
+    assert reference.ok, reference.message
+    torque_map = np.diag(STEERING_TORQUE) @ WEIGHTING
+    direct = direct_minimum_time(case, torque_map)
+    assert reference.duration == pytest.approx(direct, rel=2e-4)
+    # The steering torque has unit size in the W-weighted sense, at every time.
+    t = np.linspace(0, reference.duration, 201)
+    control = reference.sample(t).torque - reference.system.environment_torque(t, reference.state_and_costate(t)[0].T).T
+    np.testing.assert_allclose(np.linalg.norm(np.linalg.solve(torque_map, control.T), axis=0), 1.0, atol=1e-6)
+
+    class Replay:  # the reference's control torque, held over 1 ms samples, open loop
+        def reset(self, spacecraft, sample_time, target=None):
+            pass
+
+        def __call__(self, time, measurement, _):
+            lam_omega = reference.state_and_costate(time + 5e-4)[1][0, 4:7]
+            return Command(torque=reference.system.feedback_torque(lam_omega, lam_omega))
+
+    result = Simulator(case.model, 1e-3, "rk4", max_step=1e-3).run(Replay(), case.initial_state, reference.duration)
+    assert np.linalg.norm(result.omega[-1] - case.omegaf) < 2e-3 * np.linalg.norm(case.omegaf)
+
+
+def test_fixed_time_rate_acquisition_stops_short_on_the_line():
+    # T below the minimum time: the terminal cost (eq. 23) is least at the reachable point nearest
+    # ω_d, which for an isotropic steering map is on the straight line, T/t_min of the way.
+    case = problem(inertia=np.eye(3) * 2.0, omegaf=np.array([0.3, -0.2, 0.5]), duration=1.0)
+    system = RateAcquisitionSystem(case, 1.0, np.full(3, 0.4), np.eye(3), 100.0, True)
+    t_min = system.minimum_time_estimate()
+    case = problem(inertia=np.eye(3) * 2.0, omegaf=case.omegaf, duration=0.6 * t_min)
+    reference = PLANNERS["costate_tpbvp"]({"objective": "rate_acquisition", "final_time": "fixed",
+                                           "steering_torque": [0.4, 0.4, 0.4]}).plan(case)
+    assert reference.ok, reference.message
+    np.testing.assert_allclose(reference.omega(reference.duration), 0.6 * case.omegaf, atol=1e-7)
+
+
+@pytest.mark.parametrize("seed", [6, 7, 8])
+def test_minimum_time_attitude_acquisition_is_the_constant_rate_geodesic(seed):
+    rng = np.random.default_rng(seed)
+    case = problem(gravity_gradient=True, q0=quat.random_unit(rng), qf=quat.random_unit(rng), max_rate=1e-3)
+    system = AttitudeAcquisitionSystem(case, case.duration, 1e-3, 100.0, True)
+    solution, t_f, _, failure = solve(system, 40, 1, 1e-9, 5000, guess=perturbed_guess(system, rng, 0.2))
+    assert failure is None, failure
+    angle = quat.error_angle(case.q0, case.qf)
+    assert t_f == pytest.approx(angle / 1e-3, rel=1e-7)
+    s = np.linspace(0, 1, 21)
+    assert np.max(quat.error_angle(solution.sol(s)[0:4].T, quat.slerp(case.q0, case.qf, s))) < 1e-7
+
+
+def test_fixed_time_attitude_acquisition_stops_on_the_geodesic():
+    case = problem(max_rate=2e-3)
+    angle = quat.error_angle(case.q0, case.qf)
+    case = problem(max_rate=2e-3, duration=0.7 * angle / 2e-3)
+    reference = PLANNERS["costate_tpbvp"]({"objective": "attitude_acquisition", "final_time": "fixed"}).plan(case)
+    assert reference.ok, reference.message
+    assert quat.error_angle(reference.q(case.duration), quat.slerp(case.q0, case.qf, 0.7)) < 1e-7
+    rates = np.linalg.norm(reference.omega(np.linspace(0, case.duration, 11)), axis=1)
+    np.testing.assert_allclose(rates, [0] + [2e-3] * 9 + [0], atol=1e-12)  # at rest only at the ends
+
+
+@pytest.mark.parametrize("options, changes, needle", [
+    ({"objective": "rate_acquisition"}, {"omegaf": None}, "needs a target rate"),
+    ({"objective": "attitude_acquisition"}, {}, "needs a rate bound"),
+    ({"objective": "min_energy", "final_time": "minimum"}, {}, "fixed final time"),
+])
+def test_missing_problem_data_is_a_failed_reference(options, changes, needle):
+    reference = PLANNERS["costate_tpbvp"](options).plan(problem(**changes))
+    assert reference.status == "failed" and needle in reference.message
+
+
+def test_vepa_attitude_acquisition_scenario():
+    # Vepa section 8, final example. Physically checkable facts: no path with ‖ω‖ <= ω_max beats the
+    # eigenaxis rotation at ω_max (θ/ω_max), the co-state solution attains it, the shape-based
+    # polynomials cannot (they must start and stop at rest), and their torques are much larger.
+    from pathlib import Path
+
+    from scenarios.loader import load
+
+    scenario = load(Path(__file__).resolve().parents[1] / "scenarios" / "vepa_attitude_acquisition.yaml")
+    case = scenario.problem
+    bound = quat.error_angle(case.q0, case.qf) / case.max_rate
+    costate, shape = (PLANNERS[spec.name](spec.options).plan(case) for spec in scenario.planners[:2])
+    assert costate.ok and shape.ok, (costate.message, shape.message)
+    assert costate.duration == pytest.approx(bound, rel=1e-9)
+    assert shape.duration > bound
+    t = np.linspace(0, 1, 2001)
+    peak = [np.max(np.abs(reference.torque(t * reference.duration))) for reference in (costate, shape)]
+    assert peak[1] > 10 * peak[0]

@@ -59,6 +59,10 @@ def test_every_controller_honours_the_contract(name, rng):
     assert controller.name == name
     controller.reset(spacecraft, 0.5, target=(quat.random_unit(rng), None))
     measurement = Measurement(0.0, quat.random_unit(rng), rng.normal(0, 0.01, 3), np.zeros(3))
+    if controller.needs_reference:  # no regulation mode: a clear error instead
+        with pytest.raises(ValueError, match="needs"):
+            controller(0.0, measurement, None)
+        return
     command = controller(0.0, measurement, None)
     assert isinstance(command, Command)
 

@@ -58,3 +58,17 @@ def test_shape_polynomial_vepa_case(benchmark):
     planner.plan(problem)  # builds the six IPOPT solvers once
     reference = benchmark(planner.plan, problem)
     assert reference.status == "ok"
+
+
+@pytest.mark.parametrize("scenario", ["vepa_spin_up", "vepa_attitude_acquisition"])
+def test_costate_tpbvp_vepa_cases(benchmark, scenario):
+    # Issue 7 target: a TPBVP solve in at most 2 s (each call builds its CasADi functions anew).
+    from pathlib import Path
+
+    from scenarios.loader import load
+
+    spec_scenario = load(Path(__file__).resolve().parents[2] / "scenarios" / f"{scenario}.yaml")
+    spec = spec_scenario.planners[0]
+    planner = PLANNERS[spec.name](spec.options)
+    reference = benchmark(planner.plan, spec_scenario.problem)
+    assert reference.status == "ok"

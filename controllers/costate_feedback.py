@@ -1,0 +1,121 @@
+"""Co-state feedback (Vepa section 4, eq. 40-42): the optimal control of an indirect reference as
+a feedback law.
+
+Locally ``λ ≈ P x`` (eq. 40), with ``x = [q, ω]`` and ``P`` slowly varying. At each sample ``P`` is
+fitted to the reference's states and co-states at ``window_samples`` times ``window_step`` apart
+(the paper's ``t − nΔt``, n = 0…4; the window is shifted to stay inside ``[0, t_f]``), by least
+squares constrained to symmetric non-negative definite matrices (eq. 42, second part):
+
+    min ½ Σ_k ‖P x_k − λ_k‖² + ½ ρ ‖P‖²_F   subject to  P = Pᵀ ⪰ 0,
+
+solved by accelerated projected gradient, warm-started from the previous sample. The window's
+states span few directions; the small ridge ``ρ`` (relative to the data) gives the minimum-norm
+answer in the others. The control is the reference's optimal control law evaluated at the
+estimated co-state ``λ̂ = λ_ref + P (x − x_ref)`` (eq. 41-42); for the steering form that is
+``u = −r⁻¹ Gᵀ λ̂_ω`` with ``r`` taken on the reference. After ``t_f`` the law applies no torque.
+It tracks references of ``costate_tpbvp`` forms whose control is a torque.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from controllers.base import Array, Controller
+from ocp import Command, Measurement
+
+TORQUE_FORMS = ("min_energy", "rate_acquisition")
+
+
+def project_psd(matrix: Array) -> Array:
+    """Nearest symmetric non-negative definite matrix in the Frobenius norm."""
+    values, vectors = np.linalg.eigh(0.5 * (matrix + matrix.T))
+    return (vectors * np.maximum(values, 0.0)) @ vectors.T
+
+
+def fit_costate_gain(states: Array, costates: Array, ridge: float = 1e-4, start: Array | None = None,
+                     iterations: int = 200, tolerance: float = 1e-9) -> Array:
+    """Symmetric non-negative definite ``P`` with ``P x_k ≈ λ_k`` for rows ``x_k``, ``λ_k``.
+
+    The symmetric least-squares problem has a closed form in the eigenbasis of ``G = Σ x_k x_kᵀ``:
+    ``P̃_ij = C̃_ij / ((d_i + d_j)/2 + ρ)`` with ``C = sym(Σ λ_k x_kᵀ)``. If that is not
+    non-negative definite, accelerated projected gradient takes over from its projection
+    (from ``start`` if given). ``ridge`` is relative to the largest eigenvalue of ``G``.
+    """
+    X, L = np.asarray(states, dtype=float).T, np.asarray(costates, dtype=float).T
+    gram = X @ X.T
+    d, V = np.linalg.eigh(gram)
+    rho = ridge * max(d[-1], 1e-300)
+    cross = L @ X.T
+    rotated = V.T @ (0.5 * (cross + cross.T)) @ V
+    P = V @ (rotated / (0.5 * (d[:, None] + d[None, :]) + rho)) @ V.T
+    if np.linalg.eigvalsh(P)[0] >= 0:
+        return P
+    lipschitz = d[-1] + rho
+    P = project_psd(P if start is None else start)
+    Y, momentum = P.copy(), 1.0
+    for _ in range(iterations):
+        gradient = Y @ gram - cross + rho * Y
+        P_next = project_psd(Y - 0.5 * (gradient + gradient.T) / lipschitz)
+        momentum_next = 0.5 * (1 + np.sqrt(1 + 4 * momentum**2))
+        Y = P_next + (momentum - 1) / momentum_next * (P_next - P)
+        change = np.linalg.norm(P_next - P)
+        P, momentum = P_next, momentum_next
+        if change <= tolerance * max(np.linalg.norm(P), 1e-300):
+            break
+    return P
+
+
+class CostateFeedback(Controller):
+    """Vepa's co-state feedback law (see the module docstring)."""
+
+    name = "costate_feedback"
+    hold_compensation = False  # the law is not of the ``u + ω × Iω`` form the correction is for
+    needs_reference = True
+
+    @dataclass(frozen=True)
+    class Options:
+        window_samples: int = 5           # fit points t − nΔt, n = 0 … window_samples − 1
+        window_step: float | None = None  # Δt (s); default the sample time
+        ridge: float = 1e-4               # relative Tikhonov weight of the fit
+
+        def __post_init__(self) -> None:
+            if self.window_samples < 2:
+                raise ValueError("window_samples must be at least 2")
+            if self.window_step is not None and self.window_step <= 0:
+                raise ValueError("window_step must be positive")
+            if self.ridge < 0:
+                raise ValueError("ridge must be non-negative")
+
+    def planner_error(self, planner: str, options: Any) -> str | None:
+        if planner != "costate_tpbvp" or getattr(options, "objective", None) not in TORQUE_FORMS:
+            return (f"controller {self.name} tracks costate_tpbvp references whose control is a torque "
+                    f"(objective one of {list(TORQUE_FORMS)})")
+        return None
+
+    def reset(self, spacecraft, sample_time, target=None) -> None:
+        super().reset(spacecraft, sample_time, target)
+        self.gain: Array | None = None
+        self.gains: list[tuple[float, Array]] = []  # (t, P) per sample, for inspection
+
+    def window(self, t: float, duration: float) -> Array:
+        """Fit times (s): ``t − nΔt``, shifted to lie in ``[0, duration]``."""
+        step = self.options.window_step or self.sample_time
+        span = step * (self.options.window_samples - 1)
+        first = min(max(t - span, 0.0), max(duration - span, 0.0))
+        return first + step * np.arange(self.options.window_samples)
+
+    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
+        if reference is None or not hasattr(reference, "state_and_costate"):
+            raise ValueError(f"controller {self.name} needs a costate_tpbvp reference")
+        if t >= reference.duration:
+            return self.allocate(np.zeros(3), measurement)
+        states, costates = reference.state_and_costate(self.window(t, reference.duration))
+        self.gain = fit_costate_gain(states, costates, self.options.ridge, start=self.gain)
+        self.gains.append((t, self.gain))
+        x_ref, lam_ref = (a[0] for a in reference.state_and_costate(t))
+        q = measurement.q if measurement.q @ x_ref[0:4] >= 0 else -measurement.q  # same hemisphere
+        lam = lam_ref + self.gain @ (np.concatenate([q, measurement.omega]) - x_ref)
+        torque = reference.system.feedback_torque(lam[4:7], lam_ref[4:7])
+        return self.allocate(torque, measurement)
