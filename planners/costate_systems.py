@@ -70,7 +70,8 @@ class HamiltonianSystem(ABC):
         self.rhs = ca.Function("hamiltonian_rhs", [t, y], [rhs])
         self.hamiltonian = ca.Function("hamiltonian", [t, y, u], [hamiltonian])
         self.control = ca.Function("control", [y], [control])
-        self.derivatives = ca.Function("rhs_derivatives", [t, y], [ca.densify(ca.jacobian(rhs, y)), ca.densify(ca.jacobian(rhs, t))])
+        self.derivatives = ca.Function("rhs_derivatives", [t, y],
+                                       [rhs, ca.densify(ca.jacobian(rhs, y)), ca.densify(ca.jacobian(rhs, t))])
         self._mapped: dict[tuple[int, bool], BufferedFunction] = {}
 
     @abstractmethod
@@ -102,11 +103,10 @@ class HamiltonianSystem(ABC):
         times, states = np.pad(t, (0, pad), mode="edge"), np.pad(y, ((0, 0), (0, pad)), mode="edge")
         if not derivatives:
             return self._mapped[key](times, states.ravel(order="F")).reshape(width, n)[:m].T.copy(), None, None
-        jac, f_t = self._mapped[key].all_outputs(times, states.ravel(order="F"))
-        jac = jac.reshape(width, n, n)[:m].transpose(2, 1, 0)   # blocks (n x n) column-major, per time
-        f_t = f_t.reshape(width, n)[:m].T.copy()
-        f = self.evaluate(t, y, derivatives=False)[0]
-        return f, jac.copy(), f_t
+        f, jac, f_t = self._mapped[key].all_outputs(times, states.ravel(order="F"))
+        f = f.reshape(width, n)[:m].T.copy()
+        jac = jac.reshape(width, n, n)[:m].transpose(2, 1, 0).copy()  # blocks (n x n) column-major, per time
+        return f, jac, f_t.reshape(width, n)[:m].T.copy()
 
     def hamiltonian_at(self, t: float, y: Array) -> float:
         """``H`` at the optimal control."""
@@ -157,7 +157,7 @@ class _RigidBodySystem(HamiltonianSystem):
         return rhs, hamiltonian, optimal
 
     def sample(self, t: Array, y: Array, t_f: float) -> ReferenceSample:
-        f, _, _ = self.evaluate(t, y)
+        f, _, _ = self.evaluate(t, y, derivatives=False)
         omega = y[4:7].T
         return ReferenceSample(quat.normalize(y[0:4].T), omega, f[4:7].T,
                                inverse_dynamics_torque(self.inertia, omega, f[4:7].T))
