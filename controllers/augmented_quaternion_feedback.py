@@ -11,12 +11,13 @@ corrects the held gyroscopic term to mid-sample). With it the closed loop obeys
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
 
-from controllers.base import Array, Controller, gain_matrix
+from controllers.base import Array, Controller, check_gain, gain_matrix
 from ocp import Command, Measurement, quat
+from ocp.options import Range
 
 
 class AugmentedQuaternionFeedback(Controller):
@@ -26,10 +27,14 @@ class AugmentedQuaternionFeedback(Controller):
 
     @dataclass(frozen=True)
     class Options:
-        kp: float | list[list[float]] = 0.06       # 1/s² times inertia (spin paper "medium" gains)
-        kd: float | list[list[float]] = 0.48       # 1/s times inertia
+        kp: Annotated[float | list[list[float]], Range(shape=(3, 3))] = 0.06       # 1/s² times inertia (spin paper "medium" gains)
+        kd: Annotated[float | list[list[float]], Range(shape=(3, 3))] = 0.48       # 1/s times inertia
         feedforward: bool = True                    # the I ω̇* term of eq. 38
         hold_compensation: bool = True              # gyroscopic term at mid-sample (Controller.allocate)
+
+        def __post_init__(self) -> None:
+            check_gain("kp", self.kp)
+            check_gain("kd", self.kd)
 
     def reset(self, spacecraft, sample_time, target=None) -> None:
         super().reset(spacecraft, sample_time, target)

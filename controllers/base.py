@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ocp import Command, Measurement, Spacecraft
-from ocp.options import Configurable
+from ocp.options import Configurable, InvalidOption
 
 Array = NDArray[np.float64]
 
@@ -97,6 +97,24 @@ class Controller(Configurable, ABC):
             field = measurement.field_body
             command.dipole = np.cross(field, residual) / max(float(field @ field), 1e-30)
         return command
+
+
+def check_gain(option: str, gain: float | list[list[float]]) -> None:
+    """Raise :class:`~ocp.options.InvalidOption` unless ``gain`` is a non-negative scalar or a 3x3
+    matrix whose symmetric part is positive semi-definite (a gain that pumps energy in is an error).
+
+    Parameters
+    ----------
+    option : the option's name, for the message.
+    gain : the scalar (times the inertia) or the 3x3 matrix.
+    """
+    if isinstance(gain, (int, float)):
+        if gain < 0:
+            raise InvalidOption(option, f"expected a non-negative gain, got {gain!r}")
+        return
+    matrix = np.asarray(gain, dtype=float)
+    if np.linalg.eigvalsh(0.5 * (matrix + matrix.T)).min() < -1e-12 * max(1.0, float(np.abs(matrix).max())):
+        raise InvalidOption(option, "expected a 3x3 gain matrix with a positive semi-definite symmetric part")
 
 
 def gain_matrix(gain: float | list[list[float]], inertia: Array) -> Array:

@@ -18,12 +18,13 @@ It tracks references of ``costate_tpbvp`` forms whose control is a torque.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
 
 from controllers.base import Array, Controller
 from ocp import Command, Measurement
+from ocp.options import Range
 
 TORQUE_FORMS = ("min_energy", "rate_acquisition")
 
@@ -76,17 +77,9 @@ class CostateFeedback(Controller):
 
     @dataclass(frozen=True)
     class Options:
-        window_samples: int = 5           # fit points t − nΔt, n = 0 … window_samples − 1
-        window_step: float | None = None  # Δt (s); default the sample time
-        ridge: float = 1e-4               # relative Tikhonov weight of the fit
-
-        def __post_init__(self) -> None:
-            if self.window_samples < 2:
-                raise ValueError("window_samples must be at least 2")
-            if self.window_step is not None and self.window_step <= 0:
-                raise ValueError("window_step must be positive")
-            if self.ridge < 0:
-                raise ValueError("ridge must be non-negative")
+        window_samples: Annotated[int, Range(ge=2, le=1000)] = 5           # fit points t − nΔt, n = 0 … window_samples − 1
+        window_step: Annotated[float | None, Range(gt=0.0)] = None  # Δt (s); default the sample time
+        ridge: Annotated[float, Range(ge=0.0)] = 1e-4               # relative Tikhonov weight of the fit
 
     def planner_error(self, planner: str, options: Any) -> str | None:
         if planner != "costate_tpbvp" or getattr(options, "objective", None) not in TORQUE_FORMS:

@@ -7,10 +7,12 @@ slew stays on the eigenaxis, because ``q_e`` and ``ω`` remain parallel.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Annotated, Any
 
 from controllers.augmented_quaternion_feedback import AugmentedQuaternionFeedback
+from controllers.base import check_gain
 from ocp import Command, Measurement
+from ocp.options import Range
 
 
 class EigenaxisPD(AugmentedQuaternionFeedback):
@@ -20,10 +22,14 @@ class EigenaxisPD(AugmentedQuaternionFeedback):
 
     @dataclass(frozen=True)
     class Options:
-        kp: float | list[list[float]] = 0.06
-        kd: float | list[list[float]] = 0.48
+        kp: Annotated[float | list[list[float]], Range(shape=(3, 3))] = 0.06
+        kd: Annotated[float | list[list[float]], Range(shape=(3, 3))] = 0.48
         feedforward: bool = False  # eq. 39 has none; kept so the parent's law is reused as is
         hold_compensation: bool = True
+
+        def __post_init__(self) -> None:
+            check_gain("kp", self.kp)
+            check_gain("kd", self.kd)
 
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
         return self.allocate(self.body_torque(t, measurement, None), measurement)

@@ -2,26 +2,152 @@
 mapping with checks that name the offending key (``planners[1].options.weight``).
 
 Supported field types: ``float``, ``int``, ``bool``, ``str``, ``Literal[...]``, ``X | None``,
-``list[float]`` (a vector) and ``list[list[float]]`` (a matrix); ``float | list[list[float]]``
-accepts either.
+``list[float]`` (a vector), ``list[list[float]]`` (a matrix), ``dict`` and ``list[dict]``;
+``float | list[list[float]]`` accepts either.
+
+Every numeric option declares its valid range next to its type, with ``typing.Annotated``::
+
+    weight: Annotated[float, Range(ge=0.0)] = 0.0
+    intervals: Annotated[int, Range(ge=1, le=2000)] = 50
+    kp: Annotated[float | list[list[float]], Range(gt=0.0, shape=(3, 3))] = 0.06
+
+The bounds apply to every number of the value (each entry of a vector or matrix); numbers must be
+finite unless ``finite=False``. :func:`parse_options` enforces them and names the path, the
+value and the range. Checks that relate several options live in the dataclass's
+``__post_init__``, which raises :class:`InvalidOption` naming the option.
 """
 from __future__ import annotations
 
 import dataclasses
+import math
 import types
 import typing
-from typing import Any, ClassVar, Literal, Mapping, TypeVar, Union
+from dataclasses import dataclass
+from typing import Annotated, Any, ClassVar, Literal, Mapping, TypeVar, Union
 
 T = TypeVar("T")
 
+MAX_REPR = 80
+"""Characters of an offending value shown in an error message."""
+
+
+def excerpt(value: Any, limit: int = MAX_REPR) -> str:
+    """``repr(value)`` cut to ``limit`` characters, so that an error never embeds a huge value.
+
+    Parameters
+    ----------
+    value : any value, possibly a very large nested structure.
+    limit : maximum number of characters of the result.
+
+    Returns
+    -------
+    str
+        The representation, with ``...`` and the total length when it was cut.
+    """
+    text = _bounded_repr(value, limit + 1)
+    return text if len(text) <= limit else f"{text[:limit]}... (cut)"
+
+
+def _bounded_repr(value: Any, budget: int) -> str:
+    """``repr`` that stops building once ``budget`` characters are produced (alias bombs)."""
+    if isinstance(value, (list, tuple)):
+        parts, used = [], 1
+        for item in value:
+            if used >= budget:
+                parts.append("...")
+                break
+            part = _bounded_repr(item, budget - used)
+            parts.append(part)
+            used += len(part) + 2
+        return "[" + ", ".join(parts) + "]"
+    if isinstance(value, dict):
+        parts, used = [], 1
+        for key, item in value.items():
+            if used >= budget:
+                parts.append("...")
+                break
+            part = f"{_bounded_repr(key, budget - used)}: {_bounded_repr(item, budget - used)}"
+            parts.append(part)
+            used += len(part) + 2
+        return "{" + ", ".join(parts) + "}"
+    text = repr(value)
+    return text[:budget] if len(text) > budget else text
+
 
 class OptionsError(ValueError):
-    """An option is unknown or of the wrong type; ``path`` locates it, ``message`` says what was expected."""
+    """An option is unknown, of the wrong type or out of range; ``path`` locates it, ``message``
+    says what was expected."""
 
     def __init__(self, path: str, message: str):
         super().__init__(f"{path}: {message}")
         self.path = path
         self.message = message
+
+
+class InvalidOption(ValueError):
+    """Raised by an ``Options.__post_init__`` for a value that is wrong in relation to the others;
+    ``option`` is the field's name (``parse_options`` prefixes the YAML path)."""
+
+    def __init__(self, option: str, message: str):
+        super().__init__(f"{option}: {message}")
+        self.option = option
+        self.message = message
+
+
+@dataclass(frozen=True)
+class Range:
+    """Valid range of a numeric option (applied to each number of a vector or matrix).
+
+    Parameters
+    ----------
+    ge, gt, le, lt : inclusive and exclusive bounds; ``None`` for no bound.
+    finite : reject NaN and infinities (default).
+    size : required number of entries of a vector option.
+    shape : required (rows, columns) of a matrix option.
+    """
+
+    ge: float | None = None
+    gt: float | None = None
+    le: float | None = None
+    lt: float | None = None
+    finite: bool = True
+    size: int | None = None
+    shape: tuple[int, int] | None = None
+
+    def describe(self) -> str:
+        """The range in words, e.g. ``a finite number > 0 and <= 1``."""
+        parts = [f"{op} {bound:g}" for op, bound in ((">=", self.ge), (">", self.gt), ("<=", self.le), ("<", self.lt))
+                 if bound is not None]
+        return ("a finite number" if self.finite else "a number") + (" " + " and ".join(parts) if parts else "")
+
+    def violation(self, number: float) -> bool:
+        """Whether ``number`` lies outside the range."""
+        if math.isnan(number) or (self.finite and math.isinf(number)):
+            return True
+        return ((self.ge is not None and not number >= self.ge) or (self.gt is not None and not number > self.gt)
+                or (self.le is not None and not number <= self.le) or (self.lt is not None and not number < self.lt))
+
+
+NUMERIC = (int, float)
+
+
+def _split(annotation: Any) -> tuple[Any, Range | None]:
+    """``(type, Range or None)`` of a possibly ``Annotated`` type."""
+    if typing.get_origin(annotation) is Annotated:
+        base, *extras = typing.get_args(annotation)
+        ranges = [extra for extra in extras if isinstance(extra, Range)]
+        return base, (ranges[0] if ranges else None)
+    return annotation, None
+
+
+def numeric_leaves(annotation: Any) -> bool:
+    """Whether a (non-Annotated) option type can hold numbers, which then need a :class:`Range`."""
+    origin = typing.get_origin(annotation)
+    if annotation in NUMERIC:
+        return True
+    if origin in (Union, types.UnionType, list):
+        return any(numeric_leaves(arg) for arg in typing.get_args(annotation))
+    return False
 
 
 def _describe(annotation: Any) -> str:
@@ -34,16 +160,17 @@ def _describe(annotation: Any) -> str:
         return "null"
     if origin is list:
         inner = typing.get_args(annotation)[0]
-        return {float: "a list of numbers", str: "a list of names", dict: "a list of mappings"}.get(
-            inner, "a matrix (list of lists of numbers)")
-    return {float: "a number", int: "an integer", bool: "true or false", str: "a string"}.get(annotation, str(annotation))
+        return {float: "a list of numbers", int: "a list of integers", str: "a list of names",
+                dict: "a list of mappings"}.get(inner, "a matrix (list of lists of numbers)")
+    return {float: "a number", int: "an integer", bool: "true or false", str: "a string",
+            dict: "a mapping"}.get(annotation, str(annotation))
 
 
 def _convert(value: Any, annotation: Any) -> Any:
     """Converted value, or raise ``TypeError`` if it does not fit ``annotation``."""
     origin = typing.get_origin(annotation)
     if origin is Literal:
-        if value in typing.get_args(annotation):
+        if isinstance(value, typing.Hashable) and value in typing.get_args(annotation):
             return value
         raise TypeError
     if origin in (Union, types.UnionType):
@@ -85,39 +212,84 @@ def _convert(value: Any, annotation: Any) -> Any:
     raise TypeError
 
 
+def _check_range(value: Any, bounds: Range, path: str) -> None:
+    """Raise :class:`OptionsError` if a number of ``value`` is outside ``bounds`` or the shape is wrong."""
+    if isinstance(value, list):
+        if bounds.size is not None and value and not isinstance(value[0], list) and len(value) != bounds.size:
+            raise OptionsError(path, f"expected {bounds.size} numbers, got {len(value)}")
+        if bounds.shape is not None and value and isinstance(value[0], list):
+            rows, cols = bounds.shape
+            if len(value) != rows or any(len(row) != cols for row in value):
+                raise OptionsError(path, f"expected a {rows}x{cols} matrix, got {excerpt(value)}")
+        for index, item in enumerate(value):
+            _check_range(item, bounds, f"{path}[{index}]")
+        return
+    if isinstance(value, NUMERIC) and not isinstance(value, bool) and bounds.violation(float(value)):
+        raise OptionsError(path, f"expected {bounds.describe()}, got {excerpt(value)}")
+
+
+def option_fields(options_class: type) -> dict[str, tuple[Any, Range | None]]:
+    """``{name: (type, Range or None)}`` of an options dataclass."""
+    hints = typing.get_type_hints(options_class, include_extras=True)
+    return {f.name: _split(hints[f.name]) for f in dataclasses.fields(options_class)}
+
+
 def parse_options(options_class: type[T], values: Mapping[str, Any] | T | None, path: str = "options") -> T:
     """Build ``options_class`` from ``values`` (a mapping, an instance, or ``None`` for defaults).
+
+    Parameters
+    ----------
+    options_class : a dataclass whose fields are the options (see the module docstring).
+    values : the user's options.
+    path : YAML path of ``values``, used in error messages.
+
+    Returns
+    -------
+    An instance of ``options_class``.
 
     Raises
     ------
     OptionsError
-        For an unknown key (listing the known ones) or a value of the wrong type.
+        For an unknown key (listing the known ones), a value of the wrong type, or a value out of
+        its declared range; the message names the path, the value and what was expected.
     """
     if values is None:
-        return options_class()
-    if isinstance(values, options_class):
-        return values
+        values = {}
+    elif isinstance(values, options_class):
+        values = dataclasses.asdict(values)  # type: ignore[call-overload]
     if not isinstance(values, Mapping):
-        raise OptionsError(path, "expected a mapping of option names to values")
-    hints = typing.get_type_hints(options_class)
-    known = {f.name for f in dataclasses.fields(options_class)}
+        raise OptionsError(path, f"expected a mapping of option names to values, got {excerpt(values)}")
+    fields = option_fields(options_class)
     kwargs = {}
     for key, value in values.items():
-        if key not in known:
-            raise OptionsError(f"{path}.{key}", f"unknown option; expected one of {sorted(known)}")
+        if key not in fields:
+            raise OptionsError(f"{path}.{key}", f"unknown option; expected one of {sorted(fields)}")
+        annotation, bounds = fields[key]
         try:
-            kwargs[key] = _convert(value, hints[key])
+            converted = _convert(value, annotation)
         except TypeError:
-            raise OptionsError(f"{path}.{key}", f"expected {_describe(hints[key])}, got {value!r}") from None
+            raise OptionsError(f"{path}.{key}", f"expected {_describe(annotation)}, got {excerpt(value)}") from None
+        if bounds is not None:
+            _check_range(converted, bounds, f"{path}.{key}")
+        kwargs[key] = converted
     try:
         return options_class(**kwargs)
-    except ValueError as error:  # __post_init__ checks of ranges
+    except InvalidOption as error:
+        raise OptionsError(f"{path}.{error.option}", error.message) from None
+    except ValueError as error:
         raise OptionsError(path, str(error)) from None
 
 
 class Configurable:
     """Base of registered components (planners, controllers): a registry ``name`` and a frozen
-    dataclass ``Options`` whose typed fields, with defaults, are the component's options."""
+    dataclass ``Options`` whose typed fields, with defaults and declared ranges, are the
+    component's options.
+
+    Parameters
+    ----------
+    options : a mapping of option values, an ``Options`` instance, or ``None`` for the defaults.
+    path : YAML path of the options, for error messages.
+    """
 
     name: ClassVar[str]
 
@@ -126,4 +298,7 @@ class Configurable:
         pass
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
+        if not dataclasses.is_dataclass(self.Options):
+            raise TypeError(f"{type(self).__name__}.Options must be a dataclass: decorate it with "
+                            "@dataclass(frozen=True)")
         self.options = parse_options(self.Options, options, path)

@@ -13,11 +13,12 @@ perturbed copies of it) and the ``seed_planners``; the best converged optimum is
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 
 from ocp.transcription import TRANSCRIPTIONS, Cone, OptimalControlProblem
+from ocp.options import Range
 from planners.base import FailedReference, ManeuverProblem, Planner, Reference
 from planners.collocation_reference import CollocationReference, seed_vector
 
@@ -47,30 +48,28 @@ class CollocationPlanner(Planner):
     @dataclass(frozen=True)
     class Options:
         objective: Literal["min_energy", "min_l1", "min_time", "weighted"] = "min_energy"
-        intervals: int = 50
-        degree: int = 3
+        intervals: Annotated[int, Range(ge=1, le=2000)] = 50
+        degree: Annotated[int, Range(ge=1, le=9)] = 3
         transcription: Literal["collocation", "multiple_shooting"] = "collocation"
         warm_start: str = "eigenaxis"            # registered planner whose reference seeds the NLP
         warm_start_options: dict = field(default_factory=dict)  # its options, e.g. {profile: min_time}
         seed_planners: list[str] = field(default_factory=list)
-        multistart: int = 0                      # > 0: try this many randomly perturbed copies of the warm
+        multistart: Annotated[int, Range(ge=0, le=50)] = 0                      # > 0: try this many randomly perturbed copies of the warm
                                                  # start (1 %, then 5 %) instead of the warm start itself
-        energy_weight: float = 1.0               # for objective "weighted"
-        l1_weight: float = 0.0
-        time_weight: float = 0.0
-        max_rate: float | None = None            # rad/s, per body axis
+        energy_weight: Annotated[float, Range(ge=0.0)] = 1.0               # for objective "weighted"
+        l1_weight: Annotated[float, Range(ge=0.0)] = 0.0
+        time_weight: Annotated[float, Range(ge=0.0)] = 0.0
+        max_rate: Annotated[float | None, Range(gt=0.0)] = None  # rad/s, per body axis
         keep_out: list[dict] = field(default_factory=list)  # {boresight, direction, angle_deg}
         keep_in: list[dict] = field(default_factory=list)
-        cone_margin_deg: float = 0.01            # cones are imposed this much tighter, so that they
+        cone_margin_deg: Annotated[float, Range(ge=0.0, lt=90.0)] = 0.01            # cones are imposed this much tighter, so that they
                                                  # hold between the points where they are imposed
-        tolerance: float = 1e-10
-        max_iterations: int = 500
+        tolerance: Annotated[float, Range(gt=0.0, lt=1.0)] = 1e-10
+        max_iterations: Annotated[int, Range(ge=1, le=100000)] = 500
 
         def __post_init__(self) -> None:
             from planners import PLANNERS  # the registry is complete once options are parsed
 
-            if self.intervals < 1 or not 1 <= self.degree <= 9:
-                raise ValueError("intervals must be >= 1 and degree in 1..9")
             for name in [self.warm_start, *self.seed_planners]:
                 if name not in PLANNERS or name == "collocation":
                     raise ValueError(f"warm_start / seed_planners: {name!r} is not another registered planner; "

@@ -18,11 +18,12 @@ the target by continuation, each solve seeding the next. Torque bounds are not i
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Literal
+from typing import Annotated, Callable, Literal
 
 import numpy as np
 from scipy.integrate import solve_bvp
 
+from ocp.options import InvalidOption, Range
 from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample
 from planners.costate_systems import (AttitudeAcquisitionSystem, HamiltonianSystem, MinimumEnergySystem,
                                       RateAcquisitionSystem)
@@ -141,22 +142,18 @@ class CostateTPBVPPlanner(Planner):
     class Options:
         objective: Literal["min_energy", "rate_acquisition", "attitude_acquisition"] = "min_energy"
         final_time: Literal["minimum", "fixed"] | None = None   # steering forms: default minimum
-        weighting: list[float] = (1.0, 1.0, 1.0)                 # diagonal of W (eq. 34)
-        steering_torque: list[float] | None = None              # N m per axis; default the actuator limits
-        terminal_weight: float = 100.0                           # Q_f = terminal_weight · I (final_time: fixed)
-        max_rate: float | None = None                            # rad/s; default maneuver.max_rate
-        continuation_steps: int = 3                              # first step 1/continuation_steps, then adaptive
-        nodes: int = 60                                          # mesh each stage starts from
-        tolerance: float = 1e-8                                  # solve_bvp residual tolerance
-        max_nodes: int = 5000
+        weighting: Annotated[list[float], Range(gt=0.0, size=3)] = (1.0, 1.0, 1.0)                 # diagonal of W (eq. 34)
+        steering_torque: Annotated[list[float] | None, Range(gt=0.0, size=3)] = None              # N m per axis; default the actuator limits
+        terminal_weight: Annotated[float, Range(gt=0.0)] = 100.0                           # Q_f = terminal_weight · I (final_time: fixed)
+        max_rate: Annotated[float | None, Range(gt=0.0)] = None                            # rad/s; default maneuver.max_rate
+        continuation_steps: Annotated[int, Range(ge=1, le=100)] = 3                              # first step 1/continuation_steps, then adaptive
+        nodes: Annotated[int, Range(ge=5, le=5000)] = 60                                          # mesh each stage starts from
+        tolerance: Annotated[float, Range(gt=0.0, lt=1.0)] = 1e-8                                  # solve_bvp residual tolerance
+        max_nodes: Annotated[int, Range(ge=10, le=100000)] = 5000
 
         def __post_init__(self) -> None:
-            if self.continuation_steps < 1 or self.nodes < 5:
-                raise ValueError("continuation_steps must be >= 1 and nodes >= 5")
-            if len(self.weighting) != 3 or min(self.weighting) <= 0:
-                raise ValueError(f"weighting must be 3 positive numbers, got {list(self.weighting)}")
-            if self.terminal_weight <= 0:
-                raise ValueError("terminal_weight must be positive")
+            if self.max_nodes < self.nodes:
+                raise InvalidOption("max_nodes", f"must be at least nodes ({self.nodes}), got {self.max_nodes}")
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
         return FORMS[self.options.objective](problem, self.options, build=False)

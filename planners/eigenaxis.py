@@ -14,12 +14,13 @@ acceleration ``α`` is chosen with the coast rate ``w`` such that every axis res
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from ocp import quat
+from ocp.options import Range
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference,
                            ReferenceSample, inverse_dynamics_torque)
 
@@ -93,14 +94,8 @@ class EigenaxisPlanner(Planner):
     @dataclass(frozen=True)
     class Options:
         profile: Literal["smooth", "trapezoidal", "min_time"] = "smooth"
-        max_rate: float | None = None       # rad/s about the axis; default: the problem's max_rate
-        torque_fraction: float = 1.0        # share of the actuator bound the bang profiles may use
-
-        def __post_init__(self) -> None:
-            if not 0 < self.torque_fraction <= 1:
-                raise ValueError(f"torque_fraction must be in (0, 1], got {self.torque_fraction}")
-            if self.max_rate is not None and not self.max_rate > 0:
-                raise ValueError(f"max_rate must be positive, got {self.max_rate}")
+        max_rate: Annotated[float | None, Range(gt=0.0)] = None       # rad/s about the axis; default: the problem's max_rate
+        torque_fraction: Annotated[float, Range(gt=0.0, le=1.0)] = 1.0        # share of the actuator bound the bang profiles may use
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         rotvec = quat.to_rotation_vector(quat.error(problem.qf, problem.q0))

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Literal
+from typing import Annotated, Literal
 
 import casadi as ca
 import numpy as np
@@ -30,6 +30,7 @@ from scipy.special import ellipj, ellipkinc
 from ocp import Spacecraft, quat
 from ocp import quat_casadi as qc
 from ocp.integration import rk4_step
+from ocp.options import Range
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
 from planners.spin_extremal import extremal_quaternion
@@ -156,14 +157,10 @@ class NaturalMotionPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
-        stop_time: float = 10.0                     # s at the end of T spent stopping
+        stop_time: Annotated[float, Range(ge=0.0)] = 10.0                     # s at the end of T spent stopping
         stop: Literal["step", "smooth"] = "step"    # rate reference to zero at once (paper) or a cubic
-        rk4_steps: int = 60                         # RK4 steps of the asymmetric shooting (refined x4 as needed)
-        starts: int = 3                             # IPOPT starts (short, long way round, perturbed)
-
-        def __post_init__(self) -> None:
-            if self.stop_time < 0:
-                raise ValueError(f"stop_time must be non-negative, got {self.stop_time}")
+        rk4_steps: Annotated[int, Range(ge=4, le=5000)] = 60                         # RK4 steps of the asymmetric shooting (refined x4 as needed)
+        starts: Annotated[int, Range(ge=1, le=50)] = 3                             # IPOPT starts (short, long way round, perturbed)
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         if not problem.spacecraft.is_principal:

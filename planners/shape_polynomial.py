@@ -18,13 +18,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Literal
+from typing import Annotated, Literal
 
 import casadi as ca
 import numpy as np
 
 from ocp import quat
 from ocp import quat_casadi as qc
+from ocp.options import Range
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
 
@@ -126,15 +127,11 @@ class ShapePolynomialPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
-        terms: int | None = None                                    # N; None tries 1..max_terms
-        max_terms: int = 6
+        terms: Annotated[int | None, Range(ge=1, le=12)] = None                                    # N; None tries 1..max_terms
+        max_terms: Annotated[int, Range(ge=1, le=12)] = 6
         cost: Literal["path", "torque"] = "path"
         duration: Literal["rate_limit", "scenario"] = "rate_limit"
-        max_rate: float | None = None                               # rad/s; default: the problem's max_rate
-
-        def __post_init__(self) -> None:
-            if self.terms is not None and not 1 <= self.terms <= 12:
-                raise ValueError(f"terms must be in 1..12, got {self.terms}")
+        max_rate: Annotated[float | None, Range(gt=0.0)] = None                               # rad/s; default: the problem's max_rate
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         o = self.options

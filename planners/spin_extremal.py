@@ -18,6 +18,8 @@ A vectorised multi-start over branches of ``K T``, over ``β`` and over ``c`` se
 """
 from __future__ import annotations
 
+from typing import Annotated
+
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -25,6 +27,7 @@ import casadi as ca
 import numpy as np
 
 from ocp import quat
+from ocp.options import Range
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample)
 
 
@@ -140,18 +143,10 @@ class SpinExtremalPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
-        weight: float = 0.0                        # k of J = J1 + k J2 (1/(N² m² s))
-        spin_rate: float | None = None             # v (rad/s); default: the initial roll rate ω0[0]
-        parameters: list[float] | None = None      # fixed [r, c, β] (rad/s, rad/s, rad): no optimisation
-        starts: int = 3                            # multi-start candidates polished by IPOPT
-
-        def __post_init__(self) -> None:
-            if self.weight < 0:
-                raise ValueError(f"weight must be non-negative, got {self.weight}")
-            if self.parameters is not None and len(self.parameters) != 3:
-                raise ValueError(f"parameters must be [r, c, beta], got {self.parameters}")
-            if self.starts < 1:
-                raise ValueError(f"starts must be at least 1, got {self.starts}")
+        weight: Annotated[float, Range(ge=0.0)] = 0.0                        # k of J = J1 + k J2 (1/(N² m² s))
+        spin_rate: Annotated[float | None, Range(gt=-1e3, lt=1e3)] = None             # v (rad/s); default: the initial roll rate ω0[0]
+        parameters: Annotated[list[float] | None, Range(size=3)] = None      # fixed [r, c, β] (rad/s, rad/s, rad): no optimisation
+        starts: Annotated[int, Range(ge=1, le=50)] = 3                            # multi-start candidates polished by IPOPT
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         if not problem.spacecraft.is_principal:
