@@ -3,6 +3,7 @@
 Pure numeric/symbolic layer (CasADi and NumPy); it knows nothing of planners, controllers or YAML.
 """
 from ocp.actuators import ActuatorModel, Command, Measurement
+from ocp.cache import SolverCache
 from ocp.environment import CircularOrbit, Environment, TiltedDipole, gravity_gradient_torque
 from ocp.metrics import METRIC_KEYS, compute_metrics, metrics_from_reference, metrics_from_simulation
 from ocp.model import AttitudeModel
@@ -12,6 +13,6 @@ from ocp.spacecraft import Magnetorquers, ModelError, ReactionWheels, Spacecraft
 __all__ = [
     "ActuatorModel", "AttitudeModel", "CircularOrbit", "Command", "Environment", "METRIC_KEYS",
     "Magnetorquers", "Measurement", "ModelError", "ReactionWheels", "SensorNoise",
-    "SimulationError", "SimulationResult", "Simulator", "Spacecraft", "TiltedDipole", "Torquers",
+    "SimulationError", "SimulationResult", "Simulator", "SolverCache", "Spacecraft", "TiltedDipole", "Torquers",
     "compute_metrics", "gravity_gradient_torque", "metrics_from_reference", "metrics_from_simulation",
 ]

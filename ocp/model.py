@@ -11,11 +11,16 @@ Dynamics (ARCHITECTURE.md): ``I ω̇ = −ω × (I ω + A h_w) − A g + m × B_
 """
 from __future__ import annotations
 
+import dataclasses
+import hashlib
+from typing import Any
+
 import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
 from ocp import quat, quat_casadi as qc
+from ocp.cache import SolverCache
 from ocp.environment import Environment, gravity_gradient_torque
 from ocp.spacecraft import Spacecraft
 
@@ -49,7 +54,19 @@ class AttitudeModel:
                 self.control_slices[name] = slice(offset, offset + size)
                 offset += size
         self.nu = offset
+        self._fingerprint: str | None = None
+        self.solver_cache = SolverCache()
+        """Solvers built on this model by planners given no cache of their own."""
         self._build()
+
+    @property
+    def fingerprint(self) -> str:
+        """A hash of every number and choice of the spacecraft and environment that the symbolic
+        graph bakes in: two models with equal fingerprints build identical functions."""
+        if self._fingerprint is None:
+            description = repr((_plain(self.spacecraft), _plain(self.environment)))
+            self._fingerprint = hashlib.sha256(description.encode()).hexdigest()
+        return self._fingerprint
 
     @property
     def default_parameters(self) -> NDArray:
@@ -129,3 +146,14 @@ class AttitudeModel:
         x = np.asarray(x, dtype=float)
         body = x[..., 4:7] @ self.spacecraft.inertia.T + x[..., 7:self.nx] @ self.spacecraft.wheel_axes.T
         return quat.rotate(x[..., 0:4], body)
+
+
+def _plain(value: Any) -> Any:
+    """A dataclass tree as nested tuples of plain numbers and strings (for :attr:`AttitudeModel.fingerprint`)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return (type(value).__name__,) + tuple((f.name, _plain(getattr(value, f.name))) for f in dataclasses.fields(value))
+    if isinstance(value, np.ndarray):
+        return ("array", value.shape, tuple(float(v) for v in value.ravel()))
+    if isinstance(value, (list, tuple)):
+        return tuple(_plain(v) for v in value)
+    return value

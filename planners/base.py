@@ -15,7 +15,7 @@ from typing import Any, Mapping, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ocp import AttitudeModel, Environment, Spacecraft, quat
+from ocp import AttitudeModel, Environment, SolverCache, Spacecraft, quat
 from ocp.options import Configurable
 
 Array = NDArray[np.float64]
@@ -182,7 +182,19 @@ class Planner(Configurable, ABC):
       if it can); the scenario loader reports it against the planner's YAML entry and ``plan``
       returns it as a failed reference. By default a planner needs a target attitude.
     * Planners never read YAML and never simulate.
+    * ``cache`` (constructor) is an explicit :class:`~ocp.cache.SolverCache` for what the planner
+      builds (NLPs); without one, the planner keeps its builds in the model's own cache
+      (``problem.model.solver_cache``).
     """
+
+    def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options",
+                 cache: SolverCache | None = None):
+        super().__init__(options, path)
+        self.cache = cache
+
+    def solver_cache(self, problem: ManeuverProblem) -> SolverCache:
+        """The cache to build into: the one given to the constructor, else the model's."""
+        return self.cache if self.cache is not None else problem.model.solver_cache
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
         """Why this planner cannot plan ``problem``, or ``None``."""

@@ -97,13 +97,14 @@ class CollocationPlanner(Planner):
         o = self.options
         key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
                o.transcription, o.intervals, o.degree, o.tolerance, o.max_iterations)
-        cache = problem.model.__dict__.setdefault("_nlp_cache", {})
-        if key not in cache:
+        def build():
             transcription = TRANSCRIPTIONS[o.transcription](o.intervals, *([o.degree] if o.transcription == "collocation" else []))
             options = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": o.tolerance,
                        "ipopt.max_iter": o.max_iterations, "show_eval_warnings": False}
-            cache[key] = (transcription, transcription.build(ocp, options))
-        return cache[key]
+            return transcription, transcription.build(ocp, options)
+
+        # The model's numbers are baked into the graph: a shared cache needs them in the key.
+        return self.solver_cache(problem).get(("collocation", problem.model.fingerprint, key), build)
 
     def _bounds(self, problem: ManeuverProblem, nlp, duration: float):
         """lbx/ubx in the layout of the decision vector."""

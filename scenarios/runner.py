@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from controllers import CONTROLLERS
-from ocp import SimulationError, SimulationResult, Simulator, metrics_from_reference, metrics_from_simulation
+from ocp import SimulationError, SolverCache, SimulationResult, Simulator, metrics_from_reference, metrics_from_simulation
 from planners import PLANNERS, FailedReference, Reference
 from scenarios.loader import Scenario
 
@@ -96,8 +96,21 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
         settling_tolerance_deg=scenario.simulation.settling_tolerance_deg)
 
 
-def run(scenario: Scenario, progress: Callable[[str], None] | None = None) -> RunResults:
-    """Plan, simulate and score every planner of ``scenario``; ``progress`` receives a line per row."""
+def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
+        cache: SolverCache | None = None) -> RunResults:
+    """Plan, simulate and score every planner of ``scenario``.
+
+    Parameters
+    ----------
+    scenario : a loaded scenario.
+    progress : receives a line of text per finished row.
+    cache : solvers built by planners, shared across runs (a trade-study worker passes one).
+
+    Returns
+    -------
+    RunResults
+        One row per planner (or one for the controller in regulation mode).
+    """
     say = progress or (lambda line: None)
     spec = scenario.simulation
     simulator = Simulator(scenario.problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step)
@@ -108,7 +121,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None) -> Ru
         say(f"[1/1] {row.label}: {row.status} (simulated in {row.simulate_time_s:.2f} s)")
         return RunResults(scenario, [row])
     for index, planner_spec in enumerate(scenario.planners, start=1):
-        planner = PLANNERS[planner_spec.name](planner_spec.options)
+        planner = PLANNERS[planner_spec.name](planner_spec.options, cache=cache)
         try:
             reference = planner.plan(scenario.problem)
         except Exception as error:  # a planner bug must not lose the other rows
