@@ -1,4 +1,4 @@
-"""``slewbench`` command line: run, validate, list.
+"""``slewbench`` command line: run, validate, list, sweep.
 
 Exit status: 0 when the run completed (a failed planner is a row, not an error), 2 for a bad
 scenario file, 1 for an internal error.
@@ -16,6 +16,7 @@ from controllers import CONTROLLERS
 from planners import PLANNERS
 from scenarios.loader import load
 from scenarios.runner import run
+from scenarios.sweep_cli import add_sweep_parser
 from scenarios.yaml_node import ScenarioError
 
 EXIT_OK, EXIT_INTERNAL, EXIT_BAD_SCENARIO = 0, 1, 2
@@ -72,6 +73,7 @@ def build_parser() -> argparse.ArgumentParser:
     validate_parser.set_defaults(handler=command_validate)
     list_parser = commands.add_parser("list", help="registered planners and controllers")
     list_parser.set_defaults(handler=command_list)
+    add_sweep_parser(commands)
     return parser
 
 
