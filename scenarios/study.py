@@ -132,7 +132,7 @@ def _values(node: Node, path: str, base: dict[str, Any]) -> tuple[list[Any], lis
         scalar_last = base.get("maneuver", {}).get("quaternion_order") == "scalar_last"
         quaternions = []
         for angle in angles_deg:
-            q = quat.from_axis_angle(axis, np.deg2rad(float(angle)))
+            q = quat.from_axis_angle(axis / np.linalg.norm(axis), np.deg2rad(float(angle)))
             quaternions.append(_plain(quat.to_scalar_last(q) if scalar_last else q))
         return quaternions, [float(a) for a in angles_deg]
     raise node.error(f"unknown value generator {kind!r}; expected linspace, geomspace or axis_angle")
