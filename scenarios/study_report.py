@@ -16,10 +16,12 @@ import yaml
 
 from ocp import METRIC_KEYS
 from scenarios.study import Study, package_version
+from scenarios.yaml_node import ScenarioError
 
 AXES = ("x", "y", "z")
 VECTOR_METRICS = ("int_abs_u",)
 STATISTICS = ("count", "failures", "mean", "std", "median", "p5", "p95", "min", "max")
+MARKER = ".slewbench-output.json"
 IDENTITY = ["label", "planner", "controller", "status", "message", "plan_time_s"]
 
 
@@ -130,14 +132,46 @@ def _write_atomic(path: Path, text: str) -> None:
     os.replace(temporary, path)
 
 
+def claim_output_directory(path: str | Path) -> Path:
+    """Create ``path`` with slewbench's marker, or accept an existing directory carrying it.
+
+    Private stand-in for :func:`scenarios.outputs.claim_output_directory` (issue 11) with the same
+    semantics: a regular file, a non-empty directory without the marker, or a location that
+    cannot be written is a :class:`ScenarioError`.
+    """
+    from scenarios import outputs
+    claim = getattr(outputs, "claim_output_directory", None)
+    if claim is not None:
+        return claim(path)
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ScenarioError("--out", f"{path} is a file, not a directory; slewbench will not replace it")
+    if path.is_dir() and not (path / MARKER).is_file() and any(path.iterdir()):
+        raise ScenarioError("--out", f"{path} is a non-empty directory that slewbench did not create; "
+                                     "choose another --out (slewbench never overwrites what it did not write)")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        if not (path / MARKER).is_file():
+            (path / MARKER).write_text(json.dumps({"tool": "slewbench", "version": package_version()}) + "\n")
+        probe = path / ".slewbench-write-probe"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as error:
+        raise ScenarioError("--out", f"cannot write to {path}: {error.strerror or error}") from None
+    return path
+
+
 def write_report(results, directory: Path, plots: bool = True) -> list[str]:
     """Write the study's tables, resolved study and (``plots``) figures into ``directory``.
+
+    ``directory`` is created with slewbench's marker, or must already carry it.
 
     Returns
     -------
     list of the file names written.
     """
     study = results.study
+    directory = claim_output_directory(directory)
     columns, rows = case_table(study, results.records)
     summary_columns, summary = summary_table(study, rows)
     files = {"cases.csv": _csv(columns, rows), "summary.csv": _csv(summary_columns, summary),

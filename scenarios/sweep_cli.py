@@ -7,7 +7,6 @@ sweep and ``--resume`` was not given). An interrupted sweep exits 130 and says h
 from __future__ import annotations
 
 import argparse
-import json
 import signal
 import sys
 import time
@@ -16,41 +15,11 @@ from typing import Any
 
 from scenarios.store import STORE_NAME, SweepStore
 from scenarios.study import load_study, package_version, parse_study
-from scenarios.study_report import resolved_study
+from scenarios.study_report import MARKER, claim_output_directory, resolved_study
 from scenarios.sweep_engine import SweepInterrupted, SweepResults, sweep
 from scenarios.yaml_node import ScenarioError
 
 EXIT_OK, EXIT_BAD_STUDY, EXIT_INTERRUPTED = 0, 2, 130
-MARKER = ".slewbench-output.json"
-
-
-def claim_output_directory(path: str | Path) -> Path:
-    """Create ``path`` with slewbench's marker, or accept an existing directory carrying it.
-
-    Private stand-in for :func:`scenarios.outputs.claim_output_directory` (issue 11) with the same
-    semantics: a regular file, a non-empty directory without the marker, or a location that
-    cannot be written is a :class:`ScenarioError`.
-    """
-    from scenarios import outputs
-    claim = getattr(outputs, "claim_output_directory", None)
-    if claim is not None:
-        return claim(path)
-    path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise ScenarioError("--out", f"{path} is a file, not a directory; slewbench will not replace it")
-    if path.is_dir() and not (path / MARKER).is_file() and any(path.iterdir()):
-        raise ScenarioError("--out", f"{path} is a non-empty directory that slewbench did not create; "
-                                     "choose another --out (slewbench never overwrites what it did not write)")
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-        if not (path / MARKER).is_file():
-            (path / MARKER).write_text(json.dumps({"tool": "slewbench", "version": package_version()}) + "\n")
-        probe = path / ".slewbench-write-probe"
-        probe.write_text("")
-        probe.unlink()
-    except OSError as error:
-        raise ScenarioError("--out", f"cannot write to {path}: {error.strerror or error}") from None
-    return path
 
 
 def _open_store(out: Path, resume: bool) -> SweepStore:
