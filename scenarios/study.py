@@ -92,6 +92,15 @@ def case_key(scenario: dict[str, Any], version: str) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 
+def _tree_copy(value: Any) -> Any:
+    """A copy of YAML data (nested dicts and lists; leaves are immutable)."""
+    if isinstance(value, dict):
+        return {k: _tree_copy(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_tree_copy(v) for v in value]
+    return value
+
+
 def _plain(value: Any) -> Any:
     """YAML/JSON-safe Python value (numpy scalars and arrays to floats and lists)."""
     if isinstance(value, np.ndarray):
@@ -291,10 +300,10 @@ def _expand(study: Study, steps: list[list[Step]], points: list[tuple[list, list
         for sample in range(study.samples):
             index = point * study.samples + sample
             seed = int(children[index].generate_state(1)[0])
-            data = copy.deepcopy(study.base)
+            data = _tree_copy(study.base)
             varied: dict[str, Any] = {}
             for path, path_steps, value, shown in zip(study.grid_paths, steps, values, recorded):
-                set_path(data, path_steps, copy.deepcopy(value), path)
+                set_path(data, path_steps, _tree_copy(value), path)
                 varied[path] = shown
             if dispersions:
                 unit = design[sample] if design is not None else \
@@ -317,7 +326,7 @@ def _expand(study: Study, steps: list[list[Step]], points: list[tuple[list, list
 def _validate(study: Study, case: Case) -> None:
     """The scenario loader's verdict on a case, naming the study, the case and the study entry."""
     try:
-        parse_scenario(copy.deepcopy(case.scenario))
+        parse_scenario(case.scenario)  # the loader only reads its data
     except ScenarioError as error:
         entries = [p for p in case.varied if error.path.startswith(p) or p.startswith(error.path)]
         varied = ", ".join(f"{p}={json.dumps(v)[:40]}" for p, v in case.varied.items())

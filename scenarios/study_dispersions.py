@@ -11,7 +11,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.stats import norm, qmc
+from scipy.special import ndtri
+from scipy.stats import qmc
 
 from scenarios.study_paths import Step, get_path
 from scenarios.yaml_node import Node
@@ -46,7 +47,7 @@ class Dispersion:
         if self.kind == "case_seed":
             return seed
         if self.kind == "normal":
-            draw = self.a + self.b * norm.ppf(np.clip(unit, _EPS, 1.0 - _EPS))
+            draw = self.a + self.b * ndtri(np.clip(unit, _EPS, 1.0 - _EPS))  # the normal's inverse CDF
         else:
             draw = self.a + unit * (self.b - self.a)
         draw = draw if self.vector else float(draw[0])

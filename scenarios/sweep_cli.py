@@ -62,6 +62,8 @@ def command_sweep(args: argparse.Namespace) -> int:
         study.execution.scheduler = args.scheduler
     if args.workers is not None and not 1 <= args.workers <= 1024:
         raise ScenarioError("--workers", f"expected 1 to 1024, got {args.workers}")
+    if not args.no_plots:
+        import scenarios.study_plots  # noqa: F401  (fail now, not after the cases ran)
     out = claim_output_directory(Path(args.out) if args.out else Path("results") / study.name)
     start = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _terminate)

@@ -163,8 +163,11 @@ class _Engine:
             key, _ = self.in_flight.pop(future)
             try:
                 result = future.result()
-            except BrokenProcessPool:
-                broken.append(key)
+            except BrokenProcessPool as error:
+                if self.owned:
+                    broken.append(key)
+                else:  # a pool the caller owns: it cannot be restarted from here
+                    self._died([key], f"{type(error).__name__}: {error}"[:300])
                 continue
             except Exception as error:  # a lost worker on a cluster (dask's KilledWorker, ...)
                 self._died([key], f"{type(error).__name__}: {error}"[:300])

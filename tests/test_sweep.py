@@ -272,3 +272,19 @@ def test_run_case_returns_plain_data_only():
     case = parse_study(study_data()).cases[0]
     result = run_case({"key": case.key, "scenario": case.scenario, "timeout_s": 60.0})
     assert yaml.safe_load(yaml.safe_dump(result)) == result  # nothing but plain values
+
+
+def test_readme_study_and_example_studies_are_valid():
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    readme = (root / "README.md").read_text()
+    block = readme.split("## Trade studies", 1)[1].split("```yaml", 1)[1].split("```", 1)[0]
+    data = yaml.safe_load(block)
+    data["monte_carlo"]["samples"] = 2  # the schema as written, fewer samples
+    study = parse_study(data, root / "scenarios" / "README-study.yaml")
+    assert len(study.cases) == 2 * 3 * 3 * 2 * 2
+    fractions = {c.scenario["planners"][1]["options"]["torque_fraction"] for c in study.cases}
+    assert fractions == {0.5, 0.75, 1.0}
+    for name, count in (("study_spin_weight_sample_time", 20), ("study_planners_vs_slew_angle", 7),
+                        ("study_spin_monte_carlo", 1000)):
+        assert len(scenarios.load_study(root / "scenarios" / f"{name}.yaml").cases) == count
