@@ -11,7 +11,6 @@ import pytest
 import yaml
 
 import scenarios
-from ocp import quat
 from scenarios import runner
 from scenarios.cli import main
 from scenarios.store import SweepStore
