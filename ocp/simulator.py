@@ -29,6 +29,8 @@ Array = NDArray[np.float64]
 INTEGRATORS = ("rk4", "cvodes")
 MAX_SAMPLES = 1_000_000
 """Default bound on the samples of one run (a 100,000 s run at 0.1 s): more is refused, not attempted."""
+SUBSTEPS_PER_SAMPLE = 20
+"""A run may integrate at most this many RK4 sub-steps per allowed sample (``max_samples``)."""
 MAX_SUBSTEPS = 1000
 """Bound on RK4 sub-steps per sample (the step is one unrolled CasADi graph)."""
 
@@ -135,6 +137,7 @@ class Simulator:
         self.model = model
         self.sample_time = float(sample_time)
         self.max_samples = max_samples
+        self.substeps = substeps if integrator == "rk4" else 1
         self.actuators = ActuatorModel(model.spacecraft, model.control_slices, model.nu)
         self._step = self._build_step(integrator, substeps, rtol, atol)
         self._step_numeric = BufferedFunction(self._step)
@@ -190,9 +193,10 @@ class Simulator:
         if not isinstance(duration, (int, float)) or not math.isfinite(duration) or not duration > 0:
             raise ValueError(f"duration must be a finite positive number of seconds, got {duration!r}")
         n_samples = max(1, math.ceil(duration / self.sample_time - 1e-9))
-        if n_samples > self.max_samples:
+        if n_samples > self.max_samples or n_samples * self.substeps > SUBSTEPS_PER_SAMPLE * self.max_samples:
             raise SimulationError(f"{duration:g} s at {self.sample_time:g} s samples is {n_samples} samples, over the "
-                                  f"limit of {self.max_samples} (simulation.max_samples raises it)")
+                                  f"limit of {self.max_samples} samples or {SUBSTEPS_PER_SAMPLE} sub-steps each "
+                                  "(simulation.max_samples raises it)")
         times = np.minimum(np.arange(n_samples + 1) * self.sample_time, duration)
         noise = noise or SensorNoise()
         rng = np.random.default_rng(noise.seed)

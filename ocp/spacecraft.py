@@ -19,8 +19,9 @@ class ModelError(ValueError):
     """Invalid model parameter; ``field`` names the attribute (e.g. ``"inertia"``)."""
 
     def __init__(self, field_name: str, message: str):
-        super().__init__(message)
+        super().__init__(f"{field_name}: {message}")
         self.field = field_name
+        self.message = message
 
 
 def _limit_vector(value: ArrayLike | None, size: int, field_name: str) -> Array:

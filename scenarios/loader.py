@@ -18,7 +18,7 @@ from controllers import CONTROLLERS
 from ocp import (CircularOrbit, Environment, Magnetorquers, ModelError, ReactionWheels, SensorNoise,
                  Spacecraft, TiltedDipole, Torquers, quat)
 from ocp.options import OptionsError, excerpt
-from ocp.simulator import MAX_SAMPLES, MAX_SUBSTEPS
+from ocp.simulator import MAX_SAMPLES, MAX_SUBSTEPS, SUBSTEPS_PER_SAMPLE
 from planners import PLANNERS, ManeuverProblem
 from scenarios.yaml_node import Node, ScenarioError, read_yaml
 
@@ -82,7 +82,7 @@ def _model_part(node: Node, build: Callable[..., Any], **kwargs: Any) -> Any:
     try:
         return build(**kwargs)
     except ModelError as error:
-        raise ScenarioError(f"{node.path}.{error.field}" if node.path else error.field, str(error)) from None
+        raise ScenarioError(f"{node.path}.{error.field}" if node.path else error.field, error.message) from None
 
 
 def _limits(node: Node, key: str) -> Any:
@@ -259,11 +259,17 @@ def check_work(problem: ManeuverProblem, simulation: SimulationSpec) -> None:
     its own duration."""
     window = simulation.duration or problem.duration
     samples = math.ceil(window / simulation.sample_time - 1e-9)
+    substeps = 1 if simulation.integrator != "rk4" else math.ceil(simulation.sample_time / simulation.max_step - 1e-9)
+    where = "simulation.duration" if simulation.duration else "maneuver.duration"
     if samples > simulation.max_samples:
-        where = "simulation.duration" if simulation.duration else "maneuver.duration"
         raise ScenarioError(where, f"{window:g} s at a {simulation.sample_time:g} s sample time is {samples} samples, "
                                    f"over the limit of {simulation.max_samples}; raise simulation.max_samples "
                                    "if you mean it, or lengthen simulation.sample_time")
+    if samples * substeps > SUBSTEPS_PER_SAMPLE * simulation.max_samples:
+        raise ScenarioError("simulation.max_step", f"{samples} samples of {substeps} RK4 sub-steps each exceed the "
+                            f"limit of {SUBSTEPS_PER_SAMPLE} x simulation.max_samples = "
+                            f"{SUBSTEPS_PER_SAMPLE * simulation.max_samples} sub-steps; raise max_step or "
+                            "simulation.max_samples")
 
 
 def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
