@@ -7,6 +7,7 @@ missing, and a case stored twice (a retry that raced a resume) replaces itself, 
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import sqlite3
@@ -38,6 +39,17 @@ def _json_safe(value: Any) -> Any:
     if isinstance(value, (list, tuple)):
         return [_json_safe(v) for v in value]
     return value
+
+
+def is_sweep_store(directory: str | Path) -> bool:
+    """Whether ``directory/sweep.sqlite`` is a slewbench store (read only: the file is not changed)."""
+    path = Path(directory) / STORE_NAME
+    try:
+        with contextlib.closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=30.0)) as db:
+            found = db.execute("SELECT value FROM meta WHERE name = 'format'").fetchone()
+    except sqlite3.Error:
+        return False
+    return found is not None and json.loads(found[0]) == FORMAT
 
 
 class SweepStore:

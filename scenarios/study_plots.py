@@ -13,7 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
 
-from scenarios.outputs import safe_name  # noqa: E402
+from scenarios.outputs import row_stems  # noqa: E402
 from scenarios.study import Study  # noqa: E402
 
 PARETO_AXES = ("cl.int_u", "cl.settling_time_s")
@@ -58,7 +58,8 @@ def _save(fig: plt.Figure, directory: Path, name: str) -> str:
 
 def _lines(study: Study, rows: list[dict[str, Any]], directory: Path) -> list[str]:
     written = []
-    for path, xs in _numeric_axes(study, rows):
+    axes_1d = _numeric_axes(study, rows)
+    for (path, xs), stem in zip(axes_1d, row_stems([path for path, _ in axes_1d])):
         fig, axes = _grid(len(study.summary))
         for axis, metric in zip(axes, study.summary):
             for label in _labels(rows):
@@ -75,7 +76,7 @@ def _lines(study: Study, rows: list[dict[str, Any]], directory: Path) -> list[st
         axes[0].legend(fontsize=8)
         fig.suptitle(f"{study.name}: median over the other parameters and samples (band 5-95 %)"
                      if study.samples > 1 or len(study.grid_paths) > 1 else study.name)
-        written.append(_save(fig, directory, f"metrics_vs_{safe_name(path)}.png"))
+        written.append(_save(fig, directory, f"metrics_vs_{stem}.png"))
     return written
 
 
@@ -85,7 +86,7 @@ def _heat_maps(study: Study, rows: list[dict[str, Any]], directory: Path) -> lis
         return []
     (px, xs), (py, ys) = axes_2d
     written = []
-    for metric in study.summary:
+    for metric, stem in zip(study.summary, row_stems(study.summary)):
         labels = _labels(rows)
         fig, axes = _grid(len(labels))
         for axis, label in zip(axes, labels):
@@ -98,7 +99,7 @@ def _heat_maps(study: Study, rows: list[dict[str, Any]], directory: Path) -> lis
             axis.set_ylabel(py)
             axis.set_title(label)
             fig.colorbar(image, ax=axis, label=metric)
-        written.append(_save(fig, directory, f"heatmap_{safe_name(metric)}.png"))
+        written.append(_save(fig, directory, f"heatmap_{stem}.png"))
     return written
 
 

@@ -7,7 +7,8 @@ import csv
 import io
 import json
 import math
-import os
+import shutil
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -15,13 +16,14 @@ import numpy as np
 import yaml
 
 from ocp import METRIC_KEYS
+from scenarios.outputs import (MARKER, STAGING_PREFIX, OutputError, _write_manifest, claim_output_directory,
+                               commit_outputs, read_manifest)
+from scenarios.store import STORE_NAME, is_sweep_store
 from scenarios.study import Study, package_version
-from scenarios.yaml_node import ScenarioError
 
 AXES = ("x", "y", "z")
 VECTOR_METRICS = ("int_abs_u",)
 STATISTICS = ("count", "failures", "mean", "std", "median", "p5", "p95", "min", "max")
-MARKER = ".slewbench-output.json"
 IDENTITY = ["label", "planner", "controller", "status", "message", "plan_time_s"]
 
 
@@ -125,62 +127,65 @@ def resolved_study(study: Study) -> dict[str, Any]:
     return data
 
 
-def _write_atomic(path: Path, text: str) -> None:
-    """Replace a file this sweep writes (in its own claimed directory) in one step."""
-    temporary = path.with_name(f".{path.name}.partial")
-    temporary.write_text(text)
-    os.replace(temporary, path)
+STORE_FILES = (STORE_NAME, f"{STORE_NAME}-wal", f"{STORE_NAME}-shm")
 
 
-def claim_output_directory(path: str | Path) -> Path:
-    """Create ``path`` with slewbench's marker, or accept an existing directory carrying it.
+def claim_sweep_directory(path: str | Path) -> Path:
+    """Claim ``path`` for a sweep (:func:`scenarios.outputs.claim_output_directory`) and list the
+    store's files in its manifest. A ``sweep.sqlite`` already there must be a slewbench store.
 
-    Private stand-in for :func:`scenarios.outputs.claim_output_directory` (issue 11) with the same
-    semantics: a regular file, a non-empty directory without the marker, or a location that
-    cannot be written is a :class:`ScenarioError`.
+    Raises
+    ------
+    OutputError
+        As :func:`~scenarios.outputs.claim_output_directory`, or for a ``sweep.sqlite`` that is not
+        a slewbench sweep store (it is left untouched).
     """
-    from scenarios import outputs
-    claim = getattr(outputs, "claim_output_directory", None)
-    if claim is not None:
-        return claim(path)
-    path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise ScenarioError("--out", f"{path} is a file, not a directory; slewbench will not replace it")
-    if path.is_dir() and not (path / MARKER).is_file() and any(path.iterdir()):
-        raise ScenarioError("--out", f"{path} is a non-empty directory that slewbench did not create; "
-                                     "choose another --out (slewbench never overwrites what it did not write)")
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-        if not (path / MARKER).is_file():
-            (path / MARKER).write_text(json.dumps({"tool": "slewbench", "version": package_version()}) + "\n")
-        probe = path / ".slewbench-write-probe"
-        probe.write_text("")
-        probe.unlink()
-    except OSError as error:
-        raise ScenarioError("--out", f"cannot write to {path}: {error.strerror or error}") from None
-    return path
+    directory = claim_output_directory(path, kind="sweep")
+    if (directory / STORE_NAME).exists() and not is_sweep_store(directory):
+        raise OutputError(path, f"holds a {STORE_NAME} that is not a slewbench sweep store; nothing was touched")
+    manifest = read_manifest(directory) or {"files": [], "complete": False}
+    _write_manifest(directory, set(manifest["files"]) | set(STORE_FILES), complete=bool(manifest.get("complete")),
+                    kind="sweep")
+    return directory
 
 
-def write_report(results, directory: Path, plots: bool = True) -> list[str]:
+def _commit(directory: Path, staging: Path) -> list[str]:
+    """Commit the staged report (:func:`scenarios.outputs.commit_outputs`, which removes listed files
+    the new set lacks) with the store's files kept out of its reach and listed again after."""
+    manifest = read_manifest(directory)
+    if manifest is None:
+        raise OutputError(directory, f"lost its {MARKER} while running; nothing was replaced")
+    _write_manifest(directory, [f for f in manifest["files"] if f not in STORE_FILES], complete=False, kind="sweep")
+    written = commit_outputs(directory, staging, kind="sweep")
+    _write_manifest(directory, [*written, *STORE_FILES], complete=True, kind="sweep")
+    return written
+
+
+def write_report(results, directory: str | Path, plots: bool = True) -> list[str]:
     """Write the study's tables, resolved study and (``plots``) figures into ``directory``.
 
-    ``directory`` is created with slewbench's marker, or must already carry it.
+    ``directory`` is claimed (created with slewbench's marker, or already carrying it); the files
+    are staged inside it and committed together, replacing only files slewbench listed there.
 
     Returns
     -------
-    list of the file names written.
+    list of the file names written (relative to ``directory``).
     """
     study = results.study
-    directory = claim_output_directory(directory)
+    directory = claim_sweep_directory(directory)
     columns, rows = case_table(study, results.records)
     summary_columns, summary = summary_table(study, rows)
     files = {"cases.csv": _csv(columns, rows), "summary.csv": _csv(summary_columns, summary),
              "summary.md": _markdown(study, summary_columns, summary, results.missing),
              "study.yaml": yaml.safe_dump(resolved_study(study), sort_keys=False, width=120)}
-    for name, text in files.items():
-        _write_atomic(directory / name, text)
-    written = list(files)
-    if plots:
-        from scenarios.study_plots import write_plots
-        written += write_plots(study, rows, directory)
-    return written
+    staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=directory))
+    try:
+        for name, text in files.items():
+            (staging / name).write_text(text)
+        if plots:
+            from scenarios.study_plots import write_plots
+            (staging / "plots").mkdir()
+            write_plots(study, rows, staging / "plots")
+        return _commit(directory, staging)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)

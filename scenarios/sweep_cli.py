@@ -13,19 +13,17 @@ import time
 from pathlib import Path
 from typing import Any
 
-from scenarios.store import STORE_NAME, SweepStore
+from scenarios.store import STORE_NAME, SweepStore, is_sweep_store
 from scenarios.study import load_study, package_version, parse_study
-from scenarios.study_report import MARKER, claim_output_directory, resolved_study
+from scenarios.outputs import MARKER, default_output_directory, read_manifest
+from scenarios.study_report import claim_sweep_directory, resolved_study
 from scenarios.sweep_engine import SweepInterrupted, SweepResults, sweep
 from scenarios.yaml_node import ScenarioError
 
 EXIT_OK, EXIT_BAD_STUDY, EXIT_INTERRUPTED = 0, 2, 130
 
 
-def _open_store(out: Path, resume: bool) -> SweepStore:
-    if (out / STORE_NAME).exists() and not resume:
-        raise ScenarioError("--out", f"{out} already holds a sweep ({STORE_NAME}); pass --resume to continue it, "
-                                     "--report to redraw it, or choose another --out")
+def _open_store(out: Path) -> SweepStore:
     try:
         return SweepStore(out)
     except Exception as error:  # sqlite3.Error, or a store of another format
@@ -39,7 +37,7 @@ def _terminate(signum: int, frame: Any) -> None:
 def command_report(args: argparse.Namespace) -> int:
     """Redraw tables and plots of ``args.report`` from its store, without running anything."""
     out = Path(args.report)
-    if not (out / STORE_NAME).is_file() or not (out / MARKER).is_file():
+    if read_manifest(out) is None or not is_sweep_store(out):
         raise ScenarioError("--report", f"{out} holds no slewbench sweep ({STORE_NAME} and {MARKER} expected)")
     with SweepStore(out, create=False) as store:
         data, version = store.get_meta("study"), store.get_meta("version")
@@ -64,11 +62,15 @@ def command_sweep(args: argparse.Namespace) -> int:
         raise ScenarioError("--workers", f"expected 1 to 1024, got {args.workers}")
     if not args.no_plots:
         import scenarios.study_plots  # noqa: F401  (fail now, not after the cases ran)
-    out = claim_output_directory(Path(args.out) if args.out else Path("results") / study.name)
+    out = Path(args.out) if args.out else default_output_directory(study.name)
+    if (out / STORE_NAME).exists() and not args.resume:
+        raise ScenarioError("--out", f"{out} already holds a sweep ({STORE_NAME}); pass --resume to continue it, "
+                                     "--report to redraw it, or choose another --out")
+    out = claim_sweep_directory(out)
     start = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _terminate)
     try:
-        with _open_store(out, args.resume) as store:
+        with _open_store(out) as store:
             store.set_meta("study", resolved_study(study))
             store.set_meta("version", package_version())
             done = sum(case.key in store.keys() for case in study.cases)

@@ -1,8 +1,11 @@
 """Trade studies (issue 12): expansion and validation of a study, seeds, the store, resume, failures
 of cases and workers, the outputs and the command line. Studies here are tiny (eigenaxis, a few
 tens of seconds of simulated time) so that the default run stays fast."""
+import contextlib
 import copy
+import json
 import math
+import sqlite3
 from concurrent.futures import Executor, Future, ThreadPoolExecutor
 
 import numpy as np
@@ -13,6 +16,7 @@ import yaml
 import scenarios
 from scenarios import runner
 from scenarios.cli import main
+from scenarios.outputs import claim_output_directory
 from scenarios.store import SweepStore
 from scenarios.study import parse_study
 from scenarios.sweep_engine import sweep
@@ -228,10 +232,24 @@ def test_cli_refuses_a_directory_it_did_not_write_and_a_stored_sweep_without_res
     (tmp_path / "file").write_text("x")
     assert main(["sweep", str(path), "--out", str(tmp_path / "file")]) == 2
     assert (tmp_path / "file").read_text() == "x"
+    marked = claim_output_directory(tmp_path / "marked")  # slewbench's, with a user's database in it
+    with contextlib.closing(sqlite3.connect(marked / "sweep.sqlite")) as db:
+        db.execute("CREATE TABLE mine (x)")
+        db.commit()
+    before = (marked / "sweep.sqlite").read_bytes()
+    assert main(["sweep", str(path), "--out", str(marked), "--resume"]) == 2
+    assert (marked / "sweep.sqlite").read_bytes() == before
+    assert "not a slewbench sweep store" in capsys.readouterr().err
     out = tmp_path / "out"
     assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--no-plots"]) == 0
+    (out / "notes.txt").write_text("mine")
     assert main(["sweep", str(path), "--out", str(out)]) == 2
     assert "pass --resume" in capsys.readouterr().err
+    assert main(["sweep", "--report", str(out)]) == 0
+    manifest = json.loads((out / ".slewbench-output.json").read_text())
+    assert manifest["complete"] and {"cases.csv", "summary.csv", "summary.md", "study.yaml", "sweep.sqlite",
+                                     "plots/pareto.png"} <= set(manifest["files"])
+    assert (out / "notes.txt").read_text() == "mine" and "notes.txt" not in manifest["files"]
 
 
 def test_cli_outputs_summary_statistics_and_report_redraw(tmp_path):
@@ -254,8 +272,8 @@ def test_cli_outputs_summary_statistics_and_report_redraw(tmp_path):
         assert line["count"] == 3 and line["failures"] == 0
         assert line["mean"] == pytest.approx(values.mean()) and line["std"] == pytest.approx(values.std(ddof=1))
         assert line["p95"] == pytest.approx(np.percentile(values, 95)) and line["max"] == pytest.approx(values.max())
-    for name in ("summary.md", "study.yaml", "metrics_vs_maneuver.duration.png", "boxplots.png", "cdf.png",
-                 "pareto.png"):
+    for name in ("summary.md", "study.yaml", "plots/metrics_vs_maneuver.duration.png", "plots/boxplots.png",
+                 "plots/cdf.png", "plots/pareto.png"):
         assert (out / name).stat().st_size > 100, name
     resolved = yaml.safe_load((out / "study.yaml").read_text())
     assert resolved["resolved"]["case_seeds"] == cases.drop_duplicates("case")["seed"].tolist()
