@@ -21,8 +21,9 @@ PARETO_AXES = ("cl.int_u", "cl.settling_time_s")
 
 def _value(row: dict[str, Any], key: str) -> float:
     value = row.get(key)
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-    return float(value) if ok and row.get("status") == "ok" else math.nan
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or row.get("status") != "ok":
+        return math.nan
+    return float(value) if math.isfinite(value) else math.nan
 
 
 def _labels(rows: list[dict[str, Any]]) -> list[str]:
@@ -38,7 +39,7 @@ def _numeric_axes(study: Study, rows: list[dict[str, Any]]) -> list[tuple[str, l
     return axes
 
 
-def _grid(count: int) -> tuple[plt.Figure, np.ndarray]:
+def _grid(count: int) -> tuple[plt.Figure, Any]:
     cols = min(count, 3)
     fig, axes = plt.subplots(math.ceil(count / cols), cols, figsize=(5 * cols, 3.8 * math.ceil(count / cols)),
                              squeeze=False)
@@ -152,9 +153,8 @@ def _pareto(study: Study, rows: list[dict[str, Any]], directory: Path) -> list[s
         points = np.array([[_value(r, x_key), _value(r, y_key)] for r in rows if r["label"] == label])
         if not np.isfinite(points).all(axis=1).any():
             continue
-        scatter = axis.scatter(points[:, 0], points[:, 1], s=10, alpha=0.4, label=label)
-        front = pareto_front(points)
-        axis.step(front[:, 0], front[:, 1], where="post", color=scatter.get_facecolor()[0][:3], lw=1.5)
+        line, = axis.step(*pareto_front(points).T, where="post", lw=1.5)
+        axis.scatter(points[:, 0], points[:, 1], s=10, alpha=0.4, color=line.get_color(), label=label)
     axis.set_xlabel(f"{x_key} (N m s)")
     axis.set_ylabel(f"{y_key} (s)")
     axis.set_title(f"{study.name}: cases and Pareto front per planner")

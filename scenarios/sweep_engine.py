@@ -74,7 +74,7 @@ def _local_pool(workers: int) -> ProcessPoolExecutor:
     return ProcessPoolExecutor(max_workers=workers, mp_context=context)
 
 
-def _kill_pool(pool: ProcessPoolExecutor) -> None:
+def _kill_pool(pool: Executor) -> None:
     """Stop a local pool now, including a worker stuck in C code (it cannot be interrupted)."""
     for process in list(getattr(pool, "_processes", {}).values()):  # private, stable since 3.8
         if process.is_alive():
@@ -90,7 +90,7 @@ class _Engine:
         self.study, self.store, self.task = study, store, task
         self.owned = executor is None
         self.workers = workers
-        self.executor = _local_pool(workers) if self.owned else executor
+        self.executor: Executor = _local_pool(workers) if executor is None else executor
         self.timeout = study.execution.case_timeout_s
         self.records: dict[str, dict[str, Any]] = dict(store.records()) if store is not None else {}
         self.cases: dict[str, Case] = {}

@@ -305,3 +305,15 @@ def test_readme_study_and_example_studies_are_valid():
     for name, count in (("study_spin_weight_sample_time", 20), ("study_planners_vs_slew_angle", 7),
                         ("study_spin_monte_carlo", 1000)):
         assert len(scenarios.load_study(root / "scenarios" / f"{name}.yaml").cases) == count
+
+
+def test_pareto_front_is_the_set_of_non_dominated_points(rng):
+    from scenarios.study_plots import pareto_front
+    points = rng.random((200, 2))
+    points[::17] = np.nan  # failed cases are left out
+    finite = points[np.isfinite(points).all(axis=1)]
+    dominated = [any((q <= p).all() and (q < p).any() for q in finite) for p in finite]
+    expected = finite[~np.array(dominated)]
+    front = pareto_front(points)
+    assert sorted(map(tuple, front)) == sorted(map(tuple, expected))
+    assert np.all(np.diff(front[:, 0]) > 0) and np.all(np.diff(front[:, 1]) < 0)
