@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ocp import quat
+from ocp import METRIC_KEYS, quat
 from scenarios.loader import parse_scenario
 from scenarios.study_dispersions import Dispersion, draw_unit, parse_dispersion
 from scenarios.study_paths import Step, get_path, parse_path, set_path
@@ -27,7 +27,8 @@ from scenarios.yaml_node import Node, ScenarioError, read_yaml
 
 MAX_CASES = 100_000
 MAX_VALUES = 10_000
-DEFAULT_SUMMARY = ("cl.int_u", "cl.final_error_deg", "cl.settling_time_s", "cl.rms_error_deg", "ref.int_u")
+DEFAULT_SUMMARY = tuple(f"{scope}.{key}" for scope in ("ref", "cl") for key in METRIC_KEYS
+                        if key not in ("plan_time_s", "int_abs_u"))  # every scalar metric
 
 
 @dataclass
@@ -278,7 +279,6 @@ def parse_study(data: Any, source: Path | None = None, version: str | None = Non
 
 
 def _check_summary(summary: list[str]) -> None:
-    from ocp import METRIC_KEYS
     for index, metric in enumerate(summary):
         scope, _, key = metric.partition(".")
         base_key = key[:-2] if key[-2:] in ("_x", "_y", "_z") else key
