@@ -141,10 +141,13 @@ class Controller(Configurable, ABC):
         """Digest of everything :meth:`_law` bakes in (class, options, spacecraft, sample time, target)."""
         from ocp.model import _plain  # the model's fingerprint walker
 
+        cache = self.spacecraft._cache  # the spacecraft is frozen: its description is computed once
+        if "description" not in cache:
+            cache["description"] = repr(_plain(self.spacecraft))
         target = None if self.target is None else tuple(None if v is None else _plain(np.asarray(v, dtype=float))
                                                         for v in self.target)
         text = repr((type(self).__module__, type(self).__qualname__, _plain(self.options),
-                     _plain(self.spacecraft), float(self.sample_time), target))
+                     cache["description"], float(self.sample_time), target))
         return hashlib.sha256(text.encode()).hexdigest()
 
     def symbolic_law(self) -> SymbolicLaw:

@@ -232,10 +232,11 @@ class Simulator:
         reason = getattr(controller, "symbolic_error", None)
         return reason is not None and reason() is None
 
-    def closed_loop_function(self, controller: Any, noise: SensorNoise, n_samples: int) -> tuple[ca.Function, Array, str]:
-        """The run of ``n_samples`` of a reset symbolic ``controller`` as one function, its initial
-        controller state and how it is evaluated (``"interpreted"`` or ``"compiled"``); builds are
-        kept per law (``SymbolicLaw.key``), noise shape and sample count."""
+    def closed_loop_function(self, controller: Any, noise: SensorNoise, n_samples: int
+                             ) -> tuple[ClosedLoop, BufferedFunction, str]:
+        """The run of ``n_samples`` of a reset symbolic ``controller`` as one function: the loop's
+        builder, the function, and how it is evaluated (``"interpreted"`` or ``"compiled"``).
+        Builds are kept per law (:meth:`symbolic_key`), noise shape and sample count."""
         loop_key = (controller.symbolic_key(), noise.attitude_std > 0, noise.rate_std > 0)
         if loop_key not in self._loops:
             if len(self._loops) >= self.MAX_BUILDS:
@@ -255,27 +256,29 @@ class Simulator:
         run_key = loop_key + (n_samples,)
         if run_key not in self._runs:
             self._runs[run_key] = loop.run_function(sample, n_samples)
-        return self._runs[run_key], np.asarray(controller.state_vector(), dtype=float), path
+        return loop, self._runs[run_key], path
 
     def _run_symbolic(self, controller: Any, x0: Array, times: Array, p: Array, noise: SensorNoise,
                       rng: np.random.Generator, reference: Any) -> SimulationResult:
         n_samples = times.size - 1
-        run, z0, path = self.closed_loop_function(controller, noise, n_samples)
-        loop = self._loops[(controller.symbolic_key(), noise.attitude_std > 0, noise.rate_std > 0)][0]
+        loop, run, path = self.closed_loop_function(controller, noise, n_samples)
         rows = None
         if loop.shape.uses_reference:
             grid = times[:-1]
             rows = np.hstack([controller.reference_rows(reference, grid),
                               controller.reference_rows(reference, grid + self.sample_time)])
-        has_noise = noise.attitude_std > 0 or noise.rate_std > 0
-        drawn = draw_noise(rng, n_samples, noise.attitude_std, noise.rate_std) if has_noise else np.zeros((1, 6))
-        xz, commanded, applied, saturated = ClosedLoop.evaluate(run, np.concatenate([x0, z0]), times, drawn, rows, p)
-        nx = self.model.nx
-        states = np.vstack([x0[None, :], xz[:, :nx]])
-        finite = np.all(np.isfinite(states), axis=1)
+        drawn = None
+        if noise.attitude_std > 0 or noise.rate_std > 0:
+            drawn = draw_noise(rng, n_samples, noise.attitude_std, noise.rate_std)
+        z0 = np.asarray(controller.state_vector(), dtype=float)
+        xz, commanded, applied, saturated, torque = loop.evaluate(run, np.concatenate([x0, z0]), times, drawn, rows, p)
+        states = np.empty((n_samples + 1, self.model.nx))
+        states[0], states[1:] = x0, xz[:, :self.model.nx]
+        finite = np.isfinite(states).all(axis=1)
         if not finite.all():
             raise SimulationError(self._divergence(times, int(np.argmin(finite)) - 1))
-        return self._result(times, states, commanded, applied, saturated.astype(bool), path)
+        return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, torque,
+                                saturated.astype(bool), path)
 
     def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator) -> Measurement:
         q, omega = x[0:4], x[4:7]

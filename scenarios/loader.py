@@ -49,6 +49,8 @@ class SimulationSpec:
     integrator: str = "rk4"
     max_step: float = 0.05
     settling_tolerance_deg: float = 0.5
+    compile: bool = False
+    """Build the closed loop of a symbolic law as C (``ocp.compiled``); interpreted otherwise."""
 
 
 @dataclass
@@ -235,6 +237,7 @@ def parse_simulation(node: Node) -> SimulationSpec:
         integrator=node.get("integrator", "rk4").string(("rk4", "cvodes")),
         max_step=node.get("max_step", 0.05).number(positive=True),
         settling_tolerance_deg=node.get("settling_tolerance_deg", 0.5).number(positive=True),
+        compile=node.get("compile", False).boolean(),
     )
     noise.finish()
     node.finish()
