@@ -10,7 +10,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import linprog
 
 Array = NDArray[np.float64]
 
@@ -194,6 +193,8 @@ class Spacecraft:
         return self._cache["torque_limit"].copy()
 
     def _wheel_box(self) -> Array:
+        from scipy.optimize import linprog  # lazily: scipy.optimize dominates the import of slewbench
+
         axes = self.wheels.axes[:, self.wheels.working]
         g_max = self.wheels.max_torque[self.wheels.working]
         if np.all(np.isinf(g_max)):

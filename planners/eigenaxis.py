@@ -16,10 +16,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Annotated, Literal
 
+import casadi as ca
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
-from ocp import quat
+from ocp import quat, quat_casadi
 from ocp.options import Range
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference,
                            ReferenceSample, inverse_dynamics_torque)
@@ -29,6 +29,10 @@ class AngleProfile:
     """θ(t), θ̇(t), θ̈(t) of a rotation about a fixed axis."""
 
     def __call__(self, t: Array) -> tuple[Array, Array, Array]:
+        raise NotImplementedError
+
+    def symbolic(self, t: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX]:
+        """The same three on a CasADi scalar ``t``."""
         raise NotImplementedError
 
 
@@ -47,6 +51,15 @@ class QuinticProfile(AngleProfile):
 
     def __call__(self, t: Array) -> tuple[Array, Array, Array]:
         return self.position(t), self.rate(t), self.acceleration(t)
+
+    def symbolic(self, t: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX]:
+        def horner(polynomial: np.polynomial.Polynomial) -> ca.SX:
+            value = ca.SX(0.0)
+            for coefficient in polynomial.coef[::-1]:
+                value = value * t + float(coefficient)
+            return value
+
+        return horner(self.position), horner(self.rate), horner(self.acceleration)
 
 
 class BangCoastBangProfile(AngleProfile):
@@ -70,6 +83,16 @@ class BangCoastBangProfile(AngleProfile):
         acceleration = np.where(accelerating, a, np.where(decelerating, -a, 0.0))
         return position, rate, acceleration
 
+    def symbolic(self, t: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX]:
+        a, w, ramp = self.alpha, self.rate_max, self.ramp
+        late = ca.fmax(self.duration - t, 0.0)
+        accelerating, decelerating = t < ramp, t > ramp + self.coast
+        position = ca.if_else(accelerating, 0.5 * a * t**2, ca.if_else(
+            decelerating, self.angle - 0.5 * a * late**2, 0.5 * a * ramp**2 + w * (t - ramp)))
+        rate = ca.if_else(accelerating, a * t, ca.if_else(decelerating, a * late, w))
+        acceleration = ca.if_else(accelerating, a, ca.if_else(decelerating, -a, 0.0))
+        return position, rate, acceleration
+
 
 class EigenaxisReference(Reference):
     """``q(t) = q0 ⊗ [cos θ/2, e sin θ/2]``, ``ω = e θ̇`` (body axes)."""
@@ -85,11 +108,21 @@ class EigenaxisReference(Reference):
         omega_dot = acceleration[:, None] * self.axis
         return ReferenceSample(q, omega, omega_dot, inverse_dynamics_torque(self.inertia, omega, omega_dot))
 
+    def symbolic_evaluator(self) -> ca.Function:
+        t = ca.SX.sym("t")
+        angle, rate, acceleration = self.profile.symbolic(ca.fmin(ca.fmax(t, 0.0), self.duration))
+        axis, inertia = ca.DM(self.axis), ca.DM(self.inertia)
+        q = quat_casadi.product(ca.DM(self.q0), quat_casadi.from_axis_angle(axis, angle))
+        omega, omega_dot = rate * axis, acceleration * axis
+        torque = ca.mtimes(inertia, omega_dot) + ca.cross(omega, ca.mtimes(inertia, omega))
+        return ca.Function("reference", [t], [ca.vertcat(q, omega, omega_dot, torque)], ["t"], ["row"])
+
 
 class EigenaxisPlanner(Planner):
     """Eigenaxis slew planner; see the module docstring for the profiles."""
 
     name = "eigenaxis"
+    closed_form = True
 
     @dataclass(frozen=True)
     class Options:
@@ -139,6 +172,8 @@ class EigenaxisPlanner(Planner):
 
         # With no gyroscopic term the optimum is the triangle w = sqrt(Θ α); else a bounded 1-D search.
         peak = np.sqrt(angle * acceleration(0.0))
+        from scipy.optimize import brentq, minimize_scalar  # lazily: scipy.optimize is slow to import
+
         if np.all(gyro == 0) or not np.isfinite(rate_cap):
             best_rate = min(peak, rate_cap)
         else:
