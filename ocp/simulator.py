@@ -7,7 +7,10 @@ RK4 map with sub-steps, or CVODES); the quaternion is then re-normalised.
 
 Controllers are duck-typed (see ``controllers.base.Controller``): ``reset(spacecraft,
 sample_time, target=None)`` and ``__call__(t, measurement, reference) -> Command``.
-A reference, if given, is passed through to the controller untouched.
+A reference, if given, is passed to the controller as a :class:`GridSampledReference`: the same
+object as far as the controller can tell (every attribute is the reference's), whose ``sample``
+answers the sample instants ``t_k`` and ``t_k + T_s`` from one vectorised evaluation made before
+the loop, and any other time from the reference itself.
 
 Two paths compute the same numbers (to rounding; ``tests/test_closed_loop.py``):
 
@@ -44,6 +47,37 @@ SUBSTEPS_PER_SAMPLE = 20
 """A run may integrate at most this many RK4 sub-steps per allowed sample (``max_samples``)."""
 MAX_SUBSTEPS = 1000
 """Bound on RK4 sub-steps per sample (the step is one unrolled CasADi graph)."""
+
+
+class GridSampledReference:
+    """``reference`` with its samples at ``times`` computed once (vectorised) and served by
+    :meth:`sample`; other times and every other attribute go to ``reference`` itself.
+
+    Parameters
+    ----------
+    reference : anything with a vectorised ``sample(t)`` returning a named tuple of arrays.
+    times : s, the times to precompute.
+    """
+
+    def __init__(self, reference: Any, times: Array):
+        self.reference = reference
+        times = np.unique(np.asarray(times, dtype=float))
+        self._table = reference.sample(times)
+        self._index = {float(value): i for i, value in enumerate(times)}
+
+    def sample(self, t: ArrayLike) -> Any:
+        """The reference at ``t`` (scalar or array), as ``reference.sample`` returns it."""
+        index = self._index
+        if np.ndim(t) == 0:
+            i = index.get(float(t))
+            return self.reference.sample(t) if i is None else type(self._table)(*(a[i] for a in self._table))
+        rows = [index.get(float(value)) for value in np.ravel(t)]
+        if None in rows:
+            return self.reference.sample(t)
+        return type(self._table)(*(a[rows] for a in self._table))
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.reference, name)
 
 
 class SimulationError(RuntimeError):
@@ -228,6 +262,8 @@ class Simulator:
         controller.reset(model.spacecraft, self.sample_time, target=target)
         if self._symbolic(controller):
             return self._run_symbolic(controller, x, times, p, noise, rng, reference)
+        if reference is not None and hasattr(reference, "sample"):
+            reference = GridSampledReference(reference, np.concatenate([times, times[:-1] + self.sample_time]))
 
         states = np.empty((n_samples + 1, model.nx))
         commanded = np.zeros((n_samples, model.nu))
