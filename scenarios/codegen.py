@@ -28,7 +28,12 @@ from controllers import CONTROLLERS
 from ocp.layout import REFERENCE_FIELDS, control_layout
 from planners import PLANNERS
 from scenarios.loader import Scenario
-from scenarios.outputs import STAGING_PREFIX, claim_output_directory, commit_outputs, row_stems
+from scenarios.outputs import (
+    STAGING_PREFIX,
+    claim_output_directory,
+    commit_outputs,
+    row_stems,
+)
 from scenarios.yaml_node import ScenarioError
 
 

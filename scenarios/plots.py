@@ -51,7 +51,10 @@ class RowFigure:
         self.figure = Figure(figsize=(9, 13 if n_wheels else 10.5))
         axes = self.figure.subplots(5 if n_wheels else 4, 1, sharex=True)
         self.axes = axes
-        line = lambda axis, style="-", **kw: axis.plot([], [], style, **kw)[0]  # noqa: E731
+
+        def line(axis: Any, style: str = "-", **kw: Any) -> Any:
+            return axis.plot([], [], style, **kw)[0]
+
         self.torque = [line(axes[0], color=AXIS_COLORS[i], drawstyle="steps-post", label=f"u_{'xyz'[i]}")
                        for i in range(3)]
         self.rate = [line(axes[1], color=AXIS_COLORS[i], label=f"ω_{'xyz'[i]}") for i in range(3)]

@@ -7,7 +7,16 @@ import pytest
 
 import ocp.compiled
 from controllers import CONTROLLERS
-from ocp import AttitudeModel, ReactionWheels, SensorNoise, SimulationError, Simulator, Spacecraft, Torquers, quat
+from ocp import (
+    AttitudeModel,
+    ReactionWheels,
+    SensorNoise,
+    SimulationError,
+    Simulator,
+    Spacecraft,
+    Torquers,
+    quat,
+)
 from planners import PLANNERS
 from scenarios.loader import load
 
