@@ -143,7 +143,7 @@ class ClosedLoop:
         """Run the accumulated function: states ``[x; z]`` after each sample (N, nx + nz),
         commanded and applied controls (N, nu), saturation flags (N,) and actuator torques (N, 3)."""
         n = times.size - 1
-        args = [xz0, times[:-1], np.diff(times)]
+        args = [xz0, times[:-1], times[1:] - times[:-1]]
         if self.shape.attitude_noise or self.shape.rate_noise:
             args.append(noise.ravel())  # (N, 6) row-major is the (6, N) column-major input
         if self.shape.uses_reference:

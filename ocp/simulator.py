@@ -161,7 +161,9 @@ class Simulator:
     """
 
     MAX_BUILDS = 16
-    """Closed-loop builds kept per simulator (one per law and noise shape, then per sample count)."""
+    """Closed-loop builds kept per simulator (one per law and noise shape)."""
+    CHUNK = 1000
+    """Samples per accumulated call of the closed-loop function (its build unrolls them)."""
 
     def __init__(
         self,
@@ -200,7 +202,7 @@ class Simulator:
         self.compile = compile
         self.python_loop = python_loop
         self._loops: dict[Any, tuple[ClosedLoop, ca.Function, str]] = {}
-        self._runs: dict[Any, ca.Function] = {}
+        self._runs: dict[Any, BufferedFunction] = {}
 
     def _build_step(self, integrator: str, substeps: int, rtol: float, atol: float) -> ca.Function:
         """``step(x, u, t, dt, p) -> x_next``: one hold interval of length ``dt`` starting at ``t``."""
@@ -303,11 +305,10 @@ class Simulator:
         reason = getattr(controller, "symbolic_error", None)
         return reason is not None and reason() is None
 
-    def closed_loop_function(self, controller: Any, noise: SensorNoise, n_samples: int
-                             ) -> tuple[ClosedLoop, BufferedFunction, str]:
-        """The run of ``n_samples`` of a reset symbolic ``controller`` as one function: the loop's
-        builder, the function, and how it is evaluated (``"interpreted"`` or ``"compiled"``).
-        Builds are kept per law (:meth:`symbolic_key`), noise shape and sample count."""
+    def closed_loop_function(self, controller: Any, noise: SensorNoise) -> tuple[ClosedLoop, ca.Function, str]:
+        """The one-sample closed-loop function of a reset symbolic ``controller``: its builder, the
+        function (interpreted, or the compiled twin) and how it is evaluated (``"interpreted"`` or
+        ``"compiled"``). Builds are kept per law (:meth:`symbolic_key`) and noise shape."""
         loop_key = (controller.symbolic_key(), noise.attitude_std > 0, noise.rate_std > 0)
         if loop_key not in self._loops:
             if len(self._loops) >= self.MAX_BUILDS:
@@ -323,16 +324,20 @@ class Simulator:
                 except CompilerUnavailable as error:
                     notice(f"{error}; the closed loop runs interpreted")
             self._loops[loop_key] = (loop, sample, path)
-        loop, sample, path = self._loops[loop_key]
-        run_key = loop_key + (n_samples,)
-        if run_key not in self._runs:
-            self._runs[run_key] = loop.run_function(sample, n_samples)
-        return loop, self._runs[run_key], path
+        return self._loops[loop_key]
+
+    def _chunk_function(self, loop: ClosedLoop, sample: ca.Function, size: int) -> BufferedFunction:
+        """``sample`` accumulated over ``size`` samples (``mapaccum`` unrolls its calls, so long runs
+        go in chunks of at most :attr:`CHUNK` samples)."""
+        key = (id(loop), size)
+        if key not in self._runs:
+            self._runs[key] = loop.run_function(sample, size)
+        return self._runs[key]
 
     def _run_symbolic(self, controller: Any, x0: Array, times: Array, p: Array, noise: SensorNoise,
                       rng: np.random.Generator, reference: Any) -> SimulationResult:
         n_samples = times.size - 1
-        loop, run, path = self.closed_loop_function(controller, noise, n_samples)
+        loop, sample, path = self.closed_loop_function(controller, noise)
         rows = None
         if loop.shape.uses_reference:
             grid = times[:-1]
@@ -341,10 +346,22 @@ class Simulator:
         drawn = None
         if noise.attitude_std > 0 or noise.rate_std > 0:
             drawn = draw_noise(rng, n_samples, noise.attitude_std, noise.rate_std)
-        z0 = np.asarray(controller.state_vector(), dtype=float)
-        xz, commanded, applied, saturated, torque = loop.evaluate(run, np.concatenate([x0, z0]), times, drawn, rows, p)
-        states = np.empty((n_samples + 1, self.model.nx))
-        states[0], states[1:] = x0, xz[:, :self.model.nx]
+        nx, nu = self.model.nx, self.model.nu
+        xz = np.concatenate([x0, np.asarray(controller.state_vector(), dtype=float)])
+        states = np.empty((n_samples + 1, nx))
+        commanded, applied = np.empty((n_samples, nu)), np.empty((n_samples, nu))
+        saturated, torque = np.empty(n_samples), np.empty((n_samples, 3))
+        states[0] = x0
+        for start in range(0, n_samples, self.CHUNK):
+            stop = min(start + self.CHUNK, n_samples)
+            run = self._chunk_function(loop, sample, stop - start)
+            chunk = loop.evaluate(run, xz, times[start:stop + 1], None if drawn is None else drawn[start:stop],
+                                  None if rows is None else rows[start:stop], p)
+            states[start + 1:stop + 1] = chunk[0][:, :nx]
+            commanded[start:stop], applied[start:stop], saturated[start:stop], torque[start:stop] = chunk[1:]
+            xz = chunk[0][-1]
+            if not np.all(np.isfinite(xz)):
+                break
         finite = np.isfinite(states).all(axis=1)
         if not finite.all():
             raise SimulationError(self._divergence(times, int(np.argmin(finite)) - 1))
