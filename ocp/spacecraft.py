@@ -193,8 +193,6 @@ class Spacecraft:
         return self._cache["torque_limit"].copy()
 
     def _wheel_box(self) -> Array:
-        from scipy.optimize import linprog  # lazily: scipy.optimize dominates the import of slewbench
-
         axes = self.wheels.axes[:, self.wheels.working]
         g_max = self.wheels.max_torque[self.wheels.working]
         if np.all(np.isinf(g_max)):
@@ -203,6 +201,14 @@ class Spacecraft:
         reachable = np.linalg.norm(axes @ pinv - np.eye(3), axis=0) < 1e-9
         finite = np.isfinite(g_max)
         demand = np.abs(pinv[finite]) * reachable
+        significant = demand > 1e-12 * max(float(demand.max(initial=0.0)), 1e-300)
+        if np.all(significant.sum(axis=1) <= 1):
+            # Each wheel drives one body axis (e.g. wheels along the body axes): the programme
+            # decouples and each axis gets the bound of its tightest wheel.
+            ratios = np.where(significant, g_max[finite][:, None] / np.where(significant, demand, 1.0), np.inf)
+            return np.where(reachable, ratios.min(axis=0, initial=np.inf), 0.0)
+        from scipy.optimize import linprog  # lazily: scipy.optimize dominates the import of slewbench
+
         # Lexicographic: first the largest bound common to every reachable axis, then the
         # largest sum with no axis below it, so that no axis is sacrificed for the others.
         n_reach = int(reachable.sum())

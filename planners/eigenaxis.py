@@ -14,7 +14,7 @@ acceleration ``α`` is chosen with the coast rate ``w`` such that every axis res
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Literal
+from typing import Annotated, Callable, Literal
 
 import casadi as ca
 import numpy as np
@@ -23,6 +23,41 @@ from ocp import quat, quat_casadi
 from ocp.options import Range
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference,
                            ReferenceSample, inverse_dynamics_torque)
+
+
+def golden_section_minimum(function: Callable[[float], float], low: float, high: float, tolerance: float) -> float:
+    """Minimiser of a unimodal ``function`` on ``[low, high]`` to ``tolerance`` (golden section; 1-D
+    searches here are too small to pay for importing scipy.optimize, which costs more than a run)."""
+    ratio = 0.5 * (np.sqrt(5.0) - 1.0)
+    a, b = low, high
+    c, d = b - ratio * (b - a), a + ratio * (b - a)
+    fc, fd = function(c), function(d)
+    for _ in range(300):
+        if b - a <= tolerance:
+            break
+        if fc <= fd:
+            b, d, fd = d, c, fc
+            c = b - ratio * (b - a)
+            fc = function(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + ratio * (b - a)
+            fd = function(d)
+    return 0.5 * (a + b)
+
+
+def bisection_root(function: Callable[[float], float], low: float, high: float, tolerance: float) -> float:
+    """Root of ``function`` with ``function(low) < 0 < function(high)``, to ``tolerance`` (absolute)
+    plus four ulps of the bracket."""
+    for _ in range(400):
+        middle = 0.5 * (low + high)
+        if high - low <= tolerance + 4 * np.finfo(float).eps * abs(high):
+            break
+        if function(middle) > 0:
+            high = middle
+        else:
+            low = middle
+    return 0.5 * (low + high)
 
 
 class AngleProfile:
@@ -172,14 +207,10 @@ class EigenaxisPlanner(Planner):
 
         # With no gyroscopic term the optimum is the triangle w = sqrt(Θ α); else a bounded 1-D search.
         peak = np.sqrt(angle * acceleration(0.0))
-        from scipy.optimize import brentq, minimize_scalar  # lazily: scipy.optimize is slow to import
-
         if np.all(gyro == 0) or not np.isfinite(rate_cap):
             best_rate = min(peak, rate_cap)
         else:
-            found = minimize_scalar(slew_time, bounds=(1e-9 * peak, min(peak, rate_cap)), method="bounded",
-                                    options={"xatol": 1e-12 * peak})
-            best_rate = float(found.x)
+            best_rate = golden_section_minimum(slew_time, 1e-9 * peak, min(peak, rate_cap), 1e-12 * peak)
         best_rate = min(best_rate, np.sqrt(angle * acceleration(best_rate)))  # a triangle never coasts faster
         minimum_time = slew_time(best_rate)
         if self.options.profile == "min_time":
@@ -194,7 +225,7 @@ class EigenaxisPlanner(Planner):
             alpha = acceleration(w)
             return w * (problem.duration - w / alpha) - angle if alpha > 0 else -angle
 
-        coast_rate = brentq(covered, 1e-15, best_rate, xtol=1e-15) if covered(best_rate) > 0 else best_rate
+        coast_rate = bisection_root(covered, 1e-15, best_rate, 1e-15) if covered(best_rate) > 0 else best_rate
         profile = BangCoastBangProfile(angle, acceleration(coast_rate), coast_rate)
         profile.coast = problem.duration - 2 * profile.ramp  # exact T despite root tolerance
         profile.duration = problem.duration

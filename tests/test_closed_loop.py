@@ -117,3 +117,18 @@ def test_divergence_of_a_symbolic_loop_is_reported():
     simulator = Simulator(AttitudeModel(spacecraft), 1.0)
     with pytest.raises(SimulationError, match="non-finite"):
         simulator.run(controller, np.r_[1, 0, 0, 0, 0.1, 0, 0], 100.0, target=(quat.IDENTITY, None))
+
+
+def test_grid_sampled_reference_is_the_reference(rng):
+    from ocp.simulator import GridSampledReference
+    from planners import ManeuverProblem
+
+    problem = ManeuverProblem(Spacecraft([2.0, 3.0, 4.0]), quat.IDENTITY, np.zeros(3), quat.random_unit(rng), 30.0)
+    reference = PLANNERS["eigenaxis"]().plan(problem)
+    grid = np.arange(31) * 1.0
+    served = GridSampledReference(reference, grid)
+    assert served.duration == reference.duration and served.planner == "eigenaxis"
+    for t in (3.0, np.array([4.0, 5.0]), 2.5, np.array([1.0, 1.5])):  # on and off the grid
+        for got, expected in zip(served.sample(t), reference.sample(t)):
+            assert np.shape(got) == np.shape(expected)
+            np.testing.assert_allclose(got, expected, rtol=0, atol=1e-15)
