@@ -90,6 +90,9 @@ class _Engine:
         self.study, self.store, self.task = study, store, task
         self.owned = executor is None
         self.workers = workers
+        # a local pool gets one case ahead of its workers, so that none idles while the driver stores a
+        # result; other executors get one case per worker, so that a case's clock starts when it runs
+        self.window = workers + 1 if self.owned else workers
         self.executor: Executor = _local_pool(workers) if executor is None else executor
         self.timeout = study.execution.case_timeout_s
         self.records: dict[str, dict[str, Any]] = dict(store.records()) if store is not None else {}
@@ -154,7 +157,7 @@ class _Engine:
             if not self.in_flight:
                 self._submit(self.suspects.popleft())
             return
-        while self.pending and len(self.in_flight) < self.workers:
+        while self.pending and len(self.in_flight) < self.window:
             self._submit(self.pending.popleft())
 
     def _collect(self, done: set[Future]) -> None:
@@ -178,10 +181,14 @@ class _Engine:
             self._died(broken + self._restart_pool(), "its process ended abruptly")
 
     def _check_time(self) -> None:
+        """Cases past the driver's limit (a worker stuck where the in-worker alarm cannot reach).
+        On a local pool only the oldest is charged (the others may have waited behind it); the
+        pool is restarted and the others run again."""
         limit = self.timeout * _TIMEOUT_GRACE + 5.0
         now = time.monotonic()
-        late = [(future, key) for future, (key, start) in self.in_flight.items() if now - start > limit]
-        for future, key in late:
+        late = sorted(((start, key, future) for future, (key, start) in self.in_flight.items()
+                       if now - start > limit), key=lambda item: item[0])
+        for _, key, future in late[:1] if self.owned else late:
             self.in_flight.pop(future)
             future.cancel()
             self._finish(key, "crashed", crashed_rows(
