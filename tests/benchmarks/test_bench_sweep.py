@@ -49,7 +49,7 @@ def warm_forkserver(tmp: Path) -> None:
 
 
 def test_sweep_overhead_per_case(benchmark, tmp_path):
-    n, rounds = 6, 3
+    n, rounds = 40, 3  # enough cases that a fresh worker's first-case builds are spread out
     warm_forkserver(tmp_path / "warm")
     in_process(demo_study(1, 999))  # warm CasADi in this process
     direct, swept = [], []
@@ -65,7 +65,7 @@ def test_sweep_overhead_per_case(benchmark, tmp_path):
 
 
 def test_two_workers_throughput(benchmark, tmp_path):
-    n, rounds = 8, 3
+    n, rounds = 40, 3
     warm_forkserver(tmp_path / "warm")
     one, two = [], []
     for r in range(rounds):
