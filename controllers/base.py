@@ -36,6 +36,11 @@ class Controller(Configurable, ABC):
       ``reference`` is a ``planners.Reference`` or ``None`` (regulation to the target).
     * ``needs_reference``: the law cannot regulate (``reference=None``) and raises ``ValueError``
       there; the scenario loader rejects regulation mode for it.
+    * ``needs_target_attitude``: in regulation mode the law needs ``maneuver.final.q``. Laws that
+      regulate the rate alone (detumbling: ``bdot``, ``tdfc``; ``none``) set it to ``False`` and
+      then accept a free final attitude (``q: null``).
+    * ``needs_field_rate``: the law reads ``measurement.field_rate_inertial`` (ḃ_I, T/s), which
+      the simulator then provides (only the ideal B-dot does; a real spacecraft cannot).
     * ``planner_error(name, options)`` says why the law cannot track references of that planner
       (``None`` if it can); the scenario loader reports it. Most laws track any reference.
     * Saturation is the simulator's actuator model's job, not the controller's.
@@ -44,6 +49,8 @@ class Controller(Configurable, ABC):
     hold_compensation: bool = True
     """Correct the held gyroscopic term to mid-sample in :meth:`allocate`."""
     needs_reference: bool = False
+    needs_target_attitude: bool = True
+    needs_field_rate: bool = False
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
         super().__init__(options, path)

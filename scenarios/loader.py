@@ -32,8 +32,16 @@ class PlannerSpec:
 
 @dataclass
 class ControllerSpec:
+    """One controller: registry ``name``, parsed ``options`` and table ``label`` (default: the
+    name); ``path`` is its YAML entry (``controller`` or ``controllers[i]``), for messages."""
+
     name: str
     options: Any
+    label: str = ""
+    path: str = "controller"
+
+    def __post_init__(self) -> None:
+        self.label = self.label or self.name
 
 
 @dataclass
@@ -58,9 +66,14 @@ class Scenario:
     name: str
     problem: ManeuverProblem
     planners: list[PlannerSpec]
-    controller: ControllerSpec
+    controllers: list[ControllerSpec]
     simulation: SimulationSpec
     source: Path | None = None
+
+    @property
+    def controller(self) -> ControllerSpec:
+        """The first (or only) controller, for code written before ``controllers`` lists."""
+        return self.controllers[0]
 
     @property
     def true_initial_state(self) -> np.ndarray:
@@ -214,8 +227,28 @@ def parse_planners(node: Node) -> list[PlannerSpec]:
 
 def parse_controller(node: Node) -> ControllerSpec:
     name, options = _registered(node.mapping(), CONTROLLERS, "controller")
+    label = node.get("label", name).string()
     node.finish()
-    return ControllerSpec(name, options)
+    return ControllerSpec(name, options, label, node.path)
+
+
+def parse_controllers(root: Node) -> list[ControllerSpec]:
+    """``controller:`` (one) or ``controllers:`` (a non-empty list, labels unique)."""
+    if "controller" in root and "controllers" in root:
+        raise ScenarioError("controllers", "give either `controller` (one) or `controllers` (a list), not both")
+    if "controllers" not in root:
+        return [parse_controller(root.get("controller", required=True))]
+    node = root.get("controllers")
+    root.get("controller", None)  # an explicit `controller: null` next to the list is accepted
+    specs = [parse_controller(item) for item in node.items()]
+    if not specs:
+        raise ScenarioError("controllers", "expected at least one controller")
+    labels: set[str] = set()
+    for spec in specs:
+        if spec.label in labels:
+            raise ScenarioError(f"{spec.path}.label", f"duplicate label {spec.label!r}; give each controller its own label")
+        labels.add(spec.label)
+    return specs
 
 
 def parse_simulation(node: Node) -> SimulationSpec:
@@ -242,21 +275,27 @@ def parse_simulation(node: Node) -> SimulationSpec:
 
 
 def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
-                        controller: ControllerSpec) -> None:
-    """What each planner and the controller say they cannot take, reported at their YAML entries."""
+                        controllers: list[ControllerSpec] | ControllerSpec) -> None:
+    """What each planner and controller say they cannot take, reported at their YAML entries."""
+    if isinstance(controllers, ControllerSpec):
+        controllers = [controllers]
     for index, spec in enumerate(planners):
         error = PLANNERS[spec.name](spec.options).problem_error(problem)
         if error:
             raise ScenarioError(f"planners[{index}]", error)
-    if not planners and problem.qf is None:
-        raise ScenarioError("maneuver.final.q", "regulation (no planners) needs a target attitude")
-    law = CONTROLLERS[controller.name](controller.options)
-    if not planners and law.needs_reference:
-        raise ScenarioError("controller.name", f"controller {controller.name} tracks a reference; give planners")
-    for index, spec in enumerate(planners):
-        error = law.planner_error(spec.name, spec.options)
-        if error:
-            raise ScenarioError("controller.name", f"{error} (planners[{index}] is {spec.name!r})")
+    for controller in controllers:
+        law = CONTROLLERS[controller.name](controller.options)
+        where = f"{controller.path}.name"
+        if not planners and problem.qf is None and law.needs_target_attitude:
+            raise ScenarioError("maneuver.final.q", f"regulation (no planners) with controller {controller.name!r} "
+                                "needs a target attitude; only laws that need none (e.g. bdot, tdfc, none) "
+                                "accept a free final attitude")
+        if not planners and law.needs_reference:
+            raise ScenarioError(where, f"controller {controller.name} tracks a reference; give planners")
+        for index, spec in enumerate(planners):
+            error = law.planner_error(spec.name, spec.options)
+            if error:
+                raise ScenarioError(where, f"{error} (planners[{index}] is {spec.name!r})")
 
 
 def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
@@ -267,11 +306,11 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     environment = parse_environment(root.get("orbit", None), root.get("environment", {}))
     problem = parse_problem(root.get("maneuver", required=True), spacecraft, environment)
     planners = parse_planners(root.get("planners", required=True))
-    controller = parse_controller(root.get("controller", required=True))
+    controllers = parse_controllers(root)
     simulation = parse_simulation(root.get("simulation", {}))
     root.finish()
-    check_compatibility(problem, planners, controller)
-    return Scenario(name, problem, planners, controller, simulation, source)
+    check_compatibility(problem, planners, controllers)
+    return Scenario(name, problem, planners, controllers, simulation, source)
 
 
 def load(path: str | Path) -> Scenario:
