@@ -43,6 +43,9 @@ class Controller(Configurable, ABC):
       the simulator then provides (only the ideal B-dot does; a real spacecraft cannot).
     * ``planner_error(name, options)`` says why the law cannot track references of that planner
       (``None`` if it can); the scenario loader reports it. Most laws track any reference.
+    * ``environment_error(spacecraft, environment)`` and ``sample_time_error(sample_time)`` say why
+      the law cannot run there (missing actuator or sensor; an option that must fit the sample time);
+      the scenario loader reports them at the controller's entry.
     * Saturation is the simulator's actuator model's job, not the controller's.
     """
 
@@ -60,6 +63,15 @@ class Controller(Configurable, ABC):
 
     def planner_error(self, planner: str, options: Any) -> str | None:
         """Why this law cannot track the references of ``planner`` with ``options``, or ``None``."""
+        return None
+
+    def environment_error(self, spacecraft: Spacecraft, environment: Any) -> str | None:
+        """Why the law cannot run on ``spacecraft`` in ``environment`` (an actuator or a sensor it
+        needs is missing), or ``None``."""
+        return None
+
+    def sample_time_error(self, sample_time: float) -> tuple[str, str] | None:
+        """``(option name, message)`` if an option does not fit the sample time (s), else ``None``."""
         return None
 
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:

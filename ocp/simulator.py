@@ -40,12 +40,15 @@ class ControllerLike(Protocol):
 
 @dataclass(frozen=True)
 class SensorNoise:
-    """Gaussian sensor noise: attitude as a random rotation vector (rad, per axis std), body rate
-    (rad/s, per axis std); ``seed`` makes it repeatable."""
+    """Gaussian sensor noise, white per sample: attitude as a random rotation vector (rad, per axis
+    std), body rate (rad/s, per axis std), magnetometer (T, per body axis std); ``seed`` makes it
+    repeatable. Each sample draws attitude, then rate, then field (only the non-zero ones), so that
+    adding magnetometer noise leaves the attitude and rate noise of a scenario unchanged."""
 
     attitude_std: float = 0.0
     rate_std: float = 0.0
     seed: int = 0
+    field_std: float = 0.0
 
 
 @dataclass
@@ -117,6 +120,8 @@ class Simulator:
         self._step = self._build_step(integrator, substeps, rtol, atol)
         self._step_numeric = BufferedFunction(self._step)
         self._field_numeric = None if model.field_body is None else BufferedFunction(model.field_body)
+        self._field_rate_numeric = (None if model.field_rate_inertial is None
+                                    else BufferedFunction(model.field_rate_inertial))
 
     def _build_step(self, integrator: str, substeps: int, rtol: float, atol: float) -> ca.Function:
         """``step(x, u, t, dt, p) -> x_next``: one hold interval of length ``dt`` starting at ``t``."""
@@ -165,6 +170,11 @@ class Simulator:
         times = np.minimum(np.arange(n_samples + 1) * self.sample_time, duration)
         noise = noise or SensorNoise()
         rng = np.random.default_rng(noise.seed)
+        valid_until = getattr(model.environment.magnetic_field, "valid_until", None)
+        if valid_until is not None and duration > valid_until + 1e-9:
+            raise SimulationError(f"the magnetic field is tabulated up to t = {valid_until:g} s, the run lasts "
+                                  f"{duration:g} s; lengthen environment.magnetic_field.span_s")
+        field_rate = self._field_rate_numeric if getattr(controller, "needs_field_rate", False) else None
         controller.reset(model.spacecraft, self.sample_time, target=target)
 
         states = np.empty((n_samples + 1, model.nx))
@@ -175,6 +185,8 @@ class Simulator:
         for k in range(n_samples):
             t_k = times[k]
             measurement = self._measure(x, t_k, noise, rng)
+            if field_rate is not None:
+                measurement.field_rate_inertial = field_rate(t_k).copy()
             command = controller(t_k, measurement, reference)
             commanded[k] = self._command_vector(command)
             dt = times[k + 1] - t_k
@@ -198,6 +210,8 @@ class Simulator:
         if noise.rate_std > 0:
             omega = omega + rng.normal(0.0, noise.rate_std, 3)
         field = None if self._field_numeric is None else self._field_numeric(x, t).copy()
+        if noise.field_std > 0 and field is not None:  # drawn last: existing noise streams unchanged
+            field += rng.normal(0.0, noise.field_std, 3)
         return Measurement(t=t, q=q, omega=omega.copy(), wheel_momentum=x[7:].copy(), field_body=field)
 
     def _command_vector(self, command: Command) -> Array:

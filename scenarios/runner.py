@@ -102,7 +102,8 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
     row.closed_loop_metrics = metrics_from_simulation(
         result, problem.qf, problem.omegaf, reference=reference, plan_time_s=row.plan_time_s,
         duration_s=reference.duration if reference else None,
-        settling_tolerance_deg=scenario.simulation.settling_tolerance_deg)
+        settling_tolerance_deg=scenario.simulation.settling_tolerance_deg,
+        detumble_tolerance=scenario.simulation.detumble_tolerance)
 
 
 def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
@@ -146,7 +147,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         if reference.ok:
             reference_metrics = metrics_from_reference(
                 reference, scenario.problem.qf, scenario.problem.omegaf,
-                settling_tolerance_deg=spec.settling_tolerance_deg)
+                settling_tolerance_deg=spec.settling_tolerance_deg,
+                inertia=scenario.problem.spacecraft.inertia, detumble_tolerance=spec.detumble_tolerance)
         for controller in controllers:
             label = planner_spec.label if len(controllers) == 1 else f"{planner_spec.label} / {controller.label}"
             row = Row(label, planner_spec.name, reference.status, reference.message,
