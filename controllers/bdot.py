@@ -7,19 +7,24 @@
   ``K_t = K_b / T_s``.
 * ``exact``: ``Ḃ = R(q)ᵀ ḃ_I − ω × B``, the paper's ideal case. It needs the attitude, the rate
   and the inertial field's rate along the orbit (``needs_field_rate``), which a magnetometer-only
-  spacecraft does not have; with it and no saturation the power ``ω·(m × B)`` is
-  ``−K_b |ω × B|²`` up to the orbital term.
+  spacecraft does not have; in a field fixed in inertial space and without saturation its power
+  ``ω·(m × B)`` is ``−K_b |ω × B|²``.
 * ``filtered``: the backward difference through a first-order low-pass filter of time constant
   ``T_f`` (``filter_time_constant``): ``y_k = α y_{k−1} + (1 − α)(B̃_k − B̃_{k−1})/T_s`` with
   ``α = exp(−T_s/T_f)``, the filter at rest (``y = 0``) before the first difference.
 
 The command is the unsaturated ``m``; the actuator model clips it (per axis or scaled).
+Symbolic form: state ``z = [B̃_{k−1} (3), started (1)]``, plus ``y_{k−1}`` (3) when filtered;
+the exact derivative has none (ḃ_I is not in the measurement vector).
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
+
+import casadi as ca
+import numpy as np
 
 from controllers.magnetic import MagneticController, field_components
 from ocp import Command, Measurement
@@ -42,6 +47,12 @@ class BDot(MagneticController):
     @property
     def needs_field_rate(self) -> bool:  # type: ignore[override]
         return self.options.derivative == "exact"
+
+    def symbolic_error(self) -> str | None:
+        if self.options.derivative == "exact":
+            return ("bdot with derivative: exact needs the inertial field rate along the orbit, which is not "
+                    "part of the measurement vector of the symbolic form")
+        return None
 
     def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None:
         super().reset(spacecraft, sample_time, target)
@@ -78,3 +89,24 @@ class BDot(MagneticController):
         k = self.options.gain
         return self.dipole(-k * (rx - (oy * bz - oz * by)), -k * (ry - (oz * bx - ox * bz)),
                            -k * (rz - (ox * by - oy * bx)))
+
+    def state_vector(self) -> np.ndarray:
+        if self.options.derivative == "exact":
+            return np.zeros(0)
+        previous = (0.0, 0.0, 0.0) if self._previous is None else self._previous
+        state = [*previous, 0.0 if self._previous is None else 1.0]
+        if self.options.derivative == "filtered":
+            state += list(self._filtered)
+        return np.array(state)
+
+    def _law(self, t, y, z, r):
+        b = self.symbolic_field(y)
+        previous, started = z[0:3], z[3]
+        difference = b - previous
+        if self.options.derivative == "filtered":
+            filtered = ca.if_else(started, self._alpha * z[4:7] + (1 - self._alpha) * difference, z[4:7])
+            rate, extra = filtered, [filtered]
+        else:
+            rate, extra = difference, []
+        dipole = ca.if_else(started, -self._gain_per_sample * rate, ca.DM.zeros(3))
+        return self.symbolic_dipole(dipole), ca.vertcat(b, 1.0, *extra)

@@ -3,11 +3,14 @@
 ``d = τ / T_s`` samples; ``τ`` must be a whole multiple of the sample time. ``m = 0`` until a
 reading ``τ`` old exists (the first ``d`` samples). The delay buffer is cleared by ``reset``.
 
-Dissipation: for a body spinning at ``ω`` in a slowly varying field, ``B(t − τ)`` is ``B(t)``
-turned back by the angle ``|ω| τ`` about ``ω``, and the power of the law is
+Dissipation: for a body spinning at ``ω`` in a field fixed in inertial space, ``B(t − τ)`` is
+``B(t)`` turned back by the angle ``|ω| τ`` about ``ω``, and the power of the law is
 ``ω·(m × B) = −K_t |ω| sin(|ω| τ) |B_⊥|²`` (``B_⊥``: the part of ``B`` normal to ``ω``). It removes
 energy only while ``|ω| τ < π``; for ``π < |ω| τ < 2π`` it pumps energy in. The paper (τ = 2 s,
 |ω0| = 0.9 rad/s) does not state this limit: the law needs ``τ < π / |ω|max``.
+
+Symbolic form: state ``z = [B̃_{k−1}, …, B̃_{k−d}, n]`` (3d + 1 numbers), ``n`` the number of
+readings stored so far (at most d).
 """
 from __future__ import annotations
 
@@ -15,16 +18,29 @@ from collections import deque
 from dataclasses import dataclass
 from typing import Annotated, Any
 
+import casadi as ca
+import numpy as np
+
 from controllers.magnetic import MagneticController, field_components
 from ocp import Command, Measurement
 from ocp.options import Range
 
-MAX_DELAY_SAMPLES = 1_000_000
+MAX_DELAY_SAMPLES = 100_000
 """Upper bound on ``τ / T_s`` (buffer length)."""
 
 
 def delay_samples(delay: float, sample_time: float) -> int:
-    """``d = τ / T_s`` if it is a whole number (to 1e-9 relative), else ``ValueError``."""
+    """``d = τ / T_s`` if it is a whole number (to 1e-9 relative), else ``ValueError``.
+
+    Parameters
+    ----------
+    delay : s, τ; sample_time : s, T_s.
+
+    Returns
+    -------
+    int
+        d >= 1.
+    """
     ratio = delay / sample_time
     samples = round(ratio)
     if samples < 1 or abs(ratio - samples) > 1e-9 * max(1.0, ratio):
@@ -68,3 +84,21 @@ class TDFC(MagneticController):
             return self.dipole(0.0, 0.0, 0.0)
         old, k = buffer[0], self.options.gain
         return self.dipole(-k * (reading[0] - old[0]), -k * (reading[1] - old[1]), -k * (reading[2] - old[2]))
+
+    def state_vector(self) -> np.ndarray:
+        d = self._delay
+        stored = list(self._buffer)[::-1][:d]          # newest first: B̃_{k}, B̃_{k−1}, ...
+        z = np.zeros(3 * d + 1)
+        if stored:
+            z[:3 * len(stored)] = np.ravel(stored)
+        z[-1] = len(stored)
+        return z
+
+    def _law(self, t, y, z, r):
+        d = self._delay
+        b = self.symbolic_field(y)
+        count = z[3 * d]
+        oldest = z[3 * (d - 1):3 * d]
+        dipole = ca.if_else(count >= d, -self.options.gain * (b - oldest), ca.DM.zeros(3))
+        z_next = ca.vertcat(b, z[0:3 * (d - 1)], ca.fmin(count + 1, d))
+        return self.symbolic_dipole(dipole), z_next
