@@ -42,7 +42,8 @@ class ControllerLike(Protocol):
 class SensorNoise:
     """Gaussian sensor noise, white per sample: attitude as a random rotation vector (rad, per axis
     std), body rate (rad/s, per axis std), magnetometer (T, per body axis std); ``seed`` makes it
-    repeatable. Each sample draws attitude, then rate, then field (only the non-zero ones), so that
+    repeatable. Each sample draws attitude, then rate (only the non-zero ones) from the stream
+    seeded by ``seed``, and the magnetometer from its own stream (seeded by ``[seed, 1]``), so that
     adding magnetometer noise leaves the attitude and rate noise of a scenario unchanged."""
 
     attitude_std: float = 0.0
@@ -170,6 +171,7 @@ class Simulator:
         times = np.minimum(np.arange(n_samples + 1) * self.sample_time, duration)
         noise = noise or SensorNoise()
         rng = np.random.default_rng(noise.seed)
+        field_rng = np.random.default_rng([noise.seed, 1])
         valid_until = getattr(model.environment.magnetic_field, "valid_until", None)
         if valid_until is not None and duration > valid_until + 1e-9:
             raise SimulationError(f"the magnetic field is tabulated up to t = {valid_until:g} s, the run lasts "
@@ -184,7 +186,7 @@ class Simulator:
         states[0] = x
         for k in range(n_samples):
             t_k = times[k]
-            measurement = self._measure(x, t_k, noise, rng)
+            measurement = self._measure(x, t_k, noise, rng, field_rng)
             if field_rate is not None:
                 measurement.field_rate_inertial = field_rate(t_k).copy()
             command = controller(t_k, measurement, reference)
@@ -203,15 +205,16 @@ class Simulator:
         applied_torque = torque_map(states[:-1].T, applied.T, times[:-1]).full().T
         return SimulationResult(model, self.sample_time, times, states, commanded, applied, applied_torque, saturated)
 
-    def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator) -> Measurement:
+    def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator,
+                 field_rng: np.random.Generator | None = None) -> Measurement:
         q, omega = x[0:4], x[4:7]
         if noise.attitude_std > 0:
             q = quat.product(q, quat.from_rotation_vector(rng.normal(0.0, noise.attitude_std, 3)))
         if noise.rate_std > 0:
             omega = omega + rng.normal(0.0, noise.rate_std, 3)
         field = None if self._field_numeric is None else self._field_numeric(x, t).copy()
-        if noise.field_std > 0 and field is not None:  # drawn last: existing noise streams unchanged
-            field += rng.normal(0.0, noise.field_std, 3)
+        if noise.field_std > 0 and field is not None:  # its own stream: attitude and rate noise unchanged
+            field += (rng if field_rng is None else field_rng).normal(0.0, noise.field_std, 3)
         return Measurement(t=t, q=q, omega=omega.copy(), wheel_momentum=x[7:].copy(), field_body=field)
 
     def _command_vector(self, command: Command) -> Array:
