@@ -8,7 +8,9 @@ for magnetorquers with ``saturation="scale"``, the dipole vector is scaled down 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
+import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
@@ -97,3 +99,32 @@ class ActuatorModel:
                 saturated |= bool(np.any(np.abs(value) >= limit * (1 - 1e-12)))
                 u[self.slices[name]] = applied
         return u, saturated
+
+    def apply_symbolic(self, u: Any, wheel_momentum: Any, dt: Any) -> tuple[Any, Any]:
+        """:meth:`apply` on CasADi expressions of a command vector ``u`` (layout of the model's
+        controls; zeros where nothing is asked): the applied ``u`` and the saturation flag (0/1)."""
+        parts = []
+        flags = []
+        if "wheels" in self.slices:
+            g = u[self.slices["wheels"]] * ca.DM(self._wheel_mask)
+            g_max, h_max = ca.DM(self._wheel_limit), ca.DM(self._momentum_limit)
+            low = ca.fmax(-g_max, (-h_max - wheel_momentum) / dt)
+            high = ca.fmax(ca.fmin(g_max, (h_max - wheel_momentum) / dt), low)
+            applied = ca.fmin(ca.fmax(g, low), high)
+            flags += [ca.fabs(applied - g) > 1e-12 * ca.fmax(1.0, ca.fabs(g)), ca.fabs(applied) >= g_max * (1 - 1e-12)]
+            parts.append((self.slices["wheels"], applied))
+        for name, limit in (("dipole", self._dipole_limit), ("torquers", self._torquer_limit)):
+            if name in self.slices:
+                value = u[self.slices[name]]
+                bound = ca.DM(limit)
+                if name == "dipole" and self._dipole_scaled:  # as apply(): the vector scaled as a whole
+                    ratio = ca.mmax(ca.fabs(value) / bound)
+                    parts.append((self.slices[name], ca.if_else(ratio > 1.0, value / ratio, value)))
+                else:
+                    parts.append((self.slices[name], ca.fmin(ca.fmax(value, -bound), bound)))
+                flags.append(ca.fabs(value) >= bound * (1 - 1e-12))
+        applied_u = ca.SX.zeros(self.nu) if not isinstance(u, ca.MX) else ca.MX.zeros(self.nu)
+        for where, value in parts:
+            applied_u[where] = value
+        saturated = ca.mmax(ca.vertcat(*flags)) if flags else ca.SX(0)
+        return applied_u, saturated
