@@ -126,12 +126,13 @@ def test_tdfc_buffer_is_cleared_on_reset(rng):
     np.testing.assert_allclose(runs[0][3], -1e4 * (readings[3] - readings[0]), rtol=1e-15)
 
 
+@pytest.mark.parametrize("python_loop", [True, False], ids=["python", "casadi"])
 @pytest.mark.parametrize("saturation", ["per_axis", "scale"])
-def test_backward_difference_bdot_is_tdfc_with_one_sample_delay(saturation):
+def test_backward_difference_bdot_is_tdfc_with_one_sample_delay(saturation, python_loop):
     """B-dot by backward difference at T_s ≡ TDFC with τ = T_s and K_t = K_b / T_s: the same
-    trajectory, magnetometer noise included (same seed), saturated or not."""
+    trajectory, magnetometer noise included (same seed), saturated or not, in either simulator path."""
     model = ukube_model(saturation=saturation)
-    simulator = Simulator(model, 0.2, max_step=0.1)
+    simulator = Simulator(model, 0.2, max_step=0.1, python_loop=python_loop)
     x0 = np.r_[quat.IDENTITY, 0.52, 0.52, 0.52]
     noise = SensorNoise(field_std=1e-5, seed=7)
     gain = 2.0e4
@@ -203,3 +204,21 @@ def test_tdfc_pumps_energy_in_beyond_half_a_turn_per_delay():
     tdfc_energy, bdot_energy = kinetic_energy(tdfc.omega), kinetic_energy(bdot.omega)
     assert tdfc_energy[-1] > 1.05 * tdfc_energy[0]
     assert bdot_energy[-1] < 0.9 * bdot_energy[0]
+
+
+@pytest.mark.parametrize("saturation", ["per_axis", "scale"])
+@pytest.mark.parametrize("law", [BDot({"gain": 2.0e4}), BDot({"gain": 2.0e4, "derivative": "filtered",
+                                                               "filter_time_constant": 0.7}),
+                                 TDFC({"gain": 1.0e4, "delay": 1.0})], ids=["bdot", "bdot_filtered", "tdfc"])
+def test_closed_loop_function_agrees_with_the_python_loop(law, saturation):
+    """The symbolic laws run as one CasADi function give the Python loop's trajectory, with
+    magnetometer noise (drawn in advance from the same stream) and either saturation."""
+    model = ukube_model(saturation=saturation)
+    x0 = np.r_[quat.from_rotation_vector([0.3, -0.2, 0.1]), 0.52, 0.52, 0.52]
+    noise = SensorNoise(rate_std=1e-4, seed=11, field_std=1e-5)
+    python = Simulator(model, 0.2, max_step=0.1, python_loop=True).run(law, x0, 200.0, noise=noise)
+    casadi = Simulator(model, 0.2, max_step=0.1).run(law, x0, 200.0, noise=noise)
+    assert python.path == "python" and casadi.path != "python"
+    assert np.mean(python.saturated) > 0.1
+    np.testing.assert_allclose(casadi.x, python.x, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(casadi.applied_u, python.applied_u, rtol=0, atol=1e-10)
