@@ -117,6 +117,8 @@ class Simulator:
     """
 
     MAX_BUILDS = 16
+    CHUNK = 2000
+    """Samples per evaluation of the accumulated closed-loop function (longer runs loop over chunks)."""
     """Closed-loop builds kept per simulator (one per law and noise shape, then per sample count)."""
 
     def __init__(
@@ -279,7 +281,7 @@ class Simulator:
                       rng: np.random.Generator, reference: Any,
                       field_rng: np.random.Generator | None = None) -> SimulationResult:
         n_samples = times.size - 1
-        run, z0, path = self.closed_loop_function(controller, noise, n_samples)
+        run, z0, path = self.closed_loop_function(controller, noise, min(n_samples, self.CHUNK))
         loop = self._loops[self._loop_key(controller, noise)][0]
         rows = None
         if loop.shape.uses_reference:
@@ -289,7 +291,17 @@ class Simulator:
         has_noise = noise.attitude_std > 0 or noise.rate_std > 0 or noise.field_std > 0
         drawn = (draw_noise(rng, n_samples, noise.attitude_std, noise.rate_std, field_rng, noise.field_std)
                  if has_noise else np.zeros((1, NOISE_SIZE)))
-        xz, commanded, applied, saturated = ClosedLoop.evaluate(run, np.concatenate([x0, z0]), times, drawn, rows, p)
+        # chunks of at most CHUNK samples: a mapaccum's build grows with its length (tens of seconds
+        # for 10⁵ samples), so long runs reuse one chunk function
+        pieces, start, xz0 = [], 0, np.concatenate([x0, z0])
+        while start < n_samples:
+            stop = min(n_samples, start + self.CHUNK)
+            chunk_run = run if stop - start == n_samples else self.closed_loop_function(controller, noise, stop - start)[0]
+            piece = ClosedLoop.evaluate(chunk_run, xz0, times[start:stop + 1], drawn[start:stop] if has_noise else drawn,
+                                        None if rows is None else rows[start:stop], p)
+            pieces.append(piece)
+            xz0, start = piece[0][-1], stop
+        xz, commanded, applied, saturated = (np.concatenate(parts) for parts in zip(*pieces))
         nx = self.model.nx
         states = np.vstack([x0[None, :], xz[:, :nx]])
         finite = np.all(np.isfinite(states), axis=1)
