@@ -8,9 +8,19 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from controllers import BDot, TDFC
-from ocp import (AttitudeModel, CircularOrbit, Environment, Magnetorquers, Measurement, SensorNoise, Simulator,
-                 Spacecraft, TiltedDipole, quat)
+from controllers import TDFC, BDot
+from ocp import (
+    AttitudeModel,
+    CircularOrbit,
+    Environment,
+    Magnetorquers,
+    Measurement,
+    SensorNoise,
+    Simulator,
+    Spacecraft,
+    TiltedDipole,
+    quat,
+)
 
 UKUBE_INERTIA = np.diag([0.0109, 0.05, 0.05])  # kg m², nano-spacecraft paper, "Simulations"
 ORBIT = CircularOrbit(altitude=600e3, inclination=np.deg2rad(97.79))
@@ -63,7 +73,7 @@ def test_exact_bdot_derivative_matches_the_field_rate_along_the_motion(rng):
         measurement = Measurement(t, q, omega, np.zeros(0), field, field_rate_inertial=inertial_rate)
         dipole = law(t, measurement, None).dipole
 
-        def field_at(dt):
+        def field_at(dt, q=q, omega=omega, t=t):
             return model.field_body(np.r_[quat.product(q, quat.from_rotation_vector(omega * dt)), omega],
                                     t + dt).full().ravel()
 
@@ -183,7 +193,7 @@ def test_kinetic_energy_never_rises_over_a_1000_s_window_while_tumbling(law, rng
     monotone: TDFC's delayed difference points the wrong way at times while the axisymmetric body
     nutates, and the orbital motion of the field adds a small term to B-dot's.)"""
     simulator = Simulator(ukube_model(), 0.5, max_step=0.1)
-    window = int(round(1000.0 / 0.5))
+    window = round(1000.0 / 0.5)
     direction = rng.normal(0, 1, 3)
     for omega0 in (np.full(3, 0.52), 0.7 * direction / np.linalg.norm(direction)):
         result = simulator.run(law, np.r_[quat.random_unit(rng), omega0], 2000.0)

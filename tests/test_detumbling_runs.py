@@ -10,9 +10,18 @@ import numpy as np
 import pytest
 
 import scenarios
-from controllers import BDot, TDFC
-from ocp import (AttitudeModel, CircularOrbit, Environment, Magnetorquers, SensorNoise, Simulator, Spacecraft,
-                 TiltedDipole, quat)
+from controllers import TDFC, BDot
+from ocp import (
+    AttitudeModel,
+    CircularOrbit,
+    Environment,
+    Magnetorquers,
+    SensorNoise,
+    Simulator,
+    Spacecraft,
+    TiltedDipole,
+    quat,
+)
 
 HERE = Path(__file__).resolve().parent.parent / "scenarios"
 INERTIA = np.diag([0.0109, 0.05, 0.05])

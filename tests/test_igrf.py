@@ -12,9 +12,9 @@ import pytest
 
 ppigrf = pytest.importorskip("ppigrf")
 
-import scenarios  # noqa: E402
-from ocp import AttitudeModel, CircularOrbit, Environment, IGRFField, Spacecraft, quat  # noqa: E402
-from ocp.igrf import greenwich_mean_sidereal_angle  # noqa: E402
+import scenarios
+from ocp import AttitudeModel, CircularOrbit, Environment, IGRFField, Spacecraft, quat
+from ocp.igrf import greenwich_mean_sidereal_angle
 
 EPOCH = datetime.datetime(2025, 1, 1)
 MU, R_EARTH, EARTH_RATE = 3.986004418e14, 6378.137e3, 7.2921159e-5

@@ -8,8 +8,16 @@ import numpy as np
 import pytest
 
 from controllers import TDFC
-from ocp import (AttitudeModel, CircularOrbit, Environment, IGRFField, Magnetorquers, Simulator, Spacecraft,
-                 TiltedDipole)
+from ocp import (
+    AttitudeModel,
+    CircularOrbit,
+    Environment,
+    IGRFField,
+    Magnetorquers,
+    Simulator,
+    Spacecraft,
+    TiltedDipole,
+)
 
 DURATION = 100_000.0
 ORBIT = CircularOrbit(600e3, np.deg2rad(97.79))
