@@ -132,3 +132,15 @@ def test_free_attitude_needs_a_law_that_declares_it(tmp_path):
     assert error.value.path == "maneuver.final.q" and "eigenaxis_pd" in str(error.value)
     scenario = scenarios.load(HERE / "nano_detumble.yaml")
     assert scenario.problem.qf is None and [c.name for c in scenario.controllers] == ["bdot", "tdfc"]
+
+
+@pytest.mark.slow
+def test_noisy_scenario_full_run():
+    """300,000 s with 1e-5 T noise at 1 s: TDFC detumbles, B-dot takes far longer or never (its
+    noise-driven rate floor sits near the 0.01 rad/s tolerance). Measured, seed 1: 38,447 s and
+    277,907 s (at a 0.02 rad/s tolerance B-dot's time drops to 48,303 s: the criterion matters)."""
+    rows = run_scenario("nano_detumble_noisy.yaml")
+    t_bdot = rows["B-dot"].closed_loop_metrics["detumble_time_s"]
+    t_tdfc = rows["TDFC"].closed_loop_metrics["detumble_time_s"]
+    assert t_tdfc is not None and t_tdfc < 80000.0
+    assert t_bdot is None or t_bdot > 2.0 * t_tdfc
