@@ -4,9 +4,9 @@ When a controller provides a symbolic law (``controllers.base.Controller``, "Sym
 sample of the closed loop, sensor noise, measurement, law, actuator saturation, the zero-order
 hold integrated by RK4 sub-steps and the quaternion re-normalisation, is one SX function
 
-    sample([x; z], t_k, dt_k, noise_k, r_k, p) -> ([x_{k+1}; z_{k+1}], u_commanded, u_applied, saturated)
+    sample([x; z], t_k, dt_k, noise_k, r_k, p) -> ([x_{k+1}; z_{k+1}], u_commanded, u_applied, saturated, τ_k)
 
-and ``sample.mapaccum(N)`` is the run. It computes what :meth:`ocp.simulator.Simulator.run`'s
+(``τ_k`` the actuators' body torque at ``t_k``) and ``sample.mapaccum(N)`` is the run. It computes what :meth:`ocp.simulator.Simulator.run`'s
 Python loop computes, operation for operation: the noise is drawn in advance from the same seeded
 generator in the same order (:func:`draw_noise`), so both paths agree to rounding. The function
 is evaluated by CasADi's virtual machine, or compiled to C (:mod:`ocp.compiled`).
@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ocp.actuators import ActuatorModel
+from ocp.fast_call import BufferedFunction
 from ocp.layout import REFERENCE_FIELDS
 from ocp.model import AttitudeModel
 
@@ -73,6 +74,12 @@ class LoopShape:
     rate_noise: bool
     uses_reference: bool
     uses_time: bool
+    field_noise: bool = False
+
+    @property
+    def noisy(self) -> bool:
+        """Whether the run takes the noise input (any sensor noise)."""
+        return self.attitude_noise or self.rate_noise or self.field_noise
 
 
 class ClosedLoop:
@@ -112,24 +119,52 @@ class ClosedLoop:
         u_applied, saturated = actuators.apply_symbolic(u_cmd, h_w, dt)
         x_next = step(x, u_applied, t, dt, p)
         x_next = ca.vertcat(x_next[0:4] / ca.norm_2(x_next[0:4]), x_next[4:nx])
-        outputs = [ca.vertcat(x_next, z_next), u_cmd, u_applied, saturated]
+        torque = model.body_torque(x, u_applied, t)
+        outputs = [ca.vertcat(x_next, z_next), u_cmd, u_applied, saturated, torque]
         self.shape = LoopShape(attitude_noise, rate_noise, bool(ca.depends_on(ca.vertcat(u_cmd, z_next), r)),
-                               bool(ca.depends_on(ca.vertcat(*outputs), t)))
+                               bool(ca.depends_on(ca.vertcat(*outputs), t)),
+                               bool(field_noise and model.field_body is not None))
         inputs = [acc, t, dt, noise, r, p]
         self.sample = ca.Function("closed_loop_sample", inputs, outputs,
-                                  ["xz", "t", "dt", "noise", "r", "p"], ["xz_next", "u_cmd", "u_app", "saturated"],
+                                  ["xz", "t", "dt", "noise", "r", "p"], ["xz_next", "u_cmd", "u_app", "saturated", "torque"],
                                   {"cse": True})
 
-    def run_function(self, sample: ca.Function, n_samples: int) -> ca.Function:
-        """``sample`` (interpreted, or its compiled twin) accumulated over ``n_samples``."""
-        return sample.mapaccum("closed_loop", n_samples)
+    def run_function(self, sample: ca.Function, n_samples: int) -> BufferedFunction:
+        """``sample`` (interpreted, or its compiled twin) accumulated over ``n_samples``, as
+        ``run(xz0, t (N), dt (N), [noise (9N)], [r (26N)], p) -> (xz (N(nx+nz)), u_cmd, u_app,
+        saturated, torque)``: the noise and reference inputs exist only when the loop uses them
+        (:attr:`shape`), and every input and output has its exact size, so that the function is
+        evaluated through reusable buffers (:class:`~ocp.fast_call.BufferedFunction`)."""
+        accumulated = sample.mapaccum("closed_loop", n_samples)
+        xz0 = ca.MX.sym("xz0", sample.nnz_in(0))
+        t, dt = ca.MX.sym("t", 1, n_samples), ca.MX.sym("dt", 1, n_samples)
+        p = ca.MX.sym("p", 3)
+        inputs = [xz0, t, dt]
+        if self.shape.noisy:
+            noise = ca.MX.sym("noise", NOISE_SIZE, n_samples)
+            inputs.append(noise)
+        else:
+            noise = ca.MX.zeros(NOISE_SIZE, n_samples)
+        if self.shape.uses_reference:
+            r = ca.MX.sym("r", 2 * REFERENCE_FIELDS, n_samples)
+            inputs.append(r)
+        else:
+            r = ca.MX.zeros(2 * REFERENCE_FIELDS, n_samples)
+        inputs.append(p)
+        outputs = accumulated(xz0, t, dt, noise, r, ca.repmat(p, 1, n_samples))
+        return BufferedFunction(ca.Function("closed_loop_run", inputs, outputs))
 
-    @staticmethod
-    def evaluate(run: ca.Function, xz0: Array, times: Array, noise: Array, rows: Array | None,
-                 p: Array) -> tuple[Array, Array, Array, Array]:
+    def evaluate(self, run: BufferedFunction, xz0: Array, times: Array, noise: Array | None, rows: Array | None,
+                 p: Array) -> tuple[Array, Array, Array, Array, Array]:
         """Run the accumulated function: states ``[x; z]`` after each sample (N, nx + nz),
-        commanded and applied controls (N, nu) and the saturation flags (N,)."""
+        commanded and applied controls (N, nu), saturation flags (N,) and actuator torques (N, 3)."""
         n = times.size - 1
-        r = np.zeros((2 * REFERENCE_FIELDS, 1)) if rows is None else rows.T
-        xz, u_cmd, u_app, saturated = run(xz0, times[:-1][None, :], np.diff(times)[None, :], noise.T, r, p)
-        return xz.full().T, u_cmd.full().T.reshape(n, -1), u_app.full().T.reshape(n, -1), saturated.full().ravel()
+        args = [xz0, times[:-1], times[1:] - times[:-1]]
+        if self.shape.noisy:
+            args.append(noise.ravel())  # (N, 9) row-major is the (9, N) column-major input
+        if self.shape.uses_reference:
+            args.append(rows.ravel())
+        args.append(p)
+        xz, u_cmd, u_app, saturated, torque = run.all_outputs(*args)
+        return (xz.reshape(n, -1).copy(), u_cmd.reshape(n, -1).copy(), u_app.reshape(n, -1).copy(),
+                saturated.copy(), torque.reshape(n, 3).copy())

@@ -77,7 +77,7 @@ def compile_function(function: ca.Function, directory: Path | None = None) -> ca
             c_file.write_text(text)
             partial = Path(build) / library.name
             completed = subprocess.run([compiler, *CFLAGS, str(c_file), "-o", str(partial), "-lm"],
-                                       capture_output=True, text=True)
+                                       capture_output=True, text=True, check=False)
             if completed.returncode != 0:
                 raise CompilerUnavailable(f"{Path(compiler).name} failed: {completed.stderr.strip()[:300]}")
             os.replace(partial, library)  # atomic: a concurrent build of the same code is harmless

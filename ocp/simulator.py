@@ -7,7 +7,10 @@ RK4 map with sub-steps, or CVODES); the quaternion is then re-normalised.
 
 Controllers are duck-typed (see ``controllers.base.Controller``): ``reset(spacecraft,
 sample_time, target=None)`` and ``__call__(t, measurement, reference) -> Command``.
-A reference, if given, is passed through to the controller untouched.
+A reference, if given, is passed to the controller as a :class:`GridSampledReference`: the same
+object as far as the controller can tell (every attribute is the reference's), whose ``sample``
+answers the sample instants ``t_k`` and ``t_k + T_s`` from one vectorised evaluation made before
+the loop, and any other time from the reference itself.
 
 Two paths compute the same numbers (to rounding; ``tests/test_closed_loop.py``):
 
@@ -44,6 +47,37 @@ SUBSTEPS_PER_SAMPLE = 20
 """A run may integrate at most this many RK4 sub-steps per allowed sample (``max_samples``)."""
 MAX_SUBSTEPS = 1000
 """Bound on RK4 sub-steps per sample (the step is one unrolled CasADi graph)."""
+
+
+class GridSampledReference:
+    """``reference`` with its samples at ``times`` computed once (vectorised) and served by
+    :meth:`sample`; other times and every other attribute go to ``reference`` itself.
+
+    Parameters
+    ----------
+    reference : anything with a vectorised ``sample(t)`` returning a named tuple of arrays.
+    times : s, the times to precompute.
+    """
+
+    def __init__(self, reference: Any, times: Array):
+        self.reference = reference
+        times = np.unique(np.asarray(times, dtype=float))
+        self._table = reference.sample(times)
+        self._index = {float(value): i for i, value in enumerate(times)}
+
+    def sample(self, t: ArrayLike) -> Any:
+        """The reference at ``t`` (scalar or array), as ``reference.sample`` returns it."""
+        index = self._index
+        if np.ndim(t) == 0:
+            i = index.get(float(t))
+            return self.reference.sample(t) if i is None else type(self._table)(*(a[i] for a in self._table))
+        rows = [index.get(float(value)) for value in np.ravel(t)]
+        if None in rows:
+            return self.reference.sample(t)
+        return type(self._table)(*(a[rows] for a in self._table))
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.reference, name)
 
 
 class SimulationError(RuntimeError):
@@ -131,9 +165,9 @@ class Simulator:
     """
 
     MAX_BUILDS = 16
-    """Closed-loop builds kept per simulator (one per law and noise shape, then per sample count)."""
-    CHUNK = 2000
-    """Samples per evaluation of the accumulated closed-loop function (longer runs loop over chunks)."""
+    """Closed-loop builds kept per simulator (one per law and noise shape)."""
+    CHUNK = 1000
+    """Samples per accumulated call of the closed-loop function (its build unrolls them)."""
 
     def __init__(
         self,
@@ -174,7 +208,7 @@ class Simulator:
         self.compile = compile
         self.python_loop = python_loop
         self._loops: dict[Any, tuple[ClosedLoop, ca.Function, str]] = {}
-        self._runs: dict[Any, ca.Function] = {}
+        self._runs: dict[Any, BufferedFunction] = {}
 
     def _build_step(self, integrator: str, substeps: int, rtol: float, atol: float) -> ca.Function:
         """``step(x, u, t, dt, p) -> x_next``: one hold interval of length ``dt`` starting at ``t``."""
@@ -242,6 +276,8 @@ class Simulator:
         controller.reset(model.spacecraft, self.sample_time, target=target)
         if self._symbolic(controller):
             return self._run_symbolic(controller, x, times, p, noise, rng, reference, field_rng)
+        if reference is not None and hasattr(reference, "sample"):
+            reference = GridSampledReference(reference, np.concatenate([times, times[:-1] + self.sample_time]))
 
         states = np.empty((n_samples + 1, model.nx))
         commanded = np.zeros((n_samples, model.nu))
@@ -283,10 +319,10 @@ class Simulator:
         reason = getattr(controller, "symbolic_error", None)
         return reason is not None and reason() is None
 
-    def closed_loop_function(self, controller: Any, noise: SensorNoise, n_samples: int) -> tuple[ca.Function, Array, str]:
-        """The run of ``n_samples`` of a reset symbolic ``controller`` as one function, its initial
-        controller state and how it is evaluated (``"interpreted"`` or ``"compiled"``); builds are
-        kept per law (``SymbolicLaw.key``), noise shape and sample count."""
+    def closed_loop_function(self, controller: Any, noise: SensorNoise) -> tuple[ClosedLoop, ca.Function, str]:
+        """The one-sample closed-loop function of a reset symbolic ``controller``: its builder, the
+        function (interpreted, or the compiled twin) and how it is evaluated (``"interpreted"`` or
+        ``"compiled"``). Builds are kept per law (:meth:`symbolic_key`) and noise shape."""
         loop_key = self._loop_key(controller, noise)
         if loop_key not in self._loops:
             if len(self._loops) >= self.MAX_BUILDS:
@@ -302,11 +338,15 @@ class Simulator:
                 except CompilerUnavailable as error:
                     notice(f"{error}; the closed loop runs interpreted")
             self._loops[loop_key] = (loop, sample, path)
-        loop, sample, path = self._loops[loop_key]
-        run_key = loop_key + (n_samples,)
-        if run_key not in self._runs:
-            self._runs[run_key] = loop.run_function(sample, n_samples)
-        return self._runs[run_key], np.asarray(controller.state_vector(), dtype=float), path
+        return self._loops[loop_key]
+
+    def _chunk_function(self, loop: ClosedLoop, sample: ca.Function, size: int) -> BufferedFunction:
+        """``sample`` accumulated over ``size`` samples (``mapaccum`` unrolls its calls, so long runs
+        go in chunks of at most :attr:`CHUNK` samples)."""
+        key = (id(loop), size)
+        if key not in self._runs:
+            self._runs[key] = loop.run_function(sample, size)
+        return self._runs[key]
 
     @staticmethod
     def _loop_key(controller: Any, noise: SensorNoise) -> tuple:
@@ -316,33 +356,36 @@ class Simulator:
                       rng: np.random.Generator, reference: Any,
                       field_rng: np.random.Generator | None = None) -> SimulationResult:
         n_samples = times.size - 1
-        run, z0, path = self.closed_loop_function(controller, noise, min(n_samples, self.CHUNK))
-        loop = self._loops[self._loop_key(controller, noise)][0]
+        loop, sample, path = self.closed_loop_function(controller, noise)
         rows = None
         if loop.shape.uses_reference:
             grid = times[:-1]
             rows = np.hstack([controller.reference_rows(reference, grid),
                               controller.reference_rows(reference, grid + self.sample_time)])
-        has_noise = noise.attitude_std > 0 or noise.rate_std > 0 or noise.field_std > 0
-        drawn = (draw_noise(rng, n_samples, noise.attitude_std, noise.rate_std, field_rng, noise.field_std)
-                 if has_noise else np.zeros((1, NOISE_SIZE)))
-        # chunks of at most CHUNK samples: a mapaccum's build grows with its length (tens of seconds
-        # for 10⁵ samples), so long runs reuse one chunk function
-        pieces, start, xz0 = [], 0, np.concatenate([x0, z0])
-        while start < n_samples:
-            stop = min(n_samples, start + self.CHUNK)
-            chunk_run = run if stop - start == n_samples else self.closed_loop_function(controller, noise, stop - start)[0]
-            piece = ClosedLoop.evaluate(chunk_run, xz0, times[start:stop + 1], drawn[start:stop] if has_noise else drawn,
-                                        None if rows is None else rows[start:stop], p)
-            pieces.append(piece)
-            xz0, start = piece[0][-1], stop
-        xz, commanded, applied, saturated = (np.concatenate(parts) for parts in zip(*pieces))
-        nx = self.model.nx
-        states = np.vstack([x0[None, :], xz[:, :nx]])
-        finite = np.all(np.isfinite(states), axis=1)
+        drawn = None
+        if noise.attitude_std > 0 or noise.rate_std > 0 or noise.field_std > 0:
+            drawn = draw_noise(rng, n_samples, noise.attitude_std, noise.rate_std, field_rng, noise.field_std)
+        nx, nu = self.model.nx, self.model.nu
+        xz = np.concatenate([x0, np.asarray(controller.state_vector(), dtype=float)])
+        states = np.empty((n_samples + 1, nx))
+        commanded, applied = np.empty((n_samples, nu)), np.empty((n_samples, nu))
+        saturated, torque = np.empty(n_samples), np.empty((n_samples, 3))
+        states[0] = x0
+        for start in range(0, n_samples, self.CHUNK):
+            stop = min(start + self.CHUNK, n_samples)
+            run = self._chunk_function(loop, sample, stop - start)
+            chunk = loop.evaluate(run, xz, times[start:stop + 1], None if drawn is None else drawn[start:stop],
+                                  None if rows is None else rows[start:stop], p)
+            states[start + 1:stop + 1] = chunk[0][:, :nx]
+            commanded[start:stop], applied[start:stop], saturated[start:stop], torque[start:stop] = chunk[1:]
+            xz = chunk[0][-1]
+            if not np.all(np.isfinite(xz)):
+                break
+        finite = np.isfinite(states).all(axis=1)
         if not finite.all():
             raise SimulationError(self._divergence(times, int(np.argmin(finite)) - 1))
-        return self._result(times, states, commanded, applied, saturated.astype(bool), path)
+        return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, torque,
+                                saturated.astype(bool), path)
 
     def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator,
                  field_rng: np.random.Generator | None = None) -> Measurement:

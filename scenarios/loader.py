@@ -66,6 +66,8 @@ class SimulationSpec:
     max_step: float = 0.05
     settling_tolerance_deg: float = 0.5
     detumble_tolerance: float = 0.01
+    compile: bool = False
+    """Build the closed loop of a symbolic law as C (``ocp.compiled``); interpreted otherwise."""
     max_samples: int = MAX_SAMPLES
 
 
@@ -318,6 +320,7 @@ def parse_simulation(node: Node) -> SimulationSpec:
         settling_tolerance_deg=node.get("settling_tolerance_deg", 0.5).number(positive=True, maximum=180.0),
         detumble_tolerance=node.get("detumble_tolerance", 0.01).number(positive=True),
         max_samples=node.get("max_samples", MAX_SAMPLES).integer(minimum=1, maximum=100_000_000),
+        compile=node.get("compile", False).boolean(),
     )
     if spec.integrator == "rk4" and math.ceil(spec.sample_time / spec.max_step - 1e-9) > MAX_SUBSTEPS:
         raise ScenarioError(node.get("max_step").path, f"{spec.max_step:g} s gives more than {MAX_SUBSTEPS} RK4 "

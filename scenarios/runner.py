@@ -133,7 +133,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     say = progress or (lambda line: None)
     spec = scenario.simulation
     simulator = Simulator(scenario.problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step,
-                          max_samples=spec.max_samples)
+                          max_samples=spec.max_samples, compile=spec.compile)
     controllers = scenario.controllers
     rows = []
     if not scenario.planners:
