@@ -69,8 +69,16 @@ class Controller(Configurable, ABC):
       or ``None`` (regulation to the target). It is the reference implementation of the law.
     * ``needs_reference``: the law cannot regulate (``reference=None``) and raises ``ValueError``
       there; the scenario loader rejects regulation mode for it.
+    * ``needs_target_attitude``: in regulation mode the law needs ``maneuver.final.q``. Laws that
+      regulate the rate alone (detumbling: ``bdot``, ``tdfc``; ``none``) set it to ``False`` and
+      then accept a free final attitude (``q: null``).
+    * ``needs_field_rate``: the law reads ``measurement.field_rate_inertial`` (ḃ_I, T/s), which
+      the simulator then provides (only the ideal B-dot does; a real spacecraft cannot).
     * ``planner_error(name, options)`` says why the law cannot track references of that planner
       (``None`` if it can); the scenario loader reports it. Most laws track any reference.
+    * ``environment_error(spacecraft, environment)`` and ``sample_time_error(sample_time)`` say why
+      the law cannot run there (missing actuator or sensor; an option that must fit the sample time);
+      the scenario loader reports them at the controller's entry.
     * Saturation is the simulator's actuator model's job, not the controller's.
 
     Symbolic form
@@ -105,6 +113,8 @@ class Controller(Configurable, ABC):
     """
 
     needs_reference: bool = False
+    needs_target_attitude: bool = True
+    needs_field_rate: bool = False
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
         super().__init__(options, path)
@@ -114,6 +124,15 @@ class Controller(Configurable, ABC):
 
     def planner_error(self, planner: str, options: Any) -> str | None:
         """Why this law cannot track the references of ``planner`` with ``options``, or ``None``."""
+        return None
+
+    def environment_error(self, spacecraft: Spacecraft, environment: Any) -> str | None:
+        """Why the law cannot run on ``spacecraft`` in ``environment`` (an actuator or a sensor it
+        needs is missing), or ``None``."""
+        return None
+
+    def sample_time_error(self, sample_time: float) -> tuple[str, str] | None:
+        """``(option name, message)`` if an option does not fit the sample time (s), else ``None``."""
         return None
 
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:

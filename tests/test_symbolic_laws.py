@@ -71,6 +71,9 @@ def test_numpy_and_symbolic_laws_agree(name, rng):
                 controller = cls(options)
                 spacecraft = build()
                 sample_time = float(rng.uniform(0.05, 2.0))
+                if controller.sample_time_error(sample_time):  # e.g. tdfc: τ (2 s) a multiple of T_s
+                    sample_time = 2.0 / int(rng.integers(1, 4))
+                    assert controller.sample_time_error(sample_time) is None
                 target = (quat.random_unit(rng), rng.normal(0, 0.05, 3) if rng.uniform() < 0.5 else None)
                 reference = RandomReference(rng) if tracking else None
                 if controller.needs_reference and reference is None:
