@@ -3,10 +3,16 @@ from controllers.augmented_quaternion_feedback import AugmentedQuaternionFeedbac
 from controllers.base import Controller, gain_matrix
 from controllers.costate_feedback import CostateFeedback
 from controllers.eigenaxis_pd import EigenaxisPD
+from controllers.gain_scheduled_min_norm import GainScheduledMinNorm
+from controllers.min_norm import MinNorm
 from controllers.none import NoControl
+from controllers.singular_rate_tracking import SingularRateTracking
+from controllers.singular_zero_momentum import SingularZeroMomentum
 
 CONTROLLERS: dict[str, type[Controller]] = {
-    cls.name: cls for cls in (AugmentedQuaternionFeedback, CostateFeedback, EigenaxisPD, NoControl)
+    cls.name: cls for cls in (AugmentedQuaternionFeedback, CostateFeedback, EigenaxisPD, NoControl, SingularZeroMomentum,
+                                   SingularRateTracking, MinNorm, GainScheduledMinNorm)
 }
 
-__all__ = ["AugmentedQuaternionFeedback", "CONTROLLERS", "Controller", "CostateFeedback", "EigenaxisPD", "NoControl", "gain_matrix"]
+__all__ = ["AugmentedQuaternionFeedback", "CONTROLLERS", "Controller", "CostateFeedback", "EigenaxisPD", "GainScheduledMinNorm", "MinNorm", "NoControl",
+           "SingularRateTracking", "SingularZeroMomentum", "gain_matrix"]

@@ -38,11 +38,21 @@ class Controller(Configurable, ABC):
       there; the scenario loader rejects regulation mode for it.
     * ``planner_error(name, options)`` says why the law cannot track references of that planner
       (``None`` if it can); the scenario loader reports it. Most laws track any reference.
+    * ``spacecraft_error(spacecraft)`` says why the law cannot control that spacecraft (``None``
+      if it can), e.g. a two-wheel law on three working wheels; the scenario loader reports it.
     * Saturation is the simulator's actuator model's job, not the controller's.
+
+    Capability flags (class attributes) used by :meth:`allocate`: ``hold_compensation``,
+    ``gyroscopic_compensation`` and ``wheels_only``.
     """
 
     hold_compensation: bool = True
     """Correct the held gyroscopic term to mid-sample in :meth:`allocate`."""
+    gyroscopic_compensation: bool = True
+    """The law's ``u`` is for ``I ω̇ = −ω × I ω + u``: :meth:`allocate` adds the wheels' ``ω × A h_w``.
+    ``False``: ``u`` is the wheels' body torque itself (laws written for ``I ω̇ = u`` under zero momentum)."""
+    wheels_only: bool = False
+    """Pure wheel mode: what the wheels cannot give is dropped, never sent to torquers or magnetorquers."""
     needs_reference: bool = False
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
@@ -53,6 +63,10 @@ class Controller(Configurable, ABC):
 
     def planner_error(self, planner: str, options: Any) -> str | None:
         """Why this law cannot track the references of ``planner`` with ``options``, or ``None``."""
+        return None
+
+    def spacecraft_error(self, spacecraft: Spacecraft) -> str | None:
+        """Why this law cannot control ``spacecraft``, or ``None`` (most laws control any)."""
         return None
 
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
@@ -86,11 +100,17 @@ class Controller(Configurable, ABC):
         if self.hold_compensation:
             residual = residual + self._gyroscopic_drift(measurement)
         if self._working_axes is not None:
-            wheel_torque = residual + np.cross(measurement.omega, spacecraft.wheel_axes @ measurement.wheel_momentum)
+            wheel_torque = residual
+            if self.gyroscopic_compensation:
+                wheel_torque = residual + np.cross(measurement.omega, spacecraft.wheel_axes @ measurement.wheel_momentum)
             command.wheel_torque = -self._wheel_pinv @ wheel_torque
+            if self.wheels_only:
+                return command
             residual = wheel_torque + self._working_axes @ command.wheel_torque
             if np.linalg.norm(residual) <= 1e-12 * max(np.linalg.norm(wheel_torque), 1e-300):
                 return command
+        if self.wheels_only:
+            return command
         if spacecraft.torquers is not None:
             command.torque = residual
         elif spacecraft.magnetorquers is not None and measurement.field_body is not None:

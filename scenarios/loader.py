@@ -251,6 +251,9 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
     if not planners and problem.qf is None:
         raise ScenarioError("maneuver.final.q", "regulation (no planners) needs a target attitude")
     law = CONTROLLERS[controller.name](controller.options)
+    error = law.spacecraft_error(problem.spacecraft)
+    if error:
+        raise ScenarioError("spacecraft.wheels", f"{error} (controller.name is {controller.name!r})")
     if not planners and law.needs_reference:
         raise ScenarioError("controller.name", f"controller {controller.name} tracks a reference; give planners")
     for index, spec in enumerate(planners):
