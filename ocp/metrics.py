@@ -14,7 +14,7 @@ from ocp import quat
 METRIC_KEYS: tuple[str, ...] = (
     "int_u2", "int_u", "int_abs_u", "peak_u", "final_error_deg", "final_rate_error",
     "rms_error_deg", "max_error_deg", "settling_time_s", "saturation_fraction",
-    "peak_wheel_momentum", "plan_time_s", "duration_s",
+    "peak_wheel_momentum", "plan_time_s", "duration_s", "fine_settling_time_s",
 )
 DEFAULT_SETTLING_TOLERANCE_DEG = 0.5
 
@@ -25,6 +25,19 @@ def _integrate(t: NDArray, values: NDArray) -> NDArray:
     if values.shape[0] == t.shape[0] - 1:
         return np.tensordot(dt, values, axes=(0, 0))
     return np.tensordot(dt, 0.5 * (values[1:] + values[:-1]), axes=(0, 0))
+
+
+def settling_time(t: NDArray, error_deg: NDArray | None, tolerance_deg: float) -> float | None:
+    """First time (s) after which ``error_deg`` stays at or below ``tolerance_deg`` to the end;
+    ``None`` for a free attitude (``error_deg`` None) or when not settled by the last sample."""
+    if error_deg is None:
+        return None
+    above = np.nonzero(error_deg > tolerance_deg)[0]
+    if above.size == 0:
+        return 0.0
+    if above[-1] == t.size - 1:
+        return None
+    return float(t[above[-1] + 1])
 
 
 def compute_metrics(
@@ -40,6 +53,7 @@ def compute_metrics(
     plan_time_s: float | None = None,
     duration_s: float | None = None,
     settling_tolerance_deg: float = DEFAULT_SETTLING_TOLERANCE_DEG,
+    fine_settling_tolerance_deg: float | None = None,
 ) -> dict[str, Any]:
     """Metrics of a motion sampled at times ``t`` (s).
 
@@ -51,6 +65,8 @@ def compute_metrics(
     target_q, target_omega : the manoeuvre's final attitude and rate (``None``: free).
     reference_q : (N+1, 4) reference attitude at ``t`` for the tracking errors (closed loop).
     wheel_momentum : (N+1, n_w) N m s; saturated : (N,) bool per sample.
+    settling_tolerance_deg, fine_settling_tolerance_deg : error angles (deg) of ``settling_time_s``
+        and of ``fine_settling_time_s`` (``None``: that metric is null).
 
     Returns
     -------
@@ -61,15 +77,7 @@ def compute_metrics(
     torque = np.asarray(torque, dtype=float)
     norms = np.linalg.norm(torque, axis=1)
     error_to_target = None if target_q is None else np.rad2deg(quat.error_angle(q, target_q))
-    above = None if target_q is None else np.nonzero(error_to_target > settling_tolerance_deg)[0]
-    if above is None:
-        settling = None  # free final attitude
-    elif above.size == 0:
-        settling = 0.0
-    elif above[-1] == t.size - 1:
-        settling = None  # not settled by the end of the window
-    else:
-        settling = float(t[above[-1] + 1])
+    settling = settling_time(t, error_to_target, settling_tolerance_deg)
     metrics: dict[str, Any] = {
         "int_u2": float(_integrate(t, norms**2)),
         "int_u": float(_integrate(t, norms)),
@@ -85,6 +93,8 @@ def compute_metrics(
         "peak_wheel_momentum": None,
         "plan_time_s": plan_time_s,
         "duration_s": duration_s,
+        "fine_settling_time_s": None if fine_settling_tolerance_deg is None
+        else settling_time(t, error_to_target, fine_settling_tolerance_deg),
     }
     if reference_q is not None:
         tracking = np.rad2deg(quat.error_angle(q, reference_q))
@@ -103,6 +113,7 @@ def metrics_from_simulation(
     plan_time_s: float | None = None,
     duration_s: float | None = None,
     settling_tolerance_deg: float = DEFAULT_SETTLING_TOLERANCE_DEG,
+    fine_settling_tolerance_deg: float | None = None,
 ) -> dict[str, Any]:
     """Closed-loop metrics of an :class:`~ocp.simulator.SimulationResult`; ``reference`` (anything
     with a vectorised ``q(t)``) gives the tracking errors."""
@@ -111,7 +122,7 @@ def metrics_from_simulation(
         reference_q=None if reference is None else reference.q(result.t),
         wheel_momentum=result.wheel_momentum if result.wheel_momentum.shape[1] else None,
         saturated=result.saturated, plan_time_s=plan_time_s, duration_s=duration_s,
-        settling_tolerance_deg=settling_tolerance_deg,
+        settling_tolerance_deg=settling_tolerance_deg, fine_settling_tolerance_deg=fine_settling_tolerance_deg,
     )
 
 
@@ -121,6 +132,7 @@ def metrics_from_reference(
     target_omega: ArrayLike | None = None,
     points: int = 2001,
     settling_tolerance_deg: float = DEFAULT_SETTLING_TOLERANCE_DEG,
+    fine_settling_tolerance_deg: float | None = None,
 ) -> dict[str, Any]:
     """Metrics of a reference's own motion and feed-forward torque over ``[0, duration]``,
     sampled on ``points`` uniform times (trapezoidal integrals)."""
@@ -128,5 +140,5 @@ def metrics_from_reference(
     return compute_metrics(
         t, reference.q(t), reference.omega(t), reference.torque(t), target_q, target_omega,
         plan_time_s=reference.plan_time_s, duration_s=reference.duration,
-        settling_tolerance_deg=settling_tolerance_deg,
+        settling_tolerance_deg=settling_tolerance_deg, fine_settling_tolerance_deg=fine_settling_tolerance_deg,
     )

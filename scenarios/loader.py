@@ -49,6 +49,7 @@ class SimulationSpec:
     integrator: str = "rk4"
     max_step: float = 0.05
     settling_tolerance_deg: float = 0.5
+    fine_settling_tolerance_deg: float | None = None
 
 
 @dataclass
@@ -235,6 +236,7 @@ def parse_simulation(node: Node) -> SimulationSpec:
         integrator=node.get("integrator", "rk4").string(("rk4", "cvodes")),
         max_step=node.get("max_step", 0.05).number(positive=True),
         settling_tolerance_deg=node.get("settling_tolerance_deg", 0.5).number(positive=True),
+        fine_settling_tolerance_deg=node.get("fine_settling_tolerance_deg", None).optional_number(positive=True),
     )
     noise.finish()
     node.finish()

@@ -93,7 +93,8 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
     row.closed_loop_metrics = metrics_from_simulation(
         result, problem.qf, problem.omegaf, reference=reference, plan_time_s=row.plan_time_s,
         duration_s=reference.duration if reference else None,
-        settling_tolerance_deg=scenario.simulation.settling_tolerance_deg)
+        settling_tolerance_deg=scenario.simulation.settling_tolerance_deg,
+        fine_settling_tolerance_deg=scenario.simulation.fine_settling_tolerance_deg)
 
 
 def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
@@ -132,7 +133,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         if reference.ok:
             row.reference_metrics = metrics_from_reference(
                 reference, scenario.problem.qf, scenario.problem.omegaf,
-                settling_tolerance_deg=spec.settling_tolerance_deg)
+                settling_tolerance_deg=spec.settling_tolerance_deg,
+                fine_settling_tolerance_deg=spec.fine_settling_tolerance_deg)
             _simulate(scenario, simulator, reference, row)
         say(f"[{index}/{len(scenario.planners)}] {row.label}: {row.status} "
             f"(planned in {row.plan_time_s * 1e3:.1f} ms, simulated in {row.simulate_time_s:.2f} s)"
