@@ -172,11 +172,10 @@ class TwoWheelLaw(Controller):
 
     wheels_only = True
     gyroscopic_compensation = False
-    hold_compensation = False
 
-    def spacecraft_error(self, spacecraft: Spacecraft) -> str | None:
+    def environment_error(self, spacecraft: Spacecraft, environment: Any) -> str | None:
         frame = self.control_frame(spacecraft)
-        return f"controller {self.name} {frame}" if isinstance(frame, str) else None
+        return f"controller {self.name} {frame} (see spacecraft.wheels)" if isinstance(frame, str) else None
 
     def control_frame(self, spacecraft: Spacecraft) -> Array | str:
         """The control frame (see :func:`control_frame`); a test may override it."""

@@ -40,6 +40,10 @@ def plot_row(row, target_q, path: Path) -> None:
     if target_q is not None:
         to_target = np.rad2deg(quat.error_angle(sim.q, target_q))
         axes[3].semilogy(t, np.maximum(to_target, 1e-9), color="k", label="to target")
+    elif ref is None:  # rate regulation (detumbling): the rate is what converges
+        axes[3].semilogy(t, np.maximum(np.linalg.norm(sim.omega, axis=1), 1e-12), color="k", label="‖ω‖")
+        axes[3].semilogy(t, np.maximum(np.abs(sim.omega).max(axis=1), 1e-12), color="tab:gray", lw=1,
+                         label="max |ω_i|")
     if ref is not None:
         axes[3].semilogy(t, np.maximum(np.rad2deg(quat.error_angle(sim.q, ref.q)), 1e-9), color="tab:orange",
                          label="to reference")
@@ -50,12 +54,13 @@ def plot_row(row, target_q, path: Path) -> None:
     axes[0].set_ylabel("body torque (N m)")
     axes[1].set_ylabel("body rate (rad/s)")
     axes[2].set_ylabel("quaternion")
-    axes[3].set_ylabel("error angle (deg)")
+    axes[3].set_ylabel("error angle (deg)" if target_q is not None or ref is not None else "body rate (rad/s)")
     axes[-1].set_xlabel("time (s)")
     for axis in axes:
         axis.grid(alpha=0.3)
         axis.legend(loc="upper right", fontsize=8, ncol=4)
-    fig.suptitle(f"{row.label} ({row.planner or 'regulation'}): solid closed loop, dashed reference")
+    controller = f", {row.controller}" if getattr(row, "controller", None) else ""
+    fig.suptitle(f"{row.label} ({row.planner or 'regulation'}{controller}): solid closed loop, dashed reference")
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
@@ -94,11 +99,16 @@ def plot_overlay(results, path: Path) -> None:
         sim = row.simulation
         norm = np.linalg.norm(sim.applied_torque, axis=1)
         top.step(sim.t, np.r_[norm, norm[-1]], where="post", label=row.label)
-        error = (np.rad2deg(quat.error_angle(sim.q, target_q)) if target_q is not None
-                 else np.linalg.norm(sim.omega - target_omega, axis=1))
+        if target_q is not None:
+            error = np.rad2deg(quat.error_angle(sim.q, target_q))
+        elif target_omega is not None:
+            error = np.linalg.norm(sim.omega - target_omega, axis=1)
+        else:
+            error = np.linalg.norm(sim.omega, axis=1)
         bottom.semilogy(sim.t, np.maximum(error, 1e-9), label=row.label)
     top.set_ylabel("‖u‖ (N m)")
-    bottom.set_ylabel("error to target (deg)" if target_q is not None else "‖ω − ω_f‖ (rad/s)")
+    bottom.set_ylabel("error to target (deg)" if target_q is not None
+                      else "‖ω − ω_f‖ (rad/s)" if target_omega is not None else "‖ω‖ (rad/s)")
     bottom.set_xlabel("time (s)")
     for axis in (top, bottom):
         axis.grid(alpha=0.3)

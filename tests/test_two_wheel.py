@@ -229,12 +229,12 @@ def test_two_wheel_mode_is_pure():
 @pytest.mark.parametrize("name", TWO_WHEEL_LAWS)
 def test_three_working_wheels_or_a_non_principal_axis_are_rejected(name):
     law = CONTROLLERS[name]()
-    assert "two axes" in law.spacecraft_error(Spacecraft(UOSAT12, wheels=ReactionWheels.from_body_axes()))
+    assert "two axes" in law.environment_error(Spacecraft(UOSAT12, wheels=ReactionWheels.from_body_axes()), None)
     rotation = quat.rotation_matrix(quat.from_axis_angle([1, 0, 0], 0.3))
     tilted = Spacecraft(rotation @ np.diag(UOSAT12) @ rotation.T,
                         wheels=ReactionWheels.from_body_axes(failed=(2,)))
-    assert "principal" in law.spacecraft_error(tilted)
-    assert law.spacecraft_error(two_wheel_spacecraft(1)) is None
+    assert "principal" in law.environment_error(tilted, None)
+    assert law.environment_error(two_wheel_spacecraft(1), None) is None
 
 
 @pytest.mark.parametrize("name,options,path", [
