@@ -14,9 +14,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Annotated
 
+import casadi as ca
+
 from controllers.min_norm import MinNorm
 from controllers.singular_zero_momentum import check_singular_gains
-from controllers.underactuated import SingularGains, desired_rates, rate_tracking_torque
+from controllers.underactuated import (
+    SingularGains,
+    desired_rates,
+    desired_rates_symbolic,
+    rate_tracking_torque,
+)
 from ocp.options import Range
 
 
@@ -62,3 +69,10 @@ class GainScheduledMinNorm(MinNorm):
             return high
         return rate_tracking_torque(w1, w2, desired_rates(q0, q1, q2, q3, w1, w2, w3, self.low), o.K1, inertia)
 
+    def benchmark_symbolic(self, q: list, w: list) -> tuple:
+        """:meth:`benchmark` on expressions (the mode switch as ``if_else``)."""
+        o, inertia = self.options, self.moments[:2]
+        high = rate_tracking_torque(w[0], w[1], desired_rates_symbolic(q, w, self.high), o.K2, inertia)
+        low = rate_tracking_torque(w[0], w[1], desired_rates_symbolic(q, w, self.low), o.K1, inertia)
+        use_high = ca.fmax(ca.fabs(high[0]), ca.fabs(high[1])) < o.epsilon
+        return ca.if_else(use_high, high[0], low[0]), ca.if_else(use_high, high[1], low[1])

@@ -17,7 +17,15 @@ from dataclasses import dataclass
 from typing import Annotated, Any
 
 from controllers.singular_zero_momentum import check_singular_gains
-from controllers.underactuated import SingularGains, TwoWheelLaw, desired_rates, min_norm, rate_tracking_torque
+from controllers.underactuated import (
+    SingularGains,
+    TwoWheelLaw,
+    desired_rates,
+    desired_rates_symbolic,
+    min_norm,
+    min_norm_symbolic,
+    rate_tracking_torque,
+)
 from ocp import Command, Measurement
 from ocp.options import Range
 
@@ -72,3 +80,15 @@ class MinNorm(TwoWheelLaw):
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
         u, _, _ = self.torques(measurement)
         return self.command_torque(u[0], u[1], measurement)
+
+    def benchmark_symbolic(self, q: list, w: list) -> tuple:
+        """:meth:`benchmark` on expressions."""
+        rates = desired_rates_symbolic(q, w, self.gains)
+        return rate_tracking_torque(w[0], w[1], rates, self.options.K, self.moments[:2])
+
+    def _law(self, t, y, z, r):
+        q, w = self.error_symbolic(y)
+        v1, v2, _, _ = desired_rates_symbolic(q, w, self.lyapunov_gains)
+        lgv = ((w[0] - v1) / self.moments[0], (w[1] - v2) / self.moments[1])
+        u1, u2 = min_norm_symbolic(self.benchmark_symbolic(q, w), lgv)
+        return self.command_symbolic(u1, u2, y), z

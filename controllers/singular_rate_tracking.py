@@ -12,7 +12,13 @@ from dataclasses import dataclass
 from typing import Annotated, Any
 
 from controllers.singular_zero_momentum import check_singular_gains
-from controllers.underactuated import SingularGains, TwoWheelLaw, desired_rates, rate_tracking_torque
+from controllers.underactuated import (
+    SingularGains,
+    TwoWheelLaw,
+    desired_rates,
+    desired_rates_symbolic,
+    rate_tracking_torque,
+)
 from ocp import Command, Measurement
 from ocp.options import Range
 
@@ -47,3 +53,9 @@ class SingularRateTracking(TwoWheelLaw):
 
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
         return self.command_torque(*self.torque(measurement), measurement)
+
+    def _law(self, t, y, z, r):
+        q, w = self.error_symbolic(y)
+        rates = desired_rates_symbolic(q, w, self.gains)
+        u1, u2 = rate_tracking_torque(w[0], w[1], rates, self.options.K, self.moments[:2])
+        return self.command_symbolic(u1, u2, y), z

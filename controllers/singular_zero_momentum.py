@@ -12,10 +12,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Annotated, Any
 
-import numpy as np
+import casadi as ca
 
-from controllers.underactuated import SingularGains, TwoWheelLaw, desired_rates
+from controllers.underactuated import (
+    SingularGains,
+    TwoWheelLaw,
+    desired_rates,
+    desired_rates_symbolic,
+)
 from ocp import Command, Measurement
+from ocp.layout import split_measurement
 from ocp.options import InvalidOption, Range
 
 
@@ -48,6 +54,15 @@ class SingularZeroMomentum(TwoWheelLaw):
         m = self._momentum_map
         demand = m[:, 0] * wd1 + m[:, 1] * wd2
         return Command(wheel_torque=(demand - measurement.wheel_momentum) / self.sample_time)
+
+    def _law(self, t, y, z, r):
+        q, _ = self.error_symbolic(y)
+        wd1, wd2, _, _ = desired_rates_symbolic(q, [0.0, 0.0, 0.0], self.gains)
+        m = self._momentum_map
+        demand = ca.DM(m[:, 0]) * wd1 + ca.DM(m[:, 1]) * wd2
+        u = ca.SX.zeros(self._nu)
+        u[self._slices["wheels"]] = (demand - split_measurement(y, self.spacecraft.n_wheels)[2]) / self.sample_time
+        return u, z
 
 
 def check_singular_gains(option: str, k: float, g: float, suffix: str = "") -> None:

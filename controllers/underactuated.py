@@ -29,10 +29,12 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import casadi as ca
 import numpy as np
 
 from controllers.base import Array, Controller
 from ocp import Command, Measurement, Spacecraft
+from ocp.layout import split_measurement
 
 PRINCIPAL_TOLERANCE = 1e-9
 """Relative tolerance on ``‖I n − (nᵀ I n) n‖ / ‖I‖`` for the unactuated axis ``n`` to count as principal."""
@@ -123,6 +125,48 @@ def min_norm(benchmark: tuple[float, float], lgv: tuple[float, float]) -> tuple[
     return scale * lgv[0], scale * lgv[1]
 
 
+def _sat_symbolic(value: ca.SX, limit: float | None) -> tuple[ca.SX, ca.SX]:
+    """:func:`_sat` on expressions."""
+    if limit is None:
+        return value, ca.SX(1.0)
+    return ca.fmin(ca.fmax(value, -limit), limit), ca.if_else(ca.fabs(value) < limit, 1.0, 0.0)
+
+
+def _ratio_symbolic(numerator: ca.SX, denominator: ca.SX) -> ca.SX:
+    """:func:`_ratio` on expressions."""
+    safe = ca.if_else(denominator > 0, denominator, 1.0)
+    singular = ca.if_else(numerator == 0, 0.0, ca.sign(numerator) * ca.inf)
+    return ca.if_else(denominator > 0, numerator / safe, singular)
+
+
+def desired_rates_symbolic(q: list, w: list, gains: SingularGains) -> tuple[ca.SX, ca.SX, ca.SX, ca.SX]:
+    """:func:`desired_rates` on expressions: ``q = [q0, q1, q2, q3]``, ``w = [ω1, ω2, ω3]`` in the
+    control frame; the same arithmetic, branches as ``if_else``."""
+    q0, q1, q2, q3 = q
+    w1, w2, w3 = w
+    k, g = gains.k, gains.g
+    dq1 = 0.5 * (q0 * w1 - q3 * w2 + q2 * w3)
+    dq2 = 0.5 * (q0 * w2 - q1 * w3 + q3 * w1)
+    dq3 = 0.5 * (q0 * w3 - q2 * w1 + q1 * w2)
+    d = q1 * q1 + q2 * q2 + gains.epsilon_d
+    dd = 2.0 * (q1 * dq1 + q2 * dq2)
+    r1, slope1 = _sat_symbolic(_ratio_symbolic(q2 * q3, d), gains.a1)
+    r2, slope2 = _sat_symbolic(_ratio_symbolic(q1 * q3, d), gains.a2)
+    safe = ca.if_else(d > 0, d, 1.0)
+    dr1 = ca.if_else(ca.logic_and(d > 0, slope1 != 0), ((dq2 * q3 + q2 * dq3) - q2 * q3 * dd / safe) / safe, 0.0)
+    dr2 = ca.if_else(ca.logic_and(d > 0, slope2 != 0), ((dq1 * q3 + q1 * dq3) - q1 * q3 * dd / safe) / safe, 0.0)
+    return -k * q1 + g * r1, -k * q2 - g * r2, -k * dq1 + g * dr1, -k * dq2 - g * dr2
+
+
+def min_norm_symbolic(benchmark: tuple, lgv: tuple) -> tuple[ca.SX, ca.SX]:
+    """:func:`min_norm` on expressions."""
+    s = lgv[0] * benchmark[0] + lgv[1] * benchmark[1]
+    norm2 = lgv[0] * lgv[0] + lgv[1] * lgv[1]
+    acting = ca.logic_and(s < 0, norm2 != 0)
+    scale = ca.if_else(acting, s / ca.if_else(norm2 != 0, norm2, 1.0), 0.0)
+    return scale * lgv[0], scale * lgv[1]
+
+
 def control_frame(spacecraft: Spacecraft) -> Array | str:
     """Rows ``[e1; e2; e3]`` (body axes) of the right-handed principal control frame whose ``e3``
     is the unactuated axis, or the reason why the spacecraft has none.
@@ -148,15 +192,15 @@ def control_frame(spacecraft: Spacecraft) -> Array | str:
     inertia = spacecraft.inertia
     scale = float(np.max(np.abs(inertia)))
     if np.linalg.norm(inertia @ normal - (normal @ inertia @ normal) * normal) > PRINCIPAL_TOLERANCE * scale:
-        return (f"needs the unactuated axis {np.round(normal, 6).tolist()} (normal to the working wheels: the "
-                "failed wheel's axis) to be a principal axis of the inertia")
+        return (f"needs the unactuated axis {np.round(normal, 6).tolist()} (normal to the working wheels of "
+                "spacecraft.wheels: the failed wheel's axis) to be a principal axis of spacecraft.inertia")
     index = int(np.argmax(np.abs(normal)))
     if spacecraft.is_principal and abs(abs(normal[index]) - 1.0) < 1e-12:
         return np.eye(3)[[(index + 1) % 3, (index + 2) % 3, index]]  # cyclic relabelling
-    moments, vectors = np.linalg.eigh(inertia)
+    _, vectors = np.linalg.eigh(inertia)
     third = int(np.argmax(np.abs(vectors.T @ normal)))
     e3 = vectors[:, third] * np.sign(vectors[:, third] @ normal)
-    e1 = vectors[:, [i for i in range(3) if i != third][0]]
+    e1 = vectors[:, next(i for i in range(3) if i != third)]
     return np.array([e1, np.cross(e3, e1), e3])
 
 
@@ -175,7 +219,7 @@ class TwoWheelLaw(Controller):
 
     def environment_error(self, spacecraft: Spacecraft, environment: Any) -> str | None:
         frame = self.control_frame(spacecraft)
-        return f"controller {self.name} {frame} (see spacecraft.wheels)" if isinstance(frame, str) else None
+        return f"controller {self.name} {frame}" if isinstance(frame, str) else None
 
     def control_frame(self, spacecraft: Spacecraft) -> Array | str:
         """The control frame (see :func:`control_frame`); a test may override it."""
@@ -185,7 +229,7 @@ class TwoWheelLaw(Controller):
         super().reset(spacecraft, sample_time, target)
         frame = self.control_frame(spacecraft)
         if isinstance(frame, str):
-            raise ValueError(f"controller {self.name} {frame}")
+            raise ValueError(f"controller {self.name} {frame}")  # noqa: TRY004 (a value of the model)
         self.frame = frame
         self._rows = [tuple(float(v) for v in row) for row in frame]
         moments = frame @ spacecraft.inertia @ frame.T
@@ -208,6 +252,27 @@ class TwoWheelLaw(Controller):
         (a, b, c), (d, e, f), (g, h, i) = self._rows
         return (e0, a * ex + b * ey + c * ez, d * ex + e * ey + f * ez, g * ex + h * ey + i * ez,
                 a * wx + b * wy + c * wz, d * wx + e * wy + f * wz, g * wx + h * wy + i * wz)
+
+    def error_symbolic(self, y: ca.SX) -> tuple[list, list]:
+        """:meth:`error` on the measurement vector ``y``: ``([q0, q1, q2, q3], [ω1, ω2, ω3])``."""
+        q, w, _, _ = split_measurement(y, self.spacecraft.n_wheels)
+        p0, p1, p2, p3 = self._target_conjugate
+        e0 = p0 * q[0] - p1 * q[1] - p2 * q[2] - p3 * q[3]
+        ex = p0 * q[1] + p1 * q[0] + p2 * q[3] - p3 * q[2]
+        ey = p0 * q[2] - p1 * q[3] + p2 * q[0] + p3 * q[1]
+        ez = p0 * q[3] + p1 * q[2] - p2 * q[1] + p3 * q[0]
+        sign = ca.if_else(e0 < 0, -1.0, 1.0)
+        e0, ex, ey, ez = sign * e0, sign * ex, sign * ey, sign * ez
+        rows = self._rows
+        vector = [a * ex + b * ey + c * ez for a, b, c in rows]
+        rates = [a * w[0] + b * w[1] + c * w[2] for a, b, c in rows]
+        return [e0, *vector], rates
+
+    def command_symbolic(self, u1: ca.SX, u2: ca.SX, y: ca.SX) -> ca.SX:
+        """:meth:`command_torque` on expressions: the control vector for ``u`` on the actuated axes."""
+        (a, b, c), (d, e, f), _ = self._rows
+        torque = ca.vertcat(a * u1 + d * u2, b * u1 + e * u2, c * u1 + f * u2)
+        return self.allocate_symbolic(torque, y)
 
     def to_body(self, u1: float, u2: float) -> Array:
         """A torque on the actuated axes (control frame) in body axes (N m)."""

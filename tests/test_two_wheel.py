@@ -1,5 +1,7 @@
 """Horri & Palmer's two-wheel laws (paper 004): kinematic closed forms against integration, the
 zero-momentum controllability condition, the min-norm projection, and the failed-wheel handling."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -8,8 +10,16 @@ from controllers import CONTROLLERS
 from controllers.min_norm import MinNorm
 from controllers.singular_zero_momentum import SingularZeroMomentum
 from controllers.underactuated import SingularGains, control_frame, desired_rates
-from ocp import (Magnetorquers, Measurement, ReactionWheels, SimulationError, Simulator, Spacecraft,
-                 metrics_from_simulation, quat)
+from ocp import (
+    Magnetorquers,
+    Measurement,
+    ReactionWheels,
+    SimulationError,
+    Simulator,
+    Spacecraft,
+    metrics_from_simulation,
+    quat,
+)
 from planners import ManeuverProblem
 
 UOSAT12 = [40.45, 42.09, 42.36]  # kg m², paper section VI.A
@@ -248,4 +258,38 @@ def test_g_must_exceed_twice_k(name, options, path):
     from ocp.options import OptionsError
     with pytest.raises(OptionsError, match="g.* > 2 k") as error:
         CONTROLLERS[name](options)
+    assert error.value.path == path
+
+
+def test_non_diagonal_inertia_with_a_principal_unactuated_axis():
+    """Products of inertia in the wheels' plane only: the control frame is the principal one
+    (not a relabelling of body axes), and the law still converges with z still at rest."""
+    rotation = quat.rotation_matrix(quat.from_axis_angle([0, 0, 1], 0.4))
+    inertia = rotation @ np.diag(UOSAT12) @ rotation.T
+    spacecraft = Spacecraft(inertia, wheels=ReactionWheels.from_body_axes(max_torque=0.02, failed=(2,)))
+    frame = control_frame(spacecraft)
+    assert np.allclose(frame @ frame.T, np.eye(3)) and np.linalg.det(frame) == pytest.approx(1.0)
+    moments = frame @ inertia @ frame.T
+    assert np.max(np.abs(moments - np.diag(np.diag(moments)))) < 1e-12 and np.allclose(frame[2], [0, 0, 1])
+    problem, result = run("singular_zero_momentum", {"a1": None, "a2": None}, duration=2000.0, spacecraft=spacecraft)
+    assert np.max(np.abs(result.omega[:, 2])) < 1e-12
+    assert np.rad2deg(quat.error_angle(result.q[-1], problem.qf)) < 0.01
+
+
+@pytest.mark.parametrize("change,path", [
+    ({"failed": []}, "controllers[0].name"),
+    ({"failed": [0], "inertia": [[40.45, 1.0, 0.0], [1.0, 42.09, 0.0], [0.0, 0.0, 42.36]]}, "controllers[0].name"),
+])
+def test_scenario_rejects_a_spacecraft_the_laws_cannot_control(change, path):
+    import copy
+
+    import scenarios
+    from scenarios.yaml_node import ScenarioError, read_yaml
+
+    data = copy.deepcopy(read_yaml(Path(__file__).parent.parent / "scenarios" / "horri_palmer_two_wheels.yaml"))
+    if "inertia" in change:
+        data["spacecraft"]["inertia"] = change["inertia"]
+    data["spacecraft"]["wheels"]["failed"] = change["failed"]
+    with pytest.raises(ScenarioError, match="spacecraft") as error:
+        scenarios.parse_scenario(data)
     assert error.value.path == path
