@@ -57,7 +57,6 @@ class GainScheduledMinNorm(MinNorm):
         self.low = SingularGains(o.k1, o.g1, o.a1, o.a2, o.epsilon_D)
         self.high = SingularGains(o.k2, o.g2, o.a1, o.a2, o.epsilon_D)
         self.lyapunov_gains = SingularGains(o.gamma, o.sigma, o.a1, o.a2, o.epsilon_D)
-        self.high_gain_samples = 0
 
     def benchmark(self, state: tuple[float, ...]) -> tuple[float, float]:
         """The mode's snlc torque: high gain if ``‖u_hg‖∞ < ε``, else low gain (N m, control frame)."""
@@ -65,7 +64,6 @@ class GainScheduledMinNorm(MinNorm):
         o, inertia = self.options, self.moments[:2]
         high = rate_tracking_torque(w1, w2, desired_rates(q0, q1, q2, q3, w1, w2, w3, self.high), o.K2, inertia)
         if max(abs(high[0]), abs(high[1])) < o.epsilon:
-            self.high_gain_samples += 1
             return high
         return rate_tracking_torque(w1, w2, desired_rates(q0, q1, q2, q3, w1, w2, w3, self.low), o.K1, inertia)
 

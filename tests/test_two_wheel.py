@@ -202,6 +202,9 @@ class PrintedSign(MinNorm):
         u = super().project(benchmark, lgv)
         return -u[0], -u[1]
 
+    def symbolic_error(self):  # the simulator then runs this NumPy law, not MinNorm's symbolic one
+        return "test double: the printed sign exists in the NumPy law only"
+
 
 def test_printed_sign_of_eq_25_diverges():
     problem, good = run("min_norm", {"a1": None, "a2": None}, duration=2000.0)
