@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from controllers import CONTROLLERS
-from ocp import SimulationError, SolverCache, SimulationResult, Simulator, metrics_from_reference, metrics_from_simulation
+from ocp import SimulationError, SolverCache, metric_violations, SimulationResult, Simulator, metrics_from_reference, metrics_from_simulation
 from planners import PLANNERS, FailedReference, Reference
 from scenarios.loader import ControllerSpec, Scenario
 
@@ -105,6 +105,15 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
         settling_tolerance_deg=scenario.simulation.settling_tolerance_deg,
         fine_settling_tolerance_deg=scenario.simulation.fine_settling_tolerance_deg,
         detumble_tolerance=scenario.simulation.detumble_tolerance)
+    _check_physical(row, "closed loop", row.closed_loop_metrics)
+
+
+def _check_physical(row: Row, scope: str, metrics: dict[str, Any] | None) -> None:
+    """A row whose metrics physics forbids (negative, non-finite) is failed, not "ok"."""
+    problems = metric_violations(metrics)
+    if problems and row.status == "ok":
+        row.status = "failed"
+        row.message = f"{scope} metrics are not physical ({'; '.join(problems)}): the result cannot be trusted"
 
 
 def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
@@ -124,7 +133,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     """
     say = progress or (lambda line: None)
     spec = scenario.simulation
-    simulator = Simulator(scenario.problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step)
+    simulator = Simulator(scenario.problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step,
+                          max_samples=spec.max_samples)
     controllers = scenario.controllers
     rows = []
     if not scenario.planners:
@@ -157,6 +167,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
                       reference.plan_time_s, None if reference_metrics is None else dict(reference_metrics), None,
                       reference, controller=controller.name)
             if reference.ok:
+                _check_physical(row, "reference", row.reference_metrics)
                 _simulate(scenario, simulator, reference, row, controller)
             rows.append(row)
             say(f"[{len(rows)}/{total}] {row.label}: {row.status} "
