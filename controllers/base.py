@@ -232,6 +232,8 @@ class Controller(Configurable, ABC):
                 wheel_torque = residual + np.array([w[1] * h[2] - w[2] * h[1], w[2] * h[0] - w[0] * h[2],
                                                     w[0] * h[1] - w[1] * h[0]])
             command.wheel_torque = -self._wheel_pinv @ wheel_torque
+            if self.wheels_only:
+                return command
             residual = wheel_torque + self._working_axes @ command.wheel_torque
             if np.sqrt(residual @ residual) <= 1e-12 * max(np.sqrt(wheel_torque @ wheel_torque), 1e-300):
                 return command

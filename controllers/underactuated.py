@@ -241,14 +241,14 @@ class TwoWheelLaw(Controller):
         """``(q0, q1, q2, q3, ω1, ω2, ω3)``: error quaternion ``q_f* ⊗ q`` (``q0 >= 0``) and body rate
         in the control frame."""
         p0, p1, p2, p3 = self._target_conjugate
-        q0, q1, q2, q3 = (float(v) for v in measurement.q)
+        q0, q1, q2, q3 = measurement.q.tolist()
         e0 = p0 * q0 - p1 * q1 - p2 * q2 - p3 * q3
         ex = p0 * q1 + p1 * q0 + p2 * q3 - p3 * q2
         ey = p0 * q2 - p1 * q3 + p2 * q0 + p3 * q1
         ez = p0 * q3 + p1 * q2 - p2 * q1 + p3 * q0
         if e0 < 0.0:
             e0, ex, ey, ez = -e0, -ex, -ey, -ez
-        wx, wy, wz = (float(v) for v in measurement.omega)
+        wx, wy, wz = measurement.omega.tolist()
         (a, b, c), (d, e, f), (g, h, i) = self._rows
         return (e0, a * ex + b * ey + c * ez, d * ex + e * ey + f * ez, g * ex + h * ey + i * ez,
                 a * wx + b * wy + c * wz, d * wx + e * wy + f * wz, g * wx + h * wy + i * wz)
