@@ -17,6 +17,7 @@ from ocp import (
     SimulationError,
     Simulator,
     Spacecraft,
+    Torquers,
     metrics_from_simulation,
     quat,
 )
@@ -227,9 +228,17 @@ def test_K_read_as_per_second_diverges_with_a_one_second_hold():
         run("singular_rate_tracking", {"K": 10.0 * UOSAT12[0]}, duration=200.0, spacecraft=spacecraft)
 
 
-def test_two_wheel_mode_is_pure():
-    """With magnetorquers on board the laws send them nothing (flag ``wheels_only``)."""
-    spacecraft = two_wheel_spacecraft(2, magnetorquers=Magnetorquers(max_dipole=10.0))
+@pytest.mark.parametrize("extra", [{"magnetorquers": Magnetorquers(max_dipole=10.0)}, {"torquers": Torquers(1.0)}])
+def test_two_wheel_mode_is_pure(extra):
+    """With magnetorquers or torquers on board the laws send them nothing (flag ``wheels_only``),
+    though a general law's allocation would (the same torque through the base class's allocate)."""
+    spacecraft = two_wheel_spacecraft(2, **extra)
+    general = CONTROLLERS["augmented_quaternion_feedback"]()
+    general.reset(spacecraft, 1.0, target=(quat.IDENTITY, np.zeros(3)))
+    measurement = Measurement(0.0, PAPER_Q0, np.array([1e-3, -2e-3, 0.0]), np.zeros(3),
+                              field_body=np.array([2e-5, 1e-5, 3e-5]))
+    passed_on = general.allocate(np.array([0.01, 0.01, 0.01]), measurement)
+    assert passed_on.dipole is not None or passed_on.torque is not None
     for name in TWO_WHEEL_LAWS:
         law = CONTROLLERS[name]()
         law.reset(spacecraft, 1.0, target=(quat.IDENTITY, np.zeros(3)))

@@ -18,7 +18,7 @@ def test_gain_scheduled_min_norm_10000_s(benchmark, python_loop):
     problem = scenarios.load(SCENARIO).problem
     simulator = Simulator(problem.model, 1.0, python_loop=python_loop)
     law = CONTROLLERS["gain_scheduled_min_norm"]()
-    run = lambda: simulator.run(law, problem.initial_state, 10000.0, target=(problem.qf, problem.omegaf))  # noqa: E731
+    run = lambda: simulator.run(law, problem.initial_state, 10000.0, target=(problem.qf, problem.omegaf))
     run()  # first call builds the closed loop
     result = benchmark.pedantic(run, rounds=3, iterations=1)
     assert result.t[-1] == 10000.0
