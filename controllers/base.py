@@ -80,6 +80,7 @@ class Controller(Configurable, ABC):
       the law cannot run there (missing actuator or sensor; an option that must fit the sample time);
       the scenario loader reports them at the controller's entry.
     * Saturation is the simulator's actuator model's job, not the controller's.
+    * Capability flags read by :meth:`allocate`: ``gyroscopic_compensation`` and ``wheels_only``.
 
     Symbolic form
     -------------
@@ -115,6 +116,12 @@ class Controller(Configurable, ABC):
     needs_reference: bool = False
     needs_target_attitude: bool = True
     needs_field_rate: bool = False
+    gyroscopic_compensation: bool = True
+    """:meth:`allocate` adds the wheels' ``ω × A h_w`` (the law's ``u`` is for ``I ω̇ = −ω × I ω + u``).
+    ``False``: ``u`` is the wheels' body torque itself (laws written for ``I ω̇ = u``, zero momentum)."""
+    wheels_only: bool = False
+    """Pure wheel mode: :meth:`allocate` drops what the wheels cannot give instead of sending it to
+    torquers or magnetorquers (the two-wheel laws)."""
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
         super().__init__(options, path)
@@ -235,11 +242,15 @@ class Controller(Configurable, ABC):
         if self._working_axes is not None:
             w = measurement.omega if rate is None else rate
             h = spacecraft.wheel_axes @ (measurement.wheel_momentum if wheel_momentum is None else wheel_momentum)
-            wheel_torque = residual + cross3(w, h)
+            wheel_torque = residual + cross3(w, h) if self.gyroscopic_compensation else residual
             command.wheel_torque = -self._wheel_pinv @ wheel_torque
+            if self.wheels_only:
+                return command
             residual = wheel_torque + self._working_axes @ command.wheel_torque
             if np.sqrt(residual @ residual) <= 1e-12 * max(np.sqrt(wheel_torque @ wheel_torque), 1e-300):
                 return command
+        if self.wheels_only:
+            return command
         if spacecraft.torquers is not None:
             command.torque = residual
         elif spacecraft.magnetorquers is not None and measurement.field_body is not None:
@@ -259,12 +270,14 @@ class Controller(Configurable, ABC):
         if self._working_axes is not None:
             w = omega if rate is None else rate
             h = ca.mtimes(ca.DM(spacecraft.wheel_axes), h_w if wheel_momentum is None else wheel_momentum)
-            wheel_torque = residual + ca.cross(w, h)
+            wheel_torque = residual + ca.cross(w, h) if self.gyroscopic_compensation else residual
             g = -ca.mtimes(ca.DM(self._wheel_pinv), wheel_torque)
             parts["wheels"] = g
             residual = wheel_torque + ca.mtimes(ca.DM(self._working_axes), g)
             done = ca.norm_2(residual) <= 1e-12 * ca.fmax(ca.norm_2(wheel_torque), 1e-300)
-        if spacecraft.torquers is not None:
+        if self.wheels_only:
+            pass
+        elif spacecraft.torquers is not None:
             parts["torquers"] = residual if done is None else ca.if_else(done, ca.DM.zeros(3), residual)
         elif spacecraft.magnetorquers is not None:
             dipole = ca.cross(field, residual) / ca.fmax(ca.dot(field, field), 1e-30)

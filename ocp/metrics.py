@@ -16,6 +16,7 @@ METRIC_KEYS: tuple[str, ...] = (
     "rms_error_deg", "max_error_deg", "settling_time_s", "saturation_fraction",
     "peak_wheel_momentum", "plan_time_s", "duration_s",
     "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
+    "fine_settling_time_s",
 )
 DEFAULT_SETTLING_TOLERANCE_DEG = 0.5
 DEFAULT_DETUMBLE_TOLERANCE = 0.01
@@ -50,6 +51,19 @@ def _integrate(t: NDArray, values: NDArray) -> NDArray:
     return np.tensordot(dt, 0.5 * (values[1:] + values[:-1]), axes=(0, 0))
 
 
+def settling_time(t: NDArray, error_deg: NDArray | None, tolerance_deg: float) -> float | None:
+    """First time (s) after which ``error_deg`` stays at or below ``tolerance_deg`` to the end;
+    ``None`` for a free attitude (``error_deg`` None) or when not settled by the last sample."""
+    if error_deg is None:
+        return None
+    above = np.nonzero(error_deg > tolerance_deg)[0]
+    if above.size == 0:
+        return 0.0
+    if above[-1] == t.size - 1:
+        return None
+    return float(t[above[-1] + 1])
+
+
 def compute_metrics(
     t: ArrayLike,
     q: ArrayLike,
@@ -63,6 +77,7 @@ def compute_metrics(
     plan_time_s: float | None = None,
     duration_s: float | None = None,
     settling_tolerance_deg: float = DEFAULT_SETTLING_TOLERANCE_DEG,
+    fine_settling_tolerance_deg: float | None = None,
     dipole: ArrayLike | None = None,
     inertia: ArrayLike | None = None,
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
@@ -77,6 +92,8 @@ def compute_metrics(
     target_q, target_omega : the manoeuvre's final attitude and rate (``None``: free).
     reference_q : (N+1, 4) reference attitude at ``t`` for the tracking errors (closed loop).
     wheel_momentum : (N+1, n_w) N m s; saturated : (N,) bool per sample.
+    settling_tolerance_deg, fine_settling_tolerance_deg : error angles (deg) of ``settling_time_s``
+        and of ``fine_settling_time_s`` (``None``: that metric is null).
     dipole : (N, 3) A m², magnetorquer dipole held over each interval (``None``: no magnetorquers).
     inertia : (3, 3) kg m², body inertia for ``energy_ratio`` (``None``: not computed).
     detumble_tolerance : rad/s, bound on ``max_i |ω_i|`` for ``detumble_time_s``.
@@ -90,15 +107,7 @@ def compute_metrics(
     torque = np.asarray(torque, dtype=float)
     norms = np.linalg.norm(torque, axis=1)
     error_to_target = None if target_q is None else np.rad2deg(quat.error_angle(q, target_q))
-    above = None if target_q is None else np.nonzero(error_to_target > settling_tolerance_deg)[0]
-    if above is None:
-        settling = None  # free final attitude
-    elif above.size == 0:
-        settling = 0.0
-    elif above[-1] == t.size - 1:
-        settling = None  # not settled by the end of the window
-    else:
-        settling = float(t[above[-1] + 1])
+    settling = settling_time(t, error_to_target, settling_tolerance_deg)
     metrics: dict[str, Any] = {
         "int_u2": float(_integrate(t, norms**2)),
         "int_u": float(_integrate(t, norms)),
@@ -114,6 +123,8 @@ def compute_metrics(
         "peak_wheel_momentum": None,
         "plan_time_s": plan_time_s,
         "duration_s": duration_s,
+        "fine_settling_time_s": None if fine_settling_tolerance_deg is None
+        else settling_time(t, error_to_target, fine_settling_tolerance_deg),
         "detumble_time_s": detumble_time(t, np.asarray(omega, dtype=float), detumble_tolerance),
         "int_dipole": None if dipole is None
         else float(_integrate(t, np.linalg.norm(np.asarray(dipole, dtype=float), axis=1))),
@@ -141,6 +152,7 @@ def metrics_from_simulation(
     plan_time_s: float | None = None,
     duration_s: float | None = None,
     settling_tolerance_deg: float = DEFAULT_SETTLING_TOLERANCE_DEG,
+    fine_settling_tolerance_deg: float | None = None,
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
 ) -> dict[str, Any]:
     """Closed-loop metrics of an :class:`~ocp.simulator.SimulationResult`; ``reference`` (anything
@@ -152,7 +164,8 @@ def metrics_from_simulation(
         reference_q=None if reference is None else reference.q(result.t),
         wheel_momentum=result.wheel_momentum if result.wheel_momentum.shape[1] else None,
         saturated=result.saturated, plan_time_s=plan_time_s, duration_s=duration_s,
-        settling_tolerance_deg=settling_tolerance_deg, dipole=dipole,
+        settling_tolerance_deg=settling_tolerance_deg,
+        fine_settling_tolerance_deg=fine_settling_tolerance_deg, dipole=dipole,
         inertia=result.model.spacecraft.inertia, detumble_tolerance=detumble_tolerance,
     )
 
@@ -163,6 +176,7 @@ def metrics_from_reference(
     target_omega: ArrayLike | None = None,
     points: int = 2001,
     settling_tolerance_deg: float = DEFAULT_SETTLING_TOLERANCE_DEG,
+    fine_settling_tolerance_deg: float | None = None,
     inertia: ArrayLike | None = None,
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
 ) -> dict[str, Any]:
@@ -172,7 +186,8 @@ def metrics_from_reference(
     return compute_metrics(
         t, reference.q(t), reference.omega(t), reference.torque(t), target_q, target_omega,
         plan_time_s=reference.plan_time_s, duration_s=reference.duration,
-        settling_tolerance_deg=settling_tolerance_deg, inertia=inertia, detumble_tolerance=detumble_tolerance,
+        settling_tolerance_deg=settling_tolerance_deg,
+        fine_settling_tolerance_deg=fine_settling_tolerance_deg, inertia=inertia, detumble_tolerance=detumble_tolerance,
     )
 
 

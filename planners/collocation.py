@@ -96,10 +96,14 @@ class CollocationPlanner(Planner):
         def __post_init__(self) -> None:
             from planners import PLANNERS  # the registry is complete once options are parsed
 
-            for name in [self.warm_start, *self.seed_planners]:
-                if name not in PLANNERS or name == "collocation":
+            # A collocation warm start is planned with its own options (say min_energy, itself warm
+            # started from eigenaxis): the way into min_time where a kinematic seed is too far
+            # (two wheels). Only its own warm start may nest further; the depth is the YAML's.
+            for index, name in enumerate([self.warm_start, *self.seed_planners]):
+                if name not in PLANNERS or (name == "collocation" and index > 0):
                     raise InvalidOption("warm_start", f"{name!r} is not another registered planner; "
-                                     f"expected one of {sorted(set(PLANNERS) - {'collocation'})}")
+                                     f"expected one of {sorted(set(PLANNERS) - {'collocation'})} "
+                                     "(or collocation as warm_start)")
             try:
                 PLANNERS[self.warm_start](self.warm_start_options, path="warm_start_options")
             except OptionsError as error:

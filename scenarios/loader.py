@@ -65,6 +65,7 @@ class SimulationSpec:
     integrator: str = "rk4"
     max_step: float = 0.05
     settling_tolerance_deg: float = 0.5
+    fine_settling_tolerance_deg: float | None = None
     detumble_tolerance: float = 0.01
     compile: bool = False
     """Build the closed loop of a symbolic law as C (``ocp.compiled``); interpreted otherwise."""
@@ -318,6 +319,7 @@ def parse_simulation(node: Node) -> SimulationSpec:
         integrator=node.get("integrator", "rk4").string(("rk4", "cvodes")),
         max_step=node.get("max_step", 0.05).number(positive=True),
         settling_tolerance_deg=node.get("settling_tolerance_deg", 0.5).number(positive=True, maximum=180.0),
+        fine_settling_tolerance_deg=node.get("fine_settling_tolerance_deg", None).optional_number(positive=True),
         detumble_tolerance=node.get("detumble_tolerance", 0.01).number(positive=True),
         max_samples=node.get("max_samples", MAX_SAMPLES).integer(minimum=1, maximum=100_000_000),
         compile=node.get("compile", False).boolean(),

@@ -103,6 +103,7 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
         result, problem.qf, problem.omegaf, reference=reference, plan_time_s=row.plan_time_s,
         duration_s=reference.duration if reference else None,
         settling_tolerance_deg=scenario.simulation.settling_tolerance_deg,
+        fine_settling_tolerance_deg=scenario.simulation.fine_settling_tolerance_deg,
         detumble_tolerance=scenario.simulation.detumble_tolerance)
     _check_physical(row, "closed loop", row.closed_loop_metrics)
 
@@ -158,6 +159,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
             reference_metrics = metrics_from_reference(
                 reference, scenario.problem.qf, scenario.problem.omegaf,
                 settling_tolerance_deg=spec.settling_tolerance_deg,
+                fine_settling_tolerance_deg=spec.fine_settling_tolerance_deg,
                 inertia=scenario.problem.spacecraft.inertia, detumble_tolerance=spec.detumble_tolerance)
         for controller in controllers:
             label = planner_spec.label if len(controllers) == 1 else f"{planner_spec.label} / {controller.label}"
