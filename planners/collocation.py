@@ -18,7 +18,7 @@ from typing import Annotated, Literal
 import numpy as np
 
 from ocp.nlp import perturbed, solve_multistart, solver_options
-from ocp.options import InvalidOption, Range
+from ocp.options import Range
 from ocp.transcription import TRANSCRIPTIONS, Cone, OptimalControlProblem
 from planners.base import FailedReference, ManeuverProblem, Planner, Reference
 from planners.collocation_reference import CollocationReference, seed_sampler
@@ -89,10 +89,6 @@ class CollocationPlanner(Planner):
                 parse_cone(spec, True)
             for spec in self.keep_in:
                 parse_cone(spec, False)
-            if self.solver == "fatrop" and (self.keep_out or self.keep_in or l1):
-                raise InvalidOption("solver", "fatrop cannot take inequality path constraints here (cones, L1 "
-                                    "slacks): its interior point needs them per stage and fails on these; "
-                                    "use solver: ipopt")
 
     def _ocp(self, problem: ManeuverProblem) -> OptimalControlProblem:
         o = self.options
