@@ -18,6 +18,14 @@ Early stopping
 Starts are tried in order; the search stops once ``agree`` converged starts have objectives within
 ``rtol`` (relative, with ``atol``) of the best so far: the best optimum has been found again from
 a different start, which is the evidence that more starts would not improve it.
+
+Restarts
+--------
+With ``restart > 0``, after the given guesses (once one has converged) come copies of the best point
+so far perturbed by ``restart`` (relative), at most ``max_restarts`` of them. From a local minimum
+such a restart comes back in a few iterations (and confirms it, which stops the search); from a
+saddle or other stationary point (the eigenaxis slew for minimum time) it leaves for a better
+point, which then becomes the best and is checked in turn.
 """
 from __future__ import annotations
 
@@ -135,7 +143,7 @@ def converged(status: str, success: bool, violation_: float, feasibility_toleran
 def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = None, lbx: Any = None,
                      ubx: Any = None, lbg: Any = None, ubg: Any = None, agree: int = 2, rtol: float = 1e-6,
                      atol: float = 1e-12, feasibility_tolerance: float = 1e-8,
-                     max_starts: int | None = None) -> NLPResult:
+                     max_starts: int | None = None, restart: float = 0.0, max_restarts: int = 4) -> NLPResult:
     """Solve from each guess in turn, keep the best converged start, stop early on agreement.
 
     Parameters
@@ -147,6 +155,8 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         objective (1: stop at the first converged start; 0: never stop early).
     feasibility_tolerance : constraint violation accepted by the status policy.
     max_starts : try at most this many guesses.
+    restart : relative perturbation of the restarts from the best point (0: no restarts).
+    max_restarts : restarts at most.
 
     Returns
     -------
@@ -164,9 +174,16 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
     starts: list[StartResult] = []
     objectives: list[float] = []
     begin = time.perf_counter()
-    for index, guess in enumerate(guesses):
-        if max_starts is not None and index >= max_starts:
-            break
+
+    def candidates():
+        for index, guess in enumerate(guesses):
+            if max_starts is not None and index >= max_starts:
+                break
+            yield guess
+        for k in range(max_restarts if restart > 0 and best_x is not None else 0):
+            yield perturbed(best_x, 1, seed=k + 1, scales=(restart, restart))[0]
+
+    for index, guess in enumerate(candidates()):
         tic = time.perf_counter()
         solution = solver(x0=np.clip(np.asarray(guess, dtype=float), low, high), **args)
         elapsed = time.perf_counter() - tic
