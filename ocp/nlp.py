@@ -122,7 +122,7 @@ class NLPResult:
     def stats(self) -> dict[str, Any]:
         """A planner's ``stats`` entries: objective, iterations, statuses, timings, per start."""
         return {"objective": self.f, "iterations": self.iterations, "solver_status": self.statuses,
-                "ipopt_status": self.statuses, "solve_time_s": self.time_s, "best_start": self.best_start,
+                "solve_time_s": self.time_s, "best_start": self.best_start,
                 "starts": [vars(s) for s in self.starts]}
 
 

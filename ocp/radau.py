@@ -107,7 +107,7 @@ class RadauCollocation(Transcription):
         return x_low, x_high, c_low, c_high
 
     def stage_guess(self, problem, sample: Callable, duration: float):
-        N, d = self.intervals, self.degree
+        N = self.intervals
         h = duration / N
         nodes = np.arange(N + 1) * h
         x_nodes, _, _ = sample(nodes)

@@ -185,3 +185,16 @@ def test_full_inertia_optimum_by_a_second_method():
                                          "intervals": 150}).plan(full_inertia_problem())
     assert reference.status == "ok", reference.message
     assert reference.duration == pytest.approx(FULL_INERTIA_MIN_TIME, abs=2e-4)
+
+
+@pytest.mark.parametrize("solver", ["ipopt", "fatrop"])
+def test_single_axis_minimum_fuel_matches_bang_off_bang(solver):
+    # Rest to rest about x in fixed T with |u| <= u_max: accelerate to ω_c, coast, brake, with
+    # ω_c (T − I ω_c / u_max) = θ, so ∫|u| dt = 2 I ω_c. L1 slacks are inequality path constraints,
+    # which FATROP takes as well as IPOPT.
+    inertia, angle, duration, u_max = 5.0, 1.0, 20.0, 1.0
+    omega_c = (duration - np.sqrt(duration**2 - 4 * inertia * angle / u_max)) / (2 * inertia / u_max)
+    problem = single_axis_problem(inertia, angle, duration, u_max)
+    reference = PLANNERS["collocation"]({"objective": "min_l1", "intervals": 40, "solver": solver}).plan(problem)
+    assert reference.status == "ok", reference.message
+    assert reference.stats["objective"] == pytest.approx(2 * inertia * omega_c, rel=5e-3)
