@@ -1,14 +1,16 @@
-"""Direct optimal control on the full model (IPOPT): the workbench's numerical reference.
+"""Direct optimal control on the full model: the workbench's numerical reference.
 
 Objectives: ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt (slack variables),
 ``min_time`` (free T, the scenario's T is the upper bound), and ``weighted``
 (``energy_weight``, ``l1_weight``, ``time_weight``). τ is the actuators' body torque.
 Constraints: actuator bounds (wheel torques, dipoles, torquers), wheel momentum bounds, a body-rate
 bound ``max_rate`` (per axis), fixed or free final rate, keep-out / keep-in cones.
-The transcription (``collocation``: Legendre-Gauss-Radau, or ``multiple_shooting``) is injected from
-:data:`ocp.transcription.TRANSCRIPTIONS`; the NLP is built once per problem structure and cached
-on the model. Starts: the reference of the ``warm_start`` planner (or, with ``multistart`` > 0, that many randomly
-perturbed copies of it) and the ``seed_planners``; the best converged optimum is kept.
+The transcription (``collocation``: Legendre-Gauss-Radau, or ``multiple_shooting``) comes from
+:data:`ocp.transcription.TRANSCRIPTIONS` and owns its layout (bounds, seeding, interpolation); the
+NLP (IPOPT or FATROP) is built once per problem structure into the planner's ``SolverCache``.
+Starts: the reference of the ``warm_start`` planner (perturbed copies of it per ``multistart``)
+and the ``seed_planners``, solved by :func:`ocp.nlp.solve_multistart` (its status policy and early
+stopping); the best converged optimum is kept.
 """
 from __future__ import annotations
 
