@@ -72,8 +72,12 @@ class CostateFeedback(Controller):
     """Vepa's co-state feedback law (see the module docstring)."""
 
     name = "costate_feedback"
-    hold_compensation = False  # the law is not of the ``u + ω × Iω`` form the correction is for
     needs_reference = True
+
+    def symbolic_error(self) -> str | None:
+        return ("the co-state gain P is fitted at run time by constrained least squares over a window "
+                "of the reference's states and co-states (an iterative projected-gradient solve) and "
+                "the control calls the reference's own system; neither is a fixed CasADi expression")
 
     @dataclass(frozen=True)
     class Options:

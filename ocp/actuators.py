@@ -7,7 +7,9 @@ over the coming zero-order-hold interval, and dipoles and torquer torques are cl
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
+import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
@@ -71,11 +73,10 @@ class ActuatorModel:
         if "wheels" in self.slices and command.wheel_torque is not None:
             g = np.asarray(command.wheel_torque, dtype=float) * self._wheel_mask
             low = np.maximum(-self._wheel_limit, (-self._momentum_limit - wheel_momentum) / dt)
-            high = np.minimum(self._wheel_limit, (self._momentum_limit - wheel_momentum) / dt)
-            high = np.maximum(high, low)  # a wheel already beyond its limit may only come back
-            applied = np.clip(g, low, high)
-            saturated |= bool(np.any(np.abs(applied - g) > 1e-12 * np.maximum(1.0, np.abs(g))))
-            saturated |= bool(np.any(np.abs(applied) >= self._wheel_limit * (1 - 1e-12)))
+            high = np.maximum(np.minimum(self._wheel_limit, (self._momentum_limit - wheel_momentum) / dt), low)
+            applied = np.minimum(np.maximum(g, low), high)  # np.clip, without its per-call overhead
+            saturated = bool((np.abs(applied - g) > 1e-12 * np.maximum(1.0, np.abs(g))).any()
+                             or (np.abs(applied) >= self._wheel_limit * (1 - 1e-12)).any())
             u[self.slices["wheels"]] = applied
         for name, value, limit in (
             ("dipole", command.dipole, self._dipole_limit),
@@ -83,7 +84,31 @@ class ActuatorModel:
         ):
             if name in self.slices and value is not None:
                 value = np.asarray(value, dtype=float)
-                applied = np.clip(value, -limit, limit)
-                saturated |= bool(np.any(np.abs(value) >= limit * (1 - 1e-12)))
-                u[self.slices[name]] = applied
+                u[self.slices[name]] = np.minimum(np.maximum(value, -limit), limit)
+                saturated = saturated or bool((np.abs(value) >= limit * (1 - 1e-12)).any())
         return u, saturated
+
+    def apply_symbolic(self, u: Any, wheel_momentum: Any, dt: Any) -> tuple[Any, Any]:
+        """:meth:`apply` on CasADi expressions of a command vector ``u`` (layout of the model's
+        controls; zeros where nothing is asked): the applied ``u`` and the saturation flag (0/1)."""
+        parts = []
+        flags = []
+        if "wheels" in self.slices:
+            g = u[self.slices["wheels"]] * ca.DM(self._wheel_mask)
+            g_max, h_max = ca.DM(self._wheel_limit), ca.DM(self._momentum_limit)
+            low = ca.fmax(-g_max, (-h_max - wheel_momentum) / dt)
+            high = ca.fmax(ca.fmin(g_max, (h_max - wheel_momentum) / dt), low)
+            applied = ca.fmin(ca.fmax(g, low), high)
+            flags += [ca.fabs(applied - g) > 1e-12 * ca.fmax(1.0, ca.fabs(g)), ca.fabs(applied) >= g_max * (1 - 1e-12)]
+            parts.append((self.slices["wheels"], applied))
+        for name, limit in (("dipole", self._dipole_limit), ("torquers", self._torquer_limit)):
+            if name in self.slices:
+                value = u[self.slices[name]]
+                bound = ca.DM(limit)
+                parts.append((self.slices[name], ca.fmin(ca.fmax(value, -bound), bound)))
+                flags.append(ca.fabs(value) >= bound * (1 - 1e-12))
+        applied_u = ca.SX.zeros(self.nu) if not isinstance(u, ca.MX) else ca.MX.zeros(self.nu)
+        for where, value in parts:
+            applied_u[where] = value
+        saturated = ca.mmax(ca.vertcat(*flags)) if flags else ca.SX(0)
+        return applied_u, saturated

@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from ocp import quat, quat_casadi as qc
 from ocp.cache import SolverCache
 from ocp.environment import Environment, gravity_gradient_torque
+from ocp.layout import control_layout
 from ocp.spacecraft import Spacecraft
 
 
@@ -43,17 +44,7 @@ class AttitudeModel:
         self.environment = environment if environment is not None else Environment()
         self.n_wheels = spacecraft.n_wheels
         self.nx = 7 + self.n_wheels
-        self.control_slices: dict[str, slice] = {}
-        offset = 0
-        for name, present, size in (
-            ("wheels", spacecraft.wheels is not None, self.n_wheels),
-            ("dipole", spacecraft.magnetorquers is not None, 3),
-            ("torquers", spacecraft.torquers is not None, 3),
-        ):
-            if present:
-                self.control_slices[name] = slice(offset, offset + size)
-                offset += size
-        self.nu = offset
+        self.control_slices, self.nu = control_layout(spacecraft)
         self._fingerprint: str | None = None
         self.solver_cache = SolverCache()
         """Solvers built on this model by planners given no cache of their own."""

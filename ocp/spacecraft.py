@@ -10,7 +10,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import linprog
 
 Array = NDArray[np.float64]
 
@@ -202,6 +201,14 @@ class Spacecraft:
         reachable = np.linalg.norm(axes @ pinv - np.eye(3), axis=0) < 1e-9
         finite = np.isfinite(g_max)
         demand = np.abs(pinv[finite]) * reachable
+        significant = demand > 1e-12 * max(float(demand.max(initial=0.0)), 1e-300)
+        if np.all(significant.sum(axis=1) <= 1):
+            # Each wheel drives one body axis (e.g. wheels along the body axes): the programme
+            # decouples and each axis gets the bound of its tightest wheel.
+            ratios = np.where(significant, g_max[finite][:, None] / np.where(significant, demand, 1.0), np.inf)
+            return np.where(reachable, ratios.min(axis=0, initial=np.inf), 0.0)
+        from scipy.optimize import linprog  # lazily: scipy.optimize dominates the import of slewbench
+
         # Lexicographic: first the largest bound common to every reachable axis, then the
         # largest sum with no axis below it, so that no axis is sacrificed for the others.
         n_reach = int(reachable.sum())

@@ -175,6 +175,14 @@ class Reference(ABC):
     def torque(self, t: ArrayLike) -> Array:
         return self.sample(t).torque
 
+    def symbolic_evaluator(self) -> Any:
+        """The reference as a ``casadi.Function`` ``reference(t) -> row`` with ``row`` =
+        ``[q, ω, ω̇, τ]`` (13 numbers, the layout of ``ocp.layout.REFERENCE_FIELDS``) for
+        ``t`` in ``[0, duration]`` (clamped outside), or ``None`` when the reference has no closed
+        form. Closed-form references (their planner sets ``Planner.closed_form``) implement it;
+        ``slewbench codegen`` exports it as C."""
+        return None
+
 
 class FailedReference(Reference):
     """What a planner returns when it cannot produce a motion; evaluating it is an error."""
@@ -211,7 +219,11 @@ class Planner(Configurable, ABC):
     * ``cache`` (constructor) is an explicit :class:`~ocp.cache.SolverCache` for what the planner
       builds (NLPs); without one, the planner keeps its builds in the model's own cache
       (``problem.model.solver_cache``).
+    * ``closed_form``: its references are closed-form expressions of time and implement
+      :meth:`Reference.symbolic_evaluator` (``slewbench codegen`` exports them as C).
     """
+
+    closed_form: bool = False
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options",
                  cache: SolverCache | None = None):

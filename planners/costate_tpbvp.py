@@ -21,7 +21,6 @@ from dataclasses import dataclass
 from typing import Annotated, Any, Callable, Literal
 
 import numpy as np
-from scipy.integrate import solve_bvp
 
 from ocp.options import InvalidOption, Range
 from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample
@@ -103,6 +102,8 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
     only ever adds nodes). Returns ``(solution, t_f, stages, None)`` or ``(None, None, stages,
     message)``. ``guess`` replaces the system's own cold start (tests use it to start far away).
     """
+    from scipy.integrate import solve_bvp  # lazily: scipy.integrate pulls in scipy.optimize
+
     free = system.free_final_time
     t_f = 0.0
 

@@ -23,8 +23,6 @@ from typing import Annotated, Literal
 
 import casadi as ca
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.special import ellipj, ellipkinc
 
 from ocp import Spacecraft, quat
 from ocp import quat_casadi as qc
@@ -81,6 +79,7 @@ def asymmetric_rates(t: Array, omega0: Array, moments: Array) -> Array:
     m = min((Ib - Ia) * (e2 * Ic - h2) / ((Ic - Ib) * (h2 - e2 * Ia)), 1.0)
     sign_c = 1.0 if w0[c] >= 0 else -1.0
     parity = np.linalg.det(np.eye(3)[order])  # an odd sort reverses the Euler equations
+    from scipy.special import ellipj, ellipkinc  # lazily: scipy.special is slow to import
     phase = ellipkinc(np.arctan2(w0[b] / amp_b if amp_b > 0 else 0.0, w0[a] / amp_a if amp_a > 0 else 1.0), m)
     sn, cn, dn, _ = ellipj(sign_c * parity * rate * np.asarray(t, dtype=float) + phase, m)
     sorted_rates = np.empty(np.shape(t) + (3,))
@@ -104,6 +103,8 @@ class NaturalMotionReference(Reference):
         self.q0, self.omega0, self.moments, self.arc, self.stop = q0, omega0, moments, arc, stop
         self.axis = symmetry_axis(moments)
         if self.axis is None:
+            from scipy.integrate import solve_ivp  # lazily: scipy.integrate pulls in scipy.optimize
+
             solution = solve_ivp(lambda s, q: quat.kinematics(q, asymmetric_rates(s, omega0, moments)), (0, arc),
                                  quat.IDENTITY, method="DOP853", rtol=1e-12, atol=1e-13, dense_output=True)
             self._relative = lambda t: quat.normalize(solution.sol(t).T)

@@ -55,6 +55,8 @@ class SimulationSpec:
     integrator: str = "rk4"
     max_step: float = 0.05
     settling_tolerance_deg: float = 0.5
+    compile: bool = False
+    """Build the closed loop of a symbolic law as C (``ocp.compiled``); interpreted otherwise."""
     max_samples: int = MAX_SAMPLES
 
 
@@ -243,6 +245,7 @@ def parse_simulation(node: Node) -> SimulationSpec:
         max_step=node.get("max_step", 0.05).number(positive=True),
         settling_tolerance_deg=node.get("settling_tolerance_deg", 0.5).number(positive=True, maximum=180.0),
         max_samples=node.get("max_samples", MAX_SAMPLES).integer(minimum=1, maximum=100_000_000),
+        compile=node.get("compile", False).boolean(),
     )
     if spec.integrator == "rk4" and math.ceil(spec.sample_time / spec.max_step - 1e-9) > MAX_SUBSTEPS:
         raise ScenarioError(node.get("max_step").path, f"{spec.max_step:g} s gives more than {MAX_SUBSTEPS} RK4 "

@@ -123,7 +123,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     say = progress or (lambda line: None)
     spec = scenario.simulation
     simulator = Simulator(scenario.problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step,
-                          max_samples=spec.max_samples)
+                          max_samples=spec.max_samples, compile=spec.compile)
     rows = []
     if not scenario.planners:
         row = Row(scenario.controller.name, None, "ok", "regulation to the target", None, None, None)
