@@ -69,9 +69,18 @@ class Controller(Configurable, ABC):
       or ``None`` (regulation to the target). It is the reference implementation of the law.
     * ``needs_reference``: the law cannot regulate (``reference=None``) and raises ``ValueError``
       there; the scenario loader rejects regulation mode for it.
+    * ``needs_target_attitude``: in regulation mode the law needs ``maneuver.final.q``. Laws that
+      regulate the rate alone (detumbling: ``bdot``, ``tdfc``; ``none``) set it to ``False`` and
+      then accept a free final attitude (``q: null``).
+    * ``needs_field_rate``: the law reads ``measurement.field_rate_inertial`` (ḃ_I, T/s), which
+      the simulator then provides (only the ideal B-dot does; a real spacecraft cannot).
     * ``planner_error(name, options)`` says why the law cannot track references of that planner
       (``None`` if it can); the scenario loader reports it. Most laws track any reference.
+    * ``environment_error(spacecraft, environment)`` and ``sample_time_error(sample_time)`` say why
+      the law cannot run there (missing actuator or sensor; an option that must fit the sample time);
+      the scenario loader reports them at the controller's entry.
     * Saturation is the simulator's actuator model's job, not the controller's.
+    * Capability flags read by :meth:`allocate`: ``gyroscopic_compensation`` and ``wheels_only``.
 
     Symbolic form
     -------------
@@ -105,6 +114,14 @@ class Controller(Configurable, ABC):
     """
 
     needs_reference: bool = False
+    needs_target_attitude: bool = True
+    needs_field_rate: bool = False
+    gyroscopic_compensation: bool = True
+    """:meth:`allocate` adds the wheels' ``ω × A h_w`` (the law's ``u`` is for ``I ω̇ = −ω × I ω + u``).
+    ``False``: ``u`` is the wheels' body torque itself (laws written for ``I ω̇ = u``, zero momentum)."""
+    wheels_only: bool = False
+    """Pure wheel mode: :meth:`allocate` drops what the wheels cannot give instead of sending it to
+    torquers or magnetorquers (the two-wheel laws)."""
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
         super().__init__(options, path)
@@ -114,6 +131,15 @@ class Controller(Configurable, ABC):
 
     def planner_error(self, planner: str, options: Any) -> str | None:
         """Why this law cannot track the references of ``planner`` with ``options``, or ``None``."""
+        return None
+
+    def environment_error(self, spacecraft: Spacecraft, environment: Any) -> str | None:
+        """Why the law cannot run on ``spacecraft`` in ``environment`` (an actuator or a sensor it
+        needs is missing), or ``None``."""
+        return None
+
+    def sample_time_error(self, sample_time: float) -> tuple[str, str] | None:
+        """``(option name, message)`` if an option does not fit the sample time (s), else ``None``."""
         return None
 
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
@@ -216,11 +242,15 @@ class Controller(Configurable, ABC):
         if self._working_axes is not None:
             w = measurement.omega if rate is None else rate
             h = spacecraft.wheel_axes @ (measurement.wheel_momentum if wheel_momentum is None else wheel_momentum)
-            wheel_torque = residual + cross3(w, h)
+            wheel_torque = residual + cross3(w, h) if self.gyroscopic_compensation else residual
             command.wheel_torque = -self._wheel_pinv @ wheel_torque
+            if self.wheels_only:
+                return command
             residual = wheel_torque + self._working_axes @ command.wheel_torque
             if np.sqrt(residual @ residual) <= 1e-12 * max(np.sqrt(wheel_torque @ wheel_torque), 1e-300):
                 return command
+        if self.wheels_only:
+            return command
         if spacecraft.torquers is not None:
             command.torque = residual
         elif spacecraft.magnetorquers is not None and measurement.field_body is not None:
@@ -240,12 +270,14 @@ class Controller(Configurable, ABC):
         if self._working_axes is not None:
             w = omega if rate is None else rate
             h = ca.mtimes(ca.DM(spacecraft.wheel_axes), h_w if wheel_momentum is None else wheel_momentum)
-            wheel_torque = residual + ca.cross(w, h)
+            wheel_torque = residual + ca.cross(w, h) if self.gyroscopic_compensation else residual
             g = -ca.mtimes(ca.DM(self._wheel_pinv), wheel_torque)
             parts["wheels"] = g
             residual = wheel_torque + ca.mtimes(ca.DM(self._working_axes), g)
             done = ca.norm_2(residual) <= 1e-12 * ca.fmax(ca.norm_2(wheel_torque), 1e-300)
-        if spacecraft.torquers is not None:
+        if self.wheels_only:
+            pass
+        elif spacecraft.torquers is not None:
             parts["torquers"] = residual if done is None else ca.if_else(done, ca.DM.zeros(3), residual)
         elif spacecraft.magnetorquers is not None:
             dipole = ca.cross(field, residual) / ca.fmax(ca.dot(field, field), 1e-30)

@@ -13,6 +13,7 @@ class NoControl(Controller):
     """Commands nothing."""
 
     name = "none"
+    needs_target_attitude = False
 
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
         return Command()

@@ -2,7 +2,8 @@
 
 A controller returns a :class:`Command`; the simulator's :class:`ActuatorModel` enforces the
 hardware: failed wheels give nothing, each wheel's torque and momentum stay within their limits
-over the coming zero-order-hold interval, and dipoles and torquer torques are clipped per axis.
+over the coming zero-order-hold interval, and dipoles and torquer torques are clipped per axis (or,
+for magnetorquers with ``saturation="scale"``, the dipole vector is scaled down as a whole).
 """
 from __future__ import annotations
 
@@ -38,13 +39,16 @@ class Command:
 @dataclass
 class Measurement:
     """What the controller sees at a sample: time (s), attitude, body rate (rad/s), wheel momenta
-    (N m s) and the magnetometer reading in body axes (T; ``None`` without a field model)."""
+    (N m s) and the magnetometer reading in body axes (T; ``None`` without a field model).
+    ``field_rate_inertial`` (T/s, inertial axes) is the rate of the inertial field along the orbit,
+    given only to laws that declare ``needs_field_rate`` (the ideal B-dot)."""
 
     t: float
     q: Array
     omega: Array
     wheel_momentum: Array
     field_body: Array | None = None
+    field_rate_inertial: Array | None = None
 
 
 class ActuatorModel:
@@ -60,6 +64,7 @@ class ActuatorModel:
             self._wheel_limit = wheels.max_torque
             self._momentum_limit = wheels.max_momentum
         self._dipole_limit = None if spacecraft.magnetorquers is None else spacecraft.magnetorquers.max_dipole
+        self._dipole_scaled = spacecraft.magnetorquers is not None and spacecraft.magnetorquers.saturation == "scale"
         self._torquer_limit = None if spacecraft.torquers is None else spacecraft.torquers.max_torque
 
     def apply(self, command: Command, wheel_momentum: Array, dt: float) -> tuple[Array, bool]:
@@ -84,7 +89,12 @@ class ActuatorModel:
         ):
             if name in self.slices and value is not None:
                 value = np.asarray(value, dtype=float)
-                u[self.slices[name]] = np.minimum(np.maximum(value, -limit), limit)
+                if name == "dipole" and self._dipole_scaled:
+                    # the whole vector is scaled down until every axis is within its limit: direction kept
+                    ratio = float(np.max(np.abs(value) / limit))
+                    u[self.slices[name]] = value / ratio if ratio > 1.0 else value
+                else:
+                    u[self.slices[name]] = np.minimum(np.maximum(value, -limit), limit)
                 saturated = saturated or bool((np.abs(value) >= limit * (1 - 1e-12)).any())
         return u, saturated
 
@@ -105,7 +115,11 @@ class ActuatorModel:
             if name in self.slices:
                 value = u[self.slices[name]]
                 bound = ca.DM(limit)
-                parts.append((self.slices[name], ca.fmin(ca.fmax(value, -bound), bound)))
+                if name == "dipole" and self._dipole_scaled:  # as apply(): the vector scaled as a whole
+                    ratio = ca.mmax(ca.fabs(value) / bound)
+                    parts.append((self.slices[name], ca.if_else(ratio > 1.0, value / ratio, value)))
+                else:
+                    parts.append((self.slices[name], ca.fmin(ca.fmax(value, -bound), bound)))
                 flags.append(ca.fabs(value) >= bound * (1 - 1e-12))
         applied_u = ca.SX.zeros(self.nu) if not isinstance(u, ca.MX) else ca.MX.zeros(self.nu)
         for where, value in parts:

@@ -26,14 +26,20 @@ from ocp.layout import REFERENCE_FIELDS
 from ocp.model import AttitudeModel
 
 Array = NDArray[np.float64]
+NOISE_SIZE = 9
+"""Noise numbers per sample: rotation vector (rad), rate (rad/s), magnetometer (T)."""
 
 
-def draw_noise(rng: np.random.Generator, n_samples: int, attitude_std: float, rate_std: float) -> Array:
-    """(n_samples, 6) sensor noise ``[rotation vector (rad), rate (rad/s)]`` in the order the
-    Python loop draws it: per sample, the attitude's three normals (if ``attitude_std > 0``)
-    then the rate's (if ``rate_std > 0``); absent parts are zero."""
+def draw_noise(rng: np.random.Generator, n_samples: int, attitude_std: float, rate_std: float,
+               field_rng: np.random.Generator | None = None, field_std: float = 0.0) -> Array:
+    """(n_samples, 9) sensor noise ``[rotation vector (rad), rate (rad/s), magnetometer (T)]`` in
+    the order the Python loop draws it: per sample, the attitude's three normals (if
+    ``attitude_std > 0``) then the rate's (if ``rate_std > 0``) from ``rng``, the magnetometer's
+    from ``field_rng`` (if ``field_std > 0``); absent parts are zero."""
     parts = [std for std in (attitude_std, rate_std) if std > 0]
-    noise = np.zeros((n_samples, 6))
+    noise = np.zeros((n_samples, NOISE_SIZE))
+    if field_std > 0 and field_rng is not None:
+        noise[:, 6:9] = field_rng.normal(0.0, field_std, (n_samples, 3))
     if not parts:
         return noise
     normals = rng.standard_normal((n_samples, 3 * len(parts)))
@@ -68,6 +74,12 @@ class LoopShape:
     rate_noise: bool
     uses_reference: bool
     uses_time: bool
+    field_noise: bool = False
+
+    @property
+    def noisy(self) -> bool:
+        """Whether the run takes the noise input (any sensor noise)."""
+        return self.attitude_noise or self.rate_noise or self.field_noise
 
 
 class ClosedLoop:
@@ -79,17 +91,18 @@ class ClosedLoop:
     step : ``step(x, u, t, dt, p) -> x_next``, one hold of length ``dt`` (the simulator's RK4).
     actuators : the saturation model.
     law : ``law(t, y, z, r) -> (u, z_next)`` (``controllers.base.SymbolicLaw.function``).
-    attitude_noise, rate_noise : whether the measurement adds the noise input.
+    attitude_noise, rate_noise, field_noise : whether the measurement adds the noise input
+        (``noise = [rotation vector (3), rate (3), magnetometer (3)]``).
     """
 
     def __init__(self, model: AttitudeModel, step: ca.Function, actuators: ActuatorModel, law: ca.Function,
-                 attitude_noise: bool, rate_noise: bool):
+                 attitude_noise: bool, rate_noise: bool, field_noise: bool = False):
         self.model = model
         nx, nz = model.nx, law.nnz_in(2)
         self.nz = nz
         acc = ca.SX.sym("xz", nx + nz)
         t, dt = ca.SX.sym("t"), ca.SX.sym("dt")
-        noise = ca.SX.sym("noise", 6)
+        noise = ca.SX.sym("noise", NOISE_SIZE)
         r = ca.SX.sym("r", 2 * REFERENCE_FIELDS)
         p = ca.SX.sym("p", 3)
         x, z = acc[0:nx], acc[nx:nx + nz]
@@ -99,6 +112,8 @@ class ClosedLoop:
         if rate_noise:
             omega = omega + noise[3:6]
         field = ca.SX.zeros(3) if model.field_body is None else model.field_body(x, t)
+        if field_noise and model.field_body is not None:
+            field = field + noise[6:9]
         y = ca.vertcat(q, omega, h_w, field)
         u_cmd, z_next = law(t, y, z, r)
         u_applied, saturated = actuators.apply_symbolic(u_cmd, h_w, dt)
@@ -107,7 +122,8 @@ class ClosedLoop:
         torque = model.body_torque(x, u_applied, t)
         outputs = [ca.vertcat(x_next, z_next), u_cmd, u_applied, saturated, torque]
         self.shape = LoopShape(attitude_noise, rate_noise, bool(ca.depends_on(ca.vertcat(u_cmd, z_next), r)),
-                               bool(ca.depends_on(ca.vertcat(*outputs), t)))
+                               bool(ca.depends_on(ca.vertcat(*outputs), t)),
+                               bool(field_noise and model.field_body is not None))
         inputs = [acc, t, dt, noise, r, p]
         self.sample = ca.Function("closed_loop_sample", inputs, outputs,
                                   ["xz", "t", "dt", "noise", "r", "p"], ["xz_next", "u_cmd", "u_app", "saturated", "torque"],
@@ -115,7 +131,7 @@ class ClosedLoop:
 
     def run_function(self, sample: ca.Function, n_samples: int) -> BufferedFunction:
         """``sample`` (interpreted, or its compiled twin) accumulated over ``n_samples``, as
-        ``run(xz0, t (N), dt (N), [noise (6N)], [r (26N)], p) -> (xz (N(nx+nz)), u_cmd, u_app,
+        ``run(xz0, t (N), dt (N), [noise (9N)], [r (26N)], p) -> (xz (N(nx+nz)), u_cmd, u_app,
         saturated, torque)``: the noise and reference inputs exist only when the loop uses them
         (:attr:`shape`), and every input and output has its exact size, so that the function is
         evaluated through reusable buffers (:class:`~ocp.fast_call.BufferedFunction`)."""
@@ -124,11 +140,11 @@ class ClosedLoop:
         t, dt = ca.MX.sym("t", 1, n_samples), ca.MX.sym("dt", 1, n_samples)
         p = ca.MX.sym("p", 3)
         inputs = [xz0, t, dt]
-        if self.shape.attitude_noise or self.shape.rate_noise:
-            noise = ca.MX.sym("noise", 6, n_samples)
+        if self.shape.noisy:
+            noise = ca.MX.sym("noise", NOISE_SIZE, n_samples)
             inputs.append(noise)
         else:
-            noise = ca.MX.zeros(6, n_samples)
+            noise = ca.MX.zeros(NOISE_SIZE, n_samples)
         if self.shape.uses_reference:
             r = ca.MX.sym("r", 2 * REFERENCE_FIELDS, n_samples)
             inputs.append(r)
@@ -144,8 +160,8 @@ class ClosedLoop:
         commanded and applied controls (N, nu), saturation flags (N,) and actuator torques (N, 3)."""
         n = times.size - 1
         args = [xz0, times[:-1], times[1:] - times[:-1]]
-        if self.shape.attitude_noise or self.shape.rate_noise:
-            args.append(noise.ravel())  # (N, 6) row-major is the (6, N) column-major input
+        if self.shape.noisy:
+            args.append(noise.ravel())  # (N, 9) row-major is the (9, N) column-major input
         if self.shape.uses_reference:
             args.append(rows.ravel())
         args.append(p)

@@ -65,9 +65,10 @@ def reference_rows(reference: Any, times: ArrayLike, target: Any = None) -> Arra
     times = np.atleast_1d(np.asarray(times, dtype=float))
     rows = np.zeros((times.size, REFERENCE_FIELDS))
     if reference is None:
-        if target is None or target[0] is None:
+        if target is None:
             raise ValueError("regulation needs a target (q_f, ω_f) when there is no reference")
-        rows[:, 0:4] = np.asarray(target[0], dtype=float)
+        if target[0] is not None:  # a free final attitude (rate regulation, detumbling) leaves q* zero
+            rows[:, 0:4] = np.asarray(target[0], dtype=float)
         if target[1] is not None:
             rows[:, 4:7] = np.asarray(target[1], dtype=float)
         return rows

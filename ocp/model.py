@@ -36,6 +36,8 @@ class AttitudeModel:
         (``−A g + m × B_B + τ_t``), N m, body axes.
     environment_torque : casadi.Function ``(x, t, p) -> tau``: gravity gradient plus disturbance.
     field_body : casadi.Function ``(x, t) -> b`` (T, body axes), or ``None`` without a field model.
+    field_rate_inertial : casadi.Function ``(t) -> db`` (T/s, inertial axes): the rate of the
+        inertial field seen along the orbit, or ``None`` without a field model.
     control_slices : dict mapping ``"wheels"``, ``"dipole"``, ``"torquers"`` to slices of ``u``.
     """
 
@@ -131,6 +133,12 @@ class AttitudeModel:
         self.field_body = None if field_body is None else ca.Function(
             "field_body", [x, t], [field_body], ["x", "t"], ["b"]
         )
+        self.field_rate_inertial = None
+        if field_body is not None:
+            env = self.environment
+            field_inertial = env.magnetic_field.field_inertial(env.orbit.position(t), t)
+            self.field_rate_inertial = ca.Function(
+                "field_rate_inertial", [t], [ca.jacobian(field_inertial, t)], ["t"], ["db"])
 
     def inertial_momentum(self, x: NDArray) -> NDArray:
         """Total inertial angular momentum ``R(q)(I ω + A h_w)`` (N m s) for states ``(..., nx)``."""

@@ -33,7 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp import quat
 from ocp.actuators import ActuatorModel, Command, Measurement
-from ocp.closed_loop import ClosedLoop, draw_noise
+from ocp.closed_loop import NOISE_SIZE, ClosedLoop, draw_noise
 from ocp.compiled import CompilerUnavailable, compile_function, notice
 from ocp.fast_call import BufferedFunction
 from ocp.integration import rk4_step
@@ -91,15 +91,19 @@ class ControllerLike(Protocol):
 
 @dataclass(frozen=True)
 class SensorNoise:
-    """Gaussian sensor noise: attitude as a random rotation vector (rad, per axis std), body rate
-    (rad/s, per axis std); ``seed`` makes it repeatable."""
+    """Gaussian sensor noise, white per sample: attitude as a random rotation vector (rad, per axis
+    std), body rate (rad/s, per axis std), magnetometer (T, per body axis std); ``seed`` makes it
+    repeatable. Each sample draws attitude, then rate (only the non-zero ones) from the stream
+    seeded by ``seed``, and the magnetometer from its own stream (seeded by ``[seed, 1]``), so that
+    adding magnetometer noise leaves the attitude and rate noise of a scenario unchanged."""
 
     attitude_std: float = 0.0
     rate_std: float = 0.0
     seed: int = 0
+    field_std: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("attitude_std", "rate_std"):
+        for name in ("attitude_std", "rate_std", "field_std"):
             value = getattr(self, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite non-negative standard deviation, got {value!r}")
@@ -198,6 +202,8 @@ class Simulator:
         self._step = self._build_step(integrator, substeps, rtol, atol)
         self._step_numeric = BufferedFunction(self._step)
         self._field_numeric = None if model.field_body is None else BufferedFunction(model.field_body)
+        self._field_rate_numeric = (None if model.field_rate_inertial is None
+                                    else BufferedFunction(model.field_rate_inertial))
         self.integrator = integrator
         self.compile = compile
         self.python_loop = python_loop
@@ -261,9 +267,15 @@ class Simulator:
         times = np.minimum(np.arange(n_samples + 1) * self.sample_time, duration)
         noise = noise or SensorNoise()
         rng = np.random.default_rng(noise.seed)
+        field_rng = np.random.default_rng([noise.seed, 1])
+        valid_until = getattr(model.environment.magnetic_field, "valid_until", None)
+        if valid_until is not None and duration > valid_until + 1e-9:
+            raise SimulationError(f"the magnetic field is tabulated up to t = {valid_until:g} s, the run lasts "
+                                  f"{duration:g} s; lengthen environment.magnetic_field.span_s")
+        field_rate = self._field_rate_numeric if getattr(controller, "needs_field_rate", False) else None
         controller.reset(model.spacecraft, self.sample_time, target=target)
         if self._symbolic(controller):
-            return self._run_symbolic(controller, x, times, p, noise, rng, reference)
+            return self._run_symbolic(controller, x, times, p, noise, rng, reference, field_rng)
         if reference is not None and hasattr(reference, "sample"):
             reference = GridSampledReference(reference, np.concatenate([times, times[:-1] + self.sample_time]))
 
@@ -274,7 +286,9 @@ class Simulator:
         states[0] = x
         for k in range(n_samples):
             t_k = times[k]
-            measurement = self._measure(x, t_k, noise, rng)
+            measurement = self._measure(x, t_k, noise, rng, field_rng)
+            if field_rate is not None:
+                measurement.field_rate_inertial = field_rate(t_k).copy()
             command = controller(t_k, measurement, reference)
             commanded[k] = self._command_vector(command)
             dt = times[k + 1] - t_k
@@ -309,14 +323,14 @@ class Simulator:
         """The one-sample closed-loop function of a reset symbolic ``controller``: its builder, the
         function (interpreted, or the compiled twin) and how it is evaluated (``"interpreted"`` or
         ``"compiled"``). Builds are kept per law (:meth:`symbolic_key`) and noise shape."""
-        loop_key = (controller.symbolic_key(), noise.attitude_std > 0, noise.rate_std > 0)
+        loop_key = self._loop_key(controller, noise)
         if loop_key not in self._loops:
             if len(self._loops) >= self.MAX_BUILDS:
                 self._loops.clear()
                 self._runs.clear()
             law = controller.symbolic_law()
             loop = ClosedLoop(self.model, self._step, self.actuators, law.function,
-                              noise.attitude_std > 0, noise.rate_std > 0)
+                              noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0)
             sample, path = loop.sample, "interpreted"
             if self.compile:
                 try:
@@ -334,8 +348,13 @@ class Simulator:
             self._runs[key] = loop.run_function(sample, size)
         return self._runs[key]
 
+    @staticmethod
+    def _loop_key(controller: Any, noise: SensorNoise) -> tuple:
+        return (controller.symbolic_key(), noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0)
+
     def _run_symbolic(self, controller: Any, x0: Array, times: Array, p: Array, noise: SensorNoise,
-                      rng: np.random.Generator, reference: Any) -> SimulationResult:
+                      rng: np.random.Generator, reference: Any,
+                      field_rng: np.random.Generator | None = None) -> SimulationResult:
         n_samples = times.size - 1
         loop, sample, path = self.closed_loop_function(controller, noise)
         rows = None
@@ -344,8 +363,8 @@ class Simulator:
             rows = np.hstack([controller.reference_rows(reference, grid),
                               controller.reference_rows(reference, grid + self.sample_time)])
         drawn = None
-        if noise.attitude_std > 0 or noise.rate_std > 0:
-            drawn = draw_noise(rng, n_samples, noise.attitude_std, noise.rate_std)
+        if noise.attitude_std > 0 or noise.rate_std > 0 or noise.field_std > 0:
+            drawn = draw_noise(rng, n_samples, noise.attitude_std, noise.rate_std, field_rng, noise.field_std)
         nx, nu = self.model.nx, self.model.nu
         xz = np.concatenate([x0, np.asarray(controller.state_vector(), dtype=float)])
         states = np.empty((n_samples + 1, nx))
@@ -368,7 +387,8 @@ class Simulator:
         return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, torque,
                                 saturated.astype(bool), path)
 
-    def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator) -> Measurement:
+    def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator,
+                 field_rng: np.random.Generator | None = None) -> Measurement:
         q, omega = x[0:4], x[4:7]
         if noise.attitude_std > 0:  # q ⊗ exp(v/2), written out (no general quaternion helper per sample)
             v = rng.normal(0.0, noise.attitude_std, 3)
@@ -383,6 +403,8 @@ class Simulator:
         if noise.rate_std > 0:
             omega = omega + rng.normal(0.0, noise.rate_std, 3)
         field = None if self._field_numeric is None else self._field_numeric(x, t).copy()
+        if noise.field_std > 0 and field is not None:  # its own stream: attitude and rate noise unchanged
+            field += (rng if field_rng is None else field_rng).normal(0.0, noise.field_std, 3)
         return Measurement(t=t, q=q.copy(), omega=omega.copy(), wheel_momentum=x[7:].copy(), field_body=field)
 
     def _command_vector(self, command: Command) -> Array:

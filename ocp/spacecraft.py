@@ -96,14 +96,25 @@ class ReactionWheels:
         return mask
 
 
+SATURATION_MODES = ("per_axis", "scale")
+
+
 @dataclass(frozen=True)
 class Magnetorquers:
-    """Three orthogonal magnetorquers along the body axes; dipole limit per axis in A m²."""
+    """Three orthogonal magnetorquers along the body axes; dipole limit per axis in A m².
+
+    ``saturation``: ``"per_axis"`` clips each axis to its limit (the direction may change);
+    ``"scale"`` scales the whole dipole vector down until every axis is within its limit (the
+    direction is kept).
+    """
 
     max_dipole: Array | float | None = None
+    saturation: str = "per_axis"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "max_dipole", _limit_vector(self.max_dipole, 3, "max_dipole"))
+        if self.saturation not in SATURATION_MODES:
+            raise ModelError("saturation", f"expected one of {SATURATION_MODES}, got {str(self.saturation)[:40]!r}")
 
 
 @dataclass(frozen=True)

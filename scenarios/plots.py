@@ -67,8 +67,13 @@ class RowFigure:
         _log_axis(axes[3])
         self.to_target = line(axes[3], color="k", label="to target") if with_target else None
         self.to_reference = line(axes[3], color="tab:orange", label="to reference") if with_reference else None
+        self.rate_norm = self.rate_max = None
+        if not with_reference and not with_target:  # rate regulation (detumbling): the rate converges
+            self.rate_norm = line(axes[3], color="k", label="‖ω‖")
+            self.rate_max = line(axes[3], color="tab:gray", lw=1, label="max |ω_i|")
         self.wheels = [line(axes[4], label=f"h_w{i}") for i in range(n_wheels)] if n_wheels else []
-        labels = ["body torque (N m)", "body rate (rad/s)", "quaternion", "error angle (deg)"]
+        labels = ["body torque (N m)", "body rate (rad/s)", "quaternion",
+                  "error angle (deg)" if with_reference or with_target else "body rate (rad/s)"]
         if n_wheels:
             labels.append("wheel momentum (N m s)")
         for axis, label in zip(axes, labels):
@@ -97,12 +102,17 @@ class RowFigure:
             self.to_reference.set_data(t, np.maximum(np.rad2deg(quat.error_angle(sim.q, ref.q)), 1e-9))
         if self.to_target is not None:
             self.to_target.set_data(t, np.maximum(np.rad2deg(quat.error_angle(sim.q, target_q)), 1e-9))
+        if self.rate_norm is not None:
+            self.rate_norm.set_data(t, np.maximum(np.linalg.norm(sim.omega, axis=1), 1e-12))
+            self.rate_max.set_data(t, np.maximum(np.abs(sim.omega).max(axis=1), 1e-12))
         for i, item in enumerate(self.wheels):
             item.set_data(t, sim.wheel_momentum[:, i])
         for axis in self.axes:
             axis.relim()
             axis.autoscale_view()
-        self.title.set_text(f"{row.label} ({row.planner or 'regulation'}): solid closed loop, dashed reference")
+        controller = f", {row.controller}" if getattr(row, "controller", None) else ""
+        self.title.set_text(f"{row.label} ({row.planner or 'regulation'}{controller}): solid closed loop, "
+                            "dashed reference")
         self.figure.savefig(path, **SAVE)
 
 
@@ -141,11 +151,16 @@ def plot_overlay(results: Any, path: Path) -> None:
         sim = row.simulation
         norm = np.linalg.norm(sim.applied_torque, axis=1)
         top.plot(sim.t, _held(norm), drawstyle="steps-post", label=row.label)
-        error = (np.rad2deg(quat.error_angle(sim.q, target_q)) if target_q is not None
-                 else np.linalg.norm(sim.omega - target_omega, axis=1))
+        if target_q is not None:
+            error = np.rad2deg(quat.error_angle(sim.q, target_q))
+        elif target_omega is not None:
+            error = np.linalg.norm(sim.omega - target_omega, axis=1)
+        else:
+            error = np.linalg.norm(sim.omega, axis=1)
         bottom.plot(sim.t, np.maximum(error, 1e-9), label=row.label)
     top.set_ylabel("‖u‖ (N m)")
-    bottom.set_ylabel("error to target (deg)" if target_q is not None else "‖ω − ω_f‖ (rad/s)")
+    bottom.set_ylabel("error to target (deg)" if target_q is not None
+                      else "‖ω − ω_f‖ (rad/s)" if target_omega is not None else "‖ω‖ (rad/s)")
     bottom.set_xlabel("time (s)")
     for axis in (top, bottom):
         axis.grid(alpha=0.3)

@@ -70,7 +70,12 @@ def test_numpy_and_symbolic_laws_agree(name, rng):
             for tracking in (True, False):
                 controller = cls(options)
                 spacecraft = build()
+                if getattr(controller, "wheels_only", False) and controller.environment_error(spacecraft, None):
+                    continue  # a two-wheel law takes only spacecraft whose working wheels span a plane
                 sample_time = float(rng.uniform(0.05, 2.0))
+                if controller.sample_time_error(sample_time):  # e.g. tdfc: τ (2 s) a multiple of T_s
+                    sample_time = 2.0 / int(rng.integers(1, 4))
+                    assert controller.sample_time_error(sample_time) is None
                 target = (quat.random_unit(rng), rng.normal(0, 0.05, 3) if rng.uniform() < 0.5 else None)
                 reference = RandomReference(rng) if tracking else None
                 if controller.needs_reference and reference is None:
