@@ -31,20 +31,33 @@ def worker_state() -> tuple[SolverCache, threading.Lock]:
     return SolverCache(), threading.Lock()
 
 
-def row_labels(scenario: dict[str, Any]) -> list[tuple[str, str | None]]:
-    """(label, planner) of each row a scenario mapping will produce, for rows of a crashed case."""
+def _controllers(scenario: dict[str, Any]) -> list[tuple[str, str]]:
+    """(label, name) of the scenario mapping's controllers (``controllers:`` list or ``controller:``)."""
+    entries = scenario.get("controllers") or [scenario.get("controller") or {}]
+    return [(str(c.get("label", c.get("name"))), str(c.get("name"))) for c in entries]
+
+
+def row_labels(scenario: dict[str, Any]) -> list[tuple[str, str | None, str]]:
+    """(label, planner, controller) of each row the runner makes for a scenario mapping, in its
+    order (for the rows of a crashed case): one per planner and controller, or per controller."""
+    controllers = _controllers(scenario)
     planners = scenario.get("planners") or []
     if not planners:
-        return [(str((scenario.get("controller") or {}).get("name")), None)]
-    return [(str(p.get("label", p.get("name"))), p.get("name")) for p in planners]
+        return [(label, None, name) for label, name in controllers]
+    rows = []
+    for planner in planners:
+        planner_label = str(planner.get("label", planner.get("name")))
+        for label, name in controllers:
+            rows.append((planner_label if len(controllers) == 1 else f"{planner_label} / {label}",
+                         planner.get("name"), name))
+    return rows
 
 
 def crashed_rows(scenario: dict[str, Any], message: str) -> list[dict[str, Any]]:
-    """One ``crashed`` row per planner of ``scenario`` carrying ``message``."""
-    controller = (scenario.get("controller") or {}).get("name")
+    """One ``crashed`` row per row of ``scenario`` carrying ``message``."""
     return [{"label": label, "planner": planner, "controller": controller, "status": "crashed",
              "message": message, "plan_time_s": None, "ref": None, "cl": None}
-            for label, planner in row_labels(scenario)]
+            for label, planner, controller in row_labels(scenario)]
 
 
 def _plain_row(row: Any, controller: str) -> dict[str, Any]:
@@ -86,7 +99,7 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
                 signal.setitimer(signal.ITIMER_REAL, timeout)
             scenario = parse_scenario(data)
             results = run(scenario, cache=cache)
-            status, rows = "ok", [_plain_row(row, scenario.controller.name) for row in results.rows]
+            status, rows = "ok", [_plain_row(row, scenario.controllers[0].name) for row in results.rows]
         except CaseTimeout:
             status, rows = "crashed", crashed_rows(data, f"timed out after {timeout:g} s (case_timeout_s)")
         except Exception as error:  # a case that raises is a row, the sweep goes on

@@ -318,3 +318,16 @@ def test_pareto_front_is_the_set_of_non_dominated_points(rng):
     front = pareto_front(points)
     assert sorted(map(tuple, front)) == sorted(map(tuple, expected))
     assert np.all(np.diff(front[:, 0]) > 0) and np.all(np.diff(front[:, 1]) < 0)
+
+
+def test_crashed_rows_match_the_runner_rows_with_several_controllers():
+    from scenarios.sweep_worker import crashed_rows
+    data = copy.deepcopy(BASE)
+    data["controllers"] = [data.pop("controller"), {"name": "eigenaxis_pd", "label": "pd"}]
+    ran = scenarios.run(scenarios.parse_scenario(copy.deepcopy(data)))
+    assert [(r["label"], r["planner"], r["controller"]) for r in crashed_rows(data, "x")] == \
+        [(row.label, row.planner, row.controller) for row in ran.rows]
+    data["planners"] = []
+    ran = scenarios.run(scenarios.parse_scenario(copy.deepcopy(data)))
+    assert [(r["label"], r["planner"], r["controller"]) for r in crashed_rows(data, "x")] == \
+        [(row.label, row.planner, row.controller) for row in ran.rows]
