@@ -14,7 +14,7 @@ from ocp import quat
 METRIC_KEYS: tuple[str, ...] = (
     "int_u2", "int_u", "int_abs_u", "peak_u", "final_error_deg", "final_rate_error",
     "rms_error_deg", "max_error_deg", "settling_time_s", "saturation_fraction",
-    "peak_wheel_momentum", "plan_time_s", "duration_s",
+    "peak_wheel_momentum", "plan_time_s", "duration_s", "initial_rate_error",
 )
 DEFAULT_SETTLING_TOLERANCE_DEG = 0.5
 
@@ -40,6 +40,7 @@ def compute_metrics(
     plan_time_s: float | None = None,
     duration_s: float | None = None,
     settling_tolerance_deg: float = DEFAULT_SETTLING_TOLERANCE_DEG,
+    initial_omega: ArrayLike | None = None,
 ) -> dict[str, Any]:
     """Metrics of a motion sampled at times ``t`` (s).
 
@@ -51,6 +52,8 @@ def compute_metrics(
     target_q, target_omega : the manoeuvre's final attitude and rate (``None``: free).
     reference_q : (N+1, 4) reference attitude at ``t`` for the tracking errors (closed loop).
     wheel_momentum : (N+1, n_w) N m s; saturated : (N,) bool per sample.
+    initial_omega : (3,) rad/s, the manoeuvre's initial body rate ω0: gives ``initial_rate_error``
+        ``‖ω(t_0) − ω0‖`` (a reference that leaves ω(0) free starts away from it).
 
     Returns
     -------
@@ -85,6 +88,8 @@ def compute_metrics(
         "peak_wheel_momentum": None,
         "plan_time_s": plan_time_s,
         "duration_s": duration_s,
+        "initial_rate_error": None if initial_omega is None
+        else float(np.linalg.norm(np.asarray(omega)[0] - np.asarray(initial_omega, dtype=float))),
     }
     if reference_q is not None:
         tracking = np.rad2deg(quat.error_angle(q, reference_q))
@@ -121,12 +126,26 @@ def metrics_from_reference(
     target_omega: ArrayLike | None = None,
     points: int = 2001,
     settling_tolerance_deg: float = DEFAULT_SETTLING_TOLERANCE_DEG,
+    initial_omega: ArrayLike | None = None,
 ) -> dict[str, Any]:
     """Metrics of a reference's own motion and feed-forward torque over ``[0, duration]``,
-    sampled on ``points`` uniform times (trapezoidal integrals)."""
+    sampled on ``points`` uniform times (trapezoidal integrals).
+
+    Parameters
+    ----------
+    reference : a planner's reference (vectorised ``q``, ``omega``, ``torque``, ``duration``).
+    target_q, target_omega : the manoeuvre's final attitude and rate (``None``: free).
+    points : number of uniform sample times.
+    settling_tolerance_deg : deg, the settling band about ``target_q``.
+    initial_omega : (3,) rad/s, the manoeuvre's ω0, for ``initial_rate_error``.
+
+    Returns
+    -------
+    dict with every key of :data:`METRIC_KEYS`.
+    """
     t = np.linspace(0.0, reference.duration, points)
     return compute_metrics(
         t, reference.q(t), reference.omega(t), reference.torque(t), target_q, target_omega,
         plan_time_s=reference.plan_time_s, duration_s=reference.duration,
-        settling_tolerance_deg=settling_tolerance_deg,
+        settling_tolerance_deg=settling_tolerance_deg, initial_omega=initial_omega,
     )

@@ -132,7 +132,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         if reference.ok:
             row.reference_metrics = metrics_from_reference(
                 reference, scenario.problem.qf, scenario.problem.omegaf,
-                settling_tolerance_deg=spec.settling_tolerance_deg)
+                settling_tolerance_deg=spec.settling_tolerance_deg, initial_omega=scenario.problem.omega0)
             _simulate(scenario, simulator, reference, row)
         say(f"[{index}/{len(scenario.planners)}] {row.label}: {row.status} "
             f"(planned in {row.plan_time_s * 1e3:.1f} ms, simulated in {row.simulate_time_s:.2f} s)"
