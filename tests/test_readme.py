@@ -109,7 +109,7 @@ def test_pytest_command_selects_tests(command):
 @pytest.mark.parametrize("index", range(len(PYTHON)))
 def test_python_block(index, monkeypatch, capsys):
     monkeypatch.chdir(ROOT)
-    exec(compile(PYTHON[index], f"README.md python block {index}", "exec"), {"__name__": "readme"})
+    exec(compile(PYTHON[index], f"README.md python block {index}", "exec", dont_inherit=True), {"__name__": "readme"})
     assert capsys.readouterr().out.strip()  # every block prints its result
 
 
