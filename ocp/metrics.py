@@ -149,3 +149,32 @@ def metrics_from_reference(
         plan_time_s=reference.plan_time_s, duration_s=reference.duration,
         settling_tolerance_deg=settling_tolerance_deg, initial_omega=initial_omega,
     )
+
+
+def metric_violations(metrics: dict[str, Any] | None) -> list[str]:
+    """The metrics whose values physics forbids: every metric is a norm, an integral of a norm,
+    an angle, a time or a fraction, so a value must be finite and non-negative (fractions at most
+    1, a manoeuvre's duration positive). A row with a violation is not "ok".
+
+    Parameters
+    ----------
+    metrics : a mapping of metric keys to values (``None`` for metrics that do not apply).
+
+    Returns
+    -------
+    list of str
+        ``"key = value"`` for each offending metric; empty when all are physical.
+    """
+    problems = []
+    for key, value in (metrics or {}).items():
+        values = value if isinstance(value, (list, tuple)) else [value]
+        for item in values:
+            if item is None:
+                continue
+            number = float(item)
+            bad = (not np.isfinite(number) or number < 0.0
+                   or (key.endswith("fraction") and number > 1.0) or (key == "duration_s" and number == 0.0))
+            if bad:
+                problems.append(f"{key} = {value}")
+                break
+    return problems

@@ -33,9 +33,18 @@ def conjugate(q: ArrayLike) -> Array:
 
 
 def normalize(q: ArrayLike) -> Array:
-    """Unit quaternion along ``q``."""
+    """Unit quaternion along ``q`` (shape ``(..., 4)``; any vector length is normalised alike).
+
+    Raises
+    ------
+    ValueError
+        If a quaternion is zero or not finite.
+    """
     q = np.asarray(q, dtype=float)
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+    norm = np.linalg.norm(q, axis=-1, keepdims=True)
+    if not np.all(np.isfinite(norm)) or np.any(norm == 0.0):
+        raise ValueError("cannot normalise a zero or non-finite quaternion")
+    return q / norm
 
 
 def rotation_matrix(q: ArrayLike) -> Array:
@@ -102,8 +111,20 @@ def error_angle(q: ArrayLike, q_ref: ArrayLike) -> Array:
 
 
 def from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> Array:
-    """Quaternion of a rotation by ``angle`` (rad) about the unit vector ``axis``."""
+    """Quaternion of a rotation by ``angle`` (rad) about ``axis`` (normalised here).
+
+    Raises
+    ------
+    ValueError
+        If ``axis`` is not a (..., 3) array of finite, non-zero vectors.
+    """
     axis = np.asarray(axis, dtype=float)
+    if axis.ndim == 0 or axis.shape[-1] != 3:
+        raise ValueError(f"axis must have 3 components, got shape {axis.shape}")
+    length = np.linalg.norm(axis, axis=-1, keepdims=True)
+    if not np.all(np.isfinite(length)) or np.any(length == 0.0):
+        raise ValueError(f"axis must be a finite non-zero vector, got {axis.tolist()}")
+    axis = axis / length
     half = 0.5 * np.asarray(angle, dtype=float)[..., None]
     return np.concatenate([np.cos(half), np.sin(half) * axis], axis=-1)
 

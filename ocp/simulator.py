@@ -27,6 +27,12 @@ from ocp.model import AttitudeModel
 
 Array = NDArray[np.float64]
 INTEGRATORS = ("rk4", "cvodes")
+MAX_SAMPLES = 1_000_000
+"""Default bound on the samples of one run (a 100,000 s run at 0.1 s): more is refused, not attempted."""
+SUBSTEPS_PER_SAMPLE = 20
+"""A run may integrate at most this many RK4 sub-steps per allowed sample (``max_samples``)."""
+MAX_SUBSTEPS = 1000
+"""Bound on RK4 sub-steps per sample (the step is one unrolled CasADi graph)."""
 
 
 class SimulationError(RuntimeError):
@@ -46,6 +52,14 @@ class SensorNoise:
     attitude_std: float = 0.0
     rate_std: float = 0.0
     seed: int = 0
+
+    def __post_init__(self) -> None:
+        for name in ("attitude_std", "rate_std"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise ValueError(f"{name} must be a finite non-negative standard deviation, got {value!r}")
+        if not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool) or self.seed < 0:
+            raise ValueError(f"seed must be a non-negative integer, got {self.seed!r}")
 
 
 @dataclass
@@ -105,15 +119,26 @@ class Simulator:
         max_step: float = 0.05,
         rtol: float = 1e-10,
         atol: float = 1e-12,
+        max_samples: int = MAX_SAMPLES,
     ):
-        if not sample_time > 0:
-            raise ValueError(f"sample_time must be positive, got {sample_time}")
+        if not isinstance(model, AttitudeModel):
+            raise TypeError(f"model must be an ocp.AttitudeModel, got {type(model).__name__}")
+        for name, value in (("sample_time", sample_time), ("max_step", max_step), ("rtol", rtol), ("atol", atol)):
+            if not isinstance(value, (int, float)) or not math.isfinite(value) or not value > 0:
+                raise ValueError(f"{name} must be a finite positive number of seconds, got {value!r}")
         if integrator not in INTEGRATORS:
             raise ValueError(f"integrator must be one of {INTEGRATORS}, got {integrator!r}")
+        substeps = max(1, math.ceil(sample_time / max_step - 1e-9))
+        if integrator == "rk4" and substeps > MAX_SUBSTEPS:
+            raise ValueError(f"max_step = {max_step:g} s gives {substeps} RK4 sub-steps per {sample_time:g} s sample; "
+                             f"at most {MAX_SUBSTEPS} are allowed (raise max_step or lower sample_time)")
+        if not isinstance(max_samples, int) or max_samples < 1:
+            raise ValueError(f"max_samples must be a positive integer, got {max_samples!r}")
         self.model = model
         self.sample_time = float(sample_time)
+        self.max_samples = max_samples
+        self.substeps = substeps if integrator == "rk4" else 1
         self.actuators = ActuatorModel(model.spacecraft, model.control_slices, model.nu)
-        substeps = max(1, math.ceil(self.sample_time / max_step - 1e-9))
         self._step = self._build_step(integrator, substeps, rtol, atol)
         self._step_numeric = BufferedFunction(self._step)
         self._field_numeric = None if model.field_body is None else BufferedFunction(model.field_body)
@@ -157,11 +182,21 @@ class Simulator:
         """
         model = self.model
         x = np.asarray(x0, dtype=float).copy()
-        if x.shape != (model.nx,):
-            raise ValueError(f"x0 must have {model.nx} entries [q, omega, h_w], got shape {x.shape}")
+        if x.shape != (model.nx,) or not np.all(np.isfinite(x)):
+            raise ValueError(f"x0 must be {model.nx} finite numbers [q, omega, h_w], got shape {x.shape}")
+        if not np.linalg.norm(x[0:4]) > 1e-6:
+            raise ValueError(f"x0 must start with a non-zero quaternion, got {x[0:4]}")
         x[0:4] = quat.normalize(x[0:4])
         p = model.default_parameters if parameters is None else np.asarray(parameters, dtype=float)
+        if p.shape != (3,) or not np.all(np.isfinite(p)):
+            raise ValueError(f"parameters must be a finite 3-vector disturbance torque (N m), got {p}")
+        if not isinstance(duration, (int, float)) or not math.isfinite(duration) or not duration > 0:
+            raise ValueError(f"duration must be a finite positive number of seconds, got {duration!r}")
         n_samples = max(1, math.ceil(duration / self.sample_time - 1e-9))
+        if n_samples > self.max_samples or n_samples * self.substeps > SUBSTEPS_PER_SAMPLE * self.max_samples:
+            raise SimulationError(f"{duration:g} s at {self.sample_time:g} s samples is {n_samples} samples, over the "
+                                  f"limit of {self.max_samples} samples or {SUBSTEPS_PER_SAMPLE} sub-steps each "
+                                  "(simulation.max_samples raises it)")
         times = np.minimum(np.arange(n_samples + 1) * self.sample_time, duration)
         noise = noise or SensorNoise()
         rng = np.random.default_rng(noise.seed)

@@ -19,8 +19,9 @@ class ModelError(ValueError):
     """Invalid model parameter; ``field`` names the attribute (e.g. ``"inertia"``)."""
 
     def __init__(self, field_name: str, message: str):
-        super().__init__(message)
+        super().__init__(f"{field_name}: {message}")
         self.field = field_name
+        self.message = message
 
 
 def _limit_vector(value: ArrayLike | None, size: int, field_name: str) -> Array:
@@ -136,7 +137,14 @@ class Spacecraft:
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        inertia = np.asarray(self.inertia, dtype=float)
+        for name, kind in (("wheels", ReactionWheels), ("magnetorquers", Magnetorquers), ("torquers", Torquers)):
+            value = getattr(self, name)
+            if value is not None and not isinstance(value, kind):
+                raise ModelError(name, f"expected an ocp.{kind.__name__} or None, got {type(value).__name__}")
+        try:
+            inertia = np.asarray(self.inertia, dtype=float)
+        except (TypeError, ValueError):
+            raise ModelError("inertia", "expected 3 principal moments or a 3x3 matrix of numbers") from None
         if inertia.shape == (3,):
             inertia = np.diag(inertia)
         if inertia.shape != (3, 3) or not np.all(np.isfinite(inertia)):

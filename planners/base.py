@@ -49,16 +49,23 @@ class ManeuverProblem:
     max_rate: float | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "q0", quat.normalize(np.asarray(self.q0, dtype=float)))
+        if not isinstance(self.spacecraft, Spacecraft):
+            raise TypeError(f"spacecraft must be an ocp.Spacecraft, got {type(self.spacecraft).__name__}")
+        if not isinstance(self.environment, Environment):
+            raise TypeError(f"environment must be an ocp.Environment, got {type(self.environment).__name__}")
+        object.__setattr__(self, "q0", _quaternion("q0", self.q0))
         if self.qf is not None:
-            object.__setattr__(self, "qf", quat.normalize(np.asarray(self.qf, dtype=float)))
-        object.__setattr__(self, "omega0", np.asarray(self.omega0, dtype=float))
+            object.__setattr__(self, "qf", _quaternion("qf", self.qf))
+        object.__setattr__(self, "omega0", _vector("omega0", self.omega0, 3))
         if self.omegaf is not None:
-            object.__setattr__(self, "omegaf", np.asarray(self.omegaf, dtype=float))
+            object.__setattr__(self, "omegaf", _vector("omegaf", self.omegaf, 3))
         momentum = np.zeros(self.spacecraft.n_wheels) if self.wheel_momentum0 is None else self.wheel_momentum0
-        object.__setattr__(self, "wheel_momentum0", np.asarray(momentum, dtype=float))
-        if not self.duration > 0:
-            raise ValueError(f"duration must be positive, got {self.duration}")
+        object.__setattr__(self, "wheel_momentum0", _vector("wheel_momentum0", momentum, self.spacecraft.n_wheels))
+        if not isinstance(self.duration, (int, float, np.floating)) or not np.isfinite(self.duration) or not self.duration > 0:
+            raise ValueError(f"duration must be a finite positive number of seconds, got {self.duration!r}")
+        if self.max_rate is not None and (not isinstance(self.max_rate, (int, float, np.floating))
+                                          or not np.isfinite(self.max_rate) or not self.max_rate > 0):
+            raise ValueError(f"max_rate must be a finite positive rate (rad/s) or None, got {self.max_rate!r}")
 
     @property
     def torque_limit(self) -> Array:
@@ -74,6 +81,25 @@ class ManeuverProblem:
     def initial_state(self) -> Array:
         """``[q0, ω0, h_w0]``."""
         return np.concatenate([self.q0, self.omega0, self.wheel_momentum0])
+
+
+def _vector(name: str, value: ArrayLike, size: int) -> Array:
+    """``value`` as a finite float vector of ``size`` entries, or a ``ValueError`` naming ``name``."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be {size} numbers, got {value!r}") from None
+    if array.shape != (size,) or not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be {size} finite numbers, got shape {array.shape}: {array.tolist()}")
+    return array
+
+
+def _quaternion(name: str, value: ArrayLike) -> Array:
+    """A unit quaternion from ``value`` (normalised), or a ``ValueError`` for a zero one."""
+    q = _vector(name, value, 4)
+    if not np.linalg.norm(q) > 1e-6:
+        raise ValueError(f"{name} must be a non-zero quaternion [q0, q1, q2, q3] (scalar first), got {q.tolist()}")
+    return q / np.linalg.norm(q)
 
 
 class ReferenceSample(NamedTuple):

@@ -18,7 +18,7 @@ from typing import Annotated, Literal
 import numpy as np
 
 from ocp.transcription import TRANSCRIPTIONS, Cone, OptimalControlProblem
-from ocp.options import Range
+from ocp.options import InvalidOption, OptionsError, Range, excerpt
 from planners.base import FailedReference, ManeuverProblem, Planner, Reference
 from planners.collocation_reference import CollocationReference, seed_vector
 
@@ -26,18 +26,44 @@ CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 INFEASIBLE = ("Infeasible_Problem_Detected", "Restoration_Failed")
 
 
-def parse_cone(spec: dict, keep_out: bool, margin: float = 0.0) -> Cone:
-    """A :class:`Cone` from ``{boresight, direction, angle_deg}``, tightened by ``margin`` (rad)."""
+def _cone_vector(spec: dict, key: str, where: str) -> np.ndarray:
+    value = spec[key]
+    if (not isinstance(value, (list, tuple)) or len(value) != 3
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
+        raise InvalidOption(f"{where}.{key}", f"expected 3 numbers, got {excerpt(value)}")
+    vector = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(vector)) or not np.linalg.norm(vector) > 0:
+        raise InvalidOption(f"{where}.{key}", f"expected a finite non-zero vector, got {excerpt(value)}")
+    return vector / np.linalg.norm(vector)
+
+
+def parse_cone(spec: dict, keep_out: bool, margin: float = 0.0, where: str = "cone") -> Cone:
+    """A :class:`Cone` from ``{boresight, direction, angle_deg}``, tightened by ``margin`` (rad).
+
+    Parameters
+    ----------
+    spec : ``boresight`` (body axes) and ``direction`` (inertial) as 3-vectors, ``angle_deg`` the
+        cone's half-angle in degrees, in (0, 180).
+    keep_out : the boresight must stay outside (``True``) or inside (``False``) the cone.
+    margin : rad by which the cone is tightened.
+    where : the option's path (``keep_out[0]``) for error messages.
+
+    Raises
+    ------
+    InvalidOption
+        Naming ``where`` and the offending key.
+    """
     keys = {"boresight", "direction", "angle_deg"}
-    if set(spec) != keys:
-        raise ValueError(f"a cone needs exactly {sorted(keys)}, got {sorted(spec)}")
-    boresight = np.asarray(spec["boresight"], dtype=float)
-    direction = np.asarray(spec["direction"], dtype=float)
-    if boresight.shape != (3,) or direction.shape != (3,) or not np.linalg.norm(boresight) or not np.linalg.norm(direction):
-        raise ValueError("cone boresight and direction must be non-zero 3-vectors")
-    angle = float(np.deg2rad(spec["angle_deg"])) + (margin if keep_out else -margin)
-    return Cone(tuple(boresight / np.linalg.norm(boresight)), tuple(direction / np.linalg.norm(direction)),
-                angle, keep_out)
+    if not isinstance(spec, dict) or set(spec) != keys:
+        raise InvalidOption(where, f"a cone needs exactly the keys {sorted(keys)}, got {excerpt(spec)}")
+    boresight, direction = _cone_vector(spec, "boresight", where), _cone_vector(spec, "direction", where)
+    angle = spec["angle_deg"]
+    if not isinstance(angle, (int, float)) or isinstance(angle, bool) or not 0.0 < angle < 180.0:
+        raise InvalidOption(f"{where}.angle_deg", f"expected a number in (0, 180) degrees, got {excerpt(angle)}")
+    tightened = float(np.deg2rad(angle)) + (margin if keep_out else -margin)
+    if not 0.0 < tightened < np.pi:
+        raise InvalidOption(f"{where}.angle_deg", f"{angle} deg leaves no cone once tightened by cone_margin_deg")
+    return Cone(tuple(boresight), tuple(direction), tightened, keep_out)
 
 
 class CollocationPlanner(Planner):
@@ -73,17 +99,22 @@ class CollocationPlanner(Planner):
 
             for name in [self.warm_start, *self.seed_planners]:
                 if name not in PLANNERS or name == "collocation":
-                    raise ValueError(f"warm_start / seed_planners: {name!r} is not another registered planner; "
+                    raise InvalidOption("warm_start", f"{name!r} is not another registered planner; "
                                      f"expected one of {sorted(set(PLANNERS) - {'collocation'})}")
-            PLANNERS[self.warm_start](self.warm_start_options, path="warm_start_options")  # raises if invalid
+            try:
+                PLANNERS[self.warm_start](self.warm_start_options, path="warm_start_options")
+            except OptionsError as error:
+                raise InvalidOption(error.path, error.message) from None
+            if self.objective == "weighted" and not (self.energy_weight or self.l1_weight or self.time_weight):
+                raise InvalidOption("objective", "weighted needs a positive energy_weight, l1_weight or time_weight")
             if self.transcription == "multiple_shooting" and (self.keep_out or self.keep_in or self.objective == "min_l1"
                                                               or (self.objective == "weighted" and self.l1_weight)):
                 raise ValueError("multiple_shooting supports energy and time objectives without cones; "
                                  "use transcription: collocation for L1 costs and keep-out / keep-in cones")
-            for spec in self.keep_out:
-                parse_cone(spec, True)
-            for spec in self.keep_in:
-                parse_cone(spec, False)
+            for index, spec in enumerate(self.keep_out):
+                parse_cone(spec, True, np.deg2rad(self.cone_margin_deg), f"keep_out[{index}]")
+            for index, spec in enumerate(self.keep_in):
+                parse_cone(spec, False, np.deg2rad(self.cone_margin_deg), f"keep_in[{index}]")
 
     def _ocp(self, problem: ManeuverProblem) -> OptimalControlProblem:
         o = self.options

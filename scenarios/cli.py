@@ -7,14 +7,18 @@ from __future__ import annotations
 
 import argparse
 import re
+import signal
 import sys
+import threading
 import time
 import traceback
 from pathlib import Path
+from typing import Any
 
 from controllers import CONTROLLERS
 from planners import PLANNERS
 from scenarios.loader import load
+from scenarios.outputs import claim_output_directory, default_output_directory
 from scenarios.runner import run
 from scenarios.yaml_node import ScenarioError
 
@@ -48,7 +52,8 @@ def command_validate(args: argparse.Namespace) -> int:
 
 def command_run(args: argparse.Namespace) -> int:
     scenario = load(args.file)
-    out = Path(args.out) if args.out else Path("results") / scenario.name
+    out = Path(args.out) if args.out else default_output_directory(scenario.name)
+    claim_output_directory(out)  # before planning: a long run is never lost at the end
     start = time.perf_counter()
     results = run(scenario, progress=lambda line: print(line, flush=True))
     print()
@@ -75,20 +80,30 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _terminate(signum: int, frame: Any) -> None:
+    """SIGTERM ends a run like Ctrl-C, so that staged files are removed on the way out."""
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    previous = signal.signal(signal.SIGTERM, _terminate) if threading.current_thread() is threading.main_thread() else None
     try:
         return args.handler(args)
     except ScenarioError as error:
         print(f"slewbench: error in scenario: {error}", file=sys.stderr)
         return EXIT_BAD_SCENARIO
     except KeyboardInterrupt:
-        print("slewbench: interrupted; no output was written", file=sys.stderr)
+        print("slewbench: interrupted; results not written or marked incomplete in the output manifest",
+              file=sys.stderr)
         return EXIT_INTERNAL
     except Exception:
         traceback.print_exc()
         print("slewbench: internal error (this is a bug; please report it with the scenario file)", file=sys.stderr)
         return EXIT_INTERNAL
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

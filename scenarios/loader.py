@@ -7,6 +7,7 @@ code sees the papers' conventions.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
@@ -16,9 +17,14 @@ import numpy as np
 from controllers import CONTROLLERS
 from ocp import (CircularOrbit, Environment, Magnetorquers, ModelError, ReactionWheels, SensorNoise,
                  Spacecraft, TiltedDipole, Torquers, quat)
-from ocp.options import OptionsError
+from ocp.options import OptionsError, excerpt
+from ocp.simulator import MAX_SAMPLES, MAX_SUBSTEPS, SUBSTEPS_PER_SAMPLE
 from planners import PLANNERS, ManeuverProblem
 from scenarios.yaml_node import Node, ScenarioError, read_yaml
+
+
+MAX_NAME = 200
+"""Characters of a scenario name (the default output directory uses a sanitised, shorter stem)."""
 
 
 @dataclass
@@ -49,6 +55,7 @@ class SimulationSpec:
     integrator: str = "rk4"
     max_step: float = 0.05
     settling_tolerance_deg: float = 0.5
+    max_samples: int = MAX_SAMPLES
 
 
 @dataclass
@@ -75,7 +82,7 @@ def _model_part(node: Node, build: Callable[..., Any], **kwargs: Any) -> Any:
     try:
         return build(**kwargs)
     except ModelError as error:
-        raise ScenarioError(f"{node.path}.{error.field}" if node.path else error.field, str(error)) from None
+        raise ScenarioError(f"{node.path}.{error.field}" if node.path else error.field, error.message) from None
 
 
 def _limits(node: Node, key: str) -> Any:
@@ -230,15 +237,39 @@ def parse_simulation(node: Node) -> SimulationSpec:
         noise=SensorNoise(
             attitude_std=np.deg2rad(noise.get("attitude_deg", 0.0).number(non_negative=True)),
             rate_std=noise.get("rate", 0.0).number(non_negative=True),
-            seed=noise.get("seed", 0).integer(),
+            seed=noise.get("seed", 0).integer(minimum=0, maximum=2**63 - 1),
         ),
         integrator=node.get("integrator", "rk4").string(("rk4", "cvodes")),
         max_step=node.get("max_step", 0.05).number(positive=True),
-        settling_tolerance_deg=node.get("settling_tolerance_deg", 0.5).number(positive=True),
+        settling_tolerance_deg=node.get("settling_tolerance_deg", 0.5).number(positive=True, maximum=180.0),
+        max_samples=node.get("max_samples", MAX_SAMPLES).integer(minimum=1, maximum=100_000_000),
     )
+    if spec.integrator == "rk4" and math.ceil(spec.sample_time / spec.max_step - 1e-9) > MAX_SUBSTEPS:
+        raise ScenarioError(node.get("max_step").path, f"{spec.max_step:g} s gives more than {MAX_SUBSTEPS} RK4 "
+                            f"sub-steps per {spec.sample_time:g} s sample; raise it to at least "
+                            f"{spec.sample_time / MAX_SUBSTEPS:g} s")
     noise.finish()
     node.finish()
     return spec
+
+
+def check_work(problem: ManeuverProblem, simulation: SimulationSpec) -> None:
+    """Refuse a closed-loop window with more samples than ``simulation.max_samples`` (the run
+    would take too long or exhaust memory); the runner checks again once a planner has chosen
+    its own duration."""
+    window = simulation.duration or problem.duration
+    samples = math.ceil(window / simulation.sample_time - 1e-9)
+    substeps = 1 if simulation.integrator != "rk4" else math.ceil(simulation.sample_time / simulation.max_step - 1e-9)
+    where = "simulation.duration" if simulation.duration else "maneuver.duration"
+    if samples > simulation.max_samples:
+        raise ScenarioError(where, f"{window:g} s at a {simulation.sample_time:g} s sample time is {samples} samples, "
+                                   f"over the limit of {simulation.max_samples}; raise simulation.max_samples "
+                                   "if you mean it, or lengthen simulation.sample_time")
+    if samples * substeps > SUBSTEPS_PER_SAMPLE * simulation.max_samples:
+        raise ScenarioError("simulation.max_step", f"{samples} samples of {substeps} RK4 sub-steps each exceed the "
+                            f"limit of {SUBSTEPS_PER_SAMPLE} x simulation.max_samples = "
+                            f"{SUBSTEPS_PER_SAMPLE * simulation.max_samples} sub-steps; raise max_step or "
+                            "simulation.max_samples")
 
 
 def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
@@ -262,7 +293,10 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
 def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     """Build a :class:`Scenario` from parsed YAML data."""
     root = Node(data).mapping()
-    name = root.get("name", required=True).string()
+    name_node = root.get("name", required=True)
+    name = name_node.string()
+    if not name.strip() or len(name) > MAX_NAME:
+        raise name_node.error(f"expected a non-empty name of at most {MAX_NAME} characters, got {excerpt(name)}")
     spacecraft = parse_spacecraft(root.get("spacecraft", required=True))
     environment = parse_environment(root.get("orbit", None), root.get("environment", {}))
     problem = parse_problem(root.get("maneuver", required=True), spacecraft, environment)
@@ -270,6 +304,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     controller = parse_controller(root.get("controller", required=True))
     simulation = parse_simulation(root.get("simulation", {}))
     root.finish()
+    check_work(problem, simulation)
     check_compatibility(problem, planners, controller)
     return Scenario(name, problem, planners, controller, simulation, source)
 

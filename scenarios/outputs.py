@@ -1,26 +1,201 @@
-"""Writing a run's output directory atomically: everything goes to a temporary sibling that is
-moved into place only once complete, so an interrupted run never leaves a directory that
-looks finished."""
+"""Output directories that slewbench owns, and writing a run's results into them safely.
+
+The rules (README, "What slewbench writes"):
+
+* Every output directory carries slewbench's marker, :data:`MARKER`, a JSON manifest naming the
+  files slewbench wrote there and whether the set is complete. A directory is claimed only when it
+  does not exist yet, is empty, or already carries the marker; anything else (a regular file, a
+  user's directory, the working directory) is refused with a :class:`OutputError` and left untouched.
+* Inside a marked directory slewbench replaces or removes only files its manifest lists; a file a
+  user put there is never touched, and a result name that would land on such a file is an error.
+* New results are written into a staging folder inside the marked directory, then moved into place
+  file by file, and the manifest is marked complete last: an interrupted run leaves a manifest that
+  says "incomplete", and its staging folder is removed by the next run that writes there.
+* :func:`row_stems` gives every row a distinct, bounded file name whatever its label.
+"""
 from __future__ import annotations
 
 import csv
+import hashlib
+import json
 import os
 import re
 import shutil
 import tempfile
+import unicodedata
 from pathlib import Path
+from typing import Any, Iterable, Sequence
 
 import numpy as np
 
 from scenarios.tables import to_csv, to_json, to_markdown
+from scenarios.yaml_node import ScenarioError
+
+MARKER = ".slewbench-output.json"
+STAGING_PREFIX = ".slewbench-staging-"
+MAX_STEM = 64
+"""Characters of a file stem derived from a label or a scenario name (file systems allow 255 bytes)."""
+RESERVED = frozenset({"results", "comparison", "timeseries", "summary", "cases", "study", "store", "plots"})
+"""Stems slewbench uses for its own files; a row label that sanitises to one gets a suffix."""
 
 
-def safe_name(label: str) -> str:
-    """A file name for a row label."""
-    return re.sub(r"[^A-Za-z0-9_.=-]+", "_", label).strip("_") or "row"
+class OutputError(ScenarioError):
+    """An output location slewbench must not or cannot write to (exit status 2)."""
+
+    def __init__(self, path: str | Path, message: str):
+        super().__init__("--out", f"{path}: {message}")
 
 
-def write_timeseries(row, path: Path) -> None:
+def sanitize(text: str, fallback: str = "row") -> str:
+    """A file-name stem for ``text``: ASCII letters, digits and ``_.=-`` only, no leading dot,
+    at most :data:`MAX_STEM` characters; ``fallback`` when nothing is left.
+
+    Parameters
+    ----------
+    text : a label or a scenario name (any Unicode).
+    fallback : the stem used when ``text`` has no usable character.
+
+    Returns
+    -------
+    str
+        The stem; it never contains a path separator and is never ``.`` or ``..``.
+    """
+    ascii_text = unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode()
+    stem = re.sub(r"[^A-Za-z0-9_.=-]+", "_", ascii_text).strip("._-")[:MAX_STEM].strip("._-")
+    return stem or fallback
+
+
+def _digest(text: str) -> str:
+    return hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()[:8]
+
+
+def row_stems(labels: Sequence[str]) -> list[str]:
+    """Distinct file stems for row labels (compared case-insensitively, reserved names avoided).
+
+    A label whose sanitised stem is empty, reserved, or shared with another label gets a short hash
+    of the label appended, so ``a/b`` and ``a_b``, ``α`` and ``β``, or ``comparison`` never
+    overwrite each other's files.
+
+    Parameters
+    ----------
+    labels : the rows' labels, in order.
+
+    Returns
+    -------
+    list of str
+        One stem per label, pairwise distinct ignoring case.
+    """
+    stems = [sanitize(label) for label in labels]
+    counts: dict[str, int] = {}
+    for stem in stems:
+        counts[stem.lower()] = counts.get(stem.lower(), 0) + 1
+    result, taken = [], set()
+    for index, (label, stem) in enumerate(zip(labels, stems)):
+        if counts[stem.lower()] > 1 or stem.lower() in RESERVED or stem.lower().endswith("_cones"):
+            stem = f"{stem[:MAX_STEM - 9]}-{_digest(label)}"  # "_cones" is the suffix of a row's cone plot
+        while stem.lower() in taken:  # a hash collision or a label equal to another's suffixed stem
+            stem = f"{stem[:MAX_STEM - 9]}-{_digest(f'{label}#{index}')}"
+        taken.add(stem.lower())
+        result.append(stem)
+    return result
+
+
+def default_output_directory(name: str, root: str | Path = "results") -> Path:
+    """``results/<sanitised scenario name>``: always one level under ``root``.
+
+    Parameters
+    ----------
+    name : the scenario's (or study's) name, any text.
+    root : the folder that holds every default output directory.
+
+    Returns
+    -------
+    Path
+        ``root / stem`` with a stem that has no separator, is not ``..`` and is not empty.
+    """
+    stem = sanitize(name, fallback="")
+    if not stem or stem.lower() in RESERVED:
+        stem = f"{stem or 'scenario'}-{_digest(name)}"
+    return Path(root) / stem
+
+
+def read_manifest(directory: Path) -> dict[str, Any] | None:
+    """The marker's manifest of ``directory``, or ``None`` when it carries no valid marker."""
+    try:
+        manifest = json.loads((directory / MARKER).read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(manifest, dict) or manifest.get("tool") != "slewbench" or not isinstance(manifest.get("files"), list):
+        return None
+    return manifest
+
+
+def _write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: str) -> None:
+    """Replace the marker atomically (write a temporary file, then rename it)."""
+    manifest = {"tool": "slewbench", "kind": kind, "complete": complete, "files": sorted(set(files))}
+    handle, temporary = tempfile.mkstemp(prefix=".slewbench-manifest-", dir=directory)
+    with os.fdopen(handle, "w") as stream:
+        json.dump(manifest, stream, indent=1)
+    os.replace(temporary, directory / MARKER)
+
+
+def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
+    """Make ``path`` a slewbench output directory, or refuse without touching anything.
+
+    Accepted: a path that does not exist (it is created, with missing parents, and marked), an
+    empty directory (marked), or a directory that already carries slewbench's marker. Leftover
+    staging folders of an interrupted run inside a marked directory are removed. Writability is
+    checked with a probe file, so that a run never fails at its end for want of permission.
+
+    Parameters
+    ----------
+    path : the output directory.
+    kind : what writes there (``"run"``, ``"sweep"``, ``"codegen"``), recorded in the manifest.
+
+    Returns
+    -------
+    Path
+        The absolute directory.
+
+    Raises
+    ------
+    OutputError
+        For a regular file, a non-empty directory without the marker, a parent that is a file,
+        a name too long for the file system, or a location that cannot be written.
+    """
+    directory = Path(path).expanduser().absolute()
+    try:
+        if directory.is_symlink() or (directory.exists() and not directory.is_dir()):
+            raise OutputError(path, "exists and is not a directory; slewbench writes only into a new, "
+                                    "empty or slewbench-made directory")
+        if directory.is_dir():
+            manifest = read_manifest(directory)
+            if manifest is None and any(directory.iterdir()):
+                raise OutputError(path, f"is a directory that slewbench did not create (no {MARKER} in it) and is "
+                                        "not empty; choose a new or empty directory, nothing was touched")
+            if manifest is None:
+                _write_manifest(directory, [], complete=False, kind=kind)
+            for leftover in directory.glob(f"{STAGING_PREFIX}*"):
+                if leftover.is_dir() and not leftover.is_symlink():
+                    shutil.rmtree(leftover, ignore_errors=True)
+        else:
+            for parent in directory.parents:
+                if parent.exists():
+                    if not parent.is_dir():
+                        raise OutputError(path, f"its parent {parent} is not a directory")
+                    break
+            directory.mkdir(parents=True)
+            _write_manifest(directory, [], complete=False, kind=kind)
+        probe = tempfile.NamedTemporaryFile(prefix=".slewbench-probe-", dir=directory)
+        probe.close()
+    except OutputError:
+        raise
+    except OSError as error:
+        raise OutputError(path, f"cannot be written: {error.strerror or error}") from None
+    return directory
+
+
+def write_timeseries(row: Any, path: Path) -> None:
     """t, q, ω, h_w, applied body torque (held from t_k; blank on the last line), reference q, ω."""
     sim = row.simulation
     n_w = sim.wheel_momentum.shape[1]
@@ -38,32 +213,80 @@ def write_timeseries(row, path: Path) -> None:
         writer = csv.writer(handle)
         writer.writerow(header)
         for line in table:
-            writer.writerow(["" if np.isnan(v) else repr(float(v)) for v in line])
+            writer.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in line])
 
 
-def write_results(results, directory: str | Path, plots: bool = True) -> None:
-    target = Path(directory).resolve()
-    target.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.partial-", dir=target.parent))
+def _relative_files(root: Path) -> list[str]:
+    return sorted(str(p.relative_to(root)) for p in root.rglob("*") if p.is_file())
+
+
+def commit_outputs(directory: Path, staging: Path, kind: str) -> list[str]:
+    """Move everything under ``staging`` into the marked ``directory``, replacing only files the
+    manifest lists, remove the previous run's files that the new set lacks, and mark complete.
+
+    Returns
+    -------
+    list of str
+        The files now listed by the manifest (relative paths).
+    """
+    manifest = read_manifest(directory)
+    if manifest is None:
+        raise OutputError(directory, f"lost its {MARKER} while running; nothing was replaced")
+    previous = set(manifest["files"])
+    new = _relative_files(staging)
+    clashes = [name for name in new if name not in previous and os.path.lexists(directory / name)]
+    if clashes:
+        raise OutputError(directory, f"holds files slewbench did not write ({', '.join(clashes[:5])}); "
+                                     "nothing was replaced: move them or choose another --out")
+    _write_manifest(directory, previous | set(new), complete=False, kind=kind)
+    for name in new:
+        (directory / name).parent.mkdir(parents=True, exist_ok=True)
+        os.replace(staging / name, directory / name)
+    for name in sorted(previous - set(new)):
+        stale = directory / name
+        if stale.is_file() and not stale.is_symlink():
+            stale.unlink()
+    for folder in sorted({(directory / name).parent for name in previous - set(new)}, reverse=True):
+        if folder != directory and folder.is_dir() and not any(folder.iterdir()):
+            folder.rmdir()
+    _write_manifest(directory, new, complete=True, kind=kind)
+    shutil.rmtree(staging, ignore_errors=True)
+    return new
+
+
+def write_results(results: Any, directory: str | Path, plots: bool = True) -> Path:
+    """Write ``results.json/csv/md``, ``timeseries/<row>.csv`` and the PNG plots into ``directory``.
+
+    The directory is claimed first (:func:`claim_output_directory`); the files are staged inside
+    it and committed together (:func:`commit_outputs`).
+
+    Parameters
+    ----------
+    results : a ``scenarios.RunResults``.
+    directory : the output directory.
+    plots : also draw the PNG figures.
+
+    Returns
+    -------
+    Path
+        The absolute output directory.
+    """
+    target = claim_output_directory(directory)
+    staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=target))
     try:
         (staging / "results.json").write_text(to_json(results))
         (staging / "results.csv").write_text(to_csv(results))
         (staging / "results.md").write_text(to_markdown(results))
         series = staging / "timeseries"
         series.mkdir()
-        for row in results.rows:
+        stems = row_stems([row.label for row in results.rows])
+        for row, stem in zip(results.rows, stems):
             if row.simulation is not None:
-                write_timeseries(row, series / f"{safe_name(row.label)}.csv")
+                write_timeseries(row, series / f"{stem}.csv")
         if plots:
             from scenarios.plots import write_plots
-            write_plots(results, staging)
-        if target.exists():
-            previous = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
-            os.replace(target, previous / "old")
-            os.replace(staging, target)
-            shutil.rmtree(previous, ignore_errors=True)
-        else:
-            os.replace(staging, target)
-    except BaseException:
+            write_plots(results, staging, stems)
+        commit_outputs(target, staging, kind="run")
+    finally:
         shutil.rmtree(staging, ignore_errors=True)
-        raise
+    return target

@@ -10,7 +10,7 @@ import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first
 import numpy as np  # noqa: E402
 
 from ocp import quat  # noqa: E402
-from scenarios.outputs import safe_name  # noqa: E402
+from scenarios.outputs import row_stems  # noqa: E402
 
 AXIS_COLORS = ("tab:red", "tab:green", "tab:blue", "tab:purple")
 
@@ -109,11 +109,14 @@ def plot_overlay(results, path: Path) -> None:
     plt.close(fig)
 
 
-def write_plots(results, directory: Path) -> None:
+def write_plots(results, directory: Path, stems: list[str] | None = None) -> None:
+    """One PNG per simulated row (``<stem>.png``, ``<stem>_cones.png`` with cones) and
+    ``comparison.png``; ``stems`` are the rows' file stems (default ``row_stems`` of the labels)."""
     target_q = results.scenario.problem.qf
-    for row in results.rows:
+    stems = stems if stems is not None else row_stems([row.label for row in results.rows])
+    for row, stem in zip(results.rows, stems):
         if row.simulation is not None:
-            plot_row(row, target_q, directory / f"{safe_name(row.label)}.png")
+            plot_row(row, target_q, directory / f"{stem}.png")
             if row.reference is not None and row.reference.stats.get("cones"):
-                plot_cones(row, directory / f"{safe_name(row.label)}_cones.png")
+                plot_cones(row, directory / f"{stem}_cones.png")
     plot_overlay(results, directory / "comparison.png")

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from controllers import CONTROLLERS
-from ocp import SimulationError, SolverCache, SimulationResult, Simulator, metrics_from_reference, metrics_from_simulation
+from ocp import SimulationError, SolverCache, metric_violations, SimulationResult, Simulator, metrics_from_reference, metrics_from_simulation
 from planners import PLANNERS, FailedReference, Reference
 from scenarios.loader import Scenario
 
@@ -94,6 +94,15 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
         result, problem.qf, problem.omegaf, reference=reference, plan_time_s=row.plan_time_s,
         duration_s=reference.duration if reference else None,
         settling_tolerance_deg=scenario.simulation.settling_tolerance_deg)
+    _check_physical(row, "closed loop", row.closed_loop_metrics)
+
+
+def _check_physical(row: Row, scope: str, metrics: dict[str, Any] | None) -> None:
+    """A row whose metrics physics forbids (negative, non-finite) is failed, not "ok"."""
+    problems = metric_violations(metrics)
+    if problems and row.status == "ok":
+        row.status = "failed"
+        row.message = f"{scope} metrics are not physical ({'; '.join(problems)}): the result cannot be trusted"
 
 
 def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
@@ -113,7 +122,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     """
     say = progress or (lambda line: None)
     spec = scenario.simulation
-    simulator = Simulator(scenario.problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step)
+    simulator = Simulator(scenario.problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step,
+                          max_samples=spec.max_samples)
     rows = []
     if not scenario.planners:
         row = Row(scenario.controller.name, None, "ok", "regulation to the target", None, None, None)
@@ -133,6 +143,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
             row.reference_metrics = metrics_from_reference(
                 reference, scenario.problem.qf, scenario.problem.omegaf,
                 settling_tolerance_deg=spec.settling_tolerance_deg, initial_omega=scenario.problem.omega0)
+            _check_physical(row, "reference", row.reference_metrics)
             _simulate(scenario, simulator, reference, row)
         say(f"[{index}/{len(scenario.planners)}] {row.label}: {row.status} "
             f"(planned in {row.plan_time_s * 1e3:.1f} ms, simulated in {row.simulate_time_s:.2f} s)"

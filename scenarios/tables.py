@@ -67,7 +67,8 @@ def to_csv(results) -> str:
     writer = csv.DictWriter(buffer, fieldnames=flat_columns(), lineterminator="\n")
     writer.writeheader()
     for record in flat_rows(results):
-        writer.writerow({k: "" if v is None else v for k, v in record.items()})
+        writer.writerow({k: "" if v is None or (isinstance(v, float) and not math.isfinite(v)) else v
+                         for k, v in record.items()})
     return buffer.getvalue()
 
 

@@ -14,6 +14,8 @@ from typing import Any, Iterator
 import numpy as np
 import yaml
 
+from ocp.options import excerpt
+
 
 class ScenarioError(ValueError):
     """A scenario file is wrong; ``path`` is where, ``message`` what was expected."""
@@ -35,21 +37,82 @@ for _first in "-+0123456789.":
     _Loader.yaml_implicit_resolvers.setdefault(_first, []).insert(0, ("tag:yaml.org,2002:float", _EXPONENT_FLOAT))
 
 
+MAX_FILE_BYTES = 2 * 1024 * 1024
+"""Largest scenario or study file read (bytes); real files are a few kilobytes."""
+MAX_NODES = 100_000
+"""Most YAML values a file may hold once aliases are counted at every use (alias bombs)."""
+
+
+def _check_tree(root: yaml.Node, source: Path | str) -> None:
+    """Reject duplicate keys (naming both lines and the YAML path) and alias expansion beyond
+    :data:`MAX_NODES`, walking the composed node graph without building Python objects."""
+    count = 0
+    stack: list[tuple[yaml.Node, str]] = [(root, "")]
+    while stack:
+        node, path = stack.pop()
+        count += 1
+        if count > MAX_NODES:
+            raise ScenarioError(path or "(top level)", f"{source} expands to more than {MAX_NODES} values "
+                                                       "(aliases count at every use); is it an alias bomb?")
+        if isinstance(node, yaml.MappingNode):
+            seen: dict[Any, yaml.Node] = {}
+            for key_node, value_node in node.value:
+                key = key_node.value if isinstance(key_node, yaml.ScalarNode) else id(key_node)
+                child = f"{path}.{key}" if path else str(key)
+                if key in seen:
+                    first = seen[key].start_mark.line + 1
+                    raise ScenarioError(child, f"duplicate key (lines {first} and {key_node.start_mark.line + 1}); "
+                                               "each key may appear once")
+                seen[key] = key_node
+                stack.append((value_node, child))
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend((item, f"{path}[{index}]") for index, item in enumerate(node.value))
+
+
+def parse_yaml_text(text: str, source: Path | str = "<text>") -> Any:
+    """Parse YAML text with slewbench's checks (see :func:`read_yaml`)."""
+    try:
+        root = yaml.compose(text, Loader=_Loader)
+        if root is None:
+            return None
+        _check_tree(root, source)
+        return yaml.load(text, Loader=_Loader)
+    except yaml.YAMLError as error:
+        where = getattr(error, "problem_mark", None)
+        line = f" (line {where.line + 1}, column {where.column + 1})" if where else ""
+        problem = getattr(error, "problem", None) or error
+        raise ScenarioError("", f"{source} is not valid YAML{line}: {excerpt(str(problem), 200)}") from None
+    except RecursionError:
+        raise ScenarioError("", f"{source} nests too deeply") from None
+
+
 def read_yaml(path: str | Path) -> Any:
-    """Parse a YAML file; a missing file or text that is not YAML is a :class:`ScenarioError`."""
+    """Parse a YAML file.
+
+    Numbers such as ``6e5`` are read as numbers; a missing or unreadable file, a file larger than
+    :data:`MAX_FILE_BYTES`, text that is not YAML, a duplicate key, or alias expansion beyond
+    :data:`MAX_NODES` values is a :class:`ScenarioError`.
+
+    Parameters
+    ----------
+    path : the YAML file.
+
+    Returns
+    -------
+    The parsed data (mappings, lists, numbers, strings).
+    """
     path = Path(path)
     try:
+        size = path.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise ScenarioError("", f"{path} has {size} bytes; scenario and study files are limited to "
+                                    f"{MAX_FILE_BYTES} bytes")
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ScenarioError("", f"scenario file not found: {path}") from None
     except (OSError, UnicodeDecodeError) as error:
         raise ScenarioError("", f"cannot read {path}: {error}") from None
-    try:
-        return yaml.load(text, Loader=_Loader)
-    except yaml.YAMLError as error:
-        where = getattr(error, "problem_mark", None)
-        line = f" (line {where.line + 1}, column {where.column + 1})" if where else ""
-        raise ScenarioError("", f"{path} is not valid YAML{line}: {getattr(error, 'problem', error)}") from None
+    return parse_yaml_text(text, path)
 
 
 def _is_number(value: Any) -> bool:
@@ -74,7 +137,7 @@ class Node:
 
     def mapping(self) -> "Node":
         if not isinstance(self.value, dict):
-            raise self.error(f"expected a mapping, got {type(self.value).__name__}")
+            raise self.error(f"expected a mapping, got {excerpt(self.value)}")
         return self
 
     def __contains__(self, key: str) -> bool:
@@ -99,39 +162,47 @@ class Node:
 
     def items(self) -> Iterator["Node"]:
         if not isinstance(self.value, list):
-            raise self.error(f"expected a list, got {type(self.value).__name__}")
+            raise self.error(f"expected a list, got {excerpt(self.value)}")
         return (Node(item, self._child_path(i)) for i, item in enumerate(self.value))
 
     def is_null(self) -> bool:
         return self.value is None or (isinstance(self.value, str) and self.value.lower() == "none")
 
-    def number(self, positive: bool = False, non_negative: bool = False) -> float:
+    def number(self, positive: bool = False, non_negative: bool = False, maximum: float | None = None) -> float:
+        """A finite number (optionally positive, non-negative, at most ``maximum``)."""
         if not _is_number(self.value) or not np.isfinite(self.value):
-            raise self.error(f"expected a number, got {self.value!r}")
+            raise self.error(f"expected a number, got {excerpt(self.value)}")
         if positive and not self.value > 0:
-            raise self.error(f"expected a positive number, got {self.value!r}")
+            raise self.error(f"expected a positive number, got {excerpt(self.value)}")
         if non_negative and self.value < 0:
-            raise self.error(f"expected a non-negative number, got {self.value!r}")
+            raise self.error(f"expected a non-negative number, got {excerpt(self.value)}")
+        if maximum is not None and self.value > maximum:
+            raise self.error(f"expected a number <= {maximum:g}, got {excerpt(self.value)}")
         return float(self.value)
 
     def optional_number(self, **checks: bool) -> float | None:
         return None if self.is_null() else self.number(**checks)
 
-    def integer(self) -> int:
+    def integer(self, minimum: int | None = None, maximum: int | None = None) -> int:
+        """An integer in ``[minimum, maximum]`` (either bound optional)."""
         if not isinstance(self.value, int) or isinstance(self.value, bool):
-            raise self.error(f"expected an integer, got {self.value!r}")
+            raise self.error(f"expected an integer, got {excerpt(self.value)}")
+        if (minimum is not None and self.value < minimum) or (maximum is not None and self.value > maximum):
+            low = "" if minimum is None else f" >= {minimum}"
+            high = "" if maximum is None else f" <= {maximum}"
+            raise self.error(f"expected an integer{low}{' and' if low and high else ''}{high}, got {excerpt(self.value)}")
         return self.value
 
     def boolean(self) -> bool:
         if not isinstance(self.value, bool):
-            raise self.error(f"expected true or false, got {self.value!r}")
+            raise self.error(f"expected true or false, got {excerpt(self.value)}")
         return self.value
 
     def string(self, choices: tuple[str, ...] | None = None) -> str:
         if not isinstance(self.value, str):
-            raise self.error(f"expected a string, got {self.value!r}")
+            raise self.error(f"expected a string, got {excerpt(self.value)}")
         if choices is not None and self.value not in choices:
-            raise self.error(f"expected one of {list(choices)}, got {self.value!r}")
+            raise self.error(f"expected one of {list(choices)}, got {excerpt(self.value)}")
         return self.value
 
     def vector(self, size: int | None = None, allow_scalar: bool = False) -> np.ndarray:
@@ -140,7 +211,7 @@ class Node:
             return np.asarray(self.number())
         if not isinstance(self.value, list) or not all(_is_number(v) for v in self.value):
             expected = f"a list of {size} numbers" if size else "a list of numbers"
-            raise self.error(f"expected {expected}{' or a number' if allow_scalar else ''}, got {self.value!r}")
+            raise self.error(f"expected {expected}{' or a number' if allow_scalar else ''}, got {excerpt(self.value)}")
         if size is not None and len(self.value) != size:
             raise self.error(f"expected {size} numbers, got {len(self.value)}")
         array = np.asarray(self.value, dtype=float)

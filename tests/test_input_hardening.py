@@ -1,0 +1,248 @@
+"""Bad scenario input: every file that used to hang, crash or give a meaningless "ok" row (issue 11,
+section 2) is now an exit-2 error naming the YAML path, fast; a mutation property test covers the rest."""
+import contextlib
+import copy
+import io
+import json
+import math
+import signal
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from scenarios.cli import main
+
+BASE = {
+    "name": "base",
+    "spacecraft": {"inertia": [2.0, 3.0, 4.0], "wheels": {"max_torque": 0.05}},
+    "maneuver": {"duration": 20.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
+                 "final": {"q": [0.9659258, 0.2588190, 0, 0], "omega": [0, 0, 0]}, "max_rate": 0.05},
+    "planners": [{"name": "eigenaxis", "label": "smooth", "options": {"profile": "smooth", "torque_fraction": 1.0}},
+                 {"name": "shape_polynomial", "label": "shape", "options": {"duration": "scenario", "max_terms": 2}},
+                 {"name": "natural_motion", "label": "natural", "options": {"stop_time": 5.0, "starts": 2}}],
+    "controller": {"name": "augmented_quaternion_feedback", "options": {"kp": 0.2, "kd": 0.6}},
+    "simulation": {"sample_time": 0.5, "max_step": 0.05, "max_samples": 2000,
+                   "sensor_noise": {"attitude_deg": 0.0, "rate": 0.0, "seed": 0}},
+}
+
+
+def with_planner(planner: dict, **scenario_changes) -> dict:
+    data = copy.deepcopy(BASE)
+    data["planners"] = [planner]
+    data.update(scenario_changes)
+    return data
+
+
+def set_path(data: dict, path: tuple, value) -> dict:
+    data = copy.deepcopy(data)
+    node = data
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = value
+    return data
+
+
+def run_cli(tmp_path: Path, text: str, command: str = "validate") -> tuple[int, str, float]:
+    path = tmp_path / "case.yaml"
+    path.write_text(text)
+    stderr = io.StringIO()
+    start = time.perf_counter()
+    with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+        status = main([command, str(path)] + (["--out", str(tmp_path / "out"), "--no-plots"] if command == "run" else []))
+    return status, stderr.getvalue(), time.perf_counter() - start
+
+
+COLLOCATION = {"name": "collocation", "options": {"intervals": 10}}
+CASES = {
+    "negative shape max_rate": (with_planner({"name": "shape_polynomial", "options": {"max_rate": -0.1}}),
+                                "planners[0].options.max_rate"),
+    "negative energy weight": (with_planner({"name": "collocation", "options": {"objective": "weighted", "energy_weight": -1}}),
+                               "planners[0].options.energy_weight"),
+    "all weights zero": (with_planner({"name": "collocation", "options": {"objective": "weighted", "energy_weight": 0}}),
+                         "planners[0].options.objective"),
+    "negative keep-out angle": (with_planner({"name": "collocation", "options": {"keep_out": [
+        {"boresight": [1, 0, 0], "direction": [0, 1, 0], "angle_deg": -30}]}}), "planners[0].options.keep_out[0].angle_deg"),
+    "keep-out angle as a word": (with_planner({"name": "collocation", "options": {"keep_out": [
+        {"boresight": [1, 0, 0], "direction": [0, 1, 0], "angle_deg": "thirty"}]}}), "planners[0].options.keep_out[0].angle_deg"),
+    "boresight as a mapping": (with_planner({"name": "collocation", "options": {"keep_out": [
+        {"boresight": {"x": 1}, "direction": [0, 1, 0], "angle_deg": 30}]}}), "planners[0].options.keep_out[0].boresight"),
+    "negative multistart": (with_planner({"name": "collocation", "options": {"multistart": -1}}), "planners[0].options.multistart"),
+    "negative starts": (with_planner({"name": "spin_extremal", "options": {"starts": -1}}), "planners[0].options.starts"),
+    "zero max_terms": (with_planner({"name": "shape_polynomial", "options": {"max_terms": 0}}), "planners[0].options.max_terms"),
+    "huge intervals": (with_planner({"name": "collocation", "options": {"intervals": 1000000000}}), "planners[0].options.intervals"),
+    "float intervals": (with_planner({"name": "collocation", "options": {"intervals": 1e9}}), "planners[0].options.intervals"),
+    "2x2 kp": (set_path(BASE, ("controller", "options", "kp"), [[1, 0], [0, 1]]), "controller.options.kp"),
+    "negative kp": (set_path(BASE, ("controller", "options", "kp"), -0.2), "controller.options.kp"),
+    "negative seed": (set_path(BASE, ("simulation", "sensor_noise", "seed"), -1), "simulation.sensor_noise.seed"),
+    "tiny max_step": (set_path(BASE, ("simulation", "max_step"), 1e-9), "simulation.max_step"),
+    "long window": (set_path(set_path(BASE, ("simulation", "duration"), 1e7), ("simulation", "sample_time"), 0.01),
+                    "simulation.duration"),
+    "huge duration": (set_path(BASE, ("maneuver", "duration"), 1e9), "maneuver.duration"),
+    "tiny sample time": (set_path(BASE, ("simulation", "sample_time"), 1e-7), "maneuver.duration"),
+    "zero quaternion": (set_path(BASE, ("maneuver", "initial", "q"), [0, 0, 0, 0]), "maneuver.initial.q"),
+    "empty name": (set_path(BASE, ("name",), ""), "name"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_bad_values_are_exit_2_naming_the_path(case, tmp_path):
+    data, path = CASES[case]
+    status, error, seconds = run_cli(tmp_path, yaml.safe_dump(data))
+    assert status == 2, error
+    assert f"error in scenario: {path}:" in error, error
+    assert "Traceback" not in error and seconds < 10
+
+
+@pytest.mark.parametrize("text, path", [
+    ("natural_motion_nan", "planners[0].options.stop_time"),
+    ("costate_ridge_nan", "controller.options.ridge"),
+])
+def test_nan_options_are_refused(text, path, tmp_path):
+    planner = {"natural_motion_nan": "{name: natural_motion, options: {stop_time: .nan}}",
+               "costate_ridge_nan": "{name: costate_tpbvp}"}[text]
+    controller = ("{name: costate_feedback, options: {ridge: .nan}}" if text == "costate_ridge_nan"
+                  else "{name: augmented_quaternion_feedback}")
+    document = yaml.safe_dump({k: v for k, v in BASE.items() if k not in ("planners", "controller")})
+    document += f"planners: [{planner}]\ncontroller: {controller}\n"
+    status, error, _ = run_cli(tmp_path, document)
+    assert status == 2 and f"{path}: expected a finite number" in error, error
+
+
+def test_duplicate_keys_name_both_places(tmp_path):
+    text = textwrap.dedent("""\
+        name: dup
+        spacecraft: {inertia: [2, 3, 4]}
+        maneuver:
+          duration: 20.0
+          duration: 30.0
+          initial: {q: [1, 0, 0, 0]}
+          final: {q: [1, 0, 0, 0]}
+        planners: []
+        controller: {name: none}
+        """)
+    status, error, _ = run_cli(tmp_path, text)
+    assert status == 2 and "maneuver.duration: duplicate key (lines 4 and 5)" in error, error
+
+
+def test_an_alias_bomb_fails_fast_with_a_short_message(tmp_path):
+    lines = ['a0: &a0 ["x", "x", "x", "x", "x", "x", "x", "x", "x", "x"]']
+    lines += [f"a{i}: &a{i} [*a{i - 1}, *a{i - 1}, *a{i - 1}, *a{i - 1}, *a{i - 1}, *a{i - 1}, *a{i - 1}, *a{i - 1}, "
+              f"*a{i - 1}, *a{i - 1}]" for i in range(1, 9)]
+    text = "\n".join(lines) + "\nname: *a8\n"
+    status, error, seconds = run_cli(tmp_path, text)
+    assert status == 2 and "alias" in error and len(error) < 1000 and seconds < 5, (seconds, error[:300])
+
+
+def test_a_huge_file_is_refused_before_it_is_parsed(tmp_path):
+    text = yaml.safe_dump(BASE) + "# " + "x" * (3 * 1024 * 1024) + "\n"
+    status, error, seconds = run_cli(tmp_path, text)
+    assert status == 2 and "bytes" in error and seconds < 2
+
+
+def test_error_messages_show_a_bounded_excerpt(tmp_path):
+    data = set_path(BASE, ("controller", "options", "kp"), "k" * 100000)
+    status, error, _ = run_cli(tmp_path, yaml.safe_dump(data))
+    assert status == 2 and "controller.options.kp" in error and len(error) < 600
+
+
+# ----- property: mutations of a valid scenario --------------------------------------------------
+
+def leaf_paths(node, prefix=()):
+    if isinstance(node, dict):
+        for key, value in node.items():
+            yield prefix + (key,)
+            yield from leaf_paths(value, prefix + (key,))
+    elif isinstance(node, list):
+        for index, value in enumerate(node):
+            yield prefix + (index,)
+            yield from leaf_paths(value, prefix + (index,))
+
+
+PATHS = sorted(leaf_paths(BASE), key=repr)
+VALUES = st.one_of(
+    st.none(), st.booleans(), st.integers(-10**12, 10**12),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0, -1, 1e-9, 1e9, 0.5, 3, "none", "", "..", "x" * 300]),
+    st.text(max_size=8), st.lists(st.floats(-10, 10), max_size=4), st.lists(st.integers(-3, 3), max_size=5),
+    st.dictionaries(st.text(max_size=4), st.integers(), max_size=2),
+)
+MUTATIONS = st.one_of(
+    st.tuples(st.just("set"), st.sampled_from(PATHS), VALUES),
+    st.tuples(st.just("delete"), st.sampled_from(PATHS), st.none()),
+    st.tuples(st.just("add"), st.sampled_from(PATHS), st.text(min_size=1, max_size=6)),
+)
+
+
+def mutate(data: dict, mutation) -> dict:
+    kind, path, value = mutation
+    data = copy.deepcopy(data)
+    node = data
+    for key in path[:-1]:
+        node = node[key]
+    if kind == "set":
+        node[path[-1]] = value
+    elif kind == "delete":
+        del node[path[-1]]
+    elif isinstance(node[path[-1]], dict):
+        node[path[-1]][value] = 1
+    return data
+
+
+class CaseTimeout(Exception):
+    pass
+
+
+def physical(metrics: dict) -> bool:
+    """Finite and non-negative, fractions at most one: what every metric must be (an independent
+    restatement of the metric table's units, not the runner's own check)."""
+    for key, value in (metrics or {}).items():
+        for item in (value if isinstance(value, list) else [value]):
+            if item is None:
+                continue
+            if not math.isfinite(item) or item < 0 or (key == "saturation_fraction" and item > 1):
+                return False
+    return True
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture,
+                                                                  HealthCheck.too_slow])
+@given(mutation=MUTATIONS)
+def test_mutated_scenarios_exit_0_with_physical_metrics_or_2_naming_a_path(mutation, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("case")
+    data = mutate(BASE, mutation)
+    path = folder / "case.yaml"
+    path.write_text(yaml.safe_dump(data, allow_unicode=True))
+    out = folder / "out"
+    stderr = io.StringIO()
+
+    def expire(signum, frame):
+        raise CaseTimeout
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.alarm(60)  # per-case bound: an accepted scenario must never hang
+    try:
+        with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+            status = main(["run", str(path), "--out", str(out), "--no-plots"])
+    except CaseTimeout:
+        pytest.fail(f"mutation {mutation!r} ran for more than 60 s")
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+    error = stderr.getvalue()
+    assert "Traceback" not in error, (mutation, error)
+    assert status in (0, 2), (mutation, error)
+    assert sorted(p.name for p in folder.iterdir()) in (["case.yaml"], ["case.yaml", "out"]), mutation
+    if status == 2:
+        assert error.startswith("slewbench: error in scenario: "), (mutation, error)
+        assert not out.exists()
+        return
+    results = json.loads((out / "results.json").read_text())
+    for row in results["rows"]:
+        assert row["status"] in ("ok", "failed", "infeasible"), row
+        if row["status"] == "ok":
+            assert physical(row["reference"]) and physical(row["closed_loop"]), (mutation, row)

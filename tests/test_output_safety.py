@@ -1,0 +1,210 @@
+"""Output safety: slewbench writes only into directories it owns and never touches a user's files.
+
+Each test starts from a layout that lost data before this was enforced (issue 11, section 1).
+"""
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from scenarios.cli import main
+from scenarios.outputs import MARKER, STAGING_PREFIX, default_output_directory, row_stems
+
+REPO = Path(__file__).resolve().parents[1]
+
+TINY = """
+name: tiny
+spacecraft: {inertia: [2.0, 3.0, 4.0], wheels: {max_torque: 0.05}}
+maneuver:
+  duration: 20.0
+  initial: {q: [1, 0, 0, 0], omega: [0, 0, 0]}
+  final: {q: [0.9659258, 0.2588190, 0, 0], omega: [0, 0, 0]}
+planners:
+  - {name: eigenaxis, label: smooth}
+controller: {name: augmented_quaternion_feedback, options: {kp: 0.2, kd: 0.6}}
+simulation: {sample_time: 0.5}
+"""
+
+
+def scenario(tmp_path: Path, text: str = TINY, file: str = "s.yaml", **changes) -> Path:
+    data = yaml.safe_load(textwrap.dedent(text))
+    data.update(changes)
+    path = tmp_path / file
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def snapshot(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+
+
+@pytest.mark.parametrize("where", ["cwd", "scenario_folder", "parent"])
+def test_out_at_a_users_directory_is_refused_and_nothing_is_touched(where, tmp_path, monkeypatch, capsys):
+    user = tmp_path / "work"
+    user.mkdir()
+    (user / "thesis.tex").write_text("three years of work")
+    path = scenario(user)
+    before = snapshot(tmp_path)
+    monkeypatch.chdir(user)
+    out = {"cwd": ".", "scenario_folder": str(user), "parent": str(tmp_path)}[where]
+    assert main(["run", str(path), "--out", out, "--no-plots"]) == 2
+    error = capsys.readouterr().err
+    assert "did not create" in error and "nothing was touched" in error and "Traceback" not in error
+    assert snapshot(tmp_path) == before
+
+
+def test_out_at_an_existing_file_is_an_error(tmp_path, capsys):
+    path = scenario(tmp_path)
+    target = tmp_path / "results.txt"
+    target.write_text("keep me")
+    assert main(["run", str(path), "--out", str(target), "--no-plots"]) == 2
+    assert "not a directory" in capsys.readouterr().err
+    assert target.read_text() == "keep me"
+
+
+def test_subprocess_run_keeps_a_user_file_in_a_slewbench_directory(tmp_path):
+    """End to end through the console entry point: a rerun into slewbench's own directory
+    replaces slewbench's files and leaves the user's file alone."""
+    path = scenario(tmp_path)
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "scenarios.cli", "run", str(path), "--out", str(out), "--no-plots"]
+    first = subprocess.run(command, cwd=REPO, capture_output=True, text=True, timeout=300)
+    assert first.returncode == 0, first.stderr
+    (out / "notes.txt").write_text("my notes")
+    second = subprocess.run(command, cwd=REPO, capture_output=True, text=True, timeout=300)
+    assert second.returncode == 0, second.stderr
+    assert (out / "notes.txt").read_text() == "my notes"
+    manifest = json.loads((out / MARKER).read_text())
+    assert manifest["complete"] is True and "notes.txt" not in manifest["files"]
+    assert "results.json" in manifest["files"] and "timeseries/smooth.csv" in manifest["files"]
+
+
+def test_a_user_file_named_like_a_result_is_never_overwritten(tmp_path, capsys):
+    path = scenario(tmp_path)
+    out = tmp_path / "out"
+    out.mkdir()
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    manifest = json.loads((out / MARKER).read_text())
+    (out / "results.json").unlink()  # the user deletes ours and writes their own file of that name
+    manifest["files"].remove("results.json")
+    (out / MARKER).write_text(json.dumps(manifest))
+    (out / "results.json").write_text("user data")
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 2
+    assert "did not write" in capsys.readouterr().err
+    assert (out / "results.json").read_text() == "user data"
+
+
+def test_an_empty_directory_is_claimed_and_stale_results_are_removed(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    two = scenario(tmp_path, planners=[{"name": "eigenaxis", "label": "a"}, {"name": "eigenaxis", "label": "b"}])
+    assert main(["run", str(two), "--out", str(out), "--no-plots"]) == 0
+    assert (out / "timeseries" / "b.csv").exists()
+    one = scenario(tmp_path, file="one.yaml", planners=[{"name": "eigenaxis", "label": "a"}])
+    assert main(["run", str(one), "--out", str(out), "--no-plots"]) == 0
+    assert not (out / "timeseries" / "b.csv").exists() and (out / "timeseries" / "a.csv").exists()
+
+
+@pytest.mark.parametrize("name", ["..", "", " ", "/etc", "../escape", "a/../../b", "α", "results", "x" * 500])
+def test_default_output_path_stays_one_level_under_results(name):
+    path = default_output_directory(name)
+    assert path.parent == Path("results")
+    assert path.name not in ("", ".", "..") and "/" not in path.name and len(path.name) <= 80
+
+
+@pytest.mark.parametrize("name", ["..", "../escape", "/tmp/abs"])
+def test_scenario_name_cannot_write_outside_results(name, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "keep.txt").write_text("keep")
+    path = scenario(tmp_path, name=name)
+    assert main(["run", str(path), "--no-plots"]) == 0
+    produced = [p for p in tmp_path.rglob(MARKER)]
+    assert len(produced) == 1 and produced[0].parent.parent == tmp_path / "results"
+    assert (tmp_path / "keep.txt").read_text() == "keep"
+
+
+def test_empty_name_is_an_error(tmp_path, capsys):
+    assert main(["validate", str(scenario(tmp_path, name=""))]) == 2
+    assert "name: expected a non-empty name" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("labels", [["a/b", "a_b"], ["α", "β"], ["comparison", "x"], ["A", "a"], ["p", "p_cones"],
+                                    ["results", "timeseries"]])
+def test_rows_get_distinct_file_names(labels):
+    stems = row_stems(labels)
+    lowered = [s.lower() for s in stems]
+    assert len(set(lowered)) == len(labels)
+    assert not {"comparison", "results", "timeseries"} & set(lowered)
+    assert all(not s.lower().endswith("_cones") for s in stems)
+
+
+def test_colliding_labels_each_get_their_own_time_series(tmp_path):
+    path = scenario(tmp_path, planners=[{"name": "eigenaxis", "label": "a/b"}, {"name": "eigenaxis", "label": "a_b"},
+                                        {"name": "eigenaxis", "label": "comparison"}])
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out)]) == 0
+    assert len(list((out / "timeseries").glob("*.csv"))) == 3
+    assert len(list(out.glob("*.png"))) == 4  # three rows and comparison.png
+
+
+@pytest.mark.parametrize("make", ["parent_is_file", "too_long", "unwritable"])
+def test_write_failures_are_found_before_planning(make, tmp_path, capsys):
+    path = scenario(tmp_path)
+    if make == "parent_is_file":
+        (tmp_path / "file").write_text("x")
+        out = tmp_path / "file" / "out"
+    elif make == "too_long":
+        out = tmp_path / ("n" * 300)
+    else:
+        if os.geteuid() == 0:  # root ignores permissions; /proc refuses new directories to anyone
+            out = Path("/proc/slewbench-test-out")
+        else:
+            locked = tmp_path / "locked"
+            locked.mkdir(mode=0o500)
+            out = locked / "out"
+    start = time.perf_counter()
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 2
+    captured = capsys.readouterr()
+    assert "[1/1]" not in captured.out  # nothing was planned
+    assert "--out" in captured.err and "Traceback" not in captured.err
+    assert time.perf_counter() - start < 5.0
+
+
+def test_a_killed_run_leaves_nothing_that_looks_complete_and_the_next_run_cleans_up(tmp_path):
+    """SIGKILL in the middle of writing (simulated by a leftover staging folder and an incomplete
+    manifest), then a normal run: the staging folder is gone and the manifest is complete."""
+    path = scenario(tmp_path)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    leftover = out / f"{STAGING_PREFIX}abc"
+    leftover.mkdir()
+    (leftover / "results.json").write_text("{partial")
+    manifest = json.loads((out / MARKER).read_text())
+    manifest["complete"] = False
+    (out / MARKER).write_text(json.dumps(manifest))
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    assert not leftover.exists()
+    assert json.loads((out / MARKER).read_text())["complete"] is True
+
+
+def test_sigterm_during_a_run_writes_nothing_outside_the_marker(tmp_path):
+    slow = scenario(tmp_path, simulation={"sample_time": 0.01, "duration": 400.0})
+    out = tmp_path / "out"
+    process = subprocess.Popen([sys.executable, "-m", "scenarios.cli", "run", str(slow), "--out", str(out)],
+                               cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 120
+    while not (out / MARKER).exists() and time.time() < deadline and process.poll() is None:
+        time.sleep(0.05)
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode != 0 and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "s.yaml"]
+    assert json.loads((out / MARKER).read_text())["complete"] is False
+    assert not list(out.glob(f"{STAGING_PREFIX}*"))
