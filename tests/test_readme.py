@@ -89,7 +89,7 @@ def test_slewbench_command(command, tmp_path):
 
 @lru_cache(maxsize=None)
 def _collected(command: str) -> list[str]:
-    args = shlex.split(command)
+    args = shlex.split(command.replace("my_method", "eigenaxis"))  # the README's placeholder planner name
     args = args[1:] if args[0] == "pytest" else args[3:]
     done = subprocess.run([sys.executable, "-m", "pytest", *args, "--collect-only", "-q", "-p", "no:cacheprovider"],
                           cwd=ROOT, env=_environment(), capture_output=True, text=True, timeout=300)
