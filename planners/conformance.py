@@ -13,7 +13,7 @@ of the torque-free Euler and kinematic equations (continuation after T).
 """
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 from scipy.integrate import solve_ivp

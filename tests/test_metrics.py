@@ -9,7 +9,15 @@ import math
 import numpy as np
 import pytest
 
-from ocp import METRIC_KEYS, AttitudeModel, SimulationResult, Spacecraft, ReactionWheels, metrics_from_simulation, quat
+from ocp import (
+    METRIC_KEYS,
+    AttitudeModel,
+    ReactionWheels,
+    SimulationResult,
+    Spacecraft,
+    metrics_from_simulation,
+    quat,
+)
 from ocp.metrics import compute_metrics, metrics_from_reference
 from planners import Reference, ReferenceSample
 

@@ -10,10 +10,15 @@ from typing import Any
 import numpy as np
 import pytest
 
-from planners.conformance import CHECKS, ConformanceError, check_reference, standard_problems
+from planners.conformance import (
+    CHECKS,
+    ConformanceError,
+    check_reference,
+    standard_problems,
+)
 
 README = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-(EXAMPLE,) = [block for block in re.findall(r"```python\n(.*?)```", README, flags=re.S) if "class CubicSlewPlanner" in block]
+(EXAMPLE,) = [block for block in re.findall(r"```python\n(.*?)```", README, flags=re.DOTALL) if "class CubicSlewPlanner" in block]
 DEFINITIONS = EXAMPLE.split("problem = standard_problems()")[0]
 
 
@@ -84,8 +89,8 @@ def test_a_gyroscopic_term_with_the_wrong_sign_is_caught_and_the_helper_named():
 
 def test_a_three_vector_option_may_be_written_as_a_tuple():
     module = newcomer_module(("        time_fraction: Annotated[float, Range(gt=0.0, le=1.0)] = 1.0",
-                              "        time_fraction: Annotated[float, Range(gt=0.0, le=1.0)] = 1.0\n"
-                              "        axis_hint: tuple[float, float, float] = (0.0, 0.0, 1.0)"))
+                              ("        time_fraction: Annotated[float, Range(gt=0.0, le=1.0)] = 1.0\n"
+                               "        axis_hint: tuple[float, float, float] = (0.0, 0.0, 1.0)")))
     planner = module["CubicSlewPlanner"]({"axis_hint": [1, 0, 0]})
     assert planner.options.axis_hint == (1.0, 0.0, 0.0)
     with pytest.raises(ValueError, match="axis_hint: expected a list of 3 numbers"):

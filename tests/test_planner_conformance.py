@@ -9,15 +9,21 @@ runs in the default suite, the others with ``pytest -m slow``.
 """
 from __future__ import annotations
 
-from functools import lru_cache
-from typing import Any, Callable
+from collections.abc import Callable
+from functools import cache
+from typing import Any
 
 import numpy as np
 import pytest
 
 from ocp import metrics_from_reference, quat
 from planners import PLANNERS, ManeuverProblem, Reference
-from planners.conformance import CHECKS, ConformanceError, check_reference, standard_problems
+from planners.conformance import (
+    CHECKS,
+    ConformanceError,
+    check_reference,
+    standard_problems,
+)
 
 PROBLEMS = standard_problems()
 VARIANTS = [(name, index) for name, cls in PLANNERS.items() for index in range(len(cls.example_options))]
@@ -40,7 +46,7 @@ for _name, _index in VARIANTS:
         CASES.append(pytest.param(_name, _index, _key, marks=marks, id=f"{_variant_id(_name, _index)}-{_key}"))
 
 
-@lru_cache(maxsize=None)
+@cache
 def planned(name: str, index: int, key: str) -> Reference:
     """Each (planner, options, problem) is planned once for all checks."""
     return PLANNERS[name](PLANNERS[name].example_options[index]).plan(PROBLEMS[key])
