@@ -1,4 +1,4 @@
-"""Controller contract and the mapping of a body torque onto the actuators.
+"""Controller contract, its symbolic (CasADi) form, and the mapping of a body torque onto the actuators.
 
 A controller computes, at each sample, a :class:`~ocp.actuators.Command`. Laws written for the
 rigid body ``I ω̇ = −ω × I ω + u`` compute ``u`` and call :meth:`Controller.allocate`, which maps it
@@ -6,22 +6,54 @@ to the actuators as ARCHITECTURE.md states: wheels take ``τ_w = u + ω × A h_w
 ``g = −A⁺ τ_w`` (working wheels only); what the wheels cannot give (fewer than three independent
 axes) goes to the torquers if there are any, else to the magnetorquers as
 ``m = B × τ / |B|²`` (the component of τ perpendicular to B). Without wheels the torquers take
-``u``, else the magnetorquers. With ``hold_compensation`` the gyroscopic term is taken at
-mid-sample (see :meth:`Controller._gyroscopic_drift`), which removes the first-order lag of the
-zero-order hold when the body carries a large momentum (spinning spacecraft, loaded wheels).
+``u``, else the magnetorquers. :meth:`Controller.allocate_symbolic` is the same map on CasADi
+expressions; the vector layouts of the symbolic form are in :mod:`ocp.layout`.
 """
 from __future__ import annotations
 
+import hashlib
 from abc import ABC, abstractmethod
+from dataclasses import dataclass
 from typing import Any, Mapping
 
+import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
 from ocp import Command, Measurement, Spacecraft
+from ocp.layout import (
+    REFERENCE_FIELDS,
+    control_layout,
+    measurement_size,
+    reference_rows,
+    split_measurement,
+)
 from ocp.options import Configurable, InvalidOption
 
 Array = NDArray[np.float64]
+
+
+def cross3(a: Array, b: Array) -> Array:
+    """``a × b`` of two 3-vectors, written out: ``np.cross`` costs ~15 µs a call, this ~1 µs (per
+    sample code uses it; ``np.cross`` stays the choice for arrays of many vectors)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+@dataclass(frozen=True)
+class SymbolicLaw:
+    """A controller's law as one ``casadi.Function`` with an explicit state update.
+
+    Attributes
+    ----------
+    function : ``law(t, y, z, r) -> (u, z_next)``, see :class:`Controller` ("Symbolic form").
+    state0 : (n_z,) the controller state ``z`` right after ``reset`` (``state_vector()`` then).
+    key : hex digest identifying every number the function bakes in (class, options, spacecraft,
+        sample time, target); equal keys mean identical functions (build caches use it).
+    """
+
+    function: ca.Function
+    state0: Array
+    key: str
 
 
 class Controller(Configurable, ABC):
@@ -32,18 +64,64 @@ class Controller(Configurable, ABC):
     * ``name`` is the registry key; ``Options`` a dataclass of the law's options with defaults.
     * ``reset(spacecraft, sample_time, target=None)`` clears any state before a run; ``target``
       is ``(q_f, ω_f or None)``, used in regulation mode and by regulators.
-    * ``__call__(t, measurement, reference)`` returns the :class:`Command` for the coming sample;
-      ``reference`` is a ``planners.Reference`` or ``None`` (regulation to the target).
+    * ``__call__(t, measurement, reference)`` returns the :class:`Command` for the coming sample
+      ``[t, t + sample_time]`` (held constant over it); ``reference`` is a ``planners.Reference``
+      or ``None`` (regulation to the target). It is the reference implementation of the law.
     * ``needs_reference``: the law cannot regulate (``reference=None``) and raises ``ValueError``
       there; the scenario loader rejects regulation mode for it.
+    * ``needs_target_attitude``: in regulation mode the law needs ``maneuver.final.q``. Laws that
+      regulate the rate alone (detumbling: ``bdot``, ``tdfc``; ``none``) set it to ``False`` and
+      then accept a free final attitude (``q: null``).
+    * ``needs_field_rate``: the law reads ``measurement.field_rate_inertial`` (ḃ_I, T/s), which
+      the simulator then provides (only the ideal B-dot does; a real spacecraft cannot).
     * ``planner_error(name, options)`` says why the law cannot track references of that planner
       (``None`` if it can); the scenario loader reports it. Most laws track any reference.
+    * ``environment_error(spacecraft, environment)`` and ``sample_time_error(sample_time)`` say why
+      the law cannot run there (missing actuator or sensor; an option that must fit the sample time);
+      the scenario loader reports them at the controller's entry.
     * Saturation is the simulator's actuator model's job, not the controller's.
+    * Capability flags read by :meth:`allocate`: ``gyroscopic_compensation`` and ``wheels_only``.
+
+    Symbolic form
+    -------------
+    A law that can be written as a CasADi expression implements :meth:`_law`; the simulator then
+    runs the whole closed loop as one CasADi function (optionally compiled to C), and
+    ``slewbench codegen`` exports it. After ``reset``, :meth:`symbolic_law` returns
+    ``law(t, y, z, r) -> (u, z_next)`` with (layouts in :mod:`ocp.layout`):
+
+    * ``t`` (1): s, the sample instant.
+    * ``y`` (``7 + n_w + 3``): the measurement ``[q, ω, h_w, b]``: attitude, body rate (rad/s),
+      wheel momenta (N m s), magnetometer reading (T, body axes; **zeros when the model has no
+      field**, and ``__call__`` must treat ``measurement.field_body is None`` as zeros too).
+    * ``z`` (``n_z``, may be 0): the controller's own state (delay buffers, previous samples,
+      switching modes as 0/1 numbers, integrators). ``z_next`` is its value for the next sample.
+      The Python implementation keeps the same numbers: :meth:`state_vector` returns them, and
+      after ``reset`` it must equal ``SymbolicLaw.state0``; after each ``__call__`` it must equal
+      the ``z_next`` of the same inputs. A delay buffer of ``d`` samples of a 3-vector is
+      ``z = [v_{k−1}, …, v_{k−d}]`` with ``z_next = [v_k, z[0:3(d−1)]]``.
+    * ``r`` (``2 × 13``): the reference at ``t`` and at ``t + sample_time``, each
+      ``[q*, ω*, ω̇*, τ*]`` (:data:`~ocp.layout.REFERENCE_FIELDS`); in regulation mode
+      the simulator fills it from the target (:meth:`reference_rows`).
+    * ``u`` (``nu``): the command in the model's control layout ``[g, m, τ_t]`` (blocks of the
+      actuators present; zeros where nothing is asked), before saturation.
+
+    Branches and saturations inside a law are written with ``casadi.if_else`` / ``fmin`` /
+    ``fmax``, never with Python ``if`` on symbols. A law that cannot be symbolic (a run-time
+    least-squares fit, a call into a reference object) does not implement ``_law`` and overrides
+    :meth:`symbolic_error` with the reason; the simulator then uses its Python loop.
+    The test ``tests/test_symbolic_laws.py`` checks, for every registered controller, that
+    ``__call__`` and the symbolic law agree to 1e-12 at random states over several samples.
     """
 
-    hold_compensation: bool = True
-    """Correct the held gyroscopic term to mid-sample in :meth:`allocate`."""
     needs_reference: bool = False
+    needs_target_attitude: bool = True
+    needs_field_rate: bool = False
+    gyroscopic_compensation: bool = True
+    """:meth:`allocate` adds the wheels' ``ω × A h_w`` (the law's ``u`` is for ``I ω̇ = −ω × I ω + u``).
+    ``False``: ``u`` is the wheels' body torque itself (laws written for ``I ω̇ = u``, zero momentum)."""
+    wheels_only: bool = False
+    """Pure wheel mode: :meth:`allocate` drops what the wheels cannot give instead of sending it to
+    torquers or magnetorquers (the two-wheel laws)."""
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
         super().__init__(options, path)
@@ -55,11 +133,21 @@ class Controller(Configurable, ABC):
         """Why this law cannot track the references of ``planner`` with ``options``, or ``None``."""
         return None
 
+    def environment_error(self, spacecraft: Spacecraft, environment: Any) -> str | None:
+        """Why the law cannot run on ``spacecraft`` in ``environment`` (an actuator or a sensor it
+        needs is missing), or ``None``."""
+        return None
+
+    def sample_time_error(self, sample_time: float) -> tuple[str, str] | None:
+        """``(option name, message)`` if an option does not fit the sample time (s), else ``None``."""
+        return None
+
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
         """Prepare for a run of ``spacecraft`` sampled every ``sample_time`` seconds."""
         self.spacecraft = spacecraft
         self.sample_time = sample_time
         self.target = target
+        self._slices, self._nu = control_layout(spacecraft)
         wheels = spacecraft.wheels
         self._working_axes = None
         if wheels is not None and np.any(wheels.working):
@@ -70,33 +158,134 @@ class Controller(Configurable, ABC):
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
         """The command for the sample starting at ``t`` (s)."""
 
-    def _gyroscopic_drift(self, measurement: Measurement) -> Array:
-        """Mid-sample correction of the held gyroscopic term ``ω × H`` (``H = I ω + A h_w``, the
-        total body momentum): without external torque ``H`` turns in body axes as ``Ḣ = −ω × H``,
-        whatever the wheels exchange, so over the hold ``ω × H`` drifts by ``−dt/2 ω × (ω × H)``."""
-        omega = measurement.omega
-        momentum = self.spacecraft.inertia @ omega + self.spacecraft.wheel_axes @ measurement.wheel_momentum
-        return -0.5 * self.sample_time * np.cross(omega, np.cross(omega, momentum))
+    # ----------------------------------------------------------------------------------------
+    # Symbolic form
+    # ----------------------------------------------------------------------------------------
+    def symbolic_error(self) -> str | None:
+        """Why this law has no symbolic form (``None`` when it has one: it implements :meth:`_law`)."""
+        if type(self)._law is Controller._law:
+            return f"controller {self.name} does not implement a symbolic law (_law)"
+        return None
 
-    def allocate(self, torque: Array, measurement: Measurement) -> Command:
-        """Map a rigid-body control torque ``u`` (N m, body axes) to the actuators."""
+    def state_vector(self) -> Array:
+        """The controller state ``z`` of the Python implementation (empty for a static law)."""
+        return np.zeros(0)
+
+    def _law(self, t: ca.SX, y: ca.SX, z: ca.SX, r: ca.SX) -> tuple[ca.SX, ca.SX]:
+        """``(u, z_next)`` as expressions of the symbols (see "Symbolic form"); called after reset."""
+        raise NotImplementedError
+
+    def symbolic_key(self) -> str:
+        """Digest of everything :meth:`_law` bakes in (class, options, spacecraft, sample time, target)."""
+        from ocp.model import _plain  # the model's fingerprint walker
+
+        cache = self.spacecraft._cache  # the spacecraft is frozen: its description is computed once
+        if "description" not in cache:
+            cache["description"] = repr(_plain(self.spacecraft))
+        target = None if self.target is None else tuple(None if v is None else _plain(np.asarray(v, dtype=float))
+                                                        for v in self.target)
+        text = repr((type(self).__module__, type(self).__qualname__, _plain(self.options),
+                     cache["description"], float(self.sample_time), target))
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    def symbolic_law(self) -> SymbolicLaw:
+        """The law as ``law(t, y, z, r) -> (u, z_next)`` for the spacecraft and sample time of the
+        last :meth:`reset`. Raises ``NotImplementedError`` with :meth:`symbolic_error`'s reason."""
+        reason = self.symbolic_error()
+        if reason is not None:
+            raise NotImplementedError(reason)
+        if self.spacecraft is None:
+            raise RuntimeError("call reset(spacecraft, sample_time, target) before symbolic_law()")
+        state0 = np.asarray(self.state_vector(), dtype=float).ravel().copy()
+        t = ca.SX.sym("t")
+        y = ca.SX.sym("y", measurement_size(self.spacecraft))
+        z = ca.SX.sym("z", state0.size)
+        r = ca.SX.sym("r", 2 * REFERENCE_FIELDS)
+        u, z_next = self._law(t, y, z, r)
+        u = ca.SX(u) if not isinstance(u, ca.SX) else u
+        if u.shape != (self._nu, 1):
+            raise ValueError(f"{self.name}._law returned u of shape {u.shape}, expected ({self._nu}, 1)")
+        z_next = ca.SX(z_next) if not isinstance(z_next, ca.SX) else z_next
+        if z_next.numel() != state0.size:
+            raise ValueError(f"{self.name}._law returned z_next of size {z_next.numel()}, expected {state0.size}")
+        function = ca.Function(f"law_{self.name}", [t, y, z, r], [u, ca.reshape(z_next, state0.size, 1)],
+                               ["t", "y", "z", "r"], ["u", "z_next"])
+        return SymbolicLaw(function, state0, self.symbolic_key())
+
+    def reference_rows(self, reference: Any, times: Array) -> Array:
+        """(len(times), 13) reference rows ``[q*, ω*, ω̇*, τ*]`` at ``times`` (s); from the
+        target (rate ``ω_f`` or zero, no acceleration or torque) when ``reference`` is ``None``."""
+        return reference_rows(reference, times, self.target)
+
+    def command_vector(self, command: Command) -> Array:
+        """A :class:`Command` in the control layout ``u`` of the symbolic form (zeros where ``None``)."""
+        u = np.zeros(self._nu)
+        for name, value in (("wheels", command.wheel_torque), ("dipole", command.dipole), ("torquers", command.torque)):
+            if name in self._slices and value is not None:
+                u[self._slices[name]] = value
+        return u
+
+    # ----------------------------------------------------------------------------------------
+    # Allocation
+    # ----------------------------------------------------------------------------------------
+    def allocate(self, torque: Array, measurement: Measurement, rate: Array | None = None,
+                 wheel_momentum: Array | None = None) -> Command:
+        """Map a rigid-body control torque ``u`` (N m, body axes) to the actuators.
+
+        ``rate`` and ``wheel_momentum`` (default: the measured ones) are the ``ω`` and ``h_w`` of
+        the wheels' gyroscopic term ``ω × A h_w``; a law that predicts them to mid-sample passes
+        its prediction (see ``AugmentedQuaternionFeedback``).
+        """
         spacecraft = self.spacecraft
         command = Command()
         residual = np.asarray(torque, dtype=float)
-        if self.hold_compensation:
-            residual = residual + self._gyroscopic_drift(measurement)
         if self._working_axes is not None:
-            wheel_torque = residual + np.cross(measurement.omega, spacecraft.wheel_axes @ measurement.wheel_momentum)
+            w = measurement.omega if rate is None else rate
+            h = spacecraft.wheel_axes @ (measurement.wheel_momentum if wheel_momentum is None else wheel_momentum)
+            wheel_torque = residual + cross3(w, h) if self.gyroscopic_compensation else residual
             command.wheel_torque = -self._wheel_pinv @ wheel_torque
-            residual = wheel_torque + self._working_axes @ command.wheel_torque
-            if np.linalg.norm(residual) <= 1e-12 * max(np.linalg.norm(wheel_torque), 1e-300):
+            if self.wheels_only:
                 return command
+            residual = wheel_torque + self._working_axes @ command.wheel_torque
+            if np.sqrt(residual @ residual) <= 1e-12 * max(np.sqrt(wheel_torque @ wheel_torque), 1e-300):
+                return command
+        if self.wheels_only:
+            return command
         if spacecraft.torquers is not None:
             command.torque = residual
         elif spacecraft.magnetorquers is not None and measurement.field_body is not None:
-            field = measurement.field_body
-            command.dipole = np.cross(field, residual) / max(float(field @ field), 1e-30)
+            b = measurement.field_body
+            command.dipole = cross3(b, residual) / max(float(b @ b), 1e-30)
         return command
+
+    def allocate_symbolic(self, torque: ca.SX, y: ca.SX, rate: ca.SX | None = None,
+                          wheel_momentum: ca.SX | None = None) -> ca.SX:
+        """:meth:`allocate` on expressions: the command vector ``u`` (control layout) for the
+        rigid-body torque ``torque`` given the measurement vector ``y``."""
+        spacecraft = self.spacecraft
+        _, omega, h_w, field = split_measurement(y, spacecraft.n_wheels)
+        parts = {}
+        residual = torque
+        done = None
+        if self._working_axes is not None:
+            w = omega if rate is None else rate
+            h = ca.mtimes(ca.DM(spacecraft.wheel_axes), h_w if wheel_momentum is None else wheel_momentum)
+            wheel_torque = residual + ca.cross(w, h) if self.gyroscopic_compensation else residual
+            g = -ca.mtimes(ca.DM(self._wheel_pinv), wheel_torque)
+            parts["wheels"] = g
+            residual = wheel_torque + ca.mtimes(ca.DM(self._working_axes), g)
+            done = ca.norm_2(residual) <= 1e-12 * ca.fmax(ca.norm_2(wheel_torque), 1e-300)
+        if self.wheels_only:
+            pass
+        elif spacecraft.torquers is not None:
+            parts["torquers"] = residual if done is None else ca.if_else(done, ca.DM.zeros(3), residual)
+        elif spacecraft.magnetorquers is not None:
+            dipole = ca.cross(field, residual) / ca.fmax(ca.dot(field, field), 1e-30)
+            parts["dipole"] = dipole if done is None else ca.if_else(done, ca.DM.zeros(3), dipole)
+        u = ca.SX.zeros(self._nu)
+        for name, value in parts.items():
+            u[self._slices[name]] = value
+        return u
 
 
 def check_gain(option: str, gain: float | list[list[float]]) -> None:

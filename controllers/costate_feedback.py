@@ -13,7 +13,8 @@ states span few directions; the small ridge ``ρ`` (relative to the data) gives 
 answer in the others. The control is the reference's optimal control law evaluated at the
 estimated co-state ``λ̂ = λ_ref + P (x − x_ref)`` (eq. 41-42); for the steering form that is
 ``u = −r⁻¹ Gᵀ λ̂_ω`` with ``r`` taken on the reference. After ``t_f`` the law applies no torque.
-It tracks references of ``costate_tpbvp`` forms whose control is a torque.
+It tracks any reference that offers co-states (``planners.capabilities.CostateCarrier``) from a
+planner that says so (``offers_costates``), e.g. ``costate_tpbvp``'s torque forms.
 """
 from __future__ import annotations
 
@@ -25,8 +26,7 @@ import numpy as np
 from controllers.base import Array, Controller
 from ocp import Command, Measurement
 from ocp.options import Range
-
-TORQUE_FORMS = ("min_energy", "rate_acquisition")
+from planners.capabilities import CostateCarrier, offers_costates
 
 
 def project_psd(matrix: Array) -> Array:
@@ -72,8 +72,12 @@ class CostateFeedback(Controller):
     """Vepa's co-state feedback law (see the module docstring)."""
 
     name = "costate_feedback"
-    hold_compensation = False  # the law is not of the ``u + ω × Iω`` form the correction is for
     needs_reference = True
+
+    def symbolic_error(self) -> str | None:
+        return ("the co-state gain P is fitted at run time by constrained least squares over a window "
+                "of the reference's states and co-states (an iterative projected-gradient solve) and "
+                "the control calls the reference's own system; neither is a fixed CasADi expression")
 
     @dataclass(frozen=True)
     class Options:
@@ -82,10 +86,13 @@ class CostateFeedback(Controller):
         ridge: Annotated[float, Range(ge=0.0)] = 1e-4               # relative Tikhonov weight of the fit
 
     def planner_error(self, planner: str, options: Any) -> str | None:
-        if planner != "costate_tpbvp" or getattr(options, "objective", None) not in TORQUE_FORMS:
-            return (f"controller {self.name} tracks costate_tpbvp references whose control is a torque "
-                    f"(objective one of {list(TORQUE_FORMS)})")
-        return None
+        from planners import PLANNERS  # the registry, complete once scenarios are parsed
+
+        if planner in PLANNERS and offers_costates(PLANNERS[planner], options):
+            return None
+        offering = sorted(name for name, cls in PLANNERS.items() if callable(getattr(cls, "offers_costates", None)))
+        return (f"controller {self.name} tracks references that offer co-states with a torque control; "
+                f"planners offering them (for some options): {offering}")
 
     def reset(self, spacecraft, sample_time, target=None) -> None:
         super().reset(spacecraft, sample_time, target)
@@ -100,8 +107,8 @@ class CostateFeedback(Controller):
         return first + step * np.arange(self.options.window_samples)
 
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
-        if reference is None or not hasattr(reference, "state_and_costate"):
-            raise ValueError(f"controller {self.name} needs a costate_tpbvp reference")
+        if not isinstance(reference, CostateCarrier):
+            raise ValueError(f"controller {self.name} needs a reference that offers co-states")
         if t >= reference.duration:
             return self.allocate(np.zeros(3), measurement)
         states, costates = reference.state_and_costate(self.window(t, reference.duration))
@@ -110,5 +117,5 @@ class CostateFeedback(Controller):
         x_ref, lam_ref = (a[0] for a in reference.state_and_costate(t))
         q = measurement.q if measurement.q @ x_ref[0:4] >= 0 else -measurement.q  # same hemisphere
         lam = lam_ref + self.gain @ (np.concatenate([q, measurement.omega]) - x_ref)
-        torque = reference.system.feedback_torque(lam[4:7], lam_ref[4:7])
+        torque = reference.feedback_torque(lam[4:7], lam_ref[4:7])
         return self.allocate(torque, measurement)

@@ -2,16 +2,17 @@
 
 ``u = −K q_e − C ω_e + ω × J ω`` towards the manoeuvre's target ``(q_f, ω_f)``, whatever the
 reference: the law itself produces the eigenaxis slew. With ``K = k J`` and ``C = c J`` a rest-to-rest
-slew stays on the eigenaxis, because ``q_e`` and ``ω`` remain parallel.
+slew stays on the eigenaxis, because ``q_e`` and ``ω`` remain parallel. Under the zero-order hold
+the gyroscopic term is taken at the predicted mid-sample rate (``hold_compensation``, see
+``augmented_quaternion_feedback``).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Any
+from typing import Annotated
 
 from controllers.augmented_quaternion_feedback import AugmentedQuaternionFeedback
 from controllers.base import check_gain
-from ocp import Command, Measurement
 from ocp.options import Range
 
 
@@ -19,6 +20,7 @@ class EigenaxisPD(AugmentedQuaternionFeedback):
     """Regulates to the target; a reference, if any, is ignored."""
 
     name = "eigenaxis_pd"
+    tracks_reference = False
 
     @dataclass(frozen=True)
     class Options:
@@ -30,6 +32,3 @@ class EigenaxisPD(AugmentedQuaternionFeedback):
         def __post_init__(self) -> None:
             check_gain("kp", self.kp)
             check_gain("kd", self.kd)
-
-    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
-        return self.allocate(self.body_torque(t, measurement, None), measurement)

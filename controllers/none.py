@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import casadi as ca
+
 from controllers.base import Controller
 from ocp import Command, Measurement
 
@@ -11,6 +13,10 @@ class NoControl(Controller):
     """Commands nothing."""
 
     name = "none"
+    needs_target_attitude = False
 
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
         return Command()
+
+    def _law(self, t, y, z, r):
+        return ca.SX.zeros(self._nu), z

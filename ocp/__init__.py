@@ -5,6 +5,7 @@ Pure numeric/symbolic layer (CasADi and NumPy); it knows nothing of planners, co
 from ocp.actuators import ActuatorModel, Command, Measurement
 from ocp.cache import SolverCache
 from ocp.environment import CircularOrbit, Environment, TiltedDipole, gravity_gradient_torque
+from ocp.igrf import IGRFField
 from ocp.metrics import (METRIC_KEYS, compute_metrics, metric_violations, metrics_from_reference,
                          metrics_from_simulation)
 from ocp.model import AttitudeModel
@@ -12,7 +13,7 @@ from ocp.simulator import SensorNoise, SimulationError, SimulationResult, Simula
 from ocp.spacecraft import Magnetorquers, ModelError, ReactionWheels, Spacecraft, Torquers
 
 __all__ = [
-    "ActuatorModel", "AttitudeModel", "CircularOrbit", "Command", "Environment", "METRIC_KEYS",
+    "ActuatorModel", "AttitudeModel", "CircularOrbit", "Command", "Environment", "IGRFField", "METRIC_KEYS",
     "Magnetorquers", "Measurement", "ModelError", "ReactionWheels", "SensorNoise",
     "SimulationError", "SimulationResult", "Simulator", "SolverCache", "Spacecraft", "TiltedDipole", "Torquers",
     "compute_metrics", "gravity_gradient_torque", "metric_violations", "metrics_from_reference", "metrics_from_simulation",

@@ -7,6 +7,7 @@ and return CasADi expressions; :class:`ocp.model.AttitudeModel` assembles them.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -151,13 +152,14 @@ class Environment:
     ----------
     orbit : circular orbit, required by gravity gradient and the magnetic field.
     gravity_gradient : include the gravity-gradient torque.
-    magnetic_field : geomagnetic model, or ``None``.
+    magnetic_field : geomagnetic model (:class:`TiltedDipole`, or :class:`~ocp.igrf.IGRFField`
+        tabulated along ``orbit``), or ``None``.
     disturbance_torque : (3,) N m, constant, body axes.
     """
 
     orbit: CircularOrbit | None = None
     gravity_gradient: bool = False
-    magnetic_field: TiltedDipole | None = None
+    magnetic_field: TiltedDipole | Any | None = None
     disturbance_torque: NDArray = field(default_factory=lambda: np.zeros(3))
 
     def __post_init__(self) -> None:
@@ -169,4 +171,7 @@ class Environment:
             raise ModelError("gravity_gradient", "gravity gradient needs an orbit")
         if self.orbit is None and self.magnetic_field is not None:
             raise ModelError("magnetic_field", "a magnetic field model needs an orbit")
+        tabulated_along = getattr(self.magnetic_field, "orbit", None)
+        if tabulated_along is not None and tabulated_along != self.orbit:
+            raise ModelError("magnetic_field", "the field is tabulated along another orbit than the environment's")
 

@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from ocp import quat, quat_casadi as qc
 from ocp.cache import SolverCache
 from ocp.environment import Environment, gravity_gradient_torque
+from ocp.layout import control_layout
 from ocp.spacecraft import Spacecraft
 
 
@@ -35,6 +36,8 @@ class AttitudeModel:
         (``−A g + m × B_B + τ_t``), N m, body axes.
     environment_torque : casadi.Function ``(x, t, p) -> tau``: gravity gradient plus disturbance.
     field_body : casadi.Function ``(x, t) -> b`` (T, body axes), or ``None`` without a field model.
+    field_rate_inertial : casadi.Function ``(t) -> db`` (T/s, inertial axes): the rate of the
+        inertial field seen along the orbit, or ``None`` without a field model.
     control_slices : dict mapping ``"wheels"``, ``"dipole"``, ``"torquers"`` to slices of ``u``.
     """
 
@@ -43,17 +46,7 @@ class AttitudeModel:
         self.environment = environment if environment is not None else Environment()
         self.n_wheels = spacecraft.n_wheels
         self.nx = 7 + self.n_wheels
-        self.control_slices: dict[str, slice] = {}
-        offset = 0
-        for name, present, size in (
-            ("wheels", spacecraft.wheels is not None, self.n_wheels),
-            ("dipole", spacecraft.magnetorquers is not None, 3),
-            ("torquers", spacecraft.torquers is not None, 3),
-        ):
-            if present:
-                self.control_slices[name] = slice(offset, offset + size)
-                offset += size
-        self.nu = offset
+        self.control_slices, self.nu = control_layout(spacecraft)
         self._fingerprint: str | None = None
         self.solver_cache = SolverCache()
         """Solvers built on this model by planners given no cache of their own."""
@@ -140,6 +133,12 @@ class AttitudeModel:
         self.field_body = None if field_body is None else ca.Function(
             "field_body", [x, t], [field_body], ["x", "t"], ["b"]
         )
+        self.field_rate_inertial = None
+        if field_body is not None:
+            env = self.environment
+            field_inertial = env.magnetic_field.field_inertial(env.orbit.position(t), t)
+            self.field_rate_inertial = ca.Function(
+                "field_rate_inertial", [t], [ca.jacobian(field_inertial, t)], ["t"], ["db"])
 
     def inertial_momentum(self, x: NDArray) -> NDArray:
         """Total inertial angular momentum ``R(q)(I ω + A h_w)`` (N m s) for states ``(..., nx)``."""

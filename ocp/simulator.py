@@ -7,7 +7,19 @@ RK4 map with sub-steps, or CVODES); the quaternion is then re-normalised.
 
 Controllers are duck-typed (see ``controllers.base.Controller``): ``reset(spacecraft,
 sample_time, target=None)`` and ``__call__(t, measurement, reference) -> Command``.
-A reference, if given, is passed through to the controller untouched.
+A reference, if given, is passed to the controller as a :class:`GridSampledReference`: the same
+object as far as the controller can tell (every attribute is the reference's), whose ``sample``
+answers the sample instants ``t_k`` and ``t_k + T_s`` from one vectorised evaluation made before
+the loop, and any other time from the reference itself.
+
+Two paths compute the same numbers (to rounding; ``tests/test_closed_loop.py``):
+
+* the Python loop above, for any controller;
+* when the controller has a symbolic law (``symbolic_error()`` is ``None``) and the integrator is
+  RK4, the whole run is one CasADi function (:mod:`ocp.closed_loop`): the reference is sampled on
+  the sample grid in advance, the sensor noise drawn in advance from the same generator in the
+  same order. It is interpreted by CasADi's virtual machine, or with ``compile=True`` compiled to
+  C (:mod:`ocp.compiled`; without a compiler: interpreted, with a one-line notice).
 """
 from __future__ import annotations
 
@@ -21,6 +33,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp import quat
 from ocp.actuators import ActuatorModel, Command, Measurement
+from ocp.closed_loop import NOISE_SIZE, ClosedLoop, draw_noise
+from ocp.compiled import CompilerUnavailable, compile_function, notice
 from ocp.fast_call import BufferedFunction
 from ocp.integration import rk4_step
 from ocp.model import AttitudeModel
@@ -35,6 +49,37 @@ MAX_SUBSTEPS = 1000
 """Bound on RK4 sub-steps per sample (the step is one unrolled CasADi graph)."""
 
 
+class GridSampledReference:
+    """``reference`` with its samples at ``times`` computed once (vectorised) and served by
+    :meth:`sample`; other times and every other attribute go to ``reference`` itself.
+
+    Parameters
+    ----------
+    reference : anything with a vectorised ``sample(t)`` returning a named tuple of arrays.
+    times : s, the times to precompute.
+    """
+
+    def __init__(self, reference: Any, times: Array):
+        self.reference = reference
+        times = np.unique(np.asarray(times, dtype=float))
+        self._table = reference.sample(times)
+        self._index = {float(value): i for i, value in enumerate(times)}
+
+    def sample(self, t: ArrayLike) -> Any:
+        """The reference at ``t`` (scalar or array), as ``reference.sample`` returns it."""
+        index = self._index
+        if np.ndim(t) == 0:
+            i = index.get(float(t))
+            return self.reference.sample(t) if i is None else type(self._table)(*(a[i] for a in self._table))
+        rows = [index.get(float(value)) for value in np.ravel(t)]
+        if None in rows:
+            return self.reference.sample(t)
+        return type(self._table)(*(a[rows] for a in self._table))
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.reference, name)
+
+
 class SimulationError(RuntimeError):
     """The integration diverged (non-finite state), e.g. a step far too long for the rates."""
 
@@ -46,15 +91,19 @@ class ControllerLike(Protocol):
 
 @dataclass(frozen=True)
 class SensorNoise:
-    """Gaussian sensor noise: attitude as a random rotation vector (rad, per axis std), body rate
-    (rad/s, per axis std); ``seed`` makes it repeatable."""
+    """Gaussian sensor noise, white per sample: attitude as a random rotation vector (rad, per axis
+    std), body rate (rad/s, per axis std), magnetometer (T, per body axis std); ``seed`` makes it
+    repeatable. Each sample draws attitude, then rate (only the non-zero ones) from the stream
+    seeded by ``seed``, and the magnetometer from its own stream (seeded by ``[seed, 1]``), so that
+    adding magnetometer noise leaves the attitude and rate noise of a scenario unchanged."""
 
     attitude_std: float = 0.0
     rate_std: float = 0.0
     seed: int = 0
+    field_std: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("attitude_std", "rate_std"):
+        for name in ("attitude_std", "rate_std", "field_std"):
             value = getattr(self, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite non-negative standard deviation, got {value!r}")
@@ -84,6 +133,8 @@ class SimulationResult:
     applied_u: Array
     applied_torque: Array
     saturated: NDArray[np.bool_]
+    path: str = "python"
+    """How it was computed: ``"python"`` (loop), ``"interpreted"`` or ``"compiled"`` (one CasADi function)."""
 
     @property
     def q(self) -> Array:
@@ -109,7 +160,14 @@ class Simulator:
         (adaptive, ``rtol``/``atol``). RK4's local error grows as ``(h ‖ω‖)⁵``: the default
         0.05 s keeps closed-loop attitudes within ~1e-8 deg of CVODES at rates below ~0.5 rad/s;
         lower it for fast spins or conservation studies.
+    compile : build the closed loop of symbolic laws as C (cached; see :mod:`ocp.compiled`).
+    python_loop : always use the Python loop (the reference implementation), even for symbolic laws.
     """
+
+    MAX_BUILDS = 16
+    """Closed-loop builds kept per simulator (one per law and noise shape)."""
+    CHUNK = 1000
+    """Samples per accumulated call of the closed-loop function (its build unrolls them)."""
 
     def __init__(
         self,
@@ -119,6 +177,8 @@ class Simulator:
         max_step: float = 0.05,
         rtol: float = 1e-10,
         atol: float = 1e-12,
+        compile: bool = False,
+        python_loop: bool = False,
         max_samples: int = MAX_SAMPLES,
     ):
         if not isinstance(model, AttitudeModel):
@@ -142,6 +202,13 @@ class Simulator:
         self._step = self._build_step(integrator, substeps, rtol, atol)
         self._step_numeric = BufferedFunction(self._step)
         self._field_numeric = None if model.field_body is None else BufferedFunction(model.field_body)
+        self._field_rate_numeric = (None if model.field_rate_inertial is None
+                                    else BufferedFunction(model.field_rate_inertial))
+        self.integrator = integrator
+        self.compile = compile
+        self.python_loop = python_loop
+        self._loops: dict[Any, tuple[ClosedLoop, ca.Function, str]] = {}
+        self._runs: dict[Any, BufferedFunction] = {}
 
     def _build_step(self, integrator: str, substeps: int, rtol: float, atol: float) -> ca.Function:
         """``step(x, u, t, dt, p) -> x_next``: one hold interval of length ``dt`` starting at ``t``."""
@@ -200,7 +267,17 @@ class Simulator:
         times = np.minimum(np.arange(n_samples + 1) * self.sample_time, duration)
         noise = noise or SensorNoise()
         rng = np.random.default_rng(noise.seed)
+        field_rng = np.random.default_rng([noise.seed, 1])
+        valid_until = getattr(model.environment.magnetic_field, "valid_until", None)
+        if valid_until is not None and duration > valid_until + 1e-9:
+            raise SimulationError(f"the magnetic field is tabulated up to t = {valid_until:g} s, the run lasts "
+                                  f"{duration:g} s; lengthen environment.magnetic_field.span_s")
+        field_rate = self._field_rate_numeric if getattr(controller, "needs_field_rate", False) else None
         controller.reset(model.spacecraft, self.sample_time, target=target)
+        if self._symbolic(controller):
+            return self._run_symbolic(controller, x, times, p, noise, rng, reference, field_rng)
+        if reference is not None and hasattr(reference, "sample"):
+            reference = GridSampledReference(reference, np.concatenate([times, times[:-1] + self.sample_time]))
 
         states = np.empty((n_samples + 1, model.nx))
         commanded = np.zeros((n_samples, model.nu))
@@ -209,31 +286,126 @@ class Simulator:
         states[0] = x
         for k in range(n_samples):
             t_k = times[k]
-            measurement = self._measure(x, t_k, noise, rng)
+            measurement = self._measure(x, t_k, noise, rng, field_rng)
+            if field_rate is not None:
+                measurement.field_rate_inertial = field_rate(t_k).copy()
             command = controller(t_k, measurement, reference)
             commanded[k] = self._command_vector(command)
             dt = times[k + 1] - t_k
             applied[k], saturated[k] = self.actuators.apply(command, x[7:], dt)
             x = self._step_numeric(x, applied[k], t_k, dt, p).copy()
             if not np.all(np.isfinite(x)):
-                raise SimulationError(
-                    f"the state became non-finite between t = {t_k:g} s and {times[k + 1]:g} s; "
-                    "reduce max_step or check the controller's gains"
-                )
-            x[0:4] /= np.linalg.norm(x[0:4])
+                raise SimulationError(self._divergence(times, k))
+            x[0:4] /= math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3])
             states[k + 1] = x
-        torque_map = model.body_torque.map(n_samples)
-        applied_torque = torque_map(states[:-1].T, applied.T, times[:-1]).full().T
-        return SimulationResult(model, self.sample_time, times, states, commanded, applied, applied_torque, saturated)
+        return self._result(times, states, commanded, applied, saturated, "python")
 
-    def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator) -> Measurement:
+    def _result(self, times: Array, states: Array, commanded: Array, applied: Array, saturated: Array,
+                path: str) -> SimulationResult:
+        torque_map = self.model.body_torque.map(times.size - 1)
+        applied_torque = torque_map(states[:-1].T, applied.T, times[:-1]).full().T
+        return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, applied_torque,
+                                saturated, path)
+
+    @staticmethod
+    def _divergence(times: Array, k: int) -> str:
+        return (f"the state became non-finite between t = {times[k]:g} s and {times[k + 1]:g} s; "
+                "reduce max_step or check the controller's gains")
+
+    def _symbolic(self, controller: Any) -> bool:
+        """Whether ``controller`` (after reset) runs as one CasADi function."""
+        if self.python_loop or self.integrator != "rk4":
+            return False
+        reason = getattr(controller, "symbolic_error", None)
+        return reason is not None and reason() is None
+
+    def closed_loop_function(self, controller: Any, noise: SensorNoise) -> tuple[ClosedLoop, ca.Function, str]:
+        """The one-sample closed-loop function of a reset symbolic ``controller``: its builder, the
+        function (interpreted, or the compiled twin) and how it is evaluated (``"interpreted"`` or
+        ``"compiled"``). Builds are kept per law (:meth:`symbolic_key`) and noise shape."""
+        loop_key = self._loop_key(controller, noise)
+        if loop_key not in self._loops:
+            if len(self._loops) >= self.MAX_BUILDS:
+                self._loops.clear()
+                self._runs.clear()
+            law = controller.symbolic_law()
+            loop = ClosedLoop(self.model, self._step, self.actuators, law.function,
+                              noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0)
+            sample, path = loop.sample, "interpreted"
+            if self.compile:
+                try:
+                    sample, path = compile_function(loop.sample), "compiled"
+                except CompilerUnavailable as error:
+                    notice(f"{error}; the closed loop runs interpreted")
+            self._loops[loop_key] = (loop, sample, path)
+        return self._loops[loop_key]
+
+    def _chunk_function(self, loop: ClosedLoop, sample: ca.Function, size: int) -> BufferedFunction:
+        """``sample`` accumulated over ``size`` samples (``mapaccum`` unrolls its calls, so long runs
+        go in chunks of at most :attr:`CHUNK` samples)."""
+        key = (id(loop), size)
+        if key not in self._runs:
+            self._runs[key] = loop.run_function(sample, size)
+        return self._runs[key]
+
+    @staticmethod
+    def _loop_key(controller: Any, noise: SensorNoise) -> tuple:
+        return (controller.symbolic_key(), noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0)
+
+    def _run_symbolic(self, controller: Any, x0: Array, times: Array, p: Array, noise: SensorNoise,
+                      rng: np.random.Generator, reference: Any,
+                      field_rng: np.random.Generator | None = None) -> SimulationResult:
+        n_samples = times.size - 1
+        loop, sample, path = self.closed_loop_function(controller, noise)
+        rows = None
+        if loop.shape.uses_reference:
+            grid = times[:-1]
+            rows = np.hstack([controller.reference_rows(reference, grid),
+                              controller.reference_rows(reference, grid + self.sample_time)])
+        drawn = None
+        if noise.attitude_std > 0 or noise.rate_std > 0 or noise.field_std > 0:
+            drawn = draw_noise(rng, n_samples, noise.attitude_std, noise.rate_std, field_rng, noise.field_std)
+        nx, nu = self.model.nx, self.model.nu
+        xz = np.concatenate([x0, np.asarray(controller.state_vector(), dtype=float)])
+        states = np.empty((n_samples + 1, nx))
+        commanded, applied = np.empty((n_samples, nu)), np.empty((n_samples, nu))
+        saturated, torque = np.empty(n_samples), np.empty((n_samples, 3))
+        states[0] = x0
+        for start in range(0, n_samples, self.CHUNK):
+            stop = min(start + self.CHUNK, n_samples)
+            run = self._chunk_function(loop, sample, stop - start)
+            chunk = loop.evaluate(run, xz, times[start:stop + 1], None if drawn is None else drawn[start:stop],
+                                  None if rows is None else rows[start:stop], p)
+            states[start + 1:stop + 1] = chunk[0][:, :nx]
+            commanded[start:stop], applied[start:stop], saturated[start:stop], torque[start:stop] = chunk[1:]
+            xz = chunk[0][-1]
+            if not np.all(np.isfinite(xz)):
+                break
+        finite = np.isfinite(states).all(axis=1)
+        if not finite.all():
+            raise SimulationError(self._divergence(times, int(np.argmin(finite)) - 1))
+        return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, torque,
+                                saturated.astype(bool), path)
+
+    def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator,
+                 field_rng: np.random.Generator | None = None) -> Measurement:
         q, omega = x[0:4], x[4:7]
-        if noise.attitude_std > 0:
-            q = quat.product(q, quat.from_rotation_vector(rng.normal(0.0, noise.attitude_std, 3)))
+        if noise.attitude_std > 0:  # q ⊗ exp(v/2), written out (no general quaternion helper per sample)
+            v = rng.normal(0.0, noise.attitude_std, 3)
+            angle = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+            s = math.sin(0.5 * angle) / angle if angle > 0 else 0.5
+            p0, p1, p2, p3 = math.cos(0.5 * angle), s * v[0], s * v[1], s * v[2]
+            q0, q1, q2, q3 = q
+            q = np.array([q0 * p0 - q1 * p1 - q2 * p2 - q3 * p3,
+                          q0 * p1 + p0 * q1 + q2 * p3 - q3 * p2,
+                          q0 * p2 + p0 * q2 + q3 * p1 - q1 * p3,
+                          q0 * p3 + p0 * q3 + q1 * p2 - q2 * p1])
         if noise.rate_std > 0:
             omega = omega + rng.normal(0.0, noise.rate_std, 3)
         field = None if self._field_numeric is None else self._field_numeric(x, t).copy()
-        return Measurement(t=t, q=q, omega=omega.copy(), wheel_momentum=x[7:].copy(), field_body=field)
+        if noise.field_std > 0 and field is not None:  # its own stream: attitude and rate noise unchanged
+            field += (rng if field_rng is None else field_rng).normal(0.0, noise.field_std, 3)
+        return Measurement(t=t, q=q.copy(), omega=omega.copy(), wheel_momentum=x[7:].copy(), field_body=field)
 
     def _command_vector(self, command: Command) -> Array:
         """The command in the layout of ``u`` (zeros where nothing is asked)."""

@@ -10,7 +10,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import linprog
 
 Array = NDArray[np.float64]
 
@@ -97,14 +96,25 @@ class ReactionWheels:
         return mask
 
 
+SATURATION_MODES = ("per_axis", "scale")
+
+
 @dataclass(frozen=True)
 class Magnetorquers:
-    """Three orthogonal magnetorquers along the body axes; dipole limit per axis in A m²."""
+    """Three orthogonal magnetorquers along the body axes; dipole limit per axis in A m².
+
+    ``saturation``: ``"per_axis"`` clips each axis to its limit (the direction may change);
+    ``"scale"`` scales the whole dipole vector down until every axis is within its limit (the
+    direction is kept).
+    """
 
     max_dipole: Array | float | None = None
+    saturation: str = "per_axis"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "max_dipole", _limit_vector(self.max_dipole, 3, "max_dipole"))
+        if self.saturation not in SATURATION_MODES:
+            raise ModelError("saturation", f"expected one of {SATURATION_MODES}, got {str(self.saturation)[:40]!r}")
 
 
 @dataclass(frozen=True)
@@ -202,6 +212,14 @@ class Spacecraft:
         reachable = np.linalg.norm(axes @ pinv - np.eye(3), axis=0) < 1e-9
         finite = np.isfinite(g_max)
         demand = np.abs(pinv[finite]) * reachable
+        significant = demand > 1e-12 * max(float(demand.max(initial=0.0)), 1e-300)
+        if np.all(significant.sum(axis=1) <= 1):
+            # Each wheel drives one body axis (e.g. wheels along the body axes): the programme
+            # decouples and each axis gets the bound of its tightest wheel.
+            ratios = np.where(significant, g_max[finite][:, None] / np.where(significant, demand, 1.0), np.inf)
+            return np.where(reachable, ratios.min(axis=0, initial=np.inf), 0.0)
+        from scipy.optimize import linprog  # lazily: scipy.optimize dominates the import of slewbench
+
         # Lexicographic: first the largest bound common to every reachable axis, then the
         # largest sum with no axis below it, so that no axis is sacrificed for the others.
         n_reach = int(reachable.sum())

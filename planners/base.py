@@ -275,6 +275,14 @@ class Reference(ABC):
         """Feed-forward rigid-body torque(s) at ``t`` (s): (3,) or (N, 3) N m, body axes."""
         return self.sample(t).torque
 
+    def symbolic_evaluator(self) -> Any:
+        """The reference as a ``casadi.Function`` ``reference(t) -> row`` with ``row`` =
+        ``[q, ω, ω̇, τ]`` (13 numbers, the layout of ``ocp.layout.REFERENCE_FIELDS``) for
+        ``t`` in ``[0, duration]`` (clamped outside), or ``None`` when the reference has no closed
+        form. Closed-form references (their planner sets ``Planner.closed_form``) implement it;
+        ``slewbench codegen`` exports it as C."""
+        return None
+
 
 class TorqueFreeMotion:
     """Torque-free motion of a rigid body from ``(q_T, ω_T)`` at time ``start``, integrated with
@@ -385,11 +393,15 @@ class Planner(Configurable, ABC):
       ``Reference.free_boundary``; it satisfies ``q̇ = ½ q ⊗ [0, ω]``, its ``omega_dot`` is the
       derivative of its ``omega`` and its torque the inverse dynamics ``I ω̇ + ω × I ω``.
     * ``example_options`` lists option sets for the conformance test.
+    * ``closed_form``: its references are closed-form expressions of time and implement
+      :meth:`Reference.symbolic_evaluator` (``slewbench codegen`` exports them as C).
     """
 
     example_options: ClassVar[tuple[Mapping[str, Any], ...]] = ({},)
     """Option sets that exercise the planner's distinct kinds of reference (profiles, objectives);
     the conformance test (tests/test_planner_conformance.py) plans the standard problems with each."""
+
+    closed_form: bool = False
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options",
                  cache: SolverCache | None = None) -> None:

@@ -1,9 +1,7 @@
 """The reference of an optimal-control solution, and seeds for the NLP from other references.
 
-Collocation: within each interval the state is the degree-``d`` Lagrange polynomial through the
-interval start and the Radau points, the control the degree-``d−1`` polynomial through the Radau
-points (the transcription's own representation). Multiple shooting: controls are piecewise linear
-as optimised; states are cubic Hermite between nodes with the model's derivatives.
+Between its points the solution is interpolated by the transcription itself
+(``Transcription.interpolate``: Lagrange polynomials for collocation, cubic Hermite for shooting).
 The feed-forward torque is the optimal control expressed for ``I ω̇ = −ω × I ω + u``:
 ``u = τ_actuators − ω × A h_w + τ_environment``, and ``ω̇`` comes from the model, so both agree.
 """
@@ -13,16 +11,6 @@ import numpy as np
 
 from ocp import quat
 from planners.base import Array, ManeuverProblem, Reference, ReferenceSample
-
-
-def _lagrange(points: Array, tau: Array) -> Array:
-    """Basis values (len(tau), len(points)) of the Lagrange polynomials through ``points``."""
-    basis = np.ones((tau.size, points.size))
-    for r, p_r in enumerate(points):
-        for s, p_s in enumerate(points):
-            if s != r:
-                basis[:, r] *= (tau - p_s) / (p_r - p_s)
-    return basis
 
 
 class CollocationReference(Reference):
@@ -48,25 +36,7 @@ class CollocationReference(Reference):
         self.disturbance = problem.model.default_parameters
 
     def _state_control(self, t: Array) -> tuple[Array, Array]:
-        N, h = self.intervals, self.duration / self.intervals
-        k = np.minimum((t / h).astype(int), N - 1)
-        tau = t / h - k
-        if self.transcription.name == "collocation":
-            d = self.transcription.degree
-            x_basis = _lagrange(self.transcription.tau, tau)
-            u_basis = _lagrange(self.transcription.tau[1:], tau)
-            X = self.states.reshape(self.model.nx, N, d + 1)
-            U = self.controls.reshape(self.model.nu, N, d)
-            x = np.einsum("tik,tk->ti", X[:, k, :].transpose(1, 0, 2), x_basis)
-            u = np.einsum("tik,tk->ti", U[:, k, :].transpose(1, 0, 2), u_basis)
-            return x, u
-        u = (1 - tau)[:, None] * self.controls[:, k].T + tau[:, None] * self.controls[:, k + 1].T
-        x0, x1 = self.states[:, k].T, self.states[:, k + 1].T
-        f0 = self._rhs(x0, self.controls[:, k].T, k * h)
-        f1 = self._rhs(x1, self.controls[:, k + 1].T, (k + 1) * h)
-        h00, h10, h01, h11 = 2 * tau**3 - 3 * tau**2 + 1, tau**3 - 2 * tau**2 + tau, -2 * tau**3 + 3 * tau**2, tau**3 - tau**2
-        x = h00[:, None] * x0 + h10[:, None] * h * f0 + h01[:, None] * x1 + h11[:, None] * h * f1
-        return x, u
+        return self.transcription.interpolate(self.model, self.states, self.controls, self.duration, t)
 
     def control(self, t) -> Array:
         """The optimal actuator control ``u(t)`` (layout of ``model.control_slices``) within ``[0, T]``."""
@@ -109,30 +79,15 @@ def _seed_states_controls(problem: ManeuverProblem, reference: Reference, times:
         u[:, model.control_slices["wheels"]] = -wheel_torque @ np.linalg.pinv(axes).T
     elif "torquers" in model.control_slices:
         u[:, model.control_slices["torquers"]] = sample.torque
-    return x, u
+    return x, u, sample.torque
 
 
-def seed_vector(problem: ManeuverProblem, transcription, nlp, reference: Reference) -> Array:
-    """An initial guess for ``nlp`` in its decision-vector layout, from ``reference``."""
-    duration = reference.duration if nlp.layout["free_time"] else problem.duration
-    N = transcription.intervals
-    h = duration / N
-    if transcription.name == "collocation":
-        d = transcription.degree
-        x_times = (np.arange(N)[:, None] + transcription.tau[None, :]).ravel() * h
-        u_times = (np.arange(N)[:, None] + transcription.tau[None, 1:]).ravel() * h
-        x, _ = _seed_states_controls(problem, reference, x_times)
-        _, u = _seed_states_controls(problem, reference, u_times)
-        x_end, _ = _seed_states_controls(problem, reference, np.array([duration]))
-        torque = np.abs(reference.torque(u_times))
-        blocks = [x.reshape(N, d + 1, -1).reshape(-1), u.reshape(-1)]
-        if nlp.layout["S"]:
-            blocks.append(torque.reshape(-1))
-        blocks.append(x_end.ravel())
-    else:
-        times = np.linspace(0, duration, N + 1)
-        x, u = _seed_states_controls(problem, reference, times)
-        blocks = [x.reshape(-1), u.reshape(-1)]
-    if nlp.layout["free_time"]:
-        blocks.append([duration])
-    return np.concatenate(blocks)
+def seed_sampler(problem: ManeuverProblem, reference: Reference):
+    """``sample(times) -> (x (n, nx), u (n, nu), |torque| (n, 3))`` along ``reference``, the form a
+    transcription's ``stage_guess`` seeds from."""
+
+    def sample(times: Array):
+        x, u, torque = _seed_states_controls(problem, reference, times)
+        return x, u, np.abs(torque)
+
+    return sample

@@ -18,10 +18,9 @@ the target by continuation, each solve seeding the next. Torque bounds are not i
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Callable, Literal
+from typing import Annotated, Any, Callable, Literal
 
 import numpy as np
-from scipy.integrate import solve_bvp
 
 from ocp.options import InvalidOption, Range
 from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample
@@ -66,6 +65,9 @@ def _attitude_acquisition(problem: ManeuverProblem, o, build: bool = True) -> Ha
 
 # objective -> builder(problem, options, build=True): the system, or the reason it cannot be built
 # (with build=False only the reason, or None: a cheap check for scenario loading).
+TORQUE_FORMS = ("min_energy", "rate_acquisition")
+"""Objectives whose control is a body torque (the attitude-acquisition form steers the rate)."""
+
 FORMS: dict[str, Callable[..., HamiltonianSystem | str | None]] = {
     "min_energy": _min_energy,
     "rate_acquisition": _rate_acquisition,
@@ -87,6 +89,10 @@ class CostateReference(Reference):
         n = self.system.n_state
         return y[:n].T, y[n:].T
 
+    def feedback_torque(self, lam_omega: Array, lam_omega_reference: Array) -> Array:
+        """The optimal control (N m) at an estimated rate co-state (see ``CostateCarrier``)."""
+        return self.system.feedback_torque(lam_omega, lam_omega_reference)
+
     def _evaluate(self, t: Array) -> ReferenceSample:
         return self.system.sample(t, self.solution.sol(t / self.duration), self.duration)
 
@@ -100,6 +106,8 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
     only ever adds nodes). Returns ``(solution, t_f, stages, None)`` or ``(None, None, stages,
     message)``. ``guess`` replaces the system's own cold start (tests use it to start far away).
     """
+    from scipy.integrate import solve_bvp  # lazily: scipy.integrate pulls in scipy.optimize
+
     free = system.free_final_time
     t_f = 0.0
 
@@ -159,6 +167,11 @@ class CostateTPBVPPlanner(Planner):
         def __post_init__(self) -> None:
             if self.max_nodes < self.nodes:
                 raise InvalidOption("max_nodes", f"must be at least nodes ({self.nodes}), got {self.max_nodes}")
+
+    @classmethod
+    def offers_costates(cls, options: Any) -> bool:
+        """References carry co-states with a torque control for these objectives."""
+        return getattr(options, "objective", None) in TORQUE_FORMS
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
         return FORMS[self.options.objective](problem, self.options, build=False)

@@ -14,21 +14,60 @@ acceleration ``α`` is chosen with the coast rate ``w`` such that every axis res
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Literal
+from typing import Annotated, Callable, Literal
 
+import casadi as ca
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
-from ocp import quat
+from ocp import quat, quat_casadi
 from ocp.options import Range
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference,
                            ReferenceSample, inverse_dynamics_torque)
+
+
+def golden_section_minimum(function: Callable[[float], float], low: float, high: float, tolerance: float) -> float:
+    """Minimiser of a unimodal ``function`` on ``[low, high]`` to ``tolerance`` (golden section; 1-D
+    searches here are too small to pay for importing scipy.optimize, which costs more than a run)."""
+    ratio = 0.5 * (np.sqrt(5.0) - 1.0)
+    a, b = low, high
+    c, d = b - ratio * (b - a), a + ratio * (b - a)
+    fc, fd = function(c), function(d)
+    for _ in range(300):
+        if b - a <= tolerance:
+            break
+        if fc <= fd:
+            b, d, fd = d, c, fc
+            c = b - ratio * (b - a)
+            fc = function(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + ratio * (b - a)
+            fd = function(d)
+    return 0.5 * (a + b)
+
+
+def bisection_root(function: Callable[[float], float], low: float, high: float, tolerance: float) -> float:
+    """Root of ``function`` with ``function(low) < 0 < function(high)``, to ``tolerance`` (absolute)
+    plus four ulps of the bracket."""
+    for _ in range(400):
+        middle = 0.5 * (low + high)
+        if high - low <= tolerance + 4 * np.finfo(float).eps * abs(high):
+            break
+        if function(middle) > 0:
+            high = middle
+        else:
+            low = middle
+    return 0.5 * (low + high)
 
 
 class AngleProfile:
     """θ(t), θ̇(t), θ̈(t) of a rotation about a fixed axis."""
 
     def __call__(self, t: Array) -> tuple[Array, Array, Array]:
+        raise NotImplementedError
+
+    def symbolic(self, t: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX]:
+        """The same three on a CasADi scalar ``t``."""
         raise NotImplementedError
 
 
@@ -47,6 +86,15 @@ class QuinticProfile(AngleProfile):
 
     def __call__(self, t: Array) -> tuple[Array, Array, Array]:
         return self.position(t), self.rate(t), self.acceleration(t)
+
+    def symbolic(self, t: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX]:
+        def horner(polynomial: np.polynomial.Polynomial) -> ca.SX:
+            value = ca.SX(0.0)
+            for coefficient in polynomial.coef[::-1]:
+                value = value * t + float(coefficient)
+            return value
+
+        return horner(self.position), horner(self.rate), horner(self.acceleration)
 
 
 class BangCoastBangProfile(AngleProfile):
@@ -68,6 +116,16 @@ class BangCoastBangProfile(AngleProfile):
                             np.where(decelerating, self.angle - 0.5 * a * late**2, 0.5 * a * ramp**2 + w * (t - ramp)))
         rate = np.where(accelerating, a * t, np.where(decelerating, a * late, w))
         acceleration = np.where(accelerating, a, np.where(decelerating, -a, 0.0))
+        return position, rate, acceleration
+
+    def symbolic(self, t: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX]:
+        a, w, ramp = self.alpha, self.rate_max, self.ramp
+        late = ca.fmax(self.duration - t, 0.0)
+        accelerating, decelerating = t < ramp, t > ramp + self.coast
+        position = ca.if_else(accelerating, 0.5 * a * t**2, ca.if_else(
+            decelerating, self.angle - 0.5 * a * late**2, 0.5 * a * ramp**2 + w * (t - ramp)))
+        rate = ca.if_else(accelerating, a * t, ca.if_else(decelerating, a * late, w))
+        acceleration = ca.if_else(accelerating, a, ca.if_else(decelerating, -a, 0.0))
         return position, rate, acceleration
 
 
@@ -115,12 +173,22 @@ class EigenaxisReference(Reference):
         omega_dot = acceleration[:, None] * self.axis
         return ReferenceSample(q, omega, omega_dot, inverse_dynamics_torque(self.inertia, omega, omega_dot))
 
+    def symbolic_evaluator(self) -> ca.Function:
+        t = ca.SX.sym("t")
+        angle, rate, acceleration = self.profile.symbolic(ca.fmin(ca.fmax(t, 0.0), self.duration))
+        axis, inertia = ca.DM(self.axis), ca.DM(self.inertia)
+        q = quat_casadi.product(ca.DM(self.q0), quat_casadi.from_axis_angle(axis, angle))
+        omega, omega_dot = rate * axis, acceleration * axis
+        torque = ca.mtimes(inertia, omega_dot) + ca.cross(omega, ca.mtimes(inertia, omega))
+        return ca.Function("reference", [t], [ca.vertcat(q, omega, omega_dot, torque)], ["t"], ["row"])
+
 
 class EigenaxisPlanner(Planner):
     """Eigenaxis slew planner; see the module docstring for the profiles."""
 
     name = "eigenaxis"
     example_options = ({"profile": "smooth"}, {"profile": "trapezoidal"}, {"profile": "min_time"})
+    closed_form = True
 
     @dataclass(frozen=True)
     class Options:
@@ -173,9 +241,7 @@ class EigenaxisPlanner(Planner):
         if np.all(gyro == 0) or not np.isfinite(rate_cap):
             best_rate = min(peak, rate_cap)
         else:
-            found = minimize_scalar(slew_time, bounds=(1e-9 * peak, min(peak, rate_cap)), method="bounded",
-                                    options={"xatol": 1e-12 * peak})
-            best_rate = float(found.x)
+            best_rate = golden_section_minimum(slew_time, 1e-9 * peak, min(peak, rate_cap), 1e-12 * peak)
         best_rate = min(best_rate, np.sqrt(angle * acceleration(best_rate)))  # a triangle never coasts faster
         minimum_time = slew_time(best_rate)
         if self.options.profile == "min_time":
@@ -190,7 +256,7 @@ class EigenaxisPlanner(Planner):
             alpha = acceleration(w)
             return w * (problem.duration - w / alpha) - angle if alpha > 0 else -angle
 
-        coast_rate = brentq(covered, 1e-15, best_rate, xtol=1e-15) if covered(best_rate) > 0 else best_rate
+        coast_rate = bisection_root(covered, 1e-15, best_rate, 1e-15) if covered(best_rate) > 0 else best_rate
         profile = BangCoastBangProfile(angle, acceleration(coast_rate), coast_rate)
         profile.coast = problem.duration - 2 * profile.ramp  # exact T despite root tolerance
         profile.duration = problem.duration

@@ -19,21 +19,19 @@ shot from the initial attitude to the target, then brought to rest.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Annotated, Literal
 
 import casadi as ca
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.special import ellipj, ellipkinc
 
 from ocp import Spacecraft, quat
 from ocp import quat_casadi as qc
 from ocp.integration import rk4_step
+from ocp.nlp import solve_multistart, solver_options
 from ocp.options import Range
+from ocp.spin_closed_form import extremal_quaternion
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
-from planners.spin_extremal import extremal_quaternion
 
 
 def symmetry_axis(moments: Array, rtol: float = 1e-9) -> int | None:
@@ -86,6 +84,7 @@ def asymmetric_rates(t: Array, omega0: Array, moments: Array) -> Array:
     m = min((Ib - Ia) * (e2 * Ic - h2) / ((Ic - Ib) * (h2 - e2 * Ia)), 1.0)
     sign_c = 1.0 if w0[c] >= 0 else -1.0
     parity = np.linalg.det(np.eye(3)[order])  # an odd sort reverses the Euler equations
+    from scipy.special import ellipj, ellipkinc  # lazily: scipy.special is slow to import
     phase = ellipkinc(np.arctan2(w0[b] / amp_b if amp_b > 0 else 0.0, w0[a] / amp_a if amp_a > 0 else 1.0), m)
     sn, cn, dn, _ = ellipj(sign_c * parity * rate * np.asarray(t, dtype=float) + phase, m)
     sorted_rates = np.empty(np.shape(t) + (3,))
@@ -111,6 +110,8 @@ class NaturalMotionReference(Reference):
         self.q0, self.omega0, self.moments, self.arc, self.stop = q0, omega0, moments, arc, stop
         self.axis = symmetry_axis(moments)
         if self.axis is None:
+            from scipy.integrate import solve_ivp  # lazily: scipy.integrate pulls in scipy.optimize
+
             solution = solve_ivp(lambda s, q: quat.kinematics(q, asymmetric_rates(s, omega0, moments)), (0, arc),
                                  quat.IDENTITY, method="DOP853", rtol=1e-12, atol=1e-13, dense_output=True)
             self._relative = lambda t: quat.normalize(solution.sol(t).T)
@@ -225,7 +226,8 @@ class NaturalMotionPlanner(Planner):
 
     def _shoot(self, problem: ManeuverProblem, moments: Array, arc: float, steps: int | None = None,
                seeds: list[Array] | None = None):
-        solver = _shooting_solver(symmetry_axis(moments), self.options.stop, steps or self.options.rk4_steps)
+        structure = (symmetry_axis(moments), self.options.stop, steps or self.options.rk4_steps)
+        solver = self.solver_cache(problem).get(("natural_motion",) + structure, lambda: shooting_solver(*structure))
         target = quat.product(quat.conjugate(problem.q0), problem.qf)
         parameters = np.r_[moments, target, arc, problem.duration - arc]
         rotvec = quat.to_rotation_vector(target)
@@ -235,22 +237,18 @@ class NaturalMotionPlanner(Planner):
             rng = np.random.default_rng(0)
             seeds = [rotvec / arc, (angle - 2 * np.pi) * axis_vec / arc]
             seeds += [rotvec / arc + rng.normal(0, 0.3 * angle / arc + 1e-3, 3) for _ in range(self.options.starts - 2)]
-        best, best_cost, statuses = None, np.inf, []
-        for seed in seeds[: self.options.starts]:
-            result = solver(x0=seed, p=parameters, lbg=0, ubg=0)
-            statuses.append(solver.stats()["return_status"])
-            violation = float(np.max(np.abs(result["g"].full())))
-            if violation < 1e-9 and float(result["f"]) < best_cost:
-                best, best_cost = result["x"].full().ravel(), float(result["f"])
-        stats = {"ipopt_status": statuses, "momentum_sq": best_cost}
-        if best is None:
-            return FailedReference(self.name, f"shooting did not reach the target from any start: {statuses}",
-                                   stats=stats)
-        return best, stats
+        # Starts are distinct ways round (short, long, perturbed): all are tried (agree = 0).
+        result = solve_multistart(solver, seeds, p=parameters, lbg=0, ubg=0, agree=0,
+                                  feasibility_tolerance=1e-9, max_starts=self.options.starts)
+        stats = result.stats()
+        stats["momentum_sq"] = result.f
+        if not result.success:
+            return FailedReference(self.name, f"shooting did not reach the target from any start: "
+                                   f"{result.statuses}", stats=stats)
+        return result.x, stats
 
 
-@lru_cache(maxsize=None)
-def _shooting_solver(axis: int | None, stop: str, rk4_steps: int) -> ca.Function:
+def shooting_solver(axis: int | None, stop: str, rk4_steps: int) -> ca.Function:
     """IPOPT on ω(0) with parameters [I1, I2, I3, q_target (4), arc, stop_time]; built once per
     structure (symmetry axis or none, stop law, RK4 steps)."""
     omega0 = ca.SX.sym("omega0", 3)
@@ -267,8 +265,7 @@ def _shooting_solver(axis: int | None, stop: str, rk4_steps: int) -> ca.Function
     momentum = ca.sumsqr(ca.vertcat(*moments) * omega0)
     # A start that needs more than 15 iterations is heading for a poor, high-momentum optimum (the
     # long way round took 115 iterations to a 4e4 times larger objective): cut it short.
-    options = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-12,
-               "ipopt.constr_viol_tol": 1e-13, "ipopt.max_iter": 15, "show_eval_warnings": False}
+    options = solver_options("ipopt", 1e-12, 15, {"ipopt.constr_viol_tol": 1e-13})
     return ca.nlpsol("natural_motion", "ipopt", {"x": omega0, "p": p, "f": momentum, "g": miss}, options)
 
 

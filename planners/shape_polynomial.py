@@ -17,7 +17,6 @@ the planner tries ``N = 1 … max_terms`` and keeps the shortest ``t_f`` (or the
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Annotated, Literal
 
 import casadi as ca
@@ -25,6 +24,7 @@ import numpy as np
 
 from ocp import quat
 from ocp import quat_casadi as qc
+from ocp.nlp import solve_multistart, solver_options
 from ocp.options import Range
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
@@ -60,8 +60,7 @@ def polynomial(tau, q0, q1, slope0, slope1, coefficients, terms: int, math=np):
     return q, (dp - q * ca.dot(q, dp)) / norm
 
 
-@lru_cache(maxsize=None)
-def _solver(terms: int, cost: str) -> ca.Function:
+def build_solver(terms: int, cost: str) -> ca.Function:
     """IPOPT on the 4 x terms coefficients; parameters [q0, q1, slope0, slope1, I (9), T]."""
     e = ca.SX.sym("e", 4, terms)
     p = ca.SX.sym("p", 26)
@@ -92,8 +91,7 @@ def _solver(terms: int, cost: str) -> ca.Function:
             total += w * duration * ca.sumsqr(torque)
     # The cost only shapes the path (the boundary conditions hold exactly for any coefficients),
     # so a loose tolerance is enough.
-    options = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-7,
-               "ipopt.max_iter": 100}
+    options = solver_options("ipopt", 1e-7, 100)
     # Keep the raw polynomial near the unit sphere: through the normalisation, a polynomial whose
     # norm blows up could turn between quadrature points where the cost does not see it.
     return ca.nlpsol(f"shape_{terms}_{cost}", "ipopt",
@@ -162,25 +160,27 @@ class ShapePolynomialPlanner(Planner):
         best, previous = None, np.zeros((4, 0))
         candidates = [o.terms] if o.terms is not None else range(1, o.max_terms + 1)
         for terms in candidates:
-            solver = _solver(terms, o.cost)
+            solver = self.solver_cache(problem).get(("shape_polynomial", terms, o.cost),
+                                                    lambda: build_solver(terms, o.cost))
             seed = np.zeros((4, terms))
             seed[:, :min(terms, previous.shape[1])] = previous[:, :terms]  # N − 1 terms seed N
-            result = solver(x0=seed.T.ravel(), p=params, lbg=0.5, ubg=2.0)
-            status = solver.stats()["return_status"]
-            if status not in ("Solve_Succeeded", "Solved_To_Acceptable_Level"):
+            result = solve_multistart(solver, [seed.T.ravel()], p=params, lbg=0.5, ubg=2.0)
+            if not result.success:
                 continue
-            coefficients = result["x"].full().reshape(terms, 4).T
+            coefficients = result.x.reshape(terms, 4).T
             previous = coefficients
             probe = ShapeReference(q0, q1, slope0, slope1, coefficients, terms, 1.0, problem.spacecraft.inertia, "", {})
             peak = float(np.max(np.linalg.norm(probe._rate(np.linspace(0, 1, 2001))[1], axis=1)))  # per unit τ
             duration = peak / max_rate if o.duration == "rate_limit" else T
-            score = duration if o.duration == "rate_limit" else float(result["f"])
+            score = duration if o.duration == "rate_limit" else result.f
             if best is None or score < best[0]:
-                best = (score, terms, coefficients, duration, float(result["f"]))
+                best = (score, terms, coefficients, duration, result)
         if best is None:
             return FailedReference(self.name, "IPOPT did not converge for any number of shape terms")
-        _, terms, coefficients, duration, cost = best
-        stats = {"terms": terms, "cost": cost, "duration": duration}
+        _, terms, coefficients, duration, result = best
+        cost = result.f
+        stats = result.stats()
+        stats.update(terms=terms, cost=cost, duration=duration)
         message = f"N = {terms}, t_f = {duration:.4g} s, {o.cost} cost {cost:.4g}"
         return ShapeReference(q0, q1, slope0, slope1, coefficients, terms, duration, problem.spacecraft.inertia,
                               message, stats)

@@ -21,25 +21,15 @@ from __future__ import annotations
 from typing import Annotated, Iterable
 
 from dataclasses import dataclass
-from functools import lru_cache
 
 import casadi as ca
 import numpy as np
 
 from ocp import quat
+from ocp.nlp import solve_multistart, solver_options
 from ocp.options import Range
+from ocp.spin_closed_form import extremal_quaternion
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample)
-
-
-def extremal_quaternion(t, v, r, c, beta, math=np):
-    """``q*(t)`` from the identity (scalar first); ``math`` is ``numpy`` or ``casadi``."""
-    K = math.sqrt(r**2 + c**2)
-    fast, slow = (c + K + v) * t / 2, (c - K + v) * t / 2
-    spin = (v + c) * t / 2 + beta
-    nutation = r / K * math.sin(K * t / 2)
-    return ((K - c) * math.cos(fast) + (K + c) * math.cos(slow)) / (2 * K), \
-        ((K - c) * math.sin(fast) + (K + c) * math.sin(slow)) / (2 * K), \
-        nutation * math.sin(spin), nutation * math.cos(spin)
 
 
 def torque_amplitudes(v: float, r: float, c: float, moments: Array) -> Array:
@@ -86,14 +76,10 @@ def energy_cost(v, r, c, beta, duration, moments, math=np):
             + 0.5 * I3**2 * r**2 * (alpha + v * d3) ** 2 * (duration - cos2))
 
 
-# IPOPT statuses taken as converged; at a zero-cost optimum (k = 0, target reached) IPOPT
-# reports the search direction as too small, which is convergence, not failure.
-CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level", "Search_Direction_Becomes_Too_Small")
-
-
-@lru_cache(maxsize=None)
-def _solver() -> ca.Function:
-    """IPOPT on (r, c, β) with parameters [v, T, I1, I2, I3, q_target (4), k]; built once."""
+def build_solver() -> ca.Function:
+    """IPOPT on (r, c, β) with parameters [v, T, I1, I2, I3, q_target (4), k]. At a zero-cost
+    optimum (k = 0, target reached) IPOPT reports ``Search_Direction_Becomes_Too_Small``, which the
+    status policy of :mod:`ocp.nlp` counts as converged (the problem is unconstrained)."""
     x = ca.SX.sym("x", 3)
     p = ca.SX.sym("p", 10)
     r, c, beta = x[0], x[1], x[2]
@@ -104,10 +90,7 @@ def _solver() -> ca.Function:
     # Unbounded: (−r, β + π) is the same extremal, so r >= 0 is restored afterwards instead of
     # being a bound whose barrier would cost IPOPT iterations. J1 is written as eq. 30's sum of
     # squares: the equal 2 − 2|q·q_f| cancels at the optimum and leaves IPOPT a noisy gradient.
-    options = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-12,
-               "ipopt.max_iter": 200}
-    solver = ca.nlpsol("spin_extremal", "ipopt", {"x": x, "p": p, "f": j1 + weight * j2}, options)
-    return solver
+    return ca.nlpsol("spin_extremal", "ipopt", {"x": x, "p": p, "f": j1 + weight * j2}, solver_options("ipopt", 1e-12, 200))
 
 
 @dataclass(frozen=True)
@@ -174,7 +157,8 @@ class SpinExtremalPlanner(Planner):
             params = SpinParameters(*self.options.parameters)
             stats = {"fixed_parameters": True}
         else:
-            params, stats = self._optimise(v, T, moments, target)
+            params, stats = self._optimise(self.solver_cache(problem).get(("spin_extremal",), build_solver),
+                                           v, T, moments, target)
             if params is None:
                 return FailedReference(self.name, stats["message"], stats=stats)
         q_end = np.array(extremal_quaternion(T, v, params.r, params.c, params.beta))
@@ -200,23 +184,15 @@ class SpinExtremalPlanner(Planner):
         cost = attitude_cost(q_end, target) + self.options.weight * energy_cost(v, r, c, beta, T, moments)
         return np.column_stack([r, c, beta])[np.argsort(cost)[: self.options.starts]]
 
-    def _optimise(self, v: float, T: float, moments: Array, target: Array):
-        solver = _solver()
+    def _optimise(self, solver: ca.Function, v: float, T: float, moments: Array, target: Array):
         parameters = np.r_[v, T, moments, target, self.options.weight]
-        best, best_cost, iterations, statuses = None, np.inf, 0, []
-        for seed in self._seeds(v, T, moments, target):
-            solution = solver(x0=seed, p=parameters)
-            stats = solver.stats()
-            iterations += stats["iter_count"]
-            statuses.append(stats["return_status"])
-            cost = float(solution["f"])
-            if stats["return_status"] in CONVERGED and cost < best_cost:
-                best, best_cost = solution["x"].full().ravel(), cost
-        stats = {"ipopt_status": statuses, "iterations": iterations, "objective": best_cost}
-        if best is None:
-            stats["message"] = f"IPOPT did not converge from any start: {sorted(set(statuses))}"
+        # Every start is a different branch of K T by design: all are tried (agree = 0).
+        result = solve_multistart(solver, self._seeds(v, T, moments, target), p=parameters, agree=0)
+        stats = result.stats()
+        if not result.success:
+            stats["message"] = f"IPOPT did not converge from any start: {sorted(set(result.statuses))}"
             return None, stats
-        r, c, beta = (float(v) for v in best)
+        r, c, beta = (float(v) for v in result.x)
         if r < 0:
             r, beta = -r, beta + np.pi
         return SpinParameters(r, c, float(np.mod(beta + np.pi, 2 * np.pi) - np.pi)), stats

@@ -1,4 +1,4 @@
-"""``slewbench`` command line: run, validate, list.
+"""``slewbench`` command line: run, validate, list, codegen.
 
 Exit status: 0 when the run completed (a failed planner is a row, not an error), 2 for a bad
 scenario file, 1 for an internal error.
@@ -64,6 +64,19 @@ def command_run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def command_codegen(args: argparse.Namespace) -> int:
+    from scenarios.codegen import generate  # CasADi's code generator: only for this command
+
+    scenario = load(args.file)
+    report = generate(scenario, args.out)
+    print(f"wrote {report.directory}/: " + ", ".join(f"{name} ({size} bytes)" for name, size in report.files.items()))
+    print("functions: " + ", ".join(report.functions))
+    for label, reason in report.skipped.items():
+        print(f"  no C reference for row {label!r}: {reason}")
+    print(f"build: make -C {report.directory}")
+    return EXIT_OK
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="slewbench", description="Spacecraft attitude manoeuvre planning workbench")
     commands = parser.add_subparsers(dest="command", required=True)
@@ -75,6 +88,10 @@ def build_parser() -> argparse.ArgumentParser:
     validate_parser = commands.add_parser("validate", help="check a scenario file")
     validate_parser.add_argument("file")
     validate_parser.set_defaults(handler=command_validate)
+    codegen_parser = commands.add_parser("codegen", help="export the controller law (and closed-form references) as C")
+    codegen_parser.add_argument("file", help="scenario YAML file")
+    codegen_parser.add_argument("--out", required=True, help="output directory (new, empty, or written by slewbench)")
+    codegen_parser.set_defaults(handler=command_codegen)
     list_parser = commands.add_parser("list", help="registered planners and controllers")
     list_parser.set_defaults(handler=command_list)
     return parser

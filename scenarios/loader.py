@@ -7,6 +7,8 @@ code sees the papers' conventions.
 """
 from __future__ import annotations
 
+import dataclasses
+import datetime
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,7 +17,7 @@ from typing import Any, Callable
 import numpy as np
 
 from controllers import CONTROLLERS
-from ocp import (CircularOrbit, Environment, Magnetorquers, ModelError, ReactionWheels, SensorNoise,
+from ocp import (CircularOrbit, Environment, IGRFField, Magnetorquers, ModelError, ReactionWheels, SensorNoise,
                  Spacecraft, TiltedDipole, Torquers, quat)
 from ocp.options import OptionsError, excerpt
 from ocp.simulator import MAX_SAMPLES, MAX_SUBSTEPS, SUBSTEPS_PER_SAMPLE
@@ -38,8 +40,16 @@ class PlannerSpec:
 
 @dataclass
 class ControllerSpec:
+    """One controller: registry ``name``, parsed ``options`` and table ``label`` (default: the
+    name); ``path`` is its YAML entry (``controller`` or ``controllers[i]``), for messages."""
+
     name: str
     options: Any
+    label: str = ""
+    path: str = "controller"
+
+    def __post_init__(self) -> None:
+        self.label = self.label or self.name
 
 
 @dataclass
@@ -55,6 +65,10 @@ class SimulationSpec:
     integrator: str = "rk4"
     max_step: float = 0.05
     settling_tolerance_deg: float = 0.5
+    fine_settling_tolerance_deg: float | None = None
+    detumble_tolerance: float = 0.01
+    compile: bool = False
+    """Build the closed loop of a symbolic law as C (``ocp.compiled``); interpreted otherwise."""
     max_samples: int = MAX_SAMPLES
 
 
@@ -65,9 +79,14 @@ class Scenario:
     name: str
     problem: ManeuverProblem
     planners: list[PlannerSpec]
-    controller: ControllerSpec
+    controllers: list[ControllerSpec]
     simulation: SimulationSpec
     source: Path | None = None
+
+    @property
+    def controller(self) -> ControllerSpec:
+        """The first (or only) controller, for code written before ``controllers`` lists."""
+        return self.controllers[0]
 
     @property
     def true_initial_state(self) -> np.ndarray:
@@ -114,7 +133,8 @@ def parse_spacecraft(node: Node) -> Spacecraft:
     magnetorquers = torquers = None
     mtq = node.get("magnetorquers", None)
     if not mtq.is_null():
-        magnetorquers = _model_part(mtq.mapping(), Magnetorquers, max_dipole=_limits(mtq, "max_dipole"))
+        magnetorquers = _model_part(mtq.mapping(), Magnetorquers, max_dipole=_limits(mtq, "max_dipole"),
+                                    saturation=mtq.get("saturation", "per_axis").string(("per_axis", "scale")))
         mtq.finish()
     trq = node.get("torquers", None)
     if not trq.is_null():
@@ -148,14 +168,9 @@ def parse_environment(orbit_node: Node, node: Node) -> Environment:
             magnetic_field = TiltedDipole()
         else:
             field_node.mapping()
-            field_node.get("model", "tilted_dipole").string(("tilted_dipole",))
-            defaults = TiltedDipole()
-            magnetic_field = TiltedDipole(
-                strength=field_node.get("strength", defaults.strength).number(positive=True),
-                tilt=np.deg2rad(field_node.get("tilt_deg", np.rad2deg(defaults.tilt)).number()),
-                pole_longitude=np.deg2rad(field_node.get("pole_longitude_deg", np.rad2deg(defaults.pole_longitude)).number()),
-                greenwich_angle=np.deg2rad(field_node.get("greenwich_angle_deg", 0.0).number()),
-            )
+            model = field_node.get("model", "tilted_dipole").string(("tilted_dipole", "igrf"))
+            magnetic_field = (_igrf_field(field_node, orbit) if model == "igrf"
+                              else _tilted_dipole(field_node))
             field_node.finish()
     environment = _model_part(
         node, Environment, orbit=orbit,
@@ -165,6 +180,47 @@ def parse_environment(orbit_node: Node, node: Node) -> Environment:
     )
     node.finish()
     return environment
+
+
+def _tilted_dipole(node: Node) -> TiltedDipole:
+    defaults = TiltedDipole()
+    return TiltedDipole(
+        strength=node.get("strength", defaults.strength).number(positive=True),
+        tilt=np.deg2rad(node.get("tilt_deg", np.rad2deg(defaults.tilt)).number()),
+        pole_longitude=np.deg2rad(node.get("pole_longitude_deg", np.rad2deg(defaults.pole_longitude)).number()),
+        greenwich_angle=np.deg2rad(node.get("greenwich_angle_deg", 0.0).number()),
+    )
+
+
+def _igrf_field(node: Node, orbit: CircularOrbit | None) -> IGRFField:
+    """``{model: igrf, epoch, step_s, span_s, greenwich_angle_deg}``; without ``span_s`` the table
+    spans a provisional second, fitted to the closed-loop window by :func:`_fit_field_span`."""
+    if orbit is None:
+        raise ScenarioError(node.path, "the IGRF field is tabulated along the orbit; give `orbit:`")
+    epoch_node = node.get("epoch", "2025-01-01")
+    epoch = epoch_node.value
+    if not isinstance(epoch, (str, datetime.date)):
+        raise epoch_node.error(f"expected a date like 2025-01-01, got {str(epoch)[:40]!r}")
+    greenwich = node.get("greenwich_angle_deg", None).optional_number()
+    return _model_part(
+        node, IGRFField, orbit=orbit, epoch=str(epoch),
+        span=node.get("span_s", None).optional_number(positive=True) or 1.0,
+        step=node.get("step_s", 30.0).number(positive=True),
+        greenwich_angle=None if greenwich is None else float(np.deg2rad(greenwich)),
+    )
+
+
+def _fit_field_span(data: Any, problem: ManeuverProblem, simulation: SimulationSpec, planners: list) -> ManeuverProblem:
+    """Give an IGRF table without ``span_s`` the closed-loop window (twice the maneuver's when
+    planners may return longer references) plus one minute."""
+    field_model = problem.environment.magnetic_field
+    spec = ((data.get("environment") or {}).get("magnetic_field") if isinstance(data, dict) else None)
+    if not isinstance(field_model, IGRFField) or (isinstance(spec, dict) and spec.get("span_s") is not None):
+        return problem
+    window = max(problem.duration * (2.0 if planners else 1.0), simulation.duration or 0.0) + 60.0
+    environment = dataclasses.replace(problem.environment,
+                                      magnetic_field=dataclasses.replace(field_model, span=window))
+    return dataclasses.replace(problem, environment=environment)
 
 
 def parse_problem(node: Node, spacecraft: Spacecraft, environment: Environment) -> ManeuverProblem:
@@ -221,8 +277,28 @@ def parse_planners(node: Node) -> list[PlannerSpec]:
 
 def parse_controller(node: Node) -> ControllerSpec:
     name, options = _registered(node.mapping(), CONTROLLERS, "controller")
+    label = node.get("label", name).string()
     node.finish()
-    return ControllerSpec(name, options)
+    return ControllerSpec(name, options, label, node.path)
+
+
+def parse_controllers(root: Node) -> list[ControllerSpec]:
+    """``controller:`` (one) or ``controllers:`` (a non-empty list, labels unique)."""
+    if "controller" in root and "controllers" in root:
+        raise ScenarioError("controllers", "give either `controller` (one) or `controllers` (a list), not both")
+    if "controllers" not in root:
+        return [parse_controller(root.get("controller", required=True))]
+    node = root.get("controllers")
+    root.get("controller", None)  # an explicit `controller: null` next to the list is accepted
+    specs = [parse_controller(item) for item in node.items()]
+    if not specs:
+        raise ScenarioError("controllers", "expected at least one controller")
+    labels: set[str] = set()
+    for spec in specs:
+        if spec.label in labels:
+            raise ScenarioError(f"{spec.path}.label", f"duplicate label {spec.label!r}; give each controller its own label")
+        labels.add(spec.label)
+    return specs
 
 
 def parse_simulation(node: Node) -> SimulationSpec:
@@ -238,11 +314,15 @@ def parse_simulation(node: Node) -> SimulationSpec:
             attitude_std=np.deg2rad(noise.get("attitude_deg", 0.0).number(non_negative=True)),
             rate_std=noise.get("rate", 0.0).number(non_negative=True),
             seed=noise.get("seed", 0).integer(minimum=0, maximum=2**63 - 1),
+            field_std=noise.get("magnetic_field", 0.0).number(non_negative=True),
         ),
         integrator=node.get("integrator", "rk4").string(("rk4", "cvodes")),
         max_step=node.get("max_step", 0.05).number(positive=True),
         settling_tolerance_deg=node.get("settling_tolerance_deg", 0.5).number(positive=True, maximum=180.0),
+        fine_settling_tolerance_deg=node.get("fine_settling_tolerance_deg", None).optional_number(positive=True),
+        detumble_tolerance=node.get("detumble_tolerance", 0.01).number(positive=True),
         max_samples=node.get("max_samples", MAX_SAMPLES).integer(minimum=1, maximum=100_000_000),
+        compile=node.get("compile", False).boolean(),
     )
     if spec.integrator == "rk4" and math.ceil(spec.sample_time / spec.max_step - 1e-9) > MAX_SUBSTEPS:
         raise ScenarioError(node.get("max_step").path, f"{spec.max_step:g} s gives more than {MAX_SUBSTEPS} RK4 "
@@ -273,21 +353,35 @@ def check_work(problem: ManeuverProblem, simulation: SimulationSpec) -> None:
 
 
 def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
-                        controller: ControllerSpec) -> None:
-    """What each planner and the controller say they cannot take, reported at their YAML entries."""
+                        controllers: list[ControllerSpec] | ControllerSpec,
+                        simulation: SimulationSpec | None = None) -> None:
+    """What each planner and controller say they cannot take, reported at their YAML entries."""
+    if isinstance(controllers, ControllerSpec):
+        controllers = [controllers]
     for index, spec in enumerate(planners):
         error = PLANNERS[spec.name](spec.options).problem_error(problem)
         if error:
             raise ScenarioError(f"planners[{index}]", error)
-    if not planners and problem.qf is None:
-        raise ScenarioError("maneuver.final.q", "regulation (no planners) needs a target attitude")
-    law = CONTROLLERS[controller.name](controller.options)
-    if not planners and law.needs_reference:
-        raise ScenarioError("controller.name", f"controller {controller.name} tracks a reference; give planners")
-    for index, spec in enumerate(planners):
-        error = law.planner_error(spec.name, spec.options)
+    for controller in controllers:
+        law = CONTROLLERS[controller.name](controller.options)
+        where = f"{controller.path}.name"
+        error = law.environment_error(problem.spacecraft, problem.environment)
         if error:
-            raise ScenarioError("controller.name", f"{error} (planners[{index}] is {spec.name!r})")
+            raise ScenarioError(where, error)
+        timing = None if simulation is None else law.sample_time_error(simulation.sample_time)
+        if timing:
+            raise ScenarioError(f"{controller.path}.options.{timing[0]}",
+                                f"{timing[1]} (simulation.sample_time is {simulation.sample_time:g} s)")
+        if not planners and problem.qf is None and law.needs_target_attitude:
+            raise ScenarioError("maneuver.final.q", f"regulation (no planners) with controller {controller.name!r} "
+                                "needs a target attitude; only laws that need none (e.g. bdot, tdfc, none) "
+                                "accept a free final attitude")
+        if not planners and law.needs_reference:
+            raise ScenarioError(where, f"controller {controller.name} tracks a reference; give planners")
+        for index, spec in enumerate(planners):
+            error = law.planner_error(spec.name, spec.options)
+            if error:
+                raise ScenarioError(where, f"{error} (planners[{index}] is {spec.name!r})")
 
 
 def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
@@ -301,12 +395,13 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     environment = parse_environment(root.get("orbit", None), root.get("environment", {}))
     problem = parse_problem(root.get("maneuver", required=True), spacecraft, environment)
     planners = parse_planners(root.get("planners", required=True))
-    controller = parse_controller(root.get("controller", required=True))
+    controllers = parse_controllers(root)
     simulation = parse_simulation(root.get("simulation", {}))
     root.finish()
+    problem = _fit_field_span(data, problem, simulation, planners)
     check_work(problem, simulation)
-    check_compatibility(problem, planners, controller)
-    return Scenario(name, problem, planners, controller, simulation, source)
+    check_compatibility(problem, planners, controllers, simulation)
+    return Scenario(name, problem, planners, controllers, simulation, source)
 
 
 def load(path: str | Path) -> Scenario:

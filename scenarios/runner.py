@@ -13,12 +13,17 @@ from typing import Any, Callable
 from controllers import CONTROLLERS
 from ocp import SimulationError, SolverCache, metric_violations, SimulationResult, Simulator, metrics_from_reference, metrics_from_simulation
 from planners import PLANNERS, FailedReference, Reference
-from scenarios.loader import Scenario
+from scenarios.loader import ControllerSpec, Scenario
 
 
 @dataclass
 class Row:
-    """One planner (or, in regulation mode, the controller alone) and its scores."""
+    """One planner and controller pair (in regulation mode, the controller alone) and its scores.
+
+    ``label`` is the planner's label, or the controller's in regulation mode; with several
+    controllers a planner's rows are labelled ``"<planner label> / <controller label>"``.
+    ``planner`` and ``controller`` are registry names (``planner`` is ``None`` in regulation mode).
+    """
 
     label: str
     planner: str | None
@@ -30,10 +35,12 @@ class Row:
     reference: Reference | None = field(default=None, repr=False)
     simulation: SimulationResult | None = field(default=None, repr=False)
     simulate_time_s: float = 0.0
+    controller: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The row as ARCHITECTURE.md's ``results.json`` writes it."""
-        return {"label": self.label, "planner": self.planner, "status": self.status, "message": self.message,
+        """The row as ARCHITECTURE.md's ``results.json`` writes it (a plain dict)."""
+        return {"label": self.label, "planner": self.planner, "controller": self.controller,
+                "status": self.status, "message": self.message,
                 "plan_time_s": self.plan_time_s, "reference": self.reference_metrics,
                 "closed_loop": self.closed_loop_metrics}
 
@@ -76,10 +83,12 @@ class RunResults:
         write_results(self, directory, plots=plots)
 
 
-def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | None, row: Row) -> None:
+def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | None, row: Row,
+              controller_spec: ControllerSpec | None = None) -> None:
     problem = scenario.problem
+    spec = controller_spec or scenario.controller
     duration = scenario.simulation.duration or max(problem.duration, reference.duration if reference else 0.0)
-    controller = CONTROLLERS[scenario.controller.name](scenario.controller.options)
+    controller = CONTROLLERS[spec.name](spec.options)
     start = time.perf_counter()
     try:
         result = simulator.run(controller, scenario.true_initial_state, duration, reference=reference,
@@ -93,7 +102,9 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
     row.closed_loop_metrics = metrics_from_simulation(
         result, problem.qf, problem.omegaf, reference=reference, plan_time_s=row.plan_time_s,
         duration_s=reference.duration if reference else None,
-        settling_tolerance_deg=scenario.simulation.settling_tolerance_deg)
+        settling_tolerance_deg=scenario.simulation.settling_tolerance_deg,
+        fine_settling_tolerance_deg=scenario.simulation.fine_settling_tolerance_deg,
+        detumble_tolerance=scenario.simulation.detumble_tolerance)
     _check_physical(row, "closed loop", row.closed_loop_metrics)
 
 
@@ -118,35 +129,49 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     Returns
     -------
     RunResults
-        One row per planner (or one for the controller in regulation mode).
+        One row per planner and controller pair (in regulation mode, one per controller).
     """
     say = progress or (lambda line: None)
     spec = scenario.simulation
     simulator = Simulator(scenario.problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step,
-                          max_samples=spec.max_samples)
+                          max_samples=spec.max_samples, compile=spec.compile)
+    controllers = scenario.controllers
     rows = []
     if not scenario.planners:
-        row = Row(scenario.controller.name, None, "ok", "regulation to the target", None, None, None)
-        _simulate(scenario, simulator, None, row)
-        say(f"[1/1] {row.label}: {row.status} (simulated in {row.simulate_time_s:.2f} s)")
-        return RunResults(scenario, [row])
-    for index, planner_spec in enumerate(scenario.planners, start=1):
+        for index, controller in enumerate(controllers, start=1):
+            row = Row(controller.label, None, "ok", "regulation to the target", None, None, None,
+                      controller=controller.name)
+            _simulate(scenario, simulator, None, row, controller)
+            say(f"[{index}/{len(controllers)}] {row.label}: {row.status} (simulated in {row.simulate_time_s:.2f} s)"
+                + (f" - {row.message}" if row.status != "ok" else ""))
+            rows.append(row)
+        return RunResults(scenario, rows)
+    total = len(scenario.planners) * len(controllers)
+    for planner_spec in scenario.planners:
         planner = PLANNERS[planner_spec.name](planner_spec.options, cache=cache)
         try:
             reference = planner.plan(scenario.problem)
         except Exception as error:  # a planner bug must not lose the other rows
             traceback.print_exc()
             reference = FailedReference(planner_spec.name, f"planner raised {type(error).__name__}: {error}")
-        row = Row(planner_spec.label, planner_spec.name, reference.status, reference.message,
-                  reference.plan_time_s, None, None, reference)
+        reference_metrics = None
         if reference.ok:
-            row.reference_metrics = metrics_from_reference(
+            reference_metrics = metrics_from_reference(
                 reference, scenario.problem.qf, scenario.problem.omegaf,
-                settling_tolerance_deg=spec.settling_tolerance_deg, initial_omega=scenario.problem.omega0)
-            _check_physical(row, "reference", row.reference_metrics)
-            _simulate(scenario, simulator, reference, row)
-        say(f"[{index}/{len(scenario.planners)}] {row.label}: {row.status} "
-            f"(planned in {row.plan_time_s * 1e3:.1f} ms, simulated in {row.simulate_time_s:.2f} s)"
-            + (f" - {row.message}" if row.status != "ok" else ""))
-        rows.append(row)
+                settling_tolerance_deg=spec.settling_tolerance_deg,
+                fine_settling_tolerance_deg=spec.fine_settling_tolerance_deg,
+                inertia=scenario.problem.spacecraft.inertia, detumble_tolerance=spec.detumble_tolerance,
+                initial_omega=scenario.problem.omega0)
+        for controller in controllers:
+            label = planner_spec.label if len(controllers) == 1 else f"{planner_spec.label} / {controller.label}"
+            row = Row(label, planner_spec.name, reference.status, reference.message,
+                      reference.plan_time_s, None if reference_metrics is None else dict(reference_metrics), None,
+                      reference, controller=controller.name)
+            if reference.ok:
+                _check_physical(row, "reference", row.reference_metrics)
+                _simulate(scenario, simulator, reference, row, controller)
+            rows.append(row)
+            say(f"[{len(rows)}/{total}] {row.label}: {row.status} "
+                f"(planned in {row.plan_time_s * 1e3:.1f} ms, simulated in {row.simulate_time_s:.2f} s)"
+                + (f" - {row.message}" if row.status != "ok" else ""))
     return RunResults(scenario, rows)

@@ -30,7 +30,7 @@ def to_json(results) -> str:
 
 def flat_columns() -> list[str]:
     """CSV columns: row identity, then every metric per scope (vectors split per axis)."""
-    columns = ["label", "planner", "status", "message", "plan_time_s"]
+    columns = ["label", "planner", "controller", "status", "message", "plan_time_s"]
     for _, prefix in SCOPES:
         for key in METRIC_KEYS:
             if key in ("plan_time_s",):
@@ -45,7 +45,8 @@ def flat_columns() -> list[str]:
 def flat_rows(results) -> list[dict[str, Any]]:
     table = []
     for row in results.rows:
-        record = {"label": row.label, "planner": row.planner or "", "status": row.status,
+        record = {"label": row.label, "planner": row.planner or "", "controller": row.controller or "",
+                  "status": row.status,
                   "message": row.message, "plan_time_s": row.plan_time_s}
         for scope, prefix in SCOPES:
             metrics = getattr(row, f"{scope}_metrics") or {}
@@ -110,7 +111,8 @@ def to_markdown(results) -> str:
            "|---|" + "---|" * len(labels)]
     out += [f"| {name} | " + " | ".join(cells) + " |" for name, cells in _metric_lines(results)]
     out += ["", "Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s.", ""]
-    out += [f"- **{row.label}** ({row.planner or 'regulation'}): {row.message}" for row in results.rows]
+    out += [f"- **{row.label}** ({row.planner or 'regulation'}, {row.controller or '-'}): {row.message}"
+            for row in results.rows]
     return "\n".join(out) + "\n"
 
 

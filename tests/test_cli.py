@@ -52,7 +52,9 @@ def test_run_end_to_end_through_the_console_entry_point(tmp_path):
     results = json.loads((out / "results.json").read_text())
     assert results["scenario"] == "small" and [r["label"] for r in results["rows"]] == ["smooth", "fast"]
     for row in results["rows"]:
-        assert set(row) == {"label", "planner", "status", "message", "plan_time_s", "reference", "closed_loop"}
+        assert set(row) == {"label", "planner", "controller", "status", "message", "plan_time_s", "reference",
+                            "closed_loop"}
+        assert row["controller"] == "augmented_quaternion_feedback"
         assert set(row["reference"]) == set(METRIC_KEYS) == set(row["closed_loop"])
         assert row["closed_loop"]["final_error_deg"] < 0.05
     for name in ("results.csv", "results.md", "timeseries/smooth.csv", "timeseries/fast.csv",
@@ -128,7 +130,7 @@ def test_library_api_returns_tables(tmp_path):
     results = scenarios.run(scenarios.load(write(tmp_path, SMALL)))
     assert [row.status for row in results.rows] == ["ok", "ok"]
     csv_lines = results.to_csv().splitlines()
-    assert len(csv_lines) == 3 and csv_lines[0].startswith("label,planner,status")
+    assert len(csv_lines) == 3 and csv_lines[0].startswith("label,planner,controller,status")
     assert "| cl.final_error_deg |" in results.to_markdown()
 
 
@@ -195,3 +197,43 @@ def test_free_motion_with_gravity_gradient_matches_an_independent_integration(tm
     assert gg_effect > np.deg2rad(10)  # the gravity gradient matters over the orbit
     assert np.max(np.rad2deg(errors)) < 1e-6
     np.testing.assert_allclose(simulation.omega, truth.y[4:].T, atol=1e-10)
+
+
+def test_several_controllers_give_one_row_per_planner_and_controller(tmp_path):
+    laws = [{"name": "augmented_quaternion_feedback", "label": "soft", "options": {"kp": 0.2, "kd": 0.6}},
+            {"name": "augmented_quaternion_feedback", "label": "stiff", "options": {"kp": 0.8, "kd": 1.2}}]
+    text = edited(lambda d: (d.pop("controller"), d.update(controllers=laws)))
+    results = scenarios.run(scenarios.load(write(tmp_path, text)))
+    assert [row.label for row in results.rows] == ["smooth / soft", "smooth / stiff", "fast / soft", "fast / stiff"]
+    assert {row.controller for row in results.rows} == {"augmented_quaternion_feedback"}
+    # the gains differ, so the closed loops must differ while each planner's reference is shared
+    soft, stiff = results.rows[0], results.rows[1]
+    assert soft.reference_metrics == stiff.reference_metrics
+    assert soft.closed_loop_metrics["int_u2"] != stiff.closed_loop_metrics["int_u2"]
+    assert results.to_csv().splitlines()[1].startswith("smooth / soft,eigenaxis,augmented_quaternion_feedback,ok")
+    assert [row["controller"] for row in json.loads(results.to_json())["rows"]] == ["augmented_quaternion_feedback"] * 4
+
+
+def test_regulation_with_several_controllers_gives_one_row_each(tmp_path):
+    laws = [{"name": "eigenaxis_pd", "options": {"kp": 0.2, "kd": 0.6}}, {"name": "none", "label": "free"}]
+    text = edited(lambda d: (d.update(planners=[]), d.pop("controller"), d.update(controllers=laws)))
+    results = scenarios.run(scenarios.load(write(tmp_path, text)))
+    assert [(row.label, row.controller) for row in results.rows] == [("eigenaxis_pd", "eigenaxis_pd"), ("free", "none")]
+    assert results.rows[0].closed_loop_metrics["final_error_deg"] < 0.1
+    assert results.rows[1].closed_loop_metrics["final_error_deg"] > 40  # no actuation: still 45 deg away
+
+
+@pytest.mark.parametrize("change, path, fragment", [
+    (lambda d: d.update(controllers=[{"name": "none"}]), "controllers", "not both"),
+    (lambda d: (d.pop("controller"), d.update(controllers=[])), "controllers", "at least one"),
+    (lambda d: (d.pop("controller"), d.update(controllers=[{"name": "none"}, {"name": "none"}])),
+     "controllers[1].label", "duplicate label"),
+    (lambda d: (d.pop("controller"), d.update(controllers=[{"name": "none"}, {"name": "magic"}])),
+     "controllers[1].name", "unknown controller"),
+    (lambda d: (d.update(planners=[]), d["maneuver"]["final"].update(q=None)), "maneuver.final.q",
+     "needs a target attitude"),
+])
+def test_controller_list_errors_name_the_entry(tmp_path, change, path, fragment):
+    with pytest.raises(scenarios.ScenarioError) as error:
+        scenarios.load(write(tmp_path, edited(change)))
+    assert error.value.path == path and fragment in str(error.value)

@@ -30,7 +30,7 @@ HELD = np.array([[0.03, -0.04, 0.0],                     # N m held over each in
 ERROR_TO_TARGET_DEG = np.array([10.0, 0.4, 0.6, 0.3, 0.2])
 TRACKING_DEG = np.array([1.0, 2.0, 3.0, 0.0, 2.0])
 TARGET_ANGLE = 1.0  # rad about z
-OMEGA = np.array([[0.01, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.003, -0.004, 0.012]])
+OMEGA = np.array([[0.02, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.003, -0.004, 0.012]])
 WHEELS = np.array([[0.0, 0.1, 0.0], [0.2, -0.35, 0.1], [0.0, 0.0, 0.0], [0.1, 0.1, 0.1], [0.0, 0.3, 0.0]])
 SATURATED = np.array([True, False, False, True])
 
@@ -63,13 +63,15 @@ def metrics():
     result = hand_built_result()
     reference = TrackedReference(result.q)
     return metrics_from_simulation(result, quat.from_axis_angle(Z, TARGET_ANGLE), np.array([0.0, 0.0, 0.01]),
-                                   reference=reference, plan_time_s=0.25, duration_s=4.5)
+                                   reference=reference, plan_time_s=0.25, duration_s=4.5,
+                                   fine_settling_tolerance_deg=0.25, detumble_tolerance=0.0125)
 
 
 def test_every_key_is_tested_here():
     tested = {"int_u2", "int_u", "int_abs_u", "peak_u", "final_error_deg", "final_rate_error", "rms_error_deg",
               "max_error_deg", "settling_time_s", "saturation_fraction", "peak_wheel_momentum", "plan_time_s",
-              "duration_s", "initial_rate_error"}
+              "duration_s", "initial_rate_error", "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
+              "fine_settling_time_s"}
     assert set(METRIC_KEYS) == tested
 
 
@@ -140,3 +142,23 @@ def test_reference_integrals_against_closed_forms():
     assert metrics["final_rate_error"] == pytest.approx(0.1)
     assert metrics["initial_rate_error"] == pytest.approx(0.05)  # ‖[0, −0.03, 0.04]‖
     assert metrics["duration_s"] == T and metrics["final_error_deg"] is None
+
+
+def test_regulation_metrics(metrics):
+    # max_i |ω_i| per sample: 0.02, 0, 0, 0, 0.012: below 0.0125 rad/s from t[1] = 1 s on.
+    assert metrics["detumble_time_s"] == 1.0
+    assert metrics["final_rate"] == pytest.approx(math.sqrt(0.003**2 + 0.004**2 + 0.012**2), rel=1e-12)
+    start = 0.5 * 2.0 * 0.02**2                                            # ½ ωᵀ I ω, I = diag(2, 3, 4)
+    end = 0.5 * (2.0 * 0.003**2 + 3.0 * 0.004**2 + 4.0 * 0.012**2)
+    assert metrics["energy_ratio"] == pytest.approx(end / start, rel=1e-12)
+    # Fine band 0.25 deg: the 0.3 deg at t[3] is outside, the 0.2 deg at t[4] = 5 s inside.
+    assert metrics["fine_settling_time_s"] == 5.0
+    assert metrics["int_dipole"] is None  # no magnetorquers
+
+
+def test_dipole_integral_is_a_hold_integral_of_the_euclidean_norm():
+    dipole = np.array([[0.1, -0.2, 0.0], [0.0, 0.0, 0.3], [-0.05, 0.05, 0.05], [0.0, 0.0, 0.0]])
+    dt = [1.0, 1.5, 0.5, 2.0]
+    expected = sum(d * math.sqrt(a * a + b * b + c * c) for d, (a, b, c) in zip(dt, dipole))
+    metrics = compute_metrics(T_GRID, np.tile(quat.IDENTITY, (5, 1)), OMEGA, HELD, None, dipole=dipole)
+    assert metrics["int_dipole"] == pytest.approx(expected, rel=1e-12)

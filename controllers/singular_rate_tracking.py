@@ -1,0 +1,61 @@
+"""Singular nonlinear rate-tracking law, the paper's snlc (Horri & Palmer eq. 14/24):
+``u_i = −K (ω_i − ωd_i) + I_i ω̇d_i`` on the two actuated axes, with ωd of eq. 7/8.
+
+``K`` is in N m s/rad, as the units printed with eq. 31 say (eq. 14 writes ``I_i K_i``, i.e. K in
+1/s; with the paper's K = 10 that reading gives 400 N m s/rad, and with the 1 s hold the rate
+error is multiplied by 1 − 10 = −9 per sample: the loop diverges). Under zero momentum ``I ω̇ = u``
+(eq. 4): the law's torque is applied by the wheels as it is, ``N = −ḣ``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Annotated, Any
+
+from controllers.singular_zero_momentum import check_singular_gains
+from controllers.underactuated import (
+    SingularGains,
+    TwoWheelLaw,
+    desired_rates,
+    desired_rates_symbolic,
+    rate_tracking_torque,
+)
+from ocp import Command, Measurement
+from ocp.options import Range
+
+
+class SingularRateTracking(TwoWheelLaw):
+    """Full-state two-wheel law tracking the singular desired rates (see the module docstring)."""
+
+    name = "singular_rate_tracking"
+
+    @dataclass(frozen=True)
+    class Options:
+        k: Annotated[float, Range(gt=0.0)] = 0.02            # rad/s
+        g: Annotated[float, Range(gt=0.0)] = 0.08            # rad/s; g > 2k
+        K: Annotated[float, Range(gt=0.0)] = 10.0            # N m s/rad
+        a1: Annotated[float | None, Range(gt=0.0)] = 0.025   # saturation (eq. 8); null: unsaturated eq. 7
+        a2: Annotated[float | None, Range(gt=0.0)] = 0.025
+        epsilon_D: Annotated[float, Range(ge=0.0)] = 0.0     # regularisation of q1² + q2²
+
+        def __post_init__(self) -> None:
+            check_singular_gains("g", self.k, self.g)
+
+    def reset(self, spacecraft, sample_time, target=None) -> None:
+        super().reset(spacecraft, sample_time, target)
+        o = self.options
+        self.gains = SingularGains(o.k, o.g, o.a1, o.a2, o.epsilon_D)
+
+    def torque(self, measurement: Measurement) -> tuple[float, float]:
+        """The law's torque on the actuated axes (control frame, N m)."""
+        q0, q1, q2, q3, w1, w2, w3 = self.error(measurement)
+        rates = desired_rates(q0, q1, q2, q3, w1, w2, w3, self.gains)
+        return rate_tracking_torque(w1, w2, rates, self.options.K, self.moments[:2])
+
+    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
+        return self.command_torque(*self.torque(measurement), measurement)
+
+    def _law(self, t, y, z, r):
+        q, w = self.error_symbolic(y)
+        rates = desired_rates_symbolic(q, w, self.gains)
+        u1, u2 = rate_tracking_torque(w[0], w[1], rates, self.options.K, self.moments[:2])
+        return self.command_symbolic(u1, u2, y), z

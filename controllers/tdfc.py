@@ -1,0 +1,104 @@
+"""Time-delayed feedback control (nano-spacecraft paper, eq. 11): ``m = −K_t (B̃_k − B̃_{k−d})``.
+
+``d = τ / T_s`` samples; ``τ`` must be a whole multiple of the sample time. ``m = 0`` until a
+reading ``τ`` old exists (the first ``d`` samples). The delay buffer is cleared by ``reset``.
+
+Dissipation: for a body spinning at ``ω`` in a field fixed in inertial space, ``B(t − τ)`` is
+``B(t)`` turned back by the angle ``|ω| τ`` about ``ω``, and the power of the law is
+``ω·(m × B) = −K_t |ω| sin(|ω| τ) |B_⊥|²`` (``B_⊥``: the part of ``B`` normal to ``ω``). It removes
+energy only while ``|ω| τ < π``; for ``π < |ω| τ < 2π`` it pumps energy in. The paper (τ = 2 s,
+|ω0| = 0.9 rad/s) does not state this limit: the law needs ``τ < π / |ω|max``.
+
+Symbolic form: state ``z = [B̃_{k−1}, …, B̃_{k−d}, n]`` (3d + 1 numbers), ``n`` the number of
+readings stored so far (at most d).
+"""
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+from typing import Annotated, Any
+
+import casadi as ca
+import numpy as np
+
+from controllers.magnetic import MagneticController, field_components
+from ocp import Command, Measurement
+from ocp.options import Range
+
+MAX_DELAY_SAMPLES = 100_000
+"""Upper bound on ``τ / T_s`` (buffer length)."""
+
+
+def delay_samples(delay: float, sample_time: float) -> int:
+    """``d = τ / T_s`` if it is a whole number (to 1e-9 relative), else ``ValueError``.
+
+    Parameters
+    ----------
+    delay : s, τ; sample_time : s, T_s.
+
+    Returns
+    -------
+    int
+        d >= 1.
+    """
+    ratio = delay / sample_time
+    samples = round(ratio)
+    if samples < 1 or abs(ratio - samples) > 1e-9 * max(1.0, ratio):
+        raise ValueError(f"the delay {delay:g} s must be a whole multiple (>= 1) of the sample time "
+                         f"{sample_time:g} s (got {ratio:.6g} samples)")
+    if samples > MAX_DELAY_SAMPLES:
+        raise ValueError(f"the delay is {samples} samples; at most {MAX_DELAY_SAMPLES}")
+    return samples
+
+
+class TDFC(MagneticController):
+    """Time-delayed feedback: dipole against the change of the field over the delay (eq. 11)."""
+
+    name = "tdfc"
+
+    @dataclass(frozen=True)
+    class Options:
+        gain: Annotated[float, Range(ge=0.0)] = 1.0e4
+        """K_t, A m²/T."""
+        delay: Annotated[float, Range(gt=0.0, le=1.0e5)] = 2.0
+        """τ, s; a whole multiple of the sample time."""
+
+    def sample_time_error(self, sample_time: float) -> tuple[str, str] | None:
+        """``(option, message)`` if the law cannot run at ``sample_time`` (s), else ``None``."""
+        try:
+            delay_samples(self.options.delay, sample_time)
+        except ValueError as error:
+            return "delay", str(error)
+        return None
+
+    def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None:
+        super().reset(spacecraft, sample_time, target)
+        self._delay = delay_samples(self.options.delay, sample_time)
+        self._buffer: deque[tuple[float, float, float]] = deque(maxlen=self._delay + 1)
+
+    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
+        reading = field_components(measurement.field_body)
+        buffer = self._buffer
+        buffer.append(reading)
+        if len(buffer) <= self._delay:
+            return self.dipole(0.0, 0.0, 0.0)
+        old, k = buffer[0], self.options.gain
+        return self.dipole(-k * (reading[0] - old[0]), -k * (reading[1] - old[1]), -k * (reading[2] - old[2]))
+
+    def state_vector(self) -> np.ndarray:
+        d = self._delay
+        stored = list(self._buffer)[::-1][:d]          # newest first: B̃_{k}, B̃_{k−1}, ...
+        z = np.zeros(3 * d + 1)
+        if stored:
+            z[:3 * len(stored)] = np.ravel(stored)
+        z[-1] = len(stored)
+        return z
+
+    def _law(self, t, y, z, r):
+        d = self._delay
+        b = self.symbolic_field(y)
+        count = z[3 * d]
+        oldest = z[3 * (d - 1):3 * d]
+        dipole = ca.if_else(count >= d, -self.options.gain * (b - oldest), ca.DM.zeros(3))
+        z_next = ca.vertcat(b, z[0:3 * (d - 1)], ca.fmin(count + 1, d))
+        return self.symbolic_dipole(dipole), z_next

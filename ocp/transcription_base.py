@@ -1,0 +1,235 @@
+"""Optimal-control problems on the attitude model, and the stage-wise NLP every transcription shares.
+
+The problem (:class:`OptimalControlProblem`) says what is wanted; a :class:`Transcription` says how
+one mesh interval becomes NLP variables and constraints. It owns its layout: the interval as a
+CasADi function (mapped over the mesh, never called node by node from Python), the variables'
+bounds, the seeding from another reference and the interpolation of the solution.
+
+Every transcription is assembled the same way (:meth:`Transcription.build`), stage-wise as
+structure-exploiting solvers need it (FATROP's ``structure_detection: auto``):
+
+* variables ``w = [s_0, c_0, s_1, c_1, …, s_{N−1}, c_{N−1}, s_N]``: the stage state ``s_k`` (the
+  model state at the mesh point, plus what the transcription carries across intervals, plus
+  ``T`` when the final time is free: ``T_{k+1} = T_k`` is then an explicit continuity condition)
+  and the interval's own variables ``c_k``;
+* constraints ``[gap_0, path_0, x_0 − x0, gap_1, path_1, …, terminal]`` with
+  ``gap_k = s_{k+1} − F(s_k, c_k)`` (explicit continuity) and the interval's path constraints.
+
+Parameters ``p = [x0 (nx), qf (4), ωf (3), T, disturbance (3)]``: boundary values and T are not
+baked into the graph, so a built solver is reused across plans.
+
+Conventions: the terminal attitude condition is ``vec(q_f* ⊗ q(T)) = 0``, which accepts ``−q_f``;
+the quaternion norm is preserved by the kinematics to the discretisation's accuracy (reported, not
+constrained). Objective integrands use the actuators' body torque ``τ`` (N m): energy ``‖τ‖²``,
+L1 ``Σ|τ_i|`` (with slacks), plus ``time_weight · T``.
+"""
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from ocp import quat_casadi as qc
+from ocp.model import AttitudeModel
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Cone:
+    """Pointing constraint: the body ``boresight`` stays at least (keep-out) or at most (keep-in)
+    ``angle`` (rad) from the inertial unit ``direction``."""
+
+    boresight: tuple[float, float, float]
+    direction: tuple[float, float, float]
+    angle: float
+    keep_out: bool = True
+
+    def expression(self, q):
+        """``g <= 0`` when satisfied."""
+        pointing = ca.mtimes(qc.rotation_matrix(q), ca.DM(self.boresight))
+        cosine = ca.dot(pointing, ca.DM(self.direction))
+        return cosine - np.cos(self.angle) if self.keep_out else np.cos(self.angle) - cosine
+
+
+@dataclass(frozen=True)
+class OptimalControlProblem:
+    """What to optimise. Structural fields shape the NLP; values are passed at solve time."""
+
+    model: AttitudeModel
+    energy_weight: float = 1.0
+    l1_weight: float = 0.0
+    time_weight: float = 0.0
+    free_time: bool = False
+    fixed_final_rate: bool = True
+    cones: tuple[Cone, ...] = ()
+
+    @property
+    def uses_slack(self) -> bool:
+        return self.l1_weight > 0
+
+    def stage_cost(self, x, u, t, slack=None):
+        torque = self.model.actuator_torque(x, u, t)
+        cost = self.energy_weight * ca.sumsqr(torque)
+        if slack is not None:
+            cost += self.l1_weight * ca.sum1(slack)
+        return cost
+
+    def path_constraints(self, x):
+        return [cone.expression(x[0:4]) for cone in self.cones]
+
+
+@dataclass
+class NLP:
+    """A transcribed problem: a built solver and how to read its solution.
+
+    ``unpack(w, p) -> (T, states, controls)`` in the transcription's own point layout.
+    """
+
+    solver: ca.Function
+    n_w: int
+    unpack: ca.Function
+    lbg: Array
+    ubg: Array
+    free_time: bool
+    n_stage_state: int
+    n_interval: int
+    layout: dict = field(default_factory=dict)
+
+
+@dataclass
+class Interval:
+    """One mesh interval, built by a transcription. ``function(s, c, t0, h, d) -> (next, path, cost)``
+    with ``s`` the stage state without T, ``c`` the interval's variables, ``t0`` its start time,
+    ``h`` its length, ``d`` the disturbance parameter; ``path_lower <= path <= path_upper``."""
+
+    function: ca.Function
+    n_state: int
+    n_interval: int
+    path_lower: Array
+    path_upper: Array
+
+
+class Transcription(ABC):
+    """How an :class:`OptimalControlProblem` becomes an NLP on ``intervals`` mesh intervals.
+
+    Subclasses implement :meth:`interval` (one interval as a CasADi function), the layout methods
+    :meth:`stage_bounds`, :meth:`stage_guess`, :meth:`split` and :meth:`interpolate`, and
+    :meth:`problem_error` for formulations they cannot take.
+    """
+
+    name: str
+
+    def __init__(self, intervals: int):
+        self.intervals = intervals
+
+    @classmethod
+    @abstractmethod
+    def from_options(cls, options: Any) -> "Transcription":
+        """The transcription configured from a planner's options (``intervals``, ``degree``, ...)."""
+
+    @classmethod
+    def problem_error(cls, l1: bool, cones: bool) -> str | None:
+        """Why this transcription cannot take an L1 cost or cones, or ``None``."""
+        return None
+
+    @abstractmethod
+    def interval(self, problem: OptimalControlProblem) -> Interval:
+        """One interval (see :class:`Interval`)."""
+
+    @abstractmethod
+    def state_of(self, s):
+        """The model state (nx) inside a stage state ``s``."""
+
+    @abstractmethod
+    def stage_bounds(self, problem: OptimalControlProblem, x_low: Array, x_high: Array, u_low: Array,
+                     u_high: Array) -> tuple[Array, Array, Array, Array]:
+        """Bounds of ``s_k`` (without T) and of ``c_k``: ``(s_low, s_high, c_low, c_high)``."""
+
+    @abstractmethod
+    def stage_guess(self, problem: OptimalControlProblem, sample: Callable, duration: float) -> tuple[Array, Array]:
+        """Initial guess ``(S (ns, N+1), C (nc, N))``; ``sample(times) -> (x (n, nx), u (n, nu),
+        |torque| (n, 3))`` evaluates the seeding reference."""
+
+    @abstractmethod
+    def split(self, S, C) -> tuple[Any, Any]:
+        """``(states, controls)`` at the transcription's points from the stage matrices."""
+
+    @abstractmethod
+    def interpolate(self, model: AttitudeModel, states: Array, controls: Array, duration: float,
+                    t: Array) -> tuple[Array, Array]:
+        """States ``(n, nx)`` and controls ``(n, nu)`` at times ``t`` in ``[0, duration]``."""
+
+    # -- the shared stage-wise assembly -------------------------------------------------------
+    @staticmethod
+    def terminal(problem: OptimalControlProblem, x_end, qf, omegaf):
+        g = [qc.product(qc.conjugate(qf), x_end[0:4])[1:4]]
+        if problem.fixed_final_rate:
+            g.append(x_end[4:7] - omegaf)
+        return g
+
+    def build(self, problem: OptimalControlProblem, solver: str, options: dict) -> NLP:
+        """The NLP in the stage-wise layout of the module docstring, solved by ``solver``."""
+        model, N = problem.model, self.intervals
+        nx = model.nx
+        interval = self.interval(problem)
+        ns0, nc = interval.n_state, interval.n_interval
+        ns = ns0 + (1 if problem.free_time else 0)
+        p = ca.MX.sym("p", nx + 4 + 3 + 1 + 3)
+        x0, qf, omegaf, T_param, disturbance = p[0:nx], p[nx:nx + 4], p[nx + 4:nx + 7], p[nx + 7], p[nx + 8:nx + 11]
+        w = ca.MX.sym("w", (ns + nc) * N + ns)
+        Z = ca.reshape(w[:(ns + nc) * N], ns + nc, N)
+        S = ca.horzcat(Z[:ns, :], w[(ns + nc) * N:])
+        C = Z[ns:, :]
+        if problem.free_time:
+            T_row, T = S[ns0, :N], S[ns0, 0]
+        else:
+            T_row, T = ca.repmat(T_param, 1, N), T_param
+        h_row = T_row / N
+        t0_row = h_row * ca.DM(np.arange(N)).T
+        following, path, cost = interval.function.map(N)(S[:ns0, :N], C, t0_row, h_row, disturbance)
+        gap = S[:ns0, 1:] - following
+        if problem.free_time:
+            gap = ca.vertcat(gap, S[ns0, 1:] - S[ns0, :N])  # explicit continuity of T
+        blocks = ca.vertcat(gap, path)
+        initial = self.state_of(S[:ns0, 0]) - x0
+        terminal = self.terminal(problem, self.state_of(S[:ns0, N]), qf, omegaf)
+        g = ca.vertcat(blocks[:, 0], initial, ca.vec(blocks[:, 1:]), *terminal)
+        zero_gap = np.zeros(ns)
+        stage_low = np.concatenate([zero_gap, interval.path_lower])
+        stage_high = np.concatenate([zero_gap, interval.path_upper])
+        n_terminal = sum(c.numel() for c in terminal)
+        lbg = np.concatenate([stage_low, np.zeros(nx), np.tile(stage_low, N - 1), np.zeros(n_terminal)])
+        ubg = np.concatenate([stage_high, np.zeros(nx), np.tile(stage_high, N - 1), np.zeros(n_terminal)])
+        objective = ca.sum2(cost) + problem.time_weight * T
+        states, controls = self.split(S[:ns0, :], C)
+        unpack = ca.Function("unpack", [w, p], [T, states, controls])
+        opts = dict(options)
+        opts.setdefault("expand", True)
+        if solver == "fatrop":
+            opts["equality"] = [bool(v) for v in (lbg == ubg)]
+        nlp_solver = ca.nlpsol(f"{self.name}_{solver}", solver, {"x": w, "p": p, "f": objective, "g": g}, opts)
+        return NLP(nlp_solver, w.numel(), unpack, lbg, ubg, problem.free_time, ns, nc)
+
+    def bounds(self, problem: OptimalControlProblem, nlp: NLP, x_low: Array, x_high: Array, u_low: Array,
+               u_high: Array, duration: float) -> tuple[Array, Array]:
+        """``lbx``, ``ubx`` in the decision-vector layout; a free ``T`` lies in ``[1e-3, 1] × duration``."""
+        s_low, s_high, c_low, c_high = self.stage_bounds(problem, x_low, x_high, u_low, u_high)
+        if nlp.free_time:
+            s_low, s_high = np.append(s_low, 1e-3 * duration), np.append(s_high, duration)
+        N = self.intervals
+        low = np.concatenate([np.tile(np.concatenate([s_low, c_low]), N), s_low])
+        high = np.concatenate([np.tile(np.concatenate([s_high, c_high]), N), s_high])
+        return low, high
+
+    def seed(self, problem: OptimalControlProblem, nlp: NLP, sample: Callable, duration: float) -> Array:
+        """An initial decision vector from ``sample`` (see :meth:`stage_guess`) over ``duration``."""
+        S, C = self.stage_guess(problem, sample, duration)
+        if nlp.free_time:
+            S = np.vstack([S, np.full((1, S.shape[1]), duration)])
+        N = self.intervals
+        return np.concatenate([np.vstack([S[:, :N], C]).T.ravel(), S[:, N]])

@@ -1,0 +1,178 @@
+"""Minimum time and minimum energy against peers, side by side in one run (issue 16).
+
+* ``ours``: ``collocation`` with default options (``objective: min_time``; LGR N = 50, degree 3,
+  IPOPT, automatic perturbed multistart with early stopping), after the NLP build.
+* ``peer_fatrop``: a hand-written CasADi Opti multiple shooting (RK4, piecewise-constant torques,
+  N = 50, T a per-stage state with explicit continuity, stage-wise declaration) solved by FATROP
+  with ``structure_detection: auto``, one solve from the same guess as our first start (the
+  unperturbed eigenaxis guess leaves it at the eigenaxis stationary point, 3.5449 on B&W).
+* ``peer_rockit``: rockit (``rockit-meco``) multiple shooting with IPOPT, N = 50, same guess.
+
+Cases: Bilimoria & Wie (unit inertia, |u_i| <= 1, 180° about x, optimum 3.2431) and a full
+inertia, 150° about [1, 1, 1] (optimum 7.6826 s, verified by a second method: see
+tests/test_collocation.py). Minimum energy: the spin paper's case warm-started from the spin
+extremal, solve after the build (target 60 ms) and the build itself at N = 50 (target 0.25 s).
+Run: ``python -m pytest tests/benchmarks/test_bench_min_time.py -o addopts=""``.
+"""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from ocp import Spacecraft, Torquers, quat
+from ocp.nlp import perturbed, solver_options
+from planners import PLANNERS, ManeuverProblem
+from planners.collocation_reference import seed_sampler
+
+N = 50
+
+
+def bilimoria_wie():
+    return ManeuverProblem(Spacecraft([1.0, 1.0, 1.0], torquers=Torquers(1.0)), quat.IDENTITY, np.zeros(3),
+                           quat.from_axis_angle([1, 0, 0], np.pi), 10.0, omegaf=np.zeros(3))
+
+
+def full_inertia():
+    return ManeuverProblem(Spacecraft([[10, 0.5, 0.2], [0.5, 8, 0.3], [0.2, 0.3, 6]], torquers=Torquers(1.0)),
+                           quat.IDENTITY, np.zeros(3), quat.from_axis_angle([1, 1, 1], np.deg2rad(150)), 30.0,
+                           omegaf=np.zeros(3))
+
+
+CASES = {"bilimoria_wie": (bilimoria_wie, 3.2431), "full_inertia": (full_inertia, 7.6826)}
+
+
+def shared_guess(problem):
+    """Node states (7, N + 1) and T of our first start (the first perturbed eigenaxis seed)."""
+    planner = PLANNERS["collocation"]({"objective": "min_time"})
+    ocp = planner._ocp(problem)
+    transcription, nlp = planner._nlp(problem, ocp)
+    reference = planner._starts(problem)[0]
+    seed = transcription.seed(ocp, nlp, seed_sampler(problem, reference), reference.duration)
+    guess = perturbed(seed, 1)[0]
+    ns, nc = nlp.n_stage_state, nlp.n_interval
+    stages = np.concatenate([guess[:(ns + nc) * N].reshape(N, ns + nc)[:, :ns], guess[None, -ns:]])
+    return stages[:, :7].T, float(np.median(stages[:, 7]))
+
+
+def rigid_body(inertia):
+    x, u = ca.SX.sym("x", 7), ca.SX.sym("u", 3)
+    q, w = x[:4], x[4:]
+    I = ca.DM(inertia)
+    qdot = 0.5 * ca.vertcat(-ca.dot(q[1:], w), q[0] * w + ca.cross(q[1:], w))
+    return ca.Function("f", [x, u], [ca.vertcat(qdot, ca.solve(I, u - ca.cross(w, ca.mtimes(I, w))))])
+
+
+def terminal_error(qf, q_end):
+    return qf[0] * q_end[1:] - q_end[0] * ca.DM(qf[1:]) - ca.cross(ca.DM(qf[1:]), q_end[1:])
+
+
+def peer_fatrop(problem, states, T0):
+    """The hand-written Opti + FATROP multiple shooting described in the module docstring."""
+    f = rigid_body(problem.spacecraft.inertia)
+    x, u, h = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("h")
+    k1 = f(x, u); k2 = f(x + h / 2 * k1, u); k3 = f(x + h / 2 * k2, u); k4 = f(x + h * k3, u)
+    step = ca.Function("F", [x, u, h], [x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)])
+    u_max = float(problem.spacecraft.torquers.max_torque[0])
+    opti = ca.Opti()
+    X, U, T = [], [], []
+    for k in range(N + 1):
+        X.append(opti.variable(7))
+        T.append(opti.variable())
+        if k < N:
+            U.append(opti.variable(3))
+    for k in range(N):
+        opti.subject_to(X[k + 1] == step(X[k], U[k], T[k] / N))
+        opti.subject_to(T[k + 1] == T[k])
+        if k == 0:
+            opti.subject_to(X[0] == ca.DM(problem.initial_state))
+        opti.subject_to(opti.bounded(-u_max, U[k], u_max))
+        opti.subject_to(T[k] >= 0)
+    opti.subject_to(terminal_error(problem.qf, X[N][:4]) == 0)
+    opti.subject_to(X[N][4:] == 0)
+    opti.minimize(T[0])
+    for k in range(N + 1):
+        opti.set_initial(X[k], states[:, k])
+        opti.set_initial(T[k], T0)
+    opti.solver("fatrop", {"expand": True, "structure_detection": "auto", "fatrop.print_level": 0,
+                           "print_time": False})
+    return opti, T[0]
+
+
+def peer_rockit(problem, states, T0):
+    rockit = pytest.importorskip("rockit")
+    ocp = rockit.Ocp(T=rockit.FreeTime(T0))
+    x = ocp.state(7)
+    u = ocp.control(3)
+    f = rigid_body(problem.spacecraft.inertia)
+    ocp.set_der(x, f(x, u))
+    u_max = float(problem.spacecraft.torquers.max_torque[0])
+    ocp.subject_to(-u_max <= (u <= u_max))
+    ocp.subject_to(ocp.at_t0(x) == ca.DM(problem.initial_state))
+    ocp.subject_to(terminal_error(problem.qf, ocp.at_tf(x)[:4]) == 0)
+    ocp.subject_to(ocp.at_tf(x)[4:] == 0)
+    ocp.add_objective(ocp.T)
+    ocp.method(rockit.MultipleShooting(N=N, M=1, intg="rk"))
+    ocp.set_initial(x, states)
+    ocp.solver("ipopt", {"expand": True, "ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes"})
+    return ocp
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_min_time_ours(benchmark, case):
+    make, optimum = CASES[case]
+    problem = make()
+    planner = PLANNERS["collocation"]({"objective": "min_time"})
+    planner.plan(problem)  # the build
+    reference = benchmark(planner.plan, problem)
+    benchmark.extra_info.update(T=reference.duration, starts=len(reference.stats["starts"]),
+                                iterations=reference.stats["iterations"])
+    assert reference.duration == pytest.approx(optimum, abs=2e-4)
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_min_time_peer_fatrop(benchmark, case):
+    make, optimum = CASES[case]
+    problem = make()
+    opti, T = peer_fatrop(problem, *shared_guess(problem))
+    opti.solve()  # the build
+    solution = benchmark(opti.solve)
+    benchmark.extra_info.update(T=float(solution.value(T)), iterations=solution.stats()["iter_count"])
+    assert float(solution.value(T)) == pytest.approx(optimum, rel=2e-3)  # RK4, piecewise-constant torques
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_min_time_peer_rockit(benchmark, case):
+    make, optimum = CASES[case]
+    problem = make()
+    ocp = peer_rockit(problem, *shared_guess(problem))
+    ocp.solve()
+    solution = benchmark(ocp.solve)
+    T = float(solution.value(ocp.T))
+    benchmark.extra_info.update(T=T)
+    assert T == pytest.approx(optimum, rel=2e-3)
+
+
+def spin_paper_case():
+    return ManeuverProblem(Spacecraft([19.5, 19.0, 12.6], torquers=Torquers(0.1)), [1, 0, 0, 0], [0.2, 0, 0],
+                           [0, 0, 1, 0], 200.0)
+
+
+def test_min_energy_spin_case_solve(benchmark):
+    problem = spin_paper_case()
+    planner = PLANNERS["collocation"]({"intervals": N, "warm_start": "spin_extremal"})
+    planner.plan(problem)
+    reference = benchmark(planner.plan, problem)
+    benchmark.extra_info["objective"] = reference.stats["objective"]
+    assert reference.stats["objective"] == pytest.approx(0.018548, rel=1e-4)
+
+
+def test_min_energy_spin_case_build(benchmark):
+    problem = spin_paper_case()
+    planner = PLANNERS["collocation"]({"intervals": N, "warm_start": "spin_extremal"})
+    ocp = planner._ocp(problem)
+    from ocp.transcription import TRANSCRIPTIONS
+
+    transcription = TRANSCRIPTIONS["collocation"](N, 3)
+    benchmark.pedantic(lambda: transcription.build(ocp, "ipopt", solver_options("ipopt", 1e-10, 500)),
+                       rounds=3, iterations=1)
