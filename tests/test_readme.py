@@ -38,7 +38,7 @@ def _shell_commands() -> list[str]:
             line = line.split("#")[0].strip()
             commands += [part.strip() for part in line.split("&&") if part.strip()]
     # Inline mentions of a subcommand by name (`slewbench run` in prose) are not commands.
-    mentions = {f"slewbench {name}" for name in ("run", "validate", "sweep", "codegen")}
+    mentions = {"slewbench"} | {f"slewbench {name}" for name in ("run", "validate", "sweep", "codegen")}
     return commands + [c.strip() for c in INLINE if c.strip() not in commands and c.strip() not in mentions]
 
 
