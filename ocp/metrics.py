@@ -16,7 +16,7 @@ METRIC_KEYS: tuple[str, ...] = (
     "rms_error_deg", "max_error_deg", "settling_time_s", "saturation_fraction",
     "peak_wheel_momentum", "plan_time_s", "duration_s",
     "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
-    "fine_settling_time_s",
+    "fine_settling_time_s", "initial_rate_error",
 )
 DEFAULT_SETTLING_TOLERANCE_DEG = 0.5
 DEFAULT_DETUMBLE_TOLERANCE = 0.01
@@ -77,6 +77,7 @@ def compute_metrics(
     plan_time_s: float | None = None,
     duration_s: float | None = None,
     settling_tolerance_deg: float = DEFAULT_SETTLING_TOLERANCE_DEG,
+    initial_omega: ArrayLike | None = None,
     fine_settling_tolerance_deg: float | None = None,
     dipole: ArrayLike | None = None,
     inertia: ArrayLike | None = None,
@@ -92,6 +93,8 @@ def compute_metrics(
     target_q, target_omega : the manoeuvre's final attitude and rate (``None``: free).
     reference_q : (N+1, 4) reference attitude at ``t`` for the tracking errors (closed loop).
     wheel_momentum : (N+1, n_w) N m s; saturated : (N,) bool per sample.
+    initial_omega : (3,) rad/s, the manoeuvre's initial body rate ω0: gives ``initial_rate_error``
+        ``‖ω(t_0) − ω0‖`` (a reference that leaves ω(0) free starts away from it).
     settling_tolerance_deg, fine_settling_tolerance_deg : error angles (deg) of ``settling_time_s``
         and of ``fine_settling_time_s`` (``None``: that metric is null).
     dipole : (N, 3) A m², magnetorquer dipole held over each interval (``None``: no magnetorquers).
@@ -123,6 +126,8 @@ def compute_metrics(
         "peak_wheel_momentum": None,
         "plan_time_s": plan_time_s,
         "duration_s": duration_s,
+        "initial_rate_error": None if initial_omega is None
+        else float(np.linalg.norm(np.asarray(omega)[0] - np.asarray(initial_omega, dtype=float))),
         "fine_settling_time_s": None if fine_settling_tolerance_deg is None
         else settling_time(t, error_to_target, fine_settling_tolerance_deg),
         "detumble_time_s": detumble_time(t, np.asarray(omega, dtype=float), detumble_tolerance),
@@ -176,17 +181,31 @@ def metrics_from_reference(
     target_omega: ArrayLike | None = None,
     points: int = 2001,
     settling_tolerance_deg: float = DEFAULT_SETTLING_TOLERANCE_DEG,
+    initial_omega: ArrayLike | None = None,
     fine_settling_tolerance_deg: float | None = None,
     inertia: ArrayLike | None = None,
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
 ) -> dict[str, Any]:
     """Metrics of a reference's own motion and feed-forward torque over ``[0, duration]``,
-    sampled on ``points`` uniform times (trapezoidal integrals)."""
+    sampled on ``points`` uniform times (trapezoidal integrals).
+
+    Parameters
+    ----------
+    reference : a planner's reference (vectorised ``q``, ``omega``, ``torque``, ``duration``).
+    target_q, target_omega : the manoeuvre's final attitude and rate (``None``: free).
+    points : number of uniform sample times.
+    settling_tolerance_deg : deg, the settling band about ``target_q``.
+    initial_omega : (3,) rad/s, the manoeuvre's ω0, for ``initial_rate_error``.
+
+    Returns
+    -------
+    dict with every key of :data:`METRIC_KEYS`.
+    """
     t = np.linspace(0.0, reference.duration, points)
     return compute_metrics(
         t, reference.q(t), reference.omega(t), reference.torque(t), target_q, target_omega,
         plan_time_s=reference.plan_time_s, duration_s=reference.duration,
-        settling_tolerance_deg=settling_tolerance_deg,
+        settling_tolerance_deg=settling_tolerance_deg, initial_omega=initial_omega,
         fine_settling_tolerance_deg=fine_settling_tolerance_deg, inertia=inertia, detumble_tolerance=detumble_tolerance,
     )
 

@@ -2,7 +2,8 @@
 mapping with checks that name the offending key (``planners[1].options.weight``).
 
 Supported field types: ``float``, ``int``, ``bool``, ``str``, ``Literal[...]``, ``X | None``,
-``list[float]`` (a vector), ``list[list[float]]`` (a matrix), ``dict`` and ``list[dict]``;
+``list[float]`` (a vector), ``tuple[float, float, float]`` (a vector of that length, read from a
+YAML list), ``list[list[float]]`` (a matrix), ``dict`` and ``list[dict]``;
 ``float | list[list[float]]`` accepts either.
 
 Every numeric option declares its valid range next to its type, with ``typing.Annotated``::
@@ -146,9 +147,35 @@ def numeric_leaves(annotation: Any) -> bool:
     origin = typing.get_origin(annotation)
     if annotation in NUMERIC:
         return True
-    if origin in (Union, types.UnionType, list):
-        return any(numeric_leaves(arg) for arg in typing.get_args(annotation))
+    if origin in (Union, types.UnionType, list, tuple):
+        return any(numeric_leaves(arg) for arg in typing.get_args(annotation) if arg is not Ellipsis)
     return False
+
+
+SUPPORTED = ("float, int, bool, str, Literal[...], X | None, list[float] (a vector; Range(size=3) fixes its "
+             "length), tuple[float, float, float], list[list[float]] (a matrix), dict, list[dict]")
+
+
+def supported(annotation: Any) -> bool:
+    """Whether :func:`parse_options` can read an option of type ``annotation`` (see :data:`SUPPORTED`).
+
+    Parameters
+    ----------
+    annotation : a field type, without ``Annotated``.
+
+    Returns
+    -------
+    bool
+    """
+    origin = typing.get_origin(annotation)
+    if origin is Literal:
+        return True
+    if origin in (Union, types.UnionType):
+        return all(supported(arg) for arg in typing.get_args(annotation))
+    if origin in (list, tuple):
+        args = [arg for arg in typing.get_args(annotation) if arg is not Ellipsis]
+        return bool(args) and all(supported(arg) for arg in args)
+    return annotation in (float, int, bool, str, dict, type(None))
 
 
 def _describe(annotation: Any) -> str:
@@ -159,10 +186,15 @@ def _describe(annotation: Any) -> str:
         return " or ".join(_describe(a) for a in typing.get_args(annotation))
     if annotation is type(None):
         return "null"
-    if origin is list:
+    if origin is list or (origin is tuple and typing.get_args(annotation)[-1] is Ellipsis):
         inner = typing.get_args(annotation)[0]
         return {float: "a list of numbers", int: "a list of integers", str: "a list of names",
                 dict: "a list of mappings"}.get(inner, "a matrix (list of lists of numbers)")
+    if origin is tuple:
+        args = typing.get_args(annotation)
+        if all(arg is float for arg in args):
+            return f"a list of {len(args)} numbers"
+        return f"a list of {len(args)} values (" + ", ".join(_describe(a) for a in args) + ")"
     return {float: "a number", int: "an integer", bool: "true or false", str: "a string",
             dict: "a mapping"}.get(annotation, str(annotation))
 
@@ -210,12 +242,21 @@ def _convert(value: Any, annotation: Any) -> Any:
             raise TypeError
         inner = typing.get_args(annotation)[0]
         return [_convert(item, inner) for item in value]
+    if origin is tuple:
+        if not isinstance(value, (list, tuple)):
+            raise TypeError
+        args = typing.get_args(annotation)
+        if args[-1] is Ellipsis:
+            return tuple(_convert(item, args[0]) for item in value)
+        if len(value) != len(args):
+            raise TypeError
+        return tuple(_convert(item, arg) for item, arg in zip(value, args))
     raise TypeError
 
 
 def _check_range(value: Any, bounds: Range, path: str) -> None:
     """Raise :class:`OptionsError` if a number of ``value`` is outside ``bounds`` or the shape is wrong."""
-    if isinstance(value, list):
+    if isinstance(value, (list, tuple)):
         if bounds.size is not None and value and not isinstance(value[0], list) and len(value) != bounds.size:
             raise OptionsError(path, f"expected {bounds.size} numbers, got {len(value)}")
         if bounds.shape is not None and value and isinstance(value[0], list):
@@ -263,6 +304,10 @@ def parse_options(options_class: type[T], values: Mapping[str, Any] | T | None, 
     if not isinstance(values, Mapping):
         raise OptionsError(path, f"expected a mapping of option names to values, got {excerpt(values)}")
     fields = option_fields(options_class)
+    for name, (annotation, _) in fields.items():
+        if not supported(annotation):
+            raise TypeError(f"{options_class.__qualname__}.{name}: option type {annotation} is not supported; "
+                            f"write one of {SUPPORTED}")
     kwargs = {}
     for key, value in values.items():
         if key not in fields:

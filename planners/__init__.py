@@ -1,5 +1,5 @@
 """Reference-motion planners. ``PLANNERS`` maps registry names to planner classes."""
-from planners.base import (FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
+from planners.base import (BOUNDARY_CONDITIONS, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
 from planners.collocation import CollocationPlanner
 from planners.costate_tpbvp import CostateTPBVPPlanner
@@ -12,5 +12,5 @@ PLANNERS: dict[str, type[Planner]] = {
     cls.name: cls for cls in (CollocationPlanner, CostateTPBVPPlanner, EigenaxisPlanner, NaturalMotionPlanner, ShapePolynomialPlanner, SpinExtremalPlanner)
 }
 
-__all__ = ["FailedReference", "ManeuverProblem", "PLANNERS", "Planner", "Reference", "ReferenceSample",
+__all__ = ["BOUNDARY_CONDITIONS", "FailedReference", "ManeuverProblem", "PLANNERS", "Planner", "Reference", "ReferenceSample",
            "inverse_dynamics_torque"]

@@ -73,6 +73,7 @@ class CollocationPlanner(Planner):
     """Direct optimal control planner (see the module docstring)."""
 
     name = "collocation"
+    example_options = ({"intervals": 20}, {"intervals": 20, "transcription": "multiple_shooting"})
 
     @dataclass(frozen=True)
     class Options:

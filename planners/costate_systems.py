@@ -62,6 +62,11 @@ class HamiltonianSystem(ABC):
     """Solved by continuation in the target (a fixed-time steering form is not: it is singular for
     the nearby targets it can reach early, and its guess is already in the right basin)."""
 
+    def free_boundary(self) -> frozenset[str]:
+        """Boundary conditions of the problem this form leaves free or only penalises (a terminal
+        cost), as names of ``planners.base.BOUNDARY_CONDITIONS``; none by default."""
+        return frozenset()
+
     def __init__(self, problem: ManeuverProblem, t_f: float):
         self.problem, self.t_f_fixed = problem, t_f
         self.inertia = problem.spacecraft.inertia
@@ -238,6 +243,10 @@ class RateAcquisitionSystem(_RigidBodySystem):
         self.continued = minimum_time
         super().__init__(problem, t_f)
 
+    def free_boundary(self) -> frozenset[str]:
+        """The attitude is free (eq. 36); with a fixed time the final rate is a terminal cost."""
+        return frozenset({"qf"} if self.free_final_time else {"qf", "omegaf"})
+
     def torque(self, u):
         return ca.mtimes(ca.DM(self.torque_map), u)
 
@@ -312,6 +321,14 @@ class AttitudeAcquisitionSystem(HamiltonianSystem):
         t, y = ca.SX.sym("t"), ca.SX.sym("y", 8)
         rate = self.max_rate * self.control(y)
         self.rate = ca.Function("rate", [t, y], [rate, ca.mtimes(ca.jacobian(rate, y), self.rhs(t, y))])
+
+    def free_boundary(self) -> frozenset[str]:
+        """The rate starts and ends at rest (non-zero boundary rates are not met); with a fixed
+        time the final attitude is a terminal cost."""
+        p = self.problem
+        free = {name for name, rate in (("omega0", p.omega0), ("omegaf", p.omegaf))
+                if rate is not None and np.any(rate != 0)}
+        return frozenset(free | (set() if self.free_final_time else {"qf"}))
 
     def equations(self, t, y, u):
         q, lam_q = y[0:4], y[4:8]

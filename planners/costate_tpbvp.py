@@ -43,6 +43,9 @@ def _rate_acquisition(problem: ManeuverProblem, o, build: bool = True) -> Hamilt
     if torque.shape != (3,) or not np.all(np.isfinite(torque) & (torque > 0)):
         return (f"objective rate_acquisition needs a finite positive torque on every axis, got {torque}; "
                 "give the actuators limits or set options.steering_torque (N m per axis)")
+    if o.final_time != "fixed" and np.allclose(problem.omega0, problem.omegaf, rtol=0.0, atol=1e-12):
+        return ("objective rate_acquisition: the initial and target rates are equal, there is no rate to acquire "
+                "in minimum time; use objective min_energy for a slew")
     if not build:
         return None
     return RateAcquisitionSystem(problem, problem.duration, torque, np.diag(o.weighting), o.terminal_weight,
@@ -76,7 +79,8 @@ class CostateReference(Reference):
     """States and co-states from ``solve_bvp``'s C¹ interpolant on ``[0, t_f]``."""
 
     def __init__(self, system: HamiltonianSystem, solution, duration: float, message: str, stats: dict):
-        super().__init__("costate_tpbvp", duration, system.inertia, message=message, stats=stats)
+        super().__init__("costate_tpbvp", duration, system.inertia, message=message, stats=stats,
+                         free_boundary=system.free_boundary())
         self.system, self.solution = system, solution
 
     def state_and_costate(self, t) -> tuple[Array, Array]:
@@ -145,6 +149,7 @@ class CostateTPBVPPlanner(Planner):
     """Indirect (co-state) planner; see the module docstring."""
 
     name = "costate_tpbvp"
+    example_options = ({}, {"objective": "rate_acquisition"}, {"objective": "attitude_acquisition"})
 
     @dataclass(frozen=True)
     class Options:

@@ -129,11 +129,41 @@ class BangCoastBangProfile(AngleProfile):
         return position, rate, acceleration
 
 
+def unmet_rates(problem: ManeuverProblem, axis: Array, profile: AngleProfile) -> set[str]:
+    """The boundary rates an eigenaxis profile cannot meet: it rotates about ``axis`` only (the
+    quintic keeps the boundary rates' components along it), and the bang-coast-bang profiles
+    start and end at rest.
+
+    Parameters
+    ----------
+    problem : the manoeuvre.
+    axis : (3,) unit Euler axis, body axes.
+    profile : the angle profile.
+
+    Returns
+    -------
+    set of ``"omega0"`` / ``"omegaf"``.
+    """
+    along = isinstance(profile, QuinticProfile)
+    unmet = set()
+    for name, rate in (("omega0", problem.omega0), ("omegaf", problem.omegaf)):
+        if rate is None:
+            continue
+        kept = axis * (axis @ rate) if along else np.zeros(3)
+        if np.linalg.norm(rate - kept) > 1e-12 * max(1.0, float(np.linalg.norm(rate))):
+            unmet.add(name)
+    return unmet
+
+
 class EigenaxisReference(Reference):
     """``q(t) = q0 ⊗ [cos θ/2, e sin θ/2]``, ``ω = e θ̇`` (body axes)."""
 
-    def __init__(self, q0: Array, axis: Array, profile: AngleProfile, duration: float, inertia: Array, message: str):
-        super().__init__("eigenaxis", duration, inertia, message=message)
+    def __init__(self, q0: Array, axis: Array, profile: AngleProfile, duration: float, inertia: Array, message: str,
+                 problem: ManeuverProblem | None = None) -> None:
+        switches = [profile.ramp, profile.ramp + profile.coast] if isinstance(profile, BangCoastBangProfile) else []
+        super().__init__("eigenaxis", duration, inertia, message=message,
+                         free_boundary=() if problem is None else unmet_rates(problem, axis, profile),
+                         breakpoints=[t for t in switches if 0.0 < t < duration])
         self.q0, self.axis, self.profile = q0, axis, profile
 
     def _evaluate(self, t: Array) -> ReferenceSample:
@@ -157,6 +187,7 @@ class EigenaxisPlanner(Planner):
     """Eigenaxis slew planner; see the module docstring for the profiles."""
 
     name = "eigenaxis"
+    example_options = ({"profile": "smooth"}, {"profile": "trapezoidal"}, {"profile": "min_time"})
     closed_form = True
 
     @dataclass(frozen=True)
@@ -174,7 +205,7 @@ class EigenaxisPlanner(Planner):
             rate_end = 0.0 if problem.omegaf is None else float(axis @ problem.omegaf)
             profile = QuinticProfile(angle, problem.duration, float(axis @ problem.omega0), rate_end)
             return EigenaxisReference(problem.q0, axis, profile, problem.duration, inertia,
-                                      f"quintic, {np.rad2deg(angle):.2f} deg about {np.round(axis, 4).tolist()}")
+                                      f"quintic, {np.rad2deg(angle):.2f} deg about {np.round(axis, 4).tolist()}", problem)
         max_rate = self.options.max_rate if self.options.max_rate is not None else problem.max_rate
         bounds = self.options.torque_fraction * problem.torque_limit
         accel_axis = inertia @ axis
@@ -191,7 +222,7 @@ class EigenaxisPlanner(Planner):
         if angle < 1e-12:
             profile = BangCoastBangProfile(0.0, 1.0, 0.0)
             return EigenaxisReference(problem.q0, axis, profile, problem.duration if self.options.profile
-                                      == "trapezoidal" else 0.0, inertia, "no rotation needed")
+                                      == "trapezoidal" else 0.0, inertia, "no rotation needed", problem)
         if acceleration(0.0) <= 0:
             return FailedReference(self.name, f"the actuators give no torque about the axis {axis.round(4).tolist()}",
                                    "infeasible")
@@ -216,7 +247,7 @@ class EigenaxisPlanner(Planner):
         if self.options.profile == "min_time":
             profile = BangCoastBangProfile(angle, acceleration(best_rate), best_rate)
             return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,
-                                      f"minimum time {profile.duration:.3f} s, coast rate {best_rate:.4g} rad/s")
+                                      f"minimum time {profile.duration:.3f} s, coast rate {best_rate:.4g} rad/s", problem)
         if problem.duration < minimum_time * (1 - 1e-12):
             return FailedReference(self.name, f"T = {problem.duration:g} s is shorter than the minimum "
                                    f"bang-coast-bang time {minimum_time:.4g} s under the torque bounds", "infeasible")
@@ -230,4 +261,4 @@ class EigenaxisPlanner(Planner):
         profile.coast = problem.duration - 2 * profile.ramp  # exact T despite root tolerance
         profile.duration = problem.duration
         return EigenaxisReference(problem.q0, axis, profile, problem.duration, inertia,
-                                  f"bang-coast-bang, coast rate {coast_rate:.4g} rad/s")
+                                  f"bang-coast-bang, coast rate {coast_rate:.4g} rad/s", problem)

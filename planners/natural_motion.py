@@ -67,6 +67,11 @@ def symmetric_motion(t: Array, omega0: Array, moments: Array, axis: int, math=np
 
 def asymmetric_rates(t: Array, omega0: Array, moments: Array) -> Array:
     """Torque-free rates (N, 3) of an asymmetric body with Jacobi elliptic functions."""
+    omega0 = np.asarray(omega0, dtype=float)
+    if np.count_nonzero(np.abs(omega0) > 1e-15 * np.max(np.abs(omega0), initial=0.0)) <= 1:
+        # A spin about one principal axis is an equilibrium of Euler's equations; about the
+        # intermediate axis it sits on the separatrix, where the elliptic phase below is infinite.
+        return np.broadcast_to(omega0, np.shape(t) + (3,)).copy()
     order = np.argsort(moments)
     I, w0 = moments[order], omega0[order]
     h2, e2 = np.sum((I * w0) ** 2), np.sum(I * w0**2)
@@ -99,7 +104,9 @@ class NaturalMotionReference(Reference):
     """Torque-free arc on ``[0, arc]`` from ``q0`` with ``ω(0) = omega0``, then the stop."""
 
     def __init__(self, q0, omega0, moments, arc, duration, stop, message, stats):
-        super().__init__("natural_motion", duration, np.diag(moments), message=message, stats=stats)
+        # ω(0) is what the shooting found (the spin-up is left to the closed loop, as in the paper).
+        super().__init__("natural_motion", duration, np.diag(moments), message=message, stats=stats,
+                         free_boundary={"omega0"}, breakpoints=[arc] if 0 < arc < duration else [])
         self.q0, self.omega0, self.moments, self.arc, self.stop = q0, omega0, moments, arc, stop
         self.axis = symmetry_axis(moments)
         if self.axis is None:
@@ -142,7 +149,8 @@ class RotatedReference(Reference):
 
     def __init__(self, inner: Reference, axes: Array, q_body_to_principal: Array):
         super().__init__(inner.planner, inner.duration, axes @ inner.inertia @ axes.T, inner.status,
-                         inner.message + " (planned in principal axes)", inner.stats)
+                         inner.message + " (planned in principal axes)", inner.stats,
+                         free_boundary=inner.free_boundary, breakpoints=inner.breakpoints)
         self.inner, self.axes, self.q_rotation = inner, axes, q_body_to_principal
 
     def _evaluate(self, t: Array) -> ReferenceSample:
@@ -155,6 +163,7 @@ class NaturalMotionPlanner(Planner):
     """Natural-motion planner for any valid inertia (planned in its principal axes)."""
 
     name = "natural_motion"
+    example_options = ({}, {"stop": "smooth"})
 
     @dataclass(frozen=True)
     class Options:
@@ -162,6 +171,15 @@ class NaturalMotionPlanner(Planner):
         stop: Literal["step", "smooth"] = "step"    # rate reference to zero at once (paper) or a cubic
         rk4_steps: Annotated[int, Range(ge=4, le=5000)] = 60                         # RK4 steps of the asymmetric shooting (refined x4 as needed)
         starts: Annotated[int, Range(ge=1, le=50)] = 3                             # IPOPT starts (short, long way round, perturbed)
+
+    def problem_error(self, problem: ManeuverProblem) -> str | None:
+        """Why a natural motion cannot take ``problem``: no target, a non-zero final rate (it ends at
+        rest), or a ``stop_time`` that leaves no arc; else ``None``."""
+        if problem.omegaf is not None and np.any(problem.omegaf != 0):
+            return "natural_motion ends at rest: maneuver.final.omega must be zero or null"
+        if problem.duration <= self.options.stop_time:
+            return f"stop_time {self.options.stop_time} s leaves no arc in T = {problem.duration} s"
+        return super().problem_error(problem)
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         if not problem.spacecraft.is_principal:

@@ -122,6 +122,7 @@ class ShapePolynomialPlanner(Planner):
     """Shape-based quaternion polynomial planner (see the module docstring)."""
 
     name = "shape_polynomial"
+    example_options = ({"terms": 2}, {"terms": 2, "duration": "scenario", "cost": "torque"})
 
     @dataclass(frozen=True)
     class Options:
@@ -130,6 +131,17 @@ class ShapePolynomialPlanner(Planner):
         cost: Literal["path", "torque"] = "path"
         duration: Literal["rate_limit", "scenario"] = "rate_limit"
         max_rate: Annotated[float | None, Range(gt=0.0)] = None                               # rad/s; default: the problem's max_rate
+
+    def problem_error(self, problem: ManeuverProblem) -> str | None:
+        """Why the shape polynomials cannot take ``problem`` (no target; ``duration: rate_limit``
+        without a rate bound or for a slew that does not start and end at rest), or ``None``."""
+        o = self.options
+        if o.duration == "rate_limit":
+            if (o.max_rate if o.max_rate is not None else problem.max_rate) is None:
+                return "duration: rate_limit needs max_rate (option or maneuver.max_rate)"
+            if np.any(problem.omega0) or (problem.omegaf is not None and np.any(problem.omegaf)):
+                return "duration: rate_limit is for rest-to-rest slews; use duration: scenario"
+        return super().problem_error(problem)
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         o = self.options

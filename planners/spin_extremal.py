@@ -18,7 +18,7 @@ A vectorised multi-start over branches of ``K T``, over ``β`` and over ``c`` se
 """
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Iterable
 
 from dataclasses import dataclass
 
@@ -101,11 +101,20 @@ class SpinParameters:
 
 
 class SpinExtremalReference(Reference):
-    """``q(t) = q0 ⊗ q*(t)``, ``ω = ω*(t)``, torque of eq. 31."""
+    """``q(t) = q0 ⊗ q*(t)``, ``ω = ω*(t)``, torque of eq. 31.
+
+    The extremal's rates ``ω*(0) = [v, r sin β, r cos β]`` and ``ω*(T)`` are set by the parameters,
+    not by the problem: the initial transverse rates are free parameters of the method (matching
+    them would fix ``r`` and ``β`` and leave ``c`` alone to reach a three-dimensional target; with
+    the body at rest transversally, ``r = 0`` and the extremal is the free spin ``E1(v t)``), so
+    ``omega0`` and ``omegaf`` are declared free; ``qf`` too when ``J1`` is only a weighted cost
+    (``weight > 0``) or the parameters are fixed.
+    """
 
     def __init__(self, q0: Array, v: float, params: SpinParameters, duration: float, moments: Array,
-                 message: str, stats: dict):
-        super().__init__("spin_extremal", duration, np.diag(moments), message=message, stats=stats)
+                 message: str, stats: dict, free_boundary: Iterable[str] = ("omega0", "omegaf")) -> None:
+        super().__init__("spin_extremal", duration, np.diag(moments), message=message, stats=stats,
+                         free_boundary=free_boundary)
         self.q0, self.v, self.params, self.moments = q0, v, params, moments
 
     def _evaluate(self, t: Array) -> ReferenceSample:
@@ -123,6 +132,7 @@ class SpinExtremalPlanner(Planner):
     """Spin-stabilized extremal planner (Biggs & Horri); needs a principal-axis inertia."""
 
     name = "spin_extremal"
+    example_options = ({}, {"weight": 0.1})
 
     @dataclass(frozen=True)
     class Options:
@@ -131,10 +141,14 @@ class SpinExtremalPlanner(Planner):
         parameters: Annotated[list[float] | None, Range(size=3)] = None      # fixed [r, c, β] (rad/s, rad/s, rad): no optimisation
         starts: Annotated[int, Range(ge=1, le=50)] = 3                            # multi-start candidates polished by IPOPT
 
-    def _plan(self, problem: ManeuverProblem) -> Reference:
+    def problem_error(self, problem: ManeuverProblem) -> str | None:
+        """Why the spin extremals cannot take ``problem`` (no target, non-principal inertia), or ``None``."""
         if not problem.spacecraft.is_principal:
-            return FailedReference(self.name, "the spin extremals need a principal-axis (diagonal) inertia; "
-                                   "rotate the problem into principal axes first")
+            return ("the spin extremals need a principal-axis (diagonal) inertia; "
+                    "rotate the problem into principal axes first")
+        return super().problem_error(problem)
+
+    def _plan(self, problem: ManeuverProblem) -> Reference:
         moments = np.diag(problem.spacecraft.inertia).copy()
         v = float(problem.omega0[0]) if self.options.spin_rate is None else self.options.spin_rate
         T = problem.duration
@@ -155,7 +169,9 @@ class SpinExtremalPlanner(Planner):
         stats["torque_amplitudes"] = amplitudes.tolist()
         message = (f"r={params.r:.6g} c={params.c:.4g} beta={params.beta:.6g}; J1={stats['J1']:.3g} "
                    f"J2={stats['J2']:.4g}; torque amplitudes {np.array2string(amplitudes, precision=4)} N m")
-        return SpinExtremalReference(problem.q0, v, params, T, moments, message, stats)
+        soft_target = self.options.weight > 0 or self.options.parameters is not None
+        free = ("omega0", "omegaf") + (("qf",) if soft_target else ())
+        return SpinExtremalReference(problem.q0, v, params, T, moments, message, stats, free)
 
     def _seeds(self, v: float, T: float, moments: Array, target: Array) -> Array:
         """Best distinct starts of a grid over K T branches, c and β (vectorised evaluation)."""

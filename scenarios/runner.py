@@ -160,7 +160,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
                 reference, scenario.problem.qf, scenario.problem.omegaf,
                 settling_tolerance_deg=spec.settling_tolerance_deg,
                 fine_settling_tolerance_deg=spec.fine_settling_tolerance_deg,
-                inertia=scenario.problem.spacecraft.inertia, detumble_tolerance=spec.detumble_tolerance)
+                inertia=scenario.problem.spacecraft.inertia, detumble_tolerance=spec.detumble_tolerance,
+                initial_omega=scenario.problem.omega0)
         for controller in controllers:
             label = planner_spec.label if len(controllers) == 1 else f"{planner_spec.label} / {controller.label}"
             row = Row(label, planner_spec.name, reference.status, reference.message,

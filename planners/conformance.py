@@ -1,0 +1,296 @@
+"""Checks every planner's reference must pass (the planner contract of :mod:`planners.base`),
+and standard problems to plan for them.
+
+``tests/test_planner_conformance.py`` runs every check on every entry of ``PLANNERS`` (each of its
+``example_options``) for every standard problem the planner accepts (``problem_error`` is
+``None``), the way scipy tests every ``METHODS`` entry. A check raises :class:`ConformanceError`
+with a message that says what is wrong and what to do about it; a new planner can be checked by
+hand with :func:`check_reference`.
+
+Oracles: finite differences of the reference's own ``q`` and ``ω`` (kinematics, rate derivative,
+inverse dynamics), point-wise evaluation (vectorisation) and an independent numerical integration
+of the torque-free Euler and kinematic equations (continuation after T).
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from ocp import CircularOrbit, Environment, ReactionWheels, Spacecraft, Torquers, quat
+from planners.base import Array, ManeuverProblem, Reference, inverse_dynamics_torque
+
+ATTITUDE_TOLERANCE = 2e-5
+"""rad: boundary attitudes (about 1e-3 deg, what the shooting planners guarantee)."""
+RATE_TOLERANCE = 1e-7
+"""rad/s: boundary rates, plus ``RELATIVE_TOLERANCE`` times the reference's peak rate."""
+RELATIVE_TOLERANCE = 1e-5
+"""Finite-difference checks, relative to the scale of the compared quantity."""
+
+
+class ConformanceError(AssertionError):
+    """A reference breaks the planner contract; the message says what to fix."""
+
+
+def standard_problems() -> dict[str, ManeuverProblem]:
+    """Manoeuvres every planner is tried on (it may decline some through ``problem_error``).
+
+    Returns
+    -------
+    dict
+        Name to problem: rest to rest on a principal-axis body with wheels, rest to rest on a
+        non-principal body with ideal torquers, the spin paper's re-pointing of a spinning body
+        (free final rate), a rate-to-rate slew, and a rest-to-rest slew under gravity gradient.
+    """
+    wheels = ReactionWheels.from_body_axes(max_torque=0.1)
+    principal = Spacecraft([19.5, 19.0, 12.6], wheels=wheels)
+    rotation = quat.rotation_matrix(quat.from_axis_angle(np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0), 0.7))
+    non_principal = Spacecraft(rotation @ np.diag([10.0, 14.0, 18.0]) @ rotation.T, torquers=Torquers(1.0))
+    q0 = quat.from_axis_angle(np.array([0.3, -0.5, 0.8]) / np.sqrt(0.98), 0.4)
+    qf = quat.from_axis_angle(np.array([-0.6, 0.2, 0.7]) / np.sqrt(0.89), 1.9)
+    orbit = Environment(CircularOrbit(500e3, 0.9), gravity_gradient=True)
+    return {
+        "rest_to_rest": ManeuverProblem(principal, q0, np.zeros(3), qf, 150.0, omegaf=np.zeros(3), max_rate=0.05),
+        "non_principal": ManeuverProblem(non_principal, quat.IDENTITY, np.zeros(3), qf, 90.0, omegaf=np.zeros(3),
+                                         max_rate=0.08),
+        # Biggs & Horri's micro-satellite spinning at 0.2 rad/s about roll, re-pointed by 90 deg in 200 s.
+        "spinning": ManeuverProblem(principal, quat.IDENTITY, np.array([0.2, 0.0, 0.0]),
+                                    quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), np.pi / 2), 200.0),
+        "rate_to_rate": ManeuverProblem(Spacecraft([8.0, 6.0, 5.0], torquers=Torquers(0.5)), q0,
+                                        np.array([0.01, -0.02, 0.015]), qf, 80.0, omegaf=np.array([-0.01, 0.02, 0.0]),
+                                        max_rate=0.08),
+        "gravity_gradient": ManeuverProblem(non_principal, q0, np.zeros(3), qf, 120.0, omegaf=np.zeros(3),
+                                            environment=orbit, max_rate=0.05),
+    }
+
+
+def _fix_free(condition: str) -> str:
+    return (f"meet it, or, if the method cannot, declare it on the reference: "
+            f"Reference(..., free_boundary={{'{condition}'}}) (metrics then report the mismatch)")
+
+
+def check_boundary(problem: ManeuverProblem, reference: Reference) -> None:
+    """``q(0) = q0``, ``ω(0) = ω0``, ``q(T) = qf``, ``ω(T) = ωf`` (when fixed), except those the
+    reference declares in ``free_boundary``.
+
+    Parameters
+    ----------
+    problem : the planned problem.
+    reference : the planner's reference for it (status ok).
+
+    Raises
+    ------
+    ConformanceError
+        Naming the condition, both values and the fix.
+    """
+    T = reference.duration
+    start, end = reference.sample(0.0), reference.sample(T)
+    peak = float(np.max(np.linalg.norm(reference.omega(np.linspace(0.0, T, 201)), axis=1)))
+    rate_tolerance = RATE_TOLERANCE + RELATIVE_TOLERANCE * peak
+    checks = [("q0", "q(0)", start.q, problem.q0, True), ("omega0", "ω(0)", start.omega, problem.omega0, False),
+              ("qf", f"q(T = {T:g} s)", end.q, problem.qf, True),
+              ("omegaf", f"ω(T = {T:g} s)", end.omega, problem.omegaf, False)]
+    for condition, label, value, wanted, attitude in checks:
+        if wanted is None or condition in reference.free_boundary:
+            continue
+        if attitude:
+            error = float(quat.error_angle(value, wanted))
+            bad, unit, tolerance = error > ATTITUDE_TOLERANCE, "rad", ATTITUDE_TOLERANCE
+        else:
+            error = float(np.linalg.norm(value - wanted))
+            bad, unit, tolerance = error > rate_tolerance, "rad/s", rate_tolerance
+        if bad:
+            raise ConformanceError(
+                f"{reference.planner}: {label} = {np.round(value, 6).tolist()} but the problem asks "
+                f"{condition} = {np.round(wanted, 6).tolist()} (error {error:.3g} {unit} > {tolerance:.2g}); "
+                + _fix_free(condition))
+
+
+def check_times(reference: Reference, points: int = 41) -> tuple[Array, float]:
+    """Interior times for finite differences, away from 0, T and the declared breakpoints.
+
+    Parameters
+    ----------
+    reference : the reference to sample.
+    points : number of candidate times.
+
+    Returns
+    -------
+    times : (M,) s.
+    step : s, the finite-difference step.
+    """
+    T = reference.duration
+    step = 1e-5 * T
+    times = np.linspace(0.02, 0.98, points) * T
+    if reference.enforced_times is not None:
+        times = reference.enforced_times[(reference.enforced_times > 0.01 * T) & (reference.enforced_times < 0.99 * T)]
+        times = times[np.linspace(0, times.size - 1, min(points, times.size)).astype(int)]
+        step = 1e-7 * T  # the interpolant is a polynomial there: differences of the piece itself
+    if reference.breakpoints.size:
+        distance = np.min(np.abs(times[:, None] - reference.breakpoints[None, :]), axis=1)
+        times = times[distance > 5 * step]
+    return times, step
+
+
+def _aligned(q: Array, like: Array) -> Array:
+    """``q`` with each row's sign chosen to agree with ``like`` (the double cover)."""
+    return q * np.where(np.sum(q * like, axis=1) < 0, -1.0, 1.0)[:, None]
+
+
+def _where(times: Array, error: Array, scale: float) -> str:
+    k = int(np.argmax(error))
+    return f"worst at t = {times[k]:.6g} s: error {error[k]:.3g} against a scale of {scale:.3g}"
+
+
+def check_kinematics(reference: Reference) -> None:
+    """``q̇ = ½ q ⊗ [0, ω]``, with ``q̇`` by central differences of the reference's own ``q``.
+
+    Raises
+    ------
+    ConformanceError
+        If the reference's ``omega`` is not the rate of its ``q`` (a sign, a frame, inertial
+        instead of body axes, a missing factor ½).
+    """
+    times, h = check_times(reference)
+    sample = reference.sample(times)
+    q_dot = (_aligned(reference.q(times + h), sample.q) - _aligned(reference.q(times - h), sample.q)) / (2 * h)
+    expected = quat.kinematics(sample.q, sample.omega)
+    error = np.linalg.norm(q_dot - expected, axis=1)
+    scale = max(float(np.max(np.linalg.norm(expected, axis=1))), 1e-9)
+    if np.max(error) > RELATIVE_TOLERANCE * scale + 1e-12:
+        raise ConformanceError(
+            f"{reference.planner}: the reference's omega is not the body rate of its q: q̇ (finite differences) "
+            f"differs from ½ q ⊗ [0, ω], {_where(times, error, scale)}. ω must be the body rate in body axes, "
+            f"q scalar first rotating body to inertial; if ω jumps at some times, declare them in "
+            f"Reference(..., breakpoints=[...])")
+
+
+def check_dynamics(reference: Reference) -> None:
+    """``omega_dot`` is the derivative of ``omega`` and ``torque`` the inverse dynamics
+    ``I ω̇ + ω × I ω`` (both by central differences of the reference's own ``ω``).
+
+    Raises
+    ------
+    ConformanceError
+        If ``omega_dot`` has the wrong sign or scale, or the torque is not the rigid-body ``u``
+        (a missing gyroscopic term, wheel momentum or environment torque left out).
+    """
+    times, h = check_times(reference)
+    sample = reference.sample(times)
+    omega_dot = (reference.omega(times + h) - reference.omega(times - h)) / (2 * h)
+    inertia = reference.inertia
+    # A floor for references at constant rate: the rate change over the manoeuvre's time.
+    floor = float(np.max(np.linalg.norm(sample.omega, axis=1))) / reference.duration + 1e-15
+    scale_rate = max(float(np.max(np.linalg.norm(omega_dot, axis=1))), floor)
+    error = np.linalg.norm(sample.omega_dot - omega_dot, axis=1)
+    if np.max(error) > RELATIVE_TOLERANCE * scale_rate:
+        raise ConformanceError(
+            f"{reference.planner}: omega_dot is not the time derivative of omega (finite differences), "
+            f"{_where(times, error, scale_rate)}; check its sign and units (rad/s²)")
+    expected = inverse_dynamics_torque(inertia, sample.omega, omega_dot)
+    gyroscopic = np.cross(sample.omega, sample.omega @ inertia.T)
+    scale = max(float(np.max(np.linalg.norm(omega_dot @ inertia.T, axis=1))),
+                float(np.max(np.linalg.norm(gyroscopic, axis=1))), float(np.linalg.norm(inertia, 2)) * floor)
+    error = np.linalg.norm(sample.torque - expected, axis=1)
+    if np.max(error) > RELATIVE_TOLERANCE * scale:
+        raise ConformanceError(
+            f"{reference.planner}: the feed-forward torque is not the inverse dynamics I ω̇ + ω × I ω of the "
+            f"reference (ω̇ by finite differences), {_where(times, error, scale)}. The torque is the rigid-body u "
+            f"of I ω̇ = −ω × I ω + u (wheel momentum and environment torques included); use "
+            f"planners.inverse_dynamics_torque(inertia, omega, omega_dot)")
+
+
+def check_vectorised(reference: Reference) -> None:
+    """Evaluating an array of times equals evaluating each time alone (inside and after T).
+
+    Raises
+    ------
+    ConformanceError
+        If a row of the vectorised evaluation differs from the scalar one.
+    """
+    T = reference.duration
+    times = np.concatenate([np.linspace(0.0, T, 9), T * np.array([1.05, 1.3])])
+    together = reference.sample(times)
+    for k, t in enumerate(times):
+        alone = reference.sample(float(t))
+        for name, a, b in zip(together._fields, together, alone):
+            if np.shape(b) != np.shape(a[k]) or not np.allclose(a[k], b, rtol=1e-9, atol=1e-12 * (1 + np.max(np.abs(a)))):
+                raise ConformanceError(
+                    f"{reference.planner}: sample(t) for an array of times differs from sample(t) at t = {t:g} s "
+                    f"alone in {name}: {np.asarray(a[k]).round(9).tolist()} vs {np.asarray(b).round(9).tolist()}; "
+                    f"_evaluate must treat each time of its array independently")
+
+
+def check_after_end(reference: Reference, horizon: float | None = None) -> None:
+    """After T: the torque-free motion of the final state (integrated here with LSODA), zero torque.
+
+    Parameters
+    ----------
+    reference : the reference.
+    horizon : s after T to check (default ``min(T, 100)``).
+
+    Raises
+    ------
+    ConformanceError
+        If ``q``, ``ω``, ``ω̇`` after T are not torque-free motion or the torque is not zero.
+    """
+    T = reference.duration
+    horizon = min(T, 100.0) if horizon is None else horizon
+    end = reference.sample(T)
+    inertia, inverse = reference.inertia, np.linalg.inv(reference.inertia)
+
+    def rhs(_t: float, y: Array) -> Array:
+        w = y[4:]
+        return np.concatenate([quat.kinematics(y[:4], w), -inverse @ np.cross(w, inertia @ w)])
+
+    offsets = horizon * np.array([1e-3, 0.1, 0.37, 0.8, 1.0])
+    solution = solve_ivp(rhs, (0.0, horizon), np.concatenate([end.q, end.omega]), method="LSODA", t_eval=offsets,
+                         rtol=1e-11, atol=1e-13)
+    later = reference.sample(T + offsets)
+    q_expected, w_expected = quat.normalize(solution.y[:4].T), solution.y[4:].T
+    w_dot_expected = -np.cross(w_expected, w_expected @ inertia.T) @ inverse.T
+    rate_scale = 1e-9 + float(np.max(np.linalg.norm(w_expected, axis=1)))
+    problems = []
+    angle = quat.error_angle(later.q, q_expected)
+    if np.max(angle) > 1e-6:
+        problems.append(f"q differs by {np.max(angle):.3g} rad")
+    if np.max(np.linalg.norm(later.omega - w_expected, axis=1)) > 1e-7 * rate_scale:
+        problems.append(f"ω = {later.omega[-1].round(6).tolist()} instead of {w_expected[-1].round(6).tolist()} rad/s")
+    if np.max(np.linalg.norm(later.omega_dot - w_dot_expected, axis=1)) > 1e-6 * rate_scale**2 / 1 + 1e-12:
+        problems.append("ω̇ is not −I⁻¹ (ω × I ω)")
+    if np.max(np.abs(later.torque)) > 0:
+        problems.append(f"the torque is {np.max(np.abs(later.torque)):.3g} N m, not zero")
+    if problems:
+        raise ConformanceError(
+            f"{reference.planner}: after T = {T:g} s the reference must continue as the torque-free motion of its "
+            f"final state (Reference.sample does this when _evaluate only covers [0, T]): " + "; ".join(problems))
+
+
+CHECKS: dict[str, Callable[[ManeuverProblem, Reference], None]] = {
+    "boundary": check_boundary,
+    "kinematics": lambda problem, reference: check_kinematics(reference),
+    "dynamics": lambda problem, reference: check_dynamics(reference),
+    "vectorised": lambda problem, reference: check_vectorised(reference),
+    "after_end": lambda problem, reference: check_after_end(reference),
+}
+"""Every check, by name: ``check(problem, reference)`` raises :class:`ConformanceError`."""
+
+
+def check_reference(problem: ManeuverProblem, reference: Reference) -> None:
+    """Run every check of :data:`CHECKS` on a reference planned for ``problem``.
+
+    Parameters
+    ----------
+    problem : the planned problem.
+    reference : the planner's reference (must have status ``"ok"``).
+
+    Raises
+    ------
+    ConformanceError
+        At the first failed check, with what to fix.
+    """
+    if not reference.ok:
+        raise ConformanceError(f"{reference.planner}: status {reference.status!r}: {reference.message}")
+    for check in CHECKS.values():
+        check(problem, reference)

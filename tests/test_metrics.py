@@ -1,0 +1,164 @@
+"""Every metric key on hand-built motions, with the expected value worked out here from its
+definition (README, "Metrics"): zero-order-hold integrals are sums of held value x interval,
+norms are Euclidean, RMS is the root of the mean square, settling is the first sample time after
+which the error stays inside the band."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from ocp import (
+    METRIC_KEYS,
+    AttitudeModel,
+    ReactionWheels,
+    SimulationResult,
+    Spacecraft,
+    metrics_from_simulation,
+    quat,
+)
+from ocp.metrics import compute_metrics, metrics_from_reference
+from planners import Reference, ReferenceSample
+
+Z = np.array([0.0, 0.0, 1.0])
+T_GRID = np.array([0.0, 1.0, 2.5, 3.0, 5.0])           # non-uniform sample times, s
+HELD = np.array([[0.03, -0.04, 0.0],                     # N m held over each interval
+                 [0.0, 0.01, -0.02],
+                 [-0.05, 0.0, 0.012],
+                 [0.002, 0.003, 0.006]])
+ERROR_TO_TARGET_DEG = np.array([10.0, 0.4, 0.6, 0.3, 0.2])
+TRACKING_DEG = np.array([1.0, 2.0, 3.0, 0.0, 2.0])
+TARGET_ANGLE = 1.0  # rad about z
+OMEGA = np.array([[0.02, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.003, -0.004, 0.012]])
+WHEELS = np.array([[0.0, 0.1, 0.0], [0.2, -0.35, 0.1], [0.0, 0.0, 0.0], [0.1, 0.1, 0.1], [0.0, 0.3, 0.0]])
+SATURATED = np.array([True, False, False, True])
+
+
+def hand_built_result() -> SimulationResult:
+    spacecraft = Spacecraft([2.0, 3.0, 4.0], wheels=ReactionWheels.from_body_axes(max_torque=0.1))
+    q = np.stack([quat.from_axis_angle(Z, TARGET_ANGLE - np.deg2rad(e)) for e in ERROR_TO_TARGET_DEG])
+    x = np.hstack([q, OMEGA, WHEELS])
+    u = np.zeros((4, 3))
+    return SimulationResult(AttitudeModel(spacecraft), 1.0, T_GRID, x, u, u, HELD, SATURATED)
+
+
+class TrackedReference(Reference):
+    """A reference whose attitude is the simulated one turned by TRACKING_DEG about x at the samples."""
+
+    def __init__(self, q_samples: np.ndarray) -> None:
+        super().__init__("hand", T_GRID[-1], np.eye(3))
+        self.q_samples = q_samples
+
+    def _evaluate(self, t: np.ndarray) -> ReferenceSample:
+        k = np.searchsorted(T_GRID, t)
+        q = np.stack([quat.product(self.q_samples[i], quat.from_axis_angle(np.array([1.0, 0, 0]), np.deg2rad(TRACKING_DEG[i])))
+                      for i in k])
+        zeros = np.zeros((t.size, 3))
+        return ReferenceSample(q, zeros, zeros, zeros)
+
+
+@pytest.fixture(scope="module")
+def metrics():
+    result = hand_built_result()
+    reference = TrackedReference(result.q)
+    return metrics_from_simulation(result, quat.from_axis_angle(Z, TARGET_ANGLE), np.array([0.0, 0.0, 0.01]),
+                                   reference=reference, plan_time_s=0.25, duration_s=4.5,
+                                   fine_settling_tolerance_deg=0.25, detumble_tolerance=0.0125)
+
+
+def test_every_key_is_tested_here():
+    tested = {"int_u2", "int_u", "int_abs_u", "peak_u", "final_error_deg", "final_rate_error", "rms_error_deg",
+              "max_error_deg", "settling_time_s", "saturation_fraction", "peak_wheel_momentum", "plan_time_s",
+              "duration_s", "initial_rate_error", "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
+              "fine_settling_time_s"}
+    assert set(METRIC_KEYS) == tested
+
+
+def test_zero_order_hold_integrals(metrics):
+    dt = [1.0, 1.5, 0.5, 2.0]
+    int_u2 = sum(d * (a * a + b * b + c * c) for d, (a, b, c) in zip(dt, HELD))
+    int_u = sum(d * math.sqrt(a * a + b * b + c * c) for d, (a, b, c) in zip(dt, HELD))
+    int_abs = [sum(d * abs(row[i]) for d, row in zip(dt, HELD)) for i in range(3)]
+    assert metrics["int_u2"] == pytest.approx(int_u2, rel=1e-12)
+    assert metrics["int_u"] == pytest.approx(int_u, rel=1e-12)
+    assert metrics["int_abs_u"] == pytest.approx(int_abs, rel=1e-12)
+    assert metrics["peak_u"] == pytest.approx(0.05, rel=1e-12)  # |−0.05|, a negative component
+
+
+def test_errors_to_the_target(metrics):
+    assert metrics["final_error_deg"] == pytest.approx(0.2, rel=1e-9)
+    assert metrics["final_rate_error"] == pytest.approx(math.sqrt(0.003**2 + 0.004**2 + 0.002**2), rel=1e-12)
+    # Outside the 0.5 deg band at samples 0 and 2 (0.6 deg); inside from t[3] = 3 s on.
+    assert metrics["settling_time_s"] == 3.0
+
+
+def test_settling_edge_cases():
+    t = np.arange(4.0)
+    target = quat.IDENTITY
+    q = np.stack([quat.from_axis_angle(Z, np.deg2rad(e)) for e in (0.1, 0.2, 0.3, 0.9)])
+    w, u = np.zeros((4, 3)), np.zeros((3, 3))
+    assert compute_metrics(t, q, w, u, target)["settling_time_s"] is None      # leaves the band at the end
+    assert compute_metrics(t[:3], q[:3], w[:3], u[:2], target)["settling_time_s"] == 0.0  # always inside
+    assert compute_metrics(t, q, w, u, None)["settling_time_s"] is None        # free final attitude
+
+
+def test_tracking_errors(metrics):
+    assert metrics["rms_error_deg"] == pytest.approx(math.sqrt(sum(e * e for e in TRACKING_DEG) / 5), rel=1e-9)
+    assert metrics["max_error_deg"] == pytest.approx(3.0, rel=1e-9)
+
+
+def test_actuator_metrics_and_passed_values(metrics):
+    assert metrics["saturation_fraction"] == 0.5
+    assert metrics["peak_wheel_momentum"] == pytest.approx(0.35)  # |−0.35|
+    assert metrics["plan_time_s"] == 0.25 and metrics["duration_s"] == 4.5
+    assert metrics["initial_rate_error"] is None  # closed loop: the reference metric
+
+
+class RampTorque(Reference):
+    """u(t) = [a t, b, 0] on [0, T]; the attitude does not matter for the torque integrals."""
+
+    A, B, T = 0.02, -0.05, 10.0
+
+    def __init__(self) -> None:
+        super().__init__("hand", self.T, np.eye(3))
+
+    def _evaluate(self, t: np.ndarray) -> ReferenceSample:
+        q = np.tile(quat.IDENTITY, (t.size, 1))
+        omega = np.tile([0.1, 0.0, 0.0], (t.size, 1))
+        torque = np.stack([self.A * t, np.full_like(t, self.B), np.zeros_like(t)], axis=-1)
+        return ReferenceSample(q, omega, np.zeros((t.size, 3)), torque)
+
+
+def test_reference_integrals_against_closed_forms():
+    a, b, T = RampTorque.A, RampTorque.B, RampTorque.T
+    metrics = metrics_from_reference(RampTorque(), None, np.zeros(3), initial_omega=np.array([0.1, 0.03, -0.04]))
+    assert metrics["int_u2"] == pytest.approx(a**2 * T**3 / 3 + b**2 * T, rel=1e-6)
+    # ∫ sqrt(a² t² + b²) dt = [t s / 2 + b² asinh(a t / |b|) / (2 a)], s = sqrt(a² t² + b²)
+    s = math.sqrt(a * a * T * T + b * b)
+    assert metrics["int_u"] == pytest.approx(T * s / 2 + b * b * math.asinh(a * T / abs(b)) / (2 * a), rel=1e-6)
+    assert metrics["int_abs_u"] == pytest.approx([a * T**2 / 2, abs(b) * T, 0.0], rel=1e-9)
+    assert metrics["peak_u"] == pytest.approx(max(a * T, abs(b)))
+    assert metrics["final_rate_error"] == pytest.approx(0.1)
+    assert metrics["initial_rate_error"] == pytest.approx(0.05)  # ‖[0, −0.03, 0.04]‖
+    assert metrics["duration_s"] == T and metrics["final_error_deg"] is None
+
+
+def test_regulation_metrics(metrics):
+    # max_i |ω_i| per sample: 0.02, 0, 0, 0, 0.012: below 0.0125 rad/s from t[1] = 1 s on.
+    assert metrics["detumble_time_s"] == 1.0
+    assert metrics["final_rate"] == pytest.approx(math.sqrt(0.003**2 + 0.004**2 + 0.012**2), rel=1e-12)
+    start = 0.5 * 2.0 * 0.02**2                                            # ½ ωᵀ I ω, I = diag(2, 3, 4)
+    end = 0.5 * (2.0 * 0.003**2 + 3.0 * 0.004**2 + 4.0 * 0.012**2)
+    assert metrics["energy_ratio"] == pytest.approx(end / start, rel=1e-12)
+    # Fine band 0.25 deg: the 0.3 deg at t[3] is outside, the 0.2 deg at t[4] = 5 s inside.
+    assert metrics["fine_settling_time_s"] == 5.0
+    assert metrics["int_dipole"] is None  # no magnetorquers
+
+
+def test_dipole_integral_is_a_hold_integral_of_the_euclidean_norm():
+    dipole = np.array([[0.1, -0.2, 0.0], [0.0, 0.0, 0.3], [-0.05, 0.05, 0.05], [0.0, 0.0, 0.0]])
+    dt = [1.0, 1.5, 0.5, 2.0]
+    expected = sum(d * math.sqrt(a * a + b * b + c * c) for d, (a, b, c) in zip(dt, dipole))
+    metrics = compute_metrics(T_GRID, np.tile(quat.IDENTITY, (5, 1)), OMEGA, HELD, None, dipole=dipole)
+    assert metrics["int_dipole"] == pytest.approx(expected, rel=1e-12)
