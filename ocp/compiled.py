@@ -70,17 +70,20 @@ def compile_function(function: ca.Function, directory: Path | None = None) -> ca
     digest = hashlib.sha256("\n".join([text, compiler, *CFLAGS, ca.__version__]).encode()).hexdigest()[:32]
     directory = Path(directory) if directory is not None else cache_directory()
     library = directory / f"{name}_{digest}.so"
-    if not library.exists():
-        directory.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryDirectory(prefix=".build-", dir=directory) as build:
-            c_file = Path(build) / f"{name}.c"
-            c_file.write_text(text)
-            partial = Path(build) / library.name
-            completed = subprocess.run([compiler, *CFLAGS, str(c_file), "-o", str(partial), "-lm"],
-                                       capture_output=True, text=True, check=False)
-            if completed.returncode != 0:
-                raise CompilerUnavailable(f"{Path(compiler).name} failed: {completed.stderr.strip()[:300]}")
-            os.replace(partial, library)  # atomic: a concurrent build of the same code is harmless
+    try:
+        if not library.exists():
+            directory.mkdir(parents=True, exist_ok=True)
+            with tempfile.TemporaryDirectory(prefix=".build-", dir=directory) as build:
+                c_file = Path(build) / f"{name}.c"
+                c_file.write_text(text)
+                partial = Path(build) / library.name
+                completed = subprocess.run([compiler, *CFLAGS, str(c_file), "-o", str(partial), "-lm"],
+                                           capture_output=True, text=True, check=False)
+                if completed.returncode != 0:
+                    raise CompilerUnavailable(f"{Path(compiler).name} failed: {completed.stderr.strip()[:300]}")
+                os.replace(partial, library)  # atomic: a concurrent build of the same code is harmless
+    except OSError as error:  # an unusable cache directory (a file, read-only, full): build nothing
+        raise CompilerUnavailable(f"cannot build in the cache {directory}: {error.strerror or error}") from None
     return ca.external(name, str(library))
 
 

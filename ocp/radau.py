@@ -124,6 +124,14 @@ class RadauCollocation(Transcription):
         states = ca.reshape(ca.vertcat(S[:, :N], C[:nx * d, :]), nx, N * (d + 1))
         return states, C[nx * d:, :]
 
+    def smoothness(self, duration):
+        """The state polynomials join continuously at the mesh nodes, their slopes and the controls
+        do not; the dynamics hold at the Radau points inside each interval."""
+        nodes = np.arange(1, self.intervals) * duration / self.intervals
+        radau = self.tau[1:-1] if self.tau[-1] == 1.0 else self.tau[1:]
+        inner = ((np.arange(self.intervals)[:, None] + radau[None, :]) * duration / self.intervals).ravel()
+        return nodes, inner
+
     def interpolate(self, model, states, controls, duration, t):
         N, d, h = self.intervals, self.degree, duration / self.intervals
         k = np.minimum((t / h).astype(int), N - 1)

@@ -74,6 +74,10 @@ class MultipleShooting(Transcription):
         nx = self._nx
         return S[:nx, :], S[nx:, :]
 
+    def smoothness(self, duration):
+        """Cubic Hermite states with the model's derivatives at the nodes: C¹, exact at the nodes."""
+        return np.zeros(0), np.arange(1, self.intervals) * duration / self.intervals
+
     def interpolate(self, model, states, controls, duration, t):
         N = self.intervals
         h = duration / N

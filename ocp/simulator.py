@@ -33,7 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp import quat
 from ocp.actuators import ActuatorModel, Command, Measurement
-from ocp.closed_loop import NOISE_SIZE, ClosedLoop, draw_noise
+from ocp.closed_loop import ClosedLoop, draw_noise
 from ocp.compiled import CompilerUnavailable, compile_function, notice
 from ocp.fast_call import BufferedFunction
 from ocp.integration import rk4_step

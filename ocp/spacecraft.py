@@ -76,6 +76,8 @@ class ReactionWheels:
         failed = tuple(int(i) for i in self.failed)
         if any(i < 0 or i >= n for i in failed):
             raise ModelError("failed", f"failed wheel indices must be in 0..{n - 1}, got {list(failed)}")
+        if len(set(failed)) != len(failed):
+            raise ModelError("failed", f"each failed wheel is listed once, got {list(failed)}")
         object.__setattr__(self, "failed", failed)
 
     @classmethod

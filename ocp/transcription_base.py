@@ -164,6 +164,11 @@ class Transcription(ABC):
                     t: Array) -> tuple[Array, Array]:
         """States ``(n, nx)`` and controls ``(n, nu)`` at times ``t`` in ``[0, duration]``."""
 
+    @abstractmethod
+    def smoothness(self, duration: float) -> tuple[Array, Array]:
+        """``(breakpoints, enforced_times)`` of an interpolated solution over ``[0, duration]``:
+        the times where its slopes may jump, and the times where the dynamics are imposed."""
+
     # -- the shared stage-wise assembly -------------------------------------------------------
     @staticmethod
     def terminal(problem: OptimalControlProblem, x_end, qf, omegaf):

@@ -18,16 +18,7 @@ class CollocationReference(Reference):
 
     def __init__(self, problem: ManeuverProblem, transcription, duration: float, states: Array, controls: Array,
                  stats: dict):
-        nodes = np.arange(1, transcription.intervals) * duration / transcription.intervals
-        if transcription.name == "collocation":
-            # The state polynomials join continuously at the mesh nodes, their slopes and the
-            # controls do not; the dynamics hold at the Radau points inside each interval.
-            radau = transcription.tau[1:-1] if transcription.tau[-1] == 1.0 else transcription.tau[1:]
-            inner = ((np.arange(transcription.intervals)[:, None] + radau[None, :]) * duration
-                     / transcription.intervals).ravel()
-            breakpoints = nodes
-        else:  # cubic Hermite states with the model's derivatives at the nodes: C¹, exact at the nodes
-            inner, breakpoints = nodes, np.zeros(0)
+        breakpoints, inner = transcription.smoothness(duration)
         super().__init__("collocation", duration, problem.spacecraft.inertia, stats=stats,
                          free_boundary=(), breakpoints=breakpoints, enforced_times=inner)
         self.model, self.transcription = problem.model, transcription

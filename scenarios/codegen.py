@@ -17,7 +17,6 @@ from __future__ import annotations
 import json
 import re
 import shutil
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -28,12 +27,7 @@ from controllers import CONTROLLERS
 from ocp.layout import REFERENCE_FIELDS, control_layout
 from planners import PLANNERS
 from scenarios.loader import Scenario
-from scenarios.outputs import (
-    STAGING_PREFIX,
-    claim_output_directory,
-    commit_outputs,
-    row_stems,
-)
+from scenarios.outputs import claim_output_directory, commit_outputs, new_staging, row_stems
 from scenarios.yaml_node import ScenarioError
 
 
@@ -121,10 +115,12 @@ def generate(scenario: Scenario, out: str | Path) -> CodegenReport:
             report.skipped[planner_spec.label] = reference.message if not reference.ok else "no symbolic evaluator"
             continue
         name = f"slewbench_reference_{c_identifier(row)}"
+        if name in (f.name() for f in functions):  # stems a-b and a_b make the same identifier
+            name = f"{name}_{len(functions)}"
         functions.append(_renamed(evaluator, name))
         interface["references"][planner_spec.label] = {"function": name, "duration_s": reference.duration,
                                                        "output": "row [q, omega, omega_dot, torque] (13)"}
-    staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=directory))
+    staging = new_staging(directory)
     try:
         generator = ca.CodeGenerator(f"{stem}.c", {"with_header": True})
         for function in functions:

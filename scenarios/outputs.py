@@ -15,7 +15,9 @@ The rules (README, "What slewbench writes"):
 """
 from __future__ import annotations
 
+import contextlib
 import csv
+import fcntl
 import hashlib
 import json
 import os
@@ -24,7 +26,7 @@ import shutil
 import tempfile
 import unicodedata
 from pathlib import Path
-from typing import Any, Iterable, Sequence
+from typing import Any, Iterable, Iterator, Sequence
 
 import numpy as np
 
@@ -127,7 +129,61 @@ def read_manifest(directory: Path) -> dict[str, Any] | None:
         return None
     if not isinstance(manifest, dict) or manifest.get("tool") != "slewbench" or not isinstance(manifest.get("files"), list):
         return None
+    if not all(isinstance(name, str) and _is_plain_relative(name) for name in manifest["files"]):
+        return None  # a manifest naming files outside its directory is not ours to act on
     return manifest
+
+
+def _is_plain_relative(name: str) -> bool:
+    """A relative path without ``..``, empty or absolute parts: it stays inside its directory."""
+    path = Path(name)
+    return bool(name) and not path.is_absolute() and all(part not in ("", ".", "..") for part in path.parts)
+
+
+def _check_inside(directory: Path, name: str) -> None:
+    """Refuse a path whose folders under ``directory`` are symbolic links (they would send writes
+    and deletions elsewhere)."""
+    folder = directory
+    for part in Path(name).parts[:-1]:
+        folder = folder / part
+        if folder.is_symlink():
+            raise OutputError(directory, f"{folder} is a symbolic link; slewbench writes only inside its own "
+                                         "directory, nothing was replaced")
+
+
+@contextlib.contextmanager
+def _locked(directory: Path) -> Iterator[None]:
+    """An exclusive lock on ``directory`` while a run commits into it (other runs wait)."""
+    handle = os.open(directory, os.O_RDONLY)
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        yield
+    finally:
+        fcntl.flock(handle, fcntl.LOCK_UN)
+        os.close(handle)
+
+
+def new_staging(directory: Path) -> Path:
+    """A staging folder inside the marked ``directory``, named after this process, so that a later
+    run removes it only once this process is gone."""
+    return Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{os.getpid()}-", dir=directory))
+
+
+def _abandoned(staging: Path) -> bool:
+    """Whether the process that made ``staging`` has ended."""
+    try:
+        pid = int(staging.name[len(STAGING_PREFIX):].split("-")[0])
+    except ValueError:
+        return True
+    if pid == os.getpid():
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except PermissionError:
+        return False
+    return False
 
 
 def _write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: str) -> None:
@@ -175,8 +231,11 @@ def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
                                         "not empty; choose a new or empty directory, nothing was touched")
             if manifest is None:
                 _write_manifest(directory, [], complete=False, kind=kind)
+            elif manifest.get("kind", kind) != kind and manifest["files"]:
+                raise OutputError(path, f"holds slewbench {manifest.get('kind')} output; write the {kind} output "
+                                        "into a directory of its own, nothing was touched")
             for leftover in directory.glob(f"{STAGING_PREFIX}*"):
-                if leftover.is_dir() and not leftover.is_symlink():
+                if leftover.is_dir() and not leftover.is_symlink() and _abandoned(leftover):
                     shutil.rmtree(leftover, ignore_errors=True)
         else:
             for parent in directory.parents:
@@ -229,11 +288,20 @@ def commit_outputs(directory: Path, staging: Path, kind: str) -> list[str]:
     list of str
         The files now listed by the manifest (relative paths).
     """
+    with _locked(directory):
+        return _commit(directory, staging, kind)
+
+
+def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
     manifest = read_manifest(directory)
     if manifest is None:
         raise OutputError(directory, f"lost its {MARKER} while running; nothing was replaced")
+    if manifest.get("kind", kind) != kind and manifest["files"]:
+        raise OutputError(directory, f"now holds slewbench {manifest.get('kind')} output; nothing was replaced")
     previous = set(manifest["files"])
     new = _relative_files(staging)
+    for name in previous | set(new):
+        _check_inside(directory, name)
     clashes = [name for name in new if name not in previous and os.path.lexists(directory / name)]
     if clashes:
         raise OutputError(directory, f"holds files slewbench did not write ({', '.join(clashes[:5])}); "
@@ -272,7 +340,7 @@ def write_results(results: Any, directory: str | Path, plots: bool = True) -> Pa
         The absolute output directory.
     """
     target = claim_output_directory(directory)
-    staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=target))
+    staging = new_staging(target)
     try:
         (staging / "results.json").write_text(to_json(results))
         (staging / "results.csv").write_text(to_csv(results))

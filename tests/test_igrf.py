@@ -59,7 +59,9 @@ def test_tabulated_igrf_agrees_with_the_package(altitude_km, inclination_deg, ra
     between = np.sort(rng.uniform(0.0, field.valid_until, 40))
     between[:10] = field.nodes[:10] + 0.5 * field.step  # mid-intervals
     position = orbit.function()
-    for times, limit in ((nodes, lambda b: 1e-9), (between, lambda b: 1e-3 * np.linalg.norm(b))):
+    # The bound between nodes is 0.1 % of |B|; a cubic spline at 30 s nodes achieves ~4e-6, and a
+    # linear or shifted table would not, so the test holds the spline to 2e-5 (inside the bound).
+    for times, limit in ((nodes, lambda b: 1e-9), (between, lambda b: 2e-5 * np.linalg.norm(b))):
         expected = package_field(times, *args)
         for t, b in zip(times, expected):
             got = field.interpolant(t).full().ravel()

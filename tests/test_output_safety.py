@@ -209,3 +209,61 @@ def test_sigterm_during_a_run_writes_nothing_outside_the_marker(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "s.yaml"]
     assert json.loads((out / MARKER).read_text())["complete"] is False
     assert not list(out.glob(f"{STAGING_PREFIX}*"))
+
+
+def test_a_manifest_naming_files_outside_its_directory_is_not_trusted(tmp_path, capsys):
+    """A shared or edited manifest listing ``../x`` or an absolute path must not make a run
+    delete or replace those files: the directory is then not slewbench's."""
+    path = scenario(tmp_path)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    precious, absolute = tmp_path / "precious.txt", tmp_path / "abs.txt"
+    precious.write_text("keep")
+    absolute.write_text("keep")
+    manifest = json.loads((out / MARKER).read_text())
+    manifest["files"] += ["../precious.txt", str(absolute)]
+    (out / MARKER).write_text(json.dumps(manifest))
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 2
+    assert precious.read_text() == "keep" and absolute.read_text() == "keep"
+    assert "did not create" in capsys.readouterr().err
+
+
+def test_a_symlinked_folder_inside_the_output_is_refused(tmp_path, capsys):
+    path = scenario(tmp_path)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    elsewhere = tmp_path / "userdata"
+    elsewhere.mkdir()
+    (elsewhere / "smooth.csv").write_text("user")
+    (elsewhere / "old.csv").write_text("user")
+    manifest = json.loads((out / MARKER).read_text())
+    manifest["files"].append("timeseries/old.csv")
+    (out / MARKER).write_text(json.dumps(manifest))
+    for name in list((out / "timeseries").iterdir()):
+        name.unlink()
+    (out / "timeseries").rmdir()
+    (out / "timeseries").symlink_to(elsewhere)
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 2
+    assert "symbolic link" in capsys.readouterr().err
+    assert (elsewhere / "smooth.csv").read_text() == "user" and (elsewhere / "old.csv").read_text() == "user"
+
+
+def test_a_live_runs_staging_folder_survives_another_run(tmp_path):
+    """Two runs into one directory: the second removes only staging folders of dead processes."""
+    from scenarios.outputs import claim_output_directory, new_staging
+    out = claim_output_directory(tmp_path / "out")
+    mine = new_staging(out)  # this process is alive
+    dead = out / f"{STAGING_PREFIX}999999999-x"
+    dead.mkdir()
+    claim_output_directory(out)
+    assert mine.is_dir() and not dead.exists()
+
+
+def test_codegen_output_never_replaces_a_runs_results(tmp_path, capsys):
+    path = scenario(tmp_path)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    before = snapshot(out)
+    assert main(["codegen", str(path), "--out", str(out)]) == 2
+    assert "directory of its own" in capsys.readouterr().err
+    assert snapshot(out) == before
