@@ -20,6 +20,7 @@ value and the range. Checks that relate several options live in the dataclass's
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import types
 import typing
@@ -269,8 +270,10 @@ def _check_range(value: Any, bounds: Range, path: str) -> None:
         raise OptionsError(path, f"expected {bounds.describe()}, got {excerpt(value)}")
 
 
+@functools.cache
 def option_fields(options_class: type) -> dict[str, tuple[Any, Range | None]]:
-    """``{name: (type, Range or None)}`` of an options dataclass."""
+    """``{name: (type, Range or None)}`` of an options dataclass (computed once per class: a
+    trade study validates every case's options; do not mutate the result)."""
     hints = typing.get_type_hints(options_class, include_extras=True)
     return {f.name: _split(hints[f.name]) for f in dataclasses.fields(options_class)}
 

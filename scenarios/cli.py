@@ -1,4 +1,4 @@
-"""``slewbench`` command line: run, validate, list, codegen.
+"""``slewbench`` command line: run, validate, list, codegen, sweep.
 
 Exit status: 0 when the run completed (a failed planner is a row, not an error), 2 for a bad
 scenario file, 1 for an internal error.
@@ -20,6 +20,7 @@ from planners import PLANNERS
 from scenarios.loader import load
 from scenarios.outputs import claim_output_directory, default_output_directory
 from scenarios.runner import run
+from scenarios.sweep_cli import add_sweep_parser
 from scenarios.yaml_node import ScenarioError
 
 EXIT_OK, EXIT_INTERNAL, EXIT_BAD_SCENARIO = 0, 1, 2
@@ -94,6 +95,7 @@ def build_parser() -> argparse.ArgumentParser:
     codegen_parser.set_defaults(handler=command_codegen)
     list_parser = commands.add_parser("list", help="registered planners and controllers")
     list_parser.set_defaults(handler=command_list)
+    add_sweep_parser(commands)
     return parser
 
 

@@ -1,0 +1,116 @@
+"""Monte Carlo dispersions of a trade study: distributions drawn by inverse transform from unit
+samples (plain random or a Latin hypercube from ``scipy.stats.qmc``), applied to a scenario path.
+
+``{normal: {mean, std}}`` and ``{uniform: [low, high]}`` (scalars or vectors) set the value;
+``{scale: <distribution>}`` multiplies the base scenario's value and ``{offset: <distribution>}``
+adds to it; ``case_seed`` sets the case's own seed (for ``simulation.sensor_noise.seed``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.special import ndtri
+from scipy.stats import qmc
+
+from scenarios.study_paths import Step, get_path
+from scenarios.yaml_node import Node
+
+_EPS = 1e-12  # keeps the normal's inverse CDF finite at u = 0
+
+
+@dataclass
+class Dispersion:
+    """A distribution of ``dimension`` independent components and how it meets the base value.
+
+    ``kind``: normal | uniform | case_seed; ``combine``: set | scale | offset;
+    ``a``, ``b``: (mean, std) or (low, high) per component; ``vector``: a list, not a scalar.
+    """
+
+    kind: str
+    combine: str
+    a: np.ndarray
+    b: np.ndarray
+    vector: bool
+
+    @property
+    def dimension(self) -> int:
+        return 0 if self.kind == "case_seed" else int(self.a.size)
+
+    @property
+    def needs_base(self) -> bool:
+        return self.combine != "set"
+
+    def value(self, unit: np.ndarray, seed: int, base: Any) -> Any:
+        """The dispersed value from unit samples ``unit`` (in [0, 1)) and the base value."""
+        if self.kind == "case_seed":
+            return seed
+        if self.kind == "normal":
+            draw = self.a + self.b * ndtri(np.clip(unit, _EPS, 1.0 - _EPS))  # the normal's inverse CDF
+        else:
+            draw = self.a + unit * (self.b - self.a)
+        draw = draw if self.vector else float(draw[0])
+        if self.combine == "set":
+            return draw
+        base = np.asarray(base, dtype=float)
+        return base * draw if self.combine == "scale" else base + draw
+
+
+def _pair(node: Node, kind: str) -> tuple[np.ndarray, np.ndarray, bool]:
+    """(a, b, vector) of a normal or uniform entry."""
+    if kind == "normal":
+        spec = node.mapping()
+        first, second = spec.get("mean", required=True), spec.get("std", required=True)
+    else:
+        spec = node
+        if isinstance(node.value, list):
+            if len(node.value) != 2:
+                raise node.error(f"expected [low, high], got {node.value!r:.80}")
+            first, second = Node(node.value[0], f"{node.path}[0]"), Node(node.value[1], f"{node.path}[1]")
+        else:
+            spec = node.mapping()
+            first, second = spec.get("low", required=True), spec.get("high", required=True)
+    vector = isinstance(first.value, list)
+    a = first.vector() if vector else np.atleast_1d(first.number())
+    b = second.vector(a.size) if vector else np.atleast_1d(second.number())
+    if kind == "normal" and np.any(b < 0):
+        raise second.error(f"a standard deviation cannot be negative, got {second.value!r}")
+    if kind == "uniform" and np.any(b < a):
+        raise node.error(f"expected low <= high, got {node.value!r:.80}")
+    if isinstance(spec.value, dict):
+        spec.finish()
+    return a, b, vector
+
+
+def parse_dispersion(node: Node, base: dict[str, Any], steps: list[Step]) -> Dispersion:
+    """Parse the dispersion at ``node`` for the scenario path ``steps`` of ``base``."""
+    if node.value == "case_seed":
+        return Dispersion("case_seed", "set", np.zeros(0), np.zeros(0), False)
+    combine = "set"
+    if isinstance(node.value, dict) and len(node.value) == 1 and next(iter(node.value)) in ("scale", "offset"):
+        combine = next(iter(node.value))
+        node = node.get(combine)
+    if not isinstance(node.value, dict) or len(node.value) != 1 or next(iter(node.value)) not in ("normal", "uniform"):
+        raise node.error(f"expected case_seed, {{normal: {{mean, std}}}}, {{uniform: [low, high]}} or "
+                         f"{{scale|offset: <distribution>}}; got {node.value!r:.80}")
+    kind = next(iter(node.value))
+    a, b, vector = _pair(node.get(kind), kind)
+    if combine != "set":
+        base_value = get_path(base, steps, node.path)
+        try:
+            array = np.asarray(base_value, dtype=float)
+        except (TypeError, ValueError):
+            raise node.error(f"{combine} needs a number or numbers in the base scenario, got {base_value!r:.60}") from None
+        if vector and array.shape[-1:] != (a.size,):
+            raise node.error(f"{a.size} components do not match the base value of shape {array.shape}")
+    return Dispersion(kind, combine, a, b, vector)
+
+
+def draw_unit(method: str | None, dimension: int, samples: int, rng: np.random.Generator) -> np.ndarray:
+    """(samples, dimension) points in [0, 1): independent uniforms, or a Latin hypercube design."""
+    if dimension == 0:
+        return np.zeros((samples, 0))
+    if method == "latin_hypercube":
+        return qmc.LatinHypercube(d=dimension, seed=rng).random(samples)
+    return rng.random((samples, dimension))

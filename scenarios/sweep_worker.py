@@ -1,0 +1,115 @@
+"""What a trade-study worker runs: one resolved case in, plain rows out.
+
+A worker receives plain data (the case's scenario mapping, parsed here with
+:func:`scenarios.parse_scenario`), never CasADi objects, and returns a dict of plain values. Each
+worker process keeps one :class:`ocp.SolverCache` for its whole life, so a collocation NLP is
+built once per worker and structure; a process-wide lock runs one case at a time per process
+(IPOPT's linear solvers are not thread-safe), so a Dask worker should be started with
+``--nthreads 1`` and as many processes as cores.
+"""
+from __future__ import annotations
+
+import functools
+import os
+import signal
+import socket
+import threading
+import time
+import traceback
+from typing import Any
+
+from ocp import SolverCache
+
+
+class CaseTimeout(Exception):
+    """Raised inside a worker when a case exceeds its time limit."""
+
+
+@functools.cache
+def worker_state() -> tuple[SolverCache, threading.Lock]:
+    """This process's solver cache and case lock (created on first use, kept for its life)."""
+    return SolverCache(), threading.Lock()
+
+
+def _controllers(scenario: dict[str, Any]) -> list[tuple[str, str]]:
+    """(label, name) of the scenario mapping's controllers (``controllers:`` list or ``controller:``)."""
+    entries = scenario.get("controllers") or [scenario.get("controller") or {}]
+    return [(str(c.get("label", c.get("name"))), str(c.get("name"))) for c in entries]
+
+
+def row_labels(scenario: dict[str, Any]) -> list[tuple[str, str | None, str]]:
+    """(label, planner, controller) of each row the runner makes for a scenario mapping, in its
+    order (for the rows of a crashed case): one per planner and controller, or per controller."""
+    controllers = _controllers(scenario)
+    planners = scenario.get("planners") or []
+    if not planners:
+        return [(label, None, name) for label, name in controllers]
+    rows = []
+    for planner in planners:
+        planner_label = str(planner.get("label", planner.get("name")))
+        for label, name in controllers:
+            rows.append((planner_label if len(controllers) == 1 else f"{planner_label} / {label}",
+                         planner.get("name"), name))
+    return rows
+
+
+def crashed_rows(scenario: dict[str, Any], message: str) -> list[dict[str, Any]]:
+    """One ``crashed`` row per row of ``scenario`` carrying ``message``."""
+    return [{"label": label, "planner": planner, "controller": controller, "status": "crashed",
+             "message": message, "plan_time_s": None, "ref": None, "cl": None}
+            for label, planner, controller in row_labels(scenario)]
+
+
+def _plain_row(row: Any, controller: str) -> dict[str, Any]:
+    return {"label": row.label, "planner": row.planner,
+            "controller": getattr(row, "controller", None) or controller,
+            "status": row.status, "message": row.message, "plan_time_s": row.plan_time_s,
+            "ref": row.reference_metrics, "cl": row.closed_loop_metrics}
+
+
+def _on_alarm(signum: int, frame: Any) -> None:
+    raise CaseTimeout
+
+
+def run_case(payload: dict[str, Any]) -> dict[str, Any]:
+    """Run one case.
+
+    Parameters
+    ----------
+    payload : ``{"key": str, "scenario": mapping, "timeout_s": float}``.
+
+    Returns
+    -------
+    dict
+        ``key``, ``status`` (``ok``: the runner finished, whatever its rows say; ``crashed``: the
+        case raised or ran out of time), ``rows`` (plain dicts), ``elapsed_s``, ``worker``
+        (host:pid) and ``cache_builds`` (solvers built by this worker so far).
+    """
+    from scenarios.loader import parse_scenario
+    from scenarios.runner import run
+
+    cache, lock = worker_state()
+    data, timeout = payload["scenario"], float(payload["timeout_s"])
+    alarm = threading.current_thread() is threading.main_thread() and hasattr(signal, "setitimer")
+    with lock:
+        start = time.perf_counter()
+        previous = signal.signal(signal.SIGALRM, _on_alarm) if alarm else None
+        try:
+            if alarm:
+                signal.setitimer(signal.ITIMER_REAL, timeout)
+            scenario = parse_scenario(data)
+            results = run(scenario, cache=cache)
+            status, rows = "ok", [_plain_row(row, scenario.controllers[0].name) for row in results.rows]
+        except CaseTimeout:
+            status, rows = "crashed", crashed_rows(data, f"timed out after {timeout:g} s (case_timeout_s)")
+        except Exception as error:  # a case that raises is a row, the sweep goes on
+            detail = traceback.format_exc(limit=-3).strip().splitlines()
+            where = next((line.strip() for line in reversed(detail) if line.strip().startswith("File")), "")
+            status, rows = "crashed", crashed_rows(data, f"{type(error).__name__}: {error} ({where})"[:1000])
+        finally:
+            if alarm:
+                signal.setitimer(signal.ITIMER_REAL, 0.0)
+                signal.signal(signal.SIGALRM, previous)
+        elapsed = time.perf_counter() - start
+    return {"key": payload["key"], "status": status, "rows": rows, "elapsed_s": elapsed,
+            "worker": f"{socket.gethostname()}:{os.getpid()}", "cache_builds": cache.builds}

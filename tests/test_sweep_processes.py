@@ -1,0 +1,131 @@
+"""Trade studies across processes: a real Dask cluster on localhost, and a sweep stopped by
+SIGTERM and by SIGKILL, then resumed, against an uninterrupted run."""
+import contextlib
+import os
+import signal
+import socket
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+from scenarios.cli import main
+from scenarios.study import load_study
+from scenarios.sweep_engine import sweep
+from tests.test_sweep import BASE, InlineExecutor, comparable
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+@contextlib.contextmanager
+def processes(*commands):
+    """Start each command in its own session; always stop them (TERM, then KILL after 10 s)."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    started = []
+    try:
+        for command in commands:
+            started.append(subprocess.Popen(command, cwd=ROOT, env=env, start_new_session=True,
+                                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        yield started
+    finally:
+        for process in started:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(process.pid, signal.SIGTERM)
+        for process in started:
+            try:
+                process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                os.killpg(process.pid, signal.SIGKILL)
+                process.wait(timeout=10)
+
+
+def write_study(tmp_path, grid, name="study.yaml"):
+    (tmp_path / "base.yaml").write_text(yaml.safe_dump(BASE))
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump({"study": "processes", "scenario": "base.yaml", "grid": grid}))
+    return path
+
+
+def test_dask_cluster_on_localhost_gives_the_local_results(tmp_path):
+    pytest.importorskip("distributed")
+    from distributed import Client
+    port = free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+    worker = [sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads", "1", "--no-nanny",
+              "--no-dashboard", "--memory-limit", "0", "--host", "127.0.0.1"]
+    path = write_study(tmp_path, {"maneuver.final.q": {"axis_angle": {"axis": [0, 1, 0], "angle_deg": [15, 30, 60]}}})
+    with processes(dask + ["--host", "127.0.0.1", "--port", str(port), "--no-dashboard"], worker, worker):
+        with Client(address, timeout="60s") as client:
+            client.wait_for_workers(2, timeout=90)
+        assert main(["sweep", str(path), "--out", str(tmp_path / "dask"), "--scheduler", address, "--no-plots"]) == 0
+    on_cluster = pd.read_csv(tmp_path / "dask" / "cases.csv")
+    local = sweep(load_study(path), InlineExecutor())
+    local.write(tmp_path / "local", plots=False)
+    pd.testing.assert_frame_equal(comparable(on_cluster), comparable(pd.read_csv(tmp_path / "local" / "cases.csv")))
+    assert len(on_cluster) == 6 and set(on_cluster["status"]) == {"ok"}
+
+
+def stored(out: Path) -> int:
+    if not (out / "sweep.sqlite").is_file():
+        return 0
+    try:  # read-only: connecting must not create the store the sweep is about to create
+        with contextlib.closing(sqlite3.connect(f"file:{out / 'sweep.sqlite'}?mode=ro", uri=True, timeout=5)) as db:
+            return db.execute("SELECT COUNT(*) FROM cases").fetchone()[0]
+    except sqlite3.OperationalError:  # the schema is not created yet
+        return 0
+
+
+def run_until(command, out: Path, count: int, stop: int, kill_group: bool, deadline_s: float = 240.0):
+    """Start the sweep, wait until ``count`` cases are stored, send ``stop``; returns the process."""
+    process = subprocess.Popen(command, cwd=ROOT, start_new_session=True, text=True,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    start = time.monotonic()
+    try:
+        while stored(out) < count:
+            assert process.poll() is None, process.communicate()
+            assert time.monotonic() - start < deadline_s, "the sweep did not progress"
+            time.sleep(0.02)
+        (os.killpg if kill_group else os.kill)(process.pid, stop)
+        _, process.stderr_text = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait(timeout=10)
+    return process
+
+
+@pytest.mark.slow  # three sweeps in fresh processes: about 35 s on the shared 2-core machine
+def test_sigterm_then_sigkill_then_resume_equals_an_uninterrupted_run(tmp_path):
+    durations = [30.0 + 2 * i for i in range(10)]
+    path = write_study(tmp_path, {"maneuver.duration": durations})
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "scenarios.cli", "sweep", str(path), "--out", str(out), "--workers", "2",
+               "--no-plots"]
+    terminated = run_until(command, out, 1, signal.SIGTERM, kill_group=False)
+    assert terminated.returncode == 130
+    first = stored(out)
+    assert 1 <= first < 10
+    assert f"{10 - first} of 10 cases are missing" in terminated.stderr_text
+    assert f"--out {out} --resume" in terminated.stderr_text
+    killed = run_until(command + ["--resume"], out, first + 2, signal.SIGKILL, kill_group=True)
+    assert killed.returncode == -signal.SIGKILL
+    assert stored(out) < 10, "the sweep finished before it was killed; the test proves nothing"
+    assert main(["sweep", str(path), "--out", str(out), "--resume", "--no-plots"]) == 0
+    resumed = pd.read_csv(out / "cases.csv")
+    uninterrupted = sweep(load_study(path), InlineExecutor())
+    uninterrupted.write(tmp_path / "reference", plots=False)
+    reference = pd.read_csv(tmp_path / "reference" / "cases.csv")
+    assert len(resumed) == 20 and not resumed.duplicated(["case", "label"]).any()
+    pd.testing.assert_frame_equal(comparable(resumed), comparable(reference))
