@@ -186,7 +186,7 @@ def _abandoned(staging: Path) -> bool:
     return False
 
 
-def _write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: str) -> None:
+def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: str) -> None:
     """Replace the marker atomically (write a temporary file, then rename it)."""
     manifest = {"tool": "slewbench", "kind": kind, "complete": complete, "files": sorted(set(files))}
     handle, temporary = tempfile.mkstemp(prefix=".slewbench-manifest-", dir=directory)
@@ -230,7 +230,7 @@ def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
                 raise OutputError(path, f"is a directory that slewbench did not create (no {MARKER} in it) and is "
                                         "not empty; choose a new or empty directory, nothing was touched")
             if manifest is None:
-                _write_manifest(directory, [], complete=False, kind=kind)
+                write_manifest(directory, [], complete=False, kind=kind)
             elif manifest.get("kind", kind) != kind and manifest["files"]:
                 raise OutputError(path, f"holds slewbench {manifest.get('kind')} output; write the {kind} output "
                                         "into a directory of its own, nothing was touched")
@@ -244,7 +244,7 @@ def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
                         raise OutputError(path, f"its parent {parent} is not a directory")
                     break
             directory.mkdir(parents=True)
-            _write_manifest(directory, [], complete=False, kind=kind)
+            write_manifest(directory, [], complete=False, kind=kind)
         probe = tempfile.NamedTemporaryFile(prefix=".slewbench-probe-", dir=directory)
         probe.close()
     except OutputError:
@@ -306,7 +306,7 @@ def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
     if clashes:
         raise OutputError(directory, f"holds files slewbench did not write ({', '.join(clashes[:5])}); "
                                      "nothing was replaced: move them or choose another --out")
-    _write_manifest(directory, previous | set(new), complete=False, kind=kind)
+    write_manifest(directory, previous | set(new), complete=False, kind=kind)
     for name in new:
         (directory / name).parent.mkdir(parents=True, exist_ok=True)
         os.replace(staging / name, directory / name)
@@ -317,7 +317,7 @@ def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
     for folder in sorted({(directory / name).parent for name in previous - set(new)}, reverse=True):
         if folder != directory and folder.is_dir() and not any(folder.iterdir()):
             folder.rmdir()
-    _write_manifest(directory, new, complete=True, kind=kind)
+    write_manifest(directory, new, complete=True, kind=kind)
     shutil.rmtree(staging, ignore_errors=True)
     return new
 

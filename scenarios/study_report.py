@@ -8,7 +8,6 @@ import io
 import json
 import math
 import shutil
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -16,7 +15,7 @@ import numpy as np
 import yaml
 
 from ocp import METRIC_KEYS
-from scenarios.outputs import (MARKER, STAGING_PREFIX, OutputError, _write_manifest, claim_output_directory,
+from scenarios.outputs import (MARKER, OutputError, claim_output_directory, new_staging, write_manifest,
                                commit_outputs, read_manifest)
 from scenarios.store import STORE_NAME, is_sweep_store
 from scenarios.study import Study, package_version
@@ -144,7 +143,7 @@ def claim_sweep_directory(path: str | Path) -> Path:
     if (directory / STORE_NAME).exists() and not is_sweep_store(directory):
         raise OutputError(path, f"holds a {STORE_NAME} that is not a slewbench sweep store; nothing was touched")
     manifest = read_manifest(directory) or {"files": [], "complete": False}
-    _write_manifest(directory, set(manifest["files"]) | set(STORE_FILES), complete=bool(manifest.get("complete")),
+    write_manifest(directory, set(manifest["files"]) | set(STORE_FILES), complete=bool(manifest.get("complete")),
                     kind="sweep")
     return directory
 
@@ -155,9 +154,9 @@ def _commit(directory: Path, staging: Path) -> list[str]:
     manifest = read_manifest(directory)
     if manifest is None:
         raise OutputError(directory, f"lost its {MARKER} while running; nothing was replaced")
-    _write_manifest(directory, [f for f in manifest["files"] if f not in STORE_FILES], complete=False, kind="sweep")
+    write_manifest(directory, [f for f in manifest["files"] if f not in STORE_FILES], complete=False, kind="sweep")
     written = commit_outputs(directory, staging, kind="sweep")
-    _write_manifest(directory, [*written, *STORE_FILES], complete=True, kind="sweep")
+    write_manifest(directory, [*written, *STORE_FILES], complete=True, kind="sweep")
     return written
 
 
@@ -178,7 +177,7 @@ def write_report(results, directory: str | Path, plots: bool = True) -> list[str
     files = {"cases.csv": _csv(columns, rows), "summary.csv": _csv(summary_columns, summary),
              "summary.md": _markdown(study, summary_columns, summary, results.missing),
              "study.yaml": yaml.safe_dump(resolved_study(study), sort_keys=False, width=120)}
-    staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=directory))
+    staging = new_staging(directory)
     try:
         for name, text in files.items():
             (staging / name).write_text(text)
