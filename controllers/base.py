@@ -138,6 +138,12 @@ class Controller(Configurable, ABC):
         needs is missing), or ``None``."""
         return None
 
+    def initial_state_error(self, spacecraft: Spacecraft, omega0: Array, wheel_momentum0: Array,
+                            omegaf: Array | None) -> tuple[str, str] | None:
+        """``(YAML key under maneuver, message)`` if the law cannot start from the manoeuvre's
+        initial state or reach its final rate (rad/s, N m s, body axes), else ``None``."""
+        return None
+
     def sample_time_error(self, sample_time: float) -> tuple[str, str] | None:
         """``(option name, message)`` if an option does not fit the sample time (s), else ``None``."""
         return None

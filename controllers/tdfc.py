@@ -26,6 +26,8 @@ from ocp import Command, Measurement
 from ocp.options import Range
 
 MAX_DELAY_SAMPLES = 100_000
+MAX_SYMBOLIC_DELAY = 32
+"""Longest delay buffer (samples) of the symbolic law; longer delays run in the Python loop."""
 """Upper bound on ``τ / T_s`` (buffer length)."""
 
 
@@ -84,6 +86,14 @@ class TDFC(MagneticController):
             return self.dipole(0.0, 0.0, 0.0)
         old, k = buffer[0], self.options.gain
         return self.dipole(-k * (reading[0] - old[0]), -k * (reading[1] - old[1]), -k * (reading[2] - old[2]))
+
+    def symbolic_error(self) -> str | None:
+        """A delay buffer longer than :data:`MAX_SYMBOLIC_DELAY` samples is kept in the Python loop:
+        in one CasADi graph every sample would copy the whole buffer (memory grows with N d)."""
+        if getattr(self, "_delay", 0) > MAX_SYMBOLIC_DELAY:
+            return (f"the delay of {self._delay} samples is more than the {MAX_SYMBOLIC_DELAY} that the "
+                    "symbolic closed loop holds; it runs in the Python loop")
+        return super().symbolic_error()
 
     def state_vector(self) -> np.ndarray:
         d = self._delay

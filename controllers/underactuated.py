@@ -221,6 +221,19 @@ class TwoWheelLaw(Controller):
         frame = self.control_frame(spacecraft)
         return f"controller {self.name} {frame}" if isinstance(frame, str) else None
 
+    def initial_state_error(self, spacecraft: Spacecraft, omega0: Array, wheel_momentum0: Array,
+                            omegaf: Array | None) -> tuple[str, str] | None:
+        """The laws need zero total angular momentum (the unactuated rate stays zero only then) and
+        end at rest."""
+        momentum = spacecraft.inertia @ omega0 + spacecraft.wheel_axes @ wheel_momentum0
+        scale = max(float(np.abs(spacecraft.inertia).max()) * 1e-9, 1e-12)
+        if float(np.linalg.norm(momentum)) > scale:
+            return ("initial.omega", f"controller {self.name} needs zero total angular momentum I ω + A h_w, got "
+                                     f"{np.round(momentum, 9).tolist()} N m s (initial.omega, initial.wheel_momentum)")
+        if omegaf is not None and float(np.linalg.norm(omegaf)) > 0.0:
+            return ("final.omega", f"controller {self.name} regulates to rest; final.omega must be zero or null")
+        return None
+
     def control_frame(self, spacecraft: Spacecraft) -> Array | str:
         """The control frame (see :func:`control_frame`); a test may override it."""
         return control_frame(spacecraft)

@@ -111,9 +111,9 @@ class CollocationPlanner(Planner):
             # (two wheels). Only its own warm start may nest further; the depth is the YAML's.
             for index, name in enumerate([self.warm_start, *self.seed_planners]):
                 if name not in PLANNERS or (name == "collocation" and index > 0):
-                    raise InvalidOption("warm_start", f"{name!r} is not another registered planner; "
-                                     f"expected one of {sorted(set(PLANNERS) - {'collocation'})} "
-                                     "(or collocation as warm_start)")
+                    where = "warm_start" if index == 0 else f"seed_planners[{index - 1}]"
+                    raise InvalidOption(where, f"{name!r} is not another registered planner; expected one of "
+                                               f"{sorted(set(PLANNERS) - {'collocation'})} (or collocation as warm_start)")
             try:
                 PLANNERS[self.warm_start](self.warm_start_options, path="warm_start_options")
             except OptionsError as error:

@@ -80,29 +80,43 @@ def generate(scenario: Scenario, out: str | Path) -> CodegenReport:
         The controller has no symbolic law (with its reason), or ``out`` is not slewbench's to write.
     """
     problem, spec = scenario.problem, scenario.simulation
-    controller = CONTROLLERS[scenario.controller.name](scenario.controller.options)
-    reason = controller.symbolic_error()
-    if reason is not None:
-        raise ScenarioError("controller.name", f"controller {controller.name} cannot be exported as C: {reason}")
+    laws = []
+    for controller_spec in scenario.controllers:
+        controller = CONTROLLERS[controller_spec.name](controller_spec.options)
+        reason = controller.symbolic_error()
+        if reason is not None:
+            raise ScenarioError(f"{controller_spec.path}.name",
+                                f"controller {controller.name} cannot be exported as C: {reason}")
+        laws.append(controller)
     directory = claim_output_directory(out, kind="codegen")
-    controller.reset(problem.spacecraft, spec.sample_time, target=(problem.qf, problem.omegaf))
-    law = controller.symbolic_law()
     stem = f"slewbench_{c_identifier(scenario.name)}"
     report = CodegenReport(directory)
-    functions = [_renamed(law.function, "slewbench_law")]
+    functions: list[ca.Function] = []
     interface: dict[str, Any] = {
-        "scenario": scenario.name, "controller": controller.name, "sample_time_s": spec.sample_time,
-        "library": f"lib{stem}.so",
-        "slewbench_law": {
+        "scenario": scenario.name, "controller": laws[0].name, "sample_time_s": spec.sample_time,
+        "library": f"lib{stem}.so", "laws": {}, "references": {},
+    }
+    law_stems = row_stems([c.label for c in scenario.controllers])
+    for controller, controller_spec, law_stem in zip(laws, scenario.controllers, law_stems):
+        controller.reset(problem.spacecraft, spec.sample_time, target=(problem.qf, problem.omegaf))
+        law = controller.symbolic_law()
+        # One controller: "slewbench_law"; several: one function per controller, named by its label.
+        name = "slewbench_law" if len(laws) == 1 else f"slewbench_law_{c_identifier(law_stem)}"
+        if name in (f.name() for f in functions):
+            name = f"{name}_{len(functions)}"
+        functions.append(_renamed(law.function, name))
+        description = {
+            "controller": controller.name, "label": controller_spec.label,
             "inputs": {"t": 1, "y": law.function.nnz_in(1), "z": law.function.nnz_in(2), "r": 2 * REFERENCE_FIELDS},
             "outputs": {"u": law.function.nnz_out(0), "z_next": law.function.nnz_out(1)},
             "z0": law.state0.tolist(),
             "y_layout": "[q (4), omega (3, rad/s), h_w (n_w, N m s), b (3, T; zeros without a field model)]",
             "r_layout": "reference rows [q, omega, omega_dot, torque] at t and t + sample_time",
-            "u_layout": {name: [s.start, s.stop] for name, s in control_layout(problem.spacecraft)[0].items()},
-        },
-        "references": {},
-    }
+            "u_layout": {key: [s.start, s.stop] for key, s in control_layout(problem.spacecraft)[0].items()},
+        }
+        interface["laws"][name] = description
+        if len(laws) == 1:
+            interface["slewbench_law"] = description
     stems = row_stems([p.label for p in scenario.planners])
     for planner_spec, row in zip(scenario.planners, stems):
         planner = PLANNERS[planner_spec.name](planner_spec.options)

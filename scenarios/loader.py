@@ -26,6 +26,8 @@ from scenarios.yaml_node import Node, ScenarioError, read_yaml
 
 
 MAX_NAME = 200
+MAX_LABEL = 100
+"""Characters of a planner's or controller's label."""
 """Characters of a scenario name (the default output directory uses a sanitised, shorter stem)."""
 
 
@@ -205,7 +207,7 @@ def _igrf_field(node: Node, orbit: CircularOrbit | None) -> IGRFField:
     return _model_part(
         node, IGRFField, orbit=orbit, epoch=str(epoch),
         span=node.get("span_s", None).optional_number(positive=True) or 1.0,
-        step=node.get("step_s", 30.0).number(positive=True),
+        step=node.get("step_s", 30.0).number(positive=True, maximum=120.0),  # cubic spline error ~3e-4 at 120 s
         greenwich_angle=None if greenwich is None else float(np.deg2rad(greenwich)),
     )
 
@@ -266,7 +268,7 @@ def parse_planners(node: Node) -> list[PlannerSpec]:
     for item in node.items():
         item.mapping()
         name, options = _registered(item, PLANNERS, "planner")
-        label = item.get("label", name).string()
+        label = _label(item, name)
         if label in labels:
             raise ScenarioError(f"{item.path}.label", f"duplicate label {label!r}; give each row its own label")
         labels.add(label)
@@ -277,9 +279,34 @@ def parse_planners(node: Node) -> list[PlannerSpec]:
 
 def parse_controller(node: Node) -> ControllerSpec:
     name, options = _registered(node.mapping(), CONTROLLERS, "controller")
-    label = node.get("label", name).string()
+    label = _label(node, name)
     node.finish()
     return ControllerSpec(name, options, label, node.path)
+
+
+def _label(node: Node, default: str) -> str:
+    """A row label: non-empty text of at most :data:`MAX_LABEL` characters."""
+    label_node = node.get("label", default)
+    label = label_node.string()
+    if not label.strip() or len(label) > MAX_LABEL:
+        raise label_node.error(f"expected a non-empty label of at most {MAX_LABEL} characters, got {excerpt(label)}")
+    return label
+
+
+def check_row_labels(planners: list[PlannerSpec], controllers: list[ControllerSpec]) -> None:
+    """Rows are labelled ``"<planner> / <controller>"`` with several controllers: those must differ."""
+    if len(controllers) < 2:
+        return
+    seen: dict[str, tuple[int, int]] = {}
+    for i, planner in enumerate(planners):
+        for j, controller in enumerate(controllers):
+            row = f"{planner.label} / {controller.label}"
+            if row in seen:
+                a, b = seen[row]
+                raise ScenarioError(f"{controller.path}.label", f"row label {row!r} is made twice (planners[{a}] with "
+                                                                f"controllers[{b}], planners[{i}] with controllers[{j}]); "
+                                                                "choose labels without ' / '")
+            seen[row] = (i, j)
 
 
 def parse_controllers(root: Node) -> list[ControllerSpec]:
@@ -319,7 +346,7 @@ def parse_simulation(node: Node) -> SimulationSpec:
         integrator=node.get("integrator", "rk4").string(("rk4", "cvodes")),
         max_step=node.get("max_step", 0.05).number(positive=True),
         settling_tolerance_deg=node.get("settling_tolerance_deg", 0.5).number(positive=True, maximum=180.0),
-        fine_settling_tolerance_deg=node.get("fine_settling_tolerance_deg", None).optional_number(positive=True),
+        fine_settling_tolerance_deg=node.get("fine_settling_tolerance_deg", None).optional_number(positive=True, maximum=180.0),
         detumble_tolerance=node.get("detumble_tolerance", 0.01).number(positive=True),
         max_samples=node.get("max_samples", MAX_SAMPLES).integer(minimum=1, maximum=100_000_000),
         compile=node.get("compile", False).boolean(),
@@ -368,6 +395,9 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
         error = law.environment_error(problem.spacecraft, problem.environment)
         if error:
             raise ScenarioError(where, error)
+        state = law.initial_state_error(problem.spacecraft, problem.omega0, problem.wheel_momentum0, problem.omegaf)
+        if state:
+            raise ScenarioError(f"maneuver.{state[0]}", f"{state[1]} ({controller.path} is {controller.name!r})")
         timing = None if simulation is None else law.sample_time_error(simulation.sample_time)
         if timing:
             raise ScenarioError(f"{controller.path}.options.{timing[0]}",
@@ -400,6 +430,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     root.finish()
     problem = _fit_field_span(data, problem, simulation, planners)
     check_work(problem, simulation)
+    check_row_labels(planners, controllers)
     check_compatibility(problem, planners, controllers, simulation)
     return Scenario(name, problem, planners, controllers, simulation, source)
 

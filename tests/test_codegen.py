@@ -75,3 +75,31 @@ def test_a_non_symbolic_law_is_refused_with_its_reason(tmp_path, capsys):
     error = capsys.readouterr().err
     assert "controller.name" in error and "least squares" in error
     assert not (tmp_path / "c").exists()
+
+
+def test_every_controller_of_a_list_is_exported(tmp_path, rng):
+    """nano_detumble.yaml lists B-dot and TDFC: each gets its own C function, and each equals its
+    Python law, its state included, over successive samples."""
+    out = tmp_path / "c"
+    assert main(["codegen", str(SCENARIOS / "nano_detumble.yaml"), "--out", str(out)]) == 0
+    subprocess.run(["make", "-C", str(out)], check=True, capture_output=True)
+    interface = json.loads((out / "interface.json").read_text())
+    scenario = load(SCENARIOS / "nano_detumble.yaml")
+    problem, spec = scenario.problem, scenario.simulation
+    assert [law["label"] for law in interface["laws"].values()] == [c.label for c in scenario.controllers]
+    for name, description in interface["laws"].items():
+        controller_spec = next(c for c in scenario.controllers if c.label == description["label"])
+        controller = CONTROLLERS[controller_spec.name](controller_spec.options)
+        controller.reset(problem.spacecraft, spec.sample_time, target=(problem.qf, problem.omegaf))
+        law = ca.external(name, str(out / interface["library"]))
+        z = np.array(description["z0"])
+        r = controller.reference_rows(None, np.array([0.0, spec.sample_time])).ravel()
+        for k in range(8):
+            t = k * spec.sample_time
+            field = rng.normal(0.0, 3e-5, 3)
+            measurement = Measurement(t, quat.random_unit(rng), rng.normal(0, 0.3, 3), np.zeros(0), field)
+            y = np.r_[measurement.q, measurement.omega, field]
+            u, z = (v.full().ravel() for v in law(t, y, z, r))
+            expected = controller.command_vector(controller(t, measurement, None))
+            np.testing.assert_allclose(u, expected, rtol=0, atol=1e-12 * max(1.0, np.abs(expected).max()))
+            np.testing.assert_allclose(z, controller.state_vector(), rtol=0, atol=1e-12)

@@ -246,3 +246,85 @@ def test_mutated_scenarios_exit_0_with_physical_metrics_or_2_naming_a_path(mutat
         assert row["status"] in ("ok", "failed", "infeasible"), row
         if row["status"] == "ok":
             assert physical(row["reference"]) and physical(row["closed_loop"]), (mutation, row)
+
+
+# ----- found by a user trial after the second wave landed ------------------------------------------
+
+SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
+
+
+@pytest.mark.parametrize("text", ["a: &a {b: *a}\n", "name: &a [*a]\n",
+                                  "planners:\n  - name: collocation\n    options: &a {warm_start: collocation, "
+                                  "warm_start_options: *a}\n"])
+def test_a_recursive_alias_is_refused_with_a_short_message(text, tmp_path):
+    status, error, seconds = run_cli(tmp_path, text)
+    assert status == 2 and "nests deeper than" in error and len(error) < 400 and seconds < 5, error[:300]
+
+
+def test_a_file_without_a_size_is_read_only_up_to_the_limit(capsys):
+    start = time.perf_counter()
+    assert main(["validate", "/dev/zero"]) == 2
+    assert "more than" in capsys.readouterr().err and time.perf_counter() - start < 5
+
+
+@pytest.mark.parametrize("epoch, words", [("2025-02-30", "expected a date like 2025-01-01"),
+                                          ("1800-01-01", "IGRF-14 covers")])
+def test_an_impossible_epoch_names_its_path(epoch, words, tmp_path):
+    text = (SCENARIOS / "nano_detumble.yaml").read_text().replace(
+        "magnetic_field: tilted_dipole}", f"magnetic_field: {{model: igrf, epoch: {epoch}}}}}")
+    status, error, _ = run_cli(tmp_path, text)
+    assert status == 2 and f"environment.magnetic_field.epoch: {words}" in error, error
+
+
+def test_a_date_where_text_is_expected_is_just_text(tmp_path):
+    data = copy.deepcopy(BASE)
+    text = yaml.safe_dump(data).replace("name: base", "name: 2025-02-30")
+    status, error, _ = run_cli(tmp_path, text)
+    assert status == 0, error
+
+
+def test_a_coarse_igrf_table_is_refused(tmp_path):
+    """A 1000 s node spacing interpolates the field 42 % wrong along a 600 km orbit."""
+    text = (SCENARIOS / "nano_detumble.yaml").read_text().replace(
+        "magnetic_field: tilted_dipole}", "magnetic_field: {model: igrf, step_s: 1000}}")
+    status, error, _ = run_cli(tmp_path, text)
+    assert status == 2 and "environment.magnetic_field.step_s: expected a number <= 120" in error, error
+
+
+@pytest.mark.parametrize("change, path", [("omega: [0, 0, 0]}", "maneuver.initial.omega"),
+                                          ("FINAL", "maneuver.final.omega")])
+def test_two_wheel_laws_need_zero_momentum_and_end_at_rest(change, path, tmp_path):
+    data = yaml.safe_load((SCENARIOS / "horri_palmer_two_wheels.yaml").read_text())
+    if change == "FINAL":
+        data["maneuver"]["final"]["omega"] = [0.0, 0.0, 0.05]
+    else:
+        data["maneuver"]["initial"]["omega"] = [0.01, 0.0, 0.02]
+    status, error, _ = run_cli(tmp_path, yaml.safe_dump(data))
+    assert status == 2 and f"error in scenario: {path}:" in error, error
+
+
+def test_combined_row_labels_must_differ(tmp_path):
+    data = copy.deepcopy(BASE)
+    data["planners"] = [{"name": "eigenaxis", "label": "a / b"}, {"name": "eigenaxis", "label": "a"}]
+    data.pop("controller")
+    data["controllers"] = [{"name": "augmented_quaternion_feedback", "label": "c"},
+                           {"name": "eigenaxis_pd", "label": "b / c"}]
+    status, error, _ = run_cli(tmp_path, yaml.safe_dump(data))
+    assert status == 2 and "controllers[1].label: row label 'a / b / c' is made twice" in error, error
+
+
+def test_a_long_tdfc_delay_runs_in_the_python_loop_instead_of_exhausting_memory(tmp_path):
+    text = textwrap.dedent("""\
+        name: long-delay
+        spacecraft: {inertia: [0.0109, 0.05, 0.05], wheels: none, magnetorquers: {max_dipole: 0.1}}
+        orbit: {altitude_km: 600, inclination_deg: 97.79}
+        environment: {magnetic_field: tilted_dipole}
+        maneuver: {duration: 12.0, initial: {q: [1, 0, 0, 0], omega: [0.1, 0.1, 0.1]}, final: {q: null, omega: [0, 0, 0]}}
+        planners: []
+        controllers: [{name: tdfc, options: {gain: 1.0e4, delay: 10.0}}]
+        simulation: {sample_time: 0.01, max_step: 0.01}
+        """)
+    status, error, seconds = run_cli(tmp_path, text, "run")
+    assert status == 0 and seconds < 30, error
+    rows = json.loads((tmp_path / "out" / "results.json").read_text())["rows"]
+    assert rows[0]["status"] == "ok" and rows[0]["closed_loop"]["final_rate"] > 0
