@@ -196,7 +196,7 @@ def test_a_killed_run_leaves_nothing_that_looks_complete_and_the_next_run_cleans
 
 def test_sigterm_during_a_run_writes_nothing_outside_the_marker(tmp_path):
     # 400,000 samples: long enough to be interrupted even by the compiled-speed closed loop (issue 13)
-    slow = scenario(tmp_path, simulation={"sample_time": 0.01, "duration": 4000.0})
+    slow = scenario(tmp_path, simulation={"sample_time": 0.01, "duration": 10000.0})  # 10⁶ samples: seconds even compiled
     out = tmp_path / "out"
     process = subprocess.Popen([sys.executable, "-m", "scenarios.cli", "run", str(slow), "--out", str(out)],
                                cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
