@@ -14,7 +14,6 @@ from typing import Any, ClassVar, Iterable, Mapping, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.integrate import solve_ivp
 
 from ocp import AttitudeModel, Environment, SolverCache, Spacecraft, quat
 from ocp.options import Configurable
@@ -317,6 +316,8 @@ class TorqueFreeMotion:
     def _solution(self, index: int) -> Any:
         while len(self._chunks) <= index:
             k = len(self._chunks)
+            from scipy.integrate import solve_ivp  # lazily: 0.5 s to import, needed only after T
+
             solution = solve_ivp(self._rhs, (0.0, self.chunk), self._ends[k], method="DOP853", rtol=1e-12,
                                  atol=1e-14, dense_output=True)
             self._chunks.append(solution.sol)

@@ -11,8 +11,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.special import ndtri
-from scipy.stats import qmc
 
 from scenarios.study_paths import Step, get_path
 from scenarios.yaml_node import Node
@@ -47,6 +45,8 @@ class Dispersion:
         if self.kind == "case_seed":
             return seed
         if self.kind == "normal":
+            from scipy.special import ndtri  # lazily: scipy is slow to import for plain runs
+
             draw = self.a + self.b * ndtri(np.clip(unit, _EPS, 1.0 - _EPS))  # the normal's inverse CDF
         else:
             draw = self.a + unit * (self.b - self.a)
@@ -112,5 +112,7 @@ def draw_unit(method: str | None, dimension: int, samples: int, rng: np.random.G
     if dimension == 0:
         return np.zeros((samples, 0))
     if method == "latin_hypercube":
+        from scipy.stats import qmc  # lazily: 0.4 s to import, only for Latin hypercubes
+
         return qmc.LatinHypercube(d=dimension, seed=rng).random(samples)
     return rng.random((samples, dimension))
