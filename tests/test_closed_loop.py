@@ -20,7 +20,8 @@ from ocp import (
 from planners import PLANNERS
 from scenarios.loader import load
 
-SCENARIOS = sorted(Path(__file__).resolve().parents[1].joinpath("scenarios").glob("*.yaml"))
+SCENARIOS = sorted(p for p in Path(__file__).resolve().parents[1].joinpath("scenarios").glob("*.yaml")
+                   if not p.name.startswith("study_"))  # trade studies are not scenarios
 QUICK = ("eigenaxis_demo.yaml", "nano_eigenaxis_pd.yaml", "biggs_horri_spin_repoint_high.yaml")
 
 
