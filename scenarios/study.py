@@ -148,6 +148,16 @@ def _values(node: Node, path: str, base: dict[str, Any]) -> tuple[list[Any], lis
     raise node.error(f"unknown value generator {kind!r}; expected linspace, geomspace or axis_angle")
 
 
+def _varied(entry: Node, path: str, base: dict[str, Any], paths: list[str],
+            steps: list[list[Step]]) -> tuple[list, list]:
+    """Check that ``path`` reaches ``base``, record it in ``paths``/``steps``, and return its
+    values (set into the scenario, recorded in the tables)."""
+    paths.append(path)
+    steps.append(parse_path(path, entry.path))
+    get_parent_ok(base, steps[-1], entry.path)
+    return _values(entry, path, base)
+
+
 def _grid_points(root: Node, base: dict[str, Any]) -> tuple[list[str], list[list[Step]], list[tuple[list, list]]]:
     """Varied paths, their parsed steps and the points (values set, values recorded)."""
     paths, steps, axes = [], [], []
@@ -155,20 +165,14 @@ def _grid_points(root: Node, base: dict[str, Any]) -> tuple[list[str], list[list
     grid = Node({}, "grid") if grid.is_null() else grid.mapping()
     for path in grid.value:
         entry = grid.get(path)
-        paths.append(path)
-        steps.append(parse_path(path, entry.path))
-        get_parent_ok(base, steps[-1], entry.path)
-        values, recorded = _values(entry, path, base)
+        values, recorded = _varied(entry, path, base, paths, steps)
         axes.append([[pair] for pair in zip(values, recorded)])
     zipped = root.get("zip", {})
     zipped = Node({}, "zip") if zipped.is_null() else zipped.mapping()
     columns, length = [], None
     for path in zipped.value:
         entry = zipped.get(path)
-        paths.append(path)
-        steps.append(parse_path(path, entry.path))
-        get_parent_ok(base, steps[-1], entry.path)
-        values, recorded = _values(entry, path, base)
+        values, recorded = _varied(entry, path, base, paths, steps)
         if length is not None and len(values) != length:
             raise entry.error(f"zip lists must have equal lengths: {len(values)} values here, {length} before")
         length = len(values)
