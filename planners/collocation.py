@@ -14,15 +14,15 @@ stopping); the best converged optimum is kept.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Annotated, Literal
 
 import numpy as np
 
-from ocp.nlp import perturbed, solve_multistart, solver_options
+from ocp.nlp import NLPResult, perturbed, solve_multistart, solver_options, warm_start_options
 from ocp.options import InvalidOption, OptionsError, Range, excerpt
-from ocp.transcription import TRANSCRIPTIONS, Cone, OptimalControlProblem
-from planners.base import FailedReference, ManeuverProblem, Planner, Reference
+from ocp.transcription import NLP, TRANSCRIPTIONS, Cone, OptimalControlProblem, Transcription
+from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference
 from planners.collocation_reference import CollocationReference, seed_sampler
 
 AUTO_RESTART = 0.05
@@ -92,6 +92,9 @@ class CollocationPlanner(Planner):
         # A number n > 0: n perturbed copies (1 %, then 5 %); 0: the warm start itself.
         multistart: Annotated[int | Literal["auto"], Range(ge=0, le=50)] = "auto"
         agree: Annotated[int, Range(ge=0, le=50)] = 2  # stop once this many starts agree on the best optimum (0: try all)
+        # min_time only: first solve min T + ε ∫‖τ‖² dt / Σ τ_max², ε this option (0: off), from
+        # the starts above, then polish plain minimum time from that optimum and its multipliers.
+        time_regularization: Annotated[float, Range(ge=0.0, le=1.0)] = 0.0
         energy_weight: Annotated[float, Range(ge=0.0)] = 1.0               # for objective "weighted"
         l1_weight: Annotated[float, Range(ge=0.0)] = 0.0
         time_weight: Annotated[float, Range(ge=0.0)] = 0.0
@@ -118,6 +121,8 @@ class CollocationPlanner(Planner):
                 PLANNERS[self.warm_start](self.warm_start_options, path="warm_start_options")
             except OptionsError as error:
                 raise InvalidOption(error.path, error.message) from None
+            if self.time_regularization and self.objective != "min_time":
+                raise InvalidOption("time_regularization", f"applies to objective min_time only, not {self.objective!r}")
             if self.objective == "weighted" and not (self.energy_weight or self.l1_weight or self.time_weight):
                 raise InvalidOption("objective", "weighted needs a positive energy_weight, l1_weight or time_weight")
             l1 = self.objective == "min_l1" or (self.objective == "weighted" and self.l1_weight > 0)
@@ -138,14 +143,19 @@ class CollocationPlanner(Planner):
         return OptimalControlProblem(problem.model, *weights, free_time=weights[2] > 0,
                                      fixed_final_rate=problem.omegaf is not None, cones=cones)
 
-    def _nlp(self, problem: ManeuverProblem, ocp: OptimalControlProblem):
+    def _nlp(self, problem: ManeuverProblem, ocp: OptimalControlProblem,
+             warm: bool = False) -> tuple[Transcription, NLP]:
+        """The transcription and its built NLP for ``ocp`` (from the cache when built before);
+        ``warm``: solver options for a start with multipliers (:func:`ocp.nlp.warm_start_options`)."""
         o = self.options
         transcription = TRANSCRIPTIONS[o.transcription].from_options(o)
         key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
-               o.transcription, o.intervals, o.degree, o.substeps, o.solver, o.tolerance, o.max_iterations)
+               o.transcription, o.intervals, o.degree, o.substeps, o.solver, o.tolerance, o.max_iterations, warm)
+        extra = warm_start_options(o.solver) if warm else None
 
-        def build():
-            return transcription, transcription.build(ocp, o.solver, solver_options(o.solver, o.tolerance, o.max_iterations))
+        def build() -> tuple[Transcription, NLP]:
+            return transcription, transcription.build(ocp, o.solver,
+                                                      solver_options(o.solver, o.tolerance, o.max_iterations, extra))
 
         # The model's numbers are baked into the graph: a shared cache needs them in the key.
         return self.solver_cache(problem).get(("collocation", problem.model.fingerprint, key), build)
@@ -181,38 +191,73 @@ class CollocationPlanner(Planner):
                 starts.append(reference)
         return starts
 
-    def _guesses(self, ocp: OptimalControlProblem, seeds: list) -> tuple[list, float]:
-        """The starts (the warm start or its perturbed copies, then the seed planners' starts) and
-        the relative size of the restarts from the best point (0: none)."""
+    def _guesses(self, ocp: OptimalControlProblem, seeds: list[Array]) -> tuple[list[Array], list[Array], float]:
+        """The starts (the warm start or its perturbed copies, then the seed planners' starts), the
+        fallback starts (tried only if none of those converged) and the relative size of the
+        restarts from the best point (0: none)."""
         count = self.options.multistart
         if count == "auto":
             # A warm start can sit exactly on a stationary point (the eigenaxis slew is one for minimum
             # time with per-axis torque bounds: IPOPT stays there, 3.5449 in 191 iterations against
             # 3.2431 for Bilimoria & Wie's slew). A 1 % copy of it, then 5 % restarts from the best
-            # point until one comes back to it, escape such points at about 1.3 solves.
-            return (perturbed(seeds[0], 1) + seeds[1:], AUTO_RESTART) if ocp.free_time else (seeds, 0.0)
+            # point until one comes back to it, escape such points at about 1.3 solves; the warm start
+            # itself is the fallback when its perturbed copy does not converge.
+            if ocp.free_time:
+                return perturbed(seeds[0], 1) + seeds[1:], seeds[:1], AUTO_RESTART
+            return seeds, [], 0.0
         if not count:
-            return seeds, 0.0
-        return perturbed(seeds[0], count) + seeds[1:], 0.0
+            return seeds, [], 0.0
+        return perturbed(seeds[0], count) + seeds[1:], [], 0.0
+
+    def _regularized(self, problem: ManeuverProblem, ocp: OptimalControlProblem) -> OptimalControlProblem:
+        """``ocp`` (minimum time) with the energy term of ``time_regularization``: weight ε over the
+        sum of the squared torque bounds of the wheels and torquers (1 (N m)² without them)."""
+        _, _, _, u_high = self._variable_bounds(problem)
+        slices = problem.model.control_slices
+        bounds = [u_high[slices[name]] for name in ("wheels", "torquers") if name in slices]
+        scale = float(np.sum(np.square(np.concatenate(bounds)))) if bounds else 0.0
+        scale = scale if 0.0 < scale < np.inf else 1.0
+        return replace(ocp, energy_weight=self.options.time_regularization / scale)
+
+    def _solve(self, problem: ManeuverProblem, ocp: OptimalControlProblem, seeds: list[Array], params: Array,
+               bounds: tuple[Array, Array]) -> tuple[NLPResult, dict]:
+        """Solve ``ocp`` from ``seeds`` by the multistart policy; with ``time_regularization``, solve
+        the regularised problem so and polish plain minimum time from its optimum and multipliers."""
+        o = self.options
+        guesses, fallback, restart = self._guesses(ocp, seeds)
+        lbx, ubx = bounds
+        if not o.time_regularization:
+            _, nlp = self._nlp(problem, ocp)
+            result = solve_multistart(nlp.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
+                                      agree=o.agree, restart=restart, fallback=fallback)
+            return result, {}
+        _, regular = self._nlp(problem, self._regularized(problem, ocp))
+        first = solve_multistart(regular.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=regular.lbg, ubg=regular.ubg,
+                                 agree=o.agree, restart=restart, fallback=fallback)
+        extra = {"regularized": first.stats()}
+        if not first.success:
+            return first, extra
+        _, polish = self._nlp(problem, ocp, warm=True)
+        result = solve_multistart(polish.solver, [first.x], p=params, lbx=lbx, ubx=ubx, lbg=polish.lbg,
+                                  ubg=polish.ubg, agree=1, lam_x0=first.lam_x, lam_g0=first.lam_g)
+        return result, extra
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         o = self.options
         ocp = self._ocp(problem)
-        transcription, nlp = self._nlp(problem, ocp)
+        transcription, nlp = self._nlp(problem, ocp, warm=bool(o.time_regularization))  # the polish's NLP
         starts = self._starts(problem)
         if not starts:
             return FailedReference(self.name, f"no start: the warm-start planner {o.warm_start!r} failed")
         disturbance = problem.model.default_parameters
         omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf
         params = np.concatenate([problem.initial_state, problem.qf, omegaf, [problem.duration], disturbance])
-        lbx, ubx = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
+        bounds = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
         seeds = [transcription.seed(ocp, nlp, seed_sampler(problem, ref),
                                     ref.duration if ocp.free_time else problem.duration) for ref in starts]
-        guesses, restart = self._guesses(ocp, seeds)
-        result = solve_multistart(nlp.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
-                                  agree=o.agree, restart=restart)
+        result, extra = self._solve(problem, ocp, seeds, params, bounds)
         stats = result.stats()
-        stats.update(transcription=transcription.name, intervals=o.intervals, solver=o.solver)
+        stats.update(extra, transcription=transcription.name, intervals=o.intervals, solver=o.solver)
         if not result.success:
             return FailedReference(self.name, f"{o.solver} did not converge from any start: "
                                    f"{sorted(set(result.statuses))}", result.status, stats=stats)
