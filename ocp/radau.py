@@ -36,6 +36,28 @@ def lagrange(points: Array, tau: Array) -> Array:
     return basis
 
 
+def differentiation_matrix(points: Array) -> Array:
+    """Derivatives of the Lagrange basis through ``points`` at those points (barycentric form).
+
+    Parameters
+    ----------
+    points : (n,) ndarray
+        Distinct interpolation points (dimensionless, e.g. on [0, 1]).
+
+    Returns
+    -------
+    (n, n) ndarray
+        ``D[r, j] = ℓ_r'(points[j])``.
+    """
+    difference = points[:, None] - points[None, :]
+    np.fill_diagonal(difference, 1.0)
+    barycentric = 1.0 / np.prod(difference, axis=1)
+    derivative = (barycentric[None, :] / barycentric[:, None]) / difference  # [j, r], r != j
+    np.fill_diagonal(derivative, 0.0)
+    np.fill_diagonal(derivative, -derivative.sum(axis=1))
+    return derivative.T
+
+
 def radau_weights(degree: int) -> Array:
     """Weights on [0, 1] of the ``degree``-point Radau rule (right end point included)."""
     points = np.asarray(ca.collocation_points(degree, "radau"))
@@ -52,7 +74,7 @@ class RadauCollocation(Transcription):
         self.degree = degree
         tau = np.append(0.0, ca.collocation_points(degree, "radau"))
         self.tau = tau
-        self.derivative = np.array([np.polyder(_basis(tau, r))(tau) for r in range(degree + 1)])  # [r, j] = ℓ_r'(τ_j)
+        self.derivative = differentiation_matrix(tau)  # [r, j] = ℓ_r'(τ_j)
         self.quadrature = radau_weights(degree)
         midpoints = 0.5 * (tau[:-1] + tau[1:])
         self.midpoint_weights = lagrange(tau, midpoints)

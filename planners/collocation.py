@@ -29,6 +29,13 @@ AUTO_RESTART = 0.05
 """Relative perturbation of the restarts of ``multistart: auto`` when the final time is free."""
 
 
+def _merged(first: NLPResult, second: NLPResult) -> NLPResult:
+    """``second`` with the starts, iterations and time of ``first`` (which failed) counted first."""
+    best = None if second.best_start is None else second.best_start + len(first.starts)
+    return replace(second, starts=first.starts + second.starts, iterations=first.iterations + second.iterations,
+                   time_s=first.time_s + second.time_s, best_start=best)
+
+
 def _cone_vector(spec: dict, key: str, where: str) -> np.ndarray:
     value = spec[key]
     if (not isinstance(value, (list, tuple)) or len(value) != 3
@@ -95,6 +102,10 @@ class CollocationPlanner(Planner):
         # min_time only: first solve min T + ε ∫‖τ‖² dt / Σ τ_max², ε this option (0: off), from
         # the starts above, then polish plain minimum time from that optimum and its multipliers.
         time_regularization: Annotated[float, Range(ge=0.0, le=1.0)] = 0.0
+        # Free final time with multistart auto: the multistart (escape and agreement) first runs on
+        # this many intervals, then the full mesh is solved once from that optimum (falling back to
+        # the multistart on the full mesh if it does not converge). 0, or >= intervals: off.
+        coarse_intervals: Annotated[int, Range(ge=0, le=2000)] = 8
         energy_weight: Annotated[float, Range(ge=0.0)] = 1.0               # for objective "weighted"
         l1_weight: Annotated[float, Range(ge=0.0)] = 0.0
         time_weight: Annotated[float, Range(ge=0.0)] = 0.0
@@ -242,20 +253,43 @@ class CollocationPlanner(Planner):
                                   ubg=polish.ubg, agree=1, lam_x0=first.lam_x, lam_g0=first.lam_g)
         return result, extra
 
+    def _coarse(self, ocp: OptimalControlProblem) -> bool:
+        o = self.options
+        return ocp.free_time and o.multistart == "auto" and 0 < o.coarse_intervals < o.intervals
+
     def _plan(self, problem: ManeuverProblem) -> Reference:
+        starts = self._starts(problem)
+        if not starts:
+            return FailedReference(self.name, f"no start: the warm-start planner {self.options.warm_start!r} failed")
+        return self._plan_from(problem, starts)
+
+    def _plan_from(self, problem: ManeuverProblem, starts: list[Reference]) -> Reference:
+        """Plan from the given start references (see the module docstring)."""
         o = self.options
         ocp = self._ocp(problem)
         transcription, nlp = self._nlp(problem, ocp, warm=bool(o.time_regularization))  # the polish's NLP
-        starts = self._starts(problem)
-        if not starts:
-            return FailedReference(self.name, f"no start: the warm-start planner {o.warm_start!r} failed")
         disturbance = problem.model.default_parameters
         omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf
         params = np.concatenate([problem.initial_state, problem.qf, omegaf, [problem.duration], disturbance])
         bounds = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
         seeds = [transcription.seed(ocp, nlp, seed_sampler(problem, ref),
                                     ref.duration if ocp.free_time else problem.duration) for ref in starts]
-        result, extra = self._solve(problem, ocp, seeds, params, bounds)
+        result, extra = None, {}
+        if self._coarse(ocp):
+            # The escape from stationary points and its confirmation on a coarse mesh, where an
+            # iteration costs a fraction; its optimum seeds one solve on the full mesh.
+            coarse = CollocationPlanner(replace(o, intervals=o.coarse_intervals, coarse_intervals=0), cache=self.cache)
+            found = coarse._plan_from(problem, starts)
+            extra["coarse"] = found.stats
+            if found.ok:
+                single = replace(o, multistart=0, coarse_intervals=0)
+                seed = transcription.seed(ocp, nlp, seed_sampler(problem, found), found.duration)
+                result, more = CollocationPlanner(single, cache=self.cache)._solve(problem, ocp, [seed], params, bounds)
+                extra.update(more)
+        if result is None or not result.success:
+            fine, more = self._solve(problem, ocp, seeds, params, bounds)
+            result = fine if result is None else _merged(result, fine)
+            extra.update(more)
         stats = result.stats()
         stats.update(extra, transcription=transcription.name, intervals=o.intervals, solver=o.solver)
         if not result.success:
