@@ -41,8 +41,9 @@ point, which then becomes the best and is checked in turn.
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Iterable, Iterator, Mapping, Sequence
+from typing import Any
 
 import casadi as ca
 import numpy as np

@@ -19,9 +19,21 @@ from typing import Annotated, Literal
 
 import numpy as np
 
-from ocp.nlp import NLPResult, perturbed, solve_multistart, solver_options, warm_start_options
+from ocp.nlp import (
+    NLPResult,
+    perturbed,
+    solve_multistart,
+    solver_options,
+    warm_start_options,
+)
 from ocp.options import InvalidOption, OptionsError, Range, excerpt
-from ocp.transcription import NLP, TRANSCRIPTIONS, Cone, OptimalControlProblem, Transcription
+from ocp.transcription import (
+    NLP,
+    TRANSCRIPTIONS,
+    Cone,
+    OptimalControlProblem,
+    Transcription,
+)
 from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference
 from planners.collocation_reference import CollocationReference, seed_sampler
 
@@ -58,6 +70,11 @@ def parse_cone(spec: dict, keep_out: bool, margin: float = 0.0, where: str = "co
     margin : rad by which the cone is tightened.
     where : the option's path (``keep_out[0]``) for error messages.
 
+    Returns
+    -------
+    Cone
+        The (tightened) cone, unit vectors, angle in rad.
+
     Raises
     ------
     InvalidOption
@@ -84,6 +101,59 @@ class CollocationPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
+        """Options of ``collocation`` (YAML keys; see the README's planner table).
+
+        Attributes
+        ----------
+        objective : str
+            ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt, ``min_time`` (free T, the
+            scenario's duration its upper bound) or ``weighted``; τ the actuators' body torque [N m].
+        intervals : int
+            Mesh intervals.
+        degree : int
+            Radau points per interval (``collocation``).
+        transcription : str
+            ``collocation`` (Legendre-Gauss-Radau) or ``multiple_shooting``.
+        substeps : int
+            RK4 steps per interval (``multiple_shooting``).
+        solver : str
+            ``ipopt`` (default) or ``fatrop``.
+        warm_start : str
+            Registered planner whose reference seeds the NLP (default ``eigenaxis``; ``collocation``
+            itself with its own ``warm_start_options``).
+        warm_start_options : dict
+            The warm-start planner's options.
+        seed_planners : list of str
+            Further planners whose references are starts.
+        multistart : int or "auto"
+            ``auto`` (default): for a free final time a 1 % perturbed copy of the warm start, then
+            restarts from the best point perturbed by 5 % until one agrees with it (the warm start
+            itself if the copy does not converge); for a fixed final time the warm start. n > 0: n
+            perturbed copies; 0: the warm start itself.
+        agree : int
+            Stop once this many starts agree on the best objective (0: try all).
+        time_regularization : float
+            ``min_time`` only: ε > 0 first solves min T + ε ∫‖τ‖² dt / Σ τ_max² (τ_max the wheels'
+            and torquers' torque bounds [N m]) from the starts, then polishes plain minimum time
+            from that optimum and its multipliers; 0 (default): off.
+        coarse_intervals : int
+            Free final time with ``multistart: auto``: the multistart first runs on this many
+            intervals and the full mesh is solved once from its optimum (falling back to the
+            full-mesh multistart); 0 or >= ``intervals``: off. Default 8.
+        energy_weight, l1_weight, time_weight : float
+            Weights of ``weighted`` [1/(N² m² s), 1/(N m s), 1/s].
+        max_rate : float or None
+            Body-rate bound per axis [rad/s]; ``None``: none.
+        keep_out, keep_in : list of dict
+            Cones ``{boresight (body), direction (inertial), angle_deg}``.
+        cone_margin_deg : float
+            Cones are imposed this much tighter [deg], so that they hold between the points.
+        tolerance : float
+            Solver tolerance (scaled KKT error).
+        max_iterations : int
+            Solver iterations per start.
+        """
+
         objective: Literal["min_energy", "min_l1", "min_time", "weighted"] = "min_energy"
         intervals: Annotated[int, Range(ge=1, le=2000)] = 50
         degree: Annotated[int, Range(ge=1, le=9)] = 3
@@ -118,7 +188,9 @@ class CollocationPlanner(Planner):
         max_iterations: Annotated[int, Range(ge=1, le=100000)] = 500
 
         def __post_init__(self) -> None:
-            from planners import PLANNERS  # the registry is complete once options are parsed
+            from planners import (
+                PLANNERS,  # the registry is complete once options are parsed
+            )
 
             # A collocation warm start is planned with its own options (say min_energy, itself warm
             # started from eigenaxis): the way into min_time where a kinematic seed is too far
@@ -137,9 +209,9 @@ class CollocationPlanner(Planner):
             if self.objective == "weighted" and not (self.energy_weight or self.l1_weight or self.time_weight):
                 raise InvalidOption("objective", "weighted needs a positive energy_weight, l1_weight or time_weight")
             l1 = self.objective == "min_l1" or (self.objective == "weighted" and self.l1_weight > 0)
-            error = TRANSCRIPTIONS[self.transcription].problem_error(l1, bool(self.keep_out or self.keep_in))
-            if error:
-                raise ValueError(error)
+            refused = TRANSCRIPTIONS[self.transcription].problem_error(l1, bool(self.keep_out or self.keep_in))
+            if refused:
+                raise ValueError(refused)
             for index, spec in enumerate(self.keep_out):
                 parse_cone(spec, True, np.deg2rad(self.cone_margin_deg), f"keep_out[{index}]")
             for index, spec in enumerate(self.keep_in):
@@ -171,7 +243,7 @@ class CollocationPlanner(Planner):
         # The model's numbers are baked into the graph: a shared cache needs them in the key.
         return self.solver_cache(problem).get(("collocation", problem.model.fingerprint, key), build)
 
-    def _variable_bounds(self, problem: ManeuverProblem):
+    def _variable_bounds(self, problem: ManeuverProblem) -> tuple[Array, Array, Array, Array]:
         """Per-point bounds of the model state and the actuator controls."""
         spacecraft, model = problem.spacecraft, problem.model
         x_low, x_high = np.full(model.nx, -np.inf), np.full(model.nx, np.inf)
@@ -180,14 +252,18 @@ class CollocationPlanner(Planner):
             x_low[4:7], x_high[4:7] = -self.options.max_rate, self.options.max_rate
         u_low, u_high = np.full(model.nu, -np.inf), np.full(model.nu, np.inf)
         slices = model.control_slices
+        # Limits are arrays once the actuators are constructed (None becomes inf).
         if spacecraft.wheels is not None:
-            x_low[7:], x_high[7:] = -spacecraft.wheels.max_momentum, spacecraft.wheels.max_momentum
-            limit = np.where(spacecraft.wheels.working, spacecraft.wheels.max_torque, 0.0)
+            momentum = np.asarray(spacecraft.wheels.max_momentum, dtype=float)
+            x_low[7:], x_high[7:] = -momentum, momentum
+            limit = np.where(spacecraft.wheels.working, np.asarray(spacecraft.wheels.max_torque, dtype=float), 0.0)
             u_low[slices["wheels"]], u_high[slices["wheels"]] = -limit, limit
-        if "dipole" in slices:
-            u_low[slices["dipole"]], u_high[slices["dipole"]] = -spacecraft.magnetorquers.max_dipole, spacecraft.magnetorquers.max_dipole
-        if "torquers" in slices:
-            u_low[slices["torquers"]], u_high[slices["torquers"]] = -spacecraft.torquers.max_torque, spacecraft.torquers.max_torque
+        if spacecraft.magnetorquers is not None:
+            dipole = np.asarray(spacecraft.magnetorquers.max_dipole, dtype=float)
+            u_low[slices["dipole"]], u_high[slices["dipole"]] = -dipole, dipole
+        if spacecraft.torquers is not None:
+            torque = np.asarray(spacecraft.torquers.max_torque, dtype=float)
+            u_low[slices["torquers"]], u_high[slices["torquers"]] = -torque, torque
         return x_low, x_high, u_low, u_high
 
     def _starts(self, problem: ManeuverProblem) -> list[Reference]:
@@ -246,7 +322,7 @@ class CollocationPlanner(Planner):
         first = solve_multistart(regular.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=regular.lbg, ubg=regular.ubg,
                                  agree=o.agree, restart=restart, fallback=fallback)
         extra = {"regularized": first.stats()}
-        if not first.success:
+        if first.x is None:
             return first, extra
         _, polish = self._nlp(problem, ocp, warm=True)
         result = solve_multistart(polish.solver, [first.x], p=params, lbx=lbx, ubx=ubx, lbg=polish.lbg,
@@ -295,6 +371,7 @@ class CollocationPlanner(Planner):
         if not result.success:
             return FailedReference(self.name, f"{o.solver} did not converge from any start: "
                                    f"{sorted(set(result.statuses))}", result.status, stats=stats)
+        assert result.x is not None  # success implies a point
         T, states, controls = (v.full() for v in nlp.unpack(result.x, params))
         T = T.item()
         reference = CollocationReference(problem, transcription, T, states, controls, stats)
