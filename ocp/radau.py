@@ -20,14 +20,6 @@ from ocp.model import AttitudeModel
 from ocp.transcription_base import Array, Interval, OptimalControlProblem, Transcription
 
 
-def _basis(points: Array, r: int) -> np.poly1d:
-    basis = np.poly1d([1.0])
-    for s, p_s in enumerate(points):
-        if s != r:
-            basis *= np.poly1d([1.0, -p_s]) / (points[r] - p_s)
-    return basis
-
-
 def lagrange(points: Array, tau: Array) -> Array:
     """Values of the Lagrange basis through ``points``.
 
@@ -87,7 +79,8 @@ def radau_weights(degree: int) -> Array:
         ``w_j = ∫₀¹ ℓ_j`` for the Lagrange basis through the Radau points.
     """
     points = np.asarray(ca.collocation_points(degree, "radau"))
-    return np.array([np.polyint(_basis(points, r))(1.0) for r in range(degree)])
+    # Exact for the monomials 1 … τ^(d−1): Σ_j w_j τ_j^k = 1/(k + 1), the same weights as ∫ ℓ_j.
+    return np.linalg.solve(np.vander(points, degree, increasing=True).T, 1.0 / np.arange(1, degree + 1))
 
 
 class RadauCollocation(Transcription):
