@@ -94,8 +94,8 @@ class RateAcquisitionSystem(RigidBodySystem):
     weighting : (3, 3) ndarray
         ``W`` (eq. 34; diagonal in the planner).
     terminal_weight : float
-        ``Q_f = terminal_weight · I`` of the fixed-time terminal cost [N m s / (rad/s)², scaled
-        by the co-state normalisation].
+        ``Q_f = terminal_weight · I`` of the fixed-time terminal cost ``½ (ω − ω_d)ᵀ Q_f (ω − ω_d)``
+        (eq. 23).
     minimum_time : bool
         Solve for the minimum time (``ω(t_f) = ω_d`` exactly) rather than the fixed-time terminal cost.
     """
@@ -215,7 +215,7 @@ class AttitudeAcquisitionSystem(HamiltonianSystem):
     max_rate : float
         ``ω_max``, the rate norm of the control [rad/s].
     terminal_weight : float
-        ``Q_f = terminal_weight · I`` of the fixed-time terminal cost on the attitude.
+        ``Q_f = terminal_weight · I`` of the fixed-time terminal cost on the attitude (eq. 51).
     minimum_time : bool
         Solve for the minimum time (target met exactly) rather than the fixed-time terminal cost.
     """

@@ -226,7 +226,7 @@ class HamiltonianSystem(ABC):
         Returns
         -------
         f : (2n, m) ndarray
-            ``ẏ`` [per s].
+            ``ẏ`` in real time (units of ``y`` per second).
         jacobian : (2n, 2n, m) ndarray or None
             ``∂f/∂y``; ``None`` unless ``derivatives``.
         f_t : (2n, m) ndarray or None

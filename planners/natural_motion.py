@@ -149,8 +149,9 @@ class NaturalMotionPlanner(Planner):
             ``smooth``: a cubic deceleration along the final body rate over ``stop_time`` (the
             shooting then targets the attitude after the stop).
         rk4_steps : int
-            RK4 steps of the asymmetric body's shooting graph, 4 to 5000 (default 60); refined x4,
-            up to 16 times, while the exact arc misses the target by more than 1e-6 deg.
+            RK4 steps of the asymmetric body's shooting graph, 4 to 5000 (default 60); multiplied by
+            4, up to 16 × ``rk4_steps``, while the exact (elliptic) arc misses the target by more than
+            1e-6 deg. Unused for an axisymmetric body (closed form).
         starts : int
             IPOPT starts of the shooting, 1 to 50 (default 3): the short and the long way round,
             then perturbed ones.
