@@ -250,7 +250,8 @@ class CostateTPBVPPlanner(Planner):
         final_time : {"minimum", "fixed"} or None
             Steering forms: ``minimum`` (the default for them, ``None``) solves for the minimum
             time; ``fixed`` uses the scenario's T with the terminal cost ``terminal_weight`` and the
-            paper's transversality conditions. ``min_energy`` has a fixed time (``minimum`` is
+            paper's transversality conditions (rate acquisition: for a T shorter than the minimum
+            time; a target rate reachable within T makes the problem singular and the solve fails). ``min_energy`` has a fixed time (``minimum`` is
             refused).
         weighting : tuple of 3 float
             Diagonal of ``W`` (eq. 34), positive (default ``[1, 1, 1]``; rate acquisition).
@@ -260,7 +261,9 @@ class CostateTPBVPPlanner(Planner):
         terminal_weight : float
             ``Q_f = terminal_weight · I`` of the terminal cost with ``final_time: fixed`` (on the
             rate for rate acquisition, on the quaternion for attitude acquisition), positive
-            (default 100).
+            (default 100). The optimum does not depend on it: the control has unit norm and there
+            is no running cost, so the co-state equations and boundary conditions are homogeneous
+            in λ and the weight only scales the co-states.
         max_rate : float or None
             ``ω_max`` of attitude acquisition [rad/s]; ``None`` (default): ``maneuver.max_rate``.
         continuation_steps : int
