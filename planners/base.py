@@ -71,8 +71,11 @@ class Planner(Configurable, ABC):
 
     Raises
     ------
-    ocp.options.InvalidOption
-        For an unknown option or a value out of its declared range, naming ``path``.
+    ocp.options.OptionsError
+        For an unknown option, a value of the wrong type or out of its declared range, or a
+        relation ``Options.__post_init__`` refuses; the message names ``path`` and the option.
+    TypeError
+        If ``Options`` is not a dataclass (the ``@dataclass(frozen=True)`` decorator is missing).
     """
 
     example_options: ClassVar[tuple[Mapping[str, Any], ...]] = ({},)

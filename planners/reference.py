@@ -68,7 +68,9 @@ class Reference(ABC):
 
     A reference meets the problem's boundary conditions ``q(0) = q0``, ``ω(0) = ω0``,
     ``q(T) = qf``, ``ω(T) = ωf`` (those not ``None``) unless it declares them in
-    ``free_boundary``.
+    ``free_boundary``. A subclass calls ``super().__init__(name, T, problem.spacecraft.inertia,
+    ...)`` and implements ``_evaluate``; the README section "Adding a planner" has a complete one,
+    and :func:`planners.conformance.check_reference` checks it.
 
     Parameters
     ----------
@@ -77,8 +79,9 @@ class Reference(ABC):
     duration : float
         Manoeuvre time T [s]; may differ from the problem's for minimum-time planners.
     inertia : (3, 3) or (3,) array_like
-        Body inertia [kg m^2], body axes (``problem.spacecraft.inertia``): used for the torque-free
-        continuation after T and by the conformance checks of the torque. Principal moments (3,)
+        Body inertia [kg m^2], body axes (``problem.spacecraft.inertia``): stored as the (3, 3)
+        ``inertia`` attribute for the subclass's :func:`inverse_dynamics_torque`, the torque-free
+        continuation after T and the conformance checks of the torque. Principal moments (3,)
         become a diagonal matrix.
     status : str, optional
         One of :data:`STATUSES`: ``"ok"`` (default), ``"failed"`` (numerical failure) or
@@ -283,7 +286,8 @@ class Reference(ABC):
         Returns
         -------
         (3,) or (N, 3) ndarray
-            Feed-forward rigid-body torque(s) [N m], body axes (the ``u`` of ``I ω̇ = −ω × I ω + u``; zero after T).
+            Feed-forward rigid-body torque(s) [N m], body axes: the ``u`` of
+            ``I ω̇ = −ω × I ω + u``; zero after T.
         """
         return self.sample(t).torque
 
