@@ -272,9 +272,14 @@ class AttitudeModel:
 
 
 def _plain(value: Any) -> Any:
-    """A dataclass tree as nested tuples of plain numbers and strings (for :attr:`AttitudeModel.fingerprint`)."""
+    """A dataclass tree as nested tuples of plain numbers and strings (for :attr:`AttitudeModel.fingerprint`).
+
+    Fields excluded from equality (``compare=False``, e.g. ``Spacecraft._cache``) are not part of
+    what the value describes and are skipped.
+    """
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return (type(value).__name__,) + tuple((f.name, _plain(getattr(value, f.name))) for f in dataclasses.fields(value))
+        return (type(value).__name__,) + tuple((f.name, _plain(getattr(value, f.name)))
+                                               for f in dataclasses.fields(value) if f.compare)
     if isinstance(value, np.ndarray):
         return ("array", value.shape, tuple(float(v) for v in value.ravel()))
     if isinstance(value, (list, tuple)):
