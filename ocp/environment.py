@@ -33,7 +33,7 @@ class CircularOrbit:
     Parameters
     ----------
     altitude : float
-        Height above the equatorial radius ``R_EARTH`` [m]; the radius must stay positive.
+        Height above the equatorial radius ``R_EARTH`` [m]; must exceed ``−0.99 R_EARTH``.
     inclination : float, optional
         Inclination of the orbit plane to the equator [rad] (default 0).
     raan : float, optional
@@ -62,12 +62,12 @@ class CircularOrbit:
 
     @property
     def radius(self) -> float:
-        """Orbit radius (m)."""
+        """Orbit radius ``R_EARTH + altitude`` [m]."""
         return R_EARTH + self.altitude
 
     @property
     def mean_motion(self) -> float:
-        """Mean motion n (rad/s)."""
+        """Mean motion ``n = sqrt(mu / radius³)`` [rad/s]: the orbit rate."""
         return float(np.sqrt(self.mu / self.radius**3))
 
     def position(self, t: Expr) -> Expr:

@@ -75,7 +75,7 @@ def parse_epoch(epoch: str | datetime.date) -> datetime.datetime:
 
 
 def greenwich_mean_sidereal_angle(epoch: datetime.datetime) -> float:
-    """GMST (rad) at a UTC epoch, IAU 1982 linear form (UT1 = UTC; error well under 0.01°).
+    """Greenwich mean sidereal angle at a UTC epoch, IAU 1982 linear form (UT1 = UTC; error well under 0.01°).
 
     Parameters
     ----------
@@ -170,19 +170,20 @@ class IGRFField:
 
     @property
     def initial_greenwich_angle(self) -> float:
-        """rad, the Earth's rotation angle at t = 0."""
+        """The Earth-fixed x axis's angle from the inertial x axis at t = 0 [rad]: ``greenwich_angle``
+        or, when that is ``None``, the GMST of the epoch."""
         if self.greenwich_angle is not None:
             return float(self.greenwich_angle)
         return greenwich_mean_sidereal_angle(parse_epoch(self.epoch))
 
     @property
     def valid_until(self) -> float:
-        """s, end of the tabulated window (the last node, at or after ``span``)."""
+        """End of the tabulated window [s]: the last node, at or after ``span``."""
         return float(self.nodes[-1])
 
     @property
     def nodes(self) -> NDArray:
-        """(N,) s, times of the table (at least four, for the cubic spline)."""
+        """(N,) times of the table [s], ``k * step`` from 0 (at least four, for the cubic spline)."""
         count = max(4, int(np.ceil(self.span / self.step - 1e-9)) + 1)
         return np.arange(count) * self.step
 
@@ -210,7 +211,8 @@ class IGRFField:
 
     @cached_property
     def interpolant(self) -> ca.Function:
-        """``casadi.Function`` ``(t) -> b``: cubic B-spline through the table (T, inertial axes)."""
+        """``casadi.Function`` ``igrf_field(t) -> b``: cubic B-spline through the table, ``t`` [s],
+        ``b`` (3,) [T], inertial axes (built on first use)."""
         nodes = self.nodes
         values = self.exact(nodes)
         return ca.interpolant("igrf_field", "bspline", [nodes], values.ravel())

@@ -131,7 +131,7 @@ class ReactionWheels:
 
     @property
     def count(self) -> int:
-        """Number of wheels, failed ones included."""
+        """Number of wheels ``n``, failed ones included."""
         return self.axes.shape[1]
 
     @property
@@ -276,7 +276,8 @@ class Spacecraft:
 
     @property
     def wheel_axes(self) -> Array:
-        """(3, n_w) wheel axes; (3, 0) without wheels."""
+        """(3, n_w) unit wheel spin axes, body frame, the matrix ``A`` of the dynamics; (3, 0)
+        without wheels."""
         return np.zeros((3, 0)) if self.wheels is None else self.wheels.axes
 
     @property
