@@ -26,8 +26,9 @@ section IV.B). With ``ε_D = 0`` and no saturation, ``ω = ωd`` gives ``q̇3 = 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import casadi as ca
 import numpy as np
@@ -39,11 +40,26 @@ from ocp.layout import split_measurement
 PRINCIPAL_TOLERANCE = 1e-9
 """Relative tolerance on ``‖I n − (nᵀ I n) n‖ / ‖I‖`` for the unactuated axis ``n`` to count as principal."""
 
+Scalar = TypeVar("Scalar", float, ca.SX)
+"""A number or a CasADi expression: the laws' arithmetic runs on both (Python loop, symbolic form)."""
+
 
 @dataclass(frozen=True)
 class SingularGains:
-    """Gains of one desired-rate law: ``k``, ``g`` (rad/s), saturation limits ``a1``, ``a2``
-    (dimensionless, ``None``: unsaturated) and the regularisation ``epsilon_d`` of ``q1² + q2²``."""
+    """Gains of one desired-rate law (eq. 7/8, or eq. 27 for the Lyapunov function's rates).
+
+    Parameters
+    ----------
+    k : float
+        Gain on the actuated components ``q1``, ``q2`` of the error quaternion [rad/s].
+    g : float
+        Gain of the singular term ``q2 q3 / D``, ``q1 q3 / D`` [rad/s]; the laws need ``g > 2 k``.
+    a1, a2 : float or None
+        Saturation limits of the singular ratios ``q2 q3 / D`` and ``q1 q3 / D`` (dimensionless,
+        eq. 8); ``None``: unsaturated (eq. 7).
+    epsilon_d : float, optional
+        Regularisation ``ε_D`` added to ``D = q1² + q2²`` (dimensionless); 0: the paper's eq. 7/8.
+    """
 
     k: float
     g: float
@@ -76,13 +92,17 @@ def desired_rates(q0: float, q1: float, q2: float, q3: float, w1: float, w2: flo
 
     Parameters
     ----------
-    q0, q1, q2, q3 : error quaternion in the control frame (scalar first).
-    w1, w2, w3 : body rate in the control frame (rad/s); ``w3`` enters the derivative only.
-    gains : the law's gains.
+    q0, q1, q2, q3 : float
+        Error quaternion in the control frame (scalar first, dimensionless).
+    w1, w2, w3 : float
+        Body rate in the control frame [rad/s]; it enters the derivative only.
+    gains : SingularGains
+        The law's gains.
 
     Returns
     -------
-    (ωd1, ωd2, ω̇d1, ω̇d2) in rad/s and rad/s².
+    tuple of 4 float
+        ``(ωd1, ωd2, ω̇d1, ω̇d2)`` [rad/s, rad/s²]; the derivative is zero where a ratio saturates.
     """
     k, g = gains.k, gains.g
     dq1 = 0.5 * (q0 * w1 - q3 * w2 + q2 * w3)
@@ -102,11 +122,28 @@ def desired_rates(q0: float, q1: float, q2: float, q3: float, w1: float, w2: flo
     return wd1, wd2, -k * dq1 + g * dr1, -k * dq2 - g * dr2
 
 
-def rate_tracking_torque(w1: float, w2: float, rates: tuple[float, float, float, float], gain: float,
-                         inertia: tuple[float, float]) -> tuple[float, float]:
-    """snlc law (eq. 14/24 with eq. 31's units): ``u_i = −K (ω_i − ωd_i) + I_i ω̇d_i`` (N m).
+def rate_tracking_torque(w1: Scalar, w2: Scalar, rates: tuple[Scalar, Scalar, Scalar, Scalar], gain: float,
+                         inertia: tuple[float, float]) -> tuple[Scalar, Scalar]:
+    """snlc law (eq. 14/24 with eq. 31's units): ``u_i = −K (ω_i − ωd_i) + I_i ω̇d_i``.
 
-    ``gain`` K is in N m s/rad (not 1/s times the inertia); ``rates`` as :func:`desired_rates`."""
+    Works on floats and on CasADi expressions alike.
+
+    Parameters
+    ----------
+    w1, w2 : float or casadi.SX
+        Body rate on the actuated axes [rad/s], control frame.
+    rates : tuple of 4 float or casadi.SX
+        ``(ωd1, ωd2, ω̇d1, ω̇d2)`` [rad/s, rad/s²] as :func:`desired_rates` returns them.
+    gain : float
+        K [N m s/rad] (eq. 31's units; not 1/s times the inertia as eq. 14's ``I_i K_i`` reads).
+    inertia : tuple of 2 float
+        Principal moments ``I1``, ``I2`` of the actuated axes [kg m²].
+
+    Returns
+    -------
+    tuple of 2 float or casadi.SX
+        Torque ``(u1, u2)`` on the actuated axes [N m], control frame.
+    """
     wd1, wd2, dwd1, dwd2 = rates
     return -gain * (w1 - wd1) + inertia[0] * dwd1, -gain * (w2 - wd2) + inertia[1] * dwd2
 
@@ -116,7 +153,21 @@ def min_norm(benchmark: tuple[float, float], lgv: tuple[float, float]) -> tuple[
 
     ``u = (L_gV k) L_gVᵀ / (L_gV L_gVᵀ)`` when ``L_gV k < 0``, else 0. Eq. 25 prints a leading
     minus, which gives ``L_gV u = −L_gV k > 0``: V̇ increases wherever the law acts. ``‖u‖ =
-    |L_gV k| / ‖L_gV‖ <= ‖k‖`` (Cauchy-Schwarz), not ``= ‖k‖`` as the text after eq. 24 says."""
+    |L_gV k| / ‖L_gV‖ <= ‖k‖`` (Cauchy-Schwarz), not ``= ‖k‖`` as the text after eq. 24 says.
+
+    Parameters
+    ----------
+    benchmark : tuple of 2 float
+        The benchmark torque ``k(x)`` on the actuated axes [N m], control frame.
+    lgv : tuple of 2 float
+        ``L_gV``, the gradient of the Lyapunov function along the control [s/(kg m²)].
+
+    Returns
+    -------
+    tuple of 2 float
+        The min-norm torque ``(u1, u2)`` [N m], control frame; zeros where the benchmark does not
+        decrease V or ``L_gV = 0``.
+    """
     s = lgv[0] * benchmark[0] + lgv[1] * benchmark[1]
     norm2 = lgv[0] * lgv[0] + lgv[1] * lgv[1]
     if s >= 0.0 or norm2 == 0.0:
@@ -139,9 +190,24 @@ def _ratio_symbolic(numerator: ca.SX, denominator: ca.SX) -> ca.SX:
     return ca.if_else(denominator > 0, numerator / safe, singular)
 
 
-def desired_rates_symbolic(q: list, w: list, gains: SingularGains) -> tuple[ca.SX, ca.SX, ca.SX, ca.SX]:
-    """:func:`desired_rates` on expressions: ``q = [q0, q1, q2, q3]``, ``w = [ω1, ω2, ω3]`` in the
-    control frame; the same arithmetic, branches as ``if_else``."""
+def desired_rates_symbolic(q: Sequence[ca.SX], w: Sequence[ca.SX | float],
+                           gains: SingularGains) -> tuple[ca.SX, ca.SX, ca.SX, ca.SX]:
+    """:func:`desired_rates` on expressions: the same arithmetic, branches as ``if_else``.
+
+    Parameters
+    ----------
+    q : sequence of 4 casadi.SX
+        Error quaternion ``[q0, q1, q2, q3]`` in the control frame (scalar first).
+    w : sequence of 3 casadi.SX or float
+        Body rate ``[ω1, ω2, ω3]`` in the control frame [rad/s]; it enters the derivative only.
+    gains : SingularGains
+        The law's gains.
+
+    Returns
+    -------
+    tuple of 4 casadi.SX
+        ``(ωd1, ωd2, ω̇d1, ω̇d2)`` [rad/s, rad/s²].
+    """
     q0, q1, q2, q3 = q
     w1, w2, w3 = w
     k, g = gains.k, gains.g
@@ -158,8 +224,21 @@ def desired_rates_symbolic(q: list, w: list, gains: SingularGains) -> tuple[ca.S
     return -k * q1 + g * r1, -k * q2 - g * r2, -k * dq1 + g * dr1, -k * dq2 - g * dr2
 
 
-def min_norm_symbolic(benchmark: tuple, lgv: tuple) -> tuple[ca.SX, ca.SX]:
-    """:func:`min_norm` on expressions."""
+def min_norm_symbolic(benchmark: tuple[ca.SX, ca.SX], lgv: tuple[ca.SX, ca.SX]) -> tuple[ca.SX, ca.SX]:
+    """:func:`min_norm` on expressions (the branch as ``if_else``).
+
+    Parameters
+    ----------
+    benchmark : tuple of 2 casadi.SX
+        The benchmark torque ``k(x)`` on the actuated axes [N m], control frame.
+    lgv : tuple of 2 casadi.SX
+        ``L_gV`` [s/(kg m²)].
+
+    Returns
+    -------
+    tuple of 2 casadi.SX
+        The min-norm torque ``(u1, u2)`` [N m], control frame.
+    """
     s = lgv[0] * benchmark[0] + lgv[1] * benchmark[1]
     norm2 = lgv[0] * lgv[0] + lgv[1] * lgv[1]
     acting = ca.logic_and(s < 0, norm2 != 0)
@@ -173,11 +252,15 @@ def control_frame(spacecraft: Spacecraft) -> Array | str:
 
     Parameters
     ----------
-    spacecraft : with reaction wheels whose working axes span exactly a plane.
+    spacecraft : Spacecraft
+        The spacecraft; it needs reaction wheels whose working axes span exactly a plane whose
+        normal is a principal axis of the inertia.
 
     Returns
     -------
-    (3, 3) rotation matrix, or an error message.
+    (3, 3) ndarray or str
+        The rotation matrix from body to control axes (rows ``e1, e2, e3`` in body axes), or the
+        reason why there is none (the caller prefixes the controller's name).
     """
     wheels = spacecraft.wheels
     if wheels is None or not np.any(wheels.working):
@@ -217,14 +300,37 @@ class TwoWheelLaw(Controller):
     wheels_only = True
     gyroscopic_compensation = False
 
+    def _spacecraft(self) -> Spacecraft:
+        """The spacecraft of the last :meth:`reset` (an error before it)."""
+        if self.spacecraft is None:
+            raise RuntimeError(f"controller {self.name}: call reset(spacecraft, sample_time, target) first")
+        return self.spacecraft
+
     def environment_error(self, spacecraft: Spacecraft, environment: Any) -> str | None:
         frame = self.control_frame(spacecraft)
         return f"controller {self.name} {frame}" if isinstance(frame, str) else None
 
     def initial_state_error(self, spacecraft: Spacecraft, omega0: Array, wheel_momentum0: Array,
                             omegaf: Array | None) -> tuple[str, str] | None:
-        """The laws need zero total angular momentum (the unactuated rate stays zero only then) and
-        end at rest."""
+        """Refuse a non-zero total angular momentum or a final rate: the laws need ``I ω0 + A h_w0 = 0``
+        (the unactuated rate stays zero only then) and end at rest.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The spacecraft (inertia, wheel axes).
+        omega0 : (3,) ndarray
+            Initial body rate [rad/s], body frame.
+        wheel_momentum0 : (n_w,) ndarray
+            Initial wheel momenta [N m s] along the wheel axes.
+        omegaf : (3,) ndarray or None
+            Final body rate [rad/s], body frame; ``None``: free.
+
+        Returns
+        -------
+        tuple of 2 str or None
+            ``("initial.omega" or "final.omega", message)``, or ``None`` when the state is accepted.
+        """
         momentum = spacecraft.inertia @ omega0 + spacecraft.wheel_axes @ wheel_momentum0
         scale = max(float(np.abs(spacecraft.inertia).max()) * 1e-9, 1e-12)
         if float(np.linalg.norm(momentum)) > scale:
@@ -235,7 +341,18 @@ class TwoWheelLaw(Controller):
         return None
 
     def control_frame(self, spacecraft: Spacecraft) -> Array | str:
-        """The control frame (see :func:`control_frame`); a test may override it."""
+        """The control frame (see :func:`control_frame`); a test may override it.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The spacecraft.
+
+        Returns
+        -------
+        (3, 3) ndarray or str
+            Rows ``e1, e2, e3`` in body axes (``e3`` unactuated), or why there is none.
+        """
         return control_frame(spacecraft)
 
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
@@ -251,8 +368,20 @@ class TwoWheelLaw(Controller):
         self._target_conjugate = (q_target[0], -q_target[1], -q_target[2], -q_target[3])
 
     def error(self, measurement: Measurement) -> tuple[float, float, float, float, float, float, float]:
-        """``(q0, q1, q2, q3, ω1, ω2, ω3)``: error quaternion ``q_f* ⊗ q`` (``q0 >= 0``) and body rate
-        in the control frame."""
+        """Error quaternion and body rate in the control frame.
+
+        Parameters
+        ----------
+        measurement : Measurement
+            Measured attitude ``q`` (body to inertial, scalar first) and body rate [rad/s].
+
+        Returns
+        -------
+        tuple of 7 float
+            ``(q0, q1, q2, q3, ω1, ω2, ω3)``: the error quaternion ``q_f* ⊗ q`` (sign chosen so
+            that ``q0 >= 0``; ``q_f`` the target, identity without one) with its vector part in
+            the control frame, and the body rate in the control frame [rad/s].
+        """
         p0, p1, p2, p3 = self._target_conjugate
         q0, q1, q2, q3 = measurement.q.tolist()
         e0 = p0 * q0 - p1 * q1 - p2 * q2 - p3 * q3
@@ -266,9 +395,21 @@ class TwoWheelLaw(Controller):
         return (e0, a * ex + b * ey + c * ez, d * ex + e * ey + f * ez, g * ex + h * ey + i * ez,
                 a * wx + b * wy + c * wz, d * wx + e * wy + f * wz, g * wx + h * wy + i * wz)
 
-    def error_symbolic(self, y: ca.SX) -> tuple[list, list]:
-        """:meth:`error` on the measurement vector ``y``: ``([q0, q1, q2, q3], [ω1, ω2, ω3])``."""
-        q, w, _, _ = split_measurement(y, self.spacecraft.n_wheels)
+    def error_symbolic(self, y: ca.SX) -> tuple[list[ca.SX], list[ca.SX]]:
+        """:meth:`error` on the measurement vector ``y``.
+
+        Parameters
+        ----------
+        y : casadi.SX
+            Measurement vector ``[q, ω, h_w, b]`` (layout in :mod:`ocp.layout`).
+
+        Returns
+        -------
+        tuple of 2 lists of casadi.SX
+            ``([q0, q1, q2, q3], [ω1, ω2, ω3])``: error quaternion (``q0 >= 0``) and body rate
+            [rad/s], control frame.
+        """
+        q, w, _, _ = split_measurement(y, self._spacecraft().n_wheels)
         p0, p1, p2, p3 = self._target_conjugate
         e0 = p0 * q[0] - p1 * q[1] - p2 * q[2] - p3 * q[3]
         ex = p0 * q[1] + p1 * q[0] + p2 * q[3] - p3 * q[2]
@@ -282,16 +423,53 @@ class TwoWheelLaw(Controller):
         return [e0, *vector], rates
 
     def command_symbolic(self, u1: ca.SX, u2: ca.SX, y: ca.SX) -> ca.SX:
-        """:meth:`command_torque` on expressions: the control vector for ``u`` on the actuated axes."""
+        """:meth:`command_torque` on expressions.
+
+        Parameters
+        ----------
+        u1, u2 : casadi.SX
+            Torque on the actuated axes [N m], control frame.
+        y : casadi.SX
+            Measurement vector ``[q, ω, h_w, b]``.
+
+        Returns
+        -------
+        casadi.SX
+            The control vector ``u`` in the model's control layout (wheel torques [N m]).
+        """
         (a, b, c), (d, e, f), _ = self._rows
         torque = ca.vertcat(a * u1 + d * u2, b * u1 + e * u2, c * u1 + f * u2)
         return self.allocate_symbolic(torque, y)
 
     def to_body(self, u1: float, u2: float) -> Array:
-        """A torque on the actuated axes (control frame) in body axes (N m)."""
+        """A torque on the actuated axes expressed in body axes.
+
+        Parameters
+        ----------
+        u1, u2 : float
+            Torque on the actuated axes ``e1``, ``e2`` [N m], control frame.
+
+        Returns
+        -------
+        (3,) ndarray
+            The torque [N m], body frame.
+        """
         (a, b, c), (d, e, f), _ = self._rows
         return np.array([a * u1 + d * u2, b * u1 + e * u2, c * u1 + f * u2])
 
     def command_torque(self, u1: float, u2: float, measurement: Measurement) -> Command:
-        """Wheel command for the body torque ``u`` on the actuated axes."""
+        """Wheel command for a body torque on the actuated axes (pure wheel mode, no gyroscopic term).
+
+        Parameters
+        ----------
+        u1, u2 : float
+            Torque on the actuated axes [N m], control frame.
+        measurement : Measurement
+            The sample's measurement.
+
+        Returns
+        -------
+        Command
+            Wheel torques [N m] (``ḣ_w``) that give the body torque ``−A g``.
+        """
         return self.allocate(self.to_body(u1, u2), measurement)
