@@ -17,13 +17,13 @@ from typing import Annotated, Any
 import casadi as ca
 
 from controllers.min_norm import MinNorm
-from controllers.singular_zero_momentum import check_singular_gains
-from controllers.underactuated import (
+from controllers.singular_rates import (
     SingularGains,
     desired_rates,
     desired_rates_symbolic,
     rate_tracking_torque,
 )
+from controllers.singular_zero_momentum import check_singular_gains
 from ocp import Spacecraft
 from ocp.options import Range
 

@@ -18,16 +18,16 @@ from typing import Annotated, Any
 
 import casadi as ca
 
-from controllers.singular_zero_momentum import check_singular_gains
-from controllers.underactuated import (
+from controllers.singular_rates import (
     SingularGains,
-    TwoWheelLaw,
     desired_rates,
     desired_rates_symbolic,
     min_norm,
     min_norm_symbolic,
     rate_tracking_torque,
 )
+from controllers.singular_zero_momentum import check_singular_gains
+from controllers.underactuated import TwoWheelLaw
 from ocp import Command, Measurement, Spacecraft
 from ocp.options import Range
 
@@ -89,7 +89,7 @@ class MinNorm(TwoWheelLaw):
         self.lyapunov_gains = SingularGains(o.gamma, o.sigma, o.a1, o.a2, o.epsilon_D)
 
     def lgv(self, state: tuple[float, ...]) -> tuple[float, float]:
-        """``L_gV = [(ω1 − ω_γσ1)/I1, (ω2 − ω_γσ2)/I2]``, the Lyapunov function's gradient along the control.
+        """``L_gV = [(ω1 − ω_γσ1)/I1, (ω2 − ω_γσ2)/I2]``: V's gradient along the control.
 
         Parameters
         ----------
@@ -125,7 +125,7 @@ class MinNorm(TwoWheelLaw):
         return rate_tracking_torque(w1, w2, rates, self.options.K, self.moments[:2])
 
     def project(self, benchmark: tuple[float, float], lgv: tuple[float, float]) -> tuple[float, float]:
-        """The min-norm torque for ``benchmark`` (sign-corrected eq. 25, :func:`~controllers.underactuated.min_norm`).
+        """The min-norm torque for ``benchmark`` (sign-corrected eq. 25, :func:`~controllers.singular_rates.min_norm`).
 
         Parameters
         ----------

@@ -13,14 +13,14 @@ from typing import Annotated, Any
 
 import casadi as ca
 
-from controllers.singular_zero_momentum import check_singular_gains
-from controllers.underactuated import (
+from controllers.singular_rates import (
     SingularGains,
-    TwoWheelLaw,
     desired_rates,
     desired_rates_symbolic,
     rate_tracking_torque,
 )
+from controllers.singular_zero_momentum import check_singular_gains
+from controllers.underactuated import TwoWheelLaw
 from ocp import Command, Measurement, Spacecraft
 from ocp.options import Range
 

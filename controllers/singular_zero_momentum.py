@@ -14,12 +14,12 @@ from typing import Annotated, Any
 
 import casadi as ca
 
-from controllers.underactuated import (
+from controllers.singular_rates import (
     SingularGains,
-    TwoWheelLaw,
     desired_rates,
     desired_rates_symbolic,
 )
+from controllers.underactuated import TwoWheelLaw
 from ocp import Command, Measurement, Spacecraft
 from ocp.layout import split_measurement
 from ocp.options import InvalidOption, Range

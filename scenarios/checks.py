@@ -113,7 +113,9 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
         error = law.environment_error(problem.spacecraft, problem.environment)
         if error:
             raise ScenarioError(where, error)
-        momentum0 = np.zeros(problem.spacecraft.n_wheels) if problem.wheel_momentum0 is None else problem.wheel_momentum0
+        momentum0 = problem.wheel_momentum0
+        if momentum0 is None:  # ManeuverProblem fills it in; its field's type still admits None
+            momentum0 = np.zeros(problem.spacecraft.n_wheels)
         state = law.initial_state_error(problem.spacecraft, problem.omega0, momentum0, problem.omegaf)
         if state:
             raise ScenarioError(f"maneuver.{state[0]}", f"{state[1]} ({controller.path} is {controller.name!r})")
