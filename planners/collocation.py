@@ -39,6 +39,10 @@ from planners.collocation_reference import CollocationReference, seed_sampler
 
 AUTO_RESTART = 0.05
 """Relative perturbation of the restarts of ``multistart: auto`` when the final time is free."""
+POLISH_MU_INIT = 1e-4
+"""IPOPT's initial barrier parameter for the full-mesh solve from a coarse-mesh optimum of a fixed
+final time (default 0.1): the seed is near the optimum, so the barrier need not start wide (the
+spin paper's minimum energy, N = 50 from N = 8: 7 iterations against 12)."""
 
 
 def _merged(first: NLPResult, second: NLPResult) -> NLPResult:
@@ -227,14 +231,17 @@ class CollocationPlanner(Planner):
                                      fixed_final_rate=problem.omegaf is not None, cones=cones)
 
     def _nlp(self, problem: ManeuverProblem, ocp: OptimalControlProblem,
-             warm: bool = False) -> tuple[Transcription, NLP]:
+             warm: bool = False, polish: bool = False) -> tuple[Transcription, NLP]:
         """The transcription and its built NLP for ``ocp`` (from the cache when built before);
-        ``warm``: solver options for a start with multipliers (:func:`ocp.nlp.warm_start_options`)."""
+        ``warm``: solver options for a start with multipliers (:func:`ocp.nlp.warm_start_options`);
+        ``polish``: IPOPT starts its barrier at :data:`POLISH_MU_INIT` (a seed near the optimum)."""
         o = self.options
         transcription = TRANSCRIPTIONS[o.transcription].from_options(o)
+        polish = polish and o.solver == "ipopt"
         key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
-               o.transcription, o.intervals, o.degree, o.substeps, o.solver, o.tolerance, o.max_iterations, warm)
-        extra = warm_start_options(o.solver) if warm else None
+               o.transcription, o.intervals, o.degree, o.substeps, o.solver, o.tolerance, o.max_iterations, warm,
+               polish)
+        extra = warm_start_options(o.solver) if warm else {"ipopt.mu_init": POLISH_MU_INIT} if polish else None
 
         def build() -> tuple[Transcription, NLP]:
             return transcription, transcription.build(ocp, o.solver,
@@ -307,14 +314,15 @@ class CollocationPlanner(Planner):
         return replace(ocp, energy_weight=self.options.time_regularization / scale)
 
     def _solve(self, problem: ManeuverProblem, ocp: OptimalControlProblem, seeds: list[Array], params: Array,
-               bounds: tuple[Array, Array]) -> tuple[NLPResult, dict]:
+               bounds: tuple[Array, Array], polish: bool = False) -> tuple[NLPResult, dict]:
         """Solve ``ocp`` from ``seeds`` by the multistart policy; with ``time_regularization``, solve
-        the regularised problem so and polish plain minimum time from its optimum and multipliers."""
+        the regularised problem so and polish plain minimum time from its optimum and multipliers.
+        ``polish``: the seeds are near the optimum (see :meth:`_nlp`)."""
         o = self.options
         guesses, fallback, restart = self._guesses(ocp, seeds)
         lbx, ubx = bounds
         if not o.time_regularization:
-            _, nlp = self._nlp(problem, ocp)
+            _, nlp = self._nlp(problem, ocp, polish=polish)
             result = solve_multistart(nlp.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
                                       agree=o.agree, restart=restart, fallback=fallback)
             return result, {}
@@ -330,8 +338,13 @@ class CollocationPlanner(Planner):
         return result, extra
 
     def _coarse(self, ocp: OptimalControlProblem) -> bool:
+        """Whether to solve on ``coarse_intervals`` first: with ``multistart: auto``, for a free final
+        time (the escape from stationary points) and for a fixed one without cones (a cheap seed
+        near the optimum; cones are imposed at fewer points on a coarse mesh, so its optimum may cut
+        through one)."""
         o = self.options
-        return ocp.free_time and o.multistart == "auto" and 0 < o.coarse_intervals < o.intervals
+        return (o.multistart == "auto" and 0 < o.coarse_intervals < o.intervals
+                and (ocp.free_time or not ocp.cones))
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         starts = self._starts(problem)
@@ -360,7 +373,8 @@ class CollocationPlanner(Planner):
             if found.ok:
                 single = replace(o, multistart=0, coarse_intervals=0)
                 seed = transcription.seed(ocp, nlp, seed_sampler(problem, found), found.duration)
-                result, more = CollocationPlanner(single, cache=self.cache)._solve(problem, ocp, [seed], params, bounds)
+                result, more = CollocationPlanner(single, cache=self.cache)._solve(problem, ocp, [seed], params, bounds,
+                                                                                   polish=not ocp.free_time)
                 extra.update(more)
         if result is None or not result.success:
             fine, more = self._solve(problem, ocp, seeds, params, bounds)
