@@ -24,6 +24,19 @@ def test_single_axis_minimum_energy_matches_the_closed_form():
     np.testing.assert_allclose(reference.torque(t)[:, 0], 6 * 5.0 * 1.0 * (20 - 2 * t) / 20**3, atol=1e-6)
 
 
+def test_fixed_time_coarse_mesh_seed_reaches_the_closed_form():
+    # With intervals > coarse_intervals (8) a fixed final time is solved on 8 intervals first and the
+    # full mesh once from there (IPOPT's barrier starting at 1e-4): the optimum is still the closed
+    # form 12 I² θ² / T³, and the same as the direct full-mesh solve (coarse_intervals: 0).
+    problem = single_axis_problem()
+    default = PLANNERS["collocation"]({"intervals": 24}).plan(problem)
+    direct = PLANNERS["collocation"]({"intervals": 24, "coarse_intervals": 0}).plan(problem)
+    assert default.status == direct.status == "ok", default.message
+    assert default.stats["coarse"]["intervals"] == 8 and "coarse" not in direct.stats
+    assert default.stats["objective"] == pytest.approx(12 * 5.0**2 * 1.0**2 / 20.0**3, rel=1e-6)
+    assert default.stats["objective"] == pytest.approx(direct.stats["objective"], rel=1e-9)
+
+
 def test_single_axis_minimum_time_matches_bang_bang():
     # From the eigenaxis warm start alone (multistart: 0) IPOPT stays on the single-axis bang-bang,
     # a stationary point with T = 2 √(I θ / u_max). With three independently bounded axes it is not
