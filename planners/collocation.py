@@ -145,8 +145,8 @@ class CollocationPlanner(Planner):
             from that optimum and its multipliers; 0 (default): off.
         coarse_intervals : int
             With ``multistart: auto``, the starts are first solved on this many intervals (for a
-            free final time the whole multistart; for a fixed one only without cones) and the full
-            mesh is solved once from that optimum, IPOPT's barrier starting at 1e-4 (falling back to
+            free final time the whole multistart; for a fixed one only without cones and with at
+            least twice as many ``intervals``) and the full mesh is solved once from that optimum, IPOPT's barrier starting at 1e-4 (falling back to
             the full-mesh solve from the starts); 0 or >= ``intervals``: off. Default 8.
         energy_weight, l1_weight, time_weight : float
             Weights of ``weighted`` [1/(N² m² s), 1/(N m s), 1/s].
@@ -181,9 +181,9 @@ class CollocationPlanner(Planner):
         # the starts above, then polish plain minimum time from that optimum and its multipliers.
         time_regularization: Annotated[float, Range(ge=0.0, le=1.0)] = 0.0
         # Multistart auto: the starts are first solved on this many intervals (a free final time:
-        # the multistart, escape and agreement; a fixed one without cones: a cheap seed), then the
-        # full mesh once from that optimum (falling back to the full-mesh solve from the starts if
-        # it does not converge). 0, or >= intervals: off.
+        # the multistart, escape and agreement; a fixed one without cones and with >= 2x as many
+        # intervals: a cheap seed), then the full mesh once from that optimum (falling back to the
+        # full-mesh solve from the starts if it does not converge). 0, or >= intervals: off.
         coarse_intervals: Annotated[int, Range(ge=0, le=2000)] = 8
         energy_weight: Annotated[float, Range(ge=0.0)] = 1.0               # for objective "weighted"
         l1_weight: Annotated[float, Range(ge=0.0)] = 0.0
@@ -344,12 +344,14 @@ class CollocationPlanner(Planner):
 
     def _coarse(self, ocp: OptimalControlProblem) -> bool:
         """Whether to solve on ``coarse_intervals`` first: with ``multistart: auto``, for a free final
-        time (the escape from stationary points) and for a fixed one without cones (a cheap seed
-        near the optimum; cones are imposed at fewer points on a coarse mesh, so its optimum may cut
-        through one)."""
+        time (the escape from stationary points) and for a fixed one without cones with at least
+        twice as many intervals (a cheap seed near the optimum; cones are imposed at fewer points on
+        a coarse mesh, so its optimum may cut through one)."""
         o = self.options
-        return (o.multistart == "auto" and 0 < o.coarse_intervals < o.intervals
-                and (ocp.free_time or not ocp.cones))
+        if ocp.free_time:
+            return o.multistart == "auto" and 0 < o.coarse_intervals < o.intervals
+        # A fixed final time gains only when the full mesh is several times the coarse one.
+        return o.multistart == "auto" and 0 < 2 * o.coarse_intervals <= o.intervals and not ocp.cones
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         starts = self._starts(problem)
@@ -361,7 +363,9 @@ class CollocationPlanner(Planner):
         """Plan from the given start references (see the module docstring)."""
         o = self.options
         ocp = self._ocp(problem)
-        transcription, nlp = self._nlp(problem, ocp, warm=bool(o.time_regularization))  # the polish's NLP
+        # The layout (bounds, seeds, unpack) is the same in every build: use the one solved first.
+        coarse_first = self._coarse(ocp) and not o.time_regularization
+        transcription, nlp = self._nlp(problem, ocp, warm=bool(o.time_regularization), near_optimum=coarse_first)
         disturbance = problem.model.default_parameters
         omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf
         params = np.concatenate([problem.initial_state, problem.qf, omegaf, [problem.duration], disturbance])

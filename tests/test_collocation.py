@@ -2,8 +2,17 @@
 import numpy as np
 import pytest
 
-from ocp import (AttitudeModel, CircularOrbit, Command, Environment, ReactionWheels, Simulator, Spacecraft,
-                 Torquers, quat)
+from ocp import (
+    AttitudeModel,
+    CircularOrbit,
+    Command,
+    Environment,
+    ReactionWheels,
+    Simulator,
+    Spacecraft,
+    Torquers,
+    quat,
+)
 from planners import PLANNERS, ManeuverProblem
 
 
