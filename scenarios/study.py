@@ -13,6 +13,8 @@ import hashlib
 import itertools
 import json
 import os
+import re
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -82,9 +84,14 @@ def package_version() -> str:
     try:
         return version("slewbench")
     except PackageNotFoundError:  # not installed: running from a checkout
-        import tomllib
-        pyproject = Path(__file__).resolve().parents[1] / "pyproject.toml"
-        return str(tomllib.loads(pyproject.read_text())["project"]["version"])
+        text = (Path(__file__).resolve().parents[1] / "pyproject.toml").read_text()
+        if sys.version_info >= (3, 11):
+            import tomllib
+            return str(tomllib.loads(text)["project"]["version"])
+        found = re.search(r'^version\s*=\s*"([^"]+)"', text, re.MULTILINE)  # Python 3.10: no tomllib
+        if found is None:
+            raise RuntimeError("no project version in pyproject.toml") from None
+        return found.group(1)
 
 
 def case_key(scenario: dict[str, Any], version: str) -> str:

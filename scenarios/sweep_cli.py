@@ -17,7 +17,7 @@ from scenarios.store import STORE_NAME, SweepStore, is_sweep_store
 from scenarios.study import load_study, package_version, parse_study
 from scenarios.outputs import MARKER, default_output_directory, read_manifest
 from scenarios.study_report import claim_sweep_directory, resolved_study
-from scenarios.sweep_engine import SweepInterrupted, SweepResults, sweep
+from scenarios.sweep_engine import SweepInterrupted, SweepResults, start_forkserver, sweep
 from scenarios.yaml_node import ScenarioError
 
 EXIT_OK, EXIT_BAD_STUDY, EXIT_INTERRUPTED = 0, 2, 130
@@ -55,6 +55,8 @@ def command_sweep(args: argparse.Namespace) -> int:
         return command_report(args)
     if not args.file:
         raise ScenarioError("", "give a study file, or --report DIR")
+    if not args.scheduler:
+        start_forkserver()  # local workers' imports run while the study is expanded and checked
     study = load_study(args.file)
     if args.scheduler:
         study.execution.scheduler = args.scheduler

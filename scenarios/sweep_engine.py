@@ -21,7 +21,7 @@ from typing import Any, Callable
 
 from scenarios.store import SweepStore
 from scenarios.study import Case, Study, load_study, parse_study
-from scenarios.sweep_worker import crashed_rows, run_case
+from scenarios.sweep_worker import PRELOAD, crashed_rows, run_case
 
 _POLL_S = 0.5
 _TIMEOUT_GRACE = 1.25  # the driver gives up on a case at this multiple of case_timeout_s (+ 5 s)
@@ -67,11 +67,27 @@ class SweepResults:
         return write_report(self, Path(directory), plots=plots)
 
 
+def start_forkserver() -> multiprocessing.context.BaseContext:
+    """Start (once per process) the server that local workers fork from, importing :data:`PRELOAD`.
+
+    It returns at once: the server imports while the caller goes on (the CLI calls this before it
+    expands the study), and the first worker waits until the imports are done.
+
+    Returns
+    -------
+    multiprocessing.context.BaseContext
+        The ``forkserver`` context that local pools use.
+    """
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(list(PRELOAD))
+    from multiprocessing import forkserver
+    forkserver.ensure_running()
+    return context
+
+
 def _local_pool(workers: int) -> ProcessPoolExecutor:
     """Worker processes forked from a server that has imported the workbench once."""
-    context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["scenarios.sweep_worker", "scenarios.runner"])
-    return ProcessPoolExecutor(max_workers=workers, mp_context=context)
+    return ProcessPoolExecutor(max_workers=workers, mp_context=start_forkserver())
 
 
 def _kill_pool(pool: Executor) -> None:
