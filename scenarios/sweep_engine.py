@@ -45,6 +45,8 @@ class SweepResults:
     study: Study
     records: dict[str, dict[str, Any]]
     workers: dict[str, int] = field(default_factory=dict)
+    cpu_s: dict[str, float] = field(default_factory=dict)
+    worker_cpu_s: dict[str, float] = field(default_factory=dict)
 
     @property
     def missing(self) -> int:
@@ -121,6 +123,8 @@ class _Engine:
         self.in_flight: dict[Future, tuple[str, float]] = {}
         self.attempts: dict[str, int] = collections.Counter()
         self.worker_builds: dict[str, int] = {}
+        self.cpu_s: dict[str, float] = {}
+        self.worker_cpu_s: dict[str, float] = {}
         self.failures = 0
         self.bar = None
         if progress:
@@ -193,6 +197,10 @@ class _Engine:
                 continue
             self.worker_builds[result["worker"]] = result["cache_builds"]
             self._finish(key, result["status"], result["rows"], result["elapsed_s"])
+            if result.get("cpu_s") is not None:
+                self.cpu_s[key] = result["cpu_s"]
+                self.worker_cpu_s[result["worker"]] = max(result["worker_cpu_s"],
+                                                          self.worker_cpu_s.get(result["worker"], 0.0))
         if broken:
             self._died(broken + self._restart_pool(), "its process ended abruptly")
 
@@ -288,9 +296,9 @@ def sweep(study: Study | dict[str, Any] | str | Path, executor: Executor | None 
     try:
         engine.run()
     except KeyboardInterrupt:
-        results = SweepResults(study, engine.records, engine.worker_builds)
+        results = SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)
         raise SweepInterrupted(results.missing, len(study.cases)) from None
     finally:
         if close is not None:
             close()
-    return SweepResults(study, engine.records, engine.worker_builds)
+    return SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)

@@ -87,8 +87,10 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     -------
     dict
         ``key``, ``status`` (``ok``: the runner finished, whatever its rows say; ``crashed``: the
-        case raised or ran out of time), ``rows`` (plain dicts), ``elapsed_s``, ``worker``
-        (host:pid) and ``cache_builds`` (solvers built by this worker so far).
+        case raised or ran out of time), ``rows`` (plain dicts), ``elapsed_s`` (wall time [s]),
+        ``cpu_s`` (CPU time of the case [s]), ``worker_cpu_s`` (CPU time of the worker process
+        since it started [s]), ``worker`` (host:pid) and ``cache_builds`` (solvers built by this
+        worker so far).
     """
     from scenarios.loader import parse_scenario
     from scenarios.runner import run
@@ -97,7 +99,7 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     data, timeout = payload["scenario"], float(payload["timeout_s"])
     alarm = threading.current_thread() is threading.main_thread() and hasattr(signal, "setitimer")
     with lock:
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), time.process_time()
         previous = signal.signal(signal.SIGALRM, _on_alarm) if alarm else None
         try:
             if alarm:
@@ -115,6 +117,7 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
             if alarm:
                 signal.setitimer(signal.ITIMER_REAL, 0.0)
                 signal.signal(signal.SIGALRM, previous)
-        elapsed = time.perf_counter() - start
-    return {"key": payload["key"], "status": status, "rows": rows, "elapsed_s": elapsed,
+        elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu_start
+    return {"key": payload["key"], "status": status, "rows": rows, "elapsed_s": elapsed, "cpu_s": cpu,
+            "worker_cpu_s": time.process_time(),
             "worker": f"{socket.gethostname()}:{os.getpid()}", "cache_builds": cache.builds}
