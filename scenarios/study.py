@@ -35,8 +35,19 @@ DEFAULT_SUMMARY = tuple(f"{scope}.{key}" for scope in ("ref", "cl") for key in M
 
 @dataclass
 class Execution:
-    """How cases run: ``workers`` (None: one per core), a Dask ``scheduler`` address or None,
-    ``case_timeout_s`` (s), ``retries`` of a case whose worker died."""
+    """How cases run (the study's ``execution`` mapping).
+
+    Parameters
+    ----------
+    workers : int or None
+        Cases run at once on the local process pool (1 to 1024); None (``auto``): one per core.
+    scheduler : str or None
+        Address of a Dask scheduler (``tcp://host:port``); None: the local process pool.
+    case_timeout_s : float
+        Wall time after which a case is stopped and becomes a ``crashed`` row [s].
+    retries : int
+        How many times a case whose worker died is run again (0 to 10).
+    """
 
     workers: int | None = None
     scheduler: str | None = None
@@ -46,7 +57,24 @@ class Execution:
 
 @dataclass
 class Case:
-    """One resolved case: its number, seed, the varied values (by path) and the scenario data."""
+    """One resolved case.
+
+    Parameters
+    ----------
+    index : int
+        The case's number, from 0, in the study's order.
+    seed : int
+        The case's seed, from ``numpy.random.SeedSequence(seed).spawn`` (``case_seed``).
+    point : int
+        The grid point (from 0) the case belongs to; Monte Carlo samples share it.
+    varied : dict
+        Scenario path -> the value recorded in the tables (a number, a string, or JSON text for
+        lists; the rotation angle [deg] for ``axis_angle`` quaternions).
+    scenario : dict
+        The resolved scenario mapping (plain YAML data), as a worker receives it.
+    key : str
+        The store key (:func:`case_key`); empty until the study is expanded.
+    """
 
     index: int
     seed: int
@@ -58,7 +86,35 @@ class Case:
 
 @dataclass
 class Study:
-    """A parsed study with its cases expanded and validated."""
+    """A parsed study with its cases expanded and validated (:func:`parse_study`).
+
+    Parameters
+    ----------
+    name : str
+        The study's name (``study:``).
+    source : Path or None
+        The study file; None for a mapping given in code.
+    base : dict
+        The base scenario mapping (plain YAML data).
+    grid_paths : list of str
+        The scenario paths varied by ``grid`` then ``zip``, in order.
+    mc_paths : list of str
+        The scenario paths dispersed by ``monte_carlo``.
+    samples : int
+        Monte Carlo samples per grid point (1 without ``monte_carlo``).
+    method : str or None
+        ``random`` or ``latin_hypercube``; None without ``monte_carlo``.
+    seed : int
+        The study's seed (``monte_carlo.seed``; 0 without it).
+    summary : list of str
+        The metrics summarised (``ref.<metric>``, ``cl.<metric>``).
+    execution : Execution
+        How the cases run.
+    cases : list of Case
+        The expanded cases, in order.
+    raw : dict
+        The study mapping as given (for ``study.yaml``).
+    """
 
     name: str
     source: Path | None
@@ -75,11 +131,18 @@ class Study:
 
     @property
     def varied_paths(self) -> list[str]:
+        """Every varied scenario path: the grid's and zip's, then the Monte Carlo dispersions'."""
         return self.grid_paths + self.mc_paths
 
 
 def package_version() -> str:
-    """slewbench's version: the installed distribution's, else pyproject.toml's."""
+    """slewbench's version: the installed distribution's, else pyproject.toml's.
+
+    Returns
+    -------
+    str
+        The version, for example ``0.1.0``.
+    """
     from importlib.metadata import PackageNotFoundError, version
     try:
         return version("slewbench")
@@ -95,7 +158,20 @@ def package_version() -> str:
 
 
 def case_key(scenario: dict[str, Any], version: str) -> str:
-    """Store key: a hash of the resolved case (canonical JSON) and the package version."""
+    """Store key: a hash of the resolved case (canonical JSON) and the package version.
+
+    Parameters
+    ----------
+    scenario : dict
+        The resolved scenario mapping (plain YAML data).
+    version : str
+        slewbench's version (:func:`package_version`).
+
+    Returns
+    -------
+    str
+        32 hexadecimal digits of the SHA-256 of both.
+    """
     text = json.dumps({"scenario": scenario, "version": version}, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:32]
 
@@ -167,7 +243,9 @@ def _varied(entry: Node, path: str, base: dict[str, Any], paths: list[str],
 
 def _grid_points(root: Node, base: dict[str, Any]) -> tuple[list[str], list[list[Step]], list[tuple[list, list]]]:
     """Varied paths, their parsed steps and the points (values set, values recorded)."""
-    paths, steps, axes = [], [], []
+    paths: list[str] = []
+    steps: list[list[Step]] = []
+    axes: list[list[list[tuple[Any, Any]]]] = []
     grid = root.get("grid", {})
     grid = Node({}, "grid") if grid.is_null() else grid.mapping()
     for path in grid.value:
@@ -194,7 +272,22 @@ def _grid_points(root: Node, base: dict[str, Any]) -> tuple[list[str], list[list
 
 
 def get_parent_ok(base: dict[str, Any], steps: list[Step], where: str) -> None:
-    """Check on the base scenario that ``steps`` can be set (reaches existing lists and labels)."""
+    """Check on the base scenario that ``steps`` can be set (reaches existing lists and labels).
+
+    Parameters
+    ----------
+    base : dict
+        The base scenario mapping (not changed: a copy is written).
+    steps : list of Step
+        The parsed scenario path (:func:`scenarios.study_paths.parse_path`).
+    where : str
+        The study entry, for error messages.
+
+    Raises
+    ------
+    ScenarioError
+        The path does not reach the base scenario.
+    """
     set_path(copy.deepcopy(base), steps, None, where)
 
 
@@ -222,11 +315,15 @@ def parse_study(data: Any, source: Path | None = None, version: str | None = Non
 
     Parameters
     ----------
-    data : the study mapping (``study``, ``scenario``, ``grid``, ``zip``, ``monte_carlo``,
+    data : Any
+        The study mapping (``study``, ``scenario``, ``grid``, ``zip``, ``monte_carlo``,
         ``summary``, ``execution``).
-    source : the study file; a ``scenario`` path is relative to its folder.
-    version : the package version in the case keys (default: this one's; a stored study's when
-        its report is redrawn).
+    source : Path or None, optional
+        The study file; a ``scenario`` path is relative to its folder (None: the working
+        directory).
+    version : str or None, optional
+        The package version in the case keys (None: this one's; a stored study's when its
+        report is redrawn).
 
     Returns
     -------
@@ -346,7 +443,24 @@ def _validate(study: Study, case: Case) -> None:
 
 
 def load_study(path: str | os.PathLike[str]) -> Study:
-    """Read, expand and validate a study file (errors name the study file, the case and the path)."""
+    """Read, expand and validate a study file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The study YAML file.
+
+    Returns
+    -------
+    Study
+        As :func:`parse_study`.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the study file, the case and the path, for a missing file, a bad entry or a case
+        the scenario loader rejects.
+    """
     path = Path(path)
     try:
         return parse_study(read_yaml(path), path)

@@ -32,7 +32,15 @@ class CaseTimeout(Exception):
 
 @functools.cache
 def worker_state() -> tuple[SolverCache, threading.Lock]:
-    """This process's solver cache and case lock (created on first use, kept for its life)."""
+    """This process's solver cache and case lock (created on first use, kept for its life).
+
+    Returns
+    -------
+    cache : SolverCache
+        The planners' builds (NLPs), kept across cases.
+    lock : threading.Lock
+        Held while a case runs, so that a process runs one case at a time.
+    """
     return SolverCache(), threading.Lock()
 
 
@@ -43,8 +51,19 @@ def _controllers(scenario: dict[str, Any]) -> list[tuple[str, str]]:
 
 
 def row_labels(scenario: dict[str, Any]) -> list[tuple[str, str | None, str]]:
-    """(label, planner, controller) of each row the runner makes for a scenario mapping, in its
-    order (for the rows of a crashed case): one per planner and controller, or per controller."""
+    """The rows the runner makes for a scenario mapping, in its order (for a crashed case's rows).
+
+    Parameters
+    ----------
+    scenario : dict
+        A resolved scenario mapping (plain YAML data).
+
+    Returns
+    -------
+    list of (str, str or None, str)
+        (label, planner, controller) of each row: one per planner and controller, or per
+        controller in regulation mode (planner None).
+    """
     controllers = _controllers(scenario)
     planners = scenario.get("planners") or []
     if not planners:
@@ -59,7 +78,20 @@ def row_labels(scenario: dict[str, Any]) -> list[tuple[str, str | None, str]]:
 
 
 def crashed_rows(scenario: dict[str, Any], message: str) -> list[dict[str, Any]]:
-    """One ``crashed`` row per row of ``scenario`` carrying ``message``."""
+    """One ``crashed`` row per row of ``scenario`` carrying ``message``.
+
+    Parameters
+    ----------
+    scenario : dict
+        The case's scenario mapping.
+    message : str
+        Why the case crashed.
+
+    Returns
+    -------
+    list of dict
+        Plain rows (``label``, ``planner``, ``controller``, ``status``, ``message``; no metrics).
+    """
     return [{"label": label, "planner": planner, "controller": controller, "status": "crashed",
              "message": message, "plan_time_s": None, "ref": None, "cl": None}
             for label, planner, controller in row_labels(scenario)]
@@ -81,7 +113,9 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
 
     Parameters
     ----------
-    payload : ``{"key": str, "scenario": mapping, "timeout_s": float}``.
+    payload : dict
+        ``{"key": str, "scenario": mapping, "timeout_s": float}``: the case key, its resolved
+        scenario (plain data) and its time limit [s].
 
     Returns
     -------
