@@ -16,9 +16,11 @@ import socket
 import threading
 import time
 import traceback
-from typing import Any
+from typing import Any, Callable, Hashable, TypeVar
 
 from ocp import SolverCache
+
+V = TypeVar("V")
 
 PRELOAD = ("scenarios.sweep_worker", "scenarios.runner", "scipy.integrate", "scipy.optimize", "scipy.special")
 """Modules imported once by the process that local workers fork from: the workbench, and the SciPy
@@ -30,18 +32,45 @@ class CaseTimeout(Exception):
     """Raised inside a worker when a case exceeds its time limit."""
 
 
+class RecentCache(SolverCache):
+    """A :class:`~ocp.SolverCache` that keeps only its most recently used entries.
+
+    A worker keeps its simulators in one: a simulator (with its closed-loop functions) serves
+    every case of the same model and simulation settings, and a study that varies the model
+    (dispersed inertia) does not pile them up.
+
+    Parameters
+    ----------
+    size : int, optional
+        Entries kept (at least 1).
+    """
+
+    def __init__(self, size: int = 4) -> None:
+        super().__init__()
+        self.size = max(1, int(size))
+
+    def get(self, key: Hashable, build: Callable[[], V]) -> V:
+        value = super().get(key, build)
+        self._entries[key] = self._entries.pop(key)  # the most recent last
+        while len(self._entries) > self.size:
+            del self._entries[next(iter(self._entries))]
+        return value
+
+
 @functools.cache
-def worker_state() -> tuple[SolverCache, threading.Lock]:
-    """This process's solver cache and case lock (created on first use, kept for its life).
+def worker_state() -> tuple[SolverCache, RecentCache, threading.Lock]:
+    """This process's caches and case lock (created on first use, kept for its life).
 
     Returns
     -------
     cache : SolverCache
         The planners' builds (NLPs), kept across cases.
+    simulators : RecentCache
+        The last simulators built (:func:`scenarios.runner.run`'s ``simulators``).
     lock : threading.Lock
         Held while a case runs, so that a process runs one case at a time.
     """
-    return SolverCache(), threading.Lock()
+    return SolverCache(), RecentCache(), threading.Lock()
 
 
 def _controllers(scenario: dict[str, Any]) -> list[tuple[str, str]]:
@@ -129,7 +158,7 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     from scenarios.loader import parse_scenario
     from scenarios.runner import run
 
-    cache, lock = worker_state()
+    cache, simulators, lock = worker_state()
     data, timeout = payload["scenario"], float(payload["timeout_s"])
     alarm = threading.current_thread() is threading.main_thread() and hasattr(signal, "setitimer")
     with lock:
@@ -139,7 +168,7 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
             if alarm:
                 signal.setitimer(signal.ITIMER_REAL, timeout)
             scenario = parse_scenario(data)
-            results = run(scenario, cache=cache)
+            results = run(scenario, cache=cache, simulators=simulators)
             status, rows = "ok", [_plain_row(row, scenario.controllers[0].name) for row in results.rows]
         except CaseTimeout:
             status, rows = "crashed", crashed_rows(data, f"timed out after {timeout:g} s (case_timeout_s)")
