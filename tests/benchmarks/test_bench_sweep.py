@@ -6,7 +6,10 @@ worker.
 The sweep side is the command itself, ``slewbench sweep STUDY --out DIR --no-plots --workers N``,
 run in this process (``scenarios.cli.main``): it expands and checks the study, claims the
 directory, commits every case to the SQLite store and writes the tables. The in-process side is
-a loop of ``scenarios.run(scenarios.parse_scenario(case))`` over the same cases. The process that
+a loop of ``scenarios.run(scenarios.parse_scenario(case), cache=..., simulators=...)`` over the
+same cases, with the caches a worker keeps (a solver cache and a few simulators), so that the
+difference is the machinery alone; the loop without the simulators (each case builds its own, as
+``scenarios.run`` does by default) is reported beside it. The process that
 local pools fork from is started (and imports the workbench) once per session, before timing,
 as for a library user who sweeps more than once; every timed sweep starts its own pool. Sides are
 interleaved and medians compared, because the reference machine is shared.
@@ -30,6 +33,7 @@ from scenarios.store import SweepStore
 from scenarios.study import load_study, parse_study
 from scenarios.study_report import claim_sweep_directory
 from scenarios.sweep_engine import start_forkserver, sweep
+from scenarios.sweep_worker import RecentCache
 from scenarios.yaml_node import read_yaml
 
 DEMO = Path(__file__).resolve().parents[2] / "scenarios" / "eigenaxis_demo.yaml"
@@ -53,13 +57,14 @@ def cli_sweep(study: Path, workers: int, out: Path) -> float:
     return elapsed
 
 
-def in_process(study: Path) -> tuple[float, float]:
-    """Wall and CPU time [s] of ``scenarios.run`` called on each case of ``study`` in a loop."""
+def in_process(study: Path, reuse: bool = True) -> tuple[float, float]:
+    """Wall and CPU time [s] of ``scenarios.run`` called on each case of ``study`` in a loop, with
+    the caches a worker keeps (``reuse``: solvers and simulators), or a solver cache alone."""
     cases = [case.scenario for case in load_study(study).cases]
-    cache = SolverCache()
+    cache, simulators = SolverCache(), RecentCache() if reuse else None
     start, cpu = time.perf_counter(), time.process_time()
     for case in cases:
-        scenarios.run(scenarios.parse_scenario(copy.deepcopy(case)), cache=cache)
+        scenarios.run(scenarios.parse_scenario(copy.deepcopy(case)), cache=cache, simulators=simulators)
     return time.perf_counter() - start, time.process_time() - cpu
 
 
@@ -73,21 +78,25 @@ def warm_up(tmp: Path) -> None:
 def test_sweep_overhead_per_case(benchmark, tmp_path):
     n, rounds = 40, 5  # enough cases that a fresh worker's first case is spread out
     warm_up(tmp_path)
-    direct, swept = [], []
-    for r in range(rounds):  # interleaved (and alternated), so that the machine's load hits both sides
+    direct, plain, swept = [], [], []
+    for r in range(rounds):  # interleaved (and alternated), so that the machine's load hits every side
         study = demo_study(tmp_path, n, 100 * r)
         if r % 2:
             swept.append(cli_sweep(study, 1, tmp_path / f"s{r}") / n)
         direct.append(in_process(study)[0] / n)
+        plain.append(in_process(study, reuse=False)[0] / n)
         if not r % 2:
             swept.append(cli_sweep(study, 1, tmp_path / f"s{r}") / n)
     ratios = np.array(swept) / np.array(direct)
     overhead = float(np.median(ratios) - 1)
-    benchmark.extra_info.update(direct_per_case_s=direct, sweep_per_case_s=swept, overhead=overhead)
+    speedup = float(np.median(np.array(plain) / np.array(swept)))
+    benchmark.extra_info.update(direct_per_case_s=direct, plain_run_per_case_s=plain, sweep_per_case_s=swept,
+                                overhead=overhead, sweep_speedup_over_plain_run=speedup)
     benchmark.pedantic(lambda: None, rounds=1)
-    print(f"\nin process {np.median(direct):.4f} s/case {np.round(direct, 4)}, slewbench sweep --workers 1 "
-          f"--no-plots {np.median(swept):.4f} s/case {np.round(swept, 4)}: overhead (median of the rounds' "
-          f"ratios) {overhead:+.1%} {np.round(ratios - 1, 3)}")
+    print(f"\nin process with a worker's caches {np.median(direct):.4f} s/case {np.round(direct, 4)}, "
+          f"slewbench sweep --workers 1 --no-plots {np.median(swept):.4f} s/case {np.round(swept, 4)}: overhead "
+          f"(median of the rounds' ratios) {overhead:+.1%} {np.round(ratios - 1, 3)}; scenarios.run with a "
+          f"solver cache only {np.median(plain):.4f} s/case {np.round(plain, 4)} ({speedup:.2f}x the sweep's time)")
     assert overhead <= 0.10
 
 
@@ -99,10 +108,11 @@ def test_cpu_per_case_and_serial_fraction(benchmark, tmp_path):
     workers on two idle cores give at most 1 / (s + (1 - s) / 2)."""
     n, rounds = 40, 5
     warm_up(tmp_path)
-    direct, case_cpu, swept, serial = [], [], [], []
+    direct, plain, case_cpu, swept, serial = [], [], [], [], []
     for r in range(rounds):
         path = demo_study(tmp_path, n, 100 * r)
         direct.append(in_process(path)[1] / n)
+        plain.append(in_process(path, reuse=False)[1] / n)
         start, driver = time.perf_counter(), time.process_time()
         study = load_study(path)
         out = claim_sweep_directory(tmp_path / f"c{r}")
@@ -118,10 +128,12 @@ def test_cpu_per_case_and_serial_fraction(benchmark, tmp_path):
     cpu_overhead = float(np.median(np.array(swept) / np.array(direct)) - 1)
     s = float(np.median(serial))
     bound = 1.0 / (s + (1.0 - s) / 2.0)
-    benchmark.extra_info.update(direct_cpu_per_case_s=direct, case_cpu_s=case_cpu, sweep_cpu_per_case_s=swept,
+    benchmark.extra_info.update(direct_cpu_per_case_s=direct, plain_run_cpu_per_case_s=plain, case_cpu_s=case_cpu,
+                                sweep_cpu_per_case_s=swept,
                                 cpu_overhead=cpu_overhead, serial_fraction=serial, amdahl_two_workers=bound)
     benchmark.pedantic(lambda: None, rounds=1)
-    print(f"\nCPU per case: in process {np.median(direct):.4f} s {np.round(direct, 4)}; sweep (driver + "
+    print(f"\nCPU per case: in process with a worker's caches {np.median(direct):.4f} s {np.round(direct, 4)} "
+          f"(solver cache only {np.median(plain):.4f} s); sweep (driver + "
           f"worker) {np.median(swept):.4f} s {np.round(swept, 4)}: {cpu_overhead:+.1%}; median case in the "
           f"worker {np.median(case_cpu):.4f} s. Serial fraction {s:.3f} {np.round(serial, 3)}: two workers on "
           f"two idle cores give at most {bound:.2f}x")
