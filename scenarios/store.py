@@ -1,7 +1,7 @@
 """The crash-safe store of a trade study: SQLite in WAL mode in the output directory.
 
 Every finished case is one row, committed at once, keyed by the hash of its resolved scenario and
-the package version (:func:`scenarios.study.case_key`). A process killed at any moment leaves
+the package version (:func:`scenarios.study_types.case_key`). A process killed at any moment leaves
 every committed case readable and no half-written one, so ``--resume`` re-runs only what is
 missing, and a case stored twice (a retry that raced a resume) replaces itself, never duplicates.
 """
@@ -140,7 +140,7 @@ class SweepStore:
         Parameters
         ----------
         key : str
-            The case key (:func:`scenarios.study.case_key`).
+            The case key (:func:`scenarios.study_types.case_key`).
         status : str
             ``ok`` (the runner finished) or ``crashed``.
         rows : list of dict
