@@ -27,6 +27,7 @@ AXES = ("x", "y", "z")
 VECTOR_METRICS = ("int_abs_u",)
 STATISTICS = ("count", "failures", "mean", "std", "median", "p5", "p95", "min", "max")
 IDENTITY = ["label", "planner", "controller", "status", "message", "plan_time_s"]
+_DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml's emitter when built: same text, 3x faster
 
 
 def metric_columns() -> list[str]:
@@ -125,9 +126,12 @@ def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], 
             values = np.array([v for v in (_number(r.get(metric)) for r in members) if v is not None])
             line = {k: members[0].get(k) for k in keys}
             line.update(metric=metric, count=len(members), failures=sum(r["status"] != "ok" for r in members))
-            stats = (values.mean(), values.std(ddof=1) if values.size > 1 else 0.0, np.median(values),
-                     np.percentile(values, 5), np.percentile(values, 95), values.min(), values.max()) \
-                if values.size else (None,) * 7
+            if values.size:
+                p5, p95 = np.percentile(values, (5, 95))
+                stats: tuple = (values.mean(), values.std(ddof=1) if values.size > 1 else 0.0, np.median(values),
+                                p5, p95, values.min(), values.max())
+            else:
+                stats = (None,) * 7
             line.update({name: None if v is None else float(v) for name, v in zip(STATISTICS[2:], stats)})
             table.append(line)
     return columns, table
@@ -246,7 +250,7 @@ def write_report(results: SweepResults, directory: str | Path, plots: bool = Tru
     summary_columns, summary = summary_table(study, rows)
     files = {"cases.csv": _csv(columns, rows), "summary.csv": _csv(summary_columns, summary),
              "summary.md": _markdown(study, summary_columns, summary, results.missing),
-             "study.yaml": yaml.safe_dump(resolved_study(study), sort_keys=False, width=120)}
+             "study.yaml": yaml.dump(resolved_study(study), Dumper=_DUMPER, sort_keys=False, width=120)}
     staging = new_staging(directory)
     try:
         for name, text in files.items():
