@@ -340,9 +340,15 @@ def test_readme_study_and_example_studies_are_valid():
     assert len(study.cases) == 2 * 3 * 3 * 2 * 2
     fractions = {c.scenario["planners"][1]["options"]["torque_fraction"] for c in study.cases}
     assert fractions == {0.5, 0.75, 1.0}
+    from scenarios.study_report import _DUMPER, resolved_study
     for name, count in (("study_spin_weight_sample_time", 20), ("study_planners_vs_slew_angle", 7),
                         ("study_spin_monte_carlo", 1000)):
-        assert len(scenarios.load_study(root / "scenarios" / f"{name}.yaml").cases) == count
+        example = scenarios.load_study(root / "scenarios" / f"{name}.yaml")
+        assert len(example.cases) == count
+        # study.yaml goes through libyaml's emitter when built: the same text as PyYAML's own, read back whole
+        resolved = resolved_study(example)
+        text = yaml.dump(resolved, Dumper=_DUMPER, sort_keys=False, width=120)
+        assert text == yaml.safe_dump(resolved, sort_keys=False, width=120) and yaml.safe_load(text) == resolved
 
 
 def test_pareto_front_is_the_set_of_non_dominated_points(rng):
