@@ -12,15 +12,17 @@ expressions; the vector layouts of the symbolic form are in :mod:`ocp.layout`.
 from __future__ import annotations
 
 import hashlib
+import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import casadi as ca
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ocp import Command, Measurement, Spacecraft
+from ocp.fast_call import as_floats
 from ocp.layout import (
     REFERENCE_FIELDS,
     control_layout,
@@ -31,12 +33,6 @@ from ocp.layout import (
 from ocp.options import Configurable, InvalidOption
 
 Array = NDArray[np.float64]
-
-
-def cross3(a: Array, b: Array) -> Array:
-    """``a × b`` of two 3-vectors, written out: ``np.cross`` costs ~15 µs a call, this ~1 µs (per
-    sample code uses it; ``np.cross`` stays the choice for arrays of many vectors)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 @dataclass(frozen=True)
@@ -130,35 +126,115 @@ class Controller(Configurable, ABC):
         self.target: tuple[Array, Array | None] | None = None
 
     def planner_error(self, planner: str, options: Any) -> str | None:
-        """Why this law cannot track the references of ``planner`` with ``options``, or ``None``."""
+        """Why this law cannot track the references of a planner.
+
+        Parameters
+        ----------
+        planner : str
+            The planner's registry name.
+        options : planner options
+            Its options (the planner's ``Options`` instance or mapping).
+
+        Returns
+        -------
+        str or None
+            The reason, or ``None`` when the law can track them (most laws track any reference).
+        """
         return None
 
     def environment_error(self, spacecraft: Spacecraft, environment: Any) -> str | None:
-        """Why the law cannot run on ``spacecraft`` in ``environment`` (an actuator or a sensor it
-        needs is missing), or ``None``."""
+        """Why the law cannot run on a spacecraft in an environment.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            Its actuators.
+        environment : ocp.Environment or None
+            Orbit, magnetic field and disturbances (``None``: none).
+
+        Returns
+        -------
+        str or None
+            The reason (an actuator or a sensor the law needs is missing), or ``None``.
+        """
         return None
 
     def initial_state_error(self, spacecraft: Spacecraft, omega0: Array, wheel_momentum0: Array,
                             omegaf: Array | None) -> tuple[str, str] | None:
-        """``(YAML key under maneuver, message)`` if the law cannot start from the manoeuvre's
-        initial state or reach its final rate (rad/s, N m s, body axes), else ``None``."""
+        """Why the law cannot start from a manoeuvre's initial state or reach its final rate.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+        omega0 : (3,) ndarray
+            Initial body rate [rad/s], body axes.
+        wheel_momentum0 : (n_w,) ndarray
+            Initial wheel momenta [N m s].
+        omegaf : (3,) ndarray or None
+            Final body rate [rad/s], body axes; ``None``: free.
+
+        Returns
+        -------
+        (str, str) or None
+            ``(YAML key under maneuver, message)``, or ``None`` when the law can.
+        """
         return None
 
     def sample_time_error(self, sample_time: float) -> tuple[str, str] | None:
-        """``(option name, message)`` if an option does not fit the sample time (s), else ``None``."""
+        """Why an option does not fit the sample time.
+
+        Parameters
+        ----------
+        sample_time : float
+            Controller period [s].
+
+        Returns
+        -------
+        (str, str) or None
+            ``(option name, message)``, or ``None`` when every option fits.
+        """
         return None
 
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
-        """Prepare for a run of ``spacecraft`` sampled every ``sample_time`` seconds."""
+        """Prepare for a run: clear any state, precompute what the law needs.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The controlled spacecraft (inertia, actuators).
+        sample_time : float
+            Controller period and zero-order-hold length [s].
+        target : (q_f, ω_f or None), optional
+            Final attitude (scalar-first quaternion; ``None`` for laws that regulate the rate
+            alone) and final body rate [rad/s] (``None``: at rest), used in regulation mode and by
+            regulators; ``None`` when only references are tracked.
+        """
         self.spacecraft = spacecraft
         self.sample_time = sample_time
         self.target = target
         self._slices, self._nu = control_layout(spacecraft)
         wheels = spacecraft.wheels
-        self._working_axes = None
+        self._working_axes: Array | None = None
+        self._wheel_pinv: Array = np.zeros((0, 3))
+        # The same matrices as rows of Python floats, for the per-sample allocation.
+        self._pinv_rows: tuple[tuple[float, ...], ...] | None = None
+        self._axes_cols: tuple[tuple[float, ...], ...] = ()
+        self._working_cols: tuple[tuple[float, ...], ...] = ()
         if wheels is not None and np.any(wheels.working):
             self._working_axes = wheels.axes * wheels.working
-            self._wheel_pinv = np.linalg.pinv(self._working_axes)
+            self._wheel_pinv = np.asarray(np.linalg.pinv(self._working_axes), dtype=np.float64)
+            self._pinv_rows = float_rows(self._wheel_pinv)
+            self._axes_cols = float_rows(spacecraft.wheel_axes.T)
+            self._working_cols = float_rows(self._working_axes.T)
+        self._residual_sink = not self.wheels_only and (spacecraft.torquers is not None
+                                                        or spacecraft.magnetorquers is not None)
+        """Whether what the wheels cannot give goes anywhere (torquers or magnetorquers)."""
+
+    def _spacecraft(self) -> Spacecraft:
+        """The spacecraft of the last :meth:`reset` (an error before any)."""
+        if self.spacecraft is None:
+            raise RuntimeError(f"controller {self.name}: call reset(spacecraft, sample_time, target) first")
+        return self.spacecraft
 
     @abstractmethod
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
@@ -168,13 +244,25 @@ class Controller(Configurable, ABC):
     # Symbolic form
     # ----------------------------------------------------------------------------------------
     def symbolic_error(self) -> str | None:
-        """Why this law has no symbolic form (``None`` when it has one: it implements :meth:`_law`)."""
+        """Why this law has no symbolic form.
+
+        Returns
+        -------
+        str or None
+            The reason, or ``None`` when it has one (it implements :meth:`_law`).
+        """
         if type(self)._law is Controller._law:
             return f"controller {self.name} does not implement a symbolic law (_law)"
         return None
 
     def state_vector(self) -> Array:
-        """The controller state ``z`` of the Python implementation (empty for a static law)."""
+        """The controller state of the Python implementation.
+
+        Returns
+        -------
+        (n_z,) ndarray
+            ``z`` in the layout of the symbolic form (empty for a static law).
+        """
         return np.zeros(0)
 
     def _law(self, t: ca.SX, y: ca.SX, z: ca.SX, r: ca.SX) -> tuple[ca.SX, ca.SX]:
@@ -182,10 +270,16 @@ class Controller(Configurable, ABC):
         raise NotImplementedError
 
     def symbolic_key(self) -> str:
-        """Digest of everything :meth:`_law` bakes in (class, options, spacecraft, sample time, target)."""
+        """Digest of everything :meth:`_law` bakes in.
+
+        Returns
+        -------
+        str
+            SHA-256 hex digest of the class, options, spacecraft, sample time and target.
+        """
         from ocp.model import _plain  # the model's fingerprint walker
 
-        cache = self.spacecraft._cache  # the spacecraft is frozen: its description is computed once
+        cache = self._spacecraft()._cache  # the spacecraft is frozen: its description is computed once
         if "description" not in cache:
             cache["description"] = repr(_plain(self.spacecraft))
         target = None if self.target is None else tuple(None if v is None else _plain(np.asarray(v, dtype=float))
@@ -195,8 +289,18 @@ class Controller(Configurable, ABC):
         return hashlib.sha256(text.encode()).hexdigest()
 
     def symbolic_law(self) -> SymbolicLaw:
-        """The law as ``law(t, y, z, r) -> (u, z_next)`` for the spacecraft and sample time of the
-        last :meth:`reset`. Raises ``NotImplementedError`` with :meth:`symbolic_error`'s reason."""
+        """The law as one CasADi function, for the spacecraft and sample time of the last :meth:`reset`.
+
+        Returns
+        -------
+        SymbolicLaw
+            ``law(t, y, z, r) -> (u, z_next)`` (see "Symbolic form"), its initial state and key.
+
+        Raises
+        ------
+        NotImplementedError
+            With :meth:`symbolic_error`'s reason, for a law that has no symbolic form.
+        """
         reason = self.symbolic_error()
         if reason is not None:
             raise NotImplementedError(reason)
@@ -219,12 +323,37 @@ class Controller(Configurable, ABC):
         return SymbolicLaw(function, state0, self.symbolic_key())
 
     def reference_rows(self, reference: Any, times: Array) -> Array:
-        """(len(times), 13) reference rows ``[q*, ω*, ω̇*, τ*]`` at ``times`` (s); from the
-        target (rate ``ω_f`` or zero, no acceleration or torque) when ``reference`` is ``None``."""
+        """Reference rows in the layout of the symbolic form.
+
+        Parameters
+        ----------
+        reference : planners.Reference or None
+            The reference (anything with a vectorised ``sample(t)``); ``None``: the target of the
+            last :meth:`reset` (rate ``ω_f`` or zero, no acceleration or torque).
+        times : (N,) array_like
+            Sample times [s].
+
+        Returns
+        -------
+        (N, 13) ndarray
+            Rows ``[q*, ω*, ω̇*, τ*]``: attitude quaternion, body rate [rad/s], body acceleration
+            [rad/s^2], feed-forward torque [N m], body axes.
+        """
         return reference_rows(reference, times, self.target)
 
     def command_vector(self, command: Command) -> Array:
-        """A :class:`Command` in the control layout ``u`` of the symbolic form (zeros where ``None``)."""
+        """A command as the vector ``u`` of the symbolic form.
+
+        Parameters
+        ----------
+        command : Command
+
+        Returns
+        -------
+        (nu,) ndarray
+            ``[g, m, τ_t]`` (blocks of the actuators present): wheel torques [N m], dipole
+            [A m^2], torquer torque [N m]; zeros where the command asks nothing.
+        """
         u = np.zeros(self._nu)
         for name, value in (("wheels", command.wheel_torque), ("dipole", command.dipole), ("torquers", command.torque)):
             if name in self._slices and value is not None:
@@ -234,41 +363,91 @@ class Controller(Configurable, ABC):
     # ----------------------------------------------------------------------------------------
     # Allocation
     # ----------------------------------------------------------------------------------------
-    def allocate(self, torque: Array, measurement: Measurement, rate: Array | None = None,
-                 wheel_momentum: Array | None = None) -> Command:
-        """Map a rigid-body control torque ``u`` (N m, body axes) to the actuators.
+    def allocate(self, torque: ArrayLike, measurement: Measurement, rate: ArrayLike | None = None,
+                 wheel_momentum: ArrayLike | None = None) -> Command:
+        """Map a rigid-body control torque to the actuators (module docstring).
 
-        ``rate`` and ``wheel_momentum`` (default: the measured ones) are the ``ω`` and ``h_w`` of
-        the wheels' gyroscopic term ``ω × A h_w``; a law that predicts them to mid-sample passes
-        its prediction (see ``AugmentedQuaternionFeedback``).
+        Parameters
+        ----------
+        torque : (3,) array_like
+            Control torque ``u`` of ``I ω̇ = −ω × I ω + u`` [N m], body axes.
+        measurement : Measurement
+            The sample's measurement (rate, wheel momenta, magnetometer reading).
+        rate : (3,) array_like, optional
+            The ``ω`` of the wheels' gyroscopic term ``ω × A h_w`` [rad/s], body axes; ``None``:
+            the measured rate. A law that predicts it to mid-sample passes its prediction (see
+            ``AugmentedQuaternionFeedback``).
+        wheel_momentum : (n_w,) array_like, optional
+            The ``h_w`` of that term [N m s]; ``None``: the measured momenta.
+
+        Returns
+        -------
+        Command
+            Wheel torques ``g`` [N m] (``None`` without working wheels), and what the wheels cannot
+            give as torquer torque [N m] or magnetorquer dipole [A m^2], body axes (``None`` when
+            nothing is asked of them).
         """
-        spacecraft = self.spacecraft
+        return self._allocate(as_floats(torque), measurement, None if rate is None else as_floats(rate),
+                              None if wheel_momentum is None else as_floats(wheel_momentum))
+
+    def _allocate(self, torque: Sequence[float], measurement: Measurement, rate: Sequence[float] | None,
+                  wheel_momentum: Sequence[float] | None) -> Command:
+        """:meth:`allocate` on Python floats (per-sample code: no NumPy on 3-vectors)."""
         command = Command()
-        residual = np.asarray(torque, dtype=float)
-        if self._working_axes is not None:
-            w = measurement.omega if rate is None else rate
-            h = spacecraft.wheel_axes @ (measurement.wheel_momentum if wheel_momentum is None else wheel_momentum)
-            wheel_torque = residual + cross3(w, h) if self.gyroscopic_compensation else residual
-            command.wheel_torque = -self._wheel_pinv @ wheel_torque
-            if self.wheels_only:
+        r0, r1, r2 = torque
+        if self._pinv_rows is not None:
+            if self.gyroscopic_compensation:  # τ_w = u + ω × A h_w
+                w0, w1, w2 = as_floats(measurement.omega) if rate is None else rate
+                h0 = h1 = h2 = 0.0
+                for (a0, a1, a2), h in zip(self._axes_cols, as_floats(measurement.wheel_momentum)
+                                           if wheel_momentum is None else wheel_momentum):
+                    h0 += a0 * h
+                    h1 += a1 * h
+                    h2 += a2 * h
+                r0, r1, r2 = r0 + (w1 * h2 - w2 * h1), r1 + (w2 * h0 - w0 * h2), r2 + (w0 * h1 - w1 * h0)
+            g = [-(a * r0 + b * r1 + c * r2) for a, b, c in self._pinv_rows]  # g = −A⁺ τ_w
+            command.wheel_torque = np.array(g)
+            if not self._residual_sink:
                 return command
-            residual = wheel_torque + self._working_axes @ command.wheel_torque
-            if np.sqrt(residual @ residual) <= 1e-12 * max(np.sqrt(wheel_torque @ wheel_torque), 1e-300):
+            t0, t1, t2 = r0, r1, r2
+            for (a0, a1, a2), gi in zip(self._working_cols, g):  # what the wheels do not give
+                r0 += a0 * gi
+                r1 += a1 * gi
+                r2 += a2 * gi
+            if math.sqrt(r0 * r0 + r1 * r1 + r2 * r2) <= 1e-12 * max(math.sqrt(t0 * t0 + t1 * t1 + t2 * t2), 1e-300):
                 return command
-        if self.wheels_only:
+        if not self._residual_sink:
             return command
-        if spacecraft.torquers is not None:
-            command.torque = residual
-        elif spacecraft.magnetorquers is not None and measurement.field_body is not None:
-            b = measurement.field_body
-            command.dipole = cross3(b, residual) / max(float(b @ b), 1e-30)
+        if self._spacecraft().torquers is not None:
+            command.torque = np.array([r0, r1, r2])
+        elif measurement.field_body is not None:  # magnetorquers: m = b × τ / |b|²
+            b0, b1, b2 = as_floats(measurement.field_body)
+            b2_norm = max(b0 * b0 + b1 * b1 + b2 * b2, 1e-30)
+            command.dipole = np.array([(b1 * r2 - b2 * r1) / b2_norm, (b2 * r0 - b0 * r2) / b2_norm,
+                                       (b0 * r1 - b1 * r0) / b2_norm])
         return command
 
     def allocate_symbolic(self, torque: ca.SX, y: ca.SX, rate: ca.SX | None = None,
                           wheel_momentum: ca.SX | None = None) -> ca.SX:
-        """:meth:`allocate` on expressions: the command vector ``u`` (control layout) for the
-        rigid-body torque ``torque`` given the measurement vector ``y``."""
-        spacecraft = self.spacecraft
+        """:meth:`allocate` on CasADi expressions.
+
+        Parameters
+        ----------
+        torque : (3, 1) casadi.SX
+            Rigid-body control torque ``u`` [N m], body axes.
+        y : casadi.SX
+            The measurement vector ``[q, ω, h_w, b]`` (:mod:`ocp.layout`).
+        rate : (3, 1) casadi.SX, optional
+            ``ω`` of the wheels' gyroscopic term [rad/s]; ``None``: the measured one.
+        wheel_momentum : (n_w, 1) casadi.SX, optional
+            ``h_w`` of that term [N m s]; ``None``: the measured one.
+
+        Returns
+        -------
+        (nu, 1) casadi.SX
+            The command vector ``u`` in the control layout (zeros where nothing is asked).
+        """
+        spacecraft = self._spacecraft()
         _, omega, h_w, field = split_measurement(y, spacecraft.n_wheels)
         parts = {}
         residual = torque
@@ -294,6 +473,21 @@ class Controller(Configurable, ABC):
         return u
 
 
+def float_rows(matrix: ArrayLike) -> tuple[tuple[float, ...], ...]:
+    """A matrix as a tuple of rows of Python floats, for per-sample code (``sum(a * b for ...)``
+    over a row costs far less than a NumPy product on 3-vectors).
+
+    Parameters
+    ----------
+    matrix : (m, n) array_like
+
+    Returns
+    -------
+    tuple of m tuples of n floats
+    """
+    return tuple(tuple(row) for row in np.asarray(matrix, dtype=float).tolist())
+
+
 def check_gain(option: str, gain: float | list[list[float]]) -> None:
     """Raise :class:`~ocp.options.InvalidOption` unless ``gain`` is a non-negative scalar or a 3x3
     matrix whose symmetric part is positive semi-definite (a gain that pumps energy in is an error).
@@ -313,7 +507,20 @@ def check_gain(option: str, gain: float | list[list[float]]) -> None:
 
 
 def gain_matrix(gain: float | list[list[float]], inertia: Array) -> Array:
-    """A scalar gain times the inertia (the spin paper's choice), or a full 3x3 gain matrix."""
+    """A gain as a 3x3 matrix.
+
+    Parameters
+    ----------
+    gain : float or (3, 3) nested list
+        A scalar (times the inertia: the spin paper's choice) or a full matrix.
+    inertia : (3, 3) ndarray
+        Inertia [kg m^2], body axes.
+
+    Returns
+    -------
+    (3, 3) ndarray
+        ``gain * inertia`` for a scalar, else the matrix.
+    """
     if isinstance(gain, (int, float)):
         return float(gain) * inertia
     matrix = np.asarray(gain, dtype=float)

@@ -37,6 +37,7 @@ from ocp.closed_loop import ClosedLoop, draw_noise
 from ocp.compiled import CompilerUnavailable, compile_function, notice
 from ocp.fast_call import BufferedFunction
 from ocp.integration import rk4_step
+from ocp.layout import reference_rows
 from ocp.model import AttitudeModel
 
 Array = NDArray[np.float64]
@@ -50,31 +51,79 @@ MAX_SUBSTEPS = 1000
 
 
 class GridSampledReference:
-    """``reference`` with its samples at ``times`` computed once (vectorised) and served by
-    :meth:`sample`; other times and every other attribute go to ``reference`` itself.
+    """A reference with its samples on a time grid computed once (vectorised).
+
+    It is the reference as far as a controller can tell: :meth:`sample` answers the grid times
+    from the table and any other time from the reference itself, and every other attribute is the
+    reference's. :meth:`row` serves per-sample code one grid time as Python floats.
 
     Parameters
     ----------
-    reference : anything with a vectorised ``sample(t)`` returning a named tuple of arrays.
-    times : s, the times to precompute.
+    reference : planners.Reference
+        Anything with a vectorised ``sample(t)`` returning a named tuple of arrays whose first
+        axis is time (for :meth:`row`: the fields ``q``, ``omega``, ``omega_dot``, ``torque``).
+    times : (N,) array_like
+        Times to precompute [s] (duplicates are merged).
     """
 
-    def __init__(self, reference: Any, times: Array):
+    def __init__(self, reference: Any, times: ArrayLike):
         self.reference = reference
-        times = np.unique(np.asarray(times, dtype=float))
-        self._table = reference.sample(times)
-        self._index = {float(value): i for i, value in enumerate(times)}
+        grid = np.unique(np.asarray(times, dtype=float))
+        self._times = grid
+        self._table = reference.sample(grid)
+        self._index = {value: i for i, value in enumerate(grid.tolist())}
+        self._scalar: dict[int, Any] = {}
+        self._rows: list[list[float]] | None = None
 
     def sample(self, t: ArrayLike) -> Any:
-        """The reference at ``t`` (scalar or array), as ``reference.sample`` returns it."""
+        """The reference at ``t``, as ``reference.sample`` returns it.
+
+        Parameters
+        ----------
+        t : float or (M,) array_like
+            Time(s) [s]; grid times come from the table, others from the reference.
+
+        Returns
+        -------
+        named tuple
+            The reference's sample (arrays with a leading axis of ``M`` for an array ``t``). The
+            arrays of a grid time are views of the table: read them, do not write them.
+        """
         index = self._index
         if np.ndim(t) == 0:
-            i = index.get(float(t))
-            return self.reference.sample(t) if i is None else type(self._table)(*(a[i] for a in self._table))
-        rows = [index.get(float(value)) for value in np.ravel(t)]
+            i = index.get(float(t))  # type: ignore[arg-type]  # a 0-d array_like is a number
+            if i is None:
+                return self.reference.sample(t)
+            scalar = self._scalar.get(i)
+            if scalar is None:
+                scalar = self._scalar[i] = type(self._table)(*(a[i] for a in self._table))
+            return scalar
+        rows = [index.get(value) for value in np.ravel(t).astype(float).tolist()]
         if None in rows:
             return self.reference.sample(t)
         return type(self._table)(*(a[rows] for a in self._table))
+
+    def row(self, t: float) -> list[float] | None:
+        """The reference row ``[q*, ω*, ω̇*, τ*]`` at a grid time, as Python floats.
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+
+        Returns
+        -------
+        list of 13 float or None
+            Attitude quaternion, body rate [rad/s], body acceleration [rad/s^2], feed-forward
+            torque [N m] (layout of :func:`ocp.layout.reference_rows`); ``None`` when ``t`` is not
+            on the grid. Shared: do not modify it.
+        """
+        i = self._index.get(t)
+        if i is None:
+            return None
+        if self._rows is None:
+            self._rows = reference_rows(self, self._times).tolist()
+        return self._rows[i]
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self.reference, name)
@@ -200,7 +249,7 @@ class Simulator:
         self.substeps = substeps if integrator == "rk4" else 1
         self.actuators = ActuatorModel(model.spacecraft, model.control_slices, model.nu)
         self._step = self._build_step(integrator, substeps, rtol, atol)
-        self._step_numeric = BufferedFunction(self._step)
+        self._step_numeric = BufferedFunction(self._normalised(self._step))
         self._field_numeric = None if model.field_body is None else BufferedFunction(model.field_body)
         self._field_rate_numeric = (None if model.field_rate_inertial is None
                                     else BufferedFunction(model.field_rate_inertial))
@@ -209,6 +258,19 @@ class Simulator:
         self.python_loop = python_loop
         self._loops: dict[Any, tuple[ClosedLoop, ca.Function, str]] = {}
         self._runs: dict[Any, BufferedFunction] = {}
+        self._last_grid: tuple[Any, Array, GridSampledReference] | None = None
+        self._torque_map: tuple[int, ca.Function] | None = None
+        self._command_slices = [(attribute, model.control_slices[name]) for name, attribute in
+                                (("wheels", "wheel_torque"), ("dipole", "dipole"), ("torquers", "torque"))
+                                if name in model.control_slices]
+
+    @staticmethod
+    def _normalised(step: ca.Function) -> ca.Function:
+        """``step`` followed by the re-normalisation of the quaternion (the Python loop's step)."""
+        symbols = [step.sx_in(i) for i in range(step.n_in())] if step.is_a("SXFunction") else step.mx_in()
+        x_next = step(*symbols)
+        x_next = ca.vertcat(x_next[0:4] / ca.norm_2(x_next[0:4]), x_next[4:])
+        return ca.Function("zoh_step_normalised", symbols, [x_next], step.name_in(), ["x_next"])
 
     def _build_step(self, integrator: str, substeps: int, rtol: float, atol: float) -> ca.Function:
         """``step(x, u, t, dt, p) -> x_next``: one hold interval of length ``dt`` starting at ``t``."""
@@ -277,32 +339,49 @@ class Simulator:
         if self._symbolic(controller):
             return self._run_symbolic(controller, x, times, p, noise, rng, reference, field_rng)
         if reference is not None and hasattr(reference, "sample"):
-            reference = GridSampledReference(reference, np.concatenate([times, times[:-1] + self.sample_time]))
+            reference = self._grid_reference(reference, np.concatenate([times, times[:-1] + self.sample_time]))
 
-        states = np.empty((n_samples + 1, model.nx))
         commanded = np.zeros((n_samples, model.nu))
-        applied = np.zeros((n_samples, model.nu))
-        saturated = np.zeros(n_samples, dtype=bool)
-        states[0] = x
+        # Per sample: Python floats and lists, the step's own buffers (no NumPy calls on short
+        # vectors beyond the copies the measurement hands out); arrays are made at the end.
+        states: list[list[float]] = [x.tolist()]
+        applied: list[list[float]] = []
+        saturated: list[bool] = []
+        step = self._step_numeric
+        x_in, u_in, t_in, dt_in, p_in = step.inputs
+        x_out = step.outputs[0]
+        x_in[:] = x
+        p_in[:] = p
+        evaluate, apply, fill_command = step.evaluate, self.actuators.apply_floats, self._fill_command
+        times_list = times.tolist()
+        n_wheels = model.spacecraft.n_wheels
         for k in range(n_samples):
-            t_k = times[k]
-            measurement = self._measure(x, t_k, noise, rng, field_rng)
+            t_k = times_list[k]
+            measurement = self._measure(x_in, t_k, noise, rng, field_rng)
             if field_rate is not None:
                 measurement.field_rate_inertial = field_rate(t_k).copy()
             command = controller(t_k, measurement, reference)
-            commanded[k] = self._command_vector(command)
-            dt = times[k + 1] - t_k
-            applied[k], saturated[k] = self.actuators.apply(command, x[7:], dt)
-            x = self._step_numeric(x, applied[k], t_k, dt, p).copy()
-            if not np.all(np.isfinite(x)):
+            fill_command(command, commanded[k])
+            dt = times_list[k + 1] - t_k
+            u, at_limit = apply(command, states[k][7:7 + n_wheels], dt)
+            applied.append(u)
+            saturated.append(at_limit)
+            u_in[:] = u
+            t_in[0], dt_in[0] = t_k, dt
+            evaluate()
+            x_next = x_out.tolist()  # the quaternion re-normalised by the step function
+            if not math.isfinite(sum(x_next)) and not np.isfinite(x_out).all():  # the sum can overflow
                 raise SimulationError(self._divergence(times, k))
-            x[0:4] /= math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3])
-            states[k + 1] = x
-        return self._result(times, states, commanded, applied, saturated, "python")
+            x_in[:] = x_out
+            states.append(x_next)
+        return self._result(times, np.array(states), commanded, np.array(applied).reshape(n_samples, model.nu),
+                            np.array(saturated, dtype=bool), "python")
 
     def _result(self, times: Array, states: Array, commanded: Array, applied: Array, saturated: Array,
                 path: str) -> SimulationResult:
-        torque_map = self.model.body_torque.map(times.size - 1)
+        if self._torque_map is None or self._torque_map[0] != times.size - 1:
+            self._torque_map = (times.size - 1, self.model.body_torque.map(times.size - 1))
+        torque_map = self._torque_map[1]
         applied_torque = torque_map(states[:-1].T, applied.T, times[:-1]).full().T
         return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, applied_torque,
                                 saturated, path)
@@ -407,10 +486,20 @@ class Simulator:
             field += (rng if field_rng is None else field_rng).normal(0.0, noise.field_std, 3)
         return Measurement(t=t, q=q.copy(), omega=omega.copy(), wheel_momentum=x[7:].copy(), field_body=field)
 
-    def _command_vector(self, command: Command) -> Array:
-        """The command in the layout of ``u`` (zeros where nothing is asked)."""
-        u = np.zeros(self.model.nu)
-        for name, value in (("wheels", command.wheel_torque), ("dipole", command.dipole), ("torquers", command.torque)):
-            if name in self.model.control_slices and value is not None:
-                u[self.model.control_slices[name]] = value
-        return u
+    def _fill_command(self, command: Command, out: Array) -> None:
+        """Write the command into ``out`` (a zero row) in the layout of ``u``."""
+        for attribute, where in self._command_slices:
+            value = getattr(command, attribute)
+            if value is not None:
+                out[where] = value
+
+    def _grid_reference(self, reference: Any, grid: Array) -> GridSampledReference:
+        """``reference`` served on ``grid``; the last one is kept, so that runs repeated with the
+        same reference and grid (trade studies, Monte Carlo) sample it once. References are
+        immutable results (``planners.Reference``)."""
+        cached = self._last_grid
+        if cached is not None and cached[0] is reference and np.array_equal(cached[1], grid):
+            return cached[2]
+        served = GridSampledReference(reference, grid)
+        self._last_grid = (reference, grid, served)
+        return served
