@@ -55,6 +55,14 @@ class SymbolicLaw:
 class Controller(Configurable, ABC):
     """Base class of every feedback law.
 
+    Parameters
+    ----------
+    options : mapping or Options, optional
+        The law's options (its ``Options`` dataclass, or a mapping of its fields, as in the YAML
+        ``controller.options``); ``None``: the defaults.
+    path : str, optional
+        YAML path of the options, named in error messages.
+
     Contract
     --------
     * ``name`` is the registry key; ``Options`` a dataclass of the law's options with defaults.

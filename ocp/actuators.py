@@ -198,13 +198,13 @@ class ActuatorModel:
             value = getattr(command, attribute)
             if value is None:
                 continue
-            asked = as_floats(value)
+            vector = as_floats(value)
             if scaled:  # the whole vector is scaled down until every axis is within its limit: direction kept
-                ratio = max(abs(a) / limit for a, limit in zip(asked, limits))
-                values[start:start + 3] = [a / ratio for a in asked] if ratio > 1.0 else asked
+                ratio = max(abs(a) / limit for a, limit in zip(vector, limits))
+                values[start:start + 3] = [a / ratio for a in vector] if ratio > 1.0 else vector
             else:
-                values[start:start + 3] = [min(max(a, -limit), limit) for a, limit in zip(asked, limits)]
-            if any(abs(a) >= limit * (1 - 1e-12) for a, limit in zip(asked, limits)):
+                values[start:start + 3] = [min(max(a, -limit), limit) for a, limit in zip(vector, limits)]
+            if any(abs(a) >= limit * (1 - 1e-12) for a, limit in zip(vector, limits)):
                 saturated = True
         return values, saturated
 

@@ -43,9 +43,9 @@ class BufferedFunction:
         buffer: Any  # CasADi's FunctionBuffer stubs ask for (pointer, size); memoryviews are what it takes
         buffer, self._evaluate = function.buffer()
         for i, array in enumerate(self.inputs):
-            buffer.set_arg(i, memoryview(array))
+            buffer.set_arg(i, memoryview(array))  # type: ignore[arg-type]  # ndarray has the buffer protocol
         for i, array in enumerate(self.outputs):
-            buffer.set_res(i, memoryview(array))
+            buffer.set_res(i, memoryview(array))  # type: ignore[arg-type]  # ndarray has the buffer protocol
         self._buffer = buffer
 
     def __call__(self, *args: ArrayLike | float) -> NDArray[np.float64]:

@@ -133,18 +133,46 @@ class SimulationError(RuntimeError):
     """The integration diverged (non-finite state), e.g. a step far too long for the rates."""
 
 
-class ControllerLike(Protocol):
-    def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None: ...
-    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command: ...
+class _ControllerLike(Protocol):
+    """What the simulator needs of a controller (``controllers.base.Controller`` has it)."""
+
+    def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None:
+        """Prepare for a run.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The controlled spacecraft.
+        sample_time : float
+            Controller period and zero-order-hold length [s].
+        target : (q_f, ω_f or None), optional
+            Final attitude (scalar-first quaternion) and body rate [rad/s] for regulation.
+        """
+
+    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
+        """The command for the sample starting at ``t`` [s] (see ``Controller.__call__``)."""
 
 
 @dataclass(frozen=True)
 class SensorNoise:
-    """Gaussian sensor noise, white per sample: attitude as a random rotation vector (rad, per axis
-    std), body rate (rad/s, per axis std), magnetometer (T, per body axis std); ``seed`` makes it
-    repeatable. Each sample draws attitude, then rate (only the non-zero ones) from the stream
-    seeded by ``seed``, and the magnetometer from its own stream (seeded by ``[seed, 1]``), so that
-    adding magnetometer noise leaves the attitude and rate noise of a scenario unchanged."""
+    """Gaussian sensor noise, white per sample.
+
+    Each sample draws attitude, then rate (only the non-zero ones) from the stream seeded by
+    ``seed``, and the magnetometer from its own stream (seeded by ``[seed, 1]``), so that adding
+    magnetometer noise leaves the attitude and rate noise of a scenario unchanged.
+
+    Parameters
+    ----------
+    attitude_std : float, optional
+        Per-axis standard deviation of the attitude error, a rotation vector [rad] applied in
+        body axes (``q ⊗ exp(v/2)``); 0: none.
+    rate_std : float, optional
+        Per-axis standard deviation of the body-rate error [rad/s], body axes; 0: none.
+    seed : int, optional
+        Non-negative seed of the generators (same seed, same noise).
+    field_std : float, optional
+        Per-axis standard deviation of the magnetometer error [T], body axes; 0: none.
+    """
 
     attitude_std: float = 0.0
     rate_std: float = 0.0
@@ -166,12 +194,26 @@ class SimulationResult:
 
     Attributes
     ----------
-    t : (N+1,) s, sample instants and the final time.
-    x : (N+1, nx) states ``[q, ω, h_w]`` at ``t``.
-    commanded_u : (N, nu) control asked for (before saturation), layout of ``model.control_slices``.
-    applied_u : (N, nu) control applied over ``[t_k, t_k+1]``.
-    applied_torque : (N, 3) N m, actuator torque on the body at ``t_k`` (body axes).
-    saturated : (N,) bool, any actuator at its limit during sample k.
+    model : AttitudeModel
+        The simulated model.
+    sample_time : float
+        Controller period [s].
+    t : (N+1,) ndarray
+        Sample instants and the final time [s].
+    x : (N+1, nx) ndarray
+        States ``[q, ω, h_w]`` at ``t``: attitude (scalar-first, body to inertial), body rate
+        [rad/s], wheel momenta [N m s].
+    commanded_u : (N, nu) ndarray
+        Control asked for (before saturation), layout of ``model.control_slices``.
+    applied_u : (N, nu) ndarray
+        Control applied over ``[t_k, t_k+1]``.
+    applied_torque : (N, 3) ndarray
+        Actuator torque on the body at ``t_k`` [N m], body axes.
+    saturated : (N,) bool ndarray
+        Whether any actuator was at its limit during sample k.
+    path : str
+        How it was computed: ``"python"`` (loop), ``"interpreted"`` or ``"compiled"`` (one
+        CasADi function).
     """
 
     model: AttitudeModel
@@ -183,18 +225,20 @@ class SimulationResult:
     applied_torque: Array
     saturated: NDArray[np.bool_]
     path: str = "python"
-    """How it was computed: ``"python"`` (loop), ``"interpreted"`` or ``"compiled"`` (one CasADi function)."""
 
     @property
     def q(self) -> Array:
+        """(N+1, 4) attitude quaternions, scalar first, body to inertial."""
         return self.x[:, 0:4]
 
     @property
     def omega(self) -> Array:
+        """(N+1, 3) body rates [rad/s], body axes."""
         return self.x[:, 4:7]
 
     @property
     def wheel_momentum(self) -> Array:
+        """(N+1, n_w) wheel momenta [N m s]."""
         return self.x[:, 7:]
 
 
@@ -203,14 +247,26 @@ class Simulator:
 
     Parameters
     ----------
-    model : the spacecraft in its environment.
-    sample_time : s, controller period and zero-order-hold length.
-    integrator : ``"rk4"`` (fixed step, at most ``max_step`` s per sub-step) or ``"cvodes"``
-        (adaptive, ``rtol``/``atol``). RK4's local error grows as ``(h ‖ω‖)⁵``: the default
-        0.05 s keeps closed-loop attitudes within ~1e-8 deg of CVODES at rates below ~0.5 rad/s;
-        lower it for fast spins or conservation studies.
-    compile : build the closed loop of symbolic laws as C (cached; see :mod:`ocp.compiled`).
-    python_loop : always use the Python loop (the reference implementation), even for symbolic laws.
+    model : AttitudeModel
+        The spacecraft in its environment.
+    sample_time : float
+        Controller period and zero-order-hold length [s].
+    integrator : {"rk4", "cvodes"}, optional
+        ``"rk4"``: fixed step, at most ``max_step`` per sub-step; ``"cvodes"``: adaptive
+        (``rtol``/``atol``). RK4's local error grows as ``(h ‖ω‖)⁵``: the default 0.05 s keeps
+        closed-loop attitudes within ~1e-8 deg of CVODES at rates below ~0.5 rad/s; lower it for
+        fast spins or conservation studies.
+    max_step : float, optional
+        Longest RK4 sub-step [s] (at most :data:`MAX_SUBSTEPS` sub-steps per sample).
+    rtol, atol : float, optional
+        CVODES relative and absolute tolerances.
+    compile : bool, optional
+        Build the closed loop of symbolic laws as C (cached; see :mod:`ocp.compiled`).
+    python_loop : bool, optional
+        Always use the Python loop (the reference implementation), even for symbolic laws.
+    max_samples : int, optional
+        Most samples one run may take (and :data:`SUBSTEPS_PER_SAMPLE` RK4 sub-steps each); longer
+        runs are refused with :class:`SimulationError`, not attempted.
     """
 
     MAX_BUILDS = 16
@@ -296,7 +352,7 @@ class Simulator:
 
     def run(
         self,
-        controller: ControllerLike,
+        controller: _ControllerLike,
         x0: ArrayLike,
         duration: float,
         reference: Any = None,
@@ -304,10 +360,35 @@ class Simulator:
         noise: SensorNoise | None = None,
         parameters: ArrayLike | None = None,
     ) -> SimulationResult:
-        """Simulate ``duration`` seconds from ``x0`` in closed loop with ``controller``.
+        """Simulate in closed loop.
 
-        ``target`` (e.g. ``(q_f, ω_f)``) is handed to ``controller.reset`` for regulation;
-        ``parameters`` overrides the model's disturbance torque ``p``.
+        Parameters
+        ----------
+        controller : controllers.base.Controller (anything with its reset and __call__)
+            The feedback law (reset here; a symbolic law runs as one CasADi function unless
+            ``python_loop``).
+        x0 : (nx,) array_like
+            Initial state ``[q, ω, h_w]`` (the quaternion is normalised).
+        duration : float
+            Simulated time [s]; the last sample is shortened to end there.
+        reference : planners.Reference, optional
+            Reference to track; ``None``: regulation to ``target``. It is sampled once per run on
+            the sample grid (and kept for the next run with the same reference and grid).
+        target : (q_f, ω_f or None), optional
+            Handed to ``controller.reset``: final attitude and body rate [rad/s] for regulation.
+        noise : SensorNoise, optional
+            Sensor noise; ``None``: none.
+        parameters : (3,) array_like, optional
+            Disturbance torque ``p`` [N m], body axes; ``None``: the model's default.
+
+        Returns
+        -------
+        SimulationResult
+
+        Raises
+        ------
+        SimulationError
+            When the state becomes non-finite or the run exceeds the work limits.
         """
         model = self.model
         x = np.asarray(x0, dtype=float).copy()
@@ -377,7 +458,7 @@ class Simulator:
         return self._result(times, np.array(states), commanded, np.array(applied).reshape(n_samples, model.nu),
                             np.array(saturated, dtype=bool), "python")
 
-    def _result(self, times: Array, states: Array, commanded: Array, applied: Array, saturated: Array,
+    def _result(self, times: Array, states: Array, commanded: Array, applied: Array, saturated: NDArray[np.bool_],
                 path: str) -> SimulationResult:
         if self._torque_map is None or self._torque_map[0] != times.size - 1:
             self._torque_map = (times.size - 1, self.model.body_torque.map(times.size - 1))
@@ -399,9 +480,26 @@ class Simulator:
         return reason is not None and reason() is None
 
     def closed_loop_function(self, controller: Any, noise: SensorNoise) -> tuple[ClosedLoop, ca.Function, str]:
-        """The one-sample closed-loop function of a reset symbolic ``controller``: its builder, the
-        function (interpreted, or the compiled twin) and how it is evaluated (``"interpreted"`` or
-        ``"compiled"``). Builds are kept per law (:meth:`symbolic_key`) and noise shape."""
+        """The one-sample closed-loop function of a symbolic law.
+
+        Builds are kept per law (``Controller.symbolic_key``) and noise shape.
+
+        Parameters
+        ----------
+        controller : Controller
+            A reset controller with a symbolic law.
+        noise : SensorNoise
+            Which noises the function takes as inputs (those with a non-zero deviation).
+
+        Returns
+        -------
+        loop : ClosedLoop
+            Its builder.
+        function : casadi.Function
+            The function, interpreted, or its compiled twin.
+        path : str
+            ``"interpreted"`` or ``"compiled"``.
+        """
         loop_key = self._loop_key(controller, noise)
         if loop_key not in self._loops:
             if len(self._loops) >= self.MAX_BUILDS:

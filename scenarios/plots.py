@@ -28,8 +28,10 @@ from scenarios.outputs import row_stems
 
 AXIS_COLORS = ("tab:red", "tab:green", "tab:blue", "tab:purple")
 DPI = 90
-SAVE = {"dpi": DPI, "pil_kwargs": {"compress_level": 1}}
-"""PNG options: zlib level 1 encodes several times faster than the default 6 for ~20 % more bytes."""
+COMPRESS_LEVEL = 1
+"""zlib level of the PNGs: level 1 encodes several times faster than the default 6 for ~20 % more bytes."""
+SAVE: dict[str, Any] = {"dpi": DPI, "pil_kwargs": {"compress_level": COMPRESS_LEVEL}}
+"""``savefig`` options of the figures drawn once."""
 COLUMNS_PER_POINT = 2
 """Series longer than this many points per pixel column of the panel are decimated."""
 
@@ -211,12 +213,21 @@ def _write_png(canvas: FigureCanvasAgg, path: Path) -> None:
 
     width, height = canvas.get_width_height()
     image = Image.frombuffer("RGBA", (width, height), canvas.buffer_rgba(), "raw", "RGBA", 0, 1)
-    image.save(path, format="png", dpi=(DPI, DPI), compress_level=SAVE["pil_kwargs"]["compress_level"])
+    image.save(path, format="png", dpi=(DPI, DPI), compress_level=COMPRESS_LEVEL)
 
 
 def plot_cones(row: Any, path: Path) -> None:
     """Angle between each constrained boresight and its direction, closed loop and reference,
-    against the cone's limit (the planner's stats carry the cones as imposed, margin included)."""
+    against the cone's limit (the planner's stats carry the cones as imposed, margin included).
+
+    Parameters
+    ----------
+    row : scenarios.runner.Row
+        A row with a simulation and a reference whose ``stats["cones"]`` lists
+        ``(boresight (body), direction (inertial), angle [rad], keep_out)``.
+    path : pathlib.Path
+        Where to write the PNG.
+    """
     cones = row.reference.stats.get("cones", [])
     sim = row.simulation
     figure = Figure(figsize=(9, 3.2 * len(cones)))
@@ -238,7 +249,15 @@ def plot_cones(row: Any, path: Path) -> None:
 
 
 def plot_overlay(results: Any, path: Path) -> None:
-    """Torque norm, and the error to the target attitude (to the target rate when the attitude is free)."""
+    """Torque norm, and the error to the target attitude (to the target rate when the attitude is free).
+
+    Parameters
+    ----------
+    results : scenarios.runner.RunResults
+        The run (rows without a simulation are left out).
+    path : pathlib.Path
+        Where to write the PNG.
+    """
     target_q, target_omega = results.scenario.problem.qf, results.scenario.problem.omegaf
     figure = Figure(figsize=(9, 7))
     top, bottom = figure.subplots(2, 1, sharex=True)
@@ -270,8 +289,17 @@ def plot_overlay(results: Any, path: Path) -> None:
 
 
 def write_plots(results: Any, directory: Path, stems: list[str] | None = None) -> None:
-    """One PNG per simulated row (``<stem>.png``, ``<stem>_cones.png`` with cones) and
-    ``comparison.png``; ``stems`` are the rows' file stems (default ``row_stems`` of the labels)."""
+    """One PNG per simulated row (``<stem>.png``, ``<stem>_cones.png`` with cones) and ``comparison.png``.
+
+    Parameters
+    ----------
+    results : scenarios.runner.RunResults
+        The run.
+    directory : pathlib.Path
+        Existing directory to write into.
+    stems : list of str, optional
+        The rows' file stems; ``None``: ``row_stems`` of the labels.
+    """
     target_q = results.scenario.problem.qf
     stems = stems if stems is not None else row_stems([row.label for row in results.rows])
     figures: dict[tuple[int, bool, bool], RowFigure] = {}  # one per row shape, reused
