@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from matplotlib.ticker import FuncFormatter, NullLocator
+from matplotlib.ticker import FuncFormatter, MaxNLocator, NullLocator
 
 from ocp import quat
 from scenarios.outputs import row_stems
@@ -42,6 +42,23 @@ def _log_axis(axis: Any) -> None:
     axis.set_yscale("log")
     axis.yaxis.set_minor_locator(NullLocator())
     axis.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+
+
+def _label(axis: Any, text: str, offset: float = -0.095) -> None:
+    """A y label at a fixed place left of the panel, drawn with the panel's frame (matplotlib's own
+    y label is re-placed after the tick labels at every draw, which measures each of them), and
+    at most six value ticks (every tick label is a text to draw)."""
+    axis.text(offset, 0.5, text, rotation=90, ha="center", va="center", transform=axis.transAxes)
+    if axis.get_yscale() == "linear":
+        axis.yaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
+
+
+def _time_axis(axis: Any) -> None:
+    """The time axis: label at a fixed place (no measuring of the tick labels at each draw), at
+    most eight ticks (shared by the panels above)."""
+    axis.set_xlabel("time (s)")
+    axis.xaxis.set_label_coords(0.5, -0.35 / axis.get_position().height / axis.figure.get_figheight())
+    axis.xaxis.set_major_locator(MaxNLocator(nbins=7, steps=[1, 2, 2.5, 5, 10]))
 
 
 def _held(values: np.ndarray) -> np.ndarray:
@@ -128,14 +145,14 @@ class RowFigure:
         if n_wheels:
             labels.append("wheel momentum (N m s)")
         for axis, label in zip(axes, labels):
-            axis.set_ylabel(label)
+            _label(axis, label)
             axis.grid(alpha=0.3)
             if any(not item.get_label().startswith("_") for item in axis.get_lines()):
                 # beside the panel: static (drawn once), and never over a curve
                 axis.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, borderaxespad=0.0)
-        axes[-1].set_xlabel("time (s)")
         self.title = self.figure.suptitle("")
-        self.figure.subplots_adjust(left=0.09, right=0.855, bottom=0.05, top=0.95, hspace=0.08)
+        self.figure.subplots_adjust(left=0.1, right=0.855, bottom=0.05, top=0.95, hspace=0.08)
+        _time_axis(axes[-1])
         self._background: tuple[tuple[float, float], Any] | None = None
 
     def _dynamic(self) -> list[Any]:
@@ -212,7 +229,7 @@ def _write_png(canvas: FigureCanvasAgg, path: Path) -> None:
     from PIL import Image  # matplotlib's own PNG writer; imported with it
 
     width, height = canvas.get_width_height()
-    image = Image.frombuffer("RGBA", (width, height), canvas.buffer_rgba(), "raw", "RGBA", 0, 1)
+    image = Image.frombuffer("RGBA", (width, height), canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert("RGB")
     image.save(path, format="png", dpi=(DPI, DPI), compress_level=COMPRESS_LEVEL)
 
 
@@ -275,16 +292,16 @@ def plot_overlay(results: Any, path: Path) -> None:
         else:
             error = np.linalg.norm(sim.omega, axis=1)
         bottom.plot(sim.t, np.maximum(error, 1e-9), label=row.label)
-    top.set_ylabel("‖u‖ (N m)")
-    bottom.set_ylabel("error to target (deg)" if target_q is not None
-                      else "‖ω − ω_f‖ (rad/s)" if target_omega is not None else "‖ω‖ (rad/s)")
-    bottom.set_xlabel("time (s)")
+    _label(top, "‖u‖ (N m)")
+    _label(bottom, "error to target (deg)" if target_q is not None
+           else "‖ω − ω_f‖ (rad/s)" if target_omega is not None else "‖ω‖ (rad/s)")
     for axis in (top, bottom):
         axis.grid(alpha=0.3)
         if axis.get_lines():
             axis.legend(fontsize=8, loc="upper right")
     figure.suptitle(f"{results.scenario.name}: closed-loop comparison")
     figure.subplots_adjust(left=0.1, right=0.98, bottom=0.08, top=0.93, hspace=0.08)
+    _time_axis(bottom)
     figure.savefig(path, **SAVE)
 
 
