@@ -297,8 +297,8 @@ def plot_overlay(results: Any, path: Path) -> None:
            else "‖ω − ω_f‖ (rad/s)" if target_omega is not None else "‖ω‖ (rad/s)")
     for axis in (top, bottom):
         axis.grid(alpha=0.3)
-        if axis.get_lines():
-            axis.legend(fontsize=8, loc="upper right")
+    if top.get_lines():  # one legend: both panels have the same rows in the same colours
+        top.legend(fontsize=8, loc="upper right")
     figure.suptitle(f"{results.scenario.name}: closed-loop comparison")
     figure.subplots_adjust(left=0.1, right=0.98, bottom=0.08, top=0.93, hspace=0.08)
     _time_axis(bottom)
