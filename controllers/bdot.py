@@ -27,7 +27,7 @@ import casadi as ca
 import numpy as np
 
 from controllers.magnetic import MagneticController, field_components
-from ocp import Command, Measurement
+from ocp import Command, Measurement, Spacecraft
 from ocp.options import Range
 
 
@@ -38,11 +38,25 @@ class BDot(MagneticController):
 
     @dataclass(frozen=True)
     class Options:
+        """Options of ``bdot`` (the YAML keys under the controller's ``options``).
+
+        Parameters
+        ----------
+        gain : float, >= 0
+            K_b [A m² s/T]: dipole per unit rate of the body-frame field. The paper gives no value;
+            the default is the one of ``scenarios/nano_detumble.yaml``.
+        derivative : {"backward_difference", "exact", "filtered"}
+            How ``Ḃ`` is obtained (module docstring): ``backward_difference`` (default)
+            ``(B̃_k − B̃_{k−1}) / T_s`` from the magnetometer, ``m = 0`` at the first sample;
+            ``exact`` ``R(q)ᵀ ḃ_I − ω × B``, the paper's ideal case (no symbolic form); ``filtered``
+            the backward difference through a first-order low-pass filter.
+        filter_time_constant : float, > 0 and <= 1e6
+            T_f [s], time constant of the low-pass filter (``derivative: filtered`` only).
+        """
+
         gain: Annotated[float, Range(ge=0.0)] = 2.0e4
-        """K_b, A m² s/T."""
         derivative: Literal["backward_difference", "exact", "filtered"] = "backward_difference"
         filter_time_constant: Annotated[float, Range(gt=0.0, le=1.0e6)] = 1.0
-        """T_f, s (``derivative: filtered`` only)."""
 
     @property
     def needs_field_rate(self) -> bool:  # type: ignore[override]
@@ -54,7 +68,7 @@ class BDot(MagneticController):
                     "part of the measurement vector of the symbolic form")
         return None
 
-    def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None:
+    def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
         super().reset(spacecraft, sample_time, target)
         self._previous: tuple[float, float, float] | None = None
         self._filtered = (0.0, 0.0, 0.0)
@@ -99,7 +113,7 @@ class BDot(MagneticController):
             state += list(self._filtered)
         return np.array(state)
 
-    def _law(self, t, y, z, r):
+    def _law(self, t: ca.SX, y: ca.SX, z: ca.SX, r: ca.SX) -> tuple[ca.SX, ca.SX]:
         b = self.symbolic_field(y)
         previous, started = z[0:3], z[3]
         difference = b - previous

@@ -24,13 +24,24 @@ from typing import Annotated, Any
 import numpy as np
 
 from controllers.base import Array, Controller
-from ocp import Command, Measurement
+from ocp import Command, Measurement, Spacecraft
 from ocp.options import Range
 from planners.capabilities import CostateCarrier, offers_costates
 
 
 def project_psd(matrix: Array) -> Array:
-    """Nearest symmetric non-negative definite matrix in the Frobenius norm."""
+    """Nearest symmetric non-negative definite matrix in the Frobenius norm.
+
+    Parameters
+    ----------
+    matrix : (n, n) ndarray
+        A square matrix (its symmetric part is projected).
+
+    Returns
+    -------
+    (n, n) ndarray
+        The symmetric part with its negative eigenvalues set to zero.
+    """
     values, vectors = np.linalg.eigh(0.5 * (matrix + matrix.T))
     return (vectors * np.maximum(values, 0.0)) @ vectors.T
 
@@ -42,7 +53,28 @@ def fit_costate_gain(states: Array, costates: Array, ridge: float = 1e-4, start:
     The symmetric least-squares problem has a closed form in the eigenbasis of ``G = Σ x_k x_kᵀ``:
     ``P̃_ij = C̃_ij / ((d_i + d_j)/2 + ρ)`` with ``C = sym(Σ λ_k x_kᵀ)``. If that is not
     non-negative definite, accelerated projected gradient takes over from its projection
-    (from ``start`` if given). ``ridge`` is relative to the largest eigenvalue of ``G``.
+    (from ``start`` if given).
+
+    Parameters
+    ----------
+    states : (m, n) array_like
+        States ``x_k`` as rows (``[q, ω]``: scalar-first quaternion and body rate [rad/s], n = 7).
+    costates : (m, n) array_like
+        Co-states ``λ_k`` as rows, in the units of the reference's objective.
+    ridge : float, optional
+        Tikhonov weight ρ relative to the largest eigenvalue of ``G`` (dimensionless).
+    start : (n, n) ndarray or None, optional
+        Warm start of the projected gradient (the previous sample's ``P``); ``None``: the
+        projection of the unconstrained solution.
+    iterations : int, optional
+        Most projected-gradient iterations.
+    tolerance : float, optional
+        Stop once an iteration changes ``P`` by less than this, relative to ``‖P‖_F``.
+
+    Returns
+    -------
+    (n, n) ndarray
+        ``P``, symmetric non-negative definite.
     """
     X, L = np.asarray(states, dtype=float).T, np.asarray(costates, dtype=float).T
     gram = X @ X.T
@@ -63,7 +95,7 @@ def fit_costate_gain(states: Array, costates: Array, ridge: float = 1e-4, start:
         Y = P_next + (momentum - 1) / momentum_next * (P_next - P)
         change = np.linalg.norm(P_next - P)
         P, momentum = P_next, momentum_next
-        if change <= tolerance * max(np.linalg.norm(P), 1e-300):
+        if change <= tolerance * max(float(np.linalg.norm(P)), 1e-300):
             break
     return P
 
@@ -81,11 +113,40 @@ class CostateFeedback(Controller):
 
     @dataclass(frozen=True)
     class Options:
-        window_samples: Annotated[int, Range(ge=2, le=1000)] = 5           # fit points t − nΔt, n = 0 … window_samples − 1
-        window_step: Annotated[float | None, Range(gt=0.0)] = None  # Δt (s); default the sample time
-        ridge: Annotated[float, Range(ge=0.0)] = 1e-4               # relative Tikhonov weight of the fit
+        """Options of ``costate_feedback`` (the YAML keys under the controller's ``options``).
+
+        Parameters
+        ----------
+        window_samples : int, 2 to 1000
+            Number of fit points ``t − nΔt``, n = 0 … ``window_samples`` − 1 (the paper's n = 0…4:
+            default 5), shifted to stay inside ``[0, t_f]``.
+        window_step : float > 0 or None
+            Δt [s] between fit points; ``None`` (default): the sample time.
+        ridge : float, >= 0
+            Tikhonov weight ρ of the fit, relative to the largest eigenvalue of ``Σ x_k x_kᵀ``
+            (dimensionless); it picks the minimum-norm ``P`` in the directions the window's states
+            do not span.
+        """
+
+        window_samples: Annotated[int, Range(ge=2, le=1000)] = 5
+        window_step: Annotated[float | None, Range(gt=0.0)] = None
+        ridge: Annotated[float, Range(ge=0.0)] = 1e-4
 
     def planner_error(self, planner: str, options: Any) -> str | None:
+        """Refuse a planner whose references offer no co-states with a torque control.
+
+        Parameters
+        ----------
+        planner : str
+            Registry name of the planner.
+        options : object
+            The planner's parsed ``Options`` (the control form depends on them).
+
+        Returns
+        -------
+        str or None
+            The reason and the planners that offer co-states, or ``None`` when the law can track it.
+        """
         from planners import PLANNERS  # the registry, complete once scenarios are parsed
 
         if planner in PLANNERS and offers_costates(PLANNERS[planner], options):
@@ -94,13 +155,26 @@ class CostateFeedback(Controller):
         return (f"controller {self.name} tracks references that offer co-states with a torque control; "
                 f"planners offering them (for some options): {offering}")
 
-    def reset(self, spacecraft, sample_time, target=None) -> None:
+    def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
         super().reset(spacecraft, sample_time, target)
         self.gain: Array | None = None
         self.gains: list[tuple[float, Array]] = []  # (t, P) per sample, for inspection
 
     def window(self, t: float, duration: float) -> Array:
-        """Fit times (s): ``t − nΔt``, shifted to lie in ``[0, duration]``."""
+        """The fit times of the sample at ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Sample time instant [s].
+        duration : float
+            The reference's duration t_f [s].
+
+        Returns
+        -------
+        (window_samples,) ndarray
+            Times ``t − nΔt`` [s] in increasing order, shifted to lie in ``[0, duration]``.
+        """
         step = self.options.window_step or self.sample_time
         span = step * (self.options.window_samples - 1)
         first = min(max(t - span, 0.0), max(duration - span, 0.0))

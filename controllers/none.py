@@ -18,5 +18,5 @@ class NoControl(Controller):
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
         return Command()
 
-    def _law(self, t, y, z, r):
+    def _law(self, t: ca.SX, y: ca.SX, z: ca.SX, r: ca.SX) -> tuple[ca.SX, ca.SX]:
         return ca.SX.zeros(self._nu), z

@@ -22,26 +22,34 @@ import casadi as ca
 import numpy as np
 
 from controllers.magnetic import MagneticController, field_components
-from ocp import Command, Measurement
+from ocp import Command, Measurement, Spacecraft
 from ocp.options import Range
 
 MAX_DELAY_SAMPLES = 100_000
+"""Upper bound on ``τ / T_s`` (buffer length)."""
 MAX_SYMBOLIC_DELAY = 32
 """Longest delay buffer (samples) of the symbolic law; longer delays run in the Python loop."""
-"""Upper bound on ``τ / T_s`` (buffer length)."""
 
 
 def delay_samples(delay: float, sample_time: float) -> int:
-    """``d = τ / T_s`` if it is a whole number (to 1e-9 relative), else ``ValueError``.
+    """The delay in samples, ``d = τ / T_s``, if it is a whole number (to 1e-9 relative).
 
     Parameters
     ----------
-    delay : s, τ; sample_time : s, T_s.
+    delay : float
+        τ [s].
+    sample_time : float
+        T_s [s].
 
     Returns
     -------
     int
-        d >= 1.
+        d, at least 1 and at most :data:`MAX_DELAY_SAMPLES`.
+
+    Raises
+    ------
+    ValueError
+        ``τ / T_s`` is not a whole number >= 1, or exceeds :data:`MAX_DELAY_SAMPLES`.
     """
     ratio = delay / sample_time
     samples = round(ratio)
@@ -60,20 +68,42 @@ class TDFC(MagneticController):
 
     @dataclass(frozen=True)
     class Options:
+        """Options of ``tdfc`` (the YAML keys under the controller's ``options``).
+
+        Parameters
+        ----------
+        gain : float, >= 0
+            K_t [A m²/T]: dipole per unit change of the body-frame field over the delay. The paper
+            gives no value; the default is the one of ``scenarios/nano_detumble.yaml``.
+        delay : float, > 0 and <= 1e5
+            τ [s], a whole multiple of ``simulation.sample_time`` (else an error at
+            ``options.delay``). Default 2 s, the paper's. The law removes energy only while
+            ``|ω| τ < π`` (module docstring).
+        """
+
         gain: Annotated[float, Range(ge=0.0)] = 1.0e4
-        """K_t, A m²/T."""
         delay: Annotated[float, Range(gt=0.0, le=1.0e5)] = 2.0
-        """τ, s; a whole multiple of the sample time."""
 
     def sample_time_error(self, sample_time: float) -> tuple[str, str] | None:
-        """``(option, message)`` if the law cannot run at ``sample_time`` (s), else ``None``."""
+        """Refuse a sample time of which the delay is not a whole multiple.
+
+        Parameters
+        ----------
+        sample_time : float
+            T_s [s].
+
+        Returns
+        -------
+        tuple of 2 str or None
+            ``("delay", message)``, or ``None`` when ``τ / T_s`` is a whole number of samples.
+        """
         try:
             delay_samples(self.options.delay, sample_time)
         except ValueError as error:
             return "delay", str(error)
         return None
 
-    def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None:
+    def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
         super().reset(spacecraft, sample_time, target)
         self._delay = delay_samples(self.options.delay, sample_time)
         self._buffer: deque[tuple[float, float, float]] = deque(maxlen=self._delay + 1)
@@ -88,8 +118,15 @@ class TDFC(MagneticController):
         return self.dipole(-k * (reading[0] - old[0]), -k * (reading[1] - old[1]), -k * (reading[2] - old[2]))
 
     def symbolic_error(self) -> str | None:
-        """A delay buffer longer than :data:`MAX_SYMBOLIC_DELAY` samples is kept in the Python loop:
-        in one CasADi graph every sample would copy the whole buffer (memory grows with N d)."""
+        """Why the law has no symbolic form: a delay buffer longer than :data:`MAX_SYMBOLIC_DELAY`
+        samples is kept in the Python loop (in one CasADi graph every sample would copy the whole
+        buffer, memory growing with N d).
+
+        Returns
+        -------
+        str or None
+            The reason, or ``None`` when the symbolic law exists.
+        """
         if getattr(self, "_delay", 0) > MAX_SYMBOLIC_DELAY:
             return (f"the delay of {self._delay} samples is more than the {MAX_SYMBOLIC_DELAY} that the "
                     "symbolic closed loop holds; it runs in the Python loop")
@@ -104,7 +141,7 @@ class TDFC(MagneticController):
         z[-1] = len(stored)
         return z
 
-    def _law(self, t, y, z, r):
+    def _law(self, t: ca.SX, y: ca.SX, z: ca.SX, r: ca.SX) -> tuple[ca.SX, ca.SX]:
         d = self._delay
         b = self.symbolic_field(y)
         count = z[3 * d]

@@ -1,6 +1,6 @@
-"""Shared math of the two-wheel laws of Horri & Palmer (paper 004): the control frame, the singular
-desired rates (eq. 7-8) and their time derivative, the min-norm projection (eq. 25, sign
-corrected) and the base class of the four laws.
+"""The control frame and the base class of the two-wheel laws of Horri & Palmer (paper 004).
+
+The desired-rate math (eq. 7-8, 14/24, 25) is in :mod:`controllers.singular_rates`.
 
 Control frame
 -------------
@@ -13,158 +13,21 @@ inertia with the failed wheel on body axis ``a`` they are the **cyclic** relabel
 kinematics ``q̇_v = ½ q0 ω − ½ ω × q_v`` keep their form only under a proper rotation. Under an
 odd permutation the cross product changes sign, eq. 9 becomes ``q̇3 = +g/2 q3`` and the law
 diverges (tests/test_two_wheel.py shows both).
-
-Desired rates (eq. 7, 8; ``q = [q0, q1, q2, q3]`` the error quaternion in the control frame, the
-paper's scalar-last ``[q1, q2, q3, q4]`` with ``q4 = q0``, no sign change)::
-
-    ωd1 = −k q1 + g sat(q2 q3 / D, a1),   ωd2 = −k q2 − g sat(q1 q3 / D, a2),   D = q1² + q2² + ε_D
-
-``a = None`` is the unsaturated eq. 7; ``ε_D`` the regularisation the paper used in orbit (end of
-section IV.B). With ``ε_D = 0`` and no saturation, ``ω = ωd`` gives ``q̇3 = −g/2 q3`` (eq. 9) and
-``q̇0 = k/2 (q1² + q2²)`` (eq. 10), both checked against integration.
 """
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
 from typing import Any
 
 import casadi as ca
 import numpy as np
 
 from controllers.base import Array, Controller
+from controllers.singular_rates import SingularGains, desired_rates  # noqa: F401 (tests import them from here)
 from ocp import Command, Measurement, Spacecraft
 from ocp.layout import split_measurement
 
 PRINCIPAL_TOLERANCE = 1e-9
 """Relative tolerance on ``‖I n − (nᵀ I n) n‖ / ‖I‖`` for the unactuated axis ``n`` to count as principal."""
-
-
-@dataclass(frozen=True)
-class SingularGains:
-    """Gains of one desired-rate law: ``k``, ``g`` (rad/s), saturation limits ``a1``, ``a2``
-    (dimensionless, ``None``: unsaturated) and the regularisation ``epsilon_d`` of ``q1² + q2²``."""
-
-    k: float
-    g: float
-    a1: float | None
-    a2: float | None
-    epsilon_d: float = 0.0
-
-
-def _sat(value: float, limit: float | None) -> tuple[float, float]:
-    """``(sat(value, limit), d sat / d value)``."""
-    if limit is None or -limit < value < limit:
-        return value, 1.0
-    return (limit if value > 0 else -limit), 0.0
-
-
-def _ratio(numerator: float, denominator: float) -> float:
-    """``numerator / denominator`` with the singular point ``0/0`` taken as 0 (the limit along the
-    closed loop, where the numerator vanishes faster) and ``x/0`` as ±inf (saturated, or a
-    non-finite command that the simulator reports)."""
-    if denominator > 0.0:
-        return numerator / denominator
-    if numerator == 0.0:
-        return 0.0
-    return math.copysign(math.inf, numerator)
-
-
-def desired_rates(q0: float, q1: float, q2: float, q3: float, w1: float, w2: float, w3: float,
-                  gains: SingularGains) -> tuple[float, float, float, float]:
-    """Desired rates of eq. 7/8 and their time derivative along ``q̇ = ½ q ⊗ [0, ω]``.
-
-    Parameters
-    ----------
-    q0, q1, q2, q3 : error quaternion in the control frame (scalar first).
-    w1, w2, w3 : body rate in the control frame (rad/s); ``w3`` enters the derivative only.
-    gains : the law's gains.
-
-    Returns
-    -------
-    (ωd1, ωd2, ω̇d1, ω̇d2) in rad/s and rad/s².
-    """
-    k, g = gains.k, gains.g
-    dq1 = 0.5 * (q0 * w1 - q3 * w2 + q2 * w3)
-    dq2 = 0.5 * (q0 * w2 - q1 * w3 + q3 * w1)
-    dq3 = 0.5 * (q0 * w3 - q2 * w1 + q1 * w2)
-    d = q1 * q1 + q2 * q2 + gains.epsilon_d
-    dd = 2.0 * (q1 * dq1 + q2 * dq2)
-    r1, slope1 = _sat(_ratio(q2 * q3, d), gains.a1)
-    r2, slope2 = _sat(_ratio(q1 * q3, d), gains.a2)
-    wd1 = -k * q1 + g * r1
-    wd2 = -k * q2 - g * r2
-    if d > 0.0:
-        dr1 = ((dq2 * q3 + q2 * dq3) - q2 * q3 * dd / d) / d if slope1 else 0.0
-        dr2 = ((dq1 * q3 + q1 * dq3) - q1 * q3 * dd / d) / d if slope2 else 0.0
-    else:
-        dr1 = dr2 = 0.0
-    return wd1, wd2, -k * dq1 + g * dr1, -k * dq2 - g * dr2
-
-
-def rate_tracking_torque(w1: float, w2: float, rates: tuple[float, float, float, float], gain: float,
-                         inertia: tuple[float, float]) -> tuple[float, float]:
-    """snlc law (eq. 14/24 with eq. 31's units): ``u_i = −K (ω_i − ωd_i) + I_i ω̇d_i`` (N m).
-
-    ``gain`` K is in N m s/rad (not 1/s times the inertia); ``rates`` as :func:`desired_rates`."""
-    wd1, wd2, dwd1, dwd2 = rates
-    return -gain * (w1 - wd1) + inertia[0] * dwd1, -gain * (w2 - wd2) + inertia[1] * dwd2
-
-
-def min_norm(benchmark: tuple[float, float], lgv: tuple[float, float]) -> tuple[float, float]:
-    """Minimum-norm ``u`` with ``L_gV u <= L_gV k`` (eq. 22), sign corrected.
-
-    ``u = (L_gV k) L_gVᵀ / (L_gV L_gVᵀ)`` when ``L_gV k < 0``, else 0. Eq. 25 prints a leading
-    minus, which gives ``L_gV u = −L_gV k > 0``: V̇ increases wherever the law acts. ``‖u‖ =
-    |L_gV k| / ‖L_gV‖ <= ‖k‖`` (Cauchy-Schwarz), not ``= ‖k‖`` as the text after eq. 24 says."""
-    s = lgv[0] * benchmark[0] + lgv[1] * benchmark[1]
-    norm2 = lgv[0] * lgv[0] + lgv[1] * lgv[1]
-    if s >= 0.0 or norm2 == 0.0:
-        return 0.0, 0.0
-    scale = s / norm2
-    return scale * lgv[0], scale * lgv[1]
-
-
-def _sat_symbolic(value: ca.SX, limit: float | None) -> tuple[ca.SX, ca.SX]:
-    """:func:`_sat` on expressions."""
-    if limit is None:
-        return value, ca.SX(1.0)
-    return ca.fmin(ca.fmax(value, -limit), limit), ca.if_else(ca.fabs(value) < limit, 1.0, 0.0)
-
-
-def _ratio_symbolic(numerator: ca.SX, denominator: ca.SX) -> ca.SX:
-    """:func:`_ratio` on expressions."""
-    safe = ca.if_else(denominator > 0, denominator, 1.0)
-    singular = ca.if_else(numerator == 0, 0.0, ca.sign(numerator) * ca.inf)
-    return ca.if_else(denominator > 0, numerator / safe, singular)
-
-
-def desired_rates_symbolic(q: list, w: list, gains: SingularGains) -> tuple[ca.SX, ca.SX, ca.SX, ca.SX]:
-    """:func:`desired_rates` on expressions: ``q = [q0, q1, q2, q3]``, ``w = [ω1, ω2, ω3]`` in the
-    control frame; the same arithmetic, branches as ``if_else``."""
-    q0, q1, q2, q3 = q
-    w1, w2, w3 = w
-    k, g = gains.k, gains.g
-    dq1 = 0.5 * (q0 * w1 - q3 * w2 + q2 * w3)
-    dq2 = 0.5 * (q0 * w2 - q1 * w3 + q3 * w1)
-    dq3 = 0.5 * (q0 * w3 - q2 * w1 + q1 * w2)
-    d = q1 * q1 + q2 * q2 + gains.epsilon_d
-    dd = 2.0 * (q1 * dq1 + q2 * dq2)
-    r1, slope1 = _sat_symbolic(_ratio_symbolic(q2 * q3, d), gains.a1)
-    r2, slope2 = _sat_symbolic(_ratio_symbolic(q1 * q3, d), gains.a2)
-    safe = ca.if_else(d > 0, d, 1.0)
-    dr1 = ca.if_else(ca.logic_and(d > 0, slope1 != 0), ((dq2 * q3 + q2 * dq3) - q2 * q3 * dd / safe) / safe, 0.0)
-    dr2 = ca.if_else(ca.logic_and(d > 0, slope2 != 0), ((dq1 * q3 + q1 * dq3) - q1 * q3 * dd / safe) / safe, 0.0)
-    return -k * q1 + g * r1, -k * q2 - g * r2, -k * dq1 + g * dr1, -k * dq2 - g * dr2
-
-
-def min_norm_symbolic(benchmark: tuple, lgv: tuple) -> tuple[ca.SX, ca.SX]:
-    """:func:`min_norm` on expressions."""
-    s = lgv[0] * benchmark[0] + lgv[1] * benchmark[1]
-    norm2 = lgv[0] * lgv[0] + lgv[1] * lgv[1]
-    acting = ca.logic_and(s < 0, norm2 != 0)
-    scale = ca.if_else(acting, s / ca.if_else(norm2 != 0, norm2, 1.0), 0.0)
-    return scale * lgv[0], scale * lgv[1]
 
 
 def control_frame(spacecraft: Spacecraft) -> Array | str:
@@ -173,11 +36,15 @@ def control_frame(spacecraft: Spacecraft) -> Array | str:
 
     Parameters
     ----------
-    spacecraft : with reaction wheels whose working axes span exactly a plane.
+    spacecraft : Spacecraft
+        The spacecraft; it needs reaction wheels whose working axes span exactly a plane whose
+        normal is a principal axis of the inertia.
 
     Returns
     -------
-    (3, 3) rotation matrix, or an error message.
+    (3, 3) ndarray or str
+        The rotation matrix from body to control axes (rows ``e1, e2, e3`` in body axes), or the
+        reason why there is none (the caller prefixes the controller's name).
     """
     wheels = spacecraft.wheels
     if wheels is None or not np.any(wheels.working):
@@ -217,14 +84,37 @@ class TwoWheelLaw(Controller):
     wheels_only = True
     gyroscopic_compensation = False
 
+    def _spacecraft(self) -> Spacecraft:
+        """The spacecraft of the last :meth:`reset` (an error before it)."""
+        if self.spacecraft is None:
+            raise RuntimeError(f"controller {self.name}: call reset(spacecraft, sample_time, target) first")
+        return self.spacecraft
+
     def environment_error(self, spacecraft: Spacecraft, environment: Any) -> str | None:
         frame = self.control_frame(spacecraft)
         return f"controller {self.name} {frame}" if isinstance(frame, str) else None
 
     def initial_state_error(self, spacecraft: Spacecraft, omega0: Array, wheel_momentum0: Array,
                             omegaf: Array | None) -> tuple[str, str] | None:
-        """The laws need zero total angular momentum (the unactuated rate stays zero only then) and
-        end at rest."""
+        """Refuse a non-zero total angular momentum or a final rate: the laws need ``I ω0 + A h_w0 = 0``
+        (the unactuated rate stays zero only then) and end at rest.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The spacecraft (inertia, wheel axes).
+        omega0 : (3,) ndarray
+            Initial body rate [rad/s], body frame.
+        wheel_momentum0 : (n_w,) ndarray
+            Initial wheel momenta [N m s] along the wheel axes.
+        omegaf : (3,) ndarray or None
+            Final body rate [rad/s], body frame; ``None``: free.
+
+        Returns
+        -------
+        tuple of 2 str or None
+            ``("initial.omega" or "final.omega", message)``, or ``None`` when the state is accepted.
+        """
         momentum = spacecraft.inertia @ omega0 + spacecraft.wheel_axes @ wheel_momentum0
         scale = max(float(np.abs(spacecraft.inertia).max()) * 1e-9, 1e-12)
         if float(np.linalg.norm(momentum)) > scale:
@@ -235,7 +125,18 @@ class TwoWheelLaw(Controller):
         return None
 
     def control_frame(self, spacecraft: Spacecraft) -> Array | str:
-        """The control frame (see :func:`control_frame`); a test may override it."""
+        """The control frame (see :func:`control_frame`); a test may override it.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The spacecraft.
+
+        Returns
+        -------
+        (3, 3) ndarray or str
+            Rows ``e1, e2, e3`` in body axes (``e3`` unactuated), or why there is none.
+        """
         return control_frame(spacecraft)
 
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
@@ -251,8 +152,20 @@ class TwoWheelLaw(Controller):
         self._target_conjugate = (q_target[0], -q_target[1], -q_target[2], -q_target[3])
 
     def error(self, measurement: Measurement) -> tuple[float, float, float, float, float, float, float]:
-        """``(q0, q1, q2, q3, ω1, ω2, ω3)``: error quaternion ``q_f* ⊗ q`` (``q0 >= 0``) and body rate
-        in the control frame."""
+        """Error quaternion and body rate in the control frame.
+
+        Parameters
+        ----------
+        measurement : Measurement
+            Measured attitude ``q`` (body to inertial, scalar first) and body rate [rad/s].
+
+        Returns
+        -------
+        tuple of 7 float
+            ``(q0, q1, q2, q3, ω1, ω2, ω3)``: the error quaternion ``q_f* ⊗ q`` (sign chosen so
+            that ``q0 >= 0``; ``q_f`` the target, identity without one) with its vector part in
+            the control frame, and the body rate in the control frame [rad/s].
+        """
         p0, p1, p2, p3 = self._target_conjugate
         q0, q1, q2, q3 = measurement.q.tolist()
         e0 = p0 * q0 - p1 * q1 - p2 * q2 - p3 * q3
@@ -266,9 +179,21 @@ class TwoWheelLaw(Controller):
         return (e0, a * ex + b * ey + c * ez, d * ex + e * ey + f * ez, g * ex + h * ey + i * ez,
                 a * wx + b * wy + c * wz, d * wx + e * wy + f * wz, g * wx + h * wy + i * wz)
 
-    def error_symbolic(self, y: ca.SX) -> tuple[list, list]:
-        """:meth:`error` on the measurement vector ``y``: ``([q0, q1, q2, q3], [ω1, ω2, ω3])``."""
-        q, w, _, _ = split_measurement(y, self.spacecraft.n_wheels)
+    def error_symbolic(self, y: ca.SX) -> tuple[list[ca.SX], list[ca.SX]]:
+        """:meth:`error` on the measurement vector ``y``.
+
+        Parameters
+        ----------
+        y : casadi.SX
+            Measurement vector ``[q, ω, h_w, b]`` (layout in :mod:`ocp.layout`).
+
+        Returns
+        -------
+        tuple of 2 lists of casadi.SX
+            ``([q0, q1, q2, q3], [ω1, ω2, ω3])``: error quaternion (``q0 >= 0``) and body rate
+            [rad/s], control frame.
+        """
+        q, w, _, _ = split_measurement(y, self._spacecraft().n_wheels)
         p0, p1, p2, p3 = self._target_conjugate
         e0 = p0 * q[0] - p1 * q[1] - p2 * q[2] - p3 * q[3]
         ex = p0 * q[1] + p1 * q[0] + p2 * q[3] - p3 * q[2]
@@ -282,16 +207,53 @@ class TwoWheelLaw(Controller):
         return [e0, *vector], rates
 
     def command_symbolic(self, u1: ca.SX, u2: ca.SX, y: ca.SX) -> ca.SX:
-        """:meth:`command_torque` on expressions: the control vector for ``u`` on the actuated axes."""
+        """:meth:`command_torque` on expressions.
+
+        Parameters
+        ----------
+        u1, u2 : casadi.SX
+            Torque on the actuated axes [N m], control frame.
+        y : casadi.SX
+            Measurement vector ``[q, ω, h_w, b]``.
+
+        Returns
+        -------
+        casadi.SX
+            The control vector ``u`` in the model's control layout (wheel torques [N m]).
+        """
         (a, b, c), (d, e, f), _ = self._rows
         torque = ca.vertcat(a * u1 + d * u2, b * u1 + e * u2, c * u1 + f * u2)
         return self.allocate_symbolic(torque, y)
 
     def to_body(self, u1: float, u2: float) -> Array:
-        """A torque on the actuated axes (control frame) in body axes (N m)."""
+        """A torque on the actuated axes expressed in body axes.
+
+        Parameters
+        ----------
+        u1, u2 : float
+            Torque on the actuated axes ``e1``, ``e2`` [N m], control frame.
+
+        Returns
+        -------
+        (3,) ndarray
+            The torque [N m], body frame.
+        """
         (a, b, c), (d, e, f), _ = self._rows
         return np.array([a * u1 + d * u2, b * u1 + e * u2, c * u1 + f * u2])
 
     def command_torque(self, u1: float, u2: float, measurement: Measurement) -> Command:
-        """Wheel command for the body torque ``u`` on the actuated axes."""
+        """Wheel command for a body torque on the actuated axes (pure wheel mode, no gyroscopic term).
+
+        Parameters
+        ----------
+        u1, u2 : float
+            Torque on the actuated axes [N m], control frame.
+        measurement : Measurement
+            The sample's measurement.
+
+        Returns
+        -------
+        Command
+            Wheel torques [N m] (``ḣ_w``) that give the body torque ``−A g``.
+        """
         return self.allocate(self.to_body(u1, u2), measurement)

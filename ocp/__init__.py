@@ -1,6 +1,10 @@
 """slewbench's symbolic core: quaternions, spacecraft, environment, model, simulator, metrics.
 
 Pure numeric/symbolic layer (CasADi and NumPy); it knows nothing of planners, controllers or YAML.
+
+Conventions throughout: SI units; quaternions scalar first ``[q0, q1, q2, q3]``, Hamilton product,
+``q`` rotates body vectors into the inertial frame (``v_I = R(q) v_B``); ω is the body rate with
+respect to the inertial frame in body axes [rad/s]; torques, dipoles and wheel axes in body axes.
 """
 from ocp.actuators import ActuatorModel, Command, Measurement
 from ocp.cache import SolverCache

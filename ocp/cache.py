@@ -34,12 +34,16 @@ class SolverCache:
 
         Parameters
         ----------
-        key : a hashable description of the structure (tuples of numbers and strings).
-        build : called without arguments when ``key`` is not cached yet.
+        key : hashable
+            A description of the structure (tuples of numbers and strings) that fixes everything
+            the built object bakes in.
+        build : callable
+            Called without arguments when ``key`` is not cached yet; its result is stored.
 
         Returns
         -------
-        The cached or newly built object.
+        object
+            The cached or newly built object (the same object on every hit: do not mutate it).
         """
         if key in self._entries:
             self.hits += 1

@@ -32,10 +32,33 @@ NOISE_SIZE = 9
 
 def draw_noise(rng: np.random.Generator, n_samples: int, attitude_std: float, rate_std: float,
                field_rng: np.random.Generator | None = None, field_std: float = 0.0) -> Array:
-    """(n_samples, 9) sensor noise ``[rotation vector (rad), rate (rad/s), magnetometer (T)]`` in
-    the order the Python loop draws it: per sample, the attitude's three normals (if
-    ``attitude_std > 0``) then the rate's (if ``rate_std > 0``) from ``rng``, the magnetometer's
-    from ``field_rng`` (if ``field_std > 0``); absent parts are zero."""
+    """Sensor noise of a whole run, drawn in the order the Python loop draws it.
+
+    Per sample, the attitude's three normals (if ``attitude_std > 0``) then the rate's (if
+    ``rate_std > 0``) come from ``rng``; the magnetometer's come from ``field_rng`` (if
+    ``field_std > 0``).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of the attitude and rate noise.
+    n_samples : int
+        Number of samples N.
+    attitude_std : float
+        Standard deviation of each component of the attitude error rotation vector [rad],
+        body frame; 0: none.
+    rate_std : float
+        Standard deviation of each rate component [rad/s], body axes; 0: none.
+    field_rng : numpy.random.Generator or None, optional
+        Source of the magnetometer noise; ``None`` (default): none.
+    field_std : float, optional
+        Standard deviation of each magnetometer component [T], body axes (default 0: none).
+
+    Returns
+    -------
+    (n_samples, 9) ndarray
+        Rows ``[rotation vector (rad), rate (rad/s), magnetometer (T)]``; absent parts are zero.
+    """
     parts = [std for std in (attitude_std, rate_std) if std > 0]
     noise = np.zeros((n_samples, NOISE_SIZE))
     if field_std > 0 and field_rng is not None:
@@ -52,9 +75,22 @@ def draw_noise(rng: np.random.Generator, n_samples: int, attitude_std: float, ra
 
 
 def noisy_attitude(q: Any, rotvec: Any) -> Any:
-    """``q ⊗ exp(rotvec / 2)`` (the attitude sensor's error is a body-frame rotation vector),
-    with the operations in the order of the Python loop's (``Simulator._measure``), so that both
-    paths round alike."""
+    """Measured attitude ``q ⊗ exp(rotvec / 2)``: the attitude sensor's error is a body-frame
+    rotation vector. The operations follow the Python loop's (``Simulator._measure``), so that
+    both paths round alike.
+
+    Parameters
+    ----------
+    q : (4, 1) casadi.SX
+        True attitude, scalar first, body to inertial.
+    rotvec : (3, 1) casadi.SX
+        Error rotation vector [rad], body frame.
+
+    Returns
+    -------
+    (4, 1) casadi.SX
+        Noisy attitude, scalar first (unit when ``q`` is).
+    """
     v0, v1, v2 = rotvec[0], rotvec[1], rotvec[2]
     angle = ca.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
     s = ca.if_else(angle > 0, ca.sin(0.5 * angle) / ca.if_else(angle > 0, angle, 1.0), 0.5)
@@ -68,7 +104,21 @@ def noisy_attitude(q: Any, rotvec: Any) -> Any:
 
 @dataclass(frozen=True)
 class LoopShape:
-    """What one closed-loop build bakes in besides the law and the model's step."""
+    """What one closed-loop build bakes in besides the law and the model's step.
+
+    Parameters
+    ----------
+    attitude_noise : bool
+        The measurement adds the attitude noise (a body-frame rotation vector).
+    rate_noise : bool
+        The measurement adds the rate noise.
+    uses_reference : bool
+        The law reads the reference input ``r``.
+    uses_time : bool
+        An output depends on the time ``t`` (law, field or environment).
+    field_noise : bool, optional
+        The magnetometer adds noise (only with a field model; default False).
+    """
 
     attitude_noise: bool
     rate_noise: bool
@@ -87,12 +137,33 @@ class ClosedLoop:
 
     Parameters
     ----------
-    model : the spacecraft in its environment.
-    step : ``step(x, u, t, dt, p) -> x_next``, one hold of length ``dt`` (the simulator's RK4).
-    actuators : the saturation model.
-    law : ``law(t, y, z, r) -> (u, z_next)`` (``controllers.base.SymbolicLaw.function``).
-    attitude_noise, rate_noise, field_noise : whether the measurement adds the noise input
-        (``noise = [rotation vector (3), rate (3), magnetometer (3)]``).
+    model : AttitudeModel
+        The spacecraft in its environment.
+    step : casadi.Function
+        ``step(x, u, t, dt, p) -> x_next``, one zero-order hold of length ``dt`` [s] (the
+        simulator's RK4 sub-steps).
+    actuators : ActuatorModel
+        The saturation model (``apply_symbolic``).
+    law : casadi.Function
+        ``law(t, y, z, r) -> (u, z_next)`` (``controllers.base.SymbolicLaw.function``): time
+        [s], measurement ``y`` (:mod:`ocp.layout`), law state ``z``, two reference rows ``r``.
+    attitude_noise, rate_noise : bool
+        Whether the measurement adds the attitude (rotation vector [rad], body frame) and rate
+        ([rad/s]) parts of the noise input ``noise = [rotation vector (3), rate (3),
+        magnetometer (3)]``.
+    field_noise : bool, optional
+        Whether the magnetometer reading adds its part [T] (default False; ignored without a
+        field model).
+
+    Attributes
+    ----------
+    sample : casadi.Function
+        ``closed_loop_sample(xz, t, dt, noise, r, p) -> (xz_next, u_cmd, u_app, saturated,
+        torque)``, one sample (see the module docstring).
+    shape : LoopShape
+        Which inputs the loop actually uses.
+    nz : int
+        Size of the law's state ``z``.
     """
 
     def __init__(self, model: AttitudeModel, step: ca.Function, actuators: ActuatorModel, law: ca.Function,
@@ -130,11 +201,23 @@ class ClosedLoop:
                                   {"cse": True})
 
     def run_function(self, sample: ca.Function, n_samples: int) -> BufferedFunction:
-        """``sample`` (interpreted, or its compiled twin) accumulated over ``n_samples``, as
-        ``run(xz0, t (N), dt (N), [noise (9N)], [r (26N)], p) -> (xz (N(nx+nz)), u_cmd, u_app,
-        saturated, torque)``: the noise and reference inputs exist only when the loop uses them
-        (:attr:`shape`), and every input and output has its exact size, so that the function is
-        evaluated through reusable buffers (:class:`~ocp.fast_call.BufferedFunction`)."""
+        """The run of ``n_samples`` samples as one function.
+
+        Parameters
+        ----------
+        sample : casadi.Function
+            :attr:`sample`, interpreted, or its compiled twin (:func:`ocp.compiled.compile_function`).
+        n_samples : int
+            Number of samples N.
+
+        Returns
+        -------
+        BufferedFunction
+            ``run(xz0, t (N), dt (N), [noise (9N)], [r (26N)], p) -> (xz (N(nx+nz)), u_cmd,
+            u_app, saturated, torque)``: the noise and reference inputs exist only when the loop
+            uses them (:attr:`shape`), and every input and output has its exact size, so that
+            the function is evaluated through reusable buffers.
+        """
         accumulated = sample.mapaccum("closed_loop", n_samples)
         xz0 = ca.MX.sym("xz0", sample.nnz_in(0))
         t, dt = ca.MX.sym("t", 1, n_samples), ca.MX.sym("dt", 1, n_samples)
@@ -151,18 +234,51 @@ class ClosedLoop:
         else:
             r = ca.MX.zeros(2 * REFERENCE_FIELDS, n_samples)
         inputs.append(p)
-        outputs = accumulated(xz0, t, dt, noise, r, ca.repmat(p, 1, n_samples))
+        outputs = accumulated.call([xz0, t, dt, noise, r, ca.repmat(p, 1, n_samples)])
         return BufferedFunction(ca.Function("closed_loop_run", inputs, outputs))
 
     def evaluate(self, run: BufferedFunction, xz0: Array, times: Array, noise: Array | None, rows: Array | None,
                  p: Array) -> tuple[Array, Array, Array, Array, Array]:
-        """Run the accumulated function: states ``[x; z]`` after each sample (N, nx + nz),
-        commanded and applied controls (N, nu), saturation flags (N,) and actuator torques (N, 3)."""
+        """Run the accumulated function over the sample times.
+
+        Parameters
+        ----------
+        run : BufferedFunction
+            The result of :meth:`run_function` for N = ``times.size - 1`` samples.
+        xz0 : (nx + nz,) ndarray
+            Initial state ``x`` (quaternion, body rate [rad/s], wheel momenta [N m s]) and law
+            state ``z``.
+        times : (N + 1,) ndarray
+            Sample times [s]; the control computed at ``times[k]`` is held until ``times[k + 1]``.
+        noise : (N, 9) ndarray or None
+            Sensor noise per sample (:func:`draw_noise`); required when ``shape.noisy``,
+            otherwise ignored.
+        rows : (N, 26) ndarray or None
+            Reference rows at ``t_k`` and ``t_k + T_s`` per sample (:mod:`ocp.layout`); required
+            when ``shape.uses_reference``, otherwise ignored.
+        p : (3,) ndarray
+            Constant disturbance torque [N m], body frame.
+
+        Returns
+        -------
+        xz : (N, nx + nz) ndarray
+            States ``[x; z]`` after each sample.
+        u_cmd, u_app : (N, nu) ndarray
+            Commanded and applied (saturated) controls.
+        saturated : (N,) ndarray
+            Saturation flags (1.0 where an actuator was at its limit).
+        torque : (N, 3) ndarray
+            Actuators' body torque at each sample time [N m], body frame.
+        """
         n = times.size - 1
         args = [xz0, times[:-1], times[1:] - times[:-1]]
         if self.shape.noisy:
+            if noise is None:
+                raise ValueError("this closed loop takes sensor noise: pass the (N, 9) noise")
             args.append(noise.ravel())  # (N, 9) row-major is the (9, N) column-major input
         if self.shape.uses_reference:
+            if rows is None:
+                raise ValueError("this closed loop reads a reference: pass the (N, 26) rows")
             args.append(rows.ravel())
         args.append(p)
         xz, u_cmd, u_app, saturated, torque = run.all_outputs(*args)

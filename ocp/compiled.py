@@ -29,13 +29,27 @@ class CompilerUnavailable(RuntimeError):
 
 
 def cache_directory() -> Path:
-    """``$XDG_CACHE_HOME/slewbench`` (default ``~/.cache/slewbench``); the only place builds go."""
+    """The default directory of the builds, the only place they go.
+
+    Returns
+    -------
+    pathlib.Path
+        ``$XDG_CACHE_HOME/slewbench``, or ``~/.cache/slewbench`` when the variable is unset or
+        empty (not created here).
+    """
     base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     return Path(base) / "slewbench"
 
 
 def find_compiler() -> str | None:
-    """The C compiler to use: ``$CC`` if set and found, else ``cc``, else ``gcc`` (``None``: none)."""
+    """The C compiler to use.
+
+    Returns
+    -------
+    str or None
+        Full path of ``$CC`` if set and found on ``PATH``, else of ``cc``, else of ``gcc``;
+        ``None`` when none is found.
+    """
     for candidate in (os.environ.get("CC"), "cc", "gcc"):
         if candidate and shutil.which(candidate):
             return shutil.which(candidate)
@@ -47,8 +61,10 @@ def compile_function(function: ca.Function, directory: Path | None = None) -> ca
 
     Parameters
     ----------
-    function : a CasADi function that supports code generation (SX, MX, map/mapaccum of those).
-    directory : cache directory (default :func:`cache_directory`).
+    function : casadi.Function
+        A function that supports code generation (SX, MX, map/mapaccum of those).
+    directory : pathlib.Path or None, optional
+        Cache directory, created if needed; ``None`` (default): :func:`cache_directory`.
 
     Returns
     -------
@@ -67,7 +83,8 @@ def compile_function(function: ca.Function, directory: Path | None = None) -> ca
     source = ca.CodeGenerator(f"{name}.c", {"with_header": False})
     source.add(function)
     text = source.dump()
-    digest = hashlib.sha256("\n".join([text, compiler, *CFLAGS, ca.__version__]).encode()).hexdigest()[:32]
+    version = ca.__version__  # type: ignore[attr-defined]  # set at import; absent from CasADi's stubs
+    digest = hashlib.sha256("\n".join([text, compiler, *CFLAGS, version]).encode()).hexdigest()[:32]
     directory = Path(directory) if directory is not None else cache_directory()
     library = directory / f"{name}_{digest}.so"
     try:
@@ -88,5 +105,11 @@ def compile_function(function: ca.Function, directory: Path | None = None) -> ca
 
 
 def notice(message: str) -> None:
-    """One line on standard error (the fallback notice)."""
+    """Print one line, prefixed ``slewbench:``, on standard error (the fallback notice).
+
+    Parameters
+    ----------
+    message : str
+        The notice, e.g. why the compiled path is not used.
+    """
     print(f"slewbench: {message}", file=sys.stderr)

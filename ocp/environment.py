@@ -7,14 +7,18 @@ and return CasADi expressions; :class:`ocp.model.AttitudeModel` assembles them.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING
 
 import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
 from ocp import quat_casadi as qc
+from ocp.quat_casadi import Expr
 from ocp.spacecraft import ModelError
+
+if TYPE_CHECKING:  # type-only: ocp.igrf refers back to CircularOrbit
+    from ocp.igrf import IGRFField
 
 MU_EARTH = 3.986004418e14      # m³/s², EGM96 / WGS-84
 R_EARTH = 6378.137e3           # m, WGS-84 equatorial radius
@@ -24,13 +28,26 @@ DIPOLE_STRENGTH = 7.96e15      # T m³, Wertz (1978) dipole moment of the Earth'
 
 @dataclass(frozen=True)
 class CircularOrbit:
-    """Circular Keplerian orbit.
+    """Circular Keplerian orbit, fixed in the inertial (ECI) frame.
 
     Parameters
     ----------
-    altitude : m, above ``R_EARTH``.
-    inclination, raan, arg_latitude : rad; ``arg_latitude`` is the argument of latitude at t = 0.
-    mu : m³/s², gravitational parameter.
+    altitude : float
+        Height above the equatorial radius ``R_EARTH`` [m]; must exceed ``−0.99 R_EARTH``.
+    inclination : float, optional
+        Inclination of the orbit plane to the equator [rad] (default 0).
+    raan : float, optional
+        Right ascension of the ascending node [rad] (default 0).
+    arg_latitude : float, optional
+        Argument of latitude at t = 0 [rad], measured from the ascending node in the direction
+        of motion (default 0).
+    mu : float, optional
+        Gravitational parameter [m^3/s^2] (default ``MU_EARTH``).
+
+    Raises
+    ------
+    ModelError
+        If the orbit radius is not positive.
     """
 
     altitude: float
@@ -45,16 +62,27 @@ class CircularOrbit:
 
     @property
     def radius(self) -> float:
-        """Orbit radius (m)."""
+        """Orbit radius ``R_EARTH + altitude`` [m]."""
         return R_EARTH + self.altitude
 
     @property
     def mean_motion(self) -> float:
-        """Mean motion n (rad/s)."""
+        """Mean motion ``n = sqrt(mu / radius³)`` [rad/s]: the orbit rate."""
         return float(np.sqrt(self.mu / self.radius**3))
 
-    def position(self, t):
-        """Inertial position (m) at time ``t`` (s)."""
+    def position(self, t: Expr) -> Expr:
+        """Position of the spacecraft from the Earth's centre.
+
+        Parameters
+        ----------
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 1) casadi.DM, SX or MX
+            Position [m], inertial frame (``DM`` for a numeric ``t``).
+        """
         u = self.arg_latitude + self.mean_motion * t
         ci, si = np.cos(self.inclination), np.sin(self.inclination)
         cO, sO = np.cos(self.raan), np.sin(self.raan)
@@ -64,8 +92,19 @@ class CircularOrbit:
             ca.sin(u) * si,
         )
 
-    def velocity(self, t):
-        """Inertial velocity (m/s) at ``t``."""
+    def velocity(self, t: Expr) -> Expr:
+        """Velocity of the spacecraft with respect to the inertial frame.
+
+        Parameters
+        ----------
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 1) casadi.DM, SX or MX
+            Velocity [m/s], inertial frame; magnitude ``radius * mean_motion``.
+        """
         u = self.arg_latitude + self.mean_motion * t
         ci, si = np.cos(self.inclination), np.sin(self.inclination)
         cO, sO = np.cos(self.raan), np.sin(self.raan)
@@ -75,19 +114,50 @@ class CircularOrbit:
             ca.cos(u) * si,
         )
 
-    def nadir(self, t):
-        """Unit vector from the spacecraft to the Earth's centre, inertial axes."""
+    def nadir(self, t: Expr) -> Expr:
+        """Unit vector from the spacecraft to the Earth's centre.
+
+        Parameters
+        ----------
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 1) casadi.DM, SX or MX
+            Unit vector, inertial frame.
+        """
         r = self.position(t)
         return -r / ca.norm_2(r)
 
     def function(self) -> ca.Function:
-        """``casadi.Function`` ``(t) -> (position, velocity, nadir)`` in inertial axes (m, m/s, unit)."""
+        """The orbit as a CasADi function of time.
+
+        Returns
+        -------
+        casadi.Function
+            ``orbit(t) -> (position, velocity, nadir)``: ``t`` [s]; position [m], velocity [m/s]
+            and unit nadir vector, each (3, 1) in the inertial frame.
+        """
         t = ca.SX.sym("t")
         return ca.Function("orbit", [t], [self.position(t), self.velocity(t), self.nadir(t)], ["t"],
                            ["position", "velocity", "nadir"])
 
-    def lvlh_matrix(self, t):
-        """Columns: LVLH axes in inertial axes (x along-track, y = −orbit normal, z nadir)."""
+    def lvlh_matrix(self, t: Expr) -> Expr:
+        """Local-vertical local-horizontal (orbit) frame at time ``t``.
+
+        Parameters
+        ----------
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 3) casadi.DM, SX or MX
+            Columns: the LVLH axes in inertial components, x along-track (along the velocity for
+            a circular orbit), y = −orbit normal, z nadir; it maps LVLH components to inertial
+            ones, ``v_I = M v_LVLH``.
+        """
         z = self.nadir(t)
         v = self.velocity(t)
         y = ca.cross(z, v)
@@ -105,11 +175,18 @@ class TiltedDipole:
 
     Parameters
     ----------
-    strength : T m³, μ_m.
-    tilt : rad, angle between the geomagnetic and geographic north poles.
-    pole_longitude : rad, east longitude of the northern geomagnetic pole.
-    greenwich_angle : rad, angle of the Earth-fixed x axis from the inertial x axis at t = 0.
-    earth_rate : rad/s.
+    strength : float, optional
+        Dipole strength ``μ_m`` [T m^3] (default ``DIPOLE_STRENGTH``, 7.96e15: about 30 µT at the
+        equator on the ground).
+    tilt : float, optional
+        Angle between the geomagnetic and geographic north poles [rad] (default 11.5°).
+    pole_longitude : float, optional
+        East longitude of the northern geomagnetic pole [rad] (default −70°).
+    greenwich_angle : float, optional
+        Angle of the Earth-fixed x axis from the inertial x axis at t = 0 [rad] (default 0).
+    earth_rate : float, optional
+        Rotation rate of the Earth-fixed frame about the inertial z axis [rad/s] (default
+        ``EARTH_RATE``, sidereal).
     """
 
     strength: float = DIPOLE_STRENGTH
@@ -118,27 +195,76 @@ class TiltedDipole:
     greenwich_angle: float = 0.0
     earth_rate: float = EARTH_RATE
 
-    def dipole_direction(self, t):
-        """Unit dipole direction ``m̂`` in inertial axes at ``t``."""
+    def dipole_direction(self, t: Expr) -> Expr:
+        """Unit dipole direction ``m̂`` (towards the southern geomagnetic pole).
+
+        Parameters
+        ----------
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 1) casadi.DM, SX or MX
+            Unit vector, inertial frame.
+        """
         angle = self.greenwich_angle + self.earth_rate * t + self.pole_longitude
         st = np.sin(self.tilt)
         return -ca.vertcat(st * ca.cos(angle), st * ca.sin(angle), np.cos(self.tilt))
 
     def function(self) -> ca.Function:
-        """``casadi.Function`` ``(position, t) -> b``: the field (T) in inertial axes."""
+        """The field as a CasADi function.
+
+        Returns
+        -------
+        casadi.Function
+            ``dipole_field(position, t) -> b``: ``position`` (3,) [m] and ``b`` (3, 1) [T], both
+            inertial frame; ``t`` [s].
+        """
         position, t = ca.SX.sym("position", 3), ca.SX.sym("t")
         return ca.Function("dipole_field", [position, t], [self.field_inertial(position, t)], ["position", "t"], ["b"])
 
-    def field_inertial(self, position, t):
-        """Field vector (T) in inertial axes at inertial ``position`` (m) and time ``t``."""
+    def field_inertial(self, position: Expr, t: Expr) -> Expr:
+        """Geomagnetic field vector at a point and time.
+
+        Parameters
+        ----------
+        position : (3, 1) casadi.SX, MX, DM or array_like
+            Position from the Earth's centre [m], inertial frame (non-zero).
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 1) casadi.DM, SX or MX
+            Field ``B`` [T], inertial frame.
+        """
         r = ca.norm_2(position)
         r_hat = position / r
         m_hat = self.dipole_direction(t)
         return self.strength / r**3 * (3 * ca.dot(m_hat, r_hat) * r_hat - m_hat)
 
 
-def gravity_gradient_torque(q, position, inertia: NDArray, mu: float = MU_EARTH):
-    """Gravity-gradient torque (N m, body axes): ``3 μ / |r|⁵ · r_B × (I r_B)``."""
+def gravity_gradient_torque(q: Expr, position: Expr, inertia: NDArray, mu: float = MU_EARTH) -> Expr:
+    """Gravity-gradient torque on a rigid body, ``3 μ / |r|⁵ · r_B × (I r_B)``.
+
+    Parameters
+    ----------
+    q : (4, 1) casadi.SX, MX or DM
+        Attitude quaternion, scalar first, body to inertial.
+    position : (3, 1) casadi.SX, MX, DM or array_like
+        Position of the spacecraft from the Earth's centre [m], inertial frame; rotated here to
+        ``r_B = R(q)ᵀ r``.
+    inertia : (3, 3) ndarray
+        Inertia matrix about the centre of mass [kg m^2], body frame.
+    mu : float, optional
+        Gravitational parameter [m^3/s^2] (default ``MU_EARTH``).
+
+    Returns
+    -------
+    (3, 1) casadi.SX, MX or DM
+        Torque [N m], body frame.
+    """
     r_body = ca.mtimes(qc.rotation_matrix(q).T, position)
     r = ca.norm_2(position)
     return 3 * mu / r**5 * ca.cross(r_body, ca.mtimes(ca.DM(inertia), r_body))
@@ -150,16 +276,27 @@ class Environment:
 
     Parameters
     ----------
-    orbit : circular orbit, required by gravity gradient and the magnetic field.
-    gravity_gradient : include the gravity-gradient torque.
-    magnetic_field : geomagnetic model (:class:`TiltedDipole`, or :class:`~ocp.igrf.IGRFField`
-        tabulated along ``orbit``), or ``None``.
-    disturbance_torque : (3,) N m, constant, body axes.
+    orbit : CircularOrbit or None, optional
+        The orbit; required by the gravity gradient and the magnetic field (default none).
+    gravity_gradient : bool, optional
+        Include the gravity-gradient torque (default False).
+    magnetic_field : TiltedDipole or IGRFField or None, optional
+        Geomagnetic model (:class:`TiltedDipole`, or :class:`~ocp.igrf.IGRFField` tabulated along
+        ``orbit``), needed by magnetorquers; ``None`` (default): no field.
+    disturbance_torque : (3,) array_like, optional
+        Constant disturbance torque [N m], body frame (default zero); held as a (3,) ndarray. It
+        is the default of the model's parameter ``p``.
+
+    Raises
+    ------
+    ModelError
+        For a mis-sized disturbance, or a gravity gradient or field without an orbit, or an IGRF
+        table along another orbit.
     """
 
     orbit: CircularOrbit | None = None
     gravity_gradient: bool = False
-    magnetic_field: TiltedDipole | Any | None = None
+    magnetic_field: TiltedDipole | IGRFField | None = None
     disturbance_torque: NDArray = field(default_factory=lambda: np.zeros(3))
 
     def __post_init__(self) -> None:

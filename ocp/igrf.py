@@ -18,12 +18,17 @@ from __future__ import annotations
 import datetime
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import casadi as ca
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
+from ocp.quat_casadi import Expr
 from ocp.spacecraft import ModelError
+
+if TYPE_CHECKING:  # type-only: ocp.environment refers back to IGRFField
+    from ocp.environment import CircularOrbit
 
 EARTH_RATE = 7.2921159e-5      # rad/s, as ocp.environment
 MAX_NODES = 200_000
@@ -34,7 +39,25 @@ variation to 2030)."""
 
 
 def parse_epoch(epoch: str | datetime.date) -> datetime.datetime:
-    """The epoch as a UTC ``datetime`` (a date means 00:00 UTC); ``ModelError`` outside the IGRF range."""
+    """The epoch as a naive UTC ``datetime``.
+
+    Parameters
+    ----------
+    epoch : str, datetime.date or datetime.datetime
+        ISO text (``"2025-01-01"``, ``"2025-01-01T06:00:00+02:00"``), a date (00:00 UTC) or a
+        datetime (naive means UTC; an aware one is converted to UTC).
+
+    Returns
+    -------
+    datetime.datetime
+        The instant in UTC, without time zone.
+
+    Raises
+    ------
+    ModelError
+        (field ``"epoch"``) For text that is not an ISO date, or a date outside
+        :data:`EPOCH_RANGE`.
+    """
     if isinstance(epoch, datetime.datetime):
         value = epoch
     elif isinstance(epoch, datetime.date):
@@ -52,32 +75,37 @@ def parse_epoch(epoch: str | datetime.date) -> datetime.datetime:
 
 
 def greenwich_mean_sidereal_angle(epoch: datetime.datetime) -> float:
-    """GMST (rad) at a UTC epoch, IAU 1982 linear form (UT1 = UTC; error well under 0.01°).
+    """Greenwich mean sidereal angle at a UTC epoch, IAU 1982 linear form (UT1 = UTC; error well under 0.01°).
 
     Parameters
     ----------
-    epoch : UTC instant.
+    epoch : datetime.datetime
+        UTC instant (naive).
 
     Returns
     -------
     float
-        Angle of the Greenwich meridian from the vernal equinox, in [0, 2π).
+        Angle of the Greenwich meridian from the vernal equinox [rad], in [0, 2π).
     """
     days = (epoch - datetime.datetime(2000, 1, 1, 12)).total_seconds() / 86400.0
     return float(np.deg2rad((280.46061837 + 360.98564736629 * days) % 360.0))
 
 
-def igrf_earth_fixed(position_ecef: NDArray, epoch: datetime.datetime) -> NDArray:
-    """IGRF field (T) in Earth-fixed Cartesian axes at Earth-fixed positions (m), by ``ppigrf``.
+def igrf_earth_fixed(position_ecef: ArrayLike, epoch: datetime.datetime) -> NDArray:
+    """IGRF field in Earth-fixed Cartesian axes at Earth-fixed positions, by ``ppigrf``.
 
     Parameters
     ----------
-    position_ecef : (N, 3) m, Earth-fixed (geocentric) positions.
-    epoch : date of the coefficients.
+    position_ecef : (N, 3) or (3,) array_like
+        Geocentric positions [m], Earth-fixed frame (spherical Earth-centred coordinates are
+        derived from them; no geodetic conversion).
+    epoch : datetime.datetime
+        Date of the coefficients (UTC).
 
     Returns
     -------
-    (N, 3) T, Earth-fixed axes.
+    (N, 3) ndarray
+        Field [T], Earth-fixed Cartesian axes.
     """
     import ppigrf  # the dependency is needed only by the IGRF model
 
@@ -101,17 +129,30 @@ class IGRFField:
 
     Parameters
     ----------
-    orbit : the circular orbit (``ocp.environment.CircularOrbit``) along which the field is tabulated;
-        it must be the environment's orbit.
-    span : s, tabulated window; the simulator refuses to run beyond it.
-    epoch : date of the IGRF coefficients and of t = 0, ISO text (``"2025-01-01"``).
-    step : s, spacing of the nodes (cubic B-spline between them).
-    greenwich_angle : rad, Earth-fixed x axis from the inertial x axis at t = 0; ``None``: the
-        GMST of the epoch.
-    earth_rate : rad/s.
+    orbit : CircularOrbit
+        The orbit along which the field is tabulated; it must be the environment's orbit.
+    span : float
+        Tabulated window [s], positive; the simulator refuses to run beyond it. At most
+        :data:`MAX_NODES` nodes (``span / step``).
+    epoch : str, optional
+        Date of the IGRF coefficients and of t = 0, ISO text (default ``"2025-01-01"``), within
+        :data:`EPOCH_RANGE`.
+    step : float, optional
+        Spacing of the nodes [s], positive (default 30; cubic B-spline between them).
+    greenwich_angle : float or None, optional
+        Angle of the Earth-fixed x axis from the inertial x axis at t = 0 [rad]; ``None``
+        (default): the GMST of the epoch.
+    earth_rate : float, optional
+        Rotation rate of the Earth-fixed frame about the inertial z axis [rad/s] (default
+        ``EARTH_RATE``).
+
+    Raises
+    ------
+    ModelError
+        For an epoch outside the IGRF range, a non-positive step or span, or too many nodes.
     """
 
-    orbit: object
+    orbit: CircularOrbit
     span: float
     epoch: str = "2025-01-01"
     step: float = 30.0
@@ -129,24 +170,36 @@ class IGRFField:
 
     @property
     def initial_greenwich_angle(self) -> float:
-        """rad, the Earth's rotation angle at t = 0."""
+        """The Earth-fixed x axis's angle from the inertial x axis at t = 0 [rad]: ``greenwich_angle``
+        or, when that is ``None``, the GMST of the epoch."""
         if self.greenwich_angle is not None:
             return float(self.greenwich_angle)
         return greenwich_mean_sidereal_angle(parse_epoch(self.epoch))
 
     @property
     def valid_until(self) -> float:
-        """s, end of the tabulated window (the last node, at or after ``span``)."""
+        """End of the tabulated window [s]: the last node, at or after ``span``."""
         return float(self.nodes[-1])
 
     @property
     def nodes(self) -> NDArray:
-        """(N,) s, times of the table (at least four, for the cubic spline)."""
+        """(N,) times of the table [s], ``k * step`` from 0 (at least four, for the cubic spline)."""
         count = max(4, int(np.ceil(self.span / self.step - 1e-9)) + 1)
         return np.arange(count) * self.step
 
-    def exact(self, t: NDArray) -> NDArray:
-        """(N, 3) T, the package's field in inertial axes at the orbit's positions at times ``t`` (s)."""
+    def exact(self, t: ArrayLike) -> NDArray:
+        """The field evaluated by ``ppigrf`` (not interpolated) along the orbit.
+
+        Parameters
+        ----------
+        t : float or (N,) array_like
+            Times since t = 0 [s].
+
+        Returns
+        -------
+        (N, 3) ndarray
+            Field [T], inertial frame, at the orbit's positions at ``t``.
+        """
         t = np.atleast_1d(np.asarray(t, dtype=float))
         position = np.asarray(self.orbit.function().map(t.size)(t[None, :])[0]).T
         angle = self.initial_greenwich_angle + self.earth_rate * t
@@ -158,17 +211,38 @@ class IGRFField:
 
     @cached_property
     def interpolant(self) -> ca.Function:
-        """``casadi.Function`` ``(t) -> b``: cubic B-spline through the table (T, inertial axes)."""
+        """``casadi.Function`` ``igrf_field(t) -> b``: cubic B-spline through the table, ``t`` [s],
+        ``b`` (3,) [T], inertial axes (built on first use)."""
         nodes = self.nodes
         values = self.exact(nodes)
         return ca.interpolant("igrf_field", "bspline", [nodes], values.ravel())
 
-    def field_inertial(self, position, t):
-        """Field (T, inertial axes) at time ``t``; ``position`` is the orbit's at ``t`` (the table is
-        along the orbit), accepted for the interface shared with :class:`~ocp.environment.TiltedDipole`."""
+    def field_inertial(self, position: Expr, t: Expr) -> Expr:
+        """Interpolated field at time ``t`` (the table is along the orbit).
+
+        Parameters
+        ----------
+        position : (3, 1) casadi.SX, MX, DM or array_like
+            Ignored: it is the orbit's position at ``t``; accepted for the interface shared with
+            :meth:`ocp.environment.TiltedDipole.field_inertial`.
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s], within ``[0, valid_until]``.
+
+        Returns
+        -------
+        (3, 1) casadi.DM, SX or MX
+            Field [T], inertial frame.
+        """
         return self.interpolant(t)
 
     def function(self) -> ca.Function:
-        """``casadi.Function`` ``(position, t) -> b`` (T, inertial axes), as the tilted dipole's."""
+        """The field as a CasADi function, with the tilted dipole's signature.
+
+        Returns
+        -------
+        casadi.Function
+            ``igrf_field(position, t) -> b``: ``position`` (3,) [m] (ignored), ``t`` [s], ``b``
+            (3, 1) [T], inertial frame.
+        """
         position, t = ca.SX.sym("position", 3), ca.SX.sym("t")
         return ca.Function("igrf_field", [position, t], [self.field_inertial(position, t)], ["position", "t"], ["b"])

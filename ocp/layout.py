@@ -23,11 +23,16 @@ def control_layout(spacecraft: Any) -> tuple[dict[str, slice], int]:
 
     Parameters
     ----------
-    spacecraft : ``ocp.Spacecraft``.
+    spacecraft : Spacecraft
+        The actuators present fix the blocks: ``n_w`` wheel torques [N m], then the dipole
+        [A m^2] (3, with magnetorquers), then torquer torques [N m] (3, with torquers).
 
     Returns
     -------
-    (dict of slices, int)
+    slices : dict of str to slice
+        Slice of ``u`` for each block present.
+    nu : int
+        Size of ``u``.
     """
     slices: dict[str, slice] = {}
     offset = 0
@@ -43,25 +48,90 @@ def control_layout(spacecraft: Any) -> tuple[dict[str, slice], int]:
 
 
 def measurement_size(spacecraft: Any) -> int:
-    """Length of the measurement vector ``y``: ``7 + n_w + 3``."""
+    """Length of the measurement vector ``y = [q, ω, h_w, b]``.
+
+    Parameters
+    ----------
+    spacecraft : Spacecraft
+        Gives the number of wheels ``n_w`` (failed ones included).
+
+    Returns
+    -------
+    int
+        ``10 + n_w``.
+    """
     return 10 + spacecraft.n_wheels
 
 
 def split_measurement(y: Any, n_wheels: int) -> tuple[Any, Any, Any, Any]:
-    """``(q, ω, h_w, b)`` parts of a measurement vector (symbolic column or NumPy array)."""
+    """The parts of a measurement vector.
+
+    Parameters
+    ----------
+    y : (10 + n_w,) ndarray or (10 + n_w, 1) casadi.SX / MX
+        Measurement ``[q, ω, h_w, b]``.
+    n_wheels : int
+        Number of wheels ``n_w``.
+
+    Returns
+    -------
+    q : (4,) slice of ``y``
+        Measured attitude, scalar-first quaternion, body to inertial.
+    omega : (3,) slice of ``y``
+        Measured body rate [rad/s], body axes.
+    h_w : (n_w,) slice of ``y``
+        Wheel spin momenta [N m s].
+    b : (3,) slice of ``y``
+        Magnetometer reading [T], body axes (zeros without a field model).
+    """
     return y[0:4], y[4:7], y[7:7 + n_wheels], y[7 + n_wheels:10 + n_wheels]
 
 
 def measurement_vector(measurement: Any) -> Array:
-    """A :class:`~ocp.actuators.Measurement` as the vector ``y`` (a missing field is zeros)."""
+    """A measurement as the vector ``y``.
+
+    Parameters
+    ----------
+    measurement : ocp.actuators.Measurement
+        What the controller sees at one sample.
+
+    Returns
+    -------
+    (10 + n_w,) ndarray
+        ``[q, ω, h_w, b]`` (units as in the module docstring); ``b`` is zeros when the
+        measurement has no field.
+    """
     field = np.zeros(3) if measurement.field_body is None else measurement.field_body
     return np.concatenate([measurement.q, measurement.omega, measurement.wheel_momentum, field])
 
 
 def reference_rows(reference: Any, times: ArrayLike, target: Any = None) -> Array:
-    """(len(times), 13) rows ``[q*, ω*, ω̇*, τ*]`` of ``reference`` (anything with a vectorised
-    ``sample(t)``) at ``times`` (s); with ``reference=None`` the rows hold the target
-    ``(q_f, ω_f or None)`` at rest or at ``ω_f`` with no acceleration or torque."""
+    """Reference rows ``[q*, ω*, ω̇*, τ*]`` at given times, as the symbolic laws read them.
+
+    Parameters
+    ----------
+    reference : planners.base.Reference or None
+        Anything with a vectorised ``sample(t)`` returning ``q``, ``omega``, ``omega_dot`` and
+        ``torque``; ``None``: regulation to ``target``.
+    times : float or (N,) array_like
+        Times [s].
+    target : (q_f, omega_f) or None, optional
+        Used only when ``reference`` is None (then required): final attitude (scalar first,
+        body to inertial; ``None``: free, its four columns stay zero) and final body rate
+        [rad/s] (``None``: zero).
+
+    Returns
+    -------
+    (N, 13) ndarray
+        Rows: quaternion (scalar first, body to inertial), body rate [rad/s], body angular
+        acceleration [rad/s^2] and feed-forward torque [N m], body axes. Without a reference:
+        the target, no acceleration, no torque.
+
+    Raises
+    ------
+    ValueError
+        If both ``reference`` and ``target`` are None.
+    """
     times = np.atleast_1d(np.asarray(times, dtype=float))
     rows = np.zeros((times.size, REFERENCE_FIELDS))
     if reference is None:

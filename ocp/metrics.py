@@ -18,22 +18,30 @@ METRIC_KEYS: tuple[str, ...] = (
     "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
     "fine_settling_time_s", "initial_rate_error",
 )
+"""Every key :func:`compute_metrics` returns; definitions and units in the README's "Metrics" table."""
 DEFAULT_SETTLING_TOLERANCE_DEG = 0.5
+"""deg, error band about the target attitude for ``settling_time_s``."""
 DEFAULT_DETUMBLE_TOLERANCE = 0.01
 """rad/s, bound on every body-rate component for ``detumble_time_s``."""
 
 
 def detumble_time(t: NDArray, omega: NDArray, tolerance: float = DEFAULT_DETUMBLE_TOLERANCE) -> float | None:
-    """First sample time after which ``max_i |ω_i| < tolerance`` holds to the end of the window.
+    """First sample time after which ``max_i |ω_i| < tolerance`` holds at every sample to the end.
 
     Parameters
     ----------
-    t : (N+1,) s; omega : (N+1, 3) rad/s, body rate; tolerance : rad/s.
+    t : (N+1,) ndarray
+        Sample times [s], increasing.
+    omega : (N+1, 3) ndarray
+        Body rate at ``t`` [rad/s], body axes.
+    tolerance : float, optional
+        Bound on every rate component [rad/s] (default :data:`DEFAULT_DETUMBLE_TOLERANCE`).
 
     Returns
     -------
     float or None
-        s; 0 if the bound holds throughout, ``None`` if it does not hold at the final sample.
+        ``t[j + 1]`` [s] for the last sample ``j`` at or above the bound; 0 if the bound holds
+        throughout, ``None`` if it does not hold at the final sample.
     """
     above = np.nonzero(np.max(np.abs(omega), axis=1) >= tolerance)[0]
     if above.size == 0:
@@ -52,8 +60,23 @@ def _integrate(t: NDArray, values: NDArray) -> NDArray:
 
 
 def settling_time(t: NDArray, error_deg: NDArray | None, tolerance_deg: float) -> float | None:
-    """First time (s) after which ``error_deg`` stays at or below ``tolerance_deg`` to the end;
-    ``None`` for a free attitude (``error_deg`` None) or when not settled by the last sample."""
+    """First sample time after which the error stays at or below the tolerance to the end.
+
+    Parameters
+    ----------
+    t : (N+1,) ndarray
+        Sample times [s], increasing.
+    error_deg : (N+1,) ndarray or None
+        Error angle to the target attitude at ``t`` [deg]; ``None`` for a free final attitude.
+    tolerance_deg : float
+        Settling band [deg].
+
+    Returns
+    -------
+    float or None
+        ``t[j + 1]`` [s] for the last sample ``j`` whose error exceeds the band; 0 if none does;
+        ``None`` for a free attitude or when the last sample is outside the band.
+    """
     if error_deg is None:
         return None
     above = np.nonzero(error_deg > tolerance_deg)[0]
@@ -83,27 +106,58 @@ def compute_metrics(
     inertia: ArrayLike | None = None,
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
 ) -> dict[str, Any]:
-    """Metrics of a motion sampled at times ``t`` (s).
+    """Metrics of a motion sampled at times ``t`` (definitions: the README's "Metrics" table).
+
+    Integrals of a quantity given once per interval (N values) use the zero-order hold
+    ``Σ_k (t_k+1 − t_k) f_k``; given at the N+1 sample times, trapezoids.
 
     Parameters
     ----------
-    q, omega : (N+1, 4), (N+1, 3) attitude and body rate (rad/s) at ``t``.
-    torque : (N, 3) body torque held over each interval (zero-order hold, closed loop), or
-        (N+1, 3) torque samples at ``t`` (a reference; integrated with trapezoids). N m.
-    target_q, target_omega : the manoeuvre's final attitude and rate (``None``: free).
-    reference_q : (N+1, 4) reference attitude at ``t`` for the tracking errors (closed loop).
-    wheel_momentum : (N+1, n_w) N m s; saturated : (N,) bool per sample.
-    initial_omega : (3,) rad/s, the manoeuvre's initial body rate ω0: gives ``initial_rate_error``
+    t : (N+1,) array_like
+        Sample times [s], increasing.
+    q : (N+1, 4) array_like
+        Attitude at ``t``, scalar-first quaternion, body to inertial.
+    omega : (N+1, 3) array_like
+        Body rate with respect to the inertial frame at ``t`` [rad/s], body axes.
+    torque : (N, 3) or (N+1, 3) array_like
+        Body torque [N m], body axes: held over each interval (closed loop, zero-order hold), or
+        sampled at ``t`` (a reference's feed-forward, trapezoids).
+    target_q : (4,) array_like or None
+        The manoeuvre's final attitude; ``None``: free (attitude metrics null).
+    target_omega : (3,) array_like or None, optional
+        The manoeuvre's final body rate [rad/s]; ``None``: free (``final_rate_error`` null).
+    reference_q : (N+1, 4) array_like or None, optional
+        Reference attitude at ``t`` for ``rms_error_deg`` and ``max_error_deg`` (closed loop).
+    wheel_momentum : (N+1, n_w) array_like or None, optional
+        Wheel spin momenta [N m s] for ``peak_wheel_momentum``; ``None`` or empty: null.
+    saturated : (N,) array_like of bool or None, optional
+        Whether any actuator was at its limit over each interval, for ``saturation_fraction``.
+    plan_time_s : float or None, optional
+        Wall time of the planner [s], copied to ``plan_time_s``.
+    duration_s : float or None, optional
+        The manoeuvre time T [s], copied to ``duration_s``.
+    settling_tolerance_deg : float, optional
+        Band about ``target_q`` for ``settling_time_s`` [deg] (default
+        :data:`DEFAULT_SETTLING_TOLERANCE_DEG`).
+    initial_omega : (3,) array_like or None, optional
+        The manoeuvre's initial body rate ω0 [rad/s]: gives ``initial_rate_error``
         ``‖ω(t_0) − ω0‖`` (a reference that leaves ω(0) free starts away from it).
-    settling_tolerance_deg, fine_settling_tolerance_deg : error angles (deg) of ``settling_time_s``
-        and of ``fine_settling_time_s`` (``None``: that metric is null).
-    dipole : (N, 3) A m², magnetorquer dipole held over each interval (``None``: no magnetorquers).
-    inertia : (3, 3) kg m², body inertia for ``energy_ratio`` (``None``: not computed).
-    detumble_tolerance : rad/s, bound on ``max_i |ω_i|`` for ``detumble_time_s``.
+    fine_settling_tolerance_deg : float or None, optional
+        Band for ``fine_settling_time_s`` [deg]; ``None``: that metric is null.
+    dipole : (N, 3) array_like or None, optional
+        Magnetorquer dipole held over each interval [A m^2], body axes, for ``int_dipole``;
+        ``None``: no magnetorquers (null).
+    inertia : (3, 3) array_like or None, optional
+        Body inertia [kg m^2] for ``energy_ratio``; ``None``: null.
+    detumble_tolerance : float, optional
+        Bound on ``max_i |ω_i|`` for ``detumble_time_s`` [rad/s] (default
+        :data:`DEFAULT_DETUMBLE_TOLERANCE`).
 
     Returns
     -------
-    dict with every key of :data:`METRIC_KEYS`; metrics that do not apply are ``None``.
+    dict of str to float, list of float or None
+        Every key of :data:`METRIC_KEYS` (``int_abs_u`` is a list of three per-axis integrals);
+        metrics that do not apply are ``None``.
     """
     t = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
@@ -160,8 +214,38 @@ def metrics_from_simulation(
     fine_settling_tolerance_deg: float | None = None,
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
 ) -> dict[str, Any]:
-    """Closed-loop metrics of an :class:`~ocp.simulator.SimulationResult`; ``reference`` (anything
-    with a vectorised ``q(t)``) gives the tracking errors."""
+    """Closed-loop metrics of a simulation, by :func:`compute_metrics`.
+
+    The torque is the applied actuator torque held over each sample, the dipole (with
+    magnetorquers) the applied one; ``inertia`` is the spacecraft's.
+
+    Parameters
+    ----------
+    result : ocp.simulator.SimulationResult
+        The simulated run (states at the sample times, applied controls and torques).
+    target_q : (4,) array_like or None
+        The manoeuvre's final attitude (scalar first, body to inertial); ``None``: free.
+    target_omega : (3,) array_like or None, optional
+        The manoeuvre's final body rate [rad/s]; ``None``: free.
+    reference : object or None, optional
+        Anything with a vectorised ``q(t)`` (a planner's reference): gives ``rms_error_deg`` and
+        ``max_error_deg``; ``None`` (regulation): those are null.
+    plan_time_s : float or None, optional
+        Wall time of the planner [s].
+    duration_s : float or None, optional
+        The manoeuvre time T [s].
+    settling_tolerance_deg : float, optional
+        Band for ``settling_time_s`` [deg].
+    fine_settling_tolerance_deg : float or None, optional
+        Band for ``fine_settling_time_s`` [deg]; ``None``: null.
+    detumble_tolerance : float, optional
+        Bound on ``max_i |ω_i|`` for ``detumble_time_s`` [rad/s].
+
+    Returns
+    -------
+    dict of str to float, list of float or None
+        Every key of :data:`METRIC_KEYS` (``initial_rate_error`` is null in closed loop).
+    """
     slices = result.model.control_slices
     dipole = result.applied_u[:, slices["dipole"]] if "dipole" in slices else None
     return compute_metrics(
@@ -187,19 +271,35 @@ def metrics_from_reference(
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
 ) -> dict[str, Any]:
     """Metrics of a reference's own motion and feed-forward torque over ``[0, duration]``,
-    sampled on ``points`` uniform times (trapezoidal integrals).
+    sampled on ``points`` uniform times (trapezoidal integrals), by :func:`compute_metrics`.
 
     Parameters
     ----------
-    reference : a planner's reference (vectorised ``q``, ``omega``, ``torque``, ``duration``).
-    target_q, target_omega : the manoeuvre's final attitude and rate (``None``: free).
-    points : number of uniform sample times.
-    settling_tolerance_deg : deg, the settling band about ``target_q``.
-    initial_omega : (3,) rad/s, the manoeuvre's ω0, for ``initial_rate_error``.
+    reference : planners.base.Reference
+        A planner's reference: vectorised ``q(t)``, ``omega(t)``, ``torque(t)`` (the rigid-body
+        feed-forward torque [N m], body axes), ``duration`` [s] and ``plan_time_s`` [s].
+    target_q : (4,) array_like or None
+        The manoeuvre's final attitude (scalar first, body to inertial); ``None``: free.
+    target_omega : (3,) array_like or None, optional
+        The manoeuvre's final body rate [rad/s]; ``None``: free.
+    points : int, optional
+        Number of uniform sample times, including both ends (default 2001).
+    settling_tolerance_deg : float, optional
+        Band about ``target_q`` for ``settling_time_s`` [deg].
+    initial_omega : (3,) array_like or None, optional
+        The manoeuvre's ω0 [rad/s], for ``initial_rate_error``; ``None``: null.
+    fine_settling_tolerance_deg : float or None, optional
+        Band for ``fine_settling_time_s`` [deg]; ``None``: null.
+    inertia : (3, 3) array_like or None, optional
+        Body inertia [kg m^2] for ``energy_ratio``; ``None``: null.
+    detumble_tolerance : float, optional
+        Bound on ``max_i |ω_i|`` for ``detumble_time_s`` [rad/s].
 
     Returns
     -------
-    dict with every key of :data:`METRIC_KEYS`.
+    dict of str to float, list of float or None
+        Every key of :data:`METRIC_KEYS`; the closed-loop-only ones (tracking errors,
+        saturation, wheel momentum, dipole) are null.
     """
     t = np.linspace(0.0, reference.duration, points)
     return compute_metrics(
@@ -217,7 +317,9 @@ def metric_violations(metrics: dict[str, Any] | None) -> list[str]:
 
     Parameters
     ----------
-    metrics : a mapping of metric keys to values (``None`` for metrics that do not apply).
+    metrics : dict or None
+        Metric keys to values (numbers, lists of numbers, or ``None`` for metrics that do not
+        apply); ``None``: no metrics, no violation.
 
     Returns
     -------

@@ -77,8 +77,15 @@ def _bounded_repr(value: Any, budget: int) -> str:
 
 
 class OptionsError(ValueError):
-    """An option is unknown, of the wrong type or out of range; ``path`` locates it, ``message``
-    says what was expected."""
+    """An option is unknown, of the wrong type or out of range.
+
+    Parameters
+    ----------
+    path : str
+        YAML path of the offending value (``planners[1].options.weight``), kept as :attr:`path`.
+    message : str
+        What was expected and what was given, kept as :attr:`message`.
+    """
 
     def __init__(self, path: str, message: str):
         super().__init__(f"{path}: {message}")
@@ -87,8 +94,15 @@ class OptionsError(ValueError):
 
 
 class InvalidOption(ValueError):
-    """Raised by an ``Options.__post_init__`` for a value that is wrong in relation to the others;
-    ``option`` is the field's name (``parse_options`` prefixes the YAML path)."""
+    """Raised by an ``Options.__post_init__`` for a value that is wrong in relation to the others.
+
+    Parameters
+    ----------
+    option : str
+        The field's name, kept as :attr:`option` (:func:`parse_options` prefixes the YAML path).
+    message : str
+        What is wrong, kept as :attr:`message`.
+    """
 
     def __init__(self, option: str, message: str):
         super().__init__(f"{option}: {message}")
@@ -102,10 +116,15 @@ class Range:
 
     Parameters
     ----------
-    ge, gt, le, lt : inclusive and exclusive bounds; ``None`` for no bound.
-    finite : reject NaN and infinities (default).
-    size : required number of entries of a vector option.
-    shape : required (rows, columns) of a matrix option.
+    ge, gt, le, lt : float or None, optional
+        Bounds ``>= ge``, ``> gt``, ``<= le``, ``< lt`` on every number, in the option's unit;
+        ``None`` (default): no such bound.
+    finite : bool, optional
+        Reject infinities (default True); NaN is always rejected.
+    size : int or None, optional
+        Required number of entries of a vector option (``None``: any).
+    shape : (int, int) or None, optional
+        Required (rows, columns) of a matrix option (``None``: any).
     """
 
     ge: float | None = None
@@ -117,13 +136,30 @@ class Range:
     shape: tuple[int, int] | None = None
 
     def describe(self) -> str:
-        """The range in words, e.g. ``a finite number > 0 and <= 1``."""
+        """The range in words, for error messages.
+
+        Returns
+        -------
+        str
+            E.g. ``a finite number > 0 and <= 1``.
+        """
         parts = [f"{op} {bound:g}" for op, bound in ((">=", self.ge), (">", self.gt), ("<=", self.le), ("<", self.lt))
                  if bound is not None]
         return ("a finite number" if self.finite else "a number") + (" " + " and ".join(parts) if parts else "")
 
     def violation(self, number: float) -> bool:
-        """Whether ``number`` lies outside the range."""
+        """Whether ``number`` lies outside the range.
+
+        Parameters
+        ----------
+        number : float
+            One number of an option's value.
+
+        Returns
+        -------
+        bool
+            True if it is NaN, infinite while ``finite``, or beyond a bound.
+        """
         if math.isnan(number) or (self.finite and math.isinf(number)):
             return True
         return ((self.ge is not None and not number >= self.ge) or (self.gt is not None and not number > self.gt)
@@ -143,7 +179,18 @@ def _split(annotation: Any) -> tuple[Any, Range | None]:
 
 
 def numeric_leaves(annotation: Any) -> bool:
-    """Whether a (non-Annotated) option type can hold numbers, which then need a :class:`Range`."""
+    """Whether an option type can hold numbers, which then need a :class:`Range`.
+
+    Parameters
+    ----------
+    annotation : type
+        A field type, without ``Annotated`` (``float``, ``list[float]``, ``int | None`` ...).
+
+    Returns
+    -------
+    bool
+        True if an ``int`` or ``float`` appears in it (in a union, list or tuple).
+    """
     origin = typing.get_origin(annotation)
     if annotation in NUMERIC:
         return True
@@ -161,11 +208,13 @@ def supported(annotation: Any) -> bool:
 
     Parameters
     ----------
-    annotation : a field type, without ``Annotated``.
+    annotation : type
+        A field type, without ``Annotated``.
 
     Returns
     -------
     bool
+        True for the types listed in :data:`SUPPORTED` and unions of them.
     """
     origin = typing.get_origin(annotation)
     if origin is Literal:
@@ -272,8 +321,21 @@ def _check_range(value: Any, bounds: Range, path: str) -> None:
 
 @functools.cache
 def option_fields(options_class: type) -> dict[str, tuple[Any, Range | None]]:
-    """``{name: (type, Range or None)}`` of an options dataclass (computed once per class: a
-    trade study validates every case's options; do not mutate the result)."""
+    """The fields of an options dataclass with their types and declared ranges.
+
+    Computed once per class (a trade study validates every case's options): do not mutate the
+    result.
+
+    Parameters
+    ----------
+    options_class : type
+        A dataclass whose fields are options (see the module docstring).
+
+    Returns
+    -------
+    dict of str to (type, Range or None)
+        ``{name: (type without Annotated, its Range or None)}`` in field order.
+    """
     hints = typing.get_type_hints(options_class, include_extras=True)
     return {f.name: _split(hints[f.name]) for f in dataclasses.fields(options_class)}
 
@@ -283,13 +345,19 @@ def parse_options(options_class: type[T], values: Mapping[str, Any] | T | None, 
 
     Parameters
     ----------
-    options_class : a dataclass whose fields are the options (see the module docstring).
-    values : the user's options.
-    path : YAML path of ``values``, used in error messages.
+    options_class : type
+        A dataclass whose fields are the options (see the module docstring).
+    values : mapping, options_class instance or None
+        The user's options (YAML keys to values); an instance is re-validated; ``None``: the
+        defaults.
+    path : str, optional
+        YAML path of ``values``, used in error messages (default ``"options"``).
 
     Returns
     -------
-    An instance of ``options_class``.
+    options_class
+        The validated options, numbers converted (an ``int`` given for a ``float`` option
+        becomes a ``float``).
 
     Raises
     ------
@@ -303,7 +371,8 @@ def parse_options(options_class: type[T], values: Mapping[str, Any] | T | None, 
         values = dataclasses.asdict(values)  # type: ignore[call-overload]
     if not isinstance(values, Mapping):
         raise OptionsError(path, f"expected a mapping of option names to values, got {excerpt(values)}")
-    fields = option_fields(options_class)
+    dataclass_type: type = options_class  # type[T] is hashable, which mypy cannot tell for a bare T
+    fields = option_fields(dataclass_type)
     for name, (annotation, _) in fields.items():
         if not supported(annotation):
             raise TypeError(f"{options_class.__qualname__}.{name}: option type {annotation} is not supported; "
@@ -335,15 +404,28 @@ class Configurable:
 
     Parameters
     ----------
-    options : a mapping of option values, an ``Options`` instance, or ``None`` for the defaults.
-    path : YAML path of the options, for error messages.
+    options : mapping, Options instance or None, optional
+        Option values by name (the YAML ``options`` mapping), an ``Options`` instance, or
+        ``None`` (default) for the defaults; validated by :func:`parse_options` into
+        :attr:`options`.
+    path : str, optional
+        YAML path of the options, for error messages (default ``"options"``).
+
+    Raises
+    ------
+    OptionsError
+        For an unknown option, a value of the wrong type or out of its range.
+    TypeError
+        If the subclass's ``Options`` is not a dataclass.
     """
 
     name: ClassVar[str]
 
     @dataclasses.dataclass(frozen=True)
     class Options:
-        pass
+        """The component's options: subclasses replace this empty dataclass by their own
+        ``@dataclass(frozen=True) class Options`` whose fields are the YAML keys, each typed with
+        its :class:`Range` and given a default."""
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
         if not dataclasses.is_dataclass(self.Options):

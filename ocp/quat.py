@@ -16,7 +16,20 @@ IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
 
 
 def product(p: ArrayLike, q: ArrayLike) -> Array:
-    """Hamilton product ``p ⊗ q``."""
+    """Hamilton product ``p ⊗ q``.
+
+    With the body-to-inertial convention, ``R(p ⊗ q) = R(p) R(q)``: ``q`` is applied first.
+
+    Parameters
+    ----------
+    p, q : (..., 4) array_like
+        Quaternions, scalar first; broadcast against each other. Not required to be unit.
+
+    Returns
+    -------
+    (..., 4) ndarray
+        The product, scalar first.
+    """
     p = np.asarray(p, dtype=float)
     q = np.asarray(q, dtype=float)
     p0, pv = p[..., :1], p[..., 1:]
@@ -27,13 +40,34 @@ def product(p: ArrayLike, q: ArrayLike) -> Array:
 
 
 def conjugate(q: ArrayLike) -> Array:
-    """Conjugate ``q*`` (the inverse of a unit quaternion)."""
+    """Conjugate ``q* = [q0, -q1, -q2, -q3]``, the inverse of a unit quaternion.
+
+    Parameters
+    ----------
+    q : (..., 4) array_like
+        Quaternion(s), scalar first.
+
+    Returns
+    -------
+    (..., 4) ndarray
+        The conjugate; for a unit ``q`` it rotates inertial vectors to body axes.
+    """
     q = np.asarray(q, dtype=float)
     return q * np.array([1.0, -1.0, -1.0, -1.0])
 
 
 def normalize(q: ArrayLike) -> Array:
-    """Unit quaternion along ``q`` (shape ``(..., 4)``; any vector length is normalised alike).
+    """Unit quaternion along ``q``.
+
+    Parameters
+    ----------
+    q : (..., 4) array_like
+        Quaternion(s) of any non-zero norm (any last-axis length is normalised alike).
+
+    Returns
+    -------
+    (..., 4) ndarray
+        ``q / ‖q‖`` along the last axis; the sign is kept.
 
     Raises
     ------
@@ -48,7 +82,18 @@ def normalize(q: ArrayLike) -> Array:
 
 
 def rotation_matrix(q: ArrayLike) -> Array:
-    """Rotation matrix ``R(q)`` with ``v_I = R v_B``; shape ``(..., 3, 3)``."""
+    """Rotation matrix ``R(q)`` that takes body components to inertial ones, ``v_I = R v_B``.
+
+    Parameters
+    ----------
+    q : (..., 4) array_like
+        Unit attitude quaternion(s), scalar first, body to inertial. Not normalised here.
+
+    Returns
+    -------
+    (..., 3, 3) ndarray
+        ``R(q)``; its columns are the body axes in inertial components.
+    """
     q = np.asarray(q, dtype=float)
     q0, q1, q2, q3 = (q[..., i] for i in range(4))
     rows = [
@@ -60,18 +105,57 @@ def rotation_matrix(q: ArrayLike) -> Array:
 
 
 def rotate(q: ArrayLike, v_body: ArrayLike) -> Array:
-    """Body vector(s) expressed in the inertial frame, ``R(q) v``."""
+    """Body vector(s) expressed in the inertial frame, ``v_I = R(q) v_B``.
+
+    Parameters
+    ----------
+    q : (..., 4) array_like
+        Unit attitude quaternion(s), scalar first, body to inertial.
+    v_body : (..., 3) array_like
+        Vector(s) in body components (any unit); broadcast against ``q``.
+
+    Returns
+    -------
+    (..., 3) ndarray
+        The same vector(s) in inertial components (same unit).
+    """
     return np.einsum("...ij,...j->...i", rotation_matrix(q), np.asarray(v_body, dtype=float))
 
 
 def rotate_inverse(q: ArrayLike, v_inertial: ArrayLike) -> Array:
-    """Inertial vector(s) expressed in the body frame, ``R(q)ᵀ v``."""
+    """Inertial vector(s) expressed in the body frame, ``v_B = R(q)ᵀ v_I``.
+
+    Parameters
+    ----------
+    q : (..., 4) array_like
+        Unit attitude quaternion(s), scalar first, body to inertial.
+    v_inertial : (..., 3) array_like
+        Vector(s) in inertial components (any unit); broadcast against ``q``.
+
+    Returns
+    -------
+    (..., 3) ndarray
+        The same vector(s) in body components (same unit).
+    """
     return np.einsum("...ji,...j->...i", rotation_matrix(q), np.asarray(v_inertial, dtype=float))
 
 
 def from_rotation_matrix(matrix: ArrayLike) -> Array:
-    """Unit quaternion of a rotation matrix ``R`` (inverse of :func:`rotation_matrix`),
-    by Shepperd's method: the largest of the four squared components sets the branch."""
+    """Unit quaternion of a rotation matrix (inverse of :func:`rotation_matrix`).
+
+    Shepperd's method: the largest of the four squared components selects the branch, so the
+    result is accurate for every rotation, 180° included.
+
+    Parameters
+    ----------
+    matrix : (..., 3, 3) array_like
+        Proper orthogonal matrix ``R`` with ``v_I = R v_B`` (body to inertial).
+
+    Returns
+    -------
+    (..., 4) ndarray
+        Unit quaternion, scalar first, with the sign chosen so that ``q0 >= 0``.
+    """
     m = np.asarray(matrix, dtype=float)
     trace = np.trace(m, axis1=-2, axis2=-1)
     squares = np.stack(
@@ -97,7 +181,26 @@ def from_rotation_matrix(matrix: ArrayLike) -> Array:
 
 
 def error(q: ArrayLike, q_ref: ArrayLike, shortest: bool = True) -> Array:
-    """Attitude error ``q_e = q_ref* ⊗ q``; with ``shortest`` the sign gives ``q_e0 >= 0``."""
+    """Attitude error ``q_e = q_ref* ⊗ q``: the rotation from the reference to the actual body frame.
+
+    ``R(q_e) = R(q_ref)ᵀ R(q)`` takes actual-body components to reference-body components; its
+    vector part is in body axes (the same in both frames).
+
+    Parameters
+    ----------
+    q : (..., 4) array_like
+        Actual attitude(s), scalar first, body to inertial.
+    q_ref : (..., 4) array_like
+        Reference (desired) attitude(s), same convention; broadcast against ``q``.
+    shortest : bool, optional
+        If True (default), flip the sign where needed so that ``q_e0 >= 0`` (the rotation of at
+        most 180°); if False, return the raw product.
+
+    Returns
+    -------
+    (..., 4) ndarray
+        Error quaternion, scalar first; the identity when ``q == ±q_ref``.
+    """
     q_e = product(conjugate(q_ref), q)
     if shortest:
         q_e = np.where(q_e[..., :1] < 0.0, -q_e, q_e)
@@ -105,13 +208,42 @@ def error(q: ArrayLike, q_ref: ArrayLike, shortest: bool = True) -> Array:
 
 
 def error_angle(q: ArrayLike, q_ref: ArrayLike) -> Array:
-    """Rotation angle between two attitudes, ``2 acos|q_e0|`` in rad, computed with atan2."""
+    """Rotation angle between two attitudes, ``2 acos|q_e0|`` with ``q_e = q_ref* ⊗ q``.
+
+    Computed as ``2 atan2(‖q_e,v‖, |q_e0|)``, accurate near 0 and 180°; insensitive to the sign
+    of either quaternion.
+
+    Parameters
+    ----------
+    q : (..., 4) array_like
+        Actual attitude(s), scalar first, body to inertial (unit).
+    q_ref : (..., 4) array_like
+        Reference attitude(s), same convention; broadcast against ``q``.
+
+    Returns
+    -------
+    (...) ndarray
+        Angle [rad], in [0, π].
+    """
     q_e = product(conjugate(q_ref), q)
     return 2.0 * np.arctan2(np.linalg.norm(q_e[..., 1:], axis=-1), np.abs(q_e[..., 0]))
 
 
 def from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> Array:
-    """Quaternion of a rotation by ``angle`` (rad) about ``axis`` (normalised here).
+    """Quaternion of a rotation by ``angle`` about ``axis``.
+
+    Parameters
+    ----------
+    axis : (..., 3) array_like
+        Rotation axis, any non-zero length (normalised here). For an attitude the axis has the
+        same components in body and inertial axes.
+    angle : (...) array_like
+        Rotation angle [rad], right-handed about ``axis``; broadcast against ``axis``.
+
+    Returns
+    -------
+    (..., 4) ndarray
+        Unit quaternion ``[cos(angle/2), sin(angle/2) axis/‖axis‖]``, scalar first.
 
     Raises
     ------
@@ -130,7 +262,18 @@ def from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> Array:
 
 
 def from_rotation_vector(rotvec: ArrayLike) -> Array:
-    """Quaternion of the rotation vector ``θ e`` (rad); exact at and near zero."""
+    """Quaternion of the rotation vector ``θ e`` (the exponential map), exact at and near zero.
+
+    Parameters
+    ----------
+    rotvec : (..., 3) array_like
+        Rotation vector [rad]: unit axis ``e`` times angle ``θ``.
+
+    Returns
+    -------
+    (..., 4) ndarray
+        Unit quaternion ``[cos(θ/2), sin(θ/2) e]``, scalar first.
+    """
     rotvec = np.asarray(rotvec, dtype=float)
     angle = np.linalg.norm(rotvec, axis=-1, keepdims=True)
     # sin(θ/2)/θ = 0.5 sinc(θ/2π): numpy's sinc is exact at zero.
@@ -138,7 +281,19 @@ def from_rotation_vector(rotvec: ArrayLike) -> Array:
 
 
 def to_rotation_vector(q: ArrayLike) -> Array:
-    """Rotation vector (rad) of the shortest rotation represented by ``q``."""
+    """Rotation vector of the shortest rotation represented by ``q`` (inverse of
+    :func:`from_rotation_vector`).
+
+    Parameters
+    ----------
+    q : (..., 4) array_like
+        Unit quaternion(s), scalar first; ``q`` and ``-q`` give the same result.
+
+    Returns
+    -------
+    (..., 3) ndarray
+        Rotation vector ``θ e`` [rad] with ``θ`` in [0, π].
+    """
     q = np.asarray(q, dtype=float)
     q = np.where(q[..., :1] < 0.0, -q, q)
     vec_norm = np.linalg.norm(q[..., 1:], axis=-1, keepdims=True)
@@ -148,19 +303,61 @@ def to_rotation_vector(q: ArrayLike) -> Array:
 
 
 def from_scalar_last(q_xyzw: ArrayLike) -> Array:
-    """Convert ``[q1, q2, q3, q4]`` with the scalar last (the nano and Vepa papers) to ours."""
+    """Reorder a scalar-last quaternion ``[q1, q2, q3, q4]`` (``q4`` the scalar, as in the
+    nano-spacecraft and Vepa papers) to our scalar-first order.
+
+    Parameters
+    ----------
+    q_xyzw : (..., 4) array_like
+        Quaternion(s), vector part first, scalar last.
+
+    Returns
+    -------
+    (..., 4) ndarray
+        The same quaternion(s), scalar first. Only the order changes: the papers' quaternion
+        must follow the same Hamilton, body-to-inertial convention for the result to mean the
+        same attitude.
+    """
     q = np.asarray(q_xyzw, dtype=float)
     return np.concatenate([q[..., 3:], q[..., :3]], axis=-1)
 
 
 def to_scalar_last(q: ArrayLike) -> Array:
-    """Convert a scalar-first quaternion to scalar-last order."""
+    """Reorder a scalar-first quaternion to scalar-last order (inverse of :func:`from_scalar_last`).
+
+    Parameters
+    ----------
+    q : (..., 4) array_like
+        Quaternion(s), scalar first.
+
+    Returns
+    -------
+    (..., 4) ndarray
+        ``[q1, q2, q3, q0]``.
+    """
     q = np.asarray(q, dtype=float)
     return np.concatenate([q[..., 1:], q[..., :1]], axis=-1)
 
 
 def slerp(q_start: ArrayLike, q_end: ArrayLike, s: ArrayLike) -> Array:
-    """Spherical linear interpolation along the shortest arc, ``s`` in [0, 1]."""
+    """Spherical linear interpolation from ``q_start`` to ``q_end`` along the shortest arc.
+
+    The result rotates at constant rate about a fixed body axis (the axis of
+    ``q_start* ⊗ q_end``): ``q_start ⊗ exp(s θ e / 2)``.
+
+    Parameters
+    ----------
+    q_start, q_end : (4,) or (..., 4) array_like
+        Unit attitudes, scalar first, body to inertial.
+    s : (...) array_like
+        Interpolation fraction; 0 gives ``q_start``, 1 gives ``±q_end`` (the sign that makes the
+        arc shortest). Values outside [0, 1] extrapolate.
+
+    Returns
+    -------
+    (..., 4) ndarray
+        Unit quaternion(s), scalar first.
+    """
     q_start = np.asarray(q_start, dtype=float)
     q_e = error(q_end, q_start)  # q_start* ⊗ q_end with q_e0 >= 0
     rotvec = to_rotation_vector(q_e)
@@ -169,12 +366,38 @@ def slerp(q_start: ArrayLike, q_end: ArrayLike, s: ArrayLike) -> Array:
 
 
 def kinematics(q: ArrayLike, omega: ArrayLike) -> Array:
-    """Quaternion rate ``q̇ = ½ q ⊗ [0, ω]`` with ω in body axes (rad/s)."""
+    """Quaternion rate ``q̇ = ½ q ⊗ [0, ω]``.
+
+    Parameters
+    ----------
+    q : (..., 4) array_like
+        Attitude quaternion(s), scalar first, body to inertial.
+    omega : (..., 3) array_like
+        Body angular rate with respect to the inertial frame, body axes [rad/s].
+
+    Returns
+    -------
+    (..., 4) ndarray
+        ``q̇`` [1/s], scalar first.
+    """
     omega = np.asarray(omega, dtype=float)
     return 0.5 * product(q, np.concatenate([np.zeros(omega.shape[:-1] + (1,)), omega], axis=-1))
 
 
 def random_unit(rng: np.random.Generator, size: int | None = None) -> Array:
-    """Uniformly distributed random unit quaternion(s)."""
+    """Random unit quaternion(s), uniformly distributed over rotations (normalised Gaussian 4-vectors).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of the random numbers.
+    size : int or None, optional
+        Number of quaternions; ``None`` returns a single one.
+
+    Returns
+    -------
+    (4,) or (size, 4) ndarray
+        Unit quaternion(s), scalar first (either sign).
+    """
     shape = (4,) if size is None else (size, 4)
     return normalize(rng.standard_normal(shape))

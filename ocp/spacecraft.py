@@ -6,7 +6,9 @@ loader) can point at the input that caused it.
 """
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -15,7 +17,16 @@ Array = NDArray[np.float64]
 
 
 class ModelError(ValueError):
-    """Invalid model parameter; ``field`` names the attribute (e.g. ``"inertia"``)."""
+    """Invalid model parameter.
+
+    Parameters
+    ----------
+    field_name : str
+        The offending attribute (e.g. ``"inertia"``), kept as :attr:`field` so that the YAML
+        loader can point at the input.
+    message : str
+        What was wrong and what was expected, kept as :attr:`message`.
+    """
 
     def __init__(self, field_name: str, message: str):
         super().__init__(f"{field_name}: {message}")
@@ -36,29 +47,48 @@ def _limit_vector(value: ArrayLike | None, size: int, field_name: str) -> Array:
     return array
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class ReactionWheels:
-    """Array of ``n`` reaction wheels.
+    """Array of ``n`` reaction wheels; wheel ``i`` stores spin momentum ``h_i`` about its axis and
+    its motor torque ``g_i = ḣ_i`` reacts on the body as ``−a_i g_i``.
+
+    The attributes hold the normalised values: ``axes`` unit columns, the limits as (n,) arrays
+    (``inf`` where unlimited).
 
     Parameters
     ----------
-    axes : (3, n) array
-        Unit spin axes in body axes (normalised on construction).
-    max_torque : scalar or (n,), N m
-        Motor torque limit per wheel (``None``: unlimited).
-    max_momentum : scalar or (n,), N m s
-        Wheel momentum limit per wheel (``None``: unlimited).
-    spin_inertia : scalar or (n,), kg m², optional
-        Wheel spin inertia, only used to report wheel speeds.
-    failed : tuple of int
-        Indices of failed wheels; they produce no torque.
+    axes : (3, n) array_like
+        Spin axes, body frame, one column per wheel; normalised on construction.
+    max_torque : float or (n,) array_like, optional
+        Motor torque limit per wheel [N m], positive; ``None`` (default): unlimited.
+    max_momentum : float or (n,) array_like, optional
+        Spin momentum limit per wheel [N m s], positive; ``None`` (default): unlimited.
+    spin_inertia : float or (n,) array_like, optional
+        Wheel spin inertia [kg m^2], positive, only used to report wheel speeds; ``None``
+        (default): not known, stays ``None``.
+    failed : iterable of int, optional
+        Indices (0-based) of failed wheels, each listed once; they produce no torque. Stored as a
+        tuple.
+
+    Raises
+    ------
+    ModelError
+        For a malformed axis matrix, a zero axis, a non-positive or mis-sized limit, or a bad
+        failed-wheel index.
     """
 
     axes: Array
-    max_torque: Array | float | None = None
-    max_momentum: Array | float | None = None
-    spin_inertia: Array | float | None = None
-    failed: tuple[int, ...] = ()
+    max_torque: Array
+    max_momentum: Array
+    spin_inertia: Array | None
+    failed: tuple[int, ...]
+
+    def __init__(self, axes: ArrayLike, max_torque: ArrayLike | None = None, max_momentum: ArrayLike | None = None,
+                 spin_inertia: ArrayLike | None = None, failed: Iterable[int] = ()) -> None:
+        for name, value in (("axes", axes), ("max_torque", max_torque), ("max_momentum", max_momentum),
+                            ("spin_inertia", spin_inertia), ("failed", failed)):
+            object.__setattr__(self, name, value)
+        self.__post_init__()
 
     def __post_init__(self) -> None:
         axes = np.asarray(self.axes, dtype=float)
@@ -81,18 +111,32 @@ class ReactionWheels:
         object.__setattr__(self, "failed", failed)
 
     @classmethod
-    def from_body_axes(cls, n_axes: int = 3, **limits) -> "ReactionWheels":
-        """Wheels along the first ``n_axes`` body axes."""
+    def from_body_axes(cls, n_axes: int = 3, **limits: Any) -> "ReactionWheels":
+        """Wheels along the first ``n_axes`` body axes (x, then y, then z).
+
+        Parameters
+        ----------
+        n_axes : int, optional
+            Number of wheels, 1 to 3 (default 3).
+        **limits : float, array_like or None
+            ``max_torque``, ``max_momentum``, ``spin_inertia`` or ``failed``, as in the
+            constructor.
+
+        Returns
+        -------
+        ReactionWheels
+            Wheels with ``axes = eye(3)[:, :n_axes]``.
+        """
         return cls(axes=np.eye(3)[:, :n_axes], **limits)
 
     @property
     def count(self) -> int:
-        """Number of wheels, failed ones included."""
+        """Number of wheels ``n``, failed ones included."""
         return self.axes.shape[1]
 
     @property
-    def working(self) -> Array:
-        """Boolean mask of working wheels."""
+    def working(self) -> NDArray[np.bool_]:
+        """(n,) bool mask, True for the wheels that are not in :attr:`failed`."""
         mask = np.ones(self.count, dtype=bool)
         mask[list(self.failed)] = False
         return mask
@@ -101,17 +145,34 @@ class ReactionWheels:
 SATURATION_MODES = ("per_axis", "scale")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Magnetorquers:
-    """Three orthogonal magnetorquers along the body axes; dipole limit per axis in A m².
+    """Three orthogonal magnetorquers along the body axes; the dipole ``m`` [A m^2], body frame,
+    gives the torque ``m × B`` with ``B`` the geomagnetic field in body axes.
 
-    ``saturation``: ``"per_axis"`` clips each axis to its limit (the direction may change);
-    ``"scale"`` scales the whole dipole vector down until every axis is within its limit (the
-    direction is kept).
+    Parameters
+    ----------
+    max_dipole : float or (3,) array_like, optional
+        Dipole limit per body axis [A m^2], positive; stored as a (3,) array. ``None`` (default):
+        unlimited (``inf``).
+    saturation : {"per_axis", "scale"}, optional
+        ``"per_axis"`` (default) clips each axis to its limit (the direction may change);
+        ``"scale"`` scales the whole dipole vector down until every axis is within its limit
+        (the direction is kept).
+
+    Raises
+    ------
+    ModelError
+        For a non-positive or mis-sized limit or an unknown saturation mode.
     """
 
-    max_dipole: Array | float | None = None
-    saturation: str = "per_axis"
+    max_dipole: Array
+    saturation: str
+
+    def __init__(self, max_dipole: ArrayLike | None = None, saturation: str = "per_axis") -> None:
+        object.__setattr__(self, "max_dipole", max_dipole)
+        object.__setattr__(self, "saturation", saturation)
+        self.__post_init__()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "max_dipole", _limit_vector(self.max_dipole, 3, "max_dipole"))
@@ -119,34 +180,68 @@ class Magnetorquers:
             raise ModelError("saturation", f"expected one of {SATURATION_MODES}, got {str(self.saturation)[:40]!r}")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Torquers:
-    """Ideal body-axis torquers (thrusters); torque limit per axis in N m, no stored momentum."""
+    """Ideal body-axis torquers (e.g. thrusters): the commanded torque acts on the body directly,
+    with no stored momentum.
 
-    max_torque: Array | float | None = None
+    Parameters
+    ----------
+    max_torque : float or (3,) array_like, optional
+        Torque limit per body axis [N m], positive; stored as a (3,) array. ``None`` (default):
+        unlimited (``inf``).
+
+    Raises
+    ------
+    ModelError
+        For a non-positive or mis-sized limit.
+    """
+
+    max_torque: Array
+
+    def __init__(self, max_torque: ArrayLike | None = None) -> None:
+        object.__setattr__(self, "max_torque", max_torque)
+        self.__post_init__()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "max_torque", _limit_vector(self.max_torque, 3, "max_torque"))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Spacecraft:
-    """Rigid spacecraft with its actuators.
+    """Rigid spacecraft with its actuators. ``inertia`` holds the (3, 3) matrix after construction.
 
     Parameters
     ----------
-    inertia : (3,) or (3, 3), kg m²
-        Principal moments or the full inertia matrix about the centre of mass, body axes.
-        It must be symmetric positive definite and its principal moments must satisfy the
+    inertia : (3,) or (3, 3) array_like
+        Principal moments, or the full inertia matrix, about the centre of mass [kg m^2], body
+        frame. It must be symmetric positive definite and its principal moments must satisfy the
         triangle inequalities (``I_i + I_j >= I_k``).
-    wheels, magnetorquers, torquers : optional actuators.
+    wheels : ReactionWheels or None, optional
+        Reaction wheels (default none).
+    magnetorquers : Magnetorquers or None, optional
+        Magnetorquers (default none); they need a magnetic field in the environment to act.
+    torquers : Torquers or None, optional
+        Ideal body-axis torquers (default none).
+
+    Raises
+    ------
+    ModelError
+        For an actuator of the wrong type or an inertia that is not a valid rigid body's.
     """
 
     inertia: Array
-    wheels: ReactionWheels | None = None
-    magnetorquers: Magnetorquers | None = None
-    torquers: Torquers | None = None
-    _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+    wheels: ReactionWheels | None
+    magnetorquers: Magnetorquers | None
+    torquers: Torquers | None
+    _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __init__(self, inertia: ArrayLike, wheels: ReactionWheels | None = None,
+                 magnetorquers: Magnetorquers | None = None, torquers: Torquers | None = None) -> None:
+        for name, value in (("inertia", inertia), ("wheels", wheels), ("magnetorquers", magnetorquers),
+                            ("torquers", torquers), ("_cache", {})):
+            object.__setattr__(self, name, value)
+        self.__post_init__()
 
     def __post_init__(self) -> None:
         for name, kind in (("wheels", ReactionWheels), ("magnetorquers", Magnetorquers), ("torquers", Torquers)):
@@ -176,11 +271,13 @@ class Spacecraft:
 
     @property
     def n_wheels(self) -> int:
+        """Number of wheels, failed ones included (0 without wheels)."""
         return 0 if self.wheels is None else self.wheels.count
 
     @property
     def wheel_axes(self) -> Array:
-        """(3, n_w) wheel axes; (3, 0) without wheels."""
+        """(3, n_w) unit wheel spin axes, body frame, the matrix ``A`` of the dynamics; (3, 0)
+        without wheels."""
         return np.zeros((3, 0)) if self.wheels is None else self.wheels.axes
 
     @property
@@ -189,49 +286,57 @@ class Spacecraft:
         return bool(np.allclose(self.inertia, np.diag(np.diag(self.inertia)), rtol=0, atol=1e-12 * np.max(self.inertia)))
 
     def body_torque_limit(self) -> Array:
-        """Per-body-axis torque bound (N m) that the actuators can apply simultaneously on all axes.
+        """Per-body-axis torque bound that the actuators can apply simultaneously on all axes.
 
         Torquers add their per-axis limit. For wheels the box ``|τ_i| <= b_i`` is the largest
         (smallest bound, then by sum) box whose every corner the working wheels realise through ``g = -A⁺ τ`` within
         their torque limits, found by a small linear programme; axes the wheels cannot reach get 0.
         Magnetorquers are not included: their torque depends on the field.
+
+        Returns
+        -------
+        (3,) ndarray
+            Bound ``b`` [N m], body axes; ``inf`` on an axis whose actuators are unlimited. A copy
+            (computed once per spacecraft).
         """
         if "torque_limit" not in self._cache:
             limit = np.zeros(3)
             if self.torquers is not None:
                 limit += self.torquers.max_torque
             if self.wheels is not None and np.any(self.wheels.working):
-                limit += self._wheel_box()
+                limit += _wheel_box(self.wheels)
             self._cache["torque_limit"] = limit
         return self._cache["torque_limit"].copy()
 
-    def _wheel_box(self) -> Array:
-        axes = self.wheels.axes[:, self.wheels.working]
-        g_max = self.wheels.max_torque[self.wheels.working]
-        if np.all(np.isinf(g_max)):
-            return np.full(3, np.inf)
-        pinv = np.linalg.pinv(axes)
-        reachable = np.linalg.norm(axes @ pinv - np.eye(3), axis=0) < 1e-9
-        finite = np.isfinite(g_max)
-        demand = np.abs(pinv[finite]) * reachable
-        significant = demand > 1e-12 * max(float(demand.max(initial=0.0)), 1e-300)
-        if np.all(significant.sum(axis=1) <= 1):
-            # Each wheel drives one body axis (e.g. wheels along the body axes): the programme
-            # decouples and each axis gets the bound of its tightest wheel.
-            ratios = np.where(significant, g_max[finite][:, None] / np.where(significant, demand, 1.0), np.inf)
-            return np.where(reachable, ratios.min(axis=0, initial=np.inf), 0.0)
-        from scipy.optimize import linprog  # lazily: scipy.optimize dominates the import of slewbench
 
-        # Lexicographic: first the largest bound common to every reachable axis, then the
-        # largest sum with no axis below it, so that no axis is sacrificed for the others.
-        n_reach = int(reachable.sum())
-        common = linprog(
-            c=[-1.0], A_ub=demand.sum(axis=1, keepdims=True), b_ub=g_max[finite], bounds=[(0, None)]
-        ).x[0] if n_reach else 0.0
-        result = linprog(
-            c=-reachable.astype(float),
-            A_ub=demand,
-            b_ub=g_max[finite],
-            bounds=[(common * (1 - 1e-9), None) if r else (0, 0) for r in reachable],
-        )
-        return np.where(reachable, result.x, 0.0)
+def _wheel_box(wheels: ReactionWheels) -> Array:
+    """Per-axis torque box [N m] of the working wheels (see :meth:`Spacecraft.body_torque_limit`)."""
+    axes = wheels.axes[:, wheels.working]
+    g_max = wheels.max_torque[wheels.working]
+    if np.all(np.isinf(g_max)):
+        return np.full(3, np.inf)
+    pinv = np.linalg.pinv(axes)
+    reachable = np.linalg.norm(axes @ pinv - np.eye(3), axis=0) < 1e-9
+    finite = np.isfinite(g_max)
+    demand = np.abs(pinv[finite]) * reachable
+    significant = demand > 1e-12 * max(float(demand.max(initial=0.0)), 1e-300)
+    if np.all(significant.sum(axis=1) <= 1):
+        # Each wheel drives one body axis (e.g. wheels along the body axes): the programme
+        # decouples and each axis gets the bound of its tightest wheel.
+        ratios = np.where(significant, g_max[finite][:, None] / np.where(significant, demand, 1.0), np.inf)
+        return np.where(reachable, ratios.min(axis=0, initial=np.inf), 0.0)
+    from scipy.optimize import linprog  # lazily: scipy.optimize dominates the import of slewbench
+
+    # Lexicographic: first the largest bound common to every reachable axis, then the
+    # largest sum with no axis below it, so that no axis is sacrificed for the others.
+    n_reach = int(reachable.sum())
+    common = linprog(
+        c=[-1.0], A_ub=demand.sum(axis=1, keepdims=True), b_ub=g_max[finite], bounds=[(0, None)]
+    ).x[0] if n_reach else 0.0
+    result = linprog(
+        c=-reachable.astype(float),
+        A_ub=demand,
+        b_ub=g_max[finite],
+        bounds=[(common * (1 - 1e-9), None) if r else (0, 0) for r in reachable],
+    )
+    return np.where(reachable, result.x, 0.0)

@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from controllers import CONTROLLERS
 from ocp.simulator import SUBSTEPS_PER_SAMPLE
 from planners import PLANNERS, ManeuverProblem
@@ -16,7 +18,20 @@ if TYPE_CHECKING:
 
 
 def check_row_labels(planners: list[PlannerSpec], controllers: list[ControllerSpec]) -> None:
-    """Rows are labelled ``"<planner> / <controller>"`` with several controllers: those must differ."""
+    """Rows are labelled ``"<planner> / <controller>"`` with several controllers: those must differ.
+
+    Parameters
+    ----------
+    planners : list of PlannerSpec
+        The scenario's planner rows.
+    controllers : list of ControllerSpec
+        The scenario's controllers.
+
+    Raises
+    ------
+    ScenarioError
+        At ``<controller path>.label`` when two pairs make the same row label.
+    """
     if len(controllers) < 2:
         return
     seen: dict[str, tuple[int, int]] = {}
@@ -33,7 +48,21 @@ def check_row_labels(planners: list[PlannerSpec], controllers: list[ControllerSp
 def check_work(problem: ManeuverProblem, simulation: SimulationSpec) -> None:
     """Refuse a closed-loop window with more samples than ``simulation.max_samples`` (the run
     would take too long or exhaust memory); the runner checks again once a planner has chosen
-    its own duration."""
+    its own duration.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre (its ``duration`` [s] is the window unless ``simulation.duration`` is set).
+    simulation : SimulationSpec
+        Sample time [s], window [s], integrator, RK4 step [s] and sample limit.
+
+    Raises
+    ------
+    ScenarioError
+        At ``simulation.duration`` or ``maneuver.duration`` (too many samples) or
+        ``simulation.max_step`` (too many RK4 sub-steps).
+    """
     window = simulation.duration or problem.duration
     samples = math.ceil(window / simulation.sample_time - 1e-9)
     substeps = 1 if simulation.integrator != "rk4" else math.ceil(simulation.sample_time / simulation.max_step - 1e-9)
@@ -51,7 +80,27 @@ def check_work(problem: ManeuverProblem, simulation: SimulationSpec) -> None:
 def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
                         controllers: list[ControllerSpec] | ControllerSpec,
                         simulation: SimulationSpec | None = None) -> None:
-    """What each planner and controller say they cannot take, reported at their YAML entries."""
+    """What each planner and controller say they cannot take, reported at their YAML entries.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre, with its spacecraft and environment.
+    planners : list of PlannerSpec
+        The planner rows (empty: regulation mode).
+    controllers : list of ControllerSpec or ControllerSpec
+        The controllers (one spec is accepted as a list of one).
+    simulation : SimulationSpec or None, optional
+        Closed-loop settings; ``None`` skips the sample-time checks.
+
+    Raises
+    ------
+    ScenarioError
+        At ``planners[i]`` (``problem_error``), ``<controller path>.name`` (environment, planner or
+        reference needed), ``maneuver.<key>`` (initial or final state),
+        ``<controller path>.options.<option>`` (sample time) or ``maneuver.final.q`` (a target
+        attitude needed in regulation mode).
+    """
     if not isinstance(controllers, list):  # one ControllerSpec
         controllers = [controllers]
     for index, spec in enumerate(planners):
@@ -64,13 +113,17 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
         error = law.environment_error(problem.spacecraft, problem.environment)
         if error:
             raise ScenarioError(where, error)
-        state = law.initial_state_error(problem.spacecraft, problem.omega0, problem.wheel_momentum0, problem.omegaf)
+        momentum0 = problem.wheel_momentum0
+        if momentum0 is None:  # ManeuverProblem fills it in; its field's type still admits None
+            momentum0 = np.zeros(problem.spacecraft.n_wheels)
+        state = law.initial_state_error(problem.spacecraft, problem.omega0, momentum0, problem.omegaf)
         if state:
             raise ScenarioError(f"maneuver.{state[0]}", f"{state[1]} ({controller.path} is {controller.name!r})")
-        timing = None if simulation is None else law.sample_time_error(simulation.sample_time)
-        if timing:
-            raise ScenarioError(f"{controller.path}.options.{timing[0]}",
-                                f"{timing[1]} (simulation.sample_time is {simulation.sample_time:g} s)")
+        if simulation is not None:
+            timing = law.sample_time_error(simulation.sample_time)
+            if timing:
+                raise ScenarioError(f"{controller.path}.options.{timing[0]}",
+                                    f"{timing[1]} (simulation.sample_time is {simulation.sample_time:g} s)")
         if not planners and problem.qf is None and law.needs_target_attitude:
             raise ScenarioError("maneuver.final.q", f"regulation (no planners) with controller {controller.name!r} "
                                 "needs a target attitude; only laws that need none (e.g. bdot, tdfc, none) "

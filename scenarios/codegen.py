@@ -33,8 +33,19 @@ from scenarios.yaml_node import ScenarioError
 
 @dataclass
 class CodegenReport:
-    """What :func:`generate` wrote: the directory, the files (name -> bytes), the C functions, and
-    the planner rows that have no closed form (label -> reason)."""
+    """What :func:`generate` wrote.
+
+    Parameters
+    ----------
+    directory : Path
+        The absolute output directory.
+    files : dict of str to int, optional
+        Files written (name -> size in bytes).
+    functions : list of str, optional
+        Names of the C functions exported (``slewbench_law``, ``slewbench_reference_<row>``, ...).
+    skipped : dict of str to str, optional
+        Planner rows whose reference was not exported (label -> reason: no closed form, failed plan).
+    """
 
     directory: Path
     files: dict[str, int] = field(default_factory=dict)
@@ -43,7 +54,18 @@ class CodegenReport:
 
 
 def c_identifier(text: str) -> str:
-    """A C identifier made of ``text``'s letters and digits (``_`` elsewhere)."""
+    """A C identifier made of ``text``'s letters and digits (``_`` elsewhere).
+
+    Parameters
+    ----------
+    text : str
+        A scenario name or a row stem.
+
+    Returns
+    -------
+    str
+        ASCII letters, digits and ``_``, not starting with a digit (``x`` when nothing is left).
+    """
     stem = re.sub(r"[^A-Za-z0-9_]+", "_", text).strip("_") or "x"
     return stem if not stem[0].isdigit() else f"_{stem}"
 
@@ -67,12 +89,15 @@ def generate(scenario: Scenario, out: str | Path) -> CodegenReport:
 
     Parameters
     ----------
-    scenario : a loaded scenario.
-    out : the output directory (new, empty, or written by slewbench before).
+    scenario : Scenario
+        A loaded scenario.
+    out : str or Path
+        The output directory (new, empty, or written by slewbench before).
 
     Returns
     -------
     CodegenReport
+        The directory, files, exported functions and skipped planner rows.
 
     Raises
     ------

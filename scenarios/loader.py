@@ -3,38 +3,47 @@
 Every error is a :class:`~scenarios.yaml_node.ScenarioError` naming the YAML path and what was
 expected. Degrees (``*_deg``) and kilometres (``*_km``) are converted to SI here, and so are
 scalar-last quaternions (``maneuver.quaternion_order: scalar_last``), so that nothing inside the
-code sees the papers' conventions.
+code sees the papers' conventions. The model sections (``spacecraft``, ``orbit``, ``environment``)
+are read by :mod:`scenarios.model_yaml`.
 """
 from __future__ import annotations
 
 import dataclasses
-import datetime
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from controllers import CONTROLLERS
-from ocp import (CircularOrbit, Environment, IGRFField, Magnetorquers, ModelError, ReactionWheels, SensorNoise,
-                 Spacecraft, TiltedDipole, Torquers, quat)
+from ocp import Environment, IGRFField, SensorNoise, Spacecraft, quat
 from ocp.options import OptionsError, excerpt
 from ocp.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem
 from scenarios.checks import check_compatibility, check_row_labels, check_work
+from scenarios.model_yaml import parse_environment, parse_spacecraft
 from scenarios.yaml_node import Node, ScenarioError, read_yaml
 
-
 MAX_NAME = 200
+"""Characters of a scenario name (the default output directory uses a sanitised, shorter stem)."""
 MAX_LABEL = 100
 """Characters of a planner's or controller's label."""
-"""Characters of a scenario name (the default output directory uses a sanitised, shorter stem)."""
 
 
 @dataclass
 class PlannerSpec:
-    """One planner row: registry ``name``, table ``label`` and its parsed options."""
+    """One planner row of the scenario (``planners[i]``).
+
+    Parameters
+    ----------
+    name : str
+        Registry name (a key of ``planners.PLANNERS``).
+    label : str
+        The row's label in the tables (default: the name).
+    options : object
+        The planner's parsed ``Options`` dataclass.
+    """
 
     name: str
     label: str
@@ -43,8 +52,19 @@ class PlannerSpec:
 
 @dataclass
 class ControllerSpec:
-    """One controller: registry ``name``, parsed ``options`` and table ``label`` (default: the
-    name); ``path`` is its YAML entry (``controller`` or ``controllers[i]``), for messages."""
+    """One controller of the scenario (``controller`` or ``controllers[i]``).
+
+    Parameters
+    ----------
+    name : str
+        Registry name (a key of ``controllers.CONTROLLERS``).
+    options : object
+        The controller's parsed ``Options`` dataclass.
+    label : str, optional
+        Its label in the tables; empty (default): the name.
+    path : str, optional
+        Its YAML entry (``controller`` or ``controllers[i]``), for messages.
+    """
 
     name: str
     options: Any
@@ -57,8 +77,35 @@ class ControllerSpec:
 
 @dataclass
 class SimulationSpec:
-    """Closed-loop settings: sample time (s), window (s, ``None``: the manoeuvre's, or the
-    reference's if longer), errors applied to the true initial state (rad, rad/s), noise."""
+    """Closed-loop settings (the ``simulation`` keys, in SI units).
+
+    Parameters
+    ----------
+    sample_time : float
+        Zero-order-hold sample time of the controller [s].
+    duration : float or None
+        Closed-loop window [s]; ``None``: the manoeuvre's, or the reference's if longer.
+    initial_attitude_error : (3,) ndarray
+        Rotation vector applied to the initial attitude in body axes [rad]
+        (``initial_attitude_error_deg`` in YAML).
+    initial_rate_error : (3,) ndarray
+        Added to the initial body rate [rad/s], body frame.
+    noise : SensorNoise
+        Attitude [rad], rate [rad/s] and magnetometer [T] noise and its seed (``sensor_noise``).
+    integrator : {"rk4", "cvodes"}
+        Integrator of the closed loop.
+    max_step : float
+        Longest RK4 sub-step [s].
+    settling_tolerance_deg, fine_settling_tolerance_deg : float, float or None
+        Attitude-error tolerances [deg] of ``settling_time_s`` and ``fine_settling_time_s``
+        (``None``: no fine criterion).
+    detumble_tolerance : float
+        Rate bound [rad/s] of ``detumble_time_s``.
+    compile : bool
+        Build the closed loop of a symbolic law as C (``ocp.compiled``); interpreted otherwise.
+    max_samples : int
+        Most closed-loop samples a run may take.
+    """
 
     sample_time: float = 1.0
     duration: float | None = None
@@ -71,13 +118,28 @@ class SimulationSpec:
     fine_settling_tolerance_deg: float | None = None
     detumble_tolerance: float = 0.01
     compile: bool = False
-    """Build the closed loop of a symbolic law as C (``ocp.compiled``); interpreted otherwise."""
     max_samples: int = MAX_SAMPLES
 
 
 @dataclass
 class Scenario:
-    """A parsed, validated scenario."""
+    """A parsed, validated scenario.
+
+    Parameters
+    ----------
+    name : str
+        The scenario's name.
+    problem : ManeuverProblem
+        Spacecraft, environment and manoeuvre (SI units, scalar-first quaternions).
+    planners : list of PlannerSpec
+        The planner rows (empty: regulation to ``maneuver.final``).
+    controllers : list of ControllerSpec
+        The controllers (at least one).
+    simulation : SimulationSpec
+        Closed-loop settings.
+    source : Path or None, optional
+        The file it was read from; ``None`` for data parsed in memory.
+    """
 
     name: str
     problem: ManeuverProblem
@@ -99,120 +161,6 @@ class Scenario:
         return np.concatenate([q0, p.omega0 + self.simulation.initial_rate_error, p.wheel_momentum0])
 
 
-def _model_part(node: Node, build: Callable[..., Any], **kwargs: Any) -> Any:
-    """Call a model constructor, turning its ModelError into a ScenarioError at ``node.path``."""
-    try:
-        return build(**kwargs)
-    except ModelError as error:
-        raise ScenarioError(f"{node.path}.{error.field}" if node.path else error.field, error.message) from None
-
-
-def _limits(node: Node, key: str) -> Any:
-    child = node.get(key, None)
-    return None if child.is_null() else child.vector(allow_scalar=True)
-
-
-def parse_spacecraft(node: Node) -> Spacecraft:
-    node.mapping()
-    inertia_node = node.get("inertia", required=True)
-    inertia = inertia_node.value
-    if isinstance(inertia, list) and inertia and all(isinstance(row, list) for row in inertia):
-        inertia = np.array([Node(row, f"{inertia_node.path}[{i}]").vector(3) for i, row in enumerate(inertia)])
-    else:
-        inertia = inertia_node.vector(3)
-    wheels_node = node.get("wheels", {})
-    wheels = None
-    if not wheels_node.is_null():
-        wheels_node.mapping()
-        axes = wheels_node.get("axes", None)
-        axes = np.eye(3) if axes.is_null() else np.array([row.vector(3) for row in axes.items()]).T
-        failed = [item.integer() for item in wheels_node.get("failed", []).items()]
-        wheels = _model_part(
-            wheels_node, ReactionWheels, axes=axes, max_torque=_limits(wheels_node, "max_torque"),
-            max_momentum=_limits(wheels_node, "max_momentum"), spin_inertia=_limits(wheels_node, "spin_inertia"),
-            failed=tuple(failed),
-        )
-        wheels_node.finish()
-    magnetorquers = torquers = None
-    mtq = node.get("magnetorquers", None)
-    if not mtq.is_null():
-        magnetorquers = _model_part(mtq.mapping(), Magnetorquers, max_dipole=_limits(mtq, "max_dipole"),
-                                    saturation=mtq.get("saturation", "per_axis").string(("per_axis", "scale")))
-        mtq.finish()
-    trq = node.get("torquers", None)
-    if not trq.is_null():
-        torquers = _model_part(trq.mapping(), Torquers, max_torque=_limits(trq, "max_torque"))
-        trq.finish()
-    spacecraft = _model_part(node, Spacecraft, inertia=inertia, wheels=wheels, magnetorquers=magnetorquers,
-                             torquers=torquers)
-    node.finish()
-    return spacecraft
-
-
-def parse_environment(orbit_node: Node, node: Node) -> Environment:
-    orbit = None
-    if not orbit_node.is_null():
-        orbit_node.mapping()
-        orbit = _model_part(
-            orbit_node, CircularOrbit,
-            altitude=orbit_node.get("altitude_km", required=True).number() * 1e3,
-            inclination=np.deg2rad(orbit_node.get("inclination_deg", 0.0).number()),
-            raan=np.deg2rad(orbit_node.get("raan_deg", 0.0).number()),
-            arg_latitude=np.deg2rad(orbit_node.get("arg_latitude_deg", 0.0).number()),
-        )
-        orbit_node.finish()
-    node = node if not node.is_null() else Node({}, node.path)
-    node.mapping()
-    field_node = node.get("magnetic_field", None)
-    magnetic_field = None
-    if not field_node.is_null():
-        if isinstance(field_node.value, str):
-            field_node.string(("tilted_dipole", "none"))
-            magnetic_field = TiltedDipole()
-        else:
-            field_node.mapping()
-            model = field_node.get("model", "tilted_dipole").string(("tilted_dipole", "igrf"))
-            magnetic_field = (_igrf_field(field_node, orbit) if model == "igrf"
-                              else _tilted_dipole(field_node))
-            field_node.finish()
-    environment = _model_part(
-        node, Environment, orbit=orbit,
-        gravity_gradient=node.get("gravity_gradient", False).boolean(),
-        magnetic_field=magnetic_field,
-        disturbance_torque=node.get("disturbance_torque", [0.0, 0.0, 0.0]).vector(3),
-    )
-    node.finish()
-    return environment
-
-
-def _tilted_dipole(node: Node) -> TiltedDipole:
-    defaults = TiltedDipole()
-    return TiltedDipole(
-        strength=node.get("strength", defaults.strength).number(positive=True),
-        tilt=np.deg2rad(node.get("tilt_deg", np.rad2deg(defaults.tilt)).number()),
-        pole_longitude=np.deg2rad(node.get("pole_longitude_deg", np.rad2deg(defaults.pole_longitude)).number()),
-        greenwich_angle=np.deg2rad(node.get("greenwich_angle_deg", 0.0).number()),
-    )
-
-
-def _igrf_field(node: Node, orbit: CircularOrbit | None) -> IGRFField:
-    """``{model: igrf, epoch, step_s, span_s, greenwich_angle_deg}``; without ``span_s`` the table
-    spans a provisional second, fitted to the closed-loop window by :func:`_fit_field_span`."""
-    if orbit is None:
-        raise ScenarioError(node.path, "the IGRF field is tabulated along the orbit; give `orbit:`")
-    epoch_node = node.get("epoch", "2025-01-01")
-    epoch = epoch_node.value
-    if not isinstance(epoch, (str, datetime.date)):
-        raise epoch_node.error(f"expected a date like 2025-01-01, got {str(epoch)[:40]!r}")
-    greenwich = node.get("greenwich_angle_deg", None).optional_number()
-    return _model_part(
-        node, IGRFField, orbit=orbit, epoch=str(epoch),
-        span=node.get("span_s", None).optional_number(positive=True) or 1.0,
-        step=node.get("step_s", 30.0).number(positive=True, maximum=120.0),  # cubic spline error ~3e-4 at 120 s
-        greenwich_angle=None if greenwich is None else float(np.deg2rad(greenwich)),
-    )
-
-
 def _fit_field_span(data: Any, problem: ManeuverProblem, simulation: SimulationSpec, planners: list) -> ManeuverProblem:
     """Give an IGRF table without ``span_s`` the closed-loop window (twice the maneuver's when
     planners may return longer references) plus one minute."""
@@ -226,24 +174,24 @@ def _fit_field_span(data: Any, problem: ManeuverProblem, simulation: SimulationS
     return dataclasses.replace(problem, environment=environment)
 
 
-def parse_problem(node: Node, spacecraft: Spacecraft, environment: Environment) -> ManeuverProblem:
+def _parse_problem(node: Node, spacecraft: Spacecraft, environment: Environment) -> ManeuverProblem:
     node.mapping()
     order = node.get("quaternion_order", "scalar_first").string(("scalar_first", "scalar_last"))
 
-    def attitude(parent: Node, free: bool = False) -> np.ndarray | None:
-        node = parent.get("q", required=True)
-        if free and node.is_null():  # final attitude written as null: free
-            return None
+    def attitude(node: Node) -> np.ndarray:
         q = node.quaternion()
         return quat.from_scalar_last(q) if order == "scalar_last" else q
+
+    def free_attitude(node: Node) -> np.ndarray | None:
+        return None if node.is_null() else attitude(node)  # final attitude written as null: free
 
     initial = node.get("initial", required=True).mapping()
     final = node.get("final", required=True).mapping()
     momentum = initial.get("wheel_momentum", None).optional_vector(spacecraft.n_wheels)
     problem = ManeuverProblem(
         spacecraft=spacecraft, environment=environment,
-        q0=attitude(initial), omega0=initial.get("omega", [0.0, 0.0, 0.0]).vector(3),
-        qf=attitude(final, free=True), omegaf=final.get("omega", None).optional_vector(3),
+        q0=attitude(initial.get("q", required=True)), omega0=initial.get("omega", [0.0, 0.0, 0.0]).vector(3),
+        qf=free_attitude(final.get("q", required=True)), omegaf=final.get("omega", None).optional_vector(3),
         duration=node.get("duration", required=True).number(positive=True),
         wheel_momentum0=momentum, max_rate=node.get("max_rate", None).optional_number(positive=True),
     )
@@ -264,7 +212,7 @@ def _registered(node: Node, registry: dict[str, type], kind: str) -> tuple[str, 
         raise ScenarioError(error.path, error.message) from None
 
 
-def parse_planners(node: Node) -> list[PlannerSpec]:
+def _parse_planners(node: Node) -> list[PlannerSpec]:
     specs, labels = [], set()
     for item in node.items():
         item.mapping()
@@ -278,7 +226,7 @@ def parse_planners(node: Node) -> list[PlannerSpec]:
     return specs
 
 
-def parse_controller(node: Node) -> ControllerSpec:
+def _parse_controller(node: Node) -> ControllerSpec:
     name, options = _registered(node.mapping(), CONTROLLERS, "controller")
     label = _label(node, name)
     node.finish()
@@ -294,15 +242,15 @@ def _label(node: Node, default: str) -> str:
     return label
 
 
-def parse_controllers(root: Node) -> list[ControllerSpec]:
-    """``controller:`` (one) or ``controllers:`` (a non-empty list, labels unique)."""
+def _parse_controllers(root: Node) -> list[ControllerSpec]:
+    """``controller:`` (one) or ``controllers:`` (a non-empty list, labels unique) of ``root``."""
     if "controller" in root and "controllers" in root:
         raise ScenarioError("controllers", "give either `controller` (one) or `controllers` (a list), not both")
     if "controllers" not in root:
-        return [parse_controller(root.get("controller", required=True))]
+        return [_parse_controller(root.get("controller", required=True))]
     node = root.get("controllers")
     root.get("controller", None)  # an explicit `controller: null` next to the list is accepted
-    specs = [parse_controller(item) for item in node.items()]
+    specs = [_parse_controller(item) for item in node.items()]
     if not specs:
         raise ScenarioError("controllers", "expected at least one controller")
     labels: set[str] = set()
@@ -313,7 +261,7 @@ def parse_controllers(root: Node) -> list[ControllerSpec]:
     return specs
 
 
-def parse_simulation(node: Node) -> SimulationSpec:
+def _parse_simulation(node: Node) -> SimulationSpec:
     node = node if not node.is_null() else Node({}, node.path)
     node.mapping()
     noise = node.get("sensor_noise", {}).mapping()
@@ -346,7 +294,25 @@ def parse_simulation(node: Node) -> SimulationSpec:
 
 
 def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
-    """Build a :class:`Scenario` from parsed YAML data."""
+    """Build a :class:`Scenario` from parsed YAML data, checking it as a whole.
+
+    Parameters
+    ----------
+    data : object
+        The parsed YAML document (a mapping; see :func:`~scenarios.yaml_node.read_yaml`).
+    source : Path or None, optional
+        The file it came from, kept in :attr:`Scenario.source`.
+
+    Returns
+    -------
+    Scenario
+        The scenario, with degrees, kilometres and scalar-last quaternions converted.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the YAML path, the value and what was expected.
+    """
     root = Node(data).mapping()
     name_node = root.get("name", required=True)
     name = name_node.string()
@@ -354,10 +320,10 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
         raise name_node.error(f"expected a non-empty name of at most {MAX_NAME} characters, got {excerpt(name)}")
     spacecraft = parse_spacecraft(root.get("spacecraft", required=True))
     environment = parse_environment(root.get("orbit", None), root.get("environment", {}))
-    problem = parse_problem(root.get("maneuver", required=True), spacecraft, environment)
-    planners = parse_planners(root.get("planners", required=True))
-    controllers = parse_controllers(root)
-    simulation = parse_simulation(root.get("simulation", {}))
+    problem = _parse_problem(root.get("maneuver", required=True), spacecraft, environment)
+    planners = _parse_planners(root.get("planners", required=True))
+    controllers = _parse_controllers(root)
+    simulation = _parse_simulation(root.get("simulation", {}))
     root.finish()
     problem = _fit_field_span(data, problem, simulation, planners)
     check_work(problem, simulation)
@@ -367,5 +333,21 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
 
 
 def load(path: str | Path) -> Scenario:
-    """Read and validate a scenario file."""
+    """Read and validate a scenario file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The scenario YAML file.
+
+    Returns
+    -------
+    Scenario
+        The parsed scenario.
+
+    Raises
+    ------
+    ScenarioError
+        The file cannot be read or is not a valid scenario (the message names the YAML path).
+    """
     return parse_scenario(read_yaml(path), Path(path))

@@ -26,12 +26,15 @@ import shutil
 import tempfile
 import unicodedata
 from pathlib import Path
-from typing import Any, Iterable, Iterator, Sequence
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, Sequence
 
 import numpy as np
 
 from scenarios.tables import to_csv, to_json, to_markdown
 from scenarios.yaml_node import ScenarioError
+
+if TYPE_CHECKING:
+    from scenarios.runner import Row, RunResults
 
 MARKER = ".slewbench-output.json"
 STAGING_PREFIX = ".slewbench-staging-"
@@ -54,8 +57,10 @@ def sanitize(text: str, fallback: str = "row") -> str:
 
     Parameters
     ----------
-    text : a label or a scenario name (any Unicode).
-    fallback : the stem used when ``text`` has no usable character.
+    text : str
+        A label or a scenario name (any Unicode).
+    fallback : str, optional
+        The stem used when ``text`` has no usable character.
 
     Returns
     -------
@@ -80,7 +85,8 @@ def row_stems(labels: Sequence[str]) -> list[str]:
 
     Parameters
     ----------
-    labels : the rows' labels, in order.
+    labels : sequence of str
+        The rows' labels, in order.
 
     Returns
     -------
@@ -107,8 +113,10 @@ def default_output_directory(name: str, root: str | Path = "results") -> Path:
 
     Parameters
     ----------
-    name : the scenario's (or study's) name, any text.
-    root : the folder that holds every default output directory.
+    name : str
+        The scenario's (or study's) name, any text.
+    root : str or Path, optional
+        The folder that holds every default output directory.
 
     Returns
     -------
@@ -122,7 +130,19 @@ def default_output_directory(name: str, root: str | Path = "results") -> Path:
 
 
 def read_manifest(directory: Path) -> dict[str, Any] | None:
-    """The marker's manifest of ``directory``, or ``None`` when it carries no valid marker."""
+    """The manifest in the marker of ``directory``.
+
+    Parameters
+    ----------
+    directory : Path
+        A directory.
+
+    Returns
+    -------
+    dict or None
+        The manifest (``tool``, ``kind``, ``complete``, ``files``), or ``None`` when the directory
+        carries no valid marker (missing, unreadable, not slewbench's, or naming a file outside it).
+    """
     try:
         manifest = json.loads((directory / MARKER).read_text())
     except (OSError, ValueError):
@@ -165,7 +185,18 @@ def _locked(directory: Path) -> Iterator[None]:
 
 def new_staging(directory: Path) -> Path:
     """A staging folder inside the marked ``directory``, named after this process, so that a later
-    run removes it only once this process is gone."""
+    run removes it only once this process is gone.
+
+    Parameters
+    ----------
+    directory : Path
+        A directory claimed by :func:`claim_output_directory`.
+
+    Returns
+    -------
+    Path
+        The new, empty staging folder.
+    """
     return Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{os.getpid()}-", dir=directory))
 
 
@@ -187,7 +218,19 @@ def _abandoned(staging: Path) -> bool:
 
 
 def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: str) -> None:
-    """Replace the marker atomically (write a temporary file, then rename it)."""
+    """Replace the marker atomically (write a temporary file, then rename it).
+
+    Parameters
+    ----------
+    directory : Path
+        The output directory.
+    files : iterable of str
+        The files slewbench wrote there, relative to ``directory``.
+    complete : bool
+        Whether the set is complete (``False`` while a run commits).
+    kind : str
+        What writes there (``"run"``, ``"sweep"``, ``"codegen"``).
+    """
     manifest = {"tool": "slewbench", "kind": kind, "complete": complete, "files": sorted(set(files))}
     handle, temporary = tempfile.mkstemp(prefix=".slewbench-manifest-", dir=directory)
     with os.fdopen(handle, "w") as stream:
@@ -205,8 +248,10 @@ def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
 
     Parameters
     ----------
-    path : the output directory.
-    kind : what writes there (``"run"``, ``"sweep"``, ``"codegen"``), recorded in the manifest.
+    path : str or Path
+        The output directory.
+    kind : str, optional
+        What writes there (``"run"``, ``"sweep"``, ``"codegen"``), recorded in the manifest.
 
     Returns
     -------
@@ -254,9 +299,24 @@ def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
     return directory
 
 
-def write_timeseries(row: Any, path: Path) -> None:
-    """t, q, ω, h_w, applied body torque (held from t_k; blank on the last line), reference q, ω."""
+def write_timeseries(row: Row, path: Path) -> None:
+    """Write a row's closed-loop time series as CSV.
+
+    Columns: ``t`` [s], ``q0..q3`` (body to inertial, scalar first), ``omega_x..z`` [rad/s, body],
+    ``h_w0..`` [N m s], ``u_x..z`` the applied body torque [N m, body] held from ``t`` (blank on
+    the last line), ``ref_q0..3`` and ``ref_omega_x..z`` [rad/s] (blank without a reference).
+    Non-finite values are blank.
+
+    Parameters
+    ----------
+    row : Row
+        A result row with a ``simulation`` (and its ``reference``, or ``None``).
+    path : Path
+        The CSV file to write.
+    """
     sim = row.simulation
+    if sim is None:
+        raise ValueError(f"row {row.label!r} has no closed-loop simulation to write")
     n_w = sim.wheel_momentum.shape[1]
     header = (["t", "q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z"]
               + [f"h_w{i}" for i in range(n_w)] + ["u_x", "u_y", "u_z"]
@@ -283,10 +343,25 @@ def commit_outputs(directory: Path, staging: Path, kind: str) -> list[str]:
     """Move everything under ``staging`` into the marked ``directory``, replacing only files the
     manifest lists, remove the previous run's files that the new set lacks, and mark complete.
 
+    Parameters
+    ----------
+    directory : Path
+        A directory claimed by :func:`claim_output_directory`.
+    staging : Path
+        The staging folder (:func:`new_staging`) holding the new files; it is removed.
+    kind : str
+        What writes there (``"run"``, ``"sweep"``, ``"codegen"``).
+
     Returns
     -------
     list of str
         The files now listed by the manifest (relative paths).
+
+    Raises
+    ------
+    OutputError
+        The marker was lost or changed kind, a folder is a symbolic link, or a new file would
+        replace one slewbench did not write; nothing is replaced then.
     """
     with _locked(directory):
         return _commit(directory, staging, kind)
@@ -322,7 +397,7 @@ def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
     return new
 
 
-def write_results(results: Any, directory: str | Path, plots: bool = True) -> Path:
+def write_results(results: RunResults, directory: str | Path, plots: bool = True) -> Path:
     """Write ``results.json/csv/md``, ``timeseries/<row>.csv`` and the PNG plots into ``directory``.
 
     The directory is claimed first (:func:`claim_output_directory`); the files are staged inside
@@ -330,9 +405,12 @@ def write_results(results: Any, directory: str | Path, plots: bool = True) -> Pa
 
     Parameters
     ----------
-    results : a ``scenarios.RunResults``.
-    directory : the output directory.
-    plots : also draw the PNG figures.
+    results : RunResults
+        The rows of a scenario run.
+    directory : str or Path
+        The output directory.
+    plots : bool, optional
+        Also draw the PNG figures.
 
     Returns
     -------

@@ -5,9 +5,14 @@ import csv
 import io
 import json
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ocp import METRIC_KEYS
+
+if TYPE_CHECKING:
+    import pandas
+
+    from scenarios.runner import RunResults
 
 AXES = ("x", "y", "z")
 SCOPES = (("reference", "ref"), ("closed_loop", "cl"))
@@ -24,12 +29,31 @@ def _clean(value: Any) -> Any:
     return value
 
 
-def to_json(results) -> str:
+def to_json(results: RunResults) -> str:
+    """``results.json``: the layout of ARCHITECTURE.md, non-finite numbers written as ``null``.
+
+    Parameters
+    ----------
+    results : RunResults
+        The rows of a scenario run.
+
+    Returns
+    -------
+    str
+        Indented JSON text.
+    """
     return json.dumps(_clean(results.to_dict()), indent=2)
 
 
 def flat_columns() -> list[str]:
-    """CSV columns: row identity, then every metric per scope (vectors split per axis)."""
+    """CSV columns: row identity, then every metric per scope (vectors split per axis).
+
+    Returns
+    -------
+    list of str
+        ``label, planner, controller, status, message, plan_time_s``, then ``ref_<metric>`` and
+        ``cl_<metric>`` for every metric key (``int_abs_u`` as ``_x``, ``_y``, ``_z``).
+    """
     columns = ["label", "planner", "controller", "status", "message", "plan_time_s"]
     for _, prefix in SCOPES:
         for key in METRIC_KEYS:
@@ -42,7 +66,20 @@ def flat_columns() -> list[str]:
     return columns
 
 
-def flat_rows(results) -> list[dict[str, Any]]:
+def flat_rows(results: RunResults) -> list[dict[str, Any]]:
+    """The rows as flat records keyed by :func:`flat_columns` (the CSV and DataFrame table).
+
+    Parameters
+    ----------
+    results : RunResults
+        The rows of a scenario run.
+
+    Returns
+    -------
+    list of dict
+        One record per row; a metric a row lacks is ``None``. Values are in the units of the
+        README's "Metrics" table.
+    """
     table = []
     for row in results.rows:
         record = {"label": row.label, "planner": row.planner or "", "controller": row.controller or "",
@@ -63,7 +100,19 @@ def flat_rows(results) -> list[dict[str, Any]]:
     return table
 
 
-def to_csv(results) -> str:
+def to_csv(results: RunResults) -> str:
+    """``results.csv``: :func:`flat_rows` under the :func:`flat_columns` header.
+
+    Parameters
+    ----------
+    results : RunResults
+        The rows of a scenario run.
+
+    Returns
+    -------
+    str
+        CSV text; missing and non-finite values are empty cells.
+    """
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=flat_columns(), lineterminator="\n")
     writer.writeheader()
@@ -73,7 +122,24 @@ def to_csv(results) -> str:
     return buffer.getvalue()
 
 
-def to_dataframe(results):
+def to_dataframe(results: RunResults) -> pandas.DataFrame:
+    """The CSV table as a pandas DataFrame (needs pandas installed).
+
+    Parameters
+    ----------
+    results : RunResults
+        The rows of a scenario run.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per result row, the columns of :func:`flat_columns`.
+
+    Raises
+    ------
+    ImportError
+        pandas is not installed.
+    """
     try:
         import pandas
     except ImportError:
@@ -91,7 +157,7 @@ def _format(value: Any) -> str:
     return str(value)
 
 
-def _metric_lines(results) -> list[tuple[str, list[str]]]:
+def _metric_lines(results: RunResults) -> list[tuple[str, list[str]]]:
     """(metric name, one formatted cell per row), reference metrics then closed-loop ones."""
     lines = [("status", [row.status for row in results.rows]),
              ("plan_time_s", [_format(row.plan_time_s) for row in results.rows])]
@@ -104,8 +170,19 @@ def _metric_lines(results) -> list[tuple[str, list[str]]]:
     return lines
 
 
-def to_markdown(results) -> str:
-    """One column per row (planner), one line per metric, then the messages."""
+def to_markdown(results: RunResults) -> str:
+    """``results.md``: one column per row (planner), one line per metric, then the messages.
+
+    Parameters
+    ----------
+    results : RunResults
+        The rows of a scenario run.
+
+    Returns
+    -------
+    str
+        Markdown text with a units line.
+    """
     labels = [row.label for row in results.rows]
     out = [f"# {results.scenario.name}", "", "| metric | " + " | ".join(labels) + " |",
            "|---|" + "---|" * len(labels)]
@@ -116,8 +193,19 @@ def to_markdown(results) -> str:
     return "\n".join(out) + "\n"
 
 
-def to_terminal(results) -> str:
-    """A fixed-width table with metrics as lines and planners as columns."""
+def to_terminal(results: RunResults) -> str:
+    """A fixed-width table with metrics as lines and planners as columns, then the messages.
+
+    Parameters
+    ----------
+    results : RunResults
+        The rows of a scenario run.
+
+    Returns
+    -------
+    str
+        Plain text for a terminal.
+    """
     lines = _metric_lines(results)
     labels = [row.label for row in results.rows]
     name_width = max(len(name) for name, _ in lines)

@@ -85,7 +85,27 @@ def _check_tree(root: yaml.Node, source: Path | str) -> None:
 
 
 def parse_yaml_text(text: str, source: Path | str = "<text>") -> Any:
-    """Parse YAML text with slewbench's checks (see :func:`read_yaml`)."""
+    """Parse YAML text with slewbench's checks (see :func:`read_yaml`).
+
+    Parameters
+    ----------
+    text : str
+        The YAML document.
+    source : Path or str, optional
+        Where the text comes from, named in error messages.
+
+    Returns
+    -------
+    object
+        The parsed data (mappings, lists, numbers, strings; dates stay strings), ``None`` for an
+        empty document.
+
+    Raises
+    ------
+    ScenarioError
+        Text that is not YAML, a value YAML cannot build, a duplicate key, nesting deeper than
+        :data:`MAX_DEPTH` or alias expansion beyond :data:`MAX_NODES` values.
+    """
     try:
         root = yaml.compose(text, Loader=_Loader)
         if root is None:
@@ -114,11 +134,13 @@ def read_yaml(path: str | Path) -> Any:
 
     Parameters
     ----------
-    path : the YAML file.
+    path : str or Path
+        The YAML file.
 
     Returns
     -------
-    The parsed data (mappings, lists, numbers, strings).
+    object
+        The parsed data (mappings, lists, numbers, strings).
     """
     path = Path(path)
     try:
@@ -140,7 +162,15 @@ def _is_number(value: Any) -> bool:
 
 
 class Node:
-    """A YAML value with its path."""
+    """A YAML value with its path; typed accessors raise :class:`ScenarioError` naming the path.
+
+    Parameters
+    ----------
+    value : object
+        The parsed YAML value (mapping, list, number, string, bool or ``None``).
+    path : str, optional
+        Its YAML path (``planners[1].options.weight``); empty for the top level.
+    """
 
     def __init__(self, value: Any, path: str = ""):
         self.value = value
@@ -148,6 +178,18 @@ class Node:
         self._read: set[str] = set()
 
     def error(self, message: str) -> ScenarioError:
+        """An error at this node's path (to raise).
+
+        Parameters
+        ----------
+        message : str
+            What was expected (and what was found).
+
+        Returns
+        -------
+        ScenarioError
+            The error, at ``(top level)`` for the root.
+        """
         return ScenarioError(self.path or "(top level)", message)
 
     def _child_path(self, key: str | int) -> str:
@@ -156,6 +198,18 @@ class Node:
         return f"{self.path}.{key}" if self.path else key
 
     def mapping(self) -> "Node":
+        """This node, checked to hold a mapping.
+
+        Returns
+        -------
+        Node
+            ``self``.
+
+        Raises
+        ------
+        ScenarioError
+            The value is not a mapping.
+        """
         if not isinstance(self.value, dict):
             raise self.error(f"expected a mapping, got {excerpt(self.value)}")
         return self
@@ -164,7 +218,27 @@ class Node:
         return isinstance(self.value, dict) and key in self.value and self.value[key] is not None
 
     def get(self, key: str, default: Any = ..., required: bool = False) -> "Node":
-        """Child node; a missing key gives ``default`` (or an error if ``required``)."""
+        """A child of this mapping, marked as read (see :meth:`finish`).
+
+        Parameters
+        ----------
+        key : str
+            The key.
+        default : object, optional
+            Value of a missing key; not given (``...``): the key is required.
+        required : bool, optional
+            A missing key is an error even with a default.
+
+        Returns
+        -------
+        Node
+            The child (``default`` at the child's path when the key is missing).
+
+        Raises
+        ------
+        ScenarioError
+            This node is not a mapping, or a required key is missing.
+        """
         self.mapping()
         self._read.add(key)
         if key not in self.value:
@@ -181,15 +255,54 @@ class Node:
                     raise ScenarioError(self._child_path(key), f"unknown key; expected one of {sorted(self._read)}")
 
     def items(self) -> Iterator["Node"]:
+        """The entries of this list, each at its path (``planners[0]``, ...).
+
+        Returns
+        -------
+        iterator of Node
+            One node per entry.
+
+        Raises
+        ------
+        ScenarioError
+            The value is not a list.
+        """
         if not isinstance(self.value, list):
             raise self.error(f"expected a list, got {excerpt(self.value)}")
         return (Node(item, self._child_path(i)) for i, item in enumerate(self.value))
 
     def is_null(self) -> bool:
+        """Whether the value is ``null`` (or the text ``none``, any case).
+
+        Returns
+        -------
+        bool
+            ``True`` for a missing or null value.
+        """
         return self.value is None or (isinstance(self.value, str) and self.value.lower() == "none")
 
     def number(self, positive: bool = False, non_negative: bool = False, maximum: float | None = None) -> float:
-        """A finite number (optionally positive, non-negative, at most ``maximum``)."""
+        """The value as a finite number (booleans are not numbers).
+
+        Parameters
+        ----------
+        positive : bool, optional
+            Require ``> 0``.
+        non_negative : bool, optional
+            Require ``>= 0``.
+        maximum : float or None, optional
+            Upper bound (inclusive); ``None``: none.
+
+        Returns
+        -------
+        float
+            The number.
+
+        Raises
+        ------
+        ScenarioError
+            Not a finite number, or outside the bounds.
+        """
         if not _is_number(self.value) or not np.isfinite(self.value):
             raise self.error(f"expected a number, got {excerpt(self.value)}")
         if positive and not self.value > 0:
@@ -200,11 +313,42 @@ class Node:
             raise self.error(f"expected a number <= {maximum:g}, got {excerpt(self.value)}")
         return float(self.value)
 
-    def optional_number(self, **checks: bool) -> float | None:
-        return None if self.is_null() else self.number(**checks)
+    def optional_number(self, positive: bool = False, non_negative: bool = False,
+                        maximum: float | None = None) -> float | None:
+        """:meth:`number`, or ``None`` for a null value.
+
+        Parameters
+        ----------
+        positive, non_negative : bool, optional
+            Require ``> 0`` or ``>= 0``.
+        maximum : float or None, optional
+            Upper bound (inclusive); ``None``: none.
+
+        Returns
+        -------
+        float or None
+            The number, or ``None``.
+        """
+        return None if self.is_null() else self.number(positive, non_negative, maximum)
 
     def integer(self, minimum: int | None = None, maximum: int | None = None) -> int:
-        """An integer in ``[minimum, maximum]`` (either bound optional)."""
+        """The value as an integer (not a float, not a boolean).
+
+        Parameters
+        ----------
+        minimum, maximum : int or None, optional
+            Inclusive bounds; ``None``: none.
+
+        Returns
+        -------
+        int
+            The integer.
+
+        Raises
+        ------
+        ScenarioError
+            Not an integer, or outside ``[minimum, maximum]``.
+        """
         if not isinstance(self.value, int) or isinstance(self.value, bool):
             raise self.error(f"expected an integer, got {excerpt(self.value)}")
         if (minimum is not None and self.value < minimum) or (maximum is not None and self.value > maximum):
@@ -214,11 +358,40 @@ class Node:
         return self.value
 
     def boolean(self) -> bool:
+        """The value as ``true`` or ``false``.
+
+        Returns
+        -------
+        bool
+            The value.
+
+        Raises
+        ------
+        ScenarioError
+            Not a boolean.
+        """
         if not isinstance(self.value, bool):
             raise self.error(f"expected true or false, got {excerpt(self.value)}")
         return self.value
 
     def string(self, choices: tuple[str, ...] | None = None) -> str:
+        """The value as text.
+
+        Parameters
+        ----------
+        choices : tuple of str or None, optional
+            The accepted values; ``None``: any text.
+
+        Returns
+        -------
+        str
+            The text.
+
+        Raises
+        ------
+        ScenarioError
+            Not a string, or not one of ``choices``.
+        """
         if not isinstance(self.value, str):
             raise self.error(f"expected a string, got {excerpt(self.value)}")
         if choices is not None and self.value not in choices:
@@ -226,7 +399,25 @@ class Node:
         return self.value
 
     def vector(self, size: int | None = None, allow_scalar: bool = False) -> np.ndarray:
-        """A list of numbers (of ``size`` entries); a scalar if ``allow_scalar``."""
+        """The value as a list of finite numbers.
+
+        Parameters
+        ----------
+        size : int or None, optional
+            Required number of entries; ``None``: any.
+        allow_scalar : bool, optional
+            Accept a single number too (returned as a 0-d array).
+
+        Returns
+        -------
+        (size,) or () ndarray
+            The numbers as floats.
+
+        Raises
+        ------
+        ScenarioError
+            Not a list of numbers, the wrong length, or a non-finite entry.
+        """
         if allow_scalar and _is_number(self.value):
             return np.asarray(self.number())
         if not isinstance(self.value, list) or not all(_is_number(v) for v in self.value):
@@ -240,10 +431,33 @@ class Node:
         return array
 
     def optional_vector(self, size: int | None = None) -> np.ndarray | None:
+        """:meth:`vector`, or ``None`` for a null value.
+
+        Parameters
+        ----------
+        size : int or None, optional
+            Required number of entries; ``None``: any.
+
+        Returns
+        -------
+        (size,) ndarray or None
+            The numbers, or ``None``.
+        """
         return None if self.is_null() else self.vector(size)
 
     def quaternion(self) -> np.ndarray:
-        """A unit quaternion; normalised if close to unit norm, an error if zero or far from it."""
+        """The value as a unit quaternion (in the order written; the loader converts scalar-last).
+
+        Returns
+        -------
+        (4,) ndarray
+            The quaternion normalised (its norm must be within 1e-2 of 1).
+
+        Raises
+        ------
+        ScenarioError
+            Not 4 numbers, zero, or a norm farther than 1e-2 from 1.
+        """
         q = self.vector(4)
         norm = float(np.linalg.norm(q))
         if norm == 0.0:
