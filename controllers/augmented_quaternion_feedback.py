@@ -26,8 +26,9 @@ sampled at ``t_k`` (``ω̇*(t_k)``, ``ω × I ω``).
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Annotated, Any, Sequence
+from typing import Annotated, Any
 
 import casadi as ca
 import numpy as np

@@ -7,8 +7,9 @@ for magnetorquers with ``saturation="scale"``, the dipole vector is scaled down 
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -184,13 +185,14 @@ class ActuatorModel:
                 high = (h_limit - h) / dt
                 if not high < limit:
                     high = limit
-                if low > high:
+                if low > high:  # noqa: PLR1730 (comparisons: no call per wheel and sample)
                     high = low
-                applied = low if low > g else g
-                if high < applied:
+                applied = low if low > g else g  # noqa: FURB136 (max(g, low), g kept when NaN)
+                if high < applied:  # noqa: PLR1730
                     applied = high
                 size = abs(g)
-                if abs(applied - g) > 1e-12 * (size if size > 1.0 else 1.0) or abs(applied) >= limit * (1 - 1e-12):
+                scale = size if size > 1.0 else 1.0  # noqa: FURB136 (max(1.0, |g|))
+                if abs(applied - g) > 1e-12 * scale or abs(applied) >= limit * (1 - 1e-12):
                     saturated = True
                 applied_wheels.append(applied)
             values[start:start + len(applied_wheels)] = applied_wheels

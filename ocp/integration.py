@@ -1,7 +1,8 @@
 """The classical Runge-Kutta step, shared by the simulator and the transcriptions."""
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 
 def rk4_step(rhs: Callable[[Any, Any], Any], x: Any, t: Any, h: Any) -> Any:

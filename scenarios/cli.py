@@ -116,7 +116,9 @@ def command_codegen(args: argparse.Namespace) -> int:
     int
         Exit status (0).
     """
-    from scenarios.codegen import generate  # CasADi's code generator: only for this command
+    from scenarios.codegen import (
+        generate,  # CasADi's code generator: only for this command
+    )
 
     scenario = load(args.file)
     report = generate(scenario, args.out)

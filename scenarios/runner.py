@@ -7,12 +7,21 @@ from __future__ import annotations
 
 import time
 import traceback
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from controllers import CONTROLLERS
-from ocp import SimulationError, SolverCache, metric_violations, SimulationResult, Simulator, metrics_from_reference, metrics_from_simulation
+from ocp import (
+    SimulationError,
+    SimulationResult,
+    Simulator,
+    SolverCache,
+    metric_violations,
+    metrics_from_reference,
+    metrics_from_simulation,
+)
 from planners import PLANNERS, FailedReference, Reference
 from scenarios.loader import ControllerSpec, Scenario
 

@@ -15,8 +15,18 @@ import numpy as np
 import pytest
 
 from controllers import CONTROLLERS
-from ocp import (AttitudeModel, CircularOrbit, Environment, Magnetorquers, ReactionWheels, SensorNoise, Simulator,
-                 Spacecraft, TiltedDipole, quat)
+from ocp import (
+    AttitudeModel,
+    CircularOrbit,
+    Environment,
+    Magnetorquers,
+    ReactionWheels,
+    SensorNoise,
+    Simulator,
+    Spacecraft,
+    TiltedDipole,
+    quat,
+)
 from planners import PLANNERS, ManeuverProblem
 
 ROOT = Path(__file__).resolve().parents[2]
