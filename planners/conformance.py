@@ -38,13 +38,13 @@ def standard_problems() -> dict[str, ManeuverProblem]:
 
     Returns
     -------
-    dict
+    dict of str to ManeuverProblem
         Name to problem: rest to rest on a principal-axis body with wheels, rest to rest on a
         non-principal body with ideal torquers, the spin paper's re-pointing of a spinning body
         (free final rate), a rate-to-rate slew, and a rest-to-rest slew under gravity gradient.
     """
     wheels = ReactionWheels.from_body_axes(max_torque=0.1)
-    principal = Spacecraft([19.5, 19.0, 12.6], wheels=wheels)
+    principal = Spacecraft(np.array([19.5, 19.0, 12.6]), wheels=wheels)
     rotation = quat.rotation_matrix(quat.from_axis_angle(np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0), 0.7))
     non_principal = Spacecraft(rotation @ np.diag([10.0, 14.0, 18.0]) @ rotation.T, torquers=Torquers(1.0))
     q0 = quat.from_axis_angle(np.array([0.3, -0.5, 0.8]) / np.sqrt(0.98), 0.4)
@@ -57,7 +57,7 @@ def standard_problems() -> dict[str, ManeuverProblem]:
         # Biggs & Horri's micro-satellite spinning at 0.2 rad/s about roll, re-pointed by 90 deg in 200 s.
         "spinning": ManeuverProblem(principal, quat.IDENTITY, np.array([0.2, 0.0, 0.0]),
                                     quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), np.pi / 2), 200.0),
-        "rate_to_rate": ManeuverProblem(Spacecraft([8.0, 6.0, 5.0], torquers=Torquers(0.5)), q0,
+        "rate_to_rate": ManeuverProblem(Spacecraft(np.array([8.0, 6.0, 5.0]), torquers=Torquers(0.5)), q0,
                                         np.array([0.01, -0.02, 0.015]), qf, 80.0, omegaf=np.array([-0.01, 0.02, 0.0]),
                                         max_rate=0.08),
         "gravity_gradient": ManeuverProblem(non_principal, q0, np.zeros(3), qf, 120.0, omegaf=np.zeros(3),
@@ -76,8 +76,10 @@ def check_boundary(problem: ManeuverProblem, reference: Reference) -> None:
 
     Parameters
     ----------
-    problem : the planned problem.
-    reference : the planner's reference for it (status ok).
+    problem : ManeuverProblem
+        The planned problem.
+    reference : Reference
+        The planner's reference for it (status ``"ok"``).
 
     Raises
     ------
@@ -112,13 +114,18 @@ def check_times(reference: Reference, points: int = 41) -> tuple[Array, float]:
 
     Parameters
     ----------
-    reference : the reference to sample.
-    points : number of candidate times.
+    reference : Reference
+        The reference to sample.
+    points : int, optional
+        Number of candidate times (default 41): uniform on ``[0.02 T, 0.98 T]``, or picked among
+        ``enforced_times`` inside ``(0.01 T, 0.99 T)`` when the reference declares them.
 
     Returns
     -------
-    times : (M,) s.
-    step : s, the finite-difference step.
+    times : (M,) ndarray
+        Times [s], at least five steps away from every declared breakpoint (``M <= points``).
+    step : float
+        The central-difference step [s]: ``1e-5 T``, or ``1e-7 T`` at enforced times.
     """
     T = reference.duration
     step = 1e-5 * T
@@ -157,6 +164,11 @@ def _half_q_times_omega(q: Array, w: Array) -> Array:
 def check_kinematics(reference: Reference) -> None:
     """``q̇ = ½ q ⊗ [0, ω]``, with ``q̇`` by central differences of the reference's own ``q``.
 
+    Parameters
+    ----------
+    reference : Reference
+        A reference with status ``"ok"``.
+
     Raises
     ------
     ConformanceError
@@ -180,6 +192,11 @@ def check_kinematics(reference: Reference) -> None:
 def check_dynamics(reference: Reference) -> None:
     """``omega_dot`` is the derivative of ``omega`` and ``torque`` the inverse dynamics
     ``I ω̇ + ω × I ω`` (both by central differences of the reference's own ``ω``).
+
+    Parameters
+    ----------
+    reference : Reference
+        A reference with status ``"ok"``.
 
     Raises
     ------
@@ -215,6 +232,11 @@ def check_dynamics(reference: Reference) -> None:
 def check_vectorised(reference: Reference) -> None:
     """Evaluating an array of times equals evaluating each time alone (inside and after T).
 
+    Parameters
+    ----------
+    reference : Reference
+        A reference with status ``"ok"``.
+
     Raises
     ------
     ConformanceError
@@ -238,8 +260,10 @@ def check_after_end(reference: Reference, horizon: float | None = None) -> None:
 
     Parameters
     ----------
-    reference : the reference.
-    horizon : s after T to check (default ``min(T, 100)``).
+    reference : Reference
+        A reference with status ``"ok"``.
+    horizon : float or None, optional
+        How long after T to check [s]; ``None`` (default): ``min(T, 100 s)``.
 
     Raises
     ------
@@ -293,8 +317,10 @@ def check_reference(problem: ManeuverProblem, reference: Reference) -> None:
 
     Parameters
     ----------
-    problem : the planned problem.
-    reference : the planner's reference (must have status ``"ok"``).
+    problem : ManeuverProblem
+        The planned problem.
+    reference : Reference
+        The planner's reference for it (a status other than ``"ok"`` fails at once).
 
     Raises
     ------

@@ -21,11 +21,12 @@ from dataclasses import dataclass
 from typing import Annotated, Any, Callable, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ocp.options import InvalidOption, Range
 from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample
 from planners.costate_systems import (AttitudeAcquisitionSystem, HamiltonianSystem, MinimumEnergySystem,
-                                      RateAcquisitionSystem)
+                                      RateAcquisitionSystem, RigidBodySystem)
 
 
 def _min_energy(problem: ManeuverProblem, o, build: bool = True) -> HamiltonianSystem | str | None:
@@ -76,21 +77,73 @@ FORMS: dict[str, Callable[..., HamiltonianSystem | str | None]] = {
 
 
 class CostateReference(Reference):
-    """States and co-states from ``solve_bvp``'s C¹ interpolant on ``[0, t_f]``."""
+    """States and co-states from ``solve_bvp``'s C¹ interpolant on ``[0, t_f]``.
 
-    def __init__(self, system: HamiltonianSystem, solution, duration: float, message: str, stats: dict):
+    Declares the boundary conditions its form leaves free (``HamiltonianSystem.free_boundary``).
+
+    Parameters
+    ----------
+    system : HamiltonianSystem
+        The problem form that was solved.
+    solution : object
+        The result of ``scipy.integrate.solve_bvp``; ``solution.sol(s)`` gives ``y`` (2n, m) at
+        scaled times ``s = t / t_f``.
+    duration : float
+        t_f [s].
+    message : str
+        Outcome description.
+    stats : dict
+        Solver statistics.
+    """
+
+    def __init__(self, system: HamiltonianSystem, solution: Any, duration: float, message: str,
+                 stats: dict[str, Any]) -> None:
         super().__init__("costate_tpbvp", duration, system.inertia, message=message, stats=stats,
                          free_boundary=system.free_boundary())
         self.system, self.solution = system, solution
 
-    def state_and_costate(self, t) -> tuple[Array, Array]:
-        """``x`` and ``λ`` at times ``t`` (clipped to ``[0, t_f]``), rows per time."""
+    def state_and_costate(self, t: ArrayLike) -> tuple[Array, Array]:
+        """The optimal states and co-states (``planners.capabilities.CostateCarrier``).
+
+        Parameters
+        ----------
+        t : float or array_like
+            Time [s] or ``m`` times, clipped to ``[0, t_f]``.
+
+        Returns
+        -------
+        x : (m, n) ndarray
+            States, one row per time: ``[q, ω]`` (scalar first, body to inertial; rad/s, body axes)
+            for the torque forms, ``q`` for attitude acquisition.
+        lam : (m, n) ndarray
+            Co-states ``[λ_q, λ_ω]`` (or ``λ_q``), one row per time.
+        """
         y = self.solution.sol(np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration) / self.duration)
         n = self.system.n_state
         return y[:n].T, y[n:].T
 
     def feedback_torque(self, lam_omega: Array, lam_omega_reference: Array) -> Array:
-        """The optimal control (N m) at an estimated rate co-state (see ``CostateCarrier``)."""
+        """The optimal control at an estimated rate co-state (``planners.capabilities.CostateCarrier``).
+
+        Parameters
+        ----------
+        lam_omega : (3,) ndarray
+            The estimated rate co-state ``λ̂_ω``.
+        lam_omega_reference : (3,) ndarray
+            The reference's ``λ_ω`` at the same time (fixes the normalisation of eq. 42).
+
+        Returns
+        -------
+        (3,) ndarray
+            Control torque [N m], body axes, without the environment torque.
+
+        Raises
+        ------
+        AttributeError
+            For the attitude-acquisition form, whose control is a rate, not a torque.
+        """
+        if not isinstance(self.system, RigidBodySystem):
+            raise AttributeError(f"{type(self.system).__name__} has no feedback_torque: its control is not a torque")
         return self.system.feedback_torque(lam_omega, lam_omega_reference)
 
     def _evaluate(self, t: Array) -> ReferenceSample:
@@ -98,13 +151,44 @@ class CostateReference(Reference):
 
 
 def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, max_nodes: int,
-          guess: tuple[float, Array, Array] | None = None, min_step: float = 1e-3):
+          guess: tuple[float, Array, Array] | None = None,
+          min_step: float = 1e-3) -> tuple[Any, float | None, int, str | None]:
     """Solve the TPBVP of ``system`` by adaptive continuation, starting with steps of ``1/steps``.
 
     A failed stage is retried with half the step; a successful one lengthens the next by half.
     Each solution is resampled on ``nodes`` points before it seeds the next stage (``solve_bvp``
-    only ever adds nodes). Returns ``(solution, t_f, stages, None)`` or ``(None, None, stages,
-    message)``. ``guess`` replaces the system's own cold start (tests use it to start far away).
+    only ever adds nodes). Intermediate stages use ``max(tolerance, 1e-5)`` and at most
+    ``min(max_nodes, 10 nodes)`` nodes.
+
+    Parameters
+    ----------
+    system : HamiltonianSystem
+        The problem form.
+    nodes : int
+        Mesh points each stage starts from.
+    steps : int
+        The first continuation step is ``1/steps`` (a form that is not ``continued`` solves the
+        target at once).
+    tolerance : float
+        ``solve_bvp`` residual tolerance of the final stage.
+    max_nodes : int
+        ``solve_bvp`` node limit of the final stage.
+    guess : (t_f, s, y) or None, optional
+        Replaces the system's own cold start (tests use it to start far away): final time [s],
+        scaled mesh (m,) on [0, 1], ``y`` (2n, m).
+    min_step : float, optional
+        Smallest continuation step before giving up (default 1e-3).
+
+    Returns
+    -------
+    solution : object or None
+        The result of the final ``scipy.integrate.solve_bvp`` call, ``None`` on failure.
+    t_f : float or None
+        The final time [s], ``None`` on failure.
+    stages : int
+        ``solve_bvp`` calls made.
+    message : str or None
+        Why it failed, ``None`` on success.
     """
     from scipy.integrate import solve_bvp  # lazily: scipy.integrate pulls in scipy.optimize
 
@@ -118,6 +202,7 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
     def fun_jac(s, y, p=None):
         time = system.final_time(p) if free else t_f
         f, jac, f_t = system.evaluate(s * time, y)
+        assert jac is not None and f_t is not None  # evaluate gives them with derivatives=True
         if not free:
             return time * jac
         return time * jac, (f + time * s * f_t)[:, None, :]
@@ -153,9 +238,49 @@ class CostateTPBVPPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
+        """Options of ``costate_tpbvp`` (YAML ``planner.options``).
+
+        Attributes
+        ----------
+        objective : {"min_energy", "rate_acquisition", "attitude_acquisition"}
+            The problem form: ``min_energy`` (default; ``min ½∫‖M_c‖² dt`` over the scenario's T,
+            needs a target attitude), ``rate_acquisition`` (steer a torque ``diag(τ) W u``,
+            ``‖u‖ = 1``, to ``maneuver.final.omega``; the attitude is free) or
+            ``attitude_acquisition`` (the rate ``ω = max_rate u``, ``‖u‖ = 1``, is the control).
+        final_time : {"minimum", "fixed"} or None
+            Steering forms: ``minimum`` (the default for them, ``None``) solves for the minimum
+            time; ``fixed`` uses the scenario's T with the terminal cost ``terminal_weight`` and the
+            paper's transversality conditions (rate acquisition: for a T shorter than the minimum
+            time; a target rate reachable within T makes the problem singular and the solve fails). ``min_energy`` has a fixed time (``minimum`` is
+            refused).
+        weighting : tuple of 3 float
+            Diagonal of ``W`` (eq. 34), positive (default ``[1, 1, 1]``; rate acquisition).
+        steering_torque : list of 3 float or None
+            ``τ``, the steering torque per body axis [N m], positive; ``None`` (default): the
+            actuators' per-axis limits (rate acquisition).
+        terminal_weight : float
+            ``Q_f = terminal_weight · I`` of the terminal cost with ``final_time: fixed`` (on the
+            rate for rate acquisition, on the quaternion for attitude acquisition), positive
+            (default 100). The optimum does not depend on it: the control has unit norm and there
+            is no running cost, so the co-state equations and boundary conditions are homogeneous
+            in λ and the weight only scales the co-states.
+        max_rate : float or None
+            ``ω_max`` of attitude acquisition [rad/s]; ``None`` (default): ``maneuver.max_rate``.
+        continuation_steps : int
+            The first continuation step is ``1/continuation_steps`` of the way from the cold start
+            to the target, then adaptive; 1 to 100 (default 3).
+        nodes : int
+            Mesh points each continuation stage starts from, 5 to 5000 (default 60).
+        tolerance : float
+            ``solve_bvp`` residual tolerance of the final stage, in (0, 1) (default 1e-8).
+        max_nodes : int
+            ``solve_bvp`` node limit of the final stage, 10 to 100000 and at least ``nodes``
+            (default 5000).
+        """
+
         objective: Literal["min_energy", "rate_acquisition", "attitude_acquisition"] = "min_energy"
         final_time: Literal["minimum", "fixed"] | None = None   # steering forms: default minimum
-        weighting: Annotated[list[float], Range(gt=0.0, size=3)] = (1.0, 1.0, 1.0)                 # diagonal of W (eq. 34)
+        weighting: Annotated[tuple[float, float, float], Range(gt=0.0, size=3)] = (1.0, 1.0, 1.0)                # diagonal of W (eq. 34)
         steering_torque: Annotated[list[float] | None, Range(gt=0.0, size=3)] = None              # N m per axis; default the actuator limits
         terminal_weight: Annotated[float, Range(gt=0.0)] = 100.0                           # Q_f = terminal_weight · I (final_time: fixed)
         max_rate: Annotated[float | None, Range(gt=0.0)] = None                            # rad/s; default maneuver.max_rate
@@ -170,23 +295,35 @@ class CostateTPBVPPlanner(Planner):
 
     @classmethod
     def offers_costates(cls, options: Any) -> bool:
-        """References carry co-states with a torque control for these objectives."""
+        """Whether references carry co-states with a torque control (``planners.capabilities``).
+
+        Parameters
+        ----------
+        options : Options or any
+            The planner's options.
+
+        Returns
+        -------
+        bool
+            True for the torque forms (``min_energy``, ``rate_acquisition``).
+        """
         return getattr(options, "objective", None) in TORQUE_FORMS
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
-        return FORMS[self.options.objective](problem, self.options, build=False)
+        error = FORMS[self.options.objective](problem, self.options, build=False)
+        return error if isinstance(error, str) else None
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         o = self.options
         system = FORMS[o.objective](problem, o)
-        if isinstance(system, str):
-            return FailedReference(self.name, system)
+        if not isinstance(system, HamiltonianSystem):
+            return FailedReference(self.name, str(system))
         solution, t_f, stages, failure = solve(system, o.nodes, o.continuation_steps, o.tolerance, o.max_nodes)
-        if failure:
+        if failure or solution is None or t_f is None:
             return FailedReference(self.name, f"{o.objective}: {failure}")
         stats = {"objective_form": o.objective, "t_f": t_f, "nodes": int(solution.x.size),
                  "max_rms_residual": float(np.max(solution.rms_residuals)), "continuation_stages": stages}
-        if system.torque_control:
+        if system.torque_control and isinstance(system, RigidBodySystem):
             fine = np.linspace(0.0, t_f, 4001)
             reference = CostateReference(system, solution, t_f, "", {})
             control = reference.sample(fine).torque - system.environment_torque(fine, reference.state_and_costate(fine)[0].T).T

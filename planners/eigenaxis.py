@@ -26,8 +26,24 @@ from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Ref
 
 
 def golden_section_minimum(function: Callable[[float], float], low: float, high: float, tolerance: float) -> float:
-    """Minimiser of a unimodal ``function`` on ``[low, high]`` to ``tolerance`` (golden section; 1-D
-    searches here are too small to pay for importing scipy.optimize, which costs more than a run)."""
+    """Minimiser of a unimodal function by golden-section search (at most 300 iterations).
+
+    1-D searches here are too small to pay for importing scipy.optimize, which costs more than a run.
+
+    Parameters
+    ----------
+    function : callable
+        ``f(x) -> float``, unimodal on ``[low, high]``.
+    low, high : float
+        The bracket, ``low < high``.
+    tolerance : float
+        Absolute width of the final bracket (units of ``x``).
+
+    Returns
+    -------
+    float
+        The middle of the final bracket.
+    """
     ratio = 0.5 * (np.sqrt(5.0) - 1.0)
     a, b = low, high
     c, d = b - ratio * (b - a), a + ratio * (b - a)
@@ -47,8 +63,22 @@ def golden_section_minimum(function: Callable[[float], float], low: float, high:
 
 
 def bisection_root(function: Callable[[float], float], low: float, high: float, tolerance: float) -> float:
-    """Root of ``function`` with ``function(low) < 0 < function(high)``, to ``tolerance`` (absolute)
-    plus four ulps of the bracket."""
+    """Root of an increasing-through-zero function by bisection (at most 400 iterations).
+
+    Parameters
+    ----------
+    function : callable
+        ``f(x) -> float`` with ``f(low) < 0 < f(high)``.
+    low, high : float
+        The bracket.
+    tolerance : float
+        Absolute width of the final bracket (units of ``x``), plus four ulps of ``high``.
+
+    Returns
+    -------
+    float
+        The middle of the final bracket.
+    """
     for _ in range(400):
         middle = 0.5 * (low + high)
         if high - low <= tolerance + 4 * np.finfo(float).eps * abs(high):
@@ -61,20 +91,42 @@ def bisection_root(function: Callable[[float], float], low: float, high: float, 
 
 
 class AngleProfile:
-    """θ(t), θ̇(t), θ̈(t) of a rotation about a fixed axis."""
+    """θ(t), θ̇(t), θ̈(t) of a rotation about a fixed axis, from θ(0) = 0."""
 
     def __call__(self, t: Array) -> tuple[Array, Array, Array]:
+        """Angle [rad], rate [rad/s] and acceleration [rad/s^2] at times ``t`` [s] (arrays like ``t``)."""
         raise NotImplementedError
 
     def symbolic(self, t: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX]:
-        """The same three on a CasADi scalar ``t``."""
+        """The profile as CasADi expressions.
+
+        Parameters
+        ----------
+        t : casadi.SX
+            Scalar time [s].
+
+        Returns
+        -------
+        angle, rate, acceleration : casadi.SX
+            θ [rad], θ̇ [rad/s], θ̈ [rad/s^2] at ``t``.
+        """
         raise NotImplementedError
 
 
 class QuinticProfile(AngleProfile):
-    """θ(0)=0, θ(T)=Θ, θ̇(0)=w0, θ̇(T)=wT, θ̈(0)=θ̈(T)=0."""
+    """Quintic θ(t) with θ(0) = 0, θ(T) = Θ, θ̇(0) = w0, θ̇(T) = wT, θ̈(0) = θ̈(T) = 0.
 
-    def __init__(self, angle: float, duration: float, rate0: float, rate_end: float):
+    Parameters
+    ----------
+    angle : float
+        Θ, the rotation angle [rad].
+    duration : float
+        T [s].
+    rate0, rate_end : float
+        w0 and wT, the boundary rates about the axis [rad/s].
+    """
+
+    def __init__(self, angle: float, duration: float, rate0: float, rate_end: float) -> None:
         T = duration
         rows = [[1, 0, 0, 0, 0, 0], [0, 1, 0, 0, 0, 0], [0, 0, 2, 0, 0, 0],
                 [1, T, T**2, T**3, T**4, T**5], [0, 1, 2 * T, 3 * T**2, 4 * T**3, 5 * T**4],
@@ -98,9 +150,28 @@ class QuinticProfile(AngleProfile):
 
 
 class BangCoastBangProfile(AngleProfile):
-    """Accelerate at α to the coast rate w, coast, decelerate at α to rest."""
+    """From rest, accelerate at α to the coast rate w, coast, decelerate at α to rest.
 
-    def __init__(self, angle: float, acceleration: float, coast_rate: float):
+    Parameters
+    ----------
+    angle : float
+        Θ, the rotation angle [rad], non-negative.
+    acceleration : float
+        α [rad/s^2], positive.
+    coast_rate : float
+        w [rad/s]; a triangle (no coast) when ``w^2/α >= Θ``.
+
+    Attributes
+    ----------
+    ramp : float
+        Duration of each acceleration phase, ``w/α`` [s].
+    coast : float
+        Duration of the coast [s].
+    duration : float
+        Total time ``2 ramp + coast`` [s].
+    """
+
+    def __init__(self, angle: float, acceleration: float, coast_rate: float) -> None:
         self.alpha = acceleration
         self.rate_max = coast_rate
         self.ramp = coast_rate / acceleration
@@ -136,16 +207,20 @@ def unmet_rates(problem: ManeuverProblem, axis: Array, profile: AngleProfile) ->
 
     Parameters
     ----------
-    problem : the manoeuvre.
-    axis : (3,) unit Euler axis, body axes.
-    profile : the angle profile.
+    problem : ManeuverProblem
+        The manoeuvre.
+    axis : (3,) ndarray
+        Unit Euler axis, body axes.
+    profile : AngleProfile
+        The angle profile.
 
     Returns
     -------
-    set of ``"omega0"`` / ``"omegaf"``.
+    set of str
+        Among ``"omega0"`` and ``"omegaf"`` (names of ``planners.base.BOUNDARY_CONDITIONS``).
     """
     along = isinstance(profile, QuinticProfile)
-    unmet = set()
+    unmet: set[str] = set()
     for name, rate in (("omega0", problem.omega0), ("omegaf", problem.omegaf)):
         if rate is None:
             continue
@@ -156,7 +231,26 @@ def unmet_rates(problem: ManeuverProblem, axis: Array, profile: AngleProfile) ->
 
 
 class EigenaxisReference(Reference):
-    """``q(t) = q0 ⊗ [cos θ/2, e sin θ/2]``, ``ω = e θ̇`` (body axes)."""
+    """``q(t) = q0 ⊗ [cos θ/2, e sin θ/2]``, ``ω = e θ̇`` (body axes), torque ``I e θ̈ + θ̇² e × I e``.
+
+    Parameters
+    ----------
+    q0 : (4,) ndarray
+        Initial attitude, scalar first, body to inertial.
+    axis : (3,) ndarray
+        Unit Euler axis ``e``, body axes (fixed in the body and in inertial space).
+    profile : AngleProfile
+        θ(t) about ``axis``.
+    duration : float
+        T [s].
+    inertia : (3, 3) ndarray
+        Body inertia [kg m^2].
+    message : str
+        Outcome description.
+    problem : ManeuverProblem or None, optional
+        The planned problem: its boundary rates that the profile does not meet are declared in
+        ``free_boundary`` (:func:`unmet_rates`); ``None``: none declared.
+    """
 
     def __init__(self, q0: Array, axis: Array, profile: AngleProfile, duration: float, inertia: Array, message: str,
                  problem: ManeuverProblem | None = None) -> None:
@@ -192,19 +286,37 @@ class EigenaxisPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
+        """Options of ``eigenaxis`` (YAML ``planner.options``).
+
+        Attributes
+        ----------
+        profile : {"smooth", "trapezoidal", "min_time"}
+            Angle profile: ``smooth`` (default) a quintic over the scenario's T with the boundary
+            rates projected on the axis; ``trapezoidal`` a rest-to-rest bang-coast-bang over T with
+            the largest acceleration the torque bounds allow (``infeasible`` if T is below the
+            minimum time); ``min_time`` the fastest bang-coast-bang (its own duration).
+        max_rate : float or None
+            Bound on the coast rate about the axis [rad/s] for the bang profiles; ``None``
+            (default): the problem's ``maneuver.max_rate`` (if any).
+        torque_fraction : float
+            Share of the actuators' per-axis torque bound the bang profiles may use, in (0, 1];
+            default 1.
+        """
+
         profile: Literal["smooth", "trapezoidal", "min_time"] = "smooth"
         max_rate: Annotated[float | None, Range(gt=0.0)] = None       # rad/s about the axis; default: the problem's max_rate
         torque_fraction: Annotated[float, Range(gt=0.0, le=1.0)] = 1.0        # share of the actuator bound the bang profiles may use
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
+        assert problem.qf is not None  # problem_error (the default) refuses a free attitude
         rotvec = quat.to_rotation_vector(quat.error(problem.qf, problem.q0))
         angle = float(np.linalg.norm(rotvec))
         axis = rotvec / angle if angle > 1e-12 else np.array([1.0, 0.0, 0.0])
         inertia = problem.spacecraft.inertia
         if self.options.profile == "smooth":
             rate_end = 0.0 if problem.omegaf is None else float(axis @ problem.omegaf)
-            profile = QuinticProfile(angle, problem.duration, float(axis @ problem.omega0), rate_end)
-            return EigenaxisReference(problem.q0, axis, profile, problem.duration, inertia,
+            quintic = QuinticProfile(angle, problem.duration, float(axis @ problem.omega0), rate_end)
+            return EigenaxisReference(problem.q0, axis, quintic, problem.duration, inertia,
                                       f"quintic, {np.rad2deg(angle):.2f} deg about {np.round(axis, 4).tolist()}", problem)
         max_rate = self.options.max_rate if self.options.max_rate is not None else problem.max_rate
         bounds = self.options.torque_fraction * problem.torque_limit

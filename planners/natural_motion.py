@@ -5,6 +5,7 @@ shot from the initial attitude to the target, then brought to rest.
   Lax-pair reduction (eq. 25-37), which is the closed form of :mod:`planners.spin_extremal` with the
   roll rate ``v = ω_s`` and spin offset ``λ − ω_s``, ``λ = ω_s (J − J_s)/J``, about the symmetry axis
   (eq. 17-18 print ``β = (J1 − J)/J``, the opposite sign; Euler's equations and eq. 34 agree with ours).
+  The torque-free closed forms live in :mod:`planners.torque_free`.
 * Asymmetric body: ``ω`` with Jacobi elliptic functions (Landau & Lifshitz §37) in both polhode
   regimes; the attitude by DOP853 integration of the kinematics (rtol 1e-12) with that ``ω``.
 * Shooting: IPOPT finds ``ω(0)`` with ``vec(q_f* ⊗ q(T_arc)) = 0`` (3 equations) minimising the
@@ -19,7 +20,7 @@ shot from the initial attitude to the target, then brought to rest.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import casadi as ca
 import numpy as np
@@ -29,81 +30,40 @@ from ocp import quat_casadi as qc
 from ocp.integration import rk4_step
 from ocp.nlp import solve_multistart, solver_options
 from ocp.options import Range
-from ocp.spin_closed_form import extremal_quaternion
 from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
                            inverse_dynamics_torque)
-
-
-def symmetry_axis(moments: Array, rtol: float = 1e-9) -> int | None:
-    """Index of the distinct moment of an axisymmetric body (0 for a sphere), else ``None``."""
-    for axis in range(3):
-        others = np.delete(moments, axis)
-        if abs(others[0] - others[1]) <= rtol * np.max(moments):
-            return axis
-    return None
-
-
-def _cyclic(axis: int) -> Array:
-    """Cyclic axis order putting ``axis`` first (a proper rotation of the axes)."""
-    return np.roll(np.arange(3), -axis)
-
-
-def symmetric_motion(t: Array, omega0: Array, moments: Array, axis: int, math=np):
-    """Rates (N, 3) and attitude relative to t = 0 (N, 4) of an axisymmetric body (closed form)."""
-    order = _cyclic(axis)
-    w = [omega0[i] for i in order]
-    spin, J_s, J = w[0], moments[axis], moments[order[1]]
-    lam = spin * (J - J_s) / J  # eq. 17 prints (J1 − J)/J: a sign typo (its eq. 34 has J − J1)
-    r = math.sqrt(w[1] ** 2 + w[2] ** 2)
-    delta = math.arctan2(w[1], w[2]) if math is np else ca.atan2(w[1], w[2])
-    q_rel = extremal_quaternion(t, spin, r, lam - spin, delta, math=math)
-    theta = lam * t + delta
-    permuted = [spin + 0 * t, r * math.sin(theta), r * math.cos(theta)]
-    rates, vector = [None] * 3, [None] * 3
-    for k, i in enumerate(order):
-        rates[i], vector[i] = permuted[k], q_rel[1 + k]
-    return rates, [q_rel[0]] + vector
-
-
-def asymmetric_rates(t: Array, omega0: Array, moments: Array) -> Array:
-    """Torque-free rates (N, 3) of an asymmetric body with Jacobi elliptic functions."""
-    omega0 = np.asarray(omega0, dtype=float)
-    if np.count_nonzero(np.abs(omega0) > 1e-15 * np.max(np.abs(omega0), initial=0.0)) <= 1:
-        # A spin about one principal axis is an equilibrium of Euler's equations; about the
-        # intermediate axis it sits on the separatrix, where the elliptic phase below is infinite.
-        return np.broadcast_to(omega0, np.shape(t) + (3,)).copy()
-    order = np.argsort(moments)
-    I, w0 = moments[order], omega0[order]
-    h2, e2 = np.sum((I * w0) ** 2), np.sum(I * w0**2)
-    a, b, c = (0, 1, 2) if h2 >= e2 * I[1] else (2, 1, 0)  # polhode about the major / minor axis
-    Ia, Ib, Ic = I[a], I[b], I[c]
-    amp_a = np.sqrt(max((e2 * Ic - h2) / (Ia * (Ic - Ia)), 0.0))
-    amp_b = np.sqrt(max((e2 * Ic - h2) / (Ib * (Ic - Ib)), 0.0))
-    amp_c = np.sqrt(max((h2 - e2 * Ia) / (Ic * (Ic - Ia)), 0.0))
-    rate = np.sqrt((Ic - Ib) * (h2 - e2 * Ia) / (Ia * Ib * Ic))
-    m = min((Ib - Ia) * (e2 * Ic - h2) / ((Ic - Ib) * (h2 - e2 * Ia)), 1.0)
-    sign_c = 1.0 if w0[c] >= 0 else -1.0
-    parity = np.linalg.det(np.eye(3)[order])  # an odd sort reverses the Euler equations
-    from scipy.special import ellipj, ellipkinc  # lazily: scipy.special is slow to import
-    phase = ellipkinc(np.arctan2(w0[b] / amp_b if amp_b > 0 else 0.0, w0[a] / amp_a if amp_a > 0 else 1.0), m)
-    sn, cn, dn, _ = ellipj(sign_c * parity * rate * np.asarray(t, dtype=float) + phase, m)
-    sorted_rates = np.empty(np.shape(t) + (3,))
-    sorted_rates[..., a], sorted_rates[..., b], sorted_rates[..., c] = amp_a * cn, amp_b * sn, sign_c * amp_c * dn
-    rates = np.empty_like(sorted_rates)
-    rates[..., order] = sorted_rates
-    return rates
-
-
-def euler_rhs(moments):
-    """Torque-free Euler equations as a function of rates (works on NumPy and CasADi)."""
-    I1, I2, I3 = moments
-    return lambda w: [(I2 - I3) / I1 * w[1] * w[2], (I3 - I1) / I2 * w[2] * w[0], (I1 - I2) / I3 * w[0] * w[1]]
+from planners.torque_free import asymmetric_rates, euler_rhs, symmetric_motion, symmetry_axis
 
 
 class NaturalMotionReference(Reference):
-    """Torque-free arc on ``[0, arc]`` from ``q0`` with ``ω(0) = omega0``, then the stop."""
+    """Torque-free arc on ``[0, arc]`` from ``q0`` with ``ω(0) = omega0``, then the stop.
 
-    def __init__(self, q0, omega0, moments, arc, duration, stop, message, stats):
+    The torque is zero on the arc; ω(0) is what the shooting chose, so ``omega0`` of the problem
+    is declared free (the spin-up is left to the closed loop, as in the paper).
+
+    Parameters
+    ----------
+    q0 : (4,) ndarray
+        Initial attitude, scalar first, body to inertial (principal axes as the body axes).
+    omega0 : (3,) ndarray
+        Rate at the start of the arc [rad/s], principal axes.
+    moments : (3,) ndarray
+        Principal moments of inertia [kg m^2].
+    arc : float
+        Duration of the torque-free arc [s].
+    duration : float
+        T [s]; the stop occupies ``[arc, T]``.
+    stop : {"step", "smooth"}
+        ``step``: at rest with the attitude held after the arc; ``smooth``: a cubic deceleration
+        along the final body rate.
+    message : str
+        Outcome description.
+    stats : dict
+        Solver statistics.
+    """
+
+    def __init__(self, q0: Array, omega0: Array, moments: Array, arc: float, duration: float, stop: str,
+                 message: str, stats: dict[str, Any]) -> None:
         # ω(0) is what the shooting found (the spin-up is left to the closed loop, as in the paper).
         super().__init__("natural_motion", duration, np.diag(moments), message=message, stats=stats,
                          free_boundary={"omega0"}, breakpoints=[arc] if 0 < arc < duration else [])
@@ -145,9 +105,19 @@ class NaturalMotionReference(Reference):
 
 
 class RotatedReference(Reference):
-    """A reference planned in principal axes, expressed in body axes (``v_B = V v_P``)."""
+    """A reference planned in principal axes, expressed in body axes (``v_B = V v_P``).
 
-    def __init__(self, inner: Reference, axes: Array, q_body_to_principal: Array):
+    Parameters
+    ----------
+    inner : Reference
+        The reference in principal axes.
+    axes : (3, 3) ndarray
+        ``V``, principal axes as columns in body axes (a proper rotation).
+    q_body_to_principal : (4,) ndarray
+        The quaternion of ``Vᵀ`` (body to principal), scalar first: ``q_B = q_P ⊗ q``.
+    """
+
+    def __init__(self, inner: Reference, axes: Array, q_body_to_principal: Array) -> None:
         super().__init__(inner.planner, inner.duration, axes @ inner.inertia @ axes.T, inner.status,
                          inner.message + " (planned in principal axes)", inner.stats,
                          free_boundary=inner.free_boundary, breakpoints=inner.breakpoints)
@@ -167,14 +137,45 @@ class NaturalMotionPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
+        """Options of ``natural_motion`` (YAML ``planner.options``).
+
+        Attributes
+        ----------
+        stop_time : float
+            Time at the end of T spent stopping [s], non-negative (default 10 s, the paper's last
+            10 s of 110 s); the arc lasts ``T − stop_time``.
+        stop : {"step", "smooth"}
+            ``step`` (default, the paper): the rate reference drops to zero at the end of the arc;
+            ``smooth``: a cubic deceleration along the final body rate over ``stop_time`` (the
+            shooting then targets the attitude after the stop).
+        rk4_steps : int
+            RK4 steps of the asymmetric body's shooting graph, 4 to 5000 (default 60); multiplied by
+            4, up to 16 × ``rk4_steps``, while the exact (elliptic) arc misses the target by more than
+            1e-6 deg. Unused for an axisymmetric body (closed form).
+        starts : int
+            IPOPT starts of the shooting, 1 to 50 (default 3): the short and the long way round,
+            then perturbed ones.
+        """
+
         stop_time: Annotated[float, Range(ge=0.0)] = 10.0                     # s at the end of T spent stopping
         stop: Literal["step", "smooth"] = "step"    # rate reference to zero at once (paper) or a cubic
         rk4_steps: Annotated[int, Range(ge=4, le=5000)] = 60                         # RK4 steps of the asymmetric shooting (refined x4 as needed)
         starts: Annotated[int, Range(ge=1, le=50)] = 3                             # IPOPT starts (short, long way round, perturbed)
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
-        """Why a natural motion cannot take ``problem``: no target, a non-zero final rate (it ends at
-        rest), or a ``stop_time`` that leaves no arc; else ``None``."""
+        """Why a natural motion cannot take ``problem``.
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The problem to plan.
+
+        Returns
+        -------
+        str or None
+            The reason (no target attitude, a non-zero final rate: it ends at rest, or a
+            ``stop_time`` that leaves no arc), or ``None``.
+        """
         if problem.omegaf is not None and np.any(problem.omegaf != 0):
             return "natural_motion ends at rest: maneuver.final.omega must be zero or null"
         if problem.duration <= self.options.stop_time:
@@ -182,6 +183,7 @@ class NaturalMotionPlanner(Planner):
         return super().problem_error(problem)
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
+        assert problem.qf is not None  # problem_error refuses a free attitude
         if not problem.spacecraft.is_principal:
             # Plan in principal axes (columns of V, a proper rotation) and map the reference back.
             moments, axes = np.linalg.eigh(problem.spacecraft.inertia)
@@ -225,7 +227,8 @@ class NaturalMotionPlanner(Planner):
         return reference
 
     def _shoot(self, problem: ManeuverProblem, moments: Array, arc: float, steps: int | None = None,
-               seeds: list[Array] | None = None):
+               seeds: list[Array] | None = None) -> tuple[Array, dict[str, Any]] | Reference:
+        assert problem.qf is not None  # problem_error refuses a free attitude
         structure = (symmetry_axis(moments), self.options.stop, steps or self.options.rk4_steps)
         solver = self.solver_cache(problem).get(("natural_motion",) + structure, lambda: shooting_solver(*structure))
         target = quat.product(quat.conjugate(problem.q0), problem.qf)
@@ -242,15 +245,33 @@ class NaturalMotionPlanner(Planner):
                                   feasibility_tolerance=1e-9, max_starts=self.options.starts)
         stats = result.stats()
         stats["momentum_sq"] = result.f
-        if not result.success:
+        if not result.success or result.x is None:
             return FailedReference(self.name, f"shooting did not reach the target from any start: "
                                    f"{result.statuses}", stats=stats)
         return result.x, stats
 
 
 def shooting_solver(axis: int | None, stop: str, rk4_steps: int) -> ca.Function:
-    """IPOPT on ω(0) with parameters [I1, I2, I3, q_target (4), arc, stop_time]; built once per
-    structure (symmetry axis or none, stop law, RK4 steps)."""
+    """The IPOPT shooting on ω(0), built once per structure.
+
+    Minimises ``‖I ω(0)‖²`` subject to ``vec(q_target* ⊗ q_rel) = 0``, with ``q_rel`` the attitude
+    after the arc (and after a ``smooth`` stop) relative to the start.
+
+    Parameters
+    ----------
+    axis : int or None
+        Symmetry axis (closed form), or ``None`` for an asymmetric body (RK4 graph).
+    stop : {"step", "smooth"}
+        The stop law.
+    rk4_steps : int
+        RK4 steps over the arc (asymmetric body only).
+
+    Returns
+    -------
+    casadi.Function
+        ``nlpsol`` with decision ω(0) [rad/s] (principal axes) and parameters
+        ``[I1, I2, I3 (kg m^2), q_target (4, relative to q0), arc (s), stop_time (s)]``.
+    """
     omega0 = ca.SX.sym("omega0", 3)
     p = ca.SX.sym("p", 9)
     moments, target, arc, stop_time = [p[0], p[1], p[2]], p[3:7], p[7], p[8]

@@ -17,7 +17,7 @@ the planner tries ``N = 1 … max_terms`` and keeps the shortest ``t_f`` (or the
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import casadi as ca
 import numpy as np
@@ -33,8 +33,27 @@ QUADRATURE_POINTS = 41  # uniform grid of the torque cost
 GAUSS_POINTS = 16       # Gauss-Legendre points of the path cost (exact for degree 31)
 
 
-def shape_basis(tau, terms: int, math=np):
-    """Hermite basis (4 functions) and the ``terms`` free shapes of eq. 52 at ``tau``, with τ-derivatives."""
+def shape_basis(tau: Any, terms: int, math: Any = np) -> tuple[list[Any], list[Any]]:
+    """Hermite basis (4 functions) and the ``terms`` free shapes of eq. 52 at ``tau``, with τ-derivatives.
+
+    Parameters
+    ----------
+    tau : float, ndarray or casadi.SX
+        Scaled time ``τ = t / t_f`` in [0, 1] (dimensionless).
+    terms : int
+        N, the number of free shapes (``j = 5 … N+4``).
+    math : module, optional
+        ``numpy`` (default) or ``casadi``: unused by the arithmetic here, kept so that both
+        backends call it alike.
+
+    Returns
+    -------
+    basis : list
+        ``4 + terms`` values like ``tau``: the cubic Hermite functions for ``q(0)``, ``dq/dτ(0)``,
+        ``q(1)``, ``dq/dτ(1)``, then the free shapes.
+    derivatives : list
+        Their τ-derivatives, in the same order.
+    """
     h = [2 * tau**3 - 3 * tau**2 + 1, tau**3 - 2 * tau**2 + tau, -2 * tau**3 + 3 * tau**2, tau**3 - tau**2]
     dh = [6 * tau**2 - 6 * tau, 3 * tau**2 - 4 * tau + 1, -6 * tau**2 + 6 * tau, 3 * tau**2 - 2 * tau]
     free = [(j - 4) * tau**2 - (j - 3) * tau**3 + tau ** (j - 1) for j in range(5, terms + 5)]
@@ -42,9 +61,32 @@ def shape_basis(tau, terms: int, math=np):
     return h + free, dh + dfree
 
 
-def polynomial(tau, q0, q1, slope0, slope1, coefficients, terms: int, math=np):
-    """``q(τ)`` normalised and ``dq/dτ`` (coefficients: 4 x terms). NumPy: ``tau`` a row of times,
-    the other vectors columns (4, 1); results (4, m). CasADi: one scalar τ."""
+def polynomial(tau: Any, q0: Any, q1: Any, slope0: Any, slope1: Any, coefficients: Any, terms: int,
+               math: Any = np) -> tuple[Any, Any]:
+    """The normalised quaternion polynomial of eq. 52 and its τ-derivative.
+
+    Parameters
+    ----------
+    tau : (1, m) ndarray or casadi.SX
+        Scaled times ``τ = t / t_f`` in [0, 1]: a row for NumPy, one scalar for CasADi.
+    q0, q1 : (4, 1) ndarray or casadi.SX
+        Boundary attitudes (scalar first, body to inertial), columns.
+    slope0, slope1 : (4, 1) ndarray or casadi.SX
+        Boundary slopes ``dq/dτ = t_f ½ q ⊗ [0, ω]`` [dimensionless], columns.
+    coefficients : (4, terms) ndarray or casadi.SX
+        ``e_ij`` of the free shapes.
+    terms : int
+        N, the number of free shapes.
+    math : module, optional
+        ``numpy`` (default; columns are times) or ``casadi`` (one scalar τ).
+
+    Returns
+    -------
+    q : (4, m) ndarray or casadi.SX
+        ``p/‖p‖``, unit quaternions.
+    dq : (4, m) ndarray or casadi.SX
+        ``dq/dτ`` (derivative of the normalised polynomial).
+    """
     basis, dbasis = shape_basis(tau, terms, math)
     p = basis[0] * q0 + basis[1] * slope0 + basis[2] * q1 + basis[3] * slope1
     dp = dbasis[0] * q0 + dbasis[1] * slope0 + dbasis[2] * q1 + dbasis[3] * slope1
@@ -61,7 +103,24 @@ def polynomial(tau, q0, q1, slope0, slope1, coefficients, terms: int, math=np):
 
 
 def build_solver(terms: int, cost: str) -> ca.Function:
-    """IPOPT on the 4 x terms coefficients; parameters [q0, q1, slope0, slope1, I (9), T]."""
+    """The IPOPT solver of the shape coefficients for one number of terms and one cost.
+
+    Parameters
+    ----------
+    terms : int
+        N, the number of free shapes.
+    cost : {"path", "torque"}
+        ``path``: ``∫₀¹ ‖dq/dτ‖² dτ`` (Gauss-Legendre); ``torque``: ``∫ ‖I ω̇ + ω × I ω‖² dt`` [N² m² s]
+        on a uniform grid.
+
+    Returns
+    -------
+    casadi.Function
+        ``nlpsol`` with decision ``vec(e)`` (4 x terms, column-major), parameters
+        ``[q0 (4), q1 (4), slope0 (4), slope1 (4), I (9, column-major, kg m^2), T (s)]`` and
+        constraints ``‖p(τ_k)‖²`` at the quadrature points (bounded to keep the raw polynomial near
+        the unit sphere).
+    """
     e = ca.SX.sym("e", 4, terms)
     p = ca.SX.sym("p", 26)
     q0, q1, s0, s1 = p[0:4], p[4:8], p[8:12], p[12:16]
@@ -99,14 +158,38 @@ def build_solver(terms: int, cost: str) -> ca.Function:
 
 
 class ShapeReference(Reference):
-    """Normalised polynomial attitude; rate and acceleration by eq. 54, torque by inverse dynamics."""
+    """Normalised polynomial attitude; rate by eq. 54, its derivative by central differences (step
+    1e-5 in τ, one-sided at the ends), torque by inverse dynamics.
 
-    def __init__(self, q0, q1, slope0, slope1, coefficients, terms, duration, inertia, message, stats):
+    Parameters
+    ----------
+    q0, q1 : (4,) ndarray
+        Boundary attitudes, scalar first, body to inertial (``q1`` on the side of ``q0``).
+    slope0, slope1 : (4,) ndarray
+        Boundary slopes ``dq/dτ = T ½ q ⊗ [0, ω]`` with the problem's T (dimensionless).
+    coefficients : (4, terms) ndarray
+        ``e_ij`` of the free shapes.
+    terms : int
+        N, the number of free shapes.
+    duration : float
+        t_f [s], over which τ runs from 0 to 1.
+    inertia : (3, 3) ndarray
+        Body inertia [kg m^2].
+    message : str
+        Outcome description.
+    stats : dict
+        Solver statistics.
+    """
+
+    def __init__(self, q0: Array, q1: Array, slope0: Array, slope1: Array, coefficients: Array, terms: int,
+                 duration: float, inertia: Array, message: str, stats: dict[str, Any]) -> None:
         super().__init__("shape_polynomial", duration, inertia, message=message, stats=stats)
         self.args = (q0, q1, slope0, slope1, coefficients, terms)
 
     def _rate(self, tau: Array) -> tuple[Array, Array]:
-        q, dq = polynomial(tau[None, :], *(np.asarray(a)[:, None] if i < 4 else a for i, a in enumerate(self.args)))
+        q0, q1, slope0, slope1, coefficients, terms = self.args
+        q, dq = polynomial(tau[None, :], np.asarray(q0)[:, None], np.asarray(q1)[:, None],
+                           np.asarray(slope0)[:, None], np.asarray(slope1)[:, None], coefficients, terms)
         return q.T, 2 * quat.product(quat.conjugate(q.T), dq.T)[:, 1:] / self.duration
 
     def _evaluate(self, t: Array) -> ReferenceSample:
@@ -126,6 +209,27 @@ class ShapePolynomialPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
+        """Options of ``shape_polynomial`` (YAML ``planner.options``).
+
+        Attributes
+        ----------
+        terms : int or None
+            N, the number of free shapes of eq. 52, 1 to 12; ``None`` (default): try
+            ``1 … max_terms`` and keep the best (shortest t_f with ``duration: rate_limit``, else
+            the lowest cost).
+        max_terms : int
+            Largest N tried when ``terms`` is ``None``, 1 to 12 (default 6).
+        cost : {"path", "torque"}
+            What the coefficients minimise: ``path`` (default) ``∫₀¹ ‖dq/dτ‖² dτ``, or ``torque``
+            ``∫ ‖I ω̇ + ω × I ω‖² dt`` over the scenario's duration.
+        duration : {"rate_limit", "scenario"}
+            ``rate_limit`` (default; rest-to-rest only): the shortest t_f with ``‖ω‖ <= max_rate``,
+            the paper's choice; ``scenario``: the scenario's T.
+        max_rate : float or None
+            Rate bound [rad/s] for ``duration: rate_limit``; ``None`` (default): the problem's
+            ``maneuver.max_rate``.
+        """
+
         terms: Annotated[int | None, Range(ge=1, le=12)] = None                                    # N; None tries 1..max_terms
         max_terms: Annotated[int, Range(ge=1, le=12)] = 6
         cost: Literal["path", "torque"] = "path"
@@ -133,8 +237,19 @@ class ShapePolynomialPlanner(Planner):
         max_rate: Annotated[float | None, Range(gt=0.0)] = None                               # rad/s; default: the problem's max_rate
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
-        """Why the shape polynomials cannot take ``problem`` (no target; ``duration: rate_limit``
-        without a rate bound or for a slew that does not start and end at rest), or ``None``."""
+        """Why the shape polynomials cannot take ``problem``.
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The problem to plan.
+
+        Returns
+        -------
+        str or None
+            The reason (no target attitude; ``duration: rate_limit`` without a rate bound or for a
+            slew that does not start and end at rest), or ``None``.
+        """
         o = self.options
         if o.duration == "rate_limit":
             if (o.max_rate if o.max_rate is not None else problem.max_rate) is None:
@@ -152,6 +267,7 @@ class ShapePolynomialPlanner(Planner):
         rest_to_rest = not np.any(problem.omega0) and not np.any(omegaf)
         if o.duration == "rate_limit" and not rest_to_rest:
             return FailedReference(self.name, "duration: rate_limit is for rest-to-rest slews; use duration: scenario")
+        assert problem.qf is not None  # problem_error refuses a free attitude
         q0 = problem.q0
         q1 = problem.qf if problem.qf @ q0 >= 0 else -problem.qf  # the shorter way round
         T = problem.duration
@@ -165,13 +281,13 @@ class ShapePolynomialPlanner(Planner):
             seed = np.zeros((4, terms))
             seed[:, :min(terms, previous.shape[1])] = previous[:, :terms]  # N − 1 terms seed N
             result = solve_multistart(solver, [seed.T.ravel()], p=params, lbg=0.5, ubg=2.0)
-            if not result.success:
+            if not result.success or result.x is None:
                 continue
             coefficients = result.x.reshape(terms, 4).T
             previous = coefficients
             probe = ShapeReference(q0, q1, slope0, slope1, coefficients, terms, 1.0, problem.spacecraft.inertia, "", {})
             peak = float(np.max(np.linalg.norm(probe._rate(np.linspace(0, 1, 2001))[1], axis=1)))  # per unit τ
-            duration = peak / max_rate if o.duration == "rate_limit" else T
+            duration = peak / max_rate if o.duration == "rate_limit" and max_rate is not None else T
             score = duration if o.duration == "rate_limit" else result.f
             if best is None or score < best[0]:
                 best = (score, terms, coefficients, duration, result)

@@ -1,0 +1,114 @@
+"""The manoeuvre a planner is given: :class:`ManeuverProblem` (spacecraft, environment, boundary
+conditions, duration), part of the planner contract of :mod:`planners.base`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ocp import AttitudeModel, Environment, Spacecraft
+
+Array = NDArray[np.float64]
+
+
+
+@dataclass(frozen=True)
+class ManeuverProblem:
+    """A slew to plan: the spacecraft, its environment and the boundary conditions.
+
+    Inputs are checked and normalised on construction (a ``ValueError`` or ``TypeError`` names the
+    field): quaternions become unit float arrays, vectors float arrays of the right size.
+
+    Parameters
+    ----------
+    spacecraft : ocp.Spacecraft
+        The body (inertia, actuators: wheels, torquers, magnetorquers).
+    q0 : (4,) array_like
+        Initial attitude quaternion, scalar first, body to inertial (normalised here).
+    omega0 : (3,) array_like
+        Initial body rate [rad/s], body axes.
+    qf : (4,) array_like or None
+        Target attitude, scalar first, body to inertial (normalised here). ``None`` leaves the final
+        attitude free, which only suits planners that accept it in :meth:`Planner.problem_error`
+        (the default refuses it).
+    duration : float
+        Manoeuvre time T [s], finite and positive; minimum-time planners take it as an initial guess
+        or bound and return their own duration.
+    omegaf : (3,) array_like or None, optional
+        Target body rate [rad/s], body axes. ``None`` (default) leaves the final rate free.
+    environment : ocp.Environment, optional
+        Orbit and environment torques (gravity gradient, constant disturbance, magnetic field); the
+        default has none.
+    wheel_momentum0 : (n_w,) array_like or None, optional
+        Initial wheel momenta [N m s], one per wheel of ``spacecraft``; ``None`` (default): zero.
+        Stored as an array after construction.
+    max_rate : float or None, optional
+        Bound on the body rate norm [rad/s] for planners that honour it (``maneuver.max_rate``);
+        ``None`` (default): no bound.
+    """
+
+    spacecraft: Spacecraft
+    q0: Array
+    omega0: Array
+    qf: Array | None
+    duration: float
+    omegaf: Array | None = None
+    environment: Environment = field(default_factory=Environment)
+    wheel_momentum0: Array | None = None
+    max_rate: float | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.spacecraft, Spacecraft):
+            raise TypeError(f"spacecraft must be an ocp.Spacecraft, got {type(self.spacecraft).__name__}")
+        if not isinstance(self.environment, Environment):
+            raise TypeError(f"environment must be an ocp.Environment, got {type(self.environment).__name__}")
+        object.__setattr__(self, "q0", _quaternion("q0", self.q0))
+        if self.qf is not None:
+            object.__setattr__(self, "qf", _quaternion("qf", self.qf))
+        object.__setattr__(self, "omega0", _vector("omega0", self.omega0, 3))
+        if self.omegaf is not None:
+            object.__setattr__(self, "omegaf", _vector("omegaf", self.omegaf, 3))
+        momentum = np.zeros(self.spacecraft.n_wheels) if self.wheel_momentum0 is None else self.wheel_momentum0
+        object.__setattr__(self, "wheel_momentum0", _vector("wheel_momentum0", momentum, self.spacecraft.n_wheels))
+        if not isinstance(self.duration, (int, float, np.floating)) or not np.isfinite(self.duration) or not self.duration > 0:
+            raise ValueError(f"duration must be a finite positive number of seconds, got {self.duration!r}")
+        if self.max_rate is not None and (not isinstance(self.max_rate, (int, float, np.floating))
+                                          or not np.isfinite(self.max_rate) or not self.max_rate > 0):
+            raise ValueError(f"max_rate must be a finite positive rate (rad/s) or None, got {self.max_rate!r}")
+
+    @property
+    def torque_limit(self) -> Array:
+        """(3,) ndarray: per-body-axis torque bound [N m] of the actuators (``Spacecraft.body_torque_limit``)."""
+        return self.spacecraft.body_torque_limit()
+
+    @cached_property
+    def model(self) -> AttitudeModel:
+        """ocp.AttitudeModel: the symbolic model of this spacecraft in this environment (built once)."""
+        return AttitudeModel(self.spacecraft, self.environment)
+
+    @property
+    def initial_state(self) -> Array:
+        """(7 + n_w,) ndarray: the model state ``[q0, ω0, h_w0]`` at t = 0 (rad/s, N m s)."""
+        return np.concatenate([self.q0, self.omega0, self.wheel_momentum0])
+
+
+def _vector(name: str, value: ArrayLike, size: int) -> Array:
+    """``value`` as a finite float vector of ``size`` entries, or a ``ValueError`` naming ``name``."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be {size} numbers, got {value!r}") from None
+    if array.shape != (size,) or not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be {size} finite numbers, got shape {array.shape}: {array.tolist()}")
+    return array
+
+
+def _quaternion(name: str, value: ArrayLike) -> Array:
+    """A unit quaternion from ``value`` (normalised), or a ``ValueError`` for a zero one."""
+    q = _vector(name, value, 4)
+    if not np.linalg.norm(q) > 1e-6:
+        raise ValueError(f"{name} must be a non-zero quaternion [q0, q1, q2, q3] (scalar first), got {q.tolist()}")
+    return q / np.linalg.norm(q)
