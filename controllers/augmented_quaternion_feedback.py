@@ -33,12 +33,13 @@ from typing import Annotated, Any
 import casadi as ca
 import numpy as np
 
-from controllers.base import Array, Controller, check_gain, float_rows, gain_matrix
+from controllers.allocation import float_rows
+from controllers.base import Array, Controller, check_gain, gain_matrix
 from ocp import Command, Measurement, Spacecraft
 from ocp.fast_call import as_floats
 from ocp.layout import REFERENCE_FIELDS, split_measurement
 from ocp.options import Range
-from ocp.simulator import GridSampledReference
+from ocp.simulation_data import GridSampledReference
 
 
 class AugmentedQuaternionFeedback(Controller):
