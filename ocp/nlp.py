@@ -19,6 +19,17 @@ Starts are tried in order; the search stops once ``agree`` converged starts have
 ``rtol`` (relative, with ``atol``) of the best so far: the best optimum has been found again from
 a different start, which is the evidence that more starts would not improve it.
 
+Fallbacks
+---------
+``fallback`` guesses are tried only while no start has converged (e.g. the unperturbed warm start
+after a perturbed copy of it that hit the iteration limit).
+
+Warm starts with multipliers
+----------------------------
+``lam_x0`` / ``lam_g0`` pass bound and constraint multipliers with the guesses (a solve of a nearby
+problem, e.g. a regularised one); :func:`warm_start_options` are the matching IPOPT options, under
+which the interior point starts at the guess and its multipliers instead of pushing it inside.
+
 Restarts
 --------
 With ``restart > 0``, after the given guesses (once one has converged) come copies of the best point
@@ -30,8 +41,9 @@ point, which then becomes the best and is checked in turn.
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -74,9 +86,49 @@ def solver_options(solver: str = "ipopt", tolerance: float = 1e-8, max_iteration
     return common
 
 
+def warm_start_options(solver: str = "ipopt", mu_init: float = 1e-6) -> dict[str, Any]:
+    """Extra ``nlpsol`` options to start from a guess together with its multipliers.
+
+    Parameters
+    ----------
+    solver : str
+        ``"ipopt"`` (FATROP takes no multiplier warm start here: an empty dict).
+    mu_init : float
+        Initial barrier parameter: small, since the guess is already (nearly) optimal.
+
+    Returns
+    -------
+    dict
+        Options to merge into :func:`solver_options`' ``extra``.
+    """
+    if solver != "ipopt":
+        return {}
+    tiny = 1e-9
+    return {"ipopt.warm_start_init_point": "yes", "ipopt.mu_init": mu_init,
+            "ipopt.warm_start_bound_push": tiny, "ipopt.warm_start_bound_frac": tiny,
+            "ipopt.warm_start_mult_bound_push": tiny, "ipopt.warm_start_slack_bound_push": tiny,
+            "ipopt.warm_start_slack_bound_frac": tiny}
+
+
 @dataclass
 class StartResult:
-    """One start: solver status, objective, iterations, wall time (s), constraint violation."""
+    """One start of :func:`solve_multistart`.
+
+    Parameters
+    ----------
+    status : str
+        The solver's return status (e.g. IPOPT ``Solve_Succeeded``).
+    f : float
+        Objective at the point where the start stopped (the problem's units).
+    iterations : int
+        Solver iterations of this start.
+    time_s : float
+        Wall time of this start [s].
+    violation : float
+        Largest constraint violation at that point (constraint units).
+    converged : bool
+        Whether the module's status policy accepts the start.
+    """
 
     status: str
     f: float
@@ -90,18 +142,30 @@ class StartResult:
 class NLPResult:
     """The outcome of :func:`solve_multistart` (attributes as in ``scipy.optimize.OptimizeResult``).
 
-    Attributes
+    Parameters
     ----------
-    x : the best converged decision vector, or ``None``.
-    f : its objective (``inf`` without one).
-    g : its constraint values, or ``None``.
-    success : a start converged (see the module's status policy).
-    status : ``"ok"``, ``"failed"`` or ``"infeasible"`` (the planners' statuses).
-    message : a human-readable summary.
-    iterations : solver iterations over all starts.
-    time_s : wall time of all starts (s).
-    best_start : index of the winning start, or ``None``.
-    starts : per-start :class:`StartResult`.
+    x : ndarray or None
+        The best converged decision vector, or ``None``.
+    f : float
+        Its objective (``inf`` without one).
+    g : ndarray or None
+        Its constraint values, or ``None``.
+    success : bool
+        A start converged (see the module's status policy).
+    status : str
+        ``"ok"``, ``"failed"`` or ``"infeasible"`` (the planners' statuses).
+    message : str
+        A human-readable summary.
+    iterations : int
+        Solver iterations over all starts.
+    time_s : float
+        Wall time of all starts [s].
+    best_start : int or None
+        Index of the winning start, or ``None``.
+    starts : list of StartResult
+        Per-start outcomes, in the order tried.
+    lam_x, lam_g : ndarray or None
+        Bound and constraint multipliers at ``x`` (``None`` without a converged start).
     """
 
     x: Array | None
@@ -114,20 +178,43 @@ class NLPResult:
     time_s: float
     best_start: int | None
     starts: list[StartResult] = field(default_factory=list)
+    lam_x: Array | None = None
+    lam_g: Array | None = None
 
     @property
     def statuses(self) -> list[str]:
+        """The solver status of every start, in order."""
         return [s.status for s in self.starts]
 
     def stats(self) -> dict[str, Any]:
-        """A planner's ``stats`` entries: objective, iterations, statuses, timings, per start."""
+        """A planner's ``stats`` entries.
+
+        Returns
+        -------
+        dict
+            ``objective``, ``iterations``, ``solver_status`` (list), ``solve_time_s`` [s],
+            ``best_start`` and ``starts`` (one dict per start, fields of :class:`StartResult`).
+        """
         return {"objective": self.f, "iterations": self.iterations, "solver_status": self.statuses,
                 "solve_time_s": self.time_s, "best_start": self.best_start,
                 "starts": [vars(s) for s in self.starts]}
 
 
 def violation(g: Array, lbg: Any, ubg: Any) -> float:
-    """Largest violation of ``lbg <= g <= ubg`` (0 when satisfied)."""
+    """Largest violation of ``lbg <= g <= ubg``.
+
+    Parameters
+    ----------
+    g : array_like
+        Constraint values.
+    lbg, ubg : float or array_like
+        Their bounds (broadcast to ``g``).
+
+    Returns
+    -------
+    float
+        The largest excess over a bound (0 when every bound holds).
+    """
     g = np.ravel(g)
     if g.size == 0:
         return 0.0
@@ -136,52 +223,91 @@ def violation(g: Array, lbg: Any, ubg: Any) -> float:
 
 
 def converged(status: str, success: bool, violation_: float, feasibility_tolerance: float) -> bool:
-    """The status policy of the module docstring."""
+    """The status policy of the module docstring.
+
+    Parameters
+    ----------
+    status : str
+        The solver's return status.
+    success : bool
+        The solver's own ``success`` flag.
+    violation_ : float
+        Largest constraint violation at the returned point.
+    feasibility_tolerance : float
+        Violation accepted with ``Search_Direction_Becomes_Too_Small``.
+
+    Returns
+    -------
+    bool
+        Whether the start counts as converged.
+    """
     return success or status in SUCCESS or (status in STALLED_AT_FEASIBLE and violation_ <= feasibility_tolerance)
 
 
 def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = None, lbx: Any = None,
                      ubx: Any = None, lbg: Any = None, ubg: Any = None, agree: int = 2, rtol: float = 1e-6,
                      atol: float = 1e-12, feasibility_tolerance: float = 1e-8,
-                     max_starts: int | None = None, restart: float = 0.0, max_restarts: int = 4) -> NLPResult:
+                     max_starts: int | None = None, restart: float = 0.0, max_restarts: int = 4,
+                     fallback: Sequence[Array] = (), lam_x0: Any = None, lam_g0: Any = None) -> NLPResult:
     """Solve from each guess in turn, keep the best converged start, stop early on agreement.
 
     Parameters
     ----------
-    solver : a ``casadi.nlpsol`` function.
-    guesses : initial decision vectors (clipped into ``[lbx, ubx]``); may be a lazy iterable.
-    p, lbx, ubx, lbg, ubg : the solver's arguments (``None``: the solver's defaults).
-    agree : stop once this many converged starts lie within ``rtol``/``atol`` of the best
+    solver : casadi.Function
+        A ``casadi.nlpsol`` function.
+    guesses : iterable of ndarray
+        Initial decision vectors (clipped into ``[lbx, ubx]``); may be a lazy iterable.
+    p, lbx, ubx, lbg, ubg : array_like or None
+        The solver's arguments (``None``: the solver's defaults).
+    agree : int
+        Stop once this many converged starts lie within ``rtol``/``atol`` of the best
         objective (1: stop at the first converged start; 0: never stop early).
-    feasibility_tolerance : constraint violation accepted by the status policy.
-    max_starts : try at most this many guesses.
-    restart : relative perturbation of the restarts from the best point (0: no restarts).
-    max_restarts : restarts at most.
+    rtol, atol : float
+        Relative and absolute agreement of objectives.
+    feasibility_tolerance : float
+        Constraint violation accepted by the status policy.
+    max_starts : int or None
+        Try at most this many guesses (``None``: all).
+    restart : float
+        Relative perturbation of the restarts from the best point (0: no restarts).
+    max_restarts : int
+        Restarts at most.
+    fallback : sequence of ndarray
+        Guesses tried after ``guesses`` only while no start has converged.
+    lam_x0, lam_g0 : array_like or None
+        Initial bound and constraint multipliers passed with every guess (``None``: zeros).
 
     Returns
     -------
     NLPResult
+        The best converged start and the record of all starts.
     """
     args: dict[str, Any] = {}
-    for name, value in (("p", p), ("lbx", lbx), ("ubx", ubx), ("lbg", lbg), ("ubg", ubg)):
+    for name, value in (("p", p), ("lbx", lbx), ("ubx", ubx), ("lbg", lbg), ("ubg", ubg),
+                        ("lam_x0", lam_x0), ("lam_g0", lam_g0)):
         if value is not None:
             args[name] = value
     low = -np.inf if lbx is None else np.asarray(lbx, dtype=float)
     high = np.inf if ubx is None else np.asarray(ubx, dtype=float)
     g_low = -np.inf if lbg is None else lbg
     g_high = np.inf if ubg is None else ubg
-    best_x, best_g, best_f, best_index = None, None, np.inf, None
+    best: dict[str, Any] = {}
+    best_f, best_index = np.inf, None
     starts: list[StartResult] = []
     objectives: list[float] = []
     begin = time.perf_counter()
 
-    def candidates():
+    def candidates() -> Iterator[Array]:
         for index, guess in enumerate(guesses):
             if max_starts is not None and index >= max_starts:
                 break
             yield guess
-        for k in range(max_restarts if restart > 0 and best_x is not None else 0):
-            yield perturbed(best_x, 1, seed=k + 1, scales=(restart, restart))[0]
+        for guess in fallback:
+            if best:
+                break
+            yield guess
+        for k in range(max_restarts if restart > 0 and best else 0):
+            yield perturbed(best["x"], 1, seed=k + 1, scales=(restart, restart))[0]
 
     for index, guess in enumerate(candidates()):
         tic = time.perf_counter()
@@ -199,24 +325,43 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
             continue
         objectives.append(f)
         if f < best_f:
-            best_x, best_g, best_f, best_index = solution["x"].full().ravel(), g, f, index
+            best = {key: solution[key].full().ravel() for key in ("x", "lam_x", "lam_g")}
+            best["g"], best_f, best_index = g, f, index
         close = sum(abs(value - best_f) <= atol + rtol * abs(best_f) for value in objectives)
         if agree and close >= agree:
             break
     total = time.perf_counter() - begin
     iterations = sum(s.iterations for s in starts)
     statuses = [s.status for s in starts]
-    if best_x is None:
+    if best_index is None:
         status = "infeasible" if statuses and all(s in INFEASIBLE for s in statuses) else "failed"
         message = f"no start converged: {sorted(set(statuses))}"
         return NLPResult(None, np.inf, None, False, status, message, iterations, total, None, starts)
     message = f"objective {best_f:.8g} from start {best_index} of {len(starts)} tried ({statuses[best_index]})"
-    return NLPResult(best_x, best_f, best_g, True, "ok", message, iterations, total, best_index, starts)
+    return NLPResult(best["x"], best_f, best["g"], True, "ok", message, iterations, total, best_index, starts,
+                     best["lam_x"], best["lam_g"])
 
 
 def perturbed(center: Array, count: int, seed: int = 0, scales: Sequence[float] = (0.01, 0.05)) -> list[Array]:
-    """``count`` copies of ``center`` with relative normal noise: the first at ``scales[0]``, the
-    rest at ``scales[1]`` (noise proportional to ``|center| + 1e-3``, reproducible by ``seed``)."""
+    """Copies of a point with relative normal noise.
+
+    Parameters
+    ----------
+    center : ndarray
+        The point (a decision vector).
+    count : int
+        How many copies.
+    seed : int
+        Seed of the random generator (the copies are reproducible).
+    scales : (2,) sequence of float
+        Relative noise of the first copy and of the others; the noise of a component is
+        proportional to ``|center| + 1e-3``.
+
+    Returns
+    -------
+    list of ndarray
+        ``count`` perturbed copies of ``center``.
+    """
     rng = np.random.default_rng(seed)
     size = np.abs(center) + 1e-3
     return [center + rng.normal(0.0, 1.0, center.size) * size * (scales[0] if k == 0 else scales[1])

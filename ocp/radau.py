@@ -10,24 +10,31 @@ constraints (cones) hold at every state point and midway between them.
 """
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import casadi as ca
 import numpy as np
 
+from ocp.model import AttitudeModel
 from ocp.transcription_base import Array, Interval, OptimalControlProblem, Transcription
 
 
-def _basis(points: Array, r: int) -> np.poly1d:
-    basis = np.poly1d([1.0])
-    for s, p_s in enumerate(points):
-        if s != r:
-            basis *= np.poly1d([1.0, -p_s]) / (points[r] - p_s)
-    return basis
-
-
 def lagrange(points: Array, tau: Array) -> Array:
-    """Basis values (len(tau), len(points)) of the Lagrange polynomials through ``points``."""
+    """Values of the Lagrange basis through ``points``.
+
+    Parameters
+    ----------
+    points : (n,) ndarray
+        Distinct interpolation points (dimensionless).
+    tau : (m,) ndarray
+        Where to evaluate the basis.
+
+    Returns
+    -------
+    (m, n) ndarray
+        ``[i, r] = ℓ_r(tau[i])``.
+    """
     basis = np.ones((tau.size, points.size))
     for r, p_r in enumerate(points):
         for s, p_s in enumerate(points):
@@ -36,36 +43,78 @@ def lagrange(points: Array, tau: Array) -> Array:
     return basis
 
 
+def differentiation_matrix(points: Array) -> Array:
+    """Derivatives of the Lagrange basis through ``points`` at those points (barycentric form).
+
+    Parameters
+    ----------
+    points : (n,) ndarray
+        Distinct interpolation points (dimensionless, e.g. on [0, 1]).
+
+    Returns
+    -------
+    (n, n) ndarray
+        ``D[r, j] = ℓ_r'(points[j])``.
+    """
+    difference = points[:, None] - points[None, :]
+    np.fill_diagonal(difference, 1.0)
+    barycentric = 1.0 / np.prod(difference, axis=1)
+    derivative = (barycentric[None, :] / barycentric[:, None]) / difference  # [j, r], r != j
+    np.fill_diagonal(derivative, 0.0)
+    np.fill_diagonal(derivative, -derivative.sum(axis=1))
+    return derivative.T
+
+
 def radau_weights(degree: int) -> Array:
-    """Weights on [0, 1] of the ``degree``-point Radau rule (right end point included)."""
+    """Weights on [0, 1] of the ``degree``-point Radau rule (right end point included).
+
+    Parameters
+    ----------
+    degree : int
+        Number of Radau points.
+
+    Returns
+    -------
+    (degree,) ndarray
+        ``w_j = ∫₀¹ ℓ_j`` for the Lagrange basis through the Radau points.
+    """
     points = np.asarray(ca.collocation_points(degree, "radau"))
-    return np.array([np.polyint(_basis(points, r))(1.0) for r in range(degree)])
+    # Exact for the monomials 1 … τ^(d−1): Σ_j w_j τ_j^k = 1/(k + 1), the same weights as ∫ ℓ_j.
+    return np.linalg.solve(np.vander(points, degree, increasing=True).T, 1.0 / np.arange(1, degree + 1))
 
 
 class RadauCollocation(Transcription):
-    """Legendre-Gauss-Radau collocation of degree ``degree`` (see the module docstring)."""
+    """Legendre-Gauss-Radau collocation of degree ``degree`` (see the module docstring).
+
+    Parameters
+    ----------
+    intervals : int
+        Number of mesh intervals.
+    degree : int
+        Radau points per interval (state polynomials of this degree).
+    """
 
     name = "collocation"
 
-    def __init__(self, intervals: int, degree: int = 3):
+    def __init__(self, intervals: int, degree: int = 3) -> None:
         super().__init__(intervals)
         self.degree = degree
         tau = np.append(0.0, ca.collocation_points(degree, "radau"))
         self.tau = tau
-        self.derivative = np.array([np.polyder(_basis(tau, r))(tau) for r in range(degree + 1)])  # [r, j] = ℓ_r'(τ_j)
+        self.derivative = differentiation_matrix(tau)  # [r, j] = ℓ_r'(τ_j)
         self.quadrature = radau_weights(degree)
         midpoints = 0.5 * (tau[:-1] + tau[1:])
         self.midpoint_weights = lagrange(tau, midpoints)
 
     @classmethod
-    def from_options(cls, options: Any) -> "RadauCollocation":
+    def from_options(cls, options: Any) -> RadauCollocation:
         return cls(options.intervals, options.degree)
 
     def _sizes(self, problem: OptimalControlProblem) -> tuple[int, int, int]:
         model, d = problem.model, self.degree
         return model.nx * d, model.nu * d, (3 * d if problem.uses_slack else 0)
 
-    def state_of(self, s):
+    def state_of(self, s: Any) -> Any:
         return s
 
     def interval(self, problem: OptimalControlProblem) -> Interval:
@@ -99,17 +148,19 @@ class RadauCollocation(Transcription):
         function = ca.Function("radau_interval", [s, c, t0, h, dist], [X[:, d], path, cost])
         return Interval(function, nx, c.numel(), lower, upper)
 
-    def stage_bounds(self, problem, x_low, x_high, u_low, u_high):
+    def stage_bounds(self, problem: OptimalControlProblem, x_low: Array, x_high: Array, u_low: Array,
+                     u_high: Array) -> tuple[Array, Array, Array, Array]:
         d = self.degree
         _, _, n_slack = self._sizes(problem)
         c_low = np.concatenate([np.tile(x_low, d), np.tile(u_low, d), np.zeros(n_slack)])
         c_high = np.concatenate([np.tile(x_high, d), np.tile(u_high, d), np.full(n_slack, np.inf)])
         return x_low, x_high, c_low, c_high
 
-    def stage_guess(self, problem, sample: Callable, duration: float):
+    def stage_guess(self, problem: OptimalControlProblem, sample: Callable[[Array], tuple[Array, Array, Array]],
+                    duration: float) -> tuple[Array, Array]:
         N = self.intervals
         h = duration / N
-        nodes = np.arange(N + 1) * h
+        nodes = np.arange(N + 1, dtype=float) * h
         x_nodes, _, _ = sample(nodes)
         times = ((np.arange(N)[:, None] + self.tau[None, 1:]) * h).ravel()
         x, u, torque = sample(times)
@@ -118,21 +169,22 @@ class RadauCollocation(Transcription):
             blocks.append(torque.reshape(N, -1))
         return x_nodes.T, np.hstack(blocks).T
 
-    def split(self, S, C):
+    def split(self, S: Any, C: Any) -> tuple[Any, Any]:
         nx, d, N = S.shape[0], self.degree, self.intervals
         # column k of [S; interior] is [x_k0, x_k1 … x_kd]: reshaped, the states point by point
         states = ca.reshape(ca.vertcat(S[:, :N], C[:nx * d, :]), nx, N * (d + 1))
         return states, C[nx * d:, :]
 
-    def smoothness(self, duration):
-        """The state polynomials join continuously at the mesh nodes, their slopes and the controls
-        do not; the dynamics hold at the Radau points inside each interval."""
+    def smoothness(self, duration: float) -> tuple[Array, Array]:
+        # The state polynomials join continuously at the mesh nodes, their slopes and the controls
+        # do not; the dynamics hold at the Radau points inside each interval.
         nodes = np.arange(1, self.intervals) * duration / self.intervals
         radau = self.tau[1:-1] if self.tau[-1] == 1.0 else self.tau[1:]
         inner = ((np.arange(self.intervals)[:, None] + radau[None, :]) * duration / self.intervals).ravel()
         return nodes, inner
 
-    def interpolate(self, model, states, controls, duration, t):
+    def interpolate(self, model: AttitudeModel, states: Array, controls: Array, duration: float,
+                    t: Array) -> tuple[Array, Array]:
         N, d, h = self.intervals, self.degree, duration / self.intervals
         k = np.minimum((t / h).astype(int), N - 1)
         tau = t / h - k

@@ -9,26 +9,36 @@ States between nodes: cubic Hermite with the model's derivatives.
 """
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import casadi as ca
 import numpy as np
 
 from ocp.integration import rk4_step
-from ocp.transcription_base import Interval, OptimalControlProblem, Transcription
+from ocp.model import AttitudeModel
+from ocp.transcription_base import Array, Interval, OptimalControlProblem, Transcription
 
 
 class MultipleShooting(Transcription):
-    """Multiple shooting with piecewise-linear controls (see the module docstring)."""
+    """Multiple shooting with piecewise-linear controls (see the module docstring).
+
+    Parameters
+    ----------
+    intervals : int
+        Number of mesh intervals.
+    substeps : int
+        RK4 steps per interval.
+    """
 
     name = "multiple_shooting"
 
-    def __init__(self, intervals: int, substeps: int = 4):
+    def __init__(self, intervals: int, substeps: int = 4) -> None:
         super().__init__(intervals)
         self.substeps = substeps
 
     @classmethod
-    def from_options(cls, options: Any) -> "MultipleShooting":
+    def from_options(cls, options: Any) -> MultipleShooting:
         return cls(options.intervals, getattr(options, "substeps", 4))
 
     @classmethod
@@ -38,7 +48,7 @@ class MultipleShooting(Transcription):
                     "use transcription: collocation for L1 costs and keep-out / keep-in cones")
         return None
 
-    def state_of(self, s):
+    def state_of(self, s: Any) -> Any:
         return s[:self._nx]
 
     def interval(self, problem: OptimalControlProblem) -> Interval:
@@ -62,23 +72,26 @@ class MultipleShooting(Transcription):
                                [ca.vertcat(state[:nx], u1), ca.DM.zeros(0, 1), state[nx]])
         return Interval(function, nx + nu, nu, np.zeros(0), np.zeros(0))
 
-    def stage_bounds(self, problem, x_low, x_high, u_low, u_high):
+    def stage_bounds(self, problem: OptimalControlProblem, x_low: Array, x_high: Array, u_low: Array,
+                     u_high: Array) -> tuple[Array, Array, Array, Array]:
         return np.concatenate([x_low, u_low]), np.concatenate([x_high, u_high]), u_low, u_high
 
-    def stage_guess(self, problem, sample: Callable, duration: float):
+    def stage_guess(self, problem: OptimalControlProblem, sample: Callable[[Array], tuple[Array, Array, Array]],
+                    duration: float) -> tuple[Array, Array]:
         N = self.intervals
         x, u, _ = sample(np.linspace(0.0, duration, N + 1))
         return np.hstack([x, u]).T, u[1:].T
 
-    def split(self, S, C):
+    def split(self, S: Any, C: Any) -> tuple[Any, Any]:
         nx = self._nx
         return S[:nx, :], S[nx:, :]
 
-    def smoothness(self, duration):
-        """Cubic Hermite states with the model's derivatives at the nodes: C¹, exact at the nodes."""
+    def smoothness(self, duration: float) -> tuple[Array, Array]:
+        # Cubic Hermite states with the model's derivatives at the nodes: C¹, exact at the nodes.
         return np.zeros(0), np.arange(1, self.intervals) * duration / self.intervals
 
-    def interpolate(self, model, states, controls, duration, t):
+    def interpolate(self, model: AttitudeModel, states: Array, controls: Array, duration: float,
+                    t: Array) -> tuple[Array, Array]:
         N = self.intervals
         h = duration / N
         k = np.minimum((t / h).astype(int), N - 1)

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 
-def extremal_quaternion(t: Any, v: Any, r: Any, c: Any, beta: Any, math: Any = np):
+def extremal_quaternion(t: Any, v: Any, r: Any, c: Any, beta: Any, math: Any = np) -> tuple[Any, Any, Any, Any]:
     """``q*(t)`` from the identity (scalar first) as four components.
 
     Parameters

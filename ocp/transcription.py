@@ -8,9 +8,25 @@ from __future__ import annotations
 
 from ocp.radau import RadauCollocation, lagrange, radau_weights
 from ocp.shooting import MultipleShooting
-from ocp.transcription_base import NLP, Cone, Interval, OptimalControlProblem, Transcription
+from ocp.transcription_base import (
+           NLP,
+           Cone,
+           Interval,
+           OptimalControlProblem,
+           Transcription,
+)
 
 TRANSCRIPTIONS: dict[str, type[Transcription]] = {cls.name: cls for cls in (RadauCollocation, MultipleShooting)}
 
-__all__ = ["Cone", "Interval", "MultipleShooting", "NLP", "OptimalControlProblem", "RadauCollocation",
-           "TRANSCRIPTIONS", "Transcription", "lagrange", "radau_weights"]
+__all__ = [
+           "NLP",
+           "TRANSCRIPTIONS",
+           "Cone",
+           "Interval",
+           "MultipleShooting",
+           "OptimalControlProblem",
+           "RadauCollocation",
+           "Transcription",
+           "lagrange",
+           "radau_weights",
+]

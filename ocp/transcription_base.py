@@ -1,6 +1,7 @@
 """Optimal-control problems on the attitude model, and the stage-wise NLP every transcription shares.
 
-The problem (:class:`OptimalControlProblem`) says what is wanted; a :class:`Transcription` says how
+The problem (:class:`OptimalControlProblem`, in :mod:`ocp.ocp_problem` with :class:`Interval` and
+:class:`NLP`, re-exported here) says what is wanted; a :class:`Transcription` says how
 one mesh interval becomes NLP variables and constraints. It owns its layout: the interval as a
 CasADi function (mapped over the mesh, never called node by node from Python), the variables'
 bounds, the seeding from another reference and the interpolation of the solution.
@@ -26,8 +27,8 @@ L1 ``Σ|τ_i|`` (with slacks), plus ``time_weight · T``.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass, field
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -35,83 +36,10 @@ from numpy.typing import NDArray
 
 from ocp import quat_casadi as qc
 from ocp.model import AttitudeModel
+from ocp.ocp_problem import NLP, Cone, Interval, OptimalControlProblem
 
 Array = NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class Cone:
-    """Pointing constraint: the body ``boresight`` stays at least (keep-out) or at most (keep-in)
-    ``angle`` (rad) from the inertial unit ``direction``."""
-
-    boresight: tuple[float, float, float]
-    direction: tuple[float, float, float]
-    angle: float
-    keep_out: bool = True
-
-    def expression(self, q):
-        """``g <= 0`` when satisfied."""
-        pointing = ca.mtimes(qc.rotation_matrix(q), ca.DM(self.boresight))
-        cosine = ca.dot(pointing, ca.DM(self.direction))
-        return cosine - np.cos(self.angle) if self.keep_out else np.cos(self.angle) - cosine
-
-
-@dataclass(frozen=True)
-class OptimalControlProblem:
-    """What to optimise. Structural fields shape the NLP; values are passed at solve time."""
-
-    model: AttitudeModel
-    energy_weight: float = 1.0
-    l1_weight: float = 0.0
-    time_weight: float = 0.0
-    free_time: bool = False
-    fixed_final_rate: bool = True
-    cones: tuple[Cone, ...] = ()
-
-    @property
-    def uses_slack(self) -> bool:
-        return self.l1_weight > 0
-
-    def stage_cost(self, x, u, t, slack=None):
-        torque = self.model.actuator_torque(x, u, t)
-        cost = self.energy_weight * ca.sumsqr(torque)
-        if slack is not None:
-            cost += self.l1_weight * ca.sum1(slack)
-        return cost
-
-    def path_constraints(self, x):
-        return [cone.expression(x[0:4]) for cone in self.cones]
-
-
-@dataclass
-class NLP:
-    """A transcribed problem: a built solver and how to read its solution.
-
-    ``unpack(w, p) -> (T, states, controls)`` in the transcription's own point layout.
-    """
-
-    solver: ca.Function
-    n_w: int
-    unpack: ca.Function
-    lbg: Array
-    ubg: Array
-    free_time: bool
-    n_stage_state: int
-    n_interval: int
-    layout: dict = field(default_factory=dict)
-
-
-@dataclass
-class Interval:
-    """One mesh interval, built by a transcription. ``function(s, c, t0, h, d) -> (next, path, cost)``
-    with ``s`` the stage state without T, ``c`` the interval's variables, ``t0`` its start time,
-    ``h`` its length, ``d`` the disturbance parameter; ``path_lower <= path <= path_upper``."""
-
-    function: ca.Function
-    n_state: int
-    n_interval: int
-    path_lower: Array
-    path_upper: Array
+__all__ = ["NLP", "Array", "Cone", "Interval", "OptimalControlProblem", "Transcription"]
 
 
 class Transcription(ABC):
@@ -120,65 +48,217 @@ class Transcription(ABC):
     Subclasses implement :meth:`interval` (one interval as a CasADi function), the layout methods
     :meth:`stage_bounds`, :meth:`stage_guess`, :meth:`split` and :meth:`interpolate`, and
     :meth:`problem_error` for formulations they cannot take.
+
+    Parameters
+    ----------
+    intervals : int
+        Number of mesh intervals (equal lengths T / intervals).
     """
 
     name: str
 
-    def __init__(self, intervals: int):
+    def __init__(self, intervals: int) -> None:
         self.intervals = intervals
 
     @classmethod
     @abstractmethod
-    def from_options(cls, options: Any) -> "Transcription":
-        """The transcription configured from a planner's options (``intervals``, ``degree``, ...)."""
+    def from_options(cls, options: Any) -> Transcription:
+        """The transcription configured from a planner's options.
+
+        Parameters
+        ----------
+        options : object
+            A planner's ``Options`` (``intervals``, ``degree``, ``substeps``, ...).
+
+        Returns
+        -------
+        Transcription
+        """
 
     @classmethod
     def problem_error(cls, l1: bool, cones: bool) -> str | None:
-        """Why this transcription cannot take an L1 cost or cones, or ``None``."""
+        """Why this transcription cannot take a formulation.
+
+        Parameters
+        ----------
+        l1 : bool
+            The cost has an L1 term.
+        cones : bool
+            The problem has pointing cones.
+
+        Returns
+        -------
+        str or None
+            The reason, or ``None`` when it can.
+        """
         return None
 
     @abstractmethod
     def interval(self, problem: OptimalControlProblem) -> Interval:
-        """One interval (see :class:`Interval`)."""
+        """One interval as a CasADi function.
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise.
+
+        Returns
+        -------
+        Interval
+        """
 
     @abstractmethod
-    def state_of(self, s):
-        """The model state (nx) inside a stage state ``s``."""
+    def state_of(self, s: Any) -> Any:
+        """The model state inside a stage state.
+
+        Parameters
+        ----------
+        s : CasADi expression
+            A stage state ``s_k`` (without T).
+
+        Returns
+        -------
+        (nx,) CasADi expression
+        """
 
     @abstractmethod
     def stage_bounds(self, problem: OptimalControlProblem, x_low: Array, x_high: Array, u_low: Array,
                      u_high: Array) -> tuple[Array, Array, Array, Array]:
-        """Bounds of ``s_k`` (without T) and of ``c_k``: ``(s_low, s_high, c_low, c_high)``."""
+        """Bounds of ``s_k`` (without T) and of ``c_k``.
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise.
+        x_low, x_high : (nx,) ndarray
+            Bounds of the model state at every point (quaternion, rad/s, N m s).
+        u_low, u_high : (nu,) ndarray
+            Bounds of the actuator controls.
+
+        Returns
+        -------
+        tuple of ndarray
+            ``(s_low, s_high, c_low, c_high)``.
+        """
 
     @abstractmethod
-    def stage_guess(self, problem: OptimalControlProblem, sample: Callable, duration: float) -> tuple[Array, Array]:
-        """Initial guess ``(S (ns, N+1), C (nc, N))``; ``sample(times) -> (x (n, nx), u (n, nu),
-        |torque| (n, 3))`` evaluates the seeding reference."""
+    def stage_guess(self, problem: OptimalControlProblem, sample: Callable[[Array], tuple[Array, Array, Array]],
+                    duration: float) -> tuple[Array, Array]:
+        """Initial guess of the stage states and interval variables.
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise.
+        sample : callable
+            ``sample(times) -> (x (n, nx), u (n, nu), |torque| (n, 3))`` along the seeding reference.
+        duration : float
+            Duration of the guess [s].
+
+        Returns
+        -------
+        tuple of ndarray
+            ``(S (ns, N + 1), C (nc, N))``.
+        """
 
     @abstractmethod
-    def split(self, S, C) -> tuple[Any, Any]:
-        """``(states, controls)`` at the transcription's points from the stage matrices."""
+    def split(self, S: Any, C: Any) -> tuple[Any, Any]:
+        """States and controls at the transcription's points from the stage matrices.
+
+        Parameters
+        ----------
+        S : CasADi matrix (ns, N + 1)
+            Stage states (without T).
+        C : CasADi matrix (nc, N)
+            Interval variables.
+
+        Returns
+        -------
+        tuple
+            ``(states, controls)`` as CasADi matrices, one column per point.
+        """
 
     @abstractmethod
     def interpolate(self, model: AttitudeModel, states: Array, controls: Array, duration: float,
                     t: Array) -> tuple[Array, Array]:
-        """States ``(n, nx)`` and controls ``(n, nu)`` at times ``t`` in ``[0, duration]``."""
+        """The solution between its points.
+
+        Parameters
+        ----------
+        model : AttitudeModel
+            The spacecraft model.
+        states, controls : ndarray
+            ``unpack``'s states and controls (one column per point).
+        duration : float
+            T [s].
+        t : (n,) ndarray
+            Times in ``[0, duration]`` [s].
+
+        Returns
+        -------
+        tuple of ndarray
+            States ``(n, nx)`` and controls ``(n, nu)``.
+        """
 
     @abstractmethod
     def smoothness(self, duration: float) -> tuple[Array, Array]:
-        """``(breakpoints, enforced_times)`` of an interpolated solution over ``[0, duration]``:
-        the times where its slopes may jump, and the times where the dynamics are imposed."""
+        """Where an interpolated solution over ``[0, duration]`` may kink and where it is exact.
+
+        Parameters
+        ----------
+        duration : float
+            T [s].
+
+        Returns
+        -------
+        tuple of ndarray
+            ``(breakpoints, enforced_times)`` [s]: the times where its slopes may jump, and the
+            times where the dynamics are imposed.
+        """
 
     # -- the shared stage-wise assembly -------------------------------------------------------
     @staticmethod
-    def terminal(problem: OptimalControlProblem, x_end, qf, omegaf):
+    def terminal(problem: OptimalControlProblem, x_end: Any, qf: Any, omegaf: Any) -> list[Any]:
+        """The terminal equality constraints.
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise (``fixed_final_rate``).
+        x_end : CasADi expression
+            The model state at T.
+        qf : (4,) CasADi expression
+            Target quaternion.
+        omegaf : (3,) CasADi expression
+            Target body rate [rad/s].
+
+        Returns
+        -------
+        list of CasADi expressions
+            ``vec(q_f* ⊗ q(T)) = 0`` and, with a fixed final rate, ``ω(T) − ω_f = 0``.
+        """
         g = [qc.product(qc.conjugate(qf), x_end[0:4])[1:4]]
         if problem.fixed_final_rate:
             g.append(x_end[4:7] - omegaf)
         return g
 
-    def build(self, problem: OptimalControlProblem, solver: str, options: dict) -> NLP:
-        """The NLP in the stage-wise layout of the module docstring, solved by ``solver``."""
+    def build(self, problem: OptimalControlProblem, solver: str, options: dict[str, Any]) -> NLP:
+        """The NLP in the stage-wise layout of the module docstring, solved by ``solver``.
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise.
+        solver : str
+            ``"ipopt"`` or ``"fatrop"`` (a ``casadi.nlpsol`` plugin).
+        options : dict
+            ``nlpsol`` options (see :func:`ocp.nlp.solver_options`); ``expand`` defaults to true.
+
+        Returns
+        -------
+        NLP
+            The built solver, its constraint bounds and the ``unpack`` function.
+        """
         model, N = problem.model, self.intervals
         nx = model.nx
         interval = self.interval(problem)
@@ -222,7 +302,26 @@ class Transcription(ABC):
 
     def bounds(self, problem: OptimalControlProblem, nlp: NLP, x_low: Array, x_high: Array, u_low: Array,
                u_high: Array, duration: float) -> tuple[Array, Array]:
-        """``lbx``, ``ubx`` in the decision-vector layout; a free ``T`` lies in ``[1e-3, 1] × duration``."""
+        """Bounds of the decision vector.
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise.
+        nlp : NLP
+            The built NLP (its ``free_time``).
+        x_low, x_high : (nx,) ndarray
+            Bounds of the model state at every point.
+        u_low, u_high : (nu,) ndarray
+            Bounds of the actuator controls.
+        duration : float
+            The problem's duration [s]: a free ``T`` lies in ``[1e-3, 1] × duration``.
+
+        Returns
+        -------
+        tuple of ndarray
+            ``(lbx, ubx)`` in the decision-vector layout.
+        """
         s_low, s_high, c_low, c_high = self.stage_bounds(problem, x_low, x_high, u_low, u_high)
         if nlp.free_time:
             s_low, s_high = np.append(s_low, 1e-3 * duration), np.append(s_high, duration)
@@ -231,8 +330,26 @@ class Transcription(ABC):
         high = np.concatenate([np.tile(np.concatenate([s_high, c_high]), N), s_high])
         return low, high
 
-    def seed(self, problem: OptimalControlProblem, nlp: NLP, sample: Callable, duration: float) -> Array:
-        """An initial decision vector from ``sample`` (see :meth:`stage_guess`) over ``duration``."""
+    def seed(self, problem: OptimalControlProblem, nlp: NLP, sample: Callable[[Array], tuple[Array, Array, Array]],
+             duration: float) -> Array:
+        """An initial decision vector.
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise.
+        nlp : NLP
+            The built NLP (its ``free_time``).
+        sample : callable
+            The seeding reference, as in :meth:`stage_guess`.
+        duration : float
+            Duration of the guess [s] (also the guess of a free T).
+
+        Returns
+        -------
+        ndarray
+            The decision vector.
+        """
         S, C = self.stage_guess(problem, sample, duration)
         if nlp.free_time:
             S = np.vstack([S, np.full((1, S.shape[1]), duration)])

@@ -22,13 +22,57 @@ class CostateCarrier(Protocol):
 
     duration: float
 
-    def state_and_costate(self, t: Any) -> tuple[Array, Array]: ...
+    def __init__(self, *args: Any, **kwargs: Any) -> None:  # typing would insert an unannotated one
+        ...
 
-    def feedback_torque(self, lam_omega: Array, lam_omega_reference: Array) -> Array: ...
+    def state_and_costate(self, t: Any) -> tuple[Array, Array]:
+        """Optimal states and co-states.
+
+        Parameters
+        ----------
+        t : float or (n,) array_like
+            Times [s] within ``[0, duration]``.
+
+        Returns
+        -------
+        tuple of ndarray
+            ``x (n, 7) = [q, ω]`` (scalar-first quaternion, body rate [rad/s], body axes) and
+            ``λ (n, 7)``, its co-state.
+        """
+        ...
+
+    def feedback_torque(self, lam_omega: Array, lam_omega_reference: Array) -> Array:
+        """The optimal control for an estimated rate co-state.
+
+        Parameters
+        ----------
+        lam_omega : (3,) ndarray
+            Estimated rate co-state.
+        lam_omega_reference : (3,) ndarray
+            The reference's own rate co-state at the same time (fixes any normalisation).
+
+        Returns
+        -------
+        (3,) ndarray
+            Torque [N m], body axes.
+        """
+        ...
 
 
 def offers_costates(planner: type, options: Any) -> bool:
-    """Whether ``planner`` (a class) with ``options`` returns :class:`CostateCarrier` references
-    whose control is a torque: it says so through a class method ``offers_costates(options)``."""
+    """Whether a planner returns :class:`CostateCarrier` references whose control is a torque.
+
+    Parameters
+    ----------
+    planner : type
+        A planner class; it says so through a class method ``offers_costates(options)``.
+    options : object
+        The planner's parsed ``Options``.
+
+    Returns
+    -------
+    bool
+        ``True`` when it does (``False`` for planners without the class method).
+    """
     check = getattr(planner, "offers_costates", None)
     return bool(check(options)) if callable(check) else False

@@ -14,19 +14,38 @@ stopping); the best converged optimum is kept.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Annotated, Literal
 
 import numpy as np
 
-from ocp.nlp import perturbed, solve_multistart, solver_options
+from ocp.nlp import (
+    NLPResult,
+    perturbed,
+    solve_multistart,
+    solver_options,
+    warm_start_options,
+)
 from ocp.options import InvalidOption, OptionsError, Range, excerpt
-from ocp.transcription import TRANSCRIPTIONS, Cone, OptimalControlProblem
-from planners.base import FailedReference, ManeuverProblem, Planner, Reference
+from ocp.transcription import (
+    NLP,
+    TRANSCRIPTIONS,
+    Cone,
+    OptimalControlProblem,
+    Transcription,
+)
+from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference
 from planners.collocation_reference import CollocationReference, seed_sampler
 
 AUTO_RESTART = 0.05
 """Relative perturbation of the restarts of ``multistart: auto`` when the final time is free."""
+
+
+def _merged(first: NLPResult, second: NLPResult) -> NLPResult:
+    """``second`` with the starts, iterations and time of ``first`` (which failed) counted first."""
+    best = None if second.best_start is None else second.best_start + len(first.starts)
+    return replace(second, starts=first.starts + second.starts, iterations=first.iterations + second.iterations,
+                   time_s=first.time_s + second.time_s, best_start=best)
 
 
 def _cone_vector(spec: dict, key: str, where: str) -> np.ndarray:
@@ -50,6 +69,11 @@ def parse_cone(spec: dict, keep_out: bool, margin: float = 0.0, where: str = "co
     keep_out : the boresight must stay outside (``True``) or inside (``False``) the cone.
     margin : rad by which the cone is tightened.
     where : the option's path (``keep_out[0]``) for error messages.
+
+    Returns
+    -------
+    Cone
+        The (tightened) cone, unit vectors, angle in rad.
 
     Raises
     ------
@@ -77,6 +101,59 @@ class CollocationPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
+        """Options of ``collocation`` (YAML keys; see the README's planner table).
+
+        Attributes
+        ----------
+        objective : str
+            ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt, ``min_time`` (free T, the
+            scenario's duration its upper bound) or ``weighted``; τ the actuators' body torque [N m].
+        intervals : int
+            Mesh intervals.
+        degree : int
+            Radau points per interval (``collocation``).
+        transcription : str
+            ``collocation`` (Legendre-Gauss-Radau) or ``multiple_shooting``.
+        substeps : int
+            RK4 steps per interval (``multiple_shooting``).
+        solver : str
+            ``ipopt`` (default) or ``fatrop``.
+        warm_start : str
+            Registered planner whose reference seeds the NLP (default ``eigenaxis``; ``collocation``
+            itself with its own ``warm_start_options``).
+        warm_start_options : dict
+            The warm-start planner's options.
+        seed_planners : list of str
+            Further planners whose references are starts.
+        multistart : int or "auto"
+            ``auto`` (default): for a free final time a 1 % perturbed copy of the warm start, then
+            restarts from the best point perturbed by 5 % until one agrees with it (the warm start
+            itself if the copy does not converge); for a fixed final time the warm start. n > 0: n
+            perturbed copies; 0: the warm start itself.
+        agree : int
+            Stop once this many starts agree on the best objective (0: try all).
+        time_regularization : float
+            ``min_time`` only: ε > 0 first solves min T + ε ∫‖τ‖² dt / Σ τ_max² (τ_max the wheels'
+            and torquers' torque bounds [N m]) from the starts, then polishes plain minimum time
+            from that optimum and its multipliers; 0 (default): off.
+        coarse_intervals : int
+            Free final time with ``multistart: auto``: the multistart first runs on this many
+            intervals and the full mesh is solved once from its optimum (falling back to the
+            full-mesh multistart); 0 or >= ``intervals``: off. Default 8.
+        energy_weight, l1_weight, time_weight : float
+            Weights of ``weighted`` [1/(N² m² s), 1/(N m s), 1/s].
+        max_rate : float or None
+            Body-rate bound per axis [rad/s]; ``None``: none.
+        keep_out, keep_in : list of dict
+            Cones ``{boresight (body), direction (inertial), angle_deg}``.
+        cone_margin_deg : float
+            Cones are imposed this much tighter [deg], so that they hold between the points.
+        tolerance : float
+            Solver tolerance (scaled KKT error).
+        max_iterations : int
+            Solver iterations per start.
+        """
+
         objective: Literal["min_energy", "min_l1", "min_time", "weighted"] = "min_energy"
         intervals: Annotated[int, Range(ge=1, le=2000)] = 50
         degree: Annotated[int, Range(ge=1, le=9)] = 3
@@ -92,6 +169,13 @@ class CollocationPlanner(Planner):
         # A number n > 0: n perturbed copies (1 %, then 5 %); 0: the warm start itself.
         multistart: Annotated[int | Literal["auto"], Range(ge=0, le=50)] = "auto"
         agree: Annotated[int, Range(ge=0, le=50)] = 2  # stop once this many starts agree on the best optimum (0: try all)
+        # min_time only: first solve min T + ε ∫‖τ‖² dt / Σ τ_max², ε this option (0: off), from
+        # the starts above, then polish plain minimum time from that optimum and its multipliers.
+        time_regularization: Annotated[float, Range(ge=0.0, le=1.0)] = 0.0
+        # Free final time with multistart auto: the multistart (escape and agreement) first runs on
+        # this many intervals, then the full mesh is solved once from that optimum (falling back to
+        # the multistart on the full mesh if it does not converge). 0, or >= intervals: off.
+        coarse_intervals: Annotated[int, Range(ge=0, le=2000)] = 8
         energy_weight: Annotated[float, Range(ge=0.0)] = 1.0               # for objective "weighted"
         l1_weight: Annotated[float, Range(ge=0.0)] = 0.0
         time_weight: Annotated[float, Range(ge=0.0)] = 0.0
@@ -104,7 +188,9 @@ class CollocationPlanner(Planner):
         max_iterations: Annotated[int, Range(ge=1, le=100000)] = 500
 
         def __post_init__(self) -> None:
-            from planners import PLANNERS  # the registry is complete once options are parsed
+            from planners import (
+                PLANNERS,  # the registry is complete once options are parsed
+            )
 
             # A collocation warm start is planned with its own options (say min_energy, itself warm
             # started from eigenaxis): the way into min_time where a kinematic seed is too far
@@ -118,12 +204,14 @@ class CollocationPlanner(Planner):
                 PLANNERS[self.warm_start](self.warm_start_options, path="warm_start_options")
             except OptionsError as error:
                 raise InvalidOption(error.path, error.message) from None
+            if self.time_regularization and self.objective != "min_time":
+                raise InvalidOption("time_regularization", f"applies to objective min_time only, not {self.objective!r}")
             if self.objective == "weighted" and not (self.energy_weight or self.l1_weight or self.time_weight):
                 raise InvalidOption("objective", "weighted needs a positive energy_weight, l1_weight or time_weight")
             l1 = self.objective == "min_l1" or (self.objective == "weighted" and self.l1_weight > 0)
-            error = TRANSCRIPTIONS[self.transcription].problem_error(l1, bool(self.keep_out or self.keep_in))
-            if error:
-                raise ValueError(error)
+            refused = TRANSCRIPTIONS[self.transcription].problem_error(l1, bool(self.keep_out or self.keep_in))
+            if refused:
+                raise ValueError(refused)
             for index, spec in enumerate(self.keep_out):
                 parse_cone(spec, True, np.deg2rad(self.cone_margin_deg), f"keep_out[{index}]")
             for index, spec in enumerate(self.keep_in):
@@ -138,19 +226,24 @@ class CollocationPlanner(Planner):
         return OptimalControlProblem(problem.model, *weights, free_time=weights[2] > 0,
                                      fixed_final_rate=problem.omegaf is not None, cones=cones)
 
-    def _nlp(self, problem: ManeuverProblem, ocp: OptimalControlProblem):
+    def _nlp(self, problem: ManeuverProblem, ocp: OptimalControlProblem,
+             warm: bool = False) -> tuple[Transcription, NLP]:
+        """The transcription and its built NLP for ``ocp`` (from the cache when built before);
+        ``warm``: solver options for a start with multipliers (:func:`ocp.nlp.warm_start_options`)."""
         o = self.options
         transcription = TRANSCRIPTIONS[o.transcription].from_options(o)
         key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
-               o.transcription, o.intervals, o.degree, o.substeps, o.solver, o.tolerance, o.max_iterations)
+               o.transcription, o.intervals, o.degree, o.substeps, o.solver, o.tolerance, o.max_iterations, warm)
+        extra = warm_start_options(o.solver) if warm else None
 
-        def build():
-            return transcription, transcription.build(ocp, o.solver, solver_options(o.solver, o.tolerance, o.max_iterations))
+        def build() -> tuple[Transcription, NLP]:
+            return transcription, transcription.build(ocp, o.solver,
+                                                      solver_options(o.solver, o.tolerance, o.max_iterations, extra))
 
         # The model's numbers are baked into the graph: a shared cache needs them in the key.
         return self.solver_cache(problem).get(("collocation", problem.model.fingerprint, key), build)
 
-    def _variable_bounds(self, problem: ManeuverProblem):
+    def _variable_bounds(self, problem: ManeuverProblem) -> tuple[Array, Array, Array, Array]:
         """Per-point bounds of the model state and the actuator controls."""
         spacecraft, model = problem.spacecraft, problem.model
         x_low, x_high = np.full(model.nx, -np.inf), np.full(model.nx, np.inf)
@@ -159,14 +252,18 @@ class CollocationPlanner(Planner):
             x_low[4:7], x_high[4:7] = -self.options.max_rate, self.options.max_rate
         u_low, u_high = np.full(model.nu, -np.inf), np.full(model.nu, np.inf)
         slices = model.control_slices
+        # Limits are arrays once the actuators are constructed (None becomes inf).
         if spacecraft.wheels is not None:
-            x_low[7:], x_high[7:] = -spacecraft.wheels.max_momentum, spacecraft.wheels.max_momentum
-            limit = np.where(spacecraft.wheels.working, spacecraft.wheels.max_torque, 0.0)
+            momentum = np.asarray(spacecraft.wheels.max_momentum, dtype=float)
+            x_low[7:], x_high[7:] = -momentum, momentum
+            limit = np.where(spacecraft.wheels.working, np.asarray(spacecraft.wheels.max_torque, dtype=float), 0.0)
             u_low[slices["wheels"]], u_high[slices["wheels"]] = -limit, limit
-        if "dipole" in slices:
-            u_low[slices["dipole"]], u_high[slices["dipole"]] = -spacecraft.magnetorquers.max_dipole, spacecraft.magnetorquers.max_dipole
-        if "torquers" in slices:
-            u_low[slices["torquers"]], u_high[slices["torquers"]] = -spacecraft.torquers.max_torque, spacecraft.torquers.max_torque
+        if spacecraft.magnetorquers is not None:
+            dipole = np.asarray(spacecraft.magnetorquers.max_dipole, dtype=float)
+            u_low[slices["dipole"]], u_high[slices["dipole"]] = -dipole, dipole
+        if spacecraft.torquers is not None:
+            torque = np.asarray(spacecraft.torquers.max_torque, dtype=float)
+            u_low[slices["torquers"]], u_high[slices["torquers"]] = -torque, torque
         return x_low, x_high, u_low, u_high
 
     def _starts(self, problem: ManeuverProblem) -> list[Reference]:
@@ -181,41 +278,100 @@ class CollocationPlanner(Planner):
                 starts.append(reference)
         return starts
 
-    def _guesses(self, ocp: OptimalControlProblem, seeds: list) -> tuple[list, float]:
-        """The starts (the warm start or its perturbed copies, then the seed planners' starts) and
-        the relative size of the restarts from the best point (0: none)."""
+    def _guesses(self, ocp: OptimalControlProblem, seeds: list[Array]) -> tuple[list[Array], list[Array], float]:
+        """The starts (the warm start or its perturbed copies, then the seed planners' starts), the
+        fallback starts (tried only if none of those converged) and the relative size of the
+        restarts from the best point (0: none)."""
         count = self.options.multistart
         if count == "auto":
             # A warm start can sit exactly on a stationary point (the eigenaxis slew is one for minimum
             # time with per-axis torque bounds: IPOPT stays there, 3.5449 in 191 iterations against
             # 3.2431 for Bilimoria & Wie's slew). A 1 % copy of it, then 5 % restarts from the best
-            # point until one comes back to it, escape such points at about 1.3 solves.
-            return (perturbed(seeds[0], 1) + seeds[1:], AUTO_RESTART) if ocp.free_time else (seeds, 0.0)
+            # point until one comes back to it, escape such points at about 1.3 solves; the warm start
+            # itself is the fallback when its perturbed copy does not converge.
+            if ocp.free_time:
+                return perturbed(seeds[0], 1) + seeds[1:], seeds[:1], AUTO_RESTART
+            return seeds, [], 0.0
         if not count:
-            return seeds, 0.0
-        return perturbed(seeds[0], count) + seeds[1:], 0.0
+            return seeds, [], 0.0
+        return perturbed(seeds[0], count) + seeds[1:], [], 0.0
+
+    def _regularized(self, problem: ManeuverProblem, ocp: OptimalControlProblem) -> OptimalControlProblem:
+        """``ocp`` (minimum time) with the energy term of ``time_regularization``: weight ε over the
+        sum of the squared torque bounds of the wheels and torquers (1 (N m)² without them)."""
+        _, _, _, u_high = self._variable_bounds(problem)
+        slices = problem.model.control_slices
+        bounds = [u_high[slices[name]] for name in ("wheels", "torquers") if name in slices]
+        scale = float(np.sum(np.square(np.concatenate(bounds)))) if bounds else 0.0
+        scale = scale if 0.0 < scale < np.inf else 1.0
+        return replace(ocp, energy_weight=self.options.time_regularization / scale)
+
+    def _solve(self, problem: ManeuverProblem, ocp: OptimalControlProblem, seeds: list[Array], params: Array,
+               bounds: tuple[Array, Array]) -> tuple[NLPResult, dict]:
+        """Solve ``ocp`` from ``seeds`` by the multistart policy; with ``time_regularization``, solve
+        the regularised problem so and polish plain minimum time from its optimum and multipliers."""
+        o = self.options
+        guesses, fallback, restart = self._guesses(ocp, seeds)
+        lbx, ubx = bounds
+        if not o.time_regularization:
+            _, nlp = self._nlp(problem, ocp)
+            result = solve_multistart(nlp.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
+                                      agree=o.agree, restart=restart, fallback=fallback)
+            return result, {}
+        _, regular = self._nlp(problem, self._regularized(problem, ocp))
+        first = solve_multistart(regular.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=regular.lbg, ubg=regular.ubg,
+                                 agree=o.agree, restart=restart, fallback=fallback)
+        extra = {"regularized": first.stats()}
+        if first.x is None:
+            return first, extra
+        _, polish = self._nlp(problem, ocp, warm=True)
+        result = solve_multistart(polish.solver, [first.x], p=params, lbx=lbx, ubx=ubx, lbg=polish.lbg,
+                                  ubg=polish.ubg, agree=1, lam_x0=first.lam_x, lam_g0=first.lam_g)
+        return result, extra
+
+    def _coarse(self, ocp: OptimalControlProblem) -> bool:
+        o = self.options
+        return ocp.free_time and o.multistart == "auto" and 0 < o.coarse_intervals < o.intervals
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
-        o = self.options
-        ocp = self._ocp(problem)
-        transcription, nlp = self._nlp(problem, ocp)
         starts = self._starts(problem)
         if not starts:
-            return FailedReference(self.name, f"no start: the warm-start planner {o.warm_start!r} failed")
+            return FailedReference(self.name, f"no start: the warm-start planner {self.options.warm_start!r} failed")
+        return self._plan_from(problem, starts)
+
+    def _plan_from(self, problem: ManeuverProblem, starts: list[Reference]) -> Reference:
+        """Plan from the given start references (see the module docstring)."""
+        o = self.options
+        ocp = self._ocp(problem)
+        transcription, nlp = self._nlp(problem, ocp, warm=bool(o.time_regularization))  # the polish's NLP
         disturbance = problem.model.default_parameters
         omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf
         params = np.concatenate([problem.initial_state, problem.qf, omegaf, [problem.duration], disturbance])
-        lbx, ubx = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
+        bounds = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
         seeds = [transcription.seed(ocp, nlp, seed_sampler(problem, ref),
                                     ref.duration if ocp.free_time else problem.duration) for ref in starts]
-        guesses, restart = self._guesses(ocp, seeds)
-        result = solve_multistart(nlp.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
-                                  agree=o.agree, restart=restart)
+        result, extra = None, {}
+        if self._coarse(ocp):
+            # The escape from stationary points and its confirmation on a coarse mesh, where an
+            # iteration costs a fraction; its optimum seeds one solve on the full mesh.
+            coarse = CollocationPlanner(replace(o, intervals=o.coarse_intervals, coarse_intervals=0), cache=self.cache)
+            found = coarse._plan_from(problem, starts)
+            extra["coarse"] = found.stats
+            if found.ok:
+                single = replace(o, multistart=0, coarse_intervals=0)
+                seed = transcription.seed(ocp, nlp, seed_sampler(problem, found), found.duration)
+                result, more = CollocationPlanner(single, cache=self.cache)._solve(problem, ocp, [seed], params, bounds)
+                extra.update(more)
+        if result is None or not result.success:
+            fine, more = self._solve(problem, ocp, seeds, params, bounds)
+            result = fine if result is None else _merged(result, fine)
+            extra.update(more)
         stats = result.stats()
-        stats.update(transcription=transcription.name, intervals=o.intervals, solver=o.solver)
+        stats.update(extra, transcription=transcription.name, intervals=o.intervals, solver=o.solver)
         if not result.success:
             return FailedReference(self.name, f"{o.solver} did not converge from any start: "
                                    f"{sorted(set(result.statuses))}", result.status, stats=stats)
+        assert result.x is not None  # success implies a point
         T, states, controls = (v.full() for v in nlp.unpack(result.x, params))
         T = T.item()
         reference = CollocationReference(problem, transcription, T, states, controls, stats)

@@ -7,17 +7,36 @@ The feed-forward torque is the optimal control expressed for ``I ω̇ = −ω ×
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any, cast
+
 import numpy as np
 
 from ocp import quat
+from ocp.transcription_base import Transcription
 from planners.base import Array, ManeuverProblem, Reference, ReferenceSample
 
 
 class CollocationReference(Reference):
-    """Evaluates the optimal states and controls of a transcribed problem."""
+    """Evaluates the optimal states and controls of a transcribed problem.
 
-    def __init__(self, problem: ManeuverProblem, transcription, duration: float, states: Array, controls: Array,
-                 stats: dict):
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre (its model and spacecraft).
+    transcription : Transcription
+        The transcription that produced the solution (it interpolates it).
+    duration : float
+        T [s].
+    states, controls : ndarray
+        The solution at the transcription's points (``NLP.unpack``'s layout): model states
+        ``[q, ω, h_w]`` and actuator controls, one column per point.
+    stats : dict
+        Planner statistics.
+    """
+
+    def __init__(self, problem: ManeuverProblem, transcription: Transcription, duration: float, states: Array,
+                 controls: Array, stats: dict[str, Any]) -> None:
         breakpoints, inner = transcription.smoothness(duration)
         super().__init__("collocation", duration, problem.spacecraft.inertia, stats=stats,
                          free_boundary=(), breakpoints=breakpoints, enforced_times=inner)
@@ -29,8 +48,20 @@ class CollocationReference(Reference):
     def _state_control(self, t: Array) -> tuple[Array, Array]:
         return self.transcription.interpolate(self.model, self.states, self.controls, self.duration, t)
 
-    def control(self, t) -> Array:
-        """The optimal actuator control ``u(t)`` (layout of ``model.control_slices``) within ``[0, T]``."""
+    def control(self, t: float | Array) -> Array:
+        """The optimal actuator control.
+
+        Parameters
+        ----------
+        t : float or (n,) array_like
+            Times [s], clipped to ``[0, T]``.
+
+        Returns
+        -------
+        (nu,) or (n, nu) ndarray
+            Controls in the layout of ``model.control_slices`` (wheel torques [N m], dipoles
+            [A m^2], torquer torques [N m]).
+        """
         times = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
         controls = self._state_control(times)[1]
         return controls[0] if np.ndim(t) == 0 else controls
@@ -63,7 +94,8 @@ def _seed_states_controls(problem: ManeuverProblem, reference: Reference, times:
     u = np.zeros((times.size, model.nu))
     body_momentum = sample.omega @ spacecraft.inertia.T
     if model.n_wheels:
-        total = quat.rotate(problem.q0, spacecraft.inertia @ problem.omega0 + axes @ problem.wheel_momentum0)
+        wheel_momentum = cast(Array, problem.wheel_momentum0)  # zeros when not given (ManeuverProblem)
+        total = quat.rotate(problem.q0, spacecraft.inertia @ problem.omega0 + axes @ wheel_momentum)
         wheel_total = quat.rotate_inverse(sample.q, np.broadcast_to(total, sample.q.shape[:-1] + (3,))) - body_momentum
         x[:, 7:] = wheel_total @ np.linalg.pinv(axes).T
         wheel_torque = sample.torque + np.cross(sample.omega, x[:, 7:] @ axes.T)
@@ -73,11 +105,24 @@ def _seed_states_controls(problem: ManeuverProblem, reference: Reference, times:
     return x, u, sample.torque
 
 
-def seed_sampler(problem: ManeuverProblem, reference: Reference):
-    """``sample(times) -> (x (n, nx), u (n, nu), |torque| (n, 3))`` along ``reference``, the form a
-    transcription's ``stage_guess`` seeds from."""
+def seed_sampler(problem: ManeuverProblem, reference: Reference) -> Callable[[Array], tuple[Array, Array, Array]]:
+    """The seed of a transcription along another planner's reference.
 
-    def sample(times: Array):
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre (model, initial wheel momentum).
+    reference : Reference
+        The seeding reference.
+
+    Returns
+    -------
+    callable
+        ``sample(times [s]) -> (x (n, nx), u (n, nu), |torque| (n, 3) [N m])``, the form a
+        transcription's ``stage_guess`` seeds from.
+    """
+
+    def sample(times: Array) -> tuple[Array, Array, Array]:
         x, u, torque = _seed_states_controls(problem, reference, times)
         return x, u, np.abs(torque)
 

@@ -18,9 +18,9 @@ A vectorised multi-start over branches of ``K T``, over ``β`` and over ``c`` se
 """
 from __future__ import annotations
 
-from typing import Annotated, Iterable
-
+from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Annotated, Any
 
 import casadi as ca
 import numpy as np
@@ -29,11 +29,33 @@ from ocp import quat
 from ocp.nlp import solve_multistart, solver_options
 from ocp.options import Range
 from ocp.spin_closed_form import extremal_quaternion
-from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample)
+from planners.base import (
+    Array,
+    FailedReference,
+    ManeuverProblem,
+    Planner,
+    Reference,
+    ReferenceSample,
+)
 
 
 def torque_amplitudes(v: float, r: float, c: float, moments: Array) -> Array:
-    """Per-axis amplitudes (N m) of eq. 31: ``[½ I1 |δ1| r², I2 r |α − v δ2|, I3 r |α + v δ3|]``."""
+    """Per-axis amplitudes of eq. 31's torque.
+
+    Parameters
+    ----------
+    v : float
+        Spin rate about the first body axis [rad/s].
+    r, c : float
+        Transverse rate amplitude and spin offset [rad/s].
+    moments : (3,) ndarray
+        Principal moments of inertia [kg m^2].
+
+    Returns
+    -------
+    (3,) ndarray
+        ``[½ I1 |δ1| r², I2 r |α − v δ2|, I3 r |α + v δ3|]`` [N m], body axes.
+    """
     I1, I2, I3 = moments
     alpha = v + c
     return np.array([0.5 * abs(I2 - I3) * r**2, I2 * r * abs(alpha - v * (I3 - I1) / I2),
@@ -41,12 +63,44 @@ def torque_amplitudes(v: float, r: float, c: float, moments: Array) -> Array:
 
 
 def attitude_cost(q_end: Array, target: Array) -> Array:
-    """Eq. 30 invariant to the double cover: ``min(‖q − q_f‖², ‖q + q_f‖²)`` over the last axis."""
+    """Eq. 30 invariant to the double cover.
+
+    Parameters
+    ----------
+    q_end : (..., 4) ndarray
+        Final quaternions (scalar first).
+    target : (4,) ndarray
+        Target quaternion.
+
+    Returns
+    -------
+    ndarray
+        ``min(‖q − q_f‖², ‖q + q_f‖²)`` over the last axis (dimensionless).
+    """
     return np.minimum(np.sum((q_end - target) ** 2, axis=-1), np.sum((q_end + target) ** 2, axis=-1))
 
 
-def extremal_torque(t, v, r, c, beta, moments):
-    """Eq. 31: body torque (N m) that makes a principal-axis body follow ``ω*``; rows per time."""
+def extremal_torque(t: Array, v: float, r: float, c: float, beta: float, moments: Array) -> Array:
+    """Eq. 31: the body torque that makes a principal-axis body follow ``ω*``.
+
+    Parameters
+    ----------
+    t : (n,) ndarray
+        Times [s].
+    v : float
+        Spin rate [rad/s].
+    r, c : float
+        Transverse rate amplitude and spin offset [rad/s].
+    beta : float
+        Phase of the transverse rate [rad].
+    moments : (3,) ndarray
+        Principal moments of inertia [kg m^2].
+
+    Returns
+    -------
+    (n, 3) ndarray
+        Torque [N m], body axes, one row per time.
+    """
     I1, I2, I3 = moments
     d1, d2, d3 = (I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3
     alpha = v + c
@@ -64,8 +118,29 @@ def _sin_ratio(x, duration, math):
     return ca.if_else(small, duration * (1 - (x * duration) ** 2 / 6), ca.sin(x * duration) / x)
 
 
-def energy_cost(v, r, c, beta, duration, moments, math=np):
-    """``J2 = ∫₀ᵀ ‖u‖² dt`` in closed form for the torque of eq. 31 (N² m² s)."""
+def energy_cost(v: Any, r: Any, c: Any, beta: Any, duration: Any, moments: Any, math: Any = np) -> Any:
+    """``J2 = ∫₀ᵀ ‖u‖² dt`` in closed form for the torque of eq. 31.
+
+    Parameters
+    ----------
+    v : float or CasADi scalar
+        Spin rate [rad/s].
+    r, c : float, ndarray or CasADi scalar
+        Transverse rate amplitude and spin offset [rad/s].
+    beta : float, ndarray or CasADi scalar
+        Phase of the transverse rate [rad].
+    duration : float or CasADi scalar
+        T [s].
+    moments : (3,) sequence
+        Principal moments of inertia [kg m^2].
+    math : module
+        ``numpy`` (default) or ``casadi``.
+
+    Returns
+    -------
+    float, ndarray or CasADi scalar
+        J2 [N² m² s].
+    """
     I1, I2, I3 = moments
     d1, d2, d3 = (I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3
     alpha = v + c
@@ -77,9 +152,17 @@ def energy_cost(v, r, c, beta, duration, moments, math=np):
 
 
 def build_solver() -> ca.Function:
-    """IPOPT on (r, c, β) with parameters [v, T, I1, I2, I3, q_target (4), k]. At a zero-cost
-    optimum (k = 0, target reached) IPOPT reports ``Search_Direction_Becomes_Too_Small``, which the
-    status policy of :mod:`ocp.nlp` counts as converged (the problem is unconstrained)."""
+    """IPOPT on (r, c, β) with parameters [v, T, I1, I2, I3, q_target (4), k].
+
+    At a zero-cost optimum (k = 0, target reached) IPOPT reports
+    ``Search_Direction_Becomes_Too_Small``, which the status policy of :mod:`ocp.nlp` counts as
+    converged (the problem is unconstrained).
+
+    Returns
+    -------
+    casadi.Function
+        The ``nlpsol`` function.
+    """
     x = ca.SX.sym("x", 3)
     p = ca.SX.sym("p", 10)
     r, c, beta = x[0], x[1], x[2]
@@ -95,6 +178,18 @@ def build_solver() -> ca.Function:
 
 @dataclass(frozen=True)
 class SpinParameters:
+    """The extremal's free parameters.
+
+    Parameters
+    ----------
+    r : float
+        Transverse rate amplitude [rad/s].
+    c : float
+        Spin offset [rad/s].
+    beta : float
+        Phase of the transverse rate [rad].
+    """
+
     r: float
     c: float
     beta: float
@@ -109,6 +204,25 @@ class SpinExtremalReference(Reference):
     the body at rest transversally, ``r = 0`` and the extremal is the free spin ``E1(v t)``), so
     ``omega0`` and ``omegaf`` are declared free; ``qf`` too when ``J1`` is only a weighted cost
     (``weight > 0``) or the parameters are fixed.
+
+    Parameters
+    ----------
+    q0 : (4,) ndarray
+        Initial attitude (scalar first).
+    v : float
+        Spin rate about the first body axis [rad/s].
+    params : SpinParameters
+        ``(r, c, β)``.
+    duration : float
+        T [s].
+    moments : (3,) ndarray
+        Principal moments of inertia [kg m^2].
+    message : str
+        Summary for the planner's row.
+    stats : dict
+        Planner statistics.
+    free_boundary : iterable of str
+        Boundary conditions the reference does not meet (see :class:`~planners.base.Reference`).
     """
 
     def __init__(self, q0: Array, v: float, params: SpinParameters, duration: float, moments: Array,
@@ -136,13 +250,38 @@ class SpinExtremalPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
+        """Options of ``spin_extremal`` (YAML keys).
+
+        Attributes
+        ----------
+        weight : float
+            k of J = J1 + k J2 [1/(N² m² s)]; 0 (default): reach the target, J2 only breaks ties.
+        spin_rate : float or None
+            v [rad/s]; ``None`` (default): the initial roll rate ω0[0].
+        parameters : list of 3 floats or None
+            Fixed [r, c, β] (rad/s, rad/s, rad): no optimisation; ``None`` (default): optimised.
+        starts : int
+            Multi-start candidates polished by IPOPT.
+        """
+
         weight: Annotated[float, Range(ge=0.0)] = 0.0                        # k of J = J1 + k J2 (1/(N² m² s))
         spin_rate: Annotated[float | None, Range(gt=-1e3, lt=1e3)] = None             # v (rad/s); default: the initial roll rate ω0[0]
         parameters: Annotated[list[float] | None, Range(size=3)] = None      # fixed [r, c, β] (rad/s, rad/s, rad): no optimisation
         starts: Annotated[int, Range(ge=1, le=50)] = 3                            # multi-start candidates polished by IPOPT
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
-        """Why the spin extremals cannot take ``problem`` (no target, non-principal inertia), or ``None``."""
+        """Why the spin extremals cannot take ``problem``.
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The manoeuvre.
+
+        Returns
+        -------
+        str or None
+            The reason (no target, non-principal inertia), or ``None``.
+        """
         if not problem.spacecraft.is_principal:
             return ("the spin extremals need a principal-axis (diagonal) inertia; "
                     "rotate the problem into principal axes first")
@@ -152,10 +291,11 @@ class SpinExtremalPlanner(Planner):
         moments = np.diag(problem.spacecraft.inertia).copy()
         v = float(problem.omega0[0]) if self.options.spin_rate is None else self.options.spin_rate
         T = problem.duration
+        assert problem.qf is not None  # problem_error refuses a free final attitude
         target = quat.product(quat.conjugate(problem.q0), problem.qf)
         if self.options.parameters is not None:
             params = SpinParameters(*self.options.parameters)
-            stats = {"fixed_parameters": True}
+            stats: dict[str, Any] = {"fixed_parameters": True}
         else:
             params, stats = self._optimise(self.solver_cache(problem).get(("spin_extremal",), build_solver),
                                            v, T, moments, target)
@@ -176,10 +316,10 @@ class SpinExtremalPlanner(Planner):
     def _seeds(self, v: float, T: float, moments: Array, target: Array) -> Array:
         """Best distinct starts of a grid over K T branches, c and β (vectorised evaluation)."""
         base = np.pi / T
-        r, c, beta = np.meshgrid(base * np.array([0.5, 1.0, 2.0, 3.0, 5.0]),
-                                 base * np.array([0.0, -1.0, 1.0, -2.0, 2.0, -4.0, 4.0]),
-                                 np.linspace(-np.pi, np.pi, 12, endpoint=False), indexing="ij")
-        r, c, beta = r.ravel(), c.ravel(), beta.ravel()
+        grid = np.meshgrid(base * np.array([0.5, 1.0, 2.0, 3.0, 5.0]),
+                           base * np.array([0.0, -1.0, 1.0, -2.0, 2.0, -4.0, 4.0]),
+                           np.linspace(-np.pi, np.pi, 12, endpoint=False), indexing="ij")
+        r, c, beta = (axis.ravel() for axis in grid)
         q_end = np.stack(extremal_quaternion(T, v, r, c, beta), axis=-1)
         cost = attitude_cost(q_end, target) + self.options.weight * energy_cost(v, r, c, beta, T, moments)
         return np.column_stack([r, c, beta])[np.argsort(cost)[: self.options.starts]]
@@ -189,7 +329,7 @@ class SpinExtremalPlanner(Planner):
         # Every start is a different branch of K T by design: all are tried (agree = 0).
         result = solve_multistart(solver, self._seeds(v, T, moments, target), p=parameters, agree=0)
         stats = result.stats()
-        if not result.success:
+        if result.x is None:
             stats["message"] = f"IPOPT did not converge from any start: {sorted(set(result.statuses))}"
             return None, stats
         r, c, beta = (float(v) for v in result.x)
