@@ -208,7 +208,7 @@ def _check_physical(row: Row, scope: str, metrics: dict[str, Any] | None) -> Non
 
 
 def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
-        cache: SolverCache | None = None) -> RunResults:
+        cache: SolverCache | None = None, simulators: SolverCache | None = None) -> RunResults:
     """Plan, simulate and score every planner of ``scenario``.
 
     Parameters
@@ -216,6 +216,9 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     scenario : a loaded scenario.
     progress : receives a line of text per finished row.
     cache : solvers built by planners, shared across runs (a trade-study worker passes one).
+    simulators : simulators (and their closed-loop functions) shared across runs, keyed by the
+        model's fingerprint and the simulation settings; anything with SolverCache's ``get``
+        (a trade-study worker passes a bounded one). None: a new simulator per run.
 
     Returns
     -------
@@ -224,8 +227,15 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     """
     say = progress or (lambda line: None)
     spec = scenario.simulation
-    simulator = Simulator(scenario.problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step,
-                          max_samples=spec.max_samples, compile=spec.compile)
+    model = scenario.problem.model
+
+    def build() -> Simulator:
+        return Simulator(model, spec.sample_time, spec.integrator, max_step=spec.max_step,
+                         max_samples=spec.max_samples, compile=spec.compile)
+
+    simulator = build() if simulators is None else simulators.get(
+        ("simulator", model.fingerprint, spec.sample_time, spec.integrator, spec.max_step, spec.max_samples,
+         spec.compile), build)
     controllers = scenario.controllers
     rows = []
     if not scenario.planners:
