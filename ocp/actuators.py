@@ -142,6 +142,12 @@ class ActuatorModel:
             torquer torque [N m], body axes), ``out`` when given.
         saturated : bool
             Whether any actuator is at its limit.
+
+        Raises
+        ------
+        ValueError
+            A wheel command or momentum with other than one value per wheel, or a dipole or
+            torquer torque with other than 3 values.
         """
         values, saturated = self.apply_floats(command, as_floats(wheel_momentum), dt)
         if out is None:
@@ -173,9 +179,12 @@ class ActuatorModel:
         wheels = self._wheels
         if wheels is not None and command.wheel_torque is not None:
             start, mask, g_max, h_max = wheels
+            asked_torques = as_floats(command.wheel_torque)
+            if len(asked_torques) != len(mask) or len(wheel_momentum) != len(mask):
+                raise ValueError(f"wheel_torque and wheel_momentum need {len(mask)} values (one per wheel), "
+                                 f"got {len(asked_torques)} and {len(wheel_momentum)}")
             applied_wheels = []
-            for asked, working, limit, h_limit, h in zip(as_floats(command.wheel_torque), mask, g_max, h_max,
-                                                         wheel_momentum):
+            for asked, working, limit, h_limit, h in zip(asked_torques, mask, g_max, h_max, wheel_momentum):
                 # Written as comparisons (no min/max calls); each line is the NumPy/CasADi
                 # max/min of apply_symbolic, with the command first so that a NaN stays NaN.
                 g = asked * working
@@ -201,6 +210,8 @@ class ActuatorModel:
             if value is None:
                 continue
             vector = as_floats(value)
+            if len(vector) != 3:
+                raise ValueError(f"{attribute} needs 3 values (body axes), got {len(vector)}")
             if scaled:  # the whole vector is scaled down until every axis is within its limit: direction kept
                 ratio = max(abs(a) / limit for a, limit in zip(vector, limits))
                 values[start:start + 3] = [a / ratio for a in vector] if ratio > 1.0 else vector

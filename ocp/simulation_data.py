@@ -35,10 +35,15 @@ class GridSampledReference:
         self.reference = reference
         grid = np.unique(np.asarray(times, dtype=float))
         self._times = grid
-        self._table = reference.sample(grid)
+        table = reference.sample(grid)
+        # Our own copy, read only: its rows are handed out as views and kept across runs, so a law
+        # writing into a sample would otherwise change every later run.
+        self._table = type(table)(*(np.array(a) for a in table))
+        for array in self._table:
+            array.setflags(write=False)
         self._index = {value: i for i, value in enumerate(grid.tolist())}
         self._scalar: dict[int, Any] = {}
-        self._rows: list[list[float]] | None = None
+        self._rows: list[tuple[float, ...]] | None = None
 
     def sample(self, t: ArrayLike) -> Any:
         """The reference at ``t``, as ``reference.sample`` returns it.
@@ -52,7 +57,7 @@ class GridSampledReference:
         -------
         named tuple
             The reference's sample (arrays with a leading axis of ``M`` for an array ``t``). The
-            arrays of a grid time are views of the table: read them, do not write them.
+            arrays of a grid time are read-only views of the table (kept across runs).
         """
         index = self._index
         if np.ndim(t) == 0:
@@ -68,7 +73,7 @@ class GridSampledReference:
             return self.reference.sample(t)
         return type(self._table)(*(a[rows] for a in self._table))
 
-    def row(self, t: float) -> list[float] | None:
+    def row(self, t: float) -> tuple[float, ...] | None:
         """The reference row ``[q*, ω*, ω̇*, τ*]`` at a grid time, as Python floats.
 
         Parameters
@@ -78,16 +83,16 @@ class GridSampledReference:
 
         Returns
         -------
-        list of 13 float or None
+        tuple of 13 float or None
             Attitude quaternion, body rate [rad/s], body acceleration [rad/s^2], feed-forward
             torque [N m] (layout of :func:`ocp.layout.reference_rows`); ``None`` when ``t`` is not
-            on the grid. Shared: do not modify it.
+            on the grid.
         """
         i = self._index.get(t)
         if i is None:
             return None
         if self._rows is None:
-            self._rows = reference_rows(self, self._times).tolist()
+            self._rows = [tuple(row) for row in reference_rows(self, self._times).tolist()]
         return self._rows[i]
 
     def __getattr__(self, name: str) -> Any:

@@ -97,8 +97,9 @@ class Simulator:
     python_loop : bool, optional
         Always use the Python loop (the reference implementation), even for symbolic laws.
     max_samples : int, optional
-        Most samples one run may take (and :data:`SUBSTEPS_PER_SAMPLE` RK4 sub-steps each); longer
-        runs are refused with :class:`SimulationError`, not attempted.
+        Most samples one run may take, and most RK4 sub-steps in all: ``SUBSTEPS_PER_SAMPLE`` times
+        this (:data:`SUBSTEPS_PER_SAMPLE`); longer runs are refused with :class:`SimulationError`,
+        not attempted.
     """
 
     MAX_BUILDS = 16
@@ -237,7 +238,7 @@ class Simulator:
         n_samples = max(1, math.ceil(duration / self.sample_time - 1e-9))
         if n_samples > self.max_samples or n_samples * self.substeps > SUBSTEPS_PER_SAMPLE * self.max_samples:
             raise SimulationError(f"{duration:g} s at {self.sample_time:g} s samples is {n_samples} samples, over the "
-                                  f"limit of {self.max_samples} samples or {SUBSTEPS_PER_SAMPLE} sub-steps each "
+                                  f"limit of {self.max_samples} samples or {SUBSTEPS_PER_SAMPLE * self.max_samples} sub-steps in all "
                                   "(simulation.max_samples raises it)")
         times = np.minimum(np.arange(n_samples + 1) * self.sample_time, duration)
         noise = noise or SensorNoise()

@@ -44,11 +44,19 @@ def _log_axis(axis: Any) -> None:
     axis.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
 
 
-def _label(axis: Any, text: str, offset: float = -0.095) -> None:
+LABEL_OFFSET_IN = 0.82
+"""Distance of a y label's centre left of its panel [in]: clear of seven-character tick labels
+such as ``−0.0020``; less in a narrower left margin, so that the label stays inside the figure."""
+
+
+def _label(axis: Any, text: str) -> None:
     """A y label at a fixed place left of the panel, drawn with the panel's frame (matplotlib's own
     y label is re-placed after the tick labels at every draw, which measures each of them), and
     at most six value ticks (every tick label is a text to draw)."""
-    axis.text(offset, 0.5, text, rotation=90, ha="center", va="center", transform=axis.transAxes)
+    position, figure_width_in = axis.get_position(), axis.figure.get_figwidth()
+    distance_in = min(LABEL_OFFSET_IN, position.x0 * figure_width_in - 0.12)  # inside the figure
+    axis.text(-distance_in / (position.width * figure_width_in), 0.5, text, rotation=90, ha="center", va="center",
+              transform=axis.transAxes)
     if axis.get_yscale() == "linear":
         axis.yaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
 
@@ -118,6 +126,7 @@ class RowFigure:
         self.figure = Figure(figsize=(10, 13 if n_wheels else 10.5), dpi=DPI)
         self.canvas = FigureCanvasAgg(self.figure)
         axes = self.figure.subplots(5 if n_wheels else 4, 1, sharex=True)
+        self.figure.subplots_adjust(left=0.1, right=0.855, bottom=0.05, top=0.95, hspace=0.08)  # before the labels
         self.axes = axes
 
         def line(axis: Any, style: str = "-", **kw: Any) -> Any:
@@ -151,7 +160,6 @@ class RowFigure:
                 # beside the panel: static (drawn once), and never over a curve
                 axis.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, borderaxespad=0.0)
         self.title = self.figure.suptitle("")
-        self.figure.subplots_adjust(left=0.1, right=0.855, bottom=0.05, top=0.95, hspace=0.08)
         _time_axis(axes[-1])
         self._background: tuple[tuple[float, float], Any] | None = None
 
@@ -278,6 +286,7 @@ def plot_overlay(results: Any, path: Path) -> None:
     target_q, target_omega = results.scenario.problem.qf, results.scenario.problem.omegaf
     figure = Figure(figsize=(9, 7))
     top, bottom = figure.subplots(2, 1, sharex=True)
+    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.08, top=0.93, hspace=0.08)  # before the labels
     _log_axis(bottom)
     for row in results.rows:
         if row.simulation is None:
@@ -300,7 +309,6 @@ def plot_overlay(results: Any, path: Path) -> None:
     if top.get_lines():  # one legend: both panels have the same rows in the same colours
         top.legend(fontsize=8, loc="upper right")
     figure.suptitle(f"{results.scenario.name}: closed-loop comparison")
-    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.08, top=0.93, hspace=0.08)
     _time_axis(bottom)
     figure.savefig(path, **SAVE)
 
