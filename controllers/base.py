@@ -1,42 +1,34 @@
-"""Controller contract, its symbolic (CasADi) form, and the mapping of a body torque onto the actuators.
+"""Controller contract and its symbolic (CasADi) form.
 
 A controller computes, at each sample, a :class:`~ocp.actuators.Command`. Laws written for the
 rigid body ``I ω̇ = −ω × I ω + u`` compute ``u`` and call :meth:`Controller.allocate`, which maps it
-to the actuators as ARCHITECTURE.md states: wheels take ``τ_w = u + ω × A h_w`` through
-``g = −A⁺ τ_w`` (working wheels only); what the wheels cannot give (fewer than three independent
-axes) goes to the torquers if there are any, else to the magnetorquers as
-``m = B × τ / |B|²`` (the component of τ perpendicular to B). Without wheels the torquers take
-``u``, else the magnetorquers. :meth:`Controller.allocate_symbolic` is the same map on CasADi
-expressions; the vector layouts of the symbolic form are in :mod:`ocp.layout`.
+to the actuators as ARCHITECTURE.md states (:mod:`controllers.allocation`);
+:meth:`Controller.allocate_symbolic` is the same map on CasADi expressions. The vector layouts of
+the symbolic form are in :mod:`ocp.layout`.
 """
 from __future__ import annotations
 
 import hashlib
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from controllers.allocation import Allocation
 from ocp import Command, Measurement, Spacecraft
 from ocp.layout import (
     REFERENCE_FIELDS,
     control_layout,
     measurement_size,
     reference_rows,
-    split_measurement,
 )
 from ocp.options import Configurable, InvalidOption
 
 Array = NDArray[np.float64]
-
-
-def cross3(a: Array, b: Array) -> Array:
-    """``a × b`` of two 3-vectors, written out: ``np.cross`` costs ~15 µs a call, this ~1 µs (per
-    sample code uses it; ``np.cross`` stays the choice for arrays of many vectors)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 @dataclass(frozen=True)
@@ -56,8 +48,16 @@ class SymbolicLaw:
     key: str
 
 
-class Controller(Configurable, ABC):
+class Controller(Allocation, Configurable, ABC):
     """Base class of every feedback law.
+
+    Parameters
+    ----------
+    options : mapping or Options, optional
+        The law's options (its ``Options`` dataclass, or a mapping of its fields, as in the YAML
+        ``controller.options``); ``None``: the defaults.
+    path : str, optional
+        YAML path of the options, named in error messages.
 
     Contract
     --------
@@ -116,12 +116,6 @@ class Controller(Configurable, ABC):
     needs_reference: bool = False
     needs_target_attitude: bool = True
     needs_field_rate: bool = False
-    gyroscopic_compensation: bool = True
-    """:meth:`allocate` adds the wheels' ``ω × A h_w`` (the law's ``u`` is for ``I ω̇ = −ω × I ω + u``).
-    ``False``: ``u`` is the wheels' body torque itself (laws written for ``I ω̇ = u``, zero momentum)."""
-    wheels_only: bool = False
-    """Pure wheel mode: :meth:`allocate` drops what the wheels cannot give instead of sending it to
-    torquers or magnetorquers (the two-wheel laws)."""
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
         super().__init__(options, path)
@@ -130,35 +124,94 @@ class Controller(Configurable, ABC):
         self.target: tuple[Array, Array | None] | None = None
 
     def planner_error(self, planner: str, options: Any) -> str | None:
-        """Why this law cannot track the references of ``planner`` with ``options``, or ``None``."""
+        """Why this law cannot track the references of a planner.
+
+        Parameters
+        ----------
+        planner : str
+            The planner's registry name.
+        options : planner options
+            Its options (the planner's ``Options`` instance or mapping).
+
+        Returns
+        -------
+        str or None
+            The reason, or ``None`` when the law can track them (most laws track any reference).
+        """
         return None
 
     def environment_error(self, spacecraft: Spacecraft, environment: Any) -> str | None:
-        """Why the law cannot run on ``spacecraft`` in ``environment`` (an actuator or a sensor it
-        needs is missing), or ``None``."""
+        """Why the law cannot run on a spacecraft in an environment.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            Its actuators.
+        environment : ocp.Environment or None
+            Orbit, magnetic field and disturbances (``None``: none).
+
+        Returns
+        -------
+        str or None
+            The reason (an actuator or a sensor the law needs is missing), or ``None``.
+        """
         return None
 
     def initial_state_error(self, spacecraft: Spacecraft, omega0: Array, wheel_momentum0: Array,
                             omegaf: Array | None) -> tuple[str, str] | None:
-        """``(YAML key under maneuver, message)`` if the law cannot start from the manoeuvre's
-        initial state or reach its final rate (rad/s, N m s, body axes), else ``None``."""
+        """Why the law cannot start from a manoeuvre's initial state or reach its final rate.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+        omega0 : (3,) ndarray
+            Initial body rate [rad/s], body axes.
+        wheel_momentum0 : (n_w,) ndarray
+            Initial wheel momenta [N m s].
+        omegaf : (3,) ndarray or None
+            Final body rate [rad/s], body axes; ``None``: free.
+
+        Returns
+        -------
+        (str, str) or None
+            ``(YAML key under maneuver, message)``, or ``None`` when the law can.
+        """
         return None
 
     def sample_time_error(self, sample_time: float) -> tuple[str, str] | None:
-        """``(option name, message)`` if an option does not fit the sample time (s), else ``None``."""
+        """Why an option does not fit the sample time.
+
+        Parameters
+        ----------
+        sample_time : float
+            Controller period [s].
+
+        Returns
+        -------
+        (str, str) or None
+            ``(option name, message)``, or ``None`` when every option fits.
+        """
         return None
 
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
-        """Prepare for a run of ``spacecraft`` sampled every ``sample_time`` seconds."""
+        """Prepare for a run: clear any state, precompute what the law needs.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The controlled spacecraft (inertia, actuators).
+        sample_time : float
+            Controller period and zero-order-hold length [s].
+        target : (q_f, ω_f or None), optional
+            Final attitude (scalar-first quaternion; ``None`` for laws that regulate the rate
+            alone) and final body rate [rad/s] (``None``: at rest), used in regulation mode and by
+            regulators; ``None`` when only references are tracked.
+        """
         self.spacecraft = spacecraft
         self.sample_time = sample_time
         self.target = target
         self._slices, self._nu = control_layout(spacecraft)
-        wheels = spacecraft.wheels
-        self._working_axes = None
-        if wheels is not None and np.any(wheels.working):
-            self._working_axes = wheels.axes * wheels.working
-            self._wheel_pinv = np.linalg.pinv(self._working_axes)
+        self._reset_allocation(spacecraft)
 
     @abstractmethod
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
@@ -168,13 +221,25 @@ class Controller(Configurable, ABC):
     # Symbolic form
     # ----------------------------------------------------------------------------------------
     def symbolic_error(self) -> str | None:
-        """Why this law has no symbolic form (``None`` when it has one: it implements :meth:`_law`)."""
+        """Why this law has no symbolic form.
+
+        Returns
+        -------
+        str or None
+            The reason, or ``None`` when it has one (it implements :meth:`_law`).
+        """
         if type(self)._law is Controller._law:
             return f"controller {self.name} does not implement a symbolic law (_law)"
         return None
 
     def state_vector(self) -> Array:
-        """The controller state ``z`` of the Python implementation (empty for a static law)."""
+        """The controller state of the Python implementation.
+
+        Returns
+        -------
+        (n_z,) ndarray
+            ``z`` in the layout of the symbolic form (empty for a static law).
+        """
         return np.zeros(0)
 
     def _law(self, t: ca.SX, y: ca.SX, z: ca.SX, r: ca.SX) -> tuple[ca.SX, ca.SX]:
@@ -182,10 +247,16 @@ class Controller(Configurable, ABC):
         raise NotImplementedError
 
     def symbolic_key(self) -> str:
-        """Digest of everything :meth:`_law` bakes in (class, options, spacecraft, sample time, target)."""
+        """Digest of everything :meth:`_law` bakes in.
+
+        Returns
+        -------
+        str
+            SHA-256 hex digest of the class, options, spacecraft, sample time and target.
+        """
         from ocp.model import _plain  # the model's fingerprint walker
 
-        cache = self.spacecraft._cache  # the spacecraft is frozen: its description is computed once
+        cache = self._spacecraft()._cache  # the spacecraft is frozen: its description is computed once
         if "description" not in cache:
             cache["description"] = repr(_plain(self.spacecraft))
         target = None if self.target is None else tuple(None if v is None else _plain(np.asarray(v, dtype=float))
@@ -195,8 +266,18 @@ class Controller(Configurable, ABC):
         return hashlib.sha256(text.encode()).hexdigest()
 
     def symbolic_law(self) -> SymbolicLaw:
-        """The law as ``law(t, y, z, r) -> (u, z_next)`` for the spacecraft and sample time of the
-        last :meth:`reset`. Raises ``NotImplementedError`` with :meth:`symbolic_error`'s reason."""
+        """The law as one CasADi function, for the spacecraft and sample time of the last :meth:`reset`.
+
+        Returns
+        -------
+        SymbolicLaw
+            ``law(t, y, z, r) -> (u, z_next)`` (see "Symbolic form"), its initial state and key.
+
+        Raises
+        ------
+        NotImplementedError
+            With :meth:`symbolic_error`'s reason, for a law that has no symbolic form.
+        """
         reason = self.symbolic_error()
         if reason is not None:
             raise NotImplementedError(reason)
@@ -219,78 +300,41 @@ class Controller(Configurable, ABC):
         return SymbolicLaw(function, state0, self.symbolic_key())
 
     def reference_rows(self, reference: Any, times: Array) -> Array:
-        """(len(times), 13) reference rows ``[q*, ω*, ω̇*, τ*]`` at ``times`` (s); from the
-        target (rate ``ω_f`` or zero, no acceleration or torque) when ``reference`` is ``None``."""
+        """Reference rows in the layout of the symbolic form.
+
+        Parameters
+        ----------
+        reference : planners.Reference or None
+            The reference (anything with a vectorised ``sample(t)``); ``None``: the target of the
+            last :meth:`reset` (rate ``ω_f`` or zero, no acceleration or torque).
+        times : (N,) array_like
+            Sample times [s].
+
+        Returns
+        -------
+        (N, 13) ndarray
+            Rows ``[q*, ω*, ω̇*, τ*]``: attitude quaternion, body rate [rad/s], body acceleration
+            [rad/s^2], feed-forward torque [N m], body axes.
+        """
         return reference_rows(reference, times, self.target)
 
     def command_vector(self, command: Command) -> Array:
-        """A :class:`Command` in the control layout ``u`` of the symbolic form (zeros where ``None``)."""
+        """A command as the vector ``u`` of the symbolic form.
+
+        Parameters
+        ----------
+        command : Command
+
+        Returns
+        -------
+        (nu,) ndarray
+            ``[g, m, τ_t]`` (blocks of the actuators present): wheel torques [N m], dipole
+            [A m^2], torquer torque [N m]; zeros where the command asks nothing.
+        """
         u = np.zeros(self._nu)
         for name, value in (("wheels", command.wheel_torque), ("dipole", command.dipole), ("torquers", command.torque)):
             if name in self._slices and value is not None:
                 u[self._slices[name]] = value
-        return u
-
-    # ----------------------------------------------------------------------------------------
-    # Allocation
-    # ----------------------------------------------------------------------------------------
-    def allocate(self, torque: Array, measurement: Measurement, rate: Array | None = None,
-                 wheel_momentum: Array | None = None) -> Command:
-        """Map a rigid-body control torque ``u`` (N m, body axes) to the actuators.
-
-        ``rate`` and ``wheel_momentum`` (default: the measured ones) are the ``ω`` and ``h_w`` of
-        the wheels' gyroscopic term ``ω × A h_w``; a law that predicts them to mid-sample passes
-        its prediction (see ``AugmentedQuaternionFeedback``).
-        """
-        spacecraft = self.spacecraft
-        command = Command()
-        residual = np.asarray(torque, dtype=float)
-        if self._working_axes is not None:
-            w = measurement.omega if rate is None else rate
-            h = spacecraft.wheel_axes @ (measurement.wheel_momentum if wheel_momentum is None else wheel_momentum)
-            wheel_torque = residual + cross3(w, h) if self.gyroscopic_compensation else residual
-            command.wheel_torque = -self._wheel_pinv @ wheel_torque
-            if self.wheels_only:
-                return command
-            residual = wheel_torque + self._working_axes @ command.wheel_torque
-            if np.sqrt(residual @ residual) <= 1e-12 * max(np.sqrt(wheel_torque @ wheel_torque), 1e-300):
-                return command
-        if self.wheels_only:
-            return command
-        if spacecraft.torquers is not None:
-            command.torque = residual
-        elif spacecraft.magnetorquers is not None and measurement.field_body is not None:
-            b = measurement.field_body
-            command.dipole = cross3(b, residual) / max(float(b @ b), 1e-30)
-        return command
-
-    def allocate_symbolic(self, torque: ca.SX, y: ca.SX, rate: ca.SX | None = None,
-                          wheel_momentum: ca.SX | None = None) -> ca.SX:
-        """:meth:`allocate` on expressions: the command vector ``u`` (control layout) for the
-        rigid-body torque ``torque`` given the measurement vector ``y``."""
-        spacecraft = self.spacecraft
-        _, omega, h_w, field = split_measurement(y, spacecraft.n_wheels)
-        parts = {}
-        residual = torque
-        done = None
-        if self._working_axes is not None:
-            w = omega if rate is None else rate
-            h = ca.mtimes(ca.DM(spacecraft.wheel_axes), h_w if wheel_momentum is None else wheel_momentum)
-            wheel_torque = residual + ca.cross(w, h) if self.gyroscopic_compensation else residual
-            g = -ca.mtimes(ca.DM(self._wheel_pinv), wheel_torque)
-            parts["wheels"] = g
-            residual = wheel_torque + ca.mtimes(ca.DM(self._working_axes), g)
-            done = ca.norm_2(residual) <= 1e-12 * ca.fmax(ca.norm_2(wheel_torque), 1e-300)
-        if self.wheels_only:
-            pass
-        elif spacecraft.torquers is not None:
-            parts["torquers"] = residual if done is None else ca.if_else(done, ca.DM.zeros(3), residual)
-        elif spacecraft.magnetorquers is not None:
-            dipole = ca.cross(field, residual) / ca.fmax(ca.dot(field, field), 1e-30)
-            parts["dipole"] = dipole if done is None else ca.if_else(done, ca.DM.zeros(3), dipole)
-        u = ca.SX.zeros(self._nu)
-        for name, value in parts.items():
-            u[self._slices[name]] = value
         return u
 
 
@@ -313,7 +357,20 @@ def check_gain(option: str, gain: float | list[list[float]]) -> None:
 
 
 def gain_matrix(gain: float | list[list[float]], inertia: Array) -> Array:
-    """A scalar gain times the inertia (the spin paper's choice), or a full 3x3 gain matrix."""
+    """A gain as a 3x3 matrix.
+
+    Parameters
+    ----------
+    gain : float or (3, 3) nested list
+        A scalar (times the inertia: the spin paper's choice) or a full matrix.
+    inertia : (3, 3) ndarray
+        Inertia [kg m^2], body axes.
+
+    Returns
+    -------
+    (3, 3) ndarray
+        ``gain * inertia`` for a scalar, else the matrix.
+    """
     if isinstance(gain, (int, float)):
         return float(gain) * inertia
     matrix = np.asarray(gain, dtype=float)

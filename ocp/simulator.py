@@ -24,7 +24,6 @@ Two paths compute the same numbers (to rounding; ``tests/test_closed_loop.py``):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, Protocol
 
 import casadi as ca
@@ -38,6 +37,12 @@ from ocp.compiled import CompilerUnavailable, compile_function, notice
 from ocp.fast_call import BufferedFunction
 from ocp.integration import rk4_step
 from ocp.model import AttitudeModel
+from ocp.simulation_data import (
+    GridSampledReference,
+    SensorNoise,
+    SimulationError,
+    SimulationResult,
+)
 
 Array = NDArray[np.float64]
 INTEGRATORS = ("rk4", "cvodes")
@@ -49,104 +54,24 @@ MAX_SUBSTEPS = 1000
 """Bound on RK4 sub-steps per sample (the step is one unrolled CasADi graph)."""
 
 
-class GridSampledReference:
-    """``reference`` with its samples at ``times`` computed once (vectorised) and served by
-    :meth:`sample`; other times and every other attribute go to ``reference`` itself.
+class _ControllerLike(Protocol):
+    """What the simulator needs of a controller (``controllers.base.Controller`` has it)."""
 
-    Parameters
-    ----------
-    reference : anything with a vectorised ``sample(t)`` returning a named tuple of arrays.
-    times : s, the times to precompute.
-    """
+    def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None:
+        """Prepare for a run.
 
-    def __init__(self, reference: Any, times: Array):
-        self.reference = reference
-        times = np.unique(np.asarray(times, dtype=float))
-        self._table = reference.sample(times)
-        self._index = {float(value): i for i, value in enumerate(times)}
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The controlled spacecraft.
+        sample_time : float
+            Controller period and zero-order-hold length [s].
+        target : (q_f, ω_f or None), optional
+            Final attitude (scalar-first quaternion) and body rate [rad/s] for regulation.
+        """
 
-    def sample(self, t: ArrayLike) -> Any:
-        """The reference at ``t`` (scalar or array), as ``reference.sample`` returns it."""
-        index = self._index
-        if np.ndim(t) == 0:
-            i = index.get(float(t))
-            return self.reference.sample(t) if i is None else type(self._table)(*(a[i] for a in self._table))
-        rows = [index.get(float(value)) for value in np.ravel(t)]
-        if None in rows:
-            return self.reference.sample(t)
-        return type(self._table)(*(a[rows] for a in self._table))
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self.reference, name)
-
-
-class SimulationError(RuntimeError):
-    """The integration diverged (non-finite state), e.g. a step far too long for the rates."""
-
-
-class ControllerLike(Protocol):
-    def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None: ...
-    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command: ...
-
-
-@dataclass(frozen=True)
-class SensorNoise:
-    """Gaussian sensor noise, white per sample: attitude as a random rotation vector (rad, per axis
-    std), body rate (rad/s, per axis std), magnetometer (T, per body axis std); ``seed`` makes it
-    repeatable. Each sample draws attitude, then rate (only the non-zero ones) from the stream
-    seeded by ``seed``, and the magnetometer from its own stream (seeded by ``[seed, 1]``), so that
-    adding magnetometer noise leaves the attitude and rate noise of a scenario unchanged."""
-
-    attitude_std: float = 0.0
-    rate_std: float = 0.0
-    seed: int = 0
-    field_std: float = 0.0
-
-    def __post_init__(self) -> None:
-        for name in ("attitude_std", "rate_std", "field_std"):
-            value = getattr(self, name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
-                raise ValueError(f"{name} must be a finite non-negative standard deviation, got {value!r}")
-        if not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool) or self.seed < 0:
-            raise ValueError(f"seed must be a non-negative integer, got {self.seed!r}")
-
-
-@dataclass
-class SimulationResult:
-    """Time series of a simulation with ``N`` samples.
-
-    Attributes
-    ----------
-    t : (N+1,) s, sample instants and the final time.
-    x : (N+1, nx) states ``[q, ω, h_w]`` at ``t``.
-    commanded_u : (N, nu) control asked for (before saturation), layout of ``model.control_slices``.
-    applied_u : (N, nu) control applied over ``[t_k, t_k+1]``.
-    applied_torque : (N, 3) N m, actuator torque on the body at ``t_k`` (body axes).
-    saturated : (N,) bool, any actuator at its limit during sample k.
-    """
-
-    model: AttitudeModel
-    sample_time: float
-    t: Array
-    x: Array
-    commanded_u: Array
-    applied_u: Array
-    applied_torque: Array
-    saturated: NDArray[np.bool_]
-    path: str = "python"
-    """How it was computed: ``"python"`` (loop), ``"interpreted"`` or ``"compiled"`` (one CasADi function)."""
-
-    @property
-    def q(self) -> Array:
-        return self.x[:, 0:4]
-
-    @property
-    def omega(self) -> Array:
-        return self.x[:, 4:7]
-
-    @property
-    def wheel_momentum(self) -> Array:
-        return self.x[:, 7:]
+    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
+        """The command for the sample starting at ``t`` [s] (see ``Controller.__call__``)."""
 
 
 class Simulator:
@@ -154,14 +79,27 @@ class Simulator:
 
     Parameters
     ----------
-    model : the spacecraft in its environment.
-    sample_time : s, controller period and zero-order-hold length.
-    integrator : ``"rk4"`` (fixed step, at most ``max_step`` s per sub-step) or ``"cvodes"``
-        (adaptive, ``rtol``/``atol``). RK4's local error grows as ``(h ‖ω‖)⁵``: the default
-        0.05 s keeps closed-loop attitudes within ~1e-8 deg of CVODES at rates below ~0.5 rad/s;
-        lower it for fast spins or conservation studies.
-    compile : build the closed loop of symbolic laws as C (cached; see :mod:`ocp.compiled`).
-    python_loop : always use the Python loop (the reference implementation), even for symbolic laws.
+    model : AttitudeModel
+        The spacecraft in its environment.
+    sample_time : float
+        Controller period and zero-order-hold length [s].
+    integrator : {"rk4", "cvodes"}, optional
+        ``"rk4"``: fixed step, at most ``max_step`` per sub-step; ``"cvodes"``: adaptive
+        (``rtol``/``atol``). RK4's local error grows as ``(h ‖ω‖)⁵``: the default 0.05 s keeps
+        closed-loop attitudes within ~1e-8 deg of CVODES at rates below ~0.5 rad/s; lower it for
+        fast spins or conservation studies.
+    max_step : float, optional
+        Longest RK4 sub-step [s] (at most :data:`MAX_SUBSTEPS` sub-steps per sample).
+    rtol, atol : float, optional
+        CVODES relative and absolute tolerances.
+    compile : bool, optional
+        Build the closed loop of symbolic laws as C (cached; see :mod:`ocp.compiled`).
+    python_loop : bool, optional
+        Always use the Python loop (the reference implementation), even for symbolic laws.
+    max_samples : int, optional
+        Most samples one run may take, and most RK4 sub-steps in all: ``SUBSTEPS_PER_SAMPLE`` times
+        this (:data:`SUBSTEPS_PER_SAMPLE`); longer runs are refused with :class:`SimulationError`,
+        not attempted.
     """
 
     MAX_BUILDS = 16
@@ -200,7 +138,7 @@ class Simulator:
         self.substeps = substeps if integrator == "rk4" else 1
         self.actuators = ActuatorModel(model.spacecraft, model.control_slices, model.nu)
         self._step = self._build_step(integrator, substeps, rtol, atol)
-        self._step_numeric = BufferedFunction(self._step)
+        self._step_numeric = BufferedFunction(self._normalised(self._step))
         self._field_numeric = None if model.field_body is None else BufferedFunction(model.field_body)
         self._field_rate_numeric = (None if model.field_rate_inertial is None
                                     else BufferedFunction(model.field_rate_inertial))
@@ -209,6 +147,19 @@ class Simulator:
         self.python_loop = python_loop
         self._loops: dict[Any, tuple[ClosedLoop, ca.Function, str]] = {}
         self._runs: dict[Any, BufferedFunction] = {}
+        self._last_grid: tuple[Any, Array, GridSampledReference] | None = None
+        self._torque_map: tuple[int, ca.Function] | None = None
+        self._command_slices = [(attribute, model.control_slices[name]) for name, attribute in
+                                (("wheels", "wheel_torque"), ("dipole", "dipole"), ("torquers", "torque"))
+                                if name in model.control_slices]
+
+    @staticmethod
+    def _normalised(step: ca.Function) -> ca.Function:
+        """``step`` followed by the re-normalisation of the quaternion (the Python loop's step)."""
+        symbols = [step.sx_in(i) for i in range(step.n_in())] if step.is_a("SXFunction") else step.mx_in()
+        x_next = step(*symbols)
+        x_next = ca.vertcat(x_next[0:4] / ca.norm_2(x_next[0:4]), x_next[4:])
+        return ca.Function("zoh_step_normalised", symbols, [x_next], step.name_in(), ["x_next"])
 
     def _build_step(self, integrator: str, substeps: int, rtol: float, atol: float) -> ca.Function:
         """``step(x, u, t, dt, p) -> x_next``: one hold interval of length ``dt`` starting at ``t``."""
@@ -234,7 +185,7 @@ class Simulator:
 
     def run(
         self,
-        controller: ControllerLike,
+        controller: _ControllerLike,
         x0: ArrayLike,
         duration: float,
         reference: Any = None,
@@ -242,10 +193,35 @@ class Simulator:
         noise: SensorNoise | None = None,
         parameters: ArrayLike | None = None,
     ) -> SimulationResult:
-        """Simulate ``duration`` seconds from ``x0`` in closed loop with ``controller``.
+        """Simulate in closed loop.
 
-        ``target`` (e.g. ``(q_f, ω_f)``) is handed to ``controller.reset`` for regulation;
-        ``parameters`` overrides the model's disturbance torque ``p``.
+        Parameters
+        ----------
+        controller : controllers.base.Controller (anything with its reset and __call__)
+            The feedback law (reset here; a symbolic law runs as one CasADi function unless
+            ``python_loop``).
+        x0 : (nx,) array_like
+            Initial state ``[q, ω, h_w]`` (the quaternion is normalised).
+        duration : float
+            Simulated time [s]; the last sample is shortened to end there.
+        reference : planners.Reference, optional
+            Reference to track; ``None``: regulation to ``target``. It is sampled once per run on
+            the sample grid (and kept for the next run with the same reference and grid).
+        target : (q_f, ω_f or None), optional
+            Handed to ``controller.reset``: final attitude and body rate [rad/s] for regulation.
+        noise : SensorNoise, optional
+            Sensor noise; ``None``: none.
+        parameters : (3,) array_like, optional
+            Disturbance torque ``p`` [N m], body axes; ``None``: the model's default.
+
+        Returns
+        -------
+        SimulationResult
+
+        Raises
+        ------
+        SimulationError
+            When the state becomes non-finite or the run exceeds the work limits.
         """
         model = self.model
         x = np.asarray(x0, dtype=float).copy()
@@ -262,7 +238,7 @@ class Simulator:
         n_samples = max(1, math.ceil(duration / self.sample_time - 1e-9))
         if n_samples > self.max_samples or n_samples * self.substeps > SUBSTEPS_PER_SAMPLE * self.max_samples:
             raise SimulationError(f"{duration:g} s at {self.sample_time:g} s samples is {n_samples} samples, over the "
-                                  f"limit of {self.max_samples} samples or {SUBSTEPS_PER_SAMPLE} sub-steps each "
+                                  f"limit of {self.max_samples} samples or {SUBSTEPS_PER_SAMPLE * self.max_samples} sub-steps in all "
                                   "(simulation.max_samples raises it)")
         times = np.minimum(np.arange(n_samples + 1) * self.sample_time, duration)
         noise = noise or SensorNoise()
@@ -277,32 +253,49 @@ class Simulator:
         if self._symbolic(controller):
             return self._run_symbolic(controller, x, times, p, noise, rng, reference, field_rng)
         if reference is not None and hasattr(reference, "sample"):
-            reference = GridSampledReference(reference, np.concatenate([times, times[:-1] + self.sample_time]))
+            reference = self._grid_reference(reference, np.concatenate([times, times[:-1] + self.sample_time]))
 
-        states = np.empty((n_samples + 1, model.nx))
         commanded = np.zeros((n_samples, model.nu))
-        applied = np.zeros((n_samples, model.nu))
-        saturated = np.zeros(n_samples, dtype=bool)
-        states[0] = x
+        # Per sample: Python floats and lists, the step's own buffers (no NumPy calls on short
+        # vectors beyond the copies the measurement hands out); arrays are made at the end.
+        states: list[list[float]] = [x.tolist()]
+        applied: list[list[float]] = []
+        saturated: list[bool] = []
+        step = self._step_numeric
+        x_in, u_in, t_in, dt_in, p_in = step.inputs
+        x_out = step.outputs[0]
+        x_in[:] = x
+        p_in[:] = p
+        evaluate, apply, fill_command = step.evaluate, self.actuators.apply_floats, self._fill_command
+        times_list = times.tolist()
+        n_wheels = model.spacecraft.n_wheels
         for k in range(n_samples):
-            t_k = times[k]
-            measurement = self._measure(x, t_k, noise, rng, field_rng)
+            t_k = times_list[k]
+            measurement = self._measure(x_in, t_k, noise, rng, field_rng)
             if field_rate is not None:
                 measurement.field_rate_inertial = field_rate(t_k).copy()
             command = controller(t_k, measurement, reference)
-            commanded[k] = self._command_vector(command)
-            dt = times[k + 1] - t_k
-            applied[k], saturated[k] = self.actuators.apply(command, x[7:], dt)
-            x = self._step_numeric(x, applied[k], t_k, dt, p).copy()
-            if not np.all(np.isfinite(x)):
+            fill_command(command, commanded[k])
+            dt = times_list[k + 1] - t_k
+            u, at_limit = apply(command, states[k][7:7 + n_wheels], dt)
+            applied.append(u)
+            saturated.append(at_limit)
+            u_in[:] = u
+            t_in[0], dt_in[0] = t_k, dt
+            evaluate()
+            x_next = x_out.tolist()  # the quaternion re-normalised by the step function
+            if not math.isfinite(sum(x_next)) and not np.isfinite(x_out).all():  # the sum can overflow
                 raise SimulationError(self._divergence(times, k))
-            x[0:4] /= math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3])
-            states[k + 1] = x
-        return self._result(times, states, commanded, applied, saturated, "python")
+            x_in[:] = x_out
+            states.append(x_next)
+        return self._result(times, np.array(states), commanded, np.array(applied).reshape(n_samples, model.nu),
+                            np.array(saturated, dtype=bool), "python")
 
-    def _result(self, times: Array, states: Array, commanded: Array, applied: Array, saturated: Array,
+    def _result(self, times: Array, states: Array, commanded: Array, applied: Array, saturated: NDArray[np.bool_],
                 path: str) -> SimulationResult:
-        torque_map = self.model.body_torque.map(times.size - 1)
+        if self._torque_map is None or self._torque_map[0] != times.size - 1:
+            self._torque_map = (times.size - 1, self.model.body_torque.map(times.size - 1))
+        torque_map = self._torque_map[1]
         applied_torque = torque_map(states[:-1].T, applied.T, times[:-1]).full().T
         return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, applied_torque,
                                 saturated, path)
@@ -320,9 +313,26 @@ class Simulator:
         return reason is not None and reason() is None
 
     def closed_loop_function(self, controller: Any, noise: SensorNoise) -> tuple[ClosedLoop, ca.Function, str]:
-        """The one-sample closed-loop function of a reset symbolic ``controller``: its builder, the
-        function (interpreted, or the compiled twin) and how it is evaluated (``"interpreted"`` or
-        ``"compiled"``). Builds are kept per law (:meth:`symbolic_key`) and noise shape."""
+        """The one-sample closed-loop function of a symbolic law.
+
+        Builds are kept per law (``Controller.symbolic_key``) and noise shape.
+
+        Parameters
+        ----------
+        controller : Controller
+            A reset controller with a symbolic law.
+        noise : SensorNoise
+            Which noises the function takes as inputs (those with a non-zero deviation).
+
+        Returns
+        -------
+        loop : ClosedLoop
+            Its builder.
+        function : casadi.Function
+            The function, interpreted, or its compiled twin.
+        path : str
+            ``"interpreted"`` or ``"compiled"``.
+        """
         loop_key = self._loop_key(controller, noise)
         if loop_key not in self._loops:
             if len(self._loops) >= self.MAX_BUILDS:
@@ -407,10 +417,20 @@ class Simulator:
             field += (rng if field_rng is None else field_rng).normal(0.0, noise.field_std, 3)
         return Measurement(t=t, q=q.copy(), omega=omega.copy(), wheel_momentum=x[7:].copy(), field_body=field)
 
-    def _command_vector(self, command: Command) -> Array:
-        """The command in the layout of ``u`` (zeros where nothing is asked)."""
-        u = np.zeros(self.model.nu)
-        for name, value in (("wheels", command.wheel_torque), ("dipole", command.dipole), ("torquers", command.torque)):
-            if name in self.model.control_slices and value is not None:
-                u[self.model.control_slices[name]] = value
-        return u
+    def _fill_command(self, command: Command, out: Array) -> None:
+        """Write the command into ``out`` (a zero row) in the layout of ``u``."""
+        for attribute, where in self._command_slices:
+            value = getattr(command, attribute)
+            if value is not None:
+                out[where] = value
+
+    def _grid_reference(self, reference: Any, grid: Array) -> GridSampledReference:
+        """``reference`` served on ``grid``; the last one is kept, so that runs repeated with the
+        same reference and grid (trade studies, Monte Carlo) sample it once. References are
+        immutable results (``planners.Reference``)."""
+        cached = self._last_grid
+        if cached is not None and cached[0] is reference and np.array_equal(cached[1], grid):
+            return cached[2]
+        served = GridSampledReference(reference, grid)
+        self._last_grid = (reference, grid, served)
+        return served

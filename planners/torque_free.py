@@ -20,13 +20,16 @@ from ocp import quat
 from ocp.spin_closed_form import extremal_quaternion
 
 Array = NDArray[np.float64]
+REST_RATE = 1e-15
+"""rad/s: a final rate at or below this is rounding residue; the torque-free coast is then rest."""
 
 
 class TorqueFreeMotion:
     """Torque-free motion of a rigid body from ``(q_start, omega_start)`` at time ``start``.
 
     Integrated with DOP853 (rtol 1e-12, atol 1e-14) in chunks of fixed length, so that a value does
-    not depend on which times were asked for before. A state at rest holds its attitude.
+    not depend on which times were asked for before. A state at rest (rate at most
+    :data:`REST_RATE`, rounding residue) holds its attitude.
 
     Parameters
     ----------
@@ -47,7 +50,9 @@ class TorqueFreeMotion:
         self.inverse = np.linalg.inv(self.inertia)
         self.start = float(start)
         rate = float(np.linalg.norm(self.omega_start))
-        self.at_rest = rate == 0.0
+        # A rest-to-rest profile ends at rest up to rounding (~1e-17 rad/s: a degree in 10⁸
+        # years); at or below REST_RATE the coast is rest, and scipy.integrate (0.5 s) is not imported.
+        self.at_rest = rate <= REST_RATE
         # About a quarter turn per chunk at the initial rate (the rate norm is bounded by energy).
         self.chunk = 1.0 if self.at_rest else float(np.clip(1.5 / rate, 1.0, 1e4))
         self._chunks: list[Any] = []

@@ -26,7 +26,7 @@ from scenarios.yaml_node import ScenarioError
 EXIT_OK, EXIT_INTERNAL, EXIT_BAD_SCENARIO = 0, 1, 2
 
 
-def _first_doc_line(cls) -> str:
+def _first_doc_line(cls: type) -> str:
     """The first sentence of the module's docstring (the class's if the module has none)."""
     doc = (sys.modules[cls.__module__].__doc__ or cls.__doc__ or "").strip()
     paragraph = " ".join(doc.split("\n\n")[0].split())
@@ -35,16 +35,40 @@ def _first_doc_line(cls) -> str:
 
 
 def command_list(_: argparse.Namespace) -> int:
+    """``slewbench list``: print the registered planners and controllers, one line each.
+
+    Parameters
+    ----------
+    _ : argparse.Namespace
+        The parsed command line (unused).
+
+    Returns
+    -------
+    int
+        Exit status (0).
+    """
     print("planners:")
-    for name, cls in PLANNERS.items():
-        print(f"  {name:32s} {_first_doc_line(cls)}")
+    for name, planner in PLANNERS.items():
+        print(f"  {name:32s} {_first_doc_line(planner)}")
     print("controllers:")
-    for name, cls in CONTROLLERS.items():
-        print(f"  {name:32s} {_first_doc_line(cls)}")
+    for name, controller in CONTROLLERS.items():
+        print(f"  {name:32s} {_first_doc_line(controller)}")
     return EXIT_OK
 
 
 def command_validate(args: argparse.Namespace) -> int:
+    """``slewbench validate FILE``: load and check a scenario, print a one-line summary.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``file``: the scenario YAML path.
+
+    Returns
+    -------
+    int
+        Exit status (0; a bad scenario raises ``ScenarioError``, which :func:`main` reports).
+    """
     scenario = load(args.file)
     print(f"{args.file}: valid scenario {scenario.name!r} with {len(scenario.planners)} planner(s) "
           f"and controller {scenario.controller.name!r}")
@@ -52,6 +76,19 @@ def command_validate(args: argparse.Namespace) -> int:
 
 
 def command_run(args: argparse.Namespace) -> int:
+    """``slewbench run FILE``: plan, simulate and score, print the table, write the outputs.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``file`` (scenario YAML), ``out`` (output directory or ``None``: ``results/<name>``),
+        ``no_plots`` (skip the PNG figures).
+
+    Returns
+    -------
+    int
+        Exit status (0: the run completed; failed planners are rows, not errors).
+    """
     scenario = load(args.file)
     out = Path(args.out) if args.out else default_output_directory(scenario.name)
     claim_output_directory(out)  # before planning: a long run is never lost at the end
@@ -66,7 +103,22 @@ def command_run(args: argparse.Namespace) -> int:
 
 
 def command_codegen(args: argparse.Namespace) -> int:
-    from scenarios.codegen import generate  # CasADi's code generator: only for this command
+    """``slewbench codegen FILE --out DIR``: export the controller law (and closed-form
+    references) as CasADi-generated C with a header and a Makefile.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``file`` (scenario YAML) and ``out`` (output directory).
+
+    Returns
+    -------
+    int
+        Exit status (0).
+    """
+    from scenarios.codegen import (
+        generate,  # CasADi's code generator: only for this command
+    )
 
     scenario = load(args.file)
     report = generate(scenario, args.out)
@@ -79,6 +131,13 @@ def command_codegen(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``slewbench`` argument parser (run, validate, codegen, list, sweep, report).
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        Each sub-command sets ``handler``, the function that runs it.
+    """
     parser = argparse.ArgumentParser(prog="slewbench", description="Spacecraft attitude manoeuvre planning workbench")
     commands = parser.add_subparsers(dest="command", required=True)
     run_parser = commands.add_parser("run", help="plan, simulate and score every planner of a scenario")
@@ -105,6 +164,18 @@ def _terminate(signum: int, frame: Any) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the ``slewbench`` command line.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments (without the program name); ``None``: ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        Exit status: 0 done, 2 bad scenario file, 1 internal error or interrupted.
+    """
     args = build_parser().parse_args(argv)
     previous = signal.signal(signal.SIGTERM, _terminate) if threading.current_thread() is threading.main_thread() else None
     try:

@@ -7,11 +7,21 @@ from __future__ import annotations
 
 import time
 import traceback
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from pathlib import Path
+from typing import Any
 
 from controllers import CONTROLLERS
-from ocp import SimulationError, SolverCache, metric_violations, SimulationResult, Simulator, metrics_from_reference, metrics_from_simulation
+from ocp import (
+    SimulationError,
+    SimulationResult,
+    Simulator,
+    SolverCache,
+    metric_violations,
+    metrics_from_reference,
+    metrics_from_simulation,
+)
 from planners import PLANNERS, FailedReference, Reference
 from scenarios.loader import ControllerSpec, Scenario
 
@@ -20,9 +30,31 @@ from scenarios.loader import ControllerSpec, Scenario
 class Row:
     """One planner and controller pair (in regulation mode, the controller alone) and its scores.
 
-    ``label`` is the planner's label, or the controller's in regulation mode; with several
-    controllers a planner's rows are labelled ``"<planner label> / <controller label>"``.
-    ``planner`` and ``controller`` are registry names (``planner`` is ``None`` in regulation mode).
+    Parameters
+    ----------
+    label : str
+        The planner's label, or the controller's in regulation mode; with several controllers a
+        planner's rows are labelled ``"<planner label> / <controller label>"``.
+    planner : str or None
+        Planner registry name; ``None`` in regulation mode.
+    status : str
+        ``"ok"`` or ``"failed"`` (a failed planner, simulation or unphysical metrics).
+    message : str
+        Why it failed (empty when ok).
+    plan_time_s : float or None
+        Planning time [s]; ``None`` in regulation mode.
+    reference_metrics : dict or None
+        Metrics of the reference itself (ARCHITECTURE.md's metric keys); ``None`` without one.
+    closed_loop_metrics : dict or None
+        Metrics of the closed-loop simulation; ``None`` when it was not simulated.
+    reference : planners.Reference or None, optional
+        The planned reference.
+    simulation : ocp.SimulationResult or None, optional
+        The closed-loop time series.
+    simulate_time_s : float, optional
+        Simulation time [s].
+    controller : str or None, optional
+        Controller registry name.
     """
 
     label: str
@@ -38,7 +70,14 @@ class Row:
     controller: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The row as ARCHITECTURE.md's ``results.json`` writes it (a plain dict)."""
+        """The row as ARCHITECTURE.md's ``results.json`` writes it.
+
+        Returns
+        -------
+        dict
+            ``label``, ``planner``, ``controller``, ``status``, ``message``, ``plan_time_s``,
+            ``reference`` and ``closed_loop`` (the two metric dicts).
+        """
         return {"label": self.label, "planner": self.planner, "controller": self.controller,
                 "status": self.status, "message": self.message,
                 "plan_time_s": self.plan_time_s, "reference": self.reference_metrics,
@@ -48,37 +87,89 @@ class Row:
 @dataclass
 class RunResults:
     """Rows of a scenario run. ``to_json``, ``to_csv``, ``to_markdown``, ``to_dataframe`` and
-    ``write`` render them (implemented in :mod:`scenarios.tables` and :mod:`scenarios.outputs`)."""
+    ``write`` render them (implemented in :mod:`scenarios.tables` and :mod:`scenarios.outputs`).
+
+    Parameters
+    ----------
+    scenario : scenarios.loader.Scenario
+        The scenario that was run.
+    rows : list of Row
+        One per planner and controller pair (per controller in regulation mode).
+    """
 
     scenario: Scenario
     rows: list[Row]
 
     def to_dict(self) -> dict[str, Any]:
+        """The results as a plain dict.
+
+        Returns
+        -------
+        dict
+            ``{"scenario": name, "rows": [Row.to_dict(), ...]}``.
+        """
         return {"scenario": self.scenario.name, "rows": [row.to_dict() for row in self.rows]}
 
     def to_json(self) -> str:
+        """``results.json``'s text.
+
+        Returns
+        -------
+        str
+        """
         from scenarios.tables import to_json
         return to_json(self)
 
     def to_csv(self) -> str:
+        """``results.csv``'s text (one line per row, metrics as columns).
+
+        Returns
+        -------
+        str
+        """
         from scenarios.tables import to_csv
         return to_csv(self)
 
     def to_markdown(self) -> str:
+        """``results.md``'s text (a Markdown table).
+
+        Returns
+        -------
+        str
+        """
         from scenarios.tables import to_markdown
         return to_markdown(self)
 
     def to_terminal(self) -> str:
+        """The summary table ``slewbench run`` prints.
+
+        Returns
+        -------
+        str
+        """
         from scenarios.tables import to_terminal
         return to_terminal(self)
 
-    def to_dataframe(self):
-        """A pandas DataFrame of the CSV table (needs pandas installed)."""
+    def to_dataframe(self) -> Any:
+        """The CSV table as a pandas DataFrame (needs pandas installed).
+
+        Returns
+        -------
+        pandas.DataFrame
+        """
         from scenarios.tables import to_dataframe
         return to_dataframe(self)
 
-    def write(self, directory, plots: bool = True) -> None:
-        """Write results.json/csv/md, time series and plots into ``directory`` atomically."""
+    def write(self, directory: str | Path, plots: bool = True) -> None:
+        """Write results.json/csv/md, time series and plots atomically.
+
+        Parameters
+        ----------
+        directory : str or pathlib.Path
+            Output directory (created; slewbench never overwrites files it did not write).
+        plots : bool, optional
+            Also write the PNG figures.
+        """
         from scenarios.outputs import write_results
         write_results(self, directory, plots=plots)
 
@@ -117,7 +208,7 @@ def _check_physical(row: Row, scope: str, metrics: dict[str, Any] | None) -> Non
 
 
 def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
-        cache: SolverCache | None = None) -> RunResults:
+        cache: SolverCache | None = None, simulators: SolverCache | None = None) -> RunResults:
     """Plan, simulate and score every planner of ``scenario``.
 
     Parameters
@@ -125,6 +216,9 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     scenario : a loaded scenario.
     progress : receives a line of text per finished row.
     cache : solvers built by planners, shared across runs (a trade-study worker passes one).
+    simulators : simulators (and their closed-loop functions) shared across runs, keyed by the
+        model's fingerprint and the simulation settings; anything with SolverCache's ``get``
+        (a trade-study worker passes a bounded one). None: a new simulator per run.
 
     Returns
     -------
@@ -133,8 +227,15 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     """
     say = progress or (lambda line: None)
     spec = scenario.simulation
-    simulator = Simulator(scenario.problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step,
-                          max_samples=spec.max_samples, compile=spec.compile)
+    model = scenario.problem.model
+
+    def build() -> Simulator:
+        return Simulator(model, spec.sample_time, spec.integrator, max_step=spec.max_step,
+                         max_samples=spec.max_samples, compile=spec.compile)
+
+    simulator = build() if simulators is None else simulators.get(
+        ("simulator", model.fingerprint, spec.sample_time, spec.integrator, spec.max_step, spec.max_samples,
+         spec.compile), build)
     controllers = scenario.controllers
     rows = []
     if not scenario.planners:
@@ -172,6 +273,6 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
                 _simulate(scenario, simulator, reference, row, controller)
             rows.append(row)
             say(f"[{len(rows)}/{total}] {row.label}: {row.status} "
-                f"(planned in {row.plan_time_s * 1e3:.1f} ms, simulated in {row.simulate_time_s:.2f} s)"
+                f"(planned in {(row.plan_time_s or 0.0) * 1e3:.1f} ms, simulated in {row.simulate_time_s:.2f} s)"
                 + (f" - {row.message}" if row.status != "ok" else ""))
     return RunResults(scenario, rows)

@@ -4,16 +4,15 @@ expansion of a study into resolved cases, each validated by the scenario loader.
 A study varies a base scenario over a ``grid`` (cartesian product), a ``zip`` (equal-length lists
 varied together) and, per grid point, ``monte_carlo`` samples of ``dispersions``. Every case gets a
 seed from ``numpy.random.SeedSequence(seed).spawn``, so its values (and its result) do not depend
-on the number of workers or the order in which cases finish.
+on the number of workers or the order in which cases finish. The study's data classes are in
+:mod:`scenarios.study_types` (imported here too).
 """
 from __future__ import annotations
 
 import copy
-import hashlib
 import itertools
 import json
 import os
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -23,74 +22,13 @@ from ocp import METRIC_KEYS, quat
 from scenarios.loader import parse_scenario
 from scenarios.study_dispersions import Dispersion, draw_unit, parse_dispersion
 from scenarios.study_paths import Step, get_path, parse_path, set_path
+from scenarios.study_types import Case, Execution, Study, case_key, package_version
 from scenarios.yaml_node import Node, ScenarioError, read_yaml
 
 MAX_CASES = 100_000
 MAX_VALUES = 10_000
 DEFAULT_SUMMARY = tuple(f"{scope}.{key}" for scope in ("ref", "cl") for key in METRIC_KEYS
                         if key not in ("plan_time_s", "int_abs_u"))  # every scalar metric
-
-
-@dataclass
-class Execution:
-    """How cases run: ``workers`` (None: one per core), a Dask ``scheduler`` address or None,
-    ``case_timeout_s`` (s), ``retries`` of a case whose worker died."""
-
-    workers: int | None = None
-    scheduler: str | None = None
-    case_timeout_s: float = 600.0
-    retries: int = 1
-
-
-@dataclass
-class Case:
-    """One resolved case: its number, seed, the varied values (by path) and the scenario data."""
-
-    index: int
-    seed: int
-    point: int
-    varied: dict[str, Any]
-    scenario: dict[str, Any]
-    key: str = ""
-
-
-@dataclass
-class Study:
-    """A parsed study with its cases expanded and validated."""
-
-    name: str
-    source: Path | None
-    base: dict[str, Any]
-    grid_paths: list[str]
-    mc_paths: list[str]
-    samples: int
-    method: str | None
-    seed: int
-    summary: list[str]
-    execution: Execution
-    cases: list[Case] = field(default_factory=list)
-    raw: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def varied_paths(self) -> list[str]:
-        return self.grid_paths + self.mc_paths
-
-
-def package_version() -> str:
-    """slewbench's version: the installed distribution's, else pyproject.toml's."""
-    from importlib.metadata import PackageNotFoundError, version
-    try:
-        return version("slewbench")
-    except PackageNotFoundError:  # not installed: running from a checkout
-        import tomllib
-        pyproject = Path(__file__).resolve().parents[1] / "pyproject.toml"
-        return str(tomllib.loads(pyproject.read_text())["project"]["version"])
-
-
-def case_key(scenario: dict[str, Any], version: str) -> str:
-    """Store key: a hash of the resolved case (canonical JSON) and the package version."""
-    text = json.dumps({"scenario": scenario, "version": version}, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 
 def _tree_copy(value: Any) -> Any:
@@ -160,7 +98,9 @@ def _varied(entry: Node, path: str, base: dict[str, Any], paths: list[str],
 
 def _grid_points(root: Node, base: dict[str, Any]) -> tuple[list[str], list[list[Step]], list[tuple[list, list]]]:
     """Varied paths, their parsed steps and the points (values set, values recorded)."""
-    paths, steps, axes = [], [], []
+    paths: list[str] = []
+    steps: list[list[Step]] = []
+    axes: list[list[list[tuple[Any, Any]]]] = []
     grid = root.get("grid", {})
     grid = Node({}, "grid") if grid.is_null() else grid.mapping()
     for path in grid.value:
@@ -187,7 +127,22 @@ def _grid_points(root: Node, base: dict[str, Any]) -> tuple[list[str], list[list
 
 
 def get_parent_ok(base: dict[str, Any], steps: list[Step], where: str) -> None:
-    """Check on the base scenario that ``steps`` can be set (reaches existing lists and labels)."""
+    """Check on the base scenario that ``steps`` can be set (reaches existing lists and labels).
+
+    Parameters
+    ----------
+    base : dict
+        The base scenario mapping (not changed: a copy is written).
+    steps : list of Step
+        The parsed scenario path (:func:`scenarios.study_paths.parse_path`).
+    where : str
+        The study entry, for error messages.
+
+    Raises
+    ------
+    ScenarioError
+        The path does not reach the base scenario.
+    """
     set_path(copy.deepcopy(base), steps, None, where)
 
 
@@ -215,11 +170,15 @@ def parse_study(data: Any, source: Path | None = None, version: str | None = Non
 
     Parameters
     ----------
-    data : the study mapping (``study``, ``scenario``, ``grid``, ``zip``, ``monte_carlo``,
+    data : Any
+        The study mapping (``study``, ``scenario``, ``grid``, ``zip``, ``monte_carlo``,
         ``summary``, ``execution``).
-    source : the study file; a ``scenario`` path is relative to its folder.
-    version : the package version in the case keys (default: this one's; a stored study's when
-        its report is redrawn).
+    source : Path or None, optional
+        The study file; a ``scenario`` path is relative to its folder (None: the working
+        directory).
+    version : str or None, optional
+        The package version in the case keys (None: this one's; a stored study's when its
+        report is redrawn).
 
     Returns
     -------
@@ -339,7 +298,24 @@ def _validate(study: Study, case: Case) -> None:
 
 
 def load_study(path: str | os.PathLike[str]) -> Study:
-    """Read, expand and validate a study file (errors name the study file, the case and the path)."""
+    """Read, expand and validate a study file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The study YAML file.
+
+    Returns
+    -------
+    Study
+        As :func:`parse_study`.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the study file, the case and the path, for a missing file, a bad entry or a case
+        the scenario loader rejects.
+    """
     path = Path(path)
     try:
         return parse_study(read_yaml(path), path)

@@ -22,8 +22,20 @@ _EPS = 1e-12  # keeps the normal's inverse CDF finite at u = 0
 class Dispersion:
     """A distribution of ``dimension`` independent components and how it meets the base value.
 
-    ``kind``: normal | uniform | case_seed; ``combine``: set | scale | offset;
-    ``a``, ``b``: (mean, std) or (low, high) per component; ``vector``: a list, not a scalar.
+    Parameters
+    ----------
+    kind : str
+        ``normal``, ``uniform`` or ``case_seed``.
+    combine : str
+        ``set`` (the draw is the value), ``scale`` (it multiplies the base value) or ``offset``
+        (it is added to the base value).
+    a : (n,) ndarray
+        Mean (normal) or low bound (uniform) of each component, in the units of the scenario
+        key (a ``_deg`` key: degrees); empty for ``case_seed``.
+    b : (n,) ndarray
+        Standard deviation (normal) or high bound (uniform) of each component, same units.
+    vector : bool
+        The value is a list of ``n`` numbers, not a scalar.
     """
 
     kind: str
@@ -34,14 +46,32 @@ class Dispersion:
 
     @property
     def dimension(self) -> int:
+        """Unit samples the dispersion consumes (0 for ``case_seed``)."""
         return 0 if self.kind == "case_seed" else int(self.a.size)
 
     @property
     def needs_base(self) -> bool:
+        """Whether :meth:`value` needs the base scenario's value (``scale`` and ``offset``)."""
         return self.combine != "set"
 
     def value(self, unit: np.ndarray, seed: int, base: Any) -> Any:
-        """The dispersed value from unit samples ``unit`` (in [0, 1)) and the base value."""
+        """The dispersed value from unit samples and the base value.
+
+        Parameters
+        ----------
+        unit : (dimension,) ndarray
+            Unit samples in [0, 1), turned into the distribution by its inverse CDF.
+        seed : int
+            The case's seed (the value of ``case_seed``).
+        base : Any
+            The base scenario's value at the path (a number or a list; used by ``scale`` and
+            ``offset``, else ignored).
+
+        Returns
+        -------
+        Any
+            The case's value: an int (``case_seed``), a float, or an ndarray for a vector.
+        """
         if self.kind == "case_seed":
             return seed
         if self.kind == "normal":
@@ -84,7 +114,27 @@ def _pair(node: Node, kind: str) -> tuple[np.ndarray, np.ndarray, bool]:
 
 
 def parse_dispersion(node: Node, base: dict[str, Any], steps: list[Step]) -> Dispersion:
-    """Parse the dispersion at ``node`` for the scenario path ``steps`` of ``base``."""
+    """Parse the dispersion at ``node`` for the scenario path ``steps`` of ``base``.
+
+    Parameters
+    ----------
+    node : Node
+        The study entry ``monte_carlo.dispersions.<path>``.
+    base : dict
+        The base scenario mapping.
+    steps : list of Step
+        The parsed scenario path.
+
+    Returns
+    -------
+    Dispersion
+
+    Raises
+    ------
+    ScenarioError
+        Naming the entry, for an unknown distribution, a negative standard deviation, bounds out
+        of order, or a ``scale``/``offset`` of a base value that is not numbers of that shape.
+    """
     if node.value == "case_seed":
         return Dispersion("case_seed", "set", np.zeros(0), np.zeros(0), False)
     combine = "set"
@@ -108,7 +158,24 @@ def parse_dispersion(node: Node, base: dict[str, Any], steps: list[Step]) -> Dis
 
 
 def draw_unit(method: str | None, dimension: int, samples: int, rng: np.random.Generator) -> np.ndarray:
-    """(samples, dimension) points in [0, 1): independent uniforms, or a Latin hypercube design."""
+    """Unit samples: independent uniforms, or a Latin hypercube design (``scipy.stats.qmc``).
+
+    Parameters
+    ----------
+    method : str or None
+        ``latin_hypercube``; anything else draws independent uniforms.
+    dimension : int
+        Components per sample.
+    samples : int
+        Number of samples.
+    rng : numpy.random.Generator
+        The source of randomness (seeded from the study's ``SeedSequence``).
+
+    Returns
+    -------
+    (samples, dimension) ndarray
+        Points in [0, 1).
+    """
     if dimension == 0:
         return np.zeros((samples, 0))
     if method == "latin_hypercube":

@@ -21,12 +21,15 @@ def parse_path(path: str, where: str) -> list[Step]:
 
     Parameters
     ----------
-    path : a scenario path, for example ``planners[label=smooth].options.weight``.
-    where : the study path of the entry (``grid.<path>``), for error messages.
+    path : str
+        A scenario path, for example ``planners[label=smooth].options.weight``.
+    where : str
+        The study path of the entry (``grid.<path>``), for error messages.
 
     Returns
     -------
-    list of steps: ``str`` keys, ``int`` list indices, ``(key, value)`` list selectors.
+    list of Step
+        ``str`` keys, ``int`` list indices, ``(key, value)`` list selectors.
     """
     if not isinstance(path, str) or not path:
         raise ScenarioError(where, f"expected a scenario path such as 'maneuver.duration', got {path!r}")
@@ -89,7 +92,27 @@ def _child(container: Any, step: Step, done: list[Step], where: str, create: boo
 
 
 def get_path(data: Any, steps: list[Step], where: str) -> Any:
-    """The value at ``steps`` in ``data``; an error if the path does not reach it."""
+    """The value at ``steps`` in ``data``.
+
+    Parameters
+    ----------
+    data : Any
+        A scenario mapping (plain YAML data).
+    steps : list of Step
+        The parsed path (:func:`parse_path`).
+    where : str
+        The study entry, for error messages.
+
+    Returns
+    -------
+    Any
+        The value found there (not a copy).
+
+    Raises
+    ------
+    ScenarioError
+        Naming the step that does not reach ``data``.
+    """
     node = data
     for position, step in enumerate(steps):
         node = node[_child(node, step, steps[:position], where, create=False)]
@@ -97,9 +120,28 @@ def get_path(data: Any, steps: list[Step], where: str) -> Any:
 
 
 def set_path(data: Any, steps: list[Step], value: Any, where: str) -> None:
-    """Set ``value`` at ``steps`` in ``data`` (in place). Missing mapping keys are created (the
-    scenario loader then rejects a key it does not know, so a misspelt path cannot pass
-    silently); list indices and label selectors must reach an existing entry."""
+    """Set ``value`` at ``steps`` in ``data`` (in place).
+
+    Missing mapping keys are created (the scenario loader then rejects a key it does not know, so
+    a misspelt path cannot pass silently); list indices and label selectors must reach an existing
+    entry.
+
+    Parameters
+    ----------
+    data : Any
+        A scenario mapping (plain YAML data), changed in place.
+    steps : list of Step
+        The parsed path (:func:`parse_path`).
+    value : Any
+        The value to set.
+    where : str
+        The study entry, for error messages.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the step that does not reach ``data``.
+    """
     node = data
     for position, step in enumerate(steps[:-1]):
         key = _child(node, step, steps[:position], where, create=True)

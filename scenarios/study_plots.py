@@ -134,8 +134,19 @@ def _monte_carlo(study: Study, rows: list[dict[str, Any]], directory: Path) -> l
 
 
 def pareto_front(points: np.ndarray) -> np.ndarray:
-    """The points (rows of x, y) not dominated by another (both smaller or equal, one smaller),
-    sorted by x."""
+    """The points not dominated by another (both smaller or equal, one smaller), sorted by x.
+
+    Parameters
+    ----------
+    points : (N, 2) ndarray
+        Rows of (x, y), both to be minimised (for example ∫‖u‖ [N m s] and settling time [s]);
+        rows with a non-finite value are left out.
+
+    Returns
+    -------
+    (M, 2) ndarray
+        The front, by increasing x (and decreasing y).
+    """
     points = points[np.all(np.isfinite(points), axis=1)]
     order = points[np.lexsort((points[:, 1], points[:, 0]))]
     front, best = [], math.inf
@@ -164,6 +175,21 @@ def _pareto(study: Study, rows: list[dict[str, Any]], directory: Path) -> list[s
 
 
 def write_plots(study: Study, rows: list[dict[str, Any]], directory: Path) -> list[str]:
-    """Every figure that applies to the study; returns the file names."""
+    """Every figure that applies to the study.
+
+    Parameters
+    ----------
+    study : Study
+        The study (its grid paths, samples and summary metrics choose the figures).
+    rows : list of dict
+        The ``cases.csv`` rows (:func:`scenarios.study_report.case_table`).
+    directory : Path
+        Where the PNG files are written (an existing folder).
+
+    Returns
+    -------
+    list of str
+        The file names written in ``directory``.
+    """
     return (_lines(study, rows, directory) + _heat_maps(study, rows, directory)
             + _monte_carlo(study, rows, directory) + _pareto(study, rows, directory))

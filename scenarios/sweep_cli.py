@@ -17,7 +17,7 @@ from scenarios.store import STORE_NAME, SweepStore, is_sweep_store
 from scenarios.study import load_study, package_version, parse_study
 from scenarios.outputs import MARKER, default_output_directory, read_manifest
 from scenarios.study_report import claim_sweep_directory, resolved_study
-from scenarios.sweep_engine import SweepInterrupted, SweepResults, sweep
+from scenarios.sweep_engine import SweepInterrupted, SweepResults, start_forkserver, sweep
 from scenarios.yaml_node import ScenarioError
 
 EXIT_OK, EXIT_BAD_STUDY, EXIT_INTERRUPTED = 0, 2, 130
@@ -35,7 +35,23 @@ def _terminate(signum: int, frame: Any) -> None:
 
 
 def command_report(args: argparse.Namespace) -> int:
-    """Redraw tables and plots of ``args.report`` from its store, without running anything."""
+    """Redraw tables and plots of ``args.report`` from its store, without running anything.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``sweep`` arguments (``report``, ``no_plots``).
+
+    Returns
+    -------
+    int
+        The exit status (0).
+
+    Raises
+    ------
+    ScenarioError
+        The directory holds no slewbench sweep.
+    """
     out = Path(args.report)
     if read_manifest(out) is None or not is_sweep_store(out):
         raise ScenarioError("--report", f"{out} holds no slewbench sweep ({STORE_NAME} and {MARKER} expected)")
@@ -50,11 +66,31 @@ def command_report(args: argparse.Namespace) -> int:
 
 
 def command_sweep(args: argparse.Namespace) -> int:
-    """Run (or resume) the study ``args.file``."""
+    """Run (or resume) the study ``args.file``, or redraw a report (``args.report``).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``sweep`` arguments (``file``, ``out``, ``workers``, ``scheduler``,
+        ``resume``, ``no_plots``, ``report``).
+
+    Returns
+    -------
+    int
+        The exit status: 0 when every case is stored (failed rows included), 130 when the sweep
+        was interrupted.
+
+    Raises
+    ------
+    ScenarioError
+        A bad study, case, option or output directory (exit 2; nothing written).
+    """
     if args.report:
         return command_report(args)
     if not args.file:
         raise ScenarioError("", "give a study file, or --report DIR")
+    if not args.scheduler:
+        start_forkserver()  # local workers' imports run while the study is expanded and checked
     study = load_study(args.file)
     if args.scheduler:
         study.execution.scheduler = args.scheduler
@@ -94,7 +130,13 @@ def command_sweep(args: argparse.Namespace) -> int:
 
 
 def add_sweep_parser(commands: Any) -> None:
-    """Add the ``sweep`` subcommand to the ``slewbench`` parser."""
+    """Add the ``sweep`` subcommand to the ``slewbench`` parser.
+
+    Parameters
+    ----------
+    commands : Any
+        The ``argparse`` sub-parsers object of ``slewbench`` (from ``add_subparsers``).
+    """
     parser = commands.add_parser("sweep", help="run a trade study (grid, zip, Monte Carlo) on many cases")
     parser.add_argument("file", nargs="?", help="study YAML file")
     parser.add_argument("--out", help="output directory (default: results/<study name>)")

@@ -17,61 +17,132 @@ from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExe
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 from scenarios.store import SweepStore
 from scenarios.study import Case, Study, load_study, parse_study
-from scenarios.sweep_worker import crashed_rows, run_case
+from scenarios.sweep_worker import PRELOAD, crashed_rows, run_case
+
+if TYPE_CHECKING:
+    import pandas
 
 _POLL_S = 0.5
 _TIMEOUT_GRACE = 1.25  # the driver gives up on a case at this multiple of case_timeout_s (+ 5 s)
 
 
 class SweepInterrupted(Exception):
-    """The sweep was stopped before every case finished; ``missing`` cases are not stored."""
+    """The sweep was stopped before every case finished; ``missing`` cases are not stored.
 
-    def __init__(self, missing: int, total: int):
+    Parameters
+    ----------
+    missing : int
+        Cases not finished (not in the store).
+    total : int
+        Cases of the study.
+    """
+
+    def __init__(self, missing: int, total: int) -> None:
         super().__init__(f"{missing} of {total} cases are missing")
         self.missing, self.total = missing, total
 
 
 @dataclass
 class SweepResults:
-    """The cases of a study and their stored records (``key -> {status, rows, elapsed_s, attempts}``).
+    """The cases of a study and their records.
 
-    ``workers`` maps each worker (host:pid) to the number of solvers it built.
+    Parameters
+    ----------
+    study : Study
+        The expanded study.
+    records : dict
+        Case key -> ``{"status", "rows", "elapsed_s", "attempts"}`` as stored
+        (:meth:`scenarios.store.SweepStore.records`): the cases run by this call and those
+        found in the store.
+    workers : dict
+        Worker (``host:pid``) -> solvers it built, for the workers of this call.
+    cpu_s : dict
+        Case key -> CPU time of the case in its worker [s], for the cases run by this call (not
+        stored).
+    worker_cpu_s : dict
+        Worker (``host:pid``) -> CPU time of its process from its start to its last case [s]
+        (start-up and imports included; not stored).
     """
 
     study: Study
     records: dict[str, dict[str, Any]]
     workers: dict[str, int] = field(default_factory=dict)
+    cpu_s: dict[str, float] = field(default_factory=dict)
+    worker_cpu_s: dict[str, float] = field(default_factory=dict)
 
     @property
     def missing(self) -> int:
+        """Cases of the study without a record."""
         return sum(case.key not in self.records for case in self.study.cases)
 
     def table(self) -> tuple[list[str], list[dict[str, Any]]]:
-        """Columns and rows of ``cases.csv``: one row per case and planner."""
+        """Columns and rows of ``cases.csv``: one row per case and planner.
+
+        Returns
+        -------
+        columns : list of str
+        rows : list of dict
+            As :func:`scenarios.study_report.case_table`.
+        """
         from scenarios.study_report import case_table
         return case_table(self.study, self.records)
 
-    def to_dataframe(self):
-        """``cases.csv`` as a pandas DataFrame."""
+    def to_dataframe(self) -> pandas.DataFrame:
+        """``cases.csv`` as a pandas DataFrame.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per case and planner; columns as :meth:`table`.
+        """
         import pandas
         columns, rows = self.table()
         return pandas.DataFrame(rows, columns=columns)
 
     def write(self, directory: str | Path, plots: bool = True) -> list[str]:
-        """Write cases.csv, summary.csv, summary.md, study.yaml and plots; returns the file names."""
+        """Write cases.csv, summary.csv, summary.md, study.yaml and plots.
+
+        Parameters
+        ----------
+        directory : str or Path
+            The output directory (claimed for slewbench; only files it listed are replaced).
+        plots : bool, optional
+            Also draw the PNG figures.
+
+        Returns
+        -------
+        list of str
+            The file names written (relative to ``directory``).
+        """
         from scenarios.study_report import write_report
         return write_report(self, Path(directory), plots=plots)
 
 
+def start_forkserver() -> multiprocessing.context.BaseContext:
+    """Start (once per process) the server that local workers fork from, importing :data:`PRELOAD`.
+
+    It returns at once: the server imports while the caller goes on (the CLI calls this before it
+    expands the study), and the first worker waits until the imports are done.
+
+    Returns
+    -------
+    multiprocessing.context.BaseContext
+        The ``forkserver`` context that local pools use.
+    """
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(list(PRELOAD))
+    from multiprocessing import forkserver
+    forkserver.ensure_running()
+    return context
+
+
 def _local_pool(workers: int) -> ProcessPoolExecutor:
     """Worker processes forked from a server that has imported the workbench once."""
-    context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["scenarios.sweep_worker", "scenarios.runner"])
-    return ProcessPoolExecutor(max_workers=workers, mp_context=context)
+    return ProcessPoolExecutor(max_workers=workers, mp_context=start_forkserver())
 
 
 def _kill_pool(pool: Executor) -> None:
@@ -105,6 +176,8 @@ class _Engine:
         self.in_flight: dict[Future, tuple[str, float]] = {}
         self.attempts: dict[str, int] = collections.Counter()
         self.worker_builds: dict[str, int] = {}
+        self.cpu_s: dict[str, float] = {}
+        self.worker_cpu_s: dict[str, float] = {}
         self.failures = 0
         self.bar = None
         if progress:
@@ -177,6 +250,10 @@ class _Engine:
                 continue
             self.worker_builds[result["worker"]] = result["cache_builds"]
             self._finish(key, result["status"], result["rows"], result["elapsed_s"])
+            if result.get("cpu_s") is not None:
+                self.cpu_s[key] = result["cpu_s"]
+                self.worker_cpu_s[result["worker"]] = max(result["worker_cpu_s"],
+                                                          self.worker_cpu_s.get(result["worker"], 0.0))
         if broken:
             self._died(broken + self._restart_pool(), "its process ended abruptly")
 
@@ -217,12 +294,38 @@ class _Engine:
 
 
 def default_workers() -> int:
-    """One worker per core available to this process."""
+    """One worker per core available to this process.
+
+    Returns
+    -------
+    int
+        The number of cores this process may run on (at least 1).
+    """
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
 def dask_executor(address: str) -> tuple[Executor, int, Callable[[], None]]:
-    """A Dask cluster's executor, its number of worker threads, and how to close the client."""
+    """A Dask cluster's executor.
+
+    Parameters
+    ----------
+    address : str
+        The scheduler's address, for example ``tcp://127.0.0.1:8786``.
+
+    Returns
+    -------
+    executor : concurrent.futures.Executor
+        The client's executor.
+    threads : int
+        Worker threads of the cluster (cases run at once).
+    close : callable
+        Closes the client.
+
+    Raises
+    ------
+    ScenarioError
+        The scheduler cannot be reached (``execution.scheduler``).
+    """
     from distributed import Client
     try:
         client = Client(address, timeout="20s")
@@ -240,14 +343,21 @@ def sweep(study: Study | dict[str, Any] | str | Path, executor: Executor | None 
 
     Parameters
     ----------
-    study : a :class:`Study`, a study mapping, or the path of a study file.
-    executor : any ``concurrent.futures.Executor`` (a Dask client's ``get_executor()``, a process
-        pool); ``None``: a local process pool with ``workers`` processes, or the Dask cluster named
-        by the study's ``execution.scheduler``.
-    workers : cases run at once (default: the study's ``execution.workers``, else one per core).
-    store : where finished cases are committed (and skipped when already there); ``None``: memory.
-    progress : show a progress bar (only when stderr is a terminal).
-    task : the worker function (tests replace it).
+    study : Study, dict, str or Path
+        A :class:`Study`, a study mapping, or the path of a study file.
+    executor : concurrent.futures.Executor or None, optional
+        Any executor (a Dask client's ``get_executor()``, a process pool); None: a local process
+        pool with ``workers`` processes, or the Dask cluster named by the study's
+        ``execution.scheduler``.
+    workers : int or None, optional
+        Cases run at once (None: the study's ``execution.workers``, else one per core).
+    store : SweepStore or None, optional
+        Where finished cases are committed (and skipped when already there); None: memory only.
+    progress : bool, optional
+        Show a progress bar (only when stderr is a terminal).
+    task : callable, optional
+        The worker function, payload dict -> result dict (:func:`scenarios.sweep_worker.run_case`;
+        tests replace it).
 
     Returns
     -------
@@ -272,9 +382,9 @@ def sweep(study: Study | dict[str, Any] | str | Path, executor: Executor | None 
     try:
         engine.run()
     except KeyboardInterrupt:
-        results = SweepResults(study, engine.records, engine.worker_builds)
+        results = SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)
         raise SweepInterrupted(results.missing, len(study.cases)) from None
     finally:
         if close is not None:
             close()
-    return SweepResults(study, engine.records, engine.worker_builds)
+    return SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)

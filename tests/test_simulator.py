@@ -5,6 +5,7 @@ import pytest
 from ocp import (AttitudeModel, CircularOrbit, Command, Environment, Magnetorquers, ReactionWheels,
                  SensorNoise, Simulator, Spacecraft, TiltedDipole, Torquers, quat)
 from tests.conftest import WheelPD
+from planners import PLANNERS, ManeuverProblem
 
 
 class GreedyController:
@@ -106,3 +107,51 @@ def test_divergence_is_reported_not_returned_as_nan():
 
     with pytest.raises(SimulationError, match="non-finite"):
         Simulator(AttitudeModel(spacecraft), 1.0).run(Runaway(), np.r_[1, 0, 0, 0, 0, 0, 0], 100.0)
+
+
+# --- review findings of the float rewrite (2026-11-23) -------------------------------------------
+
+def _actuators(spacecraft):
+    from ocp.actuators import ActuatorModel
+    model = AttitudeModel(spacecraft)
+    return ActuatorModel(spacecraft, model.control_slices, model.nu)
+
+
+def test_a_wheel_command_of_the_wrong_length_is_refused_not_truncated():
+    axes = np.array([[1, 0, 0, 0.577], [0, 1, 0, 0.577], [0, 0, 1, 0.577]])
+    actuators = _actuators(Spacecraft([2, 3, 4], wheels=ReactionWheels(axes, max_torque=0.1)))
+    with pytest.raises(ValueError, match="4 values"):  # three torques for four wheels
+        actuators.apply(Command(wheel_torque=np.array([0.01, 0.02, 0.03])), np.zeros(4), 1.0)
+    with pytest.raises(ValueError, match="4 values"):
+        actuators.apply(Command(wheel_torque=np.zeros(4)), np.zeros(3), 1.0)
+
+
+def test_a_torquer_torque_of_the_wrong_length_is_refused():
+    actuators = _actuators(Spacecraft([2, 3, 4], torquers=Torquers(0.1)))
+    with pytest.raises(ValueError, match="3 values"):
+        actuators.apply(Command(torque=np.array([0.5, 0.01])), np.zeros(0), 1.0)
+
+
+class _WritesIntoItsSample:
+    """A user law that scales the reference sample it is handed in place (a misuse)."""
+
+    tracks_reference = True
+
+    def reset(self, spacecraft, sample_time, target=None):
+        pass
+
+    def __call__(self, t, measurement, reference):
+        torque = reference.sample(t).torque
+        torque *= 2.0
+        return Command(wheel_torque=-torque)
+
+
+def test_the_kept_reference_table_is_read_only_so_runs_stay_independent():
+    # The simulator keeps the grid-sampled reference for the next run on the same grid; a law
+    # writing into a sample would change every later run: it must fail instead.
+    spacecraft = Spacecraft([2.0, 3.0, 4.0], wheels=ReactionWheels.from_body_axes(3, max_torque=0.1))
+    problem = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.from_axis_angle([0, 0, 1], 1.0), 30.0)
+    reference = PLANNERS["eigenaxis"]().plan(problem)
+    simulator = Simulator(AttitudeModel(spacecraft), 1.0)
+    with pytest.raises(ValueError, match="read-only"):
+        simulator.run(_WritesIntoItsSample(), problem.initial_state, 30.0, reference=reference)

@@ -158,6 +158,43 @@ def test_a_sweep_row_equals_a_direct_run_and_a_case_does_not_depend_on_the_execu
         assert line["controller"] == "augmented_quaternion_feedback"
 
 
+def test_a_worker_reuses_simulators_only_where_a_fresh_one_gives_the_same_rows():
+    """Cases that share a worker's simulators (same model and settings; the gain, target and
+    sensor noise vary, and the inertia in the last grid value) give exactly the rows of a run with
+    a new simulator per case; the worker's cache keeps only its last few simulators."""
+    from scenarios.sweep_worker import RecentCache, worker_state
+
+    data = study_data(grid={"controller.options.kp": [0.2, 0.3],
+                            "maneuver.final.q": {"axis_angle": {"axis": [0, 1, 0], "angle_deg": [20, 40]}},
+                            "spacecraft.inertia": [[2.0, 3.0, 4.0], [2.5, 3.0, 4.0]],
+                            "simulation.sensor_noise": [{"attitude_deg": 0.01, "seed": 1},
+                                                        {"attitude_deg": 0.01, "seed": 2}]})
+    study = parse_study(data)
+    simulators = worker_state()[1]
+    hits = simulators.hits
+    frame = sweep(study, InlineExecutor()).to_dataframe()
+    assert simulators.hits - hits >= len(study.cases) - 4 and len(simulators) <= simulators.size
+    metrics = [c for c in frame.columns if c.startswith(("cl.", "ref."))]
+    for case in study.cases:
+        direct = scenarios.run(scenarios.parse_scenario(copy.deepcopy(case.scenario)))
+        rows = frame[frame["case"] == case.index]
+        assert len(rows) == len(direct.rows) == 2 and set(rows["status"]) == {"ok"}
+        for (_, line), row in zip(rows.iterrows(), direct.rows):
+            for column in metrics:
+                scope, key = column.split(".", 1)
+                source = row.closed_loop_metrics if scope == "cl" else row.reference_metrics
+                value = source.get(key[:-2], [None] * 3)["xyz".index(key[-1])] \
+                    if key[-2:] in ("_x", "_y", "_z") and key[:-2] in source else source.get(key)
+                assert line[column] == value or (value is None and pd.isna(line[column])) or (
+                    isinstance(value, float) and math.isnan(value) and pd.isna(line[column])), (case.index, column)
+    cache = RecentCache(size=2)
+    for key in "abcbca":  # c evicts a; b and c are hits; a is built again and evicts b (least recent)
+        cache.get(key, lambda: object())
+    assert len(cache) == 2 and cache.builds == 4 and cache.hits == 2
+    cache.get("c", lambda: object())
+    assert cache.hits == 3
+
+
 def test_resume_skips_stored_cases_and_a_raising_case_is_a_crashed_row(tmp_path, monkeypatch):
     study = parse_study(study_data(grid={"maneuver.duration": [30.0, 40.0, 50.0]}))
     original = runner.run
@@ -195,15 +232,16 @@ def test_killed_workers_are_retried_alone_and_a_hung_case_times_out(tmp_path):
     base = copy.deepcopy(BASE)
     base["name"] = str(tmp_path)  # where the die-once task leaves its marker
     data = {"study": "faults", "scenario": base, "grid": {"maneuver.duration": [30.0, 31.0, 32.0, 33.0, 34.0, 35.0]},
-            "execution": {"case_timeout_s": 1.0, "retries": 1}}
+            # 4 s: the normal cases (about 0.2 s each) must finish within it on a loaded 2-core machine
+            "execution": {"case_timeout_s": 4.0, "retries": 1}}
     results = sweep(parse_study(data), workers=2, task=misbehaving_task)
     status = {int(row["maneuver.duration"]): (row["status"], row["message"])
               for _, row in results.to_dataframe().iterrows() if row["label"] == "smooth"}
     assert status[30][0] == status[34][0] == "ok"
     assert status[31][0] == "crashed" and "worker died" in status[31][1] and "2 attempt(s)" in status[31][1]
     assert status[32][0] == "ok"  # died once, retried
-    assert status[33][0] == "crashed" and "timed out after 1 s (case_timeout_s)" == status[33][1]
-    assert status[35][0] == "crashed" and "timed out after 1 s (case_timeout_s); worker stopped" == status[35][1]
+    assert status[33][0] == "crashed" and "timed out after 4 s (case_timeout_s)" == status[33][1]
+    assert status[35][0] == "crashed" and "timed out after 4 s (case_timeout_s); worker stopped" == status[35][1]
 
 
 # --- command line and outputs -------------------------------------------------------------------
@@ -303,9 +341,15 @@ def test_readme_study_and_example_studies_are_valid():
     assert len(study.cases) == 2 * 3 * 3 * 2 * 2
     fractions = {c.scenario["planners"][1]["options"]["torque_fraction"] for c in study.cases}
     assert fractions == {0.5, 0.75, 1.0}
+    from scenarios.study_report import _DUMPER, resolved_study
     for name, count in (("study_spin_weight_sample_time", 20), ("study_planners_vs_slew_angle", 7),
                         ("study_spin_monte_carlo", 1000)):
-        assert len(scenarios.load_study(root / "scenarios" / f"{name}.yaml").cases) == count
+        example = scenarios.load_study(root / "scenarios" / f"{name}.yaml")
+        assert len(example.cases) == count
+        # study.yaml goes through libyaml's emitter when built: the same text as PyYAML's own, read back whole
+        resolved = resolved_study(example)
+        text = yaml.dump(resolved, Dumper=_DUMPER, sort_keys=False, width=120)
+        assert text == yaml.safe_dump(resolved, sort_keys=False, width=120) and yaml.safe_load(text) == resolved
 
 
 def test_pareto_front_is_the_set_of_non_dominated_points(rng):

@@ -15,8 +15,18 @@ import numpy as np
 import pytest
 
 from controllers import CONTROLLERS
-from ocp import (AttitudeModel, CircularOrbit, Environment, Magnetorquers, ReactionWheels, Simulator, Spacecraft,
-                 TiltedDipole, quat)
+from ocp import (
+    AttitudeModel,
+    CircularOrbit,
+    Environment,
+    Magnetorquers,
+    ReactionWheels,
+    SensorNoise,
+    Simulator,
+    Spacecraft,
+    TiltedDipole,
+    quat,
+)
 from planners import PLANNERS, ManeuverProblem
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -41,6 +51,39 @@ def test_200_s_closed_loop(benchmark, path):
     result = benchmark.pedantic(run, rounds=20, iterations=1)
     assert result.path == path and first.path == path
     benchmark.extra_info["us_per_sample"] = benchmark.stats.stats.median / 200 * 1e6
+
+
+def _python_loop_setup():
+    spacecraft = Spacecraft([19.5, 19.0, 12.6], wheels=ReactionWheels.from_body_axes(max_torque=0.1))
+    problem = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.from_axis_angle([0, 1, 0], 1.0), 200.0,
+                              omegaf=np.zeros(3))
+    reference = PLANNERS["eigenaxis"]().plan(problem)
+    simulator = Simulator(problem.model, 1.0, python_loop=True)
+    controller = CONTROLLERS["augmented_quaternion_feedback"]({"kp": 0.06, "kd": 0.48})
+    controller.reset(spacecraft, 1.0, target=(problem.qf, problem.omegaf))
+    times = np.arange(201) * 1.0
+    served = simulator._grid_reference(reference, np.concatenate([times, times[:-1] + 1.0]))
+    return problem, simulator, controller, served
+
+
+@pytest.mark.benchmark(group="Python loop, one sample's parts (augmented law, 3 wheels, 20 RK4 sub-steps)")
+@pytest.mark.parametrize("part", ["rk4_step", "measurement", "controller", "actuators"])
+def test_python_loop_parts(benchmark, part):
+    """The per-sample breakdown of the Python loop (issue 13: <= 100 us per sample in all)."""
+    problem, simulator, controller, served = _python_loop_setup()
+    x = problem.initial_state.copy()
+    x[4:7] = [0.01, 0.02, 0.03]
+    noise = SensorNoise()
+    rng = np.random.default_rng(0)
+    measurement = simulator._measure(x, 5.0, noise, rng)
+    command = controller(5.0, measurement, served)
+    calls = {
+        "rk4_step": simulator._step_numeric.evaluate,
+        "measurement": lambda: simulator._measure(x, 5.0, noise, rng),
+        "controller": lambda: controller(5.0, measurement, served),
+        "actuators": lambda: simulator.actuators.apply_floats(command, [0.1, 0.2, 0.3], 1.0),
+    }
+    benchmark.pedantic(calls[part], rounds=200, iterations=20, warmup_rounds=5)
 
 
 @pytest.mark.benchmark(group="100,000 s at 0.1 s, magnetorquers, tilted dipole, gravity gradient")

@@ -1,0 +1,192 @@
+"""The mapping of a rigid-body control torque onto the actuators (ARCHITECTURE.md), shared by
+every controller through :class:`Allocation`.
+
+Wheels take ``τ_w = u + ω × A h_w`` through ``g = −A⁺ τ_w`` (working wheels only); what the wheels
+cannot give (fewer than three independent axes) goes to the torquers if there are any, else to the
+magnetorquers as ``m = B × τ / |B|²`` (the component of τ perpendicular to B). Without wheels the
+torquers take ``u``, else the magnetorquers. The numeric map runs on Python floats (it is called
+at every sample); :meth:`Allocation.allocate_symbolic` is the same map on CasADi expressions.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import casadi as ca
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ocp import Command, Measurement, Spacecraft
+from ocp.fast_call import as_floats
+from ocp.layout import split_measurement
+
+Array = NDArray[np.float64]
+
+
+def float_rows(matrix: ArrayLike) -> tuple[tuple[float, ...], ...]:
+    """A matrix as a tuple of rows of Python floats, for per-sample code (``sum(a * b for ...)``
+    over a row costs far less than a NumPy product on 3-vectors).
+
+    Parameters
+    ----------
+    matrix : (m, n) array_like
+
+    Returns
+    -------
+    tuple of m tuples of n floats
+    """
+    return tuple(tuple(row) for row in np.asarray(matrix, dtype=float).tolist())
+
+
+class Allocation:
+    """Mixin of ``controllers.base.Controller``: the torque-to-actuator map and its state.
+
+    Capability flags (class attributes a law may override): :attr:`gyroscopic_compensation` and
+    :attr:`wheels_only`. :meth:`_reset_allocation` (called by ``Controller.reset``) precomputes the
+    wheel matrices for the spacecraft.
+    """
+
+    gyroscopic_compensation: bool = True
+    """:meth:`allocate` adds the wheels' ``ω × A h_w`` (the law's ``u`` is for ``I ω̇ = −ω × I ω + u``).
+    ``False``: ``u`` is the wheels' body torque itself (laws written for ``I ω̇ = u``, zero momentum)."""
+    wheels_only: bool = False
+    """Pure wheel mode: :meth:`allocate` drops what the wheels cannot give instead of sending it to
+    torquers or magnetorquers (the two-wheel laws)."""
+
+    spacecraft: Spacecraft | None
+    _slices: dict[str, slice]
+    _nu: int
+
+    def _spacecraft(self) -> Spacecraft:
+        """The spacecraft of the last reset (an error before any)."""
+        if self.spacecraft is None:
+            raise RuntimeError(f"{type(self).__name__}: call reset(spacecraft, sample_time, target) first")
+        return self.spacecraft
+
+    def _reset_allocation(self, spacecraft: Spacecraft) -> None:
+        """Precompute the wheel matrices (NumPy for the symbolic map, rows of floats for the numeric one)."""
+        wheels = spacecraft.wheels
+        self._working_axes: Array | None = None
+        self._wheel_pinv: Array = np.zeros((0, 3))
+        # The same matrices as rows of Python floats, for the per-sample allocation.
+        self._pinv_rows: tuple[tuple[float, ...], ...] | None = None
+        self._axes_cols: tuple[tuple[float, ...], ...] = ()
+        self._working_cols: tuple[tuple[float, ...], ...] = ()
+        if wheels is not None and np.any(wheels.working):
+            self._working_axes = wheels.axes * wheels.working
+            self._wheel_pinv = np.asarray(np.linalg.pinv(self._working_axes), dtype=np.float64)
+            self._pinv_rows = float_rows(self._wheel_pinv)
+            self._axes_cols = float_rows(spacecraft.wheel_axes.T)
+            self._working_cols = float_rows(self._working_axes.T)
+        self._residual_sink = not self.wheels_only and (spacecraft.torquers is not None
+                                                        or spacecraft.magnetorquers is not None)
+        """Whether what the wheels cannot give goes anywhere (torquers or magnetorquers)."""
+
+    def allocate(self, torque: ArrayLike, measurement: Measurement, rate: ArrayLike | None = None,
+                 wheel_momentum: ArrayLike | None = None) -> Command:
+        """Map a rigid-body control torque to the actuators (module docstring).
+
+        Parameters
+        ----------
+        torque : (3,) array_like
+            Control torque ``u`` of ``I ω̇ = −ω × I ω + u`` [N m], body axes.
+        measurement : Measurement
+            The sample's measurement (rate, wheel momenta, magnetometer reading).
+        rate : (3,) array_like, optional
+            The ``ω`` of the wheels' gyroscopic term ``ω × A h_w`` [rad/s], body axes; ``None``:
+            the measured rate. A law that predicts it to mid-sample passes its prediction (see
+            ``AugmentedQuaternionFeedback``).
+        wheel_momentum : (n_w,) array_like, optional
+            The ``h_w`` of that term [N m s]; ``None``: the measured momenta.
+
+        Returns
+        -------
+        Command
+            Wheel torques ``g`` [N m] (``None`` without working wheels), and what the wheels cannot
+            give as torquer torque [N m] or magnetorquer dipole [A m^2], body axes (``None`` when
+            nothing is asked of them).
+        """
+        return self._allocate(as_floats(torque), measurement, None if rate is None else as_floats(rate),
+                              None if wheel_momentum is None else as_floats(wheel_momentum))
+
+    def _allocate(self, torque: Sequence[float], measurement: Measurement, rate: Sequence[float] | None,
+                  wheel_momentum: Sequence[float] | None) -> Command:
+        """:meth:`allocate` on Python floats (per-sample code: no NumPy on 3-vectors)."""
+        command = Command()
+        r0, r1, r2 = torque
+        if self._pinv_rows is not None:
+            if self.gyroscopic_compensation:  # τ_w = u + ω × A h_w
+                w0, w1, w2 = as_floats(measurement.omega) if rate is None else rate
+                h0 = h1 = h2 = 0.0
+                for (a0, a1, a2), h in zip(self._axes_cols, as_floats(measurement.wheel_momentum)
+                                           if wheel_momentum is None else wheel_momentum):
+                    h0 += a0 * h
+                    h1 += a1 * h
+                    h2 += a2 * h
+                r0, r1, r2 = r0 + (w1 * h2 - w2 * h1), r1 + (w2 * h0 - w0 * h2), r2 + (w0 * h1 - w1 * h0)
+            g = [-(a * r0 + b * r1 + c * r2) for a, b, c in self._pinv_rows]  # g = −A⁺ τ_w
+            command.wheel_torque = np.array(g)
+            if not self._residual_sink:
+                return command
+            t0, t1, t2 = r0, r1, r2
+            for (a0, a1, a2), gi in zip(self._working_cols, g):  # what the wheels do not give
+                r0 += a0 * gi
+                r1 += a1 * gi
+                r2 += a2 * gi
+            if math.sqrt(r0 * r0 + r1 * r1 + r2 * r2) <= 1e-12 * max(math.sqrt(t0 * t0 + t1 * t1 + t2 * t2), 1e-300):
+                return command
+        if not self._residual_sink:
+            return command
+        if self._spacecraft().torquers is not None:
+            command.torque = np.array([r0, r1, r2])
+        elif measurement.field_body is not None:  # magnetorquers: m = b × τ / |b|²
+            b0, b1, b2 = as_floats(measurement.field_body)
+            b2_norm = max(b0 * b0 + b1 * b1 + b2 * b2, 1e-30)
+            command.dipole = np.array([(b1 * r2 - b2 * r1) / b2_norm, (b2 * r0 - b0 * r2) / b2_norm,
+                                       (b0 * r1 - b1 * r0) / b2_norm])
+        return command
+
+    def allocate_symbolic(self, torque: ca.SX, y: ca.SX, rate: ca.SX | None = None,
+                          wheel_momentum: ca.SX | None = None) -> ca.SX:
+        """:meth:`allocate` on CasADi expressions.
+
+        Parameters
+        ----------
+        torque : (3, 1) casadi.SX
+            Rigid-body control torque ``u`` [N m], body axes.
+        y : casadi.SX
+            The measurement vector ``[q, ω, h_w, b]`` (:mod:`ocp.layout`).
+        rate : (3, 1) casadi.SX, optional
+            ``ω`` of the wheels' gyroscopic term [rad/s]; ``None``: the measured one.
+        wheel_momentum : (n_w, 1) casadi.SX, optional
+            ``h_w`` of that term [N m s]; ``None``: the measured one.
+
+        Returns
+        -------
+        (nu, 1) casadi.SX
+            The command vector ``u`` in the control layout (zeros where nothing is asked).
+        """
+        spacecraft = self._spacecraft()
+        _, omega, h_w, field = split_measurement(y, spacecraft.n_wheels)
+        parts = {}
+        residual = torque
+        done = None
+        if self._working_axes is not None:
+            w = omega if rate is None else rate
+            h = ca.mtimes(ca.DM(spacecraft.wheel_axes), h_w if wheel_momentum is None else wheel_momentum)
+            wheel_torque = residual + ca.cross(w, h) if self.gyroscopic_compensation else residual
+            g = -ca.mtimes(ca.DM(self._wheel_pinv), wheel_torque)
+            parts["wheels"] = g
+            residual = wheel_torque + ca.mtimes(ca.DM(self._working_axes), g)
+            done = ca.norm_2(residual) <= 1e-12 * ca.fmax(ca.norm_2(wheel_torque), 1e-300)
+        if self.wheels_only:
+            pass
+        elif spacecraft.torquers is not None:
+            parts["torquers"] = residual if done is None else ca.if_else(done, ca.DM.zeros(3), residual)
+        elif spacecraft.magnetorquers is not None:
+            dipole = ca.cross(field, residual) / ca.fmax(ca.dot(field, field), 1e-30)
+            parts["dipole"] = dipole if done is None else ca.if_else(done, ca.DM.zeros(3), dipole)
+        u = ca.SX.zeros(self._nu)
+        for name, value in parts.items():
+            u[self._slices[name]] = value
+        return u
