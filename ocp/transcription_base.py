@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 from ocp import quat_casadi as qc
 from ocp.model import AttitudeModel
 from ocp.ocp_problem import NLP, Cone, Interval, OptimalControlProblem
+from ocp.stagewise import assemble
 
 Array = NDArray[np.float64]
 __all__ = ["NLP", "Array", "Cone", "Interval", "OptimalControlProblem", "Transcription"]
@@ -259,46 +260,29 @@ class Transcription(ABC):
         NLP
             The built solver, its constraint bounds and the ``unpack`` function.
         """
-        model, N = problem.model, self.intervals
-        nx = model.nx
+        nx, N = problem.model.nx, self.intervals
         interval = self.interval(problem)
         ns0, nc = interval.n_state, interval.n_interval
         ns = ns0 + (1 if problem.free_time else 0)
-        p = ca.MX.sym("p", nx + 4 + 3 + 1 + 3)
-        x0, qf, omegaf, T_param, disturbance = p[0:nx], p[nx:nx + 4], p[nx + 4:nx + 7], p[nx + 7], p[nx + 8:nx + 11]
-        w = ca.MX.sym("w", (ns + nc) * N + ns)
-        Z = ca.reshape(w[:(ns + nc) * N], ns + nc, N)
-        S = ca.horzcat(Z[:ns, :], w[(ns + nc) * N:])
-        C = Z[ns:, :]
-        if problem.free_time:
-            T_row, T = S[ns0, :N], S[ns0, 0]
-        else:
-            T_row, T = ca.repmat(T_param, 1, N), T_param
-        h_row = T_row / N
-        t0_row = h_row * ca.DM(np.arange(N)).T
-        following, path, cost = interval.function.map(N)(S[:ns0, :N], C, t0_row, h_row, disturbance)
-        gap = S[:ns0, 1:] - following
-        if problem.free_time:
-            gap = ca.vertcat(gap, S[ns0, 1:] - S[ns0, :N])  # explicit continuity of T
-        blocks = ca.vertcat(gap, path)
-        initial = self.state_of(S[:ns0, 0]) - x0
-        terminal = self.terminal(problem, self.state_of(S[:ns0, N]), qf, omegaf)
-        g = ca.vertcat(blocks[:, 0], initial, ca.vec(blocks[:, 1:]), *terminal)
+        stages = assemble(self, problem, interval)
         zero_gap = np.zeros(ns)
         stage_low = np.concatenate([zero_gap, interval.path_lower])
         stage_high = np.concatenate([zero_gap, interval.path_upper])
-        n_terminal = sum(c.numel() for c in terminal)
+        n_terminal = stages.n_terminal
         lbg = np.concatenate([stage_low, np.zeros(nx), np.tile(stage_low, N - 1), np.zeros(n_terminal)])
         ubg = np.concatenate([stage_high, np.zeros(nx), np.tile(stage_high, N - 1), np.zeros(n_terminal)])
-        objective = ca.sum2(cost) + problem.time_weight * T
-        states, controls = self.split(S[:ns0, :], C)
-        unpack = ca.Function("unpack", [w, p], [T, states, controls])
+        states, controls = self.split(stages.S[:ns0, :], stages.C)
+        unpack = ca.Function("unpack", [stages.w, stages.p], [stages.T, states, controls])
         opts = dict(options)
         opts.setdefault("expand", True)
         if solver == "fatrop":
             opts["equality"] = [bool(v) for v in (lbg == ubg)]
-        nlp_solver = ca.nlpsol(f"{self.name}_{solver}", solver, {"x": w, "p": p, "f": objective, "g": g}, opts)
-        return NLP(nlp_solver, w.numel(), unpack, lbg, ubg, problem.free_time, ns, nc)
+        else:
+            # the block-assembled derivatives (ocp.stagewise), not CasADi's of the whole graph
+            opts.update(jac_g=stages.jac_g, hess_lag=stages.hess_lag)
+        nlp = {"x": stages.w, "p": stages.p, "f": stages.f, "g": stages.g}
+        nlp_solver = ca.nlpsol(f"{self.name}_{solver}", solver, nlp, opts)
+        return NLP(nlp_solver, stages.w.numel(), unpack, lbg, ubg, problem.free_time, ns, nc)
 
     def bounds(self, problem: OptimalControlProblem, nlp: NLP, x_low: Array, x_high: Array, u_low: Array,
                u_high: Array, duration: float) -> tuple[Array, Array]:

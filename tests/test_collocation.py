@@ -2,8 +2,17 @@
 import numpy as np
 import pytest
 
-from ocp import (AttitudeModel, CircularOrbit, Command, Environment, ReactionWheels, Simulator, Spacecraft,
-                 Torquers, quat)
+from ocp import (
+    AttitudeModel,
+    CircularOrbit,
+    Command,
+    Environment,
+    ReactionWheels,
+    Simulator,
+    Spacecraft,
+    Torquers,
+    quat,
+)
 from planners import PLANNERS, ManeuverProblem
 
 
@@ -22,6 +31,19 @@ def test_single_axis_minimum_energy_matches_the_closed_form():
     t = np.linspace(0, 20, 41)
     # The controls are the NLP's variables, so they match to IPOPT's tolerance (1e-10 on the scaled KKT).
     np.testing.assert_allclose(reference.torque(t)[:, 0], 6 * 5.0 * 1.0 * (20 - 2 * t) / 20**3, atol=1e-6)
+
+
+def test_fixed_time_coarse_mesh_seed_reaches_the_closed_form():
+    # With intervals > coarse_intervals (8) a fixed final time is solved on 8 intervals first and the
+    # full mesh once from there (IPOPT's barrier starting at 1e-4): the optimum is still the closed
+    # form 12 I² θ² / T³, and the same as the direct full-mesh solve (coarse_intervals: 0).
+    problem = single_axis_problem()
+    default = PLANNERS["collocation"]({"intervals": 24}).plan(problem)
+    direct = PLANNERS["collocation"]({"intervals": 24, "coarse_intervals": 0}).plan(problem)
+    assert default.status == direct.status == "ok", default.message
+    assert default.stats["coarse"]["intervals"] == 8 and "coarse" not in direct.stats
+    assert default.stats["objective"] == pytest.approx(12 * 5.0**2 * 1.0**2 / 20.0**3, rel=1e-6)
+    assert default.stats["objective"] == pytest.approx(direct.stats["objective"], rel=1e-9)
 
 
 def test_single_axis_minimum_time_matches_bang_bang():
@@ -198,3 +220,37 @@ def test_single_axis_minimum_fuel_matches_bang_off_bang(solver):
     reference = PLANNERS["collocation"]({"objective": "min_l1", "intervals": 40, "solver": solver}).plan(problem)
     assert reference.status == "ok", reference.message
     assert reference.stats["objective"] == pytest.approx(2 * inertia * omega_c, rel=5e-3)
+
+
+@pytest.mark.parametrize("transcription", ["collocation", "multiple_shooting"])
+@pytest.mark.parametrize("objective", ["min_energy", "min_time", "min_l1_cone"])
+def test_block_assembled_derivatives_equal_casadi_ad_of_the_whole_nlp(transcription, objective):
+    # ocp.stagewise differentiates one interval and scatters the blocks; CasADi's own AD of the
+    # whole graph is the oracle, at a random point with random multipliers.
+    import casadi as ca
+
+    from ocp.stagewise import assemble
+    from ocp.transcription import TRANSCRIPTIONS
+
+    if transcription == "multiple_shooting" and objective == "min_l1_cone":
+        pytest.skip("multiple_shooting takes no L1 cost or cones")
+    options = {"objective": "min_time"} if objective == "min_time" else {}
+    if objective == "min_l1_cone":
+        options = {"objective": "min_l1", "keep_out": [{"boresight": [0, 0, 1], "direction": [1, 0, 0],
+                                                        "angle_deg": 20.0}]}
+    problem = gravity_gradient_problem()
+    planner = PLANNERS["collocation"]({**options, "transcription": transcription})
+    ocp = planner._ocp(problem)
+    method = TRANSCRIPTIONS[transcription](4, **({"degree": 3} if transcription == "collocation" else {}))
+    stages = assemble(method, ocp, method.interval(ocp))
+    lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", stages.g.numel())
+    jacobian = ca.Function("J", [stages.w, stages.p], [ca.jacobian(stages.g, stages.w)])
+    lagrangian = lam_f * stages.f + ca.dot(lam_g, stages.g)
+    hessian = ca.Function("H", [stages.w, stages.p, lam_f, lam_g], [ca.hessian(lagrangian, stages.w)[0]])
+    rng = np.random.default_rng(1)
+    w = rng.normal(size=stages.w.numel())
+    p = np.concatenate([problem.initial_state, problem.qf, [0.1, -0.2, 0.05], [30.0], [1e-4, -2e-4, 3e-4]])
+    multipliers = (0.7, rng.normal(size=stages.g.numel()))
+    np.testing.assert_allclose(stages.jac_g(w, p)[1].full(), jacobian(w, p).full(), rtol=1e-12, atol=1e-12)
+    full = hessian(w, p, *multipliers).full()
+    np.testing.assert_allclose(stages.hess_lag(w, p, *multipliers).full(), np.triu(full), rtol=1e-10, atol=1e-10)
