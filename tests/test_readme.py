@@ -5,7 +5,8 @@ test fails when the README drifts from what the code does.
   ``[--out DIR]`` filled in) in a scratch directory; the files the README promises must appear.
 * ``pytest ...`` commands are collected (``--collect-only``, ``slow``): they must select tests, and
   ``pytest -m slow`` none of the default ones. The whole default run is CI's job (``.ci/run``).
-* ``python`` blocks are executed from the repository root.
+* ``python`` blocks are executed from the repository root; ``python tests/...`` commands run there
+  and must exit 0; ``mypy`` too (``slow``: CI runs it as a step of its own).
 * ``pip install .`` into a fresh virtual environment, then the quick start's ``slewbench run``
   through the installed console script: ``slow``.
 """
@@ -25,7 +26,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text()
 BLOCKS = re.findall(r"```(\w+)\n(.*?)```", README, flags=re.DOTALL)
-INLINE = re.findall(r"`((?:pytest|slewbench|python -m pytest)\b[^`]*)`", README)
+INLINE = re.findall(r"`((?:pytest|slewbench|python -m pytest|python tests/|mypy|pip install mypy)\b[^`]*)`", README)
 
 
 def _shell_commands() -> list[str]:
@@ -46,6 +47,7 @@ COMMANDS = _shell_commands()
 SLEWBENCH = [c for c in COMMANDS if c.startswith("slewbench ")]
 PYTEST = sorted({c for c in COMMANDS if c.startswith(("pytest", "python -m pytest"))})
 PYTHON = [body for language, body in BLOCKS if language == "python"]
+SCRIPTS = [c for c in COMMANDS if c.startswith(("python tests/", "mypy"))]
 
 
 def test_the_readme_has_the_commands_it_is_tested_for():
@@ -53,7 +55,9 @@ def test_the_readme_has_the_commands_it_is_tested_for():
     assert any(c.startswith("slewbench run scenarios/") for c in SLEWBENCH)
     assert "pytest" in PYTEST and "pytest -m slow" in PYTEST
     assert len(PYTHON) >= 2
-    unknown = [c for c in COMMANDS if not c.startswith(("pip install", "slewbench ", "pytest", "python -m pytest"))]
+    assert "python tests/public_api.py" in SCRIPTS and "mypy" in SCRIPTS
+    unknown = [c for c in COMMANDS if not c.startswith(("pip install", "slewbench ", "pytest", "python -m pytest",
+                                                        "python tests/", "mypy"))]
     assert not unknown, f"commands this test does not know how to run: {unknown}"
 
 
@@ -106,6 +110,21 @@ def test_pytest_command_selects_tests(command):
         # Only slow cases, and not the default ones (the command line's -m overrides addopts').
         default = set(_collected("pytest"))
         assert not default & set(collected)
+
+
+@pytest.mark.parametrize("command", [c for c in SCRIPTS if c.startswith("python tests/")])
+def test_python_script_command(command):
+    done = subprocess.run([sys.executable, *shlex.split(command)[1:]], cwd=ROOT, env=_environment(),
+                          capture_output=True, text=True, check=False, timeout=300)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+
+
+@pytest.mark.slow  # about 25 s; CI runs it as a step of its own (.ci/run)
+def test_mypy_command():
+    pytest.importorskip("mypy")
+    done = subprocess.run([sys.executable, "-m", "mypy"], cwd=ROOT, env=_environment(),
+                          capture_output=True, text=True, check=False, timeout=600)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-2000:]
 
 
 @pytest.mark.parametrize("index", range(len(PYTHON)))
