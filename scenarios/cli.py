@@ -82,7 +82,8 @@ def command_run(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         ``file`` (scenario YAML), ``out`` (output directory or ``None``: ``results/<name>``),
-        ``no_plots`` (skip the PNG figures).
+        ``no_plots`` (skip the PNG figures), and ``interruption`` (an :class:`Interruption`, set
+        by :func:`main`; optional).
 
     Returns
     -------
@@ -93,7 +94,14 @@ def command_run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else default_output_directory(scenario.name)
     claim_output_directory(out)  # before planning: a long run is never lost at the end
     start = time.perf_counter()
-    results = run(scenario, progress=lambda line: print(line, flush=True))
+    interruption = getattr(args, "interruption", None) or Interruption()
+
+    def progress(line: str) -> None:
+        interruption.check()  # a signal swallowed on the way (see Interruption) stops the run here
+        print(line, flush=True)
+
+    results = run(scenario, progress=progress)
+    interruption.check()
     print()
     print(results.to_terminal())
     results.write(out, plots=not args.no_plots)
@@ -158,9 +166,36 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _terminate(signum: int, frame: Any) -> None:
-    """SIGTERM ends a run like Ctrl-C, so that staged files are removed on the way out."""
-    raise KeyboardInterrupt
+class Interruption:
+    """SIGTERM and Ctrl-C handler: ends a run like Ctrl-C, so that staged files are removed on the
+    way out, and remembers that it fired.
+
+    The ``KeyboardInterrupt`` can be lost: raised inside a finaliser (``__del__`` of a CasADi
+    object run by the garbage collector, where Python only prints "Exception ignored"), or turned
+    into an error that the runner records as a failed row. :meth:`check`, called between the run's
+    phases and before writing, then still stops the run.
+    """
+
+    def __init__(self) -> None:
+        self.signalled = False
+
+    def __call__(self, signum: int, frame: Any) -> None:
+        """Record the signal and raise ``KeyboardInterrupt``.
+
+        Parameters
+        ----------
+        signum : int
+            The signal number.
+        frame : frame or None
+            The interrupted frame (unused).
+        """
+        self.signalled = True
+        raise KeyboardInterrupt
+
+    def check(self) -> None:
+        """Raise ``KeyboardInterrupt`` if a signal has fired (even one swallowed on the way)."""
+        if self.signalled:
+            raise KeyboardInterrupt
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -177,7 +212,9 @@ def main(argv: list[str] | None = None) -> int:
         Exit status: 0 done, 2 bad scenario file, 1 internal error or interrupted.
     """
     args = build_parser().parse_args(argv)
-    previous = signal.signal(signal.SIGTERM, _terminate) if threading.current_thread() is threading.main_thread() else None
+    args.interruption = Interruption()
+    previous = (signal.signal(signal.SIGTERM, args.interruption)
+                if threading.current_thread() is threading.main_thread() else None)
     try:
         return args.handler(args)
     except ScenarioError as error:
