@@ -40,17 +40,28 @@ def __getattr__(name: str) -> Any:
     Parameters
     ----------
     name : str
-        One of ``__all__``.
+        One of ``__all__``, or the name of a submodule (imported too).
 
     Returns
     -------
     object
-        The class or function.
+        The class, function or submodule.
+
+    Raises
+    ------
+    AttributeError
+        ``name`` is neither.
     """
     home = _HOMES.get(name)
-    if home is None:
-        raise AttributeError(f"module 'scenarios' has no attribute {name!r}")
-    return getattr(importlib.import_module(home), name)
+    if home is not None:
+        return getattr(importlib.import_module(home), name)
+    if not name.startswith("__"):  # a submodule, as when the package imported them all (scenarios.loader)
+        try:
+            return importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as error:
+            if error.name != f"{__name__}.{name}":
+                raise
+    raise AttributeError(f"module 'scenarios' has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:

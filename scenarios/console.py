@@ -8,9 +8,16 @@ the lazy :mod:`scenarios` package.
 """
 from __future__ import annotations
 
+import signal
 import sys
+from typing import Any
 
 from scenarios.renderer import Renderer
+
+
+def _interrupt(signum: int, frame: Any) -> None:
+    """SIGTERM while the model loads: stop like Ctrl-C, so that the plot process is reaped."""
+    raise KeyboardInterrupt
 
 
 def draws_plots(argv: list[str]) -> bool:
@@ -40,15 +47,24 @@ def main(argv: list[str] | None = None) -> int:
     Returns
     -------
     int
-        The exit status of :func:`scenarios.cli.main`.
+        The exit status of :func:`scenarios.cli.main` (1 if interrupted before it started).
     """
     argv = sys.argv[1:] if argv is None else list(argv)
     renderer = Renderer.start() if draws_plots(argv) else None
     try:
-        from scenarios.cli import main as command_line  # the model, after the fork
-
-        return command_line(argv, renderer=renderer)
+        previous = signal.signal(signal.SIGTERM, _interrupt)
+    except ValueError:  # not the main thread: signals are not ours to handle
+        previous = None
+    try:
+        try:
+            from scenarios.cli import main as command_line  # the model, after the fork
+        except KeyboardInterrupt:  # Ctrl-C or SIGTERM while the model loads: nothing written yet
+            print("slewbench: interrupted; nothing written", file=sys.stderr)
+            return 1
+        return command_line(argv, renderer=renderer)  # handles SIGTERM itself from here on
     finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
         if renderer is not None:
             renderer.close()
 

@@ -16,10 +16,12 @@ same, pixel for pixel.
 """
 from __future__ import annotations
 
+import functools
 import os
 import pickle
 import signal
 import sys
+import time
 import traceback
 from pathlib import Path
 from typing import Any
@@ -29,10 +31,26 @@ SINGLE_THREAD_ENVIRONMENT = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM
 COST = {"background": 2.5, "row": 1.0, "other": 1.3}
 """Relative drawing costs (about 0.1 s each on the reference machine): the static part of a per-row
 figure (drawn once per process and row shape), one row on it, any other figure."""
+STOP_TIMEOUT_S = 5.0
+"""How long :meth:`Renderer.close` lets the plot process stop its fork and exit before killing it [s]."""
 
 
 class RenderingFailed(RuntimeError):
     """The plot process could not draw the figures (it ended early, or drawing raised)."""
+
+
+def _die_with_parent(signum: int, parent: int) -> None:
+    """Have the kernel send ``signum`` to this (just forked) process when its parent ends, so that
+    a plot process never draws on for a parent that is gone (killed, or ended by a signal it does
+    not handle); exit at once if the parent has already gone. Linux only (``prctl``)."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signum)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # no prctl: the closed pipe still ends an idle plot process
+        pass
+    if os.getppid() != parent:
+        os._exit(1)
 
 
 def _thread_count() -> int:
@@ -72,11 +90,12 @@ class Renderer:
             return None
         to_child, from_parent = os.pipe()[::-1]  # (write end, read end)
         from_child, to_parent = os.pipe()
+        parent = os.getpid()
         pid = os.fork()
         if pid == 0:  # the child: never returns
             os.close(to_child)
             os.close(from_child)
-            _serve(from_parent, to_parent)
+            _serve(from_parent, to_parent, parent)
         os.close(from_parent)
         os.close(to_parent)
         return cls(pid, to_child, from_child)
@@ -99,15 +118,18 @@ class Renderer:
         if not self._running:
             raise RenderingFailed("the plot process has already drawn or stopped")
         send_fd, receive_fd = self._fds
-        self._fds = []
         try:
-            with os.fdopen(send_fd, "wb") as stream:
+            with os.fdopen(send_fd, "wb", closefd=False) as stream:
                 pickle.dump((str(directory), jobs), stream, protocol=pickle.HIGHEST_PROTOCOL)
-            with os.fdopen(receive_fd, "rb") as stream:
+            with os.fdopen(receive_fd, "rb", closefd=False) as stream:
                 status, detail = pickle.load(stream)
         except (OSError, EOFError, pickle.UnpicklingError) as error:
             self.close()
             raise RenderingFailed(f"the plot process ended early ({type(error).__name__})") from None
+        except BaseException:  # Ctrl-C, SIGTERM: both drawers stop before the caller removes `directory`
+            self.close()
+            raise
+        self._close_fds()
         self._reap()
         if status != "ok":
             raise RenderingFailed(f"the plot process failed: {detail.strip().splitlines()[-1]}")
@@ -118,17 +140,32 @@ class Renderer:
             self._running = False
             os.waitpid(self.pid, 0)
 
-    def close(self) -> None:
-        """Stop the child if it is still running (the run failed or was interrupted); idempotent."""
+    def _close_fds(self) -> None:
         for fd in self._fds:
             os.close(fd)
         self._fds = []
-        if self._running:
-            try:
+
+    def close(self) -> None:
+        """Stop the child if it is still running (the run failed or was interrupted); idempotent.
+
+        The child is asked with SIGTERM, on which it kills and reaps its own fork (:func:`_serve`),
+        so that when this returns neither draws any more; SIGKILL after :data:`STOP_TIMEOUT_S`.
+        """
+        self._close_fds()
+        if not self._running:
+            return
+        try:
+            os.kill(self.pid, signal.SIGTERM)
+        except ProcessLookupError:
+            pass
+        deadline = time.monotonic() + STOP_TIMEOUT_S
+        while os.waitpid(self.pid, os.WNOHANG)[0] == 0:
+            if time.monotonic() > deadline:
                 os.kill(self.pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
-            self._reap()
+                os.waitpid(self.pid, 0)
+                break
+            time.sleep(0.005)
+        self._running = False
 
 
 def split(jobs: list[Any]) -> tuple[list[Any], list[Any]]:
@@ -166,42 +203,66 @@ def split(jobs: list[Any]) -> tuple[list[Any], list[Any]]:
     return ([job for job, b in zip(jobs, share) if b == 0], [job for job, b in zip(jobs, share) if b == 1])
 
 
-def _draw_in_two(jobs: list[Any], directory: Path) -> None:
+def _draw_in_two(jobs: list[Any], directory: Path, forks: list[int]) -> None:
     """Draw ``jobs`` in this process and a fork of it (the child of :func:`_serve`, which has one
-    thread); raise if either fails."""
+    thread; the fork's pid is in ``forks`` while it runs); raise if either fails."""
     from scenarios.plots import draw_jobs
 
     mine, theirs = split(jobs)
-    if not mine or not theirs:
+    if not mine or not theirs or _thread_count() != 1:  # a fork copies only the calling thread
         draw_jobs(jobs, directory)
         return
+    stopping = {signal.SIGINT, signal.SIGTERM}
+    parent = os.getpid()
+    signal.pthread_sigmask(signal.SIG_BLOCK, stopping)  # no stop between the fork and `forks` (_stop)
     pid = os.fork()
     if pid == 0:
         code = 1
         try:
+            for signum in stopping:
+                signal.signal(signum, signal.SIG_DFL)
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
+            _die_with_parent(signal.SIGKILL, parent)
             draw_jobs(theirs, directory)
             code = 0
         finally:
             os._exit(code)
+    forks.append(pid)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
     try:
         draw_jobs(mine, directory)
     finally:
         _, status = os.waitpid(pid, 0)
+        forks.remove(pid)
     if status != 0:
         raise RuntimeError(f"the second drawing process failed (wait status {status})")
 
 
-def _serve(receive_fd: int, send_fd: int) -> None:
+def _stop(forks: list[int], signum: int, frame: Any) -> None:
+    """The plot process's Ctrl-C and SIGTERM: kill and reap its running fork (``forks``, kept by
+    :func:`_draw_in_two`), then exit (no traceback; the parent reports the interruption)."""
+    for pid in forks:
+        try:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+        except OSError:
+            pass
+    os._exit(1)
+
+
+def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
     """The child: import the drawing half, draw what the parent sends, answer, exit.
 
     Exits with ``os._exit`` (never returns): nothing of the parent's state inherited by the fork
-    (buffered output, ``atexit`` handlers) runs twice. Ctrl-C and SIGTERM end it without a
-    traceback; the parent reports them.
+    (buffered output, ``atexit`` handlers) runs twice. Ctrl-C and SIGTERM, and the end of the
+    parent (``parent``, its pid), end it and its fork (:func:`_stop`).
     """
     code = 1
     try:
-        signal.signal(signal.SIGINT, signal.SIG_DFL)
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        forks: list[int] = []
+        signal.signal(signal.SIGINT, functools.partial(_stop, forks))
+        signal.signal(signal.SIGTERM, functools.partial(_stop, forks))
+        _die_with_parent(signal.SIGTERM, parent)
         for name in SINGLE_THREAD_ENVIRONMENT:
             os.environ[name] = "1"
         import scenarios.plots  # noqa: F401  (matplotlib, while the parent runs)
@@ -212,7 +273,7 @@ def _serve(receive_fd: int, send_fd: int) -> None:
             except EOFError:  # the parent ended without plots to draw
                 os._exit(0)
         try:
-            _draw_in_two(jobs, Path(directory))
+            _draw_in_two(jobs, Path(directory), forks)
             reply: tuple[str, str] = ("ok", "")
         except Exception:  # reported to the parent, which draws in its own process and raises there
             reply = ("error", traceback.format_exc())

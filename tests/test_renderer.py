@@ -88,21 +88,21 @@ def _children(pid: int) -> list[int]:
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the plot process exists on Linux only")
 def test_sigterm_during_a_run_stops_the_plot_process_too(tmp_path):
-    slow = tmp_path / "slow.yaml"
-    slow.write_text(DEMO.read_text().replace("duration: 140.0", "duration: 100000.0").replace(
-        "sample_time: 0.5", "sample_time: 0.01"))
+    slow = tmp_path / "slow.yaml"  # about 3 s per row (200 000 samples): the signal lands in row 2
+    slow.write_text(DEMO.read_text().replace("duration: 140.0", "duration: 20000.0").replace(
+        "sample_time: 0.5", "sample_time: 0.1"))
     process = subprocess.Popen([sys.executable, "-m", "scenarios.console", "run", str(slow), "--out",
                                 str(tmp_path / "out")], cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                text=True)
-    deadline, children = time.time() + 60, []
-    while not children and time.time() < deadline and process.poll() is None:
-        children = _children(process.pid)
-        time.sleep(0.05)
+    assert process.stdout is not None
+    first = process.stdout.readline()  # the first row is done: the run is under way
+    assert first.startswith("[1/3] smooth: ok"), (first, process.communicate(timeout=120))
+    children = _children(process.pid)
     assert children, "no plot process was started"
-    time.sleep(1.0)  # into the run
     process.send_signal(signal.SIGTERM)
     _, err = process.communicate(timeout=120)
-    assert process.returncode != 0 and "Traceback" not in err
+    assert process.returncode == 1 and "interrupted" in err and "Traceback" not in err, err
+    assert not (tmp_path / "out" / "results.json").exists()
     for pid in children:  # reaped by the run: gone, not a zombie nor an orphan
         assert not Path(f"/proc/{pid}").exists()
 
@@ -171,3 +171,144 @@ def test_a_run_without_a_plot_process_is_unchanged(tmp_path):
     results.write(tmp_path / "out")
     assert {p.name for p in (tmp_path / "out").glob("*.png")} == {
         "smooth.png", "bang-coast-bang.png", "min-time.png", "comparison.png"}
+
+
+def _gone(pid: int) -> bool:
+    """Not running: no such process, or a zombie (reaped by init or by whoever adopted it)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z"
+    except OSError:
+        return True
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the plot process exists on Linux only")
+def test_an_interrupted_draw_stops_both_plot_processes_before_it_returns(tmp_path):
+    """Ctrl-C or SIGTERM while the plot processes draw: when ``draw`` raises, the plot process and
+    its fork are gone (reaped, not left to init) and write nothing more (the caller removes the
+    staging folder next)."""
+    done = _python("""
+        import os, signal, sys, time
+        from pathlib import Path
+        from scenarios.renderer import Renderer
+        renderer = Renderer.start()
+        import scenarios
+        from scenarios.plot_data import plot_jobs
+        jobs = plot_jobs(scenarios.run(scenarios.load(sys.argv[1])))
+        jobs = [(f"{k}-{name}", series) for k in range(8) for name, series in jobs]  # a long draw
+        directory, forks = Path(sys.argv[2]), []
+
+        def tick(signum, frame):  # interrupt once the plot process has forked its second drawer
+            path = Path(f"/proc/{renderer.pid}/task/{renderer.pid}/children")
+            forks.extend(int(v) for v in path.read_text().split()) if path.exists() else None
+            if forks:
+                signal.setitimer(signal.ITIMER_REAL, 0)
+                raise KeyboardInterrupt
+
+        signal.signal(signal.SIGALRM, tick)
+        signal.setitimer(signal.ITIMER_REAL, 0.02, 0.02)
+        try:
+            renderer.draw(jobs, directory)
+            print("not interrupted")
+        except KeyboardInterrupt:
+            written = sorted(os.listdir(directory))
+            for pid in [renderer.pid] + forks:
+                print(pid, Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+                      if Path(f"/proc/{pid}").exists() else "gone")
+            time.sleep(1.0)
+            print("written-afterwards", len(set(os.listdir(directory)) - set(written)))
+    """, str(DEMO), str(tmp_path))
+    assert done.returncode == 0, done.stderr
+    states = dict(line.split() for line in done.stdout.splitlines())
+    assert states.pop("written-afterwards") == "0", done.stdout
+    assert len(states) == 2 and set(states.values()) == {"gone"}, states
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the plot process exists on Linux only")
+def test_the_plot_processes_stop_when_the_run_is_killed(tmp_path):
+    """SIGKILL of ``slewbench run`` while its plot processes draw: they stop too, instead of
+    drawing on into the staging folder of a process that is gone."""
+    many = tmp_path / "many.yaml"
+    rows = "".join(f"  - {{name: eigenaxis, label: r{k}, options: {{profile: smooth}}}}\n" for k in range(16))
+    text = DEMO.read_text()
+    start, end = text.index("planners:\n"), text.index("controller:")
+    many.write_text(text[:start] + "planners:\n" + rows + text[end:])
+    process = subprocess.Popen([sys.executable, "-m", "scenarios.console", "run", str(many), "--out",
+                                str(tmp_path / "out")], cwd=REPO, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    deadline, drawers = time.time() + 120, []
+    while len(drawers) < 2 and time.time() < deadline and process.poll() is None:
+        drawers = [pid for child in _children(process.pid) for pid in [child, *_children(child)]]
+        time.sleep(0.01)
+    assert len(drawers) == 2, "the plot processes never drew"
+    process.kill()
+    process.wait(timeout=60)
+    deadline = time.time() + 2.0
+    while not all(_gone(pid) for pid in drawers) and time.time() < deadline:
+        time.sleep(0.02)
+    assert all(_gone(pid) for pid in drawers)
+
+
+@pytest.mark.parametrize("interrupt", ["raise KeyboardInterrupt", "os.kill(os.getpid(), signal.SIGTERM); time.sleep(5)"])
+def test_an_interruption_while_the_model_is_imported_is_reported_without_a_traceback(tmp_path, interrupt):
+    """Ctrl-C or SIGTERM before the command line is loaded (while the plot process imports
+    matplotlib and this process imports the model): the interrupted line, status 1, and the plot
+    process reaped (not left to run on as an orphan)."""
+    done = _python("""
+        import os, signal, sys, time
+        from pathlib import Path
+        import scenarios.console
+        from scenarios.renderer import Renderer
+
+        class Interrupting:  # Ctrl-C while scenarios.cli is being imported
+            def find_spec(self, name, path=None, target=None):
+                if name == "scenarios.cli":
+                    INTERRUPT
+
+        started = []
+        start = Renderer.start
+        Renderer.start = classmethod(lambda cls: started.append(start()) or started[-1])
+        sys.meta_path.insert(0, Interrupting())
+        status = scenarios.console.main(["run", sys.argv[1], "--out", sys.argv[2]])
+        assert started and started[0] is not None
+        pid = started[0].pid
+        print(status, "gone" if not Path(f"/proc/{pid}").exists() else "left")
+    """.replace("INTERRUPT", interrupt), str(DEMO), str(tmp_path / "out"))
+    assert "Traceback" not in done.stderr, done.stderr
+    assert done.stdout.split() == ["1", "gone"], (done.stdout, done.stderr)
+    assert "interrupted" in done.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_submodules_are_attributes_of_the_package_as_before():
+    """Library code written against the eager package (``import scenarios`` then
+    ``scenarios.loader.load``) still works; an unknown name is still an AttributeError."""
+    done = _python("""
+        import scenarios
+        assert scenarios.loader.load is scenarios.load
+        assert scenarios.runner.RunResults is scenarios.RunResults
+        assert scenarios.yaml_node.ScenarioError is scenarios.ScenarioError
+        scenarios.study.parse_study, scenarios.sweep_engine.sweep, scenarios.yaml_read
+        try:
+            scenarios.no_such_name
+        except AttributeError as error:
+            print("AttributeError", error)
+        print(hasattr(scenarios, "__wrapped__"))
+    """)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == ["AttributeError module 'scenarios' has no attribute 'no_such_name'", "False"]
+
+
+def test_the_second_drawer_is_forked_only_from_a_single_thread(tmp_path, monkeypatch):
+    """A plot process that somehow has threads (a BLAS ignoring its thread variables) draws
+    everything itself: a fork of a threaded process can deadlock (and warns on Python 3.12+)."""
+    from scenarios import renderer
+
+    def no_fork() -> int:
+        raise AssertionError("forked a process with threads")
+
+    monkeypatch.setattr(renderer, "_thread_count", lambda: 3)
+    monkeypatch.setattr(renderer.os, "fork", no_fork)
+    t = np.linspace(0.0, 10.0, 11)
+    overlay = OverlaySeries("t", "error (deg)", ["a"], [(t, t)], [(t, 1 + t)])
+    renderer._draw_in_two([("a.png", overlay), ("b.png", overlay)], tmp_path, [])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png"]
