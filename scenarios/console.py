@@ -31,9 +31,12 @@ def draws_plots(argv: list[str]) -> bool:
     Returns
     -------
     bool
-        ``run`` without ``--no-plots`` and without a help request.
+        ``run`` without ``--no-plots`` and without a help request (either also as the unambiguous
+        abbreviations argparse accepts, such as ``--no-plot`` or ``--he``).
     """
-    return argv[:1] == ["run"] and not {"--no-plots", "-h", "--help"} & set(argv)
+    return argv[:1] == ["run"] and not any(
+        arg == "-h" or (len(arg) > 2 and ("--no-plots".startswith(arg) or "--help".startswith(arg)))
+        for arg in argv[1:])
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -133,7 +133,8 @@ def test_the_figures_are_shared_evenly_and_each_drawn_once(rows, shapes):
 
 def test_only_run_with_plots_starts_a_plot_process():
     assert draws_plots(["run", "a.yaml"]) and draws_plots(["run", "a.yaml", "--out", "d"])
-    for argv in (["run", "a.yaml", "--no-plots"], ["run", "-h"], ["validate", "a.yaml"], ["sweep", "s.yaml"], []):
+    for argv in (["run", "a.yaml", "--no-plots"], ["run", "-h"], ["validate", "a.yaml"], ["sweep", "s.yaml"], [],
+                 ["run", "a.yaml", "--no-plot"], ["run", "a.yaml", "--n"], ["run", "--he"]):  # argparse abbreviations
         assert not draws_plots(argv)
 
 
