@@ -16,6 +16,7 @@ same, pixel for pixel.
 """
 from __future__ import annotations
 
+import atexit
 import functools
 import os
 import pickle
@@ -247,18 +248,28 @@ def _stop(forks: list[int], signum: int, frame: Any) -> None:
             os.waitpid(pid, 0)
         except OSError:
             pass
-    os._exit(1)
+    _exit(1)
+
+
+def _exit(code: int) -> None:
+    """Run the exit handlers registered in the plot process (matplotlib's removal of a temporary
+    cache directory it made where its own is not writable), then exit without running anything
+    inherited from the parent (``os._exit``)."""
+    atexit._run_exitfuncs()
+    os._exit(code)
 
 
 def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
     """The child: import the drawing half, draw what the parent sends, answer, exit.
 
     Exits with ``os._exit`` (never returns): nothing of the parent's state inherited by the fork
-    (buffered output, ``atexit`` handlers) runs twice. Ctrl-C and SIGTERM, and the end of the
-    parent (``parent``, its pid), end it and its fork (:func:`_stop`).
+    (buffered output, ``atexit`` handlers) runs twice; the exit handlers registered here do run
+    (:func:`_exit`). Ctrl-C and SIGTERM, and the end of the parent (``parent``, its pid), end it
+    and its fork (:func:`_stop`).
     """
     code = 1
     try:
+        atexit._clear()  # the parent's: they run in the parent
         forks: list[int] = []
         signal.signal(signal.SIGINT, functools.partial(_stop, forks))
         signal.signal(signal.SIGTERM, functools.partial(_stop, forks))
@@ -271,7 +282,7 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
             try:
                 directory, jobs = pickle.load(stream)
             except EOFError:  # the parent ended without plots to draw
-                os._exit(0)
+                _exit(0)
         try:
             _draw_in_two(jobs, Path(directory), forks)
             reply: tuple[str, str] = ("ok", "")
@@ -283,4 +294,4 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
     except BaseException:  # noqa: BLE001 (the child never lets anything escape into the parent's code)
         code = 1
     finally:
-        os._exit(code)
+        _exit(code)

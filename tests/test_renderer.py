@@ -313,3 +313,33 @@ def test_the_second_drawer_is_forked_only_from_a_single_thread(tmp_path, monkeyp
     overlay = OverlaySeries("t", "error (deg)", ["a"], [(t, t)], [(t, 1 + t)])
     renderer._draw_in_two([("a.png", overlay), ("b.png", overlay)], tmp_path, [])
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png"]
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the plot process exists on Linux only")
+@pytest.mark.parametrize("draw", [True, False])
+def test_the_plot_process_removes_the_temporary_matplotlib_directory(tmp_path, draw):
+    """Where matplotlib's own directory cannot be written (a read-only home in CI or a container),
+    it makes a temporary one and removes it at exit: the plot process must too, having drawn or
+    having been stopped (``python -m scenarios.cli`` leaves nothing there either)."""
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    (tmp_path / "file").write_text("")  # MPLCONFIGDIR below it cannot be made
+    done = subprocess.run([sys.executable, "-c", textwrap.dedent("""
+        import sys, time
+        from pathlib import Path
+        from scenarios.renderer import Renderer
+        renderer = Renderer.start()
+        import scenarios
+        from scenarios.plot_data import plot_jobs
+        results = scenarios.run(scenarios.load(sys.argv[1]))
+        if sys.argv[3] == "True":
+            renderer.draw(plot_jobs(results), Path(sys.argv[2]))
+        else:
+            time.sleep(3.0)  # matplotlib imported, nothing to draw (a bad --out, a failed write)
+        renderer.close()
+    """), str(DEMO), str(tmp_path), str(draw)], cwd=REPO, capture_output=True, text=True, timeout=300, check=False,
+                          env={**os.environ, "PYTHONPATH": str(REPO), "TMPDIR": str(scratch),
+                               "MPLCONFIGDIR": str(tmp_path / "file" / "not-a-directory")})
+    assert done.returncode == 0, done.stderr
+    assert "temporary cache directory" in done.stderr  # the situation under test
+    assert sorted(p.name for p in scratch.iterdir()) == []
