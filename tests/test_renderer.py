@@ -229,7 +229,7 @@ def test_the_plot_processes_stop_when_the_run_is_killed(tmp_path):
     """SIGKILL of ``slewbench run`` while its plot processes draw: they stop too, instead of
     drawing on into the staging folder of a process that is gone."""
     many = tmp_path / "many.yaml"
-    rows = "".join(f"  - {{name: eigenaxis, label: r{k}, options: {{profile: smooth}}}}\n" for k in range(16))
+    rows = "".join(f"  - {{name: eigenaxis, label: r{k}, options: {{profile: smooth}}}}\n" for k in range(24))
     text = DEMO.read_text()
     start, end = text.index("planners:\n"), text.index("controller:")
     many.write_text(text[:start] + "planners:\n" + rows + text[end:])
@@ -243,9 +243,9 @@ def test_the_plot_processes_stop_when_the_run_is_killed(tmp_path):
     assert len(drawers) == 2, "the plot processes never drew"
     process.kill()
     process.wait(timeout=60)
-    deadline = time.time() + 2.0
+    killed, deadline = time.time(), time.time() + 0.5
     while not all(_gone(pid) for pid in drawers) and time.time() < deadline:
-        time.sleep(0.02)
+        time.sleep(0.01)
     assert all(_gone(pid) for pid in drawers)
 
 
