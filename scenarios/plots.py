@@ -165,15 +165,16 @@ class RowFigure:
         artists.append(self.title)
         return artists
 
-    def draw(self, series: RowSeries, path: Path) -> None:
-        """Draw a row's curves and write the PNG.
+    def prepare(self, series: RowSeries) -> None:
+        """Set a row's curves and limits, and have the static part for its time limits drawn
+        (drawn now if it is not yet, else restored): what :meth:`draw` does before the row's own
+        artists. A plot process prepares a figure once before it forks, so that both drawers
+        share the static part (:mod:`scenarios.renderer`).
 
         Parameters
         ----------
         series : scenarios.plot_data.RowSeries
             The row's curves (:func:`scenarios.plot_data.row_series`), of this figure's shape.
-        path : pathlib.Path
-            Where to write the PNG.
         """
         if series.shape != self.shape:
             raise ValueError(f"a row of shape {series.shape} drawn on a figure of shape {self.shape}")
@@ -203,10 +204,22 @@ class RowFigure:
                 artist.set_visible(True)
         else:
             canvas.restore_region(self._background[1])
-        renderer = canvas.get_renderer()
-        for artist in dynamic:
+
+    def draw(self, series: RowSeries, path: Path) -> None:
+        """Draw a row's curves and write the PNG.
+
+        Parameters
+        ----------
+        series : scenarios.plot_data.RowSeries
+            The row's curves (:func:`scenarios.plot_data.row_series`), of this figure's shape.
+        path : pathlib.Path
+            Where to write the PNG.
+        """
+        self.prepare(series)
+        renderer = self.canvas.get_renderer()
+        for artist in self._dynamic():
             artist.draw(renderer)
-        _write_png(canvas, path)
+        _write_png(self.canvas, path)
 
 
 def _write_png(canvas: FigureCanvasAgg, path: Path) -> None:
@@ -299,7 +312,8 @@ def plot_overlay(results: Any, path: Path) -> None:
     draw_overlay(overlay_series(results), path)
 
 
-def draw_jobs(jobs: list[PlotJob], directory: Path) -> None:
+def draw_jobs(jobs: list[PlotJob], directory: Path, figures: dict[tuple[int, bool, bool], RowFigure] | None = None
+              ) -> None:
     """Draw figures into ``directory``, reusing one :class:`RowFigure` per row shape.
 
     Parameters
@@ -308,8 +322,11 @@ def draw_jobs(jobs: list[PlotJob], directory: Path) -> None:
         File names and their series (:func:`scenarios.plot_data.plot_jobs`).
     directory : pathlib.Path
         Existing directory to write into.
+    figures : dict, optional
+        Row figures by shape (:attr:`RowSeries.shape`) to draw on, e.g. prepared ones
+        (:meth:`RowFigure.prepare`); the figures of other shapes are added to it. ``None``: new ones.
     """
-    figures: dict[tuple[int, bool, bool], RowFigure] = {}
+    figures = {} if figures is None else figures
     for name, series in jobs:
         if isinstance(series, RowSeries):
             figure = figures.get(series.shape) or figures.setdefault(series.shape, RowFigure(*series.shape))

@@ -29,9 +29,9 @@ from typing import Any
 
 SINGLE_THREAD_ENVIRONMENT = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 """Set to 1 in the child before it imports NumPy: drawing needs no BLAS threads."""
-COST = {"background": 2.5, "row": 1.0, "other": 1.3}
-"""Relative drawing costs (about 0.1 s each on the reference machine): the static part of a per-row
-figure (drawn once per process and row shape), one row on it, any other figure."""
+COST = {"row": 1.0, "other": 1.3}
+"""Relative drawing costs (about 0.1 s each on the reference machine) of one row on its figure,
+whose static part is drawn before the fork (:func:`_draw_in_two`), and of any other figure."""
 STOP_TIMEOUT_S = 5.0
 """How long :meth:`Renderer.close` lets the plot process stop its fork and exit before killing it [s]."""
 
@@ -172,9 +172,9 @@ class Renderer:
 def split(jobs: list[Any]) -> tuple[list[Any], list[Any]]:
     """Share figures between two processes so that both finish at about the same time.
 
-    Greedy, largest first: each figure goes where the total cost (:data:`COST`) stays lower,
-    counting the static part of a per-row figure once for each process that draws a row of
-    that shape.
+    Greedy, largest first: each figure goes where the total cost (:data:`COST`) stays lower. The
+    static parts of the per-row figures are drawn before the fork and shared (:func:`_draw_in_two`),
+    so they are not counted.
 
     Parameters
     ----------
@@ -188,30 +188,35 @@ def split(jobs: list[Any]) -> tuple[list[Any], list[Any]]:
     """
     from scenarios.plot_data import RowSeries
 
-    costs, shapes = [0.0, 0.0], [set(), set()]  # type: ignore[var-annotated]
+    costs = [0.0, 0.0]
     share = [0] * len(jobs)
     order = sorted(range(len(jobs)), key=lambda k: isinstance(jobs[k][1], RowSeries))  # others first
     for k in order:
-        series = jobs[k][1]
-        row = isinstance(series, RowSeries)
-        added = [COST["row"] + (COST["background"] if series.shape not in shapes[b] else 0.0) if row
-                 else COST["other"] for b in (0, 1)]
-        b = 0 if costs[0] + added[0] <= costs[1] + added[1] else 1
-        costs[b] += added[b]
+        cost = COST["row"] if isinstance(jobs[k][1], RowSeries) else COST["other"]
+        b = 0 if costs[0] <= costs[1] else 1
+        costs[b] += cost
         share[k] = b
-        if row:
-            shapes[b].add(series.shape)
     return ([job for job, b in zip(jobs, share) if b == 0], [job for job, b in zip(jobs, share) if b == 1])
 
 
 def _draw_in_two(jobs: list[Any], directory: Path, forks: list[int]) -> None:
     """Draw ``jobs`` in this process and a fork of it (the child of :func:`_serve`, which has one
-    thread; the fork's pid is in ``forks`` while it runs); raise if either fails."""
-    from scenarios.plots import draw_jobs
+    thread; the fork's pid is in ``forks`` while it runs); raise if either fails.
 
+    The static part of each row shape's figure is drawn first (:meth:`RowFigure.prepare` with the
+    first row of that shape), so that the fork inherits it instead of drawing it again.
+    """
+    from scenarios.plot_data import RowSeries
+    from scenarios.plots import RowFigure, draw_jobs
+
+    figures: dict[tuple[int, bool, bool], RowFigure] = {}
+    for _, series in jobs:
+        if isinstance(series, RowSeries) and series.shape not in figures:
+            figures[series.shape] = RowFigure(*series.shape)
+            figures[series.shape].prepare(series)
     mine, theirs = split(jobs)
     if not mine or not theirs or _thread_count() != 1:  # a fork copies only the calling thread
-        draw_jobs(jobs, directory)
+        draw_jobs(jobs, directory, figures)
         return
     stopping = {signal.SIGINT, signal.SIGTERM}
     parent = os.getpid()
@@ -224,14 +229,14 @@ def _draw_in_two(jobs: list[Any], directory: Path, forks: list[int]) -> None:
                 signal.signal(signum, signal.SIG_DFL)
             signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
             _die_with_parent(signal.SIGKILL, parent)
-            draw_jobs(theirs, directory)
+            draw_jobs(theirs, directory, figures)
             code = 0
         finally:
             os._exit(code)
     forks.append(pid)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
     try:
-        draw_jobs(mine, directory)
+        draw_jobs(mine, directory, figures)
     finally:
         _, status = os.waitpid(pid, 0)
         forks.remove(pid)
