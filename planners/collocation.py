@@ -37,7 +37,11 @@ from ocp.transcription import (
     Transcription,
 )
 from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference
-from planners.collocation_reference import CollocationReference, seed_sampler
+from planners.collocation_reference import (
+    CollocationReference,
+    seed_sampler,
+    solution_sampler,
+)
 
 AUTO_RESTART = 0.05
 """Relative perturbation of the restarts of ``multistart: auto`` when the final time is free."""
@@ -47,14 +51,16 @@ optimum: the seed is near the optimum, so the barrier need not start wide. N = 5
 the spin paper's minimum energy 7 iterations against 12, Bilimoria & Wie's minimum time 15
 against 18, the full-inertia minimum time 12 against 16 (same optima; 1e-6 takes 22-23 on the
 minimum-time cases, where the bounds are active)."""
-TRANSFER_WARM_START = {"mu_init": 1e-6, "bound_push": 1e-3, "mult_bound_push": 1e-3}
+TRANSFER_WARM_START = {"mu_init": 1e-7, "bound_push": 1e-3, "mult_bound_push": 1e-4}
 """IPOPT's warm start (:func:`ocp.nlp.warm_start_options`) of the full-mesh solve from a coarse-mesh
 optimum with its multipliers carried over (:mod:`ocp.mesh_transfer`); falls back to the start
 without multipliers (:data:`POLISH_MU_INIT`) if it does not converge. The guess is pushed 1e-3
-inside its bounds and the bound multipliers start at 1e-3 at least: the coarse active set is near,
-not at, the fine one. N = 50 from N = 8: the spin paper's minimum energy 5 iterations against 7,
-Bilimoria & Wie's minimum time 11 against 15, the full-inertia one 11 against 12 (same optima;
-IPOPT's tiny pushes of a same-mesh warm start take 20 and 12 on the minimum-time cases)."""
+inside its bounds and the bound multipliers start at 1e-4 at least: the coarse active set is near,
+not at, the fine one. N = 50 from N = 8: the spin paper's minimum energy 4 iterations against 7,
+Bilimoria & Wie's minimum time 10 against 15, the full-inertia one 10 against 12 (same optima).
+Neighbouring values do about as well (mu_init 1e-8 to 1e-5, pushes 1e-4 to 1e-2: 24 to 29
+iterations over the three); a multiplier push of 1e-2 does not (34 to 41), nor IPOPT's tiny pushes
+of a same-mesh warm start (1e-9: 20 and 12 on the minimum-time cases)."""
 
 
 _Mode = Literal["cold", "warm", "near_optimum", "transfer"]
@@ -418,7 +424,8 @@ class CollocationPlanner(Planner):
             found = self._reference(problem, ocp, params, coarse)
             extra["coarse"] = found.stats
             if found.ok:
-                seed = transcription.seed(ocp, nlp, seed_sampler(problem, found), found.duration)
+                assert isinstance(found, CollocationReference)  # found.ok
+                seed = transcription.seed(ocp, nlp, solution_sampler(found), found.duration)
                 result = self._transferred(problem, ocp, coarse, seed, params, bounds)
                 if result is None or not result.success:
                     polish, more = self._solve(problem, ocp, [seed], params, bounds, intervals, near_optimum=True)
