@@ -11,7 +11,8 @@ NLP (IPOPT or FATROP) is built once per problem structure into the planner's ``S
 Starts: the reference of the ``warm_start`` planner (perturbed copies of it per ``multistart``)
 and the ``seed_planners``, solved by :func:`ocp.nlp.solve_multistart` (its status policy and early
 stopping); the best converged optimum is kept. With ``multistart: auto`` they are solved on
-``coarse_intervals`` first and the full mesh once from that optimum (see the option).
+``coarse_intervals`` first and the full mesh once from that optimum and its multipliers (see the
+option).
 """
 from __future__ import annotations
 
@@ -28,15 +29,15 @@ from ocp.nlp import (
     solver_options,
     warm_start_options,
 )
-from ocp.options import InvalidOption, OptionsError, Range, excerpt
+from ocp.options import InvalidOption, OptionsError, Range
 from ocp.transcription import (
     NLP,
     TRANSCRIPTIONS,
-    Cone,
     OptimalControlProblem,
     Transcription,
 )
 from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference
+from planners.collocation_problem import parse_cone, variable_bounds
 from planners.collocation_reference import (
     CollocationReference,
     seed_sampler,
@@ -85,51 +86,6 @@ def _merged(first: NLPResult, second: NLPResult) -> NLPResult:
                    time_s=first.time_s + second.time_s, best_start=best)
 
 
-def _cone_vector(spec: dict, key: str, where: str) -> np.ndarray:
-    value = spec[key]
-    if (not isinstance(value, (list, tuple)) or len(value) != 3
-            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
-        raise InvalidOption(f"{where}.{key}", f"expected 3 numbers, got {excerpt(value)}")
-    vector = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(vector)) or not np.linalg.norm(vector) > 0:
-        raise InvalidOption(f"{where}.{key}", f"expected a finite non-zero vector, got {excerpt(value)}")
-    return vector / np.linalg.norm(vector)
-
-
-def parse_cone(spec: dict, keep_out: bool, margin: float = 0.0, where: str = "cone") -> Cone:
-    """A :class:`Cone` from ``{boresight, direction, angle_deg}``, tightened by ``margin`` (rad).
-
-    Parameters
-    ----------
-    spec : ``boresight`` (body axes) and ``direction`` (inertial) as 3-vectors, ``angle_deg`` the
-        cone's half-angle in degrees, in (0, 180).
-    keep_out : the boresight must stay outside (``True``) or inside (``False``) the cone.
-    margin : rad by which the cone is tightened.
-    where : the option's path (``keep_out[0]``) for error messages.
-
-    Returns
-    -------
-    Cone
-        The (tightened) cone, unit vectors, angle in rad.
-
-    Raises
-    ------
-    InvalidOption
-        Naming ``where`` and the offending key.
-    """
-    keys = {"boresight", "direction", "angle_deg"}
-    if not isinstance(spec, dict) or set(spec) != keys:
-        raise InvalidOption(where, f"a cone needs exactly the keys {sorted(keys)}, got {excerpt(spec)}")
-    boresight, direction = _cone_vector(spec, "boresight", where), _cone_vector(spec, "direction", where)
-    angle = spec["angle_deg"]
-    if not isinstance(angle, (int, float)) or isinstance(angle, bool) or not 0.0 < angle < 180.0:
-        raise InvalidOption(f"{where}.angle_deg", f"expected a number in (0, 180) degrees, got {excerpt(angle)}")
-    tightened = float(np.deg2rad(angle)) + (margin if keep_out else -margin)
-    if not 0.0 < tightened < np.pi:
-        raise InvalidOption(f"{where}.angle_deg", f"{angle} deg leaves no cone once tightened by cone_margin_deg")
-    return Cone(tuple(boresight), tuple(direction), tightened, keep_out)
-
-
 class CollocationPlanner(Planner):
     """Direct optimal control planner (see the module docstring)."""
 
@@ -176,8 +132,10 @@ class CollocationPlanner(Planner):
         coarse_intervals : int
             With ``multistart: auto``, the starts are first solved on this many intervals (for a
             free final time the whole multistart; for a fixed one only without cones and with at
-            least twice as many ``intervals``) and the full mesh is solved once from that optimum, IPOPT's barrier starting at 1e-4 (falling back to
-            the full-mesh solve from the starts); 0 or >= ``intervals``: off. Default 8.
+            least twice as many ``intervals``) and the full mesh is solved once from that optimum
+            and its multipliers carried over (IPOPT; falling back to that optimum alone with the
+            barrier starting at 1e-4, then to the full-mesh solve from the starts); 0 or >=
+            ``intervals``: off. Default 8.
         energy_weight, l1_weight, time_weight : float
             Weights of ``weighted`` [1/(N² m² s), 1/(N m s), 1/s].
         max_rate : float or None
@@ -201,19 +159,9 @@ class CollocationPlanner(Planner):
         warm_start: str = "eigenaxis"            # registered planner whose reference seeds the NLP
         warm_start_options: dict = field(default_factory=dict)  # its options, e.g. {profile: min_time}
         seed_planners: list[str] = field(default_factory=list)
-        # "auto": the warm start itself for a fixed final time; for a free final time (where a warm
-        # start can sit on a stationary point, e.g. the eigenaxis slew) a 1 % perturbed copy of it,
-        # then up to 4 restarts from the best point perturbed by 5 %, until one agrees with it.
-        # A number n > 0: n perturbed copies (1 %, then 5 %); 0: the warm start itself.
         multistart: Annotated[int | Literal["auto"], Range(ge=0, le=50)] = "auto"
         agree: Annotated[int, Range(ge=0, le=50)] = 2  # stop once this many starts agree on the best optimum (0: try all)
-        # min_time only: first solve min T + ε ∫‖τ‖² dt / Σ τ_max², ε this option (0: off), from
-        # the starts above, then polish plain minimum time from that optimum and its multipliers.
         time_regularization: Annotated[float, Range(ge=0.0, le=1.0)] = 0.0
-        # Multistart auto: the starts are first solved on this many intervals (a free final time:
-        # the multistart, escape and agreement; a fixed one without cones and with >= 2x as many
-        # intervals: a cheap seed), then the full mesh once from that optimum (falling back to the
-        # full-mesh solve from the starts if it does not converge). 0, or >= intervals: off.
         coarse_intervals: Annotated[int, Range(ge=0, le=2000)] = 8
         energy_weight: Annotated[float, Range(ge=0.0)] = 1.0               # for objective "weighted"
         l1_weight: Annotated[float, Range(ge=0.0)] = 0.0
@@ -293,26 +241,7 @@ class CollocationPlanner(Planner):
 
     def _variable_bounds(self, problem: ManeuverProblem) -> tuple[Array, Array, Array, Array]:
         """Per-point bounds of the model state and the actuator controls."""
-        spacecraft, model = problem.spacecraft, problem.model
-        x_low, x_high = np.full(model.nx, -np.inf), np.full(model.nx, np.inf)
-        x_low[0:4], x_high[0:4] = -1.5, 1.5
-        if self.options.max_rate is not None:
-            x_low[4:7], x_high[4:7] = -self.options.max_rate, self.options.max_rate
-        u_low, u_high = np.full(model.nu, -np.inf), np.full(model.nu, np.inf)
-        slices = model.control_slices
-        # Limits are arrays once the actuators are constructed (None becomes inf).
-        if spacecraft.wheels is not None:
-            momentum = np.asarray(spacecraft.wheels.max_momentum, dtype=float)
-            x_low[7:], x_high[7:] = -momentum, momentum
-            limit = np.where(spacecraft.wheels.working, np.asarray(spacecraft.wheels.max_torque, dtype=float), 0.0)
-            u_low[slices["wheels"]], u_high[slices["wheels"]] = -limit, limit
-        if spacecraft.magnetorquers is not None:
-            dipole = np.asarray(spacecraft.magnetorquers.max_dipole, dtype=float)
-            u_low[slices["dipole"]], u_high[slices["dipole"]] = -dipole, dipole
-        if spacecraft.torquers is not None:
-            torque = np.asarray(spacecraft.torquers.max_torque, dtype=float)
-            u_low[slices["torquers"]], u_high[slices["torquers"]] = -torque, torque
-        return x_low, x_high, u_low, u_high
+        return variable_bounds(problem, self.options.max_rate)
 
     def _starts(self, problem: ManeuverProblem) -> list[Reference]:
         from planners import PLANNERS
