@@ -341,7 +341,7 @@ class CollocationPlanner(Planner):
         o = self.options
         coarse_first = intervals == o.intervals and self._coarse(ocp)
         # The layout (bounds, seeds, unpack) is the same in every build: use the one solved first.
-        mode: _Mode = "warm" if o.time_regularization else "near_optimum" if coarse_first else "cold"
+        mode: _Mode = "warm" if o.time_regularization else "transfer" if coarse_first else "cold"
         transcription, nlp = self._nlp(problem, ocp, mode, intervals)
         bounds = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
         result, extra = None, {}
