@@ -60,3 +60,21 @@ def test_layouts_that_differ_beyond_the_mesh_are_refused():
     nlp, result = solved("collocation", 6)
     other, _ = solved("multiple_shooting", 6)
     assert transfer_multipliers(nlp, other, result.lam_x, result.lam_g) is None
+
+
+def test_solution_sampler_reads_the_solution_as_the_reference_does():
+    # The native seed of a fine mesh (states and controls interpolated by the transcription) against
+    # the reference's own evaluation: with torquers only and no environment, the actuator torque is
+    # the reference's torque (inverse dynamics of the interpolated states).
+    from planners.collocation_reference import solution_sampler
+
+    problem = bounded_single_axis()
+    reference = PLANNERS["collocation"]({"intervals": 8}).plan(problem)
+    assert reference.status == "ok", reference.message
+    t = np.linspace(0.0, problem.duration, 37)
+    x, u, torque = solution_sampler(reference)(t)
+    sample = reference.sample(t)
+    np.testing.assert_allclose(x[:, 0:4], sample.q, atol=1e-12)
+    np.testing.assert_allclose(x[:, 4:7], sample.omega, atol=1e-12)
+    np.testing.assert_allclose(u, reference.control(t), atol=1e-12)
+    np.testing.assert_allclose(torque, np.abs(sample.torque), atol=1e-9)
