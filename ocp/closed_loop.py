@@ -76,7 +76,7 @@ def draw_noise(rng: np.random.Generator, n_samples: int, attitude_std: float, ra
 
 def noisy_attitude(q: Any, rotvec: Any) -> Any:
     """Measured attitude ``q ⊗ exp(rotvec / 2)``: the attitude sensor's error is a body-frame
-    rotation vector. The operations follow the Python loop's (``Simulator._measure``), so that
+    rotation vector. The operations follow the Python loop's (:func:`ocp.simulation_data.measure`), so that
     both paths round alike.
 
     Parameters

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ocp.actuators import Command, Measurement
 from ocp.layout import reference_rows
 from ocp.model import AttitudeModel
 
@@ -190,3 +191,70 @@ class SimulationResult:
     def wheel_momentum(self) -> Array:
         """(N+1, n_w) wheel momenta [N m s]."""
         return self.x[:, 7:]
+
+
+class ControllerLike(Protocol):
+    """What the simulator needs of a controller (``controllers.base.Controller`` has it)."""
+
+    def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None:
+        """Prepare for a run.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The controlled spacecraft.
+        sample_time : float
+            Controller period and zero-order-hold length [s].
+        target : (q_f, ω_f or None), optional
+            Final attitude (scalar-first quaternion) and body rate [rad/s] for regulation.
+        """
+
+    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
+        """The command for the sample starting at ``t`` [s] (see ``Controller.__call__``)."""
+
+
+def measure(x: Array, t: float, noise: SensorNoise, rng: np.random.Generator, field: Array | None = None,
+            field_rng: np.random.Generator | None = None) -> Measurement:
+    """What the controller sees at one sample: the state with the sensor noise of ``noise``.
+
+    The simulator's Python loop calls it once per sample; the compiled closed loop
+    (:mod:`ocp.closed_loop`) performs the same operations symbolically, on noise drawn in advance
+    in the same order.
+
+    Parameters
+    ----------
+    x : (nx,) ndarray
+        State ``[q (scalar first, body to inertial), ω [rad/s] (body), h_w [N m s]]``.
+    t : float
+        Time [s].
+    noise : SensorNoise
+        Standard deviations (attitude [rad] as a rotation vector, rate [rad/s], field [T]).
+    rng : numpy.random.Generator
+        The attitude and rate noise stream.
+    field : (3,) ndarray, optional
+        The geomagnetic field at ``x`` and ``t`` [T] (body frame; a copy the function may modify),
+        ``None`` without magnetometer.
+    field_rng : numpy.random.Generator, optional
+        The magnetometer's own stream (``None``: ``rng``).
+
+    Returns
+    -------
+    Measurement
+        Noisy attitude, rate, field and the wheel momenta.
+    """
+    q, omega = x[0:4], x[4:7]
+    if noise.attitude_std > 0:  # q ⊗ exp(v/2), written out (no general quaternion helper per sample)
+        v = rng.normal(0.0, noise.attitude_std, 3)
+        angle = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+        s = math.sin(0.5 * angle) / angle if angle > 0 else 0.5
+        p0, p1, p2, p3 = math.cos(0.5 * angle), s * v[0], s * v[1], s * v[2]
+        q0, q1, q2, q3 = q
+        q = np.array([q0 * p0 - q1 * p1 - q2 * p2 - q3 * p3,
+                      q0 * p1 + p0 * q1 + q2 * p3 - q3 * p2,
+                      q0 * p2 + p0 * q2 + q3 * p1 - q1 * p3,
+                      q0 * p3 + p0 * q3 + q1 * p2 - q2 * p1])
+    if noise.rate_std > 0:
+        omega = omega + rng.normal(0.0, noise.rate_std, 3)
+    if noise.field_std > 0 and field is not None:  # its own stream: attitude and rate noise unchanged
+        field += (rng if field_rng is None else field_rng).normal(0.0, noise.field_std, 3)
+    return Measurement(t=t, q=q.copy(), omega=omega.copy(), wheel_momentum=x[7:].copy(), field_body=field)

@@ -24,24 +24,26 @@ Two paths compute the same numbers (to rounding; ``tests/test_closed_loop.py``):
 from __future__ import annotations
 
 import math
-from typing import Any, Protocol
+from typing import Any
 
 import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp import quat
-from ocp.actuators import ActuatorModel, Command, Measurement
+from ocp.actuators import ActuatorModel, Command
 from ocp.closed_loop import ClosedLoop, draw_noise
 from ocp.compiled import CompilerUnavailable, compile_function, notice
 from ocp.fast_call import BufferedFunction
 from ocp.integration import rk4_step
 from ocp.model import AttitudeModel
 from ocp.simulation_data import (
+    ControllerLike,
     GridSampledReference,
     SensorNoise,
     SimulationError,
     SimulationResult,
+    measure,
 )
 
 Array = NDArray[np.float64]
@@ -52,26 +54,6 @@ SUBSTEPS_PER_SAMPLE = 20
 """A run may integrate at most this many RK4 sub-steps per allowed sample (``max_samples``)."""
 MAX_SUBSTEPS = 1000
 """Bound on RK4 sub-steps per sample (the step is one unrolled CasADi graph)."""
-
-
-class _ControllerLike(Protocol):
-    """What the simulator needs of a controller (``controllers.base.Controller`` has it)."""
-
-    def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None:
-        """Prepare for a run.
-
-        Parameters
-        ----------
-        spacecraft : Spacecraft
-            The controlled spacecraft.
-        sample_time : float
-            Controller period and zero-order-hold length [s].
-        target : (q_f, ω_f or None), optional
-            Final attitude (scalar-first quaternion) and body rate [rad/s] for regulation.
-        """
-
-    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
-        """The command for the sample starting at ``t`` [s] (see ``Controller.__call__``)."""
 
 
 class Simulator:
@@ -185,7 +167,7 @@ class Simulator:
 
     def run(
         self,
-        controller: _ControllerLike,
+        controller: ControllerLike,
         x0: ArrayLike,
         duration: float,
         reference: Any = None,
@@ -398,24 +380,9 @@ class Simulator:
                                 saturated.astype(bool), path)
 
     def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator,
-                 field_rng: np.random.Generator | None = None) -> Measurement:
-        q, omega = x[0:4], x[4:7]
-        if noise.attitude_std > 0:  # q ⊗ exp(v/2), written out (no general quaternion helper per sample)
-            v = rng.normal(0.0, noise.attitude_std, 3)
-            angle = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
-            s = math.sin(0.5 * angle) / angle if angle > 0 else 0.5
-            p0, p1, p2, p3 = math.cos(0.5 * angle), s * v[0], s * v[1], s * v[2]
-            q0, q1, q2, q3 = q
-            q = np.array([q0 * p0 - q1 * p1 - q2 * p2 - q3 * p3,
-                          q0 * p1 + p0 * q1 + q2 * p3 - q3 * p2,
-                          q0 * p2 + p0 * q2 + q3 * p1 - q1 * p3,
-                          q0 * p3 + p0 * q3 + q1 * p2 - q2 * p1])
-        if noise.rate_std > 0:
-            omega = omega + rng.normal(0.0, noise.rate_std, 3)
+                 field_rng: np.random.Generator | None = None) -> Any:
         field = None if self._field_numeric is None else self._field_numeric(x, t).copy()
-        if noise.field_std > 0 and field is not None:  # its own stream: attitude and rate noise unchanged
-            field += (rng if field_rng is None else field_rng).normal(0.0, noise.field_std, 3)
-        return Measurement(t=t, q=q.copy(), omega=omega.copy(), wheel_momentum=x[7:].copy(), field_body=field)
+        return measure(x, t, noise, rng, field, field_rng)
 
     def _fill_command(self, command: Command, out: Array) -> None:
         """Write the command into ``out`` (a zero row) in the layout of ``u``."""

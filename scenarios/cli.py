@@ -82,8 +82,9 @@ def command_run(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         ``file`` (scenario YAML), ``out`` (output directory or ``None``: ``results/<name>``),
-        ``no_plots`` (skip the PNG figures), and ``interruption`` (an :class:`Interruption`, set
-        by :func:`main`; optional).
+        ``no_plots`` (skip the PNG figures), and, set by :func:`main` (optional): ``interruption``
+        (an :class:`Interruption`) and ``renderer`` (a :class:`scenarios.renderer.Renderer` to
+        draw the plots, or ``None``).
 
     Returns
     -------
@@ -104,7 +105,7 @@ def command_run(args: argparse.Namespace) -> int:
     interruption.check()
     print()
     print(results.to_terminal())
-    results.write(out, plots=not args.no_plots)
+    results.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
     print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
           f"{'' if args.no_plots else ', PNG plots'}) in {time.perf_counter() - start:.2f} s")
     return EXIT_OK
@@ -198,13 +199,16 @@ class Interruption:
             raise KeyboardInterrupt
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     """Run the ``slewbench`` command line.
 
     Parameters
     ----------
     argv : list of str, optional
         Arguments (without the program name); ``None``: ``sys.argv[1:]``.
+    renderer : scenarios.renderer.Renderer, optional
+        A plot process started before the model was imported (:mod:`scenarios.console`), used by
+        ``run``; ``None``: plots are drawn in this process.
 
     Returns
     -------
@@ -213,6 +217,7 @@ def main(argv: list[str] | None = None) -> int:
     """
     args = build_parser().parse_args(argv)
     args.interruption = Interruption()
+    args.renderer = renderer
     previous = (signal.signal(signal.SIGTERM, args.interruption)
                 if threading.current_thread() is threading.main_thread() else None)
     try:

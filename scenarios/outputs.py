@@ -21,6 +21,7 @@ import fcntl
 import json
 import os
 import shutil
+import sys
 import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Iterator
@@ -315,7 +316,26 @@ def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
     return new
 
 
-def write_results(results: RunResults, directory: str | Path, plots: bool = True) -> Path:
+def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer: Any) -> None:
+    """The run's figures into ``staging``: by the plot process if there is one, else (or if it
+    fails) in this process."""
+    from scenarios.plot_data import plot_jobs
+
+    jobs = plot_jobs(results, stems)
+    if renderer is not None:
+        from scenarios.renderer import RenderingFailed
+
+        try:
+            renderer.draw(jobs, staging)
+            return
+        except RenderingFailed as error:
+            print(f"slewbench: {error}; drawing the plots in this process", file=sys.stderr)
+    from scenarios.plots import draw_jobs
+
+    draw_jobs(jobs, staging)
+
+
+def write_results(results: RunResults, directory: str | Path, plots: bool = True, renderer: Any = None) -> Path:
     """Write ``results.json/csv/md``, ``timeseries/<row>.csv`` and the PNG plots into ``directory``.
 
     The directory is claimed first (:func:`claim_output_directory`); the files are staged inside
@@ -329,6 +349,9 @@ def write_results(results: RunResults, directory: str | Path, plots: bool = True
         The output directory.
     plots : bool, optional
         Also draw the PNG figures.
+    renderer : scenarios.renderer.Renderer, optional
+        A plot process to draw them (:mod:`scenarios.renderer`); if it fails, they are drawn in this
+        process after a one-line notice on stderr. ``None``: drawn in this process.
 
     Returns
     -------
@@ -348,8 +371,7 @@ def write_results(results: RunResults, directory: str | Path, plots: bool = True
             if row.simulation is not None:
                 write_timeseries(row, series / f"{stem}.csv")
         if plots:
-            from scenarios.plots import write_plots
-            write_plots(results, staging, stems)
+            _write_plots(results, staging, stems, renderer)
         commit_outputs(target, staging, kind="run")
     finally:
         shutil.rmtree(staging, ignore_errors=True)

@@ -1,39 +1,68 @@
 """Matplotlib (Agg) figures of a run: one PNG per row and one overlay comparing the rows.
 
+This is the drawing half: it draws the series of :mod:`scenarios.plot_data` (computed from the
+run) and imports nothing of the model, so that a separate process can draw while the run
+computes (:mod:`scenarios.renderer`). :func:`write_plots` does both halves in this process.
+
 Drawing is the largest cost of a run with plots, and nearly all of it is text (tick labels,
 legends, axis labels): lines and grids cost little. So it is kept cheap:
 
 * figures are plain ``matplotlib.figure.Figure`` objects (no pyplot state), laid out once with
   fixed margins (no ``tight_layout`` or ``bbox_inches="tight"``, which cost a draw each);
-* the per-row figure is built once per run and reused for every row of the same shape
+* the per-row figure is built once and reused for every row of the same shape
   (:class:`RowFigure`): what does not change between rows (frames, the shared time axis, axis
   labels, legends, placed beside the panels so that no curve is drawn over them) is drawn once and
   kept as a bitmap; each row then draws only its curves, its value axes and its title on a copy
   of that bitmap, which is written as the PNG without a second draw;
-* time series longer than a few points per pixel column are reduced to the minimum and maximum
-  of each column (:func:`decimate`), which draws the same picture, peaks included.
+* time series arrive decimated to the panels' pixel columns (:func:`scenarios.plot_data.decimate`).
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, MaxNLocator, NullLocator
 
-from ocp import quat
-from scenarios.outputs import row_stems
+from scenarios.plot_data import (
+    DPI,
+    OVERLAY_FIGSIZE_IN,
+    OVERLAY_MARGINS,
+    ROW_FIGSIZE_IN,
+    ROW_HEIGHT_NO_WHEELS_IN,
+    ROW_MARGINS,
+    ConeSeries,
+    OverlaySeries,
+    PlotJob,
+    RowSeries,
+    cone_series,
+    decimate,
+    overlay_series,
+    plot_jobs,
+)
+
+__all__ = [
+    "COMPRESS_LEVEL",
+    "DPI",
+    "LABEL_OFFSET_IN",
+    "SAVE",
+    "RowFigure",
+    "decimate",
+    "draw_cones",
+    "draw_jobs",
+    "draw_overlay",
+    "plot_cones",
+    "plot_overlay",
+    "write_plots",
+]
 
 AXIS_COLORS = ("tab:red", "tab:green", "tab:blue", "tab:purple")
-DPI = 90
 COMPRESS_LEVEL = 1
 """zlib level of the PNGs: level 1 encodes several times faster than the default 6 for ~20 % more bytes."""
 SAVE: dict[str, Any] = {"dpi": DPI, "pil_kwargs": {"compress_level": COMPRESS_LEVEL}}
 """``savefig`` options of the figures drawn once."""
-COLUMNS_PER_POINT = 2
-"""Series longer than this many points per pixel column of the panel are decimated."""
 
 
 def _log_axis(axis: Any) -> None:
@@ -69,45 +98,6 @@ def _time_axis(axis: Any) -> None:
     axis.xaxis.set_major_locator(MaxNLocator(nbins=7, steps=[1, 2, 2.5, 5, 10]))
 
 
-def _held(values: np.ndarray) -> np.ndarray:
-    """Zero-order-hold samples (one per interval) extended by the last one, for ``steps-post``."""
-    return np.concatenate([values, values[-1:]])
-
-
-def decimate(t: np.ndarray, values: np.ndarray, columns: int) -> tuple[np.ndarray, np.ndarray]:
-    """A time series reduced to what ``columns`` pixel columns can show.
-
-    Parameters
-    ----------
-    t : (N,) ndarray
-        Increasing times [s].
-    values : (N,) or (N, k) ndarray
-        Samples at ``t`` (columns decimated together, on the same times).
-    columns : int
-        Pixel columns the series spans.
-
-    Returns
-    -------
-    t, values : ndarray
-        Unchanged when ``N <= COLUMNS_PER_POINT * columns``; else, per bin of consecutive
-        samples (``columns`` bins), the samples at each column's minimum and maximum in time
-        order (for ``(N, k)`` values those of the first column, the others alongside), and the
-        last sample: the drawn envelope and every peak are those of the full series.
-    """
-    n = t.size
-    if n <= COLUMNS_PER_POINT * max(columns, 1):
-        return t, values
-    size = -(-n // columns)  # samples per bin
-    pad = size * columns - n
-    key = values if values.ndim == 1 else values[:, 0]
-    padded = np.concatenate([key, np.repeat(key[-1:], pad)]).reshape(columns, size)
-    start = np.arange(columns) * size
-    low = np.minimum(start + padded.argmin(axis=1), n - 1)
-    high = np.minimum(start + padded.argmax(axis=1), n - 1)
-    keep = np.unique(np.concatenate([[0, n - 1], low, high]))
-    return t[keep], values[keep]
-
-
 class RowFigure:
     """The per-row figure (torque, rate, quaternion, error angles, wheel momenta), built once and
     redrawn for each row of the same shape (module docstring).
@@ -123,10 +113,12 @@ class RowFigure:
     """
 
     def __init__(self, n_wheels: int, with_reference: bool, with_target: bool):
-        self.figure = Figure(figsize=(10, 13 if n_wheels else 10.5), dpi=DPI)
+        self.shape = (n_wheels, with_reference, with_target)
+        self.figure = Figure(figsize=(ROW_FIGSIZE_IN[0], ROW_FIGSIZE_IN[1] if n_wheels else ROW_HEIGHT_NO_WHEELS_IN),
+                             dpi=DPI)
         self.canvas = FigureCanvasAgg(self.figure)
         axes = self.figure.subplots(5 if n_wheels else 4, 1, sharex=True)
-        self.figure.subplots_adjust(left=0.1, right=0.855, bottom=0.05, top=0.95, hspace=0.08)  # before the labels
+        self.figure.subplots_adjust(**ROW_MARGINS)  # before the labels
         self.axes = axes
 
         def line(axis: Any, style: str = "-", **kw: Any) -> Any:
@@ -164,57 +156,42 @@ class RowFigure:
         self._background: tuple[tuple[float, float], Any] | None = None
 
     def _dynamic(self) -> list[Any]:
-        """What changes from row to row: value axes, curves, title."""
+        """What changes from row to row: value axes, curves, title, and the vertical spines (their
+        ends are placed through the value limits, so rounding can move a corner pixel)."""
         artists: list[Any] = []
         for axis in self.axes:
-            artists.append(axis.yaxis)
+            artists.extend([axis.yaxis, axis.spines["left"], axis.spines["right"]])
             artists.extend(axis.get_lines())
         artists.append(self.title)
         return artists
 
-    def draw(self, row: Any, target_q: Any, path: Path) -> None:
-        """Draw a row and write the PNG.
+    def draw(self, series: RowSeries, path: Path) -> None:
+        """Draw a row's curves and write the PNG.
 
         Parameters
         ----------
-        row : scenarios.runner.Row
-            A row with a simulation (and a reference unless regulating).
-        target_q : (4,) array_like or None
-            Target attitude (scalar-first quaternion, body to inertial) for the error angle.
+        series : scenarios.plot_data.RowSeries
+            The row's curves (:func:`scenarios.plot_data.row_series`), of this figure's shape.
         path : pathlib.Path
             Where to write the PNG.
         """
-        sim = row.simulation
-        columns = int(self.axes[0].bbox.width)
-        t = sim.t
-
-        def put(item: Any, values: np.ndarray) -> None:
-            item.set_data(*decimate(t, values, columns))
-
-        for i in range(3):
-            put(self.torque[i], _held(sim.applied_torque[:, i]))
-            put(self.rate[i], sim.omega[:, i])
-        for i in range(4):
-            put(self.quaternion[i], sim.q[:, i])
-        if self.reference is not None and self.to_reference is not None:
-            ref = row.reference.sample(t)
-            for lines, values in zip(self.reference, (ref.torque, ref.omega, ref.q)):
-                for i, item in enumerate(lines):
-                    put(item, values[:, i])
-            put(self.to_reference, np.maximum(np.rad2deg(quat.error_angle(sim.q, ref.q)), 1e-9))
-        if self.to_target is not None:
-            put(self.to_target, np.maximum(np.rad2deg(quat.error_angle(sim.q, target_q)), 1e-9))
-        if self.rate_norm is not None and self.rate_max is not None:
-            put(self.rate_norm, np.maximum(np.linalg.norm(sim.omega, axis=1), 1e-12))
-            put(self.rate_max, np.maximum(np.abs(sim.omega).max(axis=1), 1e-12))
-        for i, item in enumerate(self.wheels):
-            put(item, sim.wheel_momentum[:, i])
+        if series.shape != self.shape:
+            raise ValueError(f"a row of shape {series.shape} drawn on a figure of shape {self.shape}")
+        pairs = list(zip(self.torque + self.rate + self.quaternion + self.wheels,
+                         series.torque + series.rate + series.quaternion + series.wheels))
+        if self.reference is not None and series.reference is not None:
+            for items, curves in zip(self.reference, series.reference):
+                pairs.extend(zip(items, curves))
+        for item, curve in ((self.to_reference, series.to_reference), (self.to_target, series.to_target),
+                            (self.rate_norm, series.rate_norm), (self.rate_max, series.rate_max)):
+            if item is not None and curve is not None:
+                pairs.append((item, curve))
+        for item, curve in pairs:
+            item.set_data(*curve)
         for axis in self.axes:
             axis.relim()
             axis.autoscale_view()
-        controller = f", {row.controller}" if getattr(row, "controller", None) else ""
-        self.title.set_text(f"{row.label} ({row.planner or 'regulation'}{controller}): solid closed loop, "
-                            "dashed reference")
+        self.title.set_text(series.title)
         time_limits = tuple(self.axes[-1].get_xlim())
         canvas, dynamic = self.canvas, self._dynamic()
         if self._background is None or self._background[0] != time_limits:
@@ -241,40 +218,76 @@ def _write_png(canvas: FigureCanvasAgg, path: Path) -> None:
     image.save(path, format="png", dpi=(DPI, DPI), compress_level=COMPRESS_LEVEL)
 
 
-def plot_cones(row: Any, path: Path) -> None:
+def draw_cones(series: ConeSeries, path: Path) -> None:
     """Angle between each constrained boresight and its direction, closed loop and reference,
-    against the cone's limit (the planner's stats carry the cones as imposed, margin included).
+    against the cone's limit.
 
     Parameters
     ----------
-    row : scenarios.runner.Row
-        A row with a simulation and a reference whose ``stats["cones"]`` lists
-        ``(boresight (body), direction (inertial), angle [rad], keep_out)``.
+    series : scenarios.plot_data.ConeSeries
+        The curves (:func:`scenarios.plot_data.cone_series`).
     path : pathlib.Path
         Where to write the PNG.
     """
-    cones = row.reference.stats.get("cones", [])
-    sim = row.simulation
-    figure = Figure(figsize=(9, 3.2 * len(cones)))
-    axes = figure.subplots(len(cones), 1, squeeze=False)
-    reference_q = row.reference.q(sim.t)
-    for axis, (boresight, direction, angle, keep_out) in zip(axes[:, 0], cones):
-        for q, style, label in ((sim.q, "-", "closed loop"), (reference_q, "--", "reference")):
-            pointing = quat.rotate(q, np.asarray(boresight))
-            separation = np.rad2deg(np.arccos(np.clip(pointing @ np.asarray(direction), -1, 1)))
-            axis.plot(sim.t, separation, style, label=label)
-        axis.axhline(np.rad2deg(angle), color="r", lw=1, label=("keep-out" if keep_out else "keep-in") + " limit")
+    count = len(series.cones)
+    figure = Figure(figsize=(9, 3.2 * count))
+    axes = figure.subplots(count, 1, squeeze=False)
+    for axis, cone in zip(axes[:, 0], series.cones):
+        axis.plot(series.t, cone["closed_loop"], "-", label="closed loop")
+        axis.plot(series.t, cone["reference"], "--", label="reference")
+        axis.axhline(cone["limit_deg"], color="r", lw=1, label=("keep-out" if cone["keep_out"] else "keep-in") + " limit")
         axis.set_ylabel("boresight to direction (deg)")
         axis.grid(alpha=0.3)
         axis.legend(fontsize=8, loc="upper right")
     axes[-1, 0].set_xlabel("time (s)")
-    figure.suptitle(f"{row.label}: pointing constraints")
-    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.12 / len(cones), top=1 - 0.1 / len(cones), hspace=0.25)
+    figure.suptitle(series.title)
+    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.12 / count, top=1 - 0.1 / count, hspace=0.25)
     figure.savefig(path, **SAVE)
 
 
+def draw_overlay(series: OverlaySeries, path: Path) -> None:
+    """Torque norm, and the error to the target, one curve per row.
+
+    Parameters
+    ----------
+    series : scenarios.plot_data.OverlaySeries
+        The curves (:func:`scenarios.plot_data.overlay_series`).
+    path : pathlib.Path
+        Where to write the PNG.
+    """
+    figure = Figure(figsize=OVERLAY_FIGSIZE_IN)
+    top, bottom = figure.subplots(2, 1, sharex=True)
+    figure.subplots_adjust(**OVERLAY_MARGINS)  # before the labels
+    _log_axis(bottom)
+    for label, torque, error in zip(series.labels, series.torque, series.error):
+        top.plot(*torque, drawstyle="steps-post", label=label)
+        bottom.plot(*error, label=label)
+    _label(top, "‖u‖ (N m)")
+    _label(bottom, series.error_label)
+    for axis in (top, bottom):
+        axis.grid(alpha=0.3)
+    if top.get_lines():  # one legend: both panels have the same rows in the same colours
+        top.legend(fontsize=8, loc="upper right")
+    figure.suptitle(series.title)
+    _time_axis(bottom)
+    figure.savefig(path, **SAVE)
+
+
+def plot_cones(row: Any, path: Path) -> None:
+    """:func:`draw_cones` of :func:`scenarios.plot_data.cone_series` of ``row``.
+
+    Parameters
+    ----------
+    row : scenarios.runner.Row
+        A row with a simulation and a reference whose ``stats["cones"]`` lists the cones.
+    path : pathlib.Path
+        Where to write the PNG.
+    """
+    draw_cones(cone_series(row), path)
+
+
 def plot_overlay(results: Any, path: Path) -> None:
-    """Torque norm, and the error to the target attitude (to the target rate when the attitude is free).
+    """:func:`draw_overlay` of :func:`scenarios.plot_data.overlay_series` of ``results``.
 
     Parameters
     ----------
@@ -283,34 +296,30 @@ def plot_overlay(results: Any, path: Path) -> None:
     path : pathlib.Path
         Where to write the PNG.
     """
-    target_q, target_omega = results.scenario.problem.qf, results.scenario.problem.omegaf
-    figure = Figure(figsize=(9, 7))
-    top, bottom = figure.subplots(2, 1, sharex=True)
-    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.08, top=0.93, hspace=0.08)  # before the labels
-    _log_axis(bottom)
-    for row in results.rows:
-        if row.simulation is None:
-            continue
-        sim = row.simulation
-        norm = np.linalg.norm(sim.applied_torque, axis=1)
-        top.plot(sim.t, _held(norm), drawstyle="steps-post", label=row.label)
-        if target_q is not None:
-            error = np.rad2deg(quat.error_angle(sim.q, target_q))
-        elif target_omega is not None:
-            error = np.linalg.norm(sim.omega - target_omega, axis=1)
+    draw_overlay(overlay_series(results), path)
+
+
+def draw_jobs(jobs: list[PlotJob], directory: Path) -> None:
+    """Draw figures into ``directory``, reusing one :class:`RowFigure` per row shape.
+
+    Parameters
+    ----------
+    jobs : list of (str, series)
+        File names and their series (:func:`scenarios.plot_data.plot_jobs`).
+    directory : pathlib.Path
+        Existing directory to write into.
+    """
+    figures: dict[tuple[int, bool, bool], RowFigure] = {}
+    for name, series in jobs:
+        if isinstance(series, RowSeries):
+            figure = figures.get(series.shape) or figures.setdefault(series.shape, RowFigure(*series.shape))
+            figure.draw(series, directory / name)
         else:
-            error = np.linalg.norm(sim.omega, axis=1)
-        bottom.plot(sim.t, np.maximum(error, 1e-9), label=row.label)
-    _label(top, "‖u‖ (N m)")
-    _label(bottom, "error to target (deg)" if target_q is not None
-           else "‖ω − ω_f‖ (rad/s)" if target_omega is not None else "‖ω‖ (rad/s)")
-    for axis in (top, bottom):
-        axis.grid(alpha=0.3)
-    if top.get_lines():  # one legend: both panels have the same rows in the same colours
-        top.legend(fontsize=8, loc="upper right")
-    figure.suptitle(f"{results.scenario.name}: closed-loop comparison")
-    _time_axis(bottom)
-    figure.savefig(path, **SAVE)
+            DRAW[type(series)](series, directory / name)
+
+
+DRAW: dict[type, Callable[[Any, Path], None]] = {OverlaySeries: draw_overlay, ConeSeries: draw_cones}
+"""How each kind of series other than a row is drawn."""
 
 
 def write_plots(results: Any, directory: Path, stems: list[str] | None = None) -> None:
@@ -325,16 +334,4 @@ def write_plots(results: Any, directory: Path, stems: list[str] | None = None) -
     stems : list of str, optional
         The rows' file stems; ``None``: ``row_stems`` of the labels.
     """
-    target_q = results.scenario.problem.qf
-    stems = stems if stems is not None else row_stems([row.label for row in results.rows])
-    figures: dict[tuple[int, bool, bool], RowFigure] = {}  # one per row shape, reused
-    for row, stem in zip(results.rows, stems):
-        if row.simulation is None:
-            continue
-        shape = (row.simulation.wheel_momentum.shape[1], row.reference is not None, target_q is not None)
-        if shape not in figures:
-            figures[shape] = RowFigure(*shape)
-        figures[shape].draw(row, target_q, directory / f"{stem}.png")
-        if row.reference is not None and row.reference.stats.get("cones"):
-            plot_cones(row, directory / f"{stem}_cones.png")
-    plot_overlay(results, directory / "comparison.png")
+    draw_jobs(plot_jobs(results, stems), directory)

@@ -160,7 +160,7 @@ class RunResults:
         from scenarios.tables import to_dataframe
         return to_dataframe(self)
 
-    def write(self, directory: str | Path, plots: bool = True) -> None:
+    def write(self, directory: str | Path, plots: bool = True, renderer: Any = None) -> None:
         """Write results.json/csv/md, time series and plots atomically.
 
         Parameters
@@ -169,9 +169,11 @@ class RunResults:
             Output directory (created; slewbench never overwrites files it did not write).
         plots : bool, optional
             Also write the PNG figures.
+        renderer : scenarios.renderer.Renderer, optional
+            A plot process to draw them (``None``: drawn in this process).
         """
         from scenarios.outputs import write_results
-        write_results(self, directory, plots=plots)
+        write_results(self, directory, plots=plots, renderer=renderer)
 
 
 def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | None, row: Row,

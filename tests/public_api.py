@@ -143,7 +143,8 @@ def check_class(qualname: str, cls: type) -> list[str]:
             if missing:
                 problems.append(f"{qualname}: class docstring does not document constructor arguments {missing}")
     init = cls.__dict__.get("__init__")
-    if inspect.isfunction(init):
+    # An __init__ written elsewhere is not the class's (typing.Protocol installs its own).
+    if inspect.isfunction(init) and init.__module__ == cls.__module__:
         signature = _signature(init)
         for p in _parameters(signature, True) if signature else []:
             if p.annotation is inspect.Parameter.empty:

@@ -45,7 +45,7 @@ def edited(change):
 
 def test_run_end_to_end_through_the_console_entry_point(tmp_path):
     out = tmp_path / "out"
-    completed = subprocess.run([sys.executable, "-m", "scenarios.cli", "run", str(write(tmp_path, SMALL)),
+    completed = subprocess.run([sys.executable, "-m", "scenarios.console", "run", str(write(tmp_path, SMALL)),
                                 "--out", str(out)], capture_output=True, text=True, timeout=300)
     assert completed.returncode == 0, completed.stderr
     assert "[1/2] smooth: ok" in completed.stdout and "[2/2] fast: ok" in completed.stdout

@@ -8,7 +8,8 @@ from PIL import Image
 
 from ocp import quat
 from planners.base import ReferenceSample
-from scenarios.plots import RowFigure, decimate
+from scenarios.plot_data import decimate, row_series
+from scenarios.plots import RowFigure
 
 
 class Reference:
@@ -41,14 +42,17 @@ def pixels(path):
 
 
 def test_a_row_on_a_reused_figure_is_the_row_on_a_new_figure(tmp_path, rng):
+    """Every row, not only the second: the static part drawn once must not depend on the row's
+    values (the vertical spines' ends do, through the value limits: a corner pixel moved)."""
     target = quat.from_axis_angle([0, 0, 1], 1.0)
-    first, second = make_row(rng, "first", 1.0), make_row(rng, "second", 0.02)  # other scales, other ticks
+    rows = [make_row(rng, name, scale) for name, scale in (("first", 1.0), ("second", 0.02), ("third", 3.0))]
     reused = RowFigure(3, True, True)
-    reused.draw(first, target, tmp_path / "first.png")
-    reused.draw(second, target, tmp_path / "second_reused.png")
-    RowFigure(3, True, True).draw(second, target, tmp_path / "second_new.png")
-    np.testing.assert_array_equal(pixels(tmp_path / "second_reused.png"), pixels(tmp_path / "second_new.png"))
-    assert not np.array_equal(pixels(tmp_path / "first.png"), pixels(tmp_path / "second_new.png"))
+    for row in rows:
+        reused.draw(row_series(row, target), tmp_path / f"{row.label}_reused.png")
+        RowFigure(3, True, True).draw(row_series(row, target), tmp_path / f"{row.label}_new.png")
+        np.testing.assert_array_equal(pixels(tmp_path / f"{row.label}_reused.png"),
+                                      pixels(tmp_path / f"{row.label}_new.png"))
+    assert not np.array_equal(pixels(tmp_path / "first_new.png"), pixels(tmp_path / "second_new.png"))
 
 
 @pytest.mark.parametrize("n", [10, 1000, 100_003])

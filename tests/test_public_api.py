@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass
+from typing import Protocol
 
 import pytest
 
@@ -129,3 +130,39 @@ def test_audit_reports_each_breach(function, breach: str) -> None:  # type: igno
 
 def test_audit_reports_an_undocumented_dataclass_field() -> None:
     assert any("['gain']" in problem for problem in check_class("C", _UndocumentedField))
+
+
+class _Law(Protocol):
+    """What a caller needs of a law (typing.Protocol writes its own ``__init__``)."""
+
+    def command(self, t: float) -> float:
+        """The command at ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+
+        Returns
+        -------
+        float
+            Torque [N m].
+        """
+
+
+class _UntypedInit:
+    """A class whose own constructor lacks a hint.
+
+    Parameters
+    ----------
+    gain : float
+        Gain.
+    """
+
+    def __init__(self, gain):  # type: ignore[no-untyped-def]
+        self.gain = gain
+
+
+def test_audit_judges_the_constructor_a_class_writes_not_one_a_library_installs() -> None:
+    assert check_class("Law", _Law) == []
+    assert any("parameter 'gain' has no type hint" in problem for problem in check_class("C", _UntypedInit))

@@ -78,7 +78,7 @@ def _filled(command: str, scratch: Path) -> list[str]:
 def test_slewbench_command(command, tmp_path):
     (tmp_path / "scenarios").symlink_to(ROOT / "scenarios")
     args = _filled(command, tmp_path)
-    done = subprocess.run([sys.executable, "-m", "scenarios.cli", *args[1:]], cwd=tmp_path, env=_environment(),
+    done = subprocess.run([sys.executable, "-m", "scenarios.console", *args[1:]], cwd=tmp_path, env=_environment(),
                           capture_output=True, text=True, check=False, timeout=300)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     if args[1] == "run" and "--out" not in args:
