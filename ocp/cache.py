@@ -8,7 +8,8 @@ to each worker process, so a collocation NLP is built once per worker and struct
 """
 from __future__ import annotations
 
-from typing import Any, Callable, Hashable, TypeVar
+from collections.abc import Callable, Hashable
+from typing import Any, TypeVar
 
 V = TypeVar("V")
 

@@ -86,7 +86,8 @@ def solver_options(solver: str = "ipopt", tolerance: float = 1e-8, max_iteration
     return common
 
 
-def warm_start_options(solver: str = "ipopt", mu_init: float = 1e-6) -> dict[str, Any]:
+def warm_start_options(solver: str = "ipopt", mu_init: float = 1e-6, bound_push: float = 1e-9,
+                       mult_bound_push: float = 1e-9) -> dict[str, Any]:
     """Extra ``nlpsol`` options to start from a guess together with its multipliers.
 
     Parameters
@@ -95,6 +96,12 @@ def warm_start_options(solver: str = "ipopt", mu_init: float = 1e-6) -> dict[str
         ``"ipopt"`` (FATROP takes no multiplier warm start here: an empty dict).
     mu_init : float
         Initial barrier parameter: small, since the guess is already (nearly) optimal.
+    bound_push : float
+        How far (absolute and relative to the bounds' distance) the guess and its slacks are pushed
+        inside their bounds: tiny for the optimum of the same problem, larger for a guess from
+        another mesh whose active set may differ.
+    mult_bound_push : float
+        The least value of a bound multiplier at the start.
 
     Returns
     -------
@@ -103,11 +110,10 @@ def warm_start_options(solver: str = "ipopt", mu_init: float = 1e-6) -> dict[str
     """
     if solver != "ipopt":
         return {}
-    tiny = 1e-9
     return {"ipopt.warm_start_init_point": "yes", "ipopt.mu_init": mu_init,
-            "ipopt.warm_start_bound_push": tiny, "ipopt.warm_start_bound_frac": tiny,
-            "ipopt.warm_start_mult_bound_push": tiny, "ipopt.warm_start_slack_bound_push": tiny,
-            "ipopt.warm_start_slack_bound_frac": tiny}
+            "ipopt.warm_start_bound_push": bound_push, "ipopt.warm_start_bound_frac": bound_push,
+            "ipopt.warm_start_mult_bound_push": mult_bound_push, "ipopt.warm_start_slack_bound_push": bound_push,
+            "ipopt.warm_start_slack_bound_frac": bound_push}
 
 
 @dataclass

@@ -148,6 +148,17 @@ class RadauCollocation(Transcription):
         function = ca.Function("radau_interval", [s, c, t0, h, dist], [X[:, d], path, cost])
         return Interval(function, nx, c.numel(), lower, upper)
 
+    def positions(self, problem: OptimalControlProblem, interval: Interval) -> tuple[Array, Array]:
+        model, tau = problem.model, self.tau
+        slack = 3 if problem.uses_slack else 0  # per Radau point (_sizes)
+        c = np.concatenate([np.repeat(tau[1:], model.nx), np.repeat(tau[1:], model.nu), np.repeat(tau[1:], slack)])
+        # collocation equations and slack inequalities at the Radau points; cones at the node,
+        # the Radau points and the midpoints between them (the order of interval())
+        cone_points = np.concatenate([tau[:1], tau[1:], 0.5 * (tau[:-1] + tau[1:])])
+        path = np.concatenate([np.repeat(tau[1:], model.nx), np.repeat(tau[1:], 2 * slack),
+                               np.repeat(cone_points, len(problem.cones))])
+        return c, path
+
     def stage_bounds(self, problem: OptimalControlProblem, x_low: Array, x_high: Array, u_low: Array,
                      u_high: Array) -> tuple[Array, Array, Array, Array]:
         d = self.degree

@@ -72,6 +72,10 @@ class MultipleShooting(Transcription):
                                [ca.vertcat(state[:nx], u1), ca.DM.zeros(0, 1), state[nx]])
         return Interval(function, nx + nu, nu, np.zeros(0), np.zeros(0))
 
+    def positions(self, problem: OptimalControlProblem, interval: Interval) -> tuple[Array, Array]:
+        # c_k is the control at the interval's end; no path constraints
+        return np.ones(interval.n_interval), np.zeros(0)
+
     def stage_bounds(self, problem: OptimalControlProblem, x_low: Array, x_high: Array, u_low: Array,
                      u_high: Array) -> tuple[Array, Array, Array, Array]:
         return np.concatenate([x_low, u_low]), np.concatenate([x_high, u_high]), u_low, u_high

@@ -217,6 +217,25 @@ class Transcription(ABC):
             times where the dynamics are imposed.
         """
 
+    def positions(self, problem: OptimalControlProblem, interval: Interval) -> tuple[Array, Array]:
+        """Where the entries of ``c_k`` and of the path constraints sit in their interval.
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise.
+        interval : Interval
+            ``interval(problem)``.
+
+        Returns
+        -------
+        tuple of ndarray
+            ``(c_position (nc,), path_position (n_path,))``, fractions of the interval in [0, 1]
+            (used to carry multipliers between meshes, :mod:`ocp.mesh_transfer`); by default the
+            interval's midpoint.
+        """
+        return np.full(interval.n_interval, 0.5), np.full(interval.path_lower.size, 0.5)
+
     # -- the shared stage-wise assembly -------------------------------------------------------
     @staticmethod
     def terminal(problem: OptimalControlProblem, x_end: Any, qf: Any, omegaf: Any) -> list[Any]:
@@ -282,7 +301,12 @@ class Transcription(ABC):
             opts.update(jac_g=stages.jac_g, hess_lag=stages.hess_lag)
         nlp = {"x": stages.w, "p": stages.p, "f": stages.f, "g": stages.g}
         nlp_solver = ca.nlpsol(f"{self.name}_{solver}", solver, nlp, opts)
-        return NLP(nlp_solver, stages.w.numel(), unpack, lbg, ubg, problem.free_time, ns, nc)
+        c_position, path_position = self.positions(problem, interval)
+        if c_position.shape != (nc,) or path_position.shape != interval.path_lower.shape:
+            raise AssertionError(f"{self.name}: positions() does not match the interval's layout")
+        layout = {"n_path": interval.path_lower.size, "n_terminal": n_terminal, "c_position": c_position,
+                  "path_equality": interval.path_lower == interval.path_upper, "path_position": path_position}
+        return NLP(nlp_solver, stages.w.numel(), unpack, lbg, ubg, problem.free_time, ns, nc, layout)
 
     def bounds(self, problem: OptimalControlProblem, nlp: NLP, x_low: Array, x_high: Array, u_low: Array,
                u_high: Array, duration: float) -> tuple[Array, Array]:

@@ -11,7 +11,8 @@ NLP (IPOPT or FATROP) is built once per problem structure into the planner's ``S
 Starts: the reference of the ``warm_start`` planner (perturbed copies of it per ``multistart``)
 and the ``seed_planners``, solved by :func:`ocp.nlp.solve_multistart` (its status policy and early
 stopping); the best converged optimum is kept. With ``multistart: auto`` they are solved on
-``coarse_intervals`` first and the full mesh once from that optimum (see the option).
+``coarse_intervals`` first and the full mesh once from that optimum and its multipliers (see the
+option).
 """
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ from typing import Annotated, Literal
 
 import numpy as np
 
+from ocp.mesh_transfer import transfer_multipliers
 from ocp.nlp import (
     NLPResult,
     perturbed,
@@ -27,16 +29,20 @@ from ocp.nlp import (
     solver_options,
     warm_start_options,
 )
-from ocp.options import InvalidOption, OptionsError, Range, excerpt
+from ocp.options import InvalidOption, OptionsError, Range
 from ocp.transcription import (
     NLP,
     TRANSCRIPTIONS,
-    Cone,
     OptimalControlProblem,
     Transcription,
 )
 from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference
-from planners.collocation_reference import CollocationReference, seed_sampler
+from planners.collocation_problem import parse_cone, variable_bounds
+from planners.collocation_reference import (
+    CollocationReference,
+    seed_sampler,
+    solution_sampler,
+)
 
 AUTO_RESTART = 0.05
 """Relative perturbation of the restarts of ``multistart: auto`` when the final time is free."""
@@ -46,6 +52,31 @@ optimum: the seed is near the optimum, so the barrier need not start wide. N = 5
 the spin paper's minimum energy 7 iterations against 12, Bilimoria & Wie's minimum time 15
 against 18, the full-inertia minimum time 12 against 16 (same optima; 1e-6 takes 22-23 on the
 minimum-time cases, where the bounds are active)."""
+TRANSFER_WARM_START = {"mu_init": 1e-7, "bound_push": 1e-3, "mult_bound_push": 1e-4}
+"""IPOPT's warm start (:func:`ocp.nlp.warm_start_options`) of the full-mesh solve from a coarse-mesh
+optimum with its multipliers carried over (:mod:`ocp.mesh_transfer`); falls back to the start
+without multipliers (:data:`POLISH_MU_INIT`) if it does not converge. The guess is pushed 1e-3
+inside its bounds and the bound multipliers start at 1e-4 at least: the coarse active set is near,
+not at, the fine one. N = 50 from N = 8: the spin paper's minimum energy 4 iterations against 7,
+Bilimoria & Wie's minimum time 10 against 15, the full-inertia one 10 against 12 (same optima).
+Neighbouring values do about as well (mu_init 1e-8 to 1e-5, pushes 1e-4 to 1e-2: 24 to 29
+iterations over the three); a multiplier push of 1e-2 does not (34 to 41), nor IPOPT's tiny pushes
+of a same-mesh warm start (1e-9: 20 and 12 on the minimum-time cases)."""
+
+
+_Mode = Literal["cold", "warm", "near_optimum", "transfer"]
+
+
+@dataclass
+class _Optimum:
+    """What :meth:`CollocationPlanner._optimum` found: the solve, its extra stats, the transcription
+    and NLP it was solved on and their number of intervals."""
+
+    result: NLPResult
+    extra: dict
+    transcription: Transcription
+    nlp: NLP
+    intervals: int
 
 
 def _merged(first: NLPResult, second: NLPResult) -> NLPResult:
@@ -53,51 +84,6 @@ def _merged(first: NLPResult, second: NLPResult) -> NLPResult:
     best = None if second.best_start is None else second.best_start + len(first.starts)
     return replace(second, starts=first.starts + second.starts, iterations=first.iterations + second.iterations,
                    time_s=first.time_s + second.time_s, best_start=best)
-
-
-def _cone_vector(spec: dict, key: str, where: str) -> np.ndarray:
-    value = spec[key]
-    if (not isinstance(value, (list, tuple)) or len(value) != 3
-            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
-        raise InvalidOption(f"{where}.{key}", f"expected 3 numbers, got {excerpt(value)}")
-    vector = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(vector)) or not np.linalg.norm(vector) > 0:
-        raise InvalidOption(f"{where}.{key}", f"expected a finite non-zero vector, got {excerpt(value)}")
-    return vector / np.linalg.norm(vector)
-
-
-def parse_cone(spec: dict, keep_out: bool, margin: float = 0.0, where: str = "cone") -> Cone:
-    """A :class:`Cone` from ``{boresight, direction, angle_deg}``, tightened by ``margin`` (rad).
-
-    Parameters
-    ----------
-    spec : ``boresight`` (body axes) and ``direction`` (inertial) as 3-vectors, ``angle_deg`` the
-        cone's half-angle in degrees, in (0, 180).
-    keep_out : the boresight must stay outside (``True``) or inside (``False``) the cone.
-    margin : rad by which the cone is tightened.
-    where : the option's path (``keep_out[0]``) for error messages.
-
-    Returns
-    -------
-    Cone
-        The (tightened) cone, unit vectors, angle in rad.
-
-    Raises
-    ------
-    InvalidOption
-        Naming ``where`` and the offending key.
-    """
-    keys = {"boresight", "direction", "angle_deg"}
-    if not isinstance(spec, dict) or set(spec) != keys:
-        raise InvalidOption(where, f"a cone needs exactly the keys {sorted(keys)}, got {excerpt(spec)}")
-    boresight, direction = _cone_vector(spec, "boresight", where), _cone_vector(spec, "direction", where)
-    angle = spec["angle_deg"]
-    if not isinstance(angle, (int, float)) or isinstance(angle, bool) or not 0.0 < angle < 180.0:
-        raise InvalidOption(f"{where}.angle_deg", f"expected a number in (0, 180) degrees, got {excerpt(angle)}")
-    tightened = float(np.deg2rad(angle)) + (margin if keep_out else -margin)
-    if not 0.0 < tightened < np.pi:
-        raise InvalidOption(f"{where}.angle_deg", f"{angle} deg leaves no cone once tightened by cone_margin_deg")
-    return Cone(tuple(boresight), tuple(direction), tightened, keep_out)
 
 
 class CollocationPlanner(Planner):
@@ -146,8 +132,10 @@ class CollocationPlanner(Planner):
         coarse_intervals : int
             With ``multistart: auto``, the starts are first solved on this many intervals (for a
             free final time the whole multistart; for a fixed one only without cones and with at
-            least twice as many ``intervals``) and the full mesh is solved once from that optimum, IPOPT's barrier starting at 1e-4 (falling back to
-            the full-mesh solve from the starts); 0 or >= ``intervals``: off. Default 8.
+            least twice as many ``intervals``) and the full mesh is solved once from that optimum
+            and its multipliers carried over (IPOPT; falling back to that optimum alone with the
+            barrier starting at 1e-4, then to the full-mesh solve from the starts); 0 or >=
+            ``intervals``: off. Default 8.
         energy_weight, l1_weight, time_weight : float
             Weights of ``weighted`` [1/(N² m² s), 1/(N m s), 1/s].
         max_rate : float or None
@@ -171,19 +159,9 @@ class CollocationPlanner(Planner):
         warm_start: str = "eigenaxis"            # registered planner whose reference seeds the NLP
         warm_start_options: dict = field(default_factory=dict)  # its options, e.g. {profile: min_time}
         seed_planners: list[str] = field(default_factory=list)
-        # "auto": the warm start itself for a fixed final time; for a free final time (where a warm
-        # start can sit on a stationary point, e.g. the eigenaxis slew) a 1 % perturbed copy of it,
-        # then up to 4 restarts from the best point perturbed by 5 %, until one agrees with it.
-        # A number n > 0: n perturbed copies (1 %, then 5 %); 0: the warm start itself.
         multistart: Annotated[int | Literal["auto"], Range(ge=0, le=50)] = "auto"
         agree: Annotated[int, Range(ge=0, le=50)] = 2  # stop once this many starts agree on the best optimum (0: try all)
-        # min_time only: first solve min T + ε ∫‖τ‖² dt / Σ τ_max², ε this option (0: off), from
-        # the starts above, then polish plain minimum time from that optimum and its multipliers.
         time_regularization: Annotated[float, Range(ge=0.0, le=1.0)] = 0.0
-        # Multistart auto: the starts are first solved on this many intervals (a free final time:
-        # the multistart, escape and agreement; a fixed one without cones and with >= 2x as many
-        # intervals: a cheap seed), then the full mesh once from that optimum (falling back to the
-        # full-mesh solve from the starts if it does not converge). 0, or >= intervals: off.
         coarse_intervals: Annotated[int, Range(ge=0, le=2000)] = 8
         energy_weight: Annotated[float, Range(ge=0.0)] = 1.0               # for objective "weighted"
         l1_weight: Annotated[float, Range(ge=0.0)] = 0.0
@@ -235,20 +213,26 @@ class CollocationPlanner(Planner):
         return OptimalControlProblem(problem.model, *weights, free_time=weights[2] > 0,
                                      fixed_final_rate=problem.omegaf is not None, cones=cones)
 
-    def _nlp(self, problem: ManeuverProblem, ocp: OptimalControlProblem,
-             warm: bool = False, near_optimum: bool = False) -> tuple[Transcription, NLP]:
-        """The transcription and its built NLP for ``ocp`` (from the cache when built before);
-        ``warm``: solver options for a start with multipliers (:func:`ocp.nlp.warm_start_options`);
-        ``near_optimum``: IPOPT starts its barrier at :data:`POLISH_MU_INIT` (a seed near the optimum)."""
+    def _nlp(self, problem: ManeuverProblem, ocp: OptimalControlProblem, mode: _Mode = "cold",
+             intervals: int | None = None) -> tuple[Transcription, NLP]:
+        """The transcription on ``intervals`` (default the option) and its built NLP for ``ocp``
+        (from the cache when built before). ``mode``: the solver options of a start from a point
+        alone (``cold``), with its multipliers (``warm``, :func:`ocp.nlp.warm_start_options`), near
+        the optimum (``near_optimum``: IPOPT's barrier starts at :data:`POLISH_MU_INIT`) or with the
+        multipliers of a coarse-mesh optimum (``transfer``: :data:`TRANSFER_WARM_START`)."""
         o = self.options
-        transcription = TRANSCRIPTIONS[o.transcription].from_options(o)
-        near_optimum = near_optimum and o.solver == "ipopt"
+        intervals = o.intervals if intervals is None else intervals
+        if o.solver != "ipopt" and mode in ("near_optimum", "transfer"):
+            mode = "cold"
         key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
-               o.transcription, o.intervals, o.degree, o.substeps, o.solver, o.tolerance, o.max_iterations, warm,
-               near_optimum)
-        extra = warm_start_options(o.solver) if warm else {"ipopt.mu_init": POLISH_MU_INIT} if near_optimum else None
+               o.transcription, intervals, o.degree, o.substeps, o.solver, o.tolerance, o.max_iterations, mode)
+        extra = {"cold": None, "warm": warm_start_options(o.solver), "near_optimum": {"ipopt.mu_init": POLISH_MU_INIT},
+                 "transfer": warm_start_options(o.solver, **TRANSFER_WARM_START)}[mode]
 
         def build() -> tuple[Transcription, NLP]:
+            # the transcription is built here, once per entry (its constructor is not free)
+            same = intervals == o.intervals
+            transcription = TRANSCRIPTIONS[o.transcription].from_options(o if same else replace(o, intervals=intervals))
             return transcription, transcription.build(ocp, o.solver,
                                                       solver_options(o.solver, o.tolerance, o.max_iterations, extra))
 
@@ -257,26 +241,7 @@ class CollocationPlanner(Planner):
 
     def _variable_bounds(self, problem: ManeuverProblem) -> tuple[Array, Array, Array, Array]:
         """Per-point bounds of the model state and the actuator controls."""
-        spacecraft, model = problem.spacecraft, problem.model
-        x_low, x_high = np.full(model.nx, -np.inf), np.full(model.nx, np.inf)
-        x_low[0:4], x_high[0:4] = -1.5, 1.5
-        if self.options.max_rate is not None:
-            x_low[4:7], x_high[4:7] = -self.options.max_rate, self.options.max_rate
-        u_low, u_high = np.full(model.nu, -np.inf), np.full(model.nu, np.inf)
-        slices = model.control_slices
-        # Limits are arrays once the actuators are constructed (None becomes inf).
-        if spacecraft.wheels is not None:
-            momentum = np.asarray(spacecraft.wheels.max_momentum, dtype=float)
-            x_low[7:], x_high[7:] = -momentum, momentum
-            limit = np.where(spacecraft.wheels.working, np.asarray(spacecraft.wheels.max_torque, dtype=float), 0.0)
-            u_low[slices["wheels"]], u_high[slices["wheels"]] = -limit, limit
-        if spacecraft.magnetorquers is not None:
-            dipole = np.asarray(spacecraft.magnetorquers.max_dipole, dtype=float)
-            u_low[slices["dipole"]], u_high[slices["dipole"]] = -dipole, dipole
-        if spacecraft.torquers is not None:
-            torque = np.asarray(spacecraft.torquers.max_torque, dtype=float)
-            u_low[slices["torquers"]], u_high[slices["torquers"]] = -torque, torque
-        return x_low, x_high, u_low, u_high
+        return variable_bounds(problem, self.options.max_rate)
 
     def _starts(self, problem: ManeuverProblem) -> list[Reference]:
         from planners import PLANNERS
@@ -319,25 +284,27 @@ class CollocationPlanner(Planner):
         return replace(ocp, energy_weight=self.options.time_regularization / scale)
 
     def _solve(self, problem: ManeuverProblem, ocp: OptimalControlProblem, seeds: list[Array], params: Array,
-               bounds: tuple[Array, Array], near_optimum: bool = False) -> tuple[NLPResult, dict]:
-        """Solve ``ocp`` from ``seeds`` by the multistart policy; with ``time_regularization``, solve
-        the regularised problem so and polish plain minimum time from its optimum and multipliers.
-        ``near_optimum``: the seeds are near the optimum (see :meth:`_nlp`)."""
+               bounds: tuple[Array, Array], intervals: int, near_optimum: bool = False) -> tuple[NLPResult, dict]:
+        """Solve ``ocp`` on ``intervals`` from ``seeds`` by the multistart policy (``near_optimum``:
+        from the one seed given, near the optimum, see :meth:`_nlp`); with ``time_regularization``,
+        solve the regularised problem so and polish plain minimum time from its optimum and
+        multipliers."""
         o = self.options
-        guesses, fallback, restart = self._guesses(ocp, seeds)
+        guesses, fallback, restart = (seeds, [], 0.0) if near_optimum else self._guesses(ocp, seeds)
+        agree = 1 if near_optimum else o.agree
         lbx, ubx = bounds
         if not o.time_regularization:
-            _, nlp = self._nlp(problem, ocp, near_optimum=near_optimum)
+            _, nlp = self._nlp(problem, ocp, "near_optimum" if near_optimum else "cold", intervals)
             result = solve_multistart(nlp.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
-                                      agree=o.agree, restart=restart, fallback=fallback)
+                                      agree=agree, restart=restart, fallback=fallback)
             return result, {}
-        _, regular = self._nlp(problem, self._regularized(problem, ocp))
+        _, regular = self._nlp(problem, self._regularized(problem, ocp), intervals=intervals)
         first = solve_multistart(regular.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=regular.lbg, ubg=regular.ubg,
-                                 agree=o.agree, restart=restart, fallback=fallback)
+                                 agree=agree, restart=restart, fallback=fallback)
         extra = {"regularized": first.stats()}
         if first.x is None:
             return first, extra
-        _, polish = self._nlp(problem, ocp, warm=True)
+        _, polish = self._nlp(problem, ocp, "warm", intervals)
         result = solve_multistart(polish.solver, [first.x], p=params, lbx=lbx, ubx=ubx, lbg=polish.lbg,
                                   ubg=polish.ubg, agree=1, lam_x0=first.lam_x, lam_g0=first.lam_g)
         return result, extra
@@ -361,47 +328,78 @@ class CollocationPlanner(Planner):
 
     def _plan_from(self, problem: ManeuverProblem, starts: list[Reference]) -> Reference:
         """Plan from the given start references (see the module docstring)."""
-        o = self.options
         ocp = self._ocp(problem)
-        # The layout (bounds, seeds, unpack) is the same in every build: use the one solved first.
-        coarse_first = self._coarse(ocp) and not o.time_regularization
-        transcription, nlp = self._nlp(problem, ocp, warm=bool(o.time_regularization), near_optimum=coarse_first)
-        disturbance = problem.model.default_parameters
         omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf
-        params = np.concatenate([problem.initial_state, problem.qf, omegaf, [problem.duration], disturbance])
+        params = np.concatenate([problem.initial_state, problem.qf, omegaf, [problem.duration],
+                                 problem.model.default_parameters])
+        return self._reference(problem, ocp, params, self._optimum(problem, ocp, starts, params, self.options.intervals))
+
+    def _optimum(self, problem: ManeuverProblem, ocp: OptimalControlProblem, starts: list[Reference], params: Array,
+                 intervals: int) -> _Optimum:
+        """The best optimum on ``intervals`` from the starts (through the coarse mesh first, see
+        :meth:`_coarse`, when ``intervals`` is the option's)."""
+        o = self.options
+        coarse_first = intervals == o.intervals and self._coarse(ocp)
+        # The layout (bounds, seeds, unpack) is the same in every build: use the one solved first.
+        mode: _Mode = "warm" if o.time_regularization else "transfer" if coarse_first else "cold"
+        transcription, nlp = self._nlp(problem, ocp, mode, intervals)
         bounds = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
-        seeds = [transcription.seed(ocp, nlp, seed_sampler(problem, ref),
-                                    ref.duration if ocp.free_time else problem.duration) for ref in starts]
         result, extra = None, {}
-        if self._coarse(ocp):
+        if coarse_first:
             # On a coarse mesh, where an iteration costs a fraction: the escape from stationary
             # points and its confirmation (free T), or the long way from a far seed (fixed T); its
-            # optimum seeds one solve on the full mesh.
-            coarse = CollocationPlanner(replace(o, intervals=o.coarse_intervals, coarse_intervals=0), cache=self.cache)
-            found = coarse._plan_from(problem, starts)
+            # optimum (and its multipliers, carried to the full mesh) seeds one solve on the full mesh.
+            coarse = self._optimum(problem, ocp, starts, params, o.coarse_intervals)
+            found = self._reference(problem, ocp, params, coarse)
             extra["coarse"] = found.stats
             if found.ok:
-                single = replace(o, multistart=0, coarse_intervals=0)
-                seed = transcription.seed(ocp, nlp, seed_sampler(problem, found), found.duration)
-                result, more = CollocationPlanner(single, cache=self.cache)._solve(problem, ocp, [seed], params, bounds,
-                                                                                   near_optimum=True)
-                extra.update(more)
+                assert isinstance(found, CollocationReference)  # found.ok
+                seed = transcription.seed(ocp, nlp, solution_sampler(found), found.duration)
+                result = self._transferred(problem, ocp, coarse, seed, params, bounds)
+                if result is None or not result.success:
+                    polish, more = self._solve(problem, ocp, [seed], params, bounds, intervals, near_optimum=True)
+                    result = polish if result is None else _merged(result, polish)
+                    extra.update(more)
         if result is None or not result.success:
-            fine, more = self._solve(problem, ocp, seeds, params, bounds)
+            seeds = [transcription.seed(ocp, nlp, seed_sampler(problem, ref),
+                                        ref.duration if ocp.free_time else problem.duration) for ref in starts]
+            fine, more = self._solve(problem, ocp, seeds, params, bounds, intervals)
             result = fine if result is None else _merged(result, fine)
             extra.update(more)
+        return _Optimum(result, extra, transcription, nlp, intervals)
+
+    def _transferred(self, problem: ManeuverProblem, ocp: OptimalControlProblem, coarse: _Optimum, seed: Array,
+                     params: Array, bounds: tuple[Array, Array]) -> NLPResult | None:
+        """The full-mesh solve from ``seed`` with the coarse optimum's multipliers carried over
+        (:func:`ocp.mesh_transfer.transfer_multipliers`); ``None`` where that does not apply (FATROP,
+        ``time_regularization``, layouts that differ)."""
+        if self.options.solver != "ipopt" or self.options.time_regularization or coarse.result.lam_x is None:
+            return None
+        _, nlp = self._nlp(problem, ocp, "transfer")
+        assert coarse.result.lam_g is not None  # set with lam_x
+        multipliers = transfer_multipliers(coarse.nlp, nlp, coarse.result.lam_x, coarse.result.lam_g)
+        if multipliers is None:
+            return None
+        lbx, ubx = bounds
+        return solve_multistart(nlp.solver, [seed], p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg, agree=1,
+                                lam_x0=multipliers[0], lam_g0=multipliers[1])
+
+    def _reference(self, problem: ManeuverProblem, ocp: OptimalControlProblem, params: Array,
+                   solved: _Optimum) -> Reference:
+        """The reference (or the failure) of an optimum found by :meth:`_optimum`."""
+        o, result, transcription = self.options, solved.result, solved.transcription
         stats = result.stats()
-        stats.update(extra, transcription=transcription.name, intervals=o.intervals, solver=o.solver)
+        stats.update(solved.extra, transcription=transcription.name, intervals=solved.intervals, solver=o.solver)
         if not result.success:
             return FailedReference(self.name, f"{o.solver} did not converge from any start: "
                                    f"{sorted(set(result.statuses))}", result.status, stats=stats)
         assert result.x is not None  # success implies a point
-        T, states, controls = (v.full() for v in nlp.unpack(result.x, params))
+        T, states, controls = (v.full() for v in solved.nlp.unpack(result.x, params))
         T = T.item()
         reference = CollocationReference(problem, transcription, T, states, controls, stats)
         norm_error = float(np.max(np.abs(np.linalg.norm(states[0:4], axis=0) - 1)))
         reference.stats.update(duration=T, max_quaternion_norm_error=norm_error,
                                cones=[(c.boresight, c.direction, c.angle, c.keep_out) for c in ocp.cones])
-        reference.message = (f"{o.objective} by {transcription.name} (N={o.intervals}, {o.solver}): "
+        reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {o.solver}): "
                              f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}")
         return reference

@@ -127,3 +127,34 @@ def seed_sampler(problem: ManeuverProblem, reference: Reference) -> Callable[[Ar
         return x, u, np.abs(torque)
 
     return sample
+
+
+def solution_sampler(reference: CollocationReference) -> Callable[[Array], tuple[Array, Array, Array]]:
+    """The seed of a transcription along another transcription's solution, read natively.
+
+    Unlike :func:`seed_sampler`, the states and actuator controls are the solution's own,
+    interpolated by its transcription (no inverse dynamics, no mapping of the torque to the
+    actuators; the quaternion normalised as :meth:`Reference.sample` does): the seed of a fine
+    mesh from a coarse-mesh optimum of the same problem.
+
+    Parameters
+    ----------
+    reference : CollocationReference
+        The solution.
+
+    Returns
+    -------
+    callable
+        ``sample(times [s]) -> (x (n, nx), u (n, nu), |τ| (n, 3) [N m])``, τ the actuators' body
+        torque, times clipped to ``[0, T]``.
+    """
+    model = reference.model
+
+    def sample(times: Array) -> tuple[Array, Array, Array]:
+        t = np.clip(np.asarray(times, dtype=float), 0.0, reference.duration)
+        x, u = reference._state_control(t)
+        x[:, 0:4] = quat.normalize(x[:, 0:4])  # as Reference.sample does
+        torque = model.body_torque.map(t.size)(x.T, u.T, t).full().T
+        return x, u, np.abs(torque)
+
+    return sample

@@ -1,0 +1,80 @@
+"""Multipliers carried from a coarse mesh to a fine one (ocp.mesh_transfer) against the fine mesh's own."""
+import numpy as np
+import pytest
+
+from ocp import Spacecraft, Torquers, quat
+from ocp.mesh_transfer import transfer_multipliers
+from ocp.nlp import solve_multistart, solver_options
+from ocp.transcription import TRANSCRIPTIONS
+from planners import PLANNERS, ManeuverProblem
+from planners.collocation_reference import seed_sampler
+
+
+def bounded_single_axis():
+    # Rest to rest about x in 20 s: the unbounded minimum-energy torque 6 I θ (T − 2t)/T³ peaks at
+    # 0.075 N m, so |u| <= 0.06 N m is active near both ends (bound multipliers are not zero).
+    spacecraft = Spacecraft([5.0, 4.0, 3.0], torquers=Torquers(0.06))
+    return ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.from_axis_angle([1, 0, 0], 1.0), 20.0,
+                           omegaf=np.zeros(3))
+
+
+def solved(name, intervals):
+    problem = bounded_single_axis()
+    planner = PLANNERS["collocation"]({"intervals": intervals, "transcription": name})
+    ocp = planner._ocp(problem)
+    transcription = TRANSCRIPTIONS[name](intervals, *([3] if name == "collocation" else [4]))
+    nlp = transcription.build(ocp, "ipopt", solver_options("ipopt", 1e-12, 500))
+    lbx, ubx = transcription.bounds(ocp, nlp, *planner._variable_bounds(problem), problem.duration)
+    start = PLANNERS["eigenaxis"]().plan(problem)
+    seed = transcription.seed(ocp, nlp, seed_sampler(problem, start), problem.duration)
+    params = np.concatenate([problem.initial_state, problem.qf, np.zeros(3), [problem.duration],
+                             problem.model.default_parameters])
+    result = solve_multistart(nlp.solver, [seed], p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg, agree=1)
+    assert result.success, result.message
+    return nlp, result
+
+
+@pytest.mark.parametrize("name", sorted(TRANSCRIPTIONS))
+def test_transfer_onto_the_same_mesh_is_the_identity(name):
+    nlp, result = solved(name, 6)
+    lam_x, lam_g = transfer_multipliers(nlp, nlp, result.lam_x, result.lam_g)
+    np.testing.assert_allclose(lam_x, result.lam_x, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(lam_g, result.lam_g, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize("name", sorted(TRANSCRIPTIONS))
+def test_transferred_multipliers_approach_the_fine_mesh_multipliers(name):
+    # A second method: the fine mesh's own optimum. Constraint multipliers tend to the costate
+    # (mesh independent), bound multipliers to a density times h: without the h ratio (8 -> 32)
+    # the bound multipliers would be 4x too large (relative error 2.2-2.4 instead of 0.36-0.47, which
+    # comes from the ends of the active arcs: they move between the meshes).
+    coarse, coarse_result = solved(name, 8)
+    fine, fine_result = solved(name, 32)
+    lam_x, lam_g = transfer_multipliers(coarse, fine, coarse_result.lam_x, coarse_result.lam_g)
+    assert np.linalg.norm(fine_result.lam_x) > 1e-3  # the torque bound is active
+    for moved, exact, tolerance in ((lam_x, fine_result.lam_x, 0.6), (lam_g, fine_result.lam_g, 0.1)):
+        assert np.linalg.norm(moved - exact) < tolerance * np.linalg.norm(exact)
+
+
+def test_layouts_that_differ_beyond_the_mesh_are_refused():
+    nlp, result = solved("collocation", 6)
+    other, _ = solved("multiple_shooting", 6)
+    assert transfer_multipliers(nlp, other, result.lam_x, result.lam_g) is None
+
+
+def test_solution_sampler_reads_the_solution_as_the_reference_does():
+    # The native seed of a fine mesh (states and controls interpolated by the transcription) against
+    # the reference's own evaluation: with torquers only and no environment, the actuator torque is
+    # the reference's torque (inverse dynamics of the interpolated states).
+    from planners.collocation_reference import solution_sampler
+
+    problem = bounded_single_axis()
+    reference = PLANNERS["collocation"]({"intervals": 8}).plan(problem)
+    assert reference.status == "ok", reference.message
+    t = np.linspace(0.0, problem.duration, 37)
+    x, u, torque = solution_sampler(reference)(t)
+    sample = reference.sample(t)
+    np.testing.assert_allclose(x[:, 0:4], sample.q, atol=1e-12)
+    np.testing.assert_allclose(x[:, 4:7], sample.omega, atol=1e-12)
+    np.testing.assert_allclose(u, reference.control(t), atol=1e-12)
+    np.testing.assert_allclose(torque, np.abs(sample.torque), atol=1e-9)
