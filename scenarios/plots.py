@@ -86,8 +86,18 @@ def _label(axis: Any, text: str) -> None:
     distance_in = min(LABEL_OFFSET_IN, position.x0 * figure_width_in - 0.12)  # inside the figure
     axis.text(-distance_in / (position.width * figure_width_in), 0.5, text, rotation=90, ha="center", va="center",
               transform=axis.transAxes)
+    _fixed_axis_labels(axis)
     if axis.get_yscale() == "linear":
         axis.yaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
+
+
+def _fixed_axis_labels(axis: Any) -> None:
+    """Matplotlib's own axis labels placed once (they stay empty here, or are placed by
+    :func:`_time_axis`): a label placed automatically is re-placed at every draw after measuring the
+    tick labels of the panel and of every panel sharing its axis, about a fifth of a row's draw."""
+    axis.yaxis.set_label_coords(-0.1, 0.5)
+    if not axis.get_xlabel():
+        axis.xaxis.set_label_coords(0.5, -0.1)
 
 
 def _time_axis(axis: Any) -> None:
