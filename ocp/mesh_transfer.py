@@ -5,11 +5,13 @@ variables ``[s_k, c_k]`` and constraints ``[gap_k, path_k]``; each entry of a bl
 relative position ``r`` in its interval (``s_k`` at 0, ``gap_k`` at 1, a Radau point at ``τ_j``).
 As the mesh is refined the multipliers converge to functions of time, up to a known scale:
 
-* equality constraints that do not carry the step ``h`` (the gaps ``s_{k+1} − F(s_k, c_k)``, Radau's
-  ``X D_j − h f(x_j, u_j)``, the initial and terminal conditions): their multipliers tend to the
-  costate (times the quadrature weight, which is the same on both meshes), independent of ``h``;
-* bounds and path inequalities: their multipliers are a density times the quadrature weight times
-  ``h``, so they scale with ``h``.
+* equality constraints that do not carry the step ``h`` (the gaps ``s_{k+1} − F(s_k, c_k)`` of
+  integrated states, Radau's ``X D_j − h f(x_j, u_j)``, the initial and terminal conditions):
+  their multipliers tend to the costate (times the quadrature weight, which is the same on both
+  meshes), independent of ``h``;
+* bounds and path inequalities, and the gaps of copied interval variables (multiple shooting's
+  ``u_{k+1} = c_k``, ``Transcription.step_scaled_gaps``): their multipliers are a density times
+  the quadrature weight times ``h``, so they scale with ``h``.
 
 :func:`transfer_multipliers` resamples entry by entry, linearly in time (constant beyond the ends),
 and rescales by the ratio of the steps. The result is the warm start of a solve on the fine mesh
@@ -24,7 +26,7 @@ from numpy.typing import NDArray
 
 Array = NDArray[np.float64]
 
-LAYOUT_KEYS = ("n_path", "n_terminal", "path_equality", "c_position", "path_position")
+LAYOUT_KEYS = ("n_path", "n_terminal", "path_equality", "c_position", "path_position", "gap_step_scaled")
 """Entries of ``NLP.layout`` the transfer needs (written by ``Transcription.build``)."""
 
 
@@ -64,8 +66,8 @@ def transfer_multipliers(source: Any, target: Any, lam_x: Array, lam_g: Array) -
     ns, nc = target.n_stage_state, target.n_interval
     n_path, n_terminal = target.layout["n_path"], target.layout["n_terminal"]
     if (source.n_stage_state, source.n_interval, source.layout["n_path"], source.layout["n_terminal"]) != (
-            ns, nc, n_path, n_terminal) or not np.array_equal(source.layout["path_equality"],
-                                                              target.layout["path_equality"]):
+            ns, nc, n_path, n_terminal) or any(
+            not np.array_equal(source.layout[key], target.layout[key]) for key in ("path_equality", "gap_step_scaled")):
         return None
     nz, nb = ns + nc, ns + n_path
     n_source, n_target = (source.n_w - ns) // nz, (target.n_w - ns) // nz
@@ -80,7 +82,8 @@ def transfer_multipliers(source: Any, target: Any, lam_x: Array, lam_g: Array) -
     x_out = np.concatenate([np.hstack([S_new[:-1], C_new]).ravel(), S_new[-1]])
 
     rows = np.concatenate([lam_g[:nb], lam_g[nb + n_initial:nb + n_initial + (n_source - 1) * nb]]).reshape(n_source, nb)
-    gap_new = _resample(rows[:, :ns], np.ones(ns), n_source, n_target, n_target)
+    gap_scaled = np.asarray(target.layout["gap_step_scaled"], bool)
+    gap_new = _resample(rows[:, :ns], np.ones(ns), n_source, n_target, n_target) * np.where(gap_scaled, ratio, 1.0)[None, :]
     equality = np.asarray(target.layout["path_equality"], bool)
     path_new = _resample(rows[:, ns:], np.asarray(target.layout["path_position"], float), n_source, n_target,
                          n_target) * np.where(equality, 1.0, ratio)[None, :]

@@ -76,6 +76,11 @@ class MultipleShooting(Transcription):
         # c_k is the control at the interval's end; no path constraints
         return np.ones(interval.n_interval), np.zeros(0)
 
+    def step_scaled_gaps(self, problem: OptimalControlProblem, interval: Interval) -> Array:
+        # x_{k+1} = Φ(...): a costate; u_{k+1} = c_k: O(h) (the control's stationarity)
+        nx = problem.model.nx
+        return np.arange(interval.n_state) >= nx
+
     def stage_bounds(self, problem: OptimalControlProblem, x_low: Array, x_high: Array, u_low: Array,
                      u_high: Array) -> tuple[Array, Array, Array, Array]:
         return np.concatenate([x_low, u_low]), np.concatenate([x_high, u_high]), u_low, u_high

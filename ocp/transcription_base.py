@@ -236,6 +236,29 @@ class Transcription(ABC):
         """
         return np.full(interval.n_interval, 0.5), np.full(interval.path_lower.size, 0.5)
 
+    def step_scaled_gaps(self, problem: OptimalControlProblem, interval: Interval) -> Array:
+        """Which entries of the gap ``s_{k+1} − F(s_k, c_k)`` have multipliers that scale with the step.
+
+        The gap of a state that the dynamics integrate over the interval has a multiplier that tends
+        to the costate (independent of the step ``h``). The gap of a copy of an interval variable
+        (a control carried in the stage state, ``u_{k+1} = c_k``) balances that variable's
+        stationarity, whose terms (running cost, ``h f``, bound multipliers) are all ``O(h)``: its
+        multiplier scales with ``h`` (:mod:`ocp.mesh_transfer`).
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise.
+        interval : Interval
+            ``interval(problem)``.
+
+        Returns
+        -------
+        (interval.n_state,) ndarray of bool
+            ``True`` where the gap's multiplier scales with ``h``; by default none.
+        """
+        return np.zeros(interval.n_state, dtype=bool)
+
     # -- the shared stage-wise assembly -------------------------------------------------------
     @staticmethod
     def terminal(problem: OptimalControlProblem, x_end: Any, qf: Any, omegaf: Any) -> list[Any]:
@@ -304,8 +327,13 @@ class Transcription(ABC):
         c_position, path_position = self.positions(problem, interval)
         if c_position.shape != (nc,) or path_position.shape != interval.path_lower.shape:
             raise AssertionError(f"{self.name}: positions() does not match the interval's layout")
+        scaled = self.step_scaled_gaps(problem, interval)
+        if scaled.shape != (ns0,):
+            raise AssertionError(f"{self.name}: step_scaled_gaps() does not match the stage state")
         layout = {"n_path": interval.path_lower.size, "n_terminal": n_terminal, "c_position": c_position,
-                  "path_equality": interval.path_lower == interval.path_upper, "path_position": path_position}
+                  "path_equality": interval.path_lower == interval.path_upper, "path_position": path_position,
+                  # T's continuity T_{k+1} = T_k (free T): a running sum of O(1/N) terms, not scaled
+                  "gap_step_scaled": np.append(scaled, np.zeros(ns - ns0, dtype=bool))}
         return NLP(nlp_solver, stages.w.numel(), unpack, lbg, ubg, problem.free_time, ns, nc, layout)
 
     def bounds(self, problem: OptimalControlProblem, nlp: NLP, x_low: Array, x_high: Array, u_low: Array,
