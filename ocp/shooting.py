@@ -14,6 +14,7 @@ from typing import Any
 
 import casadi as ca
 import numpy as np
+from numpy.typing import NDArray
 
 from ocp.integration import rk4_step
 from ocp.model import AttitudeModel
@@ -76,7 +77,7 @@ class MultipleShooting(Transcription):
         # c_k is the control at the interval's end; no path constraints
         return np.ones(interval.n_interval), np.zeros(0)
 
-    def step_scaled_gaps(self, problem: OptimalControlProblem, interval: Interval) -> Array:
+    def step_scaled_gaps(self, problem: OptimalControlProblem, interval: Interval) -> NDArray[np.bool_]:
         # x_{k+1} = Φ(...): a costate; u_{k+1} = c_k: O(h) (the control's stationarity)
         nx = problem.model.nx
         return np.arange(interval.n_state) >= nx

@@ -236,7 +236,7 @@ class Transcription(ABC):
         """
         return np.full(interval.n_interval, 0.5), np.full(interval.path_lower.size, 0.5)
 
-    def step_scaled_gaps(self, problem: OptimalControlProblem, interval: Interval) -> Array:
+    def step_scaled_gaps(self, problem: OptimalControlProblem, interval: Interval) -> NDArray[np.bool_]:
         """Which entries of the gap ``s_{k+1} − F(s_k, c_k)`` have multipliers that scale with the step.
 
         The gap of a state that the dynamics integrate over the interval has a multiplier that tends
