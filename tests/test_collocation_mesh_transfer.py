@@ -18,11 +18,12 @@ def bounded_single_axis():
                            omegaf=np.zeros(3))
 
 
-def solved(name, intervals):
+def solved(name, intervals, order=None):
     problem = bounded_single_axis()
     planner = PLANNERS["collocation"]({"intervals": intervals, "transcription": name})
     ocp = planner._ocp(problem)
-    transcription = TRANSCRIPTIONS[name](intervals, *([3] if name == "collocation" else [4]))
+    order = order if order is not None else 3 if name == "collocation" else 4  # degree or substeps
+    transcription = TRANSCRIPTIONS[name](intervals, order)
     nlp = transcription.build(ocp, "ipopt", solver_options("ipopt", 1e-12, 500))
     lbx, ubx = transcription.bounds(ocp, nlp, *planner._variable_bounds(problem), problem.duration)
     start = PLANNERS["eigenaxis"]().plan(problem)
@@ -80,23 +81,26 @@ def test_solution_sampler_reads_the_solution_as_the_reference_does():
     np.testing.assert_allclose(torque, np.abs(sample.torque), atol=1e-9)
 
 
-@pytest.mark.parametrize("name", sorted(TRANSCRIPTIONS))
-def test_every_gap_entry_has_the_fine_mesh_scale(name):
-    # Entry by entry, not in one norm (where the costate gaps, O(1), hide the small ones): each gap
-    # row's carried multipliers against the fine mesh's own (a second solve, independent of the
-    # transfer). Multiple shooting's control gaps u_{k+1} = c_k balance the control's O(h)
-    # stationarity: left unscaled from 8 to 32 intervals they were 5.4x too large (now 1.35x;
-    # the costate gaps 0.97-1.02x, the rest is the active arcs' ends moving between meshes).
-    coarse, coarse_result = solved(name, 8)
-    fine, fine_result = solved(name, 32)
+@pytest.mark.parametrize("name, order", [("collocation", d) for d in range(1, 6)] + [("multiple_shooting", 4)])
+def test_every_equality_entry_has_the_fine_mesh_scale(name, order):
+    # Entry by entry, not in one norm (where the costate gaps, O(1), hide the small ones): each
+    # column of the stage blocks (a gap entry, a collocation equation at one Radau point) carried
+    # from 8 to 32 intervals against the fine mesh's own multipliers (a second solve, independent
+    # of the transfer), for Radau of every degree. Multiple shooting's control gaps
+    # u_{k+1} = c_k balance the control's O(h) stationarity: left unscaled they were 5.4x too
+    # large (now 1.35x; the costate entries 0.93-1.12x, the rest is the active arcs' ends moving
+    # between the meshes).
+    coarse, coarse_result = solved(name, 8, order)
+    fine, fine_result = solved(name, 32, order)
     _, lam_g = transfer_multipliers(coarse, fine, coarse_result.lam_x, coarse_result.lam_g)
-    ns, nb = fine.n_stage_state, fine.n_stage_state + fine.layout["n_path"]
+    nb = fine.n_stage_state + fine.layout["n_path"]
     n_initial = len(fine.lbg) - 32 * nb - fine.layout["n_terminal"]
-    rows = np.concatenate([np.arange(nb), nb + n_initial + np.arange(31 * nb)]).reshape(32, nb)[:, :ns]
+    rows = np.concatenate([np.arange(nb), nb + n_initial + np.arange(31 * nb)]).reshape(32, nb)
+    equality = np.concatenate([np.ones(fine.n_stage_state, bool), fine.layout["path_equality"]])
     checked = 0
-    for entry in range(ns):
-        exact = np.linalg.norm(fine_result.lam_g[rows[:, entry]])
+    for column in np.flatnonzero(equality):
+        exact = np.linalg.norm(fine_result.lam_g[rows[:, column]])
         if exact > 1e-6:
             checked += 1
-            assert 0.6 < np.linalg.norm(lam_g[rows[:, entry]]) / exact < 1.6, entry
-    assert checked >= 3
+            assert 0.6 < np.linalg.norm(lam_g[rows[:, column]]) / exact < 1.6, column
+    assert checked >= 3 * (order if name == "collocation" else 1)
