@@ -354,9 +354,13 @@ class CollocationPlanner(Planner):
             extra["coarse"] = found.stats
             if found.ok:
                 assert isinstance(found, CollocationReference)  # found.ok
-                seed = transcription.seed(ocp, nlp, solution_sampler(found), found.duration)
-                result = self._transferred(problem, ocp, coarse, seed, params, bounds)
+                result = self._transferred(problem, ocp, coarse, found, params, bounds)
                 if result is None or not result.success:
+                    # Without multipliers, the seed POLISH_MU_INIT was tuned on: the coarse optimum
+                    # through the inverse dynamics. Its own controls (a bang-bang arc's polynomial
+                    # overshoots the bounds between the Radau points, up to 55 % on two wheels) took
+                    # the two-wheel regularised solve 61 iterations instead of 31.
+                    seed = transcription.seed(ocp, nlp, seed_sampler(problem, found), found.duration)
                     polish, more = self._solve(problem, ocp, [seed], params, bounds, intervals, near_optimum=True)
                     result = polish if result is None else _merged(result, polish)
                     extra.update(more)
@@ -368,19 +372,21 @@ class CollocationPlanner(Planner):
             extra.update(more)
         return _Optimum(result, extra, transcription, nlp, intervals)
 
-    def _transferred(self, problem: ManeuverProblem, ocp: OptimalControlProblem, coarse: _Optimum, seed: Array,
-                     params: Array, bounds: tuple[Array, Array]) -> NLPResult | None:
-        """The full-mesh solve from ``seed`` with the coarse optimum's multipliers carried over
-        (:func:`ocp.mesh_transfer.transfer_multipliers`); ``None`` where that does not apply (FATROP,
-        ``time_regularization``, layouts that differ)."""
+    def _transferred(self, problem: ManeuverProblem, ocp: OptimalControlProblem, coarse: _Optimum,
+                     found: CollocationReference, params: Array, bounds: tuple[Array, Array]) -> NLPResult | None:
+        """The full-mesh solve from the coarse optimum ``found`` (its own states and controls, read
+        by :func:`~planners.collocation_reference.solution_sampler`) with its multipliers carried
+        over (:func:`ocp.mesh_transfer.transfer_multipliers`); ``None`` where that does not apply
+        (FATROP, ``time_regularization``, layouts that differ)."""
         if self.options.solver != "ipopt" or self.options.time_regularization or coarse.result.lam_x is None:
             return None
-        _, nlp = self._nlp(problem, ocp, "transfer")
+        transcription, nlp = self._nlp(problem, ocp, "transfer")
         assert coarse.result.lam_g is not None  # set with lam_x
         multipliers = transfer_multipliers(coarse.nlp, nlp, coarse.result.lam_x, coarse.result.lam_g)
         if multipliers is None:
             return None
         lbx, ubx = bounds
+        seed = transcription.seed(ocp, nlp, solution_sampler(found), found.duration)
         return solve_multistart(nlp.solver, [seed], p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg, agree=1,
                                 lam_x0=multipliers[0], lam_g0=multipliers[1])
 
