@@ -36,18 +36,24 @@ With ``restart > 0``, after the given guesses (once one has converged) come copi
 so far perturbed by ``restart`` (relative), at most ``max_restarts`` of them. From a local minimum
 such a restart comes back in a few iterations (and confirms it, which stops the search); from a
 saddle or other stationary point (the eigenaxis slew for minimum time) it leaves for a better
-point, which then becomes the best and is checked in turn.
+point, which then becomes the best and is checked in turn. With ``second_order``, the best point is
+first checked by the second-order sufficient conditions (:mod:`ocp.second_order`): a point that
+satisfies them is a strict local minimum, which is what a restart would confirm, so the restarts
+are skipped; a point that does not (a saddle, or a degenerate minimum the check cannot certify) gets
+the restarts as before.
 """
 from __future__ import annotations
 
 import time
 from collections.abc import Iterable, Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
+
+from ocp.nlp_result import NLPResult, StartResult
+from ocp.second_order import SecondOrderCheck, second_order_check
 
 Array = NDArray[np.float64]
 
@@ -116,96 +122,6 @@ def warm_start_options(solver: str = "ipopt", mu_init: float = 1e-6, bound_push:
             "ipopt.warm_start_slack_bound_frac": bound_push}
 
 
-@dataclass
-class StartResult:
-    """One start of :func:`solve_multistart`.
-
-    Parameters
-    ----------
-    status : str
-        The solver's return status (e.g. IPOPT ``Solve_Succeeded``).
-    f : float
-        Objective at the point where the start stopped (the problem's units).
-    iterations : int
-        Solver iterations of this start.
-    time_s : float
-        Wall time of this start [s].
-    violation : float
-        Largest constraint violation at that point (constraint units).
-    converged : bool
-        Whether the module's status policy accepts the start.
-    """
-
-    status: str
-    f: float
-    iterations: int
-    time_s: float
-    violation: float
-    converged: bool
-
-
-@dataclass
-class NLPResult:
-    """The outcome of :func:`solve_multistart` (attributes as in ``scipy.optimize.OptimizeResult``).
-
-    Parameters
-    ----------
-    x : ndarray or None
-        The best converged decision vector, or ``None``.
-    f : float
-        Its objective (``inf`` without one).
-    g : ndarray or None
-        Its constraint values, or ``None``.
-    success : bool
-        A start converged (see the module's status policy).
-    status : str
-        ``"ok"``, ``"failed"`` or ``"infeasible"`` (the planners' statuses).
-    message : str
-        A human-readable summary.
-    iterations : int
-        Solver iterations over all starts.
-    time_s : float
-        Wall time of all starts [s].
-    best_start : int or None
-        Index of the winning start, or ``None``.
-    starts : list of StartResult
-        Per-start outcomes, in the order tried.
-    lam_x, lam_g : ndarray or None
-        Bound and constraint multipliers at ``x`` (``None`` without a converged start).
-    """
-
-    x: Array | None
-    f: float
-    g: Array | None
-    success: bool
-    status: str
-    message: str
-    iterations: int
-    time_s: float
-    best_start: int | None
-    starts: list[StartResult] = field(default_factory=list)
-    lam_x: Array | None = None
-    lam_g: Array | None = None
-
-    @property
-    def statuses(self) -> list[str]:
-        """The solver status of every start, in order."""
-        return [s.status for s in self.starts]
-
-    def stats(self) -> dict[str, Any]:
-        """A planner's ``stats`` entries.
-
-        Returns
-        -------
-        dict
-            ``objective``, ``iterations``, ``solver_status`` (list), ``solve_time_s`` [s],
-            ``best_start`` and ``starts`` (one dict per start, fields of :class:`StartResult`).
-        """
-        return {"objective": self.f, "iterations": self.iterations, "solver_status": self.statuses,
-                "solve_time_s": self.time_s, "best_start": self.best_start,
-                "starts": [vars(s) for s in self.starts]}
-
-
 def violation(g: Array, lbg: Any, ubg: Any) -> float:
     """Largest violation of ``lbg <= g <= ubg``.
 
@@ -254,7 +170,8 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
                      ubx: Any = None, lbg: Any = None, ubg: Any = None, agree: int = 2, rtol: float = 1e-6,
                      atol: float = 1e-12, feasibility_tolerance: float = 1e-8,
                      max_starts: int | None = None, restart: float = 0.0, max_restarts: int = 4,
-                     fallback: Sequence[Array] = (), lam_x0: Any = None, lam_g0: Any = None) -> NLPResult:
+                     fallback: Sequence[Array] = (), lam_x0: Any = None, lam_g0: Any = None,
+                     second_order: bool = False) -> NLPResult:
     """Solve from each guess in turn, keep the best converged start, stop early on agreement.
 
     Parameters
@@ -282,6 +199,9 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         Guesses tried after ``guesses`` only while no start has converged.
     lam_x0, lam_g0 : array_like or None
         Initial bound and constraint multipliers passed with every guess (``None``: zeros).
+    second_order : bool
+        Before the restarts, check the best point by the second-order sufficient conditions and
+        skip the restarts when it satisfies them (see the module docstring).
 
     Returns
     -------
@@ -299,6 +219,7 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
     g_high = np.inf if ubg is None else ubg
     best: dict[str, Any] = {}
     best_f, best_index = np.inf, None
+    checks: dict[int, SecondOrderCheck] = {}
     starts: list[StartResult] = []
     objectives: list[float] = []
     begin = time.perf_counter()
@@ -313,6 +234,13 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
                 break
             yield guess
         for k in range(max_restarts if restart > 0 and best else 0):
+            if second_order:
+                assert best_index is not None  # set with best
+                if best_index not in checks:
+                    checks[best_index] = second_order_check(solver, best["x"], best["lam_x"], best["lam_g"],
+                                                            p=p, lbx=low, ubx=high, lbg=g_low, ubg=g_high)
+                if checks[best_index].certified:
+                    break
             yield perturbed(best["x"], 1, seed=k + 1, scales=(restart, restart))[0]
 
     for index, guess in enumerate(candidates()):
@@ -344,11 +272,14 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         message = f"no start converged: {sorted(set(statuses))}"
         return NLPResult(None, np.inf, None, False, status, message, iterations, total, None, starts)
     message = f"objective {best_f:.8g} from start {best_index} of {len(starts)} tried ({statuses[best_index]})"
+    if best_index in checks:
+        message += f"; second order: {checks[best_index].message}"
     return NLPResult(best["x"], best_f, best["g"], True, "ok", message, iterations, total, best_index, starts,
-                     best["lam_x"], best["lam_g"])
+                     best["lam_x"], best["lam_g"], checks.get(best_index))
 
 
-def perturbed(center: Array, count: int, seed: int = 0, scales: Sequence[float] = (0.01, 0.05)) -> list[Array]:
+def perturbed(center: Array, count: int, seed: int = 0, scales: Sequence[float] = (0.01, 0.05),
+              floor: Array | float = 1e-3) -> list[Array]:
     """Copies of a point with relative normal noise.
 
     Parameters
@@ -361,7 +292,11 @@ def perturbed(center: Array, count: int, seed: int = 0, scales: Sequence[float] 
         Seed of the random generator (the copies are reproducible).
     scales : (2,) sequence of float
         Relative noise of the first copy and of the others; the noise of a component is
-        proportional to ``|center| + 1e-3``.
+        proportional to ``|center| + floor``.
+    floor : float or ndarray
+        Added to ``|center|`` (per component when an array): the size of the noise where the
+        point is zero, e.g. half a control's range, so that a symmetric point (zero torques and
+        rates about two axes) is left in every direction.
 
     Returns
     -------
@@ -369,6 +304,6 @@ def perturbed(center: Array, count: int, seed: int = 0, scales: Sequence[float] 
         ``count`` perturbed copies of ``center``.
     """
     rng = np.random.default_rng(seed)
-    size = np.abs(center) + 1e-3
+    size = np.abs(center) + floor
     return [center + rng.normal(0.0, 1.0, center.size) * size * (scales[0] if k == 0 else scales[1])
             for k in range(count)]

@@ -43,26 +43,14 @@ from planners.collocation_reference import (
     seed_sampler,
     solution_sampler,
 )
-
-AUTO_RESTART = 0.05
-"""Relative perturbation of the restarts of ``multistart: auto`` when the final time is free."""
-POLISH_MU_INIT = 1e-4
-"""IPOPT's initial barrier parameter (its default 0.1) for the full-mesh solve from a coarse-mesh
-optimum: the seed is near the optimum, so the barrier need not start wide. N = 50 from N = 8:
-the spin paper's minimum energy 7 iterations against 12, Bilimoria & Wie's minimum time 15
-against 18, the full-inertia minimum time 12 against 16 (same optima; 1e-6 takes 22-23 on the
-minimum-time cases, where the bounds are active)."""
-TRANSFER_WARM_START = {"mu_init": 1e-7, "bound_push": 1e-3, "mult_bound_push": 1e-4}
-"""IPOPT's warm start (:func:`ocp.nlp.warm_start_options`) of the full-mesh solve from a coarse-mesh
-optimum with its multipliers carried over (:mod:`ocp.mesh_transfer`); falls back to the start
-without multipliers (:data:`POLISH_MU_INIT`) if it does not converge. The guess is pushed 1e-3
-inside its bounds and the bound multipliers start at 1e-4 at least: the coarse active set is near,
-not at, the fine one. N = 50 from N = 8: the spin paper's minimum energy 4 iterations against 7,
-Bilimoria & Wie's minimum time 10 against 15, the full-inertia one 10 against 12 (same optima).
-Neighbouring values do about as well (mu_init 1e-8 to 1e-5, pushes 1e-4 to 1e-2: 24 to 29
-iterations over the three); a multiplier push of 1e-2 does not (34 to 41), nor IPOPT's tiny pushes
-of a same-mesh warm start (1e-9: 20 and 12 on the minimum-time cases)."""
-
+from planners.collocation_strategy import (
+    AUTO_FIRST,
+    AUTO_RESTART,
+    POLISH_MU_INIT,
+    TRANSFER_WARM_START,
+    control_floor,
+    merged,
+)
 
 _Mode = Literal["cold", "warm", "near_optimum", "transfer"]
 
@@ -77,13 +65,6 @@ class _Optimum:
     transcription: Transcription
     nlp: NLP
     intervals: int
-
-
-def _merged(first: NLPResult, second: NLPResult) -> NLPResult:
-    """``second`` with the starts, iterations and time of ``first`` (which failed) counted first."""
-    best = None if second.best_start is None else second.best_start + len(first.starts)
-    return replace(second, starts=first.starts + second.starts, iterations=first.iterations + second.iterations,
-                   time_s=first.time_s + second.time_s, best_start=best)
 
 
 class CollocationPlanner(Planner):
@@ -119,10 +100,11 @@ class CollocationPlanner(Planner):
         seed_planners : list of str
             Further planners whose references are starts.
         multistart : int or "auto"
-            ``auto`` (default): for a free final time a 1 % perturbed copy of the warm start, then
-            restarts from the best point perturbed by 5 % until one agrees with it (the warm start
-            itself if the copy does not converge); for a fixed final time the warm start. n > 0: n
-            perturbed copies; 0: the warm start itself.
+            ``auto`` (default): for a free final time a perturbed copy of the warm start
+            (:data:`AUTO_FIRST`), then, unless its optimum satisfies the second-order sufficient
+            conditions (:mod:`ocp.second_order`), restarts from the best point perturbed by 5 %
+            until one agrees with it (the warm start itself if the copy does not converge); for a
+            fixed final time the warm start. n > 0: n perturbed copies; 0: the warm start itself.
         agree : int
             Stop once this many starts agree on the best objective (0: try all).
         time_regularization : float
@@ -255,7 +237,8 @@ class CollocationPlanner(Planner):
                 starts.append(reference)
         return starts
 
-    def _guesses(self, ocp: OptimalControlProblem, seeds: list[Array]) -> tuple[list[Array], list[Array], float]:
+    def _guesses(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
+                 seeds: list[Array]) -> tuple[list[Array], list[Array], float]:
         """The starts (the warm start or its perturbed copies, then the seed planners' starts), the
         fallback starts (tried only if none of those converged) and the relative size of the
         restarts from the best point (0: none)."""
@@ -263,11 +246,14 @@ class CollocationPlanner(Planner):
         if count == "auto":
             # A warm start can sit exactly on a stationary point (the eigenaxis slew is one for minimum
             # time with per-axis torque bounds: IPOPT stays there, 3.5449 in 191 iterations against
-            # 3.2431 for Bilimoria & Wie's slew). A 1 % copy of it, then 5 % restarts from the best
-            # point until one comes back to it, escape such points at about 1.3 solves; the warm start
-            # itself is the fallback when its perturbed copy does not converge.
+            # 3.2431 for Bilimoria & Wie's slew). A perturbed copy of it (AUTO_FIRST), then 5 %
+            # restarts from the best point unless it satisfies the second-order conditions (a saddle
+            # does not), escape such points; the warm start itself is the fallback when its
+            # perturbed copy does not converge.
             if ocp.free_time:
-                return perturbed(seeds[0], 1) + seeds[1:], seeds[:1], AUTO_RESTART
+                floor = control_floor(transcription, ocp, nlp, *self._variable_bounds(problem)[2:])
+                first = perturbed(seeds[0], 1, scales=(AUTO_FIRST, AUTO_FIRST), floor=floor)
+                return first + seeds[1:], seeds[:1], AUTO_RESTART
             return seeds, [], 0.0
         if not count:
             return seeds, [], 0.0
@@ -290,17 +276,18 @@ class CollocationPlanner(Planner):
         solve the regularised problem so and polish plain minimum time from its optimum and
         multipliers."""
         o = self.options
-        guesses, fallback, restart = (seeds, [], 0.0) if near_optimum else self._guesses(ocp, seeds)
+        transcription, nlp = self._nlp(problem, ocp, "near_optimum" if near_optimum else "cold", intervals)
+        guesses, fallback, restart = ((seeds, [], 0.0) if near_optimum
+                                      else self._guesses(problem, ocp, transcription, nlp, seeds))
         agree = 1 if near_optimum else o.agree
         lbx, ubx = bounds
         if not o.time_regularization:
-            _, nlp = self._nlp(problem, ocp, "near_optimum" if near_optimum else "cold", intervals)
             result = solve_multistart(nlp.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
-                                      agree=agree, restart=restart, fallback=fallback)
+                                      agree=agree, restart=restart, fallback=fallback, second_order=restart > 0)
             return result, {}
         _, regular = self._nlp(problem, self._regularized(problem, ocp), intervals=intervals)
         first = solve_multistart(regular.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=regular.lbg, ubg=regular.ubg,
-                                 agree=agree, restart=restart, fallback=fallback)
+                                 agree=agree, restart=restart, fallback=fallback, second_order=restart > 0)
         extra = {"regularized": first.stats()}
         if first.x is None:
             return first, extra
@@ -362,13 +349,13 @@ class CollocationPlanner(Planner):
                     # the two-wheel regularised solve 61 iterations instead of 31.
                     seed = transcription.seed(ocp, nlp, seed_sampler(problem, found), found.duration)
                     polish, more = self._solve(problem, ocp, [seed], params, bounds, intervals, near_optimum=True)
-                    result = polish if result is None else _merged(result, polish)
+                    result = polish if result is None else merged(result, polish)
                     extra.update(more)
         if result is None or not result.success:
             seeds = [transcription.seed(ocp, nlp, seed_sampler(problem, ref),
                                         ref.duration if ocp.free_time else problem.duration) for ref in starts]
             fine, more = self._solve(problem, ocp, seeds, params, bounds, intervals)
-            result = fine if result is None else _merged(result, fine)
+            result = fine if result is None else merged(result, fine)
             extra.update(more)
         return _Optimum(result, extra, transcription, nlp, intervals)
 

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from ocp import Spacecraft, Torquers, quat
-from ocp.nlp import perturbed, solver_options
+from ocp.nlp import solver_options
 from planners import PLANNERS, ManeuverProblem
 from planners.collocation_reference import seed_sampler
 
@@ -44,13 +44,13 @@ CASES = {"bilimoria_wie": (bilimoria_wie, 3.2431), "full_inertia": (full_inertia
 
 
 def shared_guess(problem):
-    """Node states (7, N + 1) and T of our first start (the first perturbed eigenaxis seed)."""
+    """Node states (7, N + 1) and T of our first start (the perturbed eigenaxis seed), on N intervals."""
     planner = PLANNERS["collocation"]({"objective": "min_time"})
     ocp = planner._ocp(problem)
     transcription, nlp = planner._nlp(problem, ocp)
     reference = planner._starts(problem)[0]
     seed = transcription.seed(ocp, nlp, seed_sampler(problem, reference), reference.duration)
-    guess = perturbed(seed, 1)[0]
+    guess = planner._guesses(problem, ocp, transcription, nlp, [seed])[0][0]
     ns, nc = nlp.n_stage_state, nlp.n_interval
     stages = np.concatenate([guess[:(ns + nc) * N].reshape(N, ns + nc)[:, :ns], guess[None, -ns:]])
     return stages[:, :7].T, float(np.median(stages[:, 7]))

@@ -1,0 +1,161 @@
+"""The second-order check (ocp.second_order) against closed forms, and its use by the multistart.
+
+Oracles: the reduced Hessian of small NLPs worked by hand (a saddle, a maximum on a line, a vertex,
+a weakly active bound), then the eigenaxis slew, a known saddle of Bilimoria & Wie's minimum-time
+problem (2 √π = 3.5449 against the optimum 3.2431), found by IPOPT from the unperturbed warm start.
+"""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from ocp.nlp import solve_multistart, solver_options
+from ocp.second_order import second_order_check
+from planners import PLANNERS
+from planners.collocation_reference import seed_sampler
+from planners.collocation_strategy import control_floor
+
+from tests.test_collocation import bilimoria_wie_problem
+
+
+def nlp(f, g=None, n=2):
+    x = ca.SX.sym("x", n)
+    problem = {"x": x, "f": f(x)}
+    if g is not None:
+        problem["g"] = g(x)
+    return ca.nlpsol("s", "ipopt", problem, solver_options("ipopt", 1e-12, 200))
+
+
+def test_an_unconstrained_saddle_has_its_negative_curvature():
+    # f = x² − y² at 0: ∇²f = diag(2, −2), no constraint, so Z is the plane and the least curvature −2.
+    solver = nlp(lambda x: x[0] ** 2 - x[1] ** 2)
+    check = second_order_check(solver, np.zeros(2), np.zeros(2), np.zeros(0))
+    assert not check.certified
+    assert check.null_dimension == 2
+    assert check.min_curvature == pytest.approx(-2.0)
+
+
+@pytest.mark.parametrize("sign, certified", [(-1.0, True), (1.0, False)])
+def test_the_curvature_along_an_equality_constraint(sign, certified):
+    # f = ±x y on x + y = 2 at (1, 1), multiplier ∓1 (∇f + λ ∇g = 0). Along d = (1, −1)/√2:
+    # dᵀ ∇²f d = ±(2 d₁ d₂) = ∓1, so −x y has a minimum there (curvature 1) and x y a maximum (−1).
+    solver = nlp(lambda x: sign * x[0] * x[1], lambda x: x[0] + x[1])
+    check = second_order_check(solver, np.ones(2), np.zeros(2), np.array([-sign]), lbg=2.0, ubg=2.0)
+    assert check.certified is certified
+    assert check.null_dimension == 1
+    assert check.min_curvature == pytest.approx(-sign)
+
+
+def test_strongly_active_bounds_make_a_vertex():
+    # min x + y on x, y >= 0: both bounds active with multipliers 1, nothing left to move.
+    solver = nlp(lambda x: x[0] + x[1] - 0.1 * x[0] * x[1])
+    check = second_order_check(solver, np.zeros(2), -np.ones(2), np.zeros(0), lbx=0.0)
+    assert check.certified and check.null_dimension == 0 and check.min_curvature == np.inf
+
+
+def test_a_weakly_active_bound_is_left_free():
+    # min x² − y² near 0 with y in [0, 1]: at (0, 0) the bound y >= 0 is met with a zero multiplier,
+    # so y stays free and its negative curvature −2 shows (y = 1 is the minimum). A multiplier
+    # above the tolerance would fix y and certify the point: the check must not do that.
+    solver = nlp(lambda x: x[0] ** 2 - x[1] ** 2)
+    check = second_order_check(solver, np.zeros(2), np.zeros(2), np.zeros(0), lbx=[-1, 0], ubx=[1, 1])
+    assert not check.certified and check.min_curvature == pytest.approx(-2.0)
+    fixed = second_order_check(solver, np.zeros(2), np.array([0.0, -1.0]), np.zeros(0), lbx=[-1, 0], ubx=[1, 1])
+    assert fixed.certified and fixed.null_dimension == 1 and fixed.min_curvature == pytest.approx(2.0)
+
+
+def bilimoria_wie_coarse(perturbation):
+    problem = bilimoria_wie_problem()
+    planner = PLANNERS["collocation"]({"objective": "min_time"})
+    ocp = planner._ocp(problem)
+    transcription, built = planner._nlp(problem, ocp, "cold", 8)
+    reference = planner._starts(problem)[0]
+    seed = transcription.seed(ocp, built, seed_sampler(problem, reference), reference.duration)
+    if perturbation:
+        seed = planner._guesses(problem, ocp, transcription, built, [seed])[0][0]
+    lbx, ubx = transcription.bounds(ocp, built, *planner._variable_bounds(problem), problem.duration)
+    params = np.concatenate([problem.initial_state, problem.qf, np.zeros(3), [problem.duration],
+                             problem.model.default_parameters])
+    return built, dict(p=params, lbx=lbx, ubx=ubx, lbg=built.lbg, ubg=built.ubg), seed
+
+
+@pytest.mark.parametrize("perturbation, T, certified", [(False, 3.5449, False), (True, 3.2435, True)])
+def test_bilimoria_wie_saddle_and_minimum(perturbation, T, certified):
+    # 8 intervals: the eigenaxis point 3.5449 (2 √π) is a saddle (a pair of negative curvatures, one
+    # per symmetric way off the axis); the optimum (3.2435 on this mesh) is bang-bang, a vertex.
+    built, bounds, seed = bilimoria_wie_coarse(perturbation)
+    result = solve_multistart(built.solver, [seed], agree=1, **bounds)
+    assert result.success
+    x = built.unpack(result.x, bounds["p"])[0]
+    assert float(x) == pytest.approx(T, abs=1e-4)
+    check = second_order_check(built.solver, result.x, result.lam_x, result.lam_g, **bounds)
+    assert check.certified is certified, check.message
+    if not certified:
+        assert check.min_curvature < -1e-3
+
+
+def test_restarts_only_where_the_second_order_conditions_fail():
+    # From the saddle the check fails and a restart leaves it; at the optimum it holds, no restart.
+    built, bounds, seed = bilimoria_wie_coarse(False)
+    escape = solve_multistart(built.solver, [seed], restart=0.05, second_order=True, **bounds)
+    assert escape.f == pytest.approx(3.2435, abs=1e-4)
+    assert len(escape.starts) == 2 and escape.starts[0].f == pytest.approx(3.5449, abs=1e-4)
+    assert escape.second_order is not None and escape.second_order.certified
+    _, _, perturbed = bilimoria_wie_coarse(True)
+    direct = solve_multistart(built.solver, [perturbed], restart=0.05, second_order=True, **bounds)
+    assert len(direct.starts) == 1 and direct.stats()["second_order"]["certified"]
+    # without the check, the restarts confirm the optimum by coming back to it
+    confirmed = solve_multistart(built.solver, [perturbed], restart=0.05, **bounds)
+    assert len(confirmed.starts) == 2 and confirmed.f == pytest.approx(direct.f, rel=1e-6)
+
+
+def test_the_default_minimum_time_plan_certifies_its_coarse_optimum():
+    reference = PLANNERS["collocation"]({"objective": "min_time"}).plan(bilimoria_wie_problem())
+    coarse = reference.stats["coarse"]
+    assert coarse["second_order"]["certified"] and len(coarse["starts"]) == 1
+    assert reference.duration == pytest.approx(3.2431, abs=2e-4)
+
+
+def test_the_unchecked_size_is_reported():
+    solver = nlp(lambda x: ca.sumsqr(x), n=3)
+    import ocp.second_order as second_order
+
+    limit = second_order.MAX_VARIABLES
+    try:
+        second_order.MAX_VARIABLES = 2
+        check = second_order_check(solver, np.zeros(3), np.zeros(3), np.zeros(0))
+    finally:
+        second_order.MAX_VARIABLES = limit
+    assert not check.certified and check.null_dimension == -1 and "not checked" in check.message
+
+
+def test_perturbation_floor_reaches_zero_components():
+    from ocp.nlp import perturbed
+
+    center = np.zeros(20000)
+    floor = np.where(np.arange(center.size) % 2 == 0, 1.0, 1e-3)
+    noise = perturbed(center, 1, scales=(0.03, 0.03), floor=floor)[0]
+    assert np.std(noise[0::2]) == pytest.approx(0.03, rel=0.05)
+    assert np.std(noise[1::2]) == pytest.approx(3e-5, rel=0.05)
+
+
+def test_the_control_floor_is_half_the_actuator_range_and_nothing_else():
+    problem = bilimoria_wie_problem()
+    for transcription_name in ("collocation", "multiple_shooting"):
+        planner = PLANNERS["collocation"]({"objective": "min_time", "transcription": transcription_name})
+        ocp = planner._ocp(problem)
+        transcription, built = planner._nlp(problem, ocp, "cold", 8)
+        floor = control_floor(transcription, ocp, built, *planner._variable_bounds(problem)[2:])
+        T, states, controls = (np.asarray(v) for v in built.unpack(floor, np.zeros(built.solver.nnz_in("p"))))
+        assert np.all(controls == 1.0)  # |u_i| <= 1 N m: half the range
+        assert np.all(states == 1e-3) and np.all(T == 1e-3)
+
+
+def test_a_problem_without_the_solver_derivatives_is_not_checked():
+    class NoDerivatives:
+        def get_function(self, name):
+            raise RuntimeError(f"no {name}\nmore")
+
+    check = second_order_check(NoDerivatives(), np.zeros(2), np.zeros(2), np.zeros(0))  # type: ignore[arg-type]
+    assert not check.certified and "no derivatives" in check.message and "more" not in check.message
