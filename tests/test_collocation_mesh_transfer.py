@@ -73,6 +73,7 @@ def test_solution_sampler_reads_the_solution_as_the_reference_does():
     reference = PLANNERS["collocation"]({"intervals": 8}).plan(problem)
     assert reference.status == "ok", reference.message
     t = np.linspace(0.0, problem.duration, 37)
+    t = t[np.abs(t / (problem.duration / 8) - np.round(t / (problem.duration / 8))) > 1e-6]  # nodes: below
     x, u, torque = solution_sampler(reference)(t)
     sample = reference.sample(t)
     np.testing.assert_allclose(x[:, 0:4], sample.q, atol=1e-12)
@@ -123,3 +124,39 @@ def test_without_multipliers_the_fine_mesh_starts_from_the_inverse_dynamics_seed
     assert reference.ok, reference.message
     assert reference.duration == pytest.approx(136.64, abs=0.01)  # the scenario's minimum time
     assert reference.stats["regularized"]["iterations"] <= 45
+
+
+def test_radau_controls_at_a_node_are_the_ending_intervals_point_with_left():
+    # Radau's control polynomial of interval k passes through τ_1 … τ_d = 1 only: the left limit at
+    # the node t_{k+1} is the decision variable of the point τ_d of interval k; the interval that
+    # starts there gives its polynomial extrapolated to τ = 0. Random controls, a duration whose
+    # nodes k T / N are not exact in floating point.
+    model = bounded_single_axis().model
+    N, d, T = 8, 3, 3.2431108282673753
+    transcription = TRANSCRIPTIONS["collocation"](N, d)
+    rng = np.random.default_rng(1)
+    states = rng.normal(size=(model.nx, N * (d + 1)))
+    controls = rng.normal(size=(model.nu * d, N))
+    nodes = np.arange(1, N) * T / N
+    _, u_left = transcription.interpolate(model, states, controls, T, nodes, left=True)
+    np.testing.assert_allclose(u_left, controls[(d - 1) * model.nu:, :N - 1].T, rtol=1e-12, atol=1e-12)
+    _, u_right = transcription.interpolate(model, states, controls, T, nodes)
+    _, u_start = transcription.interpolate(model, states, controls, T, nodes + 1e-12 * T)
+    np.testing.assert_allclose(u_right, u_start, atol=1e-9)  # the interval that starts at the node
+    assert np.min(np.abs(u_right - u_left)) > 1e-3  # a jump at every node (random controls)
+    inner = (np.arange(N) + 0.37) * T / N  # between the nodes both sides read the same interval
+    np.testing.assert_array_equal(transcription.interpolate(model, states, controls, T, inner, left=True)[1],
+                                  transcription.interpolate(model, states, controls, T, inner)[1])
+
+
+def test_solution_sampler_reads_a_node_from_the_interval_that_ends_there():
+    # The seed of a fine Radau point τ_d = 1 that falls on a coarse node (8 and 50 intervals meet
+    # at T/2): the coarse interval ending there, whose own point τ_d = 1 is a decision variable.
+    from planners.collocation_reference import solution_sampler
+
+    problem = bounded_single_axis()
+    reference = PLANNERS["collocation"]({"intervals": 8}).plan(problem)
+    assert reference.status == "ok", reference.message
+    _, u, _ = solution_sampler(reference)(np.array([problem.duration / 2]))
+    d, nu = reference.transcription.degree, reference.model.nu
+    np.testing.assert_allclose(u[0], reference.controls[(d - 1) * nu:d * nu, 3], rtol=1e-12, atol=1e-15)
