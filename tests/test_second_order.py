@@ -15,7 +15,6 @@ from ocp.second_order import second_order_check
 from planners import PLANNERS
 from planners.collocation_reference import seed_sampler
 from planners.collocation_strategy import control_floor
-
 from tests.test_collocation import bilimoria_wie_problem
 
 
@@ -77,7 +76,7 @@ def bilimoria_wie_coarse(perturbation):
     lbx, ubx = transcription.bounds(ocp, built, *planner._variable_bounds(problem), problem.duration)
     params = np.concatenate([problem.initial_state, problem.qf, np.zeros(3), [problem.duration],
                              problem.model.default_parameters])
-    return built, dict(p=params, lbx=lbx, ubx=ubx, lbg=built.lbg, ubg=built.ubg), seed
+    return built, {"p": params, "lbx": lbx, "ubx": ubx, "lbg": built.lbg, "ubg": built.ubg}, seed
 
 
 @pytest.mark.parametrize("perturbation, T, certified", [(False, 3.5449, False), (True, 3.2435, True)])
@@ -119,7 +118,7 @@ def test_the_default_minimum_time_plan_certifies_its_coarse_optimum():
 
 def test_the_unchecked_size_is_reported():
     solver = nlp(lambda x: ca.sumsqr(x), n=3)
-    import ocp.second_order as second_order
+    from ocp import second_order
 
     limit = second_order.MAX_VARIABLES
     try:
