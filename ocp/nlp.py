@@ -38,9 +38,10 @@ such a restart comes back in a few iterations (and confirms it, which stops the 
 saddle or other stationary point (the eigenaxis slew for minimum time) it leaves for a better
 point, which then becomes the best and is checked in turn. With ``second_order``, the best point is
 first checked by the second-order sufficient conditions (:mod:`ocp.second_order`): a point that
-satisfies them is a strict local minimum, which is what a restart would confirm, so the restarts
-are skipped; a point that does not (a saddle, or a degenerate minimum the check cannot certify) gets
-the restarts as before.
+satisfies them is a strict local minimum, which is what a restart would confirm, so the certificate
+counts as one more start agreeing on it (with ``agree=2``, the first converged start then ends the
+search); a point that does not (a saddle, or a degenerate minimum the check cannot certify) gets the
+restarts as before. ``agree=0`` (try everything) still runs every restart.
 """
 from __future__ import annotations
 
@@ -200,8 +201,9 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
     lam_x0, lam_g0 : array_like or None
         Initial bound and constraint multipliers passed with every guess (``None``: zeros).
     second_order : bool
-        Before the restarts, check the best point by the second-order sufficient conditions and
-        skip the restarts when it satisfies them (see the module docstring).
+        Before the restarts, check the best point by the second-order sufficient conditions; when
+        it satisfies them, the certificate counts as one more start agreeing on it (with
+        ``agree=2``, no restart; see the module docstring).
 
     Returns
     -------
@@ -224,6 +226,9 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
     objectives: list[float] = []
     begin = time.perf_counter()
 
+    def agreeing() -> int:
+        return sum(abs(value - best_f) <= atol + rtol * abs(best_f) for value in objectives)
+
     def candidates() -> Iterator[Array]:
         for index, guess in enumerate(guesses):
             if max_starts is not None and index >= max_starts:
@@ -234,12 +239,13 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
                 break
             yield guess
         for k in range(max_restarts if restart > 0 and best else 0):
-            if second_order:
+            if second_order and agree:
                 assert best_index is not None  # set with best
                 if best_index not in checks:
                     checks[best_index] = second_order_check(solver, best["x"], best["lam_x"], best["lam_g"],
                                                             p=p, lbx=low, ubx=high, lbg=g_low, ubg=g_high)
-                if checks[best_index].certified:
+                # the certificate counts as one more start agreeing on the best point
+                if checks[best_index].certified and agreeing() + 1 >= agree:
                     break
             yield perturbed(best["x"], 1, seed=k + 1, scales=(restart, restart))[0]
 
@@ -261,8 +267,7 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         if f < best_f:
             best = {key: solution[key].full().ravel() for key in ("x", "lam_x", "lam_g")}
             best["g"], best_f, best_index = g, f, index
-        close = sum(abs(value - best_f) <= atol + rtol * abs(best_f) for value in objectives)
-        if agree and close >= agree:
+        if agree and agreeing() >= agree:
             break
     total = time.perf_counter() - begin
     iterations = sum(s.iterations for s in starts)

@@ -45,7 +45,9 @@ class CollocationOptions:
         until one agrees with it (the warm start itself if the copy does not converge); for a
         fixed final time the warm start. n > 0: n perturbed copies; 0: the warm start itself.
     agree : int
-        Stop once this many starts agree on the best objective (0: try all).
+        Stop once this many starts agree on the best objective (0: try all); with ``multistart:
+        auto``, a best point that satisfies the second-order sufficient conditions counts as one
+        of them.
     time_regularization : float
         ``min_time`` only: ε > 0 first solves min T + ε ∫‖τ‖² dt / Σ τ_max² (τ_max the wheels'
         and torquers' torque bounds [N m]) from the starts, then polishes plain minimum time

@@ -107,6 +107,13 @@ def test_restarts_only_where_the_second_order_conditions_fail():
     # without the check, the restarts confirm the optimum by coming back to it
     confirmed = solve_multistart(built.solver, [perturbed], restart=0.05, **bounds)
     assert len(confirmed.starts) == 2 and confirmed.f == pytest.approx(direct.f, rel=1e-6)
+    # the certificate counts as one agreeing start: agree=3 still asks for one restart coming back,
+    # agree=0 (try everything) for every restart
+    three = solve_multistart(built.solver, [perturbed], restart=0.05, second_order=True, agree=3, **bounds)
+    assert len(three.starts) == 2 and three.starts[1].f == pytest.approx(direct.f, rel=1e-6)
+    every = solve_multistart(built.solver, [perturbed], restart=0.05, second_order=True, agree=0, max_restarts=2,
+                             **bounds)
+    assert len(every.starts) == 3
 
 
 def test_the_default_minimum_time_plan_certifies_its_coarse_optimum():
