@@ -106,6 +106,42 @@ def test_a_weakly_active_bound_is_left_free():
     assert fixed.certified and fixed.null_dimension == 1 and fixed.min_curvature == pytest.approx(2.0)
 
 
+def test_strongly_active_inequality_rows_make_a_vertex():
+    # The vertex of test_strongly_active_bounds_make_a_vertex with x, y >= 0 as constraint rows:
+    # both active with multipliers −1 (∇f = (1, 1) at 0), so the indefinite −0.1 x y does not count.
+    solver = nlp(lambda x: x[0] + x[1] - 0.1 * x[0] * x[1], lambda x: x)
+    check = second_order_check(solver, np.zeros(2), np.zeros(2), -np.ones(2), lbg=0.0, ubg=np.inf)
+    assert check.certified and check.null_dimension == 0
+
+
+def test_dependent_active_rows_leave_their_null_space():
+    # f = x y with x + y = 0 written twice (2 x + 2 y = 0: dependent rows, λ = 0 satisfies KKT at 0).
+    # Z is the line d = (1, −1)/√2 (rank 1, not 2), where dᵀ ∇²f d = 2 d₁ d₂ = −1: a saddle. Counting
+    # both rows as independent would leave Z = {0} and certify it as a vertex.
+    solver = nlp(lambda x: x[0] * x[1], lambda x: ca.vertcat(x[0] + x[1], 2 * x[0] + 2 * x[1]))
+    check = second_order_check(solver, np.zeros(2), np.zeros(2), np.zeros(2), lbg=0.0, ubg=0.0)
+    assert not check.certified and check.null_dimension == 1
+    assert check.min_curvature == pytest.approx(-1.0)
+
+
+def test_zero_curvature_is_not_certified():
+    # f = x² + y³ at 0: ∇²f = diag(2, 0), positive semidefinite only, and f(0, −t) = −t³ < 0.
+    solver = nlp(lambda x: x[0] ** 2 + x[1] ** 3)
+    check = second_order_check(solver, np.zeros(2), np.zeros(2), np.zeros(0))
+    assert not check.certified and check.min_curvature == pytest.approx(0.0, abs=1e-12)
+
+
+def test_an_infinite_bound_is_never_near():
+    # x >= 0 (row 1, multiplier −1000: strongly active) and y >= −1 (row 2, y = 0 is 1 away from it; a
+    # stray multiplier −1e-4, within the complementarity tolerance relative to 1000). f = 1000 x +
+    # 1e-4 y − y²: stationary, and y, being free, carries the curvature −2: a saddle. Taking row 2's
+    # infinite upper bound as "near" would fix y and certify a vertex.
+    solver = nlp(lambda x: 1000 * x[0] + 1e-4 * x[1] - x[1] ** 2, lambda x: x)
+    check = second_order_check(solver, np.zeros(2), np.zeros(2), np.array([-1000.0, -1e-4]),
+                               lbg=[0.0, -1.0], ubg=np.inf)
+    assert not check.certified and check.null_dimension == 1 and check.min_curvature == pytest.approx(-2.0)
+
+
 def bilimoria_wie_coarse(perturbation):
     problem = bilimoria_wie_problem()
     planner = PLANNERS["collocation"]({"objective": "min_time"})
