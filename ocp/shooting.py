@@ -101,7 +101,8 @@ class MultipleShooting(Transcription):
         return np.zeros(0), np.arange(1, self.intervals) * duration / self.intervals
 
     def interpolate(self, model: AttitudeModel, states: Array, controls: Array, duration: float,
-                    t: Array) -> tuple[Array, Array]:
+                    t: Array, left: bool = False) -> tuple[Array, Array]:
+        # states (cubic Hermite) and controls (linear) are continuous at the nodes: ``left`` is moot
         N = self.intervals
         h = duration / N
         k = np.minimum((t / h).astype(int), N - 1)

@@ -181,7 +181,7 @@ class Transcription(ABC):
 
     @abstractmethod
     def interpolate(self, model: AttitudeModel, states: Array, controls: Array, duration: float,
-                    t: Array) -> tuple[Array, Array]:
+                    t: Array, left: bool = False) -> tuple[Array, Array]:
         """The solution between its points.
 
         Parameters
@@ -194,6 +194,10 @@ class Transcription(ABC):
             T [s].
         t : (n,) ndarray
             Times in ``[0, duration]`` [s].
+        left : bool, optional
+            At a mesh node ``t_k`` (``0 < k < N``), read the interval that ends there (``True``:
+            the left limit) instead of the one that starts there (``False``, default). It matters
+            only where the interpolant jumps at the nodes (Radau's controls).
 
         Returns
         -------

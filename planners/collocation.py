@@ -16,8 +16,8 @@ option).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
-from typing import Annotated, Literal
+from dataclasses import dataclass, replace
+from typing import Literal
 
 import numpy as np
 
@@ -29,7 +29,6 @@ from ocp.nlp import (
     solver_options,
     warm_start_options,
 )
-from ocp.options import InvalidOption, OptionsError, Range
 from ocp.transcription import (
     NLP,
     TRANSCRIPTIONS,
@@ -37,6 +36,7 @@ from ocp.transcription import (
     Transcription,
 )
 from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference
+from planners.collocation_options import CollocationOptions
 from planners.collocation_problem import parse_cone, variable_bounds
 from planners.collocation_reference import (
     CollocationReference,
@@ -58,13 +58,15 @@ _Mode = Literal["cold", "warm", "near_optimum", "transfer"]
 @dataclass
 class _Optimum:
     """What :meth:`CollocationPlanner._optimum` found: the solve, its extra stats, the transcription
-    and NLP it was solved on and their number of intervals."""
+    and NLP it was solved on, their number of intervals and, with ``time_regularization``, the
+    regularised solve it was polished from."""
 
     result: NLPResult
     extra: dict
     transcription: Transcription
     nlp: NLP
     intervals: int
+    regularized: NLPResult | None = None
 
 
 class CollocationPlanner(Planner):
@@ -73,118 +75,8 @@ class CollocationPlanner(Planner):
     name = "collocation"
     example_options = ({"intervals": 20}, {"intervals": 20, "transcription": "multiple_shooting"})
 
-    @dataclass(frozen=True)
-    class Options:
-        """Options of ``collocation`` (YAML keys; see the README's planner table).
-
-        Attributes
-        ----------
-        objective : str
-            ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt, ``min_time`` (free T, the
-            scenario's duration its upper bound) or ``weighted``; τ the actuators' body torque [N m].
-        intervals : int
-            Mesh intervals.
-        degree : int
-            Radau points per interval (``collocation``).
-        transcription : str
-            ``collocation`` (Legendre-Gauss-Radau) or ``multiple_shooting``.
-        substeps : int
-            RK4 steps per interval (``multiple_shooting``).
-        solver : str
-            ``ipopt`` (default) or ``fatrop``.
-        warm_start : str
-            Registered planner whose reference seeds the NLP (default ``eigenaxis``; ``collocation``
-            itself with its own ``warm_start_options``).
-        warm_start_options : dict
-            The warm-start planner's options.
-        seed_planners : list of str
-            Further planners whose references are starts.
-        multistart : int or "auto"
-            ``auto`` (default): for a free final time a perturbed copy of the warm start
-            (:data:`AUTO_FIRST`), then, unless its optimum satisfies the second-order sufficient
-            conditions (:mod:`ocp.second_order`), restarts from the best point perturbed by 5 %
-            until one agrees with it (the warm start itself if the copy does not converge); for a
-            fixed final time the warm start. n > 0: n perturbed copies; 0: the warm start itself.
-        agree : int
-            Stop once this many starts agree on the best objective (0: try all).
-        time_regularization : float
-            ``min_time`` only: ε > 0 first solves min T + ε ∫‖τ‖² dt / Σ τ_max² (τ_max the wheels'
-            and torquers' torque bounds [N m]) from the starts, then polishes plain minimum time
-            from that optimum and its multipliers; 0 (default): off.
-        coarse_intervals : int
-            With ``multistart: auto``, the starts are first solved on this many intervals (for a
-            free final time the whole multistart; for a fixed one only without cones and with at
-            least twice as many ``intervals``) and the full mesh is solved once from that optimum
-            and its multipliers carried over (IPOPT; falling back to that optimum alone with the
-            barrier starting at 1e-4, then to the full-mesh solve from the starts); 0 or >=
-            ``intervals``: off. Default 8.
-        energy_weight, l1_weight, time_weight : float
-            Weights of ``weighted`` [1/(N² m² s), 1/(N m s), 1/s].
-        max_rate : float or None
-            Body-rate bound per axis [rad/s]; ``None``: none.
-        keep_out, keep_in : list of dict
-            Cones ``{boresight (body), direction (inertial), angle_deg}``.
-        cone_margin_deg : float
-            Cones are imposed this much tighter [deg], so that they hold between the points.
-        tolerance : float
-            Solver tolerance (scaled KKT error).
-        max_iterations : int
-            Solver iterations per start.
-        """
-
-        objective: Literal["min_energy", "min_l1", "min_time", "weighted"] = "min_energy"
-        intervals: Annotated[int, Range(ge=1, le=2000)] = 50
-        degree: Annotated[int, Range(ge=1, le=9)] = 3
-        transcription: Literal["collocation", "multiple_shooting"] = "collocation"
-        substeps: Annotated[int, Range(ge=1, le=100)] = 4       # RK4 steps per interval (multiple_shooting)
-        solver: Literal["ipopt", "fatrop"] = "ipopt"
-        warm_start: str = "eigenaxis"            # registered planner whose reference seeds the NLP
-        warm_start_options: dict = field(default_factory=dict)  # its options, e.g. {profile: min_time}
-        seed_planners: list[str] = field(default_factory=list)
-        multistart: Annotated[int | Literal["auto"], Range(ge=0, le=50)] = "auto"
-        agree: Annotated[int, Range(ge=0, le=50)] = 2  # stop once this many starts agree on the best optimum (0: try all)
-        time_regularization: Annotated[float, Range(ge=0.0, le=1.0)] = 0.0
-        coarse_intervals: Annotated[int, Range(ge=0, le=2000)] = 8
-        energy_weight: Annotated[float, Range(ge=0.0)] = 1.0               # for objective "weighted"
-        l1_weight: Annotated[float, Range(ge=0.0)] = 0.0
-        time_weight: Annotated[float, Range(ge=0.0)] = 0.0
-        max_rate: Annotated[float | None, Range(gt=0.0)] = None  # rad/s, per body axis
-        keep_out: list[dict] = field(default_factory=list)  # {boresight, direction, angle_deg}
-        keep_in: list[dict] = field(default_factory=list)
-        cone_margin_deg: Annotated[float, Range(ge=0.0, lt=90.0)] = 0.01            # cones are imposed this much tighter, so that they
-                                                 # hold between the points where they are imposed
-        tolerance: Annotated[float, Range(gt=0.0, lt=1.0)] = 1e-10
-        max_iterations: Annotated[int, Range(ge=1, le=100000)] = 500
-
-        def __post_init__(self) -> None:
-            from planners import (
-                PLANNERS,  # the registry is complete once options are parsed
-            )
-
-            # A collocation warm start is planned with its own options (say min_energy, itself warm
-            # started from eigenaxis): the way into min_time where a kinematic seed is too far
-            # (two wheels). Only its own warm start may nest further; the depth is the YAML's.
-            for index, name in enumerate([self.warm_start, *self.seed_planners]):
-                if name not in PLANNERS or (name == "collocation" and index > 0):
-                    where = "warm_start" if index == 0 else f"seed_planners[{index - 1}]"
-                    raise InvalidOption(where, f"{name!r} is not another registered planner; expected one of "
-                                               f"{sorted(set(PLANNERS) - {'collocation'})} (or collocation as warm_start)")
-            try:
-                PLANNERS[self.warm_start](self.warm_start_options, path="warm_start_options")
-            except OptionsError as error:
-                raise InvalidOption(error.path, error.message) from None
-            if self.time_regularization and self.objective != "min_time":
-                raise InvalidOption("time_regularization", f"applies to objective min_time only, not {self.objective!r}")
-            if self.objective == "weighted" and not (self.energy_weight or self.l1_weight or self.time_weight):
-                raise InvalidOption("objective", "weighted needs a positive energy_weight, l1_weight or time_weight")
-            l1 = self.objective == "min_l1" or (self.objective == "weighted" and self.l1_weight > 0)
-            refused = TRANSCRIPTIONS[self.transcription].problem_error(l1, bool(self.keep_out or self.keep_in))
-            if refused:
-                raise ValueError(refused)
-            for index, spec in enumerate(self.keep_out):
-                parse_cone(spec, True, np.deg2rad(self.cone_margin_deg), f"keep_out[{index}]")
-            for index, spec in enumerate(self.keep_in):
-                parse_cone(spec, False, np.deg2rad(self.cone_margin_deg), f"keep_in[{index}]")
+    class Options(CollocationOptions):
+        __doc__ = CollocationOptions.__doc__
 
     def _ocp(self, problem: ManeuverProblem) -> OptimalControlProblem:
         o = self.options
@@ -270,11 +162,12 @@ class CollocationPlanner(Planner):
         return replace(ocp, energy_weight=self.options.time_regularization / scale)
 
     def _solve(self, problem: ManeuverProblem, ocp: OptimalControlProblem, seeds: list[Array], params: Array,
-               bounds: tuple[Array, Array], intervals: int, near_optimum: bool = False) -> tuple[NLPResult, dict]:
+               bounds: tuple[Array, Array], intervals: int,
+               near_optimum: bool = False) -> tuple[NLPResult, dict, NLPResult | None]:
         """Solve ``ocp`` on ``intervals`` from ``seeds`` by the multistart policy (``near_optimum``:
         from the one seed given, near the optimum, see :meth:`_nlp`); with ``time_regularization``,
         solve the regularised problem so and polish plain minimum time from its optimum and
-        multipliers."""
+        multipliers (the regularised solve is returned third, ``None`` without one)."""
         o = self.options
         transcription, nlp = self._nlp(problem, ocp, "near_optimum" if near_optimum else "cold", intervals)
         guesses, fallback, restart = ((seeds, [], 0.0) if near_optimum
@@ -284,17 +177,22 @@ class CollocationPlanner(Planner):
         if not o.time_regularization:
             result = solve_multistart(nlp.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
                                       agree=agree, restart=restart, fallback=fallback, second_order=restart > 0)
-            return result, {}
+            return result, {}, None
         _, regular = self._nlp(problem, self._regularized(problem, ocp), intervals=intervals)
         first = solve_multistart(regular.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=regular.lbg, ubg=regular.ubg,
                                  agree=agree, restart=restart, fallback=fallback, second_order=restart > 0)
-        extra = {"regularized": first.stats()}
-        if first.x is None:
-            return first, extra
+        return self._polished(problem, ocp, first, params, bounds, intervals), {"regularized": first.stats()}, first
+
+    def _polished(self, problem: ManeuverProblem, ocp: OptimalControlProblem, regularized: NLPResult, params: Array,
+                  bounds: tuple[Array, Array], intervals: int) -> NLPResult:
+        """Plain minimum time from the optimum of the regularised problem and its multipliers
+        (``regularized`` itself when it failed)."""
+        if regularized.x is None:
+            return regularized
         _, polish = self._nlp(problem, ocp, "warm", intervals)
-        result = solve_multistart(polish.solver, [first.x], p=params, lbx=lbx, ubx=ubx, lbg=polish.lbg,
-                                  ubg=polish.ubg, agree=1, lam_x0=first.lam_x, lam_g0=first.lam_g)
-        return result, extra
+        return solve_multistart(polish.solver, [regularized.x], p=params, lbx=bounds[0], ubx=bounds[1],
+                                lbg=polish.lbg, ubg=polish.ubg, agree=1, lam_x0=regularized.lam_x,
+                                lam_g0=regularized.lam_g)
 
     def _coarse(self, ocp: OptimalControlProblem) -> bool:
         """Whether to solve on ``coarse_intervals`` first: with ``multistart: auto``, for a free final
@@ -331,7 +229,7 @@ class CollocationPlanner(Planner):
         mode: _Mode = "warm" if o.time_regularization else "transfer" if coarse_first else "cold"
         transcription, nlp = self._nlp(problem, ocp, mode, intervals)
         bounds = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
-        result, extra = None, {}
+        result, extra, regularized = None, {}, None
         if coarse_first:
             # On a coarse mesh, where an iteration costs a fraction: the escape from stationary
             # points and its confirmation (free T), or the long way from a far seed (fixed T); its
@@ -341,35 +239,62 @@ class CollocationPlanner(Planner):
             extra["coarse"] = found.stats
             if found.ok:
                 assert isinstance(found, CollocationReference)  # found.ok
-                result = self._transferred(problem, ocp, coarse, found, params, bounds)
+                transferred = self._transferred(problem, ocp, coarse, found, params, bounds)
+                if transferred is not None:
+                    result, more = transferred
+                    extra.update(more)
                 if result is None or not result.success:
                     # Without multipliers, the seed POLISH_MU_INIT was tuned on: the coarse optimum
                     # through the inverse dynamics. Its own controls (a bang-bang arc's polynomial
                     # overshoots the bounds between the Radau points, up to 55 % on two wheels) took
                     # the two-wheel regularised solve 61 iterations instead of 31.
                     seed = transcription.seed(ocp, nlp, seed_sampler(problem, found), found.duration)
-                    polish, more = self._solve(problem, ocp, [seed], params, bounds, intervals, near_optimum=True)
+                    polish, more, _ = self._solve(problem, ocp, [seed], params, bounds, intervals, near_optimum=True)
                     result = polish if result is None else merged(result, polish)
                     extra.update(more)
         if result is None or not result.success:
             seeds = [transcription.seed(ocp, nlp, seed_sampler(problem, ref),
                                         ref.duration if ocp.free_time else problem.duration) for ref in starts]
-            fine, more = self._solve(problem, ocp, seeds, params, bounds, intervals)
+            fine, more, regularized = self._solve(problem, ocp, seeds, params, bounds, intervals)
             result = fine if result is None else merged(result, fine)
             extra.update(more)
-        return _Optimum(result, extra, transcription, nlp, intervals)
+        return _Optimum(result, extra, transcription, nlp, intervals, regularized)
 
     def _transferred(self, problem: ManeuverProblem, ocp: OptimalControlProblem, coarse: _Optimum,
-                     found: CollocationReference, params: Array, bounds: tuple[Array, Array]) -> NLPResult | None:
-        """The full-mesh solve from the coarse optimum ``found`` (its own states and controls, read
-        by :func:`~planners.collocation_reference.solution_sampler`) with its multipliers carried
-        over (:func:`ocp.mesh_transfer.transfer_multipliers`); ``None`` where that does not apply
-        (FATROP, ``time_regularization``, layouts that differ)."""
-        if self.options.solver != "ipopt" or self.options.time_regularization or coarse.result.lam_x is None:
+                     found: CollocationReference, params: Array,
+                     bounds: tuple[Array, Array]) -> tuple[NLPResult, dict] | None:
+        """The full-mesh solve from the coarse optimum ``found`` with its multipliers carried over
+        (:meth:`_transfer`), and its extra stats; with ``time_regularization``, the coarse
+        regularised optimum is carried to the full mesh's regularised problem, which is then
+        polished (:meth:`_polished`). ``None`` where that does not apply (FATROP, layouts that
+        differ)."""
+        if self.options.solver != "ipopt":
+            return None
+        if not self.options.time_regularization:
+            result = self._transfer(problem, ocp, coarse.result, coarse.nlp, found, params, bounds)
+            return None if result is None else (result, {})
+        if coarse.regularized is None or not coarse.regularized.success:
+            return None
+        regular = self._regularized(problem, ocp)
+        _, coarse_nlp = self._nlp(problem, regular, intervals=coarse.intervals)
+        origin = self._reference(problem, regular, params,
+                                 _Optimum(coarse.regularized, {}, coarse.transcription, coarse_nlp, coarse.intervals))
+        assert isinstance(origin, CollocationReference)  # a converged solve
+        first = self._transfer(problem, regular, coarse.regularized, coarse_nlp, origin, params, bounds)
+        if first is None:
+            return None
+        return self._polished(problem, ocp, first, params, bounds, self.options.intervals), {"regularized": first.stats()}
+
+    def _transfer(self, problem: ManeuverProblem, ocp: OptimalControlProblem, coarse: NLPResult, coarse_nlp: NLP,
+                  found: CollocationReference, params: Array, bounds: tuple[Array, Array]) -> NLPResult | None:
+        """The full-mesh solve of ``ocp`` from ``found``, the coarse optimum ``coarse`` of
+        ``coarse_nlp`` (its own states and controls, read by
+        :func:`~planners.collocation_reference.solution_sampler`), with its multipliers carried over
+        (:func:`ocp.mesh_transfer.transfer_multipliers`); ``None`` when the layouts differ."""
+        if coarse.lam_x is None or coarse.lam_g is None:
             return None
         transcription, nlp = self._nlp(problem, ocp, "transfer")
-        assert coarse.result.lam_g is not None  # set with lam_x
-        multipliers = transfer_multipliers(coarse.nlp, nlp, coarse.result.lam_x, coarse.result.lam_g)
+        multipliers = transfer_multipliers(coarse_nlp, nlp, coarse.lam_x, coarse.lam_g)
         if multipliers is None:
             return None
         lbx, ubx = bounds
