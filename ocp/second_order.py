@@ -20,6 +20,12 @@ column-pivoted QR factorisation of those rows (dense: meant for the small NLPs o
 few hundred variables).
 ``Z = {0}`` (a vertex: as many independent active constraints as variables, e.g. a bang-bang
 optimum) is a strict local minimum by itself.
+
+The theorem assumes a KKT point, so the first-order conditions are verified first (stationarity of
+the Lagrangian ``L = f + lam_gᵀ g + lam_xᵀ x``, CasADi's signs; every multiplier of the sign of the
+bound it belongs to and zero away from it; feasibility): a solve that stalled (the multistart
+accepts IPOPT's ``Search_Direction_Becomes_Too_Small`` at a feasible point) or multipliers of another
+convention are reported as not checked, never certified.
 """
 from __future__ import annotations
 
@@ -65,6 +71,16 @@ def _not_checked(message: str) -> SecondOrderCheck:
     return SecondOrderCheck(False, -1, float("nan"), message)
 
 
+def _output(function: ca.Function, names: tuple[str, ...]) -> int:
+    """Index of the output of ``function`` named one of ``names`` (the plugins differ: IPOPT's
+    ``nlp_hess_l`` returns ``triu_hess_gamma_x_x`` alone, FATROP's ``grad_gamma_x`` first, then the
+    full ``hess_gamma_x_x``; ``nlp_grad_f`` returns ``f`` first or not at all)."""
+    for index in range(function.n_out()):
+        if function.name_out(index) in names:
+            return index
+    raise RuntimeError(f"{function.name()} has none of the outputs {names}")
+
+
 def _dense(function: BufferedFunction, index: int) -> Array:
     """Output ``index`` of the last evaluation as a dense array."""
     sparsity = function.function.sparsity_out(index)
@@ -97,34 +113,63 @@ def _broadcast(bound: Any, like: Array) -> Array:
 
 def _active(values: Array, low: Array, high: Array, multipliers: Array, multiplier_tolerance: float,
             bound_tolerance: float) -> NDArray[np.bool_]:
-    """Rows at a bound with a multiplier above the tolerance, and rows with equal bounds."""
-    near_low = values - low <= bound_tolerance * (1.0 + np.abs(low))
-    near_high = high - values <= bound_tolerance * (1.0 + np.abs(high))
+    """Rows at a (finite) bound with a multiplier above the tolerance, and rows with equal bounds."""
+    with np.errstate(invalid="ignore"):  # inf - inf where a value is infinite: not near
+        near_low = np.isfinite(low) & (values - low <= bound_tolerance * (1.0 + np.abs(low)))
+        near_high = np.isfinite(high) & (high - values <= bound_tolerance * (1.0 + np.abs(high)))
     return (low == high) | ((near_low | near_high) & (np.abs(multipliers) > multiplier_tolerance))
+
+
+def _complementarity(values: Array, low: Array, high: Array, multipliers: Array) -> float:
+    """Largest violation of the sign and complementarity conditions, ``|λ| × min(1, distance to the
+    bound λ belongs to)`` (CasADi's signs: a positive multiplier belongs to the upper bound, a
+    negative one to the lower; an infinite bound is at distance 1)."""
+    with np.errstate(invalid="ignore"):
+        to_low = np.where(np.isfinite(low), values - low, 1.0)
+        to_high = np.where(np.isfinite(high), high - values, 1.0)
+    violation = (np.maximum(multipliers, 0.0) * np.clip(to_high, 0.0, 1.0)
+                 + np.maximum(-multipliers, 0.0) * np.clip(to_low, 0.0, 1.0))
+    return float(np.max(violation, initial=0.0))
+
+
+def _infeasibility(values: Array, low: Array, high: Array) -> float:
+    """Largest distance outside a bound, relative to ``1 + |bound|``."""
+    with np.errstate(invalid="ignore"):
+        below = np.where(np.isfinite(low), (low - values) / (1.0 + np.abs(low)), 0.0)
+        above = np.where(np.isfinite(high), (values - high) / (1.0 + np.abs(high)), 0.0)
+    return float(np.max(np.maximum(below, above), initial=0.0))
 
 
 def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array, *, p: Any = None,
                        lbx: Any = -np.inf, ubx: Any = np.inf, lbg: Any = -np.inf, ubg: Any = np.inf,
                        multiplier_tolerance: float = 1e-6, bound_tolerance: float = 1e-6,
-                       curvature_tolerance: float = 1e-8) -> SecondOrderCheck:
+                       curvature_tolerance: float = 1e-8, kkt_tolerance: float = 1e-6) -> SecondOrderCheck:
     """Whether a converged point of ``solver`` satisfies the second-order sufficient conditions.
 
     Parameters
     ----------
     solver : casadi.Function
-        The ``casadi.nlpsol`` function that found the point (its ``nlp_hess_l`` and ``nlp_jac_g``).
+        The ``casadi.nlpsol`` function that found the point (its ``nlp_hess_l``, ``nlp_jac_g``
+        and ``nlp_grad_f``).
     x : (n,) ndarray
         The point.
     lam_x, lam_g : ndarray
-        Its bound and constraint multipliers (CasADi's signs; only magnitudes are used).
+        Its bound and constraint multipliers, CasADi's signs: ``∇f + J_gᵀ lam_g + lam_x = 0``, a
+        positive multiplier for an upper bound, a negative one for a lower bound.
     p, lbx, ubx, lbg, ubg : array_like
         The solver's parameters and bounds at that solve.
     multiplier_tolerance : float
         A multiplier above this (absolute) makes its constraint strongly active.
     bound_tolerance : float
-        Relative distance to a bound (``× (1 + |bound|)``) within which a value is at it.
+        Relative distance to a bound (``× (1 + |bound|)``) within which a value is at it; also the
+        largest accepted violation of a bound.
     curvature_tolerance : float
         The least curvature on ``Z`` must exceed this, relative to the largest (at least 1).
+    kkt_tolerance : float
+        The first-order conditions the theorem assumes must hold to this: the stationarity residual
+        ``‖∇f + J_gᵀ lam_g + lam_x‖∞`` relative to the largest of its terms (at least 1), and the
+        sign and complementarity of every multiplier (``|λ| × min(1, distance to its bound)``)
+        relative to the largest multiplier (at least 1). Otherwise the point is not checked.
 
     Returns
     -------
@@ -136,21 +181,37 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     if n > MAX_VARIABLES:
         return _not_checked(f"{n} variables: more than {MAX_VARIABLES}, not checked")
     try:
-        hessian = solver.get_function("nlp_hess_l")
-        jacobian = solver.get_function("nlp_jac_g")
+        hessian = BufferedFunction(solver.get_function("nlp_hess_l"))
+        jacobian = BufferedFunction(solver.get_function("nlp_jac_g"))
+        gradient = BufferedFunction(solver.get_function("nlp_grad_f"))
+        h_out = _output(hessian.function, ("triu_hess_gamma_x_x", "hess_gamma_x_x"))
+        g_out, j_out = _output(jacobian.function, ("g",)), _output(jacobian.function, ("jac_g_x",))
+        f_out = _output(gradient.function, ("grad_f_x",))
     except RuntimeError as error:  # a plugin without these functions
         return _not_checked(f"no derivatives from the solver: {str(error).splitlines()[0]}")
     p = np.zeros(solver.nnz_in("p")) if p is None else p
-    hessian_, jacobian_ = BufferedFunction(hessian), BufferedFunction(jacobian)
-    hessian_(x, p, 1.0, lam_g)
-    upper = np.triu(_dense(hessian_, 0))
+    lam_x = np.asarray(lam_x, dtype=float).ravel()
+    lam_g = np.asarray(lam_g, dtype=float).ravel()
+    hessian.all_outputs(x, p, 1.0, lam_g)
+    upper = np.triu(_dense(hessian, h_out))  # IPOPT's is upper triangular, FATROP's full
     H = upper + np.triu(upper, 1).T
-    jacobian_(x, p)
-    g, J = jacobian_.outputs[0].copy(), _dense(jacobian_, 1)
-    rows = _active(g, _broadcast(lbg, g), _broadcast(ubg, g), np.asarray(lam_g, dtype=float).ravel(),
-                   multiplier_tolerance, bound_tolerance)
-    fixed = _active(x, _broadcast(lbx, x), _broadcast(ubx, x), np.asarray(lam_x, dtype=float).ravel(),
-                    multiplier_tolerance, bound_tolerance)
+    jacobian.all_outputs(x, p)
+    g, J = jacobian.outputs[g_out].copy(), _dense(jacobian, j_out)
+    grad = gradient.all_outputs(x, p)[f_out].copy()
+    g_low, g_high, x_low, x_high = _broadcast(lbg, g), _broadcast(ubg, g), _broadcast(lbx, x), _broadcast(ubx, x)
+    # The theorem assumes a KKT point: a stalled solve or multipliers of other signs are not one.
+    terms = [grad, J.T @ lam_g, lam_x]
+    moving = x_low != x_high  # a fixed variable's multiplier takes any value
+    stationarity = float(np.max(np.abs(sum(terms))[moving], initial=0.0)) \
+        / max([1.0] + [float(np.max(np.abs(t), initial=0.0)) for t in terms])
+    complementarity = max(_complementarity(g, g_low, g_high, lam_g), _complementarity(x, x_low, x_high, lam_x)) \
+        / max(1.0, float(np.max(np.abs(lam_g), initial=0.0)), float(np.max(np.abs(lam_x), initial=0.0)))
+    infeasibility = max(_infeasibility(g, g_low, g_high), _infeasibility(x, x_low, x_high))
+    if stationarity > kkt_tolerance or complementarity > kkt_tolerance or infeasibility > bound_tolerance:
+        return _not_checked(f"not a first-order point: stationarity {stationarity:.2g}, complementarity "
+                            f"{complementarity:.2g}, infeasibility {infeasibility:.2g}")
+    rows = _active(g, g_low, g_high, lam_g, multiplier_tolerance, bound_tolerance)
+    fixed = _active(x, x_low, x_high, lam_x, multiplier_tolerance, bound_tolerance)
     free = ~fixed
     A = J[np.ix_(rows, free)]
     n_free = int(free.sum())

@@ -18,17 +18,21 @@ from planners.collocation_strategy import control_floor
 from tests.test_collocation import bilimoria_wie_problem
 
 
-def nlp(f, g=None, n=2):
+def nlp(f, g=None, n=2, solver="ipopt"):
     x = ca.SX.sym("x", n)
     problem = {"x": x, "f": f(x)}
     if g is not None:
         problem["g"] = g(x)
-    return ca.nlpsol("s", "ipopt", problem, solver_options("ipopt", 1e-12, 200))
+    # FATROP without its structure detection: only its derivative functions are used here
+    options = solver_options("ipopt", 1e-12, 200) if solver == "ipopt" else {"print_time": False}
+    return ca.nlpsol("s", solver, problem, options)
 
 
-def test_an_unconstrained_saddle_has_its_negative_curvature():
+@pytest.mark.parametrize("solver", ["ipopt", "fatrop"])
+def test_an_unconstrained_saddle_has_its_negative_curvature(solver):
     # f = x² − y² at 0: ∇²f = diag(2, −2), no constraint, so Z is the plane and the least curvature −2.
-    solver = nlp(lambda x: x[0] ** 2 - x[1] ** 2)
+    # (FATROP's nlp_hess_l returns the Lagrangian's gradient first, then its full Hessian.)
+    solver = nlp(lambda x: x[0] ** 2 - x[1] ** 2, solver=solver)
     check = second_order_check(solver, np.zeros(2), np.zeros(2), np.zeros(0))
     assert not check.certified
     assert check.null_dimension == 2
@@ -46,6 +50,42 @@ def test_the_curvature_along_an_equality_constraint(sign, certified):
     assert check.min_curvature == pytest.approx(-sign)
 
 
+@pytest.mark.parametrize("solver", ["ipopt", "fatrop"])
+@pytest.mark.parametrize("corner, certified", [(-1.0, True), (1.0, False)])
+def test_the_curvature_of_a_nonlinear_constraint_comes_from_its_multiplier(solver, corner, certified):
+    # min x + y on x² + y² = 2: ∇f + λ ∇g = (1, 1) + 2 λ (x, y) = 0 gives λ = 1/2 at (−1, −1) (the
+    # minimum) and λ = −1/2 at (1, 1) (the maximum). ∇²f = 0, so ∇²L = 2 λ I: the curvature along the
+    # circle, 2 λ = ∓1, is the multiplier's alone (its sign in CasADi's L = f + λᵀ g decides).
+    solver = nlp(lambda x: x[0] + x[1], lambda x: x[0] ** 2 + x[1] ** 2, solver=solver)
+    lam = np.array([-0.5 * corner])
+    check = second_order_check(solver, corner * np.ones(2), np.zeros(2), lam, lbg=2.0, ubg=2.0)
+    assert check.certified is certified and check.null_dimension == 1
+    assert check.min_curvature == pytest.approx(-corner)
+
+
+@pytest.mark.parametrize("case", ["maximum with multipliers of the wrong sign", "not stationary",
+                                  "multiplier of an inactive one-sided constraint"])
+def test_a_point_that_is_not_first_order_is_not_certified(case):
+    # Theorem 12.6 assumes a KKT point; a stalled solve (Search_Direction_Becomes_Too_Small is
+    # accepted by the multistart) or multipliers of another convention are not one. Each point below
+    # is a vertex or has a positive definite Hessian, yet is no minimum.
+    if case == "maximum with multipliers of the wrong sign":
+        # min −x − y on [0, 1]²: (0, 0) is the maximum; λ = (1, 1) makes ∇f + λ = 0 but belongs to
+        # upper bounds (a lower bound's multiplier is negative in CasADi)
+        solver = nlp(lambda x: -x[0] - x[1])
+        check = second_order_check(solver, np.zeros(2), np.ones(2), np.zeros(0), lbx=0.0, ubx=1.0)
+    elif case == "not stationary":
+        # min (x − 1)² + y² at (0, 0): ∇²f = 2 I, but ∇f = (−2, 0)
+        solver = nlp(lambda x: (x[0] - 1) ** 2 + x[1] ** 2)
+        check = second_order_check(solver, np.zeros(2), np.zeros(2), np.zeros(0))
+    else:
+        # min x with x >= −1 as a constraint, at x = 0 with λ = −1: stationary, but the constraint
+        # is 1 away from its bound (its upper bound is infinite, never "near")
+        solver = nlp(lambda x: x[0], lambda x: x[0], n=1)
+        check = second_order_check(solver, np.zeros(1), np.zeros(1), -np.ones(1), lbg=-1.0, ubg=np.inf)
+    assert not check.certified and "not a first-order point" in check.message
+
+
 def test_strongly_active_bounds_make_a_vertex():
     # min x + y on x, y >= 0: both bounds active with multipliers 1, nothing left to move.
     solver = nlp(lambda x: x[0] + x[1] - 0.1 * x[0] * x[1])
@@ -55,13 +95,51 @@ def test_strongly_active_bounds_make_a_vertex():
 
 def test_a_weakly_active_bound_is_left_free():
     # min x² − y² near 0 with y in [0, 1]: at (0, 0) the bound y >= 0 is met with a zero multiplier,
-    # so y stays free and its negative curvature −2 shows (y = 1 is the minimum). A multiplier
-    # above the tolerance would fix y and certify the point: the check must not do that.
+    # so y stays free and its negative curvature −2 shows (y = 1 is the minimum).
     solver = nlp(lambda x: x[0] ** 2 - x[1] ** 2)
     check = second_order_check(solver, np.zeros(2), np.zeros(2), np.zeros(0), lbx=[-1, 0], ubx=[1, 1])
     assert not check.certified and check.min_curvature == pytest.approx(-2.0)
+    # min x² − y² + y: ∇f = (0, 1) at (0, 0), balanced by the bound's multiplier −1 (strongly active,
+    # y fixed): f = x² + y − y² >= 0 nearby, a strict minimum with curvature 2 along x.
+    solver = nlp(lambda x: x[0] ** 2 - x[1] ** 2 + x[1])
     fixed = second_order_check(solver, np.zeros(2), np.array([0.0, -1.0]), np.zeros(0), lbx=[-1, 0], ubx=[1, 1])
     assert fixed.certified and fixed.null_dimension == 1 and fixed.min_curvature == pytest.approx(2.0)
+
+
+def test_strongly_active_inequality_rows_make_a_vertex():
+    # The vertex of test_strongly_active_bounds_make_a_vertex with x, y >= 0 as constraint rows:
+    # both active with multipliers −1 (∇f = (1, 1) at 0), so the indefinite −0.1 x y does not count.
+    solver = nlp(lambda x: x[0] + x[1] - 0.1 * x[0] * x[1], lambda x: x)
+    check = second_order_check(solver, np.zeros(2), np.zeros(2), -np.ones(2), lbg=0.0, ubg=np.inf)
+    assert check.certified and check.null_dimension == 0
+
+
+def test_dependent_active_rows_leave_their_null_space():
+    # f = x y with x + y = 0 written twice (2 x + 2 y = 0: dependent rows, λ = 0 satisfies KKT at 0).
+    # Z is the line d = (1, −1)/√2 (rank 1, not 2), where dᵀ ∇²f d = 2 d₁ d₂ = −1: a saddle. Counting
+    # both rows as independent would leave Z = {0} and certify it as a vertex.
+    solver = nlp(lambda x: x[0] * x[1], lambda x: ca.vertcat(x[0] + x[1], 2 * x[0] + 2 * x[1]))
+    check = second_order_check(solver, np.zeros(2), np.zeros(2), np.zeros(2), lbg=0.0, ubg=0.0)
+    assert not check.certified and check.null_dimension == 1
+    assert check.min_curvature == pytest.approx(-1.0)
+
+
+def test_zero_curvature_is_not_certified():
+    # f = x² + y³ at 0: ∇²f = diag(2, 0), positive semidefinite only, and f(0, −t) = −t³ < 0.
+    solver = nlp(lambda x: x[0] ** 2 + x[1] ** 3)
+    check = second_order_check(solver, np.zeros(2), np.zeros(2), np.zeros(0))
+    assert not check.certified and check.min_curvature == pytest.approx(0.0, abs=1e-12)
+
+
+def test_an_infinite_bound_is_never_near():
+    # x >= 0 (row 1, multiplier −1000: strongly active) and y >= −1 (row 2, y = 0 is 1 away from it; a
+    # stray multiplier −1e-4, within the complementarity tolerance relative to 1000). f = 1000 x +
+    # 1e-4 y − y²: stationary, and y, being free, carries the curvature −2: a saddle. Taking row 2's
+    # infinite upper bound as "near" would fix y and certify a vertex.
+    solver = nlp(lambda x: 1000 * x[0] + 1e-4 * x[1] - x[1] ** 2, lambda x: x)
+    check = second_order_check(solver, np.zeros(2), np.zeros(2), np.array([-1000.0, -1e-4]),
+                               lbg=[0.0, -1.0], ubg=np.inf)
+    assert not check.certified and check.null_dimension == 1 and check.min_curvature == pytest.approx(-2.0)
 
 
 def bilimoria_wie_coarse(perturbation):
@@ -123,16 +201,12 @@ def test_the_default_minimum_time_plan_certifies_its_coarse_optimum():
     assert reference.duration == pytest.approx(3.2431, abs=2e-4)
 
 
-def test_the_unchecked_size_is_reported():
-    solver = nlp(lambda x: ca.sumsqr(x), n=3)
+def test_the_unchecked_size_is_reported(monkeypatch):
     from ocp import second_order
 
-    limit = second_order.MAX_VARIABLES
-    try:
-        second_order.MAX_VARIABLES = 2
-        check = second_order_check(solver, np.zeros(3), np.zeros(3), np.zeros(0))
-    finally:
-        second_order.MAX_VARIABLES = limit
+    solver = nlp(lambda x: ca.sumsqr(x), n=3)
+    monkeypatch.setattr(second_order, "MAX_VARIABLES", 2)
+    check = second_order_check(solver, np.zeros(3), np.zeros(3), np.zeros(0))
     assert not check.certified and check.null_dimension == -1 and "not checked" in check.message
 
 
