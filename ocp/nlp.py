@@ -42,11 +42,18 @@ satisfies them is a strict local minimum, which is what a restart would confirm,
 counts as one more start agreeing on it (with ``agree=2``, the first converged start then ends the
 search); a point that does not (a saddle, or a degenerate minimum the check cannot certify) gets the
 restarts as before. ``agree=0`` (try everything) still runs every restart.
+
+Ties
+----
+With ``tie_break``, a converged start whose objective agrees with the best (``rtol``/``atol``)
+replaces it when its ``tie_break(x)`` is smaller: among optima equal in the objective, the secondary
+criterion decides (e.g. the spin extremals, whose branches all reach the target exactly, J1 = 0, and
+differ in their energy J2), not rounding at the level of ``atol``.
 """
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from typing import Any
 
 import casadi as ca
@@ -172,7 +179,8 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
                      atol: float = 1e-12, feasibility_tolerance: float = 1e-8,
                      max_starts: int | None = None, restart: float = 0.0, max_restarts: int = 4,
                      fallback: Sequence[Array] = (), lam_x0: Any = None, lam_g0: Any = None,
-                     second_order: bool = False) -> NLPResult:
+                     second_order: bool = False,
+                     tie_break: Callable[[Array], float] | None = None) -> NLPResult:
     """Solve from each guess in turn, keep the best converged start, stop early on agreement.
 
     Parameters
@@ -204,6 +212,10 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         Before the restarts, check the best point by the second-order sufficient conditions; when
         it satisfies them, the certificate counts as one more start agreeing on it (with
         ``agree=2``, no restart; see the module docstring).
+    tie_break : callable or None
+        Secondary criterion of a decision vector: among converged starts whose objectives agree
+        with the best, the one with the least value is kept (see the module docstring); ``None``:
+        the least objective.
 
     Returns
     -------
@@ -220,7 +232,7 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
     g_low = -np.inf if lbg is None else lbg
     g_high = np.inf if ubg is None else ubg
     best: dict[str, Any] = {}
-    best_f, best_index = np.inf, None
+    best_f, best_index, best_tie = np.inf, None, np.inf
     checks: dict[int, SecondOrderCheck] = {}
     starts: list[StartResult] = []
     objectives: list[float] = []
@@ -264,9 +276,12 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         if not ok:
             continue
         objectives.append(f)
-        if f < best_f:
-            best = {key: solution[key].full().ravel() for key in ("x", "lam_x", "lam_g")}
-            best["g"], best_f, best_index = g, f, index
+        x = solution["x"].full().ravel()
+        tie = np.inf if tie_break is None else float(tie_break(x))
+        equal = tie_break is not None and abs(f - best_f) <= atol + rtol * abs(best_f)
+        if (tie < best_tie) if equal else (f < best_f):
+            best = {key: solution[key].full().ravel() for key in ("lam_x", "lam_g")}
+            best["x"], best["g"], best_f, best_index, best_tie = x, g, f, index, tie
         if agree and agreeing() >= agree:
             break
     total = time.perf_counter() - begin

@@ -326,8 +326,10 @@ class SpinExtremalPlanner(Planner):
 
     def _optimise(self, solver: ca.Function, v: float, T: float, moments: Array, target: Array):
         parameters = np.r_[v, T, moments, target, self.options.weight]
-        # Every start is a different branch of K T by design: all are tried (agree = 0).
-        result = solve_multistart(solver, self._seeds(v, T, moments, target), p=parameters, agree=0)
+        # Every start is a different branch of K T by design: all are tried (agree = 0). Branches that
+        # all reach the target (J1 = 0 to rounding) differ in energy: J2 breaks the tie, not rounding.
+        result = solve_multistart(solver, self._seeds(v, T, moments, target), p=parameters, agree=0,
+                                  tie_break=lambda x: float(energy_cost(v, x[0], x[1], x[2], T, moments)))
         stats = result.stats()
         if result.x is None:
             stats["message"] = f"IPOPT did not converge from any start: {sorted(set(result.statuses))}"
