@@ -47,6 +47,7 @@ from planners.collocation_strategy import (
     AUTO_FIRST,
     AUTO_RESTART,
     POLISH_MU_INIT,
+    SEED_TOLERANCE,
     TRANSFER_WARM_START,
     control_floor,
     merged,
@@ -93,13 +94,17 @@ class CollocationPlanner(Planner):
         (from the cache when built before). ``mode``: the solver options of a start from a point
         alone (``cold``), with its multipliers (``warm``, :func:`ocp.nlp.warm_start_options`), near
         the optimum (``near_optimum``: IPOPT's barrier starts at :data:`POLISH_MU_INIT`) or with the
-        multipliers of a coarse-mesh optimum (``transfer``: :data:`TRANSFER_WARM_START`)."""
+        multipliers of a coarse-mesh optimum (``transfer``: :data:`TRANSFER_WARM_START`). A fixed final
+        time on other than the option's ``intervals`` is the coarse seed: solved to
+        :data:`SEED_TOLERANCE` at the least."""
         o = self.options
         intervals = o.intervals if intervals is None else intervals
         if o.solver != "ipopt" and mode in ("near_optimum", "transfer"):
             mode = "cold"
+        seed_only = intervals != o.intervals and not ocp.free_time
+        tolerance = max(o.tolerance, SEED_TOLERANCE) if seed_only else o.tolerance
         key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
-               o.transcription, intervals, o.degree, o.substeps, o.solver, o.tolerance, o.max_iterations, mode)
+               o.transcription, intervals, o.degree, o.substeps, o.solver, tolerance, o.max_iterations, mode)
         extra = {"cold": None, "warm": warm_start_options(o.solver), "near_optimum": {"ipopt.mu_init": POLISH_MU_INIT},
                  "transfer": warm_start_options(o.solver, **TRANSFER_WARM_START)}[mode]
 
@@ -108,7 +113,7 @@ class CollocationPlanner(Planner):
             same = intervals == o.intervals
             transcription = TRANSCRIPTIONS[o.transcription].from_options(o if same else replace(o, intervals=intervals))
             return transcription, transcription.build(ocp, o.solver,
-                                                      solver_options(o.solver, o.tolerance, o.max_iterations, extra))
+                                                      solver_options(o.solver, tolerance, o.max_iterations, extra))
 
         # The model's numbers are baked into the graph: a shared cache needs them in the key.
         return self.solver_cache(problem).get(("collocation", problem.model.fingerprint, key), build)

@@ -189,3 +189,24 @@ def test_solution_sampler_reads_a_node_from_the_interval_that_ends_there():
     _, u, _ = solution_sampler(reference)(np.array([problem.duration / 2]))
     d, nu = reference.transcription.degree, reference.model.nu
     np.testing.assert_allclose(u[0], reference.controls[(d - 1) * nu:d * nu, 3], rtol=1e-12, atol=1e-15)
+
+
+def test_the_loose_coarse_seed_of_a_fixed_time_leaves_the_optimum(monkeypatch):
+    # A fixed final time's coarse solve is only a seed, solved to SEED_TOLERANCE (1e-5, the option's
+    # 1e-10 elsewhere); the spin paper's minimum energy from the spin extremal (a 180° flip of a body
+    # spinning at 0.2 rad/s: 0.0201 on the coarse mesh, 0.0185 on 50 intervals) must still reach the
+    # optimum of the direct 50-interval solve, and the coarse NLP must be built with that tolerance.
+    from ocp import transcription_base
+
+    tolerances = []
+    build = transcription_base.Transcription.build
+    monkeypatch.setattr(transcription_base.Transcription, "build", lambda self, ocp, solver, options:
+                        tolerances.append((self.intervals, options["ipopt.tol"])) or build(self, ocp, solver, options))
+    problem = ManeuverProblem(Spacecraft([19.5, 19.0, 12.6], torquers=Torquers(0.1)), quat.IDENTITY, [0.2, 0, 0],
+                              [0, 0, 1, 0], 200.0)
+    default = PLANNERS["collocation"]({"warm_start": "spin_extremal"}).plan(problem)
+    direct = PLANNERS["collocation"]({"warm_start": "spin_extremal", "coarse_intervals": 0}).plan(problem)
+    assert default.ok and direct.ok, (default.message, direct.message)
+    assert (8, 1e-5) in tolerances and (50, 1e-10) in tolerances and (8, 1e-10) not in tolerances
+    assert default.stats["coarse"]["objective"] > 1.05 * default.stats["objective"]  # the coarse mesh is off
+    assert default.stats["objective"] == pytest.approx(direct.stats["objective"], rel=1e-8)
