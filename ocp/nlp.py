@@ -45,10 +45,12 @@ restarts as before. ``agree=0`` (try everything) still runs every restart.
 
 Ties
 ----
-With ``tie_break``, a converged start whose objective agrees with the best (``rtol``/``atol``)
-replaces it when its ``tie_break(x)`` is smaller: among optima equal in the objective, the secondary
-criterion decides (e.g. the spin extremals, whose branches all reach the target exactly, J1 = 0, and
-differ in their energy J2), not rounding at the level of ``atol``.
+With ``tie_break``, among the converged starts whose objectives agree (``rtol``/``atol``) with the
+least objective found so far, the one with the least ``tie_break(x)`` is kept (then the least
+objective, then the first): among optima equal in the objective, the secondary criterion decides
+(e.g. the spin extremals, whose branches all reach the target exactly, J1 = 0, and differ in their
+energy J2), not rounding at the level of ``atol``. A ``nan`` criterion ranks last. Early stopping
+counts agreement with the kept start's objective.
 """
 from __future__ import annotations
 
@@ -214,8 +216,8 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         ``agree=2``, no restart; see the module docstring).
     tie_break : callable or None
         Secondary criterion of a decision vector: among converged starts whose objectives agree
-        with the best, the one with the least value is kept (see the module docstring); ``None``:
-        the least objective.
+        with the least one, the one with the least value is kept (see the module docstring);
+        ``None``: the least objective.
 
     Returns
     -------
@@ -232,7 +234,8 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
     g_low = -np.inf if lbg is None else lbg
     g_high = np.inf if ubg is None else ubg
     best: dict[str, Any] = {}
-    best_f, best_index, best_tie = np.inf, None, np.inf
+    best_f, best_index = np.inf, None
+    ranked: list[tuple[float, float, int, dict[str, Any]]] = []  # with tie_break
     checks: dict[int, SecondOrderCheck] = {}
     starts: list[StartResult] = []
     objectives: list[float] = []
@@ -276,12 +279,20 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         if not ok:
             continue
         objectives.append(f)
-        x = solution["x"].full().ravel()
-        tie = np.inf if tie_break is None else float(tie_break(x))
-        equal = tie_break is not None and abs(f - best_f) <= atol + rtol * abs(best_f)
-        if (tie < best_tie) if equal else (f < best_f):
-            best = {key: solution[key].full().ravel() for key in ("lam_x", "lam_g")}
-            best["x"], best["g"], best_f, best_index, best_tie = x, g, f, index, tie
+        if tie_break is None:
+            if f < best_f:
+                best = {key: solution[key].full().ravel() for key in ("x", "lam_x", "lam_g")}
+                best["g"], best_f, best_index = g, f, index
+        else:
+            # Judged against the least objective, not the start kept so far: tolerance chains
+            # (a ≈ b ≈ c, a ≉ c) would otherwise drift away from it, and the order would decide.
+            point = {key: solution[key].full().ravel() for key in ("x", "lam_x", "lam_g")}
+            tie = float(tie_break(point["x"]))
+            ranked.append((np.inf if np.isnan(tie) else tie, f, index, {**point, "g": g}))
+            least = min(entry[1] for entry in ranked)
+            _, best_f, best_index, best = min((entry for entry in ranked
+                                               if abs(entry[1] - least) <= atol + rtol * abs(least)),
+                                              key=lambda entry: entry[:3])
         if agree and agreeing() >= agree:
             break
     total = time.perf_counter() - begin
