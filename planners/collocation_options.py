@@ -70,7 +70,9 @@ class CollocationOptions:
     cone_margin_deg : float
         Cones are imposed this much tighter [deg], so that they hold between the points.
     tolerance : float
-        Solver tolerance (scaled KKT error).
+        Solver tolerance (scaled KKT error); the coarse seed of a fixed final time
+        (``coarse_intervals``) is solved to 1e-5 at the tightest
+        (:data:`~planners.collocation_strategy.SEED_TOLERANCE`).
     max_iterations : int
         Solver iterations per start.
     """
