@@ -48,6 +48,7 @@ from planners.collocation_strategy import (
     AUTO_RESTART,
     POLISH_MU_INIT,
     SEED_TOLERANCE,
+    TRANSFER_L1_BARRIER,
     TRANSFER_WARM_START,
     control_floor,
     merged,
@@ -94,7 +95,8 @@ class CollocationPlanner(Planner):
         (from the cache when built before). ``mode``: the solver options of a start from a point
         alone (``cold``), with its multipliers (``warm``, :func:`ocp.nlp.warm_start_options`), near
         the optimum (``near_optimum``: IPOPT's barrier starts at :data:`POLISH_MU_INIT`) or with the
-        multipliers of a coarse-mesh optimum (``transfer``: :data:`TRANSFER_WARM_START`). A fixed final
+        multipliers of a coarse-mesh optimum (``transfer``: :data:`TRANSFER_WARM_START`, with
+        :data:`TRANSFER_L1_BARRIER` for an L1 objective without an energy term). A fixed final
         time on other than the option's ``intervals`` is the coarse seed: solved to
         :data:`SEED_TOLERANCE` at the least."""
         o = self.options
@@ -107,6 +109,8 @@ class CollocationPlanner(Planner):
                o.transcription, intervals, o.degree, o.substeps, o.solver, tolerance, o.max_iterations, mode)
         extra = {"cold": None, "warm": warm_start_options(o.solver), "near_optimum": {"ipopt.mu_init": POLISH_MU_INIT},
                  "transfer": warm_start_options(o.solver, **TRANSFER_WARM_START)}[mode]
+        if mode == "transfer" and ocp.l1_weight > 0 and ocp.energy_weight == 0:
+            extra = {**(extra or {}), **TRANSFER_L1_BARRIER}
 
         def build() -> tuple[Transcription, NLP]:
             # the transcription is built here, once per entry (its constructor is not free)

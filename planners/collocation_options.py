@@ -57,10 +57,11 @@ class CollocationOptions:
         free final time the whole multistart; for a fixed one only without cones and with at
         least twice as many ``intervals``, and to the looser tolerance
         :data:`~planners.collocation_strategy.SEED_TOLERANCE`: that optimum is only a seed) and the
-        full mesh is solved once from that optimum and its multipliers carried over (IPOPT; with
-        ``time_regularization`` the regularised optimum, then polished on the full mesh; falling
-        back to that optimum alone with the barrier starting at 1e-4, then to the full-mesh solve
-        from the starts); 0 or >= ``intervals``: off. Default 8.
+        full mesh is solved once from that optimum and its multipliers carried over (IPOPT, its
+        barrier adaptive for ``min_l1``; with ``time_regularization`` the regularised optimum,
+        then polished on the full mesh; falling back to that optimum alone with the barrier
+        starting at 1e-4, then to the full-mesh solve from the starts); 0 or >= ``intervals``:
+        off. Default 8.
     energy_weight, l1_weight, time_weight : float
         Weights of ``weighted`` [1/(N² m² s), 1/(N m s), 1/s].
     max_rate : float or None

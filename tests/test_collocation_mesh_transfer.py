@@ -210,3 +210,28 @@ def test_the_loose_coarse_seed_of_a_fixed_time_leaves_the_optimum(monkeypatch):
     assert (8, 1e-5) in tolerances and (50, 1e-10) in tolerances and (8, 1e-10) not in tolerances
     assert default.stats["coarse"]["objective"] > 1.05 * default.stats["objective"]  # the coarse mesh is off
     assert default.stats["objective"] == pytest.approx(direct.stats["objective"], rel=1e-8)
+
+
+@pytest.mark.parametrize("objective, adaptive", [("min_l1", True), ("min_energy", False)])
+def test_an_l1_transfer_takes_the_adaptive_barrier(monkeypatch, objective, adaptive):
+    # min_l1's optimum is bang-off-bang (torque slacks at their bounds): from the coarse optimum,
+    # IPOPT's monotone barrier at 1e-7 crawled here (63 full-mesh iterations, α ~ 1e-3 per step;
+    # 212 on the unrounded random problem) where the direct 40-interval solve takes 36. With the
+    # adaptive barrier (TRANSFER_L1_BARRIER) 16, to the direct solve's optimum; min_energy keeps
+    # the monotone one.
+    from ocp import transcription_base
+
+    strategies = []
+    build = transcription_base.Transcription.build
+    monkeypatch.setattr(transcription_base.Transcription, "build", lambda self, ocp, solver, options: strategies.append(
+        options.get("ipopt.mu_strategy")) or build(self, ocp, solver, options))
+    problem = ManeuverProblem(Spacecraft([16.605, 19.315, 12.072], torquers=Torquers(0.1)), quat.IDENTITY,
+                              [0.1047, 0, 0], quat.from_axis_angle([0.0915, 0.6701, -2.8282], 2.4077), 217.68,
+                              omegaf=np.zeros(3))
+    default = PLANNERS["collocation"]({"intervals": 40, "objective": objective}).plan(problem)
+    assert default.ok and "coarse" in default.stats, default.message
+    assert ("adaptive" in strategies) == adaptive
+    if adaptive:
+        direct = PLANNERS["collocation"]({"intervals": 40, "objective": objective, "coarse_intervals": 0}).plan(problem)
+        assert default.stats["objective"] == pytest.approx(direct.stats["objective"], rel=1e-8)
+        assert default.stats["iterations"] < 30  # 63 with the monotone barrier
