@@ -235,3 +235,34 @@ def test_an_l1_transfer_takes_the_adaptive_barrier(monkeypatch, objective, adapt
         direct = PLANNERS["collocation"]({"intervals": 40, "objective": objective, "coarse_intervals": 0}).plan(problem)
         assert default.stats["objective"] == pytest.approx(direct.stats["objective"], rel=1e-8)
         assert default.stats["iterations"] < 30  # 63 with the monotone barrier
+
+
+@pytest.mark.parametrize("options, adaptive", [
+    ({"objective": "min_l1"}, True),
+    ({"objective": "weighted", "time_weight": 1.0, "l1_weight": 1.0, "energy_weight": 0.0}, True),  # free final time
+    ({"objective": "weighted", "energy_weight": 1.0, "l1_weight": 0.1}, False),  # 172 iterations against 151
+    ({"objective": "min_energy"}, False),
+    ({"objective": "min_time"}, False),  # adaptive: 5-8 % more instructions on the benchmark cases
+    ({"objective": "min_l1", "solver": "fatrop"}, False),  # transfer is a cold start for FATROP
+])
+def test_only_the_transfer_of_an_l1_objective_without_energy_is_adaptive(monkeypatch, options, adaptive):
+    # Pins the condition of TRANSFER_L1_BARRIER build by build (the end-to-end test above covers
+    # min_l1 and min_energy only: dropping its energy or L1 test, or leaving out the time-weighted
+    # L1 objective, went unnoticed there): only the full-mesh build started from the coarse optimum
+    # takes the adaptive barrier, and only for an L1 term without an energy term.
+    from ocp import transcription_base
+
+    strategies = {}
+    build = transcription_base.Transcription.build
+    monkeypatch.setattr(transcription_base.Transcription, "build", lambda self, ocp, solver, extra: strategies.update(
+        {mode: extra.get("ipopt.mu_strategy")}) or build(self, ocp, solver, extra))
+    problem = bounded_single_axis()
+    planner = PLANNERS["collocation"]({"intervals": 4, **options})
+    ocp = planner._ocp(problem)
+    for mode in ("cold", "warm", "near_optimum", "transfer"):
+        planner._nlp(problem, ocp, mode)
+    if options.get("solver") == "fatrop":  # near_optimum and transfer are the cold build (a cache hit)
+        assert strategies == {"cold": None, "warm": None}
+    else:
+        expected = "adaptive" if adaptive else None
+        assert strategies == {"cold": None, "warm": None, "near_optimum": None, "transfer": expected}
