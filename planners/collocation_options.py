@@ -58,10 +58,10 @@ class CollocationOptions:
         least twice as many ``intervals``, and to the looser tolerance
         :data:`~planners.collocation_strategy.SEED_TOLERANCE`: that optimum is only a seed) and the
         full mesh is solved once from that optimum and its multipliers carried over (IPOPT, its
-        barrier adaptive for ``min_l1``; with ``time_regularization`` the regularised optimum,
-        then polished on the full mesh; falling back to that optimum alone with the barrier
-        starting at 1e-4, then to the full-mesh solve from the starts); 0 or >= ``intervals``:
-        off. Default 8.
+        barrier adaptive for an L1 term without an energy term; with ``time_regularization`` the
+        regularised optimum, then polished on the full mesh; falling back to that optimum alone
+        with the barrier starting at 1e-4, then to the full-mesh solve from the starts); 0 or >=
+        ``intervals``: off. Default 8.
     energy_weight, l1_weight, time_weight : float
         Weights of ``weighted`` [1/(N² m² s), 1/(N m s), 1/s].
     max_rate : float or None
