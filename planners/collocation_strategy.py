@@ -30,11 +30,11 @@ seeds the full mesh, whose discretisation moves it far more (the spin paper's mi
 on 8 intervals, 0.01855 on 50). 32 random fixed-time minimum-energy problems (random principal
 inertias, slews, spins, durations, free or zero final rates; warm starts ``spin_extremal`` or
 ``eigenaxis``): 357 coarse iterations against 428 at the default 1e-10, the full-mesh iterations
-unchanged (109), the same optima; 1e-4 and 1e-3 save a few more coarse iterations and cost full-mesh ones
-(51 against 49 on 16 of them). The 18 fixed-time cases of ``tests/benchmarks/iteration_counts.py``:
-282 coarse and 202 full-mesh iterations against 320 and 205, the same optima (the spin paper's case
-26 + 4 against 28 + 4); minimum time, whose coarse optimum is certified or confirmed, keeps the
-option's tolerance."""
+unchanged (109), the same optima; 1e-4 and 1e-3 save a few more coarse iterations and cost full-mesh
+ones (51 against 49 on 16 of them). The 18 fixed-time cases of
+``tests/benchmarks/iteration_counts.py``: 282 coarse and 202 full-mesh iterations against 320 and
+205, the same optima (the spin paper's case 26 + 4 against 28 + 4); minimum time, whose coarse
+optimum is certified or confirmed, keeps the option's tolerance."""
 POLISH_MU_INIT = 1e-4
 """IPOPT's initial barrier parameter (its default 0.1) for the full-mesh solve from a coarse-mesh
 optimum: the seed is near the optimum, so the barrier need not start wide. N = 50 from N = 8:
