@@ -49,6 +49,7 @@ from planners.collocation_strategy import (
     POLISH_MU_INIT,
     SEED_TOLERANCE,
     TRANSFER_L1_BARRIER,
+    TRANSFER_MAX_INTERVALS,
     TRANSFER_WARM_START,
     control_floor,
     merged,
@@ -275,9 +276,9 @@ class CollocationPlanner(Planner):
         """The full-mesh solve from the coarse optimum ``found`` with its multipliers carried over
         (:meth:`_transfer`), and its extra stats; with ``time_regularization``, the coarse
         regularised optimum is carried to the full mesh's regularised problem, which is then
-        polished (:meth:`_polished`). ``None`` where that does not apply (FATROP, layouts that
-        differ)."""
-        if self.options.solver != "ipopt":
+        polished (:meth:`_polished`). ``None`` where that does not apply (FATROP, more than
+        :data:`TRANSFER_MAX_INTERVALS` intervals, layouts that differ)."""
+        if self.options.solver != "ipopt" or self.options.intervals > TRANSFER_MAX_INTERVALS:
             return None
         if not self.options.time_regularization:
             result = self._transfer(problem, ocp, coarse.result, coarse.nlp, found, params, bounds)

@@ -52,6 +52,17 @@ Neighbouring values do about as well (mu_init 1e-8 to 1e-5, pushes 1e-4 to 1e-2:
 iterations over the three); a multiplier push of 1e-2 does not (34 to 41), nor IPOPT's tiny pushes
 of a same-mesh warm start (1e-9: 20 and 12 on the minimum-time cases)."""
 
+TRANSFER_MAX_INTERVALS = 150
+"""Largest full mesh solved from the coarse optimum with its multipliers carried over (IPOPT's
+``warm_start_init_point``, :data:`TRANSFER_WARM_START`); beyond it the full mesh starts from the
+coarse optimum alone (:data:`POLISH_MU_INIT`). With the default options, the 30 deg wheel slew of
+``tests/test_collocation_mesh_transfer.py`` on 300, 400 and 500 intervals ran over 120 s (killed)
+in MUMPS's first factorisation of that warm start ("INFO(1) = -9 ... reallocating", about 30 s per
+attempt), with the carried multipliers or zeros and for ``mu_init`` 1e-7 or 1e-4, while the same
+seed without ``warm_start_init_point`` converged in 0.9 s and 200 intervals took 1 s. The tuning
+above is on 40 to 50 intervals; 150 is the largest mesh of the test suite (multiple shooting's
+full-inertia minimum time)."""
+
 TRANSFER_L1_BARRIER = {"ipopt.mu_strategy": "adaptive"}
 """Added to :data:`TRANSFER_WARM_START` for an objective with an L1 term and no energy term
 (``min_l1``; its optimum is bang-off-bang, many torque slacks at their bounds): IPOPT's adaptive

@@ -266,3 +266,40 @@ def test_only_the_transfer_of_an_l1_objective_without_energy_is_adaptive(monkeyp
     else:
         expected = "adaptive" if adaptive else None
         assert strategies == {"cold": None, "warm": None, "near_optimum": None, "transfer": expected}
+
+
+def wheel_slew_30_deg():
+    # The 30 deg slew about x in 20 s of the input-hardening base scenario (three 0.05 N m wheels).
+    from ocp import ReactionWheels
+
+    spacecraft = Spacecraft([2.0, 3.0, 4.0], wheels=ReactionWheels.from_body_axes(max_torque=0.05))
+    return ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.from_axis_angle([1, 0, 0], np.deg2rad(30.0)),
+                           20.0, omegaf=np.zeros(3))
+
+
+def test_no_multiplier_transfer_onto_a_mesh_beyond_its_validated_size(monkeypatch):
+    # With the default options (coarse_intervals 8), 300, 400 and 500 intervals on this 30 deg wheel
+    # slew ran > 120 s (killed): MUMPS's first factorisation of the IPOPT warm start from the coarse
+    # optimum ("INFO(1) = -9 ... reallocating" three times, ~30 s each), with or without the carried
+    # multipliers and for mu_init 1e-7 or 1e-4; the same seed without warm_start_init_point
+    # converged in 0.9 s, the cold solve from eigenaxis in 3.4 s on 500 intervals.
+    from planners.collocation import CollocationPlanner
+    from planners.collocation_strategy import TRANSFER_MAX_INTERVALS
+
+    calls = []
+    monkeypatch.setattr(CollocationPlanner, "_transfer", lambda self, *args: calls.append(self.options.intervals))
+    problem = wheel_slew_30_deg()
+    for intervals in (TRANSFER_MAX_INTERVALS, TRANSFER_MAX_INTERVALS + 1):
+        PLANNERS["collocation"]({"intervals": intervals}).plan(problem)  # falls back without it
+    assert calls == [TRANSFER_MAX_INTERVALS]
+
+
+def test_a_fine_mesh_beyond_the_transfer_limit_is_solved_from_the_coarse_optimum():
+    # 300 intervals (beyond TRANSFER_MAX_INTERVALS): the default plan (coarse seed, then the full
+    # mesh from it without multipliers) in seconds, to the optimum of the direct solve from eigenaxis.
+    problem = wheel_slew_30_deg()
+    default = PLANNERS["collocation"]({"intervals": 300}).plan(problem)
+    assert default.ok and "coarse" in default.stats, default.message
+    direct = PLANNERS["collocation"]({"intervals": 300, "coarse_intervals": 0}).plan(problem)
+    assert direct.ok, direct.message
+    assert default.stats["objective"] == pytest.approx(direct.stats["objective"], rel=1e-8)
