@@ -12,6 +12,12 @@ from ocp.transcription import TRANSCRIPTIONS
 from planners.collocation_problem import parse_cone
 
 
+MAX_RK4_STEPS = 1000
+"""Largest ``intervals × substeps`` of ``multiple_shooting``: the NLP build expands every RK4 step
+(10 × 100 and 50 × 20 steps built in 20 s on a shared machine, 200 × 100 ran over 120 s; the
+default 50 × 4 is 200)."""
+
+
 @dataclass(frozen=True)
 class CollocationOptions:
     """Options of ``collocation`` (YAML keys; see the README's planner table).
@@ -28,7 +34,8 @@ class CollocationOptions:
     transcription : str
         ``collocation`` (Legendre-Gauss-Radau) or ``multiple_shooting``.
     substeps : int
-        RK4 steps per interval (``multiple_shooting``).
+        RK4 steps per interval (``multiple_shooting``; ``intervals × substeps`` at most
+        :data:`MAX_RK4_STEPS`).
     solver : str
         ``ipopt`` (default) or ``fatrop``.
     warm_start : str
@@ -37,7 +44,7 @@ class CollocationOptions:
     warm_start_options : dict
         The warm-start planner's options.
     seed_planners : list of str
-        Further planners whose references are starts.
+        Further planners whose references are starts (each at most once).
     multistart : int or "auto"
         ``auto`` (default): for a free final time a perturbed copy of the warm start
         (:data:`AUTO_FIRST`), then, unless its optimum satisfies the second-order sufficient
@@ -115,6 +122,13 @@ class CollocationOptions:
                 where = "warm_start" if index == 0 else f"seed_planners[{index - 1}]"
                 raise InvalidOption(where, f"{name!r} is not another registered planner; expected one of "
                                            f"{sorted(set(PLANNERS) - {'collocation'})} (or collocation as warm_start)")
+        for index, name in enumerate(self.seed_planners):
+            if name in self.seed_planners[:index]:  # the same reference again: the same start solved twice
+                raise InvalidOption(f"seed_planners[{index}]", f"{name!r} is listed twice; expected each planner once")
+        if self.transcription == "multiple_shooting" and self.intervals * self.substeps > MAX_RK4_STEPS:
+            raise InvalidOption("substeps", f"{self.intervals} intervals x {self.substeps} substeps = "
+                                            f"{self.intervals * self.substeps} RK4 steps; expected at most "
+                                            f"{MAX_RK4_STEPS} (every step is expanded into the NLP)")
         try:
             PLANNERS[self.warm_start](self.warm_start_options, path="warm_start_options")
         except OptionsError as error:

@@ -71,6 +71,12 @@ CASES = {
         {"boresight": [1, 0, 0], "direction": [0, 1, 0], "angle_deg": "thirty"}]}}), "planners[0].options.keep_out[0].angle_deg"),
     "boresight as a mapping": (with_planner({"name": "collocation", "options": {"keep_out": [
         {"boresight": {"x": 1}, "direction": [0, 1, 0], "angle_deg": 30}]}}), "planners[0].options.keep_out[0].boresight"),
+    # 200 intervals of 100 RK4 steps each: the NLP build (every step expanded) ran > 120 s; 10 x 100
+    # took 21 s, 50 x 20 took 20 s.
+    "too many RK4 steps": (with_planner({"name": "collocation", "options": {
+        "transcription": "multiple_shooting", "intervals": 200, "substeps": 100}}), "planners[0].options.substeps"),
+    "duplicate seed planner": (with_planner({"name": "collocation", "options": {
+        "seed_planners": ["eigenaxis", "natural_motion", "eigenaxis"]}}), "planners[0].options.seed_planners[2]"),
     "negative multistart": (with_planner({"name": "collocation", "options": {"multistart": -1}}), "planners[0].options.multistart"),
     "negative starts": (with_planner({"name": "spin_extremal", "options": {"starts": -1}}), "planners[0].options.starts"),
     "zero max_terms": (with_planner({"name": "shape_polynomial", "options": {"max_terms": 0}}), "planners[0].options.max_terms"),
