@@ -37,7 +37,11 @@ from ocp.transcription import (
 )
 from planners.base import Array, FailedReference, ManeuverProblem, Planner, Reference
 from planners.collocation_options import CollocationOptions
-from planners.collocation_problem import parse_cone, variable_bounds
+from planners.collocation_problem import (
+    endpoint_cone_error,
+    parse_cone,
+    variable_bounds,
+)
 from planners.collocation_reference import (
     CollocationReference,
     seed_sampler,
@@ -216,6 +220,11 @@ class CollocationPlanner(Planner):
         return o.multistart == "auto" and 0 < 2 * o.coarse_intervals <= o.intervals and not ocp.cones
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
+        o = self.options
+        names = [f"keep_out[{i}]" for i in range(len(o.keep_out))] + [f"keep_in[{i}]" for i in range(len(o.keep_in))]
+        broken = endpoint_cone_error(self._ocp(problem).cones, names, problem.q0, problem.qf)
+        if broken:
+            return FailedReference(self.name, f"no trajectory meets the cones: {broken}")
         starts = self._starts(problem)
         if not starts:
             return FailedReference(self.name, f"no start: the warm-start planner {self.options.warm_start!r} failed")

@@ -11,7 +11,6 @@ from ocp.options import InvalidOption, OptionsError, Range
 from ocp.transcription import TRANSCRIPTIONS
 from planners.collocation_problem import parse_cone
 
-
 MAX_RK4_STEPS = 1000
 """Largest ``intervals × substeps`` of ``multiple_shooting``: the NLP build expands every RK4 step
 (10 × 100 and 50 × 20 steps built in 20 s on a shared machine, 200 × 100 ran over 120 s; the

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ocp import quat
 from ocp.options import InvalidOption, excerpt
 from ocp.transcription import Cone
 from planners.base import Array, ManeuverProblem
@@ -52,6 +53,40 @@ def parse_cone(spec: dict, keep_out: bool, margin: float = 0.0, where: str = "co
     if not 0.0 < tightened < np.pi:
         raise InvalidOption(f"{where}.angle_deg", f"{angle} deg leaves no cone once tightened by cone_margin_deg")
     return Cone(tuple(boresight), tuple(direction), tightened, keep_out)
+
+
+def endpoint_cone_error(cones: tuple[Cone, ...], names: list[str], q0: Array, qf: Array | None) -> str | None:
+    """Which cones the initial or final attitude breaks (no trajectory can then meet them).
+
+    Parameters
+    ----------
+    cones : tuple of Cone
+        The (tightened) cones of the problem, unit vectors, half-angles [rad].
+    names : list of str
+        Each cone's option path (``keep_out[0]``), in the order of ``cones``.
+    q0 : (4,) array_like
+        Initial attitude (body to inertial, scalar first).
+    qf : (4,) array_like or None
+        Final attitude; ``None``: free, not checked.
+
+    Returns
+    -------
+    str or None
+        A message naming each broken cone, the attitude and the angle between the boresight
+        and the direction [deg]; ``None`` when both endpoints meet every cone.
+    """
+    broken = []
+    for cone, name in zip(cones, names):
+        for label, q in (("initial", q0), ("final", qf)):
+            if q is None:
+                continue
+            angle = float(np.arccos(np.clip(np.dot(quat.rotate(q, cone.boresight), cone.direction), -1.0, 1.0)))
+            if (angle < cone.angle) if cone.keep_out else (angle > cone.angle):
+                side = "inside" if cone.keep_out else "outside"
+                broken.append(f"{name}: the {label} attitude puts the boresight {np.rad2deg(angle):.4g} deg from "
+                              f"the direction, {side} the cone of {np.rad2deg(cone.angle):.4g} deg "
+                              f"(angle_deg tightened by cone_margin_deg)")
+    return "; ".join(broken) or None
 
 
 def variable_bounds(problem: ManeuverProblem, max_rate: float | None) -> tuple[Array, Array, Array, Array]:

@@ -254,3 +254,32 @@ def test_block_assembled_derivatives_equal_casadi_ad_of_the_whole_nlp(transcript
     np.testing.assert_allclose(stages.jac_g(w, p)[1].full(), jacobian(w, p).full(), rtol=1e-12, atol=1e-12)
     full = hessian(w, p, *multipliers).full()
     np.testing.assert_allclose(stages.hess_lag(w, p, *multipliers).full(), np.triu(full), rtol=1e-10, atol=1e-10)
+
+
+@pytest.mark.parametrize("cones, words", [
+    # body x starts along inertial x: a keep-out cone of 30 deg about inertial x holds it from the start
+    ({"keep_out": [{"boresight": [1, 0, 0], "direction": [1, 0, 0], "angle_deg": 30.0}]}, "keep_out[0]"),
+    # body x never leaves inertial x in a slew about x: 20 deg off it is never inside a keep-in cone
+    # of 10 deg about inertial y (the second cone; the first holds throughout)
+    ({"keep_in": [{"boresight": [1, 0, 0], "direction": [1, 0, 0], "angle_deg": 45.0},
+                  {"boresight": [1, 0, 0], "direction": [0, 1, 0], "angle_deg": 10.0}]}, "keep_in[1]"),
+])
+def test_a_cone_the_initial_attitude_breaks_is_a_failed_row_naming_it(cones, words):
+    # Used to be an IPOPT run to "Infeasible_Problem_Detected" (keep-out) or to its iteration limit
+    # (keep-in, 2 s), with no word of which cone: the endpoints are checked before any solve.
+    # Body x in inertial axes at q0 = identity is [1, 0, 0]: 0 deg from the keep-out direction
+    # (inside the 30 deg cone) and 90 deg from the keep-in direction (outside 10 deg).
+    reference = PLANNERS["collocation"]({"intervals": 10, **cones}).plan(single_axis_problem())
+    assert not reference.ok
+    assert words in reference.message and "initial attitude" in reference.message, reference.message
+
+
+def test_a_cone_the_final_attitude_breaks_is_named():
+    # A 1 rad slew about x takes body y to [0, cos 1, sin 1]: 57.3 deg from inertial y, inside a
+    # 60 deg keep-out cone about it, which the initial attitude (body y along inertial y, 0 deg)
+    # breaks as well: both are named.
+    cone = {"boresight": [0, 1, 0], "direction": [0, 1, 0], "angle_deg": 60.0}
+    reference = PLANNERS["collocation"]({"intervals": 10, "keep_out": [cone]}).plan(single_axis_problem())
+    assert not reference.ok and "final attitude" in reference.message, reference.message
+    moved = {**cone, "direction": [0, 0, -1]}  # 90 deg from body y at the start, 147 deg at the end
+    assert PLANNERS["collocation"]({"intervals": 10, "keep_out": [moved]}).plan(single_axis_problem()).ok
