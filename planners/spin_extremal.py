@@ -27,7 +27,7 @@ import numpy as np
 
 from ocp import quat
 from ocp.nlp import solve_multistart, solver_options
-from ocp.options import Range
+from ocp.options import InvalidOption, Range
 from ocp.spin_closed_form import extremal_quaternion
 from planners.base import (
     Array,
@@ -259,15 +259,21 @@ class SpinExtremalPlanner(Planner):
         spin_rate : float or None
             v [rad/s]; ``None`` (default): the initial roll rate ω0[0].
         parameters : list of 3 floats or None
-            Fixed [r, c, β] (rad/s, rad/s, rad): no optimisation; ``None`` (default): optimised.
+            Fixed [r, c, β] (rad/s, rad/s, rad), each in (-1000, 1000), r and c not both 0 (K =
+            √(r² + c²) > 0): no optimisation; ``None`` (default): optimised.
         starts : int
             Multi-start candidates polished by IPOPT.
         """
 
         weight: Annotated[float, Range(ge=0.0)] = 0.0                        # k of J = J1 + k J2 (1/(N² m² s))
         spin_rate: Annotated[float | None, Range(gt=-1e3, lt=1e3)] = None             # v (rad/s); default: the initial roll rate ω0[0]
-        parameters: Annotated[list[float] | None, Range(size=3)] = None      # fixed [r, c, β] (rad/s, rad/s, rad): no optimisation
+        parameters: Annotated[list[float] | None, Range(gt=-1e3, lt=1e3, size=3)] = None  # fixed [r, c, β] (rad/s, rad/s, rad): no optimisation
         starts: Annotated[int, Range(ge=1, le=50)] = 3                            # multi-start candidates polished by IPOPT
+
+        def __post_init__(self) -> None:
+            if self.parameters is not None and self.parameters[0] == 0 and self.parameters[1] == 0:
+                raise InvalidOption("parameters", f"r = c = 0 leaves K = sqrt(r^2 + c^2) = 0, which divides the "
+                                                  f"closed form; expected r or c non-zero, got {self.parameters}")
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
         """Why the spin extremals cannot take ``problem``.
@@ -302,6 +308,9 @@ class SpinExtremalPlanner(Planner):
             if params is None:
                 return FailedReference(self.name, stats["message"], stats=stats)
         q_end = np.array(extremal_quaternion(T, v, params.r, params.c, params.beta))
+        if not np.all(np.isfinite(q_end)):  # r² + c² under- or overflowed (fixed parameters)
+            return FailedReference(self.name, f"the closed form is not finite at T for r={params.r:.6g}, "
+                                              f"c={params.c:.6g}, beta={params.beta:.6g}: {q_end}")
         stats.update(r=params.r, c=params.c, beta=params.beta, spin_rate=v, weight=self.options.weight,
                      J1=float(attitude_cost(q_end, target)),
                      J2=float(energy_cost(v, params.r, params.c, params.beta, T, moments)))

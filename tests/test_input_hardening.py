@@ -77,6 +77,12 @@ CASES = {
         "transcription": "multiple_shooting", "intervals": 200, "substeps": 100}}), "planners[0].options.substeps"),
     "duplicate seed planner": (with_planner({"name": "collocation", "options": {
         "seed_planners": ["eigenaxis", "natural_motion", "eigenaxis"]}}), "planners[0].options.seed_planners[2]"),
+    # r = c = 0: K = sqrt(r^2 + c^2) = 0 divides the closed form (0/0): an "ok" row whose
+    # reference was NaN, then an internal error in the simulation; 1e200 overflowed r^2.
+    "spin parameters r = c = 0": (with_planner({"name": "spin_extremal", "options": {"parameters": [0, 0, 0.5]}}),
+                                  "planners[0].options.parameters"),
+    "huge spin parameters": (with_planner({"name": "spin_extremal", "options": {"parameters": [1e200, 1e200, 0]}}),
+                             "planners[0].options.parameters[0]"),
     "negative multistart": (with_planner({"name": "collocation", "options": {"multistart": -1}}), "planners[0].options.multistart"),
     "negative starts": (with_planner({"name": "spin_extremal", "options": {"starts": -1}}), "planners[0].options.starts"),
     "zero max_terms": (with_planner({"name": "shape_polynomial", "options": {"max_terms": 0}}), "planners[0].options.max_terms"),

@@ -166,3 +166,14 @@ def test_hold_compensation_removes_most_of_the_sampling_lag_of_a_spinning_body()
                                                        target=(problem.qf, None))
         errors[compensation] = metrics_from_simulation(simulation, problem.qf, reference=reference)["final_error_deg"]
     assert errors[True] < 0.25 * errors[False]
+
+
+def test_fixed_parameters_whose_closed_form_is_not_finite_are_a_failed_reference():
+    # r = c = 1e-170 passes the options' K > 0 check, but r^2 + c^2 underflows to 0 in the closed
+    # form (0/0): a failed reference with a message, not an "ok" one full of NaN (which crashed
+    # the simulation with an internal error).
+    problem = ManeuverProblem(Spacecraft(MOMENTS), quat.IDENTITY, np.array([0.1, 0, 0]), quat.IDENTITY, 120.0)
+    reference = PLANNERS["spin_extremal"]({"parameters": [1e-170, 1e-170, 0.0]}).plan(problem)
+    assert not reference.ok and "not finite" in reference.message, reference.message
+    fine = PLANNERS["spin_extremal"]({"parameters": [1e-3, 0.0, 0.0]}).plan(problem)
+    assert fine.ok and np.all(np.isfinite(fine.sample(np.linspace(0, 120.0, 7)).q))
