@@ -181,7 +181,7 @@ class RateAcquisitionSystem(RigidBodySystem):
         t_min = self.minimum_time_estimate(fraction)
         t_f = t_min if self.free_final_time else self.t_f_fixed
         s = np.linspace(0.0, 1.0, nodes)
-        reach = min(1.0, t_f / t_min)
+        reach = 1.0 if t_f >= t_min else t_f / t_min  # t_min = 0: no rate change (fixed T), nothing to scale
         change = reach * (self._target(fraction) - p.omega0)
         omega = p.omega0[:, None] + s * change[:, None]
         angle = t_f * (np.outer(p.omega0, s) + 0.5 * np.outer(change, s**2))  # exact for a fixed axis

@@ -210,3 +210,15 @@ def test_vepa_attitude_acquisition_scenario():
     t = np.linspace(0, 1, 2001)
     peak = [np.max(np.abs(reference.torque(t * reference.duration))) for reference in (costate, shape)]
     assert peak[1] > 10 * peak[0]
+
+
+def test_fixed_time_rate_acquisition_with_equal_rates_does_not_raise():
+    # Rest to rest (omega0 = omegaf = 0) in fixed T: the cold-start guess divided T by the minimum
+    # time of a zero rate change (ZeroDivisionError, a traceback on the run's stderr). The steering
+    # torque has unit norm at every instant, so the optimum spins up and back: the rate still ends
+    # at the target (terminal cost), or the row fails with the solver's message, never an exception.
+    planner = PLANNERS["costate_tpbvp"]({"objective": "rate_acquisition", "final_time": "fixed", "nodes": 20})
+    reference = planner.plan(problem(duration=20.0))
+    assert "ZeroDivisionError" not in reference.message, reference.message
+    if reference.ok:
+        assert np.linalg.norm(reference.sample(np.array([20.0])).omega[-1]) < 0.05
