@@ -17,7 +17,7 @@ arcs), never "certified" at a saddle: a caller falls back to its other evidence 
 
 The subspace is the null space of the active rows restricted to the free variables, from a
 column-pivoted QR factorisation of those rows (dense: meant for the small NLPs of a coarse mesh, a
-few hundred variables).
+few hundred variables; on :data:`BLAS_THREADS` BLAS threads).
 ``Z = {0}`` (a vertex: as many independent active constraints as variables, e.g. a bang-bang
 optimum) is a strict local minimum by itself.
 
@@ -36,10 +36,19 @@ import casadi as ca
 import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
+from threadpoolctl import threadpool_limits
 
 from ocp.fast_call import BufferedFunction
 
 Array = NDArray[np.float64]
+
+BLAS_THREADS = 1
+"""BLAS threads of the dense factorisations here (``threadpoolctl``). A few hundred rows are too
+few to share among threads, and a threaded BLAS waits for cores another process holds: Bilimoria &
+Wie's default minimum time (one check per plan, a 230 x 312 column-pivoted QR) took 500-540 ms per
+plan with NumPy's OpenBLAS on its default 2 threads while another process kept both cores busy,
+against 135-153 ms on one thread; on that QR alone 20.3 against 5.9 ms. Trade studies run several
+planners side by side, which is that situation."""
 
 MAX_VARIABLES = 400
 """Larger NLPs are not checked: the dense factorisation would cost more than the restarts it saves.
@@ -218,10 +227,11 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     free = ~fixed
     A = J[np.ix_(rows, free)]
     n_free = int(free.sum())
-    Z = _null_space(A, n_free)
-    if Z.shape[1] == 0:
-        return SecondOrderCheck(True, 0, float("inf"), "a vertex: the active constraints fix the point")
-    curvature = np.linalg.eigvalsh(Z.T @ H[np.ix_(free, free)] @ Z)
+    with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
+        Z = _null_space(A, n_free)
+        if Z.shape[1] == 0:
+            return SecondOrderCheck(True, 0, float("inf"), "a vertex: the active constraints fix the point")
+        curvature = np.linalg.eigvalsh(Z.T @ H[np.ix_(free, free)] @ Z)
     least = float(curvature[0])
     certified = least > curvature_tolerance * max(1.0, float(np.max(np.abs(curvature))))
     verdict = "positive definite" if certified else "not positive definite"

@@ -239,3 +239,26 @@ def test_a_problem_without_the_solver_derivatives_is_not_checked():
 
     check = second_order_check(NoDerivatives(), np.zeros(2), np.zeros(2), np.zeros(0))  # type: ignore[arg-type]
     assert not check.certified and "no derivatives" in check.message and "more" not in check.message
+
+
+def test_the_dense_factorisations_run_on_one_blas_thread(monkeypatch):
+    # A threaded BLAS waits for cores that other processes hold (a trade study's workers): the
+    # check's QR and eigenvalues must run on BLAS_THREADS threads whatever the machine's default.
+    import threadpoolctl
+
+    import ocp.second_order as second_order
+
+    seen = []
+    null_space = second_order._null_space
+
+    def recording(A, n):
+        seen.append({info["internal_api"]: info["num_threads"] for info in threadpoolctl.threadpool_info()
+                     if info["user_api"] == "blas"})
+        return null_space(A, n)
+
+    monkeypatch.setattr(second_order, "_null_space", recording)
+    solver = nlp(lambda x: sum(x[i] ** 2 for i in range(6)) - x[0] * x[1], lambda x: x[0] + x[1] + x[2], n=6)
+    check = second_order_check(solver, np.full(6, 0.0), np.zeros(6), np.zeros(1), lbg=0.0, ubg=0.0)
+    assert check.certified  # x² terms with a -x0 x1 coupling: positive definite on the plane
+    assert seen and all(seen[0].values()) and set(seen[0].values()) == {second_order.BLAS_THREADS}
+    assert second_order.BLAS_THREADS == 1
