@@ -131,7 +131,9 @@ class CollocationPlanner(Planner):
         """Per-point bounds of the model state and the actuator controls."""
         return variable_bounds(problem, self.options.max_rate)
 
-    def _starts(self, problem: ManeuverProblem) -> list[Reference]:
+    def _starts(self, problem: ManeuverProblem, failures: list[str] | None = None) -> list[Reference]:
+        """The references of the warm start and the seed planners that planned; each failure's
+        ``planner: message`` is appended to ``failures`` when given."""
         from planners import PLANNERS
 
         starts = []
@@ -141,6 +143,8 @@ class CollocationPlanner(Planner):
             reference = PLANNERS[name](options, cache=self.cache).plan(problem)
             if reference.ok:
                 starts.append(reference)
+            elif failures is not None:
+                failures.append(f"{name}: {reference.message}")
         return starts
 
     def _guesses(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
@@ -225,9 +229,11 @@ class CollocationPlanner(Planner):
         broken = endpoint_cone_error(self._ocp(problem).cones, names, problem.q0, problem.qf)
         if broken:
             return FailedReference(self.name, f"no trajectory meets the cones: {broken}")
-        starts = self._starts(problem)
+        failures: list[str] = []
+        starts = self._starts(problem, failures)
         if not starts:
-            return FailedReference(self.name, f"no start: the warm-start planner {self.options.warm_start!r} failed")
+            return FailedReference(self.name, f"no start: the warm-start planner {self.options.warm_start!r} failed ("
+                                              + "; ".join(failures) + ")")
         return self._plan_from(problem, starts)
 
     def _plan_from(self, problem: ManeuverProblem, starts: list[Reference]) -> Reference:

@@ -307,7 +307,8 @@ class SpinExtremalPlanner(Planner):
                                            v, T, moments, target)
             if params is None:
                 return FailedReference(self.name, stats["message"], stats=stats)
-        q_end = np.array(extremal_quaternion(T, v, params.r, params.c, params.beta))
+        with np.errstate(all="ignore"):  # a non-finite closed form is refused just below
+            q_end = np.array(extremal_quaternion(T, v, params.r, params.c, params.beta))
         if not np.all(np.isfinite(q_end)):  # r² + c² under- or overflowed (fixed parameters)
             return FailedReference(self.name, f"the closed form is not finite at T for r={params.r:.6g}, "
                                               f"c={params.c:.6g}, beta={params.beta:.6g}: {q_end}")

@@ -283,3 +283,11 @@ def test_a_cone_the_final_attitude_breaks_is_named():
     assert not reference.ok and "final attitude" in reference.message, reference.message
     moved = {**cone, "direction": [0, 0, -1]}  # 90 deg from body y at the start, 147 deg at the end
     assert PLANNERS["collocation"]({"intervals": 10, "keep_out": [moved]}).plan(single_axis_problem()).ok
+
+
+def test_a_failed_warm_start_says_why():
+    # shape_polynomial's default duration (rate_limit) needs a rate bound, which this problem lacks:
+    # the failed row used to say only "the warm-start planner 'shape_polynomial' failed".
+    reference = PLANNERS["collocation"]({"intervals": 10, "warm_start": "shape_polynomial"}).plan(single_axis_problem())
+    assert not reference.ok and "shape_polynomial" in reference.message, reference.message
+    assert "max_rate" in reference.message, reference.message
