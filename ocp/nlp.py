@@ -4,7 +4,8 @@ with early stopping, and a result object in the style of ``scipy.optimize.Optimi
 Status policy
 -------------
 A start has **converged** when the solver reports success (IPOPT ``Solve_Succeeded`` or
-``Solved_To_Acceptable_Level``, FATROP ``success``), or when IPOPT stopped with
+``Solved_To_Acceptable_Level``, FATROP ``success``; FATROP's integer flags are named by
+:data:`FATROP_STATUS`), or when IPOPT stopped with
 ``Search_Direction_Becomes_Too_Small`` at a point whose constraint violation (``g`` outside
 ``[lbg, ubg]``) is at most ``feasibility_tolerance``: the step has fallen below machine precision
 at a feasible point (e.g. a zero-cost optimum), so no further progress is possible. Every other
@@ -71,6 +72,11 @@ SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 STALLED_AT_FEASIBLE = ("Search_Direction_Becomes_Too_Small",)
 INFEASIBLE = ("Infeasible_Problem_Detected", "Restoration_Failed")
 SOLVERS = ("ipopt", "fatrop")
+FATROP_STATUS = {0: "Fatrop_Converged", 1: "Fatrop_Stopped"}
+"""FATROP's integer return flags, named: 0 converged (to the tolerance, to the acceptable tolerance
+after its count of acceptable iterations, or at a vanishing search direction at the least barrier
+parameter), 1 stopped without converging (the iteration limit, or a failed restoration phase: FATROP
+returns the same flag for both). Another flag is named ``Fatrop_Flag_<n>``."""
 
 
 def solver_options(solver: str = "ipopt", tolerance: float = 1e-8, max_iterations: int = 500,
@@ -130,6 +136,26 @@ def warm_start_options(solver: str = "ipopt", mu_init: float = 1e-6, bound_push:
             "ipopt.warm_start_bound_push": bound_push, "ipopt.warm_start_bound_frac": bound_push,
             "ipopt.warm_start_mult_bound_push": mult_bound_push, "ipopt.warm_start_slack_bound_push": bound_push,
             "ipopt.warm_start_slack_bound_frac": bound_push}
+
+
+def status_name(stats: Mapping[str, Any]) -> str:
+    """The solver's return status as a name.
+
+    Parameters
+    ----------
+    stats : mapping
+        ``solver.stats()`` after a solve.
+
+    Returns
+    -------
+    str
+        IPOPT's status string as it is (e.g. ``Solve_Succeeded``); FATROP's integer flag named by
+        :data:`FATROP_STATUS`; ``"unknown"`` when the solver reported none.
+    """
+    raw = stats.get("return_status", "unknown")
+    if isinstance(raw, (int, np.integer)) and not isinstance(raw, bool):
+        return FATROP_STATUS.get(int(raw), f"Fatrop_Flag_{int(raw)}")
+    return str(raw)
 
 
 def violation(g: Array, lbg: Any, ubg: Any) -> float:
@@ -269,7 +295,7 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         solution = solver(x0=np.clip(np.asarray(guess, dtype=float), low, high), **args)
         elapsed = time.perf_counter() - tic
         stats = solver.stats()
-        status = str(stats.get("return_status", "unknown"))
+        status = status_name(stats)
         g = solution["g"].full().ravel()
         excess = violation(g, g_low, g_high)
         f = float(solution["f"])
