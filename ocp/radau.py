@@ -95,6 +95,7 @@ class RadauCollocation(Transcription):
     """
 
     name = "collocation"
+    fatrop_seed = True  # see planners.collocation_strategy.SEED_FATROP
 
     def __init__(self, intervals: int, degree: int = 3) -> None:
         super().__init__(intervals)

@@ -51,6 +51,7 @@ from planners.collocation_strategy import (
     AUTO_FIRST,
     AUTO_RESTART,
     POLISH_MU_INIT,
+    SEED_FATROP,
     SEED_TOLERANCE,
     TRANSFER_L1_BARRIER,
     TRANSFER_MAX_INTERVALS,
@@ -74,6 +75,7 @@ class _Optimum:
     nlp: NLP
     intervals: int
     regularized: NLPResult | None = None
+    solver: str | None = None  # None: the option's
 
 
 class CollocationPlanner(Planner):
@@ -95,7 +97,7 @@ class CollocationPlanner(Planner):
                                      fixed_final_rate=problem.omegaf is not None, cones=cones)
 
     def _nlp(self, problem: ManeuverProblem, ocp: OptimalControlProblem, mode: _Mode = "cold",
-             intervals: int | None = None) -> tuple[Transcription, NLP]:
+             intervals: int | None = None, solver: str | None = None) -> tuple[Transcription, NLP]:
         """The transcription on ``intervals`` (default the option) and its built NLP for ``ocp``
         (from the cache when built before). ``mode``: the solver options of a start from a point
         alone (``cold``), with its multipliers (``warm``, :func:`ocp.nlp.warm_start_options`), near
@@ -103,26 +105,29 @@ class CollocationPlanner(Planner):
         multipliers of a coarse-mesh optimum (``transfer``: :data:`TRANSFER_WARM_START`, with
         :data:`TRANSFER_L1_BARRIER` for an L1 objective without an energy term). A fixed final
         time on other than the option's ``intervals`` is the coarse seed: solved to
-        :data:`SEED_TOLERANCE` at the least."""
+        :data:`SEED_TOLERANCE` at the least (by FATROP with :data:`SEED_FATROP` where
+        :meth:`_seed_solver` says so). ``solver``: ``None`` for the option's."""
         o = self.options
         intervals = o.intervals if intervals is None else intervals
-        if o.solver != "ipopt" and mode in ("near_optimum", "transfer"):
+        solver = o.solver if solver is None else solver
+        if solver != "ipopt" and mode in ("near_optimum", "transfer"):
             mode = "cold"
         seed_only = intervals != o.intervals and not ocp.free_time
         tolerance = max(o.tolerance, SEED_TOLERANCE) if seed_only else o.tolerance
         key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
-               o.transcription, intervals, o.degree, o.substeps, o.solver, tolerance, o.max_iterations, mode)
-        extra = {"cold": None, "warm": warm_start_options(o.solver), "near_optimum": {"ipopt.mu_init": POLISH_MU_INIT},
-                 "transfer": warm_start_options(o.solver, **TRANSFER_WARM_START)}[mode]
+               o.transcription, intervals, o.degree, o.substeps, solver, tolerance, o.max_iterations, mode)
+        extra = {"cold": None, "warm": warm_start_options(solver), "near_optimum": {"ipopt.mu_init": POLISH_MU_INIT},
+                 "transfer": warm_start_options(solver, **TRANSFER_WARM_START)}[mode]
         if mode == "transfer" and ocp.l1_weight > 0 and ocp.energy_weight == 0:
             extra = {**(extra or {}), **TRANSFER_L1_BARRIER}
+        if seed_only and solver == "fatrop":
+            extra = {**(extra or {}), **SEED_FATROP}
 
         def build() -> tuple[Transcription, NLP]:
             # the transcription is built here, once per entry (its constructor is not free)
             same = intervals == o.intervals
             transcription = TRANSCRIPTIONS[o.transcription].from_options(o if same else replace(o, intervals=intervals))
-            return transcription, transcription.build(ocp, o.solver,
-                                                      solver_options(o.solver, tolerance, o.max_iterations, extra))
+            return transcription, transcription.build(ocp, solver, solver_options(solver, tolerance, o.max_iterations, extra))
 
         # The model's numbers are baked into the graph: a shared cache needs them in the key.
         return self.solver_cache(problem).get(("collocation", problem.model.fingerprint, key), build)
@@ -180,14 +185,15 @@ class CollocationPlanner(Planner):
         return replace(ocp, energy_weight=self.options.time_regularization / scale)
 
     def _solve(self, problem: ManeuverProblem, ocp: OptimalControlProblem, seeds: list[Array], params: Array,
-               bounds: tuple[Array, Array], intervals: int,
-               near_optimum: bool = False) -> tuple[NLPResult, dict, NLPResult | None]:
+               bounds: tuple[Array, Array], intervals: int, near_optimum: bool = False,
+               solver: str | None = None) -> tuple[NLPResult, dict, NLPResult | None]:
         """Solve ``ocp`` on ``intervals`` from ``seeds`` by the multistart policy (``near_optimum``:
         from the one seed given, near the optimum, see :meth:`_nlp`); with ``time_regularization``,
         solve the regularised problem so and polish plain minimum time from its optimum and
-        multipliers (the regularised solve is returned third, ``None`` without one)."""
+        multipliers (the regularised solve is returned third, ``None`` without one); ``solver`` as
+        in :meth:`_nlp`."""
         o = self.options
-        transcription, nlp = self._nlp(problem, ocp, "near_optimum" if near_optimum else "cold", intervals)
+        transcription, nlp = self._nlp(problem, ocp, "near_optimum" if near_optimum else "cold", intervals, solver)
         guesses, fallback, restart = ((seeds, [], 0.0) if near_optimum
                                       else self._guesses(problem, ocp, transcription, nlp, seeds))
         agree = 1 if near_optimum else o.agree
@@ -223,6 +229,16 @@ class CollocationPlanner(Planner):
         # A fixed final time gains only when the full mesh is several times the coarse one.
         return o.multistart == "auto" and 0 < 2 * o.coarse_intervals <= o.intervals and not ocp.cones
 
+    def _seed_solver(self, ocp: OptimalControlProblem) -> str:
+        """The solver of the coarse seed: FATROP (with :data:`SEED_FATROP`) for a fixed final time
+        without an L1 term when the option's solver is IPOPT and the transcription's
+        ``fatrop_seed`` says so, else the option's."""
+        o = self.options
+        if (o.solver == "ipopt" and not ocp.free_time and ocp.l1_weight == 0
+                and TRANSCRIPTIONS[o.transcription].fatrop_seed):
+            return "fatrop"
+        return o.solver
+
     def _plan(self, problem: ManeuverProblem) -> Reference:
         o = self.options
         names = [f"keep_out[{i}]" for i in range(len(o.keep_out))] + [f"keep_in[{i}]" for i in range(len(o.keep_in))]
@@ -245,22 +261,27 @@ class CollocationPlanner(Planner):
         return self._reference(problem, ocp, params, self._optimum(problem, ocp, starts, params, self.options.intervals))
 
     def _optimum(self, problem: ManeuverProblem, ocp: OptimalControlProblem, starts: list[Reference], params: Array,
-                 intervals: int) -> _Optimum:
+                 intervals: int, solver: str | None = None) -> _Optimum:
         """The best optimum on ``intervals`` from the starts (through the coarse mesh first, see
-        :meth:`_coarse`, when ``intervals`` is the option's)."""
+        :meth:`_coarse`, when ``intervals`` is the option's); ``solver`` as in :meth:`_nlp`."""
         o = self.options
         coarse_first = intervals == o.intervals and self._coarse(ocp)
         # The layout (bounds, seeds, unpack) is the same in every build: use the one solved first.
         mode: _Mode = "warm" if o.time_regularization else "transfer" if coarse_first else "cold"
-        transcription, nlp = self._nlp(problem, ocp, mode, intervals)
+        transcription, nlp = self._nlp(problem, ocp, mode, intervals, solver)
         bounds = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
         result, extra, regularized = None, {}, None
         if coarse_first:
             # On a coarse mesh, where an iteration costs a fraction: the escape from stationary
             # points and its confirmation (free T), or the long way from a far seed (fixed T); its
             # optimum (and its multipliers, carried to the full mesh) seeds one solve on the full mesh.
-            coarse = self._optimum(problem, ocp, starts, params, o.coarse_intervals)
+            seed_solver = self._seed_solver(ocp)
+            coarse = self._optimum(problem, ocp, starts, params, o.coarse_intervals, seed_solver)
             found = self._reference(problem, ocp, params, coarse)
+            if not found.ok and seed_solver != o.solver:  # the option's solver takes the seed over
+                extra["coarse_" + seed_solver] = found.stats
+                coarse = self._optimum(problem, ocp, starts, params, o.coarse_intervals)
+                found = self._reference(problem, ocp, params, coarse)
             extra["coarse"] = found.stats
             if found.ok:
                 assert isinstance(found, CollocationReference)  # found.ok
@@ -280,10 +301,10 @@ class CollocationPlanner(Planner):
         if result is None or not result.success:
             seeds = [transcription.seed(ocp, nlp, seed_sampler(problem, ref),
                                         ref.duration if ocp.free_time else problem.duration) for ref in starts]
-            fine, more, regularized = self._solve(problem, ocp, seeds, params, bounds, intervals)
+            fine, more, regularized = self._solve(problem, ocp, seeds, params, bounds, intervals, solver=solver)
             result = fine if result is None else merged(result, fine)
             extra.update(more)
-        return _Optimum(result, extra, transcription, nlp, intervals, regularized)
+        return _Optimum(result, extra, transcription, nlp, intervals, regularized, solver)
 
     def _transferred(self, problem: ManeuverProblem, ocp: OptimalControlProblem, coarse: _Optimum,
                      found: CollocationReference, params: Array,
@@ -331,10 +352,11 @@ class CollocationPlanner(Planner):
                    solved: _Optimum) -> Reference:
         """The reference (or the failure) of an optimum found by :meth:`_optimum`."""
         o, result, transcription = self.options, solved.result, solved.transcription
+        solver = solved.solver or o.solver
         stats = result.stats()
-        stats.update(solved.extra, transcription=transcription.name, intervals=solved.intervals, solver=o.solver)
+        stats.update(solved.extra, transcription=transcription.name, intervals=solved.intervals, solver=solver)
         if not result.success:
-            return FailedReference(self.name, f"{o.solver} did not converge from any start: "
+            return FailedReference(self.name, f"{solver} did not converge from any start: "
                                    f"{sorted(set(result.statuses))}", result.status, stats=stats)
         assert result.x is not None  # success implies a point
         T, states, controls = (v.full() for v in solved.nlp.unpack(result.x, params))
@@ -343,6 +365,6 @@ class CollocationPlanner(Planner):
         norm_error = float(np.max(np.abs(np.linalg.norm(states[0:4], axis=0) - 1)))
         reference.stats.update(duration=T, max_quaternion_norm_error=norm_error,
                                cones=[(c.boresight, c.direction, c.angle, c.keep_out) for c in ocp.cones])
-        reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {o.solver}): "
+        reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {solver}): "
                              f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}")
         return reference

@@ -35,6 +35,30 @@ ones (51 against 49 on 16 of them). The 18 fixed-time cases of
 ``tests/benchmarks/iteration_counts.py``: 282 coarse and 202 full-mesh iterations against 320 and
 205, the same optima (the spin paper's case 26 + 4 against 28 + 4); minimum time, whose coarse
 optimum is certified or confirmed, keeps the option's tolerance."""
+SEED_FATROP = {"fatrop.mu_init": 1e-3}
+"""FATROP's options for the coarse seed of a fixed final time, which FATROP solves when the
+``solver`` option is IPOPT (the default) for a transcription whose ``fatrop_seed`` is true (Radau
+collocation) and an objective without an L1 term; IPOPT then solves the full mesh from FATROP's
+optimum and multipliers as before. If FATROP does not converge, IPOPT solves the seed (the failed
+attempt is in the stats as ``coarse_fatrop``). Why: FATROP's Riccati iteration on the 8-interval
+Radau mesh costs about 0.8 ms against IPOPT's 1.0 ms with MUMPS (9.0 M against 7.5 M instructions
+per iteration, but fewer inertia corrections), and it starts nearer the central path at ``mu_init``
+1e-3 (its default 0.1: 22.5 ms against 17 ms for the spin paper's seed; 14 fixed-time cases of
+``tests/benchmarks/iteration_counts.py``: fewer iterations on 11, the same optima, one better).
+Measured, stop 24, interleaved in one process against the IPOPT seed:
+- the spin paper's case: the plan's median time 0.82-0.85x in three runs (47.7 against 56.1 ms at
+  the host's fast speed), 21 coarse iterations against 26, the same optimum;
+- 98 fixed-time minimum-energy problems (the 18 of ``iteration_counts.py``, 80 random spin-like
+  and rest-to-rest ones): the same optimum on 95, a lower one on 2 (0.7427 to 0.2027, 1.4498 to
+  0.6425), a higher one on 1 (0.1354 to 0.2709, a case that moves with almost any change of the
+  path); CPU per plan 0.76x on the 95 whose FATROP seed converged; FATROP stopped (its restoration
+  failed) on 3 hard ones (two where IPOPT's seed also fails or takes 176 iterations), which then
+  cost 0.3-0.6 s more each; over the 98, 0.94-0.98x;
+- 24 problems on reaction wheels (orthogonal and pyramid) and with gravity gradient: the same
+  optima, CPU 0.91x.
+Not for multiple shooting (its ``fatrop_seed`` is false): on 30 of those problems 3 lower and 3
+higher optima, the spin case 0.0266 against 0.01855, CPU 1.05x. Not with an L1 term: FATROP failed
+on 9 of 16 random ``min_l1`` problems (stop 23)."""
 POLISH_MU_INIT = 1e-4
 """IPOPT's initial barrier parameter (its default 0.1) for the full-mesh solve from a coarse-mesh
 optimum: the seed is near the optimum, so the barrier need not start wide. N = 50 from N = 8:

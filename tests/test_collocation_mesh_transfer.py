@@ -201,7 +201,7 @@ def test_the_loose_coarse_seed_of_a_fixed_time_leaves_the_optimum(monkeypatch):
     tolerances = []
     build = transcription_base.Transcription.build
     monkeypatch.setattr(transcription_base.Transcription, "build", lambda self, ocp, solver, options:
-                        tolerances.append((self.intervals, options["ipopt.tol"])) or build(self, ocp, solver, options))
+                        tolerances.append((self.intervals, options[f"{solver}.tol"])) or build(self, ocp, solver, options))
     problem = ManeuverProblem(Spacecraft([19.5, 19.0, 12.6], torquers=Torquers(0.1)), quat.IDENTITY, [0.2, 0, 0],
                               [0, 0, 1, 0], 200.0)
     default = PLANNERS["collocation"]({"warm_start": "spin_extremal"}).plan(problem)
@@ -210,6 +210,42 @@ def test_the_loose_coarse_seed_of_a_fixed_time_leaves_the_optimum(monkeypatch):
     assert (8, 1e-5) in tolerances and (50, 1e-10) in tolerances and (8, 1e-10) not in tolerances
     assert default.stats["coarse"]["objective"] > 1.05 * default.stats["objective"]  # the coarse mesh is off
     assert default.stats["objective"] == pytest.approx(direct.stats["objective"], rel=1e-8)
+    # the seed was FATROP's (SEED_FATROP), the full mesh IPOPT's from its optimum and multipliers
+    assert default.stats["coarse"]["solver"] == "fatrop" and default.stats["solver"] == "ipopt"
+    assert default.stats["iterations"] <= 6
+
+
+def spin_paper_problem():
+    return ManeuverProblem(Spacecraft([19.5, 19.0, 12.6], torquers=Torquers(0.1)), quat.IDENTITY, [0.2, 0, 0],
+                           [0, 0, 1, 0], 200.0)
+
+
+def test_ipopt_takes_the_seed_over_when_fatrop_stops(monkeypatch):
+    # FATROP's coarse seed stopped (here: one iteration allowed) is not the end: IPOPT solves the
+    # seed, the full mesh follows from it, to the optimum of the direct 50-interval solve.
+    from planners import collocation
+
+    monkeypatch.setattr(collocation, "SEED_FATROP", {**collocation.SEED_FATROP, "fatrop.max_iter": 1})
+    problem = spin_paper_problem()
+    default = PLANNERS["collocation"]({"warm_start": "spin_extremal"}).plan(problem)
+    direct = PLANNERS["collocation"]({"warm_start": "spin_extremal", "coarse_intervals": 0}).plan(problem)
+    assert default.ok, default.message
+    assert default.stats["coarse_fatrop"]["solver_status"] == ["Fatrop_Stopped"]
+    assert default.stats["coarse"]["solver"] == "ipopt" and default.stats["coarse"]["iterations"] > 10
+    assert default.stats["objective"] == pytest.approx(direct.stats["objective"], rel=1e-8)
+
+
+@pytest.mark.parametrize("transcription, seed_solver", [("collocation", "fatrop"), ("multiple_shooting", "ipopt")])
+def test_the_seed_solver_follows_the_transcription_and_the_objective(transcription, seed_solver):
+    # FATROP seeds Radau collocation only (multiple shooting's RK4 stages led it to other optima:
+    # SEED_FATROP), and never an L1 objective (FATROP failed on most min_l1 problems).
+    problem = spin_paper_problem()
+    energy = PLANNERS["collocation"]({"transcription": transcription, "intervals": 20}).plan(problem)
+    assert energy.ok, energy.message
+    assert energy.stats["coarse"]["solver"] == seed_solver
+    if transcription == "collocation":  # multiple shooting takes no L1 cost
+        l1 = PLANNERS["collocation"]({"intervals": 20, "objective": "min_l1"}).plan(problem)
+        assert l1.ok and l1.stats["coarse"]["solver"] == "ipopt", l1.message
 
 
 @pytest.mark.parametrize("objective, adaptive", [("min_l1", True), ("min_energy", False)])
