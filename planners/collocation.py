@@ -106,7 +106,8 @@ class CollocationPlanner(Planner):
         :data:`TRANSFER_L1_BARRIER` for an L1 objective without an energy term). A fixed final
         time on other than the option's ``intervals`` is the coarse seed: solved to
         :data:`SEED_TOLERANCE` at the least (by FATROP with :data:`SEED_FATROP` where
-        :meth:`_seed_solver` says so). ``solver``: ``None`` for the option's."""
+        :meth:`_seed_solver` chooses it for the ``solver`` option IPOPT; a ``solver: fatrop`` seed
+        keeps FATROP's defaults). ``solver``: ``None`` for the option's."""
         o = self.options
         intervals = o.intervals if intervals is None else intervals
         solver = o.solver if solver is None else solver
@@ -114,14 +115,17 @@ class CollocationPlanner(Planner):
             mode = "cold"
         seed_only = intervals != o.intervals and not ocp.free_time
         tolerance = max(o.tolerance, SEED_TOLERANCE) if seed_only else o.tolerance
-        key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
-               o.transcription, intervals, o.degree, o.substeps, solver, tolerance, o.max_iterations, mode)
         extra = {"cold": None, "warm": warm_start_options(solver), "near_optimum": {"ipopt.mu_init": POLISH_MU_INIT},
                  "transfer": warm_start_options(solver, **TRANSFER_WARM_START)}[mode]
         if mode == "transfer" and ocp.l1_weight > 0 and ocp.energy_weight == 0:
             extra = {**(extra or {}), **TRANSFER_L1_BARRIER}
-        if seed_only and solver == "fatrop":
+        if seed_only and solver == "fatrop" and o.solver == "ipopt":  # the IPOPT option's FATROP seed only
             extra = {**(extra or {}), **SEED_FATROP}
+        # The extra options in the key: a shared cache also serves planners whose options differ
+        # (a FATROP seed with SEED_FATROP and a FATROP mesh without it can share all else).
+        key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
+               o.transcription, intervals, o.degree, o.substeps, solver, tolerance, o.max_iterations, mode,
+               tuple(sorted((extra or {}).items())))
 
         def build() -> tuple[Transcription, NLP]:
             # the transcription is built here, once per entry (its constructor is not free)

@@ -248,6 +248,47 @@ def test_the_seed_solver_follows_the_transcription_and_the_objective(transcripti
         assert l1.ok and l1.stats["coarse"]["solver"] == "ipopt", l1.message
 
 
+def test_a_shared_cache_keeps_the_fatrop_seed_apart_from_a_fatrop_mesh():
+    # A scenario's planners share one SolverCache. The IPOPT option's FATROP seed (SEED_FATROP's
+    # mu_init) on 8 intervals and a `solver: fatrop` plan on 8 intervals have the same structure,
+    # solver, tolerance and mode: the FATROP plan must not take the seed's NLP (with the seed's
+    # options it converged in 20 iterations instead of its own 25).
+    from ocp.cache import SolverCache
+
+    fatrop = {"warm_start": "spin_extremal", "solver": "fatrop", "intervals": 8, "coarse_intervals": 0,
+              "tolerance": 1e-4}
+    alone = PLANNERS["collocation"](fatrop, cache=SolverCache()).plan(spin_paper_problem())
+    cache = SolverCache()
+    seeded = PLANNERS["collocation"]({"warm_start": "spin_extremal", "tolerance": 1e-4}, cache=cache).plan(
+        spin_paper_problem())
+    after = PLANNERS["collocation"](fatrop, cache=cache).plan(spin_paper_problem())
+    assert alone.ok and seeded.ok and after.ok
+    assert seeded.stats["coarse"]["solver"] == "fatrop"
+    assert after.stats["iterations"] == alone.stats["iterations"]
+    assert after.stats["objective"] == alone.stats["objective"]
+
+
+def test_seed_fatrop_options_apply_to_the_ipopt_option_seed_only(monkeypatch):
+    # SEED_FATROP is documented (README, its docstring) for the seed FATROP solves in place of the
+    # `solver: ipopt` option; a `solver: fatrop` plan's coarse seed keeps FATROP's defaults.
+    from ocp import transcription_base
+
+    built = []
+    build = transcription_base.Transcription.build
+    monkeypatch.setattr(transcription_base.Transcription, "build", lambda self, ocp, solver, options:
+                        built.append((self.intervals, solver, options.get("fatrop.mu_init")))
+                        or build(self, ocp, solver, options))
+    seeds = {}
+    for solver in ("ipopt", "fatrop"):
+        built.clear()
+        reference = PLANNERS["collocation"]({"warm_start": "spin_extremal", "intervals": 20,
+                                             "solver": solver}).plan(spin_paper_problem())
+        assert reference.ok, reference.message
+        assert reference.stats["coarse"]["solver"] == "fatrop"
+        seeds[solver] = [mu for intervals, used, mu in built if intervals == 8 and used == "fatrop"]
+    assert seeds == {"ipopt": [1e-3], "fatrop": [None]}
+
+
 @pytest.mark.parametrize("objective, adaptive", [("min_l1", True), ("min_energy", False)])
 def test_an_l1_transfer_takes_the_adaptive_barrier(monkeypatch, objective, adaptive):
     # min_l1's optimum is bang-off-bang (torque slacks at their bounds): from the coarse optimum,
