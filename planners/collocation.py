@@ -316,7 +316,7 @@ class CollocationPlanner(Planner):
         """The full-mesh solve from the coarse optimum ``found`` with its multipliers carried over
         (:meth:`_transfer`), and its extra stats; with ``time_regularization``, the coarse
         regularised optimum is carried to the full mesh's regularised problem, which is then
-        polished (:meth:`_polished`). ``None`` where that does not apply (FATROP, more than
+        polished (:meth:`_polished`). ``None`` where that does not apply (``solver: fatrop``, more than
         :data:`TRANSFER_MAX_INTERVALS` intervals, layouts that differ)."""
         if self.options.solver != "ipopt" or self.options.intervals > TRANSFER_MAX_INTERVALS:
             return None

@@ -1,5 +1,8 @@
-"""IPOPT iteration counts of ``collocation``'s coarse and full-mesh solves over a broad, seeded set
-(issue 16: deterministic counts, unlike wall times on a shared machine).
+"""Iteration counts of ``collocation``'s coarse and full-mesh solves over a broad, seeded set
+(issue 16: deterministic counts, unlike wall times on a shared machine). The full mesh is IPOPT's;
+the coarse seed of a fixed final time is FATROP's (``SEED_FATROP``; ``coarse_solver`` names it),
+and when FATROP stops and IPOPT takes the seed over, ``coarse`` is IPOPT's count and
+``coarse_fatrop`` FATROP's (else 0).
 
 Cases: the three of ``test_bench_min_time.py`` (Bilimoria & Wie, the full-inertia minimum time,
 the spin paper's minimum energy from the spin extremal); 21 random minimum-time slews (full
@@ -11,7 +14,7 @@ free); 5 spin-like ones warm-started from ``spin_extremal`` (principal inertia, 
 about the largest moment: the torque bounds are active; some are infeasible).
 
 Run: ``python tests/benchmarks/iteration_counts.py [--coarse-min-time N] [--coarse-fixed N] [--only a,b]``;
-one JSON line per case (coarse and full-mesh iterations, objective).
+one JSON line per case (coarse and full-mesh iterations, the coarse solver, objective).
 """
 from __future__ import annotations
 
@@ -105,6 +108,8 @@ def main() -> None:
         reference = PLANNERS["collocation"](options).plan(problem)
         stats = reference.stats
         print(json.dumps({"name": name, "ok": reference.ok, "coarse": stats.get("coarse", {}).get("iterations", 0),
+                          "coarse_solver": stats.get("coarse", {}).get("solver"),
+                          "coarse_fatrop": stats.get("coarse_fatrop", {}).get("iterations", 0),
                           "full": stats.get("iterations"), "objective": stats.get("objective")}), flush=True)
 
 
