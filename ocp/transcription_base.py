@@ -58,8 +58,7 @@ class Transcription(ABC):
 
     name: str
     fatrop_seed: bool = False
-    """Whether a planner solving with IPOPT should solve this transcription's coarse seed of a fixed
-    final time with FATROP instead (a measured property of the transcription's stages, see
+    """Whether FATROP, not IPOPT, solves its coarse seed of a fixed final time (measured:
     :data:`planners.collocation_strategy.SEED_FATROP`)."""
 
     def __init__(self, intervals: int) -> None:
