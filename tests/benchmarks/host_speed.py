@@ -3,8 +3,8 @@ timed alternately with a fixed CPU-bound reference workload, in one process.
 
 On the shared 2-core VM the host's speed moves by 1.5x within a minute with nothing else running
 in the VM: three runs 20 s apart gave reference medians 21.7, 28.8 and 36.2 ms and plan medians
-52.7, 63.7 and 80.1 ms, while plan/reference stayed at 2.2-2.4. Quote a plan time with the
-reference time of the same run.
+52.7, 63.7 and 80.1 ms, while plan/reference stayed at 2.2-2.4 (with the IPOPT coarse seed; 1.8-2.1
+with the FATROP seed, stop 24). Quote a plan time with the reference time of the same run.
 
 Run: ``python tests/benchmarks/host_speed.py [pairs]`` (default 60); one line: medians and 10th/90th
 percentiles of the plan, of the reference and of their ratio, and their correlation.
