@@ -1,15 +1,17 @@
 """Feedback controllers. ``CONTROLLERS`` maps registry names to controller classes."""
-from controllers.augmented_quaternion_feedback import AugmentedQuaternionFeedback
 from controllers.base import Controller, gain_matrix
-from controllers.bdot import BDot
-from controllers.costate_feedback import CostateFeedback
-from controllers.eigenaxis_pd import EigenaxisPD
-from controllers.gain_scheduled_min_norm import GainScheduledMinNorm
-from controllers.min_norm import MinNorm
+from controllers.detumbling.bdot import BDot
+from controllers.detumbling.tdfc import TDFC
 from controllers.none import NoControl
-from controllers.singular_rate_tracking import SingularRateTracking
-from controllers.singular_zero_momentum import SingularZeroMomentum
-from controllers.tdfc import TDFC
+from controllers.tracking.augmented_quaternion_feedback import (
+    AugmentedQuaternionFeedback,
+)
+from controllers.tracking.costate_feedback import CostateFeedback
+from controllers.tracking.eigenaxis_pd import EigenaxisPD
+from controllers.two_wheel.gain_scheduled_min_norm import GainScheduledMinNorm
+from controllers.two_wheel.min_norm import MinNorm
+from controllers.two_wheel.singular_rate_tracking import SingularRateTracking
+from controllers.two_wheel.singular_zero_momentum import SingularZeroMomentum
 
 CONTROLLERS: dict[str, type[Controller]] = {
     cls.name: cls for cls in (AugmentedQuaternionFeedback, BDot, CostateFeedback, EigenaxisPD, NoControl, TDFC,

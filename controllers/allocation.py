@@ -17,8 +17,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp import Command, Measurement, Spacecraft
+from ocp.dynamics.layout import split_measurement
 from ocp.fast_call import as_floats
-from ocp.layout import split_measurement
 
 Array = NDArray[np.float64]
 
@@ -155,7 +155,7 @@ class Allocation:
         torque : (3, 1) casadi.SX
             Rigid-body control torque ``u`` [N m], body axes.
         y : casadi.SX
-            The measurement vector ``[q, ω, h_w, b]`` (:mod:`ocp.layout`).
+            The measurement vector ``[q, ω, h_w, b]`` (:mod:`ocp.dynamics.layout`).
         rate : (3, 1) casadi.SX, optional
             ``ω`` of the wheels' gyroscopic term [rad/s]; ``None``: the measured one.
         wheel_momentum : (n_w, 1) casadi.SX, optional

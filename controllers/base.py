@@ -1,10 +1,10 @@
 """Controller contract and its symbolic (CasADi) form.
 
-A controller computes, at each sample, a :class:`~ocp.actuators.Command`. Laws written for the
+A controller computes, at each sample, a :class:`~ocp.dynamics.actuators.Command`. Laws written for the
 rigid body ``I ω̇ = −ω × I ω + u`` compute ``u`` and call :meth:`Controller.allocate`, which maps it
 to the actuators as ARCHITECTURE.md states (:mod:`controllers.allocation`);
 :meth:`Controller.allocate_symbolic` is the same map on CasADi expressions. The vector layouts of
-the symbolic form are in :mod:`ocp.layout`.
+the symbolic form are in :mod:`ocp.dynamics.layout`.
 """
 from __future__ import annotations
 
@@ -20,13 +20,14 @@ from numpy.typing import NDArray
 
 from controllers.allocation import Allocation
 from ocp import Command, Measurement, Spacecraft
-from ocp.layout import (
+from ocp.dynamics.layout import (
     REFERENCE_FIELDS,
     control_layout,
     measurement_size,
     reference_rows,
 )
-from ocp.options import Configurable, InvalidOption
+from ocp.errors import InvalidOption
+from ocp.options import Configurable
 
 Array = NDArray[np.float64]
 
@@ -87,7 +88,7 @@ class Controller(Allocation, Configurable, ABC):
     A law that can be written as a CasADi expression implements :meth:`_law`; the simulator then
     runs the whole closed loop as one CasADi function (optionally compiled to C), and
     ``slewbench codegen`` exports it. After ``reset``, :meth:`symbolic_law` returns
-    ``law(t, y, z, r) -> (u, z_next)`` with (layouts in :mod:`ocp.layout`):
+    ``law(t, y, z, r) -> (u, z_next)`` with (layouts in :mod:`ocp.dynamics.layout`):
 
     * ``t`` (1): s, the sample instant.
     * ``y`` (``7 + n_w + 3``): the measurement ``[q, ω, h_w, b]``: attitude, body rate (rad/s),
@@ -100,7 +101,7 @@ class Controller(Allocation, Configurable, ABC):
       the ``z_next`` of the same inputs. A delay buffer of ``d`` samples of a 3-vector is
       ``z = [v_{k−1}, …, v_{k−d}]`` with ``z_next = [v_k, z[0:3(d−1)]]``.
     * ``r`` (``2 × 13``): the reference at ``t`` and at ``t + sample_time``, each
-      ``[q*, ω*, ω̇*, τ*]`` (:data:`~ocp.layout.REFERENCE_FIELDS`); in regulation mode
+      ``[q*, ω*, ω̇*, τ*]`` (:data:`~ocp.dynamics.layout.REFERENCE_FIELDS`); in regulation mode
       the simulator fills it from the target (:meth:`reference_rows`).
     * ``u`` (``nu``): the command in the model's control layout ``[g, m, τ_t]`` (blocks of the
       actuators present; zeros where nothing is asked), before saturation.
@@ -254,7 +255,7 @@ class Controller(Allocation, Configurable, ABC):
         str
             SHA-256 hex digest of the class, options, spacecraft, sample time and target.
         """
-        from ocp.model import _plain  # the model's fingerprint walker
+        from ocp.dynamics.model import _plain  # the model's fingerprint walker
 
         cache = self._spacecraft()._cache  # the spacecraft is frozen: its description is computed once
         if "description" not in cache:

@@ -6,15 +6,36 @@ Conventions throughout: SI units; quaternions scalar first ``[q0, q1, q2, q3]``,
 ``q`` rotates body vectors into the inertial frame (``v_I = R(q) v_B``); ω is the body rate with
 respect to the inertial frame in body axes [rad/s]; torques, dipoles and wheel axes in body axes.
 """
-from ocp.actuators import ActuatorModel, Command, Measurement
 from ocp.cache import SolverCache
-from ocp.environment import CircularOrbit, Environment, TiltedDipole, gravity_gradient_torque
-from ocp.igrf import IGRFField
-from ocp.metrics import (METRIC_KEYS, compute_metrics, metric_violations, metrics_from_reference,
-                         metrics_from_simulation)
-from ocp.model import AttitudeModel
-from ocp.simulator import SensorNoise, SimulationError, SimulationResult, Simulator
-from ocp.spacecraft import Magnetorquers, ModelError, ReactionWheels, Spacecraft, Torquers
+from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
+from ocp.dynamics.environment import (
+                         CircularOrbit,
+                         Environment,
+                         TiltedDipole,
+                         gravity_gradient_torque,
+)
+from ocp.dynamics.igrf import IGRFField
+from ocp.dynamics.model import AttitudeModel
+from ocp.dynamics.spacecraft import (
+                         Magnetorquers,
+                         ModelError,
+                         ReactionWheels,
+                         Spacecraft,
+                         Torquers,
+)
+from ocp.metrics import (
+                         METRIC_KEYS,
+                         compute_metrics,
+                         metric_violations,
+                         metrics_from_reference,
+                         metrics_from_simulation,
+)
+from ocp.simulation.simulator import (
+                         SensorNoise,
+                         SimulationError,
+                         SimulationResult,
+                         Simulator,
+)
 
 __all__ = [
     "ActuatorModel", "AttitudeModel", "CircularOrbit", "Command", "Environment", "IGRFField", "METRIC_KEYS",

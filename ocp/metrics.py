@@ -221,7 +221,7 @@ def metrics_from_simulation(
 
     Parameters
     ----------
-    result : ocp.simulator.SimulationResult
+    result : ocp.simulation.simulator.SimulationResult
         The simulated run (states at the sample times, applied controls and torques).
     target_q : (4,) array_like or None
         The manoeuvre's final attitude (scalar first, body to inertial); ``None``: free.

@@ -27,10 +27,7 @@ import typing
 from dataclasses import dataclass
 from typing import Annotated, Any, ClassVar, Literal, Mapping, TypeVar, Union
 
-from ocp.option_errors import MAX_REPR as MAX_REPR  # re-exported: their home before the split
-from ocp.option_errors import InvalidOption as InvalidOption
-from ocp.option_errors import OptionsError as OptionsError
-from ocp.option_errors import excerpt as excerpt
+from ocp.errors import InvalidOption, OptionsError, excerpt
 
 T = TypeVar("T")
 

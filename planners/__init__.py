@@ -2,16 +2,23 @@
 
 The contract is :mod:`planners.base` (:class:`Planner`; :class:`ManeuverProblem` in,
 :class:`Reference` out, evaluated as :class:`ReferenceSample` rows) and :mod:`planners.conformance`
-checks it for every registered planner. One module per method: :mod:`planners.collocation`,
-:mod:`planners.costate_tpbvp`, :mod:`planners.eigenaxis`, :mod:`planners.natural_motion`,
+checks it for every registered planner. One module per method: :mod:`planners.collocation.planner`,
+:mod:`planners.costate.tpbvp`, :mod:`planners.eigenaxis`, :mod:`planners.natural_motion`,
 :mod:`planners.shape_polynomial`, :mod:`planners.spin_extremal`.
 """
-from planners.base import (BOUNDARY_CONDITIONS, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
-                           inverse_dynamics_torque)
-from planners.collocation import CollocationPlanner
-from planners.costate_tpbvp import CostateTPBVPPlanner
+from planners.base import Planner
+from planners.collocation.planner import CollocationPlanner
+from planners.costate.tpbvp import CostateTPBVPPlanner
 from planners.eigenaxis import EigenaxisPlanner
 from planners.natural_motion import NaturalMotionPlanner
+from planners.problem import ManeuverProblem
+from planners.reference import (
+    BOUNDARY_CONDITIONS,
+    FailedReference,
+    Reference,
+    ReferenceSample,
+    inverse_dynamics_torque,
+)
 from planners.shape_polynomial import ShapePolynomialPlanner
 from planners.spin_extremal import SpinExtremalPlanner
 

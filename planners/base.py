@@ -23,13 +23,13 @@ from typing import Any, ClassVar
 
 from ocp import SolverCache
 from ocp.options import Configurable
-from planners.problem import Array, ManeuverProblem
-from planners.reference import (BOUNDARY_CONDITIONS, STATUSES, FailedReference, Reference, ReferenceSample,
-                                inverse_dynamics_torque)
-from planners.torque_free import TorqueFreeMotion
+from planners.problem import ManeuverProblem
+from planners.reference import (
+    FailedReference,
+    Reference,
+)
 
-__all__ = ["Array", "BOUNDARY_CONDITIONS", "FailedReference", "ManeuverProblem", "Planner", "Reference",
-           "ReferenceSample", "STATUSES", "TorqueFreeMotion", "inverse_dynamics_torque"]
+__all__ = ["Planner"]
 
 
 class Planner(Configurable, ABC):

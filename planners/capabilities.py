@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Any, Protocol, runtime_checkable
 
-from planners.base import Array
+from planners.problem import Array
 
 
 @runtime_checkable

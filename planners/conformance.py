@@ -19,7 +19,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ocp import CircularOrbit, Environment, ReactionWheels, Spacecraft, Torquers, quat
-from planners.base import Array, ManeuverProblem, Reference, inverse_dynamics_torque
+from planners.problem import Array, ManeuverProblem
+from planners.reference import Reference, inverse_dynamics_torque
 from planners.torque_free import REST_RATE
 
 ATTITUDE_TOLERANCE = 2e-5

@@ -21,8 +21,14 @@ import numpy as np
 
 from ocp import quat, quat_casadi
 from ocp.options import Range
-from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference,
-                           ReferenceSample, inverse_dynamics_torque)
+from planners.base import Planner
+from planners.problem import Array, ManeuverProblem
+from planners.reference import (
+    FailedReference,
+    Reference,
+    ReferenceSample,
+    inverse_dynamics_torque,
+)
 
 
 def golden_section_minimum(function: Callable[[float], float], low: float, high: float, tolerance: float) -> float:

@@ -27,12 +27,23 @@ import numpy as np
 
 from ocp import Spacecraft, quat
 from ocp import quat_casadi as qc
-from ocp.integration import rk4_step
-from ocp.nlp import solve_multistart, solver_options
+from ocp.dynamics.integration import rk4_step
+from ocp.nlp.solve import solve_multistart, solver_options
 from ocp.options import Range
-from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
-                           inverse_dynamics_torque)
-from planners.torque_free import asymmetric_rates, euler_rhs, symmetric_motion, symmetry_axis
+from planners.base import Planner
+from planners.problem import Array, ManeuverProblem
+from planners.reference import (
+    FailedReference,
+    Reference,
+    ReferenceSample,
+    inverse_dynamics_torque,
+)
+from planners.torque_free import (
+    asymmetric_rates,
+    euler_rhs,
+    symmetric_motion,
+    symmetry_axis,
+)
 
 
 class NaturalMotionReference(Reference):
@@ -70,7 +81,9 @@ class NaturalMotionReference(Reference):
         self.q0, self.omega0, self.moments, self.arc, self.stop = q0, omega0, moments, arc, stop
         self.axis = symmetry_axis(moments)
         if self.axis is None:
-            from scipy.integrate import solve_ivp  # lazily: scipy.integrate pulls in scipy.optimize
+            from scipy.integrate import (
+                solve_ivp,  # lazily: scipy.integrate pulls in scipy.optimize
+            )
 
             solution = solve_ivp(lambda s, q: quat.kinematics(q, asymmetric_rates(s, omega0, moments)), (0, arc),
                                  quat.IDENTITY, method="DOP853", rtol=1e-12, atol=1e-13, dense_output=True)

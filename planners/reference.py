@@ -302,7 +302,7 @@ class Reference(ABC):
         casadi.Function or None
             ``reference(t) -> row``, ``t`` [s] clamped to ``[0, duration]``, ``row`` the 13 numbers
             ``[q (4), ω (3) rad/s, ω̇ (3) rad/s^2, τ (3) N m]`` (body axes; the layout of
-            ``ocp.layout.REFERENCE_FIELDS``); ``None`` (default) when the reference has no closed form.
+            ``ocp.dynamics.layout.REFERENCE_FIELDS``); ``None`` (default) when the reference has no closed form.
         """
         return None
 

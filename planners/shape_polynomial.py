@@ -24,10 +24,16 @@ import numpy as np
 
 from ocp import quat
 from ocp import quat_casadi as qc
-from ocp.nlp import solve_multistart, solver_options
+from ocp.nlp.solve import solve_multistart, solver_options
 from ocp.options import Range
-from planners.base import (Array, FailedReference, ManeuverProblem, Planner, Reference, ReferenceSample,
-                           inverse_dynamics_torque)
+from planners.base import Planner
+from planners.problem import Array, ManeuverProblem
+from planners.reference import (
+    FailedReference,
+    Reference,
+    ReferenceSample,
+    inverse_dynamics_torque,
+)
 
 QUADRATURE_POINTS = 41  # uniform grid of the torque cost
 GAUSS_POINTS = 16       # Gauss-Legendre points of the path cost (exact for degree 31)

@@ -26,17 +26,13 @@ import casadi as ca
 import numpy as np
 
 from ocp import quat
-from ocp.nlp import solve_multistart, solver_options
-from ocp.options import InvalidOption, Range
-from ocp.spin_closed_form import extremal_quaternion
-from planners.base import (
-    Array,
-    FailedReference,
-    ManeuverProblem,
-    Planner,
-    Reference,
-    ReferenceSample,
-)
+from ocp.dynamics.spin_closed_form import extremal_quaternion
+from ocp.errors import InvalidOption
+from ocp.nlp.solve import solve_multistart, solver_options
+from ocp.options import Range
+from planners.base import Planner
+from planners.problem import Array, ManeuverProblem
+from planners.reference import FailedReference, Reference, ReferenceSample
 
 
 def torque_amplitudes(v: float, r: float, c: float, moments: Array) -> Array:
@@ -155,7 +151,7 @@ def build_solver() -> ca.Function:
     """IPOPT on (r, c, β) with parameters [v, T, I1, I2, I3, q_target (4), k].
 
     At a zero-cost optimum (k = 0, target reached) IPOPT reports
-    ``Search_Direction_Becomes_Too_Small``, which the status policy of :mod:`ocp.nlp` counts as
+    ``Search_Direction_Becomes_Too_Small``, which the status policy of :mod:`ocp.nlp.solve` counts as
     converged (the problem is unconstrained).
 
     Returns

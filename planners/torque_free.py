@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp import quat
-from ocp.spin_closed_form import extremal_quaternion
+from ocp.dynamics.spin_closed_form import extremal_quaternion
 
 Array = NDArray[np.float64]
 REST_RATE = 1e-15
@@ -65,7 +65,9 @@ class TorqueFreeMotion:
     def _solution(self, index: int) -> Any:
         while len(self._chunks) <= index:
             k = len(self._chunks)
-            from scipy.integrate import solve_ivp  # lazily: 0.5 s to import, needed only after T
+            from scipy.integrate import (
+                solve_ivp,  # lazily: 0.5 s to import, needed only after T
+            )
 
             solution = solve_ivp(self._rhs, (0.0, self.chunk), self._ends[k], method="DOP853", rtol=1e-12,
                                  atol=1e-14, dense_output=True)
@@ -207,7 +209,10 @@ def asymmetric_rates(t: Array, omega0: Array, moments: Array) -> Array:
     m = min((Ib - Ia) * (e2 * Ic - h2) / ((Ic - Ib) * (h2 - e2 * Ia)), 1.0)
     sign_c = 1.0 if w0[c] >= 0 else -1.0
     parity = np.linalg.det(np.eye(3)[order])  # an odd sort reverses the Euler equations
-    from scipy.special import ellipj, ellipkinc  # lazily: scipy.special is slow to import
+    from scipy.special import (  # lazily: scipy.special is slow to import
+        ellipj,
+        ellipkinc,
+    )
     phase = ellipkinc(np.arctan2(w0[b] / amp_b if amp_b > 0 else 0.0, w0[a] / amp_a if amp_a > 0 else 1.0), m)
     sn, cn, dn, _ = ellipj(sign_c * parity * rate * np.asarray(t, dtype=float) + phase, m)
     sorted_rates = np.empty(np.shape(t) + (3,))

@@ -1,4 +1,4 @@
-"""Scenarios: YAML loading, the runner, tables, plots and the CLI.
+"""Scenarios: YAML schema and loading, the runner, outputs, trade studies, code generation and the CLI.
 
 Library use::
 
@@ -8,68 +8,44 @@ Library use::
     print(results.to_markdown())
     study = scenarios.sweep("study.yaml")   # a trade study; .to_dataframe()
 
-The names below are imported on first use (PEP 562), so that ``import scenarios`` costs nothing
-until one is used: the command line starts its plot process before it loads the model
-(:mod:`scenarios.console`).
+Subpackages, from the bottom up (each may import only those before it, and :mod:`ocp`,
+:mod:`planners` and :mod:`controllers`):
+
+* :mod:`scenarios.schema`: reading YAML safely, typed nodes that name their path, the scenario
+  schema and its checks, and the schema reference generated from them;
+* :mod:`scenarios.output`: run results as tables, files and figures, and the output directories
+  slewbench owns;
+* :mod:`scenarios.runner` (a module): plan, track and score every row of a scenario;
+* :mod:`scenarios.codegen` (a module): a scenario's law and references as C;
+* :mod:`scenarios.study`: trade studies: their schema, cases, store, engine and report;
+* :mod:`scenarios.cli`: the ``slewbench`` command line.
+
+The names below are imported on first use (PEP 562, :func:`scenarios._faces.lazy_face`), so that
+``import scenarios`` costs nothing until one is used: the command line starts its plot process
+before it loads the model (:mod:`scenarios.console`).
 """
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from scenarios._faces import lazy_face
 
 if TYPE_CHECKING:  # the names, for type checkers and readers
-    from scenarios.loader import Scenario, load, parse_scenario
     from scenarios.runner import Row, RunResults, run
-    from scenarios.study import Study, load_study, parse_study
-    from scenarios.sweep_engine import SweepInterrupted, SweepResults, sweep
-    from scenarios.yaml_node import ScenarioError
+    from scenarios.schema.loader import Scenario, load, parse_scenario
+    from scenarios.schema.read import ScenarioError
+    from scenarios.study.engine import SweepInterrupted, SweepResults, sweep
+    from scenarios.study.spec import load_study, parse_study
+    from scenarios.study.types import Study
 
-_HOMES = {"Scenario": "scenarios.loader", "load": "scenarios.loader", "parse_scenario": "scenarios.loader",
+_HOMES = {"Scenario": "scenarios.schema.loader", "load": "scenarios.schema.loader",
+          "parse_scenario": "scenarios.schema.loader",
           "Row": "scenarios.runner", "RunResults": "scenarios.runner", "run": "scenarios.runner",
-          "Study": "scenarios.study", "load_study": "scenarios.study", "parse_study": "scenarios.study",
-          "SweepInterrupted": "scenarios.sweep_engine", "SweepResults": "scenarios.sweep_engine",
-          "sweep": "scenarios.sweep_engine", "ScenarioError": "scenarios.yaml_node"}
+          "Study": "scenarios.study.types", "load_study": "scenarios.study.spec", "parse_study": "scenarios.study.spec",
+          "SweepInterrupted": "scenarios.study.engine", "SweepResults": "scenarios.study.engine",
+          "sweep": "scenarios.study.engine", "ScenarioError": "scenarios.schema.read"}
 
 __all__ = ["Row", "RunResults", "Scenario", "ScenarioError", "Study", "SweepInterrupted", "SweepResults",
-           "load", "load_study", "parse_scenario", "parse_study", "run", "sweep"]
+           "load", "load_study", "parse_study", "parse_scenario", "run", "sweep"]
 
-
-def __getattr__(name: str) -> Any:
-    """The public name ``name``, imported from its module on first use.
-
-    Parameters
-    ----------
-    name : str
-        One of ``__all__``, or the name of a submodule (imported too).
-
-    Returns
-    -------
-    object
-        The class, function or submodule.
-
-    Raises
-    ------
-    AttributeError
-        ``name`` is neither.
-    """
-    home = _HOMES.get(name)
-    if home is not None:
-        return getattr(importlib.import_module(home), name)
-    if not name.startswith("__"):  # a submodule, as when the package imported them all (scenarios.loader)
-        try:
-            return importlib.import_module(f"{__name__}.{name}")
-        except ModuleNotFoundError as error:
-            if error.name != f"{__name__}.{name}":
-                raise
-    raise AttributeError(f"module 'scenarios' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    """The module's names, the lazily imported ones included.
-
-    Returns
-    -------
-    list of str
-        Sorted names.
-    """
-    return sorted(set(globals()) | set(_HOMES))
+__getattr__, __dir__ = lazy_face(__name__, _HOMES)

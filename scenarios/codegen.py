@@ -1,11 +1,11 @@
 """``slewbench codegen``: a scenario's controller law (and closed-form references) as C.
 
-The output directory (claimed with :func:`scenarios.outputs.claim_output_directory`, so a user's
+The output directory (claimed with :func:`scenarios.output.directory.claim_output_directory`, so a user's
 files are never touched) receives:
 
 * ``slewbench_<scenario>.c`` / ``.h``: CasADi-generated C with the standard generated interface
   (``<f>(arg, res, iw, w, mem)``, ``<f>_work``, ``<f>_sparsity_in``, …) for
-  ``slewbench_law(t, y, z, r) -> (u, z_next)`` (the layouts of ``ocp.layout``) and, for every
+  ``slewbench_law(t, y, z, r) -> (u, z_next)`` (the layouts of ``ocp.dynamics.layout``) and, for every
   planner row whose planner is closed-form, ``slewbench_reference_<row>(t) -> row``;
 * ``Makefile``: ``make`` builds ``libslewbench_<scenario>.so``, loadable with
   ``casadi.external("slewbench_law", "libslewbench_<scenario>.so")``;
@@ -24,11 +24,16 @@ from typing import Any
 import casadi as ca
 
 from controllers import CONTROLLERS
-from ocp.layout import REFERENCE_FIELDS, control_layout
+from ocp.dynamics.layout import REFERENCE_FIELDS, control_layout
 from planners import PLANNERS
-from scenarios.loader import Scenario
-from scenarios.outputs import claim_output_directory, commit_outputs, new_staging, row_stems
-from scenarios.yaml_node import ScenarioError
+from scenarios.output.directory import (
+    claim_output_directory,
+    commit_outputs,
+    new_staging,
+)
+from scenarios.output.names import row_stems
+from scenarios.schema.loader import Scenario
+from scenarios.schema.read import ScenarioError
 
 
 @dataclass

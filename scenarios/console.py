@@ -1,9 +1,9 @@
 """The ``slewbench`` console script: starts the plot process of ``run``, then the command line.
 
-``slewbench run`` with plots forks its plot process (:mod:`scenarios.renderer`) here, before
+``slewbench run`` with plots forks its plot process (:mod:`scenarios.output.renderer`) here, before
 anything imports NumPy or the model: the child then imports matplotlib while this process
 imports slewbench and runs the scenario. Every other command, and ``python -m scenarios.cli``,
-goes straight to :func:`scenarios.cli.main`. This module imports only the standard library and
+goes straight to :func:`scenarios.cli.main.main`. This module imports only the standard library and
 the lazy :mod:`scenarios` package.
 """
 from __future__ import annotations
@@ -12,7 +12,7 @@ import signal
 import sys
 from typing import Any
 
-from scenarios.renderer import Renderer
+from scenarios.output.renderer import Renderer
 
 
 def _interrupt(signum: int, frame: Any) -> None:
@@ -50,7 +50,7 @@ def main(argv: list[str] | None = None) -> int:
     Returns
     -------
     int
-        The exit status of :func:`scenarios.cli.main` (1 if interrupted before it started).
+        The exit status of :func:`scenarios.cli.main.main` (1 if interrupted before it started).
     """
     argv = sys.argv[1:] if argv is None else list(argv)
     renderer = Renderer.start() if draws_plots(argv) else None
@@ -60,7 +60,9 @@ def main(argv: list[str] | None = None) -> int:
         previous = None
     try:
         try:
-            from scenarios.cli import main as command_line  # the model, after the fork
+            from scenarios.cli.main import (
+                main as command_line,  # the model, after the fork
+            )
         except KeyboardInterrupt:  # Ctrl-C or SIGTERM while the model loads: nothing written yet
             print("slewbench: interrupted; nothing written", file=sys.stderr)
             return 1

@@ -1,7 +1,7 @@
 """Run a scenario: plan with every planner, track each reference in closed loop, score both.
 
 :func:`run` returns :class:`RunResults`, whose rows carry the metrics, the reference and the
-simulation, and which render to JSON, CSV and Markdown (see :mod:`scenarios.tables`).
+simulation, and which render to JSON, CSV and Markdown (see :mod:`scenarios.output.tables`).
 """
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ from ocp import (
     metrics_from_simulation,
 )
 from planners import PLANNERS, FailedReference, Reference
-from scenarios.loader import ControllerSpec, Scenario
+from scenarios.schema.loader import ControllerSpec, Scenario
 
 
 @dataclass
@@ -87,11 +87,11 @@ class Row:
 @dataclass
 class RunResults:
     """Rows of a scenario run. ``to_json``, ``to_csv``, ``to_markdown``, ``to_dataframe`` and
-    ``write`` render them (implemented in :mod:`scenarios.tables` and :mod:`scenarios.outputs`).
+    ``write`` render them (implemented in :mod:`scenarios.output.tables` and :mod:`scenarios.output.directory`).
 
     Parameters
     ----------
-    scenario : scenarios.loader.Scenario
+    scenario : scenarios.schema.loader.Scenario
         The scenario that was run.
     rows : list of Row
         One per planner and controller pair (per controller in regulation mode).
@@ -117,7 +117,7 @@ class RunResults:
         -------
         str
         """
-        from scenarios.tables import to_json
+        from scenarios.output.tables import to_json
         return to_json(self)
 
     def to_csv(self) -> str:
@@ -127,7 +127,7 @@ class RunResults:
         -------
         str
         """
-        from scenarios.tables import to_csv
+        from scenarios.output.tables import to_csv
         return to_csv(self)
 
     def to_markdown(self) -> str:
@@ -137,7 +137,7 @@ class RunResults:
         -------
         str
         """
-        from scenarios.tables import to_markdown
+        from scenarios.output.tables import to_markdown
         return to_markdown(self)
 
     def to_terminal(self) -> str:
@@ -147,7 +147,7 @@ class RunResults:
         -------
         str
         """
-        from scenarios.tables import to_terminal
+        from scenarios.output.tables import to_terminal
         return to_terminal(self)
 
     def to_dataframe(self) -> Any:
@@ -157,7 +157,7 @@ class RunResults:
         -------
         pandas.DataFrame
         """
-        from scenarios.tables import to_dataframe
+        from scenarios.output.tables import to_dataframe
         return to_dataframe(self)
 
     def write(self, directory: str | Path, plots: bool = True, renderer: Any = None) -> None:
@@ -169,10 +169,10 @@ class RunResults:
             Output directory (created; slewbench never overwrites files it did not write).
         plots : bool, optional
             Also write the PNG figures.
-        renderer : scenarios.renderer.Renderer, optional
+        renderer : scenarios.output.renderer.Renderer, optional
             A plot process to draw them (``None``: drawn in this process).
         """
-        from scenarios.outputs import write_results
+        from scenarios.output.directory import write_results
         write_results(self, directory, plots=plots, renderer=renderer)
 
 

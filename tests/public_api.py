@@ -29,8 +29,8 @@ import inspect
 import pkgutil
 import re
 import sys
-from pathlib import Path
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 PACKAGES = ("ocp", "planners", "controllers", "scenarios")

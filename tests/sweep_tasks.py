@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 
 from scenarios import runner
-from scenarios.sweep_worker import run_case
+from scenarios.study.worker import run_case
 
 
 def misbehaving_task(payload):

@@ -11,7 +11,7 @@ from scipy.integrate import solve_ivp
 
 import scenarios
 from ocp import METRIC_KEYS, quat
-from scenarios.cli import main
+from scenarios.cli.main import main
 
 SMALL = """
 name: small

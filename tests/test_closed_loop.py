@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import ocp.compiled
+import ocp.simulation.compiled
 from controllers import CONTROLLERS
 from ocp import (
     AttitudeModel,
@@ -18,7 +18,7 @@ from ocp import (
     quat,
 )
 from planners import PLANNERS
-from scenarios.loader import load
+from scenarios.schema.loader import load
 
 SCENARIOS = sorted(p for p in Path(__file__).resolve().parents[1].joinpath("scenarios").glob("*.yaml")
                    if not p.name.startswith("study_"))  # trade studies are not scenarios
@@ -98,13 +98,13 @@ def test_compiled_loop_equals_the_python_loop_and_is_cached(tmp_path, monkeypatc
     libraries = list((tmp_path / "slewbench").glob("*.so"))
     assert len(libraries) == 1
     # The same law and model again: loaded from the cache, the compiler is not run.
-    monkeypatch.setattr(ocp.compiled.subprocess, "run", lambda *a, **k: pytest.fail("rebuilt a cached build"))
+    monkeypatch.setattr(ocp.simulation.compiled.subprocess, "run", lambda *a, **k: pytest.fail("rebuilt a cached build"))
     assert_same(python, small_loop(compile=True))
 
 
 def test_without_a_compiler_the_loop_runs_interpreted_with_a_one_line_notice(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
-    monkeypatch.setattr(ocp.compiled, "find_compiler", lambda: None)
+    monkeypatch.setattr(ocp.simulation.compiled, "find_compiler", lambda: None)
     result = small_loop(compile=True)
     assert result.path == "interpreted"
     notice = capsys.readouterr().err
@@ -121,7 +121,7 @@ def test_divergence_of_a_symbolic_loop_is_reported():
 
 
 def test_grid_sampled_reference_is_the_reference(rng):
-    from ocp.simulator import GridSampledReference
+    from ocp.simulation.simulator import GridSampledReference
     from planners import ManeuverProblem
 
     problem = ManeuverProblem(Spacecraft([2.0, 3.0, 4.0]), quat.IDENTITY, np.zeros(3), quat.random_unit(rng), 30.0)

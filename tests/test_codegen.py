@@ -12,8 +12,8 @@ import pytest
 from controllers import CONTROLLERS
 from ocp import Measurement, quat
 from planners import PLANNERS
-from scenarios.cli import main
-from scenarios.loader import load
+from scenarios.cli.main import main
+from scenarios.schema.loader import load
 
 SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
 pytestmark = pytest.mark.skipif(shutil.which("make") is None or shutil.which("cc") is None,

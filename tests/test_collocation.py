@@ -225,12 +225,12 @@ def test_single_axis_minimum_fuel_matches_bang_off_bang(solver):
 @pytest.mark.parametrize("transcription", ["collocation", "multiple_shooting"])
 @pytest.mark.parametrize("objective", ["min_energy", "min_time", "min_l1_cone"])
 def test_block_assembled_derivatives_equal_casadi_ad_of_the_whole_nlp(transcription, objective):
-    # ocp.stagewise differentiates one interval and scatters the blocks; CasADi's own AD of the
+    # ocp.transcription.stagewise differentiates one interval and scatters the blocks; CasADi's own AD of the
     # whole graph is the oracle, at a random point with random multipliers.
     import casadi as ca
 
-    from ocp.stagewise import assemble
     from ocp.transcription import TRANSCRIPTIONS
+    from ocp.transcription.stagewise import assemble
 
     if transcription == "multiple_shooting" and objective == "min_l1_cone":
         pytest.skip("multiple_shooting takes no L1 cost or cones")

@@ -1,13 +1,13 @@
-"""Multipliers carried from a coarse mesh to a fine one (ocp.mesh_transfer) against the fine mesh's own."""
+"""Multipliers carried from a coarse mesh to a fine one (ocp.transcription.mesh_transfer) against the fine mesh's own."""
 import numpy as np
 import pytest
 
 from ocp import Spacecraft, Torquers, quat
-from ocp.mesh_transfer import transfer_multipliers
-from ocp.nlp import solve_multistart, solver_options
+from ocp.nlp.solve import solve_multistart, solver_options
 from ocp.transcription import TRANSCRIPTIONS
+from ocp.transcription.mesh_transfer import transfer_multipliers
 from planners import PLANNERS, ManeuverProblem
-from planners.collocation_reference import seed_sampler
+from planners.collocation.reference import seed_sampler
 
 
 def bounded_single_axis():
@@ -67,7 +67,7 @@ def test_solution_sampler_reads_the_solution_as_the_reference_does():
     # The native seed of a fine mesh (states and controls interpolated by the transcription) against
     # the reference's own evaluation: with torquers only and no environment, the actuator torque is
     # the reference's torque (inverse dynamics of the interpolated states).
-    from planners.collocation_reference import solution_sampler
+    from planners.collocation.reference import solution_sampler
 
     problem = bounded_single_axis()
     reference = PLANNERS["collocation"]({"intervals": 8}).plan(problem)
@@ -181,7 +181,7 @@ def test_radau_controls_at_a_node_are_the_ending_intervals_point_with_left():
 def test_solution_sampler_reads_a_node_from_the_interval_that_ends_there():
     # The seed of a fine Radau point τ_d = 1 that falls on a coarse node (8 and 50 intervals meet
     # at T/2): the coarse interval ending there, whose own point τ_d = 1 is a decision variable.
-    from planners.collocation_reference import solution_sampler
+    from planners.collocation.reference import solution_sampler
 
     problem = bounded_single_axis()
     reference = PLANNERS["collocation"]({"intervals": 8}).plan(problem)
@@ -360,8 +360,8 @@ def test_no_multiplier_transfer_onto_a_mesh_beyond_its_validated_size(monkeypatc
     # optimum ("INFO(1) = -9 ... reallocating" three times, ~30 s each), with or without the carried
     # multipliers and for mu_init 1e-7 or 1e-4; the same seed without warm_start_init_point
     # converged in 0.9 s, the cold solve from eigenaxis in 3.4 s on 500 intervals.
-    from planners.collocation import CollocationPlanner
-    from planners.collocation_strategy import TRANSFER_MAX_INTERVALS
+    from planners.collocation.planner import CollocationPlanner
+    from planners.collocation.strategy import TRANSFER_MAX_INTERVALS
 
     calls = []
     monkeypatch.setattr(CollocationPlanner, "_transfer", lambda self, *args: calls.append(self.options.intervals))

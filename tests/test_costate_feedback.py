@@ -5,10 +5,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from controllers.costate_feedback import fit_costate_gain, project_psd
-from scenarios.loader import ScenarioError, load, parse_scenario
+from controllers.tracking.costate_feedback import fit_costate_gain, project_psd
 from scenarios.runner import run
-from scenarios.yaml_node import read_yaml
+from scenarios.schema.loader import load, parse_scenario
+from scenarios.schema.read import ScenarioError, read_yaml
 
 SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
 

@@ -6,11 +6,15 @@ import numpy as np
 import pytest
 
 from ocp import CircularOrbit, Environment, Simulator, Spacecraft, Torquers, quat
-from ocp.actuators import Command
-from ocp.integration import rk4_step
+from ocp.dynamics.actuators import Command
+from ocp.dynamics.integration import rk4_step
 from planners import PLANNERS, ManeuverProblem
-from planners.costate_systems import AttitudeAcquisitionSystem, MinimumEnergySystem, RateAcquisitionSystem
-from planners.costate_tpbvp import solve
+from planners.costate.systems import (
+    AttitudeAcquisitionSystem,
+    MinimumEnergySystem,
+    RateAcquisitionSystem,
+)
+from planners.costate.tpbvp import solve
 
 INERTIA = [[10.0, 0.5, 0.2], [0.5, 8.0, 0.3], [0.2, 0.3, 6.0]]
 GRAVITY = Environment(CircularOrbit(500e3, 0.9), gravity_gradient=True)
@@ -198,7 +202,7 @@ def test_vepa_attitude_acquisition_scenario():
     # polynomials cannot (they must start and stop at rest), and their torques are much larger.
     from pathlib import Path
 
-    from scenarios.loader import load
+    from scenarios.schema.loader import load
 
     scenario = load(Path(__file__).resolve().parents[1] / "scenarios" / "vepa_attitude_acquisition.yaml")
     case = scenario.problem

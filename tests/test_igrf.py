@@ -1,4 +1,4 @@
-"""IGRF field tabulated along the orbit (ocp.igrf) against the ppigrf package it is built from.
+"""IGRF field tabulated along the orbit (ocp.dynamics.igrf) against the ppigrf package it is built from.
 
 The oracle is ppigrf itself, called here at orbit positions computed here (the orbit and the
 Earth's rotation written out independently of ocp), with the spherical-to-Cartesian conversion
@@ -14,7 +14,7 @@ ppigrf = pytest.importorskip("ppigrf")
 
 import scenarios
 from ocp import AttitudeModel, CircularOrbit, Environment, IGRFField, Spacecraft, quat
-from ocp.igrf import greenwich_mean_sidereal_angle
+from ocp.dynamics.igrf import greenwich_mean_sidereal_angle
 
 EPOCH = datetime.datetime(2025, 1, 1)
 MU, R_EARTH, EARTH_RATE = 3.986004418e14, 6378.137e3, 7.2921159e-5

@@ -5,8 +5,16 @@ import numpy as np
 import pytest
 
 from controllers import CONTROLLERS
-from ocp import AttitudeModel, ModelError, ReactionWheels, SensorNoise, Simulator, Spacecraft, quat
-from ocp.options import OptionsError
+from ocp import (
+    AttitudeModel,
+    ModelError,
+    ReactionWheels,
+    SensorNoise,
+    Simulator,
+    Spacecraft,
+    quat,
+)
+from ocp.errors import OptionsError
 from planners import PLANNERS, ManeuverProblem
 
 SPACECRAFT = Spacecraft([2.0, 3.0, 4.0], wheels=ReactionWheels.from_body_axes(max_torque=0.1))

@@ -3,9 +3,19 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from ocp import (AttitudeModel, CircularOrbit, Command, Environment, ModelError, ReactionWheels,
-                 Simulator, Spacecraft, TiltedDipole, quat)
-from ocp.environment import EARTH_RATE, MU_EARTH, R_EARTH
+from ocp import (
+    AttitudeModel,
+    CircularOrbit,
+    Command,
+    Environment,
+    ModelError,
+    ReactionWheels,
+    Simulator,
+    Spacecraft,
+    TiltedDipole,
+    quat,
+)
+from ocp.dynamics.environment import EARTH_RATE, MU_EARTH, R_EARTH
 
 
 class InternalWheelTorques:

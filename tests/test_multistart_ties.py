@@ -1,11 +1,11 @@
-"""Ties in :func:`ocp.nlp.solve_multistart`: a secondary criterion among equal optima."""
+"""Ties in :func:`ocp.nlp.solve.solve_multistart`: a secondary criterion among equal optima."""
 from __future__ import annotations
 
 import casadi as ca
 import numpy as np
 import pytest
 
-from ocp.nlp import solve_multistart, solver_options
+from ocp.nlp.solve import solve_multistart, solver_options
 
 
 @pytest.fixture(scope="module")

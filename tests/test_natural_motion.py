@@ -6,7 +6,8 @@ from scipy.integrate import solve_ivp
 from controllers import CONTROLLERS
 from ocp import ReactionWheels, Simulator, Spacecraft, metrics_from_simulation, quat
 from planners import PLANNERS, ManeuverProblem
-from planners.natural_motion import NaturalMotionReference, asymmetric_rates
+from planners.natural_motion import NaturalMotionReference
+from planners.torque_free import asymmetric_rates
 
 UKUBE1 = np.array([0.0109, 0.05, 0.05])  # nano-spacecraft paper, section III
 

@@ -1,9 +1,9 @@
-"""Solver statuses in the one solve path (:mod:`ocp.nlp`): FATROP's integer return flags are named."""
+"""Solver statuses in the one solve path (:mod:`ocp.nlp.solve`): FATROP's integer return flags are named."""
 import numpy as np
 import pytest
 
 from ocp import Spacecraft, Torquers, quat
-from ocp.nlp import FATROP_STATUS, status_name
+from ocp.nlp.solve import FATROP_STATUS, status_name
 from planners import PLANNERS, ManeuverProblem
 
 

@@ -14,8 +14,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from scenarios.cli import main
-from scenarios.outputs import MARKER, STAGING_PREFIX, default_output_directory, row_stems
+from scenarios.cli.main import main
+from scenarios.output.directory import MARKER, STAGING_PREFIX
+from scenarios.output.names import default_output_directory, row_stems
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -215,7 +216,7 @@ def test_a_sigterm_swallowed_during_the_run_still_stops_it_before_writing(tmp_pa
     """A KeyboardInterrupt raised by the SIGTERM handler can be lost on the way (inside a finaliser,
     or recorded as a failed row); seen once in CI: SIGTERM, then exit 0 with complete results. The
     run must still stop, with nothing written but the marker, marked incomplete."""
-    import scenarios.cli as cli
+    import scenarios.cli.main as cli
     real_run = cli.run
 
     def run_swallowing_a_sigterm(*args, **kwargs):
@@ -273,7 +274,7 @@ def test_a_symlinked_folder_inside_the_output_is_refused(tmp_path, capsys):
 
 def test_a_live_runs_staging_folder_survives_another_run(tmp_path):
     """Two runs into one directory: the second removes only staging folders of dead processes."""
-    from scenarios.outputs import claim_output_directory, new_staging
+    from scenarios.output.directory import claim_output_directory, new_staging
     out = claim_output_directory(tmp_path / "out")
     mine = new_staging(out)  # this process is alive
     dead = out / f"{STAGING_PREFIX}999999999-x"

@@ -84,7 +84,7 @@ def test_the_spin_extremal_declares_its_initial_rates_and_the_metrics_report_the
 def test_the_spin_extremal_family_cannot_match_a_transversally_resting_body():
     # Matching ω(0) = [v, 0, 0] forces r = 0, and then q*(t) is the free spin E1(v t) whatever c and
     # β are: the family keeps no freedom to reach a target (closed form vs the spin about roll).
-    from planners.spin_extremal import extremal_quaternion
+    from ocp.dynamics.spin_closed_form import extremal_quaternion
 
     t = np.linspace(0.0, 50.0, 11)
     for c, beta in ((0.3, 0.0), (-1.2, 2.0)):

@@ -7,9 +7,9 @@ import pytest
 from PIL import Image
 
 from ocp import quat
-from planners.base import ReferenceSample
-from scenarios.plot_data import decimate, row_series
-from scenarios.plots import RowFigure
+from planners.reference import ReferenceSample
+from scenarios.output.plot_data import decimate, row_series
+from scenarios.output.plots import RowFigure
 
 
 class Reference:

@@ -12,7 +12,13 @@ from typing import Protocol
 
 import pytest
 
-from tests.public_api import PACKAGES, audit_module, check_class, check_function, public_modules
+from tests.public_api import (
+    PACKAGES,
+    audit_module,
+    check_class,
+    check_function,
+    public_modules,
+)
 
 MODULES = [module.__name__ for module in public_modules(PACKAGES)]
 

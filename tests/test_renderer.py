@@ -16,8 +16,8 @@ import pytest
 from PIL import Image
 
 from scenarios.console import draws_plots
-from scenarios.plot_data import OverlaySeries, RowSeries
-from scenarios.renderer import COST, split
+from scenarios.output.plot_data import OverlaySeries, RowSeries
+from scenarios.output.renderer import COST, split
 
 REPO = Path(__file__).resolve().parents[1]
 DEMO = REPO / "scenarios" / "eigenaxis_demo.yaml"
@@ -38,12 +38,12 @@ def test_the_plot_process_draws_what_the_run_process_draws(tmp_path):
     done = _python("""
         import sys
         from pathlib import Path
-        from scenarios.renderer import Renderer
+        from scenarios.output.renderer import Renderer
         renderer = Renderer.start()
         assert renderer is not None, "no plot process on a one-thread Linux process"
         import scenarios
-        from scenarios.plot_data import plot_jobs
-        from scenarios.plots import draw_jobs
+        from scenarios.output.plot_data import plot_jobs
+        from scenarios.output.plots import draw_jobs
         results = scenarios.run(scenarios.load(sys.argv[1]))
         jobs = plot_jobs(results)
         forked, here = Path(sys.argv[2]) / "forked", Path(sys.argv[2]) / "here"
@@ -66,7 +66,7 @@ def test_a_dead_plot_process_costs_only_time(tmp_path):
     line, and writes complete results."""
     done = _python("""
         import os, signal, sys
-        from scenarios.renderer import Renderer
+        from scenarios.output.renderer import Renderer
         renderer = Renderer.start()
         os.kill(renderer.pid, signal.SIGKILL)
         import scenarios
@@ -154,10 +154,10 @@ def test_the_package_imports_nothing_heavy_until_used():
 
 
 def test_the_drawing_half_imports_no_model():
-    """The plot process imports ``scenarios.plots`` only: never the model (CasADi) or the run."""
+    """The plot process imports ``scenarios.output.plots`` only: never the model (CasADi) or the run."""
     done = _python("""
         import sys
-        import scenarios.plots
+        import scenarios.output.plots
         print(sorted(m for m in ("casadi", "ocp", "planners", "controllers", "scipy") if m in sys.modules))
     """)
     assert done.returncode == 0, done.stderr
@@ -190,10 +190,10 @@ def test_an_interrupted_draw_stops_both_plot_processes_before_it_returns(tmp_pat
     done = _python("""
         import os, signal, sys, time
         from pathlib import Path
-        from scenarios.renderer import Renderer
+        from scenarios.output.renderer import Renderer
         renderer = Renderer.start()
         import scenarios
-        from scenarios.plot_data import plot_jobs
+        from scenarios.output.plot_data import plot_jobs
         jobs = plot_jobs(scenarios.run(scenarios.load(sys.argv[1])))
         jobs = [(f"{k}-{name}", series) for k in range(8) for name, series in jobs]  # a long draw
         directory, forks = Path(sys.argv[2]), []
@@ -258,11 +258,11 @@ def test_an_interruption_while_the_model_is_imported_is_reported_without_a_trace
         import os, signal, sys, time
         from pathlib import Path
         import scenarios.console
-        from scenarios.renderer import Renderer
+        from scenarios.output.renderer import Renderer
 
-        class Interrupting:  # Ctrl-C while scenarios.cli is being imported
+        class Interrupting:  # Ctrl-C while scenarios.cli.main is being imported
             def find_spec(self, name, path=None, target=None):
-                if name == "scenarios.cli":
+                if name == "scenarios.cli.main":
                     INTERRUPT
 
         started = []
@@ -282,13 +282,13 @@ def test_an_interruption_while_the_model_is_imported_is_reported_without_a_trace
 
 def test_the_submodules_are_attributes_of_the_package_as_before():
     """Library code written against the eager package (``import scenarios`` then
-    ``scenarios.loader.load``) still works; an unknown name is still an AttributeError."""
+    ``scenarios.schema.loader.load``) still works; an unknown name is still an AttributeError."""
     done = _python("""
         import scenarios
-        assert scenarios.loader.load is scenarios.load
+        assert scenarios.schema.loader.load is scenarios.load
         assert scenarios.runner.RunResults is scenarios.RunResults
-        assert scenarios.yaml_node.ScenarioError is scenarios.ScenarioError
-        scenarios.study.parse_study, scenarios.sweep_engine.sweep, scenarios.yaml_read
+        assert scenarios.schema.node.ScenarioError is scenarios.ScenarioError
+        scenarios.study.spec.parse_study, scenarios.study.engine.sweep, scenarios.schema.read
         try:
             scenarios.no_such_name
         except AttributeError as error:
@@ -327,10 +327,10 @@ def test_the_plot_process_removes_the_temporary_matplotlib_directory(tmp_path, d
     done = subprocess.run([sys.executable, "-c", textwrap.dedent("""
         import sys, time
         from pathlib import Path
-        from scenarios.renderer import Renderer
+        from scenarios.output.renderer import Renderer
         renderer = Renderer.start()
         import scenarios
-        from scenarios.plot_data import plot_jobs
+        from scenarios.output.plot_data import plot_jobs
         results = scenarios.run(scenarios.load(sys.argv[1]))
         if sys.argv[3] == "True":
             renderer.draw(plot_jobs(results), Path(sys.argv[2]))

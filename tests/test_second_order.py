@@ -1,4 +1,4 @@
-"""The second-order check (ocp.second_order) against closed forms, and its use by the multistart.
+"""The second-order check (ocp.nlp.second_order) against closed forms, and its use by the multistart.
 
 Oracles: the reduced Hessian of small NLPs worked by hand (a saddle, a maximum on a line, a vertex,
 a weakly active bound), then the eigenaxis slew, a known saddle of Bilimoria & Wie's minimum-time
@@ -10,11 +10,11 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from ocp.nlp import solve_multistart, solver_options
-from ocp.second_order import second_order_check
+from ocp.nlp.second_order import second_order_check
+from ocp.nlp.solve import solve_multistart, solver_options
 from planners import PLANNERS
-from planners.collocation_reference import seed_sampler
-from planners.collocation_strategy import control_floor
+from planners.collocation.reference import seed_sampler
+from planners.collocation.strategy import control_floor
 from tests.test_collocation import bilimoria_wie_problem
 
 
@@ -211,7 +211,7 @@ def test_the_unchecked_size_is_reported(monkeypatch):
 
 
 def test_perturbation_floor_reaches_zero_components():
-    from ocp.nlp import perturbed
+    from ocp.nlp.solve import perturbed
 
     center = np.zeros(20000)
     floor = np.where(np.arange(center.size) % 2 == 0, 1.0, 1e-3)
@@ -246,7 +246,7 @@ def test_the_dense_factorisations_run_on_one_blas_thread(monkeypatch):
     # check's QR and eigenvalues must run on BLAS_THREADS threads whatever the machine's default.
     import threadpoolctl
 
-    import ocp.second_order as second_order
+    import ocp.nlp.second_order as second_order
 
     seen = []
     null_space = second_order._null_space

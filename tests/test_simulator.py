@@ -2,10 +2,22 @@
 import numpy as np
 import pytest
 
-from ocp import (AttitudeModel, CircularOrbit, Command, Environment, Magnetorquers, ReactionWheels,
-                 SensorNoise, Simulator, Spacecraft, TiltedDipole, Torquers, quat)
-from tests.conftest import WheelPD
+from ocp import (
+    AttitudeModel,
+    CircularOrbit,
+    Command,
+    Environment,
+    Magnetorquers,
+    ReactionWheels,
+    SensorNoise,
+    Simulator,
+    Spacecraft,
+    TiltedDipole,
+    Torquers,
+    quat,
+)
 from planners import PLANNERS, ManeuverProblem
+from tests.conftest import WheelPD
 
 
 class GreedyController:
@@ -112,7 +124,7 @@ def test_divergence_is_reported_not_returned_as_nan():
 # --- review findings of the float rewrite (2026-11-23) -------------------------------------------
 
 def _actuators(spacecraft):
-    from ocp.actuators import ActuatorModel
+    from ocp.dynamics.actuators import ActuatorModel
     model = AttitudeModel(spacecraft)
     return ActuatorModel(spacecraft, model.control_slices, model.nu)
 

@@ -4,7 +4,14 @@ import pytest
 from scipy.integrate import quad, solve_ivp, trapezoid
 
 from controllers import CONTROLLERS
-from ocp import ReactionWheels, Simulator, Spacecraft, Torquers, metrics_from_simulation, quat
+from ocp import (
+    ReactionWheels,
+    Simulator,
+    Spacecraft,
+    Torquers,
+    metrics_from_simulation,
+    quat,
+)
 from planners import PLANNERS, ManeuverProblem, inverse_dynamics_torque
 from planners.spin_extremal import energy_cost, extremal_torque
 from tests.conftest import finite_difference_torque

@@ -15,12 +15,12 @@ import yaml
 
 import scenarios
 from scenarios import runner
-from scenarios.cli import main
-from scenarios.outputs import claim_output_directory
-from scenarios.store import SweepStore
-from scenarios.study import parse_study
-from scenarios.sweep_engine import sweep
-from scenarios.sweep_worker import run_case
+from scenarios.cli.main import main
+from scenarios.output.directory import claim_output_directory
+from scenarios.study.engine import sweep
+from scenarios.study.spec import parse_study
+from scenarios.study.store import SweepStore
+from scenarios.study.worker import run_case
 
 BASE = {
     "name": "tiny",
@@ -162,7 +162,7 @@ def test_a_worker_reuses_simulators_only_where_a_fresh_one_gives_the_same_rows()
     """Cases that share a worker's simulators (same model and settings; the gain, target and
     sensor noise vary, and the inertia in the last grid value) give exactly the rows of a run with
     a new simulator per case; the worker's cache keeps only its last few simulators."""
-    from scenarios.sweep_worker import RecentCache, worker_state
+    from scenarios.study.worker import RecentCache, worker_state
 
     data = study_data(grid={"controller.options.kp": [0.2, 0.3],
                             "maneuver.final.q": {"axis_angle": {"axis": [0, 1, 0], "angle_deg": [20, 40]}},
@@ -341,7 +341,7 @@ def test_readme_study_and_example_studies_are_valid():
     assert len(study.cases) == 2 * 3 * 3 * 2 * 2
     fractions = {c.scenario["planners"][1]["options"]["torque_fraction"] for c in study.cases}
     assert fractions == {0.5, 0.75, 1.0}
-    from scenarios.study_report import _DUMPER, resolved_study
+    from scenarios.study.report import _DUMPER, resolved_study
     for name, count in (("study_spin_weight_sample_time", 20), ("study_planners_vs_slew_angle", 7),
                         ("study_spin_monte_carlo", 1000)):
         example = scenarios.load_study(root / "scenarios" / f"{name}.yaml")
@@ -353,7 +353,7 @@ def test_readme_study_and_example_studies_are_valid():
 
 
 def test_pareto_front_is_the_set_of_non_dominated_points(rng):
-    from scenarios.study_plots import pareto_front
+    from scenarios.study.plots import pareto_front
     points = rng.random((200, 2))
     points[::17] = np.nan  # failed cases are left out
     finite = points[np.isfinite(points).all(axis=1)]
@@ -365,7 +365,7 @@ def test_pareto_front_is_the_set_of_non_dominated_points(rng):
 
 
 def test_crashed_rows_match_the_runner_rows_with_several_controllers():
-    from scenarios.sweep_worker import crashed_rows
+    from scenarios.study.worker import crashed_rows
     data = copy.deepcopy(BASE)
     data["controllers"] = [data.pop("controller"), {"name": "eigenaxis_pd", "label": "pd"}]
     ran = scenarios.run(scenarios.parse_scenario(copy.deepcopy(data)))

@@ -14,9 +14,9 @@ import pandas as pd
 import pytest
 import yaml
 
-from scenarios.cli import main
-from scenarios.study import load_study
-from scenarios.sweep_engine import sweep
+from scenarios.cli.main import main
+from scenarios.study.engine import sweep
+from scenarios.study.spec import load_study
 from tests.test_sweep import BASE, InlineExecutor, comparable
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -11,8 +11,8 @@ import pytest
 
 from controllers import CONTROLLERS
 from ocp import Magnetorquers, Measurement, ReactionWheels, Spacecraft, Torquers, quat
-from ocp.layout import measurement_vector
-from planners.base import ReferenceSample
+from ocp.dynamics.layout import measurement_vector
+from planners.reference import ReferenceSample
 
 SPACECRAFT = {
     "three_wheels": lambda: Spacecraft([[19.5, 0.3, -0.2], [0.3, 19.0, 0.1], [-0.2, 0.1, 12.6]],

@@ -3,8 +3,16 @@ import numpy as np
 import pytest
 
 from controllers import CONTROLLERS
-from ocp import (Command, Measurement, ReactionWheels, Simulator, Spacecraft, Torquers, metrics_from_simulation,
-                 quat)
+from ocp import (
+    Command,
+    Measurement,
+    ReactionWheels,
+    Simulator,
+    Spacecraft,
+    Torquers,
+    metrics_from_simulation,
+    quat,
+)
 from planners import PLANNERS, ManeuverProblem
 
 

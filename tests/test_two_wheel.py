@@ -7,9 +7,10 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from controllers import CONTROLLERS
-from controllers.min_norm import MinNorm
-from controllers.singular_zero_momentum import SingularZeroMomentum
-from controllers.underactuated import SingularGains, control_frame, desired_rates
+from controllers.two_wheel.min_norm import MinNorm
+from controllers.two_wheel.singular_rates import SingularGains, desired_rates
+from controllers.two_wheel.singular_zero_momentum import SingularZeroMomentum
+from controllers.two_wheel.underactuated import control_frame
 from ocp import (
     Magnetorquers,
     Measurement,
@@ -269,7 +270,7 @@ def test_three_working_wheels_or_a_non_principal_axis_are_rejected(name):
     ("gain_scheduled_min_norm", {"k1": 0.05}, "options.g1"),
 ])
 def test_g_must_exceed_twice_k(name, options, path):
-    from ocp.options import OptionsError
+    from ocp.errors import OptionsError
     with pytest.raises(OptionsError, match="g.* > 2 k") as error:
         CONTROLLERS[name](options)
     assert error.value.path == path
@@ -298,7 +299,7 @@ def test_scenario_rejects_a_spacecraft_the_laws_cannot_control(change, path):
     import copy
 
     import scenarios
-    from scenarios.yaml_node import ScenarioError, read_yaml
+    from scenarios.schema.read import ScenarioError, read_yaml
 
     data = copy.deepcopy(read_yaml(Path(__file__).parent.parent / "scenarios" / "horri_palmer_two_wheels.yaml"))
     if "inertia" in change:

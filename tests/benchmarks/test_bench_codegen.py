@@ -5,7 +5,7 @@ import re
 import subprocess
 from pathlib import Path
 
-from scenarios.cli import main
+from scenarios.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[2]
 

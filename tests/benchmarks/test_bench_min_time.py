@@ -22,9 +22,9 @@ import numpy as np
 import pytest
 
 from ocp import Spacecraft, Torquers, quat
-from ocp.nlp import solver_options
+from ocp.nlp.solve import solver_options
 from planners import PLANNERS, ManeuverProblem
-from planners.collocation_reference import seed_sampler
+from planners.collocation.reference import seed_sampler
 
 N = 50
 

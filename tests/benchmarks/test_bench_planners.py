@@ -65,7 +65,7 @@ def test_costate_tpbvp_vepa_cases(benchmark, scenario):
     # Issue 7 target: a TPBVP solve in at most 2 s (each call builds its CasADi functions anew).
     from pathlib import Path
 
-    from scenarios.loader import load
+    from scenarios.schema.loader import load
 
     spec_scenario = load(Path(__file__).resolve().parents[2] / "scenarios" / f"{scenario}.yaml")
     spec = spec_scenario.planners[0]

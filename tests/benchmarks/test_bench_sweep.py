@@ -4,7 +4,7 @@ least 1.7x the throughput of one; 100 cases of one collocation structure build t
 worker.
 
 The sweep side is the command itself, ``slewbench sweep STUDY --out DIR --no-plots --workers N``,
-run in this process (``scenarios.cli.main``): it expands and checks the study, claims the
+run in this process (``scenarios.cli.main.main``): it expands and checks the study, claims the
 directory, commits every case to the SQLite store and writes the tables. The in-process side is
 a loop of ``scenarios.run(scenarios.parse_scenario(case), cache=..., simulators=...)`` over the
 same cases, with the caches a worker keeps (a solver cache and a few simulators), so that the
@@ -29,13 +29,13 @@ import yaml
 
 import scenarios
 from ocp import SolverCache
-from scenarios.cli import main
-from scenarios.store import SweepStore
-from scenarios.study import load_study, parse_study
-from scenarios.study_report import claim_sweep_directory
-from scenarios.sweep_engine import start_forkserver, sweep
-from scenarios.sweep_worker import RecentCache
-from scenarios.yaml_node import read_yaml
+from scenarios.cli.main import main
+from scenarios.schema.read import read_yaml
+from scenarios.study.engine import start_forkserver, sweep
+from scenarios.study.report import claim_sweep_directory
+from scenarios.study.spec import load_study, parse_study
+from scenarios.study.store import SweepStore
+from scenarios.study.worker import RecentCache
 
 DEMO = Path(__file__).resolve().parents[2] / "scenarios" / "eigenaxis_demo.yaml"
 

@@ -1,0 +1,17 @@
+"""Tracking and regulation laws with full three-axis actuation.
+
+What lives here: the augmented quaternion feedback of the spin and nano papers
+(:mod:`~controllers.tracking.augmented_quaternion_feedback`), the eigenaxis PD regulator
+(:mod:`~controllers.tracking.eigenaxis_pd`) and Vepa's co-state feedback
+(:mod:`~controllers.tracking.costate_feedback`).
+
+May import: :mod:`ocp`, :mod:`controllers.base` and :mod:`controllers.allocation`; the co-state
+feedback also the :mod:`planners` contract (it needs an indirect reference's co-states).
+"""
+from controllers.tracking.augmented_quaternion_feedback import (
+    AugmentedQuaternionFeedback,
+)
+from controllers.tracking.costate_feedback import CostateFeedback
+from controllers.tracking.eigenaxis_pd import EigenaxisPD
+
+__all__ = ["AugmentedQuaternionFeedback", "CostateFeedback", "EigenaxisPD"]

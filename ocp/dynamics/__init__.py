@@ -1,0 +1,33 @@
+"""The spacecraft and its environment as equations: rigid body, actuators, orbit, fields, the model.
+
+What lives here: the spacecraft and its actuators (:mod:`~ocp.dynamics.spacecraft`), what a command
+becomes once applied (:mod:`~ocp.dynamics.actuators`), the orbit, gravity gradient and magnetic
+field models (:mod:`~ocp.dynamics.environment`, :mod:`~ocp.dynamics.igrf`), the assembled symbolic
+model ``ẋ = f(x, u, t, p)`` (:mod:`~ocp.dynamics.model`), the vector layouts shared with the laws and
+the generated C (:mod:`~ocp.dynamics.layout`), the RK4 step (:mod:`~ocp.dynamics.integration`) and
+the closed-form spinning attitude (:mod:`~ocp.dynamics.spin_closed_form`).
+
+May import: NumPy, CasADi, ppigrf and the top-level modules of :mod:`ocp` (``quat``,
+``quat_casadi``, ``cache``, ``fast_call``, ``errors``); never the other subpackages of ``ocp``.
+"""
+from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
+from ocp.dynamics.environment import (
+           CircularOrbit,
+           Environment,
+           TiltedDipole,
+           gravity_gradient_torque,
+)
+from ocp.dynamics.igrf import IGRFField
+from ocp.dynamics.integration import rk4_step
+from ocp.dynamics.model import AttitudeModel
+from ocp.dynamics.spacecraft import (
+           Magnetorquers,
+           ModelError,
+           ReactionWheels,
+           Spacecraft,
+           Torquers,
+)
+
+__all__ = ["ActuatorModel", "AttitudeModel", "CircularOrbit", "Command", "Environment", "IGRFField", "Magnetorquers",
+           "Measurement", "ModelError", "ReactionWheels", "Spacecraft", "TiltedDipole", "Torquers",
+           "gravity_gradient_torque", "rk4_step"]

@@ -1,0 +1,314 @@
+"""Environment: circular orbit, gravity-gradient torque, tilted-dipole geomagnetic field.
+
+Frames: the inertial frame is Earth-centred (ECI, z along the Earth's spin axis); the Earth-fixed
+frame turns about z at ``earth_rate``. The expression builders take CasADi symbols (or numbers)
+and return CasADi expressions; :class:`ocp.dynamics.model.AttitudeModel` assembles them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from ocp import quat_casadi as qc
+from ocp.dynamics.spacecraft import ModelError
+from ocp.quat_casadi import Expr
+
+if TYPE_CHECKING:  # type-only: ocp.dynamics.igrf refers back to CircularOrbit
+    from ocp.dynamics.igrf import IGRFField
+
+MU_EARTH = 3.986004418e14      # m³/s², EGM96 / WGS-84
+R_EARTH = 6378.137e3           # m, WGS-84 equatorial radius
+EARTH_RATE = 7.2921159e-5      # rad/s, sidereal rotation rate
+DIPOLE_STRENGTH = 7.96e15      # T m³, Wertz (1978) dipole moment of the Earth's field
+
+
+@dataclass(frozen=True)
+class CircularOrbit:
+    """Circular Keplerian orbit, fixed in the inertial (ECI) frame.
+
+    Parameters
+    ----------
+    altitude : float
+        Height above the equatorial radius ``R_EARTH`` [m]; must exceed ``−0.99 R_EARTH``.
+    inclination : float, optional
+        Inclination of the orbit plane to the equator [rad] (default 0).
+    raan : float, optional
+        Right ascension of the ascending node [rad] (default 0).
+    arg_latitude : float, optional
+        Argument of latitude at t = 0 [rad], measured from the ascending node in the direction
+        of motion (default 0).
+    mu : float, optional
+        Gravitational parameter [m^3/s^2] (default ``MU_EARTH``).
+
+    Raises
+    ------
+    ModelError
+        If the orbit radius is not positive.
+    """
+
+    altitude: float
+    inclination: float = 0.0
+    raan: float = 0.0
+    arg_latitude: float = 0.0
+    mu: float = MU_EARTH
+
+    def __post_init__(self) -> None:
+        if not self.altitude > -R_EARTH * 0.99:
+            raise ModelError("altitude", f"the orbit radius must be positive, got altitude {self.altitude} m")
+
+    @property
+    def radius(self) -> float:
+        """Orbit radius ``R_EARTH + altitude`` [m]."""
+        return R_EARTH + self.altitude
+
+    @property
+    def mean_motion(self) -> float:
+        """Mean motion ``n = sqrt(mu / radius³)`` [rad/s]: the orbit rate."""
+        return float(np.sqrt(self.mu / self.radius**3))
+
+    def position(self, t: Expr) -> Expr:
+        """Position of the spacecraft from the Earth's centre.
+
+        Parameters
+        ----------
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 1) casadi.DM, SX or MX
+            Position [m], inertial frame (``DM`` for a numeric ``t``).
+        """
+        u = self.arg_latitude + self.mean_motion * t
+        ci, si = np.cos(self.inclination), np.sin(self.inclination)
+        cO, sO = np.cos(self.raan), np.sin(self.raan)
+        return self.radius * ca.vertcat(
+            ca.cos(u) * cO - ca.sin(u) * ci * sO,
+            ca.cos(u) * sO + ca.sin(u) * ci * cO,
+            ca.sin(u) * si,
+        )
+
+    def velocity(self, t: Expr) -> Expr:
+        """Velocity of the spacecraft with respect to the inertial frame.
+
+        Parameters
+        ----------
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 1) casadi.DM, SX or MX
+            Velocity [m/s], inertial frame; magnitude ``radius * mean_motion``.
+        """
+        u = self.arg_latitude + self.mean_motion * t
+        ci, si = np.cos(self.inclination), np.sin(self.inclination)
+        cO, sO = np.cos(self.raan), np.sin(self.raan)
+        return self.radius * self.mean_motion * ca.vertcat(
+            -ca.sin(u) * cO - ca.cos(u) * ci * sO,
+            -ca.sin(u) * sO + ca.cos(u) * ci * cO,
+            ca.cos(u) * si,
+        )
+
+    def nadir(self, t: Expr) -> Expr:
+        """Unit vector from the spacecraft to the Earth's centre.
+
+        Parameters
+        ----------
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 1) casadi.DM, SX or MX
+            Unit vector, inertial frame.
+        """
+        r = self.position(t)
+        return -r / ca.norm_2(r)
+
+    def function(self) -> ca.Function:
+        """The orbit as a CasADi function of time.
+
+        Returns
+        -------
+        casadi.Function
+            ``orbit(t) -> (position, velocity, nadir)``: ``t`` [s]; position [m], velocity [m/s]
+            and unit nadir vector, each (3, 1) in the inertial frame.
+        """
+        t = ca.SX.sym("t")
+        return ca.Function("orbit", [t], [self.position(t), self.velocity(t), self.nadir(t)], ["t"],
+                           ["position", "velocity", "nadir"])
+
+    def lvlh_matrix(self, t: Expr) -> Expr:
+        """Local-vertical local-horizontal (orbit) frame at time ``t``.
+
+        Parameters
+        ----------
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 3) casadi.DM, SX or MX
+            Columns: the LVLH axes in inertial components, x along-track (along the velocity for
+            a circular orbit), y = −orbit normal, z nadir; it maps LVLH components to inertial
+            ones, ``v_I = M v_LVLH``.
+        """
+        z = self.nadir(t)
+        v = self.velocity(t)
+        y = ca.cross(z, v)
+        y = y / ca.norm_2(y)
+        return ca.horzcat(ca.cross(y, z), y, z)
+
+
+@dataclass(frozen=True)
+class TiltedDipole:
+    """Tilted dipole geomagnetic field rotating with the Earth (nano-spacecraft paper, eq. 6).
+
+    ``B = μ_m / r³ [3 (m̂·r̂) r̂ − m̂]`` where ``m̂`` is the dipole direction, which points to the
+    southern geomagnetic pole. In geomagnetic latitude λ and longitude η this is exactly eq. 6:
+    ``b = −μ_m/r³ [3 sinλ cosλ cosη, 3 sinλ cosλ sinη, 3 sin²λ − 1]``.
+
+    Parameters
+    ----------
+    strength : float, optional
+        Dipole strength ``μ_m`` [T m^3] (default ``DIPOLE_STRENGTH``, 7.96e15: about 30 µT at the
+        equator on the ground).
+    tilt : float, optional
+        Angle between the geomagnetic and geographic north poles [rad] (default 11.5°).
+    pole_longitude : float, optional
+        East longitude of the northern geomagnetic pole [rad] (default −70°).
+    greenwich_angle : float, optional
+        Angle of the Earth-fixed x axis from the inertial x axis at t = 0 [rad] (default 0).
+    earth_rate : float, optional
+        Rotation rate of the Earth-fixed frame about the inertial z axis [rad/s] (default
+        ``EARTH_RATE``, sidereal).
+    """
+
+    strength: float = DIPOLE_STRENGTH
+    tilt: float = np.deg2rad(11.5)
+    pole_longitude: float = np.deg2rad(-70.0)
+    greenwich_angle: float = 0.0
+    earth_rate: float = EARTH_RATE
+
+    def dipole_direction(self, t: Expr) -> Expr:
+        """Unit dipole direction ``m̂`` (towards the southern geomagnetic pole).
+
+        Parameters
+        ----------
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 1) casadi.DM, SX or MX
+            Unit vector, inertial frame.
+        """
+        angle = self.greenwich_angle + self.earth_rate * t + self.pole_longitude
+        st = np.sin(self.tilt)
+        return -ca.vertcat(st * ca.cos(angle), st * ca.sin(angle), np.cos(self.tilt))
+
+    def function(self) -> ca.Function:
+        """The field as a CasADi function.
+
+        Returns
+        -------
+        casadi.Function
+            ``dipole_field(position, t) -> b``: ``position`` (3,) [m] and ``b`` (3, 1) [T], both
+            inertial frame; ``t`` [s].
+        """
+        position, t = ca.SX.sym("position", 3), ca.SX.sym("t")
+        return ca.Function("dipole_field", [position, t], [self.field_inertial(position, t)], ["position", "t"], ["b"])
+
+    def field_inertial(self, position: Expr, t: Expr) -> Expr:
+        """Geomagnetic field vector at a point and time.
+
+        Parameters
+        ----------
+        position : (3, 1) casadi.SX, MX, DM or array_like
+            Position from the Earth's centre [m], inertial frame (non-zero).
+        t : float or scalar casadi.SX / MX
+            Time since t = 0 [s].
+
+        Returns
+        -------
+        (3, 1) casadi.DM, SX or MX
+            Field ``B`` [T], inertial frame.
+        """
+        r = ca.norm_2(position)
+        r_hat = position / r
+        m_hat = self.dipole_direction(t)
+        return self.strength / r**3 * (3 * ca.dot(m_hat, r_hat) * r_hat - m_hat)
+
+
+def gravity_gradient_torque(q: Expr, position: Expr, inertia: NDArray, mu: float = MU_EARTH) -> Expr:
+    """Gravity-gradient torque on a rigid body, ``3 μ / |r|⁵ · r_B × (I r_B)``.
+
+    Parameters
+    ----------
+    q : (4, 1) casadi.SX, MX or DM
+        Attitude quaternion, scalar first, body to inertial.
+    position : (3, 1) casadi.SX, MX, DM or array_like
+        Position of the spacecraft from the Earth's centre [m], inertial frame; rotated here to
+        ``r_B = R(q)ᵀ r``.
+    inertia : (3, 3) ndarray
+        Inertia matrix about the centre of mass [kg m^2], body frame.
+    mu : float, optional
+        Gravitational parameter [m^3/s^2] (default ``MU_EARTH``).
+
+    Returns
+    -------
+    (3, 1) casadi.SX, MX or DM
+        Torque [N m], body frame.
+    """
+    r_body = ca.mtimes(qc.rotation_matrix(q).T, position)
+    r = ca.norm_2(position)
+    return 3 * mu / r**5 * ca.cross(r_body, ca.mtimes(ca.DM(inertia), r_body))
+
+
+@dataclass(frozen=True)
+class Environment:
+    """What acts on the spacecraft besides its actuators.
+
+    Parameters
+    ----------
+    orbit : CircularOrbit or None, optional
+        The orbit; required by the gravity gradient and the magnetic field (default none).
+    gravity_gradient : bool, optional
+        Include the gravity-gradient torque (default False).
+    magnetic_field : TiltedDipole or IGRFField or None, optional
+        Geomagnetic model (:class:`TiltedDipole`, or :class:`~ocp.dynamics.igrf.IGRFField` tabulated along
+        ``orbit``), needed by magnetorquers; ``None`` (default): no field.
+    disturbance_torque : (3,) array_like, optional
+        Constant disturbance torque [N m], body frame (default zero); held as a (3,) ndarray. It
+        is the default of the model's parameter ``p``.
+
+    Raises
+    ------
+    ModelError
+        For a mis-sized disturbance, or a gravity gradient or field without an orbit, or an IGRF
+        table along another orbit.
+    """
+
+    orbit: CircularOrbit | None = None
+    gravity_gradient: bool = False
+    magnetic_field: TiltedDipole | IGRFField | None = None
+    disturbance_torque: NDArray = field(default_factory=lambda: np.zeros(3))
+
+    def __post_init__(self) -> None:
+        disturbance = np.asarray(self.disturbance_torque, dtype=float)
+        if disturbance.shape != (3,):
+            raise ModelError("disturbance_torque", f"expected 3 values, got shape {disturbance.shape}")
+        object.__setattr__(self, "disturbance_torque", disturbance)
+        if self.orbit is None and self.gravity_gradient:
+            raise ModelError("gravity_gradient", "gravity gradient needs an orbit")
+        if self.orbit is None and self.magnetic_field is not None:
+            raise ModelError("magnetic_field", "a magnetic field model needs an orbit")
+        tabulated_along = getattr(self.magnetic_field, "orbit", None)
+        if tabulated_along is not None and tabulated_along != self.orbit:
+            raise ModelError("magnetic_field", "the field is tabulated along another orbit than the environment's")
+

@@ -1,0 +1,288 @@
+"""The assembled symbolic model ``ẋ = f(x, u, t, p)`` of a spacecraft in its environment.
+
+State ``x = [q (4), ω (3), h_w (n_w)]``: scalar-first attitude quaternion (body to inertial),
+body rate w.r.t. inertial in body axes (rad/s), wheel spin momenta (N m s).
+Control ``u = [g (n_w), m (3), τ_t (3)]`` with only the blocks of the actuators present:
+wheel motor torques (N m, ``ḣ_w = g``), magnetorquer dipole (A m², body axes), torquer torques
+(N m, body axes). Parameter ``p`` (3): the constant disturbance torque in body axes (N m); its
+default value is the environment's, and passing it lets one built model serve many runs.
+
+Dynamics (ARCHITECTURE.md): ``I ω̇ = −ω × (I ω + A h_w) − A g + m × B_B + τ_t + τ_gg + p``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+from typing import Any
+
+import casadi as ca
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ocp import quat
+from ocp import quat_casadi as qc
+from ocp.cache import SolverCache
+from ocp.dynamics.environment import Environment, gravity_gradient_torque
+from ocp.dynamics.layout import control_layout
+from ocp.dynamics.spacecraft import Spacecraft
+from ocp.quat_casadi import Expr
+
+
+class AttitudeModel:
+    """Symbolic model of one spacecraft in one environment (see the module docstring for the
+    state ``x``, control ``u`` and parameter ``p``, and the dynamics).
+
+    The CasADi functions are built on ``SX`` symbols at construction; all take and return column
+    vectors, ``t`` in s.
+
+    Parameters
+    ----------
+    spacecraft : Spacecraft
+        Rigid body and actuators; the actuators present fix the layout of ``u``.
+    environment : Environment or None, optional
+        Orbit, gravity gradient, magnetic field and disturbance; ``None`` (default): an empty
+        :class:`~ocp.dynamics.environment.Environment` (no orbit, no external torque).
+
+    Attributes
+    ----------
+    spacecraft : Spacecraft
+        As given.
+    environment : Environment
+        As given, or the empty environment.
+    n_wheels : int
+        Number of wheels (failed ones included), ``n_w``.
+    nx : int
+        State size, ``7 + n_w``.
+    nu : int
+        Control size: ``n_w`` with wheels, plus 3 with magnetorquers, plus 3 with torquers.
+    rhs : casadi.Function
+        ``f(x, u, t, p) -> xdot``, the state derivative.
+    body_torque : casadi.Function
+        ``body_torque(x, u, t) -> tau``: the actuators' torque on the body
+        (``−A g + m × B_B + τ_t``) [N m], body axes.
+    environment_torque : casadi.Function
+        ``environment_torque(x, t, p) -> tau``: gravity gradient plus the disturbance ``p``
+        [N m], body axes.
+    field_body : casadi.Function or None
+        ``field_body(x, t) -> b``: geomagnetic field [T], body axes; ``None`` without a field model.
+    field_rate_inertial : casadi.Function or None
+        ``field_rate_inertial(t) -> db``: time derivative of the inertial-frame field seen along
+        the orbit [T/s], inertial axes; ``None`` without a field model.
+    control_slices : dict of str to slice
+        Slices of ``u`` for the blocks present among ``"wheels"``, ``"dipole"``, ``"torquers"``.
+    solver_cache : SolverCache
+        Solvers built on this model by planners given no cache of their own.
+    """
+
+    def __init__(self, spacecraft: Spacecraft, environment: Environment | None = None):
+        self.spacecraft = spacecraft
+        self.environment = environment if environment is not None else Environment()
+        self.n_wheels = spacecraft.n_wheels
+        self.nx = 7 + self.n_wheels
+        self.control_slices: dict[str, slice]
+        self.control_slices, self.nu = control_layout(spacecraft)
+        self._fingerprint: str | None = None
+        self.solver_cache = SolverCache()
+        """Solvers built on this model by planners given no cache of their own."""
+        self._build()
+
+    @property
+    def fingerprint(self) -> str:
+        """A hash of every number and choice of the spacecraft and environment that the symbolic
+        graph bakes in: two models with equal fingerprints build identical functions."""
+        if self._fingerprint is None:
+            description = repr((_plain(self.spacecraft), _plain(self.environment)))
+            self._fingerprint = hashlib.sha256(description.encode()).hexdigest()
+        return self._fingerprint
+
+    @property
+    def default_parameters(self) -> NDArray:
+        """(3,) default ``p``: the environment's constant disturbance torque [N m], body axes."""
+        return np.asarray(self.environment.disturbance_torque, dtype=float)
+
+    def split_state(self, x: Expr) -> tuple[Expr, Expr, Expr]:
+        """The parts of a state vector.
+
+        Parameters
+        ----------
+        x : (nx,) or (nx, 1) casadi.SX, MX, DM or ndarray
+            State ``[q, ω, h_w]``.
+
+        Returns
+        -------
+        q : (4,) slice of ``x``
+            Attitude quaternion, scalar first, body to inertial.
+        omega : (3,) slice of ``x``
+            Body rate with respect to the inertial frame [rad/s], body axes.
+        h_w : (n_w,) slice of ``x``
+            Wheel spin momenta [N m s] (empty without wheels).
+        """
+        return x[0:4], x[4:7], x[7:self.nx]
+
+    def magnetic_field_body(self, q: Expr, t: Expr) -> Expr | None:
+        """Geomagnetic field seen by the spacecraft, ``R(q)ᵀ B_I(r(t), t)``.
+
+        Parameters
+        ----------
+        q : (4, 1) casadi.SX, MX or DM
+            Attitude quaternion, scalar first, body to inertial.
+        t : float or scalar casadi.SX / MX
+            Time [s].
+
+        Returns
+        -------
+        (3, 1) casadi.SX, MX or DM, or None
+            Field [T], body frame; ``None`` without a field model.
+        """
+        env = self.environment
+        if env.magnetic_field is None or env.orbit is None:  # Environment requires an orbit for a field
+            return None
+        field_inertial = env.magnetic_field.field_inertial(env.orbit.position(t), t)
+        return ca.mtimes(qc.rotation_matrix(q).T, field_inertial)
+
+    def actuator_torque(self, x: Expr, u: Expr, t: Expr) -> Expr:
+        """Torque of the actuators on the body, ``−A g + m × B_B + τ_t``.
+
+        Parameters
+        ----------
+        x : (nx, 1) casadi.SX or MX
+            State ``[q, ω, h_w]``; ``MX`` gives an ``MX`` result, anything else ``SX``.
+        u : (nu, 1) casadi.SX or MX
+            Control ``[g, m, τ_t]`` (the blocks present): wheel motor torques [N m], dipole
+            [A m^2] and torquer torques [N m], body axes.
+        t : float or scalar casadi.SX / MX
+            Time [s] (for the magnetic field).
+
+        Returns
+        -------
+        (3, 1) casadi.SX or MX
+            Torque [N m], body frame. The dipole term is absent without a field model.
+        """
+        q = x[0:4]
+        torque = ca.MX.zeros(3, 1) if isinstance(x, ca.MX) else ca.SX.zeros(3, 1)
+        if "wheels" in self.control_slices:
+            torque -= ca.mtimes(ca.DM(self.spacecraft.wheel_axes), u[self.control_slices["wheels"]])
+        if "dipole" in self.control_slices:
+            field_body = self.magnetic_field_body(q, t)
+            if field_body is not None:
+                torque += ca.cross(u[self.control_slices["dipole"]], field_body)
+        if "torquers" in self.control_slices:
+            torque += u[self.control_slices["torquers"]]
+        return torque
+
+    def external_torque(self, x: Expr, t: Expr, p: Expr) -> Expr:
+        """Torque of the environment on the body: gravity gradient (if enabled) plus ``p``.
+
+        Parameters
+        ----------
+        x : (nx, 1) casadi.SX, MX or DM
+            State ``[q, ω, h_w]``.
+        t : float or scalar casadi.SX / MX
+            Time [s] (for the orbit position).
+        p : (3, 1) casadi.SX, MX, DM or array_like
+            Constant disturbance torque [N m], body frame.
+
+        Returns
+        -------
+        (3, 1) casadi.SX, MX or DM
+            Torque [N m], body frame.
+        """
+        env = self.environment
+        torque = p
+        if env.gravity_gradient and env.orbit is not None:  # Environment requires an orbit for it
+            torque = torque + gravity_gradient_torque(
+                x[0:4], env.orbit.position(t), self.spacecraft.inertia, env.orbit.mu
+            )
+        return torque
+
+    def dynamics(self, x: Expr, u: Expr, t: Expr, p: Expr) -> Expr:
+        """State derivative ``ẋ = [½ q ⊗ [0, ω], ω̇, g]`` with
+        ``I ω̇ = −ω × (I ω + A h_w) − A g + m × B_B + τ_t + τ_gg + p``.
+
+        Parameters
+        ----------
+        x : (nx, 1) casadi.SX or MX
+            State ``[q, ω, h_w]``: quaternion (scalar first, body to inertial), body rate
+            [rad/s] (body axes), wheel momenta [N m s].
+        u : (nu, 1) casadi.SX or MX
+            Control ``[g, m, τ_t]`` (the blocks present, :attr:`control_slices`).
+        t : float or scalar casadi.SX / MX
+            Time [s].
+        p : (3, 1) casadi.SX, MX, DM or array_like
+            Constant disturbance torque [N m], body frame.
+
+        Returns
+        -------
+        (nx, 1) casadi.SX or MX
+            ``ẋ``: quaternion rate [1/s], body angular acceleration [rad/s^2], wheel momentum
+            rates [N m].
+        """
+        q, omega, h_w = self.split_state(x)
+        inertia = ca.DM(self.spacecraft.inertia)
+        axes = ca.DM(self.spacecraft.wheel_axes)
+        momentum = ca.mtimes(inertia, omega)
+        if self.n_wheels:
+            momentum += ca.mtimes(axes, h_w)
+        torque = self.actuator_torque(x, u, t) + self.external_torque(x, t, p)
+        omega_dot = ca.solve(inertia, -ca.cross(omega, momentum) + torque)
+        parts = [qc.kinematics(q, omega), omega_dot]
+        if self.n_wheels:
+            parts.append(u[self.control_slices["wheels"]])
+        return ca.vertcat(*parts)
+
+    def _build(self) -> None:
+        x = ca.SX.sym("x", self.nx)
+        u = ca.SX.sym("u", self.nu)
+        t = ca.SX.sym("t")
+        p = ca.SX.sym("p", 3)
+        self.rhs = ca.Function("f", [x, u, t, p], [self.dynamics(x, u, t, p)], ["x", "u", "t", "p"], ["xdot"])
+        self.body_torque = ca.Function(
+            "body_torque", [x, u, t], [self.actuator_torque(x, u, t)], ["x", "u", "t"], ["tau"]
+        )
+        self.environment_torque = ca.Function(
+            "environment_torque", [x, t, p], [self.external_torque(x, t, p)], ["x", "t", "p"], ["tau"]
+        )
+        field_body = self.magnetic_field_body(x[0:4], t)
+        self.field_body: ca.Function | None = None if field_body is None else ca.Function(
+            "field_body", [x, t], [field_body], ["x", "t"], ["b"]
+        )
+        self.field_rate_inertial: ca.Function | None = None
+        env = self.environment
+        if field_body is not None and env.magnetic_field is not None and env.orbit is not None:
+            field_inertial = env.magnetic_field.field_inertial(env.orbit.position(t), t)
+            self.field_rate_inertial = ca.Function(
+                "field_rate_inertial", [t], [ca.jacobian(field_inertial, t)], ["t"], ["db"])
+
+    def inertial_momentum(self, x: ArrayLike) -> NDArray:
+        """Total angular momentum of body and wheels, ``R(q)(I ω + A h_w)``, conserved without
+        external torque.
+
+        Parameters
+        ----------
+        x : (..., nx) array_like
+            State(s) ``[q, ω, h_w]``.
+
+        Returns
+        -------
+        (..., 3) ndarray
+            Angular momentum [N m s], inertial frame.
+        """
+        x = np.asarray(x, dtype=float)
+        body = x[..., 4:7] @ self.spacecraft.inertia.T + x[..., 7:self.nx] @ self.spacecraft.wheel_axes.T
+        return quat.rotate(x[..., 0:4], body)
+
+
+def _plain(value: Any) -> Any:
+    """A dataclass tree as nested tuples of plain numbers and strings (for :attr:`AttitudeModel.fingerprint`).
+
+    Fields excluded from equality (``compare=False``, e.g. ``Spacecraft._cache``) are not part of
+    what the value describes and are skipped.
+    """
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return (type(value).__name__,) + tuple((f.name, _plain(getattr(value, f.name)))
+                                               for f in dataclasses.fields(value) if f.compare)
+    if isinstance(value, np.ndarray):
+        return ("array", value.shape, tuple(float(v) for v in value.ravel()))
+    if isinstance(value, (list, tuple)):
+        return tuple(_plain(v) for v in value)
+    return value

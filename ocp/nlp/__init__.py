@@ -1,0 +1,23 @@
+"""Solving NLPs: one solve path for every optimising planner, and the second-order check.
+
+What lives here: solver options, the status policy, multistart with warm starts and the result
+objects (:mod:`~ocp.nlp.solve`); the second-order sufficient conditions at a converged point
+(:mod:`~ocp.nlp.second_order`).
+
+May import: CasADi, NumPy, SciPy, threadpoolctl and the top-level modules of :mod:`ocp`; it knows
+nothing of attitude, models or transcriptions.
+"""
+from ocp.nlp.second_order import SecondOrderCheck, second_order_check
+from ocp.nlp.solve import (
+                           NLPResult,
+                           StartResult,
+                           converged,
+                           perturbed,
+                           solve_multistart,
+                           solver_options,
+                           status_name,
+                           warm_start_options,
+)
+
+__all__ = ["NLPResult", "SecondOrderCheck", "StartResult", "converged", "perturbed", "second_order_check",
+           "solve_multistart", "solver_options", "status_name", "warm_start_options"]

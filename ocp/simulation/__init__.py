@@ -1,0 +1,22 @@
+"""Closed-loop simulation: zero-order hold, actuator saturation, sensor noise, scored time series.
+
+What lives here: the :class:`Simulator` and what it takes and gives
+(:mod:`~ocp.simulation.simulator`), the whole closed loop as one CasADi function
+(:mod:`~ocp.simulation.closed_loop`) and its compilation to C with an on-disk cache
+(:mod:`~ocp.simulation.compiled`).
+
+May import: :mod:`ocp.dynamics` and the top-level modules of :mod:`ocp`; never
+:mod:`ocp.transcription` or :mod:`ocp.nlp`.
+"""
+from ocp.simulation.closed_loop import ClosedLoop
+from ocp.simulation.compiled import CompilerUnavailable, compile_function
+from ocp.simulation.simulator import (
+                                      GridSampledReference,
+                                      SensorNoise,
+                                      SimulationError,
+                                      SimulationResult,
+                                      Simulator,
+)
+
+__all__ = ["ClosedLoop", "CompilerUnavailable", "GridSampledReference", "SensorNoise", "SimulationError",
+           "SimulationResult", "Simulator", "compile_function"]

@@ -1,0 +1,644 @@
+"""Closed-loop simulation with zero-order hold, actuator saturation and sensor noise.
+
+Each sample: the controller sees a (noisy) :class:`~ocp.dynamics.actuators.Measurement` and returns a
+:class:`~ocp.dynamics.actuators.Command`; the :class:`~ocp.dynamics.actuators.ActuatorModel` turns it into the
+applied control, held constant while the full model is integrated to the next sample (a CasADi
+RK4 map with sub-steps, or CVODES); the quaternion is then re-normalised.
+
+Controllers are duck-typed (see ``controllers.base.Controller``): ``reset(spacecraft,
+sample_time, target=None)`` and ``__call__(t, measurement, reference) -> Command``.
+A reference, if given, is passed to the controller as a :class:`GridSampledReference`: the same
+object as far as the controller can tell (every attribute is the reference's), whose ``sample``
+answers the sample instants ``t_k`` and ``t_k + T_s`` from one vectorised evaluation made before
+the loop, and any other time from the reference itself.
+
+Two paths compute the same numbers (to rounding; ``tests/test_closed_loop.py``):
+
+* the Python loop above, for any controller;
+* when the controller has a symbolic law (``symbolic_error()`` is ``None``) and the integrator is
+  RK4, the whole run is one CasADi function (:mod:`ocp.simulation.closed_loop`): the reference is sampled on
+  the sample grid in advance, the sensor noise drawn in advance from the same generator in the
+  same order. It is interpreted by CasADi's virtual machine, or with ``compile=True`` compiled to
+  C (:mod:`ocp.simulation.compiled`; without a compiler: interpreted, with a one-line notice).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import casadi as ca
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ocp import quat
+from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
+from ocp.dynamics.integration import rk4_step
+from ocp.dynamics.layout import reference_rows
+from ocp.dynamics.model import AttitudeModel
+from ocp.fast_call import BufferedFunction
+from ocp.simulation.closed_loop import ClosedLoop, draw_noise
+from ocp.simulation.compiled import CompilerUnavailable, compile_function, notice
+
+Array = NDArray[np.float64]
+
+
+class GridSampledReference:
+    """A reference with its samples on a time grid computed once (vectorised).
+
+    It is the reference as far as a controller can tell: :meth:`sample` answers the grid times
+    from the table and any other time from the reference itself, and every other attribute is the
+    reference's. :meth:`row` serves per-sample code one grid time as Python floats.
+
+    Parameters
+    ----------
+    reference : planners.Reference
+        Anything with a vectorised ``sample(t)`` returning a named tuple of arrays whose first
+        axis is time (for :meth:`row`: the fields ``q``, ``omega``, ``omega_dot``, ``torque``).
+    times : (N,) array_like
+        Times to precompute [s] (duplicates are merged).
+    """
+
+    def __init__(self, reference: Any, times: ArrayLike):
+        self.reference = reference
+        grid = np.unique(np.asarray(times, dtype=float))
+        self._times = grid
+        table = reference.sample(grid)
+        # Our own copy, read only: its rows are handed out as views and kept across runs, so a law
+        # writing into a sample would otherwise change every later run.
+        self._table = type(table)(*(np.array(a) for a in table))
+        for array in self._table:
+            array.setflags(write=False)
+        self._index = {value: i for i, value in enumerate(grid.tolist())}
+        self._scalar: dict[int, Any] = {}
+        self._rows: list[tuple[float, ...]] | None = None
+
+    def sample(self, t: ArrayLike) -> Any:
+        """The reference at ``t``, as ``reference.sample`` returns it.
+
+        Parameters
+        ----------
+        t : float or (M,) array_like
+            Time(s) [s]; grid times come from the table, others from the reference.
+
+        Returns
+        -------
+        named tuple
+            The reference's sample (arrays with a leading axis of ``M`` for an array ``t``). The
+            arrays of a grid time are read-only views of the table (kept across runs).
+        """
+        index = self._index
+        if np.ndim(t) == 0:
+            i = index.get(float(t))  # type: ignore[arg-type]  # a 0-d array_like is a number
+            if i is None:
+                return self.reference.sample(t)
+            scalar = self._scalar.get(i)
+            if scalar is None:
+                scalar = self._scalar[i] = type(self._table)(*(a[i] for a in self._table))
+            return scalar
+        rows = [index.get(value) for value in np.ravel(t).astype(float).tolist()]
+        if None in rows:
+            return self.reference.sample(t)
+        return type(self._table)(*(a[rows] for a in self._table))
+
+    def row(self, t: float) -> tuple[float, ...] | None:
+        """The reference row ``[q*, ω*, ω̇*, τ*]`` at a grid time, as Python floats.
+
+        Parameters
+        ----------
+        t : float
+            Time [s].
+
+        Returns
+        -------
+        tuple of 13 float or None
+            Attitude quaternion, body rate [rad/s], body acceleration [rad/s^2], feed-forward
+            torque [N m] (layout of :func:`ocp.dynamics.layout.reference_rows`); ``None`` when ``t`` is not
+            on the grid.
+        """
+        i = self._index.get(t)
+        if i is None:
+            return None
+        if self._rows is None:
+            self._rows = [tuple(row) for row in reference_rows(self, self._times).tolist()]
+        return self._rows[i]
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.reference, name)
+
+
+class SimulationError(RuntimeError):
+    """The integration diverged (non-finite state), e.g. a step far too long for the rates."""
+
+
+@dataclass(frozen=True)
+class SensorNoise:
+    """Gaussian sensor noise, white per sample.
+
+    Each sample draws attitude, then rate (only the non-zero ones) from the stream seeded by
+    ``seed``, and the magnetometer from its own stream (seeded by ``[seed, 1]``), so that adding
+    magnetometer noise leaves the attitude and rate noise of a scenario unchanged.
+
+    Parameters
+    ----------
+    attitude_std : float, optional
+        Per-axis standard deviation of the attitude error, a rotation vector [rad] applied in
+        body axes (``q ⊗ exp(v/2)``); 0: none.
+    rate_std : float, optional
+        Per-axis standard deviation of the body-rate error [rad/s], body axes; 0: none.
+    seed : int, optional
+        Non-negative seed of the generators (same seed, same noise).
+    field_std : float, optional
+        Per-axis standard deviation of the magnetometer error [T], body axes; 0: none.
+    """
+
+    attitude_std: float = 0.0
+    rate_std: float = 0.0
+    seed: int = 0
+    field_std: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("attitude_std", "rate_std", "field_std"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise ValueError(f"{name} must be a finite non-negative standard deviation, got {value!r}")
+        if not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool) or self.seed < 0:
+            raise ValueError(f"seed must be a non-negative integer, got {self.seed!r}")
+
+
+@dataclass
+class SimulationResult:
+    """Time series of a simulation with ``N`` samples.
+
+    Attributes
+    ----------
+    model : AttitudeModel
+        The simulated model.
+    sample_time : float
+        Controller period [s].
+    t : (N+1,) ndarray
+        Sample instants and the final time [s].
+    x : (N+1, nx) ndarray
+        States ``[q, ω, h_w]`` at ``t``: attitude (scalar-first, body to inertial), body rate
+        [rad/s], wheel momenta [N m s].
+    commanded_u : (N, nu) ndarray
+        Control asked for (before saturation), layout of ``model.control_slices``.
+    applied_u : (N, nu) ndarray
+        Control applied over ``[t_k, t_k+1]``.
+    applied_torque : (N, 3) ndarray
+        Actuator torque on the body at ``t_k`` [N m], body axes.
+    saturated : (N,) bool ndarray
+        Whether any actuator was at its limit during sample k.
+    path : str
+        How it was computed: ``"python"`` (loop), ``"interpreted"`` or ``"compiled"`` (one
+        CasADi function).
+    """
+
+    model: AttitudeModel
+    sample_time: float
+    t: Array
+    x: Array
+    commanded_u: Array
+    applied_u: Array
+    applied_torque: Array
+    saturated: NDArray[np.bool_]
+    path: str = "python"
+
+    @property
+    def q(self) -> Array:
+        """(N+1, 4) attitude quaternions, scalar first, body to inertial."""
+        return self.x[:, 0:4]
+
+    @property
+    def omega(self) -> Array:
+        """(N+1, 3) body rates [rad/s], body axes."""
+        return self.x[:, 4:7]
+
+    @property
+    def wheel_momentum(self) -> Array:
+        """(N+1, n_w) wheel momenta [N m s]."""
+        return self.x[:, 7:]
+
+
+class ControllerLike(Protocol):
+    """What the simulator needs of a controller (``controllers.base.Controller`` has it)."""
+
+    def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None:
+        """Prepare for a run.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The controlled spacecraft.
+        sample_time : float
+            Controller period and zero-order-hold length [s].
+        target : (q_f, ω_f or None), optional
+            Final attitude (scalar-first quaternion) and body rate [rad/s] for regulation.
+        """
+
+    def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
+        """The command for the sample starting at ``t`` [s] (see ``Controller.__call__``)."""
+
+
+def measure(x: Array, t: float, noise: SensorNoise, rng: np.random.Generator, field: Array | None = None,
+            field_rng: np.random.Generator | None = None) -> Measurement:
+    """What the controller sees at one sample: the state with the sensor noise of ``noise``.
+
+    The simulator's Python loop calls it once per sample; the compiled closed loop
+    (:mod:`ocp.simulation.closed_loop`) performs the same operations symbolically, on noise drawn in advance
+    in the same order.
+
+    Parameters
+    ----------
+    x : (nx,) ndarray
+        State ``[q (scalar first, body to inertial), ω [rad/s] (body), h_w [N m s]]``.
+    t : float
+        Time [s].
+    noise : SensorNoise
+        Standard deviations (attitude [rad] as a rotation vector, rate [rad/s], field [T]).
+    rng : numpy.random.Generator
+        The attitude and rate noise stream.
+    field : (3,) ndarray, optional
+        The geomagnetic field at ``x`` and ``t`` [T] (body frame; a copy the function may modify),
+        ``None`` without magnetometer.
+    field_rng : numpy.random.Generator, optional
+        The magnetometer's own stream (``None``: ``rng``).
+
+    Returns
+    -------
+    Measurement
+        Noisy attitude, rate, field and the wheel momenta.
+    """
+    q, omega = x[0:4], x[4:7]
+    if noise.attitude_std > 0:  # q ⊗ exp(v/2), written out (no general quaternion helper per sample)
+        v = rng.normal(0.0, noise.attitude_std, 3)
+        angle = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+        s = math.sin(0.5 * angle) / angle if angle > 0 else 0.5
+        p0, p1, p2, p3 = math.cos(0.5 * angle), s * v[0], s * v[1], s * v[2]
+        q0, q1, q2, q3 = q
+        q = np.array([q0 * p0 - q1 * p1 - q2 * p2 - q3 * p3,
+                      q0 * p1 + p0 * q1 + q2 * p3 - q3 * p2,
+                      q0 * p2 + p0 * q2 + q3 * p1 - q1 * p3,
+                      q0 * p3 + p0 * q3 + q1 * p2 - q2 * p1])
+    if noise.rate_std > 0:
+        omega = omega + rng.normal(0.0, noise.rate_std, 3)
+    if noise.field_std > 0 and field is not None:  # its own stream: attitude and rate noise unchanged
+        field += (rng if field_rng is None else field_rng).normal(0.0, noise.field_std, 3)
+    return Measurement(t=t, q=q.copy(), omega=omega.copy(), wheel_momentum=x[7:].copy(), field_body=field)
+
+
+Array = NDArray[np.float64]
+INTEGRATORS = ("rk4", "cvodes")
+MAX_SAMPLES = 1_000_000
+"""Default bound on the samples of one run (a 100,000 s run at 0.1 s): more is refused, not attempted."""
+SUBSTEPS_PER_SAMPLE = 20
+"""A run may integrate at most this many RK4 sub-steps per allowed sample (``max_samples``)."""
+MAX_SUBSTEPS = 1000
+"""Bound on RK4 sub-steps per sample (the step is one unrolled CasADi graph)."""
+
+
+class Simulator:
+    """Zero-order-hold simulator of an :class:`~ocp.dynamics.model.AttitudeModel`.
+
+    Parameters
+    ----------
+    model : AttitudeModel
+        The spacecraft in its environment.
+    sample_time : float
+        Controller period and zero-order-hold length [s].
+    integrator : {"rk4", "cvodes"}, optional
+        ``"rk4"``: fixed step, at most ``max_step`` per sub-step; ``"cvodes"``: adaptive
+        (``rtol``/``atol``). RK4's local error grows as ``(h ‖ω‖)⁵``: the default 0.05 s keeps
+        closed-loop attitudes within ~1e-8 deg of CVODES at rates below ~0.5 rad/s; lower it for
+        fast spins or conservation studies.
+    max_step : float, optional
+        Longest RK4 sub-step [s] (at most :data:`MAX_SUBSTEPS` sub-steps per sample).
+    rtol, atol : float, optional
+        CVODES relative and absolute tolerances.
+    compile : bool, optional
+        Build the closed loop of symbolic laws as C (cached; see :mod:`ocp.simulation.compiled`).
+    python_loop : bool, optional
+        Always use the Python loop (the reference implementation), even for symbolic laws.
+    max_samples : int, optional
+        Most samples one run may take, and most RK4 sub-steps in all: ``SUBSTEPS_PER_SAMPLE`` times
+        this (:data:`SUBSTEPS_PER_SAMPLE`); longer runs are refused with :class:`SimulationError`,
+        not attempted.
+    """
+
+    MAX_BUILDS = 16
+    """Closed-loop builds kept per simulator (one per law and noise shape)."""
+    CHUNK = 1000
+    """Samples per accumulated call of the closed-loop function (its build unrolls them)."""
+
+    def __init__(
+        self,
+        model: AttitudeModel,
+        sample_time: float,
+        integrator: str = "rk4",
+        max_step: float = 0.05,
+        rtol: float = 1e-10,
+        atol: float = 1e-12,
+        compile: bool = False,
+        python_loop: bool = False,
+        max_samples: int = MAX_SAMPLES,
+    ):
+        if not isinstance(model, AttitudeModel):
+            raise TypeError(f"model must be an ocp.AttitudeModel, got {type(model).__name__}")
+        for name, value in (("sample_time", sample_time), ("max_step", max_step), ("rtol", rtol), ("atol", atol)):
+            if not isinstance(value, (int, float)) or not math.isfinite(value) or not value > 0:
+                raise ValueError(f"{name} must be a finite positive number of seconds, got {value!r}")
+        if integrator not in INTEGRATORS:
+            raise ValueError(f"integrator must be one of {INTEGRATORS}, got {integrator!r}")
+        substeps = max(1, math.ceil(sample_time / max_step - 1e-9))
+        if integrator == "rk4" and substeps > MAX_SUBSTEPS:
+            raise ValueError(f"max_step = {max_step:g} s gives {substeps} RK4 sub-steps per {sample_time:g} s sample; "
+                             f"at most {MAX_SUBSTEPS} are allowed (raise max_step or lower sample_time)")
+        if not isinstance(max_samples, int) or max_samples < 1:
+            raise ValueError(f"max_samples must be a positive integer, got {max_samples!r}")
+        self.model = model
+        self.sample_time = float(sample_time)
+        self.max_samples = max_samples
+        self.substeps = substeps if integrator == "rk4" else 1
+        self.actuators = ActuatorModel(model.spacecraft, model.control_slices, model.nu)
+        self._step = self._build_step(integrator, substeps, rtol, atol)
+        self._step_numeric = BufferedFunction(self._normalised(self._step))
+        self._field_numeric = None if model.field_body is None else BufferedFunction(model.field_body)
+        self._field_rate_numeric = (None if model.field_rate_inertial is None
+                                    else BufferedFunction(model.field_rate_inertial))
+        self.integrator = integrator
+        self.compile = compile
+        self.python_loop = python_loop
+        self._loops: dict[Any, tuple[ClosedLoop, ca.Function, str]] = {}
+        self._runs: dict[Any, BufferedFunction] = {}
+        self._last_grid: tuple[Any, Array, GridSampledReference] | None = None
+        self._torque_map: tuple[int, ca.Function] | None = None
+        self._command_slices = [(attribute, model.control_slices[name]) for name, attribute in
+                                (("wheels", "wheel_torque"), ("dipole", "dipole"), ("torquers", "torque"))
+                                if name in model.control_slices]
+
+    @staticmethod
+    def _normalised(step: ca.Function) -> ca.Function:
+        """``step`` followed by the re-normalisation of the quaternion (the Python loop's step)."""
+        symbols = [step.sx_in(i) for i in range(step.n_in())] if step.is_a("SXFunction") else step.mx_in()
+        x_next = step(*symbols)
+        x_next = ca.vertcat(x_next[0:4] / ca.norm_2(x_next[0:4]), x_next[4:])
+        return ca.Function("zoh_step_normalised", symbols, [x_next], step.name_in(), ["x_next"])
+
+    def _build_step(self, integrator: str, substeps: int, rtol: float, atol: float) -> ca.Function:
+        """``step(x, u, t, dt, p) -> x_next``: one hold interval of length ``dt`` starting at ``t``."""
+        model = self.model
+        x = ca.SX.sym("x", model.nx)
+        u = ca.SX.sym("u", model.nu)
+        t = ca.SX.sym("t")
+        dt = ca.SX.sym("dt")
+        p = ca.SX.sym("p", 3)
+        if integrator == "rk4":
+            h = dt / substeps
+            x_next = x
+            for k in range(substeps):
+                x_next = rk4_step(lambda state, time: model.rhs(state, u, time, p), x_next, t + k * h, h)
+            return ca.Function("zoh_step", [x, u, t, dt, p], [x_next], ["x", "u", "t", "dt", "p"], ["x_next"])
+        # CVODES on normalised time s in [0, 1]: dx/ds = dt f(x, u, t + s dt, p).
+        s = ca.SX.sym("s")
+        params = ca.vertcat(u, t, dt, p)
+        dae = {"x": x, "p": params, "t": s, "ode": dt * model.rhs(x, u, t + s * dt, p)}
+        solver = ca.integrator("zoh_cvodes", "cvodes", dae, 0.0, 1.0, {"reltol": rtol, "abstol": atol})
+        x_next = solver(x0=x, p=params)["xf"]
+        return ca.Function("zoh_step", [x, u, t, dt, p], [x_next], ["x", "u", "t", "dt", "p"], ["x_next"])
+
+    def run(
+        self,
+        controller: ControllerLike,
+        x0: ArrayLike,
+        duration: float,
+        reference: Any = None,
+        target: Any = None,
+        noise: SensorNoise | None = None,
+        parameters: ArrayLike | None = None,
+    ) -> SimulationResult:
+        """Simulate in closed loop.
+
+        Parameters
+        ----------
+        controller : controllers.base.Controller (anything with its reset and __call__)
+            The feedback law (reset here; a symbolic law runs as one CasADi function unless
+            ``python_loop``).
+        x0 : (nx,) array_like
+            Initial state ``[q, ω, h_w]`` (the quaternion is normalised).
+        duration : float
+            Simulated time [s]; the last sample is shortened to end there.
+        reference : planners.Reference, optional
+            Reference to track; ``None``: regulation to ``target``. It is sampled once per run on
+            the sample grid (and kept for the next run with the same reference and grid).
+        target : (q_f, ω_f or None), optional
+            Handed to ``controller.reset``: final attitude and body rate [rad/s] for regulation.
+        noise : SensorNoise, optional
+            Sensor noise; ``None``: none.
+        parameters : (3,) array_like, optional
+            Disturbance torque ``p`` [N m], body axes; ``None``: the model's default.
+
+        Returns
+        -------
+        SimulationResult
+
+        Raises
+        ------
+        SimulationError
+            When the state becomes non-finite or the run exceeds the work limits.
+        """
+        model = self.model
+        x = np.asarray(x0, dtype=float).copy()
+        if x.shape != (model.nx,) or not np.all(np.isfinite(x)):
+            raise ValueError(f"x0 must be {model.nx} finite numbers [q, omega, h_w], got shape {x.shape}")
+        if not np.linalg.norm(x[0:4]) > 1e-6:
+            raise ValueError(f"x0 must start with a non-zero quaternion, got {x[0:4]}")
+        x[0:4] = quat.normalize(x[0:4])
+        p = model.default_parameters if parameters is None else np.asarray(parameters, dtype=float)
+        if p.shape != (3,) or not np.all(np.isfinite(p)):
+            raise ValueError(f"parameters must be a finite 3-vector disturbance torque (N m), got {p}")
+        if not isinstance(duration, (int, float)) or not math.isfinite(duration) or not duration > 0:
+            raise ValueError(f"duration must be a finite positive number of seconds, got {duration!r}")
+        n_samples = max(1, math.ceil(duration / self.sample_time - 1e-9))
+        if n_samples > self.max_samples or n_samples * self.substeps > SUBSTEPS_PER_SAMPLE * self.max_samples:
+            raise SimulationError(f"{duration:g} s at {self.sample_time:g} s samples is {n_samples} samples, over the "
+                                  f"limit of {self.max_samples} samples or {SUBSTEPS_PER_SAMPLE * self.max_samples} sub-steps in all "
+                                  "(simulation.max_samples raises it)")
+        times = np.minimum(np.arange(n_samples + 1) * self.sample_time, duration)
+        noise = noise or SensorNoise()
+        rng = np.random.default_rng(noise.seed)
+        field_rng = np.random.default_rng([noise.seed, 1])
+        valid_until = getattr(model.environment.magnetic_field, "valid_until", None)
+        if valid_until is not None and duration > valid_until + 1e-9:
+            raise SimulationError(f"the magnetic field is tabulated up to t = {valid_until:g} s, the run lasts "
+                                  f"{duration:g} s; lengthen environment.magnetic_field.span_s")
+        field_rate = self._field_rate_numeric if getattr(controller, "needs_field_rate", False) else None
+        controller.reset(model.spacecraft, self.sample_time, target=target)
+        if self._symbolic(controller):
+            return self._run_symbolic(controller, x, times, p, noise, rng, reference, field_rng)
+        if reference is not None and hasattr(reference, "sample"):
+            reference = self._grid_reference(reference, np.concatenate([times, times[:-1] + self.sample_time]))
+
+        commanded = np.zeros((n_samples, model.nu))
+        # Per sample: Python floats and lists, the step's own buffers (no NumPy calls on short
+        # vectors beyond the copies the measurement hands out); arrays are made at the end.
+        states: list[list[float]] = [x.tolist()]
+        applied: list[list[float]] = []
+        saturated: list[bool] = []
+        step = self._step_numeric
+        x_in, u_in, t_in, dt_in, p_in = step.inputs
+        x_out = step.outputs[0]
+        x_in[:] = x
+        p_in[:] = p
+        evaluate, apply, fill_command = step.evaluate, self.actuators.apply_floats, self._fill_command
+        times_list = times.tolist()
+        n_wheels = model.spacecraft.n_wheels
+        for k in range(n_samples):
+            t_k = times_list[k]
+            measurement = self._measure(x_in, t_k, noise, rng, field_rng)
+            if field_rate is not None:
+                measurement.field_rate_inertial = field_rate(t_k).copy()
+            command = controller(t_k, measurement, reference)
+            fill_command(command, commanded[k])
+            dt = times_list[k + 1] - t_k
+            u, at_limit = apply(command, states[k][7:7 + n_wheels], dt)
+            applied.append(u)
+            saturated.append(at_limit)
+            u_in[:] = u
+            t_in[0], dt_in[0] = t_k, dt
+            evaluate()
+            x_next = x_out.tolist()  # the quaternion re-normalised by the step function
+            if not math.isfinite(sum(x_next)) and not np.isfinite(x_out).all():  # the sum can overflow
+                raise SimulationError(self._divergence(times, k))
+            x_in[:] = x_out
+            states.append(x_next)
+        return self._result(times, np.array(states), commanded, np.array(applied).reshape(n_samples, model.nu),
+                            np.array(saturated, dtype=bool), "python")
+
+    def _result(self, times: Array, states: Array, commanded: Array, applied: Array, saturated: NDArray[np.bool_],
+                path: str) -> SimulationResult:
+        if self._torque_map is None or self._torque_map[0] != times.size - 1:
+            self._torque_map = (times.size - 1, self.model.body_torque.map(times.size - 1))
+        torque_map = self._torque_map[1]
+        applied_torque = torque_map(states[:-1].T, applied.T, times[:-1]).full().T
+        return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, applied_torque,
+                                saturated, path)
+
+    @staticmethod
+    def _divergence(times: Array, k: int) -> str:
+        return (f"the state became non-finite between t = {times[k]:g} s and {times[k + 1]:g} s; "
+                "reduce max_step or check the controller's gains")
+
+    def _symbolic(self, controller: Any) -> bool:
+        """Whether ``controller`` (after reset) runs as one CasADi function."""
+        if self.python_loop or self.integrator != "rk4":
+            return False
+        reason = getattr(controller, "symbolic_error", None)
+        return reason is not None and reason() is None
+
+    def closed_loop_function(self, controller: Any, noise: SensorNoise) -> tuple[ClosedLoop, ca.Function, str]:
+        """The one-sample closed-loop function of a symbolic law.
+
+        Builds are kept per law (``Controller.symbolic_key``) and noise shape.
+
+        Parameters
+        ----------
+        controller : Controller
+            A reset controller with a symbolic law.
+        noise : SensorNoise
+            Which noises the function takes as inputs (those with a non-zero deviation).
+
+        Returns
+        -------
+        loop : ClosedLoop
+            Its builder.
+        function : casadi.Function
+            The function, interpreted, or its compiled twin.
+        path : str
+            ``"interpreted"`` or ``"compiled"``.
+        """
+        loop_key = self._loop_key(controller, noise)
+        if loop_key not in self._loops:
+            if len(self._loops) >= self.MAX_BUILDS:
+                self._loops.clear()
+                self._runs.clear()
+            law = controller.symbolic_law()
+            loop = ClosedLoop(self.model, self._step, self.actuators, law.function,
+                              noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0)
+            sample, path = loop.sample, "interpreted"
+            if self.compile:
+                try:
+                    sample, path = compile_function(loop.sample), "compiled"
+                except CompilerUnavailable as error:
+                    notice(f"{error}; the closed loop runs interpreted")
+            self._loops[loop_key] = (loop, sample, path)
+        return self._loops[loop_key]
+
+    def _chunk_function(self, loop: ClosedLoop, sample: ca.Function, size: int) -> BufferedFunction:
+        """``sample`` accumulated over ``size`` samples (``mapaccum`` unrolls its calls, so long runs
+        go in chunks of at most :attr:`CHUNK` samples)."""
+        key = (id(loop), size)
+        if key not in self._runs:
+            self._runs[key] = loop.run_function(sample, size)
+        return self._runs[key]
+
+    @staticmethod
+    def _loop_key(controller: Any, noise: SensorNoise) -> tuple:
+        return (controller.symbolic_key(), noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0)
+
+    def _run_symbolic(self, controller: Any, x0: Array, times: Array, p: Array, noise: SensorNoise,
+                      rng: np.random.Generator, reference: Any,
+                      field_rng: np.random.Generator | None = None) -> SimulationResult:
+        n_samples = times.size - 1
+        loop, sample, path = self.closed_loop_function(controller, noise)
+        rows = None
+        if loop.shape.uses_reference:
+            grid = times[:-1]
+            rows = np.hstack([controller.reference_rows(reference, grid),
+                              controller.reference_rows(reference, grid + self.sample_time)])
+        drawn = None
+        if noise.attitude_std > 0 or noise.rate_std > 0 or noise.field_std > 0:
+            drawn = draw_noise(rng, n_samples, noise.attitude_std, noise.rate_std, field_rng, noise.field_std)
+        nx, nu = self.model.nx, self.model.nu
+        xz = np.concatenate([x0, np.asarray(controller.state_vector(), dtype=float)])
+        states = np.empty((n_samples + 1, nx))
+        commanded, applied = np.empty((n_samples, nu)), np.empty((n_samples, nu))
+        saturated, torque = np.empty(n_samples), np.empty((n_samples, 3))
+        states[0] = x0
+        for start in range(0, n_samples, self.CHUNK):
+            stop = min(start + self.CHUNK, n_samples)
+            run = self._chunk_function(loop, sample, stop - start)
+            chunk = loop.evaluate(run, xz, times[start:stop + 1], None if drawn is None else drawn[start:stop],
+                                  None if rows is None else rows[start:stop], p)
+            states[start + 1:stop + 1] = chunk[0][:, :nx]
+            commanded[start:stop], applied[start:stop], saturated[start:stop], torque[start:stop] = chunk[1:]
+            xz = chunk[0][-1]
+            if not np.all(np.isfinite(xz)):
+                break
+        finite = np.isfinite(states).all(axis=1)
+        if not finite.all():
+            raise SimulationError(self._divergence(times, int(np.argmin(finite)) - 1))
+        return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, torque,
+                                saturated.astype(bool), path)
+
+    def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator,
+                 field_rng: np.random.Generator | None = None) -> Any:
+        field = None if self._field_numeric is None else self._field_numeric(x, t).copy()
+        return measure(x, t, noise, rng, field, field_rng)
+
+    def _fill_command(self, command: Command, out: Array) -> None:
+        """Write the command into ``out`` (a zero row) in the layout of ``u``."""
+        for attribute, where in self._command_slices:
+            value = getattr(command, attribute)
+            if value is not None:
+                out[where] = value
+
+    def _grid_reference(self, reference: Any, grid: Array) -> GridSampledReference:
+        """``reference`` served on ``grid``; the last one is kept, so that runs repeated with the
+        same reference and grid (trade studies, Monte Carlo) sample it once. References are
+        immutable results (``planners.Reference``)."""
+        cached = self._last_grid
+        if cached is not None and cached[0] is reference and np.array_equal(cached[1], grid):
+            return cached[2]
+        served = GridSampledReference(reference, grid)
+        self._last_grid = (reference, grid, served)
+        return served

@@ -1,0 +1,16 @@
+"""``collocation``: direct optimal control on the full model, the workbench's numerical reference.
+
+What lives here: the planner and its options (:mod:`~planners.collocation.planner`), the problem
+side (pointing cones from YAML, variable bounds from the spacecraft;
+:mod:`~planners.collocation.problem`), the reference of a solution and seeds from other references
+(:mod:`~planners.collocation.reference`) and the search strategy's tuned constants
+(:mod:`~planners.collocation.strategy`).
+
+May import: :mod:`ocp` (transcriptions and the NLP core) and the contract modules of
+:mod:`planners` (``base``, ``problem``, ``reference``); other planners only through the
+``PLANNERS`` registry, to seed from their references.
+"""
+from planners.collocation.planner import CollocationOptions, CollocationPlanner
+from planners.collocation.reference import CollocationReference
+
+__all__ = ["CollocationOptions", "CollocationPlanner", "CollocationReference"]

@@ -1,0 +1,512 @@
+"""Direct optimal control on the full model: the workbench's numerical reference.
+
+Objectives: ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt (slack variables),
+``min_time`` (free T, the scenario's T is the upper bound), and ``weighted``
+(``energy_weight``, ``l1_weight``, ``time_weight``). τ is the actuators' body torque.
+Constraints: actuator bounds (wheel torques, dipoles, torquers), wheel momentum bounds, a body-rate
+bound ``max_rate`` (per axis), fixed or free final rate, keep-out / keep-in cones.
+The transcription (``collocation``: Legendre-Gauss-Radau, or ``multiple_shooting``) comes from
+:data:`ocp.transcription.TRANSCRIPTIONS` and owns its layout (bounds, seeding, interpolation); the
+NLP (IPOPT or FATROP) is built once per problem structure into the planner's ``SolverCache``.
+Starts: the reference of the ``warm_start`` planner (perturbed copies of it per ``multistart``)
+and the ``seed_planners``, solved by :func:`ocp.nlp.solve.solve_multistart` (its status policy and early
+stopping); the best converged optimum is kept. With ``multistart: auto`` they are solved on
+``coarse_intervals`` first and the full mesh once from that optimum and its multipliers (see the
+option).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Annotated, Literal
+
+import numpy as np
+
+from ocp.errors import InvalidOption, OptionsError
+from ocp.nlp.solve import (
+    NLPResult,
+    perturbed,
+    solve_multistart,
+    solver_options,
+    warm_start_options,
+)
+from ocp.options import Range
+from ocp.transcription import (
+    NLP,
+    TRANSCRIPTIONS,
+    OptimalControlProblem,
+    Transcription,
+)
+from ocp.transcription.mesh_transfer import transfer_multipliers
+from planners.base import Planner
+from planners.collocation.problem import (
+    endpoint_cone_error,
+    parse_cone,
+    variable_bounds,
+)
+from planners.collocation.reference import (
+    CollocationReference,
+    seed_sampler,
+    solution_sampler,
+)
+from planners.collocation.strategy import (
+    AUTO_FIRST,
+    AUTO_RESTART,
+    POLISH_MU_INIT,
+    SEED_FATROP,
+    SEED_TOLERANCE,
+    TRANSFER_L1_BARRIER,
+    TRANSFER_MAX_INTERVALS,
+    TRANSFER_WARM_START,
+    control_floor,
+    merged,
+)
+from planners.problem import Array, ManeuverProblem
+from planners.reference import FailedReference, Reference
+
+MAX_RK4_STEPS = 1000
+"""Largest ``intervals × substeps`` of ``multiple_shooting``: the NLP build expands every RK4 step
+(10 × 100 and 50 × 20 steps built in 20 s on a shared machine, 200 × 100 ran over 120 s; the
+default 50 × 4 is 200)."""
+
+
+@dataclass(frozen=True)
+class CollocationOptions:
+    """Options of ``collocation`` (YAML keys; see the README's planner table).
+
+    Attributes
+    ----------
+    objective : str
+        ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt, ``min_time`` (free T, the
+        scenario's duration its upper bound) or ``weighted``; τ the actuators' body torque [N m].
+    intervals : int
+        Mesh intervals.
+    degree : int
+        Radau points per interval (``collocation``).
+    transcription : str
+        ``collocation`` (Legendre-Gauss-Radau) or ``multiple_shooting``.
+    substeps : int
+        RK4 steps per interval (``multiple_shooting``; ``intervals × substeps`` at most
+        :data:`MAX_RK4_STEPS`).
+    solver : str
+        ``ipopt`` (default) or ``fatrop``.
+    warm_start : str
+        Registered planner whose reference seeds the NLP (default ``eigenaxis``; ``collocation``
+        itself with its own ``warm_start_options``).
+    warm_start_options : dict
+        The warm-start planner's options.
+    seed_planners : list of str
+        Further planners whose references are starts (each at most once).
+    multistart : int or "auto"
+        ``auto`` (default): for a free final time a perturbed copy of the warm start
+        (:data:`AUTO_FIRST`), then, unless its optimum satisfies the second-order sufficient
+        conditions (:mod:`ocp.nlp.second_order`), restarts from the best point perturbed by 5 %
+        until one agrees with it (the warm start itself if the copy does not converge); for a
+        fixed final time the warm start. n > 0: n perturbed copies; 0: the warm start itself.
+    agree : int
+        Stop once this many starts agree on the best objective (0: try all); with ``multistart:
+        auto``, a best point that satisfies the second-order sufficient conditions counts as one
+        of them.
+    time_regularization : float
+        ``min_time`` only: ε > 0 first solves min T + ε ∫‖τ‖² dt / Σ τ_max² (τ_max the wheels'
+        and torquers' torque bounds [N m]) from the starts, then polishes plain minimum time
+        from that optimum and its multipliers; 0 (default): off.
+    coarse_intervals : int
+        With ``multistart: auto``, the starts are first solved on this many intervals (for a
+        free final time the whole multistart; for a fixed one only without cones and with at
+        least twice as many ``intervals``, and to the looser tolerance
+        :data:`~planners.collocation.strategy.SEED_TOLERANCE`: that optimum is only a seed) and the
+        full mesh is solved once from that optimum and its multipliers carried over (IPOPT, its
+        barrier adaptive for an L1 term without an energy term; with ``time_regularization`` the
+        regularised optimum, then polished on the full mesh; falling back to that optimum alone
+        with the barrier starting at 1e-4, then to the full-mesh solve from the starts); 0 or >=
+        ``intervals``: off. Default 8.
+    energy_weight, l1_weight, time_weight : float
+        Weights of ``weighted`` [1/(N² m² s), 1/(N m s), 1/s].
+    max_rate : float or None
+        Body-rate bound per axis [rad/s]; ``None``: none.
+    keep_out, keep_in : list of dict
+        Cones ``{boresight (body), direction (inertial), angle_deg}``.
+    cone_margin_deg : float
+        Cones are imposed this much tighter [deg], so that they hold between the points.
+    tolerance : float
+        Solver tolerance (scaled KKT error); the coarse seed of a fixed final time
+        (``coarse_intervals``) is solved to 1e-5 at the tightest
+        (:data:`~planners.collocation.strategy.SEED_TOLERANCE`).
+    max_iterations : int
+        Solver iterations per start.
+    """
+
+    objective: Literal["min_energy", "min_l1", "min_time", "weighted"] = "min_energy"
+    intervals: Annotated[int, Range(ge=1, le=2000)] = 50
+    degree: Annotated[int, Range(ge=1, le=9)] = 3
+    transcription: Literal["collocation", "multiple_shooting"] = "collocation"
+    substeps: Annotated[int, Range(ge=1, le=100)] = 4       # RK4 steps per interval (multiple_shooting)
+    solver: Literal["ipopt", "fatrop"] = "ipopt"
+    warm_start: str = "eigenaxis"            # registered planner whose reference seeds the NLP
+    warm_start_options: dict = field(default_factory=dict)  # its options, e.g. {profile: min_time}
+    seed_planners: list[str] = field(default_factory=list)
+    multistart: Annotated[int | Literal["auto"], Range(ge=0, le=50)] = "auto"
+    agree: Annotated[int, Range(ge=0, le=50)] = 2  # stop once this many starts agree on the best optimum (0: try all)
+    time_regularization: Annotated[float, Range(ge=0.0, le=1.0)] = 0.0
+    coarse_intervals: Annotated[int, Range(ge=0, le=2000)] = 8
+    energy_weight: Annotated[float, Range(ge=0.0)] = 1.0               # for objective "weighted"
+    l1_weight: Annotated[float, Range(ge=0.0)] = 0.0
+    time_weight: Annotated[float, Range(ge=0.0)] = 0.0
+    max_rate: Annotated[float | None, Range(gt=0.0)] = None  # rad/s, per body axis
+    keep_out: list[dict] = field(default_factory=list)  # {boresight, direction, angle_deg}
+    keep_in: list[dict] = field(default_factory=list)
+    cone_margin_deg: Annotated[float, Range(ge=0.0, lt=90.0)] = 0.01            # cones are imposed this much tighter, so that they
+                                             # hold between the points where they are imposed
+    tolerance: Annotated[float, Range(gt=0.0, lt=1.0)] = 1e-10
+    max_iterations: Annotated[int, Range(ge=1, le=100000)] = 500
+
+    def __post_init__(self) -> None:
+        from planners import (
+            PLANNERS,  # the registry is complete once options are parsed
+        )
+
+        # A collocation warm start is planned with its own options (say min_energy, itself warm
+        # started from eigenaxis): the way into min_time where a kinematic seed is too far
+        # (two wheels). Only its own warm start may nest further; the depth is the YAML's.
+        for index, name in enumerate([self.warm_start, *self.seed_planners]):
+            if name not in PLANNERS or (name == "collocation" and index > 0):
+                where = "warm_start" if index == 0 else f"seed_planners[{index - 1}]"
+                raise InvalidOption(where, f"{name!r} is not another registered planner; expected one of "
+                                           f"{sorted(set(PLANNERS) - {'collocation'})} (or collocation as warm_start)")
+        for index, name in enumerate(self.seed_planners):
+            if name in self.seed_planners[:index]:  # the same reference again: the same start solved twice
+                raise InvalidOption(f"seed_planners[{index}]", f"{name!r} is listed twice; expected each planner once")
+        if self.transcription == "multiple_shooting" and self.intervals * self.substeps > MAX_RK4_STEPS:
+            raise InvalidOption("substeps", f"{self.intervals} intervals x {self.substeps} substeps = "
+                                            f"{self.intervals * self.substeps} RK4 steps; expected at most "
+                                            f"{MAX_RK4_STEPS} (every step is expanded into the NLP)")
+        try:
+            PLANNERS[self.warm_start](self.warm_start_options, path="warm_start_options")
+        except OptionsError as error:
+            raise InvalidOption(error.path, error.message) from None
+        if self.time_regularization and self.objective != "min_time":
+            raise InvalidOption("time_regularization", f"applies to objective min_time only, not {self.objective!r}")
+        if self.objective == "weighted" and not (self.energy_weight or self.l1_weight or self.time_weight):
+            raise InvalidOption("objective", "weighted needs a positive energy_weight, l1_weight or time_weight")
+        l1 = self.objective == "min_l1" or (self.objective == "weighted" and self.l1_weight > 0)
+        refused = TRANSCRIPTIONS[self.transcription].problem_error(l1, bool(self.keep_out or self.keep_in))
+        if refused:
+            raise ValueError(refused)
+        for index, spec in enumerate(self.keep_out):
+            parse_cone(spec, True, np.deg2rad(self.cone_margin_deg), f"keep_out[{index}]")
+        for index, spec in enumerate(self.keep_in):
+            parse_cone(spec, False, np.deg2rad(self.cone_margin_deg), f"keep_in[{index}]")
+
+
+_Mode = Literal["cold", "warm", "near_optimum", "transfer"]
+
+
+@dataclass
+class _Optimum:
+    """What :meth:`CollocationPlanner._optimum` found: the solve, its extra stats, the transcription
+    and NLP it was solved on, their number of intervals and, with ``time_regularization``, the
+    regularised solve it was polished from."""
+
+    result: NLPResult
+    extra: dict
+    transcription: Transcription
+    nlp: NLP
+    intervals: int
+    regularized: NLPResult | None = None
+    solver: str | None = None  # None: the option's
+
+
+class CollocationPlanner(Planner):
+    """Direct optimal control planner (see the module docstring)."""
+
+    name = "collocation"
+    example_options = ({"intervals": 20}, {"intervals": 20, "transcription": "multiple_shooting"})
+
+    class Options(CollocationOptions):
+        __doc__ = CollocationOptions.__doc__
+
+    def _ocp(self, problem: ManeuverProblem) -> OptimalControlProblem:
+        o = self.options
+        weights = {"min_energy": (1.0, 0.0, 0.0), "min_l1": (0.0, 1.0, 0.0), "min_time": (0.0, 0.0, 1.0),
+                   "weighted": (o.energy_weight, o.l1_weight, o.time_weight)}[o.objective]
+        margin = np.deg2rad(o.cone_margin_deg)
+        cones = tuple(parse_cone(c, True, margin) for c in o.keep_out) + tuple(parse_cone(c, False, margin) for c in o.keep_in)
+        return OptimalControlProblem(problem.model, *weights, free_time=weights[2] > 0,
+                                     fixed_final_rate=problem.omegaf is not None, cones=cones)
+
+    def _nlp(self, problem: ManeuverProblem, ocp: OptimalControlProblem, mode: _Mode = "cold",
+             intervals: int | None = None, solver: str | None = None) -> tuple[Transcription, NLP]:
+        """The transcription on ``intervals`` (default the option) and its built NLP for ``ocp``
+        (from the cache when built before). ``mode``: the solver options of a start from a point
+        alone (``cold``), with its multipliers (``warm``, :func:`ocp.nlp.solve.warm_start_options`), near
+        the optimum (``near_optimum``: IPOPT's barrier starts at :data:`POLISH_MU_INIT`) or with the
+        multipliers of a coarse-mesh optimum (``transfer``: :data:`TRANSFER_WARM_START`, with
+        :data:`TRANSFER_L1_BARRIER` for an L1 objective without an energy term). A fixed final
+        time on other than the option's ``intervals`` is the coarse seed: solved to
+        :data:`SEED_TOLERANCE` at the least (by FATROP with :data:`SEED_FATROP` where
+        :meth:`_seed_solver` chooses it for the ``solver`` option IPOPT; a ``solver: fatrop`` seed
+        keeps FATROP's defaults). ``solver``: ``None`` for the option's."""
+        o = self.options
+        intervals = o.intervals if intervals is None else intervals
+        solver = o.solver if solver is None else solver
+        if solver != "ipopt" and mode in ("near_optimum", "transfer"):
+            mode = "cold"
+        seed_only = intervals != o.intervals and not ocp.free_time
+        tolerance = max(o.tolerance, SEED_TOLERANCE) if seed_only else o.tolerance
+        extra = {"cold": None, "warm": warm_start_options(solver), "near_optimum": {"ipopt.mu_init": POLISH_MU_INIT},
+                 "transfer": warm_start_options(solver, **TRANSFER_WARM_START)}[mode]
+        if mode == "transfer" and ocp.l1_weight > 0 and ocp.energy_weight == 0:
+            extra = {**(extra or {}), **TRANSFER_L1_BARRIER}
+        if seed_only and solver == "fatrop" and o.solver == "ipopt":  # the IPOPT option's FATROP seed only
+            extra = {**(extra or {}), **SEED_FATROP}
+        # The extra options in the key: a shared cache also serves planners whose options differ
+        # (a FATROP seed with SEED_FATROP and a FATROP mesh without it can share all else).
+        key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
+               o.transcription, intervals, o.degree, o.substeps, solver, tolerance, o.max_iterations, mode,
+               tuple(sorted((extra or {}).items())))
+
+        def build() -> tuple[Transcription, NLP]:
+            # the transcription is built here, once per entry (its constructor is not free)
+            same = intervals == o.intervals
+            transcription = TRANSCRIPTIONS[o.transcription].from_options(o if same else replace(o, intervals=intervals))
+            return transcription, transcription.build(ocp, solver, solver_options(solver, tolerance, o.max_iterations, extra))
+
+        # The model's numbers are baked into the graph: a shared cache needs them in the key.
+        return self.solver_cache(problem).get(("collocation", problem.model.fingerprint, key), build)
+
+    def _variable_bounds(self, problem: ManeuverProblem) -> tuple[Array, Array, Array, Array]:
+        """Per-point bounds of the model state and the actuator controls."""
+        return variable_bounds(problem, self.options.max_rate)
+
+    def _starts(self, problem: ManeuverProblem, failures: list[str] | None = None) -> list[Reference]:
+        """The references of the warm start and the seed planners that planned; each failure's
+        ``planner: message`` is appended to ``failures`` when given."""
+        from planners import PLANNERS
+
+        starts = []
+        requested = [(self.options.warm_start, self.options.warm_start_options)]
+        requested += [(name, None) for name in self.options.seed_planners]
+        for name, options in requested:
+            reference = PLANNERS[name](options, cache=self.cache).plan(problem)
+            if reference.ok:
+                starts.append(reference)
+            elif failures is not None:
+                failures.append(f"{name}: {reference.message}")
+        return starts
+
+    def _guesses(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
+                 seeds: list[Array]) -> tuple[list[Array], list[Array], float]:
+        """The starts (the warm start or its perturbed copies, then the seed planners' starts), the
+        fallback starts (tried only if none of those converged) and the relative size of the
+        restarts from the best point (0: none)."""
+        count = self.options.multistart
+        if count == "auto":
+            # A warm start can sit exactly on a stationary point (the eigenaxis slew is one for minimum
+            # time with per-axis torque bounds: IPOPT stays there, 3.5449 in 191 iterations against
+            # 3.2431 for Bilimoria & Wie's slew). A perturbed copy of it (AUTO_FIRST), then 5 %
+            # restarts from the best point unless it satisfies the second-order conditions (a saddle
+            # does not), escape such points; the warm start itself is the fallback when its
+            # perturbed copy does not converge.
+            if ocp.free_time:
+                floor = control_floor(transcription, ocp, nlp, *self._variable_bounds(problem)[2:])
+                first = perturbed(seeds[0], 1, scales=(AUTO_FIRST, AUTO_FIRST), floor=floor)
+                return first + seeds[1:], seeds[:1], AUTO_RESTART
+            return seeds, [], 0.0
+        if not count:
+            return seeds, [], 0.0
+        return perturbed(seeds[0], count) + seeds[1:], [], 0.0
+
+    def _regularized(self, problem: ManeuverProblem, ocp: OptimalControlProblem) -> OptimalControlProblem:
+        """``ocp`` (minimum time) with the energy term of ``time_regularization``: weight ε over the
+        sum of the squared torque bounds of the wheels and torquers (1 (N m)² without them)."""
+        _, _, _, u_high = self._variable_bounds(problem)
+        slices = problem.model.control_slices
+        bounds = [u_high[slices[name]] for name in ("wheels", "torquers") if name in slices]
+        scale = float(np.sum(np.square(np.concatenate(bounds)))) if bounds else 0.0
+        scale = scale if 0.0 < scale < np.inf else 1.0
+        return replace(ocp, energy_weight=self.options.time_regularization / scale)
+
+    def _solve(self, problem: ManeuverProblem, ocp: OptimalControlProblem, seeds: list[Array], params: Array,
+               bounds: tuple[Array, Array], intervals: int, near_optimum: bool = False,
+               solver: str | None = None) -> tuple[NLPResult, dict, NLPResult | None]:
+        """Solve ``ocp`` on ``intervals`` from ``seeds`` by the multistart policy (``near_optimum``:
+        from the one seed given, near the optimum, see :meth:`_nlp`); with ``time_regularization``,
+        solve the regularised problem so and polish plain minimum time from its optimum and
+        multipliers (the regularised solve is returned third, ``None`` without one); ``solver`` as
+        in :meth:`_nlp`."""
+        o = self.options
+        transcription, nlp = self._nlp(problem, ocp, "near_optimum" if near_optimum else "cold", intervals, solver)
+        guesses, fallback, restart = ((seeds, [], 0.0) if near_optimum
+                                      else self._guesses(problem, ocp, transcription, nlp, seeds))
+        agree = 1 if near_optimum else o.agree
+        lbx, ubx = bounds
+        if not o.time_regularization:
+            result = solve_multistart(nlp.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
+                                      agree=agree, restart=restart, fallback=fallback, second_order=restart > 0)
+            return result, {}, None
+        _, regular = self._nlp(problem, self._regularized(problem, ocp), intervals=intervals)
+        first = solve_multistart(regular.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=regular.lbg, ubg=regular.ubg,
+                                 agree=agree, restart=restart, fallback=fallback, second_order=restart > 0)
+        return self._polished(problem, ocp, first, params, bounds, intervals), {"regularized": first.stats()}, first
+
+    def _polished(self, problem: ManeuverProblem, ocp: OptimalControlProblem, regularized: NLPResult, params: Array,
+                  bounds: tuple[Array, Array], intervals: int) -> NLPResult:
+        """Plain minimum time from the optimum of the regularised problem and its multipliers
+        (``regularized`` itself when it failed)."""
+        if regularized.x is None:
+            return regularized
+        _, polish = self._nlp(problem, ocp, "warm", intervals)
+        return solve_multistart(polish.solver, [regularized.x], p=params, lbx=bounds[0], ubx=bounds[1],
+                                lbg=polish.lbg, ubg=polish.ubg, agree=1, lam_x0=regularized.lam_x,
+                                lam_g0=regularized.lam_g)
+
+    def _coarse(self, ocp: OptimalControlProblem) -> bool:
+        """Whether to solve on ``coarse_intervals`` first: with ``multistart: auto``, for a free final
+        time (the escape from stationary points) and for a fixed one without cones with at least
+        twice as many intervals (a cheap seed near the optimum; cones are imposed at fewer points on
+        a coarse mesh, so its optimum may cut through one)."""
+        o = self.options
+        if ocp.free_time:
+            return o.multistart == "auto" and 0 < o.coarse_intervals < o.intervals
+        # A fixed final time gains only when the full mesh is several times the coarse one.
+        return o.multistart == "auto" and 0 < 2 * o.coarse_intervals <= o.intervals and not ocp.cones
+
+    def _seed_solver(self, ocp: OptimalControlProblem) -> str:
+        """The solver of the coarse seed: FATROP (with :data:`SEED_FATROP`) for a fixed final time
+        without an L1 term when the option's solver is IPOPT and the transcription's
+        ``fatrop_seed`` says so, else the option's."""
+        o = self.options
+        if (o.solver == "ipopt" and not ocp.free_time and ocp.l1_weight == 0
+                and TRANSCRIPTIONS[o.transcription].fatrop_seed):
+            return "fatrop"
+        return o.solver
+
+    def _plan(self, problem: ManeuverProblem) -> Reference:
+        o = self.options
+        names = [f"keep_out[{i}]" for i in range(len(o.keep_out))] + [f"keep_in[{i}]" for i in range(len(o.keep_in))]
+        broken = endpoint_cone_error(self._ocp(problem).cones, names, problem.q0, problem.qf)
+        if broken:
+            return FailedReference(self.name, f"no trajectory meets the cones: {broken}")
+        failures: list[str] = []
+        starts = self._starts(problem, failures)
+        if not starts:
+            return FailedReference(self.name, f"no start: the warm-start planner {self.options.warm_start!r} failed ("
+                                              + "; ".join(failures) + ")")
+        return self._plan_from(problem, starts)
+
+    def _plan_from(self, problem: ManeuverProblem, starts: list[Reference]) -> Reference:
+        """Plan from the given start references (see the module docstring)."""
+        ocp = self._ocp(problem)
+        omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf
+        params = np.concatenate([problem.initial_state, problem.qf, omegaf, [problem.duration],
+                                 problem.model.default_parameters])
+        return self._reference(problem, ocp, params, self._optimum(problem, ocp, starts, params, self.options.intervals))
+
+    def _optimum(self, problem: ManeuverProblem, ocp: OptimalControlProblem, starts: list[Reference], params: Array,
+                 intervals: int, solver: str | None = None) -> _Optimum:
+        """The best optimum on ``intervals`` from the starts (through the coarse mesh first, see
+        :meth:`_coarse`, when ``intervals`` is the option's); ``solver`` as in :meth:`_nlp`."""
+        o = self.options
+        coarse_first = intervals == o.intervals and self._coarse(ocp)
+        # The layout (bounds, seeds, unpack) is the same in every build: use the one solved first.
+        mode: _Mode = "warm" if o.time_regularization else "transfer" if coarse_first else "cold"
+        transcription, nlp = self._nlp(problem, ocp, mode, intervals, solver)
+        bounds = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
+        result, extra, regularized = None, {}, None
+        if coarse_first:
+            # On a coarse mesh, where an iteration costs a fraction: the escape from stationary
+            # points and its confirmation (free T), or the long way from a far seed (fixed T); its
+            # optimum (and its multipliers, carried to the full mesh) seeds one solve on the full mesh.
+            seed_solver = self._seed_solver(ocp)
+            coarse = self._optimum(problem, ocp, starts, params, o.coarse_intervals, seed_solver)
+            found = self._reference(problem, ocp, params, coarse)
+            if not found.ok and seed_solver != o.solver:  # the option's solver takes the seed over
+                extra["coarse_" + seed_solver] = found.stats
+                coarse = self._optimum(problem, ocp, starts, params, o.coarse_intervals)
+                found = self._reference(problem, ocp, params, coarse)
+            extra["coarse"] = found.stats
+            if found.ok:
+                assert isinstance(found, CollocationReference)  # found.ok
+                transferred = self._transferred(problem, ocp, coarse, found, params, bounds)
+                if transferred is not None:
+                    result, more = transferred
+                    extra.update(more)
+                if result is None or not result.success:
+                    # Without multipliers, the seed POLISH_MU_INIT was tuned on: the coarse optimum
+                    # through the inverse dynamics. Its own controls (a bang-bang arc's polynomial
+                    # overshoots the bounds between the Radau points, up to 55 % on two wheels) took
+                    # the two-wheel regularised solve 61 iterations instead of 31.
+                    seed = transcription.seed(ocp, nlp, seed_sampler(problem, found), found.duration)
+                    polish, more, _ = self._solve(problem, ocp, [seed], params, bounds, intervals, near_optimum=True)
+                    result = polish if result is None else merged(result, polish)
+                    extra.update(more)
+        if result is None or not result.success:
+            seeds = [transcription.seed(ocp, nlp, seed_sampler(problem, ref),
+                                        ref.duration if ocp.free_time else problem.duration) for ref in starts]
+            fine, more, regularized = self._solve(problem, ocp, seeds, params, bounds, intervals, solver=solver)
+            result = fine if result is None else merged(result, fine)
+            extra.update(more)
+        return _Optimum(result, extra, transcription, nlp, intervals, regularized, solver)
+
+    def _transferred(self, problem: ManeuverProblem, ocp: OptimalControlProblem, coarse: _Optimum,
+                     found: CollocationReference, params: Array,
+                     bounds: tuple[Array, Array]) -> tuple[NLPResult, dict] | None:
+        """The full-mesh solve from the coarse optimum ``found`` with its multipliers carried over
+        (:meth:`_transfer`), and its extra stats; with ``time_regularization``, the coarse
+        regularised optimum is carried to the full mesh's regularised problem, which is then
+        polished (:meth:`_polished`). ``None`` where that does not apply (``solver: fatrop``, more than
+        :data:`TRANSFER_MAX_INTERVALS` intervals, layouts that differ)."""
+        if self.options.solver != "ipopt" or self.options.intervals > TRANSFER_MAX_INTERVALS:
+            return None
+        if not self.options.time_regularization:
+            result = self._transfer(problem, ocp, coarse.result, coarse.nlp, found, params, bounds)
+            return None if result is None else (result, {})
+        if coarse.regularized is None or not coarse.regularized.success:
+            return None
+        regular = self._regularized(problem, ocp)
+        _, coarse_nlp = self._nlp(problem, regular, intervals=coarse.intervals)
+        origin = self._reference(problem, regular, params,
+                                 _Optimum(coarse.regularized, {}, coarse.transcription, coarse_nlp, coarse.intervals))
+        assert isinstance(origin, CollocationReference)  # a converged solve
+        first = self._transfer(problem, regular, coarse.regularized, coarse_nlp, origin, params, bounds)
+        if first is None:
+            return None
+        return self._polished(problem, ocp, first, params, bounds, self.options.intervals), {"regularized": first.stats()}
+
+    def _transfer(self, problem: ManeuverProblem, ocp: OptimalControlProblem, coarse: NLPResult, coarse_nlp: NLP,
+                  found: CollocationReference, params: Array, bounds: tuple[Array, Array]) -> NLPResult | None:
+        """The full-mesh solve of ``ocp`` from ``found``, the coarse optimum ``coarse`` of
+        ``coarse_nlp`` (its own states and controls, read by
+        :func:`~planners.collocation.reference.solution_sampler`), with its multipliers carried over
+        (:func:`ocp.transcription.mesh_transfer.transfer_multipliers`); ``None`` when the layouts differ."""
+        if coarse.lam_x is None or coarse.lam_g is None:
+            return None
+        transcription, nlp = self._nlp(problem, ocp, "transfer")
+        multipliers = transfer_multipliers(coarse_nlp, nlp, coarse.lam_x, coarse.lam_g)
+        if multipliers is None:
+            return None
+        lbx, ubx = bounds
+        seed = transcription.seed(ocp, nlp, solution_sampler(found), found.duration)
+        return solve_multistart(nlp.solver, [seed], p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg, agree=1,
+                                lam_x0=multipliers[0], lam_g0=multipliers[1])
+
+    def _reference(self, problem: ManeuverProblem, ocp: OptimalControlProblem, params: Array,
+                   solved: _Optimum) -> Reference:
+        """The reference (or the failure) of an optimum found by :meth:`_optimum`."""
+        o, result, transcription = self.options, solved.result, solved.transcription
+        solver = solved.solver or o.solver
+        stats = result.stats()
+        stats.update(solved.extra, transcription=transcription.name, intervals=solved.intervals, solver=solver)
+        if not result.success:
+            return FailedReference(self.name, f"{solver} did not converge from any start: "
+                                   f"{sorted(set(result.statuses))}", result.status, stats=stats)
+        assert result.x is not None  # success implies a point
+        T, states, controls = (v.full() for v in solved.nlp.unpack(result.x, params))
+        T = T.item()
+        reference = CollocationReference(problem, transcription, T, states, controls, stats)
+        norm_error = float(np.max(np.abs(np.linalg.norm(states[0:4], axis=0) - 1)))
+        reference.stats.update(duration=T, max_quaternion_norm_error=norm_error,
+                               cones=[(c.boresight, c.direction, c.angle, c.keep_out) for c in ocp.cones])
+        reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {solver}): "
+                             f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}")
+        return reference

@@ -1,0 +1,152 @@
+"""How ``collocation`` searches: the tuned constants of ``multistart: auto`` and of the coarse-to-fine
+mesh transfer, the perturbation floor of its first start, and merging the record of a failed solve
+into its fallback's (split from :mod:`planners.collocation.planner` by responsibility; the planner
+re-exports the constants).
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ocp.nlp.solve import NLPResult
+from ocp.transcription import NLP, OptimalControlProblem, Transcription
+from planners.problem import Array
+
+AUTO_RESTART = 0.05
+"""Relative perturbation of the restarts of ``multistart: auto`` when the final time is free."""
+AUTO_FIRST = 0.03
+"""Relative perturbation of the first start of ``multistart: auto`` when the final time is free: each
+decision variable moves by ``AUTO_FIRST × (|value| + floor)`` (normal noise), the floor half the
+range of a bounded control (actuator torques, dipoles; 1e-3 elsewhere), so that the torques about
+the axes where the warm start has none are perturbed at the scale of the actuators. Ten random
+minimum-time slews (B&W, the full-inertia case and eight random inertias and slews, ten noise
+seeds each; 8 intervals): 24 IPOPT iterations on average against 30 for a 1 % perturbation
+floored at 1e-3, the best optimum found in 97 % of the starts against 91 % (3 % and 5 % did the
+same, 10 % slightly worse)."""
+SEED_TOLERANCE = 1e-5
+"""Solver tolerance (at the least) of the coarse-mesh solve of a fixed final time: its optimum only
+seeds the full mesh, whose discretisation moves it far more (the spin paper's minimum energy 0.02012
+on 8 intervals, 0.01855 on 50). 32 random fixed-time minimum-energy problems (random principal
+inertias, slews, spins, durations, free or zero final rates; warm starts ``spin_extremal`` or
+``eigenaxis``): 357 coarse iterations against 428 at the default 1e-10, the full-mesh iterations
+unchanged (109), the same optima; 1e-4 and 1e-3 save a few more coarse iterations and cost full-mesh
+ones (51 against 49 on 16 of them). The 18 fixed-time cases of
+``tests/benchmarks/iteration_counts.py``: 282 coarse and 202 full-mesh iterations against 320 and
+205, the same optima (the spin paper's case 26 + 4 against 28 + 4); minimum time, whose coarse
+optimum is certified or confirmed, keeps the option's tolerance."""
+SEED_FATROP = {"fatrop.mu_init": 1e-3}
+"""FATROP's options for the coarse seed of a fixed final time, which FATROP solves when the
+``solver`` option is IPOPT (the default) for a transcription whose ``fatrop_seed`` is true (Radau
+collocation) and an objective without an L1 term; IPOPT then solves the full mesh from FATROP's
+optimum and multipliers as before. If FATROP does not converge, IPOPT solves the seed (the failed
+attempt is in the stats as ``coarse_fatrop``). Why: FATROP's Riccati iteration on the 8-interval
+Radau mesh costs about 0.8 ms against IPOPT's 1.0 ms with MUMPS (9.0 M against 7.5 M instructions
+per iteration, but fewer inertia corrections), and it starts nearer the central path at ``mu_init``
+1e-3 (its default 0.1: 22.5 ms against 17 ms for the spin paper's seed; 14 fixed-time cases of
+``tests/benchmarks/iteration_counts.py``: fewer iterations on 11, the same optima, one better).
+Measured, stop 24, interleaved in one process against the IPOPT seed:
+- the spin paper's case: the plan's median time 0.82-0.85x in three runs (47.7 against 56.1 ms at
+  the host's fast speed), 21 coarse iterations against 26, the same optimum;
+- 98 fixed-time minimum-energy problems (the 18 of ``iteration_counts.py``, 80 random spin-like
+  and rest-to-rest ones): the same optimum on 95, a lower one on 2 (0.7427 to 0.2027, 1.4498 to
+  0.6425), a higher one on 1 (0.1354 to 0.2709, a case that moves with almost any change of the
+  path); CPU per plan 0.76x on the 95 whose FATROP seed converged; FATROP stopped (its restoration
+  failed) on 3 hard ones (two where IPOPT's seed also fails or takes 176 iterations), which then
+  cost 0.3-0.6 s more each; over the 98, 0.94-0.98x;
+- 24 problems on reaction wheels (orthogonal and pyramid) and with gravity gradient: the same
+  optima, CPU 0.91x.
+Not for multiple shooting (its ``fatrop_seed`` is false): on 30 of those problems 3 lower and 3
+higher optima, the spin case 0.0266 against 0.01855, CPU 1.05x. Not with an L1 term: FATROP failed
+on 9 of 16 random ``min_l1`` problems (stop 23)."""
+POLISH_MU_INIT = 1e-4
+"""IPOPT's initial barrier parameter (its default 0.1) for the full-mesh solve from a coarse-mesh
+optimum: the seed is near the optimum, so the barrier need not start wide. N = 50 from N = 8:
+the spin paper's minimum energy 7 iterations against 12, Bilimoria & Wie's minimum time 15
+against 18, the full-inertia minimum time 12 against 16 (same optima; 1e-6 takes 22-23 on the
+minimum-time cases, where the bounds are active)."""
+TRANSFER_WARM_START = {"mu_init": 1e-7, "bound_push": 1e-3, "mult_bound_push": 1e-4}
+"""IPOPT's warm start (:func:`ocp.nlp.solve.warm_start_options`) of the full-mesh solve from a coarse-mesh
+optimum with its multipliers carried over (:mod:`ocp.transcription.mesh_transfer`); falls back to the start
+without multipliers (:data:`POLISH_MU_INIT`) if it does not converge. The guess is pushed 1e-3
+inside its bounds and the bound multipliers start at 1e-4 at least: the coarse active set is near,
+not at, the fine one. N = 50 from N = 8: the spin paper's minimum energy 4 iterations against 7,
+Bilimoria & Wie's minimum time 10 against 15, the full-inertia one 10 against 12 (same optima).
+Neighbouring values do about as well (mu_init 1e-8 to 1e-5, pushes 1e-4 to 1e-2: 24 to 29
+iterations over the three); a multiplier push of 1e-2 does not (34 to 41), nor IPOPT's tiny pushes
+of a same-mesh warm start (1e-9: 20 and 12 on the minimum-time cases)."""
+
+TRANSFER_MAX_INTERVALS = 150
+"""Largest full mesh solved from the coarse optimum with its multipliers carried over (IPOPT's
+``warm_start_init_point``, :data:`TRANSFER_WARM_START`); beyond it the full mesh starts from the
+coarse optimum alone (:data:`POLISH_MU_INIT`). With the default options, the 30 deg wheel slew of
+``tests/test_collocation_mesh_transfer.py`` on 300, 400 and 500 intervals ran over 120 s (killed)
+in MUMPS's first factorisation of that warm start ("INFO(1) = -9 ... reallocating", about 30 s per
+attempt), with the carried multipliers or zeros and for ``mu_init`` 1e-7 or 1e-4, while the same
+seed without ``warm_start_init_point`` converged in 0.9 s and 200 intervals took 1 s. The tuning
+above is on 40 to 50 intervals; 150 is the largest mesh of the test suite (multiple shooting's
+full-inertia minimum time)."""
+
+TRANSFER_L1_BARRIER = {"ipopt.mu_strategy": "adaptive"}
+"""Added to :data:`TRANSFER_WARM_START` for an objective with an L1 term and no energy term
+(``min_l1``; its optimum is bang-off-bang, many torque slacks at their bounds): IPOPT's adaptive
+barrier (quality-function oracle) instead of the monotone one from 1e-7, which crawls (steps cut to
+α ≈ 1e-3 by the fraction-to-the-boundary rule) when the coarse point is far from the fine central
+path. 16 random fixed-time ``min_l1`` problems (principal inertias 10-20 kg m², 0.1 N m torquers,
+0-0.3 rad/s spins, 60-250 s, two seeds, 40 intervals): 226 full-mesh iterations against 587 (one
+case 212 against 17, another 139 against 17), the same optima to the tolerance (closer to a tight
+solve: smaller complementarity gaps). Not for the others: with an energy term (``weighted``, L1
+weight 0.1) 172 against 151; on the 41 cases of ``tests/benchmarks/iteration_counts.py`` 502 against
+523 but 5-8 % more instructions per plan (its oracle's extra solves). The adaptive strategy
+ignores ``mu_init`` (IPOPT reads it in the monotone mode only: 1e-7, 1e-2 and 0.1 give the same
+iterates); the pushes of :data:`TRANSFER_WARM_START` still apply. ``weighted`` with L1 and time
+weights and no energy term (free final time) takes it too: 10 problems, 136 full-mesh iterations
+against 213."""
+
+
+def control_floor(transcription: Transcription, ocp: OptimalControlProblem, nlp: NLP, u_low: Array,
+                  u_high: Array) -> Array:
+    """The ``floor`` of :func:`ocp.nlp.solve.perturbed` for a decision vector of ``nlp``.
+
+    Parameters
+    ----------
+    transcription : Transcription
+        The transcription ``nlp`` was built by (its variable layout).
+    ocp : OptimalControlProblem
+        What is optimised.
+    nlp : NLP
+        The built NLP.
+    u_low, u_high : (nu,) ndarray
+        Bounds of the actuator controls (model units: N m, A m²).
+
+    Returns
+    -------
+    ndarray
+        Per decision variable, half the range of a bounded control, 1e-3 for every other
+        variable (states, a free T, slacks, unbounded controls).
+    """
+    free = np.full(ocp.dynamics.model.nx, np.inf)
+    low, high = transcription.bounds(ocp, nlp, -free, free, u_low, u_high, np.inf)
+    with np.errstate(invalid="ignore"):  # a free T: [1e-3, 1] × inf
+        half = 0.5 * (high - low)
+    return np.where(np.isfinite(half) & (half > 0), half, 1e-3)
+
+
+def merged(first: NLPResult, second: NLPResult) -> NLPResult:
+    """A fallback's result with the record of the solve that failed before it.
+
+    Parameters
+    ----------
+    first : NLPResult
+        The solve that failed (e.g. the full mesh from a coarse optimum).
+    second : NLPResult
+        The fallback solve after it.
+
+    Returns
+    -------
+    NLPResult
+        ``second`` with the starts, iterations and time of ``first`` counted first.
+    """
+    best = None if second.best_start is None else second.best_start + len(first.starts)
+    return replace(second, starts=first.starts + second.starts, iterations=first.iterations + second.iterations,
+                   time_s=first.time_s + second.time_s, best_start=best)

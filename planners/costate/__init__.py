@@ -1,0 +1,19 @@
+"""``costate_tpbvp``: Vepa's indirect method, states and co-states as a two-point boundary-value problem.
+
+What lives here: the planner and its reference (:mod:`~planners.costate.tpbvp`), the Hamiltonian
+systems' common contract and the rigid body's (:mod:`~planners.costate.hamiltonian`) and the
+problem forms of sections 3 and 6 (:mod:`~planners.costate.systems`).
+
+May import: :mod:`ocp` and the contract modules of :mod:`planners` (``base``, ``problem``,
+``reference``) and :mod:`planners.eigenaxis` (its cold-start guess).
+"""
+from planners.costate.hamiltonian import HamiltonianSystem, RigidBodySystem
+from planners.costate.systems import (
+           AttitudeAcquisitionSystem,
+           MinimumEnergySystem,
+           RateAcquisitionSystem,
+)
+from planners.costate.tpbvp import CostateReference, CostateTPBVPPlanner
+
+__all__ = ["AttitudeAcquisitionSystem", "CostateReference", "CostateTPBVPPlanner", "HamiltonianSystem",
+           "MinimumEnergySystem", "RateAcquisitionSystem", "RigidBodySystem"]

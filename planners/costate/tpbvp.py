@@ -1,0 +1,346 @@
+"""Indirect optimal control: the states and co-states of Pontryagin's principle as a two-point
+boundary-value problem (Vepa, sections 3 and 6), solved with ``scipy.integrate.solve_bvp``.
+
+Problem forms (``objective``; the Hamiltonian systems are in :mod:`planners.costate.systems`):
+
+* ``min_energy``: ``min ½∫‖M_c‖² dt`` for any rest-to-rest or rate-to-rate slew in the scenario's
+  time, ``M_c = −I⁻¹λ_ω``. Cross-checked against the collocation planner.
+* ``rate_acquisition``: reach the target rate ``ω_f`` steering a torque of fixed size,
+  ``M_c = diag(τ) W u``, ``u = −Gᵀλ_ω/‖Gᵀλ_ω‖`` (eq. 21, 34); the attitude is free.
+* ``attitude_acquisition``: reach ``q_f`` with the rate as the control, ``ω = ω_max u`` (eq. 44, 50).
+
+The steering forms solve for the minimum time (``final_time: minimum``, default) or, with
+``final_time: fixed``, minimise the paper's terminal cost at ``t_f = T`` with its transversality
+conditions (eq. 36-38, 51). Gravity gradient enters whenever the scenario has it (eq. 5-8, orbit
+frame from the scenario's orbit). A cold start (eigenaxis slew or straight-line rates) is walked to
+the target by continuation, each solve seeding the next. Torque bounds are not imposed.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Annotated, Any, Callable, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ocp.errors import InvalidOption
+from ocp.options import Range
+from planners.base import Planner
+from planners.costate.hamiltonian import HamiltonianSystem, RigidBodySystem
+from planners.costate.systems import (
+    AttitudeAcquisitionSystem,
+    MinimumEnergySystem,
+    RateAcquisitionSystem,
+)
+from planners.problem import Array, ManeuverProblem
+from planners.reference import FailedReference, Reference, ReferenceSample
+
+
+def _min_energy(problem: ManeuverProblem, o, build: bool = True) -> HamiltonianSystem | str | None:
+    if problem.qf is None:
+        return "objective min_energy needs a target attitude (maneuver.final.q)"
+    if o.final_time == "minimum":
+        return "objective min_energy has a fixed final time (final_time: fixed)"
+    return MinimumEnergySystem(problem, problem.duration) if build else None
+
+
+def _rate_acquisition(problem: ManeuverProblem, o, build: bool = True) -> HamiltonianSystem | str | None:
+    if problem.omegaf is None:
+        return "objective rate_acquisition needs a target rate (maneuver.final.omega)"
+    torque = np.asarray(o.steering_torque if o.steering_torque is not None else problem.torque_limit, dtype=float)
+    if torque.shape != (3,) or not np.all(np.isfinite(torque) & (torque > 0)):
+        return (f"objective rate_acquisition needs a finite positive torque on every axis, got {torque}; "
+                "give the actuators limits or set options.steering_torque (N m per axis)")
+    if o.final_time != "fixed" and np.allclose(problem.omega0, problem.omegaf, rtol=0.0, atol=1e-12):
+        return ("objective rate_acquisition: the initial and target rates are equal, there is no rate to acquire "
+                "in minimum time; use objective min_energy for a slew")
+    if not build:
+        return None
+    return RateAcquisitionSystem(problem, problem.duration, torque, np.diag(o.weighting), o.terminal_weight,
+                                 o.final_time != "fixed")
+
+
+def _attitude_acquisition(problem: ManeuverProblem, o, build: bool = True) -> HamiltonianSystem | str | None:
+    max_rate = o.max_rate if o.max_rate is not None else problem.max_rate
+    if max_rate is None:
+        return "objective attitude_acquisition needs a rate bound (options.max_rate or maneuver.max_rate)"
+    if problem.qf is None:
+        return "objective attitude_acquisition needs a target attitude (maneuver.final.q)"
+    if not build:
+        return None
+    return AttitudeAcquisitionSystem(problem, problem.duration, max_rate, o.terminal_weight, o.final_time != "fixed")
+
+
+# objective -> builder(problem, options, build=True): the system, or the reason it cannot be built
+# (with build=False only the reason, or None: a cheap check for scenario loading).
+TORQUE_FORMS = ("min_energy", "rate_acquisition")
+"""Objectives whose control is a body torque (the attitude-acquisition form steers the rate)."""
+
+FORMS: dict[str, Callable[..., HamiltonianSystem | str | None]] = {
+    "min_energy": _min_energy,
+    "rate_acquisition": _rate_acquisition,
+    "attitude_acquisition": _attitude_acquisition,
+}
+
+
+class CostateReference(Reference):
+    """States and co-states from ``solve_bvp``'s C¹ interpolant on ``[0, t_f]``.
+
+    Declares the boundary conditions its form leaves free (``HamiltonianSystem.free_boundary``).
+
+    Parameters
+    ----------
+    system : HamiltonianSystem
+        The problem form that was solved.
+    solution : object
+        The result of ``scipy.integrate.solve_bvp``; ``solution.sol(s)`` gives ``y`` (2n, m) at
+        scaled times ``s = t / t_f``.
+    duration : float
+        t_f [s].
+    message : str
+        Outcome description.
+    stats : dict
+        Solver statistics.
+    """
+
+    def __init__(self, system: HamiltonianSystem, solution: Any, duration: float, message: str,
+                 stats: dict[str, Any]) -> None:
+        super().__init__("costate_tpbvp", duration, system.inertia, message=message, stats=stats,
+                         free_boundary=system.free_boundary())
+        self.system, self.solution = system, solution
+
+    def state_and_costate(self, t: ArrayLike) -> tuple[Array, Array]:
+        """The optimal states and co-states (``planners.capabilities.CostateCarrier``).
+
+        Parameters
+        ----------
+        t : float or array_like
+            Time [s] or ``m`` times, clipped to ``[0, t_f]``.
+
+        Returns
+        -------
+        x : (m, n) ndarray
+            States, one row per time: ``[q, ω]`` (scalar first, body to inertial; rad/s, body axes)
+            for the torque forms, ``q`` for attitude acquisition.
+        lam : (m, n) ndarray
+            Co-states ``[λ_q, λ_ω]`` (or ``λ_q``), one row per time.
+        """
+        y = self.solution.sol(np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration) / self.duration)
+        n = self.system.n_state
+        return y[:n].T, y[n:].T
+
+    def feedback_torque(self, lam_omega: Array, lam_omega_reference: Array) -> Array:
+        """The optimal control at an estimated rate co-state (``planners.capabilities.CostateCarrier``).
+
+        Parameters
+        ----------
+        lam_omega : (3,) ndarray
+            The estimated rate co-state ``λ̂_ω``.
+        lam_omega_reference : (3,) ndarray
+            The reference's ``λ_ω`` at the same time (fixes the normalisation of eq. 42).
+
+        Returns
+        -------
+        (3,) ndarray
+            Control torque [N m], body axes, without the environment torque.
+
+        Raises
+        ------
+        AttributeError
+            For the attitude-acquisition form, whose control is a rate, not a torque.
+        """
+        if not isinstance(self.system, RigidBodySystem):
+            raise AttributeError(f"{type(self.system).__name__} has no feedback_torque: its control is not a torque")
+        return self.system.feedback_torque(lam_omega, lam_omega_reference)
+
+    def _evaluate(self, t: Array) -> ReferenceSample:
+        return self.system.sample(t, self.solution.sol(t / self.duration), self.duration)
+
+
+def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, max_nodes: int,
+          guess: tuple[float, Array, Array] | None = None,
+          min_step: float = 1e-3) -> tuple[Any, float | None, int, str | None]:
+    """Solve the TPBVP of ``system`` by adaptive continuation, starting with steps of ``1/steps``.
+
+    A failed stage is retried with half the step; a successful one lengthens the next by half.
+    Each solution is resampled on ``nodes`` points before it seeds the next stage (``solve_bvp``
+    only ever adds nodes). Intermediate stages use ``max(tolerance, 1e-5)`` and at most
+    ``min(max_nodes, 10 nodes)`` nodes.
+
+    Parameters
+    ----------
+    system : HamiltonianSystem
+        The problem form.
+    nodes : int
+        Mesh points each stage starts from.
+    steps : int
+        The first continuation step is ``1/steps`` (a form that is not ``continued`` solves the
+        target at once).
+    tolerance : float
+        ``solve_bvp`` residual tolerance of the final stage.
+    max_nodes : int
+        ``solve_bvp`` node limit of the final stage.
+    guess : (t_f, s, y) or None, optional
+        Replaces the system's own cold start (tests use it to start far away): final time [s],
+        scaled mesh (m,) on [0, 1], ``y`` (2n, m).
+    min_step : float, optional
+        Smallest continuation step before giving up (default 1e-3).
+
+    Returns
+    -------
+    solution : object or None
+        The result of the final ``scipy.integrate.solve_bvp`` call, ``None`` on failure.
+    t_f : float or None
+        The final time [s], ``None`` on failure.
+    stages : int
+        ``solve_bvp`` calls made.
+    message : str or None
+        Why it failed, ``None`` on success.
+    """
+    from scipy.integrate import (
+        solve_bvp,  # lazily: scipy.integrate pulls in scipy.optimize
+    )
+
+    free = system.free_final_time
+    t_f = 0.0
+
+    def fun(s, y, p=None):
+        time = system.final_time(p) if free else t_f
+        return time * system.evaluate(s * time, y, derivatives=False)[0]
+
+    def fun_jac(s, y, p=None):
+        time = system.final_time(p) if free else t_f
+        f, jac, f_t = system.evaluate(s * time, y)
+        assert jac is not None and f_t is not None  # evaluate gives them with derivatives=True
+        if not free:
+            return time * jac
+        return time * jac, (f + time * s * f_t)[:, None, :]
+
+    done, step, stages, start, solution = 0.0, 1.0 / steps if system.continued else 1.0, 0, guess, None
+    while done < 1.0:
+        fraction = min(1.0, done + step)
+        t_f, s, y = start if start is not None else system.guess(nodes, fraction)
+        bc = system.boundary(fraction)
+        final = fraction == 1.0  # intermediate stages only seed the next: loose and small
+        trial = solve_bvp(fun, bc if free else (lambda ya, yb: bc(ya, yb)), s, y, p=[t_f] if free else None,
+                          fun_jac=fun_jac, tol=tolerance if final else max(tolerance, 1e-5),
+                          max_nodes=max_nodes if final else min(max_nodes, 10 * nodes))
+        stages += 1
+        if trial.status == 0 and (not free or trial.p[0] > 0):
+            solution, done, step = trial, fraction, 1.5 * step
+            t_f = float(trial.p[0]) if free else t_f
+            mesh = np.linspace(0.0, 1.0, nodes)
+            start = (t_f, mesh, trial.sol(mesh))
+            continue
+        step /= 2
+        if step < min_step:
+            detail = trial.message if trial.status != 0 else f"non-positive t_f = {trial.p[0]:.4g} s"
+            return None, None, stages, f"solve_bvp failed at continuation fraction {fraction:.3f}: {detail}"
+    return solution, t_f, stages, None
+
+
+class CostateTPBVPPlanner(Planner):
+    """Indirect (co-state) planner; see the module docstring."""
+
+    name = "costate_tpbvp"
+    example_options = ({}, {"objective": "rate_acquisition"}, {"objective": "attitude_acquisition"})
+
+    @dataclass(frozen=True)
+    class Options:
+        """Options of ``costate_tpbvp`` (YAML ``planner.options``).
+
+        Attributes
+        ----------
+        objective : {"min_energy", "rate_acquisition", "attitude_acquisition"}
+            The problem form: ``min_energy`` (default; ``min ½∫‖M_c‖² dt`` over the scenario's T,
+            needs a target attitude), ``rate_acquisition`` (steer a torque ``diag(τ) W u``,
+            ``‖u‖ = 1``, to ``maneuver.final.omega``; the attitude is free) or
+            ``attitude_acquisition`` (the rate ``ω = max_rate u``, ``‖u‖ = 1``, is the control).
+        final_time : {"minimum", "fixed"} or None
+            Steering forms: ``minimum`` (the default for them, ``None``) solves for the minimum
+            time; ``fixed`` uses the scenario's T with the terminal cost ``terminal_weight`` and the
+            paper's transversality conditions (rate acquisition: for a T shorter than the minimum
+            time; a target rate reachable within T makes the problem singular and the solve fails). ``min_energy`` has a fixed time (``minimum`` is
+            refused).
+        weighting : tuple of 3 float
+            Diagonal of ``W`` (eq. 34), positive (default ``[1, 1, 1]``; rate acquisition).
+        steering_torque : list of 3 float or None
+            ``τ``, the steering torque per body axis [N m], positive; ``None`` (default): the
+            actuators' per-axis limits (rate acquisition).
+        terminal_weight : float
+            ``Q_f = terminal_weight · I`` of the terminal cost with ``final_time: fixed`` (on the
+            rate for rate acquisition, on the quaternion for attitude acquisition), positive
+            (default 100). The optimum does not depend on it: the control has unit norm and there
+            is no running cost, so the co-state equations and boundary conditions are homogeneous
+            in λ and the weight only scales the co-states.
+        max_rate : float or None
+            ``ω_max`` of attitude acquisition [rad/s]; ``None`` (default): ``maneuver.max_rate``.
+        continuation_steps : int
+            The first continuation step is ``1/continuation_steps`` of the way from the cold start
+            to the target, then adaptive; 1 to 100 (default 3).
+        nodes : int
+            Mesh points each continuation stage starts from, 5 to 5000 (default 60).
+        tolerance : float
+            ``solve_bvp`` residual tolerance of the final stage, in (0, 1) (default 1e-8).
+        max_nodes : int
+            ``solve_bvp`` node limit of the final stage, 10 to 100000 and at least ``nodes``
+            (default 5000).
+        """
+
+        objective: Literal["min_energy", "rate_acquisition", "attitude_acquisition"] = "min_energy"
+        final_time: Literal["minimum", "fixed"] | None = None   # steering forms: default minimum
+        weighting: Annotated[tuple[float, float, float], Range(gt=0.0, size=3)] = (1.0, 1.0, 1.0)                # diagonal of W (eq. 34)
+        steering_torque: Annotated[list[float] | None, Range(gt=0.0, size=3)] = None              # N m per axis; default the actuator limits
+        terminal_weight: Annotated[float, Range(gt=0.0)] = 100.0                           # Q_f = terminal_weight · I (final_time: fixed)
+        max_rate: Annotated[float | None, Range(gt=0.0)] = None                            # rad/s; default maneuver.max_rate
+        continuation_steps: Annotated[int, Range(ge=1, le=100)] = 3                              # first step 1/continuation_steps, then adaptive
+        nodes: Annotated[int, Range(ge=5, le=5000)] = 60                                          # mesh each stage starts from
+        tolerance: Annotated[float, Range(gt=0.0, lt=1.0)] = 1e-8                                  # solve_bvp residual tolerance
+        max_nodes: Annotated[int, Range(ge=10, le=100000)] = 5000
+
+        def __post_init__(self) -> None:
+            if self.max_nodes < self.nodes:
+                raise InvalidOption("max_nodes", f"must be at least nodes ({self.nodes}), got {self.max_nodes}")
+
+    @classmethod
+    def offers_costates(cls, options: Any) -> bool:
+        """Whether references carry co-states with a torque control (``planners.capabilities``).
+
+        Parameters
+        ----------
+        options : Options or any
+            The planner's options.
+
+        Returns
+        -------
+        bool
+            True for the torque forms (``min_energy``, ``rate_acquisition``).
+        """
+        return getattr(options, "objective", None) in TORQUE_FORMS
+
+    def problem_error(self, problem: ManeuverProblem) -> str | None:
+        error = FORMS[self.options.objective](problem, self.options, build=False)
+        return error if isinstance(error, str) else None
+
+    def _plan(self, problem: ManeuverProblem) -> Reference:
+        o = self.options
+        system = FORMS[o.objective](problem, o)
+        if not isinstance(system, HamiltonianSystem):
+            return FailedReference(self.name, str(system))
+        solution, t_f, stages, failure = solve(system, o.nodes, o.continuation_steps, o.tolerance, o.max_nodes)
+        if failure or solution is None or t_f is None:
+            return FailedReference(self.name, f"{o.objective}: {failure}")
+        stats = {"objective_form": o.objective, "t_f": t_f, "nodes": int(solution.x.size),
+                 "max_rms_residual": float(np.max(solution.rms_residuals)), "continuation_stages": stages}
+        if system.torque_control and isinstance(system, RigidBodySystem):
+            fine = np.linspace(0.0, t_f, 4001)
+            reference = CostateReference(system, solution, t_f, "", {})
+            control = reference.sample(fine).torque - system.environment_torque(fine, reference.state_and_costate(fine)[0].T).T
+            stats["int_u2"] = float(np.trapezoid(np.sum(control**2, axis=1), fine))
+        reference = CostateReference(system, solution, t_f, "", stats)
+        timing = "minimum time" if system.free_final_time else "fixed time"
+        reference.message = (f"{o.objective} ({timing}) t_f = {t_f:.6g} s"
+                             + (f", ∫‖M_c‖² = {stats['int_u2']:.6g}" if "int_u2" in stats else "")
+                             + f" on {solution.x.size} nodes (solve_bvp)")
+        return reference
+

@@ -1,0 +1,18 @@
+"""The ``slewbench`` command line: ``run``, ``validate``, ``list``, ``codegen``, ``sweep``.
+
+What lives here: the parser and the single-scenario commands (:mod:`~scenarios.cli.main`) and the
+study commands (:mod:`~scenarios.cli.sweep`). ``python -m scenarios.cli`` runs it in one process;
+the console script (:mod:`scenarios.console`) starts the plot process first.
+
+May import: everything of :mod:`scenarios`; nothing imports it but the console script.
+"""
+from __future__ import annotations
+
+from scenarios._faces import lazy_face
+
+_HOMES = {"build_parser": "scenarios.cli.main",
+          "main": "scenarios.cli.main"}
+
+__all__ = ["build_parser", "main"]
+
+__getattr__, __dir__ = lazy_face(__name__, _HOMES)

@@ -1,0 +1,240 @@
+"""``slewbench`` command line: run, validate, list, codegen, sweep.
+
+Exit status: 0 when the run completed (a failed planner is a row, not an error), 2 for a bad
+scenario file, 1 for an internal error.
+"""
+from __future__ import annotations
+
+import argparse
+import re
+import signal
+import sys
+import threading
+import time
+import traceback
+from pathlib import Path
+from typing import Any
+
+from controllers import CONTROLLERS
+from planners import PLANNERS
+from scenarios.cli.sweep import add_sweep_parser
+from scenarios.output.directory import claim_output_directory
+from scenarios.output.names import default_output_directory
+from scenarios.runner import run
+from scenarios.schema.loader import load
+from scenarios.schema.read import ScenarioError
+
+EXIT_OK, EXIT_INTERNAL, EXIT_BAD_SCENARIO = 0, 1, 2
+
+
+def _first_doc_line(cls: type) -> str:
+    """The first sentence of the module's docstring (the class's if the module has none)."""
+    doc = (sys.modules[cls.__module__].__doc__ or cls.__doc__ or "").strip()
+    paragraph = " ".join(doc.split("\n\n")[0].split())
+    sentence = re.match(r"(.+?[.:])\s+(?=[A-Z*`])", paragraph)  # not at "eq. 38"
+    return (sentence.group(1) if sentence else paragraph).rstrip(".:")
+
+
+def command_list(_: argparse.Namespace) -> int:
+    """``slewbench list``: print the registered planners and controllers, one line each.
+
+    Parameters
+    ----------
+    _ : argparse.Namespace
+        The parsed command line (unused).
+
+    Returns
+    -------
+    int
+        Exit status (0).
+    """
+    print("planners:")
+    for name, planner in PLANNERS.items():
+        print(f"  {name:32s} {_first_doc_line(planner)}")
+    print("controllers:")
+    for name, controller in CONTROLLERS.items():
+        print(f"  {name:32s} {_first_doc_line(controller)}")
+    return EXIT_OK
+
+
+def command_validate(args: argparse.Namespace) -> int:
+    """``slewbench validate FILE``: load and check a scenario, print a one-line summary.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``file``: the scenario YAML path.
+
+    Returns
+    -------
+    int
+        Exit status (0; a bad scenario raises ``ScenarioError``, which :func:`main` reports).
+    """
+    scenario = load(args.file)
+    print(f"{args.file}: valid scenario {scenario.name!r} with {len(scenario.planners)} planner(s) "
+          f"and controller {scenario.controller.name!r}")
+    return EXIT_OK
+
+
+def command_run(args: argparse.Namespace) -> int:
+    """``slewbench run FILE``: plan, simulate and score, print the table, write the outputs.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``file`` (scenario YAML), ``out`` (output directory or ``None``: ``results/<name>``),
+        ``no_plots`` (skip the PNG figures), and, set by :func:`main` (optional): ``interruption``
+        (an :class:`Interruption`) and ``renderer`` (a :class:`scenarios.output.renderer.Renderer` to
+        draw the plots, or ``None``).
+
+    Returns
+    -------
+    int
+        Exit status (0: the run completed; failed planners are rows, not errors).
+    """
+    scenario = load(args.file)
+    out = Path(args.out) if args.out else default_output_directory(scenario.name)
+    claim_output_directory(out)  # before planning: a long run is never lost at the end
+    start = time.perf_counter()
+    interruption = getattr(args, "interruption", None) or Interruption()
+
+    def progress(line: str) -> None:
+        interruption.check()  # a signal swallowed on the way (see Interruption) stops the run here
+        print(line, flush=True)
+
+    results = run(scenario, progress=progress)
+    interruption.check()
+    print()
+    print(results.to_terminal())
+    results.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
+    print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
+          f"{'' if args.no_plots else ', PNG plots'}) in {time.perf_counter() - start:.2f} s")
+    return EXIT_OK
+
+
+def command_codegen(args: argparse.Namespace) -> int:
+    """``slewbench codegen FILE --out DIR``: export the controller law (and closed-form
+    references) as CasADi-generated C with a header and a Makefile.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``file`` (scenario YAML) and ``out`` (output directory).
+
+    Returns
+    -------
+    int
+        Exit status (0).
+    """
+    from scenarios.codegen import (
+        generate,  # CasADi's code generator: only for this command
+    )
+
+    scenario = load(args.file)
+    report = generate(scenario, args.out)
+    print(f"wrote {report.directory}/: " + ", ".join(f"{name} ({size} bytes)" for name, size in report.files.items()))
+    print("functions: " + ", ".join(report.functions))
+    for label, reason in report.skipped.items():
+        print(f"  no C reference for row {label!r}: {reason}")
+    print(f"build: make -C {report.directory}")
+    return EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``slewbench`` argument parser (run, validate, codegen, list, sweep, report).
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        Each sub-command sets ``handler``, the function that runs it.
+    """
+    parser = argparse.ArgumentParser(prog="slewbench", description="Spacecraft attitude manoeuvre planning workbench")
+    commands = parser.add_subparsers(dest="command", required=True)
+    run_parser = commands.add_parser("run", help="plan, simulate and score every planner of a scenario")
+    run_parser.add_argument("file", help="scenario YAML file")
+    run_parser.add_argument("--out", help="output directory (default: results/<scenario name>)")
+    run_parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    run_parser.set_defaults(handler=command_run)
+    validate_parser = commands.add_parser("validate", help="check a scenario file")
+    validate_parser.add_argument("file")
+    validate_parser.set_defaults(handler=command_validate)
+    codegen_parser = commands.add_parser("codegen", help="export the controller law (and closed-form references) as C")
+    codegen_parser.add_argument("file", help="scenario YAML file")
+    codegen_parser.add_argument("--out", required=True, help="output directory (new, empty, or written by slewbench)")
+    codegen_parser.set_defaults(handler=command_codegen)
+    list_parser = commands.add_parser("list", help="registered planners and controllers")
+    list_parser.set_defaults(handler=command_list)
+    add_sweep_parser(commands)
+    return parser
+
+
+class Interruption:
+    """SIGTERM and Ctrl-C handler: ends a run like Ctrl-C, so that staged files are removed on the
+    way out, and remembers that it fired.
+
+    The ``KeyboardInterrupt`` can be lost: raised inside a finaliser (``__del__`` of a CasADi
+    object run by the garbage collector, where Python only prints "Exception ignored"), or turned
+    into an error that the runner records as a failed row. :meth:`check`, called between the run's
+    phases and before writing, then still stops the run.
+    """
+
+    def __init__(self) -> None:
+        self.signalled = False
+
+    def __call__(self, signum: int, frame: Any) -> None:
+        """Record the signal and raise ``KeyboardInterrupt``.
+
+        Parameters
+        ----------
+        signum : int
+            The signal number.
+        frame : frame or None
+            The interrupted frame (unused).
+        """
+        self.signalled = True
+        raise KeyboardInterrupt
+
+    def check(self) -> None:
+        """Raise ``KeyboardInterrupt`` if a signal has fired (even one swallowed on the way)."""
+        if self.signalled:
+            raise KeyboardInterrupt
+
+
+def main(argv: list[str] | None = None, renderer: Any = None) -> int:
+    """Run the ``slewbench`` command line.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments (without the program name); ``None``: ``sys.argv[1:]``.
+    renderer : scenarios.output.renderer.Renderer, optional
+        A plot process started before the model was imported (:mod:`scenarios.console`), used by
+        ``run``; ``None``: plots are drawn in this process.
+
+    Returns
+    -------
+    int
+        Exit status: 0 done, 2 bad scenario file, 1 internal error or interrupted.
+    """
+    args = build_parser().parse_args(argv)
+    args.interruption = Interruption()
+    args.renderer = renderer
+    previous = (signal.signal(signal.SIGTERM, args.interruption)
+                if threading.current_thread() is threading.main_thread() else None)
+    try:
+        return args.handler(args)
+    except ScenarioError as error:
+        print(f"slewbench: error in scenario: {error}", file=sys.stderr)
+        return EXIT_BAD_SCENARIO
+    except KeyboardInterrupt:
+        print("slewbench: interrupted; results not written or marked incomplete in the output manifest",
+              file=sys.stderr)
+        return EXIT_INTERNAL
+    except Exception:
+        traceback.print_exc()
+        print("slewbench: internal error (this is a bug; please report it with the scenario file)", file=sys.stderr)
+        return EXIT_INTERNAL
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+

@@ -1,0 +1,33 @@
+"""What a run writes: tables, time series and figures, in output directories slewbench owns.
+
+What lives here: file names from labels (:mod:`~scenarios.output.names`), the table renderings
+(:mod:`~scenarios.output.tables`), output directories, their manifest and staged commits
+(:mod:`~scenarios.output.directory`), the figures' data as arrays
+(:mod:`~scenarios.output.plot_data`), the matplotlib drawing (:mod:`~scenarios.output.plots`) and the
+plot process that draws while the run goes on (:mod:`~scenarios.output.renderer`).
+
+May import: :mod:`ocp`, :mod:`planners` (types), :mod:`scenarios.errors` and
+:mod:`scenarios.schema`. :mod:`~scenarios.output.plots` and :mod:`~scenarios.output.renderer` import
+no model (the plot process starts before it is loaded), so this face imports its names on first
+use.
+"""
+from __future__ import annotations
+
+from scenarios._faces import lazy_face
+
+_HOMES = {"OutputError": "scenarios.output.directory",
+          "Renderer": "scenarios.output.renderer",
+          "claim_output_directory": "scenarios.output.directory",
+          "read_manifest": "scenarios.output.directory",
+          "row_stems": "scenarios.output.names",
+          "sanitize": "scenarios.output.names",
+          "to_csv": "scenarios.output.tables",
+          "to_dataframe": "scenarios.output.tables",
+          "to_json": "scenarios.output.tables",
+          "to_markdown": "scenarios.output.tables",
+          "to_terminal": "scenarios.output.tables",
+          "write_results": "scenarios.output.directory"}
+
+__all__ = ["OutputError", "Renderer", "claim_output_directory", "read_manifest", "row_stems", "sanitize", "to_csv", "to_dataframe", "to_json", "to_markdown", "to_terminal", "write_results"]
+
+__getattr__, __dir__ = lazy_face(__name__, _HOMES)

@@ -1,0 +1,379 @@
+"""Output directories that slewbench owns, and writing a run's results into them safely.
+
+The rules (README, "What slewbench writes"):
+
+* Every output directory carries slewbench's marker, :data:`MARKER`, a JSON manifest naming the
+  files slewbench wrote there and whether the set is complete. A directory is claimed only when it
+  does not exist yet, is empty, or already carries the marker; anything else (a regular file, a
+  user's directory, the working directory) is refused with a :class:`OutputError` and left untouched.
+* Inside a marked directory slewbench replaces or removes only files its manifest lists; a file a
+  user put there is never touched, and a result name that would land on such a file is an error.
+* New results are written into a staging folder inside the marked directory, then moved into place
+  file by file, and the manifest is marked complete last: an interrupted run leaves a manifest that
+  says "incomplete", and its staging folder is removed by the next run that writes there.
+* :func:`row_stems` gives every row a distinct, bounded file name whatever its label.
+"""
+from __future__ import annotations
+
+import contextlib
+import csv
+import fcntl
+import json
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Iterable, Iterator
+
+import numpy as np
+
+from scenarios.output.names import (
+    row_stems,
+)
+from scenarios.output.tables import to_csv, to_json, to_markdown
+from scenarios.schema.read import ScenarioError
+
+if TYPE_CHECKING:
+    from scenarios.runner import Row, RunResults
+
+__all__ = ["MARKER", "STAGING_PREFIX", "OutputError", "claim_output_directory", "commit_outputs", "new_staging",
+           "read_manifest", "write_manifest", "write_results", "write_timeseries"]
+
+MARKER = ".slewbench-output.json"
+STAGING_PREFIX = ".slewbench-staging-"
+class OutputError(ScenarioError):
+    """An output location slewbench must not or cannot write to (exit status 2)."""
+
+    def __init__(self, path: str | Path, message: str):
+        super().__init__("--out", f"{path}: {message}")
+
+
+def read_manifest(directory: Path) -> dict[str, Any] | None:
+    """The manifest in the marker of ``directory``.
+
+    Parameters
+    ----------
+    directory : Path
+        A directory.
+
+    Returns
+    -------
+    dict or None
+        The manifest (``tool``, ``kind``, ``complete``, ``files``), or ``None`` when the directory
+        carries no valid marker (missing, unreadable, not slewbench's, or naming a file outside it).
+    """
+    try:
+        manifest = json.loads((directory / MARKER).read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(manifest, dict) or manifest.get("tool") != "slewbench" or not isinstance(manifest.get("files"), list):
+        return None
+    if not all(isinstance(name, str) and _is_plain_relative(name) for name in manifest["files"]):
+        return None  # a manifest naming files outside its directory is not ours to act on
+    return manifest
+
+
+def _is_plain_relative(name: str) -> bool:
+    """A relative path without ``..``, empty or absolute parts: it stays inside its directory."""
+    path = Path(name)
+    return bool(name) and not path.is_absolute() and all(part not in ("", ".", "..") for part in path.parts)
+
+
+def _check_inside(directory: Path, name: str) -> None:
+    """Refuse a path whose folders under ``directory`` are symbolic links (they would send writes
+    and deletions elsewhere)."""
+    folder = directory
+    for part in Path(name).parts[:-1]:
+        folder = folder / part
+        if folder.is_symlink():
+            raise OutputError(directory, f"{folder} is a symbolic link; slewbench writes only inside its own "
+                                         "directory, nothing was replaced")
+
+
+@contextlib.contextmanager
+def _locked(directory: Path) -> Iterator[None]:
+    """An exclusive lock on ``directory`` while a run commits into it (other runs wait)."""
+    handle = os.open(directory, os.O_RDONLY)
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        yield
+    finally:
+        fcntl.flock(handle, fcntl.LOCK_UN)
+        os.close(handle)
+
+
+def new_staging(directory: Path) -> Path:
+    """A staging folder inside the marked ``directory``, named after this process, so that a later
+    run removes it only once this process is gone.
+
+    Parameters
+    ----------
+    directory : Path
+        A directory claimed by :func:`claim_output_directory`.
+
+    Returns
+    -------
+    Path
+        The new, empty staging folder.
+    """
+    return Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{os.getpid()}-", dir=directory))
+
+
+def _abandoned(staging: Path) -> bool:
+    """Whether the process that made ``staging`` has ended."""
+    try:
+        pid = int(staging.name[len(STAGING_PREFIX):].split("-")[0])
+    except ValueError:
+        return True
+    if pid == os.getpid():
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except PermissionError:
+        return False
+    return False
+
+
+def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: str) -> None:
+    """Replace the marker atomically (write a temporary file, then rename it).
+
+    Parameters
+    ----------
+    directory : Path
+        The output directory.
+    files : iterable of str
+        The files slewbench wrote there, relative to ``directory``.
+    complete : bool
+        Whether the set is complete (``False`` while a run commits).
+    kind : str
+        What writes there (``"run"``, ``"sweep"``, ``"codegen"``).
+    """
+    manifest = {"tool": "slewbench", "kind": kind, "complete": complete, "files": sorted(set(files))}
+    handle, temporary = tempfile.mkstemp(prefix=".slewbench-manifest-", dir=directory)
+    with os.fdopen(handle, "w") as stream:
+        json.dump(manifest, stream, indent=1)
+    os.replace(temporary, directory / MARKER)
+
+
+def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
+    """Make ``path`` a slewbench output directory, or refuse without touching anything.
+
+    Accepted: a path that does not exist (it is created, with missing parents, and marked), an
+    empty directory (marked), or a directory that already carries slewbench's marker. Leftover
+    staging folders of an interrupted run inside a marked directory are removed. Writability is
+    checked with a probe file, so that a run never fails at its end for want of permission.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output directory.
+    kind : str, optional
+        What writes there (``"run"``, ``"sweep"``, ``"codegen"``), recorded in the manifest.
+
+    Returns
+    -------
+    Path
+        The absolute directory.
+
+    Raises
+    ------
+    OutputError
+        For a regular file, a non-empty directory without the marker, a parent that is a file,
+        a name too long for the file system, or a location that cannot be written.
+    """
+    directory = Path(path).expanduser().absolute()
+    try:
+        if directory.is_symlink() or (directory.exists() and not directory.is_dir()):
+            raise OutputError(path, "exists and is not a directory; slewbench writes only into a new, "
+                                    "empty or slewbench-made directory")
+        if directory.is_dir():
+            manifest = read_manifest(directory)
+            if manifest is None and any(directory.iterdir()):
+                raise OutputError(path, f"is a directory that slewbench did not create (no {MARKER} in it) and is "
+                                        "not empty; choose a new or empty directory, nothing was touched")
+            if manifest is None:
+                write_manifest(directory, [], complete=False, kind=kind)
+            elif manifest.get("kind", kind) != kind and manifest["files"]:
+                raise OutputError(path, f"holds slewbench {manifest.get('kind')} output; write the {kind} output "
+                                        "into a directory of its own, nothing was touched")
+            for leftover in directory.glob(f"{STAGING_PREFIX}*"):
+                if leftover.is_dir() and not leftover.is_symlink() and _abandoned(leftover):
+                    shutil.rmtree(leftover, ignore_errors=True)
+        else:
+            for parent in directory.parents:
+                if parent.exists():
+                    if not parent.is_dir():
+                        raise OutputError(path, f"its parent {parent} is not a directory")
+                    break
+            directory.mkdir(parents=True)
+            write_manifest(directory, [], complete=False, kind=kind)
+        probe = tempfile.NamedTemporaryFile(prefix=".slewbench-probe-", dir=directory)
+        probe.close()
+    except OutputError:
+        raise
+    except OSError as error:
+        raise OutputError(path, f"cannot be written: {error.strerror or error}") from None
+    return directory
+
+
+def write_timeseries(row: Row, path: Path) -> None:
+    """Write a row's closed-loop time series as CSV.
+
+    Columns: ``t`` [s], ``q0..q3`` (body to inertial, scalar first), ``omega_x..z`` [rad/s, body],
+    ``h_w0..`` [N m s], ``u_x..z`` the applied body torque [N m, body] held from ``t`` (blank on
+    the last line), ``ref_q0..3`` and ``ref_omega_x..z`` [rad/s] (blank without a reference).
+    Non-finite values are blank.
+
+    Parameters
+    ----------
+    row : Row
+        A result row with a ``simulation`` (and its ``reference``, or ``None``).
+    path : Path
+        The CSV file to write.
+    """
+    sim = row.simulation
+    if sim is None:
+        raise ValueError(f"row {row.label!r} has no closed-loop simulation to write")
+    n_w = sim.wheel_momentum.shape[1]
+    header = (["t", "q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z"]
+              + [f"h_w{i}" for i in range(n_w)] + ["u_x", "u_y", "u_z"]
+              + ["ref_q0", "ref_q1", "ref_q2", "ref_q3", "ref_omega_x", "ref_omega_y", "ref_omega_z"])
+    torque = np.vstack([sim.applied_torque, np.full((1, 3), np.nan)])
+    if row.reference is not None:
+        sample = row.reference.sample(sim.t)
+        ref = np.hstack([sample.q, sample.omega])
+    else:
+        ref = np.full((sim.t.size, 7), np.nan)
+    table = np.hstack([sim.t[:, None], sim.x, torque, ref])
+    with path.open("w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(header)
+        for line in table:
+            writer.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in line])
+
+
+def _relative_files(root: Path) -> list[str]:
+    return sorted(str(p.relative_to(root)) for p in root.rglob("*") if p.is_file())
+
+
+def commit_outputs(directory: Path, staging: Path, kind: str) -> list[str]:
+    """Move everything under ``staging`` into the marked ``directory``, replacing only files the
+    manifest lists, remove the previous run's files that the new set lacks, and mark complete.
+
+    Parameters
+    ----------
+    directory : Path
+        A directory claimed by :func:`claim_output_directory`.
+    staging : Path
+        The staging folder (:func:`new_staging`) holding the new files; it is removed.
+    kind : str
+        What writes there (``"run"``, ``"sweep"``, ``"codegen"``).
+
+    Returns
+    -------
+    list of str
+        The files now listed by the manifest (relative paths).
+
+    Raises
+    ------
+    OutputError
+        The marker was lost or changed kind, a folder is a symbolic link, or a new file would
+        replace one slewbench did not write; nothing is replaced then.
+    """
+    with _locked(directory):
+        return _commit(directory, staging, kind)
+
+
+def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
+    manifest = read_manifest(directory)
+    if manifest is None:
+        raise OutputError(directory, f"lost its {MARKER} while running; nothing was replaced")
+    if manifest.get("kind", kind) != kind and manifest["files"]:
+        raise OutputError(directory, f"now holds slewbench {manifest.get('kind')} output; nothing was replaced")
+    previous = set(manifest["files"])
+    new = _relative_files(staging)
+    for name in previous | set(new):
+        _check_inside(directory, name)
+    clashes = [name for name in new if name not in previous and os.path.lexists(directory / name)]
+    if clashes:
+        raise OutputError(directory, f"holds files slewbench did not write ({', '.join(clashes[:5])}); "
+                                     "nothing was replaced: move them or choose another --out")
+    write_manifest(directory, previous | set(new), complete=False, kind=kind)
+    for name in new:
+        (directory / name).parent.mkdir(parents=True, exist_ok=True)
+        os.replace(staging / name, directory / name)
+    for name in sorted(previous - set(new)):
+        stale = directory / name
+        if stale.is_file() and not stale.is_symlink():
+            stale.unlink()
+    for folder in sorted({(directory / name).parent for name in previous - set(new)}, reverse=True):
+        if folder != directory and folder.is_dir() and not any(folder.iterdir()):
+            folder.rmdir()
+    write_manifest(directory, new, complete=True, kind=kind)
+    shutil.rmtree(staging, ignore_errors=True)
+    return new
+
+
+def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer: Any) -> None:
+    """The run's figures into ``staging``: by the plot process if there is one, else (or if it
+    fails) in this process."""
+    from scenarios.output.plot_data import plot_jobs
+
+    jobs = plot_jobs(results, stems)
+    if renderer is not None:
+        from scenarios.output.renderer import RenderingFailed
+
+        try:
+            renderer.draw(jobs, staging)
+            return
+        except RenderingFailed as error:
+            print(f"slewbench: {error}; drawing the plots in this process", file=sys.stderr)
+    from scenarios.output.plots import draw_jobs
+
+    draw_jobs(jobs, staging)
+
+
+def write_results(results: RunResults, directory: str | Path, plots: bool = True, renderer: Any = None) -> Path:
+    """Write ``results.json/csv/md``, ``timeseries/<row>.csv`` and the PNG plots into ``directory``.
+
+    The directory is claimed first (:func:`claim_output_directory`); the files are staged inside
+    it and committed together (:func:`commit_outputs`).
+
+    Parameters
+    ----------
+    results : RunResults
+        The rows of a scenario run.
+    directory : str or Path
+        The output directory.
+    plots : bool, optional
+        Also draw the PNG figures.
+    renderer : scenarios.output.renderer.Renderer, optional
+        A plot process to draw them (:mod:`scenarios.output.renderer`); if it fails, they are drawn in this
+        process after a one-line notice on stderr. ``None``: drawn in this process.
+
+    Returns
+    -------
+    Path
+        The absolute output directory.
+    """
+    target = claim_output_directory(directory)
+    staging = new_staging(target)
+    try:
+        (staging / "results.json").write_text(to_json(results))
+        (staging / "results.csv").write_text(to_csv(results))
+        (staging / "results.md").write_text(to_markdown(results))
+        series = staging / "timeseries"
+        series.mkdir()
+        stems = row_stems([row.label for row in results.rows])
+        for row, stem in zip(results.rows, stems):
+            if row.simulation is not None:
+                write_timeseries(row, series / f"{stem}.csv")
+        if plots:
+            _write_plots(results, staging, stems, renderer)
+        commit_outputs(target, staging, kind="run")
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return target

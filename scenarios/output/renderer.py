@@ -1,0 +1,302 @@
+"""A separate process that draws a run's figures, so that importing matplotlib overlaps the run.
+
+Importing matplotlib costs about as much as importing slewbench and running the demo scenario
+(0.6-0.9 s each on the 2-core reference machine), and drawing needs neither the model nor the
+run's objects: only the arrays of :mod:`scenarios.output.plot_data`. So ``slewbench run`` forks this
+process first thing, before it imports the model (:mod:`scenarios.console`). The child imports the
+drawing half (:mod:`scenarios.output.plots`, which imports matplotlib but not the model) and waits. The run
+sends it the figures to draw (file names and series, pickled through a pipe) and the directory
+to write them into. The child draws them there and answers.
+
+The process is used only where forking this early is safe and cheap: Linux, and a parent with one
+thread (a fork copies only the calling thread). The child limits its BLAS to one thread before it
+imports NumPy, so it never has threads either. Everywhere else, and whenever the process fails,
+the caller draws the same figures itself (:func:`scenarios.output.plots.draw_jobs`): the PNGs are the
+same, pixel for pixel.
+"""
+from __future__ import annotations
+
+import atexit
+import functools
+import os
+import pickle
+import signal
+import sys
+import time
+import traceback
+from pathlib import Path
+from typing import Any
+
+SINGLE_THREAD_ENVIRONMENT = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+"""Set to 1 in the child before it imports NumPy: drawing needs no BLAS threads."""
+COST = {"row": 1.0, "other": 1.3}
+"""Relative drawing costs (about 0.1 s each on the reference machine) of one row on its figure,
+whose static part is drawn before the fork (:func:`_draw_in_two`), and of any other figure."""
+STOP_TIMEOUT_S = 5.0
+"""How long :meth:`Renderer.close` lets the plot process stop its fork and exit before killing it [s]."""
+
+
+class RenderingFailed(RuntimeError):
+    """The plot process could not draw the figures (it ended early, or drawing raised)."""
+
+
+def _die_with_parent(signum: int, parent: int) -> None:
+    """Have the kernel send ``signum`` to this (just forked) process when its parent ends, so that
+    a plot process never draws on for a parent that is gone (killed, or ended by a signal it does
+    not handle); exit at once if the parent has already gone. Linux only (``prctl``)."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signum)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # no prctl: the closed pipe still ends an idle plot process
+        pass
+    if os.getppid() != parent:
+        os._exit(1)
+
+
+def _thread_count() -> int:
+    """Threads of this process, as the kernel counts them (native ones included)."""
+    try:
+        return len(os.listdir("/proc/self/task"))
+    except OSError:
+        return 2  # unknown: assume threads, do not fork
+
+
+class Renderer:
+    """The parent's handle on a plot process (module docstring); :meth:`start` creates one.
+
+    Parameters
+    ----------
+    pid : int
+        The child's process id.
+    send_fd, receive_fd : int
+        The parent's ends of the two pipes: to the child, from the child.
+    """
+
+    def __init__(self, pid: int, send_fd: int, receive_fd: int):
+        self.pid = pid
+        self._fds = [send_fd, receive_fd]
+        self._running = True
+
+    @classmethod
+    def start(cls) -> Renderer | None:
+        """Fork the plot process, if this platform and process allow it (module docstring).
+
+        Returns
+        -------
+        Renderer or None
+            The handle; ``None`` where the figures are to be drawn in this process.
+        """
+        if not sys.platform.startswith("linux") or _thread_count() != 1:
+            return None
+        to_child, from_parent = os.pipe()[::-1]  # (write end, read end)
+        from_child, to_parent = os.pipe()
+        parent = os.getpid()
+        pid = os.fork()
+        if pid == 0:  # the child: never returns
+            os.close(to_child)
+            os.close(from_child)
+            _serve(from_parent, to_parent, parent)
+        os.close(from_parent)
+        os.close(to_parent)
+        return cls(pid, to_child, from_child)
+
+    def draw(self, jobs: list[Any], directory: Path) -> None:
+        """Have the child draw ``jobs`` into ``directory`` and wait until it has written them.
+
+        Parameters
+        ----------
+        jobs : list of (str, series)
+            File names and series (:func:`scenarios.output.plot_data.plot_jobs`).
+        directory : pathlib.Path
+            Existing directory to write into (the run's staging directory).
+
+        Raises
+        ------
+        RenderingFailed
+            The child ended early or drawing raised; nothing the child wrote is to be trusted.
+        """
+        if not self._running:
+            raise RenderingFailed("the plot process has already drawn or stopped")
+        send_fd, receive_fd = self._fds
+        try:
+            with os.fdopen(send_fd, "wb", closefd=False) as stream:
+                pickle.dump((str(directory), jobs), stream, protocol=pickle.HIGHEST_PROTOCOL)
+            with os.fdopen(receive_fd, "rb", closefd=False) as stream:
+                status, detail = pickle.load(stream)
+        except (OSError, EOFError, pickle.UnpicklingError) as error:
+            self.close()
+            raise RenderingFailed(f"the plot process ended early ({type(error).__name__})") from None
+        except BaseException:  # Ctrl-C, SIGTERM: both drawers stop before the caller removes `directory`
+            self.close()
+            raise
+        self._close_fds()
+        self._reap()
+        if status != "ok":
+            raise RenderingFailed(f"the plot process failed: {detail.strip().splitlines()[-1]}")
+
+    def _reap(self) -> None:
+        """Wait for the child's exit (it exits once it has answered)."""
+        if self._running:
+            self._running = False
+            os.waitpid(self.pid, 0)
+
+    def _close_fds(self) -> None:
+        for fd in self._fds:
+            os.close(fd)
+        self._fds = []
+
+    def close(self) -> None:
+        """Stop the child if it is still running (the run failed or was interrupted); idempotent.
+
+        The child is asked with SIGTERM, on which it kills and reaps its own fork (:func:`_serve`),
+        so that when this returns neither draws any more; SIGKILL after :data:`STOP_TIMEOUT_S`.
+        """
+        self._close_fds()
+        if not self._running:
+            return
+        try:
+            os.kill(self.pid, signal.SIGTERM)
+        except ProcessLookupError:
+            pass
+        deadline = time.monotonic() + STOP_TIMEOUT_S
+        while os.waitpid(self.pid, os.WNOHANG)[0] == 0:
+            if time.monotonic() > deadline:
+                os.kill(self.pid, signal.SIGKILL)
+                os.waitpid(self.pid, 0)
+                break
+            time.sleep(0.005)
+        self._running = False
+
+
+def split(jobs: list[Any]) -> tuple[list[Any], list[Any]]:
+    """Share figures between two processes so that both finish at about the same time.
+
+    Greedy, largest first: each figure goes where the total cost (:data:`COST`) stays lower. The
+    static parts of the per-row figures are drawn before the fork and shared (:func:`_draw_in_two`),
+    so they are not counted.
+
+    Parameters
+    ----------
+    jobs : list of (str, series)
+        File names and series (:func:`scenarios.output.plot_data.plot_jobs`).
+
+    Returns
+    -------
+    tuple of two lists
+        The two shares, each in the original order.
+    """
+    from scenarios.output.plot_data import RowSeries
+
+    costs = [0.0, 0.0]
+    share = [0] * len(jobs)
+    order = sorted(range(len(jobs)), key=lambda k: isinstance(jobs[k][1], RowSeries))  # others first
+    for k in order:
+        cost = COST["row"] if isinstance(jobs[k][1], RowSeries) else COST["other"]
+        b = 0 if costs[0] <= costs[1] else 1
+        costs[b] += cost
+        share[k] = b
+    return ([job for job, b in zip(jobs, share) if b == 0], [job for job, b in zip(jobs, share) if b == 1])
+
+
+def _draw_in_two(jobs: list[Any], directory: Path, forks: list[int]) -> None:
+    """Draw ``jobs`` in this process and a fork of it (the child of :func:`_serve`, which has one
+    thread; the fork's pid is in ``forks`` while it runs); raise if either fails.
+
+    The static part of each row shape's figure is drawn first (:meth:`RowFigure.prepare` with the
+    first row of that shape), so that the fork inherits it instead of drawing it again.
+    """
+    from scenarios.output.plot_data import RowSeries
+    from scenarios.output.plots import RowFigure, draw_jobs
+
+    figures: dict[tuple[int, bool, bool], RowFigure] = {}
+    for _, series in jobs:
+        if isinstance(series, RowSeries) and series.shape not in figures:
+            figures[series.shape] = RowFigure(*series.shape)
+            figures[series.shape].prepare(series)
+    mine, theirs = split(jobs)
+    if not mine or not theirs or _thread_count() != 1:  # a fork copies only the calling thread
+        draw_jobs(jobs, directory, figures)
+        return
+    stopping = {signal.SIGINT, signal.SIGTERM}
+    parent = os.getpid()
+    signal.pthread_sigmask(signal.SIG_BLOCK, stopping)  # no stop between the fork and `forks` (_stop)
+    pid = os.fork()
+    if pid == 0:
+        code = 1
+        try:
+            for signum in stopping:
+                signal.signal(signum, signal.SIG_DFL)
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
+            _die_with_parent(signal.SIGKILL, parent)
+            draw_jobs(theirs, directory, figures)
+            code = 0
+        finally:
+            os._exit(code)
+    forks.append(pid)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
+    try:
+        draw_jobs(mine, directory, figures)
+    finally:
+        _, status = os.waitpid(pid, 0)
+        forks.remove(pid)
+    if status != 0:
+        raise RuntimeError(f"the second drawing process failed (wait status {status})")
+
+
+def _stop(forks: list[int], signum: int, frame: Any) -> None:
+    """The plot process's Ctrl-C and SIGTERM: kill and reap its running fork (``forks``, kept by
+    :func:`_draw_in_two`), then exit (no traceback; the parent reports the interruption)."""
+    for pid in forks:
+        try:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+        except OSError:
+            pass
+    _exit(1)
+
+
+def _exit(code: int) -> None:
+    """Run the exit handlers registered in the plot process (matplotlib's removal of a temporary
+    cache directory it made where its own is not writable), then exit without running anything
+    inherited from the parent (``os._exit``)."""
+    atexit._run_exitfuncs()
+    os._exit(code)
+
+
+def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
+    """The child: import the drawing half, draw what the parent sends, answer, exit.
+
+    Exits with ``os._exit`` (never returns): nothing of the parent's state inherited by the fork
+    (buffered output, ``atexit`` handlers) runs twice; the exit handlers registered here do run
+    (:func:`_exit`). Ctrl-C and SIGTERM, and the end of the parent (``parent``, its pid), end it
+    and its fork (:func:`_stop`).
+    """
+    code = 1
+    try:
+        atexit._clear()  # the parent's: they run in the parent
+        forks: list[int] = []
+        signal.signal(signal.SIGINT, functools.partial(_stop, forks))
+        signal.signal(signal.SIGTERM, functools.partial(_stop, forks))
+        _die_with_parent(signal.SIGTERM, parent)
+        for name in SINGLE_THREAD_ENVIRONMENT:
+            os.environ[name] = "1"
+        import scenarios.output.plots  # noqa: F401  (matplotlib, while the parent runs)
+
+        with os.fdopen(receive_fd, "rb") as stream:
+            try:
+                directory, jobs = pickle.load(stream)
+            except EOFError:  # the parent ended without plots to draw
+                _exit(0)
+        try:
+            _draw_in_two(jobs, Path(directory), forks)
+            reply: tuple[str, str] = ("ok", "")
+        except Exception:  # reported to the parent, which draws in its own process and raises there
+            reply = ("error", traceback.format_exc())
+        with os.fdopen(send_fd, "wb") as stream:
+            pickle.dump(reply, stream)
+        code = 0
+    except BaseException:  # noqa: BLE001 (the child never lets anything escape into the parent's code)
+        code = 1
+    finally:
+        _exit(code)

@@ -1,0 +1,136 @@
+"""Checks of a parsed scenario as a whole, each reported at the YAML entry it concerns: rows whose
+combined labels clash, a closed-loop window over the work limit, and what planners and controllers
+say they cannot take (``problem_error``, ``environment_error``, ``initial_state_error``, ...)."""
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from controllers import CONTROLLERS
+from ocp.simulation.simulator import SUBSTEPS_PER_SAMPLE
+from planners import PLANNERS, ManeuverProblem
+from scenarios.schema.read import ScenarioError
+
+if TYPE_CHECKING:
+    from scenarios.schema.loader import ControllerSpec, PlannerSpec, SimulationSpec
+
+
+def check_row_labels(planners: list[PlannerSpec], controllers: list[ControllerSpec]) -> None:
+    """Rows are labelled ``"<planner> / <controller>"`` with several controllers: those must differ.
+
+    Parameters
+    ----------
+    planners : list of PlannerSpec
+        The scenario's planner rows.
+    controllers : list of ControllerSpec
+        The scenario's controllers.
+
+    Raises
+    ------
+    ScenarioError
+        At ``<controller path>.label`` when two pairs make the same row label.
+    """
+    if len(controllers) < 2:
+        return
+    seen: dict[str, tuple[int, int]] = {}
+    for i, planner in enumerate(planners):
+        for j, controller in enumerate(controllers):
+            row = f"{planner.label} / {controller.label}"
+            if row in seen:
+                a, b = seen[row]
+                raise ScenarioError(f"{controller.path}.label", f"row label {row!r} is made twice (planners[{a}] with "
+                                                                f"controllers[{b}], planners[{i}] with controllers[{j}]); "
+                                                                "choose labels without ' / '")
+            seen[row] = (i, j)
+
+def check_work(problem: ManeuverProblem, simulation: SimulationSpec) -> None:
+    """Refuse a closed-loop window with more samples than ``simulation.max_samples`` (the run
+    would take too long or exhaust memory); the runner checks again once a planner has chosen
+    its own duration.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre (its ``duration`` [s] is the window unless ``simulation.duration`` is set).
+    simulation : SimulationSpec
+        Sample time [s], window [s], integrator, RK4 step [s] and sample limit.
+
+    Raises
+    ------
+    ScenarioError
+        At ``simulation.duration`` or ``maneuver.duration`` (too many samples) or
+        ``simulation.max_step`` (too many RK4 sub-steps).
+    """
+    window = simulation.duration or problem.duration
+    samples = math.ceil(window / simulation.sample_time - 1e-9)
+    substeps = 1 if simulation.integrator != "rk4" else math.ceil(simulation.sample_time / simulation.max_step - 1e-9)
+    where = "simulation.duration" if simulation.duration else "maneuver.duration"
+    if samples > simulation.max_samples:
+        raise ScenarioError(where, f"{window:g} s at a {simulation.sample_time:g} s sample time is {samples} samples, "
+                                   f"over the limit of {simulation.max_samples}; raise simulation.max_samples "
+                                   "if you mean it, or lengthen simulation.sample_time")
+    if samples * substeps > SUBSTEPS_PER_SAMPLE * simulation.max_samples:
+        raise ScenarioError("simulation.max_step", f"{samples} samples of {substeps} RK4 sub-steps each exceed the "
+                            f"limit of {SUBSTEPS_PER_SAMPLE} x simulation.max_samples = "
+                            f"{SUBSTEPS_PER_SAMPLE * simulation.max_samples} sub-steps; raise max_step or "
+                            "simulation.max_samples")
+
+def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
+                        controllers: list[ControllerSpec] | ControllerSpec,
+                        simulation: SimulationSpec | None = None) -> None:
+    """What each planner and controller say they cannot take, reported at their YAML entries.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre, with its spacecraft and environment.
+    planners : list of PlannerSpec
+        The planner rows (empty: regulation mode).
+    controllers : list of ControllerSpec or ControllerSpec
+        The controllers (one spec is accepted as a list of one).
+    simulation : SimulationSpec or None, optional
+        Closed-loop settings; ``None`` skips the sample-time checks.
+
+    Raises
+    ------
+    ScenarioError
+        At ``planners[i]`` (``problem_error``), ``<controller path>.name`` (environment, planner or
+        reference needed), ``maneuver.<key>`` (initial or final state),
+        ``<controller path>.options.<option>`` (sample time) or ``maneuver.final.q`` (a target
+        attitude needed in regulation mode).
+    """
+    if not isinstance(controllers, list):  # one ControllerSpec
+        controllers = [controllers]
+    for index, spec in enumerate(planners):
+        error = PLANNERS[spec.name](spec.options).problem_error(problem)
+        if error:
+            raise ScenarioError(f"planners[{index}]", error)
+    for controller in controllers:
+        law = CONTROLLERS[controller.name](controller.options)
+        where = f"{controller.path}.name"
+        error = law.environment_error(problem.spacecraft, problem.environment)
+        if error:
+            raise ScenarioError(where, error)
+        momentum0 = problem.wheel_momentum0
+        if momentum0 is None:  # ManeuverProblem fills it in; its field's type still admits None
+            momentum0 = np.zeros(problem.spacecraft.n_wheels)
+        state = law.initial_state_error(problem.spacecraft, problem.omega0, momentum0, problem.omegaf)
+        if state:
+            raise ScenarioError(f"maneuver.{state[0]}", f"{state[1]} ({controller.path} is {controller.name!r})")
+        if simulation is not None:
+            timing = law.sample_time_error(simulation.sample_time)
+            if timing:
+                raise ScenarioError(f"{controller.path}.options.{timing[0]}",
+                                    f"{timing[1]} (simulation.sample_time is {simulation.sample_time:g} s)")
+        if not planners and problem.qf is None and law.needs_target_attitude:
+            raise ScenarioError("maneuver.final.q", f"regulation (no planners) with controller {controller.name!r} "
+                                "needs a target attitude; only laws that need none (e.g. bdot, tdfc, none) "
+                                "accept a free final attitude")
+        if not planners and law.needs_reference:
+            raise ScenarioError(where, f"controller {controller.name} tracks a reference; give planners")
+        for index, spec in enumerate(planners):
+            error = law.planner_error(spec.name, spec.options)
+            if error:
+                raise ScenarioError(where, f"{error} (planners[{index}] is {spec.name!r})")

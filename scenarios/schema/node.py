@@ -1,0 +1,327 @@
+"""YAML values with errors that name the path (``planners[1].options.weight``).
+
+:class:`Node` wraps a parsed value with its path; typed accessors raise :class:`ScenarioError`
+naming the path and what was expected, and :meth:`Node.finish` rejects keys that were never read.
+Reading the file itself (:func:`~scenarios.schema.read.read_yaml`, with its limits) is
+:mod:`scenarios.schema.read`.
+"""
+from __future__ import annotations
+
+from typing import Any, Iterator
+
+import numpy as np
+
+from ocp.errors import excerpt
+from scenarios.schema.read import ScenarioError
+
+__all__ = ["Node"]
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+class Node:
+    """A YAML value with its path; typed accessors raise :class:`ScenarioError` naming the path.
+
+    Parameters
+    ----------
+    value : object
+        The parsed YAML value (mapping, list, number, string, bool or ``None``).
+    path : str, optional
+        Its YAML path (``planners[1].options.weight``); empty for the top level.
+    """
+
+    def __init__(self, value: Any, path: str = ""):
+        self.value = value
+        self.path = path
+        self._read: set[str] = set()
+
+    def error(self, message: str) -> ScenarioError:
+        """An error at this node's path (to raise).
+
+        Parameters
+        ----------
+        message : str
+            What was expected (and what was found).
+
+        Returns
+        -------
+        ScenarioError
+            The error, at ``(top level)`` for the root.
+        """
+        return ScenarioError(self.path or "(top level)", message)
+
+    def _child_path(self, key: str | int) -> str:
+        if isinstance(key, int):
+            return f"{self.path}[{key}]"
+        return f"{self.path}.{key}" if self.path else key
+
+    def mapping(self) -> "Node":
+        """This node, checked to hold a mapping.
+
+        Returns
+        -------
+        Node
+            ``self``.
+
+        Raises
+        ------
+        ScenarioError
+            The value is not a mapping.
+        """
+        if not isinstance(self.value, dict):
+            raise self.error(f"expected a mapping, got {excerpt(self.value)}")
+        return self
+
+    def __contains__(self, key: str) -> bool:
+        return isinstance(self.value, dict) and key in self.value and self.value[key] is not None
+
+    def get(self, key: str, default: Any = ..., required: bool = False) -> "Node":
+        """A child of this mapping, marked as read (see :meth:`finish`).
+
+        Parameters
+        ----------
+        key : str
+            The key.
+        default : object, optional
+            Value of a missing key; not given (``...``): the key is required.
+        required : bool, optional
+            A missing key is an error even with a default.
+
+        Returns
+        -------
+        Node
+            The child (``default`` at the child's path when the key is missing).
+
+        Raises
+        ------
+        ScenarioError
+            This node is not a mapping, or a required key is missing.
+        """
+        self.mapping()
+        self._read.add(key)
+        if key not in self.value:
+            if required or default is ...:
+                raise ScenarioError(self._child_path(key), "required key is missing")
+            return Node(default, self._child_path(key))
+        return Node(self.value[key], self._child_path(key))
+
+    def finish(self) -> None:
+        """Reject keys that were not read."""
+        if isinstance(self.value, dict):
+            for key in self.value:
+                if key not in self._read:
+                    raise ScenarioError(self._child_path(key), f"unknown key; expected one of {sorted(self._read)}")
+
+    def items(self) -> Iterator["Node"]:
+        """The entries of this list, each at its path (``planners[0]``, ...).
+
+        Returns
+        -------
+        iterator of Node
+            One node per entry.
+
+        Raises
+        ------
+        ScenarioError
+            The value is not a list.
+        """
+        if not isinstance(self.value, list):
+            raise self.error(f"expected a list, got {excerpt(self.value)}")
+        return (Node(item, self._child_path(i)) for i, item in enumerate(self.value))
+
+    def is_null(self) -> bool:
+        """Whether the value is ``null`` (or the text ``none``, any case).
+
+        Returns
+        -------
+        bool
+            ``True`` for a missing or null value.
+        """
+        return self.value is None or (isinstance(self.value, str) and self.value.lower() == "none")
+
+    def number(self, positive: bool = False, non_negative: bool = False, maximum: float | None = None) -> float:
+        """The value as a finite number (booleans are not numbers).
+
+        Parameters
+        ----------
+        positive : bool, optional
+            Require ``> 0``.
+        non_negative : bool, optional
+            Require ``>= 0``.
+        maximum : float or None, optional
+            Upper bound (inclusive); ``None``: none.
+
+        Returns
+        -------
+        float
+            The number.
+
+        Raises
+        ------
+        ScenarioError
+            Not a finite number, or outside the bounds.
+        """
+        if not _is_number(self.value) or not np.isfinite(self.value):
+            raise self.error(f"expected a number, got {excerpt(self.value)}")
+        if positive and not self.value > 0:
+            raise self.error(f"expected a positive number, got {excerpt(self.value)}")
+        if non_negative and self.value < 0:
+            raise self.error(f"expected a non-negative number, got {excerpt(self.value)}")
+        if maximum is not None and self.value > maximum:
+            raise self.error(f"expected a number <= {maximum:g}, got {excerpt(self.value)}")
+        return float(self.value)
+
+    def optional_number(self, positive: bool = False, non_negative: bool = False,
+                        maximum: float | None = None) -> float | None:
+        """:meth:`number`, or ``None`` for a null value.
+
+        Parameters
+        ----------
+        positive, non_negative : bool, optional
+            Require ``> 0`` or ``>= 0``.
+        maximum : float or None, optional
+            Upper bound (inclusive); ``None``: none.
+
+        Returns
+        -------
+        float or None
+            The number, or ``None``.
+        """
+        return None if self.is_null() else self.number(positive, non_negative, maximum)
+
+    def integer(self, minimum: int | None = None, maximum: int | None = None) -> int:
+        """The value as an integer (not a float, not a boolean).
+
+        Parameters
+        ----------
+        minimum, maximum : int or None, optional
+            Inclusive bounds; ``None``: none.
+
+        Returns
+        -------
+        int
+            The integer.
+
+        Raises
+        ------
+        ScenarioError
+            Not an integer, or outside ``[minimum, maximum]``.
+        """
+        if not isinstance(self.value, int) or isinstance(self.value, bool):
+            raise self.error(f"expected an integer, got {excerpt(self.value)}")
+        if (minimum is not None and self.value < minimum) or (maximum is not None and self.value > maximum):
+            low = "" if minimum is None else f" >= {minimum}"
+            high = "" if maximum is None else f" <= {maximum}"
+            raise self.error(f"expected an integer{low}{' and' if low and high else ''}{high}, got {excerpt(self.value)}")
+        return self.value
+
+    def boolean(self) -> bool:
+        """The value as ``true`` or ``false``.
+
+        Returns
+        -------
+        bool
+            The value.
+
+        Raises
+        ------
+        ScenarioError
+            Not a boolean.
+        """
+        if not isinstance(self.value, bool):
+            raise self.error(f"expected true or false, got {excerpt(self.value)}")
+        return self.value
+
+    def string(self, choices: tuple[str, ...] | None = None) -> str:
+        """The value as text.
+
+        Parameters
+        ----------
+        choices : tuple of str or None, optional
+            The accepted values; ``None``: any text.
+
+        Returns
+        -------
+        str
+            The text.
+
+        Raises
+        ------
+        ScenarioError
+            Not a string, or not one of ``choices``.
+        """
+        if not isinstance(self.value, str):
+            raise self.error(f"expected a string, got {excerpt(self.value)}")
+        if choices is not None and self.value not in choices:
+            raise self.error(f"expected one of {list(choices)}, got {excerpt(self.value)}")
+        return self.value
+
+    def vector(self, size: int | None = None, allow_scalar: bool = False) -> np.ndarray:
+        """The value as a list of finite numbers.
+
+        Parameters
+        ----------
+        size : int or None, optional
+            Required number of entries; ``None``: any.
+        allow_scalar : bool, optional
+            Accept a single number too (returned as a 0-d array).
+
+        Returns
+        -------
+        (size,) or () ndarray
+            The numbers as floats.
+
+        Raises
+        ------
+        ScenarioError
+            Not a list of numbers, the wrong length, or a non-finite entry.
+        """
+        if allow_scalar and _is_number(self.value):
+            return np.asarray(self.number())
+        if not isinstance(self.value, list) or not all(_is_number(v) for v in self.value):
+            expected = f"a list of {size} numbers" if size else "a list of numbers"
+            raise self.error(f"expected {expected}{' or a number' if allow_scalar else ''}, got {excerpt(self.value)}")
+        if size is not None and len(self.value) != size:
+            raise self.error(f"expected {size} numbers, got {len(self.value)}")
+        array = np.asarray(self.value, dtype=float)
+        if not np.all(np.isfinite(array)):
+            raise self.error("expected finite numbers")
+        return array
+
+    def optional_vector(self, size: int | None = None) -> np.ndarray | None:
+        """:meth:`vector`, or ``None`` for a null value.
+
+        Parameters
+        ----------
+        size : int or None, optional
+            Required number of entries; ``None``: any.
+
+        Returns
+        -------
+        (size,) ndarray or None
+            The numbers, or ``None``.
+        """
+        return None if self.is_null() else self.vector(size)
+
+    def quaternion(self) -> np.ndarray:
+        """The value as a unit quaternion (in the order written; the loader converts scalar-last).
+
+        Returns
+        -------
+        (4,) ndarray
+            The quaternion normalised (its norm must be within 1e-2 of 1).
+
+        Raises
+        ------
+        ScenarioError
+            Not 4 numbers, zero, or a norm farther than 1e-2 from 1.
+        """
+        q = self.vector(4)
+        norm = float(np.linalg.norm(q))
+        if norm == 0.0:
+            raise self.error("a quaternion cannot be zero")
+        if abs(norm - 1.0) > 1e-2:
+            raise self.error(f"a quaternion must have unit norm (got norm {norm:.6g}; tolerance 1e-2)")
+        return q / norm

@@ -1,0 +1,156 @@
+"""Reading scenario and study YAML safely: bounded size, depth and alias expansion, duplicate keys
+refused, dates kept as text, and exponent numbers such as ``6e5`` read as floats (YAML 1.1 reads
+them as strings). Errors are :class:`ScenarioError` naming the YAML path.
+
+:mod:`scenarios.schema.node` re-exports everything here; :class:`~scenarios.schema.node.Node` wraps a
+parsed value with its path.
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from ocp.errors import excerpt
+
+
+class ScenarioError(ValueError):
+    """A scenario file is wrong; ``path`` is where, ``message`` what was expected."""
+
+    def __init__(self, path: str, message: str):
+        super().__init__(f"{path}: {message}" if path else message)
+        self.path = path
+        self.message = message
+
+
+class _Loader(yaml.SafeLoader):
+    """SafeLoader that also reads exponent numbers without a dot or exponent sign (``6e5``),
+    which YAML 1.1 leaves as strings and YAML 1.2 reads as floats."""
+
+
+_Loader.yaml_implicit_resolvers = {key: list(value) for key, value in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+_EXPONENT_FLOAT = re.compile(r"^[-+]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[eE][-+]?[0-9]+$")
+# Dates stay text: the fields that take a date parse it themselves and name their path when it is
+# impossible (2025-02-30), instead of the YAML reader failing on the whole file.
+_Loader.yaml_implicit_resolvers = {key: [(tag, regexp) for tag, regexp in value if tag != "tag:yaml.org,2002:timestamp"]
+                                   for key, value in _Loader.yaml_implicit_resolvers.items()}
+for _first in "-+0123456789.":
+    _Loader.yaml_implicit_resolvers.setdefault(_first, []).insert(0, ("tag:yaml.org,2002:float", _EXPONENT_FLOAT))
+
+
+MAX_FILE_BYTES = 2 * 1024 * 1024
+"""Largest scenario or study file read (bytes); real files are a few kilobytes."""
+MAX_DEPTH = 32
+"""Deepest nesting of mappings and lists (scenarios nest about six levels)."""
+MAX_NODES = 100_000
+"""Most YAML values a file may hold once aliases are counted at every use (alias bombs)."""
+
+
+def _short(path: str, limit: int = 80) -> str:
+    """A YAML path cut to ``limit`` characters for a message."""
+    return path if len(path) <= limit else f"{path[:limit - 3]}..."
+
+
+def _check_tree(root: yaml.Node, source: Path | str) -> None:
+    """Reject duplicate keys (naming both lines and the YAML path), nesting deeper than
+    :data:`MAX_DEPTH` (a recursive alias nests forever) and alias expansion beyond
+    :data:`MAX_NODES`, walking the composed node graph without building Python objects."""
+    count = 0
+    stack: list[tuple[yaml.Node, str, int]] = [(root, "", 0)]
+    while stack:
+        node, path, depth = stack.pop()
+        count += 1
+        if depth > MAX_DEPTH:
+            raise ScenarioError(_short(path), f"{source} nests deeper than {MAX_DEPTH} levels; "
+                                                   "is an alias used inside itself?")
+        if count > MAX_NODES:
+            raise ScenarioError(_short(path) or "(top level)", f"{source} expands to more than {MAX_NODES} values "
+                                                                    "(aliases count at every use); is it an alias bomb?")
+        if isinstance(node, yaml.MappingNode):
+            seen: dict[Any, yaml.Node] = {}
+            for key_node, value_node in node.value:
+                key = key_node.value if isinstance(key_node, yaml.ScalarNode) else id(key_node)
+                child = f"{path}.{key}" if path else str(key)
+                if key in seen:
+                    first = seen[key].start_mark.line + 1
+                    raise ScenarioError(child, f"duplicate key (lines {first} and {key_node.start_mark.line + 1}); "
+                                               "each key may appear once")
+                seen[key] = key_node
+                stack.append((value_node, child, depth + 1))
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend((item, f"{path}[{index}]", depth + 1) for index, item in enumerate(node.value))
+
+
+def parse_yaml_text(text: str, source: Path | str = "<text>") -> Any:
+    """Parse YAML text with slewbench's checks (see :func:`read_yaml`).
+
+    Parameters
+    ----------
+    text : str
+        The YAML document.
+    source : Path or str, optional
+        Where the text comes from, named in error messages.
+
+    Returns
+    -------
+    object
+        The parsed data (mappings, lists, numbers, strings; dates stay strings), ``None`` for an
+        empty document.
+
+    Raises
+    ------
+    ScenarioError
+        Text that is not YAML, a value YAML cannot build, a duplicate key, nesting deeper than
+        :data:`MAX_DEPTH` or alias expansion beyond :data:`MAX_NODES` values.
+    """
+    try:
+        root = yaml.compose(text, Loader=_Loader)
+        if root is None:
+            return None
+        _check_tree(root, source)
+        return yaml.load(text, Loader=_Loader)
+    except ScenarioError:
+        raise
+    except (ValueError, TypeError, OverflowError) as error:  # a value YAML recognised but cannot build
+        raise ScenarioError("", f"{source}: a value cannot be read: {excerpt(str(error), 200)}") from None
+    except yaml.YAMLError as error:
+        where = getattr(error, "problem_mark", None)
+        line = f" (line {where.line + 1}, column {where.column + 1})" if where else ""
+        problem = getattr(error, "problem", None) or error
+        raise ScenarioError("", f"{source} is not valid YAML{line}: {excerpt(str(problem), 200)}") from None
+    except RecursionError:
+        raise ScenarioError("", f"{source} nests too deeply") from None
+
+
+def read_yaml(path: str | Path) -> Any:
+    """Parse a YAML file.
+
+    Numbers such as ``6e5`` are read as numbers; a missing or unreadable file, a file larger than
+    :data:`MAX_FILE_BYTES`, text that is not YAML, a duplicate key, or alias expansion beyond
+    :data:`MAX_NODES` values is a :class:`ScenarioError`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The YAML file.
+
+    Returns
+    -------
+    object
+        The parsed data (mappings, lists, numbers, strings).
+    """
+    path = Path(path)
+    try:
+        with path.open("rb") as stream:  # read at most the limit: /dev/zero or a pipe reports no size
+            data = stream.read(MAX_FILE_BYTES + 1)
+        if len(data) > MAX_FILE_BYTES:
+            raise ScenarioError("", f"{path} has more than {MAX_FILE_BYTES} bytes; scenario and study files are "
+                                    "limited to that")
+        text = data.decode("utf-8")
+    except FileNotFoundError:
+        raise ScenarioError("", f"scenario file not found: {path}") from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise ScenarioError("", f"cannot read {path}: {error}") from None
+    return parse_yaml_text(text, path)

@@ -1,0 +1,30 @@
+"""Trade studies: a scenario swept over grids, zips and Monte Carlo dispersions, run crash-safely.
+
+What lives here: the study's data (:mod:`~scenarios.study.types`), scenario paths as a study spells
+them (:mod:`~scenarios.study.paths`), dispersions (:mod:`~scenarios.study.dispersions`), the study
+schema and its cases (:mod:`~scenarios.study.spec`), the crash-safe store
+(:mod:`~scenarios.study.store`), what a worker runs (:mod:`~scenarios.study.worker`), the engine on a
+local pool or Dask (:mod:`~scenarios.study.engine`), and the report's tables
+(:mod:`~scenarios.study.report`) and figures (:mod:`~scenarios.study.plots`).
+
+May import: :mod:`ocp`, :mod:`scenarios.errors`, :mod:`scenarios.schema`, :mod:`scenarios.output`
+and :mod:`scenarios.runner`. Its names are imported on first use.
+"""
+from __future__ import annotations
+
+from scenarios._faces import lazy_face
+
+_HOMES = {"Case": "scenarios.study.types",
+          "Dispersion": "scenarios.study.dispersions",
+          "Execution": "scenarios.study.types",
+          "Study": "scenarios.study.types",
+          "SweepInterrupted": "scenarios.study.engine",
+          "SweepResults": "scenarios.study.engine",
+          "SweepStore": "scenarios.study.store",
+          "load_study": "scenarios.study.spec",
+          "parse_study": "scenarios.study.spec",
+          "sweep": "scenarios.study.engine"}
+
+__all__ = ["Case", "Dispersion", "Execution", "Study", "SweepInterrupted", "SweepResults", "SweepStore", "load_study", "parse_study", "sweep"]
+
+__getattr__, __dir__ = lazy_face(__name__, _HOMES)

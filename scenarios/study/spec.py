@@ -1,0 +1,326 @@
+"""Trade-study files (ARCHITECTURE.md, "Trade studies"): schema, value generators and the
+expansion of a study into resolved cases, each validated by the scenario loader.
+
+A study varies a base scenario over a ``grid`` (cartesian product), a ``zip`` (equal-length lists
+varied together) and, per grid point, ``monte_carlo`` samples of ``dispersions``. Every case gets a
+seed from ``numpy.random.SeedSequence(seed).spawn``, so its values (and its result) do not depend
+on the number of workers or the order in which cases finish. The study's data classes are in
+:mod:`scenarios.study.types` (imported here too).
+"""
+from __future__ import annotations
+
+import copy
+import itertools
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ocp import METRIC_KEYS, quat
+from scenarios.schema.loader import parse_scenario
+from scenarios.schema.node import Node
+from scenarios.schema.read import ScenarioError, read_yaml
+from scenarios.study.dispersions import Dispersion, draw_unit, parse_dispersion
+from scenarios.study.paths import Step, get_path, parse_path, set_path
+from scenarios.study.types import Case, Execution, Study, case_key, package_version
+
+MAX_CASES = 100_000
+MAX_VALUES = 10_000
+DEFAULT_SUMMARY = tuple(f"{scope}.{key}" for scope in ("ref", "cl") for key in METRIC_KEYS
+                        if key not in ("plan_time_s", "int_abs_u"))  # every scalar metric
+
+
+def _tree_copy(value: Any) -> Any:
+    """A copy of YAML data (nested dicts and lists; leaves are immutable)."""
+    if isinstance(value, dict):
+        return {k: _tree_copy(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_tree_copy(v) for v in value]
+    return value
+
+
+def _plain(value: Any) -> Any:
+    """YAML/JSON-safe Python value (numpy scalars and arrays to floats and lists)."""
+    if isinstance(value, np.ndarray):
+        return [_plain(v) for v in value.tolist()]
+    if isinstance(value, (np.floating, np.integer)):
+        return value.item()
+    if isinstance(value, list):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _values(node: Node, path: str, base: dict[str, Any]) -> tuple[list[Any], list[Any]]:
+    """(values set in the scenario, values recorded in the table) of one grid or zip entry."""
+    spec = node.value
+    if isinstance(spec, list):
+        if not spec or len(spec) > MAX_VALUES:
+            raise node.error(f"expected a list of 1 to {MAX_VALUES} values")
+        return list(spec), [v if not isinstance(v, (list, dict)) else json.dumps(v) for v in spec]
+    if not isinstance(spec, dict) or len(spec) != 1:
+        raise node.error(f"expected a list of values or one of linspace, geomspace, axis_angle; got {spec!r:.80}")
+    (kind, _), = spec.items()
+    if kind in ("linspace", "geomspace"):
+        start, stop, count = node.get(kind).vector(3)
+        if count != int(count) or not 1 <= count <= MAX_VALUES:
+            raise ScenarioError(f"{node.path}.{kind}[2]", f"expected a count from 1 to {MAX_VALUES}, got {count}")
+        if kind == "geomspace" and (start <= 0 or stop <= 0):
+            raise ScenarioError(f"{node.path}.{kind}", "geomspace needs positive bounds")
+        values = [float(v) for v in getattr(np, kind)(start, stop, int(count))]
+        return values, values
+    if kind == "axis_angle":
+        spec_node = node.get(kind).mapping()
+        axis = spec_node.get("axis", required=True).vector(3)
+        if not np.linalg.norm(axis) > 0:
+            raise ScenarioError(f"{spec_node.path}.axis", "the rotation axis cannot be zero")
+        angles = spec_node.get("angle_deg", required=True)
+        angles_deg = angles.vector() if isinstance(angles.value, list) else _values(angles, path, base)[0]
+        spec_node.finish()
+        scalar_last = base.get("maneuver", {}).get("quaternion_order") == "scalar_last"
+        quaternions = []
+        for angle in angles_deg:
+            q = quat.from_axis_angle(axis / np.linalg.norm(axis), np.deg2rad(float(angle)))
+            quaternions.append(_plain(quat.to_scalar_last(q) if scalar_last else q))
+        return quaternions, [float(a) for a in angles_deg]
+    raise node.error(f"unknown value generator {kind!r}; expected linspace, geomspace or axis_angle")
+
+
+def _varied(entry: Node, path: str, base: dict[str, Any], paths: list[str],
+            steps: list[list[Step]]) -> tuple[list, list]:
+    """Check that ``path`` reaches ``base``, record it in ``paths``/``steps``, and return its
+    values (set into the scenario, recorded in the tables)."""
+    paths.append(path)
+    steps.append(parse_path(path, entry.path))
+    get_parent_ok(base, steps[-1], entry.path)
+    return _values(entry, path, base)
+
+
+def _grid_points(root: Node, base: dict[str, Any]) -> tuple[list[str], list[list[Step]], list[tuple[list, list]]]:
+    """Varied paths, their parsed steps and the points (values set, values recorded)."""
+    paths: list[str] = []
+    steps: list[list[Step]] = []
+    axes: list[list[list[tuple[Any, Any]]]] = []
+    grid = root.get("grid", {})
+    grid = Node({}, "grid") if grid.is_null() else grid.mapping()
+    for path in grid.value:
+        entry = grid.get(path)
+        values, recorded = _varied(entry, path, base, paths, steps)
+        axes.append([[pair] for pair in zip(values, recorded)])
+    zipped = root.get("zip", {})
+    zipped = Node({}, "zip") if zipped.is_null() else zipped.mapping()
+    columns, length = [], None
+    for path in zipped.value:
+        entry = zipped.get(path)
+        values, recorded = _varied(entry, path, base, paths, steps)
+        if length is not None and len(values) != length:
+            raise entry.error(f"zip lists must have equal lengths: {len(values)} values here, {length} before")
+        length = len(values)
+        columns.append(list(zip(values, recorded)))
+    if columns:
+        axes.append([list(row) for row in zip(*columns)])
+    points = []
+    for combination in itertools.product(*axes):
+        flat = [pair for part in combination for pair in part]
+        points.append(([v for v, _ in flat], [r for _, r in flat]))
+    return paths, steps, points
+
+
+def get_parent_ok(base: dict[str, Any], steps: list[Step], where: str) -> None:
+    """Check on the base scenario that ``steps`` can be set (reaches existing lists and labels).
+
+    Parameters
+    ----------
+    base : dict
+        The base scenario mapping (not changed: a copy is written).
+    steps : list of Step
+        The parsed scenario path (:func:`scenarios.study.paths.parse_path`).
+    where : str
+        The study entry, for error messages.
+
+    Raises
+    ------
+    ScenarioError
+        The path does not reach the base scenario.
+    """
+    set_path(copy.deepcopy(base), steps, None, where)
+
+
+def _execution(node: Node) -> Execution:
+    node = Node({}, node.path) if node.is_null() else node.mapping()
+    workers = node.get("workers", "auto")
+    execution = Execution(
+        workers=None if workers.value == "auto" or workers.is_null() else workers.integer(),
+        scheduler=node.get("scheduler", None).value,
+        case_timeout_s=node.get("case_timeout_s", 600.0).number(positive=True),
+        retries=node.get("retries", 1).integer(),
+    )
+    if execution.workers is not None and not 1 <= execution.workers <= 1024:
+        raise ScenarioError(f"{node.path}.workers", f"expected auto or 1 to 1024, got {execution.workers}")
+    if not 0 <= execution.retries <= 10:
+        raise ScenarioError(f"{node.path}.retries", f"expected 0 to 10, got {execution.retries}")
+    if execution.scheduler is not None and not isinstance(execution.scheduler, str):
+        raise ScenarioError(f"{node.path}.scheduler", f"expected an address such as tcp://host:8786, got {execution.scheduler!r}")
+    node.finish()
+    return execution
+
+
+def parse_study(data: Any, source: Path | None = None, version: str | None = None) -> Study:
+    """Parse a study (YAML data), expand its cases and validate every one with the scenario loader.
+
+    Parameters
+    ----------
+    data : Any
+        The study mapping (``study``, ``scenario``, ``grid``, ``zip``, ``monte_carlo``,
+        ``summary``, ``execution``).
+    source : Path or None, optional
+        The study file; a ``scenario`` path is relative to its folder (None: the working
+        directory).
+    version : str or None, optional
+        The package version in the case keys (None: this one's; a stored study's when its
+        report is redrawn).
+
+    Returns
+    -------
+    Study
+        With ``cases`` in order: grid points (the last grid key varies fastest, then the zip),
+        then the Monte Carlo samples of each point.
+    """
+    root = Node(data).mapping()
+    name = root.get("study", required=True).string()
+    scenario_node = root.get("scenario", required=True)
+    if isinstance(scenario_node.value, str):
+        folder = source.parent if source else Path.cwd()
+        try:
+            base = read_yaml(folder / scenario_node.value)
+        except ScenarioError as error:
+            raise ScenarioError("scenario", error.message) from None
+    else:
+        base = copy.deepcopy(scenario_node.mapping().value)
+    if not isinstance(base, dict):
+        raise ScenarioError("scenario", "the base scenario is not a mapping")
+    try:
+        parse_scenario(copy.deepcopy(base))
+    except ScenarioError as error:
+        raise ScenarioError(f"scenario: {error.path}", error.message) from None
+    paths, steps, points = _grid_points(root, base)
+    mc = root.get("monte_carlo", None)
+    dispersions: list[tuple[str, list[Step], Dispersion]] = []
+    samples, method, seed = 1, None, 0
+    if not mc.is_null():
+        mc.mapping()
+        samples = mc.get("samples", required=True).integer()
+        if not 1 <= samples <= MAX_CASES:
+            raise ScenarioError("monte_carlo.samples", f"expected 1 to {MAX_CASES}, got {samples}")
+        method = mc.get("method", "random").string(("random", "latin_hypercube"))
+        seed = mc.get("seed", 0).integer()
+        if seed < 0:
+            raise ScenarioError("monte_carlo.seed", f"expected a non-negative integer, got {seed}")
+        disp_node = mc.get("dispersions", required=True).mapping()
+        for path in disp_node.value:
+            entry = disp_node.get(path)
+            path_steps = parse_path(path, entry.path)
+            if path in paths:
+                raise entry.error("this path is also in grid or zip; vary it in one place")
+            get_parent_ok(base, path_steps, entry.path)
+            dispersions.append((path, path_steps, parse_dispersion(entry, base, path_steps)))
+        mc.finish()
+    total = len(points) * samples
+    if total > MAX_CASES:
+        raise ScenarioError("grid", f"the study has {total} cases; at most {MAX_CASES} are accepted")
+    summary_node = root.get("summary", None)
+    summary = list(DEFAULT_SUMMARY) if summary_node.is_null() else [
+        item.string() for item in summary_node.items()]
+    _check_summary(summary)
+    execution = _execution(root.get("execution", {}))
+    root.get("resolved", None)  # written into study.yaml for the record (version, case seeds)
+    root.finish()
+    study = Study(name, source, base, paths, [p for p, _, _ in dispersions], samples, method, seed,
+                  summary, execution, raw=copy.deepcopy(data))
+    study.cases = _expand(study, steps, points, dispersions, version or package_version())
+    return study
+
+
+def _check_summary(summary: list[str]) -> None:
+    for index, metric in enumerate(summary):
+        scope, _, key = metric.partition(".")
+        base_key = key[:-2] if key[-2:] in ("_x", "_y", "_z") else key
+        if scope not in ("ref", "cl") or base_key not in METRIC_KEYS:
+            raise ScenarioError(f"summary[{index}]", f"expected ref.<metric> or cl.<metric> with a metric of "
+                                                     f"{list(METRIC_KEYS)}, got {metric!r}")
+
+
+def _expand(study: Study, steps: list[list[Step]], points: list[tuple[list, list]],
+            dispersions: list[tuple[str, list[Step], Dispersion]], version: str) -> list[Case]:
+    n_cases = len(points) * study.samples
+    children = np.random.SeedSequence(study.seed).spawn(n_cases + len(points))
+    dims = sum(d.dimension for _, _, d in dispersions)
+    cases = []
+    for point, (values, recorded) in enumerate(points):
+        design = None
+        if dispersions and study.method == "latin_hypercube":
+            design = draw_unit(study.method, dims, study.samples, np.random.default_rng(children[n_cases + point]))
+        for sample in range(study.samples):
+            index = point * study.samples + sample
+            seed = int(children[index].generate_state(1)[0])
+            data = _tree_copy(study.base)
+            varied: dict[str, Any] = {}
+            for path, path_steps, value, shown in zip(study.grid_paths, steps, values, recorded):
+                set_path(data, path_steps, _tree_copy(value), path)
+                varied[path] = shown
+            if dispersions:
+                unit = design[sample] if design is not None else \
+                    draw_unit("random", dims, 1, np.random.default_rng(children[index]))[0]
+                column = 0
+                for path, path_steps, dispersion in dispersions:
+                    u = unit[column:column + dispersion.dimension]
+                    column += dispersion.dimension
+                    value = _plain(dispersion.value(u, seed, get_path(study.base, path_steps, path)
+                                                    if dispersion.needs_base else None))
+                    set_path(data, path_steps, value, path)
+                    varied[path] = value if not isinstance(value, list) else json.dumps(value)
+            case = Case(index, seed, point, varied, data)
+            _validate(study, case)
+            case.key = case_key(data, version)
+            cases.append(case)
+    return cases
+
+
+def _validate(study: Study, case: Case) -> None:
+    """The scenario loader's verdict on a case, naming the study, the case and the study entry."""
+    try:
+        parse_scenario(case.scenario)  # the loader only reads its data
+    except ScenarioError as error:
+        entries = [p for p in case.varied if error.path.startswith(p) or p.startswith(error.path)]
+        varied = ", ".join(f"{p}={json.dumps(v)[:40]}" for p, v in case.varied.items())
+        culprit = f" (set by {', '.join(entries)})" if entries else ""
+        raise ScenarioError(f"case {case.index} [{varied}]: {error.path}{culprit}", error.message) from None
+
+
+def load_study(path: str | os.PathLike[str]) -> Study:
+    """Read, expand and validate a study file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The study YAML file.
+
+    Returns
+    -------
+    Study
+        As :func:`parse_study`.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the study file, the case and the path, for a missing file, a bad entry or a case
+        the scenario loader rejects.
+    """
+    path = Path(path)
+    try:
+        return parse_study(read_yaml(path), path)
+    except ScenarioError as error:
+        if error.message.startswith(f"scenario file not found: {path}"):
+            raise ScenarioError("", f"study file not found: {path}") from None
+        raise ScenarioError(f"{path}: {error.path}" if error.path else str(path), error.message) from None

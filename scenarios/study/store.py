@@ -1,0 +1,179 @@
+"""The crash-safe store of a trade study: SQLite in WAL mode in the output directory.
+
+Every finished case is one row, committed at once, keyed by the hash of its resolved scenario and
+the package version (:func:`scenarios.study.types.case_key`). A process killed at any moment leaves
+every committed case readable and no half-written one, so ``--resume`` re-runs only what is
+missing, and a case stored twice (a retry that raced a resume) replaces itself, never duplicates.
+"""
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import sqlite3
+import time
+from pathlib import Path
+from typing import Any
+
+STORE_NAME = "sweep.sqlite"
+FORMAT = "slewbench-sweep-1"
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (name TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS cases (
+    key TEXT PRIMARY KEY,
+    status TEXT NOT NULL,
+    rows TEXT NOT NULL,
+    elapsed_s REAL,
+    attempts INTEGER NOT NULL,
+    finished_at REAL NOT NULL
+);
+"""
+
+
+def _json_safe(value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(v) for v in value]
+    return value
+
+
+def is_sweep_store(directory: str | Path) -> bool:
+    """Whether ``directory/sweep.sqlite`` is a slewbench store (read only: the file is not changed).
+
+    Parameters
+    ----------
+    directory : str or Path
+        The output directory that may hold the store.
+
+    Returns
+    -------
+    bool
+        True if the file exists, is an SQLite database and carries slewbench's format tag.
+    """
+    path = Path(directory) / STORE_NAME
+    try:
+        with contextlib.closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=30.0)) as db:
+            found = db.execute("SELECT value FROM meta WHERE name = 'format'").fetchone()
+    except sqlite3.Error:
+        return False
+    return found is not None and json.loads(found[0]) == FORMAT
+
+
+class SweepStore:
+    """Finished cases of a study in ``directory/sweep.sqlite``.
+
+    Parameters
+    ----------
+    directory : str or Path
+        The study's output directory (must exist).
+    create : bool, optional
+        Create the database if it does not exist (else an absent store is an error).
+
+    Raises
+    ------
+    FileNotFoundError
+        ``create`` is false and there is no store.
+    ValueError
+        The file is an SQLite database of another format.
+    """
+
+    def __init__(self, directory: str | Path, create: bool = True) -> None:
+        self.path = Path(directory) / STORE_NAME
+        if not create and not self.path.is_file():
+            raise FileNotFoundError(self.path)
+        self._db = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
+        self._db.execute("PRAGMA journal_mode=WAL")
+        self._db.execute("PRAGMA synchronous=NORMAL")  # durable against a killed process
+        self._db.executescript(_SCHEMA)
+        stored = self.get_meta("format")
+        if stored is None:
+            self.set_meta("format", FORMAT)
+        elif stored != FORMAT:
+            raise ValueError(f"{self.path} holds {stored!r}, not a {FORMAT!r} store")
+
+    def close(self) -> None:
+        """Close the connection (committed cases are already on disk)."""
+        self._db.close()
+
+    def __enter__(self) -> "SweepStore":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def set_meta(self, name: str, value: Any) -> None:
+        """Store a JSON value under ``name`` (the resolved study, the version).
+
+        Parameters
+        ----------
+        name : str
+            The entry's name (``study``, ``version``, ``format``).
+        value : Any
+            JSON-serialisable data; non-finite floats are stored as null.
+        """
+        self._db.execute("INSERT OR REPLACE INTO meta VALUES (?, ?)", (name, json.dumps(_json_safe(value))))
+
+    def get_meta(self, name: str) -> Any:
+        """The JSON value stored under ``name``.
+
+        Parameters
+        ----------
+        name : str
+            The entry's name.
+
+        Returns
+        -------
+        Any
+            The stored value, or None if there is no such entry.
+        """
+        found = self._db.execute("SELECT value FROM meta WHERE name = ?", (name,)).fetchone()
+        return None if found is None else json.loads(found[0])
+
+    def put(self, key: str, status: str, rows: list[dict[str, Any]], elapsed_s: float | None,
+            attempts: int) -> None:
+        """Commit one finished case at once (one transaction); a stored key is replaced.
+
+        Parameters
+        ----------
+        key : str
+            The case key (:func:`scenarios.study.types.case_key`).
+        status : str
+            ``ok`` (the runner finished) or ``crashed``.
+        rows : list of dict
+            The case's rows, plain dicts, one per planner and controller; non-finite floats are
+            stored as null.
+        elapsed_s : float or None
+            Wall time of the case in its worker [s]; None when the driver gave up on it.
+        attempts : int
+            How many times the case was started.
+        """
+        self._db.execute("INSERT OR REPLACE INTO cases VALUES (?, ?, ?, ?, ?, ?)",
+                         (key, status, json.dumps(_json_safe(rows)), elapsed_s, attempts, time.time()))
+
+    def keys(self) -> set[str]:
+        """The keys of the stored cases.
+
+        Returns
+        -------
+        set of str
+        """
+        return {key for (key,) in self._db.execute("SELECT key FROM cases")}
+
+    def records(self) -> dict[str, dict[str, Any]]:
+        """Every stored case.
+
+        Returns
+        -------
+        dict
+            Case key -> ``{"status", "rows", "elapsed_s", "attempts"}`` as given to :meth:`put`.
+        """
+        return {key: {"status": status, "rows": json.loads(rows), "elapsed_s": elapsed, "attempts": attempts}
+                for key, status, rows, elapsed, attempts
+                in self._db.execute("SELECT key, status, rows, elapsed_s, attempts FROM cases")}
+
+    def __len__(self) -> int:
+        return int(self._db.execute("SELECT COUNT(*) FROM cases").fetchone()[0])

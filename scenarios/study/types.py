@@ -1,0 +1,157 @@
+"""The data of a trade study (ARCHITECTURE.md, "Trade studies"): how its cases run
+(:class:`Execution`), one resolved case (:class:`Case`), the expanded study (:class:`Study`), and
+the store key of a case (:func:`case_key`, with :func:`package_version`). :mod:`scenarios.study.spec`
+builds them from a study file.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+
+@dataclass
+class Execution:
+    """How cases run (the study's ``execution`` mapping).
+
+    Parameters
+    ----------
+    workers : int or None
+        Cases run at once on the local process pool (1 to 1024); None (``auto``): one per core.
+    scheduler : str or None
+        Address of a Dask scheduler (``tcp://host:port``); None: the local process pool.
+    case_timeout_s : float
+        Wall time after which a case is stopped and becomes a ``crashed`` row [s].
+    retries : int
+        How many times a case whose worker died is run again (0 to 10).
+    """
+
+    workers: int | None = None
+    scheduler: str | None = None
+    case_timeout_s: float = 600.0
+    retries: int = 1
+
+
+@dataclass
+class Case:
+    """One resolved case.
+
+    Parameters
+    ----------
+    index : int
+        The case's number, from 0, in the study's order.
+    seed : int
+        The case's seed, from ``numpy.random.SeedSequence(seed).spawn`` (``case_seed``).
+    point : int
+        The grid point (from 0) the case belongs to; Monte Carlo samples share it.
+    varied : dict
+        Scenario path -> the value recorded in the tables (a number, a string, or JSON text for
+        lists; the rotation angle [deg] for ``axis_angle`` quaternions).
+    scenario : dict
+        The resolved scenario mapping (plain YAML data), as a worker receives it.
+    key : str
+        The store key (:func:`case_key`); empty until the study is expanded.
+    """
+
+    index: int
+    seed: int
+    point: int
+    varied: dict[str, Any]
+    scenario: dict[str, Any]
+    key: str = ""
+
+
+@dataclass
+class Study:
+    """A parsed study with its cases expanded and validated (:func:`scenarios.study.spec.parse_study`).
+
+    Parameters
+    ----------
+    name : str
+        The study's name (``study:``).
+    source : Path or None
+        The study file; None for a mapping given in code.
+    base : dict
+        The base scenario mapping (plain YAML data).
+    grid_paths : list of str
+        The scenario paths varied by ``grid`` then ``zip``, in order.
+    mc_paths : list of str
+        The scenario paths dispersed by ``monte_carlo``.
+    samples : int
+        Monte Carlo samples per grid point (1 without ``monte_carlo``).
+    method : str or None
+        ``random`` or ``latin_hypercube``; None without ``monte_carlo``.
+    seed : int
+        The study's seed (``monte_carlo.seed``; 0 without it).
+    summary : list of str
+        The metrics summarised (``ref.<metric>``, ``cl.<metric>``).
+    execution : Execution
+        How the cases run.
+    cases : list of Case
+        The expanded cases, in order.
+    raw : dict
+        The study mapping as given (for ``study.yaml``).
+    """
+
+    name: str
+    source: Path | None
+    base: dict[str, Any]
+    grid_paths: list[str]
+    mc_paths: list[str]
+    samples: int
+    method: str | None
+    seed: int
+    summary: list[str]
+    execution: Execution
+    cases: list[Case] = field(default_factory=list)
+    raw: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def varied_paths(self) -> list[str]:
+        """Every varied scenario path: the grid's and zip's, then the Monte Carlo dispersions'."""
+        return self.grid_paths + self.mc_paths
+
+
+def package_version() -> str:
+    """slewbench's version: the installed distribution's, else pyproject.toml's.
+
+    Returns
+    -------
+    str
+        The version, for example ``0.1.0``.
+    """
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("slewbench")
+    except PackageNotFoundError:  # not installed: running from a checkout
+        text = (Path(__file__).resolve().parents[2] / "pyproject.toml").read_text()
+        if sys.version_info >= (3, 11):
+            import tomllib
+            return str(tomllib.loads(text)["project"]["version"])
+        found = re.search(r'^version\s*=\s*"([^"]+)"', text, re.MULTILINE)  # Python 3.10: no tomllib
+        if found is None:
+            raise RuntimeError("no project version in pyproject.toml") from None
+        return found.group(1)
+
+
+def case_key(scenario: dict[str, Any], version: str) -> str:
+    """Store key: a hash of the resolved case (canonical JSON) and the package version.
+
+    Parameters
+    ----------
+    scenario : dict
+        The resolved scenario mapping (plain YAML data).
+    version : str
+        slewbench's version (:func:`package_version`).
+
+    Returns
+    -------
+    str
+        32 hexadecimal digits of the SHA-256 of both.
+    """
+    text = json.dumps({"scenario": scenario, "version": version}, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:32]

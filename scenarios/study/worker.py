@@ -1,0 +1,186 @@
+"""What a trade-study worker runs: one resolved case in, plain rows out.
+
+A worker receives plain data (the case's scenario mapping, parsed here with
+:func:`scenarios.parse_scenario`), never CasADi objects, and returns a dict of plain values. Each
+worker process keeps one :class:`ocp.SolverCache` for its whole life, so a collocation NLP is
+built once per worker and structure; a process-wide lock runs one case at a time per process
+(IPOPT's linear solvers are not thread-safe), so a Dask worker should be started with
+``--nthreads 1`` and as many processes as cores.
+"""
+from __future__ import annotations
+
+import functools
+import os
+import signal
+import socket
+import threading
+import time
+import traceback
+from typing import Any, Callable, Hashable, TypeVar
+
+from ocp import SolverCache
+
+V = TypeVar("V")
+
+PRELOAD = ("scenarios.study.worker", "scenarios.runner", "scipy.integrate", "scipy.optimize", "scipy.special")
+"""Modules imported once by the process that local workers fork from: the workbench, and the SciPy
+modules that planners import lazily on their first case (about 0.6 s that every fresh worker would
+otherwise pay; with 40 cases of 0.13 s that alone was a 12 % overhead)."""
+
+
+class CaseTimeout(Exception):
+    """Raised inside a worker when a case exceeds its time limit."""
+
+
+class RecentCache(SolverCache):
+    """A :class:`~ocp.SolverCache` that keeps only its most recently used entries.
+
+    A worker keeps its simulators in one: a simulator (with its closed-loop functions) serves
+    every case of the same model and simulation settings, and a study that varies the model
+    (dispersed inertia) does not pile them up.
+
+    Parameters
+    ----------
+    size : int, optional
+        Entries kept (at least 1).
+    """
+
+    def __init__(self, size: int = 4) -> None:
+        super().__init__()
+        self.size = max(1, int(size))
+
+    def get(self, key: Hashable, build: Callable[[], V]) -> V:
+        value = super().get(key, build)
+        self._entries[key] = self._entries.pop(key)  # the most recent last
+        while len(self._entries) > self.size:
+            del self._entries[next(iter(self._entries))]
+        return value
+
+
+@functools.cache
+def worker_state() -> tuple[SolverCache, RecentCache, threading.Lock]:
+    """This process's caches and case lock (created on first use, kept for its life).
+
+    Returns
+    -------
+    cache : SolverCache
+        The planners' builds (NLPs), kept across cases.
+    simulators : RecentCache
+        The last simulators built (:func:`scenarios.runner.run`'s ``simulators``).
+    lock : threading.Lock
+        Held while a case runs, so that a process runs one case at a time.
+    """
+    return SolverCache(), RecentCache(), threading.Lock()
+
+
+def _controllers(scenario: dict[str, Any]) -> list[tuple[str, str]]:
+    """(label, name) of the scenario mapping's controllers (``controllers:`` list or ``controller:``)."""
+    entries = scenario.get("controllers") or [scenario.get("controller") or {}]
+    return [(str(c.get("label", c.get("name"))), str(c.get("name"))) for c in entries]
+
+
+def row_labels(scenario: dict[str, Any]) -> list[tuple[str, str | None, str]]:
+    """The rows the runner makes for a scenario mapping, in its order (for a crashed case's rows).
+
+    Parameters
+    ----------
+    scenario : dict
+        A resolved scenario mapping (plain YAML data).
+
+    Returns
+    -------
+    list of (str, str or None, str)
+        (label, planner, controller) of each row: one per planner and controller, or per
+        controller in regulation mode (planner None).
+    """
+    controllers = _controllers(scenario)
+    planners = scenario.get("planners") or []
+    if not planners:
+        return [(label, None, name) for label, name in controllers]
+    rows = []
+    for planner in planners:
+        planner_label = str(planner.get("label", planner.get("name")))
+        for label, name in controllers:
+            rows.append((planner_label if len(controllers) == 1 else f"{planner_label} / {label}",
+                         planner.get("name"), name))
+    return rows
+
+
+def crashed_rows(scenario: dict[str, Any], message: str) -> list[dict[str, Any]]:
+    """One ``crashed`` row per row of ``scenario`` carrying ``message``.
+
+    Parameters
+    ----------
+    scenario : dict
+        The case's scenario mapping.
+    message : str
+        Why the case crashed.
+
+    Returns
+    -------
+    list of dict
+        Plain rows (``label``, ``planner``, ``controller``, ``status``, ``message``; no metrics).
+    """
+    return [{"label": label, "planner": planner, "controller": controller, "status": "crashed",
+             "message": message, "plan_time_s": None, "ref": None, "cl": None}
+            for label, planner, controller in row_labels(scenario)]
+
+
+def _plain_row(row: Any, controller: str) -> dict[str, Any]:
+    return {"label": row.label, "planner": row.planner,
+            "controller": getattr(row, "controller", None) or controller,
+            "status": row.status, "message": row.message, "plan_time_s": row.plan_time_s,
+            "ref": row.reference_metrics, "cl": row.closed_loop_metrics}
+
+
+def _on_alarm(signum: int, frame: Any) -> None:
+    raise CaseTimeout
+
+
+def run_case(payload: dict[str, Any]) -> dict[str, Any]:
+    """Run one case.
+
+    Parameters
+    ----------
+    payload : dict
+        ``{"key": str, "scenario": mapping, "timeout_s": float}``: the case key, its resolved
+        scenario (plain data) and its time limit [s].
+
+    Returns
+    -------
+    dict
+        ``key``, ``status`` (``ok``: the runner finished, whatever its rows say; ``crashed``: the
+        case raised or ran out of time), ``rows`` (plain dicts), ``elapsed_s`` (wall time [s]),
+        ``cpu_s`` (CPU time of the case [s]), ``worker_cpu_s`` (CPU time of the worker process
+        since it started [s]), ``worker`` (host:pid) and ``cache_builds`` (solvers built by this
+        worker so far).
+    """
+    from scenarios.runner import run
+    from scenarios.schema.loader import parse_scenario
+
+    cache, simulators, lock = worker_state()
+    data, timeout = payload["scenario"], float(payload["timeout_s"])
+    alarm = threading.current_thread() is threading.main_thread() and hasattr(signal, "setitimer")
+    with lock:
+        start, cpu_start = time.perf_counter(), time.process_time()
+        previous = signal.signal(signal.SIGALRM, _on_alarm) if alarm else None
+        try:
+            if alarm:
+                signal.setitimer(signal.ITIMER_REAL, timeout)
+            scenario = parse_scenario(data)
+            results = run(scenario, cache=cache, simulators=simulators)
+            status, rows = "ok", [_plain_row(row, scenario.controllers[0].name) for row in results.rows]
+        except CaseTimeout:
+            status, rows = "crashed", crashed_rows(data, f"timed out after {timeout:g} s (case_timeout_s)")
+        except Exception as error:  # a case that raises is a row, the sweep goes on
+            detail = traceback.format_exc(limit=-3).strip().splitlines()
+            where = next((line.strip() for line in reversed(detail) if line.strip().startswith("File")), "")
+            status, rows = "crashed", crashed_rows(data, f"{type(error).__name__}: {error} ({where})"[:1000])
+        finally:
+            if alarm:
+                signal.setitimer(signal.ITIMER_REAL, 0.0)
+                signal.signal(signal.SIGALRM, previous)
+        elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu_start
+    return {"key": payload["key"], "status": status, "rows": rows, "elapsed_s": elapsed, "cpu_s": cpu,
+            "worker_cpu_s": time.process_time(),
+            "worker": f"{socket.gethostname()}:{os.getpid()}", "cache_builds": cache.builds}
