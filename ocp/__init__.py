@@ -1,6 +1,16 @@
-"""slewbench's symbolic core: quaternions, spacecraft, environment, model, simulator, metrics.
+"""slewbench's symbolic core: quaternions, spacecraft, environment, model, simulator, metrics, NLPs.
 
-Pure numeric/symbolic layer (CasADi and NumPy); it knows nothing of planners, controllers or YAML.
+Pure numeric and symbolic layer (CasADi, NumPy, SciPy); it knows nothing of planners, controllers
+or YAML. Subpackages, from the bottom up; each may import the top-level modules and those before it:
+
+* top-level modules: :mod:`~ocp.errors` (the exceptions and their base :class:`SlewbenchError`),
+  :mod:`~ocp.options` (typed options), :mod:`~ocp.quat` and :mod:`~ocp.quat_casadi` (quaternion
+  algebra), :mod:`~ocp.cache` (solver caches), :mod:`~ocp.fast_call` (low-overhead calls of CasADi
+  functions), :mod:`~ocp.metrics` (the common score);
+* :mod:`ocp.dynamics`: the spacecraft, its actuators and environment, the assembled model;
+* :mod:`ocp.simulation`: the closed-loop simulator (imports :mod:`ocp.dynamics`);
+* :mod:`ocp.transcription`: optimal-control problems and their NLPs (imports :mod:`ocp.dynamics`);
+* :mod:`ocp.nlp`: solving NLPs and the second-order check (imports neither of the above).
 
 Conventions throughout: SI units; quaternions scalar first ``[q0, q1, q2, q3]``, Hamilton product,
 ``q`` rotates body vectors into the inertial frame (``v_I = R(q) v_B``); ω is the body rate with
@@ -8,38 +18,20 @@ respect to the inertial frame in body axes [rad/s]; torques, dipoles and wheel a
 """
 from ocp.cache import SolverCache
 from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
-from ocp.dynamics.environment import (
-                         CircularOrbit,
-                         Environment,
-                         TiltedDipole,
-                         gravity_gradient_torque,
-)
+from ocp.dynamics.environment import CircularOrbit, Environment, TiltedDipole, gravity_gradient_torque
 from ocp.dynamics.igrf import IGRFField
 from ocp.dynamics.model import AttitudeModel
-from ocp.dynamics.spacecraft import (
-                         Magnetorquers,
-                         ModelError,
-                         ReactionWheels,
-                         Spacecraft,
-                         Torquers,
-)
-from ocp.metrics import (
-                         METRIC_KEYS,
-                         compute_metrics,
-                         metric_violations,
-                         metrics_from_reference,
-                         metrics_from_simulation,
-)
-from ocp.simulation.simulator import (
-                         SensorNoise,
-                         SimulationError,
-                         SimulationResult,
-                         Simulator,
-)
+from ocp.dynamics.spacecraft import Magnetorquers, ReactionWheels, Spacecraft, Torquers
+from ocp.errors import (CompilerUnavailable, InvalidOption, ModelError, OptionsError, SimulationError,
+                        SlewbenchError)
+from ocp.metrics import (METRIC_KEYS, compute_metrics, metric_violations, metrics_from_reference,
+                         metrics_from_simulation)
+from ocp.simulation.simulator import SensorNoise, SimulationResult, Simulator
 
 __all__ = [
-    "ActuatorModel", "AttitudeModel", "CircularOrbit", "Command", "Environment", "IGRFField", "METRIC_KEYS",
-    "Magnetorquers", "Measurement", "ModelError", "ReactionWheels", "SensorNoise",
-    "SimulationError", "SimulationResult", "Simulator", "SolverCache", "Spacecraft", "TiltedDipole", "Torquers",
-    "compute_metrics", "gravity_gradient_torque", "metric_violations", "metrics_from_reference", "metrics_from_simulation",
+    "ActuatorModel", "AttitudeModel", "CircularOrbit", "Command", "CompilerUnavailable", "Environment", "IGRFField",
+    "InvalidOption", "METRIC_KEYS", "Magnetorquers", "Measurement", "ModelError", "OptionsError", "ReactionWheels",
+    "SensorNoise", "SimulationError", "SimulationResult", "Simulator", "SlewbenchError", "SolverCache", "Spacecraft",
+    "TiltedDipole", "Torquers", "compute_metrics", "gravity_gradient_torque", "metric_violations",
+    "metrics_from_reference", "metrics_from_simulation",
 ]

@@ -10,6 +10,15 @@ from __future__ import annotations
 
 from typing import Any
 
+
+class SlewbenchError(Exception):
+    """Base of every exception slewbench raises on purpose (a user's mistake or a refused operation).
+
+    Catch it to tell slewbench's errors from Python's own; each package's ``errors`` module derives
+    its exceptions from it.
+    """
+
+
 MAX_REPR = 80
 """Characters of an offending value shown in an error message."""
 
@@ -57,7 +66,7 @@ def _bounded_repr(value: Any, budget: int) -> str:
     return text[:budget] if len(text) > budget else text
 
 
-class OptionsError(ValueError):
+class OptionsError(SlewbenchError, ValueError):
     """An option is unknown, of the wrong type or out of range.
 
     Parameters
@@ -74,7 +83,7 @@ class OptionsError(ValueError):
         self.message = message
 
 
-class InvalidOption(ValueError):
+class InvalidOption(SlewbenchError, ValueError):
     """Raised by an ``Options.__post_init__`` for a value that is wrong in relation to the others.
 
     Parameters
@@ -89,3 +98,29 @@ class InvalidOption(ValueError):
         super().__init__(f"{option}: {message}")
         self.option = option
         self.message = message
+
+
+class ModelError(SlewbenchError, ValueError):
+    """Invalid model parameter.
+
+    Parameters
+    ----------
+    field_name : str
+        The offending attribute (e.g. ``"inertia"``), kept as :attr:`field` so that the YAML
+        loader can point at the input.
+    message : str
+        What was wrong and what was expected, kept as :attr:`message`.
+    """
+
+    def __init__(self, field_name: str, message: str):
+        super().__init__(f"{field_name}: {message}")
+        self.field = field_name
+        self.message = message
+
+
+class SimulationError(SlewbenchError, RuntimeError):
+    """The integration diverged (non-finite state), e.g. a step far too long for the rates."""
+
+
+class CompilerUnavailable(SlewbenchError, RuntimeError):
+    """No working C compiler (the caller falls back to the interpreted function)."""

@@ -19,6 +19,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ocp import CircularOrbit, Environment, ReactionWheels, Spacecraft, Torquers, quat
+from planners.errors import ConformanceError
 from planners.problem import Array, ManeuverProblem
 from planners.reference import Reference, inverse_dynamics_torque
 from planners.torque_free import REST_RATE
@@ -29,10 +30,6 @@ RATE_TOLERANCE = 1e-7
 """rad/s: boundary rates, plus ``RELATIVE_TOLERANCE`` times the reference's peak rate."""
 RELATIVE_TOLERANCE = 1e-5
 """Finite-difference checks, relative to the scale of the compared quantity."""
-
-
-class ConformanceError(AssertionError):
-    """A reference breaks the planner contract; the message says what to fix."""
 
 
 def standard_problems() -> dict[str, ManeuverProblem]:

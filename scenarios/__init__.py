@@ -31,10 +31,10 @@ from typing import TYPE_CHECKING
 from scenarios._faces import lazy_face
 
 if TYPE_CHECKING:  # the names, for type checkers and readers
+    from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
     from scenarios.runner import Row, RunResults, run
     from scenarios.schema.loader import Scenario, load, parse_scenario
-    from scenarios.schema.read import ScenarioError
-    from scenarios.study.engine import SweepInterrupted, SweepResults, sweep
+    from scenarios.study.engine import SweepResults, sweep
     from scenarios.study.spec import load_study, parse_study
     from scenarios.study.types import Study
 
@@ -42,10 +42,10 @@ _HOMES = {"Scenario": "scenarios.schema.loader", "load": "scenarios.schema.loade
           "parse_scenario": "scenarios.schema.loader",
           "Row": "scenarios.runner", "RunResults": "scenarios.runner", "run": "scenarios.runner",
           "Study": "scenarios.study.types", "load_study": "scenarios.study.spec", "parse_study": "scenarios.study.spec",
-          "SweepInterrupted": "scenarios.study.engine", "SweepResults": "scenarios.study.engine",
-          "sweep": "scenarios.study.engine", "ScenarioError": "scenarios.schema.read"}
+          "SweepInterrupted": "scenarios.errors", "SweepResults": "scenarios.study.engine",
+          "sweep": "scenarios.study.engine", "ScenarioError": "scenarios.errors", "OutputError": "scenarios.errors"}
 
-__all__ = ["Row", "RunResults", "Scenario", "ScenarioError", "Study", "SweepInterrupted", "SweepResults",
+__all__ = ["OutputError", "Row", "RunResults", "Scenario", "ScenarioError", "Study", "SweepInterrupted", "SweepResults",
            "load", "load_study", "parse_study", "parse_scenario", "run", "sweep"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)

@@ -26,6 +26,7 @@ import casadi as ca
 from controllers import CONTROLLERS
 from ocp.dynamics.layout import REFERENCE_FIELDS, control_layout
 from planners import PLANNERS
+from scenarios.errors import ScenarioError
 from scenarios.output.directory import (
     claim_output_directory,
     commit_outputs,
@@ -33,7 +34,6 @@ from scenarios.output.directory import (
 )
 from scenarios.output.names import row_stems
 from scenarios.schema.loader import Scenario
-from scenarios.schema.read import ScenarioError
 
 
 @dataclass

@@ -39,13 +39,13 @@ _ENTRY = re.compile(r"^(?P<names>\*{0,2}[A-Za-z_][\w]*(?:\s*,\s*\*{0,2}[A-Za-z_]
 
 
 def public_modules(packages: tuple[str, ...] = PACKAGES) -> Iterator[Any]:
-    """Import and yield every public module of ``packages`` (the packages themselves included)."""
+    """Import and yield every public module of ``packages``, subpackages at any depth (the packages included)."""
     for package_name in packages:
         package = importlib.import_module(package_name)
         yield package
-        for info in pkgutil.iter_modules(package.__path__, prefix=f"{package_name}."):
-            if info.name.rsplit(".", 1)[-1].startswith("_"):
-                continue
+        for info in pkgutil.walk_packages(package.__path__, prefix=f"{package_name}."):
+            if any(part.startswith("_") for part in info.name.split(".")):
+                continue  # private modules and __main__
             yield importlib.import_module(info.name)
 
 

@@ -119,7 +119,7 @@ def test_the_full_mesh_seed_with_and_without_the_transfer(monkeypatch, transfer)
     # states and controls; when the transfer fails (here: refused, as for layouts that differ), it
     # falls back to that optimum through the inverse dynamics (the seed IPOPT's barrier 1e-4 was
     # tuned on) and still reaches the published optimum, both attempts on the record.
-    from planners import collocation
+    from planners.collocation import planner as collocation
 
     used = []
     for name in ("seed_sampler", "solution_sampler"):
@@ -196,7 +196,7 @@ def test_the_loose_coarse_seed_of_a_fixed_time_leaves_the_optimum(monkeypatch):
     # 1e-10 elsewhere); the spin paper's minimum energy from the spin extremal (a 180° flip of a body
     # spinning at 0.2 rad/s: 0.0201 on the coarse mesh, 0.0185 on 50 intervals) must still reach the
     # optimum of the direct 50-interval solve, and the coarse NLP must be built with that tolerance.
-    from ocp import transcription_base
+    from ocp.transcription import base as transcription_base
 
     tolerances = []
     build = transcription_base.Transcription.build
@@ -223,7 +223,7 @@ def spin_paper_problem():
 def test_ipopt_takes_the_seed_over_when_fatrop_stops(monkeypatch):
     # FATROP's coarse seed stopped (here: one iteration allowed) is not the end: IPOPT solves the
     # seed, the full mesh follows from it, to the optimum of the direct 50-interval solve.
-    from planners import collocation
+    from planners.collocation import planner as collocation
 
     monkeypatch.setattr(collocation, "SEED_FATROP", {**collocation.SEED_FATROP, "fatrop.max_iter": 1})
     problem = spin_paper_problem()
@@ -271,7 +271,7 @@ def test_a_shared_cache_keeps_the_fatrop_seed_apart_from_a_fatrop_mesh():
 def test_seed_fatrop_options_apply_to_the_ipopt_option_seed_only(monkeypatch):
     # SEED_FATROP is documented (README, its docstring) for the seed FATROP solves in place of the
     # `solver: ipopt` option; a `solver: fatrop` plan's coarse seed keeps FATROP's defaults.
-    from ocp import transcription_base
+    from ocp.transcription import base as transcription_base
 
     built = []
     build = transcription_base.Transcription.build
@@ -296,7 +296,7 @@ def test_an_l1_transfer_takes_the_adaptive_barrier(monkeypatch, objective, adapt
     # 212 on the unrounded random problem) where the direct 40-interval solve takes 36. With the
     # adaptive barrier (TRANSFER_L1_BARRIER) 16, to the direct solve's optimum; min_energy keeps
     # the monotone one.
-    from ocp import transcription_base
+    from ocp.transcription import base as transcription_base
 
     strategies = []
     build = transcription_base.Transcription.build
@@ -327,7 +327,7 @@ def test_only_the_transfer_of_an_l1_objective_without_energy_is_adaptive(monkeyp
     # min_l1 and min_energy only: dropping its energy or L1 test, or leaving out the time-weighted
     # L1 objective, went unnoticed there): only the full-mesh build started from the coarse optimum
     # takes the adaptive barrier, and only for an L1 term without an energy term.
-    from ocp import transcription_base
+    from ocp.transcription import base as transcription_base
 
     strategies = {}
     build = transcription_base.Transcription.build

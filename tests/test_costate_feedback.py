@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 from controllers.tracking.costate_feedback import fit_costate_gain, project_psd
+from scenarios.errors import ScenarioError
 from scenarios.runner import run
 from scenarios.schema.loader import load, parse_scenario
-from scenarios.schema.read import ScenarioError, read_yaml
+from scenarios.schema.read import read_yaml
 
 SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
 

@@ -10,12 +10,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from planners.conformance import (
-    CHECKS,
-    ConformanceError,
-    check_reference,
-    standard_problems,
-)
+from planners.conformance import CHECKS, check_reference, standard_problems
+from planners.errors import ConformanceError
 
 README = (Path(__file__).resolve().parents[1] / "README.md").read_text()
 (EXAMPLE,) = [block for block in re.findall(r"```python\n(.*?)```", README, flags=re.DOTALL) if "class CubicSlewPlanner" in block]

@@ -18,12 +18,8 @@ import pytest
 
 from ocp import metrics_from_reference, quat
 from planners import PLANNERS, ManeuverProblem, Reference
-from planners.conformance import (
-    CHECKS,
-    ConformanceError,
-    check_reference,
-    standard_problems,
-)
+from planners.conformance import CHECKS, check_reference, standard_problems
+from planners.errors import ConformanceError
 
 PROBLEMS = standard_problems()
 VARIANTS = [(name, index) for name, cls in PLANNERS.items() for index in range(len(cls.example_options))]

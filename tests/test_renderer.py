@@ -287,7 +287,7 @@ def test_the_submodules_are_attributes_of_the_package_as_before():
         import scenarios
         assert scenarios.schema.loader.load is scenarios.load
         assert scenarios.runner.RunResults is scenarios.RunResults
-        assert scenarios.schema.node.ScenarioError is scenarios.ScenarioError
+        assert scenarios.errors.ScenarioError is scenarios.ScenarioError
         scenarios.study.spec.parse_study, scenarios.study.engine.sweep, scenarios.schema.read
         try:
             scenarios.no_such_name
@@ -302,7 +302,7 @@ def test_the_submodules_are_attributes_of_the_package_as_before():
 def test_the_second_drawer_is_forked_only_from_a_single_thread(tmp_path, monkeypatch):
     """A plot process that somehow has threads (a BLAS ignoring its thread variables) draws
     everything itself: a fork of a threaded process can deadlock (and warns on Python 3.12+)."""
-    from scenarios import renderer
+    from scenarios.output import renderer
 
     def no_fork() -> int:
         raise AssertionError("forked a process with threads")

@@ -202,7 +202,7 @@ def test_the_default_minimum_time_plan_certifies_its_coarse_optimum():
 
 
 def test_the_unchecked_size_is_reported(monkeypatch):
-    from ocp import second_order
+    from ocp.nlp import second_order
 
     solver = nlp(lambda x: ca.sumsqr(x), n=3)
     monkeypatch.setattr(second_order, "MAX_VARIABLES", 2)

@@ -299,7 +299,8 @@ def test_scenario_rejects_a_spacecraft_the_laws_cannot_control(change, path):
     import copy
 
     import scenarios
-    from scenarios.schema.read import ScenarioError, read_yaml
+    from scenarios.errors import ScenarioError
+    from scenarios.schema.read import read_yaml
 
     data = copy.deepcopy(read_yaml(Path(__file__).parent.parent / "scenarios" / "horri_palmer_two_wheels.yaml"))
     if "inertia" in change:

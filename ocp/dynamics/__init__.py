@@ -20,14 +20,8 @@ from ocp.dynamics.environment import (
 from ocp.dynamics.igrf import IGRFField
 from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.model import AttitudeModel
-from ocp.dynamics.spacecraft import (
-           Magnetorquers,
-           ModelError,
-           ReactionWheels,
-           Spacecraft,
-           Torquers,
-)
+from ocp.dynamics.spacecraft import Magnetorquers, ReactionWheels, Spacecraft, Torquers
 
 __all__ = ["ActuatorModel", "AttitudeModel", "CircularOrbit", "Command", "Environment", "IGRFField", "Magnetorquers",
-           "Measurement", "ModelError", "ReactionWheels", "Spacecraft", "TiltedDipole", "Torquers",
+           "Measurement", "ReactionWheels", "Spacecraft", "TiltedDipole", "Torquers",
            "gravity_gradient_torque", "rk4_step"]

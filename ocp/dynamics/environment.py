@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ocp import quat_casadi as qc
-from ocp.dynamics.spacecraft import ModelError
+from ocp.errors import ModelError
 from ocp.quat_casadi import Expr
 
 if TYPE_CHECKING:  # type-only: ocp.dynamics.igrf refers back to CircularOrbit

@@ -24,7 +24,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ocp.dynamics.spacecraft import ModelError
+from ocp.errors import ModelError
 from ocp.quat_casadi import Expr
 
 if TYPE_CHECKING:  # type-only: ocp.dynamics.environment refers back to IGRFField

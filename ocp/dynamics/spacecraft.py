@@ -13,25 +13,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ocp.errors import ModelError
+
 Array = NDArray[np.float64]
-
-
-class ModelError(ValueError):
-    """Invalid model parameter.
-
-    Parameters
-    ----------
-    field_name : str
-        The offending attribute (e.g. ``"inertia"``), kept as :attr:`field` so that the YAML
-        loader can point at the input.
-    message : str
-        What was wrong and what was expected, kept as :attr:`message`.
-    """
-
-    def __init__(self, field_name: str, message: str):
-        super().__init__(f"{field_name}: {message}")
-        self.field = field_name
-        self.message = message
 
 
 def _limit_vector(value: ArrayLike | None, size: int, field_name: str) -> Array:

@@ -9,14 +9,12 @@ May import: :mod:`ocp.dynamics` and the top-level modules of :mod:`ocp`; never
 :mod:`ocp.transcription` or :mod:`ocp.nlp`.
 """
 from ocp.simulation.closed_loop import ClosedLoop
-from ocp.simulation.compiled import CompilerUnavailable, compile_function
+from ocp.simulation.compiled import compile_function
 from ocp.simulation.simulator import (
-                                      GridSampledReference,
-                                      SensorNoise,
-                                      SimulationError,
-                                      SimulationResult,
-                                      Simulator,
+           GridSampledReference,
+           SensorNoise,
+           SimulationResult,
+           Simulator,
 )
 
-__all__ = ["ClosedLoop", "CompilerUnavailable", "GridSampledReference", "SensorNoise", "SimulationError",
-           "SimulationResult", "Simulator", "compile_function"]
+__all__ = ["ClosedLoop", "GridSampledReference", "SensorNoise", "SimulationResult", "Simulator", "compile_function"]

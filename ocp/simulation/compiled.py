@@ -19,13 +19,11 @@ from pathlib import Path
 
 import casadi as ca
 
+from ocp.errors import CompilerUnavailable
+
 CFLAGS = ("-O1", "-fPIC", "-shared")
 """-O1: the generated code is long straight-line arithmetic; -O2/-O3 build several times slower
 for a few per cent of run time."""
-
-
-class CompilerUnavailable(RuntimeError):
-    """No working C compiler (the caller falls back to the interpreted function)."""
 
 
 def cache_directory() -> Path:

@@ -36,9 +36,10 @@ from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
 from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.layout import reference_rows
 from ocp.dynamics.model import AttitudeModel
+from ocp.errors import CompilerUnavailable, SimulationError
 from ocp.fast_call import BufferedFunction
 from ocp.simulation.closed_loop import ClosedLoop, draw_noise
-from ocp.simulation.compiled import CompilerUnavailable, compile_function, notice
+from ocp.simulation.compiled import compile_function, notice
 
 Array = NDArray[np.float64]
 
@@ -125,10 +126,6 @@ class GridSampledReference:
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self.reference, name)
-
-
-class SimulationError(RuntimeError):
-    """The integration diverged (non-finite state), e.g. a step far too long for the rates."""
 
 
 @dataclass(frozen=True)

@@ -125,7 +125,7 @@ def control_floor(transcription: Transcription, ocp: OptimalControlProblem, nlp:
         Per decision variable, half the range of a bounded control, 1e-3 for every other
         variable (states, a free T, slacks, unbounded controls).
     """
-    free = np.full(ocp.dynamics.model.nx, np.inf)
+    free = np.full(ocp.model.nx, np.inf)
     low, high = transcription.bounds(ocp, nlp, -free, free, u_low, u_high, np.inf)
     with np.errstate(invalid="ignore"):  # a free T: [1e-3, 1] × inf
         half = 0.5 * (high - low)

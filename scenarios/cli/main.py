@@ -18,11 +18,11 @@ from typing import Any
 from controllers import CONTROLLERS
 from planners import PLANNERS
 from scenarios.cli.sweep import add_sweep_parser
+from scenarios.errors import ScenarioError
 from scenarios.output.directory import claim_output_directory
 from scenarios.output.names import default_output_directory
 from scenarios.runner import run
 from scenarios.schema.loader import load
-from scenarios.schema.read import ScenarioError
 
 EXIT_OK, EXIT_INTERNAL, EXIT_BAD_SCENARIO = 0, 1, 2
 

@@ -13,15 +13,10 @@ import time
 from pathlib import Path
 from typing import Any
 
+from scenarios.errors import ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, read_manifest
 from scenarios.output.names import default_output_directory
-from scenarios.schema.read import ScenarioError
-from scenarios.study.engine import (
-    SweepInterrupted,
-    SweepResults,
-    start_forkserver,
-    sweep,
-)
+from scenarios.study.engine import SweepResults, start_forkserver, sweep
 from scenarios.study.report import claim_sweep_directory, resolved_study
 from scenarios.study.spec import load_study, parse_study
 from scenarios.study.store import STORE_NAME, SweepStore, is_sweep_store

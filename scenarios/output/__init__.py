@@ -15,8 +15,7 @@ from __future__ import annotations
 
 from scenarios._faces import lazy_face
 
-_HOMES = {"OutputError": "scenarios.output.directory",
-          "Renderer": "scenarios.output.renderer",
+_HOMES = {"Renderer": "scenarios.output.renderer",
           "claim_output_directory": "scenarios.output.directory",
           "read_manifest": "scenarios.output.directory",
           "row_stems": "scenarios.output.names",
@@ -28,6 +27,6 @@ _HOMES = {"OutputError": "scenarios.output.directory",
           "to_terminal": "scenarios.output.tables",
           "write_results": "scenarios.output.directory"}
 
-__all__ = ["OutputError", "Renderer", "claim_output_directory", "read_manifest", "row_stems", "sanitize", "to_csv", "to_dataframe", "to_json", "to_markdown", "to_terminal", "write_results"]
+__all__ = ["Renderer", "claim_output_directory", "read_manifest", "row_stems", "sanitize", "to_csv", "to_dataframe", "to_json", "to_markdown", "to_terminal", "write_results"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)

@@ -28,11 +28,11 @@ from typing import TYPE_CHECKING, Any, Iterable, Iterator
 
 import numpy as np
 
+from scenarios.errors import OutputError
 from scenarios.output.names import (
     row_stems,
 )
 from scenarios.output.tables import to_csv, to_json, to_markdown
-from scenarios.schema.read import ScenarioError
 
 if TYPE_CHECKING:
     from scenarios.runner import Row, RunResults
@@ -42,11 +42,6 @@ __all__ = ["MARKER", "STAGING_PREFIX", "OutputError", "claim_output_directory", 
 
 MARKER = ".slewbench-output.json"
 STAGING_PREFIX = ".slewbench-staging-"
-class OutputError(ScenarioError):
-    """An output location slewbench must not or cannot write to (exit status 2)."""
-
-    def __init__(self, path: str | Path, message: str):
-        super().__init__("--out", f"{path}: {message}")
 
 
 def read_manifest(directory: Path) -> dict[str, Any] | None:

@@ -11,7 +11,7 @@ import numpy as np
 from controllers import CONTROLLERS
 from ocp.simulation.simulator import SUBSTEPS_PER_SAMPLE
 from planners import PLANNERS, ManeuverProblem
-from scenarios.schema.read import ScenarioError
+from scenarios.errors import ScenarioError
 
 if TYPE_CHECKING:
     from scenarios.schema.loader import ControllerSpec, PlannerSpec, SimulationSpec

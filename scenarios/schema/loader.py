@@ -21,10 +21,11 @@ from ocp import Environment, IGRFField, SensorNoise, Spacecraft, quat
 from ocp.errors import OptionsError, excerpt
 from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem
+from scenarios.errors import ScenarioError
 from scenarios.schema.checks import check_compatibility, check_row_labels, check_work
 from scenarios.schema.model import parse_environment, parse_spacecraft
 from scenarios.schema.node import Node
-from scenarios.schema.read import ScenarioError, read_yaml
+from scenarios.schema.read import read_yaml
 
 MAX_NAME = 200
 """Characters of a scenario name (the default output directory uses a sanitised, shorter stem)."""

@@ -22,8 +22,8 @@ from ocp import (
     TiltedDipole,
     Torquers,
 )
+from scenarios.errors import ScenarioError
 from scenarios.schema.node import Node
-from scenarios.schema.read import ScenarioError
 
 
 def _model_part(node: Node, build: Callable[..., Any], **kwargs: Any) -> Any:

@@ -12,7 +12,7 @@ from typing import Any, Iterator
 import numpy as np
 
 from ocp.errors import excerpt
-from scenarios.schema.read import ScenarioError
+from scenarios.errors import ScenarioError
 
 __all__ = ["Node"]
 

@@ -14,15 +14,7 @@ from typing import Any
 import yaml
 
 from ocp.errors import excerpt
-
-
-class ScenarioError(ValueError):
-    """A scenario file is wrong; ``path`` is where, ``message`` what was expected."""
-
-    def __init__(self, path: str, message: str):
-        super().__init__(f"{path}: {message}" if path else message)
-        self.path = path
-        self.message = message
+from scenarios.errors import ScenarioError
 
 
 class _Loader(yaml.SafeLoader):

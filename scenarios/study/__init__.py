@@ -18,13 +18,12 @@ _HOMES = {"Case": "scenarios.study.types",
           "Dispersion": "scenarios.study.dispersions",
           "Execution": "scenarios.study.types",
           "Study": "scenarios.study.types",
-          "SweepInterrupted": "scenarios.study.engine",
           "SweepResults": "scenarios.study.engine",
           "SweepStore": "scenarios.study.store",
           "load_study": "scenarios.study.spec",
           "parse_study": "scenarios.study.spec",
           "sweep": "scenarios.study.engine"}
 
-__all__ = ["Case", "Dispersion", "Execution", "Study", "SweepInterrupted", "SweepResults", "SweepStore", "load_study", "parse_study", "sweep"]
+__all__ = ["Case", "Dispersion", "Execution", "Study", "SweepResults", "SweepStore", "load_study", "parse_study", "sweep"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable
 
+from scenarios.errors import SweepInterrupted
 from scenarios.study.spec import load_study, parse_study
 from scenarios.study.store import SweepStore
 from scenarios.study.types import Case, Study
@@ -35,22 +36,6 @@ if TYPE_CHECKING:
 
 _POLL_S = 0.5
 _TIMEOUT_GRACE = 1.25  # the driver gives up on a case at this multiple of case_timeout_s (+ 5 s)
-
-
-class SweepInterrupted(Exception):
-    """The sweep was stopped before every case finished; ``missing`` cases are not stored.
-
-    Parameters
-    ----------
-    missing : int
-        Cases not finished (not in the store).
-    total : int
-        Cases of the study.
-    """
-
-    def __init__(self, missing: int, total: int) -> None:
-        super().__init__(f"{missing} of {total} cases are missing")
-        self.missing, self.total = missing, total
 
 
 @dataclass
@@ -337,7 +322,7 @@ def dask_executor(address: str) -> tuple[Executor, int, Callable[[], None]]:
     try:
         client = Client(address, timeout="20s")
     except OSError as error:
-        from scenarios.schema.read import ScenarioError
+        from scenarios.errors import ScenarioError
         raise ScenarioError("execution.scheduler", f"cannot reach the Dask scheduler at {address}: {error}") from None
     threads = sum(client.nthreads().values()) or 1
     return client.get_executor(), threads, client.close

@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
-from scenarios.schema.read import ScenarioError
+from scenarios.errors import ScenarioError
 
 Step = str | int | tuple[str, str]  # mapping key, list index, (key, value) selector
 _TOKEN = re.compile(r"\.?([A-Za-z_][A-Za-z0-9_]*)|\[(-?\d+)\]|\[([A-Za-z_][A-Za-z0-9_]*)=([^\]]+)\]")

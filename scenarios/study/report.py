@@ -15,9 +15,9 @@ import numpy as np
 import yaml
 
 from ocp import METRIC_KEYS
+from scenarios.errors import OutputError
 from scenarios.output.directory import (
     MARKER,
-    OutputError,
     claim_output_directory,
     commit_outputs,
     new_staging,

@@ -19,9 +19,10 @@ from typing import Any
 import numpy as np
 
 from ocp import METRIC_KEYS, quat
+from scenarios.errors import ScenarioError
 from scenarios.schema.loader import parse_scenario
 from scenarios.schema.node import Node
-from scenarios.schema.read import ScenarioError, read_yaml
+from scenarios.schema.read import read_yaml
 from scenarios.study.dispersions import Dispersion, draw_unit, parse_dispersion
 from scenarios.study.paths import Step, get_path, parse_path, set_path
 from scenarios.study.types import Case, Execution, Study, case_key, package_version

@@ -19,6 +19,7 @@ import traceback
 from typing import Any, Callable, Hashable, TypeVar
 
 from ocp import SolverCache
+from scenarios.errors import CaseTimeout
 
 V = TypeVar("V")
 
@@ -26,10 +27,6 @@ PRELOAD = ("scenarios.study.worker", "scenarios.runner", "scipy.integrate", "sci
 """Modules imported once by the process that local workers fork from: the workbench, and the SciPy
 modules that planners import lazily on their first case (about 0.6 s that every fresh worker would
 otherwise pay; with 40 cases of 0.13 s that alone was a 12 % overhead)."""
-
-
-class CaseTimeout(Exception):
-    """Raised inside a worker when a case exceeds its time limit."""
 
 
 class RecentCache(SolverCache):
