@@ -13,8 +13,9 @@ Subpackages, from the bottom up (each may import only those before it, and :mod:
 
 * :mod:`scenarios.schema`: reading YAML safely, typed nodes that name their path, the scenario
   schema and its checks, and the schema reference generated from them;
-* :mod:`scenarios.output`: run results as tables, files and figures, and the output directories
-  slewbench owns;
+* :mod:`scenarios.output`: a run's rows and results (:class:`~scenarios.output.results.Row`,
+  :class:`~scenarios.output.results.RunResults`) as tables, files and figures, and the output
+  directories slewbench owns;
 * :mod:`scenarios.runner` (a module): plan, track and score every row of a scenario;
 * :mod:`scenarios.codegen` (a module): a scenario's law and references as C;
 * :mod:`scenarios.study`: trade studies: their schema, cases, store, engine and report;
@@ -32,7 +33,8 @@ from scenarios._faces import lazy_face
 
 if TYPE_CHECKING:  # the names, for type checkers and readers
     from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
-    from scenarios.runner import Row, RunResults, run
+    from scenarios.output.results import Row, RunResults
+    from scenarios.runner import run
     from scenarios.schema.loader import Scenario, load, parse_scenario
     from scenarios.study.engine import SweepResults, sweep
     from scenarios.study.spec import load_study, parse_study
@@ -40,7 +42,7 @@ if TYPE_CHECKING:  # the names, for type checkers and readers
 
 _HOMES = {"Scenario": "scenarios.schema.loader", "load": "scenarios.schema.loader",
           "parse_scenario": "scenarios.schema.loader",
-          "Row": "scenarios.runner", "RunResults": "scenarios.runner", "run": "scenarios.runner",
+          "Row": "scenarios.output.results", "RunResults": "scenarios.output.results", "run": "scenarios.runner",
           "Study": "scenarios.study.types", "load_study": "scenarios.study.spec", "parse_study": "scenarios.study.spec",
           "SweepInterrupted": "scenarios.errors", "SweepResults": "scenarios.study.engine",
           "sweep": "scenarios.study.engine", "ScenarioError": "scenarios.errors", "OutputError": "scenarios.errors"}

@@ -107,7 +107,9 @@ def generate(scenario: Scenario, out: str | Path) -> CodegenReport:
     Raises
     ------
     ScenarioError
-        The controller has no symbolic law (with its reason), or ``out`` is not slewbench's to write.
+        The controller has no symbolic law (with its reason).
+    OutputError
+        ``out`` is not slewbench's to write (:func:`scenarios.output.directory.claim_output_directory`).
     """
     problem, spec = scenario.problem, scenario.simulation
     laws = []

@@ -1,9 +1,10 @@
 """The exceptions of :mod:`scenarios`, derived from :class:`ocp.errors.SlewbenchError`.
 
 :class:`ScenarioError` is a user's mistake in a scenario or study file (or a library argument), at
-its YAML path; :class:`OutputError` an output location slewbench must not or cannot write to; both
-end the command line with exit status 2. :class:`SweepInterrupted` is a study stopped before every
-case finished. Imports only :mod:`ocp.errors`.
+its YAML path; :class:`OutputError` an output location slewbench must not or cannot write to, at
+that location (it is not a :class:`ScenarioError`: the scenario may be right). Both end the command
+line with exit status 2. :class:`SweepInterrupted` is a study stopped before every case finished.
+Imports only :mod:`ocp.errors`.
 """
 from __future__ import annotations
 
@@ -23,11 +24,21 @@ class ScenarioError(SlewbenchError, ValueError):
         self.message = message
 
 
-class OutputError(ScenarioError):
-    """An output location slewbench must not or cannot write to (exit status 2)."""
+class OutputError(SlewbenchError):
+    """An output location slewbench must not or cannot write to (exit status 2); nothing was written.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output location (a directory, or a file in it).
+    message : str
+        What is wrong with it and what to do.
+    """
 
     def __init__(self, path: str | Path, message: str):
-        super().__init__("--out", f"{path}: {message}")
+        super().__init__(f"{path}: {message}")
+        self.path = Path(path)
+        self.message = message
 
 
 class CaseTimeout(SlewbenchError):

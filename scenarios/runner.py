@@ -8,14 +8,11 @@ from __future__ import annotations
 import time
 import traceback
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from controllers import CONTROLLERS
 from ocp import (
     SimulationError,
-    SimulationResult,
     Simulator,
     SolverCache,
     metric_violations,
@@ -23,157 +20,9 @@ from ocp import (
     metrics_from_simulation,
 )
 from planners import PLANNERS, FailedReference, Reference
-from scenarios.schema.loader import ControllerSpec, Scenario
-
-
-@dataclass
-class Row:
-    """One planner and controller pair (in regulation mode, the controller alone) and its scores.
-
-    Parameters
-    ----------
-    label : str
-        The planner's label, or the controller's in regulation mode; with several controllers a
-        planner's rows are labelled ``"<planner label> / <controller label>"``.
-    planner : str or None
-        Planner registry name; ``None`` in regulation mode.
-    status : str
-        ``"ok"`` or ``"failed"`` (a failed planner, simulation or unphysical metrics).
-    message : str
-        Why it failed (empty when ok).
-    plan_time_s : float or None
-        Planning time [s]; ``None`` in regulation mode.
-    reference_metrics : dict or None
-        Metrics of the reference itself (ARCHITECTURE.md's metric keys); ``None`` without one.
-    closed_loop_metrics : dict or None
-        Metrics of the closed-loop simulation; ``None`` when it was not simulated.
-    reference : planners.Reference or None, optional
-        The planned reference.
-    simulation : ocp.SimulationResult or None, optional
-        The closed-loop time series.
-    simulate_time_s : float, optional
-        Simulation time [s].
-    controller : str or None, optional
-        Controller registry name.
-    """
-
-    label: str
-    planner: str | None
-    status: str
-    message: str
-    plan_time_s: float | None
-    reference_metrics: dict[str, Any] | None
-    closed_loop_metrics: dict[str, Any] | None
-    reference: Reference | None = field(default=None, repr=False)
-    simulation: SimulationResult | None = field(default=None, repr=False)
-    simulate_time_s: float = 0.0
-    controller: str | None = None
-
-    def to_dict(self) -> dict[str, Any]:
-        """The row as ARCHITECTURE.md's ``results.json`` writes it.
-
-        Returns
-        -------
-        dict
-            ``label``, ``planner``, ``controller``, ``status``, ``message``, ``plan_time_s``,
-            ``reference`` and ``closed_loop`` (the two metric dicts).
-        """
-        return {"label": self.label, "planner": self.planner, "controller": self.controller,
-                "status": self.status, "message": self.message,
-                "plan_time_s": self.plan_time_s, "reference": self.reference_metrics,
-                "closed_loop": self.closed_loop_metrics}
-
-
-@dataclass
-class RunResults:
-    """Rows of a scenario run. ``to_json``, ``to_csv``, ``to_markdown``, ``to_dataframe`` and
-    ``write`` render them (implemented in :mod:`scenarios.output.tables` and :mod:`scenarios.output.directory`).
-
-    Parameters
-    ----------
-    scenario : scenarios.schema.loader.Scenario
-        The scenario that was run.
-    rows : list of Row
-        One per planner and controller pair (per controller in regulation mode).
-    """
-
-    scenario: Scenario
-    rows: list[Row]
-
-    def to_dict(self) -> dict[str, Any]:
-        """The results as a plain dict.
-
-        Returns
-        -------
-        dict
-            ``{"scenario": name, "rows": [Row.to_dict(), ...]}``.
-        """
-        return {"scenario": self.scenario.name, "rows": [row.to_dict() for row in self.rows]}
-
-    def to_json(self) -> str:
-        """``results.json``'s text.
-
-        Returns
-        -------
-        str
-        """
-        from scenarios.output.tables import to_json
-        return to_json(self)
-
-    def to_csv(self) -> str:
-        """``results.csv``'s text (one line per row, metrics as columns).
-
-        Returns
-        -------
-        str
-        """
-        from scenarios.output.tables import to_csv
-        return to_csv(self)
-
-    def to_markdown(self) -> str:
-        """``results.md``'s text (a Markdown table).
-
-        Returns
-        -------
-        str
-        """
-        from scenarios.output.tables import to_markdown
-        return to_markdown(self)
-
-    def to_terminal(self) -> str:
-        """The summary table ``slewbench run`` prints.
-
-        Returns
-        -------
-        str
-        """
-        from scenarios.output.tables import to_terminal
-        return to_terminal(self)
-
-    def to_dataframe(self) -> Any:
-        """The CSV table as a pandas DataFrame (needs pandas installed).
-
-        Returns
-        -------
-        pandas.DataFrame
-        """
-        from scenarios.output.tables import to_dataframe
-        return to_dataframe(self)
-
-    def write(self, directory: str | Path, plots: bool = True, renderer: Any = None) -> None:
-        """Write results.json/csv/md, time series and plots atomically.
-
-        Parameters
-        ----------
-        directory : str or pathlib.Path
-            Output directory (created; slewbench never overwrites files it did not write).
-        plots : bool, optional
-            Also write the PNG figures.
-        renderer : scenarios.output.renderer.Renderer, optional
-            A plot process to draw them (``None``: drawn in this process).
-        """
-        from scenarios.output.directory import write_results
-        write_results(self, directory, plots=plots, renderer=renderer)
+from scenarios.output.results import Row, RunResults
+from scenarios.schema.labels import row_labels
+from scenarios.schema.loader import ControllerSpec, PlannerSpec, Scenario
 
 
 def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | None, row: Row,
@@ -226,6 +75,11 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     -------
     RunResults
         One row per planner and controller pair (in regulation mode, one per controller).
+
+    Raises
+    ------
+    ScenarioError
+        Two rows would have the same label (a scenario built without :func:`scenarios.load`).
     """
     say = progress or (lambda line: None)
     spec = scenario.simulation
@@ -239,42 +93,47 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         ("simulator", model.fingerprint, spec.sample_time, spec.integrator, spec.max_step, spec.max_samples,
          spec.compile), build)
     controllers = scenario.controllers
-    rows = []
-    if not scenario.planners:
-        for index, controller in enumerate(controllers, start=1):
-            row = Row(controller.label, None, "ok", "regulation to the target", None, None, None,
-                      controller=controller.name)
-            _simulate(scenario, simulator, None, row, controller)
-            say(f"[{index}/{len(controllers)}] {row.label}: {row.status} (simulated in {row.simulate_time_s:.2f} s)"
-                + (f" - {row.message}" if row.status != "ok" else ""))
-            rows.append(row)
-        return RunResults(scenario, rows)
-    total = len(scenario.planners) * len(controllers)
-    for planner_spec in scenario.planners:
-        planner = PLANNERS[planner_spec.name](planner_spec.options, cache=cache)
-        try:
-            reference = planner.plan(scenario.problem)
-        except Exception as error:  # a planner bug must not lose the other rows
-            traceback.print_exc()
-            reference = FailedReference(planner_spec.name, f"planner raised {type(error).__name__}: {error}")
-        reference_metrics = None
-        if reference.ok:
-            reference_metrics = metrics_from_reference(
-                reference, scenario.problem.qf, scenario.problem.omegaf,
-                settling_tolerance_deg=spec.settling_tolerance_deg,
-                fine_settling_tolerance_deg=spec.fine_settling_tolerance_deg,
-                inertia=scenario.problem.spacecraft.inertia, detumble_tolerance=spec.detumble_tolerance,
-                initial_omega=scenario.problem.omega0)
-        for controller in controllers:
-            label = planner_spec.label if len(controllers) == 1 else f"{planner_spec.label} / {controller.label}"
-            row = Row(label, planner_spec.name, reference.status, reference.message,
+    labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in controllers])
+    references: dict[int, tuple[Reference, dict[str, Any] | None]] = {}
+    rows: list[Row] = []
+    for label, i, j in labels:
+        if i is None:  # regulation mode: the controller alone, to the target
+            row = Row(label, None, "ok", "regulation to the target", None, None, None, controller=controllers[j].name)
+            _simulate(scenario, simulator, None, row, controllers[j])
+            timing = f"simulated in {row.simulate_time_s:.2f} s"
+        else:
+            if i not in references:  # planned once, tracked by every controller
+                references[i] = _plan(scenario, scenario.planners[i], cache)
+            reference, reference_metrics = references[i]
+            row = Row(label, scenario.planners[i].name, reference.status, reference.message,
                       reference.plan_time_s, None if reference_metrics is None else dict(reference_metrics), None,
-                      reference, controller=controller.name)
+                      reference, controller=controllers[j].name)
             if reference.ok:
                 _check_physical(row, "reference", row.reference_metrics)
-                _simulate(scenario, simulator, reference, row, controller)
-            rows.append(row)
-            say(f"[{len(rows)}/{total}] {row.label}: {row.status} "
-                f"(planned in {(row.plan_time_s or 0.0) * 1e3:.1f} ms, simulated in {row.simulate_time_s:.2f} s)"
-                + (f" - {row.message}" if row.status != "ok" else ""))
+                _simulate(scenario, simulator, reference, row, controllers[j])
+            timing = (f"planned in {(row.plan_time_s or 0.0) * 1e3:.1f} ms, "
+                      f"simulated in {row.simulate_time_s:.2f} s")
+        rows.append(row)
+        say(f"[{len(rows)}/{len(labels)}] {row.label}: {row.status} ({timing})"
+            + (f" - {row.message}" if row.status != "ok" else ""))
     return RunResults(scenario, rows)
+
+
+def _plan(scenario: Scenario, planner_spec: PlannerSpec,
+          cache: SolverCache | None) -> tuple[Reference, dict[str, Any] | None]:
+    """A planner's reference (a failed one when it raises) and the reference's metrics (None when failed)."""
+    spec = scenario.simulation
+    planner = PLANNERS[planner_spec.name](planner_spec.options, cache=cache)
+    try:
+        reference = planner.plan(scenario.problem)
+    except Exception as error:  # a planner bug must not lose the other rows
+        traceback.print_exc()
+        reference = FailedReference(planner_spec.name, f"planner raised {type(error).__name__}: {error}")
+    if not reference.ok:
+        return reference, None
+    return reference, metrics_from_reference(
+        reference, scenario.problem.qf, scenario.problem.omegaf,
+        settling_tolerance_deg=spec.settling_tolerance_deg,
+        fine_settling_tolerance_deg=spec.fine_settling_tolerance_deg,
+        inertia=scenario.problem.spacecraft.inertia, detumble_tolerance=spec.detumble_tolerance,
+        initial_omega=scenario.problem.omega0)

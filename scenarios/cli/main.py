@@ -1,7 +1,7 @@
 """``slewbench`` command line: run, validate, list, codegen, sweep.
 
 Exit status: 0 when the run completed (a failed planner is a row, not an error), 2 for a bad
-scenario file, 1 for an internal error.
+scenario file or an output location slewbench must not or cannot write to, 1 for an internal error.
 """
 from __future__ import annotations
 
@@ -18,13 +18,13 @@ from typing import Any
 from controllers import CONTROLLERS
 from planners import PLANNERS
 from scenarios.cli.sweep import add_sweep_parser
-from scenarios.errors import ScenarioError
+from scenarios.errors import OutputError, ScenarioError
 from scenarios.output.directory import claim_output_directory
 from scenarios.output.names import default_output_directory
 from scenarios.runner import run
 from scenarios.schema.loader import load
 
-EXIT_OK, EXIT_INTERNAL, EXIT_BAD_SCENARIO = 0, 1, 2
+EXIT_OK, EXIT_INTERNAL, EXIT_BAD_SCENARIO, EXIT_BAD_OUTPUT = 0, 1, 2, 2
 
 
 def _first_doc_line(cls: type) -> str:
@@ -214,7 +214,8 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     Returns
     -------
     int
-        Exit status: 0 done, 2 bad scenario file, 1 internal error or interrupted.
+        Exit status: 0 done, 2 bad scenario file or output location (the message names its path),
+        1 internal error or interrupted.
     """
     args = build_parser().parse_args(argv)
     args.interruption = Interruption()
@@ -226,6 +227,10 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     except ScenarioError as error:
         print(f"slewbench: error in scenario: {error}", file=sys.stderr)
         return EXIT_BAD_SCENARIO
+    except OutputError as error:
+        option = "--report" if getattr(args, "report", None) else "--out"
+        print(f"slewbench: output error: {option} {error}", file=sys.stderr)
+        return EXIT_BAD_OUTPUT
     except KeyboardInterrupt:
         print("slewbench: interrupted; results not written or marked incomplete in the output manifest",
               file=sys.stderr)

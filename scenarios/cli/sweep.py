@@ -1,8 +1,9 @@
 """``slewbench sweep``: run a trade study into a directory, resume it, or redraw its report.
 
 Everything that can fail before a case runs is checked first: the study and every case (exit 2,
-nothing written), then the output directory (exit 2 if it is not slewbench's, or already holds a
-sweep and ``--resume`` was not given). An interrupted sweep exits 130 and says how to resume.
+nothing written), then the output directory (exit 2 if it is not slewbench's, already holds a
+sweep and ``--resume`` was not given, or holds a sweep of an earlier slewbench, which ``--report``
+still redraws). An interrupted sweep exits 130 and says how to resume.
 """
 from __future__ import annotations
 
@@ -13,13 +14,13 @@ import time
 from pathlib import Path
 from typing import Any
 
-from scenarios.errors import ScenarioError, SweepInterrupted
+from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, read_manifest
 from scenarios.output.names import default_output_directory
 from scenarios.study.engine import SweepResults, start_forkserver, sweep
 from scenarios.study.report import claim_sweep_directory, resolved_study
 from scenarios.study.spec import load_study, parse_study
-from scenarios.study.store import STORE_NAME, SweepStore, is_sweep_store
+from scenarios.study.store import EARLIER_FORMATS, STORE_NAME, SweepStore, is_sweep_store, store_format
 from scenarios.study.types import package_version
 
 EXIT_OK, EXIT_BAD_STUDY, EXIT_INTERRUPTED = 0, 2, 130
@@ -29,7 +30,7 @@ def _open_store(out: Path) -> SweepStore:
     try:
         return SweepStore(out)
     except Exception as error:  # sqlite3.Error, or a store of another format
-        raise ScenarioError("--out", f"cannot open the sweep store in {out}: {error}") from None
+        raise OutputError(out, f"cannot open the sweep store: {error}") from None
 
 
 def _terminate(signum: int, frame: Any) -> None:
@@ -51,12 +52,13 @@ def command_report(args: argparse.Namespace) -> int:
 
     Raises
     ------
-    ScenarioError
-        The directory holds no slewbench sweep.
+    OutputError
+        The directory holds no slewbench sweep (a sweep of an earlier slewbench whose store is
+        still readable is redrawn).
     """
     out = Path(args.report)
     if read_manifest(out) is None or not is_sweep_store(out):
-        raise ScenarioError("--report", f"{out} holds no slewbench sweep ({STORE_NAME} and {MARKER} expected)")
+        raise OutputError(out, f"holds no slewbench sweep ({STORE_NAME} and {MARKER} expected)")
     with SweepStore(out, create=False) as store:
         data, version = store.get_meta("study"), store.get_meta("version")
         records = store.records()
@@ -85,7 +87,9 @@ def command_sweep(args: argparse.Namespace) -> int:
     Raises
     ------
     ScenarioError
-        A bad study, case, option or output directory (exit 2; nothing written).
+        A bad study, case or option (exit 2; nothing written).
+    OutputError
+        An output directory slewbench must not or cannot write to (exit 2; nothing written).
     """
     if args.report:
         return command_report(args)
@@ -101,9 +105,14 @@ def command_sweep(args: argparse.Namespace) -> int:
     if not args.no_plots:
         import scenarios.study.plots  # noqa: F401  (fail now, not after the cases ran)
     out = Path(args.out) if args.out else default_output_directory(study.name)
+    earlier = store_format(out)
+    if earlier in EARLIER_FORMATS:
+        raise OutputError(out, f"holds a sweep written by an earlier slewbench ({STORE_NAME} format {earlier!r}); "
+                               f"it takes no new cases: redraw its report with `slewbench sweep --report {out}`, "
+                               "or choose another --out to run the study")
     if (out / STORE_NAME).exists() and not args.resume:
-        raise ScenarioError("--out", f"{out} already holds a sweep ({STORE_NAME}); pass --resume to continue it, "
-                                     "--report to redraw it, or choose another --out")
+        raise OutputError(out, f"already holds a sweep ({STORE_NAME}); pass --resume to continue it, "
+                               "--report to redraw it, or choose another --out")
     out = claim_sweep_directory(out)
     start = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _terminate)

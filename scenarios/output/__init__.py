@@ -1,10 +1,11 @@
 """What a run writes: tables, time series and figures, in output directories slewbench owns.
 
-What lives here: file names from labels (:mod:`~scenarios.output.names`), the table renderings
-(:mod:`~scenarios.output.tables`), output directories, their manifest and staged commits
-(:mod:`~scenarios.output.directory`), the figures' data as arrays
-(:mod:`~scenarios.output.plot_data`), the matplotlib drawing (:mod:`~scenarios.output.plots`) and the
-plot process that draws while the run goes on (:mod:`~scenarios.output.renderer`).
+What lives here: a run's rows and results (:mod:`~scenarios.output.results`), file names from
+labels (:mod:`~scenarios.output.names`), the table forms of rows, their column names and the one
+rule for missing and non-finite values (:mod:`~scenarios.output.tables`), output directories, their
+manifest and staged commits (:mod:`~scenarios.output.directory`), the figures' data as arrays
+(:mod:`~scenarios.output.plot_data`), the matplotlib drawing (:mod:`~scenarios.output.plots`) and
+the plot process that draws while the run goes on (:mod:`~scenarios.output.renderer`).
 
 May import: :mod:`ocp`, :mod:`planners` (types), :mod:`scenarios.errors` and
 :mod:`scenarios.schema`. :mod:`~scenarios.output.plots` and :mod:`~scenarios.output.renderer` import
@@ -16,9 +17,14 @@ from __future__ import annotations
 from scenarios._faces import lazy_face
 
 _HOMES = {"Renderer": "scenarios.output.renderer",
+          "Row": "scenarios.output.results",
+          "RunResults": "scenarios.output.results",
           "claim_output_directory": "scenarios.output.directory",
           "read_manifest": "scenarios.output.directory",
           "row_stems": "scenarios.output.names",
+          "flatten_row": "scenarios.output.tables",
+          "metric_columns": "scenarios.output.tables",
+          "row_columns": "scenarios.output.tables",
           "sanitize": "scenarios.output.names",
           "to_csv": "scenarios.output.tables",
           "to_dataframe": "scenarios.output.tables",
@@ -27,6 +33,8 @@ _HOMES = {"Renderer": "scenarios.output.renderer",
           "to_terminal": "scenarios.output.tables",
           "write_results": "scenarios.output.directory"}
 
-__all__ = ["Renderer", "claim_output_directory", "read_manifest", "row_stems", "sanitize", "to_csv", "to_dataframe", "to_json", "to_markdown", "to_terminal", "write_results"]
+__all__ = ["Renderer", "Row", "RunResults", "claim_output_directory", "flatten_row", "metric_columns", "read_manifest",
+           "row_columns", "row_stems", "sanitize", "to_csv", "to_dataframe", "to_json", "to_markdown", "to_terminal",
+           "write_results"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)

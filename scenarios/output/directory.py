@@ -29,15 +29,13 @@ from typing import TYPE_CHECKING, Any, Iterable, Iterator
 import numpy as np
 
 from scenarios.errors import OutputError
-from scenarios.output.names import (
-    row_stems,
-)
-from scenarios.output.tables import to_csv, to_json, to_markdown
+from scenarios.output.names import row_stems
+from scenarios.output.tables import csv_cell, to_csv, to_json, to_markdown
 
 if TYPE_CHECKING:
-    from scenarios.runner import Row, RunResults
+    from scenarios.output.results import Row, RunResults
 
-__all__ = ["MARKER", "STAGING_PREFIX", "OutputError", "claim_output_directory", "commit_outputs", "new_staging",
+__all__ = ["MARKER", "STAGING_PREFIX", "claim_output_directory", "commit_outputs", "new_staging",
            "read_manifest", "write_manifest", "write_results", "write_timeseries"]
 
 MARKER = ".slewbench-output.json"
@@ -220,7 +218,7 @@ def write_timeseries(row: Row, path: Path) -> None:
     Columns: ``t`` [s], ``q0..q3`` (body to inertial, scalar first), ``omega_x..z`` [rad/s, body],
     ``h_w0..`` [N m s], ``u_x..z`` the applied body torque [N m, body] held from ``t`` (blank on
     the last line), ``ref_q0..3`` and ``ref_omega_x..z`` [rad/s] (blank without a reference).
-    Non-finite values are blank.
+    Non-finite values are blank (:func:`scenarios.output.tables.csv_cell`).
 
     Parameters
     ----------
@@ -247,7 +245,7 @@ def write_timeseries(row: Row, path: Path) -> None:
         writer = csv.writer(handle)
         writer.writerow(header)
         for line in table:
-            writer.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in line])
+            writer.writerow([csv_cell(float(v)) for v in line])
 
 
 def _relative_files(root: Path) -> list[str]:

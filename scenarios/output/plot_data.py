@@ -159,7 +159,7 @@ def row_series(row: Any, target_q: Any) -> RowSeries:
 
     Parameters
     ----------
-    row : scenarios.runner.Row
+    row : scenarios.output.results.Row
         A row with a simulation (and a reference unless regulating).
     target_q : (4,) array_like or None
         Target attitude (scalar-first quaternion, body to inertial) for the error angle.
@@ -231,7 +231,7 @@ def overlay_series(results: Any) -> OverlaySeries:
 
     Parameters
     ----------
-    results : scenarios.runner.RunResults
+    results : scenarios.output.results.RunResults
         The run.
 
     Returns
@@ -288,7 +288,7 @@ def cone_series(row: Any) -> ConeSeries:
 
     Parameters
     ----------
-    row : scenarios.runner.Row
+    row : scenarios.output.results.Row
         A row with a simulation and a reference whose ``stats["cones"]`` lists
         ``(boresight (body), direction (inertial), angle [rad], keep_out)``.
 
@@ -322,7 +322,7 @@ def plot_jobs(results: Any, stems: list[str] | None = None) -> list[PlotJob]:
 
     Parameters
     ----------
-    results : scenarios.runner.RunResults
+    results : scenarios.output.results.RunResults
         The run.
     stems : list of str, optional
         The rows' file stems; ``None``: ``row_stems`` of the labels.

@@ -301,7 +301,7 @@ def plot_cones(row: Any, path: Path) -> None:
 
     Parameters
     ----------
-    row : scenarios.runner.Row
+    row : scenarios.output.results.Row
         A row with a simulation and a reference whose ``stats["cones"]`` lists the cones.
     path : pathlib.Path
         Where to write the PNG.
@@ -314,7 +314,7 @@ def plot_overlay(results: Any, path: Path) -> None:
 
     Parameters
     ----------
-    results : scenarios.runner.RunResults
+    results : scenarios.output.results.RunResults
         The run (rows without a simulation are left out).
     path : pathlib.Path
         Where to write the PNG.
@@ -354,7 +354,7 @@ def write_plots(results: Any, directory: Path, stems: list[str] | None = None) -
 
     Parameters
     ----------
-    results : scenarios.runner.RunResults
+    results : scenarios.output.results.RunResults
         The run.
     directory : pathlib.Path
         Existing directory to write into.

@@ -1,10 +1,24 @@
-"""Rendering run results: JSON (ARCHITECTURE.md layout), flat CSV, Markdown, terminal text."""
+"""The table forms of result rows and the one rule for values a table cannot hold.
+
+A row's plain form is nested (:meth:`scenarios.output.results.Row.to_dict`: ``reference`` and
+``closed_loop`` metric dicts); its flat form (:func:`flatten_row`) has one column per metric and
+scope, ``ref.<metric>`` and ``cl.<metric>``, a vector metric split into ``<metric>_x``, ``_y`` and
+``_z``. A run's ``results.csv`` and :meth:`~scenarios.output.results.RunResults.to_dataframe`, a
+trade study's ``cases.csv``, :meth:`~scenarios.study.engine.SweepResults.to_dataframe` and its
+``summary:`` keys all use these columns.
+
+Missing and non-finite numbers (NaN, ±inf: a metric that does not apply, or a failed row's) follow
+one rule, applied by every writer here: JSON writes ``null`` (:func:`json_safe`), CSV an empty cell
+(:func:`csv_cell`), a DataFrame NaN in a float column (:func:`data_frame`), Markdown and the
+terminal ``-``.
+"""
 from __future__ import annotations
 
 import csv
 import io
 import json
 import math
+from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from ocp import METRIC_KEYS
@@ -12,25 +26,208 @@ from ocp import METRIC_KEYS
 if TYPE_CHECKING:
     import pandas
 
-    from scenarios.runner import RunResults
+    from scenarios.output.results import RunResults
 
-AXES = ("x", "y", "z")
 SCOPES = (("reference", "ref"), ("closed_loop", "cl"))
+"""(key of the nested row, prefix of its flat columns) for the reference's and the closed loop's metrics."""
+VECTOR_METRICS = ("int_abs_u",)
+"""Metrics whose value is a list of per-axis values, split into one column per axis."""
+AXES = ("x", "y", "z")
+IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s")
+"""The columns that name a row, before its metrics."""
+_SCORED = tuple(key for key in METRIC_KEYS if key != "plan_time_s")  # plan_time_s is an identity column
 
 
-def _clean(value: Any) -> Any:
-    """JSON-safe value: non-finite floats become null."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
+def is_missing(value: Any) -> bool:
+    """Whether a table value is missing: ``None``, or a non-finite number (NaN, ±inf).
+
+    Parameters
+    ----------
+    value : Any
+        A cell's value.
+
+    Returns
+    -------
+    bool
+        True for ``None`` and non-finite floats (NumPy's included).
+    """
+    return value is None or (isinstance(value, float) and not math.isfinite(value))
+
+
+def metric_columns(vectors: bool = True) -> list[str]:
+    """The flat metric columns: ``ref.<metric>`` then ``cl.<metric>``, in :data:`ocp.METRIC_KEYS` order.
+
+    Parameters
+    ----------
+    vectors : bool, optional
+        Include the per-axis columns of vector metrics (``ref.int_abs_u_x``, ``_y``, ``_z``).
+
+    Returns
+    -------
+    list of str
+        The column names.
+    """
+    columns = []
+    for _, prefix in SCOPES:
+        for key in _SCORED:
+            if key in VECTOR_METRICS:
+                columns += [f"{prefix}.{key}_{axis}" for axis in AXES] if vectors else []
+            else:
+                columns.append(f"{prefix}.{key}")
+    return columns
+
+
+def row_columns() -> list[str]:
+    """The columns of a flat row: :data:`IDENTITY_COLUMNS`, then :func:`metric_columns`.
+
+    Returns
+    -------
+    list of str
+        ``label, planner, controller, status, message, plan_time_s, ref.int_u2, ...``.
+    """
+    return [*IDENTITY_COLUMNS, *metric_columns()]
+
+
+def numeric_columns() -> list[str]:
+    """The columns of a flat row that hold numbers (float in a DataFrame).
+
+    Returns
+    -------
+    list of str
+        ``plan_time_s`` and every metric column.
+    """
+    return ["plan_time_s", *metric_columns()]
+
+
+def flatten_row(row: Mapping[str, Any]) -> dict[str, Any]:
+    """The flat form of a row's plain form: the one way from ``reference``/``closed_loop`` metric dicts
+    to ``ref.<metric>``/``cl.<metric>`` columns.
+
+    Parameters
+    ----------
+    row : mapping
+        A row as :meth:`scenarios.output.results.Row.to_dict` gives it (and a study stores it).
+
+    Returns
+    -------
+    dict
+        Keyed by :func:`row_columns`; a metric the row lacks (no reference, not simulated, crashed)
+        is ``None``, other values are as given (the writers apply the non-finite rule).
+    """
+    flat = {name: row.get(name) for name in IDENTITY_COLUMNS}
+    for scope, prefix in SCOPES:
+        metrics = row.get(scope) or {}
+        for key in _SCORED:
+            value = metrics.get(key)
+            if key in VECTOR_METRICS:
+                for axis, component in zip(AXES, value if value is not None else (None,) * len(AXES)):
+                    flat[f"{prefix}.{key}_{axis}"] = component
+            else:
+                flat[f"{prefix}.{key}"] = value
+    return flat
+
+
+def json_safe(value: Any) -> Any:
+    """``value`` with every missing or non-finite number as ``None`` (JSON ``null``), in nested
+    dicts, lists and tuples.
+
+    Parameters
+    ----------
+    value : Any
+        Plain data (dicts, lists, numbers, text).
+
+    Returns
+    -------
+    Any
+        The same structure (tuples as lists), ready for :func:`json.dumps` without NaN.
+    """
     if isinstance(value, dict):
-        return {k: _clean(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_clean(v) for v in value]
-    return value
+        return {k: json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    return None if is_missing(value) else value
+
+
+def csv_cell(value: Any) -> str:
+    """The text of a CSV cell: empty when missing or non-finite, ``repr`` of a float (it reads
+    back exactly), ``str`` otherwise.
+
+    Parameters
+    ----------
+    value : Any
+        The cell's value.
+
+    Returns
+    -------
+    str
+        The cell's text.
+    """
+    if is_missing(value):
+        return ""
+    if isinstance(value, float):
+        return repr(float(value))
+    return str(value)
+
+
+def csv_text(columns: Sequence[str], records: Iterable[Mapping[str, Any]]) -> str:
+    """A CSV table: a header of ``columns``, one line per record, cells by :func:`csv_cell`.
+
+    Parameters
+    ----------
+    columns : sequence of str
+        The columns, in order (a record's other keys are left out; a column it lacks is empty).
+    records : iterable of mapping
+        The lines.
+
+    Returns
+    -------
+    str
+        CSV text, one line per record after the header (LF line ends).
+    """
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(columns)
+    for record in records:
+        writer.writerow([csv_cell(record.get(column)) for column in columns])
+    return buffer.getvalue()
+
+
+def data_frame(columns: Sequence[str], records: Iterable[Mapping[str, Any]], numeric: Iterable[str]) -> pandas.DataFrame:
+    """A DataFrame of ``records`` whose ``numeric`` columns are float, NaN where missing or non-finite.
+
+    Parameters
+    ----------
+    columns : sequence of str
+        The columns, in order.
+    records : iterable of mapping
+        The lines.
+    numeric : iterable of str
+        The columns that hold numbers (never ``None`` in the DataFrame).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One line per record.
+
+    Raises
+    ------
+    ImportError
+        pandas is not installed.
+    """
+    try:
+        import pandas
+    except ImportError:
+        raise ImportError("to_dataframe needs pandas: pip install pandas") from None
+    numbers = set(numeric) & set(columns)
+    lines = [{column: (math.nan if is_missing(record.get(column)) else record.get(column)) if column in numbers
+              else record.get(column) for column in columns} for record in records]
+    frame = pandas.DataFrame(lines, columns=list(columns))
+    return frame.astype({column: float for column in columns if column in numbers})
 
 
 def to_json(results: RunResults) -> str:
-    """``results.json``: the layout of ARCHITECTURE.md, non-finite numbers written as ``null``.
+    """``results.json``: ``{"scenario": name, "rows": [Row.to_dict(), ...]}``, non-finite numbers
+    written as ``null``.
 
     Parameters
     ----------
@@ -42,66 +239,11 @@ def to_json(results: RunResults) -> str:
     str
         Indented JSON text.
     """
-    return json.dumps(_clean(results.to_dict()), indent=2)
-
-
-def flat_columns() -> list[str]:
-    """CSV columns: row identity, then every metric per scope (vectors split per axis).
-
-    Returns
-    -------
-    list of str
-        ``label, planner, controller, status, message, plan_time_s``, then ``ref_<metric>`` and
-        ``cl_<metric>`` for every metric key (``int_abs_u`` as ``_x``, ``_y``, ``_z``).
-    """
-    columns = ["label", "planner", "controller", "status", "message", "plan_time_s"]
-    for _, prefix in SCOPES:
-        for key in METRIC_KEYS:
-            if key in ("plan_time_s",):
-                continue
-            if key == "int_abs_u":
-                columns += [f"{prefix}_{key}_{axis}" for axis in AXES]
-            else:
-                columns.append(f"{prefix}_{key}")
-    return columns
-
-
-def flat_rows(results: RunResults) -> list[dict[str, Any]]:
-    """The rows as flat records keyed by :func:`flat_columns` (the CSV and DataFrame table).
-
-    Parameters
-    ----------
-    results : RunResults
-        The rows of a scenario run.
-
-    Returns
-    -------
-    list of dict
-        One record per row; a metric a row lacks is ``None``. Values are in the units of the
-        README's "Metrics" table.
-    """
-    table = []
-    for row in results.rows:
-        record = {"label": row.label, "planner": row.planner or "", "controller": row.controller or "",
-                  "status": row.status,
-                  "message": row.message, "plan_time_s": row.plan_time_s}
-        for scope, prefix in SCOPES:
-            metrics = getattr(row, f"{scope}_metrics") or {}
-            for key in METRIC_KEYS:
-                if key == "plan_time_s":
-                    continue
-                value = metrics.get(key)
-                if key == "int_abs_u":
-                    for axis, component in zip(AXES, value or (None, None, None)):
-                        record[f"{prefix}_{key}_{axis}"] = component
-                else:
-                    record[f"{prefix}_{key}"] = value
-        table.append(record)
-    return table
+    return json.dumps(json_safe(results.to_dict()), indent=2, allow_nan=False)
 
 
 def to_csv(results: RunResults) -> str:
-    """``results.csv``: :func:`flat_rows` under the :func:`flat_columns` header.
+    """``results.csv``: one line per row, the columns of :func:`row_columns`.
 
     Parameters
     ----------
@@ -113,13 +255,7 @@ def to_csv(results: RunResults) -> str:
     str
         CSV text; missing and non-finite values are empty cells.
     """
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=flat_columns(), lineterminator="\n")
-    writer.writeheader()
-    for record in flat_rows(results):
-        writer.writerow({k: "" if v is None or (isinstance(v, float) and not math.isfinite(v)) else v
-                         for k, v in record.items()})
-    return buffer.getvalue()
+    return csv_text(row_columns(), (flatten_row(row.to_dict()) for row in results.rows))
 
 
 def to_dataframe(results: RunResults) -> pandas.DataFrame:
@@ -133,25 +269,23 @@ def to_dataframe(results: RunResults) -> pandas.DataFrame:
     Returns
     -------
     pandas.DataFrame
-        One row per result row, the columns of :func:`flat_columns`.
+        One line per row, the columns of :func:`row_columns`; ``plan_time_s`` and the metric
+        columns are float, NaN where missing or non-finite.
 
     Raises
     ------
     ImportError
         pandas is not installed.
     """
-    try:
-        import pandas
-    except ImportError:
-        raise ImportError("to_dataframe needs pandas: pip install pandas") from None
-    return pandas.DataFrame(flat_rows(results), columns=flat_columns())
+    return data_frame(row_columns(), [flatten_row(row.to_dict()) for row in results.rows], numeric_columns())
 
 
 def _format(value: Any) -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, list):
+    """A Markdown and terminal cell: ``-`` when missing or non-finite, 4 significant digits."""
+    if isinstance(value, (list, tuple)):
         return "[" + ", ".join(_format(v) for v in value) + "]"
+    if is_missing(value):
+        return "-"
     if isinstance(value, float):
         return f"{value:.4g}"
     return str(value)
@@ -159,14 +293,12 @@ def _format(value: Any) -> str:
 
 def _metric_lines(results: RunResults) -> list[tuple[str, list[str]]]:
     """(metric name, one formatted cell per row), reference metrics then closed-loop ones."""
-    lines = [("status", [row.status for row in results.rows]),
-             ("plan_time_s", [_format(row.plan_time_s) for row in results.rows])]
+    rows = [row.to_dict() for row in results.rows]
+    lines = [("status", [row["status"] for row in rows]),
+             ("plan_time_s", [_format(row["plan_time_s"]) for row in rows])]
     for scope, prefix in SCOPES:
-        for key in METRIC_KEYS:
-            if key == "plan_time_s":
-                continue
-            cells = [_format((getattr(row, f"{scope}_metrics") or {}).get(key)) for row in results.rows]
-            lines.append((f"{prefix}.{key}", cells))
+        for key in _SCORED:
+            lines.append((f"{prefix}.{key}", [_format((row[scope] or {}).get(key)) for row in rows]))
     return lines
 
 

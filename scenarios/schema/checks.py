@@ -12,13 +12,14 @@ from controllers import CONTROLLERS
 from ocp.simulation.simulator import SUBSTEPS_PER_SAMPLE
 from planners import PLANNERS, ManeuverProblem
 from scenarios.errors import ScenarioError
+from scenarios.schema.labels import row_labels
 
 if TYPE_CHECKING:
     from scenarios.schema.loader import ControllerSpec, PlannerSpec, SimulationSpec
 
 
 def check_row_labels(planners: list[PlannerSpec], controllers: list[ControllerSpec]) -> None:
-    """Rows are labelled ``"<planner> / <controller>"`` with several controllers: those must differ.
+    """The rows' labels must be distinct (:func:`scenarios.schema.labels.row_labels`).
 
     Parameters
     ----------
@@ -30,20 +31,10 @@ def check_row_labels(planners: list[PlannerSpec], controllers: list[ControllerSp
     Raises
     ------
     ScenarioError
-        At ``<controller path>.label`` when two pairs make the same row label.
+        At ``planners[i].label`` or ``controllers[j].label`` when two rows get the same label.
     """
-    if len(controllers) < 2:
-        return
-    seen: dict[str, tuple[int, int]] = {}
-    for i, planner in enumerate(planners):
-        for j, controller in enumerate(controllers):
-            row = f"{planner.label} / {controller.label}"
-            if row in seen:
-                a, b = seen[row]
-                raise ScenarioError(f"{controller.path}.label", f"row label {row!r} is made twice (planners[{a}] with "
-                                                                f"controllers[{b}], planners[{i}] with controllers[{j}]); "
-                                                                "choose labels without ' / '")
-            seen[row] = (i, j)
+    row_labels([planner.label for planner in planners], [controller.label for controller in controllers])
+
 
 def check_work(problem: ManeuverProblem, simulation: SimulationSpec) -> None:
     """Refuse a closed-loop window with more samples than ``simulation.max_samples`` (the run

@@ -215,14 +215,11 @@ def _registered(node: Node, registry: dict[str, type], kind: str) -> tuple[str, 
 
 
 def _parse_planners(node: Node) -> list[PlannerSpec]:
-    specs, labels = [], set()
+    specs = []
     for item in node.items():
         item.mapping()
         name, options = _registered(item, PLANNERS, "planner")
         label = _label(item, name)
-        if label in labels:
-            raise ScenarioError(f"{item.path}.label", f"duplicate label {label!r}; give each row its own label")
-        labels.add(label)
         item.finish()
         specs.append(PlannerSpec(name, label, options))
     return specs
@@ -245,7 +242,8 @@ def _label(node: Node, default: str) -> str:
 
 
 def _parse_controllers(root: Node) -> list[ControllerSpec]:
-    """``controller:`` (one) or ``controllers:`` (a non-empty list, labels unique) of ``root``."""
+    """``controller:`` (one) or ``controllers:`` (a non-empty list) of ``root``; distinct labels are
+    checked with the rows' (:func:`~scenarios.schema.checks.check_row_labels`)."""
     if "controller" in root and "controllers" in root:
         raise ScenarioError("controllers", "give either `controller` (one) or `controllers` (a list), not both")
     if "controllers" not in root:
@@ -255,11 +253,6 @@ def _parse_controllers(root: Node) -> list[ControllerSpec]:
     specs = [_parse_controller(item) for item in node.items()]
     if not specs:
         raise ScenarioError("controllers", "expected at least one controller")
-    labels: set[str] = set()
-    for spec in specs:
-        if spec.label in labels:
-            raise ScenarioError(f"{spec.path}.label", f"duplicate label {spec.label!r}; give each controller its own label")
-        labels.add(spec.label)
     return specs
 
 

@@ -48,8 +48,9 @@ class SweepResults:
         The expanded study.
     records : dict
         Case key -> ``{"status", "rows", "elapsed_s", "attempts"}`` as stored
-        (:meth:`scenarios.study.store.SweepStore.records`): the cases run by this call and those
-        found in the store.
+        (:meth:`scenarios.study.store.SweepStore.records`; ``rows`` as
+        :meth:`scenarios.output.results.Row.to_dict` gives them): the cases run by this call and
+        those found in the store.
     workers : dict
         Worker (``host:pid``) -> solvers it built, for the workers of this call.
     cpu_s : dict
@@ -84,16 +85,18 @@ class SweepResults:
         return case_table(self.study, self.records)
 
     def to_dataframe(self) -> pandas.DataFrame:
-        """``cases.csv`` as a pandas DataFrame.
+        """``cases.csv`` as a pandas DataFrame (needs pandas installed).
 
         Returns
         -------
         pandas.DataFrame
-            One row per case and planner; columns as :meth:`table`.
+            One row per case and planner; columns as :meth:`table`. ``plan_time_s`` and the
+            metric columns are float, NaN where missing or non-finite (as
+            :meth:`scenarios.output.results.RunResults.to_dataframe`).
         """
-        import pandas
+        from scenarios.output.tables import data_frame, numeric_columns
         columns, rows = self.table()
-        return pandas.DataFrame(rows, columns=columns)
+        return data_frame(columns, rows, numeric_columns())
 
     def write(self, directory: str | Path, plots: bool = True) -> list[str]:
         """Write cases.csv, summary.csv, summary.md, study.yaml and plots.

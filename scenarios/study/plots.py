@@ -14,16 +14,18 @@ import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first
 import numpy as np  # noqa: E402
 
 from scenarios.output.names import row_stems
+from scenarios.output.tables import is_missing
 from scenarios.study.types import Study
 
 PARETO_AXES = ("cl.int_u", "cl.settling_time_s")
 
 
 def _value(row: dict[str, Any], key: str) -> float:
+    """A plotted value: NaN when missing or non-finite (the tables' rule) or when the row is not ok."""
     value = row.get(key)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or row.get("status") != "ok":
+    if row.get("status") != "ok" or isinstance(value, bool) or not isinstance(value, (int, float)) or is_missing(value):
         return math.nan
-    return float(value) if math.isfinite(value) else math.nan
+    return float(value)
 
 
 def _labels(rows: list[dict[str, Any]]) -> list[str]:

@@ -1,12 +1,12 @@
 """Tables and files of a trade study: ``cases.csv`` (one row per case and planner),
 ``summary.csv`` / ``summary.md`` (statistics per planner, and per grid point when there is
-Monte Carlo), the resolved ``study.yaml`` and the plots (:mod:`scenarios.study.plots`)."""
+Monte Carlo), the resolved ``study.yaml`` and the plots (:mod:`scenarios.study.plots`).
+
+A case's rows are flattened and written as a run's are (:mod:`scenarios.output.tables`: the same
+``ref.<metric>`` and ``cl.<metric>`` columns, the same rule for missing and non-finite values)."""
 from __future__ import annotations
 
-import csv
-import io
 import json
-import math
 import shutil
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -14,7 +14,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import yaml
 
-from ocp import METRIC_KEYS
 from scenarios.errors import OutputError
 from scenarios.output.directory import (
     MARKER,
@@ -24,34 +23,15 @@ from scenarios.output.directory import (
     read_manifest,
     write_manifest,
 )
+from scenarios.output.tables import csv_text, flatten_row, is_missing, row_columns
 from scenarios.study.store import STORE_NAME, is_sweep_store
 from scenarios.study.types import Study, package_version
 
 if TYPE_CHECKING:  # the engine imports this module lazily
     from scenarios.study.engine import SweepResults
 
-AXES = ("x", "y", "z")
-VECTOR_METRICS = ("int_abs_u",)
 STATISTICS = ("count", "failures", "mean", "std", "median", "p5", "p95", "min", "max")
-IDENTITY = ["label", "planner", "controller", "status", "message", "plan_time_s"]
 _DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml's emitter when built: same text, 3x faster
-
-
-def metric_columns() -> list[str]:
-    """The metric columns of ``cases.csv``.
-
-    Returns
-    -------
-    list of str
-        ``ref.<metric>`` then ``cl.<metric>``; vectors split into ``_x``, ``_y``, ``_z``.
-    """
-    columns = []
-    for scope in ("ref", "cl"):
-        for key in METRIC_KEYS:
-            if key == "plan_time_s":
-                continue
-            columns += [f"{scope}.{key}_{a}" for a in AXES] if key in VECTOR_METRICS else [f"{scope}.{key}"]
-    return columns
 
 
 def case_table(study: Study, records: dict[str, dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
@@ -67,36 +47,25 @@ def case_table(study: Study, records: dict[str, dict[str, Any]]) -> tuple[list[s
     Returns
     -------
     columns : list of str
-        ``case``, ``seed``, the varied paths, the row identity and the metric columns.
+        ``case``, ``seed``, the varied paths, then a run's columns
+        (:func:`scenarios.output.tables.row_columns`).
     rows : list of dict
-        One per case and planner (and controller), keyed by column.
+        One per case and planner (and controller), keyed by column: the stored row flattened by
+        :func:`scenarios.output.tables.flatten_row`.
     """
-    columns = ["case", "seed", *study.varied_paths, *IDENTITY, *metric_columns()]
+    columns = ["case", "seed", *study.varied_paths, *row_columns()]
     table = []
     for case in study.cases:
         record = records.get(case.key)
         if record is None:
             continue
         for row in record["rows"]:
-            line: dict[str, Any] = {"case": case.index, "seed": case.seed, **case.varied}
-            line.update({name: row.get(name) for name in IDENTITY})
-            for scope in ("ref", "cl"):
-                metrics = row.get(scope) or {}
-                for key in METRIC_KEYS:
-                    if key == "plan_time_s":
-                        continue
-                    value = metrics.get(key)
-                    if key in VECTOR_METRICS:
-                        for axis, component in zip(AXES, value or (None,) * 3):
-                            line[f"{scope}.{key}_{axis}"] = component
-                    else:
-                        line[f"{scope}.{key}"] = value
-            table.append(line)
+            table.append({"case": case.index, "seed": case.seed, **case.varied, **flatten_row(row)})
     return columns, table
 
 
 def _number(value: Any) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or is_missing(value):
         return None
     return float(value)
 
@@ -144,18 +113,9 @@ def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], 
     return columns, table
 
 
-def _csv(columns: list[str], rows: list[dict[str, Any]]) -> str:
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=columns, lineterminator="\n", extrasaction="ignore")
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: "" if v is None else (repr(v) if isinstance(v, float) else v) for k, v in row.items()})
-    return buffer.getvalue()
-
-
 def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], missing: int) -> str:
     def cell(value: Any) -> str:
-        return "-" if value is None else f"{value:.4g}" if isinstance(value, float) else str(value)
+        return "-" if is_missing(value) else f"{value:.4g}" if isinstance(value, float) else str(value)
 
     out = [f"# {study.name}", "", f"{len(study.cases)} cases ({missing} missing), "
            f"{study.samples} Monte Carlo sample(s) per grid point, slewbench {package_version()}.", "",
@@ -255,7 +215,7 @@ def write_report(results: SweepResults, directory: str | Path, plots: bool = Tru
     directory = claim_sweep_directory(directory)
     columns, rows = case_table(study, results.records)
     summary_columns, summary = summary_table(study, rows)
-    files = {"cases.csv": _csv(columns, rows), "summary.csv": _csv(summary_columns, summary),
+    files = {"cases.csv": csv_text(columns, rows), "summary.csv": csv_text(summary_columns, summary),
              "summary.md": _markdown(study, summary_columns, summary, results.missing),
              "study.yaml": yaml.dump(resolved_study(study), Dumper=_DUMPER, sort_keys=False, width=120)}
     staging = new_staging(directory)

@@ -20,6 +20,7 @@ import numpy as np
 
 from ocp import METRIC_KEYS, quat
 from scenarios.errors import ScenarioError
+from scenarios.output.tables import VECTOR_METRICS, metric_columns
 from scenarios.schema.loader import parse_scenario
 from scenarios.schema.node import Node
 from scenarios.schema.read import read_yaml
@@ -29,8 +30,7 @@ from scenarios.study.types import Case, Execution, Study, case_key, package_vers
 
 MAX_CASES = 100_000
 MAX_VALUES = 10_000
-DEFAULT_SUMMARY = tuple(f"{scope}.{key}" for scope in ("ref", "cl") for key in METRIC_KEYS
-                        if key not in ("plan_time_s", "int_abs_u"))  # every scalar metric
+DEFAULT_SUMMARY = tuple(metric_columns(vectors=False))  # every scalar metric, reference and closed loop
 
 
 def _tree_copy(value: Any) -> Any:
@@ -244,12 +244,15 @@ def parse_study(data: Any, source: Path | None = None, version: str | None = Non
 
 
 def _check_summary(summary: list[str]) -> None:
+    """Summary keys are metric columns of ``cases.csv`` (:func:`scenarios.output.tables.metric_columns`)."""
+    columns = metric_columns()
     for index, metric in enumerate(summary):
-        scope, _, key = metric.partition(".")
-        base_key = key[:-2] if key[-2:] in ("_x", "_y", "_z") else key
-        if scope not in ("ref", "cl") or base_key not in METRIC_KEYS:
+        if metric not in columns:
+            scalars = [key for key in METRIC_KEYS if key != "plan_time_s" and key not in VECTOR_METRICS]
+            vectors = ", ".join(f"cl.{key}_x" for key in VECTOR_METRICS)
             raise ScenarioError(f"summary[{index}]", f"expected ref.<metric> or cl.<metric> with a metric of "
-                                                     f"{list(METRIC_KEYS)}, got {metric!r}")
+                                                     f"{scalars}, or one axis of a vector metric ({vectors}, _y, _z), "
+                                                     f"got {metric!r}")
 
 
 def _expand(study: Study, steps: list[list[Step]], points: list[tuple[list, list]],

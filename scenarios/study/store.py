@@ -4,19 +4,38 @@ Every finished case is one row, committed at once, keyed by the hash of its reso
 the package version (:func:`scenarios.study.types.case_key`). A process killed at any moment leaves
 every committed case readable and no half-written one, so ``--resume`` re-runs only what is
 missing, and a case stored twice (a retry that raced a resume) replaces itself, never duplicates.
+
+A case's rows are stored in their plain form (:meth:`scenarios.output.results.Row.to_dict`),
+non-finite numbers as JSON ``null`` (:func:`scenarios.output.tables.json_safe`). A store written by
+an earlier slewbench (:data:`EARLIER_FORMATS`) opens for reading only (``--report``); its rows are
+read in today's form.
 """
 from __future__ import annotations
 
 import contextlib
 import json
-import math
 import sqlite3
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from scenarios.output.tables import json_safe
+
 STORE_NAME = "sweep.sqlite"
-FORMAT = "slewbench-sweep-1"
+FORMAT = "slewbench-sweep-2"
+"""The format this version writes: rows keyed ``reference`` and ``closed_loop``."""
+
+
+def _rows_of_format_1(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Rows of ``slewbench-sweep-1`` (metrics under ``ref`` and ``cl``) in today's form."""
+    return [{**{k: v for k, v in row.items() if k not in ("ref", "cl")},
+             "reference": row.get("ref"), "closed_loop": row.get("cl")} for row in rows]
+
+
+EARLIER_FORMATS: dict[str, Callable[[list[dict[str, Any]]], list[dict[str, Any]]]] = {
+    "slewbench-sweep-1": _rows_of_format_1}
+"""Formats of earlier versions that can still be read, and how their rows are read in today's form."""
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (name TEXT PRIMARY KEY, value TEXT NOT NULL);
@@ -31,14 +50,30 @@ CREATE TABLE IF NOT EXISTS cases (
 """
 
 
-def _json_safe(value: Any) -> Any:
-    if isinstance(value, float) and not math.isfinite(value):
+def store_format(directory: str | Path) -> str | None:
+    """The format tag of ``directory/sweep.sqlite`` (read only: the file is not changed).
+
+    Parameters
+    ----------
+    directory : str or Path
+        The output directory that may hold the store.
+
+    Returns
+    -------
+    str or None
+        The tag (:data:`FORMAT`, one of :data:`EARLIER_FORMATS`, or another), or None when there is
+        no such file, it is not an SQLite database or it carries no tag.
+    """
+    path = Path(directory) / STORE_NAME
+    if not path.is_file():
         return None
-    if isinstance(value, dict):
-        return {k: _json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(v) for v in value]
-    return value
+    try:
+        with contextlib.closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=30.0)) as db:
+            found = db.execute("SELECT value FROM meta WHERE name = 'format'").fetchone()
+        tag = None if found is None else json.loads(found[0])
+    except (sqlite3.Error, ValueError):
+        return None
+    return tag if isinstance(tag, str) else None
 
 
 def is_sweep_store(directory: str | Path) -> bool:
@@ -52,15 +87,11 @@ def is_sweep_store(directory: str | Path) -> bool:
     Returns
     -------
     bool
-        True if the file exists, is an SQLite database and carries slewbench's format tag.
+        True if the file exists, is an SQLite database and carries slewbench's format tag (this
+        version's or one of :data:`EARLIER_FORMATS`).
     """
-    path = Path(directory) / STORE_NAME
-    try:
-        with contextlib.closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=30.0)) as db:
-            found = db.execute("SELECT value FROM meta WHERE name = 'format'").fetchone()
-    except sqlite3.Error:
-        return False
-    return found is not None and json.loads(found[0]) == FORMAT
+    tag = store_format(directory)
+    return tag == FORMAT or tag in EARLIER_FORMATS
 
 
 class SweepStore:
@@ -71,14 +102,16 @@ class SweepStore:
     directory : str or Path
         The study's output directory (must exist).
     create : bool, optional
-        Create the database if it does not exist (else an absent store is an error).
+        Create the database if it does not exist, to run cases into. False: open an existing
+        store to read it (a store of one of :data:`EARLIER_FORMATS` opens only so).
 
     Raises
     ------
     FileNotFoundError
         ``create`` is false and there is no store.
     ValueError
-        The file is an SQLite database of another format.
+        The file is an SQLite database of another format, or of an earlier slewbench's format and
+        ``create`` is true.
     """
 
     def __init__(self, directory: str | Path, create: bool = True) -> None:
@@ -90,9 +123,17 @@ class SweepStore:
         self._db.execute("PRAGMA synchronous=NORMAL")  # durable against a killed process
         self._db.executescript(_SCHEMA)
         stored = self.get_meta("format")
+        self._read_rows: Callable[[list[dict[str, Any]]], list[dict[str, Any]]] = list
         if stored is None:
             self.set_meta("format", FORMAT)
+        elif stored in EARLIER_FORMATS and not create:
+            self._read_rows = EARLIER_FORMATS[stored]
+        elif stored in EARLIER_FORMATS:
+            self._db.close()
+            raise ValueError(f"{self.path} was written by an earlier slewbench (format {stored!r}); it can be "
+                             "read (create=False) but takes no new cases")
         elif stored != FORMAT:
+            self._db.close()
             raise ValueError(f"{self.path} holds {stored!r}, not a {FORMAT!r} store")
 
     def close(self) -> None:
@@ -115,7 +156,8 @@ class SweepStore:
         value : Any
             JSON-serialisable data; non-finite floats are stored as null.
         """
-        self._db.execute("INSERT OR REPLACE INTO meta VALUES (?, ?)", (name, json.dumps(_json_safe(value))))
+        self._db.execute("INSERT OR REPLACE INTO meta VALUES (?, ?)",
+                         (name, json.dumps(json_safe(value), allow_nan=False)))
 
     def get_meta(self, name: str) -> Any:
         """The JSON value stored under ``name``.
@@ -144,15 +186,15 @@ class SweepStore:
         status : str
             ``ok`` (the runner finished) or ``crashed``.
         rows : list of dict
-            The case's rows, plain dicts, one per planner and controller; non-finite floats are
-            stored as null.
+            The case's rows (:meth:`scenarios.output.results.Row.to_dict`), one per planner and
+            controller; non-finite floats are stored as null.
         elapsed_s : float or None
             Wall time of the case in its worker [s]; None when the driver gave up on it.
         attempts : int
             How many times the case was started.
         """
         self._db.execute("INSERT OR REPLACE INTO cases VALUES (?, ?, ?, ?, ?, ?)",
-                         (key, status, json.dumps(_json_safe(rows)), elapsed_s, attempts, time.time()))
+                         (key, status, json.dumps(json_safe(rows), allow_nan=False), elapsed_s, attempts, time.time()))
 
     def keys(self) -> set[str]:
         """The keys of the stored cases.
@@ -169,9 +211,11 @@ class SweepStore:
         Returns
         -------
         dict
-            Case key -> ``{"status", "rows", "elapsed_s", "attempts"}`` as given to :meth:`put`.
+            Case key -> ``{"status", "rows", "elapsed_s", "attempts"}`` as given to :meth:`put`
+            (the rows of an earlier format in today's form).
         """
-        return {key: {"status": status, "rows": json.loads(rows), "elapsed_s": elapsed, "attempts": attempts}
+        return {key: {"status": status, "rows": self._read_rows(json.loads(rows)), "elapsed_s": elapsed,
+                      "attempts": attempts}
                 for key, status, rows, elapsed, attempts
                 in self._db.execute("SELECT key, status, rows, elapsed_s, attempts FROM cases")}
 

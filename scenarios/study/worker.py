@@ -20,6 +20,8 @@ from typing import Any, Callable, Hashable, TypeVar
 
 from ocp import SolverCache
 from scenarios.errors import CaseTimeout
+from scenarios.output.results import Row
+from scenarios.schema.labels import row_labels
 
 V = TypeVar("V")
 
@@ -70,64 +72,34 @@ def worker_state() -> tuple[SolverCache, RecentCache, threading.Lock]:
     return SolverCache(), RecentCache(), threading.Lock()
 
 
-def _controllers(scenario: dict[str, Any]) -> list[tuple[str, str]]:
-    """(label, name) of the scenario mapping's controllers (``controllers:`` list or ``controller:``)."""
-    entries = scenario.get("controllers") or [scenario.get("controller") or {}]
-    return [(str(c.get("label", c.get("name"))), str(c.get("name"))) for c in entries]
-
-
-def row_labels(scenario: dict[str, Any]) -> list[tuple[str, str | None, str]]:
-    """The rows the runner makes for a scenario mapping, in its order (for a crashed case's rows).
-
-    Parameters
-    ----------
-    scenario : dict
-        A resolved scenario mapping (plain YAML data).
-
-    Returns
-    -------
-    list of (str, str or None, str)
-        (label, planner, controller) of each row: one per planner and controller, or per
-        controller in regulation mode (planner None).
-    """
-    controllers = _controllers(scenario)
-    planners = scenario.get("planners") or []
-    if not planners:
-        return [(label, None, name) for label, name in controllers]
-    rows = []
-    for planner in planners:
-        planner_label = str(planner.get("label", planner.get("name")))
-        for label, name in controllers:
-            rows.append((planner_label if len(controllers) == 1 else f"{planner_label} / {label}",
-                         planner.get("name"), name))
-    return rows
+def _labels(entries: list[Any]) -> list[str]:
+    """The labels of planner or controller mappings (a label defaults to the name, as the schema says)."""
+    return [str(entry.get("label", entry.get("name"))) for entry in entries]
 
 
 def crashed_rows(scenario: dict[str, Any], message: str) -> list[dict[str, Any]]:
-    """One ``crashed`` row per row of ``scenario`` carrying ``message``.
+    """One ``crashed`` row per row the runner makes for ``scenario``, carrying ``message``.
+
+    The rows are labelled as the runner labels them (:func:`scenarios.schema.labels.row_labels`),
+    from the scenario's mapping: the case may have crashed before or while it was parsed.
 
     Parameters
     ----------
     scenario : dict
-        The case's scenario mapping.
+        The case's scenario mapping (plain YAML data, checked when the study was expanded).
     message : str
         Why the case crashed.
 
     Returns
     -------
     list of dict
-        Plain rows (``label``, ``planner``, ``controller``, ``status``, ``message``; no metrics).
+        Plain rows (:meth:`scenarios.output.results.Row.to_dict`, status ``crashed``, no metrics).
     """
-    return [{"label": label, "planner": planner, "controller": controller, "status": "crashed",
-             "message": message, "plan_time_s": None, "ref": None, "cl": None}
-            for label, planner, controller in row_labels(scenario)]
-
-
-def _plain_row(row: Any, controller: str) -> dict[str, Any]:
-    return {"label": row.label, "planner": row.planner,
-            "controller": getattr(row, "controller", None) or controller,
-            "status": row.status, "message": row.message, "plan_time_s": row.plan_time_s,
-            "ref": row.reference_metrics, "cl": row.closed_loop_metrics}
+    planners = scenario.get("planners") or []
+    controllers = scenario.get("controllers") or [scenario.get("controller") or {}]
+    return [Row(label, None if i is None else planners[i].get("name"), "crashed", message, None, None, None,
+                controller=controllers[j].get("name")).to_dict()
+            for label, i, j in row_labels(_labels(planners), _labels(controllers))]
 
 
 def _on_alarm(signum: int, frame: Any) -> None:
@@ -147,7 +119,8 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     -------
     dict
         ``key``, ``status`` (``ok``: the runner finished, whatever its rows say; ``crashed``: the
-        case raised or ran out of time), ``rows`` (plain dicts), ``elapsed_s`` (wall time [s]),
+        case raised or ran out of time), ``rows`` (:meth:`scenarios.output.results.Row.to_dict`
+        of each row), ``elapsed_s`` (wall time [s]),
         ``cpu_s`` (CPU time of the case [s]), ``worker_cpu_s`` (CPU time of the worker process
         since it started [s]), ``worker`` (host:pid) and ``cache_builds`` (solvers built by this
         worker so far).
@@ -166,7 +139,7 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
                 signal.setitimer(signal.ITIMER_REAL, timeout)
             scenario = parse_scenario(data)
             results = run(scenario, cache=cache, simulators=simulators)
-            status, rows = "ok", [_plain_row(row, scenario.controllers[0].name) for row in results.rows]
+            status, rows = "ok", [row.to_dict() for row in results.rows]
         except CaseTimeout:
             status, rows = "crashed", crashed_rows(data, f"timed out after {timeout:g} s (case_timeout_s)")
         except Exception as error:  # a case that raises is a row, the sweep goes on
