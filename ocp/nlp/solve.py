@@ -166,8 +166,6 @@ class NLPResult:
         return stats
 
 
-Array = NDArray[np.float64]
-
 SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 STALLED_AT_FEASIBLE = ("Search_Direction_Becomes_Too_Small",)
 INFEASIBLE = ("Infeasible_Problem_Detected", "Restoration_Failed")

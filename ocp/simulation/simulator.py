@@ -284,7 +284,6 @@ def measure(x: Array, t: float, noise: SensorNoise, rng: np.random.Generator, fi
     return Measurement(t=t, q=q.copy(), omega=omega.copy(), wheel_momentum=x[7:].copy(), field_body=field)
 
 
-Array = NDArray[np.float64]
 INTEGRATORS = ("rk4", "cvodes")
 MAX_SAMPLES = 1_000_000
 """Default bound on the samples of one run (a 100,000 s run at 0.1 s): more is refused, not attempted."""
