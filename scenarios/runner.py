@@ -44,7 +44,7 @@ class Row:
     plan_time_s : float or None
         Planning time [s]; ``None`` in regulation mode.
     reference_metrics : dict or None
-        Metrics of the reference itself (ARCHITECTURE.md's metric keys); ``None`` without one.
+        Metrics of the reference itself (the keys of :doc:`/metrics`); ``None`` without one.
     closed_loop_metrics : dict or None
         Metrics of the closed-loop simulation; ``None`` when it was not simulated.
     reference : planners.Reference or None, optional
@@ -70,7 +70,7 @@ class Row:
     controller: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The row as ARCHITECTURE.md's ``results.json`` writes it.
+        """The row as ``results.json`` writes it (:doc:`/outputs`).
 
         Returns
         -------

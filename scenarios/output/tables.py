@@ -1,4 +1,4 @@
-"""Rendering run results: JSON (ARCHITECTURE.md layout), flat CSV, Markdown, terminal text."""
+"""Rendering run results: JSON, flat CSV, Markdown, terminal text (layouts: :doc:`/outputs`)."""
 from __future__ import annotations
 
 import csv
@@ -30,7 +30,7 @@ def _clean(value: Any) -> Any:
 
 
 def to_json(results: RunResults) -> str:
-    """``results.json``: the layout of ARCHITECTURE.md, non-finite numbers written as ``null``.
+    """``results.json`` (layout: :doc:`/outputs`), non-finite numbers written as ``null``.
 
     Parameters
     ----------
@@ -78,7 +78,7 @@ def flat_rows(results: RunResults) -> list[dict[str, Any]]:
     -------
     list of dict
         One record per row; a metric a row lacks is ``None``. Values are in the units of the
-        README's "Metrics" table.
+        metrics page (:doc:`/metrics`).
     """
     table = []
     for row in results.rows:
