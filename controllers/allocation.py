@@ -1,4 +1,4 @@
-"""The mapping of a rigid-body control torque onto the actuators (ARCHITECTURE.md), shared by
+"""The mapping of a rigid-body control torque onto the actuators (:doc:`/architecture`), shared by
 every controller through :class:`Allocation`.
 
 Wheels take ``τ_w = u + ω × A h_w`` through ``g = −A⁺ τ_w`` (working wheels only); what the wheels

@@ -2,7 +2,7 @@
 
 A controller computes, at each sample, a :class:`~ocp.dynamics.actuators.Command`. Laws written for the
 rigid body ``I ω̇ = −ω × I ω + u`` compute ``u`` and call :meth:`Controller.allocate`, which maps it
-to the actuators as ARCHITECTURE.md states (:mod:`controllers.allocation`);
+to the actuators as :doc:`/architecture` states (:mod:`controllers.allocation`);
 :meth:`Controller.allocate_symbolic` is the same map on CasADi expressions. The vector layouts of
 the symbolic form are in :mod:`ocp.dynamics.layout`.
 """

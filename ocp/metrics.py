@@ -1,10 +1,10 @@
 """The common score of a motion: one function, :func:`compute_metrics`, used for references
-sampled on a grid and for closed-loop simulations alike. Keys are part of the contract
-(ARCHITECTURE.md, "Metrics").
+sampled on a grid and for closed-loop simulations alike. Keys are part of the contract; each is
+defined, with its unit, in :data:`METRIC_INFO` (the documentation's metrics page is that table).
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -18,7 +18,84 @@ METRIC_KEYS: tuple[str, ...] = (
     "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
     "fine_settling_time_s", "initial_rate_error",
 )
-"""Every key :func:`compute_metrics` returns; definitions and units in the README's "Metrics" table."""
+"""Every key :func:`compute_metrics` returns; definitions and units in :data:`METRIC_INFO`."""
+
+
+class MetricInfo(NamedTuple):
+    """Unit and definition of one metric key.
+
+    Attributes
+    ----------
+    unit : str
+        SI unit of the value (``–`` for a ratio).
+    meaning : str
+        Its definition as :func:`compute_metrics` computes it (reStructuredText inline markup).
+    """
+
+    unit: str
+    meaning: str
+
+
+METRIC_INFO: dict[str, MetricInfo] = {
+    "int_u2": MetricInfo(
+        "N² m² s", "∫ ‖u‖₂² dt over the window: the control effort."),
+    "int_u": MetricInfo(
+        "N m s", "∫ ‖u‖₂ dt, the integrated torque (Euclidean norm, not the sum of the axes)."),
+    "int_abs_u": MetricInfo(
+        "N m s", "[∫ |u_x| dt, ∫ |u_y| dt, ∫ |u_z| dt], one integral per body axis (a list of three; "
+        "the CSV tables split it into ``_x``, ``_y``, ``_z`` columns)."),
+    "peak_u": MetricInfo(
+        "N m", "max over the samples and the axes of |u_i| (0 without any torque sample)."),
+    "final_error_deg": MetricInfo(
+        "deg", "Error angle 2 acos|q_e0| (``q_e = q_f* ⊗ q``) between the attitude at the last sample and "
+        "the target ``q_f``; null when the final attitude is free."),
+    "final_rate_error": MetricInfo(
+        "rad/s", "‖ω(t_N) − ω_f‖ at the last sample; null when the final rate is free."),
+    "rms_error_deg": MetricInfo(
+        "deg", "Closed loop with a reference: √(mean over the samples of e_k²), e_k the error angle between "
+        "the attitude and the reference attitude at t_k; null for a reference and in regulation."),
+    "max_error_deg": MetricInfo(
+        "deg", "Closed loop with a reference: max over the samples of e_k (as for ``rms_error_deg``); null for a "
+        "reference and in regulation."),
+    "settling_time_s": MetricInfo(
+        "s", "t_(j+1) for the last sample j whose error angle to ``q_f`` exceeds the band "
+        "(``simulation.settling_tolerance_deg``, default 0.5°); 0 if no sample does; null if the last "
+        "sample does, or when the final attitude is free."),
+    "saturation_fraction": MetricInfo(
+        "–", "Closed loop: fraction of the held intervals in which any actuator was at its limit (a wheel "
+        "torque clipped by its torque or momentum limit or at its torque limit, a dipole or torquer axis "
+        "at or beyond its limit); null for a reference."),
+    "peak_wheel_momentum": MetricInfo(
+        "N m s", "Closed loop: max over the samples and the wheels of |h_w|; null without wheels and for a "
+        "reference."),
+    "plan_time_s": MetricInfo(
+        "s", "Wall time of the planner's ``plan``; null in regulation (no planner)."),
+    "duration_s": MetricInfo(
+        "s", "The reference's manoeuvre time T (chosen by the planner when the time is free); null in "
+        "regulation."),
+    "detumble_time_s": MetricInfo(
+        "s", "t_(j+1) for the last sample j where max_i |ω_i| ≥ ``simulation.detumble_tolerance`` "
+        "(default 0.01 rad/s), i.e. the first sample time after which the rate stays below it to the end; "
+        "0 if it holds throughout; null if it does not hold at the last sample."),
+    "int_dipole": MetricInfo(
+        "A m² s", "∫ ‖m‖ dt of the applied (saturated) magnetorquer dipole, zero-order hold; null without "
+        "magnetorquers and for a reference."),
+    "final_rate": MetricInfo(
+        "rad/s", "‖ω(t_N)‖, the body rate at the last sample."),
+    "energy_ratio": MetricInfo(
+        "–", "½ ω(t_N)ᵀ I ω(t_N) / ½ ω(t_0)ᵀ I ω(t_0), the body's rotational kinetic energy at the end over "
+        "that at the start (wheels excluded); null when the initial energy is zero."),
+    "fine_settling_time_s": MetricInfo(
+        "s", "As ``settling_time_s`` with the band ``simulation.fine_settling_tolerance_deg``; null when it "
+        "is not set."),
+    "initial_rate_error": MetricInfo(
+        "rad/s", "Reference: ‖ω(t_0) − ω_0‖, the initial rate a planner that declares ``omega0`` free leaves "
+        "to the closed loop; null in closed loop."),
+}
+"""Unit and definition of every key of :data:`METRIC_KEYS`, in the same order. ``u`` is the body
+torque (body axes): a reference's feed-forward torque, or in closed loop the applied actuator torque
+held over each sample; t_0 … t_N are the sample times of the scored window. A metric that does not
+apply is null (``None``)."""
 DEFAULT_SETTLING_TOLERANCE_DEG = 0.5
 """deg, error band about the target attitude for ``settling_time_s``."""
 DEFAULT_DETUMBLE_TOLERANCE = 0.01
@@ -106,7 +183,7 @@ def compute_metrics(
     inertia: ArrayLike | None = None,
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
 ) -> dict[str, Any]:
-    """Metrics of a motion sampled at times ``t`` (definitions: the README's "Metrics" table).
+    """Metrics of a motion sampled at times ``t`` (definitions: :data:`METRIC_INFO`).
 
     Integrals of a quantity given once per interval (N values) use the zero-order hold
     ``Σ_k (t_k+1 − t_k) f_k``; given at the N+1 sample times, trapezoids.

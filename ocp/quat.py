@@ -1,6 +1,6 @@
 """Quaternion algebra in NumPy, vectorised over leading axes.
 
-Conventions (ARCHITECTURE.md): ``q = [q0, q1, q2, q3]`` scalar first, Hamilton product, unit
+Conventions (:doc:`/architecture`): ``q = [q0, q1, q2, q3]`` scalar first, Hamilton product, unit
 norm; ``q`` rotates body vectors into the inertial frame, ``v_I = R(q) v_B``. Every function
 accepts arrays of shape ``(..., 4)`` (and ``(..., 3)`` for vectors) and broadcasts.
 The CasADi twins live in :mod:`ocp.quat_casadi`; tests check that both agree.

@@ -1,4 +1,4 @@
-"""Quaternion algebra on CasADi symbols, and the same operations as named ``casadi.Function``s.
+"""Quaternion algebra on CasADi symbols, and the same operations as named ``casadi.Function`` objects.
 
 The expression builders (``product``, ``rotation_matrix``, …) take and return 4- or 3-vectors of
 ``SX``/``MX``/``DM`` and are what the model uses to build its right-hand side. :data:`FUNCTIONS`

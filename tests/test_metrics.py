@@ -1,7 +1,7 @@
 """Every metric key on hand-built motions, with the expected value worked out here from its
-definition (README, "Metrics"): zero-order-hold integrals are sums of held value x interval,
-norms are Euclidean, RMS is the root of the mean square, settling is the first sample time after
-which the error stays inside the band."""
+definition (the metrics page of the documentation): zero-order-hold integrals are sums of held
+value x interval, norms are Euclidean, RMS is the root of the mean square, settling is the first
+sample time after which the error stays inside the band."""
 from __future__ import annotations
 
 import math

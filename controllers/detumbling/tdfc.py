@@ -7,7 +7,7 @@ Dissipation: for a body spinning at ``ω`` in a field fixed in inertial space, `
 ``B(t)`` turned back by the angle ``|ω| τ`` about ``ω``, and the power of the law is
 ``ω·(m × B) = −K_t |ω| sin(|ω| τ) |B_⊥|²`` (``B_⊥``: the part of ``B`` normal to ``ω``). It removes
 energy only while ``|ω| τ < π``; for ``π < |ω| τ < 2π`` it pumps energy in. The paper (τ = 2 s,
-|ω0| = 0.9 rad/s) does not state this limit: the law needs ``τ < π / |ω|max``.
+``|ω0|`` = 0.9 rad/s) does not state this limit: the law needs ``τ < π / |ω|max``.
 
 Symbolic form: state ``z = [B̃_{k−1}, …, B̃_{k−d}, n]`` (3d + 1 numbers), ``n`` the number of
 readings stored so far (at most d).

@@ -7,7 +7,7 @@ wheel motor torques (N m, ``ḣ_w = g``), magnetorquer dipole (A m², body axes)
 (N m, body axes). Parameter ``p`` (3): the constant disturbance torque in body axes (N m); its
 default value is the environment's, and passing it lets one built model serve many runs.
 
-Dynamics (ARCHITECTURE.md): ``I ω̇ = −ω × (I ω + A h_w) − A g + m × B_B + τ_t + τ_gg + p``.
+Dynamics (:doc:`/architecture`): ``I ω̇ = −ω × (I ω + A h_w) − A g + m × B_B + τ_t + τ_gg + p``.
 """
 from __future__ import annotations
 

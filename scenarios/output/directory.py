@@ -1,6 +1,6 @@
 """Output directories that slewbench owns, and writing a run's results into them safely.
 
-The rules (README, "What slewbench writes"):
+The rules (:doc:`/outputs`, "What slewbench writes, and what it never touches"):
 
 * Every output directory carries slewbench's marker, :data:`MARKER`, a JSON manifest naming the
   files slewbench wrote there and whether the set is complete. A directory is claimed only when it

@@ -1,4 +1,4 @@
-"""Scenario YAML schema (ARCHITECTURE.md, "Scenario YAML") and the :class:`Scenario` it builds.
+"""Scenario YAML schema (:doc:`/reference/schema`) and the :class:`Scenario` it builds.
 
 Every error is a :class:`~scenarios.schema.node.ScenarioError` naming the YAML path and what was
 expected. Degrees (``*_deg``) and kilometres (``*_km``) are converted to SI here, and so are

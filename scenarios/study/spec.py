@@ -1,4 +1,4 @@
-"""Trade-study files (ARCHITECTURE.md, "Trade studies"): schema, value generators and the
+"""Trade-study files (:doc:`/reference/schema`): schema, value generators and the
 expansion of a study into resolved cases, each validated by the scenario loader.
 
 A study varies a base scenario over a ``grid`` (cartesian product), a ``zip`` (equal-length lists
