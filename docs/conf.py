@@ -284,15 +284,14 @@ def write_output_fragments() -> None:
     """``_generated/*.inc``: column lists, reserved names and markers of the outputs."""
     from scenarios.output.directory import MARKER, STAGING_PREFIX
     from scenarios.output.names import MAX_STEM, RESERVED
-    from scenarios.output.tables import flat_columns
-    from scenarios.study.report import IDENTITY, STATISTICS, STORE_FILES, metric_columns
+    from scenarios.output.tables import row_columns
+    from scenarios.study.report import STATISTICS, STORE_FILES
 
     generated = DOCS / "_generated"
-    _write(generated / "results_csv_columns.inc", _literal_list(flat_columns()) + "\n")
+    _write(generated / "results_csv_columns.inc", _literal_list(row_columns()) + "\n")
     _write(generated / "timeseries_columns.inc", _literal_list(_timeseries_header()) + "\n")
     _write(generated / "cases_csv_columns.inc",
-           "``case``, ``seed``, *one column per varied path*, " + _literal_list(IDENTITY) + ", "
-           + _literal_list(metric_columns()) + "\n")
+           "``case``, ``seed``, *one column per varied path*, " + _literal_list(row_columns()) + "\n")
     _write(generated / "summary_statistics.inc", _literal_list(list(STATISTICS)) + "\n")
     _write(generated / "reserved_stems.inc", _literal_list(sorted(RESERVED)) + "\n")
     _write(generated / "store_files.inc", _literal_list(list(STORE_FILES)) + "\n")
