@@ -1,9 +1,12 @@
-"""The first planner a newcomer writes, following only the README: the README's example passes the
-conformance test as written, and the usual first mistakes fail with a message that says what to do.
-The code is the README's own block (edited per mistake), so the test follows the README."""
+"""The first planner a newcomer writes, following only the guide to adding a planner
+(docs/extending/planner.rst): its example passes the conformance test as written, and the usual
+first mistakes fail with a message that says what to do. The code is the page's own block (edited
+per mistake), so the test follows the documentation."""
 from __future__ import annotations
 
 import re
+import textwrap
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -13,23 +16,37 @@ import pytest
 from planners.conformance import CHECKS, check_reference, standard_problems
 from planners.errors import ConformanceError
 
-README = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-(EXAMPLE,) = [block for block in re.findall(r"```python\n(.*?)```", README, flags=re.DOTALL) if "class CubicSlewPlanner" in block]
-DEFINITIONS = EXAMPLE.split("problem = standard_problems()")[0]
+DOCS = Path(__file__).resolve().parents[1] / "docs"
+PAGE = DOCS / "extending" / "planner.rst"
+
+
+@cache
+def definitions() -> str:
+    """The page's example planner: its python block that defines ``CubicSlewPlanner``, up to the
+    lines that use it (a reStructuredText ``code-block`` or ``literalinclude``, or a Markdown fence)."""
+    assert PAGE.is_file(), f"{PAGE} is missing: the guide to adding a planner holds the example this test runs"
+    text = PAGE.read_text()
+    blocks = [textwrap.dedent(body) for body in re.findall(
+        r"^\.\. code-block:: python\n(?: {3}:.*\n)*\n((?:(?: {3}.*)?\n)+)", text, flags=re.MULTILINE)]
+    blocks += re.findall(r"```python\n(.*?)```", text, flags=re.DOTALL)
+    for path in re.findall(r"^\.\. literalinclude:: (\S+)", text, flags=re.MULTILINE):  # "/x": from docs/
+        blocks.append((DOCS / path[1:] if path.startswith("/") else PAGE.parent / path).read_text())
+    (example,) = [block for block in blocks if "class CubicSlewPlanner" in block]
+    return example.split("problem = standard_problems()")[0]
 
 
 def newcomer_module(*edits: tuple[str, str]) -> dict[str, Any]:
-    """The README's planner, with each ``(old, new)`` edit applied (``old`` must be in the README)."""
-    source = DEFINITIONS
+    """The page's planner, with each ``(old, new)`` edit applied (``old`` must be in the page)."""
+    source = definitions()
     for old, new in edits:
-        assert old in source, f"the README example no longer contains {old!r}"
+        assert old in source, f"the example of {PAGE.name} no longer contains {old!r}"
         source = source.replace(old, new)
     namespace: dict[str, Any] = {"__name__": "newcomer"}
-    exec(compile(source, "README.md example planner", "exec", dont_inherit=True), namespace)
+    exec(compile(source, f"{PAGE.name} example planner", "exec", dont_inherit=True), namespace)
     return namespace
 
 
-def test_the_readme_planner_passes_every_check_on_every_problem_it_accepts():
+def test_the_documented_planner_passes_every_check_on_every_problem_it_accepts():
     planner = newcomer_module()["CubicSlewPlanner"]()
     accepted = 0
     for problem in standard_problems().values():

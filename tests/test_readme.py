@@ -1,14 +1,23 @@
-"""Every command and code block of README.md is run here, taken from the README itself, so that a
-test fails when the README drifts from what the code does.
+"""Every command and code block of README.md and of the user guide (docs/guide/*.rst) is run or
+checked here, taken from the text itself, so that a test fails when the documentation drifts from
+what the code does.
 
-* ``slewbench ...`` lines run as ``python -m scenarios.cli ...`` (placeholders ``FILE.yaml`` and
-  ``[--out DIR]`` filled in) in a scratch directory; the files the README promises must appear.
+* ``slewbench ...`` commands run as ``python -m scenarios.console ...`` (placeholders ``FILE.yaml``
+  and ``[--out DIR]`` filled in) in a scratch directory; the files the README promises must appear.
 * ``pytest ...`` commands are collected (``--collect-only``, ``slow``): they must select tests, and
   ``pytest -m slow`` none of the default ones. The whole default run is CI's job (``.ci/run``).
-* ``python`` blocks are executed from the repository root; ``python tests/...`` commands run there
-  and must exit 0; ``mypy`` too (``slow``: CI runs it as a step of its own).
-* ``pip install .`` into a fresh virtual environment, then the quick start's ``slewbench run``
-  through the installed console script: ``slow``.
+* ``python`` blocks are executed from the repository root and must print; ``python tests/...``
+  commands run there and must exit 0; ``mypy`` too (``slow``: CI runs it as a step of its own).
+* ``yaml`` blocks that are whole scenarios (a ``maneuver`` key) or studies (a ``study`` key) are
+  read and parsed as slewbench reads a file, every case of a study included; a scenario block named like a shipped
+  scenario must be that file. Fragments (a ``controllers:`` list alone) are not checked.
+* ``pip install ".[extra]"`` must name an extra of ``pyproject.toml``; ``pip install .`` into a
+  fresh virtual environment, then the quick start's ``slewbench run`` through the installed console
+  script: ``slow``. ``sphinx-build`` builds the documentation as the README says: ``slow``.
+
+Commands are taken from the README's ``bash`` blocks and its inline code, and from the guide's
+``.. code-block:: bash`` blocks (not from its inline literals, which name keys and commands in
+prose); ``text`` blocks are shown, not run. A command written in several places runs once.
 """
 from __future__ import annotations
 
@@ -17,22 +26,42 @@ import re
 import shlex
 import subprocess
 import sys
+import textwrap
 import venv
 from functools import cache
 from pathlib import Path
 
 import pytest
 
+from scenarios.schema.read import parse_yaml_text, read_yaml
+
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text()
-BLOCKS = re.findall(r"```(\w+)\n(.*?)```", README, flags=re.DOTALL)
-INLINE = re.findall(r"`((?:pytest|slewbench|python -m pytest|python tests/|mypy|pip install mypy)\b[^`]*)`", README)
+GUIDE = {path.relative_to(ROOT).as_posix(): path.read_text() for path in sorted((ROOT / "docs" / "guide").glob("*.rst"))}
+
+
+def _markdown_blocks(text: str) -> list[tuple[str, str]]:
+    return re.findall(r"```(\w+)\n(.*?)```", text, flags=re.DOTALL)
+
+
+def _rst_blocks(text: str) -> list[tuple[str, str]]:
+    """``.. code-block:: LANG`` directives: their indented body, dedented."""
+    found = re.findall(r"^\.\. code-block:: (\w+)\n(?: {3}:.*\n)*\n((?:(?: {3}.*)?\n)+)", text, flags=re.MULTILINE)
+    return [(language, textwrap.dedent(body).strip("\n") + "\n") for language, body in found]
+
+
+BLOCKS = [("README.md", language, body) for language, body in _markdown_blocks(README)]
+BLOCKS += [(name, language, body) for name, text in GUIDE.items() for language, body in _rst_blocks(text)]
+# Inline code of the README that is a command (multi-line spans joined into one line).
+INLINE = [" ".join(c.split()) for c in re.findall(
+    r"`((?:pytest|slewbench|python -m pytest|python tests/|mypy|pip install mypy)\b[^`]*)`", README)]
 
 
 def _shell_commands() -> list[str]:
-    """Every command of the README: bash block lines (comments dropped, ``&&`` split) and inline ones."""
+    """Every command: bash block lines (comments dropped, ``&&`` split) and the README's inline ones,
+    each once, in order of appearance."""
     commands = []
-    for language, body in BLOCKS:
+    for _, language, body in BLOCKS:
         if language != "bash":
             continue
         for line in body.splitlines():
@@ -40,25 +69,49 @@ def _shell_commands() -> list[str]:
             commands += [part.strip() for part in line.split("&&") if part.strip()]
     # Inline mentions of a subcommand by name (`slewbench run` in prose) are not commands.
     mentions = {"slewbench"} | {f"slewbench {name}" for name in ("run", "validate", "sweep", "codegen")}
-    return commands + [c.strip() for c in INLINE if c.strip() not in commands and c.strip() not in mentions]
+    commands += [c for c in INLINE if c not in mentions]
+    return list(dict.fromkeys(commands))
 
 
 COMMANDS = _shell_commands()
 SLEWBENCH = [c for c in COMMANDS if c.startswith("slewbench ")]
 PYTEST = sorted({c for c in COMMANDS if c.startswith(("pytest", "python -m pytest"))})
-PYTHON = [body for language, body in BLOCKS if language == "python"]
+PYTHON = [(source, body) for source, language, body in BLOCKS if language == "python"]
 SCRIPTS = [c for c in COMMANDS if c.startswith(("python tests/", "mypy"))]
+SPHINX = [c for c in COMMANDS if c.startswith("sphinx-build ")]
+YAML = [(source, parse_yaml_text(body, source)) for source, language, body in BLOCKS if language == "yaml"]
+SCENARIOS = [(source, data) for source, data in YAML if isinstance(data, dict) and "maneuver" in data]
+STUDIES = [(source, data) for source, data in YAML if isinstance(data, dict) and "study" in data]
 
 
-def test_the_readme_has_the_commands_it_is_tested_for():
-    assert any(c.startswith("pip install .") for c in COMMANDS)
-    assert any(c.startswith("slewbench run scenarios/") for c in SLEWBENCH)
-    assert "pytest" in PYTEST and "pytest -m slow" in PYTEST
-    assert len(PYTHON) >= 2
-    assert "python tests/public_api.py" in SCRIPTS and "mypy" in SCRIPTS
+def test_the_documentation_has_the_commands_it_is_tested_for():
+    readme = _markdown_commands()
+    assert any(c.startswith("pip install .") for c in readme)
+    assert any(c.startswith("slewbench run scenarios/") for c in readme)
+    assert "pytest" in readme and "pytest -m slow" in readme
+    assert sum(language == "python" for source, language, _ in BLOCKS if source == "README.md") >= 2
+    assert "python tests/public_api.py" in readme and "mypy" in readme
+    assert any(c.startswith("sphinx-build ") for c in readme)
+    assert GUIDE and SCENARIOS and STUDIES
     unknown = [c for c in COMMANDS if not c.startswith(("pip install", "slewbench ", "pytest", "python -m pytest",
-                                                        "python tests/", "mypy"))]
+                                                        "python tests/", "mypy", "sphinx-build "))]
     assert not unknown, f"commands this test does not know how to run: {unknown}"
+
+
+def _markdown_commands() -> list[str]:
+    """The README's own commands (its bash blocks and inline code)."""
+    readme = [body for source, language, body in BLOCKS if source == "README.md" and language == "bash"]
+    commands = [part.strip() for body in readme for line in body.splitlines()
+                for part in line.split("#")[0].split("&&") if part.strip()]
+    return commands + INLINE
+
+
+def test_the_guide_is_every_page_of_its_index():
+    """Each guide page is in the guide's toctree (else Sphinx warns and the page is unreachable)."""
+    index = GUIDE["docs/guide/index.rst"]
+    entries = set(re.findall(r"^ {3}(\w+)$", index.split(".. toctree::")[1], flags=re.MULTILINE))
+    pages = {Path(name).stem for name in GUIDE} - {"index"}
+    assert entries == pages
 
 
 def _environment() -> dict[str, str]:
@@ -89,11 +142,15 @@ def test_slewbench_command(command, tmp_path):
         assert any((folder / "timeseries").glob("*.csv"))
     if args[1] == "list":
         assert "spin_extremal" in done.stdout and "augmented_quaternion_feedback" in done.stdout
+    if args[1] == "codegen":
+        (folder,) = [tmp_path / args[args.index("--out") + 1]]
+        assert {"Makefile", "interface.json"} <= {path.name for path in folder.iterdir()}
+        assert any(folder.glob("*.c")) and any(folder.glob("*.h"))
 
 
 @cache
 def _collected(command: str) -> list[str]:
-    args = shlex.split(command.replace("my_method", "eigenaxis"))  # the README's placeholder planner name
+    args = shlex.split(command.replace("my_method", "eigenaxis"))  # the documentation's placeholder planner name
     args = args[1:] if args[0] == "pytest" else args[3:]
     done = subprocess.run([sys.executable, "-m", "pytest", *args, "--collect-only", "-q", "-p", "no:cacheprovider"],
                           cwd=ROOT, env=_environment(), capture_output=True, text=True, check=False, timeout=300)
@@ -127,11 +184,56 @@ def test_mypy_command():
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-2000:]
 
 
-@pytest.mark.parametrize("index", range(len(PYTHON)))
+@pytest.mark.parametrize("index", range(len(PYTHON)), ids=[f"{source}-{i}" for i, (source, _) in enumerate(PYTHON)])
 def test_python_block(index, monkeypatch, capsys):
     monkeypatch.chdir(ROOT)
-    exec(compile(PYTHON[index], f"README.md python block {index}", "exec", dont_inherit=True), {"__name__": "readme"})
+    source, body = PYTHON[index]
+    exec(compile(body, f"{source} python block {index}", "exec", dont_inherit=True), {"__name__": "readme"})
     assert capsys.readouterr().out.strip()  # every block prints its result
+
+
+@pytest.mark.parametrize("index", range(len(SCENARIOS)),
+                         ids=[f"{source}-{data.get('name')}" for source, data in SCENARIOS])
+def test_yaml_scenario_block_loads(index):
+    import scenarios
+
+    _, data = SCENARIOS[index]
+    scenario = scenarios.parse_scenario(data, ROOT / "scenarios" / "documentation.yaml")
+    shipped = {read_yaml(path).get("name"): path for path in (ROOT / "scenarios").glob("*.yaml")}
+    if scenario.name in shipped:
+        # A block named like a shipped scenario shows that file, as it is.
+        assert data == read_yaml(shipped[scenario.name]), shipped[scenario.name].name
+
+
+@pytest.mark.parametrize("index", range(len(STUDIES)), ids=[f"{source}-{data.get('study')}" for source, data in STUDIES])
+def test_yaml_study_block_loads(index):
+    import scenarios
+
+    _, data = STUDIES[index]
+    study = scenarios.parse_study(data, ROOT / "scenarios" / "documentation.yaml")
+    assert study.cases  # every case was checked by the scenario loader
+
+
+@pytest.mark.parametrize("command", [c for c in COMMANDS if re.match(r"pip install \S*\[", c)])
+def test_pip_extra_exists(command):
+    (extra,) = re.findall(r"\[(\w+)\]", command)
+    # The keys of [project.optional-dependencies] (tomllib is Python 3.11+; the project supports 3.10).
+    section = (ROOT / "pyproject.toml").read_text().split("[project.optional-dependencies]\n")[1].split("\n[")[0]
+    extras = re.findall(r"^(\w+)\s*=", section, flags=re.MULTILINE)
+    assert extra in extras, f"{command!r}: pyproject.toml has no extra {extra!r} (it has {sorted(extras)})"
+
+
+@pytest.mark.slow  # builds every page, the API reference and the gallery (minutes)
+@pytest.mark.parametrize("command", SPHINX)
+def test_sphinx_build_command(command, tmp_path):
+    pytest.importorskip("sphinx")
+    args = shlex.split(command)[1:]
+    args[-1] = str(tmp_path / "html")  # the README's output folder, moved out of the checkout
+    done = subprocess.run([sys.executable, "-m", "sphinx", *args], cwd=ROOT, env=_environment(),
+                          capture_output=True, text=True, check=False, timeout=1800)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    assert (tmp_path / "html" / "index.html").is_file()
+    assert (tmp_path / "html" / "guide" / "index.html").is_file()
 
 
 @pytest.mark.slow
