@@ -1,5 +1,5 @@
 """The problem side of ``collocation``: pointing cones from their YAML form, and the variables'
-bounds from the spacecraft (split from :mod:`planners.collocation.planner` by responsibility)."""
+bounds from the spacecraft."""
 from __future__ import annotations
 
 import numpy as np

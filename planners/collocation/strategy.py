@@ -1,7 +1,6 @@
 """How ``collocation`` searches: the tuned constants of ``multistart: auto`` and of the coarse-to-fine
 mesh transfer, the perturbation floor of its first start, and merging the record of a failed solve
-into its fallback's (split from :mod:`planners.collocation.planner` by responsibility; the planner
-re-exports the constants).
+into its fallback's. :mod:`planners.collocation.planner` reads them from here.
 """
 from __future__ import annotations
 

@@ -37,7 +37,7 @@ from scenarios.output.tables import to_csv, to_json, to_markdown
 if TYPE_CHECKING:
     from scenarios.runner import Row, RunResults
 
-__all__ = ["MARKER", "STAGING_PREFIX", "OutputError", "claim_output_directory", "commit_outputs", "new_staging",
+__all__ = ["MARKER", "STAGING_PREFIX", "claim_output_directory", "commit_outputs", "new_staging",
            "read_manifest", "write_manifest", "write_results", "write_timeseries"]
 
 MARKER = ".slewbench-output.json"
