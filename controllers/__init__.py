@@ -1,4 +1,13 @@
-"""Feedback controllers. ``CONTROLLERS`` maps registry names to controller classes."""
+"""Feedback controllers. ``CONTROLLERS`` maps registry names to controller classes.
+
+The contract is :mod:`controllers.base` (:class:`Controller`: a numeric law, its symbolic form,
+options and capabilities) with the torque-to-actuator map of :mod:`controllers.allocation`;
+:mod:`controllers.conformance` checks it for any law (``check_controller``), and
+:mod:`controllers.errors` holds the package's exceptions. The laws: :mod:`controllers.none`,
+:mod:`controllers.tracking`, :mod:`controllers.detumbling` and :mod:`controllers.two_wheel`.
+
+May import: :mod:`ocp` and :mod:`planners`; never :mod:`scenarios`.
+"""
 from controllers.base import Controller, gain_matrix
 from controllers.detumbling.bdot import BDot
 from controllers.detumbling.tdfc import TDFC
@@ -18,5 +27,5 @@ CONTROLLERS: dict[str, type[Controller]] = {
                               SingularZeroMomentum, SingularRateTracking, MinNorm, GainScheduledMinNorm)
 }
 
-__all__ = ["AugmentedQuaternionFeedback", "BDot", "TDFC", "CONTROLLERS", "Controller", "CostateFeedback", "EigenaxisPD",
+__all__ = ["CONTROLLERS", "TDFC", "AugmentedQuaternionFeedback", "BDot", "Controller", "CostateFeedback", "EigenaxisPD",
            "GainScheduledMinNorm", "MinNorm", "NoControl", "SingularRateTracking", "SingularZeroMomentum", "gain_matrix"]

@@ -18,7 +18,8 @@ A method that overrides a documented base-class method inherits its docstring (`
 so the contract is written once, on the base class.
 
 Run ``python tests/public_api.py [PACKAGE ...]`` from the repository root to list the breaches by
-file; ``tests/test_public_api.py`` fails on any.
+file and count what was audited (modules, classes, functions and methods); ``tests/test_public_api.py``
+fails on any breach, and if the count falls below the house's.
 """
 from __future__ import annotations
 
@@ -149,9 +150,7 @@ def check_class(qualname: str, cls: type) -> list[str]:
         for p in _parameters(signature, True) if signature else []:
             if p.annotation is inspect.Parameter.empty:
                 problems.append(f"{qualname}.__init__: parameter '{p.name}' has no type hint")
-    for name, member in cls.__dict__.items():
-        if name.startswith("_"):
-            continue
+    for name, member in class_members(cls):
         where = f"{qualname}.{name}"
         if isinstance(member, property):
             if member.fget is not None:
@@ -163,9 +162,60 @@ def check_class(qualname: str, cls: type) -> list[str]:
                                        doc=_inherited_doc(cls, name, member.__func__))
         elif inspect.isfunction(member):
             problems += check_function(where, member, method=True, doc=_inherited_doc(cls, name, member))
-        elif inspect.isclass(member) and member.__qualname__.startswith(cls.__qualname__ + "."):
+        elif inspect.isclass(member):
             problems += check_class(where, member)
     return problems
+
+
+def class_members(cls: type) -> Iterator[tuple[str, Any]]:
+    """The public members a class defines itself that the audit checks: functions, properties,
+    static and class methods, and the classes nested in it."""
+    for name, member in cls.__dict__.items():
+        if name.startswith("_"):
+            continue
+        if (isinstance(member, (property, staticmethod, classmethod)) or inspect.isfunction(member)
+                or (inspect.isclass(member) and member.__qualname__.startswith(cls.__qualname__ + "."))):
+            yield name, member
+
+
+def module_members(module: Any) -> Iterator[tuple[str, Any]]:
+    """The public classes and functions defined in ``module`` (not those it imports)."""
+    for name, obj in vars(module).items():
+        if name.startswith("_") or getattr(obj, "__module__", None) != module.__name__:
+            continue
+        if inspect.isclass(obj) or inspect.isfunction(obj):
+            yield name, obj
+
+
+def audited(module: Any) -> list[tuple[str, Any]]:
+    """``(qualified name, object)`` of everything the audit checks in ``module``: its classes and
+    functions, and the members of its classes (nested classes' members too)."""
+    found: list[tuple[str, Any]] = []
+
+    def walk(qualname: str, obj: Any) -> None:
+        found.append((qualname, obj))
+        if inspect.isclass(obj):
+            for name, member in class_members(obj):
+                walk(f"{qualname}.{name}", member)
+
+    for name, obj in module_members(module):
+        walk(f"{module.__name__}.{name}", obj)
+    return found
+
+
+def census(packages: tuple[str, ...] = PACKAGES) -> tuple[int, int, int]:
+    """How much the audit covers: ``(modules, classes, functions)``, the public modules walked
+    (subpackages at any depth), the classes audited (nested ones included), and the functions,
+    methods and properties audited."""
+    modules = classes = functions = 0
+    for module in public_modules(packages):
+        modules += 1
+        for _, obj in audited(module):
+            if inspect.isclass(obj):
+                classes += 1
+            else:
+                functions += 1
+    return modules, classes, functions
 
 
 def _inherited_doc(cls: type, name: str, function: Callable[..., Any]) -> str | None:
@@ -182,9 +232,7 @@ def _inherited_doc(cls: type, name: str, function: Callable[..., Any]) -> str | 
 def audit_module(module: Any) -> list[str]:
     """Every breach of the rules by the public classes and functions defined in ``module``."""
     problems: list[str] = []
-    for name, obj in vars(module).items():
-        if name.startswith("_") or getattr(obj, "__module__", None) != module.__name__:
-            continue
+    for name, obj in module_members(module):
         where = f"{module.__name__}.{name}"
         if inspect.isclass(obj):
             problems += check_class(where, obj)
@@ -213,4 +261,7 @@ if __name__ == "__main__":
             print(f"    {problem}")
         total += len(problems)
     print(f"{total} breaches in {len(result)} files")
+    modules, classes, functions = census(tuple(sys.argv[1:]) or PACKAGES)
+    print(f"audited {modules} modules: {classes} classes and {functions} functions, methods and properties "
+          f"({classes + functions} names)")
     sys.exit(1 if total else 0)

@@ -4,7 +4,8 @@ What lives here: the parser and the single-scenario commands (:mod:`~scenarios.c
 study commands (:mod:`~scenarios.cli.sweep`). ``python -m scenarios.cli`` runs it in one process;
 the console script (:mod:`scenarios.console`) starts the plot process first.
 
-May import: everything of :mod:`scenarios`; nothing imports it but the console script.
+May import: everything of :mod:`scenarios`, and :mod:`planners` and :mod:`controllers` (their
+registries); nothing imports it but the console script.
 """
 from __future__ import annotations
 

@@ -45,11 +45,9 @@ from scenarios.output.plot_data import (
 
 __all__ = [
     "COMPRESS_LEVEL",
-    "DPI",
     "LABEL_OFFSET_IN",
     "SAVE",
     "RowFigure",
-    "decimate",
     "draw_cones",
     "draw_jobs",
     "draw_overlay",

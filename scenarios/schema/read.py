@@ -2,8 +2,8 @@
 refused, dates kept as text, and exponent numbers such as ``6e5`` read as floats (YAML 1.1 reads
 them as strings). Errors are :class:`ScenarioError` naming the YAML path.
 
-:mod:`scenarios.schema.node` re-exports everything here; :class:`~scenarios.schema.node.Node` wraps a
-parsed value with its path.
+Values that name their path are :mod:`scenarios.schema.node`'s :class:`~scenarios.schema.node.Node`,
+which wraps a value parsed here.
 """
 from __future__ import annotations
 
