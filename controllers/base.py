@@ -70,6 +70,9 @@ class Controller(Allocation, Configurable, ABC):
       or ``None`` (regulation to the target). It is the reference implementation of the law.
     * ``needs_reference``: the law cannot regulate (``reference=None``) and raises ``ValueError``
       there; the scenario loader rejects regulation mode for it.
+    * ``tracks_reference``: given a reference, the law follows it (``augmented_quaternion_feedback``;
+      implied by ``needs_reference``); otherwise it regulates to the target whatever the reference
+      (``eigenaxis_pd``, the two-wheel laws, the detumbling laws).
     * ``needs_target_attitude``: in regulation mode the law needs ``maneuver.final.q``. Laws that
       regulate the rate alone (detumbling: ``bdot``, ``tdfc``; ``none``) set it to ``False`` and
       then accept a free final attitude (``q: null``).
@@ -111,10 +114,13 @@ class Controller(Allocation, Configurable, ABC):
     least-squares fit, a call into a reference object) does not implement ``_law`` and overrides
     :meth:`symbolic_error` with the reason; the simulator then uses its Python loop.
     The test ``tests/test_symbolic_laws.py`` checks, for every registered controller, that
-    ``__call__`` and the symbolic law agree to 1e-12 at random states over several samples.
+    ``__call__`` and the symbolic law agree to 1e-12 at random states over several samples;
+    :mod:`controllers.conformance` checks that and the rest of this contract for any law
+    (:func:`~controllers.conformance.check_controller`).
     """
 
     needs_reference: bool = False
+    tracks_reference: bool = False
     needs_target_attitude: bool = True
     needs_field_rate: bool = False
 

@@ -3,8 +3,8 @@
 A planner turns a manoeuvre problem into a reference motion. The base class :class:`Planner`
 states the contract, :class:`Reference` what a reference provides (a :class:`ReferenceSample` of
 ``q``, ``ω``, ``ω̇`` and the rigid-body feed-forward torque at any times); one module per method
-implements it; ``planners.PLANNERS`` maps registry names to classes. The README section "Adding a
-planner" walks through a complete example, and :mod:`planners.conformance` checks the contract.
+implements it; ``planners.PLANNERS`` maps registry names to classes. The extension guide
+:doc:`/extending/planner` walks through a complete example, and :mod:`planners.conformance` checks the contract.
 
 The parts of the contract live in :mod:`planners.problem` (:class:`ManeuverProblem`),
 :mod:`planners.reference` (:class:`Reference`, :class:`ReferenceSample`, :class:`FailedReference`,

@@ -69,7 +69,7 @@ class Reference(ABC):
     A reference meets the problem's boundary conditions ``q(0) = q0``, ``ω(0) = ω0``,
     ``q(T) = qf``, ``ω(T) = ωf`` (those not ``None``) unless it declares them in
     ``free_boundary``. A subclass calls ``super().__init__(name, T, problem.spacecraft.inertia,
-    ...)`` and implements ``_evaluate``; the README section "Adding a planner" has a complete one,
+    ...)`` and implements ``_evaluate``; the extension guide :doc:`/extending/planner` has a complete one,
     and :func:`planners.conformance.check_reference` checks it.
 
     Parameters

@@ -269,7 +269,7 @@ def test_a_shared_cache_keeps_the_fatrop_seed_apart_from_a_fatrop_mesh():
 
 
 def test_seed_fatrop_options_apply_to_the_ipopt_option_seed_only(monkeypatch):
-    # SEED_FATROP is documented (README, its docstring) for the seed FATROP solves in place of the
+    # SEED_FATROP is documented (the optimal-control guide, its docstring) for the seed FATROP solves in place of the
     # `solver: ipopt` option; a `solver: fatrop` plan's coarse seed keeps FATROP's defaults.
     from ocp.transcription import base as transcription_base
 

@@ -55,7 +55,7 @@ def read_csv(text):
 # --- columns and the non-finite rule ------------------------------------------------------------
 
 def expected_metric_columns():
-    """Written out from the README's metric table: ref then cl, int_abs_u split per axis, no plan_time_s."""
+    """Written out from the metrics page's table: ref then cl, int_abs_u split per axis, no plan_time_s."""
     columns = []
     for scope in ("ref", "cl"):
         for key in METRIC_KEYS:

@@ -71,7 +71,7 @@ default 50 × 4 is 200)."""
 
 @dataclass(frozen=True)
 class CollocationOptions:
-    """Options of ``collocation`` (YAML keys; see the README's planner table).
+    """Options of ``collocation`` (YAML keys; see :doc:`/guide/planners` and :doc:`/reference/schema`).
 
     Attributes
     ----------
