@@ -1,4 +1,4 @@
-"""Reference-motion planners. ``PLANNERS`` maps registry names to planner classes.
+"""Reference-motion planners. ``PLANNERS`` (:mod:`planners.registry`) maps registry names to planner classes.
 
 The contract is :mod:`planners.base` (:class:`Planner`; :class:`ManeuverProblem` in,
 :class:`Reference` out, evaluated as :class:`ReferenceSample` rows) and :mod:`planners.conformance`
@@ -19,12 +19,12 @@ from planners.reference import (
     ReferenceSample,
     inverse_dynamics_torque,
 )
+from planners.registry import PLANNERS
 from planners.shape_polynomial import ShapePolynomialPlanner
 from planners.spin_extremal import SpinExtremalPlanner
 
-PLANNERS: dict[str, type[Planner]] = {
-    cls.name: cls for cls in (CollocationPlanner, CostateTPBVPPlanner, EigenaxisPlanner, NaturalMotionPlanner, ShapePolynomialPlanner, SpinExtremalPlanner)
-}
+PLANNERS.update({cls.name: cls for cls in (CollocationPlanner, CostateTPBVPPlanner, EigenaxisPlanner,
+                                            NaturalMotionPlanner, ShapePolynomialPlanner, SpinExtremalPlanner)})
 
 __all__ = ["BOUNDARY_CONDITIONS", "FailedReference", "ManeuverProblem", "PLANNERS", "Planner", "Reference", "ReferenceSample",
            "inverse_dynamics_torque"]

@@ -8,7 +8,7 @@ side (pointing cones from YAML, variable bounds from the spacecraft;
 
 May import: :mod:`ocp` (transcriptions and the NLP core) and the contract modules of
 :mod:`planners` (``base``, ``problem``, ``reference``); other planners only through the
-``PLANNERS`` registry, to seed from their references.
+``PLANNERS`` registry (:mod:`planners.registry`), to seed from their references.
 """
 from planners.collocation.planner import CollocationOptions, CollocationPlanner
 from planners.collocation.reference import CollocationReference

@@ -62,6 +62,7 @@ from planners.collocation.strategy import (
 )
 from planners.problem import Array, ManeuverProblem
 from planners.reference import FailedReference, Reference
+from planners.registry import PLANNERS
 
 MAX_RK4_STEPS = 1000
 """Largest ``intervals × substeps`` of ``multiple_shooting``: the NLP build expands every RK4 step
@@ -161,9 +162,6 @@ class CollocationOptions:
     max_iterations: Annotated[int, Range(ge=1, le=100000)] = 500
 
     def __post_init__(self) -> None:
-        from planners import (
-            PLANNERS,  # the registry is complete once options are parsed
-        )
 
         # A collocation warm start is planned with its own options (say min_energy, itself warm
         # started from eigenaxis): the way into min_time where a kinematic seed is too far
@@ -281,8 +279,6 @@ class CollocationPlanner(Planner):
     def _starts(self, problem: ManeuverProblem, failures: list[str] | None = None) -> list[Reference]:
         """The references of the warm start and the seed planners that planned; each failure's
         ``planner: message`` is appended to ``failures`` when given."""
-        from planners import PLANNERS
-
         starts = []
         requested = [(self.options.warm_start, self.options.warm_start_options)]
         requested += [(name, None) for name in self.options.seed_planners]
