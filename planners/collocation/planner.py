@@ -84,7 +84,8 @@ class CollocationOptions:
     degree : int
         Radau points per interval (``collocation``).
     transcription : str
-        ``collocation`` (Legendre-Gauss-Radau) or ``multiple_shooting``.
+        A registered transcription (:data:`ocp.transcription.TRANSCRIPTIONS`): ``collocation``
+        (Legendre-Gauss-Radau, default) or ``multiple_shooting``, or one a user registered.
     substeps : int
         RK4 steps per interval (``multiple_shooting``; ``intervals × substeps`` at most
         :data:`MAX_RK4_STEPS`).
@@ -140,7 +141,7 @@ class CollocationOptions:
     objective: Literal["min_energy", "min_l1", "min_time", "weighted"] = "min_energy"
     intervals: Annotated[int, Range(ge=1, le=2000)] = 50
     degree: Annotated[int, Range(ge=1, le=9)] = 3
-    transcription: Literal["collocation", "multiple_shooting"] = "collocation"
+    transcription: str = "collocation"       # a key of ocp.transcription.TRANSCRIPTIONS
     substeps: Annotated[int, Range(ge=1, le=100)] = 4       # RK4 steps per interval (multiple_shooting)
     solver: Literal["ipopt", "fatrop"] = "ipopt"
     warm_start: str = "eigenaxis"            # registered planner whose reference seeds the NLP
@@ -174,6 +175,9 @@ class CollocationOptions:
         for index, name in enumerate(self.seed_planners):
             if name in self.seed_planners[:index]:  # the same reference again: the same start solved twice
                 raise InvalidOption(f"seed_planners[{index}]", f"{name!r} is listed twice; expected each planner once")
+        if self.transcription not in TRANSCRIPTIONS:
+            raise InvalidOption("transcription", f"{self.transcription!r} is not a registered transcription; "
+                                                 f"expected one of {sorted(TRANSCRIPTIONS)}")
         if self.transcription == "multiple_shooting" and self.intervals * self.substeps > MAX_RK4_STEPS:
             raise InvalidOption("substeps", f"{self.intervals} intervals x {self.substeps} substeps = "
                                             f"{self.intervals * self.substeps} RK4 steps; expected at most "
