@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from controllers import CONTROLLERS
 from ocp import (
     SimulationError,
     SimulationResult,
@@ -22,7 +21,7 @@ from ocp import (
     metrics_from_reference,
     metrics_from_simulation,
 )
-from planners import PLANNERS, FailedReference, Reference
+from planners import FailedReference, Reference
 from scenarios.schema.loader import ControllerSpec, Scenario
 
 
@@ -181,7 +180,7 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
     problem = scenario.problem
     spec = controller_spec or scenario.controller
     duration = scenario.simulation.duration or max(problem.duration, reference.duration if reference else 0.0)
-    controller = CONTROLLERS[spec.name](spec.options)
+    controller = spec.controller
     start = time.perf_counter()
     try:
         result = simulator.run(controller, scenario.true_initial_state, duration, reference=reference,
@@ -251,7 +250,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         return RunResults(scenario, rows)
     total = len(scenario.planners) * len(controllers)
     for planner_spec in scenario.planners:
-        planner = PLANNERS[planner_spec.name](planner_spec.options, cache=cache)
+        planner = planner_spec.planner.with_cache(cache)
         try:
             reference = planner.plan(scenario.problem)
         except Exception as error:  # a planner bug must not lose the other rows

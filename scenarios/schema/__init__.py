@@ -1,10 +1,14 @@
-"""The scenario schema: reading YAML safely, values that name their path, the sections and the checks.
+"""The scenario and study schema: reading YAML safely, values that name their path, the keys of every
+section, the checks, and the schema reference generated from the keys.
 
 What lives here: bounded, duplicate-refusing YAML reading (:mod:`~scenarios.schema.read`), typed
-nodes whose errors name the YAML path (:mod:`~scenarios.schema.node`), the model sections
-(``spacecraft``, ``orbit``, ``environment``; :mod:`~scenarios.schema.model`), the whole scenario and
-the :class:`~scenarios.schema.loader.Scenario` it builds (:mod:`~scenarios.schema.loader`) and the
-checks of a parsed scenario as a whole (:mod:`~scenarios.schema.checks`).
+nodes whose errors name the YAML path (:mod:`~scenarios.schema.node`), the vocabulary the keys are
+declared in (:mod:`~scenarios.schema.keys`), the model sections (``spacecraft``, ``orbit``,
+``environment``; :mod:`~scenarios.schema.model`), the whole scenario and the
+:class:`~scenarios.schema.loader.Scenario` it builds (:mod:`~scenarios.schema.loader`), the checks
+of a parsed scenario as a whole (:mod:`~scenarios.schema.checks`), the study file's keys, value
+generators and distributions (:mod:`~scenarios.schema.study`), and the reference of them all
+(:mod:`~scenarios.schema.reference`: ``slewbench schema``).
 
 May import: :mod:`ocp`, :mod:`planners`, :mod:`controllers` and :mod:`scenarios.errors`; nothing
 else of :mod:`scenarios`. Its names are imported on first use.
@@ -14,15 +18,22 @@ from __future__ import annotations
 from scenarios._faces import lazy_face
 
 _HOMES = {"ControllerSpec": "scenarios.schema.loader",
+          "DISTRIBUTIONS": "scenarios.schema.study",
+          "Key": "scenarios.schema.keys",
           "Node": "scenarios.schema.node",
           "PlannerSpec": "scenarios.schema.loader",
           "Scenario": "scenarios.schema.loader",
+          "Section": "scenarios.schema.keys",
           "SimulationSpec": "scenarios.schema.loader",
+          "VALUE_GENERATORS": "scenarios.schema.study",
           "load": "scenarios.schema.loader",
           "parse_scenario": "scenarios.schema.loader",
           "parse_yaml_text": "scenarios.schema.read",
-          "read_yaml": "scenarios.schema.read"}
+          "read_yaml": "scenarios.schema.read",
+          "schema_rst": "scenarios.schema.reference",
+          "schema_text": "scenarios.schema.reference"}
 
-__all__ = ["ControllerSpec", "Node", "PlannerSpec", "Scenario", "SimulationSpec", "load", "parse_scenario", "parse_yaml_text", "read_yaml"]
+__all__ = ["DISTRIBUTIONS", "VALUE_GENERATORS", "ControllerSpec", "Key", "Node", "PlannerSpec", "Scenario", "Section",
+           "SimulationSpec", "load", "parse_scenario", "parse_yaml_text", "read_yaml", "schema_rst", "schema_text"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)

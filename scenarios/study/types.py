@@ -1,4 +1,4 @@
-"""The data of a trade study (ARCHITECTURE.md, "Trade studies"): how its cases run
+"""The data of a trade study: how its cases run
 (:class:`Execution`), one resolved case (:class:`Case`), the expanded study (:class:`Study`), and
 the store key of a case (:func:`case_key`, with :func:`package_version`). :mod:`scenarios.study.spec`
 builds them from a study file.
