@@ -18,14 +18,30 @@ respect to the inertial frame in body axes [rad/s]; torques, dipoles and wheel a
 """
 from ocp.cache import SolverCache
 from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
-from ocp.dynamics.environment import CircularOrbit, Environment, TiltedDipole, gravity_gradient_torque
+from ocp.dynamics.environment import (
+                        CircularOrbit,
+                        Environment,
+                        TiltedDipole,
+                        gravity_gradient_torque,
+)
 from ocp.dynamics.igrf import IGRFField
 from ocp.dynamics.model import AttitudeModel
 from ocp.dynamics.spacecraft import Magnetorquers, ReactionWheels, Spacecraft, Torquers
-from ocp.errors import (CompilerUnavailable, InvalidOption, ModelError, OptionsError, SimulationError,
-                        SlewbenchError)
-from ocp.metrics import (METRIC_KEYS, compute_metrics, metric_violations, metrics_from_reference,
-                         metrics_from_simulation)
+from ocp.errors import (
+                        CompilerUnavailable,
+                        InvalidOption,
+                        ModelError,
+                        OptionsError,
+                        SimulationError,
+                        SlewbenchError,
+)
+from ocp.metrics import (
+                        METRIC_KEYS,
+                        compute_metrics,
+                        metric_violations,
+                        metrics_from_reference,
+                        metrics_from_simulation,
+)
 from ocp.simulation.simulator import SensorNoise, SimulationResult, Simulator
 
 __all__ = [

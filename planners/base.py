@@ -16,6 +16,7 @@ Conventions: scalar-first Hamilton quaternions ``q`` rotating body vectors to in
 """
 from __future__ import annotations
 
+import copy
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
@@ -89,6 +90,25 @@ class Planner(Configurable, ABC):
                  cache: SolverCache | None = None) -> None:
         super().__init__(options, path)
         self.cache = cache
+
+    def with_cache(self, cache: SolverCache | None) -> Planner:
+        """This planner, its options as validated, building into ``cache`` (no second validation).
+
+        Parameters
+        ----------
+        cache : ocp.SolverCache or None
+            Where the returned planner keeps what it builds; ``None``: the model's own cache.
+
+        Returns
+        -------
+        Planner
+            ``self`` when it already uses ``cache``; else a shallow copy that does.
+        """
+        if cache is self.cache:
+            return self
+        planner = copy.copy(self)
+        planner.cache = cache
+        return planner
 
     def solver_cache(self, problem: ManeuverProblem) -> SolverCache:
         """The cache to build into.

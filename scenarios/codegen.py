@@ -23,9 +23,7 @@ from typing import Any
 
 import casadi as ca
 
-from controllers import CONTROLLERS
 from ocp.dynamics.layout import REFERENCE_FIELDS, control_layout
-from planners import PLANNERS
 from scenarios.errors import ScenarioError
 from scenarios.output.directory import (
     claim_output_directory,
@@ -114,7 +112,7 @@ def generate(scenario: Scenario, out: str | Path) -> CodegenReport:
     problem, spec = scenario.problem, scenario.simulation
     laws = []
     for controller_spec in scenario.controllers:
-        controller = CONTROLLERS[controller_spec.name](controller_spec.options)
+        controller = controller_spec.controller
         reason = controller.symbolic_error()
         if reason is not None:
             raise ScenarioError(f"{controller_spec.path}.name",
@@ -151,7 +149,7 @@ def generate(scenario: Scenario, out: str | Path) -> CodegenReport:
             interface["slewbench_law"] = description
     stems = row_stems([p.label for p in scenario.planners])
     for planner_spec, row in zip(scenario.planners, stems):
-        planner = PLANNERS[planner_spec.name](planner_spec.options)
+        planner = planner_spec.planner
         if not planner.closed_form:
             report.skipped[planner_spec.label] = f"planner {planner_spec.name} has no closed form"
             continue

@@ -10,7 +10,6 @@ import traceback
 from collections.abc import Callable
 from typing import Any
 
-from controllers import CONTROLLERS
 from ocp import (
     SimulationError,
     Simulator,
@@ -19,7 +18,7 @@ from ocp import (
     metrics_from_reference,
     metrics_from_simulation,
 )
-from planners import PLANNERS, FailedReference, Reference
+from planners import FailedReference, Reference
 from scenarios.output.results import Row, RunResults
 from scenarios.schema.labels import row_labels
 from scenarios.schema.loader import ControllerSpec, PlannerSpec, Scenario
@@ -30,7 +29,7 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
     problem = scenario.problem
     spec = controller_spec or scenario.controller
     duration = scenario.simulation.duration or max(problem.duration, reference.duration if reference else 0.0)
-    controller = CONTROLLERS[spec.name](spec.options)
+    controller = spec.controller
     start = time.perf_counter()
     try:
         result = simulator.run(controller, scenario.true_initial_state, duration, reference=reference,
@@ -123,7 +122,7 @@ def _plan(scenario: Scenario, planner_spec: PlannerSpec,
           cache: SolverCache | None) -> tuple[Reference, dict[str, Any] | None]:
     """A planner's reference (a failed one when it raises) and the reference's metrics (None when failed)."""
     spec = scenario.simulation
-    planner = PLANNERS[planner_spec.name](planner_spec.options, cache=cache)
+    planner = planner_spec.planner.with_cache(cache)
     try:
         reference = planner.plan(scenario.problem)
     except Exception as error:  # a planner bug must not lose the other rows

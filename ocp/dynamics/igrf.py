@@ -15,20 +15,20 @@ the inertial frame is the epoch's equatorial frame, precession and nutation negl
 """
 from __future__ import annotations
 
+import dataclasses
 import datetime
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING
+from typing import Annotated, Any, ClassVar
 
 import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ocp.dynamics.environment import MAGNETIC_FIELDS, CircularOrbit, FieldModel
 from ocp.errors import ModelError
+from ocp.options import Range
 from ocp.quat_casadi import Expr
-
-if TYPE_CHECKING:  # type-only: ocp.dynamics.environment refers back to IGRFField
-    from ocp.dynamics.environment import CircularOrbit
 
 EARTH_RATE = 7.2921159e-5      # rad/s, as ocp.dynamics.environment
 MAX_NODES = 200_000
@@ -124,8 +124,8 @@ def igrf_earth_fixed(position_ecef: ArrayLike, epoch: datetime.datetime) -> NDAr
 
 
 @dataclass(frozen=True)
-class IGRFField:
-    """IGRF field along ``orbit`` over ``[0, span]`` s, interpolated in time.
+class IGRFField(FieldModel):
+    """The IGRF-14 field tabulated along ``orbit`` over ``[0, span]`` s and interpolated in time.
 
     Parameters
     ----------
@@ -145,6 +145,9 @@ class IGRFField:
     earth_rate : float, optional
         Rotation rate of the Earth-fixed frame about the inertial z axis [rad/s] (default
         ``EARTH_RATE``).
+    span_from_window : bool, optional
+        ``span`` is provisional: :meth:`for_window` replaces it by the closed-loop window (a
+        scenario that leaves ``span_s`` out). Not part of the field's value (default False).
 
     Raises
     ------
@@ -152,12 +155,86 @@ class IGRFField:
         For an epoch outside the IGRF range, a non-positive step or span, or too many nodes.
     """
 
+    name: ClassVar[str] = "igrf"
+
     orbit: CircularOrbit
     span: float
     epoch: str = "2025-01-01"
     step: float = 30.0
     greenwich_angle: float | None = None
     earth_rate: float = EARTH_RATE
+    span_from_window: bool = dataclasses.field(default=False, compare=False, repr=False)
+
+    @dataclass(frozen=True)
+    class Options:
+        """Options of ``igrf`` (YAML keys of ``environment.magnetic_field``).
+
+        Attributes
+        ----------
+        epoch : str
+            Date of the IGRF-14 coefficients and of t = 0, ISO text (``2025-01-01``), from 1900 to
+            2029.
+        step_s : float
+            Spacing of the table's nodes [s] (cubic B-spline between them; at 1000 s the spline
+            misses the field by 42 %).
+        span_s : float or None
+            Tabulated window [s]; ``null``: the closed-loop window (twice the manoeuvre's duration
+            when there are planners) plus 60 s. A run beyond it is a failed row naming this key.
+        greenwich_angle_deg : float or None
+            Angle of the Earth-fixed x axis from the inertial x axis at t = 0 [deg]; ``null``: the
+            Greenwich mean sidereal time of the epoch.
+        """
+
+        epoch: str = "2025-01-01"
+        step_s: Annotated[float, Range(gt=0.0, le=120.0)] = 30.0
+        span_s: Annotated[float | None, Range(gt=0.0)] = None
+        greenwich_angle_deg: Annotated[float | None, Range()] = None
+
+    @classmethod
+    def from_options(cls, options: Any, orbit: CircularOrbit | None) -> IGRFField:
+        """The table of ``options`` along ``orbit`` (without ``span_s``, a provisional one-second
+        span that :meth:`for_window` replaces).
+
+        Parameters
+        ----------
+        options : IGRFField.Options
+            The YAML options.
+        orbit : CircularOrbit or None
+            The orbit to tabulate the field along.
+
+        Returns
+        -------
+        IGRFField
+            The field.
+
+        Raises
+        ------
+        ModelError
+            Without an orbit (field ``""``: the whole entry), or for a bad epoch, step or span.
+        """
+        if orbit is None:
+            raise ModelError("", "the IGRF field is tabulated along the orbit; give `orbit:`")
+        greenwich = options.greenwich_angle_deg
+        return cls(orbit, epoch=options.epoch, span=options.span_s or 1.0, step=options.step_s,
+                   greenwich_angle=None if greenwich is None else float(np.deg2rad(greenwich)),
+                   span_from_window=options.span_s is None)
+
+    def for_window(self, window: float) -> IGRFField:
+        """This table over a closed-loop window of ``window`` seconds, if its span is provisional.
+
+        Parameters
+        ----------
+        window : float
+            The window to tabulate [s].
+
+        Returns
+        -------
+        IGRFField
+            ``self`` when ``span`` was given; else a copy spanning ``window``.
+        """
+        if not self.span_from_window:
+            return self
+        return dataclasses.replace(self, span=window, span_from_window=False)
 
     def __post_init__(self) -> None:
         parse_epoch(self.epoch)
@@ -246,3 +323,6 @@ class IGRFField:
         """
         position, t = ca.SX.sym("position", 3), ca.SX.sym("t")
         return ca.Function("igrf_field", [position, t], [self.field_inertial(position, t)], ["position", "t"], ["b"])
+
+
+MAGNETIC_FIELDS[IGRFField.name] = IGRFField

@@ -1,4 +1,4 @@
-"""``slewbench`` command line: run, validate, list, codegen, sweep.
+"""``slewbench`` command line: run, validate, list, schema, codegen, sweep.
 
 Exit status: 0 when the run completed (a failed planner is a row, not an error), 2 for a bad
 scenario file or an output location slewbench must not or cannot write to, 1 for an internal error.
@@ -6,6 +6,7 @@ scenario file or an output location slewbench must not or cannot write to, 1 for
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import signal
 import sys
@@ -54,6 +55,35 @@ def command_list(_: argparse.Namespace) -> int:
     print("controllers:")
     for name, controller in CONTROLLERS.items():
         print(f"  {name:32s} {_first_doc_line(controller)}")
+    return EXIT_OK
+
+
+def command_schema(args: argparse.Namespace) -> int:
+    """``slewbench schema [KEY]``: print the scenario and study schema reference, or its part under KEY.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``key``: a key such as ``maneuver``, ``planners.collocation`` or ``study.execution``
+        (see :mod:`scenarios.schema.reference`), or ``None`` for everything.
+
+    Returns
+    -------
+    int
+        Exit status: 0, or 2 for a key the schema does not have (its close matches are listed).
+    """
+    from scenarios.schema.reference import schema_text
+
+    try:
+        text = schema_text(args.key)
+    except ScenarioError as error:
+        print(f"slewbench: {error}", file=sys.stderr)
+        return EXIT_BAD_SCENARIO
+    try:
+        sys.stdout.write(text)
+        sys.stdout.flush()
+    except BrokenPipeError:  # `slewbench schema | head`: the reader has gone
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return EXIT_OK
 
 
@@ -141,7 +171,7 @@ def command_codegen(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The ``slewbench`` argument parser (run, validate, codegen, list, sweep, report).
+    """The ``slewbench`` argument parser (run, validate, codegen, list, schema, sweep, report).
 
     Returns
     -------
@@ -164,6 +194,13 @@ def build_parser() -> argparse.ArgumentParser:
     codegen_parser.set_defaults(handler=command_codegen)
     list_parser = commands.add_parser("list", help="registered planners and controllers")
     list_parser.set_defaults(handler=command_list)
+    schema_parser = commands.add_parser("schema", help="every scenario and study key: type, unit, default, range, "
+                                                       "meaning")
+    schema_parser.add_argument("key", nargs="?", help="only the keys under KEY: a YAML path without list indices "
+                                                      "(maneuver, simulation.sensor_noise.seed), "
+                                                      "planners.<planner>[.<option>], controller.<controller>, "
+                                                      "environment.magnetic_field.<model>, scenario, or study[.<key>]")
+    schema_parser.set_defaults(handler=command_schema)
     add_sweep_parser(commands)
     return parser
 

@@ -20,7 +20,13 @@ from scenarios.output.names import default_output_directory
 from scenarios.study.engine import SweepResults, start_forkserver, sweep
 from scenarios.study.report import claim_sweep_directory, resolved_study
 from scenarios.study.spec import load_study, parse_study
-from scenarios.study.store import EARLIER_FORMATS, STORE_NAME, SweepStore, is_sweep_store, store_format
+from scenarios.study.store import (
+    EARLIER_FORMATS,
+    STORE_NAME,
+    SweepStore,
+    is_sweep_store,
+    store_format,
+)
 from scenarios.study.types import package_version
 
 EXIT_OK, EXIT_BAD_STUDY, EXIT_INTERRUPTED = 0, 2, 130

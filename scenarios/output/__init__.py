@@ -23,7 +23,6 @@ _HOMES = {"Renderer": "scenarios.output.renderer",
           "read_manifest": "scenarios.output.directory",
           "row_stems": "scenarios.output.names",
           "flatten_row": "scenarios.output.tables",
-          "metric_columns": "scenarios.output.tables",
           "row_columns": "scenarios.output.tables",
           "sanitize": "scenarios.output.names",
           "to_csv": "scenarios.output.tables",
@@ -33,7 +32,7 @@ _HOMES = {"Renderer": "scenarios.output.renderer",
           "to_terminal": "scenarios.output.tables",
           "write_results": "scenarios.output.directory"}
 
-__all__ = ["Renderer", "Row", "RunResults", "claim_output_directory", "flatten_row", "metric_columns", "read_manifest",
+__all__ = ["Renderer", "Row", "RunResults", "claim_output_directory", "flatten_row", "read_manifest",
            "row_columns", "row_stems", "sanitize", "to_csv", "to_dataframe", "to_json", "to_markdown", "to_terminal",
            "write_results"]
 

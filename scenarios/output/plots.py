@@ -38,7 +38,6 @@ from scenarios.output.plot_data import (
     PlotJob,
     RowSeries,
     cone_series,
-    decimate,
     overlay_series,
     plot_jobs,
 )

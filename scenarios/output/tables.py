@@ -2,7 +2,7 @@
 
 A row's plain form is nested (:meth:`scenarios.output.results.Row.to_dict`: ``reference`` and
 ``closed_loop`` metric dicts); its flat form (:func:`flatten_row`) has one column per metric and
-scope, ``ref.<metric>`` and ``cl.<metric>``, a vector metric split into ``<metric>_x``, ``_y`` and
+scope, ``ref.<metric>`` and ``cl.<metric>`` (:mod:`scenarios.schema.columns`), a vector metric split into ``<metric>_x``, ``_y`` and
 ``_z``. A run's ``results.csv`` and :meth:`~scenarios.output.results.RunResults.to_dataframe`, a
 trade study's ``cases.csv``, :meth:`~scenarios.study.engine.SweepResults.to_dataframe` and its
 ``summary:`` keys all use these columns.
@@ -21,21 +21,21 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from ocp import METRIC_KEYS
+from scenarios.schema.columns import (
+    AXES,
+    SCOPES,
+    SCORED_METRICS,
+    VECTOR_METRICS,
+    metric_columns,
+)
 
 if TYPE_CHECKING:
     import pandas
 
     from scenarios.output.results import RunResults
 
-SCOPES = (("reference", "ref"), ("closed_loop", "cl"))
-"""(key of the nested row, prefix of its flat columns) for the reference's and the closed loop's metrics."""
-VECTOR_METRICS = ("int_abs_u",)
-"""Metrics whose value is a list of per-axis values, split into one column per axis."""
-AXES = ("x", "y", "z")
 IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s")
 """The columns that name a row, before its metrics."""
-_SCORED = tuple(key for key in METRIC_KEYS if key != "plan_time_s")  # plan_time_s is an identity column
 
 
 def is_missing(value: Any) -> bool:
@@ -53,28 +53,6 @@ def is_missing(value: Any) -> bool:
     """
     return value is None or (isinstance(value, float) and not math.isfinite(value))
 
-
-def metric_columns(vectors: bool = True) -> list[str]:
-    """The flat metric columns: ``ref.<metric>`` then ``cl.<metric>``, in :data:`ocp.METRIC_KEYS` order.
-
-    Parameters
-    ----------
-    vectors : bool, optional
-        Include the per-axis columns of vector metrics (``ref.int_abs_u_x``, ``_y``, ``_z``).
-
-    Returns
-    -------
-    list of str
-        The column names.
-    """
-    columns = []
-    for _, prefix in SCOPES:
-        for key in _SCORED:
-            if key in VECTOR_METRICS:
-                columns += [f"{prefix}.{key}_{axis}" for axis in AXES] if vectors else []
-            else:
-                columns.append(f"{prefix}.{key}")
-    return columns
 
 
 def row_columns() -> list[str]:
@@ -117,7 +95,7 @@ def flatten_row(row: Mapping[str, Any]) -> dict[str, Any]:
     flat = {name: row.get(name) for name in IDENTITY_COLUMNS}
     for scope, prefix in SCOPES:
         metrics = row.get(scope) or {}
-        for key in _SCORED:
+        for key in SCORED_METRICS:
             value = metrics.get(key)
             if key in VECTOR_METRICS:
                 for axis, component in zip(AXES, value if value is not None else (None,) * len(AXES)):
@@ -297,7 +275,7 @@ def _metric_lines(results: RunResults) -> list[tuple[str, list[str]]]:
     lines = [("status", [row["status"] for row in rows]),
              ("plan_time_s", [_format(row["plan_time_s"]) for row in rows])]
     for scope, prefix in SCOPES:
-        for key in _SCORED:
+        for key in SCORED_METRICS:
             lines.append((f"{prefix}.{key}", [_format((row[scope] or {}).get(key)) for row in rows]))
     return lines
 

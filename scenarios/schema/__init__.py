@@ -1,11 +1,16 @@
-"""The scenario schema: reading YAML safely, values that name their path, the sections and the checks.
+"""The scenario and study schema: reading YAML safely, values that name their path, the keys of every
+section, the checks, and the schema reference generated from the keys.
 
 What lives here: bounded, duplicate-refusing YAML reading (:mod:`~scenarios.schema.read`), typed
-nodes whose errors name the YAML path (:mod:`~scenarios.schema.node`), the model sections
-(``spacecraft``, ``orbit``, ``environment``; :mod:`~scenarios.schema.model`), the whole scenario and
-the :class:`~scenarios.schema.loader.Scenario` it builds (:mod:`~scenarios.schema.loader`), how
-planner and controller labels name the rows (:mod:`~scenarios.schema.labels`) and the checks of a
-parsed scenario as a whole (:mod:`~scenarios.schema.checks`).
+nodes whose errors name the YAML path (:mod:`~scenarios.schema.node`), the vocabulary the keys are
+declared in (:mod:`~scenarios.schema.keys`), the model sections (``spacecraft``, ``orbit``,
+``environment``; :mod:`~scenarios.schema.model`), the whole scenario and the
+:class:`~scenarios.schema.loader.Scenario` it builds (:mod:`~scenarios.schema.loader`), how planner
+and controller labels name the rows (:mod:`~scenarios.schema.labels`), the names of the metric
+columns (:mod:`~scenarios.schema.columns`), the checks of a parsed scenario as a whole
+(:mod:`~scenarios.schema.checks`), the study file's keys, value generators and distributions
+(:mod:`~scenarios.schema.study`), and the reference of them all (:mod:`~scenarios.schema.reference`:
+``slewbench schema``).
 
 May import: :mod:`ocp`, :mod:`planners`, :mod:`controllers` and :mod:`scenarios.errors`; nothing
 else of :mod:`scenarios`. Its names are imported on first use.
@@ -15,18 +20,26 @@ from __future__ import annotations
 from scenarios._faces import lazy_face
 
 _HOMES = {"ControllerSpec": "scenarios.schema.loader",
+          "DISTRIBUTIONS": "scenarios.schema.study",
+          "Key": "scenarios.schema.keys",
           "Node": "scenarios.schema.node",
           "PlannerSpec": "scenarios.schema.loader",
           "RowLabel": "scenarios.schema.labels",
           "Scenario": "scenarios.schema.loader",
+          "Section": "scenarios.schema.keys",
           "SimulationSpec": "scenarios.schema.loader",
+          "VALUE_GENERATORS": "scenarios.schema.study",
           "load": "scenarios.schema.loader",
           "parse_scenario": "scenarios.schema.loader",
           "parse_yaml_text": "scenarios.schema.read",
           "read_yaml": "scenarios.schema.read",
-          "row_labels": "scenarios.schema.labels"}
+          "metric_columns": "scenarios.schema.columns",
+          "row_labels": "scenarios.schema.labels",
+          "schema_rst": "scenarios.schema.reference",
+          "schema_text": "scenarios.schema.reference"}
 
-__all__ = ["ControllerSpec", "Node", "PlannerSpec", "RowLabel", "Scenario", "SimulationSpec", "load", "parse_scenario",
-           "parse_yaml_text", "read_yaml", "row_labels"]
+__all__ = ["DISTRIBUTIONS", "VALUE_GENERATORS", "ControllerSpec", "Key", "Node", "PlannerSpec", "RowLabel", "Scenario",
+           "Section", "SimulationSpec", "load", "metric_columns", "parse_scenario", "parse_yaml_text", "read_yaml",
+           "row_labels", "schema_rst", "schema_text"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)

@@ -8,9 +8,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from controllers import CONTROLLERS
 from ocp.simulation.simulator import SUBSTEPS_PER_SAMPLE
-from planners import PLANNERS, ManeuverProblem
+from planners import ManeuverProblem
 from scenarios.errors import ScenarioError
 from scenarios.schema.labels import row_labels
 
@@ -78,9 +77,9 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
     problem : ManeuverProblem
         The manoeuvre, with its spacecraft and environment.
     planners : list of PlannerSpec
-        The planner rows (empty: regulation mode).
+        The planner rows (empty: regulation mode), each with its validated planner.
     controllers : list of ControllerSpec or ControllerSpec
-        The controllers (one spec is accepted as a list of one).
+        The controllers (one spec is accepted as a list of one), each with its validated law.
     simulation : SimulationSpec or None, optional
         Closed-loop settings; ``None`` skips the sample-time checks.
 
@@ -95,11 +94,11 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
     if not isinstance(controllers, list):  # one ControllerSpec
         controllers = [controllers]
     for index, spec in enumerate(planners):
-        error = PLANNERS[spec.name](spec.options).problem_error(problem)
+        error = spec.planner.problem_error(problem)
         if error:
             raise ScenarioError(f"planners[{index}]", error)
     for controller in controllers:
-        law = CONTROLLERS[controller.name](controller.options)
+        law = controller.controller
         where = f"{controller.path}.name"
         error = law.environment_error(problem.spacecraft, problem.environment)
         if error:

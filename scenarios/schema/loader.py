@@ -1,10 +1,14 @@
-"""Scenario YAML schema (:doc:`/reference/schema`) and the :class:`Scenario` it builds.
+"""The scenario YAML: its top-level keys, the manoeuvre, planner and controller rows, the
+simulation settings, and the :class:`Scenario` it builds.
 
-Every error is a :class:`~scenarios.schema.node.ScenarioError` naming the YAML path and what was
-expected. Degrees (``*_deg``) and kilometres (``*_km``) are converted to SI here, and so are
-scalar-last quaternions (``maneuver.quaternion_order: scalar_last``), so that nothing inside the
-code sees the papers' conventions. The model sections (``spacecraft``, ``orbit``, ``environment``)
-are read by :mod:`scenarios.schema.model`.
+Each mapping's keys are declared here (:data:`SCENARIO`, :data:`MANEUVER`, :data:`PLANNER`,
+:data:`CONTROLLER`, :data:`SIMULATION` ...; the model sections in :mod:`scenarios.schema.model`) and
+every value is read through them, so the schema reference (:mod:`scenarios.schema.reference`)
+lists exactly what is accepted. Every error is a :class:`~scenarios.errors.ScenarioError` naming
+the YAML path and what was expected. Degrees (``*_deg``) and kilometres (``*_km``) are converted to
+SI here, and so are scalar-last quaternions (``maneuver.quaternion_order: scalar_last``), so that
+nothing inside the code sees the papers' conventions. Planners and controllers are validated
+once, here: :class:`PlannerSpec` and :class:`ControllerSpec` carry the instances.
 """
 from __future__ import annotations
 
@@ -16,14 +20,32 @@ from typing import Any
 
 import numpy as np
 
-from controllers import CONTROLLERS
-from ocp import Environment, IGRFField, SensorNoise, Spacecraft, quat
+from controllers import CONTROLLERS, Controller
+from ocp import Environment, SensorNoise, Spacecraft, quat
 from ocp.errors import OptionsError, excerpt
 from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
-from planners import PLANNERS, ManeuverProblem
+from planners import PLANNERS, ManeuverProblem, Planner
 from scenarios.errors import ScenarioError
 from scenarios.schema.checks import check_compatibility, check_row_labels, check_work
-from scenarios.schema.model import parse_environment, parse_spacecraft
+from scenarios.schema.keys import (
+    Described,
+    Section,
+    boolean,
+    choice,
+    custom,
+    integer,
+    mapping,
+    number,
+    quaternion,
+    vector,
+)
+from scenarios.schema.model import (
+    ENVIRONMENT,
+    ORBIT,
+    SPACECRAFT,
+    parse_environment,
+    parse_spacecraft,
+)
 from scenarios.schema.node import Node
 from scenarios.schema.read import read_yaml
 
@@ -35,7 +57,7 @@ MAX_LABEL = 100
 
 @dataclass
 class PlannerSpec:
-    """One planner row of the scenario (``planners[i]``).
+    """One planner row of the scenario (``planners[i]``), validated once.
 
     Parameters
     ----------
@@ -44,37 +66,53 @@ class PlannerSpec:
     label : str
         The row's label in the tables (default: the name).
     options : object
-        The planner's parsed ``Options`` dataclass.
+        The planner's validated ``Options`` dataclass.
+    planner : Planner or None, optional
+        The planner built from them (the loader passes the one it validated); ``None``
+        (default): built here from ``options``.
     """
 
     name: str
     label: str
     options: Any
+    planner: Planner = field(default=None, repr=False, compare=False)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        if self.planner is None:
+            self.planner = PLANNERS[self.name](self.options)
+            self.options = self.planner.options
 
 
 @dataclass
 class ControllerSpec:
-    """One controller of the scenario (``controller`` or ``controllers[i]``).
+    """One controller of the scenario (``controller`` or ``controllers[i]``), validated once.
 
     Parameters
     ----------
     name : str
         Registry name (a key of ``controllers.CONTROLLERS``).
     options : object
-        The controller's parsed ``Options`` dataclass.
+        The controller's validated ``Options`` dataclass.
     label : str, optional
         Its label in the tables; empty (default): the name.
     path : str, optional
         Its YAML entry (``controller`` or ``controllers[i]``), for messages.
+    controller : Controller or None, optional
+        The law built from the options (the loader passes the one it validated; a run resets it,
+        see :meth:`Controller.reset`); ``None`` (default): built here from ``options``.
     """
 
     name: str
     options: Any
     label: str = ""
     path: str = "controller"
+    controller: Controller = field(default=None, repr=False, compare=False)  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         self.label = self.label or self.name
+        if self.controller is None:
+            self.controller = CONTROLLERS[self.name](self.options)
+            self.options = self.controller.options
 
 
 @dataclass
@@ -163,82 +201,187 @@ class Scenario:
         return np.concatenate([q0, p.omega0 + self.simulation.initial_rate_error, p.wheel_momentum0])
 
 
-def _fit_field_span(data: Any, problem: ManeuverProblem, simulation: SimulationSpec, planners: list) -> ManeuverProblem:
-    """Give an IGRF table without ``span_s`` the closed-loop window (twice the maneuver's when
-    planners may return longer references) plus one minute."""
+def _fit_field_span(problem: ManeuverProblem, simulation: SimulationSpec, planners: list) -> ManeuverProblem:
+    """Give a field whose extent follows the run (``for_window``: an IGRF table without ``span_s``)
+    the closed-loop window (twice the maneuver's when planners may return longer references) plus
+    one minute."""
     field_model = problem.environment.magnetic_field
-    spec = ((data.get("environment") or {}).get("magnetic_field") if isinstance(data, dict) else None)
-    if not isinstance(field_model, IGRFField) or (isinstance(spec, dict) and spec.get("span_s") is not None):
+    for_window = getattr(field_model, "for_window", None)
+    if for_window is None:
         return problem
     window = max(problem.duration * (2.0 if planners else 1.0), simulation.duration or 0.0) + 60.0
-    environment = dataclasses.replace(problem.environment,
-                                      magnetic_field=dataclasses.replace(field_model, span=window))
+    fitted = for_window(window)
+    if fitted is field_model:
+        return problem
+    environment = dataclasses.replace(problem.environment, magnetic_field=fitted)
     return dataclasses.replace(problem, environment=environment)
+
+
+def _name(node: Node) -> str:
+    name = node.string()
+    if not name.strip() or len(name) > MAX_NAME:
+        raise node.error(f"expected a non-empty name of at most {MAX_NAME} characters, got {excerpt(name)}")
+    return name
+
+
+def _label(node: Node) -> str | None:
+    """A row label: non-empty text of at most :data:`MAX_LABEL` characters (``None`` when missing:
+    the caller uses the registry name)."""
+    if isinstance(node.value, Described):
+        return None
+    label = node.string()
+    if not label.strip() or len(label) > MAX_LABEL:
+        raise node.error(f"expected a non-empty label of at most {MAX_LABEL} characters, got {excerpt(label)}")
+    return label
+
+
+def _registered(registry: dict[str, Any], kind: str) -> Any:
+    def read(node: Node) -> str:
+        name = node.string()
+        if name not in registry:
+            raise node.error(f"unknown {kind} {name!r}; registered: {sorted(registry)}")
+        return name
+    return read
+
+
+INITIAL = Section((
+    quaternion("q", "Initial attitude, body to inertial (scalar first unless ``quaternion_order: scalar_last``)."),
+    vector("omega", "Initial body rate, body frame.", 3, unit="rad/s", default=[0.0, 0.0, 0.0]),
+    custom("wheel_momentum", "Initial spin momentum of each wheel; ``null``: zero.",
+           "list of numbers (one per wheel) or null", None, unit="N m s", default=None),
+), "The state at t = 0.")
+
+FINAL = Section((
+    quaternion("q", "Target attitude; ``null``: free (rate acquisition; the attitude metrics are then null). "
+               "Only laws that need no target attitude accept it without planners.", nullable=True),
+    vector("omega", "Target body rate, body frame; ``null``: free.", 3, unit="rad/s", default=None, nullable=True),
+), "The state at t = ``duration``.")
+
+MANEUVER = Section((
+    choice("quaternion_order", "Order of every quaternion of the scenario as written; ``scalar_last`` for "
+           "quaternions copied from papers written scalar last.", ("scalar_first", "scalar_last"),
+           default="scalar_first"),
+    mapping("initial", "The initial state.", INITIAL),
+    mapping("final", "The target state.", FINAL),
+    number("duration", "Manoeuvre time T (a planner minimising time may choose its own).", unit="s", positive=True),
+    number("max_rate", "Bound on the body rate about any axis, for the planners that take one; ``null``: none.",
+           unit="rad/s", default=None, positive=True, nullable=True),
+), "The slew: boundary states, duration and rate bound.")
+
+PLANNER = Section((
+    custom("name", "The planner (its options are listed per planner below).", "text",
+           _registered(PLANNERS, "planner"), choices=PLANNERS),
+    custom("label", f"The row's label in the tables (unique, at most {MAX_LABEL} characters).", "text", _label,
+           default=Described("the planner's name")),
+    custom("options", "The planner's options (see its entry below).", "mapping", None, default={}),
+), "One row of the table: a planner, its label and its options.")
+
+CONTROLLER = Section((
+    custom("name", "The feedback law (its options are listed per controller below).", "text",
+           _registered(CONTROLLERS, "controller"), choices=CONTROLLERS),
+    custom("label", f"Its label in the tables (unique, at most {MAX_LABEL} characters).", "text", _label,
+           default=Described("the controller's name")),
+    custom("options", "The controller's options (see its entry below).", "mapping", None, default={}),
+), "A tracking or regulating controller and its options.")
+
+SENSOR_NOISE = Section((
+    number("attitude_deg", "Standard deviation of the attitude measurement error per axis.", unit="deg",
+           default=0.0, non_negative=True),
+    number("rate", "Standard deviation of the rate measurement error per axis.", unit="rad/s", default=0.0,
+           non_negative=True),
+    integer("seed", "Seed of the noise (the magnetometer's on a stream of its own).", default=0, minimum=0,
+            maximum=2**63 - 1),
+    number("magnetic_field", "Standard deviation of the magnetometer error per body axis, white per sample.",
+           unit="T", default=0.0, non_negative=True),
+), "Measurement noise, white and Gaussian.")
+
+SIMULATION = Section((
+    number("sample_time", "Zero-order-hold sample time of the controller.", unit="s", default=1.0, positive=True),
+    number("duration", "Closed-loop window; ``null``: the larger of ``maneuver.duration`` and the reference's "
+           "duration.", unit="s", default=None, positive=True, nullable=True),
+    vector("initial_attitude_error_deg", "Rotation vector applied to the true initial attitude, body axes.", 3,
+           unit="deg", default=[0.0, 0.0, 0.0]),
+    vector("initial_rate_error", "Added to the true initial body rate, body frame.", 3, unit="rad/s",
+           default=[0.0, 0.0, 0.0]),
+    mapping("sensor_noise", "Measurement noise.", SENSOR_NOISE, default={}),
+    choice("integrator", "Integrator of the closed loop.", ("rk4", "cvodes"), default="rk4"),
+    number("max_step", f"Longest RK4 sub-step (at most {MAX_SUBSTEPS} sub-steps per sample).", unit="s",
+           default=0.05, positive=True),
+    number("settling_tolerance_deg", "Attitude-error tolerance of the metric ``settling_time_s``.", unit="deg",
+           default=0.5, positive=True, maximum=180.0),
+    number("fine_settling_tolerance_deg", "A second, finer tolerance (metric ``fine_settling_time_s``); "
+           "``null``: none.", unit="deg", default=None, positive=True, maximum=180.0, nullable=True),
+    number("detumble_tolerance", "Rate bound of the metric ``detumble_time_s``.", unit="rad/s", default=0.01,
+           positive=True),
+    integer("max_samples", "Most closed-loop samples a run may take (with 20 RK4 sub-steps per allowed sample).",
+            default=MAX_SAMPLES, minimum=1, maximum=100_000_000),
+    boolean("compile", "Build the closed loop of a symbolic law as C (needs a C compiler); interpreted "
+            "otherwise.", default=False),
+), "Closed-loop settings.")
+
+SCENARIO = Section((
+    custom("name", f"The scenario's name (at most {MAX_NAME} characters; the default output directory is "
+           "``results/<name>``, sanitised).", "text", _name),
+    custom("spacecraft", "The rigid body and its actuators.", "mapping", None, section=SPACECRAFT),
+    custom("orbit", "A circular orbit; absent or ``null``: none.", "mapping or null", None, default=None,
+           section=ORBIT),
+    custom("environment", "Gravity gradient, magnetic field and disturbance torque; absent or ``null``: none.",
+           "mapping or null", None, default={}, section=ENVIRONMENT),
+    custom("maneuver", "The slew to plan and track.", "mapping", None, section=MANEUVER),
+    custom("planners", "The planner rows; ``[]``: regulation to ``maneuver.final`` by the controllers alone.",
+           "list of mappings", None, section=PLANNER, entries=True),
+    custom("controller", "The controller (give either ``controller`` or ``controllers``).", "mapping", None,
+           default=Described("required unless ``controllers`` is given"), section=CONTROLLER),
+    custom("controllers", "Several controllers compared row by row (one row per planner and controller); "
+           "labels unique.", "list of mappings", None, default=None, section=CONTROLLER, entries=True),
+    mapping("simulation", "Closed-loop settings.", SIMULATION, default={}, null="defaults"),
+), "A scenario file.")
 
 
 def _parse_problem(node: Node, spacecraft: Spacecraft, environment: Environment) -> ManeuverProblem:
     node.mapping()
-    order = node.get("quaternion_order", "scalar_first").string(("scalar_first", "scalar_last"))
+    order = MANEUVER["quaternion_order"].value(node)
 
-    def attitude(node: Node) -> np.ndarray:
-        q = node.quaternion()
+    def attitude(q: np.ndarray) -> np.ndarray:
         return quat.from_scalar_last(q) if order == "scalar_last" else q
 
-    def free_attitude(node: Node) -> np.ndarray | None:
-        return None if node.is_null() else attitude(node)  # final attitude written as null: free
-
-    initial = node.get("initial", required=True).mapping()
-    final = node.get("final", required=True).mapping()
-    momentum = initial.get("wheel_momentum", None).optional_vector(spacecraft.n_wheels)
+    initial, final = MANEUVER["initial"].value(node), MANEUVER["final"].value(node)
+    momentum = initial["wheel_momentum"].optional_vector(spacecraft.n_wheels)
     problem = ManeuverProblem(
-        spacecraft=spacecraft, environment=environment,
-        q0=attitude(initial.get("q", required=True)), omega0=initial.get("omega", [0.0, 0.0, 0.0]).vector(3),
-        qf=free_attitude(final.get("q", required=True)), omegaf=final.get("omega", None).optional_vector(3),
-        duration=node.get("duration", required=True).number(positive=True),
-        wheel_momentum0=momentum, max_rate=node.get("max_rate", None).optional_number(positive=True),
+        spacecraft=spacecraft, environment=environment, q0=attitude(initial["q"]), omega0=initial["omega"],
+        qf=None if final["q"] is None else attitude(final["q"]),  # a final attitude written as null: free
+        omegaf=final["omega"], duration=MANEUVER["duration"].value(node),
+        wheel_momentum0=momentum, max_rate=MANEUVER["max_rate"].value(node),
     )
-    for part in (initial, final, node):
-        part.finish()
+    node.finish()
     return problem
 
 
-def _registered(node: Node, registry: dict[str, type], kind: str) -> tuple[str, Any]:
-    """``name`` and parsed ``options`` of a registry entry (planner or controller) at ``node``."""
-    name = node.get("name", required=True).string()
-    if name not in registry:
-        raise ScenarioError(f"{node.path}.name", f"unknown {kind} {name!r}; registered: {sorted(registry)}")
-    options = node.get("options", {})
+def _validated(node: Node, registry: dict[str, Any], section: Section) -> tuple[str, str | None, Any]:
+    """``(name, label or None, instance)`` of a planner or controller entry, its options validated
+    by the registered class (once: the instance travels to the checks and the runner)."""
+    values = section.read(node)
+    options = values["options"]
     try:
-        return name, registry[name](options.value, path=options.path).options
+        instance = registry[values["name"]](options.value, path=options.path)
     except OptionsError as error:
         raise ScenarioError(error.path, error.message) from None
+    return values["name"], values["label"], instance
 
 
 def _parse_planners(node: Node) -> list[PlannerSpec]:
     specs = []
     for item in node.items():
-        item.mapping()
-        name, options = _registered(item, PLANNERS, "planner")
-        label = _label(item, name)
-        item.finish()
-        specs.append(PlannerSpec(name, label, options))
+        name, label, planner = _validated(item, PLANNERS, PLANNER)
+        specs.append(PlannerSpec(name, label or name, planner.options, planner))  # labels: checks.check_row_labels
     return specs
 
 
 def _parse_controller(node: Node) -> ControllerSpec:
-    name, options = _registered(node.mapping(), CONTROLLERS, "controller")
-    label = _label(node, name)
-    node.finish()
-    return ControllerSpec(name, options, label, node.path)
-
-
-def _label(node: Node, default: str) -> str:
-    """A row label: non-empty text of at most :data:`MAX_LABEL` characters."""
-    label_node = node.get("label", default)
-    label = label_node.string()
-    if not label.strip() or len(label) > MAX_LABEL:
-        raise label_node.error(f"expected a non-empty label of at most {MAX_LABEL} characters, got {excerpt(label)}")
-    return label
+    if isinstance(node.value, Described):
+        raise ScenarioError(node.path, "required key is missing")
+    name, label, controller = _validated(node, CONTROLLERS, CONTROLLER)
+    return ControllerSpec(name, controller.options, label or name, node.path, controller)
 
 
 def _parse_controllers(root: Node) -> list[ControllerSpec]:
@@ -247,44 +390,34 @@ def _parse_controllers(root: Node) -> list[ControllerSpec]:
     if "controller" in root and "controllers" in root:
         raise ScenarioError("controllers", "give either `controller` (one) or `controllers` (a list), not both")
     if "controllers" not in root:
-        return [_parse_controller(root.get("controller", required=True))]
-    node = root.get("controllers")
-    root.get("controller", None)  # an explicit `controller: null` next to the list is accepted
+        SCENARIO["controllers"].value(root)  # an explicit `controllers: null` next to `controller` is accepted
+        return [_parse_controller(SCENARIO["controller"].value(root))]
+    node = SCENARIO["controllers"].value(root)
+    root.get("controller", None)  # an explicit `controller: null` next to the list is accepted (its
+    # default, "required unless controllers is given", is in words)
     specs = [_parse_controller(item) for item in node.items()]
     if not specs:
         raise ScenarioError("controllers", "expected at least one controller")
     return specs
 
 
-def _parse_simulation(node: Node) -> SimulationSpec:
-    node = node if not node.is_null() else Node({}, node.path)
-    node.mapping()
-    noise = node.get("sensor_noise", {}).mapping()
+def _parse_simulation(values: dict[str, Any], path: str) -> SimulationSpec:
+    noise = values["sensor_noise"]
     spec = SimulationSpec(
-        sample_time=node.get("sample_time", 1.0).number(positive=True),
-        duration=node.get("duration", None).optional_number(positive=True),
-        initial_attitude_error=np.deg2rad(node.get("initial_attitude_error_deg", [0.0, 0.0, 0.0]).vector(3)),
-        initial_rate_error=node.get("initial_rate_error", [0.0, 0.0, 0.0]).vector(3),
-        noise=SensorNoise(
-            attitude_std=np.deg2rad(noise.get("attitude_deg", 0.0).number(non_negative=True)),
-            rate_std=noise.get("rate", 0.0).number(non_negative=True),
-            seed=noise.get("seed", 0).integer(minimum=0, maximum=2**63 - 1),
-            field_std=noise.get("magnetic_field", 0.0).number(non_negative=True),
-        ),
-        integrator=node.get("integrator", "rk4").string(("rk4", "cvodes")),
-        max_step=node.get("max_step", 0.05).number(positive=True),
-        settling_tolerance_deg=node.get("settling_tolerance_deg", 0.5).number(positive=True, maximum=180.0),
-        fine_settling_tolerance_deg=node.get("fine_settling_tolerance_deg", None).optional_number(positive=True, maximum=180.0),
-        detumble_tolerance=node.get("detumble_tolerance", 0.01).number(positive=True),
-        max_samples=node.get("max_samples", MAX_SAMPLES).integer(minimum=1, maximum=100_000_000),
-        compile=node.get("compile", False).boolean(),
+        sample_time=values["sample_time"], duration=values["duration"],
+        initial_attitude_error=np.deg2rad(values["initial_attitude_error_deg"]),
+        initial_rate_error=values["initial_rate_error"],
+        noise=SensorNoise(attitude_std=np.deg2rad(noise["attitude_deg"]), rate_std=noise["rate"],
+                          seed=noise["seed"], field_std=noise["magnetic_field"]),
+        integrator=values["integrator"], max_step=values["max_step"],
+        settling_tolerance_deg=values["settling_tolerance_deg"],
+        fine_settling_tolerance_deg=values["fine_settling_tolerance_deg"],
+        detumble_tolerance=values["detumble_tolerance"], max_samples=values["max_samples"], compile=values["compile"],
     )
     if spec.integrator == "rk4" and math.ceil(spec.sample_time / spec.max_step - 1e-9) > MAX_SUBSTEPS:
-        raise ScenarioError(node.get("max_step").path, f"{spec.max_step:g} s gives more than {MAX_SUBSTEPS} RK4 "
+        raise ScenarioError(f"{path}.max_step", f"{spec.max_step:g} s gives more than {MAX_SUBSTEPS} RK4 "
                             f"sub-steps per {spec.sample_time:g} s sample; raise it to at least "
                             f"{spec.sample_time / MAX_SUBSTEPS:g} s")
-    noise.finish()
-    node.finish()
     return spec
 
 
@@ -309,18 +442,15 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
         Naming the YAML path, the value and what was expected.
     """
     root = Node(data).mapping()
-    name_node = root.get("name", required=True)
-    name = name_node.string()
-    if not name.strip() or len(name) > MAX_NAME:
-        raise name_node.error(f"expected a non-empty name of at most {MAX_NAME} characters, got {excerpt(name)}")
-    spacecraft = parse_spacecraft(root.get("spacecraft", required=True))
-    environment = parse_environment(root.get("orbit", None), root.get("environment", {}))
-    problem = _parse_problem(root.get("maneuver", required=True), spacecraft, environment)
-    planners = _parse_planners(root.get("planners", required=True))
+    name = SCENARIO["name"].value(root)
+    spacecraft = parse_spacecraft(SCENARIO["spacecraft"].value(root))
+    environment = parse_environment(SCENARIO["orbit"].value(root), SCENARIO["environment"].value(root))
+    problem = _parse_problem(SCENARIO["maneuver"].value(root), spacecraft, environment)
+    planners = _parse_planners(SCENARIO["planners"].value(root))
     controllers = _parse_controllers(root)
-    simulation = _parse_simulation(root.get("simulation", {}))
+    simulation = _parse_simulation(SCENARIO["simulation"].value(root), "simulation")
     root.finish()
-    problem = _fit_field_span(data, problem, simulation, planners)
+    problem = _fit_field_span(problem, simulation, planners)
     check_work(problem, simulation)
     check_row_labels(planners, controllers)
     check_compatibility(problem, planners, controllers, simulation)

@@ -1,11 +1,13 @@
 """The model sections of a scenario YAML: ``spacecraft``, ``orbit`` and ``environment``.
 
-Errors are :class:`~scenarios.schema.node.ScenarioError` at the YAML path; a model constructor's
+Each section's keys are declared here (:data:`SPACECRAFT`, :data:`ORBIT`, :data:`ENVIRONMENT`) and
+read through them; the magnetic field models and their options come from the registry
+:data:`~ocp.dynamics.environment.MAGNETIC_FIELDS`. Errors are
+:class:`~scenarios.errors.ScenarioError` at the YAML path; a model constructor's
 :class:`~ocp.ModelError` is reported at the field it names. Kilometres and degrees become SI here.
 """
 from __future__ import annotations
 
-import datetime
 from collections.abc import Callable
 from typing import Any
 
@@ -14,42 +16,120 @@ import numpy as np
 from ocp import (
     CircularOrbit,
     Environment,
-    IGRFField,
     Magnetorquers,
     ModelError,
     ReactionWheels,
     Spacecraft,
-    TiltedDipole,
     Torquers,
 )
+from ocp.dynamics.environment import MAGNETIC_FIELDS, MagneticField
+from ocp.errors import InvalidOption
 from scenarios.errors import ScenarioError
+from scenarios.schema.keys import (
+    Section,
+    boolean,
+    choice,
+    custom,
+    mapping,
+    number,
+    option_keys,
+    vector,
+)
 from scenarios.schema.node import Node
+
+__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "ORBIT", "SPACECRAFT", "TORQUERS", "WHEELS",
+           "parse_environment", "parse_magnetic_field", "parse_orbit", "parse_spacecraft"]
 
 
 def _model_part(node: Node, build: Callable[..., Any], **kwargs: Any) -> Any:
-    """Call a model constructor, turning its ModelError into a ScenarioError at ``node.path``."""
+    """Call a model constructor, turning its ModelError into a ScenarioError at ``node.path``
+    (at ``<node.path>.<field>`` when the error names a field)."""
     try:
         return build(**kwargs)
     except ModelError as error:
-        raise ScenarioError(f"{node.path}.{error.field}" if node.path else error.field, error.message) from None
+        where = (f"{node.path}.{error.field}" if node.path else error.field) if error.field else node.path
+        raise ScenarioError(where, error.message) from None
 
 
-def _limits(node: Node, key: str) -> Any:
-    child = node.get(key, None)
-    return None if child.is_null() else child.vector(allow_scalar=True)
+def _limits(node: Node) -> Any:
+    return None if node.is_null() else node.vector(allow_scalar=True)
+
+
+def _inertia(node: Node) -> np.ndarray:
+    inertia = node.value
+    if isinstance(inertia, list) and inertia and all(isinstance(row, list) for row in inertia):
+        return np.array([Node(row, f"{node.path}[{i}]").vector(3) for i, row in enumerate(inertia)])
+    return node.vector(3)
+
+
+def _axes(node: Node) -> np.ndarray:
+    return np.eye(3) if node.is_null() else np.array([row.vector(3) for row in node.items()]).T
+
+
+def _limit(name: str, meaning: str, unit: str, each: str = "wheel") -> Any:
+    return custom(name, meaning, f"number, list of numbers (one per {each}) or null", _limits, unit=unit, default=None)
+
+
+WHEELS = Section((
+    custom("axes", "Spin axes of the wheels, one row (3 numbers, body axes) per wheel; ``null``: the body axes.",
+           "list of lists of 3 numbers or null", _axes, default=None),
+    _limit("max_torque", "Torque bound of each wheel (one number for all); ``null``: none.", "N m"),
+    _limit("max_momentum", "Momentum bound of each wheel; ``null``: none.", "N m s"),
+    _limit("spin_inertia", "Spin inertia of each wheel (wheel speeds are reported with it); ``null``: none.",
+           "kg m²"),
+    custom("failed", "Indices (from 0) of failed wheels, which give no torque.", "list of integers",
+           lambda node: tuple(item.integer() for item in node.items()), default=[]),
+), "Reaction wheels; ``null`` (or ``none``): no wheels.")
+
+MAGNETORQUERS = Section((
+    _limit("max_dipole", "Dipole bound per axis (one number for all three); ``null``: none.", "A m²", "axis"),
+    choice("saturation", "``per_axis``: each axis clipped to ``max_dipole``; ``scale``: the dipole vector "
+           "scaled down as a whole, keeping its direction.", ("per_axis", "scale"), default="per_axis"),
+), "Magnetorquers on the body axes; absent or ``null``: none.")
+
+TORQUERS = Section((
+    _limit("max_torque", "Torque bound per body axis (one number for all three); ``null``: none.", "N m", "axis"),
+), "Ideal body-axis torquers (thrusters) that store no momentum; absent or ``null``: none.")
+
+SPACECRAFT = Section((
+    custom("inertia", "Principal moments (3 numbers) or the 3x3 inertia matrix about the centre of mass, body "
+           "frame; positive definite, the moments meeting the triangle inequality.",
+           "list of 3 numbers or 3x3 matrix", _inertia, unit="kg m²"),
+    mapping("wheels", "Reaction wheels (default: three wheels on the body axes without bounds).", WHEELS,
+            default={}, null="none"),
+    mapping("magnetorquers", "Magnetorquers.", MAGNETORQUERS, default=None, null="none"),
+    mapping("torquers", "Ideal body-axis torquers.", TORQUERS, default=None, null="none"),
+), "The rigid body and its actuators.")
+
+ORBIT = Section((
+    number("altitude_km", "Height of the circular orbit above the equatorial radius (6378.137 km).", unit="km"),
+    number("inclination_deg", "Inclination of the orbit plane to the equator.", unit="deg", default=0.0),
+    number("raan_deg", "Right ascension of the ascending node.", unit="deg", default=0.0),
+    number("arg_latitude_deg", "Argument of latitude at t = 0, from the ascending node.", unit="deg", default=0.0),
+), "A circular orbit (absent or ``null``: none); the gravity gradient and magnetic fields need one.")
+
+MAGNETIC_FIELD = Section((
+    choice("model", "The field model (a name registered in ``MAGNETIC_FIELDS``); the other keys of the mapping "
+           "are its options.", MAGNETIC_FIELDS, default="tilted_dipole"),
+), "A field model's name, ``none``, or a mapping of ``model`` and the model's options.")
+
+
+ENVIRONMENT = Section((
+    boolean("gravity_gradient", "Include the gravity-gradient torque (needs ``orbit``).", default=False),
+    custom("magnetic_field", "The geomagnetic field: a model name (its default options), ``none``, or "
+           "``{model: <name>, <option>: <value>, ...}``; needs ``orbit``.", "text, mapping or null", None,
+           default=None, section=MAGNETIC_FIELD, choices=MAGNETIC_FIELDS),
+    vector("disturbance_torque", "Constant disturbance torque, body frame.", 3, unit="N m", default=[0.0, 0.0, 0.0]),
+), "What acts on the spacecraft besides its actuators (absent or ``null``: nothing).")
 
 
 def parse_spacecraft(node: Node) -> Spacecraft:
-    """The ``spacecraft`` section: inertia, wheels, magnetorquers and torquers.
+    """The ``spacecraft`` section (:data:`SPACECRAFT`): inertia, wheels, magnetorquers and torquers.
 
     Parameters
     ----------
     node : Node
-        The ``spacecraft`` mapping: ``inertia`` (3 principal moments or a 3x3 matrix [kg m²],
-        body frame), ``wheels`` (``axes`` as rows in body axes, ``max_torque`` [N m],
-        ``max_momentum`` [N m s], ``spin_inertia`` [kg m²], ``failed`` indices),
-        ``magnetorquers`` (``max_dipole`` [A m²], ``saturation``) and ``torquers``
-        (``max_torque`` [N m]).
+        The ``spacecraft`` mapping.
 
     Returns
     -------
@@ -62,39 +142,87 @@ def parse_spacecraft(node: Node) -> Spacecraft:
         At the offending key's YAML path.
     """
     node.mapping()
-    inertia_node = node.get("inertia", required=True)
-    inertia = inertia_node.value
-    if isinstance(inertia, list) and inertia and all(isinstance(row, list) for row in inertia):
-        inertia = np.array([Node(row, f"{inertia_node.path}[{i}]").vector(3) for i, row in enumerate(inertia)])
-    else:
-        inertia = inertia_node.vector(3)
-    wheels_node = node.get("wheels", {})
+    inertia = SPACECRAFT["inertia"].value(node)
+    wheels_node = SPACECRAFT["wheels"].node(node)
     wheels = None
     if not wheels_node.is_null():
-        wheels_node.mapping()
-        axes_node = wheels_node.get("axes", None)
-        axes = np.eye(3) if axes_node.is_null() else np.array([row.vector(3) for row in axes_node.items()]).T
-        failed = [item.integer() for item in wheels_node.get("failed", []).items()]
-        wheels = _model_part(
-            wheels_node, ReactionWheels, axes=axes, max_torque=_limits(wheels_node, "max_torque"),
-            max_momentum=_limits(wheels_node, "max_momentum"), spin_inertia=_limits(wheels_node, "spin_inertia"),
-            failed=tuple(failed),
-        )
-        wheels_node.finish()
+        values = WHEELS.read(wheels_node)
+        wheels = _model_part(wheels_node, ReactionWheels, **values)
     magnetorquers = torquers = None
-    mtq = node.get("magnetorquers", None)
+    mtq = SPACECRAFT["magnetorquers"].node(node)
     if not mtq.is_null():
-        magnetorquers = _model_part(mtq.mapping(), Magnetorquers, max_dipole=_limits(mtq, "max_dipole"),
-                                    saturation=mtq.get("saturation", "per_axis").string(("per_axis", "scale")))
-        mtq.finish()
-    trq = node.get("torquers", None)
+        magnetorquers = _model_part(mtq, Magnetorquers, **MAGNETORQUERS.read(mtq))
+    trq = SPACECRAFT["torquers"].node(node)
     if not trq.is_null():
-        torquers = _model_part(trq.mapping(), Torquers, max_torque=_limits(trq, "max_torque"))
-        trq.finish()
+        torquers = _model_part(trq, Torquers, **TORQUERS.read(trq))
     spacecraft = _model_part(node, Spacecraft, inertia=inertia, wheels=wheels, magnetorquers=magnetorquers,
                              torquers=torquers)
     node.finish()
     return spacecraft
+
+
+def parse_orbit(node: Node) -> CircularOrbit | None:
+    """The ``orbit`` section (:data:`ORBIT`), kilometres and degrees converted to SI.
+
+    Parameters
+    ----------
+    node : Node
+        The ``orbit`` mapping, or null for none.
+
+    Returns
+    -------
+    CircularOrbit or None
+        The orbit.
+
+    Raises
+    ------
+    ScenarioError
+        At the offending key's YAML path.
+    """
+    if node.is_null():
+        return None
+    values = ORBIT.read(node)
+    return _model_part(node, CircularOrbit, altitude=values["altitude_km"] * 1e3,
+                       inclination=np.deg2rad(values["inclination_deg"]), raan=np.deg2rad(values["raan_deg"]),
+                       arg_latitude=np.deg2rad(values["arg_latitude_deg"]))
+
+
+def parse_magnetic_field(node: Node, orbit: CircularOrbit | None) -> MagneticField | None:
+    """``environment.magnetic_field``: a registered model's name, ``none``, or a mapping of ``model``
+    and the model's options (read by the keys of its ``Options``).
+
+    Parameters
+    ----------
+    node : Node
+        The ``magnetic_field`` value.
+    orbit : CircularOrbit or None
+        The scenario's orbit.
+
+    Returns
+    -------
+    MagneticField or None
+        The field (``None`` for null or ``none``).
+
+    Raises
+    ------
+    ScenarioError
+        At the offending key's YAML path.
+    """
+    if node.is_null():
+        return None
+    if isinstance(node.value, str):
+        model = MAGNETIC_FIELDS[node.string((*MAGNETIC_FIELDS, "none"))]
+        options = model.Options()
+    else:
+        node.mapping()
+        model = MAGNETIC_FIELDS[MAGNETIC_FIELD["model"].value(node)]
+        values = {key.name: key.value(node) for key in option_keys(model.Options)}
+        node.finish()
+        try:
+            options = model.Options(**values)
+        except InvalidOption as error:  # a relation between options (Options.__post_init__)
+            raise ScenarioError(f"{node.path}.{error.option}", error.message) from None
+    return _model_part(node, model.from_options, options=options, orbit=orbit)
 
 
 def parse_environment(orbit_node: Node, node: Node) -> Environment:
@@ -103,81 +231,28 @@ def parse_environment(orbit_node: Node, node: Node) -> Environment:
     Parameters
     ----------
     orbit_node : Node
-        The ``orbit`` mapping (``altitude_km``, ``inclination_deg``, ``raan_deg``,
-        ``arg_latitude_deg``), or null for none.
+        The ``orbit`` mapping (:data:`ORBIT`), or null for none.
     node : Node
-        The ``environment`` mapping (``gravity_gradient``, ``magnetic_field``,
-        ``disturbance_torque`` [N m, body frame]), or null for the defaults.
+        The ``environment`` mapping (:data:`ENVIRONMENT`), or null for the defaults.
 
     Returns
     -------
     Environment
-        The environment model (an IGRF table spans a provisional second until the loader fits it
-        to the closed-loop window).
+        The environment model (a field whose extent follows the closed-loop window, such as an
+        IGRF table without ``span_s``, spans a provisional second until the loader fits it).
 
     Raises
     ------
     ScenarioError
         At the offending key's YAML path.
     """
-    orbit = None
-    if not orbit_node.is_null():
-        orbit_node.mapping()
-        orbit = _model_part(
-            orbit_node, CircularOrbit,
-            altitude=orbit_node.get("altitude_km", required=True).number() * 1e3,
-            inclination=np.deg2rad(orbit_node.get("inclination_deg", 0.0).number()),
-            raan=np.deg2rad(orbit_node.get("raan_deg", 0.0).number()),
-            arg_latitude=np.deg2rad(orbit_node.get("arg_latitude_deg", 0.0).number()),
-        )
-        orbit_node.finish()
+    orbit = parse_orbit(orbit_node)
     node = node if not node.is_null() else Node({}, node.path)
     node.mapping()
-    field_node = node.get("magnetic_field", None)
-    magnetic_field: TiltedDipole | IGRFField | None = None
-    if not field_node.is_null():
-        if isinstance(field_node.value, str):
-            field_node.string(("tilted_dipole", "none"))
-            magnetic_field = TiltedDipole()
-        else:
-            field_node.mapping()
-            model = field_node.get("model", "tilted_dipole").string(("tilted_dipole", "igrf"))
-            magnetic_field = (_igrf_field(field_node, orbit) if model == "igrf"
-                              else _tilted_dipole(field_node))
-            field_node.finish()
+    magnetic_field = parse_magnetic_field(ENVIRONMENT["magnetic_field"].value(node), orbit)
     environment = _model_part(
-        node, Environment, orbit=orbit,
-        gravity_gradient=node.get("gravity_gradient", False).boolean(),
-        magnetic_field=magnetic_field,
-        disturbance_torque=node.get("disturbance_torque", [0.0, 0.0, 0.0]).vector(3),
+        node, Environment, orbit=orbit, gravity_gradient=ENVIRONMENT["gravity_gradient"].value(node),
+        magnetic_field=magnetic_field, disturbance_torque=ENVIRONMENT["disturbance_torque"].value(node),
     )
     node.finish()
     return environment
-
-
-def _tilted_dipole(node: Node) -> TiltedDipole:
-    defaults = TiltedDipole()
-    return TiltedDipole(
-        strength=node.get("strength", defaults.strength).number(positive=True),
-        tilt=np.deg2rad(node.get("tilt_deg", np.rad2deg(defaults.tilt)).number()),
-        pole_longitude=np.deg2rad(node.get("pole_longitude_deg", np.rad2deg(defaults.pole_longitude)).number()),
-        greenwich_angle=np.deg2rad(node.get("greenwich_angle_deg", 0.0).number()),
-    )
-
-
-def _igrf_field(node: Node, orbit: CircularOrbit | None) -> IGRFField:
-    """``{model: igrf, epoch, step_s, span_s, greenwich_angle_deg}``; without ``span_s`` the table
-    spans a provisional second, fitted to the closed-loop window by :func:`_fit_field_span`."""
-    if orbit is None:
-        raise ScenarioError(node.path, "the IGRF field is tabulated along the orbit; give `orbit:`")
-    epoch_node = node.get("epoch", "2025-01-01")
-    epoch = epoch_node.value
-    if not isinstance(epoch, (str, datetime.date)):
-        raise epoch_node.error(f"expected a date like 2025-01-01, got {str(epoch)[:40]!r}")
-    greenwich = node.get("greenwich_angle_deg", None).optional_number()
-    return _model_part(
-        node, IGRFField, orbit=orbit, epoch=str(epoch),
-        span=node.get("span_s", None).optional_number(positive=True) or 1.0,
-        step=node.get("step_s", 30.0).number(positive=True, maximum=120.0),  # cubic spline error ~3e-4 at 120 s
-        greenwich_angle=None if greenwich is None else float(np.deg2rad(greenwich)),
-    )

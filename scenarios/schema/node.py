@@ -7,7 +7,8 @@ Reading the file itself (:func:`~scenarios.schema.read.read_yaml`, with its limi
 """
 from __future__ import annotations
 
-from typing import Any, Iterator
+from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 
@@ -57,7 +58,7 @@ class Node:
             return f"{self.path}[{key}]"
         return f"{self.path}.{key}" if self.path else key
 
-    def mapping(self) -> "Node":
+    def mapping(self) -> Node:
         """This node, checked to hold a mapping.
 
         Returns
@@ -77,7 +78,7 @@ class Node:
     def __contains__(self, key: str) -> bool:
         return isinstance(self.value, dict) and key in self.value and self.value[key] is not None
 
-    def get(self, key: str, default: Any = ..., required: bool = False) -> "Node":
+    def get(self, key: str, default: Any = ..., required: bool = False) -> Node:
         """A child of this mapping, marked as read (see :meth:`finish`).
 
         Parameters
@@ -114,7 +115,7 @@ class Node:
                 if key not in self._read:
                     raise ScenarioError(self._child_path(key), f"unknown key; expected one of {sorted(self._read)}")
 
-    def items(self) -> Iterator["Node"]:
+    def items(self) -> Iterator[Node]:
         """The entries of this list, each at its path (``planners[0]``, ...).
 
         Returns

@@ -1,9 +1,12 @@
 """Monte Carlo dispersions of a trade study: distributions drawn by inverse transform from unit
 samples (plain random or a Latin hypercube from ``scipy.stats.qmc``), applied to a scenario path.
 
-``{normal: {mean, std}}`` and ``{uniform: [low, high]}`` (scalars or vectors) set the value;
-``{scale: <distribution>}`` multiplies the base scenario's value and ``{offset: <distribution>}``
-adds to it; ``case_seed`` sets the case's own seed (for ``simulation.sensor_noise.seed``).
+The forms are the study schema's (:mod:`scenarios.schema.study`): a distribution of the registry
+:data:`~scenarios.schema.study.DISTRIBUTIONS` (``{normal: {mean, std}}``, ``{uniform: [low,
+high]}``, scalars or vectors) sets the value; ``{scale: <distribution>}`` multiplies the base
+scenario's value and ``{offset: <distribution>}`` adds to it
+(:data:`~scenarios.schema.study.COMBINATIONS`); ``case_seed`` sets the case's own seed (for
+``simulation.sensor_noise.seed``).
 """
 from __future__ import annotations
 
@@ -13,9 +16,8 @@ from typing import Any
 import numpy as np
 
 from scenarios.schema.node import Node
+from scenarios.schema.study import CASE_SEED, COMBINATIONS, DISTRIBUTIONS
 from scenarios.study.paths import Step, get_path
-
-_EPS = 1e-12  # keeps the normal's inverse CDF finite at u = 0
 
 
 @dataclass
@@ -25,10 +27,12 @@ class Dispersion:
     Parameters
     ----------
     kind : str
-        ``normal``, ``uniform`` or ``case_seed``.
+        A distribution of :data:`~scenarios.schema.study.DISTRIBUTIONS` (``normal``,
+        ``uniform``) or ``case_seed``.
     combine : str
-        ``set`` (the draw is the value), ``scale`` (it multiplies the base value) or ``offset``
-        (it is added to the base value).
+        ``set`` (the draw is the value) or a combination of
+        :data:`~scenarios.schema.study.COMBINATIONS`: ``scale`` (it multiplies the base value),
+        ``offset`` (it is added to the base value).
     a : (n,) ndarray
         Mean (normal) or low bound (uniform) of each component, in the units of the scenario
         key (a ``_deg`` key: degrees); empty for ``case_seed``.
@@ -47,7 +51,7 @@ class Dispersion:
     @property
     def dimension(self) -> int:
         """Unit samples the dispersion consumes (0 for ``case_seed``)."""
-        return 0 if self.kind == "case_seed" else int(self.a.size)
+        return 0 if self.kind == CASE_SEED.name else int(self.a.size)
 
     @property
     def needs_base(self) -> bool:
@@ -72,47 +76,20 @@ class Dispersion:
         Any
             The case's value: an int (``case_seed``), a float, or an ndarray for a vector.
         """
-        if self.kind == "case_seed":
+        if self.kind == CASE_SEED.name:
             return seed
-        if self.kind == "normal":
-            from scipy.special import (
-                ndtri,  # lazily: scipy is slow to import for plain runs
-            )
-
-            draw = self.a + self.b * ndtri(np.clip(unit, _EPS, 1.0 - _EPS))  # the normal's inverse CDF
-        else:
-            draw = self.a + unit * (self.b - self.a)
-        draw = draw if self.vector else float(draw[0])
+        draws = DISTRIBUTIONS[self.kind].inverse_cdf(unit, self.a, self.b)
+        draw = draws if self.vector else float(draws[0])
         if self.combine == "set":
             return draw
-        base = np.asarray(base, dtype=float)
-        return base * draw if self.combine == "scale" else base + draw
+        return COMBINATIONS[self.combine][1](np.asarray(base, dtype=float), draw)
 
 
-def _pair(node: Node, kind: str) -> tuple[np.ndarray, np.ndarray, bool]:
-    """(a, b, vector) of a normal or uniform entry."""
-    if kind == "normal":
-        spec = node.mapping()
-        first, second = spec.get("mean", required=True), spec.get("std", required=True)
-    else:
-        spec = node
-        if isinstance(node.value, list):
-            if len(node.value) != 2:
-                raise node.error(f"expected [low, high], got {node.value!r:.80}")
-            first, second = Node(node.value[0], f"{node.path}[0]"), Node(node.value[1], f"{node.path}[1]")
-        else:
-            spec = node.mapping()
-            first, second = spec.get("low", required=True), spec.get("high", required=True)
-    vector = isinstance(first.value, list)
-    a = first.vector() if vector else np.atleast_1d(first.number())
-    b = second.vector(a.size) if vector else np.atleast_1d(second.number())
-    if kind == "normal" and np.any(b < 0):
-        raise second.error(f"a standard deviation cannot be negative, got {second.value!r}")
-    if kind == "uniform" and np.any(b < a):
-        raise node.error(f"expected low <= high, got {node.value!r:.80}")
-    if isinstance(spec.value, dict):
-        spec.finish()
-    return a, b, vector
+def _forms() -> str:
+    def form(key: Any) -> str:
+        return "{" + ", ".join(k.name for k in key.section.keys) + "}" if key.section else "..."
+    distributions = ", ".join(f"{{{name}: {form(d.argument)}}}" for name, d in DISTRIBUTIONS.items())
+    return f"{CASE_SEED.name}, {distributions} or {{{'|'.join(COMBINATIONS)}: <distribution>}}"
 
 
 def parse_dispersion(node: Node, base: dict[str, Any], steps: list[Step]) -> Dispersion:
@@ -137,17 +114,16 @@ def parse_dispersion(node: Node, base: dict[str, Any], steps: list[Step]) -> Dis
         Naming the entry, for an unknown distribution, a negative standard deviation, bounds out
         of order, or a ``scale``/``offset`` of a base value that is not numbers of that shape.
     """
-    if node.value == "case_seed":
-        return Dispersion("case_seed", "set", np.zeros(0), np.zeros(0), False)
+    if node.value == CASE_SEED.name:
+        return Dispersion(CASE_SEED.name, "set", np.zeros(0), np.zeros(0), False)
     combine = "set"
-    if isinstance(node.value, dict) and len(node.value) == 1 and next(iter(node.value)) in ("scale", "offset"):
+    if isinstance(node.value, dict) and len(node.value) == 1 and next(iter(node.value)) in COMBINATIONS:
         combine = next(iter(node.value))
-        node = node.get(combine)
-    if not isinstance(node.value, dict) or len(node.value) != 1 or next(iter(node.value)) not in ("normal", "uniform"):
-        raise node.error(f"expected case_seed, {{normal: {{mean, std}}}}, {{uniform: [low, high]}} or "
-                         f"{{scale|offset: <distribution>}}; got {node.value!r:.80}")
+        node = COMBINATIONS[combine][0].value(node)
+    if not isinstance(node.value, dict) or len(node.value) != 1 or next(iter(node.value)) not in DISTRIBUTIONS:
+        raise node.error(f"expected {_forms()}; got {node.value!r:.80}")
     kind = next(iter(node.value))
-    a, b, vector = _pair(node.get(kind), kind)
+    a, b, vector = DISTRIBUTIONS[kind].argument.value(node)
     if combine != "set":
         base_value = get_path(base, steps, node.path)
         try:

@@ -1,11 +1,12 @@
-"""Trade-study files (:doc:`/reference/schema`): schema, value generators and the
-expansion of a study into resolved cases, each validated by the scenario loader.
+"""Trade-study files (:doc:`/reference/schema`): reading a study and expanding it into resolved
+cases, each validated by the scenario loader.
 
 A study varies a base scenario over a ``grid`` (cartesian product), a ``zip`` (equal-length lists
 varied together) and, per grid point, ``monte_carlo`` samples of ``dispersions``. Every case gets a
 seed from ``numpy.random.SeedSequence(seed).spawn``, so its values (and its result) do not depend
-on the number of workers or the order in which cases finish. The study's data classes are in
-:mod:`scenarios.study.types` (imported here too).
+on the number of workers or the order in which cases finish. The study file's keys, its value
+generators and its distributions are declared in :mod:`scenarios.schema.study`; the study's data
+classes are in :mod:`scenarios.study.types`.
 """
 from __future__ import annotations
 
@@ -18,19 +19,14 @@ from typing import Any
 
 import numpy as np
 
-from ocp import METRIC_KEYS, quat
 from scenarios.errors import ScenarioError
-from scenarios.output.tables import VECTOR_METRICS, metric_columns
 from scenarios.schema.loader import parse_scenario
 from scenarios.schema.node import Node
 from scenarios.schema.read import read_yaml
+from scenarios.schema.study import MAX_CASES, STUDY, grid_values
 from scenarios.study.dispersions import Dispersion, draw_unit, parse_dispersion
 from scenarios.study.paths import Step, get_path, parse_path, set_path
 from scenarios.study.types import Case, Execution, Study, case_key, package_version
-
-MAX_CASES = 100_000
-MAX_VALUES = 10_000
-DEFAULT_SUMMARY = tuple(metric_columns(vectors=False))  # every scalar metric, reference and closed loop
 
 
 def _tree_copy(value: Any) -> Any:
@@ -53,41 +49,6 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def _values(node: Node, path: str, base: dict[str, Any]) -> tuple[list[Any], list[Any]]:
-    """(values set in the scenario, values recorded in the table) of one grid or zip entry."""
-    spec = node.value
-    if isinstance(spec, list):
-        if not spec or len(spec) > MAX_VALUES:
-            raise node.error(f"expected a list of 1 to {MAX_VALUES} values")
-        return list(spec), [v if not isinstance(v, (list, dict)) else json.dumps(v) for v in spec]
-    if not isinstance(spec, dict) or len(spec) != 1:
-        raise node.error(f"expected a list of values or one of linspace, geomspace, axis_angle; got {spec!r:.80}")
-    (kind, _), = spec.items()
-    if kind in ("linspace", "geomspace"):
-        start, stop, count = node.get(kind).vector(3)
-        if count != int(count) or not 1 <= count <= MAX_VALUES:
-            raise ScenarioError(f"{node.path}.{kind}[2]", f"expected a count from 1 to {MAX_VALUES}, got {count}")
-        if kind == "geomspace" and (start <= 0 or stop <= 0):
-            raise ScenarioError(f"{node.path}.{kind}", "geomspace needs positive bounds")
-        values = [float(v) for v in getattr(np, kind)(start, stop, int(count))]
-        return values, values
-    if kind == "axis_angle":
-        spec_node = node.get(kind).mapping()
-        axis = spec_node.get("axis", required=True).vector(3)
-        if not np.linalg.norm(axis) > 0:
-            raise ScenarioError(f"{spec_node.path}.axis", "the rotation axis cannot be zero")
-        angles = spec_node.get("angle_deg", required=True)
-        angles_deg = angles.vector() if isinstance(angles.value, list) else _values(angles, path, base)[0]
-        spec_node.finish()
-        scalar_last = base.get("maneuver", {}).get("quaternion_order") == "scalar_last"
-        quaternions = []
-        for angle in angles_deg:
-            q = quat.from_axis_angle(axis / np.linalg.norm(axis), np.deg2rad(float(angle)))
-            quaternions.append(_plain(quat.to_scalar_last(q) if scalar_last else q))
-        return quaternions, [float(a) for a in angles_deg]
-    raise node.error(f"unknown value generator {kind!r}; expected linspace, geomspace or axis_angle")
-
-
 def _varied(entry: Node, path: str, base: dict[str, Any], paths: list[str],
             steps: list[list[Step]]) -> tuple[list, list]:
     """Check that ``path`` reaches ``base``, record it in ``paths``/``steps``, and return its
@@ -95,7 +56,7 @@ def _varied(entry: Node, path: str, base: dict[str, Any], paths: list[str],
     paths.append(path)
     steps.append(parse_path(path, entry.path))
     get_parent_ok(base, steps[-1], entry.path)
-    return _values(entry, path, base)
+    return grid_values(entry, base)
 
 
 def _grid_points(root: Node, base: dict[str, Any]) -> tuple[list[str], list[list[Step]], list[tuple[list, list]]]:
@@ -103,14 +64,12 @@ def _grid_points(root: Node, base: dict[str, Any]) -> tuple[list[str], list[list
     paths: list[str] = []
     steps: list[list[Step]] = []
     axes: list[list[list[tuple[Any, Any]]]] = []
-    grid = root.get("grid", {})
-    grid = Node({}, "grid") if grid.is_null() else grid.mapping()
+    grid = STUDY["grid"].value(root)
     for path in grid.value:
         entry = grid.get(path)
         values, recorded = _varied(entry, path, base, paths, steps)
         axes.append([[pair] for pair in zip(values, recorded)])
-    zipped = root.get("zip", {})
-    zipped = Node({}, "zip") if zipped.is_null() else zipped.mapping()
+    zipped = STUDY["zip"].value(root)
     columns, length = [], None
     for path in zipped.value:
         entry = zipped.get(path)
@@ -148,25 +107,6 @@ def get_parent_ok(base: dict[str, Any], steps: list[Step], where: str) -> None:
     set_path(copy.deepcopy(base), steps, None, where)
 
 
-def _execution(node: Node) -> Execution:
-    node = Node({}, node.path) if node.is_null() else node.mapping()
-    workers = node.get("workers", "auto")
-    execution = Execution(
-        workers=None if workers.value == "auto" or workers.is_null() else workers.integer(),
-        scheduler=node.get("scheduler", None).value,
-        case_timeout_s=node.get("case_timeout_s", 600.0).number(positive=True),
-        retries=node.get("retries", 1).integer(),
-    )
-    if execution.workers is not None and not 1 <= execution.workers <= 1024:
-        raise ScenarioError(f"{node.path}.workers", f"expected auto or 1 to 1024, got {execution.workers}")
-    if not 0 <= execution.retries <= 10:
-        raise ScenarioError(f"{node.path}.retries", f"expected 0 to 10, got {execution.retries}")
-    if execution.scheduler is not None and not isinstance(execution.scheduler, str):
-        raise ScenarioError(f"{node.path}.scheduler", f"expected an address such as tcp://host:8786, got {execution.scheduler!r}")
-    node.finish()
-    return execution
-
-
 def parse_study(data: Any, source: Path | None = None, version: str | None = None) -> Study:
     """Parse a study (YAML data), expand its cases and validate every one with the scenario loader.
 
@@ -189,8 +129,8 @@ def parse_study(data: Any, source: Path | None = None, version: str | None = Non
         then the Monte Carlo samples of each point.
     """
     root = Node(data).mapping()
-    name = root.get("study", required=True).string()
-    scenario_node = root.get("scenario", required=True)
+    name = STUDY["study"].value(root)
+    scenario_node = STUDY["scenario"].value(root)
     if isinstance(scenario_node.value, str):
         folder = source.parent if source else Path.cwd()
         try:
@@ -206,19 +146,12 @@ def parse_study(data: Any, source: Path | None = None, version: str | None = Non
     except ScenarioError as error:
         raise ScenarioError(f"scenario: {error.path}", error.message) from None
     paths, steps, points = _grid_points(root, base)
-    mc = root.get("monte_carlo", None)
+    mc = STUDY["monte_carlo"].value(root)
     dispersions: list[tuple[str, list[Step], Dispersion]] = []
     samples, method, seed = 1, None, 0
-    if not mc.is_null():
-        mc.mapping()
-        samples = mc.get("samples", required=True).integer()
-        if not 1 <= samples <= MAX_CASES:
-            raise ScenarioError("monte_carlo.samples", f"expected 1 to {MAX_CASES}, got {samples}")
-        method = mc.get("method", "random").string(("random", "latin_hypercube"))
-        seed = mc.get("seed", 0).integer()
-        if seed < 0:
-            raise ScenarioError("monte_carlo.seed", f"expected a non-negative integer, got {seed}")
-        disp_node = mc.get("dispersions", required=True).mapping()
+    if mc is not None:
+        samples, method, seed = mc["samples"], mc["method"], mc["seed"]
+        disp_node = mc["dispersions"]
         for path in disp_node.value:
             entry = disp_node.get(path)
             path_steps = parse_path(path, entry.path)
@@ -226,33 +159,17 @@ def parse_study(data: Any, source: Path | None = None, version: str | None = Non
                 raise entry.error("this path is also in grid or zip; vary it in one place")
             get_parent_ok(base, path_steps, entry.path)
             dispersions.append((path, path_steps, parse_dispersion(entry, base, path_steps)))
-        mc.finish()
     total = len(points) * samples
     if total > MAX_CASES:
         raise ScenarioError("grid", f"the study has {total} cases; at most {MAX_CASES} are accepted")
-    summary_node = root.get("summary", None)
-    summary = list(DEFAULT_SUMMARY) if summary_node.is_null() else [
-        item.string() for item in summary_node.items()]
-    _check_summary(summary)
-    execution = _execution(root.get("execution", {}))
-    root.get("resolved", None)  # written into study.yaml for the record (version, case seeds)
+    summary = STUDY["summary"].value(root)
+    execution = Execution(**STUDY["execution"].value(root))
+    STUDY["resolved"].value(root)  # written into study.yaml for the record (version, case seeds)
     root.finish()
     study = Study(name, source, base, paths, [p for p, _, _ in dispersions], samples, method, seed,
                   summary, execution, raw=copy.deepcopy(data))
     study.cases = _expand(study, steps, points, dispersions, version or package_version())
     return study
-
-
-def _check_summary(summary: list[str]) -> None:
-    """Summary keys are metric columns of ``cases.csv`` (:func:`scenarios.output.tables.metric_columns`)."""
-    columns = metric_columns()
-    for index, metric in enumerate(summary):
-        if metric not in columns:
-            scalars = [key for key in METRIC_KEYS if key != "plan_time_s" and key not in VECTOR_METRICS]
-            vectors = ", ".join(f"cl.{key}_x" for key in VECTOR_METRICS)
-            raise ScenarioError(f"summary[{index}]", f"expected ref.<metric> or cl.<metric> with a metric of "
-                                                     f"{scalars}, or one axis of a vector metric ({vectors}, _y, _z), "
-                                                     f"got {metric!r}")
 
 
 def _expand(study: Study, steps: list[list[Step]], points: list[tuple[list, list]],

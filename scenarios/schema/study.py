@@ -1,0 +1,410 @@
+"""The study file's schema: its keys, the value generators of ``grid`` and ``zip`` entries and the
+distributions of Monte Carlo dispersions.
+
+A study varies a base scenario (:mod:`scenarios.study.spec` expands it into cases). Its keys are
+declared here (:data:`STUDY`, :data:`MONTE_CARLO`, :data:`EXECUTION`) and read through them. A
+``grid`` or ``zip`` entry is a list of values or ``{<generator>: <argument>}`` with a generator of
+the registry :data:`VALUE_GENERATORS`; a dispersion draws from a distribution of the registry
+:data:`DISTRIBUTIONS` (``{normal: ...}``, ``{uniform: ...}``), possibly wrapped in ``{scale: ...}``
+or ``{offset: ...}`` (:data:`COMBINATIONS`), or is the word ``case_seed``. Each registry entry
+declares its argument as a :class:`~scenarios.schema.keys.Key`, which reads it and describes it
+in the schema reference.
+"""
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ocp import METRIC_KEYS, quat
+from scenarios.errors import ScenarioError
+from scenarios.schema.columns import VECTOR_METRICS, metric_columns
+from scenarios.schema.keys import (
+    Described,
+    Key,
+    Section,
+    choice,
+    custom,
+    mapping,
+    number,
+    text,
+)
+from scenarios.schema.node import Node
+
+__all__ = [
+    "CASE_SEED",
+    "COMBINATIONS",
+    "DEFAULT_SUMMARY",
+    "DISPERSION",
+    "DISTRIBUTIONS",
+    "EXECUTION",
+    "GRID_ENTRY",
+    "MAX_CASES",
+    "MAX_VALUES",
+    "MONTE_CARLO",
+    "STUDY",
+    "VALUE_GENERATORS",
+    "Distribution",
+    "ValueGenerator",
+    "grid_values",
+]
+
+MAX_CASES = 100_000
+"""Most cases a study may expand to (grid points times Monte Carlo samples)."""
+MAX_VALUES = 10_000
+"""Most values of one ``grid`` or ``zip`` entry."""
+DEFAULT_SUMMARY = tuple(metric_columns(vectors=False))
+"""The metrics summarised when ``summary`` is not given: every scalar metric of the reference
+(``ref.``) and of the closed loop (``cl.``)."""
+
+
+# --- value generators of grid and zip entries -------------------------------------------------
+
+@dataclass(frozen=True)
+class ValueGenerator:
+    """A value generator of ``grid`` and ``zip`` entries, written ``{<name>: <argument>}``.
+
+    Parameters
+    ----------
+    argument : Key
+        Reads and checks the argument; its ``name`` is the generator's name and its ``type``,
+        ``meaning`` (and ``section`` for a mapping) describe it in the reference.
+    generate : callable
+        ``generate(argument, base) -> (values, recorded)``: the values set into the scenario and
+        the values recorded in the tables (numbers or text), from the argument as read and the
+        base scenario mapping.
+    """
+
+    argument: Key
+    generate: Callable[[Any, Mapping[str, Any]], tuple[list[Any], list[Any]]]
+
+    @property
+    def name(self) -> str:
+        """The generator's name (its argument's key)."""
+        return self.argument.name
+
+
+def _spaced(kind: str) -> Callable[[Node], tuple[float, float, int]]:
+    def read(node: Node) -> tuple[float, float, int]:
+        start, stop, count = node.vector(3)
+        if count != int(count) or not 1 <= count <= MAX_VALUES:
+            raise ScenarioError(f"{node.path}[2]", f"expected a count from 1 to {MAX_VALUES}, got {count}")
+        if kind == "geomspace" and (start <= 0 or stop <= 0):
+            raise node.error("geomspace needs positive bounds")
+        return float(start), float(stop), int(count)
+    return read
+
+
+def _linspace(argument: tuple[float, float, int], base: Mapping[str, Any]) -> tuple[list[Any], list[Any]]:
+    values = [float(v) for v in np.linspace(*argument)]
+    return values, values
+
+
+def _geomspace(argument: tuple[float, float, int], base: Mapping[str, Any]) -> tuple[list[Any], list[Any]]:
+    values = [float(v) for v in np.geomspace(*argument)]
+    return values, values
+
+
+def _axis(node: Node) -> np.ndarray:
+    axis = node.vector(3)
+    if not np.linalg.norm(axis) > 0:
+        raise node.error("the rotation axis cannot be zero")
+    return axis
+
+
+def _angles(node: Node) -> np.ndarray:
+    if isinstance(node.value, list):
+        return node.vector()
+    return Node(grid_values(node, {})[0], node.path).vector()
+
+
+AXIS_ANGLE = Section((
+    custom("axis", "Rotation axis (any length but zero), body axes of the base attitude's frame.",
+           "list of 3 numbers", _axis),
+    custom("angle_deg", "Rotation angles: a list, or a generator such as ``{linspace: [0, 180, 7]}``.",
+           "list of numbers or {generator: argument}", _angles, unit="deg"),
+), "Quaternions of rotations about one axis.")
+
+
+def _axis_angle(argument: dict[str, Any], base: Mapping[str, Any]) -> tuple[list[Any], list[Any]]:
+    axis, angles_deg = argument["axis"], argument["angle_deg"]
+    maneuver = base.get("maneuver", {})
+    scalar_last = isinstance(maneuver, dict) and maneuver.get("quaternion_order") == "scalar_last"
+    quaternions = []
+    for angle in angles_deg:
+        q = quat.from_axis_angle(axis / np.linalg.norm(axis), np.deg2rad(float(angle)))
+        quaternions.append([float(v) for v in (quat.to_scalar_last(q) if scalar_last else q)])
+    return quaternions, [float(a) for a in angles_deg]
+
+
+VALUE_GENERATORS: dict[str, ValueGenerator] = {generator.name: generator for generator in (
+    ValueGenerator(custom("linspace", "``count`` evenly spaced numbers from ``start`` to ``stop`` (both included).",
+                          "list [start, stop, count]", _spaced("linspace"), bounds=f"count from 1 to {MAX_VALUES}"),
+                   _linspace),
+    ValueGenerator(custom("geomspace", "``count`` numbers evenly spaced on a log scale from ``start`` to ``stop``.",
+                          "list [start, stop, count]", _spaced("geomspace"),
+                          bounds=f"start, stop > 0; count from 1 to {MAX_VALUES}"), _geomspace),
+    ValueGenerator(mapping("axis_angle", "Unit quaternions rotating by each angle about ``axis`` (in the order of "
+                           "``maneuver.quaternion_order``); the tables record the angle [deg].", AXIS_ANGLE),
+                   _axis_angle),
+)}
+"""The value generators of ``grid`` and ``zip`` entries: name -> :class:`ValueGenerator`. Register a
+generator of your own by adding it under its name."""
+
+
+def _listing(names: list[str], last: str) -> str:
+    return ", ".join(names) if len(names) < 2 else f"{', '.join(names[:-1])} {last} {names[-1]}"
+
+
+def grid_values(node: Node, base: Mapping[str, Any]) -> tuple[list[Any], list[Any]]:
+    """The values of one ``grid`` or ``zip`` entry: a list, or ``{<generator>: <argument>}``.
+
+    Parameters
+    ----------
+    node : Node
+        The entry (``grid.<scenario path>``).
+    base : mapping
+        The base scenario mapping (a generator may read it, e.g. the quaternion order).
+
+    Returns
+    -------
+    values : list
+        The values set into the scenario.
+    recorded : list
+        The values recorded in the tables (lists and mappings as JSON text).
+
+    Raises
+    ------
+    ScenarioError
+        At the entry: an empty or too long list, an unknown generator or a bad argument.
+    """
+    spec = node.value
+    if isinstance(spec, list):
+        if not spec or len(spec) > MAX_VALUES:
+            raise node.error(f"expected a list of 1 to {MAX_VALUES} values")
+        return list(spec), [v if not isinstance(v, (list, dict)) else json.dumps(v) for v in spec]
+    names = list(VALUE_GENERATORS)
+    if not isinstance(spec, dict) or len(spec) != 1:
+        raise node.error(f"expected a list of values or one of {', '.join(names)}; got {spec!r:.80}")
+    (kind, _), = spec.items()
+    generator = VALUE_GENERATORS.get(kind)
+    if generator is None:
+        raise node.error(f"unknown value generator {kind!r}; expected {_listing(names, 'or')}")
+    return generator.generate(generator.argument.value(node), base)
+
+
+GRID_ENTRY = custom("<path>", "A scenario path (``maneuver.duration``, ``planners[1].options.weight``, "
+                    "``planners[label=smooth].options.weight``) and its values: a list, or a value generator "
+                    "(listed below).", f"list of 1 to {MAX_VALUES} values or {{generator: argument}}", None)
+"""A ``grid`` or ``zip`` entry, keyed by the scenario path it varies."""
+
+
+# --- distributions of dispersions --------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Distribution:
+    """A distribution of Monte Carlo dispersions, written ``{<name>: <argument>}`` and drawn by
+    inverse transform of unit samples.
+
+    Parameters
+    ----------
+    argument : Key
+        Reads the argument into ``(a, b, vector)``: two ``(n,)`` arrays of parameters (in the
+        units of the scenario key dispersed) and whether the value is a list of ``n`` numbers;
+        its ``name`` is the distribution's.
+    inverse_cdf : callable
+        ``inverse_cdf(unit, a, b) -> draws``: unit samples in [0, 1) turned into draws, each
+        ``(n,)`` array.
+    """
+
+    argument: Key
+    inverse_cdf: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+
+    @property
+    def name(self) -> str:
+        """The distribution's name (its argument's key)."""
+        return self.argument.name
+
+
+def _numbers(first: Node, second: Node) -> tuple[np.ndarray, np.ndarray, bool]:
+    vector = isinstance(first.value, list)
+    a = first.vector() if vector else np.atleast_1d(first.number())
+    b = second.vector(a.size) if vector else np.atleast_1d(second.number())
+    return a, b, vector
+
+
+_PARAMETER = "number or list of numbers"
+
+NORMAL = Section((
+    custom("mean", "Mean of each component (a list: the value is a vector).", _PARAMETER, None),
+    custom("std", "Standard deviation of each component (as many as ``mean``).", _PARAMETER, None,
+           bounds=">= 0"),
+), "A normal distribution per component.")
+
+UNIFORM = Section((
+    custom("low", "Low bound of each component (a list: the value is a vector).", _PARAMETER, None),
+    custom("high", "High bound of each component (as many as ``low``).", _PARAMETER, None, bounds=">= low"),
+), "A uniform distribution per component, written ``[low, high]`` or ``{low, high}``.")
+
+
+def _normal(node: Node) -> tuple[np.ndarray, np.ndarray, bool]:
+    values = NORMAL.read(node)
+    a, b, vector = _numbers(values["mean"], values["std"])
+    if np.any(b < 0):
+        raise values["std"].error(f"a standard deviation cannot be negative, got {values['std'].value!r}")
+    return a, b, vector
+
+
+def _uniform(node: Node) -> tuple[np.ndarray, np.ndarray, bool]:
+    if isinstance(node.value, list):
+        if len(node.value) != 2:
+            raise node.error(f"expected [low, high], got {node.value!r:.80}")
+        a, b, vector = _numbers(Node(node.value[0], f"{node.path}[0]"), Node(node.value[1], f"{node.path}[1]"))
+    else:
+        values = UNIFORM.read(node)
+        a, b, vector = _numbers(values["low"], values["high"])
+    if np.any(b < a):
+        raise node.error(f"expected low <= high, got {node.value!r:.80}")
+    return a, b, vector
+
+
+_EPS = 1e-12  # keeps the normal's inverse CDF finite at u = 0
+
+
+def _normal_inverse_cdf(unit: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    from scipy.special import ndtri  # lazily: scipy is slow to import for plain runs
+    return a + b * ndtri(np.clip(unit, _EPS, 1.0 - _EPS))
+
+
+def _uniform_inverse_cdf(unit: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a + unit * (b - a)
+
+
+DISTRIBUTIONS: dict[str, Distribution] = {distribution.name: distribution for distribution in (
+    Distribution(custom("normal", "Normal draws: ``{mean, std}``.", "mapping", _normal, section=NORMAL),
+                 _normal_inverse_cdf),
+    Distribution(custom("uniform", "Uniform draws: ``[low, high]`` or ``{low, high}``.", "list [low, high] or mapping",
+                        _uniform, section=UNIFORM), _uniform_inverse_cdf),
+)}
+"""The distributions of dispersions: name -> :class:`Distribution`."""
+
+COMBINATIONS: dict[str, tuple[Key, Callable[[np.ndarray, Any], Any]]] = {
+    "scale": (custom("scale", "The base scenario's value times the draw.", "{distribution: argument}", None),
+              lambda base, draw: base * draw),
+    "offset": (custom("offset", "The base scenario's value plus the draw.", "{distribution: argument}", None),
+               lambda base, draw: base + draw),
+}
+"""How a draw meets the base scenario's value when it does not replace it: name -> (its key,
+``combine(base, draw)``)."""
+
+CASE_SEED = custom("case_seed", "The case's own seed (for ``simulation.sensor_noise.seed``), written as the word "
+                   "``case_seed``.", "the word case_seed", None)
+"""The dispersion that sets a case's own seed."""
+
+DISPERSION = custom("<path>", "A scenario path and how it is dispersed: ``{<distribution>: <argument>}`` (the draw "
+                    "is the value), ``{scale|offset: {<distribution>: <argument>}}``, or ``case_seed``.",
+                    "mapping or the word case_seed", None)
+"""A ``monte_carlo.dispersions`` entry, keyed by the scenario path it disperses."""
+
+
+# --- the study's own keys ----------------------------------------------------------------------
+
+def _samples(node: Node) -> int:
+    samples = node.integer()
+    if not 1 <= samples <= MAX_CASES:
+        raise node.error(f"expected 1 to {MAX_CASES}, got {samples}")
+    return samples
+
+
+def _seed(node: Node) -> int:
+    seed = node.integer()
+    if seed < 0:
+        raise node.error(f"expected a non-negative integer, got {seed}")
+    return seed
+
+
+def _entries(node: Node) -> Node:
+    return Node({}, node.path) if node.is_null() else node.mapping()
+
+
+MONTE_CARLO = Section((
+    custom("samples", "Monte Carlo samples per grid point.", "integer", _samples,
+           bounds=f"1 to {MAX_CASES} cases in all"),
+    choice("method", "``random``: independent uniforms; ``latin_hypercube``: a Latin hypercube per grid point "
+           "(``scipy.stats.qmc``).", ("random", "latin_hypercube"), default="random"),
+    custom("seed", "The study's seed: case ``i`` has ``SeedSequence(seed).spawn(n)[i].generate_state(1)[0]``.",
+           "integer", _seed, default=0, bounds=">= 0"),
+    custom("dispersions", "Scenario path -> dispersion (see the dispersions below).", "mapping",
+           lambda node: node.mapping()),
+), "Samples per grid point and what they disperse.")
+
+
+def _workers(node: Node) -> int | None:
+    if node.value == "auto" or node.is_null():
+        return None
+    workers = node.integer()
+    if not 1 <= workers <= 1024:
+        raise node.error(f"expected auto or 1 to 1024, got {workers}")
+    return workers
+
+
+def _scheduler(node: Node) -> str | None:
+    if node.value is not None and not isinstance(node.value, str):
+        raise node.error(f"expected an address such as tcp://host:8786, got {node.value!r}")
+    return node.value
+
+
+def _retries(node: Node) -> int:
+    retries = node.integer()
+    if not 0 <= retries <= 10:
+        raise node.error(f"expected 0 to 10, got {retries}")
+    return retries
+
+
+EXECUTION = Section((
+    custom("workers", "Cases run at once on the local process pool; ``auto``: one per core.", "integer, auto or null",
+           _workers, default="auto", bounds="1 to 1024"),
+    custom("scheduler", "Address of a Dask scheduler (``tcp://host:8786``); ``null``: the local process pool.",
+           "text or null", _scheduler, default=None),
+    number("case_timeout_s", "Wall time after which a case is stopped and becomes a ``crashed`` row.", unit="s",
+           default=600.0, positive=True),
+    custom("retries", "How many times a case whose worker died is run again.", "integer", _retries, default=1,
+           bounds="0 to 10"),
+), "How the cases run.")
+
+
+def _summary(node: Node) -> list[str]:
+    if isinstance(node.value, Described) or node.is_null():
+        return list(DEFAULT_SUMMARY)
+    summary = [item.string() for item in node.items()]
+    columns = metric_columns()
+    for index, metric in enumerate(summary):
+        if metric not in columns:  # a metric column of cases.csv
+            scalars = [key for key in METRIC_KEYS if key != "plan_time_s" and key not in VECTOR_METRICS]
+            vectors = ", ".join(f"cl.{key}_x" for key in VECTOR_METRICS)
+            raise ScenarioError(f"summary[{index}]", f"expected ref.<metric> or cl.<metric> with a metric of "
+                                                     f"{scalars}, or one axis of a vector metric ({vectors}, _y, _z), "
+                                                     f"got {metric!r}")
+    return summary
+
+
+STUDY = Section((
+    text("study", "The study's name (names ``results/<study>/`` by default)."),
+    custom("scenario", "The base scenario: a file path relative to the study file, or the scenario mapping itself.",
+           "text or mapping", None),
+    custom("grid", "Scenario path -> values; the cases are the cartesian product (the last key varies fastest).",
+           "mapping", _entries, default={}),
+    custom("zip", "Scenario path -> values, lists of equal length varied together (one more grid axis).",
+           "mapping", _entries, default={}),
+    mapping("monte_carlo", "Monte Carlo samples per grid point; absent or ``null``: none.", MONTE_CARLO, default=None,
+            null="none"),
+    custom("summary", "The metrics summarised per planner label (and grid point): ``ref.<metric>`` or "
+           "``cl.<metric>``, a vector's component as ``<metric>_x``.", "list of text or null", _summary,
+           default=Described("every scalar metric, ref. and cl.")),
+    mapping("execution", "How the cases run.", EXECUTION, default={}, null="defaults"),
+    custom("resolved", "Written by slewbench into the stored ``study.yaml`` (version, case seeds) and ignored "
+           "when read.", "mapping", None, default=None),
+), "A trade study file.")
