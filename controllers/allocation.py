@@ -1,5 +1,5 @@
 """The mapping of a rigid-body control torque onto the actuators (the documentation's architecture
-page), shared by every controller through :class:`Allocation`.
+page, :doc:`/architecture`), shared by every controller through :class:`Allocation`.
 
 Wheels take ``τ_w = u + ω × A h_w`` through ``g = −A⁺ τ_w`` (working wheels only); what the wheels
 cannot give (fewer than three independent axes) goes to the actuator whose kind has the lowest

@@ -147,12 +147,15 @@ class ActuatorModel:
         self.nu = nu
         self._blocks = [(block.actuator, slices[block.actuator.block], block.state)
                         for block in actuator_blocks(spacecraft) if block.actuator.block in slices]
-        # Per sample: the command's reader, the actuator's saturation, where its block and its
-        # states sit (plain ints: no slice objects per sample).
-        self._parts = [(command_getter(actuator.command), actuator.saturate, where.start, where.stop,
-                        state.start, state.stop, actuator.state_size > 0)
-                       for actuator, where, state in self._blocks]
         self._n_states = sum(actuator.state_size for actuator, _, _ in self._blocks)
+        # Per sample: the command's reader, the actuator's saturation, where its block sits (plain
+        # ints), and its states: None when they are all the states (handed over as they are),
+        # else a slice (empty for a kind without states).
+        self._parts = [(command_getter(actuator.command), actuator.saturate, where.start, where.stop,
+                        None if 0 < state.stop - state.start == self._n_states else state)
+                       for actuator, where, state in self._blocks]
+        self._check_states = any(state is not None and state.stop > state.start for *_, state in self._parts)
+        """Whether the states are split among several kinds (then their total length is checked here)."""
 
     def command_vector(self, command: Command, out: Array | None = None) -> Array:
         """A command as the vector ``u`` (before saturation).
@@ -172,7 +175,7 @@ class ActuatorModel:
         """
         if out is None:
             out = np.zeros(self.nu)
-        for read, _, start, stop, _, _, _ in self._parts:
+        for read, _, start, stop, _ in self._parts:
             value = read(command)
             if value is not None:
                 out[start:stop] = value
@@ -240,14 +243,14 @@ class ActuatorModel:
         """
         values = [0.0] * self.nu
         saturated = False
-        if self._n_states and len(wheel_momentum) != self._n_states:
+        if self._check_states and len(wheel_momentum) != self._n_states:
             raise ValueError(f"wheel_momentum needs {self._n_states} values (the actuators' states), "
                              f"got {len(wheel_momentum)}")
-        for read, saturate, start, stop, s_start, s_stop, has_state in self._parts:
+        for read, saturate, start, stop, state in self._parts:
             value = read(command)
             if value is None:
                 continue
-            applied, at_limit = saturate(as_floats(value), wheel_momentum[s_start:s_stop] if has_state else (), dt)
+            applied, at_limit = saturate(as_floats(value), wheel_momentum if state is None else wheel_momentum[state], dt)
             values[start:stop] = applied
             if at_limit:
                 saturated = True

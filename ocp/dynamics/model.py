@@ -7,7 +7,7 @@ wheel motor torques (N m, ``ḣ_w = g``), magnetorquer dipole (A m², body axes)
 (N m, body axes). Parameter ``p`` (3): the constant disturbance torque in body axes (N m); its
 default value is the environment's, and passing it lets one built model serve many runs.
 
-Dynamics (the documentation's architecture page, ``docs/architecture.rst``):
+Dynamics (the documentation's architecture page, :doc:`/architecture`):
 ``I ω̇ = −ω × (I ω + A h_w) − A g + m × B_B + τ_t + τ_gg + p``. The model names no actuator
 kind: each of the spacecraft's actuators (:class:`~ocp.dynamics.spacecraft.Actuator`) gives its
 torque on the body, the momentum its states store (``A h_w``) and their rates (``ḣ_w = g``).
@@ -57,7 +57,8 @@ class AttitudeModel:
     nx : int
         State size, ``7 +`` the actuators' states (``7 + n_w``).
     nu : int
-        Control size: ``n_w`` with wheels, plus 3 with magnetorquers, plus 3 with torquers.
+        Control size: ``n_w`` with wheels, plus 3 with magnetorquers, plus 3 with torquers, plus
+        the blocks of the other kinds present.
     rhs : casadi.Function
         ``f(x, u, t, p) -> xdot``, the state derivative.
     body_torque : casadi.Function
@@ -72,7 +73,8 @@ class AttitudeModel:
         ``field_rate_inertial(t) -> db``: time derivative of the inertial-frame field seen along
         the orbit [T/s], inertial axes; ``None`` without a field model.
     control_slices : dict of str to slice
-        Slices of ``u`` for the blocks present among ``"wheels"``, ``"dipole"``, ``"torquers"``.
+        Slices of ``u`` for the blocks present among ``"wheels"``, ``"dipole"``, ``"torquers"``
+        and those of other kinds (keyed by :attr:`~ocp.dynamics.spacecraft.Actuator.block`).
     solver_cache : SolverCache
         Solvers built on this model by planners given no cache of their own.
     """

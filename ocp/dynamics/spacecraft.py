@@ -281,29 +281,105 @@ def actuator_kind(cls: _Kind) -> _Kind:
     return cls
 
 
-def _per_axis_floats(asked: Sequence[float], limits: tuple[float, ...], scaled: bool,
-                     what: str) -> tuple[list[float], bool]:
-    """Clip a body-axis vector to its per-axis limits, or scale it down as a whole (``scaled``)."""
-    vector = asked
-    if len(vector) != 3:
-        raise ValueError(f"{what} needs 3 values (body axes), got {len(vector)}")
-    if scaled:  # the whole vector is scaled down until every axis is within its limit: direction kept
-        ratio = max(abs(a) / limit for a, limit in zip(vector, limits))
-        applied = [a / ratio for a in vector] if ratio > 1.0 else list(vector)
-    else:
-        applied = [min(max(a, -limit), limit) for a, limit in zip(vector, limits)]
-    return applied, any(abs(a) >= limit * (1 - 1e-12) for a, limit in zip(vector, limits))
+class _BodyAxisVector(Actuator):
+    """Base of the kinds whose block is a body-axis 3-vector with a limit per axis: clipped per
+    axis, or (:attr:`_scaled`) scaled down as a whole until every axis is within its limit (the
+    direction kept)."""
 
+    @property
+    @abstractmethod
+    def _axis_limit(self) -> Array:
+        """(3,) per-axis limit, in the unit of the block."""
 
-def _per_axis_symbolic(value: Expr, limit: Array, scaled: bool) -> tuple[Expr, list[Expr]]:
-    """:func:`_per_axis_floats` on CasADi expressions."""
-    bound = ca.DM(limit)
-    if scaled:  # as the numeric form: the vector scaled as a whole
-        ratio = ca.mmax(ca.fabs(value) / bound)
-        applied = ca.if_else(ratio > 1.0, value / ratio, value)
-    else:
-        applied = ca.fmin(ca.fmax(value, -bound), bound)
-    return applied, [ca.fabs(value) >= bound * (1 - 1e-12)]
+    @property
+    def _scaled(self) -> bool:
+        """Whether the vector is scaled as a whole (else clipped per axis)."""
+        return False
+
+    @functools.cached_property
+    def _floats(self) -> tuple[tuple[float, float, float], tuple[float, float, float], bool]:
+        """The limits and the values at which an axis counts as at its limit, as Python floats
+        (per-sample code), and whether the vector is scaled."""
+        l0, l1, l2 = self._axis_limit.tolist()
+        near = 1 - 1e-12
+        return (l0, l1, l2), (l0 * near, l1 * near, l2 * near), self._scaled
+
+    @property
+    def control_size(self) -> int:
+        """3: a vector in body axes."""
+        return 3
+
+    def control_bounds(self) -> tuple[Array, Array]:
+        """Minus and plus the per-axis limit.
+
+        Returns
+        -------
+        low, high : (3,) ndarray
+            In the unit of the block, body axes.
+        """
+        return -self._axis_limit, self._axis_limit.copy()
+
+    def saturate(self, asked: Sequence[float], state: Sequence[float], dt: float) -> tuple[list[float], bool]:
+        """Each axis clipped to its limit, or the vector scaled down as a whole.
+
+        Parameters
+        ----------
+        asked : sequence of 3 float
+            The commanded vector, body axes.
+        state : sequence of float
+            Empty.
+        dt : float
+            Length of the hold [s] (not used).
+
+        Returns
+        -------
+        applied : list of 3 float
+            The applied vector.
+        saturated : bool
+            Whether an axis asks its limit or more.
+
+        Raises
+        ------
+        ValueError
+            For other than 3 values.
+        """
+        (l0, l1, l2), (n0, n1, n2), scaled = self._floats
+        if len(asked) != 3:
+            raise ValueError(f"{self.command} needs 3 values (body axes), got {len(asked)}")
+        a0, a1, a2 = asked  # written out: no generator per sample
+        if scaled:  # the whole vector is scaled down until every axis is within its limit: direction kept
+            ratio = max(abs(a0) / l0, abs(a1) / l1, abs(a2) / l2)
+            applied = [a0 / ratio, a1 / ratio, a2 / ratio] if ratio > 1.0 else [a0, a1, a2]
+        else:
+            applied = [min(max(a0, -l0), l0), min(max(a1, -l1), l1), min(max(a2, -l2), l2)]
+        return applied, abs(a0) >= n0 or abs(a1) >= n1 or abs(a2) >= n2
+
+    def saturate_symbolic(self, u: Expr, state: Expr, dt: Expr) -> tuple[Expr, list[Expr]]:
+        """:meth:`saturate` on CasADi expressions.
+
+        Parameters
+        ----------
+        u : (3, 1) casadi.SX or MX
+            The commanded vector.
+        state : casadi.SX or MX
+            Empty.
+        dt : casadi.SX, casadi.MX or float
+            Not used.
+
+        Returns
+        -------
+        applied : (3, 1) casadi.SX or MX
+            The applied vector.
+        flags : list of casadi.SX or MX
+            1 where an axis asks its limit or more.
+        """
+        bound = ca.DM(self._axis_limit)
+        if self._scaled:  # as the numeric form: the vector scaled as a whole
+            ratio = ca.mmax(ca.fabs(u) / bound)
+            applied = ca.if_else(ratio > 1.0, u / ratio, u)
+        else:
+            applied = ca.fmin(ca.fmax(u, -bound), bound)
+        return applied, [ca.fabs(u) >= bound * (1 - 1e-12)]
 
 
 @actuator_kind
@@ -479,10 +555,11 @@ class ReactionWheels(Actuator):
         return u
 
     @functools.cached_property
-    def _floats(self) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
-        """Working mask (1.0 / 0.0), torque and momentum limits as Python floats (per-sample code)."""
-        return (tuple(self.working.astype(float).tolist()), tuple(self.max_torque.tolist()),
-                tuple(self.max_momentum.tolist()))
+    def _floats(self) -> tuple[tuple[float, float, float, float, float, float], ...]:
+        """Per wheel, as Python floats (per-sample code): working (1.0 / 0.0), ``g_max``,
+        ``−g_max``, ``h_max``, ``−h_max``, and the torque at which the wheel counts as at its limit."""
+        return tuple((working, g_max, -g_max, h_max, -h_max, g_max * (1 - 1e-12)) for working, g_max, h_max in
+                     zip(self.working.astype(float).tolist(), self.max_torque.tolist(), self.max_momentum.tolist()))
 
     def saturate(self, asked: Sequence[float], state: Sequence[float], dt: float) -> tuple[list[float], bool]:
         """Motor torques within ``±g_max`` and such that ``h_w + g dt`` stays within ``±h_max``
@@ -509,19 +586,19 @@ class ReactionWheels(Actuator):
         ValueError
             When ``asked`` or ``state`` has other than one value per wheel.
         """
-        mask, g_max, h_max = self._floats
-        if len(asked) != len(mask) or len(state) != len(mask):
-            raise ValueError(f"wheel_torque and wheel_momentum need {len(mask)} values (one per wheel), "
+        wheels = self._floats
+        if len(asked) != len(wheels) or len(state) != len(wheels):
+            raise ValueError(f"wheel_torque and wheel_momentum need {len(wheels)} values (one per wheel), "
                              f"got {len(asked)} and {len(state)}")
         saturated = False
         applied_wheels = []
-        for g_asked, working, limit, h_limit, h in zip(asked, mask, g_max, h_max, state):
+        for (working, limit, minus_limit, h_limit, minus_h_limit, at_limit), g_asked, h in zip(wheels, asked, state):
             # Written as comparisons (no min/max calls); each line is the NumPy/CasADi
             # max/min of saturate_symbolic, with the command first so that a NaN stays NaN.
             g = g_asked * working
-            low = (-h_limit - h) / dt
-            if not low > -limit:
-                low = -limit
+            low = (minus_h_limit - h) / dt
+            if not low > minus_limit:
+                low = minus_limit
             high = (h_limit - h) / dt
             if not high < limit:
                 high = limit
@@ -532,7 +609,7 @@ class ReactionWheels(Actuator):
                 applied = high
             size = abs(g)
             scale = size if size > 1.0 else 1.0  # noqa: FURB136 (max(1.0, |g|))
-            if abs(applied - g) > 1e-12 * scale or abs(applied) >= limit * (1 - 1e-12):
+            if abs(applied - g) > 1e-12 * scale or abs(applied) >= at_limit:
                 saturated = True
             applied_wheels.append(applied)
         return applied_wheels, saturated
@@ -582,7 +659,7 @@ SATURATION_MODES = ("per_axis", "scale")
 
 @actuator_kind
 @dataclass(frozen=True, init=False)
-class Magnetorquers(Actuator):
+class Magnetorquers(_BodyAxisVector):
     """Three orthogonal magnetorquers along the body axes; the dipole ``m`` [A m^2], body frame,
     gives the torque ``m × B`` with ``B`` the geomagnetic field in body axes. Control block
     ``"dipole"``.
@@ -623,18 +700,12 @@ class Magnetorquers(Actuator):
             raise ModelError("saturation", f"expected one of {SATURATION_MODES}, got {str(self.saturation)[:40]!r}")
 
     @property
-    def control_size(self) -> int:
-        """3: the dipole in body axes."""
-        return 3
+    def _axis_limit(self) -> Array:
+        return self.max_dipole
 
-    def control_bounds(self) -> tuple[Array, Array]:
-        """``±max_dipole`` [A m^2].
-
-        Returns
-        -------
-        low, high : (3,) ndarray
-        """
-        return -self.max_dipole, self.max_dipole.copy()
+    @property
+    def _scaled(self) -> bool:
+        return self.saturation == "scale"
 
     def body_torque(self, u: Expr, state: Expr, field_body: Expr | None) -> Expr | None:
         """``m × B`` [N m], body axes; ``None`` without a field.
@@ -653,59 +724,6 @@ class Magnetorquers(Actuator):
         (3, 1) casadi.SX or MX, or None
         """
         return None if field_body is None else ca.cross(u, field_body)
-
-    @functools.cached_property
-    def _limits(self) -> tuple[float, ...]:
-        """The dipole limits as Python floats (per-sample code)."""
-        return tuple(self.max_dipole.tolist())
-
-    def saturate(self, asked: Sequence[float], state: Sequence[float], dt: float) -> tuple[list[float], bool]:
-        """Each axis clipped to its limit, or (``saturation="scale"``) the dipole scaled down as a
-        whole.
-
-        Parameters
-        ----------
-        asked : sequence of 3 float
-            Commanded dipole [A m^2], body axes.
-        state : sequence of float
-            Empty.
-        dt : float
-            Length of the hold [s] (not used).
-
-        Returns
-        -------
-        applied : list of 3 float
-            Applied dipole [A m^2].
-        saturated : bool
-            Whether an axis asks its limit or more.
-
-        Raises
-        ------
-        ValueError
-            For other than 3 values.
-        """
-        return _per_axis_floats(asked, self._limits, self.saturation == "scale", self.command)
-
-    def saturate_symbolic(self, u: Expr, state: Expr, dt: Expr) -> tuple[Expr, list[Expr]]:
-        """:meth:`saturate` on CasADi expressions.
-
-        Parameters
-        ----------
-        u : (3, 1) casadi.SX or MX
-            Commanded dipole [A m^2].
-        state : casadi.SX or MX
-            Empty.
-        dt : casadi.SX, casadi.MX or float
-            Not used.
-
-        Returns
-        -------
-        applied : (3, 1) casadi.SX or MX
-            Applied dipole [A m^2].
-        flags : list of casadi.SX or MX
-            1 where an axis asks its limit or more.
-        """
-        return _per_axis_symbolic(u, self.max_dipole, self.saturation == "scale")
 
     def take_residual(self, residual: Sequence[float], field_body: Sequence[float] | None) -> list[float] | None:
         """``m = B × τ / |B|²``: the part of ``τ`` perpendicular to ``B`` (none without a field).
@@ -749,7 +767,7 @@ class Magnetorquers(Actuator):
 
 @actuator_kind
 @dataclass(frozen=True, init=False)
-class Torquers(Actuator):
+class Torquers(_BodyAxisVector):
     """Ideal body-axis torquers (e.g. thrusters): the commanded torque acts on the body directly,
     with no stored momentum. Control block ``"torquers"``.
 
@@ -780,18 +798,8 @@ class Torquers(Actuator):
         object.__setattr__(self, "max_torque", _limit_vector(self.max_torque, 3, "max_torque"))
 
     @property
-    def control_size(self) -> int:
-        """3: the torque in body axes."""
-        return 3
-
-    def control_bounds(self) -> tuple[Array, Array]:
-        """``±max_torque`` [N m].
-
-        Returns
-        -------
-        low, high : (3,) ndarray
-        """
-        return -self.max_torque, self.max_torque.copy()
+    def _axis_limit(self) -> Array:
+        return self.max_torque
 
     def body_torque(self, u: Expr, state: Expr, field_body: Expr | None) -> Expr:
         """The commanded torque itself [N m], body axes.
@@ -810,58 +818,6 @@ class Torquers(Actuator):
         (3, 1) casadi.SX or MX
         """
         return u
-
-    @functools.cached_property
-    def _limits(self) -> tuple[float, ...]:
-        """The torque limits as Python floats (per-sample code)."""
-        return tuple(self.max_torque.tolist())
-
-    def saturate(self, asked: Sequence[float], state: Sequence[float], dt: float) -> tuple[list[float], bool]:
-        """Each axis clipped to its limit.
-
-        Parameters
-        ----------
-        asked : sequence of 3 float
-            Commanded torque [N m], body axes.
-        state : sequence of float
-            Empty.
-        dt : float
-            Length of the hold [s] (not used).
-
-        Returns
-        -------
-        applied : list of 3 float
-            Applied torque [N m].
-        saturated : bool
-            Whether an axis asks its limit or more.
-
-        Raises
-        ------
-        ValueError
-            For other than 3 values.
-        """
-        return _per_axis_floats(asked, self._limits, False, self.command)
-
-    def saturate_symbolic(self, u: Expr, state: Expr, dt: Expr) -> tuple[Expr, list[Expr]]:
-        """:meth:`saturate` on CasADi expressions.
-
-        Parameters
-        ----------
-        u : (3, 1) casadi.SX or MX
-            Commanded torque [N m].
-        state : casadi.SX or MX
-            Empty.
-        dt : casadi.SX, casadi.MX or float
-            Not used.
-
-        Returns
-        -------
-        applied : (3, 1) casadi.SX or MX
-            Applied torque [N m].
-        flags : list of casadi.SX or MX
-            1 where an axis asks its limit or more.
-        """
-        return _per_axis_symbolic(u, self.max_torque, False)
 
     def body_torque_box(self) -> Array:
         """``max_torque`` [N m] on each body axis.
