@@ -1,11 +1,11 @@
-"""The mapping of a rigid-body control torque onto the actuators (:doc:`/architecture`), shared by
-every controller through :class:`Allocation`.
+"""The mapping of a rigid-body control torque onto the actuators (:doc:`/architecture`), shared by every controller through :class:`Allocation`.
 
 Wheels take ``τ_w = u + ω × A h_w`` through ``g = −A⁺ τ_w`` (working wheels only); what the wheels
-cannot give (fewer than three independent axes) goes to the torquers if there are any, else to the
-magnetorquers as ``m = B × τ / |B|²`` (the component of τ perpendicular to B). Without wheels the
-torquers take ``u``, else the magnetorquers. The numeric map runs on Python floats (it is called
-at every sample); :meth:`Allocation.allocate_symbolic` is the same map on CasADi expressions.
+cannot give (fewer than three independent axes) goes to the actuator whose kind has the lowest
+:attr:`~ocp.dynamics.spacecraft.Actuator.residual_rank`: the torquers if there are any, else the
+magnetorquers as ``m = B × τ / |B|²`` (the component of τ perpendicular to B). Without wheels that
+actuator takes ``u``. The numeric map runs on Python floats (it is called at every sample);
+:meth:`Allocation.allocate_symbolic` is the same map on CasADi expressions.
 """
 from __future__ import annotations
 
@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp import Command, Measurement, Spacecraft
 from ocp.dynamics.layout import split_measurement
+from ocp.dynamics.spacecraft import Actuator
 from ocp.fast_call import as_floats
 
 Array = NDArray[np.float64]
@@ -78,9 +79,9 @@ class Allocation:
             self._pinv_rows = float_rows(self._wheel_pinv)
             self._axes_cols = float_rows(spacecraft.wheel_axes.T)
             self._working_cols = float_rows(self._working_axes.T)
-        self._residual_sink = not self.wheels_only and (spacecraft.torquers is not None
-                                                        or spacecraft.magnetorquers is not None)
-        """Whether what the wheels cannot give goes anywhere (torquers or magnetorquers)."""
+        ranked = [(a.residual_rank, i, a) for i, a in enumerate(spacecraft.actuators) if a.residual_rank is not None]
+        self._sink: Actuator | None = None if self.wheels_only or not ranked else min(ranked)[2]
+        """The actuator that takes what the wheels cannot give (torquers, else magnetorquers), if any."""
 
     def allocate(self, torque: ArrayLike, measurement: Measurement, rate: ArrayLike | None = None,
                  wheel_momentum: ArrayLike | None = None) -> Command:
@@ -126,7 +127,7 @@ class Allocation:
                 r0, r1, r2 = r0 + (w1 * h2 - w2 * h1), r1 + (w2 * h0 - w0 * h2), r2 + (w0 * h1 - w1 * h0)
             g = [-(a * r0 + b * r1 + c * r2) for a, b, c in self._pinv_rows]  # g = −A⁺ τ_w
             command.wheel_torque = np.array(g)
-            if not self._residual_sink:
+            if self._sink is None:
                 return command
             t0, t1, t2 = r0, r1, r2
             for (a0, a1, a2), gi in zip(self._working_cols, g):  # what the wheels do not give
@@ -135,15 +136,13 @@ class Allocation:
                 r2 += a2 * gi
             if math.sqrt(r0 * r0 + r1 * r1 + r2 * r2) <= 1e-12 * max(math.sqrt(t0 * t0 + t1 * t1 + t2 * t2), 1e-300):
                 return command
-        if not self._residual_sink:
+        sink = self._sink
+        if sink is None:
             return command
-        if self._spacecraft().torquers is not None:
-            command.torque = np.array([r0, r1, r2])
-        elif measurement.field_body is not None:  # magnetorquers: m = b × τ / |b|²
-            b0, b1, b2 = as_floats(measurement.field_body)
-            b2_norm = max(b0 * b0 + b1 * b1 + b2 * b2, 1e-30)
-            command.dipole = np.array([(b1 * r2 - b2 * r1) / b2_norm, (b2 * r0 - b0 * r2) / b2_norm,
-                                       (b0 * r1 - b1 * r0) / b2_norm])
+        field = measurement.field_body
+        value = sink.take_residual((r0, r1, r2), None if field is None else as_floats(field))
+        if value is not None:
+            command.set(sink.command, np.array(value))
         return command
 
     def allocate_symbolic(self, torque: ca.SX, y: ca.SX, rate: ca.SX | None = None,
@@ -179,13 +178,10 @@ class Allocation:
             parts["wheels"] = g
             residual = wheel_torque + ca.mtimes(ca.DM(self._working_axes), g)
             done = ca.norm_2(residual) <= 1e-12 * ca.fmax(ca.norm_2(wheel_torque), 1e-300)
-        if self.wheels_only:
-            pass
-        elif spacecraft.torquers is not None:
-            parts["torquers"] = residual if done is None else ca.if_else(done, ca.DM.zeros(3), residual)
-        elif spacecraft.magnetorquers is not None:
-            dipole = ca.cross(field, residual) / ca.fmax(ca.dot(field, field), 1e-30)
-            parts["dipole"] = dipole if done is None else ca.if_else(done, ca.DM.zeros(3), dipole)
+        sink = self._sink
+        if sink is not None:
+            value = sink.take_residual_symbolic(residual, field)
+            parts[sink.block] = value if done is None else ca.if_else(done, ca.DM.zeros(sink.control_size), value)
         u = ca.SX.zeros(self._nu)
         for name, value in parts.items():
             u[self._slices[name]] = value

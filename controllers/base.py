@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from controllers.allocation import Allocation
-from ocp import Command, Measurement, Spacecraft
+from ocp import ActuatorModel, Command, Measurement, Spacecraft
 from ocp.dynamics.layout import (
     REFERENCE_FIELDS,
     control_layout,
@@ -338,11 +338,7 @@ class Controller(Allocation, Configurable, ABC):
             ``[g, m, τ_t]`` (blocks of the actuators present): wheel torques [N m], dipole
             [A m^2], torquer torque [N m]; zeros where the command asks nothing.
         """
-        u = np.zeros(self._nu)
-        for name, value in (("wheels", command.wheel_torque), ("dipole", command.dipole), ("torquers", command.torque)):
-            if name in self._slices and value is not None:
-                u[self._slices[name]] = value
-        return u
+        return ActuatorModel(self._spacecraft(), self._slices, self._nu).command_vector(command)
 
 
 def check_gain(option: str, gain: float | list[list[float]]) -> None:

@@ -1,6 +1,8 @@
 """The spacecraft and its environment as equations: rigid body, actuators, orbit, fields, the model.
 
-What lives here: the spacecraft and its actuators (:mod:`~ocp.dynamics.spacecraft`), what a command
+What lives here: the spacecraft and its actuators, with the :class:`~ocp.dynamics.spacecraft.Actuator`
+base class a new actuator kind extends and registers with
+:func:`~ocp.dynamics.spacecraft.actuator_kind` (:mod:`~ocp.dynamics.spacecraft`), what a command
 becomes once applied (:mod:`~ocp.dynamics.actuators`), the orbit, gravity gradient and magnetic
 field models (:mod:`~ocp.dynamics.environment`, :mod:`~ocp.dynamics.igrf`), the assembled symbolic
 model ``ẋ = f(x, u, t, p)`` (:mod:`~ocp.dynamics.model`), the vector layouts shared with the laws and
@@ -20,8 +22,16 @@ from ocp.dynamics.environment import (
 from ocp.dynamics.igrf import IGRFField
 from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.model import AttitudeModel
-from ocp.dynamics.spacecraft import Magnetorquers, ReactionWheels, Spacecraft, Torquers
+from ocp.dynamics.spacecraft import (
+           ACTUATOR_KINDS,
+           Actuator,
+           Magnetorquers,
+           ReactionWheels,
+           Spacecraft,
+           Torquers,
+           actuator_kind,
+)
 
-__all__ = ["ActuatorModel", "AttitudeModel", "CircularOrbit", "Command", "Environment", "IGRFField", "Magnetorquers",
+__all__ = ["ACTUATOR_KINDS", "Actuator", "ActuatorModel", "AttitudeModel", "CircularOrbit", "Command", "Environment", "IGRFField", "Magnetorquers",
            "Measurement", "ReactionWheels", "Spacecraft", "TiltedDipole", "Torquers",
-           "gravity_gradient_torque", "rk4_step"]
+           "actuator_kind", "gravity_gradient_torque", "rk4_step"]

@@ -1,6 +1,8 @@
 """Vector layouts shared by the symbolic controller laws, the simulator and the generated C code.
 
-* control ``u = [g (n_w), m (3), τ_t (3)]``: blocks of the actuators present (:func:`control_layout`);
+* control ``u = [g (n_w), m (3), τ_t (3)]``: blocks of the actuators present, in the order of
+  their kinds' registration (:func:`actuator_blocks`, :func:`control_layout`); the actuators'
+  states (the wheel momenta ``h_w``) follow ``q`` and ``ω`` in the state ``x`` in the same order;
 * measurement ``y = [q (4), ω (3), h_w (n_w), b (3)]``: attitude, body rate (rad/s), wheel
   momenta (N m s), magnetometer reading (T, body axes; zeros without a field model);
 * reference row ``[q* (4), ω* (3), ω̇* (3), τ* (3)]`` (:data:`REFERENCE_FIELDS` numbers), and a
@@ -8,24 +10,71 @@
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from ocp.dynamics.spacecraft import Actuator, Spacecraft
 
 Array = NDArray[np.float64]
 REFERENCE_FIELDS = 13
 """Numbers in one reference row ``[q*, ω*, ω̇*, τ*]``."""
 
 
-def control_layout(spacecraft: Any) -> tuple[dict[str, slice], int]:
-    """Slices of ``"wheels"``, ``"dipole"``, ``"torquers"`` in ``u`` and its size ``nu``.
+@dataclass(frozen=True)
+class ActuatorBlock:
+    """Where one actuator sits in the control and the state.
+
+    Parameters
+    ----------
+    actuator : Actuator
+        The actuator.
+    control : slice
+        Its block of the control ``u``.
+    state : slice
+        Its block of the actuator states ``x[7:]`` (empty for a kind without states).
+    """
+
+    actuator: Actuator
+    control: slice
+    state: slice
+
+
+def actuator_blocks(spacecraft: Spacecraft) -> tuple[ActuatorBlock, ...]:
+    """The blocks of the spacecraft's actuators, in the order of :attr:`Spacecraft.actuators`.
 
     Parameters
     ----------
     spacecraft : Spacecraft
-        The actuators present fix the blocks: ``n_w`` wheel torques [N m], then the dipole
-        [A m^2] (3, with magnetorquers), then torquer torques [N m] (3, with torquers).
+        Its actuators fix the blocks (sizes :attr:`Actuator.control_size` and
+        :attr:`Actuator.state_size`).
+
+    Returns
+    -------
+    tuple of ActuatorBlock
+        One per actuator present.
+    """
+    blocks = []
+    control = state = 0
+    for actuator in spacecraft.actuators:
+        nu, ns = actuator.control_size, actuator.state_size
+        blocks.append(ActuatorBlock(actuator, slice(control, control + nu), slice(state, state + ns)))
+        control, state = control + nu, state + ns
+    return tuple(blocks)
+
+
+def control_layout(spacecraft: Spacecraft) -> tuple[dict[str, slice], int]:
+    """Slices of the actuators' blocks in ``u`` (``"wheels"``, ``"dipole"``, ``"torquers"``, ...)
+    and its size ``nu``.
+
+    Parameters
+    ----------
+    spacecraft : Spacecraft
+        The actuators present fix the blocks, keyed by their kind's :attr:`Actuator.block`:
+        ``n_w`` wheel torques [N m], then the dipole [A m^2] (3, with magnetorquers), then
+        torquer torques [N m] (3, with torquers), then the blocks of other registered kinds.
 
     Returns
     -------
@@ -34,17 +83,8 @@ def control_layout(spacecraft: Any) -> tuple[dict[str, slice], int]:
     nu : int
         Size of ``u``.
     """
-    slices: dict[str, slice] = {}
-    offset = 0
-    for name, present, size in (
-        ("wheels", spacecraft.wheels is not None, spacecraft.n_wheels),
-        ("dipole", spacecraft.magnetorquers is not None, 3),
-        ("torquers", spacecraft.torquers is not None, 3),
-    ):
-        if present:
-            slices[name] = slice(offset, offset + size)
-            offset += size
-    return slices, offset
+    blocks = actuator_blocks(spacecraft)
+    return {block.actuator.block: block.control for block in blocks}, sum(b.actuator.control_size for b in blocks)
 
 
 def measurement_size(spacecraft: Any) -> int:

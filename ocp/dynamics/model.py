@@ -1,13 +1,16 @@
 """The assembled symbolic model ``ẋ = f(x, u, t, p)`` of a spacecraft in its environment.
 
 State ``x = [q (4), ω (3), h_w (n_w)]``: scalar-first attitude quaternion (body to inertial),
-body rate w.r.t. inertial in body axes (rad/s), wheel spin momenta (N m s).
-Control ``u = [g (n_w), m (3), τ_t (3)]`` with only the blocks of the actuators present:
+body rate w.r.t. inertial in body axes (rad/s), then the actuators' states: wheel spin momenta
+(N m s). Control ``u = [g (n_w), m (3), τ_t (3)]`` with only the blocks of the actuators present:
 wheel motor torques (N m, ``ḣ_w = g``), magnetorquer dipole (A m², body axes), torquer torques
 (N m, body axes). Parameter ``p`` (3): the constant disturbance torque in body axes (N m); its
 default value is the environment's, and passing it lets one built model serve many runs.
 
-Dynamics (:doc:`/architecture`): ``I ω̇ = −ω × (I ω + A h_w) − A g + m × B_B + τ_t + τ_gg + p``.
+Dynamics (:doc:`/architecture`):
+``I ω̇ = −ω × (I ω + A h_w) − A g + m × B_B + τ_t + τ_gg + p``. The model names no actuator
+kind: each of the spacecraft's actuators (:class:`~ocp.dynamics.spacecraft.Actuator`) gives its
+torque on the body, the momentum its states store (``A h_w``) and their rates (``ḣ_w = g``).
 """
 from __future__ import annotations
 
@@ -23,7 +26,7 @@ from ocp import quat
 from ocp import quat_casadi as qc
 from ocp.cache import SolverCache
 from ocp.dynamics.environment import Environment, gravity_gradient_torque
-from ocp.dynamics.layout import control_layout
+from ocp.dynamics.layout import actuator_blocks, control_layout
 from ocp.dynamics.spacecraft import Spacecraft
 from ocp.quat_casadi import Expr
 
@@ -52,9 +55,10 @@ class AttitudeModel:
     n_wheels : int
         Number of wheels (failed ones included), ``n_w``.
     nx : int
-        State size, ``7 + n_w``.
+        State size, ``7 +`` the actuators' states (``7 + n_w``).
     nu : int
-        Control size: ``n_w`` with wheels, plus 3 with magnetorquers, plus 3 with torquers.
+        Control size: ``n_w`` with wheels, plus 3 with magnetorquers, plus 3 with torquers, plus
+        the blocks of the other kinds present.
     rhs : casadi.Function
         ``f(x, u, t, p) -> xdot``, the state derivative.
     body_torque : casadi.Function
@@ -69,7 +73,8 @@ class AttitudeModel:
         ``field_rate_inertial(t) -> db``: time derivative of the inertial-frame field seen along
         the orbit [T/s], inertial axes; ``None`` without a field model.
     control_slices : dict of str to slice
-        Slices of ``u`` for the blocks present among ``"wheels"``, ``"dipole"``, ``"torquers"``.
+        Slices of ``u`` for the blocks present among ``"wheels"``, ``"dipole"``, ``"torquers"``
+        and those of other kinds (keyed by :attr:`~ocp.dynamics.spacecraft.Actuator.block`).
     solver_cache : SolverCache
         Solvers built on this model by planners given no cache of their own.
     """
@@ -78,9 +83,13 @@ class AttitudeModel:
         self.spacecraft = spacecraft
         self.environment = environment if environment is not None else Environment()
         self.n_wheels = spacecraft.n_wheels
-        self.nx = 7 + self.n_wheels
+        self._blocks = actuator_blocks(spacecraft)
+        self.nx = 7 + sum(block.actuator.state_size for block in self._blocks)
         self.control_slices: dict[str, slice]
         self.control_slices, self.nu = control_layout(spacecraft)
+        self._momentum_matrix = np.hstack([np.zeros((3, 0))] + [block.actuator.momentum_matrix()
+                                                                for block in self._blocks])
+        """(3, nx - 7): the momentum stored in the actuators' states is this times ``x[7:]``."""
         self._fingerprint: str | None = None
         self.solver_cache = SolverCache()
         """Solvers built on this model by planners given no cache of their own."""
@@ -114,8 +123,8 @@ class AttitudeModel:
             Attitude quaternion, scalar first, body to inertial.
         omega : (3,) slice of ``x``
             Body rate with respect to the inertial frame [rad/s], body axes.
-        h_w : (n_w,) slice of ``x``
-            Wheel spin momenta [N m s] (empty without wheels).
+        h_w : (nx - 7,) slice of ``x``
+            The actuators' states: wheel spin momenta [N m s] (empty without wheels).
         """
         return x[0:4], x[4:7], x[7:self.nx]
 
@@ -158,16 +167,17 @@ class AttitudeModel:
         (3, 1) casadi.SX or MX
             Torque [N m], body frame. The dipole term is absent without a field model.
         """
-        q = x[0:4]
+        q, states = x[0:4], x[7:self.nx]
         torque = ca.MX.zeros(3, 1) if isinstance(x, ca.MX) else ca.SX.zeros(3, 1)
-        if "wheels" in self.control_slices:
-            torque -= ca.mtimes(ca.DM(self.spacecraft.wheel_axes), u[self.control_slices["wheels"]])
-        if "dipole" in self.control_slices:
+        field_body = None
+        if any(block.actuator.needs_field for block in self._blocks):
             field_body = self.magnetic_field_body(q, t)
-            if field_body is not None:
-                torque += ca.cross(u[self.control_slices["dipole"]], field_body)
-        if "torquers" in self.control_slices:
-            torque += u[self.control_slices["torquers"]]
+        for block in self._blocks:
+            actuator = block.actuator
+            part = actuator.body_torque(u[block.control], states[block.state],
+                                        field_body if actuator.needs_field else None)
+            if part is not None:
+                torque += part
         return torque
 
     def external_torque(self, x: Expr, t: Expr, p: Expr) -> Expr:
@@ -217,17 +227,16 @@ class AttitudeModel:
             ``ẋ``: quaternion rate [1/s], body angular acceleration [rad/s^2], wheel momentum
             rates [N m].
         """
-        q, omega, h_w = self.split_state(x)
+        q, omega, states = self.split_state(x)
         inertia = ca.DM(self.spacecraft.inertia)
-        axes = ca.DM(self.spacecraft.wheel_axes)
         momentum = ca.mtimes(inertia, omega)
-        if self.n_wheels:
-            momentum += ca.mtimes(axes, h_w)
+        stateful = [block for block in self._blocks if block.actuator.state_size]
+        for block in stateful:
+            momentum += ca.mtimes(ca.DM(block.actuator.momentum_matrix()), states[block.state])
         torque = self.actuator_torque(x, u, t) + self.external_torque(x, t, p)
         omega_dot = ca.solve(inertia, -ca.cross(omega, momentum) + torque)
         parts = [qc.kinematics(q, omega), omega_dot]
-        if self.n_wheels:
-            parts.append(u[self.control_slices["wheels"]])
+        parts += [block.actuator.state_rate(u[block.control], states[block.state]) for block in stateful]
         return ca.vertcat(*parts)
 
     def _build(self) -> None:
@@ -268,7 +277,7 @@ class AttitudeModel:
             Angular momentum [N m s], inertial frame.
         """
         x = np.asarray(x, dtype=float)
-        body = x[..., 4:7] @ self.spacecraft.inertia.T + x[..., 7:self.nx] @ self.spacecraft.wheel_axes.T
+        body = x[..., 4:7] @ self.spacecraft.inertia.T + x[..., 7:self.nx] @ self._momentum_matrix.T
         return quat.rotate(x[..., 0:4], body)
 
 

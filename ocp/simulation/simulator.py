@@ -368,9 +368,6 @@ class Simulator:
         self._runs: dict[Any, BufferedFunction] = {}
         self._last_grid: tuple[Any, Array, GridSampledReference] | None = None
         self._torque_map: tuple[int, ca.Function] | None = None
-        self._command_slices = [(attribute, model.control_slices[name]) for name, attribute in
-                                (("wheels", "wheel_torque"), ("dipole", "dipole"), ("torquers", "torque"))
-                                if name in model.control_slices]
 
     @staticmethod
     def _normalised(step: ca.Function) -> ca.Function:
@@ -485,9 +482,8 @@ class Simulator:
         x_out = step.outputs[0]
         x_in[:] = x
         p_in[:] = p
-        evaluate, apply, fill_command = step.evaluate, self.actuators.apply_floats, self._fill_command
+        evaluate, apply, fill_command = step.evaluate, self.actuators.apply_floats, self.actuators.command_vector
         times_list = times.tolist()
-        n_wheels = model.spacecraft.n_wheels
         for k in range(n_samples):
             t_k = times_list[k]
             measurement = self._measure(x_in, t_k, noise, rng, field_rng)
@@ -496,7 +492,7 @@ class Simulator:
             command = controller(t_k, measurement, reference)
             fill_command(command, commanded[k])
             dt = times_list[k + 1] - t_k
-            u, at_limit = apply(command, states[k][7:7 + n_wheels], dt)
+            u, at_limit = apply(command, states[k][7:], dt)
             applied.append(u)
             saturated.append(at_limit)
             u_in[:] = u
@@ -620,13 +616,6 @@ class Simulator:
                  field_rng: np.random.Generator | None = None) -> Any:
         field = None if self._field_numeric is None else self._field_numeric(x, t).copy()
         return measure(x, t, noise, rng, field, field_rng)
-
-    def _fill_command(self, command: Command, out: Array) -> None:
-        """Write the command into ``out`` (a zero row) in the layout of ``u``."""
-        for attribute, where in self._command_slices:
-            value = getattr(command, attribute)
-            if value is not None:
-                out[where] = value
 
     def _grid_reference(self, reference: Any, grid: Array) -> GridSampledReference:
         """``reference`` served on ``grid``; the last one is kept, so that runs repeated with the

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ocp import quat
+from ocp.dynamics.layout import actuator_blocks
 from ocp.errors import InvalidOption, excerpt
 from ocp.transcription import Cone
 from planners.problem import Array, ManeuverProblem
@@ -112,17 +113,8 @@ def variable_bounds(problem: ManeuverProblem, max_rate: float | None) -> tuple[A
     if max_rate is not None:
         x_low[4:7], x_high[4:7] = -max_rate, max_rate
     u_low, u_high = np.full(model.nu, -np.inf), np.full(model.nu, np.inf)
-    slices = model.control_slices
-    # Limits are arrays once the actuators are constructed (None becomes inf).
-    if spacecraft.wheels is not None:
-        momentum = np.asarray(spacecraft.wheels.max_momentum, dtype=float)
-        x_low[7:], x_high[7:] = -momentum, momentum
-        limit = np.where(spacecraft.wheels.working, np.asarray(spacecraft.wheels.max_torque, dtype=float), 0.0)
-        u_low[slices["wheels"]], u_high[slices["wheels"]] = -limit, limit
-    if spacecraft.magnetorquers is not None:
-        dipole = np.asarray(spacecraft.magnetorquers.max_dipole, dtype=float)
-        u_low[slices["dipole"]], u_high[slices["dipole"]] = -dipole, dipole
-    if spacecraft.torquers is not None:
-        torque = np.asarray(spacecraft.torquers.max_torque, dtype=float)
-        u_low[slices["torquers"]], u_high[slices["torquers"]] = -torque, torque
+    states_low, states_high = x_low[7:], x_high[7:]  # views: the actuators' states
+    for block in actuator_blocks(spacecraft):
+        u_low[block.control], u_high[block.control] = block.actuator.control_bounds()
+        states_low[block.state], states_high[block.state] = block.actuator.state_bounds()
     return x_low, x_high, u_low, u_high
