@@ -1,8 +1,9 @@
-"""The mapping of a rigid-body control torque onto the actuators (:doc:`/architecture`), shared by every controller through :class:`Allocation`.
+"""The mapping of a rigid-body control torque onto the actuators (:doc:`/architecture`), shared by
+every controller through :class:`Allocation`.
 
 Wheels take ``τ_w = u + ω × A h_w`` through ``g = −A⁺ τ_w`` (working wheels only); what the wheels
 cannot give (fewer than three independent axes) goes to the actuator whose kind has the lowest
-:attr:`~ocp.dynamics.spacecraft.Actuator.residual_rank`: the torquers if there are any, else the
+:attr:`~ocp.dynamics.actuator_kinds.Actuator.residual_rank`: the torquers if there are any, else the
 magnetorquers as ``m = B × τ / |B|²`` (the component of τ perpendicular to B). Without wheels that
 actuator takes ``u``. The numeric map runs on Python floats (it is called at every sample);
 :meth:`Allocation.allocate_symbolic` is the same map on CasADi expressions.
@@ -17,8 +18,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp import Command, Measurement, Spacecraft
+from ocp.dynamics.actuator_kinds import Actuator
 from ocp.dynamics.layout import split_measurement
-from ocp.dynamics.spacecraft import Actuator
 from ocp.fast_call import as_floats
 
 Array = NDArray[np.float64]

@@ -17,6 +17,7 @@ Conventions throughout: SI units; quaternions scalar first ``[q0, q1, q2, q3]``,
 respect to the inertial frame in body axes [rad/s]; torques, dipoles and wheel axes in body axes.
 """
 from ocp.cache import SolverCache
+from ocp.dynamics.actuator_kinds import Magnetorquers, ReactionWheels, Torquers
 from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
 from ocp.dynamics.environment import (
                         CircularOrbit,
@@ -26,7 +27,7 @@ from ocp.dynamics.environment import (
 )
 from ocp.dynamics.igrf import IGRFField
 from ocp.dynamics.model import AttitudeModel
-from ocp.dynamics.spacecraft import Magnetorquers, ReactionWheels, Spacecraft, Torquers
+from ocp.dynamics.spacecraft import Spacecraft
 from ocp.errors import (
                         CompilerUnavailable,
                         InvalidOption,

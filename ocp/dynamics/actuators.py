@@ -1,7 +1,7 @@
 """Actuator commands and the actuator model that turns a command into what is applied.
 
 A controller returns a :class:`Command`; the simulator's :class:`ActuatorModel` enforces the
-hardware through each actuator's own saturation (:meth:`~ocp.dynamics.spacecraft.Actuator.saturate`):
+hardware through each actuator's own saturation (:meth:`~ocp.dynamics.actuator_kinds.Actuator.saturate`):
 failed wheels give nothing, each wheel's torque and momentum stay within their limits over the
 coming zero-order-hold interval, and dipoles and torquer torques are clipped per axis (or, for
 magnetorquers with ``saturation="scale"``, the dipole vector is scaled down as a whole).
@@ -34,7 +34,7 @@ class Command:
     dipole : (3,) A m², magnetorquer dipole in body axes.
     torque : (3,) N m, ideal torquer torque in body axes.
     other : dict of str to array_like, the commands of actuator kinds without a field here, by
-        their kind's :attr:`~ocp.dynamics.spacecraft.Actuator.command` name.
+        their kind's :attr:`~ocp.dynamics.actuator_kinds.Actuator.command` name.
     Any may be ``None`` (nothing asked of that actuator).
     """
 
@@ -49,7 +49,7 @@ class Command:
         Parameters
         ----------
         name : str
-            The kind's :attr:`~ocp.dynamics.spacecraft.Actuator.command`.
+            The kind's :attr:`~ocp.dynamics.actuator_kinds.Actuator.command`.
 
         Returns
         -------
@@ -64,7 +64,7 @@ class Command:
         Parameters
         ----------
         name : str
-            The kind's :attr:`~ocp.dynamics.spacecraft.Actuator.command`.
+            The kind's :attr:`~ocp.dynamics.actuator_kinds.Actuator.command`.
         value : array_like
             Its command, in the unit of its block.
         """
@@ -84,7 +84,7 @@ def command_getter(name: str) -> Callable[[Command], Any]:
     Parameters
     ----------
     name : str
-        The kind's :attr:`~ocp.dynamics.spacecraft.Actuator.command`.
+        The kind's :attr:`~ocp.dynamics.actuator_kinds.Actuator.command`.
 
     Returns
     -------
@@ -189,7 +189,7 @@ class ActuatorModel:
         stays within ``±h_max`` (``ḣ_w = g`` is constant over the hold, so this is exact); failed
         wheels give nothing. Dipoles and torquer torques are clipped per axis, or (magnetorquers
         with ``saturation="scale"``) the dipole vector is scaled down as a whole. Each actuator
-        saturates its own block (:meth:`~ocp.dynamics.spacecraft.Actuator.saturate`).
+        saturates its own block (:meth:`~ocp.dynamics.actuator_kinds.Actuator.saturate`).
 
         Parameters
         ----------

@@ -16,7 +16,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ocp.dynamics.spacecraft import Actuator, Spacecraft
+from ocp.dynamics.actuator_kinds import Actuator
+from ocp.dynamics.spacecraft import Spacecraft
 
 Array = NDArray[np.float64]
 REFERENCE_FIELDS = 13

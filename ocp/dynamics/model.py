@@ -9,7 +9,7 @@ default value is the environment's, and passing it lets one built model serve ma
 
 Dynamics (:doc:`/architecture`):
 ``I ω̇ = −ω × (I ω + A h_w) − A g + m × B_B + τ_t + τ_gg + p``. The model names no actuator
-kind: each of the spacecraft's actuators (:class:`~ocp.dynamics.spacecraft.Actuator`) gives its
+kind: each of the spacecraft's actuators (:class:`~ocp.dynamics.actuator_kinds.Actuator`) gives its
 torque on the body, the momentum its states store (``A h_w``) and their rates (``ḣ_w = g``).
 """
 from __future__ import annotations
@@ -74,7 +74,7 @@ class AttitudeModel:
         the orbit [T/s], inertial axes; ``None`` without a field model.
     control_slices : dict of str to slice
         Slices of ``u`` for the blocks present among ``"wheels"``, ``"dipole"``, ``"torquers"``
-        and those of other kinds (keyed by :attr:`~ocp.dynamics.spacecraft.Actuator.block`).
+        and those of other kinds (keyed by :attr:`~ocp.dynamics.actuator_kinds.Actuator.block`).
     solver_cache : SolverCache
         Solvers built on this model by planners given no cache of their own.
     """
