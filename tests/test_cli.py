@@ -3,6 +3,7 @@ import json
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -237,3 +238,22 @@ def test_controller_list_errors_name_the_entry(tmp_path, change, path, fragment)
     with pytest.raises(scenarios.ScenarioError) as error:
         scenarios.load(write(tmp_path, edited(change)))
     assert error.value.path == path and fragment in str(error.value)
+
+
+@pytest.mark.parametrize("command", [["schema"], ["list"]])
+def test_a_reader_that_stops_early_is_not_an_internal_error(command):
+    """``slewbench schema | head -1``: the pipe closes under the writer; the command ends quietly."""
+    import fcntl
+    import os
+
+    read_end, write_end = os.pipe()
+    fcntl.fcntl(write_end, 1031, 4096)  # F_SETPIPE_SZ: one page, so that the writer meets the closed pipe
+    process = subprocess.Popen([sys.executable, "-m", "scenarios.cli", *command], stdout=write_end,
+                               stderr=subprocess.PIPE, cwd=Path(__file__).resolve().parents[1])
+    os.close(write_end)
+    with os.fdopen(read_end, "rb") as reader:
+        reader.read(10)
+    assert process.stderr is not None
+    error = process.stderr.read().decode()
+    assert process.wait(timeout=60) == 0, error
+    assert "Traceback" not in error and "internal error" not in error

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import signal
 import sys
 import threading
@@ -24,16 +23,11 @@ from scenarios.output.directory import claim_output_directory
 from scenarios.output.names import default_output_directory
 from scenarios.runner import run
 from scenarios.schema.loader import load
+from scenarios.schema.reference import summary_line
 
 EXIT_OK, EXIT_INTERNAL, EXIT_BAD_SCENARIO, EXIT_BAD_OUTPUT = 0, 1, 2, 2
 
 
-def _first_doc_line(cls: type) -> str:
-    """The first sentence of the module's docstring (the class's if the module has none)."""
-    doc = (sys.modules[cls.__module__].__doc__ or cls.__doc__ or "").strip()
-    paragraph = " ".join(doc.split("\n\n")[0].split())
-    sentence = re.match(r"(.+?[.:])\s+(?=[A-Z*`])", paragraph)  # not at "eq. 38"
-    return (sentence.group(1) if sentence else paragraph).rstrip(".:")
 
 
 def command_list(_: argparse.Namespace) -> int:
@@ -51,10 +45,10 @@ def command_list(_: argparse.Namespace) -> int:
     """
     print("planners:")
     for name, planner in PLANNERS.items():
-        print(f"  {name:32s} {_first_doc_line(planner)}")
+        print(f"  {name:32s} {summary_line(planner)}")
     print("controllers:")
     for name, controller in CONTROLLERS.items():
-        print(f"  {name:32s} {_first_doc_line(controller)}")
+        print(f"  {name:32s} {summary_line(controller)}")
     return EXIT_OK
 
 
@@ -79,11 +73,8 @@ def command_schema(args: argparse.Namespace) -> int:
     except ScenarioError as error:
         print(f"slewbench: {error}", file=sys.stderr)
         return EXIT_BAD_SCENARIO
-    try:
-        sys.stdout.write(text)
-        sys.stdout.flush()
-    except BrokenPipeError:  # `slewbench schema | head`: the reader has gone
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    sys.stdout.write(text)
+    sys.stdout.flush()
     return EXIT_OK
 
 
@@ -268,6 +259,9 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         option = "--report" if getattr(args, "report", None) else "--out"
         print(f"slewbench: output error: {option} {error}", file=sys.stderr)
         return EXIT_BAD_OUTPUT
+    except BrokenPipeError:  # `slewbench list | head`: the reader has gone; nothing is lost
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
     except KeyboardInterrupt:
         print("slewbench: interrupted; results not written or marked incomplete in the output manifest",
               file=sys.stderr)
