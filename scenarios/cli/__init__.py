@@ -1,6 +1,6 @@
-"""The ``slewbench`` command line: ``run``, ``validate``, ``list``, ``codegen``, ``sweep``.
+"""The ``slewbench`` command line: ``run``, ``validate``, ``list``, ``schema``, ``codegen``, ``sweep``.
 
-What lives here: the parser and the single-scenario commands (:mod:`~scenarios.cli.main`) and the
+What lives here: the parser, the single-scenario commands and ``schema`` (:mod:`~scenarios.cli.main`) and the
 study commands (:mod:`~scenarios.cli.sweep`). ``python -m scenarios.cli`` runs it in one process;
 the console script (:mod:`scenarios.console`) starts the plot process first.
 
