@@ -1,7 +1,8 @@
 """slewbench's symbolic core: quaternions, spacecraft, environment, model, simulator, metrics, NLPs.
 
 Pure numeric and symbolic layer (CasADi, NumPy, SciPy); it knows nothing of planners, controllers
-or YAML. Subpackages, from the bottom up; each may import the top-level modules and those before it:
+or YAML. Subpackages, from the bottom up; each may import the top-level modules and the
+subpackages it names:
 
 * top-level modules: :mod:`~ocp.errors` (the exceptions and their base :class:`SlewbenchError`),
   :mod:`~ocp.options` (typed options), :mod:`~ocp.quat` and :mod:`~ocp.quat_casadi` (quaternion

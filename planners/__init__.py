@@ -5,6 +5,11 @@ The contract is :mod:`planners.base` (:class:`Planner`; :class:`ManeuverProblem`
 checks it for every registered planner. One module per method: :mod:`planners.collocation.planner`,
 :mod:`planners.costate.tpbvp`, :mod:`planners.eigenaxis`, :mod:`planners.natural_motion`,
 :mod:`planners.shape_polynomial`, :mod:`planners.spin_extremal`.
+
+May import: :mod:`ocp`; never :mod:`controllers` or :mod:`scenarios`. Inside, the contract modules
+(``errors``, ``problem``, ``reference``, ``torque_free``, ``base``, ``registry``, ``capabilities``,
+``conformance``) import no planner; a planner imports the contract, and other planners only through
+the registry or, for :mod:`planners.costate`, :mod:`planners.eigenaxis` (its cold start).
 """
 from planners.base import Planner
 from planners.collocation.planner import CollocationPlanner

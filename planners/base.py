@@ -3,13 +3,14 @@
 A planner turns a manoeuvre problem into a reference motion. The base class :class:`Planner`
 states the contract, :class:`Reference` what a reference provides (a :class:`ReferenceSample` of
 ``q``, ``ω``, ``ω̇`` and the rigid-body feed-forward torque at any times); one module per method
-implements it; ``planners.PLANNERS`` maps registry names to classes. The extension guide
-:doc:`/extending/planner` walks through a complete example, and :mod:`planners.conformance` checks the contract.
+implements it; ``planners.PLANNERS`` (:mod:`planners.registry`) maps registry names to classes. The
+extension guide :doc:`/extending/planner` walks through a complete example, and
+:mod:`planners.conformance` checks the contract.
 
 The parts of the contract live in :mod:`planners.problem` (:class:`ManeuverProblem`),
 :mod:`planners.reference` (:class:`Reference`, :class:`ReferenceSample`, :class:`FailedReference`,
-:func:`inverse_dynamics_torque`) and :mod:`planners.torque_free` (the continuation after T); this
-module imports them all, so ``from planners.base import ...`` reaches every name.
+:func:`inverse_dynamics_torque`) and :mod:`planners.torque_free` (the continuation after T); the
+package's face (:mod:`planners`) exports the names a planner needs.
 
 Conventions: scalar-first Hamilton quaternions ``q`` rotating body vectors to inertial, body rate
 ``ω`` of the body relative to inertial in body axes, SI units (s, rad, rad/s, N m, kg m^2).

@@ -3,8 +3,8 @@
 ``slewbench run`` with plots forks its plot process (:mod:`scenarios.output.renderer`) here, before
 anything imports NumPy or the model: the child then imports matplotlib while this process
 imports slewbench and runs the scenario. Every other command, and ``python -m scenarios.cli``,
-goes straight to :func:`scenarios.cli.main.main`. This module imports only the standard library and
-the lazy :mod:`scenarios` package.
+goes straight to :func:`scenarios.cli.commands.main`. This module imports only the standard library,
+the lazy :mod:`scenarios` faces and :mod:`scenarios.output.renderer` (which imports no model).
 """
 from __future__ import annotations
 
@@ -50,7 +50,7 @@ def main(argv: list[str] | None = None) -> int:
     Returns
     -------
     int
-        The exit status of :func:`scenarios.cli.main.main` (1 if interrupted before it started).
+        The exit status of :func:`scenarios.cli.commands.main` (1 if interrupted before it started).
     """
     argv = sys.argv[1:] if argv is None else list(argv)
     renderer = Renderer.start() if draws_plots(argv) else None
@@ -60,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
         previous = None
     try:
         try:
-            from scenarios.cli.main import (
+            from scenarios.cli.commands import (
                 main as command_line,  # the model, after the fork
             )
         except KeyboardInterrupt:  # Ctrl-C or SIGTERM while the model loads: nothing written yet

@@ -61,6 +61,11 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         cache: SolverCache | None = None, simulators: SolverCache | None = None) -> RunResults:
     """Plan, simulate and score every planner of ``scenario``.
 
+    The scenario's validated planner and controller instances serve every row (their options are
+    checked once, when the scenario is loaded). The simulator resets a controller before each run,
+    which the controller contract requires to clear its state (``controllers.conformance`` checks
+    it), so the rows do not share state; one scenario is not meant to run in two threads at once.
+
     Parameters
     ----------
     scenario : a loaded scenario.

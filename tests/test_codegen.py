@@ -12,7 +12,7 @@ import pytest
 from controllers import CONTROLLERS
 from ocp import Measurement, quat
 from planners import PLANNERS
-from scenarios.cli.main import main
+from scenarios.cli.commands import main
 from scenarios.schema.loader import load
 
 SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"

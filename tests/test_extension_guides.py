@@ -151,7 +151,6 @@ def test_controller_guide(registries, rng):
 
 
 def test_controller_guide_conformance(registries):
-    pytest.importorskip(CONFORMANCE_IMPORT)
     blocks = [block for block in code_blocks("controller.rst") if CONFORMANCE_IMPORT in block]
     assert len(blocks) == 1, "the guide's conformance block is kept apart"
     run_guide("controller.rst")  # every block, the conformance call included: it raises on failure

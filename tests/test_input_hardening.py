@@ -15,7 +15,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from scenarios.cli.main import main
+from scenarios.cli.commands import main
 
 BASE = {
     "name": "base",

@@ -256,7 +256,12 @@ def _all(module: Module) -> list[str] | None:
 def _defined(module: Module) -> set[str]:
     """Names a module's own top-level statements define (not the names it imports)."""
     names: set[str] = set()
-    for node in _nodes(ast.parse(module.source)):
+    tree = ast.parse(module.source)
+    top = [node for statement in tree.body for node in ([statement] if not _type_checking(statement) else [])]
+    for node in top:  # module level only: a name bound inside a function is not the module's
+        if isinstance(node, ast.If):  # e.g. a platform branch: its direct statements
+            top.extend(node.body + node.orelse)
+            continue
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
             names.add(node.name)
         elif isinstance(node, (ast.Assign, ast.AnnAssign, ast.AugAssign)):
@@ -300,6 +305,8 @@ def test_no_docstring_or_comment_speaks_of_splits_or_re_exports():
 def test_planted_re_export_and_split_remark_are_caught():
     tree = _planted("ocp.metrics", "__all__ = ['compute_metrics', 'quat']")
     assert foreign_names(tree) == {"ocp.metrics": ["quat"]}
+    tree = _planted("ocp.metrics", "def _helper():\n    above = 1\n    return above\n__all__ = ['compute_metrics', 'above']")
+    assert foreign_names(tree) == {"ocp.metrics": ["above"]}  # a function's local is not the module's name
     tree = _planted("ocp.metrics", "# split from ocp.quat; it re-exports normalize")
     assert "ocp.metrics" in split_remarks(tree)
 
@@ -318,6 +325,9 @@ def face_problems(module: types.ModuleType) -> list[str]:
     missing = [name for name in listed if not hasattr(module, name)]
     if missing:
         problems.append(f"__all__ names that do not resolve: {missing}")
+    shadowed = [name for name in listed if name not in missing and isinstance(getattr(module, name), types.ModuleType)]
+    if shadowed:  # a public name that is also a submodule's: the first import binds the module over it
+        problems.append(f"__all__ names that resolve to a module: {shadowed}")
     if len(set(listed)) != len(listed):
         problems.append("__all__ repeats a name")
     return problems
@@ -338,6 +348,10 @@ def test_planted_face_defects_are_caught():
     lazy.__getattr__, _ = lazy_face("scenarios.output", {"to_csv": "scenarios.output.plots",  # type: ignore[attr-defined]
                                                          "nowhere": "scenarios.output.tables"})
     assert face_problems(lazy) == ["__all__ names that do not resolve: ['to_csv', 'nowhere']"]
+    shadow = types.ModuleType("shadow", "A face one of whose public names is also the name of its submodule.")
+    shadow.__all__ = ["names"]
+    shadow.names = importlib.import_module("scenarios.output.names")  # type: ignore[attr-defined]
+    assert face_problems(shadow) == ["__all__ names that resolve to a module: ['names']"]
 
 
 # --- "May import:" in the faces' docstrings ------------------------------------------------------

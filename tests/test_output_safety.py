@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from scenarios.cli.main import main
+from scenarios.cli.commands import main
 from scenarios.output.directory import MARKER, STAGING_PREFIX
 from scenarios.output.names import default_output_directory, row_stems
 
@@ -216,7 +216,7 @@ def test_a_sigterm_swallowed_during_the_run_still_stops_it_before_writing(tmp_pa
     """A KeyboardInterrupt raised by the SIGTERM handler can be lost on the way (inside a finaliser,
     or recorded as a failed row); seen once in CI: SIGTERM, then exit 0 with complete results. The
     run must still stop, with nothing written but the marker, marked incomplete."""
-    import scenarios.cli.main as cli
+    import scenarios.cli.commands as cli
     real_run = cli.run
 
     def run_swallowing_a_sigterm(*args, **kwargs):

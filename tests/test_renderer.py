@@ -260,9 +260,9 @@ def test_an_interruption_while_the_model_is_imported_is_reported_without_a_trace
         import scenarios.console
         from scenarios.output.renderer import Renderer
 
-        class Interrupting:  # Ctrl-C while scenarios.cli.main is being imported
+        class Interrupting:  # Ctrl-C while scenarios.cli.commands is being imported
             def find_spec(self, name, path=None, target=None):
-                if name == "scenarios.cli.main":
+                if name == "scenarios.cli.commands":
                     INTERRUPT
 
         started = []

@@ -19,7 +19,7 @@ import yaml
 
 import scenarios
 from ocp import METRIC_KEYS, SlewbenchError
-from scenarios.cli.main import main
+from scenarios.cli.commands import main
 from scenarios.errors import OutputError, ScenarioError
 from scenarios.output.results import Row, RunResults
 from scenarios.schema.labels import RowLabel, row_labels
@@ -243,7 +243,7 @@ def test_a_label_collision_is_the_same_error_in_the_loader_the_runner_and_the_sw
 
 # --- output errors ------------------------------------------------------------------------------
 
-def test_an_output_problem_is_an_output_error_not_a_scenario_error(tmp_path, capsys):
+def test_an_output_problem_is_an_output_error_not_a_scenario_error(tmp_path, capsys, monkeypatch):
     path = tmp_path / "scenario.yaml"
     path.write_text(yaml.safe_dump(BASE))
     target = tmp_path / "file.txt"
@@ -256,6 +256,15 @@ def test_an_output_problem_is_an_output_error_not_a_scenario_error(tmp_path, cap
     assert capsys.readouterr().err.startswith(f"slewbench: output error: --out {target}:")
     assert main(["sweep", "--report", str(tmp_path)]) == 2
     assert capsys.readouterr().err.startswith(f"slewbench: output error: --report {tmp_path}: holds no slewbench sweep")
+
+    default = tmp_path / "results" / BASE["name"]  # the default results/<name>, occupied by a file of the user's
+    default.parent.mkdir()
+    default.write_text("keep")
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", str(path), "--no-plots"]) == 2
+    error = capsys.readouterr().err
+    assert error.startswith(f"slewbench: output error: results/{BASE['name']}: exists and is not a directory"), error
+    assert default.read_text() == "keep"  # and --out, which the user did not give, is not named
 
     results = hand_built_results()
     with pytest.raises(OutputError) as raised:
@@ -294,32 +303,3 @@ def test_a_store_of_the_previous_format_is_redrawn_by_report_and_refused_by_resu
                                 "slewbench (sweep.sqlite format 'slewbench-sweep-1')"), error
         assert f"slewbench sweep --report {out}" in error
     assert (out / "sweep.sqlite").read_bytes() == stored
-
-
-# --- layering -------------------------------------------------------------------------------------
-
-LAYERS = ["scenarios.errors", "scenarios.schema", "scenarios.output", "scenarios.runner", "scenarios.codegen",
-          "scenarios.study", "scenarios.cli"]
-"""The layers of ``scenarios`` from the bottom up (the package's face): a module imports only its own
-layer and those below, lazily or for type checking included."""
-
-
-def test_no_import_of_scenarios_runs_back_up_a_layer():
-    import ast
-    from pathlib import Path
-
-    def layer(name):
-        return next((i for i, top in enumerate(LAYERS) if name == top or name.startswith(f"{top}.")), None)
-
-    root = Path(__file__).resolve().parents[1]
-    upward = []
-    for path in sorted((root / "scenarios").rglob("*.py")):
-        module = ".".join(path.relative_to(root).with_suffix("").parts)
-        own = layer(module)
-        for node in ast.walk(ast.parse(path.read_text())):
-            names = [alias.name for alias in node.names] if isinstance(node, ast.Import) else (
-                [node.module] if isinstance(node, ast.ImportFrom) and node.module else [])
-            upward += [f"{module} imports {name}" for name in names
-                       if own is not None and (layer(name) or 0) > own]
-    assert not upward, upward
-    assert layer("scenarios.output.results") < layer("scenarios.runner")  # Row and RunResults live below the runner

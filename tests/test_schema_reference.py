@@ -17,8 +17,9 @@ import sys
 import textwrap
 from html import unescape
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, ClassVar
 
+import casadi as ca
 import numpy as np
 import pytest
 
@@ -26,7 +27,7 @@ import ocp.options
 import scenarios
 from controllers import CONTROLLERS
 from ocp import SolverCache, quat
-from ocp.dynamics.environment import MAGNETIC_FIELDS
+from ocp.dynamics.environment import MAGNETIC_FIELDS, FieldModel
 from planners import PLANNERS
 from scenarios.errors import ScenarioError
 from scenarios.schema.node import Node
@@ -524,3 +525,45 @@ def test_the_study_generator_guide_registers_a_generator_that_a_study_uses():
             parse_study(data, ROOT / "scenarios" / "study.yaml")
     finally:
         VALUE_GENERATORS.pop("arange", None)
+
+
+def test_a_field_model_option_with_any_declared_range_is_read_and_checked_by_it():
+    """A user's field model may declare any Range: the scenario reads it, refuses a value outside it at
+    its YAML path in the Range's own words, and the reference states it (no TypeError at load)."""
+    @dataclasses.dataclass(frozen=True)
+    class Scaled(FieldModel):
+        name: ClassVar[str] = "scaled_test"
+        b: float = 1.0
+
+        @dataclasses.dataclass(frozen=True)
+        class Options:
+            gain: Annotated[float, ocp.options.Range(ge=1.0, lt=10.0)] = 2.0
+
+        @classmethod
+        def from_options(cls, options: Any, orbit: Any) -> Scaled:
+            return cls(3e-5 * options.gain)
+
+        def field_inertial(self, position: Any, t: Any) -> Any:
+            return ca.DM([0.0, 0.0, self.b])
+
+    MAGNETIC_FIELDS[Scaled.name] = Scaled
+    try:
+        data = parse_yaml_text(textwrap.dedent("""
+            spacecraft: {inertia: [1, 1, 1], magnetorquers: {max_dipole: 0.1}, wheels: null}
+            orbit: {altitude_km: 500}
+            environment: {magnetic_field: {model: scaled_test, gain: 4.0}}
+            name: scaled-field
+            maneuver: {duration: 10, initial: {q: [1, 0, 0, 0]}, final: {q: null, omega: [0, 0, 0]}}
+            planners: []
+            controller: {name: bdot}
+        """))
+        scenario = scenarios.parse_scenario(copy.deepcopy(data))
+        assert scenario.problem.environment.magnetic_field == Scaled(1.2e-4)
+        for bad in (0.5, 10.0, "x"):
+            data["environment"]["magnetic_field"]["gain"] = bad
+            with pytest.raises(ScenarioError, match=r"environment\.magnetic_field\.gain: expected a (finite )?number"):
+                scenarios.parse_scenario(copy.deepcopy(data))
+        assert ">= 1" in schema_text("environment.magnetic_field.scaled_test") and "< 10" in schema_text(
+            "environment.magnetic_field.scaled_test")
+    finally:
+        MAGNETIC_FIELDS.pop("scaled_test", None)

@@ -16,7 +16,7 @@ import yaml
 
 import scenarios
 from scenarios import runner
-from scenarios.cli.main import main
+from scenarios.cli.commands import main
 from scenarios.output.directory import claim_output_directory
 from scenarios.study.engine import sweep
 from scenarios.study.spec import parse_study

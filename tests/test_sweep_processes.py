@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from scenarios.cli.main import main
+from scenarios.cli.commands import main
 from scenarios.study.engine import sweep
 from scenarios.study.spec import load_study
 from tests.test_sweep import BASE, InlineExecutor, comparable

@@ -1,7 +1,7 @@
 """The ``slewbench`` command line: ``run``, ``validate``, ``list``, ``schema``, ``codegen``, ``sweep``.
 
-What lives here: the parser, the single-scenario commands and ``schema`` (:mod:`~scenarios.cli.main`) and the
-study commands (:mod:`~scenarios.cli.sweep`). ``python -m scenarios.cli`` runs it in one process;
+What lives here: the parser, the single-scenario commands and ``schema``
+(:mod:`~scenarios.cli.commands`) and the study commands (:mod:`~scenarios.cli.sweep`). ``python -m scenarios.cli`` runs it in one process;
 the console script (:mod:`scenarios.console`) starts the plot process first.
 
 May import: everything of :mod:`scenarios`, and :mod:`planners` and :mod:`controllers` (their
@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from scenarios._faces import lazy_face
 
-_HOMES = {"build_parser": "scenarios.cli.main",
-          "main": "scenarios.cli.main"}
+_HOMES = {"build_parser": "scenarios.cli.commands",
+          "main": "scenarios.cli.commands"}
 
 __all__ = ["build_parser", "main"]
 

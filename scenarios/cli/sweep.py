@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from scenarios.cli.status import EXIT_INTERRUPTED, EXIT_OK
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, read_manifest
 from scenarios.output.names import default_output_directory
@@ -28,8 +29,6 @@ from scenarios.study.store import (
     store_format,
 )
 from scenarios.study.types import package_version
-
-EXIT_OK, EXIT_BAD_STUDY, EXIT_INTERRUPTED = 0, 2, 130
 
 
 def _open_store(out: Path) -> SweepStore:

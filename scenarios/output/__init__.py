@@ -1,8 +1,9 @@
 """What a run writes: tables, time series and figures, in output directories slewbench owns.
 
 What lives here: a run's rows and results (:mod:`~scenarios.output.results`), file names from
-labels (:mod:`~scenarios.output.names`), the table forms of rows, their column names and the one
-rule for missing and non-finite values (:mod:`~scenarios.output.tables`), output directories, their
+labels (:mod:`~scenarios.output.names`), the table forms of rows (flattened by the column names of
+:mod:`scenarios.schema.columns`) and the one rule for missing and non-finite values
+(:mod:`~scenarios.output.tables`), output directories, their
 manifest and staged commits (:mod:`~scenarios.output.directory`), the figures' data as arrays
 (:mod:`~scenarios.output.plot_data`), the matplotlib drawing (:mod:`~scenarios.output.plots`) and
 the plot process that draws while the run goes on (:mod:`~scenarios.output.renderer`).

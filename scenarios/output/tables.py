@@ -258,10 +258,21 @@ def to_dataframe(results: RunResults) -> pandas.DataFrame:
     return data_frame(row_columns(), [flatten_row(row.to_dict()) for row in results.rows], numeric_columns())
 
 
-def _format(value: Any) -> str:
-    """A Markdown and terminal cell: ``-`` when missing or non-finite, 4 significant digits."""
+def text_cell(value: Any) -> str:
+    """A Markdown or terminal cell: ``-`` when missing or non-finite, 4 significant digits.
+
+    Parameters
+    ----------
+    value : object
+        A number, text, ``None`` or a list of them (a vector metric).
+
+    Returns
+    -------
+    str
+        The cell's text.
+    """
     if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_format(v) for v in value) + "]"
+        return "[" + ", ".join(text_cell(v) for v in value) + "]"
     if is_missing(value):
         return "-"
     if isinstance(value, float):
@@ -273,10 +284,10 @@ def _metric_lines(results: RunResults) -> list[tuple[str, list[str]]]:
     """(metric name, one formatted cell per row), reference metrics then closed-loop ones."""
     rows = [row.to_dict() for row in results.rows]
     lines = [("status", [row["status"] for row in rows]),
-             ("plan_time_s", [_format(row["plan_time_s"]) for row in rows])]
+             ("plan_time_s", [text_cell(row["plan_time_s"]) for row in rows])]
     for scope, prefix in SCOPES:
         for key in SCORED_METRICS:
-            lines.append((f"{prefix}.{key}", [_format((row[scope] or {}).get(key)) for row in rows]))
+            lines.append((f"{prefix}.{key}", [text_cell((row[scope] or {}).get(key)) for row in rows]))
     return lines
 
 

@@ -24,6 +24,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal, Union
 
+from ocp.errors import excerpt
 from ocp.options import Range, numeric_leaves, option_fields
 from scenarios.schema.node import Node
 
@@ -602,11 +603,21 @@ def _option_key(name: str, annotation: Any, bounds: Range | None, default: Any, 
     kind = base[0] if len(base) == 1 else None
     if kind is float:
         bounds = bounds or Range()
-        if bounds.gt not in (None, 0.0) or bounds.ge not in (None, 0.0) or bounds.lt is not None or not bounds.finite:
-            raise TypeError(f"option {name}: only Range(gt=0), Range(ge=0) and Range(le=...) are read by the "
-                            f"scenario schema, got {bounds}")
-        return number(name, meaning, unit=unit, default=default, positive=bounds.gt == 0.0,
-                      non_negative=bounds.ge == 0.0, maximum=bounds.le, nullable=optional)
+        if bounds.gt in (None, 0.0) and bounds.ge in (None, 0.0) and bounds.lt is None and bounds.finite:
+            # the scenario's own number checks (and their messages)
+            return number(name, meaning, unit=unit, default=default, positive=bounds.gt == 0.0,
+                          non_negative=bounds.ge == 0.0, maximum=bounds.le, nullable=optional)
+        declared = bounds
+
+        def read_bounded(node: Node) -> float | None:  # any other declared Range, in its own words
+            if optional and node.is_null():
+                return None
+            value = node.number() if declared.finite else node.value
+            if not isinstance(value, (int, float)) or isinstance(value, bool) or declared.violation(float(value)):
+                raise node.error(f"expected {declared.describe()}, got {excerpt(node.value)}")
+            return float(value)
+        return Key(name, "number or null" if optional else "number", meaning, read_bounded, unit, default,
+                   _range_words(declared))
     unit = unit if numeric_leaves(annotation) else ""
     args = typing.get_args(kind)
     if typing.get_origin(kind) is tuple and args and all(arg is float for arg in args) and not optional:

@@ -427,7 +427,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     Parameters
     ----------
     data : object
-        The parsed YAML document (a mapping; see :func:`~scenarios.schema.node.read_yaml`).
+        The parsed YAML document (a mapping; see :func:`~scenarios.schema.read.read_yaml`).
     source : Path or None, optional
         The file it came from, kept in :attr:`Scenario.source`.
 

@@ -30,6 +30,7 @@ from typing import Any
 
 from controllers import CONTROLLERS
 from ocp.dynamics.environment import MAGNETIC_FIELDS
+from ocp.errors import excerpt
 from planners import PLANNERS
 from scenarios.errors import ScenarioError
 from scenarios.schema.keys import (
@@ -454,6 +455,6 @@ def schema_text(key: str | None = None) -> str:
             lines += _entry_text(entry) + [""]
     if not lines:
         matches = _close_matches(wanted or "", parts)
-        raise ScenarioError(key or "", "not a key of the scenario or study schema"
+        raise ScenarioError("", f"{excerpt(key)} is not a key of the scenario or study schema"  # quoted, bounded
                             + (f"; close matches: {', '.join(matches)}" if matches else ""))
     return "\n".join(lines).rstrip() + "\n"

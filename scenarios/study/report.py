@@ -23,7 +23,7 @@ from scenarios.output.directory import (
     read_manifest,
     write_manifest,
 )
-from scenarios.output.tables import csv_text, flatten_row, is_missing, row_columns
+from scenarios.output.tables import csv_text, flatten_row, is_missing, row_columns, text_cell
 from scenarios.study.store import STORE_NAME, is_sweep_store
 from scenarios.study.types import Study, package_version
 
@@ -114,13 +114,10 @@ def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], 
 
 
 def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], missing: int) -> str:
-    def cell(value: Any) -> str:
-        return "-" if is_missing(value) else f"{value:.4g}" if isinstance(value, float) else str(value)
-
     out = [f"# {study.name}", "", f"{len(study.cases)} cases ({missing} missing), "
            f"{study.samples} Monte Carlo sample(s) per grid point, slewbench {package_version()}.", "",
            "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    out += ["| " + " | ".join(cell(row.get(c)) for c in columns) + " |" for row in rows]
+    out += ["| " + " | ".join(text_cell(row.get(c)) for c in columns) + " |" for row in rows]
     out += ["", "Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s. "
                 "std is the sample standard deviation; p5 and p95 are linear percentiles.", ""]
     return "\n".join(out)

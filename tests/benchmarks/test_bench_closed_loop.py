@@ -103,10 +103,10 @@ def test_100000_s_magnetorquer_run(benchmark, path):
 
 
 @pytest.mark.benchmark(group="slewbench run eigenaxis_demo.yaml with plots (new process)")
-@pytest.mark.parametrize("entry", ["scenarios.console", "scenarios.cli.main"])
+@pytest.mark.parametrize("entry", ["scenarios.console", "scenarios.cli.commands"])
 def test_demo_run_with_plots_wall_time(benchmark, tmp_path, entry):
     """``scenarios.console`` is the ``slewbench`` console script (the plot process draws while the
-    run computes); ``scenarios.cli.main`` draws in the run's process (the path before the plot process).
+    run computes); ``scenarios.cli.commands`` draws in the run's process (the path before the plot process).
     Bytecode is cached as after ``pip install`` (a first, untimed run writes it)."""
     environment = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
 

@@ -5,7 +5,7 @@ import re
 import subprocess
 from pathlib import Path
 
-from scenarios.cli.main import main
+from scenarios.cli.commands import main
 
 ROOT = Path(__file__).resolve().parents[2]
 

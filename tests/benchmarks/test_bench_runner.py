@@ -9,7 +9,7 @@ import scenarios
 from controllers import CONTROLLERS
 from ocp import Simulator, metrics_from_reference, metrics_from_simulation
 from planners import PLANNERS
-from scenarios.cli.main import main
+from scenarios.cli.commands import main
 
 DEMO = Path(__file__).resolve().parents[2] / "scenarios" / "eigenaxis_demo.yaml"
 

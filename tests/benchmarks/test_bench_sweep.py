@@ -4,7 +4,7 @@ least 1.7x the throughput of one; 100 cases of one collocation structure build t
 worker.
 
 The sweep side is the command itself, ``slewbench sweep STUDY --out DIR --no-plots --workers N``,
-run in this process (``scenarios.cli.main.main``): it expands and checks the study, claims the
+run in this process (``scenarios.cli.commands.main``): it expands and checks the study, claims the
 directory, commits every case to the SQLite store and writes the tables. The in-process side is
 a loop of ``scenarios.run(scenarios.parse_scenario(case), cache=..., simulators=...)`` over the
 same cases, with the caches a worker keeps (a solver cache and a few simulators), so that the
@@ -29,7 +29,7 @@ import yaml
 
 import scenarios
 from ocp import SolverCache
-from scenarios.cli.main import main
+from scenarios.cli.commands import main
 from scenarios.schema.read import read_yaml
 from scenarios.study.engine import start_forkserver, sweep
 from scenarios.study.report import claim_sweep_directory

@@ -17,6 +17,12 @@ from typing import Any
 
 from controllers import CONTROLLERS
 from planners import PLANNERS
+from scenarios.cli.status import (
+    EXIT_BAD_OUTPUT,
+    EXIT_BAD_SCENARIO,
+    EXIT_INTERNAL,
+    EXIT_OK,
+)
 from scenarios.cli.sweep import add_sweep_parser
 from scenarios.errors import OutputError, ScenarioError
 from scenarios.output.directory import claim_output_directory
@@ -24,10 +30,6 @@ from scenarios.output.names import default_output_directory
 from scenarios.runner import run
 from scenarios.schema.loader import load
 from scenarios.schema.reference import summary_line
-
-EXIT_OK, EXIT_INTERNAL, EXIT_BAD_SCENARIO, EXIT_BAD_OUTPUT = 0, 1, 2, 2
-
-
 
 
 def command_list(_: argparse.Namespace) -> int:
@@ -256,8 +258,9 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         print(f"slewbench: error in scenario: {error}", file=sys.stderr)
         return EXIT_BAD_SCENARIO
     except OutputError as error:
-        option = "--report" if getattr(args, "report", None) else "--out"
-        print(f"slewbench: output error: {option} {error}", file=sys.stderr)
+        given = "--report" if getattr(args, "report", None) else "--out" if getattr(args, "out", None) else None
+        where = f"{given} " if given else ""  # the default results/<name> was not given as --out
+        print(f"slewbench: output error: {where}{error}", file=sys.stderr)
         return EXIT_BAD_OUTPUT
     except BrokenPipeError:  # `slewbench list | head`: the reader has gone; nothing is lost
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -1,0 +1,18 @@
+"""The exit statuses of the ``slewbench`` command line, one set for every command.
+
+May import: nothing of slewbench.
+"""
+from __future__ import annotations
+
+__all__ = ["EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_OK"]
+
+EXIT_OK = 0
+"""The command completed (a run's failed rows included: they are results)."""
+EXIT_INTERNAL = 1
+"""An internal error (a bug), or a run interrupted by Ctrl-C or SIGTERM."""
+EXIT_BAD_SCENARIO = 2
+"""A bad scenario or study file (or key of ``slewbench schema``): nothing was written."""
+EXIT_BAD_OUTPUT = 2
+"""An output location slewbench must not or cannot write to: nothing was touched."""
+EXIT_INTERRUPTED = 130
+"""A sweep stopped before every case finished (rerun it with ``--resume``)."""
