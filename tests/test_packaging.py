@@ -3,7 +3,8 @@
 The wheel is built from a copy of the project (pip builds in the tree it is given, and a stale
 ``build/`` would hide a package the configuration leaves out), installed with ``--no-deps`` into a
 fresh virtual environment whose dependencies come from the test's own environment through a
-``.pth`` file (as ``tests/test_readme.py`` does). From a directory outside the source tree, the
+``.pth`` file (as ``tests/test_readme.py`` does); ``--ignore-installed``, because that environment
+may hold slewbench itself (CI installs it), which pip would otherwise take as already there. From a directory outside the source tree, the
 installed Python imports every module found under ``ocp/``, ``planners/``, ``controllers/`` and
 ``scenarios/`` of the checkout, each from the environment, not from the checkout; then
 ``slewbench --help``, ``python -m scenarios.cli --help`` and the version lookup run there.
@@ -90,7 +91,7 @@ def test_the_installed_wheel_holds_and_imports_every_module(tmp_path):
                           capture_output=True, text=True, check=True).stdout.strip()
     Path(site, "test_environment.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
     installed = subprocess.run([sys.executable, "-m", "pip", "--python", str(python), "install", "--no-deps",
-                                "--quiet", str(wheel)], cwd=tmp_path, env=_environment(), capture_output=True,
+                                "--ignore-installed", "--quiet", str(wheel)], cwd=tmp_path, env=_environment(), capture_output=True,
                                text=True, timeout=600, check=False)
     assert installed.returncode == 0, installed.stdout[-2000:] + installed.stderr[-2000:]
 
