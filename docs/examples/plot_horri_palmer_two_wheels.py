@@ -86,8 +86,10 @@ with pd.option_context("display.float_format", "{:.4g}".format):
 # The minimum time as a lower bound
 # ---------------------------------
 # ``REPRODUCTION.md``: T = 136.64 s (50 intervals, degree 3), checked by a second transcription
-# (multiple shooting, 136.74 s at N = 50, 136.661 s at N = 100) and by restarts; the control is
-# bang-bang on both working wheels. No law comes within a factor of 36 of it to 0.5°.
+# (multiple shooting, 136.74 s at N = 50, 136.661 s at N = 100) and by restarts (three of five
+# perturbed restarts return to it, two stop at poorer points: it is the best optimum found, not a
+# proven bound); the control is bang-bang on both working wheels. No law comes within a factor of
+# 36 of it to 0.5°.
 print(f"minimum two-wheel slew time T = {optimal.duration:.2f} s (REPRODUCTION.md: 136.64 s)")
 for law, values in table.items():
     if not isinstance(values["0.5° [s]"], str):

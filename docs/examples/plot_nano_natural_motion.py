@@ -15,7 +15,8 @@ last 10 s at rest. Three manoeuvres are compared:
 The scenarios run as shipped (0.1 s samples; the paper gives no sample time). The gains are ours:
 the paper tuned its own "until the minimum torque manoeuvre which satisfied the boundary
 conditions was found" and gives none; ``scenarios/REPRODUCTION.md`` records the grid sweep that
-chose them.
+chose them (re-run with the current law, it would now give the natural motion a lower stiffness,
+for 6 % less torque; the scenario keeps its gains).
 """
 
 # %%
@@ -44,9 +45,9 @@ for row in rows.values():
 # [0.1013, 0.1252, 0.0973] N m s, so the natural motion saves 82 % of the total torque.
 #
 # What reproduces is the ranking: the natural motion needs the least torque, and less than a
-# smooth eigenaxis reference tracked by the same law. **Discrepancy recorded**: our absolute values
-# are 5 to 25 times smaller than the paper's, whose gains, sample time, noise and perturbations
-# are not given, so its magnitudes cannot be reproduced; the saving is 56 % in
+# smooth eigenaxis reference tracked by the same law. **Discrepancy recorded**: our totals are 16
+# (natural motion) and 37 (PD law) times smaller than the paper's, whose gains, sample time, noise
+# and perturbations are not given, so its magnitudes cannot be reproduced; the saving is 59 % in
 # ``REPRODUCTION.md`` (paper 82 %). A physical floor limits it for a rest-to-rest slew: any such
 # manoeuvre must spin up and stop, so a natural arc saves only the mid-course torque (the
 # momentum to give the body at the start is printed below).
@@ -67,12 +68,12 @@ spin_up = natural_reference.inertia @ natural_reference.omega(0.0)
 print(f"spin-up momentum of the natural arc |I ω*(0)| = {np.linalg.norm(spin_up):.2e} N m s")
 
 # %%
-# **Discrepancy with** ``REPRODUCTION.md``: it records, for the natural motion, ∫|u| =
-# [0.00040, 0.00174, 0.00175] N m s (Σ 0.0039, a 56 % saving) and a peak torque of 1.3e-3 N m
-# (paper: "of the order of 1e-3 N m"). The current code gives the smaller integrals above (a
-# saving near 59 %); its torque peaks at 1.2e-3 N m while the body spins up, and once more, for a
-# single sample, at 100 s, where the reference's rate steps to zero (``stop: step``) and the
-# hold-compensated feed-forward spreads that step over one 0.1 s hold:
+# ``REPRODUCTION.md`` records, for the natural motion, ∫|u| = [0.00036, 0.00157, 0.00171] N m s
+# (Σ 0.0036, a 59 % saving) and a torque that peaks at 1.24e-3 N m while the body spins up (paper:
+# "of the order of 1e-3 N m"), and once more, 7.7e-3 N m for a single sample, at 100 s, where the
+# reference's rate steps to zero (``stop: step``) and the hold-compensated feed-forward puts that
+# step into one 0.1 s hold (its values before that feed-forward, Σ 0.0039 and a 1.3e-3 N m peak,
+# are kept there as history):
 natural = rows["natural motion"].simulation
 first_second = natural.t[:-1] < 1.0
 print(f"peak |u_i| while spinning up: {np.abs(natural.applied_torque[first_second]).max():.2e} N m; "

@@ -109,13 +109,14 @@ with pd.option_context("display.float_format", "{:.4g}".format):
     print(pd.DataFrame(table).T.to_string())
 
 # %%
-# **Discrepancy with** ``REPRODUCTION.md``: it records a closed-loop ∫‖u‖ dt of 6.7e-3 (co-state),
-# 7.7e-3 (N = 5) and 6.1e-3 N m s (N = 1), and for the co-state path a 4.6e-4 N m torque peak and
-# 0.26° of peak tracking error caused by its rate steps at both ends (ω jumps between 0 and
-# ω_max; the impulsive torque is not in the reference's torque history, nor in the paper's
-# Fig. 11). The current code, whose feed-forward spreads such a step over one 1 s hold, gives the
-# values printed above: still the fastest path, but no longer the cheapest once the body has to
-# start and stop.
+# ``REPRODUCTION.md`` records a closed-loop ∫‖u‖ dt of 6.0e-3 (co-state), 7.5e-3 (N = 5) and
+# 6.1e-3 N m s (N = 1), and for the co-state path a 2.2e-3 N m torque peak and 0.029° of peak
+# tracking error caused by its rate steps at both ends (ω jumps between 0 and ω_max; the impulsive
+# torque is not in the reference's torque history, nor in the paper's Fig. 11). The law's
+# feed-forward puts each step into one 1 s hold, and the steps make up most of the co-state row's
+# ∫‖u‖: the co-state path is the fastest and, by a small margin over N = 1, also the cheapest in
+# closed loop. (Before that feed-forward the record read 6.7e-3 and 7.7e-3 N m s, 4.6e-4 N m and
+# 0.26°, and the co-state path was not the cheapest.)
 #
 # Figs. 9-13: quaternions, rates and reference torques
 # ----------------------------------------------------
