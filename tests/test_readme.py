@@ -121,9 +121,11 @@ def _environment() -> dict[str, str]:
 
 
 def _filled(command: str, scratch: Path) -> list[str]:
-    """Placeholders replaced: FILE.yaml by the demo scenario, [--out DIR] by a scratch directory."""
+    """Placeholders replaced: FILE.yaml by the demo scenario, [--out DIR] by a scratch directory, [KEY]
+    by a schema key."""
     command = command.replace("FILE.yaml", "scenarios/eigenaxis_demo.yaml")
     command = command.replace("[--out DIR]", f"--out {scratch / 'out'}").replace("[--no-plots]", "--no-plots")
+    command = command.replace("[KEY]", "maneuver.duration")
     return shlex.split(command)
 
 
@@ -140,6 +142,8 @@ def test_slewbench_command(command, tmp_path):
         for name in ("results.json", "results.csv", "results.md", "comparison.png"):
             assert (folder / name).is_file(), name
         assert any((folder / "timeseries").glob("*.csv"))
+    if args[1] == "schema":
+        assert "maneuver.duration" in done.stdout and "number" in done.stdout
     if args[1] == "list":
         assert "spin_extremal" in done.stdout and "augmented_quaternion_feedback" in done.stdout
     if args[1] == "codegen":
