@@ -268,7 +268,7 @@ def _timeseries_header() -> list[str]:
     """The header ``write_timeseries`` writes, for a three-wheel row, read back from the file."""
     import numpy as np
 
-    from scenarios.output.directory import write_timeseries
+    from scenarios.output.writer import write_timeseries
 
     n_w, samples = 3, 2
     simulation = SimpleNamespace(t=np.arange(samples + 1.0), x=np.zeros((samples + 1, 7 + n_w)),
@@ -285,7 +285,8 @@ def write_output_fragments() -> None:
     from scenarios.output.directory import MARKER, STAGING_PREFIX
     from scenarios.output.names import MAX_STEM, RESERVED
     from scenarios.output.tables import row_columns
-    from scenarios.study.report import STATISTICS, STORE_FILES
+    from scenarios.study.report import STATISTICS
+    from scenarios.study.store import STORE_FILES
 
     generated = DOCS / "_generated"
     _write(generated / "results_csv_columns.inc", _literal_list(row_columns()) + "\n")

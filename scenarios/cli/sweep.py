@@ -19,12 +19,13 @@ from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, read_manifest
 from scenarios.output.names import default_output_directory
 from scenarios.study.engine import SweepResults, start_forkserver, sweep
-from scenarios.study.report import claim_sweep_directory, resolved_study
+from scenarios.study.report import resolved_study
 from scenarios.study.spec import load_study, parse_study
 from scenarios.study.store import (
     EARLIER_FORMATS,
     STORE_NAME,
     SweepStore,
+    claim_sweep_directory,
     is_sweep_store,
     store_format,
 )

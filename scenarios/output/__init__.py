@@ -4,7 +4,8 @@ What lives here: a run's rows and results (:mod:`~scenarios.output.results`), fi
 labels (:mod:`~scenarios.output.names`), the table forms of rows (flattened by the column names of
 :mod:`scenarios.schema.columns`) and the one rule for missing and non-finite values
 (:mod:`~scenarios.output.tables`), output directories, their
-manifest and staged commits (:mod:`~scenarios.output.directory`), the figures' data as arrays
+manifest and staged commits (:mod:`~scenarios.output.directory`), writing a run's files into one
+(:mod:`~scenarios.output.writer`), the figures' data as arrays
 (:mod:`~scenarios.output.plot_data`), the matplotlib drawing (:mod:`~scenarios.output.plots`) and
 the plot process that draws while the run goes on (:mod:`~scenarios.output.renderer`).
 
@@ -31,7 +32,7 @@ _HOMES = {"Renderer": "scenarios.output.renderer",
           "to_json": "scenarios.output.tables",
           "to_markdown": "scenarios.output.tables",
           "to_terminal": "scenarios.output.tables",
-          "write_results": "scenarios.output.directory"}
+          "write_results": "scenarios.output.writer"}
 
 __all__ = ["Renderer", "Row", "RunResults", "claim_output_directory", "flatten_row", "read_manifest",
            "row_columns", "row_stems", "sanitize", "to_csv", "to_dataframe", "to_json", "to_markdown", "to_terminal",

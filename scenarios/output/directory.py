@@ -1,4 +1,4 @@
-"""Output directories that slewbench owns, and writing a run's results into them safely.
+"""Output directories that slewbench owns: the marker and manifest, staging, claims and commits.
 
 The rules (:doc:`/outputs`, "What slewbench writes, and what it never touches"):
 
@@ -11,32 +11,27 @@ The rules (:doc:`/outputs`, "What slewbench writes, and what it never touches"):
 * New results are written into a staging folder inside the marked directory, then moved into place
   file by file, and the manifest is marked complete last: an interrupted run leaves a manifest that
   says "incomplete", and its staging folder is removed by the next run that writes there.
-* :func:`row_stems` gives every row a distinct, bounded file name whatever its label.
+* :func:`~scenarios.output.names.row_stems` gives every row a distinct, bounded file name whatever
+  its label; :mod:`scenarios.output.writer` writes a run's files through these rules.
 """
 from __future__ import annotations
 
 import contextlib
-import csv
 import fcntl
 import json
 import os
 import shutil
-import sys
 import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Iterator
 
-import numpy as np
-
 from scenarios.errors import OutputError
-from scenarios.output.names import row_stems
-from scenarios.output.tables import csv_cell, to_csv, to_json, to_markdown
 
 if TYPE_CHECKING:
-    from scenarios.output.results import Row, RunResults
+    pass
 
 __all__ = ["MARKER", "STAGING_PREFIX", "claim_output_directory", "commit_outputs", "new_staging",
-           "read_manifest", "write_manifest", "write_results", "write_timeseries"]
+           "read_manifest", "write_manifest"]
 
 MARKER = ".slewbench-output.json"
 STAGING_PREFIX = ".slewbench-staging-"
@@ -212,42 +207,6 @@ def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
     return directory
 
 
-def write_timeseries(row: Row, path: Path) -> None:
-    """Write a row's closed-loop time series as CSV.
-
-    Columns: ``t`` [s], ``q0..q3`` (body to inertial, scalar first), ``omega_x..z`` [rad/s, body],
-    ``h_w0..`` [N m s], ``u_x..z`` the applied body torque [N m, body] held from ``t`` (blank on
-    the last line), ``ref_q0..3`` and ``ref_omega_x..z`` [rad/s] (blank without a reference).
-    Non-finite values are blank (:func:`scenarios.output.tables.csv_cell`).
-
-    Parameters
-    ----------
-    row : Row
-        A result row with a ``simulation`` (and its ``reference``, or ``None``).
-    path : Path
-        The CSV file to write.
-    """
-    sim = row.simulation
-    if sim is None:
-        raise ValueError(f"row {row.label!r} has no closed-loop simulation to write")
-    n_w = sim.wheel_momentum.shape[1]
-    header = (["t", "q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z"]
-              + [f"h_w{i}" for i in range(n_w)] + ["u_x", "u_y", "u_z"]
-              + ["ref_q0", "ref_q1", "ref_q2", "ref_q3", "ref_omega_x", "ref_omega_y", "ref_omega_z"])
-    torque = np.vstack([sim.applied_torque, np.full((1, 3), np.nan)])
-    if row.reference is not None:
-        sample = row.reference.sample(sim.t)
-        ref = np.hstack([sample.q, sample.omega])
-    else:
-        ref = np.full((sim.t.size, 7), np.nan)
-    table = np.hstack([sim.t[:, None], sim.x, torque, ref])
-    with path.open("w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(header)
-        for line in table:
-            writer.writerow([csv_cell(float(v)) for v in line])
-
-
 def _relative_files(root: Path) -> list[str]:
     return sorted(str(p.relative_to(root)) for p in root.rglob("*") if p.is_file())
 
@@ -308,65 +267,3 @@ def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
     write_manifest(directory, new, complete=True, kind=kind)
     shutil.rmtree(staging, ignore_errors=True)
     return new
-
-
-def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer: Any) -> None:
-    """The run's figures into ``staging``: by the plot process if there is one, else (or if it
-    fails) in this process."""
-    from scenarios.output.plot_data import plot_jobs
-
-    jobs = plot_jobs(results, stems)
-    if renderer is not None:
-        from scenarios.output.renderer import RenderingFailed
-
-        try:
-            renderer.draw(jobs, staging)
-            return
-        except RenderingFailed as error:
-            print(f"slewbench: {error}; drawing the plots in this process", file=sys.stderr)
-    from scenarios.output.plots import draw_jobs
-
-    draw_jobs(jobs, staging)
-
-
-def write_results(results: RunResults, directory: str | Path, plots: bool = True, renderer: Any = None) -> Path:
-    """Write ``results.json/csv/md``, ``timeseries/<row>.csv`` and the PNG plots into ``directory``.
-
-    The directory is claimed first (:func:`claim_output_directory`); the files are staged inside
-    it and committed together (:func:`commit_outputs`).
-
-    Parameters
-    ----------
-    results : RunResults
-        The rows of a scenario run.
-    directory : str or Path
-        The output directory.
-    plots : bool, optional
-        Also draw the PNG figures.
-    renderer : scenarios.output.renderer.Renderer, optional
-        A plot process to draw them (:mod:`scenarios.output.renderer`); if it fails, they are drawn in this
-        process after a one-line notice on stderr. ``None``: drawn in this process.
-
-    Returns
-    -------
-    Path
-        The absolute output directory.
-    """
-    target = claim_output_directory(directory)
-    staging = new_staging(target)
-    try:
-        (staging / "results.json").write_text(to_json(results))
-        (staging / "results.csv").write_text(to_csv(results))
-        (staging / "results.md").write_text(to_markdown(results))
-        series = staging / "timeseries"
-        series.mkdir()
-        stems = row_stems([row.label for row in results.rows])
-        for row, stem in zip(results.rows, stems):
-            if row.simulation is not None:
-                write_timeseries(row, series / f"{stem}.csv")
-        if plots:
-            _write_plots(results, staging, stems, renderer)
-        commit_outputs(target, staging, kind="run")
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
-    return target

@@ -3,7 +3,7 @@
 :class:`Row` is one row; :meth:`Row.to_dict` is its plain, nested form, the one ``results.json``
 writes and a trade study stores for each case (a crashed case's rows are :class:`Row` too).
 :class:`RunResults` holds a run's rows and renders them (:mod:`scenarios.output.tables`,
-:mod:`scenarios.output.directory`). The flat form of a row (``ref.<metric>``, ``cl.<metric>``
+:mod:`scenarios.output.writer`). The flat form of a row (``ref.<metric>``, ``cl.<metric>``
 columns) is derived from :meth:`Row.to_dict` by :func:`scenarios.output.tables.flatten_row`.
 """
 from __future__ import annotations
@@ -89,7 +89,7 @@ class Row:
 class RunResults:
     """Rows of a scenario run. ``to_json``, ``to_csv``, ``to_markdown``, ``to_dataframe`` and
     ``write`` render them (implemented in :mod:`scenarios.output.tables` and
-    :mod:`scenarios.output.directory`).
+    :mod:`scenarios.output.writer`).
 
     Parameters
     ----------
@@ -176,5 +176,5 @@ class RunResults:
         renderer : scenarios.output.renderer.Renderer, optional
             A plot process to draw them (``None``: drawn in this process).
         """
-        from scenarios.output.directory import write_results
+        from scenarios.output.writer import write_results
         write_results(self, directory, plots=plots, renderer=renderer)

@@ -3,7 +3,7 @@
 What lives here: the study's data (:mod:`~scenarios.study.types`), scenario paths as a study spells
 them (:mod:`~scenarios.study.paths`), dispersions (:mod:`~scenarios.study.dispersions`), reading a
 study and expanding it into cases (:mod:`~scenarios.study.spec`; the study file's keys are declared
-in :mod:`scenarios.schema.study`), the crash-safe store
+in :mod:`scenarios.schema.study`), the crash-safe store and the sweep directory that holds it
 (:mod:`~scenarios.study.store`), what a worker runs (:mod:`~scenarios.study.worker`), the engine on a
 local pool or Dask (:mod:`~scenarios.study.engine`), and the report's tables
 (:mod:`~scenarios.study.report`) and figures (:mod:`~scenarios.study.plots`).

@@ -14,17 +14,17 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import yaml
 
-from scenarios.errors import OutputError
 from scenarios.output.directory import (
-    MARKER,
-    claim_output_directory,
-    commit_outputs,
     new_staging,
-    read_manifest,
-    write_manifest,
 )
-from scenarios.output.tables import csv_text, flatten_row, is_missing, row_columns, text_cell
-from scenarios.study.store import STORE_NAME, is_sweep_store
+from scenarios.output.tables import (
+    csv_text,
+    flatten_row,
+    is_missing,
+    row_columns,
+    text_cell,
+)
+from scenarios.study.store import claim_sweep_directory, commit_sweep_outputs
 from scenarios.study.types import Study, package_version
 
 if TYPE_CHECKING:  # the engine imports this module lazily
@@ -144,50 +144,6 @@ def resolved_study(study: Study) -> dict[str, Any]:
     return data
 
 
-STORE_FILES = (STORE_NAME, f"{STORE_NAME}-wal", f"{STORE_NAME}-shm")
-
-
-def claim_sweep_directory(path: str | Path) -> Path:
-    """Claim ``path`` for a sweep (:func:`scenarios.output.directory.claim_output_directory`) and list the
-    store's files in its manifest. A ``sweep.sqlite`` already there must be a slewbench store.
-
-    Parameters
-    ----------
-    path : str or Path
-        The output directory (created if absent).
-
-    Returns
-    -------
-    Path
-        The claimed directory.
-
-    Raises
-    ------
-    OutputError
-        As :func:`~scenarios.output.directory.claim_output_directory`, or for a ``sweep.sqlite`` that is not
-        a slewbench sweep store (it is left untouched).
-    """
-    directory = claim_output_directory(path, kind="sweep")
-    if (directory / STORE_NAME).exists() and not is_sweep_store(directory):
-        raise OutputError(path, f"holds a {STORE_NAME} that is not a slewbench sweep store; nothing was touched")
-    manifest = read_manifest(directory) or {"files": [], "complete": False}
-    write_manifest(directory, set(manifest["files"]) | set(STORE_FILES), complete=bool(manifest.get("complete")),
-                    kind="sweep")
-    return directory
-
-
-def _commit(directory: Path, staging: Path) -> list[str]:
-    """Commit the staged report (:func:`scenarios.output.directory.commit_outputs`, which removes listed files
-    the new set lacks) with the store's files kept out of its reach and listed again after."""
-    manifest = read_manifest(directory)
-    if manifest is None:
-        raise OutputError(directory, f"lost its {MARKER} while running; nothing was replaced")
-    write_manifest(directory, [f for f in manifest["files"] if f not in STORE_FILES], complete=False, kind="sweep")
-    written = commit_outputs(directory, staging, kind="sweep")
-    write_manifest(directory, [*written, *STORE_FILES], complete=True, kind="sweep")
-    return written
-
-
 def write_report(results: SweepResults, directory: str | Path, plots: bool = True) -> list[str]:
     """Write the study's tables, resolved study and (``plots``) figures into ``directory``.
 
@@ -223,6 +179,6 @@ def write_report(results: SweepResults, directory: str | Path, plots: bool = Tru
             from scenarios.study.plots import write_plots
             (staging / "plots").mkdir()
             write_plots(study, rows, staging / "plots")
-        return _commit(directory, staging)
+        return commit_sweep_outputs(directory, staging)
     finally:
         shutil.rmtree(staging, ignore_errors=True)

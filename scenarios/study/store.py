@@ -1,4 +1,4 @@
-"""The crash-safe store of a trade study: SQLite in WAL mode in the output directory.
+"""The crash-safe store of a trade study (SQLite in WAL mode) and the sweep directory that holds it.
 
 Every finished case is one row, committed at once, keyed by the hash of its resolved scenario and
 the package version (:func:`scenarios.study.types.case_key`). A process killed at any moment leaves
@@ -9,6 +9,11 @@ A case's rows are stored in their plain form (:meth:`scenarios.output.results.Ro
 non-finite numbers as JSON ``null`` (:func:`scenarios.output.tables.json_safe`). A store written by
 an earlier slewbench (:data:`EARLIER_FORMATS`) opens for reading only (``--report``); its rows are
 read in today's form.
+
+The directory that holds the store is an output directory slewbench owns
+(:mod:`scenarios.output.directory`): :func:`claim_sweep_directory` claims it with the store's files
+listed in its manifest, and :func:`commit_sweep_outputs` commits a report beside the store without
+ever replacing it.
 """
 from __future__ import annotations
 
@@ -20,6 +25,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from scenarios.errors import OutputError
+from scenarios.output.directory import (
+    MARKER,
+    claim_output_directory,
+    commit_outputs,
+    read_manifest,
+    write_manifest,
+)
 from scenarios.output.tables import json_safe
 
 STORE_NAME = "sweep.sqlite"
@@ -221,3 +234,69 @@ class SweepStore:
 
     def __len__(self) -> int:
         return int(self._db.execute("SELECT COUNT(*) FROM cases").fetchone()[0])
+
+
+STORE_FILES = (STORE_NAME, f"{STORE_NAME}-wal", f"{STORE_NAME}-shm")
+"""The store's files (SQLite's write-ahead log and shared memory included): listed in the manifest, never
+replaced by a report."""
+
+
+def claim_sweep_directory(path: str | Path) -> Path:
+    """Claim ``path`` for a sweep (:func:`scenarios.output.directory.claim_output_directory`) and list the
+    store's files in its manifest. A ``sweep.sqlite`` already there must be a slewbench store.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output directory (created if absent).
+
+    Returns
+    -------
+    Path
+        The claimed directory.
+
+    Raises
+    ------
+    OutputError
+        As :func:`~scenarios.output.directory.claim_output_directory`, or for a ``sweep.sqlite`` that is not
+        a slewbench sweep store (it is left untouched).
+    """
+    directory = claim_output_directory(path, kind="sweep")
+    if (directory / STORE_NAME).exists() and not is_sweep_store(directory):
+        raise OutputError(path, f"holds a {STORE_NAME} that is not a slewbench sweep store; nothing was touched")
+    manifest = read_manifest(directory) or {"files": [], "complete": False}
+    write_manifest(directory, set(manifest["files"]) | set(STORE_FILES), complete=bool(manifest.get("complete")),
+                    kind="sweep")
+    return directory
+
+
+def commit_sweep_outputs(directory: Path, staging: Path) -> list[str]:
+    """Commit a staged report into a sweep directory, the store's files kept out of the commit's reach.
+
+    :func:`scenarios.output.directory.commit_outputs` removes listed files the new set lacks; the
+    store's files are taken off the manifest for the commit and listed again after it.
+
+    Parameters
+    ----------
+    directory : Path
+        The claimed sweep directory (:func:`claim_sweep_directory`).
+    staging : Path
+        The staging folder inside it holding the new report's files.
+
+    Returns
+    -------
+    list of str
+        The report's files, relative to ``directory``.
+
+    Raises
+    ------
+    OutputError
+        The directory lost slewbench's marker while the sweep ran.
+    """
+    manifest = read_manifest(directory)
+    if manifest is None:
+        raise OutputError(directory, f"lost its {MARKER} while running; nothing was replaced")
+    write_manifest(directory, [f for f in manifest["files"] if f not in STORE_FILES], complete=False, kind="sweep")
+    written = commit_outputs(directory, staging, kind="sweep")
+    write_manifest(directory, [*written, *STORE_FILES], complete=True, kind="sweep")
+    return written
