@@ -31,7 +31,10 @@ from planners.reference import (
     Reference,
 )
 
-__all__ = ["Planner"]
+__all__ = ["REQUIREMENT_KINDS", "Planner"]
+
+REQUIREMENT_KINDS: tuple[str, ...] = ("pointing", "actuators", "rate")
+"""The requirement kinds a planner may honour (:attr:`Planner.honours`)."""
 
 
 class Planner(Configurable, ABC):
@@ -60,6 +63,12 @@ class Planner(Configurable, ABC):
     * ``example_options`` lists option sets for the conformance test.
     * ``closed_form``: its references are closed-form expressions of time and implement
       :meth:`Reference.symbolic_evaluator` (``slewbench codegen`` exports them as C).
+    * ``honours`` names the scenario requirements (:data:`REQUIREMENT_KINDS`) the planner imposes
+      on its references: ``"pointing"`` (``problem.pointing``, every window and moving direction
+      included), ``"actuators"`` (the actuators' limits tightened by ``problem.actuator_margin``),
+      ``"rate"`` (``problem.max_rate``). A planner that honours a kind guarantees its reference
+      meets it (checked densely, not only at its own points) or returns a failed reference; one that
+      does not still plans, and the scenario scores what it made.
 
     Parameters
     ----------
@@ -86,6 +95,9 @@ class Planner(Configurable, ABC):
 
     closed_form: ClassVar[bool] = False
     """Whether its references implement :meth:`Reference.symbolic_evaluator`."""
+
+    honours: ClassVar[frozenset[str]] = frozenset()
+    """The requirement kinds (of :data:`REQUIREMENT_KINDS`) the planner imposes on its references."""
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options",
                  cache: SolverCache | None = None) -> None:

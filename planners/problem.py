@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp import AttitudeModel, Environment, Spacecraft
+from ocp.geometry import PointingConstraint
 
 Array = NDArray[np.float64]
 
@@ -46,8 +47,15 @@ class ManeuverProblem:
         Initial wheel momenta [N m s], one per wheel of ``spacecraft``; ``None`` (default): zero.
         Stored as an array after construction.
     max_rate : float or None, optional
-        Bound on the body rate norm [rad/s] for planners that honour it (``maneuver.max_rate``);
-        ``None`` (default): no bound.
+        Bound on the body rate norm [rad/s] for planners that honour it (``maneuver.max_rate``,
+        ``requirements.rate``); ``None`` (default): no bound.
+    pointing : tuple of ocp.geometry.PointingConstraint, optional
+        Pointing requirements (keep-out and keep-in cones, their directions tabulated along the
+        run) for planners that honour them (:attr:`planners.base.Planner.honours`); default none.
+    actuator_margin : float or None, optional
+        The actuator requirement: a reference may ask at most ``(1 - actuator_margin)`` of each
+        actuator limit (torque, momentum, dipole), in [0, 1). ``None`` (default): no requirement
+        beyond the limits themselves.
     """
 
     spacecraft: Spacecraft
@@ -59,6 +67,8 @@ class ManeuverProblem:
     environment: Environment = field(default_factory=Environment)
     wheel_momentum0: Array | None = None
     max_rate: float | None = None
+    pointing: tuple[PointingConstraint, ...] = ()
+    actuator_margin: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.spacecraft, Spacecraft):
@@ -78,6 +88,12 @@ class ManeuverProblem:
         if self.max_rate is not None and (not isinstance(self.max_rate, (int, float, np.floating))
                                           or not np.isfinite(self.max_rate) or not self.max_rate > 0):
             raise ValueError(f"max_rate must be a finite positive rate (rad/s) or None, got {self.max_rate!r}")
+        object.__setattr__(self, "pointing", tuple(self.pointing))
+        if not all(isinstance(c, PointingConstraint) for c in self.pointing):
+            raise TypeError("pointing must hold ocp.geometry.PointingConstraint objects")
+        if self.actuator_margin is not None and not (isinstance(self.actuator_margin, (int, float, np.floating))
+                                                     and 0.0 <= self.actuator_margin < 1.0):
+            raise ValueError(f"actuator_margin must lie in [0, 1) or be None, got {self.actuator_margin!r}")
 
     @property
     def torque_limit(self) -> Array:

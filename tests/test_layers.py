@@ -2,8 +2,8 @@
 
 * No import runs back up. Packages: ``ocp`` < ``planners`` < ``controllers`` < ``scenarios``. Inside
   them the layers of :data:`GROUPS` may import what :data:`ALLOWED` lists (``ocp``: its top-level
-  modules < ``dynamics`` < ``simulation``, ``transcription``; ``nlp`` beside them; ``scenarios``:
-  errors < schema < output < runner < codegen < study < cli < console). Every import counts,
+  modules < ``dynamics`` < ``geometry``, ``simulation``, ``transcription`` (which imports ``geometry``);
+  ``nlp`` beside them; ``scenarios``: errors < requirements < schema < output < runner < codegen < study < cli < console). Every import counts,
   inside functions too, except those under ``if TYPE_CHECKING:``; importing a face counts as
   importing every module it covers. A face may import its own package's modules.
 * A module's ``__all__`` lists only names it defines (faces excepted); no docstring or comment says
@@ -32,6 +32,7 @@ GROUPS: dict[str, tuple[str, ...]] = {
     # ocp: the top-level modules, then the subpackages
     "ocp": ("ocp.errors", "ocp.options", "ocp.quat", "ocp.quat_casadi", "ocp.cache", "ocp.fast_call", "ocp.metrics"),
     "ocp.dynamics": ("ocp.dynamics",),
+    "ocp.geometry": ("ocp.geometry",),
     "ocp.simulation": ("ocp.simulation",),
     "ocp.transcription": ("ocp.transcription",),
     "ocp.nlp": ("ocp.nlp",),
@@ -50,6 +51,7 @@ GROUPS: dict[str, tuple[str, ...]] = {
     "controllers.two_wheel": ("controllers.two_wheel",),
     # scenarios, from the bottom up
     "scenarios.errors": ("scenarios.errors", "scenarios._faces"),
+    "scenarios.requirements": ("scenarios.requirements",),
     "scenarios.schema": ("scenarios.schema",),
     "scenarios.output": ("scenarios.output",),
     "scenarios.runner": ("scenarios.runner",),
@@ -60,13 +62,14 @@ GROUPS: dict[str, tuple[str, ...]] = {
 }
 """Layers inside the packages, by module (or subpackage) name."""
 
-_SCENARIOS = ["scenarios.errors", "scenarios.schema", "scenarios.output", "scenarios.runner", "scenarios.codegen",
+_SCENARIOS = ["scenarios.errors", "scenarios.requirements", "scenarios.schema", "scenarios.output", "scenarios.runner", "scenarios.codegen",
               "scenarios.study", "scenarios.cli", "scenarios.console"]
 ALLOWED: dict[str, set[str]] = {
     "ocp": {"ocp"},
     "ocp.dynamics": {"ocp", "ocp.dynamics"},
+    "ocp.geometry": {"ocp", "ocp.dynamics", "ocp.geometry"},
     "ocp.simulation": {"ocp", "ocp.dynamics", "ocp.simulation"},
-    "ocp.transcription": {"ocp", "ocp.dynamics", "ocp.transcription"},
+    "ocp.transcription": {"ocp", "ocp.dynamics", "ocp.geometry", "ocp.transcription"},
     "ocp.nlp": {"ocp", "ocp.nlp"},
     "planners": {"planners"},
     "planners.collocation": {"planners", "planners.collocation"},
