@@ -227,7 +227,7 @@ def test_a_table_interpolated_linearly_is_within_1e_4_deg_between_rows(kind, orb
     elements = ORBITS[orbit]
     epoch = datetime.datetime(2024, 4, 8, 18)   # near a perigee of the Moon (and the eclipse): fast Moon
     times, directions, growth = direction_table(kind, geometry_of(elements, epoch), 7200.0)
-    constraint = PointingConstraint(kind, [1.0, 0.0, 0.0], True, 0.5, times=times, directions=directions,
+    constraint = PointingConstraint(kind, np.array([1.0, 0.0, 0.0]), True, 0.5, times=times, directions=directions,
                                     growth=growth)
     h = np.diff(times)
     between = np.concatenate([times[:-1] + f * h for f in FRACTIONS])
@@ -247,7 +247,7 @@ def test_the_step_is_not_far_finer_than_the_tolerance_needs():
         assert step is not None
         times = np.arange(0.0, 7200.0, 3.0 * step)
         table, _ = exact(name, elements, EPOCH, times)
-        constraint = PointingConstraint(name, [1.0, 0.0, 0.0], True, 0.5, times=times, directions=table)
+        constraint = PointingConstraint(name, np.array([1.0, 0.0, 0.0]), True, 0.5, times=times, directions=table)
         between = np.concatenate([times[:-1] + f * 3.0 * step for f in FRACTIONS])
         assert angle_deg(constraint.direction(between), exact(name, elements, EPOCH, between)[0]).max() \
             > np.degrees(INTERPOLATION_TOLERANCE)

@@ -95,7 +95,7 @@ def test_the_sun_at_the_2000_march_equinox_lies_20_arcsec_ahead_of_the_true_equi
                          np.sin(longitude) * np.sin(obliquity)])
     of_date = erfa.pnm06a(*tt_by_hand(epoch)) @ sun
     assert angle_deg(of_date, expected)[0] < 3.0 / 3600.0
-    assert angle_deg(of_date, [1.0, 0.0, 0.0])[0] > 15.0 / 3600.0         # not the apparent Sun
+    assert angle_deg(of_date, np.array([1.0, 0.0, 0.0]))[0] > 15.0 / 3600.0         # not the apparent Sun
 
 
 # --- time scales and leap seconds -----------------------------------------------------------------
@@ -174,8 +174,10 @@ def test_check_epoch_accepts_the_range_and_rejects_a_run_that_leaves_it():
     low, high = EPHEMERIS_RANGE
     assert check_epoch("2025-06-01T00:00:00Z", 86400.0) == datetime.datetime(2025, 6, 1)
     assert check_epoch(low) == low and check_epoch(high - datetime.timedelta(seconds=10), 10.0)
-    for epoch, duration in [(low - datetime.timedelta(seconds=1), 0.0), (high, 1.0),
-                            (high - datetime.timedelta(hours=1), 7200.0), ("1950-01-01", 0.0), ("2250-01-01", 0.0)]:
+    outside: list[tuple[datetime.datetime | str, float]] = [
+        (low - datetime.timedelta(seconds=1), 0.0), (high, 1.0), (high - datetime.timedelta(hours=1), 7200.0),
+        ("1950-01-01", 0.0), ("2250-01-01", 0.0)]
+    for epoch, duration in outside:
         with pytest.raises(ModelError, match=r"DE421\) covers 1960-01-01 to 2200-01-01") as error:
             check_epoch(epoch, duration)
         assert error.value.field == "epoch"

@@ -30,7 +30,7 @@ def sweep(t: np.ndarray, rate: float = W) -> np.ndarray:
 
 
 def cone(keep_out: bool = True, angle: float = ALPHA, **kwargs) -> PointingConstraint:
-    return PointingConstraint("tracker", [2.0, 0.0, 0.0], keep_out, angle, directions=kwargs.pop("directions", Y),
+    return PointingConstraint("tracker", np.array([2.0, 0.0, 0.0]), keep_out, angle, directions=kwargs.pop("directions", Y),
                               **kwargs)
 
 
