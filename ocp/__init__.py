@@ -9,8 +9,11 @@ subpackages it names:
   algebra), :mod:`~ocp.cache` (solver caches), :mod:`~ocp.fast_call` (low-overhead calls of CasADi
   functions), :mod:`~ocp.metrics` (the common score);
 * :mod:`ocp.dynamics`: the spacecraft, its actuators and environment, the assembled model;
+* :mod:`ocp.geometry`: pointing constraints and the directions they are measured from (the Sun,
+  the Moon, the Earth, the orbital velocity; imports :mod:`ocp.dynamics`);
 * :mod:`ocp.simulation`: the closed-loop simulator (imports :mod:`ocp.dynamics`);
-* :mod:`ocp.transcription`: optimal-control problems and their NLPs (imports :mod:`ocp.dynamics`);
+* :mod:`ocp.transcription`: optimal-control problems and their NLPs (imports :mod:`ocp.dynamics`
+  and :mod:`ocp.geometry`);
 * :mod:`ocp.nlp`: solving NLPs and the second-order check (imports neither of the above).
 
 Conventions throughout: SI units; quaternions scalar first ``[q0, q1, q2, q3]``, Hamilton product,
