@@ -287,3 +287,24 @@ def test_block_derivatives_with_moving_windowed_cones_and_a_rate_norm_equal_casa
     np.testing.assert_allclose(stages.jac_g(w, p)[1].full(), jacobian(w, p).full(), rtol=1e-12, atol=1e-12)
     full = hessian(w, p, *multipliers).full()
     np.testing.assert_allclose(stages.hess_lag(w, p, *multipliers).full(), np.triu(full), rtol=1e-10, atol=1e-10)
+
+
+def test_the_symbolic_constraint_agrees_with_the_margins_inside_and_beyond_its_table():
+    # What the NLP imposes (cos θ − cos(limit) <= 0) and what the dense check and the scenario score
+    # (the margin θ − limit) must agree in sign everywhere, before and after the direction table too
+    # (held there; CasADi's linear interpolant alone would extrapolate).
+    import casadi as ca
+
+    table = np.arange(10.0, 50.0 + 1e-9, 5.0)
+    cone = PointingConstraint("nadir", [1, 0, 0], True, np.deg2rad(20.0), table, nadir_like(table),
+                              growth=np.linspace(0.0, 0.1, table.size))
+    q, t = ca.SX.sym("q", 4), ca.SX.sym("t")
+    g = ca.Function("g", [q, t], [cone.expression(q, t)])
+    rng = np.random.default_rng(5)
+    times = np.concatenate([[0.0, 5.0, 55.0, 60.0], rng.uniform(0.0, 60.0, 40)])
+    attitudes = quat.random_unit(rng, times.size)
+    margins = cone.margins(times, attitudes)
+    values = np.array([float(g(a, s)) for a, s in zip(attitudes, times)])
+    limits = cone.limit(times)
+    # cos θ − cos(limit) against the margin θ − limit, both exact
+    np.testing.assert_allclose(values, np.cos(limits + margins) - np.cos(limits), atol=1e-12)

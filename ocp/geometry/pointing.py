@@ -362,9 +362,10 @@ class PointingConstraint:
             direction: Any = ca.DM(self.directions[0])
             limit: Any = self.angle + float(np.asarray(self.growth)[0])
         else:
-            raw = tables[0](t)
+            held = ca.fmin(ca.fmax(t, float(self.times[0])), float(self.times[-1]))  # held beyond the table, as in NumPy
+            raw = tables[0](held)
             direction = raw / ca.norm_2(raw)
-            limit = self.angle + tables[1](t)
+            limit = self.angle + tables[1](held)
         cosine = ca.dot(pointing, direction) / ca.norm_2(pointing)
         return cosine - ca.cos(limit) if self.keep_out else ca.cos(limit) - cosine
 
