@@ -101,7 +101,8 @@ def endpoint_cone_error(constraints: tuple[PointingConstraint, ...], q0: Array, 
                 broken.append(f"{constraint.name}: the {label} attitude puts the boresight {np.rad2deg(angle):.4g} deg "
                               f"from the direction, {side} the cone of {np.rad2deg(limit):.4g} deg (the angle "
                               f"tightened by cone_margin_deg" + (", its window imposed over the whole run with a "
-                                                                 "free final time" if free_time else "") + ")")
+                                                                 "free final time: a fixed final time imposes it "
+                                                                 "in its window only" if free_time else "") + ")")
     return "; ".join(broken) or None
 
 

@@ -70,10 +70,10 @@ class Tightening:
         Per pointing requirement, in their order: how much tighter its cone is imposed [rad]
         (``cone_margin_deg`` at first).
     rate : float
-        Fraction of ``max_rate`` taken off the imposed rate-norm bound.
+        Fraction of ``max_rate`` taken off the imposed rate-norm bound, in [0, 1).
     actuators : float
         Fraction of the required actuator limits (``1 − actuator_margin`` of the limits) taken off
-        the imposed bounds.
+        the imposed bounds, in [0, 1).
     """
 
     pointing: tuple[float, ...] = ()
@@ -100,9 +100,11 @@ class Tightening:
     def after(self, check: DenseCheck, requirements: Requirements) -> Tightening:
         """The tightening for the next solve, after a dense check found violations.
 
-        Every broken requirement is tightened further by 1.5 times its violation plus a floor
-        (:data:`POINTING_STEP` [rad] for a cone, :data:`BOUND_STEP` of the limit for a bound); the
-        others are left as they are.
+        Every broken requirement is tightened further: a cone by 1.5 times its violation plus
+        :data:`POINTING_STEP` [rad]; a bound's imposed value is divided by ``1 + 1.5 v +``
+        :data:`BOUND_STEP`, ``v`` its violation as a fraction of it (an overshoot between the points
+        scales with the bound, so this takes it below the bound in one round when the solution keeps
+        its shape). The others are left as they are.
 
         Parameters
         ----------
@@ -120,9 +122,12 @@ class Tightening:
             for c, extra in zip(requirements.pointing, self.pointing))
         rate = check.violations.get("rate", 0.0)
         actuators = max((v for name, v in check.violations.items() if name.startswith("actuators.")), default=0.0)
-        return replace(self, pointing=pointing,
-                       rate=self.rate + (1.5 * rate + BOUND_STEP if rate else 0.0),
-                       actuators=self.actuators + (1.5 * actuators + BOUND_STEP if actuators else 0.0))
+
+        def further(taken: float, violation: float) -> float:
+            return 1.0 - (1.0 - taken) / (1.0 + 1.5 * violation + BOUND_STEP) if violation else taken
+
+        return replace(self, pointing=pointing, rate=further(self.rate, rate),
+                       actuators=further(self.actuators, actuators))
 
 
 POINTING_STEP = float(np.deg2rad(1e-3))
