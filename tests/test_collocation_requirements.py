@@ -308,3 +308,12 @@ def test_the_symbolic_constraint_agrees_with_the_margins_inside_and_beyond_its_t
     limits = cone.limit(times)
     # cos θ − cos(limit) against the margin θ − limit, both exact
     np.testing.assert_allclose(values, np.cos(limits + margins) - np.cos(limits), atol=1e-12)
+
+
+def test_a_free_final_time_imposes_a_window_over_the_whole_run_and_says_so():
+    # min_time does not know its points' times before the solve: a windowed keep-in that the start
+    # breaks before its window is then refused at once, the message saying why.
+    window = PointingConstraint("keep_in", [1, 0, 0], False, np.deg2rad(30.0), directions=[[0, 1, 0]],
+                                window=(30.0, 60.0))
+    reference = PLANNERS["collocation"]({"objective": "min_time"}).plan(plane_slew([window]))
+    assert not reference.ok and "keep_in" in reference.message and "fixed final time" in reference.message
