@@ -66,9 +66,11 @@ class Planner(Configurable, ABC):
     * ``honours`` names the scenario requirements (:data:`REQUIREMENT_KINDS`) the planner imposes
       on its references: ``"pointing"`` (``problem.pointing``, every window and moving direction
       included), ``"actuators"`` (the actuators' limits tightened by ``problem.actuator_margin``),
-      ``"rate"`` (``problem.max_rate``). A planner that honours a kind guarantees its reference
-      meets it (checked densely, not only at its own points) or returns a failed reference; one that
-      does not still plans, and the scenario scores what it made.
+      ``"rate"`` (``problem.max_rate``). A planner that honours a kind imposes it and checks its
+      reference densely (not only at its own points); a reference that still misses returns as a
+      failed reference, or keeps its status and says in its message and stats by how much it
+      misses (``collocation`` does: ``stats["dense_check"]``). One that does not honour a kind still
+      plans, and the scenario scores what it made, as it scores every row.
 
     Parameters
     ----------

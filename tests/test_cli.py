@@ -87,10 +87,9 @@ BAD_INPUTS = {
     "bad warm start option": (lambda d: d["planners"].append({"name": "collocation", "label": "c",
                                                               "options": {"warm_start_options": {"profile": "fast"}}}),
                               "planners[2].options", "warm_start_options.profile"),
-    "shooting with a cone": (lambda d: d["planners"].append({"name": "collocation", "label": "c", "options": {
-        "transcription": "multiple_shooting",
-        "keep_out": [{"boresight": [1, 0, 0], "direction": [0, 1, 0], "angle_deg": 10}]}}),
-                             "planners[2].options", "use transcription: collocation"),
+    "shooting with an L1 cost": (lambda d: d["planners"].append({"name": "collocation", "label": "c", "options": {
+        "transcription": "multiple_shooting", "objective": "min_l1"}}),
+                                 "planners[2].options", "use transcription: collocation"),
     "unknown warm start": (lambda d: d["planners"].append({"name": "collocation", "label": "c",
                                                            "options": {"warm_start": "magic"}}),
                            "planners[2].options", "not another registered planner"),

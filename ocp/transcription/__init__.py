@@ -7,14 +7,15 @@ transcription shares (:mod:`~ocp.transcription.stagewise`), one module per metho
 multipliers between meshes (:mod:`~ocp.transcription.mesh_transfer`). ``TRANSCRIPTIONS`` maps the
 ``transcription`` option to the class; planners construct one with ``from_options``.
 
-May import: :mod:`ocp.dynamics` and the top-level modules of :mod:`ocp`; never
+May import: :mod:`ocp.dynamics`, :mod:`ocp.geometry` (the pointing constraints a problem imposes) and
+the top-level modules of :mod:`ocp`; never
 :mod:`ocp.simulation` or :mod:`ocp.nlp` (a transcription builds an NLP; it does not solve it).
 """
 from __future__ import annotations
 
 from ocp.transcription.base import Transcription
 from ocp.transcription.mesh_transfer import transfer_multipliers
-from ocp.transcription.problem import NLP, Cone, Interval, OptimalControlProblem
+from ocp.transcription.problem import NLP, Interval, OptimalControlProblem
 from ocp.transcription.radau import RadauCollocation, lagrange, radau_weights
 from ocp.transcription.shooting import MultipleShooting
 
@@ -23,7 +24,6 @@ TRANSCRIPTIONS: dict[str, type[Transcription]] = {cls.name: cls for cls in (Rada
 __all__ = [
            "NLP",
            "TRANSCRIPTIONS",
-           "Cone",
            "Interval",
            "MultipleShooting",
            "OptimalControlProblem",

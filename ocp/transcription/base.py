@@ -88,7 +88,8 @@ class Transcription(ABC):
         l1 : bool
             The cost has an L1 term.
         cones : bool
-            The problem has pointing cones.
+            The problem has path constraints (pointing cones or a rate-norm bound,
+            :meth:`OptimalControlProblem.path_constraints`).
 
         Returns
         -------

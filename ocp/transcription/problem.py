@@ -1,8 +1,9 @@
 r"""What an optimal-control problem asks for, and what a transcription builds from it.
 
-:class:`OptimalControlProblem` (objective weights, free final time, final rate, pointing
-:class:`Cone`\ s) is the problem; :class:`Interval` is one mesh interval as a transcription builds
-it and :class:`NLP` the assembled, built problem (see :mod:`ocp.transcription.base`).
+:class:`OptimalControlProblem` (objective weights, free final time, final rate, path constraints:
+pointing cones as :class:`~ocp.geometry.PointingConstraint`\ s and a bound on the body-rate norm)
+is the problem; :class:`Interval` is one mesh interval as a transcription builds it and :class:`NLP`
+the assembled, built problem (see :mod:`ocp.transcription.base`).
 """
 from __future__ import annotations
 
@@ -13,51 +14,10 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ocp import quat_casadi as qc
 from ocp.dynamics.model import AttitudeModel
+from ocp.geometry import PointingConstraint
 
 Array = NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class Cone:
-    """Pointing constraint: the body ``boresight`` stays at least (keep-out) or at most (keep-in)
-    ``angle`` from the inertial unit ``direction``.
-
-    Parameters
-    ----------
-    boresight : (3,) tuple of float
-        Unit vector, body axes.
-    direction : (3,) tuple of float
-        Unit vector, inertial frame.
-    angle : float
-        Cone half-angle [rad].
-    keep_out : bool
-        ``True``: the boresight stays outside the cone; ``False``: inside.
-    """
-
-    boresight: tuple[float, float, float]
-    direction: tuple[float, float, float]
-    angle: float
-    keep_out: bool = True
-
-    def expression(self, q: Any) -> Any:
-        """The constraint as ``g <= 0`` (satisfied when non-positive).
-
-        Parameters
-        ----------
-        q : (4,) CasADi expression
-            Attitude quaternion (scalar first, body to inertial).
-
-        Returns
-        -------
-        CasADi scalar expression
-            Cosine of the boresight-direction angle minus ``cos(angle)`` (keep-out), or the
-            negative (keep-in).
-        """
-        pointing = ca.mtimes(qc.rotation_matrix(q), ca.DM(self.boresight))
-        cosine = ca.dot(pointing, ca.DM(self.direction))
-        return cosine - np.cos(self.angle) if self.keep_out else np.cos(self.angle) - cosine
 
 
 @dataclass(frozen=True)
@@ -78,8 +38,21 @@ class OptimalControlProblem:
         T is a decision variable (bounded by the problem's duration) instead of a parameter.
     fixed_final_rate : bool
         The final body rate is constrained to ``ω_f``.
-    cones : tuple of Cone
-        Pointing constraints along the path.
+    cones : tuple of ocp.geometry.PointingConstraint
+        Pointing constraints along the path, as imposed (a planner passes them already tightened);
+        a moving direction is evaluated at each point's own time.
+    max_rate : float or None
+        Bound on the body-rate norm ``‖ω‖`` [rad/s], imposed where the cones are; ``None``: none
+        (a per-axis bound is a bound on the state variables instead, set by the planner).
+
+    Notes
+    -----
+    Windows. With a fixed final time a transcription's points have known times (``T`` is a
+    parameter), and a cone whose window does not cover the whole run is switched off at the points
+    outside it: its constraint there is the constant ``-1`` (``if_else`` on the parameters, no
+    discontinuity in the decision variables). With a free final time the points' times are
+    unknown before the solve, and a windowed cone is imposed over the whole run (conservative: a
+    superset of its window).
     """
 
     model: AttitudeModel
@@ -88,7 +61,8 @@ class OptimalControlProblem:
     time_weight: float = 0.0
     free_time: bool = False
     fixed_final_rate: bool = True
-    cones: tuple[Cone, ...] = ()
+    cones: tuple[PointingConstraint, ...] = ()
+    max_rate: float | None = None
 
     @property
     def uses_slack(self) -> bool:
@@ -120,20 +94,44 @@ class OptimalControlProblem:
             cost += self.l1_weight * ca.sum1(slack)
         return cost
 
-    def path_constraints(self, x: Any) -> list[Any]:
-        """The cones' constraints at one state.
+    @property
+    def n_path(self) -> int:
+        """Number of path constraints at each point (:meth:`path_constraints`)."""
+        return len(self.cones) + (self.max_rate is not None)
+
+    def path_constraints(self, x: Any, t: Any) -> list[Any]:
+        """The cones' constraints and the rate-norm bound at one point.
 
         Parameters
         ----------
         x : (nx,) CasADi expression
-            Model state (its first four entries are the quaternion).
+            Model state (its first four entries are the quaternion, the next three the body rate).
+        t : CasADi scalar
+            The point's time [s] (a moving direction is interpolated there; a window is tested
+            there when the final time is fixed).
 
         Returns
         -------
         list of CasADi scalar expressions
-            One ``g <= 0`` per cone.
+            :attr:`n_path` constraints ``g <= 0``: one per cone
+            (:meth:`~ocp.geometry.PointingConstraint.expression`, the constant ``-1`` outside its
+            window), then ``‖ω‖² / max_rate² − 1`` with a rate bound.
         """
-        return [cone.expression(x[0:4]) for cone in self.cones]
+        constraints = []
+        for cone in self.cones:
+            g = cone.expression(x[0:4], t)
+            start, end = cone.window
+            if not self.free_time and (start > 0.0 or np.isfinite(end)):
+                inside = 1
+                if start > 0.0:
+                    inside = inside * (t >= start)
+                if np.isfinite(end):
+                    inside = inside * (t <= end)
+                g = ca.if_else(inside, g, -1.0)
+            constraints.append(g)
+        if self.max_rate is not None:
+            constraints.append(ca.sumsqr(x[4:7]) / self.max_rate**2 - 1.0)
+        return constraints
 
 
 @dataclass

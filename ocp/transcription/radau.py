@@ -140,9 +140,11 @@ class RadauCollocation(Transcription):
                 inequalities += [s_j - torque, s_j + torque]
             cost += h * self.quadrature[j - 1] * problem.stage_cost(x_j, u_j, t_j, s_j)
         cones = []
-        points = [X[:, j] for j in range(1, d + 1)] + [ca.mtimes(X, ca.DM(w)) for w in self.midpoint_weights]
-        for state in [X[:, 0]] + points:
-            cones += problem.path_constraints(state)
+        if problem.n_path:
+            # the node, the Radau points and the midpoints between them (positions()), each at its time
+            states = [X[:, j] for j in range(d + 1)] + [ca.mtimes(X, ca.DM(w)) for w in self.midpoint_weights]
+            for state, tau in zip(states, self._path_points()):
+                cones += problem.path_constraints(state, t0 + h * tau)
         path = ca.vertcat(*equalities, *inequalities, *cones)
         n_eq, n_ineq = nx * d, 6 * d if n_slack else 0
         lower = np.concatenate([np.zeros(n_eq), np.zeros(n_ineq), np.full(len(cones), -np.inf)])
@@ -154,12 +156,17 @@ class RadauCollocation(Transcription):
         model, tau = problem.model, self.tau
         slack = 3 if problem.uses_slack else 0  # per Radau point (_sizes)
         c = np.concatenate([np.repeat(tau[1:], model.nx), np.repeat(tau[1:], model.nu), np.repeat(tau[1:], slack)])
-        # collocation equations and slack inequalities at the Radau points; cones at the node,
-        # the Radau points and the midpoints between them (the order of interval())
-        cone_points = np.concatenate([tau[:1], tau[1:], 0.5 * (tau[:-1] + tau[1:])])
+        # collocation equations and slack inequalities at the Radau points; cones (and the rate
+        # norm) at the node, the Radau points and the midpoints between them (the order of interval())
         path = np.concatenate([np.repeat(tau[1:], model.nx), np.repeat(tau[1:], 2 * slack),
-                               np.repeat(cone_points, len(problem.cones))])
+                               np.repeat(self._path_points(), problem.n_path)])
         return c, path
+
+    def _path_points(self) -> Array:
+        """Where the path constraints are imposed, as fractions of the interval: the node, the
+        Radau points and the midpoints between consecutive points."""
+        tau = self.tau
+        return np.concatenate([tau, 0.5 * (tau[:-1] + tau[1:])])
 
     def stage_bounds(self, problem: OptimalControlProblem, x_low: Array, x_high: Array, u_low: Array,
                      u_high: Array) -> tuple[Array, Array, Array, Array]:

@@ -4,8 +4,9 @@ Controls are piecewise linear and continuous. To keep the stage-wise structure (
 state carries the control at the mesh point, ``s_k = [x_k, u_k]``, and the interval's variable is
 the next control, ``c_k = u_{k+1}``; the gap conditions are ``x_{k+1} = Φ(x_k, u_k, u_{k+1})``
 (``substeps`` RK4 steps, the running cost integrated as an extra state by the same RK4) and
-``u_{k+1} = c_k``. The interval is expanded to SX (one compact function mapped over the mesh).
-States between nodes: cubic Hermite with the model's derivatives.
+``u_{k+1} = c_k``. Path constraints (cones, the rate norm) hold at the end of every RK4 step, at its
+time (the initial state is given). The interval is expanded to SX (one compact function mapped over
+the mesh). States between nodes: cubic Hermite with the model's derivatives.
 """
 from __future__ import annotations
 
@@ -45,9 +46,8 @@ class MultipleShooting(Transcription):
 
     @classmethod
     def problem_error(cls, l1: bool, cones: bool) -> str | None:
-        if l1 or cones:
-            return ("multiple_shooting supports energy and time objectives without cones; "
-                    "use transcription: collocation for L1 costs and keep-out / keep-in cones")
+        if l1:
+            return "multiple_shooting supports energy and time objectives; use transcription: collocation for L1 costs"
         return None
 
     def state_of(self, s: Any) -> Any:
@@ -68,15 +68,20 @@ class MultipleShooting(Transcription):
             return ca.vertcat(model.dynamics(state[:nx], control, t, dist), problem.stage_cost(state[:nx], control, t))
 
         state = ca.vertcat(x, 0)
+        path = []
         for m in range(M):
             state = rk4_step(augmented, state, t0 + h * m, h)
+            # path constraints at the end of every RK4 step, at its time (positions())
+            path += problem.path_constraints(state[:nx], t0 + h * (m + 1))
         function = ca.Function("shooting_interval", [s, u1, t0, h_interval, dist],
-                               [ca.vertcat(state[:nx], u1), ca.DM.zeros(0, 1), state[nx]])
-        return Interval(function, nx + nu, nu, np.zeros(0), np.zeros(0))
+                               [ca.vertcat(state[:nx], u1), ca.vertcat(*path) if path else ca.DM.zeros(0, 1),
+                                state[nx]])
+        return Interval(function, nx + nu, nu, np.full(len(path), -np.inf), np.zeros(len(path)))
 
     def positions(self, problem: OptimalControlProblem, interval: Interval) -> tuple[Array, Array]:
-        # c_k is the control at the interval's end; no path constraints
-        return np.ones(interval.n_interval), np.zeros(0)
+        # c_k is the control at the interval's end; path constraints at the ends of the RK4 steps
+        steps = np.arange(1, self.substeps + 1) / self.substeps
+        return np.ones(interval.n_interval), np.repeat(steps, problem.n_path)
 
     def step_scaled_gaps(self, problem: OptimalControlProblem, interval: Interval) -> NDArray[np.bool_]:
         # x_{k+1} = Φ(...): a costate; u_{k+1} = c_k: O(h) (the control's stationarity)

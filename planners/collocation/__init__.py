@@ -1,10 +1,11 @@
 """``collocation``: direct optimal control on the full model, the workbench's numerical reference.
 
 What lives here: the planner and its options (:mod:`~planners.collocation.planner`), the problem
-side (pointing cones from YAML, variable bounds from the spacecraft;
-:mod:`~planners.collocation.problem`), the reference of a solution and seeds from other references
-(:mod:`~planners.collocation.reference`) and the search strategy's tuned constants
-(:mod:`~planners.collocation.strategy`).
+side (its own cones from YAML, the endpoints checked against the pointing constraints, variable
+bounds from the spacecraft; :mod:`~planners.collocation.problem`), the reference of a solution and
+seeds from other references, bent round keep-out cones (:mod:`~planners.collocation.reference`),
+the requirements it honours and their dense check (:mod:`~planners.collocation.requirements`) and
+the search strategy's tuned constants (:mod:`~planners.collocation.strategy`).
 
 May import: :mod:`ocp` (transcriptions and the NLP core) and the contract modules of
 :mod:`planners` (``base``, ``problem``, ``reference``); other planners only through the

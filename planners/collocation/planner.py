@@ -4,7 +4,12 @@ Objectives: ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt
 ``min_time`` (free T, the scenario's T is the upper bound), and ``weighted``
 (``energy_weight``, ``l1_weight``, ``time_weight``). τ is the actuators' body torque.
 Constraints: actuator bounds (wheel torques, dipoles, torquers), wheel momentum bounds, a body-rate
-bound ``max_rate`` (per axis), fixed or free final rate, keep-out / keep-in cones.
+bound ``max_rate`` (option, per axis), fixed or free final rate, keep-out / keep-in cones (options).
+It honours every requirement of the problem (:attr:`CollocationPlanner.honours`): the pointing
+constraints ``problem.pointing`` (moving directions and windows included), the actuator limits
+tightened by ``problem.actuator_margin`` and the body-rate norm ``‖ω‖ <= problem.max_rate``; each
+converged reference is checked against them between its points and solved again tighter where it
+breaks one (:mod:`planners.collocation.requirements`; see :meth:`CollocationPlanner.plan`).
 The transcription (``collocation``: Legendre-Gauss-Radau, or ``multiple_shooting``) comes from
 :data:`ocp.transcription.TRANSCRIPTIONS` and owns its layout (bounds, seeding, interpolation); the
 NLP (IPOPT or FATROP) is built once per problem structure into the planner's ``SolverCache``.
@@ -45,13 +50,25 @@ from planners.collocation.problem import (
 )
 from planners.collocation.reference import (
     CollocationReference,
+    cone_avoiding_sampler,
+    cone_sides,
     seed_sampler,
     solution_sampler,
+)
+from planners.collocation.requirements import (
+    DENSE_POINTS,
+    DenseCheck,
+    Requirements,
+    Tightening,
+    dense_check,
+    imposed_pointing,
 )
 from planners.collocation.strategy import (
     AUTO_FIRST,
     AUTO_RESTART,
+    DENSE_ROUNDS,
     POLISH_MU_INIT,
+    SEED_CONE_PAD,
     SEED_FATROP,
     SEED_TOLERANCE,
     TRANSFER_L1_BARRIER,
@@ -125,11 +142,15 @@ class CollocationOptions:
     energy_weight, l1_weight, time_weight : float
         Weights of ``weighted`` [1/(N² m² s), 1/(N m s), 1/s].
     max_rate : float or None
-        Body-rate bound per axis [rad/s]; ``None``: none.
+        Body-rate bound per axis [rad/s] (a box on ω at the points, not checked between them);
+        ``None``: none. The problem's ``max_rate`` (``maneuver.max_rate``, ``requirements.rate``)
+        is a bound on the norm ‖ω‖, honoured besides it.
     keep_out, keep_in : list of dict
-        Cones ``{boresight (body), direction (inertial), angle_deg}``.
+        Cones ``{boresight (body), direction (inertial), angle_deg}`` over the whole run, honoured
+        as the problem's pointing constraints are (named ``keep_out[i]``, ``keep_in[i]``).
     cone_margin_deg : float
-        Cones are imposed this much tighter [deg], so that they hold between the points.
+        Every cone (these and the problem's) is imposed this much tighter [deg] at first, so that
+        it holds between the points; the dense check tightens further where needed.
     tolerance : float
         Solver tolerance (scaled KKT error); the coarse seed of a fixed final time
         (``coarse_intervals``) is solved to 1e-5 at the tightest
@@ -154,7 +175,7 @@ class CollocationOptions:
     energy_weight: Annotated[float, Range(ge=0.0)] = 1.0               # for objective "weighted"
     l1_weight: Annotated[float, Range(ge=0.0)] = 0.0
     time_weight: Annotated[float, Range(ge=0.0)] = 0.0
-    max_rate: Annotated[float | None, Range(gt=0.0)] = None  # rad/s, per body axis
+    max_rate: Annotated[float | None, Range(gt=0.0)] = None  # rad/s, per body axis (the problem's: the norm)
     keep_out: list[dict] = field(default_factory=list)  # {boresight, direction, angle_deg}
     keep_in: list[dict] = field(default_factory=list)
     cone_margin_deg: Annotated[float, Range(ge=0.0, lt=90.0)] = 0.01            # cones are imposed this much tighter, so that they
@@ -219,22 +240,63 @@ class _Optimum:
 
 
 class CollocationPlanner(Planner):
-    """Direct optimal control planner (see the module docstring)."""
+    """Direct optimal control planner (see the module docstring).
+
+    How it honours the problem's requirements (:attr:`honours`): before any solve, a pointing
+    constraint that the initial attitude (at t = 0) or the final one (at t = T) breaks inside its
+    window is a failed reference naming it. After each successful solve the reference is checked
+    on :data:`~planners.collocation.requirements.DENSE_POINTS` points per mesh interval against the
+    requirements as stated (:func:`~planners.collocation.requirements.dense_check`: pointing
+    margins, the body-rate norm, the actuator limits less ``actuator_margin``); what it breaks is
+    imposed tighter (:meth:`~planners.collocation.requirements.Tightening.after`) and solved again
+    from the solution and its multipliers, at most :data:`~planners.collocation.strategy.DENSE_ROUNDS`
+    times. A reference that still breaks one keeps its status (it is a solution, only not within
+    the requirement everywhere); its message states the residual violation, and
+    ``stats["dense_check"]`` records the rounds, the least margins [deg] and the violations (a
+    scenario scores such a row violated). A start whose boresight enters a keep-out cone is bent
+    round it first (:meth:`_seeds`).
+    """
 
     name = "collocation"
     example_options = ({"intervals": 20}, {"intervals": 20, "transcription": "multiple_shooting"})
+    honours = frozenset({"pointing", "actuators", "rate"})
 
     class Options(CollocationOptions):
         __doc__ = CollocationOptions.__doc__
 
-    def _ocp(self, problem: ManeuverProblem) -> OptimalControlProblem:
+    def problem_error(self, problem: ManeuverProblem) -> str | None:
+        error = super().problem_error(problem)
+        if error is None and (problem.pointing or problem.max_rate is not None):
+            o = self.options
+            l1 = o.objective == "min_l1" or (o.objective == "weighted" and o.l1_weight > 0)
+            refused = TRANSCRIPTIONS[o.transcription].problem_error(l1, True)
+            if refused:
+                return f"options.transcription: {refused} (the pointing or rate requirements are path constraints)"
+        return error
+
+    def _requirements(self, problem: ManeuverProblem) -> Requirements:
+        """The problem's requirements and the options' cones, as stated."""
+        o = self.options
+        cones = tuple(parse_cone(c, True, where=f"keep_out[{i}]") for i, c in enumerate(o.keep_out))
+        cones += tuple(parse_cone(c, False, where=f"keep_in[{i}]") for i, c in enumerate(o.keep_in))
+        return Requirements(tuple(problem.pointing) + cones, problem.max_rate, problem.actuator_margin)
+
+    def _ocp(self, problem: ManeuverProblem, tightening: Tightening | None = None) -> OptimalControlProblem:
+        """The optimal-control problem, its requirements imposed with ``tightening`` (default the
+        first solve's: the cones by ``cone_margin_deg``); a ``ValueError`` names a cone that the
+        tightening leaves empty."""
         o = self.options
         weights = {"min_energy": (1.0, 0.0, 0.0), "min_l1": (0.0, 1.0, 0.0), "min_time": (0.0, 0.0, 1.0),
                    "weighted": (o.energy_weight, o.l1_weight, o.time_weight)}[o.objective]
-        margin = np.deg2rad(o.cone_margin_deg)
-        cones = tuple(parse_cone(c, True, margin) for c in o.keep_out) + tuple(parse_cone(c, False, margin) for c in o.keep_in)
-        return OptimalControlProblem(problem.model, *weights, free_time=weights[2] > 0,
-                                     fixed_final_rate=problem.omegaf is not None, cones=cones)
+        free_time = weights[2] > 0
+        requirements = self._requirements(problem)
+        if tightening is None:
+            tightening = Tightening.initial(requirements, float(np.deg2rad(o.cone_margin_deg)))
+        cones = imposed_pointing(requirements, tightening, None if free_time else problem.duration / o.intervals,
+                                 problem.duration)
+        max_rate = None if requirements.max_rate is None else requirements.max_rate * (1.0 - tightening.rate)
+        return OptimalControlProblem(problem.model, *weights, free_time=free_time,
+                                     fixed_final_rate=problem.omegaf is not None, cones=cones, max_rate=max_rate)
 
     def _nlp(self, problem: ManeuverProblem, ocp: OptimalControlProblem, mode: _Mode = "cold",
              intervals: int | None = None, solver: str | None = None) -> tuple[Transcription, NLP]:
@@ -264,7 +326,7 @@ class CollocationPlanner(Planner):
         # The extra options in the key: a shared cache also serves planners whose options differ
         # (a FATROP seed with SEED_FATROP and a FATROP mesh without it can share all else).
         key = (ocp.energy_weight, ocp.l1_weight, ocp.time_weight, ocp.free_time, ocp.fixed_final_rate, ocp.cones,
-               o.transcription, intervals, o.degree, o.substeps, solver, tolerance, o.max_iterations, mode,
+               ocp.max_rate, o.transcription, intervals, o.degree, o.substeps, solver, tolerance, o.max_iterations, mode,
                tuple(sorted((extra or {}).items())))
 
         def build() -> tuple[Transcription, NLP]:
@@ -276,9 +338,14 @@ class CollocationPlanner(Planner):
         # The model's numbers are baked into the graph: a shared cache needs them in the key.
         return self.solver_cache(problem).get(("collocation", problem.model.fingerprint, key), build)
 
-    def _variable_bounds(self, problem: ManeuverProblem) -> tuple[Array, Array, Array, Array]:
-        """Per-point bounds of the model state and the actuator controls."""
-        return variable_bounds(problem, self.options.max_rate)
+    def _variable_bounds(self, problem: ManeuverProblem,
+                         tightening: Tightening | None = None) -> tuple[Array, Array, Array, Array]:
+        """Per-point bounds of the model state and the actuator controls: the actuators' limits
+        scaled by ``1 − actuator_margin`` and by ``1 − tightening.actuators``."""
+        scale = 1.0 - (problem.actuator_margin or 0.0)
+        if tightening is not None:
+            scale *= 1.0 - tightening.actuators
+        return variable_bounds(problem, self.options.max_rate, scale)
 
     def _starts(self, problem: ManeuverProblem, failures: list[str] | None = None) -> list[Reference]:
         """The references of the warm start and the seed planners that planned; each failure's
@@ -295,10 +362,16 @@ class CollocationPlanner(Planner):
         return starts
 
     def _guesses(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
-                 seeds: list[Array]) -> tuple[list[Array], list[Array], float]:
+                 seeds: list[Array], alternates: list[Array] | None = None) -> tuple[list[Array], list[Array], float]:
         """The starts (the warm start or its perturbed copies, then the seed planners' starts), the
-        fallback starts (tried only if none of those converged) and the relative size of the
-        restarts from the best point (0: none)."""
+        fallback starts (tried only if none of those converged: ``alternates`` last) and the
+        relative size of the restarts from the best point (0: none)."""
+        starts, fallback, restart = self._policy(problem, ocp, transcription, nlp, seeds)
+        return starts, fallback + list(alternates or []), restart
+
+    def _policy(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
+                seeds: list[Array]) -> tuple[list[Array], list[Array], float]:
+        """The ``multistart`` policy of :meth:`_guesses`."""
         count = self.options.multistart
         if count == "auto":
             # A warm start can sit exactly on a stationary point (the eigenaxis slew is one for minimum
@@ -328,16 +401,17 @@ class CollocationPlanner(Planner):
 
     def _solve(self, problem: ManeuverProblem, ocp: OptimalControlProblem, seeds: list[Array], params: Array,
                bounds: tuple[Array, Array], intervals: int, near_optimum: bool = False,
-               solver: str | None = None) -> tuple[NLPResult, dict, NLPResult | None]:
+               solver: str | None = None,
+               alternates: list[Array] | None = None) -> tuple[NLPResult, dict, NLPResult | None]:
         """Solve ``ocp`` on ``intervals`` from ``seeds`` by the multistart policy (``near_optimum``:
         from the one seed given, near the optimum, see :meth:`_nlp`); with ``time_regularization``,
         solve the regularised problem so and polish plain minimum time from its optimum and
         multipliers (the regularised solve is returned third, ``None`` without one); ``solver`` as
-        in :meth:`_nlp`."""
+        in :meth:`_nlp`; ``alternates``: further fallback starts (:meth:`_seeds`)."""
         o = self.options
         transcription, nlp = self._nlp(problem, ocp, "near_optimum" if near_optimum else "cold", intervals, solver)
         guesses, fallback, restart = ((seeds, [], 0.0) if near_optimum
-                                      else self._guesses(problem, ocp, transcription, nlp, seeds))
+                                      else self._guesses(problem, ocp, transcription, nlp, seeds, alternates))
         agree = 1 if near_optimum else o.agree
         lbx, ubx = bounds
         if not o.time_regularization:
@@ -382,11 +456,14 @@ class CollocationPlanner(Planner):
         return o.solver
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
-        o = self.options
-        names = [f"keep_out[{i}]" for i in range(len(o.keep_out))] + [f"keep_in[{i}]" for i in range(len(o.keep_in))]
-        broken = endpoint_cone_error(self._ocp(problem).cones, names, problem.q0, problem.qf)
+        try:
+            ocp = self._ocp(problem)
+        except ValueError as error:
+            return FailedReference(self.name, f"a pointing constraint leaves no cone once tightened by "
+                                              f"cone_margin_deg: {error}")
+        broken = endpoint_cone_error(ocp.cones, problem.q0, problem.qf, problem.duration, ocp.free_time)
         if broken:
-            return FailedReference(self.name, f"no trajectory meets the cones: {broken}")
+            return FailedReference(self.name, f"no trajectory meets the pointing constraints: {broken}")
         failures: list[str] = []
         starts = self._starts(problem, failures)
         if not starts:
@@ -395,12 +472,104 @@ class CollocationPlanner(Planner):
         return self._plan_from(problem, starts)
 
     def _plan_from(self, problem: ManeuverProblem, starts: list[Reference]) -> Reference:
-        """Plan from the given start references (see the module docstring)."""
+        """Plan from the given start references (see the module docstring), then honour the
+        requirements between the points (:meth:`_honoured`)."""
         ocp = self._ocp(problem)
         omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf
         params = np.concatenate([problem.initial_state, problem.qf, omegaf, [problem.duration],
                                  problem.model.default_parameters])
-        return self._reference(problem, ocp, params, self._optimum(problem, ocp, starts, params, self.options.intervals))
+        solved = self._optimum(problem, ocp, starts, params, self.options.intervals)
+        return self._honoured(problem, params, solved, self._reference(problem, ocp, params, solved))
+
+    def _honoured(self, problem: ManeuverProblem, params: Array, solved: _Optimum, reference: Reference) -> Reference:
+        """``reference`` checked densely against the requirements, and solved again tighter while it
+        breaks one (see :meth:`plan`)."""
+        requirements = self._requirements(problem)
+        if not requirements.any or not isinstance(reference, CollocationReference):
+            return reference
+        tightening = Tightening.initial(requirements, float(np.deg2rad(self.options.cone_margin_deg)))
+        check = dense_check(problem, reference, requirements)
+        rounds: list[dict] = []
+        stopped = ""
+        while not check.met and len(rounds) < DENSE_ROUNDS:
+            tightening = tightening.after(check, requirements)
+            try:
+                ocp = self._ocp(problem, tightening)
+            except ValueError as error:
+                stopped = f"; cannot tighten further: {error}"
+                break
+            again = self._resolved(problem, ocp, params, solved, tightening)
+            candidate = self._reference(problem, ocp, params, again)
+            rounds.append({"violations": dict(check.violations), "iterations": again.result.iterations,
+                           "time_s": again.result.time_s, "status": again.result.status})
+            if not isinstance(candidate, CollocationReference):
+                stopped = f"; the tightened solve failed ({candidate.message})"
+                break
+            solved, reference = again, candidate
+            check = dense_check(problem, reference, requirements)
+        reference.stats["dense_check"] = self._dense_stats(requirements, tightening, check, rounds)
+        if not check.met:
+            reference.message += (f"; still breaks {check.summary()} between the mesh points after "
+                                   f"{len(rounds)} tightening rounds{stopped} (try more intervals, a larger "
+                                   f"cone_margin_deg or a longer duration)")
+        return reference
+
+    @staticmethod
+    def _dense_stats(requirements: Requirements, tightening: Tightening, check: DenseCheck,
+                     rounds: list[dict]) -> dict:
+        """The ``dense_check`` entry of a reference's stats (see :meth:`plan`)."""
+        return {"points_per_interval": DENSE_POINTS, "points": check.points, "rounds": len(rounds),
+                "met": check.met, "margins_deg": dict(check.margins_deg), "violations": dict(check.violations),
+                "tightening_deg": {c.name: float(np.rad2deg(extra))
+                                   for c, extra in zip(requirements.pointing, tightening.pointing)},
+                "rate_tightening": tightening.rate, "actuator_tightening": tightening.actuators,
+                "round_solves": rounds}
+
+    def _resolved(self, problem: ManeuverProblem, ocp: OptimalControlProblem, params: Array, solved: _Optimum,
+                  tightening: Tightening) -> _Optimum:
+        """``ocp`` (tightened) solved on the mesh of ``solved`` from its optimum and multipliers
+        (IPOPT's warm start of :data:`TRANSFER_WARM_START`: near, not at, the new optimum), else from
+        its optimum alone."""
+        o, x = self.options, solved.result.x
+        assert x is not None  # a converged solve
+        transcription, nlp = self._nlp(problem, ocp, "transfer", solved.intervals, solved.solver)
+        lbx, ubx = transcription.bounds(ocp, nlp, *self._variable_bounds(problem, tightening), problem.duration)
+        result = solve_multistart(nlp.solver, [x], p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg, agree=1,
+                                  lam_x0=solved.result.lam_x, lam_g0=solved.result.lam_g)
+        if not result.success and (o.solver if solved.solver is None else solved.solver) == "ipopt":
+            _, cold = self._nlp(problem, ocp, "near_optimum", solved.intervals, solved.solver)
+            result = merged(result, solve_multistart(cold.solver, [x], p=params, lbx=lbx, ubx=ubx, lbg=cold.lbg,
+                                                     ubg=cold.ubg, agree=1))
+        return _Optimum(result, {}, transcription, nlp, solved.intervals, None, solved.solver)
+
+    def _seeds(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
+               starts: list[Reference]) -> tuple[list[Array], list[Array]]:
+        """The decision vectors of the start references, and alternates tried only if none converges.
+
+        A start whose boresight enters a keep-out cone is bent round it
+        (:func:`~planners.collocation.reference.cone_avoiding_sampler`, :data:`SEED_CONE_PAD`
+        outside the cone) on the side where it passes nearest the rim. The first start bent round
+        the other side is a start too when it passes within half the cone's angle of the centre
+        (neither side is clearly better: the solve keeps the better optimum), else an alternate;
+        the first start as it was is the last alternate."""
+        seeds: list[Array] = []
+        alternates: list[Array] = []
+        for index, reference in enumerate(starts):
+            duration = reference.duration if ocp.free_time else problem.duration
+            sample = seed_sampler(problem, reference)
+            sides, central = cone_sides(sample, ocp.cones, duration) if ocp.cones else ([], False)
+            if not any(side is not None for side in sides):
+                seeds.append(transcription.seed(ocp, nlp, sample, duration))
+                continue
+            seeds.append(transcription.seed(ocp, nlp, cone_avoiding_sampler(sample, ocp.cones, sides, SEED_CONE_PAD),
+                                            duration))
+            if index == 0:
+                opposite = [None if side is None else -side for side in sides]
+                other = transcription.seed(ocp, nlp, cone_avoiding_sampler(sample, ocp.cones, opposite, SEED_CONE_PAD),
+                                           duration)
+                (seeds if central else alternates).append(other)
+                alternates.append(transcription.seed(ocp, nlp, sample, duration))
+        return seeds, alternates
 
     def _optimum(self, problem: ManeuverProblem, ocp: OptimalControlProblem, starts: list[Reference], params: Array,
                  intervals: int, solver: str | None = None) -> _Optimum:
@@ -441,9 +610,9 @@ class CollocationPlanner(Planner):
                     result = polish if result is None else merged(result, polish)
                     extra.update(more)
         if result is None or not result.success:
-            seeds = [transcription.seed(ocp, nlp, seed_sampler(problem, ref),
-                                        ref.duration if ocp.free_time else problem.duration) for ref in starts]
-            fine, more, regularized = self._solve(problem, ocp, seeds, params, bounds, intervals, solver=solver)
+            seeds, alternates = self._seeds(problem, ocp, transcription, nlp, starts)
+            fine, more, regularized = self._solve(problem, ocp, seeds, params, bounds, intervals, solver=solver,
+                                                  alternates=alternates)
             result = fine if result is None else merged(result, fine)
             extra.update(more)
         return _Optimum(result, extra, transcription, nlp, intervals, regularized, solver)
@@ -498,15 +667,19 @@ class CollocationPlanner(Planner):
         stats = result.stats()
         stats.update(solved.extra, transcription=transcription.name, intervals=solved.intervals, solver=solver)
         if not result.success:
+            hint = (" (with pointing or rate constraints, try multistart: 4, more intervals, a larger "
+                    "cone_margin_deg or a longer duration)" if ocp.cones or ocp.max_rate is not None else "")
             return FailedReference(self.name, f"{solver} did not converge from any start: "
-                                   f"{sorted(set(result.statuses))}", result.status, stats=stats)
+                                   f"{sorted(set(result.statuses))}{hint}", result.status, stats=stats)
         assert result.x is not None  # success implies a point
         T, states, controls = (v.full() for v in solved.nlp.unpack(result.x, params))
         T = T.item()
         reference = CollocationReference(problem, transcription, T, states, controls, stats)
         norm_error = float(np.max(np.abs(np.linalg.norm(states[0:4], axis=0) - 1)))
+        # the fixed-direction cones as stated (their angles not tightened), for the cone plots
+        fixed = [c for c in self._requirements(problem).pointing if not c.moving]
         reference.stats.update(duration=T, max_quaternion_norm_error=norm_error,
-                               cones=[(c.boresight, c.direction, c.angle, c.keep_out) for c in ocp.cones])
+                               cones=[(c.boresight, c.directions[0], c.angle, c.keep_out) for c in fixed])
         reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {solver}): "
                              f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}")
         return reference

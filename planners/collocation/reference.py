@@ -1,4 +1,5 @@
-"""The reference of an optimal-control solution, and seeds for the NLP from other references.
+"""The reference of an optimal-control solution, and seeds for the NLP from other references (bent
+round the keep-out cones they enter).
 
 Between its points the solution is interpolated by the transcription itself
 (``Transcription.interpolate``: Lagrange polynomials for collocation, cubic Hermite for shooting).
@@ -13,6 +14,7 @@ from typing import Any, cast
 import numpy as np
 
 from ocp import quat
+from ocp.geometry import PointingConstraint
 from ocp.transcription.base import Transcription
 from planners.problem import Array, ManeuverProblem
 from planners.reference import Reference, ReferenceSample
@@ -166,3 +168,111 @@ def solution_sampler(reference: CollocationReference) -> Callable[[Array], tuple
         return x, u, np.abs(torque)
 
     return sample
+
+
+def cone_sides(sample: Callable[[Array], tuple[Array, Array, Array]], constraints: tuple[PointingConstraint, ...],
+               duration: float, points: int = 401) -> tuple[list[Array | None], bool]:
+    """Per keep-out constraint, the side a seed goes round its cone (:func:`cone_avoiding_sampler`).
+
+    Where the seed's boresight comes nearest the cone's centre, the side is the direction from the
+    centre towards it (on the sphere); when it passes through the centre (within 0.1 deg, the
+    eigenaxis seed of a symmetric case), the side is perpendicular to its path there.
+
+    Parameters
+    ----------
+    sample : callable
+        The seed, ``sample(times) -> (x, u, |τ|)``.
+    constraints : tuple of PointingConstraint
+        The constraints imposed.
+    duration : float
+        The seed's duration [s].
+    points : int, optional
+        Samples of the seed searched for the closest approach.
+
+    Returns
+    -------
+    sides : list of (3,) ndarray or None
+        A unit vector, inertial frame, per constraint (perpendicular to the direction at the
+        closest approach; :func:`cone_avoiding_sampler` projects it on the plane perpendicular to a
+        moving direction); ``None`` for a keep-in or a constraint the seed never enters.
+    central : bool
+        Whether the seed passes within half a cone's angle of its centre, where neither side is
+        clearly nearer.
+    """
+    t = np.linspace(0.0, duration, points)
+    q = quat.normalize(sample(t)[0][:, 0:4])
+    sides: list[Array | None] = []
+    central = False
+    for constraint in constraints:
+        margin = constraint.margins(t, q)
+        if not constraint.keep_out or not np.any(margin < 0.0):
+            sides.append(None)
+            continue
+        pointing, centres = quat.rotate(q, constraint.boresight), constraint.direction(t)
+        nearest = int(np.nanargmin(np.where(np.isfinite(margin), -np.einsum("ij,ij->i", pointing, centres), np.nan)))
+        centre = centres[nearest]
+        central |= bool(pointing[nearest] @ centre > np.cos(0.5 * constraint.limit([t[nearest]])[0]))
+        radial = pointing[nearest] - (pointing[nearest] @ centre) * centre
+        if np.linalg.norm(radial) > np.sin(np.deg2rad(0.1)):
+            sides.append(radial / np.linalg.norm(radial))
+            continue
+        before, after = pointing[max(nearest - 1, 0)], pointing[min(nearest + 1, points - 1)]
+        side = np.cross(centre, after - before)
+        sides.append(side / np.linalg.norm(side) if np.linalg.norm(side) > 0 else None)
+    return sides, central
+
+
+def cone_avoiding_sampler(sample: Callable[[Array], tuple[Array, Array, Array]],
+                          constraints: tuple[PointingConstraint, ...], sides: list[Array | None],
+                          pad: float) -> Callable[[Array], tuple[Array, Array, Array]]:
+    """A seed bent round the keep-out cones it enters.
+
+    The eigenaxis seed of a slew whose boresight passes through a cone's centre is a poor start:
+    the solver must choose a side with nothing to choose it by (one start of the issue's 12U case
+    ran to its iteration limit). Here, where the seed's boresight ``p`` lies within ``limit + pad``
+    of the centre ``d``, the attitude is turned (in inertial axes) about ``d × s``, ``s`` the
+    constraint's side (:func:`cone_sides`), by the least angle that takes ``p`` to ``limit + pad``
+    from ``d``: the boresight then runs along the cone's rim on that side. Body rates, wheel
+    momenta and controls are the seed's own (a start need not be consistent).
+
+    Parameters
+    ----------
+    sample : callable
+        The seed, ``sample(times) -> (x, u, |τ|)``.
+    constraints : tuple of PointingConstraint
+        The constraints imposed (only those with a side are used).
+    sides : list of (3,) ndarray or None
+        :func:`cone_sides` (or the opposite sides).
+    pad : float
+        How far outside the cone the seed is put [rad].
+
+    Returns
+    -------
+    callable
+        ``sample(times) -> (x, u, |τ|)`` with the attitudes bent.
+    """
+
+    def bent(times: Array) -> tuple[Array, Array, Array]:
+        x, u, torque = sample(times)
+        x = np.array(x, dtype=float)
+        q = quat.normalize(x[:, 0:4])
+        for constraint, side in zip(constraints, sides):
+            if side is None:
+                continue
+            centre = constraint.direction(times)
+            sideways = side - (centre @ side)[:, None] * centre
+            sideways /= np.linalg.norm(sideways, axis=1, keepdims=True)
+            pointing = quat.rotate(q, constraint.boresight)
+            a, b = np.einsum("ij,ij->i", pointing, centre), np.einsum("ij,ij->i", pointing, sideways)
+            radius, phase = np.hypot(a, b), np.arctan2(b, a)
+            target = np.cos(constraint.limit(times) + pad)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                reach = np.arccos(np.clip(target / radius, -1.0, 1.0))
+            turn = np.where(constraint.in_window(times) & (a > target) & (radius > np.abs(target)),
+                            np.maximum(reach - phase, 0.0), 0.0)
+            # about d × s: d turns towards s (the boresight away from d, round the side s)
+            q = quat.normalize(quat.product(quat.from_axis_angle(np.cross(centre, sideways), turn), q))
+        x[:, 0:4] = q
+        return x, u, torque
+
+    return bent

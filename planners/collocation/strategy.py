@@ -149,3 +149,10 @@ def merged(first: NLPResult, second: NLPResult) -> NLPResult:
     best = None if second.best_start is None else second.best_start + len(first.starts)
     return replace(second, starts=first.starts + second.starts, iterations=first.iterations + second.iterations,
                    time_s=first.time_s + second.time_s, best_start=best)
+
+DENSE_ROUNDS = 3
+"""Most re-solves, each tighter where the dense check of the last solution found a requirement broken
+between the mesh points (:mod:`planners.collocation.requirements`)."""
+SEED_CONE_PAD = float(np.deg2rad(2.0))
+"""How far outside a keep-out cone a start that enters it is bent [rad]
+(:func:`planners.collocation.reference.cone_avoiding_sampler`)."""

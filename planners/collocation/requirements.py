@@ -1,0 +1,285 @@
+"""The requirements ``collocation`` honours, how much tighter it imposes them, and the dense check.
+
+A problem's requirements (:class:`Requirements`: its pointing constraints and the planner's own
+``keep_out`` / ``keep_in`` cones, the bound on the body-rate norm, the actuator margin) are imposed
+by the NLP at the transcription's points only, and tighter than stated (:class:`Tightening`):
+the cones by ``cone_margin_deg``, a window widened by one mesh interval (:func:`imposed_pointing`).
+Between the points the interpolated solution may still cut a cone or overshoot a bound, so every
+converged reference is checked on a dense grid (:func:`dense_check`, :data:`DENSE_POINTS` points per
+interval) against the requirements **as stated**; the planner tightens what is broken
+(:meth:`Tightening.after`) and solves again from the solution (see
+:class:`~planners.collocation.planner.CollocationPlanner`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ocp.dynamics.layout import actuator_blocks
+from ocp.geometry import PointingConstraint
+from planners.collocation.problem import variable_bounds
+from planners.collocation.reference import CollocationReference
+from planners.problem import ManeuverProblem
+
+__all__ = ["DENSE_POINTS", "DenseCheck", "Requirements", "Tightening", "dense_check", "imposed_pointing"]
+
+DENSE_POINTS = 20
+"""Points per mesh interval of the dense check (equally spaced, the nodes included)."""
+
+
+@dataclass(frozen=True)
+class Requirements:
+    """What a ``collocation`` reference must meet, as stated (not tightened).
+
+    Parameters
+    ----------
+    pointing : tuple of PointingConstraint
+        The problem's pointing requirements, then the planner's own ``keep_out`` and ``keep_in``
+        cones (named ``keep_out[i]``, ``keep_in[i]``).
+    max_rate : float or None
+        Bound on the body-rate norm ``‖ω‖`` [rad/s] (``ManeuverProblem.max_rate``); ``None``: none.
+    actuator_margin : float or None
+        The reference may ask at most ``1 − actuator_margin`` of every actuator limit (torques,
+        dipoles, wheel momenta); ``None``: no actuator requirement (the limits are still imposed at
+        the points, not checked between them).
+    """
+
+    pointing: tuple[PointingConstraint, ...] = ()
+    max_rate: float | None = None
+    actuator_margin: float | None = None
+
+    @property
+    def any(self) -> bool:
+        """Whether there is anything to check densely."""
+        return bool(self.pointing) or self.max_rate is not None or self.actuator_margin is not None
+
+    @property
+    def actuator_scale(self) -> float:
+        """``1 − actuator_margin`` (1 without an actuator requirement)."""
+        return 1.0 - (self.actuator_margin or 0.0)
+
+
+@dataclass(frozen=True)
+class Tightening:
+    """How much tighter than the :class:`Requirements` the NLP imposes them.
+
+    Parameters
+    ----------
+    pointing : tuple of float
+        Per pointing requirement, in their order: how much tighter its cone is imposed [rad]
+        (``cone_margin_deg`` at first).
+    rate : float
+        Fraction of ``max_rate`` taken off the imposed rate-norm bound, in [0, 1).
+    actuators : float
+        Fraction of the required actuator limits (``1 − actuator_margin`` of the limits) taken off
+        the imposed bounds, in [0, 1).
+    """
+
+    pointing: tuple[float, ...] = ()
+    rate: float = 0.0
+    actuators: float = 0.0
+
+    @classmethod
+    def initial(cls, requirements: Requirements, cone_margin: float) -> Tightening:
+        """The first solve's tightening: the cones by ``cone_margin``, nothing else.
+
+        Parameters
+        ----------
+        requirements : Requirements
+            What is required.
+        cone_margin : float
+            ``cone_margin_deg`` [rad].
+
+        Returns
+        -------
+        Tightening
+        """
+        return cls((cone_margin,) * len(requirements.pointing))
+
+    def after(self, check: DenseCheck, requirements: Requirements) -> Tightening:
+        """The tightening for the next solve, after a dense check found violations.
+
+        Every broken requirement is tightened further: a cone by 1.5 times its violation plus
+        :data:`POINTING_STEP` [rad]; a bound's imposed value is divided by ``1 + 1.5 v +``
+        :data:`BOUND_STEP`, ``v`` its violation as a fraction of it (an overshoot between the points
+        scales with the bound, so this takes it below the bound in one round when the solution keeps
+        its shape). The others are left as they are.
+
+        Parameters
+        ----------
+        check : DenseCheck
+            The dense check of the last solution.
+        requirements : Requirements
+            What is required (the order of :attr:`pointing`).
+
+        Returns
+        -------
+        Tightening
+        """
+        pointing = tuple(
+            extra + (1.5 * np.deg2rad(check.violations[c.name]) + POINTING_STEP if check.violations.get(c.name) else 0.0)
+            for c, extra in zip(requirements.pointing, self.pointing))
+        rate = check.violations.get("rate", 0.0)
+        actuators = max((v for name, v in check.violations.items() if name.startswith("actuators.")), default=0.0)
+
+        def further(taken: float, violation: float) -> float:
+            return 1.0 - (1.0 - taken) / (1.0 + 1.5 * violation + BOUND_STEP) if violation else taken
+
+        return replace(self, pointing=pointing, rate=further(self.rate, rate),
+                       actuators=further(self.actuators, actuators))
+
+
+POINTING_STEP = float(np.deg2rad(1e-3))
+"""Floor of a cone's further tightening after a dense check [rad] (1e-3 deg)."""
+BOUND_STEP = 1e-6
+"""Floor of a bound's further tightening after a dense check (fraction of the limit)."""
+BOUND_TOLERANCE = 1e-6
+"""A bound (rate norm, actuator limit) counts as broken by the dense check when exceeded by more
+than this fraction of it: the solver meets an inequality to about 1e-8 of its scale, and its
+variable bounds exactly."""
+
+
+def imposed_pointing(requirements: Requirements, tightening: Tightening, interval: float | None,
+                     duration: float) -> tuple[PointingConstraint, ...]:
+    """The pointing constraints as the NLP imposes them.
+
+    Each is tightened by its :attr:`Tightening.pointing`; with a fixed final time a window that
+    starts after 0 or ends before ``duration`` is widened by one mesh interval on that side (by half
+    the distance to 0 or to ``duration`` when nearer, so that an end the window leaves out stays
+    out), so that the constraint holds at the window's edge between the points where it is imposed.
+
+    Parameters
+    ----------
+    requirements : Requirements
+        What is required.
+    tightening : Tightening
+        How much tighter.
+    interval : float or None
+        The mesh interval [s] (``T / intervals``) with a fixed final time; ``None`` with a free one
+        (windows are then imposed over the whole run, see
+        :class:`~ocp.transcription.OptimalControlProblem`).
+    duration : float
+        The final time [s].
+
+    Returns
+    -------
+    tuple of PointingConstraint
+
+    Raises
+    ------
+    ValueError
+        When a tightened cone is no cone (half-angle outside (0, π)), naming it.
+    """
+    imposed = []
+    for constraint, extra in zip(requirements.pointing, tightening.pointing):
+        cone = constraint.tightened(extra)
+        start, end = cone.window
+        if interval is not None:
+            if start > 0.0:
+                start -= min(interval, 0.5 * start)
+            if end < duration:
+                end += min(interval, 0.5 * (duration - end))
+            cone = replace(cone, window=(start, end))
+        imposed.append(cone)
+    return tuple(imposed)
+
+
+@dataclass(frozen=True)
+class DenseCheck:
+    """A reference checked on a dense grid against the :class:`Requirements` as stated.
+
+    Parameters
+    ----------
+    margins_deg : dict
+        Per pointing requirement (by name): its least margin on the grid inside its window [deg]
+        (negative when broken; ``None`` when no grid point lies in the window).
+    violations : dict
+        Per broken requirement: by how much, in degrees for a pointing requirement (minus its
+        least margin), as a fraction of the required bound for ``"rate"`` (the body-rate norm)
+        and ``"actuators.<block>"`` / ``"actuators.<block>.state"`` (an actuator's controls and
+        states: wheel torques, wheel momenta, dipoles, torquer torques). A requirement met is
+        not listed.
+    points : int
+        Points of the grid.
+    """
+
+    margins_deg: dict[str, float | None]
+    violations: dict[str, float]
+    points: int
+
+    @property
+    def met(self) -> bool:
+        """Whether nothing is broken."""
+        return not self.violations
+
+    def summary(self) -> str:
+        """The violations in words (empty when met).
+
+        Returns
+        -------
+        str
+        """
+        words = []
+        for name, value in self.violations.items():
+            words.append(f"{name} by {value:.3g} deg" if name in self.margins_deg
+                         else f"{name} by {100 * value:.3g} % of its bound")
+        return ", ".join(words)
+
+
+def dense_check(problem: ManeuverProblem, reference: CollocationReference, requirements: Requirements,
+                points_per_interval: int = DENSE_POINTS) -> DenseCheck:
+    """Check a reference between its points against the requirements as stated.
+
+    The grid has ``points_per_interval`` equally spaced points per mesh interval, the nodes
+    included (at a node the controls are read from both intervals that meet there). A pointing
+    requirement is broken where its margin (:meth:`~ocp.geometry.PointingConstraint.margins` on the
+    reference's normalised attitude) is negative; a bound where it is exceeded by more than
+    :data:`BOUND_TOLERANCE` of it.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre (its actuators' limits).
+    reference : CollocationReference
+        The solution to check.
+    requirements : Requirements
+        What is required.
+    points_per_interval : int, optional
+        Grid points per mesh interval (default :data:`DENSE_POINTS`).
+
+    Returns
+    -------
+    DenseCheck
+    """
+    t = np.linspace(0.0, reference.duration, points_per_interval * reference.intervals + 1)
+    sample = reference.sample(t)
+    margins: dict[str, float | None] = {}
+    violations: dict[str, float] = {}
+    for constraint in requirements.pointing:
+        margin = constraint.margins(t, sample.q)
+        least = float(np.rad2deg(np.nanmin(margin))) if np.any(np.isfinite(margin)) else None
+        margins[constraint.name] = least
+        if least is not None and least < 0.0:
+            violations[constraint.name] = -least
+    if requirements.max_rate is not None:
+        excess = float(np.max(np.linalg.norm(sample.omega, axis=1))) / requirements.max_rate - 1.0
+        if excess > BOUND_TOLERANCE:
+            violations["rate"] = excess
+    if requirements.actuator_margin is not None:
+        _, x_high, _, u_high = variable_bounds(problem, None, requirements.actuator_scale)
+        x_right, u_right = reference._state_control(t)
+        x_left, u_left = reference._state_control(t, left=True)
+        controls = np.maximum(np.abs(u_right), np.abs(u_left))
+        states = np.maximum(np.abs(x_right), np.abs(x_left))
+        for block in actuator_blocks(problem.spacecraft):
+            name = f"actuators.{block.actuator.block}"
+            for label, values, limits in ((name, controls[:, block.control], u_high[block.control]),
+                                          (name + ".state", states[:, 7:][:, block.state], x_high[7:][block.state])):
+                bounded = np.isfinite(limits) & (limits > 0)
+                if not np.any(bounded):
+                    continue
+                excess = float(np.max(values[:, bounded] / limits[bounded])) - 1.0
+                if excess > BOUND_TOLERANCE:
+                    violations[label] = excess
+    return DenseCheck(margins, violations, t.size)
