@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp.dynamics.environment import MAGNETIC_FIELDS, CircularOrbit, FieldModel
+from ocp.dynamics.ephemeris import parse_utc
 from ocp.errors import ModelError
 from ocp.options import Range
 from ocp.quat_casadi import Expr
@@ -39,13 +40,14 @@ variation to 2030)."""
 
 
 def parse_epoch(epoch: str | datetime.date) -> datetime.datetime:
-    """The epoch as a naive UTC ``datetime``.
+    """The epoch as a naive UTC ``datetime``, within the IGRF's dates.
 
     Parameters
     ----------
     epoch : str, datetime.date or datetime.datetime
-        ISO text (``"2025-01-01"``, ``"2025-01-01T06:00:00+02:00"``), a date (00:00 UTC) or a
-        datetime (naive means UTC; an aware one is converted to UTC).
+        As :func:`~ocp.dynamics.ephemeris.parse_utc` reads it: ISO text (``"2025-01-01"``,
+        ``"2025-01-01T06:00:00+02:00"``), a date (00:00 UTC) or a datetime (naive means UTC; an
+        aware one is converted to UTC).
 
     Returns
     -------
@@ -58,17 +60,7 @@ def parse_epoch(epoch: str | datetime.date) -> datetime.datetime:
         (field ``"epoch"``) For text that is not an ISO date, or a date outside
         :data:`EPOCH_RANGE`.
     """
-    if isinstance(epoch, datetime.datetime):
-        value = epoch
-    elif isinstance(epoch, datetime.date):
-        value = datetime.datetime(epoch.year, epoch.month, epoch.day)
-    else:
-        try:
-            value = datetime.datetime.fromisoformat(str(epoch))
-        except ValueError:
-            raise ModelError("epoch", f"expected a date like 2025-01-01, got {str(epoch)[:40]!r}") from None
-    if value.tzinfo is not None:
-        value = value.astimezone(datetime.timezone.utc).replace(tzinfo=None)
+    value = parse_utc(epoch)
     if not EPOCH_RANGE[0] <= value.date() < EPOCH_RANGE[1]:
         raise ModelError("epoch", f"IGRF-14 covers {EPOCH_RANGE[0]} to {EPOCH_RANGE[1]}, got {value.date()}")
     return value

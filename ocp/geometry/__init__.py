@@ -1,11 +1,18 @@
 """Mission geometry: pointing constraints and the directions they are measured from.
 
 What lives here: :mod:`~ocp.geometry.pointing` (a body boresight kept out of or inside a cone about a
-direction tabulated along the run, scored in NumPy and imposed in CasADi).
+direction tabulated along the run, scored in NumPy and imposed in CasADi) and
+:mod:`~ocp.geometry.directions` (the epoch and orbit as a :class:`~ocp.geometry.directions.Geometry`
+in the GCRF, the registry :data:`~ocp.geometry.directions.DIRECTIONS` of the direction kinds a
+requirement names: the Sun, the Moon, the Earth's centre, the Earth's limb, the orbital velocity,
+and their tables along a run).
 
 May import: NumPy, CasADi and the top-level modules of :mod:`ocp`, and :mod:`ocp.dynamics` (the
-orbit); never the other subpackages of ``ocp``.
+orbit, the ephemeris); never the other subpackages of ``ocp``.
 """
+from ocp.geometry.directions import (DIRECTIONS, FRAMES, INTERPOLATION_TOLERANCE, DirectionKind, Geometry,
+                                     direction_kind, direction_table)
 from ocp.geometry.pointing import PointingConstraint, PointingScore, violation_intervals
 
-__all__ = ["PointingConstraint", "PointingScore", "violation_intervals"]
+__all__ = ["DIRECTIONS", "FRAMES", "INTERPOLATION_TOLERANCE", "DirectionKind", "Geometry", "PointingConstraint",
+           "PointingScore", "direction_kind", "direction_table", "violation_intervals"]
