@@ -7,22 +7,30 @@ cannot give (fewer than three independent axes) goes to the actuator whose kind 
 magnetorquers as ``m = B × τ / |B|²`` (the component of τ perpendicular to B). Without wheels that
 actuator takes ``u``. The numeric map runs on Python floats (it is called at every sample);
 :meth:`Allocation.allocate_symbolic` is the same map on CasADi expressions.
+
+:func:`reference_demand` runs a reference's feed-forward torque through a law's own map, sample by
+sample, and gives what it asks of each actuator (commands, and the states they drive, such as the
+wheel momenta): the scenario's actuator requirement scores it against the limits.
 """
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ocp import Command, Measurement, Spacecraft
+from ocp import AttitudeModel, Command, Measurement, Spacecraft
 from ocp.dynamics.actuator_kinds import Actuator
-from ocp.dynamics.layout import split_measurement
-from ocp.fast_call import as_floats
+from ocp.dynamics.layout import actuator_blocks, split_measurement
+from ocp.fast_call import BufferedFunction, as_floats
 
 Array = NDArray[np.float64]
+
+__all__ = ["Allocation", "Demand", "float_rows", "reference_demand"]
 
 
 def float_rows(matrix: ArrayLike) -> tuple[tuple[float, ...], ...]:
@@ -187,3 +195,143 @@ class Allocation:
         for name, value in parts.items():
             u[self._slices[name]] = value
         return u
+
+
+@dataclass(frozen=True)
+class Demand:
+    """What a motion asks of one actuator quantity, sample by sample, and its limits.
+
+    Attributes
+    ----------
+    name : str
+        ``<kind>_<quantity>``: the kind's name (``wheels``, ``magnetorquers``, ``torquers``) and
+        the last word of its command (``torque``, ``dipole``) for its command, ``momentum`` for
+        states that store angular momentum, ``state`` for other states.
+    values : (N, k) ndarray
+        The demand at each sample, in the unit of the quantity (N m, A m², N m s).
+    limit : (k,) ndarray
+        The bound of each element (positive; ``inf``: none; 0: a failed element).
+    """
+
+    name: str
+    values: Array
+    limit: Array
+
+    def ratios(self) -> Array:
+        """``|values| / limit`` per sample and element: 0 where there is no limit (or nothing
+        asked of a failed element), ``inf`` where a failed element is asked something.
+
+        Returns
+        -------
+        (N, k) ndarray
+        """
+        magnitude = np.abs(self.values)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = magnitude / self.limit
+        ratio = np.where(np.isinf(self.limit), 0.0, ratio)
+        return np.where(self.limit == 0.0, np.where(magnitude > 0.0, np.inf, 0.0), ratio)
+
+    @property
+    def limited(self) -> bool:
+        """Whether any element has a finite bound (else there is nothing to score)."""
+        return bool(np.any(np.isfinite(self.limit)))
+
+
+def _quantity(actuator: Actuator, state: bool) -> str:
+    if not state:
+        return f"{actuator.name}_{actuator.command.split('_')[-1]}"
+    stores_momentum = bool(np.any(actuator.momentum_matrix()))
+    return f"{actuator.name}_{'momentum' if stores_momentum else 'state'}"
+
+
+def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: ArrayLike,
+                     torque: ArrayLike, state0: ArrayLike | None = None) -> dict[str, Demand]:
+    """What a reference asks of each actuator through a law's own allocation (module docstring).
+
+    At each sample the feed-forward torque goes through the law's map (:meth:`Allocation.allocate`,
+    its flags included) with the reference's rate, the actuators' states so far and the field
+    along the reference; the states (the wheel momenta, ``ḣ_w = g``) are integrated from
+    ``state0`` by trapezoids, the command at the next sample taken at the predicted state. The
+    law itself is not changed (a copy is prepared for the spacecraft).
+
+    Parameters
+    ----------
+    allocation : Allocation
+        The law whose map the closed loop will use (a :class:`controllers.base.Controller`).
+    model : ocp.AttitudeModel
+        The spacecraft and its environment (the field, for magnetorquers).
+    t : (N,) array_like
+        Increasing sample times [s].
+    q : (N, 4) array_like
+        Reference attitude (scalar first, body to inertial) at ``t``.
+    omega : (N, 3) array_like
+        Reference body rate [rad/s], body axes.
+    torque : (N, 3) array_like
+        Feed-forward torque ``u`` of ``I ω̇ = −ω × I ω + u`` [N m], body axes.
+    state0 : (nx - 7,) array_like or None, optional
+        The actuators' states at ``t[0]`` (the initial wheel momenta [N m s]); ``None``: zero.
+
+    Returns
+    -------
+    dict of str to Demand
+        Keyed by :attr:`Demand.name`: each actuator kind's command, and its states when it has
+        any, in the order of ``spacecraft.actuators``.
+    """
+    spacecraft = model.spacecraft
+    law = copy.copy(allocation)
+    law._reset_allocation(spacecraft)
+    t = np.asarray(t, dtype=float)
+    q = np.asarray(q, dtype=float).reshape(-1, 4)
+    omega = np.asarray(omega, dtype=float).reshape(-1, 3)
+    torque = np.asarray(torque, dtype=float).reshape(-1, 3)
+    n = t.size
+    blocks = actuator_blocks(spacecraft)
+    n_states = sum(block.actuator.state_size for block in blocks)
+    states = np.zeros((n, n_states))
+    if n_states and state0 is not None:
+        states[0] = np.asarray(state0, dtype=float)
+    commands = {block.actuator.name: np.zeros((n, block.actuator.control_size)) for block in blocks}
+    fields: list[list[float]] | None = None
+    if model.field_body is not None and n:
+        x = np.hstack([q, omega, np.zeros((n, model.nx - 7))])
+        fields = np.asarray(model.field_body.map(n)(x.T, t).full()).T.tolist()
+    stateful = [(block.actuator, block.state, _rate_function(block.actuator), commands[block.actuator.name])
+                for block in blocks if block.actuator.state_size]
+    n_w = spacecraft.n_wheels
+    times, q_rows, omega_rows, torque_rows = t.tolist(), q.tolist(), omega.tolist(), torque.tolist()
+    rate_before = np.zeros(n_states)
+    for k in range(n):
+        if k > 0:  # the state predicted at k, corrected by the trapezoid once its rate is known
+            states[k] = states[k - 1] + (times[k] - times[k - 1]) * rate_before
+        state = states[k]
+        measurement = Measurement(times[k], q_rows[k], omega_rows[k], state[:n_w].tolist(),  # type: ignore[arg-type]
+                                  None if fields is None else fields[k])  # type: ignore[arg-type]
+        command = law._allocate(torque_rows[k], measurement, None, None)
+        for block in blocks:
+            value = command.value(block.actuator.command)
+            if value is not None:
+                commands[block.actuator.name][k] = value
+        if not stateful:
+            continue
+        rate = np.empty(n_states)
+        for actuator, where, function, asked in stateful:
+            rate[where] = function(asked[k], state[where])
+        if k > 0:
+            states[k] = states[k - 1] + 0.5 * (times[k] - times[k - 1]) * (rate_before + rate)
+        rate_before = rate
+    demand: dict[str, Demand] = {}
+    for block in blocks:
+        actuator = block.actuator
+        demand[_quantity(actuator, False)] = Demand(_quantity(actuator, False), commands[actuator.name],
+                                                    actuator.control_bounds()[1])
+        if actuator.state_size:
+            demand[_quantity(actuator, True)] = Demand(_quantity(actuator, True), states[:, block.state],
+                                                       actuator.state_bounds()[1])
+    return demand
+
+
+def _rate_function(actuator: Actuator) -> BufferedFunction:
+    """``rate(u_block, state_block)``: the kind's :meth:`~Actuator.state_rate`, evaluated cheaply."""
+    u = ca.SX.sym("u", actuator.control_size)
+    state = ca.SX.sym("s", actuator.state_size)
+    return BufferedFunction(ca.Function(f"{actuator.name}_rate", [u, state], [actuator.state_rate(u, state)]))

@@ -37,7 +37,8 @@ BASE = {
     "controller": {"name": "augmented_quaternion_feedback", "options": {"kp": 0.2, "kd": 0.6}},
     "simulation": {"sample_time": 1.0, "duration": 35.0},
 }
-ROW_KEYS = {"label", "planner", "controller", "status", "message", "plan_time_s", "reference", "closed_loop"}
+ROW_KEYS = {"label", "planner", "controller", "status", "message", "plan_time_s", "reference", "closed_loop",
+            "requirements"}
 IDENTITY = ["label", "planner", "controller", "status", "message", "plan_time_s"]
 
 

@@ -167,7 +167,8 @@ def _walk(section: Section, path: str, name: str, aliases: tuple[str, ...] = ())
         key_aliases = tuple(f"{alias}.{key.name}" for alias in aliases)
         yield _key_entry(key, key_path, key_name, key_aliases)
         if key.section is not None:
-            yield from _walk(key.section, f"{key_path}[i]" if key.entries else key_path, key_name, key_aliases)
+            nested = f"{key_path}[i]" if key.entries else f"{key_path}.<name>" if key.named else key_path
+            yield from _walk(key.section, nested, key_name, key_aliases)
 
 
 def summary_line(cls: type, module_first: bool = True) -> str:
