@@ -249,10 +249,11 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     """What a reference asks of each actuator through a law's own allocation (module docstring).
 
     At each sample the feed-forward torque goes through the law's map (:meth:`Allocation.allocate`,
-    its flags included) with the reference's rate, the actuators' states so far and the field
-    along the reference; the states (the wheel momenta, ``ḣ_w = g``) are integrated from
-    ``state0`` by trapezoids, the command at the next sample taken at the predicted state. The
-    law itself is not changed (a copy is prepared for the spacecraft).
+    its flags included) with the reference's rate, the actuators' states and the field along the
+    reference; the states (the wheel momenta, ``ḣ_w = g``) are integrated from ``state0`` by
+    Heun's method (trapezoids, the rate at the end predicted by an Euler step), and the commands
+    reported are those at the states reported. The law itself is not changed (a copy is prepared
+    for the spacecraft).
 
     Parameters
     ----------
@@ -299,26 +300,29 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
                 for block in blocks if block.actuator.state_size]
     n_w = spacecraft.n_wheels
     times, q_rows, omega_rows, torque_rows = t.tolist(), q.tolist(), omega.tolist(), torque.tolist()
-    rate_before = np.zeros(n_states)
-    for k in range(n):
-        if k > 0:  # the state predicted at k, corrected by the trapezoid once its rate is known
-            states[k] = states[k - 1] + (times[k] - times[k - 1]) * rate_before
-        state = states[k]
+
+    def allocate(k: int, state: Array) -> Array:
+        """The commands at sample ``k`` for the actuators' ``state``, stored; the states' rate."""
         measurement = Measurement(times[k], q_rows[k], omega_rows[k], state[:n_w].tolist(),  # type: ignore[arg-type]
                                   None if fields is None else fields[k])  # type: ignore[arg-type]
         command = law._allocate(torque_rows[k], measurement, None, None)
         for block in blocks:
             value = command.value(block.actuator.command)
-            if value is not None:
-                commands[block.actuator.name][k] = value
-        if not stateful:
-            continue
+            commands[block.actuator.name][k] = 0.0 if value is None else value
         rate = np.empty(n_states)
-        for actuator, where, function, asked in stateful:
+        for _, where, function, asked in stateful:
             rate[where] = function(asked[k], state[where])
-        if k > 0:
-            states[k] = states[k - 1] + 0.5 * (times[k] - times[k - 1]) * (rate_before + rate)
-        rate_before = rate
+        return rate
+
+    rate_before = allocate(0, states[0]) if n else np.zeros(n_states)
+    for k in range(1, n):
+        if not stateful:
+            allocate(k, states[k])
+            continue
+        step = times[k] - times[k - 1]
+        predicted = states[k - 1] + step * rate_before  # Heun: predict, evaluate, correct, evaluate
+        states[k] = states[k - 1] + 0.5 * step * (rate_before + allocate(k, predicted))
+        rate_before = allocate(k, states[k])  # the commands kept are those at the corrected state
     demand: dict[str, Demand] = {}
     for block in blocks:
         actuator = block.actuator

@@ -53,7 +53,7 @@ METRIC_INFO: dict[str, MetricInfo] = {
     "peak_actuator_torque": MetricInfo(
         "N m", "Closed loop: max over the samples and the body axes of |τ_act,i|, τ_act the actuators' "
         "applied torque on the body (wheels −A g, magnetorquers m × B, torquers); null for a reference "
-        "(its demand on the actuators is the requirement ``actuators``, see :doc:`guide/requirements`)."),
+        "(its demand on the actuators is scored by the requirement ``actuators``)."),
     "peak_wheel_torque": MetricInfo(
         "N m", "Closed loop: max over the samples and the wheels of the applied motor torque |g_i| (compare "
         "with ``spacecraft.wheels.max_torque``); null without wheels and for a reference."),
