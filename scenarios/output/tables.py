@@ -25,9 +25,11 @@ from typing import TYPE_CHECKING, Any
 
 from scenarios.schema.columns import (
     AXES,
+    REQUIREMENT_MARK,
     SCOPES,
     SCORED_METRICS,
     VECTOR_METRICS,
+    is_requirement_column,
     metric_columns,
 )
 
@@ -38,8 +40,6 @@ if TYPE_CHECKING:
 
 IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s")
 """The columns that name a row, before its metrics."""
-REQUIREMENT_MARK = "req"
-"""The segment after the scope prefix of a requirement column (``ref.req.<name>.<field>``)."""
 
 
 def is_missing(value: Any) -> bool:
@@ -57,21 +57,6 @@ def is_missing(value: Any) -> bool:
     """
     return value is None or (isinstance(value, float) and not math.isfinite(value))
 
-
-
-def is_requirement_column(column: str) -> bool:
-    """Whether a column holds a requirement score (``ref.req.<name>.<field>``, ``cl.req...``).
-
-    Parameters
-    ----------
-    column : str
-        A column name.
-
-    Returns
-    -------
-    bool
-    """
-    return any(column.startswith(f"{prefix}.{REQUIREMENT_MARK}.") for _, prefix in SCOPES)
 
 
 def requirement_columns(rows: Iterable[Mapping[str, Any]]) -> list[str]:
@@ -243,7 +228,7 @@ def data_frame(columns: Sequence[str], records: Iterable[Mapping[str, Any]], num
         The lines.
     numeric : iterable of str
         The columns that hold numbers (never ``None`` in the DataFrame); the requirement columns
-        (:func:`is_requirement_column`) are numeric too.
+        (:func:`~scenarios.schema.columns.is_requirement_column`) are numeric too.
 
     Returns
     -------
