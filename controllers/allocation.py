@@ -17,6 +17,7 @@ from __future__ import annotations
 import copy
 import math
 from collections.abc import Sequence
+from typing import Any
 from dataclasses import dataclass
 
 import casadi as ca
@@ -25,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp import AttitudeModel, Command, Measurement, Spacecraft
 from ocp.dynamics.actuator_kinds import Actuator
-from ocp.dynamics.layout import actuator_blocks, split_measurement
+from ocp.dynamics.layout import actuator_blocks, control_layout, split_measurement
 from ocp.fast_call import BufferedFunction, as_floats
 
 Array = NDArray[np.float64]
@@ -248,12 +249,13 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
                      torque: ArrayLike, state0: ArrayLike | None = None) -> dict[str, Demand]:
     """What a reference asks of each actuator through a law's own allocation (module docstring).
 
-    At each sample the feed-forward torque goes through the law's map (:meth:`Allocation.allocate`,
-    its flags included) with the reference's rate, the actuators' states and the field along the
-    reference; the states (the wheel momenta, ``ḣ_w = g``) are integrated from ``state0`` by
-    Heun's method (trapezoids, the rate at the end predicted by an Euler step), and the commands
-    reported are those at the states reported. The law itself is not changed (a copy is prepared
-    for the spacecraft).
+    At each sample the feed-forward torque goes through the law's map (its flags included; the
+    map on CasADi expressions, :meth:`Allocation.allocate_symbolic`, which the symbolic-law tests
+    hold equal to :meth:`Allocation.allocate`) with the reference's rate, the actuators' states
+    and the field along the reference (zero without a field model); the states (the wheel
+    momenta, ``ḣ_w = g``) are integrated from ``state0`` by Heun's method (trapezoids, the rate
+    at the end predicted by an Euler step), and the commands reported are those at the states
+    reported. The law itself is not changed (a copy is prepared for the spacecraft).
 
     Parameters
     ----------
@@ -280,62 +282,78 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     """
     spacecraft = model.spacecraft
     law = copy.copy(allocation)
+    law.spacecraft = spacecraft
+    law._slices, law._nu = control_layout(spacecraft)
     law._reset_allocation(spacecraft)
-    t = np.asarray(t, dtype=float)
-    q = np.asarray(q, dtype=float).reshape(-1, 4)
-    omega = np.asarray(omega, dtype=float).reshape(-1, 3)
-    torque = np.asarray(torque, dtype=float).reshape(-1, 3)
+    t = np.asarray(t, dtype=float).reshape(-1)
     n = t.size
+    q = np.asarray(q, dtype=float).reshape(n, 4)
+    omega = np.asarray(omega, dtype=float).reshape(n, 3)
+    torque = np.asarray(torque, dtype=float).reshape(n, 3)
     blocks = actuator_blocks(spacecraft)
     n_states = sum(block.actuator.state_size for block in blocks)
-    states = np.zeros((n, n_states))
-    if n_states and state0 is not None:
-        states[0] = np.asarray(state0, dtype=float)
-    commands = {block.actuator.name: np.zeros((n, block.actuator.control_size)) for block in blocks}
-    fields: list[list[float]] | None = None
+    fields = np.zeros((n, 3))
     if model.field_body is not None and n:
         x = np.hstack([q, omega, np.zeros((n, model.nx - 7))])
-        fields = np.asarray(model.field_body.map(n)(x.T, t).full()).T.tolist()
-    stateful = [(block.actuator, block.state, _rate_function(block.actuator), commands[block.actuator.name])
-                for block in blocks if block.actuator.state_size]
-    n_w = spacecraft.n_wheels
-    times, q_rows, omega_rows, torque_rows = t.tolist(), q.tolist(), omega.tolist(), torque.tolist()
-
-    def allocate(k: int, state: Array) -> Array:
-        """The commands at sample ``k`` for the actuators' ``state``, stored; the states' rate."""
-        measurement = Measurement(times[k], q_rows[k], omega_rows[k], state[:n_w].tolist(),  # type: ignore[arg-type]
-                                  None if fields is None else fields[k])  # type: ignore[arg-type]
-        command = law._allocate(torque_rows[k], measurement, None, None)
-        for block in blocks:
-            value = command.value(block.actuator.command)
-            commands[block.actuator.name][k] = 0.0 if value is None else value
-        rate = np.empty(n_states)
-        for _, where, function, asked in stateful:
-            rate[where] = function(asked[k], state[where])
-        return rate
-
-    rate_before = allocate(0, states[0]) if n else np.zeros(n_states)
-    for k in range(1, n):
-        if not stateful:
-            allocate(k, states[k])
-            continue
-        step = times[k] - times[k - 1]
-        predicted = states[k - 1] + step * rate_before  # Heun: predict, evaluate, correct, evaluate
-        states[k] = states[k - 1] + 0.5 * step * (rate_before + allocate(k, predicted))
-        rate_before = allocate(k, states[k])  # the commands kept are those at the corrected state
+        fields = np.asarray(model.field_body.map(n)(x.T, t).full()).T
+    inputs = np.hstack([torque, q, omega, fields])  # (N, 13): what the map reads at each sample
+    key = ("reference_demand", type(law).__module__, type(law).__qualname__, law.gyroscopic_compensation,
+           law.wheels_only, _CHUNK)
+    chunk = BufferedFunction(model.solver_cache.get(key, lambda: _demand_step(law, spacecraft, blocks, n_states)
+                                                    .mapaccum("reference_demand", _CHUNK)))
+    # (the law's map depends on its class, its flags and the spacecraft: the key and the model)
+    states = np.zeros((n, n_states))
+    if n_states and state0 is not None:
+        states[0] = np.asarray(state0, dtype=float).reshape(n_states)
+    commands = np.zeros((n, law._nu))
+    padded = -(-n // _CHUNK) * _CHUNK  # whole chunks: the last input repeated, with steps of zero length
+    now = np.vstack([inputs, np.repeat(inputs[-1:], padded - n, axis=0)]) if n else inputs
+    then = np.vstack([now[1:], now[-1:]]) if n else now
+    dt = np.zeros(padded)
+    dt[:n - 1] = np.diff(t)
+    state = states[0] if n else np.zeros(n_states)
+    for start in range(0, padded, _CHUNK):  # one call per chunk of samples
+        stop = start + _CHUNK
+        flat = chunk.all_outputs(state, now[start:stop].ravel(), then[start:stop].ravel(), dt[start:stop])
+        ahead, asked = flat[0].reshape(_CHUNK, n_states).T, flat[1].reshape(_CHUNK, law._nu).T  # column-major
+        within = min(stop, n) - start
+        commands[start:start + within] = asked[:, :within].T
+        states[start + 1:min(stop + 1, n)] = ahead[:, :min(stop + 1, n) - start - 1].T
+        state = ahead[:, -1].copy()
     demand: dict[str, Demand] = {}
     for block in blocks:
         actuator = block.actuator
-        demand[_quantity(actuator, False)] = Demand(_quantity(actuator, False), commands[actuator.name],
-                                                    actuator.control_bounds()[1])
+        name = _quantity(actuator, False)
+        demand[name] = Demand(name, commands[:, block.control], actuator.control_bounds()[1])
         if actuator.state_size:
-            demand[_quantity(actuator, True)] = Demand(_quantity(actuator, True), states[:, block.state],
-                                                       actuator.state_bounds()[1])
+            name = _quantity(actuator, True)
+            demand[name] = Demand(name, states[:, block.state], actuator.state_bounds()[1])
     return demand
 
 
-def _rate_function(actuator: Actuator) -> BufferedFunction:
-    """``rate(u_block, state_block)``: the kind's :meth:`~Actuator.state_rate`, evaluated cheaply."""
-    u = ca.SX.sym("u", actuator.control_size)
-    state = ca.SX.sym("s", actuator.state_size)
-    return BufferedFunction(ca.Function(f"{actuator.name}_rate", [u, state], [actuator.state_rate(u, state)]))
+_CHUNK = 512
+"""Samples per call of the accumulated step of :func:`reference_demand`."""
+
+
+def _demand_step(law: Allocation, spacecraft: Spacecraft, blocks: Sequence[Any], n_states: int) -> ca.Function:
+    """``step(state_k, inputs_k, inputs_k+1, dt) -> (state_k+1, u_k)``: the command ``u_k`` of the
+    law's map at sample k and Heun's step of the actuators' states; ``inputs`` = [τ, q, ω, b]."""
+    inputs = ca.SX.sym("inputs", 13)
+    state = ca.SX.sym("state", n_states)
+    n_w = spacecraft.n_wheels
+
+    def command(at: ca.SX, states: ca.SX) -> ca.SX:
+        measurement = ca.vertcat(at[3:7], at[7:10], states[:n_w], at[10:13])  # y = [q, ω, h_w, b]
+        return law.allocate_symbolic(at[0:3], measurement)
+
+    def rate(at: ca.SX, states: ca.SX) -> ca.SX:
+        u = command(at, states)
+        parts = [block.actuator.state_rate(u[block.control], states[block.state]) for block in blocks
+                 if block.actuator.state_size]
+        return ca.vertcat(*parts) if parts else ca.SX(0, 1)
+
+    after = ca.SX.sym("after", 13)
+    dt = ca.SX.sym("dt")
+    before = rate(inputs, state)
+    following = state + 0.5 * dt * (before + rate(after, state + dt * before))
+    return ca.Function("demand_step", [state, inputs, after, dt], [following, command(inputs, state)])

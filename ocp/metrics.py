@@ -388,6 +388,7 @@ def metrics_from_reference(
     fine_settling_tolerance_deg: float | None = None,
     inertia: ArrayLike | None = None,
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
+    sample: Any = None,
 ) -> dict[str, Any]:
     """Metrics of a reference's own motion and feed-forward torque over ``[0, duration]``,
     sampled on ``points`` uniform times (trapezoidal integrals), by :func:`compute_metrics`.
@@ -413,16 +414,21 @@ def metrics_from_reference(
         Body inertia [kg m^2] for ``energy_ratio``; ``None``: null.
     detumble_tolerance : float, optional
         Bound on ``max_i |ω_i|`` for ``detumble_time_s`` [rad/s].
+    sample : planners.reference.ReferenceSample or None, optional
+        The reference already sampled at those ``points`` uniform times (its ``q``, ``omega`` and
+        ``torque`` rows), by a caller that needs them too; ``None`` (default): sampled here.
 
     Returns
     -------
     dict of str to float, list of float or None
         Every key of :data:`METRIC_KEYS`; the closed-loop-only ones (tracking errors,
-        saturation, wheel momentum, dipole) are null.
+        saturation, wheel momentum, peak actuator and wheel torques, dipole) are null.
     """
     t = np.linspace(0.0, reference.duration, points)
+    if sample is None:
+        sample = reference.sample(t)
     return compute_metrics(
-        t, reference.q(t), reference.omega(t), reference.torque(t), target_q, target_omega,
+        t, sample.q, sample.omega, sample.torque, target_q, target_omega,
         plan_time_s=reference.plan_time_s, duration_s=reference.duration,
         settling_tolerance_deg=settling_tolerance_deg, initial_omega=initial_omega,
         fine_settling_tolerance_deg=fine_settling_tolerance_deg, inertia=inertia, detumble_tolerance=detumble_tolerance,

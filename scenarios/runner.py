@@ -18,6 +18,8 @@ import traceback
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
+
 from ocp import (
     SimulationError,
     Simulator,
@@ -26,9 +28,10 @@ from ocp import (
     metrics_from_reference,
     metrics_from_simulation,
 )
-from planners import FailedReference, Reference
+from planners import FailedReference, Reference, ReferenceSample
 from scenarios.output.results import Row, RunResults
 from scenarios.requirements.scoring import (
+    REFERENCE_POINTS,
     SCOPE_WORDS,
     Score,
     endpoint_violations,
@@ -138,7 +141,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
          spec.compile), build)
     controllers = scenario.controllers
     labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in controllers])
-    references: dict[int, tuple[Reference, dict[str, Any] | None]] = {}
+    references: dict[int, tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]] = {}
     scoring = _SCORE_REQUIREMENTS and bool(scenario.requirements)
     broken_ends = endpoint_violations(scenario.problem) if scoring else []
     rows: list[Row] = []
@@ -152,19 +155,18 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         else:
             planner_spec = scenario.planners[i]
             if broken_ends:  # no planner can meet them: nothing is planned
-                references.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends)), None))
+                references.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends)), None, None))
             if i not in references:  # planned once, tracked by every controller
-                references[i] = _plan(scenario, planner_spec, cache)
-            reference, reference_metrics = references[i]
+                references[i] = _plan(scenario, planner_spec, cache, scoring)
+            reference, reference_metrics, sampled = references[i]
             row = Row(label, planner_spec.name, reference.status, reference.message,
                       reference.plan_time_s, None if reference_metrics is None else dict(reference_metrics), None,
                       reference, controller=controllers[j].name)
             if reference.ok:
                 _check_physical(row, "reference", row.reference_metrics)
-                if scoring:
-                    times = reference_times(reference.duration, _window(scenario, reference), spec.sample_time)
-                    scores["reference"] = score_reference(scenario.requirements, scenario.problem, reference,
-                                                          controllers[j].controller, times)
+                if sampled is not None:
+                    scores["reference"] = score_reference(scenario.requirements, scenario.problem, *sampled,
+                                                          controllers[j].controller)
                 _simulate(scenario, simulator, reference, row, controllers[j])
             timing = (f"planned in {(row.plan_time_s or 0.0) * 1e3:.1f} ms, "
                       f"simulated in {row.simulate_time_s:.2f} s")
@@ -182,9 +184,11 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     return RunResults(scenario, rows)
 
 
-def _plan(scenario: Scenario, planner_spec: PlannerSpec,
-          cache: SolverCache | None) -> tuple[Reference, dict[str, Any] | None]:
-    """A planner's reference (a failed one when it raises) and the reference's metrics (None when failed)."""
+def _plan(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache | None,
+          scoring: bool = False) -> tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]:
+    """A planner's reference (a failed one when it raises), the reference's metrics (None when
+    failed) and, when ``scoring``, its times and sample for the requirements (one sampling serves
+    both: the metrics' uniform times come first)."""
     spec = scenario.simulation
     planner = planner_spec.planner.with_cache(cache)
     try:
@@ -193,10 +197,15 @@ def _plan(scenario: Scenario, planner_spec: PlannerSpec,
         traceback.print_exc()
         reference = FailedReference(planner_spec.name, f"planner raised {type(error).__name__}: {error}")
     if not reference.ok:
-        return reference, None
-    return reference, metrics_from_reference(
-        reference, scenario.problem.qf, scenario.problem.omegaf,
+        return reference, None, None
+    times = (reference_times(reference.duration, _window(scenario, reference), spec.sample_time, REFERENCE_POINTS)
+             if scoring else np.linspace(0.0, reference.duration, REFERENCE_POINTS))
+    sample = reference.sample(times)
+    metrics = metrics_from_reference(
+        reference, scenario.problem.qf, scenario.problem.omegaf, points=REFERENCE_POINTS,
         settling_tolerance_deg=spec.settling_tolerance_deg,
         fine_settling_tolerance_deg=spec.fine_settling_tolerance_deg,
         inertia=scenario.problem.spacecraft.inertia, detumble_tolerance=spec.detumble_tolerance,
-        initial_omega=scenario.problem.omega0)
+        initial_omega=scenario.problem.omega0,
+        sample=ReferenceSample(*(values[:REFERENCE_POINTS] for values in sample)))
+    return reference, metrics, (times, sample) if scoring else None

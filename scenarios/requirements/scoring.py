@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 from controllers.allocation import Allocation, reference_demand
 from ocp import quat
 from ocp.geometry.pointing import PointingConstraint
-from planners import ManeuverProblem, Planner, Reference
+from planners import ManeuverProblem, Planner
 from planners.base import REQUIREMENT_KINDS
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
@@ -74,8 +74,10 @@ class Score:
 
 
 def reference_times(duration: float, run_end: float, sample_time: float, points: int = REFERENCE_POINTS) -> Array:
-    """Where a reference is scored: ``points`` uniform times over ``[0, T]``, then the closed loop's
-    sample spacing to the end of the run (the reference coasts there, and the closed loop tracks it).
+    """Where a reference is scored: ``points`` uniform times over ``[0, T]`` (those of its metrics,
+    :func:`ocp.metrics.metrics_from_reference`, so that one sampling serves both), then the closed
+    loop's sample spacing to the end of the run (the reference coasts there, and the closed loop
+    tracks it).
 
     Parameters
     ----------
@@ -170,9 +172,9 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array) -> Sc
     return Score("actuators", values, not broken, detail)
 
 
-def score_reference(requirements: Requirements, problem: ManeuverProblem, reference: Reference,
-                    allocation: Allocation | None, times: ArrayLike) -> dict[str, Score]:
-    """Score a reference against every requirement that applies to it.
+def score_reference(requirements: Requirements, problem: ManeuverProblem, times: ArrayLike, sample: Any,
+                    allocation: Allocation | None) -> dict[str, Score]:
+    """Score a reference, sampled densely, against every requirement that applies to it.
 
     Parameters
     ----------
@@ -181,13 +183,13 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, refere
     problem : ManeuverProblem
         The problem planned (its ``pointing`` constraints, spacecraft, environment and initial
         wheel momenta).
-    reference : planners.Reference
-        The reference (status ok).
+    times : (N,) array_like
+        The sample times [s] (:func:`reference_times`).
+    sample : planners.ReferenceSample
+        The reference at ``times`` (``reference.sample(times)``: ``q``, ``omega``, ``torque``).
     allocation : controllers.allocation.Allocation or None
         The row's controller, whose allocation the actuator demand goes through; ``None``: the
         actuator requirement is not scored.
-    times : (N,) array_like
-        Where to sample the reference [s] (:func:`reference_times`).
 
     Returns
     -------
@@ -196,7 +198,6 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, refere
         is scored in closed loop only).
     """
     t = np.asarray(times, dtype=float)
-    sample = reference.sample(t)
     scores = {constraint.name: _pointing(constraint, t, sample.q) for constraint in problem.pointing}
     if requirements.actuators is not None and allocation is not None:
         demand = reference_demand(allocation, problem.model, t, sample.q, sample.omega, sample.torque,
