@@ -18,7 +18,16 @@ from scipy.integrate import solve_ivp
 
 from controllers import CONTROLLERS
 from controllers.allocation import Demand, reference_demand
-from ocp import AttitudeModel, CircularOrbit, Environment, Magnetorquers, ReactionWheels, Spacecraft, Torquers, quat
+from ocp import (
+    AttitudeModel,
+    CircularOrbit,
+    Environment,
+    Magnetorquers,
+    ReactionWheels,
+    Spacecraft,
+    Torquers,
+    quat,
+)
 from ocp.dynamics.environment import MAGNETIC_FIELDS
 from scenarios.requirements.scoring import _actuators
 

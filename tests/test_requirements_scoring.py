@@ -16,7 +16,7 @@ import pytest
 
 from ocp import CircularOrbit, Environment, Spacecraft, quat
 from ocp.geometry.directions import Geometry
-from planners import ManeuverProblem, Reference, ReferenceSample
+from planners import PLANNERS, ManeuverProblem, Reference, ReferenceSample
 from scenarios.requirements.scoring import (
     endpoint_violations,
     reference_times,
@@ -33,7 +33,6 @@ from scenarios.requirements.spec import (
     Requirements,
     Sensor,
 )
-from planners import PLANNERS
 
 T = 10.0
 RATE = math.pi / T  # rad/s about z: the body x axis sweeps 180 deg of azimuth in T

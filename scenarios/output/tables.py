@@ -415,8 +415,8 @@ def to_markdown(results: RunResults) -> str:
     out = [f"# {results.scenario.name}", "", "| metric | " + " | ".join(labels) + " |",
            "|---|" + "---|" * len(labels)]
     out += [f"| {name} | " + " | ".join(cells) + " |" for name, cells in _metric_lines(results)]
-    out += ["", "Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s; "
-                "actuator requirement fields: peak demand over the limit.", "", status_line(results), ""]
+    out += ["", ("Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s; "
+                 "actuator requirement fields: peak demand over the limit."), "", status_line(results), ""]
     out += [f"- **{row.label}** ({row.planner or 'regulation'}, {row.controller or '-'}): {row.message}"
             for row in results.rows]
     return "\n".join(out) + "\n"

@@ -243,16 +243,16 @@ def parse_magnetic_field(node: Node, orbit: CircularOrbit | None,
         except InvalidOption as error:  # a relation between options (Options.__post_init__)
             raise ScenarioError(f"{node.path}.{error.option}", error.message) from None
     inherited = epoch is not None and "epoch" in {spec.name for spec in dataclasses.fields(options)}
-    if inherited and given_epoch:
+    if epoch is not None and inherited and given_epoch:
         try:
-            own = parse_utc(options.epoch)
-        except Exception:  # noqa: BLE001 - the model reports its own epoch's error below
+            own: datetime.datetime | None = parse_utc(getattr(options, "epoch"))  # noqa: B009 - any model's
+        except ModelError:  # the model reports its own epoch's error below
             own = None
         if own is not None and own != epoch:
             raise ScenarioError(f"{node.path}.epoch", f"{own.isoformat()} differs from the scenario's epoch "
                                 f"(epoch: {epoch.isoformat()}Z); give one of them, or the same instant")
-    elif inherited:
-        options = dataclasses.replace(options, epoch=epoch.isoformat())  # type: ignore[union-attr]
+    elif epoch is not None and inherited:
+        options = dataclasses.replace(options, epoch=epoch.isoformat())  # type: ignore[call-arg]  # a model's Options
     try:
         return model.from_options(options=options, orbit=orbit)
     except ModelError as error:

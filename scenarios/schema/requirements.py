@@ -34,9 +34,20 @@ from scenarios.requirements.spec import (
 from scenarios.schema.keys import Section, custom, mapping, number, vector
 from scenarios.schema.node import Node
 
-__all__ = ["INERTIAL_DIRECTION", "POINTING", "REQUIREMENTS", "REQUIREMENT_ACTUATORS", "REQUIREMENT_FINAL",
-           "REQUIREMENT_RATE", "RunSpan", "SENSOR", "check_ephemeris", "parse_epoch", "parse_requirements",
-           "parse_sensors"]
+__all__ = [
+    "INERTIAL_DIRECTION",
+    "POINTING",
+    "REQUIREMENTS",
+    "REQUIREMENT_ACTUATORS",
+    "REQUIREMENT_FINAL",
+    "REQUIREMENT_RATE",
+    "SENSOR",
+    "RunSpan",
+    "check_ephemeris",
+    "parse_epoch",
+    "parse_requirements",
+    "parse_sensors",
+]
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,63}$")
 """A sensor's or requirement's name: it names result columns (``ref.req.<name>.<field>``)."""

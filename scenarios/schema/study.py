@@ -21,7 +21,11 @@ import numpy as np
 
 from ocp import METRIC_KEYS, quat
 from scenarios.errors import ScenarioError
-from scenarios.schema.columns import VECTOR_METRICS, is_requirement_column, metric_columns
+from scenarios.schema.columns import (
+    VECTOR_METRICS,
+    is_requirement_column,
+    metric_columns,
+)
 from scenarios.schema.keys import (
     Described,
     Key,

@@ -202,11 +202,12 @@ def _table_lines(columns: list[str], rows: list[dict[str, Any]]) -> list[str]:
 
 def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], missing: int,
               requirements: tuple[list[str], list[dict[str, Any]]] | None = None) -> str:
-    out = [f"# {study.name}", "", f"{len(study.cases)} cases ({missing} missing), "
-           f"{study.samples} Monte Carlo sample(s) per grid point, slewbench {package_version()}.", ""]
+    out = [f"# {study.name}", "", (f"{len(study.cases)} cases ({missing} missing), "
+                                   f"{study.samples} Monte Carlo sample(s) per grid point, slewbench "
+                                   f"{package_version()}."), ""]
     out += _table_lines(columns, rows)
-    out += ["", "Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s. "
-                "std is the sample standard deviation; p5 and p95 are linear percentiles.", ""]
+    out += ["", ("Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s. "
+                 "std is the sample standard deviation; p5 and p95 are linear percentiles."), ""]
     if requirements is not None:
         out += ["## Cases meeting every requirement", "",
                 "Rows whose status is ok among the completed ones (not crashed), with the Wilson 95 % interval.", ""]

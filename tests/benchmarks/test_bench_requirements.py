@@ -17,7 +17,7 @@ import numpy as np
 import yaml
 
 import scenarios
-import scenarios.runner as runner
+from scenarios import runner
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "cubesat_12u_sun_keep_out.yaml"
 ROUNDS = 15
