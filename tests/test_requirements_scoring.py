@@ -55,6 +55,12 @@ class UniformTurn(Reference):
         return ReferenceSample(q, omega, zeros, zeros)
 
 
+def scored(requirements: Requirements, problem: ManeuverProblem, reference: Reference) -> dict:
+    """The reference's scores on its dense sampling (no actuator requirement here)."""
+    times = reference_times(reference.duration, reference.duration, 0.1)
+    return score_reference(requirements, problem, times, reference.sample(times), None)
+
+
 def problem_with(requirements: Requirements, geometry: Geometry | None = None, q0=quat.IDENTITY,
                  qf=None, duration: float = T, environment: Environment | None = None) -> ManeuverProblem:
     geometry = geometry or Geometry(None, None)
@@ -70,8 +76,7 @@ def test_a_keep_out_swept_through_its_centre_by_closed_form():
     keep_out = PointingRequirement("x_out", X_AXIS, True, np.deg2rad(30.0), Direction(None, [0.0, 1.0, 0.0]))
     requirements = Requirements((keep_out,))
     problem = problem_with(requirements)
-    times = reference_times(T, T, 0.1)
-    score = score_reference(requirements, problem, UniformTurn(), None, times)["x_out"]
+    score = scored(requirements, problem, UniformTurn())["x_out"]
     assert not score.met
     assert score.values["min_margin_deg"] == pytest.approx(-30.0, abs=1e-9)
     assert score.values["min_margin_time_s"] == pytest.approx(5.0, abs=1e-12)
@@ -84,7 +89,7 @@ def test_a_keep_out_the_path_misses_is_met_with_its_smallest_margin():
     """The cone 30 deg about azimuth -60 deg (behind the start): the margin grows from 30 deg."""
     direction = Direction(None, [math.cos(math.radians(-60)), math.sin(math.radians(-60)), 0.0])
     requirements = Requirements((PointingRequirement("behind", X_AXIS, True, np.deg2rad(30.0), direction),))
-    score = score_reference(requirements, problem_with(requirements), UniformTurn(), None, reference_times(T, T, 0.1))
+    score = scored(requirements, problem_with(requirements), UniformTurn())
     assert score["behind"].met and score["behind"].detail == ""
     assert score["behind"].values["min_margin_deg"] == pytest.approx(30.0, abs=1e-9)
     assert score["behind"].values["time_in_violation_s"] == 0.0 and score["behind"].values["first_violation_s"] is None
@@ -96,8 +101,7 @@ def test_a_keep_in_inside_a_window_by_closed_form():
     keep_in = PointingRequirement("x_in", X_AXIS, False, np.deg2rad(45.0), Direction(None, [1.0, 0.0, 0.0]),
                                   (0.0, 4.0))
     requirements = Requirements((keep_in,))
-    score = score_reference(requirements, problem_with(requirements), UniformTurn(), None,
-                            reference_times(T, T, 0.1))["x_in"]
+    score = scored(requirements, problem_with(requirements), UniformTurn())["x_in"]
     assert score.values["min_margin_deg"] == pytest.approx(-27.0, abs=1e-9)
     assert score.values["min_margin_time_s"] == pytest.approx(4.0, abs=1e-12)
     assert score.values["first_violation_s"] == pytest.approx(2.5, abs=1e-9)
@@ -128,13 +132,12 @@ def test_a_moving_nadir_against_a_held_attitude():
 
 def test_the_rate_by_closed_form():
     requirements = Requirements(rate=RateRequirement(0.25))
-    score = score_reference(requirements, problem_with(requirements), UniformTurn(), None,
-                            reference_times(T, T, 0.1))["rate"]
+    score = scored(requirements, problem_with(requirements), UniformTurn())["rate"]
     assert score.values["peak_rate"] == pytest.approx(RATE, rel=1e-12)
     assert score.values["ratio"] == pytest.approx(RATE / 0.25, rel=1e-12)
     assert not score.met and "1.26 x the 0.25 rad/s bound" in score.detail
     relaxed = Requirements(rate=RateRequirement(0.32))
-    assert score_reference(relaxed, problem_with(relaxed), UniformTurn(), None, reference_times(T, T, 0.1))["rate"].met
+    assert scored(relaxed, problem_with(relaxed), UniformTurn())["rate"].met
 
 
 def test_the_final_error_and_rate_from_t_plus_after():
@@ -180,7 +183,7 @@ def test_messages_name_requirement_and_scope_and_what_a_planner_does_not_honour(
     keep_out = PointingRequirement("x_out", X_AXIS, True, np.deg2rad(30.0), Direction(None, [0.0, 1.0, 0.0]))
     requirements = Requirements((keep_out,), rate=RateRequirement(1.0))
     problem = problem_with(requirements)
-    scores = {"reference": score_reference(requirements, problem, UniformTurn(), None, reference_times(T, T, 0.1))}
+    scores = {"reference": scored(requirements, problem, UniformTurn())}
     assert violations(scores) == ["x_out (reference): min margin -30 deg at 5.0 s, 3.3 s inside"]
     eigenaxis = PLANNERS["eigenaxis"]()
     assert unhonoured(requirements, eigenaxis) == ("eigenaxis does not honour the pointing and rate requirements "
