@@ -7,22 +7,31 @@ cannot give (fewer than three independent axes) goes to the actuator whose kind 
 magnetorquers as ``m = B × τ / |B|²`` (the component of τ perpendicular to B). Without wheels that
 actuator takes ``u``. The numeric map runs on Python floats (it is called at every sample);
 :meth:`Allocation.allocate_symbolic` is the same map on CasADi expressions.
+
+:func:`reference_demand` runs a reference's feed-forward torque through a law's own map, sample by
+sample, and gives what it asks of each actuator (commands, and the states they drive, such as the
+wheel momenta): the scenario's actuator requirement scores it against the limits.
 """
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ocp import Command, Measurement, Spacecraft
+from ocp import AttitudeModel, Command, Measurement, Spacecraft
 from ocp.dynamics.actuator_kinds import Actuator
-from ocp.dynamics.layout import split_measurement
-from ocp.fast_call import as_floats
+from ocp.dynamics.layout import actuator_blocks, control_layout, split_measurement
+from ocp.fast_call import BufferedFunction, as_floats
 
 Array = NDArray[np.float64]
+
+__all__ = ["Allocation", "Demand", "float_rows", "reference_demand"]
 
 
 def float_rows(matrix: ArrayLike) -> tuple[tuple[float, ...], ...]:
@@ -187,3 +196,164 @@ class Allocation:
         for name, value in parts.items():
             u[self._slices[name]] = value
         return u
+
+
+@dataclass(frozen=True)
+class Demand:
+    """What a motion asks of one actuator quantity, sample by sample, and its limits.
+
+    Attributes
+    ----------
+    name : str
+        ``<kind>_<quantity>``: the kind's name (``wheels``, ``magnetorquers``, ``torquers``) and
+        the last word of its command (``torque``, ``dipole``) for its command, ``momentum`` for
+        states that store angular momentum, ``state`` for other states.
+    values : (N, k) ndarray
+        The demand at each sample, in the unit of the quantity (N m, A m², N m s).
+    limit : (k,) ndarray
+        The bound of each element (positive; ``inf``: none; 0: a failed element).
+    """
+
+    name: str
+    values: Array
+    limit: Array
+
+    def ratios(self) -> Array:
+        """``|values| / limit`` per sample and element: 0 where there is no limit (or nothing
+        asked of a failed element), ``inf`` where a failed element is asked something.
+
+        Returns
+        -------
+        (N, k) ndarray
+        """
+        magnitude = np.abs(self.values)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = magnitude / self.limit
+        ratio = np.where(np.isinf(self.limit), 0.0, ratio)
+        return np.where(self.limit == 0.0, np.where(magnitude > 0.0, np.inf, 0.0), ratio)
+
+    @property
+    def limited(self) -> bool:
+        """Whether any element has a finite bound (else there is nothing to score)."""
+        return bool(np.any(np.isfinite(self.limit)))
+
+
+def _quantity(actuator: Actuator, state: bool) -> str:
+    if not state:
+        return f"{actuator.name}_{actuator.command.split('_')[-1]}"
+    stores_momentum = bool(np.any(actuator.momentum_matrix()))
+    return f"{actuator.name}_{'momentum' if stores_momentum else 'state'}"
+
+
+def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: ArrayLike,
+                     torque: ArrayLike, state0: ArrayLike | None = None) -> dict[str, Demand]:
+    """What a reference asks of each actuator through a law's own allocation (module docstring).
+
+    At each sample the feed-forward torque goes through the law's map (its flags included; the
+    map on CasADi expressions, :meth:`Allocation.allocate_symbolic`, which the symbolic-law tests
+    hold equal to :meth:`Allocation.allocate`) with the reference's rate, the actuators' states
+    and the field along the reference (zero without a field model); the states (the wheel
+    momenta, ``ḣ_w = g``) are integrated from ``state0`` by Heun's method (trapezoids, the rate
+    at the end predicted by an Euler step), and the commands reported are those at the states
+    reported. The law itself is not changed (a copy is prepared for the spacecraft).
+
+    Parameters
+    ----------
+    allocation : Allocation
+        The law whose map the closed loop will use (a :class:`controllers.base.Controller`).
+    model : ocp.AttitudeModel
+        The spacecraft and its environment (the field, for magnetorquers).
+    t : (N,) array_like
+        Increasing sample times [s].
+    q : (N, 4) array_like
+        Reference attitude (scalar first, body to inertial) at ``t``.
+    omega : (N, 3) array_like
+        Reference body rate [rad/s], body axes.
+    torque : (N, 3) array_like
+        Feed-forward torque ``u`` of ``I ω̇ = −ω × I ω + u`` [N m], body axes.
+    state0 : (nx - 7,) array_like or None, optional
+        The actuators' states at ``t[0]`` (the initial wheel momenta [N m s]); ``None``: zero.
+
+    Returns
+    -------
+    dict of str to Demand
+        Keyed by :attr:`Demand.name`: each actuator kind's command, and its states when it has
+        any, in the order of ``spacecraft.actuators``.
+    """
+    spacecraft = model.spacecraft
+    law = copy.copy(allocation)
+    law.spacecraft = spacecraft
+    law._slices, law._nu = control_layout(spacecraft)
+    law._reset_allocation(spacecraft)
+    t = np.asarray(t, dtype=float).reshape(-1)
+    n = t.size
+    q = np.asarray(q, dtype=float).reshape(n, 4)
+    omega = np.asarray(omega, dtype=float).reshape(n, 3)
+    torque = np.asarray(torque, dtype=float).reshape(n, 3)
+    blocks = actuator_blocks(spacecraft)
+    n_states = sum(block.actuator.state_size for block in blocks)
+    fields = np.zeros((n, 3))
+    if model.field_body is not None and n:
+        x = np.hstack([q, omega, np.zeros((n, model.nx - 7))])
+        fields = np.asarray(model.field_body.map(n)(x.T, t).full()).T
+    inputs = np.hstack([torque, q, omega, fields])  # (N, 13): what the map reads at each sample
+    key = ("reference_demand", type(law).__module__, type(law).__qualname__, law.gyroscopic_compensation,
+           law.wheels_only, _CHUNK)
+    chunk = BufferedFunction(model.solver_cache.get(key, lambda: _demand_step(law, spacecraft, blocks, n_states)
+                                                    .mapaccum("reference_demand", _CHUNK)))
+    # (the law's map depends on its class, its flags and the spacecraft: the key and the model)
+    states = np.zeros((n, n_states))
+    if n_states and state0 is not None:
+        states[0] = np.asarray(state0, dtype=float).reshape(n_states)
+    commands = np.zeros((n, law._nu))
+    padded = -(-n // _CHUNK) * _CHUNK  # whole chunks: the last input repeated, with steps of zero length
+    now = np.vstack([inputs, np.repeat(inputs[-1:], padded - n, axis=0)]) if n else inputs
+    then = np.vstack([now[1:], now[-1:]]) if n else now
+    dt = np.zeros(padded)
+    dt[:n - 1] = np.diff(t)
+    state = states[0] if n else np.zeros(n_states)
+    for start in range(0, padded, _CHUNK):  # one call per chunk of samples
+        stop = start + _CHUNK
+        flat = chunk.all_outputs(state, now[start:stop].ravel(), then[start:stop].ravel(), dt[start:stop])
+        ahead, asked = flat[0].reshape(_CHUNK, n_states).T, flat[1].reshape(_CHUNK, law._nu).T  # column-major
+        within = min(stop, n) - start
+        commands[start:start + within] = asked[:, :within].T
+        states[start + 1:min(stop + 1, n)] = ahead[:, :min(stop + 1, n) - start - 1].T
+        state = ahead[:, -1].copy()
+    demand: dict[str, Demand] = {}
+    for block in blocks:
+        actuator = block.actuator
+        name = _quantity(actuator, False)
+        demand[name] = Demand(name, commands[:, block.control], actuator.control_bounds()[1])
+        if actuator.state_size:
+            name = _quantity(actuator, True)
+            demand[name] = Demand(name, states[:, block.state], actuator.state_bounds()[1])
+    return demand
+
+
+_CHUNK = 512
+"""Samples per call of the accumulated step of :func:`reference_demand`."""
+
+
+def _demand_step(law: Allocation, spacecraft: Spacecraft, blocks: Sequence[Any], n_states: int) -> ca.Function:
+    """``step(state_k, inputs_k, inputs_k+1, dt) -> (state_k+1, u_k)``: the command ``u_k`` of the
+    law's map at sample k and Heun's step of the actuators' states; ``inputs`` = [τ, q, ω, b]."""
+    inputs = ca.SX.sym("inputs", 13)
+    state = ca.SX.sym("state", n_states)
+    n_w = spacecraft.n_wheels
+
+    def command(at: ca.SX, states: ca.SX) -> ca.SX:
+        measurement = ca.vertcat(at[3:7], at[7:10], states[:n_w], at[10:13])  # y = [q, ω, h_w, b]
+        return law.allocate_symbolic(at[0:3], measurement)
+
+    def rate(at: ca.SX, states: ca.SX) -> ca.SX:
+        u = command(at, states)
+        parts = [block.actuator.state_rate(u[block.control], states[block.state]) for block in blocks
+                 if block.actuator.state_size]
+        return ca.vertcat(*parts) if parts else ca.SX(0, 1)
+
+    after = ca.SX.sym("after", 13)
+    dt = ca.SX.sym("dt")
+    before = rate(inputs, state)
+    following = state + 0.5 * dt * (before + rate(after, state + dt * before))
+    return ca.Function("demand_step", [state, inputs, after, dt], [following, command(inputs, state)])

@@ -12,7 +12,8 @@ from numpy.typing import ArrayLike, NDArray
 from ocp import quat
 
 METRIC_KEYS: tuple[str, ...] = (
-    "int_u2", "int_u", "int_abs_u", "peak_u", "final_error_deg", "final_rate_error",
+    "int_u2", "int_u", "int_abs_u", "peak_body_torque", "peak_actuator_torque", "peak_wheel_torque",
+    "final_error_deg", "final_rate_error",
     "rms_error_deg", "max_error_deg", "settling_time_s", "saturation_fraction",
     "peak_wheel_momentum", "plan_time_s", "duration_s",
     "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
@@ -44,8 +45,18 @@ METRIC_INFO: dict[str, MetricInfo] = {
     "int_abs_u": MetricInfo(
         "N m s", "[∫ |u_x| dt, ∫ |u_y| dt, ∫ |u_z| dt], one integral per body axis (a list of three; "
         "the CSV tables split it into ``_x``, ``_y``, ``_z`` columns)."),
-    "peak_u": MetricInfo(
-        "N m", "max over the samples and the axes of |u_i| (0 without any torque sample)."),
+    "peak_body_torque": MetricInfo(
+        "N m", "max over the samples and the body axes of |u_i|, u the control torque on the rigid body of "
+        "I ω̇ = −ω × I ω + u: a reference's feed-forward torque (I ω̇ + ω × I ω); in closed loop the applied "
+        "actuator torque less the wheels' gyroscopic torque, τ_act − ω × A h_w at each sample (the u the "
+        "allocation realised, so that reference and closed loop compare); 0 without any torque sample."),
+    "peak_actuator_torque": MetricInfo(
+        "N m", "Closed loop: max over the samples and the body axes of |τ_act,i|, τ_act the actuators' "
+        "applied torque on the body (wheels −A g, magnetorquers m × B, torquers); null for a reference "
+        "(its demand on the actuators is scored by the requirement ``actuators``)."),
+    "peak_wheel_torque": MetricInfo(
+        "N m", "Closed loop: max over the samples and the wheels of the applied motor torque |g_i| (compare "
+        "with ``spacecraft.wheels.max_torque``); null without wheels and for a reference."),
     "final_error_deg": MetricInfo(
         "deg", "Error angle 2 acos|q_e0| (``q_e = q_f* ⊗ q``) between the attitude at the last sample and "
         "the target ``q_f``; null when the final attitude is free."),
@@ -92,10 +103,11 @@ METRIC_INFO: dict[str, MetricInfo] = {
         "rad/s", "Reference: ‖ω(t_0) − ω_0‖, the initial rate a planner that declares ``omega0`` free leaves "
         "to the closed loop; null in closed loop."),
 }
-"""Unit and definition of every key of :data:`METRIC_KEYS`, in the same order. ``u`` is the body
-torque (body axes): a reference's feed-forward torque, or in closed loop the applied actuator torque
-held over each sample; t_0 … t_N are the sample times of the scored window. A metric that does not
-apply is null (``None``)."""
+"""Unit and definition of every key of :data:`METRIC_KEYS`, in the same order. ``u`` in the integrals
+``int_u2``, ``int_u`` and ``int_abs_u`` is the torque given to :func:`compute_metrics` (body axes): a
+reference's feed-forward torque, or in closed loop the applied actuator torque held over each
+sample; the peaks name what they measure. t_0 … t_N are the sample times of the scored window. A
+metric that does not apply is null (``None``)."""
 DEFAULT_SETTLING_TOLERANCE_DEG = 0.5
 """deg, error band about the target attitude for ``settling_time_s``."""
 DEFAULT_DETUMBLE_TOLERANCE = 0.01
@@ -134,6 +146,14 @@ def _integrate(t: NDArray, values: NDArray) -> NDArray:
     if values.shape[0] == t.shape[0] - 1:
         return np.tensordot(dt, values, axes=(0, 0))
     return np.tensordot(dt, 0.5 * (values[1:] + values[:-1]), axes=(0, 0))
+
+
+def _peak(values: ArrayLike | None, empty: float | None) -> float | None:
+    """max |v| over every entry; ``empty`` for ``None`` or no entries (``None`` stays null)."""
+    if values is None:
+        return None
+    array = np.asarray(values, dtype=float)
+    return float(np.max(np.abs(array))) if array.size else empty
 
 
 def settling_time(t: NDArray, error_deg: NDArray | None, tolerance_deg: float) -> float | None:
@@ -182,6 +202,9 @@ def compute_metrics(
     dipole: ArrayLike | None = None,
     inertia: ArrayLike | None = None,
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
+    body_torque: ArrayLike | None = None,
+    actuator_torque: ArrayLike | None = None,
+    wheel_torque: ArrayLike | None = None,
 ) -> dict[str, Any]:
     """Metrics of a motion sampled at times ``t`` (definitions: :data:`METRIC_INFO`).
 
@@ -197,8 +220,9 @@ def compute_metrics(
     omega : (N+1, 3) array_like
         Body rate with respect to the inertial frame at ``t`` [rad/s], body axes.
     torque : (N, 3) or (N+1, 3) array_like
-        Body torque [N m], body axes: held over each interval (closed loop, zero-order hold), or
-        sampled at ``t`` (a reference's feed-forward, trapezoids).
+        Torque of the integrals ``int_u2``, ``int_u``, ``int_abs_u`` [N m], body axes: held over
+        each interval (closed loop: the applied actuator torque, zero-order hold), or sampled at
+        ``t`` (a reference's feed-forward, trapezoids).
     target_q : (4,) array_like or None
         The manoeuvre's final attitude; ``None``: free (attitude metrics null).
     target_omega : (3,) array_like or None, optional
@@ -229,6 +253,14 @@ def compute_metrics(
     detumble_tolerance : float, optional
         Bound on ``max_i |ω_i|`` for ``detumble_time_s`` [rad/s] (default
         :data:`DEFAULT_DETUMBLE_TOLERANCE`).
+    body_torque : (N, 3) or (N+1, 3) array_like or None, optional
+        The control torque on the rigid body ``u`` of ``I ω̇ = −ω × I ω + u`` [N m], body axes,
+        for ``peak_body_torque``; ``None``: ``torque`` (a reference's feed-forward is that torque).
+    actuator_torque : (N, 3) array_like or None, optional
+        The actuators' applied torque on the body [N m], body axes, for ``peak_actuator_torque``;
+        ``None``: null (a reference).
+    wheel_torque : (N, n_w) array_like or None, optional
+        Applied wheel motor torques [N m] for ``peak_wheel_torque``; ``None`` or empty: null.
 
     Returns
     -------
@@ -246,7 +278,9 @@ def compute_metrics(
         "int_u2": float(_integrate(t, norms**2)),
         "int_u": float(_integrate(t, norms)),
         "int_abs_u": [float(v) for v in _integrate(t, np.abs(torque))],
-        "peak_u": float(np.max(np.abs(torque))) if torque.size else 0.0,
+        "peak_body_torque": _peak(torque if body_torque is None else body_torque, 0.0),
+        "peak_actuator_torque": _peak(actuator_torque, None),
+        "peak_wheel_torque": _peak(wheel_torque, None),
         "final_error_deg": None if error_to_target is None else float(error_to_target[-1]),
         "final_rate_error": None if target_omega is None
         else float(np.linalg.norm(np.asarray(omega)[-1] - np.asarray(target_omega, dtype=float))),
@@ -293,8 +327,12 @@ def metrics_from_simulation(
 ) -> dict[str, Any]:
     """Closed-loop metrics of a simulation, by :func:`compute_metrics`.
 
-    The torque is the applied actuator torque held over each sample, the dipole (with
-    magnetorquers) the applied one; ``inertia`` is the spacecraft's.
+    The integrals' torque is the applied actuator torque held over each sample, and so is
+    ``peak_actuator_torque``'s; ``peak_body_torque`` takes that torque less the wheels'
+    gyroscopic torque ``ω × A h_w`` at the start of each sample (the ``u`` of
+    ``I ω̇ = −ω × I ω + u`` the allocation realised), ``peak_wheel_torque`` the applied wheel
+    motor torques; the dipole (with magnetorquers) is the applied one; ``inertia`` is the
+    spacecraft's.
 
     Parameters
     ----------
@@ -325,6 +363,9 @@ def metrics_from_simulation(
     """
     slices = result.model.control_slices
     dipole = result.applied_u[:, slices["dipole"]] if "dipole" in slices else None
+    wheel_torque = result.applied_u[:, slices["wheels"]] if "wheels" in slices else None
+    stored = result.wheel_momentum[:-1] @ result.model.spacecraft.wheel_axes.T  # A h_w, body axes
+    body_torque = result.applied_torque - np.cross(result.omega[:-1], stored)
     return compute_metrics(
         result.t, result.q, result.omega, result.applied_torque, target_q, target_omega,
         reference_q=None if reference is None else reference.q(result.t),
@@ -333,6 +374,7 @@ def metrics_from_simulation(
         settling_tolerance_deg=settling_tolerance_deg,
         fine_settling_tolerance_deg=fine_settling_tolerance_deg, dipole=dipole,
         inertia=result.model.spacecraft.inertia, detumble_tolerance=detumble_tolerance,
+        body_torque=body_torque, actuator_torque=result.applied_torque, wheel_torque=wheel_torque,
     )
 
 
@@ -346,6 +388,7 @@ def metrics_from_reference(
     fine_settling_tolerance_deg: float | None = None,
     inertia: ArrayLike | None = None,
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
+    sample: Any = None,
 ) -> dict[str, Any]:
     """Metrics of a reference's own motion and feed-forward torque over ``[0, duration]``,
     sampled on ``points`` uniform times (trapezoidal integrals), by :func:`compute_metrics`.
@@ -371,16 +414,21 @@ def metrics_from_reference(
         Body inertia [kg m^2] for ``energy_ratio``; ``None``: null.
     detumble_tolerance : float, optional
         Bound on ``max_i |ω_i|`` for ``detumble_time_s`` [rad/s].
+    sample : planners.reference.ReferenceSample or None, optional
+        The reference already sampled at those ``points`` uniform times (its ``q``, ``omega`` and
+        ``torque`` rows), by a caller that needs them too; ``None`` (default): sampled here.
 
     Returns
     -------
     dict of str to float, list of float or None
         Every key of :data:`METRIC_KEYS`; the closed-loop-only ones (tracking errors,
-        saturation, wheel momentum, dipole) are null.
+        saturation, wheel momentum, peak actuator and wheel torques, dipole) are null.
     """
     t = np.linspace(0.0, reference.duration, points)
+    if sample is None:
+        sample = reference.sample(t)
     return compute_metrics(
-        t, reference.q(t), reference.omega(t), reference.torque(t), target_q, target_omega,
+        t, sample.q, sample.omega, sample.torque, target_q, target_omega,
         plan_time_s=reference.plan_time_s, duration_s=reference.duration,
         settling_tolerance_deg=settling_tolerance_deg, initial_omega=initial_omega,
         fine_settling_tolerance_deg=fine_settling_tolerance_deg, inertia=inertia, detumble_tolerance=detumble_tolerance,

@@ -11,6 +11,8 @@ Library use::
 Subpackages, from the bottom up (each may import only those before it, and :mod:`ocp`,
 :mod:`planners` and :mod:`controllers`):
 
+* :mod:`scenarios.requirements`: the requirements a scenario states once (sensors, pointing cones,
+  the actuators' margin, a rate limit, the final error) and the scoring of every row against them;
 * :mod:`scenarios.schema`: reading YAML safely, typed nodes that name their path, the scenario
   schema and its checks, and the schema reference generated from them;
 * :mod:`scenarios.output`: a run's rows and results (:class:`~scenarios.output.results.Row`,

@@ -1,7 +1,15 @@
 """Run a scenario: plan with every planner, track each reference in closed loop, score both.
 
-:func:`run` returns :class:`RunResults`, whose rows carry the metrics, the reference and the
-simulation, and which render to JSON, CSV and Markdown (see :mod:`scenarios.output.tables`).
+:func:`run` returns :class:`RunResults`, whose rows carry the metrics, the requirement scores, the
+reference and the simulation, and which render to JSON, CSV and Markdown (see
+:mod:`scenarios.output.tables`).
+
+Requirements (:mod:`scenarios.requirements`): before anything is planned, a pointing requirement
+that the initial or target attitude already breaks makes every planner's row ``failed``, naming it.
+Then each row's reference and closed loop are scored against every requirement; a row that breaks
+one is ``violated`` (never ``ok``), its message naming the requirement, the scope, the margin and
+the time, and a planner that does not honour a kind of requirement present says so in its message.
+Statuses rank ``failed`` over ``violated`` over ``ok``.
 """
 from __future__ import annotations
 
@@ -9,6 +17,8 @@ import time
 import traceback
 from collections.abc import Callable
 from typing import Any
+
+import numpy as np
 
 from ocp import (
     SimulationError,
@@ -18,17 +28,37 @@ from ocp import (
     metrics_from_reference,
     metrics_from_simulation,
 )
-from planners import FailedReference, Reference
+from planners import FailedReference, Reference, ReferenceSample
 from scenarios.output.results import Row, RunResults
+from scenarios.requirements.scoring import (
+    REFERENCE_POINTS,
+    SCOPE_WORDS,
+    Score,
+    endpoint_violations,
+    reference_times,
+    score_closed_loop,
+    score_reference,
+    unhonoured,
+    violations,
+)
 from scenarios.schema.labels import row_labels
 from scenarios.schema.loader import ControllerSpec, PlannerSpec, Scenario
+
+_SCORE_REQUIREMENTS = True
+"""Score the rows against the scenario's requirements (off only to measure what scoring costs:
+``tests/benchmarks/test_bench_requirements.py``)."""
+
+
+def _window(scenario: Scenario, reference: Reference | None) -> float:
+    """The closed-loop window [s]: ``simulation.duration``, else the manoeuvre's or the reference's if longer."""
+    return scenario.simulation.duration or max(scenario.problem.duration, reference.duration if reference else 0.0)
 
 
 def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | None, row: Row,
               controller_spec: ControllerSpec | None = None) -> None:
     problem = scenario.problem
     spec = controller_spec or scenario.controller
-    duration = scenario.simulation.duration or max(problem.duration, reference.duration if reference else 0.0)
+    duration = _window(scenario, reference)
     controller = spec.controller
     start = time.perf_counter()
     try:
@@ -47,6 +77,19 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
         fine_settling_tolerance_deg=scenario.simulation.fine_settling_tolerance_deg,
         detumble_tolerance=scenario.simulation.detumble_tolerance)
     _check_physical(row, "closed loop", row.closed_loop_metrics)
+
+
+def _judge(row: Row, scores: dict[str, dict[str, Score]], note: str) -> None:
+    """Put a row's requirement scores on it: a row that breaks one is ``violated`` unless it already
+    failed; the message names what breaks (first), then the row's own message and ``note``."""
+    row.requirements = {scope: {name: dict(score.values) for name, score in scores[scope].items()}
+                        for scope in SCOPE_WORDS if scope in scores} or None
+    broken = violations(scores)
+    if broken and row.status == "ok":
+        row.status = "violated"
+    own = [row.message] if row.message else []
+    parts = (own + broken if row.status != "violated" else broken + own) + ([note] if note else [])
+    row.message = "; ".join(parts)
 
 
 def _check_physical(row: Row, scope: str, metrics: dict[str, Any] | None) -> None:
@@ -98,34 +141,54 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
          spec.compile), build)
     controllers = scenario.controllers
     labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in controllers])
-    references: dict[int, tuple[Reference, dict[str, Any] | None]] = {}
+    references: dict[int, tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]] = {}
+    scoring = _SCORE_REQUIREMENTS and bool(scenario.requirements)
+    broken_ends = endpoint_violations(scenario.problem) if scoring else []
     rows: list[Row] = []
     for label, i, j in labels:
+        scores: dict[str, dict[str, Score]] = {}
         if i is None:  # regulation mode: the controller alone, to the target
             row = Row(label, None, "ok", "regulation to the target", None, None, None, controller=controllers[j].name)
             _simulate(scenario, simulator, None, row, controllers[j])
             timing = f"simulated in {row.simulate_time_s:.2f} s"
+            note = ""
         else:
+            planner_spec = scenario.planners[i]
+            if broken_ends:  # no planner can meet them: nothing is planned
+                references.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends)), None, None))
             if i not in references:  # planned once, tracked by every controller
-                references[i] = _plan(scenario, scenario.planners[i], cache)
-            reference, reference_metrics = references[i]
-            row = Row(label, scenario.planners[i].name, reference.status, reference.message,
+                references[i] = _plan(scenario, planner_spec, cache, scoring)
+            reference, reference_metrics, sampled = references[i]
+            row = Row(label, planner_spec.name, reference.status, reference.message,
                       reference.plan_time_s, None if reference_metrics is None else dict(reference_metrics), None,
                       reference, controller=controllers[j].name)
             if reference.ok:
                 _check_physical(row, "reference", row.reference_metrics)
+                if sampled is not None:
+                    scores["reference"] = score_reference(scenario.requirements, scenario.problem, *sampled,
+                                                          controllers[j].controller)
                 _simulate(scenario, simulator, reference, row, controllers[j])
             timing = (f"planned in {(row.plan_time_s or 0.0) * 1e3:.1f} ms, "
                       f"simulated in {row.simulate_time_s:.2f} s")
+            note = unhonoured(scenario.requirements, planner_spec.planner) if scoring and not broken_ends else ""
+        if scoring and row.simulation is not None:
+            end = row.reference.duration if row.reference is not None else scenario.problem.duration
+            result = row.simulation
+            scores["closed_loop"] = score_closed_loop(scenario.requirements, scenario.problem, result.t, result.q,
+                                                      result.omega, end)
+        if scoring:
+            _judge(row, scores, note)
         rows.append(row)
         say(f"[{len(rows)}/{len(labels)}] {row.label}: {row.status} ({timing})"
             + (f" - {row.message}" if row.status != "ok" else ""))
     return RunResults(scenario, rows)
 
 
-def _plan(scenario: Scenario, planner_spec: PlannerSpec,
-          cache: SolverCache | None) -> tuple[Reference, dict[str, Any] | None]:
-    """A planner's reference (a failed one when it raises) and the reference's metrics (None when failed)."""
+def _plan(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache | None,
+          scoring: bool = False) -> tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]:
+    """A planner's reference (a failed one when it raises), the reference's metrics (None when
+    failed) and, when ``scoring``, its times and sample for the requirements (one sampling serves
+    both: the metrics' uniform times come first)."""
     spec = scenario.simulation
     planner = planner_spec.planner.with_cache(cache)
     try:
@@ -134,10 +197,15 @@ def _plan(scenario: Scenario, planner_spec: PlannerSpec,
         traceback.print_exc()
         reference = FailedReference(planner_spec.name, f"planner raised {type(error).__name__}: {error}")
     if not reference.ok:
-        return reference, None
-    return reference, metrics_from_reference(
-        reference, scenario.problem.qf, scenario.problem.omegaf,
+        return reference, None, None
+    times = (reference_times(reference.duration, _window(scenario, reference), spec.sample_time, REFERENCE_POINTS)
+             if scoring else np.linspace(0.0, reference.duration, REFERENCE_POINTS))
+    sample = reference.sample(times)
+    metrics = metrics_from_reference(
+        reference, scenario.problem.qf, scenario.problem.omegaf, points=REFERENCE_POINTS,
         settling_tolerance_deg=spec.settling_tolerance_deg,
         fine_settling_tolerance_deg=spec.fine_settling_tolerance_deg,
         inertia=scenario.problem.spacecraft.inertia, detumble_tolerance=spec.detumble_tolerance,
-        initial_omega=scenario.problem.omega0)
+        initial_omega=scenario.problem.omega0,
+        sample=ReferenceSample(*(values[:REFERENCE_POINTS] for values in sample)))
+    return reference, metrics, (times, sample) if scoring else None

@@ -8,7 +8,7 @@ import numpy as np
 from ocp import METRIC_KEYS, quat
 from ocp.metrics import METRIC_INFO, MetricInfo, compute_metrics
 
-NEVER_NULL = {"int_u2", "int_u", "int_abs_u", "peak_u", "final_rate"}
+NEVER_NULL = {"int_u2", "int_u", "int_abs_u", "peak_body_torque", "final_rate"}
 """Keys that compute_metrics fills whatever the optional inputs (read off its return statement)."""
 
 

@@ -68,7 +68,8 @@ def metrics():
 
 
 def test_every_key_is_tested_here():
-    tested = {"int_u2", "int_u", "int_abs_u", "peak_u", "final_error_deg", "final_rate_error", "rms_error_deg",
+    tested = {"int_u2", "int_u", "int_abs_u", "peak_body_torque", "peak_actuator_torque", "peak_wheel_torque",
+              "final_error_deg", "final_rate_error", "rms_error_deg",
               "max_error_deg", "settling_time_s", "saturation_fraction", "peak_wheel_momentum", "plan_time_s",
               "duration_s", "initial_rate_error", "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
               "fine_settling_time_s"}
@@ -83,7 +84,7 @@ def test_zero_order_hold_integrals(metrics):
     assert metrics["int_u2"] == pytest.approx(int_u2, rel=1e-12)
     assert metrics["int_u"] == pytest.approx(int_u, rel=1e-12)
     assert metrics["int_abs_u"] == pytest.approx(int_abs, rel=1e-12)
-    assert metrics["peak_u"] == pytest.approx(0.05, rel=1e-12)  # |−0.05|, a negative component
+    assert metrics["peak_actuator_torque"] == pytest.approx(0.05, rel=1e-12)  # |−0.05|, a negative component
 
 
 def test_errors_to_the_target(metrics):
@@ -106,6 +107,27 @@ def test_settling_edge_cases():
 def test_tracking_errors(metrics):
     assert metrics["rms_error_deg"] == pytest.approx(math.sqrt(sum(e * e for e in TRACKING_DEG) / 5), rel=1e-9)
     assert metrics["max_error_deg"] == pytest.approx(3.0, rel=1e-9)
+
+
+def test_peak_body_and_wheel_torques_by_hand():
+    """Two wheels on x and y holding momentum: the body torque is the applied actuator torque less
+    ω × A h_w at the start of each sample, the wheel torque the applied motor torque."""
+    axes = np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
+    spacecraft = Spacecraft([2.0, 3.0, 4.0], wheels=ReactionWheels(axes=axes, max_torque=0.1))
+    t = np.array([0.0, 1.0, 3.0])
+    q = np.tile(quat.IDENTITY, (3, 1))
+    omega = np.array([[0.0, 0.0, 0.5], [0.1, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    h = np.array([[0.2, -0.1], [0.0, 0.3], [0.0, 0.0]])
+    g = np.array([[0.01, -0.02], [0.004, 0.003]])
+    actuator = np.array([[-0.01, 0.02, 0.0], [-0.004, -0.003, 0.0]])  # −A g
+    result = SimulationResult(AttitudeModel(spacecraft), 1.0, t, np.hstack([q, omega, h]), g, g, actuator,
+                              np.zeros(2, dtype=bool))
+    metrics = metrics_from_simulation(result, None)
+    # sample 0: ω × A h = [0, 0, 0.5] × [0.2, −0.1, 0] = [0.05, 0.1, 0]; u = [−0.06, −0.08, 0]
+    # sample 1: [0.1, 0, 0] × [0, 0.3, 0] = [0, 0, 0.03]; u = [−0.004, −0.003, −0.03]
+    assert metrics["peak_body_torque"] == pytest.approx(0.08, rel=1e-12)
+    assert metrics["peak_actuator_torque"] == pytest.approx(0.02, rel=1e-12)
+    assert metrics["peak_wheel_torque"] == pytest.approx(0.02, rel=1e-12)
 
 
 def test_actuator_metrics_and_passed_values(metrics):
@@ -138,7 +160,8 @@ def test_reference_integrals_against_closed_forms():
     s = math.sqrt(a * a * T * T + b * b)
     assert metrics["int_u"] == pytest.approx(T * s / 2 + b * b * math.asinh(a * T / abs(b)) / (2 * a), rel=1e-6)
     assert metrics["int_abs_u"] == pytest.approx([a * T**2 / 2, abs(b) * T, 0.0], rel=1e-9)
-    assert metrics["peak_u"] == pytest.approx(max(a * T, abs(b)))
+    assert metrics["peak_body_torque"] == pytest.approx(max(a * T, abs(b)))
+    assert metrics["peak_actuator_torque"] is None and metrics["peak_wheel_torque"] is None  # closed loop only
     assert metrics["final_rate_error"] == pytest.approx(0.1)
     assert metrics["initial_rate_error"] == pytest.approx(0.05)  # ‖[0, −0.03, 0.04]‖
     assert metrics["duration_s"] == T and metrics["final_error_deg"] is None

@@ -37,7 +37,8 @@ BASE = {
     "controller": {"name": "augmented_quaternion_feedback", "options": {"kp": 0.2, "kd": 0.6}},
     "simulation": {"sample_time": 1.0, "duration": 35.0},
 }
-ROW_KEYS = {"label", "planner", "controller", "status", "message", "plan_time_s", "reference", "closed_loop"}
+ROW_KEYS = {"label", "planner", "controller", "status", "message", "plan_time_s", "reference", "closed_loop",
+            "requirements"}
 IDENTITY = ["label", "planner", "controller", "status", "message", "plan_time_s"]
 
 
@@ -68,7 +69,7 @@ def expected_metric_columns():
 def hand_built_results():
     scenario = scenarios.parse_scenario(copy.deepcopy(BASE))
     reference = dict.fromkeys(METRIC_KEYS)
-    reference.update(int_u2=2.0, int_u=math.nan, peak_u=math.inf, settling_time_s=-math.inf,
+    reference.update(int_u2=2.0, int_u=math.nan, peak_body_torque=math.inf, settling_time_s=-math.inf,
                      int_abs_u=[1.0, math.nan, 3.0], duration_s=30.0)
     closed = dict.fromkeys(METRIC_KEYS)
     closed.update(final_error_deg=0.25, int_u=0.5)
@@ -92,7 +93,7 @@ def test_missing_and_non_finite_values_are_null_in_json_empty_in_csv_and_float_n
     odd, regulating = read_csv(text)
     assert (odd["ref.int_u2"], odd["ref.int_abs_u_x"], odd["ref.int_abs_u_z"], odd["ref.duration_s"]) == \
         ("2.0", "1.0", "3.0", "30.0")
-    for column in ("ref.int_u", "ref.peak_u", "ref.settling_time_s", "ref.int_abs_u_y", "ref.rms_error_deg", "cl.int_u"):
+    for column in ("ref.int_u", "ref.peak_body_torque", "ref.settling_time_s", "ref.int_abs_u_y", "ref.rms_error_deg", "cl.int_u"):
         assert odd[column] == "", column
     assert odd["plan_time_s"] == "0.125" and regulating["plan_time_s"] == "" and regulating["planner"] == ""
     assert regulating["cl.final_error_deg"] == "0.25" and regulating["ref.int_u"] == ""
@@ -102,13 +103,13 @@ def test_missing_and_non_finite_values_are_null_in_json_empty_in_csv_and_float_n
     numeric = ["plan_time_s", *expected_metric_columns()]
     assert all(frame[column].dtype == "float64" for column in numeric), frame.dtypes[frame.dtypes != "float64"]
     assert not frame[numeric].map(lambda value: value is None).to_numpy().any()
-    for column in ("ref.int_u", "ref.peak_u", "ref.settling_time_s", "ref.int_abs_u_y", "cl.int_u"):
+    for column in ("ref.int_u", "ref.peak_body_torque", "ref.settling_time_s", "ref.int_abs_u_y", "cl.int_u"):
         assert math.isnan(frame.loc[0, column]), column
     assert frame.loc[0, "ref.int_u2"] == 2.0 and frame.loc[1, "cl.int_u"] == 0.5 and math.isnan(frame.loc[1, "plan_time_s"])
 
     markdown = results.to_markdown()
     assert "| ref.int_u | - | - |" in markdown and "| ref.int_u2 | 2 | - |" in markdown
-    assert "| ref.peak_u | - | - |" in markdown and "nan" not in markdown and "inf" not in markdown
+    assert "| ref.peak_body_torque | - | - |" in markdown and "nan" not in markdown and "inf" not in markdown
 
 
 def test_a_runs_results_csv_and_a_sweeps_cases_csv_agree_cell_for_cell(tmp_path):

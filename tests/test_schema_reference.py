@@ -40,12 +40,14 @@ ROOT = Path(__file__).resolve().parents[1]
 
 MAXIMAL_A = """
 name: maximal-a
+epoch: 2027-03-20T12:00:00Z
 spacecraft:
   inertia: [[2.0, 0.0, 0.0], [0.0, 3.0, 0.0], [0.0, 0.0, 4.0]]
   wheels: {axes: [[1, 0, 0], [0, 1, 0], [0, 0, 1]], max_torque: 0.05, max_momentum: [1.0, 1.0, 1.0],
            spin_inertia: 0.001, failed: []}
   magnetorquers: {max_dipole: 0.1, saturation: scale}
   torquers: {max_torque: 0.01}
+  sensors: {star_tracker: {boresight: [0, 0, 1]}, antenna: {boresight: [1, 0, 0]}}
 orbit: {altitude_km: 600, inclination_deg: 97.79, raan_deg: 10.0, arg_latitude_deg: 5.0}
 environment:
   gravity_gradient: true
@@ -74,6 +76,13 @@ simulation:
   detumble_tolerance: 0.01
   max_samples: 100000
   compile: false
+requirements:
+  pointing:
+    st_out: {sensor: star_tracker, keep_out: {inertial: [0, 1, 0]}, angle_deg: 20}
+    antenna_in: {sensor: antenna, keep_in: {inertial: [1, 0, 0]}, angle_deg: 60, window: [10, null]}
+  actuators: {margin: 0.1}
+  rate: {max: 0.2}
+  final: {after_s: 5, error_deg: 1.0, rate: 0.01}
 """
 
 MAXIMAL_B = """
@@ -173,8 +182,12 @@ def yaml_paths(data: Any, prefix: str = "") -> set[str]:
 
 def scenario_path(path: str) -> str:
     """A scenario path as the reference writes it: indices as ``[i]``, ``controllers[i]`` as
-    ``controller`` (both take the keys of one controller)."""
-    return re.sub(r"\[\d+\]", "[i]", path).replace("controllers[i]", "controller")
+    ``controller`` (both take the keys of one controller), a user's name under a key of named
+    entries (``spacecraft.sensors.st``) as ``<name>``."""
+    path = re.sub(r"\[\d+\]", "[i]", path).replace("controllers[i]", "controller")
+    for named in {entry.path.split(".<name>")[0] for entry in entries() if ".<name>" in entry.path}:
+        path = re.sub(rf"^{re.escape(named)}\.[^.]+", f"{named}.<name>", path)
+    return path
 
 
 # --- every key accepted is documented, every documented key accepted ------------------------------

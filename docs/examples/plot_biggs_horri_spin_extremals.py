@@ -93,7 +93,7 @@ print("largest relative difference:", f"{np.max(np.abs(ours / paper_amplitudes -
 tracking = {}
 for gains in rows:
     metrics = rows[gains]["paper eq.35-37"].closed_loop_metrics
-    tracking[gains] = {"peak |u_i| [N m]": metrics["peak_u"],
+    tracking[gains] = {"peak actuator torque |τ_i| [N m]": metrics["peak_actuator_torque"],
                        "saturated samples": metrics["saturation_fraction"],
                        "final error [deg]": metrics["final_error_deg"],
                        "RMS tracking error [deg]": metrics["rms_error_deg"]}

@@ -46,7 +46,7 @@ print(f"{len(cases)} rows, statuses: {cases['status'].value_counts().to_dict()}"
 # One row per case and planner; the columns are the study's ``summary`` metrics (``ref.`` of the
 # reference itself, ``cl.`` of the closed loop).
 angle = "maneuver.final.q"
-columns = ["ref.int_u", "cl.int_u", "cl.peak_u", "cl.rms_error_deg", "cl.settling_time_s"]
+columns = ["ref.int_u", "cl.int_u", "cl.peak_actuator_torque", "cl.rms_error_deg", "cl.settling_time_s"]
 table = cases.pivot_table(index=[angle, "label"], values=columns, sort=True)[columns]
 print(table.to_string(float_format="{:.4g}".format))
 

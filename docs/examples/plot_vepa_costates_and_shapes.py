@@ -101,9 +101,9 @@ fig.tight_layout()
 table = {}
 for label, row in acquisition.items():
     table[label] = {"t_f [s]": row.reference.duration,
-                    "reference peak |u_i| [N m]": row.reference_metrics["peak_u"],
+                    "reference peak body torque [N m]": row.reference_metrics["peak_body_torque"],
                     "closed loop ∫‖u‖ dt [N m s]": row.closed_loop_metrics["int_u"],
-                    "closed loop peak |u_i| [N m]": row.closed_loop_metrics["peak_u"],
+                    "closed loop peak actuator torque [N m]": row.closed_loop_metrics["peak_actuator_torque"],
                     "largest tracking error [deg]": row.closed_loop_metrics["max_error_deg"]}
 with pd.option_context("display.float_format", "{:.4g}".format):
     print(pd.DataFrame(table).T.to_string())

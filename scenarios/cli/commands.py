@@ -1,7 +1,9 @@
 """``slewbench`` command line: run, validate, list, schema, codegen, sweep.
 
-Exit status: 0 when the run completed (a failed planner is a row, not an error), 2 for a bad
-scenario file or an output location slewbench must not or cannot write to, 1 for an internal error.
+Exit status (:mod:`scenarios.cli.status`): 0 when the run completed (a failed planner or a
+violated requirement is a row, not an error), 1 under ``run --strict`` when some row is not ``ok``
+(the results are written all the same), 2 for a bad scenario file or an output location slewbench
+must not or cannot write to, 1 for an internal error.
 """
 from __future__ import annotations
 
@@ -21,6 +23,8 @@ from scenarios.cli.status import (
     EXIT_BAD_OUTPUT,
     EXIT_BAD_SCENARIO,
     EXIT_INTERNAL,
+    EXIT_INTERRUPTED,
+    EXIT_NOT_OK,
     EXIT_OK,
 )
 from scenarios.cli.sweep import add_sweep_parser
@@ -106,14 +110,15 @@ def command_run(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         ``file`` (scenario YAML), ``out`` (output directory or ``None``: ``results/<name>``),
-        ``no_plots`` (skip the PNG figures), and, set by :func:`main` (optional): ``interruption``
-        (an :class:`Interruption`) and ``renderer`` (a :class:`scenarios.output.renderer.Renderer` to
-        draw the plots, or ``None``).
+        ``no_plots`` (skip the PNG figures), ``strict`` (optional: exit 1 when a row is not ok), and,
+        set by :func:`main` (optional): ``interruption`` (an :class:`Interruption`) and ``renderer``
+        (a :class:`scenarios.output.renderer.Renderer` to draw the plots, or ``None``).
 
     Returns
     -------
     int
-        Exit status (0: the run completed; failed planners are rows, not errors).
+        Exit status: 0, the run completed (failed and violated rows are results, not errors); 1
+        with ``strict`` when some row is not ``ok`` (the results are written first).
     """
     scenario = load(args.file)
     out = Path(args.out) if args.out else default_output_directory(scenario.name)
@@ -132,6 +137,11 @@ def command_run(args: argparse.Namespace) -> int:
     results.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
     print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
           f"{'' if args.no_plots else ', PNG plots'}) in {time.perf_counter() - start:.2f} s")
+    not_ok = [row.label for row in results.rows if row.status != "ok"]
+    if getattr(args, "strict", False) and not_ok:
+        print(f"slewbench: --strict: {len(not_ok)} of {len(results.rows)} rows not ok ({', '.join(not_ok)})",
+              file=sys.stderr)
+        return EXIT_NOT_OK
     return EXIT_OK
 
 
@@ -171,12 +181,19 @@ def build_parser() -> argparse.ArgumentParser:
     argparse.ArgumentParser
         Each sub-command sets ``handler``, the function that runs it.
     """
-    parser = argparse.ArgumentParser(prog="slewbench", description="Spacecraft attitude manoeuvre planning workbench")
+    parser = argparse.ArgumentParser(
+        prog="slewbench", description="Spacecraft attitude manoeuvre planning workbench",
+        epilog=f"exit status: {EXIT_OK} done (failed and violated rows are results); {EXIT_NOT_OK} a row not ok "
+               f"under run --strict; {EXIT_BAD_SCENARIO} bad scenario or study file, or output location; "
+               f"{EXIT_INTERNAL} internal error or interrupted run; {EXIT_INTERRUPTED} interrupted sweep")
     commands = parser.add_subparsers(dest="command", required=True)
     run_parser = commands.add_parser("run", help="plan, simulate and score every planner of a scenario")
     run_parser.add_argument("file", help="scenario YAML file")
     run_parser.add_argument("--out", help="output directory (default: results/<scenario name>)")
     run_parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    run_parser.add_argument("--strict", action="store_true",
+                            help=f"exit {EXIT_NOT_OK} when any row is not ok (violated or failed), after writing the "
+                                 "results (for continuous integration)")
     run_parser.set_defaults(handler=command_run)
     validate_parser = commands.add_parser("validate", help="check a scenario file")
     validate_parser.add_argument("file")
@@ -245,7 +262,7 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     -------
     int
         Exit status: 0 done, 2 bad scenario file or output location (the message names its path),
-        1 internal error or interrupted.
+        1 internal error or interrupted, or a row not ok under ``run --strict``.
     """
     args = build_parser().parse_args(argv)
     args.interruption = Interruption()

@@ -4,12 +4,16 @@ May import: nothing of slewbench.
 """
 from __future__ import annotations
 
-__all__ = ["EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_OK"]
+__all__ = ["EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_NOT_OK", "EXIT_OK"]
 
 EXIT_OK = 0
-"""The command completed (a run's failed rows included: they are results)."""
+"""The command completed (a run's failed and violated rows included: they are results), unless
+``run --strict`` found a row that is not ok."""
 EXIT_INTERNAL = 1
 """An internal error (a bug), or a run interrupted by Ctrl-C or SIGTERM."""
+EXIT_NOT_OK = 1
+"""``slewbench run --strict``: the run completed and wrote its results, and some row is not ``ok``
+(``violated`` or ``failed``): for users' continuous integration."""
 EXIT_BAD_SCENARIO = 2
 """A bad scenario or study file (or key of ``slewbench schema``): nothing was written."""
 EXIT_BAD_OUTPUT = 2

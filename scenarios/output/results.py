@@ -35,10 +35,12 @@ class Row:
     planner : str or None
         Planner registry name; ``None`` in regulation mode.
     status : str
-        ``"ok"``, ``"failed"`` (a failed planner, simulation or unphysical metrics) or, in a trade
-        study, ``"crashed"`` (the case raised, timed out or lost its worker).
+        ``"ok"``; ``"violated"`` (the reference or the closed loop breaks a requirement of the
+        scenario); ``"failed"`` (a failed planner or simulation, unphysical metrics, or a pointing
+        requirement the end points already break); or, in a trade study, ``"crashed"`` (the case
+        raised, timed out or lost its worker). Ranked crashed, failed > violated > ok.
     message : str
-        Why it failed (empty when ok).
+        Why it failed or what it breaks, and what its planner does not honour (may be empty when ok).
     plan_time_s : float or None
         Planning time [s]; ``None`` in regulation mode and for a crashed case.
     reference_metrics : dict or None
@@ -53,6 +55,10 @@ class Row:
         Simulation time [s].
     controller : str or None, optional
         Controller registry name.
+    requirements : dict or None, optional
+        The requirement scores by scope (``reference``, ``closed_loop``), then requirement name,
+        then field (:mod:`scenarios.requirements.scoring`); ``None`` when the scenario has no
+        requirements.
     """
 
     label: str
@@ -66,6 +72,7 @@ class Row:
     simulation: SimulationResult | None = field(default=None, repr=False)
     simulate_time_s: float = 0.0
     controller: str | None = None
+    requirements: dict[str, dict[str, dict[str, Any]]] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The row's plain, nested form: a ``results.json`` row and a trade study's stored row.
@@ -77,12 +84,13 @@ class Row:
         -------
         dict
             ``label``, ``planner``, ``controller``, ``status``, ``message``, ``plan_time_s``,
-            ``reference`` and ``closed_loop`` (the two metric dicts, or ``None``).
+            ``reference`` and ``closed_loop`` (the two metric dicts, or ``None``) and
+            ``requirements`` (the requirement scores by scope, name and field, or ``None``).
         """
         return {"label": self.label, "planner": self.planner, "controller": self.controller,
                 "status": self.status, "message": self.message,
                 "plan_time_s": self.plan_time_s, "reference": self.reference_metrics,
-                "closed_loop": self.closed_loop_metrics}
+                "closed_loop": self.closed_loop_metrics, "requirements": self.requirements}
 
 
 @dataclass
@@ -108,9 +116,28 @@ class RunResults:
         Returns
         -------
         dict
-            ``{"scenario": name, "rows": [Row.to_dict(), ...]}``.
+            ``{"scenario": name, "frame": ..., "epoch": ..., "rows": [Row.to_dict(), ...]}``: the
+            inertial frame the attitudes are in (``GCRF`` with an epoch, else ``inertial (no
+            epoch)``) and the epoch (UTC, ISO 8601 with ``Z``, or ``None``).
         """
-        return {"scenario": self.scenario.name, "rows": [row.to_dict() for row in self.rows]}
+        epoch = self.scenario.epoch
+        return {"scenario": self.scenario.name, "frame": self.scenario.frame,
+                "epoch": None if epoch is None else epoch.isoformat() + "Z",
+                "rows": [row.to_dict() for row in self.rows]}
+
+    def status_counts(self) -> dict[str, int]:
+        """How many rows have each status, in rank order (``failed``, ``violated``, ``ok``, then any other).
+
+        Returns
+        -------
+        dict of str to int
+            Status -> number of rows (statuses without rows left out).
+        """
+        order = ["crashed", "failed", "violated", "ok"]
+        counts = {status: sum(row.status == status for row in self.rows) for status in order}
+        for row in self.rows:
+            counts.setdefault(row.status, sum(other.status == row.status for other in self.rows))
+        return {status: count for status, count in counts.items() if count}
 
     def to_json(self) -> str:
         """``results.json``'s text (non-finite numbers written as ``null``).

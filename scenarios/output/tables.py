@@ -3,9 +3,11 @@
 A row's plain form is nested (:meth:`scenarios.output.results.Row.to_dict`: ``reference`` and
 ``closed_loop`` metric dicts); its flat form (:func:`flatten_row`) has one column per metric and
 scope, ``ref.<metric>`` and ``cl.<metric>`` (:mod:`scenarios.schema.columns`), a vector metric split into ``<metric>_x``, ``_y`` and
-``_z``. A run's ``results.csv`` and :meth:`~scenarios.output.results.RunResults.to_dataframe`, a
-trade study's ``cases.csv``, :meth:`~scenarios.study.engine.SweepResults.to_dataframe` and its
-``summary:`` keys all use these columns.
+``_z``, then the requirement scores, ``ref.req.<name>.<field>`` and ``cl.req.<name>.<field>``
+(:func:`requirement_columns`: which there are depends on the scenario's requirements). A run's
+``results.csv`` and :meth:`~scenarios.output.results.RunResults.to_dataframe`, a trade study's
+``cases.csv``, :meth:`~scenarios.study.engine.SweepResults.to_dataframe` and its ``summary:`` keys
+all use these columns.
 
 Missing and non-finite numbers (NaN, ±inf: a metric that does not apply, or a failed row's) follow
 one rule, applied by every writer here: JSON writes ``null`` (:func:`json_safe`), CSV an empty cell
@@ -23,9 +25,11 @@ from typing import TYPE_CHECKING, Any
 
 from scenarios.schema.columns import (
     AXES,
+    REQUIREMENT_MARK,
     SCOPES,
     SCORED_METRICS,
     VECTOR_METRICS,
+    is_requirement_column,
     metric_columns,
 )
 
@@ -55,26 +59,63 @@ def is_missing(value: Any) -> bool:
 
 
 
-def row_columns() -> list[str]:
-    """The columns of a flat row: :data:`IDENTITY_COLUMNS`, then :func:`metric_columns`.
+def requirement_columns(rows: Iterable[Mapping[str, Any]]) -> list[str]:
+    """The requirement columns of some rows, in order: the reference's then the closed loop's, each
+    in the order the rows first give them.
+
+    Parameters
+    ----------
+    rows : iterable of mapping
+        Rows as :meth:`scenarios.output.results.Row.to_dict` gives them (``requirements``: scope ->
+        requirement name -> field -> value, or ``None``).
 
     Returns
     -------
     list of str
-        ``label, planner, controller, status, message, plan_time_s, ref.int_u2, ...``.
+        ``ref.req.<name>.<field>`` then ``cl.req.<name>.<field>``.
     """
-    return [*IDENTITY_COLUMNS, *metric_columns()]
+    found: dict[str, dict[str, None]] = {prefix: {} for _, prefix in SCOPES}
+    for row in rows:
+        scores = row.get("requirements") or {}
+        for scope, prefix in SCOPES:
+            for name, fields in (scores.get(scope) or {}).items():
+                for key in fields:
+                    found[prefix].setdefault(f"{prefix}.{REQUIREMENT_MARK}.{name}.{key}")
+    return [column for _, prefix in SCOPES for column in found[prefix]]
 
 
-def numeric_columns() -> list[str]:
+def row_columns(requirements: Sequence[str] = ()) -> list[str]:
+    """The columns of a flat row: :data:`IDENTITY_COLUMNS`, :func:`metric_columns`, then the
+    requirement columns given.
+
+    Parameters
+    ----------
+    requirements : sequence of str, optional
+        Requirement columns (:func:`requirement_columns` of the rows); default none.
+
+    Returns
+    -------
+    list of str
+        ``label, planner, controller, status, message, plan_time_s, ref.int_u2, ..., ref.req...``.
+    """
+    return [*IDENTITY_COLUMNS, *metric_columns(), *requirements]
+
+
+def numeric_columns(requirements: Sequence[str] = ()) -> list[str]:
     """The columns of a flat row that hold numbers (float in a DataFrame).
 
+    Parameters
+    ----------
+    requirements : sequence of str, optional
+        Requirement columns present; default none (:func:`data_frame` takes every requirement
+        column of its columns as numeric anyway).
+
     Returns
     -------
     list of str
-        ``plan_time_s`` and every metric column.
+        ``plan_time_s``, every metric column and the requirement columns given.
     """
-    return ["plan_time_s", *metric_columns()]
+    return ["plan_time_s", *metric_columns(), *requirements]
 
 
 def flatten_row(row: Mapping[str, Any]) -> dict[str, Any]:
@@ -89,8 +130,9 @@ def flatten_row(row: Mapping[str, Any]) -> dict[str, Any]:
     Returns
     -------
     dict
-        Keyed by :func:`row_columns`; a metric the row lacks (no reference, not simulated, crashed)
-        is ``None``, other values are as given (the writers apply the non-finite rule).
+        Keyed by :func:`row_columns` and the row's own requirement columns; a metric the row lacks
+        (no reference, not simulated, crashed) is ``None``, other values are as given (the
+        writers apply the non-finite rule).
     """
     flat = {name: row.get(name) for name in IDENTITY_COLUMNS}
     for scope, prefix in SCOPES:
@@ -102,6 +144,11 @@ def flatten_row(row: Mapping[str, Any]) -> dict[str, Any]:
                     flat[f"{prefix}.{key}_{axis}"] = component
             else:
                 flat[f"{prefix}.{key}"] = value
+    scores = row.get("requirements") or {}
+    for scope, prefix in SCOPES:
+        for name, fields in (scores.get(scope) or {}).items():
+            for key, value in fields.items():
+                flat[f"{prefix}.{REQUIREMENT_MARK}.{name}.{key}"] = value
     return flat
 
 
@@ -180,7 +227,8 @@ def data_frame(columns: Sequence[str], records: Iterable[Mapping[str, Any]], num
     records : iterable of mapping
         The lines.
     numeric : iterable of str
-        The columns that hold numbers (never ``None`` in the DataFrame).
+        The columns that hold numbers (never ``None`` in the DataFrame); the requirement columns
+        (:func:`~scenarios.schema.columns.is_requirement_column`) are numeric too.
 
     Returns
     -------
@@ -196,7 +244,7 @@ def data_frame(columns: Sequence[str], records: Iterable[Mapping[str, Any]], num
         import pandas
     except ImportError:
         raise ImportError("to_dataframe needs pandas: pip install pandas") from None
-    numbers = set(numeric) & set(columns)
+    numbers = (set(numeric) | {column for column in columns if is_requirement_column(column)}) & set(columns)
     lines = [{column: (math.nan if is_missing(record.get(column)) else record.get(column)) if column in numbers
               else record.get(column) for column in columns} for record in records]
     frame = pandas.DataFrame(lines, columns=list(columns))
@@ -221,7 +269,8 @@ def to_json(results: RunResults) -> str:
 
 
 def to_csv(results: RunResults) -> str:
-    """``results.csv``: one line per row, the columns of :func:`row_columns`.
+    """``results.csv``: one line per row, the columns of :func:`row_columns` with the rows'
+    requirement columns.
 
     Parameters
     ----------
@@ -233,7 +282,8 @@ def to_csv(results: RunResults) -> str:
     str
         CSV text; missing and non-finite values are empty cells.
     """
-    return csv_text(row_columns(), (flatten_row(row.to_dict()) for row in results.rows))
+    rows = [row.to_dict() for row in results.rows]
+    return csv_text(row_columns(requirement_columns(rows)), (flatten_row(row) for row in rows))
 
 
 def to_dataframe(results: RunResults) -> pandas.DataFrame:
@@ -247,15 +297,18 @@ def to_dataframe(results: RunResults) -> pandas.DataFrame:
     Returns
     -------
     pandas.DataFrame
-        One line per row, the columns of :func:`row_columns`; ``plan_time_s`` and the metric
-        columns are float, NaN where missing or non-finite.
+        One line per row, the columns of :func:`row_columns` (with the rows' requirement
+        columns); ``plan_time_s``, the metric and the requirement columns are float, NaN where
+        missing or non-finite.
 
     Raises
     ------
     ImportError
         pandas is not installed.
     """
-    return data_frame(row_columns(), [flatten_row(row.to_dict()) for row in results.rows], numeric_columns())
+    rows = [row.to_dict() for row in results.rows]
+    requirements = requirement_columns(rows)
+    return data_frame(row_columns(requirements), [flatten_row(row) for row in rows], numeric_columns(requirements))
 
 
 def text_cell(value: Any) -> str:
@@ -280,15 +333,69 @@ def text_cell(value: Any) -> str:
     return str(value)
 
 
-def _metric_lines(results: RunResults) -> list[tuple[str, list[str]]]:
-    """(metric name, one formatted cell per row), reference metrics then closed-loop ones."""
+def _metric_lines(results: RunResults, requirements: bool = True) -> list[tuple[str, list[str]]]:
+    """(metric name, one formatted cell per row), reference metrics then closed-loop ones, then
+    (``requirements``) every requirement column."""
     rows = [row.to_dict() for row in results.rows]
     lines = [("status", [row["status"] for row in rows]),
              ("plan_time_s", [text_cell(row["plan_time_s"]) for row in rows])]
     for scope, prefix in SCOPES:
         for key in SCORED_METRICS:
             lines.append((f"{prefix}.{key}", [text_cell((row[scope] or {}).get(key)) for row in rows]))
+    if requirements:
+        flat = [flatten_row(row) for row in rows]
+        lines += [(column, [text_cell(line.get(column)) for line in flat]) for column in requirement_columns(rows)]
     return lines
+
+
+_HEADLINES = (("min_margin_deg", "min margin, deg"), ("ratio", "peak rate / bound"),
+              ("worst_error_deg", "worst error after T, deg"))
+"""The number the terminal shows of a requirement, by the field that identifies its kind (the
+actuators, which have none of these: the largest demand over its limit)."""
+
+
+def _headline(values: Mapping[str, Any] | None) -> tuple[str, Any]:
+    """(what the number is, the number) of one requirement's score."""
+    if not values:
+        return "", None
+    for key, words in _HEADLINES:
+        if key in values:
+            return words, values[key]
+    ratios = [value for key, value in values.items() if not key.endswith("_time_s") and value is not None]
+    return "peak demand / limit", max(ratios) if ratios else None
+
+
+def _requirement_lines(results: RunResults) -> list[tuple[str, list[str]]]:
+    """One line per requirement for the terminal: its headline number, ``reference | closed loop``."""
+    scores = [row.requirements or {} for row in results.rows]
+    names: dict[str, None] = {}
+    for row in scores:
+        for scope, _ in SCOPES:
+            names.update(dict.fromkeys(row.get(scope) or {}))
+    lines = []
+    for name in names:
+        words = next((_headline(row.get(scope, {}).get(name))[0] for row in scores for scope, _ in SCOPES
+                      if row.get(scope, {}).get(name)), "")
+        cells = [" | ".join(text_cell(_headline(row.get(scope, {}).get(name))[1]) for scope, _ in SCOPES)
+                 for row in scores]
+        lines.append((f"req.{name} ({words}; ref | cl)", cells))
+    return lines
+
+
+def status_line(results: RunResults) -> str:
+    """``rows: 4 (1 ok, 3 violated)``: the rows by status, in rank order.
+
+    Parameters
+    ----------
+    results : RunResults
+        The rows of a scenario run.
+
+    Returns
+    -------
+    str
+    """
+    counts = results.status_counts()
+    return f"rows: {len(results.rows)} (" + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")"
 
 
 def to_markdown(results: RunResults) -> str:
@@ -308,14 +415,16 @@ def to_markdown(results: RunResults) -> str:
     out = [f"# {results.scenario.name}", "", "| metric | " + " | ".join(labels) + " |",
            "|---|" + "---|" * len(labels)]
     out += [f"| {name} | " + " | ".join(cells) + " |" for name, cells in _metric_lines(results)]
-    out += ["", "Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s.", ""]
+    out += ["", ("Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s; "
+                 "actuator requirement fields: peak demand over the limit."), "", status_line(results), ""]
     out += [f"- **{row.label}** ({row.planner or 'regulation'}, {row.controller or '-'}): {row.message}"
             for row in results.rows]
     return "\n".join(out) + "\n"
 
 
 def to_terminal(results: RunResults) -> str:
-    """A fixed-width table with metrics as lines and planners as columns, then the messages.
+    """A fixed-width table with metrics as lines and planners as columns, one line per requirement
+    (its headline number, ``reference | closed loop``), then the messages and the rows by status.
 
     Parameters
     ----------
@@ -327,11 +436,11 @@ def to_terminal(results: RunResults) -> str:
     str
         Plain text for a terminal.
     """
-    lines = _metric_lines(results)
+    lines = _metric_lines(results, requirements=False) + _requirement_lines(results)
     labels = [row.label for row in results.rows]
     name_width = max(len(name) for name, _ in lines)
     widths = [max(len(label), *(len(cells[i]) for _, cells in lines)) for i, label in enumerate(labels)]
     header = " " * name_width + "  " + "  ".join(label.rjust(w) for label, w in zip(labels, widths))
     body = [name.ljust(name_width) + "  " + "  ".join(c.rjust(w) for c, w in zip(cells, widths)) for name, cells in lines]
     messages = [f"{row.label}: {row.message}" for row in results.rows if row.message]
-    return "\n".join([f"scenario: {results.scenario.name}", header, *body, "", *messages])
+    return "\n".join([f"scenario: {results.scenario.name}", header, *body, "", *messages, "", status_line(results)])

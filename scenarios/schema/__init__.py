@@ -4,7 +4,8 @@ section, the checks, and the schema reference generated from the keys.
 What lives here: bounded, duplicate-refusing YAML reading (:mod:`~scenarios.schema.read`), typed
 nodes whose errors name the YAML path (:mod:`~scenarios.schema.node`), the vocabulary the keys are
 declared in (:mod:`~scenarios.schema.keys`), the model sections (``spacecraft``, ``orbit``,
-``environment``; :mod:`~scenarios.schema.model`), the whole scenario and the
+``environment``; :mod:`~scenarios.schema.model`), the epoch, the sensors and the
+requirements (:mod:`~scenarios.schema.requirements`), the whole scenario and the
 :class:`~scenarios.schema.loader.Scenario` it builds (:mod:`~scenarios.schema.loader`), how planner
 and controller labels name the rows (:mod:`~scenarios.schema.labels`), the names of the metric
 columns (:mod:`~scenarios.schema.columns`), the checks of a parsed scenario as a whole
@@ -12,8 +13,8 @@ columns (:mod:`~scenarios.schema.columns`), the checks of a parsed scenario as a
 (:mod:`~scenarios.schema.study`), and the reference of them all (:mod:`~scenarios.schema.reference`:
 ``slewbench schema``).
 
-May import: :mod:`ocp`, :mod:`planners`, :mod:`controllers` and :mod:`scenarios.errors`; nothing
-else of :mod:`scenarios`. Its names are imported on first use.
+May import: :mod:`ocp`, :mod:`planners`, :mod:`controllers`, :mod:`scenarios.errors` and
+:mod:`scenarios.requirements`; nothing else of :mod:`scenarios`. Its names are imported on first use.
 """
 from __future__ import annotations
 

@@ -91,6 +91,9 @@ class Key:
         The keys of a nested mapping (of each entry of a list when ``entries``).
     entries : bool, optional
         The key holds a list of ``section`` mappings (``planners[i]``).
+    named : bool, optional
+        The key holds a mapping of names (chosen by the user) to ``section`` mappings
+        (``requirements.pointing.<name>``).
     """
 
     name: str
@@ -103,6 +106,7 @@ class Key:
     choices: tuple[str, ...] | Mapping[str, Any] = ()
     section: Section | None = None
     entries: bool = False
+    named: bool = False
 
     def node(self, parent: Node) -> Node:
         """This key's node in ``parent`` (marked as read), or its default's.
@@ -405,7 +409,7 @@ def mapping(name: str, meaning: str, section: Section, *, default: Any = REQUIRE
 
 def custom(name: str, meaning: str, type: str, read: Callable[[Node], Any] | None, *, unit: str = "",
            default: Any = REQUIRED, bounds: str = "", section: Section | None = None, entries: bool = False,
-           choices: tuple[str, ...] | Mapping[str, Any] = ()) -> Key:
+           choices: tuple[str, ...] | Mapping[str, Any] = (), named: bool = False) -> Key:
     """A key with a reader of its own (a value of several forms, a check across entries).
 
     Parameters
@@ -424,13 +428,15 @@ def custom(name: str, meaning: str, type: str, read: Callable[[Node], Any] | Non
         A list of ``section`` mappings.
     choices : tuple of str or mapping, optional
         Accepted words.
+    named : bool, optional
+        A mapping of names to ``section`` mappings.
 
     Returns
     -------
     Key
         The key.
     """
-    return Key(name, type, meaning, read, unit, default, bounds, choices, section, entries)
+    return Key(name, type, meaning, read, unit, default, bounds, choices, section, entries, named)
 
 
 # --- options declared as typed dataclasses (ocp.options) --------------------------------------

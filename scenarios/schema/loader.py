@@ -13,6 +13,7 @@ once, here: :class:`PlannerSpec` and :class:`ControllerSpec` carry the instances
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,9 +24,11 @@ import numpy as np
 from controllers import CONTROLLERS, Controller
 from ocp import Environment, SensorNoise, Spacecraft, quat
 from ocp.errors import OptionsError, excerpt
+from ocp.geometry.directions import Geometry
 from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem, Planner
 from scenarios.errors import ScenarioError
+from scenarios.requirements.spec import Requirements
 from scenarios.schema.checks import check_compatibility, check_row_labels, check_work
 from scenarios.schema.keys import (
     Described,
@@ -48,6 +51,13 @@ from scenarios.schema.model import (
 )
 from scenarios.schema.node import Node
 from scenarios.schema.read import read_yaml
+from scenarios.schema.requirements import (
+    REQUIREMENTS,
+    RunSpan,
+    check_ephemeris,
+    parse_epoch,
+    parse_requirements,
+)
 
 MAX_NAME = 200
 """Characters of a scenario name (the default output directory uses a sanitised, shorter stem)."""
@@ -179,6 +189,11 @@ class Scenario:
         Closed-loop settings.
     source : Path or None, optional
         The file it was read from; ``None`` for data parsed in memory.
+    requirements : Requirements, optional
+        What every row is scored against (``requirements``; default none). The pointing
+        requirements' constraints, tabulated for the run, are ``problem.pointing``.
+    epoch : datetime.datetime or None, optional
+        The instant of t = 0, UTC (``epoch``); ``None``: none.
     """
 
     name: str
@@ -187,6 +202,15 @@ class Scenario:
     controllers: list[ControllerSpec]
     simulation: SimulationSpec
     source: Path | None = None
+    requirements: Requirements = field(default_factory=Requirements)
+    epoch: datetime.datetime | None = None
+
+    @property
+    def frame(self) -> str:
+        """The inertial frame the attitudes and directions are in: ``GCRF`` with an epoch (the
+        Earth-centred frame of the ephemeris, :class:`~ocp.geometry.directions.Geometry`), else
+        ``inertial (no epoch)``: an Earth-centred inertial frame tied to no date."""
+        return Geometry(self.epoch, None).frame if self.epoch is not None else "inertial (no epoch)"
 
     @property
     def controller(self) -> ControllerSpec:
@@ -201,16 +225,20 @@ class Scenario:
         return np.concatenate([q0, p.omega0 + self.simulation.initial_rate_error, p.wheel_momentum0])
 
 
+def _table_window(problem: ManeuverProblem, simulation: SimulationSpec, planners: list) -> float:
+    """How far what follows the run is tabulated (a field, a direction): the closed-loop window
+    (twice the maneuver's when planners may return longer references) plus one minute [s]."""
+    return max(problem.duration * (2.0 if planners else 1.0), simulation.duration or 0.0) + 60.0
+
+
 def _fit_field_span(problem: ManeuverProblem, simulation: SimulationSpec, planners: list) -> ManeuverProblem:
     """Give a field whose extent follows the run (``for_window``: an IGRF table without ``span_s``)
-    the closed-loop window (twice the maneuver's when planners may return longer references) plus
-    one minute."""
+    the tabulated window (:func:`_table_window`)."""
     field_model = problem.environment.magnetic_field
     for_window = getattr(field_model, "for_window", None)
     if for_window is None:
         return problem
-    window = max(problem.duration * (2.0 if planners else 1.0), simulation.duration or 0.0) + 60.0
-    fitted = for_window(window)
+    fitted = for_window(_table_window(problem, simulation, planners))
     if fitted is field_model:
         return problem
     environment = dataclasses.replace(problem.environment, magnetic_field=fitted)
@@ -264,7 +292,9 @@ MANEUVER = Section((
     mapping("initial", "The initial state.", INITIAL),
     mapping("final", "The target state.", FINAL),
     number("duration", "Manoeuvre time T (a planner minimising time may choose its own).", unit="s", positive=True),
-    number("max_rate", "Bound on the body rate about any axis, for the planners that take one; ``null``: none.",
+    number("max_rate", "Bound on the body-rate norm ‖ω‖, for the planners that take one; ``null``: "
+           "``requirements.rate.max`` if given, else none. Given with ``requirements.rate``, it must not exceed "
+           "it (a tighter planning bound leaves the closed loop room).",
            unit="rad/s", default=None, positive=True, nullable=True),
 ), "The slew: boundary states, duration and rate bound.")
 
@@ -322,6 +352,10 @@ SIMULATION = Section((
 SCENARIO = Section((
     custom("name", f"The scenario's name (at most {MAX_NAME} characters; the default output directory is "
            "``results/<name>``, sanitised).", "text", _name),
+    custom("epoch", "The instant of t = 0, UTC, ISO 8601 (``2027-03-20T12:00:00Z``): places the orbit in the GCRF "
+           "and gives the Sun and the Moon (JPL DE421), checked against the ephemeris over the run; a magnetic "
+           "field model with an epoch of its own (IGRF) takes it when not given one. ``null``: none (the frame "
+           "is an inertial one tied to no date).", "text or null", parse_epoch, unit="UTC", default=None),
     custom("spacecraft", "The rigid body and its actuators.", "mapping", None, section=SPACECRAFT),
     custom("orbit", "A circular orbit; absent or ``null``: none.", "mapping or null", None, default=None,
            section=ORBIT),
@@ -335,6 +369,9 @@ SCENARIO = Section((
     custom("controllers", "Several controllers compared row by row (one row per planner and controller); "
            "labels unique.", "list of mappings", None, default=None, section=CONTROLLER, entries=True),
     mapping("simulation", "Closed-loop settings.", SIMULATION, default={}, null="defaults"),
+    custom("requirements", "What every row is scored against: pointing cones, the actuators' margin, a rate "
+           "limit, the final error (the user guide's page on requirements); absent or ``null``: none.", "mapping or null",
+           None, default={}, section=REQUIREMENTS),
 ), "A scenario file.")
 
 
@@ -443,18 +480,42 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     """
     root = Node(data).mapping()
     name = SCENARIO["name"].value(root)
-    spacecraft = parse_spacecraft(SCENARIO["spacecraft"].value(root))
-    environment = parse_environment(SCENARIO["orbit"].value(root), SCENARIO["environment"].value(root))
+    epoch = SCENARIO["epoch"].value(root)
+    spacecraft, sensors = parse_spacecraft(SCENARIO["spacecraft"].value(root))
+    environment = parse_environment(SCENARIO["orbit"].value(root), SCENARIO["environment"].value(root), epoch)
     problem = _parse_problem(SCENARIO["maneuver"].value(root), spacecraft, environment)
     planners = _parse_planners(SCENARIO["planners"].value(root))
     controllers = _parse_controllers(root)
     simulation = _parse_simulation(SCENARIO["simulation"].value(root), "simulation")
+    requirements_node = SCENARIO["requirements"].value(root)
     root.finish()
     problem = _fit_field_span(problem, simulation, planners)
+    span = RunSpan(problem.duration, simulation.duration or problem.duration, simulation.duration is not None,
+                   _table_window(problem, simulation, planners))
+    check_ephemeris(epoch, span)
+    requirements, constraints = parse_requirements(requirements_node, sensors, Geometry(epoch, environment.orbit),
+                                                   span, problem.qf is None, problem.omegaf is None)
+    problem = _with_requirements(problem, requirements, constraints)
     check_work(problem, simulation)
     check_row_labels(planners, controllers)
     check_compatibility(problem, planners, controllers, simulation)
-    return Scenario(name, problem, planners, controllers, simulation, source)
+    return Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch)
+
+
+def _with_requirements(problem: ManeuverProblem, requirements: Requirements,
+                       constraints: tuple) -> ManeuverProblem:
+    """The problem the planners get: the pointing constraints, the actuator margin, and the rate
+    bound of ``requirements.rate`` unless ``maneuver.max_rate`` is given (and no looser)."""
+    max_rate = problem.max_rate
+    if requirements.rate is not None:
+        if max_rate is None:
+            max_rate = requirements.rate.max_rate
+        elif max_rate > requirements.rate.max_rate:
+            raise ScenarioError("maneuver.max_rate", f"{max_rate:g} rad/s exceeds requirements.rate.max "
+                                f"({requirements.rate.max_rate:g} rad/s): the planners would plan past the "
+                                "requirement; lower it or leave it out (the requirement's bound then applies)")
+    margin = None if requirements.actuators is None else requirements.actuators.margin
+    return dataclasses.replace(problem, pointing=constraints, actuator_margin=margin, max_rate=max_rate)
 
 
 def load(path: str | Path) -> Scenario:

@@ -8,6 +8,8 @@ read through them; the magnetic field models and their options come from the reg
 """
 from __future__ import annotations
 
+import dataclasses
+import datetime
 from collections.abc import Callable
 from typing import Any
 
@@ -23,8 +25,10 @@ from ocp import (
     Torquers,
 )
 from ocp.dynamics.environment import MAGNETIC_FIELDS, MagneticField
+from ocp.dynamics.ephemeris import parse_utc
 from ocp.errors import InvalidOption
 from scenarios.errors import ScenarioError
+from scenarios.requirements.spec import Sensor
 from scenarios.schema.keys import (
     Section,
     boolean,
@@ -36,6 +40,7 @@ from scenarios.schema.keys import (
     vector,
 )
 from scenarios.schema.node import Node
+from scenarios.schema.requirements import SENSOR, parse_sensors
 
 __all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "ORBIT", "SPACECRAFT", "TORQUERS", "WHEELS",
            "parse_environment", "parse_magnetic_field", "parse_orbit", "parse_spacecraft"]
@@ -99,7 +104,10 @@ SPACECRAFT = Section((
             default={}, null="none"),
     mapping("magnetorquers", "Magnetorquers.", MAGNETORQUERS, default=None, null="none"),
     mapping("torquers", "Ideal body-axis torquers.", TORQUERS, default=None, null="none"),
-), "The rigid body and its actuators.")
+    custom("sensors", "Named sensors (star trackers, cameras, antennas, panels) that ``requirements.pointing`` "
+           "constrains; the name is the key.", "mapping of names to mappings", parse_sensors, default={},
+           section=SENSOR, named=True),
+), "The rigid body, its actuators and its sensors.")
 
 ORBIT = Section((
     number("altitude_km", "Height of the circular orbit above the equatorial radius (6378.137 km).", unit="km"),
@@ -123,8 +131,9 @@ ENVIRONMENT = Section((
 ), "What acts on the spacecraft besides its actuators (absent or ``null``: nothing).")
 
 
-def parse_spacecraft(node: Node) -> Spacecraft:
-    """The ``spacecraft`` section (:data:`SPACECRAFT`): inertia, wheels, magnetorquers and torquers.
+def parse_spacecraft(node: Node) -> tuple[Spacecraft, dict[str, Sensor]]:
+    """The ``spacecraft`` section (:data:`SPACECRAFT`): inertia, wheels, magnetorquers, torquers
+    and sensors.
 
     Parameters
     ----------
@@ -133,8 +142,10 @@ def parse_spacecraft(node: Node) -> Spacecraft:
 
     Returns
     -------
-    Spacecraft
+    spacecraft : Spacecraft
         The spacecraft model.
+    sensors : dict of str to Sensor
+        The named sensors (``spacecraft.sensors``), in the order written.
 
     Raises
     ------
@@ -155,10 +166,11 @@ def parse_spacecraft(node: Node) -> Spacecraft:
     trq = SPACECRAFT["torquers"].node(node)
     if not trq.is_null():
         torquers = _model_part(trq, Torquers, **TORQUERS.read(trq))
+    sensors = SPACECRAFT["sensors"].value(node)
     spacecraft = _model_part(node, Spacecraft, inertia=inertia, wheels=wheels, magnetorquers=magnetorquers,
                              torquers=torquers)
     node.finish()
-    return spacecraft
+    return spacecraft, sensors
 
 
 def parse_orbit(node: Node) -> CircularOrbit | None:
@@ -187,9 +199,13 @@ def parse_orbit(node: Node) -> CircularOrbit | None:
                        arg_latitude=np.deg2rad(values["arg_latitude_deg"]))
 
 
-def parse_magnetic_field(node: Node, orbit: CircularOrbit | None) -> MagneticField | None:
+def parse_magnetic_field(node: Node, orbit: CircularOrbit | None,
+                         epoch: datetime.datetime | None = None) -> MagneticField | None:
     """``environment.magnetic_field``: a registered model's name, ``none``, or a mapping of ``model``
     and the model's options (read by the keys of its ``Options``).
+
+    A model whose options have an ``epoch`` (IGRF) takes the scenario's epoch when its own is not
+    given; given both, they must be the same instant.
 
     Parameters
     ----------
@@ -197,6 +213,8 @@ def parse_magnetic_field(node: Node, orbit: CircularOrbit | None) -> MagneticFie
         The ``magnetic_field`` value.
     orbit : CircularOrbit or None
         The scenario's orbit.
+    epoch : datetime.datetime or None, optional
+        The scenario's epoch (top-level ``epoch``), UTC.
 
     Returns
     -------
@@ -210,22 +228,41 @@ def parse_magnetic_field(node: Node, orbit: CircularOrbit | None) -> MagneticFie
     """
     if node.is_null():
         return None
+    given_epoch = False
     if isinstance(node.value, str):
         model = MAGNETIC_FIELDS[node.string((*MAGNETIC_FIELDS, "none"))]
         options = model.Options()
     else:
         node.mapping()
         model = MAGNETIC_FIELDS[MAGNETIC_FIELD["model"].value(node)]
+        given_epoch = "epoch" in node
         values = {key.name: key.value(node) for key in option_keys(model.Options)}
         node.finish()
         try:
             options = model.Options(**values)
         except InvalidOption as error:  # a relation between options (Options.__post_init__)
             raise ScenarioError(f"{node.path}.{error.option}", error.message) from None
-    return _model_part(node, model.from_options, options=options, orbit=orbit)
+    inherited = epoch is not None and "epoch" in {spec.name for spec in dataclasses.fields(options)}
+    if epoch is not None and inherited and given_epoch:
+        try:
+            own: datetime.datetime | None = parse_utc(getattr(options, "epoch"))  # noqa: B009 - any model's
+        except ModelError:  # the model reports its own epoch's error below
+            own = None
+        if own is not None and own != epoch:
+            raise ScenarioError(f"{node.path}.epoch", f"{own.isoformat()} differs from the scenario's epoch "
+                                f"(epoch: {epoch.isoformat()}Z); give one of them, or the same instant")
+    elif epoch is not None and inherited:
+        options = dataclasses.replace(options, epoch=epoch.isoformat())  # type: ignore[call-arg]  # a model's Options
+    try:
+        return model.from_options(options=options, orbit=orbit)
+    except ModelError as error:
+        if inherited and not given_epoch and error.field == "epoch":
+            raise ScenarioError("epoch", f"{error.message} ({node.path} takes the scenario's epoch)") from None
+        where = (f"{node.path}.{error.field}" if node.path else error.field) if error.field else node.path
+        raise ScenarioError(where, error.message) from None
 
 
-def parse_environment(orbit_node: Node, node: Node) -> Environment:
+def parse_environment(orbit_node: Node, node: Node, epoch: datetime.datetime | None = None) -> Environment:
     """The ``orbit`` and ``environment`` sections (``*_km`` and ``*_deg`` converted to SI).
 
     Parameters
@@ -234,6 +271,8 @@ def parse_environment(orbit_node: Node, node: Node) -> Environment:
         The ``orbit`` mapping (:data:`ORBIT`), or null for none.
     node : Node
         The ``environment`` mapping (:data:`ENVIRONMENT`), or null for the defaults.
+    epoch : datetime.datetime or None, optional
+        The scenario's epoch, UTC, for a field model that has one (:func:`parse_magnetic_field`).
 
     Returns
     -------
@@ -249,7 +288,7 @@ def parse_environment(orbit_node: Node, node: Node) -> Environment:
     orbit = parse_orbit(orbit_node)
     node = node if not node.is_null() else Node({}, node.path)
     node.mapping()
-    magnetic_field = parse_magnetic_field(ENVIRONMENT["magnetic_field"].value(node), orbit)
+    magnetic_field = parse_magnetic_field(ENVIRONMENT["magnetic_field"].value(node), orbit, epoch)
     environment = _model_part(
         node, Environment, orbit=orbit, gravity_gradient=ENVIRONMENT["gravity_gradient"].value(node),
         magnetic_field=magnetic_field, disturbance_torque=ENVIRONMENT["disturbance_torque"].value(node),

@@ -167,7 +167,11 @@ def _walk(section: Section, path: str, name: str, aliases: tuple[str, ...] = ())
         key_aliases = tuple(f"{alias}.{key.name}" for alias in aliases)
         yield _key_entry(key, key_path, key_name, key_aliases)
         if key.section is not None:
-            yield from _walk(key.section, f"{key_path}[i]" if key.entries else key_path, key_name, key_aliases)
+            nested = f"{key_path}[i]" if key.entries else f"{key_path}.<name>" if key.named else key_path
+            if key.named:  # the entry a name heads (its name is the user's)
+                yield Entry(f"{key_name}.<name>", nested, "mapping", "", "", "", key.section.meaning,
+                            tuple(f"{alias}.<name>" for alias in key_aliases))
+            yield from _walk(key.section, nested, key_name, key_aliases)
 
 
 def summary_line(cls: type, module_first: bool = True) -> str:

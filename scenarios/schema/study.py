@@ -21,7 +21,11 @@ import numpy as np
 
 from ocp import METRIC_KEYS, quat
 from scenarios.errors import ScenarioError
-from scenarios.schema.columns import VECTOR_METRICS, metric_columns
+from scenarios.schema.columns import (
+    VECTOR_METRICS,
+    is_requirement_column,
+    metric_columns,
+)
 from scenarios.schema.keys import (
     Described,
     Key,
@@ -382,12 +386,12 @@ def _summary(node: Node) -> list[str]:
     summary = [item.string() for item in node.items()]
     columns = metric_columns()
     for index, metric in enumerate(summary):
-        if metric not in columns:  # a metric column of cases.csv
+        if metric not in columns and not is_requirement_column(metric):  # a metric or requirement column
             scalars = [key for key in METRIC_KEYS if key != "plan_time_s" and key not in VECTOR_METRICS]
             vectors = ", ".join(f"cl.{key}_x" for key in VECTOR_METRICS)
             raise ScenarioError(f"summary[{index}]", f"expected ref.<metric> or cl.<metric> with a metric of "
                                                      f"{scalars}, or one axis of a vector metric ({vectors}, _y, _z), "
-                                                     f"got {metric!r}")
+                                                     f"or a requirement's ref.req.<name>.<field>, got {metric!r}")
     return summary
 
 
@@ -402,7 +406,8 @@ STUDY = Section((
     mapping("monte_carlo", "Monte Carlo samples per grid point; absent or ``null``: none.", MONTE_CARLO, default=None,
             null="none"),
     custom("summary", "The metrics summarised per planner label (and grid point): ``ref.<metric>`` or "
-           "``cl.<metric>``, a vector's component as ``<metric>_x``.", "list of text or null", _summary,
+           "``cl.<metric>``, a vector's component as ``<metric>_x``, or a requirement's "
+           "``ref.req.<name>.<field>`` (``cl.req...``).", "list of text or null", _summary,
            default=Described("every scalar metric, ref. and cl.")),
     mapping("execution", "How the cases run.", EXECUTION, default={}, null="defaults"),
     custom("resolved", "Written by slewbench into the stored ``study.yaml`` (version, case seeds) and ignored "

@@ -1,12 +1,16 @@
 """Tables and files of a trade study: ``cases.csv`` (one row per case and planner),
 ``summary.csv`` / ``summary.md`` (statistics per planner, and per grid point when there is
-Monte Carlo), the resolved ``study.yaml`` and the plots (:mod:`scenarios.study.plots`).
+Monte Carlo), ``requirements.csv`` (per planner, the fraction of cases that meet every requirement,
+with its Wilson interval; also in ``summary.md``), the resolved ``study.yaml`` and the plots
+(:mod:`scenarios.study.plots`).
 
 A case's rows are flattened and written as a run's are (:mod:`scenarios.output.tables`: the same
-``ref.<metric>`` and ``cl.<metric>`` columns, the same rule for missing and non-finite values)."""
+``ref.<metric>`` and ``cl.<metric>`` columns, then the requirement columns, the same rule for
+missing and non-finite values)."""
 from __future__ import annotations
 
 import json
+import math
 import shutil
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -21,6 +25,7 @@ from scenarios.output.tables import (
     csv_text,
     flatten_row,
     is_missing,
+    requirement_columns,
     row_columns,
     text_cell,
 )
@@ -31,6 +36,11 @@ if TYPE_CHECKING:  # the engine imports this module lazily
     from scenarios.study.engine import SweepResults
 
 STATISTICS = ("count", "failures", "mean", "std", "median", "p5", "p95", "min", "max")
+REQUIREMENT_STATISTICS = ("completed", "met", "fraction_met", "wilson_low", "wilson_high")
+"""The columns of ``requirements.csv`` after the grouping keys: rows that completed (not
+``crashed``), those ``ok`` (meeting every requirement), their fraction and its Wilson 95 % interval."""
+WILSON_Z = 1.959963984540054
+"""The standard normal quantile of 97.5 %: a two-sided 95 % interval."""
 _DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml's emitter when built: same text, 3x faster
 
 
@@ -48,19 +58,21 @@ def case_table(study: Study, records: dict[str, dict[str, Any]]) -> tuple[list[s
     -------
     columns : list of str
         ``case``, ``seed``, the varied paths, then a run's columns
-        (:func:`scenarios.output.tables.row_columns`).
+        (:func:`scenarios.output.tables.row_columns`, with the stored rows' requirement columns).
     rows : list of dict
         One per case and planner (and controller), keyed by column: the stored row flattened by
         :func:`scenarios.output.tables.flatten_row`.
     """
-    columns = ["case", "seed", *study.varied_paths, *row_columns()]
     table = []
+    stored = []
     for case in study.cases:
         record = records.get(case.key)
         if record is None:
             continue
         for row in record["rows"]:
+            stored.append(row)
             table.append({"case": case.index, "seed": case.seed, **case.varied, **flatten_row(row)})
+    columns = ["case", "seed", *study.varied_paths, *row_columns(requirement_columns(stored))]
     return columns, table
 
 
@@ -90,11 +102,7 @@ def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], 
     rows : list of dict
         One per group and summary metric; a statistic without values is None.
     """
-    by_point = study.samples > 1 and bool(study.grid_paths)
-    keys = (study.grid_paths if by_point else []) + ["label"]
-    groups: dict[tuple, list[dict[str, Any]]] = {}
-    for row in rows:
-        groups.setdefault(tuple(json.dumps(row.get(k)) for k in keys), []).append(row)
+    keys, groups = _groups(study, rows)
     columns = [*keys, "metric", *STATISTICS]
     table = []
     for members in groups.values():
@@ -113,13 +121,97 @@ def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], 
     return columns, table
 
 
-def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], missing: int) -> str:
-    out = [f"# {study.name}", "", f"{len(study.cases)} cases ({missing} missing), "
-           f"{study.samples} Monte Carlo sample(s) per grid point, slewbench {package_version()}.", "",
-           "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    out += ["| " + " | ".join(text_cell(row.get(c)) for c in columns) + " |" for row in rows]
-    out += ["", "Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s. "
-                "std is the sample standard deviation; p5 and p95 are linear percentiles.", ""]
+def wilson_interval(successes: int, trials: int, z: float = WILSON_Z) -> tuple[float, float] | None:
+    """The Wilson score interval of a binomial proportion.
+
+    ``(p + z²/2n ± z √(p(1 − p)/n + z²/4n²)) / (1 + z²/n)`` with ``p = successes / trials``: unlike the
+    normal approximation it stays inside [0, 1] and is sensible at 0 and n successes.
+
+    Parameters
+    ----------
+    successes : int
+        Trials that succeeded, 0 to ``trials``.
+    trials : int
+        Trials, non-negative.
+    z : float, optional
+        Standard normal quantile (default :data:`WILSON_Z`: 95 %).
+
+    Returns
+    -------
+    (float, float) or None
+        Lower and upper bound; ``None`` without trials.
+    """
+    if trials <= 0:
+        return None
+    p = successes / trials
+    scale = 1.0 + z * z / trials
+    centre = (p + z * z / (2 * trials)) / scale
+    half = z / scale * math.sqrt(p * (1.0 - p) / trials + z * z / (4.0 * trials * trials))
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def _groups(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], dict[tuple, list[dict[str, Any]]]]:
+    """The grouping keys (the grid point under Monte Carlo, then the label) and the rows of each group."""
+    by_point = study.samples > 1 and bool(study.grid_paths)
+    keys = (study.grid_paths if by_point else []) + ["label"]
+    groups: dict[tuple, list[dict[str, Any]]] = {}
+    for row in rows:
+        groups.setdefault(tuple(json.dumps(row.get(k)) for k in keys), []).append(row)
+    return keys, groups
+
+
+def requirement_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
+    """Per planner row label (and grid point under Monte Carlo): the fraction of the completed cases
+    that meet every requirement (status ``ok``) and its Wilson 95 % interval (:func:`wilson_interval`).
+
+    A completed case is one whose row is not ``crashed``; a ``failed`` or ``violated`` row completed
+    and does not meet them.
+
+    Parameters
+    ----------
+    study : Study
+        The study (its grid paths and samples).
+    rows : list of dict
+        The ``cases.csv`` rows (:func:`case_table`).
+
+    Returns
+    -------
+    columns : list of str
+        The grouping keys and :data:`REQUIREMENT_STATISTICS`.
+    rows : list of dict
+        One per group; the fraction and the interval are None without completed cases.
+    """
+    keys, groups = _groups(study, rows)
+    table = []
+    for members in groups.values():
+        completed = [r for r in members if r["status"] != "crashed"]
+        met = sum(r["status"] == "ok" for r in completed)
+        interval = wilson_interval(met, len(completed))
+        line = {k: members[0].get(k) for k in keys}
+        line.update(completed=len(completed), met=met, fraction_met=met / len(completed) if completed else None,
+                    wilson_low=None if interval is None else interval[0],
+                    wilson_high=None if interval is None else interval[1])
+        table.append(line)
+    return [*keys, *REQUIREMENT_STATISTICS], table
+
+
+def _table_lines(columns: list[str], rows: list[dict[str, Any]]) -> list[str]:
+    return (["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+            + ["| " + " | ".join(text_cell(row.get(c)) for c in columns) + " |" for row in rows])
+
+
+def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], missing: int,
+              requirements: tuple[list[str], list[dict[str, Any]]] | None = None) -> str:
+    out = [f"# {study.name}", "", (f"{len(study.cases)} cases ({missing} missing), "
+                                   f"{study.samples} Monte Carlo sample(s) per grid point, slewbench "
+                                   f"{package_version()}."), ""]
+    out += _table_lines(columns, rows)
+    out += ["", ("Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s. "
+                 "std is the sample standard deviation; p5 and p95 are linear percentiles."), ""]
+    if requirements is not None:
+        out += ["## Cases meeting every requirement", "",
+                "Rows whose status is ok among the completed ones (not crashed), with the Wilson 95 % interval.", ""]
+        out += _table_lines(*requirements) + [""]
     return "\n".join(out)
 
 
@@ -168,8 +260,10 @@ def write_report(results: SweepResults, directory: str | Path, plots: bool = Tru
     directory = claim_sweep_directory(directory)
     columns, rows = case_table(study, results.records)
     summary_columns, summary = summary_table(study, rows)
+    requirements = requirement_table(study, rows)
     files = {"cases.csv": csv_text(columns, rows), "summary.csv": csv_text(summary_columns, summary),
-             "summary.md": _markdown(study, summary_columns, summary, results.missing),
+             "requirements.csv": csv_text(*requirements),
+             "summary.md": _markdown(study, summary_columns, summary, results.missing, requirements),
              "study.yaml": yaml.dump(resolved_study(study), Dumper=_DUMPER, sort_keys=False, width=120)}
     staging = new_staging(directory)
     try:

@@ -1,0 +1,320 @@
+"""Scoring a row against every requirement: the reference on its own dense sampling, the closed loop
+on its samples, and the end points of the manoeuvre before anything is planned.
+
+One :class:`Score` per requirement and scope (``reference``, ``closed_loop``): the numbers that go
+into the result columns ``ref.req.<name>.<field>`` and ``cl.req.<name>.<field>``, whether it is met,
+and what breaks it in words. The fields:
+
+* a pointing requirement: ``min_margin_deg`` (negative when violated), ``time_in_violation_s``,
+  ``first_violation_s`` (null if never), ``min_margin_time_s``
+  (:meth:`ocp.geometry.pointing.PointingConstraint.score`);
+* ``actuators`` (reference only): for each actuator quantity with a limit
+  (:func:`controllers.allocation.reference_demand`, through the row's controller's allocation),
+  ``<quantity>`` the peak demand over the limit and ``<quantity>_time_s`` when it peaks; met when
+  every ratio is at most ``1 − margin``;
+* ``rate``: ``peak_rate`` [rad/s] (of ``‖ω‖``), ``peak_time_s``, ``ratio`` (over the bound);
+* ``final`` (closed loop only): ``worst_error_deg`` and ``worst_rate_error`` [rad/s] from
+  ``T + after_s`` to the end, and ``from_s``.
+
+The runner (:mod:`scenarios.runner`) glues this to the rows and turns the scores into statuses and
+messages (:func:`violations`, :func:`unhonoured`).
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from controllers.allocation import Allocation, reference_demand
+from ocp import quat
+from ocp.geometry.pointing import PointingConstraint
+from planners import ManeuverProblem, Planner
+from planners.base import REQUIREMENT_KINDS
+from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
+
+__all__ = ["REFERENCE_POINTS", "SCOPE_WORDS", "Score", "endpoint_violations", "reference_times", "score_closed_loop",
+           "score_reference", "unhonoured", "violations"]
+
+Array = NDArray[np.float64]
+
+REFERENCE_POINTS = 2001
+"""Uniform sample times of a reference over ``[0, T]`` for its scores (as its metrics,
+:func:`ocp.metrics.metrics_from_reference`)."""
+
+SCOPE_WORDS = {"reference": "reference", "closed_loop": "closed loop"}
+"""A scope's key (of ``Row.requirements`` and ``results.json``) and its words in messages."""
+
+_TOLERANCE = 1e-9
+"""Relative slack on the ratio and bound checks (rounding, not a margin)."""
+
+
+@dataclass(frozen=True)
+class Score:
+    """How one scope of a row meets one requirement.
+
+    Attributes
+    ----------
+    name : str
+        The requirement's name (a pointing requirement's key, ``actuators``, ``rate``, ``final``).
+    values : dict of str to float or None
+        The fields (the module docstring), in column order.
+    met : bool
+        Whether the requirement holds.
+    detail : str
+        What breaks it, in words (empty when met): ``min margin -0.19 deg at 31.2 s, 3.2 s inside``.
+    """
+
+    name: str
+    values: dict[str, float | None]
+    met: bool
+    detail: str = ""
+
+
+def reference_times(duration: float, run_end: float, sample_time: float, points: int = REFERENCE_POINTS) -> Array:
+    """Where a reference is scored: ``points`` uniform times over ``[0, T]`` (those of its metrics,
+    :func:`ocp.metrics.metrics_from_reference`, so that one sampling serves both), then the closed
+    loop's sample spacing to the end of the run (the reference coasts there, and the closed loop
+    tracks it).
+
+    Parameters
+    ----------
+    duration : float
+        The reference's duration T [s].
+    run_end : float
+        End of the closed-loop window [s].
+    sample_time : float
+        The closed loop's sample time [s].
+    points : int, optional
+        Uniform times over ``[0, T]`` (default :data:`REFERENCE_POINTS`).
+
+    Returns
+    -------
+    (N,) ndarray
+        Increasing times [s].
+    """
+    times = np.linspace(0.0, duration, points)
+    if run_end > duration:
+        tail = np.linspace(duration, run_end, int(np.ceil((run_end - duration) / sample_time - 1e-9)) + 1)
+        times = np.concatenate([times, tail[1:]])
+    return times
+
+
+def _pointing(constraint: PointingConstraint, t: Array, q: Array) -> Score:
+    score = constraint.score(t, q)
+    values: dict[str, float | None] = {"min_margin_deg": score.min_margin_deg,
+                                       "time_in_violation_s": score.time_in_violation_s,
+                                       "first_violation_s": score.first_violation_s,
+                                       "min_margin_time_s": score.min_margin_time_s}
+    if score.met:
+        return Score(constraint.name, values, True)
+    assert score.min_margin_deg is not None and score.min_margin_time_s is not None
+    where = "inside" if constraint.keep_out else "outside"
+    return Score(constraint.name, values, False,
+                 f"min margin {score.min_margin_deg:.3g} deg at {score.min_margin_time_s:.1f} s, "
+                 f"{score.time_in_violation_s:.1f} s {where}")
+
+
+def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
+    norms = np.linalg.norm(omega, axis=1)
+    worst = int(np.argmax(norms))
+    peak = float(norms[worst])
+    ratio = peak / requirement.max_rate
+    values: dict[str, float | None] = {"peak_rate": peak, "peak_time_s": float(t[worst]), "ratio": ratio}
+    met = ratio <= 1.0 + _TOLERANCE
+    return Score("rate", values, met, "" if met else f"peak rate {peak:.4g} rad/s at {t[worst]:.1f} s, "
+                                                     f"{ratio:.3g} x the {requirement.max_rate:g} rad/s bound")
+
+
+def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, problem: ManeuverProblem,
+           end_of_manoeuvre: float) -> Score:
+    start = end_of_manoeuvre + requirement.after_s
+    inside = t >= start - 1e-9
+    values: dict[str, float | None] = {"worst_error_deg": None, "worst_rate_error": None, "from_s": start}
+    if not np.any(inside):
+        return Score("final", values, False, f"no closed-loop sample from {start:g} s (T + after_s) on; lengthen "
+                                             "simulation.duration")
+    problems = []
+    if problem.qf is not None:
+        errors = np.rad2deg(quat.error_angle(q[inside], problem.qf))
+        worst = int(np.argmax(errors))
+        values["worst_error_deg"] = float(errors[worst])
+        if requirement.error_deg is not None and errors[worst] > requirement.error_deg * (1 + _TOLERANCE):
+            problems.append(f"error {errors[worst]:.3g} deg at {t[inside][worst]:.1f} s over "
+                            f"{requirement.error_deg:g} deg")
+    if problem.omegaf is not None:
+        rates = np.linalg.norm(omega[inside] - problem.omegaf, axis=1)
+        worst = int(np.argmax(rates))
+        values["worst_rate_error"] = float(rates[worst])
+        if requirement.rate is not None and rates[worst] > requirement.rate * (1 + _TOLERANCE):
+            problems.append(f"rate error {rates[worst]:.3g} rad/s at {t[inside][worst]:.1f} s over "
+                            f"{requirement.rate:g} rad/s")
+    return Score("final", values, not problems, (", ".join(problems) + f" (from {start:g} s)") if problems else "")
+
+
+def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array) -> Score:
+    values: dict[str, float | None] = {}
+    broken = []
+    for name, quantity in demand.items():
+        if not quantity.limited:
+            continue
+        ratios = quantity.ratios()
+        peaks = np.max(ratios, axis=1) if ratios.size else np.zeros(len(t))
+        worst = int(np.argmax(peaks)) if peaks.size else 0
+        ratio = float(peaks[worst]) if peaks.size else 0.0
+        values[name] = ratio
+        values[f"{name}_time_s"] = float(t[worst]) if peaks.size else None
+        if ratio > margin_allowed * (1 + _TOLERANCE):
+            broken.append(f"{name} {ratio:.3g} x its limit at {t[worst]:.1f} s")
+    detail = ", ".join(broken) + f" (allowed {margin_allowed:.3g} x)" if broken else ""
+    return Score("actuators", values, not broken, detail)
+
+
+def score_reference(requirements: Requirements, problem: ManeuverProblem, times: ArrayLike, sample: Any,
+                    allocation: Allocation | None) -> dict[str, Score]:
+    """Score a reference, sampled densely, against every requirement that applies to it.
+
+    Parameters
+    ----------
+    requirements : Requirements
+        The scenario's requirements.
+    problem : ManeuverProblem
+        The problem planned (its ``pointing`` constraints, spacecraft, environment and initial
+        wheel momenta).
+    times : (N,) array_like
+        The sample times [s] (:func:`reference_times`).
+    sample : planners.ReferenceSample
+        The reference at ``times`` (``reference.sample(times)``: ``q``, ``omega``, ``torque``).
+    allocation : controllers.allocation.Allocation or None
+        The row's controller, whose allocation the actuator demand goes through; ``None``: the
+        actuator requirement is not scored.
+
+    Returns
+    -------
+    dict of str to Score
+        By requirement name: the pointing requirements, then ``actuators`` and ``rate`` (``final``
+        is scored in closed loop only).
+    """
+    t = np.asarray(times, dtype=float)
+    scores = {constraint.name: _pointing(constraint, t, sample.q) for constraint in problem.pointing}
+    if requirements.actuators is not None and allocation is not None:
+        demand = reference_demand(allocation, problem.model, t, sample.q, sample.omega, sample.torque,
+                                  problem.wheel_momentum0)
+        scores["actuators"] = _actuators(requirements.actuators.allowed, demand, t)
+    if requirements.rate is not None:
+        scores["rate"] = _rate(requirements.rate, t, sample.omega)
+    return scores
+
+
+def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: ArrayLike, q: ArrayLike,
+                      omega: ArrayLike, end_of_manoeuvre: float) -> dict[str, Score]:
+    """Score a closed-loop run (its samples) against every requirement that applies to it.
+
+    Parameters
+    ----------
+    requirements : Requirements
+        The scenario's requirements.
+    problem : ManeuverProblem
+        The problem (its ``pointing`` constraints and targets).
+    t : (N,) array_like
+        Sample times [s].
+    q : (N, 4) array_like
+        Attitude at ``t`` (scalar first, body to inertial).
+    omega : (N, 3) array_like
+        Body rate at ``t`` [rad/s], body axes.
+    end_of_manoeuvre : float
+        T [s]: the reference's duration, the manoeuvre's in regulation (``final`` starts
+        ``after_s`` later).
+
+    Returns
+    -------
+    dict of str to Score
+        By requirement name: the pointing requirements, then ``rate`` and ``final`` (the actuator
+        requirement is the reference's: the closed loop's actuators saturate).
+    """
+    t = np.asarray(t, dtype=float)
+    q = np.asarray(q, dtype=float)
+    omega = np.asarray(omega, dtype=float)
+    scores = {constraint.name: _pointing(constraint, t, q) for constraint in problem.pointing}
+    if requirements.rate is not None:
+        scores["rate"] = _rate(requirements.rate, t, omega)
+    if requirements.final is not None:
+        scores["final"] = _final(requirements.final, t, q, omega, problem, end_of_manoeuvre)
+    return scores
+
+
+def endpoint_violations(problem: ManeuverProblem) -> list[str]:
+    """Pointing requirements that the manoeuvre's end points already break, before anything is planned.
+
+    The initial attitude is checked at t = 0 and the target at T (or at the window's start when it
+    opens after T: the target is held), each when the window covers that time.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre with its pointing constraints.
+
+    Returns
+    -------
+    list of str
+        One sentence per broken requirement and end (empty when none is broken).
+    """
+    found = []
+    ends: list[tuple[str, Any, float]] = [("initial attitude", problem.q0, 0.0)]
+    if problem.qf is not None:
+        ends.append(("target attitude", problem.qf, problem.duration))
+    for constraint in problem.pointing:
+        for words, q, time in ends:
+            time = max(time, constraint.window[0]) if words == "target attitude" else time
+            margin = constraint.margins(np.array([time]), np.asarray(q).reshape(1, 4))[0]
+            if np.isfinite(margin) and margin < 0.0:
+                kind = "keep-out" if constraint.keep_out else "keep-in"
+                found.append(f"{constraint.name}: the {words} already breaks it at {time:g} s (margin "
+                             f"{np.rad2deg(margin):.3g} deg to the {np.rad2deg(constraint.angle):g} deg {kind} cone); "
+                             "no reference can meet it")
+    return found
+
+
+def violations(scores: Mapping[str, Mapping[str, Score]]) -> list[str]:
+    """The broken requirements of a row, in words.
+
+    Parameters
+    ----------
+    scores : mapping
+        Scope (``reference``, ``closed_loop``) -> requirement name -> :class:`Score`.
+
+    Returns
+    -------
+    list of str
+        ``"<name> (<scope>): <detail>"`` per broken requirement, reference first.
+    """
+    return [f"{name} ({SCOPE_WORDS[scope]}): {score.detail}"
+            for scope in SCOPE_WORDS for name, score in scores.get(scope, {}).items() if not score.met]
+
+
+def unhonoured(requirements: Requirements, planner: Planner | None) -> str:
+    """What a planner does not impose of the scenario's requirements, in words.
+
+    Parameters
+    ----------
+    requirements : Requirements
+        The scenario's requirements.
+    planner : planners.Planner or None
+        The row's planner; ``None`` in regulation mode.
+
+    Returns
+    -------
+    str
+        ``"<planner> does not honour the pointing and actuators requirements (scored only)"``, or
+        empty when it honours them all (or there is no planner).
+    """
+    if planner is None:
+        return ""
+    missing: Sequence[str] = [kind for kind in REQUIREMENT_KINDS
+                              if kind in requirements.kinds and kind not in planner.honours]
+    if not missing:
+        return ""
+    words = missing[0] if len(missing) == 1 else ", ".join(missing[:-1]) + " and " + missing[-1]
+    return f"{planner.name} does not honour the {words} requirement{'s' if len(missing) > 1 else ''} (scored only)"

@@ -1,0 +1,127 @@
+"""A reference's actuator demand through a law's allocation, against independent computations.
+
+* Three orthogonal wheels: the allocation's wheel torque is ``g = -(u + ω × h)`` component-wise
+  (hand-worked), and the wheel momenta, integrated by the demand, must equal what the conservation
+  of the total angular momentum gives without any allocation: ``h(t) = R(q)ᵀ R(q₀)(I ω₀ + h₀) − I ω(t)``
+  along a motion whose attitude is integrated from its rate (SciPy, tight tolerances) and whose
+  torque is the inverse dynamics.
+* Two wheels and torquers: what the wheels cannot give goes to the torquers (hand-worked); a
+  ``wheels_only`` law drops it.
+* Magnetorquers: ``m = B × τ / |B|²`` with the field along the reference.
+* The actuator score: demand over limit against ``1 − margin``.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from controllers import CONTROLLERS
+from controllers.allocation import Demand, reference_demand
+from ocp import (
+    AttitudeModel,
+    CircularOrbit,
+    Environment,
+    Magnetorquers,
+    ReactionWheels,
+    Spacecraft,
+    Torquers,
+    quat,
+)
+from ocp.dynamics.environment import MAGNETIC_FIELDS
+from scenarios.requirements.scoring import _actuators
+
+INERTIA = np.diag([0.25, 0.28, 0.12])
+
+
+def rate(t: np.ndarray) -> np.ndarray:
+    return np.stack([0.02 * np.sin(0.3 * t), 0.015 * np.cos(0.2 * t) - 0.015, 0.01 * t / (1 + 0.1 * t)], axis=-1)
+
+
+def rate_dot(t: np.ndarray) -> np.ndarray:
+    return np.stack([0.006 * np.cos(0.3 * t), -0.003 * np.sin(0.2 * t), 0.01 / (1 + 0.1 * t) ** 2], axis=-1)
+
+
+def motion(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Attitude integrated from the rate (q̇ = ½ q ⊗ [0, ω]), the rate, the inverse-dynamics torque."""
+    def rhs(time, q):
+        return 0.5 * quat.product(q, np.concatenate([[0.0], rate(np.array([time]))[0]]))
+    solution = solve_ivp(rhs, (t[0], t[-1]), quat.IDENTITY, t_eval=t, rtol=1e-12, atol=1e-13, method="DOP853")
+    omega = rate(t)
+    torque = rate_dot(t) @ INERTIA.T + np.cross(omega, omega @ INERTIA.T)
+    return solution.y.T, omega, torque
+
+
+def test_three_orthogonal_wheels_torque_by_hand_and_momentum_by_conservation():
+    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(max_torque=0.003, max_momentum=0.02))
+    model = AttitudeModel(spacecraft)
+    t = np.linspace(0.0, 40.0, 4001)
+    q, omega, torque = motion(t)
+    h0 = np.array([0.004, -0.002, 0.001])
+    demand = reference_demand(CONTROLLERS["augmented_quaternion_feedback"](), model, t, q, omega, torque, h0)
+    assert list(demand) == ["wheels_torque", "wheels_momentum"]
+    # momentum: conserved total angular momentum, no allocation involved
+    total = quat.rotate(quat.IDENTITY, INERTIA @ omega[0] + h0)
+    expected_h = quat.rotate(quat.conjugate(q), np.tile(total, (t.size, 1))) - omega @ INERTIA.T
+    h = demand["wheels_momentum"].values
+    assert np.max(np.abs(h - expected_h)) < 1e-6 * np.max(np.abs(expected_h))
+    # torque: g = -(u + ω × h), component by component, at the demand's own momenta
+    g = demand["wheels_torque"].values
+    for k in (0, 1234, 4000):
+        u, w, hk = torque[k], omega[k], h[k]
+        hand = [-(u[0] + w[1] * hk[2] - w[2] * hk[1]),
+                -(u[1] + w[2] * hk[0] - w[0] * hk[2]),
+                -(u[2] + w[0] * hk[1] - w[1] * hk[0])]
+        assert g[k] == pytest.approx(hand, rel=1e-12, abs=1e-15)
+    np.testing.assert_array_equal(demand["wheels_torque"].limit, [0.003] * 3)
+    np.testing.assert_array_equal(demand["wheels_momentum"].limit, [0.02] * 3)
+
+
+def test_what_two_wheels_cannot_give_goes_to_the_torquers_unless_the_law_is_wheels_only():
+    """Wheels on body x and y with zero momentum and ω = 0: g = [-u_x, -u_y], torquers [0, 0, u_z]."""
+    axes = np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
+    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels(axes=axes, max_torque=0.01), torquers=Torquers(max_torque=0.02))
+    model = AttitudeModel(spacecraft)
+    t = np.array([0.0, 1.0])
+    u = np.array([[0.001, -0.002, 0.003], [0.004, 0.005, -0.006]])
+    q, omega = np.tile(quat.IDENTITY, (2, 1)), np.zeros((2, 3))
+    demand = reference_demand(CONTROLLERS["augmented_quaternion_feedback"](), model, t, q, omega, u)
+    np.testing.assert_allclose(demand["wheels_torque"].values, [[-0.001, 0.002], [-0.004, -0.005]], rtol=1e-12)
+    np.testing.assert_allclose(demand["torquers_torque"].values, [[0.0, 0.0, 0.003], [0.0, 0.0, -0.006]], atol=1e-15)
+    np.testing.assert_allclose(demand["wheels_momentum"].values, [[0.0, 0.0], [-0.0025, -0.0015]], rtol=1e-12)
+    wheels_only = CONTROLLERS["min_norm"]
+    assert wheels_only.wheels_only
+    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels(axes=axes, max_torque=0.01), torquers=Torquers(max_torque=0.02))
+    demand = reference_demand(wheels_only(), AttitudeModel(spacecraft), t, q, omega, u)
+    np.testing.assert_array_equal(demand["torquers_torque"].values, np.zeros((2, 3)))
+
+
+def test_magnetorquers_take_the_torque_across_the_field_along_the_reference():
+    orbit = CircularOrbit(altitude=600e3, inclination=np.deg2rad(97.8))
+    field = MAGNETIC_FIELDS["tilted_dipole"].from_options(MAGNETIC_FIELDS["tilted_dipole"].Options(), orbit)
+    spacecraft = Spacecraft(INERTIA, wheels=None, magnetorquers=Magnetorquers(max_dipole=0.2))
+    model = AttitudeModel(spacecraft, Environment(orbit=orbit, magnetic_field=field))
+    t = np.array([0.0, 30.0, 60.0])
+    q = np.stack([quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), a) for a in (0.0, 0.4, 0.9)])
+    u = np.array([[1e-5, 0.0, -2e-5], [0.0, 3e-5, 0.0], [-1e-5, 1e-5, 1e-5]])
+    demand = reference_demand(CONTROLLERS["augmented_quaternion_feedback"](), model, t, q, np.zeros((3, 3)), u)
+    for k in range(3):
+        b_inertial = np.asarray(field.field_inertial(orbit.position(t[k]), t[k])).ravel()
+        b = quat.rotate(quat.conjugate(q[k]), b_inertial)
+        np.testing.assert_allclose(demand["magnetorquers_dipole"].values[k], np.cross(b, u[k]) / b.dot(b), rtol=1e-9)
+
+
+def test_ratios_and_the_actuator_score():
+    demand = Demand("wheels_torque", np.array([[0.001, -0.0027, 0.0], [0.0005, 0.001, 0.0]]),
+                    np.array([0.003, 0.003, np.inf]))
+    ratios = demand.ratios()
+    np.testing.assert_allclose(ratios, [[1 / 3, 0.9, 0.0], [1 / 6, 1 / 3, 0.0]])
+    failed = Demand("wheels_torque", np.array([[0.0, 0.001]]), np.array([0.0, 0.0]))
+    np.testing.assert_array_equal(failed.ratios(), [[0.0, np.inf]])
+    t = np.array([0.0, 2.0])
+    met = _actuators(0.9, {"wheels_torque": demand}, t)
+    assert met.met and met.values == {"wheels_torque": pytest.approx(0.9), "wheels_torque_time_s": 0.0}
+    broken = _actuators(0.8, {"wheels_torque": demand}, t)
+    assert not broken.met and broken.detail == "wheels_torque 0.9 x its limit at 0.0 s (allowed 0.8 x)"
+    unlimited = Demand("wheels_momentum", np.ones((2, 3)), np.full(3, np.inf))
+    assert _actuators(0.5, {"wheels_momentum": unlimited}, t).values == {}

@@ -1,0 +1,170 @@
+"""Runs scored against requirements: statuses, messages, ``--strict``, the columns of every table.
+
+The slew turns 120 deg about the inertial z axis from the inertial attitude; the star tracker's
+boresight lies in the body xy-plane at azimuth -60 deg, so along the eigenaxis path it sweeps the
+azimuths -60 to +60 deg in the xy-plane and crosses the inertial x axis mid-way: a 30 deg keep-out
+about inertial x is entered at azimuth -30 deg and its margin reaches -30 deg (the boresight on the
+axis), whatever the profile in time. A keep-out about inertial -x is never nearer than 120 deg.
+"""
+from __future__ import annotations
+
+import contextlib
+import copy
+import csv
+import io
+import json
+import math
+from pathlib import Path
+
+import pytest
+import yaml
+
+import scenarios
+from scenarios.cli.commands import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SUN_SCENARIO = ROOT / "scenarios" / "cubesat_12u_sun_keep_out.yaml"
+
+BASE = {
+    "name": "requirements-run",
+    "spacecraft": {"inertia": [0.25, 0.28, 0.12], "wheels": {"max_torque": 0.003, "max_momentum": 0.02},
+                   "sensors": {"star_tracker": {"boresight": [0.5, -0.8660254, 0.0]}}},
+    "maneuver": {"duration": 60.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
+                 "final": {"q": [0.5, 0, 0, 0.8660254], "omega": [0, 0, 0]}},
+    "planners": [{"name": "eigenaxis"}],
+    "controller": {"name": "augmented_quaternion_feedback"},
+    "simulation": {"sample_time": 0.5},
+    "requirements": {"pointing": {"st": {"sensor": "star_tracker", "keep_out": {"inertial": [1, 0, 0]},
+                                         "angle_deg": 30}}},
+}
+
+
+def with_direction(direction: list) -> dict:
+    data = copy.deepcopy(BASE)
+    data["requirements"]["pointing"]["st"]["keep_out"] = {"inertial": direction}
+    return data
+
+
+def run_cli(tmp_path: Path, data: dict, *flags: str) -> tuple[int, str, str]:
+    tmp_path.mkdir(parents=True, exist_ok=True)
+    path = tmp_path / "case.yaml"
+    path.write_text(yaml.safe_dump(data))
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        status = main(["run", str(path), "--out", str(tmp_path / "out"), "--no-plots", *flags])
+    return status, out.getvalue(), err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def crossing():
+    return scenarios.run(scenarios.parse_scenario(copy.deepcopy(BASE)))
+
+
+def test_an_eigenaxis_row_through_a_keep_out_is_violated_and_says_why(crossing):
+    row = crossing.rows[0]
+    assert row.status == "violated"
+    assert row.message.startswith("st (reference): min margin -30 deg at 30.0 s")
+    assert "st (closed loop): min margin" in row.message
+    assert row.message.endswith("eigenaxis does not honour the pointing requirement (scored only)")
+    reference = row.requirements["reference"]["st"]
+    assert reference["min_margin_deg"] == pytest.approx(-30.0, abs=1e-6)  # the boresight on the axis
+    assert reference["min_margin_time_s"] == pytest.approx(30.0, abs=0.03)  # mid-way, by symmetry
+    # symmetric profile: in from azimuth -30 deg to +30 deg, i.e. the middle third of the angle
+    first, inside = reference["first_violation_s"], reference["time_in_violation_s"]
+    assert first + inside / 2 == pytest.approx(30.0, abs=1e-3)
+    assert row.requirements["closed_loop"]["st"]["min_margin_deg"] < 0
+    assert crossing.status_counts() == {"violated": 1}
+
+
+def test_a_keep_out_the_path_never_nears_leaves_the_row_ok(tmp_path):
+    results = scenarios.run(scenarios.parse_scenario(with_direction([-1, 0, 0])))
+    row = results.rows[0]
+    assert row.status == "ok"
+    assert row.requirements["reference"]["st"]["min_margin_deg"] == pytest.approx(90.0, abs=1e-6)  # 120 - 30
+    assert "does not honour the pointing requirement" in row.message
+
+
+def test_strict_exits_1_when_a_row_is_not_ok_and_writes_the_results_all_the_same(tmp_path):
+    status, out, err = run_cli(tmp_path / "a", copy.deepcopy(BASE))
+    assert status == 0 and "rows: 1 (1 violated)" in out, err
+    status, out, err = run_cli(tmp_path / "b", copy.deepcopy(BASE), "--strict")
+    assert status == 1 and "--strict: 1 of 1 rows not ok (eigenaxis)" in err
+    assert (tmp_path / "b" / "out" / "results.json").is_file()
+    status, out, err = run_cli(tmp_path / "c", with_direction([-1, 0, 0]), "--strict")
+    assert status == 0 and "rows: 1 (1 ok)" in out, err
+
+
+def test_the_requirement_columns_in_every_table(crossing, tmp_path):
+    data = json.loads(crossing.to_json())
+    assert data["frame"] == "inertial (no epoch)" and data["epoch"] is None
+    scores = data["rows"][0]["requirements"]
+    assert set(scores) == {"reference", "closed_loop"}
+    assert list(scores["reference"]["st"]) == ["min_margin_deg", "time_in_violation_s", "first_violation_s",
+                                               "min_margin_time_s"]
+    lines = list(csv.DictReader(io.StringIO(crossing.to_csv())))
+    header = crossing.to_csv().splitlines()[0].split(",")
+    req = [c for c in header if ".req." in c]
+    assert req == [f"{scope}.req.st.{field}" for scope in ("ref", "cl")
+                   for field in ("min_margin_deg", "time_in_violation_s", "first_violation_s", "min_margin_time_s")]
+    assert header.index(req[0]) > header.index("cl.initial_rate_error")  # after the metric columns
+    assert float(lines[0]["ref.req.st.min_margin_deg"]) == scores["reference"]["st"]["min_margin_deg"]
+    frame = crossing.to_dataframe()
+    assert all(frame[c].dtype == "float64" for c in req)
+    markdown = crossing.to_markdown()
+    assert "| ref.req.st.min_margin_deg | -30 |" in markdown and "rows: 1 (1 violated)" in markdown
+    terminal = crossing.to_terminal()
+    assert "req.st (min margin, deg; ref | cl)" in terminal and terminal.rstrip().endswith("rows: 1 (1 violated)")
+
+
+def test_a_row_without_requirements_keeps_its_columns():
+    data = copy.deepcopy(BASE)
+    del data["requirements"]
+    results = scenarios.run(scenarios.parse_scenario(data))
+    assert results.rows[0].status == "ok" and results.rows[0].requirements is None
+    assert ".req." not in results.to_csv().splitlines()[0] and results.rows[0].message.startswith("quintic")
+
+
+def test_the_actuator_rate_and_final_requirements_on_a_run():
+    data = copy.deepcopy(BASE)
+    data["simulation"]["duration"] = 80.0
+    data["requirements"] = {"actuators": {"margin": 0.5}, "rate": {"max": 0.05},
+                            "final": {"after_s": 10.0, "error_deg": 0.5, "rate": 1e-3}}
+    row = scenarios.run(scenarios.parse_scenario(data)).rows[0]
+    reference, closed = row.requirements["reference"], row.requirements["closed_loop"]
+    # eigenaxis quintic about body z (I = 0.12): peak rate 1.875 θ / T, θ = 120 deg
+    peak = 1.875 * math.radians(120.0) / 60.0
+    assert reference["rate"]["peak_rate"] == pytest.approx(peak, rel=1e-6)
+    assert reference["rate"]["ratio"] == pytest.approx(peak / 0.05, rel=1e-6)
+    # the wheel about z stores I_z ω: 0.12 x peak against 0.02 N m s (0.39, within 1 - margin = 0.5);
+    # its torque peaks at I_z x 5.7735 θ / T² (the quintic's peak acceleration) against 0.003 N m
+    assert reference["actuators"]["wheels_momentum"] == pytest.approx(0.12 * peak / 0.02, rel=1e-3)
+    accel = 5.7735 * math.radians(120.0) / 60.0**2
+    assert reference["actuators"]["wheels_torque"] == pytest.approx(0.12 * accel / 0.003, rel=1e-3)
+    assert set(closed) == {"rate", "final"} and closed["final"]["from_s"] == 70.0
+    assert row.status == "violated" and row.message.startswith("rate (reference): peak rate")
+    assert "actuators (reference)" not in row.message
+
+
+def test_the_sun_scenario_others_violated_with_their_margins():
+    """The shipped 12U CubeSat case without its collocation row (which honours pointing once the
+    collocation branch lands): every other planner sweeps the star tracker through the Sun."""
+    scenario = scenarios.load(SUN_SCENARIO)
+    scenario.planners = [spec for spec in scenario.planners if spec.name in ("eigenaxis", "natural_motion")]
+    results = scenarios.run(scenario)
+    for row in results.rows:
+        assert row.status == "violated", (row.label, row.message)
+        assert row.message.startswith("st_sun (reference): min margin")
+        assert row.requirements["reference"]["st_sun"]["min_margin_deg"] < -29.0  # through the Sun's centre
+        assert row.requirements["closed_loop"]["st_sun"]["min_margin_deg"] < -29.0
+    assert json.loads(results.to_json())["frame"] == "GCRF"
+    assert json.loads(results.to_json())["epoch"] == "2027-03-20T12:00:00Z"
+
+
+def test_end_points_inside_a_keep_out_fail_every_planner_row_before_planning():
+    text = SUN_SCENARIO.read_text().replace("boresight: [0.5, -0.8660254, 0.0]", "boresight: [1, 0, 0]")
+    scenario = scenarios.parse_scenario(yaml.safe_load(text))
+    results = scenarios.run(scenario)
+    assert [row.status for row in results.rows] == ["failed"] * 4
+    for row in results.rows:
+        assert row.message.startswith("st_sun: the initial attitude already breaks it at 0 s")
+        assert row.reference_metrics is None and row.simulation is None and row.plan_time_s == 0.0
