@@ -36,7 +36,7 @@ def solve(outcomes, **options):
     return result, solver
 
 
-@pytest.mark.parametrize("violation, accepted", [(1e-3, False), (1e-7, False), (1e-9, True), (0.0, True)])
+@pytest.mark.parametrize("violation, accepted", [(1e-3, False), (-1e-3, False), (1e-7, False), (1e-9, True), (0.0, True)])
 def test_a_stalled_point_counts_only_when_feasible(violation, accepted):
     result, _ = solve([(STALLED, False, 1.0, [violation])], feasibility_tolerance=1e-8)
     assert result.success is accepted

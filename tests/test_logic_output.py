@@ -90,12 +90,14 @@ def test_a_refused_commit_leaves_no_staging_folder(tmp_path, capsys):
     assert staging_folders(out) == []
 
 
-@pytest.mark.parametrize("name", ["../precious.txt", "timeseries/../../precious.txt"])
-def test_a_manifest_naming_only_a_parent_path_is_not_trusted(name, tmp_path, capsys):
-    """Only ``..`` (no absolute path beside it): without its guard the run would delete the file."""
+@pytest.mark.parametrize("name", ["../precious.txt", "timeseries/../../precious.txt", "ABSOLUTE"])
+def test_a_manifest_naming_one_path_outside_is_not_trusted(name, tmp_path, capsys):
+    """One guard at a time: only ``..`` (no absolute path beside it), or only an absolute path;
+    without its guard the run would delete the file as a stale result."""
     path, out = scenario(tmp_path), tmp_path / "out"
     assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
     precious = tmp_path / "precious.txt"
+    name = str(precious) if name == "ABSOLUTE" else name
     precious.write_text("keep")
     data = manifest(out)
     data["files"].append(name)
