@@ -51,7 +51,7 @@ def test_filtered_bdot_is_the_first_order_filter_of_the_backward_difference(time
 
 def eq7_rates(q, k, g):
     """ωd of eq. 7 (unsaturated), written out: ωd1 = −k q1 + g q2 q3 / D, ωd2 = −k q2 − g q1 q3 / D."""
-    q0, q1, q2, q3 = q
+    _, q1, q2, q3 = q
     d = q1 * q1 + q2 * q2
     return np.array([-k * q1 + g * q2 * q3 / d, -k * q2 - g * q1 * q3 / d])
 

@@ -4,7 +4,6 @@ dynamics must be evaluated at each Radau point's own time. Oracle: ``solve_ivp``
 tolerances) of the model's right-hand side driven by the plan's control polynomial, interval by
 interval, compared with the plan's states at the mesh nodes."""
 import numpy as np
-import pytest
 from scipy.integrate import solve_ivp
 
 from ocp import CircularOrbit, Environment, Spacecraft, Torquers, quat
@@ -31,7 +30,7 @@ def test_collocation_under_gravity_gradient_agrees_with_integration_of_its_contr
     for k in range(reference.intervals):
         a, b = nodes[k], nodes[k + 1]
         # the control polynomial of interval k, evaluated strictly inside it
-        def rhs(t, state):
+        def rhs(t, state, a=a, b=b):
             u = reference.control(min(max(t, a + 1e-9 * (b - a)), b - 1e-9 * (b - a)))
             return model.rhs(state, u, t, disturbance).full().ravel()
         x = solve_ivp(rhs, (a, b), x, method="DOP853", rtol=1e-12, atol=1e-13).y[:, -1]

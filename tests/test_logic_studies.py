@@ -55,7 +55,7 @@ def fake_task(values_by_key, calls):
     return task
 
 
-DISPERSIONS = {"controller.options.kd": {"offset": {"uniform": [0.0, 0.1]}},
+DISPERSIONS = {"controller.options.kd": {"offset": {"uniform": [0.05, 0.15]}},
                "controller.options.kp": {"scale": {"normal": {"mean": 1.0, "std": 0.1}}}}
 
 
@@ -75,11 +75,34 @@ def test_each_case_draws_from_its_own_spawned_stream():
         assert case.seed == int(children[i].generate_state(1)[0])
         u = np.random.default_rng(children[i]).random((1, 2))[0]
         options = case.scenario["controller"]["options"]
-        assert options["kd"] == pytest.approx(0.6 + 0.1 * u[0], rel=1e-12)
+        assert options["kd"] == pytest.approx(0.6 + 0.05 + 0.1 * u[0], rel=1e-12)
         assert options["kp"] == pytest.approx(0.2 * (1.0 + 0.1 * norm.ppf(u[1])), rel=1e-12)
         assert case.scenario["maneuver"]["duration"] == [30.0, 31.0][i // samples]
     kds = [c.scenario["controller"]["options"]["kd"] for c in study.cases]
     assert len(set(kds)) == n  # every case has its own stream
+
+
+def test_a_latin_hypercube_per_grid_point_from_the_streams_after_the_cases():
+    """``latin_hypercube``: grid point p's design is ``qmc.LatinHypercube(d, seed=default_rng(child))``
+    with child ``n_cases + p`` of the spawn; sample s of the point takes row s of it, and the case
+    seed is still child ``p × samples + s``. Each column of a design is stratified: one value in
+    each of ``samples`` equal bins."""
+    from scipy.stats import qmc
+    seed, samples, points = 11, 4, 2
+    study = scenarios.parse_study(study_data(
+        grid={"maneuver.duration": [30.0, 31.0]},
+        monte_carlo={"samples": samples, "seed": seed, "method": "latin_hypercube", "dispersions": DISPERSIONS}))
+    n = points * samples
+    children = np.random.SeedSequence(seed).spawn(n + points)
+    for point in range(points):
+        design = qmc.LatinHypercube(d=2, seed=np.random.default_rng(children[n + point])).random(samples)
+        assert sorted(np.floor(design[:, 0] * samples)) == list(range(samples))
+        for sample in range(samples):
+            case = study.cases[point * samples + sample]
+            assert case.seed == int(children[point * samples + sample].generate_state(1)[0])
+            options = case.scenario["controller"]["options"]
+            assert options["kd"] == pytest.approx(0.6 + 0.05 + 0.1 * design[sample, 0], rel=1e-12)
+            assert options["kp"] == pytest.approx(0.2 * (1.0 + 0.1 * norm.ppf(design[sample, 1])), rel=1e-12)
 
 
 def test_the_study_seed_reaches_the_case_seeds_and_keys():
@@ -99,7 +122,7 @@ def test_the_store_key_depends_on_the_whole_resolved_case_and_the_version():
     again = scenarios.parse_study(copy.deepcopy(data))
     assert [case.key for case in again.cases] == keys  # and nothing else does
     other = scenarios.parse_study(copy.deepcopy(data), version="999.0")
-    assert not set(case.key for case in other.cases) & set(keys)  # another version: other keys
+    assert not {case.key for case in other.cases} & set(keys)  # another version: other keys
 
 
 def test_resume_reuses_only_cases_of_the_same_version(tmp_path):
@@ -140,10 +163,10 @@ def test_summary_statistics_per_grid_point_against_hand_worked_values(tmp_path):
         lines = list(csv.DictReader(handle))
     assert len(lines) == 2
     by_point = {float(line["maneuver.duration"]): line for line in lines}
-    expected = {30.0: dict(count=4, failures=0, mean=4.25, std=np.sqrt(48.75 / 3), median=3.0, p5=1.15, p95=9.1,
-                           min=1.0, max=10.0),
-                40.0: dict(count=4, failures=1, mean=14 / 3, std=np.sqrt(14 / 3 / 2), median=5.0, p5=3.2, p95=5.9,
-                           min=3.0, max=6.0)}
+    expected = {30.0: {"count": 4, "failures": 0, "mean": 4.25, "std": np.sqrt(48.75 / 3), "median": 3.0,
+                       "p5": 1.15, "p95": 9.1, "min": 1.0, "max": 10.0},
+                40.0: {"count": 4, "failures": 1, "mean": 14 / 3, "std": np.sqrt(14 / 3 / 2), "median": 5.0,
+                       "p5": 3.2, "p95": 5.9, "min": 3.0, "max": 6.0}}
     for duration, stats in expected.items():
         line = by_point[duration]
         assert line["label"] == "smooth" and line["metric"] == "cl.int_u"

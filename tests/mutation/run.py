@@ -179,9 +179,10 @@ def table(outcomes: Sequence[Outcome]) -> str:
               for key in ("caught", "survived", "equivalent", "EQUIVALENT?", "error")}
     judged = counts["caught"] + counts["survived"]
     rate = 100.0 * counts["caught"] / judged if judged else 0.0
-    lines += ["", f"{len(outcomes)} mutations: {counts['caught']} caught, {counts['survived']} survived, "
-                  f"{counts['equivalent']} equivalent ({counts['EQUIVALENT?']} listed as equivalent but caught), "
-                  f"{counts['error']} in error; caught {rate:.1f} % of those that change behaviour."]
+    summary = (f"{len(outcomes)} mutations: {counts['caught']} caught, {counts['survived']} survived, "
+               f"{counts['equivalent']} equivalent ({counts['EQUIVALENT?']} listed as equivalent but caught), "
+               f"{counts['error']} in error; caught {rate:.1f} % of those that change behaviour.")
+    lines += ["", summary]
     survivors = [o for o in outcomes if o.result in ("survived", "error", "EQUIVALENT?")]
     if survivors:
         lines += ["", "To look at:"] + [f"- {o.mutation.name} ({o.result}): {o.detail}" for o in survivors]
@@ -206,7 +207,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     chosen = [m for m in MUTATIONS if not args.k or any(word in m.name for word in args.k)]
     if args.list:
         for m in chosen:
-            print(f"{m.name}: {m.file}: {' '.join(m.tests)}" + (f"  [equivalent: {m.equivalent}]" if m.equivalent else ""))
+            note = f"  [equivalent: {m.equivalent}]" if m.equivalent else ""
+            print(f"{m.name}: {m.file}: {' '.join(m.tests)}{note}")
         return 0
     try:
         outcomes = run(chosen, timeout=args.timeout, baseline=not args.no_baseline)
