@@ -42,3 +42,14 @@ def test_only_fractions_are_bounded_by_one():
     assert metric_violations({"saturation_fraction": 2.0, "int_u": 3.5}) == ["saturation_fraction = 2.0"]
     assert metric_violations({"duration_s": 0.0}) == ["duration_s = 0.0"]
     assert metric_violations({"int_abs_u": [0.1, -0.2, 0.3]}) == ["int_abs_u = [0.1, -0.2, 0.3]"]
+
+
+@pytest.mark.parametrize("errors, expected", [
+    ([5.0, 2.0, 1.0, 0.5, 1.0, 0.2], 2.0),   # 1.0 deg is at the band: settled (docs: "at or below")
+    ([5.0, 2.0, 1.0, 0.5, 1.01, 0.2], 5.0),  # just outside at t = 4
+    ([0.5, 0.2, 0.1, 0.0, 0.0, 1.0], 0.0),   # inside throughout
+    ([0.5, 0.2, 0.1, 0.0, 0.0, 1.5], None),  # outside at the last sample
+])
+def test_settling_time_boundary(errors, expected):
+    from ocp.metrics import settling_time
+    assert settling_time(T, np.array(errors), 1.0) == expected
