@@ -104,8 +104,12 @@ def test_the_requirement_columns_in_every_table(crossing, tmp_path):
     lines = list(csv.DictReader(io.StringIO(crossing.to_csv())))
     header = crossing.to_csv().splitlines()[0].split(",")
     req = [c for c in header if ".req." in c]
-    assert req == [f"{scope}.req.st.{field}" for scope in ("ref", "cl")
-                   for field in ("min_margin_deg", "time_in_violation_s", "first_violation_s", "min_margin_time_s")]
+    pointing = ("min_margin_deg", "time_in_violation_s", "first_violation_s", "min_margin_time_s")
+    # the actuator requirement every scenario carries (margin 0) is scored on the reference only
+    assert req == ([f"ref.req.st.{field}" for field in pointing]
+                   + [f"ref.req.actuators.{field}" for field in ("wheels_torque", "wheels_torque_time_s",
+                                                                 "wheels_momentum", "wheels_momentum_time_s")]
+                   + [f"cl.req.st.{field}" for field in pointing])
     assert header.index(req[0]) > header.index("cl.initial_rate_error")  # after the metric columns
     assert float(lines[0]["ref.req.st.min_margin_deg"]) == scores["reference"]["st"]["min_margin_deg"]
     frame = crossing.to_dataframe()
@@ -118,10 +122,24 @@ def test_the_requirement_columns_in_every_table(crossing, tmp_path):
 
 def test_a_row_without_requirements_keeps_its_columns():
     data = copy.deepcopy(BASE)
-    del data["requirements"]
+    data["requirements"] = None  # stated null: nothing required, not even the actuators' limits
     results = scenarios.run(scenarios.parse_scenario(data))
     assert results.rows[0].status == "ok" and results.rows[0].requirements is None
     assert ".req." not in results.to_csv().splitlines()[0] and results.rows[0].message.startswith("quintic")
+
+
+def test_without_a_requirements_section_the_actuator_limits_are_still_required():
+    data = copy.deepcopy(BASE)
+    del data["requirements"]
+    row = scenarios.run(scenarios.parse_scenario(data)).rows[0]
+    # eigenaxis quintic about body z (I = 0.12, wheel momentum limit 0.02 N m s): peak rate
+    # 1.875 theta / T, so the peak momentum asked is 0.12 * 1.875 * (2 pi / 3) / 60 = 0.0078540
+    assert row.status == "ok" and row.message.startswith("quintic")  # unstated: no "does not honour" note
+    ratio = row.requirements["reference"]["actuators"]["wheels_momentum"]
+    assert ratio == pytest.approx(0.12 * 1.875 * (2 * math.pi / 3) / 60.0 / 0.02, rel=1e-4)
+    data["spacecraft"]["wheels"]["max_momentum"] = 0.005  # now the reference asks 1.57 x the limit
+    row = scenarios.run(scenarios.parse_scenario(data)).rows[0]
+    assert row.status == "violated" and "actuators (reference): wheels_momentum 1.57 x its limit" in row.message
 
 
 def test_the_actuator_rate_and_final_requirements_on_a_run():

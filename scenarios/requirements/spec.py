@@ -185,9 +185,13 @@ class ActuatorRequirement:
     ----------
     margin : float
         In [0, 1).
+    stated : bool, optional
+        Whether the scenario states it (``requirements.actuators``); ``False`` for the margin-0
+        requirement every scenario carries, which a row's message does not mention unless broken.
     """
 
     margin: float
+    stated: bool = True
 
     def __post_init__(self) -> None:
         if not (0.0 <= self.margin < 1.0):

@@ -174,8 +174,10 @@ REQUIREMENTS = Section((
     custom("pointing", "Pointing requirements by name (the name heads the result columns "
            "``ref.req.<name>.*`` and ``cl.req.<name>.*``).", "mapping of names to mappings", None, default={},
            section=POINTING, named=True),
-    mapping("actuators", "The reference's demand on the actuators; absent or ``null``: not required.",
-            REQUIREMENT_ACTUATORS, default=None, null="none"),
+    mapping("actuators", "The reference's demand on the actuators. Absent: required with margin 0 (the "
+            "actuators' limits are the scenario's: a reference that asks more than they give is never ok); "
+            "``null``: not required (scored only by the closed loop's saturation).",
+            REQUIREMENT_ACTUATORS, default={}, null="none"),
     mapping("rate", "A body-rate limit; absent or ``null``: none.", REQUIREMENT_RATE, default=None, null="none"),
     mapping("final", "The closed loop's final error and rate; absent or ``null``: none.", REQUIREMENT_FINAL,
             default=None, null="none"),
@@ -349,6 +351,7 @@ def parse_requirements(node: Node, sensors: dict[str, Sensor], geometry: Geometr
             pointing.append(requirement)
             constraints.append(constraint)
         pointing_node.finish()
+    stated = isinstance(node.value, dict) and "actuators" in node.value
     actuators = REQUIREMENTS["actuators"].value(node)
     rate = REQUIREMENTS["rate"].value(node)
     final_node = REQUIREMENTS["final"].node(node)
@@ -356,7 +359,7 @@ def parse_requirements(node: Node, sensors: dict[str, Sensor], geometry: Geometr
     node.finish()
     requirements = Requirements(
         tuple(pointing),
-        None if actuators is None else ActuatorRequirement(actuators["margin"]),
+        None if actuators is None else ActuatorRequirement(actuators["margin"], stated),
         None if rate is None else RateRequirement(rate["max"]),
         None if final_values is None else _final(final_node, final_values, qf_free, omegaf_free, span),
     )
