@@ -591,8 +591,9 @@ def sky_figure(series: SkySeries) -> Figure:
                 axis.plot(*_on_map(boundary), "-" if number == 0 else "-.", color=color, lw=1.6,
                           label=f"{cone.label} ({kind}){' at the end' if number else ''}")
             x, y = _on_map(cone.centre)
-            axis.plot(x, y, ":" if len(x) > 1 else "+", color=color, ms=9, mew=2)
-            axis.text(x[0], y[0], f" {cone.label}", color=color, fontsize=8, va="bottom")
+            axis.plot(x, y, ":" if len(x) > 1 else "+", color=color, ms=9, mew=2, zorder=4)
+            axis.text(x[0], y[0], f" {cone.label}", color=color, fontsize=8, va="top",
+                      bbox={"facecolor": "white", "alpha": 0.7, "linewidth": 0, "pad": 1})
             for number, disc in enumerate(cone.discs):
                 dx, dy = _on_map(disc)
                 filled = bool(np.all(np.isfinite(dx)))  # a disc that does not wrap round the map is filled
