@@ -38,6 +38,9 @@ MARGIN_MARGINS = {"left": 0.09, "right": 0.7}
 SKY_TRACK_POINTS = 2000
 """Most points of a boresight track on the sky map (a track is a curve on the sphere, not a time
 series: it is thinned evenly in time, which keeps its shape at the map's resolution)."""
+STILL_DEG = 0.05
+"""A cone whose direction and angle change less than this over the run [deg] (the Sun's does over an
+hour) is drawn once on the sky map, as a fixed one."""
 CIRCLE_POINTS = 181
 """Points on a cone's boundary circle on the sky map."""
 COLUMNS_PER_POINT = 2
@@ -410,28 +413,29 @@ def sensor_text(boresight: Any) -> str:
 
 
 def requirement_text(constraint: Any) -> str:
-    """A pointing requirement in words: its name, kind, angle, sensor and direction.
+    """A pointing requirement in words: its name, what it asks (sensor, kind, angle, direction), the
+    boresight, and the window when it is not the whole run.
 
     Parameters
     ----------
     constraint : ocp.geometry.PointingConstraint
-        The requirement.
+        The requirement. Its ``description`` says what it asks (the scenario's requirements give
+        ``"star_tracker keep-out 30 deg about sun"``); without one, the kind, angle and direction
+        are written here.
 
     Returns
     -------
     str
-        For example ``"sun_keep_out: keep-out 30° from sun, boresight [1, 0, 0] (body)"``; the
-        Earth's apparent radius is named when the cone grows by it, the window when it is not the
-        whole run.
+        For example ``"st_sun: star_tracker keep-out 30 deg about sun; boresight [1, 0, 0] (body)"``;
+        a cone that grows (the Earth's limb) says so.
     """
-    kind = "keep-out" if constraint.keep_out else "keep-in"
-    direction = constraint.description or (f"inertial {_vector_text(constraint.directions[0])}"
-                                           if not constraint.moving else "a moving direction")
-    grows = " + Earth radius" if np.any(np.asarray(constraint.growth) > 0) else ""
+    what = constraint.description or (
+        f"{'keep-out' if constraint.keep_out else 'keep-in'} {np.rad2deg(constraint.angle):.4g} deg about "
+        + (f"inertial {_vector_text(constraint.directions[0])}" if not constraint.moving else "a moving direction"))
+    grows = " (+ the Earth's apparent radius)" if np.any(np.asarray(constraint.growth) > 0) else ""
     start, end = constraint.window
     window = f", {start:g}-{end:g} s" if start > 0 or np.isfinite(end) else ""
-    return (f"{constraint.name}: {kind} {np.rad2deg(constraint.angle):.4g}°{grows} from {direction}, "
-            f"{sensor_text(constraint.boresight)}{window}")
+    return f"{constraint.name}: {what}{grows}; {sensor_text(constraint.boresight)}{window}"
 
 
 def pointing_constraints(results: Any) -> list[Any]:
@@ -472,8 +476,7 @@ def pointing_constraints(results: Any) -> list[Any]:
             direction = np.asarray(direction, dtype=float) / np.linalg.norm(direction)
             if not known(boresight, direction, keep_out):
                 constraints.append(PointingConstraint(f"{row.label}: {option} option", boresight, keep_out,
-                                                      float(angle), directions=direction[None, :],
-                                                      description=f"inertial {_vector_text(direction)}"))
+                                                      float(angle), directions=direction[None, :]))
     return constraints
 
 
@@ -698,10 +701,11 @@ class SkyCone:
     keep_out : bool
         Keep-out (drawn red) or keep-in (green).
     boundaries : list of SkyPath
-        The cone's boundary (its limit, the Earth's radius included) at the start of the run and,
-        for a moving direction, at its end.
+        The cone's boundary (its limit, the Earth's radius included) at the start of the run (or
+        of its window) and, when the direction or the limit moves more than :data:`STILL_DEG`, at
+        its end.
     centre : SkyPath
-        The direction over the run (one point when fixed).
+        The direction over the run (one point when it does not move).
     discs : list of SkyPath
         The Earth's disc (radius: the cone's growth) at the start and end, when the cone grows.
     """
@@ -720,7 +724,7 @@ class SkyPanel:
     Parameters
     ----------
     title : str
-        The sensor (:func:`sensor_text`).
+        The sensor (:func:`sensor_text`) and the names of its requirements.
     reference, closed_loop : list of SkyPath or None
         Per row, the boresight's inertial direction along the reference and the closed loop.
     cones : list of SkyCone
@@ -789,16 +793,20 @@ def sky_series(results: Any, constraints: list[Any] | None = None, sampled: list
                for motion in rows]
     panels = []
     for boresight, group in sensors.items():
-        panel = SkyPanel(sensor_text(boresight), [], [], [])
+        panel = SkyPanel(f"{sensor_text(boresight)}: {', '.join(c.name for c in group)}", [], [], [])
         for reference, closed_loop in thinned:
             for paths, attitude in ((panel.reference, reference), (panel.closed_loop, closed_loop)):
                 paths.append(None if attitude is None else sky_path(quat.rotate(attitude[1], np.asarray(boresight))))
         for constraint in group:
             start, stop = max(constraint.window[0], 0.0), min(constraint.window[1], end)
-            times = np.array([start, stop]) if constraint.moving else np.array([start])
-            directions, limits = constraint.direction(times), constraint.limit(times)
+            times = np.linspace(start, stop, 200)
+            path, limits = constraint.direction(times), constraint.limit(times)
+            moves = (np.rad2deg(np.arccos(np.clip(path @ path[0], -1.0, 1.0))).max() > STILL_DEG
+                     or np.rad2deg(np.ptp(limits)) > STILL_DEG)
+            keep = [0, len(times) - 1] if moves else [0]
+            directions, limits = path[keep], limits[keep]
             growth = limits - constraint.angle
-            centre = constraint.direction(np.linspace(start, stop, 200)) if constraint.moving else directions
+            centre = path if moves else directions
             panel.cones.append(SkyCone(
                 constraint.name, constraint.keep_out,
                 [sky_path(cone_circle(d, a)) for d, a in zip(directions, limits)], sky_path(centre),
