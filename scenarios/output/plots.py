@@ -426,8 +426,9 @@ def margin_axis(axis: Any, low: float, high: float, closest: float) -> None:
     The value axis is symmetric-logarithmic (matplotlib's ``symlog``): linear within
     ``±linthresh``, logarithmic beyond. ``linthresh`` is the smallest margin any row reaches in
     magnitude (``closest``), rounded up to 1, 2 or 5 times a power of ten and kept within
-    :data:`MARGIN_LINEAR_DEG`: so a dip of 0.2° below zero takes the whole linear half below the
-    zero line, whether the other margins reach 1° or 150°. The limits leave :data:`MARGIN_PAD` of
+    :data:`MARGIN_LINEAR_DEG`: the margin nearest zero (a 0.2° dip into the cone, or a 0.01°
+    clearance) lies at the edge of the linear part or beyond it, a visible distance from the zero
+    line, whether the other margins reach 1° or 150°. The limits leave :data:`MARGIN_PAD` of
     the axis (in its own scale) below ``min(low, -linthresh / 2)`` and above ``high``, so that the
     zero line and some of the violated side are always in view.
 
