@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from ocp import quat
+from ocp import ReactionWheels, Spacecraft, quat
 from planners.reference import ReferenceSample
 from scenarios.output.plot_data import decimate, row_series
 from scenarios.output.plots import RowFigure
@@ -31,8 +31,9 @@ def make_row(rng, label, scale, samples=300):
     ref = reference.sample(t)
     q = quat.normalize(ref.q + rng.normal(0, 1e-3, ref.q.shape))
     x = np.hstack([q, ref.omega + rng.normal(0, 1e-4, (t.size, 3)), rng.normal(0, scale, (t.size, 3))])
+    wheel_torque = rng.normal(0, 0.01 * scale, (samples, 3))
     simulation = SimpleNamespace(t=t, x=x, q=x[:, 0:4], omega=x[:, 4:7], wheel_momentum=x[:, 7:],
-                                 applied_torque=rng.normal(0, 0.01 * scale, (samples, 3)))
+                                 applied_torque=-wheel_torque, applied_u=wheel_torque)
     return SimpleNamespace(label=label, planner="eigenaxis", controller="augmented_quaternion_feedback",
                            simulation=simulation, reference=reference)
 
@@ -45,11 +46,14 @@ def test_a_row_on_a_reused_figure_is_the_row_on_a_new_figure(tmp_path, rng):
     """Every row, not only the second: the static part drawn once must not depend on the row's
     values (the vertical spines' ends do, through the value limits: a corner pixel moved)."""
     target = quat.from_axis_angle([0, 0, 1], 1.0)
+    spacecraft = Spacecraft([1.0, 2.0, 3.0], wheels=ReactionWheels(np.eye(3), max_torque=0.02, max_momentum=[1.0, 2.0, 3.0],
+                                                                   spin_inertia=1e-3, failed=[1]))
     rows = [make_row(rng, name, scale) for name, scale in (("first", 1.0), ("second", 0.02), ("third", 3.0))]
-    reused = RowFigure(3, True, True)
-    for row in rows:
-        reused.draw(row_series(row, target), tmp_path / f"{row.label}_reused.png")
-        RowFigure(3, True, True).draw(row_series(row, target), tmp_path / f"{row.label}_new.png")
+    shape = row_series(rows[0], target, spacecraft).shape
+    reused = RowFigure(*shape)
+    for row in rows:  # the limit lines in view for the first and third rows, beyond it for the second
+        reused.draw(row_series(row, target, spacecraft), tmp_path / f"{row.label}_reused.png")
+        RowFigure(*shape).draw(row_series(row, target, spacecraft), tmp_path / f"{row.label}_new.png")
         np.testing.assert_array_equal(pixels(tmp_path / f"{row.label}_reused.png"),
                                       pixels(tmp_path / f"{row.label}_new.png"))
     assert not np.array_equal(pixels(tmp_path / "first_new.png"), pixels(tmp_path / "second_new.png"))

@@ -11,7 +11,8 @@ from typing import Sequence
 
 MAX_STEM = 64
 """Characters of a file stem derived from a label or a scenario name (file systems allow 255 bytes)."""
-RESERVED = frozenset({"results", "comparison", "timeseries", "summary", "cases", "study", "store", "plots"})
+RESERVED = frozenset({"results", "comparison", "margins", "sky", "timeseries", "summary", "cases", "study", "store",
+                      "plots"})
 """Stems slewbench uses for its own files; a row label that sanitises to one gets a suffix."""
 
 
@@ -64,8 +65,8 @@ def row_stems(labels: Sequence[str]) -> list[str]:
         counts[stem.lower()] = counts.get(stem.lower(), 0) + 1
     result, taken = [], set()
     for index, (label, stem) in enumerate(zip(labels, stems)):
-        if counts[stem.lower()] > 1 or stem.lower() in RESERVED or stem.lower().endswith("_cones"):
-            stem = f"{stem[:MAX_STEM - 9]}-{_digest(label)}"  # "_cones" is the suffix of a row's cone plot
+        if counts[stem.lower()] > 1 or stem.lower() in RESERVED:
+            stem = f"{stem[:MAX_STEM - 9]}-{_digest(label)}"
         while stem.lower() in taken:  # a hash collision or a label equal to another's suffixed stem
             stem = f"{stem[:MAX_STEM - 9]}-{_digest(f'{label}#{index}')}"
         taken.add(stem.lower())

@@ -13,25 +13,63 @@ figure layouts below fix the pixel columns without a figure.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 DPI = 90
 """Resolution of every PNG [dots per inch]."""
-ROW_FIGSIZE_IN = (10.0, 13.0)
-"""Size of the per-row figure with wheels [in]; without wheels its height is :data:`ROW_HEIGHT_NO_WHEELS_IN`."""
-ROW_HEIGHT_NO_WHEELS_IN = 10.5
-ROW_MARGINS = {"left": 0.1, "right": 0.855, "bottom": 0.05, "top": 0.95, "hspace": 0.08}
-"""``subplots_adjust`` of the per-row figure (fractions of the figure); the legends sit right of 0.855."""
+ROW_WIDTH_IN = 10.0
+"""Width of the per-row figure [in]."""
+ROW_PANEL_IN = 2.34
+"""Height of one panel of the per-row figure, its gap included [in]: the figure's height follows its panels."""
+ROW_EDGES_IN = 0.65
+"""Space above the top panel (the title) and below the bottom one (the time axis) [in]."""
+ROW_MARGINS = {"left": 0.1, "right": 0.855, "hspace": 0.08}
+"""``subplots_adjust`` of the per-row figure (fractions of the figure; top and bottom from
+:func:`row_figure_layout`); the legends sit right of 0.855."""
 OVERLAY_FIGSIZE_IN = (9.0, 7.0)
 OVERLAY_MARGINS = {"left": 0.1, "right": 0.98, "bottom": 0.08, "top": 0.93, "hspace": 0.08}
+MARGIN_WIDTH_IN = 11.0
+"""Width of the pointing-margin figure [in]; its height is :data:`MARGIN_PANEL_IN` per requirement."""
+MARGIN_PANEL_IN = 2.7
+MARGIN_MARGINS = {"left": 0.09, "right": 0.7}
+"""Left and right edges of the margin panels (fractions of the figure); the legends sit right of them."""
+SKY_TRACK_POINTS = 2000
+"""Most points of a boresight track on the sky map (a track is a curve on the sphere, not a time
+series: it is thinned evenly in time, which keeps its shape at the map's resolution)."""
+STILL_DEG = 0.05
+"""A cone whose direction and angle change less than this over the run [deg] (the Sun's does over an
+hour) is drawn once on the sky map, as a fixed one."""
+CIRCLE_POINTS = 181
+"""Points on a cone's boundary circle on the sky map."""
 COLUMNS_PER_POINT = 2
 """Series longer than this many points per pixel column of the panel are decimated."""
 FLOOR_DEG = 1e-9
 """Smallest angle drawn on the logarithmic error axes [deg] (an exact zero has no logarithm)."""
 FLOOR_RATE = 1e-12
 """Smallest rate drawn on the logarithmic rate axes [rad/s]."""
+RPM_PER_RAD_S = 60.0 / (2.0 * np.pi)
+"""Revolutions per minute in one rad/s."""
+
+
+def row_figure_layout(n_panels: int) -> tuple[tuple[float, float], dict[str, float]]:
+    """Size and margins of a per-row figure of ``n_panels`` panels.
+
+    Parameters
+    ----------
+    n_panels : int
+        Number of stacked panels.
+
+    Returns
+    -------
+    figsize : (float, float)
+        Width and height [in].
+    margins : dict
+        ``subplots_adjust`` arguments (fractions of the figure).
+    """
+    height = n_panels * ROW_PANEL_IN + 2 * ROW_EDGES_IN
+    return (ROW_WIDTH_IN, height), {**ROW_MARGINS, "top": 1 - ROW_EDGES_IN / height, "bottom": ROW_EDGES_IN / height}
 
 
 def panel_columns(figure_width_in: float, margins: dict[str, float]) -> int:
@@ -70,7 +108,8 @@ def decimate(t: np.ndarray, values: np.ndarray, columns: int) -> tuple[np.ndarra
         Unchanged when ``N <= COLUMNS_PER_POINT * columns``; else, per bin of consecutive
         samples (``columns`` bins), the samples at each column's minimum and maximum in time
         order (for ``(N, k)`` values those of the first column, the others alongside), and the
-        last sample: the drawn envelope and every peak are those of the full series.
+        last sample: the drawn envelope and every peak are those of the full series. NaN (a gap)
+        is ignored in a bin that has numbers, and kept once from a bin that has none.
     """
     n = t.size
     if n <= COLUMNS_PER_POINT * max(columns, 1):
@@ -80,8 +119,9 @@ def decimate(t: np.ndarray, values: np.ndarray, columns: int) -> tuple[np.ndarra
     key = values if values.ndim == 1 else values[:, 0]
     padded = np.concatenate([key, np.repeat(key[-1:], pad)]).reshape(columns, size)
     start = np.arange(columns) * size
-    low = np.minimum(start + padded.argmin(axis=1), n - 1)
-    high = np.minimum(start + padded.argmax(axis=1), n - 1)
+    gaps = np.isnan(padded)  # NaN (a gap in the curve) is never an extreme; a bin of NaN only keeps one
+    low = np.minimum(start + np.where(gaps, np.inf, padded).argmin(axis=1), n - 1)
+    high = np.minimum(start + np.where(gaps, -np.inf, padded).argmax(axis=1), n - 1)
     keep = np.unique(np.concatenate([[0, n - 1], low, high]))
     return t[keep], values[keep]
 
@@ -105,15 +145,22 @@ def held(values: np.ndarray) -> np.ndarray:
 Curve = tuple[np.ndarray, np.ndarray]
 """A drawn curve: times [s] and values, decimated."""
 
+RowShape = tuple[Any, ...]
+"""What fixes a per-row figure's static part (:attr:`RowSeries.shape`): rows of one shape share a figure."""
+
+LIMITED_PANELS = ("torque", "wheel_torque", "wheel_momentum", "wheel_speed", "dipole")
+"""Panels of the per-row figure that can carry actuator limit lines (keys of :attr:`RowSeries.limits`)."""
+
 
 @dataclass
 class RowSeries:
-    """The curves of one row's figure (torque, rate, quaternion, error angles, wheel momenta).
+    """The curves of one row's figure: body torque, rate, quaternion, error angles, and per
+    actuator (wheel torque, momentum and speed; magnetorquer dipole) with their limits.
 
     Parameters
     ----------
     n_wheels : int
-        Number of wheels (a fifth panel with their momenta when > 0).
+        Number of wheels, failed ones included (wheel torque and momentum panels when > 0).
     with_reference : bool
         The reference is drawn dashed and the error to it in orange.
     with_target : bool
@@ -132,6 +179,20 @@ class RowSeries:
         ``‖ω‖`` and ``max |ω_i|`` [rad/s] (regulation without a target attitude).
     wheels : list of Curve
         Wheel momenta [N m s].
+    failed : tuple of int, optional
+        Indices of the failed wheels (drawn grey and dotted, marked in the legend).
+    wheel_axis : tuple of int, optional
+        Per wheel, the body axis (0, 1, 2) its spin axis lies along, or -1 (its colour follows).
+    wheel_torque : list of Curve, optional
+        Wheel motor torques [N m] (held), applied.
+    wheel_speed : list of Curve, optional
+        Wheel speeds [rpm] (``h_w / J_s``; only when the wheels' spin inertia is known).
+    dipole : list of Curve, optional
+        Magnetorquer dipole [A m^2] (held), applied, per body axis.
+    limits : dict of str to tuple of float, optional
+        Actuator limits drawn as ``±`` lines, per panel of :data:`LIMITED_PANELS`, one value per
+        curve of the panel (NaN: none): the per-axis body torque the actuators can apply on all
+        axes at once [N m], wheel torque [N m], momentum [N m s] and speed [rpm], dipole [A m^2].
     """
 
     n_wheels: int
@@ -147,14 +208,57 @@ class RowSeries:
     rate_norm: Curve | None = None
     rate_max: Curve | None = None
     wheels: list[Curve] = field(default_factory=list)
+    failed: tuple[int, ...] = ()
+    wheel_axis: tuple[int, ...] = ()
+    wheel_torque: list[Curve] = field(default_factory=list)
+    wheel_speed: list[Curve] = field(default_factory=list)
+    dipole: list[Curve] = field(default_factory=list)
+    limits: dict[str, tuple[float, ...]] = field(default_factory=dict)
 
     @property
-    def shape(self) -> tuple[int, bool, bool]:
-        """``(n_wheels, with_reference, with_target)``: rows of one shape share a figure."""
-        return self.n_wheels, self.with_reference, self.with_target
+    def shape(self) -> RowShape:
+        """``(n_wheels, with_reference, with_target, failed, wheel_axis, wheel speed panel, dipole
+        panel, limit styles)``, the arguments of :class:`scenarios.output.plots.RowFigure`: rows of
+        one shape share a figure. A limit style is ``(panel, common)``: ``common`` when every
+        limit of the panel is the same (one black pair of lines), else one pair per curve."""
+        styles = tuple((panel, _common(values)) for panel, values in self.limits.items()
+                       if np.any(np.isfinite(values)))
+        return (self.n_wheels, self.with_reference, self.with_target, tuple(self.failed), tuple(self.wheel_axis),
+                bool(self.wheel_speed), bool(self.dipole), styles)
 
 
-def row_series(row: Any, target_q: Any) -> RowSeries:
+def _common(values: tuple[float, ...]) -> bool:
+    """Whether the finite limits of a panel are all equal."""
+    finite = np.asarray(values, dtype=float)
+    finite = finite[np.isfinite(finite)]
+    return bool(finite.size and np.all(np.abs(finite - finite[0]) <= 1e-12 * np.abs(finite[0])))
+
+
+def _limits(values: Any, keep: Any = True) -> tuple[float, ...]:
+    """Finite limits as floats (zero included: an axis no actuator reaches), NaN for unlimited or
+    dropped (``keep`` False) entries."""
+    values = np.asarray(values, dtype=float)
+    usable = np.isfinite(values) & (values >= 0) & np.asarray(keep, dtype=bool)
+    return tuple(float(v) for v in np.where(usable, values, np.nan))
+
+
+def wheel_axes(axes: np.ndarray) -> tuple[int, ...]:
+    """The body axis each wheel spins about, when it lies along one.
+
+    Parameters
+    ----------
+    axes : (3, n) ndarray
+        Unit spin axes, body frame.
+
+    Returns
+    -------
+    tuple of int
+        Per wheel, 0, 1 or 2 when its axis is ``±x``, ``±y`` or ``±z`` (within 1e-9), else -1.
+    """
+    return tuple(int(np.argmax(np.abs(a))) if np.max(np.abs(a)) > 1 - 1e-9 else -1 for a in np.asarray(axes).T)
+
+
+def row_series(row: Any, target_q: Any, spacecraft: Any) -> RowSeries:
     """The curves of a simulated row, decimated to the per-row figure's panels.
 
     Parameters
@@ -163,6 +267,8 @@ def row_series(row: Any, target_q: Any) -> RowSeries:
         A row with a simulation (and a reference unless regulating).
     target_q : (4,) array_like or None
         Target attitude (scalar-first quaternion, body to inertial) for the error angle.
+    spacecraft : ocp.Spacecraft
+        The simulated spacecraft: its actuators fix the actuator panels and their limit lines.
 
     Returns
     -------
@@ -171,22 +277,44 @@ def row_series(row: Any, target_q: Any) -> RowSeries:
     """
     # the model's helpers, in the process that ran it (module docstring)
     from ocp import quat
+    from ocp.dynamics.layout import control_layout
 
     sim = row.simulation
     t = sim.t
-    columns = panel_columns(ROW_FIGSIZE_IN[0], ROW_MARGINS)
+    columns = panel_columns(ROW_WIDTH_IN, ROW_MARGINS)
 
     def curve(values: np.ndarray) -> Curve:
         return decimate(t, values, columns)
 
-    n_wheels = sim.wheel_momentum.shape[1]
+    def held_curves(values: np.ndarray) -> list[Curve]:
+        return [curve(held(values[:, i])) for i in range(values.shape[1])]
+
+    n_wheels = spacecraft.n_wheels
     with_reference, with_target = row.reference is not None, target_q is not None
     controller = f", {row.controller}" if getattr(row, "controller", None) else ""
     series = RowSeries(
         n_wheels, with_reference, with_target,
         f"{row.label} ({row.planner or 'regulation'}{controller}): solid closed loop, dashed reference",
-        [curve(held(sim.applied_torque[:, i])) for i in range(3)], [curve(sim.omega[:, i]) for i in range(3)],
+        held_curves(sim.applied_torque), [curve(sim.omega[:, i]) for i in range(3)],
         [curve(sim.q[:, i]) for i in range(4)], wheels=[curve(sim.wheel_momentum[:, i]) for i in range(n_wheels)])
+    slices, _ = control_layout(spacecraft)
+    wheels, magnetorquers = spacecraft.wheels, spacecraft.magnetorquers
+    if magnetorquers is None and (wheels is not None or spacecraft.torquers is not None):
+        # the body box of the wheels and torquers (magnetorquers' torque depends on the field)
+        series.limits["torque"] = _limits(spacecraft.body_torque_limit())
+    if wheels is not None:
+        series.failed, series.wheel_axis = tuple(wheels.failed), wheel_axes(wheels.axes)
+        series.wheel_torque = held_curves(sim.applied_u[:, slices["wheels"]])
+        series.limits["wheel_torque"] = _limits(wheels.max_torque, wheels.working)
+        series.limits["wheel_momentum"] = _limits(wheels.max_momentum, wheels.working)
+        if wheels.spin_inertia is not None:
+            speed = sim.wheel_momentum / wheels.spin_inertia * RPM_PER_RAD_S
+            series.wheel_speed = [curve(speed[:, i]) for i in range(n_wheels)]
+            series.limits["wheel_speed"] = _limits(wheels.max_momentum / wheels.spin_inertia * RPM_PER_RAD_S,
+                                                   wheels.working)
+    if magnetorquers is not None:
+        series.dipole = held_curves(sim.applied_u[:, slices["dipole"]])
+        series.limits["dipole"] = _limits(magnetorquers.max_dipole)
     if with_reference:
         ref = row.reference.sample(t)
         series.reference = tuple([curve(values[:, i]) for i in range(values.shape[1])]  # type: ignore[assignment]
@@ -263,62 +391,443 @@ def overlay_series(results: Any) -> OverlaySeries:
     return series
 
 
+def _vector_text(v: Any) -> str:
+    """A short ``[1, 0, 0]`` form of a vector (three significant digits)."""
+    return "[" + ", ".join(f"{float(x):.3g}" for x in np.asarray(v, dtype=float).ravel()) + "]"
+
+
+def sensor_text(boresight: Any) -> str:
+    """How a sensor is named in the figures: its body boresight.
+
+    Parameters
+    ----------
+    boresight : (3,) array_like
+        Unit boresight, body axes.
+
+    Returns
+    -------
+    str
+        ``"boresight [1, 0, 0] (body)"``.
+    """
+    return f"boresight {_vector_text(boresight)} (body)"
+
+
+def requirement_text(constraint: Any) -> str:
+    """A pointing requirement in words: its name, what it asks (sensor, kind, angle, direction), the
+    boresight, and the window when it is not the whole run.
+
+    Parameters
+    ----------
+    constraint : ocp.geometry.PointingConstraint
+        The requirement. Its ``description`` says what it asks (the scenario's requirements give
+        ``"star_tracker keep-out 30 deg about sun"``); without one, the kind, angle and direction
+        are written here.
+
+    Returns
+    -------
+    str
+        For example ``"st_sun: star_tracker keep-out 30 deg about sun; boresight [1, 0, 0] (body)"``;
+        a cone that grows (the Earth's limb) says so.
+    """
+    what = constraint.description or (
+        f"{'keep-out' if constraint.keep_out else 'keep-in'} {np.rad2deg(constraint.angle):.4g} deg about "
+        + (f"inertial {_vector_text(constraint.directions[0])}" if not constraint.moving else "a moving direction"))
+    grows = " (+ the Earth's apparent radius)" if np.any(np.asarray(constraint.growth) > 0) else ""
+    start, end = constraint.window
+    window = f", {start:g}-{end:g} s" if start > 0 or np.isfinite(end) else ""
+    return f"{constraint.name}: {what}{grows}; {sensor_text(constraint.boresight)}{window}"
+
+
+def pointing_constraints(results: Any) -> list[Any]:
+    """The pointing requirements a run's figures show.
+
+    The scenario's (``results.scenario.problem.pointing``), then cones a planner imposed from its
+    own options (a reference's ``stats["cones"]``: ``(boresight, direction, angle [rad],
+    keep_out)``) that none of those already is (same kind, boresight and fixed direction), named
+    after the row and the option (``"keep-out: keep_out[0] option"``).
+
+    Parameters
+    ----------
+    results : scenarios.output.results.RunResults
+        The run.
+
+    Returns
+    -------
+    list of ocp.geometry.PointingConstraint
+    """
+    from ocp.geometry import PointingConstraint
+
+    constraints = list(results.scenario.problem.pointing)
+
+    def known(boresight: np.ndarray, direction: np.ndarray, keep_out: bool) -> bool:
+        return any(c.keep_out == keep_out and not c.moving and np.allclose(c.boresight, boresight, atol=1e-9)
+                   and np.allclose(c.directions[0], direction, atol=1e-9) for c in constraints)
+
+    for row in results.rows:
+        reference = row.reference
+        if reference is None or not getattr(reference, "ok", False):
+            continue
+        counts = {True: 0, False: 0}
+        for boresight, direction, angle, keep_out in reference.stats.get("cones", []):
+            keep_out = bool(keep_out)
+            option = f"{'keep_out' if keep_out else 'keep_in'}[{counts[keep_out]}]"
+            counts[keep_out] += 1
+            boresight = np.asarray(boresight, dtype=float) / np.linalg.norm(boresight)
+            direction = np.asarray(direction, dtype=float) / np.linalg.norm(direction)
+            if not known(boresight, direction, keep_out):
+                constraints.append(PointingConstraint(f"{row.label}: {option} option", boresight, keep_out,
+                                                      float(angle), directions=direction[None, :]))
+    return constraints
+
+
+class Motion(NamedTuple):
+    """A row's attitude along the run, as the pointing figures sample it.
+
+    Attributes
+    ----------
+    label : str
+        The row's label.
+    reference, closed_loop : (t (N,), q (N, 4)) or None
+        Times [s] and attitudes (scalar first, body to inertial) of the reference and of the
+        closed loop; ``None`` where the row has none.
+    """
+
+    label: str
+    reference: tuple[np.ndarray, np.ndarray] | None
+    closed_loop: tuple[np.ndarray, np.ndarray] | None
+
+
+REFERENCE_SAMPLES = 2001
+"""Samples of a reference that has no closed loop to share its times with."""
+
+
+def motions(results: Any) -> list[Motion]:
+    """Every row's reference and closed loop, sampled: a row with a simulation on its times (the
+    reference too), a row with only a reference on :data:`REFERENCE_SAMPLES` times over its duration.
+    Rows with neither (a failed planner) are left out.
+
+    Parameters
+    ----------
+    results : scenarios.output.results.RunResults
+        The run.
+
+    Returns
+    -------
+    list of Motion
+    """
+    found = []
+    for row in results.rows:
+        reference = row.reference if row.reference is not None and getattr(row.reference, "ok", False) else None
+        sim = row.simulation
+        if sim is None and reference is None:
+            continue
+        t = np.asarray(sim.t) if sim is not None else np.linspace(0.0, row.reference.duration, REFERENCE_SAMPLES)
+        found.append(Motion(row.label, (t, reference.q(t)) if reference is not None else None,
+                            (t, np.asarray(sim.q)) if sim is not None else None))
+    return found
+
+
 @dataclass
-class ConeSeries:
-    """Angle between each constrained boresight and its direction, closed loop and reference.
+class MarginPanel:
+    """One pointing requirement's margin against time, every row.
+
+    Parameters
+    ----------
+    title : str
+        The requirement, its sensor and its direction (:func:`requirement_text`).
+    window : (float, float)
+        The requirement's window [s].
+    reference, closed_loop : list of Curve or None
+        Per row (in :attr:`MarginSeries.labels` order), the margin [deg] (``angle − limit`` for a
+        keep-out, ``limit − angle`` for a keep-in; negative when violated, NaN outside the window).
+    worst_reference, worst_closed_loop : list of float or None
+        Per row, the smallest margin over all samples [deg] (before decimation).
+    """
+
+    title: str
+    window: tuple[float, float]
+    reference: list[Curve | None]
+    closed_loop: list[Curve | None]
+    worst_reference: list[float | None]
+    worst_closed_loop: list[float | None]
+
+
+@dataclass
+class MarginSeries:
+    """The margin of every pointing requirement against time, one panel per requirement.
 
     Parameters
     ----------
     title : str
         The figure's title.
-    t : (N,) ndarray
-        Times [s].
-    cones : list of dict
-        Per cone: ``closed_loop`` and ``reference`` separations [deg] (N,), ``limit_deg`` (the
-        cone's angle as imposed, margin included) and ``keep_out`` (bool).
+    labels : list of str
+        The rows (their colours are shared with the sky map).
+    end : float
+        The end of the time axis [s].
+    panels : list of MarginPanel
+        One per requirement.
     """
 
     title: str
-    t: np.ndarray
-    cones: list[dict[str, Any]]
+    labels: list[str]
+    end: float
+    panels: list[MarginPanel]
 
 
-def cone_series(row: Any) -> ConeSeries:
-    """The pointing-constraint curves of a row whose planner imposed cones.
+def _worst(margin: np.ndarray) -> float | None:
+    return float(np.nanmin(margin)) if np.any(np.isfinite(margin)) else None
+
+
+def margin_series(results: Any, constraints: list[Any] | None = None, sampled: list[Motion] | None = None) -> MarginSeries:
+    """The pointing-margin figure's curves.
 
     Parameters
     ----------
-    row : scenarios.output.results.Row
-        A row with a simulation and a reference whose ``stats["cones"]`` lists
-        ``(boresight (body), direction (inertial), angle [rad], keep_out)``.
+    results : scenarios.output.results.RunResults
+        The run.
+    constraints : list of ocp.geometry.PointingConstraint, optional
+        The requirements; ``None``: :func:`pointing_constraints` of ``results``.
+    sampled : list of Motion, optional
+        The rows' motions; ``None``: :func:`motions` of ``results``.
 
     Returns
     -------
-    ConeSeries
-        What :func:`scenarios.output.plots.draw_cones` draws.
+    MarginSeries
+        What :func:`scenarios.output.plots.draw_margins` draws.
     """
-    # the model's helpers, in the process that ran it (module docstring)
+    constraints = pointing_constraints(results) if constraints is None else constraints
+    rows = motions(results) if sampled is None else sampled
+    columns = panel_columns(MARGIN_WIDTH_IN, MARGIN_MARGINS)
+    end = max([results.scenario.problem.duration]
+              + [float(m[0][-1]) for motion in rows for m in (motion.reference, motion.closed_loop) if m is not None])
+    panels = []
+    for constraint in constraints:
+        panel = MarginPanel(requirement_text(constraint), constraint.window, [], [], [], [])
+        for motion in rows:
+            for curves, worst, attitude in ((panel.reference, panel.worst_reference, motion.reference),
+                                            (panel.closed_loop, panel.worst_closed_loop, motion.closed_loop)):
+                if attitude is None:
+                    curves.append(None)
+                    worst.append(None)
+                    continue
+                margin = np.rad2deg(constraint.margins(*attitude))
+                curves.append(decimate(attitude[0], margin, columns))
+                worst.append(_worst(margin))
+        panels.append(panel)
+    return MarginSeries(f"{results.scenario.name}: pointing margins (negative: violated); solid closed loop, "
+                        "dashed reference", [motion.label for motion in rows], end, panels)
+
+
+SkyPath = tuple[np.ndarray, np.ndarray]
+"""A path on the sky: right ascension in [0, 360) and declination [deg], NaN where the map's
+longitude wraps (:func:`sky_path`)."""
+
+
+def map_longitude(ra_deg: np.ndarray) -> np.ndarray:
+    """Where a right ascension lies on the full-sky map: the map is centred on RA 0 and, as a
+    star chart seen from inside the sphere, RA grows to the left.
+
+    Parameters
+    ----------
+    ra_deg : ndarray
+        Right ascension [deg].
+
+    Returns
+    -------
+    ndarray
+        Map longitude in (-180, 180] [deg], ``-RA`` wrapped.
+    """
+    return -(((np.asarray(ra_deg, dtype=float) + 180.0) % 360.0) - 180.0)
+
+
+def sky_path(vectors: np.ndarray) -> SkyPath:
+    """Right ascension and declination of inertial directions, broken where the map wraps.
+
+    Parameters
+    ----------
+    vectors : (N, 3) ndarray
+        Directions, inertial frame (need not be unit).
+
+    Returns
+    -------
+    SkyPath
+        RA in [0, 360) and Dec in [-90, 90] [deg]; a NaN pair is inserted between two points
+        whose map longitudes (:func:`map_longitude`) lie more than 180° apart, so that a drawn
+        path does not cross the whole map.
+    """
+    v = np.asarray(vectors, dtype=float)
+    v = v / np.linalg.norm(v, axis=1, keepdims=True)
+    ra = np.rad2deg(np.arctan2(v[:, 1], v[:, 0])) % 360.0
+    dec = np.rad2deg(np.arcsin(np.clip(v[:, 2], -1.0, 1.0)))
+    breaks = np.flatnonzero(np.abs(np.diff(map_longitude(ra))) > 180.0) + 1
+    return np.insert(ra, breaks, np.nan), np.insert(dec, breaks, np.nan)
+
+
+def cone_circle(direction: np.ndarray, angle: float, points: int = CIRCLE_POINTS) -> np.ndarray:
+    """The directions at ``angle`` from ``direction``: a cone's boundary on the sphere.
+
+    Parameters
+    ----------
+    direction : (3,) ndarray
+        The cone's axis (unit), inertial frame.
+    angle : float
+        Half-angle [rad].
+    points : int, optional
+        Points on the circle (the first repeated as the last).
+
+    Returns
+    -------
+    (points, 3) ndarray
+        Unit vectors, inertial frame.
+    """
+    d = np.asarray(direction, dtype=float)
+    d = d / np.linalg.norm(d)
+    helper = np.eye(3)[int(np.argmin(np.abs(d)))]
+    e1 = np.cross(d, helper)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(d, e1)
+    phi = np.linspace(0.0, 2.0 * np.pi, points)[:, None]
+    return np.cos(angle) * d + np.sin(angle) * (np.cos(phi) * e1 + np.sin(phi) * e2)
+
+
+@dataclass
+class SkyCone:
+    """A pointing requirement's cone on the sky map.
+
+    Parameters
+    ----------
+    label : str
+        The requirement's name.
+    keep_out : bool
+        Keep-out (drawn red) or keep-in (green).
+    boundaries : list of SkyPath
+        The cone's boundary (its limit, the Earth's radius included) at the start of the run (or
+        of its window) and, when the direction or the limit moves more than :data:`STILL_DEG`, at
+        its end.
+    centre : SkyPath
+        The direction over the run (one point when it does not move).
+    discs : list of SkyPath
+        The Earth's disc (radius: the cone's growth) at the start and end, when the cone grows.
+    """
+
+    label: str
+    keep_out: bool
+    boundaries: list[SkyPath]
+    centre: SkyPath
+    discs: list[SkyPath]
+
+
+@dataclass
+class SkyPanel:
+    """One sensor's boresight on the sky, every row, with the cones of its requirements.
+
+    Parameters
+    ----------
+    title : str
+        The sensor (:func:`sensor_text`) and the names of its requirements.
+    reference, closed_loop : list of SkyPath or None
+        Per row, the boresight's inertial direction along the reference and the closed loop.
+    cones : list of SkyCone
+        The requirements on this sensor.
+    """
+
+    title: str
+    reference: list[SkyPath | None]
+    closed_loop: list[SkyPath | None]
+    cones: list[SkyCone]
+
+
+@dataclass
+class SkySeries:
+    """The boresights of every sensor with a pointing requirement on a full-sky map.
+
+    Parameters
+    ----------
+    title : str
+        The figure's title.
+    labels : list of str
+        The rows (colours shared with the margin figure).
+    panels : list of SkyPanel
+        One per sensor (boresight).
+    """
+
+    title: str
+    labels: list[str]
+    panels: list[SkyPanel]
+
+
+def _thinned(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """At most :data:`SKY_TRACK_POINTS` samples, evenly in index, the last kept."""
+    step = -(-len(t) // SKY_TRACK_POINTS)
+    keep = np.unique(np.append(np.arange(0, len(t), step), len(t) - 1))
+    return t[keep], q[keep]
+
+
+def sky_series(results: Any, constraints: list[Any] | None = None, sampled: list[Motion] | None = None) -> SkySeries:
+    """The sky map's paths: per sensor, each row's boresight track and the requirements' cones.
+
+    Parameters
+    ----------
+    results : scenarios.output.results.RunResults
+        The run.
+    constraints : list of ocp.geometry.PointingConstraint, optional
+        The requirements; ``None``: :func:`pointing_constraints` of ``results``.
+    sampled : list of Motion, optional
+        The rows' motions; ``None``: :func:`motions` of ``results``.
+
+    Returns
+    -------
+    SkySeries
+        What :func:`scenarios.output.plots.draw_sky` draws.
+    """
     from ocp import quat
 
-    sim = row.simulation
-    reference_q = row.reference.q(sim.t)
-    cones = []
-    for boresight, direction, angle, keep_out in row.reference.stats.get("cones", []):
-        separations = {}
-        for name, q in (("closed_loop", sim.q), ("reference", reference_q)):
-            pointing = quat.rotate(q, np.asarray(boresight))
-            separations[name] = np.rad2deg(np.arccos(np.clip(pointing @ np.asarray(direction), -1, 1)))
-        cones.append({**separations, "limit_deg": float(np.rad2deg(angle)), "keep_out": bool(keep_out)})
-    return ConeSeries(f"{row.label}: pointing constraints", np.asarray(sim.t), cones)
+    constraints = pointing_constraints(results) if constraints is None else constraints
+    rows = motions(results) if sampled is None else sampled
+    end = max([results.scenario.problem.duration]
+              + [float(m[0][-1]) for motion in rows for m in (motion.reference, motion.closed_loop) if m is not None])
+    sensors: dict[tuple[float, ...], list[Any]] = {}
+    for constraint in constraints:
+        sensors.setdefault(tuple(np.round(constraint.boresight, 9)), []).append(constraint)
+    thinned = [tuple(None if m is None else _thinned(*m) for m in (motion.reference, motion.closed_loop))
+               for motion in rows]
+    panels = []
+    for boresight, group in sensors.items():
+        panel = SkyPanel(f"{sensor_text(boresight)}: {', '.join(c.name for c in group)}", [], [], [])
+        for reference, closed_loop in thinned:
+            for paths, attitude in ((panel.reference, reference), (panel.closed_loop, closed_loop)):
+                paths.append(None if attitude is None else sky_path(quat.rotate(attitude[1], np.asarray(boresight))))
+        for constraint in group:
+            start, stop = max(constraint.window[0], 0.0), min(constraint.window[1], end)
+            times = np.linspace(start, stop, 200)
+            path, limits = constraint.direction(times), constraint.limit(times)
+            moves = (np.rad2deg(np.arccos(np.clip(path @ path[0], -1.0, 1.0))).max() > STILL_DEG
+                     or np.rad2deg(np.ptp(limits)) > STILL_DEG)
+            keep = [0, len(times) - 1] if moves else [0]
+            directions, limits = path[keep], limits[keep]
+            growth = limits - constraint.angle
+            centre = path if moves else directions
+            panel.cones.append(SkyCone(
+                constraint.name, constraint.keep_out,
+                [sky_path(cone_circle(d, a)) for d, a in zip(directions, limits)], sky_path(centre),
+                [sky_path(cone_circle(d, g)) for d, g in zip(directions, growth) if g > 0]))
+        panels.append(panel)
+    return SkySeries(f"{results.scenario.name}: sensor boresights on the sky (inertial frame); solid closed loop, "
+                     "dashed reference", [motion.label for motion in rows], panels)
 
 
-PlotJob = tuple[str, "RowSeries | OverlaySeries | ConeSeries"]
+PlotJob = tuple[str, "RowSeries | OverlaySeries | MarginSeries | SkySeries"]
 """A figure to draw: its file name in the output directory and its series."""
+
+MARGINS_FILE = "margins.png"
+"""The pointing-margin figure of a run with pointing requirements."""
+SKY_FILE = "sky.png"
+"""The sky map of a run with pointing requirements."""
 
 
 def plot_jobs(results: Any, stems: list[str] | None = None) -> list[PlotJob]:
-    """The figures of a run: one per simulated row (``<stem>.png``, ``<stem>_cones.png`` with
-    cones) and ``comparison.png``.
+    """The figures of a run: one per simulated row (``<stem>.png``), with pointing requirements
+    :data:`MARGINS_FILE` and :data:`SKY_FILE`, and ``comparison.png``.
 
     Parameters
     ----------
@@ -330,18 +839,21 @@ def plot_jobs(results: Any, stems: list[str] | None = None) -> list[PlotJob]:
     Returns
     -------
     list of (str, series)
-        File names and series, in drawing order (rows, each followed by its cones; the overlay last).
+        File names and series, in drawing order (rows, the pointing figures, the overlay last).
     """
     from scenarios.output.names import row_stems
 
-    target_q = results.scenario.problem.qf
+    problem = results.scenario.problem
     stems = stems if stems is not None else row_stems([row.label for row in results.rows])
     jobs: list[PlotJob] = []
     for row, stem in zip(results.rows, stems):
         if row.simulation is None:
             continue
-        jobs.append((f"{stem}.png", row_series(row, target_q)))
-        if row.reference is not None and row.reference.stats.get("cones"):
-            jobs.append((f"{stem}_cones.png", cone_series(row)))
+        jobs.append((f"{stem}.png", row_series(row, problem.qf, problem.spacecraft)))
+    constraints = pointing_constraints(results)
+    sampled = motions(results) if constraints else []
+    if sampled:
+        jobs.append((MARGINS_FILE, margin_series(results, constraints, sampled)))
+        jobs.append((SKY_FILE, sky_series(results, constraints, sampled)))
     jobs.append(("comparison.png", overlay_series(results)))
     return jobs

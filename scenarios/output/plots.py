@@ -1,4 +1,5 @@
-"""Matplotlib (Agg) figures of a run: one PNG per row and one overlay comparing the rows.
+"""Matplotlib (Agg) figures of a run: one PNG per row, one overlay comparing the rows, and with
+pointing requirements the margin of each against time and the sensors' boresights on the sky.
 
 This is the drawing half: it draws the series of :mod:`scenarios.output.plot_data` (computed from the
 run) and imports nothing of the model, so that a separate process can draw while the run
@@ -15,6 +16,13 @@ legends, axis labels): lines and grids cost little. So it is kept cheap:
   kept as a bitmap; each row then draws only its curves, its value axes and its title on a copy
   of that bitmap, which is written as the PNG without a second draw;
 * time series arrive decimated to the panels' pixel columns (:func:`scenarios.output.plot_data.decimate`).
+
+The pointing figures are drawn only for runs with pointing requirements. The margin against time
+uses a symmetric logarithmic value axis, linear within the smallest margin any row reaches: a
+dip of a fraction of a degree below zero shows as plainly as a pass at tens of degrees. The sky
+map is Mollweide's equal-area projection of the whole sphere: every direction a boresight or a
+cone can take is on one flat picture, areas (the cones) keep their proportions, and no part of
+the sphere hides behind another as on a drawn 3-D globe.
 """
 from __future__ import annotations
 
@@ -22,40 +30,60 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from matplotlib.ticker import FuncFormatter, MaxNLocator, NullLocator
+from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullLocator
 
 from scenarios.output.plot_data import (
     DPI,
+    MARGIN_MARGINS,
+    MARGIN_PANEL_IN,
+    MARGIN_WIDTH_IN,
     OVERLAY_FIGSIZE_IN,
     OVERLAY_MARGINS,
-    ROW_FIGSIZE_IN,
-    ROW_HEIGHT_NO_WHEELS_IN,
-    ROW_MARGINS,
-    ConeSeries,
+    MarginPanel,
+    MarginSeries,
     OverlaySeries,
     PlotJob,
     RowSeries,
-    cone_series,
+    RowShape,
+    SkyPath,
+    SkySeries,
+    map_longitude,
     overlay_series,
     plot_jobs,
+    row_figure_layout,
 )
 
 __all__ = [
     "COMPRESS_LEVEL",
     "LABEL_OFFSET_IN",
+    "ROW_COLORS",
     "SAVE",
     "RowFigure",
-    "draw_cones",
     "draw_jobs",
+    "draw_margins",
     "draw_overlay",
-    "plot_cones",
+    "draw_sky",
+    "margin_axis",
+    "margin_figure",
     "plot_overlay",
+    "sky_figure",
     "write_plots",
 ]
 
 AXIS_COLORS = ("tab:red", "tab:green", "tab:blue", "tab:purple")
+"""Colours of the body axes x, y, z (and the quaternion's fourth component)."""
+WHEEL_COLORS = ("tab:orange", "tab:brown", "tab:pink", "tab:olive", "tab:cyan", "tab:gray", "gold", "navy")
+"""Colours of wheels whose spin axes are not distinct body axes (those take the axis' colour)."""
+FAILED_STYLE: dict[str, Any] = {"color": "0.55", "linestyle": ":"}
+"""How a failed wheel's curves are drawn."""
+ROW_COLORS = ("tab:blue", "tab:orange", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan",
+              "tab:gray", "navy", "goldenrod")
+"""Colours of the rows in the pointing figures (red and green are the keep-out and keep-in cones')."""
+KEEP_COLORS = {True: "tab:red", False: "tab:green"}
+"""Colour of a keep-out (``True``) and a keep-in (``False``) cone."""
 COMPRESS_LEVEL = 1
 """zlib level of the PNGs: level 1 encodes several times faster than the default 6 for ~20 % more bytes."""
 SAVE: dict[str, Any] = {"dpi": DPI, "pil_kwargs": {"compress_level": COMPRESS_LEVEL}}
@@ -105,35 +133,99 @@ def _time_axis(axis: Any) -> None:
     axis.xaxis.set_major_locator(MaxNLocator(nbins=7, steps=[1, 2, 2.5, 5, 10]))
 
 
-class RowFigure:
-    """The per-row figure (torque, rate, quaternion, error angles, wheel momenta), built once and
-    redrawn for each row of the same shape (module docstring).
+PANEL_LABELS = {"torque": "body torque (N m)", "rate": "body rate (rad/s)", "quaternion": "quaternion (-)",
+                "wheel_torque": "wheel torque (N m)", "wheel_momentum": "wheel momentum (N m s)",
+                "wheel_speed": "wheel speed (rpm)", "dipole": "dipole (A m²)"}
+"""Value-axis labels of the per-row figure's panels (the error panel's depends on the row)."""
+
+
+def wheel_colors(n_wheels: int, wheel_axis: tuple[int, ...]) -> list[str]:
+    """Colours of the wheels: a wheel along a body axis takes that axis' colour (:data:`AXIS_COLORS`)
+    when no other wheel lies along it, the others :data:`WHEEL_COLORS` in turn.
 
     Parameters
     ----------
     n_wheels : int
-        Number of wheels (a fifth panel with their momenta when > 0).
+        Number of wheels.
+    wheel_axis : tuple of int
+        Per wheel, the body axis (0, 1, 2) it spins about or -1 (empty: none known).
+
+    Returns
+    -------
+    list of str
+        A matplotlib colour per wheel.
+    """
+    axes = list(wheel_axis) if len(wheel_axis) == n_wheels else [-1] * n_wheels
+    colors, spare = [], iter(WHEEL_COLORS * (1 + n_wheels // len(WHEEL_COLORS)))
+    for axis in axes:
+        colors.append(AXIS_COLORS[axis] if axis >= 0 and axes.count(axis) == 1 else next(spare))
+    return colors
+
+
+class RowFigure:
+    """The per-row figure, built once and redrawn for each row of the same shape (module docstring).
+
+    Panels, top to bottom: body torque, body rate, quaternion, error angles; with wheels their
+    motor torques and momenta, and speeds when their spin inertia is known; with magnetorquers
+    their dipole. Actuator limits are dotted ``±`` lines (one black pair when every curve of the
+    panel has the same limit, else one pair per curve in its colour); failed wheels are grey,
+    dotted and marked in the legend.
+
+    Parameters
+    ----------
+    n_wheels : int
+        Number of wheels, failed ones included.
     with_reference : bool
         Draw the reference dashed and the error to it.
     with_target : bool
         Draw the error to the target attitude.
+    failed : tuple of int, optional
+        Indices of failed wheels.
+    wheel_axis : tuple of int, optional
+        Per wheel, the body axis it spins about or -1 (:func:`wheel_colors`).
+    wheel_speed : bool, optional
+        A wheel speed panel.
+    dipole : bool, optional
+        A magnetorquer dipole panel.
+    limited : tuple of (str, bool), optional
+        Panels with limit lines and whether their limits are common (:attr:`RowSeries.shape`).
     """
 
-    def __init__(self, n_wheels: int, with_reference: bool, with_target: bool):
-        self.shape = (n_wheels, with_reference, with_target)
-        self.figure = Figure(figsize=(ROW_FIGSIZE_IN[0], ROW_FIGSIZE_IN[1] if n_wheels else ROW_HEIGHT_NO_WHEELS_IN),
-                             dpi=DPI)
+    def __init__(self, n_wheels: int, with_reference: bool, with_target: bool, failed: tuple[int, ...] = (),
+                 wheel_axis: tuple[int, ...] = (), wheel_speed: bool = False, dipole: bool = False,
+                 limited: tuple[tuple[str, bool], ...] = ()):
+        self.shape: RowShape = (n_wheels, with_reference, with_target, tuple(failed), tuple(wheel_axis),
+                                wheel_speed, dipole, tuple(limited))
+        names = ["torque", "rate", "quaternion", "error"]
+        names += ["wheel_torque", "wheel_momentum"] if n_wheels else []
+        names += ["wheel_speed"] if n_wheels and wheel_speed else []
+        names += ["dipole"] if dipole else []
+        figsize, margins = row_figure_layout(len(names))
+        self.figure = Figure(figsize=figsize, dpi=DPI)
         self.canvas = FigureCanvasAgg(self.figure)
-        axes = self.figure.subplots(5 if n_wheels else 4, 1, sharex=True)
-        self.figure.subplots_adjust(**ROW_MARGINS)  # before the labels
+        axes = self.figure.subplots(len(names), 1, sharex=True)
+        self.figure.subplots_adjust(**margins)  # before the labels
         self.axes = axes
+        panel = dict(zip(names, axes))
 
-        def line(axis: Any, style: str = "-", **kw: Any) -> Any:
-            return axis.plot([], [], style, **kw)[0]
+        def line(axis: Any, style: str | None = None, **kw: Any) -> Any:
+            return (axis.plot([], [], style, **kw) if style else axis.plot([], [], **kw))[0]
 
-        self.torque = [line(axes[0], color=AXIS_COLORS[i], drawstyle="steps-post", label=f"u_{'xyz'[i]}")
-                       for i in range(3)]
-        self.rate = [line(axes[1], color=AXIS_COLORS[i], label=f"ω_{'xyz'[i]}") for i in range(3)]
+        def curves(name: str, count: int, colors: list[str], label: str, **kw: Any) -> list[Any]:
+            """One line per curve of a panel (none without the panel); failed wheels grey and dotted."""
+            if name not in panel:
+                return []
+            items = []
+            for i in range(count):
+                dead = name.startswith("wheel") and i in failed
+                style = {**kw, "color": colors[i], **(FAILED_STYLE if dead else {})}
+                items.append(line(panel[name], label=label.format(i=i, axis="xyz"[i % 3]) + (" failed" if dead else ""),
+                                  **style))
+            return items
+
+        axis_colors = list(AXIS_COLORS)
+        self.torque = curves("torque", 3, axis_colors, "u_{axis}", drawstyle="steps-post")
+        self.rate = curves("rate", 3, axis_colors, "ω_{axis}")
         self.quaternion = [line(axes[2], color=AXIS_COLORS[i], label=f"q{i}") for i in range(4)]
         self.reference: tuple[list[Any], list[Any], list[Any]] | None = None
         if with_reference:
@@ -147,13 +239,32 @@ class RowFigure:
         if not with_reference and not with_target:  # rate regulation (detumbling): the rate converges
             self.rate_norm = line(axes[3], color="k", label="‖ω‖")
             self.rate_max = line(axes[3], color="tab:gray", lw=1, label="max |ω_i|")
-        self.wheels = [line(axes[4], label=f"h_w{i}") for i in range(n_wheels)] if n_wheels else []
-        labels = ["body torque (N m)", "body rate (rad/s)", "quaternion",
-                  "error angle (deg)" if with_reference or with_target else "body rate (rad/s)"]
-        if n_wheels:
-            labels.append("wheel momentum (N m s)")
-        for axis, label in zip(axes, labels):
-            _label(axis, label)
+        colors = wheel_colors(n_wheels, tuple(wheel_axis))
+        self.wheel_torque = curves("wheel_torque", n_wheels, colors, "g_w{i}", drawstyle="steps-post")
+        self.wheels = curves("wheel_momentum", n_wheels, colors, "h_w{i}")
+        self.wheel_speed = curves("wheel_speed", n_wheels, colors, "Ω_w{i}")
+        self.dipole = curves("dipole", 3, axis_colors, "m_{axis}", drawstyle="steps-post")
+        self.limit_lines: list[tuple[str, int | None, float, Any]] = []
+        """(panel, curve index or None for a common limit, sign, line)."""
+        self.off_scale: dict[str, Any] = {}
+        """Per limited panel, the note shown when its limits lie beyond the view (:data:`LIMIT_VIEW_FACTOR`)."""
+        for name, common in limited:
+            if name not in panel:
+                continue
+            count = {"torque": 3, "dipole": 3}.get(name, n_wheels)
+            items: list[int | None] = [None] if common else list(range(count))
+            for index in items:
+                color = "k" if index is None else (axis_colors if name in ("torque", "dipole") else colors)[index]
+                for sign in (1.0, -1.0):
+                    label = ("±limit" if common else "±limit (per curve)") if sign > 0 and index in (None, 0) else None
+                    self.limit_lines.append((name, index, sign, line(panel[name], linestyle=":", color=color,
+                                                                     lw=1.3, label=label or "_limit")))
+            self.off_scale[name] = panel[name].text(0.995, 0.96, "", transform=panel[name].transAxes, ha="right",
+                                                    va="top", fontsize=7, color="0.3")
+        self.panels = panel
+        error_label = "error angle (deg)" if with_reference or with_target else "body rate (rad/s)"
+        for name, axis in panel.items():
+            _label(axis, PANEL_LABELS.get(name, error_label))
             axis.grid(alpha=0.3)
             if any(not item.get_label().startswith("_") for item in axis.get_lines()):
                 # beside the panel: static (drawn once), and never over a curve
@@ -170,6 +281,7 @@ class RowFigure:
             artists.extend([axis.yaxis, axis.spines["left"], axis.spines["right"]])
             artists.extend(axis.get_lines())
         artists.append(self.title)
+        artists.extend(self.off_scale.values())
         return artists
 
     def prepare(self, series: RowSeries) -> None:
@@ -185,8 +297,10 @@ class RowFigure:
         """
         if series.shape != self.shape:
             raise ValueError(f"a row of shape {series.shape} drawn on a figure of shape {self.shape}")
-        pairs = list(zip(self.torque + self.rate + self.quaternion + self.wheels,
-                         series.torque + series.rate + series.quaternion + series.wheels))
+        pairs = list(zip(self.torque + self.rate + self.quaternion + self.wheels + self.wheel_torque
+                         + self.wheel_speed + self.dipole,
+                         series.torque + series.rate + series.quaternion + series.wheels + series.wheel_torque
+                         + series.wheel_speed + series.dipole))
         if self.reference is not None and series.reference is not None:
             for items, curves in zip(self.reference, series.reference):
                 pairs.extend(zip(items, curves))
@@ -196,9 +310,30 @@ class RowFigure:
                 pairs.append((item, curve))
         for item, curve in pairs:
             item.set_data(*curve)
-        for axis in self.axes:
+        for *_, item in self.limit_lines:
+            item.set_data([], [])
+        for axis in self.axes:  # fitted to the curves; the limits are added below
             axis.relim()
             axis.autoscale_view()
+        span = [series.torque[0][0][0], series.torque[0][0][-1]] if series.torque and len(series.torque[0][0]) else []
+        for name, index, sign, item in self.limit_lines:
+            values = np.asarray(series.limits[name], dtype=float)
+            finite = values[np.isfinite(values)]
+            value = (finite.max() if finite.size else np.nan) if index is None else values[index]
+            item.set_data(span, np.full(len(span), sign * value))
+        for name, note in self.off_scale.items():
+            values = np.asarray(series.limits[name], dtype=float)
+            limit = float(np.nanmax(values)) if np.any(np.isfinite(values)) else np.nan
+            low, high = self.panels[name].get_ylim()
+            peak = max(abs(low), abs(high))
+            if not np.isfinite(limit):
+                note.set_text("")
+            elif limit <= LIMIT_VIEW_FACTOR * peak:
+                self.panels[name].set_ylim(min(low, -1.05 * limit), max(high, 1.05 * limit), auto=None)
+                note.set_text("")
+            else:
+                common = any(index is None for panel, index, _, _ in self.limit_lines if panel == name)
+                note.set_text(f"{'limit' if common else 'limits up to'} ±{limit:.3g} beyond the view")
         self.title.set_text(series.title)
         time_limits = tuple(self.axes[-1].get_xlim())
         canvas, dynamic = self.canvas, self._dynamic()
@@ -238,33 +373,6 @@ def _write_png(canvas: FigureCanvasAgg, path: Path) -> None:
     image.save(path, format="png", dpi=(DPI, DPI), compress_level=COMPRESS_LEVEL)
 
 
-def draw_cones(series: ConeSeries, path: Path) -> None:
-    """Angle between each constrained boresight and its direction, closed loop and reference,
-    against the cone's limit.
-
-    Parameters
-    ----------
-    series : scenarios.output.plot_data.ConeSeries
-        The curves (:func:`scenarios.output.plot_data.cone_series`).
-    path : pathlib.Path
-        Where to write the PNG.
-    """
-    count = len(series.cones)
-    figure = Figure(figsize=(9, 3.2 * count))
-    axes = figure.subplots(count, 1, squeeze=False)
-    for axis, cone in zip(axes[:, 0], series.cones):
-        axis.plot(series.t, cone["closed_loop"], "-", label="closed loop")
-        axis.plot(series.t, cone["reference"], "--", label="reference")
-        axis.axhline(cone["limit_deg"], color="r", lw=1, label=("keep-out" if cone["keep_out"] else "keep-in") + " limit")
-        axis.set_ylabel("boresight to direction (deg)")
-        axis.grid(alpha=0.3)
-        axis.legend(fontsize=8, loc="upper right")
-    axes[-1, 0].set_xlabel("time (s)")
-    figure.suptitle(series.title)
-    figure.subplots_adjust(left=0.1, right=0.98, bottom=0.12 / count, top=1 - 0.1 / count, hspace=0.25)
-    figure.savefig(path, **SAVE)
-
-
 def draw_overlay(series: OverlaySeries, path: Path) -> None:
     """Torque norm, and the error to the target, one curve per row.
 
@@ -293,17 +401,227 @@ def draw_overlay(series: OverlaySeries, path: Path) -> None:
     figure.savefig(path, **SAVE)
 
 
-def plot_cones(row: Any, path: Path) -> None:
-    """:func:`draw_cones` of :func:`scenarios.output.plot_data.cone_series` of ``row``.
+def _row_color(k: int) -> str:
+    return ROW_COLORS[k % len(ROW_COLORS)]
+
+
+def _nice_up(value: float) -> float:
+    """The smallest of 1, 2, 5 times a power of ten that is at least ``value`` (> 0)."""
+    power = 10.0 ** np.floor(np.log10(value))
+    return float(next(m * power for m in (1.0, 2.0, 5.0, 10.0) if m * power >= value * (1 - 1e-12)))
+
+
+LIMIT_VIEW_FACTOR = 3.0
+"""A panel's view is widened to its actuator limits when they are at most this many times its
+largest value; beyond, the curves keep the view and a note gives the limit."""
+MARGIN_LINEAR_DEG = (0.01, 1.0)
+"""Bounds of the linear part of the margin axis [deg] (:func:`margin_axis`)."""
+MARGIN_PAD = 0.08
+"""Room left below the lowest and above the highest margin, as a fraction of the axis (in its scale)."""
+
+
+def margin_axis(axis: Any, low: float, high: float, closest: float) -> None:
+    """Scale and limits of a margin axis, so that a small violation shows beside large margins.
+
+    The value axis is symmetric-logarithmic (matplotlib's ``symlog``): linear within
+    ``±linthresh``, logarithmic beyond. ``linthresh`` is the smallest margin any row reaches in
+    magnitude (``closest``), rounded up to 1, 2 or 5 times a power of ten and kept within
+    :data:`MARGIN_LINEAR_DEG`: the margin nearest zero (a 0.2° dip into the cone, or a 0.01°
+    clearance) lies at the edge of the linear part or beyond it, a visible distance from the zero
+    line, whether the other margins reach 1° or 150°. The limits leave :data:`MARGIN_PAD` of
+    the axis (in its own scale) below ``min(low, -linthresh / 2)`` and above ``high``, so that the
+    zero line and some of the violated side are always in view.
 
     Parameters
     ----------
-    row : scenarios.output.results.Row
-        A row with a simulation and a reference whose ``stats["cones"]`` lists the cones.
+    axis : matplotlib.axes.Axes
+        The panel.
+    low, high : float
+        Smallest and largest margin drawn [deg] (NaN: none).
+    closest : float
+        Smallest magnitude among the rows' minimum margins [deg] (NaN: none).
+    """
+    linthresh = float(np.clip(_nice_up(max(closest, MARGIN_LINEAR_DEG[0])) if np.isfinite(closest) else 1.0,
+                              *MARGIN_LINEAR_DEG))
+    axis.set_yscale("symlog", linthresh=linthresh, linscale=1.0)
+    low = min(low if np.isfinite(low) else 0.0, -linthresh / 2)
+    high = max(high if np.isfinite(high) else 0.0, linthresh)
+    scale = axis.yaxis.get_transform()
+    bottom, top = scale.transform(np.array([low, high]))
+    pad = MARGIN_PAD * (top - bottom)
+    bottom, top = scale.inverted().transform(np.array([bottom - pad, top + pad]))
+    axis.set_ylim(bottom, top)
+    ticks = [0.0]
+    for side, end in ((1.0, top), (-1.0, bottom)):
+        decades = [10.0 ** k for k in range(int(np.floor(np.log10(linthresh))) + 1, 4)
+                   if 10.0 ** k < abs(end) and 10.0 ** k > 1.5 * linthresh]
+        decades = decades[::2] if len(decades) > 4 else decades
+        ticks += [side * v for v in [linthresh] + decades if v <= abs(end)]
+    axis.yaxis.set_major_locator(FixedLocator(sorted(ticks)))
+    axis.yaxis.set_minor_locator(NullLocator())
+    axis.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+
+
+def _margin_panel(axis: Any, panel: MarginPanel, series: MarginSeries) -> None:
+    """One requirement's panel of :func:`margin_figure`."""
+    drawn: list[np.ndarray] = []
+    handles = []
+    for k, label in enumerate(series.labels):
+        color = _row_color(k)
+        for curve, worst, style, name in ((panel.reference[k], panel.worst_reference[k], "--", "reference"),
+                                          (panel.closed_loop[k], panel.worst_closed_loop[k], "-", "closed loop")):
+            if curve is None:
+                continue
+            t, margin = curve
+            minimum = "no sample in the window" if worst is None else f"min {worst:+.3g}°"
+            handles.append(axis.plot(t, margin, style, color=color, lw=1.4 if style == "-" else 1.1,
+                                     label=f"{label}, {name}: {minimum}")[0])
+            axis.fill_between(t, margin, 0.0, where=margin < 0, interpolate=True, color=color, alpha=0.35, lw=0)
+            drawn.append(margin)
+    values = np.concatenate(drawn) if drawn else np.array([np.nan])
+    closest = [abs(w) for w in panel.worst_reference + panel.worst_closed_loop if w is not None]
+    finite = values[np.isfinite(values)]
+    margin_axis(axis, float(finite.min()) if finite.size else np.nan, float(finite.max()) if finite.size else np.nan,
+                min(closest) if closest else np.nan)
+    bottom = axis.get_ylim()[0]
+    axis.axhspan(bottom, 0.0, color="tab:red", alpha=0.08, lw=0)
+    axis.axhline(0.0, color="k", lw=1.2, label="zero: the limit")
+    start, end = panel.window
+    if start > 0:
+        axis.axvspan(0.0, start, color="0.5", alpha=0.15, lw=0)
+    if end < series.end:
+        axis.axvspan(end, series.end, color="0.5", alpha=0.15, lw=0)
+    axis.set_ylim(bottom, axis.get_ylim()[1])
+    axis.set_title(panel.title, fontsize=9, loc="left")
+    axis.set_ylabel("margin (deg)")
+    axis.grid(alpha=0.3)
+    axis.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, borderaxespad=0.0)
+
+
+def margin_figure(series: MarginSeries) -> Figure:
+    """The margin of every pointing requirement against time: one panel per requirement, each row's
+    reference dashed and closed loop solid (colours of :data:`ROW_COLORS`), the zero line black,
+    the violated side tinted red and each violation filled, the time outside the requirement's
+    window grey, the value axis of :func:`margin_axis`; the legends beside the panels give each
+    curve's minimum margin.
+
+    Parameters
+    ----------
+    series : scenarios.output.plot_data.MarginSeries
+        The curves (:func:`scenarios.output.plot_data.margin_series`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, on an Agg canvas.
+    """
+    count = max(len(series.panels), 1)
+    height = count * MARGIN_PANEL_IN + 1.1
+    figure = Figure(figsize=(MARGIN_WIDTH_IN, height), dpi=DPI)
+    FigureCanvasAgg(figure)
+    axes = figure.subplots(count, 1, sharex=True, squeeze=False)[:, 0]
+    figure.subplots_adjust(**MARGIN_MARGINS, top=1 - 0.75 / height, bottom=0.55 / height, hspace=0.42)
+    for axis, panel in zip(axes, series.panels):
+        _margin_panel(axis, panel, series)
+    axes[-1].set_xlim(0.0, series.end)
+    axes[-1].set_xlabel("time (s)")
+    figure.suptitle(series.title, fontsize=10)
+    return figure
+
+
+def draw_margins(series: MarginSeries, path: Path) -> None:
+    """:func:`margin_figure` as a PNG.
+
+    Parameters
+    ----------
+    series : scenarios.output.plot_data.MarginSeries
+        The curves (:func:`scenarios.output.plot_data.margin_series`).
     path : pathlib.Path
         Where to write the PNG.
     """
-    draw_cones(cone_series(row), path)
+    margin_figure(series).savefig(path, **SAVE)
+
+
+def _on_map(path: SkyPath) -> tuple[np.ndarray, np.ndarray]:
+    """A sky path in the map's coordinates [rad] (:func:`scenarios.output.plot_data.map_longitude`)."""
+    ra, dec = path
+    return np.deg2rad(map_longitude(ra)), np.deg2rad(dec)
+
+
+def sky_figure(series: SkySeries) -> Figure:
+    """The sensors' boresights on the sky: one full-sky map (Mollweide, right ascension growing to
+    the left, declination up, inertial frame) per sensor; each row's closed loop solid (start ○,
+    end □) and reference dashed, in the colours of the margin figure; each requirement's cone
+    drawn as its boundary (red keep-out, green keep-in; solid at the start of the run, dash-dot
+    at the end for a moving direction), the path of its centre dotted and its name at the centre,
+    and the Earth's disc filled blue for a cone that grows by the Earth's apparent radius.
+
+    Parameters
+    ----------
+    series : scenarios.output.plot_data.SkySeries
+        The paths (:func:`scenarios.output.plot_data.sky_series`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, on an Agg canvas.
+    """
+    count = max(len(series.panels), 1)
+    height = count * 5.0 + 0.7
+    figure = Figure(figsize=(12.0, height), dpi=DPI)
+    FigureCanvasAgg(figure)
+    figure.subplots_adjust(left=0.04, right=0.7, top=1 - 0.6 / height, bottom=0.3 / height, hspace=0.25)
+    for index, panel in enumerate(series.panels):
+        axis = figure.add_subplot(count, 1, index + 1, projection="mollweide")
+        axis.grid(alpha=0.35)
+        for k, label in enumerate(series.labels):
+            color = _row_color(k)
+            reference, closed_loop = panel.reference[k], panel.closed_loop[k]
+            if reference is not None:
+                axis.plot(*_on_map(reference), "--", color=color, lw=1.1, label=f"{label}, reference")
+            if closed_loop is not None:
+                x, y = _on_map(closed_loop)
+                axis.plot(x, y, "-", color=color, lw=1.5, label=f"{label}, closed loop")
+                ends = np.flatnonzero(np.isfinite(x))
+                axis.plot(x[ends[0]], y[ends[0]], "o", mfc="none", color=color, ms=6)
+                axis.plot(x[ends[-1]], y[ends[-1]], "s", mfc="none", color=color, ms=6)
+        for cone in panel.cones:
+            color = KEEP_COLORS[cone.keep_out]
+            kind = "keep-out" if cone.keep_out else "keep-in"
+            for number, boundary in enumerate(cone.boundaries):
+                axis.plot(*_on_map(boundary), "-" if number == 0 else "-.", color=color, lw=1.6,
+                          label=f"{cone.label} ({kind}){' at the end' if number else ''}")
+            x, y = _on_map(cone.centre)
+            axis.plot(x, y, ":" if len(x) > 1 else "+", color=color, ms=9, mew=2, zorder=4)
+            axis.text(x[0], y[0], f" {cone.label}", color=color, fontsize=8, va="top",
+                      bbox={"facecolor": "white", "alpha": 0.7, "linewidth": 0, "pad": 1})
+            for number, disc in enumerate(cone.discs):
+                dx, dy = _on_map(disc)
+                filled = bool(np.all(np.isfinite(dx)))  # a disc that does not wrap round the map is filled
+                if filled:
+                    axis.fill(dx, dy, color="tab:blue", alpha=0.2, lw=0, label="Earth disc" if number == 0 else None)
+                axis.plot(dx, dy, color="tab:blue", lw=1.0, label="Earth disc" if number == 0 and not filled else None)
+        axis.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{(-np.rad2deg(x)) % 360:.0f}°"))
+        axis.tick_params(labelsize=8)
+        axis.set_xlabel("right ascension (deg)", fontsize=9)
+        axis.set_ylabel("declination (deg)", fontsize=9)
+        axis.set_title(panel.title, fontsize=10, pad=12)
+        axis.legend(loc="upper left", bbox_to_anchor=(1.03, 1.0), fontsize=7, borderaxespad=0.0)
+    figure.suptitle(series.title + "; closed loop start ○, end □", fontsize=10)
+    return figure
+
+
+def draw_sky(series: SkySeries, path: Path) -> None:
+    """:func:`sky_figure` as a PNG.
+
+    Parameters
+    ----------
+    series : scenarios.output.plot_data.SkySeries
+        The paths (:func:`scenarios.output.plot_data.sky_series`).
+    path : pathlib.Path
+        Where to write the PNG.
+    """
+    sky_figure(series).savefig(path, **SAVE)
 
 
 def plot_overlay(results: Any, path: Path) -> None:
@@ -319,8 +637,7 @@ def plot_overlay(results: Any, path: Path) -> None:
     draw_overlay(overlay_series(results), path)
 
 
-def draw_jobs(jobs: list[PlotJob], directory: Path, figures: dict[tuple[int, bool, bool], RowFigure] | None = None
-              ) -> None:
+def draw_jobs(jobs: list[PlotJob], directory: Path, figures: dict[RowShape, RowFigure] | None = None) -> None:
     """Draw figures into ``directory``, reusing one :class:`RowFigure` per row shape.
 
     Parameters
@@ -342,12 +659,14 @@ def draw_jobs(jobs: list[PlotJob], directory: Path, figures: dict[tuple[int, boo
             DRAW[type(series)](series, directory / name)
 
 
-DRAW: dict[type, Callable[[Any, Path], None]] = {OverlaySeries: draw_overlay, ConeSeries: draw_cones}
+DRAW: dict[type, Callable[[Any, Path], None]] = {OverlaySeries: draw_overlay, MarginSeries: draw_margins,
+                                                  SkySeries: draw_sky}
 """How each kind of series other than a row is drawn."""
 
 
 def write_plots(results: Any, directory: Path, stems: list[str] | None = None) -> None:
-    """One PNG per simulated row (``<stem>.png``, ``<stem>_cones.png`` with cones) and ``comparison.png``.
+    """The figures of :func:`scenarios.output.plot_data.plot_jobs`: one PNG per simulated row
+    (``<stem>.png``), ``margins.png`` and ``sky.png`` with pointing requirements, and ``comparison.png``.
 
     Parameters
     ----------

@@ -206,10 +206,10 @@ def _draw_in_two(jobs: list[Any], directory: Path, forks: list[int]) -> None:
     The static part of each row shape's figure is drawn first (:meth:`RowFigure.prepare` with the
     first row of that shape), so that the fork inherits it instead of drawing it again.
     """
-    from scenarios.output.plot_data import RowSeries
+    from scenarios.output.plot_data import RowSeries, RowShape
     from scenarios.output.plots import RowFigure, draw_jobs
 
-    figures: dict[tuple[int, bool, bool], RowFigure] = {}
+    figures: dict[RowShape, RowFigure] = {}
     for _, series in jobs:
         if isinstance(series, RowSeries) and series.shape not in figures:
             figures[series.shape] = RowFigure(*series.shape)
