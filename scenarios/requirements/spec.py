@@ -191,7 +191,7 @@ class ActuatorRequirement:
     """
 
     margin: float
-    stated: bool = True
+    stated: bool = field(default=True, compare=False)
 
     def __post_init__(self) -> None:
         if not (0.0 <= self.margin < 1.0):
