@@ -12,6 +12,7 @@ once, here: :class:`PlannerSpec` and :class:`ControllerSpec` carry the instances
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import datetime
 import math
@@ -194,6 +195,9 @@ class Scenario:
         requirements' constraints, tabulated for the run, are ``problem.pointing``.
     epoch : datetime.datetime or None, optional
         The instant of t = 0, UTC (``epoch``); ``None``: none.
+    data : dict or None, optional
+        A copy of the YAML data it was parsed from (recorded in ``results.json``); ``None`` for a
+        scenario built in code.
     """
 
     name: str
@@ -204,6 +208,7 @@ class Scenario:
     source: Path | None = None
     requirements: Requirements = field(default_factory=Requirements)
     epoch: datetime.datetime | None = None
+    data: dict[str, Any] | None = field(default=None, repr=False, compare=False)
 
     @property
     def frame(self) -> str:
@@ -499,7 +504,8 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     check_work(problem, simulation)
     check_row_labels(planners, controllers)
     check_compatibility(problem, planners, controllers, simulation)
-    return Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch)
+    return Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch,
+                    data=copy.deepcopy(data))
 
 
 def _with_requirements(problem: ManeuverProblem, requirements: Requirements,
