@@ -411,7 +411,7 @@ _GIMBAL_LOCK = 1e-7
 
 def _sequence_axes(sequence: str) -> tuple[int, int, int]:
     """Axis indices (0 = x) of an Euler sequence such as ``"321"`` or ``"zyx"``."""
-    axes = tuple(_AXES.get(letter) for letter in str(sequence).lower())
+    axes = tuple(_AXES.get(letter) for letter in sequence.lower()) if isinstance(sequence, str) else ()
     if len(axes) != 3 or None in axes or axes[0] == axes[1] or axes[1] == axes[2]:
         raise ValueError(f"sequence must name three body axes (1, 2, 3 or x, y, z), no two consecutive ones "
                          f"equal, such as '321' or '313', got {sequence!r}")
