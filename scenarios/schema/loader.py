@@ -332,8 +332,11 @@ SENSOR_NOISE = Section((
 
 SIMULATION = Section((
     number("sample_time", "Zero-order-hold sample time of the controller.", unit="s", default=1.0, positive=True),
-    number("duration", "Closed-loop window; ``null``: the larger of ``maneuver.duration`` and the reference's "
-           "duration.", unit="s", default=None, positive=True, nullable=True),
+    number("duration", "Closed-loop window of every row. ``null`` (the default): each row runs for "
+           "``maneuver.duration``, or for its reference's duration when that is longer (a minimum-time or "
+           "rate-limited planner's); a row without a planner for ``maneuver.duration``. After its duration a "
+           "reference continues as the torque-free motion of its final state.", unit="s", default=None,
+           positive=True, nullable=True),
     vector("initial_attitude_error_deg", "Rotation vector applied to the true initial attitude, body axes.", 3,
            unit="deg", default=[0.0, 0.0, 0.0]),
     vector("initial_rate_error", "Added to the true initial body rate, body frame.", 3, unit="rad/s",
