@@ -153,7 +153,8 @@ class RunResults:
 
     scenario: Scenario
     rows: list[Row]
-    finished: datetime.datetime = field(default_factory=lambda: datetime.datetime.now(datetime.timezone.utc))
+    finished: datetime.datetime = field(default_factory=lambda: datetime.datetime.now(datetime.timezone.utc),
+                                        compare=False)
 
     def to_dict(self) -> dict[str, Any]:
         """The results as a plain dict.
