@@ -29,3 +29,8 @@ CONTROLLERS: dict[str, type[Controller]] = {
 
 __all__ = ["CONTROLLERS", "TDFC", "AugmentedQuaternionFeedback", "BDot", "Controller", "CostateFeedback", "EigenaxisPD",
            "GainScheduledMinNorm", "MinNorm", "NoControl", "SingularRateTracking", "SingularZeroMomentum", "gain_matrix"]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

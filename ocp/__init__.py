@@ -56,3 +56,8 @@ __all__ = [
     "TiltedDipole", "Torquers", "compute_metrics", "gravity_gradient_torque", "metric_violations",
     "metrics_from_reference", "metrics_from_simulation",
 ]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

@@ -401,3 +401,116 @@ def random_unit(rng: np.random.Generator, size: int | None = None) -> Array:
     """
     shape = (4,) if size is None else (size, 4)
     return normalize(rng.standard_normal(shape))
+
+
+_AXES = {"1": 0, "2": 1, "3": 2, "x": 0, "y": 1, "z": 2}
+"""Body axis index of each letter of an Euler sequence."""
+_GIMBAL_LOCK = 1e-7
+"""rad: a middle Euler angle this close to its singular value is treated as gimbal lock."""
+
+
+def _sequence_axes(sequence: str) -> tuple[int, int, int]:
+    """Axis indices (0 = x) of an Euler sequence such as ``"321"`` or ``"zyx"``."""
+    axes = tuple(_AXES.get(letter) for letter in sequence.lower()) if isinstance(sequence, str) else ()
+    if len(axes) != 3 or None in axes or axes[0] == axes[1] or axes[1] == axes[2]:
+        raise ValueError(f"sequence must name three body axes (1, 2, 3 or x, y, z), no two consecutive ones "
+                         f"equal, such as '321' or '313', got {sequence!r}")
+    return axes  # type: ignore[return-value]  # None excluded above
+
+
+def to_euler(q: ArrayLike, sequence: str = "321") -> Array:
+    """Euler angles of an attitude: rotations about body axes in the order of ``sequence``.
+
+    For ``sequence = "321"`` (the default, yaw-pitch-roll) the angles ``(ψ, θ, φ)`` satisfy
+    ``q = q_z(ψ) ⊗ q_y(θ) ⊗ q_x(φ)`` up to sign (``R(q) = R_z(ψ) R_y(θ) R_x(φ)``): from the
+    inertial frame, yaw about z, then pitch about the new y, then roll about the newest x, reach
+    the body axes. Any sequence of three body axes with no two consecutive ones equal works: the six
+    Tait-Bryan (``"321"``, ``"123"`` ...) and the six proper Euler sequences (``"313"`` ...). The
+    angles are computed from the quaternion directly (Bernardes and Viollet, 2022), so ``q`` and
+    ``-q`` give the same angles; at gimbal lock (middle angle ±90° for Tait-Bryan, 0 or 180° for
+    proper sequences) the third angle is set to zero and the first carries the rotation.
+
+    Parameters
+    ----------
+    q : (..., 4) array_like
+        Unit quaternion(s), scalar first, body to inertial.
+    sequence : str, optional
+        The body axes in the order the rotations are applied from the inertial frame: three of
+        ``1``, ``2``, ``3`` (or ``x``, ``y``, ``z``); default ``"321"``.
+
+    Returns
+    -------
+    (..., 3) ndarray
+        The three angles [rad], in the order of ``sequence``: the first and last in (-π, π], the
+        middle one in [-π/2, π/2] for a Tait-Bryan sequence and [0, π] for a proper one.
+
+    Raises
+    ------
+    ValueError
+        A sequence that is not three body axes with no two consecutive ones equal.
+    """
+    first, middle, last = _sequence_axes(sequence)
+    q = np.asarray(q, dtype=float)
+    # Written for the extrinsic sequence (i, j, k): the intrinsic (first, middle, last) is the
+    # extrinsic (last, middle, first), its angles in reverse order.
+    i, j, k = last, middle, first
+    proper = i == k
+    if proper:
+        k = 3 - i - j
+    sign = (i - j) * (j - k) * (k - i) // 2  # Levi-Civita symbol of (i, j, k): +1 or -1
+    w, v = q[..., 0], q[..., 1:]
+    if proper:
+        a, b, c, d = w, v[..., i], v[..., j], sign * v[..., k]
+    else:
+        a, b, c, d = w - v[..., j], v[..., i] + sign * v[..., k], v[..., j] + w, sign * v[..., k] - v[..., i]
+    middle_angle = 2.0 * np.arctan2(np.hypot(c, d), np.hypot(a, b))
+    half_sum, half_difference = np.arctan2(b, a), np.arctan2(d, c)
+    at_zero = np.abs(middle_angle) <= _GIMBAL_LOCK
+    at_pi = np.abs(middle_angle - np.pi) <= _GIMBAL_LOCK
+    # extrinsic first angle (the intrinsic last): zero at gimbal lock, where only a sum or a
+    # difference of the outer angles is defined
+    outer_first = np.where(at_zero | at_pi, 0.0, half_sum - half_difference)
+    outer_last = np.where(at_zero, 2.0 * half_sum, np.where(at_pi, 2.0 * half_difference,
+                                                            half_sum + half_difference))
+    if not proper:
+        outer_last = sign * outer_last
+        middle_angle = middle_angle - np.pi / 2
+    return _wrap(np.stack([outer_last, middle_angle, outer_first], axis=-1))
+
+
+def _wrap(angles: Array) -> Array:
+    """Angles in (-π, π]."""
+    return np.pi - (np.pi - angles) % (2.0 * np.pi)
+
+
+def continuous(q: ArrayLike) -> Array:
+    """A quaternion time series with each sample's sign chosen so that no sample jumps to ``-q``.
+
+    ``q`` and ``-q`` are the same attitude; a series that switches between them (a solver, a
+    canonical form ``q0 >= 0``) looks like a jump in a plot or a table. Each sample after the first
+    takes the sign that makes its dot product with the previous (sign-corrected) sample
+    non-negative; the first sample keeps its sign.
+
+    Parameters
+    ----------
+    q : (N, 4) array_like
+        Quaternions, scalar first, in time order.
+
+    Returns
+    -------
+    (N, 4) ndarray
+        The same attitudes, each ``+q_k`` or ``-q_k``.
+
+    Raises
+    ------
+    ValueError
+        ``q`` is not an (N, 4) array.
+    """
+    q = np.array(q, dtype=float)
+    if q.ndim != 2 or q.shape[1] != 4:
+        raise ValueError(f"q must be an (N, 4) series of quaternions, got shape {q.shape}")
+    if len(q) < 2:
+        return q
+    flips = np.where(np.sum(q[1:] * q[:-1], axis=1) < 0.0, -1.0, 1.0)
+    signs = np.concatenate([[1.0], np.cumprod(flips)])
+    return q * signs[:, None]

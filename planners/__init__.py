@@ -33,3 +33,8 @@ PLANNERS.update({cls.name: cls for cls in (CollocationPlanner, CostateTPBVPPlann
 
 __all__ = ["BOUNDARY_CONDITIONS", "FailedReference", "ManeuverProblem", "PLANNERS", "Planner", "Reference", "ReferenceSample",
            "inverse_dynamics_torque"]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

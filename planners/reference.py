@@ -6,6 +6,8 @@ Conventions: scalar-first Hamilton quaternions ``q`` rotating body vectors to in
 """
 from __future__ import annotations
 
+import html
+import textwrap
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Mapping
 from typing import Any, NamedTuple
@@ -18,6 +20,8 @@ from planners.torque_free import TorqueFreeMotion
 Array = NDArray[np.float64]
 STATUSES = ("ok", "failed", "infeasible")
 """Values of :attr:`Reference.status`."""
+_MESSAGE_CHARS = 100
+"""Characters of a reference's message shown by its repr."""
 
 
 class ReferenceSample(NamedTuple):
@@ -143,6 +147,24 @@ class Reference(ABC):
     def ok(self) -> bool:
         """Whether the planner succeeded (``status == "ok"``)."""
         return self.status == "ok"
+
+    def _summary(self) -> dict[str, str]:
+        """What the repr and the HTML table show: planner, status, duration, planning time, message."""
+        return {"planner": self.planner, "status": self.status, "duration": f"{self.duration:.4g} s",
+                "planned in": f"{self.plan_time_s:.3g} s",
+                "message": textwrap.shorten(self.message, _MESSAGE_CHARS, placeholder=" ...")}
+
+    def __repr__(self) -> str:
+        facts = self._summary()
+        message = facts.pop("message")
+        return (f"<{type(self).__name__} of {facts.pop('planner')}: " + ", ".join(f"{k} {v}" for k, v in facts.items())
+                + (f"; {message}" if message else "") + ">")
+
+    def _repr_html_(self) -> str:
+        facts = self._summary()
+        header = "".join(f"<th>{html.escape(name)}</th>" for name in facts)
+        cells = "".join(f"<td>{html.escape(value)}</td>" for value in facts.values())
+        return f"<table><caption>{html.escape(type(self).__name__)}</caption><tr>{header}</tr><tr>{cells}</tr></table>"
 
     @abstractmethod
     def _evaluate(self, t: Array) -> ReferenceSample:

@@ -27,7 +27,8 @@ def lazy_face(package: str, homes: Mapping[str, str]) -> tuple[Callable[[str], A
     tuple of callable
         ``(__getattr__, __dir__)`` for the package's namespace: ``__getattr__(name)`` returns the
         public name from its home, or the submodule ``name`` (imported), and raises
-        ``AttributeError`` otherwise; ``__dir__()`` lists the module's names and the public ones.
+        ``AttributeError`` otherwise; ``__dir__()`` lists the public names (``__all__``) and the
+        module's dunder attributes, not its helpers or imports (submodules stay reachable).
     """
     def __getattr__(name: str) -> Any:
         home = homes.get(name)
@@ -42,6 +43,12 @@ def lazy_face(package: str, homes: Mapping[str, str]) -> tuple[Callable[[str], A
         raise AttributeError(f"module {package!r} has no attribute {name!r}")
 
     def __dir__() -> list[str]:
-        return sorted(set(vars(importlib.import_module(package))) | set(homes))
+        namespace = vars(importlib.import_module(package))
+        return sorted(set(namespace.get("__all__", homes)) | {name for name in namespace if _is_dunder(name)})
 
     return __getattr__, __dir__
+
+
+def _is_dunder(name: str) -> bool:
+    """``__name__``, ``__all__`` ...: the module attributes ``dir()`` keeps beside the public names."""
+    return name.startswith("__") and name.endswith("__")

@@ -60,7 +60,7 @@ found = {}
 for name in names:
     module = importlib.import_module(name)
     found[name] = module.__file__
-from scenarios.study.types import package_version
+from scenarios.output.provenance import package_version
 print(json.dumps({"files": found, "version": package_version(), "prefix": sys.prefix}))
 """
 
@@ -108,7 +108,7 @@ def test_the_installed_wheel_holds_and_imports_every_module(tmp_path):
              if not Path(path).resolve().is_relative_to(prefix) or Path(path).resolve().is_relative_to(ROOT)}
     assert not stray, f"imported from outside the installed environment: {stray}"
     assert sorted(report["files"]) == sorted(modules)
-    from scenarios.study.types import (
+    from scenarios.output.provenance import (
         package_version,  # the checkout's answer, from pyproject.toml
     )
 

@@ -144,8 +144,15 @@ def test_slewbench_command(command, tmp_path):
         assert any((folder / "timeseries").glob("*.csv"))
     if args[1] == "schema":
         assert "maneuver.duration" in done.stdout and "number" in done.stdout
-    if args[1] == "list":
+    if args[1] == "list" and "--options" in args:  # one registry entry's options, one line each
+        name = args[args.index("--options") + 1]
+        assert done.stdout.startswith(f"{name} (") and "\n  option " in done.stdout
+    elif args[1] == "list":
         assert "spin_extremal" in done.stdout and "augmented_quaternion_feedback" in done.stdout
+    if args[1] == "--version":
+        assert done.stdout.startswith("slewbench ")
+    if args[1] == "validate" and "study_" in args[2]:
+        assert " cases (" in done.stdout
     if args[1] == "codegen":
         (folder,) = [tmp_path / args[args.index("--out") + 1]]
         assert {"Makefile", "interface.json"} <= {path.name for path in folder.iterdir()}

@@ -10,3 +10,8 @@ from controllers.detumbling.magnetic import MagneticController
 from controllers.detumbling.tdfc import TDFC
 
 __all__ = ["BDot", "MagneticController", "TDFC"]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

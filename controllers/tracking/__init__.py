@@ -15,3 +15,8 @@ from controllers.tracking.costate_feedback import CostateFeedback
 from controllers.tracking.eigenaxis_pd import EigenaxisPD
 
 __all__ = ["AugmentedQuaternionFeedback", "CostateFeedback", "EigenaxisPD"]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

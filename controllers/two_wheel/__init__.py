@@ -15,3 +15,8 @@ from controllers.two_wheel.underactuated import TwoWheelLaw, control_frame
 
 __all__ = ["GainScheduledMinNorm", "MinNorm", "SingularGains", "SingularRateTracking", "SingularZeroMomentum",
            "TwoWheelLaw", "control_frame"]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

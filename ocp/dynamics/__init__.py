@@ -29,3 +29,8 @@ __all__ = ["ACTUATOR_KINDS", "EPHEMERIS_RANGE", "MAGNETIC_FIELDS", "Actuator", "
            "CircularOrbit", "Command", "Environment", "FieldModel", "IGRFField", "MagneticField", "Magnetorquers",
            "Measurement", "ReactionWheels", "Spacecraft", "TiltedDipole", "Torquers", "actuator_kind", "check_epoch",
            "gravity_gradient_torque", "moon_position", "parse_utc", "rk4_step", "sun_position", "tdb_julian_date"]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

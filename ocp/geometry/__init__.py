@@ -16,3 +16,8 @@ from ocp.geometry.pointing import PointingConstraint, PointingScore, violation_i
 
 __all__ = ["DIRECTIONS", "FRAMES", "INTERPOLATION_TOLERANCE", "DirectionKind", "Geometry", "PointingConstraint",
            "PointingScore", "direction_kind", "direction_table", "violation_intervals"]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

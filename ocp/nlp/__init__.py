@@ -21,3 +21,8 @@ from ocp.nlp.solve import (
 
 __all__ = ["NLPResult", "SecondOrderCheck", "StartResult", "converged", "perturbed", "second_order_check",
            "solve_multistart", "solver_options", "status_name", "warm_start_options"]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

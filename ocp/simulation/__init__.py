@@ -18,3 +18,8 @@ from ocp.simulation.simulator import (
 )
 
 __all__ = ["ClosedLoop", "GridSampledReference", "SensorNoise", "SimulationResult", "Simulator", "compile_function"]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

@@ -23,9 +23,10 @@ Two paths compute the same numbers (to rounding; ``tests/test_closed_loop.py``):
 """
 from __future__ import annotations
 
+import html
 import math
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import casadi as ca
 import numpy as np
@@ -34,14 +35,32 @@ from numpy.typing import ArrayLike, NDArray
 from ocp import quat
 from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
 from ocp.dynamics.integration import rk4_step
-from ocp.dynamics.layout import reference_rows
+from ocp.dynamics.layout import actuator_blocks, reference_rows
 from ocp.dynamics.model import AttitudeModel
 from ocp.errors import CompilerUnavailable, SimulationError
 from ocp.fast_call import BufferedFunction
 from ocp.simulation.closed_loop import ClosedLoop, draw_noise
 from ocp.simulation.compiled import compile_function, notice
 
+if TYPE_CHECKING:
+    import pandas
+
 Array = NDArray[np.float64]
+
+_CONTROL_COLUMNS = {"wheels": ("wheel{}_torque", "N_m", False), "dipole": ("dipole_{}", "A_m2", True),
+                    "torquers": ("torquer_{}", "N_m", True)}
+"""Column stem, unit and per-body-axis naming of the built-in actuator blocks' controls in
+:meth:`SimulationResult.to_dataframe` (another kind's block: ``<block><i>``, no unit)."""
+_STATE_COLUMNS = {"wheels": ("wheel{}_momentum_N_m_s", "wheel{}_speed_rpm")}
+"""Column of each state and of its speed (state over the spin inertia) of the built-in actuator
+blocks with states (another kind's: ``<block>_state<i>``)."""
+RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
+"""Revolutions per minute in one rad/s."""
+
+
+def _number(value: float) -> str:
+    """A number for a repr: four significant digits."""
+    return f"{value:.4g}"
 
 
 class GridSampledReference:
@@ -215,6 +234,104 @@ class SimulationResult:
     def wheel_momentum(self) -> Array:
         """(N+1, n_w) wheel momenta [N m s]."""
         return self.x[:, 7:]
+
+    def __repr__(self) -> str:
+        return "<SimulationResult: " + ", ".join(f"{name} {value}" for name, value in self._summary()) + ">"
+
+    def _summary(self) -> list[tuple[str, str]]:
+        """(what, value) lines of the repr and of the HTML table."""
+        final_rate = float(np.linalg.norm(self.omega[-1])) if self.t.size else math.nan
+        blocks = [block.actuator.name for block in actuator_blocks(self.model.spacecraft)]
+        return [("samples", str(self.t.size)),
+                ("window", f"{_number(self.t[0])} to {_number(self.t[-1])} s"),
+                ("sample time", f"{_number(self.sample_time)} s ({self.path})"),
+                ("actuators", ", ".join(blocks) or "none"),
+                ("final |ω|", f"{_number(final_rate)} rad/s"),
+                ("saturated", f"{int(np.count_nonzero(self.saturated))} of {self.saturated.size} intervals")]
+
+    def _repr_html_(self) -> str:
+        rows = "".join(f"<tr><th style='text-align:left'>{html.escape(name)}</th><td>{html.escape(value)}</td></tr>"
+                       for name, value in self._summary())
+        return f"<table><caption>SimulationResult</caption>{rows}</table>"
+
+    def to_dataframe(self, sequence: str = "321") -> pandas.DataFrame:
+        """The time series as a pandas DataFrame, one line per sample, units in the column names.
+
+        Columns, in order (``_rad_s`` is rad/s, ``_N_m`` N m, ``_N_m_s`` N m s, ``_A_m2`` A m²):
+
+        * ``t_s``: the time [s];
+        * ``q0``, ``q1``, ``q2``, ``q3``: the attitude (scalar first, body to inertial), each sample's
+          sign chosen so that none jumps to ``-q`` (:func:`ocp.quat.continuous`);
+        * the Euler angles of ``sequence`` [deg] (:func:`ocp.quat.to_euler`): ``yaw_deg``,
+          ``pitch_deg``, ``roll_deg`` for ``"321"``, else ``euler_<sequence>_1_deg`` ... ``_3_deg``;
+        * ``omega_x_rad_s``, ``omega_y_rad_s``, ``omega_z_rad_s``: the body rate, body axes;
+        * ``actuator_torque_x_N_m`` ... ``_z_N_m``: the actuators' applied torque on the body, body axes;
+        * per actuator, the command asked for (``_cmd``) and the one applied after saturation: the
+          wheels' motor torques ``wheel<i>_torque_cmd_N_m`` and ``wheel<i>_torque_N_m``, the
+          magnetorquers' dipole ``dipole_<axis>_cmd_A_m2`` and ``dipole_<axis>_A_m2``, the torquers'
+          ``torquer_<axis>_cmd_N_m`` and ``torquer_<axis>_N_m`` (another kind's block:
+          ``<block><i>_cmd`` and ``<block><i>``, in its own unit);
+        * ``wheel<i>_momentum_N_m_s``: each wheel's spin momentum ``h_w``, and, when the wheels' spin
+          inertia ``J_s`` is known, ``wheel<i>_speed_rpm``: ``h_w / J_s`` in revolutions per minute;
+        * ``saturated``: whether any actuator was at its limit in the interval from this sample.
+
+        A command is held from its sample to the next, so the commands, the applied torque and
+        ``saturated`` are missing (NaN, ``<NA>``) on the last line, the final time.
+
+        Parameters
+        ----------
+        sequence : str, optional
+            The Euler sequence of the angle columns (:func:`ocp.quat.to_euler`); default ``"321"``
+            (yaw, pitch, roll).
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``N + 1`` lines, the columns above.
+
+        Raises
+        ------
+        ImportError
+            pandas is not installed.
+        ValueError
+            A sequence :func:`ocp.quat.to_euler` does not take.
+        """
+        try:
+            import pandas
+        except ImportError:
+            raise ImportError("to_dataframe needs pandas: pip install pandas") from None
+        euler = np.rad2deg(quat.to_euler(self.q, sequence))
+        names = (("yaw_deg", "pitch_deg", "roll_deg") if sequence == "321"
+                 else tuple(f"euler_{sequence}_{i}_deg" for i in (1, 2, 3)))
+        columns: dict[str, Any] = {"t_s": self.t}
+        columns.update(zip(("q0", "q1", "q2", "q3"), quat.continuous(self.q).T))
+        columns.update(zip(names, euler.T))
+        columns.update(zip(("omega_x_rad_s", "omega_y_rad_s", "omega_z_rad_s"), self.omega.T))
+
+        def held(values: Array) -> Array:  # a value per interval, NaN at the final time
+            return np.concatenate([values, np.full((1,) + values.shape[1:], np.nan)])
+
+        columns.update(zip((f"actuator_torque_{axis}_N_m" for axis in "xyz"), held(self.applied_torque).T))
+        momentum: dict[str, Array] = {}
+        for block in actuator_blocks(self.model.spacecraft):
+            actuator = block.actuator
+            label, unit, per_axis = _CONTROL_COLUMNS.get(actuator.block, (f"{actuator.block}{{}}", "", False))
+            suffix = f"_{unit}" if unit else ""
+            for i in range(actuator.control_size):
+                name = label.format("xyz"[i] if per_axis else i)
+                columns[f"{name}_cmd{suffix}"] = held(self.commanded_u[:, block.control][:, i])
+                columns[f"{name}{suffix}"] = held(self.applied_u[:, block.control][:, i])
+            states = self.x[:, 7:][:, block.state]
+            state_name, speed_name = _STATE_COLUMNS.get(actuator.block, (f"{actuator.block}_state{{}}", ""))
+            spin_inertia = getattr(actuator, "spin_inertia", None)  # known for wheels that give it
+            for i in range(actuator.state_size):
+                momentum[state_name.format(i)] = states[:, i]
+                if speed_name and spin_inertia is not None:
+                    momentum[speed_name.format(i)] = states[:, i] / spin_inertia[i] * RPM_PER_RAD_S
+        columns.update(momentum)
+        frame = pandas.DataFrame(columns)
+        frame["saturated"] = pandas.array([*map(bool, self.saturated), None], dtype="boolean")
+        return frame
 
 
 class ControllerLike(Protocol):

@@ -33,3 +33,8 @@ __all__ = [
            "radau_weights",
            "transfer_multipliers",
 ]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

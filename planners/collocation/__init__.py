@@ -15,3 +15,8 @@ from planners.collocation.planner import CollocationOptions, CollocationPlanner
 from planners.collocation.reference import CollocationReference
 
 __all__ = ["CollocationOptions", "CollocationPlanner", "CollocationReference"]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

@@ -17,3 +17,8 @@ from planners.costate.tpbvp import CostateReference, CostateTPBVPPlanner
 
 __all__ = ["AttitudeAcquisitionSystem", "CostateReference", "CostateTPBVPPlanner", "HamiltonianSystem",
            "MinimumEnergySystem", "RateAcquisitionSystem", "RigidBodySystem"]
+
+
+def __dir__() -> list[str]:
+    """What ``dir()`` lists: the public names (``__all__``) and the module's dunder attributes."""
+    return sorted({*__all__, *(name for name in globals() if name.startswith("__") and name.endswith("__"))})

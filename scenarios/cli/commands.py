@@ -1,4 +1,4 @@
-"""``slewbench`` command line: run, validate, list, schema, codegen, sweep.
+"""``slewbench`` command line: run, validate, list, schema, codegen, sweep, and ``--version``.
 
 Exit status (:mod:`scenarios.cli.status`): 0 when the run completed (a failed planner or a
 violated requirement is a row, not an error), 1 under ``run --strict`` when some row is not ``ok``
@@ -29,32 +29,52 @@ from scenarios.cli.status import (
 )
 from scenarios.cli.sweep import add_sweep_parser
 from scenarios.errors import OutputError, ScenarioError
-from scenarios.output.directory import claim_output_directory
+from scenarios.output.directory import claim_output_directory, read_manifest
 from scenarios.output.names import default_output_directory
+from scenarios.output.provenance import package_version
 from scenarios.runner import run
-from scenarios.schema.loader import load
-from scenarios.schema.reference import summary_line
+from scenarios.schema.labels import row_labels
+from scenarios.schema.loader import load, parse_scenario
+from scenarios.schema.read import read_yaml
+from scenarios.schema.reference import options_text, summary_line
+from scenarios.study.spec import load_study
+
+STUDY_KEY = "study"
+"""The top-level key that makes a YAML file a study (the study's name) for ``validate``."""
 
 
-def command_list(_: argparse.Namespace) -> int:
-    """``slewbench list``: print the registered planners and controllers, one line each.
+def command_list(args: argparse.Namespace) -> int:
+    """``slewbench list [--options NAME]``: print the registered planners and controllers, one line
+    each, or the options of one of them.
 
     Parameters
     ----------
-    _ : argparse.Namespace
-        The parsed command line (unused).
+    args : argparse.Namespace
+        ``options`` (optional): a planner's or controller's registry name, whose options are printed
+        with their type, unit, default and range (:func:`scenarios.schema.reference.options_text`).
 
     Returns
     -------
     int
-        Exit status (0).
+        Exit status: 0, or 2 for a name that is neither a planner nor a controller (its close
+        matches are listed).
     """
+    name = getattr(args, "options", None)
+    if name is not None:
+        try:
+            text = options_text(name)
+        except ScenarioError as error:
+            print(f"slewbench: {error}", file=sys.stderr)
+            return EXIT_BAD_SCENARIO
+        sys.stdout.write(text)
+        return EXIT_OK
     print("planners:")
     for name, planner in PLANNERS.items():
         print(f"  {name:32s} {summary_line(planner)}")
     print("controllers:")
     for name, controller in CONTROLLERS.items():
         print(f"  {name:32s} {summary_line(controller)}")
+    print("(slewbench list --options NAME: the options of one, with type, unit, default and range)")
     return EXIT_OK
 
 
@@ -85,21 +105,35 @@ def command_schema(args: argparse.Namespace) -> int:
 
 
 def command_validate(args: argparse.Namespace) -> int:
-    """``slewbench validate FILE``: load and check a scenario, print a one-line summary.
+    """``slewbench validate FILE``: load and check a scenario or a study file, print what would run.
+
+    A file whose top level has the key ``study`` is a study (:func:`scenarios.study.spec.load_study`:
+    every case is expanded and checked); any other is a scenario.
 
     Parameters
     ----------
     args : argparse.Namespace
-        ``file``: the scenario YAML path.
+        ``file``: the scenario or study YAML path.
 
     Returns
     -------
     int
-        Exit status (0; a bad scenario raises ``ScenarioError``, which :func:`main` reports).
+        Exit status (0; a bad file raises ``ScenarioError``, which :func:`main` reports with exit 2).
     """
-    scenario = load(args.file)
-    print(f"{args.file}: valid scenario {scenario.name!r} with {len(scenario.planners)} planner(s) "
-          f"and controller {scenario.controller.name!r}")
+    data = read_yaml(args.file)
+    if isinstance(data, dict) and STUDY_KEY in data:
+        study = load_study(args.file)
+        points = len({case.point for case in study.cases})
+        varied = ", ".join(study.varied_paths) or "nothing"
+        print(f"{args.file}: valid study {study.name!r}: {len(study.cases)} cases ({points} grid point(s) x "
+              f"{study.samples} sample(s)), varying {varied}; run it with `slewbench sweep {args.file}`")
+        return EXIT_OK
+    scenario = parse_scenario(data, Path(args.file))
+    labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in scenario.controllers])
+    controllers = ", ".join(repr(c.name) for c in scenario.controllers)
+    print(f"{args.file}: valid scenario {scenario.name!r} with {len(scenario.planners)} planner(s) and "
+          f"controller{'s' if len(scenario.controllers) > 1 else ''} {controllers}: {len(labels)} row(s) "
+          f"({', '.join(label.label for label in labels)})")
     return EXIT_OK
 
 
@@ -133,16 +167,27 @@ def command_run(args: argparse.Namespace) -> int:
     results = run(scenario, progress=progress)
     interruption.check()
     print()
-    print(results.to_terminal())
+    print(results.to_terminal(all_metrics=getattr(args, "all_metrics", False)))
+    earlier = _written_files(out)
     results.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
     print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
           f"{'' if args.no_plots else ', PNG plots'}) in {time.perf_counter() - start:.2f} s")
+    removed = sorted(earlier - _written_files(out))
+    if removed:
+        print(f"removed {len(removed)} file(s) of the earlier run in {out}/ that this run did not write: "
+              + ", ".join(removed))
     not_ok = [row.label for row in results.rows if row.status != "ok"]
     if getattr(args, "strict", False) and not_ok:
         print(f"slewbench: --strict: {len(not_ok)} of {len(results.rows)} rows not ok ({', '.join(not_ok)})",
               file=sys.stderr)
         return EXIT_NOT_OK
     return EXIT_OK
+
+
+def _written_files(directory: Path) -> set[str]:
+    """The files slewbench's manifest lists in ``directory`` that exist (none without a manifest)."""
+    manifest = read_manifest(directory)
+    return {name for name in (manifest or {}).get("files", []) if (directory / name).is_file()}
 
 
 def command_codegen(args: argparse.Namespace) -> int:
@@ -186,23 +231,28 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=f"exit status: {EXIT_OK} done (failed and violated rows are results); {EXIT_NOT_OK} a row not ok "
                f"under run --strict; {EXIT_BAD_SCENARIO} bad scenario or study file, or output location; "
                f"{EXIT_INTERNAL} internal error or interrupted run; {EXIT_INTERRUPTED} interrupted sweep")
+    parser.add_argument("--version", action="version", version=f"slewbench {package_version()}")
     commands = parser.add_subparsers(dest="command", required=True)
     run_parser = commands.add_parser("run", help="plan, simulate and score every planner of a scenario")
     run_parser.add_argument("file", help="scenario YAML file")
     run_parser.add_argument("--out", help="output directory (default: results/<scenario name>)")
     run_parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    run_parser.add_argument("--all-metrics", action="store_true",
+                            help="show every metric in the table, also those with no value in any row")
     run_parser.add_argument("--strict", action="store_true",
                             help=f"exit {EXIT_NOT_OK} when any row is not ok (violated or failed), after writing the "
                                  "results (for continuous integration)")
     run_parser.set_defaults(handler=command_run)
-    validate_parser = commands.add_parser("validate", help="check a scenario file")
-    validate_parser.add_argument("file")
+    validate_parser = commands.add_parser("validate", help="check a scenario or study file; print what would run")
+    validate_parser.add_argument("file", help="scenario or study YAML file (a study has the top-level key 'study')")
     validate_parser.set_defaults(handler=command_validate)
     codegen_parser = commands.add_parser("codegen", help="export the controller law (and closed-form references) as C")
     codegen_parser.add_argument("file", help="scenario YAML file")
     codegen_parser.add_argument("--out", required=True, help="output directory (new, empty, or written by slewbench)")
     codegen_parser.set_defaults(handler=command_codegen)
     list_parser = commands.add_parser("list", help="registered planners and controllers")
+    list_parser.add_argument("--options", metavar="NAME",
+                             help="the options of planner or controller NAME: type, unit, default and range")
     list_parser.set_defaults(handler=command_list)
     schema_parser = commands.add_parser("schema", help="every scenario and study key: type, unit, default, range, "
                                                        "meaning")

@@ -18,6 +18,7 @@ from scenarios.cli.status import EXIT_INTERRUPTED, EXIT_OK
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, read_manifest
 from scenarios.output.names import default_output_directory
+from scenarios.output.provenance import package_version
 from scenarios.study.engine import SweepResults, start_forkserver, sweep
 from scenarios.study.report import resolved_study
 from scenarios.study.spec import load_study, parse_study
@@ -29,7 +30,6 @@ from scenarios.study.store import (
     is_sweep_store,
     store_format,
 )
-from scenarios.study.types import package_version
 
 
 def _open_store(out: Path) -> SweepStore:

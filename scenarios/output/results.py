@@ -8,9 +8,14 @@ columns) is derived from :meth:`Row.to_dict` by :func:`scenarios.output.tables.f
 """
 from __future__ import annotations
 
+import datetime
+import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from scenarios.output.provenance import run_provenance
+from scenarios.output.tables import html_table, is_missing, status_line, text_cell
 
 if TYPE_CHECKING:
     import pandas
@@ -19,7 +24,20 @@ if TYPE_CHECKING:
     from planners import Reference
     from scenarios.schema.loader import Scenario
 
-__all__ = ["Row", "RunResults"]
+__all__ = ["HEADLINE_METRICS", "Row", "RunResults"]
+
+HEADLINE_METRICS = (("final_error_deg", "settling_time_s", "int_u", "peak_actuator_torque"),
+                    ("final_rate", "detumble_time_s", "int_u", "int_dipole"))
+"""The metrics a row's repr and a run's notebook table show (those with a value; closed loop, else
+the reference's): a slew's, or, when the row has no ``final_error_deg`` (a free final attitude,
+detumbling), a rate acquisition's. Units in :data:`ocp.metrics.METRIC_INFO`."""
+_MESSAGE_CHARS = 100
+"""Characters of a row's message in a repr."""
+
+
+def _short(message: str) -> str:
+    """A message on one line, cut to :data:`_MESSAGE_CHARS`."""
+    return textwrap.shorten(message, _MESSAGE_CHARS, placeholder=" ...")
 
 
 @dataclass
@@ -92,6 +110,29 @@ class Row:
                 "plan_time_s": self.plan_time_s, "reference": self.reference_metrics,
                 "closed_loop": self.closed_loop_metrics, "requirements": self.requirements}
 
+    def headline(self) -> dict[str, Any]:
+        """The row's key numbers: the :data:`HEADLINE_METRICS` it has a value for.
+
+        Returns
+        -------
+        dict
+            Metric key -> value (:data:`HEADLINE_METRICS`), from the closed loop when it was
+            simulated, else from the reference (empty for a failed row without either).
+        """
+        metrics = self.closed_loop_metrics or self.reference_metrics or {}
+        keys = HEADLINE_METRICS[0] if not is_missing(metrics.get("final_error_deg")) else HEADLINE_METRICS[1]
+        return {key: metrics[key] for key in keys if not is_missing(metrics.get(key))}
+
+    def __repr__(self) -> str:
+        pair = " / ".join(name for name in (self.planner or "regulation", self.controller) if name)
+        numbers = ", ".join(f"{key}={text_cell(value)}" for key, value in self.headline().items())
+        message = _short(self.message) if self.status != "ok" else ""
+        return (f"<Row {self.label!r}: {self.status} ({pair})" + (f"; {numbers}" if numbers else "")
+                + (f"; {message}" if message else "") + ">")
+
+    def _repr_html_(self) -> str:
+        return _rows_html([self], caption=f"Row {self.label}")
+
 
 @dataclass
 class RunResults:
@@ -105,10 +146,15 @@ class RunResults:
         The scenario that was run.
     rows : list of Row
         One per planner and controller pair (per controller in regulation mode).
+    finished : datetime.datetime, optional
+        When the run finished, UTC (default: when the results were made), recorded in
+        ``results.json``'s provenance.
     """
 
     scenario: Scenario
     rows: list[Row]
+    finished: datetime.datetime = field(default_factory=lambda: datetime.datetime.now(datetime.timezone.utc),
+                                        compare=False)
 
     def to_dict(self) -> dict[str, Any]:
         """The results as a plain dict.
@@ -116,14 +162,26 @@ class RunResults:
         Returns
         -------
         dict
-            ``{"scenario": name, "frame": ..., "epoch": ..., "rows": [Row.to_dict(), ...]}``: the
-            inertial frame the attitudes are in (``GCRF`` with an epoch, else ``inertial (no
-            epoch)``) and the epoch (UTC, ISO 8601 with ``Z``, or ``None``).
+            ``{"scenario": name, "frame": ..., "epoch": ..., "rows": [Row.to_dict(), ...],
+            "provenance": {...}}``: the inertial frame the attitudes are in (``GCRF`` with an
+            epoch, else ``inertial (no epoch)``), the epoch (UTC, ISO 8601 with ``Z``, or
+            ``None``) and what produced the results
+            (:func:`~scenarios.output.provenance.run_provenance`: versions, platform, date, seeds
+            and the scenario's YAML data).
         """
         epoch = self.scenario.epoch
         return {"scenario": self.scenario.name, "frame": self.scenario.frame,
                 "epoch": None if epoch is None else epoch.isoformat() + "Z",
-                "rows": [row.to_dict() for row in self.rows]}
+                "rows": [row.to_dict() for row in self.rows],
+                "provenance": run_provenance(self.scenario, self.finished)}
+
+    def __repr__(self) -> str:
+        lines = [f"<RunResults {self.scenario.name!r}: {status_line(self)}"]
+        lines += [f"  {row!r}" for row in self.rows]
+        return "\n".join(lines) + ">"
+
+    def _repr_html_(self) -> str:
+        return _rows_html(self.rows, caption=f"{self.scenario.name}: {status_line(self)}")
 
     def status_counts(self) -> dict[str, int]:
         """How many rows have each status, in rank order (``failed``, ``violated``, ``ok``, then any other).
@@ -170,15 +228,20 @@ class RunResults:
         from scenarios.output.tables import to_markdown
         return to_markdown(self)
 
-    def to_terminal(self) -> str:
+    def to_terminal(self, all_metrics: bool = False) -> str:
         """The summary table ``slewbench run`` prints.
+
+        Parameters
+        ----------
+        all_metrics : bool, optional
+            Also the metrics that have no value in any row (left out by default).
 
         Returns
         -------
         str
         """
         from scenarios.output.tables import to_terminal
-        return to_terminal(self)
+        return to_terminal(self, all_metrics=all_metrics)
 
     def to_dataframe(self) -> pandas.DataFrame:
         """The CSV table as a pandas DataFrame (needs pandas installed); numeric columns are float,
@@ -205,3 +268,14 @@ class RunResults:
         """
         from scenarios.output.writer import write_results
         write_results(self, directory, plots=plots, renderer=renderer)
+
+
+def _rows_html(rows: list[Row], caption: str) -> str:
+    """Rows as a small HTML table: label, planner, controller, status, planning time, the headline
+    metrics any row has, and the message cut short."""
+    headlines = [row.headline() for row in rows]
+    keys = list(dict.fromkeys(key for numbers in headlines for key in numbers))
+    columns = ["label", "planner", "controller", "status", "plan_time_s", *keys, "message"]
+    records = [[row.label, row.planner or "regulation", row.controller, row.status, row.plan_time_s,
+                *(numbers.get(key) for key in keys), _short(row.message)] for row, numbers in zip(rows, headlines)]
+    return html_table(columns, records, caption)

@@ -17,6 +17,7 @@ terminal ``-``.
 from __future__ import annotations
 
 import csv
+import html
 import io
 import json
 import math
@@ -252,8 +253,9 @@ def data_frame(columns: Sequence[str], records: Iterable[Mapping[str, Any]], num
 
 
 def to_json(results: RunResults) -> str:
-    """``results.json``: ``{"scenario": name, "rows": [Row.to_dict(), ...]}``, non-finite numbers
-    written as ``null``.
+    """``results.json``: :meth:`RunResults.to_dict <scenarios.output.results.RunResults.to_dict>`
+    (the scenario's name, frame and epoch, the rows and the provenance), non-finite numbers written
+    as ``null``.
 
     Parameters
     ----------
@@ -265,7 +267,7 @@ def to_json(results: RunResults) -> str:
     str
         Indented JSON text.
     """
-    return json.dumps(json_safe(results.to_dict()), indent=2, allow_nan=False)
+    return json.dumps(json_safe(results.to_dict()), indent=2, allow_nan=False, default=str)
 
 
 def to_csv(results: RunResults) -> str:
@@ -422,7 +424,13 @@ def to_markdown(results: RunResults) -> str:
     return "\n".join(out) + "\n"
 
 
-def to_terminal(results: RunResults) -> str:
+def _applies(cells: Sequence[str]) -> bool:
+    """Whether some cell of a terminal line holds a value (not only ``-``, as in ``-``,
+    ``[-, -, -]`` or ``- | -``)."""
+    return any(set(cell) - set("-|[], ") for cell in cells)
+
+
+def to_terminal(results: RunResults, all_metrics: bool = False) -> str:
     """A fixed-width table with metrics as lines and planners as columns, one line per requirement
     (its headline number, ``reference | closed loop``), then the messages and the rows by status.
 
@@ -430,6 +438,9 @@ def to_terminal(results: RunResults) -> str:
     ----------
     results : RunResults
         The rows of a scenario run.
+    all_metrics : bool, optional
+        Keep the lines that are ``-`` for every row (metrics that apply to no row); by default
+        they are left out and a closing line says how many.
 
     Returns
     -------
@@ -437,10 +448,39 @@ def to_terminal(results: RunResults) -> str:
         Plain text for a terminal.
     """
     lines = _metric_lines(results, requirements=False) + _requirement_lines(results)
+    hidden = [] if all_metrics else [name for name, cells in lines if not _applies(cells)]
+    lines = [(name, cells) for name, cells in lines if name not in hidden]
     labels = [row.label for row in results.rows]
     name_width = max(len(name) for name, _ in lines)
     widths = [max(len(label), *(len(cells[i]) for _, cells in lines)) for i, label in enumerate(labels)]
     header = " " * name_width + "  " + "  ".join(label.rjust(w) for label, w in zip(labels, widths))
     body = [name.ljust(name_width) + "  " + "  ".join(c.rjust(w) for c, w in zip(cells, widths)) for name, cells in lines]
     messages = [f"{row.label}: {row.message}" for row in results.rows if row.message]
-    return "\n".join([f"scenario: {results.scenario.name}", header, *body, "", *messages, "", status_line(results)])
+    note = [f"({len(hidden)} metrics with no value in any row not shown; --all-metrics shows them)"] if hidden else []
+    return "\n".join([f"scenario: {results.scenario.name}", header, *body, *note, "", *messages, "",
+                      status_line(results)])
+
+
+def html_table(columns: Sequence[str], records: Iterable[Sequence[Any]], caption: str = "") -> str:
+    """A small HTML table (for a notebook's ``_repr_html_``): a header and one line per record, cells
+    by :func:`text_cell`, every text escaped.
+
+    Parameters
+    ----------
+    columns : sequence of str
+        The header.
+    records : iterable of sequence
+        The lines, one value per column.
+    caption : str, optional
+        A caption above the table; empty: none.
+
+    Returns
+    -------
+    str
+        ``<table>...</table>``.
+    """
+    head = "".join(f"<th>{html.escape(column)}</th>" for column in columns)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(text_cell(value))}</td>" for value in record) + "</tr>"
+                   for record in records)
+    title = f"<caption>{html.escape(caption)}</caption>" if caption else ""
+    return f"<table>{title}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"

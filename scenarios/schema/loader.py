@@ -12,6 +12,7 @@ once, here: :class:`PlannerSpec` and :class:`ControllerSpec` carry the instances
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import datetime
 import math
@@ -194,6 +195,9 @@ class Scenario:
         requirements' constraints, tabulated for the run, are ``problem.pointing``.
     epoch : datetime.datetime or None, optional
         The instant of t = 0, UTC (``epoch``); ``None``: none.
+    data : dict or None, optional
+        A copy of the YAML data it was parsed from (recorded in ``results.json``); ``None`` for a
+        scenario built in code.
     """
 
     name: str
@@ -204,6 +208,7 @@ class Scenario:
     source: Path | None = None
     requirements: Requirements = field(default_factory=Requirements)
     epoch: datetime.datetime | None = None
+    data: dict[str, Any] | None = field(default=None, repr=False, compare=False)
 
     @property
     def frame(self) -> str:
@@ -327,8 +332,11 @@ SENSOR_NOISE = Section((
 
 SIMULATION = Section((
     number("sample_time", "Zero-order-hold sample time of the controller.", unit="s", default=1.0, positive=True),
-    number("duration", "Closed-loop window; ``null``: the larger of ``maneuver.duration`` and the reference's "
-           "duration.", unit="s", default=None, positive=True, nullable=True),
+    number("duration", "Closed-loop window of every row. ``null`` (the default): each row runs for "
+           "``maneuver.duration``, or for its reference's duration when that is longer (a minimum-time or "
+           "rate-limited planner's); a row without a planner for ``maneuver.duration``. After its duration a "
+           "reference continues as the torque-free motion of its final state.", unit="s", default=None,
+           positive=True, nullable=True),
     vector("initial_attitude_error_deg", "Rotation vector applied to the true initial attitude, body axes.", 3,
            unit="deg", default=[0.0, 0.0, 0.0]),
     vector("initial_rate_error", "Added to the true initial body rate, body frame.", 3, unit="rad/s",
@@ -499,7 +507,8 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     check_work(problem, simulation)
     check_row_labels(planners, controllers)
     check_compatibility(problem, planners, controllers, simulation)
-    return Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch)
+    return Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch,
+                    data=copy.deepcopy(data))
 
 
 def _with_requirements(problem: ManeuverProblem, requirements: Requirements,

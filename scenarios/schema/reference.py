@@ -55,7 +55,7 @@ from scenarios.schema.study import (
     VALUE_GENERATORS,
 )
 
-__all__ = ["Entry", "Part", "reference_parts", "schema_rst", "schema_text", "summary_line"]
+__all__ = ["Entry", "Part", "options_text", "reference_parts", "schema_rst", "schema_text", "summary_line"]
 
 
 @dataclass(frozen=True)
@@ -461,4 +461,56 @@ def schema_text(key: str | None = None) -> str:
         matches = _close_matches(wanted or "", parts)
         raise ScenarioError("", f"{excerpt(key)} is not a key of the scenario or study schema"  # quoted, bounded
                             + (f"; close matches: {', '.join(matches)}" if matches else ""))
+    return "\n".join(lines).rstrip() + "\n"
+
+
+_REGISTRY_PARTS: tuple[tuple[str, str, dict[str, Any]], ...] = (("planners.", "planner", PLANNERS),
+                                                                  ("controller.", "controller", CONTROLLERS))
+"""The reference parts of a registry entry's options: the key prefix, what the entry is, its registry."""
+
+
+def options_text(name: str) -> str:
+    """The options of a registered planner or controller as a table for a terminal (``slewbench
+    list --options NAME``), from the same entries as the schema reference.
+
+    Parameters
+    ----------
+    name : str
+        A registry name of :data:`planners.PLANNERS` or :data:`controllers.CONTROLLERS` (both
+        are listed if it names one of each).
+
+    Returns
+    -------
+    str
+        Per registry entry: a heading (its name, kind and summary), one line per option (name,
+        type, unit, default, range or choices), and where the options are explained.
+
+    Raises
+    ------
+    ScenarioError
+        ``name`` is neither a planner nor a controller; the message lists close matches.
+    """
+    parts = {part.key: part for part in reference_parts()}
+    lines: list[str] = []
+    for prefix, kind, registry in _REGISTRY_PARTS:
+        part = parts.get(prefix + name)
+        if part is None:
+            continue
+        lines += [f"{name} ({kind}): {_plain(summary_line(registry[name]))}"]
+        if not part.entries:
+            lines += ["  no options", ""]
+            continue
+        table = [("option", "type", "unit", "default", "range")]
+        table += [(entry.key.rsplit(".", 1)[-1], entry.type, entry.unit or "-", _plain(entry.default) or "-",
+                   _plain(entry.bounds) or "-") for entry in part.entries]
+        widths = [max(len(line[i]) for line in table) for i in range(4)]
+        lines += ["  " + "  ".join(cell.ljust(width) for cell, width in zip(line, widths)) + "  " + line[4]
+                  for line in table]
+        lines += [f"(meanings: slewbench schema {part.key})", ""]
+    if not lines:
+        names = sorted({entry for _, _, registry in _REGISTRY_PARTS for entry in registry})
+        close = difflib.get_close_matches(name, names, n=5, cutoff=0.5)
+        raise ScenarioError("", f"{excerpt(name)} is neither a registered planner nor controller"
+                            + (f"; close matches: {', '.join(close)}" if close else
+                               "; `slewbench list` shows them"))
     return "\n".join(lines).rstrip() + "\n"

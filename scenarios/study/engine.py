@@ -116,6 +116,14 @@ class SweepResults:
         from scenarios.study.report import write_report
         return write_report(self, Path(directory), plots=plots)
 
+    def __repr__(self) -> str:
+        from scenarios.study.types import sweep_repr
+        return sweep_repr(self.study, self.records)
+
+    def _repr_html_(self) -> str:
+        from scenarios.study.types import sweep_repr_html
+        return sweep_repr_html(self.study, self.records)
+
 
 def start_forkserver() -> multiprocessing.context.BaseContext:
     """Start (once per process) the server that local workers fork from, importing :data:`PRELOAD`.

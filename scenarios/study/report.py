@@ -21,6 +21,7 @@ import yaml
 from scenarios.output.directory import (
     new_staging,
 )
+from scenarios.output.provenance import environment, package_version, utc_stamp
 from scenarios.output.tables import (
     csv_text,
     flatten_row,
@@ -30,7 +31,7 @@ from scenarios.output.tables import (
     text_cell,
 )
 from scenarios.study.store import claim_sweep_directory, commit_sweep_outputs
-from scenarios.study.types import Study, package_version
+from scenarios.study.types import Study
 
 if TYPE_CHECKING:  # the engine imports this module lazily
     from scenarios.study.engine import SweepResults
@@ -226,13 +227,16 @@ def resolved_study(study: Study) -> dict[str, Any]:
     Returns
     -------
     dict
-        The study mapping with its base scenario inlined and a ``resolved`` entry: the version,
-        the number of cases and every case's seed.
+        The study mapping with its base scenario inlined and a ``resolved`` entry: slewbench's
+        version, the date (UTC), Python, the platform and the numerical libraries
+        (:func:`~scenarios.output.provenance.environment`), the number of cases and every case's
+        seed.
     """
     data = dict(study.raw)
     data["scenario"] = study.base
-    data["resolved"] = {"version": package_version(), "cases": len(study.cases),
-                        "case_seeds": [case.seed for case in study.cases]}
+    run_environment = environment()
+    data["resolved"] = {"version": run_environment.pop("slewbench"), "date_utc": utc_stamp(), **run_environment,
+                        "cases": len(study.cases), "case_seeds": [case.seed for case in study.cases]}
     return data
 
 

@@ -20,13 +20,14 @@ from typing import Any
 import numpy as np
 
 from scenarios.errors import ScenarioError
+from scenarios.output.provenance import package_version
 from scenarios.schema.loader import parse_scenario
 from scenarios.schema.node import Node
 from scenarios.schema.read import read_yaml
 from scenarios.schema.study import MAX_CASES, STUDY, grid_values
 from scenarios.study.dispersions import Dispersion, draw_unit, parse_dispersion
 from scenarios.study.paths import Step, get_path, parse_path, set_path
-from scenarios.study.types import Case, Execution, Study, case_key, package_version
+from scenarios.study.types import Case, Execution, Study, case_key
 
 
 def _tree_copy(value: Any) -> Any:

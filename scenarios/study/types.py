@@ -1,17 +1,19 @@
 """The data of a trade study (:doc:`/reference/schema`): how its cases run
 (:class:`Execution`), one resolved case (:class:`Case`), the expanded study (:class:`Study`), and
-the store key of a case (:func:`case_key`, with :func:`package_version`). :mod:`scenarios.study.spec`
-builds them from a study file.
+the store key of a case (:func:`case_key`), and the short forms a notebook shows of a study and its
+results (:func:`sweep_repr`, :func:`sweep_repr_html`). :mod:`scenarios.study.spec` builds them from a
+study file.
 """
 from __future__ import annotations
 
+import collections
 import hashlib
 import json
-import re
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+from scenarios.output.tables import html_table
 
 
 @dataclass
@@ -115,27 +117,10 @@ class Study:
         """Every varied scenario path: the grid's and zip's, then the Monte Carlo dispersions'."""
         return self.grid_paths + self.mc_paths
 
-
-def package_version() -> str:
-    """slewbench's version: the installed distribution's, else pyproject.toml's.
-
-    Returns
-    -------
-    str
-        The version, for example ``0.1.0``.
-    """
-    from importlib.metadata import PackageNotFoundError, version
-    try:
-        return version("slewbench")
-    except PackageNotFoundError:  # not installed: running from a checkout
-        text = (Path(__file__).resolve().parents[2] / "pyproject.toml").read_text()
-        if sys.version_info >= (3, 11):
-            import tomllib
-            return str(tomllib.loads(text)["project"]["version"])
-        found = re.search(r'^version\s*=\s*"([^"]+)"', text, re.MULTILINE)  # Python 3.10: no tomllib
-        if found is None:
-            raise RuntimeError("no project version in pyproject.toml") from None
-        return found.group(1)
+    def __repr__(self) -> str:
+        varied = ", ".join(self.varied_paths) or "nothing"
+        return (f"<Study {self.name!r}: {len(self.cases)} cases, {self.samples} sample(s) per grid point; "
+                f"varies {varied}>")
 
 
 def case_key(scenario: dict[str, Any], version: str) -> str:
@@ -146,7 +131,7 @@ def case_key(scenario: dict[str, Any], version: str) -> str:
     scenario : dict
         The resolved scenario mapping (plain YAML data).
     version : str
-        slewbench's version (:func:`package_version`).
+        slewbench's version (:func:`scenarios.output.provenance.package_version`).
 
     Returns
     -------
@@ -155,3 +140,68 @@ def case_key(scenario: dict[str, Any], version: str) -> str:
     """
     text = json.dumps({"scenario": scenario, "version": version}, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:32]
+
+
+def _status_counts(study: Study, records: dict[str, dict[str, Any]]) -> dict[str, collections.Counter[str]]:
+    """Row label -> how many of its rows have each status, over the stored cases of the study."""
+    counts: dict[str, collections.Counter[str]] = {}
+    for case in study.cases:
+        for row in (records.get(case.key) or {}).get("rows", []):
+            counts.setdefault(str(row.get("label")), collections.Counter())[str(row.get("status"))] += 1
+    return counts
+
+
+_STATUS_ORDER = ("ok", "violated", "failed", "crashed")
+"""The statuses of a row in the order a study's summary lists them."""
+
+
+def _headline(study: Study, records: dict[str, dict[str, Any]]) -> str:
+    missing = sum(case.key not in records for case in study.cases)
+    crashed = sum((records.get(case.key) or {}).get("status") == "crashed" for case in study.cases)
+    return (f"{study.name!r}: {len(study.cases)} cases ({missing} missing"
+            + (f", {crashed} crashed" if crashed else "") + ")")
+
+
+def sweep_repr(study: Study, records: dict[str, dict[str, Any]]) -> str:
+    """The repr of a study's results: the cases, then each row label's rows by status.
+
+    Parameters
+    ----------
+    study : Study
+        The expanded study.
+    records : dict
+        Case key -> stored record (``status``, ``rows`` as :meth:`scenarios.output.results.Row.to_dict`).
+
+    Returns
+    -------
+    str
+        ``<SweepResults 'name': 12 cases (0 missing)`` and one line per row label, such as
+        ``  smooth: 10 ok, 2 violated``.
+    """
+    lines = [f"<SweepResults {_headline(study, records)}"]
+    for label, counts in _status_counts(study, records).items():
+        statuses = [status for status in _STATUS_ORDER if counts[status]] + sorted(set(counts) - set(_STATUS_ORDER))
+        lines.append(f"  {label}: " + ", ".join(f"{counts[status]} {status}" for status in statuses))
+    return "\n".join(lines) + ">"
+
+
+def sweep_repr_html(study: Study, records: dict[str, dict[str, Any]]) -> str:
+    """The notebook table of a study's results: one line per row label, its rows by status.
+
+    Parameters
+    ----------
+    study : Study
+        The expanded study.
+    records : dict
+        Case key -> stored record, as :func:`sweep_repr`.
+
+    Returns
+    -------
+    str
+        An HTML table (label, rows, then one column per status) captioned with the case count.
+    """
+    counts = _status_counts(study, records)
+    statuses = [status for status in _STATUS_ORDER if any(c[status] for c in counts.values())]
+    statuses += sorted({status for c in counts.values() for status in c} - set(_STATUS_ORDER))
+    records_table = [[label, sum(c.values()), *(c[status] for status in statuses)] for label, c in counts.items()]
+    return html_table(["label", "rows", *statuses], records_table, caption=_headline(study, records))

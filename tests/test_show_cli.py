@@ -1,0 +1,205 @@
+"""The command line that explains itself (issue 31, item 5): ``--version``, ``list --options``,
+``validate`` of study files, the compact terminal table and the files a run removes.
+
+Oracles: the package metadata (or pyproject.toml for a checkout), the Options dataclasses'
+``Annotated[..., Range(...)]`` declarations read with ``typing``, case counts worked by hand from the
+shipped study files, rows whose missing metrics are chosen by hand, and the directory's listing.
+"""
+from __future__ import annotations
+
+import dataclasses
+import importlib.metadata
+import math
+import re
+import sys
+import typing
+from pathlib import Path
+
+import pytest
+import yaml
+
+import scenarios
+from ocp.options import Range
+from planners import PLANNERS
+from scenarios.cli.commands import main
+from scenarios.output import provenance
+from scenarios.output.results import Row, RunResults
+from scenarios.schema.columns import SCOPES, SCORED_METRICS, VECTOR_METRICS
+
+ROOT = Path(__file__).resolve().parents[1]
+DEMO = ROOT / "scenarios" / "eigenaxis_demo.yaml"
+STUDY_CASES = {"study_planners_vs_slew_angle.yaml": 7,  # seven angle_deg values of one axis_angle grid entry
+               "study_spin_monte_carlo.yaml": 1000,  # one point, monte_carlo.samples: 1000
+               "study_spin_weight_sample_time.yaml": 20}  # 5 weights x 4 sample times
+"""Cases of each shipped study, counted by hand from its file."""
+
+
+def source_version() -> str:
+    try:
+        return importlib.metadata.version("slewbench")
+    except importlib.metadata.PackageNotFoundError:
+        text = (ROOT / "pyproject.toml").read_text()
+        return re.search(r'^version\s*=\s*"([^"]+)"', text, re.MULTILINE).group(1)
+
+
+# --- --version ------------------------------------------------------------------------------------------
+
+def test_version_is_the_package_metadata(capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["--version"])
+    assert stop.value.code == 0
+    assert capsys.readouterr().out.strip() == f"slewbench {source_version()}"
+
+
+def test_version_prefers_the_installed_metadata_and_falls_back_to_the_source(monkeypatch, capsys):
+    monkeypatch.setattr(provenance, "version", lambda name: {"slewbench": "9.8.7"}[name])
+    with pytest.raises(SystemExit):
+        main(["--version"])
+    assert capsys.readouterr().out.strip() == "slewbench 9.8.7"
+
+    def missing(name):
+        raise importlib.metadata.PackageNotFoundError(name)
+
+    monkeypatch.setattr(provenance, "version", missing)
+    text = (ROOT / "pyproject.toml").read_text()
+    assert provenance.package_version() == re.search(r'^version\s*=\s*"([^"]+)"', text, re.MULTILINE).group(1)
+
+
+# --- list --options -------------------------------------------------------------------------------------
+
+def declared(options: type, name: str) -> tuple[Range, typing.Any]:
+    """The Range and default an Options dataclass declares for a field."""
+    hints = typing.get_type_hints(options, include_extras=True)
+    (bounds,) = [item for item in typing.get_args(hints[name])[1:] if isinstance(item, Range)]
+    (field,) = [field for field in dataclasses.fields(options) if field.name == name]
+    return bounds, field.default
+
+
+def test_list_options_of_collocation_gives_each_option_with_its_range(capsys):
+    assert main(["list", "--options", "collocation"]) == 0
+    out = capsys.readouterr().out
+    lines = {line.split()[0]: line for line in out.splitlines()[2:] if line.startswith("  ")}
+    options = PLANNERS["collocation"].Options
+    assert set(lines) == {field.name for field in dataclasses.fields(options)}
+    bounds, default = declared(options, "intervals")
+    line = lines["intervals"].split()
+    assert line[1] == "integer" and line[2] == "-" and line[3] == str(default)
+    assert f">= {bounds.ge:g} and <= {bounds.le:g}" in lines["intervals"]
+    bounds, default = declared(options, "cone_margin_deg")
+    assert lines["cone_margin_deg"].split()[2] == "deg" and f"< {bounds.lt:g}" in lines["cone_margin_deg"]
+    assert out.splitlines()[0].startswith("collocation (planner): ")
+    assert "slewbench schema planners.collocation" in out
+
+
+def test_list_options_of_a_controller_and_of_an_unknown_name(capsys):
+    assert main(["list", "--options", "eigenaxis_pd"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("eigenaxis_pd (controller): ") and "\n  kp " in out
+    assert main(["list", "--options", "colocation"]) == 2
+    error = capsys.readouterr().err
+    assert "'colocation' is neither a registered planner nor controller" in error and "collocation" in error
+
+
+def test_list_names_the_options_flag(capsys):
+    assert main(["list"]) == 0
+    assert "list --options NAME" in capsys.readouterr().out
+
+
+# --- validate ------------------------------------------------------------------------------------------
+
+def test_every_shipped_study_is_counted_by_hand():
+    assert {path.name for path in (ROOT / "scenarios").glob("study_*.yaml")} == set(STUDY_CASES)
+
+
+@pytest.mark.parametrize("name", sorted(STUDY_CASES))
+def test_validate_a_shipped_study_prints_its_case_count(name, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert main(["validate", f"scenarios/{name}"]) == 0
+    out = capsys.readouterr().out
+    study = yaml.safe_load((ROOT / "scenarios" / name).read_text())["study"]
+    assert out.startswith(f"scenarios/{name}: valid study {study!r}: {STUDY_CASES[name]} cases (")
+    assert f"slewbench sweep scenarios/{name}" in out
+
+
+def test_validate_a_broken_study_exits_2_naming_the_path(tmp_path, capsys):
+    data = yaml.safe_load((ROOT / "scenarios" / "study_spin_weight_sample_time.yaml").read_text())
+    data["grid"]["simulation.sample_time"] = [0.5, "fast"]
+    path = tmp_path / "broken.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["validate", str(path)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and str(path) in captured.err and "simulation.sample_time" in captured.err
+    assert "'fast'" in captured.err
+
+
+def test_validate_a_scenario_names_its_rows(capsys):
+    assert main(["validate", str(DEMO)]) == 0
+    out = capsys.readouterr().out
+    assert "valid scenario 'eigenaxis-demo'" in out and "3 row(s) (smooth, bang-coast-bang, min-time)" in out
+
+
+# --- the compact table ------------------------------------------------------------------------------
+
+def none_metrics() -> dict:
+    return {key: ([None] * 3 if key in VECTOR_METRICS else None) for key in SCORED_METRICS}
+
+
+def test_the_compact_table_hides_exactly_the_lines_without_a_value():
+    scenario = scenarios.load(DEMO)
+    first_ref, first_cl, second_ref, second_cl = none_metrics(), none_metrics(), none_metrics(), none_metrics()
+    first_ref["int_u"] = 1.0
+    second_ref["int_u"] = math.nan  # missing too
+    second_ref["energy_ratio"] = 2.0
+    first_cl["final_error_deg"] = 0.5
+    second_cl["int_abs_u"] = [0.1, None, None]  # one component: the line applies
+    second_cl["final_rate"] = math.inf  # non-finite: missing
+    rows = [Row("one", "eigenaxis", "ok", "", 0.1, first_ref, first_cl, controller="pd"),
+            Row("two", "eigenaxis", "violated", "why", None, second_ref, second_cl, controller="pd",
+                requirements={"reference": {"cone": {"min_margin_deg": None}},
+                              "closed_loop": {"cone": {"min_margin_deg": None}}})]
+    results = RunResults(scenario, rows)
+    full, compact = results.to_terminal(all_metrics=True), results.to_terminal()
+    everything = ["status", "plan_time_s"] + [f"{prefix}.{key}" for _, prefix in SCOPES for key in SCORED_METRICS]
+    shown = {"status", "plan_time_s", "ref.int_u", "ref.energy_ratio", "cl.final_error_deg", "cl.int_abs_u"}
+
+    def names(text):
+        return [line.split()[0] for line in text.splitlines()[2:] if line and not line.startswith(("(", " "))]
+
+    assert names(full)[:len(everything)] == everything and "req.cone" in names(full)
+    assert set(names(compact)) - {"one:", "two:", "rows:"} == shown
+    hidden = len(everything) + 1 - len(shown)  # every metric line and the requirement's, less those shown
+    assert f"({hidden} metrics with no value in any row not shown; --all-metrics shows them)" in compact
+    assert "not shown" not in full
+
+
+def test_run_prints_the_compact_table_unless_all_metrics(tmp_path, capsys):
+    assert main(["run", str(DEMO), "--out", str(tmp_path / "a"), "--no-plots"]) == 0
+    compact = capsys.readouterr().out
+    assert main(["run", str(DEMO), "--out", str(tmp_path / "b"), "--no-plots", "--all-metrics"]) == 0
+    full = capsys.readouterr().out
+    assert "ref.int_dipole" in full and "ref.int_dipole" not in compact  # no magnetorquers: never a value
+    assert "cl.final_error_deg" in compact and "--all-metrics shows them" in compact
+
+
+# --- removed files ------------------------------------------------------------------------------------
+
+def test_a_run_names_the_files_it_removed(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["run", str(DEMO), "--out", str(out)]) == 0
+    pictures = sorted(path.name for path in out.glob("*.png"))
+    assert len(pictures) == 4  # one per row and the comparison
+    capsys.readouterr()
+    assert main(["run", str(DEMO), "--out", str(out), "--no-plots"]) == 0
+    said = [line for line in capsys.readouterr().out.splitlines() if line.startswith("removed")]
+    assert said == [f"removed {len(pictures)} file(s) of the earlier run in {out}/ that this run did not write: "
+                    + ", ".join(pictures)]
+    assert not list(out.glob("*.png"))
+    assert main(["run", str(DEMO), "--out", str(out), "--no-plots"]) == 0
+    assert "removed" not in capsys.readouterr().out  # nothing removed, nothing said
+
+
+def test_console_script_version(tmp_path):
+    import subprocess
+    completed = subprocess.run([sys.executable, "-m", "scenarios.console", "--version"], capture_output=True,
+                               text=True, timeout=120, cwd=ROOT)
+    assert completed.returncode == 0 and completed.stdout.strip() == f"slewbench {source_version()}"
