@@ -14,8 +14,8 @@ Content, without a browser (oracles independent of the page's code):
 * the page is self-contained (no script or link loaded from elsewhere, one plotly.js);
 * ``report.html`` follows the output directory's ownership rules (manifest, a user's file).
 
-In a real headless browser (Debian's Chromium driven by Selenium; skipped with the reason when the
-browser, its driver or Selenium is missing; ``.ci/run`` installs them): the page loads with no error
+In a real headless browser (Debian's Chromium driven by Selenium, ``tests/browser.py``; skipped with
+the reason when the browser, its driver or Selenium is missing; ``.ci/run`` installs them): the page loads with no error
 in the browser's console, every figure is drawn (SVG or canvas), the tables sort on a header click
 (the order read back from the page), the study's paged table sorts over all its rows and filters,
 and a screenshot is a real picture.
@@ -25,8 +25,6 @@ from __future__ import annotations
 import csv
 import json
 import re
-import shutil
-import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -41,9 +39,7 @@ from scenarios.output.directory import MARKER, read_manifest
 from scenarios.output.report.run import run_report
 from scenarios.output.writer import write_results
 from scenarios.study.engine import sweep
-
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMEDRIVER = Path("/usr/bin/chromedriver")
+from tests.browser import chromium, errors_in, needs_browser, open_page
 KEEP_OUT = np.array([-1.0, 1.0, 0.0]) / np.sqrt(2.0)
 """The camera's keep-out direction: where its boresight (body y) points half-way through the slew."""
 CONE_DEG = 20.0
@@ -307,60 +303,23 @@ def test_the_study_cases_table_equals_cases_csv(study_out):
     assert [[str(v) if not isinstance(v, float) else v for v in row] for row in shown["rows"]] == [
         [float(line[k]) if k.startswith(("fraction", "wilson")) else line[k] for k in keys] for line in requirements]
     assert {f"histogram-{k}" for k in range(2)} == set(data["figures"])
+    # each row label's histogram counts its cases, over bins spanning its values
+    for k, column in enumerate(STUDY["summary"]):
+        for trace in data["figures"][f"histogram-{k}"]["data"]:
+            label = trace["name"].rsplit(" (", 1)[0]
+            mine = [float(line[column]) for line in lines if line["label"] == label and line[column] != ""]
+            assert sum(trace["y"]) == len(mine) == 60 and trace["y"][0] == trace["y"][-1] == 0
+            assert trace["x"][0] == pytest.approx(min(mine), rel=1e-6) and trace["x"][-1] == pytest.approx(max(mine), rel=1e-6)
     assert data["explorers"]["explorer"]["x"] == "simulation.initial_attitude_error_deg[0]"
 
 
 # ---------------------------------------------------------------- in a browser
 
 
-def browser_missing() -> str | None:
-    """Why the browser tests cannot run here, or None."""
-    try:
-        import selenium  # noqa: F401
-    except ImportError:
-        return "selenium is not installed (pip install selenium)"
-    for path, package in ((CHROMIUM, "chromium"), (CHROMEDRIVER, "chromium-driver")):
-        if not path.exists():
-            return f"{path} is missing (apt-get install chromium chromium-driver; {package})"
-    return None
-
-
-needs_browser = pytest.mark.skipif(browser_missing() is not None, reason=str(browser_missing()))
-
-
 @pytest.fixture(scope="module")
 def browser():
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-
-    profile = tempfile.mkdtemp(prefix="slewbench-chromium-")
-    options = webdriver.ChromeOptions()
-    options.binary_location = str(CHROMIUM)
-    for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-                 "--disable-component-update", "--no-first-run", "--disable-sync", "--window-size=1400,1000",
-                 f"--user-data-dir={profile}"):
-        options.add_argument(flag)
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    driver = webdriver.Chrome(service=Service(str(CHROMEDRIVER)), options=options)
-    try:
+    with chromium() as driver:
         yield driver
-    finally:
-        driver.quit()
-        shutil.rmtree(profile, ignore_errors=True)
-
-
-def open_page(driver, path: Path, timeout: float = 60.0) -> list[dict]:
-    """Load a page, wait until every figure is drawn, and return the console's messages."""
-    driver.get(path.as_uri())
-    deadline = time.monotonic() + timeout
-    while not driver.execute_script("return !!(window.slewbench && window.slewbench.drawn)"):
-        assert time.monotonic() < deadline, "the figures were not drawn in time"
-        time.sleep(0.1)
-    return driver.get_log("browser")
-
-
-def errors_in(log: list[dict]) -> list[dict]:
-    return [entry for entry in log if entry["level"] == "SEVERE"]
 
 
 def column_order(driver, table: str, column: str) -> list:

@@ -5,12 +5,13 @@ tables' values exactly as in the CSV files, opening offline. In order:
 
 * the fraction of cases meeting every requirement per planner (``requirements.csv``);
 * the summary statistics (``summary.csv``), with each metric's unit;
-* one step histogram per summary metric, the planner rows overlaid, on a logarithmic axis when the
-  values are positive and span more than :data:`LOG_SPAN` (bins shared by the rows);
+* one step histogram per summary metric, the planner rows overlaid, each on its own bins, on a
+  logarithmic axis when the values are positive and span more than :data:`LOG_SPAN`;
 * a scatter of any two numeric columns of the cases, chosen by the reader (a dispersed vector
   gives one choice per component), coloured by row label;
-* the cases (``cases.csv``), :data:`PAGE_SIZE` rows at a time, with a filter; columns without a
-  value in any row are left out.
+* the cases (``cases.csv``), :data:`PAGE_SIZE` rows at a time, with a filter: the case, its row
+  label and status, the summary metrics and the varied values first, then the other columns;
+  columns without a value in any row are left out.
 """
 from __future__ import annotations
 
@@ -88,8 +89,18 @@ def _values(rows: list[dict[str, Any]], column: str, label: str) -> np.ndarray:
                      and not isinstance(row.get(column), bool) and not is_missing(row.get(column))], dtype=float)
 
 
+def _edges(values: np.ndarray, log: bool) -> np.ndarray:
+    """:data:`BINS` bins over the values' range (log-spaced on a logarithmic axis; a range of one
+    value widened by 0.1 % about it)."""
+    low, high = float(values.min()), float(values.max())
+    if high - low <= 1e-12 * max(abs(low), abs(high), 1e-300):
+        half = max(abs(low) * 1e-3, 1e-12)
+        low, high = (low / 1.001, high * 1.001) if log else (low - half, high + half)
+    return np.geomspace(low, high, BINS + 1) if log else np.linspace(low, high, BINS + 1)
+
+
 def histogram_figure(column: str, rows: list[dict[str, Any]], labels: list[str]) -> dict[str, Any]:
-    """A step histogram of one metric column, one curve per row label, on shared bins.
+    """A step histogram of one metric column, one curve per row label on its own bins.
 
     Parameters
     ----------
@@ -103,28 +114,24 @@ def histogram_figure(column: str, rows: list[dict[str, Any]], labels: list[str])
     Returns
     -------
     dict
-        A plotly figure: counts of cases per bin (:data:`BINS` bins over all labels' values,
-        log-spaced when they are positive and span more than :data:`LOG_SPAN`).
+        A plotly figure: per label, the count of its cases in each of :data:`BINS` bins over its
+        own range (so that rows whose values lie decades apart are each resolved), drawn as a
+        closed step curve; the axis is logarithmic, and the bins log-spaced, when every value is
+        positive and they span more than :data:`LOG_SPAN`.
     """
     values = {label: _values(rows, column, label) for label in labels}
-    everything = np.concatenate([v for v in values.values()]) if values else np.zeros(0)
+    present = [v for v in values.values() if v.size]
+    everything = np.concatenate(present) if present else np.zeros(0)
     unit = column_unit(column)
     log = bool(everything.size) and everything.min() > 0 and everything.max() > LOG_SPAN * everything.min()
-    if not everything.size:
-        edges = np.array([0.0, 1.0])
-    elif log:
-        edges = np.geomspace(everything.min(), everything.max(), BINS + 1)
-    else:
-        low, high = float(everything.min()), float(everything.max())
-        if high - low <= 1e-12 * max(abs(low), abs(high), 1e-300):
-            half = max(abs(low) * 1e-3, 1e-12)
-            low, high = low - half, high + half
-        edges = np.linspace(low, high, BINS + 1)
     data = []
     for k, label in enumerate(labels):
-        counts, _ = np.histogram(np.clip(values[label], edges[0], edges[-1]), bins=edges)
-        data.append({"type": "scatter", "mode": "lines", "name": f"{label} ({values[label].size})",
-                     "x": edges, "y": np.append(counts, counts[-1]).astype(float),
+        if not values[label].size:
+            continue
+        edges = _edges(values[label], log)
+        counts, _ = np.histogram(values[label], bins=edges)
+        data.append({"type": "scatter", "mode": "lines", "name": f"{label} ({values[label].size} cases)",
+                     "x": np.concatenate([edges[:1], edges]), "y": np.concatenate([[0], counts, [0]]).astype(float),
                      "line": {"shape": "hv", "color": _COLOURS[k % len(_COLOURS)], "width": 1.8},
                      "fill": "tozeroy", "opacity": 0.6,
                      "hovertemplate": f"from %{{x:.4g}} {unit}: %{{y}} cases<extra>{label}</extra>"})
@@ -133,7 +140,7 @@ def histogram_figure(column: str, rows: list[dict[str, Any]], labels: list[str])
               "margin": {"l": 60, "r": 20, "t": 45, "b": 45}, "hovermode": "closest",
               "legend": {"orientation": "h", "y": -0.25},
               "xaxis": {"title": {"text": title}, "type": "log" if log else "linear", "exponentformat": "power"},
-              "yaxis": {"title": {"text": "cases"}, "rangemode": "tozero"}}
+              "yaxis": {"title": {"text": f"cases per bin ({BINS} bins per row)"}, "rangemode": "tozero"}}
     return {"data": data, "layout": layout}
 
 
@@ -183,7 +190,9 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
         page.section("Distributions", "Cases per bin of each summary metric, one curve per planner row.")
         for k, column in enumerate(study.summary):
             page.figure(f"histogram-{k}", histogram_figure(column, rows, labels))
-    shown = [name for name in names if name in IDENTITY_COLUMNS or name in ("case", "seed")
+    first_columns = ["case", "label", "status", *study.summary, *varied]
+    ordered = [name for name in first_columns if name in names] + [name for name in names if name not in first_columns]
+    shown = [name for name in ordered if name in IDENTITY_COLUMNS or name in ("case", "seed")
              or any(not is_missing(row.get(name)) for row in rows)]
     if rows:
         first = next((path for path in varied if any(isinstance(row.get(path), float) for row in rows)), None)

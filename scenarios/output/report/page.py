@@ -7,9 +7,9 @@ columns of a table chosen by the reader), and renders one HTML file:
 
 * plotly.js is inlined once per page (the copy shipped with the ``plotly`` package), so the page
   opens without a network and loads nothing from elsewhere;
-* the tables' and figures' data are one JSON document in the page (``<script type=
-  "application/json" id="slewbench-data">``): table values exactly as computed (non-finite numbers
-  ``null``), figure arrays rounded to :data:`FIGURE_DIGITS` significant digits;
+* the tables' and figures' data are one JSON document in the page (the script element of id
+  ``slewbench-data``): table values exactly as computed (non-finite numbers ``null``), figure
+  arrays rounded to :data:`FIGURE_DIGITS` significant digits;
 * a small script (:data:`SCRIPT`) draws the tables and figures when the page loads.
 
 Units: whatever the caller gives; :func:`column_unit` gives those of a run's and a study's result
