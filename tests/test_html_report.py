@@ -23,6 +23,7 @@ and a screenshot is a real picture.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import re
 import time
@@ -36,6 +37,7 @@ import scenarios
 from ocp import quat
 from scenarios.errors import OutputError
 from scenarios.output.directory import MARKER, read_manifest
+from scenarios.output.report.figures import margin_figure
 from scenarios.output.report.run import run_report
 from scenarios.output.writer import write_results
 from scenarios.study.engine import sweep
@@ -182,6 +184,17 @@ def test_margin_trace_equals_the_margin_of_the_simulated_attitude(run_results, r
     assert len(reference) == 2
     zero = [trace for trace in figure["data"] if trace.get("name", "").startswith("zero")]
     assert zero and set(zero[0]["y"]) == {0.0}
+
+
+def test_a_margin_outside_its_window_is_not_drawn(run_results):
+    """A requirement that applies from 10 s to 40 s: no point of its margin outside, a break at each end."""
+    windowed = dataclasses.replace(run_results.scenario.problem.pointing[0], window=(10.0, 40.0))
+    figure = json.loads(json.dumps(margin_figure(windowed, run_results.rows), default=lambda a: a.tolist()))
+    trace = next(trace for trace in figure["data"] if trace.get("name") == run_results.rows[0].label)
+    x, y = trace_x(trace), trace_y(trace)
+    drawn = np.isfinite(y)
+    assert 10.0 - 1e-9 <= x[drawn].min() < 10.1 and 39.9 < x[drawn].max() <= 40.0 + 1e-9
+    assert np.all(np.isnan(y[~drawn]) | ~np.isfinite(x[~drawn]))  # outside: gaps only
 
 
 def test_time_series_are_decimated_and_keep_their_extremes(run_results, run_html):

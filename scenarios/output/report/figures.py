@@ -79,8 +79,9 @@ def _gapped(t: np.ndarray, index: np.ndarray, values: np.ndarray) -> tuple[np.nd
     """``t[index]``, ``values[index]`` with a gap (NaN, drawn as a break) where ``index`` skips a
     non-finite sample."""
     x, y = t[index].astype(float), values[index].astype(float)
-    holes = np.array([h + 1 for h in np.flatnonzero(np.diff(index) > 1)
-                      if not np.all(np.isfinite(values[index[h]:index[h + 1] + 1]))], dtype=int)
+    bad = np.concatenate([[0], np.cumsum(~np.isfinite(values))])  # non-finite samples before each index
+    skipped = bad[index[1:]] - bad[index[:-1] + 1] if index.size > 1 else np.zeros(0, dtype=int)
+    holes = np.flatnonzero(skipped > 0) + 1
     return np.insert(x, holes, np.nan), np.insert(y, holes, np.nan)
 
 
