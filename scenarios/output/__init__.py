@@ -6,8 +6,9 @@ labels (:mod:`~scenarios.output.names`), the table forms of rows (flattened by t
 (:mod:`~scenarios.output.tables`), output directories, their
 manifest and staged commits (:mod:`~scenarios.output.directory`), writing a run's files into one
 (:mod:`~scenarios.output.writer`), the figures' data as arrays
-(:mod:`~scenarios.output.plot_data`), the matplotlib drawing (:mod:`~scenarios.output.plots`) and
-the plot process that draws while the run goes on (:mod:`~scenarios.output.renderer`).
+(:mod:`~scenarios.output.plot_data`), the matplotlib drawing (:mod:`~scenarios.output.plots`),
+the plot process that draws while the run goes on (:mod:`~scenarios.output.renderer`) and the
+interactive ``report.html`` (:mod:`scenarios.output.report`).
 
 May import: :mod:`ocp`, :mod:`planners` (types), :mod:`scenarios.errors` and
 :mod:`scenarios.schema`. :mod:`~scenarios.output.plots` and :mod:`~scenarios.output.renderer` import
