@@ -6,9 +6,10 @@ labels (:mod:`~scenarios.output.names`), the table forms of rows (flattened by t
 (:mod:`~scenarios.output.tables`), output directories, their
 manifest and staged commits (:mod:`~scenarios.output.directory`), writing a run's files into one
 (:mod:`~scenarios.output.writer`), the figures' data as arrays
-(:mod:`~scenarios.output.plot_data`), the matplotlib drawing (:mod:`~scenarios.output.plots`) and
-the plot process that draws while the run goes on (:mod:`~scenarios.output.renderer`), and where
-results come from: versions, platform, date and seeds (:mod:`~scenarios.output.provenance`).
+(:mod:`~scenarios.output.plot_data`), the matplotlib drawing (:mod:`~scenarios.output.plots`),
+the plot process that draws while the run goes on (:mod:`~scenarios.output.renderer`), the
+interactive ``report.html`` (:mod:`scenarios.output.report`), and where results come from:
+versions, platform, date and seeds (:mod:`~scenarios.output.provenance`).
 
 May import: :mod:`ocp`, :mod:`planners` (types), :mod:`scenarios.errors` and
 :mod:`scenarios.schema`. :mod:`~scenarios.output.plots` and :mod:`~scenarios.output.renderer` import

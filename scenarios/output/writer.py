@@ -1,6 +1,6 @@
 """Writing a run's results into an output directory slewbench owns: the tables, one time series per
-row and the figures, staged and committed together (:mod:`scenarios.output.directory` holds the
-ownership rules, :doc:`/outputs` the layout).
+row, the figures and the interactive report, staged and committed together
+(:mod:`scenarios.output.directory` holds the ownership rules, :doc:`/outputs` the layout).
 """
 from __future__ import annotations
 
@@ -82,7 +82,8 @@ def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer:
 
 
 def write_results(results: RunResults, directory: str | Path, plots: bool = True, renderer: Any = None) -> Path:
-    """Write ``results.json/csv/md``, ``timeseries/<row>.csv`` and the PNG plots into ``directory``.
+    """Write ``results.json/csv/md``, ``timeseries/<row>.csv``, the PNG plots and ``report.html``
+    into ``directory``.
 
     The directory is claimed first (:func:`claim_output_directory`); the files are staged inside
     it and committed together (:func:`commit_outputs`).
@@ -94,7 +95,8 @@ def write_results(results: RunResults, directory: str | Path, plots: bool = True
     directory : str or Path
         The output directory.
     plots : bool, optional
-        Also draw the PNG figures.
+        Also draw the PNG figures and write the interactive ``report.html``
+        (:func:`scenarios.output.report.run.run_report`).
     renderer : scenarios.output.renderer.Renderer, optional
         A plot process to draw them (:mod:`scenarios.output.renderer`); if it fails, they are drawn in this
         process after a one-line notice on stderr. ``None``: drawn in this process.
@@ -117,6 +119,9 @@ def write_results(results: RunResults, directory: str | Path, plots: bool = True
             if row.simulation is not None:
                 write_timeseries(row, series / f"{stem}.csv")
         if plots:
+            from scenarios.output.report.run import run_report
+
+            (staging / "report.html").write_text(run_report(results), encoding="utf-8")
             _write_plots(results, staging, stems, renderer)
         commit_outputs(target, staging, kind="run")
     finally:

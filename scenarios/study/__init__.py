@@ -6,7 +6,8 @@ study and expanding it into cases (:mod:`~scenarios.study.spec`; the study file'
 in :mod:`scenarios.schema.study`), the crash-safe store and the sweep directory that holds it
 (:mod:`~scenarios.study.store`), what a worker runs (:mod:`~scenarios.study.worker`), the engine on a
 local pool or Dask (:mod:`~scenarios.study.engine`), and the report's tables
-(:mod:`~scenarios.study.report`) and figures (:mod:`~scenarios.study.plots`).
+(:mod:`~scenarios.study.report`), figures (:mod:`~scenarios.study.plots`) and interactive
+``report.html`` (:mod:`~scenarios.study.html`).
 
 May import: :mod:`ocp`, :mod:`scenarios.errors`, :mod:`scenarios.schema`, :mod:`scenarios.output`
 and :mod:`scenarios.runner`. Its names are imported on first use.

@@ -1,8 +1,8 @@
 """Tables and files of a trade study: ``cases.csv`` (one row per case and planner),
 ``summary.csv`` / ``summary.md`` (statistics per planner, and per grid point when there is
 Monte Carlo), ``requirements.csv`` (per planner, the fraction of cases that meet every requirement,
-with its Wilson interval; also in ``summary.md``), the resolved ``study.yaml`` and the plots
-(:mod:`scenarios.study.plots`).
+with its Wilson interval; also in ``summary.md``), the resolved ``study.yaml``, the plots
+(:mod:`scenarios.study.plots`) and the interactive ``report.html`` (:mod:`scenarios.study.html`).
 
 A case's rows are flattened and written as a run's are (:mod:`scenarios.output.tables`: the same
 ``ref.<metric>`` and ``cl.<metric>`` columns, then the requirement columns, the same rule for
@@ -241,7 +241,7 @@ def resolved_study(study: Study) -> dict[str, Any]:
 
 
 def write_report(results: SweepResults, directory: str | Path, plots: bool = True) -> list[str]:
-    """Write the study's tables, resolved study and (``plots``) figures into ``directory``.
+    """Write the study's tables, resolved study and (``plots``) figures and ``report.html`` into ``directory``.
 
     ``directory`` is claimed (created with slewbench's marker, or already carrying it); the files
     are staged inside it and committed together, replacing only files slewbench listed there.
@@ -253,7 +253,8 @@ def write_report(results: SweepResults, directory: str | Path, plots: bool = Tru
     directory : str or Path
         The output directory.
     plots : bool, optional
-        Also draw the PNG figures (``plots/``).
+        Also draw the PNG figures (``plots/``) and write the interactive ``report.html``
+        (:mod:`scenarios.study.html`).
 
     Returns
     -------
@@ -274,9 +275,12 @@ def write_report(results: SweepResults, directory: str | Path, plots: bool = Tru
         for name, text in files.items():
             (staging / name).write_text(text)
         if plots:
+            from scenarios.study.html import study_report
             from scenarios.study.plots import write_plots
             (staging / "plots").mkdir()
             write_plots(study, rows, staging / "plots")
+            (staging / "report.html").write_text(study_report(study, (columns, rows), (summary_columns, summary),
+                                                              requirements, results.missing), encoding="utf-8")
         return commit_sweep_outputs(directory, staging)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
