@@ -26,7 +26,8 @@ from scenarios.output.tables import IDENTITY_COLUMNS, is_missing
 from scenarios.schema.keys import Section
 from scenarios.schema.loader import SCENARIO
 from scenarios.study.paths import parse_path
-from scenarios.study.types import Study, package_version
+from scenarios.output.provenance import package_version
+from scenarios.study.types import Study
 
 __all__ = ["LOG_SPAN", "PAGE_SIZE", "histogram_figure", "path_unit", "study_report"]
 
