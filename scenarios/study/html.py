@@ -20,13 +20,13 @@ from typing import Any
 
 import numpy as np
 
+from scenarios.output.provenance import package_version
 from scenarios.output.report.page import Column, Page, column_unit
 from scenarios.output.report.run import result_columns
 from scenarios.output.tables import IDENTITY_COLUMNS, is_missing
 from scenarios.schema.keys import Section
 from scenarios.schema.loader import SCENARIO
 from scenarios.study.paths import parse_path
-from scenarios.output.provenance import package_version
 from scenarios.study.types import Study
 
 __all__ = ["LOG_SPAN", "PAGE_SIZE", "histogram_figure", "path_unit", "study_report"]
