@@ -171,7 +171,7 @@ def command_run(args: argparse.Namespace) -> int:
     earlier = _written_files(out)
     results.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
     print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
-          f"{'' if args.no_plots else ', PNG plots'}) in {time.perf_counter() - start:.2f} s")
+          f"{'' if args.no_plots else ', PNG plots, report.html'}) in {time.perf_counter() - start:.2f} s")
     removed = sorted(earlier - _written_files(out))
     if removed:
         print(f"removed {len(removed)} file(s) of the earlier run in {out}/ that this run did not write: "
@@ -236,7 +236,7 @@ def build_parser() -> argparse.ArgumentParser:
     run_parser = commands.add_parser("run", help="plan, simulate and score every planner of a scenario")
     run_parser.add_argument("file", help="scenario YAML file")
     run_parser.add_argument("--out", help="output directory (default: results/<scenario name>)")
-    run_parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    run_parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots and report.html")
     run_parser.add_argument("--all-metrics", action="store_true",
                             help="show every metric in the table, also those with no value in any row")
     run_parser.add_argument("--strict", action="store_true",
