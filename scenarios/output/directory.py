@@ -22,14 +22,12 @@ import json
 import os
 import shutil
 import tempfile
+from collections.abc import Iterable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterable, Iterator
+from typing import Any
 
 from scenarios.errors import OutputError
 from scenarios.schema.read import read_bounded
-
-if TYPE_CHECKING:
-    pass
 
 __all__ = ["MARKER", "STAGING_PREFIX", "claim_output_directory", "commit_outputs", "new_staging",
            "read_manifest", "write_manifest"]

@@ -47,7 +47,14 @@ from scenarios.schema.study import (
 )
 from scenarios.study.dispersions import Dispersion, draw_unit, parse_dispersion
 from scenarios.study.paths import Step, get_path, parse_path, with_values
-from scenarios.study.types import Case, Execution, Study, case_key, case_text, package_version
+from scenarios.study.types import (
+    Case,
+    Execution,
+    Study,
+    case_key,
+    case_text,
+    package_version,
+)
 
 PROGRESS_EVERY = 2048
 """Cases checked between two calls of the ``progress`` callback of :func:`parse_study`."""
