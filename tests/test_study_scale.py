@@ -6,6 +6,7 @@ import contextlib
 import copy
 import http.server
 import io
+import itertools
 import os
 import signal
 import socket
