@@ -278,7 +278,7 @@ def test_a_full_small_file_system_leaves_no_partial_folder(tmp_path, small_file_
 
 def test_a_disk_full_while_running_keeps_the_stored_cases_and_says_how_to_resume(tmp_path, monkeypatch):
     path = write_study(tmp_path, study_data(grid={"maneuver.duration": [30.0, 31.0, 32.0, 33.0]}))
-    original, commits = SweepStore.put_many, []
+    original, commits = SweepStore.put_encoded, []
 
     def filling(self, cases):
         cases = list(cases)
@@ -287,7 +287,7 @@ def test_a_disk_full_while_running_keeps_the_stored_cases_and_says_how_to_resume
         commits.append(len(cases))
         original(self, cases)
 
-    monkeypatch.setattr(SweepStore, "put_many", filling)
+    monkeypatch.setattr(SweepStore, "put_encoded", filling)
     monkeypatch.setattr(engine_module, "_POLL_S", 0.05)
     out = tmp_path / "out"
     status, _, error = cli("sweep", path, "--out", out, "--no-plots", "--workers", "1", seconds=120)
@@ -478,7 +478,7 @@ def test_the_store_commits_what_finishes_together_in_one_transaction(tmp_path):
     from tests.study_scale_tasks import cheap_task
     with SweepStore(out) as store:
         calls = []
-        original = store.put_many
-        store.put_many = lambda cases: (calls.append(len(list(cases))), original(cases))  # type: ignore[method-assign]
+        original = store.put_encoded
+        store.put_encoded = lambda cases: (calls.append(len(cases)), original(cases))  # type: ignore[method-assign]
         sweep(study, InlineExecutor(), store=store, task=cheap_task)
         assert sum(calls) == 12 and len(store) == 12

@@ -100,12 +100,13 @@ def parse_yaml_text(text: str, source: Path | str = "<text>") -> Any:
         Text that is not YAML, a value YAML cannot build, a duplicate key, nesting deeper than
         :data:`MAX_DEPTH` or alias expansion beyond :data:`MAX_NODES` values.
     """
-    try:
-        root = yaml.compose(text, Loader=_Loader)
+    loader = _Loader(text)
+    try:  # composed once, checked, then built from the same nodes
+        root = loader.get_single_node()
         if root is None:
             return None
         _check_tree(root, source)
-        return yaml.load(text, Loader=_Loader)
+        return loader.construct_document(root)
     except ScenarioError:
         raise
     except (ValueError, TypeError, OverflowError) as error:  # a value YAML recognised but cannot build
@@ -117,6 +118,8 @@ def parse_yaml_text(text: str, source: Path | str = "<text>") -> Any:
         raise ScenarioError("", f"{source} is not valid YAML{line}: {excerpt(str(problem), 200)}") from None
     except RecursionError:
         raise ScenarioError("", f"{source} nests too deeply") from None
+    finally:
+        loader.dispose()
 
 
 def read_bounded(path: str | Path, limit: int) -> bytes:

@@ -24,6 +24,7 @@ progress) is kept small, so that it keeps up with many workers.
 from __future__ import annotations
 
 import collections
+import json
 import math
 import multiprocessing
 import os
@@ -47,7 +48,7 @@ from ocp.errors import excerpt
 from scenarios.errors import ScenarioError, SweepInterrupted
 from scenarios.schema.study import scheduler_address
 from scenarios.study.spec import load_study, parse_study
-from scenarios.study.store import SweepStore
+from scenarios.study.store import SweepStore, encode_rows
 from scenarios.study.types import Case, Study
 from scenarios.study.worker import (
     PARENT_ENVIRONMENT,
@@ -57,7 +58,6 @@ from scenarios.study.worker import (
     run_case,
     run_chunk,
     start_local_worker,
-    tracked_case,
 )
 
 if TYPE_CHECKING:
@@ -70,11 +70,12 @@ HANDSHAKE_TIMEOUT_S = 10.0
 WORKER_WAIT_S = 60.0
 """How long a sweep waits for a Dask cluster without workers: before it starts (then it is refused,
 nothing written) and while it runs (then it stops like an interrupted sweep) [s]."""
-CHUNK_TARGET_S = 0.25
-"""Run time aimed at for one Dask task of several cases [s]: the scheduler's cost per task (about a
-millisecond) is then shared by the cases of the chunk."""
+CHUNK_TARGET_S = 0.5
+"""Run time aimed at for one task of several cases, on a local pool or Dask [s]: the cost of a task
+to the sweep (about half a millisecond on a local pool, a millisecond on Dask) is then shared by the
+cases of the chunk."""
 MAX_CHUNK = 64
-"""Most cases in one Dask task."""
+"""Most cases in one task."""
 MAX_WORKERS = 1024
 """Most cases run at once."""
 
@@ -273,10 +274,11 @@ class _Engine:
         self.study, self.store, self.task, self.cluster = study, store, task, cluster
         self.owned = executor is None
         self.workers = workers
-        self.chunked = not self.owned and type(executor).__module__.startswith("distributed")
-        # a local pool gets one case ahead of its workers, so that none idles while the driver stores a
-        # result; other executors get one batch per worker, two on Dask (whose workers take chunks)
-        self.window = workers + 1 if self.owned else workers * (2 if self.chunked else 1)
+        self.dask = not self.owned and type(executor).__module__.startswith("distributed")
+        self.chunked = self.owned or self.dask
+        # a local pool gets one chunk ahead of its workers, so that none idles while the driver stores a
+        # result; Dask two chunks per worker; other executors one case per worker
+        self.window = workers + 1 if self.owned else workers * (2 if self.dask else 1)
         self.pool = _LocalPool(workers) if self.owned else None
         self.executor: Executor = self.pool.executor if self.pool is not None else executor  # type: ignore[assignment]
         self.timeout = study.execution.case_timeout_s
@@ -314,9 +316,7 @@ class _Engine:
 
     def _submit(self, keys: list[str]) -> None:
         now = time.monotonic()
-        if self.pool is not None:
-            future = self.executor.submit(tracked_case, self.task, self._payload(keys[0]))
-        elif self.chunked:
+        if self.chunked:
             future = self.executor.submit(run_chunk, self.task, [self._payload(key) for key in keys])
         else:
             future = self.executor.submit(self.task, self._payload(keys[0]))
@@ -325,8 +325,8 @@ class _Engine:
         self.in_flight[future] = _Batch(keys, now)
 
     def _chunk_size(self) -> int:
-        """Cases per Dask task: about :data:`CHUNK_TARGET_S` of work, fewer near the end so that every
-        worker gets a share."""
+        """Cases per task: about :data:`CHUNK_TARGET_S` of work (one case until cases have been
+        timed), fewer near the end so that every worker gets a share."""
         if not self.chunked or len(self.elapsed) < min(self.workers, 8):
             return 1
         typical = statistics.median(self.elapsed) or 1e-3
@@ -355,19 +355,20 @@ class _Engine:
 
     # --- collecting ---------------------------------------------------------------------------
 
-    def _record(self, key: str, status: str, rows: list[dict[str, Any]], elapsed: float | None,
-                batch: list[tuple[str, str, list[dict[str, Any]], float | None, int]]) -> None:
+    def _record(self, key: str, status: str, rows: list[dict[str, Any]], elapsed: float | None, batch: list,
+                text: str | None = None) -> None:
+        """Keep a finished case's record and queue it for the store (``text``: its rows encoded)."""
         attempts = max(self.starts[key], 1)
         self.records[key] = {"status": status, "rows": rows, "elapsed_s": elapsed, "attempts": attempts}
-        batch.append((key, status, rows, elapsed, attempts))
+        batch.append((key, status, encode_rows(rows) if text is None else text, elapsed, attempts))
         self.failures += any(row["status"] != "ok" for row in rows)
 
-    def _commit(self, batch: list[tuple[str, str, list[dict[str, Any]], float | None, int]]) -> None:
+    def _commit(self, batch: list[tuple[str, str, str, float | None, int]]) -> None:
         """Commit finished cases in one transaction, then report them (a case shown done is stored)."""
         if not batch:
             return
         if self.store is not None:
-            self.store.put_many(batch)
+            self.store.put_encoded(batch)
         if self.bar is not None:
             self.bar.set_postfix(failures=self.failures, refresh=False)
             self.bar.update(len(batch))
@@ -386,7 +387,9 @@ class _Engine:
 
     def _result(self, key: str, result: dict[str, Any], batch: list) -> None:
         self.worker_builds[result["worker"]] = result["cache_builds"]
-        self._record(key, result["status"], result["rows"], result["elapsed_s"], batch)
+        text = result.get("rows_json")
+        rows = json.loads(text) if text is not None else result["rows"]  # as stored: non-finite numbers null
+        self._record(key, result["status"], rows, result["elapsed_s"], batch, text)
         if result.get("elapsed_s") is not None:
             self.elapsed.append(result["elapsed_s"])
         if result.get("cpu_s") is not None:
@@ -425,12 +428,20 @@ class _Engine:
             if key in self.records:
                 del self.shared[key]
 
-    def _requeue(self, keys: list[str], started: set[int]) -> None:
-        """Cases of a stopped pool run again, first; a case no worker took is not counted as started."""
-        for key in keys:
-            if self.cases[key].index not in started:
-                self.starts[key] -= 1
-        self.pending.extendleft(sorted(keys, key=lambda key: -self.cases[key].index))
+    def _requeue(self, batches: list[_Batch], started: set[int], keep: set[str]) -> None:
+        """Cases of a stopped pool run again, first (but those in ``keep``, dealt with by the caller).
+        A chunk's cases run in order: those up to the last one a worker started were started, the
+        others are not counted as started."""
+        again = []
+        for batch in batches:
+            positions = [at for at, key in enumerate(batch.keys) if self.cases[key].index in started]
+            last = max(positions, default=-1)
+            for at, key in enumerate(batch.keys):
+                if at > last:
+                    self.starts[key] -= 1
+                if key not in keep:
+                    again.append(key)
+        self.pending.extendleft(sorted(again, key=lambda key: -self.cases[key].index))
 
     def _new_pool(self) -> None:
         self.pool = _LocalPool(self.workers)
@@ -443,39 +454,33 @@ class _Engine:
         running, started = self.pool.running(), self.pool.started()
         self.pool.kill()
         culprits = self.pool.culprits()
-        keys = [key for batch in self.in_flight.values() for key in batch.keys]
+        batches = list(self.in_flight.values())
         self.in_flight.clear()
+        keys = [key for batch in batches for key in batch.keys]
         ran = sorted((key for key in keys if self.cases[key].index in running), key=lambda key: self.cases[key].index)
         guilty = [key for key in ran if running[self.cases[key].index][0] in culprits]
+        suspects: list[str] = []
         if len(guilty) == 1 or (not culprits and len(ran) == 1):
-            charged = (guilty or ran)[0]
+            charged: str | None = (guilty or ran)[0]
         else:
             charged = None
             suspects = guilty or ([] if culprits else ran)  # a culprit between cases: no one to charge
             for key in suspects:
                 self.shared[key] += 1
-            self.suspects.extend(suspects)
+        self._requeue(batches, started, set(suspects) | ({charged} if charged is not None else set()))
+        self.suspects.extend(suspects)
         batch: list = []
         if charged is not None:
             self._charge(charged, 1 + self.shared.get(charged, 0), "its process ended abruptly", batch)
-        self._requeue([key for key in keys if key != charged and key not in self.suspects], started)
         self._commit(batch)
         self._new_pool()
 
     # --- time limits and the cluster -----------------------------------------------------------
 
     def _clocks(self, now: float) -> list[tuple[float, Future, _Batch]]:
-        """Batches in flight with the time their clock started: a local worker's slot says when it
-        started a case; elsewhere a batch's clock starts when it is among the oldest ``workers``
-        batches in flight (cases wait behind the running ones)."""
-        if self.pool is not None:
-            running = self.pool.running()
-            clocks = []
-            for future, batch in self.in_flight.items():
-                slot = running.get(self.cases[batch.keys[0]].index)
-                if slot is not None:
-                    clocks.append((slot[1], future, batch))
-            return clocks
+        """Batches in flight with the time their clock started (not on a local pool): a batch's clock
+        starts when it is among the oldest ``workers`` batches in flight (cases wait behind the
+        running ones)."""
         for position, batch in enumerate(self.in_flight.values()):  # in submission order
             if position >= self.workers:
                 break
@@ -485,27 +490,42 @@ class _Engine:
 
     def _check_time(self) -> None:
         """Cases past the driver's limit (a worker stuck where the in-worker alarm cannot reach)."""
-        now = time.monotonic()
-        late = [(start, future, batch) for start, future, batch in self._clocks(now)
-                if now - start > self._chunk_limit(len(batch.keys))]
-        if not late:
+        if self.pool is not None:
+            self._check_pool_time()
             return
+        now = time.monotonic()
+        late = [(future, batch) for start, future, batch in self._clocks(now)
+                if now - start > self._chunk_limit(len(batch.keys))]
         batch_out: list = []
-        for _, future, batch in late:
+        for future, batch in late:
             self.in_flight.pop(future)
             future.cancel()
             if len(batch.keys) > 1:  # a chunk: its cases again, one by one, each with its own clock
                 self.singles.extend(batch.keys)
                 continue
-            key = batch.keys[0]
+            self._crash(batch.keys[0], f"timed out after {self.timeout:g} s (case_timeout_s); worker stopped", batch_out)
+        self._commit(batch_out)
+
+    def _check_pool_time(self) -> None:
+        """On a local pool a case's clock starts when its worker starts it (the slot table): a late
+        case is crashed, its worker stopped with the pool, and the other cases run again."""
+        assert self.pool is not None
+        now = time.monotonic()
+        running = self.pool.running()
+        late = [key for batch in self.in_flight.values() for key in batch.keys
+                if self.cases[key].index in running and now - running[self.cases[key].index][1] > self.limit]
+        if not late:
+            return
+        started = self.pool.started()
+        self.pool.kill()
+        batches = list(self.in_flight.values())
+        self.in_flight.clear()
+        self._requeue(batches, started, keep=set(late))
+        batch_out: list = []
+        for key in late:
             self._crash(key, f"timed out after {self.timeout:g} s (case_timeout_s); worker stopped", batch_out)
         self._commit(batch_out)
-        if self.pool is not None:  # the stuck worker is stopped with its pool; the other cases run again
-            started = self.pool.started()
-            self.pool.kill()
-            self._requeue([key for batch in self.in_flight.values() for key in batch.keys], started)
-            self.in_flight.clear()
-            self._new_pool()
+        self._new_pool()
 
     def _check_cluster(self) -> None:
         """A Dask cluster without workers: clocks wait, and after :data:`WORKER_WAIT_S` the sweep stops."""

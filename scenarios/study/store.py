@@ -25,7 +25,7 @@ import os
 import sqlite3
 import stat
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -56,6 +56,24 @@ def _rows_of_format_1(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
 EARLIER_FORMATS: dict[str, Callable[[list[dict[str, Any]]], list[dict[str, Any]]]] = {
     "slewbench-sweep-1": _rows_of_format_1}
 """Formats of earlier versions that can still be read, and how their rows are read in today's form."""
+
+def encode_rows(rows: list[dict[str, Any]]) -> str:
+    """A case's rows as the store keeps them: JSON, non-finite numbers as ``null``
+    (:func:`scenarios.output.tables.json_safe`). A trade study's workers encode their rows so
+    (:func:`scenarios.study.worker.run_chunk`), and the sweep stores the text as it comes.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The case's rows (:meth:`scenarios.output.results.Row.to_dict`).
+
+    Returns
+    -------
+    str
+        The JSON text.
+    """
+    return json.dumps(json_safe(rows), allow_nan=False)
+
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (name TEXT PRIMARY KEY, value TEXT NOT NULL);
@@ -264,12 +282,25 @@ class SweepStore:
             An entry of the wrong type or value, named in the message (nothing is committed).
         """
         now = time.time()
-        values = [self._row(*case, now) for case in cases]
+        self._insert([self._row(*case, now) for case in cases])
+
+    def put_encoded(self, cases: Iterable[tuple[str, str, str, float | None, int]]) -> None:
+        """:meth:`put_many` for rows already encoded by :func:`encode_rows` (a sweep's workers do it).
+
+        Parameters
+        ----------
+        cases : iterable of (key, status, rows_json, elapsed_s, attempts)
+            As :meth:`put`, the rows as JSON text.
+        """
+        now = time.time()
+        self._insert([(key, status, text, elapsed, attempts, now) for key, status, text, elapsed, attempts in cases])
+
+    def _insert(self, values: list[tuple[Any, ...]]) -> None:
         with self._transaction():
             self._db.executemany("INSERT OR REPLACE INTO cases VALUES (?, ?, ?, ?, ?, ?)", values)
 
     @contextlib.contextmanager
-    def _transaction(self) -> Any:
+    def _transaction(self) -> Iterator[None]:
         self._db.execute("BEGIN IMMEDIATE")
         try:
             yield
@@ -290,7 +321,7 @@ class SweepStore:
             raise TypeError(f"elapsed_s must be a number or None, got {excerpt(elapsed_s)}")
         if isinstance(attempts, bool) or not isinstance(attempts, int) or attempts < 1:
             raise ValueError(f"attempts must be an integer >= 1, got {excerpt(attempts)}")
-        return key, status, json.dumps(json_safe(rows), allow_nan=False), elapsed_s, attempts, now
+        return key, status, encode_rows(rows), elapsed_s, attempts, now
 
     def keys(self) -> set[str]:
         """The keys of the stored cases.

@@ -24,6 +24,7 @@ from scenarios.errors import CaseTimeout
 from scenarios.output.renderer import die_with_parent
 from scenarios.output.results import Row
 from scenarios.schema.labels import row_labels
+from scenarios.study.store import encode_rows
 
 V = TypeVar("V")
 
@@ -102,7 +103,8 @@ def tracked_case(task: Callable[[dict[str, Any]], dict[str, Any]], payload: dict
 
 
 def run_chunk(task: Callable[[dict[str, Any]], dict[str, Any]], payloads: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Run several cases in one task, one after the other (a Dask task of a chunk of cases).
+    """Run several cases in one task, one after the other, each tracked (:func:`tracked_case`: in a
+    local pool's worker, its slot names the case running).
 
     Parameters
     ----------
@@ -114,9 +116,15 @@ def run_chunk(task: Callable[[dict[str, Any]], dict[str, Any]], payloads: list[d
     Returns
     -------
     list of dict
-        What ``task`` returns for each, in order.
+        What ``task`` returns for each, in order, its ``rows`` as the store's JSON text under
+        ``rows_json`` (:func:`scenarios.study.store.encode_rows`).
     """
-    return [task(payload) for payload in payloads]
+    results = []
+    for payload in payloads:
+        result = dict(tracked_case(task, payload))
+        result["rows_json"] = encode_rows(result.pop("rows"))  # the store's text, made here in parallel
+        results.append(result)
+    return results
 
 
 class RecentCache(SolverCache):
