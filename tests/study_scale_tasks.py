@@ -43,3 +43,18 @@ def cheap_task(payload):
 
 def real_task(payload):
     return run_case(payload)
+
+
+def hanging_task(payload):
+    """38 s: stuck where the worker's alarm cannot reach it (as in C code); anything else cheap."""
+    if payload["scenario"]["maneuver"]["duration"] == 38.0:
+        import signal
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGALRM})
+        time.sleep(600)
+    return cheap_task(payload)
+
+
+def slow_task(payload):
+    """A cheap result after 0.2 s (a Dask worker can be retired meanwhile)."""
+    time.sleep(0.2)
+    return cheap_task(payload)

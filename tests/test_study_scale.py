@@ -482,3 +482,77 @@ def test_the_store_commits_what_finishes_together_in_one_transaction(tmp_path):
         store.put_encoded = lambda cases: (calls.append(len(cases)), original(cases))  # type: ignore[method-assign]
         sweep(study, InlineExecutor(), store=store, task=cheap_task)
         assert sum(calls) == 12 and len(store) == 12
+
+
+def many_cases(tmp_path, special, count=60, retries=1, timeout=60.0):
+    durations = [100.0 + i for i in range(count)]
+    for position, value in special.items():
+        durations[position] = value
+    return dying_study(tmp_path, durations, retries) if timeout == 60.0 else parse_study({
+        "study": "dying", "scenario": {**copy.deepcopy(BASE), "name": str(tmp_path)},
+        "grid": {"maneuver.duration": durations}, "execution": {"retries": retries, "case_timeout_s": timeout}})
+
+
+@pytest.mark.parametrize("duration, status, attempts", [(37.0, "ok", 2), (36.0, "crashed", 2)])
+def test_deaths_inside_chunks_are_charged_to_their_cases_and_nothing_is_lost(tmp_path, duration, status, attempts):
+    """Cheap cases go several to a task; a case that kills its worker in the middle of a chunk is
+    charged (once it dies, twice it dies, with one retry), the chunk's other cases run again, and
+    every case ends stored once."""
+    from tests.study_scale_tasks import dying_task
+    study = many_cases(tmp_path, {30: duration})
+    results = sweep(study, workers=2, task=dying_task)
+    assert results.missing == 0 and len(results.records) == 60
+    by_duration = {c.scenario["maneuver"]["duration"]: results.records[c.key] for c in study.cases}
+    assert by_duration[duration]["status"] == status and by_duration[duration]["attempts"] == attempts
+    others = [record for d, record in by_duration.items() if d != duration]
+    assert all(record["status"] == "ok" and 1 <= record["attempts"] <= 3 for record in others)
+
+
+def test_a_case_stuck_inside_a_chunk_is_crashed_and_the_others_run(tmp_path, monkeypatch):
+    from tests.study_scale_tasks import hanging_task
+    monkeypatch.setattr(engine_module, "_POLL_S", 0.1)
+    study = many_cases(tmp_path, {25: 38.0}, count=40, timeout=1.0)
+    start = time.monotonic()
+    results = sweep(study, workers=2, task=hanging_task)
+    assert time.monotonic() - start < 60
+    by_duration = {c.scenario["maneuver"]["duration"]: results.records[c.key] for c in study.cases}
+    assert by_duration[38.0]["status"] == "crashed"
+    assert by_duration[38.0]["rows"][0]["message"] == "timed out after 1 s (case_timeout_s); worker stopped"
+    assert all(r["status"] == "ok" for d, r in by_duration.items() if d != 38.0) and results.missing == 0
+
+
+def test_a_dask_cluster_that_loses_every_worker_stops_the_sweep_like_an_interruption(tmp_path, monkeypatch):
+    distributed = pytest.importorskip("distributed")
+    from scenarios.errors import SweepInterrupted
+    from scenarios.study.engine import connect_scheduler
+    from tests.study_scale_tasks import slow_task
+    monkeypatch.setattr(engine_module, "WORKER_WAIT_S", 1.0)
+    study = many_cases(tmp_path, {}, count=30)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp",
+                                           host="127.0.0.1", dashboard_address=None)
+    with cluster:
+        connected = connect_scheduler(cluster.scheduler_address, wait_s=10.0)
+        out = claim_sweep_directory(tmp_path / "out")
+        retired = threading.Event()
+
+        def retire():
+            with SweepStore(out, create=False) as store:
+                deadline = time.monotonic() + 60
+                while len(store) < 1 and time.monotonic() < deadline:
+                    time.sleep(0.05)
+            cluster.scale(0)
+            retired.set()
+
+        try:
+            with SweepStore(out) as store, bounded(120):
+                store.set_meta("format", "slewbench-sweep-2")
+                helper = threading.Thread(target=retire, daemon=True)
+                helper.start()
+                with pytest.raises(SweepInterrupted, match="no workers for 1 s") as stopped:
+                    sweep(study, store=store, task=slow_task, cluster=connected)
+                assert retired.is_set() and 1 <= len(store) < 30
+                assert stopped.value.missing == 30 - len(store)
+        finally:
+            connected.close()

@@ -88,15 +88,22 @@ def command_report(args: argparse.Namespace) -> int:
 
 
 def _checking(name: str) -> Any:
-    """A progress callback for the cases' checks (a bar on a terminal, nothing otherwise)."""
-    if not sys.stderr.isatty():
-        return None
-    from tqdm import tqdm
+    """A progress callback for the cases' checks: a bar on a terminal, else a line when a large
+    study starts being checked and one when it is done."""
+    started = time.perf_counter()
     bar = None
 
     def show(checked: int, total: int) -> None:
         nonlocal bar
+        if not sys.stderr.isatty():
+            if checked < total and bar is None:
+                bar = print(f"{name}: checking {total} cases ...", file=sys.stderr, flush=True) or True
+            elif checked >= total and bar is not None:
+                print(f"{name}: {total} cases checked in {time.perf_counter() - started:.1f} s", file=sys.stderr,
+                      flush=True)
+            return
         if bar is None:
+            from tqdm import tqdm
             bar = tqdm(total=total, unit="case", desc=f"checking {name[:30]}", file=sys.stderr, leave=False,
                        mininterval=0.5)
         bar.update(checked - bar.n)
