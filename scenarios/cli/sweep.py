@@ -91,24 +91,23 @@ def _checking(name: str) -> Any:
     """A progress callback for the cases' checks: a bar on a terminal, else a line when a large
     study starts being checked and one when it is done."""
     started = time.perf_counter()
-    bar = None
+    state: dict[str, Any] = {}
 
     def show(checked: int, total: int) -> None:
-        nonlocal bar
         if not sys.stderr.isatty():
-            if checked < total and bar is None:
-                bar = print(f"{name}: checking {total} cases ...", file=sys.stderr, flush=True) or True
-            elif checked >= total and bar is not None:
+            if checked < total and not state:
+                state["said"] = print(f"{name}: checking {total} cases ...", file=sys.stderr, flush=True)
+            elif checked >= total and state:
                 print(f"{name}: {total} cases checked in {time.perf_counter() - started:.1f} s", file=sys.stderr,
                       flush=True)
             return
-        if bar is None:
+        if "bar" not in state:
             from tqdm import tqdm
-            bar = tqdm(total=total, unit="case", desc=f"checking {name[:30]}", file=sys.stderr, leave=False,
-                       mininterval=0.5)
-        bar.update(checked - bar.n)
+            state["bar"] = tqdm(total=total, unit="case", desc=f"checking {name[:30]}", file=sys.stderr, leave=False,
+                                mininterval=0.5)
+        state["bar"].update(checked - state["bar"].n)
         if checked >= total:
-            bar.close()
+            state["bar"].close()
 
     return show
 
@@ -231,7 +230,10 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
             print(f"{study.name}: {len(study.cases)} cases" + (f", {done} already stored" if done else "")
                   + f", {cluster.address if cluster else 'local process pool'}", flush=True)
             results = sweep(study, workers=args.workers, store=store, progress=True, cluster=cluster)
-    except SweepInterrupted as stop:
+    except (SweepInterrupted, KeyboardInterrupt) as stop:  # KeyboardInterrupt: before the sweep took over
+        if isinstance(stop, KeyboardInterrupt):
+            with SweepStore(out, create=False) as stored:
+                stop = SweepInterrupted(len({case.key for case in study.cases} - stored.keys()), len(study.cases))
         resume = f"slewbench sweep {args.file} --out {out} --resume"
         print(f"slewbench: sweep {'stopped: ' + stop.reason if stop.reason else 'interrupted'}; {stop.missing} of "
               f"{stop.total} cases are missing (finished cases are stored in {out / STORE_NAME}). Resume with:\n"

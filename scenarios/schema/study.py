@@ -519,7 +519,8 @@ def declared_key(steps: Sequence[Step]) -> Key | None:
         The key (its reader checks a value), or None where the schema declares none (a planner's
         or controller's options, an unknown key).
     """
-    section, key = SCENARIO, None
+    section: Section | None = SCENARIO
+    key: Key | None = None
     for step in steps:
         if isinstance(step, str):
             if section is None or key is not None and key.entries:
@@ -559,7 +560,8 @@ def _option_type(steps: Sequence[Step], base: Mapping[str, Any]) -> Any:
     """The type of a planner's or controller's option at ``steps`` (``planners[i].options.<name>``,
     ``controller.options.<name>``, ``controllers[i].options.<name>``), from the entry's name in
     ``base``; None when the path is not an option of a registered component."""
-    registries = {"planners": PLANNERS, "controllers": CONTROLLERS, "controller": CONTROLLERS}
+    registries: dict[str, Mapping[str, Any]] = {"planners": PLANNERS, "controllers": CONTROLLERS,
+                                                "controller": CONTROLLERS}
     head = steps[0] if steps else None
     if not isinstance(head, str) or head not in registries:
         return None
@@ -578,7 +580,8 @@ def _option_type(steps: Sequence[Step], base: Mapping[str, Any]) -> Any:
             return None
     if len(rest) != 2 or rest[0] != "options" or not isinstance(entry, dict):
         return None
-    component = registries[head].get(entry.get("name")) if isinstance(entry.get("name"), str) else None
+    name = entry.get("name")
+    component = registries[head].get(name) if isinstance(name, str) else None
     if component is None:
         return None
     field = option_fields(component.Options).get(str(rest[1]))

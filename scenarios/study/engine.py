@@ -218,7 +218,7 @@ class _LocalPool:
         self.executor = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=start_local_worker,
                                             initargs=(self.slots, context.Lock(), server))
         self.ours: set[int] = set()  # workers this pool killed itself
-        self.processes: dict[int, Any] = self.executor._processes  # private, stable since 3.8; kept after shutdown
+        self.processes: Any = self.executor._processes  # private, stable since 3.8; kept after shutdown
 
     def running(self) -> dict[int, tuple[int, float]]:
         """Case index -> (worker pid, start time) of the cases the workers are running now."""
@@ -316,6 +316,7 @@ class _Engine:
 
     def _submit(self, keys: list[str]) -> None:
         now = time.monotonic()
+        future: Future[Any]
         if self.chunked:
             future = self.executor.submit(run_chunk, self.task, [self._payload(key) for key in keys])
         else:

@@ -451,9 +451,9 @@ def _case_error(case: Case, error: ScenarioError) -> ScenarioError:
     """The loader's error on a case, naming the case, its varied values (cut short) and the study
     entry that set the offending path."""
     entries = [p for p in case.varied if error.path.startswith(p) or p.startswith(error.path)]
-    shown = []
+    shown: list[str] = []
     for path, value in case.varied.items():
-        if sum(map(len, shown)) > 240:
+        if sum(len(part) for part in shown) > 240:
             shown.append(f"... ({len(case.varied)} values)")
             break
         shown.append(f"{_cut(path)}={json.dumps(value)[:40]}")
