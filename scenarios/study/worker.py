@@ -6,6 +6,12 @@ worker process keeps one :class:`ocp.SolverCache` for its whole life, so a collo
 built once per worker and structure; a process-wide lock runs one case at a time per process
 (IPOPT's linear solvers are not thread-safe), so a Dask worker should be started with
 ``--nthreads 1`` and as many processes as cores.
+
+Cases come several to a task (:func:`run_chunk`), each encoding its rows as the store keeps them.
+In a local pool's worker each case is tracked (:func:`tracked_case`): the worker writes the case it
+runs and when it started it into a slot table shared with the sweep, which so knows whose case
+killed a worker and how long a case has run. The local workers, and the server they fork from, die
+with the sweep (:func:`start_local_worker`, :data:`PARENT_ENVIRONMENT`).
 """
 from __future__ import annotations
 
@@ -63,9 +69,10 @@ def start_local_worker(slots: Any, lock: Any, parent: int) -> None:
     lock : multiprocessing.Lock
         Guards the claiming of slots.
     parent : int
-        The process id of the fork server the worker was started from.
+        The process id of the fork server the worker was started from (not positive: unknown, this
+        process's parent now).
     """
-    die_with_parent(signal.SIGKILL, parent)
+    die_with_parent(signal.SIGKILL, parent if parent > 0 else os.getppid())
     with lock:
         for index in range(len(slots) // SLOT_FIELDS):
             if slots[index * SLOT_FIELDS] == 0:
