@@ -317,6 +317,11 @@ def test_report_of_a_damaged_store_is_exit_2(tmp_path):
 @pytest.mark.parametrize("change, words", [
     ({"execution": {"case_timeout_s": 1.0e300}}, r"execution\.case_timeout_s: expected a number <= 604800"),
     ({"execution": {"case_timeout_s": float("nan")}}, r"execution\.case_timeout_s: expected a number"),
+    ({"execution": {"case_timeout_s": 2**64}}, r"execution\.case_timeout_s: expected a number <= 604800"),
+    ({"grid": {"maneuver.duration": [30.0, 10**400]}}, r"case 1 .*maneuver\.duration.*: expected a number, got"),
+    ({"grid": {"planners[label=fast].options.torque_fraction": [10**400]}},
+     r"case 0 .*planners\[1\]\.options\.torque_fraction.*expected a number"),
+    ({"grid": {"spacecraft.inertia": [[2.0, 10**400, 3.0]]}}, r"case 0 .*spacecraft\.inertia.*expected finite numbers"),
     ({"monte_carlo": {"samples": 2, "seed": 2**70, "dispersions": {}}}, r"monte_carlo\.seed: expected an integer"),
     ({"monte_carlo": {"samples": 2, "dispersions": {"maneuver.duration": "case_seed"}}},
      r"monte_carlo\.dispersions\.maneuver\.duration: case_seed sets an integer"),
