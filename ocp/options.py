@@ -197,7 +197,10 @@ def _convert(value: Any, annotation: Any) -> Any:
         raise TypeError
     if annotation is float:
         if isinstance(value, (int, float)) and not isinstance(value, bool):
-            return float(value)
+            try:
+                return float(value)
+            except OverflowError:  # an integer too large for a float is not a number here
+                raise TypeError from None
         raise TypeError
     if annotation is str:
         if isinstance(value, str):

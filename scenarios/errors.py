@@ -14,12 +14,30 @@ from ocp.errors import SlewbenchError
 
 __all__ = ["CaseTimeout", "OutputError", "ScenarioError", "SweepInterrupted"]
 
+MAX_PATH_CHARS = 300
+"""Characters of a path shown in an error's text (the attribute keeps it whole)."""
+MAX_MESSAGE_CHARS = 2000
+"""Characters of a message shown in an error's text (the attribute keeps it whole)."""
+
+
+def _bounded(text: str, limit: int) -> str:
+    """``text`` with its middle cut out when longer than ``limit``: head and tail stay."""
+    if len(text) <= limit:
+        return text
+    keep = max(limit - 40, 20)
+    return f"{text[:keep * 2 // 3]}...({len(text)} characters)...{text[-(keep - keep * 2 // 3):]}"
+
 
 class ScenarioError(SlewbenchError, ValueError):
-    """A scenario file is wrong; ``path`` is where, ``message`` what was expected."""
+    """A scenario file is wrong; ``path`` is where, ``message`` what was expected.
+
+    The error's text shows at most :data:`MAX_PATH_CHARS` of the path and
+    :data:`MAX_MESSAGE_CHARS` of the message, whatever a file holds.
+    """
 
     def __init__(self, path: str, message: str):
-        super().__init__(f"{path}: {message}" if path else message)
+        shown = _bounded(message, MAX_MESSAGE_CHARS)
+        super().__init__(f"{_bounded(path, MAX_PATH_CHARS)}: {shown}" if path else shown)
         self.path = path
         self.message = message
 
@@ -36,7 +54,7 @@ class OutputError(SlewbenchError):
     """
 
     def __init__(self, path: str | Path, message: str):
-        super().__init__(f"{path}: {message}")
+        super().__init__(f"{_bounded(str(path), MAX_PATH_CHARS)}: {_bounded(message, MAX_MESSAGE_CHARS)}")
         self.path = Path(path)
         self.message = message
 
@@ -54,8 +72,10 @@ class SweepInterrupted(SlewbenchError):
         Cases not finished (not in the store).
     total : int
         Cases of the study.
+    reason : str, optional
+        Why it stopped, when not by Ctrl-C or SIGTERM (a Dask cluster left without workers).
     """
 
-    def __init__(self, missing: int, total: int) -> None:
-        super().__init__(f"{missing} of {total} cases are missing")
-        self.missing, self.total = missing, total
+    def __init__(self, missing: int, total: int, reason: str = "") -> None:
+        super().__init__(f"{missing} of {total} cases are missing" + (f" ({reason})" if reason else ""))
+        self.missing, self.total, self.reason = missing, total, reason

@@ -127,7 +127,19 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     ------
     ScenarioError
         Two rows would have the same label (a scenario built without :func:`scenarios.load`).
+    TypeError
+        An argument of the wrong type, named in the message.
     """
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario must be a Scenario (scenarios.load or scenarios.parse_scenario), got "
+                        f"{type(scenario).__name__}")
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be callable or None, got {type(progress).__name__}")
+    if cache is not None and not isinstance(cache, SolverCache):
+        raise TypeError(f"cache must be an ocp.SolverCache or None, got {type(cache).__name__}")
+    if simulators is not None and not callable(getattr(simulators, "get", None)):
+        raise TypeError(f"simulators must have SolverCache's get (an ocp.SolverCache) or be None, got "
+                        f"{type(simulators).__name__}")
     say = progress or (lambda line: None)
     spec = scenario.simulation
     model = scenario.problem.model

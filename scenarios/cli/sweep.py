@@ -1,14 +1,18 @@
 """``slewbench sweep``: run a trade study into a directory, resume it, or redraw its report.
 
-Everything that can fail before a case runs is checked first: the study and every case (exit 2,
-nothing written), then the output directory (exit 2 if it is not slewbench's, already holds a
-sweep and ``--resume`` was not given, or holds a sweep of an earlier slewbench, which ``--report``
-still redraws). An interrupted sweep exits 130 and says how to resume.
+Everything that can fail before a case runs is checked first, and nothing is written until it
+passes: the study and every case (exit 2), the options, the output directory (exit 2 if it is not
+slewbench's, already holds a sweep and ``--resume`` was not given, or holds a sweep of an earlier
+slewbench, which ``--report`` still redraws), and a Dask scheduler (it must answer as one and have
+workers). A directory this command created is removed again if the sweep cannot start in it (a
+full disk). An interrupted sweep exits 130 and says how to resume.
 """
 from __future__ import annotations
 
 import argparse
+import shutil
 import signal
+import sqlite3
 import sys
 import time
 from pathlib import Path
@@ -19,24 +23,25 @@ from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, read_manifest
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
-from scenarios.study.engine import SweepResults, start_forkserver, sweep
+from scenarios.study.engine import (
+    DaskCluster,
+    SweepResults,
+    connect_scheduler,
+    start_forkserver,
+    sweep,
+)
 from scenarios.study.report import resolved_study
 from scenarios.study.spec import load_study, parse_study
 from scenarios.study.store import (
     EARLIER_FORMATS,
+    STORE_FILES,
     STORE_NAME,
     SweepStore,
     claim_sweep_directory,
     is_sweep_store,
     store_format,
 )
-
-
-def _open_store(out: Path) -> SweepStore:
-    try:
-        return SweepStore(out)
-    except Exception as error:  # sqlite3.Error, or a store of another format
-        raise OutputError(out, f"cannot open the sweep store: {error}") from None
+from scenarios.study.types import Study
 
 
 def _terminate(signum: int, frame: Any) -> None:
@@ -60,19 +65,113 @@ def command_report(args: argparse.Namespace) -> int:
     ------
     OutputError
         The directory holds no slewbench sweep (a sweep of an earlier slewbench whose store is
-        still readable is redrawn).
+        still readable is redrawn), or its store is damaged.
     """
     out = Path(args.report)
-    if read_manifest(out) is None or not is_sweep_store(out):
-        raise OutputError(out, f"holds no slewbench sweep ({STORE_NAME} and {MARKER} expected)")
-    with SweepStore(out, create=False) as store:
-        data, version = store.get_meta("study"), store.get_meta("version")
-        records = store.records()
-    study = parse_study(data, version=version)
+    try:
+        if read_manifest(out) is None or not is_sweep_store(out):
+            raise OutputError(out, f"holds no slewbench sweep ({STORE_NAME} and {MARKER} expected)")
+        with SweepStore(out, create=False) as store:
+            data, version = store.get_meta("study"), store.get_meta("version")
+            records = store.records()
+    except (ValueError, OSError, sqlite3.Error) as error:
+        raise OutputError(out, f"its sweep store cannot be read: {error}") from None
+    if not isinstance(version, str):
+        raise OutputError(out, "its sweep store has no version of slewbench; it cannot be redrawn")
+    try:
+        study = parse_study(data, version=version)
+    except ScenarioError as error:
+        raise OutputError(out, f"the study stored in it is not valid ({error}); it cannot be redrawn") from None
     results = SweepResults(study, records)
     files = results.write(out, plots=not args.no_plots)
     print(f"redrew {out}/ ({', '.join(files)}) from {len(records)} stored case(s); {results.missing} missing")
     return EXIT_OK
+
+
+def _checking(name: str) -> Any:
+    """A progress callback for the cases' checks: a bar on a terminal, else a line when a large
+    study starts being checked and one when it is done."""
+    started = time.perf_counter()
+    state: dict[str, Any] = {}
+
+    def show(checked: int, total: int) -> None:
+        if not sys.stderr.isatty():
+            if checked < total and not state:
+                state["said"] = print(f"{name}: checking {total} cases ...", file=sys.stderr, flush=True)
+            elif checked >= total and state:
+                print(f"{name}: {total} cases checked in {time.perf_counter() - started:.1f} s", file=sys.stderr,
+                      flush=True)
+            return
+        if "bar" not in state:
+            from tqdm import tqdm
+            state["bar"] = tqdm(total=total, unit="case", desc=f"checking {name[:30]}", file=sys.stderr, leave=False,
+                                mininterval=0.5)
+        state["bar"].update(checked - state["bar"].n)
+        if checked >= total:
+            state["bar"].close()
+
+    return show
+
+
+def _output(args: argparse.Namespace, study: Study) -> Path:
+    """The output directory, checked without writing anything."""
+    out = Path(args.out) if args.out else default_output_directory(study.name)
+    try:
+        earlier = store_format(out)
+        stored = (out / STORE_NAME).exists() or (out / STORE_NAME).is_symlink()
+    except OSError as error:  # a name too long for the file system, a parent that is a file ...
+        raise OutputError(out, f"cannot be used: {error.strerror or error}") from None
+    if earlier in EARLIER_FORMATS:
+        raise OutputError(out, f"holds a sweep written by an earlier slewbench ({STORE_NAME} format {earlier!r}); "
+                               f"it takes no new cases: redraw its report with `slewbench sweep --report {out}`, "
+                               "or choose another --out to run the study")
+    if stored and not args.resume:
+        raise OutputError(out, f"already holds a sweep ({STORE_NAME}); pass --resume to continue it, "
+                               "--report to redraw it, or choose another --out")
+    return out
+
+
+def _created(out: Path) -> tuple[Path | None, bool]:
+    """What a claim of ``out`` would create: the topmost missing folder (None: ``out`` exists), and
+    whether ``out`` is an empty directory now."""
+    missing = None
+    for folder in [out, *out.absolute().parents]:
+        if folder.exists():
+            break
+        missing = folder
+    empty = missing is None and out.is_dir() and not any(out.iterdir())
+    return missing, empty
+
+
+def _undo(out: Path, missing: Path | None, empty: bool) -> None:
+    """Remove what a sweep that could not start wrote: the folders it created, or what it put into a
+    directory that was empty."""
+    if missing is not None:
+        shutil.rmtree(missing, ignore_errors=True)
+    elif empty:
+        for name in (MARKER, *STORE_FILES):
+            (out / name).unlink(missing_ok=True)
+
+
+def _open(out: Path, study: Study) -> tuple[Path, SweepStore]:
+    """Claim the directory and open the store with the study in it; on failure (a full disk), undo."""
+    missing, empty = _created(Path(out).absolute())
+    try:
+        directory = claim_sweep_directory(out)
+        store = SweepStore(directory)
+        try:
+            store.set_meta("study", resolved_study(study))
+            store.set_meta("version", package_version())
+        except BaseException:
+            store.close()
+            raise
+    except OutputError:
+        _undo(Path(out).absolute(), missing, empty)
+        raise
+    except (OSError, ValueError, sqlite3.Error) as error:  # sqlite3.Error, or a store of another format
+        _undo(Path(out).absolute(), missing, empty)
+        raise OutputError(out, f"cannot start the sweep store: {error}; nothing was left behind") from None
+    return directory, store
 
 
 def command_sweep(args: argparse.Namespace) -> int:
@@ -88,54 +187,63 @@ def command_sweep(args: argparse.Namespace) -> int:
     -------
     int
         The exit status: 0 when every case is stored (failed rows included), 130 when the sweep
-        was interrupted.
+        was interrupted (or its Dask cluster lost every worker).
 
     Raises
     ------
     ScenarioError
-        A bad study, case or option (exit 2; nothing written).
+        A bad study, case, option or scheduler (exit 2; nothing written).
     OutputError
-        An output directory slewbench must not or cannot write to (exit 2; nothing written).
+        An output directory slewbench must not or cannot write to (exit 2; nothing written), or a
+        store that cannot be written while the sweep runs (the cases stored so far are kept).
     """
     if args.report:
         return command_report(args)
     if not args.file:
         raise ScenarioError("", "give a study file, or --report DIR")
-    if not args.scheduler:
-        start_forkserver()  # local workers' imports run while the study is expanded and checked
-    study = load_study(args.file)
-    if args.scheduler:
-        study.execution.scheduler = args.scheduler
     if args.workers is not None and not 1 <= args.workers <= 1024:
         raise ScenarioError("--workers", f"expected 1 to 1024, got {args.workers}")
+    scheduler = args.scheduler
+    if not scheduler:
+        start_forkserver()  # local workers' imports run while the study is expanded and checked
+    name = Path(args.file).stem
+    study = load_study(args.file, progress=_checking(name))
+    where = "--scheduler" if scheduler else "execution.scheduler"
+    scheduler = scheduler or study.execution.scheduler
     if not args.no_plots:
         import scenarios.study.plots  # noqa: F401  (fail now, not after the cases ran)
-    out = Path(args.out) if args.out else default_output_directory(study.name)
-    earlier = store_format(out)
-    if earlier in EARLIER_FORMATS:
-        raise OutputError(out, f"holds a sweep written by an earlier slewbench ({STORE_NAME} format {earlier!r}); "
-                               f"it takes no new cases: redraw its report with `slewbench sweep --report {out}`, "
-                               "or choose another --out to run the study")
-    if (out / STORE_NAME).exists() and not args.resume:
-        raise OutputError(out, f"already holds a sweep ({STORE_NAME}); pass --resume to continue it, "
-                               "--report to redraw it, or choose another --out")
-    out = claim_sweep_directory(out)
+    out = _output(args, study)
+    cluster: DaskCluster | None = connect_scheduler(scheduler, where) if scheduler else None
+    try:
+        return _run(args, study, out, cluster)
+    finally:
+        if cluster is not None:
+            cluster.close()
+
+
+def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster | None) -> int:
+    out, store = _open(out, study)
     start = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _terminate)
     try:
-        with _open_store(out) as store:
-            store.set_meta("study", resolved_study(study))
-            store.set_meta("version", package_version())
-            done = sum(case.key in store.keys() for case in study.cases)
-            print(f"{study.name}: {len(study.cases)} cases"
-                  + (f", {done} already stored" if done else "")
-                  + f", {args.scheduler or study.execution.scheduler or 'local process pool'}", flush=True)
-            results = sweep(study, workers=args.workers, store=store, progress=True)
-    except SweepInterrupted as stop:
+        with store:
+            done = len(store.keys() & {case.key for case in study.cases})
+            print(f"{study.name}: {len(study.cases)} cases" + (f", {done} already stored" if done else "")
+                  + f", {cluster.address if cluster else 'local process pool'}", flush=True)
+            results = sweep(study, workers=args.workers, store=store, progress=True, cluster=cluster)
+    except (SweepInterrupted, KeyboardInterrupt) as stop:  # KeyboardInterrupt: before the sweep took over
+        if isinstance(stop, KeyboardInterrupt):
+            with SweepStore(out, create=False) as stored:
+                stop = SweepInterrupted(len({case.key for case in study.cases} - stored.keys()), len(study.cases))
         resume = f"slewbench sweep {args.file} --out {out} --resume"
-        print(f"slewbench: sweep interrupted; {stop.missing} of {stop.total} cases are missing "
-              f"(finished cases are stored in {out / STORE_NAME}). Resume with:\n  {resume}", file=sys.stderr)
+        print(f"slewbench: sweep {'stopped: ' + stop.reason if stop.reason else 'interrupted'}; {stop.missing} of "
+              f"{stop.total} cases are missing (finished cases are stored in {out / STORE_NAME}). Resume with:\n"
+              f"  {resume}", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except (sqlite3.Error, OSError) as error:  # the store could not take a case (a full disk)
+        raise OutputError(out, f"the sweep store could not be written ({error}); the cases stored so far are "
+                               f"kept: free some space and resume with `slewbench sweep {args.file} --out {out} "
+                               "--resume`") from None
     finally:
         signal.signal(signal.SIGTERM, previous)
     files = results.write(out, plots=not args.no_plots)

@@ -22,19 +22,20 @@ import json
 import os
 import shutil
 import tempfile
+from collections.abc import Iterable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterable, Iterator
+from typing import Any
 
 from scenarios.errors import OutputError
-
-if TYPE_CHECKING:
-    pass
+from scenarios.schema.read import read_bounded
 
 __all__ = ["MARKER", "STAGING_PREFIX", "claim_output_directory", "commit_outputs", "new_staging",
            "read_manifest", "write_manifest"]
 
 MARKER = ".slewbench-output.json"
 STAGING_PREFIX = ".slewbench-staging-"
+MAX_MANIFEST_BYTES = 16 * 1024 * 1024
+"""Largest marker read (bytes); a larger one is not slewbench's."""
 
 
 def read_manifest(directory: Path) -> dict[str, Any] | None:
@@ -51,8 +52,9 @@ def read_manifest(directory: Path) -> dict[str, Any] | None:
         The manifest (``tool``, ``kind``, ``complete``, ``files``), or ``None`` when the directory
         carries no valid marker (missing, unreadable, not slewbench's, or naming a file outside it).
     """
-    try:
-        manifest = json.loads((directory / MARKER).read_text())
+    try:  # never waits: a marker that is a named pipe is no marker
+        text = read_bounded(directory / MARKER, MAX_MANIFEST_BYTES)
+        manifest = json.loads(text) if len(text) <= MAX_MANIFEST_BYTES else None
     except (OSError, ValueError):
         return None
     if not isinstance(manifest, dict) or manifest.get("tool") != "slewbench" or not isinstance(manifest.get("files"), list):

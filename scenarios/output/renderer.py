@@ -40,10 +40,19 @@ class RenderingFailed(RuntimeError):
     """The plot process could not draw the figures (it ended early, or drawing raised)."""
 
 
-def _die_with_parent(signum: int, parent: int) -> None:
-    """Have the kernel send ``signum`` to this (just forked) process when its parent ends, so that
-    a plot process never draws on for a parent that is gone (killed, or ended by a signal it does
-    not handle); exit at once if the parent has already gone. Linux only (``prctl``)."""
+def die_with_parent(signum: int, parent: int) -> None:
+    """Have the kernel send ``signum`` to this (just started) process when its parent ends, so that
+    a helper process (a plot process, a trade study's worker) never works on for a parent that is
+    gone (killed, or ended by a signal it does not handle); exit at once if the parent has already
+    gone. Linux only (``prctl``); elsewhere nothing is set.
+
+    Parameters
+    ----------
+    signum : int
+        The signal the kernel sends (``signal.SIGKILL``, ``signal.SIGTERM``).
+    parent : int
+        The parent's process id as the caller knew it before this process started.
+    """
     try:
         import ctypes
 
@@ -228,7 +237,7 @@ def _draw_in_two(jobs: list[Any], directory: Path, forks: list[int]) -> None:
             for signum in stopping:
                 signal.signal(signum, signal.SIG_DFL)
             signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
-            _die_with_parent(signal.SIGKILL, parent)
+            die_with_parent(signal.SIGKILL, parent)
             draw_jobs(theirs, directory, figures)
             code = 0
         finally:
@@ -278,7 +287,7 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
         forks: list[int] = []
         signal.signal(signal.SIGINT, functools.partial(_stop, forks))
         signal.signal(signal.SIGTERM, functools.partial(_stop, forks))
-        _die_with_parent(signal.SIGTERM, parent)
+        die_with_parent(signal.SIGTERM, parent)
         for name in SINGLE_THREAD_ENVIRONMENT:
             os.environ[name] = "1"
         import scenarios.output.plots  # noqa: F401  (matplotlib, while the parent runs)

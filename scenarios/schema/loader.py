@@ -64,6 +64,9 @@ MAX_NAME = 200
 """Characters of a scenario name (the default output directory uses a sanitised, shorter stem)."""
 MAX_LABEL = 100
 """Characters of a planner's or controller's label."""
+MAX_DURATION_S = 1.0e8
+"""Longest ``maneuver.duration`` [s] (about three years): planners raise powers of it, which must
+stay finite."""
 
 
 @dataclass
@@ -296,7 +299,8 @@ MANEUVER = Section((
            default="scalar_first"),
     mapping("initial", "The initial state.", INITIAL),
     mapping("final", "The target state.", FINAL),
-    number("duration", "Manoeuvre time T (a planner minimising time may choose its own).", unit="s", positive=True),
+    number("duration", "Manoeuvre time T (a planner minimising time may choose its own).", unit="s", positive=True,
+           maximum=MAX_DURATION_S),
     number("max_rate", "Bound on the body-rate norm ‖ω‖, for the planners that take one; ``null``: "
            "``requirements.rate.max`` if given, else none. Given with ``requirements.rate``, it must not exceed "
            "it (a tighter planning bound leaves the closed loop room).",

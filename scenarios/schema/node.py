@@ -7,6 +7,7 @@ Reading the file itself (:func:`~scenarios.schema.read.read_yaml`, with its limi
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from typing import Any
 
@@ -20,6 +21,14 @@ __all__ = ["Node"]
 
 def _is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _is_finite(value: int | float) -> bool:
+    """Whether a number is finite as a float (an integer too large for a float is not)."""
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
 
 
 class Node:
@@ -164,7 +173,7 @@ class Node:
         ScenarioError
             Not a finite number, or outside the bounds.
         """
-        if not _is_number(self.value) or not np.isfinite(self.value):
+        if not _is_number(self.value) or not _is_finite(self.value):
             raise self.error(f"expected a number, got {excerpt(self.value)}")
         if positive and not self.value > 0:
             raise self.error(f"expected a positive number, got {excerpt(self.value)}")
@@ -286,9 +295,9 @@ class Node:
             raise self.error(f"expected {expected}{' or a number' if allow_scalar else ''}, got {excerpt(self.value)}")
         if size is not None and len(self.value) != size:
             raise self.error(f"expected {size} numbers, got {len(self.value)}")
-        array = np.asarray(self.value, dtype=float)
-        if not np.all(np.isfinite(array)):
+        if not all(_is_finite(v) for v in self.value):
             raise self.error("expected finite numbers")
+        array = np.asarray(self.value, dtype=float)
         return array
 
     def optional_vector(self, size: int | None = None) -> np.ndarray | None:

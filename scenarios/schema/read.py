@@ -7,7 +7,10 @@ which wraps a value parsed here.
 """
 from __future__ import annotations
 
+import errno
+import os
 import re
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -97,12 +100,13 @@ def parse_yaml_text(text: str, source: Path | str = "<text>") -> Any:
         Text that is not YAML, a value YAML cannot build, a duplicate key, nesting deeper than
         :data:`MAX_DEPTH` or alias expansion beyond :data:`MAX_NODES` values.
     """
-    try:
-        root = yaml.compose(text, Loader=_Loader)
+    loader = _Loader(text)
+    try:  # composed once, checked, then built from the same nodes
+        root = loader.get_single_node()
         if root is None:
             return None
         _check_tree(root, source)
-        return yaml.load(text, Loader=_Loader)
+        return loader.construct_document(root)
     except ScenarioError:
         raise
     except (ValueError, TypeError, OverflowError) as error:  # a value YAML recognised but cannot build
@@ -114,14 +118,67 @@ def parse_yaml_text(text: str, source: Path | str = "<text>") -> Any:
         raise ScenarioError("", f"{source} is not valid YAML{line}: {excerpt(str(problem), 200)}") from None
     except RecursionError:
         raise ScenarioError("", f"{source} nests too deeply") from None
+    finally:
+        loader.dispose()
+
+
+def read_bounded(path: str | Path, limit: int) -> bytes:
+    """At most ``limit + 1`` bytes of the file at ``path``, without ever waiting for a writer.
+
+    The file is opened non-blocking and its type checked before anything is read: a named pipe
+    (with or without a writer) or a socket is refused at once, a directory too; a device that has
+    nothing to give (a terminal) fails instead of waiting. ``/dev/zero`` and other endless files
+    are read only up to the limit.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    limit : int
+        Bytes wanted; one more is read so that the caller can tell a longer file.
+
+    Returns
+    -------
+    bytes
+        The first ``limit + 1`` bytes at most.
+
+    Raises
+    ------
+    OSError
+        The file cannot be opened or read, or is a named pipe, a socket or a directory
+        (``strerror`` says which).
+    """
+    flags = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_CLOEXEC", 0)
+    handle = os.open(path, flags)
+    try:
+        mode = os.fstat(handle).st_mode
+        for check, what in ((stat.S_ISFIFO, "a named pipe"), (stat.S_ISSOCK, "a socket"),
+                            (stat.S_ISDIR, "a directory")):
+            if check(mode):
+                raise OSError(errno.EINVAL, f"it is {what}, not a file", str(path))
+        chunks: list[bytes] = []
+        size = 0
+        while size <= limit:
+            try:
+                chunk = os.read(handle, min(1 << 20, limit + 1 - size))
+            except BlockingIOError:
+                raise OSError(errno.EAGAIN, "it has nothing to read now (a terminal or a device?)", str(path)) from None
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+        return b"".join(chunks)
+    finally:
+        os.close(handle)
 
 
 def read_yaml(path: str | Path) -> Any:
     """Parse a YAML file.
 
-    Numbers such as ``6e5`` are read as numbers; a missing or unreadable file, a file larger than
-    :data:`MAX_FILE_BYTES`, text that is not YAML, a duplicate key, or alias expansion beyond
-    :data:`MAX_NODES` values is a :class:`ScenarioError`.
+    Numbers such as ``6e5`` are read as numbers; a missing or unreadable file, a named pipe, a
+    file larger than :data:`MAX_FILE_BYTES`, text that is not YAML, a duplicate key, or alias
+    expansion beyond :data:`MAX_NODES` values is a :class:`ScenarioError`. Nothing here waits for
+    a writer (:func:`read_bounded`).
 
     Parameters
     ----------
@@ -135,8 +192,7 @@ def read_yaml(path: str | Path) -> Any:
     """
     path = Path(path)
     try:
-        with path.open("rb") as stream:  # read at most the limit: /dev/zero or a pipe reports no size
-            data = stream.read(MAX_FILE_BYTES + 1)
+        data = read_bounded(path, MAX_FILE_BYTES)  # /dev/zero or a pipe reports no size
         if len(data) > MAX_FILE_BYTES:
             raise ScenarioError("", f"{path} has more than {MAX_FILE_BYTES} bytes; scenario and study files are "
                                     "limited to that")
@@ -144,5 +200,6 @@ def read_yaml(path: str | Path) -> Any:
     except FileNotFoundError:
         raise ScenarioError("", f"scenario file not found: {path}") from None
     except (OSError, UnicodeDecodeError) as error:
-        raise ScenarioError("", f"cannot read {path}: {error}") from None
+        reason = error.strerror if isinstance(error, OSError) and error.strerror else error
+        raise ScenarioError("", f"cannot read {path}: {reason}") from None
     return parse_yaml_text(text, path)

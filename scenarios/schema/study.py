@@ -13,13 +13,20 @@ in the schema reference.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Mapping
+import re
+import types
+import typing
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from controllers import CONTROLLERS
 from ocp import METRIC_KEYS, quat
+from ocp.errors import excerpt
+from ocp.options import option_fields
+from planners import PLANNERS
 from scenarios.errors import ScenarioError
 from scenarios.schema.columns import (
     VECTOR_METRICS,
@@ -34,8 +41,8 @@ from scenarios.schema.keys import (
     custom,
     mapping,
     number,
-    text,
 )
+from scenarios.schema.loader import MAX_NAME, SCENARIO
 from scenarios.schema.node import Node
 
 __all__ = [
@@ -46,20 +53,37 @@ __all__ = [
     "DISTRIBUTIONS",
     "EXECUTION",
     "GRID_ENTRY",
+    "INDEPENDENT_KEYS",
     "MAX_CASES",
+    "MAX_CASE_TIMEOUT_S",
+    "MAX_SEED",
     "MAX_VALUES",
+    "MAX_VARIED",
     "MONTE_CARLO",
+    "SCHEDULER_SCHEMES",
     "STUDY",
     "VALUE_GENERATORS",
     "Distribution",
     "ValueGenerator",
+    "declared_key",
     "grid_values",
+    "independent_key",
+    "scheduler_address",
+    "takes_integers",
 ]
 
 MAX_CASES = 100_000
 """Most cases a study may expand to (grid points times Monte Carlo samples)."""
 MAX_VALUES = 10_000
 """Most values of one ``grid`` or ``zip`` entry."""
+MAX_VARIED = 100
+"""Most scenario paths a study varies (``grid``, ``zip`` and ``monte_carlo.dispersions`` together)."""
+MAX_CASE_TIMEOUT_S = 7 * 86400.0
+"""Longest ``execution.case_timeout_s`` accepted [s] (a week)."""
+MAX_SEED = 2**63 - 1
+"""Largest ``monte_carlo.seed``."""
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss")
+"""The schemes of a Dask scheduler's address (none given: ``tcp``)."""
 DEFAULT_SUMMARY = tuple(metric_columns(vectors=False))
 """The metrics summarised when ``summary`` is not given: every scalar metric of the reference
 (``ref.``) and of the closed loop (``cl.``)."""
@@ -102,25 +126,28 @@ def _spaced(kind: str) -> Callable[[Node], tuple[float, float, int]]:
     return read
 
 
-def _linspace(argument: tuple[float, float, int], base: Mapping[str, Any]) -> tuple[list[Any], list[Any]]:
-    values = [float(v) for v in np.linspace(*argument)]
-    return values, values
-
-
-def _geomspace(argument: tuple[float, float, int], base: Mapping[str, Any]) -> tuple[list[Any], list[Any]]:
-    values = [float(v) for v in np.geomspace(*argument)]
+def _spaced_values(node: Node, space: Callable[..., np.ndarray]) -> tuple[list[Any], list[Any]]:
+    start, stop, count = _spaced(space.__name__)(node)
+    with np.errstate(all="ignore"):  # bounds near the largest float: refused below, without NumPy's warnings
+        array = space(start, stop, count)
+    if not np.all(np.isfinite(array)):
+        raise node.error(f"{space.__name__} from {start:g} to {stop:g} gives numbers that are not finite")
+    values = [float(v) for v in array]
     return values, values
 
 
 def _axis(node: Node) -> np.ndarray:
     axis = node.vector(3)
-    if not np.linalg.norm(axis) > 0:
+    largest = float(np.max(np.abs(axis)))
+    if not largest > 0:
         raise node.error("the rotation axis cannot be zero")
-    return axis
+    return axis / largest  # a direction; scaled so that its norm cannot overflow
 
 
 def _angles(node: Node) -> np.ndarray:
     if isinstance(node.value, list):
+        if not 1 <= len(node.value) <= MAX_VALUES:
+            raise node.error(f"expected a list of 1 to {MAX_VALUES} angles")
         return node.vector()
     return Node(grid_values(node, {})[0], node.path).vector()
 
@@ -146,11 +173,11 @@ def _axis_angle(argument: dict[str, Any], base: Mapping[str, Any]) -> tuple[list
 
 VALUE_GENERATORS: dict[str, ValueGenerator] = {generator.name: generator for generator in (
     ValueGenerator(custom("linspace", "``count`` evenly spaced numbers from ``start`` to ``stop`` (both included).",
-                          "list [start, stop, count]", _spaced("linspace"), bounds=f"count from 1 to {MAX_VALUES}"),
-                   _linspace),
+                          "list [start, stop, count]", lambda node: _spaced_values(node, np.linspace),
+                          bounds=f"count from 1 to {MAX_VALUES}"), lambda values, base: values),
     ValueGenerator(custom("geomspace", "``count`` numbers evenly spaced on a log scale from ``start`` to ``stop``.",
-                          "list [start, stop, count]", _spaced("geomspace"),
-                          bounds=f"start, stop > 0; count from 1 to {MAX_VALUES}"), _geomspace),
+                          "list [start, stop, count]", lambda node: _spaced_values(node, np.geomspace),
+                          bounds=f"start, stop > 0; count from 1 to {MAX_VALUES}"), lambda values, base: values),
     ValueGenerator(mapping("axis_angle", "Unit quaternions rotating by each angle about ``axis`` (in the order of "
                            "``maneuver.quaternion_order``); the tables record the angle [deg].", AXIS_ANGLE),
                    _axis_angle),
@@ -324,10 +351,14 @@ def _samples(node: Node) -> int:
 
 
 def _seed(node: Node) -> int:
-    seed = node.integer()
-    if seed < 0:
-        raise node.error(f"expected a non-negative integer, got {seed}")
-    return seed
+    return node.integer(0, MAX_SEED)
+
+
+def _name(node: Node) -> str:
+    name = node.string()
+    if not name.strip() or len(name) > MAX_NAME:
+        raise node.error(f"expected a non-empty name of at most {MAX_NAME} characters, got {excerpt(name)}")
+    return name
 
 
 def _entries(node: Node) -> Node:
@@ -340,7 +371,7 @@ MONTE_CARLO = Section((
     choice("method", "``random``: independent uniforms; ``latin_hypercube``: a Latin hypercube per grid point "
            "(``scipy.stats.qmc``).", ("random", "latin_hypercube"), default="random"),
     custom("seed", "The study's seed: case ``i`` has ``SeedSequence(seed).spawn(n)[i].generate_state(1)[0]``.",
-           "integer", _seed, default=0, bounds=">= 0"),
+           "integer", _seed, default=0, bounds=f">= 0 and <= {MAX_SEED}"),
     custom("dispersions", "Scenario path -> dispersion (see the dispersions below).", "mapping",
            lambda node: node.mapping()),
 ), "Samples per grid point and what they disperse.")
@@ -355,10 +386,48 @@ def _workers(node: Node) -> int | None:
     return workers
 
 
+_ADDRESS = re.compile(r"^(?:(?P<scheme>[A-Za-z][A-Za-z0-9+.-]*)://)?"
+                      r"(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9](?:[A-Za-z0-9.-]{0,251}[A-Za-z0-9])?):(?P<port>[0-9]{1,5})$")
+
+
+def scheduler_address(text: Any, where: str) -> str:
+    """A Dask scheduler's address, checked before anything connects to it.
+
+    Parameters
+    ----------
+    text : Any
+        The address as given: ``[scheme://]host:port`` with a scheme of
+        :data:`SCHEDULER_SCHEMES` (none: ``tcp``), a host name, an IPv4 address or an IPv6
+        address in brackets (``tcp://[::1]:8786``), and a port from 1 to 65535.
+    where : str
+        Where it was given (``execution.scheduler``, ``--scheduler``), for the message.
+
+    Returns
+    -------
+    str
+        The address with its scheme (``tcp://`` added when none was given).
+
+    Raises
+    ------
+    ScenarioError
+        At ``where``, for anything else (the value shown cut to 80 characters).
+    """
+    example = "expected an address such as tcp://127.0.0.1:8786"
+    if not isinstance(text, str):
+        raise ScenarioError(where, f"{example}, got {excerpt(text)}")
+    match = _ADDRESS.match(text.strip())
+    if match is None:
+        raise ScenarioError(where, f"{example} ([scheme://]host:port), got {excerpt(text)}")
+    scheme = (match["scheme"] or "tcp").lower()
+    if scheme not in SCHEDULER_SCHEMES:
+        raise ScenarioError(where, f"unknown scheme {excerpt(scheme)}; expected one of {', '.join(SCHEDULER_SCHEMES)}")
+    if not 1 <= int(match["port"]) <= 65535:
+        raise ScenarioError(where, f"expected a port from 1 to 65535, got {match['port']}")
+    return f"{scheme}://{match['host']}:{int(match['port'])}"
+
+
 def _scheduler(node: Node) -> str | None:
-    if node.value is not None and not isinstance(node.value, str):
-        raise node.error(f"expected an address such as tcp://host:8786, got {node.value!r}")
-    return node.value
+    return None if node.value is None else scheduler_address(node.value, node.path)
 
 
 def _retries(node: Node) -> int:
@@ -374,7 +443,7 @@ EXECUTION = Section((
     custom("scheduler", "Address of a Dask scheduler (``tcp://host:8786``); ``null``: the local process pool.",
            "text or null", _scheduler, default=None),
     number("case_timeout_s", "Wall time after which a case is stopped and becomes a ``crashed`` row.", unit="s",
-           default=600.0, positive=True),
+           default=600.0, positive=True, maximum=MAX_CASE_TIMEOUT_S),
     custom("retries", "How many times a case whose worker died is run again.", "integer", _retries, default=1,
            bounds="0 to 10"),
 ), "How the cases run.")
@@ -396,7 +465,8 @@ def _summary(node: Node) -> list[str]:
 
 
 STUDY = Section((
-    text("study", "The study's name (names ``results/<study>/`` by default)."),
+    custom("study", f"The study's name (names ``results/<study>/`` by default; at most {MAX_NAME} characters).",
+           "text", _name),
     custom("scenario", "The base scenario: a file path relative to the study file, or the scenario mapping itself.",
            "text or mapping", None),
     custom("grid", "Scenario path -> values; the cases are the cartesian product (the last key varies fastest).",
@@ -413,3 +483,140 @@ STUDY = Section((
     custom("resolved", "Written by slewbench into the stored ``study.yaml`` (version, case seeds) and ignored "
            "when read.", "mapping", None, default=None),
 ), "A trade study file.")
+
+
+# --- the scenario keys a study varies -----------------------------------------------------------
+
+Step = str | int | tuple[str, str]
+"""One step of a scenario path: a mapping key, a list index or a ``(key, value)`` selector."""
+
+INDEPENDENT_KEYS = (
+    "simulation.initial_attitude_error_deg",
+    "simulation.initial_rate_error",
+    "simulation.sensor_noise.attitude_deg",
+    "simulation.sensor_noise.rate",
+    "simulation.sensor_noise.seed",
+    "simulation.sensor_noise.magnetic_field",
+    "simulation.settling_tolerance_deg",
+    "simulation.fine_settling_tolerance_deg",
+    "simulation.detumble_tolerance",
+)
+"""Scenario keys that no check of the scenario as a whole reads: the loader's verdict on a scenario
+is its verdict on the key's value alone (the key's own reader) and on the rest of the scenario.
+A study checks the values it gives these keys with their readers, and runs the whole loader once
+per combination of its other values (:mod:`scenarios.study.spec`). Add a key here only when
+nothing but its reader, and the run itself, reads it; ``tests/test_study_validation.py`` compares
+both verdicts."""
+
+
+def declared_key(steps: Sequence[Step]) -> Key | None:
+    """The scenario key the schema declares at a path of mapping keys (list entries of a key that
+    holds entries, such as ``planners[0]``, pass through).
+
+    Parameters
+    ----------
+    steps : sequence of Step
+        The parsed scenario path.
+
+    Returns
+    -------
+    Key or None
+        The key (its reader checks a value), or None where the schema declares none (a planner's
+        or controller's options, an unknown key).
+    """
+    section: Section | None = SCENARIO
+    key: Key | None = None
+    for step in steps:
+        if isinstance(step, str):
+            if section is None or key is not None and key.entries:
+                return None
+            try:
+                key = section[step]
+            except KeyError:
+                return None
+            section = key.section
+        elif key is None or not key.entries:
+            return None
+        else:
+            key = Key(key.name, "mapping", key.meaning, None, section=key.section)  # one entry of the list
+    return key
+
+
+def independent_key(steps: Sequence[Step]) -> Key | None:
+    """The key at ``steps`` when it is one of :data:`INDEPENDENT_KEYS`, with a reader.
+
+    Parameters
+    ----------
+    steps : sequence of Step
+        The parsed scenario path.
+
+    Returns
+    -------
+    Key or None
+        The key, or None when the path is not an independent key.
+    """
+    if not all(isinstance(step, str) for step in steps) or ".".join(map(str, steps)) not in INDEPENDENT_KEYS:
+        return None
+    key = declared_key(steps)
+    return key if key is not None and key.read is not None else None
+
+
+def _option_type(steps: Sequence[Step], base: Mapping[str, Any]) -> Any:
+    """The type of a planner's or controller's option at ``steps`` (``planners[i].options.<name>``,
+    ``controller.options.<name>``, ``controllers[i].options.<name>``), from the entry's name in
+    ``base``; None when the path is not an option of a registered component."""
+    registries: dict[str, Mapping[str, Any]] = {"planners": PLANNERS, "controllers": CONTROLLERS,
+                                                "controller": CONTROLLERS}
+    head = steps[0] if steps else None
+    if not isinstance(head, str) or head not in registries:
+        return None
+    entry: Any = base.get(head)
+    rest = list(steps[1:])
+    if head != "controller":
+        if not rest or not isinstance(entry, list):
+            return None
+        step = rest.pop(0)
+        if isinstance(step, int):
+            entry = entry[step] if -len(entry) <= step < len(entry) else None
+        elif isinstance(step, tuple):
+            found = [item for item in entry if isinstance(item, dict) and str(item.get(step[0])) == step[1]]
+            entry = found[0] if len(found) == 1 else None
+        else:
+            return None
+    if len(rest) != 2 or rest[0] != "options" or not isinstance(entry, dict):
+        return None
+    name = entry.get("name")
+    component = registries[head].get(name) if isinstance(name, str) else None
+    if component is None:
+        return None
+    field = option_fields(component.Options).get(str(rest[1]))
+    return None if field is None else field[0]
+
+
+def takes_integers(steps: Sequence[Step], base: Mapping[str, Any]) -> bool | None:
+    """Whether the scenario key at ``steps`` takes an integer (the keys ``case_seed`` may set).
+
+    Parameters
+    ----------
+    steps : sequence of Step
+        The parsed scenario path.
+    base : mapping
+        The base scenario (it names the planner or controller of an option path).
+
+    Returns
+    -------
+    bool or None
+        True for an integer key of the scenario schema (``simulation.sensor_noise.seed``), or a
+        planner's or controller's option typed ``int`` (or ``int | None``); False for any other
+        key the schema declares; None where it declares none (the scenario loader then refuses an
+        unknown key).
+    """
+    key = declared_key(steps)
+    if key is not None:
+        return key.type == "integer"
+    annotation = _option_type(steps, base)
+    if annotation is None:
+        return None
+    if annotation is int:
+        return True
+    return typing.get_origin(annotation) in (typing.Union, types.UnionType) and int in typing.get_args(annotation)

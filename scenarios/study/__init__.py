@@ -17,15 +17,18 @@ from __future__ import annotations
 from scenarios._faces import lazy_face
 
 _HOMES = {"Case": "scenarios.study.types",
+          "DaskCluster": "scenarios.study.engine",
           "Dispersion": "scenarios.study.dispersions",
           "Execution": "scenarios.study.types",
           "Study": "scenarios.study.types",
           "SweepResults": "scenarios.study.engine",
           "SweepStore": "scenarios.study.store",
+          "connect_scheduler": "scenarios.study.engine",
           "load_study": "scenarios.study.spec",
           "parse_study": "scenarios.study.spec",
           "sweep": "scenarios.study.engine"}
 
-__all__ = ["Case", "Dispersion", "Execution", "Study", "SweepResults", "SweepStore", "load_study", "parse_study", "sweep"]
+__all__ = ["Case", "DaskCluster", "Dispersion", "Execution", "Study", "SweepResults", "SweepStore", "connect_scheduler",
+           "load_study", "parse_study", "sweep"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)

@@ -78,11 +78,41 @@ class Dispersion:
         """
         if self.kind == CASE_SEED.name:
             return seed
-        draws = DISTRIBUTIONS[self.kind].inverse_cdf(unit, self.a, self.b)
-        draw = draws if self.vector else float(draws[0])
-        if self.combine == "set":
-            return draw
-        return COMBINATIONS[self.combine][1](np.asarray(base, dtype=float), draw)
+        value = self.values(np.asarray(unit, dtype=float).reshape(1, -1), [seed], base)
+        return value[0] if isinstance(value, list) else value[0] if value.ndim > 1 else float(value[0])
+
+    def values(self, units: np.ndarray, seeds: list[int], base: Any) -> np.ndarray | list[int]:
+        """The dispersed values of many cases at once, each as :meth:`value` gives it.
+
+        Parameters
+        ----------
+        units : (cases, dimension) ndarray
+            Unit samples in [0, 1), one row per case.
+        seeds : list of int
+            The cases' seeds (the values of ``case_seed``).
+        base : Any
+            The base scenario's value at the path (used by ``scale`` and ``offset``).
+
+        Returns
+        -------
+        ndarray or list of int
+            The seeds for ``case_seed``; else one row per case (a float per case for a scalar, a
+            row of the value's shape for a vector or a scaled list), not finite where a draw or
+            its combination overflowed (NumPy's warnings silenced: the caller reports it).
+        """
+        if self.kind == CASE_SEED.name:
+            return list(seeds)
+        with np.errstate(all="ignore"):
+            draws = DISTRIBUTIONS[self.kind].inverse_cdf(units, self.a, self.b)  # (cases, n)
+            if not self.vector:
+                draws = draws[:, 0]
+            if self.combine == "set":
+                return draws
+            base_value = np.asarray(base, dtype=float)
+            shape = draws.shape[1:]
+            rank = max(base_value.ndim, len(shape))
+            draws = draws.reshape((draws.shape[0],) + (1,) * (rank - len(shape)) + shape)
+            return COMBINATIONS[self.combine][1](base_value, draws)
 
 
 def _forms() -> str:

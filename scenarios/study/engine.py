@@ -3,16 +3,35 @@
 by address; finished cases go to the crash-safe store as they arrive.
 
 A case that raises or exceeds ``case_timeout_s`` is a ``crashed`` row and the sweep goes on. A
-case whose worker died is retried ``retries`` times; when several cases were running on a local
-pool that broke, each is re-run alone so that only the one that kills its worker is charged.
+case whose worker died is retried ``retries`` times (its stored ``attempts`` counts every start).
+On a local pool each worker writes the case it runs and when it started it into a shared slot
+table (:func:`scenarios.study.worker.tracked_case`), so a worker's death is charged to the case
+that worker was running, never to a case that was only queued; when the pool cannot tell (several
+workers died at once), each case that was running is re-run alone, and one that kills its worker
+alone is charged that death and the one it shared. A case's time limit counts from its start in
+its worker. The local workers fork from a server that dies with the sweep, and they die with it
+(:data:`scenarios.study.worker.PARENT_ENVIRONMENT`): a sweep killed outright leaves no process.
+
+On Dask, :func:`connect_scheduler` checks that the address answers as a Dask scheduler within
+:data:`HANDSHAKE_TIMEOUT_S` and that it has workers (waiting at most :data:`WORKER_WAIT_S`) before
+anything is written; cases go in chunks sized from the cases' run times (about
+:data:`CHUNK_TARGET_S` each), and a sweep whose cluster stays without workers for
+:data:`WORKER_WAIT_S` stops as if interrupted (resume it later).
+
+The parent's own work per case (the store's commits, one per batch of results; collection;
+progress) is kept small, so that it keeps up with many workers.
 """
 from __future__ import annotations
 
 import collections
+import json
+import math
 import multiprocessing
 import os
+import statistics
 import sys
 import time
+from collections.abc import Callable
 from concurrent.futures import (
     FIRST_COMPLETED,
     Executor,
@@ -23,19 +42,42 @@ from concurrent.futures import (
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any
 
-from scenarios.errors import SweepInterrupted
+from ocp.errors import excerpt
+from scenarios.errors import ScenarioError, SweepInterrupted
+from scenarios.schema.study import scheduler_address
 from scenarios.study.spec import load_study, parse_study
-from scenarios.study.store import SweepStore
+from scenarios.study.store import SweepStore, encode_rows
 from scenarios.study.types import Case, Study
-from scenarios.study.worker import PRELOAD, crashed_rows, run_case
+from scenarios.study.worker import (
+    PARENT_ENVIRONMENT,
+    PRELOAD,
+    SLOT_FIELDS,
+    crashed_rows,
+    run_case,
+    run_chunk,
+    start_local_worker,
+)
 
 if TYPE_CHECKING:
     import pandas
 
 _POLL_S = 0.5
 _TIMEOUT_GRACE = 1.25  # the driver gives up on a case at this multiple of case_timeout_s (+ 5 s)
+HANDSHAKE_TIMEOUT_S = 10.0
+"""How long a Dask scheduler's address has to answer as a Dask scheduler [s]."""
+WORKER_WAIT_S = 60.0
+"""How long a sweep waits for a Dask cluster without workers: before it starts (then it is refused,
+nothing written) and while it runs (then it stops like an interrupted sweep) [s]."""
+CHUNK_TARGET_S = 0.5
+"""Run time aimed at for one task of several cases, on a local pool or Dask [s]: the cost of a task
+to the sweep (about half a millisecond on a local pool, a millisecond on Dask) is then shared by the
+cases of the chunk."""
+MAX_CHUNK = 64
+"""Most cases in one task."""
+MAX_WORKERS = 1024
+"""Most cases run at once."""
 
 
 @dataclass
@@ -59,6 +101,11 @@ class SweepResults:
     worker_cpu_s : dict
         Worker (``host:pid``) -> CPU time of its process from its start to its last case [s]
         (start-up and imports included; not stored).
+
+    Raises
+    ------
+    TypeError
+        ``study`` is not a :class:`Study` or ``records`` not a dict.
     """
 
     study: Study
@@ -66,6 +113,13 @@ class SweepResults:
     workers: dict[str, int] = field(default_factory=dict)
     cpu_s: dict[str, float] = field(default_factory=dict)
     worker_cpu_s: dict[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.study, Study):
+            raise TypeError(f"study must be a scenarios.study.Study, got {type(self.study).__name__}")
+        for name in ("records", "workers", "cpu_s", "worker_cpu_s"):
+            if not isinstance(getattr(self, name), dict):
+                raise TypeError(f"{name} must be a dict, got {type(getattr(self, name)).__name__}")
 
     @property
     def missing(self) -> int:
@@ -112,7 +166,16 @@ class SweepResults:
         -------
         list of str
             The file names written (relative to ``directory``).
+
+        Raises
+        ------
+        TypeError
+            ``directory`` is not a path or ``plots`` not a bool.
         """
+        if not isinstance(directory, (str, os.PathLike)):
+            raise TypeError(f"directory must be a str or os.PathLike, got {type(directory).__name__}")
+        if not isinstance(plots, bool):
+            raise TypeError(f"plots must be True or False, got {excerpt(plots)}")
         from scenarios.study.report import write_report
         return write_report(self, Path(directory), plots=plots)
 
@@ -129,7 +192,8 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
     """Start (once per process) the server that local workers fork from, importing :data:`PRELOAD`.
 
     It returns at once: the server imports while the caller goes on (the CLI calls this before it
-    expands the study), and the first worker waits until the imports are done.
+    expands the study), and the first worker waits until the imports are done. The server dies
+    with this process (:data:`scenarios.study.worker.PARENT_ENVIRONMENT`), and the workers with it.
 
     Returns
     -------
@@ -139,142 +203,353 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(list(PRELOAD))
     from multiprocessing import forkserver
-    forkserver.ensure_running()
+    previous = os.environ.get(PARENT_ENVIRONMENT)
+    os.environ[PARENT_ENVIRONMENT] = str(os.getpid())  # seen by the server only: it starts now, if not yet
+    try:
+        forkserver.ensure_running()
+    finally:
+        if previous is None:
+            os.environ.pop(PARENT_ENVIRONMENT, None)
+        else:
+            os.environ[PARENT_ENVIRONMENT] = previous
     return context
 
 
-def _local_pool(workers: int) -> ProcessPoolExecutor:
-    """Worker processes forked from a server that has imported the workbench once."""
-    return ProcessPoolExecutor(max_workers=workers, mp_context=start_forkserver())
+class _LocalPool:
+    """A process pool forked from the server, with its slot table (module docstring)."""
+
+    def __init__(self, workers: int):
+        from multiprocessing import forkserver
+        context = start_forkserver()
+        self.slots = context.Array("d", SLOT_FIELDS * workers, lock=False)
+        server = getattr(forkserver._forkserver, "_forkserver_pid", None) or -1  # private, stable since 3.4
+        self.executor = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=start_local_worker,
+                                            initargs=(self.slots, context.Lock(), server))
+        self.ours: set[int] = set()  # workers this pool killed itself
+        self.processes: Any = self.executor._processes  # private, stable since 3.8; kept after shutdown
+
+    def running(self) -> dict[int, tuple[int, float]]:
+        """Case index -> (worker pid, start time) of the cases the workers are running now."""
+        found = {}
+        for at in range(0, len(self.slots), SLOT_FIELDS):
+            pid, index, start = self.slots[at:at + 3]
+            if pid and index:
+                found[int(index) - 1] = (int(pid), start)
+        return found
+
+    def started(self) -> set[int]:
+        """Indices of the cases the workers are running or have finished (since their last results
+        may not have reached the sweep)."""
+        found = set(self.running())
+        for at in range(0, len(self.slots), SLOT_FIELDS):
+            if self.slots[at + 3]:
+                found.add(int(self.slots[at + 3]) - 1)
+        return found
+
+    def kill(self) -> None:
+        """Stop now, including a worker stuck in C code (it cannot be interrupted)."""
+        for process in list(self.processes.values()):
+            if process.is_alive():
+                self.ours.add(process.pid)
+                process.kill()
+        self.executor.shutdown(wait=False, cancel_futures=True)
+
+    def culprits(self) -> set[int]:
+        """Workers that ended by themselves (not stopped by the pool or by :meth:`kill`)."""
+        import signal
+        found = set()
+        for process in list(self.processes.values()):
+            process.join(timeout=5.0)
+            if process.exitcode is not None and process.exitcode != -signal.SIGTERM and process.pid not in self.ours:
+                found.add(process.pid)
+        return found
 
 
-def _kill_pool(pool: Executor) -> None:
-    """Stop a local pool now, including a worker stuck in C code (it cannot be interrupted)."""
-    for process in list(getattr(pool, "_processes", {}).values()):  # private, stable since 3.8
-        if process.is_alive():
-            process.kill()
-    pool.shutdown(wait=False, cancel_futures=True)
+@dataclass
+class _Batch:
+    """Cases submitted together (one case, or a Dask chunk) and when their clock started."""
+
+    keys: list[str]
+    submitted: float
+    started: float | None = None
 
 
 class _Engine:
     """The submit / collect loop; see the module docstring for the failure rules."""
 
     def __init__(self, study: Study, executor: Executor | None, workers: int, store: SweepStore | None,
-                 progress: bool, task: Callable[[dict[str, Any]], dict[str, Any]]):
-        self.study, self.store, self.task = study, store, task
+                 progress: bool, task: Callable[[dict[str, Any]], dict[str, Any]], cluster: Any = None):
+        self.study, self.store, self.task, self.cluster = study, store, task, cluster
         self.owned = executor is None
         self.workers = workers
-        # a local pool gets one case ahead of its workers, so that none idles while the driver stores a
-        # result; other executors get one case per worker, so that a case's clock starts when it runs
-        self.window = workers + 1 if self.owned else workers
-        self.executor: Executor = _local_pool(workers) if executor is None else executor
+        self.dask = not self.owned and type(executor).__module__.startswith("distributed")
+        self.chunked = self.owned or self.dask
+        # a local pool gets one chunk ahead of its workers, so that none idles while the driver stores a
+        # result; Dask two chunks per worker; other executors one case per worker
+        self.window = workers + 1 if self.owned else workers * (2 if self.dask else 1)
+        self.pool = _LocalPool(workers) if self.owned else None
+        self.executor: Executor = self.pool.executor if self.pool is not None else executor  # type: ignore[assignment]
         self.timeout = study.execution.case_timeout_s
+        self.limit = self.timeout * _TIMEOUT_GRACE + 5.0
         self.records: dict[str, dict[str, Any]] = dict(store.records()) if store is not None else {}
         self.cases: dict[str, Case] = {}
         for case in study.cases:
             if case.key not in self.records:
                 self.cases.setdefault(case.key, case)
         self.pending = collections.deque(self.cases)
-        self.suspects: collections.deque[str] = collections.deque()
-        self.in_flight: dict[Future, tuple[str, float]] = {}
-        self.attempts: dict[str, int] = collections.Counter()
+        self.suspects: collections.deque[str] = collections.deque()  # run alone, one at a time
+        self.singles: collections.deque[str] = collections.deque()  # cases of a failed chunk, one per task
+        self.in_flight: dict[Future, _Batch] = {}
+        self.starts: dict[str, int] = collections.Counter()  # times started (stored as attempts)
+        self.deaths: dict[str, int] = collections.Counter()  # worker deaths charged (against retries)
+        self.shared: dict[str, int] = collections.Counter()  # deaths shared with others, charged if it dies alone
         self.worker_builds: dict[str, int] = {}
         self.cpu_s: dict[str, float] = {}
         self.worker_cpu_s: dict[str, float] = {}
+        self.elapsed: collections.deque[float] = collections.deque(maxlen=64)
         self.failures = 0
+        self.no_workers_since: float | None = None
+        self.next_cluster_check = 0.0
         self.bar = None
         if progress:
             from tqdm import tqdm
-            self.bar = tqdm(total=len(self.cases), unit="case", desc=study.name, dynamic_ncols=True,
-                            disable=not sys.stderr.isatty(), file=sys.stderr)
+            self.bar = tqdm(total=len(self.cases), unit="case", desc=study.name[:40], dynamic_ncols=True,
+                            disable=not sys.stderr.isatty(), file=sys.stderr, mininterval=0.5)
 
-    def _submit(self, key: str) -> None:
-        payload = {"key": key, "scenario": self.cases[key].scenario, "timeout_s": self.timeout}
-        self.in_flight[self.executor.submit(self.task, payload)] = (key, time.monotonic())
+    # --- submitting ---------------------------------------------------------------------------
 
-    def _finish(self, key: str, status: str, rows: list[dict[str, Any]], elapsed: float | None,
-                attempts: int | None = None) -> None:
-        attempts = self.attempts[key] + 1 if attempts is None else attempts
-        record = {"status": status, "rows": rows, "elapsed_s": elapsed, "attempts": attempts}
-        if self.store is not None:
-            self.store.put(key, status, rows, elapsed, attempts)
-        self.records[key] = record
-        self.failures += any(row["status"] != "ok" for row in rows)
-        if self.bar is not None:
-            self.bar.set_postfix(failures=self.failures, refresh=False)
-            self.bar.update(1)
+    def _payload(self, key: str) -> dict[str, Any]:
+        case = self.cases[key]
+        return {"key": key, "index": case.index, "scenario": case.scenario, "timeout_s": self.timeout}
 
-    def _died(self, keys: list[str], why: str) -> None:
-        """Cases whose worker died: one alone is charged an attempt; several are re-run alone."""
-        if len(keys) > 1 and self.owned:
-            self.suspects.extend(keys)
-            return
+    def _submit(self, keys: list[str]) -> None:
+        now = time.monotonic()
+        future: Future[Any]
+        if self.chunked:
+            future = self.executor.submit(run_chunk, self.task, [self._payload(key) for key in keys])
+        else:
+            future = self.executor.submit(self.task, self._payload(keys[0]))
         for key in keys:
-            self.attempts[key] += 1
-            if self.attempts[key] > self.study.execution.retries:
-                self._finish(key, "crashed", crashed_rows(
-                    self.cases[key].scenario, f"worker died ({why}); {self.attempts[key]} attempt(s)"),
-                    None, self.attempts[key])
-            elif self.owned:
-                self.suspects.append(key)
-            else:
-                self.pending.appendleft(key)
+            self.starts[key] += 1  # taken back for a case a broken pool never started (_requeue)
+        self.in_flight[future] = _Batch(keys, now)
 
-    def _restart_pool(self) -> list[str]:
-        """Replace a broken or stuck local pool; returns the keys that were running on it."""
-        keys = [key for key, _ in self.in_flight.values()]
-        self.in_flight.clear()
-        _kill_pool(self.executor)
-        self.executor = _local_pool(self.workers)
-        return keys
+    def _chunk_size(self) -> int:
+        """Cases per task: about :data:`CHUNK_TARGET_S` of work (one case until cases have been
+        timed), fewer near the end so that every worker gets a share."""
+        if not self.chunked or len(self.elapsed) < min(self.workers, 8):
+            return 1
+        typical = statistics.median(self.elapsed) or 1e-3
+        size = int(CHUNK_TARGET_S / typical)
+        share = math.ceil(len(self.pending) / (2 * self.workers))
+        return max(1, min(size, MAX_CHUNK, share))
+
+    def _chunk_limit(self, size: int) -> float:
+        """The driver's limit for a batch of ``size`` cases [s]: one case's, plus a generous share of
+        the typical case's time for each other case (a chunk over it is run again case by case)."""
+        typical = statistics.median(self.elapsed) if self.elapsed else self.timeout
+        return self.limit + (size - 1) * max(4.0 * typical, 1.0)
 
     def _fill(self) -> None:
         if self.suspects:
             if not self.in_flight:
-                self._submit(self.suspects.popleft())
+                key = self.suspects.popleft()
+                self._submit([key])
             return
-        while self.pending and len(self.in_flight) < self.window:
-            self._submit(self.pending.popleft())
+        while (self.singles or self.pending) and len(self.in_flight) < self.window:
+            if self.singles:
+                self._submit([self.singles.popleft()])
+                continue
+            size = self._chunk_size()
+            self._submit([self.pending.popleft() for _ in range(min(size, len(self.pending)))])
+
+    # --- collecting ---------------------------------------------------------------------------
+
+    def _record(self, key: str, status: str, rows: list[dict[str, Any]], elapsed: float | None, batch: list,
+                text: str | None = None) -> None:
+        """Keep a finished case's record and queue it for the store (``text``: its rows encoded)."""
+        attempts = max(self.starts[key], 1)
+        self.records[key] = {"status": status, "rows": rows, "elapsed_s": elapsed, "attempts": attempts}
+        batch.append((key, status, encode_rows(rows) if text is None else text, elapsed, attempts))
+        self.failures += any(row["status"] != "ok" for row in rows)
+
+    def _commit(self, batch: list[tuple[str, str, str, float | None, int]]) -> None:
+        """Commit finished cases in one transaction, then report them (a case shown done is stored)."""
+        if not batch:
+            return
+        if self.store is not None:
+            self.store.put_encoded(batch)
+        if self.bar is not None:
+            self.bar.set_postfix(failures=self.failures, refresh=False)
+            self.bar.update(len(batch))
+
+    def _crash(self, key: str, message: str, batch: list) -> None:
+        self._record(key, "crashed", crashed_rows(self.cases[key].scenario, message), None, batch)
+
+    def _charge(self, key: str, deaths: int, why: str, batch: list) -> None:
+        """Charge ``deaths`` worker deaths to ``key``: crashed past ``retries``, else run again."""
+        self.deaths[key] += deaths
+        self.shared.pop(key, None)
+        if self.deaths[key] > self.study.execution.retries:
+            self._crash(key, f"worker died ({why}); {self.starts[key]} attempt(s)", batch)
+        else:
+            self.pending.appendleft(key)
+
+    def _result(self, key: str, result: dict[str, Any], batch: list) -> None:
+        self.worker_builds[result["worker"]] = result["cache_builds"]
+        text = result.get("rows_json")
+        rows = json.loads(text) if text is not None else result["rows"]  # as stored: non-finite numbers null
+        self._record(key, result["status"], rows, result["elapsed_s"], batch, text)
+        if result.get("elapsed_s") is not None:
+            self.elapsed.append(result["elapsed_s"])
+        if result.get("cpu_s") is not None:
+            self.cpu_s[key] = result["cpu_s"]
+            self.worker_cpu_s[result["worker"]] = max(result["worker_cpu_s"], self.worker_cpu_s.get(result["worker"], 0.0))
 
     def _collect(self, done: set[Future]) -> None:
-        broken: list[str] = []
+        batch: list = []
+        broken = False
         for future in done:
-            key, _ = self.in_flight.pop(future)
+            entry = self.in_flight.pop(future)
             try:
-                result = future.result()
-            except BrokenProcessPool as error:
-                if self.owned:
-                    broken.append(key)
+                outcome = future.result()
+            except BrokenProcessPool:
+                if self.pool is not None:
+                    broken = True
+                    self.in_flight[future] = entry  # sorted out with the other cases of the pool below
                 else:  # a pool the caller owns: it cannot be restarted from here
-                    self._died([key], f"{type(error).__name__}: {error}"[:300])
+                    for key in entry.keys:
+                        self._charge(key, 1, "its process ended abruptly", batch)
                 continue
             except Exception as error:  # a lost worker on a cluster (dask's KilledWorker, ...)
-                self._died([key], f"{type(error).__name__}: {error}"[:300])
+                why = excerpt(f"{type(error).__name__}: {error}", 300)
+                if len(entry.keys) > 1:  # a chunk: each of its cases again, one per task
+                    self.singles.extend(entry.keys)
+                else:
+                    self._charge(entry.keys[0], 1, why, batch)
                 continue
-            self.worker_builds[result["worker"]] = result["cache_builds"]
-            self._finish(key, result["status"], result["rows"], result["elapsed_s"])
-            if result.get("cpu_s") is not None:
-                self.cpu_s[key] = result["cpu_s"]
-                self.worker_cpu_s[result["worker"]] = max(result["worker_cpu_s"],
-                                                          self.worker_cpu_s.get(result["worker"], 0.0))
+            results = outcome if isinstance(outcome, list) else [outcome]
+            for key, result in zip(entry.keys, results):
+                self._result(key, result, batch)
+        self._commit(batch)
         if broken:
-            self._died(broken + self._restart_pool(), "its process ended abruptly")
+            self._pool_broke()
+        for key in list(self.shared):
+            if key in self.records:
+                del self.shared[key]
+
+    def _requeue(self, batches: list[_Batch], started: set[int], keep: set[str]) -> None:
+        """Cases of a stopped pool run again, first (but those in ``keep``, dealt with by the caller).
+        A chunk's cases run in order: those up to the last one a worker started were started, the
+        others are not counted as started."""
+        again = []
+        for batch in batches:
+            positions = [at for at, key in enumerate(batch.keys) if self.cases[key].index in started]
+            last = max(positions, default=-1)
+            for at, key in enumerate(batch.keys):
+                if at > last:
+                    self.starts[key] -= 1
+                if key not in keep:
+                    again.append(key)
+        self.pending.extendleft(sorted(again, key=lambda key: -self.cases[key].index))
+
+    def _new_pool(self) -> None:
+        self.pool = _LocalPool(self.workers)
+        self.executor = self.pool.executor
+
+    def _pool_broke(self) -> None:
+        """The local pool lost a worker: charge the case that worker was running; when the pool cannot
+        tell, each case that was running runs alone (and owns this death if it dies alone)."""
+        assert self.pool is not None
+        running, started = self.pool.running(), self.pool.started()
+        self.pool.kill()
+        culprits = self.pool.culprits()
+        batches = list(self.in_flight.values())
+        self.in_flight.clear()
+        keys = [key for batch in batches for key in batch.keys]
+        ran = sorted((key for key in keys if self.cases[key].index in running), key=lambda key: self.cases[key].index)
+        guilty = [key for key in ran if running[self.cases[key].index][0] in culprits]
+        suspects: list[str] = []
+        if len(guilty) == 1 or (not culprits and len(ran) == 1):
+            charged: str | None = (guilty or ran)[0]
+        else:
+            charged = None
+            suspects = guilty or ([] if culprits else ran)  # a culprit between cases: no one to charge
+            for key in suspects:
+                self.shared[key] += 1
+        self._requeue(batches, started, set(suspects) | ({charged} if charged is not None else set()))
+        self.suspects.extend(suspects)
+        batch: list = []
+        if charged is not None:
+            self._charge(charged, 1 + self.shared.get(charged, 0), "its process ended abruptly", batch)
+        self._commit(batch)
+        self._new_pool()
+
+    # --- time limits and the cluster -----------------------------------------------------------
+
+    def _clocks(self, now: float) -> list[tuple[float, Future, _Batch]]:
+        """Batches in flight with the time their clock started (not on a local pool): a batch's clock
+        starts when it is among the oldest ``workers`` batches in flight (cases wait behind the
+        running ones)."""
+        for position, batch in enumerate(self.in_flight.values()):  # in submission order
+            if position >= self.workers:
+                break
+            if batch.started is None:
+                batch.started = now
+        return [(batch.started, future, batch) for future, batch in self.in_flight.items() if batch.started is not None]
 
     def _check_time(self) -> None:
-        """Cases past the driver's limit (a worker stuck where the in-worker alarm cannot reach).
-        On a local pool only the oldest is charged (the others may have waited behind it); the
-        pool is restarted and the others run again."""
-        limit = self.timeout * _TIMEOUT_GRACE + 5.0
+        """Cases past the driver's limit (a worker stuck where the in-worker alarm cannot reach)."""
+        if self.pool is not None:
+            self._check_pool_time()
+            return
         now = time.monotonic()
-        late = sorted(((start, key, future) for future, (key, start) in self.in_flight.items()
-                       if now - start > limit), key=lambda item: item[0])
-        for _, key, future in late[:1] if self.owned else late:
+        late = [(future, batch) for start, future, batch in self._clocks(now)
+                if now - start > self._chunk_limit(len(batch.keys))]
+        batch_out: list = []
+        for future, batch in late:
             self.in_flight.pop(future)
             future.cancel()
-            self._finish(key, "crashed", crashed_rows(
-                self.cases[key].scenario, f"timed out after {self.timeout:g} s (case_timeout_s); worker stopped"), None)
-        if late and self.owned:
-            self.pending.extendleft(reversed(self._restart_pool()))
+            if len(batch.keys) > 1:  # a chunk: its cases again, one by one, each with its own clock
+                self.singles.extend(batch.keys)
+                continue
+            self._crash(batch.keys[0], f"timed out after {self.timeout:g} s (case_timeout_s); worker stopped", batch_out)
+        self._commit(batch_out)
+
+    def _check_pool_time(self) -> None:
+        """On a local pool a case's clock starts when its worker starts it (the slot table): a late
+        case is crashed, its worker stopped with the pool, and the other cases run again."""
+        assert self.pool is not None
+        now = time.monotonic()
+        running = self.pool.running()
+        late = [key for batch in self.in_flight.values() for key in batch.keys
+                if self.cases[key].index in running and now - running[self.cases[key].index][1] > self.limit]
+        if not late:
+            return
+        started = self.pool.started()
+        self.pool.kill()
+        batches = list(self.in_flight.values())
+        self.in_flight.clear()
+        self._requeue(batches, started, keep=set(late))
+        batch_out: list = []
+        for key in late:
+            self._crash(key, f"timed out after {self.timeout:g} s (case_timeout_s); worker stopped", batch_out)
+        self._commit(batch_out)
+        self._new_pool()
+
+    def _check_cluster(self) -> None:
+        """A Dask cluster without workers: clocks wait, and after :data:`WORKER_WAIT_S` the sweep stops."""
+        now = time.monotonic()
+        if self.cluster is None or now < self.next_cluster_check:
+            return
+        self.next_cluster_check = now + 1.0
+        if self.cluster.workers() > 0:
+            self.no_workers_since = None
+            return
+        self.no_workers_since = self.no_workers_since or now
+        for batch in self.in_flight.values():
+            batch.started = None  # no case runs without a worker
+        if now - self.no_workers_since > WORKER_WAIT_S:
+            raise _ClusterLost(f"the Dask cluster has had no workers for {WORKER_WAIT_S:g} s")
 
     def run(self) -> None:
         try:
@@ -282,18 +557,23 @@ class _Engine:
                 self._fill()
                 done, _ = wait(list(self.in_flight), timeout=_POLL_S, return_when=FIRST_COMPLETED)
                 self._collect(done)
+                self._check_cluster()
                 self._check_time()
         finally:
             if self.bar is not None:
                 self.bar.close()
-            if self.owned:
+            if self.pool is not None:
                 if self.in_flight:
-                    _kill_pool(self.executor)
+                    self.pool.kill()
                 else:
                     self.executor.shutdown(wait=True)
             else:
                 for future in self.in_flight:
                     future.cancel()
+
+
+class _ClusterLost(Exception):
+    """The Dask cluster stayed without workers."""
 
 
 def default_workers() -> int:
@@ -307,8 +587,126 @@ def default_workers() -> int:
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
+def _identity(address: str, timeout_s: float) -> dict[str, Any]:
+    """Ask ``address`` who it is, over Dask's protocol, giving up after ``timeout_s``; runs in a
+    thread of its own so that it works under a caller's running event loop."""
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed.comm import connect
+
+    async def ask() -> Any:
+        comm = await connect(address, timeout=timeout_s)
+        try:
+            await comm.write({"op": "identity"})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    def run() -> Any:
+        return asyncio.run(asyncio.wait_for(ask(), timeout_s))
+
+    pool = ThreadPoolExecutor(1, thread_name_prefix="slewbench-handshake")
+    try:
+        return pool.submit(run).result(timeout=timeout_s + 5.0)
+    finally:
+        pool.shutdown(wait=False)
+
+
+@dataclass
+class DaskCluster:
+    """A Dask cluster the sweep connected to (:func:`connect_scheduler`).
+
+    Parameters
+    ----------
+    address : str
+        The scheduler's address.
+    client : distributed.Client
+        The client connected to it.
+    """
+
+    address: str
+    client: Any
+
+    @property
+    def executor(self) -> Executor:
+        """The client's ``concurrent.futures`` executor."""
+        return self.client.get_executor()
+
+    def workers(self) -> int:
+        """Worker threads the scheduler knows now.
+
+        Returns
+        -------
+        int
+            The sum of the workers' threads (0: no worker).
+        """
+        info = self.client.scheduler_info()
+        return sum(int(worker.get("nthreads", 1)) for worker in info.get("workers", {}).values())
+
+    def close(self) -> None:
+        """Close the client (the cluster goes on)."""
+        self.client.close()
+
+
+def connect_scheduler(address: str, where: str = "execution.scheduler", wait_s: float | None = None) -> DaskCluster:
+    """Connect to a Dask scheduler, or refuse at once: a malformed address, an address that does not
+    answer as a Dask scheduler within :data:`HANDSHAKE_TIMEOUT_S` (a web server, a closed port),
+    or a scheduler without workers after ``wait_s``.
+
+    Parameters
+    ----------
+    address : str
+        ``[scheme://]host:port`` (:func:`scenarios.schema.study.scheduler_address`).
+    where : str, optional
+        Where the address was given (``execution.scheduler`` or ``--scheduler``), for messages.
+    wait_s : float or None, optional
+        How long to wait for a first worker [s]; None: :data:`WORKER_WAIT_S`.
+
+    Returns
+    -------
+    DaskCluster
+        The connected client.
+
+    Raises
+    ------
+    ScenarioError
+        At ``where``, saying what is wrong (exit status 2 on the command line; nothing written).
+    """
+    address = scheduler_address(address, where)
+    wait_s = WORKER_WAIT_S if wait_s is None else wait_s
+    try:
+        import distributed
+    except ImportError:
+        raise ScenarioError(where, "a Dask scheduler needs the distributed package (pip install distributed)") from None
+    try:
+        identity = _identity(address, HANDSHAKE_TIMEOUT_S)
+    except (TimeoutError, OSError) as error:
+        why = "no answer" if isinstance(error, TimeoutError) or "Timed out" in str(error) else excerpt(str(error), 200)
+        raise ScenarioError(where, f"no Dask scheduler answered at {address} within {HANDSHAKE_TIMEOUT_S:g} s "
+                                   f"({why}); is one running there?") from None
+    except Exception as error:  # anything that is not Dask's protocol
+        raise ScenarioError(where, f"{address} did not answer as a Dask scheduler "
+                                   f"({type(error).__name__}: {excerpt(str(error), 200)})") from None
+    if not isinstance(identity, dict) or identity.get("type") != "Scheduler":
+        raise ScenarioError(where, f"{address} answered, but not as a Dask scheduler ({excerpt(identity, 100)})")
+    deadline = time.monotonic() + wait_s
+    while not identity.get("workers") and time.monotonic() < deadline:
+        time.sleep(min(1.0, max(0.0, deadline - time.monotonic())))
+        identity = _identity(address, HANDSHAKE_TIMEOUT_S)
+    if not identity.get("workers"):
+        raise ScenarioError(where, f"the Dask scheduler at {address} has no workers (waited {wait_s:g} s); start "
+                                   f"some with `dask worker {address} --nthreads 1`")
+    try:
+        client = distributed.Client(address, timeout=f"{HANDSHAKE_TIMEOUT_S}s")
+    except (OSError, TimeoutError) as error:
+        raise ScenarioError(where, f"cannot connect to the Dask scheduler at {address}: "
+                                   f"{excerpt(str(error), 200)}") from None
+    return DaskCluster(address, client)
+
+
 def dask_executor(address: str) -> tuple[Executor, int, Callable[[], None]]:
-    """A Dask cluster's executor.
+    """A Dask cluster's executor (:func:`connect_scheduler`).
 
     Parameters
     ----------
@@ -327,40 +725,58 @@ def dask_executor(address: str) -> tuple[Executor, int, Callable[[], None]]:
     Raises
     ------
     ScenarioError
-        The scheduler cannot be reached (``execution.scheduler``).
+        As :func:`connect_scheduler`.
     """
-    from distributed import Client
-    try:
-        client = Client(address, timeout="20s")
-    except OSError as error:
-        from scenarios.errors import ScenarioError
-        raise ScenarioError("execution.scheduler", f"cannot reach the Dask scheduler at {address}: {error}") from None
-    threads = sum(client.nthreads().values()) or 1
-    return client.get_executor(), threads, client.close
+    cluster = connect_scheduler(address)
+    return cluster.executor, max(cluster.workers(), 1), cluster.close
 
 
-def sweep(study: Study | dict[str, Any] | str | Path, executor: Executor | None = None, *,
+def _check_arguments(study: Any, executor: Any, workers: Any, store: Any, progress: Any, task: Any,
+                     cluster: Any) -> None:
+    if not isinstance(study, (Study, dict, str, os.PathLike)):
+        raise TypeError(f"study must be a Study, a study mapping or a path, got {type(study).__name__}")
+    if executor is not None and not isinstance(executor, Executor):
+        raise TypeError(f"executor must be a concurrent.futures.Executor or None, got {type(executor).__name__}")
+    if workers is not None and (not isinstance(workers, int) or isinstance(workers, bool)
+                                or not 1 <= workers <= MAX_WORKERS):
+        raise ValueError(f"workers must be an integer from 1 to {MAX_WORKERS} or None, got {excerpt(workers)}")
+    if store is not None and not isinstance(store, SweepStore):
+        raise TypeError(f"store must be a SweepStore or None, got {type(store).__name__}")
+    if not isinstance(progress, bool):
+        raise TypeError(f"progress must be True or False, got {excerpt(progress)}")
+    if not callable(task):
+        raise TypeError(f"task must be a callable (payload dict -> result dict), got {excerpt(task)}")
+    if cluster is not None and not isinstance(cluster, DaskCluster):
+        raise TypeError(f"cluster must be a DaskCluster or None, got {type(cluster).__name__}")
+
+
+def sweep(study: Study | dict[str, Any] | str | os.PathLike[str], executor: Executor | None = None, *,
           workers: int | None = None, store: SweepStore | None = None, progress: bool = False,
-          task: Callable[[dict[str, Any]], dict[str, Any]] = run_case) -> SweepResults:
+          task: Callable[[dict[str, Any]], dict[str, Any]] = run_case, cluster: DaskCluster | None = None
+          ) -> SweepResults:
     """Run every case of a trade study.
 
     Parameters
     ----------
-    study : Study, dict, str or Path
+    study : Study, dict, str or os.PathLike
         A :class:`Study`, a study mapping, or the path of a study file.
     executor : concurrent.futures.Executor or None, optional
         Any executor (a Dask client's ``get_executor()``, a process pool); None: a local process
-        pool with ``workers`` processes, or the Dask cluster named by the study's
-        ``execution.scheduler``.
+        pool with ``workers`` processes, or the Dask cluster ``cluster``, or the one named by the
+        study's ``execution.scheduler`` (:func:`connect_scheduler`).
     workers : int or None, optional
-        Cases run at once (None: the study's ``execution.workers``, else one per core).
+        Cases run at once, 1 to 1024 (None: the study's ``execution.workers``, else one per core;
+        on Dask, the cluster's worker threads).
     store : SweepStore or None, optional
         Where finished cases are committed (and skipped when already there); None: memory only.
     progress : bool, optional
         Show a progress bar (only when stderr is a terminal).
     task : callable, optional
         The worker function, payload dict -> result dict (:func:`scenarios.study.worker.run_case`;
-        tests replace it).
+        tests replace it). On a local pool it must be importable by the worker processes.
+    cluster : DaskCluster or None, optional
+        A Dask cluster already connected (:func:`connect_scheduler`; the command line connects
+        before it writes anything); this call does not close it.
 
     Returns
     -------
@@ -370,24 +786,36 @@ def sweep(study: Study | dict[str, Any] | str | Path, executor: Executor | None 
     Raises
     ------
     SweepInterrupted
-        On Ctrl-C (or SIGTERM turned into KeyboardInterrupt): committed cases stay in the store.
+        On Ctrl-C (or SIGTERM turned into KeyboardInterrupt), or a Dask cluster left without
+        workers for :data:`WORKER_WAIT_S`: committed cases stay in the store.
+    ScenarioError
+        A bad study, or a scheduler that cannot be used (:func:`connect_scheduler`).
+    TypeError, ValueError
+        An argument of the wrong type or out of range, named in the message.
     """
-    if isinstance(study, (str, Path)):
+    _check_arguments(study, executor, workers, store, progress, task, cluster)
+    if isinstance(study, (str, os.PathLike)):
         study = load_study(study)
     elif isinstance(study, dict):
         study = parse_study(study)
-    close = None
-    if executor is None and study.execution.scheduler:
-        executor, threads, close = dask_executor(study.execution.scheduler)
-        workers = workers or threads
-    workers = workers or study.execution.workers or default_workers()
-    engine = _Engine(study, executor, workers, store, progress, task)
+    own = None
+    if executor is None and cluster is None and study.execution.scheduler:
+        cluster = own = connect_scheduler(study.execution.scheduler)
     try:
-        engine.run()
-    except KeyboardInterrupt:
-        results = SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)
-        raise SweepInterrupted(results.missing, len(study.cases)) from None
+        if executor is None and cluster is not None:
+            executor = cluster.executor
+            workers = workers or max(cluster.workers(), 1)
+        workers = workers or study.execution.workers or default_workers()
+        engine = _Engine(study, executor, workers, store, progress, task, cluster)
+        try:
+            engine.run()
+        except KeyboardInterrupt:
+            results = SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)
+            raise SweepInterrupted(results.missing, len(study.cases)) from None
+        except _ClusterLost as lost:
+            results = SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)
+            raise SweepInterrupted(results.missing, len(study.cases), str(lost)) from None
     finally:
-        if close is not None:
-            close()
+        if own is not None:
+            own.close()
     return SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)

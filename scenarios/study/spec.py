@@ -1,5 +1,5 @@
-"""Trade-study files (:doc:`/reference/schema`): reading a study and expanding it into resolved
-cases, each validated by the scenario loader.
+"""Trade-study files (:doc:`/reference/schema`): reading a study and expanding it into resolved,
+validated cases.
 
 A study varies a base scenario over a ``grid`` (cartesian product), a ``zip`` (equal-length lists
 varied together) and, per grid point, ``monte_carlo`` samples of ``dispersions``. Every case gets a
@@ -7,85 +7,89 @@ seed from ``numpy.random.SeedSequence(seed).spawn``, so its values (and its resu
 on the number of workers or the order in which cases finish. The study file's keys, its value
 generators and its distributions are declared in :mod:`scenarios.schema.study`; the study's data
 classes are in :mod:`scenarios.study.types`.
+
+The number of cases is known from the lengths of the varied lists before any case is built, and a
+study over :data:`~scenarios.schema.study.MAX_CASES` is refused then. Every case is checked before
+anything runs, with the scenario loader's verdict, but without running the whole loader on every
+case where that gives the same verdict: a value given to one of the scenario keys that no check
+of the scenario as a whole reads (:data:`~scenarios.schema.study.INDEPENDENT_KEYS`) is checked by
+that key's own reader, and the loader runs once per combination of the other varied values. A
+case shares the parts of the base scenario it does not vary (:func:`scenarios.study.paths.with_values`).
 """
 from __future__ import annotations
 
 import copy
-import itertools
+import hashlib
 import json
+import math
 import os
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ocp.errors import excerpt
 from scenarios.errors import ScenarioError
 from scenarios.output.provenance import package_version
+from scenarios.schema.keys import Key
 from scenarios.schema.loader import parse_scenario
 from scenarios.schema.node import Node
 from scenarios.schema.read import read_yaml
-from scenarios.schema.study import MAX_CASES, STUDY, grid_values
+from scenarios.schema.study import (
+    CASE_SEED,
+    MAX_CASES,
+    MAX_VARIED,
+    STUDY,
+    grid_values,
+    independent_key,
+    takes_integers,
+)
 from scenarios.study.dispersions import Dispersion, draw_unit, parse_dispersion
-from scenarios.study.paths import Step, get_path, parse_path, set_path
-from scenarios.study.types import Case, Execution, Study, case_key
+from scenarios.study.paths import Step, get_path, parse_path, with_values
+from scenarios.study.types import (
+    Case,
+    Execution,
+    Study,
+    case_key,
+    case_text,
+)
+
+PROGRESS_EVERY = 2048
+"""Cases checked between two calls of the ``progress`` callback of :func:`parse_study`."""
 
 
-def _tree_copy(value: Any) -> Any:
-    """A copy of YAML data (nested dicts and lists; leaves are immutable)."""
-    if isinstance(value, dict):
-        return {k: _tree_copy(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_tree_copy(v) for v in value]
-    return value
+@dataclass
+class _Varied:
+    """One varied scenario path: where the study sets it and how its values are checked."""
+
+    path: str
+    entry: str  # the study entry, for messages (grid.<path>, zip.<path>, monte_carlo.dispersions.<path>)
+    steps: list[Step]
+    independent: Key | None = None  # the key's reader checks each value (INDEPENDENT_KEYS)
+
+
+@dataclass
+class _Axis:
+    """One grid axis: a grid entry, or every zip entry together."""
+
+    varied: list[_Varied]
+    values: list[list[Any]]  # per path, the values set
+    recorded: list[list[Any]]  # per path, the values shown in the tables
+    length: int = 0
+    verdicts: list[dict[int, ScenarioError]] = field(default_factory=list)  # independent paths: bad values
 
 
 def _plain(value: Any) -> Any:
     """YAML/JSON-safe Python value (numpy scalars and arrays to floats and lists)."""
     if isinstance(value, np.ndarray):
-        return [_plain(v) for v in value.tolist()]
+        return value.tolist()
     if isinstance(value, (np.floating, np.integer)):
         return value.item()
     if isinstance(value, list):
         return [_plain(v) for v in value]
     return value
-
-
-def _varied(entry: Node, path: str, base: dict[str, Any], paths: list[str],
-            steps: list[list[Step]]) -> tuple[list, list]:
-    """Check that ``path`` reaches ``base``, record it in ``paths``/``steps``, and return its
-    values (set into the scenario, recorded in the tables)."""
-    paths.append(path)
-    steps.append(parse_path(path, entry.path))
-    get_parent_ok(base, steps[-1], entry.path)
-    return grid_values(entry, base)
-
-
-def _grid_points(root: Node, base: dict[str, Any]) -> tuple[list[str], list[list[Step]], list[tuple[list, list]]]:
-    """Varied paths, their parsed steps and the points (values set, values recorded)."""
-    paths: list[str] = []
-    steps: list[list[Step]] = []
-    axes: list[list[list[tuple[Any, Any]]]] = []
-    grid = STUDY["grid"].value(root)
-    for path in grid.value:
-        entry = grid.get(path)
-        values, recorded = _varied(entry, path, base, paths, steps)
-        axes.append([[pair] for pair in zip(values, recorded)])
-    zipped = STUDY["zip"].value(root)
-    columns, length = [], None
-    for path in zipped.value:
-        entry = zipped.get(path)
-        values, recorded = _varied(entry, path, base, paths, steps)
-        if length is not None and len(values) != length:
-            raise entry.error(f"zip lists must have equal lengths: {len(values)} values here, {length} before")
-        length = len(values)
-        columns.append(list(zip(values, recorded)))
-    if columns:
-        axes.append([list(row) for row in zip(*columns)])
-    points = []
-    for combination in itertools.product(*axes):
-        flat = [pair for part in combination for pair in part]
-        points.append(([v for v, _ in flat], [r for _, r in flat]))
-    return paths, steps, points
 
 
 def get_parent_ok(base: dict[str, Any], steps: list[Step], where: str) -> None:
@@ -94,7 +98,7 @@ def get_parent_ok(base: dict[str, Any], steps: list[Step], where: str) -> None:
     Parameters
     ----------
     base : dict
-        The base scenario mapping (not changed: a copy is written).
+        The base scenario mapping (not changed).
     steps : list of Step
         The parsed scenario path (:func:`scenarios.study.paths.parse_path`).
     where : str
@@ -105,128 +109,367 @@ def get_parent_ok(base: dict[str, Any], steps: list[Step], where: str) -> None:
     ScenarioError
         The path does not reach the base scenario.
     """
-    set_path(copy.deepcopy(base), steps, None, where)
+    with_values(base, [(steps, None, where)])
 
 
-def parse_study(data: Any, source: Path | None = None, version: str | None = None) -> Study:
-    """Parse a study (YAML data), expand its cases and validate every one with the scenario loader.
+def _recorded(value: Any) -> Any:
+    """A varied value as the tables record it: lists as JSON text (a list of finite floats, the
+    draws of a vector dispersion, written as ``json.dumps`` writes it, without its overhead)."""
+    if not isinstance(value, list):
+        return value
+    if all(type(v) is float and math.isfinite(v) for v in value):
+        return f"[{', '.join(map(float.__repr__, value))}]"
+    return json.dumps(value)
+
+
+class _KeyTemplate:
+    """Case keys (:func:`scenarios.study.types.case_key`) without encoding each case's whole
+    scenario: the canonical JSON of a case is the text of the first case with the varied values
+    spliced in. Used when no varied path lies inside another (then every case has the same keys
+    in the same places); None from :meth:`make` otherwise."""
+
+    def __init__(self, pieces: list[str], order: list[int]):
+        self.pieces, self.order = pieces, order
+
+    @classmethod
+    def make(cls, base: dict[str, Any], varied: list[_Varied], version: str) -> _KeyTemplate | None:
+        if any(a is not b and a.steps[:len(b.steps)] == b.steps for a in varied for b in varied):
+            return None
+        marks = [f"\x00slewbench-varied-{index}\x00" for index in range(len(varied))]
+        data = with_values(base, [(item.steps, mark, item.entry) for item, mark in zip(varied, marks)])
+        text = case_text(data, version)
+        found = []
+        for index, mark in enumerate(marks):
+            written = json.dumps(mark)
+            if text.count(written) != 1:
+                return None
+            found.append((text.index(written), index, len(written)))
+        pieces, order, position = [], [], 0
+        for start, index, length in sorted(found):
+            pieces.append(text[position:start])
+            order.append(index)
+            position = start + length
+        pieces.append(text[position:])
+        return cls(pieces, order)
+
+    def key(self, values: list[Any]) -> str:
+        parts = [self.pieces[0]]
+        for index, piece in zip(self.order, self.pieces[1:]):
+            parts.append(json.dumps(values[index], sort_keys=True, separators=(",", ":")))
+            parts.append(piece)
+        return hashlib.sha256("".join(parts).encode()).hexdigest()[:32]
+
+
+def _cut(text: str, limit: int = 60) -> str:
+    """A path cut to ``limit`` characters for a message."""
+    return text if len(text) <= limit else f"{text[:limit - 3]}..."
+
+
+def _describe(varied: _Varied) -> str:
+    return {"grid": "grid", "zip": "zip"}.get(varied.entry.split(".", 1)[0], "monte_carlo.dispersions")
+
+
+def _register(varied: _Varied, seen: list[_Varied]) -> None:
+    """Refuse a path varied twice, or one that replaces what an earlier entry varies inside it (the
+    later entry would silently win); a longer path refining an earlier one is fine (a grid of noise
+    mappings, each with the case's own seed)."""
+    if len(seen) >= MAX_VARIED:
+        raise ScenarioError(varied.entry, f"a study varies at most {MAX_VARIED} scenario paths")
+    for earlier in seen:
+        if earlier.steps == varied.steps:
+            raise ScenarioError(varied.entry, f"this path is also in {_describe(earlier)}; vary it in one place")
+        if earlier.steps[:len(varied.steps)] == varied.steps:
+            raise ScenarioError(varied.entry, f"it replaces {_cut(earlier.path)} (varied by {_describe(earlier)}) "
+                                              "as a whole; vary it in one place")
+    seen.append(varied)
+
+
+def _axes(root: Node, base: dict[str, Any], seen: list[_Varied]) -> list[_Axis]:
+    """The grid axes (one per grid entry, then one for the zip entries together), every value read
+    and checked against its entry, before any case is built."""
+    axes: list[_Axis] = []
+    for section in ("grid", "zip"):
+        node = STUDY[section].value(root)
+        zipped: _Axis | None = None
+        for path in node.value:
+            entry = node.get(path)
+            varied = _Varied(path, entry.path, parse_path(path, entry.path))
+            _register(varied, seen)
+            get_parent_ok(base, varied.steps, entry.path)
+            values, recorded = grid_values(entry, base)
+            if section == "grid":
+                axes.append(_Axis([varied], [values], [recorded], len(values)))
+                continue
+            if zipped is None:
+                zipped = _Axis([], [], [], len(values))
+                axes.append(zipped)
+            elif len(values) != zipped.length:
+                raise entry.error(f"zip lists must have equal lengths: {len(values)} values here, {zipped.length} before")
+            zipped.varied.append(varied)
+            zipped.values.append(values)
+            zipped.recorded.append(recorded)
+    return axes
+
+
+def _base(root: Node, source: Path | None) -> dict[str, Any]:
+    """The base scenario (a file next to the study, or a mapping), checked by the scenario loader."""
+    node = STUDY["scenario"].value(root)
+    if isinstance(node.value, str):
+        folder = source.parent if source else Path.cwd()
+        try:
+            base = read_yaml(folder / node.value)
+        except ScenarioError as error:
+            raise ScenarioError("scenario", error.message) from None
+    else:
+        base = copy.deepcopy(node.mapping().value)
+    if not isinstance(base, dict):
+        raise ScenarioError("scenario", "the base scenario is not a mapping")
+    try:
+        parse_scenario(base)  # the loader only reads its data
+    except ScenarioError as error:
+        raise ScenarioError(f"scenario: {error.path}", error.message) from None
+    return base
+
+
+def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version: str | None = None,
+                progress: Callable[[int, int], None] | None = None) -> Study:
+    """Parse a study (YAML data), expand its cases and check every one (see the module docstring).
 
     Parameters
     ----------
     data : Any
         The study mapping (``study``, ``scenario``, ``grid``, ``zip``, ``monte_carlo``,
         ``summary``, ``execution``).
-    source : Path or None, optional
+    source : str, os.PathLike or None, optional
         The study file; a ``scenario`` path is relative to its folder (None: the working
         directory).
     version : str or None, optional
         The package version in the case keys (None: this one's; a stored study's when its
         report is redrawn).
+    progress : callable or None, optional
+        ``progress(checked, total)``, called while the cases are checked (every
+        :data:`PROGRESS_EVERY` cases and at the end).
 
     Returns
     -------
     Study
         With ``cases`` in order: grid points (the last grid key varies fastest, then the zip),
         then the Monte Carlo samples of each point.
+
+    Raises
+    ------
+    ScenarioError
+        Naming the study entry (or the case and the scenario path), for a bad study or a case the
+        scenario loader rejects.
+    TypeError
+        ``source``, ``version`` or ``progress`` of the wrong type.
     """
+    if source is not None and not isinstance(source, (str, os.PathLike)):
+        raise TypeError(f"source must be a path or None, got {type(source).__name__}")
+    if version is not None and not isinstance(version, str):
+        raise TypeError(f"version must be a str or None, got {type(version).__name__}")
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be callable or None, got {type(progress).__name__}")
+    source = None if source is None else Path(source)
     root = Node(data).mapping()
     name = STUDY["study"].value(root)
-    scenario_node = STUDY["scenario"].value(root)
-    if isinstance(scenario_node.value, str):
-        folder = source.parent if source else Path.cwd()
-        try:
-            base = read_yaml(folder / scenario_node.value)
-        except ScenarioError as error:
-            raise ScenarioError("scenario", error.message) from None
-    else:
-        base = copy.deepcopy(scenario_node.mapping().value)
-    if not isinstance(base, dict):
-        raise ScenarioError("scenario", "the base scenario is not a mapping")
-    try:
-        parse_scenario(copy.deepcopy(base))
-    except ScenarioError as error:
-        raise ScenarioError(f"scenario: {error.path}", error.message) from None
-    paths, steps, points = _grid_points(root, base)
+    base = _base(root, source)
+    seen: list[_Varied] = []
+    axes = _axes(root, base, seen)
     mc = STUDY["monte_carlo"].value(root)
-    dispersions: list[tuple[str, list[Step], Dispersion]] = []
-    samples, method, seed = 1, None, 0
+    samples, method, seed = (1, None, 0) if mc is None else (mc["samples"], mc["method"], mc["seed"])
+    points = math.prod(axis.length for axis in axes)  # the count before any case is built
+    if points * samples > MAX_CASES:
+        sizes = " x ".join(str(n) for n in [*(axis.length for axis in axes), *([samples] if mc else [])])
+        raise ScenarioError("grid" if points > MAX_CASES or mc is None else "monte_carlo.samples",
+                            f"the study has {sizes} = {points * samples} cases; at most {MAX_CASES} are accepted")
+    dispersions: list[tuple[_Varied, Dispersion]] = []
     if mc is not None:
-        samples, method, seed = mc["samples"], mc["method"], mc["seed"]
-        disp_node = mc["dispersions"]
-        for path in disp_node.value:
-            entry = disp_node.get(path)
-            path_steps = parse_path(path, entry.path)
-            if path in paths:
-                raise entry.error("this path is also in grid or zip; vary it in one place")
-            get_parent_ok(base, path_steps, entry.path)
-            dispersions.append((path, path_steps, parse_dispersion(entry, base, path_steps)))
-    total = len(points) * samples
-    if total > MAX_CASES:
-        raise ScenarioError("grid", f"the study has {total} cases; at most {MAX_CASES} are accepted")
+        node = mc["dispersions"]
+        for path in node.value:
+            entry = node.get(path)
+            varied = _Varied(path, entry.path, parse_path(path, entry.path))
+            _register(varied, seen)
+            get_parent_ok(base, varied.steps, entry.path)
+            dispersion = parse_dispersion(entry, base, varied.steps)
+            if dispersion.kind == CASE_SEED.name and takes_integers(varied.steps, base) is False:
+                raise entry.error(f"case_seed sets an integer (the case's seed); {_cut(path)} does not take one "
+                                  "(simulation.sensor_noise.seed does)")
+            dispersions.append((varied, dispersion))
     summary = STUDY["summary"].value(root)
     execution = Execution(**STUDY["execution"].value(root))
     STUDY["resolved"].value(root)  # written into study.yaml for the record (version, case seeds)
     root.finish()
-    study = Study(name, source, base, paths, [p for p, _, _ in dispersions], samples, method, seed,
-                  summary, execution, raw=copy.deepcopy(data))
-    study.cases = _expand(study, steps, points, dispersions, version or package_version())
+    _mark_independent(seen)
+    study = Study(name, source, base, [v.path for axis in axes for v in axis.varied], [v.path for v, _ in dispersions],
+                  samples, method, seed, summary, execution, raw=copy.deepcopy(data))
+    study.cases = _Expansion(study, axes, dispersions, version or package_version(), progress).cases()
     return study
 
 
-def _expand(study: Study, steps: list[list[Step]], points: list[tuple[list, list]],
-            dispersions: list[tuple[str, list[Step], Dispersion]], version: str) -> list[Case]:
-    n_cases = len(points) * study.samples
-    children = np.random.SeedSequence(study.seed).spawn(n_cases + len(points))
-    dims = sum(d.dimension for _, _, d in dispersions)
-    cases = []
-    for point, (values, recorded) in enumerate(points):
-        design = None
-        if dispersions and study.method == "latin_hypercube":
-            design = draw_unit(study.method, dims, study.samples, np.random.default_rng(children[n_cases + point]))
-        for sample in range(study.samples):
-            index = point * study.samples + sample
-            seed = int(children[index].generate_state(1)[0])
-            data = _tree_copy(study.base)
-            varied: dict[str, Any] = {}
-            for path, path_steps, value, shown in zip(study.grid_paths, steps, values, recorded):
-                set_path(data, path_steps, _tree_copy(value), path)
-                varied[path] = shown
-            if dispersions:
-                unit = design[sample] if design is not None else \
-                    draw_unit("random", dims, 1, np.random.default_rng(children[index]))[0]
-                column = 0
-                for path, path_steps, dispersion in dispersions:
-                    u = unit[column:column + dispersion.dimension]
-                    column += dispersion.dimension
-                    value = _plain(dispersion.value(u, seed, get_path(study.base, path_steps, path)
-                                                    if dispersion.needs_base else None))
-                    set_path(data, path_steps, value, path)
-                    varied[path] = value if not isinstance(value, list) else json.dumps(value)
-            case = Case(index, seed, point, varied, data)
-            _validate(study, case)
-            case.key = case_key(data, version)
-            cases.append(case)
-    return cases
+def _mark_independent(seen: list[_Varied]) -> None:
+    """Give each varied path whose key no whole-scenario check reads its key, unless another varied
+    path lies inside it or holds it (then the two are checked together by the loader)."""
+    for varied in seen:
+        overlaps = any(other is not varied and (other.steps[:len(varied.steps)] == varied.steps
+                                                or varied.steps[:len(other.steps)] == other.steps) for other in seen)
+        varied.independent = None if overlaps else independent_key(varied.steps)
 
 
-def _validate(study: Study, case: Case) -> None:
-    """The scenario loader's verdict on a case, naming the study, the case and the study entry."""
-    try:
-        parse_scenario(case.scenario)  # the loader only reads its data
-    except ScenarioError as error:
-        entries = [p for p in case.varied if error.path.startswith(p) or p.startswith(error.path)]
-        varied = ", ".join(f"{p}={json.dumps(v)[:40]}" for p, v in case.varied.items())
-        culprit = f" (set by {', '.join(entries)})" if entries else ""
-        raise ScenarioError(f"case {case.index} [{varied}]: {error.path}{culprit}", error.message) from None
+class _Expansion:
+    """The cases of a study, built and checked in order (see the module docstring)."""
+
+    def __init__(self, study: Study, axes: list[_Axis], dispersions: list[tuple[_Varied, Dispersion]], version: str,
+                 progress: Callable[[int, int], None] | None):
+        self.study, self.axes, self.dispersions, self.version = study, axes, dispersions, version
+        self.progress = progress
+        self.points = math.prod(axis.length for axis in axes)
+        self.total = self.points * study.samples
+        self.checked: set[tuple[int, ...]] = set()  # classes of cases the whole loader has passed
+        for axis in axes:
+            axis.verdicts = [self._verdicts(varied, values) for varied, values in zip(axis.varied, axis.values)]
+
+    @staticmethod
+    def _verdicts(varied: _Varied, values: list[Any]) -> dict[int, ScenarioError]:
+        """The errors of an independent grid path's values, by position (each value checked once)."""
+        if varied.independent is None:
+            return {}
+        found = {}
+        for position, value in enumerate(values):
+            try:
+                _read(varied.independent, value, varied.path)
+            except ScenarioError as error:
+                found[position] = error
+        return found
+
+    def _draws(self, seeds: list[int], children: list[np.random.SeedSequence]) -> list[list[Any]]:
+        """Per dispersion, the value of every case (in case order), drawn as case by case."""
+        if not self.dispersions:
+            return []
+        study, n = self.study, self.total
+        dims = sum(d.dimension for _, d in self.dispersions)
+        units = np.zeros((n, dims))
+        if dims and study.method == "latin_hypercube":
+            for point in range(self.points):
+                rng = np.random.default_rng(children[n + point])
+                units[point * study.samples:(point + 1) * study.samples] = draw_unit(study.method, dims, study.samples, rng)
+        elif dims:
+            for index in range(n):
+                units[index] = np.random.default_rng(children[index]).random(dims)
+        columns: list[list[Any]] = []
+        column = 0
+        for varied, dispersion in self.dispersions:
+            base = get_path(study.base, varied.steps, varied.entry) if dispersion.needs_base else None
+            values = dispersion.values(units[:, column:column + dispersion.dimension], seeds, base)
+            column += dispersion.dimension
+            if isinstance(values, np.ndarray):
+                finite = np.isfinite(values.reshape(n, -1)).all(axis=1)
+                if not finite.all():
+                    bad = int(np.argmin(finite))
+                    raise ScenarioError(varied.entry, f"case {bad} draws a value that is not finite "
+                                                      f"({excerpt(values[bad].tolist())}); the distribution's "
+                                                      "parameters are too large")
+                columns.append(values.tolist())
+            else:
+                columns.append(values)
+        return columns
+
+    def cases(self) -> list[Case]:
+        """Every case, built, checked and keyed."""
+        study, n, samples = self.study, self.total, self.study.samples
+        children = np.random.SeedSequence(study.seed).spawn(n + self.points)
+        seeds = [int(child.generate_state(1)[0]) for child in children[:n]]
+        draws = self._draws(seeds, children)
+        radix = [axis.length for axis in self.axes]
+        template = _KeyTemplate.make(study.base, [item for axis in self.axes for item in axis.varied]
+                                     + [item for item, _ in self.dispersions], self.version)
+        cases = []
+        for point in range(self.points):
+            positions, rest = [], point
+            for length in reversed(radix):  # the last axis varies fastest
+                rest, position = divmod(rest, length)
+                positions.append(position)
+            positions.reverse()
+            updates, varied, grid_class = [], {}, []
+            for axis, position in zip(self.axes, positions):
+                independent = True
+                for item, values, recorded in zip(axis.varied, axis.values, axis.recorded):
+                    updates.append((item.steps, values[position], item.entry))
+                    varied[item.path] = recorded[position]
+                    independent &= item.independent is not None
+                grid_class.append(-1 if independent else position)
+            for sample in range(samples):
+                index = point * samples + sample
+                case_updates, case_varied = list(updates), dict(varied)
+                case_class, drawn = tuple(grid_class), []
+                for (item, _), column in zip(self.dispersions, draws):
+                    value = column[index]
+                    case_updates.append((item.steps, value, item.entry))
+                    case_varied[item.path] = _recorded(value)
+                    if item.independent is None:
+                        case_class += (index,)
+                    else:
+                        drawn.append((item, value))
+                case = Case(index, seeds[index], point, case_varied, with_values(study.base, case_updates))
+                self._check(case, case_class, positions, drawn)
+                case.key = case_key(case.scenario, self.version) if template is None else \
+                    template.key([value for _, value, _ in case_updates])
+                cases.append(case)
+                if self.progress is not None and (index + 1) % PROGRESS_EVERY == 0:
+                    self.progress(index + 1, n)
+        if self.progress is not None:
+            self.progress(n, n)
+        return cases
+
+    def _check(self, case: Case, case_class: tuple[int, ...], positions: list[int],
+               drawn: list[tuple[_Varied, Any]]) -> None:
+        """The loader's verdict on ``case``: its independent values by their keys' readers, the rest
+        by the whole loader once per class of cases."""
+        for axis, position in zip(self.axes, positions):
+            for verdicts in axis.verdicts:
+                if position in verdicts:
+                    raise _case_error(case, verdicts[position])
+        for item, value in drawn:
+            try:
+                _read(item.independent, value, item.path)  # type: ignore[arg-type]
+            except ScenarioError as error:
+                raise _case_error(case, error) from None
+        if case_class not in self.checked:
+            try:
+                parse_scenario(case.scenario)  # the loader only reads its data
+            except ScenarioError as error:
+                raise _case_error(case, error) from None
+            self.checked.add(case_class)
 
 
-def load_study(path: str | os.PathLike[str]) -> Study:
-    """Read, expand and validate a study file.
+def _read(key: Key, value: Any, path: str) -> Any:
+    """``value`` read by ``key``'s reader at the scenario ``path`` (as the loader reads it)."""
+    return key.read(Node(value, path))  # type: ignore[misc]
+
+
+def _case_error(case: Case, error: ScenarioError) -> ScenarioError:
+    """The loader's error on a case, naming the case, its varied values (cut short) and the study
+    entry that set the offending path."""
+    entries = [p for p in case.varied if error.path.startswith(p) or p.startswith(error.path)]
+    shown: list[str] = []
+    for path, value in case.varied.items():
+        if sum(len(part) for part in shown) > 240:
+            shown.append(f"... ({len(case.varied)} values)")
+            break
+        shown.append(f"{_cut(path)}={json.dumps(value)[:40]}")
+    culprit = f" (set by {', '.join(_cut(p) for p in entries[:3])})" if entries else ""
+    return ScenarioError(f"case {case.index} [{', '.join(shown)}]: {error.path}{culprit}", error.message)
+
+
+def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None] | None = None) -> Study:
+    """Read, expand and check a study file.
 
     Parameters
     ----------
     path : str or os.PathLike
         The study YAML file.
+    progress : callable or None, optional
+        As :func:`parse_study`.
 
     Returns
     -------
@@ -238,11 +481,16 @@ def load_study(path: str | os.PathLike[str]) -> Study:
     ScenarioError
         Naming the study file, the case and the path, for a missing file, a bad entry or a case
         the scenario loader rejects.
+    TypeError
+        ``path`` is not a path.
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a str or os.PathLike, got {type(path).__name__}")
     path = Path(path)
     try:
-        return parse_study(read_yaml(path), path)
+        return parse_study(read_yaml(path), path, progress=progress)
     except ScenarioError as error:
         if error.message.startswith(f"scenario file not found: {path}"):
             raise ScenarioError("", f"study file not found: {path}") from None
         raise ScenarioError(f"{path}: {error.path}" if error.path else str(path), error.message) from None
+

@@ -1,9 +1,11 @@
 """The crash-safe store of a trade study (SQLite in WAL mode) and the sweep directory that holds it.
 
-Every finished case is one row, committed at once, keyed by the hash of its resolved scenario and
-the package version (:func:`scenarios.study.types.case_key`). A process killed at any moment leaves
-every committed case readable and no half-written one, so ``--resume`` re-runs only what is
-missing, and a case stored twice (a retry that raced a resume) replaces itself, never duplicates.
+Every finished case is one row, keyed by the hash of its resolved scenario and the package version
+(:func:`scenarios.study.types.case_key`); the cases that finish together are committed in one
+transaction (:meth:`SweepStore.put_many`) before the sweep reports them done. A process killed at
+any moment leaves every committed case readable and no half-written one, so ``--resume`` re-runs
+only what is missing, and a case stored twice (a retry that raced a resume) replaces itself, never
+duplicates.
 
 A case's rows are stored in their plain form (:meth:`scenarios.output.results.Row.to_dict`),
 non-finite numbers as JSON ``null`` (:func:`scenarios.output.tables.json_safe`). A store written by
@@ -19,12 +21,15 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import sqlite3
+import stat
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
+from ocp.errors import excerpt
 from scenarios.errors import OutputError
 from scenarios.output.directory import (
     MARKER,
@@ -38,6 +43,8 @@ from scenarios.output.tables import json_safe
 STORE_NAME = "sweep.sqlite"
 FORMAT = "slewbench-sweep-2"
 """The format this version writes: rows keyed ``reference`` and ``closed_loop``."""
+STATUSES = ("ok", "crashed")
+"""A stored case's status: the runner finished (whatever its rows say), or the case crashed."""
 
 
 def _rows_of_format_1(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -49,6 +56,24 @@ def _rows_of_format_1(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
 EARLIER_FORMATS: dict[str, Callable[[list[dict[str, Any]]], list[dict[str, Any]]]] = {
     "slewbench-sweep-1": _rows_of_format_1}
 """Formats of earlier versions that can still be read, and how their rows are read in today's form."""
+
+def encode_rows(rows: list[dict[str, Any]]) -> str:
+    """A case's rows as the store keeps them: JSON, non-finite numbers as ``null``
+    (:func:`scenarios.output.tables.json_safe`). A trade study's workers encode their rows so
+    (:func:`scenarios.study.worker.run_chunk`), and the sweep stores the text as it comes.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The case's rows (:meth:`scenarios.output.results.Row.to_dict`).
+
+    Returns
+    -------
+    str
+        The JSON text.
+    """
+    return json.dumps(json_safe(rows), allow_nan=False)
+
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (name TEXT PRIMARY KEY, value TEXT NOT NULL);
@@ -120,22 +145,47 @@ class SweepStore:
 
     Raises
     ------
+    TypeError
+        ``directory`` is not a path or ``create`` not a bool.
     FileNotFoundError
-        ``create`` is false and there is no store.
+        ``directory`` does not exist, or ``create`` is false and there is no store.
+    NotADirectoryError
+        ``directory`` is not a directory.
     ValueError
-        The file is an SQLite database of another format, or of an earlier slewbench's format and
-        ``create`` is true.
+        The file is not a regular file, an SQLite database of another format, or of an earlier
+        slewbench's format and ``create`` is true.
+    OSError
+        SQLite cannot open or write the store (a full disk, a read-only directory).
     """
 
-    def __init__(self, directory: str | Path, create: bool = True) -> None:
-        self.path = Path(directory) / STORE_NAME
+    def __init__(self, directory: str | os.PathLike[str], create: bool = True) -> None:
+        if not isinstance(directory, (str, os.PathLike)):
+            raise TypeError(f"directory must be a str or os.PathLike, got {type(directory).__name__}")
+        if not isinstance(create, bool):
+            raise TypeError(f"create must be True or False, got {excerpt(create)}")
+        folder = Path(directory)
+        if not folder.exists():
+            raise FileNotFoundError(f"directory {folder} does not exist")
+        if not folder.is_dir():
+            raise NotADirectoryError(f"directory {folder} is not a directory")
+        self.path = folder / STORE_NAME
         if not create and not self.path.is_file():
-            raise FileNotFoundError(self.path)
-        self._db = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
-        self._db.execute("PRAGMA journal_mode=WAL")
-        self._db.execute("PRAGMA synchronous=NORMAL")  # durable against a killed process
-        self._db.executescript(_SCHEMA)
-        stored = self.get_meta("format")
+            raise FileNotFoundError(f"no sweep store in {folder} ({STORE_NAME} expected)")
+        for name in STORE_FILES:  # SQLite would wait on a named pipe
+            if (folder / name).exists() and not stat.S_ISREG((folder / name).stat().st_mode):
+                raise ValueError(f"{folder / name} is not a regular file")
+        try:
+            self._db = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
+            self._db.execute("PRAGMA journal_mode=WAL")
+            self._db.execute("PRAGMA synchronous=NORMAL")  # durable against a killed process
+            self._db.executescript(_SCHEMA)
+            stored = self.get_meta("format")
+        except sqlite3.DatabaseError as error:
+            with contextlib.suppress(Exception):
+                self._db.close()
+            if isinstance(error, sqlite3.OperationalError):
+                raise OSError(f"cannot open the sweep store {self.path}: {error}") from None
+            raise ValueError(f"{self.path} is not a sweep store: {error}") from None
         self._read_rows: Callable[[list[dict[str, Any]]], list[dict[str, Any]]] = list
         if stored is None:
             self.set_meta("format", FORMAT)
@@ -153,7 +203,7 @@ class SweepStore:
         """Close the connection (committed cases are already on disk)."""
         self._db.close()
 
-    def __enter__(self) -> "SweepStore":
+    def __enter__(self) -> SweepStore:
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -186,7 +236,12 @@ class SweepStore:
             The stored value, or None if there is no such entry.
         """
         found = self._db.execute("SELECT value FROM meta WHERE name = ?", (name,)).fetchone()
-        return None if found is None else json.loads(found[0])
+        if found is None:
+            return None
+        try:
+            return json.loads(found[0])
+        except (TypeError, ValueError):
+            raise ValueError(f"{self.path}: the stored {name!r} is not valid JSON; the store is damaged") from None
 
     def put(self, key: str, status: str, rows: list[dict[str, Any]], elapsed_s: float | None,
             attempts: int) -> None:
@@ -204,10 +259,69 @@ class SweepStore:
         elapsed_s : float or None
             Wall time of the case in its worker [s]; None when the driver gave up on it.
         attempts : int
-            How many times the case was started.
+            How many times the case was started (at least 1).
+
+        Raises
+        ------
+        TypeError, ValueError
+            An argument of the wrong type or value, named in the message.
         """
-        self._db.execute("INSERT OR REPLACE INTO cases VALUES (?, ?, ?, ?, ?, ?)",
-                         (key, status, json.dumps(json_safe(rows), allow_nan=False), elapsed_s, attempts, time.time()))
+        self.put_many([(key, status, rows, elapsed_s, attempts)])
+
+    def put_many(self, cases: Iterable[tuple[str, str, list[dict[str, Any]], float | None, int]]) -> None:
+        """Commit finished cases in one transaction (all or none of them); stored keys are replaced.
+
+        Parameters
+        ----------
+        cases : iterable of (key, status, rows, elapsed_s, attempts)
+            Each as the arguments of :meth:`put`.
+
+        Raises
+        ------
+        TypeError, ValueError
+            An entry of the wrong type or value, named in the message (nothing is committed).
+        """
+        now = time.time()
+        self._insert([self._row(*case, now) for case in cases])
+
+    def put_encoded(self, cases: Iterable[tuple[str, str, str, float | None, int]]) -> None:
+        """:meth:`put_many` for rows already encoded by :func:`encode_rows` (a sweep's workers do it).
+
+        Parameters
+        ----------
+        cases : iterable of (key, status, rows_json, elapsed_s, attempts)
+            As :meth:`put`, the rows as JSON text.
+        """
+        now = time.time()
+        self._insert([(key, status, text, elapsed, attempts, now) for key, status, text, elapsed, attempts in cases])
+
+    def _insert(self, values: list[tuple[Any, ...]]) -> None:
+        with self._transaction():
+            self._db.executemany("INSERT OR REPLACE INTO cases VALUES (?, ?, ?, ?, ?, ?)", values)
+
+    @contextlib.contextmanager
+    def _transaction(self) -> Iterator[None]:
+        self._db.execute("BEGIN IMMEDIATE")
+        try:
+            yield
+        except BaseException:
+            self._db.execute("ROLLBACK")
+            raise
+        self._db.execute("COMMIT")
+
+    @staticmethod
+    def _row(key: Any, status: Any, rows: Any, elapsed_s: Any, attempts: Any, now: float) -> tuple[Any, ...]:
+        if not isinstance(key, str) or not key:
+            raise TypeError(f"key must be a non-empty str, got {excerpt(key)}")
+        if status not in STATUSES:
+            raise ValueError(f"status must be one of {', '.join(STATUSES)}, got {excerpt(status)}")
+        if not isinstance(rows, list) or not all(isinstance(row, dict) for row in rows):
+            raise TypeError(f"rows must be a list of dicts, got {excerpt(rows)}")
+        if elapsed_s is not None and (isinstance(elapsed_s, bool) or not isinstance(elapsed_s, (int, float))):
+            raise TypeError(f"elapsed_s must be a number or None, got {excerpt(elapsed_s)}")
+        if isinstance(attempts, bool) or not isinstance(attempts, int) or attempts < 1:
+            raise ValueError(f"attempts must be an integer >= 1, got {excerpt(attempts)}")
+        return key, status, encode_rows(rows), elapsed_s, attempts, now
 
     def keys(self) -> set[str]:
         """The keys of the stored cases.
@@ -226,11 +340,24 @@ class SweepStore:
         dict
             Case key -> ``{"status", "rows", "elapsed_s", "attempts"}`` as given to :meth:`put`
             (the rows of an earlier format in today's form).
+
+        Raises
+        ------
+        ValueError
+            A stored case whose rows are not valid JSON rows (a damaged store), naming it.
         """
-        return {key: {"status": status, "rows": self._read_rows(json.loads(rows)), "elapsed_s": elapsed,
-                      "attempts": attempts}
-                for key, status, rows, elapsed, attempts
-                in self._db.execute("SELECT key, status, rows, elapsed_s, attempts FROM cases")}
+        records = {}
+        for key, status, rows, elapsed, attempts in self._db.execute(
+                "SELECT key, status, rows, elapsed_s, attempts FROM cases"):
+            try:
+                decoded = self._read_rows(json.loads(rows))
+                if not isinstance(decoded, list) or not all(isinstance(row, dict) for row in decoded):
+                    raise ValueError("not a list of rows")
+            except (TypeError, ValueError) as error:
+                raise ValueError(f"{self.path}: the rows of case {excerpt(key, 40)} are not valid ({excerpt(str(error), 80)}); "
+                                 "the store is damaged") from None
+            records[key] = {"status": status, "rows": decoded, "elapsed_s": elapsed, "attempts": attempts}
+        return records
 
     def __len__(self) -> int:
         return int(self._db.execute("SELECT COUNT(*) FROM cases").fetchone()[0])

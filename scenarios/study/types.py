@@ -138,8 +138,25 @@ def case_key(scenario: dict[str, Any], version: str) -> str:
     str
         32 hexadecimal digits of the SHA-256 of both.
     """
-    text = json.dumps({"scenario": scenario, "version": version}, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest()[:32]
+    return hashlib.sha256(case_text(scenario, version).encode()).hexdigest()[:32]
+
+
+def case_text(scenario: dict[str, Any], version: str) -> str:
+    """The canonical JSON that :func:`case_key` hashes.
+
+    Parameters
+    ----------
+    scenario : dict
+        The resolved scenario mapping (plain YAML data).
+    version : str
+        slewbench's version.
+
+    Returns
+    -------
+    str
+        ``{"scenario": ..., "version": ...}`` with sorted keys and no spaces.
+    """
+    return json.dumps({"scenario": scenario, "version": version}, sort_keys=True, separators=(",", ":"))
 
 
 def _status_counts(study: Study, records: dict[str, dict[str, Any]]) -> dict[str, collections.Counter[str]]:

@@ -6,6 +6,12 @@ worker process keeps one :class:`ocp.SolverCache` for its whole life, so a collo
 built once per worker and structure; a process-wide lock runs one case at a time per process
 (IPOPT's linear solvers are not thread-safe), so a Dask worker should be started with
 ``--nthreads 1`` and as many processes as cores.
+
+Cases come several to a task (:func:`run_chunk`), each encoding its rows as the store keeps them.
+In a local pool's worker each case is tracked (:func:`tracked_case`): the worker writes the case it
+runs and when it started it into a slot table shared with the sweep, which so knows whose case
+killed a worker and how long a case has run. The local workers, and the server they fork from, die
+with the sweep (:func:`start_local_worker`, :data:`PARENT_ENVIRONMENT`).
 """
 from __future__ import annotations
 
@@ -16,12 +22,15 @@ import socket
 import threading
 import time
 import traceback
-from typing import Any, Callable, Hashable, TypeVar
+from collections.abc import Callable, Hashable
+from typing import Any, TypeVar
 
 from ocp import SolverCache
 from scenarios.errors import CaseTimeout
+from scenarios.output.renderer import die_with_parent
 from scenarios.output.results import Row
 from scenarios.schema.labels import row_labels
+from scenarios.study.store import encode_rows
 
 V = TypeVar("V")
 
@@ -29,6 +38,100 @@ PRELOAD = ("scenarios.study.worker", "scenarios.runner", "scipy.integrate", "sci
 """Modules imported once by the process that local workers fork from: the workbench, and the SciPy
 modules that planners import lazily on their first case (about 0.6 s that every fresh worker would
 otherwise pay; with 40 cases of 0.13 s that alone was a 12 % overhead)."""
+
+PARENT_ENVIRONMENT = "SLEWBENCH_SWEEP_PARENT"
+"""Environment variable holding the process id of a sweep that starts local workers
+(:func:`scenarios.study.engine.start_forkserver` sets it): a direct child of that process which
+imports this module (the server local workers fork from) dies with it."""
+
+if os.environ.get(PARENT_ENVIRONMENT) == str(os.getppid()):  # the fork server of a sweep: dies with it
+    die_with_parent(signal.SIGKILL, os.getppid())
+
+SLOT_FIELDS = 4
+"""Numbers per worker in a local pool's slot table: the worker's process id, the index + 1 of the
+case it runs (0: none), when it started it (``time.monotonic()``, the same clock in every process
+of the machine) and the index + 1 of the last case it finished."""
+
+_slot: dict[str, Any] = {}  # this local worker's slot table and its place in it
+
+
+def start_local_worker(slots: Any, lock: Any, parent: int) -> None:
+    """Initialise a worker of a local pool: die with the process that forked it, and claim a slot.
+
+    The fork server dies with the sweep (:data:`PARENT_ENVIRONMENT`) and its workers with it, so a
+    sweep killed outright leaves no process behind. The slot tells the sweep which case each
+    worker was running when one died (:func:`tracked_case`).
+
+    Parameters
+    ----------
+    slots : multiprocessing.Array
+        The pool's slot table, :data:`SLOT_FIELDS` doubles per worker (shared memory).
+    lock : multiprocessing.Lock
+        Guards the claiming of slots.
+    parent : int
+        The process id of the fork server the worker was started from (not positive: unknown, this
+        process's parent now).
+    """
+    die_with_parent(signal.SIGKILL, parent if parent > 0 else os.getppid())
+    with lock:
+        for index in range(len(slots) // SLOT_FIELDS):
+            if slots[index * SLOT_FIELDS] == 0:
+                slots[index * SLOT_FIELDS] = os.getpid()
+                _slot.update(table=slots, index=index)
+                return
+
+
+def tracked_case(task: Callable[[dict[str, Any]], dict[str, Any]], payload: dict[str, Any]) -> dict[str, Any]:
+    """Run ``task(payload)`` in a local worker, its case and start time written in the worker's slot.
+
+    Parameters
+    ----------
+    task : callable
+        The worker function (:func:`run_case`).
+    payload : dict
+        Its argument; ``payload["index"]`` is the case's index.
+
+    Returns
+    -------
+    dict
+        What ``task`` returns.
+    """
+    table, index = _slot.get("table"), _slot.get("index", 0)
+    if table is None:
+        return task(payload)
+    at = index * SLOT_FIELDS
+    table[at + 2] = time.monotonic()
+    table[at + 1] = payload["index"] + 1
+    try:
+        return task(payload)
+    finally:
+        table[at + 3] = payload["index"] + 1
+        table[at + 1] = 0
+
+
+def run_chunk(task: Callable[[dict[str, Any]], dict[str, Any]], payloads: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Run several cases in one task, one after the other, each tracked (:func:`tracked_case`: in a
+    local pool's worker, its slot names the case running).
+
+    Parameters
+    ----------
+    task : callable
+        The worker function (:func:`run_case`).
+    payloads : list of dict
+        Its arguments, one per case.
+
+    Returns
+    -------
+    list of dict
+        What ``task`` returns for each, in order, its ``rows`` as the store's JSON text under
+        ``rows_json`` (:func:`scenarios.study.store.encode_rows`).
+    """
+    results = []
+    for payload in payloads:
+        result = dict(tracked_case(task, payload))
+        result["rows_json"] = encode_rows(result.pop("rows"))  # the store's text, made here in parallel
+        results.append(result)
+    return results
 
 
 class RecentCache(SolverCache):
