@@ -26,7 +26,9 @@ def test_every_listed_mutation_names_its_file_and_tests():
     root = Path(__file__).resolve().parents[1]
     assert len({m.name for m in MUTATIONS}) == len(MUTATIONS) >= 60
     for m in MUTATIONS:
-        assert (root / m.file).is_file(), m.name  # the snippet itself may drift: the tool reports it
+        # the snippet must still occur exactly once: a change to the code that moves it away would
+        # otherwise leave its area silently unchecked until the next run of the tool
+        assert (root / m.file).read_text().count(m.find) == 1, m.name
         assert m.find != m.replace and m.tests, m.name
         for test in m.tests:
             assert test.startswith("-") or (root / test.split("::")[0]).is_file(), (m.name, test)
