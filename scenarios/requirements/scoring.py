@@ -271,8 +271,11 @@ def endpoint_violations(problem: ManeuverProblem) -> list[str]:
             margin = constraint.margins(np.array([time]), np.asarray(q).reshape(1, 4))[0]
             if np.isfinite(margin) and margin < 0.0:
                 kind = "keep-out" if constraint.keep_out else "keep-in"
+                # the cone at that time: the angle and its growth (the Earth's apparent radius about the limb)
+                limit = float(np.rad2deg(constraint.limit([time])[0]))
+                grown = f": {constraint.description}" if abs(limit - np.rad2deg(constraint.angle)) > 1e-9 else ""
                 found.append(f"{constraint.name}: the {words} already breaks it at {time:g} s (margin "
-                             f"{np.rad2deg(margin):.3g} deg to the {np.rad2deg(constraint.angle):g} deg {kind} cone); "
+                             f"{np.rad2deg(margin):.3g} deg to the {limit:.4g} deg {kind} cone{grown}); "
                              "no reference can meet it")
     return found
 
