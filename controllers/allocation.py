@@ -31,7 +31,7 @@ from ocp.fast_call import BufferedFunction, as_floats
 
 Array = NDArray[np.float64]
 
-__all__ = ["Allocation", "Demand", "float_rows", "reference_demand"]
+__all__ = ["Allocation", "Demand", "demand_limits", "float_rows", "reference_demand"]
 
 
 def float_rows(matrix: ArrayLike) -> tuple[tuple[float, ...], ...]:
@@ -245,6 +245,29 @@ def _quantity(actuator: Actuator, state: bool) -> str:
     return f"{actuator.name}_{'momentum' if stores_momentum else 'state'}"
 
 
+def demand_limits(spacecraft: Spacecraft) -> dict[str, Array]:
+    """The quantities :func:`reference_demand` reports for a spacecraft, and their limits.
+
+    Parameters
+    ----------
+    spacecraft : ocp.Spacecraft
+        The spacecraft (its actuators, in order).
+
+    Returns
+    -------
+    dict of str to ndarray
+        :attr:`Demand.name` -> :attr:`Demand.limit` (positive; ``inf``: none; 0: a failed
+        element): each actuator kind's command, then its states when it has any.
+    """
+    limits: dict[str, Array] = {}
+    for block in actuator_blocks(spacecraft):
+        actuator = block.actuator
+        limits[_quantity(actuator, False)] = np.asarray(actuator.control_bounds()[1], dtype=float)
+        if actuator.state_size:
+            limits[_quantity(actuator, True)] = np.asarray(actuator.state_bounds()[1], dtype=float)
+    return limits
+
+
 def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: ArrayLike,
                      torque: ArrayLike, state0: ArrayLike | None = None) -> dict[str, Demand]:
     """What a reference asks of each actuator through a law's own allocation (module docstring).
@@ -320,14 +343,15 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
         commands[start:start + within] = asked[:, :within].T
         states[start + 1:min(stop + 1, n)] = ahead[:, :min(stop + 1, n) - start - 1].T
         state = ahead[:, -1].copy()
+    limits = demand_limits(spacecraft)
     demand: dict[str, Demand] = {}
     for block in blocks:
         actuator = block.actuator
         name = _quantity(actuator, False)
-        demand[name] = Demand(name, commands[:, block.control], actuator.control_bounds()[1])
+        demand[name] = Demand(name, commands[:, block.control], limits[name])
         if actuator.state_size:
             name = _quantity(actuator, True)
-            demand[name] = Demand(name, states[:, block.state], actuator.state_bounds()[1])
+            demand[name] = Demand(name, states[:, block.state], limits[name])
     return demand
 
 

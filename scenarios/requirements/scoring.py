@@ -28,15 +28,16 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from controllers.allocation import Allocation, reference_demand
-from ocp import quat
+from controllers.allocation import Allocation, demand_limits, reference_demand
+from ocp import Spacecraft, quat
 from ocp.geometry.pointing import PointingConstraint
 from planners import ManeuverProblem, Planner
 from planners.base import REQUIREMENT_KINDS
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
-__all__ = ["REFERENCE_POINTS", "SCOPE_WORDS", "Score", "endpoint_violations", "reference_times", "score_closed_loop",
-           "score_reference", "unhonoured", "violations"]
+__all__ = ["FINAL_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS", "SCOPE_WORDS", "Score",
+           "endpoint_violations", "reference_times", "score_closed_loop", "score_fields", "score_reference",
+           "unhonoured", "violations"]
 
 Array = NDArray[np.float64]
 
@@ -46,6 +47,13 @@ REFERENCE_POINTS = 2001
 
 SCOPE_WORDS = {"reference": "reference", "closed_loop": "closed loop"}
 """A scope's key (of ``Row.requirements`` and ``results.json``) and its words in messages."""
+
+POINTING_FIELDS = ("min_margin_deg", "time_in_violation_s", "first_violation_s", "min_margin_time_s")
+"""The fields of a pointing requirement's score, in column order (both scopes)."""
+RATE_FIELDS = ("peak_rate", "peak_time_s", "ratio")
+"""The fields of the rate requirement's score (both scopes)."""
+FINAL_FIELDS = ("worst_error_deg", "worst_rate_error", "from_s")
+"""The fields of the final requirement's score (closed loop only)."""
 
 _TOLERANCE = 1e-9
 """Relative slack on the ratio and bound checks (rounding, not a margin)."""
@@ -104,10 +112,8 @@ def reference_times(duration: float, run_end: float, sample_time: float, points:
 
 def _pointing(constraint: PointingConstraint, t: Array, q: Array) -> Score:
     score = constraint.score(t, q)
-    values: dict[str, float | None] = {"min_margin_deg": score.min_margin_deg,
-                                       "time_in_violation_s": score.time_in_violation_s,
-                                       "first_violation_s": score.first_violation_s,
-                                       "min_margin_time_s": score.min_margin_time_s}
+    values: dict[str, float | None] = dict(zip(POINTING_FIELDS, (score.min_margin_deg, score.time_in_violation_s,
+                                                                 score.first_violation_s, score.min_margin_time_s)))
     if score.met:
         return Score(constraint.name, values, True)
     assert score.min_margin_deg is not None and score.min_margin_time_s is not None
@@ -122,7 +128,7 @@ def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
     worst = int(np.argmax(norms))
     peak = float(norms[worst])
     ratio = peak / requirement.max_rate
-    values: dict[str, float | None] = {"peak_rate": peak, "peak_time_s": float(t[worst]), "ratio": ratio}
+    values: dict[str, float | None] = dict(zip(RATE_FIELDS, (peak, float(t[worst]), ratio)))
     met = ratio <= 1.0 + _TOLERANCE
     return Score("rate", values, met, "" if met else f"peak rate {peak:.4g} rad/s at {t[worst]:.1f} s, "
                                                      f"{ratio:.3g} x the {requirement.max_rate:g} rad/s bound")
@@ -132,7 +138,7 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
            end_of_manoeuvre: float) -> Score:
     start = end_of_manoeuvre + requirement.after_s
     inside = t >= start - 1e-9
-    values: dict[str, float | None] = {"worst_error_deg": None, "worst_rate_error": None, "from_s": start}
+    values: dict[str, float | None] = dict(zip(FINAL_FIELDS, (None, None, start)))
     if not np.any(inside):
         return Score("final", values, False, f"no closed-loop sample from {start:g} s (T + after_s) on; lengthen "
                                              "simulation.duration")
@@ -243,6 +249,38 @@ def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: A
     if requirements.final is not None:
         scores["final"] = _final(requirements.final, t, q, omega, problem, end_of_manoeuvre)
     return scores
+
+
+def score_fields(requirements: Requirements, spacecraft: Spacecraft) -> dict[str, dict[str, tuple[str, ...]]]:
+    """The fields a row's scores may hold, by scope and requirement: the result columns
+    ``ref.req.<name>.<field>`` and ``cl.req.<name>.<field>`` a scenario can give.
+
+    Parameters
+    ----------
+    requirements : Requirements
+        The scenario's requirements.
+    spacecraft : ocp.Spacecraft
+        Its spacecraft (the actuator requirement has a field per limited actuator quantity,
+        :func:`controllers.allocation.demand_limits`, and its time).
+
+    Returns
+    -------
+    dict
+        Scope (``reference``, ``closed_loop``) -> requirement name -> fields, in column order:
+        pointing and rate in both scopes, ``actuators`` in the reference only, ``final`` in the
+        closed loop only.
+    """
+    pointing = {requirement.name: POINTING_FIELDS for requirement in requirements.pointing}
+    reference: dict[str, tuple[str, ...]] = dict(pointing)
+    closed_loop: dict[str, tuple[str, ...]] = dict(pointing)
+    if requirements.actuators is not None:
+        limited = [name for name, limit in demand_limits(spacecraft).items() if np.any(np.isfinite(limit))]
+        reference["actuators"] = tuple(field for name in limited for field in (name, f"{name}_time_s"))
+    if requirements.rate is not None:
+        reference["rate"] = closed_loop["rate"] = RATE_FIELDS
+    if requirements.final is not None:
+        closed_loop["final"] = FINAL_FIELDS
+    return {"reference": reference, "closed_loop": closed_loop}
 
 
 def endpoint_violations(problem: ManeuverProblem) -> list[str]:

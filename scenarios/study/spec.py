@@ -20,7 +20,9 @@ from typing import Any
 import numpy as np
 
 from scenarios.errors import ScenarioError
-from scenarios.schema.loader import parse_scenario
+from scenarios.requirements.scoring import score_fields
+from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES, is_requirement_column
+from scenarios.schema.loader import Scenario, parse_scenario
 from scenarios.schema.node import Node
 from scenarios.schema.read import read_yaml
 from scenarios.schema.study import MAX_CASES, STUDY, grid_values
@@ -168,12 +170,48 @@ def parse_study(data: Any, source: Path | None = None, version: str | None = Non
     root.finish()
     study = Study(name, source, base, paths, [p for p, _, _ in dispersions], samples, method, seed,
                   summary, execution, raw=copy.deepcopy(data))
-    study.cases = _expand(study, steps, points, dispersions, version or package_version())
+    columns: dict[str, None] = {}
+    study.cases = _expand(study, steps, points, dispersions, version or package_version(), columns)
+    _check_summary(summary, columns)
     return study
 
 
+def _requirement_columns(scenario: Scenario) -> list[str]:
+    """The requirement columns a case's rows can give (``ref.req.<name>.<field>``, ``cl.req...``)."""
+    fields = score_fields(scenario.requirements, scenario.problem.spacecraft)
+    return [f"{prefix}.{REQUIREMENT_MARK}.{name}.{field}" for scope, prefix in SCOPES
+            for name, names in fields[scope].items() for field in names]
+
+
+def _check_summary(summary: list[str], columns: dict[str, None]) -> None:
+    """Refuse a summary entry naming a requirement column that no case gives (a typo would
+    summarise nothing, silently)."""
+    for index, column in enumerate(summary):
+        if not is_requirement_column(column) or column in columns:
+            continue
+        prefix, _, name, field = column.split(".")
+        scope = {p: s for s, p in SCOPES}[prefix]
+        own = [c for c in columns if c.split(".")[2] == name]
+        if not own:
+            names = sorted({c.split(".")[2] for c in columns})
+            why = (f"no case has a requirement {name!r}; the study's requirements are {names}" if names
+                   else f"no case has a requirement {name!r}: the scenario states none")
+        elif not any(c.startswith(f"{prefix}.") for c in own):
+            why = (f"requirement {name!r} is not scored in the {scope.replace('_', ' ')}; its columns are "
+                   f"{own}")
+        else:
+            why = f"requirement {name!r} has no field {field!r}; its columns are {own}"
+        listed = list(columns)
+        more = f" ... ({len(listed)} in all)" if len(listed) > 12 else ""
+        raise ScenarioError(f"summary[{index}]", f"{column!r}: {why}"
+                            + (f" (the study's requirement columns: {listed[:12]}{more})" if listed else ""))
+
+
 def _expand(study: Study, steps: list[list[Step]], points: list[tuple[list, list]],
-            dispersions: list[tuple[str, list[Step], Dispersion]], version: str) -> list[Case]:
+            dispersions: list[tuple[str, list[Step], Dispersion]], version: str,
+            columns: dict[str, None] | None = None) -> list[Case]:
+    """The cases, each validated by the scenario loader; ``columns`` collects the requirement columns
+    the cases can give (in order)."""
     n_cases = len(points) * study.samples
     children = np.random.SeedSequence(study.seed).spawn(n_cases + len(points))
     dims = sum(d.dimension for _, _, d in dispersions)
@@ -202,16 +240,18 @@ def _expand(study: Study, steps: list[list[Step]], points: list[tuple[list, list
                     set_path(data, path_steps, value, path)
                     varied[path] = value if not isinstance(value, list) else json.dumps(value)
             case = Case(index, seed, point, varied, data)
-            _validate(study, case)
+            scenario = _validate(study, case)
+            if columns is not None:
+                columns.update(dict.fromkeys(_requirement_columns(scenario)))
             case.key = case_key(data, version)
             cases.append(case)
     return cases
 
 
-def _validate(study: Study, case: Case) -> None:
+def _validate(study: Study, case: Case) -> Scenario:
     """The scenario loader's verdict on a case, naming the study, the case and the study entry."""
     try:
-        parse_scenario(case.scenario)  # the loader only reads its data
+        return parse_scenario(case.scenario)  # the loader only reads its data
     except ScenarioError as error:
         entries = [p for p in case.varied if error.path.startswith(p) or p.startswith(error.path)]
         varied = ", ".join(f"{p}={json.dumps(v)[:40]}" for p, v in case.varied.items())
