@@ -7,6 +7,7 @@ per defect found in review, each failing before its fix.
 from __future__ import annotations
 
 import contextlib
+import copy
 import io
 from pathlib import Path
 
@@ -128,3 +129,91 @@ def test_the_fields_a_study_checks_its_summary_against_are_those_a_run_gives():
     for scope in ("reference", "closed_loop"):
         given = {name: tuple(values) for name, values in row.requirements[scope].items()}
         assert given == fields[scope], scope
+
+
+def test_rate_jumps_are_taken_up_by_the_wheels_as_momentum_conservation_says():
+    """A reference that starts at a rate other than the spacecraft's and steps its rate at 20 s (as
+    natural motion's spin-up and step stop do): the wheels take each jump's momentum at once. Oracle:
+    the total angular momentum is conserved in inertial axes (no external torque),
+    ``h(t) = R(q)ᵀ R(q₀)(I ω_actual(0) + h₀) − I ω(t)``, the attitude integrated from the rate
+    across the step (SciPy). Before the fix the jumps were ignored: the wheels stayed at h₀."""
+    from scipy.integrate import solve_ivp
+
+    from controllers import CONTROLLERS
+    from controllers.allocation import reference_demand
+    from ocp import AttitudeModel, ReactionWheels, Spacecraft, quat
+
+    inertia = np.diag([0.25, 0.28, 0.12])
+    step = np.array([0.004, -0.003, 0.01])
+
+    def rate(t):
+        t = np.atleast_1d(t)
+        smooth = np.stack([0.02 * np.sin(0.3 * t), 0.015 * np.cos(0.2 * t) - 0.015, 0.01 * t / (1 + 0.1 * t)], -1)
+        return smooth + (t[:, None] >= 20.0) * step
+
+    def rate_dot(t):
+        return np.stack([0.006 * np.cos(0.3 * t), -0.003 * np.sin(0.2 * t), 0.01 / (1 + 0.1 * t) ** 2], -1)
+
+    def rhs(time, q):
+        return 0.5 * quat.product(q, np.concatenate([[0.0], rate(time)[0]]))
+
+    t = np.linspace(0.0, 40.0, 4001)
+    first = solve_ivp(rhs, (0.0, 20.0), quat.IDENTITY, t_eval=t[t < 20.0], rtol=1e-12, atol=1e-13,
+                      method="DOP853", dense_output=True)
+    second = solve_ivp(rhs, (20.0, 40.0), first.sol(20.0), t_eval=t[t >= 20.0], rtol=1e-12, atol=1e-13,
+                       method="DOP853")
+    q = np.vstack([first.y.T, second.y.T])
+    omega = rate(t)
+    torque = rate_dot(t) @ inertia.T + np.cross(omega, omega @ inertia.T)
+    actual0 = rate(0.0)[0] - np.array([0.01, 0.02, -0.03])  # the spacecraft's rate at 0: the reference jumps from it
+    jumps = np.zeros((t.size, 3))
+    jumps[0] = rate(0.0)[0] - actual0
+    jumps[np.searchsorted(t, 20.0)] = step
+    h0 = np.array([0.004, -0.002, 0.001])
+    spacecraft = Spacecraft(inertia, wheels=ReactionWheels.from_body_axes(max_torque=0.003, max_momentum=0.05))
+    demand = reference_demand(CONTROLLERS["augmented_quaternion_feedback"](), AttitudeModel(spacecraft), t, q, omega,
+                              torque, h0, jumps=jumps)
+    total = quat.rotate(q[0], inertia @ actual0 + h0)
+    expected = quat.rotate_inverse(q, total) - omega @ inertia.T
+    values, k = demand["wheels_momentum"].values, int(np.searchsorted(t, 20.0))
+    np.testing.assert_allclose(values[:k], expected[:k], atol=2e-8)  # the jump at 0 taken up exactly
+    # After the step: Heun's trapezoid over the interval that holds it reads the rate after the step
+    # at its end, an error of at most dt |Δω| |h| / 2 = 0.01 x 0.0113 x 0.03 / 2 = 1.7e-6 N m s (first
+    # order at a discontinuity, whatever the method; then carried exactly).
+    np.testing.assert_allclose(values[k:], expected[k:], atol=1.7e-6)
+    assert np.max(np.abs(values[k:] - expected[k:])) > 1e-8  # (the bound is that interval's, not slack)
+
+
+NATURAL = {
+    "name": "natural-motion-momentum",
+    "spacecraft": {"inertia": [0.25, 0.28, 0.12], "wheels": {"max_torque": 0.003, "max_momentum": 0.004}},
+    "maneuver": {"duration": 60.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
+                 "final": {"q": [0.5, 0, 0, 0.8660254], "omega": [0, 0, 0]}},
+    "planners": [{"name": "natural_motion"}, {"name": "eigenaxis", "options": {"profile": "trapezoidal"}}],
+    "controller": {"name": "augmented_quaternion_feedback"},
+    "simulation": {"sample_time": 0.1, "duration": 70.0},
+}
+
+
+def test_a_reference_that_jumps_its_rate_is_never_ok():
+    """Natural motion (stop_time 10 s) turns 120 deg about z on a torque-free arc of 50 s at
+    ω = (2π/3)/50 = 0.041888 rad/s, reached at once from rest and left at once at 50 s. No finite
+    torque does that, and during the arc the wheels hold I_zz ω = 0.0050265 N m s, 1.2566 x their
+    0.004 N m s: the row was ``ok`` (demand 0: the jumps were not seen) while its closed loop
+    saturated and ended 27 deg off. The trapezoidal eigenaxis (ω continuous, ω̇ jumps at its switches)
+    has no rate jump."""
+    import scenarios
+
+    results = scenarios.run(parse_scenario(copy.deepcopy(NATURAL)))
+    natural, eigenaxis = results.rows
+    assert natural.requirements is not None and eigenaxis.requirements is not None
+    arc_rate = (2.0 * np.pi / 3.0) / 50.0
+    score = natural.requirements["reference"]["actuators"]
+    assert natural.status == "violated", natural.message
+    assert score["rate_jump"] == pytest.approx(arc_rate, rel=1e-6)
+    assert score["rate_jump_time_s"] == 0.0
+    assert score["wheels_momentum"] == pytest.approx(0.12 * arc_rate / 0.004, rel=1e-4)
+    assert f"rate jumps by {arc_rate:.3g} rad/s at 0 s" in natural.message, natural.message
+    assert eigenaxis.requirements["reference"]["actuators"]["rate_jump"] == 0.0
+    assert eigenaxis.requirements["reference"]["actuators"]["rate_jump_time_s"] is None
+    assert "rate jump" not in eigenaxis.message
