@@ -16,6 +16,7 @@ import pytest
 import yaml
 
 from scenarios.cli.commands import main
+from scenarios.errors import ScenarioError
 from scenarios.requirements.scoring import endpoint_violations
 from scenarios.schema.loader import parse_scenario
 
@@ -217,3 +218,17 @@ def test_a_reference_that_jumps_its_rate_is_never_ok():
     assert eigenaxis.requirements["reference"]["actuators"]["rate_jump"] == 0.0
     assert eigenaxis.requirements["reference"]["actuators"]["rate_jump_time_s"] is None
     assert "rate jump" not in eigenaxis.message
+
+
+def test_an_epoch_outside_the_ephemeris_names_the_run_as_written():
+    """The 12U case runs 70 s (simulation.duration); its directions are tabulated over 180 s (twice
+    the manoeuvre plus a minute, room for a longer reference). The message said 'the run ... for
+    180 s', a run the user never wrote."""
+    data = base()
+    data["epoch"] = "1900-01-01T00:00:00Z"
+    with pytest.raises(ScenarioError) as raised:
+        parse_scenario(data)
+    error = str(raised.value)
+    assert "epoch" in error and "1900-01-01T00:00:00" in error and "1960-01-01" in error and "2200-01-01" in error
+    assert "70 s" in error and "180 s" in error, error
+    assert "run from 1900-01-01T00:00:00 for 180 s" not in error, error

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ocp.dynamics.ephemeris import check_epoch, parse_utc
+from ocp.dynamics.ephemeris import EPHEMERIS_RANGE, check_epoch, parse_utc
 from ocp.errors import ModelError, excerpt
 from ocp.geometry.directions import DIRECTIONS, Geometry
 from ocp.geometry.pointing import PointingConstraint
@@ -385,5 +385,9 @@ def check_ephemeris(epoch: datetime.datetime | None, span: RunSpan) -> None:
         return
     try:
         check_epoch(epoch, span.table)
-    except ModelError as error:
-        raise ScenarioError("epoch", error.message) from None
+    except ModelError:  # the epoch is parsed and the span finite: the range is what it leaves
+        low, high = EPHEMERIS_RANGE
+        raise ScenarioError("epoch", f"the ephemeris (JPL DE421) covers {low:%Y-%m-%d} to {high:%Y-%m-%d} UTC; "
+                            f"{epoch.isoformat()}Z is outside it, or the directions tabulated from it over "
+                            f"{span.table:g} s (the run of {span.run:g} s, with room for a longer reference) "
+                            "leave it") from None
