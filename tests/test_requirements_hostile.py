@@ -232,3 +232,24 @@ def test_an_epoch_outside_the_ephemeris_names_the_run_as_written():
     assert "epoch" in error and "1900-01-01T00:00:00" in error and "1960-01-01" in error and "2200-01-01" in error
     assert "70 s" in error and "180 s" in error, error
     assert "run from 1900-01-01T00:00:00 for 180 s" not in error, error
+
+
+def test_a_collocation_failure_names_what_the_requirements_ask():
+    """An actuator margin of 0.99 leaves 1 % of each limit: the 120 deg slew in 60 s cannot be made,
+    and IPOPT says so. The hint named cones ('a larger cone_margin_deg', which would make it harder)
+    for a problem without any; it must point at the margin (and the duration)."""
+    from planners import PLANNERS
+
+    data = base()
+    data["requirements"] = {"actuators": {"margin": 0.99}}
+    problem = parse_scenario(data).problem
+    reference = PLANNERS["collocation"]({"intervals": 10}).plan(problem)
+    assert not reference.ok
+    assert "requirements.actuators.margin" in reference.message and "0.99" in reference.message, reference.message
+    assert "cone_margin_deg" not in reference.message, reference.message
+    # with a rate bound too slow for the slew, the hint names it
+    data["requirements"] = {"rate": {"max": 0.01}, "actuators": None}
+    reference = PLANNERS["collocation"]({"intervals": 10}).plan(parse_scenario(data).problem)
+    assert not reference.ok
+    assert "requirements.rate.max" in reference.message and "0.01" in reference.message, reference.message
+    assert "cone_margin_deg" not in reference.message, reference.message
