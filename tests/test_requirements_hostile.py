@@ -253,3 +253,162 @@ def test_a_collocation_failure_names_what_the_requirements_ask():
     assert not reference.ok
     assert "requirements.rate.max" in reference.message and "0.01" in reference.message, reference.message
     assert "cone_margin_deg" not in reference.message, reference.message
+
+
+def _edit(**paths) -> dict:
+    """The 12U case with ``a__b=value`` set (``DELETE`` removes the key)."""
+    data = base()
+    for path, value in paths.items():
+        keys = path.split("__")
+        node = data
+        for key in keys[:-1]:
+            node = node.setdefault(key, {})
+        if value is DELETE:
+            node.pop(keys[-1], None)
+        else:
+            node[keys[-1]] = value
+    return data
+
+
+DELETE = object()
+ST = "requirements__pointing__st_sun"
+
+
+def _st(**entry) -> dict:
+    values = {"sensor": "star_tracker", "keep_out": "sun", "angle_deg": 30, **entry}
+    return {key: value for key, value in values.items() if value is not None}
+
+
+_TEXT = SCENARIO.read_text()
+HOSTILE = {  # case: (scenario data or YAML text, the path named, words the message holds)
+    "boresight of strings": (_edit(spacecraft__sensors={"star_tracker": {"boresight": ["a", "b", "c"]}}),
+                             "spacecraft.sensors.star_tracker.boresight", ["list of 3 numbers", "'a'"]),
+    "boresight of two": (_edit(spacecraft__sensors={"star_tracker": {"boresight": [1, 0]}}),
+                         "spacecraft.sensors.star_tracker.boresight", ["3 numbers", "2"]),
+    "boresight NaN": (_edit(spacecraft__sensors={"star_tracker": {"boresight": [float("nan"), 0, 1]}}),
+                      "spacecraft.sensors.star_tracker.boresight", ["finite"]),
+    "sensors a list": (_edit(spacecraft__sensors=[]), "spacecraft.sensors", ["mapping", "[]"]),
+    "sensor without boresight": (_edit(spacecraft__sensors={"star_tracker": {}}),
+                                 "spacecraft.sensors.star_tracker.boresight", ["required"]),
+    "angle 'abc'": (_edit(**{ST: _st(angle_deg="abc")}), "requirements.pointing.st_sun.angle_deg",
+                    ["a number", "'abc'"]),
+    "angle true": (_edit(**{ST: _st(angle_deg=True)}), "requirements.pointing.st_sun.angle_deg", ["a number"]),
+    "angle inf": (_edit(**{ST: _st(angle_deg=float("inf"))}), "requirements.pointing.st_sun.angle_deg", ["inf"]),
+    "angle -5": (_edit(**{ST: _st(angle_deg=-5)}), "requirements.pointing.st_sun.angle_deg", ["(0, 180)", "-5"]),
+    "Sun without an epoch": (_edit(epoch=DELETE), "requirements.pointing.st_sun.keep_out", ["'sun'", "epoch"]),
+    "epoch 2300": (_edit(epoch="2300-01-01T00:00:00Z"), "epoch", ["2200-01-01", "2300-01-01"]),
+    "epoch 1900": (_edit(epoch="1900-01-01"), "epoch", ["1960-01-01", "1900-01-01", "70 s"]),
+    "epoch month 13": (_edit(epoch="2027-13-01"), "epoch", ["'2027-13-01'", "2025-01-01"]),
+    "epoch 'yesterday'": (_edit(epoch="yesterday"), "epoch", ["'yesterday'"]),
+    "epoch a number": (_edit(epoch=12345), "epoch", ["12345"]),
+    "epoch empty": (_edit(epoch=""), "epoch", ["''"]),
+    "epoch a list": (_edit(epoch=[2027, 3, 20]), "epoch", ["[2027, 3, 20]"]),
+    "epoch a leap second": (_edit(epoch="2016-12-31T23:59:60Z"), "epoch", ["leap second"]),
+    "window empty": (_edit(**{ST: _st(window=[10, 10])}), "requirements.pointing.st_sun.window", ["[10, 10]"]),
+    "window reversed": (_edit(**{ST: _st(window=[40, 10])}), "requirements.pointing.st_sun.window", ["[40, 10]"]),
+    "window after the run": (_edit(**{ST: _st(window=[80, None])}), "requirements.pointing.st_sun.window",
+                             ["80", "70"]),
+    "window ends after the run": (_edit(**{ST: _st(window=[0, 100])}), "requirements.pointing.st_sun.window",
+                                  ["100", "70", "null"]),
+    "window start null": (_edit(**{ST: _st(window=[None, 10])}), "requirements.pointing.st_sun.window[0]",
+                          ["a number", "None"]),
+    "window a word": (_edit(**{ST: _st(window="all")}), "requirements.pointing.st_sun.window", ["list", "'all'"]),
+    "direction 'Sun'": (_edit(**{ST: _st(keep_out="Sun")}), "requirements.pointing.st_sun.keep_out",
+                        ["'Sun'", "'sun'"]),
+    "direction 'mars'": (_edit(**{ST: _st(keep_out="mars")}), "requirements.pointing.st_sun.keep_out",
+                         ["'mars'", "inertial"]),
+    "direction a number": (_edit(**{ST: _st(keep_out=42)}), "requirements.pointing.st_sun.keep_out", ["42"]),
+    "inertial zero": (_edit(**{ST: _st(keep_out={"inertial": [0, 0, 0]})}),
+                      "requirements.pointing.st_sun.keep_out.inertial", ["cannot be zero"]),
+    "inertial of two": (_edit(**{ST: _st(keep_out={"inertial": [1, 0]})}),
+                        "requirements.pointing.st_sun.keep_out.inertial", ["3 numbers"]),
+    "inertial with a frame": (_edit(**{ST: _st(keep_out={"inertial": [1, 0, 0], "frame": "gcrf"})}),
+                              "requirements.pointing.st_sun.keep_out.frame", ["unknown key", "inertial"]),
+    "inertial misspelt": (_edit(**{ST: _st(keep_out={"inertal": [1, 0, 0]})}),   # said only that it is missing
+                          "requirements.pointing.st_sun.keep_out.inertial", ["missing", "'inertal' is given"]),
+    "boresight misspelt": (_edit(spacecraft__sensors={"star_tracker": {"boresite": [1, 0, 0]}}),
+                           "spacecraft.sensors.star_tracker.boresight", ["'boresite' is given"]),
+    "limb without an orbit": (_edit(orbit=DELETE, environment={"gravity_gradient": False},
+                                    **{ST: _st(keep_out="earth_limb", angle_deg=10)}),
+                              "requirements.pointing.st_sun.keep_out", ["'earth_limb'", "orbit"]),
+    "keep_out and keep_in": (_edit(**{ST: _st(keep_in="moon")}), "requirements.pointing.st_sun",
+                             ["exactly one of keep_out and keep_in"]),
+    "neither": (_edit(**{ST: _st(keep_out=None)}), "requirements.pointing.st_sun", ["exactly one"]),
+    "duplicated requirement names": (_TEXT.replace(
+        "    st_sun: {sensor: star_tracker, keep_out: sun, angle_deg: 30}",
+        "    st_sun: {sensor: star_tracker, keep_out: sun, angle_deg: 30}\n"
+        "    st_sun: {sensor: star_tracker, keep_out: moon, angle_deg: 20}"),
+        "requirements.pointing.st_sun", ["duplicate key"]),
+    "duplicated sensor names": (_TEXT.replace(
+        "    star_tracker: {boresight: [0.5, -0.8660254, 0.0]}",
+        "    star_tracker: {boresight: [0.5, -0.8660254, 0.0]}\n    star_tracker: {boresight: [0, 0, 1]}"),
+        "spacecraft.sensors.star_tracker", ["duplicate key"]),
+    "requirements a list": (_edit(requirements=[]), "requirements", ["mapping", "[]"]),
+    "requirements a word": (_edit(requirements="yes"), "requirements", ["mapping", "'yes'"]),
+    "pointing a list": (_edit(requirements__pointing=[]), "requirements.pointing", ["mapping", "[]"]),
+    "a pointing entry null": (_edit(**{ST: None}), "requirements.pointing.st_sun", ["mapping", "None"]),
+    "unknown requirement kind": (_edit(requirements__thermal={"max": 1}), "requirements.thermal",
+                                 ["unknown key", "pointing"]),
+    "name starting with a digit": (_edit(requirements__pointing={"1st": _st()}), "requirements.pointing.1st",
+                                   ["letter", "'1st'"]),
+    "margin 1.0": (_edit(requirements__actuators={"margin": 1.0}), "requirements.actuators.margin", ["[0, 1)", "1.0"]),
+    "margin -0.1": (_edit(requirements__actuators={"margin": -0.1}), "requirements.actuators.margin", ["-0.1"]),
+    "margin '10%'": (_edit(requirements__actuators={"margin": "10%"}), "requirements.actuators.margin", ["'10%'"]),
+    "rate max 0": (_edit(requirements__rate={"max": 0}), "requirements.rate.max", ["positive", "0"]),
+    "rate max -1": (_edit(requirements__rate={"max": -1}), "requirements.rate.max", ["positive", "-1"]),
+    "final after the run": (_edit(requirements__final={"after_s": 20, "error_deg": 0.1}),
+                            "requirements.final.after_s", ["80", "70"]),
+    "final error 0": (_edit(requirements__final={"after_s": 5, "error_deg": 0}), "requirements.final.error_deg",
+                      ["positive"]),
+    "final with nothing": (_edit(requirements__final={}), "requirements.final", ["error_deg, rate or both"]),
+}
+
+
+@pytest.mark.parametrize("case", sorted(HOSTILE))
+def test_hostile_input_is_exit_2_naming_the_path_and_the_value(case, tmp_path):
+    data, path, words = HOSTILE[case]
+    status, error = run_cli(tmp_path, data)
+    assert status == 2, error
+    assert f"error in scenario: {path}:" in error, error
+    for word in words:
+        assert word in error, (word, error)
+    assert "Traceback" not in error
+
+
+@pytest.mark.parametrize(("grid", "path", "words"), [
+    ({"requirements.pointing.st_sun.angle_deg": [20, 200]}, "requirements.pointing.st_sun.angle_deg",
+     ["case 1", "200", "(0, 180)"]),
+    ({"epoch": ["2027-03-20T12:00:00Z", "1900-01-01"]}, "epoch", ["case 1", "1900-01-01", "1960-01-01"]),
+    ({"epoch": ["2027-03-20T12:00:00Z", "yesterday"]}, "epoch", ["case 1", "'yesterday'"]),
+])
+def test_a_study_sweeping_a_requirement_or_the_epoch_refuses_a_bad_case(tmp_path, grid, path, words):
+    status, error = run_cli(tmp_path, study(**{key.replace(".", "__"): values for key, values in grid.items()}),
+                            command="sweep")
+    assert status == 2, error
+    assert f"{path} (set by {path})" in error, error
+    for word in words:
+        assert word in error, (word, error)
+    assert "Traceback" not in error and not (tmp_path / "out").exists()
+
+
+def test_a_study_sweeping_the_angle_and_the_epoch_runs_and_reports_each_case(tmp_path):
+    """Two angles at two epochs (March and June 2027): in June the Sun lies 23 deg off the equator, the
+    target then 37 deg from it, inside a 40 deg cone (every row failed, before planning), outside a
+    20 deg one; in March the eigenaxis path crosses the Sun (violated)."""
+    import csv
+
+    status, error = run_cli(tmp_path, study(summary=["ref.req.st_sun.min_margin_deg"],
+                                            requirements__pointing__st_sun__angle_deg=[20, 40],
+                                            epoch=["2027-03-20T12:00:00Z", "2027-06-21T12:00:00Z"]),
+                            command="sweep")
+    assert status == 0, error
+    rows = list(csv.DictReader((tmp_path / "out" / "cases.csv").open()))
+    by_case = {(row["epoch"], row["requirements.pointing.st_sun.angle_deg"]): row for row in rows}
+    assert by_case[("2027-03-20T12:00:00Z", "20")]["status"] == "violated"
+    assert by_case[("2027-06-21T12:00:00Z", "20")]["status"] == "ok"
+    june_40 = by_case[("2027-06-21T12:00:00Z", "40")]
+    assert june_40["status"] == "failed" and "target attitude already breaks it" in june_40["message"]
+    assert float(by_case[("2027-03-20T12:00:00Z", "20")]["ref.req.st_sun.min_margin_deg"]) < -19.0
+    summary = (tmp_path / "out" / "requirements.csv").read_text().splitlines()
+    assert summary[0] == "label,completed,met,fraction_met,wilson_low,wilson_high"
+    assert summary[1].startswith("eigenaxis,4,1,0.25,")
