@@ -215,6 +215,7 @@ def test_a_reference_that_jumps_its_rate_is_never_ok():
     assert score["rate_jump_time_s"] == 0.0
     assert score["wheels_momentum"] == pytest.approx(0.12 * arc_rate / 0.004, rel=1e-4)
     assert f"rate jumps by {arc_rate:.3g} rad/s at 0 s" in natural.message, natural.message
+    assert "2 jumps" in natural.message, natural.message  # the spin-up and the step stop at 50 s (a breakpoint)
     assert eigenaxis.requirements["reference"]["actuators"]["rate_jump"] == 0.0
     assert eigenaxis.requirements["reference"]["actuators"]["rate_jump_time_s"] is None
     assert "rate jump" not in eigenaxis.message

@@ -197,15 +197,16 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
     start = np.asarray(omega[0], dtype=float) - np.asarray(omega0, dtype=float)
     if np.linalg.norm(start) > JUMP_TOLERANCE:
         found.append((float(t[0]), 0, start))
-    if reference is not None:
+    breakpoints = np.array([] if reference is None else reference.breakpoints, dtype=float)
+    breakpoints = breakpoints[(breakpoints > t[0]) & (breakpoints < t[-1])]
+    if breakpoints.size:
+        assert reference is not None
         instant = 1e-9 * max(reference.duration, 1.0)
-        for time in reference.breakpoints:
-            if not t[0] < time < t[-1]:
-                continue
-            around = reference.sample(np.array([time - instant, time + instant]))
-            jump = around.omega[1] - around.omega[0]
-            explained = 2.0 * instant * float(np.max(np.abs(around.omega_dot)))
-            if np.linalg.norm(jump) > JUMP_TOLERANCE + explained:
+        around = reference.sample(np.concatenate([breakpoints - instant, breakpoints + instant]))  # one call
+        before, after = np.split(around.omega, 2)
+        slopes = np.max(np.abs(np.stack(np.split(around.omega_dot, 2))), axis=(0, 2))
+        for time, jump, slope in zip(breakpoints, after - before, slopes):
+            if np.linalg.norm(jump) > JUMP_TOLERANCE + 2.0 * instant * slope:  # beyond what ω̇ explains
                 found.append((float(time), int(np.searchsorted(t, time, side="right")), jump))
     return found
 
