@@ -281,7 +281,7 @@ def _st(**entry) -> dict:
 
 
 _TEXT = SCENARIO.read_text()
-HOSTILE = {  # case: (scenario data or YAML text, the path named, words the message holds)
+HOSTILE: dict[str, tuple[dict | str, str, list[str]]] = {  # case: (scenario data or YAML text, the path named, words the message holds)
     "boresight of strings": (_edit(spacecraft__sensors={"star_tracker": {"boresight": ["a", "b", "c"]}}),
                              "spacecraft.sensors.star_tracker.boresight", ["list of 3 numbers", "'a'"]),
     "boresight of two": (_edit(spacecraft__sensors={"star_tracker": {"boresight": [1, 0]}}),
