@@ -31,7 +31,7 @@ from ocp.fast_call import BufferedFunction, as_floats
 
 Array = NDArray[np.float64]
 
-__all__ = ["Allocation", "Demand", "float_rows", "reference_demand"]
+__all__ = ["Allocation", "Demand", "demand_limits", "float_rows", "reference_demand"]
 
 
 def float_rows(matrix: ArrayLike) -> tuple[tuple[float, ...], ...]:
@@ -245,8 +245,32 @@ def _quantity(actuator: Actuator, state: bool) -> str:
     return f"{actuator.name}_{'momentum' if stores_momentum else 'state'}"
 
 
+def demand_limits(spacecraft: Spacecraft) -> dict[str, Array]:
+    """The quantities :func:`reference_demand` reports for a spacecraft, and their limits.
+
+    Parameters
+    ----------
+    spacecraft : ocp.Spacecraft
+        The spacecraft (its actuators, in order).
+
+    Returns
+    -------
+    dict of str to ndarray
+        :attr:`Demand.name` -> :attr:`Demand.limit` (positive; ``inf``: none; 0: a failed
+        element): each actuator kind's command, then its states when it has any.
+    """
+    limits: dict[str, Array] = {}
+    for block in actuator_blocks(spacecraft):
+        actuator = block.actuator
+        limits[_quantity(actuator, False)] = np.asarray(actuator.control_bounds()[1], dtype=float)
+        if actuator.state_size:
+            limits[_quantity(actuator, True)] = np.asarray(actuator.state_bounds()[1], dtype=float)
+    return limits
+
+
 def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: ArrayLike,
-                     torque: ArrayLike, state0: ArrayLike | None = None) -> dict[str, Demand]:
+                     torque: ArrayLike, state0: ArrayLike | None = None,
+                     jumps: ArrayLike | None = None) -> dict[str, Demand]:
     """What a reference asks of each actuator through a law's own allocation (module docstring).
 
     At each sample the feed-forward torque goes through the law's map (its flags included; the
@@ -256,6 +280,14 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     momenta, ``ḣ_w = g``) are integrated from ``state0`` by Heun's method (trapezoids, the rate
     at the end predicted by an Euler step), and the commands reported are those at the states
     reported. The law itself is not changed (a copy is prepared for the spacecraft).
+
+    A jump of the reference's body rate (``jumps``: a rate the reference starts at that is not the
+    spacecraft's, a step such as natural motion's stop) is no torque the feed-forward holds: the
+    body's momentum changes at once by ``I Δω``, and the working wheels take it up at once,
+    ``Δh_w = −A⁺ I Δω`` (the total angular momentum is conserved across it); what they cannot take
+    (fewer than three independent axes) leaves no state. The impulse itself is no finite demand:
+    the caller reports the jumps (:mod:`scenarios.requirements.scoring` breaks the actuator
+    requirement on one).
 
     Parameters
     ----------
@@ -273,6 +305,10 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
         Feed-forward torque ``u`` of ``I ω̇ = −ω × I ω + u`` [N m], body axes.
     state0 : (nx - 7,) array_like or None, optional
         The actuators' states at ``t[0]`` (the initial wheel momenta [N m s]); ``None``: zero.
+    jumps : (N, 3) array_like or None, optional
+        Jumps of the body rate [rad/s], body axes, arriving at each sample: row 0 from the
+        spacecraft's rate at ``t[0]`` to the reference's, row k between ``t[k-1]`` and ``t[k]``;
+        ``None``: none.
 
     Returns
     -------
@@ -311,23 +347,31 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     then = np.vstack([now[1:], now[-1:]]) if n else now
     dt = np.zeros(padded)
     dt[:n - 1] = np.diff(t)
+    kicks = np.zeros((padded, n_states))  # the states' jumps at each sample: the wheels take up the rate's
+    if jumps is not None and n and law._working_axes is not None:
+        wheels = next(block for block in blocks if block.actuator.block == "wheels")
+        momentum = np.asarray(jumps, dtype=float).reshape(n, 3) @ np.asarray(spacecraft.inertia, dtype=float).T
+        kicks[:n, wheels.state] = -momentum @ law._wheel_pinv.T  # Δh_w = −A⁺ I Δω
     state = states[0] if n else np.zeros(n_states)
     for start in range(0, padded, _CHUNK):  # one call per chunk of samples
         stop = start + _CHUNK
-        flat = chunk.all_outputs(state, now[start:stop].ravel(), then[start:stop].ravel(), dt[start:stop])
+        flat = chunk.all_outputs(state, now[start:stop].ravel(), then[start:stop].ravel(), dt[start:stop],
+                                 kicks[start:stop].ravel())
         ahead, asked = flat[0].reshape(_CHUNK, n_states).T, flat[1].reshape(_CHUNK, law._nu).T  # column-major
         within = min(stop, n) - start
         commands[start:start + within] = asked[:, :within].T
         states[start + 1:min(stop + 1, n)] = ahead[:, :min(stop + 1, n) - start - 1].T
         state = ahead[:, -1].copy()
+    states += kicks[:n]  # each sample's state after its jump (the step from it started there)
+    limits = demand_limits(spacecraft)
     demand: dict[str, Demand] = {}
     for block in blocks:
         actuator = block.actuator
         name = _quantity(actuator, False)
-        demand[name] = Demand(name, commands[:, block.control], actuator.control_bounds()[1])
+        demand[name] = Demand(name, commands[:, block.control], limits[name])
         if actuator.state_size:
             name = _quantity(actuator, True)
-            demand[name] = Demand(name, states[:, block.state], actuator.state_bounds()[1])
+            demand[name] = Demand(name, states[:, block.state], limits[name])
     return demand
 
 
@@ -336,8 +380,9 @@ _CHUNK = 512
 
 
 def _demand_step(law: Allocation, spacecraft: Spacecraft, blocks: Sequence[Any], n_states: int) -> ca.Function:
-    """``step(state_k, inputs_k, inputs_k+1, dt) -> (state_k+1, u_k)``: the command ``u_k`` of the
-    law's map at sample k and Heun's step of the actuators' states; ``inputs`` = [τ, q, ω, b]."""
+    """``step(state_k, inputs_k, inputs_k+1, dt, kick_k) -> (state_k+1, u_k)``: the state's jump
+    ``kick_k`` at sample k (the wheels taking up a jump of the rate), the command ``u_k`` of the
+    law's map there and Heun's step of the actuators' states; ``inputs`` = [τ, q, ω, b]."""
     inputs = ca.SX.sym("inputs", 13)
     state = ca.SX.sym("state", n_states)
     n_w = spacecraft.n_wheels
@@ -354,6 +399,8 @@ def _demand_step(law: Allocation, spacecraft: Spacecraft, blocks: Sequence[Any],
 
     after = ca.SX.sym("after", 13)
     dt = ca.SX.sym("dt")
-    before = rate(inputs, state)
-    following = state + 0.5 * dt * (before + rate(after, state + dt * before))
-    return ca.Function("demand_step", [state, inputs, after, dt], [following, command(inputs, state)])
+    kick = ca.SX.sym("kick", n_states)
+    kicked = state + kick
+    before = rate(inputs, kicked)
+    following = kicked + 0.5 * dt * (before + rate(after, kicked + dt * before))
+    return ca.Function("demand_step", [state, inputs, after, dt, kick], [following, command(inputs, kicked)])

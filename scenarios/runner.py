@@ -178,7 +178,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
                 _check_physical(row, "reference", row.reference_metrics)
                 if sampled is not None:
                     scores["reference"] = score_reference(scenario.requirements, scenario.problem, *sampled,
-                                                          controllers[j].controller)
+                                                          controllers[j].controller, reference)
                 _simulate(scenario, simulator, reference, row, controllers[j])
             timing = (f"planned in {(row.plan_time_s or 0.0) * 1e3:.1f} ms, "
                       f"simulated in {row.simulate_time_s:.2f} s")

@@ -250,7 +250,7 @@ def test_a_failed_solve_with_cones_says_what_to_try():
     problem = plane_slew([PointingConstraint("sun", [1, 0, 0], True, np.deg2rad(20.0), directions=[nadir_like(30.0)])])
     reference = PLANNERS["collocation"]({"max_iterations": 2, "intervals": 10}).plan(problem)
     assert not reference.ok
-    assert "multistart" in reference.message and "cone_margin_deg" in reference.message, reference.message
+    assert "multistart" in reference.message and "max_iterations" in reference.message, reference.message
 
 
 @pytest.mark.parametrize("transcription", ["collocation", "multiple_shooting"])

@@ -515,6 +515,26 @@ class CollocationPlanner(Planner):
         return reference
 
     @staticmethod
+    def _failure_hint(problem: ManeuverProblem, ocp: OptimalControlProblem, statuses: list[str]) -> str:
+        """What to try when no start converged, by what the problem asks: the cones (more starts or
+        intervals), the rate bound and the actuator margin (looser, or a longer duration); more
+        iterations when the solver ran out of them."""
+        tries = []
+        if "Maximum_Iterations_Exceeded" in statuses:
+            tries.append("a larger max_iterations")
+        if ocp.cones:
+            tries.append("multistart: 4 or more intervals (pointing constraints)")
+        if problem.max_rate is not None:
+            tries.append(f"a larger rate bound than {problem.max_rate:g} rad/s (requirements.rate.max, "
+                         "maneuver.max_rate)")
+        if problem.actuator_margin:
+            tries.append(f"a smaller requirements.actuators.margin than {problem.actuator_margin:g} (the reference "
+                         f"may use {100.0 * (1.0 - problem.actuator_margin):.3g} % of each actuator limit)")
+        if not tries:
+            return ""
+        return " (try " + "; ".join(tries) + "; or a longer duration)"
+
+    @staticmethod
     def _dense_stats(requirements: Requirements, tightening: Tightening, check: DenseCheck,
                      rounds: list[dict]) -> dict:
         """The ``dense_check`` entry of a reference's stats (see :meth:`plan`)."""
@@ -667,8 +687,7 @@ class CollocationPlanner(Planner):
         stats = result.stats()
         stats.update(solved.extra, transcription=transcription.name, intervals=solved.intervals, solver=solver)
         if not result.success:
-            hint = (" (with pointing or rate constraints, try multistart: 4, more intervals, a larger "
-                    "cone_margin_deg or a longer duration)" if ocp.cones or ocp.max_rate is not None else "")
+            hint = self._failure_hint(problem, ocp, result.statuses)
             return FailedReference(self.name, f"{solver} did not converge from any start: "
                                    f"{sorted(set(result.statuses))}{hint}", result.status, stats=stats)
         assert result.x is not None  # success implies a point

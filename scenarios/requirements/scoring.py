@@ -10,8 +10,10 @@ and what breaks it in words. The fields:
   (:meth:`ocp.geometry.pointing.PointingConstraint.score`);
 * ``actuators`` (reference only): for each actuator quantity with a limit
   (:func:`controllers.allocation.reference_demand`, through the row's controller's allocation),
-  ``<quantity>`` the peak demand over the limit and ``<quantity>_time_s`` when it peaks; met when
-  every ratio is at most ``1 − margin``;
+  ``<quantity>`` the peak demand over the limit and ``<quantity>_time_s`` when it peaks, then
+  ``rate_jump`` [rad/s] and ``rate_jump_time_s``, the largest jump of the reference's body rate
+  (:func:`rate_jumps`: an impulse no finite torque gives; its momentum goes to the wheels); met when
+  every ratio is at most ``1 − margin`` and the rate never jumps;
 * ``rate``: ``peak_rate`` [rad/s] (of ``‖ω‖``), ``peak_time_s``, ``ratio`` (over the bound);
 * ``final`` (closed loop only): ``worst_error_deg`` and ``worst_rate_error`` [rad/s] from
   ``T + after_s`` to the end, and ``from_s``.
@@ -28,15 +30,16 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from controllers.allocation import Allocation, reference_demand
-from ocp import quat
+from controllers.allocation import Allocation, demand_limits, reference_demand
+from ocp import Spacecraft, quat
 from ocp.geometry.pointing import PointingConstraint
-from planners import ManeuverProblem, Planner
+from planners import ManeuverProblem, Planner, Reference
 from planners.base import REQUIREMENT_KINDS
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
-__all__ = ["REFERENCE_POINTS", "SCOPE_WORDS", "Score", "endpoint_violations", "reference_times", "score_closed_loop",
-           "score_reference", "unhonoured", "violations"]
+__all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "JUMP_TOLERANCE", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
+           "SCOPE_WORDS", "Score", "endpoint_violations", "rate_jumps", "reference_times", "score_closed_loop",
+           "score_fields", "score_reference", "unhonoured", "violations"]
 
 Array = NDArray[np.float64]
 
@@ -46,6 +49,18 @@ REFERENCE_POINTS = 2001
 
 SCOPE_WORDS = {"reference": "reference", "closed_loop": "closed loop"}
 """A scope's key (of ``Row.requirements`` and ``results.json``) and its words in messages."""
+
+POINTING_FIELDS = ("min_margin_deg", "time_in_violation_s", "first_violation_s", "min_margin_time_s")
+"""The fields of a pointing requirement's score, in column order (both scopes)."""
+RATE_FIELDS = ("peak_rate", "peak_time_s", "ratio")
+"""The fields of the rate requirement's score (both scopes)."""
+FINAL_FIELDS = ("worst_error_deg", "worst_rate_error", "from_s")
+"""The fields of the final requirement's score (closed loop only)."""
+JUMP_FIELDS = ("rate_jump", "rate_jump_time_s")
+"""The actuator score's fields after its quantities': the largest jump of the reference's body rate
+[rad/s] (0 without one) and when it happens [s] (``None`` without one)."""
+JUMP_TOLERANCE = 1e-6
+"""A jump of a reference's body rate up to this [rad/s] is rounding, not a jump."""
 
 _TOLERANCE = 1e-9
 """Relative slack on the ratio and bound checks (rounding, not a margin)."""
@@ -104,10 +119,8 @@ def reference_times(duration: float, run_end: float, sample_time: float, points:
 
 def _pointing(constraint: PointingConstraint, t: Array, q: Array) -> Score:
     score = constraint.score(t, q)
-    values: dict[str, float | None] = {"min_margin_deg": score.min_margin_deg,
-                                       "time_in_violation_s": score.time_in_violation_s,
-                                       "first_violation_s": score.first_violation_s,
-                                       "min_margin_time_s": score.min_margin_time_s}
+    values: dict[str, float | None] = dict(zip(POINTING_FIELDS, (score.min_margin_deg, score.time_in_violation_s,
+                                                                 score.first_violation_s, score.min_margin_time_s)))
     if score.met:
         return Score(constraint.name, values, True)
     assert score.min_margin_deg is not None and score.min_margin_time_s is not None
@@ -122,7 +135,7 @@ def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
     worst = int(np.argmax(norms))
     peak = float(norms[worst])
     ratio = peak / requirement.max_rate
-    values: dict[str, float | None] = {"peak_rate": peak, "peak_time_s": float(t[worst]), "ratio": ratio}
+    values: dict[str, float | None] = dict(zip(RATE_FIELDS, (peak, float(t[worst]), ratio)))
     met = ratio <= 1.0 + _TOLERANCE
     return Score("rate", values, met, "" if met else f"peak rate {peak:.4g} rad/s at {t[worst]:.1f} s, "
                                                      f"{ratio:.3g} x the {requirement.max_rate:g} rad/s bound")
@@ -132,7 +145,7 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
            end_of_manoeuvre: float) -> Score:
     start = end_of_manoeuvre + requirement.after_s
     inside = t >= start - 1e-9
-    values: dict[str, float | None] = {"worst_error_deg": None, "worst_rate_error": None, "from_s": start}
+    values: dict[str, float | None] = dict(zip(FINAL_FIELDS, (None, None, start)))
     if not np.any(inside):
         return Score("final", values, False, f"no closed-loop sample from {start:g} s (T + after_s) on; lengthen "
                                              "simulation.duration")
@@ -154,7 +167,52 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
     return Score("final", values, not problems, (", ".join(problems) + f" (from {start:g} s)") if problems else "")
 
 
-def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array) -> Score:
+def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference | None = None) -> list[tuple[float, int, Array]]:
+    """Where a reference's body rate jumps: no finite torque gives a jump, so no actuator can follow it.
+
+    At t = 0 the reference's rate against the manoeuvre's initial rate (a reference that leaves
+    ``omega0`` free starts elsewhere: natural motion's spin-up), and across each of the reference's
+    breakpoints (:attr:`planners.Reference.breakpoints`, where ``ω`` may jump: natural motion's step
+    stop). A change of more than :data:`JUMP_TOLERANCE` across a breakpoint, beyond what ``ω̇``
+    explains over the instant either side sampled, is a jump.
+
+    Parameters
+    ----------
+    t : (N,) ndarray
+        The sample times [s], from 0.
+    omega : (N, 3) ndarray
+        The reference's rate at ``t`` [rad/s], body axes.
+    omega0 : (3,) array_like
+        The manoeuvre's initial rate [rad/s], body axes.
+    reference : planners.Reference or None, optional
+        The reference, for its breakpoints; ``None``: the start only.
+
+    Returns
+    -------
+    list of (time, index, jump)
+        The time [s] of each jump, the first sample after it (0 for the start), and the jump
+        ``ω⁺ − ω⁻`` [rad/s], body axes; in time order.
+    """
+    found = []
+    start = np.asarray(omega[0], dtype=float) - np.asarray(omega0, dtype=float)
+    if np.linalg.norm(start) > JUMP_TOLERANCE:
+        found.append((float(t[0]), 0, start))
+    breakpoints = np.array([] if reference is None else reference.breakpoints, dtype=float)
+    breakpoints = breakpoints[(breakpoints > t[0]) & (breakpoints < t[-1])]
+    if breakpoints.size:
+        assert reference is not None
+        instant = 1e-9 * max(reference.duration, 1.0)
+        around = reference.sample(np.concatenate([breakpoints - instant, breakpoints + instant]))  # one call
+        before, after = np.split(around.omega, 2)
+        slopes = np.max(np.abs(np.stack(np.split(around.omega_dot, 2))), axis=(0, 2))
+        for time, jump, slope in zip(breakpoints, after - before, slopes):
+            if np.linalg.norm(jump) > JUMP_TOLERANCE + 2.0 * instant * slope:  # beyond what ω̇ explains
+                found.append((float(time), int(np.searchsorted(t, time, side="right")), jump))
+    return found
+
+
+def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
+               jumps: list[tuple[float, int, Array]] | None = None) -> Score:
     values: dict[str, float | None] = {}
     broken = []
     for name, quantity in demand.items():
@@ -169,11 +227,20 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array) -> Sc
         if ratio > margin_allowed * (1 + _TOLERANCE):
             broken.append(f"{name} {ratio:.3g} x its limit at {t[worst]:.1f} s")
     detail = ", ".join(broken) + f" (allowed {margin_allowed:.3g} x)" if broken else ""
-    return Score("actuators", values, not broken, detail)
+    if jumps is not None:
+        largest = max(jumps, key=lambda jump: float(np.linalg.norm(jump[2])), default=None)
+        values.update(zip(JUMP_FIELDS, (0.0, None) if largest is None
+                          else (float(np.linalg.norm(largest[2])), largest[0])))
+        if largest is not None:
+            count = f", {len(jumps)} jumps" if len(jumps) > 1 else ""
+            jumped = (f"the body rate jumps by {np.linalg.norm(largest[2]):.3g} rad/s at {largest[0]:g} s "
+                      f"(an impulse: no finite torque gives it{count})")
+            detail = jumped + (f", {detail}" if detail else "")
+    return Score("actuators", values, not detail, detail)
 
 
 def score_reference(requirements: Requirements, problem: ManeuverProblem, times: ArrayLike, sample: Any,
-                    allocation: Allocation | None) -> dict[str, Score]:
+                    allocation: Allocation | None, reference: Reference | None = None) -> dict[str, Score]:
     """Score a reference, sampled densely, against every requirement that applies to it.
 
     Parameters
@@ -190,6 +257,9 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
     allocation : controllers.allocation.Allocation or None
         The row's controller, whose allocation the actuator demand goes through; ``None``: the
         actuator requirement is not scored.
+    reference : planners.Reference or None, optional
+        The reference sampled, for the jumps of its rate at its breakpoints (:func:`rate_jumps`);
+        ``None``: only a jump at the start (against the manoeuvre's initial rate) is found.
 
     Returns
     -------
@@ -200,9 +270,14 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
     t = np.asarray(times, dtype=float)
     scores = {constraint.name: _pointing(constraint, t, sample.q) for constraint in problem.pointing}
     if requirements.actuators is not None and allocation is not None:
+        jumps = rate_jumps(t, sample.omega, problem.omega0, reference)
+        steps = np.zeros((t.size, 3))
+        for _, index, jump in jumps:
+            if index < t.size:
+                steps[index] += jump
         demand = reference_demand(allocation, problem.model, t, sample.q, sample.omega, sample.torque,
-                                  problem.wheel_momentum0)
-        scores["actuators"] = _actuators(requirements.actuators.allowed, demand, t)
+                                  problem.wheel_momentum0, jumps=steps)
+        scores["actuators"] = _actuators(requirements.actuators.allowed, demand, t, jumps)
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, sample.omega)
     return scores
@@ -245,6 +320,38 @@ def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: A
     return scores
 
 
+def score_fields(requirements: Requirements, spacecraft: Spacecraft) -> dict[str, dict[str, tuple[str, ...]]]:
+    """The fields a row's scores may hold, by scope and requirement: the result columns
+    ``ref.req.<name>.<field>`` and ``cl.req.<name>.<field>`` a scenario can give.
+
+    Parameters
+    ----------
+    requirements : Requirements
+        The scenario's requirements.
+    spacecraft : ocp.Spacecraft
+        Its spacecraft (the actuator requirement has a field per limited actuator quantity,
+        :func:`controllers.allocation.demand_limits`, and its time).
+
+    Returns
+    -------
+    dict
+        Scope (``reference``, ``closed_loop``) -> requirement name -> fields, in column order:
+        pointing and rate in both scopes, ``actuators`` in the reference only, ``final`` in the
+        closed loop only.
+    """
+    pointing = {requirement.name: POINTING_FIELDS for requirement in requirements.pointing}
+    reference: dict[str, tuple[str, ...]] = dict(pointing)
+    closed_loop: dict[str, tuple[str, ...]] = dict(pointing)
+    if requirements.actuators is not None:
+        limited = [name for name, limit in demand_limits(spacecraft).items() if np.any(np.isfinite(limit))]
+        reference["actuators"] = tuple(field for name in limited for field in (name, f"{name}_time_s")) + JUMP_FIELDS
+    if requirements.rate is not None:
+        reference["rate"] = closed_loop["rate"] = RATE_FIELDS
+    if requirements.final is not None:
+        closed_loop["final"] = FINAL_FIELDS
+    return {"reference": reference, "closed_loop": closed_loop}
+
+
 def endpoint_violations(problem: ManeuverProblem) -> list[str]:
     """Pointing requirements that the manoeuvre's end points already break, before anything is planned.
 
@@ -271,8 +378,11 @@ def endpoint_violations(problem: ManeuverProblem) -> list[str]:
             margin = constraint.margins(np.array([time]), np.asarray(q).reshape(1, 4))[0]
             if np.isfinite(margin) and margin < 0.0:
                 kind = "keep-out" if constraint.keep_out else "keep-in"
+                # the cone at that time: the angle and its growth (the Earth's apparent radius about the limb)
+                limit = float(np.rad2deg(constraint.limit([time])[0]))
+                grown = f": {constraint.description}" if abs(limit - np.rad2deg(constraint.angle)) > 1e-9 else ""
                 found.append(f"{constraint.name}: the {words} already breaks it at {time:g} s (margin "
-                             f"{np.rad2deg(margin):.3g} deg to the {np.rad2deg(constraint.angle):g} deg {kind} cone); "
+                             f"{np.rad2deg(margin):.3g} deg to the {limit:.4g} deg {kind} cone{grown}); "
                              "no reference can meet it")
     return found
 

@@ -382,7 +382,8 @@ SCENARIO = Section((
            "labels unique.", "list of mappings", None, default=None, section=CONTROLLER, entries=True),
     mapping("simulation", "Closed-loop settings.", SIMULATION, default={}, null="defaults"),
     custom("requirements", "What every row is scored against: pointing cones, the actuators' margin, a rate "
-           "limit, the final error (the user guide's page on requirements); absent or ``null``: none.", "mapping or null",
+           "limit, the final error (the user guide's page on requirements). Absent: the actuators' limits only "
+           "(``actuators`` with margin 0); ``null``: none.", "mapping or null",
            None, default={}, section=REQUIREMENTS),
 ), "A scenario file.")
 

@@ -7,6 +7,7 @@ Reading the file itself (:func:`~scenarios.schema.read.read_yaml`, with its limi
 """
 from __future__ import annotations
 
+import difflib
 import math
 from collections.abc import Iterator
 from typing import Any
@@ -113,7 +114,10 @@ class Node:
         self._read.add(key)
         if key not in self.value:
             if required or default is ...:
-                raise ScenarioError(self._child_path(key), "required key is missing")
+                given = [k for k in self.value if isinstance(k, str) and k not in self._read]
+                close = difflib.get_close_matches(key, given, n=1, cutoff=0.7)
+                raise ScenarioError(self._child_path(key), "required key is missing" + (
+                    f"; {close[0]!r} is given: a misspelling of {key!r}?" if close else ""))
             return Node(default, self._child_path(key))
         return Node(self.value[key], self._child_path(key))
 

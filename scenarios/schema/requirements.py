@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ocp.dynamics.ephemeris import check_epoch, parse_utc
+from ocp.dynamics.ephemeris import EPHEMERIS_RANGE, check_epoch, parse_utc
 from ocp.errors import ModelError, excerpt
 from ocp.geometry.directions import DIRECTIONS, Geometry
 from ocp.geometry.pointing import PointingConstraint
@@ -31,7 +31,7 @@ from scenarios.requirements.spec import (
     Requirements,
     Sensor,
 )
-from scenarios.schema.keys import Section, custom, mapping, number, vector
+from scenarios.schema.keys import Described, Section, custom, mapping, number, vector
 from scenarios.schema.node import Node
 
 __all__ = [
@@ -156,6 +156,15 @@ REQUIREMENT_ACTUATORS = Section((
            "number", _margin, default=0.0, bounds=">= 0 and < 1"),
 ), "The reference must be feasible for the actuators.")
 
+def _actuators(node: Node) -> dict | None:
+    """``requirements.actuators``: its values, ``None`` for null; absent, margin 0 (unstated)."""
+    if isinstance(node.value, Described):
+        return {"margin": 0.0}
+    if node.is_null():
+        return None
+    return REQUIREMENT_ACTUATORS.read(node)
+
+
 REQUIREMENT_RATE = Section((
     number("max", "Bound on the body-rate norm ‖ω‖, reference and closed loop; also the planners' rate bound "
            "unless ``maneuver.max_rate`` is given (which must then not exceed it).", unit="rad/s", positive=True),
@@ -174,10 +183,11 @@ REQUIREMENTS = Section((
     custom("pointing", "Pointing requirements by name (the name heads the result columns "
            "``ref.req.<name>.*`` and ``cl.req.<name>.*``).", "mapping of names to mappings", None, default={},
            section=POINTING, named=True),
-    mapping("actuators", "The reference's demand on the actuators. Absent: required with margin 0 (the "
-            "actuators' limits are the scenario's: a reference that asks more than they give is never ok); "
-            "``null``: not required (scored only by the closed loop's saturation).",
-            REQUIREMENT_ACTUATORS, default={}, null="none"),
+    custom("actuators", "The reference's demand on the actuators. Absent: required with margin 0 (the "
+           "actuators' limits are the scenario's: a reference that asks more than they give is never ok), and "
+           "named in a row's note only when broken (``{}`` states it: named wherever a planner does not honour "
+           "it); ``null``: not required (scored only by the closed loop's saturation).", "mapping or null",
+           _actuators, default=Described("margin 0, unstated"), section=REQUIREMENT_ACTUATORS),
     mapping("rate", "A body-rate limit; absent or ``null``: none.", REQUIREMENT_RATE, default=None, null="none"),
     mapping("final", "The closed loop's final error and rate; absent or ``null``: none.", REQUIREMENT_FINAL,
             default=None, null="none"),
@@ -385,5 +395,9 @@ def check_ephemeris(epoch: datetime.datetime | None, span: RunSpan) -> None:
         return
     try:
         check_epoch(epoch, span.table)
-    except ModelError as error:
-        raise ScenarioError("epoch", error.message) from None
+    except ModelError:  # the epoch is parsed and the span finite: the range is what it leaves
+        low, high = EPHEMERIS_RANGE
+        raise ScenarioError("epoch", f"the ephemeris (JPL DE421) covers {low:%Y-%m-%d} to {high:%Y-%m-%d} UTC; "
+                            f"{epoch.isoformat()}Z is outside it, or the directions tabulated from it over "
+                            f"{span.table:g} s (the run of {span.run:g} s, with room for a longer reference) "
+                            "leave it") from None

@@ -477,7 +477,7 @@ STUDY = Section((
             null="none"),
     custom("summary", "The metrics summarised per planner label (and grid point): ``ref.<metric>`` or "
            "``cl.<metric>``, a vector's component as ``<metric>_x``, or a requirement's "
-           "``ref.req.<name>.<field>`` (``cl.req...``).", "list of text or null", _summary,
+           "``ref.req.<name>.<field>`` (``cl.req...``) that some case gives.", "list of text or null", _summary,
            default=Described("every scalar metric, ref. and cl.")),
     mapping("execution", "How the cases run.", EXECUTION, default={}, null="defaults"),
     custom("resolved", "Written by slewbench into the stored ``study.yaml`` (version, case seeds) and ignored "

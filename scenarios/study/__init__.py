@@ -9,8 +9,9 @@ local pool or Dask (:mod:`~scenarios.study.engine`), and the report's tables
 (:mod:`~scenarios.study.report`), figures (:mod:`~scenarios.study.plots`) and interactive
 ``report.html`` (:mod:`~scenarios.study.html`).
 
-May import: :mod:`ocp`, :mod:`scenarios.errors`, :mod:`scenarios.schema`, :mod:`scenarios.output`
-and :mod:`scenarios.runner`. Its names are imported on first use.
+May import: :mod:`ocp`, :mod:`scenarios.errors`, :mod:`scenarios.requirements` (the requirement
+columns a summary may name), :mod:`scenarios.schema`, :mod:`scenarios.output` and
+:mod:`scenarios.runner`. Its names are imported on first use.
 """
 from __future__ import annotations
 

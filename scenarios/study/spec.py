@@ -33,8 +33,10 @@ import numpy as np
 from ocp.errors import excerpt
 from scenarios.errors import ScenarioError
 from scenarios.output.provenance import package_version
+from scenarios.requirements.scoring import score_fields
+from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES, is_requirement_column
 from scenarios.schema.keys import Key
-from scenarios.schema.loader import parse_scenario
+from scenarios.schema.loader import Scenario, parse_scenario
 from scenarios.schema.node import Node
 from scenarios.schema.read import read_yaml
 from scenarios.schema.study import (
@@ -303,8 +305,41 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
     _mark_independent(seen)
     study = Study(name, source, base, [v.path for axis in axes for v in axis.varied], [v.path for v, _ in dispersions],
                   samples, method, seed, summary, execution, raw=copy.deepcopy(data))
-    study.cases = _Expansion(study, axes, dispersions, version or package_version(), progress).cases()
+    expansion = _Expansion(study, axes, dispersions, version or package_version(), progress)
+    study.cases = expansion.cases()
+    _check_summary(summary, expansion.columns)
     return study
+
+
+def _requirement_columns(scenario: Scenario) -> list[str]:
+    """The requirement columns a case's rows can give (``ref.req.<name>.<field>``, ``cl.req...``)."""
+    fields = score_fields(scenario.requirements, scenario.problem.spacecraft)
+    return [f"{prefix}.{REQUIREMENT_MARK}.{name}.{field}" for scope, prefix in SCOPES
+            for name, names in fields[scope].items() for field in names]
+
+
+def _check_summary(summary: list[str], columns: dict[str, None]) -> None:
+    """Refuse a summary entry naming a requirement column that no case gives (a typo would
+    summarise nothing, silently)."""
+    for index, column in enumerate(summary):
+        if not is_requirement_column(column) or column in columns:
+            continue
+        prefix, _, name, field = column.split(".")
+        scope = {p: s for s, p in SCOPES}[prefix]
+        own = [c for c in columns if c.split(".")[2] == name]
+        if not own:
+            names = sorted({c.split(".")[2] for c in columns})
+            why = (f"no case has a requirement {name!r}; the study's requirements are {names}" if names
+                   else f"no case has a requirement {name!r}: the scenario states none")
+        elif not any(c.startswith(f"{prefix}.") for c in own):
+            why = (f"requirement {name!r} is not scored in the {scope.replace('_', ' ')}; its columns are "
+                   f"{own}")
+        else:
+            why = f"requirement {name!r} has no field {field!r}; its columns are {own}"
+        listed = list(columns)
+        more = f" ... ({len(listed)} in all)" if len(listed) > 12 else ""
+        raise ScenarioError(f"summary[{index}]", f"{column!r}: {why}"
+                            + (f" (the study's requirement columns: {listed[:12]}{more})" if listed else ""))
 
 
 def _mark_independent(seen: list[_Varied]) -> None:
@@ -326,6 +361,7 @@ class _Expansion:
         self.points = math.prod(axis.length for axis in axes)
         self.total = self.points * study.samples
         self.checked: set[tuple[int, ...]] = set()  # classes of cases the whole loader has passed
+        self.columns: dict[str, None] = {}  # requirement columns the cases give, in order
         for axis in axes:
             axis.verdicts = [self._verdicts(varied, values) for varied, values in zip(axis.varied, axis.values)]
 
@@ -436,10 +472,13 @@ class _Expansion:
                 raise _case_error(case, error) from None
         if case_class not in self.checked:
             try:
-                parse_scenario(case.scenario)  # the loader only reads its data
+                scenario = parse_scenario(case.scenario)  # the loader only reads its data
             except ScenarioError as error:
                 raise _case_error(case, error) from None
             self.checked.add(case_class)
+            # a class of cases shares every key a requirement column depends on (independent keys
+            # are initial errors, noise and tolerances), so one parse per class lists them all
+            self.columns.update(dict.fromkeys(_requirement_columns(scenario)))
 
 
 def _read(key: Key, value: Any, path: str) -> Any:
