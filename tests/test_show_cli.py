@@ -186,14 +186,14 @@ def test_run_prints_the_compact_table_unless_all_metrics(tmp_path, capsys):
 def test_a_run_names_the_files_it_removed(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["run", str(DEMO), "--out", str(out)]) == 0
-    pictures = sorted(path.name for path in out.glob("*.png"))
-    assert len(pictures) == 4  # one per row and the comparison
+    pictures = sorted(path.name for path in [*out.glob("*.png"), out / "report.html"])
+    assert len(pictures) == 5  # one PNG per row, the comparison and the interactive report
     capsys.readouterr()
     assert main(["run", str(DEMO), "--out", str(out), "--no-plots"]) == 0
     said = [line for line in capsys.readouterr().out.splitlines() if line.startswith("removed")]
     assert said == [f"removed {len(pictures)} file(s) of the earlier run in {out}/ that this run did not write: "
                     + ", ".join(pictures)]
-    assert not list(out.glob("*.png"))
+    assert not list(out.glob("*.png")) and not (out / "report.html").exists()
     assert main(["run", str(DEMO), "--out", str(out), "--no-plots"]) == 0
     assert "removed" not in capsys.readouterr().out  # nothing removed, nothing said
 
