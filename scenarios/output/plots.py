@@ -37,11 +37,14 @@ from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullLoca
 
 from scenarios.output.plot_data import (
     DPI,
+    EULER_SEQUENCE,
     MARGIN_MARGINS,
     MARGIN_PANEL_IN,
     MARGIN_WIDTH_IN,
-    OVERLAY_FIGSIZE_IN,
+    OVERLAY_EDGES_IN,
     OVERLAY_MARGINS,
+    OVERLAY_ROW_IN,
+    OVERLAY_WIDTH_IN,
     MarginPanel,
     MarginSeries,
     OverlaySeries,
@@ -50,6 +53,7 @@ from scenarios.output.plot_data import (
     RowShape,
     SkyPath,
     SkySeries,
+    euler_sequence_axes,
     map_longitude,
     overlay_series,
     plot_jobs,
@@ -66,15 +70,22 @@ __all__ = [
     "draw_margins",
     "draw_overlay",
     "draw_sky",
+    "euler_names",
     "margin_axis",
     "margin_figure",
+    "overlay_figure",
     "plot_overlay",
     "sky_figure",
     "write_plots",
 ]
 
-AXIS_COLORS = ("tab:red", "tab:green", "tab:blue", "tab:purple")
-"""Colours of the body axes x, y, z (and the quaternion's fourth component)."""
+AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
+"""Colours of the body axes x, y, z: of every per-axis curve (torque, rate, the quaternion's vector
+part, the Euler angle about each axis, a wheel along the axis, the dipole)."""
+QUATERNION_COLORS = ("tab:purple", *AXIS_COLORS)
+"""Colours of the quaternion's components: the scalar part, then the vector part in the axes' colours."""
+PROPER_EULER_COLOR = "tab:purple"
+"""Colour of the third angle of a proper Euler sequence (its first rotates about the same axis)."""
 WHEEL_COLORS = ("tab:orange", "tab:brown", "tab:pink", "tab:olive", "tab:cyan", "tab:gray", "gold", "navy")
 """Colours of wheels whose spin axes are not distinct body axes (those take the axis' colour)."""
 FAILED_STYLE: dict[str, Any] = {"color": "0.55", "linestyle": ":"}
@@ -133,10 +144,38 @@ def _time_axis(axis: Any) -> None:
     axis.xaxis.set_major_locator(MaxNLocator(nbins=7, steps=[1, 2, 2.5, 5, 10]))
 
 
-PANEL_LABELS = {"torque": "body torque (N m)", "rate": "body rate (rad/s)", "quaternion": "quaternion (-)",
+PANEL_LABELS = {"torque": "body torque (N m)", "rate": "body rate (deg/s)", "quaternion": "quaternion (–)",
                 "wheel_torque": "wheel torque (N m)", "wheel_momentum": "wheel momentum (N m s)",
                 "wheel_speed": "wheel speed (rpm)", "dipole": "dipole (A m²)"}
-"""Value-axis labels of the per-row figure's panels (the error panel's depends on the row)."""
+"""Value-axis labels of the per-row figure's panels (the error panel's and the Euler angles' depend on the row)."""
+
+
+def euler_names(sequence: str) -> tuple[str, list[str], list[str]]:
+    """How the Euler angles of a sequence are named and coloured.
+
+    Parameters
+    ----------
+    sequence : str
+        An Euler sequence (:func:`scenarios.output.plot_data.euler_sequence_axes`).
+
+    Returns
+    -------
+    label : str
+        The panel's value-axis label, with the sequence and the unit (``"Euler 3-2-1 (deg)"``).
+    names : list of str
+        The legend's name of each angle, with its axis (``"ψ yaw (z)"`` for 3-2-1).
+    colors : list of str
+        Each angle's colour: its axis' (:data:`AXIS_COLORS`); the third of a proper sequence
+        :data:`PROPER_EULER_COLOR`.
+    """
+    axes = euler_sequence_axes(sequence)
+    names = (["ψ yaw", "θ pitch", "φ roll"] if axes == (2, 1, 0)
+             else [f"{symbol}{number}" for symbol, number in zip("αβγ", ("₁", "₂", "₃"))])
+    colors = [AXIS_COLORS[a] for a in axes]
+    if axes[0] == axes[2]:
+        colors[2] = PROPER_EULER_COLOR
+    label = f"Euler {'-'.join(str(a + 1) for a in axes)} (deg)"
+    return label, [f"{name} ({'xyz'[a]})" for name, a in zip(names, axes)], colors
 
 
 def wheel_colors(n_wheels: int, wheel_axis: tuple[int, ...]) -> list[str]:
@@ -165,9 +204,9 @@ def wheel_colors(n_wheels: int, wheel_axis: tuple[int, ...]) -> list[str]:
 class RowFigure:
     """The per-row figure, built once and redrawn for each row of the same shape (module docstring).
 
-    Panels, top to bottom: body torque, body rate, quaternion, error angles; with wheels their
-    motor torques and momenta, and speeds when their spin inertia is known; with magnetorquers
-    their dipole. Actuator limits are dotted ``±`` lines (one black pair when every curve of the
+    Panels, top to bottom: body torque, body rate, quaternion, Euler angles, error angles; with
+    wheels their motor torques and momenta, and speeds when their spin inertia is known; with
+    magnetorquers their dipole. Every per-axis curve takes its axis' colour (:data:`AXIS_COLORS`). Actuator limits are dotted ``±`` lines (one black pair when every curve of the
     panel has the same limit, else one pair per curve in its colour); failed wheels are grey,
     dotted and marked in the legend.
 
@@ -189,14 +228,17 @@ class RowFigure:
         A magnetorquer dipole panel.
     limited : tuple of (str, bool), optional
         Panels with limit lines and whether their limits are common (:attr:`RowSeries.shape`).
+    euler_sequence : str, optional
+        The Euler angles' sequence (:func:`euler_names`); default
+        :data:`scenarios.output.plot_data.EULER_SEQUENCE`.
     """
 
     def __init__(self, n_wheels: int, with_reference: bool, with_target: bool, failed: tuple[int, ...] = (),
                  wheel_axis: tuple[int, ...] = (), wheel_speed: bool = False, dipole: bool = False,
-                 limited: tuple[tuple[str, bool], ...] = ()):
+                 limited: tuple[tuple[str, bool], ...] = (), euler_sequence: str = EULER_SEQUENCE):
         self.shape: RowShape = (n_wheels, with_reference, with_target, tuple(failed), tuple(wheel_axis),
-                                wheel_speed, dipole, tuple(limited))
-        names = ["torque", "rate", "quaternion", "error"]
+                                wheel_speed, dipole, tuple(limited), euler_sequence)
+        names = ["torque", "rate", "quaternion", "euler", "error"]
         names += ["wheel_torque", "wheel_momentum"] if n_wheels else []
         names += ["wheel_speed"] if n_wheels and wheel_speed else []
         names += ["dipole"] if dipole else []
@@ -224,21 +266,24 @@ class RowFigure:
             return items
 
         axis_colors = list(AXIS_COLORS)
+        euler_label, euler_legend, euler_colors = euler_names(euler_sequence)
         self.torque = curves("torque", 3, axis_colors, "u_{axis}", drawstyle="steps-post")
         self.rate = curves("rate", 3, axis_colors, "ω_{axis}")
-        self.quaternion = [line(axes[2], color=AXIS_COLORS[i], label=f"q{i}") for i in range(4)]
-        self.reference: tuple[list[Any], list[Any], list[Any]] | None = None
+        self.quaternion = [line(panel["quaternion"], color=QUATERNION_COLORS[i], label=f"q{i}") for i in range(4)]
+        self.euler = [line(panel["euler"], color=euler_colors[i], label=euler_legend[i]) for i in range(3)]
+        self.reference: tuple[list[Any], ...] | None = None
         if with_reference:
-            self.reference = ([line(axes[0], "--", color=AXIS_COLORS[i], lw=1) for i in range(3)],
-                              [line(axes[1], "--", color=AXIS_COLORS[i], lw=1) for i in range(3)],
-                              [line(axes[2], "--", color=AXIS_COLORS[i], lw=1) for i in range(4)])
-        _log_axis(axes[3])
-        self.to_target = line(axes[3], color="k", label="to target") if with_target else None
-        self.to_reference = line(axes[3], color="tab:orange", label="to reference") if with_reference else None
+            self.reference = tuple([line(panel[name], "--", color=color, lw=1) for color in colors]
+                                   for name, colors in (("torque", AXIS_COLORS), ("rate", AXIS_COLORS),
+                                                        ("quaternion", QUATERNION_COLORS), ("euler", euler_colors)))
+        error = panel["error"]
+        _log_axis(error)
+        self.to_target = line(error, color="k", label="to target") if with_target else None
+        self.to_reference = line(error, color="tab:orange", label="to reference") if with_reference else None
         self.rate_norm = self.rate_max = None
         if not with_reference and not with_target:  # rate regulation (detumbling): the rate converges
-            self.rate_norm = line(axes[3], color="k", label="‖ω‖")
-            self.rate_max = line(axes[3], color="tab:gray", lw=1, label="max |ω_i|")
+            self.rate_norm = line(error, color="k", label="‖ω‖")
+            self.rate_max = line(error, color="tab:gray", lw=1, label="max |ω_i|")
         colors = wheel_colors(n_wheels, tuple(wheel_axis))
         self.wheel_torque = curves("wheel_torque", n_wheels, colors, "g_w{i}", drawstyle="steps-post")
         self.wheels = curves("wheel_momentum", n_wheels, colors, "h_w{i}")
@@ -262,9 +307,10 @@ class RowFigure:
             self.off_scale[name] = panel[name].text(0.995, 0.96, "", transform=panel[name].transAxes, ha="right",
                                                     va="top", fontsize=7, color="0.3")
         self.panels = panel
-        error_label = "error angle (deg)" if with_reference or with_target else "body rate (rad/s)"
+        labels = {**PANEL_LABELS, "euler": euler_label,
+                  "error": "error angle (deg)" if with_reference or with_target else "body rate (deg/s)"}
         for name, axis in panel.items():
-            _label(axis, PANEL_LABELS.get(name, error_label))
+            _label(axis, labels[name])
             axis.grid(alpha=0.3)
             if any(not item.get_label().startswith("_") for item in axis.get_lines()):
                 # beside the panel: static (drawn once), and never over a curve
@@ -297,10 +343,10 @@ class RowFigure:
         """
         if series.shape != self.shape:
             raise ValueError(f"a row of shape {series.shape} drawn on a figure of shape {self.shape}")
-        pairs = list(zip(self.torque + self.rate + self.quaternion + self.wheels + self.wheel_torque
+        pairs = list(zip(self.torque + self.rate + self.quaternion + self.euler + self.wheels + self.wheel_torque
                          + self.wheel_speed + self.dipole,
-                         series.torque + series.rate + series.quaternion + series.wheels + series.wheel_torque
-                         + series.wheel_speed + series.dipole))
+                         series.torque + series.rate + series.quaternion + series.euler + series.wheels
+                         + series.wheel_torque + series.wheel_speed + series.dipole))
         if self.reference is not None and series.reference is not None:
             for items, curves in zip(self.reference, series.reference):
                 pairs.extend(zip(items, curves))
@@ -373,8 +419,77 @@ def _write_png(canvas: FigureCanvasAgg, path: Path) -> None:
     image.save(path, format="png", dpi=(DPI, DPI), compress_level=COMPRESS_LEVEL)
 
 
+LINE_STYLES = ("-", "--", "-.", ":")
+"""Line styles of the rows in the comparison figure, in turn with :data:`ROW_COLORS`: rows whose curves
+lie on one another still show (a dashed line over a solid one)."""
+
+
+def _row_style(k: int) -> dict[str, Any]:
+    """Colour, line style and width of row ``k`` in the comparison figure (the first rows widest, so
+    that a later row drawn over them leaves their edges in view)."""
+    return {"color": _row_color(k), "linestyle": LINE_STYLES[k % len(LINE_STYLES)], "lw": max(1.0, 2.2 - 0.4 * k)}
+
+
+def overlay_figure(series: OverlaySeries) -> Figure:
+    """The rows overlaid: per body axis (columns x, y, z) the body torque, the body rate and the
+    wheels' momentum in body axes; below, the torque norm and the error to the target
+    (logarithmic). Each row has its colour and line style; the legend, beside the panels, gives
+    each row's final values.
+
+    Parameters
+    ----------
+    series : scenarios.output.plot_data.OverlaySeries
+        The curves (:func:`scenarios.output.plot_data.overlay_series`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, on an Agg canvas.
+    """
+    per_axis = [(series.axis_torque, "u_{axis} (N m)", "steps-post"), (series.rate, "ω_{axis} (deg/s)", "default")]
+    if any(series.wheel_momentum):
+        per_axis.append((series.wheel_momentum, "(A h_w)_{axis} (N m s)", "default"))
+    if not any(series.axis_torque):
+        per_axis = []
+    rows = len(per_axis) + 1
+    top, bottom = OVERLAY_EDGES_IN
+    height = rows * OVERLAY_ROW_IN + top + bottom
+    figure = Figure(figsize=(OVERLAY_WIDTH_IN, height), dpi=DPI)
+    FigureCanvasAgg(figure)
+    grid = figure.add_gridspec(rows, 6, **OVERLAY_MARGINS, top=1 - top / height, bottom=bottom / height)
+    norm = figure.add_subplot(grid[-1, :3])
+    error = figure.add_subplot(grid[-1, 3:], sharex=norm)
+    _log_axis(error)
+    handles = []
+    for k, (torque, curve) in enumerate(zip(series.torque, series.error)):
+        style = _row_style(k)
+        norm.plot(*torque, drawstyle="steps-post", **style)
+        handles.append(error.plot(*curve, **style)[0])
+    for r, (curves, label, drawstyle) in enumerate(per_axis):
+        for i, name in enumerate("xyz"):
+            axis = figure.add_subplot(grid[r, 2 * i:2 * i + 2], sharex=norm)
+            for k, row in enumerate(curves):
+                if row:
+                    axis.plot(*row[i], drawstyle=drawstyle, **_row_style(k))
+            axis.tick_params(labelbottom=False)
+            axis.grid(alpha=0.3)
+            _label(axis, label.format(axis=name))
+    _label(norm, "‖u‖ (N m)")
+    _label(error, series.error_label)
+    for axis in (norm, error):
+        axis.grid(alpha=0.3)
+        _time_axis(axis)
+    if handles:
+        texts = [f"{label}\n  " + "\n  ".join(final.split(", ")) if final else label
+                 for label, final in zip(series.labels, series.finals or [""] * len(series.labels))]
+        figure.legend(handles, texts, loc="upper left", bbox_to_anchor=(OVERLAY_MARGINS["right"] + 0.01, 1 - top / height),
+                      fontsize=8, borderaxespad=0.0, handlelength=3.0, labelspacing=0.9)
+    figure.suptitle(series.title)
+    return figure
+
+
 def draw_overlay(series: OverlaySeries, path: Path) -> None:
-    """Torque norm, and the error to the target, one curve per row.
+    """:func:`overlay_figure` as a PNG.
 
     Parameters
     ----------
@@ -383,22 +498,7 @@ def draw_overlay(series: OverlaySeries, path: Path) -> None:
     path : pathlib.Path
         Where to write the PNG.
     """
-    figure = Figure(figsize=OVERLAY_FIGSIZE_IN)
-    top, bottom = figure.subplots(2, 1, sharex=True)
-    figure.subplots_adjust(**OVERLAY_MARGINS)  # before the labels
-    _log_axis(bottom)
-    for label, torque, error in zip(series.labels, series.torque, series.error):
-        top.plot(*torque, drawstyle="steps-post", label=label)
-        bottom.plot(*error, label=label)
-    _label(top, "‖u‖ (N m)")
-    _label(bottom, series.error_label)
-    for axis in (top, bottom):
-        axis.grid(alpha=0.3)
-    if top.get_lines():  # one legend: both panels have the same rows in the same colours
-        top.legend(fontsize=8, loc="upper right")
-    figure.suptitle(series.title)
-    _time_axis(bottom)
-    figure.savefig(path, **SAVE)
+    overlay_figure(series).savefig(path, **SAVE)
 
 
 def _row_color(k: int) -> str:
