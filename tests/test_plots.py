@@ -228,3 +228,16 @@ def test_the_comparison_overlays_every_row_per_axis_with_its_final_values_beside
     assert len(set(styles)) == 3  # ... drawn apart
     box = legend.get_window_extent()
     assert all(not box.overlaps(axis.get_window_extent()) for axis in figure.axes)  # beside the data
+
+
+def test_another_euler_sequence_is_named_in_its_panel(rng):
+    row = make_row(rng, "row", 1.0)
+    wheels = ReactionWheels(np.eye(3), max_torque=0.1, max_momentum=1.0)
+    series = row_series(row, None, Spacecraft([1.0, 2.0, 3.0], wheels=wheels), euler_sequence="313")
+    figure = RowFigure(*series.shape)
+    (label,) = [t.get_text() for t in figure.panels["euler"].texts if t.get_rotation() == 90]
+    assert label == "Euler 3-1-3 (deg)"
+    assert [line.get_label() for line in figure.euler] == ["α₁ (z)", "β₂ (x)", "γ₃ (z)"]
+    assert to_hex(figure.euler[0].get_color()) != to_hex(figure.euler[2].get_color())  # two angles about z
+    with pytest.raises(ValueError, match="Euler sequence"):
+        row_series(row, None, Spacecraft([1.0, 2.0, 3.0], wheels=wheels), euler_sequence="331")

@@ -986,7 +986,7 @@ SKY_FILE = "sky.png"
 """The sky map of a run with pointing requirements."""
 
 
-def plot_jobs(results: Any, stems: list[str] | None = None) -> list[PlotJob]:
+def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str = EULER_SEQUENCE) -> list[PlotJob]:
     """The figures of a run: one per simulated row (``<stem>.png``), with pointing requirements
     :data:`MARGINS_FILE` and :data:`SKY_FILE`, and ``comparison.png``.
 
@@ -996,12 +996,15 @@ def plot_jobs(results: Any, stems: list[str] | None = None) -> list[PlotJob]:
         The run.
     stems : list of str, optional
         The rows' file stems; ``None``: ``row_stems`` of the labels.
+    euler_sequence : str, optional
+        The row figures' Euler sequence (:func:`euler_angles`); default :data:`EULER_SEQUENCE`.
 
     Returns
     -------
     list of (str, series)
         File names and series, in drawing order (rows, the pointing figures, the overlay last).
     """
+    euler_sequence_axes(euler_sequence)  # a bad sequence fails before any series is computed
     from scenarios.output.names import row_stems
 
     problem = results.scenario.problem
@@ -1010,7 +1013,7 @@ def plot_jobs(results: Any, stems: list[str] | None = None) -> list[PlotJob]:
     for row, stem in zip(results.rows, stems):
         if row.simulation is None:
             continue
-        jobs.append((f"{stem}.png", row_series(row, problem.qf, problem.spacecraft)))
+        jobs.append((f"{stem}.png", row_series(row, problem.qf, problem.spacecraft, euler_sequence)))
     constraints = pointing_constraints(results)
     sampled = motions(results) if constraints else []
     if sampled:

@@ -465,20 +465,28 @@ def overlay_figure(series: OverlaySeries) -> Figure:
         style = _row_style(k)
         norm.plot(*torque, drawstyle="steps-post", **style)
         handles.append(error.plot(*curve, **style)[0])
-    for r, (curves, label, drawstyle) in enumerate(per_axis):
-        for i, name in enumerate("xyz"):
-            axis = figure.add_subplot(grid[r, 2 * i:2 * i + 2], sharex=norm)
-            for k, row in enumerate(curves):
-                if row:
-                    axis.plot(*row[i], drawstyle=drawstyle, **_row_style(k))
-            axis.tick_params(labelbottom=False)
-            axis.grid(alpha=0.3)
-            _label(axis, label.format(axis=name))
     _label(norm, "‖u‖ (N m)")
     _label(error, series.error_label)
     for axis in (norm, error):
         axis.grid(alpha=0.3)
         _time_axis(axis)
+    # the per-axis panels take the time axis of the panels below without its ticks: their vertical
+    # grid is one collection of lines at its ticks (a tick costs three artists and a text to draw)
+    norm.autoscale_view()
+    limits = norm.get_xlim()
+    grid_times = [t for t in norm.xaxis.get_majorticklocs() if limits[0] <= t <= limits[1]]
+    for r, (curves, label, drawstyle) in enumerate(per_axis):
+        for i, name in enumerate("xyz"):
+            axis = figure.add_subplot(grid[r, 2 * i:2 * i + 2])
+            for k, row in enumerate(curves):
+                if row:
+                    axis.plot(*row[i], drawstyle=drawstyle, **_row_style(k))
+            axis.set_xlim(limits)
+            axis.xaxis.set_major_locator(NullLocator())
+            axis.grid(alpha=0.3, axis="y")
+            axis.vlines(grid_times, 0, 1, transform=axis.get_xaxis_transform(), color="#b0b0b0", alpha=0.3, lw=0.8,
+                        zorder=0.5)
+            _label(axis, label.format(axis=name))
     if handles:
         texts = [f"{label}\n  " + "\n  ".join(final.split(", ")) if final else label
                  for label, final in zip(series.labels, series.finals or [""] * len(series.labels))]
@@ -764,7 +772,8 @@ DRAW: dict[type, Callable[[Any, Path], None]] = {OverlaySeries: draw_overlay, Ma
 """How each kind of series other than a row is drawn."""
 
 
-def write_plots(results: Any, directory: Path, stems: list[str] | None = None) -> None:
+def write_plots(results: Any, directory: Path, stems: list[str] | None = None,
+                euler_sequence: str = EULER_SEQUENCE) -> None:
     """The figures of :func:`scenarios.output.plot_data.plot_jobs`: one PNG per simulated row
     (``<stem>.png``), ``margins.png`` and ``sky.png`` with pointing requirements, and ``comparison.png``.
 
@@ -776,5 +785,8 @@ def write_plots(results: Any, directory: Path, stems: list[str] | None = None) -
         Existing directory to write into.
     stems : list of str, optional
         The rows' file stems; ``None``: ``row_stems`` of the labels.
+    euler_sequence : str, optional
+        The row figures' Euler sequence (:func:`scenarios.output.plot_data.euler_angles`), such as
+        ``"313"``; default ``"321"``.
     """
-    draw_jobs(plot_jobs(results, stems), directory)
+    draw_jobs(plot_jobs(results, stems, euler_sequence), directory)

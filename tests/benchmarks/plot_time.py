@@ -8,13 +8,15 @@ warm-up run of each fills the caches. Each run is also repeated with ``--no-plot
 alternation, to give the plots' own share. The load average is printed before and after.
 
 Run: ``python tests/benchmarks/plot_time.py [--base REV] [--pairs N]`` (defaults ``main``, 8);
-one line per kind of run: medians, 10th and 90th percentiles and the ratio of the medians
-(target: whole command with plots, this checkout over the base, at most 1.1).
+per kind of run, wall and CPU time (user + system of the command): medians, 10th and 90th
+percentiles and the ratio of the medians (target: wall time of the whole command with plots, this
+checkout over the base, at most 1.1; the CPU time is less sensitive to a loaded host).
 """
 from __future__ import annotations
 
 import argparse
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -29,21 +31,27 @@ TARGET_RATIO = 1.1
 """Largest ratio of the medians (with plots, this checkout over the base) that meets the target."""
 
 
-def timed_run(checkout: Path, out: Path, plots: bool) -> float:
-    """Wall time [s] of one ``run`` of the demo scenario in ``checkout``."""
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def timed_run(checkout: Path, out: Path, plots: bool) -> tuple[float, float]:
+    """Wall time and CPU time (user + system) [s] of one ``run`` of the demo scenario in ``checkout``."""
     command = [sys.executable, "-m", "scenarios.cli", "run", str(SCENARIO), "--out", str(out)]
     command += [] if plots else ["--no-plots"]
-    start = time.perf_counter()
+    cpu, start = _children_cpu(), time.perf_counter()
     done = subprocess.run(command, cwd=checkout, capture_output=True, text=True, check=False)
-    elapsed = time.perf_counter() - start
+    elapsed, cpu = time.perf_counter() - start, _children_cpu() - cpu
     if done.returncode != 0:
         raise RuntimeError(f"{' '.join(command)} in {checkout} exited {done.returncode}:\n{done.stderr[-2000:]}")
-    return elapsed
+    return elapsed, cpu
 
 
-def compare(base: Path, new: Path, pairs: int, scratch: Path) -> dict[tuple[str, bool], list[float]]:
+def compare(base: Path, new: Path, pairs: int, scratch: Path) -> dict[tuple[str, bool], list[tuple[float, float]]]:
     """Alternate the runs: per pair, both checkouts with and without plots, in alternating order."""
-    times: dict[tuple[str, bool], list[float]] = {(name, plots): [] for name in ("base", "new") for plots in (True, False)}
+    times: dict[tuple[str, bool], list[tuple[float, float]]] = {(name, plots): [] for name in ("base", "new")
+                                                                for plots in (True, False)}
     checkouts = {"base": base, "new": new}
     for name, checkout in checkouts.items():  # warm-up: caches
         timed_run(checkout, scratch / f"warm-{name}", True)
@@ -55,27 +63,31 @@ def compare(base: Path, new: Path, pairs: int, scratch: Path) -> dict[tuple[str,
     return times
 
 
-def summary(times: dict[tuple[str, bool], list[float]]) -> tuple[list[str], float]:
-    """Lines of medians, spreads and ratios, and the ratio of the medians with plots."""
+def summary(times: dict[tuple[str, bool], list[tuple[float, float]]]) -> tuple[list[str], float]:
+    """Lines of medians, spreads and ratios (wall time, then CPU time), and the ratio of the wall
+    time medians with plots."""
     lines = []
     ratios = {}
-    for plots in (True, False):
+    for column, what in ((0, "wall"), (1, "CPU ")):
         medians = {}
-        for name in ("base", "new"):
-            values = np.asarray(times[(name, plots)])
-            medians[name] = float(np.median(values))
-            p10, p90 = np.percentile(values, (10, 90))
-            lines.append(f"{'with plots' if plots else 'no plots  '} {name:4s}: median {medians[name]:.3f} s, "
-                         f"p10 {p10:.3f} s, p90 {p90:.3f} s, n {values.size}")
-        ratios[plots] = medians["new"] / medians["base"]
-        lines.append(f"{'with plots' if plots else 'no plots  '} ratio new/base of the medians: {ratios[plots]:.3f}")
-    per_pair = np.asarray(times[("new", True)]) / np.asarray(times[("base", True)])
-    lines.append(f"with plots, ratio per pair: median {np.median(per_pair):.3f}, "
-                 f"p10 {np.percentile(per_pair, 10):.3f}, p90 {np.percentile(per_pair, 90):.3f}")
-    plot_base = np.median(times[("base", True)]) - np.median(times[("base", False)])
-    plot_new = np.median(times[("new", True)]) - np.median(times[("new", False)])
-    lines.append(f"plots' own share (median with - median without): base {plot_base:.3f} s, new {plot_new:.3f} s")
-    return lines, ratios[True]
+        for plots in (True, False):
+            for name in ("base", "new"):
+                values = np.asarray([t[column] for t in times[(name, plots)]])
+                medians[(name, plots)] = float(np.median(values))
+                p10, p90 = np.percentile(values, (10, 90))
+                lines.append(f"{what} {'with plots' if plots else 'no plots  '} {name:4s}: median {np.median(values):.3f} s, "
+                             f"p10 {p10:.3f} s, p90 {p90:.3f} s, n {values.size}")
+            ratio = medians[("new", plots)] / medians[("base", plots)]
+            ratios[(column, plots)] = ratio
+            lines.append(f"{what} {'with plots' if plots else 'no plots  '} ratio new/base of the medians: {ratio:.3f}")
+        per_pair = (np.asarray([t[column] for t in times[("new", True)]])
+                    / np.asarray([t[column] for t in times[("base", True)]]))
+        lines.append(f"{what} with plots, ratio per pair: median {np.median(per_pair):.3f}, "
+                     f"p10 {np.percentile(per_pair, 10):.3f}, p90 {np.percentile(per_pair, 90):.3f}")
+        lines.append(f"{what} plots' own share (median with - median without): "
+                     f"base {medians[('base', True)] - medians[('base', False)]:.3f} s, "
+                     f"new {medians[('new', True)] - medians[('new', False)]:.3f} s")
+    return lines, ratios[(0, True)]
 
 
 def main(argv: list[str] | None = None) -> float:
