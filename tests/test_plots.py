@@ -204,27 +204,36 @@ def test_the_comparison_overlays_every_row_per_axis_with_its_final_values_beside
     results, axes, target = comparison_results(rng)
     figure = overlay_figure(overlay_series(results))
     figure.canvas.draw()
-    panels = {}
+    rows = {}  # the panels by row of panels (top to bottom), left to right
     for axis in figure.axes:
-        (label,) = [t.get_text() for t in axis.texts if t.get_rotation() == 90]
-        panels[label] = axis
-    assert set(panels) == {"u_x (N m)", "u_y (N m)", "u_z (N m)", "ω_x (deg/s)", "ω_y (deg/s)", "ω_z (deg/s)",
-                           "(A h_w)_x (N m s)", "(A h_w)_y (N m s)", "(A h_w)_z (N m s)", "‖u‖ (N m)",
-                           "error to target (deg)"}
+        rows.setdefault(-round(axis.get_position().y0, 3), []).append(axis)
+    rows = [sorted(row, key=lambda a: a.get_position().x0) for _, row in sorted(rows.items())]
+
+    def label(axis):
+        return next((t.get_text() for t in axis.texts if t.get_rotation() == 90), "")
+
+    assert [[label(a) for a in row] for row in rows] == [
+        ["body torque (N m)", "", ""], ["body rate (deg/s)", "", ""], ["wheel momentum (N m s)", "", ""],
+        ["‖u‖ (N m)", "error to target (deg)"]]
+    assert [a.get_title() for a in rows[0]] == ["body x axis", "body y axis", "body z axis"]
+    for row in rows[:3]:  # one value scale per quantity, its ticks on the x panel only
+        assert len({a.get_ylim() for a in row}) == 1
+        assert [len(a.get_yticks()) > 0 for a in row] == [True, False, False]
     for k, row in enumerate(results.rows):
         sim = row.simulation
         body = sim.wheel_momentum @ axes.T  # the wheels' momentum in body axes, by hand
-        for i, name in enumerate("xyz"):
-            np.testing.assert_allclose(panels[f"u_{name} (N m)"].get_lines()[k].get_ydata(),
+        for i in range(3):
+            np.testing.assert_allclose(rows[0][i].get_lines()[k].get_ydata(),
                                        np.append(sim.applied_torque[:, i], sim.applied_torque[-1, i]))
-            np.testing.assert_allclose(panels[f"ω_{name} (deg/s)"].get_lines()[k].get_ydata(), np.rad2deg(sim.omega[:, i]))
-            np.testing.assert_allclose(panels[f"(A h_w)_{name} (N m s)"].get_lines()[k].get_ydata(), body[:, i])
+            np.testing.assert_allclose(rows[1][i].get_lines()[k].get_ydata(), np.rad2deg(sim.omega[:, i]))
+            np.testing.assert_allclose(rows[2][i].get_lines()[k].get_ydata(), body[:, i])
+    error = rows[3][1]
     legend = figure.legends[0]
     texts = [t.get_text() for t in legend.get_texts()]
     final = np.rad2deg(quat.error_angle(results.rows[2].simulation.q[-1], target))
     assert texts[2].startswith("C\n") and f"final {final:.3g} deg" in texts[2]
     assert texts[0].split("\n", 1)[1] == texts[1].split("\n", 1)[1]  # identical rows: the same final values
-    styles = [(to_hex(line.get_color()), line.get_linestyle()) for line in panels["error to target (deg)"].get_lines()]
+    styles = [(to_hex(line.get_color()), line.get_linestyle()) for line in error.get_lines()]
     assert len(set(styles)) == 3  # ... drawn apart
     box = legend.get_window_extent()
     assert all(not box.overlaps(axis.get_window_extent()) for axis in figure.axes)  # beside the data

@@ -34,9 +34,14 @@ OVERLAY_ROW_IN = 2.25
 """Height of one row of panels of the comparison figure, its gap included [in]."""
 OVERLAY_EDGES_IN = (0.6, 0.55)
 """Space above the top panels (the title) and below the bottom ones (the time axis) [in]."""
-OVERLAY_MARGINS = {"left": 0.075, "right": 0.8, "wspace": 1.35, "hspace": 0.2}
-"""``subplots_adjust`` of the comparison figure (fractions of the figure; top and bottom from
-:data:`OVERLAY_EDGES_IN`); the legend sits right of 0.8."""
+OVERLAY_GAP_IN = 0.4
+"""Vertical gap between two rows of panels of the comparison figure [in]."""
+OVERLAY_MARGINS = {"left": 0.075, "right": 0.8, "wspace": 0.25}
+"""Left and right edges of the comparison figure's panels (fractions of the figure; top and bottom from
+:data:`OVERLAY_EDGES_IN`; the legend sits right of them), and the gap between the norm's and the
+error's panels (a fraction of a panel's width: room for the error's value axis)."""
+OVERLAY_AXES_WSPACE = 0.1
+"""Gap between the comparison figure's per-axis panels (a fraction of a panel's width): they share one value axis."""
 OVERLAY_WIDEST_PANEL = 0.5
 """The widest panel of the comparison figure (the norm's and the error's, half of it) as a fraction
 of the panels' width: the curves are decimated to its pixel columns."""
@@ -212,7 +217,7 @@ def euler_sequence_axes(sequence: str) -> tuple[int, int, int]:
     if len(axes) != 3 or -1 in axes or axes[0] == axes[1] or axes[1] == axes[2]:
         raise ValueError(f"an Euler sequence is three of 1, 2, 3 with no two consecutive ones equal, such as "
                          f"'321' or '313'; got {sequence!r}")
-    return axes  # type: ignore[return-value]
+    return axes[0], axes[1], axes[2]
 
 
 def euler_angles(q: np.ndarray, sequence: str = EULER_SEQUENCE) -> np.ndarray:

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullLocator
 
@@ -41,7 +42,9 @@ from scenarios.output.plot_data import (
     MARGIN_MARGINS,
     MARGIN_PANEL_IN,
     MARGIN_WIDTH_IN,
+    OVERLAY_AXES_WSPACE,
     OVERLAY_EDGES_IN,
+    OVERLAY_GAP_IN,
     OVERLAY_MARGINS,
     OVERLAY_ROW_IN,
     OVERLAY_WIDTH_IN,
@@ -245,7 +248,7 @@ class RowFigure:
         figsize, margins = row_figure_layout(len(names))
         self.figure = Figure(figsize=figsize, dpi=DPI)
         self.canvas = FigureCanvasAgg(self.figure)
-        axes = self.figure.subplots(len(names), 1, sharex=True)
+        axes = self.figure.subplots(len(names), 1)  # one time axis, drawn on the last panel (see prepare)
         self.figure.subplots_adjust(**margins)  # before the labels
         self.axes = axes
         panel = dict(zip(names, axes))
@@ -309,9 +312,17 @@ class RowFigure:
         self.panels = panel
         labels = {**PANEL_LABELS, "euler": euler_label,
                   "error": "error angle (deg)" if with_reference or with_target else "body rate (deg/s)"}
+        self.time_grid: list[LineCollection] = []
+        """Vertical grid lines of the panels above the last, at its time ticks: they have no ticks
+        of their own (a tick costs three artists and a text to draw)."""
         for name, axis in panel.items():
             _label(axis, labels[name])
-            axis.grid(alpha=0.3)
+            if axis is axes[-1]:
+                axis.grid(alpha=0.3)
+            else:
+                axis.xaxis.set_major_locator(NullLocator())
+                axis.grid(alpha=0.3, axis="y")
+                self.time_grid.append(_grid_lines(axis, "x"))
             if any(not item.get_label().startswith("_") for item in axis.get_lines()):
                 # beside the panel: static (drawn once), and never over a curve
                 axis.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, borderaxespad=0.0)
@@ -361,6 +372,9 @@ class RowFigure:
         for axis in self.axes:  # fitted to the curves; the limits are added below
             axis.relim()
             axis.autoscale_view()
+        low, high = min(axis.get_xlim()[0] for axis in self.axes), max(axis.get_xlim()[1] for axis in self.axes)
+        for axis in self.axes:  # one time axis
+            axis.set_xlim(low, high, auto=None)
         span = [series.torque[0][0][0], series.torque[0][0][-1]] if series.torque and len(series.torque[0][0]) else []
         for name, index, sign, item in self.limit_lines:
             values = np.asarray(series.limits[name], dtype=float)
@@ -384,6 +398,9 @@ class RowFigure:
         time_limits = tuple(self.axes[-1].get_xlim())
         canvas, dynamic = self.canvas, self._dynamic()
         if self._background is None or self._background[0] != time_limits:
+            ticks = [t for t in self.axes[-1].xaxis.get_majorticklocs() if low <= t <= high]
+            for lines in self.time_grid:
+                _set_grid_lines(lines, "x", ticks)
             for artist in dynamic:
                 artist.set_visible(False)
             canvas.draw()
@@ -430,11 +447,26 @@ def _row_style(k: int) -> dict[str, Any]:
     return {"color": _row_color(k), "linestyle": LINE_STYLES[k % len(LINE_STYLES)], "lw": max(1.0, 2.2 - 0.4 * k)}
 
 
+def _grid_lines(axis: Any, which: str, values: Any = ()) -> LineCollection:
+    """Grid lines where the axis has no ticks (the look of :meth:`Axes.grid` with ``alpha=0.3``): one
+    collection, out of the data limits (:func:`_set_grid_lines` moves them)."""
+    lines = LineCollection([], colors="#b0b0b0", alpha=0.3, linewidths=0.8, zorder=0.5,
+                           transform=axis.get_xaxis_transform() if which == "x" else axis.get_yaxis_transform())
+    axis.add_collection(lines, autolim=False)
+    _set_grid_lines(lines, which, values)
+    return lines
+
+
+def _set_grid_lines(lines: LineCollection, which: str, values: Any) -> None:
+    """Put grid lines of :func:`_grid_lines` at ``values`` (data coordinates of their axis)."""
+    lines.set_segments([[(v, 0.0), (v, 1.0)] if which == "x" else [(0.0, v), (1.0, v)] for v in values])
+
+
 def overlay_figure(series: OverlaySeries) -> Figure:
     """The rows overlaid: per body axis (columns x, y, z) the body torque, the body rate and the
-    wheels' momentum in body axes; below, the torque norm and the error to the target
-    (logarithmic). Each row has its colour and line style; the legend, beside the panels, gives
-    each row's final values.
+    wheels' momentum in body axes, the three axes of a quantity on one value scale; below, the
+    torque norm and the error to the target (logarithmic). Each row has its colour and line style;
+    the legend, beside the panels, gives each row's final values.
 
     Parameters
     ----------
@@ -446,9 +478,9 @@ def overlay_figure(series: OverlaySeries) -> Figure:
     matplotlib.figure.Figure
         The figure, on an Agg canvas.
     """
-    per_axis = [(series.axis_torque, "u_{axis} (N m)", "steps-post"), (series.rate, "ω_{axis} (deg/s)", "default")]
+    per_axis = [(series.axis_torque, "body torque (N m)", "steps-post"), (series.rate, "body rate (deg/s)", "default")]
     if any(series.wheel_momentum):
-        per_axis.append((series.wheel_momentum, "(A h_w)_{axis} (N m s)", "default"))
+        per_axis.append((series.wheel_momentum, "wheel momentum (N m s)", "default"))
     if not any(series.axis_torque):
         per_axis = []
     rows = len(per_axis) + 1
@@ -456,9 +488,12 @@ def overlay_figure(series: OverlaySeries) -> Figure:
     height = rows * OVERLAY_ROW_IN + top + bottom
     figure = Figure(figsize=(OVERLAY_WIDTH_IN, height), dpi=DPI)
     FigureCanvasAgg(figure)
-    grid = figure.add_gridspec(rows, 6, **OVERLAY_MARGINS, top=1 - top / height, bottom=bottom / height)
-    norm = figure.add_subplot(grid[-1, :3])
-    error = figure.add_subplot(grid[-1, 3:], sharex=norm)
+    sides = {"left": OVERLAY_MARGINS["left"], "right": OVERLAY_MARGINS["right"]}
+    # the norm and the error below, each with its value axis; the per-axis panels above, close together
+    lower = figure.add_gridspec(1, 2, **sides, wspace=OVERLAY_MARGINS["wspace"], bottom=bottom / height,
+                                top=(bottom + OVERLAY_ROW_IN - OVERLAY_GAP_IN) / height)
+    norm = figure.add_subplot(lower[0, 0])
+    error = figure.add_subplot(lower[0, 1], sharex=norm)
     _log_axis(error)
     handles = []
     for k, (torque, curve) in enumerate(zip(series.torque, series.error)):
@@ -470,23 +505,35 @@ def overlay_figure(series: OverlaySeries) -> Figure:
     for axis in (norm, error):
         axis.grid(alpha=0.3)
         _time_axis(axis)
-    # the per-axis panels take the time axis of the panels below without its ticks: their vertical
-    # grid is one collection of lines at its ticks (a tick costs three artists and a text to draw)
+    # The per-axis panels of a quantity share one value scale, on the x panel's axis; they take the
+    # time axis of the panels below. Their grids are lines at those ticks: a tick costs three artists
+    # and a text to draw, and a panel without ticks draws no tick label.
     norm.autoscale_view()
     limits = norm.get_xlim()
     grid_times = [t for t in norm.xaxis.get_majorticklocs() if limits[0] <= t <= limits[1]]
+    upper = figure.add_gridspec(max(len(per_axis), 1), 3, **sides, wspace=OVERLAY_AXES_WSPACE,
+                                hspace=OVERLAY_GAP_IN / (OVERLAY_ROW_IN - OVERLAY_GAP_IN),
+                                bottom=(bottom + OVERLAY_ROW_IN) / height, top=1 - top / height)
     for r, (curves, label, drawstyle) in enumerate(per_axis):
-        for i, name in enumerate("xyz"):
-            axis = figure.add_subplot(grid[r, 2 * i:2 * i + 2])
+        panels = [figure.add_subplot(upper[r, i]) for i in range(3)]
+        for i, axis in enumerate(panels):
             for k, row in enumerate(curves):
                 if row:
                     axis.plot(*row[i], drawstyle=drawstyle, **_row_style(k))
             axis.set_xlim(limits)
             axis.xaxis.set_major_locator(NullLocator())
-            axis.grid(alpha=0.3, axis="y")
-            axis.vlines(grid_times, 0, 1, transform=axis.get_xaxis_transform(), color="#b0b0b0", alpha=0.3, lw=0.8,
-                        zorder=0.5)
-            _label(axis, label.format(axis=name))
+            _grid_lines(axis, "x", grid_times)
+            if r == 0:
+                axis.set_title(f"body {'xyz'[i]} axis", fontsize=10)
+        low, high = min(a.get_ylim()[0] for a in panels), max(a.get_ylim()[1] for a in panels)
+        panels[0].set_ylim(low, high)
+        _label(panels[0], label)
+        panels[0].grid(alpha=0.3, axis="y")
+        values = [v for v in panels[0].yaxis.get_majorticklocs() if low <= v <= high]
+        for axis in panels[1:]:
+            axis.set_ylim(low, high)
+            axis.yaxis.set_major_locator(NullLocator())
+            _grid_lines(axis, "y", values)
     if handles:
         texts = [f"{label}\n  " + "\n  ".join(final.split(", ")) if final else label
                  for label, final in zip(series.labels, series.finals or [""] * len(series.labels))]

@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import json
 import math
+import re
 import textwrap
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -54,7 +55,7 @@ MAX_GROUPS = 12
 pooled over the grid points (and the title says so)."""
 MAX_ANNOTATED_CELLS = 64
 """Heat map panels with at most this many cells print each cell's value."""
-FAILED_MARK = {"marker": "x", "linestyle": "none", "markersize": 7, "markeredgewidth": 1.6}
+FAILED_MARK: dict[str, Any] = {"marker": "x", "linestyle": "none", "markersize": 7, "markeredgewidth": 1.6}
 """How a grid point or case with a failed row is marked (at the bottom of the panel, in the planner's colour)."""
 UNKNOWN_UNIT = "YAML units"
 """The unit given to a varied path the schema does not describe."""
@@ -139,6 +140,17 @@ KEY_WORDS = {"q": "attitude", "omega": "rate"}
 """Scenario keys that read better as words on an axis."""
 
 
+def _entry(study: Study, steps: list[Step], path: str) -> Any:
+    """What the base scenario holds along ``steps``; None where it holds nothing (a path the study
+    sets but its base lacks)."""
+    from scenarios.errors import ScenarioError
+
+    try:
+        return get_path(study.base, steps, path)
+    except ScenarioError:
+        return None
+
+
 def _path_words(study: Study, path: str) -> str:
     """A scenario path in words: keys spaced, ``options`` and unit suffixes dropped, a list entry by
     its label (or name), the first key dropped when three or more words remain."""
@@ -149,10 +161,7 @@ def _path_words(study: Study, path: str) -> str:
             if step != "options":
                 words.append(KEY_WORDS.get(step, step.removesuffix("_deg").removesuffix("_s")))
             continue
-        try:
-            entry = get_path(study.base, steps[:number + 1], path)
-        except Exception:  # noqa: BLE001 - the words are a courtesy; the path was checked when the study was read
-            entry = None
+        entry = _entry(study, steps[:number + 1], path)
         words.append(str(entry.get("label") or entry.get("name")) if isinstance(entry, dict)
                      else str(step[1] if isinstance(step, tuple) else step))
     if len(words) >= 3:
@@ -164,8 +173,6 @@ def _path_words(study: Study, path: str) -> str:
 def _schema_units() -> tuple[dict[str, str], dict[str, str]]:
     """Units of the scenario keys by YAML path (list indices dropped) and of the registry entries'
     options by reference key (``planners.<planner>.<option>``), from the schema reference."""
-    import re
-
     from scenarios.schema.reference import reference_parts
 
     by_path, by_key = {}, {}
@@ -188,11 +195,7 @@ def _schema_unit(study: Study, path: str) -> str | None:
     keys = [step for step in steps if isinstance(step, str)]
     by_path, by_key = _schema_units()
     if keys[0] in _REGISTRY_KEYS and "options" in keys and keys[-1] != "options":
-        at = steps.index("options")
-        try:
-            entry = get_path(study.base, steps[:at], path)
-        except Exception:  # noqa: BLE001 - the path was checked when the study was read
-            return None
+        entry = _entry(study, steps[:steps.index("options")], path)
         name = entry.get("name") if isinstance(entry, dict) else None
         return by_key.get(f"{_REGISTRY_KEYS[keys[0]]}.{name}.{keys[-1]}")
     if keys[:2] == ["environment", "magnetic_field"] and len(keys) == 3:
@@ -303,8 +306,8 @@ def _mark_failed(axis: Any, xs: list[float], color: Any) -> None:
 def _legend(figure: Figure, colors: dict[str, Any], failed: bool, extra: list[Any] | None = None,
             style: str = "o-") -> None:
     """The planners' colours (and the failed mark) beside the panels."""
-    handles = [Line2D([], [], color=color, marker=style[0], linestyle=style[1:] or "none", label=label)
-               for label, color in colors.items()]
+    line: Any = style[1:] or "none"
+    handles = [Line2D([], [], color=color, marker=style[0], linestyle=line, label=label) for label, color in colors.items()]
     if failed:
         handles.append(Line2D([], [], color="0.3", label="failed row (no value)", **FAILED_MARK))
     handles += extra or []
@@ -396,6 +399,7 @@ def _heat_maps(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, 
             axis.set_xlabel(axis_label(*parameter_quantity(study, px)))
             axis.set_ylabel(axis_label(*parameter_quantity(study, py)))
             axis.set_title(label)
+        assert image is not None  # one panel per planner, at least one
         figure.colorbar(image, ax=axes, label=_metric_label(metric))
         _title(figure, f"{study.name}: median per grid point (one colour scale for every planner; "
                        "× n: rows that failed; hatched: no value)")
