@@ -23,7 +23,7 @@ from scenarios.output.plot_data import (
     overlay_series,
     row_series,
 )
-from scenarios.output.plots import RowFigure, overlay_figure
+from scenarios.output.plots import LogTicks, RowFigure, overlay_figure
 
 
 class Reference:
@@ -219,6 +219,11 @@ def test_the_comparison_overlays_every_row_per_axis_with_its_final_values_beside
     for row in rows[:3]:  # one value scale per quantity, its ticks on the x panel only
         assert len({a.get_ylim() for a in row}) == 1
         assert [len(a.get_yticks()) > 0 for a in row] == [True, False, False]
+    # one time span everywhere, its ticks below the per-axis panels and below the norm and the error
+    assert len({a.get_xlim() for row in rows for a in row}) == 1
+    assert [[a.get_xlabel() for a in row] for row in rows] == [["", "", ""], ["", "", ""], ["time (s)"] * 3,
+                                                               ["time (s)"] * 2]
+    assert all(len(a.get_xticks()) == 0 for row in rows[:2] for a in row)
     for k, row in enumerate(results.rows):
         sim = row.simulation
         body = sim.wheel_momentum @ axes.T  # the wheels' momentum in body axes, by hand
@@ -250,3 +255,14 @@ def test_another_euler_sequence_is_named_in_its_panel(rng):
     assert to_hex(figure.euler[0].get_color()) != to_hex(figure.euler[2].get_color())  # two angles about z
     with pytest.raises(ValueError, match="Euler sequence"):
         row_series(row, None, Spacecraft([1.0, 2.0, 3.0], wheels=wheels), euler_sequence="331")
+
+
+@pytest.mark.parametrize("low,high,expected", [
+    (1e-9, 100.0, [1e-8, 1e-6, 1e-4, 1e-2, 1.0, 100.0]),  # many decades: at most seven powers of ten
+    (1e-3, 100.0, [1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0]),
+    (0.15, 0.6, [0.2, 0.5]),  # less than a decade: 1, 2, 5 times a power of ten
+    (17.0, 40.0, [18.0, 24.0, 30.0, 36.0]),  # fewer than two of those: evenly spaced
+])
+def test_a_logarithmic_axis_has_ticks_however_narrow_its_view(low, high, expected):
+    ticks = np.asarray(LogTicks().tick_values(low, high))
+    np.testing.assert_allclose(ticks[(ticks >= low) & (ticks <= high)], expected)

@@ -36,6 +36,8 @@ OVERLAY_EDGES_IN = (0.6, 0.55)
 """Space above the top panels (the title) and below the bottom ones (the time axis) [in]."""
 OVERLAY_GAP_IN = 0.4
 """Vertical gap between two rows of panels of the comparison figure [in]."""
+OVERLAY_TIME_IN = 0.35
+"""Room for the time axis below the comparison figure's per-axis panels [in]."""
 OVERLAY_MARGINS = {"left": 0.075, "right": 0.8, "wspace": 0.25}
 """Left and right edges of the comparison figure's panels (fractions of the figure; top and bottom from
 :data:`OVERLAY_EDGES_IN`; the legend sits right of them), and the gap between the norm's and the
@@ -425,7 +427,8 @@ def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = E
     q = continuous_quaternions(sim.q)
     series = RowSeries(
         n_wheels, with_reference, with_target,
-        f"{row.label} ({row.planner or 'regulation'}{controller}): solid closed loop, dashed reference",
+        f"{row.label} ({row.planner or 'regulation'}{controller}): "
+        + ("solid closed loop, dashed reference" if with_reference else "closed loop"),
         held_curves(sim.applied_torque), [curve(DEG_PER_RAD * sim.omega[:, i]) for i in range(3)],
         [curve(q[:, i]) for i in range(4)], wheels=[curve(sim.wheel_momentum[:, i]) for i in range(n_wheels)],
         euler_sequence=euler_sequence)

@@ -26,6 +26,7 @@ the sphere hides behind another as on a drawn 3-D globe.
 """
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -34,7 +35,14 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
-from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullLocator
+from matplotlib.ticker import (
+    FixedLocator,
+    FuncFormatter,
+    Locator,
+    LogLocator,
+    MaxNLocator,
+    NullLocator,
+)
 
 from scenarios.output.plot_data import (
     DPI,
@@ -47,6 +55,7 @@ from scenarios.output.plot_data import (
     OVERLAY_GAP_IN,
     OVERLAY_MARGINS,
     OVERLAY_ROW_IN,
+    OVERLAY_TIME_IN,
     OVERLAY_WIDTH_IN,
     MarginPanel,
     MarginSeries,
@@ -68,6 +77,7 @@ __all__ = [
     "LABEL_OFFSET_IN",
     "ROW_COLORS",
     "SAVE",
+    "LogTicks",
     "RowFigure",
     "draw_jobs",
     "draw_margins",
@@ -104,10 +114,49 @@ SAVE: dict[str, Any] = {"dpi": DPI, "pil_kwargs": {"compress_level": COMPRESS_LE
 """``savefig`` options of the figures drawn once."""
 
 
+class LogTicks(Locator):
+    """Ticks of a logarithmic axis that always has some: at most seven powers of ten, and within
+    less than a decade 1, 2 and 5 times a power of ten, or evenly spaced numbers (matplotlib's own
+    log locator has none there, and its minor ticks are left out here)."""
+
+    def __call__(self) -> Any:
+        """The ticks of the axis' view."""
+        if self.axis is None:
+            return np.array([])
+        low, high = self.axis.get_view_interval()
+        return self.tick_values(low, high)
+
+    def tick_values(self, vmin: float, vmax: float) -> Any:
+        """Tick positions for a view.
+
+        Parameters
+        ----------
+        vmin, vmax : float
+            The view's ends (positive).
+
+        Returns
+        -------
+        ndarray
+            The ticks (some may lie outside the view; matplotlib drops those).
+        """
+        low, high = sorted((float(vmin), float(vmax)))
+        if not (low > 0 and np.isfinite(high)):
+            return np.array([])
+        decades = np.asarray(LogLocator(base=10.0, subs=(1.0,), numticks=7).tick_values(low, high), dtype=float)
+        if np.count_nonzero((decades >= low) & (decades <= high)) >= 2:
+            return decades
+        powers = 10.0 ** np.arange(np.floor(np.log10(low)), np.ceil(np.log10(high)) + 1)
+        nice = np.sort(np.outer(powers, [1.0, 2.0, 5.0]).ravel())
+        inside = nice[(nice >= low) & (nice <= high)]
+        return inside if inside.size >= 2 else MaxNLocator(nbins=4).tick_values(low, high)
+
+
 def _log_axis(axis: Any) -> None:
     """A logarithmic y axis with plain ``1e-05`` labels (the default ``10⁻⁵`` labels go through
-    mathtext, which parses every label and costs more than drawing the whole figure)."""
+    mathtext, which parses every label and costs more than drawing the whole figure), and ticks
+    however narrow its view (:class:`LogTicks`)."""
     axis.set_yscale("log")
+    axis.yaxis.set_major_locator(LogTicks())
     axis.yaxis.set_minor_locator(NullLocator())
     axis.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
 
@@ -139,12 +188,12 @@ def _fixed_axis_labels(axis: Any) -> None:
         axis.xaxis.set_label_coords(0.5, -0.1)
 
 
-def _time_axis(axis: Any) -> None:
+def _time_axis(axis: Any, locator: Locator | None = None) -> None:
     """The time axis: label at a fixed place (no measuring of the tick labels at each draw), at
-    most eight ticks (shared by the panels above)."""
+    most eight ticks (shared by the panels above) or those of ``locator``."""
     axis.set_xlabel("time (s)")
     axis.xaxis.set_label_coords(0.5, -0.35 / axis.get_position().height / axis.figure.get_figheight())
-    axis.xaxis.set_major_locator(MaxNLocator(nbins=7, steps=[1, 2, 2.5, 5, 10]))
+    axis.xaxis.set_major_locator(locator or MaxNLocator(nbins=7, steps=[1, 2, 2.5, 5, 10]))
 
 
 PANEL_LABELS = {"torque": "body torque (N m)", "rate": "body rate (deg/s)", "quaternion": "quaternion (–)",
@@ -394,7 +443,7 @@ class RowFigure:
             else:
                 common = any(index is None for panel, index, _, _ in self.limit_lines if panel == name)
                 note.set_text(f"{'limit' if common else 'limits up to'} ±{limit:.3g} beyond the view")
-        self.title.set_text(series.title)
+        self.title.set_text("\n".join(textwrap.wrap(series.title, TITLE_CHARS)))
         time_limits = tuple(self.axes[-1].get_xlim())
         canvas, dynamic = self.canvas, self._dynamic()
         if self._background is None or self._background[0] != time_limits:
@@ -436,6 +485,10 @@ def _write_png(canvas: FigureCanvasAgg, path: Path) -> None:
     image.save(path, format="png", dpi=(DPI, DPI), compress_level=COMPRESS_LEVEL)
 
 
+LEGEND_CHARS = 34
+"""Longest line of a row's label in the comparison figure's legend (a longer label is wrapped)."""
+TITLE_CHARS = 100
+"""Longest line of a row figure's title (a longer one is wrapped)."""
 LINE_STYLES = ("-", "--", "-.", ":")
 """Line styles of the rows in the comparison figure, in turn with :data:`ROW_COLORS`: rows whose curves
 lie on one another still show (a dashed line over a solid one)."""
@@ -485,7 +538,7 @@ def overlay_figure(series: OverlaySeries) -> Figure:
         per_axis = []
     rows = len(per_axis) + 1
     top, bottom = OVERLAY_EDGES_IN
-    height = rows * OVERLAY_ROW_IN + top + bottom
+    height = rows * OVERLAY_ROW_IN + top + bottom + (OVERLAY_TIME_IN if per_axis else 0.0)
     figure = Figure(figsize=(OVERLAY_WIDTH_IN, height), dpi=DPI)
     FigureCanvasAgg(figure)
     sides = {"left": OVERLAY_MARGINS["left"], "right": OVERLAY_MARGINS["right"]}
@@ -505,15 +558,16 @@ def overlay_figure(series: OverlaySeries) -> Figure:
     for axis in (norm, error):
         axis.grid(alpha=0.3)
         _time_axis(axis)
-    # The per-axis panels of a quantity share one value scale, on the x panel's axis; they take the
-    # time axis of the panels below. Their grids are lines at those ticks: a tick costs three artists
-    # and a text to draw, and a panel without ticks draws no tick label.
+    # The per-axis panels of a quantity share one value scale, on the x panel's axis, and the time
+    # span of the panels below, its ticks on the last row. Elsewhere their grids are lines at those
+    # ticks: a tick costs three artists and a text to draw, and a panel without ticks draws no label.
     norm.autoscale_view()
     limits = norm.get_xlim()
-    grid_times = [t for t in norm.xaxis.get_majorticklocs() if limits[0] <= t <= limits[1]]
+    times = [t for t in MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]).tick_values(*limits)
+             if limits[0] <= t <= limits[1]]
     upper = figure.add_gridspec(max(len(per_axis), 1), 3, **sides, wspace=OVERLAY_AXES_WSPACE,
                                 hspace=OVERLAY_GAP_IN / (OVERLAY_ROW_IN - OVERLAY_GAP_IN),
-                                bottom=(bottom + OVERLAY_ROW_IN) / height, top=1 - top / height)
+                                bottom=(bottom + OVERLAY_ROW_IN + OVERLAY_TIME_IN) / height, top=1 - top / height)
     for r, (curves, label, drawstyle) in enumerate(per_axis):
         panels = [figure.add_subplot(upper[r, i]) for i in range(3)]
         for i, axis in enumerate(panels):
@@ -521,8 +575,12 @@ def overlay_figure(series: OverlaySeries) -> Figure:
                 if row:
                     axis.plot(*row[i], drawstyle=drawstyle, **_row_style(k))
             axis.set_xlim(limits)
-            axis.xaxis.set_major_locator(NullLocator())
-            _grid_lines(axis, "x", grid_times)
+            if r == len(per_axis) - 1:
+                _time_axis(axis, FixedLocator(times))
+                axis.grid(alpha=0.3, axis="x")
+            else:
+                axis.xaxis.set_major_locator(NullLocator())
+                _grid_lines(axis, "x", times)
             if r == 0:
                 axis.set_title(f"body {'xyz'[i]} axis", fontsize=10)
         low, high = min(a.get_ylim()[0] for a in panels), max(a.get_ylim()[1] for a in panels)
@@ -535,7 +593,7 @@ def overlay_figure(series: OverlaySeries) -> Figure:
             axis.yaxis.set_major_locator(NullLocator())
             _grid_lines(axis, "y", values)
     if handles:
-        texts = [f"{label}\n  " + "\n  ".join(final.split(", ")) if final else label
+        texts = ["\n".join(textwrap.wrap(label, LEGEND_CHARS)) + ("\n  " + "\n  ".join(final.split(", ")) if final else "")
                  for label, final in zip(series.labels, series.finals or [""] * len(series.labels))]
         figure.legend(handles, texts, loc="upper left", bbox_to_anchor=(OVERLAY_MARGINS["right"] + 0.01, 1 - top / height),
                       fontsize=8, borderaxespad=0.0, handlelength=3.0, labelspacing=0.9)
@@ -553,7 +611,9 @@ def draw_overlay(series: OverlaySeries, path: Path) -> None:
     path : pathlib.Path
         Where to write the PNG.
     """
-    overlay_figure(series).savefig(path, **SAVE)
+    canvas = FigureCanvasAgg(overlay_figure(series))
+    canvas.draw()
+    _write_png(canvas, path)  # RGB, one draw
 
 
 def _row_color(k: int) -> str:
