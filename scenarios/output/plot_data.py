@@ -470,7 +470,8 @@ def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = E
 
 @dataclass
 class OverlaySeries:
-    """The comparison figure: every row's curves overlaid, per body axis and in norm.
+    """The comparison figure: every row's curves overlaid, per body axis (rate, wheels' momentum)
+    and in norm (torque, error).
 
     Parameters
     ----------
@@ -485,9 +486,8 @@ class OverlaySeries:
     error : list of Curve
         Error to the target per row: angle [deg] to the target attitude, or rate error [deg/s]
         when the attitude is free.
-    axis_torque, rate : list of list of Curve, optional
-        Per row, the applied body torque [N m] (held) and the body rate [deg/s] per body axis
-        (x, y, z); empty: no per-axis panels.
+    rate : list of list of Curve, optional
+        Per row, the body rate [deg/s] per body axis (x, y, z); empty: no per-axis panels.
     wheel_momentum : list of list of Curve, optional
         Per row, the wheels' momentum in body axes, ``A h_w`` [N m s], per axis; empty lists
         without wheels.
@@ -501,7 +501,6 @@ class OverlaySeries:
     labels: list[str]
     torque: list[Curve]
     error: list[Curve]
-    axis_torque: list[list[Curve]] = field(default_factory=list)
     rate: list[list[Curve]] = field(default_factory=list)
     wheel_momentum: list[list[Curve]] = field(default_factory=list)
     finals: list[str] = field(default_factory=list)
@@ -528,7 +527,8 @@ def overlay_series(results: Any) -> OverlaySeries:
     wheels = problem.spacecraft.wheels
     columns = panel_columns(OVERLAY_WIDTH_IN * OVERLAY_WIDEST_PANEL, OVERLAY_MARGINS)
     error_label, unit = (("error to target (deg)", "deg") if target_q is not None
-                         else ("‖ω − ω_f‖ (deg/s)", "deg/s") if target_omega is not None else ("‖ω‖ (deg/s)", "deg/s"))
+                         else ("‖ω − ω_f‖ (deg/s)", "deg/s") if target_omega is not None
+                         else ("‖ω‖ (deg/s)", "deg/s"))
     series = OverlaySeries(f"{results.scenario.name}: closed-loop comparison", error_label, [], [], [])
     for row in results.rows:
         if row.simulation is None:
@@ -547,7 +547,6 @@ def overlay_series(results: Any) -> OverlaySeries:
         series.labels.append(row.label)
         series.torque.append(curve(held(np.linalg.norm(sim.applied_torque, axis=1))))
         series.error.append(curve(np.maximum(error, FLOOR_DEG)))
-        series.axis_torque.append([curve(held(sim.applied_torque[:, i])) for i in range(3)])
         series.rate.append([curve(DEG_PER_RAD * sim.omega[:, i]) for i in range(3)])
         finals = [f"final {error[-1]:.3g} {unit}"]
         if wheels is not None and sim.wheel_momentum.shape[1]:
@@ -1035,8 +1034,9 @@ def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str 
 
 SCOPE_NAMES = {"ref": "reference", "cl": "closed-loop"}
 """How a column's scope prefix (``ref.``, ``cl.``) reads on an axis."""
-METRIC_NAMES = {"int_u2": "∫‖u‖² dt", "int_u": "∫‖u‖ dt", "int_abs_u": "∫|u_i| dt", "int_dipole": "∫‖m‖ dt",
-                "rms_error_deg": "RMS error", "duration_s": "manoeuvre time", "plan_time_s": "plan time"}
+METRIC_NAMES = {"int_u2": "∫‖u‖² dt", "int_u": "∫‖u‖ dt", "int_abs_u": "∫|u_i| dt",
+                "int_dipole": "∫‖m‖ dt", "rms_error_deg": "RMS error", "duration_s": "manoeuvre time",
+                "plan_time_s": "plan time"}
 """Metrics whose key does not read as words (the others: the key without its unit suffix, spaced)."""
 REQUIREMENT_FIELDS = {"min_margin_deg": ("min margin", "deg"), "time_in_violation_s": ("time in violation", "s"),
                       "first_violation_s": ("first violation", "s"), "min_margin_time_s": ("time of min margin", "s"),

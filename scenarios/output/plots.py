@@ -258,9 +258,10 @@ class RowFigure:
 
     Panels, top to bottom: body torque, body rate, quaternion, Euler angles, error angles; with
     wheels their motor torques and momenta, and speeds when their spin inertia is known; with
-    magnetorquers their dipole. Every per-axis curve takes its axis' colour (:data:`AXIS_COLORS`). Actuator limits are dotted ``±`` lines (one black pair when every curve of the
-    panel has the same limit, else one pair per curve in its colour); failed wheels are grey,
-    dotted and marked in the legend.
+    magnetorquers their dipole. Every per-axis curve takes its axis' colour (:data:`AXIS_COLORS`).
+    Actuator limits are dotted ``±`` lines (one black pair when every curve of the panel has the
+    same limit, else one pair per curve in its colour); failed wheels are grey, dotted and marked
+    in the legend. The panels share one time axis, its ticks on the last panel.
 
     Parameters
     ----------
@@ -516,10 +517,11 @@ def _set_grid_lines(lines: LineCollection, which: str, values: Any) -> None:
 
 
 def overlay_figure(series: OverlaySeries) -> Figure:
-    """The rows overlaid: per body axis (columns x, y, z) the body torque, the body rate and the
-    wheels' momentum in body axes, the three axes of a quantity on one value scale; below, the
-    torque norm and the error to the target (logarithmic). Each row has its colour and line style;
-    the legend, beside the panels, gives each row's final values.
+    """The rows overlaid: per body axis (columns x, y, z) the body rate and the wheels' momentum
+    in body axes, the three axes of a quantity on one value scale; below, the torque norm and the
+    error to the target (logarithmic). Each row has its colour and line style; the legend, beside
+    the panels, gives each row's final values. (The torque per axis, with the actuators' limits,
+    is in each row's figure.)
 
     Parameters
     ----------
@@ -531,11 +533,9 @@ def overlay_figure(series: OverlaySeries) -> Figure:
     matplotlib.figure.Figure
         The figure, on an Agg canvas.
     """
-    per_axis = [(series.axis_torque, "body torque (N m)", "steps-post"), (series.rate, "body rate (deg/s)", "default")]
-    if any(series.wheel_momentum):
-        per_axis.append((series.wheel_momentum, "wheel momentum (N m s)", "default"))
-    if not any(series.axis_torque):
-        per_axis = []
+    per_axis = [(series.rate, "body rate (deg/s)")] if any(series.rate) else []
+    if per_axis and any(series.wheel_momentum):
+        per_axis.append((series.wheel_momentum, "wheel momentum (N m s)"))
     rows = len(per_axis) + 1
     top, bottom = OVERLAY_EDGES_IN
     height = rows * OVERLAY_ROW_IN + top + bottom + (OVERLAY_TIME_IN if per_axis else 0.0)
@@ -568,12 +568,12 @@ def overlay_figure(series: OverlaySeries) -> Figure:
     upper = figure.add_gridspec(max(len(per_axis), 1), 3, **sides, wspace=OVERLAY_AXES_WSPACE,
                                 hspace=OVERLAY_GAP_IN / (OVERLAY_ROW_IN - OVERLAY_GAP_IN),
                                 bottom=(bottom + OVERLAY_ROW_IN + OVERLAY_TIME_IN) / height, top=1 - top / height)
-    for r, (curves, label, drawstyle) in enumerate(per_axis):
+    for r, (curves, label) in enumerate(per_axis):
         panels = [figure.add_subplot(upper[r, i]) for i in range(3)]
         for i, axis in enumerate(panels):
             for k, row in enumerate(curves):
                 if row:
-                    axis.plot(*row[i], drawstyle=drawstyle, **_row_style(k))
+                    axis.plot(*row[i], **_row_style(k))
             axis.set_xlim(limits)
             if r == len(per_axis) - 1:
                 _time_axis(axis, FixedLocator(times))
@@ -593,9 +593,11 @@ def overlay_figure(series: OverlaySeries) -> Figure:
             axis.yaxis.set_major_locator(NullLocator())
             _grid_lines(axis, "y", values)
     if handles:
-        texts = ["\n".join(textwrap.wrap(label, LEGEND_CHARS)) + ("\n  " + "\n  ".join(final.split(", ")) if final else "")
+        texts = ["\n".join(textwrap.wrap(label, LEGEND_CHARS))
+                 + ("\n  " + "\n  ".join(final.split(", ")) if final else "")
                  for label, final in zip(series.labels, series.finals or [""] * len(series.labels))]
-        figure.legend(handles, texts, loc="upper left", bbox_to_anchor=(OVERLAY_MARGINS["right"] + 0.01, 1 - top / height),
+        figure.legend(handles, texts, loc="upper left",
+                      bbox_to_anchor=(OVERLAY_MARGINS["right"] + 0.01, 1 - top / height),
                       fontsize=8, borderaxespad=0.0, handlelength=3.0, labelspacing=0.9)
     figure.suptitle(series.title)
     return figure

@@ -299,7 +299,8 @@ def _scale(axis: Any, which: str, values: Any) -> None:
 def _mark_failed(axis: Any, xs: list[float], color: Any) -> None:
     """× at the bottom of the panel at each x with a failed row."""
     if xs:
-        axis.plot(xs, [0.03] * len(xs), color=color, transform=blended_transform_factory(axis.transData, axis.transAxes),
+        axis.plot(xs, [0.03] * len(xs), color=color,
+                  transform=blended_transform_factory(axis.transData, axis.transAxes),
                   clip_on=False, **FAILED_MARK)
 
 
@@ -307,7 +308,8 @@ def _legend(figure: Figure, colors: dict[str, Any], failed: bool, extra: list[An
             style: str = "o-") -> None:
     """The planners' colours (and the failed mark) beside the panels."""
     line: Any = style[1:] or "none"
-    handles = [Line2D([], [], color=color, marker=style[0], linestyle=line, label=label) for label, color in colors.items()]
+    handles = [Line2D([], [], color=color, marker=style[0], linestyle=line, label=label)
+               for label, color in colors.items()]
     if failed:
         handles.append(Line2D([], [], color="0.3", label="failed row (no value)", **FAILED_MARK))
     handles += extra or []
@@ -554,7 +556,8 @@ def _pareto(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Fig
     for axis, (key, members) in zip(axes, shown):
         missing = []
         for label in labels:
-            mine = np.array([[_value(r, x_key), _value(r, y_key)] for r in members if r["label"] == label]).reshape(-1, 2)
+            mine = np.array([[_value(r, x_key), _value(r, y_key)] for r in members
+                             if r["label"] == label]).reshape(-1, 2)
             axis.plot(mine[:, 0], mine[:, 1], "o", color=colors[label], ms=5 if study.samples == 1 else 3,
                       alpha=1.0 if study.samples == 1 else 0.5)
             lacking = int(np.sum(~np.isfinite(mine).all(axis=1)))

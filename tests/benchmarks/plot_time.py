@@ -75,7 +75,8 @@ def summary(times: dict[tuple[str, bool], list[tuple[float, float]]]) -> tuple[l
                 values = np.asarray([t[column] for t in times[(name, plots)]])
                 medians[(name, plots)] = float(np.median(values))
                 p10, p90 = np.percentile(values, (10, 90))
-                lines.append(f"{what} {'with plots' if plots else 'no plots  '} {name:4s}: median {np.median(values):.3f} s, "
+                kind = "with plots" if plots else "no plots  "
+                lines.append(f"{what} {kind} {name:4s}: median {np.median(values):.3f} s, "
                              f"p10 {p10:.3f} s, p90 {p90:.3f} s, n {values.size}")
             ratio = medians[("new", plots)] / medians[("base", plots)]
             ratios[(column, plots)] = ratio
@@ -123,7 +124,8 @@ def main(argv: list[str] | None = None) -> float:
                            capture_output=True)
     lines, ratio = summary(times)
     print("\n".join(lines))
-    print(f"load average after {os.getloadavg()}; target ratio <= {TARGET_RATIO}: {'met' if ratio <= TARGET_RATIO else 'NOT met'}")
+    verdict = "met" if ratio <= TARGET_RATIO else "NOT met"
+    print(f"load average after {os.getloadavg()}; target ratio <= {TARGET_RATIO}: {verdict}")
     return ratio
 
 
