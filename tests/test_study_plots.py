@@ -223,3 +223,27 @@ def test_write_plots_writes_every_figure_and_leaves_none_open(tmp_path):
     assert {"heatmap_cl.final_error_deg.png", "metrics_vs_maneuver.duration.png",
             "metrics_vs_simulation.sample_time.png"} <= set(written)
     assert plt.get_fignums() == []
+
+
+def test_grid_points_with_samples_count_their_failed_rows_and_group_the_box_plots():
+    parsed = study(grid={"maneuver.duration": [30.0, 40.0], "simulation.sample_time": [0.5, 1.0]},
+                   monte_carlo={"samples": 3, "seed": 1, "dispersions": {
+                       "simulation.initial_attitude_error_deg": {"normal": {"mean": [0, 0, 0], "std": [1, 1, 1]}}}},
+                   summary=["cl.final_error_deg"])
+
+    def values(case, label):  # the first sample of the last grid point fails for spin
+        if label == "spin" and case.index == 9:
+            return "failed", {}
+        return "ok", {"cl.final_error_deg": 1.0 + case.index}
+
+    made = built(parsed, rows_of(parsed, values))
+    heat = made["heatmap_cl.final_error_deg.png"]
+    spin = next(a for a in heat.axes if a.get_title() == "spin")
+    marks = [t for t in spin.texts if t.get_text().startswith("×")]
+    assert [(m.get_text(), round(m.get_position()[0]), round(m.get_position()[1])) for m in marks] == [("× 1", 1, 1)]
+    cell = next(t for t in spin.texts if t.get_position() == (1, 1))  # the median of the two samples left
+    assert cell.get_text() == f"{(11.0 + 12.0) / 2:.3g}"
+    box = made["boxplots.png"]
+    (panel,) = [a for a in box.axes if a.get_ylabel()]
+    groups = [t.get_text() for t in panel.get_xticklabels()]
+    assert len(groups) == 8 and groups[0] == "smooth\nmaneuver duration 30 s, simulation sample time 0.5 s"
