@@ -28,8 +28,25 @@ ROW_EDGES_IN = 0.65
 ROW_MARGINS = {"left": 0.1, "right": 0.855, "hspace": 0.08}
 """``subplots_adjust`` of the per-row figure (fractions of the figure; top and bottom from
 :func:`row_figure_layout`); the legends sit right of 0.855."""
-OVERLAY_FIGSIZE_IN = (9.0, 7.0)
-OVERLAY_MARGINS = {"left": 0.1, "right": 0.98, "bottom": 0.08, "top": 0.93, "hspace": 0.08}
+OVERLAY_WIDTH_IN = 13.0
+"""Width of the comparison figure [in]."""
+OVERLAY_ROW_IN = 2.25
+"""Height of one row of panels of the comparison figure, its gap included [in]."""
+OVERLAY_EDGES_IN = (0.6, 0.55)
+"""Space above the top panels (the title) and below the bottom ones (the time axis) [in]."""
+OVERLAY_GAP_IN = 0.4
+"""Vertical gap between two rows of panels of the comparison figure [in]."""
+OVERLAY_TIME_IN = 0.35
+"""Room for the time axis below the comparison figure's per-axis panels [in]."""
+OVERLAY_MARGINS = {"left": 0.075, "right": 0.8, "wspace": 0.25}
+"""Left and right edges of the comparison figure's panels (fractions of the figure; top and bottom from
+:data:`OVERLAY_EDGES_IN`; the legend sits right of them), and the gap between the norm's and the
+error's panels (a fraction of a panel's width: room for the error's value axis)."""
+OVERLAY_AXES_WSPACE = 0.1
+"""Gap between the comparison figure's per-axis panels (a fraction of a panel's width): they share one value axis."""
+OVERLAY_WIDEST_PANEL = 0.5
+"""The widest panel of the comparison figure (the norm's and the error's, half of it) as a fraction
+of the panels' width: the curves are decimated to its pixel columns."""
 MARGIN_WIDTH_IN = 11.0
 """Width of the pointing-margin figure [in]; its height is :data:`MARGIN_PANEL_IN` per requirement."""
 MARGIN_PANEL_IN = 2.7
@@ -51,6 +68,11 @@ FLOOR_RATE = 1e-12
 """Smallest rate drawn on the logarithmic rate axes [rad/s]."""
 RPM_PER_RAD_S = 60.0 / (2.0 * np.pi)
 """Revolutions per minute in one rad/s."""
+DEG_PER_RAD = 180.0 / np.pi
+"""Degrees in one radian: rates are drawn in deg/s."""
+EULER_SEQUENCE = "321"
+"""Default Euler sequence of the row figures: yaw about z, pitch about the new y, roll about the
+newest x, from the inertial frame to the body (:func:`euler_angles`)."""
 
 
 def row_figure_layout(n_panels: int) -> tuple[tuple[float, float], dict[str, float]]:
@@ -142,6 +164,105 @@ def held(values: np.ndarray) -> np.ndarray:
     return np.concatenate([values, values[-1:]])
 
 
+def continuous_quaternions(q: np.ndarray, like: np.ndarray | None = None) -> np.ndarray:
+    """A quaternion series drawn without sign jumps: ``q`` and ``-q`` are the same attitude, and a
+    series that switches between them (a solver, a canonical form ``q0 >= 0``) or a reference on
+    the other sign from its closed loop looks like a failure in a plot.
+
+    Parameters
+    ----------
+    q : (N, 4) ndarray
+        Quaternions, scalar first, in time order.
+    like : (N, 4) ndarray, optional
+        A series on the same times to share a hemisphere with (the closed loop, for its reference).
+
+    Returns
+    -------
+    (N, 4) ndarray
+        The same attitudes, each ``+q_k`` or ``-q_k``: every sample after the first on the side of
+        the one before (non-negative dot product), the whole series on the side of ``like`` (the sum
+        of the samples' dot products with it non-negative) or, without ``like``, starting with a
+        non-negative scalar part.
+    """
+    q = np.array(q, dtype=float)
+    if len(q) == 0:
+        return q
+    flips = np.where(np.einsum("ij,ij->i", q[1:], q[:-1]) < 0.0, -1.0, 1.0)
+    q *= np.concatenate([[1.0], np.cumprod(flips)])[:, None]
+    side = np.einsum("ij,ij->", q, like) if like is not None else q[0, 0]
+    return -q if side < 0 else q
+
+
+_CYCLIC = {(0, 1, 2), (1, 2, 0), (2, 0, 1)}
+
+
+def euler_sequence_axes(sequence: str) -> tuple[int, int, int]:
+    """The body axes (0 = x) of an Euler sequence.
+
+    Parameters
+    ----------
+    sequence : str
+        Three of ``1``, ``2``, ``3``, no two consecutive ones equal: a Tait-Bryan sequence
+        (``"321"``, ``"123"`` ...) or a proper Euler one (``"313"`` ...).
+
+    Returns
+    -------
+    (int, int, int)
+        The axes in the order of the rotations.
+
+    Raises
+    ------
+    ValueError
+        Another sequence.
+    """
+    axes = tuple("123".find(c) for c in str(sequence))
+    if len(axes) != 3 or -1 in axes or axes[0] == axes[1] or axes[1] == axes[2]:
+        raise ValueError(f"an Euler sequence is three of 1, 2, 3 with no two consecutive ones equal, such as "
+                         f"'321' or '313'; got {sequence!r}")
+    return axes[0], axes[1], axes[2]
+
+
+def euler_angles(q: np.ndarray, sequence: str = EULER_SEQUENCE) -> np.ndarray:
+    """Euler angles of an attitude series, in degrees and unwrapped in time.
+
+    The angles ``(α, β, γ)`` of the sequence ``a-b-c`` satisfy ``R(q) = R_a(α) R_b(β) R_c(γ)``
+    (``R(q)`` body to inertial): from the inertial frame, a rotation about axis ``a``, then about
+    the new ``b``, then about the newest ``c`` reach the body axes. For ``"321"`` they are yaw,
+    pitch and roll.
+
+    Parameters
+    ----------
+    q : (N, 4) ndarray
+        Unit quaternions, scalar first, body to inertial, in time order (their signs do not matter).
+    sequence : str, optional
+        The rotation axes (:func:`euler_sequence_axes`); default :data:`EULER_SEQUENCE`.
+
+    Returns
+    -------
+    (N, 3) ndarray
+        The angles in the order of the sequence [deg]. The middle one lies in [-90, 90] (Tait-Bryan)
+        or [0, 180] (proper); the outer ones start in (-180, 180] and are unwrapped (no jump of
+        360°). At gimbal lock (middle angle ±90° or 0, 180°) only their sum or difference is defined.
+    """
+    # the model's helper, in the process that ran it (module docstring)
+    from ocp import quat
+
+    a, b, c = euler_sequence_axes(sequence)
+    matrix = quat.rotation_matrix(np.asarray(q, dtype=float))
+    if a != c:  # Tait-Bryan
+        s = 1.0 if (a, b, c) in _CYCLIC else -1.0
+        middle = np.arcsin(np.clip(s * matrix[:, a, c], -1.0, 1.0))
+        first = np.arctan2(-s * matrix[:, b, c], matrix[:, c, c])
+        last = np.arctan2(-s * matrix[:, a, b], matrix[:, a, a])
+    else:  # proper Euler: the third axis is the one not named
+        d = 3 - a - b
+        s = 1.0 if (a, b, d) in _CYCLIC else -1.0
+        middle = np.arccos(np.clip(matrix[:, a, a], -1.0, 1.0))
+        first = np.arctan2(matrix[:, b, a], -s * matrix[:, d, a])
+        last = np.arctan2(matrix[:, a, b], s * matrix[:, a, d])
+    return np.rad2deg(np.unwrap(np.stack([first, middle, last], axis=1), axis=0))
+
+
 Curve = tuple[np.ndarray, np.ndarray]
 """A drawn curve: times [s] and values, decimated."""
 
@@ -154,8 +275,8 @@ LIMITED_PANELS = ("torque", "wheel_torque", "wheel_momentum", "wheel_speed", "di
 
 @dataclass
 class RowSeries:
-    """The curves of one row's figure: body torque, rate, quaternion, error angles, and per
-    actuator (wheel torque, momentum and speed; magnetorquer dipole) with their limits.
+    """The curves of one row's figure: body torque, rate, quaternion, Euler angles, error angles,
+    and per actuator (wheel torque, momentum and speed; magnetorquer dipole) with their limits.
 
     Parameters
     ----------
@@ -168,15 +289,17 @@ class RowSeries:
     title : str
         The figure's title.
     torque, rate : list of Curve
-        Applied body torque [N m] (held) and body rate [rad/s], per body axis (x, y, z).
+        Applied body torque [N m] (held) and body rate [deg/s], per body axis (x, y, z).
     quaternion : list of Curve
-        Attitude, scalar first (body to inertial).
-    reference : tuple of three lists of Curve, optional
-        The reference's torque, rate and quaternion (``with_reference``).
+        Attitude, scalar first (body to inertial), without sign jumps
+        (:func:`continuous_quaternions`).
+    reference : tuple of lists of Curve, optional
+        The reference's torque, rate, quaternion (on the closed loop's side) and Euler angles
+        (``with_reference``).
     to_target, to_reference : Curve, optional
         Error angles [deg] to the target attitude and to the reference attitude.
     rate_norm, rate_max : Curve, optional
-        ``‖ω‖`` and ``max |ω_i|`` [rad/s] (regulation without a target attitude).
+        ``‖ω‖`` and ``max |ω_i|`` [deg/s] (regulation without a target attitude).
     wheels : list of Curve
         Wheel momenta [N m s].
     failed : tuple of int, optional
@@ -193,6 +316,10 @@ class RowSeries:
         Actuator limits drawn as ``±`` lines, per panel of :data:`LIMITED_PANELS`, one value per
         curve of the panel (NaN: none): the per-axis body torque the actuators can apply on all
         axes at once [N m], wheel torque [N m], momentum [N m s] and speed [rpm], dipole [A m^2].
+    euler : list of Curve, optional
+        Euler angles [deg] of ``euler_sequence`` (:func:`euler_angles`), in its order.
+    euler_sequence : str, optional
+        Their sequence (default :data:`EULER_SEQUENCE`).
     """
 
     n_wheels: int
@@ -202,7 +329,7 @@ class RowSeries:
     torque: list[Curve]
     rate: list[Curve]
     quaternion: list[Curve]
-    reference: tuple[list[Curve], list[Curve], list[Curve]] | None = None
+    reference: tuple[list[Curve], ...] | None = None
     to_target: Curve | None = None
     to_reference: Curve | None = None
     rate_norm: Curve | None = None
@@ -214,17 +341,20 @@ class RowSeries:
     wheel_speed: list[Curve] = field(default_factory=list)
     dipole: list[Curve] = field(default_factory=list)
     limits: dict[str, tuple[float, ...]] = field(default_factory=dict)
+    euler: list[Curve] = field(default_factory=list)
+    euler_sequence: str = EULER_SEQUENCE
 
     @property
     def shape(self) -> RowShape:
         """``(n_wheels, with_reference, with_target, failed, wheel_axis, wheel speed panel, dipole
-        panel, limit styles)``, the arguments of :class:`scenarios.output.plots.RowFigure`: rows of
-        one shape share a figure. A limit style is ``(panel, common)``: ``common`` when every
-        limit of the panel is the same (one black pair of lines), else one pair per curve."""
+        panel, limit styles, Euler sequence)``, the arguments of
+        :class:`scenarios.output.plots.RowFigure`: rows of one shape share a figure. A limit style
+        is ``(panel, common)``: ``common`` when every limit of the panel is the same (one black pair
+        of lines), else one pair per curve."""
         styles = tuple((panel, _common(values)) for panel, values in self.limits.items()
                        if np.any(np.isfinite(values)))
         return (self.n_wheels, self.with_reference, self.with_target, tuple(self.failed), tuple(self.wheel_axis),
-                bool(self.wheel_speed), bool(self.dipole), styles)
+                bool(self.wheel_speed), bool(self.dipole), styles, self.euler_sequence)
 
 
 def _common(values: tuple[float, ...]) -> bool:
@@ -258,7 +388,7 @@ def wheel_axes(axes: np.ndarray) -> tuple[int, ...]:
     return tuple(int(np.argmax(np.abs(a))) if np.max(np.abs(a)) > 1 - 1e-9 else -1 for a in np.asarray(axes).T)
 
 
-def row_series(row: Any, target_q: Any, spacecraft: Any) -> RowSeries:
+def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = EULER_SEQUENCE) -> RowSeries:
     """The curves of a simulated row, decimated to the per-row figure's panels.
 
     Parameters
@@ -269,6 +399,8 @@ def row_series(row: Any, target_q: Any, spacecraft: Any) -> RowSeries:
         Target attitude (scalar-first quaternion, body to inertial) for the error angle.
     spacecraft : ocp.Spacecraft
         The simulated spacecraft: its actuators fix the actuator panels and their limit lines.
+    euler_sequence : str, optional
+        The Euler angles' sequence (:func:`euler_angles`); default :data:`EULER_SEQUENCE`.
 
     Returns
     -------
@@ -292,11 +424,16 @@ def row_series(row: Any, target_q: Any, spacecraft: Any) -> RowSeries:
     n_wheels = spacecraft.n_wheels
     with_reference, with_target = row.reference is not None, target_q is not None
     controller = f", {row.controller}" if getattr(row, "controller", None) else ""
+    q = continuous_quaternions(sim.q)
     series = RowSeries(
         n_wheels, with_reference, with_target,
-        f"{row.label} ({row.planner or 'regulation'}{controller}): solid closed loop, dashed reference",
-        held_curves(sim.applied_torque), [curve(sim.omega[:, i]) for i in range(3)],
-        [curve(sim.q[:, i]) for i in range(4)], wheels=[curve(sim.wheel_momentum[:, i]) for i in range(n_wheels)])
+        f"{row.label} ({row.planner or 'regulation'}{controller}): "
+        + ("solid closed loop, dashed reference" if with_reference else "closed loop"),
+        held_curves(sim.applied_torque), [curve(DEG_PER_RAD * sim.omega[:, i]) for i in range(3)],
+        [curve(q[:, i]) for i in range(4)], wheels=[curve(sim.wheel_momentum[:, i]) for i in range(n_wheels)],
+        euler_sequence=euler_sequence)
+    euler = euler_angles(q, euler_sequence)
+    series.euler = [curve(euler[:, i]) for i in range(3)]
     slices, _ = control_layout(spacecraft)
     wheels, magnetorquers = spacecraft.wheels, spacecraft.magnetorquers
     if magnetorquers is None and (wheels is not None or spacecraft.torquers is not None):
@@ -317,34 +454,46 @@ def row_series(row: Any, target_q: Any, spacecraft: Any) -> RowSeries:
         series.limits["dipole"] = _limits(magnetorquers.max_dipole)
     if with_reference:
         ref = row.reference.sample(t)
-        series.reference = tuple([curve(values[:, i]) for i in range(values.shape[1])]  # type: ignore[assignment]
-                                 for values in (ref.torque, ref.omega, ref.q))
+        ref_q = continuous_quaternions(ref.q, like=q)
+        ref_euler = euler_angles(ref_q, euler_sequence)
+        ref_euler += 360.0 * np.round((euler[0] - ref_euler[0]) / 360.0)  # the same turn as the closed loop
+        series.reference = tuple([curve(values[:, i]) for i in range(values.shape[1])]
+                                 for values in (ref.torque, DEG_PER_RAD * ref.omega, ref_q, ref_euler))
         series.to_reference = curve(np.maximum(np.rad2deg(quat.error_angle(sim.q, ref.q)), FLOOR_DEG))
     if with_target:
         series.to_target = curve(np.maximum(np.rad2deg(quat.error_angle(sim.q, target_q)), FLOOR_DEG))
     if not with_reference and not with_target:  # rate regulation (detumbling): the rate converges
-        series.rate_norm = curve(np.maximum(np.linalg.norm(sim.omega, axis=1), FLOOR_RATE))
-        series.rate_max = curve(np.maximum(np.abs(sim.omega).max(axis=1), FLOOR_RATE))
+        series.rate_norm = curve(DEG_PER_RAD * np.maximum(np.linalg.norm(sim.omega, axis=1), FLOOR_RATE))
+        series.rate_max = curve(DEG_PER_RAD * np.maximum(np.abs(sim.omega).max(axis=1), FLOOR_RATE))
     return series
 
 
 @dataclass
 class OverlaySeries:
-    """The comparison figure: torque norm and error to the target, one curve per row.
+    """The comparison figure: every row's curves overlaid, per body axis (rate, wheels' momentum)
+    and in norm (torque, error).
 
     Parameters
     ----------
     title : str
         The figure's title.
     error_label : str
-        The lower panel's y label (what the error is, with its unit).
+        The error panel's y label (what the error is, with its unit).
     labels : list of str
         Row labels, in the rows' order.
     torque : list of Curve
         ``‖u‖`` [N m] (held) per row.
     error : list of Curve
-        Error to the target per row: angle [deg] to the target attitude, or rate error [rad/s]
+        Error to the target per row: angle [deg] to the target attitude, or rate error [deg/s]
         when the attitude is free.
+    rate : list of list of Curve, optional
+        Per row, the body rate [deg/s] per body axis (x, y, z); empty: no per-axis panels.
+    wheel_momentum : list of list of Curve, optional
+        Per row, the wheels' momentum in body axes, ``A h_w`` [N m s], per axis; empty lists
+        without wheels.
+    finals : list of str, optional
+        Per row, its final values in words (the legend gives them, so that rows whose curves lie
+        on one another are told apart).
     """
 
     title: str
@@ -352,6 +501,9 @@ class OverlaySeries:
     labels: list[str]
     torque: list[Curve]
     error: list[Curve]
+    rate: list[list[Curve]] = field(default_factory=list)
+    wheel_momentum: list[list[Curve]] = field(default_factory=list)
+    finals: list[str] = field(default_factory=list)
 
 
 def overlay_series(results: Any) -> OverlaySeries:
@@ -370,10 +522,13 @@ def overlay_series(results: Any) -> OverlaySeries:
     # the model's helpers, in the process that ran it (module docstring)
     from ocp import quat
 
-    target_q, target_omega = results.scenario.problem.qf, results.scenario.problem.omegaf
-    columns = panel_columns(OVERLAY_FIGSIZE_IN[0], OVERLAY_MARGINS)
-    error_label = ("error to target (deg)" if target_q is not None
-                   else "‖ω − ω_f‖ (rad/s)" if target_omega is not None else "‖ω‖ (rad/s)")
+    problem = results.scenario.problem
+    target_q, target_omega = problem.qf, problem.omegaf
+    wheels = problem.spacecraft.wheels
+    columns = panel_columns(OVERLAY_WIDTH_IN * OVERLAY_WIDEST_PANEL, OVERLAY_MARGINS)
+    error_label, unit = (("error to target (deg)", "deg") if target_q is not None
+                         else ("‖ω − ω_f‖ (deg/s)", "deg/s") if target_omega is not None
+                         else ("‖ω‖ (deg/s)", "deg/s"))
     series = OverlaySeries(f"{results.scenario.name}: closed-loop comparison", error_label, [], [], [])
     for row in results.rows:
         if row.simulation is None:
@@ -382,12 +537,25 @@ def overlay_series(results: Any) -> OverlaySeries:
         if target_q is not None:
             error = np.rad2deg(quat.error_angle(sim.q, target_q))
         elif target_omega is not None:
-            error = np.linalg.norm(sim.omega - target_omega, axis=1)
+            error = DEG_PER_RAD * np.linalg.norm(sim.omega - target_omega, axis=1)
         else:
-            error = np.linalg.norm(sim.omega, axis=1)
+            error = DEG_PER_RAD * np.linalg.norm(sim.omega, axis=1)
+
+        def curve(values: np.ndarray, t: np.ndarray = sim.t) -> Curve:
+            return decimate(t, values, columns)
+
         series.labels.append(row.label)
-        series.torque.append(decimate(sim.t, held(np.linalg.norm(sim.applied_torque, axis=1)), columns))
-        series.error.append(decimate(sim.t, np.maximum(error, FLOOR_DEG), columns))
+        series.torque.append(curve(held(np.linalg.norm(sim.applied_torque, axis=1))))
+        series.error.append(curve(np.maximum(error, FLOOR_DEG)))
+        series.rate.append([curve(DEG_PER_RAD * sim.omega[:, i]) for i in range(3)])
+        finals = [f"final {error[-1]:.3g} {unit}"]
+        if wheels is not None and sim.wheel_momentum.shape[1]:
+            body = sim.wheel_momentum @ np.asarray(wheels.axes, dtype=float).T
+            series.wheel_momentum.append([curve(body[:, i]) for i in range(3)])
+            finals.append(f"‖A h_w‖ {np.linalg.norm(body[-1]):.3g} N m s")
+        else:
+            series.wheel_momentum.append([])
+        series.finals.append(", ".join(finals))
     return series
 
 
@@ -825,7 +993,7 @@ SKY_FILE = "sky.png"
 """The sky map of a run with pointing requirements."""
 
 
-def plot_jobs(results: Any, stems: list[str] | None = None) -> list[PlotJob]:
+def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str = EULER_SEQUENCE) -> list[PlotJob]:
     """The figures of a run: one per simulated row (``<stem>.png``), with pointing requirements
     :data:`MARGINS_FILE` and :data:`SKY_FILE`, and ``comparison.png``.
 
@@ -835,12 +1003,15 @@ def plot_jobs(results: Any, stems: list[str] | None = None) -> list[PlotJob]:
         The run.
     stems : list of str, optional
         The rows' file stems; ``None``: ``row_stems`` of the labels.
+    euler_sequence : str, optional
+        The row figures' Euler sequence (:func:`euler_angles`); default :data:`EULER_SEQUENCE`.
 
     Returns
     -------
     list of (str, series)
         File names and series, in drawing order (rows, the pointing figures, the overlay last).
     """
+    euler_sequence_axes(euler_sequence)  # a bad sequence fails before any series is computed
     from scenarios.output.names import row_stems
 
     problem = results.scenario.problem
@@ -849,7 +1020,7 @@ def plot_jobs(results: Any, stems: list[str] | None = None) -> list[PlotJob]:
     for row, stem in zip(results.rows, stems):
         if row.simulation is None:
             continue
-        jobs.append((f"{stem}.png", row_series(row, problem.qf, problem.spacecraft)))
+        jobs.append((f"{stem}.png", row_series(row, problem.qf, problem.spacecraft, euler_sequence)))
     constraints = pointing_constraints(results)
     sampled = motions(results) if constraints else []
     if sampled:
@@ -857,3 +1028,93 @@ def plot_jobs(results: Any, stems: list[str] | None = None) -> list[PlotJob]:
         jobs.append((SKY_FILE, sky_series(results, constraints, sampled)))
     jobs.append(("comparison.png", overlay_series(results)))
     return jobs
+
+
+# --- axis names of the result columns --------------------------------------------------------------
+
+SCOPE_NAMES = {"ref": "reference", "cl": "closed-loop"}
+"""How a column's scope prefix (``ref.``, ``cl.``) reads on an axis."""
+METRIC_NAMES = {"int_u2": "∫‖u‖² dt", "int_u": "∫‖u‖ dt", "int_abs_u": "∫|u_i| dt",
+                "int_dipole": "∫‖m‖ dt", "rms_error_deg": "RMS error", "duration_s": "manoeuvre time",
+                "plan_time_s": "plan time"}
+"""Metrics whose key does not read as words (the others: the key without its unit suffix, spaced)."""
+REQUIREMENT_FIELDS = {"min_margin_deg": ("min margin", "deg"), "time_in_violation_s": ("time in violation", "s"),
+                      "first_violation_s": ("first violation", "s"), "min_margin_time_s": ("time of min margin", "s"),
+                      "peak_rate": ("peak rate", "rad/s"), "peak_time_s": ("time of peak rate", "s"),
+                      "ratio": ("peak rate / bound", "–"), "worst_error_deg": ("worst final error", "deg"),
+                      "worst_rate_error": ("worst final rate error", "rad/s"), "from_s": ("final window start", "s")}
+"""Words and unit of each requirement field (the requirements' columns, ``<scope>.req.<name>.<field>``); the
+``actuators`` fields are ``<quantity>`` (peak demand over the limit, –) and ``<quantity>_time_s``."""
+
+
+def _words(key: str) -> str:
+    """A key without its unit suffix, spaced: ``settling_time_s`` -> ``settling time``."""
+    return key.removesuffix("_deg").removesuffix("_s").replace("_", " ")
+
+
+def column_quantity(column: str) -> tuple[str, str]:
+    """What a result column holds, for an axis: its name in words and its unit.
+
+    Parameters
+    ----------
+    column : str
+        A metric column (``cl.final_error_deg``, ``ref.int_abs_u_x``), a requirement column
+        (``cl.req.<name>.<field>``) or ``plan_time_s``.
+
+    Returns
+    -------
+    name : str
+        For example ``"closed-loop final error"``, ``"reference ∫‖u‖ dt"``, ``"closed-loop st_sun:
+        min margin"``.
+    unit : str
+        Its unit (:data:`ocp.metrics.METRIC_INFO`, or the requirement field's): ``"deg"``,
+        ``"N m s"``, ``"–"`` for a ratio.
+
+    Raises
+    ------
+    KeyError
+        A column that is none of these.
+    """
+    from ocp.metrics import METRIC_INFO  # the metric table (plain data)
+
+    scope, _, rest = column.partition(".")
+    if not rest:
+        if column in METRIC_INFO:
+            return METRIC_NAMES.get(column, _words(column)), METRIC_INFO[column].unit
+        raise KeyError(f"not a result column: {column!r}")
+    prefix = SCOPE_NAMES[scope]
+    if rest.startswith("req."):
+        _, name, field_name = rest.split(".", 2)
+        if field_name in REQUIREMENT_FIELDS:
+            words, unit = REQUIREMENT_FIELDS[field_name]
+        elif field_name.endswith("_time_s"):
+            words, unit = f"time of peak {field_name[:-len('_time_s')].replace('_', ' ')}", "s"
+        else:
+            words, unit = f"peak {field_name.replace('_', ' ')} / limit", "–"
+        return f"{prefix} {name}: {words}", unit
+    key, axis = rest, ""
+    if key not in METRIC_INFO and key[-2:] in ("_x", "_y", "_z") and key[:-2] in METRIC_INFO:
+        key, axis = key[:-2], key[-1]
+    if key not in METRIC_INFO:
+        raise KeyError(f"not a result column: {column!r}")
+    name = METRIC_NAMES.get(key, _words(key))
+    if axis:
+        name = name.replace("_i", f"_{axis}") if "_i" in name else f"{name} {axis}"
+    return f"{prefix} {name}", METRIC_INFO[key].unit
+
+
+def axis_label(name: str, unit: str) -> str:
+    """An axis label: ``"<name> (<unit>)"``, ``(–)`` for a quantity without a unit.
+
+    Parameters
+    ----------
+    name : str
+        The quantity in words.
+    unit : str
+        Its unit; empty: none.
+
+    Returns
+    -------
+    str
+    """
+    return f"{name} ({unit or '–'})"

@@ -26,22 +26,37 @@ the sphere hides behind another as on a drawn 3-D globe.
 """
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
-from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullLocator
+from matplotlib.ticker import (
+    FixedLocator,
+    FuncFormatter,
+    Locator,
+    LogLocator,
+    MaxNLocator,
+    NullLocator,
+)
 
 from scenarios.output.plot_data import (
     DPI,
+    EULER_SEQUENCE,
     MARGIN_MARGINS,
     MARGIN_PANEL_IN,
     MARGIN_WIDTH_IN,
-    OVERLAY_FIGSIZE_IN,
+    OVERLAY_AXES_WSPACE,
+    OVERLAY_EDGES_IN,
+    OVERLAY_GAP_IN,
     OVERLAY_MARGINS,
+    OVERLAY_ROW_IN,
+    OVERLAY_TIME_IN,
+    OVERLAY_WIDTH_IN,
     MarginPanel,
     MarginSeries,
     OverlaySeries,
@@ -50,6 +65,7 @@ from scenarios.output.plot_data import (
     RowShape,
     SkyPath,
     SkySeries,
+    euler_sequence_axes,
     map_longitude,
     overlay_series,
     plot_jobs,
@@ -61,20 +77,28 @@ __all__ = [
     "LABEL_OFFSET_IN",
     "ROW_COLORS",
     "SAVE",
+    "LogTicks",
     "RowFigure",
     "draw_jobs",
     "draw_margins",
     "draw_overlay",
     "draw_sky",
+    "euler_names",
     "margin_axis",
     "margin_figure",
+    "overlay_figure",
     "plot_overlay",
     "sky_figure",
     "write_plots",
 ]
 
-AXIS_COLORS = ("tab:red", "tab:green", "tab:blue", "tab:purple")
-"""Colours of the body axes x, y, z (and the quaternion's fourth component)."""
+AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
+"""Colours of the body axes x, y, z: of every per-axis curve (torque, rate, the quaternion's vector
+part, the Euler angle about each axis, a wheel along the axis, the dipole)."""
+QUATERNION_COLORS = ("tab:purple", *AXIS_COLORS)
+"""Colours of the quaternion's components: the scalar part, then the vector part in the axes' colours."""
+PROPER_EULER_COLOR = "tab:purple"
+"""Colour of the third angle of a proper Euler sequence (its first rotates about the same axis)."""
 WHEEL_COLORS = ("tab:orange", "tab:brown", "tab:pink", "tab:olive", "tab:cyan", "tab:gray", "gold", "navy")
 """Colours of wheels whose spin axes are not distinct body axes (those take the axis' colour)."""
 FAILED_STYLE: dict[str, Any] = {"color": "0.55", "linestyle": ":"}
@@ -90,10 +114,49 @@ SAVE: dict[str, Any] = {"dpi": DPI, "pil_kwargs": {"compress_level": COMPRESS_LE
 """``savefig`` options of the figures drawn once."""
 
 
+class LogTicks(Locator):
+    """Ticks of a logarithmic axis that always has some: at most seven powers of ten, and within
+    less than a decade 1, 2 and 5 times a power of ten, or evenly spaced numbers (matplotlib's own
+    log locator has none there, and its minor ticks are left out here)."""
+
+    def __call__(self) -> Any:
+        """The ticks of the axis' view."""
+        if self.axis is None:
+            return np.array([])
+        low, high = self.axis.get_view_interval()
+        return self.tick_values(low, high)
+
+    def tick_values(self, vmin: float, vmax: float) -> Any:
+        """Tick positions for a view.
+
+        Parameters
+        ----------
+        vmin, vmax : float
+            The view's ends (positive).
+
+        Returns
+        -------
+        ndarray
+            The ticks (some may lie outside the view; matplotlib drops those).
+        """
+        low, high = sorted((float(vmin), float(vmax)))
+        if not (low > 0 and np.isfinite(high)):
+            return np.array([])
+        decades = np.asarray(LogLocator(base=10.0, subs=(1.0,), numticks=7).tick_values(low, high), dtype=float)
+        if np.count_nonzero((decades >= low) & (decades <= high)) >= 2:
+            return decades
+        powers = 10.0 ** np.arange(np.floor(np.log10(low)), np.ceil(np.log10(high)) + 1)
+        nice = np.sort(np.outer(powers, [1.0, 2.0, 5.0]).ravel())
+        inside = nice[(nice >= low) & (nice <= high)]
+        return inside if inside.size >= 2 else MaxNLocator(nbins=4).tick_values(low, high)
+
+
 def _log_axis(axis: Any) -> None:
     """A logarithmic y axis with plain ``1e-05`` labels (the default ``10⁻⁵`` labels go through
-    mathtext, which parses every label and costs more than drawing the whole figure)."""
+    mathtext, which parses every label and costs more than drawing the whole figure), and ticks
+    however narrow its view (:class:`LogTicks`)."""
     axis.set_yscale("log")
+    axis.yaxis.set_major_locator(LogTicks())
     axis.yaxis.set_minor_locator(NullLocator())
     axis.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
 
@@ -125,18 +188,46 @@ def _fixed_axis_labels(axis: Any) -> None:
         axis.xaxis.set_label_coords(0.5, -0.1)
 
 
-def _time_axis(axis: Any) -> None:
+def _time_axis(axis: Any, locator: Locator | None = None) -> None:
     """The time axis: label at a fixed place (no measuring of the tick labels at each draw), at
-    most eight ticks (shared by the panels above)."""
+    most eight ticks (shared by the panels above) or those of ``locator``."""
     axis.set_xlabel("time (s)")
     axis.xaxis.set_label_coords(0.5, -0.35 / axis.get_position().height / axis.figure.get_figheight())
-    axis.xaxis.set_major_locator(MaxNLocator(nbins=7, steps=[1, 2, 2.5, 5, 10]))
+    axis.xaxis.set_major_locator(locator or MaxNLocator(nbins=7, steps=[1, 2, 2.5, 5, 10]))
 
 
-PANEL_LABELS = {"torque": "body torque (N m)", "rate": "body rate (rad/s)", "quaternion": "quaternion (-)",
+PANEL_LABELS = {"torque": "body torque (N m)", "rate": "body rate (deg/s)", "quaternion": "quaternion (–)",
                 "wheel_torque": "wheel torque (N m)", "wheel_momentum": "wheel momentum (N m s)",
                 "wheel_speed": "wheel speed (rpm)", "dipole": "dipole (A m²)"}
-"""Value-axis labels of the per-row figure's panels (the error panel's depends on the row)."""
+"""Value-axis labels of the per-row figure's panels (the error panel's and the Euler angles' depend on the row)."""
+
+
+def euler_names(sequence: str) -> tuple[str, list[str], list[str]]:
+    """How the Euler angles of a sequence are named and coloured.
+
+    Parameters
+    ----------
+    sequence : str
+        An Euler sequence (:func:`scenarios.output.plot_data.euler_sequence_axes`).
+
+    Returns
+    -------
+    label : str
+        The panel's value-axis label, with the sequence and the unit (``"Euler 3-2-1 (deg)"``).
+    names : list of str
+        The legend's name of each angle, with its axis (``"ψ yaw (z)"`` for 3-2-1).
+    colors : list of str
+        Each angle's colour: its axis' (:data:`AXIS_COLORS`); the third of a proper sequence
+        :data:`PROPER_EULER_COLOR`.
+    """
+    axes = euler_sequence_axes(sequence)
+    names = (["ψ yaw", "θ pitch", "φ roll"] if axes == (2, 1, 0)
+             else [f"{symbol}{number}" for symbol, number in zip("αβγ", ("₁", "₂", "₃"))])
+    colors = [AXIS_COLORS[a] for a in axes]
+    if axes[0] == axes[2]:
+        colors[2] = PROPER_EULER_COLOR
+    label = f"Euler {'-'.join(str(a + 1) for a in axes)} (deg)"
+    return label, [f"{name} ({'xyz'[a]})" for name, a in zip(names, axes)], colors
 
 
 def wheel_colors(n_wheels: int, wheel_axis: tuple[int, ...]) -> list[str]:
@@ -165,11 +256,12 @@ def wheel_colors(n_wheels: int, wheel_axis: tuple[int, ...]) -> list[str]:
 class RowFigure:
     """The per-row figure, built once and redrawn for each row of the same shape (module docstring).
 
-    Panels, top to bottom: body torque, body rate, quaternion, error angles; with wheels their
-    motor torques and momenta, and speeds when their spin inertia is known; with magnetorquers
-    their dipole. Actuator limits are dotted ``±`` lines (one black pair when every curve of the
-    panel has the same limit, else one pair per curve in its colour); failed wheels are grey,
-    dotted and marked in the legend.
+    Panels, top to bottom: body torque, body rate, quaternion, Euler angles, error angles; with
+    wheels their motor torques and momenta, and speeds when their spin inertia is known; with
+    magnetorquers their dipole. Every per-axis curve takes its axis' colour (:data:`AXIS_COLORS`).
+    Actuator limits are dotted ``±`` lines (one black pair when every curve of the panel has the
+    same limit, else one pair per curve in its colour); failed wheels are grey, dotted and marked
+    in the legend. The panels share one time axis, its ticks on the last panel.
 
     Parameters
     ----------
@@ -189,21 +281,24 @@ class RowFigure:
         A magnetorquer dipole panel.
     limited : tuple of (str, bool), optional
         Panels with limit lines and whether their limits are common (:attr:`RowSeries.shape`).
+    euler_sequence : str, optional
+        The Euler angles' sequence (:func:`euler_names`); default
+        :data:`scenarios.output.plot_data.EULER_SEQUENCE`.
     """
 
     def __init__(self, n_wheels: int, with_reference: bool, with_target: bool, failed: tuple[int, ...] = (),
                  wheel_axis: tuple[int, ...] = (), wheel_speed: bool = False, dipole: bool = False,
-                 limited: tuple[tuple[str, bool], ...] = ()):
+                 limited: tuple[tuple[str, bool], ...] = (), euler_sequence: str = EULER_SEQUENCE):
         self.shape: RowShape = (n_wheels, with_reference, with_target, tuple(failed), tuple(wheel_axis),
-                                wheel_speed, dipole, tuple(limited))
-        names = ["torque", "rate", "quaternion", "error"]
+                                wheel_speed, dipole, tuple(limited), euler_sequence)
+        names = ["torque", "rate", "quaternion", "euler", "error"]
         names += ["wheel_torque", "wheel_momentum"] if n_wheels else []
         names += ["wheel_speed"] if n_wheels and wheel_speed else []
         names += ["dipole"] if dipole else []
         figsize, margins = row_figure_layout(len(names))
         self.figure = Figure(figsize=figsize, dpi=DPI)
         self.canvas = FigureCanvasAgg(self.figure)
-        axes = self.figure.subplots(len(names), 1, sharex=True)
+        axes = self.figure.subplots(len(names), 1)  # one time axis, drawn on the last panel (see prepare)
         self.figure.subplots_adjust(**margins)  # before the labels
         self.axes = axes
         panel = dict(zip(names, axes))
@@ -224,21 +319,24 @@ class RowFigure:
             return items
 
         axis_colors = list(AXIS_COLORS)
+        euler_label, euler_legend, euler_colors = euler_names(euler_sequence)
         self.torque = curves("torque", 3, axis_colors, "u_{axis}", drawstyle="steps-post")
         self.rate = curves("rate", 3, axis_colors, "ω_{axis}")
-        self.quaternion = [line(axes[2], color=AXIS_COLORS[i], label=f"q{i}") for i in range(4)]
-        self.reference: tuple[list[Any], list[Any], list[Any]] | None = None
+        self.quaternion = [line(panel["quaternion"], color=QUATERNION_COLORS[i], label=f"q{i}") for i in range(4)]
+        self.euler = [line(panel["euler"], color=euler_colors[i], label=euler_legend[i]) for i in range(3)]
+        self.reference: tuple[list[Any], ...] | None = None
         if with_reference:
-            self.reference = ([line(axes[0], "--", color=AXIS_COLORS[i], lw=1) for i in range(3)],
-                              [line(axes[1], "--", color=AXIS_COLORS[i], lw=1) for i in range(3)],
-                              [line(axes[2], "--", color=AXIS_COLORS[i], lw=1) for i in range(4)])
-        _log_axis(axes[3])
-        self.to_target = line(axes[3], color="k", label="to target") if with_target else None
-        self.to_reference = line(axes[3], color="tab:orange", label="to reference") if with_reference else None
+            self.reference = tuple([line(panel[name], "--", color=color, lw=1) for color in colors]
+                                   for name, colors in (("torque", AXIS_COLORS), ("rate", AXIS_COLORS),
+                                                        ("quaternion", QUATERNION_COLORS), ("euler", euler_colors)))
+        error = panel["error"]
+        _log_axis(error)
+        self.to_target = line(error, color="k", label="to target") if with_target else None
+        self.to_reference = line(error, color="tab:orange", label="to reference") if with_reference else None
         self.rate_norm = self.rate_max = None
         if not with_reference and not with_target:  # rate regulation (detumbling): the rate converges
-            self.rate_norm = line(axes[3], color="k", label="‖ω‖")
-            self.rate_max = line(axes[3], color="tab:gray", lw=1, label="max |ω_i|")
+            self.rate_norm = line(error, color="k", label="‖ω‖")
+            self.rate_max = line(error, color="tab:gray", lw=1, label="max |ω_i|")
         colors = wheel_colors(n_wheels, tuple(wheel_axis))
         self.wheel_torque = curves("wheel_torque", n_wheels, colors, "g_w{i}", drawstyle="steps-post")
         self.wheels = curves("wheel_momentum", n_wheels, colors, "h_w{i}")
@@ -262,10 +360,19 @@ class RowFigure:
             self.off_scale[name] = panel[name].text(0.995, 0.96, "", transform=panel[name].transAxes, ha="right",
                                                     va="top", fontsize=7, color="0.3")
         self.panels = panel
-        error_label = "error angle (deg)" if with_reference or with_target else "body rate (rad/s)"
+        labels = {**PANEL_LABELS, "euler": euler_label,
+                  "error": "error angle (deg)" if with_reference or with_target else "body rate (deg/s)"}
+        self.time_grid: list[LineCollection] = []
+        """Vertical grid lines of the panels above the last, at its time ticks: they have no ticks
+        of their own (a tick costs three artists and a text to draw)."""
         for name, axis in panel.items():
-            _label(axis, PANEL_LABELS.get(name, error_label))
-            axis.grid(alpha=0.3)
+            _label(axis, labels[name])
+            if axis is axes[-1]:
+                axis.grid(alpha=0.3)
+            else:
+                axis.xaxis.set_major_locator(NullLocator())
+                axis.grid(alpha=0.3, axis="y")
+                self.time_grid.append(_grid_lines(axis, "x"))
             if any(not item.get_label().startswith("_") for item in axis.get_lines()):
                 # beside the panel: static (drawn once), and never over a curve
                 axis.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, borderaxespad=0.0)
@@ -297,10 +404,10 @@ class RowFigure:
         """
         if series.shape != self.shape:
             raise ValueError(f"a row of shape {series.shape} drawn on a figure of shape {self.shape}")
-        pairs = list(zip(self.torque + self.rate + self.quaternion + self.wheels + self.wheel_torque
+        pairs = list(zip(self.torque + self.rate + self.quaternion + self.euler + self.wheels + self.wheel_torque
                          + self.wheel_speed + self.dipole,
-                         series.torque + series.rate + series.quaternion + series.wheels + series.wheel_torque
-                         + series.wheel_speed + series.dipole))
+                         series.torque + series.rate + series.quaternion + series.euler + series.wheels
+                         + series.wheel_torque + series.wheel_speed + series.dipole))
         if self.reference is not None and series.reference is not None:
             for items, curves in zip(self.reference, series.reference):
                 pairs.extend(zip(items, curves))
@@ -315,6 +422,9 @@ class RowFigure:
         for axis in self.axes:  # fitted to the curves; the limits are added below
             axis.relim()
             axis.autoscale_view()
+        low, high = min(axis.get_xlim()[0] for axis in self.axes), max(axis.get_xlim()[1] for axis in self.axes)
+        for axis in self.axes:  # one time axis
+            axis.set_xlim(low, high, auto=None)
         span = [series.torque[0][0][0], series.torque[0][0][-1]] if series.torque and len(series.torque[0][0]) else []
         for name, index, sign, item in self.limit_lines:
             values = np.asarray(series.limits[name], dtype=float)
@@ -334,10 +444,13 @@ class RowFigure:
             else:
                 common = any(index is None for panel, index, _, _ in self.limit_lines if panel == name)
                 note.set_text(f"{'limit' if common else 'limits up to'} ±{limit:.3g} beyond the view")
-        self.title.set_text(series.title)
+        self.title.set_text("\n".join(textwrap.wrap(series.title, TITLE_CHARS)))
         time_limits = tuple(self.axes[-1].get_xlim())
         canvas, dynamic = self.canvas, self._dynamic()
         if self._background is None or self._background[0] != time_limits:
+            ticks = [t for t in self.axes[-1].xaxis.get_majorticklocs() if low <= t <= high]
+            for lines in self.time_grid:
+                _set_grid_lines(lines, "x", ticks)
             for artist in dynamic:
                 artist.set_visible(False)
             canvas.draw()
@@ -373,8 +486,125 @@ def _write_png(canvas: FigureCanvasAgg, path: Path) -> None:
     image.save(path, format="png", dpi=(DPI, DPI), compress_level=COMPRESS_LEVEL)
 
 
+LEGEND_CHARS = 34
+"""Longest line of a row's label in the comparison figure's legend (a longer label is wrapped)."""
+TITLE_CHARS = 100
+"""Longest line of a row figure's title (a longer one is wrapped)."""
+LINE_STYLES = ("-", "--", "-.", ":")
+"""Line styles of the rows in the comparison figure, in turn with :data:`ROW_COLORS`: rows whose curves
+lie on one another still show (a dashed line over a solid one)."""
+
+
+def _row_style(k: int) -> dict[str, Any]:
+    """Colour, line style and width of row ``k`` in the comparison figure (the first rows widest, so
+    that a later row drawn over them leaves their edges in view)."""
+    return {"color": _row_color(k), "linestyle": LINE_STYLES[k % len(LINE_STYLES)], "lw": max(1.0, 2.2 - 0.4 * k)}
+
+
+def _grid_lines(axis: Any, which: str, values: Any = ()) -> LineCollection:
+    """Grid lines where the axis has no ticks (the look of :meth:`Axes.grid` with ``alpha=0.3``): one
+    collection, out of the data limits (:func:`_set_grid_lines` moves them)."""
+    lines = LineCollection([], colors="#b0b0b0", alpha=0.3, linewidths=0.8, zorder=0.5,
+                           transform=axis.get_xaxis_transform() if which == "x" else axis.get_yaxis_transform())
+    axis.add_collection(lines, autolim=False)
+    _set_grid_lines(lines, which, values)
+    return lines
+
+
+def _set_grid_lines(lines: LineCollection, which: str, values: Any) -> None:
+    """Put grid lines of :func:`_grid_lines` at ``values`` (data coordinates of their axis)."""
+    lines.set_segments([[(v, 0.0), (v, 1.0)] if which == "x" else [(0.0, v), (1.0, v)] for v in values])
+
+
+def overlay_figure(series: OverlaySeries) -> Figure:
+    """The rows overlaid: per body axis (columns x, y, z) the body rate and the wheels' momentum
+    in body axes, the three axes of a quantity on one value scale; below, the torque norm and the
+    error to the target (logarithmic). Each row has its colour and line style; the legend, beside
+    the panels, gives each row's final values. (The torque per axis, with the actuators' limits,
+    is in each row's figure.)
+
+    Parameters
+    ----------
+    series : scenarios.output.plot_data.OverlaySeries
+        The curves (:func:`scenarios.output.plot_data.overlay_series`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, on an Agg canvas.
+    """
+    per_axis = [(series.rate, "body rate (deg/s)")] if any(series.rate) else []
+    if per_axis and any(series.wheel_momentum):
+        per_axis.append((series.wheel_momentum, "wheel momentum (N m s)"))
+    rows = len(per_axis) + 1
+    top, bottom = OVERLAY_EDGES_IN
+    height = rows * OVERLAY_ROW_IN + top + bottom + (OVERLAY_TIME_IN if per_axis else 0.0)
+    figure = Figure(figsize=(OVERLAY_WIDTH_IN, height), dpi=DPI)
+    FigureCanvasAgg(figure)
+    sides = {"left": OVERLAY_MARGINS["left"], "right": OVERLAY_MARGINS["right"]}
+    # the norm and the error below, each with its value axis; the per-axis panels above, close together
+    lower = figure.add_gridspec(1, 2, **sides, wspace=OVERLAY_MARGINS["wspace"], bottom=bottom / height,
+                                top=(bottom + OVERLAY_ROW_IN - OVERLAY_GAP_IN) / height)
+    norm = figure.add_subplot(lower[0, 0])
+    error = figure.add_subplot(lower[0, 1], sharex=norm)
+    _log_axis(error)
+    handles = []
+    for k, (torque, curve) in enumerate(zip(series.torque, series.error)):
+        style = _row_style(k)
+        norm.plot(*torque, drawstyle="steps-post", **style)
+        handles.append(error.plot(*curve, **style)[0])
+    _label(norm, "‖u‖ (N m)")
+    _label(error, series.error_label)
+    for axis in (norm, error):
+        axis.grid(alpha=0.3)
+        _time_axis(axis)
+    # The per-axis panels of a quantity share one value scale, on the x panel's axis, and the time
+    # span of the panels below, its ticks on the last row. Elsewhere their grids are lines at those
+    # ticks: a tick costs three artists and a text to draw, and a panel without ticks draws no label.
+    norm.autoscale_view()
+    limits = norm.get_xlim()
+    times = [t for t in MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]).tick_values(*limits)
+             if limits[0] <= t <= limits[1]]
+    upper = figure.add_gridspec(max(len(per_axis), 1), 3, **sides, wspace=OVERLAY_AXES_WSPACE,
+                                hspace=OVERLAY_GAP_IN / (OVERLAY_ROW_IN - OVERLAY_GAP_IN),
+                                bottom=(bottom + OVERLAY_ROW_IN + OVERLAY_TIME_IN) / height, top=1 - top / height)
+    for r, (curves, label) in enumerate(per_axis):
+        panels = [figure.add_subplot(upper[r, i]) for i in range(3)]
+        for i, axis in enumerate(panels):
+            for k, row in enumerate(curves):
+                if row:
+                    axis.plot(*row[i], **_row_style(k))
+            axis.set_xlim(limits)
+            if r == len(per_axis) - 1:
+                _time_axis(axis, FixedLocator(times))
+                axis.grid(alpha=0.3, axis="x")
+            else:
+                axis.xaxis.set_major_locator(NullLocator())
+                _grid_lines(axis, "x", times)
+            if r == 0:
+                axis.set_title(f"body {'xyz'[i]} axis", fontsize=10)
+        low, high = min(a.get_ylim()[0] for a in panels), max(a.get_ylim()[1] for a in panels)
+        panels[0].set_ylim(low, high)
+        _label(panels[0], label)
+        panels[0].grid(alpha=0.3, axis="y")
+        values = [v for v in panels[0].yaxis.get_majorticklocs() if low <= v <= high]
+        for axis in panels[1:]:
+            axis.set_ylim(low, high)
+            axis.yaxis.set_major_locator(NullLocator())
+            _grid_lines(axis, "y", values)
+    if handles:
+        texts = ["\n".join(textwrap.wrap(label, LEGEND_CHARS))
+                 + ("\n  " + "\n  ".join(final.split(", ")) if final else "")
+                 for label, final in zip(series.labels, series.finals or [""] * len(series.labels))]
+        figure.legend(handles, texts, loc="upper left",
+                      bbox_to_anchor=(OVERLAY_MARGINS["right"] + 0.01, 1 - top / height),
+                      fontsize=8, borderaxespad=0.0, handlelength=3.0, labelspacing=0.9)
+    figure.suptitle(series.title)
+    return figure
+
+
 def draw_overlay(series: OverlaySeries, path: Path) -> None:
-    """Torque norm, and the error to the target, one curve per row.
+    """:func:`overlay_figure` as a PNG.
 
     Parameters
     ----------
@@ -383,22 +613,9 @@ def draw_overlay(series: OverlaySeries, path: Path) -> None:
     path : pathlib.Path
         Where to write the PNG.
     """
-    figure = Figure(figsize=OVERLAY_FIGSIZE_IN)
-    top, bottom = figure.subplots(2, 1, sharex=True)
-    figure.subplots_adjust(**OVERLAY_MARGINS)  # before the labels
-    _log_axis(bottom)
-    for label, torque, error in zip(series.labels, series.torque, series.error):
-        top.plot(*torque, drawstyle="steps-post", label=label)
-        bottom.plot(*error, label=label)
-    _label(top, "‖u‖ (N m)")
-    _label(bottom, series.error_label)
-    for axis in (top, bottom):
-        axis.grid(alpha=0.3)
-    if top.get_lines():  # one legend: both panels have the same rows in the same colours
-        top.legend(fontsize=8, loc="upper right")
-    figure.suptitle(series.title)
-    _time_axis(bottom)
-    figure.savefig(path, **SAVE)
+    canvas = FigureCanvasAgg(overlay_figure(series))
+    canvas.draw()
+    _write_png(canvas, path)  # RGB, one draw
 
 
 def _row_color(k: int) -> str:
@@ -664,7 +881,8 @@ DRAW: dict[type, Callable[[Any, Path], None]] = {OverlaySeries: draw_overlay, Ma
 """How each kind of series other than a row is drawn."""
 
 
-def write_plots(results: Any, directory: Path, stems: list[str] | None = None) -> None:
+def write_plots(results: Any, directory: Path, stems: list[str] | None = None,
+                euler_sequence: str = EULER_SEQUENCE) -> None:
     """The figures of :func:`scenarios.output.plot_data.plot_jobs`: one PNG per simulated row
     (``<stem>.png``), ``margins.png`` and ``sky.png`` with pointing requirements, and ``comparison.png``.
 
@@ -676,5 +894,8 @@ def write_plots(results: Any, directory: Path, stems: list[str] | None = None) -
         Existing directory to write into.
     stems : list of str, optional
         The rows' file stems; ``None``: ``row_stems`` of the labels.
+    euler_sequence : str, optional
+        The row figures' Euler sequence (:func:`scenarios.output.plot_data.euler_angles`), such as
+        ``"313"``; default ``"321"``.
     """
-    draw_jobs(plot_jobs(results, stems), directory)
+    draw_jobs(plot_jobs(results, stems, euler_sequence), directory)

@@ -315,6 +315,8 @@ class _Engine:
             from tqdm import tqdm
             self.bar = tqdm(total=len(self.cases), unit="case", desc=study.name[:40], dynamic_ncols=True,
                             disable=not sys.stderr.isatty(), file=sys.stderr, mininterval=0.5)
+            if not self.bar.disable and not (self.bar.ncols or 0) > 0:  # a terminal reporting no size (0 x 0):
+                self.bar.dynamic_ncols, self.bar.ncols, self.bar.nrows = False, 80, None  # tqdm would draw nothing
 
     # --- submitting ---------------------------------------------------------------------------
 

@@ -1,35 +1,122 @@
-"""Figures of a trade study (matplotlib, Agg): a summary metric against each numeric 1-D grid
+"""Figures of a trade study (matplotlib, Agg): each summary metric against each numeric grid
 parameter (one line per planner, median with the 5-95 % band under Monte Carlo), heat maps over a
-2-D grid, box plots and empirical CDFs across Monte Carlo samples, and a Pareto front per planner."""
+2-D grid (one colour scale shared by the planners), box plots, empirical CDFs and scatter plots
+against each dispersed parameter across Monte Carlo samples, and the Pareto front of each grid point.
+
+Every axis names its quantity in words with its unit: a metric or requirement column by
+:func:`scenarios.output.plot_data.column_quantity`, a varied scenario path by
+:func:`parameter_quantity` (the schema's unit of the key; the angle in degrees for a grid of
+``axis_angle`` quaternions). A quantity spanning :data:`DECADES` decades or more is drawn on a
+logarithmic axis. Rows whose status is ``failed`` or ``crashed`` have no value and are marked (×,
+hatched cells); ``violated`` rows completed and are drawn."""
 from __future__ import annotations
 
+import functools
+import json
 import math
+import re
+import textwrap
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 import matplotlib
+from matplotlib.colors import LogNorm, Normalize
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Rectangle
+from matplotlib.transforms import blended_transform_factory
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
 from scenarios.output.names import row_stems
+from scenarios.output.plot_data import axis_label, column_quantity
 from scenarios.output.tables import is_missing
+from scenarios.study.paths import Step, get_path, parse_path
 from scenarios.study.types import Study
 
-PARETO_AXES = ("cl.int_u", "cl.settling_time_s")
+__all__ = ["DECADES", "PARETO_AXES", "PLOTTED_STATUSES", "RECORDED", "figures", "parameter_quantity", "pareto_front",
+           "spans_decades", "write_plots"]
 
+PARETO_AXES = ("cl.int_u", "cl.settling_time_s")
+"""The two metrics of the Pareto fronts (both to be minimised)."""
+PLOTTED_STATUSES = ("ok", "violated")
+"""Statuses of the rows whose metrics are drawn: the motion completed (a broken requirement is a result
+and its metrics stand); ``failed`` and ``crashed`` rows are marked instead."""
+DECADES = 2.0
+"""A quantity whose positive values span this many decades or more (largest over smallest >= 100)
+is drawn on a logarithmic axis."""
+MAX_PARETO_PANELS = 30
+"""Most grid points given a Pareto panel (the first ones, in grid order)."""
+MAX_GROUPS = 12
+"""Most (grid point, planner) groups in the box plots and CDFs; with more, each planner's cases are
+pooled over the grid points (and the title says so)."""
+MAX_ANNOTATED_CELLS = 64
+"""Heat map panels with at most this many cells print each cell's value."""
+FAILED_MARK: dict[str, Any] = {"marker": "x", "linestyle": "none", "markersize": 7, "markeredgewidth": 1.6}
+"""How a grid point or case with a failed row is marked (at the bottom of the panel, in the planner's colour)."""
+UNKNOWN_UNIT = "YAML units"
+"""The unit given to a varied path the schema does not describe."""
+DPI = 110
+
+
+# --- values -----------------------------------------------------------------------------------------
 
 def _value(row: dict[str, Any], key: str) -> float:
-    """A plotted value: NaN when missing or non-finite (the tables' rule) or when the row is not ok."""
+    """A plotted value: NaN when missing or non-finite (the tables' rule) or when the row did not complete."""
     value = row.get(key)
-    if row.get("status") != "ok" or isinstance(value, bool) or not isinstance(value, (int, float)) or is_missing(value):
+    if (row.get("status") not in PLOTTED_STATUSES or isinstance(value, bool) or not isinstance(value, (int, float))
+            or is_missing(value)):
         return math.nan
     return float(value)
 
 
+def _failed(row: dict[str, Any]) -> bool:
+    return row.get("status") not in PLOTTED_STATUSES
+
+
+def _finite(values: Any) -> np.ndarray:
+    array = np.asarray(values, dtype=float).ravel()
+    return array[np.isfinite(array)]
+
+
+def _median(values: Any) -> float:
+    """Median of the finite values; NaN when there are none (without NumPy's all-NaN warning)."""
+    finite = _finite(values)
+    return float(np.median(finite)) if finite.size else math.nan
+
+
+def _percentile(values: Any, q: float) -> float:
+    finite = _finite(values)
+    return float(np.percentile(finite, q)) if finite.size else math.nan
+
+
+def spans_decades(values: Any) -> bool:
+    """Whether values are drawn on a logarithmic axis.
+
+    Parameters
+    ----------
+    values : array_like
+        The values of one axis (non-finite ones ignored).
+
+    Returns
+    -------
+    bool
+        At least two finite values, all positive, the largest at least ``10**DECADES`` times the smallest.
+    """
+    finite = _finite(values)
+    return bool(finite.size > 1 and finite.min() > 0 and finite.max() >= 10.0 ** DECADES * finite.min())
+
+
 def _labels(rows: list[dict[str, Any]]) -> list[str]:
     return list(dict.fromkeys(row["label"] for row in rows))
+
+
+def _colors(labels: list[str]) -> dict[str, Any]:
+    cycle = [f"C{k % 10}" for k in range(len(labels))]
+    return dict(zip(labels, cycle))
 
 
 def _numeric_axes(study: Study, rows: list[dict[str, Any]]) -> list[tuple[str, list[float]]]:
@@ -41,98 +128,392 @@ def _numeric_axes(study: Study, rows: list[dict[str, Any]]) -> list[tuple[str, l
     return axes
 
 
-def _grid(count: int) -> tuple[plt.Figure, Any]:
+def _with_values(study: Study, rows: list[dict[str, Any]]) -> list[str]:
+    """The summary metrics that have a value in some row (a metric that does not apply to any row,
+    such as a reference's peak actuator torque, has no panel)."""
+    return [metric for metric in study.summary if np.isfinite([_value(r, metric) for r in rows]).any()]
+
+
+# --- axis names -------------------------------------------------------------------------------------
+
+KEY_WORDS = {"q": "attitude", "omega": "rate"}
+"""Scenario keys that read better as words on an axis."""
+
+
+def _entry(study: Study, steps: list[Step], path: str) -> Any:
+    """What the base scenario holds along ``steps``; None where it holds nothing (a path the study
+    sets but its base lacks)."""
+    from scenarios.errors import ScenarioError
+
+    try:
+        return get_path(study.base, steps, path)
+    except ScenarioError:
+        return None
+
+
+def _path_words(study: Study, path: str) -> str:
+    """A scenario path in words: keys spaced, ``options`` and unit suffixes dropped, a list entry by
+    its label (or name), the first key dropped when three or more words remain."""
+    steps = parse_path(path, path)
+    words: list[str] = []
+    for number, step in enumerate(steps):
+        if isinstance(step, str):
+            if step != "options":
+                words.append(KEY_WORDS.get(step, step.removesuffix("_deg").removesuffix("_s")))
+            continue
+        entry = _entry(study, steps[:number + 1], path)
+        words.append(str(entry.get("label") or entry.get("name")) if isinstance(entry, dict)
+                     else str(step[1] if isinstance(step, tuple) else step))
+    if len(words) >= 3:
+        words = words[1:]
+    return " ".join(words).replace("_", " ")
+
+
+@functools.lru_cache(maxsize=1)
+def _schema_units() -> tuple[dict[str, str], dict[str, str]]:
+    """Units of the scenario keys by YAML path (list indices dropped) and of the registry entries'
+    options by reference key (``planners.<planner>.<option>``), from the schema reference."""
+    from scenarios.schema.reference import reference_parts
+
+    by_path, by_key = {}, {}
+    for part in reference_parts():
+        for entry in part.entries:
+            if part.group == "Scenario file":
+                by_path[re.sub(r"\[[^\]]*\]", "", entry.path)] = entry.unit
+            else:
+                by_key[entry.key] = entry.unit
+    return by_path, by_key
+
+
+_REGISTRY_KEYS = {"planners": "planners", "controller": "controller", "controllers": "controller"}
+"""First key of a path into a registry entry's options -> the reference's key prefix."""
+
+
+def _schema_unit(study: Study, path: str) -> str | None:
+    """The unit the schema gives the key at ``path`` (empty: none); None when it does not describe it."""
+    steps: list[Step] = parse_path(path, path)
+    keys = [step for step in steps if isinstance(step, str)]
+    by_path, by_key = _schema_units()
+    if keys[0] in _REGISTRY_KEYS and "options" in keys and keys[-1] != "options":
+        entry = _entry(study, steps[:steps.index("options")], path)
+        name = entry.get("name") if isinstance(entry, dict) else None
+        return by_key.get(f"{_REGISTRY_KEYS[keys[0]]}.{name}.{keys[-1]}")
+    if keys[:2] == ["environment", "magnetic_field"] and len(keys) == 3:
+        field = study.base.get("environment", {}).get("magnetic_field")
+        model = field.get("model") if isinstance(field, dict) else field
+        found = by_key.get(f"environment.magnetic_field.{model}.{keys[2]}")
+        if found is not None:
+            return found
+    return by_path.get(".".join(keys))
+
+
+def _vector_text(values: Any) -> str:
+    return "[" + ", ".join(f"{float(v):.3g}" for v in values) + "]"
+
+
+def _axis_angle_quantity(study: Study, path: str, argument: dict[str, Any]) -> tuple[str, str]:
+    """``axis_angle`` quaternions are recorded as their angle [deg]: the slew angle for the final
+    attitude from an initial one at the identity."""
+    initial = study.base.get("maneuver", {}).get("initial", {}) or {}
+    identity = [0.0, 0.0, 0.0, 1.0] if study.base.get("maneuver", {}).get("quaternion_order") == "scalar_last" \
+        else [1.0, 0.0, 0.0, 0.0]
+    q0 = initial.get("q") if isinstance(initial, dict) else None
+    about = f"about {_vector_text(argument.get('axis', []))}"
+    if path == "maneuver.final.q" and (q0 is None or np.allclose(np.asarray(q0, dtype=float), identity)):
+        return f"slew angle {about}", "deg"
+    return f"{_path_words(study, path)}: rotation angle {about}", "deg"
+
+
+RECORDED: dict[str, Callable[[Study, str, dict[str, Any]], tuple[str, str]]] = {"axis_angle": _axis_angle_quantity}
+"""Value generators (:data:`scenarios.schema.study.VALUE_GENERATORS`) whose recorded value is not the value
+set into the scenario: generator name -> ``(study, path, argument) -> (words, unit)`` of what the tables record."""
+
+
+def parameter_quantity(study: Study, path: str) -> tuple[str, str]:
+    """What a varied scenario path's column holds, for an axis: its name in words and its unit.
+
+    Parameters
+    ----------
+    study : Study
+        The study (its base scenario, and its ``grid`` and ``zip`` entries as given).
+    path : str
+        A varied path (:attr:`Study.varied_paths`).
+
+    Returns
+    -------
+    name : str
+        For example ``"simulation sample time"``, ``"spin extremal weight"``, ``"slew angle about [1, 1, 1]"``.
+    unit : str
+        The schema's unit of the key (``"s"``, ``"1/(N² m² s)"``; ``"–"`` for a key without one), the
+        unit of what a value generator records (:data:`RECORDED`), or :data:`UNKNOWN_UNIT`.
+    """
+    given = {**(study.raw.get("grid") or {}), **(study.raw.get("zip") or {})}.get(path)
+    if isinstance(given, dict) and len(given) == 1:
+        (kind, argument), = given.items()
+        if kind in RECORDED and isinstance(argument, dict):
+            return RECORDED[kind](study, path, argument)
+    unit = _schema_unit(study, path)
+    return _path_words(study, path), UNKNOWN_UNIT if unit is None else (unit or "–")
+
+
+def _metric_label(metric: str) -> str:
+    return axis_label(*column_quantity(metric))
+
+
+def _point_text(study: Study, point: dict[str, Any]) -> str:
+    """A grid point in words: ``slew angle about [1, 1, 1] 90 deg``."""
+    parts = []
+    for path, value in point.items():
+        name, unit = parameter_quantity(study, path)
+        shown = f"{value:g}" if isinstance(value, (int, float)) else str(value)
+        parts.append(f"{name} {shown}" + ("" if unit in ("–", UNKNOWN_UNIT) else f" {unit}"))
+    return ", ".join(parts)
+
+
+# --- figures ----------------------------------------------------------------------------------------
+
+def _grid(count: int, width: float = 5.0, height: float = 3.8) -> tuple[Figure, list[Any]]:
+    """A figure of ``count`` panels, three a row (smaller ones beyond nine), with room for a legend right."""
     cols = min(count, 3)
-    fig, axes = plt.subplots(math.ceil(count / cols), cols, figsize=(5 * cols, 3.8 * math.ceil(count / cols)),
-                             squeeze=False)
-    for axis in axes.flat[count:]:
+    rows = math.ceil(count / cols)
+    if count > 9:
+        width, height = 0.8 * width, 0.8 * height
+    figure = plt.figure(figsize=(max(width * cols + 2.4, 8.0), height * rows + 0.9), layout="constrained")
+    axes = figure.subplots(rows, cols, squeeze=False).ravel()
+    for axis in axes[count:]:
         axis.set_visible(False)
-    return fig, axes.flat
+    return figure, list(axes[:count])
 
 
-def _save(fig: plt.Figure, directory: Path, name: str) -> str:
-    fig.tight_layout()
-    temporary = directory / f".{name}.partial.png"
-    fig.savefig(temporary, dpi=110)
-    plt.close(fig)
-    temporary.replace(directory / name)
-    return name
+def _title(figure: Figure, text: str) -> None:
+    """The figure's title, wrapped to its width."""
+    figure.suptitle(textwrap.fill(text, max(40, int((figure.get_figwidth() - 2.0) * 9))))
 
 
-def _lines(study: Study, rows: list[dict[str, Any]], directory: Path) -> list[str]:
-    written = []
+def _scale(axis: Any, which: str, values: Any) -> None:
+    """A logarithmic x or y axis when ``values`` span :data:`DECADES` decades."""
+    if spans_decades(values):
+        (axis.set_xscale if which == "x" else axis.set_yscale)("log")
+
+
+def _mark_failed(axis: Any, xs: list[float], color: Any) -> None:
+    """× at the bottom of the panel at each x with a failed row."""
+    if xs:
+        axis.plot(xs, [0.03] * len(xs), color=color,
+                  transform=blended_transform_factory(axis.transData, axis.transAxes),
+                  clip_on=False, **FAILED_MARK)
+
+
+def _legend(figure: Figure, colors: dict[str, Any], failed: bool, extra: list[Any] | None = None,
+            style: str = "o-") -> None:
+    """The planners' colours (and the failed mark) beside the panels."""
+    line: Any = style[1:] or "none"
+    handles = [Line2D([], [], color=color, marker=style[0], linestyle=line, label=label)
+               for label, color in colors.items()]
+    if failed:
+        handles.append(Line2D([], [], color="0.3", label="failed row (no value)", **FAILED_MARK))
+    handles += extra or []
+    figure.legend(handles=handles, loc="outside right upper", fontsize=8)
+
+
+def _lines(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figure]]:
+    metrics = _with_values(study, rows)
     axes_1d = _numeric_axes(study, rows)
+    if not metrics:
+        return
+    spread = study.samples > 1 or len(study.grid_paths) > 1
+    labels = _labels(rows)
+    colors = _colors(labels)
     for (path, xs), stem in zip(axes_1d, row_stems([path for path, _ in axes_1d])):
-        fig, axes = _grid(len(study.summary))
-        for axis, metric in zip(axes, study.summary):
-            for label in _labels(rows):
-                per_x = [[_value(r, metric) for r in rows if r["label"] == label and r[path] == x] for x in xs]
-                median = [np.nanmedian(v) if np.isfinite(v).any() else np.nan for v in per_x]
-                line, = axis.plot(xs, median, "o-", label=label)
-                if study.samples > 1 or len(study.grid_paths) > 1:
-                    low = [np.nanpercentile(v, 5) if np.isfinite(v).any() else np.nan for v in per_x]
-                    high = [np.nanpercentile(v, 95) if np.isfinite(v).any() else np.nan for v in per_x]
-                    axis.fill_between(xs, low, high, color=line.get_color(), alpha=0.15)
-            axis.set_xlabel(path)
-            axis.set_ylabel(metric)
+        figure, axes = _grid(len(metrics))
+        any_failed = False
+        for axis, metric in zip(axes, metrics):
+            drawn: list[float] = []
+            for label in labels:
+                groups = [[r for r in rows if r["label"] == label and r[path] == x] for x in xs]
+                values = [[_value(r, metric) for r in group] for group in groups]
+                median = [_median(v) for v in values]
+                axis.plot(xs, median, "o-", color=colors[label], ms=4)
+                drawn += median
+                if spread:
+                    low, high = [_percentile(v, 5) for v in values], [_percentile(v, 95) for v in values]
+                    axis.fill_between(xs, low, high, color=colors[label], alpha=0.15, lw=0)
+                    drawn += low + high
+                failed = [x for x, group in zip(xs, groups) if any(_failed(r) for r in group)]
+                _mark_failed(axis, failed, colors[label])
+                any_failed |= bool(failed)
+            _scale(axis, "x", xs)
+            _scale(axis, "y", drawn)
+            axis.set_xlabel(axis_label(*parameter_quantity(study, path)))
+            axis.set_ylabel(_metric_label(metric))
             axis.grid(alpha=0.3)
-        axes[0].legend(fontsize=8)
-        fig.suptitle(f"{study.name}: median over the other parameters and samples (band 5-95 %)"
-                     if study.samples > 1 or len(study.grid_paths) > 1 else study.name)
-        written.append(_save(fig, directory, f"metrics_vs_{stem}.png"))
-    return written
+        _legend(figure, colors, any_failed)
+        _title(figure, f"{study.name}: median over the other parameters and samples (band 5-95 %)"
+               if spread else study.name)
+        yield f"metrics_vs_{stem}.png", figure
 
 
-def _heat_maps(study: Study, rows: list[dict[str, Any]], directory: Path) -> list[str]:
+def _cell_text(value: float) -> str:
+    return f"{value:.3g}"
+
+
+def _heat_maps(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figure]]:
     axes_2d = _numeric_axes(study, rows)
     if len(study.grid_paths) != 2 or len(axes_2d) != 2:
-        return []
+        return
     (px, xs), (py, ys) = axes_2d
-    written = []
+    labels = _labels(rows)
+    cells = {(label, x, y): [] for label in labels for x in xs for y in ys}  # type: dict[tuple, list]
+    for row in rows:
+        cells[(row["label"], row[px], row[py])].append(row)
     for metric, stem in zip(study.summary, row_stems(study.summary)):
-        labels = _labels(rows)
-        fig, axes = _grid(len(labels))
+        grids = {label: np.array([[_median([_value(r, metric) for r in cells[(label, x, y)]]) for x in xs] for y in ys])
+                 for label in labels}
+        finite = _finite(np.concatenate([grid.ravel() for grid in grids.values()]))
+        if not finite.size:
+            continue
+        norm = (LogNorm(finite.min(), finite.max()) if spans_decades(finite)
+                else Normalize(finite.min(), finite.max() if finite.max() > finite.min() else finite.min() + 1.0))
+        figure, axes = _grid(len(labels), 4.6, 3.9)
+        image = None
         for axis, label in zip(axes, labels):
-            grid = np.array([[np.nanmedian([_value(r, metric) for r in rows if r["label"] == label
-                                            and r[px] == x and r[py] == y] or [np.nan]) for x in xs] for y in ys])
-            image = axis.imshow(grid, origin="lower", aspect="auto", cmap="viridis")
+            grid = grids[label]
+            image = axis.imshow(grid, origin="lower", aspect="auto", cmap="viridis", norm=norm)
+            for j, y in enumerate(ys):
+                for i, x in enumerate(xs):
+                    members = cells[(label, x, y)]
+                    failures = sum(_failed(r) for r in members)
+                    if not np.isfinite(grid[j, i]):
+                        axis.add_patch(Rectangle((i - 0.5, j - 0.5), 1, 1, facecolor="0.92", edgecolor="0.45",
+                                                 hatch="xx", lw=0))
+                        axis.text(i, j, "failed" if failures else "no value", ha="center", va="center", fontsize=7,
+                                  color="0.25")
+                        continue
+                    if grid.size <= MAX_ANNOTATED_CELLS:
+                        shade = image.cmap(image.norm(grid[j, i]))
+                        axis.text(i, j, _cell_text(grid[j, i]), ha="center", va="center", fontsize=7,
+                                  color="k" if 0.299 * shade[0] + 0.587 * shade[1] + 0.114 * shade[2] > 0.5 else "w")
+                    if failures:
+                        axis.text(i + 0.45, j + 0.45, f"× {failures}", ha="right", va="top", fontsize=7,
+                                  color="tab:red", fontweight="bold")
             axis.set_xticks(range(len(xs)), [f"{x:.3g}" for x in xs])
             axis.set_yticks(range(len(ys)), [f"{y:.3g}" for y in ys])
-            axis.set_xlabel(px)
-            axis.set_ylabel(py)
+            axis.set_xlabel(axis_label(*parameter_quantity(study, px)))
+            axis.set_ylabel(axis_label(*parameter_quantity(study, py)))
             axis.set_title(label)
-            fig.colorbar(image, ax=axis, label=metric)
-        written.append(_save(fig, directory, f"heatmap_{stem}.png"))
-    return written
+        assert image is not None  # one panel per planner, at least one
+        figure.colorbar(image, ax=axes, label=_metric_label(metric))
+        _title(figure, f"{study.name}: median per grid point (one colour scale for every planner; "
+                       "× n: rows that failed; hatched: no value)")
+        yield f"heatmap_{stem}.png", figure
 
 
-def _monte_carlo(study: Study, rows: list[dict[str, Any]], directory: Path) -> list[str]:
-    if study.samples <= 1:
-        return []
+def _sample_groups(study: Study, rows: list[dict[str, Any]]) -> tuple[list[tuple[str, Any, list[dict[str, Any]]]], str]:
+    """Groups of Monte Carlo cases: per grid point and planner when there are few, else per planner
+    (pooled over the grid points); each ``(name, planner label, rows)``, and a note for the title."""
     labels = _labels(rows)
-    fig, axes = _grid(len(study.summary))
-    for axis, metric in zip(axes, study.summary):
-        data = [[v for v in (_value(r, metric) for r in rows if r["label"] == label) if math.isfinite(v)]
-                for label in labels]
-        axis.boxplot([d or [np.nan] for d in data], showfliers=True)
-        axis.set_xticks(range(1, len(labels) + 1), labels, rotation=20, fontsize=8)
-        axis.set_ylabel(metric)
-        axis.grid(alpha=0.3)
-    fig.suptitle(f"{study.name}: {study.samples} Monte Carlo samples per grid point")
-    written = [_save(fig, directory, "boxplots.png")]
-    fig, axes = _grid(len(study.summary))
-    for axis, metric in zip(axes, study.summary):
+    points = list(dict.fromkeys(json.dumps([row.get(p) for p in study.grid_paths]) for row in rows))
+    if len(points) <= 1 or len(points) * len(labels) > MAX_GROUPS:
+        note = f"; pooled over {len(points)} grid points" if len(points) > 1 else ""
+        return [(label, label, [r for r in rows if r["label"] == label]) for label in labels], note
+    groups = []
+    for point in points:
+        values = dict(zip(study.grid_paths, json.loads(point)))
+        members = [r for r in rows if json.dumps([r.get(p) for p in study.grid_paths]) == point]
         for label in labels:
-            values = np.sort([v for v in (_value(r, metric) for r in rows if r["label"] == label) if math.isfinite(v)])
-            if values.size:
-                axis.step(values, np.arange(1, values.size + 1) / values.size, where="post", label=label)
-        axis.set_xlabel(metric)
-        axis.set_ylabel("fraction of cases ≤ x")
+            groups.append((f"{label}\n{_point_text(study, values)}", label,
+                           [r for r in members if r["label"] == label]))
+    return groups, ""
+
+
+def _monte_carlo(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figure]]:
+    if study.samples <= 1:
+        return
+    metrics = _with_values(study, rows)
+    if not metrics:
+        return
+    groups, note = _sample_groups(study, rows)
+    colors = _colors(_labels(rows))
+    figure, axes = _grid(len(metrics))
+    for axis, metric in zip(axes, metrics):
+        data = [_finite([_value(r, metric) for r in members]) for _, _, members in groups]
+        positions = [k + 1 for k, values in enumerate(data) if values.size]
+        if positions:
+            axis.boxplot([data[k - 1] for k in positions], positions=positions, showfliers=True)
+        axis.set_xticks(range(1, len(groups) + 1), [name for name, _, _ in groups], rotation=20, fontsize=7,
+                        ha="right")
+        axis.set_xlim(0.5, len(groups) + 0.5)
+        _scale(axis, "y", np.concatenate(data) if data else [])
+        axis.set_ylabel(_metric_label(metric))
         axis.grid(alpha=0.3)
-    axes[0].legend(fontsize=8)
-    fig.suptitle(f"{study.name}: empirical CDFs")
-    written.append(_save(fig, directory, "cdf.png"))
-    return written
+    _title(figure, f"{study.name}: {study.samples} Monte Carlo samples per grid point{note}")
+    yield "boxplots.png", figure
+    figure, axes = _grid(len(metrics))
+    for axis, metric in zip(axes, metrics):
+        for name, label, members in groups:
+            values = np.sort(_finite([_value(r, metric) for r in members]))
+            if values.size:  # over every case of the group: failed ones keep the curve below 1
+                fraction = np.arange(1, values.size + 1) / len(members)
+                axis.step(values, fraction, where="post", color=colors[label],
+                          label=name.replace("\n", ", ") + (f" ({len(members) - values.size} without a value)"
+                                                             if values.size < len(members) else ""))
+        _scale(axis, "x", np.concatenate([_finite([_value(r, metric) for r in m]) for _, _, m in groups]))
+        axis.set_xlabel(_metric_label(metric))
+        axis.set_ylabel("fraction of cases ≤ x (–)")
+        axis.set_ylim(0.0, 1.02)
+        axis.grid(alpha=0.3)
+    handles, texts = axes[0].get_legend_handles_labels()
+    figure.legend(handles, texts, loc="outside right upper", fontsize=8)
+    _title(figure, f"{study.name}: empirical CDFs over every case (a failed case has no value){note}")
+    yield "cdf.png", figure
+    yield from _scatter(study, rows, metrics, colors)
+
+
+def _dispersed(study: Study, row: dict[str, Any], path: str) -> float:
+    """A dispersed value as a number: a scalar, or a vector's norm (stored as JSON text)."""
+    value = row.get(path)
+    if isinstance(value, str):
+        try:
+            value = json.loads(value)
+        except ValueError:
+            return math.nan
+    if isinstance(value, list):
+        try:
+            return float(np.linalg.norm(np.asarray(value, dtype=float)))
+        except (TypeError, ValueError):
+            return math.nan
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else math.nan
+
+
+def _scatter(study: Study, rows: list[dict[str, Any]], metrics: list[str],
+             colors: dict[str, Any]) -> Iterator[tuple[str, Figure]]:
+    """Each summary metric against each dispersed parameter (a vector's norm); case seeds are not parameters."""
+    dispersions = (study.raw.get("monte_carlo") or {}).get("dispersions") or {}
+    paths = [p for p in study.mc_paths if dispersions.get(p) != "case_seed"]
+    for path, stem in zip(paths, row_stems(paths)):
+        xs = np.array([_dispersed(study, r, path) for r in rows])
+        if not np.isfinite(xs).any():
+            continue
+        vector = any(isinstance(r.get(path), (str, list)) for r in rows)
+        name, unit = parameter_quantity(study, path)
+        figure, axes = _grid(len(metrics))
+        any_failed = False
+        for axis, metric in zip(axes, metrics):
+            ys = np.array([_value(r, metric) for r in rows])
+            for label, color in colors.items():
+                mine = np.array([r["label"] == label for r in rows])
+                axis.plot(xs[mine], ys[mine], ".", color=color, ms=4, alpha=0.6)
+                failed = mine & np.array([_failed(r) for r in rows])
+                _mark_failed(axis, list(xs[failed]), color)
+                any_failed |= bool(failed.any())
+            _scale(axis, "x", xs)
+            _scale(axis, "y", ys)
+            axis.set_xlabel(axis_label(f"‖{name}‖" if vector else name, unit))
+            axis.set_ylabel(_metric_label(metric))
+            axis.grid(alpha=0.3)
+        _legend(figure, colors, any_failed, style=".")
+        _title(figure, f"{study.name}: each case against {'the norm of ' if vector else ''}{name}")
+        yield f"scatter_{stem}.png", figure
 
 
 def pareto_front(points: np.ndarray) -> np.ndarray:
@@ -159,25 +540,86 @@ def pareto_front(points: np.ndarray) -> np.ndarray:
     return np.array(front).reshape(-1, 2)
 
 
-def _pareto(study: Study, rows: list[dict[str, Any]], directory: Path) -> list[str]:
+def _pareto(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figure]]:
     x_key, y_key = PARETO_AXES
-    fig, axis = plt.subplots(figsize=(7, 5))
-    for label in _labels(rows):
-        points = np.array([[_value(r, x_key), _value(r, y_key)] for r in rows if r["label"] == label])
-        if not np.isfinite(points).all(axis=1).any():
-            continue
-        line, = axis.step(*pareto_front(points).T, where="post", lw=1.5)
-        axis.scatter(points[:, 0], points[:, 1], s=10, alpha=0.4, color=line.get_color(), label=label)
-    axis.set_xlabel(f"{x_key} (N m s)")
-    axis.set_ylabel(f"{y_key} (s)")
-    axis.set_title(f"{study.name}: cases and Pareto front per planner")
-    axis.grid(alpha=0.3)
-    axis.legend(fontsize=8)
-    return [_save(fig, directory, "pareto.png")]
+    labels = _labels(rows)
+    colors = _colors(labels)
+    points: dict[str, list[dict[str, Any]]] = {}
+    for row in rows:
+        points.setdefault(json.dumps([row.get(p) for p in study.grid_paths]), []).append(row)
+    usable = [(key, members) for key, members in points.items()
+              if np.isfinite([[_value(r, x_key), _value(r, y_key)] for r in members]).all(axis=1).any()]
+    if not usable:
+        return
+    shown = usable[:MAX_PARETO_PANELS]
+    figure, axes = _grid(len(shown), 4.6, 3.6)
+    for axis, (key, members) in zip(axes, shown):
+        missing = []
+        for label in labels:
+            mine = np.array([[_value(r, x_key), _value(r, y_key)] for r in members
+                             if r["label"] == label]).reshape(-1, 2)
+            axis.plot(mine[:, 0], mine[:, 1], "o", color=colors[label], ms=5 if study.samples == 1 else 3,
+                      alpha=1.0 if study.samples == 1 else 0.5)
+            lacking = int(np.sum(~np.isfinite(mine).all(axis=1)))
+            if lacking:
+                missing.append(f"{label}: {lacking}" if study.samples > 1 else label)
+        if missing:  # a row that failed, or did not settle: no point
+            axis.text(0.98, 0.02, "no value: " + ", ".join(missing), transform=axis.transAxes, ha="right",
+                      va="bottom", fontsize=7, color="0.3")
+        every = np.array([[_value(r, x_key), _value(r, y_key)] for r in members])
+        front = pareto_front(every)
+        axis.step(front[:, 0], front[:, 1], where="post", color="k", lw=1.2)
+        axis.plot(front[:, 0], front[:, 1], "o", mfc="none", mec="k", ms=9)
+        _scale(axis, "x", every[:, 0])
+        _scale(axis, "y", every[:, 1])
+        axis.set_xlabel(_metric_label(x_key))
+        axis.set_ylabel(_metric_label(y_key))
+        if study.grid_paths:
+            axis.set_title(_point_text(study, dict(zip(study.grid_paths, json.loads(key)))), fontsize=8)
+        axis.grid(alpha=0.3)
+    front_handle = Line2D([], [], color="k", marker="o", mfc="none", ms=9, label="Pareto front")
+    _legend(figure, colors, False, [front_handle], style="o")
+    more = f" (the first {len(shown)} of {len(usable)} grid points)" if len(shown) < len(usable) else ""
+    _title(figure, f"{study.name}: every case and the Pareto front "
+           + ("of each grid point, all planners together" if study.grid_paths else "of all planners together") + more)
+    yield "pareto.png", figure
+
+
+def figures(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figure]]:
+    """Every figure that applies to the study, one at a time (the caller closes each).
+
+    Parameters
+    ----------
+    study : Study
+        The study (its grid paths, samples and summary metrics choose the figures).
+    rows : list of dict
+        The ``cases.csv`` rows (:func:`scenarios.study.report.case_table`).
+
+    Yields
+    ------
+    name : str
+        The PNG's file name.
+    figure : matplotlib.figure.Figure
+        The figure (pyplot's: close it with ``matplotlib.pyplot.close``).
+    """
+    yield from _lines(study, rows)
+    yield from _heat_maps(study, rows)
+    yield from _monte_carlo(study, rows)
+    yield from _pareto(study, rows)
+
+
+def _save(figure: Figure, directory: Path, name: str) -> str:
+    temporary = directory / f".{name}.partial.png"
+    try:
+        figure.savefig(temporary, dpi=DPI)
+    finally:
+        plt.close(figure)
+    temporary.replace(directory / name)
+    return name
 
 
 def write_plots(study: Study, rows: list[dict[str, Any]], directory: Path) -> list[str]:
-    """Every figure that applies to the study.
+    """Every figure that applies to the study (:func:`figures`), as PNG files.
 
     Parameters
     ----------
@@ -193,5 +635,4 @@ def write_plots(study: Study, rows: list[dict[str, Any]], directory: Path) -> li
     list of str
         The file names written in ``directory``.
     """
-    return (_lines(study, rows, directory) + _heat_maps(study, rows, directory)
-            + _monte_carlo(study, rows, directory) + _pareto(study, rows, directory))
+    return [_save(figure, directory, name) for name, figure in figures(study, rows)]

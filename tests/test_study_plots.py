@@ -1,0 +1,249 @@
+"""The figures of a trade study (issue 31): axes named in words with their units, one colour scale
+for every planner of a heat map, failed cells and points marked, logarithmic axes where a quantity
+spans decades, a Pareto front per grid point, each metric against each dispersed parameter, and
+no warning on the way.
+
+The studies are parsed as a user writes them; their case rows are made up here (values chosen so
+that the expected scales, fronts and marks are known by hand), so that nothing is run."""
+from __future__ import annotations
+
+import copy
+import math
+import warnings
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib.colors import LogNorm, Normalize
+from matplotlib.image import AxesImage
+from matplotlib.patches import Rectangle
+
+from scenarios.output.plot_data import axis_label, column_quantity
+from scenarios.study.plots import (
+    PARETO_AXES,
+    UNKNOWN_UNIT,
+    figures,
+    parameter_quantity,
+    write_plots,
+)
+from scenarios.study.spec import parse_study
+
+BASE = {
+    "name": "tiny",
+    "spacecraft": {"inertia": [2.0, 3.0, 4.0], "wheels": {"max_torque": 0.05}},
+    "maneuver": {"duration": 30.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
+                 "final": {"q": [0.9238795, 0.3826834, 0, 0], "omega": [0, 0, 0]}},
+    "planners": [{"name": "eigenaxis", "label": "smooth"},
+                 {"name": "spin_extremal", "label": "spin", "options": {"weight": 0.01}}],
+    "controller": {"name": "augmented_quaternion_feedback", "options": {"kp": 0.2, "kd": 0.6}},
+    "simulation": {"sample_time": 1.0, "duration": 35.0},
+}
+
+
+def study(**parts):
+    return parse_study({"study": "tiny-study", "scenario": copy.deepcopy(BASE), **parts})
+
+
+def rows_of(parsed, values):
+    """Case rows as ``cases.csv`` has them: ``values(case, label) -> (status, {column: value})``."""
+    rows = []
+    for case in parsed.cases:
+        for label in ("smooth", "spin"):
+            status, metrics = values(case, label)
+            rows.append({"case": case.index, "seed": case.seed, **case.varied, "label": label, "status": status,
+                         **metrics})
+    return rows
+
+
+def built(parsed, rows):
+    """Every figure by name, built with warnings raised as errors (none may reach stderr)."""
+    made = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for name, figure in figures(parsed, rows):
+            figure.canvas.draw()
+            made[name] = figure
+    return made
+
+
+@pytest.fixture(autouse=True)
+def close_figures():
+    yield
+    plt.close("all")
+
+
+def test_axes_name_varied_paths_and_columns_in_words_with_their_units():
+    parsed = study(grid={"maneuver.final.q": {"axis_angle": {"axis": [1, 1, 1], "angle_deg": [10, 90]}},
+                         "simulation.sample_time": [0.5, 1.0]},
+                   zip={"planners[label=spin].options.weight": [0.001, 0.01], "controller.options.kp": [0.1, 0.2]})
+    assert parameter_quantity(parsed, "maneuver.final.q") == ("slew angle about [1, 1, 1]", "deg")
+    assert parameter_quantity(parsed, "simulation.sample_time") == ("simulation sample time", "s")
+    assert parameter_quantity(parsed, "planners[label=spin].options.weight") == ("spin weight", "1/(N² m² s)")
+    assert parameter_quantity(parsed, "controller.options.kp")[1] in ("1/s^2", "1/s²")
+    assert parameter_quantity(parsed, "spacecraft.inertia[2]") == ("inertia 2", "kg m²")
+    assert parameter_quantity(parsed, "simulation.sensor_noise.seed") == ("sensor noise seed", "–")
+    assert parameter_quantity(parsed, "simulation.no_such_key")[1] == UNKNOWN_UNIT
+    assert column_quantity("cl.final_error_deg") == ("closed-loop final error", "deg")
+    assert column_quantity("ref.int_u") == ("reference ∫‖u‖ dt", "N m s")
+    assert column_quantity("cl.int_abs_u_y") == ("closed-loop ∫|u_y| dt", "N m s")
+    assert column_quantity("cl.req.st_sun.min_margin_deg") == ("closed-loop st_sun: min margin", "deg")
+    assert column_quantity("cl.req.rate.peak_rate") == ("closed-loop rate: peak rate", "rad/s")
+    assert column_quantity("ref.req.actuators.wheels_torque") == ("reference actuators: peak wheels torque / limit", "–")
+    assert axis_label("closed-loop saturation fraction", "–") == "closed-loop saturation fraction (–)"
+    with pytest.raises(KeyError):
+        column_quantity("maneuver.final.q")
+
+
+def test_an_initial_attitude_away_from_the_identity_is_no_slew_angle():
+    data = copy.deepcopy(BASE)
+    data["maneuver"]["initial"]["q"] = [0, 1, 0, 0]
+    parsed = parse_study({"study": "s", "scenario": data,
+                          "grid": {"maneuver.final.q": {"axis_angle": {"axis": [0, 0, 1], "angle_deg": [10, 90]}}}})
+    assert parameter_quantity(parsed, "maneuver.final.q") == ("final attitude: rotation angle about [0, 0, 1]", "deg")
+
+
+def heat_map_study(spin_value, failed_cell):
+    """3 x 2 grid; smooth's metric 1..6, spin's ``spin_value(k)``; one spin case failed."""
+    parsed = study(grid={"maneuver.duration": [30.0, 40.0, 50.0], "simulation.sample_time": [0.5, 1.0]},
+                   summary=["cl.final_error_deg", "ref.peak_actuator_torque"])
+
+    def values(case, label):
+        k = case.index + 1
+        if label == "spin" and case.index == failed_cell:
+            return "failed", {"cl.final_error_deg": None}
+        return "ok", {"cl.final_error_deg": float(k) if label == "smooth" else spin_value(k),
+                      "ref.peak_actuator_torque": None}  # a metric no row has: no panel, no warning
+
+    return parsed, rows_of(parsed, values)
+
+
+@pytest.mark.parametrize("spin_value,norm", [(lambda k: 100.0 * k, LogNorm), (lambda k: k + 1.0, Normalize)])
+def test_heat_maps_share_one_colour_scale_and_mark_the_failed_cell(spin_value, norm):
+    parsed, rows = heat_map_study(spin_value, failed_cell=3)
+    made = built(parsed, rows)
+    assert "heatmap_cl.final_error_deg.png" in made and "heatmap_ref.peak_actuator_torque.png" not in made
+    figure = made["heatmap_cl.final_error_deg.png"]
+    panels = [axis for axis in figure.axes if axis.get_title() in ("smooth", "spin")]
+    images = [next(a for a in axis.get_children() if isinstance(a, AxesImage)) for axis in panels]
+    finite = [float(k) for k in range(1, 7)] + [spin_value(k) for k in (1, 2, 3, 5, 6)]
+    for image in images:  # one scale: the smallest and largest cell of every planner
+        assert type(image.norm) is norm
+        assert (image.norm.vmin, image.norm.vmax) == (min(finite), max(finite))
+    assert len([a for a in figure.axes if a.get_label() == "<colorbar>"]) == 1
+    spin = panels[[a.get_title() for a in panels].index("spin")]
+    # case 3 is duration 40 (x index 1), sample time 1.0 (y index 1): its cell is hatched and says so
+    hatched = [p for p in spin.patches if isinstance(p, Rectangle) and p.get_hatch()]
+    assert [(p.get_x(), p.get_y()) for p in hatched] == [(0.5, 0.5)]
+    assert "failed" in [t.get_text() for t in spin.texts]
+    assert spin.get_xlabel() == "maneuver duration (s)" and spin.get_ylabel() == "simulation sample time (s)"
+
+
+def test_the_line_plots_mark_failed_points_and_take_a_log_axis_over_decades():
+    parsed, rows = heat_map_study(lambda k: 10.0 ** -k, failed_cell=3)
+    figure = built(parsed, rows)["metrics_vs_maneuver.duration.png"]
+    (panel,) = [a for a in figure.axes if a.get_ylabel() == "closed-loop final error (deg)"]
+    assert panel.get_yscale() == "log" and panel.get_xscale() == "linear"
+    marks = [line for line in panel.get_lines() if line.get_marker() == "x"]
+    assert len(marks) == 1 and list(marks[0].get_xdata()) == [40.0]  # spin's failed case, at its duration
+    assert "failed row (no value)" in [t.get_text() for t in figure.legends[0].get_texts()]
+    smooth = panel.get_lines()[0]  # median over the two sample times of a duration: k = 1, 2 | 3, 4 | 5, 6
+    np.testing.assert_allclose(smooth.get_ydata(), [1.5, 3.5, 5.5])
+
+
+def test_each_grid_point_has_its_own_pareto_front():
+    """Pooled over the points, the second point's cases are all dominated by the first's."""
+    parsed = study(grid={"maneuver.duration": [30.0, 40.0]})
+    table = {(0, "smooth"): (1.0, 10.0), (0, "spin"): (2.0, 5.0), (1, "smooth"): (10.0, 100.0), (1, "spin"): (20.0, 50.0)}
+    rows = rows_of(parsed, lambda case, label: ("ok", dict(zip(PARETO_AXES, table[(case.index, label)]))))
+    figure = built(parsed, rows)["pareto.png"]
+    panels = [a for a in figure.axes if a.get_xlabel()]
+    assert [a.get_title() for a in panels] == ["maneuver duration 30 s", "maneuver duration 40 s"]
+    for axis, point in zip(panels, (0, 1)):
+        (front,) = [line for line in axis.get_lines() if line.get_color() == "k" and line.get_linestyle() == "-"]
+        expected = sorted(table[(point, label)] for label in ("smooth", "spin"))
+        np.testing.assert_allclose(np.c_[front.get_xdata(), front.get_ydata()], expected)
+        assert axis.get_xlabel() == "closed-loop ∫‖u‖ dt (N m s)" and axis.get_ylabel() == "closed-loop settling time (s)"
+
+
+def monte_carlo_study():
+    return study(monte_carlo={"samples": 40, "seed": 3, "dispersions": {
+        "simulation.initial_attitude_error_deg": {"normal": {"mean": [0, 0, 0], "std": [1.0, 1.0, 1.0]}},
+        "simulation.initial_rate_error": {"uniform": {"low": [0, 0, 0], "high": [0.001, 0.002, 0.0]}},
+        "simulation.sensor_noise.seed": "case_seed"}},
+        summary=["cl.final_error_deg", "cl.int_u"])
+
+
+def test_monte_carlo_cdfs_and_box_plots_go_logarithmic_over_decades_and_count_failed_cases():
+    parsed = monte_carlo_study()
+    rng = np.random.default_rng(5)
+
+    def values(case, label):
+        if label == "spin" and case.index % 10 == 0:
+            return "crashed", {}
+        return "ok", {"cl.final_error_deg": 10.0 ** rng.uniform(-4, 0), "cl.int_u": rng.uniform(10.0, 12.0)}
+
+    rows = rows_of(parsed, values)
+    made = built(parsed, rows)
+    cdf = made["cdf.png"]
+    (error,) = [a for a in cdf.axes if a.get_xlabel() == "closed-loop final error (deg)"]
+    (effort,) = [a for a in cdf.axes if a.get_xlabel() == "closed-loop ∫‖u‖ dt (N m s)"]
+    assert error.get_xscale() == "log" and effort.get_xscale() == "linear"
+    spin = next(line for line in error.get_lines() if line.get_label().startswith("spin"))
+    assert spin.get_ydata()[-1] == pytest.approx(36 / 40)  # 4 of 40 crashed: the curve stops at 0.9
+    assert spin.get_label() == "spin (4 without a value)"
+    box = made["boxplots.png"]
+    assert [a.get_yscale() for a in box.axes if a.get_ylabel()] == ["log", "linear"]
+
+
+def test_each_metric_is_drawn_against_each_dispersed_parameter_but_the_seed():
+    parsed = monte_carlo_study()
+    rows = rows_of(parsed, lambda case, label: ("ok", {"cl.final_error_deg": 1.0 + case.index,
+                                                       "cl.int_u": 2.0 + case.index}))
+    made = built(parsed, rows)
+    names = sorted(n for n in made if n.startswith("scatter_"))
+    assert names == ["scatter_simulation.initial_attitude_error_deg.png", "scatter_simulation.initial_rate_error.png"]
+    figure = made["scatter_simulation.initial_attitude_error_deg.png"]
+    (panel,) = [a for a in figure.axes if a.get_ylabel() == "closed-loop final error (deg)"]
+    assert panel.get_xlabel() == "‖simulation initial attitude error‖ (deg)"
+    smooth = panel.get_lines()[0]
+    norms = [math.sqrt(sum(v * v for v in case.scenario["simulation"]["initial_attitude_error_deg"]))
+             for case in parsed.cases]
+    np.testing.assert_allclose(smooth.get_xdata(), norms)
+    np.testing.assert_allclose(smooth.get_ydata(), [1.0 + case.index for case in parsed.cases])
+    rate = made["scatter_simulation.initial_rate_error.png"]
+    assert {a.get_xlabel() for a in rate.axes if a.get_xlabel()} == {"‖simulation initial rate error‖ (rad/s)"}
+
+
+def test_write_plots_writes_every_figure_and_leaves_none_open(tmp_path):
+    parsed, rows = heat_map_study(lambda k: 2.0 * k, failed_cell=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        written = write_plots(parsed, rows, tmp_path)
+    assert sorted(written) == sorted(p.name for p in tmp_path.iterdir())
+    assert {"heatmap_cl.final_error_deg.png", "metrics_vs_maneuver.duration.png",
+            "metrics_vs_simulation.sample_time.png"} <= set(written)
+    assert plt.get_fignums() == []
+
+
+def test_grid_points_with_samples_count_their_failed_rows_and_group_the_box_plots():
+    parsed = study(grid={"maneuver.duration": [30.0, 40.0], "simulation.sample_time": [0.5, 1.0]},
+                   monte_carlo={"samples": 3, "seed": 1, "dispersions": {
+                       "simulation.initial_attitude_error_deg": {"normal": {"mean": [0, 0, 0], "std": [1, 1, 1]}}}},
+                   summary=["cl.final_error_deg"])
+
+    def values(case, label):  # the first sample of the last grid point fails for spin
+        if label == "spin" and case.index == 9:
+            return "failed", {}
+        return "ok", {"cl.final_error_deg": 1.0 + case.index}
+
+    made = built(parsed, rows_of(parsed, values))
+    heat = made["heatmap_cl.final_error_deg.png"]
+    spin = next(a for a in heat.axes if a.get_title() == "spin")
+    marks = [t for t in spin.texts if t.get_text().startswith("×")]
+    assert [(m.get_text(), round(m.get_position()[0]), round(m.get_position()[1])) for m in marks] == [("× 1", 1, 1)]
+    cell = next(t for t in spin.texts if t.get_position() == (1, 1))  # the median of the two samples left
+    assert cell.get_text() == f"{(11.0 + 12.0) / 2:.3g}"
+    box = made["boxplots.png"]
+    (panel,) = [a for a in box.axes if a.get_ylabel()]
+    groups = [t.get_text() for t in panel.get_xticklabels()]
+    assert len(groups) == 8 and groups[0] == "smooth\nmaneuver duration 30 s, simulation sample time 0.5 s"
