@@ -193,9 +193,6 @@ def continuous_quaternions(q: np.ndarray, like: np.ndarray | None = None) -> np.
     return -q if side < 0 else q
 
 
-_CYCLIC = {(0, 1, 2), (1, 2, 0), (2, 0, 1)}
-
-
 def euler_sequence_axes(sequence: str) -> tuple[int, int, int]:
     """The body axes (0 = x) of an Euler sequence.
 
@@ -244,23 +241,11 @@ def euler_angles(q: np.ndarray, sequence: str = EULER_SEQUENCE) -> np.ndarray:
         or [0, 180] (proper); the outer ones start in (-180, 180] and are unwrapped (no jump of
         360°). At gimbal lock (middle angle ±90° or 0, 180°) only their sum or difference is defined.
     """
-    # the model's helper, in the process that ran it (module docstring)
+    # the model's helper (ocp.quat.to_euler), in the process that ran it (module docstring)
     from ocp import quat
 
-    a, b, c = euler_sequence_axes(sequence)
-    matrix = quat.rotation_matrix(np.asarray(q, dtype=float))
-    if a != c:  # Tait-Bryan
-        s = 1.0 if (a, b, c) in _CYCLIC else -1.0
-        middle = np.arcsin(np.clip(s * matrix[:, a, c], -1.0, 1.0))
-        first = np.arctan2(-s * matrix[:, b, c], matrix[:, c, c])
-        last = np.arctan2(-s * matrix[:, a, b], matrix[:, a, a])
-    else:  # proper Euler: the third axis is the one not named
-        d = 3 - a - b
-        s = 1.0 if (a, b, d) in _CYCLIC else -1.0
-        middle = np.arccos(np.clip(matrix[:, a, a], -1.0, 1.0))
-        first = np.arctan2(matrix[:, b, a], -s * matrix[:, d, a])
-        last = np.arctan2(matrix[:, a, b], s * matrix[:, a, d])
-    return np.rad2deg(np.unwrap(np.stack([first, middle, last], axis=1), axis=0))
+    euler_sequence_axes(sequence)  # its error names the figures' option
+    return np.rad2deg(np.unwrap(quat.to_euler(np.asarray(q, dtype=float), sequence), axis=0))
 
 
 Curve = tuple[np.ndarray, np.ndarray]
