@@ -208,6 +208,9 @@ def command_sweep(args: argparse.Namespace) -> int:
         start_forkserver()  # local workers' imports run while the study is expanded and checked
     name = Path(args.file).stem
     study = load_study(args.file, progress=_checking(name))
+    if args.dry_run:
+        _list_cases(study)
+        return EXIT_OK
     where = "--scheduler" if scheduler else "execution.scheduler"
     scheduler = scheduler or study.execution.scheduler
     if not args.no_plots:
@@ -219,6 +222,23 @@ def command_sweep(args: argparse.Namespace) -> int:
     finally:
         if cluster is not None:
             cluster.close()
+
+
+DRY_RUN_SHOWN = 50
+"""Cases ``sweep --dry-run`` lists one per line (the others are counted)."""
+
+
+def _list_cases(study: Study) -> None:
+    """Print what ``sweep`` would run: the checked cases and their varied values (nothing written)."""
+    varied = [*study.grid_paths, *study.mc_paths]
+    print(f"{study.name}: {len(study.cases)} cases, checked; nothing run, nothing written"
+          + (f"; varying {', '.join(varied)}" if varied else ""))
+    for case in study.cases[:DRY_RUN_SHOWN]:
+        values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
+        print(f"  case {case.index} (grid point {case.point}, seed {case.seed}, key {case.key[:12]})"
+              + (f": {values}" if values else ""))
+    if len(study.cases) > DRY_RUN_SHOWN:
+        print(f"  ... and {len(study.cases) - DRY_RUN_SHOWN} more")
 
 
 def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster | None) -> int:
@@ -248,9 +268,11 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
         signal.signal(signal.SIGTERM, previous)
     files = results.write(out, plots=not args.no_plots)
     crashed = sum(record["status"] == "crashed" for record in results.records.values())
-    failed = sum(any(r["status"] != "ok" for r in record["rows"]) for record in results.records.values())
-    print(f"{len(study.cases)} cases in {time.perf_counter() - start:.1f} s ({failed} with a failed row, "
-          f"{crashed} crashed); wrote {out}/ ({', '.join(files)})")
+    not_ok = sum(any(r["status"] != "ok" for r in record["rows"]) for record in results.records.values())
+    ran = len(study.cases) - done
+    print(f"{ran} case{'s' if ran != 1 else ''} run in {time.perf_counter() - start:.1f} s"
+          + (f" ({done} already stored, {len(study.cases)} in all)" if done else "")
+          + f"; {not_ok} with a row not ok, {crashed} crashed; wrote {out}/ ({', '.join(files)})")
     return EXIT_OK
 
 
@@ -268,6 +290,8 @@ def add_sweep_parser(commands: Any) -> None:
     parser.add_argument("--workers", type=int, help="cases at once (default: execution.workers, else one per core)")
     parser.add_argument("--scheduler", help="Dask scheduler address (tcp://host:port) instead of local processes")
     parser.add_argument("--resume", action="store_true", help="skip the cases already stored in --out")
-    parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots and report.html")
+    parser.add_argument("--dry-run", action="store_true",
+                        help="check the study and list its cases; run nothing, write nothing")
     parser.add_argument("--report", metavar="DIR", help="redraw tables and plots of DIR from its store; run nothing")
     parser.set_defaults(handler=command_sweep)

@@ -1,0 +1,47 @@
+"""``slewbench sweep --dry-run`` lists the cases and writes nothing; the summary of a resumed sweep
+counts the cases it ran, not the study's."""
+from __future__ import annotations
+
+import copy
+import re
+
+import yaml
+
+from scenarios.cli.commands import main
+from tests.test_sweep import BASE
+
+
+def _study(tmp_path, values=(0.2, 0.3, 0.4)):
+    path = tmp_path / "study.yaml"
+    path.write_text(yaml.safe_dump({"study": "summary-study", "scenario": copy.deepcopy(BASE),
+                                    "grid": {"controller.options.kp": list(values)}}))
+    return path
+
+
+def test_dry_run_lists_every_case_and_writes_nothing(tmp_path, capsys):
+    study = _study(tmp_path)
+    out = tmp_path / "out"
+    assert main(["sweep", str(study), "--out", str(out), "--dry-run"]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    assert printed[0].startswith("summary-study: 3 cases, checked; nothing run, nothing written; varying "
+                                 "controller.options.kp")
+    cases = [line for line in printed if line.startswith("  case ")]
+    assert [re.search(r"kp=([0-9.]+)", line).group(1) for line in cases] == ["0.2", "0.3", "0.4"]
+    assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["study.yaml"]
+
+
+def test_a_dry_run_of_a_bad_study_exits_2(tmp_path, capsys):
+    study = _study(tmp_path, values=(0.2, "stiff"))
+    assert main(["sweep", str(study), "--out", str(tmp_path / "out"), "--dry-run"]) == 2
+    assert "controller.options.kp" in capsys.readouterr().err and not (tmp_path / "out").exists()
+
+
+def test_a_resumed_sweep_counts_what_it_ran(tmp_path, capsys):
+    out = tmp_path / "out"
+    study = _study(tmp_path, values=(0.2, 0.3))
+    assert main(["sweep", str(study), "--out", str(out), "--workers", "1", "--no-plots"]) == 0
+    assert re.search(r"^2 cases run in [0-9.]+ s; ", capsys.readouterr().out, re.M)
+    study = _study(tmp_path, values=(0.2, 0.3, 0.4))  # one case more: only it runs on resume
+    assert main(["sweep", str(study), "--out", str(out), "--workers", "1", "--no-plots", "--resume"]) == 0
+    said = capsys.readouterr().out
+    assert re.search(r"^1 case run in [0-9.]+ s \(2 already stored, 3 in all\); ", said, re.M), said
