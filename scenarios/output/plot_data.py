@@ -184,11 +184,13 @@ def continuous_quaternions(q: np.ndarray, like: np.ndarray | None = None) -> np.
         of the samples' dot products with it non-negative) or, without ``like``, starting with a
         non-negative scalar part.
     """
+    # the model's helper (ocp.quat.continuous), in the process that ran it (module docstring)
+    from ocp import quat
+
     q = np.array(q, dtype=float)
     if len(q) == 0:
         return q
-    flips = np.where(np.einsum("ij,ij->i", q[1:], q[:-1]) < 0.0, -1.0, 1.0)
-    q *= np.concatenate([[1.0], np.cumprod(flips)])[:, None]
+    q = quat.continuous(q)
     side = np.einsum("ij,ij->", q, like) if like is not None else q[0, 0]
     return -q if side < 0 else q
 
