@@ -170,8 +170,11 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
 def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference | None = None) -> list[tuple[float, int, Array]]:
     """Where a reference's body rate jumps: no finite torque gives a jump, so no actuator can follow it.
 
-    At t = 0 the reference's rate against the manoeuvre's initial rate (a reference that leaves
-    ``omega0`` free starts elsewhere: natural motion's spin-up), and across each of the reference's
+    At t = 0 the reference's rate against the manoeuvre's initial rate, unless the reference declares
+    ``omega0`` free (:attr:`planners.Reference.free_boundary`: natural motion's spin-up, the spin
+    extremals' transverse rates, an eigenaxis slew from a spinning state): that start is an initial
+    tracking error the closed loop absorbs, reported as ``ref.initial_rate_error`` and scored in the
+    closed loop, not an actuator demand of the reference; and across each of the reference's
     breakpoints (:attr:`planners.Reference.breakpoints`, where ``ω`` may jump: natural motion's step
     stop). A change of more than :data:`JUMP_TOLERANCE` across a breakpoint, beyond what ``ω̇``
     explains over the instant either side sampled, is a jump.
@@ -195,7 +198,8 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
     """
     found = []
     start = np.asarray(omega[0], dtype=float) - np.asarray(omega0, dtype=float)
-    if np.linalg.norm(start) > JUMP_TOLERANCE:
+    declared = reference is not None and "omega0" in reference.free_boundary
+    if np.linalg.norm(start) > JUMP_TOLERANCE and not declared:
         found.append((float(t[0]), 0, start))
     breakpoints = np.array([] if reference is None else reference.breakpoints, dtype=float)
     breakpoints = breakpoints[(breakpoints > t[0]) & (breakpoints < t[-1])]
