@@ -409,11 +409,32 @@ _GIMBAL_LOCK = 1e-7
 """rad: a middle Euler angle this close to its singular value is treated as gimbal lock."""
 
 
-def _sequence_axes(sequence: str) -> tuple[int, int, int]:
-    """Axis indices (0 = x) of an Euler sequence such as ``"321"`` or ``"zyx"``."""
+EULER_SEQUENCES = ("321", "123", "312", "213", "231", "132", "121", "131", "212", "232", "313", "323")
+"""The twelve Euler sequences: six Tait-Bryan, then six proper (body axes, ``1`` = x)."""
+
+
+def sequence_axes(sequence: str) -> tuple[int, int, int]:
+    """Axis indices of an Euler sequence.
+
+    Parameters
+    ----------
+    sequence : str
+        Three body axes in the order the rotations are applied: ``1``, ``2``, ``3`` (or ``x``,
+        ``y``, ``z``), no two consecutive ones equal, such as ``"321"``, ``"313"`` or ``"zyx"``.
+
+    Returns
+    -------
+    (int, int, int)
+        The axes (0 = x), in the order of the rotations.
+
+    Raises
+    ------
+    ValueError
+        Another sequence.
+    """
     axes = tuple(_AXES.get(letter) for letter in sequence.lower()) if isinstance(sequence, str) else ()
     if len(axes) != 3 or None in axes or axes[0] == axes[1] or axes[1] == axes[2]:
-        raise ValueError(f"sequence must name three body axes (1, 2, 3 or x, y, z), no two consecutive ones "
+        raise ValueError(f"an Euler sequence must name three body axes (1, 2, 3 or x, y, z), no two consecutive ones "
                          f"equal, such as '321' or '313', got {sequence!r}")
     return axes  # type: ignore[return-value]  # None excluded above
 
@@ -449,7 +470,7 @@ def to_euler(q: ArrayLike, sequence: str = "321") -> Array:
     ValueError
         A sequence that is not three body axes with no two consecutive ones equal.
     """
-    first, middle, last = _sequence_axes(sequence)
+    first, middle, last = sequence_axes(sequence)
     q = np.asarray(q, dtype=float)
     # Written for the extrinsic sequence (i, j, k): the intrinsic (first, middle, last) is the
     # extrinsic (last, middle, first), its angles in reverse order.

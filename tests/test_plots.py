@@ -5,6 +5,7 @@ What a review reads off them (issue 31): Euler angles (checked against SciPy's r
 against rotations composed by hand), quaternions without sign jumps and on the closed loop's side,
 rates in deg/s, one colour per body axis in every panel, and a comparison figure per axis whose
 legend lies outside the data and tells near-identical rows apart."""
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -15,15 +16,23 @@ from scipy.spatial.transform import Rotation
 
 from ocp import ReactionWheels, Spacecraft, quat
 from planners.reference import ReferenceSample
+from scenarios.errors import ScenarioError
 from scenarios.output.plot_data import (
     EULER_SEQUENCE,
+    RowSeries,
     continuous_quaternions,
     decimate,
     euler_angles,
     overlay_series,
+    plot_jobs,
     row_series,
 )
 from scenarios.output.plots import LogTicks, RowFigure, overlay_figure
+from scenarios.runner import run
+from scenarios.schema.loader import parse_scenario
+from scenarios.schema.read import read_yaml
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 class Reference:
@@ -264,3 +273,30 @@ def test_another_euler_sequence_is_named_in_its_panel(rng):
 def test_a_logarithmic_axis_has_ticks_however_narrow_its_view(low, high, expected):
     ticks = np.asarray(LogTicks().tick_values(low, high))
     np.testing.assert_allclose(ticks[(ticks >= low) & (ticks <= high)], expected)
+
+
+@pytest.mark.parametrize("written,drawn", [("313", "313"), (321, "321"), (None, "321")])
+def test_the_scenarios_euler_sequence_reaches_the_row_figures(written, drawn):
+    """``plots.euler_sequence`` (absent: 3-2-1) is the sequence of every row figure's Euler panel,
+    whose angles, composed by SciPy as intrinsic rotations, give back the closed loop's attitude
+    (valid at gimbal lock too, where the angles themselves are not unique)."""
+    data = read_yaml(ROOT / "scenarios" / "eigenaxis_demo.yaml")
+    data["planners"] = data["planners"][:1]
+    if written is not None:
+        data["plots"] = {"euler_sequence": written}
+    results = run(parse_scenario(data))
+    (row_job,) = [series for _, series in plot_jobs(results) if isinstance(series, RowSeries)]
+    assert row_job.euler_sequence == drawn
+    assert RowFigure(*row_job.shape).panels["euler"] is not None
+    q = results.rows[0].simulation.q
+    composed = Rotation.from_euler("".join("XYZ"[int(c) - 1] for c in drawn), euler_angles(q, drawn), degrees=True)
+    mismatch = (composed.inv() * Rotation.from_quat(q[:, [1, 2, 3, 0]])).magnitude()
+    assert mismatch.max() < 1e-9
+
+
+@pytest.mark.parametrize("value", ["zyx", "331", 312.5, True, None])
+def test_a_bad_euler_sequence_names_its_yaml_path(value):
+    data = read_yaml(ROOT / "scenarios" / "eigenaxis_demo.yaml")
+    data["plots"] = {"euler_sequence": value}
+    with pytest.raises(ScenarioError, match=r"plots\.euler_sequence: expected an Euler sequence, one of \['321'"):
+        parse_scenario(data)

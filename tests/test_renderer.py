@@ -81,6 +81,50 @@ def test_a_dead_plot_process_costs_only_time(tmp_path):
         assert (tmp_path / "out" / name).is_file(), name
 
 
+def test_report_html_is_built_while_the_plot_process_draws_and_a_death_meanwhile_costs_only_time(tmp_path):
+    """``report.html`` is built after the figures went to the plot process and before the run
+    waits for them; the plot process killed in between (inside the report's build): the run draws
+    the figures itself, says so on one line, and writes complete results."""
+    done = _python("""
+        import os, signal, sys
+        from scenarios.output.renderer import Renderer
+        renderer = Renderer.start()
+        import scenarios
+        import scenarios.output.report.run as report
+        build = report.run_report
+        def killing(results):
+            assert renderer._submitted, "report.html built before the figures were sent"
+            os.kill(renderer.pid, signal.SIGKILL)
+            return build(results)
+        report.run_report = killing
+        results = scenarios.run(scenarios.load(sys.argv[1]))
+        results.write(sys.argv[2], renderer=renderer)
+        renderer.close()
+    """, str(DEMO), str(tmp_path / "out"))
+    assert done.returncode == 0, done.stderr
+    assert "the plot process ended early" in done.stderr and "Traceback" not in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
+    for name in ("smooth.png", "bang-coast-bang.png", "min-time.png", "comparison.png", "results.json",
+                 "report.html"):
+        assert (tmp_path / "out" / name).is_file(), name
+
+
+def test_waiting_with_nothing_sent_is_a_rendering_failure():
+    done = _python("""
+        from scenarios.output.renderer import Renderer, RenderingFailed
+        renderer = Renderer.start()
+        assert renderer is not None, "no plot process on a one-thread Linux process"
+        try:
+            renderer.wait()
+        except RenderingFailed as error:
+            print(error)
+        finally:
+            renderer.close()
+    """)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "no figures were sent to the plot process"
+
+
 def _children(pid: int) -> list[int]:
     path = Path(f"/proc/{pid}/task/{pid}/children")
     return [int(v) for v in path.read_text().split()] if path.exists() else []

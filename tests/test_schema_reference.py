@@ -83,6 +83,7 @@ requirements:
   actuators: {margin: 0.1}
   rate: {max: 0.2}
   final: {after_s: 5, error_deg: 1.0, rate: 0.01}
+plots: {euler_sequence: "313"}
 """
 
 MAXIMAL_B = """

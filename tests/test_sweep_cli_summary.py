@@ -45,3 +45,21 @@ def test_a_resumed_sweep_counts_what_it_ran(tmp_path, capsys):
     assert main(["sweep", str(study), "--out", str(out), "--workers", "1", "--no-plots", "--resume"]) == 0
     said = capsys.readouterr().out
     assert re.search(r"^1 case run in [0-9.]+ s \(2 already stored, 3 in all\); ", said, re.M), said
+
+
+def test_a_report_redrawn_without_plots_names_the_pictures_it_removed(tmp_path, capsys):
+    """``sweep --report DIR --no-plots`` removes the earlier figures and report.html (they would no
+    longer match the tables) and says which, as ``run --no-plots`` does."""
+    out = tmp_path / "out"
+    study = _study(tmp_path, values=(0.2, 0.3))
+    assert main(["sweep", str(study), "--out", str(out), "--workers", "1"]) == 0
+    pictures = sorted(p.relative_to(out).as_posix() for p in out.rglob("*") if p.suffix in (".png", ".html"))
+    assert pictures and "report.html" in pictures
+    capsys.readouterr()
+    assert main(["sweep", "--report", str(out), "--no-plots"]) == 0
+    said = capsys.readouterr().out.splitlines()
+    assert said[-1] == (f"removed {len(pictures)} file(s) of the earlier output in {out}/ that this one did not "
+                        "write: " + ", ".join(pictures))
+    assert not [p for p in out.rglob("*") if p.suffix in (".png", ".html")]
+    assert main(["sweep", "--report", str(out), "--no-plots"]) == 0  # nothing more to remove: nothing said
+    assert "removed" not in capsys.readouterr().out

@@ -29,7 +29,10 @@ from scenarios.cli.status import (
 )
 from scenarios.cli.sweep import add_sweep_parser
 from scenarios.errors import OutputError, ScenarioError
-from scenarios.output.directory import claim_output_directory, read_manifest
+from scenarios.output.directory import (
+    claim_output_directory,
+    written_files,
+)
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
 from scenarios.runner import run
@@ -168,11 +171,11 @@ def command_run(args: argparse.Namespace) -> int:
     interruption.check()
     print()
     print(results.to_terminal(all_metrics=getattr(args, "all_metrics", False)))
-    earlier = _written_files(out)
+    earlier = written_files(out)
     results.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
     print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
           f"{'' if args.no_plots else ', PNG plots, report.html'}) in {time.perf_counter() - start:.2f} s")
-    removed = sorted(earlier - _written_files(out))
+    removed = sorted(earlier - written_files(out))
     if removed:
         print(f"removed {len(removed)} file(s) of the earlier run in {out}/ that this run did not write: "
               + ", ".join(removed))
@@ -182,12 +185,6 @@ def command_run(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return EXIT_NOT_OK
     return EXIT_OK
-
-
-def _written_files(directory: Path) -> set[str]:
-    """The files slewbench's manifest lists in ``directory`` that exist (none without a manifest)."""
-    manifest = read_manifest(directory)
-    return {name for name in (manifest or {}).get("files", []) if (directory / name).is_file()}
 
 
 def command_codegen(args: argparse.Namespace) -> int:

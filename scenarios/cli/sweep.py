@@ -20,7 +20,7 @@ from typing import Any
 
 from scenarios.cli.status import EXIT_INTERRUPTED, EXIT_OK
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
-from scenarios.output.directory import MARKER, read_manifest
+from scenarios.output.directory import MARKER, read_manifest, written_files
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
 from scenarios.study.engine import (
@@ -83,9 +83,19 @@ def command_report(args: argparse.Namespace) -> int:
     except ScenarioError as error:
         raise OutputError(out, f"the study stored in it is not valid ({error}); it cannot be redrawn") from None
     results = SweepResults(study, records)
+    earlier = written_files(out)
     files = results.write(out, plots=not args.no_plots)
     print(f"redrew {out}/ ({', '.join(files)}) from {len(records)} stored case(s); {results.missing} missing")
+    _say_removed(out, earlier)
     return EXIT_OK
+
+
+def _say_removed(out: Path, earlier: set[str]) -> None:
+    """Name the files of ``out`` that an earlier write left and this one removed (plots, with ``--no-plots``)."""
+    removed = sorted(earlier - written_files(out))
+    if removed:
+        print(f"removed {len(removed)} file(s) of the earlier output in {out}/ that this one did not write: "
+              + ", ".join(removed))
 
 
 def _checking(name: str) -> Any:
@@ -266,6 +276,7 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
                                "--resume`") from None
     finally:
         signal.signal(signal.SIGTERM, previous)
+    earlier = written_files(out)
     files = results.write(out, plots=not args.no_plots)
     crashed = sum(record["status"] == "crashed" for record in results.records.values())
     not_ok = sum(any(r["status"] != "ok" for r in record["rows"]) for record in results.records.values())
@@ -273,6 +284,7 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
     print(f"{ran} case{'s' if ran != 1 else ''} run in {time.perf_counter() - start:.1f} s"
           + (f" ({done} already stored, {len(study.cases)} in all)" if done else "")
           + f"; {not_ok} with a row not ok, {crashed} crashed; wrote {out}/ ({', '.join(files)})")
+    _say_removed(out, earlier)
     return EXIT_OK
 
 

@@ -30,7 +30,7 @@ from scenarios.errors import OutputError
 from scenarios.schema.read import read_bounded
 
 __all__ = ["MARKER", "STAGING_PREFIX", "claim_output_directory", "commit_outputs", "new_staging",
-           "read_manifest", "write_manifest"]
+           "read_manifest", "write_manifest", "written_files"]
 
 MARKER = ".slewbench-output.json"
 STAGING_PREFIX = ".slewbench-staging-"
@@ -62,6 +62,24 @@ def read_manifest(directory: Path) -> dict[str, Any] | None:
     if not all(isinstance(name, str) and _is_plain_relative(name) for name in manifest["files"]):
         return None  # a manifest naming files outside its directory is not ours to act on
     return manifest
+
+
+def written_files(directory: Path) -> set[str]:
+    """The files slewbench's manifest lists in ``directory`` that exist: what a command's earlier
+    output there holds, so that the command can name what its own commit removed.
+
+    Parameters
+    ----------
+    directory : Path
+        An output directory (need not exist).
+
+    Returns
+    -------
+    set of str
+        Relative paths; empty without a manifest.
+    """
+    manifest = read_manifest(directory)
+    return {name for name in (manifest or {}).get("files", []) if (directory / name).is_file()}
 
 
 def _is_plain_relative(name: str) -> bool:

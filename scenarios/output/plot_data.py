@@ -195,32 +195,6 @@ def continuous_quaternions(q: np.ndarray, like: np.ndarray | None = None) -> np.
     return -q if side < 0 else q
 
 
-def euler_sequence_axes(sequence: str) -> tuple[int, int, int]:
-    """The body axes (0 = x) of an Euler sequence.
-
-    Parameters
-    ----------
-    sequence : str
-        Three of ``1``, ``2``, ``3``, no two consecutive ones equal: a Tait-Bryan sequence
-        (``"321"``, ``"123"`` ...) or a proper Euler one (``"313"`` ...).
-
-    Returns
-    -------
-    (int, int, int)
-        The axes in the order of the rotations.
-
-    Raises
-    ------
-    ValueError
-        Another sequence.
-    """
-    axes = tuple("123".find(c) for c in str(sequence))
-    if len(axes) != 3 or -1 in axes or axes[0] == axes[1] or axes[1] == axes[2]:
-        raise ValueError(f"an Euler sequence is three of 1, 2, 3 with no two consecutive ones equal, such as "
-                         f"'321' or '313'; got {sequence!r}")
-    return axes[0], axes[1], axes[2]
-
-
 def euler_angles(q: np.ndarray, sequence: str = EULER_SEQUENCE) -> np.ndarray:
     """Euler angles of an attitude series, in degrees and unwrapped in time.
 
@@ -234,7 +208,7 @@ def euler_angles(q: np.ndarray, sequence: str = EULER_SEQUENCE) -> np.ndarray:
     q : (N, 4) ndarray
         Unit quaternions, scalar first, body to inertial, in time order (their signs do not matter).
     sequence : str, optional
-        The rotation axes (:func:`euler_sequence_axes`); default :data:`EULER_SEQUENCE`.
+        The rotation axes (:func:`ocp.quat.sequence_axes`); default :data:`EULER_SEQUENCE`.
 
     Returns
     -------
@@ -246,7 +220,6 @@ def euler_angles(q: np.ndarray, sequence: str = EULER_SEQUENCE) -> np.ndarray:
     # the model's helper (ocp.quat.to_euler), in the process that ran it (module docstring)
     from ocp import quat
 
-    euler_sequence_axes(sequence)  # its error names the figures' option
     return np.rad2deg(np.unwrap(quat.to_euler(np.asarray(q, dtype=float), sequence), axis=0))
 
 
@@ -980,7 +953,7 @@ SKY_FILE = "sky.png"
 """The sky map of a run with pointing requirements."""
 
 
-def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str = EULER_SEQUENCE) -> list[PlotJob]:
+def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str | None = None) -> list[PlotJob]:
     """The figures of a run: one per simulated row (``<stem>.png``), with pointing requirements
     :data:`MARGINS_FILE` and :data:`SKY_FILE`, and ``comparison.png``.
 
@@ -991,15 +964,21 @@ def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str 
     stems : list of str, optional
         The rows' file stems; ``None``: ``row_stems`` of the labels.
     euler_sequence : str, optional
-        The row figures' Euler sequence (:func:`euler_angles`); default :data:`EULER_SEQUENCE`.
+        The row figures' Euler sequence (:func:`euler_angles`); ``None`` (default): the scenario's
+        (``plots.euler_sequence``; :data:`EULER_SEQUENCE` unless given).
 
     Returns
     -------
     list of (str, series)
         File names and series, in drawing order (rows, the pointing figures, the overlay last).
     """
-    euler_sequence_axes(euler_sequence)  # a bad sequence fails before any series is computed
+    from ocp import quat
     from scenarios.output.names import row_stems
+
+    if euler_sequence is None:
+        euler_sequence = getattr(results.scenario, "euler_sequence", EULER_SEQUENCE)
+    # a bad sequence fails before any series is computed; "zyx" is drawn as "321"
+    euler_sequence = "".join(str(axis + 1) for axis in quat.sequence_axes(euler_sequence))
 
     problem = results.scenario.problem
     stems = stems if stems is not None else row_stems([row.label for row in results.rows])

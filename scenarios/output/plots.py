@@ -65,7 +65,6 @@ from scenarios.output.plot_data import (
     RowShape,
     SkyPath,
     SkySeries,
-    euler_sequence_axes,
     map_longitude,
     overlay_series,
     plot_jobs,
@@ -208,7 +207,8 @@ def euler_names(sequence: str) -> tuple[str, list[str], list[str]]:
     Parameters
     ----------
     sequence : str
-        An Euler sequence (:func:`scenarios.output.plot_data.euler_sequence_axes`).
+        A valid Euler sequence of digits (:func:`ocp.quat.sequence_axes`, checked where its series were
+        computed: this module does not import the model).
 
     Returns
     -------
@@ -220,7 +220,7 @@ def euler_names(sequence: str) -> tuple[str, list[str], list[str]]:
         Each angle's colour: its axis' (:data:`AXIS_COLORS`); the third of a proper sequence
         :data:`PROPER_EULER_COLOR`.
     """
-    axes = euler_sequence_axes(sequence)
+    axes = tuple(int(digit) - 1 for digit in sequence)
     names = (["ψ yaw", "θ pitch", "φ roll"] if axes == (2, 1, 0)
              else [f"{symbol}{number}" for symbol, number in zip("αβγ", ("₁", "₂", "₃"))])
     colors = [AXIS_COLORS[a] for a in axes]
@@ -882,7 +882,7 @@ DRAW: dict[type, Callable[[Any, Path], None]] = {OverlaySeries: draw_overlay, Ma
 
 
 def write_plots(results: Any, directory: Path, stems: list[str] | None = None,
-                euler_sequence: str = EULER_SEQUENCE) -> None:
+                euler_sequence: str | None = None) -> None:
     """The figures of :func:`scenarios.output.plot_data.plot_jobs`: one PNG per simulated row
     (``<stem>.png``), ``margins.png`` and ``sky.png`` with pointing requirements, and ``comparison.png``.
 
@@ -896,6 +896,6 @@ def write_plots(results: Any, directory: Path, stems: list[str] | None = None,
         The rows' file stems; ``None``: ``row_stems`` of the labels.
     euler_sequence : str, optional
         The row figures' Euler sequence (:func:`scenarios.output.plot_data.euler_angles`), such as
-        ``"313"``; default ``"321"``.
+        ``"313"``; ``None`` (default): the scenario's (``plots.euler_sequence``, ``"321"`` unless given).
     """
     draw_jobs(plot_jobs(results, stems, euler_sequence), directory)

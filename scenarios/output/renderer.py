@@ -86,6 +86,7 @@ class Renderer:
         self.pid = pid
         self._fds = [send_fd, receive_fd]
         self._running = True
+        self._submitted = False
 
     @classmethod
     def start(cls) -> Renderer | None:
@@ -111,7 +112,8 @@ class Renderer:
         return cls(pid, to_child, from_child)
 
     def draw(self, jobs: list[Any], directory: Path) -> None:
-        """Have the child draw ``jobs`` into ``directory`` and wait until it has written them.
+        """Have the child draw ``jobs`` into ``directory`` and wait until it has written them
+        (:meth:`submit`, then :meth:`wait`).
 
         Parameters
         ----------
@@ -125,13 +127,52 @@ class Renderer:
         RenderingFailed
             The child ended early or drawing raised; nothing the child wrote is to be trusted.
         """
-        if not self._running:
+        self.submit(jobs, directory)
+        self.wait()
+
+    def submit(self, jobs: list[Any], directory: Path) -> None:
+        """Send ``jobs`` to the child and return while it draws (the caller then works on, for
+        instance on ``report.html``, and calls :meth:`wait` before it uses ``directory``'s figures).
+
+        Parameters
+        ----------
+        jobs : list of (str, series)
+            File names and series (:func:`scenarios.output.plot_data.plot_jobs`).
+        directory : pathlib.Path
+            Existing directory to write into (the run's staging directory).
+
+        Raises
+        ------
+        RenderingFailed
+            The child has already drawn or stopped, or ended before it took the jobs.
+        """
+        if not self._running or len(self._fds) != 2:
             raise RenderingFailed("the plot process has already drawn or stopped")
-        send_fd, receive_fd = self._fds
         try:
-            with os.fdopen(send_fd, "wb", closefd=False) as stream:
+            with os.fdopen(self._fds[0], "wb", closefd=False) as stream:
                 pickle.dump((str(directory), jobs), stream, protocol=pickle.HIGHEST_PROTOCOL)
-            with os.fdopen(receive_fd, "rb", closefd=False) as stream:
+        except OSError as error:
+            self.close()
+            raise RenderingFailed(f"the plot process ended early ({type(error).__name__})") from None
+        except BaseException:  # Ctrl-C, SIGTERM: the child stops before the caller removes `directory`
+            self.close()
+            raise
+        self._submitted = True
+
+    def wait(self) -> None:
+        """Wait until the child has written the figures sent by :meth:`submit`, and reap it.
+
+        Raises
+        ------
+        RenderingFailed
+            Nothing was submitted, the child ended early or drawing raised; nothing the child wrote
+            is to be trusted.
+        """
+        if not self._submitted:
+            raise RenderingFailed("no figures were sent to the plot process")
+        self._submitted = False
+        try:
+            with os.fdopen(self._fds[1], "rb", closefd=False) as stream:
                 status, detail = pickle.load(stream)
         except (OSError, EOFError, pickle.UnpicklingError) as error:
             self.close()

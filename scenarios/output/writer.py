@@ -63,16 +63,25 @@ def write_timeseries(row: Row, path: Path) -> None:
 
 
 def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer: Any) -> None:
-    """The run's figures into ``staging``: by the plot process if there is one, else (or if it
-    fails) in this process."""
+    """The run's figures and ``report.html`` into ``staging``. With a plot process, the figures are
+    sent to it first and the report is built here while it draws; without one (or if it fails),
+    both are made in this process."""
     from scenarios.output.plot_data import plot_jobs
+    from scenarios.output.report.run import run_report
 
     jobs = plot_jobs(results, stems)
     if renderer is not None:
         from scenarios.output.renderer import RenderingFailed
 
         try:
-            renderer.draw(jobs, staging)
+            renderer.submit(jobs, staging)
+        except RenderingFailed as error:
+            print(f"slewbench: {error}; drawing the plots in this process", file=sys.stderr)
+            renderer = None
+    (staging / "report.html").write_text(run_report(results), encoding="utf-8")
+    if renderer is not None:
+        try:
+            renderer.wait()
             return
         except RenderingFailed as error:
             print(f"slewbench: {error}; drawing the plots in this process", file=sys.stderr)
@@ -119,9 +128,6 @@ def write_results(results: RunResults, directory: str | Path, plots: bool = True
             if row.simulation is not None:
                 write_timeseries(row, series / f"{stem}.csv")
         if plots:
-            from scenarios.output.report.run import run_report
-
-            (staging / "report.html").write_text(run_report(results), encoding="utf-8")
             _write_plots(results, staging, stems, renderer)
         commit_outputs(target, staging, kind="run")
     finally:

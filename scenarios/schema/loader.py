@@ -198,6 +198,8 @@ class Scenario:
         requirements' constraints, tabulated for the run, are ``problem.pointing``.
     epoch : datetime.datetime or None, optional
         The instant of t = 0, UTC (``epoch``); ``None``: none.
+    euler_sequence : str, optional
+        The Euler sequence of the figures (``plots.euler_sequence``; default ``"321"``).
     data : dict or None, optional
         A copy of the YAML data it was parsed from (recorded in ``results.json``); ``None`` for a
         scenario built in code.
@@ -211,6 +213,7 @@ class Scenario:
     source: Path | None = None
     requirements: Requirements = field(default_factory=Requirements)
     epoch: datetime.datetime | None = None
+    euler_sequence: str = "321"
     data: dict[str, Any] | None = field(default=None, repr=False, compare=False)
 
     @property
@@ -361,6 +364,21 @@ SIMULATION = Section((
             "otherwise.", default=False),
 ), "Closed-loop settings.")
 
+def _euler_sequence(node: Node) -> str:
+    """An Euler sequence: one of :data:`ocp.quat.EULER_SEQUENCES` (an unquoted ``321`` is read as the text)."""
+    value = node.value
+    text = str(value) if isinstance(value, int) and not isinstance(value, bool) else value
+    if text not in quat.EULER_SEQUENCES:
+        raise node.error(f"expected an Euler sequence, one of {list(quat.EULER_SEQUENCES)}, got {excerpt(value)}")
+    return text
+
+
+PLOTS = Section((
+    custom("euler_sequence", "The Euler sequence of the row figures' attitude panel: body axes "
+           "in the order of the rotations from the inertial frame (``\"321\"``: yaw about z, pitch, roll).",
+           "text", _euler_sequence, default="321", choices=quat.EULER_SEQUENCES),
+), "How the figures show a run.")
+
 SCENARIO = Section((
     custom("name", f"The scenario's name (at most {MAX_NAME} characters; the default output directory is "
            "``results/<name>``, sanitised).", "text", _name),
@@ -381,6 +399,7 @@ SCENARIO = Section((
     custom("controllers", "Several controllers compared row by row (one row per planner and controller); "
            "labels unique.", "list of mappings", None, default=None, section=CONTROLLER, entries=True),
     mapping("simulation", "Closed-loop settings.", SIMULATION, default={}, null="defaults"),
+    mapping("plots", "How the figures show a run.", PLOTS, default={}, null="defaults"),
     custom("requirements", "What every row is scored against: pointing cones, the actuators' margin, a rate "
            "limit, the final error (the user guide's page on requirements). Absent: the actuators' limits only "
            "(``actuators`` with margin 0); ``null``: none.", "mapping or null",
@@ -500,6 +519,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     planners = _parse_planners(SCENARIO["planners"].value(root))
     controllers = _parse_controllers(root)
     simulation = _parse_simulation(SCENARIO["simulation"].value(root), "simulation")
+    plots = SCENARIO["plots"].value(root)
     requirements_node = SCENARIO["requirements"].value(root)
     root.finish()
     problem = _fit_field_span(problem, simulation, planners)
@@ -513,7 +533,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     check_row_labels(planners, controllers)
     check_compatibility(problem, planners, controllers, simulation)
     return Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch,
-                    data=copy.deepcopy(data))
+                    euler_sequence=plots["euler_sequence"], data=copy.deepcopy(data))
 
 
 def _with_requirements(problem: ManeuverProblem, requirements: Requirements,

@@ -1,5 +1,7 @@
-"""Plot time does not grow (issue 31): ``python -m scenarios.cli run scenarios/eigenaxis_demo.yaml``
-with its plots, this checkout against an earlier commit, side by side.
+"""Plot time does not grow (issue 31): ``slewbench run scenarios/eigenaxis_demo.yaml`` with its
+plots, this checkout against an earlier commit, side by side. The command is the console script's
+own entry point (:func:`scenarios.console.main`, which starts the plot process), run from each
+checkout; ``python -m scenarios.cli`` has no plot process and draws in the run's process.
 
 The earlier commit is checked out into a temporary ``git worktree`` (removed at the end). The two
 commands alternate, the first of each pair alternating too, so that a change in the host's speed
@@ -27,6 +29,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIO = Path("scenarios") / "eigenaxis_demo.yaml"
+CONSOLE = "import sys; from scenarios.console import main; sys.exit(main())"
+"""The ``slewbench`` console script (``[project.scripts]``), run from a checkout."""
 TARGET_RATIO = 1.1
 """Largest ratio of the medians (with plots, this checkout over the base) that meets the target."""
 
@@ -38,7 +42,7 @@ def _children_cpu() -> float:
 
 def timed_run(checkout: Path, out: Path, plots: bool) -> tuple[float, float]:
     """Wall time and CPU time (user + system) [s] of one ``run`` of the demo scenario in ``checkout``."""
-    command = [sys.executable, "-m", "scenarios.cli", "run", str(SCENARIO), "--out", str(out)]
+    command = [sys.executable, "-c", CONSOLE, "run", str(SCENARIO), "--out", str(out)]
     command += [] if plots else ["--no-plots"]
     cpu, start = _children_cpu(), time.perf_counter()
     done = subprocess.run(command, cwd=checkout, capture_output=True, text=True, check=False)
