@@ -35,9 +35,10 @@ from __future__ import annotations
 import datetime
 import re
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -49,8 +50,19 @@ from scenarios.errors import ScenarioError
 if TYPE_CHECKING:
     from scenarios.output.export import RunRecord
 
-__all__ = ["ATTITUDE_TYPES", "AemMessage", "AemOptions", "AemSegment", "TIME_SYSTEMS", "aem_text", "check_aem_export",
-           "format_number", "read_aem", "time_tags", "write_aem_files"]
+__all__ = [
+    "ATTITUDE_TYPES",
+    "TIME_SYSTEMS",
+    "AemMessage",
+    "AemOptions",
+    "AemSegment",
+    "aem_text",
+    "check_aem_export",
+    "format_number",
+    "read_aem",
+    "time_tags",
+    "write_aem_files",
+]
 
 Array = NDArray[np.float64]
 
@@ -455,8 +467,8 @@ def write_aem_files(run: RunRecord, directory: Path, options: AemOptions) -> lis
                                 originator=options.originator, time_system=options.time_system,
                                 header_comments=[f"{produced}: scenario {run.scenario}"],
                                 comments=[f"row {row.label} ({pair}), status {row.status}: {words} attitude",
-                                          f"quaternion from GCRF to SC_BODY_1 (slewbench's body-to-inertial q), "
-                                          f"t = 0 at {run.epoch}"])
+                                          (f"quaternion from GCRF to SC_BODY_1 (slewbench's body-to-inertial q), "
+                                           f"t = 0 at {run.epoch}")])
             except ValueError as error:
                 notes.append(f"row {row.label!r}: {words} not exported: {error}")
                 continue

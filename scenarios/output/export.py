@@ -18,16 +18,22 @@ import csv
 import dataclasses
 import json
 import shutil
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from scenarios.errors import ScenarioError
 from scenarios.output.aem import AemOptions, check_aem_export, write_aem_files
-from scenarios.output.directory import claim_output_directory, commit_outputs, new_staging, read_manifest
+from scenarios.output.directory import (
+    claim_output_directory,
+    commit_outputs,
+    new_staging,
+    read_manifest,
+)
 from scenarios.output.names import row_stems
 
 __all__ = ["EXPORT_FORMATS", "ExportFormat", "ExportReport", "RunRecord", "RunRow", "default_export_directory",
