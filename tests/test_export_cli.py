@@ -143,3 +143,21 @@ def test_an_export_never_writes_into_a_users_directory(run_directory, tmp_path, 
     assert main(["export", str(run_directory), "--format", "aem", "--out", str(mine)]) == 2
     assert "did not create" in capsys.readouterr().err
     assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
+
+
+def test_a_regulation_row_exports_its_closed_loop_only_and_says_so(tmp_path, capsys):
+    text = SCENARIO.replace("""planners:
+  - {name: eigenaxis, label: smooth}
+  - {name: eigenaxis, label: fast, options: {profile: min_time}}
+controller: {name: augmented_quaternion_feedback, options: {kp: 0.2, kd: 0.6}}""",
+                            """planners: []
+controller: {name: eigenaxis_pd, options: {kp: 0.2, kd: 0.6}}""")
+    out = tmp_path / "regulation"
+    assert main(["run", str(scenario_file(tmp_path, text)), "--out", str(out), "--no-plots", "--export", "aem"]) == 0
+    printed = capsys.readouterr().out
+    assert "no reference (regulation mode)" in printed
+    export = out.with_name("regulation-aem")
+    assert sorted(p.name for p in export.glob("*.aem")) == ["eigenaxis_pd.closed_loop.aem"]
+    segment, = read_aem((export / "eigenaxis_pd.closed_loop.aem").read_text()).segments
+    q = csv_columns(out / "timeseries" / "eigenaxis_pd.csv", ["q0", "q1", "q2", "q3"])
+    assert np.max(np.abs(segment.quaternions() - q)) < 1e-12
