@@ -1,4 +1,4 @@
-"""``slewbench`` command line: run, validate, list, schema, codegen, sweep, and ``--version``.
+"""``slewbench`` command line: run, validate, list, schema, codegen, export, sweep, and ``--version``.
 
 Exit status (:mod:`scenarios.cli.status`): 0 when the run completed (a failed planner or a
 violated requirement is a row, not an error), 1 under ``run --strict`` when some row is not ``ok``
@@ -33,6 +33,7 @@ from scenarios.output.directory import (
     claim_output_directory,
     written_files,
 )
+from scenarios.output.export import EXPORT_FORMATS, default_export_directory, export_run
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
 from scenarios.runner import run
@@ -159,7 +160,12 @@ def command_run(args: argparse.Namespace) -> int:
     """
     scenario = load(args.file)
     out = Path(args.out) if args.out else default_output_directory(scenario.name)
+    exports = getattr(args, "export", None) or []
+    for name in exports:  # before planning: an export the run cannot give is refused first
+        _check_run_export(name, scenario.epoch)
     claim_output_directory(out)  # before planning: a long run is never lost at the end
+    for name in exports:
+        claim_output_directory(default_export_directory(out, name), kind="export")
     start = time.perf_counter()
     interruption = getattr(args, "interruption", None) or Interruption()
 
@@ -179,11 +185,58 @@ def command_run(args: argparse.Namespace) -> int:
     if removed:
         print(f"removed {len(removed)} file(s) of the earlier run in {out}/ that this run did not write: "
               + ", ".join(removed))
+    for name in exports:
+        _print_export(export_run(out, name))
     not_ok = [row.label for row in results.rows if row.status != "ok"]
     if getattr(args, "strict", False) and not_ok:
         print(f"slewbench: --strict: {len(not_ok)} of {len(results.rows)} rows not ok ({', '.join(not_ok)})",
               file=sys.stderr)
         return EXIT_NOT_OK
+    return EXIT_OK
+
+
+def _check_run_export(name: str, epoch: Any) -> None:
+    """Refuse ``run --export NAME`` for an unknown format, or an AEM of a scenario without an epoch."""
+    if name not in EXPORT_FORMATS:
+        raise ScenarioError("--export", f"{name!r} is not an export format; known: {', '.join(EXPORT_FORMATS)}")
+    if name == "aem" and epoch is None:
+        raise ScenarioError("epoch", "the scenario has no epoch, so its times are not absolute and its inertial "
+                                     "frame is not the GCRF; `--export aem` needs both: give the scenario an `epoch` "
+                                     "(UTC, e.g. 2027-03-20T12:00:00Z)")
+
+
+def _print_export(report: Any) -> None:
+    """The lines ``export`` (and ``run --export``) print: what was written and what was left out."""
+    print(f"wrote {report.directory}/: " + (", ".join(report.files) or "nothing"))
+    for note in report.notes:
+        print(f"  {note}")
+
+
+def command_export(args: argparse.Namespace) -> int:
+    """``slewbench export RUN_DIR --format NAME [--out DIR] [--option NAME=VALUE ...]``: write a
+    finished run's rows in another tool's format (:data:`scenarios.output.export.EXPORT_FORMATS`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``run_directory`` (the output directory of ``slewbench run``), ``format``, ``out``
+        (``None``: ``<RUN_DIR>-<format>``) and ``option`` (``NAME=VALUE`` texts, or ``None``).
+
+    Returns
+    -------
+    int
+        Exit status: 0, or 2 for a directory that is not a finished run, a run the format cannot
+        take (an AEM of a run without an epoch), an unknown option, or an output location
+        slewbench must not write to.
+    """
+    try:
+        export = EXPORT_FORMATS[args.format]
+        options = export.parse_options(args.option or [])
+        report = export_run(args.run_directory, args.format, args.out, options)
+    except ScenarioError as error:
+        print(f"slewbench: export: {error}", file=sys.stderr)
+        return EXIT_BAD_SCENARIO
+    _print_export(report)
     return EXIT_OK
 
 
@@ -216,7 +269,7 @@ def command_codegen(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The ``slewbench`` argument parser (run, validate, codegen, list, schema, sweep, report).
+    """The ``slewbench`` argument parser (run, validate, codegen, export, list, schema, sweep, report).
 
     Returns
     -------
@@ -239,6 +292,9 @@ def build_parser() -> argparse.ArgumentParser:
     run_parser.add_argument("--strict", action="store_true",
                             help=f"exit {EXIT_NOT_OK} when any row is not ok (violated or failed), after writing the "
                                  "results (for continuous integration)")
+    run_parser.add_argument("--export", action="append", choices=sorted(EXPORT_FORMATS), metavar="FORMAT",
+                            help="also export the rows into <out>-FORMAT/ (formats: "
+                                 f"{', '.join(sorted(EXPORT_FORMATS))}; as `slewbench export` with default options)")
     run_parser.set_defaults(handler=command_run)
     validate_parser = commands.add_parser("validate", help="check a scenario or study file; print what would run")
     validate_parser.add_argument("file", help="scenario or study YAML file (a study has the top-level key 'study')")
@@ -247,6 +303,16 @@ def build_parser() -> argparse.ArgumentParser:
     codegen_parser.add_argument("file", help="scenario YAML file")
     codegen_parser.add_argument("--out", required=True, help="output directory (new, empty, or written by slewbench)")
     codegen_parser.set_defaults(handler=command_codegen)
+    export_parser = commands.add_parser("export", help="write a finished run's rows in another tool's format "
+                                                       "(aem: CCSDS attitude ephemeris messages)")
+    export_parser.add_argument("run_directory", metavar="RUN_DIR", help="output directory of `slewbench run`")
+    export_parser.add_argument("--format", required=True, choices=sorted(EXPORT_FORMATS),
+                               help="; ".join(f"{name}: {fmt.description}" for name, fmt in EXPORT_FORMATS.items()))
+    export_parser.add_argument("--out", help="export directory (default: RUN_DIR-FORMAT beside RUN_DIR)")
+    export_parser.add_argument("--option", action="append", metavar="NAME=VALUE",
+                               help="a format option, repeatable (aem: time_system=UTC|TAI|TT|TDB, "
+                                    "attitude_type=QUATERNION/ANGVEL|QUATERNION, originator, object_name, object_id)")
+    export_parser.set_defaults(handler=command_export)
     list_parser = commands.add_parser("list", help="registered planners and controllers")
     list_parser.add_argument("--options", metavar="NAME",
                              help="the options of planner or controller NAME: type, unit, default and range")

@@ -8,8 +8,10 @@ manifest and staged commits (:mod:`~scenarios.output.directory`), writing a run'
 (:mod:`~scenarios.output.writer`), the figures' data as arrays
 (:mod:`~scenarios.output.plot_data`), the matplotlib drawing (:mod:`~scenarios.output.plots`),
 the plot process that draws while the run goes on (:mod:`~scenarios.output.renderer`), the
-interactive ``report.html`` (:mod:`scenarios.output.report`), and where results come from:
-versions, platform, date and seeds (:mod:`~scenarios.output.provenance`).
+interactive ``report.html`` (:mod:`scenarios.output.report`), where results come from:
+versions, platform, date and seeds (:mod:`~scenarios.output.provenance`), and exports of a finished
+run into other tools' formats (:mod:`~scenarios.output.export`, the ``EXPORT_FORMATS`` registry;
+CCSDS attitude ephemeris messages in :mod:`~scenarios.output.aem`).
 
 May import: :mod:`ocp`, :mod:`planners` (types), :mod:`scenarios.errors` and
 :mod:`scenarios.schema`. :mod:`~scenarios.output.plots` and :mod:`~scenarios.output.renderer` import
@@ -20,10 +22,13 @@ from __future__ import annotations
 
 from scenarios._faces import lazy_face
 
-_HOMES = {"Renderer": "scenarios.output.renderer",
+_HOMES = {"EXPORT_FORMATS": "scenarios.output.export",
+          "Renderer": "scenarios.output.renderer",
           "Row": "scenarios.output.results",
           "RunResults": "scenarios.output.results",
           "claim_output_directory": "scenarios.output.directory",
+          "export_run": "scenarios.output.export",
+          "read_aem": "scenarios.output.aem",
           "read_manifest": "scenarios.output.directory",
           "row_stems": "scenarios.output.names",
           "flatten_row": "scenarios.output.tables",
@@ -36,7 +41,8 @@ _HOMES = {"Renderer": "scenarios.output.renderer",
           "to_terminal": "scenarios.output.tables",
           "write_results": "scenarios.output.writer"}
 
-__all__ = ["Renderer", "Row", "RunResults", "claim_output_directory", "flatten_row", "read_manifest",
+__all__ = ["EXPORT_FORMATS", "Renderer", "Row", "RunResults", "claim_output_directory", "export_run", "flatten_row",
+           "read_aem", "read_manifest",
            "row_columns", "row_stems", "sanitize", "to_csv", "to_dataframe", "to_json", "to_markdown", "to_terminal",
            "write_results"]
 

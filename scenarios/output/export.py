@@ -1,0 +1,305 @@
+"""Exports of a finished run into other tools' formats: the ``EXPORT_FORMATS`` registry, the run
+directory read back, and ``export_run``, which writes an export into a directory slewbench owns.
+
+An export reads what ``slewbench run`` wrote (``results.json`` and ``timeseries/<row>.csv``), so
+that nothing is run again: the closed-loop attitude and rate and the reference's, at the
+simulation's samples, with the run's epoch and frame.
+
+A format is an :class:`ExportFormat`: a name, a one-line description, a frozen dataclass of
+options (text fields, given on the command line as ``--option NAME=VALUE``) and a writer
+``write(run, directory, options) -> list[str]`` that writes its files into ``directory`` (a
+staging folder) and returns notes (rows it left out, and why). It raises
+:class:`~scenarios.errors.ScenarioError` when the run cannot be exported at all (an AEM without an
+epoch).
+"""
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import shutil
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from scenarios.errors import ScenarioError
+from scenarios.output.aem import AemOptions, check_aem_export, write_aem_files
+from scenarios.output.directory import (
+    claim_output_directory,
+    commit_outputs,
+    new_staging,
+    read_manifest,
+)
+from scenarios.output.names import row_stems
+
+__all__ = ["EXPORT_FORMATS", "ExportFormat", "ExportReport", "RunRecord", "RunRow", "default_export_directory",
+           "export_run", "read_run"]
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class RunRow:
+    """One row of a finished run, as ``results.json`` and its time series give it.
+
+    Parameters
+    ----------
+    label, planner, controller, status : str or None
+        As in ``results.json`` (``planner`` ``None`` in regulation mode).
+    stem : str
+        The row's file stem (:func:`~scenarios.output.names.row_stems`).
+    timeseries : Path or None
+        Its ``timeseries/<stem>.csv``; ``None`` when the row was not simulated.
+    """
+
+    label: str
+    planner: str | None
+    controller: str | None
+    status: str
+    stem: str
+    timeseries: Path | None
+
+    def series(self) -> dict[str, Array]:
+        """The row's time series as arrays (blank cells NaN).
+
+        Returns
+        -------
+        dict of str to ndarray
+            ``t`` (N,) [s]; ``q`` (N, 4) closed-loop attitude, body to inertial, scalar first;
+            ``omega`` (N, 3) body rate [rad/s, body]; ``ref_q`` and ``ref_omega`` the reference's
+            (NaN without a reference).
+        """
+        if self.timeseries is None:
+            raise ValueError(f"row {self.label!r} has no time series")
+        with self.timeseries.open(newline="") as handle:
+            reader = csv.reader(handle)
+            header = next(reader)
+            table = np.array([[float(cell) if cell else np.nan for cell in line] for line in reader], dtype=float)
+        table = table.reshape(-1, len(header))
+        column = {name: index for index, name in enumerate(header)}
+
+        def block(*names: str) -> Array:
+            return table[:, [column[name] for name in names]]
+
+        return {"t": table[:, column["t"]], "q": block("q0", "q1", "q2", "q3"),
+                "omega": block("omega_x", "omega_y", "omega_z"),
+                "ref_q": block("ref_q0", "ref_q1", "ref_q2", "ref_q3"),
+                "ref_omega": block("ref_omega_x", "ref_omega_y", "ref_omega_z")}
+
+
+@dataclass(frozen=True)
+class RunRecord:
+    """A finished run directory, read back.
+
+    Parameters
+    ----------
+    directory : Path
+        The run directory.
+    scenario : str
+        The scenario's name.
+    frame : str
+        The inertial frame (``GCRF``, or ``inertial (no epoch)``).
+    epoch : str or None
+        The epoch, UTC, ISO 8601 with ``Z``; ``None`` without one.
+    rows : list of RunRow
+        The rows, in order.
+    provenance : dict
+        ``results.json``'s provenance (version, date, ...).
+    """
+
+    directory: Path
+    scenario: str
+    frame: str
+    epoch: str | None
+    rows: list[RunRow]
+    provenance: dict[str, Any]
+
+
+def read_run(directory: str | Path) -> RunRecord:
+    """Read a run directory that ``slewbench run`` wrote completely.
+
+    Parameters
+    ----------
+    directory : str or Path
+        The run's output directory.
+
+    Returns
+    -------
+    RunRecord
+
+    Raises
+    ------
+    ScenarioError
+        Not a directory, not a complete slewbench run, or an unreadable ``results.json``
+        (at the directory).
+    """
+    path = Path(directory).expanduser()
+    if not path.is_dir():
+        raise ScenarioError(str(directory), "is not a directory; give the output directory of `slewbench run` "
+                                            "(results/<scenario> by default)")
+    manifest = read_manifest(path)
+    if manifest is None or manifest.get("kind") != "run" or "results.json" not in manifest["files"]:
+        raise ScenarioError(str(directory), "holds no run written by `slewbench run` (no run manifest naming "
+                                            "results.json); give a run's output directory")
+    if not manifest.get("complete"):
+        raise ScenarioError(str(directory), "holds an incomplete run (interrupted while writing); run it again")
+    try:
+        data = json.loads((path / "results.json").read_text())
+        labels = [row["label"] for row in data["rows"]]
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise ScenarioError(str(path / "results.json"), f"cannot be read as a run's results: {error}") from None
+    rows = []
+    for row, stem in zip(data["rows"], row_stems(labels)):
+        name = f"timeseries/{stem}.csv"
+        series = path / name if name in manifest["files"] and (path / name).is_file() else None
+        rows.append(RunRow(row["label"], row.get("planner"), row.get("controller"), row.get("status", ""), stem,
+                           series))
+    return RunRecord(path.absolute(), str(data.get("scenario", "")), str(data.get("frame", "")), data.get("epoch"),
+                     rows, data.get("provenance") or {})
+
+
+@dataclass(frozen=True)
+class ExportFormat:
+    """An export format of a finished run.
+
+    Parameters
+    ----------
+    name : str
+        The registry key (``slewbench export --format NAME``).
+    description : str
+        One line: what it writes.
+    options : type
+        A frozen dataclass whose fields (text) are the format's options.
+    check : callable
+        ``check(run, options)``: raises :class:`~scenarios.errors.ScenarioError` when the run
+        cannot be exported with these options (before anything is written).
+    write : callable
+        ``write(run, directory, options) -> list of notes``: writes the files into ``directory``.
+    """
+
+    name: str
+    description: str
+    options: type
+    check: Callable[[RunRecord, Any], None]
+    write: Callable[[RunRecord, Path, Any], list[str]]
+
+    def parse_options(self, pairs: list[str]) -> Any:
+        """The options from ``NAME=VALUE`` texts.
+
+        Parameters
+        ----------
+        pairs : list of str
+            ``NAME=VALUE`` texts (the command line's ``--option``).
+
+        Returns
+        -------
+        object
+            An instance of :attr:`options`.
+
+        Raises
+        ------
+        ScenarioError
+            A text without ``=`` or a name the format does not have (the names are listed).
+        """
+        names = [item.name for item in dataclasses.fields(self.options)]
+        values: dict[str, str] = {}
+        for pair in pairs:
+            name, equals, value = pair.partition("=")
+            if not equals or name.strip() not in names:
+                raise ScenarioError(f"--option {pair}", f"expected NAME=VALUE with NAME one of {', '.join(names)} "
+                                                        f"(the {self.name} export's options)")
+            values[name.strip()] = value.strip()
+        return self.options(**values)
+
+
+EXPORT_FORMATS: dict[str, ExportFormat] = {
+    "aem": ExportFormat("aem", "CCSDS Attitude Ephemeris Messages (504.0-B-2, KVN): each simulated row's closed-loop "
+                               "and reference attitude, body to GCRF", AemOptions, check_aem_export, write_aem_files),
+}
+"""The export formats by name."""
+
+
+@dataclass(frozen=True)
+class ExportReport:
+    """What :func:`export_run` wrote.
+
+    Parameters
+    ----------
+    directory : Path
+        The export directory.
+    files : list of str
+        The files written there.
+    notes : list of str
+        Rows or histories left out, and why.
+    """
+
+    directory: Path
+    files: list[str]
+    notes: list[str]
+
+
+def default_export_directory(run_directory: str | Path, format_name: str) -> Path:
+    """``<run directory>-<format>``, beside the run directory (never inside it: a later run there
+    would not know the export's files).
+
+    Parameters
+    ----------
+    run_directory : str or Path
+        The run's output directory.
+    format_name : str
+        The export format.
+
+    Returns
+    -------
+    Path
+    """
+    path = Path(run_directory).expanduser().absolute()
+    return path.with_name(f"{path.name}-{format_name}")
+
+
+def export_run(run_directory: str | Path, format_name: str, out: str | Path | None = None,
+               options: Any = None) -> ExportReport:
+    """Export a finished run into ``out``, a directory slewbench owns (new, empty or an earlier export).
+
+    Parameters
+    ----------
+    run_directory : str or Path
+        The output directory of ``slewbench run``.
+    format_name : str
+        A key of :data:`EXPORT_FORMATS`.
+    out : str or Path, optional
+        The export directory (default :func:`default_export_directory`).
+    options : object, optional
+        The format's options (an instance of its ``options`` class; default: its defaults).
+
+    Returns
+    -------
+    ExportReport
+
+    Raises
+    ------
+    ScenarioError
+        An unknown format, a directory that is not a finished run, or a run the format cannot
+        take (an AEM without an epoch). Nothing is written then.
+    OutputError
+        ``out`` is not slewbench's to write (:func:`~scenarios.output.directory.claim_output_directory`).
+    """
+    export = EXPORT_FORMATS.get(format_name)
+    if export is None:
+        raise ScenarioError("--format", f"{format_name!r} is not an export format; known: {', '.join(EXPORT_FORMATS)}")
+    run = read_run(run_directory)
+    options = export.options() if options is None else options
+    export.check(run, options)
+    target = claim_output_directory(out if out is not None else default_export_directory(run.directory, format_name),
+                                    kind="export")
+    staging = new_staging(target)
+    try:
+        notes = export.write(run, staging, options)
+        files = commit_outputs(target, staging, kind="export")
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return ExportReport(target, files, notes)

@@ -1,0 +1,163 @@
+"""``slewbench export`` and ``slewbench run --export``: a finished run's rows as CCSDS AEMs, read
+back independently (the run's own time series CSV, parsed here, and ``ccsds-ndm-py`` when
+installed), and the command line's refusals (exit status 2, nothing written)."""
+import csv
+import json
+import textwrap
+
+import numpy as np
+import pytest
+
+from scenarios.cli.commands import main
+from scenarios.output.aem import read_aem
+
+SCENARIO = """
+name: export check
+epoch: 2027-03-20T12:00:00Z
+spacecraft:
+  inertia: [2.0, 3.0, 4.0]
+  wheels: {max_torque: 0.05}
+maneuver:
+  duration: 30.0
+  initial: {q: [1, 0, 0, 0], omega: [0, 0, 0]}
+  final: {q: [0.9238795, 0.3826834, 0, 0], omega: [0, 0, 0]}
+planners:
+  - {name: eigenaxis, label: smooth}
+  - {name: eigenaxis, label: fast, options: {profile: min_time}}
+controller: {name: augmented_quaternion_feedback, options: {kp: 0.2, kd: 0.6}}
+simulation: {sample_time: 0.5, duration: 35.0, initial_attitude_error_deg: [0.5, 0.2, 0]}
+"""
+
+
+def scenario_file(tmp_path, text=SCENARIO, name="scenario.yaml"):
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def csv_columns(path, names):
+    """Columns of a time series CSV, parsed here with the csv module."""
+    with path.open(newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    return np.array([[float(row[name]) for name in names] for row in rows])
+
+
+@pytest.fixture(scope="module")
+def run_directory(tmp_path_factory):
+    root = tmp_path_factory.mktemp("export")
+    out = root / "run"
+    assert main(["run", str(scenario_file(root)), "--out", str(out), "--no-plots", "--export", "aem"]) == 0
+    return out
+
+
+def test_run_export_writes_each_rows_reference_and_closed_loop_with_the_csv_quaternions(run_directory):
+    export = run_directory.with_name("run-aem")
+    names = sorted(p.name for p in export.iterdir() if not p.name.startswith("."))
+    assert names == ["fast.closed_loop.aem", "fast.reference.aem", "smooth.closed_loop.aem", "smooth.reference.aem"]
+    manifest = json.loads((export / ".slewbench-output.json").read_text())
+    assert manifest["kind"] == "export" and manifest["complete"] and sorted(manifest["files"]) == names
+    for label in ("smooth", "fast"):
+        series = run_directory / "timeseries" / f"{label}.csv"
+        t = csv_columns(series, ["t"])[:, 0]
+        for scope, prefix in (("closed_loop", ""), ("reference", "ref_")):
+            q = csv_columns(series, [f"{prefix}q{i}" for i in range(4)])
+            omega = csv_columns(series, [f"{prefix}omega_{axis}" for axis in "xyz"])
+            segment, = read_aem((export / f"{label}.{scope}.aem").read_text()).segments
+            assert segment.metadata["ATTITUDE_TYPE"] == "QUATERNION/ANGVEL"
+            assert segment.metadata["TIME_SYSTEM"] == "UTC" and segment.metadata["REF_FRAME_A"] == "GCRF"
+            assert np.max(np.abs(segment.quaternions() - q)) < 1e-12
+            assert np.max(np.abs(np.radians(segment.values[:, 4:]) - omega)) < 1e-12
+            # the time tags: the epoch 12:00:00 plus the CSV's t (no leap second in March 2027)
+            seconds = [int(tag[11:13]) * 3600 + int(tag[14:16]) * 60 + float(tag[17:]) - 12 * 3600
+                       for tag in segment.epochs]
+            assert np.max(np.abs(np.array(seconds) - t)) < 1e-9
+            assert segment.epochs[0] == "2027-03-20T12:00:00.000000000"
+
+
+def test_the_independent_reader_agrees_on_every_exported_file(run_directory):
+    ndm = pytest.importorskip("ccsds_ndm", reason="ccsds-ndm-py (the `test` extra) reads AEMs independently")
+    export = run_directory.with_name("run-aem")
+    for path in sorted(export.glob("*.aem")):
+        message = ndm.from_file(str(path))
+        message.validate()
+        data = message.segments[0].data.attitude_states_numpy
+        mine = read_aem(path.read_text()).segments[0]
+        assert np.max(np.abs(np.column_stack([data[:, 3], data[:, :3]]) - mine.quaternions())) < 1e-12
+        assert list(message.segments[0].data.attitude_states_epochs) == mine.epochs
+
+
+def test_export_command_with_options_and_a_rerun_into_its_own_directory(run_directory, tmp_path, capsys):
+    out = tmp_path / "tt"
+    argv = ["export", str(run_directory), "--format", "aem", "--out", str(out), "--option", "time_system=TT",
+            "--option", "attitude_type=QUATERNION", "--option", "object_id=2027-012A"]
+    assert main(argv) == 0
+    assert main(argv) == 0  # its own directory: replaced
+    assert "smooth.reference.aem" in capsys.readouterr().out
+    segment, = read_aem((out / "smooth.reference.aem").read_text()).segments
+    assert segment.metadata["TIME_SYSTEM"] == "TT" and segment.metadata["OBJECT_ID"] == "2027-012A"
+    assert segment.values.shape[1] == 4 and "ANGVEL_FRAME" not in segment.metadata
+    assert segment.epochs[0] == "2027-03-20T12:01:09.184000000"  # TT = UTC + 37 s + 32.184 s
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["--option", "time_system=GPS"], "time_system"),
+    (["--option", "colour=red"], "NAME one of time_system"),
+    (["--option", "attitude_type=EULER_ANGLE"], "attitude_type"),
+])
+def test_bad_options_exit_2_and_write_nothing(run_directory, tmp_path, capsys, argv, fragment):
+    out = tmp_path / "bad"
+    assert main(["export", str(run_directory), "--format", "aem", "--out", str(out), *argv]) == 2
+    assert fragment in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_a_run_without_epoch_is_refused_naming_epoch(tmp_path, capsys):
+    text = SCENARIO.replace("epoch: 2027-03-20T12:00:00Z\n", "")
+    path = scenario_file(tmp_path, text)
+    out = tmp_path / "plain"
+    assert main(["run", str(path), "--out", str(out), "--no-plots", "--export", "aem"]) == 2
+    assert "epoch" in capsys.readouterr().err and not out.exists()  # refused before planning
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    capsys.readouterr()
+    assert main(["export", str(out), "--format", "aem"]) == 2
+    error = capsys.readouterr().err
+    assert "epoch" in error and "GCRF" in error
+    assert not out.with_name("plain-aem").exists()
+
+
+def test_a_missing_or_foreign_directory_exits_2(tmp_path, capsys):
+    assert main(["export", str(tmp_path / "nowhere"), "--format", "aem"]) == 2
+    assert "is not a directory" in capsys.readouterr().err
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("a user's file")
+    assert main(["export", str(mine), "--format", "aem"]) == 2
+    assert "no run" in capsys.readouterr().err
+    assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
+
+
+def test_an_export_never_writes_into_a_users_directory(run_directory, tmp_path, capsys):
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("a user's file")
+    assert main(["export", str(run_directory), "--format", "aem", "--out", str(mine)]) == 2
+    assert "did not create" in capsys.readouterr().err
+    assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
+
+
+def test_a_regulation_row_exports_its_closed_loop_only_and_says_so(tmp_path, capsys):
+    text = SCENARIO.replace("""planners:
+  - {name: eigenaxis, label: smooth}
+  - {name: eigenaxis, label: fast, options: {profile: min_time}}
+controller: {name: augmented_quaternion_feedback, options: {kp: 0.2, kd: 0.6}}""",
+                            """planners: []
+controller: {name: eigenaxis_pd, options: {kp: 0.2, kd: 0.6}}""")
+    out = tmp_path / "regulation"
+    assert main(["run", str(scenario_file(tmp_path, text)), "--out", str(out), "--no-plots", "--export", "aem"]) == 0
+    printed = capsys.readouterr().out
+    assert "no reference (regulation mode)" in printed
+    export = out.with_name("regulation-aem")
+    assert sorted(p.name for p in export.glob("*.aem")) == ["eigenaxis_pd.closed_loop.aem"]
+    segment, = read_aem((export / "eigenaxis_pd.closed_loop.aem").read_text()).segments
+    q = csv_columns(out / "timeseries" / "eigenaxis_pd.csv", ["q0", "q1", "q2", "q3"])
+    assert np.max(np.abs(segment.quaternions() - q)) < 1e-12
