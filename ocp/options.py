@@ -24,9 +24,8 @@ import functools
 import math
 import types
 import typing
-from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Annotated, Any, ClassVar, Literal, TypeVar, Union
+from typing import Annotated, Any, ClassVar, Literal, Mapping, TypeVar, Union
 
 from ocp.errors import InvalidOption, OptionsError, excerpt
 

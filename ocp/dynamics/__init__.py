@@ -17,48 +17,22 @@ closed-form spinning attitude (:mod:`~ocp.dynamics.spin_closed_form`).
 May import: NumPy, CasADi, ppigrf, pyerfa, sgp4, jplephem with de421 and the top-level modules of :mod:`ocp` (``quat``,
 ``quat_casadi``, ``cache``, ``fast_call``, ``errors``); never the other subpackages of ``ocp``.
 """
-from ocp.dynamics.actuator_kinds import (
-    ACTUATOR_KINDS,
-    Actuator,
-    Magnetorquers,
-    ReactionWheels,
-    Torquers,
-    actuator_kind,
-)
+from ocp.dynamics.actuator_kinds import ACTUATOR_KINDS, Actuator, Magnetorquers, ReactionWheels, Torquers, actuator_kind
 from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
-from ocp.dynamics.environment import (
-    MAGNETIC_FIELDS,
-    Environment,
-    FieldModel,
-    MagneticField,
-    TiltedDipole,
-    gravity_gradient_torque,
-)
-from ocp.dynamics.ephemeris import (
-    EPHEMERIS_RANGE,
-    check_epoch,
-    moon_position,
-    parse_utc,
-    sun_position,
-    tdb_julian_date,
-)
+from ocp.dynamics.environment import (MAGNETIC_FIELDS, Environment, FieldModel, MagneticField, TiltedDipole,
+                                      gravity_gradient_torque)
+from ocp.dynamics.ephemeris import EPHEMERIS_RANGE, check_epoch, moon_position, parse_utc, sun_position, tdb_julian_date
 from ocp.dynamics.igrf import IGRFField
 from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.model import AttitudeModel
-from ocp.dynamics.orbits import (
-    ORBITS,
-    CircularOrbit,
-    KeplerianOrbit,
-    Orbit,
-    OrbitKind,
-    TLEOrbit,
-)
+from ocp.dynamics.orbits import ORBITS, CircularOrbit, KeplerianOrbit, Orbit, OrbitKind, TLEOrbit
 from ocp.dynamics.spacecraft import Spacecraft
 
-__all__ = ["ACTUATOR_KINDS", "EPHEMERIS_RANGE", "MAGNETIC_FIELDS", "ORBITS", "Actuator", "ActuatorModel", "AttitudeModel",
-           "CircularOrbit", "Command", "Environment", "FieldModel", "IGRFField", "KeplerianOrbit", "MagneticField",
-           "Magnetorquers", "Measurement", "Orbit", "OrbitKind", "ReactionWheels", "Spacecraft", "TLEOrbit", "TiltedDipole", "Torquers", "actuator_kind", "check_epoch",
-           "gravity_gradient_torque", "moon_position", "parse_utc", "rk4_step", "sun_position", "tdb_julian_date"]
+__all__ = ["ACTUATOR_KINDS", "EPHEMERIS_RANGE", "MAGNETIC_FIELDS", "ORBITS", "Actuator", "ActuatorModel",
+           "AttitudeModel", "CircularOrbit", "Command", "Environment", "FieldModel", "IGRFField", "KeplerianOrbit",
+           "MagneticField", "Magnetorquers", "Measurement", "Orbit", "OrbitKind", "ReactionWheels", "Spacecraft",
+           "TLEOrbit", "TiltedDipole", "Torquers", "actuator_kind", "check_epoch", "gravity_gradient_torque",
+           "moon_position", "parse_utc", "rk4_step", "sun_position", "tdb_julian_date"]
 
 
 def __dir__() -> list[str]:

@@ -666,16 +666,21 @@ def _tai(epoch: datetime.datetime, t: NDArray) -> tuple[NDArray, NDArray]:
 def teme_to_gcrf_matrices(epoch: datetime.datetime, t: ArrayLike) -> NDArray:
     """Rotation matrices from SGP4's TEME frame to the GCRF at ``epoch + t``.
 
-    TEME's axes are the true equator of date and the *mean* equinox; the true equator and
-    equinox of date (TOD) follow by the equation of the equinoxes about the pole, and the GCRF
-    from TOD by the transpose of the IAU 2006/2000A bias-precession-nutation matrix (ERFA's
-    ``pnm06a``, ``ee06a``; TT from UTC by ERFA's leap-second table)::
+    TEME's x axis lies at the Greenwich mean sidereal angle of the IAU 1982 model (GMST82, which
+    SGP4 uses) from the Greenwich meridian, about the true pole of date (Vallado et al. 2006,
+    "Revisiting Spacetrack Report #3"). A TEME vector's components in the true equator and
+    equinox of date (TOD) follow by turning it about that pole by ``GAST − GMST82`` (an equation
+    of the equinoxes), and the GCRF from TOD by the transpose of the IAU 2006/2000A
+    bias-precession-nutation matrix (ERFA's ``gmst82``, ``gst06a``, ``pnm06a``; TT from UTC by
+    ERFA's leap-second table)::
 
-        r_GCRF = NPB(t)ᵀ R3(−EE(t)) r_TEME
+        r_GCRF = NPB(t)ᵀ Rz(GAST(t) − GMST82(t)) r_TEME    (Rz(a): a vector turned by a about z)
 
-    No Earth rotation angle (so no UT1) and no polar motion enter. The route agrees with the
-    IAU 1976/1980 one SGP4 was defined with to the difference of the nutation models (a few
-    milliarcseconds, centimetres in low orbit), far below SGP4's own error (about a kilometre at
+    The two sidereal angles are taken with UT1 = UTC: their difference changes by 1e-11 rad over
+    the 0.9 s UT1 − UTC may reach, so no Earth orientation data are needed; polar motion does not
+    enter. The result agrees with ERFA's CIO-based route (``c2t06a`` with GMST82, tested) to under
+    a millimetre in low orbit, and with the older IAU 1976/1980 route to the few milliarcseconds
+    between the nutation models (centimetres), far below SGP4's own error (about a kilometre at
     the TLE epoch, growing by kilometres a day). The matrices' rate (precession, 50″ a year) is
     neglected in the velocity (under 1e-4 m/s).
 
@@ -696,12 +701,15 @@ def teme_to_gcrf_matrices(epoch: datetime.datetime, t: ArrayLike) -> NDArray:
     t = np.atleast_1d(np.asarray(t, dtype=float)).reshape(-1)
     tai1, tai2 = _tai(parse_utc(epoch), t)
     tt1, tt2 = erfa.taitt(tai1, tai2)
-    npb = erfa.pnm06a(tt1, tt2)                              # GCRS -> true of date
-    ee = erfa.ee06a(tt1, tt2)
-    c, s = np.cos(ee), np.sin(ee)
-    zeros, ones = np.zeros_like(ee), np.ones_like(ee)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", erfa.ErfaWarning)
+        ut1, ut2 = erfa.taiutc(tai1, tai2)                     # UT1 = UTC (see above)
+    npb = erfa.pnm06a(tt1, tt2)                                # GCRS -> true of date
+    angle = erfa.gst06a(ut1, ut2, tt1, tt2) - erfa.gmst82(ut1, ut2)  # the equation of the equinoxes
+    c, s = np.cos(angle), np.sin(angle)
+    zeros, ones = np.zeros_like(angle), np.ones_like(angle)
     r3 = np.stack([np.stack([c, -s, zeros], -1), np.stack([s, c, zeros], -1),
-                   np.stack([zeros, zeros, ones], -1)], -2)  # R3(-EE): TEME -> TOD
+                   np.stack([zeros, zeros, ones], -1)], -2)    # TEME -> TOD (vectors turned by the angle)
     return np.einsum("nji,njk->nik", npb, r3)
 
 

@@ -10,15 +10,8 @@ and their tables along a run).
 May import: NumPy, CasADi and the top-level modules of :mod:`ocp`, and :mod:`ocp.dynamics` (the
 orbit, the ephemeris); never the other subpackages of ``ocp``.
 """
-from ocp.geometry.directions import (
-    DIRECTIONS,
-    FRAMES,
-    INTERPOLATION_TOLERANCE,
-    DirectionKind,
-    Geometry,
-    direction_kind,
-    direction_table,
-)
+from ocp.geometry.directions import (DIRECTIONS, FRAMES, INTERPOLATION_TOLERANCE, DirectionKind, Geometry,
+                                     direction_kind, direction_table)
 from ocp.geometry.pointing import PointingConstraint, PointingScore, violation_intervals
 
 __all__ = ["DIRECTIONS", "FRAMES", "INTERPOLATION_TOLERANCE", "DirectionKind", "Geometry", "PointingConstraint",

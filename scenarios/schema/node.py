@@ -24,7 +24,7 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
-def _is_finite(value: float) -> bool:
+def _is_finite(value: int | float) -> bool:
     """Whether a number is finite as a float (an integer too large for a float is not)."""
     try:
         return math.isfinite(value)
