@@ -9,6 +9,7 @@ import copy
 import datetime
 import io
 from pathlib import Path
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -18,7 +19,12 @@ from scipy.optimize import brentq
 
 import scenarios
 from ocp import AttitudeModel, Environment, Spacecraft, TiltedDipole, quat
-from ocp.dynamics.orbits import ORBITS, KeplerianOrbit, TLEOrbit, kepler_newton_iterations
+from ocp.dynamics.orbits import (
+    ORBITS,
+    KeplerianOrbit,
+    TLEOrbit,
+    kepler_newton_iterations,
+)
 from ocp.geometry.directions import DIRECTIONS, Geometry
 from scenarios.cli.commands import main
 
@@ -51,7 +57,7 @@ def rx(angle: float) -> np.ndarray:
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
-def kepler_position(a, e, i, raan, argp, m0, t) -> np.ndarray:
+def kepler_position(a: float, e: float, i: float, raan: float, argp: float, m0: float, t: float) -> np.ndarray:
     """Two-body position [m], perifocal frame rotated by Rz(Ω) Rx(i) Rz(ω)."""
     big_e = eccentric_anomaly(m0 + np.sqrt(MU / a**3) * t, e)
     perifocal = np.array([a * (np.cos(big_e) - e), a * np.sqrt(1 - e**2) * np.sin(big_e), 0.0])
@@ -62,7 +68,7 @@ def columns(expression) -> np.ndarray:
     return np.asarray(ca.DM(expression), dtype=float).T
 
 
-CASES = [  # a [m], e, i, raan, argp, M0
+CASES: list[tuple[float, float, float, float, float, float]] = [  # a [m], e, i, raan, argp, M0
     (6878e3, 0.0, 0.9, 0.3, 0.0, 0.2),
     (7200e3, 0.01, np.deg2rad(97.8), 1.0, 2.0, 3.0),
     (12000e3, 0.3, 0.5, 4.0, 1.0, -2.0),
@@ -90,7 +96,8 @@ def test_kepler_newton_iterations_reach_round_off(e):
 # --- the Keplerian orbit ------------------------------------------------------------------------
 
 @pytest.mark.parametrize("case", CASES)
-def test_keplerian_positions_agree_with_an_independent_solver_to_a_millimetre_over_a_day(case):
+def test_keplerian_positions_agree_with_an_independent_solver_to_a_millimetre_over_a_day(
+        case: tuple[float, float, float, float, float, float]) -> None:
     orbit = KeplerianOrbit(*case)
     times = np.linspace(0.0, DAY, 1441)
     ours = columns(orbit.position(times))
@@ -181,7 +188,7 @@ def test_j2_secular_rates_match_their_closed_forms():
     sso = KeplerianOrbit(a_sso, 0.0, i_sso, j2=True)
     assert np.rad2deg(sso.secular_rates[0]) * DAY == pytest.approx(0.9856, abs=0.002)
     still = KeplerianOrbit(a, e, i, 0.5, 1.0, 0.0)
-    (s0, still0), (s1, still1) = _ascending_node(still, 0.0), _ascending_node(still, span)
+    (_, still0), (_, still1) = _ascending_node(still, 0.0), _ascending_node(still, span)
     assert abs(np.angle(np.exp(1j * (still1 - still0)))) < 1e-9
     assert abs(np.angle(np.exp(1j * (_perigee_angle(still, span)[1] - _perigee_angle(still, 0.0)[1])))) < 1e-7
 
@@ -241,7 +248,7 @@ def test_tle_states_are_sgp4_s_own_at_the_nodes(tle):
 
 def test_tle_interpolant_reproduces_the_table_at_the_nodes_and_stays_within_3_mm_between(tle):
     nodes = tle.nodes
-    exact_r, exact_v = tle.exact(nodes)
+    exact_r, _ = tle.exact(nodes)
     assert np.abs(columns(tle.position(nodes)) - exact_r).max() <= 1e-6          # 1e-9 km
     middles = nodes[:-1] + tle.step / 2
     mid_r, mid_v = tle.exact(middles)
@@ -304,7 +311,7 @@ def test_a_shipped_circular_scenario_is_bit_identical():
 
 # --- scenarios ----------------------------------------------------------------------------------
 
-BASE = {
+BASE: dict[str, Any] = {
     "name": "orbits",
     "epoch": "2019-12-10T00:00:00Z",
     "spacecraft": {"inertia": [0.25, 0.28, 0.12], "wheels": {"max_torque": 0.003, "max_momentum": 0.02}},
@@ -317,7 +324,7 @@ BASE = {
     "controller": {"name": "augmented_quaternion_feedback"},
     "simulation": {"sample_time": 0.5},
 }
-TLE_ORBIT = {"type": "tle", "line1": L1, "line2": L2, "span_s": 3600.0}
+TLE_ORBIT: dict[str, Any] = {"type": "tle", "line1": L1, "line2": L2, "span_s": 3600.0}
 
 
 def with_orbit(orbit=None, **top) -> dict:
