@@ -46,8 +46,8 @@ TLE_EPOCH_WARN_DAYS = 30.0
 """A TLE whose epoch lies more than this many days from the scenario's epoch is used with a warning."""
 TLE_EPOCH_REFUSE_DAYS = 365.0
 """A TLE whose epoch lies more than this many days from the scenario's epoch is refused."""
-KEPLER_ITERATIONS = 6
-"""Newton steps on Kepler's equation from :func:`_kepler_start` (enough for 1e-15 rad for e ≤ 0.95)."""
+KEPLER_ITERATIONS = 7
+"""Newton steps on Kepler's equation from :func:`_kepler_start` (round-off, a few 1e-16 rad, for e ≤ 0.95; six leave 5e-15 near perigee at e = 0.95)."""
 MAX_TLE_NODES = 200_000
 """Upper bound on a TLE table's nodes (``span / step``)."""
 
@@ -384,7 +384,7 @@ def kepler_newton_iterations(mean_anomaly: Expr, e: float, iterations: int = KEP
     """Eccentric anomaly solving Kepler's equation ``E − e sin E = M`` by a fixed number of Newton steps.
 
     ``M`` is first wrapped to [−π, π); from Danby's start each Newton step at least squares the
-    error once it is small: six steps reach round-off (1e-15 rad) for ``e ≤ 0.95`` (tested against
+    error once it is small: seven steps reach round-off (under 1e-15 rad) for ``e ≤ 0.95`` (tested against
     a bracketing root finder). A fixed count keeps the expression one CasADi graph, symbolic in ``M``.
 
     Parameters
@@ -721,10 +721,13 @@ class TLEOrbit(OrbitKind):
     fitted with) gives TEME positions and velocities at nodes ``k·step`` over ``[0, span]``; they
     are rotated to the GCRF (:func:`teme_to_gcrf_matrices`) and interpolated by CasADi cubic
     B-splines in time (position and velocity separately). At the nodes the spline reproduces the
-    table to 1e-12 km; between them, at the default 10 s step in low orbit, it is within 3 mm of
-    SGP4 in position and 2 mm/s... far less in velocity (tested at the mid-points of a day's nodes).
-    SGP4 itself is good to about a kilometre near the TLE epoch: the interpolation adds nothing
-    that matters. ``t = 0`` is ``epoch`` (the scenario's), which need not be the TLE's epoch.
+    table to under 1e-9 km (the spline's fit, 6e-7 m for the ISS); between them, at the default
+    10 s step in low orbit, it is within 3 mm of SGP4 in position (2.2 mm for the ISS, the error
+    growing as the fourth power of the step: 0.17 m at 30 s) and 1e-5 m/s in velocity (tested at
+    the mid-points of six hours of nodes). SGP4 itself is good to about a kilometre near the TLE
+    epoch: the interpolation adds nothing that matters. ``t = 0`` is ``epoch`` (the scenario's),
+    which need not be the TLE's epoch; SGP4 is given the UTC instant of ``epoch + t`` (``t``
+    counts SI seconds, leap seconds included).
 
     Parameters
     ----------
