@@ -401,3 +401,41 @@ def test_a_tle_a_month_and_more_away_is_used_with_a_warning(tmp_path):
     assert "warning: orbit: the TLE's epoch lies 41.3 days" in error
     status, error = run_cli(tmp_path, with_orbit(TLE_ORBIT, epoch="2020-01-01T00:00:00Z"))
     assert status == 0 and "warning" not in error, error
+
+
+@pytest.mark.parametrize("kind", ["earth", "earth_limb", "velocity"])
+@pytest.mark.parametrize("case", [CASES[2], CASES[3]], ids=["e=0.3", "molniya"])
+def test_direction_steps_follow_an_elliptic_orbit_through_perigee(kind, case):
+    """The step a direction is tabulated at comes from the orbit's bounds: linear interpolation
+    through perigee (where an elliptic orbit turns fastest) stays within the tolerance."""
+    from ocp.geometry.directions import INTERPOLATION_TOLERANCE
+    a, e, i, raan, argp, _ = case
+    period = 2 * np.pi * np.sqrt(a**3 / MU)
+    orbit = KeplerianOrbit(a, e, i, raan, argp, -2 * np.pi * 600.0 / period)   # perigee 600 s after t = 0
+    geometry = Geometry(None, orbit)
+    step = DIRECTIONS[kind].step_s(geometry)
+    assert step is not None and step > 0
+    nodes = np.arange(0.0, 1200.0 + step, step)
+    table, growth = DIRECTIONS[kind].table(geometry, nodes)
+    middles = nodes[:-1] + step / 2
+    exact, exact_growth = DIRECTIONS[kind].table(geometry, middles)
+    linear = table[:-1] + table[1:]
+    linear /= np.linalg.norm(linear, axis=1, keepdims=True)
+    angle = np.arccos(np.clip(np.sum(linear * exact, axis=1), -1.0, 1.0))
+    assert angle.max() <= INTERPOLATION_TOLERANCE
+    circular_step = DIRECTIONS[kind].step_s(Geometry(None, KeplerianOrbit(a, 0.0, i)))
+    assert step < circular_step   # faster at perigee than the mean motion
+
+
+def test_igrf_is_tabulated_along_a_keplerian_orbit():
+    from ocp.dynamics.igrf import IGRFField, greenwich_mean_sidereal_angle, igrf_earth_fixed
+    case = CASES[2]
+    field = IGRFField(KeplerianOrbit(*case), span=600.0, epoch="2025-01-01")
+    times = np.array([0.0, 250.0, 600.0])
+    theta = greenwich_mean_sidereal_angle(datetime.datetime(2025, 1, 1)) + 7.2921159e-5 * times
+    expected = []
+    for t, angle in zip(times, theta):
+        to_ecef = rz(angle).T
+        b = igrf_earth_fixed(to_ecef @ kepler_position(*case, t), datetime.datetime(2025, 1, 1))[0]
+        expected.append(to_ecef.T @ b)
+    assert np.allclose(field.exact(times), np.array(expected), rtol=1e-9, atol=1e-15)
