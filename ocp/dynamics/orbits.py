@@ -47,7 +47,8 @@ TLE_EPOCH_WARN_DAYS = 30.0
 TLE_EPOCH_REFUSE_DAYS = 365.0
 """A TLE whose epoch lies more than this many days from the scenario's epoch is refused."""
 KEPLER_ITERATIONS = 7
-"""Newton steps on Kepler's equation from :func:`_kepler_start` (round-off, a few 1e-16 rad, for e ≤ 0.95; six leave 5e-15 near perigee at e = 0.95)."""
+"""Newton steps on Kepler's equation from Danby's start: round-off (a few 1e-16 rad) for e ≤ 0.95;
+six leave 5e-15 rad near perigee at e = 0.95."""
 MAX_TLE_NODES = 200_000
 """Upper bound on a TLE table's nodes (``span / step``)."""
 
