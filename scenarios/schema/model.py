@@ -207,6 +207,9 @@ def parse_orbit(node: Node, epoch: datetime.datetime | None = None) -> Orbit | N
         options = kind.Options(**values)
     except InvalidOption as error:  # a relation between options (Options.__post_init__)
         raise ScenarioError(f"{node.path}.{error.option}", error.message) from None
+    if kind.needs_epoch and epoch is None:
+        raise ScenarioError("epoch", f"orbit type {kind.name!r} is dated: it needs the scenario's epoch (t = 0), a UTC "
+                                     "date-time like 2025-01-01T06:00:00Z; none is given")
     try:
         orbit = kind.from_options(options, epoch)
     except ModelError as error:
