@@ -8,7 +8,7 @@ subpackages it names:
   :mod:`~ocp.options` (typed options), :mod:`~ocp.quat` and :mod:`~ocp.quat_casadi` (quaternion
   algebra), :mod:`~ocp.cache` (solver caches), :mod:`~ocp.fast_call` (low-overhead calls of CasADi
   functions), :mod:`~ocp.metrics` (the common score);
-* :mod:`ocp.dynamics`: the spacecraft, its actuators and environment, the assembled model;
+* :mod:`ocp.dynamics`: the spacecraft, its actuators, orbits and environment, the assembled model;
 * :mod:`ocp.geometry`: pointing constraints and the directions they are measured from (the Sun,
   the Moon, the Earth, the orbital velocity; imports :mod:`ocp.dynamics`);
 * :mod:`ocp.simulation`: the closed-loop simulator (imports :mod:`ocp.dynamics`);
@@ -24,13 +24,13 @@ from ocp.cache import SolverCache
 from ocp.dynamics.actuator_kinds import Magnetorquers, ReactionWheels, Torquers
 from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
 from ocp.dynamics.environment import (
-                        CircularOrbit,
                         Environment,
                         TiltedDipole,
                         gravity_gradient_torque,
 )
 from ocp.dynamics.igrf import IGRFField
 from ocp.dynamics.model import AttitudeModel
+from ocp.dynamics.orbits import CircularOrbit, KeplerianOrbit, TLEOrbit
 from ocp.dynamics.spacecraft import Spacecraft
 from ocp.errors import (
                         CompilerUnavailable,
@@ -51,10 +51,10 @@ from ocp.simulation.simulator import SensorNoise, SimulationResult, Simulator
 
 __all__ = [
     "ActuatorModel", "AttitudeModel", "CircularOrbit", "Command", "CompilerUnavailable", "Environment", "IGRFField",
-    "InvalidOption", "METRIC_KEYS", "Magnetorquers", "Measurement", "ModelError", "OptionsError", "ReactionWheels",
-    "SensorNoise", "SimulationError", "SimulationResult", "Simulator", "SlewbenchError", "SolverCache", "Spacecraft",
-    "TiltedDipole", "Torquers", "compute_metrics", "gravity_gradient_torque", "metric_violations",
-    "metrics_from_reference", "metrics_from_simulation",
+    "InvalidOption", "KeplerianOrbit", "METRIC_KEYS", "Magnetorquers", "Measurement", "ModelError", "OptionsError",
+    "ReactionWheels", "SensorNoise", "SimulationError", "SimulationResult", "Simulator", "SlewbenchError",
+    "SolverCache", "Spacecraft", "TLEOrbit", "TiltedDipole", "Torquers", "compute_metrics", "gravity_gradient_torque",
+    "metric_violations", "metrics_from_reference", "metrics_from_simulation",
 ]
 
 

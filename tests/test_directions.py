@@ -13,8 +13,8 @@ import time
 import numpy as np
 import pytest
 
-from ocp.dynamics.environment import MU_EARTH, CircularOrbit
 from ocp.dynamics.ephemeris import moon_position, sun_position
+from ocp.dynamics.orbits import MU_EARTH, CircularOrbit
 from ocp.errors import ModelError
 from ocp.geometry import (DIRECTIONS, INTERPOLATION_TOLERANCE, DirectionKind, Geometry, PointingConstraint,
                           direction_kind, direction_table)

@@ -15,7 +15,8 @@ from ocp import (
     TiltedDipole,
     quat,
 )
-from ocp.dynamics.environment import EARTH_RATE, MU_EARTH, R_EARTH
+from ocp.dynamics.environment import EARTH_RATE
+from ocp.dynamics.orbits import MU_EARTH, R_EARTH
 
 
 class InternalWheelTorques:

@@ -175,7 +175,7 @@ def test_the_sun_scenario_others_violated_with_their_margins():
         assert row.message.startswith("st_sun (reference): min margin")
         assert row.requirements["reference"]["st_sun"]["min_margin_deg"] < -29.0  # through the Sun's centre
         assert row.requirements["closed_loop"]["st_sun"]["min_margin_deg"] < -29.0
-    assert json.loads(results.to_json())["frame"] == "GCRF"
+    assert json.loads(results.to_json())["frame"] == "GCRF (epoch 2027-03-20T12:00:00Z)"
     assert json.loads(results.to_json())["epoch"] == "2027-03-20T12:00:00Z"
 
 

@@ -143,7 +143,7 @@ def test_a_field_model_takes_the_scenarios_epoch_or_must_agree_with_it(tmp_path)
     data = changed(epoch=EPOCH, orbit=ORBIT, environment={"magnetic_field": igrf})
     scenario = scenarios.parse_scenario(copy.deepcopy(data))
     assert scenario.problem.environment.magnetic_field.epoch == "2027-03-20T12:00:00"
-    assert scenario.epoch == datetime.datetime(2027, 3, 20, 12) and scenario.frame == "GCRF"
+    assert scenario.epoch == datetime.datetime(2027, 3, 20, 12) and scenario.frame == "GCRF (epoch 2027-03-20T12:00:00Z)"
     same = changed(epoch=EPOCH, orbit=ORBIT, environment={"magnetic_field": {"model": "igrf",
                                                                              "epoch": "2027-03-20T13:00:00+01:00"}})
     assert scenarios.parse_scenario(same).problem.environment.magnetic_field.epoch == "2027-03-20T13:00:00+01:00"

@@ -48,7 +48,7 @@ spacecraft:
   magnetorquers: {max_dipole: 0.1, saturation: scale}
   torquers: {max_torque: 0.01}
   sensors: {star_tracker: {boresight: [0, 0, 1]}, antenna: {boresight: [1, 0, 0]}}
-orbit: {altitude_km: 600, inclination_deg: 97.79, raan_deg: 10.0, arg_latitude_deg: 5.0}
+orbit: {type: circular, altitude_km: 600, inclination_deg: 97.79, raan_deg: 10.0, arg_latitude_deg: 5.0}
 environment:
   gravity_gradient: true
   magnetic_field: {model: tilted_dipole, strength: 7.9e15, tilt_deg: 11.0, pole_longitude_deg: -72.0,

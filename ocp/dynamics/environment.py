@@ -1,8 +1,9 @@
-"""Environment: circular orbit, gravity-gradient torque, geomagnetic field models.
+"""Environment: gravity-gradient torque, geomagnetic field models, and what acts on the spacecraft.
 
 Frames: the inertial frame is Earth-centred (ECI, z along the Earth's spin axis); the Earth-fixed
 frame turns about z at ``earth_rate``. The expression builders take CasADi symbols (or numbers)
-and return CasADi expressions; :class:`ocp.dynamics.model.AttitudeModel` assembles them.
+and return CasADi expressions; :class:`ocp.dynamics.model.AttitudeModel` assembles them. The orbit
+they follow is an :class:`~ocp.dynamics.orbits.Orbit` (:mod:`ocp.dynamics.orbits`).
 
 A geomagnetic field is anything with the :class:`MagneticField` interface. The models a scenario
 names (``environment.magnetic_field.model``) are registered in :data:`MAGNETIC_FIELDS`, each a
@@ -20,12 +21,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ocp import quat_casadi as qc
+from ocp.dynamics.orbits import MU_EARTH, Orbit
 from ocp.errors import ModelError
 from ocp.options import Range
 from ocp.quat_casadi import Expr
 
-MU_EARTH = 3.986004418e14      # m³/s², EGM96 / WGS-84
-R_EARTH = 6378.137e3           # m, WGS-84 equatorial radius
 EARTH_RATE = 7.2921159e-5      # rad/s, sidereal rotation rate
 DIPOLE_STRENGTH = 7.96e15      # T m³, Wertz (1978) dipole moment of the Earth's field
 
@@ -39,7 +39,7 @@ class MagneticField(Protocol):
 
     * ``valid_until`` (float [s]): the field is known on ``[0, valid_until]`` only (a table); the
       simulator refuses a longer run.
-    * ``orbit`` (:class:`CircularOrbit`): the orbit the field is tabulated along; it must be the
+    * ``orbit`` (:class:`~ocp.dynamics.orbits.Orbit`): the orbit the field is tabulated along; it must be the
       environment's.
 
     The model's fingerprint (:attr:`~ocp.dynamics.model.AttitudeModel.fingerprint`, which keys the
@@ -92,14 +92,14 @@ class FieldModel(ABC):
 
     @classmethod
     @abstractmethod
-    def from_options(cls, options: Any, orbit: CircularOrbit | None) -> FieldModel:
+    def from_options(cls, options: Any, orbit: Orbit | None) -> FieldModel:
         """The field of validated options along the environment's orbit.
 
         Parameters
         ----------
         options : Options
             The options (an instance of the class's ``Options``).
-        orbit : CircularOrbit or None
+        orbit : Orbit or None
             The scenario's orbit (``None``: none given).
 
         Returns
@@ -129,145 +129,6 @@ class FieldModel(ABC):
         (3, 1) casadi.DM, SX or MX
             Field ``B`` [T], inertial frame.
         """
-
-
-@dataclass(frozen=True)
-class CircularOrbit:
-    """Circular Keplerian orbit, fixed in the inertial (ECI) frame.
-
-    Parameters
-    ----------
-    altitude : float
-        Height above the equatorial radius ``R_EARTH`` [m]; must exceed ``−0.99 R_EARTH``.
-    inclination : float, optional
-        Inclination of the orbit plane to the equator [rad] (default 0).
-    raan : float, optional
-        Right ascension of the ascending node [rad] (default 0).
-    arg_latitude : float, optional
-        Argument of latitude at t = 0 [rad], measured from the ascending node in the direction
-        of motion (default 0).
-    mu : float, optional
-        Gravitational parameter [m^3/s^2] (default ``MU_EARTH``).
-
-    Raises
-    ------
-    ModelError
-        If the orbit radius is not positive.
-    """
-
-    altitude: float
-    inclination: float = 0.0
-    raan: float = 0.0
-    arg_latitude: float = 0.0
-    mu: float = MU_EARTH
-
-    def __post_init__(self) -> None:
-        if not self.altitude > -R_EARTH * 0.99:
-            raise ModelError("altitude", f"the orbit radius must be positive, got altitude {self.altitude} m")
-
-    @property
-    def radius(self) -> float:
-        """Orbit radius ``R_EARTH + altitude`` [m]."""
-        return R_EARTH + self.altitude
-
-    @property
-    def mean_motion(self) -> float:
-        """Mean motion ``n = sqrt(mu / radius³)`` [rad/s]: the orbit rate."""
-        return float(np.sqrt(self.mu / self.radius**3))
-
-    def position(self, t: Expr) -> Expr:
-        """Position of the spacecraft from the Earth's centre.
-
-        Parameters
-        ----------
-        t : float or scalar casadi.SX / MX
-            Time since t = 0 [s].
-
-        Returns
-        -------
-        (3, 1) casadi.DM, SX or MX
-            Position [m], inertial frame (``DM`` for a numeric ``t``).
-        """
-        u = self.arg_latitude + self.mean_motion * t
-        ci, si = np.cos(self.inclination), np.sin(self.inclination)
-        cO, sO = np.cos(self.raan), np.sin(self.raan)
-        return self.radius * ca.vertcat(
-            ca.cos(u) * cO - ca.sin(u) * ci * sO,
-            ca.cos(u) * sO + ca.sin(u) * ci * cO,
-            ca.sin(u) * si,
-        )
-
-    def velocity(self, t: Expr) -> Expr:
-        """Velocity of the spacecraft with respect to the inertial frame.
-
-        Parameters
-        ----------
-        t : float or scalar casadi.SX / MX
-            Time since t = 0 [s].
-
-        Returns
-        -------
-        (3, 1) casadi.DM, SX or MX
-            Velocity [m/s], inertial frame; magnitude ``radius * mean_motion``.
-        """
-        u = self.arg_latitude + self.mean_motion * t
-        ci, si = np.cos(self.inclination), np.sin(self.inclination)
-        cO, sO = np.cos(self.raan), np.sin(self.raan)
-        return self.radius * self.mean_motion * ca.vertcat(
-            -ca.sin(u) * cO - ca.cos(u) * ci * sO,
-            -ca.sin(u) * sO + ca.cos(u) * ci * cO,
-            ca.cos(u) * si,
-        )
-
-    def nadir(self, t: Expr) -> Expr:
-        """Unit vector from the spacecraft to the Earth's centre.
-
-        Parameters
-        ----------
-        t : float or scalar casadi.SX / MX
-            Time since t = 0 [s].
-
-        Returns
-        -------
-        (3, 1) casadi.DM, SX or MX
-            Unit vector, inertial frame.
-        """
-        r = self.position(t)
-        return -r / ca.norm_2(r)
-
-    def function(self) -> ca.Function:
-        """The orbit as a CasADi function of time.
-
-        Returns
-        -------
-        casadi.Function
-            ``orbit(t) -> (position, velocity, nadir)``: ``t`` [s]; position [m], velocity [m/s]
-            and unit nadir vector, each (3, 1) in the inertial frame.
-        """
-        t = ca.SX.sym("t")
-        return ca.Function("orbit", [t], [self.position(t), self.velocity(t), self.nadir(t)], ["t"],
-                           ["position", "velocity", "nadir"])
-
-    def lvlh_matrix(self, t: Expr) -> Expr:
-        """Local-vertical local-horizontal (orbit) frame at time ``t``.
-
-        Parameters
-        ----------
-        t : float or scalar casadi.SX / MX
-            Time since t = 0 [s].
-
-        Returns
-        -------
-        (3, 3) casadi.DM, SX or MX
-            Columns: the LVLH axes in inertial components, x along-track (along the velocity for
-            a circular orbit), y = −orbit normal, z nadir; it maps LVLH components to inertial
-            ones, ``v_I = M v_LVLH``.
-        """
-        z = self.nadir(t)
-        v = self.velocity(t)
-        y = ca.cross(z, v)
-        y = y / ca.norm_2(y)
-        return ca.horzcat(ca.cross(y, z), y, z)
 
 
 @dataclass(frozen=True)
@@ -325,14 +186,14 @@ class TiltedDipole(FieldModel):
         greenwich_angle_deg: Annotated[float, Range()] = 0.0
 
     @classmethod
-    def from_options(cls, options: Any, orbit: CircularOrbit | None) -> TiltedDipole:
+    def from_options(cls, options: Any, orbit: Orbit | None) -> TiltedDipole:
         """The dipole of ``options`` (degrees converted to radians).
 
         Parameters
         ----------
         options : TiltedDipole.Options
             The YAML options.
-        orbit : CircularOrbit or None
+        orbit : Orbit or None
             Not used (the dipole is defined everywhere); the :class:`FieldModel` interface.
 
         Returns
@@ -425,7 +286,7 @@ class Environment:
 
     Parameters
     ----------
-    orbit : CircularOrbit or None, optional
+    orbit : Orbit or None, optional
         The orbit; required by the gravity gradient and the magnetic field (default none).
     gravity_gradient : bool, optional
         Include the gravity-gradient torque (default False).
@@ -444,7 +305,7 @@ class Environment:
         is not a :class:`MagneticField`, or a table along another orbit.
     """
 
-    orbit: CircularOrbit | None = None
+    orbit: Orbit | None = None
     gravity_gradient: bool = False
     magnetic_field: MagneticField | None = None
     disturbance_torque: NDArray = field(default_factory=lambda: np.zeros(3))

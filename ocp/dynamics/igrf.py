@@ -25,8 +25,9 @@ import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ocp.dynamics.environment import MAGNETIC_FIELDS, CircularOrbit, FieldModel
+from ocp.dynamics.environment import MAGNETIC_FIELDS, FieldModel
 from ocp.dynamics.ephemeris import parse_utc
+from ocp.dynamics.orbits import Orbit
 from ocp.errors import ModelError
 from ocp.options import Range
 from ocp.quat_casadi import Expr
@@ -121,7 +122,7 @@ class IGRFField(FieldModel):
 
     Parameters
     ----------
-    orbit : CircularOrbit
+    orbit : Orbit
         The orbit along which the field is tabulated; it must be the environment's orbit.
     span : float
         Tabulated window [s], positive; the simulator refuses to run beyond it. At most
@@ -149,7 +150,7 @@ class IGRFField(FieldModel):
 
     name: ClassVar[str] = "igrf"
 
-    orbit: CircularOrbit
+    orbit: Orbit
     span: float
     epoch: str = "2025-01-01"
     step: float = 30.0
@@ -183,7 +184,7 @@ class IGRFField(FieldModel):
         greenwich_angle_deg: Annotated[float | None, Range()] = None
 
     @classmethod
-    def from_options(cls, options: Any, orbit: CircularOrbit | None) -> IGRFField:
+    def from_options(cls, options: Any, orbit: Orbit | None) -> IGRFField:
         """The table of ``options`` along ``orbit`` (without ``span_s``, a provisional one-second
         span that :meth:`for_window` replaces).
 
@@ -191,7 +192,7 @@ class IGRFField(FieldModel):
         ----------
         options : IGRFField.Options
             The YAML options.
-        orbit : CircularOrbit or None
+        orbit : Orbit or None
             The orbit to tabulate the field along.
 
         Returns

@@ -27,8 +27,8 @@ import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ocp.dynamics.environment import R_EARTH, CircularOrbit
 from ocp.dynamics.ephemeris import check_epoch, moon_position, parse_utc, sun_position
+from ocp.dynamics.orbits import R_EARTH, Orbit
 from ocp.errors import ModelError
 
 __all__ = ["DIRECTIONS", "FRAMES", "INTERPOLATION_TOLERANCE", "DirectionKind", "Geometry", "direction_kind",
@@ -66,7 +66,7 @@ class Geometry:
     epoch : datetime.datetime or None
         Instant of t = 0, UTC (naive, or aware and converted to UTC); ``None``: no epoch (no Sun
         or Moon).
-    orbit : CircularOrbit or None
+    orbit : Orbit or None
         The spacecraft's orbit, inertial frame; ``None``: no orbit (no Earth or velocity direction;
         the Sun and the Moon are then seen from the Earth's centre).
     frame : str, optional
@@ -80,7 +80,7 @@ class Geometry:
     """
 
     epoch: datetime.datetime | None
-    orbit: CircularOrbit | None
+    orbit: Orbit | None
     frame: str = "GCRF"
 
     def __post_init__(self) -> None:
@@ -89,7 +89,7 @@ class Geometry:
         if self.epoch is not None:
             object.__setattr__(self, "epoch", parse_utc(self.epoch))
 
-    def _need_orbit(self, what: str) -> CircularOrbit:
+    def _need_orbit(self, what: str) -> Orbit:
         if self.orbit is None:
             raise ModelError("orbit", f"{what} needs an orbit (environment.orbit), and none is given")
         return self.orbit
@@ -305,9 +305,9 @@ def _body_step(geometry: Geometry, rate: float, distance_min: float) -> float:
     about it, seen from the orbit (the parallax swings at the orbit rate)."""
     if geometry.orbit is None:
         return _step(rate, rate**2)
-    n, r = geometry.orbit.mean_motion, geometry.orbit.radius
+    n, r = geometry.orbit.max_rate, geometry.orbit.max_radius
     parallax = r / (distance_min - r)
-    return _step(rate + n * parallax, rate**2 + n**2 * parallax)
+    return _step(rate + n * parallax, rate**2 + (n**2 + geometry.orbit.max_rate_change) * parallax)
 
 
 @direction_kind
@@ -343,9 +343,10 @@ class Moon(DirectionKind):
 
 
 def _orbit_step(geometry: Geometry) -> float:
-    """Step for a direction that turns uniformly with a circular orbit."""
+    """Step for a direction that turns with the orbit (uniformly for a circular one): its bounds
+    :attr:`~ocp.dynamics.orbits.Orbit.max_rate` and :attr:`~ocp.dynamics.orbits.Orbit.max_rate_change`."""
     orbit = geometry._need_orbit("this direction")
-    return _step(orbit.mean_motion, 0.0)
+    return _step(orbit.max_rate, orbit.max_rate_change)
 
 
 @direction_kind

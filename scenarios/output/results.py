@@ -163,8 +163,9 @@ class RunResults:
         -------
         dict
             ``{"scenario": name, "frame": ..., "epoch": ..., "rows": [Row.to_dict(), ...],
-            "provenance": {...}}``: the inertial frame the attitudes are in (``GCRF`` with an
-            epoch, else ``inertial (no epoch)``), the epoch (UTC, ISO 8601 with ``Z``, or
+            "provenance": {...}}``: the inertial frame the attitudes are in
+            (:attr:`Scenario.frame <scenarios.schema.loader.Scenario.frame>`: ``GCRF (epoch ...Z)``
+            with an epoch, else ``inertial (no epoch)``), the epoch (UTC, ISO 8601 with ``Z``, or
             ``None``) and what produced the results
             (:func:`~scenarios.output.provenance.run_provenance`: versions, platform, date, seeds
             and the scenario's YAML data).

@@ -218,10 +218,16 @@ class Scenario:
 
     @property
     def frame(self) -> str:
-        """The inertial frame the attitudes and directions are in: ``GCRF`` with an epoch (the
-        Earth-centred frame of the ephemeris, :class:`~ocp.geometry.directions.Geometry`), else
+        """The inertial frame the attitudes and directions are in: with an epoch, ``GCRF (epoch
+        2027-03-20T12:00:00Z)`` (the Earth-centred frame of the ephemeris,
+        :class:`~ocp.geometry.directions.Geometry`), and the conversion an orbit went through
+        when it was not given in it (``GCRF (epoch ...Z; SGP4 TEME -> GCRF)`` for a TLE); else
         ``inertial (no epoch)``: an Earth-centred inertial frame tied to no date."""
-        return Geometry(self.epoch, None).frame if self.epoch is not None else "inertial (no epoch)"
+        if self.epoch is None:
+            return "inertial (no epoch)"
+        route = getattr(self.problem.environment.orbit, "frame", None)
+        details = "; ".join(part for part in (f"epoch {self.epoch.isoformat()}Z", route() if route else "") if part)
+        return f"{Geometry(self.epoch, None).frame} ({details})"
 
     @property
     def controller(self) -> ControllerSpec:
@@ -254,6 +260,14 @@ def _fit_field_span(problem: ManeuverProblem, simulation: SimulationSpec, planne
         return problem
     environment = dataclasses.replace(problem.environment, magnetic_field=fitted)
     return dataclasses.replace(problem, environment=environment)
+
+
+def _check_orbit_window(orbit: Any, window: float) -> None:
+    """Refuse a run that leaves a tabulated orbit's window (``valid_until``: a TLE's table)."""
+    valid_until = getattr(orbit, "valid_until", None)
+    if valid_until is not None and window > valid_until + 1e-9:
+        raise ScenarioError("orbit.span_s", f"the orbit is tabulated up to t = {valid_until:g} s, the run (with its "
+                                            f"margin) reaches {window:g} s; raise span_s")
 
 
 def _name(node: Node) -> str:
@@ -387,7 +401,8 @@ SCENARIO = Section((
            "field model with an epoch of its own (IGRF) takes it when not given one. ``null``: none (the frame "
            "is an inertial one tied to no date).", "text or null", parse_epoch, unit="UTC", default=None),
     custom("spacecraft", "The rigid body and its actuators.", "mapping", None, section=SPACECRAFT),
-    custom("orbit", "A circular orbit; absent or ``null``: none.", "mapping or null", None, default=None,
+    custom("orbit", "The orbit: ``type`` (``circular``, ``keplerian``, ``tle``, ...) and its keys; absent or "
+           "``null``: none.", "mapping or null", None, default=None,
            section=ORBIT),
     custom("environment", "Gravity gradient, magnetic field and disturbance torque; absent or ``null``: none.",
            "mapping or null", None, default={}, section=ENVIRONMENT),
@@ -525,6 +540,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     problem = _fit_field_span(problem, simulation, planners)
     span = RunSpan(problem.duration, simulation.duration or problem.duration, simulation.duration is not None,
                    _table_window(problem, simulation, planners))
+    _check_orbit_window(environment.orbit, span.table)
     check_ephemeris(epoch, span)
     requirements, constraints = parse_requirements(requirements_node, sensors, Geometry(epoch, environment.orbit),
                                                    span, problem.qf is None, problem.omegaf is None)

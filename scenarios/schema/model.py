@@ -1,7 +1,8 @@
 """The model sections of a scenario YAML: ``spacecraft``, ``orbit`` and ``environment``.
 
 Each section's keys are declared here (:data:`SPACECRAFT`, :data:`ORBIT`, :data:`ENVIRONMENT`) and
-read through them; the magnetic field models and their options come from the registry
+read through them; the orbit kinds and their options come from the registry
+:data:`~ocp.dynamics.orbits.ORBITS`, the magnetic field models and their options from
 :data:`~ocp.dynamics.environment.MAGNETIC_FIELDS`. Errors are
 :class:`~scenarios.errors.ScenarioError` at the YAML path; a model constructor's
 :class:`~ocp.ModelError` is reported at the field it names. Kilometres and degrees become SI here.
@@ -16,7 +17,6 @@ from typing import Any
 import numpy as np
 
 from ocp import (
-    CircularOrbit,
     Environment,
     Magnetorquers,
     ModelError,
@@ -26,7 +26,9 @@ from ocp import (
 )
 from ocp.dynamics.environment import MAGNETIC_FIELDS, MagneticField
 from ocp.dynamics.ephemeris import parse_utc
+from ocp.dynamics.orbits import ORBITS, TLE_EPOCH_WARN_DAYS, Orbit
 from ocp.errors import InvalidOption
+from ocp.simulation.compiled import notice
 from scenarios.errors import ScenarioError
 from scenarios.requirements.spec import Sensor
 from scenarios.schema.keys import (
@@ -35,7 +37,6 @@ from scenarios.schema.keys import (
     choice,
     custom,
     mapping,
-    number,
     option_keys,
     vector,
 )
@@ -110,11 +111,10 @@ SPACECRAFT = Section((
 ), "The rigid body, its actuators and its sensors.")
 
 ORBIT = Section((
-    number("altitude_km", "Height of the circular orbit above the equatorial radius (6378.137 km).", unit="km"),
-    number("inclination_deg", "Inclination of the orbit plane to the equator.", unit="deg", default=0.0),
-    number("raan_deg", "Right ascension of the ascending node.", unit="deg", default=0.0),
-    number("arg_latitude_deg", "Argument of latitude at t = 0, from the ascending node.", unit="deg", default=0.0),
-), "A circular orbit (absent or ``null``: none); the gravity gradient and magnetic fields need one.")
+    choice("type", "The orbit kind (a name registered in ``ORBITS``); the other keys of the mapping are its options.",
+           ORBITS, default="circular"),
+), "The orbit (absent or ``null``: none): ``type`` and that kind's keys; the gravity gradient and magnetic fields "
+   "need one, and so do the directions of the Earth and of the velocity.")
 
 MAGNETIC_FIELD = Section((
     choice("model", "The field model (a name registered in ``MAGNETIC_FIELDS``); the other keys of the mapping "
@@ -173,33 +173,58 @@ def parse_spacecraft(node: Node) -> tuple[Spacecraft, dict[str, Sensor]]:
     return spacecraft, sensors
 
 
-def parse_orbit(node: Node) -> CircularOrbit | None:
-    """The ``orbit`` section (:data:`ORBIT`), kilometres and degrees converted to SI.
+def parse_orbit(node: Node, epoch: datetime.datetime | None = None) -> Orbit | None:
+    """The ``orbit`` section (:data:`ORBIT`): ``type`` (default ``circular``) and that kind's options,
+    kilometres and degrees converted to SI.
+
+    A kind that needs a calendar epoch (``tle``) takes the scenario's; a TLE whose own epoch lies
+    more than :data:`~ocp.dynamics.orbits.TLE_EPOCH_WARN_DAYS` from it is used with a warning.
 
     Parameters
     ----------
     node : Node
         The ``orbit`` mapping, or null for none.
+    epoch : datetime.datetime or None, optional
+        The scenario's epoch (top-level ``epoch``), UTC.
 
     Returns
     -------
-    CircularOrbit or None
+    Orbit or None
         The orbit.
 
     Raises
     ------
     ScenarioError
-        At the offending key's YAML path.
+        At the offending key's YAML path (``epoch`` for a missing epoch or one too far from a TLE's).
     """
     if node.is_null():
         return None
-    values = ORBIT.read(node)
-    return _model_part(node, CircularOrbit, altitude=values["altitude_km"] * 1e3,
-                       inclination=np.deg2rad(values["inclination_deg"]), raan=np.deg2rad(values["raan_deg"]),
-                       arg_latitude=np.deg2rad(values["arg_latitude_deg"]))
+    node.mapping()
+    kind = ORBITS[ORBIT["type"].value(node)]
+    values = {key.name: key.value(node) for key in option_keys(kind.Options)}
+    node.finish()
+    try:
+        options = kind.Options(**values)
+    except InvalidOption as error:  # a relation between options (Options.__post_init__)
+        raise ScenarioError(f"{node.path}.{error.option}", error.message) from None
+    if kind.needs_epoch and epoch is None:
+        raise ScenarioError("epoch", f"orbit type {kind.name!r} is dated: it needs the scenario's epoch (t = 0), a UTC "
+                                     "date-time like 2025-01-01T06:00:00Z; none is given")
+    try:
+        orbit = kind.from_options(options, epoch)
+    except ModelError as error:
+        if error.field == "epoch":
+            raise ScenarioError("epoch", f"{error.message} (orbit type {kind.name!r})") from None
+        where = (f"{node.path}.{error.field}" if node.path else error.field) if error.field else node.path
+        raise ScenarioError(where, error.message) from None
+    offset = getattr(orbit, "epoch_offset_days", None)
+    if offset is not None and abs(offset) > TLE_EPOCH_WARN_DAYS:
+        notice(f"warning: {node.path}: the TLE's epoch lies {abs(offset):.1f} days from the scenario's epoch "
+               f"(more than {TLE_EPOCH_WARN_DAYS:g}); SGP4's error grows by kilometres a day")
+    return orbit
 
 
-def parse_magnetic_field(node: Node, orbit: CircularOrbit | None,
+def parse_magnetic_field(node: Node, orbit: Orbit | None,
                          epoch: datetime.datetime | None = None) -> MagneticField | None:
     """``environment.magnetic_field``: a registered model's name, ``none``, or a mapping of ``model``
     and the model's options (read by the keys of its ``Options``).
@@ -211,7 +236,7 @@ def parse_magnetic_field(node: Node, orbit: CircularOrbit | None,
     ----------
     node : Node
         The ``magnetic_field`` value.
-    orbit : CircularOrbit or None
+    orbit : Orbit or None
         The scenario's orbit.
     epoch : datetime.datetime or None, optional
         The scenario's epoch (top-level ``epoch``), UTC.
@@ -285,7 +310,7 @@ def parse_environment(orbit_node: Node, node: Node, epoch: datetime.datetime | N
     ScenarioError
         At the offending key's YAML path.
     """
-    orbit = parse_orbit(orbit_node)
+    orbit = parse_orbit(orbit_node, epoch)
     node = node if not node.is_null() else Node({}, node.path)
     node.mapping()
     magnetic_field = parse_magnetic_field(ENVIRONMENT["magnetic_field"].value(node), orbit, epoch)

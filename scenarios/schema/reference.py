@@ -30,6 +30,7 @@ from typing import Any
 
 from controllers import CONTROLLERS
 from ocp.dynamics.environment import MAGNETIC_FIELDS
+from ocp.dynamics.orbits import ORBITS
 from ocp.errors import excerpt
 from planners import PLANNERS
 from scenarios.errors import ScenarioError
@@ -239,6 +240,14 @@ def _registry_parts() -> list[Part]:
                           f"{summary_line(controller)} Options under ``controller.options`` (or "
                           f"``controllers[i].options``) when its ``name`` is {_literal(name)}"
                           + (":" if entries else "; it has none."), entries))
+    for name, kind in ORBITS.items():
+        base = f"orbit.{name}"
+        entries = tuple(_key_entry(key, f"orbit.{key.name}", f"{base}.{key.name}",
+                                   (f"orbit.{key.name}", f"scenario.{base}.{key.name}"))
+                        for key in option_keys(kind.Options))
+        parts.append(Part(base, "Orbit kinds", _literal(name),
+                          f"{summary_line(kind, module_first=False)} Keys next to ``type: {name}`` in ``orbit``:",
+                          entries))
     for name, model in MAGNETIC_FIELDS.items():
         base = f"environment.magnetic_field.{name}"
         entries = tuple(_key_entry(key, f"environment.magnetic_field.{key.name}", f"{base}.{key.name}",
@@ -320,6 +329,7 @@ _GROUPS = {
     "Planner options": "The options of each registered planner (``planners[i].options``).",
     "Controller options": "The options of each registered controller (``controller.options`` or "
                           "``controllers[i].options``).",
+    "Orbit kinds": "The kinds of ``orbit`` (``ORBITS``, by ``orbit.type``) and their keys.",
     "Magnetic field models": "The models of ``environment.magnetic_field`` (``MAGNETIC_FIELDS``) and their options.",
     "Study file": "The keys of a trade-study file (``slewbench sweep``).",
 }
