@@ -86,8 +86,9 @@ def run_report(results: RunResults) -> str:
                + [c for c in everything if c not in IDENTITY_COLUMNS and not is_requirement_column(c)])
     names = [name for name in ordered if name in IDENTITY_COLUMNS or any(not is_missing(row.get(name)) for row in flat)]
     counts = ", ".join(f"{n} {status}" for status, n in results.status_counts().items())
-    epoch = "no epoch" if scenario.epoch is None else f"epoch {scenario.epoch.isoformat()}Z (UTC)"
-    lines = [f"{len(results.rows)} rows ({counts}); attitudes in the {scenario.frame} frame, {epoch}."]
+    frame = (f"attitudes in the frame {scenario.frame}, times in seconds from the epoch (UTC)"
+             if scenario.epoch is not None else "attitudes in an inertial frame tied to no date (no epoch)")
+    lines = [f"{len(results.rows)} rows ({counts}); {frame}."]
     if scenario.source is not None:
         lines.append(f"Scenario file: {scenario.source.name}")
     page = Page(f"{scenario.name}: slewbench run", lines)
