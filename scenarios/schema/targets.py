@@ -132,17 +132,20 @@ GROUND = Section((
     number("alt_m", "Height above the WGS-84 ellipsoid.", unit="m", default=0.0),
 ), "A point on the ground; needs the epoch (the Earth's orientation) and the orbit.")
 
+_ONE_DIRECTION = Described("absent (the mapping has one of inertial, lvlh, rtn, ground)")
+
 TARGET_DIRECTION = Section((
-    vector("inertial", "A fixed direction, inertial frame (normalised; zero refused).", 3),
+    vector("inertial", "A fixed direction, inertial frame (normalised; zero refused).", 3, default=_ONE_DIRECTION),
     vector("lvlh", "A direction fixed in the LVLH frame at the instant (``[0, -1, 0]``: the orbit normal); needs "
-           "the orbit.", 3),
+           "the orbit.", 3, default=_ONE_DIRECTION),
     vector("rtn", "A direction fixed in the RTN frame at the instant (``[0, 0, 1]``: the orbit normal); needs the "
-           "orbit.", 3),
-    mapping("ground", "A ground point, seen from the spacecraft at the instant; it must be above the horizon "
-            "(the spacecraft above the point's horizon).", GROUND),
+           "orbit.", 3, default=_ONE_DIRECTION),
+    mapping("ground", "A ground point, seen from the spacecraft at the instant; the spacecraft must be above the "
+            "point's horizon.", GROUND, default=_ONE_DIRECTION),
 ), "A direction written as a mapping of one key.")
 
-_DIRECTION_WORDS = ("a direction: a name of ``DIRECTIONS`` (``sun``, ``moon``, ``earth``: nadir, ``velocity``), "
+_DIRECTION_WORDS = ("a direction: a name of ``DIRECTIONS`` (``sun``, ``moon``, ``earth``: nadir, ``velocity``; not the "
+                    "disc ``earth_limb``), "
                     "``{inertial: [x, y, z]}``, ``{lvlh: [x, y, z]}``, ``{rtn: [x, y, z]}`` or "
                     "``{ground: {lat_deg, lon_deg, alt_m}}``, evaluated at ``at_time_s``")
 
@@ -257,8 +260,9 @@ def _body_axis(node: Node, keys: tuple[str, str], sensors: dict[str, Sensor]) ->
 
 SECONDARY = Section((
     custom("sensor", "The body axis that fixes the roll: a sensor's boresight (a name under "
-           "``spacecraft.sensors``); or give ``axis``.", "text", None, default=None),
-    vector("axis", "The body axis that fixes the roll, body axes; or give ``sensor``.", 3, default=None),
+           "``spacecraft.sensors``); or give ``axis``.", "text", None, default=Described("absent when axis is given")),
+    vector("axis", "The body axis that fixes the roll, body axes; or give ``sensor``.", 3,
+           default=Described("absent when sensor is given")),
     custom("toward", "Where it is turned (as near as the primary allows: into the half-plane of the target and "
            "this direction): " + _DIRECTION_WORDS + ".", "text or mapping", None, choices=DIRECTIONS,
            section=TARGET_DIRECTION),
@@ -266,8 +270,9 @@ SECONDARY = Section((
 
 POINT = Section((
     custom("sensor", "The body axis to point: a sensor's boresight (a name under ``spacecraft.sensors``); or give "
-           "``boresight``.", "text", None, default=None),
-    vector("boresight", "The body axis to point, body axes; or give ``sensor``.", 3, default=None),
+           "``boresight``.", "text", None, default=Described("absent when boresight is given")),
+    vector("boresight", "The body axis to point, body axes; or give ``sensor``.", 3,
+           default=Described("absent when sensor is given")),
     custom("at", "The target the boresight points at exactly: " + _DIRECTION_WORDS + ".", "text or mapping", None,
            choices=DIRECTIONS, section=TARGET_DIRECTION),
     mapping("secondary", "The second body axis and its direction, which fix the roll about the target.", SECONDARY),
@@ -331,16 +336,18 @@ def _euler(node: Node, context: AttitudeContext, t: float) -> Array:
     return quat.from_euler(np.deg2rad(values["angles_deg"]), values["sequence"])
 
 
+_ONE_FORM = Described("absent (the mapping has exactly one form)")
+
 ATTITUDE_FORMS: dict[str, AttitudeForm] = {form.name: form for form in (
     AttitudeForm(custom("quaternion", "A quaternion, ``frame`` to body (scalar first unless "
                         "``maneuver.quaternion_order: scalar_last``).", "list of 4 numbers", None,
-                        default=None, bounds="norm within 1e-2 of 1 (normalised)"), True, _quaternion),
+                        default=_ONE_FORM, bounds="norm within 1e-2 of 1 (normalised)"), True, _quaternion),
     AttitudeForm(custom("axis_angle", "A rotation about an axis, from ``frame`` to the body.", "mapping", None,
-                        default=None, section=AXIS_ANGLE), True, _axis_angle),
-    AttitudeForm(custom("euler", "Euler angles from ``frame`` to the body.", "mapping", None, default=None,
+                        default=_ONE_FORM, section=AXIS_ANGLE), True, _axis_angle),
+    AttitudeForm(custom("euler", "Euler angles from ``frame`` to the body.", "mapping", None, default=_ONE_FORM,
                         section=EULER), True, _euler),
     AttitudeForm(custom("point", "A boresight on a target with a second axis fixing the roll (its own "
-                        "directions: no ``frame``).", "mapping", None, default=None, section=POINT), False, _point),
+                        "directions: no ``frame``).", "mapping", None, default=_ONE_FORM, section=POINT), False, _point),
 )}
 """The forms of an attitude mapping: name -> :class:`AttitudeForm` (exactly one per mapping)."""
 
