@@ -39,7 +39,15 @@ from ocp.geometry.directions import DIRECTIONS, Geometry
 from ocp.geometry.targets import ATTITUDE_FRAMES, ground_point, two_vector_attitude
 from scenarios.errors import ScenarioError
 from scenarios.requirements.spec import Sensor
-from scenarios.schema.keys import Described, Key, Section, custom, mapping, number, vector
+from scenarios.schema.keys import (
+    Described,
+    Key,
+    Section,
+    custom,
+    mapping,
+    number,
+    vector,
+)
 from scenarios.schema.node import Node
 
 __all__ = ["ATTITUDE", "ATTITUDE_FORMS", "AXIS_ANGLE", "EULER", "GROUND", "POINT", "SECONDARY", "TARGET_DIRECTION",
