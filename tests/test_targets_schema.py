@@ -291,3 +291,11 @@ def test_initial_attitude_frames_and_null():
     data = scenario()
     data["maneuver"]["initial"]["q"] = None
     assert refused(data).path == "maneuver.initial.q"
+
+
+def test_an_initial_pointing_target_is_taken_at_t0():
+    nadir = {"point": {"sensor": "camera", "at": "earth", "secondary": {"axis": [1, 0, 0], "toward": "velocity"}}}
+    loaded = parsed(initial=nadir)
+    np.testing.assert_allclose(quat.rotation_matrix(loaded.problem.q0), lvlh_by_hand(geometry(), 0.0), atol=1e-12)
+    later = parsed(initial={**nadir, "at_time_s": 60.0})
+    np.testing.assert_allclose(quat.rotation_matrix(later.problem.q0), lvlh_by_hand(geometry(), 60.0), atol=1e-12)

@@ -412,10 +412,10 @@ def parse_attitude(node: Node, context: AttitudeContext) -> Array:
     timed = not form.framed or frame in _TIMED_FRAMES
     t = context.time if isinstance(time_node.value, Described) else time_node.number(non_negative=True)
     if not isinstance(time_node.value, Described) and not timed:
-        raise time_node.error(f"a {form.name} attitude in the {frame} frame does not depend on time; at_time_s "
-                              f"applies to the frames {list(_TIMED_FRAMES)} and to point")
+        raise time_node.error(f"an attitude given as {form.name} in the {frame} frame does not depend on time; "
+                              f"at_time_s applies to the frames {list(_TIMED_FRAMES)} and to point")
     if not form.framed and "frame" in node:
-        raise frame_node.error(f"a {form.name} attitude is fixed by its own directions; frame applies to "
+        raise frame_node.error(f"an attitude given as {form.name} is fixed by its own directions; frame applies to "
                                f"{[name for name, other in ATTITUDE_FORMS.items() if other.framed]}")
     if frame == INITIAL_FRAME and context.initial is None:
         raise frame_node.error("frame 'initial' is for the final attitude (relative to the initial one); the initial "
