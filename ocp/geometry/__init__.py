@@ -12,11 +12,24 @@ points in the GCRF).
 May import: NumPy, CasADi and the top-level modules of :mod:`ocp`, and :mod:`ocp.dynamics` (the
 orbit, the ephemeris); never the other subpackages of ``ocp``.
 """
-from ocp.geometry.directions import (DIRECTIONS, FRAMES, INTERPOLATION_TOLERANCE, DirectionKind, Geometry,
-                                     direction_kind, direction_table)
+from ocp.geometry.directions import (
+    DIRECTIONS,
+    FRAMES,
+    INTERPOLATION_TOLERANCE,
+    DirectionKind,
+    Geometry,
+    direction_kind,
+    direction_table,
+)
 from ocp.geometry.pointing import PointingConstraint, PointingScore, violation_intervals
-from ocp.geometry.targets import (ATTITUDE_FRAMES, AttitudeFrame, geodetic_to_ecef, ground_point, itrs_to_gcrf,
-                                  two_vector_attitude)
+from ocp.geometry.targets import (
+    ATTITUDE_FRAMES,
+    AttitudeFrame,
+    geodetic_to_ecef,
+    ground_point,
+    itrs_to_gcrf,
+    two_vector_attitude,
+)
 
 __all__ = ["ATTITUDE_FRAMES", "DIRECTIONS", "FRAMES", "INTERPOLATION_TOLERANCE", "AttitudeFrame", "DirectionKind",
            "Geometry", "PointingConstraint", "PointingScore", "direction_kind", "direction_table", "geodetic_to_ecef",

@@ -146,7 +146,8 @@ def _angles(node: Node) -> np.ndarray:
 
 
 AXIS_ANGLE = Section((
-    custom("axis", "Rotation axis (any length but zero), body axes of the base attitude's frame.",
+    custom("axis", "Rotation axis (any length but zero): each quaternion is the rotation from the identity about "
+           "it, as the scenario's ``axis_angle`` attitude form in the inertial frame.",
            "list of 3 numbers", rotation_axis),
     custom("angle_deg", "Rotation angles: a list, or a generator such as ``{linspace: [0, 180, 7]}``.",
            "list of numbers or {generator: argument}", _angles, unit="deg"),
