@@ -499,6 +499,46 @@ def to_euler(q: ArrayLike, sequence: str = "321") -> Array:
     return _wrap(np.stack([outer_last, middle_angle, outer_first], axis=-1))
 
 
+def from_euler(angles: ArrayLike, sequence: str = "321") -> Array:
+    """Attitude of Euler angles: rotations about body axes in the order of ``sequence`` (inverse of
+    :func:`to_euler`).
+
+    For ``sequence = "321"`` (the default) the angles ``(ψ, θ, φ)`` give
+    ``q = q_z(ψ) ⊗ q_y(θ) ⊗ q_x(φ)``, ``R(q) = R_z(ψ) R_y(θ) R_x(φ)``: from the reference frame,
+    yaw about z, then pitch about the new y, then roll about the newest x, reach the body axes.
+    Any sequence :func:`to_euler` takes (Tait-Bryan or proper) is accepted; the angles may lie
+    anywhere (no range is imposed).
+
+    Parameters
+    ----------
+    angles : (..., 3) array_like
+        The three angles [rad], in the order of ``sequence``.
+    sequence : str, optional
+        The body axes in the order the rotations are applied: three of ``1``, ``2``, ``3`` (or
+        ``x``, ``y``, ``z``), no two consecutive ones equal; default ``"321"``.
+
+    Returns
+    -------
+    (..., 4) ndarray
+        Unit quaternion(s), scalar first, reference frame to body (body to reference: ``v_ref =
+        R(q) v_B``), with the sign chosen so that ``q0 >= 0``.
+
+    Raises
+    ------
+    ValueError
+        A sequence that is not three body axes with no two consecutive ones equal, or angles whose
+        last axis is not 3 long.
+    """
+    axes = sequence_axes(sequence)
+    angles = np.asarray(angles, dtype=float)
+    if angles.ndim == 0 or angles.shape[-1] != 3:
+        raise ValueError(f"angles must have 3 components, got shape {angles.shape}")
+    q = np.broadcast_to(IDENTITY, angles.shape[:-1] + (4,))
+    for index, axis in enumerate(axes):
+        q = product(q, from_axis_angle(np.eye(3)[axis], angles[..., index]))
+    return np.where(q[..., :1] < 0.0, -q, q)
+
+
 def _wrap(angles: Array) -> Array:
     """Angles in (-π, π]."""
     return np.pi - (np.pi - angles) % (2.0 * np.pi)

@@ -116,6 +116,42 @@ planners: [{name: eigenaxis}]
 controller: {name: augmented_quaternion_feedback}
 """
 
+ATTITUDES = [  # (maneuver.initial.q, maneuver.final.q) set into MAXIMAL_A: every form of an attitude once
+    ({"point": {"sensor": "star_tracker", "at": {"ground": {"lat_deg": 6, "lon_deg": 12, "alt_m": 100}},
+                "secondary": {"axis": [1, 0, 0], "toward": {"lvlh": [1, 0, 0]}}}, "at_time_s": 0},
+     {"axis_angle": {"axis": [0, 0, 1], "angle_deg": 30}, "frame": "initial"}),
+    ({"point": {"boresight": [0, 0, 1], "at": {"inertial": [1, 0, 0]},
+                "secondary": {"sensor": "antenna", "toward": {"rtn": [0, 0, 1]}}}},
+     {"euler": {"angles_deg": [10, 20, 30], "sequence": "313"}, "frame": "lvlh", "at_time_s": 35}),
+    ({"quaternion": [1, 0, 0, 0], "frame": "rtn"},
+     {"point": {"sensor": "star_tracker", "at": {"lvlh": [0, 0, 1]},
+                "secondary": {"axis": [1, 0, 0], "toward": {"ground": {"lat_deg": 10, "lon_deg": 11, "alt_m": 0}}}}}),
+    ({"euler": {"angles_deg": [1, 2, 3], "sequence": "321"}},
+     {"point": {"boresight": [0, 0, 1], "at": {"rtn": [1, 0, 0]},
+                "secondary": {"sensor": "antenna", "toward": {"inertial": [0, 0, 1]}}}, "at_time_s": 20}),
+    ({"point": {"sensor": "star_tracker", "at": {"lvlh": [0, 0, 1]},
+                "secondary": {"axis": [1, 0, 0], "toward": {"ground": {"lat_deg": 3, "lon_deg": 12, "alt_m": 0}}}}},
+     {"point": {"sensor": "star_tracker", "at": {"ground": {"lat_deg": 7, "lon_deg": 12, "alt_m": 50}},
+                "secondary": {"axis": [1, 0, 0], "toward": {"lvlh": [1, 0, 0]}}}}),
+    ({"point": {"boresight": [0, 0, 1], "at": {"rtn": [-1, 0, 0]},
+                "secondary": {"sensor": "antenna", "toward": {"inertial": [0, 0, 1]}}}},
+     {"point": {"boresight": [0, 0, 1], "at": {"inertial": [0, 1, 0]},
+                "secondary": {"sensor": "antenna", "toward": {"rtn": [0, 0, 1]}}}}),
+    ({"axis_angle": {"axis": [1, 0, 0], "angle_deg": 10}}, {"quaternion": [1, 0, 0, 0], "frame": "lvlh"}),
+]
+"""The attitude forms (``scenarios.schema.targets``), which MAXIMAL_A's plain quaternions do not use."""
+
+
+def maximal_scenarios() -> list[dict]:
+    """MAXIMAL_A, MAXIMAL_B and MAXIMAL_A with each pair of :data:`ATTITUDES`."""
+    data = [parse_yaml_text(MAXIMAL_A), parse_yaml_text(MAXIMAL_B)]
+    for initial, final in ATTITUDES:
+        variant = copy.deepcopy(data[0])
+        variant["maneuver"]["initial"]["q"], variant["maneuver"]["final"]["q"] = initial, final
+        data.append(variant)
+    return data
+
+
 MAXIMAL_STUDY = """
 study: maximal-study
 scenario:
@@ -195,8 +231,7 @@ def scenario_path(path: str) -> str:
 
 def test_the_maximal_scenarios_use_every_documented_scenario_key_and_only_documented_keys():
     found = set()
-    for text in (MAXIMAL_A, MAXIMAL_B):
-        data = parse_yaml_text(text)
+    for data in maximal_scenarios():
         scenarios.parse_scenario(copy.deepcopy(data))  # every key in them is accepted
         found |= {scenario_path(path) for path in yaml_paths(data)}
     assert found <= documented_paths(), sorted(found - documented_paths())
@@ -227,8 +262,8 @@ def keys_read(monkeypatch):
 
 
 def test_every_key_the_scenario_parser_reads_is_documented(keys_read):
-    for text in (MAXIMAL_A, MAXIMAL_B, MINIMAL):
-        scenarios.parse_scenario(parse_yaml_text(text))
+    for data in [*maximal_scenarios(), parse_yaml_text(MINIMAL)]:
+        scenarios.parse_scenario(data)
     read = {scenario_path(path) for path in keys_read}
     assert read - documented_paths() == set(), sorted(read - documented_paths())
     assert "environment.magnetic_field.span_s" in read and "simulation.sensor_noise.seed" in read
@@ -410,8 +445,9 @@ def test_slewbench_schema_prints_the_entries_under_a_key():
     assert completed.returncode == 0, completed.stderr
     paths = [line for line in completed.stdout.splitlines() if line and not line[0].isspace() and "=" not in line
              and not line.startswith(("Scenario file", "The slew"))]
-    assert paths == ["maneuver.initial", "maneuver.initial.q", "maneuver.initial.omega",
-                     "maneuver.initial.wheel_momentum"]
+    assert [path for path in paths if path.count(".") < 3] == [
+        "maneuver.initial", "maneuver.initial.q", "maneuver.initial.omega", "maneuver.initial.wheel_momentum"]
+    assert "maneuver.initial.q.point.secondary.toward" in paths  # the attitude's forms
     assert "list of 3 numbers [rad/s]; default [0.0, 0.0, 0.0]" in completed.stdout
     collocation = run_schema("planners.collocation.intervals")
     assert collocation.returncode == 0 and "planners[i].options.intervals" in collocation.stdout

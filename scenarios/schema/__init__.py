@@ -5,7 +5,8 @@ What lives here: bounded, duplicate-refusing YAML reading (:mod:`~scenarios.sche
 nodes whose errors name the YAML path (:mod:`~scenarios.schema.node`), the vocabulary the keys are
 declared in (:mod:`~scenarios.schema.keys`), the model sections (``spacecraft``, ``orbit``,
 ``environment``; :mod:`~scenarios.schema.model`), the epoch, the sensors and the
-requirements (:mod:`~scenarios.schema.requirements`), the whole scenario and the
+requirements (:mod:`~scenarios.schema.requirements`), the attitudes in mission terms (axis and
+angle, Euler angles, pointing targets, orbit frames; :mod:`~scenarios.schema.targets`), the whole scenario and the
 :class:`~scenarios.schema.loader.Scenario` it builds (:mod:`~scenarios.schema.loader`), how planner
 and controller labels name the rows (:mod:`~scenarios.schema.labels`), the names of the metric
 columns (:mod:`~scenarios.schema.columns`), the checks of a parsed scenario as a whole
@@ -20,7 +21,8 @@ from __future__ import annotations
 
 from scenarios._faces import lazy_face
 
-_HOMES = {"ControllerSpec": "scenarios.schema.loader",
+_HOMES = {"ATTITUDE_FORMS": "scenarios.schema.targets",
+          "ControllerSpec": "scenarios.schema.loader",
           "DISTRIBUTIONS": "scenarios.schema.study",
           "Key": "scenarios.schema.keys",
           "Node": "scenarios.schema.node",
@@ -39,7 +41,7 @@ _HOMES = {"ControllerSpec": "scenarios.schema.loader",
           "schema_rst": "scenarios.schema.reference",
           "schema_text": "scenarios.schema.reference"}
 
-__all__ = ["DISTRIBUTIONS", "VALUE_GENERATORS", "ControllerSpec", "Key", "Node", "PlannerSpec", "RowLabel", "Scenario",
+__all__ = ["ATTITUDE_FORMS", "DISTRIBUTIONS", "VALUE_GENERATORS", "ControllerSpec", "Key", "Node", "PlannerSpec", "RowLabel", "Scenario",
            "Section", "SimulationSpec", "load", "metric_columns", "parse_scenario", "parse_yaml_text", "read_yaml",
            "row_labels", "schema_rst", "schema_text"]
 

@@ -7,7 +7,9 @@ every value is read through them, so the schema reference (:mod:`scenarios.schem
 lists exactly what is accepted. Every error is a :class:`~scenarios.errors.ScenarioError` naming
 the YAML path and what was expected. Degrees (``*_deg``) and kilometres (``*_km``) are converted to
 SI here, and so are scalar-last quaternions (``maneuver.quaternion_order: scalar_last``), so that
-nothing inside the code sees the papers' conventions. Planners and controllers are validated
+nothing inside the code sees the papers' conventions; attitudes written in mission terms (axis and
+angle, Euler angles, a pointing target, an orbit frame) become inertial quaternions here too
+(:mod:`scenarios.schema.targets`). Planners and controllers are validated
 once, here: :class:`PlannerSpec` and :class:`ControllerSpec` carry the instances.
 """
 from __future__ import annotations
@@ -29,7 +31,7 @@ from ocp.geometry.directions import Geometry
 from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem, Planner
 from scenarios.errors import ScenarioError
-from scenarios.requirements.spec import Requirements
+from scenarios.requirements.spec import Requirements, Sensor
 from scenarios.schema.checks import check_compatibility, check_row_labels, check_work
 from scenarios.schema.keys import (
     Described,
@@ -40,7 +42,6 @@ from scenarios.schema.keys import (
     integer,
     mapping,
     number,
-    quaternion,
     vector,
 )
 from scenarios.schema.model import (
@@ -59,6 +60,7 @@ from scenarios.schema.requirements import (
     parse_epoch,
     parse_requirements,
 )
+from scenarios.schema.targets import AttitudeContext, attitude_key, parse_attitude
 
 MAX_NAME = 200
 """Characters of a scenario name (the default output directory uses a sanitised, shorter stem)."""
@@ -298,15 +300,18 @@ def _registered(registry: dict[str, Any], kind: str) -> Any:
 
 
 INITIAL = Section((
-    quaternion("q", "Initial attitude, body to inertial (scalar first unless ``quaternion_order: scalar_last``)."),
+    attitude_key("q", "Initial attitude, body to inertial: a quaternion (scalar first unless ``quaternion_order: "
+                 "scalar_last``), or a mapping of one form (``axis_angle``, ``euler``, ``point`` ...; the user guide's "
+                 "page on manoeuvres); its instant is t = 0."),
     vector("omega", "Initial body rate, body frame.", 3, unit="rad/s", default=[0.0, 0.0, 0.0]),
     custom("wheel_momentum", "Initial spin momentum of each wheel; ``null``: zero.",
            "list of numbers (one per wheel) or null", None, unit="N m s", default=None),
 ), "The state at t = 0.")
 
 FINAL = Section((
-    quaternion("q", "Target attitude; ``null``: free (rate acquisition; the attitude metrics are then null). "
-               "Only laws that need no target attitude accept it without planners.", nullable=True),
+    attitude_key("q", "Target attitude, written as ``initial.q`` is (its instant is ``duration``; ``frame: initial`` "
+                 "is relative to the initial attitude); ``null``: free (rate acquisition; the attitude metrics are "
+                 "then null). Only laws that need no target attitude accept it without planners.", nullable=True),
     vector("omega", "Target body rate, body frame; ``null``: free.", 3, unit="rad/s", default=None, nullable=True),
 ), "The state at t = ``duration``.")
 
@@ -422,20 +427,21 @@ SCENARIO = Section((
 ), "A scenario file.")
 
 
-def _parse_problem(node: Node, spacecraft: Spacecraft, environment: Environment) -> ManeuverProblem:
+def _parse_problem(node: Node, spacecraft: Spacecraft, environment: Environment, sensors: dict[str, Sensor],
+                   epoch: datetime.datetime | None) -> ManeuverProblem:
     node.mapping()
     order = MANEUVER["quaternion_order"].value(node)
-
-    def attitude(q: np.ndarray) -> np.ndarray:
-        return quat.from_scalar_last(q) if order == "scalar_last" else q
-
+    duration = MANEUVER["duration"].value(node)
     initial, final = MANEUVER["initial"].value(node), MANEUVER["final"].value(node)
+    # the attitudes' forms (scenarios.schema.targets): t = 0 for the initial, the duration for the final
+    context = AttitudeContext(Geometry(epoch, environment.orbit), sensors, order == "scalar_last", 0.0)
+    q0 = parse_attitude(initial["q"], context)
+    final_context = dataclasses.replace(context, time=duration, initial=q0)
+    qf = None if final["q"].is_null() else parse_attitude(final["q"], final_context)  # null: a free final attitude
     momentum = initial["wheel_momentum"].optional_vector(spacecraft.n_wheels)
     problem = ManeuverProblem(
-        spacecraft=spacecraft, environment=environment, q0=attitude(initial["q"]), omega0=initial["omega"],
-        qf=None if final["q"] is None else attitude(final["q"]),  # a final attitude written as null: free
-        omegaf=final["omega"], duration=MANEUVER["duration"].value(node),
-        wheel_momentum0=momentum, max_rate=MANEUVER["max_rate"].value(node),
+        spacecraft=spacecraft, environment=environment, q0=q0, omega0=initial["omega"], qf=qf,
+        omegaf=final["omega"], duration=duration, wheel_momentum0=momentum, max_rate=MANEUVER["max_rate"].value(node),
     )
     node.finish()
     return problem
@@ -530,7 +536,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     epoch = SCENARIO["epoch"].value(root)
     spacecraft, sensors = parse_spacecraft(SCENARIO["spacecraft"].value(root))
     environment = parse_environment(SCENARIO["orbit"].value(root), SCENARIO["environment"].value(root), epoch)
-    problem = _parse_problem(SCENARIO["maneuver"].value(root), spacecraft, environment)
+    problem = _parse_problem(SCENARIO["maneuver"].value(root), spacecraft, environment, sensors, epoch)
     planners = _parse_planners(SCENARIO["planners"].value(root))
     controllers = _parse_controllers(root)
     simulation = _parse_simulation(SCENARIO["simulation"].value(root), "simulation")

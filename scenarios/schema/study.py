@@ -44,6 +44,7 @@ from scenarios.schema.keys import (
 )
 from scenarios.schema.loader import MAX_NAME, SCENARIO
 from scenarios.schema.node import Node
+from scenarios.schema.targets import axis_angle_quaternion, rotation_axis
 
 __all__ = [
     "CASE_SEED",
@@ -136,14 +137,6 @@ def _spaced_values(node: Node, space: Callable[..., np.ndarray]) -> tuple[list[A
     return values, values
 
 
-def _axis(node: Node) -> np.ndarray:
-    axis = node.vector(3)
-    largest = float(np.max(np.abs(axis)))
-    if not largest > 0:
-        raise node.error("the rotation axis cannot be zero")
-    return axis / largest  # a direction; scaled so that its norm cannot overflow
-
-
 def _angles(node: Node) -> np.ndarray:
     if isinstance(node.value, list):
         if not 1 <= len(node.value) <= MAX_VALUES:
@@ -153,8 +146,9 @@ def _angles(node: Node) -> np.ndarray:
 
 
 AXIS_ANGLE = Section((
-    custom("axis", "Rotation axis (any length but zero), body axes of the base attitude's frame.",
-           "list of 3 numbers", _axis),
+    custom("axis", "Rotation axis (any length but zero): each quaternion is the rotation from the identity about "
+           "it, as the scenario's ``axis_angle`` attitude form in the inertial frame.",
+           "list of 3 numbers", rotation_axis),
     custom("angle_deg", "Rotation angles: a list, or a generator such as ``{linspace: [0, 180, 7]}``.",
            "list of numbers or {generator: argument}", _angles, unit="deg"),
 ), "Quaternions of rotations about one axis.")
@@ -166,7 +160,7 @@ def _axis_angle(argument: dict[str, Any], base: Mapping[str, Any]) -> tuple[list
     scalar_last = isinstance(maneuver, dict) and maneuver.get("quaternion_order") == "scalar_last"
     quaternions = []
     for angle in angles_deg:
-        q = quat.from_axis_angle(axis / np.linalg.norm(axis), np.deg2rad(float(angle)))
+        q = axis_angle_quaternion(axis, angle)  # the conversion of the scenario's axis_angle form
         quaternions.append([float(v) for v in (quat.to_scalar_last(q) if scalar_last else q)])
     return quaternions, [float(a) for a in angles_deg]
 
