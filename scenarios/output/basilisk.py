@@ -8,7 +8,9 @@ line::
 
 * ``t`` [s], from the start of the simulation; the module converts it to integer nanoseconds by
   truncation (``(uint64_t)(t * 1e9)``), so times must be non-negative, and strictly increasing
-  (equal times would make its interpolation divide by zero);
+  (equal times would make its interpolation divide by zero). A time on a whole nanosecond is
+  written as the nearest double that truncates to that nanosecond (0.7 s would read as
+  699 999 999 ns);
 * the attitude of the reference frame R relative to the inertial frame N, by ``attitudeType``:
   0, MRPs ``σ_RN``; 1, Euler parameters ``(β_0, β_1, β_2, β_3)`` scalar first; 2, scalar last.
   Basilisk's Euler parameters of R relative to N are the same four numbers as slewbench's
@@ -92,6 +94,19 @@ def _mrp(q: Array) -> Array:
     return np.asarray(q[:, 1:] / (1.0 + q[:, :1]), dtype=float)
 
 
+def _nanosecond_exact(t: float) -> float:
+    """``t`` [s], or the next double above it when Basilisk's ``(uint64_t)(t * 1e9)`` would truncate
+    a time on a whole nanosecond to the nanosecond before (0.7 s reads as 699999999 ns otherwise);
+    the shift is a few units in the last place."""
+    ns = round(t * 1e9)
+    if abs(t * 1e9 - ns) > 1e-3:  # not on a nanosecond: truncated as any time is
+        return t
+    x = t
+    while int(x * 1e9) < ns:
+        x = float(np.nextafter(x, np.inf))
+    return x
+
+
 def write_waypoint_reference(reference: Any, times: ArrayLike, path: str | Path, attitude_type: str = "mrp",
                              delimiter: str = ",", header: bool = True) -> WaypointFile:
     """Write a reference, sampled on a grid, as a Basilisk ``waypointReference`` data file.
@@ -156,5 +171,6 @@ def write_waypoint_reference(reference: Any, times: ArrayLike, path: str | Path,
         if header:
             handle.write(delimiter.join(columns) + "\n")
         for row in table:
-            handle.write(delimiter.join(f"{value:.17g}" for value in row) + "\n")
+            fields = [_nanosecond_exact(float(row[0])), *row[1:]]
+            handle.write(delimiter.join(f"{value:.17g}" for value in fields) + "\n")
     return WaypointFile(path, attitude_type, delimiter, 1 if header else 0, len(t))
