@@ -41,20 +41,20 @@ import yaml
 
 pytest.importorskip("Basilisk", reason="the Basilisk cross-check needs bsk from PyPI (the 'basilisk' extra)")
 
-from Basilisk.architecture import messaging  # noqa: E402
-from Basilisk.fswAlgorithms import (  # noqa: E402
+from Basilisk.architecture import messaging
+from Basilisk.fswAlgorithms import (
     attTrackingError,
     mrpFeedback,
     rwMotorTorque,
     waypointReference,
 )
-from Basilisk.simulation import reactionWheelStateEffector, simpleNav, spacecraft  # noqa: E402
-from Basilisk.utilities import SimulationBaseClass, macros  # noqa: E402
+from Basilisk.simulation import reactionWheelStateEffector, simpleNav, spacecraft
+from Basilisk.utilities import SimulationBaseClass, macros
 
-from controllers.tracking.mrp_feedback import MRPFeedback  # noqa: E402
-from ocp import Simulator, quat  # noqa: E402
-from scenarios.output.basilisk import write_waypoint_reference  # noqa: E402
-from scenarios.schema.loader import Scenario, parse_scenario  # noqa: E402
+from controllers.tracking.mrp_feedback import MRPFeedback
+from ocp import Simulator, quat
+from scenarios.output.basilisk import write_waypoint_reference
+from scenarios.schema.loader import Scenario, parse_scenario
 
 pytestmark = pytest.mark.slow
 
