@@ -8,8 +8,9 @@ manifest and staged commits (:mod:`~scenarios.output.directory`), writing a run'
 (:mod:`~scenarios.output.writer`), the figures' data as arrays
 (:mod:`~scenarios.output.plot_data`), the matplotlib drawing (:mod:`~scenarios.output.plots`),
 the plot process that draws while the run goes on (:mod:`~scenarios.output.renderer`), the
-interactive ``report.html`` (:mod:`scenarios.output.report`), and where results come from:
-versions, platform, date and seeds (:mod:`~scenarios.output.provenance`).
+interactive ``report.html`` (:mod:`scenarios.output.report`), where results come from:
+versions, platform, date and seeds (:mod:`~scenarios.output.provenance`), and a reference as
+Basilisk's ``waypointReference`` data file (:mod:`~scenarios.output.basilisk`).
 
 May import: :mod:`ocp`, :mod:`planners` (types), :mod:`scenarios.errors` and
 :mod:`scenarios.schema`. :mod:`~scenarios.output.plots` and :mod:`~scenarios.output.renderer` import
@@ -21,6 +22,7 @@ from __future__ import annotations
 from scenarios._faces import lazy_face
 
 _HOMES = {"Renderer": "scenarios.output.renderer",
+          "WaypointFile": "scenarios.output.basilisk",
           "Row": "scenarios.output.results",
           "RunResults": "scenarios.output.results",
           "claim_output_directory": "scenarios.output.directory",
@@ -34,10 +36,11 @@ _HOMES = {"Renderer": "scenarios.output.renderer",
           "to_json": "scenarios.output.tables",
           "to_markdown": "scenarios.output.tables",
           "to_terminal": "scenarios.output.tables",
-          "write_results": "scenarios.output.writer"}
+          "write_results": "scenarios.output.writer",
+          "write_waypoint_reference": "scenarios.output.basilisk"}
 
-__all__ = ["Renderer", "Row", "RunResults", "claim_output_directory", "flatten_row", "read_manifest",
+__all__ = ["Renderer", "Row", "RunResults", "WaypointFile", "claim_output_directory", "flatten_row", "read_manifest",
            "row_columns", "row_stems", "sanitize", "to_csv", "to_dataframe", "to_json", "to_markdown", "to_terminal",
-           "write_results"]
+           "write_results", "write_waypoint_reference"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)
