@@ -16,9 +16,16 @@ gain ``Ki`` < 0, i.e. off, no known external torque), written for slewbench's st
 * ``ω_g = ω_r`` (``gyroscopic_rate: reference``, Basilisk's ``controlLawType = 0``, the default)
   or ``ω_g = ω`` (``body``, ``controlLawType = 1``).
 
-``L_r`` is the torque the actuators are to exert on the body: the wheels' gyroscopic term is part of
-the law, so the allocation maps ``L_r`` itself (``gyroscopic_compensation = False``): ``g = −A⁺ L_r``,
-which is Basilisk's ``rwMotorTorque`` with control axes the body axes. ``I`` is slewbench's inertia,
+``L_r`` is the torque the actuators are to exert on the body, mapped to the wheels as
+``g = −A⁺ L_r``, Basilisk's ``rwMotorTorque`` with control axes the body axes. With
+``gyroscopic_rate: body`` the law is a rigid-body law: ``u = L_r − ω × A h_w`` does not depend on the
+wheel momenta, and the allocation adds ``ω × A h_w`` back (``gyroscopic_compensation`` true). With
+``reference`` (Basilisk's default) it is not: ``L_r − ω × A h_w`` keeps ``−δω × A h_w``, so the
+wheels' term stays in the law and ``L_r`` is mapped as it is (``gyroscopic_compensation`` false;
+the controller conformance tells the two kinds apart). A consequence for the scenario's actuator
+requirement: it scores a reference's demand through the law's map, which for such a law is the
+feed-forward torque as the wheels' torque, without the ``ω × A h_w`` that the law adds along the
+reference (the closed loop itself is exact). ``I`` is slewbench's inertia,
 which excludes the wheels' spin inertia about their axes (Basilisk's ``[I_RW]``; its module reads
 the inertia from its vehicle configuration message, which is to hold this matrix for the two laws
 to be one). The law is sampled at ``t_k`` and held, as Basilisk's task does: there is no hold
@@ -27,6 +34,7 @@ compensation. With ``V = ½ δωᵀ I δω + 2K ln(1 + σᵀσ)`` the continuous
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
@@ -54,6 +62,7 @@ class MRPFeedback(Controller):
     name = "mrp_feedback"
     tracks_reference = True
     gyroscopic_compensation = False
+    """Per instance: true with ``gyroscopic_rate: body`` (module docstring)."""
 
     @dataclass(frozen=True)
     class Options:
@@ -74,6 +83,10 @@ class MRPFeedback(Controller):
         p: Annotated[float, Range(ge=0.0)] = 8.0
         gyroscopic_rate: Literal["reference", "body"] = "reference"
 
+    def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options"):
+        super().__init__(options, path)
+        self.gyroscopic_compensation = self.options.gyroscopic_rate == "body"
+
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:
         super().reset(spacecraft, sample_time, target)
         self._inertia = np.asarray(spacecraft.inertia, dtype=float)
@@ -93,9 +106,9 @@ class MRPFeedback(Controller):
         to_body = rotation_matrix(q_e).T
         omega_r, omega_dot_r = to_body @ row[4:7], to_body @ row[7:10]
         momentum = self._inertia @ omega
-        if self._axes.shape[1]:
+        if self._axes.shape[1] and not self.gyroscopic_compensation:  # else the allocation adds ω × A h_w
             momentum = momentum + self._axes @ np.asarray(measurement.wheel_momentum, dtype=float)
-        spin = omega_r if self.options.gyroscopic_rate == "reference" else omega
+        spin = omega if self.gyroscopic_compensation else omega_r
         torque = (-self.options.k * sigma - self.options.p * (omega - omega_r) + np.cross(spin, momentum)
                   - self._inertia @ (np.cross(omega, omega_r) - omega_dot_r))
         return self.allocate(torque, measurement)
@@ -117,9 +130,9 @@ class MRPFeedback(Controller):
         omega_r, omega_dot_r = to_body(w_ref), to_body(a_ref)
         inertia = ca.DM(self._inertia)
         momentum = ca.mtimes(inertia, omega)
-        if spacecraft.n_wheels:
+        if spacecraft.n_wheels and not self.gyroscopic_compensation:  # else the allocation adds ω × A h_w
             momentum = momentum + ca.mtimes(ca.DM(self._axes), h)
-        spin = omega_r if self.options.gyroscopic_rate == "reference" else omega
+        spin = omega if self.gyroscopic_compensation else omega_r
         torque = (-self.options.k * sigma - self.options.p * (omega - omega_r) + ca.cross(spin, momentum)
                   - ca.mtimes(inertia, ca.cross(omega, omega_r) - omega_dot_r))
         return self.allocate_symbolic(torque, y), z
