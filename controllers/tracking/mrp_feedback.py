@@ -16,6 +16,12 @@ gain ``Ki`` < 0, i.e. off, no known external torque), written for slewbench's st
 * ``ω_g = ω_r`` (``gyroscopic_rate: reference``, Basilisk's ``controlLawType = 0``, the default)
   or ``ω_g = ω`` (``body``, ``controlLawType = 1``).
 
+``I`` is slewbench's inertia, which excludes the wheels' spin inertia about their axes (Basilisk's
+``[I_RW]``; its module reads the inertia from its vehicle configuration message, which is to hold
+this matrix for the two laws to be one). The law is sampled at ``t_k`` and held, as Basilisk's task
+does: there is no hold compensation. With ``V = ½ δωᵀ I δω + 2K ln(1 + σᵀσ)`` the continuous closed
+loop has ``V̇ = −P δωᵀ δω``.
+
 ``L_r`` is the torque the actuators are to exert on the body, mapped to the wheels as
 ``g = −A⁺ L_r``, Basilisk's ``rwMotorTorque`` with control axes the body axes. With
 ``gyroscopic_rate: body`` the law is a rigid-body law: ``u = L_r − ω × A h_w`` does not depend on the
@@ -25,12 +31,7 @@ wheels' term stays in the law and ``L_r`` is mapped as it is (``gyroscopic_compe
 the controller conformance tells the two kinds apart). A consequence for the scenario's actuator
 requirement: it scores a reference's demand through the law's map, which for such a law is the
 feed-forward torque as the wheels' torque, without the ``ω × A h_w`` that the law adds along the
-reference (the closed loop itself is exact). ``I`` is slewbench's inertia,
-which excludes the wheels' spin inertia about their axes (Basilisk's ``[I_RW]``; its module reads
-the inertia from its vehicle configuration message, which is to hold this matrix for the two laws
-to be one). The law is sampled at ``t_k`` and held, as Basilisk's task does: there is no hold
-compensation. With ``V = ½ δωᵀ I δω + 2K ln(1 + σᵀσ)`` the continuous closed loop has
-``V̇ = −P δωᵀ δω``.
+reference (the closed loop itself is exact).
 """
 from __future__ import annotations
 
