@@ -17,18 +17,19 @@ from controllers.tracking.augmented_quaternion_feedback import (
 )
 from controllers.tracking.costate_feedback import CostateFeedback
 from controllers.tracking.eigenaxis_pd import EigenaxisPD
+from controllers.tracking.mrp_feedback import MRPFeedback
 from controllers.two_wheel.gain_scheduled_min_norm import GainScheduledMinNorm
 from controllers.two_wheel.min_norm import MinNorm
 from controllers.two_wheel.singular_rate_tracking import SingularRateTracking
 from controllers.two_wheel.singular_zero_momentum import SingularZeroMomentum
 
 CONTROLLERS: dict[str, type[Controller]] = {
-    cls.name: cls for cls in (AugmentedQuaternionFeedback, BDot, CostateFeedback, EigenaxisPD, NoControl, TDFC,
+    cls.name: cls for cls in (AugmentedQuaternionFeedback, BDot, CostateFeedback, EigenaxisPD, MRPFeedback, NoControl, TDFC,
                               SingularZeroMomentum, SingularRateTracking, MinNorm, GainScheduledMinNorm)
 }
 
 __all__ = ["CONTROLLERS", "TDFC", "AugmentedQuaternionFeedback", "BDot", "Controller", "CostateFeedback", "EigenaxisPD",
-           "GainScheduledMinNorm", "MinNorm", "NoControl", "SingularRateTracking", "SingularZeroMomentum", "gain_matrix"]
+           "GainScheduledMinNorm", "MRPFeedback", "MinNorm", "NoControl", "SingularRateTracking", "SingularZeroMomentum", "gain_matrix"]
 
 
 def __dir__() -> list[str]:

@@ -11,7 +11,8 @@ the plot process that draws while the run goes on (:mod:`~scenarios.output.rende
 interactive ``report.html`` (:mod:`scenarios.output.report`), where results come from:
 versions, platform, date and seeds (:mod:`~scenarios.output.provenance`), and exports of a finished
 run into other tools' formats (:mod:`~scenarios.output.export`, the ``EXPORT_FORMATS`` registry;
-CCSDS attitude ephemeris messages in :mod:`~scenarios.output.aem`).
+CCSDS attitude ephemeris messages in :mod:`~scenarios.output.aem`; a reference as Basilisk's
+``waypointReference`` data file in :mod:`~scenarios.output.basilisk`).
 
 May import: :mod:`ocp`, :mod:`planners` (types), :mod:`scenarios.errors` and
 :mod:`scenarios.schema`. :mod:`~scenarios.output.plots` and :mod:`~scenarios.output.renderer` import
@@ -24,6 +25,7 @@ from scenarios._faces import lazy_face
 
 _HOMES = {"EXPORT_FORMATS": "scenarios.output.export",
           "Renderer": "scenarios.output.renderer",
+          "WaypointFile": "scenarios.output.basilisk",
           "Row": "scenarios.output.results",
           "RunResults": "scenarios.output.results",
           "claim_output_directory": "scenarios.output.directory",
@@ -39,11 +41,12 @@ _HOMES = {"EXPORT_FORMATS": "scenarios.output.export",
           "to_json": "scenarios.output.tables",
           "to_markdown": "scenarios.output.tables",
           "to_terminal": "scenarios.output.tables",
-          "write_results": "scenarios.output.writer"}
+          "write_results": "scenarios.output.writer",
+          "write_waypoint_reference": "scenarios.output.basilisk"}
 
-__all__ = ["EXPORT_FORMATS", "Renderer", "Row", "RunResults", "claim_output_directory", "export_run", "flatten_row",
-           "read_aem", "read_manifest",
+__all__ = ["EXPORT_FORMATS", "Renderer", "Row", "RunResults", "WaypointFile", "claim_output_directory", "export_run",
+           "flatten_row", "read_aem", "read_manifest",
            "row_columns", "row_stems", "sanitize", "to_csv", "to_dataframe", "to_json", "to_markdown", "to_terminal",
-           "write_results"]
+           "write_results", "write_waypoint_reference"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)
