@@ -5,16 +5,18 @@ A :class:`SensorSuite` declares the sensors (and the MEKF, if any). Per sample `
 
     s = [β (3): the gyro's true bias [rad/s], q̂ (4): the attitude the controller was given
          (the MEKF's estimate, or the last star tracker reading), b̂ (3): the bias estimate
-         [rad/s], P (21): the MEKF covariance's upper triangle, ω̃ (3): the last gyro reading
-         [rad/s], Δt (1): the last sample's length [s] (0 before the first)]
+         [rad/s], P (21): the MEKF covariance's upper triangle, ω (3): the true rate at the
+         previous sample [rad/s], Δt (1): the previous sample's length [s] (0 before the first)]
 
 and takes a row of :data:`SENSOR_NOISE_SIZE` numbers drawn in advance by :func:`draw_sensor_noise`
 (bias increment, gyro white noise, star tracker rotation vector in body axes, all scaled, and
 the star tracker's availability). One step (:func:`sensor_step`, :func:`sensor_step_symbolic`):
 
-1. the gyro reads ``ω̃_k = ω + ½(β + β⁺) + n_v`` (Farrenkopf), ``β⁺ = β + n_u``;
-2. with the MEKF: it propagates from the previous sample with the mean of the two readings,
-   ``½(ω̃_{k−1} + ω̃_k) − b̂`` (the rate changes over a sample: a slew, a spin), over the previous
+1. the gyro reads the rate ``ω̃_k = ω_k + ½(β + β⁺) + n_v`` (Farrenkopf), ``β⁺ = β + n_u``,
+   and, as a rate-integrating gyro, the mean rate since the previous sample
+   ``ω̄_k = ½(ω_{k−1} + ω_k) + ½(β + β⁺) + n_v`` (its angle increment over the sample's length;
+   the rate changes over a sample in a slew or a spin, the trapezoid follows it to second order);
+2. with the MEKF: it propagates from the previous sample with ``ω̄_k − b̂`` over the previous
    sample's length;
 3. the star tracker reads ``q̃ = q ⊗ exp(v/2)`` when available; the MEKF updates with it;
 4. the controller gets ``q̂`` and ``ω̃_k − b̂`` (without a MEKF: the last reading ``q̃`` and ``ω̃_k``);
@@ -219,6 +221,7 @@ def sensor_step(suite: SensorSuite, s: Array, q: Array, omega: Array, field: Arr
     """
     s_next = s.copy()
     beta = s[0:3]
+    true_rate = omega
     if suite.gyro is not None:
         beta_next = beta + noise[0:3]
         omega = omega + 0.5 * (beta + beta_next) + noise[3:6]
@@ -235,10 +238,11 @@ def sensor_step(suite: SensorSuite, s: Array, q: Array, omega: Array, field: Arr
     gyro = suite.gyro
     assert gyro is not None
     bias = s[7:10]
-    q_hat, P = propagate(s[3:7], unpack(s[10:31]), 0.5 * (s[31:34] + omega) - bias, s[34], gyro.arw, gyro.rrw)
+    mean_rate = omega + 0.5 * (s[31:34] - true_rate)  # ω̄_k: the reading's bias and noise, the rates' mean
+    q_hat, P = propagate(s[3:7], unpack(s[10:31]), mean_rate - bias, s[34], gyro.arw, gyro.rrw)
     if available:
         q_hat, bias, P = update(q_hat, bias, P, _rotate_by(q, noise[6:9]), suite.star_tracker.covariance)
-    s_next[3:7], s_next[7:10], s_next[10:31], s_next[31:34], s_next[34] = q_hat, bias, pack(P), omega, dt
+    s_next[3:7], s_next[7:10], s_next[10:31], s_next[31:34], s_next[34] = q_hat, bias, pack(P), true_rate, dt
     return q_hat, omega - bias, field, s_next
 
 
@@ -268,6 +272,7 @@ def sensor_step_symbolic(suite: SensorSuite, s: Any, q: Any, omega: Any, field: 
     """
     beta = s[0:3]
     beta_next = beta
+    true_rate = omega
     if suite.gyro is not None:
         beta_next = beta + noise[0:3]
         omega = omega + 0.5 * (beta + beta_next) + noise[3:6]
@@ -282,10 +287,11 @@ def sensor_step_symbolic(suite: SensorSuite, s: Any, q: Any, omega: Any, field: 
     gyro = suite.gyro
     assert gyro is not None
     bias = s[7:10]
-    q_hat, P = propagate_symbolic(s[3:7], unpack(s[10:31]), 0.5 * (s[31:34] + omega) - bias, s[34], gyro.arw, gyro.rrw)
+    mean_rate = omega + 0.5 * (s[31:34] - true_rate)
+    q_hat, P = propagate_symbolic(s[3:7], unpack(s[10:31]), mean_rate - bias, s[34], gyro.arw, gyro.rrw)
     q_up, bias_up, P_up = update_symbolic(q_hat, bias, P, _rotate_by_symbolic(q, noise[6:9]),
                                           suite.star_tracker.covariance)
     q_hat = ca.if_else(available, q_up, q_hat)
     bias = ca.if_else(available, bias_up, bias)
     P = ca.if_else(available, P_up, P)
-    return q_hat, omega - bias, field, ca.vertcat(beta_next, q_hat, bias, pack_symbolic(P), omega, dt)
+    return q_hat, omega - bias, field, ca.vertcat(beta_next, q_hat, bias, pack_symbolic(P), true_rate, dt)
