@@ -178,3 +178,18 @@ def test_the_example_scenario_reads_in_si(example):
     np.testing.assert_allclose(sensors.star_tracker.noise, np.array([5, 5, 40]) * np.pi / 180 / 3600)
     assert sensors.star_tracker.outages == ((50.0, 60.0),) and sensors.star_tracker.rate == 1.0
     assert sensors.estimator.attitude_sigma == pytest.approx(np.deg2rad(0.1))
+
+
+def test_knowledge_error_metrics(example):
+    """Zero with a noiseless star tracker; with the MEKF about the filter's accuracy (under 0.1 deg,
+    far from the 2 deg initial error the true state starts with); null without a star tracker."""
+    from ocp.metrics import metrics_from_simulation
+    scenario, reference = example
+    problem = scenario.problem
+    cases = {"silent": SensorSuite(star_tracker=StarTracker(noise=[0.0, 0.0, 0.0])),
+             "mekf": scenario.simulation.sensors, "gyro only": SensorSuite(gyro=scenario.simulation.sensors.gyro)}
+    metrics = {name: metrics_from_simulation(run(scenario, reference, suite, duration=60.0), problem.qf,
+                                             reference=reference) for name, suite in cases.items()}
+    assert metrics["silent"]["max_knowledge_error_deg"] == 0.0
+    assert 0.0 < metrics["mekf"]["final_knowledge_error_deg"] <= metrics["mekf"]["max_knowledge_error_deg"] < 0.2
+    assert metrics["gyro only"]["final_knowledge_error_deg"] is None

@@ -215,6 +215,8 @@ class SimulationResult:
         given at ``t_k``: the attitude estimate ``q̂`` (the MEKF's; without it the last star
         tracker reading), the bias estimate [rad/s] and the MEKF covariance's upper triangle,
         and the gyro's true bias [rad/s] and last reading; ``None`` without sensors.
+    sensors : SensorSuite or None
+        The sensors of the run (``None``: none).
     """
 
     model: AttitudeModel
@@ -227,6 +229,7 @@ class SimulationResult:
     saturated: NDArray[np.bool_]
     path: str = "python"
     sensor_state: Array | None = None
+    sensors: SensorSuite | None = None
 
     @property
     def q(self) -> Array:
@@ -661,6 +664,7 @@ class Simulator:
         result = self._result(times, np.array(states), commanded, np.array(applied).reshape(n_samples, model.nu),
                               np.array(saturated, dtype=bool), "python")
         result.sensor_state = np.array(sensor_states) if sensors is not None else None
+        result.sensors = sensors
         return result
 
     @staticmethod
@@ -792,7 +796,7 @@ class Simulator:
         if not finite.all():
             raise SimulationError(self._divergence(times, int(np.argmin(finite)) - 1))
         return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, torque,
-                                saturated.astype(bool), path, sensor_states)
+                                saturated.astype(bool), path, sensor_states, sensors)
 
     def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator,
                  field_rng: np.random.Generator | None = None) -> Any:
