@@ -11,15 +11,21 @@ May import: NumPy, CasADi, :mod:`ocp.dynamics` and the top-level modules of :mod
 :mod:`ocp.simulation`, :mod:`ocp.geometry`, :mod:`ocp.transcription` or :mod:`ocp.nlp`.
 """
 from ocp.estimation.loop import (
-           SENSOR_NOISE_SIZE,
-           SENSOR_STATE_SIZE,
-           SensorSuite,
-           draw_sensor_noise,
-           initial_sensor_state,
-           sensor_step,
-           sensor_step_symbolic,
+    SENSOR_NOISE_SIZE,
+    SENSOR_STATE_SIZE,
+    SensorSuite,
+    draw_sensor_noise,
+    initial_sensor_state,
+    sensor_step,
+    sensor_step_symbolic,
 )
-from ocp.estimation.mekf import Mekf, propagate, propagate_symbolic, update, update_symbolic
+from ocp.estimation.mekf import (
+    Mekf,
+    propagate,
+    propagate_symbolic,
+    update,
+    update_symbolic,
+)
 from ocp.estimation.sensors import Gyro, Magnetometer, StarTracker
 
 __all__ = ["SENSOR_NOISE_SIZE", "SENSOR_STATE_SIZE", "Gyro", "Magnetometer", "Mekf", "SensorSuite", "StarTracker",

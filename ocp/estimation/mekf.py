@@ -90,7 +90,7 @@ def unpack(values: Any) -> Any:
     (6, 6) ndarray or casadi.SX
     """
     if isinstance(values, (ca.SX, ca.MX)):
-        entries = [[None] * 6 for _ in range(6)]
+        entries: list[list[Any]] = [[None] * 6 for _ in range(6)]
         for n, (i, j) in enumerate(zip(*_UPPER)):
             entries[i][j] = entries[j][i] = values[n]
         return ca.vertcat(*[ca.horzcat(*row) for row in entries])

@@ -23,7 +23,12 @@ from numpy.typing import NDArray
 from ocp.dynamics.actuators import ActuatorModel
 from ocp.dynamics.layout import REFERENCE_FIELDS
 from ocp.dynamics.model import AttitudeModel
-from ocp.estimation import SENSOR_NOISE_SIZE, SENSOR_STATE_SIZE, SensorSuite, sensor_step_symbolic
+from ocp.estimation import (
+    SENSOR_NOISE_SIZE,
+    SENSOR_STATE_SIZE,
+    SensorSuite,
+    sensor_step_symbolic,
+)
 from ocp.fast_call import BufferedFunction
 
 Array = NDArray[np.float64]

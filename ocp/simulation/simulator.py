@@ -38,7 +38,13 @@ from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.layout import actuator_blocks, reference_rows
 from ocp.dynamics.model import AttitudeModel
 from ocp.errors import CompilerUnavailable, SimulationError
-from ocp.estimation import SENSOR_STATE_SIZE, SensorSuite, draw_sensor_noise, initial_sensor_state, sensor_step
+from ocp.estimation import (
+    SENSOR_STATE_SIZE,
+    SensorSuite,
+    draw_sensor_noise,
+    initial_sensor_state,
+    sensor_step,
+)
 from ocp.fast_call import BufferedFunction
 from ocp.simulation.closed_loop import ClosedLoop, draw_noise
 from ocp.simulation.compiled import compile_function, notice
