@@ -136,7 +136,7 @@ def test_a_perfect_star_tracker_at_rest_brings_the_estimate_to_the_truth():
 
 def test_one_update_by_hand():
     """P = diag(p I, c I), R = r I, a measured error v along x: δθ = p/(p+r) v, b̂ unchanged,
-    P_θθ = p r/(p+r) (the Joseph form for the optimal gain)."""
+    P_θθ = p r/(p+r) (P − K H P)."""
     p, c, r = 4e-6, 1e-10, 1e-6
     P = np.diag([p] * 3 + [c] * 3)
     v = np.array([1e-3, 0.0, 0.0])

@@ -9,8 +9,8 @@ the gyro bias error ``δb = b − b̂`` [rad/s]. With ``ω̂ = ω̃ − b̂`` he
 * propagation: ``q̂ ← q̂ ⊗ exp(ω̂ Δt / 2)``, ``P ← Φ P Φᵀ + Q`` with the closed-form ``Φ`` of
   ``F = [[−[ω̂×], −I], [0, 0]]`` and Farrenkopf's discrete ``Q`` (``σ_v`` the ARW, ``σ_u`` the RRW);
 * update by a star tracker quaternion ``q̃ = q ⊗ exp(v/2)``, ``v ~ N(0, R)``: residual
-  ``z = 2 vec(q̂⁻¹ ⊗ q̃)`` (the sign with a non-negative scalar part), ``H = [I, 0]``, Joseph form
-  covariance update, reset ``q̂ ← normalise(q̂ ⊗ [1, δθ/2])``, ``b̂ ← b̂ + δb``.
+  ``z = 2 vec(q̂⁻¹ ⊗ q̃)`` (the sign with a non-negative scalar part), ``H = [I, 0]``, the
+  covariance update ``P − K H P`` (by blocks, symmetrised), reset ``q̂ ← normalise(q̂ ⊗ [1, δθ/2])``, ``b̂ ← b̂ + δb``.
 
 Each step exists twice, in NumPy (:func:`propagate`, :func:`update`: the Python loop) and in CasADi
 (:func:`propagate_symbolic`, :func:`update_symbolic`: the closed loop as one function), operation
@@ -114,21 +114,43 @@ def pack_symbolic(P: Any) -> Any:
     return ca.vertcat(*[P[i, j] if i == j else 0.5 * (P[i, j] + P[j, i]) for i, j in zip(*_UPPER)])
 
 
-def _series(theta: Any, dt: Any, w: Any, small: Any, if_else: Any, sin: Any, cos: Any) -> tuple[Any, Any, Any]:
-    """``sin θ / w``, ``(1 − cos θ) / w²``, ``(θ − sin θ) / w³`` (θ = w Δt), their series below SMALL_ANGLE."""
+def _series(theta: Any, dt: Any, w: Any, small: Any, if_else: Any, sh: Any, ch: Any) -> tuple[Any, Any, Any]:
+    """``sin θ / w``, ``(1 − cos θ) / w²``, ``(θ − sin θ) / w³`` (θ = w Δt) from ``sh = sin(θ/2)``,
+    ``ch = cos(θ/2)`` (two trigonometric calls per step, not four), their series below SMALL_ANGLE."""
     w_safe = if_else(small, 1.0, w)
     th2 = theta * theta
-    a = if_else(small, dt * (1.0 - th2 / 6.0), sin(theta) / w_safe)
-    b = if_else(small, dt * dt * (0.5 - th2 / 24.0), (1.0 - cos(theta)) / (w_safe * w_safe))
-    c = if_else(small, dt * dt * dt * (1.0 / 6.0 - th2 / 120.0), (theta - sin(theta)) / (w_safe * w_safe * w_safe))
+    sin_theta = 2.0 * sh * ch
+    a = if_else(small, dt * (1.0 - th2 / 6.0), sin_theta / w_safe)
+    b = if_else(small, dt * dt * (0.5 - th2 / 24.0), 2.0 * sh * sh / (w_safe * w_safe))
+    c = if_else(small, dt * dt * dt * (1.0 / 6.0 - th2 / 120.0), (theta - sin_theta) / (w_safe * w_safe * w_safe))
     return a, b, c
 
 
-def _noise_matrix(dt: Any, arw: float, rrw: float, zeros: Any, eye: Any, block: Any) -> Any:
-    qa = (arw ** 2) * dt + (rrw ** 2) * dt * dt * dt / 3.0
+def _propagated(P: Any, phi11: Any, phi12: Any, dt: Any, arw: float, rrw: float, mm: Any, block: Any,
+                 eye: Any) -> Any:
+    """``Φ P Φᵀ + Q`` by blocks (``Φ = [[Φ11, Φ12], [0, I]]``, ``P = [[A, B], [Bᵀ, C]]``), the same
+    operations for NumPy and CasADi (``mm`` the matrix product, ``block`` the block matrix)."""
+    A, B, C = P[0:3, 0:3], P[0:3, 3:6], P[3:6, 3:6]
+    M = mm(phi11, A) + mm(phi12, B.T)
+    N = mm(phi11, B) + mm(phi12, C)
+    top = mm(M, phi11.T) + mm(N, phi12.T)
+    qa = (arw ** 2) * dt + (rrw ** 2) * dt * dt * dt / 3.0  # Farrenkopf's discrete Q
     qc = -(rrw ** 2) * dt * dt / 2.0
     qb = (rrw ** 2) * dt
-    return block([[qa * eye, qc * eye], [qc * eye, qb * eye]])
+    top = 0.5 * (top + top.T) + qa * eye
+    N = N + qc * eye
+    return block([[top, N], [N.T, C + qb * eye]])
+
+
+def _updated(P: Any, R: Any, z: Any, mm: Any, block: Any) -> tuple[Any, Any]:
+    """The star tracker update by blocks (``H = [I, 0]``): the correction ``δx = K z`` and
+    ``P − K H P`` (``K = P Hᵀ S⁻¹``, ``S = A + R``), the same operations for NumPy and CasADi."""
+    A, B, C = P[0:3, 0:3], P[0:3, 3:6], P[3:6, 3:6]
+    S_inv = _inverse3(A + R, block)
+    K1, K2 = mm(A, S_inv), mm(B.T, S_inv)
+    top, right, bottom = A - mm(K1, A), B - mm(K1, B), C - mm(K2, B)
+    top, bottom = 0.5 * (top + top.T), 0.5 * (bottom + bottom.T)
+    return (mm(K1, z), mm(K2, z)), block([[top, right], [right.T, bottom]])
 
 
 def propagate(q: Array, P: Array, omega: Array, dt: float, arw: float, rrw: float) -> tuple[Array, Array]:
@@ -157,10 +179,11 @@ def propagate(q: Array, P: Array, omega: Array, dt: float, arw: float, rrw: floa
     w = math.sqrt(omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2])
     theta = w * dt
     small = theta < SMALL_ANGLE
-    a, b, c = _series(theta, dt, w, small, lambda s, x, y: x if s else y, math.sin, math.cos)
     half = 0.5 * theta
-    s = 0.5 * dt * (1.0 - theta * theta / 24.0) if small else math.sin(half) / w
-    p0, p1, p2, p3 = math.cos(half), s * omega[0], s * omega[1], s * omega[2]
+    sh, ch = math.sin(half), math.cos(half)
+    a, b, c = _series(theta, dt, w, small, lambda s, x, y: x if s else y, sh, ch)
+    s = 0.5 * dt * (1.0 - theta * theta / 24.0) if small else sh / w
+    p0, p1, p2, p3 = ch, s * omega[0], s * omega[1], s * omega[2]
     q0, q1, q2, q3 = q
     q_next = np.array([q0 * p0 - q1 * p1 - q2 * p2 - q3 * p3,
                        q0 * p1 + p0 * q1 + q2 * p3 - q3 * p2,
@@ -170,12 +193,8 @@ def propagate(q: Array, P: Array, omega: Array, dt: float, arw: float, rrw: floa
     wx = np.array([[0.0, -omega[2], omega[1]], [omega[2], 0.0, -omega[0]], [-omega[1], omega[0], 0.0]])
     wx2 = wx @ wx
     eye = np.eye(3)
-    phi = np.eye(6)
-    phi[0:3, 0:3] = eye - wx * a + wx2 * b
-    phi[0:3, 3:6] = -eye * dt + wx * b - wx2 * c
-    Q = _noise_matrix(dt, arw, rrw, None, eye, np.block)
-    P_next = phi @ P @ phi.T + Q
-    return q_next, 0.5 * (P_next + P_next.T)
+    return q_next, _propagated(P, eye - wx * a + wx2 * b, -eye * dt + wx * b - wx2 * c, dt, arw, rrw, np.matmul,
+                               np.block, eye)
 
 
 def update(q: Array, bias: Array, P: Array, measured: Array, R: Array) -> tuple[Array, Array, Array]:
@@ -201,7 +220,7 @@ def update(q: Array, bias: Array, P: Array, measured: Array, R: Array) -> tuple[
     bias : (3,) ndarray
         Updated bias estimate [rad/s].
     P : (6, 6) ndarray
-        Updated covariance (Joseph form).
+        Updated covariance ``P − K H P``.
     """
     q0, q1, q2, q3 = q
     m0, m1, m2, m3 = measured
@@ -211,19 +230,14 @@ def update(q: Array, bias: Array, P: Array, measured: Array, R: Array) -> tuple[
                   q0 * m2 - m0 * q2 - q3 * m1 + q1 * m3,
                   q0 * m3 - m0 * q3 - q1 * m2 + q2 * m1])
     z = (2.0 if d0 >= 0 else -2.0) * d
-    S = P[0:3, 0:3] + R
-    K = P[:, 0:3] @ _inverse3(S, np.array)
-    dx = K @ z
-    IKH = np.eye(6)
-    IKH[:, 0:3] -= K
-    P_next = IKH @ P @ IKH.T + K @ R @ K.T
-    e = 0.5 * dx[0:3]
+    (d_theta, d_bias), P_next = _updated(P, R, z, np.matmul, np.block)
+    e = 0.5 * d_theta
     q_next = np.array([q0 - q1 * e[0] - q2 * e[1] - q3 * e[2],
                        q1 + q0 * e[0] + q2 * e[2] - q3 * e[1],
                        q2 + q0 * e[1] + q3 * e[0] - q1 * e[2],
                        q3 + q0 * e[2] + q1 * e[1] - q2 * e[0]])
     q_next = q_next / math.sqrt(float(q_next @ q_next))
-    return q_next, bias + dx[3:6], 0.5 * (P_next + P_next.T)
+    return q_next, bias + d_bias, P_next
 
 
 def _inverse3(S: Any, build: Any) -> Any:
@@ -236,7 +250,7 @@ def _inverse3(S: Any, build: Any) -> Any:
     rows = [[A, -(b * i - c * h), b * f - c * e],
             [B, a * i - c * g, -(a * f - c * d)],
             [C, -(a * h - b * g), a * e - b * d]]
-    if build is np.array:
+    if build is np.block:
         return np.array(rows) / det
     return ca.vertcat(*[ca.horzcat(*row) for row in rows]) / det
 
@@ -267,10 +281,11 @@ def propagate_symbolic(q: Any, P: Any, omega: Any, dt: Any, arw: float, rrw: flo
     w = ca.sqrt(omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2])
     theta = w * dt
     small = theta < SMALL_ANGLE
-    a, b, c = _series(theta, dt, w, small, ca.if_else, ca.sin, ca.cos)
     half = 0.5 * theta
-    s = ca.if_else(small, 0.5 * dt * (1.0 - theta * theta / 24.0), ca.sin(half) / ca.if_else(small, 1.0, w))
-    p0, p1, p2, p3 = ca.cos(half), s * omega[0], s * omega[1], s * omega[2]
+    sh, ch = ca.sin(half), ca.cos(half)
+    a, b, c = _series(theta, dt, w, small, ca.if_else, sh, ch)
+    s = ca.if_else(small, 0.5 * dt * (1.0 - theta * theta / 24.0), sh / ca.if_else(small, 1.0, w))
+    p0, p1, p2, p3 = ch, s * omega[0], s * omega[1], s * omega[2]
     q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
     q_next = ca.vertcat(q0 * p0 - q1 * p1 - q2 * p2 - q3 * p3,
                         q0 * p1 + p0 * q1 + q2 * p3 - q3 * p2,
@@ -280,10 +295,8 @@ def propagate_symbolic(q: Any, P: Any, omega: Any, dt: Any, arw: float, rrw: flo
     wx = ca.skew(omega)
     wx2 = ca.mtimes(wx, wx)
     eye = ca.SX.eye(3)
-    phi = ca.blockcat([[eye - wx * a + wx2 * b, -eye * dt + wx * b - wx2 * c], [ca.SX.zeros(3, 3), eye]])
-    Q = _noise_matrix(dt, arw, rrw, None, eye, ca.blockcat)
-    P_next = ca.mtimes([phi, P, phi.T]) + Q
-    return q_next, 0.5 * (P_next + P_next.T)
+    return q_next, _propagated(P, eye - wx * a + wx2 * b, -eye * dt + wx * b - wx2 * c, dt, arw, rrw, ca.mtimes,
+                               ca.blockcat, eye)
 
 
 def update_symbolic(q: Any, bias: Any, P: Any, measured: Any, R: Array) -> tuple[Any, Any, Any]:
@@ -315,16 +328,11 @@ def update_symbolic(q: Any, bias: Any, P: Any, measured: Any, R: Array) -> tuple
                    q0 * m2 - m0 * q2 - q3 * m1 + q1 * m3,
                    q0 * m3 - m0 * q3 - q1 * m2 + q2 * m1)
     z = ca.if_else(d0 >= 0, 2.0, -2.0) * d
-    R_sx = ca.SX(R)
-    S = P[0:3, 0:3] + R_sx
-    K = ca.mtimes(P[:, 0:3], _inverse3(S, None))
-    dx = ca.mtimes(K, z)
-    IKH = ca.SX.eye(6) - ca.horzcat(K, ca.SX.zeros(6, 3))
-    P_next = ca.mtimes([IKH, P, IKH.T]) + ca.mtimes([K, R_sx, K.T])
-    e = 0.5 * dx[0:3]
+    (d_theta, d_bias), P_next = _updated(P, ca.SX(R), z, ca.mtimes, ca.blockcat)
+    e = 0.5 * d_theta
     q_next = ca.vertcat(q0 - q1 * e[0] - q2 * e[1] - q3 * e[2],
                         q1 + q0 * e[0] + q2 * e[2] - q3 * e[1],
                         q2 + q0 * e[1] + q3 * e[0] - q1 * e[2],
                         q3 + q0 * e[2] + q1 * e[1] - q2 * e[0])
     q_next = q_next / ca.sqrt(ca.dot(q_next, q_next))
-    return q_next, bias + dx[3:6], 0.5 * (P_next + P_next.T)
+    return q_next, bias + d_bias, P_next
