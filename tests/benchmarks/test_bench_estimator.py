@@ -6,8 +6,10 @@ The spin paper's re-pointing (``scenarios/spin_repoint_estimator.yaml``: torquer
 (:meth:`ocp.simulation.ClosedLoop.evaluate`, the reference rows sampled beforehand: what a
 run costs per sample besides sampling its reference), with the true state plus noise
 (``sensor_noise``) and with the gyro, star tracker and MEKF. The cases alternate round by round,
-so that the load of a shared machine falls on both alike. Target: the ratio of the medians per
-sample at most 2.
+so that the load of a shared machine falls on both alike, and each round is timed in the thread's
+CPU time (``time.thread_time``: the time the process is descheduled on a loaded machine is not
+counted; the wall time is printed too). Target: the ratio of the CPU-time medians per sample at
+most 2.
 """
 import time
 from pathlib import Path
@@ -22,7 +24,7 @@ from scenarios.schema.loader import load
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = 1000
-ROUNDS = 60
+ROUNDS = 100
 
 
 def test_the_estimator_costs_at_most_twice_the_compiled_closed_loop():
@@ -49,18 +51,22 @@ def test_the_estimator_costs_at_most_twice_the_compiled_closed_loop():
             drawn[:, 9:] = draw_sensor_noise(sensors, noise.seed, times)
             xz = np.concatenate([xz, initial_sensor_state(sensors, x0[0:4], noise.seed)])
         cases[case] = (loop, run, xz, drawn)
-    times_us = {case: [] for case in cases}
+    cpu_us: dict[str, list[float]] = {case: [] for case in cases}
+    wall_us: dict[str, list[float]] = {case: [] for case in cases}
     for _ in range(ROUNDS):
         for case, (loop, run, xz, drawn) in cases.items():
-            start = time.perf_counter()
+            wall, cpu = time.perf_counter(), time.thread_time()
             states = loop.evaluate(run, xz, times, drawn, rows, np.zeros(3))[0]
-            times_us[case].append((time.perf_counter() - start) / SAMPLES * 1e6)
+            cpu_us[case].append((time.thread_time() - cpu) / SAMPLES * 1e6)
+            wall_us[case].append((time.perf_counter() - wall) / SAMPLES * 1e6)
             assert np.isfinite(states).all()
-    medians = {case: float(np.median(values)) for case, values in times_us.items()}
-    for case, values in times_us.items():
-        q1, q3 = np.percentile(values, [25, 75])
-        print(f"{case}: median {medians[case]:.2f} us per sample, interquartile {q1:.2f} to {q3:.2f} us "
-              f"({ROUNDS} rounds of {SAMPLES} samples)")
+    medians = {case: float(np.median(values)) for case, values in cpu_us.items()}
+    for case in cases:
+        q1, q3 = np.percentile(cpu_us[case], [25, 75])
+        w1, w2, w3 = np.percentile(wall_us[case], [25, 50, 75])
+        print(f"{case}: CPU median {medians[case]:.2f} us per sample, interquartile {q1:.2f} to {q3:.2f} us; "
+              f"wall median {w2:.2f} us ({w1:.2f} to {w3:.2f}); {ROUNDS} rounds of {SAMPLES} samples")
     ratio = medians["gyro + star tracker + MEKF"] / medians["true state + noise"]
-    print(f"ratio of the medians: {ratio:.2f}")
+    wall_ratio = np.median(wall_us["gyro + star tracker + MEKF"]) / np.median(wall_us["true state + noise"])
+    print(f"ratio of the medians: CPU {ratio:.2f}, wall {wall_ratio:.2f}")
     assert ratio <= 2.0
