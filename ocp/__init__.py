@@ -11,7 +11,10 @@ subpackages it names:
 * :mod:`ocp.dynamics`: the spacecraft, its actuators, orbits and environment, the assembled model;
 * :mod:`ocp.geometry`: pointing constraints and the directions they are measured from (the Sun,
   the Moon, the Earth, the orbital velocity; imports :mod:`ocp.dynamics`);
-* :mod:`ocp.simulation`: the closed-loop simulator (imports :mod:`ocp.dynamics`);
+* :mod:`ocp.estimation`: attitude sensors and the MEKF of the closed loop (imports
+  :mod:`ocp.dynamics`);
+* :mod:`ocp.simulation`: the closed-loop simulator (imports :mod:`ocp.dynamics` and
+  :mod:`ocp.estimation`);
 * :mod:`ocp.transcription`: optimal-control problems and their NLPs (imports :mod:`ocp.dynamics`
   and :mod:`ocp.geometry`);
 * :mod:`ocp.nlp`: solving NLPs and the second-order check (imports neither of the above).

@@ -18,6 +18,7 @@ METRIC_KEYS: tuple[str, ...] = (
     "peak_wheel_momentum", "plan_time_s", "duration_s",
     "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
     "fine_settling_time_s", "initial_rate_error",
+    "final_knowledge_error_deg", "max_knowledge_error_deg",
 )
 """Every key :func:`compute_metrics` returns; definitions and units in :data:`METRIC_INFO`."""
 
@@ -102,6 +103,13 @@ METRIC_INFO: dict[str, MetricInfo] = {
     "initial_rate_error": MetricInfo(
         "rad/s", "Reference: ‖ω(t_0) − ω_0‖, the initial rate a planner that declares ``omega0`` free leaves "
         "to the closed loop; null in closed loop."),
+    "final_knowledge_error_deg": MetricInfo(
+        "deg", "Closed loop with a star tracker (``simulation.sensors``): the angle between the attitude given "
+        "to the controller (the estimator's, else the tracker's last reading) and the true attitude at the "
+        "last sample t_(N−1); null otherwise."),
+    "max_knowledge_error_deg": MetricInfo(
+        "deg", "As ``final_knowledge_error_deg``, its maximum over the samples t_0 … t_(N−1); null without a "
+        "star tracker."),
 }
 """Unit and definition of every key of :data:`METRIC_KEYS`, in the same order. ``u`` in the integrals
 ``int_u2``, ``int_u`` and ``int_abs_u`` is the torque given to :func:`compute_metrics` (body axes): a
@@ -205,6 +213,7 @@ def compute_metrics(
     body_torque: ArrayLike | None = None,
     actuator_torque: ArrayLike | None = None,
     wheel_torque: ArrayLike | None = None,
+    known_q: ArrayLike | None = None,
 ) -> dict[str, Any]:
     """Metrics of a motion sampled at times ``t`` (definitions: :data:`METRIC_INFO`).
 
@@ -261,6 +270,9 @@ def compute_metrics(
         ``None``: null (a reference).
     wheel_torque : (N, n_w) array_like or None, optional
         Applied wheel motor torques [N m] for ``peak_wheel_torque``; ``None`` or empty: null.
+    known_q : (N, 4) array_like or None, optional
+        The attitude the controller was given at ``t_0 … t_(N−1)`` (scalar first, body to
+        inertial), for ``final_knowledge_error_deg`` and ``max_knowledge_error_deg``; ``None``: null.
 
     Returns
     -------
@@ -300,7 +312,14 @@ def compute_metrics(
         else float(_integrate(t, np.linalg.norm(np.asarray(dipole, dtype=float), axis=1))),
         "final_rate": float(np.linalg.norm(np.asarray(omega, dtype=float)[-1])),
         "energy_ratio": None,
+        "final_knowledge_error_deg": None,
+        "max_knowledge_error_deg": None,
     }
+    if known_q is not None:
+        known = np.asarray(known_q, dtype=float)
+        knowledge = np.rad2deg(quat.error_angle(known, q[:known.shape[0]]))
+        metrics["final_knowledge_error_deg"] = float(knowledge[-1])
+        metrics["max_knowledge_error_deg"] = float(np.max(knowledge))
     if inertia is not None:
         omega_ends = np.asarray(omega, dtype=float)[[0, -1]]
         energy = 0.5 * np.einsum("ni,ij,nj->n", omega_ends, np.asarray(inertia, dtype=float), omega_ends)
@@ -332,7 +351,8 @@ def metrics_from_simulation(
     gyroscopic torque ``ω × A h_w`` at the start of each sample (the ``u`` of
     ``I ω̇ = −ω × I ω + u`` the allocation realised), ``peak_wheel_torque`` the applied wheel
     motor torques; the dipole (with magnetorquers) is the applied one; ``inertia`` is the
-    spacecraft's.
+    spacecraft's; with a star tracker among the run's sensors, the attitude the controller was
+    given is ``result.sensor_state``'s (``known_q``).
 
     Parameters
     ----------
@@ -375,7 +395,16 @@ def metrics_from_simulation(
         fine_settling_tolerance_deg=fine_settling_tolerance_deg, dipole=dipole,
         inertia=result.model.spacecraft.inertia, detumble_tolerance=detumble_tolerance,
         body_torque=body_torque, actuator_torque=result.applied_torque, wheel_torque=wheel_torque,
+        known_q=_known_attitude(result),
     )
+
+
+def _known_attitude(result: Any) -> NDArray | None:
+    """The attitude the controller was given at each sample, when a star tracker gave it."""
+    sensors = getattr(result, "sensors", None)
+    if sensors is None or getattr(sensors, "star_tracker", None) is None or result.sensor_state is None:
+        return None
+    return result.sensor_state[1:, 3:7]  # the state after sample k holds what the controller saw at t_k
 
 
 def metrics_from_reference(

@@ -63,7 +63,8 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
     start = time.perf_counter()
     try:
         result = simulator.run(controller, scenario.true_initial_state, duration, reference=reference,
-                               target=(problem.qf, problem.omegaf), noise=scenario.simulation.noise)
+                               target=(problem.qf, problem.omegaf), noise=scenario.simulation.noise,
+                               sensors=scenario.simulation.sensors)
     except SimulationError as error:
         row.status, row.message = "failed", f"simulation: {error}"
         return

@@ -72,8 +72,23 @@ def test_every_key_is_tested_here():
               "final_error_deg", "final_rate_error", "rms_error_deg",
               "max_error_deg", "settling_time_s", "saturation_fraction", "peak_wheel_momentum", "plan_time_s",
               "duration_s", "initial_rate_error", "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
-              "fine_settling_time_s"}
+              "fine_settling_time_s", "final_knowledge_error_deg", "max_knowledge_error_deg"}
     assert set(METRIC_KEYS) == tested
+
+
+def test_knowledge_error_by_hand():
+    """The attitude given at t_0..t_(N-1) off the truth by 0.1, 0.3, 0.2 deg about three axes:
+    final 0.2 deg (at the last sample given), max 0.3 deg; null when none is given."""
+    t = np.array([0.0, 1.0, 2.0, 3.0])
+    q = np.array([quat.from_axis_angle(Z, a) for a in (0.0, 0.1, 0.2, 0.3)])
+    offsets = [(np.array([1.0, 0, 0]), 0.1), (np.array([0, 1.0, 0]), 0.3), (np.array([0, 0.6, 0.8]), 0.2)]
+    known = np.array([quat.product(q[k], quat.from_axis_angle(axis, np.deg2rad(angle)))
+                      for k, (axis, angle) in enumerate(offsets)])
+    metrics = compute_metrics(t, q, np.zeros((4, 3)), np.zeros((3, 3)), None, known_q=known)
+    assert metrics["final_knowledge_error_deg"] == pytest.approx(0.2, rel=1e-9)
+    assert metrics["max_knowledge_error_deg"] == pytest.approx(0.3, rel=1e-9)
+    none = compute_metrics(t, q, np.zeros((4, 3)), np.zeros((3, 3)), None)
+    assert none["final_knowledge_error_deg"] is None and none["max_knowledge_error_deg"] is None
 
 
 def test_zero_order_hold_integrals(metrics):

@@ -102,7 +102,13 @@ controller: null
 controllers:
   - {name: bdot, label: B-dot, options: {gain: 1.0e4}}
   - {name: tdfc, label: TDFC, options: {gain: 1.0e4, delay: 2.0}}
-simulation: {sample_time: 0.5}
+simulation:
+  sample_time: 0.5
+  sensors:
+    gyro: {arw_deg_per_sqrt_h: 0.01, rrw_deg_per_h_per_sqrt_h: 0.1, bias_deg_per_h: [1.0, 0, 0]}
+    star_tracker: {noise_arcsec: [5, 5, 40], rate_hz: 1.0, outages_s: [[5, 8]], boresight: [0, 1, 0]}
+    magnetometer: {noise_T: 1.0e-8, bias_T: [1.0e-7, 0, 0]}
+  estimator: {type: mekf, initial_attitude_sigma_deg: 0.1, initial_bias_sigma_deg_per_h: 5.0}
 """
 
 MINIMAL = """

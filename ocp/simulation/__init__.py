@@ -5,7 +5,7 @@ What lives here: the :class:`Simulator` and what it takes and gives
 (:mod:`~ocp.simulation.closed_loop`) and its compilation to C with an on-disk cache
 (:mod:`~ocp.simulation.compiled`).
 
-May import: :mod:`ocp.dynamics` and the top-level modules of :mod:`ocp`; never
+May import: :mod:`ocp.dynamics`, :mod:`ocp.estimation` and the top-level modules of :mod:`ocp`; never
 :mod:`ocp.transcription` or :mod:`ocp.nlp`.
 """
 from ocp.simulation.closed_loop import ClosedLoop

@@ -23,6 +23,12 @@ from numpy.typing import NDArray
 from ocp.dynamics.actuators import ActuatorModel
 from ocp.dynamics.layout import REFERENCE_FIELDS
 from ocp.dynamics.model import AttitudeModel
+from ocp.estimation import (
+    SENSOR_NOISE_SIZE,
+    SENSOR_STATE_SIZE,
+    SensorSuite,
+    sensor_step_symbolic,
+)
 from ocp.fast_call import BufferedFunction
 
 Array = NDArray[np.float64]
@@ -118,6 +124,9 @@ class LoopShape:
         An output depends on the time ``t`` (law, field or environment).
     field_noise : bool, optional
         The magnetometer adds noise (only with a field model; default False).
+    sensors : bool, optional
+        The loop runs a :class:`~ocp.estimation.SensorSuite` (its noise rows follow the nine
+        numbers of the noise input; default False).
     """
 
     attitude_noise: bool
@@ -125,11 +134,12 @@ class LoopShape:
     uses_reference: bool
     uses_time: bool
     field_noise: bool = False
+    sensors: bool = False
 
     @property
     def noisy(self) -> bool:
         """Whether the run takes the noise input (any sensor noise)."""
-        return self.attitude_noise or self.rate_noise or self.field_noise
+        return self.attitude_noise or self.rate_noise or self.field_noise or self.sensors
 
 
 class ClosedLoop:
@@ -154,6 +164,9 @@ class ClosedLoop:
     field_noise : bool, optional
         Whether the magnetometer reading adds its part [T] (default False; ignored without a
         field model).
+    sensors : SensorSuite or None, optional
+        Sensors and estimator (:mod:`ocp.estimation.loop`): their state ``s`` follows ``z`` in
+        the carried state ``[x; z; s]`` and their noise row (10 numbers) follows the nine above.
 
     Attributes
     ----------
@@ -164,16 +177,21 @@ class ClosedLoop:
         Which inputs the loop actually uses.
     nz : int
         Size of the law's state ``z``.
+    noise_size : int
+        Noise numbers per sample: 9, and 10 more with sensors.
     """
 
     def __init__(self, model: AttitudeModel, step: ca.Function, actuators: ActuatorModel, law: ca.Function,
-                 attitude_noise: bool, rate_noise: bool, field_noise: bool = False):
+                 attitude_noise: bool, rate_noise: bool, field_noise: bool = False,
+                 sensors: SensorSuite | None = None):
         self.model = model
         nx, nz = model.nx, law.nnz_in(2)
         self.nz = nz
-        acc = ca.SX.sym("xz", nx + nz)
+        ns = 0 if sensors is None else SENSOR_STATE_SIZE
+        self.noise_size = NOISE_SIZE + (0 if sensors is None else SENSOR_NOISE_SIZE)
+        acc = ca.SX.sym("xz", nx + nz + ns)
         t, dt = ca.SX.sym("t"), ca.SX.sym("dt")
-        noise = ca.SX.sym("noise", NOISE_SIZE)
+        noise = ca.SX.sym("noise", self.noise_size)
         r = ca.SX.sym("r", 2 * REFERENCE_FIELDS)
         p = ca.SX.sym("p", 3)
         x, z = acc[0:nx], acc[nx:nx + nz]
@@ -185,16 +203,23 @@ class ClosedLoop:
         field = ca.SX.zeros(3) if model.field_body is None else model.field_body(x, t)
         if field_noise and model.field_body is not None:
             field = field + noise[6:9]
+        s_next = ca.SX.zeros(0, 1)
+        if sensors is not None:  # the sensors read the true state where declared (ocp.estimation.loop)
+            q, omega, read, s_next = sensor_step_symbolic(
+                sensors, acc[nx + nz:], x[0:4] if sensors.star_tracker is not None else q,
+                x[4:7] if sensors.gyro is not None else omega, None if model.field_body is None else field,
+                noise[NOISE_SIZE:], dt)
+            field = field if read is None else read
         y = ca.vertcat(q, omega, h_w, field)
         u_cmd, z_next = law(t, y, z, r)
         u_applied, saturated = actuators.apply_symbolic(u_cmd, h_w, dt)
         x_next = step(x, u_applied, t, dt, p)
         x_next = ca.vertcat(x_next[0:4] / ca.norm_2(x_next[0:4]), x_next[4:nx])
         torque = model.body_torque(x, u_applied, t)
-        outputs = [ca.vertcat(x_next, z_next), u_cmd, u_applied, saturated, torque]
+        outputs = [ca.vertcat(x_next, z_next, s_next), u_cmd, u_applied, saturated, torque]
         self.shape = LoopShape(attitude_noise, rate_noise, bool(ca.depends_on(ca.vertcat(u_cmd, z_next), r)),
                                bool(ca.depends_on(ca.vertcat(*outputs), t)),
-                               bool(field_noise and model.field_body is not None))
+                               bool(field_noise and model.field_body is not None), sensors is not None)
         inputs = [acc, t, dt, noise, r, p]
         self.sample = ca.Function("closed_loop_sample", inputs, outputs,
                                   ["xz", "t", "dt", "noise", "r", "p"], ["xz_next", "u_cmd", "u_app", "saturated", "torque"],
@@ -224,10 +249,10 @@ class ClosedLoop:
         p = ca.MX.sym("p", 3)
         inputs = [xz0, t, dt]
         if self.shape.noisy:
-            noise = ca.MX.sym("noise", NOISE_SIZE, n_samples)
+            noise = ca.MX.sym("noise", self.noise_size, n_samples)
             inputs.append(noise)
         else:
-            noise = ca.MX.zeros(NOISE_SIZE, n_samples)
+            noise = ca.MX.zeros(self.noise_size, n_samples)
         if self.shape.uses_reference:
             r = ca.MX.sym("r", 2 * REFERENCE_FIELDS, n_samples)
             inputs.append(r)
@@ -245,14 +270,15 @@ class ClosedLoop:
         ----------
         run : BufferedFunction
             The result of :meth:`run_function` for N = ``times.size - 1`` samples.
-        xz0 : (nx + nz,) ndarray
-            Initial state ``x`` (quaternion, body rate [rad/s], wheel momenta [N m s]) and law
-            state ``z``.
+        xz0 : (nx + nz [+ 35],) ndarray
+            Initial state ``x`` (quaternion, body rate [rad/s], wheel momenta [N m s]), law
+            state ``z`` and, with sensors, their state ``s``.
         times : (N + 1,) ndarray
             Sample times [s]; the control computed at ``times[k]`` is held until ``times[k + 1]``.
-        noise : (N, 9) ndarray or None
-            Sensor noise per sample (:func:`draw_noise`); required when ``shape.noisy``,
-            otherwise ignored.
+        noise : (N, 9) or (N, 19) ndarray or None
+            Sensor noise per sample (:func:`draw_noise`, then with sensors
+            :func:`ocp.estimation.draw_sensor_noise`); required when ``shape.noisy``, otherwise
+            ignored.
         rows : (N, 26) ndarray or None
             Reference rows at ``t_k`` and ``t_k + T_s`` per sample (:mod:`ocp.dynamics.layout`); required
             when ``shape.uses_reference``, otherwise ignored.
@@ -274,7 +300,7 @@ class ClosedLoop:
         args = [xz0, times[:-1], times[1:] - times[:-1]]
         if self.shape.noisy:
             if noise is None:
-                raise ValueError("this closed loop takes sensor noise: pass the (N, 9) noise")
+                raise ValueError(f"this closed loop takes sensor noise: pass the (N, {self.noise_size}) noise")
             args.append(noise.ravel())  # (N, 9) row-major is the (9, N) column-major input
         if self.shape.uses_reference:
             if rows is None:

@@ -38,6 +38,13 @@ from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.layout import actuator_blocks, reference_rows
 from ocp.dynamics.model import AttitudeModel
 from ocp.errors import CompilerUnavailable, SimulationError
+from ocp.estimation import (
+    SENSOR_STATE_SIZE,
+    SensorSuite,
+    draw_sensor_noise,
+    initial_sensor_state,
+    sensor_step,
+)
 from ocp.fast_call import BufferedFunction
 from ocp.simulation.closed_loop import ClosedLoop, draw_noise
 from ocp.simulation.compiled import compile_function, notice
@@ -208,6 +215,14 @@ class SimulationResult:
     path : str
         How it was computed: ``"python"`` (loop), ``"interpreted"`` or ``"compiled"`` (one
         CasADi function).
+    sensor_state : (N+1, 35) ndarray or None
+        With a :class:`~ocp.estimation.SensorSuite`, its state (:mod:`ocp.estimation.loop`): the
+        initial one, then the one after each sample ``k``, which holds what the controller was
+        given at ``t_k``: the attitude estimate ``q̂`` (the MEKF's; without it the last star
+        tracker reading), the bias estimate [rad/s] and the MEKF covariance's upper triangle,
+        and the gyro's true bias [rad/s] and last reading; ``None`` without sensors.
+    sensors : SensorSuite or None
+        The sensors of the run (``None``: none).
     """
 
     model: AttitudeModel
@@ -219,6 +234,8 @@ class SimulationResult:
     applied_torque: Array
     saturated: NDArray[np.bool_]
     path: str = "python"
+    sensor_state: Array | None = None
+    sensors: SensorSuite | None = None
 
     @property
     def q(self) -> Array:
@@ -352,6 +369,19 @@ class ControllerLike(Protocol):
 
     def __call__(self, t: float, measurement: Measurement, reference: Any) -> Command:
         """The command for the sample starting at ``t`` [s] (see ``Controller.__call__``)."""
+
+
+def _with_sensors(noise: SensorNoise, sensors: SensorSuite) -> SensorNoise:
+    """``noise`` with the magnetometer's white noise of ``sensors``; a sensor given twice is refused."""
+    for declared, name, std in ((sensors.star_tracker, "attitude_std", noise.attitude_std),
+                                (sensors.gyro, "rate_std", noise.rate_std),
+                                (sensors.magnetometer, "field_std", noise.field_std)):
+        if declared is not None and std > 0:
+            raise ValueError(f"{type(declared).__name__} is declared in sensors and SensorNoise.{name} is "
+                             f"{std:g}: give that sensor's noise once")
+    if sensors.magnetometer is not None:
+        noise = SensorNoise(noise.attitude_std, noise.rate_std, noise.seed, sensors.magnetometer.noise)
+    return noise
 
 
 def measure(x: Array, t: float, noise: SensorNoise, rng: np.random.Generator, field: Array | None = None,
@@ -525,6 +555,7 @@ class Simulator:
         target: Any = None,
         noise: SensorNoise | None = None,
         parameters: ArrayLike | None = None,
+        sensors: SensorSuite | None = None,
     ) -> SimulationResult:
         """Simulate in closed loop.
 
@@ -546,6 +577,11 @@ class Simulator:
             Sensor noise; ``None``: none.
         parameters : (3,) array_like, optional
             Disturbance torque ``p`` [N m], body axes; ``None``: the model's default.
+        sensors : SensorSuite, optional
+            Gyro, star tracker, magnetometer and MEKF (:mod:`ocp.estimation`), seeded by
+            ``noise.seed``; they replace ``noise``'s rate, attitude and magnetometer parts (which
+            must then be zero; the magnetometer's white noise becomes ``noise.field_std``).
+            ``None``: the measurement is ``noise``'s alone.
 
         Returns
         -------
@@ -555,6 +591,8 @@ class Simulator:
         ------
         SimulationError
             When the state becomes non-finite or the run exceeds the work limits.
+        ValueError
+            A sensor declared twice (in ``sensors`` and with a non-zero deviation in ``noise``).
         """
         model = self.model
         x = np.asarray(x0, dtype=float).copy()
@@ -575,6 +613,8 @@ class Simulator:
                                   "(simulation.max_samples raises it)")
         times = np.minimum(np.arange(n_samples + 1) * self.sample_time, duration)
         noise = noise or SensorNoise()
+        if sensors is not None:
+            noise = _with_sensors(noise, sensors)
         rng = np.random.default_rng(noise.seed)
         field_rng = np.random.default_rng([noise.seed, 1])
         valid_until = getattr(model.environment.magnetic_field, "valid_until", None)
@@ -584,7 +624,7 @@ class Simulator:
         field_rate = self._field_rate_numeric if getattr(controller, "needs_field_rate", False) else None
         controller.reset(model.spacecraft, self.sample_time, target=target)
         if self._symbolic(controller):
-            return self._run_symbolic(controller, x, times, p, noise, rng, reference, field_rng)
+            return self._run_symbolic(controller, x, times, p, noise, rng, reference, field_rng, sensors)
         if reference is not None and hasattr(reference, "sample"):
             reference = self._grid_reference(reference, np.concatenate([times, times[:-1] + self.sample_time]))
 
@@ -601,9 +641,16 @@ class Simulator:
         p_in[:] = p
         evaluate, apply, fill_command = step.evaluate, self.actuators.apply_floats, self.actuators.command_vector
         times_list = times.tolist()
+        sensor_states: list[Array] = []
+        if sensors is not None:
+            drawn = draw_sensor_noise(sensors, noise.seed, times)
+            sensor_states.append(initial_sensor_state(sensors, x[0:4], noise.seed))
         for k in range(n_samples):
             t_k = times_list[k]
             measurement = self._measure(x_in, t_k, noise, rng, field_rng)
+            if sensors is not None:
+                measurement = self._sensed(sensors, measurement, x_in, sensor_states, drawn[k],
+                                           times_list[k + 1] - t_k)
             if field_rate is not None:
                 measurement.field_rate_inertial = field_rate(t_k).copy()
             command = controller(t_k, measurement, reference)
@@ -620,8 +667,23 @@ class Simulator:
                 raise SimulationError(self._divergence(times, k))
             x_in[:] = x_out
             states.append(x_next)
-        return self._result(times, np.array(states), commanded, np.array(applied).reshape(n_samples, model.nu),
-                            np.array(saturated, dtype=bool), "python")
+        result = self._result(times, np.array(states), commanded, np.array(applied).reshape(n_samples, model.nu),
+                              np.array(saturated, dtype=bool), "python")
+        result.sensor_state = np.array(sensor_states) if sensors is not None else None
+        result.sensors = sensors
+        return result
+
+    @staticmethod
+    def _sensed(sensors: SensorSuite, measurement: Measurement, x: Array, sensor_states: list[Array],
+                noise: Array, dt: float) -> Measurement:
+        """The measurement once the sensors of ``sensors`` (and the MEKF) have read the true state
+        ``x``; appends the next sensor state to ``sensor_states``."""
+        q = x[0:4].copy() if sensors.star_tracker is not None else measurement.q
+        omega = x[4:7].copy() if sensors.gyro is not None else measurement.omega
+        q, omega, field, s_next = sensor_step(sensors, sensor_states[-1], q, omega, measurement.field_body, noise, dt)
+        sensor_states.append(s_next)
+        measurement.q, measurement.omega, measurement.field_body = q.copy(), omega.copy(), field
+        return measurement
 
     def _result(self, times: Array, states: Array, commanded: Array, applied: Array, saturated: NDArray[np.bool_],
                 path: str) -> SimulationResult:
@@ -644,7 +706,8 @@ class Simulator:
         reason = getattr(controller, "symbolic_error", None)
         return reason is not None and reason() is None
 
-    def closed_loop_function(self, controller: Any, noise: SensorNoise) -> tuple[ClosedLoop, ca.Function, str]:
+    def closed_loop_function(self, controller: Any, noise: SensorNoise,
+                             sensors: SensorSuite | None = None) -> tuple[ClosedLoop, ca.Function, str]:
         """The one-sample closed-loop function of a symbolic law.
 
         Builds are kept per law (``Controller.symbolic_key``) and noise shape.
@@ -655,6 +718,8 @@ class Simulator:
             A reset controller with a symbolic law.
         noise : SensorNoise
             Which noises the function takes as inputs (those with a non-zero deviation).
+        sensors : SensorSuite, optional
+            Sensors and estimator in the loop (:mod:`ocp.estimation`); ``None``: none.
 
         Returns
         -------
@@ -665,14 +730,14 @@ class Simulator:
         path : str
             ``"interpreted"`` or ``"compiled"``.
         """
-        loop_key = self._loop_key(controller, noise)
+        loop_key = (self._loop_key(controller, noise), None if sensors is None else sensors.key)
         if loop_key not in self._loops:
             if len(self._loops) >= self.MAX_BUILDS:
                 self._loops.clear()
                 self._runs.clear()
             law = controller.symbolic_law()
             loop = ClosedLoop(self.model, self._step, self.actuators, law.function,
-                              noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0)
+                              noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0, sensors)
             sample, path = loop.sample, "interpreted"
             if self.compile:
                 try:
@@ -696,9 +761,10 @@ class Simulator:
 
     def _run_symbolic(self, controller: Any, x0: Array, times: Array, p: Array, noise: SensorNoise,
                       rng: np.random.Generator, reference: Any,
-                      field_rng: np.random.Generator | None = None) -> SimulationResult:
+                      field_rng: np.random.Generator | None = None,
+                      sensors: SensorSuite | None = None) -> SimulationResult:
         n_samples = times.size - 1
-        loop, sample, path = self.closed_loop_function(controller, noise)
+        loop, sample, path = self.closed_loop_function(controller, noise, sensors)
         rows = None
         if loop.shape.uses_reference:
             grid = times[:-1]
@@ -709,6 +775,13 @@ class Simulator:
             drawn = draw_noise(rng, n_samples, noise.attitude_std, noise.rate_std, field_rng, noise.field_std)
         nx, nu = self.model.nx, self.model.nu
         xz = np.concatenate([x0, np.asarray(controller.state_vector(), dtype=float)])
+        sensor_states = None
+        if sensors is not None:  # their noise after the nine of draw_noise, their state after z
+            drawn = np.hstack([np.zeros((n_samples, 9)) if drawn is None else drawn,
+                               draw_sensor_noise(sensors, noise.seed, times)])
+            sensor_states = np.empty((n_samples + 1, SENSOR_STATE_SIZE))
+            sensor_states[0] = initial_sensor_state(sensors, x0[0:4], noise.seed)
+            xz = np.concatenate([xz, sensor_states[0]])
         states = np.empty((n_samples + 1, nx))
         commanded, applied = np.empty((n_samples, nu)), np.empty((n_samples, nu))
         saturated, torque = np.empty(n_samples), np.empty((n_samples, 3))
@@ -719,6 +792,8 @@ class Simulator:
             chunk = loop.evaluate(run, xz, times[start:stop + 1], None if drawn is None else drawn[start:stop],
                                   None if rows is None else rows[start:stop], p)
             states[start + 1:stop + 1] = chunk[0][:, :nx]
+            if sensor_states is not None:
+                sensor_states[start + 1:stop + 1] = chunk[0][:, nx + loop.nz:]
             commanded[start:stop], applied[start:stop], saturated[start:stop], torque[start:stop] = chunk[1:]
             xz = chunk[0][-1]
             if not np.all(np.isfinite(xz)):
@@ -727,7 +802,7 @@ class Simulator:
         if not finite.all():
             raise SimulationError(self._divergence(times, int(np.argmin(finite)) - 1))
         return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, torque,
-                                saturated.astype(bool), path)
+                                saturated.astype(bool), path, sensor_states, sensors)
 
     def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator,
                  field_rng: np.random.Generator | None = None) -> Any:

@@ -27,12 +27,14 @@ import numpy as np
 from controllers import CONTROLLERS, Controller
 from ocp import Environment, SensorNoise, Spacecraft, quat
 from ocp.errors import OptionsError, excerpt
+from ocp.estimation import SensorSuite
 from ocp.geometry.directions import Geometry
 from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem, Planner
 from scenarios.errors import ScenarioError
 from scenarios.requirements.spec import Requirements, Sensor
 from scenarios.schema.checks import check_compatibility, check_row_labels, check_work
+from scenarios.schema.estimation import ESTIMATOR, SENSORS, parse_sensor_suite
 from scenarios.schema.keys import (
     Described,
     Section,
@@ -161,6 +163,9 @@ class SimulationSpec:
         Build the closed loop of a symbolic law as C (``ocp.simulation.compiled``); interpreted otherwise.
     max_samples : int
         Most closed-loop samples a run may take.
+    sensors : SensorSuite or None
+        Gyro, star tracker, magnetometer and estimator (``sensors``, ``estimator``); ``None``:
+        the measurement is ``noise``'s alone.
     """
 
     sample_time: float = 1.0
@@ -175,6 +180,7 @@ class SimulationSpec:
     detumble_tolerance: float = 0.01
     compile: bool = False
     max_samples: int = MAX_SAMPLES
+    sensors: SensorSuite | None = None
 
 
 @dataclass
@@ -368,6 +374,10 @@ SIMULATION = Section((
     vector("initial_rate_error", "Added to the true initial body rate, body frame.", 3, unit="rad/s",
            default=[0.0, 0.0, 0.0]),
     mapping("sensor_noise", "Measurement noise.", SENSOR_NOISE, default={}),
+    mapping("sensors", "Sensor models (gyro, star tracker, magnetometer); absent or ``null``: the measurement is "
+            "``sensor_noise``'s.", SENSORS, default=None, null="none"),
+    mapping("estimator", "An attitude estimator in the loop; absent or ``null``: none.", ESTIMATOR, default=None,
+            null="none"),
     choice("integrator", "Integrator of the closed loop.", ("rk4", "cvodes"), default="rk4"),
     number("max_step", f"Longest RK4 sub-step (at most {MAX_SUBSTEPS} sub-steps per sample).", unit="s",
            default=0.05, positive=True),
@@ -503,6 +513,7 @@ def _parse_simulation(values: dict[str, Any], path: str) -> SimulationSpec:
         settling_tolerance_deg=values["settling_tolerance_deg"],
         fine_settling_tolerance_deg=values["fine_settling_tolerance_deg"],
         detumble_tolerance=values["detumble_tolerance"], max_samples=values["max_samples"], compile=values["compile"],
+        sensors=parse_sensor_suite(values["sensors"], values["estimator"], noise, path),
     )
     if spec.integrator == "rk4" and math.ceil(spec.sample_time / spec.max_step - 1e-9) > MAX_SUBSTEPS:
         raise ScenarioError(f"{path}.max_step", f"{spec.max_step:g} s gives more than {MAX_SUBSTEPS} RK4 "

@@ -1,0 +1,187 @@
+"""Attitude sensors of the closed loop: a rate-integrating gyro, a star tracker, a magnetometer.
+
+All values are SI. The gyro follows Farrenkopf's discrete model (Markley & Crassidis,
+*Fundamentals of Spacecraft Attitude Determination and Control*, 2014, sec. 6.4; Crassidis &
+Junkins, *Optimal Estimation of Dynamic Systems*, eq. 7.56): over a sample of length ``Δt`` the
+bias walks ``β_{k+1} = β_k + σ_u √Δt N_u`` (rate random walk, RRW) and the reading is
+
+    ω̃_k = ω_k + ½ (β_{k+1} + β_k) + √(σ_v² / Δt + σ_u² Δt / 12) N_v
+
+(``σ_v`` the angle random walk, ARW: the gyro's white rate noise; ``N_u``, ``N_v`` standard
+normal 3-vectors). Its Allan variance is ``σ_v² / τ + σ_u² τ / 3``. The star tracker measures
+``q ⊗ exp(v / 2)``, ``v`` a rotation vector with independent per-axis noise in the sensor frame,
+at its own rate and outside its outage windows. The magnetometer adds a constant bias to the
+field reading and white noise (``ocp.simulation.SensorNoise.field_std``'s stream).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+
+
+def _vector(name: str, value: Any, non_negative: bool = False) -> Array:
+    array = np.asarray(value, dtype=float)
+    if array.shape != (3,) or not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be 3 finite numbers, got {value!r}")
+    if non_negative and np.any(array < 0):
+        raise ValueError(f"{name} must be non-negative, got {array.tolist()}")
+    return array
+
+
+def _non_negative(name: str, value: Any) -> float:
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value) or value < 0:
+        raise ValueError(f"{name} must be a finite non-negative number, got {value!r}")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class Gyro:
+    """A three-axis rate gyro with angle random walk, rate random walk and bias (Farrenkopf).
+
+    Parameters
+    ----------
+    arw : float, optional
+        Angle random walk ``σ_v`` [rad/s^(1/2)], the white rate noise density; 0: none.
+    rrw : float, optional
+        Rate random walk ``σ_u`` [rad/s^(3/2)], the density of the bias's white derivative; 0: none.
+    bias : (3,) array_like, optional
+        The bias at ``t = 0`` [rad/s], body axes (default zero).
+    """
+
+    arw: float = 0.0
+    rrw: float = 0.0
+    bias: Array = field(default_factory=lambda: np.zeros(3))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "arw", _non_negative("arw", self.arw))
+        object.__setattr__(self, "rrw", _non_negative("rrw", self.rrw))
+        object.__setattr__(self, "bias", _vector("bias", self.bias))
+
+    def scales(self, dt: float) -> tuple[float, float]:
+        """The deviations of one sample's draws.
+
+        Parameters
+        ----------
+        dt : float
+            Sample length [s].
+
+        Returns
+        -------
+        walk : float
+            Deviation of the bias increment ``σ_u √Δt`` [rad/s].
+        white : float
+            Deviation of the reading's white part ``√(σ_v²/Δt + σ_u² Δt/12)`` [rad/s].
+        """
+        return (self.rrw * math.sqrt(dt), math.sqrt(self.arw ** 2 / dt + self.rrw ** 2 * dt / 12.0))
+
+
+def _sensor_to_body(boresight: Array) -> Array:
+    """The rotation taking the sensor's z axis to ``boresight`` (body axes) by the shortest way."""
+    z = np.array([0.0, 0.0, 1.0])
+    b = boresight / np.linalg.norm(boresight)
+    c = float(z @ b)
+    if c < -1.0 + 1e-12:
+        return np.diag([1.0, -1.0, -1.0])  # half turn about x
+    k = np.cross(z, b)
+    kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + kx + kx @ kx / (1.0 + c)
+
+
+@dataclass(frozen=True)
+class StarTracker:
+    """A star tracker: attitude with per-axis noise in its own frame, at a rate, with outages.
+
+    Parameters
+    ----------
+    noise : (3,) array_like
+        Standard deviation of the measured rotation vector per sensor axis [rad]: about the
+        sensor's x and y axes (cross-boresight) and about its z axis, the boresight.
+    rate : float or None, optional
+        Updates per second [Hz]; ``None``: every sample. An update falls on a sample when the
+        count ``floor(t rate)`` has advanced since the previous sample (and on the first sample).
+    outages : tuple of (float, float), optional
+        Windows ``[t0, t1)`` [s] without updates (sun blinding, slews).
+    boresight : (3,) array_like, optional
+        The sensor's z axis in body axes (default ``[0, 0, 1]``); its x and y axes are the body's
+        turned by the shortest rotation taking body z to the boresight.
+    """
+
+    noise: Array
+    rate: float | None = None
+    outages: tuple[tuple[float, float], ...] = ()
+    boresight: Array = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "noise", _vector("noise", self.noise, non_negative=True))
+        if self.rate is not None and (not isinstance(self.rate, (int, float)) or not math.isfinite(self.rate)
+                                      or not self.rate > 0):
+            raise ValueError(f"rate must be a finite positive number of Hz or None, got {self.rate!r}")
+        windows = tuple((float(a), float(b)) for a, b in self.outages)
+        for a, b in windows:
+            if not (math.isfinite(a) and math.isfinite(b) and b > a):
+                raise ValueError(f"an outage must be [t0, t1] with t0 < t1 (s), got {[a, b]}")
+        object.__setattr__(self, "outages", windows)
+        boresight = _vector("boresight", self.boresight)
+        if not np.linalg.norm(boresight) > 0:
+            raise ValueError("the boresight cannot be zero")
+        object.__setattr__(self, "boresight", boresight / np.linalg.norm(boresight))
+
+    @property
+    def sensor_to_body(self) -> Array:
+        """(3, 3) rotation matrix taking sensor-frame vectors to body axes."""
+        return _sensor_to_body(self.boresight)
+
+    @property
+    def covariance(self) -> Array:
+        """(3, 3) covariance of the measured rotation vector in body axes [rad²]."""
+        rotation = self.sensor_to_body
+        return rotation @ np.diag(self.noise ** 2) @ rotation.T
+
+    def available(self, times: Array) -> NDArray[np.bool_]:
+        """Which samples carry an update.
+
+        Parameters
+        ----------
+        times : (N,) ndarray
+            Sample instants [s], increasing.
+
+        Returns
+        -------
+        (N,) bool ndarray
+            True where the tracker gives an attitude.
+        """
+        times = np.asarray(times, dtype=float)
+        if self.rate is None:
+            due = np.ones(times.size, dtype=bool)
+        else:
+            count = np.floor(times * self.rate + 1e-9)
+            due = np.concatenate([[True], count[1:] > count[:-1]]) if times.size else np.zeros(0, dtype=bool)
+        for a, b in self.outages:
+            due &= ~((times >= a) & (times < b))
+        return due
+
+
+@dataclass(frozen=True)
+class Magnetometer:
+    """A three-axis magnetometer: the field plus a constant bias and white noise.
+
+    Parameters
+    ----------
+    noise : float, optional
+        Standard deviation of the white noise per body axis [T].
+    bias : (3,) array_like, optional
+        Constant bias [T], body axes (default zero).
+    """
+
+    noise: float = 0.0
+    bias: Array = field(default_factory=lambda: np.zeros(3))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "noise", _non_negative("noise", self.noise))
+        object.__setattr__(self, "bias", _vector("bias", self.bias))

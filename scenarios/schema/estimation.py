@@ -1,0 +1,156 @@
+"""The sensor and estimator keys of a scenario: ``simulation.sensors`` and ``simulation.estimator``.
+
+Units are in the key names (``arw_deg_per_sqrt_h``, ``noise_arcsec``, ``bias_T`` ...) and are
+converted to SI here for :mod:`ocp.estimation`. A sensor declared here replaces that part of
+``simulation.sensor_noise`` (giving both is refused); the MEKF needs a gyro and a star tracker.
+Every error names the YAML path, the value and what was expected.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ocp.estimation import Gyro, Magnetometer, Mekf, SensorSuite, StarTracker
+from scenarios.errors import ScenarioError
+from scenarios.schema.keys import Section, choice, custom, mapping, number
+from scenarios.schema.node import Node
+
+DEG_PER_H = math.pi / 180.0 / 3600.0
+"""One deg/h in rad/s."""
+ARCSEC = math.pi / 180.0 / 3600.0
+"""One arcsecond in rad."""
+SQRT_HOUR = 60.0
+"""√(1 h) in √s."""
+
+
+def _non_negative_vector(node: Node) -> np.ndarray:
+    values = node.vector(3)
+    if np.any(values < 0):
+        raise node.error(f"expected 3 non-negative numbers, got {values.tolist()}")
+    return values
+
+
+def _vector3(node: Node) -> np.ndarray:
+    return node.vector(3)
+
+
+def _boresight(node: Node) -> np.ndarray:
+    values = node.vector(3)
+    if not np.linalg.norm(values) > 0:
+        raise node.error(f"a boresight cannot be zero, got {values.tolist()}; give its direction in body axes")
+    return values
+
+
+def _outages(node: Node) -> tuple[tuple[float, float], ...]:
+    windows = []
+    for item in node.items():
+        start, stop = item.vector(2)
+        if not stop > start:
+            raise item.error(f"expected [t0, t1] with t0 < t1 (s), got {[float(start), float(stop)]}")
+        windows.append((float(start), float(stop)))
+    return tuple(windows)
+
+
+GYRO = Section((
+    number("arw_deg_per_sqrt_h", "Angle random walk ``σ_v``: the white rate noise density.", unit="deg/√h",
+           default=0.0, non_negative=True),
+    number("rrw_deg_per_h_per_sqrt_h", "Rate random walk ``σ_u``: the density of the bias's white derivative.",
+           unit="deg/h/√h", default=0.0, non_negative=True),
+    custom("bias_deg_per_h", "The bias at t = 0, body axes.", "list of 3 numbers", _vector3, unit="deg/h",
+           default=[0.0, 0.0, 0.0]),
+), "A rate gyro (Farrenkopf's model: angle and rate random walk, bias); it replaces ``sensor_noise.rate``.")
+
+STAR_TRACKER = Section((
+    custom("noise_arcsec", "Standard deviation of the attitude error about the sensor's x, y (cross-boresight) "
+           "and z (boresight) axes.", "list of 3 numbers", _non_negative_vector, unit="arcsec"),
+    number("rate_hz", "Updates per second; ``null``: every sample.", unit="Hz", default=None, positive=True,
+           nullable=True),
+    custom("outages_s", "Windows ``[t0, t1]`` without updates.", "list of [t0, t1]", _outages, unit="s", default=[]),
+    custom("boresight", "The sensor's z axis in body axes (its x and y: the body's, turned by the shortest "
+           "rotation taking body z there).", "list of 3 numbers", _boresight, default=[0.0, 0.0, 1.0]),
+), "A star tracker; it replaces ``sensor_noise.attitude_deg``.")
+
+MAGNETOMETER = Section((
+    number("noise_T", "Standard deviation of the white noise per body axis.", unit="T", default=0.0,
+           non_negative=True),
+    custom("bias_T", "Constant bias, body axes.", "list of 3 numbers", _vector3, unit="T", default=[0.0, 0.0, 0.0]),
+), "A magnetometer; it replaces ``sensor_noise.magnetic_field``.")
+
+SENSORS = Section((
+    mapping("gyro", "The rate gyro; absent: the rate of ``sensor_noise``.", GYRO, default=None, null="none"),
+    mapping("star_tracker", "The star tracker; absent: the attitude of ``sensor_noise``.", STAR_TRACKER,
+            default=None, null="none"),
+    mapping("magnetometer", "The magnetometer; absent: the field of ``sensor_noise``.", MAGNETOMETER,
+            default=None, null="none"),
+), "The attitude sensors of the closed loop (seeded by ``sensor_noise.seed``, each on a stream of its own).")
+
+ESTIMATOR = Section((
+    choice("type", "The estimator: a multiplicative extended Kalman filter (gyro propagation, star tracker "
+           "updates).", ("mekf",), default="mekf"),
+    number("initial_attitude_sigma_deg", "Initial attitude standard deviation per axis (the estimate starts "
+           "off by a draw from it).", unit="deg", positive=True, maximum=180.0),
+    number("initial_bias_sigma_deg_per_h", "Initial gyro-bias standard deviation per axis (the estimate starts "
+           "at zero).", unit="deg/h", positive=True),
+), "The attitude estimator in the loop: the controller gets its attitude and the gyro's rate less its bias "
+   "estimate. It needs ``sensors.gyro`` and ``sensors.star_tracker``.")
+
+
+def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any] | None,
+                       noise: dict[str, Any], path: str) -> SensorSuite | None:
+    """The :class:`~ocp.estimation.SensorSuite` of ``simulation.sensors`` and ``simulation.estimator``.
+
+    Parameters
+    ----------
+    sensors : dict or None
+        :data:`SENSORS`'s values (``None``: absent).
+    estimator : dict or None
+        :data:`ESTIMATOR`'s values (``None``: absent).
+    noise : dict
+        ``simulation.sensor_noise``'s values (a sensor given there and here is refused).
+    path : str
+        YAML path of the simulation mapping.
+
+    Returns
+    -------
+    SensorSuite or None
+        ``None`` when neither key is given (the measurement is ``sensor_noise``'s, as before).
+
+    Raises
+    ------
+    ScenarioError
+        A sensor given twice, or an estimator without a gyro or a star tracker.
+    """
+    sensors = sensors or {}
+    gyro = tracker = magnetometer = None
+    if sensors.get("gyro") is not None:
+        values = sensors["gyro"]
+        gyro = Gyro(arw=values["arw_deg_per_sqrt_h"] * math.pi / 180.0 / SQRT_HOUR,
+                    rrw=values["rrw_deg_per_h_per_sqrt_h"] * DEG_PER_H / SQRT_HOUR,
+                    bias=values["bias_deg_per_h"] * DEG_PER_H)
+    if sensors.get("star_tracker") is not None:
+        values = sensors["star_tracker"]
+        tracker = StarTracker(noise=values["noise_arcsec"] * ARCSEC, rate=values["rate_hz"],
+                              outages=values["outages_s"], boresight=values["boresight"])
+    if sensors.get("magnetometer") is not None:
+        values = sensors["magnetometer"]
+        magnetometer = Magnetometer(noise=values["noise_T"], bias=values["bias_T"])
+    for declared, name, legacy in ((gyro, "gyro", "rate"), (tracker, "star_tracker", "attitude_deg"),
+                                   (magnetometer, "magnetometer", "magnetic_field")):
+        if declared is not None and noise[legacy] > 0:
+            raise ScenarioError(f"{path}.sensor_noise.{legacy}",
+                                f"{noise[legacy]:g} is given and {path}.sensors.{name} is declared: give that "
+                                f"sensor's noise once (set sensor_noise.{legacy} to 0 or remove it)")
+    mekf = None
+    if estimator is not None:
+        missing = [name for name, value in (("gyro", gyro), ("star_tracker", tracker)) if value is None]
+        if missing:
+            raise ScenarioError(f"{path}.estimator", f"the {estimator['type']} needs "
+                                f"{' and '.join(f'{path}.sensors.{m}' for m in missing)}; declare "
+                                f"{'it' if len(missing) == 1 else 'them'} or remove the estimator")
+        mekf = Mekf(attitude_sigma=math.radians(estimator["initial_attitude_sigma_deg"]),
+                    bias_sigma=estimator["initial_bias_sigma_deg_per_h"] * DEG_PER_H)
+    if gyro is None and tracker is None and magnetometer is None:
+        return None
+    return SensorSuite(gyro, tracker, magnetometer, mekf)
