@@ -192,7 +192,7 @@ def test_the_casadi_step_is_the_numpy_step(estimator):
     s_num = s_cas = initial_sensor_state(suite, Q0, 7)
     for k in range(300):
         q, w, _, s_num = sensor_step(suite, s_num, truth(times[k]), OMEGA, None, noise[k], 1.0)
-        qc, wc, s_cas = (np.ravel(o) for o in function(s_cas, truth(times[k]), OMEGA, noise[k], 1.0))
+        qc, wc, s_cas = (np.ravel(o.full()) for o in function(s_cas, truth(times[k]), OMEGA, noise[k], 1.0))
         np.testing.assert_allclose(qc, q, atol=1e-13)
         np.testing.assert_allclose(wc, w, atol=1e-13)
         np.testing.assert_allclose(s_cas, s_num, atol=1e-13, rtol=1e-10)
