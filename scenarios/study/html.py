@@ -40,12 +40,12 @@ LOG_SPAN = 100.0
 BINS = 40
 """Bins of a histogram."""
 ROBUSTNESS_SECTIONS = (
-    ("Robustness", "Fraction of the completed cases meeting every requirement and each threshold of "
-                   "robustness.thresholds, with the Wilson 95 % interval (robustness.csv)."),
-    ("Sensitivity", "Spearman rank correlation of each summary metric with each dispersed parameter, a vector per "
-                    "component, over the rows where the metric has a value (sensitivity.csv)."),
-    ("Worst cases", "The largest values of each summary metric (smallest for an at_least threshold), by case id; "
-                    "re-run one in full with slewbench sweep DIR --case N (worst_cases.csv)."),
+    ("Robustness", ("Fraction of the completed cases meeting every requirement and each threshold of "
+                    "robustness.thresholds, with the Wilson 95 % interval (robustness.csv).")),
+    ("Sensitivity", ("Spearman rank correlation of each summary metric with each dispersed parameter, a vector per "
+                     "component, over the rows where the metric has a value (sensitivity.csv).")),
+    ("Worst cases", ("The largest values of each summary metric (smallest for an at_least threshold), by case id; "
+                     "re-run one in full with slewbench sweep DIR --case N (worst_cases.csv).")),
 )
 """Titles and explanations of the robustness sections, in the order of the robustness tables."""
 _COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f")

@@ -305,7 +305,11 @@ def robustness_tables(study: Study, rows: list[dict[str, Any]]) -> tuple[Table, 
     """
     if study.samples <= 1 and not study.mc_paths and not study.thresholds:
         return None
-    from scenarios.study.robustness import proportion_table, sensitivity_table, worst_table
+    from scenarios.study.robustness import (
+        proportion_table,
+        sensitivity_table,
+        worst_table,
+    )
     return proportion_table(study, rows), sensitivity_table(study, rows), worst_table(study, rows)
 
 

@@ -312,8 +312,8 @@ def robustness_markdown(study: Study, rows: list[dict[str, Any]],
         parameter) and the worst cases.
     """
     out = ["## Robustness", "",
-           "Fraction of the completed cases (not crashed) meeting every requirement (status ok) and each "
-           "threshold of `robustness.thresholds`, with the Wilson 95 % interval.", ""]
+           ("Fraction of the completed cases (not crashed) meeting every requirement (status ok) and each "
+            "threshold of `robustness.thresholds`, with the Wilson 95 % interval."), ""]
     out += _lines(*proportions) + [""]
     not_ok = _not_ok(study, rows)
     if not_ok:
@@ -327,12 +327,12 @@ def robustness_markdown(study: Study, rows: list[dict[str, Any]],
             entry = wide.setdefault(tuple(json.dumps(line.get(k)) for k in keys) + (line["metric"],),
                                     {**{k: line.get(k) for k in keys}, "metric": line["metric"]})
             entry[line["parameter"]] = line["spearman_rho"]
-        out += ["## Sensitivity", "", "Spearman rank correlation of each summary metric (rows) with each dispersed "
-                "parameter (columns; a vector per component), over the rows where the metric has a value; "
-                "empty: the metric does not vary.", ""]
+        out += ["## Sensitivity", "", ("Spearman rank correlation of each summary metric (rows) with each dispersed "
+                                       "parameter (columns; a vector per component), over the rows where the metric "
+                                       "has a value; empty: the metric does not vary."), ""]
         out += _lines([*keys, "metric", *parameters], list(wide.values())) + [""]
     if worst[1]:
-        out += ["## Worst cases", "", f"The {study.worst} largest values of each summary metric (smallest for an "
-                "at_least threshold), by case id.", ""]
+        out += ["## Worst cases", "", (f"The {study.worst} largest values of each summary metric (smallest for "
+                                       "an at_least threshold), by case id."), ""]
         out += _lines(*worst) + [""]
     return "\n".join(out)
