@@ -64,6 +64,7 @@ __all__ = [
     "ROBUSTNESS",
     "SCHEDULER_SCHEMES",
     "STUDY",
+    "THRESHOLD",
     "THRESHOLD_SENSES",
     "VALUE_GENERATORS",
     "Distribution",
@@ -497,12 +498,20 @@ def _worst(node: Node) -> int:
     return node.integer(1, MAX_WORST)
 
 
+THRESHOLD = Section((
+    number("at_most", "The metric meets the threshold when at most this (a bare number means the same).",
+           default=None, nullable=True),
+    number("at_least", "The metric meets the threshold when at least this (a margin, say).", default=None,
+           nullable=True),
+), "A bound on a metric column (``cl.final_error_deg``, ``cl.req.<name>.<field>``), in its unit: a number, "
+   "``{at_most: number}`` or ``{at_least: number}``.")
+
 ROBUSTNESS = Section((
     custom("thresholds", "Metric column -> bound: the robustness table gives, per planner row, the fraction of "
            "the completed cases whose metric is at most the bound (``{at_least: bound}``: at least it), with its "
            "Wilson 95 % interval, beside the fraction meeting every requirement. A case without a value (a failed "
            "row) does not meet it.", "mapping of metric columns to a number, {at_most: number} or "
-           "{at_least: number}", _thresholds, default={}),
+           "{at_least: number}", _thresholds, default={}, section=THRESHOLD, named=True),
     custom("worst", "How many worst cases are listed per planner row and summary metric (the largest values; the "
            "smallest for a metric with an ``at_least`` threshold).", "integer", _worst, default=5,
            bounds=f"1 to {MAX_WORST}"),

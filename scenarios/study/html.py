@@ -196,11 +196,11 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
     page.table("requirements", result_columns(requirements[0], requirements[1]),
                [[row.get(c) for c in requirements[0]] for row in requirements[1]])
     if robustness is not None:
-        for (title, text), (names, table), key in zip(ROBUSTNESS_SECTIONS, robustness, ("robustness", "sensitivity",
-                                                                                      "worst")):
+        for (title, text), (keys, table), key in zip(ROBUSTNESS_SECTIONS, robustness, ("robustness", "sensitivity",
+                                                                                     "worst")):
             if table:
                 page.section(title, text)
-                page.table(key, result_columns(names, table), [[row.get(c) for c in names] for row in table])
+                page.table(key, result_columns(keys, table), [[row.get(c) for c in keys] for row in table])
     metric = summary[0].index("metric") + 1
     summary_names = [*summary[0][:metric], "unit", *summary[0][metric:]]
     summary_rows = [{**row, "unit": column_unit(row["metric"])} for row in summary[1]]
