@@ -60,6 +60,10 @@ def test_wilson_interval_equals_scipys(met, n):
     assert wilson_interval(met, n) == pytest.approx((expected.low, expected.high), abs=1e-12)
 
 
+def test_wilson_interval_is_exactly_0_or_1_at_the_ends():
+    assert wilson_interval(0, 100)[0] == 0.0 and wilson_interval(100, 100)[1] == 1.0
+
+
 def test_wilson_interval_by_hand():
     """8 of 10, z = 1.959964: centre (0.8 + z²/20) / (1 + z²/10) = 0.71674, half-width
     z √(0.016 + z²/400) / (1 + z²/10) = 0.22658."""
@@ -268,3 +272,44 @@ def test_sweep_case_reports_a_row_that_differs(swept, capsys, monkeypatch):
     assert "differs from the stored case in 1 column(s)" in printed and "fast: cl.final_error_deg stored" in printed
     stored, now = re.search(r"cl\.final_error_deg stored (\S+), now (\S+)", printed).groups()
     assert float(stored) - float(now) == pytest.approx(1e-9, rel=1e-3)
+
+
+def test_the_sensitivity_heat_map_draws_the_table(swept):
+    import matplotlib.pyplot as plt
+
+    from scenarios.study.plots import figures
+    from scenarios.study.rerun import stored_results
+
+    _, out = swept
+    results, _ = stored_results(out)
+    _, rows = results.table()
+    sensitivity = pd.read_csv(out / "sensitivity.csv")
+    drawn = {}
+    for name, figure in figures(results.study, rows):
+        if name == "sensitivity.png":
+            drawn = {axis.get_title(): axis.images[0].get_array() for axis in figure.axes if axis.images}
+        plt.close(figure)
+    assert set(drawn) == {"smooth", "fast"}
+    parameters = list(dict.fromkeys(sensitivity["parameter"]))
+    for label, image in drawn.items():
+        expected = sensitivity[sensitivity["label"] == label].pivot(index="metric", columns="parameter",
+                                                                    values="spearman_rho").loc[SUMMARY, parameters]
+        np.testing.assert_allclose(np.ma.filled(image.astype(float), np.nan), expected.to_numpy(), rtol=0, atol=1e-15)
+
+
+def test_the_sweep_prints_each_criterion_and_the_worst_cases(swept):
+    from scenarios.study.robustness import robustness_lines
+    from scenarios.study.rerun import stored_results
+    from scenarios.study.report import robustness_tables
+
+    _, out = swept
+    results, _ = stored_results(out)
+    proportions, _, worst = robustness_tables(results.study, results.table()[1])
+    lines = robustness_lines(proportions, worst)
+    robustness = pd.read_csv(out / "robustness.csv")
+    line = robustness[(robustness["label"] == "fast") & (robustness["criterion"] == "every requirement")].iloc[0]
+    assert (f"  fast: every requirement {line['met']}/10 = {line['fraction_met']:.3g} "
+            f"[{line['wilson_low']:.3f}, {line['wilson_high']:.3f}]") in lines
+    worst_cases = pd.read_csv(out / "worst_cases.csv")
+    mine = worst_cases[(worst_cases["label"] == "smooth") & (worst_cases["metric"] == "cl.int_u")]["case"]
+    assert f"  smooth: worst cl.int_u: case {', '.join(map(str, mine))}" in lines

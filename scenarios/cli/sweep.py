@@ -29,8 +29,9 @@ from scenarios.study.engine import (
     start_forkserver,
     sweep,
 )
-from scenarios.study.report import resolved_study
+from scenarios.study.report import resolved_study, robustness_tables
 from scenarios.study.rerun import rerun_case, row_differences, stored_results
+from scenarios.study.robustness import robustness_lines
 from scenarios.study.spec import load_study
 from scenarios.study.store import (
     EARLIER_FORMATS,
@@ -331,6 +332,13 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
     print(f"{ran} case{'s' if ran != 1 else ''} run in {time.perf_counter() - start:.1f} s"
           + (f" ({done} already stored, {len(study.cases)} in all)" if done else "")
           + f"; {not_ok} with a row not ok, {crashed} crashed; wrote {out}/ ({', '.join(files)})")
+    tables = robustness_tables(study, results.table()[1])
+    if tables is not None:
+        proportions, _, worst = tables
+        print("robustness (fraction of the completed cases, Wilson 95 % interval; robustness.csv, "
+              "sensitivity.csv, worst_cases.csv):")
+        print("\n".join(robustness_lines(proportions, worst)))
+        print(f"re-run a case in full: slewbench sweep {out} --case N")
     return EXIT_OK
 
 

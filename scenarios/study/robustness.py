@@ -33,7 +33,8 @@ from scenarios.study.report import PROPORTION_STATISTICS, group_rows, proportion
 from scenarios.study.types import Study
 
 __all__ = ["EVERY_REQUIREMENT", "SENSITIVITY_STATISTICS", "WORST_COLUMNS", "criterion_text", "parameter_columns",
-           "proportion_table", "robustness_markdown", "sensitivity_table", "spearman", "worst_table"]
+           "proportion_table", "robustness_lines", "robustness_markdown", "sensitivity_table", "spearman",
+           "worst_table"]
 
 EVERY_REQUIREMENT = "every requirement"
 """The criterion of the rows whose status is ``ok``."""
@@ -336,3 +337,38 @@ def robustness_markdown(study: Study, rows: list[dict[str, Any]],
                                        "an at_least threshold), by case id."), ""]
         out += _lines(*worst) + [""]
     return "\n".join(out)
+
+
+def robustness_lines(proportions: tuple[list[str], list[dict[str, Any]]],
+                     worst: tuple[list[str], list[dict[str, Any]]]) -> list[str]:
+    """The robustness summary ``slewbench sweep`` prints: per group, each criterion's fraction with
+    its Wilson interval, and the worst cases of each summary metric by id.
+
+    Parameters
+    ----------
+    proportions, worst : (list of str, list of dict)
+        :func:`proportion_table` and :func:`worst_table`.
+
+    Returns
+    -------
+    list of str
+        One line per group and criterion (``  fast: every requirement 98/100 = 0.98 [0.930, 0.994]``),
+        then one per group and metric (``  fast: worst cl.int_u: case 17, 3, 55``).
+    """
+    columns, table = proportions
+    keys = columns[:columns.index("criterion")]
+
+    def group(line: dict[str, Any]) -> str:
+        return ", ".join(text_cell(line.get(k)) for k in keys)
+
+    lines = []
+    for line in table:
+        if line["fraction_met"] is None:
+            continue
+        lines.append(f"  {group(line)}: {line['criterion']} {line['met']}/{line['completed']} = "
+                     f"{line['fraction_met']:.3g} [{line['wilson_low']:.3f}, {line['wilson_high']:.3f}]")
+    listed: dict[tuple[str, str], list[str]] = {}
+    for line in worst[1]:
+        listed.setdefault((group(line), line["metric"]), []).append(str(line["case"]))
+    lines += [f"  {name}: worst {metric}: case {', '.join(cases)}" for (name, metric), cases in listed.items()]
+    return lines
