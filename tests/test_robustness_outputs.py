@@ -181,6 +181,7 @@ def test_worst_cases_skip_rows_without_a_value():
     rows = _rows([0.3, None, 0.5, 0.1], ["ok", "failed", "ok", "ok"])
     _, table = worst_table(study, rows)
     assert [(line["case"], line["value"]) for line in table] == [(2, 0.5), (0, 0.3)]
+    assert worst_table(study, _rows([0.2, 0.2, None], ["ok", "ok", "failed"]))[1] == []  # all alike: none is worst
 
 
 def test_a_grid_study_writes_no_robustness_tables(tmp_path):

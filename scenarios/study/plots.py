@@ -488,11 +488,11 @@ def _sensitivity(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str
     parameters = list(dict.fromkeys(line["parameter"] for line in table))
     shown = list(groups.items())[:MAX_GROUPS]
     figure, axes = _grid(len(shown), max(4.0, 0.9 * len(parameters) + 2.5), max(3.0, 0.45 * len(metrics) + 2.0))
-    image = None
+    images = []
     for axis, (name, values) in zip(axes, shown):
         matrix = np.array([[math.nan if values.get((m, q)) is None else values[(m, q)] for q in parameters]
                            for m in metrics])
-        image = axis.imshow(matrix, cmap="RdBu_r", vmin=-1.0, vmax=1.0, aspect="auto")
+        images.append(axis.imshow(matrix, cmap="RdBu_r", vmin=-1.0, vmax=1.0, aspect="auto"))
         if matrix.size <= MAX_ANNOTATED_CELLS:
             for (i, j), value in np.ndenumerate(matrix):
                 axis.text(j, i, "–" if math.isnan(value) else f"{value:.2f}", ha="center", va="center", fontsize=7)
@@ -500,7 +500,7 @@ def _sensitivity(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str
                         ha="right", fontsize=7)
         axis.set_yticks(range(len(metrics)), metrics, fontsize=7)
         axis.set_title(name, fontsize=9)
-    figure.colorbar(image, ax=axes, label="Spearman rank correlation (–)")
+    figure.colorbar(images[0], ax=axes, label="Spearman rank correlation (–)")
     more = f" (the first {len(shown)} of {len(groups)} groups)" if len(shown) < len(groups) else ""
     _title(figure, f"{study.name}: rank correlation of each summary metric with each dispersed parameter "
                    f"(sensitivity.csv; –: the metric does not vary){more}")

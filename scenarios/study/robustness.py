@@ -254,7 +254,8 @@ def worst_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], li
         The grouping keys and :data:`WORST_COLUMNS`.
     rows : list of dict
         Per group and metric, ranks 1 to ``worst`` among the rows with a value: the largest values
-        first (the smallest for a metric with an ``at_least`` threshold); ties in case order.
+        first (the smallest for a metric with an ``at_least`` threshold); ties in case order. A
+        metric with one value in every row of the group lists none.
     """
     keys, groups = group_rows(study, rows)
     table = []
@@ -262,6 +263,8 @@ def worst_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], li
         for metric in study.summary:
             least = study.thresholds.get(metric, ("at_most", 0.0))[0] == "at_least"
             valued = [(v, r) for v, r in ((_number(r.get(metric)), r) for r in members) if math.isfinite(v)]
+            if len({v for v, _ in valued}) < 2:
+                continue  # one value in every row: no case is worse than another
             valued.sort(key=lambda pair: pair[0] if least else -pair[0])  # stable: ties keep case order
             for rank, (value, row) in enumerate(valued[:study.worst], start=1):
                 line = {k: members[0].get(k) for k in keys}
