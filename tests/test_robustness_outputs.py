@@ -18,17 +18,10 @@ from scenarios.output.directory import MARKER
 from scenarios.study.report import wilson_interval
 from scenarios.study.robustness import proportion_table, spearman, worst_table
 from scenarios.study.spec import parse_study
+from tests.test_sweep import BASE as SWEEP_BASE  # the tiny two-row eigenaxis scenario
 
-BASE = {
-    "name": "tiny",
-    "spacecraft": {"inertia": [2.0, 3.0, 4.0], "wheels": {"max_torque": 0.05}},
-    "maneuver": {"duration": 30.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
-                 "final": {"q": [0.9238795, 0.3826834, 0, 0], "omega": [0, 0, 0]}},
-    "planners": [{"name": "eigenaxis", "label": "smooth"},
-                 {"name": "eigenaxis", "label": "fast", "options": {"profile": "min_time", "torque_fraction": 0.8}}],
-    "controller": {"name": "augmented_quaternion_feedback", "options": {"kp": 0.2, "kd": 0.6}},
-    "simulation": {"sample_time": 1.0, "duration": 35.0, "sensor_noise": {"attitude_deg": 0.01}},
-}
+BASE = {**copy.deepcopy(SWEEP_BASE),
+        "simulation": {"sample_time": 1.0, "duration": 35.0, "sensor_noise": {"attitude_deg": 0.01}}}
 SUMMARY = ["cl.final_error_deg", "cl.int_u", "cl.max_error_deg"]
 THRESHOLD = 0.0045  # about the median final error of these cases [deg]: some meet it, some do not
 STUDY = {"study": "robust-mc", "scenario": "base.yaml",
