@@ -495,7 +495,8 @@ def _sensitivity(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str
         images.append(axis.imshow(matrix, cmap="RdBu_r", vmin=-1.0, vmax=1.0, aspect="auto"))
         if matrix.size <= MAX_ANNOTATED_CELLS:
             for (i, j), value in np.ndenumerate(matrix):
-                axis.text(j, i, "–" if math.isnan(value) else f"{value:.2f}", ha="center", va="center", fontsize=7)
+                axis.text(j, i, "–" if math.isnan(value) else f"{value:.2f}", ha="center", va="center", fontsize=7,
+                          color="white" if abs(value) > 0.6 else "black")  # NaN > 0.6 is False: black
         axis.set_xticks(range(len(parameters)), [textwrap.shorten(q, 40) for q in parameters], rotation=30,
                         ha="right", fontsize=7)
         axis.set_yticks(range(len(metrics)), metrics, fontsize=7)
