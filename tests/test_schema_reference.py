@@ -190,6 +190,7 @@ monte_carlo:
     simulation.sensor_noise.seed: case_seed
 summary: [cl.int_u, ref.final_error_deg]
 execution: {workers: 2, scheduler: null, case_timeout_s: 60, retries: 0}
+robustness: {thresholds: {cl.final_error_deg: 0.1, cl.int_u: {at_least: 0.01}, cl.max_error_deg: {at_most: 5}}, worst: 3}
 resolved: {version: "0"}
 """
 
@@ -279,6 +280,9 @@ def study_path(path: str, varied: list[str]) -> str:
     """A study path as the reference writes it: the scenario path of a grid, zip or dispersion
     entry as ``<path>`` (zip entries as grid's), a generator inside ``axis_angle.angle_deg`` as a
     generator, a distribution inside ``scale`` or ``offset`` as a distribution."""
+    if path.startswith("robustness.thresholds."):  # keyed by a metric column, which has dots of its own
+        sense = path.rsplit(".", 1)[-1]
+        return "robustness.thresholds.<name>" + (f".{sense}" if sense in ("at_most", "at_least") else "")
     for scope in ("grid", "zip", "monte_carlo.dispersions"):
         for scenario in sorted(varied, key=len, reverse=True):
             if path == f"{scope}.{scenario}" or path.startswith(f"{scope}.{scenario}."):
@@ -293,7 +297,7 @@ def test_the_maximal_study_uses_every_documented_study_key_and_the_parser_reads_
     study = parse_study(copy.deepcopy(data))
     assert len(study.cases) == 2 * 2 * 2 * 2 * 2  # four grid axes of two values, a zip of one, two samples
     varied = study.grid_paths + study.mc_paths
-    study_keys = ("study", "scenario", "grid", "zip", "monte_carlo", "summary", "execution", "resolved")
+    study_keys = ("study", "scenario", "grid", "zip", "monte_carlo", "summary", "execution", "robustness", "resolved")
     read = {study_path(path, varied) for path in keys_read if path.split(".")[0] in study_keys}
     written = {study_path(path, varied) for path in yaml_paths({k: v for k, v in data.items() if k != "scenario"})}
     written |= {"scenario", "monte_carlo.dispersions.<path>: case_seed"}

@@ -20,25 +20,25 @@ from typing import Any
 
 from scenarios.cli.status import EXIT_INTERRUPTED, EXIT_OK
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
-from scenarios.output.directory import MARKER, read_manifest, written_files
+from scenarios.output.directory import MARKER, claim_output_directory, written_files
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
 from scenarios.study.engine import (
     DaskCluster,
-    SweepResults,
     connect_scheduler,
     start_forkserver,
     sweep,
 )
-from scenarios.study.report import resolved_study
-from scenarios.study.spec import load_study, parse_study
+from scenarios.study.report import resolved_study, robustness_tables
+from scenarios.study.rerun import rerun_case, row_differences, stored_results
+from scenarios.study.robustness import robustness_lines
+from scenarios.study.spec import load_study
 from scenarios.study.store import (
     EARLIER_FORMATS,
     STORE_FILES,
     STORE_NAME,
     SweepStore,
     claim_sweep_directory,
-    is_sweep_store,
     store_format,
 )
 from scenarios.study.types import Study
@@ -68,25 +68,82 @@ def command_report(args: argparse.Namespace) -> int:
         still readable is redrawn), or its store is damaged.
     """
     out = Path(args.report)
-    try:
-        if read_manifest(out) is None or not is_sweep_store(out):
-            raise OutputError(out, f"holds no slewbench sweep ({STORE_NAME} and {MARKER} expected)")
-        with SweepStore(out, create=False) as store:
-            data, version = store.get_meta("study"), store.get_meta("version")
-            records = store.records()
-    except (ValueError, OSError, sqlite3.Error) as error:
-        raise OutputError(out, f"its sweep store cannot be read: {error}") from None
-    if not isinstance(version, str):
-        raise OutputError(out, "its sweep store has no version of slewbench; it cannot be redrawn")
-    try:
-        study = parse_study(data, version=version)
-    except ScenarioError as error:
-        raise OutputError(out, f"the study stored in it is not valid ({error}); it cannot be redrawn") from None
-    results = SweepResults(study, records)
+    results, _ = stored_results(out)
     earlier = written_files(out)
     files = results.write(out, plots=not args.no_plots)
-    print(f"redrew {out}/ ({', '.join(files)}) from {len(records)} stored case(s); {results.missing} missing")
+    print(f"redrew {out}/ ({', '.join(files)}) from {len(results.records)} stored case(s); {results.missing} missing")
     _say_removed(out, earlier)
+    return EXIT_OK
+
+
+CASE_FOLDER = "cases"
+"""The folder of a sweep directory that ``sweep DIR --case N`` writes case ``N`` into by default
+(``DIR/cases/N``)."""
+
+
+def command_case(args: argparse.Namespace) -> int:
+    """Run case ``args.case`` of the sweep stored in ``args.file`` again, in full, and write it as a run.
+
+    The case's resolved scenario comes from the stored study; the outputs (tables, time series,
+    plots, ``report.html``) go to ``--out`` or ``DIR/cases/N``, a directory claimed as
+    ``slewbench run`` claims its own. The re-run's rows are compared with the stored ones.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``sweep`` arguments (``file``: the sweep directory, ``case``, ``out``,
+        ``no_plots``, ``renderer``).
+
+    Returns
+    -------
+    int
+        The exit status (0; rows that differ from the stored ones are reported, not an error).
+
+    Raises
+    ------
+    ScenarioError
+        Options that do not go with ``--case``, or a case the study does not have (exit 2).
+    OutputError
+        The directory holds no sweep, or the output directory cannot be claimed (exit 2).
+    """
+    clashing = [name for name, given in (("--report", args.report), ("--resume", args.resume),
+                                         ("--dry-run", args.dry_run), ("--workers", args.workers is not None),
+                                         ("--scheduler", args.scheduler)) if given]
+    if clashing:
+        raise ScenarioError("--case", f"re-runs one stored case in this process; it does not take {clashing[0]}")
+    if not args.file:
+        raise ScenarioError("--case", "give the sweep directory: slewbench sweep DIR --case N")
+    directory = Path(args.file)
+    results, version = stored_results(directory)
+    cases = results.study.cases
+    if not 0 <= args.case < len(cases):
+        raise ScenarioError("--case", f"expected a case of the study, 0 to {len(cases) - 1}, got {args.case}")
+    case = cases[args.case]
+    out = Path(args.out) if args.out else directory / CASE_FOLDER / str(args.case)
+    claim_output_directory(out)  # before running: a long case is never lost at the end
+    varied = ", ".join(f"{path}={value}" for path, value in case.varied.items())
+    print(f"{results.study.name}: case {case.index} (grid point {case.point}, seed {case.seed})"
+          + (f": {varied}" if varied else ""), flush=True)
+    if version != package_version():
+        print(f"note: the sweep was stored by slewbench {version}; this is {package_version()}", flush=True)
+    rerun = rerun_case(results, args.case, progress=lambda line: print(line, flush=True))
+    print()
+    print(rerun.to_terminal())
+    rerun.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
+    print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
+          f"{'' if args.no_plots else ', PNG plots, report.html'})")
+    record = results.records.get(case.key)
+    if record is None:
+        print(f"case {case.index} is not stored in {directory}/ (the sweep did not run it yet): nothing to compare")
+        return EXIT_OK
+    differences = row_differences(record["rows"], rerun)
+    if differences:
+        print(f"the re-run differs from the stored case in {len(differences)} column(s):")
+        for line in differences[:20]:
+            print(f"  {line}")
+    else:
+        print(f"the re-run's rows equal the stored case's ({len(rerun.rows)} row(s), every metric and requirement "
+              "column; planning times aside)")
     return EXIT_OK
 
 
@@ -207,6 +264,8 @@ def command_sweep(args: argparse.Namespace) -> int:
         An output directory slewbench must not or cannot write to (exit 2; nothing written), or a
         store that cannot be written while the sweep runs (the cases stored so far are kept).
     """
+    if args.case is not None:
+        return command_case(args)
     if args.report:
         return command_report(args)
     if not args.file:
@@ -285,6 +344,13 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
           + (f" ({done} already stored, {len(study.cases)} in all)" if done else "")
           + f"; {not_ok} with a row not ok, {crashed} crashed; wrote {out}/ ({', '.join(files)})")
     _say_removed(out, earlier)
+    tables = robustness_tables(study, results.table()[1])
+    if tables is not None:
+        proportions, _, worst = tables
+        print("robustness (fraction of the completed cases, Wilson 95 % interval; robustness.csv, "
+              "sensitivity.csv, worst_cases.csv):")
+        print("\n".join(robustness_lines(proportions, worst)))
+        print(f"re-run a case in full: slewbench sweep {out} --case N")
     return EXIT_OK
 
 
@@ -297,7 +363,7 @@ def add_sweep_parser(commands: Any) -> None:
         The ``argparse`` sub-parsers object of ``slewbench`` (from ``add_subparsers``).
     """
     parser = commands.add_parser("sweep", help="run a trade study (grid, zip, Monte Carlo) on many cases")
-    parser.add_argument("file", nargs="?", help="study YAML file")
+    parser.add_argument("file", nargs="?", help="study YAML file (with --case: the sweep directory)")
     parser.add_argument("--out", help="output directory (default: results/<study name>)")
     parser.add_argument("--workers", type=int, help="cases at once (default: execution.workers, else one per core)")
     parser.add_argument("--scheduler", help="Dask scheduler address (tcp://host:port) instead of local processes")
@@ -306,4 +372,7 @@ def add_sweep_parser(commands: Any) -> None:
     parser.add_argument("--dry-run", action="store_true",
                         help="check the study and list its cases; run nothing, write nothing")
     parser.add_argument("--report", metavar="DIR", help="redraw tables and plots of DIR from its store; run nothing")
+    parser.add_argument("--case", metavar="N", type=int,
+                        help="re-run case N of the sweep stored in DIR (given as the first argument) in full, "
+                             "writing a run's outputs into --out (default: DIR/cases/N)")
     parser.set_defaults(handler=command_sweep)

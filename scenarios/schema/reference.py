@@ -52,6 +52,7 @@ from scenarios.schema.study import (
     EXECUTION,
     GRID_ENTRY,
     MONTE_CARLO,
+    ROBUSTNESS,
     STUDY,
     VALUE_GENERATORS,
 )
@@ -297,6 +298,8 @@ def _study_parts() -> list[Part]:
              "of ``DISTRIBUTIONS``, in the units of that key (a ``_deg`` key: degrees):", tuple(forms)),
         Part("study.execution", group, "``execution``", EXECUTION.meaning,
              tuple(_walk(EXECUTION, "execution", "study.execution"))),
+        Part("study.robustness", group, "``robustness``", ROBUSTNESS.meaning,
+             tuple(_walk(ROBUSTNESS, "robustness", "study.robustness"))),
     ]
 
 

@@ -60,9 +60,13 @@ __all__ = [
     "MAX_SEED",
     "MAX_VALUES",
     "MAX_VARIED",
+    "MAX_WORST",
     "MONTE_CARLO",
+    "ROBUSTNESS",
     "SCHEDULER_SCHEMES",
     "STUDY",
+    "THRESHOLD",
+    "THRESHOLD_SENSES",
     "VALUE_GENERATORS",
     "Distribution",
     "ValueGenerator",
@@ -443,19 +447,70 @@ EXECUTION = Section((
 ), "How the cases run.")
 
 
+def _metric_column(metric: str, where: str) -> str:
+    """``metric`` when it names a metric column or a requirement column, else an error at ``where``."""
+    if not isinstance(metric, str) or metric not in metric_columns() and not is_requirement_column(metric):
+        scalars = [key for key in METRIC_KEYS if key != "plan_time_s" and key not in VECTOR_METRICS]
+        vectors = ", ".join(f"cl.{key}_x" for key in VECTOR_METRICS)
+        raise ScenarioError(where, f"expected ref.<metric> or cl.<metric> with a metric of {scalars}, or one axis "
+                                   f"of a vector metric ({vectors}, _y, _z), or a requirement's "
+                                   f"ref.req.<name>.<field>, got {excerpt(metric)}")
+    return metric
+
+
 def _summary(node: Node) -> list[str]:
     if isinstance(node.value, Described) or node.is_null():
         return list(DEFAULT_SUMMARY)
-    summary = [item.string() for item in node.items()]
-    columns = metric_columns()
-    for index, metric in enumerate(summary):
-        if metric not in columns and not is_requirement_column(metric):  # a metric or requirement column
-            scalars = [key for key in METRIC_KEYS if key != "plan_time_s" and key not in VECTOR_METRICS]
-            vectors = ", ".join(f"cl.{key}_x" for key in VECTOR_METRICS)
-            raise ScenarioError(f"summary[{index}]", f"expected ref.<metric> or cl.<metric> with a metric of "
-                                                     f"{scalars}, or one axis of a vector metric ({vectors}, _y, _z), "
-                                                     f"or a requirement's ref.req.<name>.<field>, got {metric!r}")
-    return summary
+    return [_metric_column(item.string(), f"summary[{index}]") for index, item in enumerate(node.items())]
+
+
+THRESHOLD_SENSES = ("at_most", "at_least")
+"""How a ``robustness.thresholds`` entry compares a metric with its bound: a bare number is ``at_most``."""
+MAX_WORST = 100
+"""Most worst cases listed per planner row and metric (``robustness.worst``)."""
+
+
+def _thresholds(node: Node) -> dict[str, tuple[str, float]]:
+    """``robustness.thresholds``: metric column -> ``(sense, bound)``."""
+    thresholds = {}
+    mapped = _entries(node)
+    for metric in mapped.value:
+        entry = mapped.get(metric)
+        _metric_column(metric, entry.path)
+        if isinstance(entry.value, dict):
+            if len(entry.value) != 1 or next(iter(entry.value)) not in THRESHOLD_SENSES:
+                raise entry.error(f"expected a number (the metric at most it) or {{at_most: number}} or "
+                                  f"{{at_least: number}}, got {excerpt(entry.value)}")
+            sense = next(iter(entry.value))
+            thresholds[metric] = (sense, entry.get(sense).number())
+        else:
+            thresholds[metric] = ("at_most", entry.number())
+    return thresholds
+
+
+def _worst(node: Node) -> int:
+    return node.integer(1, MAX_WORST)
+
+
+THRESHOLD = Section((
+    number("at_most", "The metric meets the threshold when at most this (a bare number means the same).",
+           default=None, nullable=True),
+    number("at_least", "The metric meets the threshold when at least this (a margin, say).", default=None,
+           nullable=True),
+), "A bound on a metric column (``cl.final_error_deg``, ``cl.req.<name>.<field>``), in its unit: a number, "
+   "``{at_most: number}`` or ``{at_least: number}``.")
+
+ROBUSTNESS = Section((
+    custom("thresholds", "Metric column -> bound: the robustness table gives, per planner row, the fraction of "
+           "the completed cases whose metric is at most the bound (``{at_least: bound}``: at least it), with its "
+           "Wilson 95 % interval, beside the fraction meeting every requirement. A case without a value (a failed "
+           "row) does not meet it.", "mapping of metric columns to a number, {at_most: number} or "
+           "{at_least: number}", _thresholds, default={}, section=THRESHOLD, named=True),
+    custom("worst", "How many worst cases are listed per planner row and summary metric (the largest values; the "
+           "smallest for a metric with an ``at_least`` threshold).", "integer", _worst, default=5,
+           bounds=f"1 to {MAX_WORST}"),
+), "The robustness outputs of a Monte Carlo study: probabilities of meeting the requirements and thresholds, "
+   "rank correlations of the summary metrics with the dispersed parameters, the worst cases.")
 
 
 STUDY = Section((
@@ -474,6 +529,8 @@ STUDY = Section((
            "``ref.req.<name>.<field>`` (``cl.req...``) that some case gives.", "list of text or null", _summary,
            default=Described("every scalar metric, ref. and cl.")),
     mapping("execution", "How the cases run.", EXECUTION, default={}, null="defaults"),
+    mapping("robustness", "The robustness outputs (``robustness.csv``, ``sensitivity.csv``, ``worst_cases.csv``): "
+            "thresholds on metrics and how many worst cases to list.", ROBUSTNESS, default={}, null="defaults"),
     custom("resolved", "Written by slewbench into the stored ``study.yaml`` (version, case seeds) and ignored "
            "when read.", "mapping", None, default=None),
 ), "A trade study file.")

@@ -5,9 +5,11 @@ them (:mod:`~scenarios.study.paths`), dispersions (:mod:`~scenarios.study.disper
 study and expanding it into cases (:mod:`~scenarios.study.spec`; the study file's keys are declared
 in :mod:`scenarios.schema.study`), the crash-safe store and the sweep directory that holds it
 (:mod:`~scenarios.study.store`), what a worker runs (:mod:`~scenarios.study.worker`), the engine on a
-local pool or Dask (:mod:`~scenarios.study.engine`), and the report's tables
-(:mod:`~scenarios.study.report`), figures (:mod:`~scenarios.study.plots`) and interactive
-``report.html`` (:mod:`~scenarios.study.html`).
+local pool or Dask (:mod:`~scenarios.study.engine`), the report's tables
+(:mod:`~scenarios.study.report`), robustness tables of a Monte Carlo study
+(:mod:`~scenarios.study.robustness`), figures (:mod:`~scenarios.study.plots`) and interactive
+``report.html`` (:mod:`~scenarios.study.html`), and a stored sweep read back with one of its cases
+re-run in full (:mod:`~scenarios.study.rerun`).
 
 May import: :mod:`ocp`, :mod:`scenarios.errors`, :mod:`scenarios.requirements` (the requirement
 columns a summary may name), :mod:`scenarios.schema`, :mod:`scenarios.output` and
@@ -27,9 +29,11 @@ _HOMES = {"Case": "scenarios.study.types",
           "connect_scheduler": "scenarios.study.engine",
           "load_study": "scenarios.study.spec",
           "parse_study": "scenarios.study.spec",
+          "rerun_case": "scenarios.study.rerun",
+          "stored_results": "scenarios.study.rerun",
           "sweep": "scenarios.study.engine"}
 
 __all__ = ["Case", "DaskCluster", "Dispersion", "Execution", "Study", "SweepResults", "SweepStore", "connect_scheduler",
-           "load_study", "parse_study", "sweep"]
+           "load_study", "parse_study", "rerun_case", "stored_results", "sweep"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)

@@ -4,6 +4,8 @@ Built on the run report's page (:class:`scenarios.output.report.page.Page`): plo
 tables' values exactly as in the CSV files, opening offline. In order:
 
 * the fraction of cases meeting every requirement per planner (``requirements.csv``);
+* for a Monte Carlo study, the robustness tables (:mod:`scenarios.study.robustness`): the
+  fractions meeting every requirement and each threshold, the rank correlations and the worst cases;
 * the summary statistics (``summary.csv``), with each metric's unit;
 * one step histogram per summary metric, the planner rows overlaid, each on its own bins, on a
   logarithmic axis when the values are positive and span more than :data:`LOG_SPAN`;
@@ -29,7 +31,7 @@ from scenarios.schema.loader import SCENARIO
 from scenarios.study.paths import parse_path
 from scenarios.study.types import Study
 
-__all__ = ["LOG_SPAN", "PAGE_SIZE", "histogram_figure", "path_unit", "study_report"]
+__all__ = ["LOG_SPAN", "PAGE_SIZE", "ROBUSTNESS_SECTIONS", "histogram_figure", "path_unit", "study_report"]
 
 PAGE_SIZE = 50
 """Rows of the cases table shown at once."""
@@ -37,6 +39,15 @@ LOG_SPAN = 100.0
 """A histogram's axis is logarithmic when its positive values' largest over smallest exceeds this."""
 BINS = 40
 """Bins of a histogram."""
+ROBUSTNESS_SECTIONS = (
+    ("Robustness", ("Fraction of the completed cases meeting every requirement and each threshold of "
+                    "robustness.thresholds, with the Wilson 95 % interval (robustness.csv).")),
+    ("Sensitivity", ("Spearman rank correlation of each summary metric with each dispersed parameter, a vector per "
+                     "component, over the rows where the metric has a value (sensitivity.csv).")),
+    ("Worst cases", ("The largest values of each summary metric (smallest for an at_least threshold), by case id; "
+                     "re-run one in full with slewbench sweep DIR --case N (worst_cases.csv).")),
+)
+"""Titles and explanations of the robustness sections, in the order of the robustness tables."""
 _COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f")
 
 
@@ -147,7 +158,8 @@ def histogram_figure(column: str, rows: list[dict[str, Any]], labels: list[str])
 
 def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
                  summary: tuple[list[str], list[dict[str, Any]]],
-                 requirements: tuple[list[str], list[dict[str, Any]]], missing: int) -> str:
+                 requirements: tuple[list[str], list[dict[str, Any]]], missing: int,
+                 robustness: tuple[tuple[list[str], list[dict[str, Any]]], ...] | None = None) -> str:
     """The HTML of a study's interactive report (module docstring).
 
     Parameters
@@ -162,6 +174,9 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
         Columns and rows of ``requirements.csv`` (:func:`scenarios.study.report.requirement_table`).
     missing : int
         Cases of the study without a record.
+    robustness : tuple of (list of str, list of dict), or None, optional
+        The robustness tables of a Monte Carlo study (:func:`scenarios.study.report.robustness_tables`:
+        proportions, rank correlations, worst cases); None: no robustness sections.
 
     Returns
     -------
@@ -180,6 +195,12 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
                  "Rows whose status is ok among the completed ones (not crashed), with the Wilson 95 % interval.")
     page.table("requirements", result_columns(requirements[0], requirements[1]),
                [[row.get(c) for c in requirements[0]] for row in requirements[1]])
+    if robustness is not None:
+        for (title, text), (keys, table), key in zip(ROBUSTNESS_SECTIONS, robustness, ("robustness", "sensitivity",
+                                                                                     "worst")):
+            if table:
+                page.section(title, text)
+                page.table(key, result_columns(keys, table), [[row.get(c) for c in keys] for row in table])
     metric = summary[0].index("metric") + 1
     summary_names = [*summary[0][:metric], "unit", *summary[0][metric:]]
     summary_rows = [{**row, "unit": column_unit(row["metric"])} for row in summary[1]]

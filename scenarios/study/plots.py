@@ -1,7 +1,8 @@
 """Figures of a trade study (matplotlib, Agg): each summary metric against each numeric grid
 parameter (one line per planner, median with the 5-95 % band under Monte Carlo), heat maps over a
 2-D grid (one colour scale shared by the planners), box plots, empirical CDFs and scatter plots
-against each dispersed parameter across Monte Carlo samples, and the Pareto front of each grid point.
+against each dispersed parameter across Monte Carlo samples with the heat map of their rank
+correlations (:mod:`scenarios.study.robustness`), and the Pareto front of each grid point.
 
 Every axis names its quantity in words with its unit: a metric or requirement column by
 :func:`scenarios.output.plot_data.column_quantity`, a varied scenario path by
@@ -467,6 +468,44 @@ def _monte_carlo(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str
     _title(figure, f"{study.name}: empirical CDFs over every case (a failed case has no value){note}")
     yield "cdf.png", figure
     yield from _scatter(study, rows, metrics, colors)
+    yield from _sensitivity(study, rows)
+
+
+def _sensitivity(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figure]]:
+    """The rank correlations of ``sensitivity.csv`` as one heat map per group (at most
+    :data:`MAX_GROUPS`): summary metrics down, dispersed parameter components across, -1 to 1."""
+    from scenarios.study.robustness import sensitivity_table
+
+    columns, table = sensitivity_table(study, rows)
+    if not table:
+        return
+    keys = columns[:columns.index("metric")]
+    groups: dict[str, dict[tuple[str, str], Any]] = {}
+    for line in table:
+        name = ", ".join(str(line.get(k)) for k in keys)
+        groups.setdefault(name, {})[(line["metric"], line["parameter"])] = line["spearman_rho"]
+    metrics = list(dict.fromkeys(line["metric"] for line in table))
+    parameters = list(dict.fromkeys(line["parameter"] for line in table))
+    shown = list(groups.items())[:MAX_GROUPS]
+    figure, axes = _grid(len(shown), max(4.0, 0.9 * len(parameters) + 2.5), max(3.0, 0.45 * len(metrics) + 2.0))
+    images = []
+    for axis, (name, values) in zip(axes, shown):
+        matrix = np.array([[math.nan if values.get((m, q)) is None else values[(m, q)] for q in parameters]
+                           for m in metrics])
+        images.append(axis.imshow(matrix, cmap="RdBu_r", vmin=-1.0, vmax=1.0, aspect="auto"))
+        if matrix.size <= MAX_ANNOTATED_CELLS:
+            for (i, j), value in np.ndenumerate(matrix):
+                axis.text(j, i, "–" if math.isnan(value) else f"{value:.2f}", ha="center", va="center", fontsize=7,
+                          color="white" if abs(value) > 0.6 else "black")  # NaN > 0.6 is False: black
+        axis.set_xticks(range(len(parameters)), [textwrap.shorten(q, 40) for q in parameters], rotation=30,
+                        ha="right", fontsize=7)
+        axis.set_yticks(range(len(metrics)), metrics, fontsize=7)
+        axis.set_title(name, fontsize=9)
+    figure.colorbar(images[0], ax=axes, label="Spearman rank correlation (–)")
+    more = f" (the first {len(shown)} of {len(groups)} groups)" if len(shown) < len(groups) else ""
+    _title(figure, f"{study.name}: rank correlation of each summary metric with each dispersed parameter "
+                   f"(sensitivity.csv; –: the metric does not vary){more}")
+    yield "sensitivity.png", figure
 
 
 def _dispersed(study: Study, row: dict[str, Any], path: str) -> float:

@@ -1,7 +1,9 @@
 """Tables and files of a trade study: ``cases.csv`` (one row per case and planner),
 ``summary.csv`` / ``summary.md`` (statistics per planner, and per grid point when there is
 Monte Carlo), ``requirements.csv`` (per planner, the fraction of cases that meet every requirement,
-with its Wilson interval; also in ``summary.md``), the resolved ``study.yaml``, the plots
+with its Wilson interval; also in ``summary.md``), for a Monte Carlo study the robustness tables
+``robustness.csv``, ``sensitivity.csv`` and ``worst_cases.csv`` (:mod:`scenarios.study.robustness`;
+also in ``summary.md``), the resolved ``study.yaml``, the plots
 (:mod:`scenarios.study.plots`) and the interactive ``report.html`` (:mod:`scenarios.study.html`).
 
 A case's rows are flattened and written as a run's are (:mod:`scenarios.output.tables`: the same
@@ -37,9 +39,10 @@ if TYPE_CHECKING:  # the engine imports this module lazily
     from scenarios.study.engine import SweepResults
 
 STATISTICS = ("count", "failures", "mean", "std", "median", "p5", "p95", "min", "max")
-REQUIREMENT_STATISTICS = ("completed", "met", "fraction_met", "wilson_low", "wilson_high")
-"""The columns of ``requirements.csv`` after the grouping keys: rows that completed (not
-``crashed``), those ``ok`` (meeting every requirement), their fraction and its Wilson 95 % interval."""
+PROPORTION_STATISTICS = ("completed", "met", "fraction_met", "wilson_low", "wilson_high")
+"""The columns of ``requirements.csv`` (and ``robustness.csv``) after the grouping keys: rows that
+completed (not ``crashed``), those meeting the criterion (``ok``: every requirement), their fraction
+and its Wilson 95 % interval (:func:`proportion`)."""
 WILSON_Z = 1.959963984540054
 """The standard normal quantile of 97.5 %: a two-sided 95 % interval."""
 _DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml's emitter when built: same text, 3x faster
@@ -103,7 +106,7 @@ def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], 
     rows : list of dict
         One per group and summary metric; a statistic without values is None.
     """
-    keys, groups = _groups(study, rows)
+    keys, groups = group_rows(study, rows)
     columns = [*keys, "metric", *STATISTICS]
     table = []
     for members in groups.values():
@@ -148,11 +151,49 @@ def wilson_interval(successes: int, trials: int, z: float = WILSON_Z) -> tuple[f
     scale = 1.0 + z * z / trials
     centre = (p + z * z / (2 * trials)) / scale
     half = z / scale * math.sqrt(p * (1.0 - p) / trials + z * z / (4.0 * trials * trials))
-    return max(0.0, centre - half), min(1.0, centre + half)
+    # at 0 (n) successes the bound is 0 (1) exactly, not the rounding of centre -/+ half
+    return 0.0 if successes == 0 else max(0.0, centre - half), 1.0 if successes == trials else min(1.0, centre + half)
 
 
-def _groups(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], dict[tuple, list[dict[str, Any]]]]:
-    """The grouping keys (the grid point under Monte Carlo, then the label) and the rows of each group."""
+def proportion(met: int, completed: int) -> dict[str, Any]:
+    """The statistics of :data:`PROPORTION_STATISTICS` for ``met`` successes among ``completed`` cases.
+
+    Parameters
+    ----------
+    met : int
+        Cases meeting the criterion, 0 to ``completed``.
+    completed : int
+        Cases that completed (non-negative).
+
+    Returns
+    -------
+    dict
+        ``completed``, ``met``, ``fraction_met``, ``wilson_low`` and ``wilson_high``
+        (:func:`wilson_interval`); the last three are None without completed cases.
+    """
+    interval = wilson_interval(met, completed)
+    return {"completed": completed, "met": met, "fraction_met": met / completed if completed else None,
+            "wilson_low": None if interval is None else interval[0],
+            "wilson_high": None if interval is None else interval[1]}
+
+
+def group_rows(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], dict[tuple, list[dict[str, Any]]]]:
+    """The grouping keys of the study's tables and the rows of each group.
+
+    Parameters
+    ----------
+    study : Study
+        The study (its grid paths and samples).
+    rows : list of dict
+        The ``cases.csv`` rows (:func:`case_table`).
+
+    Returns
+    -------
+    keys : list of str
+        The grid paths under a grid of Monte Carlo samples, then ``label``.
+    groups : dict
+        The keys' values (as JSON text) -> the group's rows, in the order first met.
+    """
     by_point = study.samples > 1 and bool(study.grid_paths)
     keys = (study.grid_paths if by_point else []) + ["label"]
     groups: dict[tuple, list[dict[str, Any]]] = {}
@@ -178,22 +219,18 @@ def requirement_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[st
     Returns
     -------
     columns : list of str
-        The grouping keys and :data:`REQUIREMENT_STATISTICS`.
+        The grouping keys and :data:`PROPORTION_STATISTICS`.
     rows : list of dict
         One per group; the fraction and the interval are None without completed cases.
     """
-    keys, groups = _groups(study, rows)
+    keys, groups = group_rows(study, rows)
     table = []
     for members in groups.values():
         completed = [r for r in members if r["status"] != "crashed"]
-        met = sum(r["status"] == "ok" for r in completed)
-        interval = wilson_interval(met, len(completed))
         line = {k: members[0].get(k) for k in keys}
-        line.update(completed=len(completed), met=met, fraction_met=met / len(completed) if completed else None,
-                    wilson_low=None if interval is None else interval[0],
-                    wilson_high=None if interval is None else interval[1])
+        line.update(proportion(sum(r["status"] == "ok" for r in completed), len(completed)))
         table.append(line)
-    return [*keys, *REQUIREMENT_STATISTICS], table
+    return [*keys, *PROPORTION_STATISTICS], table
 
 
 def _table_lines(columns: list[str], rows: list[dict[str, Any]]) -> list[str]:
@@ -202,7 +239,7 @@ def _table_lines(columns: list[str], rows: list[dict[str, Any]]) -> list[str]:
 
 
 def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], missing: int,
-              requirements: tuple[list[str], list[dict[str, Any]]] | None = None) -> str:
+              requirements: tuple[list[str], list[dict[str, Any]]] | None = None, robustness: str = "") -> str:
     out = [f"# {study.name}", "", (f"{len(study.cases)} cases ({missing} missing), "
                                    f"{study.samples} Monte Carlo sample(s) per grid point, slewbench "
                                    f"{package_version()}."), ""]
@@ -213,6 +250,8 @@ def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], miss
         out += ["## Cases meeting every requirement", "",
                 "Rows whose status is ok among the completed ones (not crashed), with the Wilson 95 % interval.", ""]
         out += _table_lines(*requirements) + [""]
+    if robustness:
+        out += [robustness]
     return "\n".join(out)
 
 
@@ -238,6 +277,41 @@ def resolved_study(study: Study) -> dict[str, Any]:
     data["resolved"] = {"version": run_environment.pop("slewbench"), "date_utc": utc_stamp(), **run_environment,
                         "cases": len(study.cases), "case_seeds": [case.seed for case in study.cases]}
     return data
+
+
+ROBUSTNESS_FILES = ("robustness.csv", "sensitivity.csv", "worst_cases.csv")
+"""The robustness tables of a Monte Carlo study (:mod:`scenarios.study.robustness`), in the order of
+:func:`robustness_tables`."""
+
+Table = tuple[list[str], list[dict[str, Any]]]
+
+
+def robustness_tables(study: Study, rows: list[dict[str, Any]]) -> tuple[Table, Table, Table] | None:
+    """The robustness tables of a study with Monte Carlo samples or thresholds.
+
+    Parameters
+    ----------
+    study : Study
+        The study.
+    rows : list of dict
+        The ``cases.csv`` rows (:func:`case_table`).
+
+    Returns
+    -------
+    tuple or None
+        The proportions, the rank correlations and the worst cases
+        (:func:`scenarios.study.robustness.proportion_table`, ``sensitivity_table``,
+        ``worst_table``), written as :data:`ROBUSTNESS_FILES`; None for a study with neither
+        Monte Carlo samples nor ``robustness.thresholds``.
+    """
+    if study.samples <= 1 and not study.mc_paths and not study.thresholds:
+        return None
+    from scenarios.study.robustness import (
+        proportion_table,
+        sensitivity_table,
+        worst_table,
+    )
+    return proportion_table(study, rows), sensitivity_table(study, rows), worst_table(study, rows)
 
 
 def write_report(results: SweepResults, directory: str | Path, plots: bool = True) -> list[str]:
@@ -266,9 +340,16 @@ def write_report(results: SweepResults, directory: str | Path, plots: bool = Tru
     columns, rows = case_table(study, results.records)
     summary_columns, summary = summary_table(study, rows)
     requirements = requirement_table(study, rows)
+    robustness = robustness_tables(study, rows)
+    markdown = ""
+    if robustness is not None:
+        from scenarios.study.robustness import robustness_markdown
+        markdown = robustness_markdown(study, rows, *robustness)
     files = {"cases.csv": csv_text(columns, rows), "summary.csv": csv_text(summary_columns, summary),
              "requirements.csv": csv_text(*requirements),
-             "summary.md": _markdown(study, summary_columns, summary, results.missing, requirements),
+             **({} if robustness is None else {name: csv_text(*table) for name, table in zip(ROBUSTNESS_FILES,
+                                                                                             robustness)}),
+             "summary.md": _markdown(study, summary_columns, summary, results.missing, requirements, markdown),
              "study.yaml": yaml.dump(resolved_study(study), Dumper=_DUMPER, sort_keys=False, width=120)}
     staging = new_staging(directory)
     try:
@@ -280,7 +361,8 @@ def write_report(results: SweepResults, directory: str | Path, plots: bool = Tru
             (staging / "plots").mkdir()
             write_plots(study, rows, staging / "plots")
             (staging / "report.html").write_text(study_report(study, (columns, rows), (summary_columns, summary),
-                                                              requirements, results.missing), encoding="utf-8")
+                                                              requirements, results.missing, robustness),
+                                                 encoding="utf-8")
         return commit_sweep_outputs(directory, staging)
     finally:
         shutil.rmtree(staging, ignore_errors=True)

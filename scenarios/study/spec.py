@@ -300,14 +300,17 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
             dispersions.append((varied, dispersion))
     summary = STUDY["summary"].value(root)
     execution = Execution(**STUDY["execution"].value(root))
+    robustness = STUDY["robustness"].value(root)
     STUDY["resolved"].value(root)  # written into study.yaml for the record (version, case seeds)
     root.finish()
     _mark_independent(seen)
     study = Study(name, source, base, [v.path for axis in axes for v in axis.varied], [v.path for v, _ in dispersions],
-                  samples, method, seed, summary, execution, raw=copy.deepcopy(data))
+                  samples, method, seed, summary, execution, raw=copy.deepcopy(data),
+                  thresholds=robustness["thresholds"], worst=robustness["worst"])
     expansion = _Expansion(study, axes, dispersions, version or package_version(), progress)
     study.cases = expansion.cases()
-    _check_summary(summary, expansion.columns)
+    _check_summary([(f"summary[{index}]", column) for index, column in enumerate(summary)]
+                   + [(f"robustness.thresholds.{column}", column) for column in study.thresholds], expansion.columns)
     return study
 
 
@@ -318,10 +321,10 @@ def _requirement_columns(scenario: Scenario) -> list[str]:
             for name, names in fields[scope].items() for field in names]
 
 
-def _check_summary(summary: list[str], columns: dict[str, None]) -> None:
-    """Refuse a summary entry naming a requirement column that no case gives (a typo would
-    summarise nothing, silently)."""
-    for index, column in enumerate(summary):
+def _check_summary(summary: list[tuple[str, str]], columns: dict[str, None]) -> None:
+    """Refuse a summary entry (or threshold), given as ``(where, column)``, naming a requirement
+    column that no case gives (a typo would summarise nothing, silently)."""
+    for where, column in summary:
         if not is_requirement_column(column) or column in columns:
             continue
         prefix, _, name, field = column.split(".")
@@ -338,7 +341,7 @@ def _check_summary(summary: list[str], columns: dict[str, None]) -> None:
             why = f"requirement {name!r} has no field {field!r}; its columns are {own}"
         listed = list(columns)
         more = f" ... ({len(listed)} in all)" if len(listed) > 12 else ""
-        raise ScenarioError(f"summary[{index}]", f"{column!r}: {why}"
+        raise ScenarioError(where, f"{column!r}: {why}"
                             + (f" (the study's requirement columns: {listed[:12]}{more})" if listed else ""))
 
 

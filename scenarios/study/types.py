@@ -97,6 +97,11 @@ class Study:
         The expanded cases, in order.
     raw : dict
         The study mapping as given (for ``study.yaml``).
+    thresholds : dict
+        Metric column -> ``(sense, bound)`` with sense ``at_most`` or ``at_least``
+        (``robustness.thresholds``): the robustness table's criteria beside every requirement.
+    worst : int
+        Worst cases listed per planner row and summary metric (``robustness.worst``).
     """
 
     name: str
@@ -111,6 +116,8 @@ class Study:
     execution: Execution
     cases: list[Case] = field(default_factory=list)
     raw: dict[str, Any] = field(default_factory=dict)
+    thresholds: dict[str, tuple[str, float]] = field(default_factory=dict)
+    worst: int = 5
 
     @property
     def varied_paths(self) -> list[str]:

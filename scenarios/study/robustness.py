@@ -1,0 +1,377 @@
+"""Robustness outputs of a Monte Carlo study: how often each planner row meets its requirements and
+the study's metric thresholds, how each summary metric ranks with each dispersed parameter, and the
+worst cases.
+
+Three tables, each per planner row label (and per grid point under a grid of Monte Carlo samples,
+as ``summary.csv`` groups them), written as ``robustness.csv``, ``sensitivity.csv`` and
+``worst_cases.csv`` and shown in ``summary.md`` and ``report.html``:
+
+* :func:`proportion_table`: the fraction of the completed cases (not ``crashed``) that meet every
+  requirement (status ``ok``, as ``requirements.csv``) and, for each ``robustness.thresholds``
+  entry, whose metric is at most (or at least) its bound, each with its Wilson 95 % interval
+  (:func:`scenarios.study.report.wilson_interval`). A completed row without a value (a failed
+  planner) does not meet a threshold.
+* :func:`sensitivity_table`: Spearman's rank correlation of each summary metric with each dispersed
+  parameter over the rows where the metric has a value; a dispersed vector (or matrix) gives one
+  parameter per component (``spacecraft.inertia[1]``), and components that do not vary are left
+  out. Ties get their average rank.
+* :func:`worst_table`: the ``robustness.worst`` cases with the largest value of each summary metric
+  (the smallest for a metric with an ``at_least`` threshold), by case id, with their seeds, to be
+  re-run in full with ``slewbench sweep DIR --case N``.
+"""
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+import numpy as np
+
+from scenarios.output.tables import is_missing, text_cell
+from scenarios.schema.study import CASE_SEED
+from scenarios.study.report import PROPORTION_STATISTICS, group_rows, proportion
+from scenarios.study.types import Study
+
+__all__ = ["EVERY_REQUIREMENT", "SENSITIVITY_STATISTICS", "WORST_COLUMNS", "criterion_text", "parameter_columns",
+           "proportion_table", "robustness_lines", "robustness_markdown", "sensitivity_table", "spearman",
+           "worst_table"]
+
+EVERY_REQUIREMENT = "every requirement"
+"""The criterion of the rows whose status is ``ok``."""
+SENSITIVITY_STATISTICS = ("cases", "spearman_rho")
+"""The columns of ``sensitivity.csv`` after the grouping keys, ``metric`` and ``parameter``: the rows
+with a value of the metric, and their rank correlation (None when either side does not vary)."""
+WORST_COLUMNS = ("metric", "rank", "case", "seed", "value", "status")
+"""The columns of ``worst_cases.csv`` after the grouping keys."""
+MIN_CASES = 3
+"""Fewest rows a rank correlation is computed from."""
+NOT_OK_LISTED = 20
+"""Rows not ok named per group in ``summary.md`` (the rest are counted)."""
+
+
+def criterion_text(metric: str, sense: str, bound: float) -> str:
+    """A threshold as the tables name it: ``cl.final_error_deg <= 0.1``.
+
+    Parameters
+    ----------
+    metric : str
+        The metric column.
+    sense : {"at_most", "at_least"}
+        How the metric compares with the bound.
+    bound : float
+        The bound, in the metric's unit.
+
+    Returns
+    -------
+    str
+        The metric, ``<=`` or ``>=``, and the bound (``%g``).
+    """
+    return f"{metric} {'<=' if sense == 'at_most' else '>='} {bound:g}"
+
+
+def _number(value: Any) -> float:
+    """A metric value as a float; NaN when missing or not a number."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or is_missing(value):
+        return math.nan
+    return float(value)
+
+
+def proportion_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
+    """Per group: the fraction of completed cases meeting every requirement, then each threshold.
+
+    Parameters
+    ----------
+    study : Study
+        The study (its grid paths, samples and ``thresholds``).
+    rows : list of dict
+        The ``cases.csv`` rows (:func:`scenarios.study.report.case_table`).
+
+    Returns
+    -------
+    columns : list of str
+        The grouping keys, ``criterion`` and :data:`~scenarios.study.report.PROPORTION_STATISTICS`.
+    rows : list of dict
+        One per group and criterion (:data:`EVERY_REQUIREMENT` first); the fraction and its
+        interval are None without completed cases.
+    """
+    keys, groups = group_rows(study, rows)
+    table = []
+    for members in groups.values():
+        completed = [r for r in members if r["status"] != "crashed"]
+        criteria = [(EVERY_REQUIREMENT, sum(r["status"] == "ok" for r in completed))]
+        for metric, (sense, bound) in study.thresholds.items():
+            values = np.array([_number(r.get(metric)) for r in completed])
+            with np.errstate(invalid="ignore"):
+                meets = values <= bound if sense == "at_most" else values >= bound
+            criteria.append((criterion_text(metric, sense, bound), int(np.sum(meets & np.isfinite(values)))))
+        for criterion, met in criteria:
+            line = {k: members[0].get(k) for k in keys}
+            line.update(criterion=criterion, **proportion(met, len(completed)))
+            table.append(line)
+    return [*keys, "criterion", *PROPORTION_STATISTICS], table
+
+
+def _components(value: Any) -> list[float] | None:
+    """A dispersed value's numbers: one for a scalar, each component of a vector or matrix recorded
+    as JSON text (row by row); None when it holds anything else."""
+    if isinstance(value, str):
+        try:
+            value = json.loads(value)
+        except ValueError:
+            return None
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)):
+        return [float(value)]
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return None
+    return [float(v) for v in array.ravel()] if array.size else None
+
+
+def parameter_columns(study: Study, rows: list[dict[str, Any]]) -> list[tuple[str, np.ndarray]]:
+    """The dispersed parameters as numbers: one column per scalar path, one per component of a vector
+    (``simulation.initial_rate_error[0]``) or matrix (``spacecraft.inertia[4]``, row by row).
+
+    Parameters
+    ----------
+    study : Study
+        The study (its dispersed paths and their dispersions; ``case_seed`` ones are not parameters).
+    rows : list of dict
+        The ``cases.csv`` rows.
+
+    Returns
+    -------
+    list of (str, ndarray)
+        The parameter's name and its value in each row (NaN where a row has none); parameters that
+        take one value in every row are left out.
+    """
+    dispersions = (study.raw.get("monte_carlo") or {}).get("dispersions") or {}
+    columns = []
+    for path in study.mc_paths:
+        if dispersions.get(path) == CASE_SEED.name:
+            continue
+        parsed = [_components(row.get(path)) for row in rows]
+        size = max((len(p) for p in parsed if p is not None), default=0)
+        for k in range(size):
+            values = np.array([p[k] if p is not None and len(p) == size else math.nan for p in parsed])
+            finite = values[np.isfinite(values)]
+            if finite.size and np.ptp(finite) > 0:
+                columns.append((path if size == 1 else f"{path}[{k}]", values))
+    return columns
+
+
+def _ranks(values: np.ndarray) -> np.ndarray:
+    """Ranks from 1, ties given the average of the ranks they span."""
+    order = np.argsort(values, kind="mergesort")
+    ordered = values[order]
+    ranks = np.empty(values.size)
+    start = 0
+    while start < values.size:
+        stop = start + 1
+        while stop < values.size and ordered[stop] == ordered[start]:
+            stop += 1
+        ranks[order[start:stop]] = (start + stop + 1) / 2.0  # the mean of ranks start+1 .. stop
+        start = stop
+    return ranks
+
+
+def spearman(x: np.ndarray, y: np.ndarray) -> float | None:
+    """Spearman's rank correlation: the Pearson correlation of the ranks (ties averaged).
+
+    Parameters
+    ----------
+    x, y : (n,) ndarray
+        Paired values; pairs with a non-finite value are left out.
+
+    Returns
+    -------
+    float or None
+        In [-1, 1]; None with fewer than :data:`MIN_CASES` pairs or when either side's ranks do
+        not vary.
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    keep = np.isfinite(x) & np.isfinite(y)
+    if keep.sum() < MIN_CASES:
+        return None
+    rx, ry = _ranks(x[keep]), _ranks(y[keep])
+    rx, ry = rx - rx.mean(), ry - ry.mean()
+    scale = math.sqrt(float(np.dot(rx, rx)) * float(np.dot(ry, ry)))
+    if scale == 0.0:
+        return None
+    return max(-1.0, min(1.0, float(np.dot(rx, ry)) / scale))
+
+
+def sensitivity_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
+    """Spearman's rank correlation of each summary metric with each dispersed parameter, per group.
+
+    Parameters
+    ----------
+    study : Study
+        The study (its summary metrics and dispersions).
+    rows : list of dict
+        The ``cases.csv`` rows.
+
+    Returns
+    -------
+    columns : list of str
+        The grouping keys, ``metric``, ``parameter`` and :data:`SENSITIVITY_STATISTICS`.
+    rows : list of dict
+        One per group, summary metric and parameter (:func:`parameter_columns`); empty without
+        dispersed parameters.
+    """
+    keys, groups = group_rows(study, rows)
+    table = []
+    parameters = parameter_columns(study, rows)
+    position = {id(row): k for k, row in enumerate(rows)}
+    for members in groups.values():
+        index = np.array([position[id(r)] for r in members], dtype=int)
+        for metric in study.summary:
+            values = np.array([_number(r.get(metric)) for r in members])
+            for name, column in parameters:
+                line = {k: members[0].get(k) for k in keys}
+                line.update(metric=metric, parameter=name,
+                            cases=int(np.sum(np.isfinite(values) & np.isfinite(column[index]))),
+                            spearman_rho=spearman(column[index], values))
+                table.append(line)
+    return [*keys, "metric", "parameter", *SENSITIVITY_STATISTICS], table
+
+
+def worst_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
+    """The ``study.worst`` worst cases of each summary metric, per group.
+
+    Parameters
+    ----------
+    study : Study
+        The study (its summary metrics, ``worst`` and ``thresholds``).
+    rows : list of dict
+        The ``cases.csv`` rows.
+
+    Returns
+    -------
+    columns : list of str
+        The grouping keys and :data:`WORST_COLUMNS`.
+    rows : list of dict
+        Per group and metric, ranks 1 to ``worst`` among the rows with a value: the largest values
+        first (the smallest for a metric with an ``at_least`` threshold); ties in case order. A
+        metric with one value in every row of the group lists none.
+    """
+    keys, groups = group_rows(study, rows)
+    table = []
+    for members in groups.values():
+        for metric in study.summary:
+            least = study.thresholds.get(metric, ("at_most", 0.0))[0] == "at_least"
+            valued = [(v, r) for v, r in ((_number(r.get(metric)), r) for r in members) if math.isfinite(v)]
+            if len({v for v, _ in valued}) < 2:
+                continue  # one value in every row: no case is worse than another
+            valued.sort(key=lambda pair: pair[0] if least else -pair[0])  # stable: ties keep case order
+            for rank, (value, row) in enumerate(valued[:study.worst], start=1):
+                line = {k: members[0].get(k) for k in keys}
+                line.update(metric=metric, rank=rank, case=row["case"], seed=row.get("seed"), value=value,
+                            status=row["status"])
+                table.append(line)
+    return [*keys, *WORST_COLUMNS], table
+
+
+def _lines(columns: list[str], rows: list[dict[str, Any]]) -> list[str]:
+    return (["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+            + ["| " + " | ".join(text_cell(row.get(c)) for c in columns) + " |" for row in rows])
+
+
+def _not_ok(study: Study, rows: list[dict[str, Any]]) -> list[str]:
+    """One line per group with rows not ok: their case ids and statuses."""
+    keys, groups = group_rows(study, rows)
+    lines = []
+    for members in groups.values():
+        bad = [r for r in members if r["status"] != "ok"]
+        if not bad:
+            continue
+        named = ", ".join(f"{r['case']} ({r['status']})" for r in bad[:NOT_OK_LISTED])
+        more = f" and {len(bad) - NOT_OK_LISTED} more" if len(bad) > NOT_OK_LISTED else ""
+        group = ", ".join(f"{k}={text_cell(members[0].get(k))}" for k in keys)
+        lines.append(f"* {group}: {len(bad)} of {len(members)} not ok: case {named}{more}")
+    return lines
+
+
+def robustness_markdown(study: Study, rows: list[dict[str, Any]],
+                        proportions: tuple[list[str], list[dict[str, Any]]],
+                        sensitivity: tuple[list[str], list[dict[str, Any]]],
+                        worst: tuple[list[str], list[dict[str, Any]]]) -> str:
+    """The robustness sections of ``summary.md``.
+
+    Parameters
+    ----------
+    study : Study
+        The study.
+    rows : list of dict
+        The ``cases.csv`` rows (for the cases not ok).
+    proportions, sensitivity, worst : (list of str, list of dict)
+        :func:`proportion_table`, :func:`sensitivity_table` and :func:`worst_table`.
+
+    Returns
+    -------
+    str
+        Markdown: the proportions, the cases not ok by id, the rank correlations (one column per
+        parameter) and the worst cases.
+    """
+    out = ["## Robustness", "",
+           ("Fraction of the completed cases (not crashed) meeting every requirement (status ok) and each "
+            "threshold of `robustness.thresholds`, with the Wilson 95 % interval."), ""]
+    out += _lines(*proportions) + [""]
+    not_ok = _not_ok(study, rows)
+    if not_ok:
+        out += ["Rows not ok, by case id (re-run one in full with `slewbench sweep DIR --case N`):", "", *not_ok, ""]
+    columns, table = sensitivity
+    if table:
+        parameters = list(dict.fromkeys(line["parameter"] for line in table))
+        keys = columns[:columns.index("metric")]
+        wide: dict[tuple, dict[str, Any]] = {}
+        for line in table:
+            entry = wide.setdefault(tuple(json.dumps(line.get(k)) for k in keys) + (line["metric"],),
+                                    {**{k: line.get(k) for k in keys}, "metric": line["metric"]})
+            entry[line["parameter"]] = line["spearman_rho"]
+        out += ["## Sensitivity", "", ("Spearman rank correlation of each summary metric (rows) with each dispersed "
+                                       "parameter (columns; a vector per component), over the rows where the metric "
+                                       "has a value; empty: the metric does not vary."), ""]
+        out += _lines([*keys, "metric", *parameters], list(wide.values())) + [""]
+    if worst[1]:
+        out += ["## Worst cases", "", (f"The {study.worst} largest values of each summary metric (smallest for "
+                                       "an at_least threshold), by case id."), ""]
+        out += _lines(*worst) + [""]
+    return "\n".join(out)
+
+
+def robustness_lines(proportions: tuple[list[str], list[dict[str, Any]]],
+                     worst: tuple[list[str], list[dict[str, Any]]]) -> list[str]:
+    """The robustness summary ``slewbench sweep`` prints: per group, each criterion's fraction with
+    its Wilson interval, and the worst cases of each summary metric by id.
+
+    Parameters
+    ----------
+    proportions, worst : (list of str, list of dict)
+        :func:`proportion_table` and :func:`worst_table`.
+
+    Returns
+    -------
+    list of str
+        One line per group and criterion (``  fast: every requirement 98/100 = 0.98 [0.930, 0.994]``),
+        then one per group and metric (``  fast: worst cl.int_u: case 17, 3, 55``).
+    """
+    columns, table = proportions
+    keys = columns[:columns.index("criterion")]
+
+    def group(line: dict[str, Any]) -> str:
+        return ", ".join(text_cell(line.get(k)) for k in keys)
+
+    lines = []
+    for line in table:
+        if line["fraction_met"] is None:
+            continue
+        lines.append(f"  {group(line)}: {line['criterion']} {line['met']}/{line['completed']} = "
+                     f"{line['fraction_met']:.3g} [{line['wilson_low']:.3f}, {line['wilson_high']:.3f}]")
+    listed: dict[tuple[str, str], list[str]] = {}
+    for line in worst[1]:
+        listed.setdefault((group(line), line["metric"]), []).append(str(line["case"]))
+    lines += [f"  {name}: worst {metric}: case {', '.join(cases)}" for (name, metric), cases in listed.items()]
+    return lines

@@ -1,0 +1,387 @@
+"""Dispersions that provably arrive (issue 28, part 4).
+
+A Monte Carlo study that disperses a scenario path must change what the path names in the loaded
+scenario, and nothing else: the spacecraft (and the plant the simulator integrates), the orbit, the
+environment, the manoeuvre, the planners' bounds, one planner's or controller's options, the
+simulation settings or the requirements. Basilisk's users were bitten by dispersions that silently
+did not reach the simulation (its issue 1164); here every dispersible path has a case.
+
+How it works: each entry of :data:`ARRIVALS` (scenario keys, written by hand) and of the generated
+planner, controller and field-model option entries names a scenario path, a base scenario, a new
+value and the parts of the loaded :class:`~scenarios.schema.loader.Scenario` that the value must
+change (:data:`PARTS`). The value is set by a one-case study, a Monte Carlo dispersion
+(``uniform: [v, v]`` draws exactly ``v``; a matrix is scaled) or a one-value grid for integers, so it
+travels the study's own path machinery; the case's scenario is loaded and each part compared with
+the base's. :func:`test_every_dispersible_key_has_an_arrival_case` makes the table complete: every
+numeric key of the generated schema reference (scenario keys, planner and controller options,
+magnetic field options) must have an entry, or a reason in :data:`NOT_DISPERSIBLE`.
+
+Adding a key (for example the truth model's ``truth.*`` keys): give its reference key (as
+``slewbench schema`` lists it) an :class:`Arrival` in :data:`ARRIVALS` with the parts it must change
+(a truth key changes ``plant`` and nothing else: not ``spacecraft``, which is the design model the
+planners and controllers see), and, if the loaded scenario gains a part of its own, add a function
+for it to :data:`PARTS` (every other entry then checks that it does *not* change that part).
+"""
+from __future__ import annotations
+
+import copy
+import dataclasses
+import math
+import typing
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+import pytest
+
+from controllers import CONTROLLERS
+from ocp.options import numeric_leaves, option_fields
+from planners import PLANNERS
+from scenarios.schema.loader import Scenario, parse_scenario
+from scenarios.schema.read import read_yaml
+from scenarios.schema.reference import reference_parts
+from scenarios.study.paths import get_path, parse_path
+from scenarios.study.spec import parse_study
+
+# --- the parts of a loaded scenario ---------------------------------------------------------------
+
+
+def plain(value: Any) -> Any:
+    """A value as nested tuples of plain numbers and text, for comparison (dataclasses by their
+    fields, arrays by their numbers, other objects by their public attributes)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return (type(value).__name__,) + tuple((f.name, plain(getattr(value, f.name)))
+                                               for f in dataclasses.fields(value))
+    if isinstance(value, np.ndarray):
+        return ("array", value.shape, tuple(value.ravel().tolist()))
+    if isinstance(value, dict):
+        return tuple(sorted((str(k), plain(v)) for k, v in value.items()))
+    if isinstance(value, (list, tuple)):
+        return tuple(plain(v) for v in value)
+    if value is None or isinstance(value, (bool, int, float, str, np.floating, np.integer)):
+        return value.item() if isinstance(value, (np.floating, np.integer)) else value
+    if callable(value) and not hasattr(value, "__dict__"):
+        return type(value).__name__
+    public = {k: v for k, v in vars(value).items() if not k.startswith("_")} if hasattr(value, "__dict__") else {}
+    return (type(value).__name__, plain(public))
+
+
+def _environment(scenario: Scenario) -> Any:
+    environment = scenario.problem.environment
+    return plain((environment.gravity_gradient, environment.magnetic_field, environment.disturbance_torque))
+
+
+def _maneuver(scenario: Scenario) -> Any:
+    p = scenario.problem
+    return plain((p.q0, p.omega0, p.qf, p.omegaf, p.duration, p.wheel_momentum0))
+
+
+def _bounds(scenario: Scenario) -> Any:
+    p = scenario.problem
+    return plain((p.max_rate, p.actuator_margin, p.pointing))
+
+
+PARTS: dict[str, Callable[[Scenario], Any]] = {
+    "spacecraft": lambda s: plain(s.problem.spacecraft),  # the design model planners and controllers see
+    "plant": lambda s: s.problem.model.fingerprint,  # every number of the model the simulator integrates
+    "orbit": lambda s: plain(s.problem.environment.orbit),
+    "environment": _environment,
+    "maneuver": _maneuver,
+    "planning bounds": _bounds,  # what the planners must honour: rate bound, actuator margin, pointing
+    "simulation": lambda s: plain(s.simulation),
+    "requirements": lambda s: plain(s.requirements),
+}
+"""The parts a value may change: name -> the part of a loaded scenario, comparable. Each planner row
+(``planner:<label>``) and controller (``controller:<label>``) is a part of its own, its options."""
+
+
+def parts(scenario: Scenario) -> dict[str, Any]:
+    found = {name: part(scenario) for name, part in PARTS.items()}
+    found.update({f"planner:{p.label}": plain(p.options) for p in scenario.planners})
+    found.update({f"controller:{c.label}": plain(c.options) for c in scenario.controllers})
+    return found
+
+
+# --- base scenarios --------------------------------------------------------------------------------
+
+FULL = {
+    "name": "arrival",
+    "spacecraft": {"inertia": [2.0, 3.0, 4.0],
+                   "wheels": {"max_torque": 0.05, "max_momentum": 0.5, "spin_inertia": 1.0e-4},
+                   "magnetorquers": {"max_dipole": 0.2}, "torquers": {"max_torque": 0.01},
+                   "sensors": {"tracker": {"boresight": [0, 0, 1]}}},
+    "orbit": {"altitude_km": 500.0, "inclination_deg": 51.6},
+    "environment": {"magnetic_field": {"model": "tilted_dipole"}, "disturbance_torque": [1e-6, 0, 0]},
+    "maneuver": {"duration": 30.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
+                 "final": {"q": [0.9238795, 0.3826834, 0, 0], "omega": [0, 0, 0]}, "max_rate": 0.2},
+    "planners": [{"name": "eigenaxis", "label": "smooth"},
+                 {"name": "eigenaxis", "label": "fast", "options": {"profile": "min_time", "torque_fraction": 0.8}}],
+    "controller": {"name": "augmented_quaternion_feedback", "options": {"kp": 0.2, "kd": 0.6}},
+    "simulation": {"sample_time": 1.0, "duration": 35.0, "fine_settling_tolerance_deg": 0.1},
+    "requirements": {"pointing": {"sun": {"sensor": "tracker", "keep_out": {"inertial": [0, 1, 0]},
+                                          "angle_deg": 10.0, "window": [0.0, 30.0]}},
+                     "actuators": {"margin": 0.1}, "rate": {"max": 0.3},
+                     "final": {"after_s": 2.0, "error_deg": 1.0, "rate": 0.01}},
+}
+"""A scenario with every section a scenario key lives in."""
+
+KEEP_IN = copy.deepcopy(FULL)
+KEEP_IN["requirements"]["pointing"] = {"antenna": {"sensor": "tracker", "keep_in": {"inertial": [0, 0, 1]},
+                                                   "angle_deg": 80.0}}
+KEEP_IN["requirements"].pop("rate")
+KEEP_IN["maneuver"]["max_rate"] = None
+IGRF = copy.deepcopy(FULL)
+IGRF["epoch"] = "2025-03-20T12:00:00Z"
+IGRF["environment"]["magnetic_field"] = {"model": "igrf", "step_s": 10.0}
+IGRF["requirements"] = None
+
+BASES: dict[str, dict[str, Any]] = {"full": FULL, "keep_in": KEEP_IN, "igrf": IGRF}
+
+
+@dataclass(frozen=True)
+class Arrival:
+    """One dispersible key: the scenario path set, the base it is set in, the value and the parts it
+    must change (and no other)."""
+
+    path: str
+    value: Any
+    changes: frozenset[str]
+    base: str = "full"
+
+
+def arrival(path: str, value: Any, *changes: str, base: str = "full") -> Arrival:
+    return Arrival(path, value, frozenset(changes), base)
+
+
+MODEL = ("spacecraft", "plant")
+ORBIT = ("orbit", "plant")
+ENVIRONMENT = ("environment", "plant")
+POINTING = ("requirements", "planning bounds")
+
+ARRIVALS: dict[str, Arrival] = {
+    "spacecraft.inertia": arrival("spacecraft.inertia", [2.2, 3.0, 4.1], *MODEL),
+    "spacecraft.wheels.axes": arrival("spacecraft.wheels.axes", [[1, 0, 0], [0, 1, 0], [0, 0.1, 1]], *MODEL),
+    "spacecraft.wheels.max_torque": arrival("spacecraft.wheels.max_torque", 0.06, *MODEL),
+    "spacecraft.wheels.max_momentum": arrival("spacecraft.wheels.max_momentum", [0.5, 0.6, 0.5], *MODEL),
+    "spacecraft.wheels.spin_inertia": arrival("spacecraft.wheels.spin_inertia", 2.0e-4, *MODEL),
+    "spacecraft.wheels.failed": arrival("spacecraft.wheels.failed", [2], *MODEL),
+    "spacecraft.magnetorquers.max_dipole": arrival("spacecraft.magnetorquers.max_dipole", 0.3, *MODEL),
+    "spacecraft.torquers.max_torque": arrival("spacecraft.torquers.max_torque", [0.01, 0.02, 0.01], *MODEL),
+    "spacecraft.sensors.boresight": arrival("spacecraft.sensors.tracker.boresight", [0, 0.1, 1], *POINTING),
+    "orbit.altitude_km": arrival("orbit.altitude_km", 550.0, *ORBIT),
+    "orbit.inclination_deg": arrival("orbit.inclination_deg", 97.4, *ORBIT),
+    "orbit.raan_deg": arrival("orbit.raan_deg", 30.0, *ORBIT),
+    "orbit.arg_latitude_deg": arrival("orbit.arg_latitude_deg", 45.0, *ORBIT),
+    "environment.disturbance_torque": arrival("environment.disturbance_torque", [1e-6, 2e-6, 0], *ENVIRONMENT),
+    "environment.magnetic_field.tilted_dipole.strength": arrival("environment.magnetic_field.strength", 7.0e15,
+                                                                 *ENVIRONMENT),
+    "environment.magnetic_field.tilted_dipole.tilt_deg": arrival("environment.magnetic_field.tilt_deg", 9.0,
+                                                                 *ENVIRONMENT),
+    "environment.magnetic_field.tilted_dipole.pole_longitude_deg": arrival(
+        "environment.magnetic_field.pole_longitude_deg", 100.0, *ENVIRONMENT),
+    "environment.magnetic_field.tilted_dipole.greenwich_angle_deg": arrival(
+        "environment.magnetic_field.greenwich_angle_deg", 20.0, *ENVIRONMENT),
+    "environment.magnetic_field.igrf.step_s": arrival("environment.magnetic_field.step_s", 5.0, *ENVIRONMENT,
+                                                      base="igrf"),
+    "environment.magnetic_field.igrf.span_s": arrival("environment.magnetic_field.span_s", 400.0, *ENVIRONMENT,
+                                                      base="igrf"),
+    "environment.magnetic_field.igrf.greenwich_angle_deg": arrival("environment.magnetic_field.greenwich_angle_deg",
+                                                                   20.0, *ENVIRONMENT, base="igrf"),
+    "maneuver.initial.q": arrival("maneuver.initial.q", [0.9998477, 0.0174524, 0, 0], "maneuver"),
+    "maneuver.initial.omega": arrival("maneuver.initial.omega", [0.001, 0, 0], "maneuver"),
+    "maneuver.initial.wheel_momentum": arrival("maneuver.initial.wheel_momentum", [0.01, 0, 0], "maneuver"),
+    "maneuver.final.q": arrival("maneuver.final.q", [0.9063078, 0.4226183, 0, 0], "maneuver"),
+    "maneuver.final.omega": arrival("maneuver.final.omega", [0, 0, 0.001], "maneuver"),
+    "maneuver.duration": arrival("maneuver.duration", 32.0, "maneuver"),
+    "maneuver.max_rate": arrival("maneuver.max_rate", 0.25, "planning bounds"),
+    "simulation.sample_time": arrival("simulation.sample_time", 0.5, "simulation"),
+    "simulation.duration": arrival("simulation.duration", 40.0, "simulation"),
+    "simulation.initial_attitude_error_deg": arrival("simulation.initial_attitude_error_deg", [1.0, -0.5, 0.2],
+                                                     "simulation"),
+    "simulation.initial_rate_error": arrival("simulation.initial_rate_error", [1e-3, 0, -1e-3], "simulation"),
+    "simulation.sensor_noise.attitude_deg": arrival("simulation.sensor_noise.attitude_deg", 0.01, "simulation"),
+    "simulation.sensor_noise.rate": arrival("simulation.sensor_noise.rate", 1e-5, "simulation"),
+    "simulation.sensor_noise.seed": arrival("simulation.sensor_noise.seed", 7, "simulation"),
+    "simulation.sensor_noise.magnetic_field": arrival("simulation.sensor_noise.magnetic_field", 1e-8, "simulation"),
+    "simulation.max_step": arrival("simulation.max_step", 0.04, "simulation"),
+    "simulation.settling_tolerance_deg": arrival("simulation.settling_tolerance_deg", 0.4, "simulation"),
+    "simulation.fine_settling_tolerance_deg": arrival("simulation.fine_settling_tolerance_deg", 0.05, "simulation"),
+    "simulation.detumble_tolerance": arrival("simulation.detumble_tolerance", 0.02, "simulation"),
+    "simulation.max_samples": arrival("simulation.max_samples", 50_000, "simulation"),
+    "requirements.pointing.angle_deg": arrival("requirements.pointing.sun.angle_deg", 12.0, *POINTING),
+    "requirements.pointing.window": arrival("requirements.pointing.sun.window", [1.0, 25.0], *POINTING),
+    "requirements.pointing.keep_out.inertial": arrival("requirements.pointing.sun.keep_out.inertial", [0, 1, 0.1],
+                                                       *POINTING),
+    "requirements.pointing.keep_in.inertial": arrival("requirements.pointing.antenna.keep_in.inertial",
+                                                      [0, 0.1, 1], *POINTING, base="keep_in"),
+    "requirements.actuators.margin": arrival("requirements.actuators.margin", 0.2, *POINTING),
+    "requirements.rate.max": arrival("requirements.rate.max", 0.35, "requirements"),  # maneuver.max_rate binds
+    "requirements.final.after_s": arrival("requirements.final.after_s", 3.0, "requirements"),
+    "requirements.final.error_deg": arrival("requirements.final.error_deg", 0.8, "requirements"),
+    "requirements.final.rate": arrival("requirements.final.rate", 0.02, "requirements"),
+}
+"""Scenario keys (by their key in the schema reference) and what setting them must change."""
+
+NOT_DISPERSIBLE: dict[str, str] = {
+    "maneuver.quaternion_order": "a word, not a number",
+}
+"""Keys of the reference that hold numbers but are not dispersed, with the reason."""
+
+REQUIREMENT_RATE_ALONE = arrival("requirements.rate.max", 0.35, *POINTING, base="keep_in")
+
+
+# --- planner, controller and field model options: generated ---------------------------------------
+
+def _shipped(kind: str) -> dict[str, list[tuple[dict[str, Any], str]]]:
+    """Registry name -> every (shipped scenario, YAML path of its row or controller) that uses it."""
+    from pathlib import Path
+
+    found: dict[str, list[tuple[dict[str, Any], str]]] = {}
+    for path in sorted(Path(__file__).parent.parent.joinpath("scenarios").glob("*.yaml")):
+        data = read_yaml(path)
+        if "study" in data:
+            continue
+        head = kind if kind == "planners" or "controllers" in data else "controller"
+        entries = data.get(head) if head != "controller" else [data.get("controller")]
+        for index, entry in enumerate(entries or []):
+            if isinstance(entry, dict):
+                where = head if head == "controller" else f"{head}[{index}]"
+                found.setdefault(entry["name"], []).append((data, where))
+    return found
+
+
+def _candidates(annotation: Any, default: Any) -> list[Any]:
+    """New values to try for a numeric option: its default moved within range, or typical values."""
+    args = [a for a in typing.get_args(annotation) if a is not type(None)] or [annotation]
+    if isinstance(default, bool):
+        return []
+    if isinstance(default, int):
+        return [default + 1, default * 2, default - 1]
+    if isinstance(default, float) and math.isfinite(default):
+        return [default * 1.25, default * 0.8, default * 2.0, default + 1.0] if default else [0.1, 1.0]
+    if isinstance(default, (list, tuple)) and default and all(isinstance(v, (int, float)) for v in default):
+        return [[float(v) * 1.25 or 0.1 for v in default]]
+    values: list[Any] = []
+    if int in args:
+        values += [3, 2, 10]
+    if float in args:
+        values += [0.05, 0.5, 1.0, 2.0]
+    if any(typing.get_origin(a) is list for a in args):
+        values += [[0.05, 0.05, 0.05], [1.0, 1.0, 1.0]]
+    return values
+
+
+def _option_arrivals() -> list[tuple[str, dict[str, Any], str, Any, str]]:
+    """(reference key, base scenario, option path, new value, changed part) for every numeric option
+    of every registered planner and controller, set in a shipped scenario that uses it: the first
+    (scenario, candidate value) the scenario loader accepts (value None when none is)."""
+    found = []
+    for kind, registry, shipped in (("planners", PLANNERS, _shipped("planners")),
+                                    ("controller", CONTROLLERS, _shipped("controllers"))):
+        for name, component in registry.items():
+            defaults = component.Options()
+            for option, (annotation, _) in option_fields(component.Options).items():
+                if not numeric_leaves(annotation):
+                    continue
+                accepted = None
+                for base, where in shipped.get(name, []):
+                    for candidate in _candidates(annotation, getattr(defaults, option)):
+                        try:
+                            parse_scenario(_with(base, f"{where}.options.{option}", candidate))
+                        except Exception:  # noqa: BLE001 - the loader refuses this one; try the next
+                            continue
+                        accepted = (base, where, candidate)
+                        break
+                    if accepted:
+                        break
+                base, where, value = accepted or (shipped.get(name, [({}, kind)])[0] + (None,))
+                entry = get_path(base, parse_path(where, where), where) if base else {}
+                part = f"{'planner' if kind == 'planners' else 'controller'}:{entry.get('label', name)}"
+                found.append((f"{kind}.{name}.{option}", base, f"{where}.options.{option}", value, part))
+    return found
+
+
+def _with(base: dict[str, Any], path: str, value: Any) -> dict[str, Any]:
+    from scenarios.study.paths import set_path
+
+    data = copy.deepcopy(base)
+    set_path(data, parse_path(path, path), value, path)
+    return data
+
+
+OPTION_ARRIVALS = _option_arrivals()
+
+
+# --- the check -------------------------------------------------------------------------------------
+
+def _study(base: dict[str, Any], path: str, value: Any) -> dict[str, Any]:
+    """A one-case study setting ``value`` at ``path``: a Monte Carlo dispersion for numbers (a draw
+    of ``uniform: [v, v]`` is ``v``; a matrix is scaled), a one-value grid for integers and lists of
+    lists."""
+    study: dict[str, Any] = {"study": "arrival", "scenario": copy.deepcopy(base)}
+    numbers = np.asarray(value, dtype=float) if not isinstance(value, bool) else None
+    integral = isinstance(value, int) or (isinstance(value, list) and all(isinstance(v, int) for v in value))
+    if numbers is not None and numbers.ndim <= 1 and not integral:
+        low = value if numbers.ndim == 0 else [float(v) for v in value]
+        study["monte_carlo"] = {"samples": 1, "seed": 1, "dispersions": {path: {"uniform": {"low": low, "high": low}}}}
+    else:
+        study["grid"] = {path: [value]}
+    return study
+
+
+def check_arrival(base: dict[str, Any], path: str, value: Any, changes: frozenset[str]) -> None:
+    study = parse_study(_study(base, path, value))
+    (case,) = study.cases
+    steps = parse_path(path, path)
+    assert np.allclose(np.asarray(get_path(case.scenario, steps, path), dtype=float),
+                       np.asarray(value, dtype=float), rtol=1e-15, atol=0.0), "the case does not hold the value"
+    before, after = parts(parse_scenario(copy.deepcopy(base))), parts(parse_scenario(case.scenario))
+    assert before.keys() == after.keys()
+    changed = {name for name in before if before[name] != after[name]}
+    assert changed == set(changes), f"{path} = {value!r} changed {sorted(changed)}, expected {sorted(changes)}"
+
+
+@pytest.mark.parametrize("key", sorted(ARRIVALS))
+def test_a_dispersed_scenario_key_changes_what_it_names_and_nothing_else(key):
+    entry = ARRIVALS[key]
+    check_arrival(BASES[entry.base], entry.path, entry.value, entry.changes)
+
+
+def test_a_rate_requirement_alone_bounds_the_planners():
+    """Without ``maneuver.max_rate`` the rate requirement is also the planners' bound."""
+    check_arrival(BASES[REQUIREMENT_RATE_ALONE.base], REQUIREMENT_RATE_ALONE.path, REQUIREMENT_RATE_ALONE.value,
+                  REQUIREMENT_RATE_ALONE.changes)
+
+
+@pytest.mark.parametrize("key, base, path, value, part", OPTION_ARRIVALS, ids=[a[0] for a in OPTION_ARRIVALS])
+def test_a_dispersed_option_changes_its_planner_or_controller_and_nothing_else(key, base, path, value, part):
+    assert value is not None, f"no new value of {key} is accepted in the shipped scenario that uses it"
+    check_arrival(base, path, value, frozenset({part}))
+
+
+def test_every_dispersible_key_has_an_arrival_case():
+    """Every key of the schema reference that takes numbers has an arrival case (or a reason)."""
+    covered = set(ARRIVALS) | set(NOT_DISPERSIBLE) | {key for key, *_ in OPTION_ARRIVALS}
+    numeric = []
+    for part in reference_parts():
+        if part.group.startswith("Study"):
+            continue
+        for entry in part.entries:
+            if any(word in entry.type for word in ("number", "integer", "matrix")):
+                numeric.append(entry.key)
+    missing = [key for key in numeric if key not in covered]
+    assert not missing, f"dispersible keys without an arrival case (add them to ARRIVALS): {missing}"
+    assert {"planner:smooth", "controller:augmented_quaternion_feedback"} <= set(parts(parse_scenario(FULL)))
+
+
+def test_the_parts_compare_equal_for_the_same_scenario_and_see_a_change():
+    """The comparison itself: two loads of one scenario are equal part by part, and a part that
+    differs is seen (so an empty difference is not a blind one)."""
+    first, second = parts(parse_scenario(copy.deepcopy(FULL))), parts(parse_scenario(copy.deepcopy(FULL)))
+    assert first == second
+    changed = copy.deepcopy(FULL)
+    changed["controller"]["options"]["kd"] = 0.61
+    changed["spacecraft"]["inertia"] = [2.0, 3.0, 4.0000001]
+    after = parts(parse_scenario(changed))
+    assert {name for name in first if first[name] != after[name]} == {"controller:augmented_quaternion_feedback",
+                                                                      "spacecraft", "plant"}
