@@ -135,7 +135,53 @@ IGRF["epoch"] = "2025-03-20T12:00:00Z"
 IGRF["environment"]["magnetic_field"] = {"model": "igrf", "step_s": 10.0}
 IGRF["requirements"] = None
 
-BASES: dict[str, dict[str, Any]] = {"full": FULL, "keep_in": KEEP_IN, "igrf": IGRF}
+KEPLER = copy.deepcopy(FULL)
+KEPLER["orbit"] = {"type": "keplerian", "semi_major_axis_km": 7000.0, "eccentricity": 0.01, "inclination_deg": 60.0,
+                   "raan_deg": 20.0, "arg_perigee_deg": 30.0, "mean_anomaly_deg": 40.0, "j2": True}
+KEPLER_BY_ALTITUDE = copy.deepcopy(KEPLER)
+KEPLER_BY_ALTITUDE["orbit"] = {"type": "keplerian", "altitude_km": 600.0, "eccentricity": 0.01,
+                               "inclination_deg": 60.0, "true_anomaly_deg": 40.0}
+TLE = copy.deepcopy(FULL)
+TLE["epoch"] = "2019-12-10T00:00:00Z"
+TLE["orbit"] = {"type": "tle", "line1": "1 25544U 98067A   19343.69339541  .00001764  00000-0  38792-4 0  9991",
+                "line2": "2 25544  51.6439 211.2001 0007417  17.6667  85.6398 15.50103472202482"}
+TARGETS = copy.deepcopy(FULL)  # attitudes in mission terms: every form of maneuver.initial.q and .final.q
+TARGETS["epoch"] = "2027-06-21T10:30:00Z"  # the orbit of cubesat_12u_ground_target.yaml: Toulouse and Paris in view
+TARGETS["orbit"] = {"altitude_km": 500, "inclination_deg": 97.4, "raan_deg": 78.5, "arg_latitude_deg": 38.13}
+TARGETS["spacecraft"]["sensors"]["panel"] = {"boresight": [0, 1, 0]}
+TARGETS["requirements"] = None
+TARGETS["maneuver"]["max_rate"] = None
+TARGET_FORMS = {
+    "quaternion": {"quaternion": [1, 0, 0, 0], "frame": "lvlh", "at_time_s": 1.0},
+    "axis_angle": {"axis_angle": {"axis": [0, 0, 1], "angle_deg": 20.0}},
+    "euler": {"euler": {"angles_deg": [10.0, 5.0, 0.0], "sequence": "321"}},
+    "point": {"point": {"boresight": [0, 0, 1], "at": {"inertial": [1, 0, 0]},
+                        "secondary": {"axis": [0, 1, 0], "toward": {"inertial": [0, 0, 1]}}}},
+    "point.at.lvlh": {"point": {"sensor": "tracker", "at": {"lvlh": [0, 0, 1]},
+                                "secondary": {"sensor": "panel", "toward": {"lvlh": [1, 0, 0]}}}},
+    "point.at.rtn": {"point": {"sensor": "tracker", "at": {"rtn": [0, 0, 1]},
+                               "secondary": {"sensor": "panel", "toward": {"rtn": [1, 0, 0]}}}},
+    "point.at.ground": {"point": {"sensor": "tracker", "at": {"ground": {"lat_deg": 43.6, "lon_deg": 1.44, "alt_m": 150.0}},
+                                  "secondary": {"sensor": "panel",
+                                                "toward": {"ground": {"lat_deg": 48.85, "lon_deg": 2.35,
+                                                                      "alt_m": 35.0}}}}},
+}
+"""One attitude of each form (:mod:`scenarios.schema.targets`), written as maneuver.initial.q and as
+maneuver.final.q of a base of its own."""
+SENSORS = copy.deepcopy(FULL)
+SENSORS["simulation"]["sensors"] = {
+    "gyro": {"arw_deg_per_sqrt_h": 0.01, "rrw_deg_per_h_per_sqrt_h": 0.1, "bias_deg_per_h": [1.0, -0.5, 0.3]},
+    "star_tracker": {"noise_arcsec": [5, 5, 40], "rate_hz": 1.0, "outages_s": [[5, 6]], "boresight": [0, 0, 1]},
+    "magnetometer": {"noise_T": 1e-8, "bias_T": [1e-7, 0, 0]}}
+SENSORS["simulation"]["estimator"] = {"type": "mekf", "initial_attitude_sigma_deg": 0.1,
+                                      "initial_bias_sigma_deg_per_h": 5.0}
+
+BASES: dict[str, dict[str, Any]] = {"full": FULL, "keep_in": KEEP_IN, "igrf": IGRF, "kepler": KEPLER,
+                                    "kepler_altitude": KEPLER_BY_ALTITUDE, "tle": TLE, "sensors": SENSORS}
+for _form, _attitude in TARGET_FORMS.items():
+    for _end in ("initial", "final"):
+        BASES[f"{_end}:{_form}"] = copy.deepcopy(TARGETS)
+        BASES[f"{_end}:{_form}"]["maneuver"][_end]["q"] = copy.deepcopy(_attitude)
 
 
 @dataclass(frozen=True)
@@ -168,10 +214,10 @@ ARRIVALS: dict[str, Arrival] = {
     "spacecraft.magnetorquers.max_dipole": arrival("spacecraft.magnetorquers.max_dipole", 0.3, *MODEL),
     "spacecraft.torquers.max_torque": arrival("spacecraft.torquers.max_torque", [0.01, 0.02, 0.01], *MODEL),
     "spacecraft.sensors.boresight": arrival("spacecraft.sensors.tracker.boresight", [0, 0.1, 1], *POINTING),
-    "orbit.altitude_km": arrival("orbit.altitude_km", 550.0, *ORBIT),
-    "orbit.inclination_deg": arrival("orbit.inclination_deg", 97.4, *ORBIT),
-    "orbit.raan_deg": arrival("orbit.raan_deg", 30.0, *ORBIT),
-    "orbit.arg_latitude_deg": arrival("orbit.arg_latitude_deg", 45.0, *ORBIT),
+    "orbit.circular.altitude_km": arrival("orbit.altitude_km", 550.0, *ORBIT),
+    "orbit.circular.inclination_deg": arrival("orbit.inclination_deg", 97.4, *ORBIT),
+    "orbit.circular.raan_deg": arrival("orbit.raan_deg", 30.0, *ORBIT),
+    "orbit.circular.arg_latitude_deg": arrival("orbit.arg_latitude_deg", 45.0, *ORBIT),
     "environment.disturbance_torque": arrival("environment.disturbance_torque", [1e-6, 2e-6, 0], *ENVIRONMENT),
     "environment.magnetic_field.tilted_dipole.strength": arrival("environment.magnetic_field.strength", 7.0e15,
                                                                  *ENVIRONMENT),
@@ -219,8 +265,61 @@ ARRIVALS: dict[str, Arrival] = {
     "requirements.final.after_s": arrival("requirements.final.after_s", 3.0, "requirements"),
     "requirements.final.error_deg": arrival("requirements.final.error_deg", 0.8, "requirements"),
     "requirements.final.rate": arrival("requirements.final.rate", 0.02, "requirements"),
+    "orbit.keplerian.semi_major_axis_km": arrival("orbit.semi_major_axis_km", 7100.0, *ORBIT, base="kepler"),
+    "orbit.keplerian.altitude_km": arrival("orbit.altitude_km", 650.0, *ORBIT, base="kepler_altitude"),
+    "orbit.keplerian.eccentricity": arrival("orbit.eccentricity", 0.02, *ORBIT, base="kepler"),
+    "orbit.keplerian.inclination_deg": arrival("orbit.inclination_deg", 70.0, *ORBIT, base="kepler"),
+    "orbit.keplerian.raan_deg": arrival("orbit.raan_deg", 25.0, *ORBIT, base="kepler"),
+    "orbit.keplerian.arg_perigee_deg": arrival("orbit.arg_perigee_deg", 35.0, *ORBIT, base="kepler"),
+    "orbit.keplerian.mean_anomaly_deg": arrival("orbit.mean_anomaly_deg", 45.0, *ORBIT, base="kepler"),
+    "orbit.keplerian.true_anomaly_deg": arrival("orbit.true_anomaly_deg", 45.0, *ORBIT, base="kepler_altitude"),
+    "orbit.tle.span_s": arrival("orbit.span_s", 7200.0, *ORBIT, base="tle"),
+    "orbit.tle.step_s": arrival("orbit.step_s", 5.0, *ORBIT, base="tle"),
+    "simulation.sensors.gyro.arw_deg_per_sqrt_h": arrival("simulation.sensors.gyro.arw_deg_per_sqrt_h", 0.02,
+                                                          "simulation", base="sensors"),
+    "simulation.sensors.gyro.rrw_deg_per_h_per_sqrt_h": arrival(
+        "simulation.sensors.gyro.rrw_deg_per_h_per_sqrt_h", 0.2, "simulation", base="sensors"),
+    "simulation.sensors.gyro.bias_deg_per_h": arrival("simulation.sensors.gyro.bias_deg_per_h", [1.5, -0.5, 0.3],
+                                                      "simulation", base="sensors"),
+    "simulation.sensors.star_tracker.noise_arcsec": arrival("simulation.sensors.star_tracker.noise_arcsec",
+                                                            [6.0, 5.0, 40.0], "simulation", base="sensors"),
+    "simulation.sensors.star_tracker.rate_hz": arrival("simulation.sensors.star_tracker.rate_hz", 2.0, "simulation",
+                                                       base="sensors"),
+    "simulation.sensors.star_tracker.boresight": arrival("simulation.sensors.star_tracker.boresight", [0, 0.1, 1.0],
+                                                         "simulation", base="sensors"),
+    "simulation.sensors.magnetometer.noise_T": arrival("simulation.sensors.magnetometer.noise_T", 2e-8, "simulation",
+                                                       base="sensors"),
+    "simulation.sensors.magnetometer.bias_T": arrival("simulation.sensors.magnetometer.bias_T", [2e-7, 0.0, 0.0],
+                                                      "simulation", base="sensors"),
+    "simulation.estimator.initial_attitude_sigma_deg": arrival("simulation.estimator.initial_attitude_sigma_deg",
+                                                               0.2, "simulation", base="sensors"),
+    "simulation.estimator.initial_bias_sigma_deg_per_h": arrival(
+        "simulation.estimator.initial_bias_sigma_deg_per_h", 6.0, "simulation", base="sensors"),
 }
 """Scenario keys (by their key in the schema reference) and what setting them must change."""
+
+TARGET_VALUES = {  # reference key below maneuver.<end>.q -> (form, path below it, new value)
+    "quaternion": ("quaternion", "quaternion", [0.9998477, 0.0174524, 0.0, 0.0]),
+    "at_time_s": ("quaternion", "at_time_s", 2.0),
+    "axis_angle.axis": ("axis_angle", "axis_angle.axis", [0.0, 0.1, 1.0]),
+    "axis_angle.angle_deg": ("axis_angle", "axis_angle.angle_deg", 25.0),
+    "euler.angles_deg": ("euler", "euler.angles_deg", [12.0, 5.0, 0.0]),
+    "point.boresight": ("point", "point.boresight", [0.0, 0.1, 1.0]),
+    "point.at.inertial": ("point", "point.at.inertial", [1.0, 0.1, 0.0]),
+    "point.secondary.axis": ("point", "point.secondary.axis", [0.1, 1.0, 0.0]),
+    "point.secondary.toward.inertial": ("point", "point.secondary.toward.inertial", [0.0, 0.1, 1.0]),
+    "point.at.lvlh": ("point.at.lvlh", "point.at.lvlh", [0.0, 0.1, 1.0]),
+    "point.secondary.toward.lvlh": ("point.at.lvlh", "point.secondary.toward.lvlh", [1.0, 0.1, 0.0]),
+    "point.at.rtn": ("point.at.rtn", "point.at.rtn", [0.0, 0.1, 1.0]),
+    "point.secondary.toward.rtn": ("point.at.rtn", "point.secondary.toward.rtn", [1.0, 0.1, 0.0]),
+    **{f"point.{where}.ground.{leaf}": ("point.at.ground", f"point.{where}.ground.{leaf}", value)
+       for where in ("at", "secondary.toward") for leaf, value in (("lat_deg", 45.0), ("lon_deg", 3.0),
+                                                                   ("alt_m", 500.0))},
+}
+for _end in ("initial", "final"):
+    for _key, (_form, _below, _value) in TARGET_VALUES.items():
+        ARRIVALS[f"maneuver.{_end}.q.{_key}"] = arrival(f"maneuver.{_end}.q.{_below}", _value, "maneuver",
+                                                        base=f"{_end}:{_form}")
 
 NOT_DISPERSIBLE: dict[str, str] = {
     "maneuver.quaternion_order": "a word, not a number",
@@ -271,10 +370,22 @@ def _candidates(annotation: Any, default: Any) -> list[Any]:
     return values
 
 
+def _in_full(kind: str, name: str) -> list[tuple[dict[str, Any], str]]:
+    """:data:`FULL` with the planner or controller ``name`` as its only one: the base of a
+    component no shipped scenario uses."""
+    base = copy.deepcopy(FULL)
+    if kind == "planners":
+        base["planners"] = [{"name": name}]
+        return [(base, "planners[0]")]
+    base["controller"] = {"name": name}
+    return [(base, "controller")]
+
+
 def _option_arrivals() -> list[tuple[str, dict[str, Any], str, Any, str]]:
     """(reference key, base scenario, option path, new value, changed part) for every numeric option
-    of every registered planner and controller, set in a shipped scenario that uses it: the first
-    (scenario, candidate value) the scenario loader accepts (value None when none is)."""
+    of every registered planner and controller, set in a shipped scenario that uses it (else in
+    :data:`FULL`, :func:`_in_full`): the first (scenario, candidate value) the scenario loader
+    accepts (value None when none is)."""
     found = []
     for kind, registry, shipped in (("planners", PLANNERS, _shipped("planners")),
                                     ("controller", CONTROLLERS, _shipped("controllers"))):
@@ -284,7 +395,7 @@ def _option_arrivals() -> list[tuple[str, dict[str, Any], str, Any, str]]:
                 if not numeric_leaves(annotation):
                     continue
                 accepted = None
-                for base, where in shipped.get(name, []):
+                for base, where in shipped.get(name) or _in_full(kind, name):
                     for candidate in _candidates(annotation, getattr(defaults, option)):
                         try:
                             parse_scenario(_with(base, f"{where}.options.{option}", candidate))
@@ -294,7 +405,7 @@ def _option_arrivals() -> list[tuple[str, dict[str, Any], str, Any, str]]:
                         break
                     if accepted:
                         break
-                base, where, value = accepted or (shipped.get(name, [({}, kind)])[0] + (None,))
+                base, where, value = accepted or ((shipped.get(name) or _in_full(kind, name))[0] + (None,))
                 entry = get_path(base, parse_path(where, where), where) if base else {}
                 part = f"{'planner' if kind == 'planners' else 'controller'}:{entry.get('label', name)}"
                 found.append((f"{kind}.{name}.{option}", base, f"{where}.options.{option}", value, part))
