@@ -83,10 +83,11 @@ def c_identifier(text: str) -> str:
     Returns
     -------
     str
-        ASCII letters, digits and ``_``, not starting with a digit (``x`` when nothing is left).
+        ASCII letters, digits and single ``_`` (CasADi refuses ``__`` in a function's name), starting
+        with a letter (``n`` before a leading digit; ``x`` when nothing is left).
     """
-    stem = re.sub(r"[^A-Za-z0-9_]+", "_", text).strip("_") or "x"
-    return stem if not stem[0].isdigit() else f"_{stem}"
+    stem = re.sub(r"[^A-Za-z0-9]+", "_", text).strip("_") or "x"
+    return stem if not stem[0].isdigit() else f"n{stem}"
 
 
 def _renamed(function: ca.Function, name: str) -> ca.Function:
@@ -172,11 +173,12 @@ def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str
              "Python): the interval is the last node with `t_k <= t` (`t` clamped to the table); `q` cubic "
              "Hermite with derivatives `0.5 q (x) [0, omega]`, then renormalised; `omega` cubic Hermite with "
              "derivatives `omega_dot`; `omega_dot` and `torque` linear. Nodes: a uniform grid refined until the "
-             "tolerances hold at every interval's midpoint (attitude "
+             "tolerances hold inside every interval (attitude "
              f"{tolerance.attitude_rad:g} rad, rate {tolerance.rate:g} and omega_dot/torque {tolerance.linear:g} "
              f"relative to their largest component, at most {tolerance.max_intervals} intervals), with the "
              "reference's own points (collocation's nodes) and its breakpoints (doubled: left and right limits).",
-             "", "Error against the continuous reference, largest over the midpoints:", "",
+             "", "Error against the continuous reference, largest over seven points of every interval "
+             "(s = 1/8, ..., 7/8 of its length; the midpoint is where a smooth reference's error peaks):", "",
              "| row | table | nodes | attitude | rate [rad/s] | omega_dot [rad/s^2] | torque [N m] | tolerances met |",
              "|---|---|---|---|---|---|---|---|"]
     for label, (name, table) in tables.items():
@@ -270,7 +272,7 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
             "table": table_name, "nodes": int(table.times.size), "duration_s": reference.duration,
             "error": {"attitude_rad": error.attitude_rad, "rate_rad_s": error.rate,
                       "omega_dot_rad_s2": error.acceleration, "torque_N_m": error.torque,
-                      "midpoints": error.points, "tolerances_met": error.met}}
+                      "points_checked": error.points, "tolerances_met": error.met}}
         evaluator = reference.symbolic_evaluator() if planner_spec.planner.closed_form else None
         if evaluator is not None:
             name = _unique(f"slewbench_reference_{c_identifier(row)}", taken)
@@ -297,6 +299,7 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
               "Z0": _c_numbers(z0), "STEM": stem,
               "DEFAULT_DECLARATION": ("" if default_reference is None else
                                       f"extern const slewbench_table {default_reference}; /* slewbench_tables.c */")}
+    interface["skipped"] = dict(report.skipped)
     interface["step"] = {"law": step_law, "saturation": "slewbench_saturate", "segment": "slewbench_segment",
                          "default_reference": default_reference, "target": target.tolist()}
     tables_h, tables_c = _tables_files(tables)

@@ -2,7 +2,7 @@
 
 A table holds rows ``[q*, ω*, ω̇*, τ*]`` (13 numbers, :data:`~ocp.dynamics.layout.REFERENCE_FIELDS`)
 at increasing times ``t_0 = 0 < … < t_{N-1} = T``. Its nodes are a uniform grid, refined by halving
-until the interpolation meets the tolerances at the midpoints of every interval (or the node count
+until the interpolation meets the tolerances inside every interval (or the node count
 reaches its cap, which the table then says), together with the reference's own points
 (``Reference.enforced_times``: collocation's nodes) and its ``breakpoints``, where the node is
 doubled (the left and the right limits at the same time) so that a jump of ``ω̇`` is not smeared.
@@ -16,9 +16,10 @@ with ``k`` the last node such that ``t_k ≤ t`` (``t`` clamped to ``[t_0, t_{N-
 * ``ω``: cubic Hermite with the nodes' ``ω̇`` as derivatives;
 * ``ω̇`` and ``τ``: linear.
 
-The table states its error against the continuous reference (:class:`TableError`), measured at the
-midpoint of every interval, where the Hermite and the linear interpolation errors of a smooth
-function peak.
+The table states its error against the continuous reference (:class:`TableError`), the largest over
+seven points of every interval (:data:`CHECK_POINTS`): the midpoint, where the Hermite and the linear
+interpolation errors of a smooth function peak, and six more for a kink inside an interval (a switch
+that is not a declared breakpoint). The tolerances are checked on the same points.
 """
 from __future__ import annotations
 
@@ -34,13 +35,17 @@ from ocp.dynamics.layout import REFERENCE_FIELDS
 from planners.reference import Reference, ReferenceSample
 
 Array = NDArray[np.float64]
+CHECK_POINTS = np.arange(1, 8) / 8.0
+"""Where in each interval (fractions ``s`` of its length) a table's error is measured: the midpoint,
+where a smooth function's interpolation error peaks, and six more points, for the intervals that
+hold a kink of the reference that is no declared breakpoint (a switch inside an interval)."""
 
 __all__ = ["ReferenceTable", "TableError", "TableReference", "TableTolerance", "interpolate", "segment_function", "tabulate"]
 
 
 @dataclass(frozen=True)
 class TableTolerance:
-    """What a table must meet at the midpoints of its intervals.
+    """What a table must meet at :data:`CHECK_POINTS` of every interval.
 
     Parameters
     ----------
@@ -65,7 +70,7 @@ class TableTolerance:
 
 @dataclass(frozen=True)
 class TableError:
-    """A table's error against the continuous reference, at the midpoints of its intervals.
+    """A table's error against the continuous reference, largest over :data:`CHECK_POINTS` of every interval.
 
     Parameters
     ----------
@@ -78,7 +83,7 @@ class TableError:
     torque : float
         Largest feed-forward torque error [N m], any component.
     points : int
-        Midpoints checked.
+        Times checked.
     met : bool
         Whether the tolerances were met.
     """
@@ -252,7 +257,7 @@ def _nodes(reference: Reference, intervals: int) -> tuple[Array, Array]:
 
 
 def table_error(reference: Reference, table: ReferenceTable, tolerance: TableTolerance) -> TableError:
-    """A table's error against its reference at the midpoints of its intervals.
+    """A table's error against its reference at :data:`CHECK_POINTS` of every interval.
 
     Parameters
     ----------
@@ -270,7 +275,8 @@ def table_error(reference: Reference, table: ReferenceTable, tolerance: TableTol
     """
     times = table.times
     h = np.diff(times)
-    mid = (times[:-1] + 0.5 * h)[h > 0]
+    inside = h > 0
+    mid = (times[:-1][inside, None] + CHECK_POINTS[None, :] * h[inside, None]).ravel()
     exact = _rows(reference, mid)
     got = table.evaluate(mid)
     angle = float(np.max(quat.error_angle(got[:, 0:4], exact[:, 0:4])))
@@ -283,7 +289,7 @@ def table_error(reference: Reference, table: ReferenceTable, tolerance: TableTol
 
 
 def tabulate(reference: Reference, tolerance: TableTolerance | None = None) -> tuple[ReferenceTable, TableError]:
-    """A reference as a table meeting ``tolerance`` at its midpoints (module docstring).
+    """A reference as a table meeting ``tolerance`` inside every interval (module docstring).
 
     Parameters
     ----------
@@ -298,7 +304,7 @@ def tabulate(reference: Reference, tolerance: TableTolerance | None = None) -> t
         The smallest uniform refinement (from 32 intervals, halving) that meets ``tolerance``, with
         the reference's own points and breakpoints; the finest allowed if none does.
     error : TableError
-        Its error against ``reference`` at its midpoints.
+        Its error against ``reference`` at :data:`CHECK_POINTS` of every interval.
     """
     tolerance = tolerance or TableTolerance()
     intervals = 32
