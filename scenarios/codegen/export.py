@@ -107,7 +107,7 @@ def _unique(name: str, taken: set[str]) -> str:
 
 def _template(name: str, values: dict[str, str]) -> str:
     """A template of ``scenarios/codegen/templates`` with its ``@KEY@`` fields filled."""
-    text = files("scenarios.codegen").joinpath("templates", name).read_text()
+    text = files("scenarios.codegen").joinpath("templates").joinpath(name).read_text()
     for key, value in values.items():
         text = text.replace(f"@{key}@", value)
     left = re.findall(r"@[A-Z_]+@", text)

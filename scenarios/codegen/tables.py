@@ -175,12 +175,12 @@ def interpolate(times: ArrayLike, rows: ArrayLike, t: ArrayLike) -> Array:
     """
     times = np.asarray(times, dtype=float)
     rows = np.asarray(rows, dtype=float)
-    t = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), times[0], times[-1])
-    k = interval_index(times, t)
+    at: Array = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), times[0], times[-1])
+    k = interval_index(times, at)
     t0, t1 = times[k], times[k + 1]
     a, b = rows[k], rows[k + 1]
     h = t1 - t0
-    s = np.where(h > 0, (t - t0) / np.where(h > 0, h, 1.0), 0.0)
+    s = np.where(h > 0, (at - t0) / np.where(h > 0, h, 1.0), 0.0)
     s2, s3 = s * s, s * s * s
     h00 = (2 * s3 - 3 * s2 + 1)[:, None]
     h10 = ((s3 - 2 * s2 + s) * h)[:, None]
