@@ -60,9 +60,17 @@ class Built:
             _fields_ = [("q", ctypes.c_double * 4), ("omega", ctypes.c_double * 3),
                         ("wheel_momentum", ctypes.c_double * _dim(self.n_w)), ("field", ctypes.c_double * 3)]
 
+        def c_type(shape):
+            kind = ctypes.c_double
+            for size in reversed(shape):
+                kind = kind * size
+            return kind
+
+        self.parameters = self.interface["parameters"]
+
         class Params(ctypes.Structure):
-            _fields_ = [("sample_time", ctypes.c_double), ("saturate", ctypes.c_int),
-                        ("reference", ctypes.POINTER(Table)), ("target", ctypes.c_double * ROW)]
+            _fields_ = [(p["name"], c_type(p["shape"])) for p in self.parameters] + [
+                ("saturate", ctypes.c_int), ("reference", ctypes.POINTER(Table)), ("target", ctypes.c_double * ROW)]
 
         class CommandC(ctypes.Structure):
             _fields_ = [("u", ctypes.c_double * _dim(self.nu)), ("u_applied", ctypes.c_double * _dim(self.nu)),
@@ -76,6 +84,21 @@ class Built:
                                             ctypes.POINTER(CommandC), ctypes.POINTER(State)]
         self.lib.slewbench_reference_row.argtypes = [ctypes.POINTER(Table), ctypes.c_double,
                                                      ctypes.POINTER(ctypes.c_double)]
+
+    def params(self, saturate=1, **values):
+        """The parameter struct: the defaults (the scenario's numbers), some replaced."""
+        params = self.Params(saturate=saturate)
+        for p in self.parameters:
+            value = np.asarray(values.get(p["name"], p["default"]), dtype=float)
+            field = getattr(params, p["name"])
+            if value.ndim == 0:
+                setattr(params, p["name"], float(value))
+            elif value.ndim == 1:
+                field[:] = list(value)
+            else:
+                for i, row in enumerate(value):
+                    field[i][:] = list(row)
+        return params
 
     def table(self, label):
         """The C table of a row, and the same numbers as a ReferenceTable."""
@@ -127,7 +150,7 @@ def test_step_equals_the_python_law_then_the_simulators_saturation(name, tmp_pat
     for label, table in references:
         controller.reset(spacecraft, spec.sample_time, target=(problem.qf, problem.omegaf))
         reference = None if table is None else TableReference(table[1], spacecraft.inertia)
-        params = built.Params(sample_time=built.sample_time, saturate=1)
+        params = built.params()
         params.target[:] = list(controller.reference_rows(None, np.array([0.0]))[0])
         if table is not None:
             params.reference = ctypes.pointer(table[0])
@@ -152,13 +175,16 @@ def test_step_equals_the_python_law_then_the_simulators_saturation(name, tmp_pat
     assert saturated_seen > 0  # the saturation stage was exercised
 
 
-def test_step_refuses_another_sample_time_and_can_skip_the_saturation(tmp_path, rng):
+def test_step_can_skip_the_saturation_and_a_law_that_bakes_its_sample_time_refuses_another(tmp_path, rng):
+    built = Built("nano_detumble.yaml", tmp_path / "d")  # B-dot compiles its sample time in
+    assert "sample_time" not in built.interface["laws"][built.interface["step"]["law"]]["reads_parameters"]
+    state = built.init()
+    measurement = Measurement(0.0, quat.random_unit(rng), np.full(3, 0.05), np.zeros(0), np.full(3, 2e-5))
+    assert built.step(0.0, measurement, built.params(sample_time=2 * built.sample_time), state)[0] == 2  # ESAMPLE
     built = Built("eigenaxis_demo.yaml", tmp_path / "c")
     state = built.init()
-    params = built.Params(sample_time=2 * built.sample_time, saturate=1)
     measurement = Measurement(0.0, quat.random_unit(rng), np.full(3, 0.05), np.full(3, 2.0), None)
-    assert built.step(0.0, measurement, params, state)[0] == 2  # SLEWBENCH_ESAMPLE: the law bakes its sample time
-    params = built.Params(sample_time=built.sample_time, saturate=0)
+    params = built.params(saturate=0)
     params.target[:] = [1.0] + [0.0] * 12
     status, u, applied, saturated = built.step(0.0, measurement, params, state)
     assert status == 0 and saturated == 0
@@ -259,3 +285,69 @@ def test_a_row_that_fails_to_plan_is_skipped_with_its_reason(tmp_path, monkeypat
     assert "solver gave up (test)" in readme
     subprocess.run(["make", "-C", str(out)], check=True, capture_output=True)  # regulation only, still builds
     assert "regulation" in subprocess.run([str(out / "example")], check=True, capture_output=True, text=True).stdout
+
+
+@pytest.mark.parametrize("name, law_reads", [
+    ("eigenaxis_demo.yaml", {"sample_time", "stiffness", "damping", "inertia", "wheel_axes"}),
+    ("horri_palmer_two_wheels.yaml", set()),  # the two-wheel laws compile their numbers in (README says so)
+])
+def test_parameters_are_inputs_the_law_and_saturation_read(name, law_reads, tmp_path, rng):
+    """Other gains, inertia, wheel axes, wheel limits and sample time, set in slewbench_params at run
+    time (no regeneration): the C step equals the Python controller reset for a spacecraft and
+    options built with those numbers, followed by that spacecraft's ActuatorModel.apply."""
+    from dataclasses import replace
+
+    from ocp import Spacecraft
+    from ocp.dynamics.actuator_kinds import ReactionWheels
+
+    built = Built(name, tmp_path / "c")
+    scenario = load(SCENARIOS / name)
+    problem, spec = scenario.problem, scenario.simulation
+    law = built.interface["laws"][built.interface["step"]["law"]]
+    reads = set(law["reads_parameters"])
+    assert reads == law_reads
+    controller_spec = scenario.controllers[0]
+    wheels = problem.spacecraft.wheels
+    rotation = quat.rotation_matrix(quat.from_rotation_vector(rng.normal(0, 0.3, 3)))
+    root = rng.normal(0, 0.2, (3, 3))
+    # The saturation stage reads the limits and the hold; the law what it reads (the others it bakes in).
+    values = {"wheel_max_torque": 0.6 * np.minimum(wheels.max_torque, 1.0),
+              "wheel_max_momentum": 0.5 * np.minimum(wheels.max_momentum, 5.0)}
+    inertia, axes, sample_time = problem.spacecraft.inertia, wheels.axes, built.sample_time
+    if "inertia" in reads:
+        inertia = values["inertia"] = problem.spacecraft.inertia * 1.3 + 0.05 * (root @ root.T)
+    if "wheel_axes" in reads:
+        axes = values["wheel_axes"] = rotation @ wheels.axes
+    if "sample_time" in reads:
+        sample_time = values["sample_time"] = 0.7 * built.sample_time
+    others = {a.name: a for a in problem.spacecraft.actuators if a.name != "wheels"}
+    spacecraft = Spacecraft(inertia, ReactionWheels(axes, values["wheel_max_torque"], values["wheel_max_momentum"],
+                                                    wheels.spin_inertia, wheels.failed), **others)
+    options = controller_spec.controller.options
+    changed = {}
+    if {"stiffness", "damping"} <= reads:  # the gains as matrices: kp, kd of the law's options
+        values["stiffness"] = rng.normal(0, 0.05, (3, 3)) + 0.3 * np.eye(3)
+        values["damping"] = rng.normal(0, 0.1, (3, 3)) + 2.0 * np.eye(3)
+        changed = {"kp": values["stiffness"].tolist(), "kd": values["damping"].tolist()}
+    controller = type(controller_spec.controller)(replace(options, **changed))
+    controller.reset(spacecraft, sample_time, target=(problem.qf, problem.omegaf))
+    actuators = ActuatorModel(spacecraft, *control_layout(spacecraft))
+    params = built.params(**values)
+    params.target[:] = list(controller.reference_rows(None, np.array([0.0]))[0])
+    state = built.init()
+    saturated = 0
+    for k in range(10):
+        t = k * sample_time
+        measurement = Measurement(t, quat.random_unit(rng), rng.normal(0, 0.05, 3),
+                                  rng.uniform(-3, 3, spacecraft.n_wheels), None)
+        status, u, applied, flag = built.step(t, measurement, params, state)
+        assert status == 0
+        command = controller(t, measurement, None)
+        expected = controller.command_vector(command)
+        scale = max(1.0, float(np.abs(expected).max()))
+        np.testing.assert_allclose(u, expected, rtol=0, atol=1e-12 * scale)
+        expected_applied, expected_flag = actuators.apply(command, measurement.wheel_momentum, sample_time)
+        np.testing.assert_allclose(applied, expected_applied, rtol=0, atol=1e-12 * scale)
+        assert bool(flag) == expected_flag
+        saturated += expected_flag
+    assert saturated > 0

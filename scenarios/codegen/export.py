@@ -33,6 +33,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from controllers.allocation import SymbolicConstants
 from ocp.dynamics.actuators import ActuatorModel
 from ocp.dynamics.layout import REFERENCE_FIELDS, control_layout, reference_rows
 from scenarios.codegen.tables import TableError, TableTolerance, angle_text, segment_function, tabulate
@@ -122,15 +123,98 @@ def _c_numbers(values: Any) -> str:
     return ", ".join(repr(float(v)) for v in flat) if flat.size else "0.0"
 
 
-def _saturation(spacecraft: Any) -> ca.Function:
-    """The simulator's saturation stage (:meth:`ActuatorModel.apply_symbolic`) as a function."""
+SATURATION_PARAMETERS: dict[str, dict[str, str]] = {
+    "wheels": {"max_torque": "wheel_max_torque", "max_momentum": "wheel_max_momentum"},
+    "magnetorquers": {"_axis_limit": "dipole_limit"},
+    "torquers": {"_axis_limit": "torquer_limit"},
+}
+"""Per actuator kind (its ``name``): the attributes its symbolic saturation reads that become
+parameters, and their names in ``slewbench_params``. A kind not listed keeps its limits compiled in."""
+
+
+class _Limits:
+    """An actuator whose limits are symbols, for its own ``saturate_symbolic``."""
+
+    def __init__(self, actuator: Any, overrides: dict[str, ca.SX]) -> None:
+        self._actuator, self._overrides = actuator, overrides
+
+    def __getattr__(self, name: str) -> Any:
+        if name in self._overrides:
+            return self._overrides[name]
+        return getattr(self._actuator, name)
+
+    def saturate_symbolic(self, u: Any, state: Any, dt: Any) -> Any:
+        return type(self._actuator).saturate_symbolic(self, u, state, dt)
+
+
+def _saturation(spacecraft: Any, constants: SymbolicConstants) -> ca.Function:
+    """The simulator's saturation stage (:meth:`ActuatorModel.apply_symbolic`) as a function of the
+    command, the wheel momenta and the parameters (limits of :data:`SATURATION_PARAMETERS`, the hold
+    ``sample_time``)."""
     slices, nu = control_layout(spacecraft)
     actuators = ActuatorModel(spacecraft, slices, nu)
+    blocks = []
+    for actuator, where, state in actuators._blocks:
+        names = SATURATION_PARAMETERS.get(actuator.name, {})
+        overrides = {attribute: constants.get(name, getattr(actuator, attribute)) for attribute, name in names.items()}
+        blocks.append((_Limits(actuator, overrides) if overrides else actuator, where, state))
+    actuators._blocks = blocks  # the same saturation, reading its limits from the parameters
     n_states = sum(a.state_size for a in spacecraft.actuators)
-    u, h, dt = ca.SX.sym("u", nu), ca.SX.sym("h_w", n_states), ca.SX.sym("dt")
-    applied, saturated = actuators.apply_symbolic(u, h, dt)
-    return ca.Function("slewbench_saturate", [u, h, dt], [ca.SX(applied), ca.SX(saturated)],
-                       ["u", "h_w", "dt"], ["u_applied", "saturated"])
+    u, h = ca.SX.sym("u", nu), ca.SX.sym("h_w", n_states)
+    applied, saturated = actuators.apply_symbolic(u, h, constants.get("sample_time", 0.0))
+    return ca.Function("slewbench_saturate", [u, h, constants.vector()], [ca.SX(applied), ca.SX(saturated)],
+                       ["u", "h_w", "p"], ["u_applied", "saturated"])
+
+
+def parameters_offset(parameters: list[dict[str, Any]], name: str) -> slice:
+    """Where parameter ``name`` sits in the parameter vector ``p``.
+
+    Parameters
+    ----------
+    parameters : list of dict
+        The parameters' descriptions (``name``, ``shape``, ``offset``).
+    name : str
+
+    Returns
+    -------
+    slice
+    """
+    entry = next(p for p in parameters if p["name"] == name)
+    return slice(entry["offset"], entry["offset"] + int(np.prod(entry["shape"], dtype=int)))
+
+
+def _c_value(value: float) -> str:
+    """One number in C (round-trip exact; ``INFINITY`` for an absent limit)."""
+    if np.isinf(value):
+        return "INFINITY" if value > 0 else "-INFINITY"
+    return repr(float(value))
+
+
+def _parameter_code(constants: SymbolicConstants) -> tuple[str, str, str, list[dict[str, Any]]]:
+    """The struct fields, their default initializer, the packing into the parameter vector (CasADi's
+    column-major order) and their description."""
+    fields, defaults, pack, described = [], [], [], []
+    offset = 0
+    for name, (symbol, value) in constants.symbols.items():
+        rows, columns = symbol.shape
+        array = np.asarray(value, dtype=float).reshape(rows, columns, order="F") if value.ndim < 2 else value
+        if value.ndim == 0:
+            fields.append(f"    double {name};")
+            defaults.append(_c_value(float(value)))
+            pack.append(f"    pv_[{offset}] = (casadi_real) p->{name};")
+        elif value.ndim == 1:
+            fields.append(f"    double {name}[{rows}];")
+            defaults.append("{ " + ", ".join(_c_value(v) for v in value) + " }")
+            pack.append(f"    for (i = 0; i < {rows}; ++i) pv_[{offset} + i] = (casadi_real) p->{name}[i];")
+        else:
+            fields.append(f"    double {name}[{rows}][{columns}];  /* row-major */")
+            defaults.append("{ " + ", ".join("{ " + ", ".join(_c_value(v) for v in row) + " }" for row in array) + " }")
+            pack.append(f"    for (i = 0; i < {rows}; ++i) for (j = 0; j < {columns}; ++j) "
+                        f"pv_[{offset} + {rows} * j + i] = (casadi_real) p->{name}[i][j];")
+        described.append({"name": name, "shape": list(value.shape), "offset": offset,
+                          "default": np.asarray(value, dtype=float).tolist()})
+        offset += rows * columns
+    return "\n".join(fields), ", ".join(defaults), "\n".join(pack), described
 
 
 def _tables_files(tables: dict[str, tuple[str, Any]]) -> tuple[str, str]:
@@ -150,7 +234,8 @@ def _tables_files(tables: dict[str, tuple[str, Any]]) -> tuple[str, str]:
 
 
 def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str, Any]],
-            errors: dict[str, TableError], skipped: dict[str, str], tolerance: TableTolerance) -> str:
+            errors: dict[str, TableError], skipped: dict[str, str], tolerance: TableTolerance,
+            parameters: list[tuple[str, list[int], list[str]]], law_reads: set[str]) -> str:
     lines = [f"# C export of scenario `{scenario.name}` (slewbench codegen)", "",
              "Build: `make` (the library `lib" + stem + ".so` and `./example`), `make float` (single precision).",
              "", "## Flight interface (`slewbench_step.h`)", "",
@@ -166,8 +251,20 @@ def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str
              "scaled). `command.u` is the law's command, `command.u_applied` what the actuators apply. "
              "It uses static work arrays sized from the generated `_work` functions (checked by "
              "`slewbench_init`), no allocation, and is not re-entrant.", "",
-             "The law's gains, inertia and wheel axes and the actuators' limits are baked into the generated "
-             "functions: regenerate to change them. `example.c` is a worked use.", "",
+             "`example.c` is a worked use.", "", "## Parameters (`slewbench_params`)", "",
+             "The numbers the generated functions read as inputs (matrices row-major in the struct); the "
+             "defaults (`SLEWBENCH_PARAMS_DEFAULT`) are the scenario's. Numbers a law does not read through "
+             "its parameters are compiled into it: change them by regenerating.", "",
+             "| field | shape | read by |", "|---|---|---|"]
+    for name, shape, readers in parameters:
+        lines.append(f"| `{name}` | {shape or 'scalar'} | {', '.join(readers) or 'nothing'} |")
+    lines += ["| `saturate` | int | `slewbench_step`: 1 applies the saturation stage |",
+              "| `reference` | table pointer | `slewbench_step`: the table to track; `NULL`: regulation to `target` |",
+              "| `target` | 13 | the regulation row `[q_f, omega_f, 0, 0]` |", ""]
+    if "sample_time" not in law_reads:
+        lines += [f"The law `{law}` compiles the sample time in: `params.sample_time` must equal "
+                  "`SLEWBENCH_SAMPLE_TIME` (`slewbench_step` returns `SLEWBENCH_ESAMPLE` otherwise).", ""]
+    lines += [
              "## Reference tables", "",
              "Interpolation (`slewbench_reference_row`; the same as `scenarios.codegen.tables.interpolate` in "
              "Python): the interval is the last node with `t_k <= t` (`t` clamped to the table); `q` cubic "
@@ -236,12 +333,21 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
     }
     law_stems = row_stems([c.label for c in scenario.controllers])
     z0: Any = None
+    constants = SymbolicConstants()
+    law_parameters: dict[str, tuple[list[ca.SX], list[ca.SX], SymbolicConstants]] = {}
+    law_reads: dict[str, set[str]] = {}
     for controller, controller_spec, law_stem in zip(laws, scenario.controllers, law_stems):
         controller.reset(spacecraft, spec.sample_time, target=(problem.qf, problem.omegaf))
         law = controller.symbolic_law()
         # One controller: "slewbench_law"; several: one function per controller, named by its label.
         name = _unique("slewbench_law" if len(laws) == 1 else f"slewbench_law_{c_identifier(law_stem)}", taken)
-        functions.append(_renamed(law.function, name))
+        # The first law shares its parameters with the saturation stage (slewbench_step); others have their own.
+        own = constants if z0 is None else SymbolicConstants()
+        own.get("sample_time", float(spec.sample_time))
+        inputs, outputs = controller.parametric_law(own)
+        law_reads[name] = {key for key, (symbol, _) in own.symbols.items()
+                           if ca.depends_on(ca.vertcat(*outputs), ca.vec(symbol))}
+        law_parameters[name] = (inputs, outputs, own)
         z0 = law.state0 if z0 is None else z0
         description = {
             "controller": controller.name, "label": controller_spec.label,
@@ -255,8 +361,14 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
         interface["laws"][name] = description
         if len(laws) == 1:
             interface["slewbench_law"] = description
+    saturation = _saturation(spacecraft, constants)  # adds the limits to the first law's parameters
+    for name, (inputs, outputs, own) in law_parameters.items():
+        functions.append(ca.Function(name, [*inputs, own.vector()], outputs, ["t", "y", "z", "r", "p"], ["u", "z_next"]))
+        interface["laws"][name]["inputs"]["p"] = int(own.vector().numel())
+        interface["laws"][name]["parameters"] = _parameter_code(own)[3]
+        interface["laws"][name]["reads_parameters"] = sorted(law_reads[name])
     step_law = functions[0].name()
-    functions += [_saturation(spacecraft), segment_function("slewbench_segment")]
+    functions += [saturation, segment_function("slewbench_segment")]
     tables: dict[str, tuple[str, Any]] = {}
     stems = row_stems([p.label for p in scenario.planners])
     for planner_spec, row in zip(scenario.planners, stems):
@@ -287,6 +399,16 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
     u_layout = "[" + ", ".join(f"{key} ({s.stop - s.start})" for key, s in slices.items()) + "]"
     work = [f.sz_arg() for f in functions], [f.sz_res() for f in functions], \
         [f.sz_iw() for f in functions], [f.sz_w() for f in functions]
+    parameter_fields, parameter_defaults, parameter_pack, parameters = _parameter_code(constants)
+    saturation_output = ca.vertcat(*saturation.call(saturation.sx_in()))
+    saturation_reads = {key for key, (symbol, _) in constants.symbols.items()
+                        if ca.depends_on(saturation_output, ca.vec(saturation.sx_in(2)[parameters_offset(parameters, key)]))}
+    readers = [(p["name"], p["shape"], [who for who, reads in ((step_law, law_reads[step_law]),
+                                                               ("slewbench_saturate", saturation_reads))
+                                        if p["name"] in reads]) for p in parameters]
+    for p, (_, _, who) in zip(parameters, readers):
+        p["read_by"] = who
+    interface["parameters"] = parameters
     values = {"SCENARIO": scenario.name, "CONTROLLER": laws[0].name, "VERSION": package_version(),
               "N_WHEELS": str(spacecraft.n_wheels), "NU": str(nu), "NZ": str(int(np.size(z0))),
               "U_LAYOUT": u_layout, "SAMPLE_TIME": repr(float(spec.sample_time)),
@@ -298,7 +420,10 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
               "SZ_IW": str(max(1, *work[2])), "SZ_W": str(max(1, *work[3])),
               "Z0": _c_numbers(z0), "STEM": stem,
               "DEFAULT_DECLARATION": ("" if default_reference is None else
-                                      f"extern const slewbench_table {default_reference}; /* slewbench_tables.c */")}
+                                      f"extern const slewbench_table {default_reference}; /* slewbench_tables.c */"),
+              "PARAM_FIELDS": parameter_fields, "PARAM_DEFAULTS": parameter_defaults, "PACK": parameter_pack,
+              "NP": str(max(1, int(constants.vector().numel()))),
+              "BAKES_SAMPLE_TIME": "0" if "sample_time" in law_reads[step_law] else "1"}
     interface["skipped"] = dict(report.skipped)
     interface["step"] = {"law": step_law, "saturation": "slewbench_saturate", "segment": "slewbench_segment",
                          "default_reference": default_reference, "target": target.tolist()}
@@ -312,7 +437,8 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
         texts = {"slewbench_step.h": _template("slewbench_step.h.in", values), "slewbench_step.c": _template("slewbench_step.c.in", values),
                  "example.c": _template("example.c.in", values), "Makefile": _template("Makefile.in", values),
                  "slewbench_tables.h": tables_h, "slewbench_tables.c": tables_c,
-                 "README.md": _readme(scenario, stem, step_law, tables, report.tables, report.skipped, tolerance),
+                 "README.md": _readme(scenario, stem, step_law, tables, report.tables, report.skipped, tolerance,
+                                      readers, law_reads[step_law]),
                  "interface.json": json.dumps(interface, indent=1) + "\n"}
         for name, text in texts.items():
             (staging / name).write_text(text)
