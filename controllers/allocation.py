@@ -160,11 +160,14 @@ class Allocation:
         number when the working axes are rank deficient)."""
         spacecraft = self._spacecraft()
         axes = self.constant("wheel_axes", spacecraft.wheel_axes)
-        if self._constants is None or self._working_axes is None:
-            return axes, ca.DM(self._working_axes), ca.DM(self._wheel_pinv)
-        working = np.asarray(spacecraft.wheels.working, dtype=float)
+        working_value = self._working_axes
+        if working_value is None:
+            raise RuntimeError("the symbolic wheel matrices need working wheels")
+        if self._constants is None:
+            return axes, ca.DM(working_value), ca.DM(self._wheel_pinv)
+        working = np.any(working_value != 0.0, axis=0).astype(float)  # failed wheels: zero columns
         working_axes = ca.mtimes(axes, ca.diag(ca.DM(working)))
-        rank_ok = np.linalg.matrix_rank(self._working_axes) == min(3, int(working.sum()))
+        rank_ok = np.linalg.matrix_rank(working_value) == min(3, int(working.sum()))
         pinv = _pseudo_inverse_symbolic(axes, working) if rank_ok else None
         return axes, working_axes, ca.DM(self._wheel_pinv) if pinv is None else pinv
 

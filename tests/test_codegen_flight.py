@@ -176,11 +176,15 @@ def test_step_equals_the_python_law_then_the_simulators_saturation(name, tmp_pat
 
 
 def test_step_can_skip_the_saturation_and_a_law_that_bakes_its_sample_time_refuses_another(tmp_path, rng):
-    built = Built("nano_detumble.yaml", tmp_path / "d")  # B-dot compiles its sample time in
-    assert "sample_time" not in built.interface["laws"][built.interface["step"]["law"]]["reads_parameters"]
+    text = (SCENARIOS / "nano_detumble.yaml").read_text()
+    lines = [line for line in text.splitlines() if "name: bdot" not in line]  # TDFC alone: its delay is in samples
+    (tmp_path / "tdfc.yaml").write_text("\n".join(lines) + "\n")
+    built = Built(tmp_path / "tdfc.yaml", tmp_path / "d")
+    assert built.interface["laws"][built.interface["step"]["law"]]["reads_parameters"] == ["gain"]
     state = built.init()
     measurement = Measurement(0.0, quat.random_unit(rng), np.full(3, 0.05), np.zeros(0), np.full(3, 2e-5))
     assert built.step(0.0, measurement, built.params(sample_time=2 * built.sample_time), state)[0] == 2  # ESAMPLE
+    assert built.step(0.0, measurement, built.params(), state)[0] == 0
     built = Built("eigenaxis_demo.yaml", tmp_path / "c")
     state = built.init()
     measurement = Measurement(0.0, quat.random_unit(rng), np.full(3, 0.05), np.full(3, 2.0), None)
@@ -289,65 +293,79 @@ def test_a_row_that_fails_to_plan_is_skipped_with_its_reason(tmp_path, monkeypat
 
 @pytest.mark.parametrize("name, law_reads", [
     ("eigenaxis_demo.yaml", {"sample_time", "stiffness", "damping", "inertia", "wheel_axes"}),
+    ("nano_detumble.yaml", {"sample_time", "gain"}),  # B-dot: K_b / T_s from both
     ("horri_palmer_two_wheels.yaml", set()),  # the two-wheel laws compile their numbers in (README says so)
 ])
 def test_parameters_are_inputs_the_law_and_saturation_read(name, law_reads, tmp_path, rng):
-    """Other gains, inertia, wheel axes, wheel limits and sample time, set in slewbench_params at run
-    time (no regeneration): the C step equals the Python controller reset for a spacecraft and
-    options built with those numbers, followed by that spacecraft's ActuatorModel.apply."""
+    """Other gains, inertia, wheel axes, actuator limits and sample time, set in slewbench_params at
+    run time (no regeneration): the C step equals the Python controller built with those options
+    and reset for a spacecraft built with those numbers, followed by that spacecraft's
+    ActuatorModel.apply."""
     from dataclasses import replace
 
     from ocp import Spacecraft
-    from ocp.dynamics.actuator_kinds import ReactionWheels
+    from ocp.dynamics.actuator_kinds import Magnetorquers, ReactionWheels
 
     built = Built(name, tmp_path / "c")
     scenario = load(SCENARIOS / name)
-    problem, spec = scenario.problem, scenario.simulation
+    problem = scenario.problem
     law = built.interface["laws"][built.interface["step"]["law"]]
     reads = set(law["reads_parameters"])
     assert reads == law_reads
     controller_spec = scenario.controllers[0]
-    wheels = problem.spacecraft.wheels
-    rotation = quat.rotation_matrix(quat.from_rotation_vector(rng.normal(0, 0.3, 3)))
-    root = rng.normal(0, 0.2, (3, 3))
-    # The saturation stage reads the limits and the hold; the law what it reads (the others it bakes in).
-    values = {"wheel_max_torque": 0.6 * np.minimum(wheels.max_torque, 1.0),
-              "wheel_max_momentum": 0.5 * np.minimum(wheels.max_momentum, 5.0)}
-    inertia, axes, sample_time = problem.spacecraft.inertia, wheels.axes, built.sample_time
+    original = problem.spacecraft
+    values = {}
+    inertia, sample_time = original.inertia, built.sample_time
     if "inertia" in reads:
-        inertia = values["inertia"] = problem.spacecraft.inertia * 1.3 + 0.05 * (root @ root.T)
-    if "wheel_axes" in reads:
-        axes = values["wheel_axes"] = rotation @ wheels.axes
+        root = rng.normal(0, 0.2, (3, 3))
+        inertia = values["inertia"] = original.inertia * 1.3 + 0.05 * (root @ root.T)
     if "sample_time" in reads:
         sample_time = values["sample_time"] = 0.7 * built.sample_time
-    others = {a.name: a for a in problem.spacecraft.actuators if a.name != "wheels"}
-    spacecraft = Spacecraft(inertia, ReactionWheels(axes, values["wheel_max_torque"], values["wheel_max_momentum"],
-                                                    wheels.spin_inertia, wheels.failed), **others)
-    options = controller_spec.controller.options
+    actuators = {}
+    for actuator in original.actuators:
+        if actuator.name == "wheels":  # the saturation reads the limits; the law the axes
+            axes = actuator.axes
+            if "wheel_axes" in reads:
+                rotation = quat.rotation_matrix(quat.from_rotation_vector(rng.normal(0, 0.3, 3)))
+                axes = values["wheel_axes"] = rotation @ actuator.axes
+            values["wheel_max_torque"] = 0.6 * np.minimum(actuator.max_torque, 1.0)
+            values["wheel_max_momentum"] = 0.5 * np.minimum(actuator.max_momentum, 5.0)
+            actuators["wheels"] = ReactionWheels(axes, values["wheel_max_torque"], values["wheel_max_momentum"],
+                                                 actuator.spin_inertia, actuator.failed)
+        elif actuator.name == "magnetorquers":
+            values["dipole_limit"] = 0.3 * actuator.control_bounds()[1]
+            actuators["magnetorquers"] = Magnetorquers(values["dipole_limit"], actuator.saturation)
+        else:
+            actuators[actuator.name] = actuator
+    spacecraft = Spacecraft(inertia, **actuators)
     changed = {}
     if {"stiffness", "damping"} <= reads:  # the gains as matrices: kp, kd of the law's options
         values["stiffness"] = rng.normal(0, 0.05, (3, 3)) + 0.3 * np.eye(3)
         values["damping"] = rng.normal(0, 0.1, (3, 3)) + 2.0 * np.eye(3)
         changed = {"kp": values["stiffness"].tolist(), "kd": values["damping"].tolist()}
-    controller = type(controller_spec.controller)(replace(options, **changed))
+    if "gain" in reads:
+        values["gain"] = changed["gain"] = 1.7 * controller_spec.controller.options.gain
+    controller = type(controller_spec.controller)(replace(controller_spec.controller.options, **changed))
     controller.reset(spacecraft, sample_time, target=(problem.qf, problem.omegaf))
-    actuators = ActuatorModel(spacecraft, *control_layout(spacecraft))
+    model = ActuatorModel(spacecraft, *control_layout(spacecraft))
     params = built.params(**values)
     params.target[:] = list(controller.reference_rows(None, np.array([0.0]))[0])
     state = built.init()
     saturated = 0
+    has_field = problem.model.field_body is not None
     for k in range(10):
         t = k * sample_time
         measurement = Measurement(t, quat.random_unit(rng), rng.normal(0, 0.05, 3),
-                                  rng.uniform(-3, 3, spacecraft.n_wheels), None)
+                                  rng.uniform(-3, 3, spacecraft.n_wheels), rng.normal(0, 3e-5, 3) if has_field else None)
         status, u, applied, flag = built.step(t, measurement, params, state)
         assert status == 0
         command = controller(t, measurement, None)
         expected = controller.command_vector(command)
         scale = max(1.0, float(np.abs(expected).max()))
         np.testing.assert_allclose(u, expected, rtol=0, atol=1e-12 * scale)
-        expected_applied, expected_flag = actuators.apply(command, measurement.wheel_momentum, sample_time)
+        expected_applied, expected_flag = model.apply(command, measurement.wheel_momentum, sample_time)
         np.testing.assert_allclose(applied, expected_applied, rtol=0, atol=1e-12 * scale)
         assert bool(flag) == expected_flag
+        np.testing.assert_allclose(state.z[:built.nz], controller.state_vector(), rtol=0, atol=1e-12 * scale)
         saturated += expected_flag
     assert saturated > 0

@@ -153,7 +153,7 @@ def _saturation(spacecraft: Any, constants: SymbolicConstants) -> ca.Function:
     ``sample_time``)."""
     slices, nu = control_layout(spacecraft)
     actuators = ActuatorModel(spacecraft, slices, nu)
-    blocks = []
+    blocks: list[Any] = []
     for actuator, where, state in actuators._blocks:
         names = SATURATION_PARAMETERS.get(actuator.name, {})
         overrides = {attribute: constants.get(name, getattr(actuator, attribute)) for attribute, name in names.items()}
