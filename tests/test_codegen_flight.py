@@ -293,6 +293,7 @@ def test_a_row_that_fails_to_plan_is_skipped_with_its_reason(tmp_path, monkeypat
 
 @pytest.mark.parametrize("name, law_reads", [
     ("eigenaxis_demo.yaml", {"sample_time", "stiffness", "damping", "inertia", "wheel_axes"}),
+    ("nano_eigenaxis_pd.yaml", {"sample_time", "stiffness", "damping", "inertia", "wheel_axes"}),  # a regulator
     ("nano_detumble.yaml", {"sample_time", "gain"}),  # B-dot: K_b / T_s from both
     ("horri_palmer_two_wheels.yaml", set()),  # the two-wheel laws compile their numbers in (README says so)
 ])
@@ -346,7 +347,9 @@ def test_parameters_are_inputs_the_law_and_saturation_read(name, law_reads, tmp_
     if "gain" in reads:
         values["gain"] = changed["gain"] = 1.7 * controller_spec.controller.options.gain
     controller = type(controller_spec.controller)(replace(controller_spec.controller.options, **changed))
-    controller.reset(spacecraft, sample_time, target=(problem.qf, problem.omegaf))
+    # Regulation to another attitude, for a law that reads its target (the two-wheel laws compile it in).
+    target = quat.random_unit(rng) if problem.qf is not None and law["reads_r"] else problem.qf
+    controller.reset(spacecraft, sample_time, target=(target, problem.omegaf))
     model = ActuatorModel(spacecraft, *control_layout(spacecraft))
     params = built.params(**values)
     params.target[:] = list(controller.reference_rows(None, np.array([0.0]))[0])

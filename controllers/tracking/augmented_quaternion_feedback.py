@@ -190,7 +190,9 @@ class AugmentedQuaternionFeedback(Controller):
         spacecraft = self._spacecraft()
         n_w = spacecraft.n_wheels
         q, w, h, _ = split_measurement(y, n_w)
-        rows = r if self.tracks_reference else ca.DM(self.setpoints(0.0, None).ravel())
+        # A regulator reads its target from r when it is built for code generation (the generated
+        # step fills r with the target then); otherwise the target is compiled in.
+        rows = r if self.tracks_reference or self._constants is not None else ca.DM(self.setpoints(0.0, None).ravel())
         q_ref, w_ref = rows[0:4], rows[4:7]
         w_ref_next, accel_ref = rows[REFERENCE_FIELDS + 4:REFERENCE_FIELDS + 7], rows[7:10]
         scalar = ca.dot(q_ref, q)

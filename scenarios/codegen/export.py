@@ -235,7 +235,7 @@ def _tables_files(tables: dict[str, tuple[str, Any]]) -> tuple[str, str]:
 
 def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str, Any]],
             errors: dict[str, TableError], skipped: dict[str, str], tolerance: TableTolerance,
-            parameters: list[tuple[str, list[int], list[str]]], law_reads: set[str]) -> str:
+            parameters: list[tuple[str, list[int], list[str]]], law_reads: set[str], reads_rows: bool) -> str:
     lines = [f"# C export of scenario `{scenario.name}` (slewbench codegen)", "",
              "Build: `make` (the library `lib" + stem + ".so` and `./example`), `make float` (single precision).",
              "", "## Flight interface (`slewbench_step.h`)", "",
@@ -261,6 +261,9 @@ def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str
     lines += ["| `saturate` | int | `slewbench_step`: 1 applies the saturation stage |",
               "| `reference` | table pointer | `slewbench_step`: the table to track; `NULL`: regulation to `target` |",
               "| `target` | 13 | the regulation row `[q_f, omega_f, 0, 0]` |", ""]
+    if not reads_rows:
+        lines += [f"The law `{law}` compiles its target in and reads no reference: `reference` and `target` "
+                  "are not read.", ""]
     if "sample_time" not in law_reads:
         lines += [f"The law `{law}` compiles the sample time in: `params.sample_time` must equal "
                   "`SLEWBENCH_SAMPLE_TIME` (`slewbench_step` returns `SLEWBENCH_ESAMPLE` otherwise).", ""]
@@ -336,6 +339,7 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
     constants = SymbolicConstants()
     law_parameters: dict[str, tuple[list[ca.SX], list[ca.SX], SymbolicConstants]] = {}
     law_reads: dict[str, set[str]] = {}
+    reads_rows: dict[str, bool] = {}
     for controller, controller_spec, law_stem in zip(laws, scenario.controllers, law_stems):
         controller.reset(spacecraft, spec.sample_time, target=(problem.qf, problem.omegaf))
         law = controller.symbolic_law()
@@ -347,6 +351,7 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
         inputs, outputs = controller.parametric_law(own)
         law_reads[name] = {key for key, (symbol, _) in own.symbols.items()
                            if ca.depends_on(ca.vertcat(*outputs), ca.vec(symbol))}
+        reads_rows[name] = bool(ca.depends_on(ca.vertcat(*outputs), inputs[3]))
         law_parameters[name] = (inputs, outputs, own)
         z0 = law.state0 if z0 is None else z0
         description = {
@@ -355,7 +360,8 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
             "outputs": {"u": law.function.nnz_out(0), "z_next": law.function.nnz_out(1)},
             "z0": law.state0.tolist(),
             "y_layout": "[q (4), omega (3, rad/s), h_w (n_w, N m s), b (3, T; zeros without a field model)]",
-            "r_layout": "reference rows [q, omega, omega_dot, torque] at t and t + sample_time",
+            "r_layout": ("reference rows [q, omega, omega_dot, torque] at t and t + sample_time (the target rows "
+                         "for a law that regulates)"),
             "u_layout": {key: [s.start, s.stop] for key, s in control_layout(spacecraft)[0].items()},
         }
         interface["laws"][name] = description
@@ -367,6 +373,7 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
         interface["laws"][name]["inputs"]["p"] = int(own.vector().numel())
         interface["laws"][name]["parameters"] = _parameter_code(own)[3]
         interface["laws"][name]["reads_parameters"] = sorted(law_reads[name])
+        interface["laws"][name]["reads_r"] = reads_rows[name]
     step_law = functions[0].name()
     functions += [saturation, segment_function("slewbench_segment")]
     tables: dict[str, tuple[str, Any]] = {}
@@ -423,7 +430,8 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
                                       f"extern const slewbench_table {default_reference}; /* slewbench_tables.c */"),
               "PARAM_FIELDS": parameter_fields, "PARAM_DEFAULTS": parameter_defaults, "PACK": parameter_pack,
               "NP": str(max(1, int(constants.vector().numel()))),
-              "BAKES_SAMPLE_TIME": "0" if "sample_time" in law_reads[step_law] else "1"}
+              "BAKES_SAMPLE_TIME": "0" if "sample_time" in law_reads[step_law] else "1",
+              "TRACKS": "1" if tracks else "0"}
     interface["skipped"] = dict(report.skipped)
     interface["step"] = {"law": step_law, "saturation": "slewbench_saturate", "segment": "slewbench_segment",
                          "default_reference": default_reference, "target": target.tolist()}
@@ -438,7 +446,7 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
                  "example.c": _template("example.c.in", values), "Makefile": _template("Makefile.in", values),
                  "slewbench_tables.h": tables_h, "slewbench_tables.c": tables_c,
                  "README.md": _readme(scenario, stem, step_law, tables, report.tables, report.skipped, tolerance,
-                                      readers, law_reads[step_law]),
+                                      readers, law_reads[step_law], reads_rows[step_law]),
                  "interface.json": json.dumps(interface, indent=1) + "\n"}
         for name, text in texts.items():
             (staging / name).write_text(text)
