@@ -35,5 +35,6 @@ _HOMES = {"CodegenReport": "scenarios.codegen.export", "c_identifier": "scenario
           "TableTolerance": "scenarios.codegen.tables", "interpolate": "scenarios.codegen.tables",
           "segment_function": "scenarios.codegen.tables", "tabulate": "scenarios.codegen.tables"}
 
-__all__ = sorted(_HOMES)
+__all__ = ["CodegenReport", "ReferenceTable", "TableError", "TableReference", "TableTolerance", "c_identifier",
+           "generate", "interpolate", "segment_function", "tabulate"]
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)

@@ -36,7 +36,13 @@ import numpy as np
 from controllers.allocation import SymbolicConstants
 from ocp.dynamics.actuators import ActuatorModel
 from ocp.dynamics.layout import REFERENCE_FIELDS, control_layout, reference_rows
-from scenarios.codegen.tables import TableError, TableTolerance, angle_text, segment_function, tabulate
+from scenarios.codegen.tables import (
+    TableError,
+    TableTolerance,
+    angle_text,
+    segment_function,
+    tabulate,
+)
 from scenarios.errors import ScenarioError
 from scenarios.output.directory import (
     claim_output_directory,
@@ -243,18 +249,18 @@ def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str
              "slewbench_init(&s);",
              "/* every SLEWBENCH_SAMPLE_TIME seconds: */",
              "slewbench_step(t, &measurement, &p, &command, &s);  /* 0: ok */", "```", "",
-             "`slewbench_step` reads the reference rows at `t` and `t + sample_time` from `p.reference` (a table "
+             ("`slewbench_step` reads the reference rows at `t` and `t + sample_time` from `p.reference` (a table "
              "of `slewbench_tables.h`; `NULL`: regulation to `p.target`), calls the law "
              f"(`{law}`), then, when `p.saturate` is 1, the saturation stage of the simulator "
              "(`slewbench_saturate`: failed wheels give nothing, wheel torque clipped to its limit and so that "
              "the momentum stays within its limit over the hold, dipole and torquer torques clipped per axis or "
              "scaled). `command.u` is the law's command, `command.u_applied` what the actuators apply. "
              "It uses static work arrays sized from the generated `_work` functions (checked by "
-             "`slewbench_init`), no allocation, and is not re-entrant.", "",
+             "`slewbench_init`), no allocation, and is not re-entrant."), "",
              "`example.c` is a worked use.", "", "## Parameters (`slewbench_params`)", "",
-             "The numbers the generated functions read as inputs (matrices row-major in the struct); the "
+             ("The numbers the generated functions read as inputs (matrices row-major in the struct); the "
              "defaults (`SLEWBENCH_PARAMS_DEFAULT`) are the scenario's. Numbers a law does not read through "
-             "its parameters are compiled into it: change them by regenerating.", "",
+             "its parameters are compiled into it: change them by regenerating."), "",
              "| field | shape | read by |", "|---|---|---|"]
     for name, shape, readers in parameters:
         lines.append(f"| `{name}` | {shape or 'scalar'} | {', '.join(readers) or 'nothing'} |")
@@ -262,23 +268,23 @@ def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str
               "| `reference` | table pointer | `slewbench_step`: the table to track; `NULL`: regulation to `target` |",
               "| `target` | 13 | the regulation row `[q_f, omega_f, 0, 0]` |", ""]
     if not reads_rows:
-        lines += [f"The law `{law}` compiles its target in and reads no reference: `reference` and `target` "
-                  "are not read.", ""]
+        lines += [(f"The law `{law}` compiles its target in and reads no reference: `reference` and `target` "
+                  "are not read."), ""]
     if "sample_time" not in law_reads:
-        lines += [f"The law `{law}` compiles the sample time in: `params.sample_time` must equal "
-                  "`SLEWBENCH_SAMPLE_TIME` (`slewbench_step` returns `SLEWBENCH_ESAMPLE` otherwise).", ""]
+        lines += [(f"The law `{law}` compiles the sample time in: `params.sample_time` must equal "
+                  "`SLEWBENCH_SAMPLE_TIME` (`slewbench_step` returns `SLEWBENCH_ESAMPLE` otherwise)."), ""]
     lines += [
              "## Reference tables", "",
-             "Interpolation (`slewbench_reference_row`; the same as `scenarios.codegen.tables.interpolate` in "
+             ("Interpolation (`slewbench_reference_row`; the same as `scenarios.codegen.tables.interpolate` in "
              "Python): the interval is the last node with `t_k <= t` (`t` clamped to the table); `q` cubic "
              "Hermite with derivatives `0.5 q (x) [0, omega]`, then renormalised; `omega` cubic Hermite with "
              "derivatives `omega_dot`; `omega_dot` and `torque` linear. Nodes: a uniform grid refined until the "
              "tolerances hold inside every interval (attitude "
              f"{tolerance.attitude_rad:g} rad, rate {tolerance.rate:g} and omega_dot/torque {tolerance.linear:g} "
              f"relative to their largest component, at most {tolerance.max_intervals} intervals), with the "
-             "reference's own points (collocation's nodes) and its breakpoints (doubled: left and right limits).",
-             "", "Error against the continuous reference, largest over seven points of every interval "
-             "(s = 1/8, ..., 7/8 of its length; the midpoint is where a smooth reference's error peaks):", "",
+             "reference's own points (collocation's nodes) and its breakpoints (doubled: left and right limits)."),
+             "", ("Error against the continuous reference, largest over seven points of every interval "
+             "(s = 1/8, ..., 7/8 of its length; the midpoint is where a smooth reference's error peaks):"), "",
              "| row | table | nodes | attitude | rate [rad/s] | omega_dot [rad/s^2] | torque [N m] | tolerances met |",
              "|---|---|---|---|---|---|---|---|"]
     for label, (name, table) in tables.items():
