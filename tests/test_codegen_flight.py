@@ -372,3 +372,18 @@ def test_parameters_are_inputs_the_law_and_saturation_read(name, law_reads, tmp_
         np.testing.assert_allclose(state.z[:built.nz], controller.state_vector(), rtol=0, atol=1e-12 * scale)
         saturated += expected_flag
     assert saturated > 0
+
+
+def test_the_c_templates_ship_as_package_data():
+    """The templates are read with importlib.resources: the wheel must hold them (pyproject's
+    package-data patterns of the scenarios package match every one)."""
+    import fnmatch
+    import tomllib
+
+    root = Path(__file__).resolve().parents[1]
+    patterns = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]["scenarios"]
+    templates = sorted((root / "scenarios" / "codegen" / "templates").iterdir())
+    assert {t.name for t in templates} >= {"slewbench_step.h.in", "slewbench_step.c.in", "example.c.in", "Makefile.in"}
+    for template in templates:
+        relative = template.relative_to(root / "scenarios").as_posix()
+        assert any(fnmatch.fnmatch(relative, pattern) for pattern in patterns), relative
