@@ -31,7 +31,7 @@ from ocp.fast_call import BufferedFunction, as_floats
 
 Array = NDArray[np.float64]
 
-__all__ = ["Allocation", "Demand", "demand_limits", "float_rows", "reference_demand"]
+__all__ = ["Allocation", "Demand", "SymbolicConstants", "demand_limits", "float_rows", "reference_demand"]
 
 
 def float_rows(matrix: ArrayLike) -> tuple[tuple[float, ...], ...]:
@@ -47,6 +47,70 @@ def float_rows(matrix: ArrayLike) -> tuple[tuple[float, ...], ...]:
     tuple of m tuples of n floats
     """
     return tuple(tuple(row) for row in np.asarray(matrix, dtype=float).tolist())
+
+
+class SymbolicConstants:
+    """The numbers a law reads through :meth:`Allocation.constant` while it is built as a function of
+    them (``Controller.parametric_law``, for ``slewbench codegen``): named CasADi symbols, each with
+    the value it has for the spacecraft and options of the last reset.
+
+    Attributes
+    ----------
+    symbols : dict of str to (casadi.SX, ndarray)
+        Name -> its symbol (the value's shape; a scalar is 1 x 1) and its value, in the order read.
+    """
+
+    def __init__(self) -> None:
+        self.symbols: dict[str, tuple[ca.SX, Array]] = {}
+
+    def get(self, name: str, value: ArrayLike) -> ca.SX:
+        """The symbol of ``name`` (created on first use with ``value``'s shape).
+
+        Parameters
+        ----------
+        name : str
+            The number's name (a C identifier: it becomes a field of the generated parameter struct).
+        value : float or array_like
+            Its value for the last reset.
+
+        Returns
+        -------
+        casadi.SX
+            The symbol, the same for every read of ``name``.
+        """
+        if name not in self.symbols:
+            array = np.asarray(value, dtype=np.float64)
+            shape = (1, 1) if array.ndim == 0 else (array.shape[0], 1) if array.ndim == 1 else array.shape
+            self.symbols[name] = (ca.SX.sym(name, *shape), array)
+        return self.symbols[name][0]
+
+    def vector(self) -> ca.SX:
+        """Every symbol, flattened column by column and stacked in the order read.
+
+        Returns
+        -------
+        (n, 1) casadi.SX
+        """
+        return ca.vertcat(*(ca.vec(symbol) for symbol, _ in self.symbols.values())) if self.symbols else ca.SX(0, 1)
+
+
+def _pseudo_inverse_symbolic(axes: ca.SX, working: Array) -> ca.SX | None:
+    """``A⁺`` of the working columns of ``axes`` (zero rows for failed wheels) as an expression, for
+    full-rank cases (``Aᵀ(AAᵀ)⁻¹`` with three independent axes, ``(AᵀA)⁻¹Aᵀ`` with fewer); ``None``
+    when the working axes are rank deficient (the pseudo-inverse is then a compiled-in number)."""
+    index = [int(i) for i in np.flatnonzero(working)]
+    if not index:
+        return None
+    reduced = axes[:, index]
+    return_rows = ca.SX.zeros(axes.shape[1], 3)
+    if len(index) >= 3:
+        inner = ca.mtimes(reduced, reduced.T)
+        rows = ca.mtimes(reduced.T, ca.inv_minor(inner))
+    else:
+        inner = ca.mtimes(reduced.T, reduced)
+        rows = ca.mtimes(ca.inv_minor(inner), reduced.T)
+    return_rows[index, :] = rows
+    return return_rows
 
 
 class Allocation:
@@ -67,6 +131,45 @@ class Allocation:
     spacecraft: Spacecraft | None
     _slices: dict[str, slice]
     _nu: int
+    _constants: SymbolicConstants | None = None
+    """Set while the law is built as a function of its numbers (:meth:`constant`)."""
+
+    def constant(self, name: str, value: Any) -> Any:
+        """A number the symbolic law reads (a gain, the inertia, the sample time, ...).
+
+        Parameters
+        ----------
+        name : str
+            Its name, a C identifier (the field of the generated parameter struct).
+        value : float or array_like
+            Its value for the spacecraft and options of the last reset.
+
+        Returns
+        -------
+        float, casadi.DM or casadi.SX
+            ``value`` itself (a Python float) or as a ``casadi.DM``; while the law is built as a
+            function of its numbers (``Controller.parametric_law``), the named symbol instead.
+        """
+        if self._constants is not None:
+            return self._constants.get(name, value)
+        return value if isinstance(value, float) else ca.DM(np.asarray(value, dtype=np.float64))
+
+    def _wheel_matrices_symbolic(self) -> tuple[Any, Any, Any]:
+        """The wheel axes, the working axes and their pseudo-inverse for the symbolic law: numbers,
+        or (parametric build) expressions of the ``wheel_axes`` symbol (the pseudo-inverse stays a
+        number when the working axes are rank deficient)."""
+        spacecraft = self._spacecraft()
+        axes = self.constant("wheel_axes", spacecraft.wheel_axes)
+        working_value = self._working_axes
+        if working_value is None:
+            raise RuntimeError("the symbolic wheel matrices need working wheels")
+        if self._constants is None:
+            return axes, ca.DM(working_value), ca.DM(self._wheel_pinv)
+        working = np.any(working_value != 0.0, axis=0).astype(float)  # failed wheels: zero columns
+        working_axes = ca.mtimes(axes, ca.diag(ca.DM(working)))
+        rank_ok = np.linalg.matrix_rank(working_value) == min(3, int(working.sum()))
+        pinv = _pseudo_inverse_symbolic(axes, working) if rank_ok else None
+        return axes, working_axes, ca.DM(self._wheel_pinv) if pinv is None else pinv
 
     def _spacecraft(self) -> Spacecraft:
         """The spacecraft of the last reset (an error before any)."""
@@ -181,12 +284,13 @@ class Allocation:
         residual = torque
         done = None
         if self._working_axes is not None:
+            axes, working_axes, wheel_pinv = self._wheel_matrices_symbolic()
             w = omega if rate is None else rate
-            h = ca.mtimes(ca.DM(spacecraft.wheel_axes), h_w if wheel_momentum is None else wheel_momentum)
+            h = ca.mtimes(axes, h_w if wheel_momentum is None else wheel_momentum)
             wheel_torque = residual + ca.cross(w, h) if self.gyroscopic_compensation else residual
-            g = -ca.mtimes(ca.DM(self._wheel_pinv), wheel_torque)
+            g = -ca.mtimes(wheel_pinv, wheel_torque)
             parts["wheels"] = g
-            residual = wheel_torque + ca.mtimes(ca.DM(self._working_axes), g)
+            residual = wheel_torque + ca.mtimes(working_axes, g)
             done = ca.norm_2(residual) <= 1e-12 * ca.fmax(ca.norm_2(wheel_torque), 1e-300)
         sink = self._sink
         if sink is not None:

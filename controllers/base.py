@@ -18,7 +18,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from controllers.allocation import Allocation
+from controllers.allocation import Allocation, SymbolicConstants
 from ocp import ActuatorModel, Command, Measurement, Spacecraft
 from ocp.dynamics.layout import (
     REFERENCE_FIELDS,
@@ -305,6 +305,40 @@ class Controller(Allocation, Configurable, ABC):
         function = ca.Function(f"law_{self.name}", [t, y, z, r], [u, ca.reshape(z_next, state0.size, 1)],
                                ["t", "y", "z", "r"], ["u", "z_next"])
         return SymbolicLaw(function, state0, self.symbolic_key())
+
+    def parametric_law(self, constants: SymbolicConstants) -> tuple[list[ca.SX], list[ca.SX]]:
+        """The law's expressions with the numbers it reads through :meth:`constant` (gains, inertia,
+        wheel axes, sample time, ...) as symbols, for code generation that makes them inputs.
+
+        Laws that read their numbers through :meth:`constant` have them all as symbols; numbers a law
+        bakes in otherwise stay numbers (the generated code then compiles them in).
+
+        Parameters
+        ----------
+        constants : SymbolicConstants
+            Receives the named symbols and their values for the last :meth:`reset` (shared with other
+            parametric expressions, such as the saturation stage's).
+
+        Returns
+        -------
+        inputs : list of casadi.SX
+            The symbols ``t``, ``y``, ``z``, ``r`` (see "Symbolic form").
+        outputs : list of casadi.SX
+            ``u`` and ``z_next``, expressions of the inputs and of ``constants``' symbols.
+
+        Raises
+        ------
+        NotImplementedError
+            For a law that has no symbolic form.
+        """
+        law = self.symbolic_law()  # checks the law and gives the initial state's size
+        inputs = law.function.sx_in()
+        self._constants = constants
+        try:
+            u, z_next = self._law(*inputs)
+        finally:
+            self._constants = None
+        return inputs, [ca.SX(u), ca.reshape(ca.SX(z_next), law.state0.size, 1)]
 
     def reference_rows(self, reference: Any, times: Array) -> Array:
         """Reference rows in the layout of the symbolic form.

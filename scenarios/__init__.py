@@ -19,7 +19,8 @@ Subpackages, from the bottom up (each may import only those before it, and :mod:
   :class:`~scenarios.output.results.RunResults`) as tables, files and figures, and the output
   directories slewbench owns;
 * :mod:`scenarios.runner` (a module): plan, track and score every row of a scenario;
-* :mod:`scenarios.codegen` (a module): a scenario's law and references as C;
+* :mod:`scenarios.codegen`: flight C of a scenario (the law, the saturation stage, every
+  row's reference as a table, behind ``slewbench_step``);
 * :mod:`scenarios.study`: trade studies: their schema, cases, store, engine and report;
 * :mod:`scenarios.cli`: the ``slewbench`` command line.
 

@@ -1,5 +1,6 @@
 """``slewbench codegen``: the generated C, built with its Makefile and loaded with
-``casadi.external``, equals the Python law and the Python reference at random inputs (issue 13)."""
+``casadi.external``, equals the Python law (at its default parameters, the scenario's numbers) and
+the Python reference at random inputs (issue 13)."""
 import json
 import shutil
 import subprocess
@@ -20,6 +21,12 @@ pytestmark = pytest.mark.skipif(shutil.which("make") is None or shutil.which("cc
                                 reason="needs make and a C compiler")
 
 
+def _default_parameters(parameters):
+    """The parameter vector ``p`` of the defaults (column-major blocks, as interface.json says)."""
+    return np.concatenate([np.asarray(p["default"], dtype=float).ravel(order="F") for p in parameters]
+                          or [np.zeros(0)])
+
+
 @pytest.mark.parametrize("name", ["eigenaxis_demo.yaml", "nano_eigenaxis_pd.yaml"])
 def test_generated_c_equals_the_python_law_and_references(name, tmp_path, rng):
     out = tmp_path / "c"
@@ -35,13 +42,14 @@ def test_generated_c_equals_the_python_law_and_references(name, tmp_path, rng):
     references = [PLANNERS[p.name](p.options).plan(problem) for p in scenario.planners]
     n_w = problem.spacecraft.n_wheels
     z = np.array(interface["slewbench_law"]["z0"])
+    defaults = _default_parameters(interface["slewbench_law"]["parameters"])
     for _ in range(50):
         t = float(rng.uniform(0, 150))
         measurement = Measurement(t, quat.random_unit(rng), rng.normal(0, 0.05, 3), rng.normal(0, 0.5, n_w), None)
         reference = references[rng.integers(len(references))] if references else None
         r = controller.reference_rows(reference, np.array([t, t + spec.sample_time])).ravel()
         y = np.r_[measurement.q, measurement.omega, measurement.wheel_momentum, np.zeros(3)]
-        u, z_next = (v.full().ravel() for v in law(t, y, z, r))
+        u, z_next = (v.full().ravel() for v in law(t, y, z, r, defaults))
         expected = controller.command_vector(controller(t, measurement, reference))
         np.testing.assert_allclose(u, expected, rtol=0, atol=1e-12 * max(1.0, np.abs(expected).max()))
         np.testing.assert_allclose(z_next, controller.state_vector(), rtol=0, atol=1e-12)
@@ -99,7 +107,7 @@ def test_every_controller_of_a_list_is_exported(tmp_path, rng):
             field = rng.normal(0.0, 3e-5, 3)
             measurement = Measurement(t, quat.random_unit(rng), rng.normal(0, 0.3, 3), np.zeros(0), field)
             y = np.r_[measurement.q, measurement.omega, field]
-            u, z = (v.full().ravel() for v in law(t, y, z, r))
+            u, z = (v.full().ravel() for v in law(t, y, z, r, _default_parameters(description["parameters"])))
             expected = controller.command_vector(controller(t, measurement, None))
             np.testing.assert_allclose(u, expected, rtol=0, atol=1e-12 * max(1.0, np.abs(expected).max()))
             np.testing.assert_allclose(z, controller.state_vector(), rtol=0, atol=1e-12)

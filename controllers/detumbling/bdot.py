@@ -117,10 +117,15 @@ class BDot(MagneticController):
         b = self.symbolic_field(y)
         previous, started = z[0:3], z[3]
         difference = b - previous
+        # K_b / T_s and the filter's factor from the named numbers (inputs of the generated C).
+        gain, sample_time = self.constant("gain", float(self.options.gain)), self.constant("sample_time", float(self.sample_time))
+        gain_per_sample = self._gain_per_sample if self._constants is None else gain / sample_time
         if self.options.derivative == "filtered":
-            filtered = ca.if_else(started, self._alpha * z[4:7] + (1 - self._alpha) * difference, z[4:7])
+            time_constant = self.constant("filter_time_constant", float(self.options.filter_time_constant))
+            alpha = self._alpha if self._constants is None else ca.exp(-sample_time / time_constant)
+            filtered = ca.if_else(started, alpha * z[4:7] + (1 - alpha) * difference, z[4:7])
             rate, extra = filtered, [filtered]
         else:
             rate, extra = difference, []
-        dipole = ca.if_else(started, -self._gain_per_sample * rate, ca.DM.zeros(3))
+        dipole = ca.if_else(started, -gain_per_sample * rate, ca.DM.zeros(3))
         return self.symbolic_dipole(dipole), ca.vertcat(b, 1.0, *extra)

@@ -146,6 +146,7 @@ class TDFC(MagneticController):
         b = self.symbolic_field(y)
         count = z[3 * d]
         oldest = z[3 * (d - 1):3 * d]
-        dipole = ca.if_else(count >= d, -self.options.gain * (b - oldest), ca.DM.zeros(3))
+        gain = self.constant("gain", float(self.options.gain))  # the delay (in samples) fixes the state's size
+        dipole = ca.if_else(count >= d, -gain * (b - oldest), ca.DM.zeros(3))
         z_next = ca.vertcat(b, z[0:3 * (d - 1)], ca.fmin(count + 1, d))
         return self.symbolic_dipole(dipole), z_next

@@ -190,16 +190,18 @@ class AugmentedQuaternionFeedback(Controller):
         spacecraft = self._spacecraft()
         n_w = spacecraft.n_wheels
         q, w, h, _ = split_measurement(y, n_w)
-        rows = r if self.tracks_reference else ca.DM(self.setpoints(0.0, None).ravel())
+        # A regulator reads its target from r when it is built for code generation (the generated
+        # step fills r with the target then); otherwise the target is compiled in.
+        rows = r if self.tracks_reference or self._constants is not None else ca.DM(self.setpoints(0.0, None).ravel())
         q_ref, w_ref = rows[0:4], rows[4:7]
         w_ref_next, accel_ref = rows[REFERENCE_FIELDS + 4:REFERENCE_FIELDS + 7], rows[7:10]
         scalar = ca.dot(q_ref, q)
         vector = q_ref[0] * q[1:4] - q[0] * q_ref[1:4] - ca.cross(q_ref[1:4], q[1:4])
         vector = ca.if_else(scalar < 0, -vector, vector)
-        K, C = ca.DM(self.stiffness), ca.DM(self.damping)
+        K, C = self.constant("stiffness", self.stiffness), self.constant("damping", self.damping)
         feedback = -ca.mtimes(K, vector) - ca.mtimes(C, w - w_ref)
-        options, T = self.options, self.sample_time
-        inertia = ca.DM(spacecraft.inertia)
+        options, T = self.options, self.constant("sample_time", float(self.sample_time))
+        inertia = self.constant("inertia", spacecraft.inertia)
         accel: ca.SX | ca.DM
         if not options.feedforward:
             accel = ca.DM.zeros(3)
@@ -208,12 +210,13 @@ class AugmentedQuaternionFeedback(Controller):
         else:
             accel = accel_ref
         if options.hold_compensation:
-            w_mid = w + 0.5 * T * (ca.mtimes(ca.DM(self._inverse_inertia), feedback) + accel)
+            inverse = ca.inv_minor(inertia) if self._constants is not None else ca.DM(self._inverse_inertia)
+            w_mid = w + 0.5 * T * (ca.mtimes(inverse, feedback) + accel)
         else:
             w_mid = w
         torque = feedback + ca.mtimes(inertia, accel) + ca.cross(w_mid, ca.mtimes(inertia, w_mid))
         h_mid = None
         if options.hold_compensation and self._working_axes is not None:
-            axes = ca.DM(spacecraft.wheel_axes)
-            h_mid = h - 0.5 * T * ca.mtimes(ca.DM(self._wheel_pinv), torque + ca.cross(w_mid, ca.mtimes(axes, h)))
+            axes, _, wheel_pinv = self._wheel_matrices_symbolic()
+            h_mid = h - 0.5 * T * ca.mtimes(wheel_pinv, torque + ca.cross(w_mid, ca.mtimes(axes, h)))
         return self.allocate_symbolic(torque, y, rate=w_mid, wheel_momentum=h_mid), z

@@ -35,6 +35,22 @@ __all__ = ["ACTUATOR_KINDS", "SATURATION_MODES", "Actuator", "Magnetorquers", "R
            "actuator_kind"]
 
 
+def casadi_number(value: Any) -> Any:
+    """A limit for the symbolic saturation: a ``casadi.DM`` of the number, or the symbol itself when
+    code generation makes the limit an input (``slewbench codegen``).
+
+    Parameters
+    ----------
+    value : array_like, casadi.SX or casadi.MX
+        The limit (its unit).
+
+    Returns
+    -------
+    casadi.DM, casadi.SX or casadi.MX
+    """
+    return value if isinstance(value, (ca.SX, ca.MX)) else ca.DM(value)
+
+
 def _limit_vector(value: ArrayLike | None, size: int, field_name: str) -> Array:
     """Per-element positive limit; ``None`` means unlimited (inf)."""
     if value is None:
@@ -375,7 +391,7 @@ class _BodyAxisVector(Actuator):
         flags : list of casadi.SX or MX
             1 where an axis asks its limit or more.
         """
-        bound = ca.DM(self._axis_limit)
+        bound = casadi_number(self._axis_limit)
         if self._scaled:  # as the numeric form: the vector scaled as a whole
             ratio = ca.mmax(ca.fabs(u) / bound)
             applied = ca.if_else(ratio > 1.0, u / ratio, u)
@@ -636,7 +652,7 @@ class ReactionWheels(Actuator):
             1 where a wheel was clipped, and where a wheel is at its torque limit.
         """
         g = u * ca.DM(self.working.astype(float))
-        g_max, h_max = ca.DM(self.max_torque), ca.DM(self.max_momentum)
+        g_max, h_max = casadi_number(self.max_torque), casadi_number(self.max_momentum)
         low = ca.fmax(-g_max, (-h_max - state) / dt)
         high = ca.fmax(ca.fmin(g_max, (h_max - state) / dt), low)
         applied = ca.fmin(ca.fmax(g, low), high)

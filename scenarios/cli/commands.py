@@ -241,8 +241,8 @@ def command_export(args: argparse.Namespace) -> int:
 
 
 def command_codegen(args: argparse.Namespace) -> int:
-    """``slewbench codegen FILE --out DIR``: export the controller law (and closed-form
-    references) as CasADi-generated C with a header and a Makefile.
+    """``slewbench codegen FILE --out DIR``: export the controller law, its saturation stage and every
+    planner row's reference (as a table) as C behind ``slewbench_step``, with a Makefile and an example.
 
     Parameters
     ----------
@@ -262,6 +262,9 @@ def command_codegen(args: argparse.Namespace) -> int:
     report = generate(scenario, args.out)
     print(f"wrote {report.directory}/: " + ", ".join(f"{name} ({size} bytes)" for name, size in report.files.items()))
     print("functions: " + ", ".join(report.functions))
+    for label, error in report.tables.items():
+        print(f"  table of row {label!r}: attitude error {error.attitude_rad:.2g} rad, rate {error.rate:.2g} rad/s, "
+              f"torque {error.torque:.2g} N m" + ("" if error.met else " (tolerances NOT met: see README.md)"))
     for label, reason in report.skipped.items():
         print(f"  no C reference for row {label!r}: {reason}")
     print(f"build: make -C {report.directory}")
@@ -299,7 +302,7 @@ def build_parser() -> argparse.ArgumentParser:
     validate_parser = commands.add_parser("validate", help="check a scenario or study file; print what would run")
     validate_parser.add_argument("file", help="scenario or study YAML file (a study has the top-level key 'study')")
     validate_parser.set_defaults(handler=command_validate)
-    codegen_parser = commands.add_parser("codegen", help="export the controller law (and closed-form references) as C")
+    codegen_parser = commands.add_parser("codegen", help="export the controller law, saturation and reference tables as flight C")
     codegen_parser.add_argument("file", help="scenario YAML file")
     codegen_parser.add_argument("--out", required=True, help="output directory (new, empty, or written by slewbench)")
     codegen_parser.set_defaults(handler=command_codegen)
