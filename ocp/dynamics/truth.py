@@ -372,7 +372,9 @@ class TruthPlant:
             g = g - ca.DM(self._coulomb) * ca.sign(speed)
         if self._viscous is not None:
             g = g - ca.DM(self._viscous) * speed
-        return ca.vertcat(u[0:where.start], g, u[where.stop:u.shape[0]])
+        parts = [u[i] for i in range(u.shape[0])]
+        parts[where.start:where.stop] = [g[i] for i in range(g.shape[0])]
+        return ca.vertcat(*parts)
 
     def plant_torque(self, x: Any, t: Any) -> Any:
         """The truth's torques besides the actuators': residual dipole and periodic disturbances.
