@@ -342,7 +342,7 @@ class TruthPlant:
         wheels = self.model.spacecraft.wheels
         assert wheels is not None and wheels.spin_inertia is not None
         omega, h_w = x[4:7], x[7:self.model.nx]
-        return h_w / ca.DM(wheels.spin_inertia) - ca.mtimes(ca.DM(wheels.axes.T), omega)
+        return h_w * ca.DM(1.0 / wheels.spin_inertia) - ca.mtimes(ca.DM(wheels.axes.T), omega)
 
     def effective_control(self, x: Any, u: Any) -> Any:
         """The control the dynamics see: each wheel's motor torque cut at its speed limit, less
@@ -367,7 +367,7 @@ class TruthPlant:
         speed = self.wheel_speed(x)
         g = u[where]
         if self._max_speed is not None:
-            g = ca.if_else(ca.logic_and(ca.fabs(speed) >= ca.DM(self._max_speed), g * speed > 0), 0.0, g)
+            g = g * (1 - (ca.fabs(speed) >= ca.DM(self._max_speed)) * (g * speed > 0))
         if self._coulomb is not None:
             g = g - ca.DM(self._coulomb) * ca.sign(speed)
         if self._viscous is not None:
@@ -396,10 +396,18 @@ class TruthPlant:
             field = self.design.magnetic_field_body(x[0:4], t)
             torque = ca.cross(ca.DM(self.truth.residual_dipole), field)
         orbit = self.design.environment.orbit
-        for item in self.truth.periodic_disturbance:
+        if self.truth.periodic_disturbance:
+            # A sin(k θ + φ) = (A cos φ) sin kθ + (A sin φ) cos kθ, θ = n t: one sine and one cosine
+            # per time, the second harmonic by the double-angle formulas.
             assert orbit is not None
-            part = ca.DM(item.amplitude) * ca.sin(item.harmonic * orbit.mean_motion * t + ca.DM(item.phase))
-            torque = part if torque is None else torque + part
+            angle = orbit.mean_motion * t
+            sine, cosine = ca.sin(angle), ca.cos(angle)
+            harmonics = {1: (sine, cosine), 2: (2 * sine * cosine, 1 - 2 * sine * sine)}
+            for item in self.truth.periodic_disturbance:
+                sin_k, cos_k = harmonics[item.harmonic]
+                part = (ca.DM(item.amplitude * np.cos(item.phase)) * sin_k
+                        + ca.DM(item.amplitude * np.sin(item.phase)) * cos_k)
+                torque = part if torque is None else torque + part
         return torque
 
     def _build(self) -> None:
