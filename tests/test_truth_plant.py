@@ -43,7 +43,8 @@ class Constant:
         return Command(wheel_torque=self.torque.copy())
 
 
-def wheel_model(axes=np.eye(3), inertia=(19.5, 19.0, 12.6), environment=None, **wheels):
+def wheel_model(axes=None, inertia=(19.5, 19.0, 12.6), environment=None, **wheels):
+    axes = np.eye(3) if axes is None else axes
     spacecraft = Spacecraft(inertia, wheels=ReactionWheels(axes, spin_inertia=SPIN_INERTIA, **wheels))
     return AttitudeModel(spacecraft, environment)
 

@@ -289,7 +289,7 @@ class TruthPlant:
                                                  **limits)
         inertia = spacecraft.inertia if truth.inertia is None else truth.inertia
         try:
-            truth_spacecraft = Spacecraft(inertia, **actuators)
+            truth_spacecraft = Spacecraft(inertia, **actuators)  # type: ignore[arg-type]  # kinds by their names
         except ModelError as error:
             raise ModelError(f"spacecraft.{error.field}", error.message) from None
         self.model = AttitudeModel(truth_spacecraft, design.environment)
@@ -394,6 +394,7 @@ class TruthPlant:
         torque = None
         if self.truth.residual_dipole is not None:
             field = self.design.magnetic_field_body(x[0:4], t)
+            assert field is not None  # checked at construction
             torque = ca.cross(ca.DM(self.truth.residual_dipole), field)
         orbit = self.design.environment.orbit
         if self.truth.periodic_disturbance:

@@ -24,8 +24,8 @@ import numpy as np
 
 from controllers import CONTROLLERS, Controller
 from ocp import Environment, SensorNoise, Spacecraft, quat
-from ocp.errors import OptionsError, excerpt
 from ocp.dynamics.truth import TruthPlant
+from ocp.errors import OptionsError, excerpt
 from ocp.geometry.directions import Geometry
 from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem, Planner
@@ -53,7 +53,6 @@ from scenarios.schema.model import (
 )
 from scenarios.schema.node import Node
 from scenarios.schema.read import read_yaml
-from scenarios.schema.truth import TRUTH, parse_truth
 from scenarios.schema.requirements import (
     REQUIREMENTS,
     RunSpan,
@@ -61,6 +60,7 @@ from scenarios.schema.requirements import (
     parse_epoch,
     parse_requirements,
 )
+from scenarios.schema.truth import TRUTH, parse_truth
 
 MAX_NAME = 200
 """Characters of a scenario name (the default output directory uses a sanitised, shorter stem)."""
