@@ -35,12 +35,12 @@ BASE = {
     "truth": {
         "spacecraft": {"inertia": [2.0, 1.8, 1.2]},
         "wheels": {"misalignment_deg": [[0, 1, 0], [0, 0, 1], [1, 0, 0]], "max_torque": 0.004,
-                   "max_momentum": 0.04, "friction": {"coulomb_N_m": 1e-5, "viscous_N_m_s": 1e-6},
-                   "max_speed_rpm": 3000.0, "torque_noise_N_m": 1e-5},
+                   "max_momentum": 0.04, "friction": {"coulomb": 1e-5, "viscous": 1e-6},
+                   "max_speed_rpm": 3000.0, "torque_noise": 1e-5},
         "magnetorquers": {"scale_error": 0.05},
-        "residual_dipole_A_m2": [0.01, 0.0, 0.0],
-        "disturbance": {"constant_N_m": [0.0, 1e-7, 0.0],
-                        "orbit_periodic": [{"harmonic": 1, "amplitude_N_m": [1e-7, 0, 0], "phase_deg": [0, 0, 0]}]},
+        "residual_dipole": [0.01, 0.0, 0.0],
+        "disturbance": {"constant": [0.0, 1e-7, 0.0],
+                        "orbit_periodic": [{"harmonic": 1, "amplitude": [1e-7, 0, 0], "phase_deg": [0, 0, 0]}]},
     },
 }
 
@@ -50,15 +50,15 @@ CHANGES = {
     "truth.wheels.misalignment_deg": ("wheel_misalignment", [[0, 2, 0], [0, 0, 1], [1, 0, 0]]),
     "truth.wheels.max_torque": ("wheel_max_torque", 0.003),
     "truth.wheels.max_momentum": ("wheel_max_momentum", [0.04, 0.03, 0.04]),
-    "truth.wheels.friction.coulomb_N_m": ("wheel_coulomb", 2e-5),
-    "truth.wheels.friction.viscous_N_m_s": ("wheel_viscous", 3e-6),
+    "truth.wheels.friction.coulomb": ("wheel_coulomb", 2e-5),
+    "truth.wheels.friction.viscous": ("wheel_viscous", 3e-6),
     "truth.wheels.max_speed_rpm": ("wheel_max_speed", 2000.0),
-    "truth.wheels.torque_noise_N_m": ("wheel_torque_noise", 2e-5),
+    "truth.wheels.torque_noise": ("wheel_torque_noise", 2e-5),
     "truth.magnetorquers.scale_error": ("dipole_scale_error", -0.05),
-    "truth.residual_dipole_A_m2": ("residual_dipole", [0.0, 0.02, 0.0]),
-    "truth.disturbance.constant_N_m": ("constant_disturbance", [0.0, 0.0, 2e-7]),
+    "truth.residual_dipole": ("residual_dipole", [0.0, 0.02, 0.0]),
+    "truth.disturbance.constant": ("constant_disturbance", [0.0, 0.0, 2e-7]),
     "truth.disturbance.orbit_periodic[0].harmonic": ("periodic_disturbance", 2),
-    "truth.disturbance.orbit_periodic[0].amplitude_N_m": ("periodic_disturbance", [0, 2e-7, 0]),
+    "truth.disturbance.orbit_periodic[0].amplitude": ("periodic_disturbance", [0, 2e-7, 0]),
     "truth.disturbance.orbit_periodic[0].phase_deg": ("periodic_disturbance", [10, 0, 0]),
 }
 
@@ -117,8 +117,8 @@ def _base_value(path):
 
 @pytest.mark.parametrize(("path", "value", "words"), [
     ("wheels.misalignment_deg", [[0, 10.5, 0], [0, 0, 1], [1, 0, 0]], "exceeds 10 deg"),
-    ("wheels.torque_noise_N_m", -1e-5, "expected numbers >= 0"),
-    ("wheels.friction.viscous_N_m_s", [1e-6, -1e-6, 0], "expected numbers >= 0"),
+    ("wheels.torque_noise", -1e-5, "expected numbers >= 0"),
+    ("wheels.friction.viscous", [1e-6, -1e-6, 0], "expected numbers >= 0"),
     ("spacecraft.inertia", [[1.0, 2.0, 0.0], [2.0, 1.0, 0.0], [0.0, 0.0, 1.0]], "positive definite"),
     ("magnetorquers.scale_error", -1.0, "> -1"),
     ("wheels.max_torque", [0.1, 0.1], "one per wheel"),
@@ -142,7 +142,7 @@ def test_residual_dipole_without_a_field_names_its_path():
     del data["environment"]["magnetic_field"]
     with pytest.raises(ScenarioError, match="magnetic field") as caught:
         parse_scenario(data)
-    assert caught.value.path == "truth.residual_dipole_A_m2"
+    assert caught.value.path == "truth.residual_dipole"
 
 
 def test_without_truth_the_scenario_has_none():

@@ -173,10 +173,10 @@ class Truth:
             object.__setattr__(self, "wheel_misalignment", angles)
         for name, key, checks in (("wheel_max_torque", "wheels.max_torque", {"positive": True}),
                                   ("wheel_max_momentum", "wheels.max_momentum", {"positive": True}),
-                                  ("wheel_coulomb", "wheels.friction.coulomb_N_m", {"non_negative": True}),
-                                  ("wheel_viscous", "wheels.friction.viscous_N_m_s", {"non_negative": True}),
+                                  ("wheel_coulomb", "wheels.friction.coulomb", {"non_negative": True}),
+                                  ("wheel_viscous", "wheels.friction.viscous", {"non_negative": True}),
                                   ("wheel_max_speed", "wheels.max_speed_rpm", {"positive": True}),
-                                  ("wheel_torque_noise", "wheels.torque_noise_N_m", {"non_negative": True})):
+                                  ("wheel_torque_noise", "wheels.torque_noise", {"non_negative": True})):
             value = getattr(self, name)
             if value is not None:
                 array = np.asarray(value, dtype=float)
@@ -188,9 +188,9 @@ class Truth:
             raise ModelError("magnetorquers.scale_error", f"expected scale errors > -1 (a dipole that keeps its sign), "
                                                           f"got {scale.tolist()}")
         object.__setattr__(self, "dipole_scale_error", scale)
-        object.__setattr__(self, "residual_dipole", _optional(self.residual_dipole, (3,), "residual_dipole_A_m2"))
+        object.__setattr__(self, "residual_dipole", _optional(self.residual_dipole, (3,), "residual_dipole"))
         object.__setattr__(self, "constant_disturbance",
-                           _optional(self.constant_disturbance, (3,), "disturbance.constant_N_m"))
+                           _optional(self.constant_disturbance, (3,), "disturbance.constant"))
         periodic = tuple(self.periodic_disturbance)
         if not all(isinstance(item, PeriodicTorque) for item in periodic):
             raise ModelError("disturbance.orbit_periodic", "expected PeriodicTorque entries")
@@ -254,9 +254,9 @@ class TruthPlant:
         wheels = spacecraft.wheels
         n = spacecraft.n_wheels
         wheel_fields = {"wheel_misalignment": "wheels.misalignment_deg", "wheel_max_torque": "wheels.max_torque",
-                        "wheel_max_momentum": "wheels.max_momentum", "wheel_coulomb": "wheels.friction.coulomb_N_m",
-                        "wheel_viscous": "wheels.friction.viscous_N_m_s", "wheel_max_speed": "wheels.max_speed_rpm",
-                        "wheel_torque_noise": "wheels.torque_noise_N_m"}
+                        "wheel_max_momentum": "wheels.max_momentum", "wheel_coulomb": "wheels.friction.coulomb",
+                        "wheel_viscous": "wheels.friction.viscous", "wheel_max_speed": "wheels.max_speed_rpm",
+                        "wheel_torque_noise": "wheels.torque_noise"}
         if wheels is None:
             for name, key in wheel_fields.items():
                 if getattr(truth, name) is not None:
@@ -279,8 +279,8 @@ class TruthPlant:
                                             ("wheel_max_momentum", "max_momentum", wheels.max_momentum)):
                 value = _per_wheel(getattr(truth, name), n, wheel_fields[name])
                 limits[key] = design_value if value is None else value
-            needs_inertia = [key for key, value in (("wheels.friction.viscous_N_m_s", self._viscous),
-                                                    ("wheels.friction.coulomb_N_m", self._coulomb),
+            needs_inertia = [key for key, value in (("wheels.friction.viscous", self._viscous),
+                                                    ("wheels.friction.coulomb", self._coulomb),
                                                     ("wheels.max_speed_rpm", self._max_speed)) if value is not None]
             if needs_inertia and wheels.spin_inertia is None:
                 raise ModelError(needs_inertia[0], "the wheels' speed needs their spin inertia "
@@ -297,7 +297,7 @@ class TruthPlant:
         if truth.dipole_scale_error is not None and spacecraft.magnetorquers is None:
             raise ModelError("magnetorquers.scale_error", "the spacecraft has no magnetorquers")
         if truth.residual_dipole is not None and design.field_body is None:
-            raise ModelError("residual_dipole_A_m2", "a residual dipole needs a magnetic field model "
+            raise ModelError("residual_dipole", "a residual dipole needs a magnetic field model "
                                                      "(environment.magnetic_field)")
         if truth.periodic_disturbance and env.orbit is None:
             raise ModelError("disturbance.orbit_periodic", "an orbit-periodic disturbance needs an orbit (orbit:)")

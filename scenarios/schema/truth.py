@@ -86,11 +86,11 @@ TRUTH_SPACECRAFT = Section((
 ), "The true rigid body.")
 
 TRUTH_FRICTION = Section((
-    custom("coulomb_N_m", "Coulomb friction torque of each wheel's bearing, ``c sign(Ω)`` with ``Ω`` the wheel's "
+    custom("coulomb", "Coulomb friction torque of each wheel's bearing, ``c sign(Ω)`` with ``Ω`` the wheel's "
            "speed relative to the body (needs ``spacecraft.wheels.spin_inertia``).",
            "number, list of numbers (one per wheel) or null", _per_wheel(non_negative=True), unit="N m",
            default=None, bounds=">= 0"),
-    custom("viscous_N_m_s", "Viscous friction coefficient of each wheel's bearing, torque ``b Ω`` (needs "
+    custom("viscous", "Viscous friction coefficient of each wheel's bearing, torque ``b Ω`` (needs "
            "``spacecraft.wheels.spin_inertia``).", "number, list of numbers (one per wheel) or null",
            _per_wheel(non_negative=True), unit="N m s", default=None, bounds=">= 0"),
 ), "Bearing friction, internal to the spacecraft: it slows each wheel and turns the body the other way.")
@@ -112,7 +112,7 @@ TRUTH_WHEELS = Section((
            "is at it and the motor would drive it further (needs ``spacecraft.wheels.spin_inertia``); "
            "``null``: none.", "number, list of numbers (one per wheel) or null", _per_wheel(positive=True),
            unit="rpm", default=None, bounds="> 0"),
-    custom("torque_noise_N_m", "Standard deviation of each wheel's motor torque noise, white per sample, drawn from "
+    custom("torque_noise", "Standard deviation of each wheel's motor torque noise, white per sample, drawn from "
            "a stream of its own (seeded by ``[simulation.sensor_noise.seed, 2]``).",
            "number, list of numbers (one per wheel) or null", _per_wheel(non_negative=True), unit="N m",
            default=None, bounds=">= 0"),
@@ -126,12 +126,12 @@ TRUTH_MAGNETORQUERS = Section((
 
 TRUTH_PERIODIC = Section((
     integer("harmonic", "1: at the orbit rate ``n``; 2: at twice it.", minimum=1, maximum=2),
-    vector("amplitude_N_m", "Amplitude ``A`` per body axis of ``A sin(k n t + φ)``.", 3, unit="N m"),
+    vector("amplitude", "Amplitude ``A`` per body axis of ``A sin(k n t + φ)``.", 3, unit="N m"),
     vector("phase_deg", "Phase ``φ`` per body axis.", 3, unit="deg", default=[0.0, 0.0, 0.0]),
 ), "A disturbance torque periodic at a harmonic of the orbit rate, body frame (needs ``orbit``).")
 
 TRUTH_DISTURBANCE = Section((
-    vector("constant_N_m", "The plant's constant disturbance torque, body frame, in place of "
+    vector("constant", "The plant's constant disturbance torque, body frame, in place of "
            "``environment.disturbance_torque`` (which the planners see); ``null``: that one.", 3, unit="N m",
            default=None, nullable=True),
     custom("orbit_periodic", "Disturbance torques periodic at the orbit rate or twice it, added to the constant one.",
@@ -144,7 +144,7 @@ TRUTH = Section((
             null="defaults"),
     mapping("magnetorquers", "The true magnetorquers (needs ``spacecraft.magnetorquers``).", TRUTH_MAGNETORQUERS,
             default={}, null="defaults"),
-    vector("residual_dipole_A_m2", "Residual magnetic dipole of the spacecraft, body frame: torque "
+    vector("residual_dipole", "Residual magnetic dipole of the spacecraft, body frame: torque "
            "``m_res × B`` (needs ``environment.magnetic_field``); ``null``: none.", 3, unit="A m²", default=None,
            nullable=True),
     mapping("disturbance", "Disturbance torques.", TRUTH_DISTURBANCE, default={}, null="defaults"),
@@ -179,16 +179,16 @@ def parse_truth(node: Node, design: AttitudeModel) -> TruthPlant | None:
     periodic = []
     for item in disturbance["orbit_periodic"].items():
         entry = TRUTH_PERIODIC.read(item)
-        periodic.append(PeriodicTorque(entry["harmonic"], entry["amplitude_N_m"], np.radians(entry["phase_deg"])))
+        periodic.append(PeriodicTorque(entry["harmonic"], entry["amplitude"], np.radians(entry["phase_deg"])))
     max_speed = wheels["max_speed_rpm"]
     try:
         truth = Truth(
             inertia=values["spacecraft"]["inertia"], wheel_misalignment=wheels["misalignment_deg"],
             wheel_max_torque=wheels["max_torque"], wheel_max_momentum=wheels["max_momentum"],
-            wheel_coulomb=friction["coulomb_N_m"], wheel_viscous=friction["viscous_N_m_s"],
+            wheel_coulomb=friction["coulomb"], wheel_viscous=friction["viscous"],
             wheel_max_speed=None if max_speed is None else max_speed * RAD_S_PER_RPM,
-            wheel_torque_noise=wheels["torque_noise_N_m"], dipole_scale_error=values["magnetorquers"]["scale_error"],
-            residual_dipole=values["residual_dipole_A_m2"], constant_disturbance=disturbance["constant_N_m"],
+            wheel_torque_noise=wheels["torque_noise"], dipole_scale_error=values["magnetorquers"]["scale_error"],
+            residual_dipole=values["residual_dipole"], constant_disturbance=disturbance["constant"],
             periodic_disturbance=tuple(periodic))
         return TruthPlant(design, truth)
     except ModelError as error:
