@@ -299,8 +299,9 @@ class TruthPlant:
         if truth.residual_dipole is not None and design.field_body is None:
             raise ModelError("residual_dipole", "a residual dipole needs a magnetic field model "
                                                      "(environment.magnetic_field)")
-        if truth.periodic_disturbance and env.orbit is None:
-            raise ModelError("disturbance.orbit_periodic", "an orbit-periodic disturbance needs an orbit (orbit:)")
+        if truth.periodic_disturbance and not isinstance(getattr(env.orbit, "mean_motion", None), float):
+            raise ModelError("disturbance.orbit_periodic", "an orbit-periodic disturbance needs an orbit with a mean "
+                                                           "motion, its rate (orbit:)")
         self._wheel_slice = design.control_slices.get("wheels")
         self._dipole_slice = design.control_slices.get("dipole")
         working = np.zeros(0) if wheels is None else wheels.working.astype(float)
@@ -400,8 +401,7 @@ class TruthPlant:
         if self.truth.periodic_disturbance:
             # A sin(k θ + φ) = (A cos φ) sin kθ + (A sin φ) cos kθ, θ = n t: one sine and one cosine
             # per time, the second harmonic by the double-angle formulas.
-            assert orbit is not None
-            angle = orbit.mean_motion * t
+            angle = getattr(orbit, "mean_motion") * t  # noqa: B009 - checked at construction, any orbit kind
             sine, cosine = ca.sin(angle), ca.cos(angle)
             harmonics = {1: (sine, cosine), 2: (2 * sine * cosine, 1 - 2 * sine * sine)}
             for item in self.truth.periodic_disturbance:
