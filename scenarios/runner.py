@@ -145,13 +145,15 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     spec = scenario.simulation
     model = scenario.problem.model
 
+    plant = scenario.truth  # the truth model the closed loop integrates (None: the design model)
+
     def build() -> Simulator:
         return Simulator(model, spec.sample_time, spec.integrator, max_step=spec.max_step,
-                         max_samples=spec.max_samples, compile=spec.compile)
+                         max_samples=spec.max_samples, compile=spec.compile, plant=plant)
 
     simulator = build() if simulators is None else simulators.get(
-        ("simulator", model.fingerprint, spec.sample_time, spec.integrator, spec.max_step, spec.max_samples,
-         spec.compile), build)
+        ("simulator", model.fingerprint, None if plant is None else plant.fingerprint, spec.sample_time,
+         spec.integrator, spec.max_step, spec.max_samples, spec.compile), build)
     controllers = scenario.controllers
     labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in controllers])
     references: dict[int, tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]] = {}

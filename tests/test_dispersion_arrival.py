@@ -90,6 +90,7 @@ PARTS: dict[str, Callable[[Scenario], Any]] = {
     "planning bounds": _bounds,  # what the planners must honour: rate bound, actuator margin, pointing
     "simulation": lambda s: plain(s.simulation),
     "requirements": lambda s: plain(s.requirements),
+    "truth": lambda s: None if s.truth is None else s.truth.fingerprint,  # the plant alone (truth:)
 }
 """The parts a value may change: name -> the part of a loaded scenario, comparable. Each planner row
 (``planner:<label>``) and controller (``controller:<label>``) is a part of its own, its options."""
@@ -176,7 +177,19 @@ SENSORS["simulation"]["sensors"] = {
 SENSORS["simulation"]["estimator"] = {"type": "mekf", "initial_attitude_sigma_deg": 0.1,
                                       "initial_bias_sigma_deg_per_h": 5.0}
 
-BASES: dict[str, dict[str, Any]] = {"full": FULL, "keep_in": KEEP_IN, "igrf": IGRF, "kepler": KEPLER,
+TRUTH = copy.deepcopy(FULL)  # every truth key set, so that each can change (tests/test_truth_study.py has its own)
+TRUTH["spacecraft"]["wheels"]["spin_inertia"] = 2e-4
+TRUTH["truth"] = {
+    "spacecraft": {"inertia": [2.0, 3.0, 4.0]},
+    "wheels": {"misalignment_deg": [[0, 1, 0], [0, 0, 1], [1, 0, 0]], "max_torque": 0.04, "max_momentum": 0.4,
+               "friction": {"coulomb": 1e-5, "viscous": 1e-6}, "max_speed_rpm": 3000.0, "torque_noise": 1e-5},
+    "magnetorquers": {"scale_error": 0.05},
+    "residual_dipole": [0.01, 0.0, 0.0],
+    "disturbance": {"constant": [0.0, 1e-7, 0.0],
+                    "orbit_periodic": [{"harmonic": 1, "amplitude": [1e-7, 0, 0], "phase_deg": [0, 0, 0]}]},
+}
+
+BASES: dict[str, dict[str, Any]] = {"truth": TRUTH, "full": FULL, "keep_in": KEEP_IN, "igrf": IGRF, "kepler": KEPLER,
                                     "kepler_altitude": KEPLER_BY_ALTITUDE, "tle": TLE, "sensors": SENSORS}
 for _form, _attitude in TARGET_FORMS.items():
     for _end in ("initial", "final"):
@@ -297,6 +310,25 @@ ARRIVALS: dict[str, Arrival] = {
         "simulation.estimator.initial_bias_sigma_deg_per_h", 6.0, "simulation", base="sensors"),
 }
 """Scenario keys (by their key in the schema reference) and what setting them must change."""
+
+TRUTH_VALUES = {  # truth keys change the plant alone: not the design spacecraft the planners and laws see
+    "truth.spacecraft.inertia": ("truth.spacecraft.inertia", [2.2, 3.0, 3.9]),
+    "truth.wheels.misalignment_deg": ("truth.wheels.misalignment_deg", [[0, 2, 0], [0, 0, 1], [1, 0, 0]]),
+    "truth.wheels.max_torque": ("truth.wheels.max_torque", 0.03),
+    "truth.wheels.max_momentum": ("truth.wheels.max_momentum", [0.4, 0.3, 0.4]),
+    "truth.wheels.friction.coulomb": ("truth.wheels.friction.coulomb", 2e-5),
+    "truth.wheels.friction.viscous": ("truth.wheels.friction.viscous", 3e-6),
+    "truth.wheels.max_speed_rpm": ("truth.wheels.max_speed_rpm", 2000.0),
+    "truth.wheels.torque_noise": ("truth.wheels.torque_noise", 2e-5),
+    "truth.magnetorquers.scale_error": ("truth.magnetorquers.scale_error", -0.05),
+    "truth.residual_dipole": ("truth.residual_dipole", [0.0, 0.02, 0.0]),
+    "truth.disturbance.constant": ("truth.disturbance.constant", [0.0, 0.0, 2e-7]),
+    "truth.disturbance.orbit_periodic.harmonic": ("truth.disturbance.orbit_periodic[0].harmonic", 2),
+    "truth.disturbance.orbit_periodic.amplitude": ("truth.disturbance.orbit_periodic[0].amplitude", [0, 2e-7, 0]),
+    "truth.disturbance.orbit_periodic.phase_deg": ("truth.disturbance.orbit_periodic[0].phase_deg", [10, 0, 0]),
+}
+for _key, (_path, _value) in TRUTH_VALUES.items():
+    ARRIVALS[_key] = arrival(_path, _value, "truth", base="truth")
 
 TARGET_VALUES = {  # reference key below maneuver.<end>.q -> (form, path below it, new value)
     "quaternion": ("quaternion", "quaternion", [0.9998477, 0.0174524, 0.0, 0.0]),

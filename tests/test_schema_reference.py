@@ -84,6 +84,20 @@ requirements:
   rate: {max: 0.2}
   final: {after_s: 5, error_deg: 1.0, rate: 0.01}
 plots: {euler_sequence: "313"}
+truth:
+  spacecraft: {inertia: [[2.1, 0.01, 0.0], [0.01, 2.9, 0.0], [0.0, 0.0, 4.1]]}
+  wheels:
+    misalignment_deg: [[0, 0.5, 0], [0, 0, 0.5], [0.5, 0, 0]]
+    max_torque: 0.04
+    max_momentum: [0.9, 0.9, 0.9]
+    friction: {coulomb: 1.0e-5, viscous: 1.0e-7}
+    max_speed_rpm: 6000
+    torque_noise: 1.0e-5
+  magnetorquers: {scale_error: 0.02}
+  residual_dipole: [0.001, 0, 0]
+  disturbance:
+    constant: [0, 1.0e-7, 0]
+    orbit_periodic: [{harmonic: 2, amplitude: [1.0e-7, 0, 0], phase_deg: [0, 0, 0]}]
 """
 
 MAXIMAL_B = """

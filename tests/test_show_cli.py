@@ -30,7 +30,8 @@ ROOT = Path(__file__).resolve().parents[1]
 DEMO = ROOT / "scenarios" / "eigenaxis_demo.yaml"
 STUDY_CASES = {"study_planners_vs_slew_angle.yaml": 7,  # seven angle_deg values of one axis_angle grid entry
                "study_spin_monte_carlo.yaml": 1000,  # one point, monte_carlo.samples: 1000
-               "study_spin_weight_sample_time.yaml": 20}  # 5 weights x 4 sample times
+               "study_spin_weight_sample_time.yaml": 20,  # 5 weights x 4 sample times
+               "study_truth_inertia_monte_carlo.yaml": 40}  # one point, monte_carlo.samples: 40
 """Cases of each shipped study, counted by hand from its file."""
 
 

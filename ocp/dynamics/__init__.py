@@ -11,8 +11,9 @@ the :class:`~ocp.dynamics.environment.MagneticField` protocol and their registry
 (:mod:`~ocp.dynamics.environment`, :mod:`~ocp.dynamics.igrf`), the epoch (UTC) and the Sun's and
 the Moon's geocentric positions in the GCRF from JPL DE421 (:mod:`~ocp.dynamics.ephemeris`), the assembled symbolic model
 ``ẋ = f(x, u, t, p)`` (:mod:`~ocp.dynamics.model`), the vector layouts shared with the laws and the
-generated C (:mod:`~ocp.dynamics.layout`), the RK4 step (:mod:`~ocp.dynamics.integration`) and the
-closed-form spinning attitude (:mod:`~ocp.dynamics.spin_closed_form`).
+generated C (:mod:`~ocp.dynamics.layout`), the RK4 step (:mod:`~ocp.dynamics.integration`), the
+closed-form spinning attitude (:mod:`~ocp.dynamics.spin_closed_form`) and the truth model the closed
+loop integrates beside the design model (:mod:`~ocp.dynamics.truth`).
 
 May import: NumPy, CasADi, ppigrf, pyerfa, sgp4, jplephem with de421 and the top-level modules of :mod:`ocp` (``quat``,
 ``quat_casadi``, ``cache``, ``fast_call``, ``errors``); never the other subpackages of ``ocp``.
@@ -27,12 +28,13 @@ from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.model import AttitudeModel
 from ocp.dynamics.orbits import ORBITS, CircularOrbit, KeplerianOrbit, Orbit, OrbitKind, TLEOrbit
 from ocp.dynamics.spacecraft import Spacecraft
+from ocp.dynamics.truth import PeriodicTorque, Truth, TruthPlant
 
 __all__ = ["ACTUATOR_KINDS", "EPHEMERIS_RANGE", "MAGNETIC_FIELDS", "ORBITS", "Actuator", "ActuatorModel",
            "AttitudeModel", "CircularOrbit", "Command", "Environment", "FieldModel", "IGRFField", "KeplerianOrbit",
-           "MagneticField", "Magnetorquers", "Measurement", "Orbit", "OrbitKind", "ReactionWheels", "Spacecraft",
-           "TLEOrbit", "TiltedDipole", "Torquers", "actuator_kind", "check_epoch", "gravity_gradient_torque",
-           "moon_position", "parse_utc", "rk4_step", "sun_position", "tdb_julian_date"]
+           "MagneticField", "Magnetorquers", "Measurement", "Orbit", "OrbitKind", "PeriodicTorque", "ReactionWheels",
+           "Spacecraft", "TLEOrbit", "TiltedDipole", "Torquers", "Truth", "TruthPlant", "actuator_kind", "check_epoch",
+           "gravity_gradient_torque", "moon_position", "parse_utc", "rk4_step", "sun_position", "tdb_julian_date"]
 
 
 def __dir__() -> list[str]:

@@ -4,9 +4,13 @@ When a controller provides a symbolic law (``controllers.base.Controller``, "Sym
 sample of the closed loop, sensor noise, measurement, law, actuator saturation, the zero-order
 hold integrated by RK4 sub-steps and the quaternion re-normalisation, is one SX function
 
-    sample([x; z], t_k, dt_k, noise_k, r_k, p) -> ([x_{k+1}; z_{k+1}], u_commanded, u_applied, saturated, τ_k)
+    sample([x; z], t_k, dt_k, noise_k, r_k, p[, w_k]) -> ([x_{k+1}; z_{k+1}], u_commanded, u_applied, saturated, τ_k)
 
-(``τ_k`` the actuators' body torque at ``t_k``) and ``sample.mapaccum(N)`` is the run. It computes what :meth:`ocp.simulation.simulator.Simulator.run`'s
+(``τ_k`` the actuators' body torque at ``t_k``) and ``sample.mapaccum(N)`` is the run. With a
+truth plant (:class:`~ocp.dynamics.truth.TruthPlant`) the saturation is the truth's, the applied
+control is what the truth delivers (its motor torque noise ``w_k``, one per wheel, is an input of
+its own, present only when the truth has such noise), the step integrates the truth's dynamics and
+the torque is the truth's; the measurement and the law are the design's. It computes what :meth:`ocp.simulation.simulator.Simulator.run`'s
 Python loop computes, operation for operation: the noise is drawn in advance from the same seeded
 generator in the same order (:func:`draw_noise`), so both paths agree to rounding. The function
 is evaluated by CasADi's virtual machine, or compiled to C (:mod:`ocp.simulation.compiled`).
@@ -23,6 +27,7 @@ from numpy.typing import NDArray
 from ocp.dynamics.actuators import ActuatorModel
 from ocp.dynamics.layout import REFERENCE_FIELDS
 from ocp.dynamics.model import AttitudeModel
+from ocp.dynamics.truth import TruthPlant
 from ocp.estimation import (
     SENSOR_NOISE_SIZE,
     SENSOR_STATE_SIZE,
@@ -167,12 +172,17 @@ class ClosedLoop:
     sensors : SensorSuite or None, optional
         Sensors and estimator (:mod:`ocp.estimation.loop`): their state ``s`` follows ``z`` in
         the carried state ``[x; z; s]`` and their noise row (10 numbers) follows the nine above.
+    plant : TruthPlant or None, optional
+        The truth plant whose dynamics ``step`` integrates and whose limits ``actuators`` hold:
+        the applied control is what it delivers (:meth:`~ocp.dynamics.truth.TruthPlant.deliver_symbolic`)
+        and the torque its own; ``None`` (default): ``model`` is the plant.
 
     Attributes
     ----------
     sample : casadi.Function
-        ``closed_loop_sample(xz, t, dt, noise, r, p) -> (xz_next, u_cmd, u_app, saturated,
-        torque)``, one sample (see the module docstring).
+        ``closed_loop_sample(xz, t, dt, noise, r, p[, plant_noise]) -> (xz_next, u_cmd, u_app,
+        saturated, torque)``, one sample (see the module docstring; ``plant_noise`` only when the
+        plant has motor torque noise).
     shape : LoopShape
         Which inputs the loop actually uses.
     nz : int
@@ -183,8 +193,10 @@ class ClosedLoop:
 
     def __init__(self, model: AttitudeModel, step: ca.Function, actuators: ActuatorModel, law: ca.Function,
                  attitude_noise: bool, rate_noise: bool, field_noise: bool = False,
-                 sensors: SensorSuite | None = None):
+                 sensors: SensorSuite | None = None, plant: TruthPlant | None = None):
         self.model = model
+        self.plant_noise_size = 0 if plant is None else plant.noise_size
+        """Motor torque noises per sample the loop takes (0: no ``plant_noise`` input)."""
         nx, nz = model.nx, law.nnz_in(2)
         self.nz = nz
         ns = 0 if sensors is None else SENSOR_STATE_SIZE
@@ -213,17 +225,20 @@ class ClosedLoop:
         y = ca.vertcat(q, omega, h_w, field)
         u_cmd, z_next = law(t, y, z, r)
         u_applied, saturated = actuators.apply_symbolic(u_cmd, h_w, dt)
+        plant_noise = ca.SX.sym("plant_noise", self.plant_noise_size) if self.plant_noise_size else None
+        if plant is not None:
+            u_applied = plant.deliver_symbolic(u_applied, plant_noise)
         x_next = step(x, u_applied, t, dt, p)
         x_next = ca.vertcat(x_next[0:4] / ca.norm_2(x_next[0:4]), x_next[4:nx])
-        torque = model.body_torque(x, u_applied, t)
+        torque = (model if plant is None else plant).body_torque(x, u_applied, t)
         outputs = [ca.vertcat(x_next, z_next, s_next), u_cmd, u_applied, saturated, torque]
         self.shape = LoopShape(attitude_noise, rate_noise, bool(ca.depends_on(ca.vertcat(u_cmd, z_next), r)),
                                bool(ca.depends_on(ca.vertcat(*outputs), t)),
                                bool(field_noise and model.field_body is not None), sensors is not None)
-        inputs = [acc, t, dt, noise, r, p]
+        inputs = [acc, t, dt, noise, r, p] + ([plant_noise] if plant_noise is not None else [])
         self.sample = ca.Function("closed_loop_sample", inputs, outputs,
-                                  ["xz", "t", "dt", "noise", "r", "p"], ["xz_next", "u_cmd", "u_app", "saturated", "torque"],
-                                  {"cse": True})
+                                  ["xz", "t", "dt", "noise", "r", "p"] + (["plant_noise"] if plant_noise is not None else []),
+                                  ["xz_next", "u_cmd", "u_app", "saturated", "torque"], {"cse": True})
 
     def run_function(self, sample: ca.Function, n_samples: int) -> BufferedFunction:
         """The run of ``n_samples`` samples as one function.
@@ -238,10 +253,11 @@ class ClosedLoop:
         Returns
         -------
         BufferedFunction
-            ``run(xz0, t (N), dt (N), [noise (9N)], [r (26N)], p) -> (xz (N(nx+nz)), u_cmd,
-            u_app, saturated, torque)``: the noise and reference inputs exist only when the loop
-            uses them (:attr:`shape`), and every input and output has its exact size, so that
-            the function is evaluated through reusable buffers.
+            ``run(xz0, t (N), dt (N), [noise (9N or 19N)], [r (26N)], p, [plant_noise (n_w N)]) ->
+            (xz (N(nx+nz[+35])), u_cmd, u_app, saturated, torque)``: the noise and reference inputs
+            exist only when the loop uses them (:attr:`shape`, :attr:`plant_noise_size`), and every
+            input and output has its exact size, so that the function is evaluated through
+            reusable buffers.
         """
         accumulated = sample.mapaccum("closed_loop", n_samples)
         xz0 = ca.MX.sym("xz0", sample.nnz_in(0))
@@ -259,11 +275,16 @@ class ClosedLoop:
         else:
             r = ca.MX.zeros(2 * REFERENCE_FIELDS, n_samples)
         inputs.append(p)
-        outputs = accumulated.call([xz0, t, dt, noise, r, ca.repmat(p, 1, n_samples)])
+        arguments = [xz0, t, dt, noise, r, ca.repmat(p, 1, n_samples)]
+        if self.plant_noise_size:
+            plant_noise = ca.MX.sym("plant_noise", self.plant_noise_size, n_samples)
+            inputs.append(plant_noise)
+            arguments.append(plant_noise)
+        outputs = accumulated.call(arguments)
         return BufferedFunction(ca.Function("closed_loop_run", inputs, outputs))
 
     def evaluate(self, run: BufferedFunction, xz0: Array, times: Array, noise: Array | None, rows: Array | None,
-                 p: Array) -> tuple[Array, Array, Array, Array, Array]:
+                 p: Array, plant_noise: Array | None = None) -> tuple[Array, Array, Array, Array, Array]:
         """Run the accumulated function over the sample times.
 
         Parameters
@@ -284,6 +305,10 @@ class ClosedLoop:
             when ``shape.uses_reference``, otherwise ignored.
         p : (3,) ndarray
             Constant disturbance torque [N m], body frame.
+        plant_noise : (N, n_w) ndarray or None, optional
+            The truth's motor torque noise per sample and wheel [N m]
+            (:meth:`~ocp.dynamics.truth.TruthPlant.draw_noise`); required when
+            :attr:`plant_noise_size` is not 0, otherwise ignored.
 
         Returns
         -------
@@ -307,6 +332,10 @@ class ClosedLoop:
                 raise ValueError("this closed loop reads a reference: pass the (N, 26) rows")
             args.append(rows.ravel())
         args.append(p)
+        if self.plant_noise_size:
+            if plant_noise is None:
+                raise ValueError("this closed loop takes the plant's motor torque noise: pass the (N, n_w) noise")
+            args.append(plant_noise.ravel())
         xz, u_cmd, u_app, saturated, torque = run.all_outputs(*args)
         return (xz.reshape(n, -1).copy(), u_cmd.reshape(n, -1).copy(), u_app.reshape(n, -1).copy(),
                 saturated.copy(), torque.reshape(n, 3).copy())

@@ -37,6 +37,7 @@ from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
 from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.layout import actuator_blocks, reference_rows
 from ocp.dynamics.model import AttitudeModel
+from ocp.dynamics.truth import TruthPlant
 from ocp.errors import CompilerUnavailable, SimulationError
 from ocp.estimation import (
     SENSOR_STATE_SIZE,
@@ -196,7 +197,8 @@ class SimulationResult:
     Attributes
     ----------
     model : AttitudeModel
-        The simulated model.
+        The simulated model (with a truth plant, its truth model: the axes, inertia and limits
+        the run had).
     sample_time : float
         Controller period [s].
     t : (N+1,) ndarray
@@ -466,6 +468,11 @@ class Simulator:
         Most samples one run may take, and most RK4 sub-steps in all: ``SUBSTEPS_PER_SAMPLE`` times
         this (:data:`SUBSTEPS_PER_SAMPLE`); longer runs are refused with :class:`SimulationError`,
         not attempted.
+    plant : TruthPlant or None, optional
+        The truth model to integrate (:mod:`ocp.dynamics.truth`), built on ``model``: the loop
+        saturates with its limits, delivers with its effects and integrates its dynamics, while
+        the controller is reset with ``model``'s spacecraft (the design). ``None`` (default):
+        ``model`` is the plant.
     """
 
     MAX_BUILDS = 16
@@ -484,6 +491,7 @@ class Simulator:
         compile: bool = False,
         python_loop: bool = False,
         max_samples: int = MAX_SAMPLES,
+        plant: TruthPlant | None = None,
     ):
         if not isinstance(model, AttitudeModel):
             raise TypeError(f"model must be an ocp.AttitudeModel, got {type(model).__name__}")
@@ -498,11 +506,17 @@ class Simulator:
                              f"at most {MAX_SUBSTEPS} are allowed (raise max_step or lower sample_time)")
         if not isinstance(max_samples, int) or max_samples < 1:
             raise ValueError(f"max_samples must be a positive integer, got {max_samples!r}")
+        if plant is not None and (not isinstance(plant, TruthPlant) or plant.design is not model):
+            raise TypeError("plant must be an ocp.dynamics.truth.TruthPlant built on this simulator's model")
         self.model = model
+        self.plant = plant
+        self.simulated = model if plant is None else plant.model
+        """The model integrated: ``model``, or the plant's truth model."""
         self.sample_time = float(sample_time)
         self.max_samples = max_samples
         self.substeps = substeps if integrator == "rk4" else 1
-        self.actuators = ActuatorModel(model.spacecraft, model.control_slices, model.nu)
+        simulated = self.simulated
+        self.actuators = ActuatorModel(simulated.spacecraft, simulated.control_slices, simulated.nu)
         self._step = self._build_step(integrator, substeps, rtol, atol)
         self._step_numeric = BufferedFunction(self._normalised(self._step))
         self._field_numeric = None if model.field_body is None else BufferedFunction(model.field_body)
@@ -525,8 +539,10 @@ class Simulator:
         return ca.Function("zoh_step_normalised", symbols, [x_next], step.name_in(), ["x_next"])
 
     def _build_step(self, integrator: str, substeps: int, rtol: float, atol: float) -> ca.Function:
-        """``step(x, u, t, dt, p) -> x_next``: one hold interval of length ``dt`` starting at ``t``."""
+        """``step(x, u, t, dt, p) -> x_next``: one hold interval of length ``dt`` starting at ``t``
+        (of the plant's dynamics when there is one)."""
         model = self.model
+        rhs = model.rhs if self.plant is None else self.plant.rhs
         x = ca.SX.sym("x", model.nx)
         u = ca.SX.sym("u", model.nu)
         t = ca.SX.sym("t")
@@ -536,12 +552,12 @@ class Simulator:
             h = dt / substeps
             x_next = x
             for k in range(substeps):
-                x_next = rk4_step(lambda state, time: model.rhs(state, u, time, p), x_next, t + k * h, h)
+                x_next = rk4_step(lambda state, time: rhs(state, u, time, p), x_next, t + k * h, h)
             return ca.Function("zoh_step", [x, u, t, dt, p], [x_next], ["x", "u", "t", "dt", "p"], ["x_next"])
         # CVODES on normalised time s in [0, 1]: dx/ds = dt f(x, u, t + s dt, p).
         s = ca.SX.sym("s")
         params = ca.vertcat(u, t, dt, p)
-        dae = {"x": x, "p": params, "t": s, "ode": dt * model.rhs(x, u, t + s * dt, p)}
+        dae = {"x": x, "p": params, "t": s, "ode": dt * rhs(x, u, t + s * dt, p)}
         solver = ca.integrator("zoh_cvodes", "cvodes", dae, 0.0, 1.0, {"reltol": rtol, "abstol": atol})
         x_next = solver(x0=x, p=params)["xf"]
         return ca.Function("zoh_step", [x, u, t, dt, p], [x_next], ["x", "u", "t", "dt", "p"], ["x_next"])
@@ -576,7 +592,8 @@ class Simulator:
         noise : SensorNoise, optional
             Sensor noise; ``None``: none.
         parameters : (3,) array_like, optional
-            Disturbance torque ``p`` [N m], body axes; ``None``: the model's default.
+            Disturbance torque ``p`` [N m], body axes; ``None``: the plant's default (the truth's
+            constant disturbance, else the model's).
         sensors : SensorSuite, optional
             Gyro, star tracker, magnetometer and MEKF (:mod:`ocp.estimation`), seeded by
             ``noise.seed``; they replace ``noise``'s rate, attitude and magnetometer parts (which
@@ -601,7 +618,9 @@ class Simulator:
         if not np.linalg.norm(x[0:4]) > 1e-6:
             raise ValueError(f"x0 must start with a non-zero quaternion, got {x[0:4]}")
         x[0:4] = quat.normalize(x[0:4])
-        p = model.default_parameters if parameters is None else np.asarray(parameters, dtype=float)
+        plant = self.plant
+        default = model.default_parameters if plant is None else plant.default_parameters
+        p = default if parameters is None else np.asarray(parameters, dtype=float)
         if p.shape != (3,) or not np.all(np.isfinite(p)):
             raise ValueError(f"parameters must be a finite 3-vector disturbance torque (N m), got {p}")
         if not isinstance(duration, (int, float)) or not math.isfinite(duration) or not duration > 0:
@@ -622,9 +641,10 @@ class Simulator:
             raise SimulationError(f"the magnetic field is tabulated up to t = {valid_until:g} s, the run lasts "
                                   f"{duration:g} s; lengthen environment.magnetic_field.span_s")
         field_rate = self._field_rate_numeric if getattr(controller, "needs_field_rate", False) else None
-        controller.reset(model.spacecraft, self.sample_time, target=target)
+        controller.reset(model.spacecraft, self.sample_time, target=target)  # the design, also with a plant
+        plant_noise = None if plant is None else plant.draw_noise(noise.seed, n_samples)
         if self._symbolic(controller):
-            return self._run_symbolic(controller, x, times, p, noise, rng, reference, field_rng, sensors)
+            return self._run_symbolic(controller, x, times, p, noise, rng, reference, field_rng, sensors, plant_noise)
         if reference is not None and hasattr(reference, "sample"):
             reference = self._grid_reference(reference, np.concatenate([times, times[:-1] + self.sample_time]))
 
@@ -640,6 +660,7 @@ class Simulator:
         x_in[:] = x
         p_in[:] = p
         evaluate, apply, fill_command = step.evaluate, self.actuators.apply_floats, self.actuators.command_vector
+        deliver = None if plant is None else plant.deliver
         times_list = times.tolist()
         sensor_states: list[Array] = []
         if sensors is not None:
@@ -657,6 +678,8 @@ class Simulator:
             fill_command(command, commanded[k])
             dt = times_list[k + 1] - t_k
             u, at_limit = apply(command, states[k][7:], dt)
+            if deliver is not None:  # the truth's noise and scale errors
+                u = deliver(u, None if plant_noise is None else plant_noise[k].tolist())
             applied.append(u)
             saturated.append(at_limit)
             u_in[:] = u
@@ -688,10 +711,11 @@ class Simulator:
     def _result(self, times: Array, states: Array, commanded: Array, applied: Array, saturated: NDArray[np.bool_],
                 path: str) -> SimulationResult:
         if self._torque_map is None or self._torque_map[0] != times.size - 1:
-            self._torque_map = (times.size - 1, self.model.body_torque.map(times.size - 1))
+            body_torque = self.model.body_torque if self.plant is None else self.plant.body_torque
+            self._torque_map = (times.size - 1, body_torque.map(times.size - 1))
         torque_map = self._torque_map[1]
         applied_torque = torque_map(states[:-1].T, applied.T, times[:-1]).full().T
-        return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, applied_torque,
+        return SimulationResult(self.simulated, self.sample_time, times, states, commanded, applied, applied_torque,
                                 saturated, path)
 
     @staticmethod
@@ -737,7 +761,7 @@ class Simulator:
                 self._runs.clear()
             law = controller.symbolic_law()
             loop = ClosedLoop(self.model, self._step, self.actuators, law.function,
-                              noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0, sensors)
+                              noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0, sensors, plant=self.plant)
             sample, path = loop.sample, "interpreted"
             if self.compile:
                 try:
@@ -762,7 +786,8 @@ class Simulator:
     def _run_symbolic(self, controller: Any, x0: Array, times: Array, p: Array, noise: SensorNoise,
                       rng: np.random.Generator, reference: Any,
                       field_rng: np.random.Generator | None = None,
-                      sensors: SensorSuite | None = None) -> SimulationResult:
+                      sensors: SensorSuite | None = None,
+                      plant_noise: Array | None = None) -> SimulationResult:
         n_samples = times.size - 1
         loop, sample, path = self.closed_loop_function(controller, noise, sensors)
         rows = None
@@ -790,7 +815,8 @@ class Simulator:
             stop = min(start + self.CHUNK, n_samples)
             run = self._chunk_function(loop, sample, stop - start)
             chunk = loop.evaluate(run, xz, times[start:stop + 1], None if drawn is None else drawn[start:stop],
-                                  None if rows is None else rows[start:stop], p)
+                                  None if rows is None else rows[start:stop], p,
+                                  None if plant_noise is None else plant_noise[start:stop])
             states[start + 1:stop + 1] = chunk[0][:, :nx]
             if sensor_states is not None:
                 sensor_states[start + 1:stop + 1] = chunk[0][:, nx + loop.nz:]
@@ -801,7 +827,7 @@ class Simulator:
         finite = np.isfinite(states).all(axis=1)
         if not finite.all():
             raise SimulationError(self._divergence(times, int(np.argmin(finite)) - 1))
-        return SimulationResult(self.model, self.sample_time, times, states, commanded, applied, torque,
+        return SimulationResult(self.simulated, self.sample_time, times, states, commanded, applied, torque,
                                 saturated.astype(bool), path, sensor_states, sensors)
 
     def _measure(self, x: Array, t: float, noise: SensorNoise, rng: np.random.Generator,

@@ -26,6 +26,7 @@ import numpy as np
 
 from controllers import CONTROLLERS, Controller
 from ocp import Environment, SensorNoise, Spacecraft, quat
+from ocp.dynamics.truth import TruthPlant
 from ocp.errors import OptionsError, excerpt
 from ocp.estimation import SensorSuite
 from ocp.geometry.directions import Geometry
@@ -63,6 +64,7 @@ from scenarios.schema.requirements import (
     parse_requirements,
 )
 from scenarios.schema.targets import AttitudeContext, attitude_key, parse_attitude
+from scenarios.schema.truth import TRUTH, parse_truth
 
 MAX_NAME = 200
 """Characters of a scenario name (the default output directory uses a sanitised, shorter stem)."""
@@ -211,6 +213,9 @@ class Scenario:
     data : dict or None, optional
         A copy of the YAML data it was parsed from (recorded in ``results.json``); ``None`` for a
         scenario built in code.
+    truth : TruthPlant or None, optional
+        The simulated plant where it differs from the design model (``truth``; built on
+        ``problem.model``); ``None`` (default): the design model is the plant.
     """
 
     name: str
@@ -223,6 +228,7 @@ class Scenario:
     epoch: datetime.datetime | None = None
     euler_sequence: str = "321"
     data: dict[str, Any] | None = field(default=None, repr=False, compare=False)
+    truth: TruthPlant | None = field(default=None, repr=False, compare=False)
 
     @property
     def frame(self) -> str:
@@ -434,6 +440,10 @@ SCENARIO = Section((
            "limit, the final error (the user guide's page on requirements). Absent: the actuators' limits only "
            "(``actuators`` with margin 0); ``null``: none.", "mapping or null",
            None, default={}, section=REQUIREMENTS),
+    custom("truth", "The simulated plant where it differs from the design model (the user guide's section on the "
+           "truth model): only the closed loop integrates it; planners and controllers keep the design values. "
+           "Absent or ``null``: the design model is the plant.", "mapping or null", None, default=None,
+           section=TRUTH),
 ), "A scenario file.")
 
 
@@ -553,6 +563,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     simulation = _parse_simulation(SCENARIO["simulation"].value(root), "simulation")
     plots = SCENARIO["plots"].value(root)
     requirements_node = SCENARIO["requirements"].value(root)
+    truth_node = SCENARIO["truth"].value(root)
     root.finish()
     problem = _fit_field_span(problem, simulation, planners)
     span = RunSpan(problem.duration, simulation.duration or problem.duration, simulation.duration is not None,
@@ -562,11 +573,12 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     requirements, constraints = parse_requirements(requirements_node, sensors, Geometry(epoch, environment.orbit),
                                                    span, problem.qf is None, problem.omegaf is None)
     problem = _with_requirements(problem, requirements, constraints)
+    truth = parse_truth(truth_node, problem.model)
     check_work(problem, simulation)
     check_row_labels(planners, controllers)
     check_compatibility(problem, planners, controllers, simulation)
     return Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch,
-                    euler_sequence=plots["euler_sequence"], data=copy.deepcopy(data))
+                    euler_sequence=plots["euler_sequence"], data=copy.deepcopy(data), truth=truth)
 
 
 def _with_requirements(problem: ManeuverProblem, requirements: Requirements,
