@@ -33,18 +33,25 @@ The fields are written with 17 significant digits, so they read back to the same
 """
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from types import SimpleNamespace
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp.quat import rotation_matrix
+from scenarios.errors import ScenarioError
+
+if TYPE_CHECKING:
+    from scenarios.output.export import RunRecord
 
 Array = NDArray[np.float64]
 
-__all__ = ["ATTITUDE_TYPES", "WaypointFile", "write_waypoint_reference"]
+__all__ = ["ATTITUDE_TYPES", "BasiliskOptions", "WaypointFile", "check_waypoint_export", "write_waypoint_files",
+           "write_waypoint_reference"]
 
 ATTITUDE_TYPES: dict[str, int] = {"mrp": 0, "quaternion": 1, "quaternion_scalar_last": 2}
 """The attitude sets a waypoint file can hold, and ``waypointReference.attitudeType``'s number for each."""
@@ -174,3 +181,86 @@ def write_waypoint_reference(reference: Any, times: ArrayLike, path: str | Path,
             fields = [_nanosecond_exact(float(row[0])), *row[1:]]
             handle.write(delimiter.join(f"{value:.17g}" for value in fields) + "\n")
     return WaypointFile(path, attitude_type, delimiter, 1 if header else 0, len(t))
+
+
+@dataclass(frozen=True)
+class BasiliskOptions:
+    """Options of the ``basilisk`` export (:data:`scenarios.output.export.EXPORT_FORMATS`).
+
+    Parameters
+    ----------
+    attitude_type : str, optional
+        A key of :data:`ATTITUDE_TYPES` (default ``mrp``).
+    delimiter : str, optional
+        The field separator, one character (default ``,``).
+    """
+
+    attitude_type: str = "mrp"
+    delimiter: str = ","
+
+
+def check_waypoint_export(run: RunRecord, options: BasiliskOptions) -> None:
+    """Refuse, before anything is written, options a waypoint file cannot take.
+
+    Parameters
+    ----------
+    run : scenarios.output.export.RunRecord
+        The finished run (any: a waypoint file needs no epoch, its times run from t = 0).
+    options : BasiliskOptions
+        The export's options.
+
+    Raises
+    ------
+    ScenarioError
+        An attitude type or delimiter the format does not take (at ``--option NAME``).
+    """
+    if options.attitude_type not in ATTITUDE_TYPES:
+        raise ScenarioError("--option attitude_type",
+                            f"{options.attitude_type!r} is not one of {', '.join(ATTITUDE_TYPES)}")
+    if len(options.delimiter) != 1 or options.delimiter.isspace() or options.delimiter in "0123456789+-.eE":
+        raise ScenarioError("--option delimiter", f"{options.delimiter!r} is not one character that cannot occur in "
+                                                  "a number")
+
+
+def write_waypoint_files(run: RunRecord, directory: Path, options: BasiliskOptions) -> list[str]:
+    """The ``basilisk`` export: ``<row>.waypoints.csv`` per planner row that was simulated, its
+    reference at the controller's samples (:func:`write_waypoint_reference`), and
+    ``waypoints.json``, the ``waypointReference`` settings that read each file.
+
+    Parameters
+    ----------
+    run : scenarios.output.export.RunRecord
+        The finished run.
+    directory : Path
+        Where to write the files.
+    options : BasiliskOptions
+        The files' attitude set and separator.
+
+    Returns
+    -------
+    list of str
+        Notes: the rows left out, and why.
+    """
+    check_waypoint_export(run, options)
+    notes, settings = [], {}
+    for row in run.rows:
+        if row.timeseries is None:
+            notes.append(f"row {row.label!r}: not simulated ({row.status}), no reference samples to export")
+            continue
+        series = row.series()
+        if np.all(np.isnan(series["ref_q"])):
+            notes.append(f"row {row.label!r}: no reference (regulation mode), no waypoint file")
+            continue
+        if not np.all(np.isfinite(series["ref_omega_dot"])):
+            notes.append(f"row {row.label!r}: its time series holds no reference acceleration (a run written by an "
+                         "earlier slewbench): run it again to export it")
+            continue
+        tabulated = SimpleNamespace(sample=lambda t, s=series: SimpleNamespace(
+            q=s["ref_q"][np.searchsorted(s["t"], t)], omega=s["ref_omega"][np.searchsorted(s["t"], t)],
+            omega_dot=s["ref_omega_dot"][np.searchsorted(s["t"], t)]))
+        name = f"{row.stem}.waypoints.csv"
+        written = write_waypoint_reference(tabulated, series["t"], directory / name, options.attitude_type,
+                                           options.delimiter)
+        settings[name] = {**written.basilisk_settings(), "dataFileName": name, "rows": written.rows}
+    (directory / "waypoints.json").write_text(json.dumps(settings, indent=2) + "\n")
+    return notes

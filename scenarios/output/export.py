@@ -28,6 +28,11 @@ from numpy.typing import NDArray
 
 from scenarios.errors import ScenarioError
 from scenarios.output.aem import AemOptions, check_aem_export, write_aem_files
+from scenarios.output.basilisk import (
+    BasiliskOptions,
+    check_waypoint_export,
+    write_waypoint_files,
+)
 from scenarios.output.directory import (
     claim_output_directory,
     commit_outputs,
@@ -70,8 +75,9 @@ class RunRow:
         -------
         dict of str to ndarray
             ``t`` (N,) [s]; ``q`` (N, 4) closed-loop attitude, body to inertial, scalar first;
-            ``omega`` (N, 3) body rate [rad/s, body]; ``ref_q`` and ``ref_omega`` the reference's
-            (NaN without a reference).
+            ``omega`` (N, 3) body rate [rad/s, body]; ``ref_q``, ``ref_omega`` and ``ref_omega_dot``
+            [rad/s², reference body axes] the reference's (NaN without a reference, and
+            ``ref_omega_dot`` NaN in a run written before slewbench recorded it).
         """
         if self.timeseries is None:
             raise ValueError(f"row {self.label!r} has no time series")
@@ -88,7 +94,9 @@ class RunRow:
         return {"t": table[:, column["t"]], "q": block("q0", "q1", "q2", "q3"),
                 "omega": block("omega_x", "omega_y", "omega_z"),
                 "ref_q": block("ref_q0", "ref_q1", "ref_q2", "ref_q3"),
-                "ref_omega": block("ref_omega_x", "ref_omega_y", "ref_omega_z")}
+                "ref_omega": block("ref_omega_x", "ref_omega_y", "ref_omega_z"),
+                "ref_omega_dot": (block("ref_omega_dot_x", "ref_omega_dot_y", "ref_omega_dot_z")
+                                  if "ref_omega_dot_x" in column else np.full((table.shape[0], 3), np.nan))}
 
 
 @dataclass(frozen=True)
@@ -219,6 +227,9 @@ class ExportFormat:
 EXPORT_FORMATS: dict[str, ExportFormat] = {
     "aem": ExportFormat("aem", "CCSDS Attitude Ephemeris Messages (504.0-B-2, KVN): each simulated row's closed-loop "
                                "and reference attitude, body to GCRF", AemOptions, check_aem_export, write_aem_files),
+    "basilisk": ExportFormat("basilisk", "Basilisk waypointReference data files: each planner row's reference at the "
+                                         "controller's samples", BasiliskOptions, check_waypoint_export,
+                             write_waypoint_files),
 }
 """The export formats by name."""
 

@@ -31,7 +31,8 @@ def write_timeseries(row: Row, path: Path) -> None:
 
     Columns: ``t`` [s], ``q0..q3`` (body to inertial, scalar first), ``omega_x..z`` [rad/s, body],
     ``h_w0..`` [N m s], ``u_x..z`` the applied body torque [N m, body] held from ``t`` (blank on
-    the last line), ``ref_q0..3`` and ``ref_omega_x..z`` [rad/s] (blank without a reference).
+    the last line), ``ref_q0..3``, ``ref_omega_x..z`` [rad/s] and ``ref_omega_dot_x..z`` [rad/s², reference
+    body axes] (blank without a reference).
     Non-finite values are blank (:func:`scenarios.output.tables.csv_cell`).
 
     Parameters
@@ -47,13 +48,14 @@ def write_timeseries(row: Row, path: Path) -> None:
     n_w = sim.wheel_momentum.shape[1]
     header = (["t", "q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z"]
               + [f"h_w{i}" for i in range(n_w)] + ["u_x", "u_y", "u_z"]
-              + ["ref_q0", "ref_q1", "ref_q2", "ref_q3", "ref_omega_x", "ref_omega_y", "ref_omega_z"])
+              + ["ref_q0", "ref_q1", "ref_q2", "ref_q3", "ref_omega_x", "ref_omega_y", "ref_omega_z",
+                 "ref_omega_dot_x", "ref_omega_dot_y", "ref_omega_dot_z"])
     torque = np.vstack([sim.applied_torque, np.full((1, 3), np.nan)])
     if row.reference is not None:
         sample = row.reference.sample(sim.t)
-        ref = np.hstack([sample.q, sample.omega])
+        ref = np.hstack([sample.q, sample.omega, sample.omega_dot])
     else:
-        ref = np.full((sim.t.size, 7), np.nan)
+        ref = np.full((sim.t.size, 10), np.nan)
     table = np.hstack([sim.t[:, None], sim.x, torque, ref])
     with path.open("w", newline="") as handle:
         writer = csv.writer(handle)
