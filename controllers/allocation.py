@@ -377,7 +377,9 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
                      jumps: ArrayLike | None = None) -> dict[str, Demand]:
     """What a reference asks of each actuator through a law's own allocation (module docstring).
 
-    At each sample the feed-forward torque goes through the law's map (its flags included; the
+    At each sample the feed-forward torque goes through the law's map (its flags included, except
+    that the wheels' gyroscopic term ``ω × A h_w`` is always asked for: it is what following the
+    reference demands, whether the law computes it, adds it in its allocation or neglects it; the
     map on CasADi expressions, :meth:`Allocation.allocate_symbolic`, which the symbolic-law tests
     hold equal to :meth:`Allocation.allocate`) with the reference's rate, the actuators' states
     and the field along the reference (zero without a field model); the states (the wheel
@@ -422,6 +424,11 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     """
     spacecraft = model.spacecraft
     law = copy.copy(allocation)
+    # Following the reference asks the wheels for ω × A h_w beside the feed-forward, whatever the
+    # law's own formula: a law without gyroscopic compensation computes that term inside its u
+    # (mrp_feedback's reference rate) or neglects it (the two-wheel laws' zero momentum), and
+    # neither changes what the reference demands of the wheels.
+    law.gyroscopic_compensation = True
     law.spacecraft = spacecraft
     law._slices, law._nu = control_layout(spacecraft)
     law._reset_allocation(spacecraft)

@@ -77,6 +77,29 @@ def test_three_orthogonal_wheels_torque_by_hand_and_momentum_by_conservation():
     np.testing.assert_array_equal(demand["wheels_momentum"].limit, [0.02] * 3)
 
 
+@pytest.mark.parametrize("options", [{"gyroscopic_rate": "reference"}, {"gyroscopic_rate": "body"}])
+def test_the_demand_is_physics_whatever_the_laws_formula(options):
+    """``mrp_feedback`` with the reference rate computes ``ω × A h_w`` inside its law and declares
+    no gyroscopic compensation; following the reference still asks the wheels for that term. Its
+    demand equals the hand-worked ``g = -(u + ω × h)`` with the momenta the conservation of total
+    angular momentum gives (the oracles of the test above), for both of its forms."""
+    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(max_torque=0.003, max_momentum=0.02))
+    t = np.linspace(0.0, 40.0, 4001)
+    q, omega, torque = motion(t)
+    h0 = np.array([0.004, -0.002, 0.001])
+    law = CONTROLLERS["mrp_feedback"](CONTROLLERS["mrp_feedback"].Options(**options))
+    law.reset(spacecraft, 0.1)
+    assert law.gyroscopic_compensation == (options["gyroscopic_rate"] == "body")
+    demand = reference_demand(law, AttitudeModel(spacecraft), t, q, omega, torque, h0)
+    total = quat.rotate(quat.IDENTITY, INERTIA @ omega[0] + h0)
+    expected_h = quat.rotate(quat.conjugate(q), np.tile(total, (t.size, 1))) - omega @ INERTIA.T
+    h = demand["wheels_momentum"].values
+    assert np.max(np.abs(h - expected_h)) < 1e-6 * np.max(np.abs(expected_h))
+    expected_g = -(torque + np.cross(omega, h))
+    np.testing.assert_allclose(demand["wheels_torque"].values, expected_g, rtol=1e-12, atol=1e-15)
+    assert law.gyroscopic_compensation == (options["gyroscopic_rate"] == "body")  # the law is not changed
+
+
 def test_what_two_wheels_cannot_give_goes_to_the_torquers_unless_the_law_is_wheels_only():
     """Wheels on body x and y with zero momentum and ω = 0: g = [-u_x, -u_y], torquers [0, 0, u_z]."""
     axes = np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]])

@@ -28,10 +28,9 @@ loop has ``V̇ = −P δωᵀ δω``.
 wheel momenta, and the allocation adds ``ω × A h_w`` back (``gyroscopic_compensation`` true). With
 ``reference`` (Basilisk's default) it is not: ``L_r − ω × A h_w`` keeps ``−δω × A h_w``, so the
 wheels' term stays in the law and ``L_r`` is mapped as it is (``gyroscopic_compensation`` false;
-the controller conformance tells the two kinds apart). A consequence for the scenario's actuator
-requirement: it scores a reference's demand through the law's map, which for such a law is the
-feed-forward torque as the wheels' torque, without the ``ω × A h_w`` that the law adds along the
-reference (the closed loop itself is exact).
+the controller conformance tells the two kinds apart). The scenario's actuator requirement asks
+the wheels for ``ω × A h_w`` along the reference with either form
+(:func:`controllers.allocation.reference_demand`).
 """
 from __future__ import annotations
 
