@@ -102,7 +102,8 @@ def _check_physical(row: Row, scope: str, metrics: dict[str, Any] | None) -> Non
 
 
 def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
-        cache: SolverCache | None = None, simulators: SolverCache | None = None) -> RunResults:
+        cache: SolverCache | None = None, simulators: SolverCache | None = None,
+        on_row: Callable[[Row], None] | None = None) -> RunResults:
     """Plan, simulate and score every planner of ``scenario``.
 
     The scenario's validated planner and controller instances serve every row (their options are
@@ -118,6 +119,9 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     simulators : simulators (and their closed-loop functions) shared across runs, keyed by the
         model's fingerprint and the simulation settings; anything with SolverCache's ``get``
         (a trade-study worker passes a bounded one). None: a new simulator per run.
+    on_row : receives each row as soon as it is done (scored and judged), before its progress
+        line: ``slewbench run`` sends its figure to the plot process
+        (:func:`scenarios.output.writer.plot_streamer`).
 
     Returns
     -------
@@ -136,6 +140,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
                         f"{type(scenario).__name__}")
     if progress is not None and not callable(progress):
         raise TypeError(f"progress must be callable or None, got {type(progress).__name__}")
+    if on_row is not None and not callable(on_row):
+        raise TypeError(f"on_row must be callable or None, got {type(on_row).__name__}")
     if cache is not None and not isinstance(cache, SolverCache):
         raise TypeError(f"cache must be an ocp.SolverCache or None, got {type(cache).__name__}")
     if simulators is not None and not callable(getattr(simulators, "get", None)):
@@ -194,6 +200,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         if scoring:
             _judge(row, scores, note)
         rows.append(row)
+        if on_row is not None:
+            on_row(row)
         say(f"[{len(rows)}/{len(labels)}] {row.label}: {row.status} ({timing})"
             + (f" - {row.message}" if row.status != "ok" else ""))
     return RunResults(scenario, rows)

@@ -61,6 +61,82 @@ def test_the_plot_process_draws_what_the_run_process_draws(tmp_path):
         np.testing.assert_array_equal(_pixels(tmp_path / "forked" / name), _pixels(tmp_path / "here" / name))
 
 
+def test_rows_streamed_during_the_run_are_the_rows_drawn_in_process(tmp_path):
+    """Each row's figure goes to the plot process as soon as the row is done (``on_row``), before
+    the next row is planned; the streamed figures, written at the end, are those drawn in process
+    pixel for pixel (oracle: ``draw_jobs`` in the script's own process), and a streamed figure the
+    run does not keep is not written."""
+    done = _python("""
+        import sys
+        from pathlib import Path
+        from scenarios.output.renderer import Renderer
+        renderer = Renderer.start()
+        assert renderer is not None, "no plot process on a one-thread Linux process"
+        import scenarios
+        from scenarios.output.plot_data import plot_jobs
+        from scenarios.output.plots import draw_jobs
+        from scenarios.output.writer import plot_streamer
+        scenario = scenarios.load(sys.argv[1])
+        stream = plot_streamer(scenario, renderer)
+        order = []
+        def on_row(row):
+            stream(row)
+            order.append((row.label, sorted(renderer.streamed)))
+        results = scenarios.run(scenario, on_row=on_row)
+        for label, streamed in order:
+            print(label, "|", ",".join(streamed))
+        forked, here = Path(sys.argv[2]) / "forked", Path(sys.argv[2]) / "here"
+        forked.mkdir(); here.mkdir()
+        keep = set(renderer.streamed) - {"smooth.png"}
+        renderer.submit(plot_jobs(results, drawn=keep), forked, keep)
+        renderer.wait()
+        renderer.close()
+        draw_jobs(plot_jobs(results), here)
+    """, str(DEMO), str(tmp_path))
+    assert done.returncode == 0, done.stderr
+    # streamed one by one, as the rows finish (the demo's rows in order)
+    assert done.stdout.splitlines() == ["smooth | smooth.png", "bang-coast-bang | bang-coast-bang.png,smooth.png",
+                                        "min-time | bang-coast-bang.png,min-time.png,smooth.png"]
+    names = ["bang-coast-bang.png", "comparison.png", "min-time.png", "smooth.png"]
+    # smooth.png was streamed but not kept: drawn again from the submitted jobs, not dropped
+    assert sorted(p.name for p in (tmp_path / "forked").iterdir()) == names
+    for name in names:
+        np.testing.assert_array_equal(_pixels(tmp_path / "forked" / name), _pixels(tmp_path / "here" / name))
+
+
+def test_a_plot_process_dying_while_rows_stream_costs_only_time(tmp_path):
+    """The plot process killed after the first row was streamed: the later rows are not sent, the
+    run draws every figure itself (the streamed one too), says so on one line, and writes
+    complete results."""
+    done = _python("""
+        import os, signal, sys, time
+        from scenarios.output.renderer import Renderer
+        renderer = Renderer.start()
+        import scenarios
+        from scenarios.output.writer import plot_streamer
+        scenario = scenarios.load(sys.argv[1])
+        stream = plot_streamer(scenario, renderer)
+        def on_row(row):
+            stream(row)
+            if len(renderer.streamed) == 1 and not killed:
+                os.kill(renderer.pid, signal.SIGKILL)
+                killed.append(True)
+                while open(f"/proc/{renderer.pid}/stat").read().split(")")[-1].split()[0] != "Z":
+                    time.sleep(0.01)  # dead (its pipe closed), not yet reaped
+        killed = []
+        results = scenarios.run(scenario, on_row=on_row)
+        print(sorted(renderer.streamed))
+        results.write(sys.argv[2], renderer=renderer)
+        renderer.close()
+    """, str(DEMO), str(tmp_path / "out"))
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "['smooth.png']"
+    assert "the plot process has already drawn or stopped" in done.stderr and "Traceback" not in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
+    for name in ("smooth.png", "bang-coast-bang.png", "min-time.png", "comparison.png", "results.json"):
+        assert (tmp_path / "out" / name).is_file(), name
+
+
 def test_a_dead_plot_process_costs_only_time(tmp_path):
     """The plot process killed before it draws: the run draws the figures itself, says so on one
     line, and writes complete results."""
@@ -355,7 +431,7 @@ def test_the_second_drawer_is_forked_only_from_a_single_thread(tmp_path, monkeyp
     monkeypatch.setattr(renderer.os, "fork", no_fork)
     t = np.linspace(0.0, 10.0, 11)
     overlay = OverlaySeries("t", "error (deg)", ["a"], [(t, t)], [(t, 1 + t)])
-    renderer._draw_in_two([("a.png", overlay), ("b.png", overlay)], tmp_path, [])
+    renderer._draw_in_two([("a.png", overlay), ("b.png", overlay)], tmp_path, [], {})
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.png"]
 
 

@@ -36,6 +36,7 @@ from scenarios.output.directory import (
 from scenarios.output.export import EXPORT_FORMATS, default_export_directory, export_run
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
+from scenarios.output.writer import plot_streamer
 from scenarios.runner import run
 from scenarios.schema.labels import row_labels
 from scenarios.schema.loader import load, parse_scenario
@@ -173,12 +174,14 @@ def command_run(args: argparse.Namespace) -> int:
         interruption.check()  # a signal swallowed on the way (see Interruption) stops the run here
         print(line, flush=True)
 
-    results = run(scenario, progress=progress)
+    renderer = getattr(args, "renderer", None)
+    results = run(scenario, progress=progress,
+                  on_row=plot_streamer(scenario, renderer) if renderer is not None and not args.no_plots else None)
     interruption.check()
     print()
     print(results.to_terminal(all_metrics=getattr(args, "all_metrics", False)))
     earlier = written_files(out)
-    results.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
+    results.write(out, plots=not args.no_plots, renderer=renderer)
     print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
           f"{'' if args.no_plots else ', PNG plots, report.html'}) in {time.perf_counter() - start:.2f} s")
     removed = sorted(earlier - written_files(out))

@@ -16,33 +16,18 @@ import sqlite3
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from scenarios.cli.status import EXIT_INTERRUPTED, EXIT_OK
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, claim_output_directory, written_files
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
-from scenarios.study.engine import (
-    DaskCluster,
-    connect_scheduler,
-    start_forkserver,
-    sweep,
-)
-from scenarios.study.report import resolved_study, robustness_tables
-from scenarios.study.rerun import rerun_case, row_differences, stored_results
-from scenarios.study.robustness import robustness_lines
-from scenarios.study.spec import load_study
-from scenarios.study.store import (
-    EARLIER_FORMATS,
-    STORE_FILES,
-    STORE_NAME,
-    SweepStore,
-    claim_sweep_directory,
-    store_format,
-)
-from scenarios.study.types import Study
 
+if TYPE_CHECKING:  # the trade-study machinery is imported by the handlers: `slewbench run` does not load it
+    from scenarios.study.engine import DaskCluster
+    from scenarios.study.store import SweepStore
+    from scenarios.study.types import Study
 
 def _terminate(signum: int, frame: Any) -> None:
     raise KeyboardInterrupt
@@ -67,6 +52,8 @@ def command_report(args: argparse.Namespace) -> int:
         The directory holds no slewbench sweep (a sweep of an earlier slewbench whose store is
         still readable is redrawn), or its store is damaged.
     """
+    from scenarios.study.rerun import stored_results
+
     out = Path(args.report)
     results, _ = stored_results(out)
     earlier = written_files(out)
@@ -106,6 +93,8 @@ def command_case(args: argparse.Namespace) -> int:
     OutputError
         The directory holds no sweep, or the output directory cannot be claimed (exit 2).
     """
+    from scenarios.study.rerun import rerun_case, row_differences, stored_results
+
     clashing = [name for name, given in (("--report", args.report), ("--resume", args.resume),
                                          ("--dry-run", args.dry_run), ("--workers", args.workers is not None),
                                          ("--scheduler", args.scheduler)) if given]
@@ -182,6 +171,8 @@ def _checking(name: str) -> Any:
 
 def _output(args: argparse.Namespace, study: Study) -> Path:
     """The output directory, checked without writing anything."""
+    from scenarios.study.store import EARLIER_FORMATS, STORE_NAME, store_format
+
     out = Path(args.out) if args.out else default_output_directory(study.name)
     try:
         earlier = store_format(out)
@@ -213,6 +204,8 @@ def _created(out: Path) -> tuple[Path | None, bool]:
 def _undo(out: Path, missing: Path | None, empty: bool) -> None:
     """Remove what a sweep that could not start wrote: the folders it created, or what it put into a
     directory that was empty."""
+    from scenarios.study.store import STORE_FILES
+
     if missing is not None:
         shutil.rmtree(missing, ignore_errors=True)
     elif empty:
@@ -222,6 +215,9 @@ def _undo(out: Path, missing: Path | None, empty: bool) -> None:
 
 def _open(out: Path, study: Study) -> tuple[Path, SweepStore]:
     """Claim the directory and open the store with the study in it; on failure (a full disk), undo."""
+    from scenarios.study.report import resolved_study
+    from scenarios.study.store import SweepStore, claim_sweep_directory
+
     missing, empty = _created(Path(out).absolute())
     try:
         directory = claim_sweep_directory(out)
@@ -264,6 +260,9 @@ def command_sweep(args: argparse.Namespace) -> int:
         An output directory slewbench must not or cannot write to (exit 2; nothing written), or a
         store that cannot be written while the sweep runs (the cases stored so far are kept).
     """
+    from scenarios.study.engine import connect_scheduler, start_forkserver
+    from scenarios.study.spec import load_study
+
     if args.case is not None:
         return command_case(args)
     if args.report:
@@ -311,6 +310,11 @@ def _list_cases(study: Study) -> None:
 
 
 def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster | None) -> int:
+    from scenarios.study.engine import sweep
+    from scenarios.study.report import robustness_tables
+    from scenarios.study.robustness import robustness_lines
+    from scenarios.study.store import STORE_NAME, SweepStore
+
     out, store = _open(out, study)
     start = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _terminate)

@@ -12,6 +12,7 @@ figure layouts below fix the pixel columns without a figure.
 """
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
@@ -953,9 +954,47 @@ SKY_FILE = "sky.png"
 """The sky map of a run with pointing requirements."""
 
 
-def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str | None = None) -> list[PlotJob]:
-    """The figures of a run: one per simulated row (``<stem>.png``), with pointing requirements
-    :data:`MARGINS_FILE` and :data:`SKY_FILE`, and ``comparison.png``.
+def _euler_sequence(results_or_scenario: Any, euler_sequence: str | None) -> str:
+    """The row figures' Euler sequence as digits ("321"): ``euler_sequence``, else the scenario's."""
+    from ocp import quat
+
+    if euler_sequence is None:
+        scenario = getattr(results_or_scenario, "scenario", results_or_scenario)
+        euler_sequence = getattr(scenario, "euler_sequence", EULER_SEQUENCE)
+    # a bad sequence fails before any series is computed; "zyx" is drawn as "321"
+    return "".join(str(axis + 1) for axis in quat.sequence_axes(euler_sequence))
+
+
+def row_job(row: Any, stem: str, scenario: Any, euler_sequence: str | None = None) -> PlotJob | None:
+    """A simulated row's figure, as in :func:`plot_jobs`: what a run sends its plot process as soon
+    as the row is done (:meth:`scenarios.output.renderer.Renderer.stream`).
+
+    Parameters
+    ----------
+    row : scenarios.output.results.Row
+        A finished row.
+    stem : str
+        Its file stem (:func:`scenarios.output.names.row_stems` of the run's labels).
+    scenario : scenarios.schema.loader.Scenario
+        The run's scenario (its target attitude, spacecraft and ``plots.euler_sequence``).
+    euler_sequence : str, optional
+        As in :func:`plot_jobs`.
+
+    Returns
+    -------
+    (str, RowSeries) or None
+        ``<stem>.png`` and the row's series; ``None`` for a row without a simulation (no figure).
+    """
+    if row.simulation is None:
+        return None
+    problem = scenario.problem
+    return f"{stem}.png", row_series(row, problem.qf, problem.spacecraft, _euler_sequence(scenario, euler_sequence))
+
+
+def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str | None = None,
+              drawn: Collection[str] = ()) -> list[PlotJob]:
+    """The figures of a run: one per simulated row (``<stem>.png``, :func:`row_job`), with pointing
+    requirements :data:`MARGINS_FILE` and :data:`SKY_FILE`, and ``comparison.png``.
 
     Parameters
     ----------
@@ -966,27 +1005,22 @@ def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str 
     euler_sequence : str, optional
         The row figures' Euler sequence (:func:`euler_angles`); ``None`` (default): the scenario's
         (``plots.euler_sequence``; :data:`EULER_SEQUENCE` unless given).
+    drawn : collection of str, optional
+        File names of row figures drawn already (streamed to the plot process): left out.
 
     Returns
     -------
     list of (str, series)
         File names and series, in drawing order (rows, the pointing figures, the overlay last).
     """
-    from ocp import quat
     from scenarios.output.names import row_stems
 
-    if euler_sequence is None:
-        euler_sequence = getattr(results.scenario, "euler_sequence", EULER_SEQUENCE)
-    # a bad sequence fails before any series is computed; "zyx" is drawn as "321"
-    euler_sequence = "".join(str(axis + 1) for axis in quat.sequence_axes(euler_sequence))
-
-    problem = results.scenario.problem
+    euler_sequence = _euler_sequence(results, euler_sequence)
     stems = stems if stems is not None else row_stems([row.label for row in results.rows])
     jobs: list[PlotJob] = []
     for row, stem in zip(results.rows, stems):
-        if row.simulation is None:
-            continue
-        jobs.append((f"{stem}.png", row_series(row, problem.qf, problem.spacecraft, euler_sequence)))
+        if f"{stem}.png" not in drawn and (job := row_job(row, stem, results.scenario, euler_sequence)) is not None:
+            jobs.append(job)
     constraints = pointing_constraints(results)
     sampled = motions(results) if constraints else []
     if sampled:

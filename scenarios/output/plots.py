@@ -29,7 +29,7 @@ from __future__ import annotations
 import textwrap
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -460,15 +460,15 @@ class RowFigure:
         else:
             canvas.restore_region(self._background[1])
 
-    def draw(self, series: RowSeries, path: Path) -> None:
+    def draw(self, series: RowSeries, path: Path | BinaryIO) -> None:
         """Draw a row's curves and write the PNG.
 
         Parameters
         ----------
         series : scenarios.output.plot_data.RowSeries
             The row's curves (:func:`scenarios.output.plot_data.row_series`), of this figure's shape.
-        path : pathlib.Path
-            Where to write the PNG.
+        path : pathlib.Path or binary file
+            Where to write the PNG (a file object: into it, e.g. a ``BytesIO``).
         """
         self.prepare(series)
         renderer = self.canvas.get_renderer()
@@ -477,7 +477,7 @@ class RowFigure:
         _write_png(self.canvas, path)
 
 
-def _write_png(canvas: FigureCanvasAgg, path: Path) -> None:
+def _write_png(canvas: FigureCanvasAgg, path: Path | BinaryIO) -> None:
     """The canvas as it is drawn (no second draw, unlike ``savefig``) as a PNG."""
     from PIL import Image  # matplotlib's own PNG writer; imported with it
 

@@ -5,8 +5,10 @@ Importing matplotlib costs about as much as importing slewbench and running the 
 run's objects: only the arrays of :mod:`scenarios.output.plot_data`. So ``slewbench run`` forks this
 process first thing, before it imports the model (:mod:`scenarios.console`). The child imports the
 drawing half (:mod:`scenarios.output.plots`, which imports matplotlib but not the model) and waits. The run
-sends it the figures to draw (file names and series, pickled through a pipe) and the directory
-to write them into. The child draws them there and answers.
+sends it each row's figure as soon as the row is done (:meth:`Renderer.stream`): the child draws
+it into memory while the run goes on with the next row. At the end the run sends the remaining
+figures and the directory to write into (:meth:`Renderer.submit`); the child writes the rows it
+has drawn, draws the others there and answers.
 
 The process is used only where forking this early is safe and cheap: Linux, and a parent with one
 thread (a fork copies only the calling thread). The child limits its BLAS to one thread before it
@@ -17,7 +19,9 @@ same, pixel for pixel.
 from __future__ import annotations
 
 import atexit
+import fcntl
 import functools
+import io
 import os
 import pickle
 import signal
@@ -32,6 +36,12 @@ SINGLE_THREAD_ENVIRONMENT = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM
 COST = {"row": 1.0, "other": 1.3}
 """Relative drawing costs (about 0.1 s each on the reference machine) of one row on its figure,
 whose static part is drawn before the fork (:func:`_draw_in_two`), and of any other figure."""
+PIPE_BYTES = 1 << 20
+"""Capacity asked for the pipe to the child (Linux's ``F_SETPIPE_SZ``; 1 MiB is the unprivileged
+limit): a streamed row's series (about 80 kB pickled for the demo scenario, more than the default
+64 kB) is written at once while the child is busy drawing, and the run does not wait for it."""
+F_SETPIPE_SZ = 1031
+"""``fcntl`` command that sets a pipe's capacity (Linux; the constant is not in Python 3.11's ``fcntl``)."""
 STOP_TIMEOUT_S = 5.0
 """How long :meth:`Renderer.close` lets the plot process stop its fork and exit before killing it [s]."""
 
@@ -87,6 +97,8 @@ class Renderer:
         self._fds = [send_fd, receive_fd]
         self._running = True
         self._submitted = False
+        self.streamed: set[str] = set()
+        """File names of the figures sent by :meth:`stream` (drawn by the child into memory)."""
 
     @classmethod
     def start(cls) -> Renderer | None:
@@ -100,6 +112,10 @@ class Renderer:
         if not sys.platform.startswith("linux") or _thread_count() != 1:
             return None
         to_child, from_parent = os.pipe()[::-1]  # (write end, read end)
+        try:
+            fcntl.fcntl(to_child, F_SETPIPE_SZ, PIPE_BYTES)
+        except OSError:  # a lower limit: a large row then waits until the child reads it
+            pass
         from_child, to_parent = os.pipe()
         parent = os.getpid()
         pid = os.fork()
@@ -130,16 +146,49 @@ class Renderer:
         self.submit(jobs, directory)
         self.wait()
 
-    def submit(self, jobs: list[Any], directory: Path) -> None:
+    def stream(self, job: tuple[str, Any]) -> None:
+        """Send one row's figure to the child, which draws it into memory while the caller runs on;
+        :meth:`submit` later has it written (or dropped). Nothing happens once the child has
+        drawn, stopped or failed: :meth:`submit` then reports it, and the caller draws everything.
+
+        Parameters
+        ----------
+        job : (str, scenarios.output.plot_data.RowSeries)
+            File name and series of a row's figure (:func:`scenarios.output.plot_data.row_job`).
+        """
+        if not self._running or len(self._fds) != 2 or self._submitted:
+            return
+        try:
+            self._send(("row", job))
+        except OSError:
+            self.close()  # submit raises RenderingFailed
+            return
+        self.streamed.add(job[0])
+
+    def _send(self, message: tuple[Any, ...]) -> None:
+        """Pickle ``message`` into the pipe to the child (closing the child on Ctrl-C or SIGTERM)."""
+        try:
+            with os.fdopen(self._fds[0], "wb", closefd=False) as stream:
+                pickle.dump(message, stream, protocol=pickle.HIGHEST_PROTOCOL)
+        except OSError:  # the child has gone: the caller says what that means
+            raise
+        except BaseException:  # Ctrl-C, SIGTERM: the child stops before the caller removes `directory`
+            self.close()
+            raise
+
+    def submit(self, jobs: list[Any], directory: Path, keep: set[str] | frozenset[str] = frozenset()) -> None:
         """Send ``jobs`` to the child and return while it draws (the caller then works on, for
         instance on ``report.html``, and calls :meth:`wait` before it uses ``directory``'s figures).
 
         Parameters
         ----------
         jobs : list of (str, series)
-            File names and series (:func:`scenarios.output.plot_data.plot_jobs`).
+            File names and series (:func:`scenarios.output.plot_data.plot_jobs`) still to draw.
         directory : pathlib.Path
             Existing directory to write into (the run's staging directory).
+        keep : set of str, optional
+            File names of figures sent by :meth:`stream` to write into ``directory`` too (any other
+            streamed figure is dropped).
 
         Raises
         ------
@@ -149,14 +198,10 @@ class Renderer:
         if not self._running or len(self._fds) != 2:
             raise RenderingFailed("the plot process has already drawn or stopped")
         try:
-            with os.fdopen(self._fds[0], "wb", closefd=False) as stream:
-                pickle.dump((str(directory), jobs), stream, protocol=pickle.HIGHEST_PROTOCOL)
+            self._send(("draw", str(directory), jobs, sorted(keep)))
         except OSError as error:
             self.close()
             raise RenderingFailed(f"the plot process ended early ({type(error).__name__})") from None
-        except BaseException:  # Ctrl-C, SIGTERM: the child stops before the caller removes `directory`
-            self.close()
-            raise
         self._submitted = True
 
     def wait(self) -> None:
@@ -249,17 +294,17 @@ def split(jobs: list[Any]) -> tuple[list[Any], list[Any]]:
     return ([job for job, b in zip(jobs, share) if b == 0], [job for job, b in zip(jobs, share) if b == 1])
 
 
-def _draw_in_two(jobs: list[Any], directory: Path, forks: list[int]) -> None:
+def _draw_in_two(jobs: list[Any], directory: Path, forks: list[int], figures: dict[Any, Any]) -> None:
     """Draw ``jobs`` in this process and a fork of it (the child of :func:`_serve`, which has one
     thread; the fork's pid is in ``forks`` while it runs); raise if either fails.
 
     The static part of each row shape's figure is drawn first (:meth:`RowFigure.prepare` with the
-    first row of that shape), so that the fork inherits it instead of drawing it again.
+    first row of that shape) unless ``figures`` (row figures by shape, those the streamed rows were
+    drawn on) has it, so that the fork inherits it instead of drawing it again.
     """
-    from scenarios.output.plot_data import RowSeries, RowShape
+    from scenarios.output.plot_data import RowSeries
     from scenarios.output.plots import RowFigure, draw_jobs
 
-    figures: dict[RowShape, RowFigure] = {}
     for _, series in jobs:
         if isinstance(series, RowSeries) and series.shape not in figures:
             figures[series.shape] = RowFigure(*series.shape)
@@ -331,15 +376,35 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
         die_with_parent(signal.SIGTERM, parent)
         for name in SINGLE_THREAD_ENVIRONMENT:
             os.environ[name] = "1"
-        import scenarios.output.plots  # noqa: F401  (matplotlib, while the parent runs)
+        from scenarios.output.plots import RowFigure  # matplotlib, while the parent runs
 
+        figures: dict[Any, RowFigure] = {}
+        drawn: dict[str, bytes] = {}
+        failure = ""
         with os.fdopen(receive_fd, "rb") as stream:
-            try:
-                directory, jobs = pickle.load(stream)
-            except EOFError:  # the parent ended without plots to draw
-                _exit(0)
+            while True:
+                try:
+                    message = pickle.load(stream)
+                except EOFError:  # the parent ended without plots to draw
+                    _exit(0)
+                if message[0] == "draw":
+                    _, directory, jobs, keep = message
+                    break
+                (name, series), buffer = message[1], io.BytesIO()
+                if failure:
+                    continue
+                try:  # a streamed row: drawn now, written when the directory is known
+                    figure = figures.get(series.shape) or figures.setdefault(series.shape, RowFigure(*series.shape))
+                    figure.draw(series, buffer)
+                    drawn[name] = buffer.getvalue()
+                except Exception:  # reported with the answer
+                    failure = traceback.format_exc()
         try:
-            _draw_in_two(jobs, Path(directory), forks)
+            if failure:
+                raise RuntimeError(f"drawing a streamed row failed: {failure}")
+            for name in keep:
+                (Path(directory) / name).write_bytes(drawn[name])
+            _draw_in_two(jobs, Path(directory), forks, figures)
             reply: tuple[str, str] = ("ok", "")
         except Exception:  # reported to the parent, which draws in its own process and raises there
             reply = ("error", traceback.format_exc())

@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import shutil
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -23,7 +24,7 @@ from scenarios.output.tables import csv_cell, to_csv, to_json, to_markdown
 if TYPE_CHECKING:
     from scenarios.output.results import Row, RunResults
 
-__all__ = ["write_results", "write_timeseries"]
+__all__ = ["plot_streamer", "write_results", "write_timeseries"]
 
 
 def write_timeseries(row: Row, path: Path) -> None:
@@ -64,19 +65,52 @@ def write_timeseries(row: Row, path: Path) -> None:
             writer.writerow([csv_cell(float(v)) for v in line])
 
 
+def plot_streamer(scenario: Any, renderer: Any) -> Callable[[Row], None]:
+    """A run's ``on_row`` (:func:`scenarios.runner.run`) that sends each simulated row's figure to
+    the plot process as soon as the row is done (:meth:`scenarios.output.renderer.Renderer.stream`),
+    so that it is drawn while the run goes on; :func:`write_results` then has it written.
+
+    Parameters
+    ----------
+    scenario : scenarios.schema.loader.Scenario
+        The scenario about to run (its rows' labels give the file stems).
+    renderer : scenarios.output.renderer.Renderer
+        The plot process.
+
+    Returns
+    -------
+    callable
+        ``on_row(row)``.
+    """
+    from scenarios.output.plot_data import row_job
+    from scenarios.schema.labels import row_labels
+
+    labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in scenario.controllers])
+    stems = dict(zip((label for label, *_ in labels), row_stems([label for label, *_ in labels])))
+
+    def on_row(row: Row) -> None:
+        stem = stems.get(row.label)
+        job = None if stem is None else row_job(row, stem, scenario)
+        if job is not None:
+            renderer.stream(job)
+
+    return on_row
+
+
 def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer: Any) -> None:
-    """The run's figures and ``report.html`` into ``staging``. With a plot process, the figures are
-    sent to it first and the report is built here while it draws; without one (or if it fails),
-    both are made in this process."""
+    """The run's figures and ``report.html`` into ``staging``. With a plot process, the figures not
+    streamed to it already (:func:`plot_streamer`) are sent to it and the report is built here
+    while it draws; without one (or if it fails), both are made in this process."""
     from scenarios.output.plot_data import plot_jobs
     from scenarios.output.report.run import run_report
 
-    jobs = plot_jobs(results, stems)
     if renderer is not None:
         from scenarios.output.renderer import RenderingFailed
 
+        names = {f"{stem}.png" for row, stem in zip(results.rows, stems) if row.simulation is not None}
+        keep = names & renderer.streamed  # streamed under this run's file names
         try:
-            renderer.submit(jobs, staging)
+            renderer.submit(plot_jobs(results, stems, drawn=keep), staging, keep)
         except RenderingFailed as error:
             print(f"slewbench: {error}; drawing the plots in this process", file=sys.stderr)
             renderer = None
@@ -89,7 +123,7 @@ def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer:
             print(f"slewbench: {error}; drawing the plots in this process", file=sys.stderr)
     from scenarios.output.plots import draw_jobs
 
-    draw_jobs(jobs, staging)
+    draw_jobs(plot_jobs(results, stems), staging)
 
 
 def write_results(results: RunResults, directory: str | Path, plots: bool = True, renderer: Any = None) -> Path:
