@@ -21,6 +21,7 @@ from scenarios.output.renderer import COST, split
 
 REPO = Path(__file__).resolve().parents[1]
 DEMO = REPO / "scenarios" / "eigenaxis_demo.yaml"
+KEEP_OUT = REPO / "scenarios" / "collocation_keep_out.yaml"
 
 
 def _python(code: str, *args: str, timeout: float = 300) -> subprocess.CompletedProcess:
@@ -61,11 +62,13 @@ def test_the_plot_process_draws_what_the_run_process_draws(tmp_path):
         np.testing.assert_array_equal(_pixels(tmp_path / "forked" / name), _pixels(tmp_path / "here" / name))
 
 
-def test_rows_streamed_during_the_run_are_the_rows_drawn_in_process(tmp_path):
+@pytest.mark.parametrize("scenario", [DEMO, KEEP_OUT], ids=["demo", "keep_out"])
+def test_figures_streamed_during_the_run_are_those_drawn_in_process(tmp_path, scenario):
     """Each row's figure goes to the plot process as soon as the row is done (``on_row``), before
-    the next row is planned; the streamed figures, written at the end, are those drawn in process
-    pixel for pixel (oracle: ``draw_jobs`` in the script's own process), and a streamed figure the
-    run does not keep is not written."""
+    the next row is planned, and the whole run's figures (comparison; margins and sky with a
+    pointing requirement) with the last row; the streamed figures, written at the end, are those
+    drawn in process pixel for pixel (oracle: ``draw_jobs`` in the script's own process), and a
+    streamed figure the run does not keep is drawn again, not written as streamed."""
     done = _python("""
         import sys
         from pathlib import Path
@@ -78,27 +81,33 @@ def test_rows_streamed_during_the_run_are_the_rows_drawn_in_process(tmp_path):
         from scenarios.output.writer import plot_streamer
         scenario = scenarios.load(sys.argv[1])
         stream = plot_streamer(scenario, renderer)
-        order = []
         def on_row(row):
             stream(row)
-            order.append((row.label, sorted(renderer.streamed)))
+            print(row.label, "|", ",".join(sorted(renderer.streamed)))
         results = scenarios.run(scenario, on_row=on_row)
-        for label, streamed in order:
-            print(label, "|", ",".join(streamed))
         forked, here = Path(sys.argv[2]) / "forked", Path(sys.argv[2]) / "here"
         forked.mkdir(); here.mkdir()
-        keep = set(renderer.streamed) - {"smooth.png"}
+        first = sorted(renderer.streamed)[0]
+        keep = set(renderer.streamed) - {first}
+        print("dropped", first)
         renderer.submit(plot_jobs(results, drawn=keep), forked, keep)
         renderer.wait()
         renderer.close()
-        draw_jobs(plot_jobs(results), here)
-    """, str(DEMO), str(tmp_path))
+        jobs = plot_jobs(results)
+        draw_jobs(jobs, here)
+        print("jobs", " ".join(sorted(name for name, _ in jobs)))
+    """, str(scenario), str(tmp_path))
     assert done.returncode == 0, done.stderr
-    # streamed one by one, as the rows finish (the demo's rows in order)
-    assert done.stdout.splitlines() == ["smooth | smooth.png", "bang-coast-bang | bang-coast-bang.png,smooth.png",
-                                        "min-time | bang-coast-bang.png,min-time.png,smooth.png"]
-    names = ["bang-coast-bang.png", "comparison.png", "min-time.png", "smooth.png"]
-    # smooth.png was streamed but not kept: drawn again from the submitted jobs, not dropped
+    *streaming, dropped, jobs = done.stdout.splitlines()
+    names = jobs.split()[1:]
+    if scenario == DEMO:  # streamed one by one, as the rows finish (the demo's rows in order)
+        assert streaming == ["smooth | smooth.png", "bang-coast-bang | bang-coast-bang.png,smooth.png",
+                             "min-time | bang-coast-bang.png,comparison.png,min-time.png,smooth.png"]
+    else:  # the pointing figures come with the last row
+        assert {"margins.png", "sky.png", "comparison.png"} <= set(names)
+        assert not {"margins.png", "sky.png", "comparison.png"} & set(streaming[-2].split("|")[1].split(","))
+        assert streaming[-1].split("|")[1].strip().split(",") == names
+    # the dropped figure was drawn again from the submitted jobs, not lost
     assert sorted(p.name for p in (tmp_path / "forked").iterdir()) == names
     for name in names:
         np.testing.assert_array_equal(_pixels(tmp_path / "forked" / name), _pixels(tmp_path / "here" / name))

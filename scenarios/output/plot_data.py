@@ -952,6 +952,8 @@ MARGINS_FILE = "margins.png"
 """The pointing-margin figure of a run with pointing requirements."""
 SKY_FILE = "sky.png"
 """The sky map of a run with pointing requirements."""
+COMPARISON_FILE = "comparison.png"
+"""The rows overlaid (:class:`OverlaySeries`)."""
 
 
 def _euler_sequence(results_or_scenario: Any, euler_sequence: str | None) -> str:
@@ -994,7 +996,7 @@ def row_job(row: Any, stem: str, scenario: Any, euler_sequence: str | None = Non
 def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str | None = None,
               drawn: Collection[str] = ()) -> list[PlotJob]:
     """The figures of a run: one per simulated row (``<stem>.png``, :func:`row_job`), with pointing
-    requirements :data:`MARGINS_FILE` and :data:`SKY_FILE`, and ``comparison.png``.
+    requirements :data:`MARGINS_FILE` and :data:`SKY_FILE`, and :data:`COMPARISON_FILE`.
 
     Parameters
     ----------
@@ -1006,7 +1008,8 @@ def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str 
         The row figures' Euler sequence (:func:`euler_angles`); ``None`` (default): the scenario's
         (``plots.euler_sequence``; :data:`EULER_SEQUENCE` unless given).
     drawn : collection of str, optional
-        File names of row figures drawn already (streamed to the plot process): left out.
+        File names of figures drawn already (streamed to the plot process): left out, their series
+        not computed.
 
     Returns
     -------
@@ -1021,12 +1024,14 @@ def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str 
     for row, stem in zip(results.rows, stems):
         if f"{stem}.png" not in drawn and (job := row_job(row, stem, results.scenario, euler_sequence)) is not None:
             jobs.append(job)
-    constraints = pointing_constraints(results)
+    constraints = pointing_constraints(results) if not {MARGINS_FILE, SKY_FILE} <= set(drawn) else []
     sampled = motions(results) if constraints else []
-    if sampled:
+    if sampled and MARGINS_FILE not in drawn:
         jobs.append((MARGINS_FILE, margin_series(results, constraints, sampled)))
+    if sampled and SKY_FILE not in drawn:
         jobs.append((SKY_FILE, sky_series(results, constraints, sampled)))
-    jobs.append(("comparison.png", overlay_series(results)))
+    if COMPARISON_FILE not in drawn:
+        jobs.append((COMPARISON_FILE, overlay_series(results)))
     return jobs
 
 

@@ -603,15 +603,15 @@ def overlay_figure(series: OverlaySeries) -> Figure:
     return figure
 
 
-def draw_overlay(series: OverlaySeries, path: Path) -> None:
+def draw_overlay(series: OverlaySeries, path: Path | BinaryIO) -> None:
     """:func:`overlay_figure` as a PNG.
 
     Parameters
     ----------
     series : scenarios.output.plot_data.OverlaySeries
         The curves (:func:`scenarios.output.plot_data.overlay_series`).
-    path : pathlib.Path
-        Where to write the PNG.
+    path : pathlib.Path or binary file
+        Where to write the PNG (a file object: into it).
     """
     canvas = FigureCanvasAgg(overlay_figure(series))
     canvas.draw()
@@ -746,15 +746,15 @@ def margin_figure(series: MarginSeries) -> Figure:
     return figure
 
 
-def draw_margins(series: MarginSeries, path: Path) -> None:
+def draw_margins(series: MarginSeries, path: Path | BinaryIO) -> None:
     """:func:`margin_figure` as a PNG.
 
     Parameters
     ----------
     series : scenarios.output.plot_data.MarginSeries
         The curves (:func:`scenarios.output.plot_data.margin_series`).
-    path : pathlib.Path
-        Where to write the PNG.
+    path : pathlib.Path or binary file
+        Where to write the PNG (a file object: into it).
     """
     margin_figure(series).savefig(path, **SAVE)
 
@@ -828,15 +828,15 @@ def sky_figure(series: SkySeries) -> Figure:
     return figure
 
 
-def draw_sky(series: SkySeries, path: Path) -> None:
+def draw_sky(series: SkySeries, path: Path | BinaryIO) -> None:
     """:func:`sky_figure` as a PNG.
 
     Parameters
     ----------
     series : scenarios.output.plot_data.SkySeries
         The paths (:func:`scenarios.output.plot_data.sky_series`).
-    path : pathlib.Path
-        Where to write the PNG.
+    path : pathlib.Path or binary file
+        Where to write the PNG (a file object: into it).
     """
     sky_figure(series).savefig(path, **SAVE)
 
@@ -876,7 +876,7 @@ def draw_jobs(jobs: list[PlotJob], directory: Path, figures: dict[RowShape, RowF
             DRAW[type(series)](series, directory / name)
 
 
-DRAW: dict[type, Callable[[Any, Path], None]] = {OverlaySeries: draw_overlay, MarginSeries: draw_margins,
+DRAW: dict[type, Callable[[Any, Path | BinaryIO], None]] = {OverlaySeries: draw_overlay, MarginSeries: draw_margins,
                                                   SkySeries: draw_sky}
 """How each kind of series other than a row is drawn."""
 

@@ -5,10 +5,11 @@ Importing matplotlib costs about as much as importing slewbench and running the 
 run's objects: only the arrays of :mod:`scenarios.output.plot_data`. So ``slewbench run`` forks this
 process first thing, before it imports the model (:mod:`scenarios.console`). The child imports the
 drawing half (:mod:`scenarios.output.plots`, which imports matplotlib but not the model) and waits. The run
-sends it each row's figure as soon as the row is done (:meth:`Renderer.stream`): the child draws
-it into memory while the run goes on with the next row. At the end the run sends the remaining
-figures and the directory to write into (:meth:`Renderer.submit`); the child writes the rows it
-has drawn, draws the others there and answers.
+sends it each row's figure as soon as the row is done (:meth:`Renderer.stream`), and the figures
+of the whole run (the comparison, the margins, the sky) as soon as the last row is: the child draws
+them into memory while the run goes on. At the end the run sends whatever is left and the directory
+to write into (:meth:`Renderer.submit`); the child writes the figures it has drawn, draws the others
+there and answers.
 
 The process is used only where forking this early is safe and cheap: Linux, and a parent with one
 thread (a fork copies only the calling thread). The child limits its BLAS to one thread before it
@@ -97,8 +98,9 @@ class Renderer:
         self._fds = [send_fd, receive_fd]
         self._running = True
         self._submitted = False
-        self.streamed: set[str] = set()
-        """File names of the figures sent by :meth:`stream` (drawn by the child into memory)."""
+        self.streamed: dict[str, Any] = {}
+        """File names of the figures sent by :meth:`stream` (drawn by the child into memory), and
+        what each was computed from (its ``source``)."""
 
     @classmethod
     def start(cls) -> Renderer | None:
@@ -146,15 +148,19 @@ class Renderer:
         self.submit(jobs, directory)
         self.wait()
 
-    def stream(self, job: tuple[str, Any]) -> None:
-        """Send one row's figure to the child, which draws it into memory while the caller runs on;
+    def stream(self, job: tuple[str, Any], source: Any) -> None:
+        """Send one figure to the child, which draws it into memory while the caller runs on;
         :meth:`submit` later has it written (or dropped). Nothing happens once the child has
         drawn, stopped or failed: :meth:`submit` then reports it, and the caller draws everything.
 
         Parameters
         ----------
-        job : (str, scenarios.output.plot_data.RowSeries)
-            File name and series of a row's figure (:func:`scenarios.output.plot_data.row_job`).
+        job : (str, series)
+            File name and series (:func:`scenarios.output.plot_data.row_job`,
+            :func:`scenarios.output.plot_data.plot_jobs`).
+        source : object
+            What the series was computed from (a row, the run's rows), kept in :attr:`streamed`
+            for the caller to decide at the end whether the figure is still the one to write.
         """
         if not self._running or len(self._fds) != 2 or self._submitted:
             return
@@ -163,7 +169,7 @@ class Renderer:
         except OSError:
             self.close()  # submit raises RenderingFailed
             return
-        self.streamed.add(job[0])
+        self.streamed[job[0]] = source
 
     def _send(self, message: tuple[Any, ...]) -> None:
         """Pickle ``message`` into the pipe to the child (closing the child on Ctrl-C or SIGTERM)."""
@@ -376,7 +382,8 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
         die_with_parent(signal.SIGTERM, parent)
         for name in SINGLE_THREAD_ENVIRONMENT:
             os.environ[name] = "1"
-        from scenarios.output.plots import RowFigure  # matplotlib, while the parent runs
+        from scenarios.output.plot_data import RowSeries
+        from scenarios.output.plots import DRAW, RowFigure  # matplotlib, while the parent runs
 
         figures: dict[Any, RowFigure] = {}
         drawn: dict[str, bytes] = {}
@@ -393,9 +400,13 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
                 (name, series), buffer = message[1], io.BytesIO()
                 if failure:
                     continue
-                try:  # a streamed row: drawn now, written when the directory is known
-                    figure = figures.get(series.shape) or figures.setdefault(series.shape, RowFigure(*series.shape))
-                    figure.draw(series, buffer)
+                try:  # a streamed figure: drawn now, written when the directory is known
+                    if isinstance(series, RowSeries):
+                        figure = figures.get(series.shape) or figures.setdefault(series.shape,
+                                                                                 RowFigure(*series.shape))
+                        figure.draw(series, buffer)
+                    else:
+                        DRAW[type(series)](series, buffer)
                     drawn[name] = buffer.getvalue()
                 except Exception:  # reported with the answer
                     failure = traceback.format_exc()

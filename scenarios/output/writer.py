@@ -67,8 +67,9 @@ def write_timeseries(row: Row, path: Path) -> None:
 
 def plot_streamer(scenario: Any, renderer: Any) -> Callable[[Row], None]:
     """A run's ``on_row`` (:func:`scenarios.runner.run`) that sends each simulated row's figure to
-    the plot process as soon as the row is done (:meth:`scenarios.output.renderer.Renderer.stream`),
-    so that it is drawn while the run goes on; :func:`write_results` then has it written.
+    the plot process as soon as the row is done, and the figures of the whole run (comparison,
+    margins, sky) once the last row is (:meth:`scenarios.output.renderer.Renderer.stream`), so that
+    they are drawn while the run goes on; :func:`write_results` then has them written.
 
     Parameters
     ----------
@@ -82,19 +83,38 @@ def plot_streamer(scenario: Any, renderer: Any) -> Callable[[Row], None]:
     callable
         ``on_row(row)``.
     """
-    from scenarios.output.plot_data import row_job
+    from scenarios.output.plot_data import plot_jobs, row_job
+    from scenarios.output.results import RunResults
     from scenarios.schema.labels import row_labels
 
-    labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in scenario.controllers])
-    stems = dict(zip((label for label, *_ in labels), row_stems([label for label, *_ in labels])))
+    labels = [label for label, *_ in row_labels([planner.label for planner in scenario.planners],
+                                                 [c.label for c in scenario.controllers])]
+    stems = row_stems(labels)
+    rows: list[Row] = []
 
     def on_row(row: Row) -> None:
-        stem = stems.get(row.label)
-        job = None if stem is None else row_job(row, stem, scenario)
+        rows.append(row)
+        if len(rows) > len(labels) or row.label != labels[len(rows) - 1]:
+            return  # not the rows announced: the figures are drawn at the end
+        job = row_job(row, stems[len(rows) - 1], scenario)
         if job is not None:
-            renderer.stream(job)
+            renderer.stream(job, row)
+        if len(rows) == len(labels):  # the last row: the whole run's figures
+            drawn = {f"{stem}.png" for stem in stems}
+            for job in plot_jobs(RunResults(scenario, list(rows)), stems, drawn=drawn):
+                renderer.stream(job, tuple(rows))
 
     return on_row
+
+
+def _still_valid(results: RunResults, stems: list[str], streamed: dict[str, Any]) -> set[str]:
+    """The streamed figures (:attr:`Renderer.streamed`) that are this run's: a row's figure drawn
+    from the row written under its file name, a whole-run figure drawn from exactly these rows."""
+    rows = {f"{stem}.png": row for row, stem in zip(results.rows, stems) if row.simulation is not None}
+    every = tuple(results.rows)
+    return {name for name, source in streamed.items()
+            if rows.get(name) is source
+            or (isinstance(source, tuple) and len(source) == len(every) and all(a is b for a, b in zip(source, every)))}
 
 
 def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer: Any) -> None:
@@ -107,8 +127,7 @@ def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer:
     if renderer is not None:
         from scenarios.output.renderer import RenderingFailed
 
-        names = {f"{stem}.png" for row, stem in zip(results.rows, stems) if row.simulation is not None}
-        keep = names & renderer.streamed  # streamed under this run's file names
+        keep = _still_valid(results, stems, renderer.streamed)
         try:
             renderer.submit(plot_jobs(results, stems, drawn=keep), staging, keep)
         except RenderingFailed as error:
