@@ -211,16 +211,19 @@ def test_sigterm_during_a_run_writes_nothing_outside_the_marker(tmp_path):
     assert not list(out.glob(f"{STAGING_PREFIX}*"))
 
 
-def test_a_sigterm_swallowed_during_the_run_still_stops_it_before_writing(tmp_path, monkeypatch, capsys):
-    """A KeyboardInterrupt raised by the SIGTERM handler can be lost on the way (inside a finaliser,
-    or recorded as a failed row); seen once in CI: SIGTERM, then exit 0 with complete results. The
-    run must still stop, with nothing written but the marker, marked incomplete."""
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_signal_swallowed_during_the_run_still_stops_it_before_writing(tmp_path, monkeypatch, capsys, signum):
+    """A KeyboardInterrupt raised by the SIGTERM or Ctrl-C handler can be lost on the way (inside
+    a finaliser, recorded as a failed row, or turned into a failed solve by CasADi inside IPOPT);
+    seen in CI: SIGTERM, then exit 0 with complete results; seen in review: Ctrl-C during a
+    collocation solve, the same. The run must still stop, with nothing written but the marker,
+    marked incomplete."""
     import scenarios.cli.commands as cli
     real_run = cli.run
 
     def run_swallowing_a_sigterm(*args, **kwargs):
         try:
-            os.kill(os.getpid(), signal.SIGTERM)
+            os.kill(os.getpid(), signum)
             time.sleep(1.0)  # the handler runs here
         except KeyboardInterrupt:
             pass  # swallowed on the way, as a C extension may

@@ -24,10 +24,11 @@ DEMO = REPO / "scenarios" / "eigenaxis_demo.yaml"
 KEEP_OUT = REPO / "scenarios" / "collocation_keep_out.yaml"
 
 
-def _python(code: str, *args: str, timeout: float = 300) -> subprocess.CompletedProcess:
+def _python(code: str, *args: str, timeout: float = 300, env: dict[str, str] | None = None
+            ) -> subprocess.CompletedProcess:
     """``code`` in a new interpreter (one thread, nothing imported: where the plot process starts)."""
     return subprocess.run([sys.executable, "-c", textwrap.dedent(code), *args], cwd=REPO, capture_output=True,
-                          text=True, timeout=timeout, env={**os.environ, "PYTHONPATH": str(REPO)})
+                          text=True, timeout=timeout, env={**os.environ, "PYTHONPATH": str(REPO), **(env or {})})
 
 
 def _pixels(path: Path) -> np.ndarray:
@@ -68,7 +69,11 @@ def test_figures_streamed_during_the_run_are_those_drawn_in_process(tmp_path, sc
     the next row is planned, and the whole run's figures (comparison; margins and sky with a
     pointing requirement) with the last row; the streamed figures, written at the end, are those
     drawn in process pixel for pixel (oracle: ``draw_jobs`` in the script's own process), and a
-    streamed figure the run does not keep is drawn again, not written as streamed."""
+    streamed figure the run does not keep is drawn again, not written as streamed. A user's
+    ``savefig.format`` does not change what is written into memory (PNG, as into a ``.png`` file)."""
+    rc = tmp_path / "rc"
+    rc.mkdir()
+    (rc / "matplotlibrc").write_text("savefig.format: jpg\n")
     done = _python("""
         import sys
         from pathlib import Path
@@ -96,7 +101,7 @@ def test_figures_streamed_during_the_run_are_those_drawn_in_process(tmp_path, sc
         jobs = plot_jobs(results)
         draw_jobs(jobs, here)
         print("jobs", " ".join(sorted(name for name, _ in jobs)))
-    """, str(scenario), str(tmp_path))
+    """, str(scenario), str(tmp_path), env={"MATPLOTLIBRC": str(rc)})
     assert done.returncode == 0, done.stderr
     *streaming, dropped, jobs = done.stdout.splitlines()
     names = jobs.split()[1:]
@@ -110,6 +115,7 @@ def test_figures_streamed_during_the_run_are_those_drawn_in_process(tmp_path, sc
     # the dropped figure was drawn again from the submitted jobs, not lost
     assert sorted(p.name for p in (tmp_path / "forked").iterdir()) == names
     for name in names:
+        assert (tmp_path / "forked" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
         np.testing.assert_array_equal(_pixels(tmp_path / "forked" / name), _pixels(tmp_path / "here" / name))
 
 
@@ -355,24 +361,28 @@ def test_an_interrupted_draw_stops_both_plot_processes_before_it_returns(tmp_pat
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the plot process exists on Linux only")
 def test_the_plot_processes_stop_when_the_run_is_killed(tmp_path):
-    """SIGKILL of ``slewbench run`` while its plot processes draw: they stop too, instead of
-    drawing on into the staging folder of a process that is gone."""
+    """SIGKILL of ``slewbench run`` while its plot process draws the streamed rows: it stops too
+    (with any fork of its own), instead of drawing on for a process that is gone."""
     many = tmp_path / "many.yaml"
     rows = "".join(f"  - {{name: eigenaxis, label: r{k}, options: {{profile: smooth}}}}\n" for k in range(24))
     text = DEMO.read_text()
     start, end = text.index("planners:\n"), text.index("controller:")
     many.write_text(text[:start] + "planners:\n" + rows + text[end:])
     process = subprocess.Popen([sys.executable, "-m", "scenarios.console", "run", str(many), "--out",
-                                str(tmp_path / "out")], cwd=REPO, stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
-    deadline, drawers = time.time() + 120, []
-    while len(drawers) < 2 and time.time() < deadline and process.poll() is None:
-        drawers = [pid for child in _children(process.pid) for pid in [child, *_children(child)]]
-        time.sleep(0.01)
-    assert len(drawers) == 2, "the plot processes never drew"
+                                str(tmp_path / "out")], cwd=REPO, stdout=subprocess.PIPE,
+                               stderr=subprocess.DEVNULL, text=True)
+    for line in process.stdout:  # rows 1 and 2 done: both streamed, the plot process is drawing
+        if line.startswith("[2/24]"):
+            break
+    command = Path(f"/proc/{process.pid}/cmdline").read_bytes()  # read once the run has started
+    # the plot process is a fork of the run (the same command line), unlike a tool the run calls
+    drawers = [pid for pid in _children(process.pid) if Path(f"/proc/{pid}/cmdline").read_bytes() == command]
+    assert len(drawers) == 1, "no plot process while the rows stream"
+    drawers += _children(drawers[0])
     process.kill()
     process.wait(timeout=60)
-    killed, deadline = time.time(), time.time() + 0.5
+    process.stdout.close()
+    deadline = time.time() + 0.5
     while not all(_gone(pid) for pid in drawers) and time.time() < deadline:
         time.sleep(0.01)
     assert all(_gone(pid) for pid in drawers)

@@ -259,7 +259,7 @@ def test_sweep_case_reports_a_row_that_differs(swept, capsys, monkeypatch):
         results.records[key]["rows"][1]["closed_loop"]["final_error_deg"] += 1e-9
         return results, version
 
-    monkeypatch.setattr("scenarios.cli.sweep.stored_results", tampered)
+    monkeypatch.setattr("scenarios.study.rerun.stored_results", tampered)  # imported by the handler
     capsys.readouterr()
     assert main(["sweep", str(out), "--case", "2", "--no-plots"]) == 0
     printed = capsys.readouterr().out

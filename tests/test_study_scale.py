@@ -565,12 +565,12 @@ def test_a_dask_cluster_that_loses_every_worker_stops_the_sweep_like_an_interrup
 
 def test_a_signal_between_the_store_and_the_sweep_says_how_to_resume(tmp_path, monkeypatch):
     """SIGTERM once the store exists but before the engine took over: exit 130 with the command to resume."""
-    import scenarios.cli.sweep as command
+    import scenarios.study.engine as engine  # the sweep command imports `sweep` from it when it runs
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(command, "sweep", interrupted)
+    monkeypatch.setattr(engine, "sweep", interrupted)
     path = write_study(tmp_path, study_data(grid={"maneuver.duration": [30.0, 31.0]}))
     status, _, error = cli("sweep", path, "--out", tmp_path / "out", "--no-plots", seconds=60)
     assert status == 130 and "2 of 2 cases are missing" in error and "--resume" in error, error

@@ -335,8 +335,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 class Interruption:
-    """SIGTERM and Ctrl-C handler: ends a run like Ctrl-C, so that staged files are removed on the
-    way out, and remembers that it fired.
+    """SIGTERM and Ctrl-C (SIGINT) handler: ends a run like Ctrl-C, so that staged files are removed
+    on the way out, and remembers that it fired.
 
     The ``KeyboardInterrupt`` can be lost: raised inside a finaliser (``__del__`` of a CasADi
     object run by the garbage collector, where Python only prints "Exception ignored"), or turned
@@ -386,7 +386,9 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     args = build_parser().parse_args(argv)
     args.interruption = Interruption()
     args.renderer = renderer
-    previous = (signal.signal(signal.SIGTERM, args.interruption)
+    # Ctrl-C too: CasADi turns a KeyboardInterrupt raised inside IPOPT into a failed solve, and the
+    # run would go on; Interruption remembers it, and the run's next check() stops it
+    previous = ({signum: signal.signal(signum, args.interruption) for signum in (signal.SIGTERM, signal.SIGINT)}
                 if threading.current_thread() is threading.main_thread() else None)
     try:
         return args.handler(args)
@@ -410,6 +412,6 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         print("slewbench: internal error (this is a bug; please report it with the scenario file)", file=sys.stderr)
         return EXIT_INTERNAL
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        for signum, handler in (previous or {}).items():
+            signal.signal(signum, handler)
 

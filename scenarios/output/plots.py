@@ -109,8 +109,9 @@ KEEP_COLORS = {True: "tab:red", False: "tab:green"}
 """Colour of a keep-out (``True``) and a keep-in (``False``) cone."""
 COMPRESS_LEVEL = 1
 """zlib level of the PNGs: level 1 encodes several times faster than the default 6 for ~20 % more bytes."""
-SAVE: dict[str, Any] = {"dpi": DPI, "pil_kwargs": {"compress_level": COMPRESS_LEVEL}}
-"""``savefig`` options of the figures drawn once."""
+SAVE: dict[str, Any] = {"dpi": DPI, "format": "png", "pil_kwargs": {"compress_level": COMPRESS_LEVEL}}
+"""``savefig`` options of the figures drawn once (PNG also into a file object, whatever the user's
+``savefig.format``)."""
 
 
 class LogTicks(Locator):

@@ -20,7 +20,6 @@ same, pixel for pixel.
 from __future__ import annotations
 
 import atexit
-import fcntl
 import functools
 import io
 import os
@@ -113,6 +112,8 @@ class Renderer:
         """
         if not sys.platform.startswith("linux") or _thread_count() != 1:
             return None
+        import fcntl  # POSIX only: after the platform check
+
         to_child, from_parent = os.pipe()[::-1]  # (write end, read end)
         try:
             fcntl.fcntl(to_child, F_SETPIPE_SZ, PIPE_BYTES)
@@ -172,10 +173,13 @@ class Renderer:
         self.streamed[job[0]] = source
 
     def _send(self, message: tuple[Any, ...]) -> None:
-        """Pickle ``message`` into the pipe to the child (closing the child on Ctrl-C or SIGTERM)."""
+        """Pickle ``message`` into the pipe to the child (closing the child on Ctrl-C or SIGTERM).
+        Unbuffered: a signal while the pipe is full stops the child at once (no buffered rest to
+        flush into a pipe nobody reads)."""
+        data = memoryview(pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL))
         try:
-            with os.fdopen(self._fds[0], "wb", closefd=False) as stream:
-                pickle.dump(message, stream, protocol=pickle.HIGHEST_PROTOCOL)
+            while data:
+                data = data[os.write(self._fds[0], data):]
         except OSError:  # the child has gone: the caller says what that means
             raise
         except BaseException:  # Ctrl-C, SIGTERM: the child stops before the caller removes `directory`
