@@ -46,6 +46,8 @@ class PeerResult:
         The solver's return status or why it failed.
     build_time_s : float or None, optional
         Wall time of the peer's build [s], when measured.
+    extra : dict, optional
+        Anything else the peer reports (JSON-serialisable).
     """
 
     objective: float | None
@@ -61,6 +63,16 @@ class Peer(Protocol):
     """A benchmark peer (the ``PEER`` object of a module named in :data:`scenarios.bench.peers.PEERS`)."""
 
     name: str
+
+    def unavailable(self) -> str | None:
+        """Why the peer cannot run on this machine (a missing library), or ``None``.
+
+        Returns
+        -------
+        str or None
+            The reason, or ``None``.
+        """
+        ...
 
     def problem_error(self, problem: ManeuverProblem, objective: str) -> str | None:
         """Why the peer cannot express ``problem`` with ``objective`` (``None``: it can).
@@ -117,18 +129,23 @@ def load_peer(name: str, registry: dict[str, str] | None = None) -> Peer:
     KeyError
         ``name`` is not registered.
     PeerUnavailable
-        Its module or the library it drives cannot be imported.
+        Its module or the library it drives cannot be imported, its module defines no ``PEER``
+        with ``problem_error`` and ``solve``, or ``PEER.unavailable()`` gives a reason.
     """
     if registry is None:
         from scenarios.bench.peers import PEERS as registry  # the face fills it
     path = registry[name]
     try:
         module = importlib.import_module(path)
-    except ImportError as error:
+    except (ImportError, PeerUnavailable) as error:
         raise PeerUnavailable(f"peer {name} skipped: {error}") from None
     peer = getattr(module, "PEER", None)
-    if peer is None:
-        raise PeerUnavailable(f"peer {name} skipped: {path} defines no PEER")
+    if peer is None or not callable(getattr(peer, "solve", None)) or not callable(getattr(peer, "problem_error", None)):
+        raise PeerUnavailable(f"peer {name} skipped: {path} defines no PEER with problem_error and solve")
+    check = getattr(peer, "unavailable", None)
+    reason = check() if callable(check) else None
+    if reason:
+        raise PeerUnavailable(f"peer {name} skipped: {reason}")
     return peer
 
 

@@ -14,12 +14,9 @@ import numpy as np
 
 from planners.problem import ManeuverProblem
 from scenarios.bench.peers._shooting import N, eigenaxis_guess, rigid_body, rk4_step, terminal_error
-from scenarios.bench.peers.base import PeerResult, PeerUnavailable, box_torque_problem_error, torque_bounds
+from scenarios.bench.peers.base import PeerResult, box_torque_problem_error, torque_bounds
 
 __all__ = ["PEER", "FatropPeer", "build_opti"]
-
-if not ca.has_nlpsol("fatrop"):
-    raise PeerUnavailable("peer fatrop skipped: this CasADi has no FATROP plugin")
 
 
 def build_opti(problem: ManeuverProblem, states: np.ndarray, T0: float, objective: str = "min_time",
@@ -86,6 +83,16 @@ class FatropPeer:
     """The FATROP multiple-shooting peer (module docstring)."""
 
     name = "fatrop"
+
+    def unavailable(self) -> str | None:
+        """Why the peer cannot run here (``None``: it can).
+
+        Returns
+        -------
+        str or None
+            ``None`` when CasADi has its FATROP plugin.
+        """
+        return None if ca.has_nlpsol("fatrop") else "this CasADi has no FATROP plugin"
 
     def problem_error(self, problem: ManeuverProblem, objective: str) -> str | None:
         """Why the peer cannot express the problem (``None``: it can).
