@@ -8,7 +8,6 @@ import json
 import math
 import shutil
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -67,9 +66,11 @@ def test_the_norm_bounded_problem_meets_its_closed_form():
     inertia = spacecraft.inertia
     assert np.allclose(inertia, inertia[0, 0] * np.eye(3))  # spherical
     wheels = spacecraft.wheels
+    assert wheels is not None
     assert wheels.count == 1 and np.allclose(wheels.axes[:, 0], [1.0, 0.0, 0.0])
     # theta from the scenario's quaternions, by hand: q = [cos(theta/2), sin(theta/2) e]
     qf = scenario.problem.qf
+    assert qf is not None
     theta = 2.0 * math.atan2(np.linalg.norm(qf[1:]), qf[0])
     axis = qf[1:] / np.linalg.norm(qf[1:])
     assert np.allclose(axis, [1.0, 0.0, 0.0])  # about the wheel's axis
@@ -106,7 +107,7 @@ def test_the_peer_registry_is_lazy_and_a_missing_peer_is_a_note():
     with pytest.raises(PeerUnavailable, match="peer nowhere skipped"):
         load_peer("nowhere", {"nowhere": "scenarios.bench.peers.not_a_module"})
     try:
-        import rockit  # noqa: F401
+        import rockit  # type: ignore[import-not-found]  # noqa: F401
     except ImportError:
         with pytest.raises(PeerUnavailable, match="rockit-meco"):
             load_peer("rockit")

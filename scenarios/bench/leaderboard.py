@@ -24,7 +24,11 @@ from pathlib import Path
 from typing import Any
 
 from scenarios.bench.suite import OBJECTIVE_METRICS, BenchProblem, Suite
-from scenarios.output.directory import claim_output_directory, commit_outputs, new_staging
+from scenarios.output.directory import (
+    claim_output_directory,
+    commit_outputs,
+    new_staging,
+)
 from scenarios.output.provenance import environment, utc_stamp
 
 __all__ = ["BENCH_FILES", "BenchRow", "Leaderboard", "certificate_text", "gap", "run_bench"]
@@ -234,16 +238,16 @@ class Leaderboard:
         """
         env = environment()
         lines = [f"# slewbench bench: suite version {self.suite.version}", "",
-                 f"slewbench {env['slewbench']}, {self.date}, {env['platform']}; {len(self.problems)} problem(s), "
-                 f"{len(self.rows)} row(s) in {self.wall_time_s:.1f} s.", "",
-                 "Gap: value − optimum (the objective's unit) and relative to the optimum; ✓ within the problem's "
-                 "tolerance. Plan time: a peer's solve time after its build.", ""]
+                 (f"slewbench {env['slewbench']}, {self.date}, {env['platform']}; {len(self.problems)} problem(s), "
+                  f"{len(self.rows)} row(s) in {self.wall_time_s:.1f} s."), "",
+                 ("Gap: value − optimum (the objective's unit) and relative to the optimum; ✓ within the problem's "
+                  "tolerance. Plan time: a peer's solve time after its build."), ""]
         for problem in self.problems:
             lines += [f"## {problem.name}: {problem.title}", "",
-                      f"{problem.objective} [{problem.unit}]; optimum {problem.optimum:.6g} ± {problem.tolerance:.2g} "
-                      f"({problem.optimum_kind.replace('_', ' ')}: {problem.optimum_source}); eigenaxis "
-                      f"{'-' if problem.eigenaxis is None else f'{problem.eigenaxis:.6g}'} ({problem.eigenaxis_source}). "
-                      f"Source: {problem.source}", "",
+                      (f"{problem.objective} [{problem.unit}]; optimum {problem.optimum:.6g} ± {problem.tolerance:.2g} "
+                       f"({problem.optimum_kind.replace('_', ' ')}: {problem.optimum_source}); eigenaxis "
+                       f"{'-' if problem.eigenaxis is None else f'{problem.eigenaxis:.6g}'} ({problem.eigenaxis_source}). "
+                       f"Source: {problem.source}"), "",
                       "| row | kind | status | value | gap | gap (rel) | plan time [s] | iterations | certificate | note |",
                       "|---|---|---|---|---|---|---|---|---|---|"]
             for row in (r for r in self.rows if r.problem == problem.name):
@@ -417,7 +421,7 @@ def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Ite
                 continue
             try:
                 result = peer.solve(scenario.problem, problem.objective)
-            except Exception as error:  # a peer's crash is a failed row, not the end of the run
+            except Exception as error:  # noqa: BLE001 (a peer's crash is a failed row, not the end of the run)
                 from scenarios.bench.peers import PeerResult
 
                 result = PeerResult(None, 0.0, "failed", None, f"{type(error).__name__}: {error}")

@@ -55,13 +55,13 @@ def rk4_step(f: ca.Function) -> ca.Function:
     return ca.Function("F", [x, u, h], [x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)])
 
 
-def terminal_error(qf: np.ndarray, q_end: ca.MX) -> ca.MX:
+def terminal_error(qf: np.ndarray | None, q_end: ca.MX) -> ca.MX:
     """The vector part of ``qf* ⊗ q_end`` (up to sign): zero when ``q_end = ±qf``.
 
     Parameters
     ----------
-    qf : (4,) ndarray
-        Target attitude, scalar first.
+    qf : (4,) ndarray or None
+        Target attitude, scalar first (``None`` is refused).
     q_end : casadi expression (4,)
         Final attitude.
 
@@ -69,7 +69,14 @@ def terminal_error(qf: np.ndarray, q_end: ca.MX) -> ca.MX:
     -------
     casadi expression (3,)
         The attitude error's vector part.
+
+    Raises
+    ------
+    ValueError
+        Without a target attitude.
     """
+    if qf is None:
+        raise ValueError("the problem has no target attitude")
     return qf[0] * q_end[1:] - q_end[0] * ca.DM(qf[1:]) - ca.cross(ca.DM(qf[1:]), q_end[1:])
 
 

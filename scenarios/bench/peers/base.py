@@ -133,7 +133,9 @@ def load_peer(name: str, registry: dict[str, str] | None = None) -> Peer:
         with ``problem_error`` and ``solve``, or ``PEER.unavailable()`` gives a reason.
     """
     if registry is None:
-        from scenarios.bench.peers import PEERS as registry  # the face fills it
+        from scenarios.bench.peers import PEERS  # the face fills it
+
+        registry = PEERS
     path = registry[name]
     try:
         module = importlib.import_module(path)
@@ -195,5 +197,8 @@ def torque_bounds(problem: ManeuverProblem) -> np.ndarray:
     (3,) ndarray
         ``u_max,i`` [N m], body axes.
     """
-    limits = np.asarray(problem.spacecraft.torquers.max_torque, dtype=float) * np.ones(3)
+    torquers = problem.spacecraft.torquers
+    if torquers is None:
+        raise ValueError("the problem has no torquers (box_torque_problem_error refuses it)")
+    limits = np.asarray(torquers.max_torque, dtype=float) * np.ones(3)
     return limits * (1.0 - (problem.actuator_margin or 0.0))

@@ -13,8 +13,18 @@ import casadi as ca
 import numpy as np
 
 from planners.problem import ManeuverProblem
-from scenarios.bench.peers._shooting import N, eigenaxis_guess, rigid_body, rk4_step, terminal_error
-from scenarios.bench.peers.base import PeerResult, box_torque_problem_error, torque_bounds
+from scenarios.bench.peers._shooting import (
+    N,
+    eigenaxis_guess,
+    rigid_body,
+    rk4_step,
+    terminal_error,
+)
+from scenarios.bench.peers.base import (
+    PeerResult,
+    box_torque_problem_error,
+    torque_bounds,
+)
 
 __all__ = ["PEER", "FatropPeer", "build_opti"]
 

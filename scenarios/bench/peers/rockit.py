@@ -11,11 +11,20 @@ import casadi as ca
 import numpy as np
 
 from planners.problem import ManeuverProblem
-from scenarios.bench.peers._shooting import N, eigenaxis_guess, rigid_body, terminal_error
-from scenarios.bench.peers.base import PeerResult, box_torque_problem_error, torque_bounds
+from scenarios.bench.peers._shooting import (
+    N,
+    eigenaxis_guess,
+    rigid_body,
+    terminal_error,
+)
+from scenarios.bench.peers.base import (
+    PeerResult,
+    box_torque_problem_error,
+    torque_bounds,
+)
 
 try:
-    import rockit
+    import rockit  # type: ignore[import-not-found]
 except ImportError:  # optional: the peer says so through unavailable()
     rockit = None
 
