@@ -152,6 +152,7 @@ def test_bench_writes_the_leaderboard_with_the_hand_worked_gap(tmp_path, capsys)
     assert len(data["rows"]) == len(rows) == 2
     text = (out / "leaderboard.md").read_text()
     assert "## bilimoria_wie_90" in text and "+0.0855" in text
+    assert "| eigenaxis | planner | 1 | 0 | 3.53e-02 |" in text  # the summary: one row, not at the optimum
     assert (out / "gap_vs_time.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 

@@ -242,6 +242,7 @@ class Leaderboard:
                   f"{len(self.rows)} row(s) in {self.wall_time_s:.1f} s."), "",
                  ("Gap: value − optimum (the objective's unit) and relative to the optimum; ✓ within the problem's "
                   "tolerance. Plan time: a peer's solve time after its build."), ""]
+        lines += self._summary()
         for problem in self.problems:
             lines += [f"## {problem.name}: {problem.title}", "",
                       (f"{problem.objective} [{problem.unit}]; optimum {problem.optimum:.6g} ± {problem.tolerance:.2g} "
@@ -254,12 +255,25 @@ class Leaderboard:
                 mark = "" if row.reached is None else (" ✓" if row.reached else "")
                 lines.append(
                     f"| {_md(row.label)} | {row.kind} | {row.status} | {_fmt(row.objective)} | {_fmt(row.gap_abs, '+.3g')}"
-                    f"{mark} | {_fmt(row.gap_rel, '+.2e')} | {_fmt(row.plan_time_s, '.3f')} | "
+                    f"{mark} | {_fmt(row.gap_rel, '+.2e')} | {_fmt(row.plan_time_s, '.3g')} | "
                     f"{'-' if row.iterations is None else row.iterations} | {_md(row.certificate)} | {_md(_note(row))} |")
             lines.append("")
         if self.notes:
             lines += ["## Notes", ""] + [f"- {_md(note)}" for note in self.notes] + [""]
         return "\n".join(lines)
+
+    def _summary(self) -> list[str]:
+        """Markdown lines: per planner or peer, its rows, how many reach the optimum, the median
+        relative gap of those with a gap and the median plan time."""
+        lines = ["## Summary", "", "| planner | kind | rows | at the optimum | median gap (rel) | median plan time [s] |",
+                 "|---|---|---|---|---|---|"]
+        for name in dict.fromkeys(row.planner for row in self.rows):
+            rows = [row for row in self.rows if row.planner == name]
+            gaps = [abs(row.gap_rel) for row in rows if row.gap_rel is not None]
+            times = [row.plan_time_s for row in rows if row.plan_time_s is not None]
+            lines.append(f"| {_md(name)} | {rows[0].kind} | {len(rows)} | {sum(1 for row in rows if row.reached)} | "
+                         f"{_fmt(_median(gaps), '.2e')} | {_fmt(_median(times), '.3g')} |")
+        return lines + [""]
 
     def plot(self, path: Path) -> None:
         """Relative gap against plan time, one marker per planner or peer, log axes; rows without a
@@ -338,6 +352,14 @@ def _json_default(value: Any) -> Any:
     if hasattr(value, "tolist"):
         return value.tolist()
     return str(value)
+
+
+def _median(values: list[float]) -> float | None:
+    if not values:
+        return None
+    ordered = sorted(values)
+    middle = len(ordered) // 2
+    return ordered[middle] if len(ordered) % 2 else 0.5 * (ordered[middle - 1] + ordered[middle])
 
 
 def _csv(value: float | None) -> str:
