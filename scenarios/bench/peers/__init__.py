@@ -8,11 +8,17 @@ A peer is a module with a ``PEER`` object satisfying :class:`~scenarios.bench.pe
 path; the module is imported only when the peer runs (:func:`load_peer`), and a peer whose module
 or library is missing is skipped with a note.
 
-May import: :mod:`ocp`, :mod:`planners` (the problem), :mod:`scenarios.bench.peers` itself.
+May import: :mod:`ocp`, :mod:`planners` (the problem), :mod:`scenarios.bench.peers` itself. Its
+names are imported on first use.
 """
 from __future__ import annotations
 
-from scenarios.bench.peers.base import Peer, PeerResult, PeerUnavailable, load_peer
+from scenarios._faces import lazy_face
+
+_HOMES = {"Peer": "scenarios.bench.peers.base",
+          "PeerResult": "scenarios.bench.peers.base",
+          "PeerUnavailable": "scenarios.bench.peers.base",
+          "load_peer": "scenarios.bench.peers.base"}
 
 __all__ = ["PEERS", "Peer", "PeerResult", "PeerUnavailable", "load_peer"]
 
@@ -22,3 +28,5 @@ PEERS: dict[str, str] = {
     "acados": "scenarios.bench.peers.acados",
 }
 """Peer name -> module path (the module defines ``PEER``); imported lazily by :func:`load_peer`."""
+
+__getattr__, __dir__ = lazy_face(__name__, _HOMES)
