@@ -58,13 +58,14 @@ GROUPS: dict[str, tuple[str, ...]] = {
     "scenarios.runner": ("scenarios.runner",),
     "scenarios.codegen": ("scenarios.codegen",),
     "scenarios.study": ("scenarios.study",),
+    "scenarios.bench": ("scenarios.bench",),
     "scenarios.cli": ("scenarios.cli",),
     "scenarios.console": ("scenarios.console",),
 }
 """Layers inside the packages, by module (or subpackage) name."""
 
 _SCENARIOS = ["scenarios.errors", "scenarios.requirements", "scenarios.schema", "scenarios.output", "scenarios.runner", "scenarios.codegen",
-              "scenarios.study", "scenarios.cli", "scenarios.console"]
+              "scenarios.study", "scenarios.bench", "scenarios.cli", "scenarios.console"]
 ALLOWED: dict[str, set[str]] = {
     "ocp": {"ocp"},
     "ocp.dynamics": {"ocp", "ocp.dynamics"},

@@ -19,6 +19,7 @@ from typing import Any
 
 from controllers import CONTROLLERS
 from planners import PLANNERS
+from scenarios.cli.bench import add_bench_parser
 from scenarios.cli.status import (
     EXIT_BAD_OUTPUT,
     EXIT_BAD_SCENARIO,
@@ -331,6 +332,7 @@ def build_parser() -> argparse.ArgumentParser:
                                                       "environment.magnetic_field.<model>, scenario, or study[.<key>]")
     schema_parser.set_defaults(handler=command_schema)
     add_sweep_parser(commands)
+    add_bench_parser(commands)
     return parser
 
 

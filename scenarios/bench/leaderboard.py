@@ -1,0 +1,458 @@
+"""The leaderboard: every problem of the suite run through the planners that apply (the scenario's
+rows, through :func:`scenarios.runner.run`, so each row's requirement status is the run's) and the
+installed peers, then tabulated against the best known optimum.
+
+Per row: the objective value (the reference metric of the problem's objective, :data:`~scenarios.bench.suite.OBJECTIVE_METRICS`,
+the same measure for every planner), its gap to the optimum (absolute, in the objective's unit,
+and relative), whether it reaches the optimum within the problem's tolerance, the row's status,
+the plan time, the solver iterations (``reference.stats["iterations"]``) and the certificate
+(``reference.stats["certificate"]``'s ``summary`` or ``verdict``; ``-`` without one). A reference
+that leaves a boundary condition of the problem free (``Reference.free_boundary``) solves another
+problem: its value is shown, its gap is not.
+"""
+from __future__ import annotations
+
+import csv
+import dataclasses
+import io
+import json
+import math
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from scenarios.bench.suite import OBJECTIVE_METRICS, BenchProblem, Suite
+from scenarios.output.directory import (
+    claim_output_directory,
+    commit_outputs,
+    new_staging,
+)
+from scenarios.output.provenance import environment, utc_stamp
+
+__all__ = ["BENCH_FILES", "BenchRow", "Leaderboard", "certificate_text", "gap", "run_bench"]
+
+BENCH_FILES = ("leaderboard.md", "leaderboard.csv", "leaderboard.json", "gap_vs_time.png")
+"""What ``slewbench bench`` writes (the plot only with plots on)."""
+
+GAP_FLOOR = 1e-9
+"""Relative gaps below this are drawn at it on the log axis of the plot."""
+
+
+@dataclass
+class BenchRow:
+    """One (problem, planner or peer) entry of the leaderboard.
+
+    Parameters
+    ----------
+    problem : str
+        The problem's name.
+    label : str
+        The row's label (the scenario row's, or ``"<peer> (peer)"``).
+    planner : str
+        The planner's registry name, or the peer's name.
+    kind : str
+        ``"planner"`` or ``"peer"``.
+    status : str
+        The row's status (``ok``, ``violated``, ``failed``; a peer's ``ok`` or ``failed``).
+    objective : float or None
+        The objective value in the problem's unit; ``None`` without a reference.
+    gap_abs : float or None
+        ``objective − optimum`` in the problem's unit; ``None`` when not comparable.
+    gap_rel : float or None
+        ``gap_abs / optimum``.
+    reached : bool or None
+        ``|gap_abs| <= tolerance``.
+    plan_time_s : float or None
+        Plan time [s] (a peer's solve time, its build excluded).
+    iterations : int or None
+        Solver iterations, when the planner or peer reports them.
+    certificate : str
+        The certificate's summary or verdict, ``-`` without one.
+    message : str
+        The row's message, or why its gap is not shown.
+    """
+
+    problem: str
+    label: str
+    planner: str
+    kind: str
+    status: str
+    objective: float | None
+    gap_abs: float | None
+    gap_rel: float | None
+    reached: bool | None
+    plan_time_s: float | None
+    iterations: int | None
+    certificate: str
+    message: str = ""
+
+
+def gap(value: float | None, optimum: float) -> tuple[float | None, float | None]:
+    """The gap of ``value`` to ``optimum``.
+
+    Parameters
+    ----------
+    value : float or None
+        An objective value (``None``: none).
+    optimum : float
+        The best known optimum (nonzero), same unit.
+
+    Returns
+    -------
+    tuple
+        ``(value − optimum, (value − optimum) / |optimum|)``; ``(None, None)`` for ``None`` or a
+        non-finite value.
+    """
+    if value is None or not math.isfinite(value):
+        return None, None
+    difference = value - optimum
+    return difference, difference / abs(optimum)
+
+
+def certificate_text(stats: Any) -> str:
+    """The certificate column: ``stats["certificate"]``'s ``summary``, else its ``verdict``, else ``-``.
+
+    Parameters
+    ----------
+    stats : mapping or None
+        A reference's ``stats``.
+
+    Returns
+    -------
+    str
+        One short line.
+    """
+    certificate = stats.get("certificate") if isinstance(stats, dict) else None
+    if not isinstance(certificate, dict):
+        return "-"
+    text = certificate.get("summary") or certificate.get("verdict")
+    return str(text) if text else "-"
+
+
+def _number(value: Any) -> int | None:
+    return int(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+
+
+def _planner_rows(problem: BenchProblem, scenario: Any, results: Any) -> list[BenchRow]:
+    metric = OBJECTIVE_METRICS[problem.objective][0]
+    rows = []
+    for row in results.rows:
+        reference = row.reference
+        stats = getattr(reference, "stats", None) if reference is not None else None
+        value = None
+        if row.reference_metrics is not None and row.reference_metrics.get(metric) is not None:
+            value = float(row.reference_metrics[metric])
+        gap_abs, gap_rel = gap(value, problem.optimum)
+        message = row.message
+        free = sorted(getattr(reference, "free_boundary", ()) or ())
+        if value is not None and free:
+            gap_abs = gap_rel = None
+            message = f"leaves {', '.join(free)} free: solves another problem, no gap; {message}"
+        rows.append(BenchRow(
+            problem.name, row.label, row.planner or "-", "planner", row.status, value, gap_abs, gap_rel,
+            None if gap_abs is None else abs(gap_abs) <= problem.tolerance, row.plan_time_s,
+            _number((stats or {}).get("iterations")), certificate_text(stats), message))
+    return rows
+
+
+def _peer_row(problem: BenchProblem, name: str, result: Any) -> BenchRow:
+    gap_abs, gap_rel = gap(result.objective, problem.optimum)
+    return BenchRow(problem.name, f"{name} (peer)", name, "peer", result.status, result.objective, gap_abs, gap_rel,
+                    None if gap_abs is None else abs(gap_abs) <= problem.tolerance, result.solve_time_s,
+                    _number(result.iterations), "-", result.message)
+
+
+@dataclass
+class Leaderboard:
+    """The rows of a bench run, with what was skipped and where the run took place.
+
+    Parameters
+    ----------
+    suite : Suite
+        The suite run.
+    problems : list of BenchProblem
+        The problems run, in order.
+    rows : list of BenchRow
+        The entries, problem by problem.
+    notes : list of str
+        Peers skipped and why, problems without a row.
+    wall_time_s : float
+        Wall time of the whole run [s].
+    date : str
+        When it ran (UTC, ISO 8601).
+    """
+
+    suite: Suite
+    problems: list[BenchProblem]
+    rows: list[BenchRow] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    wall_time_s: float = 0.0
+    date: str = ""
+
+    def to_json(self) -> dict[str, Any]:
+        """The leaderboard as JSON-ready data: suite version, provenance, problems, rows, notes.
+
+        Returns
+        -------
+        dict
+            ``suite_version``, ``slewbench``, ``date``, ``environment`` (versions and platform),
+            ``wall_time_s``, ``problems`` (metadata), ``rows``, ``notes``.
+        """
+        env = environment()
+        return {"suite_version": self.suite.version, "slewbench": env["slewbench"], "date": self.date,
+                "platform": env["platform"], "environment": env, "wall_time_s": self.wall_time_s,
+                "problems": [problem.metadata() for problem in self.problems],
+                "rows": [dataclasses.asdict(row) for row in self.rows], "notes": list(self.notes)}
+
+    def to_csv(self) -> str:
+        """One line per row, with the problem's objective, unit, optimum and tolerance.
+
+        Returns
+        -------
+        str
+            CSV text with a header.
+        """
+        problems = {problem.name: problem for problem in self.problems}
+        stream = io.StringIO()
+        writer = csv.writer(stream, lineterminator="\n")
+        writer.writerow(["problem", "objective", "unit", "optimum", "tolerance", "label", "planner", "kind", "status",
+                         "value", "gap_abs", "gap_rel", "reached", "plan_time_s", "iterations", "certificate",
+                         "message"])
+        for row in self.rows:
+            problem = problems[row.problem]
+            writer.writerow([row.problem, problem.objective, problem.unit, repr(problem.optimum), repr(problem.tolerance),
+                             row.label, row.planner, row.kind, row.status, _csv(row.objective), _csv(row.gap_abs),
+                             _csv(row.gap_rel), "" if row.reached is None else row.reached, _csv(row.plan_time_s),
+                             "" if row.iterations is None else row.iterations, row.certificate, row.message])
+        return stream.getvalue()
+
+    def to_markdown(self) -> str:
+        """A section per problem (its optimum and where it comes from, then a table of its rows).
+
+        Returns
+        -------
+        str
+            Markdown text.
+        """
+        env = environment()
+        lines = [f"# slewbench bench: suite version {self.suite.version}", "",
+                 (f"slewbench {env['slewbench']}, {self.date}, {env['platform']}; {len(self.problems)} problem(s), "
+                  f"{len(self.rows)} row(s) in {self.wall_time_s:.1f} s."), "",
+                 ("Gap: value − optimum (the objective's unit) and relative to the optimum; ✓ within the problem's "
+                  "tolerance. Plan time: a peer's solve time after its build."), ""]
+        lines += self._summary()
+        for problem in self.problems:
+            lines += [f"## {problem.name}: {problem.title}", "",
+                      (f"{problem.objective} [{problem.unit}]; optimum {problem.optimum:.6g} ± {problem.tolerance:.2g} "
+                       f"({problem.optimum_kind.replace('_', ' ')}: {problem.optimum_source}); eigenaxis "
+                       f"{'-' if problem.eigenaxis is None else f'{problem.eigenaxis:.6g}'} ({problem.eigenaxis_source}). "
+                       f"Source: {problem.source}"), "",
+                      "| row | kind | status | value | gap | gap (rel) | plan time [s] | iterations | certificate | note |",
+                      "|---|---|---|---|---|---|---|---|---|---|"]
+            for row in (r for r in self.rows if r.problem == problem.name):
+                mark = "" if row.reached is None else (" ✓" if row.reached else "")
+                lines.append(
+                    f"| {_md(row.label)} | {row.kind} | {row.status} | {_fmt(row.objective)} | {_fmt(row.gap_abs, '+.3g')}"
+                    f"{mark} | {_fmt(row.gap_rel, '+.2e')} | {_fmt(row.plan_time_s, '.3g')} | "
+                    f"{'-' if row.iterations is None else row.iterations} | {_md(row.certificate)} | {_md(_note(row))} |")
+            lines.append("")
+        if self.notes:
+            lines += ["## Notes", ""] + [f"- {_md(note)}" for note in self.notes] + [""]
+        return "\n".join(lines)
+
+    def _summary(self) -> list[str]:
+        """Markdown lines: per planner or peer, its rows, how many reach the optimum, the median
+        relative gap of those with a gap and the median plan time."""
+        lines = ["## Summary", "", "| planner | kind | rows | at the optimum | median gap (rel) | median plan time [s] |",
+                 "|---|---|---|---|---|---|"]
+        for name in dict.fromkeys(row.planner for row in self.rows):
+            rows = [row for row in self.rows if row.planner == name]
+            gaps = [abs(row.gap_rel) for row in rows if row.gap_rel is not None]
+            times = [row.plan_time_s for row in rows if row.plan_time_s is not None]
+            lines.append(f"| {_md(name)} | {rows[0].kind} | {len(rows)} | {sum(1 for row in rows if row.reached)} | "
+                         f"{_fmt(_median(gaps), '.2e')} | {_fmt(_median(times), '.3g')} |")
+        return lines + [""]
+
+    def plot(self, path: Path) -> None:
+        """Relative gap against plan time, one marker per planner or peer, log axes; rows without a
+        gap are left out, gaps below :data:`GAP_FLOOR` drawn at it.
+
+        Parameters
+        ----------
+        path : Path
+            The PNG to write.
+        """
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        figure = Figure(figsize=(7.0, 4.8), dpi=110)
+        canvas = FigureCanvasAgg(figure)
+        axis = figure.add_subplot(1, 1, 1)
+        markers = "osD^v<>pPX*h"
+        names = sorted({row.planner for row in self.rows})
+        drawn = 0
+        for k, name in enumerate(names):
+            points = [(row.plan_time_s, max(abs(row.gap_rel), GAP_FLOOR)) for row in self.rows
+                      if row.planner == name and row.gap_rel is not None and row.plan_time_s]
+            if not points:
+                continue
+            kind = next(row.kind for row in self.rows if row.planner == name)
+            x, y = zip(*points)
+            axis.scatter(x, y, marker=markers[k % len(markers)], label=f"{name}{' (peer)' if kind == 'peer' else ''}",
+                         facecolors="none" if kind == "peer" else None, color=f"C{k % 10}")
+            drawn += 1
+        axis.set_xscale("log")
+        axis.set_yscale("log")
+        axis.set_xlabel("plan time [s]")
+        axis.set_ylabel(f"relative gap |J − J*| / J* [-] (floor {GAP_FLOOR:g})")
+        axis.set_title(f"slewbench bench, suite version {self.suite.version}")
+        axis.grid(True, which="major", alpha=0.3)
+        if drawn:
+            axis.legend(fontsize="small", loc="best")
+        figure.tight_layout()
+        canvas.print_png(str(path))
+
+    def write(self, out: str | Path, plots: bool = True) -> list[str]:
+        """Write the tables (and the plot) into ``out``, a directory slewbench owns (claimed as
+        ``kind="bench"``; files it did not write are never replaced).
+
+        Parameters
+        ----------
+        out : str or Path
+            The output directory.
+        plots : bool, optional
+            Draw ``gap_vs_time.png`` (default ``True``).
+
+        Returns
+        -------
+        list of str
+            The files written (relative to ``out``).
+
+        Raises
+        ------
+        scenarios.errors.OutputError
+            The directory is not slewbench's, or a result would replace a file slewbench did not write.
+        """
+        directory = claim_output_directory(out, kind="bench")
+        staging = new_staging(directory)
+        (staging / "leaderboard.md").write_text(self.to_markdown(), encoding="utf-8")
+        (staging / "leaderboard.csv").write_text(self.to_csv(), encoding="utf-8")
+        (staging / "leaderboard.json").write_text(json.dumps(self.to_json(), indent=1, default=_json_default) + "\n",
+                                                  encoding="utf-8")
+        if plots:
+            self.plot(staging / "gap_vs_time.png")
+        return commit_outputs(directory, staging, "bench")
+
+
+def _json_default(value: Any) -> Any:
+    if hasattr(value, "item"):
+        return value.item()
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    return str(value)
+
+
+def _median(values: list[float]) -> float | None:
+    if not values:
+        return None
+    ordered = sorted(values)
+    middle = len(ordered) // 2
+    return ordered[middle] if len(ordered) % 2 else 0.5 * (ordered[middle - 1] + ordered[middle])
+
+
+def _csv(value: float | None) -> str:
+    return "" if value is None else repr(float(value))
+
+
+def _fmt(value: float | None, spec: str = ".6g") -> str:
+    return "-" if value is None else format(value, spec)
+
+
+NOTE_CHARS = 100
+"""Longest note in the Markdown table (the CSV and JSON keep the whole message)."""
+
+
+def _note(row: BenchRow) -> str:
+    """The row's message when it is not ok or has no gap, shortened; else empty."""
+    if row.status == "ok" and row.gap_abs is not None:
+        return ""
+    text = row.message.strip()
+    return text if len(text) <= NOTE_CHARS else text[:NOTE_CHARS - 1] + "…"
+
+
+def _md(text: str) -> str:
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Iterable[str] | None = None,
+              peers: Iterable[str] = (), progress: Callable[[str], None] | None = None) -> Leaderboard:
+    """Run problems of ``suite`` through their planners (and ``peers``) and collect the leaderboard.
+
+    Parameters
+    ----------
+    suite : Suite
+        The suite (:func:`~scenarios.bench.suite.load_suite`).
+    problems : iterable of str or None, optional
+        Names of the problems to run (``None``: all, in the suite's order).
+    planners : iterable of str or None, optional
+        Planner registry names to keep of each scenario's rows (``None``: all of them).
+    peers : iterable of str, optional
+        Names of :data:`scenarios.bench.peers.PEERS` to run beside them (default none).
+    progress : callable or None, optional
+        Receives a line per problem.
+
+    Returns
+    -------
+    Leaderboard
+        The rows; peers missing or unable to express a problem are notes.
+
+    Raises
+    ------
+    KeyError
+        A problem name the suite does not hold (the CLI checks names first).
+    """
+    from scenarios.bench.peers import PEERS, PeerUnavailable, load_peer
+    from scenarios.runner import run
+    from scenarios.schema.loader import load
+
+    say = progress or (lambda line: None)
+    chosen = [suite.problems[name] for name in (problems if problems is not None else suite.problems)]
+    keep = None if planners is None else set(planners)
+    board = Leaderboard(suite, chosen, date=utc_stamp())
+    loaded: dict[str, Any] = {}
+    for name in peers:
+        try:
+            loaded[name] = load_peer(name, PEERS)
+        except PeerUnavailable as error:
+            board.notes.append(str(error))
+    start = time.perf_counter()
+    for i, problem in enumerate(chosen, 1):
+        began = time.perf_counter()
+        scenario = load(problem.file)
+        specs = [spec for spec in scenario.planners if keep is None or spec.name in keep]
+        rows: list[BenchRow] = []
+        if specs:
+            results = run(dataclasses.replace(scenario, planners=specs))
+            rows += _planner_rows(problem, scenario, results)
+        for name, peer in loaded.items() if problem.peers else ():
+            reason = peer.problem_error(scenario.problem, problem.objective)
+            if reason is not None:
+                board.notes.append(f"peer {name} skipped on {problem.name}: {reason}")
+                continue
+            try:
+                result = peer.solve(scenario.problem, problem.objective)
+            except Exception as error:  # noqa: BLE001 (a peer's crash is a failed row, not the end of the run)
+                from scenarios.bench.peers import PeerResult
+
+                result = PeerResult(None, 0.0, "failed", None, f"{type(error).__name__}: {error}")
+            rows.append(_peer_row(problem, name, result))
+        if not rows:
+            board.notes.append(f"{problem.name}: no planner or peer selected applies")
+        board.rows += rows
+        reached = sum(1 for row in rows if row.reached)
+        say(f"[{i}/{len(chosen)}] {problem.name}: {len(rows)} row(s), {reached} at the optimum, "
+            f"{time.perf_counter() - began:.1f} s")
+    board.wall_time_s = time.perf_counter() - start
+    return board

@@ -1,0 +1,195 @@
+"""The benchmark suite and ``slewbench bench``: the index and its problem files, the leaderboard's gap
+against hand-worked values, the closed-form problem against its closed form, the peers, bad names
+and output safety."""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import shutil
+import time
+
+import numpy as np
+import pytest
+
+from ocp import Spacecraft, Torquers, quat
+from planners import PLANNERS, ManeuverProblem
+from scenarios.bench import SUITE_FILE, load_suite
+from scenarios.bench.leaderboard import BENCH_FILES, certificate_text, gap
+from scenarios.bench.peers import PEERS, PeerUnavailable, load_peer
+from scenarios.bench.suite import OBJECTIVE_METRICS, OPTIMUM_KINDS
+from scenarios.cli.commands import main
+from scenarios.errors import ScenarioError
+from scenarios.schema.loader import load
+from scenarios.schema.read import read_yaml
+
+
+def test_the_index_loads_and_every_problem_is_a_scenario_with_its_planners():
+    suite = load_suite()
+    assert suite.version == 1
+    assert len(suite.problems) >= 10
+    for problem in suite.problems.values():
+        scenario = load(problem.file)  # an ordinary scenario: `slewbench run` runs it too
+        assert sorted({spec.name for spec in scenario.planners}) == sorted(set(problem.planners)), problem.name
+        assert all(name in PLANNERS for name in problem.planners)
+
+
+def test_every_problem_states_its_source_optimum_and_tolerance():
+    raw = read_yaml(SUITE_FILE)["problems"]
+    for name, problem in load_suite().problems.items():
+        entry = raw[name]
+        assert problem.source and problem.optimum_source and problem.eigenaxis_source and problem.title
+        assert problem.objective in OBJECTIVE_METRICS
+        assert problem.optimum_kind in OPTIMUM_KINDS
+        assert problem.optimum == entry["optimum"]["value"] > 0
+        # A tolerance is a band around the optimum, not a licence: at most 0.1 % of it.
+        assert 0 < problem.tolerance <= 1e-3 * problem.optimum, name
+        if problem.optimum_kind == "best_known":  # ours: established by two methods, said so
+            assert "ours" in problem.optimum_source, name
+
+
+def test_a_malformed_index_names_the_field(tmp_path):
+    shutil.copytree(SUITE_FILE.parent / "problems", tmp_path / "problems")
+    text = SUITE_FILE.read_text().replace("    source: \"ours (the repository's minimum-time test case; no published value).\"\n", "")
+    (tmp_path / "suite.yaml").write_text(text)
+    with pytest.raises(ScenarioError, match=r"problems.full_inertia_150: missing source"):
+        load_suite(tmp_path / "suite.yaml")
+    (tmp_path / "suite.yaml").write_text(SUITE_FILE.read_text().replace("value: 3.2431", "value: fast"))
+    with pytest.raises(ScenarioError, match=r"problems.bilimoria_wie_180.optimum.value: expected a number"):
+        load_suite(tmp_path / "suite.yaml")
+
+
+def test_the_norm_bounded_problem_meets_its_closed_form():
+    problem = load_suite().problems["norm_bounded_eigenaxis"]
+    scenario = load(problem.file)
+    spacecraft = scenario.problem.spacecraft
+    inertia = spacecraft.inertia
+    assert np.allclose(inertia, inertia[0, 0] * np.eye(3))  # spherical
+    wheels = spacecraft.wheels
+    assert wheels is not None
+    assert wheels.count == 1 and np.allclose(wheels.axes[:, 0], [1.0, 0.0, 0.0])
+    # theta from the scenario's quaternions, by hand: q = [cos(theta/2), sin(theta/2) e]
+    qf = scenario.problem.qf
+    assert qf is not None
+    theta = 2.0 * math.atan2(np.linalg.norm(qf[1:]), qf[0])
+    axis = qf[1:] / np.linalg.norm(qf[1:])
+    assert np.allclose(axis, [1.0, 0.0, 0.0])  # about the wheel's axis
+    u_max = float(np.max(wheels.max_torque))
+    closed_form = 2.0 * math.sqrt(theta * inertia[0, 0] / u_max)
+    assert closed_form == pytest.approx(2.0 * math.sqrt(math.pi / 2 * 2.0 / 0.1), rel=1e-7)  # the stated data
+    assert problem.optimum == pytest.approx(closed_form, abs=1e-6)
+    assert problem.eigenaxis == pytest.approx(closed_form, abs=1e-6)
+    # The double integrator's bang-bang, integrated by hand: half the time at +u, half at -u.
+    t_half = closed_form / 2.0
+    rate_peak = u_max / inertia[0, 0] * t_half
+    assert rate_peak * t_half == pytest.approx(theta, rel=1e-12)  # the area under the triangle
+
+
+def test_the_unit_inertia_eigenaxis_values_are_the_closed_form():
+    suite = load_suite()
+    for name, degrees in (("bilimoria_wie_180", 180), ("bilimoria_wie_90", 90), ("bilimoria_wie_45", 45)):
+        assert suite.problems[name].eigenaxis == pytest.approx(2.0 * math.sqrt(math.radians(degrees)), abs=1e-4)
+
+
+def test_gap_and_certificate_columns_by_hand():
+    assert gap(3.5449077, 3.2431) == pytest.approx((0.3018077, 0.3018077 / 3.2431))
+    assert gap(None, 1.0) == (None, None)
+    assert gap(float("nan"), 1.0) == (None, None)
+    assert certificate_text({"certificate": {"verdict": "certified", "summary": "KKT 1e-9, SOSC"}}) == "KKT 1e-9, SOSC"
+    assert certificate_text({"certificate": {"verdict": "first-order"}}) == "first-order"
+    assert certificate_text({"iterations": 3}) == "-"
+    assert certificate_text(None) == "-"
+
+
+def test_the_peer_registry_is_lazy_and_a_missing_peer_is_a_note():
+    assert set(PEERS) >= {"fatrop", "rockit", "acados"}
+    assert PEERS["acados"] == "scenarios.bench.peers.acados"
+    with pytest.raises(PeerUnavailable, match="peer nowhere skipped"):
+        load_peer("nowhere", {"nowhere": "scenarios.bench.peers.not_a_module"})
+    try:
+        import rockit  # type: ignore[import-not-found]  # noqa: F401
+    except ImportError:
+        with pytest.raises(PeerUnavailable, match="rockit-meco"):
+            load_peer("rockit")
+
+
+def test_the_fatrop_peer_meets_the_single_axis_minimum_energy_closed_form():
+    # Rest to rest, theta about x, spherical J, fixed T, bounds inactive: the optimum of the integral
+    # of u^2 is 12 J^2 theta^2 / T^3 (the cubic angle profile); FATROP holds the torque piecewise
+    # constant on 50 intervals, within 1e-3 of it.
+    peer = load_peer("fatrop")
+    J, theta, T = 2.0, 1.0, 10.0
+    problem = ManeuverProblem(Spacecraft([J, J, J], torquers=Torquers(1.0)), quat.IDENTITY, np.zeros(3),
+                              quat.from_axis_angle([1, 0, 0], theta), T, omegaf=np.zeros(3))
+    assert peer.problem_error(problem, "min_energy") is None
+    result = peer.solve(problem, "min_energy")
+    assert result.status == "ok", result.message
+    assert result.objective == pytest.approx(12 * J**2 * theta**2 / T**3, rel=1e-3)
+    assert result.iterations is not None and result.solve_time_s > 0
+
+
+def test_bench_writes_the_leaderboard_with_the_hand_worked_gap(tmp_path, capsys):
+    out = tmp_path / "board"
+    code = main(["bench", "--problems", "bilimoria_wie_90", "--planners", "eigenaxis", "fatrop", "--out", str(out)])
+    printed = capsys.readouterr().out
+    assert code == 0
+    assert "[1/1] bilimoria_wie_90" in printed
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == sorted(BENCH_FILES)
+    rows = list(csv.DictReader((out / "leaderboard.csv").open()))
+    eigenaxis = next(row for row in rows if row["planner"] == "eigenaxis")
+    # 2 sqrt(pi/2) = 2.5066283 against the best known 2.42112: +0.0855083, +3.5318 %
+    assert float(eigenaxis["value"]) == pytest.approx(2.5066283, abs=1e-6)
+    assert float(eigenaxis["gap_abs"]) == pytest.approx(0.0855083, abs=1e-6)
+    assert float(eigenaxis["gap_rel"]) == pytest.approx(0.0855083 / 2.42112, abs=1e-6)
+    assert eigenaxis["reached"] == "False" and eigenaxis["certificate"] == "-"
+    peer = next(row for row in rows if row["kind"] == "peer")
+    assert peer["planner"] == "fatrop" and peer["status"] in ("ok", "failed")
+    if peer["value"]:
+        assert float(peer["gap_abs"]) == pytest.approx(float(peer["value"]) - 2.42112, abs=1e-12)
+    data = json.loads((out / "leaderboard.json").read_text())
+    assert data["suite_version"] == 1 and data["slewbench"] and data["date"].endswith("Z") and data["platform"]
+    assert [problem["name"] for problem in data["problems"]] == ["bilimoria_wie_90"]
+    assert len(data["rows"]) == len(rows) == 2
+    text = (out / "leaderboard.md").read_text()
+    assert "## bilimoria_wie_90" in text and "+0.0855" in text
+    assert "| eigenaxis | planner | 1 | 0 | 3.53e-02 |" in text  # the summary: one row, not at the optimum
+    assert (out / "gap_vs_time.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("argv, expected", [
+    (["--problems", "no_such_problem"], "--problems: unknown problem 'no_such_problem'"),
+    (["--planners", "no_such_planner"], "--planners: unknown planner or peer 'no_such_planner'"),
+])
+def test_unknown_names_exit_2_before_anything_is_written(tmp_path, capsys, argv, expected):
+    out = tmp_path / "board"
+    assert main(["bench", *argv, "--out", str(out)]) == 2
+    assert expected in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_bench_never_touches_what_slewbench_did_not_write(tmp_path, capsys):
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("keep")
+    fast = ["bench", "--problems", "bilimoria_wie_45", "--planners", "eigenaxis", "--no-peers", "--no-plots"]
+    assert main([*fast, "--out", str(mine)]) == 2  # a user's directory
+    assert "did not create" in capsys.readouterr().err
+    assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
+    out = tmp_path / "board"
+    assert main([*fast, "--out", str(out)]) == 0
+    (out / "user.txt").write_text("keep")
+    assert main([*fast, "--out", str(out)]) == 0  # its own files are replaced, the user's kept
+    assert (out / "user.txt").read_text() == "keep"
+    assert (out / "leaderboard.csv").is_file() and not (out / "gap_vs_time.png").exists()
+
+
+@pytest.mark.slow
+def test_the_whole_suite_runs_in_five_minutes(tmp_path, capsys):
+    start = time.perf_counter()
+    assert main(["bench", "--out", str(tmp_path / "board")]) == 0
+    elapsed = time.perf_counter() - start
+    capsys.readouterr()
+    data = json.loads((tmp_path / "board" / "leaderboard.json").read_text())
+    suite = load_suite()
+    assert {row["problem"] for row in data["rows"]} == set(suite.problems)
+    assert elapsed < 300.0
