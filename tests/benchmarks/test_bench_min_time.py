@@ -14,8 +14,22 @@ inertia, 150° about [1, 1, 1] (optimum 7.6826 s, verified by a second method: s
 tests/test_collocation.py). Minimum energy: the spin paper's case warm-started from the spin
 extremal, solve after the build (target 60 ms) and the build itself at N = 50 (target 0.25 s).
 Run: ``python -m pytest tests/benchmarks/test_bench_min_time.py -o addopts=""``.
+
+acados side by side (:mod:`scenarios.bench.peers.acados`, skipped without it): ``test_side_by_side_acados``
+alternates ours (default options, after the build) with acados (RK4 multiple shooting, N = 50, exact
+Hessian SQP, partially condensing HPIPM; min time from the shared guess, min energy from its own
+eigenaxis guess), ROUNDS pairs per case, and prints medians, spreads (min..max), the ratio of the
+medians of the pairwise ratios, SQP/IPOPT iterations, acados's build time and the load (``uptime``).
+acados options: ``regularize_method: PROJECT`` with merit backtracking (17 SQP iterations on
+Bilimoria & Wie); on the full-inertia case that stops at a QP failure in SQP iteration 2 (T driven to
+its lower bound; so do MIRROR, CONVEXIFY, a Levenberg-Marquardt term of 1e-3 and 200 QP
+iterations), and only ``levenberg_marquardt: 0.1`` with MIRROR converges (7.68339, 64 iterations).
+Run it with ``SLEWBENCH_ACADOS_PYTHON`` naming the interpreter that has ``comma-deps-acados``.
 """
 from __future__ import annotations
+
+import os
+import time
 
 import casadi as ca
 import numpy as np
@@ -179,3 +193,59 @@ def test_min_energy_spin_case_build(benchmark):
     transcription = TRANSCRIPTIONS["collocation"](N, 3)
     benchmark.pedantic(lambda: transcription.build(ocp, "ipopt", solver_options("ipopt", 1e-10, 500)),
                        rounds=3, iterations=1)
+
+
+ROUNDS = 9
+ACADOS_OPTIONS = {"bilimoria_wie": {}, "full_inertia": {"levenberg_marquardt": 0.1, "regularize_method": "MIRROR"},
+                  "spin_min_energy": {}}
+"""acados options per case (the module docstring says why)."""
+
+
+def _spread(values):
+    values = np.asarray(values) * 1e3
+    return f"{np.median(values):7.1f} ms [{values.min():.1f}..{values.max():.1f}]"
+
+
+@pytest.mark.parametrize("case", ["bilimoria_wie", "full_inertia", "spin_min_energy"])
+def test_side_by_side_acados(case):
+    from scenarios.bench.peers import acados
+
+    ok, note = acados.available()
+    if not ok:
+        pytest.skip(note)
+    if case == "spin_min_energy":
+        problem, objective, optimum = spin_paper_case(), "min_energy", 0.018548
+        planner = PLANNERS["collocation"]({"intervals": N})
+        guess = None
+    else:
+        make, optimum = CASES[case]
+        problem, objective = make(), "min_time"
+        planner = PLANNERS["collocation"]({"objective": "min_time"})
+        guess = shared_guess(problem)
+    planner.plan(problem)  # the build
+    ours, theirs, ours_f, answers = [], [], [], []
+    with acados.AcadosPeer() as peer:
+        build_s = peer.build(problem, objective, guess=guess, options=ACADOS_OPTIONS[case])
+        peer.solve()  # warm the caches as ours was
+        for _ in range(ROUNDS):
+            tic = time.perf_counter()
+            reference = planner.plan(problem)
+            ours.append(time.perf_counter() - tic)
+            ours_f.append(reference.stats["objective"])
+            answer = peer.solve()
+            theirs.append(answer["time_s"])
+            answers.append(answer)
+    ratio = np.asarray(ours) / np.asarray(theirs)
+    load = os.popen("uptime").read().strip()
+    print(f"\n{case}: ours {_spread(ours)} f = {ours_f[-1]:.6f} ({reference.stats['iterations']} IPOPT iterations); "
+          f"acados {_spread(theirs)} f = {answers[-1]['objective']:.6f} ({answers[-1]['iterations']} SQP, "
+          f"{answers[-1]['status']}), build {build_s:.2f} s; ours/acados median {np.median(ratio):.2f} "
+          f"[{ratio.min():.2f}..{ratio.max():.2f}]; load: {load}")
+    if objective == "min_time":
+        assert ours_f[-1] == pytest.approx(optimum, abs=2e-4)
+        assert answers[-1]["status"] == "ok"
+        assert answers[-1]["objective"] == pytest.approx(optimum, rel=2e-3)  # RK4, piecewise-constant torques
+    else:
+        # acados stops at the eigenaxis-side local minimum (0.0933), 5x the best known
+        assert answers[-1]["status"] == "ok"
+        assert answers[-1]["objective"] > 1.5 * optimum
