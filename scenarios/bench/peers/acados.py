@@ -186,7 +186,7 @@ class AcadosPeer:
             self._process.stdin.close()
             self._process.wait(timeout=30)
 
-    def __enter__(self) -> AcadosPeer:
+    def __enter__(self) -> AcadosPeer:  # noqa: PYI034 (no Self on Python 3.10)
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -220,7 +220,7 @@ def solve(problem: Any, objective: str = "min_time", intervals: int = N,
 # -- the worker side (the interpreter with the acados wheel) --------------------------------------
 def _environment() -> dict[str, str] | None:
     """The environment acados needs, or ``None`` when the process already has it."""
-    import acados  # the comma-deps-acados wheel
+    import acados  # type: ignore[import-not-found]  # the comma-deps-acados wheel, in its own environment
 
     root = os.path.dirname(acados.__file__)
     wanted = {"ACADOS_SOURCE_DIR": acados.DIR, "ACADOS_PYTHON_INTERFACE_PATH": os.path.join(root, "acados_template"),
@@ -266,7 +266,7 @@ class _Worker:
 
     def build(self, data: dict) -> dict:
         import casadi as ca
-        from acados_template import AcadosModel, AcadosOcp, AcadosOcpSolver
+        from acados_template import AcadosModel, AcadosOcp, AcadosOcpSolver  # type: ignore[import-not-found]
 
         self.count += 1
         free = data["objective"] == "min_time"
@@ -365,7 +365,7 @@ def _serve() -> None:
             request = json.loads(line)
             op = request.pop("op")
             answer = worker.build(request) if op == "build" else worker.solve()
-        except Exception as error:  # reported to the parent, which raises
+        except Exception as error:  # noqa: BLE001 (any failure is reported to the parent, which raises it)
             answer = {"error": f"{type(error).__name__}: {error}"}
         answers.write(json.dumps(answer) + "\n")
         answers.flush()
