@@ -464,6 +464,9 @@ def _serve() -> None:
             answer = {"error": f"{type(error).__name__}: {error}"}
         answers.write(json.dumps(answer) + "\n")
         answers.flush()
+    import shutil
+
+    shutil.rmtree(worker.home, ignore_errors=True)  # the generated code and libraries of this run
 
 
 if __name__ == "__main__" and sys.argv[1:] == ["--worker"]:
