@@ -65,3 +65,14 @@ def test_min_time_reaches_the_published_optimum():
     assert result["status"] == "ok", result
     assert result["objective"] == pytest.approx(3.2431, rel=2e-3)
     assert result["build_s"] > 0 and result["iterations"] > 0
+
+
+def test_bench_registry_skips_it_with_the_note(monkeypatch):
+    base = pytest.importorskip("scenarios.bench.peers.base")  # the bench's peer contract
+    monkeypatch.setenv(acados.ENV_PYTHON, "/nonexistent/python")
+    with pytest.raises(base.PeerUnavailable, match="/nonexistent/python"):
+        base.load_peer("acados")
+    assert acados.PEER.problem_error(bilimoria_wie(), "min_time") is None
+    assert "target" in acados.PEER.problem_error(
+        ManeuverProblem(Spacecraft([1.0, 1.0, 1.0], torquers=Torquers(1.0)), quat.IDENTITY, np.zeros(3), None, 10.0),
+        "min_time")
