@@ -1,0 +1,78 @@
+"""The acados benchmark peer (scenarios/bench/peers/acados.py): its request, its skip, and (slow, when an
+interpreter with acados is configured) its minimum time against the published optimum.
+
+Oracle: Bilimoria & Wie's published minimum time 3.2431 s (unit inertia, |u_i| <= 1, 180° about x); the peer's
+RK4 multiple shooting on 50 intervals stops at its discretisation's optimum, within 2e-3 of it.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ocp import Spacecraft, Torquers, quat
+from planners import ManeuverProblem
+from scenarios.bench.peers import acados
+
+
+def bilimoria_wie() -> ManeuverProblem:
+    return ManeuverProblem(Spacecraft([1.0, 1.0, 1.0], torquers=Torquers(1.0)), quat.IDENTITY, np.zeros(3),
+                           quat.from_axis_angle([1, 0, 0], np.pi), 10.0, omegaf=np.zeros(3))
+
+
+def test_request_carries_the_problem():
+    data = acados.problem_data(bilimoria_wie(), "min_time")
+    assert data["inertia"] == np.eye(3).tolist()
+    assert data["u_max"] == [1.0, 1.0, 1.0]
+    assert data["x0"] == [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    assert np.allclose(data["qf"], [0.0, 1.0, 0.0, 0.0], atol=1e-15)
+    assert data["omegaf"] == [0.0, 0.0, 0.0] and data["N"] == 50 and data["duration"] == 10.0
+    with pytest.raises(ValueError, match="objective"):
+        acados.problem_data(bilimoria_wie(), "min_fuel")
+
+
+def test_default_guess_is_the_eigenaxis_slerp():
+    data = acados.problem_data(bilimoria_wie(), "min_energy", intervals=4)
+    states, T = acados._guess(data)
+    assert T == 10.0 and states.shape == (7, 5)
+    assert np.allclose(np.linalg.norm(states[:4], axis=0), 1.0)
+    half = quat.from_axis_angle([1, 0, 0], np.pi / 2)  # halfway along the 180° slew
+    assert np.allclose(states[:4, 2], half)
+    assert np.all(states[4:] == 0.0)
+
+
+def test_skipped_with_a_note_when_absent(monkeypatch):
+    monkeypatch.setenv(acados.ENV_PYTHON, "/nonexistent/python")
+    ok, note = acados.available()
+    assert not ok and "/nonexistent/python" in note
+    result = acados.solve(bilimoria_wie())
+    assert result["skipped"] is True and "not an executable" in result["note"]
+
+
+@pytest.mark.slow
+def test_min_time_reaches_the_published_optimum():
+    ok, note = acados.available()
+    if not ok:
+        pytest.skip(note)
+    problem = bilimoria_wie()
+    # a guess near the bang-bang optimum: the slew about x at the optimum's duration, rates from a
+    # bang-bang profile about x (the eigenaxis guess at rest sends acados's QP to a failure)
+    n, T0 = acados.N, 3.3
+    t = np.linspace(0.0, T0, n + 1)
+    rate = np.where(t < T0 / 2, t, T0 - t) * np.pi / (T0 / 2) ** 2
+    angle = np.concatenate([[0.0], np.cumsum((rate[1:] + rate[:-1]) / 2 * np.diff(t))])
+    states = np.vstack([np.cos(angle / 2), np.sin(angle / 2), 0 * t, 0 * t, rate + 0.05, 0.05 + 0 * t, 0.05 + 0 * t])
+    result = acados.solve(problem, "min_time", guess=(states, T0))
+    assert result["status"] == "ok", result
+    assert result["objective"] == pytest.approx(3.2431, rel=2e-3)
+    assert result["build_s"] > 0 and result["iterations"] > 0
+
+
+def test_bench_registry_skips_it_with_the_note(monkeypatch):
+    base = pytest.importorskip("scenarios.bench.peers.base")  # the bench's peer contract
+    monkeypatch.setenv(acados.ENV_PYTHON, "/nonexistent/python")
+    with pytest.raises(base.PeerUnavailable, match="/nonexistent/python"):
+        base.load_peer("acados")
+    assert acados.PEER.problem_error(bilimoria_wie(), "min_time") is None
+    assert "target" in acados.PEER.problem_error(
+        ManeuverProblem(Spacecraft([1.0, 1.0, 1.0], torquers=Torquers(1.0)), quat.IDENTITY, np.zeros(3), None, 10.0),
+        "min_time")
