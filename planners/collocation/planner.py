@@ -373,10 +373,11 @@ class CollocationPlanner(Planner):
             if name in (self.name, o.warm_start) or not cls.cheap:
                 continue
             try:
-                if cls(None, cache=self.cache).problem_error(problem) is None:
-                    names.append(name)
-            except Exception:  # a planner that cannot even judge the problem is no seed  # noqa: BLE001
-                continue
+                refused = cls(None, cache=self.cache).problem_error(problem)
+            except Exception as error:  # a planner that cannot even judge the problem is no seed
+                refused = str(error)
+            if refused is None:
+                names.append(name)
         return names
 
     def _starts(self, problem: ManeuverProblem, failures: list[str] | None = None) -> list[Reference]:
@@ -389,7 +390,7 @@ class CollocationPlanner(Planner):
         for name, options in requested:
             try:
                 reference = PLANNERS[name](options, cache=self.cache).plan(problem)
-            except Exception as error:  # a seed is optional: its crash is recorded, not raised  # noqa: BLE001
+            except Exception as error:  # a seed is optional: its crash is recorded, not raised
                 if failures is not None:
                     failures.append(f"{name}: raised {type(error).__name__}: {error}")
                 continue
