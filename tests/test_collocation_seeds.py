@@ -135,3 +135,19 @@ def test_seed_planners_auto_is_the_default_and_validated():
         PLANNERS["collocation"]({"seed_planners": "all"})
     with pytest.raises(OptionsError, match=r"seed_planners\[0\]"):
         PLANNERS["collocation"]({"seed_planners": ["collocation"]})
+
+
+def test_auto_seeds_only_where_the_starts_are_solved_on_the_coarse_mesh():
+    # Without the coarse mesh (coarse_intervals: 0, or cones at a fixed final time) a seed would
+    # cost a full-mesh solve: auto adds none, an explicit list still applies.
+    problem = spin_paper_problem()
+    direct = PLANNERS["collocation"]({"coarse_intervals": 0}, cache=SolverCache())
+    assert direct._seed_names(problem) == []
+    cones = PLANNERS["collocation"]({"keep_out": [{"boresight": [0, 0, 1], "direction": [1, 0, 0], "angle_deg": 20}]})
+    assert cones._seed_names(problem) == []
+    assert PLANNERS["collocation"]()._seed_names(problem) == ["spin_extremal"]
+    assert PLANNERS["collocation"]({"coarse_intervals": 0, "seed_planners": ["spin_extremal"]})._seed_names(
+        problem) == ["spin_extremal"]
+    reference = direct.plan(problem)
+    assert round(reference.stats["objective"], 6) == 0.093244
+    assert reference.stats["seeds"]["tried"] == 1

@@ -117,16 +117,17 @@ class CollocationOptions:
     warm_start_options : dict
         The warm-start planner's options.
     seed_planners : "auto" or list of str
-        Further planners whose references are starts, each solved after the warm start and the
-        best converged optimum kept. ``auto`` (default): every registered planner that plans in
+        Further planners whose references are starts, each solved after the warm start; the best
+        converged optimum is kept. ``auto`` (default): every registered planner that plans in
         milliseconds (:attr:`~planners.base.Planner.cheap`: ``eigenaxis``, ``spin_extremal``)
-        and accepts the problem (:meth:`~planners.base.Planner.problem_error`), in name order,
-        with its default options, besides the warm start (the spin paper's minimum energy:
-        0.018548 from ``spin_extremal`` where the eigenaxis warm start alone stops at 0.0932); a
-        list: those planners (each at most once); ``[]``: the warm start alone. A seed planner
-        that fails or raises is skipped and named in ``stats["seeds"]["skipped"]``;
-        ``stats["seeds"]`` records the starts tried, how many agreed on the best optimum and
-        where it came from.
+        and accepts the problem (:meth:`~planners.base.Planner.problem_error`), besides the warm
+        start, in name order, with its default options; only where the starts are solved on the
+        coarse mesh (``coarse_intervals``: ``multistart: auto``, and no cones at a fixed final
+        time), none elsewhere. On the spin paper's minimum energy ``spin_extremal``'s start
+        reaches 0.018548 where the eigenaxis warm start alone stops at 0.0932. A list: those
+        planners (each at most once); ``[]``: the warm start alone. A seed planner that fails or
+        raises is skipped and named in ``stats["seeds"]["skipped"]``; ``stats["seeds"]`` records
+        the starts tried, how many agreed on the best optimum and where it came from.
     multistart : int or "auto"
         ``auto`` (default): for a free final time a perturbed copy of the warm start
         (:data:`AUTO_FIRST`), then, unless its optimum satisfies the second-order sufficient
@@ -363,10 +364,19 @@ class CollocationPlanner(Planner):
     def _seed_names(self, problem: ManeuverProblem) -> list[str]:
         """The seed planners: the option's list, or with ``seed_planners: auto`` every registered
         planner but this one and the warm start that is :attr:`~planners.base.Planner.cheap` and
-        accepts ``problem`` (with its default options), in name order."""
+        accepts ``problem`` (with its default options), in name order, where the starts are solved
+        on the coarse mesh (:meth:`_coarse`), none elsewhere: there a seed would cost a full-mesh
+        solve (the 12U CubeSat's fixed-time keep-out, solved on the full mesh: the same optimum
+        from one more start, at 1.8 times the plan time)."""
         o = self.options
         if o.seed_planners != "auto":
             return list(o.seed_planners)
+        try:
+            coarse = self._coarse(self._ocp(problem))
+        except ValueError:  # a cone left empty: no plan (_plan says why)
+            coarse = False
+        if not coarse:
+            return []
         names = []
         for name in sorted(PLANNERS):
             cls = PLANNERS[name]
