@@ -384,7 +384,7 @@ class CollocationPlanner(Planner):
                 continue
             try:
                 refused = cls(None, cache=self.cache).problem_error(problem)
-            except Exception as error:  # a planner that cannot even judge the problem is no seed
+            except Exception as error:  # noqa: BLE001 (a planner that cannot judge the problem is no seed)
                 refused = str(error)
             if refused is None:
                 names.append(name)
@@ -400,7 +400,7 @@ class CollocationPlanner(Planner):
         for name, options in requested:
             try:
                 reference = PLANNERS[name](options, cache=self.cache).plan(problem)
-            except Exception as error:  # a seed is optional: its crash is recorded, not raised
+            except Exception as error:  # noqa: BLE001 (a seed is optional: its crash is recorded, not raised)
                 if failures is not None:
                     failures.append(f"{name}: raised {type(error).__name__}: {error}")
                 continue
