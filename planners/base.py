@@ -63,6 +63,9 @@ class Planner(Configurable, ABC):
     * ``example_options`` lists option sets for the conformance test.
     * ``closed_form``: its references are closed-form expressions of time and implement
       :meth:`Reference.symbolic_evaluator` (``slewbench codegen`` exports them as C).
+    * ``cheap``: it plans in milliseconds (a closed form or a small parameter search, not a
+      trajectory optimisation), so ``collocation`` plans it as a start by default
+      (``seed_planners: auto``) wherever :meth:`problem_error` accepts the problem.
     * ``honours`` names the scenario requirements (:data:`REQUIREMENT_KINDS`) the planner imposes
       on its references: ``"pointing"`` (``problem.pointing``, every window and moving direction
       included), ``"actuators"`` (the actuators' limits tightened by ``problem.actuator_margin``),
@@ -97,6 +100,9 @@ class Planner(Configurable, ABC):
 
     closed_form: ClassVar[bool] = False
     """Whether its references implement :meth:`Reference.symbolic_evaluator`."""
+
+    cheap: ClassVar[bool] = False
+    """Whether it plans in milliseconds, so that ``collocation`` seeds from it by default."""
 
     honours: ClassVar[frozenset[str]] = frozenset()
     """The requirement kinds (of :data:`REQUIREMENT_KINDS`) the planner imposes on its references."""

@@ -289,6 +289,7 @@ class EigenaxisPlanner(Planner):
     name = "eigenaxis"
     example_options = ({"profile": "smooth"}, {"profile": "trapezoidal"}, {"profile": "min_time"})
     closed_form = True
+    cheap = True
 
     @dataclass(frozen=True)
     class Options:

@@ -243,6 +243,7 @@ class SpinExtremalPlanner(Planner):
 
     name = "spin_extremal"
     example_options = ({}, {"weight": 0.1})
+    cheap = True
 
     @dataclass(frozen=True)
     class Options:

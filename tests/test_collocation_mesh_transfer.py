@@ -127,7 +127,7 @@ def test_the_full_mesh_seed_with_and_without_the_transfer(monkeypatch, transfer)
         monkeypatch.setattr(collocation, name, lambda *args, _f=original, _n=name: used.append(_n) or _f(*args))
     if not transfer:
         monkeypatch.setattr(collocation, "transfer_multipliers", lambda *args: None)
-    reference = PLANNERS["collocation"]({"objective": "min_time"}).plan(bilimoria_wie())
+    reference = PLANNERS["collocation"]({"objective": "min_time", "seed_planners": []}).plan(bilimoria_wie())
     assert reference.ok, reference.message
     assert reference.duration == pytest.approx(3.2431, abs=2e-4)
     # the coarse mesh is seeded from the warm start, then the full mesh from the coarse optimum
@@ -227,8 +227,9 @@ def test_ipopt_takes_the_seed_over_when_fatrop_stops(monkeypatch):
 
     monkeypatch.setattr(collocation, "SEED_FATROP", {**collocation.SEED_FATROP, "fatrop.max_iter": 1})
     problem = spin_paper_problem()
-    default = PLANNERS["collocation"]({"warm_start": "spin_extremal"}).plan(problem)
-    direct = PLANNERS["collocation"]({"warm_start": "spin_extremal", "coarse_intervals": 0}).plan(problem)
+    default = PLANNERS["collocation"]({"warm_start": "spin_extremal", "seed_planners": []}).plan(problem)
+    direct = PLANNERS["collocation"]({"warm_start": "spin_extremal", "seed_planners": [],
+                                      "coarse_intervals": 0}).plan(problem)
     assert default.ok, default.message
     assert default.stats["coarse_fatrop"]["solver_status"] == ["Fatrop_Stopped"]
     assert default.stats["coarse"]["solver"] == "ipopt" and default.stats["coarse"]["iterations"] > 10

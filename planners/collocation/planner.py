@@ -64,6 +64,8 @@ from planners.collocation.requirements import (
     imposed_pointing,
 )
 from planners.collocation.strategy import (
+    AGREE_ATOL,
+    AGREE_RTOL,
     AUTO_FIRST,
     AUTO_RESTART,
     DENSE_ROUNDS,
@@ -76,6 +78,7 @@ from planners.collocation.strategy import (
     TRANSFER_WARM_START,
     control_floor,
     merged,
+    seed_record,
 )
 from planners.problem import Array, ManeuverProblem
 from planners.reference import FailedReference, Reference
@@ -113,8 +116,18 @@ class CollocationOptions:
         itself with its own ``warm_start_options``).
     warm_start_options : dict
         The warm-start planner's options.
-    seed_planners : list of str
-        Further planners whose references are starts (each at most once).
+    seed_planners : "auto" or list of str
+        Further planners whose references are starts, each solved after the warm start; the best
+        converged optimum is kept. ``auto`` (default): every registered planner that plans in
+        milliseconds (:attr:`~planners.base.Planner.cheap`: ``eigenaxis``, ``spin_extremal``)
+        and accepts the problem (:meth:`~planners.base.Planner.problem_error`), besides the warm
+        start, in name order, with its default options; only where the starts are solved on the
+        coarse mesh (``coarse_intervals``: ``multistart: auto``, and no cones at a fixed final
+        time), none elsewhere. On the spin paper's minimum energy ``spin_extremal``'s start
+        reaches 0.018548 where the eigenaxis warm start alone stops at 0.0932. A list: those
+        planners (each at most once); ``[]``: the warm start alone. A seed planner that fails or
+        raises is skipped and named in ``stats["seeds"]["skipped"]``; ``stats["seeds"]`` records
+        the starts tried, how many agreed on the best optimum and where it came from.
     multistart : int or "auto"
         ``auto`` (default): for a free final time a perturbed copy of the warm start
         (:data:`AUTO_FIRST`), then, unless its optimum satisfies the second-order sufficient
@@ -167,7 +180,7 @@ class CollocationOptions:
     solver: Literal["ipopt", "fatrop"] = "ipopt"
     warm_start: str = "eigenaxis"            # registered planner whose reference seeds the NLP
     warm_start_options: dict = field(default_factory=dict)  # its options, e.g. {profile: min_time}
-    seed_planners: list[str] = field(default_factory=list)
+    seed_planners: list[str] | Literal["auto"] = "auto"
     multistart: Annotated[int | Literal["auto"], Range(ge=0, le=50)] = "auto"
     agree: Annotated[int, Range(ge=0, le=50)] = 2  # stop once this many starts agree on the best optimum (0: try all)
     time_regularization: Annotated[float, Range(ge=0.0, le=1.0)] = 0.0
@@ -188,13 +201,14 @@ class CollocationOptions:
         # A collocation warm start is planned with its own options (say min_energy, itself warm
         # started from eigenaxis): the way into min_time where a kinematic seed is too far
         # (two wheels). Only its own warm start may nest further; the depth is the YAML's.
-        for index, name in enumerate([self.warm_start, *self.seed_planners]):
+        listed = [] if self.seed_planners == "auto" else list(self.seed_planners)
+        for index, name in enumerate([self.warm_start, *listed]):
             if name not in PLANNERS or (name == "collocation" and index > 0):
                 where = "warm_start" if index == 0 else f"seed_planners[{index - 1}]"
                 raise InvalidOption(where, f"{name!r} is not another registered planner; expected one of "
                                            f"{sorted(set(PLANNERS) - {'collocation'})} (or collocation as warm_start)")
-        for index, name in enumerate(self.seed_planners):
-            if name in self.seed_planners[:index]:  # the same reference again: the same start solved twice
+        for index, name in enumerate(listed):
+            if name in listed[:index]:  # the same reference again: the same start solved twice
                 raise InvalidOption(f"seed_planners[{index}]", f"{name!r} is listed twice; expected each planner once")
         if self.transcription not in TRANSCRIPTIONS:
             raise InvalidOption("transcription", f"{self.transcription!r} is not a registered transcription; "
@@ -347,14 +361,49 @@ class CollocationPlanner(Planner):
             scale *= 1.0 - tightening.actuators
         return variable_bounds(problem, self.options.max_rate, scale)
 
+    def _seed_names(self, problem: ManeuverProblem) -> list[str]:
+        """The seed planners: the option's list, or with ``seed_planners: auto`` every registered
+        planner but this one and the warm start that is :attr:`~planners.base.Planner.cheap` and
+        accepts ``problem`` (with its default options), in name order, where the starts are solved
+        on the coarse mesh (:meth:`_coarse`), none elsewhere: there a seed would cost a full-mesh
+        solve (the 12U CubeSat's fixed-time keep-out, solved on the full mesh: the same optimum
+        from one more start, at 1.8 times the plan time)."""
+        o = self.options
+        if o.seed_planners != "auto":
+            return list(o.seed_planners)
+        try:
+            coarse = self._coarse(self._ocp(problem))
+        except ValueError:  # a cone left empty: no plan (_plan says why)
+            coarse = False
+        if not coarse:
+            return []
+        names = []
+        for name in sorted(PLANNERS):
+            cls = PLANNERS[name]
+            if name in (self.name, o.warm_start) or not cls.cheap:
+                continue
+            try:
+                refused = cls(None, cache=self.cache).problem_error(problem)
+            except Exception as error:  # noqa: BLE001 (a planner that cannot judge the problem is no seed)
+                refused = str(error)
+            if refused is None:
+                names.append(name)
+        return names
+
     def _starts(self, problem: ManeuverProblem, failures: list[str] | None = None) -> list[Reference]:
-        """The references of the warm start and the seed planners that planned; each failure's
-        ``planner: message`` is appended to ``failures`` when given."""
+        """The references of the warm start and the seed planners (:meth:`_seed_names`) that
+        planned; a planner that fails or raises is skipped, its ``planner: message`` appended to
+        ``failures`` when given."""
         starts = []
         requested = [(self.options.warm_start, self.options.warm_start_options)]
-        requested += [(name, None) for name in self.options.seed_planners]
+        requested += [(name, None) for name in self._seed_names(problem)]
         for name, options in requested:
-            reference = PLANNERS[name](options, cache=self.cache).plan(problem)
+            try:
+                reference = PLANNERS[name](options, cache=self.cache).plan(problem)
+            except Exception as error:  # noqa: BLE001 (a seed is optional: its crash is recorded, not raised)
+                if failures is not None:
+                    failures.append(f"{name}: raised {type(error).__name__}: {error}")
+                continue
             if reference.ok:
                 starts.append(reference)
             elif failures is not None:
@@ -362,16 +411,23 @@ class CollocationPlanner(Planner):
         return starts
 
     def _guesses(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
-                 seeds: list[Array], alternates: list[Array] | None = None) -> tuple[list[Array], list[Array], float]:
+                 seeds: list[Array], alternates: list[Array] | None = None,
+                 labels: list[str] | None = None) -> tuple[list[Array], list[Array], float, list[str]]:
         """The starts (the warm start or its perturbed copies, then the seed planners' starts), the
-        fallback starts (tried only if none of those converged: ``alternates`` last) and the
-        relative size of the restarts from the best point (0: none)."""
-        starts, fallback, restart = self._policy(problem, ocp, transcription, nlp, seeds)
-        return starts, fallback + list(alternates or []), restart
+        fallback starts (tried only if none of those converged: ``alternates`` last), the
+        relative size of the restarts from the best point (0: none) and where each start and
+        fallback comes from (from ``labels``, one per seed then per alternate; default
+        ``start i``)."""
+        alternates = list(alternates or [])
+        if labels is None:
+            labels = [f"start {i}" for i in range(len(seeds) + len(alternates))]
+        starts, fallback, restart, names = self._policy(problem, ocp, transcription, nlp, seeds, labels[:len(seeds)])
+        return starts, fallback + alternates, restart, names + labels[len(seeds):]
 
     def _policy(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
-                seeds: list[Array]) -> tuple[list[Array], list[Array], float]:
-        """The ``multistart`` policy of :meth:`_guesses`."""
+                seeds: list[Array], labels: list[str]) -> tuple[list[Array], list[Array], float, list[str]]:
+        """The ``multistart`` policy of :meth:`_guesses` (the labels of its starts, then of its
+        fallbacks, last)."""
         count = self.options.multistart
         if count == "auto":
             # A warm start can sit exactly on a stationary point (the eigenaxis slew is one for minimum
@@ -383,11 +439,13 @@ class CollocationPlanner(Planner):
             if ocp.free_time:
                 floor = control_floor(transcription, ocp, nlp, *self._variable_bounds(problem)[2:])
                 first = perturbed(seeds[0], 1, scales=(AUTO_FIRST, AUTO_FIRST), floor=floor)
-                return first + seeds[1:], seeds[:1], AUTO_RESTART
-            return seeds, [], 0.0
+                return (first + seeds[1:], seeds[:1], AUTO_RESTART,
+                        [f"{labels[0]} perturbed 1", *labels[1:], labels[0]])
+            return seeds, [], 0.0, list(labels)
         if not count:
-            return seeds, [], 0.0
-        return perturbed(seeds[0], count) + seeds[1:], [], 0.0
+            return seeds, [], 0.0, list(labels)
+        copies = [f"{labels[0]} perturbed {k + 1}" for k in range(count)]
+        return perturbed(seeds[0], count) + seeds[1:], [], 0.0, copies + labels[1:]
 
     def _regularized(self, problem: ManeuverProblem, ocp: OptimalControlProblem) -> OptimalControlProblem:
         """``ocp`` (minimum time) with the energy term of ``time_regularization``: weight ε over the
@@ -401,27 +459,35 @@ class CollocationPlanner(Planner):
 
     def _solve(self, problem: ManeuverProblem, ocp: OptimalControlProblem, seeds: list[Array], params: Array,
                bounds: tuple[Array, Array], intervals: int, near_optimum: bool = False,
-               solver: str | None = None,
-               alternates: list[Array] | None = None) -> tuple[NLPResult, dict, NLPResult | None]:
+               solver: str | None = None, alternates: list[Array] | None = None,
+               labels: list[str] | None = None) -> tuple[NLPResult, dict, NLPResult | None]:
         """Solve ``ocp`` on ``intervals`` from ``seeds`` by the multistart policy (``near_optimum``:
         from the one seed given, near the optimum, see :meth:`_nlp`); with ``time_regularization``,
         solve the regularised problem so and polish plain minimum time from its optimum and
         multipliers (the regularised solve is returned third, ``None`` without one); ``solver`` as
-        in :meth:`_nlp`; ``alternates``: further fallback starts (:meth:`_seeds`)."""
+        in :meth:`_nlp`; ``alternates``: further fallback starts and ``labels`` where the seeds and
+        alternates come from (:meth:`_seeds`). The extra stats of a multistart hold ``seeds``
+        (:func:`~planners.collocation.strategy.seed_record`)."""
         o = self.options
         transcription, nlp = self._nlp(problem, ocp, "near_optimum" if near_optimum else "cold", intervals, solver)
-        guesses, fallback, restart = ((seeds, [], 0.0) if near_optimum
-                                      else self._guesses(problem, ocp, transcription, nlp, seeds, alternates))
+        guesses, fallback, restart, names = ((seeds, [], 0.0, []) if near_optimum
+                                             else self._guesses(problem, ocp, transcription, nlp, seeds, alternates,
+                                                                labels))
         agree = 1 if near_optimum else o.agree
         lbx, ubx = bounds
         if not o.time_regularization:
             result = solve_multistart(nlp.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
-                                      agree=agree, restart=restart, fallback=fallback, second_order=restart > 0)
-            return result, {}, None
+                                      agree=agree, restart=restart, fallback=fallback, second_order=restart > 0,
+                                      rtol=AGREE_RTOL, atol=AGREE_ATOL)
+            return result, {} if near_optimum else {"seeds": seed_record(result, len(guesses), names)}, None
         _, regular = self._nlp(problem, self._regularized(problem, ocp), intervals=intervals)
         first = solve_multistart(regular.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=regular.lbg, ubg=regular.ubg,
-                                 agree=agree, restart=restart, fallback=fallback, second_order=restart > 0)
-        return self._polished(problem, ocp, first, params, bounds, intervals), {"regularized": first.stats()}, first
+                                 agree=agree, restart=restart, fallback=fallback, second_order=restart > 0,
+                                 rtol=AGREE_RTOL, atol=AGREE_ATOL)
+        extra = {"regularized": first.stats()}
+        if not near_optimum:
+            extra["seeds"] = seed_record(first, len(guesses), names)
+        return self._polished(problem, ocp, first, params, bounds, intervals), extra, first
 
     def _polished(self, problem: ManeuverProblem, ocp: OptimalControlProblem, regularized: NLPResult, params: Array,
                   bounds: tuple[Array, Array], intervals: int) -> NLPResult:
@@ -469,7 +535,10 @@ class CollocationPlanner(Planner):
         if not starts:
             return FailedReference(self.name, f"no start: the warm-start planner {self.options.warm_start!r} failed ("
                                               + "; ".join(failures) + ")")
-        return self._plan_from(problem, starts)
+        reference = self._plan_from(problem, starts)
+        if isinstance(reference.stats.get("seeds"), dict):  # the seed planners that failed or raised
+            reference.stats["seeds"]["skipped"] = failures
+        return reference
 
     def _plan_from(self, problem: ManeuverProblem, starts: list[Reference]) -> Reference:
         """Plan from the given start references (see the module docstring), then honour the
@@ -489,6 +558,7 @@ class CollocationPlanner(Planner):
             return reference
         tightening = Tightening.initial(requirements, float(np.deg2rad(self.options.cone_margin_deg)))
         check = dense_check(problem, reference, requirements)
+        first_seeds = reference.stats.get("seeds")
         rounds: list[dict] = []
         stopped = ""
         while not check.met and len(rounds) < DENSE_ROUNDS:
@@ -507,6 +577,8 @@ class CollocationPlanner(Planner):
                 break
             solved, reference = again, candidate
             check = dense_check(problem, reference, requirements)
+        if first_seeds is not None:  # the tightened solves start from the first one's optimum
+            reference.stats["seeds"] = first_seeds
         reference.stats["dense_check"] = self._dense_stats(requirements, tightening, check, rounds)
         if not check.met:
             reference.message += (f"; still breaks {check.summary()} between the mesh points after "
@@ -563,8 +635,9 @@ class CollocationPlanner(Planner):
         return _Optimum(result, {}, transcription, nlp, solved.intervals, None, solved.solver)
 
     def _seeds(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
-               starts: list[Reference]) -> tuple[list[Array], list[Array]]:
-        """The decision vectors of the start references, and alternates tried only if none converges.
+               starts: list[Reference]) -> tuple[list[Array], list[Array], list[str]]:
+        """The decision vectors of the start references, alternates tried only if none converges,
+        and where each comes from (the planner's name, one per start then per alternate).
 
         A start whose boresight enters a keep-out cone is bent round it
         (:func:`~planners.collocation.reference.cone_avoiding_sampler`, :data:`SEED_CONE_PAD`
@@ -574,10 +647,13 @@ class CollocationPlanner(Planner):
         the first start as it was is the last alternate."""
         seeds: list[Array] = []
         alternates: list[Array] = []
+        labels: list[str] = []
+        alternate_labels: list[str] = []
         for index, reference in enumerate(starts):
             duration = reference.duration if ocp.free_time else problem.duration
             sample = seed_sampler(problem, reference)
             sides, central = cone_sides(sample, ocp.cones, duration) if ocp.cones else ([], False)
+            labels.append(reference.planner)
             if not any(side is not None for side in sides):
                 seeds.append(transcription.seed(ocp, nlp, sample, duration))
                 continue
@@ -588,8 +664,10 @@ class CollocationPlanner(Planner):
                 other = transcription.seed(ocp, nlp, cone_avoiding_sampler(sample, ocp.cones, opposite, SEED_CONE_PAD),
                                            duration)
                 (seeds if central else alternates).append(other)
+                (labels if central else alternate_labels).append(f"{reference.planner} other side")
                 alternates.append(transcription.seed(ocp, nlp, sample, duration))
-        return seeds, alternates
+                alternate_labels.append(f"{reference.planner} unbent")
+        return seeds, alternates, labels + alternate_labels
 
     def _optimum(self, problem: ManeuverProblem, ocp: OptimalControlProblem, starts: list[Reference], params: Array,
                  intervals: int, solver: str | None = None) -> _Optimum:
@@ -614,6 +692,8 @@ class CollocationPlanner(Planner):
                 coarse = self._optimum(problem, ocp, starts, params, o.coarse_intervals)
                 found = self._reference(problem, ocp, params, coarse)
             extra["coarse"] = found.stats
+            if "seeds" in found.stats:  # the multistart was the coarse one
+                extra["seeds"] = found.stats["seeds"]
             if found.ok:
                 assert isinstance(found, CollocationReference)  # found.ok
                 transferred = self._transferred(problem, ocp, coarse, found, params, bounds)
@@ -630,9 +710,9 @@ class CollocationPlanner(Planner):
                     result = polish if result is None else merged(result, polish)
                     extra.update(more)
         if result is None or not result.success:
-            seeds, alternates = self._seeds(problem, ocp, transcription, nlp, starts)
+            seeds, alternates, labels = self._seeds(problem, ocp, transcription, nlp, starts)
             fine, more, regularized = self._solve(problem, ocp, seeds, params, bounds, intervals, solver=solver,
-                                                  alternates=alternates)
+                                                  alternates=alternates, labels=labels)
             result = fine if result is None else merged(result, fine)
             extra.update(more)
         return _Optimum(result, extra, transcription, nlp, intervals, regularized, solver)
