@@ -75,7 +75,6 @@ from __future__ import annotations
 import os
 import time
 
-import casadi as ca
 import numpy as np
 import pytest
 
@@ -114,67 +113,19 @@ def shared_guess(problem):
     return stages[:, :7].T, float(np.median(stages[:, 7]))
 
 
-def rigid_body(inertia):
-    x, u = ca.SX.sym("x", 7), ca.SX.sym("u", 3)
-    q, w = x[:4], x[4:]
-    I = ca.DM(inertia)
-    qdot = 0.5 * ca.vertcat(-ca.dot(q[1:], w), q[0] * w + ca.cross(q[1:], w))
-    return ca.Function("f", [x, u], [ca.vertcat(qdot, ca.solve(I, u - ca.cross(w, ca.mtimes(I, w))))])
-
-
-def terminal_error(qf, q_end):
-    return qf[0] * q_end[1:] - q_end[0] * ca.DM(qf[1:]) - ca.cross(ca.DM(qf[1:]), q_end[1:])
-
-
 def peer_fatrop(problem, states, T0):
-    """The hand-written Opti + FATROP multiple shooting described in the module docstring."""
-    f = rigid_body(problem.spacecraft.inertia)
-    x, u, h = ca.SX.sym("x", 7), ca.SX.sym("u", 3), ca.SX.sym("h")
-    k1 = f(x, u); k2 = f(x + h / 2 * k1, u); k3 = f(x + h / 2 * k2, u); k4 = f(x + h * k3, u)
-    step = ca.Function("F", [x, u, h], [x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)])
-    u_max = float(problem.spacecraft.torquers.max_torque[0])
-    opti = ca.Opti()
-    X, U, T = [], [], []
-    for k in range(N + 1):
-        X.append(opti.variable(7))
-        T.append(opti.variable())
-        if k < N:
-            U.append(opti.variable(3))
-    for k in range(N):
-        opti.subject_to(X[k + 1] == step(X[k], U[k], T[k] / N))
-        opti.subject_to(T[k + 1] == T[k])
-        if k == 0:
-            opti.subject_to(X[0] == ca.DM(problem.initial_state))
-        opti.subject_to(opti.bounded(-u_max, U[k], u_max))
-        opti.subject_to(T[k] >= 0)
-    opti.subject_to(terminal_error(problem.qf, X[N][:4]) == 0)
-    opti.subject_to(X[N][4:] == 0)
-    opti.minimize(T[0])
-    for k in range(N + 1):
-        opti.set_initial(X[k], states[:, k])
-        opti.set_initial(T[k], T0)
-    opti.solver("fatrop", {"expand": True, "structure_detection": "auto", "fatrop.print_level": 0,
-                           "print_time": False})
-    return opti, T[0]
+    """The hand-written Opti + FATROP multiple shooting (:mod:`scenarios.bench.peers.fatrop`)."""
+    from scenarios.bench.peers.fatrop import build_opti
+
+    return build_opti(problem, states, T0)
 
 
 def peer_rockit(problem, states, T0):
-    rockit = pytest.importorskip("rockit")
-    ocp = rockit.Ocp(T=rockit.FreeTime(T0))
-    x = ocp.state(7)
-    u = ocp.control(3)
-    f = rigid_body(problem.spacecraft.inertia)
-    ocp.set_der(x, f(x, u))
-    u_max = float(problem.spacecraft.torquers.max_torque[0])
-    ocp.subject_to(-u_max <= (u <= u_max))
-    ocp.subject_to(ocp.at_t0(x) == ca.DM(problem.initial_state))
-    ocp.subject_to(terminal_error(problem.qf, ocp.at_tf(x)[:4]) == 0)
-    ocp.subject_to(ocp.at_tf(x)[4:] == 0)
-    ocp.add_objective(ocp.T)
-    ocp.method(rockit.MultipleShooting(N=N, M=1, intg="rk"))
-    ocp.set_initial(x, states)
-    ocp.solver("ipopt", {"expand": True, "ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes"})
-    return ocp
+    """rockit's multiple shooting (:mod:`scenarios.bench.peers.rockit`), skipped without rockit."""
+    pytest.importorskip("rockit")
+    from scenarios.bench.peers.rockit import build_ocp
+
+    return build_ocp(problem, states, T0)
 
 
 @pytest.mark.parametrize("case", sorted(CASES))
