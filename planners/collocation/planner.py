@@ -43,6 +43,7 @@ from ocp.transcription import (
 )
 from ocp.transcription.mesh_transfer import transfer_multipliers
 from planners.base import Planner
+from planners.collocation.certificate import collocation_certificate
 from planners.collocation.problem import (
     endpoint_cone_error,
     parse_cone,
@@ -701,4 +702,8 @@ class CollocationPlanner(Planner):
                                cones=[(c.boresight, c.directions[0], c.angle, c.keep_out) for c in fixed])
         reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {solver}): "
                              f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}")
+        if solved.intervals == o.intervals:  # the final mesh: the optimum's certificate (planners.collocation.certificate)
+            lbx, ubx = transcription.bounds(ocp, solved.nlp, *self._variable_bounds(problem), problem.duration)
+            reference.stats["certificate"] = collocation_certificate(result, transcription, ocp, solved.nlp, params,
+                                                                     lbx, ubx, solver, reference.stats)
         return reference
