@@ -500,7 +500,7 @@ class CollocationPlanner(Planner):
                 stopped = f"; cannot tighten further: {error}"
                 break
             again = self._resolved(problem, ocp, params, solved, tightening)
-            candidate = self._reference(problem, ocp, params, again)
+            candidate = self._reference(problem, ocp, params, again, tightening)
             rounds.append({"violations": dict(check.violations), "iterations": again.result.iterations,
                            "time_s": again.result.time_s, "status": again.result.status})
             if not isinstance(candidate, CollocationReference):
@@ -681,8 +681,9 @@ class CollocationPlanner(Planner):
                                 lam_x0=multipliers[0], lam_g0=multipliers[1])
 
     def _reference(self, problem: ManeuverProblem, ocp: OptimalControlProblem, params: Array,
-                   solved: _Optimum) -> Reference:
-        """The reference (or the failure) of an optimum found by :meth:`_optimum`."""
+                   solved: _Optimum, tightening: Tightening | None = None) -> Reference:
+        """The reference (or the failure) of an optimum found by :meth:`_optimum` (with the variable
+        bounds of ``tightening``, :meth:`_variable_bounds`)."""
         o, result, transcription = self.options, solved.result, solved.transcription
         solver = solved.solver or o.solver
         stats = result.stats()
@@ -703,7 +704,7 @@ class CollocationPlanner(Planner):
         reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {solver}): "
                              f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}")
         if solved.intervals == o.intervals:  # the final mesh: the optimum's certificate (planners.collocation.certificate)
-            lbx, ubx = transcription.bounds(ocp, solved.nlp, *self._variable_bounds(problem), problem.duration)
+            lbx, ubx = transcription.bounds(ocp, solved.nlp, *self._variable_bounds(problem, tightening), problem.duration)
             reference.stats["certificate"] = collocation_certificate(result, transcription, ocp, solved.nlp, params,
                                                                      lbx, ubx, solver, reference.stats)
         return reference
