@@ -218,3 +218,18 @@ def test_the_certificate_is_in_a_runs_results(tmp_path):
     assert float(lines["collocation"]["certificate_kkt_scaled"]) <= 1e-6
     assert lines["eigenaxis"]["certificate"] == ""
     assert "| certificate | certified: KKT" in (out / "results.md").read_text()
+
+
+def test_the_certificate_is_in_a_one_case_studys_cases_csv(tmp_path):
+    import shutil
+
+    from scenarios.cli import main
+    shutil.copy("scenarios/collocation_min_time.yaml", tmp_path / "scenario.yaml")
+    study = tmp_path / "study.yaml"
+    study.write_text("study: one-case\nscenario: scenario.yaml\n")
+    assert main(["sweep", str(study), "--out", str(tmp_path / "sweep"), "--workers", "1", "--no-plots"]) == 0
+    lines = {line["planner"]: line for line in csv.DictReader((tmp_path / "sweep" / "cases.csv").open())}
+    assert lines["collocation"]["certificate_verdict"] == "certified"
+    assert float(lines["collocation"]["certificate_kkt_scaled"]) <= 1e-6
+    assert float(lines["collocation"]["certificate_kkt_unscaled"]) <= 1e-6
+    assert lines["eigenaxis"]["certificate_verdict"] == ""
