@@ -15,6 +15,7 @@ from ocp.nlp.certificate import (
                                  certificate,
                                  certify,
                                  kkt_residuals,
+                                 necessary_conditions_certificate,
                                  seed_counts,
                                  switching_agreement,
 )
@@ -31,7 +32,7 @@ from ocp.nlp.solve import (
 )
 
 __all__ = ["KKTResiduals", "NLPResult", "SecondOrderCheck", "StartResult", "Switching", "certificate", "certify",
-           "converged", "kkt_residuals", "perturbed", "second_order_check", "seed_counts", "solve_multistart",
+           "converged", "kkt_residuals", "necessary_conditions_certificate", "perturbed", "second_order_check", "seed_counts", "solve_multistart",
            "solver_options", "status_name", "switching_agreement", "warm_start_options"]
 
 

@@ -388,3 +388,34 @@ def certify(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array, *, p: Any
     if second_order is None:
         second_order = second_order_check(solver, x, lam_x, lam_g, **bounds)
     return certificate(kkt, second_order, switching, costate_gap=costate_gap, seeds=seeds, seeds_agreed=seeds_agreed)
+
+
+def necessary_conditions_certificate(residual: float, method: str, *, tolerance: float = KKT_TOLERANCE,
+                                     costate_gap: float | None = None) -> dict[str, Any]:
+    """The record of :func:`certificate` for an indirect solution: Pontryagin's necessary conditions
+    solved as a boundary-value problem, whose residual stands for both KKT entries; nothing is known
+    of second order, so the verdict is at best ``"first-order"``.
+
+    Parameters
+    ----------
+    residual : float
+        The largest residual of the boundary-value solution (differential equations and boundary
+        conditions).
+    method : str
+        What solved it, for the ``second_order`` text and the summary (e.g. ``"solve_bvp"``).
+    tolerance : float
+        Largest residual of a first-order point.
+    costate_gap : float or None
+        Relative difference to another solution, when known.
+
+    Returns
+    -------
+    dict
+        The keys of :func:`certificate`; ``verdict`` ``"first-order"`` or ``"not certified"``.
+    """
+    verdict = "first-order" if residual <= tolerance else "not certified"
+    return {"kkt_scaled": float(residual), "kkt_unscaled": float(residual),
+            "second_order": f"not checked: an indirect solution ({method}), Pontryagin's necessary conditions only",
+            "switching": None, "costate_gap": costate_gap, "seeds": None, "seeds_agreed": None, "verdict": verdict,
+            "summary": f"{verdict}: {method} residual {residual:.1g} (Pontryagin's necessary conditions)",
+            "kkt": None, "switching_detail": None}
