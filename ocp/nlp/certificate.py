@@ -48,6 +48,7 @@ from typing import Any
 
 import casadi as ca
 import numpy as np
+import scipy.sparse
 from numpy.typing import NDArray
 
 from ocp.fast_call import BufferedFunction
@@ -55,7 +56,6 @@ from ocp.nlp.second_order import (
     SecondOrderCheck,
     _broadcast,
     _complementarity,
-    _dense,
     _output,
     second_order_check,
 )
@@ -111,12 +111,20 @@ class KKTResiduals:
     objective_scaling: float
 
 
-def _scaling(gradient: Array, jacobian: Array, solver_name: str) -> tuple[float, Array]:
+def _sparse(function: BufferedFunction, index: int) -> scipy.sparse.csc_matrix:
+    """Output ``index`` of the last evaluation as a sparse matrix (a collocation NLP's Jacobian,
+    dense, took most of the certificate's time)."""
+    sparsity = function.function.sparsity_out(index)
+    colind, row = sparsity.get_ccs()
+    return scipy.sparse.csc_matrix((np.array(function.outputs[index], dtype=float), row, colind), shape=sparsity.shape)
+
+
+def _scaling(gradient: Array, jacobian: scipy.sparse.csc_matrix, solver_name: str) -> tuple[float, Array]:
     """IPOPT's gradient-based factors ``(s_f, s_i)`` from the gradient and Jacobian at its scaling point."""
     if solver_name != "ipopt":
         return 1.0, np.ones(jacobian.shape[0])
     s_f = float(np.clip(MAX_GRADIENT / max(float(np.max(np.abs(gradient), initial=0.0)), 1e-300), MIN_SCALING, 1.0))
-    rows = np.max(np.abs(jacobian), axis=1, initial=0.0)
+    rows = abs(jacobian).max(axis=1).toarray().ravel() if jacobian.shape[1] else np.zeros(jacobian.shape[0])
     s_g = np.clip(MAX_GRADIENT / np.maximum(rows, 1e-300), MIN_SCALING, 1.0)
     return s_f, s_g
 
@@ -165,9 +173,9 @@ def kkt_residuals(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array, *, 
     if scaling_point is not None:
         jacobian.all_outputs(np.asarray(scaling_point, dtype=float).ravel(), p)
         grad0 = gradient.all_outputs(np.asarray(scaling_point, dtype=float).ravel(), p)[f_out].copy()
-        s_f, s_g = _scaling(grad0, _dense(jacobian, j_out), solver_name)
+        s_f, s_g = _scaling(grad0, _sparse(jacobian, j_out), solver_name)
     jacobian.all_outputs(x, p)
-    g, J = jacobian.outputs[g_out].copy(), _dense(jacobian, j_out)
+    g, J = jacobian.outputs[g_out].copy(), _sparse(jacobian, j_out)
     grad = gradient.all_outputs(x, p)[f_out].copy()
     if scaling_point is None:
         s_f, s_g = _scaling(grad, J, solver_name)
