@@ -20,7 +20,7 @@ import numpy as np
 
 from ocp.dynamics.model import AttitudeModel
 from ocp.nlp.certificate import Switching, certify, seed_counts, switching_agreement
-from ocp.nlp.second_order import MAX_VARIABLES
+from ocp.nlp.second_order import MAX_VARIABLES, SecondOrderCheck
 from ocp.nlp.solve import NLPResult
 from ocp.transcription import NLP, OptimalControlProblem, Transcription
 from ocp.transcription.radau import RadauCollocation
@@ -131,11 +131,10 @@ def collocation_certificate(result: NLPResult, transcription: Transcription, ocp
         The record of :func:`ocp.nlp.certificate.certificate`.
     """
     assert result.x is not None and result.lam_x is not None and result.lam_g is not None  # converged
-    bang_bang = (ocp.free_time and ocp.energy_weight == 0 and ocp.l1_weight == 0
-                 and isinstance(transcription, RadauCollocation))
-    agreement = (switching(transcription, ocp.model, nlp, result.x, result.lam_g, lbx, ubx, params)
-                 if bang_bang else None)
-    second = result.second_order
+    agreement = None
+    if ocp.free_time and ocp.energy_weight == 0 and ocp.l1_weight == 0 and isinstance(transcription, RadauCollocation):
+        agreement = switching(transcription, ocp.model, nlp, result.x, result.lam_g, lbx, ubx, params)
+    second: SecondOrderCheck | str | None = result.second_order
     if second is None and result.x.size > MAX_VARIABLES:
         coarse = stats.get("coarse", {}).get("second_order")
         also = ""
