@@ -19,7 +19,13 @@ import casadi as ca
 import numpy as np
 
 from ocp.dynamics.model import AttitudeModel
-from ocp.nlp.certificate import Switching, certify, seed_counts, switching_agreement
+from ocp.nlp.certificate import (
+    Switching,
+    certificate,
+    certify,
+    seed_counts,
+    switching_agreement,
+)
 from ocp.nlp.second_order import MAX_VARIABLES, SecondOrderCheck
 from ocp.nlp.solve import NLPResult
 from ocp.transcription import NLP, OptimalControlProblem, Transcription
@@ -128,9 +134,12 @@ def collocation_certificate(result: NLPResult, transcription: Transcription, ocp
     Returns
     -------
     dict
-        The record of :func:`ocp.nlp.certificate.certificate`.
+        The record of :func:`ocp.nlp.certificate.certificate` (``"not certified"``, saying why, for a
+        solve without multipliers or a solver without the derivative functions).
     """
-    assert result.x is not None and result.lam_x is not None and result.lam_g is not None  # converged
+    tried, agreed = seed_counts(stats)
+    if result.x is None or result.lam_x is None or result.lam_g is None:
+        return certificate(None, "not checked: no multipliers", seeds=tried, seeds_agreed=agreed)
     agreement = None
     if ocp.free_time and ocp.energy_weight == 0 and ocp.l1_weight == 0 and isinstance(transcription, RadauCollocation):
         agreement = switching(transcription, ocp.model, nlp, result.x, result.lam_g, lbx, ubx, params)
@@ -141,7 +150,10 @@ def collocation_certificate(result: NLPResult, transcription: Transcription, ocp
         if coarse is not None:
             also = "; the coarse mesh's optimum: " + ("strict local minimum" if coarse["certified"] else coarse["message"])
         second = f"not checked: {result.x.size} variables, more than {MAX_VARIABLES}{also}"
-    tried, agreed = seed_counts(stats)
-    return certify(nlp.solver, result.x, result.lam_x, result.lam_g, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg,
-                   ubg=nlp.ubg, solver_name=solver, second_order=second, switching=agreement, seeds=tried,
-                   seeds_agreed=agreed)
+    try:
+        return certify(nlp.solver, result.x, result.lam_x, result.lam_g, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg,
+                       ubg=nlp.ubg, solver_name=solver, second_order=second, switching=agreement, seeds=tried,
+                       seeds_agreed=agreed)
+    except RuntimeError as error:  # a solver plugin without nlp_jac_g / nlp_grad_f
+        return certificate(None, f"not checked: {str(error).splitlines()[0]}", agreement, seeds=tried,
+                           seeds_agreed=agreed)
