@@ -54,7 +54,7 @@ def test_run_end_to_end_through_the_console_entry_point(tmp_path):
     assert results["scenario"] == "small" and [r["label"] for r in results["rows"]] == ["smooth", "fast"]
     for row in results["rows"]:
         assert set(row) == {"label", "planner", "controller", "status", "message", "plan_time_s", "reference",
-                            "closed_loop", "requirements"}
+                            "closed_loop", "requirements", "certificate"}
         assert row["controller"] == "augmented_quaternion_feedback"
         assert set(row["reference"]) == set(METRIC_KEYS) == set(row["closed_loop"])
         assert row["closed_loop"]["final_error_deg"] < 0.05

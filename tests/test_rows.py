@@ -38,8 +38,9 @@ BASE = {
     "simulation": {"sample_time": 1.0, "duration": 35.0},
 }
 ROW_KEYS = {"label", "planner", "controller", "status", "message", "plan_time_s", "reference", "closed_loop",
-            "requirements"}
+            "requirements", "certificate"}
 IDENTITY = ["label", "planner", "controller", "status", "message", "plan_time_s"]
+CERTIFICATE = ["certificate", "certificate_verdict", "certificate_kkt_scaled", "certificate_kkt_unscaled"]
 
 
 def strict_json(text):
@@ -89,8 +90,9 @@ def test_missing_and_non_finite_values_are_null_in_json_empty_in_csv_and_float_n
 
     text = results.to_csv()
     header = text.splitlines()[0].split(",")
-    assert header == IDENTITY + expected_metric_columns()
+    assert header == IDENTITY + expected_metric_columns() + CERTIFICATE
     odd, regulating = read_csv(text)
+    assert odd["certificate"] == "" and odd["certificate_kkt_scaled"] == ""  # no reference: no certificate
     assert (odd["ref.int_u2"], odd["ref.int_abs_u_x"], odd["ref.int_abs_u_z"], odd["ref.duration_s"]) == \
         ("2.0", "1.0", "3.0", "30.0")
     for column in ("ref.int_u", "ref.peak_body_torque", "ref.settling_time_s", "ref.int_abs_u_y", "ref.rms_error_deg", "cl.int_u"):
@@ -100,7 +102,7 @@ def test_missing_and_non_finite_values_are_null_in_json_empty_in_csv_and_float_n
 
     frame = results.to_dataframe()
     assert list(frame.columns) == header
-    numeric = ["plan_time_s", *expected_metric_columns()]
+    numeric = ["plan_time_s", *expected_metric_columns(), *CERTIFICATE[2:]]
     assert all(frame[column].dtype == "float64" for column in numeric), frame.dtypes[frame.dtypes != "float64"]
     assert not frame[numeric].map(lambda value: value is None).to_numpy().any()
     for column in ("ref.int_u", "ref.peak_body_torque", "ref.settling_time_s", "ref.int_abs_u_y", "cl.int_u"):

@@ -2,11 +2,23 @@
 
 What lives here: solver options, the status policy, multistart with warm starts and the result
 objects (:mod:`~ocp.nlp.solve`); the second-order sufficient conditions at a converged point
-(:mod:`~ocp.nlp.second_order`).
+(:mod:`~ocp.nlp.second_order`); the certificate of a converged point, its KKT residuals unscaled and
+in the solver's scaling, the second-order check and Pontryagin's switching agreement in one record
+(:mod:`~ocp.nlp.certificate`).
 
 May import: CasADi, NumPy, SciPy, threadpoolctl and the top-level modules of :mod:`ocp`; it knows
 nothing of attitude, models or transcriptions.
 """
+from ocp.nlp.certificate import (
+                                 KKTResiduals,
+                                 Switching,
+                                 certificate,
+                                 certify,
+                                 kkt_residuals,
+                                 necessary_conditions_certificate,
+                                 seed_counts,
+                                 switching_agreement,
+)
 from ocp.nlp.second_order import SecondOrderCheck, second_order_check
 from ocp.nlp.solve import (
                            NLPResult,
@@ -19,8 +31,9 @@ from ocp.nlp.solve import (
                            warm_start_options,
 )
 
-__all__ = ["NLPResult", "SecondOrderCheck", "StartResult", "converged", "perturbed", "second_order_check",
-           "solve_multistart", "solver_options", "status_name", "warm_start_options"]
+__all__ = ["KKTResiduals", "NLPResult", "SecondOrderCheck", "StartResult", "Switching", "certificate", "certify",
+           "converged", "kkt_residuals", "necessary_conditions_certificate", "perturbed", "second_order_check", "seed_counts", "solve_multistart",
+           "solver_options", "status_name", "switching_agreement", "warm_start_options"]
 
 
 def __dir__() -> list[str]:

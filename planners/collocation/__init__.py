@@ -4,8 +4,9 @@ What lives here: the planner and its options (:mod:`~planners.collocation.planne
 side (its own cones from YAML, the endpoints checked against the pointing constraints, variable
 bounds from the spacecraft; :mod:`~planners.collocation.problem`), the reference of a solution and
 seeds from other references, bent round keep-out cones (:mod:`~planners.collocation.reference`),
-the requirements it honours and their dense check (:mod:`~planners.collocation.requirements`) and
-the search strategy's tuned constants (:mod:`~planners.collocation.strategy`).
+the requirements it honours and their dense check (:mod:`~planners.collocation.requirements`),
+the search strategy's tuned constants (:mod:`~planners.collocation.strategy`) and the certificate of
+an optimum, with the co-states in the collocation multipliers (:mod:`~planners.collocation.certificate`).
 
 May import: :mod:`ocp` (transcriptions and the NLP core) and the contract modules of
 :mod:`planners` (``base``, ``problem``, ``reference``); other planners only through the

@@ -43,6 +43,7 @@ from ocp.transcription import (
 )
 from ocp.transcription.mesh_transfer import transfer_multipliers
 from planners.base import Planner
+from planners.collocation.certificate import collocation_certificate
 from planners.collocation.problem import (
     endpoint_cone_error,
     parse_cone,
@@ -569,7 +570,7 @@ class CollocationPlanner(Planner):
                 stopped = f"; cannot tighten further: {error}"
                 break
             again = self._resolved(problem, ocp, params, solved, tightening)
-            candidate = self._reference(problem, ocp, params, again)
+            candidate = self._reference(problem, ocp, params, again, tightening)
             rounds.append({"violations": dict(check.violations), "iterations": again.result.iterations,
                            "time_s": again.result.time_s, "status": again.result.status})
             if not isinstance(candidate, CollocationReference):
@@ -760,8 +761,9 @@ class CollocationPlanner(Planner):
                                 lam_x0=multipliers[0], lam_g0=multipliers[1])
 
     def _reference(self, problem: ManeuverProblem, ocp: OptimalControlProblem, params: Array,
-                   solved: _Optimum) -> Reference:
-        """The reference (or the failure) of an optimum found by :meth:`_optimum`."""
+                   solved: _Optimum, tightening: Tightening | None = None) -> Reference:
+        """The reference (or the failure) of an optimum found by :meth:`_optimum` (with the variable
+        bounds of ``tightening``, :meth:`_variable_bounds`)."""
         o, result, transcription = self.options, solved.result, solved.transcription
         solver = solved.solver or o.solver
         stats = result.stats()
@@ -781,4 +783,8 @@ class CollocationPlanner(Planner):
                                cones=[(c.boresight, c.directions[0], c.angle, c.keep_out) for c in fixed])
         reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {solver}): "
                              f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}")
+        if solved.intervals == o.intervals:  # the final mesh: the optimum's certificate (planners.collocation.certificate)
+            lbx, ubx = transcription.bounds(ocp, solved.nlp, *self._variable_bounds(problem, tightening), problem.duration)
+            reference.stats["certificate"] = collocation_certificate(result, transcription, ocp, solved.nlp, params,
+                                                                     lbx, ubx, solver, reference.stats)
         return reference

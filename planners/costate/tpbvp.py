@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ocp.errors import InvalidOption
+from ocp.nlp.certificate import necessary_conditions_certificate
 from ocp.options import Range
 from planners.base import Planner
 from planners.costate.hamiltonian import HamiltonianSystem, RigidBodySystem
@@ -337,6 +338,9 @@ class CostateTPBVPPlanner(Planner):
             reference = CostateReference(system, solution, t_f, "", {})
             control = reference.sample(fine).torque - system.environment_torque(fine, reference.state_and_costate(fine)[0].T).T
             stats["int_u2"] = float(np.trapezoid(np.sum(control**2, axis=1), fine))
+        ends = (solution.y[:, 0], solution.y[:, -1]) + ((solution.p,) if system.free_final_time else ())
+        boundary = float(np.max(np.abs(system.boundary(1.0)(*ends)), initial=0.0))
+        stats["certificate"] = necessary_conditions_certificate(max(stats["max_rms_residual"], boundary), "solve_bvp")
         reference = CostateReference(system, solution, t_f, "", stats)
         timing = "minimum time" if system.free_final_time else "fixed time"
         reference.message = (f"{o.objective} ({timing}) t_f = {t_f:.6g} s"

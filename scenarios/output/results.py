@@ -103,12 +103,16 @@ class Row:
         dict
             ``label``, ``planner``, ``controller``, ``status``, ``message``, ``plan_time_s``,
             ``reference`` and ``closed_loop`` (the two metric dicts, or ``None``) and
-            ``requirements`` (the requirement scores by scope, name and field, or ``None``).
+            ``requirements`` (the requirement scores by scope, name and field, or ``None``) and
+            ``certificate`` (the reference's ``stats["certificate"]``, :mod:`ocp.nlp.certificate`,
+            or ``None``: no reference, or a planner that writes none).
         """
+        certificate = None if self.reference is None else self.reference.stats.get("certificate")
         return {"label": self.label, "planner": self.planner, "controller": self.controller,
                 "status": self.status, "message": self.message,
                 "plan_time_s": self.plan_time_s, "reference": self.reference_metrics,
-                "closed_loop": self.closed_loop_metrics, "requirements": self.requirements}
+                "closed_loop": self.closed_loop_metrics, "requirements": self.requirements,
+                "certificate": None if certificate is None else dict(certificate)}
 
     def headline(self) -> dict[str, Any]:
         """The row's key numbers: the :data:`HEADLINE_METRICS` it has a value for.

@@ -4,7 +4,8 @@ A row's plain form is nested (:meth:`scenarios.output.results.Row.to_dict`: ``re
 ``closed_loop`` metric dicts); its flat form (:func:`flatten_row`) has one column per metric and
 scope, ``ref.<metric>`` and ``cl.<metric>`` (:mod:`scenarios.schema.columns`), a vector metric split into ``<metric>_x``, ``_y`` and
 ``_z``, then the requirement scores, ``ref.req.<name>.<field>`` and ``cl.req.<name>.<field>``
-(:func:`requirement_columns`: which there are depends on the scenario's requirements). A run's
+(:func:`requirement_columns`: which there are depends on the scenario's requirements), between them
+the certificate of the reference's optimum (:data:`CERTIFICATE_COLUMNS`). A run's
 ``results.csv`` and :meth:`~scenarios.output.results.RunResults.to_dataframe`, a trade study's
 ``cases.csv``, :meth:`~scenarios.study.engine.SweepResults.to_dataframe` and its ``summary:`` keys
 all use these columns.
@@ -41,6 +42,15 @@ if TYPE_CHECKING:
 
 IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s")
 """The columns that name a row, before its metrics."""
+
+CERTIFICATE_COLUMNS = ("certificate", "certificate_verdict", "certificate_kkt_scaled", "certificate_kkt_unscaled")
+"""The columns of a row's certificate (the reference's ``stats["certificate"]``, :mod:`ocp.nlp.certificate`;
+the row's ``certificate`` in its plain form): its summary line, its verdict and its KKT residuals
+(in the solver's scaling and unscaled); empty for a planner that writes none."""
+CERTIFICATE_NUMBERS = ("certificate_kkt_scaled", "certificate_kkt_unscaled")
+"""The certificate columns that hold numbers."""
+_CERTIFICATE_KEYS = ("summary", "verdict", "kkt_scaled", "kkt_unscaled")
+"""The certificate's keys behind :data:`CERTIFICATE_COLUMNS`, in order."""
 
 
 def is_missing(value: Any) -> bool:
@@ -86,8 +96,8 @@ def requirement_columns(rows: Iterable[Mapping[str, Any]]) -> list[str]:
 
 
 def row_columns(requirements: Sequence[str] = ()) -> list[str]:
-    """The columns of a flat row: :data:`IDENTITY_COLUMNS`, :func:`metric_columns`, then the
-    requirement columns given.
+    """The columns of a flat row: :data:`IDENTITY_COLUMNS`, :func:`metric_columns`,
+    :data:`CERTIFICATE_COLUMNS`, then the requirement columns given.
 
     Parameters
     ----------
@@ -97,9 +107,10 @@ def row_columns(requirements: Sequence[str] = ()) -> list[str]:
     Returns
     -------
     list of str
-        ``label, planner, controller, status, message, plan_time_s, ref.int_u2, ..., ref.req...``.
+        ``label, planner, controller, status, message, plan_time_s, ref.int_u2, ..., certificate, ...,
+        ref.req...``.
     """
-    return [*IDENTITY_COLUMNS, *metric_columns(), *requirements]
+    return [*IDENTITY_COLUMNS, *metric_columns(), *CERTIFICATE_COLUMNS, *requirements]
 
 
 def numeric_columns(requirements: Sequence[str] = ()) -> list[str]:
@@ -114,9 +125,10 @@ def numeric_columns(requirements: Sequence[str] = ()) -> list[str]:
     Returns
     -------
     list of str
-        ``plan_time_s``, every metric column and the requirement columns given.
+        ``plan_time_s``, every metric column, the certificate's KKT residuals and the requirement
+        columns given.
     """
-    return ["plan_time_s", *metric_columns(), *requirements]
+    return ["plan_time_s", *metric_columns(), *CERTIFICATE_NUMBERS, *requirements]
 
 
 def flatten_row(row: Mapping[str, Any]) -> dict[str, Any]:
@@ -145,6 +157,9 @@ def flatten_row(row: Mapping[str, Any]) -> dict[str, Any]:
                     flat[f"{prefix}.{key}_{axis}"] = component
             else:
                 flat[f"{prefix}.{key}"] = value
+    certificate = row.get("certificate") or {}
+    for column, key in zip(CERTIFICATE_COLUMNS, _CERTIFICATE_KEYS):
+        flat[column] = certificate.get(key)
     scores = row.get("requirements") or {}
     for scope, prefix in SCOPES:
         for name, fields in (scores.get(scope) or {}).items():
@@ -335,12 +350,15 @@ def text_cell(value: Any) -> str:
     return str(value)
 
 
-def _metric_lines(results: RunResults, requirements: bool = True) -> list[tuple[str, list[str]]]:
-    """(metric name, one formatted cell per row), reference metrics then closed-loop ones, then
-    (``requirements``) every requirement column."""
+def _metric_lines(results: RunResults, requirements: bool = True,
+                  certificate: str = "summary") -> list[tuple[str, list[str]]]:
+    """(metric name, one formatted cell per row): the status, the plan time, the certificate's
+    ``certificate`` entry (``summary`` or ``verdict``), reference metrics then closed-loop ones,
+    then (``requirements``) every requirement column."""
     rows = [row.to_dict() for row in results.rows]
     lines = [("status", [row["status"] for row in rows]),
-             ("plan_time_s", [text_cell(row["plan_time_s"]) for row in rows])]
+             ("plan_time_s", [text_cell(row["plan_time_s"]) for row in rows]),
+             ("certificate", [text_cell((row.get("certificate") or {}).get(certificate)) for row in rows])]
     for scope, prefix in SCOPES:
         for key in SCORED_METRICS:
             lines.append((f"{prefix}.{key}", [text_cell((row[scope] or {}).get(key)) for row in rows]))
@@ -448,7 +466,7 @@ def to_terminal(results: RunResults, all_metrics: bool = False) -> str:
     str
         Plain text for a terminal.
     """
-    lines = _metric_lines(results, requirements=False) + _requirement_lines(results)
+    lines = _metric_lines(results, requirements=False, certificate="verdict") + _requirement_lines(results)
     hidden = [] if all_metrics else [name for name, cells in lines if not _applies(cells)]
     lines = [(name, cells) for name, cells in lines if name not in hidden]
     labels = [row.label for row in results.rows]
@@ -457,6 +475,8 @@ def to_terminal(results: RunResults, all_metrics: bool = False) -> str:
     header = " " * name_width + "  " + "  ".join(label.rjust(w) for label, w in zip(labels, widths))
     body = [name.ljust(name_width) + "  " + "  ".join(c.rjust(w) for c, w in zip(cells, widths)) for name, cells in lines]
     messages = [f"{row.label}: {row.message}" for row in results.rows if row.message]
+    summaries = [(row.label, (row.to_dict().get("certificate") or {}).get("summary")) for row in results.rows]
+    messages += [f"{label} certificate: {summary}" for label, summary in summaries if summary]
     note = [f"({len(hidden)} metrics with no value in any row not shown; --all-metrics shows them)"] if hidden else []
     return "\n".join([f"scenario: {results.scenario.name}", header, *body, *note, "", *messages, "",
                       status_line(results)])

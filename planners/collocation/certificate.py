@@ -1,0 +1,159 @@
+"""The certificate of a collocation optimum: the NLP's evidence (:mod:`ocp.nlp.certificate`) and,
+for bang-bang minimum time, Pontryagin's switching functions from the co-states in the multipliers.
+
+Co-states of Legendre-Gauss-Radau collocation. The collocation equation at Radau point ``j`` of
+interval ``k`` is ``X_k D_j − h f(x_kj, u_kj) = 0`` (:mod:`ocp.transcription.radau`), with
+multiplier ``λ_kj`` (CasADi's ``L = f + λᵀ g``). It is the quadrature ``h w_j (ẋ − f)`` of the
+continuous constraint divided by ``h``, and the continuous Lagrangian is ``J + ∫ −pᵀ(ẋ − f) dt``
+(``H = L + pᵀ f``), so the co-state there is ``p_kj = −λ_kj / w_j`` (``w_j`` the Radau weights on
+[0, 1]). The sign is checked numerically by the tests: with it the minimum-time Hamiltonian
+``1 + pᵀ f`` vanishes along Bilimoria & Wie's optimum and the controls minimise ``H``. The
+switching functions are ``σ_kj = ∂H/∂u = p_kjᵀ ∂f/∂u (x_kj, u_kj)`` (for ``ω̇ = J⁻¹(u − ω × J ω)``,
+``σ = J⁻ᵀ p_ω``), the model's own Jacobian.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ocp.dynamics.model import AttitudeModel
+from ocp.nlp.certificate import (
+    Switching,
+    certificate,
+    certify,
+    seed_counts,
+    switching_agreement,
+)
+from ocp.nlp.second_order import MAX_VARIABLES, SecondOrderCheck
+from ocp.nlp.solve import NLPResult
+from ocp.transcription import NLP, OptimalControlProblem, Transcription
+from ocp.transcription.radau import RadauCollocation
+from planners.problem import Array
+
+
+def radau_points(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array,
+                 lam_g: Array) -> tuple[Array, Array, Array, Array]:
+    """States, controls, co-states and times at the Radau points of a collocation solution.
+
+    Parameters
+    ----------
+    transcription : RadauCollocation
+        The transcription of the solution.
+    model : AttitudeModel
+        The spacecraft model (``nx``, ``nu``).
+    nlp : NLP
+        The built NLP (its stage sizes, free time).
+    w : (n_w,) ndarray
+        The decision vector.
+    lam_g : ndarray
+        The constraint multipliers (CasADi's signs).
+
+    Returns
+    -------
+    tuple of ndarray
+        ``x (N d, nx)``, ``u (N d, nu)``, co-states ``p (N d, nx)`` (``−λ / w_j``, see the module
+        docstring) and the points' times ``t (N d,)`` [s] in the NLP's time.
+    """
+    N, d, nx, nu = transcription.intervals, transcription.degree, model.nx, model.nu
+    ns, nc = nlp.n_stage_state, nlp.n_interval
+    nz = ns + nc
+    stages = np.asarray(w, dtype=float)[:nz * N].reshape(N, nz)
+    c = stages[:, ns:]
+    x = c[:, :nx * d].reshape(N * d, nx)
+    u = c[:, nx * d:nx * d + nu * d].reshape(N * d, nu)
+    nb = ns + int(nlp.layout["n_path"])
+    lam_g = np.asarray(lam_g, dtype=float)
+    starts = [0] + [nb + nx + k * nb for k in range(N - 1)]  # the blocks of ocp.transcription.stagewise
+    lam = np.stack([lam_g[start + ns:start + ns + nx * d] for start in starts]).reshape(N, d, nx)
+    p = -(lam / transcription.quadrature[None, :, None]).reshape(N * d, nx)
+    T = stages[0, ns - 1] if nlp.free_time else None
+    times = (np.arange(N)[:, None] + transcription.tau[None, 1:]).ravel() / N
+    return x, u, p, times if T is None else times * T
+
+
+def switching(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array, lam_g: Array,
+              lbx: Array, ubx: Array, params: Array, costate_sign: float = 1.0) -> Switching:
+    """Pontryagin's switching agreement of a minimum-time collocation solution.
+
+    Parameters
+    ----------
+    transcription, model, nlp, w, lam_g
+        As in :func:`radau_points`.
+    lbx, ubx : (n_w,) ndarray
+        The decision vector's bounds (the controls' bounds are read there).
+    params : ndarray
+        The NLP's parameters (the disturbance torque [N m] at their end, and ``T`` for a fixed time).
+    costate_sign : float
+        Multiplies the co-states (1: the convention of the module docstring; −1 only to show that
+        a wrong sign fails the check).
+
+    Returns
+    -------
+    ocp.nlp.certificate.Switching
+        Agreement of ``sign(u) = −sign(σ)`` over every control at every Radau point.
+    """
+    x, u, p, t = radau_points(transcription, model, nlp, w, lam_g)
+    if not nlp.free_time:
+        t = t * float(params[model.nx + 7])
+    N, d, nx, nu = transcription.intervals, transcription.degree, model.nx, model.nu
+    nz = nlp.n_stage_state + nlp.n_interval
+    offset = nlp.n_stage_state + nx * d
+    low = np.asarray(lbx, dtype=float)[:nz * N].reshape(N, nz)[:, offset:offset + nu * d].reshape(N * d, nu)
+    high = np.asarray(ubx, dtype=float)[:nz * N].reshape(N, nz)[:, offset:offset + nu * d].reshape(N * d, nu)
+    xs, us, ts, ds = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("t"), ca.SX.sym("d", 3)
+    jacobian = ca.Function("f_u", [xs, us, ts, ds], [ca.jacobian(model.rhs(xs, us, ts, ds), us)])
+    f_u = np.asarray(jacobian.map(x.shape[0])(x.T, u.T, t[None, :], np.tile(params[-3:], (x.shape[0], 1)).T))
+    f_u = f_u.reshape(nx, x.shape[0], nu).transpose(1, 0, 2)  # (points, nx, nu)
+    sigma = costate_sign * np.einsum("ki,kij->kj", p, f_u)
+    return switching_agreement(u, low, high, sigma)
+
+
+def collocation_certificate(result: NLPResult, transcription: Transcription, ocp: OptimalControlProblem, nlp: NLP,
+                            params: Array, lbx: Array, ubx: Array, solver: str, stats: dict[str, Any]) -> dict[str, Any]:
+    """``Reference.stats["certificate"]`` of a converged collocation solve.
+
+    Parameters
+    ----------
+    result : NLPResult
+        The converged solve (point and multipliers).
+    transcription : Transcription
+        Its transcription (switching only for Radau collocation).
+    ocp : OptimalControlProblem
+        The problem solved (switching only for pure minimum time).
+    nlp : NLP
+        The built NLP that solved it.
+    params, lbx, ubx : ndarray
+        The solve's parameters and variable bounds.
+    solver : str
+        The ``nlpsol`` plugin.
+    stats : dict
+        The reference's stats so far (``seeds`` or its starts are counted).
+
+    Returns
+    -------
+    dict
+        The record of :func:`ocp.nlp.certificate.certificate` (``"not certified"``, saying why, for a
+        solve without multipliers or a solver without the derivative functions).
+    """
+    tried, agreed = seed_counts(stats)
+    if result.x is None or result.lam_x is None or result.lam_g is None:
+        return certificate(None, "not checked: no multipliers", seeds=tried, seeds_agreed=agreed)
+    agreement = None
+    if ocp.free_time and ocp.energy_weight == 0 and ocp.l1_weight == 0 and isinstance(transcription, RadauCollocation):
+        agreement = switching(transcription, ocp.model, nlp, result.x, result.lam_g, lbx, ubx, params)
+    second: SecondOrderCheck | str | None = result.second_order
+    if second is None and result.x.size > MAX_VARIABLES:
+        coarse = stats.get("coarse", {}).get("second_order")
+        also = ""
+        if coarse is not None:
+            also = "; the coarse mesh's optimum: " + ("strict local minimum" if coarse["certified"] else coarse["message"])
+        second = f"not checked: {result.x.size} variables, more than {MAX_VARIABLES}{also}"
+    try:
+        return certify(nlp.solver, result.x, result.lam_x, result.lam_g, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg,
+                       ubg=nlp.ubg, solver_name=solver, second_order=second, switching=agreement, seeds=tried,
+                       seeds_agreed=agreed)
+    except RuntimeError as error:  # a solver plugin without nlp_jac_g / nlp_grad_f
+        return certificate(None, f"not checked: {str(error).splitlines()[0]}", agreement, seeds=tried,
+                           seeds_agreed=agreed)
