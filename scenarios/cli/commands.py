@@ -28,6 +28,7 @@ from scenarios.cli.status import (
     EXIT_OK,
 )
 from scenarios.cli.sweep import add_sweep_parser
+from scenarios.cli.table import add_table_parser
 from scenarios.errors import OutputError, ScenarioError
 from scenarios.output.directory import (
     claim_output_directory,
@@ -328,6 +329,7 @@ def build_parser() -> argparse.ArgumentParser:
                                                       "environment.magnetic_field.<model>, scenario, or study[.<key>]")
     schema_parser.set_defaults(handler=command_schema)
     add_sweep_parser(commands)
+    add_table_parser(commands)
     return parser
 
 
