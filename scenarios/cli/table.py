@@ -52,7 +52,10 @@ def command_table(args: argparse.Namespace) -> int:
     from scenarios.output.directory import new_staging
     from scenarios.output.names import default_output_directory
     from scenarios.slewtable.compute import compute_table
-    from scenarios.slewtable.directory import claim_table_directory, commit_table_outputs
+    from scenarios.slewtable.directory import (
+        claim_table_directory,
+        commit_table_outputs,
+    )
     from scenarios.slewtable.files import write_table_files
     from scenarios.slewtable.spec import parse_table_spec
     from scenarios.study.engine import connect_scheduler, start_forkserver
@@ -63,7 +66,7 @@ def command_table(args: argparse.Namespace) -> int:
         raise ScenarioError("--workers", f"expected 1 to 1024, got {args.workers}")
     if not args.scheduler:
         start_forkserver()
-    overrides = {"axes": args.axes, "angles": args.angles, "objective": args.objective,
+    overrides = {"axes": args.axes, "grid": args.grid, "angles": args.angles, "objective": args.objective,
                  "duration": args.duration, "held-out": args.held_out, "workers": args.workers,
                  "scheduler": args.scheduler}
     spec = parse_table_spec(args.file, overrides)
@@ -125,7 +128,9 @@ def add_table_parser(commands: Any) -> None:
     parser = commands.add_parser("table", help="slew table: minimum slew time over eigen-axes and angles, "
                                                "CSV, NetCDF and a fast fit slew_time(q0, qf)")
     parser.add_argument("file", help="scenario YAML file, or a table file (top-level key 'table')")
-    parser.add_argument("--axes", type=_integer, help="number of eigen-axes (a Fibonacci lattice; default 40)")
+    parser.add_argument("--axes", type=_integer, help="number of eigen-axes (about; default 40)")
+    parser.add_argument("--grid", help="how the axes are spread: polytope (default: along the actuators' kinks) "
+                                       "or fibonacci")
     parser.add_argument("--angles", help="slew angles [deg]: a comma-separated list, or a count from 10 to 180 "
                                          "(default 10,30,60,90,120,150,180)")
     parser.add_argument("--objective", help="min_time (default) or min_energy (needs --duration)")

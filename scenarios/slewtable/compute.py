@@ -14,6 +14,7 @@ import json
 import statistics
 import time
 import timeit
+from concurrent.futures import Executor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -21,10 +22,9 @@ from typing import Any
 import numpy as np
 
 from scenarios.slewtable.fit import SlewTimeFit
-from scenarios.slewtable.spec import TableCase, TableSpec, table_cases
+from scenarios.slewtable.spec import TableCase, TableSpec, table_cases, torque_generators
 
-__all__ = ["PART_NAMES", "SlewTable", "TablePart", "compute_table", "eval_time_us", "fit_entries", "held_out_errors",
-           "torque_generators"]
+__all__ = ["PART_NAMES", "SlewTable", "TablePart", "compute_table", "eval_time_us", "fit_entries", "held_out_errors"]
 
 PART_NAMES = ("table", "held_out")
 """The two grids of a table: the fitted one and the held-out one."""
@@ -117,40 +117,6 @@ class SlewTable:
     fit_quality: dict[str, Any] = field(default_factory=dict)
 
 
-def torque_generators(scenario: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
-    """The spacecraft's inertia and its working actuators' torque generators.
-
-    Parameters
-    ----------
-    scenario : dict
-        A scenario mapping (plain YAML data).
-
-    Returns
-    -------
-    inertia : numpy.ndarray, shape (3, 3)
-        [kg m²], body frame.
-    generators : numpy.ndarray, shape (m, 3)
-        Each working wheel's axis times its torque bound, each torquer axis times its bound [N m],
-        body frame; empty when an actuator is unbounded (no shape for the fit).
-    """
-    from scenarios.schema.loader import parse_scenario
-    spacecraft = parse_scenario(scenario).problem.spacecraft
-    generators = []
-    wheels = spacecraft.wheels
-    if wheels is not None:
-        for i in range(wheels.count):
-            if i not in wheels.failed:
-                generators.append(wheels.axes[:, i] * wheels.max_torque[i])
-    torquers = spacecraft.torquers
-    if torquers is not None:
-        for i in range(3):
-            generators.append(np.eye(3)[i] * torquers.max_torque[i])
-    g = np.array(generators).reshape(-1, 3)
-    if not np.all(np.isfinite(g)):
-        g = np.zeros((0, 3))
-    return np.asarray(spacecraft.inertia, dtype=float), g
-
-
 def _study(spec: TableSpec, cases: list[TableCase]) -> Any:
     from scenarios.output.provenance import package_version
     from scenarios.study.types import Case, Execution, Study, case_key
@@ -181,7 +147,8 @@ def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objec
 
 
 def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: np.ndarray | None = None,
-                meta: dict[str, Any] | None = None) -> tuple[SlewTimeFit | None, str]:
+                meta: dict[str, Any] | None = None, triangles: np.ndarray | None = None
+                ) -> tuple[SlewTimeFit | None, str]:
     """Fit a grid's ``ok`` entries (module docstring).
 
     Parameters
@@ -194,6 +161,9 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
         Torque generators [N m], body frame (:func:`torque_generators`).
     meta : dict, optional
         Kept with the fit.
+    triangles : numpy.ndarray, shape (t, 3), optional
+        The grid's triangles (:func:`scenarios.slewtable.grid.polytope_grid`), used when every axis
+        enters the fit; otherwise (or None) the convex hull of the axes that do.
 
     Returns
     -------
@@ -225,7 +195,8 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
     if len(keep) < 4:
         return None, "; ".join([*notes, f"no fit over the sphere: {len(keep)} axes with ok entries (4 or more needed)"])
     try:
-        fit = SlewTimeFit(angles, part.axes[keep], np.array(rows), meta, inertia, generators)
+        use = triangles if triangles is not None and len(keep) == len(part.axes) else None
+        fit = SlewTimeFit(angles, part.axes[keep], np.array(rows), meta, inertia, generators, use)
     except ValueError as error:
         return None, "; ".join([*notes, f"no fit: {error}"])
     return fit, "; ".join(notes)
@@ -285,13 +256,13 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart) -> dict[str, Any]:
     estimate = fit.many_axis_angle(part.axes[i], angles)
     rel = np.abs(estimate / truth - 1.0)
     w = int(np.argmax(rel))
-    return {"points": int(len(rel)), "max_rel_error": float(rel.max()), "rms_rel_error": float(np.sqrt(np.mean(rel ** 2))),
+    return {"points": len(rel), "max_rel_error": float(rel.max()), "rms_rel_error": float(np.sqrt(np.mean(rel ** 2))),
             "worst": {"axis": part.axes[i[w]].tolist(), "angle_deg": float(part.angles_deg[k[w]]),
                       "table_s": float(truth[w]), "fit_s": float(estimate[w])}}
 
 
 def compute_table(spec: TableSpec, directory: str | Path | None = None, *, workers: int | None = None,
-                  cluster: Any = None, progress: bool = False) -> SlewTable:
+                  cluster: Any = None, executor: Executor | None = None, progress: bool = False) -> SlewTable:
     """Compute every entry of a table (and its held-out grid) and fit it.
 
     Parameters
@@ -306,6 +277,8 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
     cluster : DaskCluster or None, optional
         A connected Dask cluster (:func:`scenarios.study.connect_scheduler`); None: the local pool
         (or ``spec.scheduler``, connected here).
+    executor : concurrent.futures.Executor or None, optional
+        Any executor instead (:func:`scenarios.study.sweep`'s); None: the local pool or ``cluster``.
     progress : bool, optional
         Show the engine's progress bar.
 
@@ -327,7 +300,8 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
     store = SweepStore(directory) if directory is not None else None
     try:
         stored = len(store.keys() & {case.key for case in study.cases}) if store is not None else 0
-        results = sweep(study, workers=workers or spec.workers, store=store, progress=progress, cluster=cluster)
+        results = sweep(study, executor, workers=workers or spec.workers, store=store, progress=progress,
+                        cluster=cluster)
     finally:
         if store is not None:
             store.close()
@@ -343,7 +317,8 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
     inertia, generators = torque_generators(spec.base)
     meta = {"scenario": spec.name, "objective": spec.objective,
             "from_identity_only": _inertially_dependent(spec.base)}
-    table.fit, table.fit_note = fit_entries(parts["table"], inertia, generators, meta)
+    meta["grid"] = spec.grid
+    table.fit, table.fit_note = fit_entries(parts["table"], inertia, generators, meta, spec.triangles)
     if table.fit is not None:
         quality = held_out_errors(table.fit, parts["held_out"])
         quality["eval_time_us"] = eval_time_us(table.fit)

@@ -10,7 +10,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from scenarios.errors import OutputError
-from scenarios.output.directory import MARKER, claim_output_directory, commit_outputs, read_manifest, write_manifest
+from scenarios.output.directory import (
+    MARKER,
+    claim_output_directory,
+    commit_outputs,
+    read_manifest,
+    write_manifest,
+)
 from scenarios.study.store import STORE_FILES, STORE_NAME, is_sweep_store
 
 __all__ = ["KIND", "claim_table_directory", "commit_table_outputs"]

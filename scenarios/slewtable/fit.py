@@ -4,14 +4,15 @@ Model. Let ``g(e, θ) = T(e, θ) / √(θ s(e))`` (``T`` the table's slew time [
 angle [rad], ``e`` the unit eigen-axis in the body frame) with ``s(e) = ‖J e‖_Z``, the gauge of
 ``J e`` in the zonotope ``Z`` of body torques the working actuators can give (wheels' and
 torquers' torque bounds; magnetorquers left out): ``1 / s(e)`` is the largest angular acceleration
-about ``e``, and the eigenaxis bang-bang takes ``T = 2 √(θ s(e))``. The table's times divided by
-that shape are smooth over the sphere where the times themselves have kinks (where the bounding
-facet of ``Z`` changes), and nearly constant in ``θ``, so ``g`` is what is interpolated (without
-torque bounds, or with fewer than three independent torque directions, ``s = 1``). Per axis of
-the table, ``g`` is a monotone-preserving piecewise cubic (PCHIP) in ``θ`` through the table's
-angles; over the sphere the three axes of the spherical triangle (of the convex hull of the axes)
-that holds ``e`` are blended linearly (barycentric weights of the gnomonic projection, continuous
-across edges). Below the smallest angle ``g`` is held at its value there (``T → 0`` as ``√θ``);
+about ``e``, and the eigenaxis bang-bang takes ``T = 2 √(θ s(e))``. Divided by that shape the
+times are nearly constant in ``θ``, so ``g`` is what is interpolated (without torque bounds, or with
+fewer than three independent torque directions, ``s = 1``). Over the sphere the times (and ``g``)
+have kinks where the bounding facet of ``Z`` changes, on great circles; the default grid
+(:func:`scenarios.slewtable.grid.polytope_grid`) puts triangle edges on them. Per axis of the
+table, ``g`` is a monotone-preserving piecewise cubic (PCHIP) in ``θ`` through the table's angles;
+over the sphere the three axes of the triangle that holds ``e`` (the grid's triangles, else the
+axes' convex hull) are blended linearly (barycentric weights of the gnomonic projection,
+continuous across edges). Below the smallest angle ``g`` is held at its value there (``T → 0`` as ``√θ``);
 above the largest it is continued linearly.
 
 Evaluation (:meth:`SlewTimeFit.__call__`) is pure Python on precomputed lists (a cube-map lookup
@@ -94,7 +95,7 @@ def _cube_cells(inverses: np.ndarray) -> list[list[int]]:
             for j in range(_CELLS):
                 block = found[i * (_SAMPLES - 1):(i + 1) * (_SAMPLES - 1) + 1,
                               j * (_SAMPLES - 1):(j + 1) * (_SAMPLES - 1) + 1]
-                cells.append(sorted(set(int(t) for t in block.ravel())))
+                cells.append(sorted({int(t) for t in block.ravel()}))
     return cells
 
 
@@ -192,6 +193,9 @@ class SlewTimeFit:
     generators : array_like, shape (m, 3), optional
         The working actuators' torque directions times their bounds [N m], body frame; None or
         fewer than three independent ones: ``s = 1``.
+    triangles : array_like of int, shape (t, 3), optional
+        Triangles over the axes (vertex indices) that cover the sphere once by central projection
+        (:func:`scenarios.slewtable.grid.polytope_grid`); None: the axes' convex hull.
 
     Raises
     ------
@@ -201,7 +205,8 @@ class SlewTimeFit:
     """
 
     def __init__(self, angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[str, Any] | None = None,
-                 inertia: ArrayLike | None = None, generators: ArrayLike | None = None):
+                 inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
+                 triangles: ArrayLike | None = None):
         from scipy.interpolate import PchipInterpolator
         theta = np.asarray(angles, dtype=float)
         e = np.asarray(axes, dtype=float)
@@ -215,7 +220,9 @@ class SlewTimeFit:
         e = e / np.linalg.norm(e, axis=1, keepdims=True)
         self.angles, self.axes, self.times = theta, e, t
         self.meta: dict[str, Any] = dict(meta or {})
-        self.triangles = _hull(e)
+        self.triangles = _hull(e) if triangles is None else np.asarray(triangles, dtype=int).reshape(-1, 3)
+        if self.triangles.size and (self.triangles.min() < 0 or self.triangles.max() >= len(e)):
+            raise ValueError("triangles must index the axes")
         self.inverses = _inverses(e, self.triangles)
         self.inertia = np.eye(3) if inertia is None else np.asarray(inertia, dtype=float).reshape(3, 3)
         self.generators = np.zeros((0, 3)) if generators is None else np.asarray(generators, dtype=float).reshape(-1, 3)
@@ -314,7 +321,7 @@ class SlewTimeFit:
                 v = a * x + b * y + c * z
                 if v < 0.0:
                     v = -v
-                if v > scale:
+                if v > scale:  # noqa: PLR1730  (max() costs a call in the hot loop)
                     scale = v
             scale /= norm
         return (w0 * r0 + w1 * r1 + w2 * r2) / s * math.sqrt(angle * scale)
@@ -417,14 +424,16 @@ class SlewTimeFit:
         dict
             ``format``, ``model``, ``angles_rad``, ``axes`` (body frame), ``times_s``,
             ``g`` (T/√(θ s)) and ``dg_dangle`` (its PCHIP slopes [1/rad]), ``triangles``,
+            ``facets`` (the rows ``a_f`` of ``s(e)`` [s²/rad]),
             ``inertia`` [kg m²], ``torque_generators`` [N m] and ``meta``.
         """
         return {"format": FIT_FORMAT,
-                "model": "T(e, θ) = √θ · g(e, θ); g: PCHIP in θ per axis, linear (barycentric) over the "
-                         "spherical triangles of the axes' convex hull",
+                "model": "T(e, θ) = √(θ s(e)) · g(e, θ), s(e) = max_f |facets_f · e|; g: PCHIP in θ per axis, "
+                         "linear (barycentric, gnomonic) over the triangles",
                 "angles_rad": self.angles.tolist(), "axes": self.axes.tolist(), "times_s": self.times.tolist(),
                 "g": self._g.tolist(), "dg_dangle": self._dg.tolist(), "triangles": self.triangles.tolist(),
-                "inertia": self.inertia.tolist(), "torque_generators": self.generators.tolist(), "meta": self.meta}
+                "facets": self.facets.tolist(), "inertia": self.inertia.tolist(),
+                "torque_generators": self.generators.tolist(), "meta": self.meta}
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write :meth:`to_dict` as JSON.
@@ -442,7 +451,8 @@ class SlewTimeFit:
 
 
 def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[str, Any] | None = None,
-              inertia: ArrayLike | None = None, generators: ArrayLike | None = None) -> SlewTimeFit:
+              inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
+              triangles: ArrayLike | None = None) -> SlewTimeFit:
     """Fit a slew table (module docstring).
 
     Parameters
@@ -459,13 +469,15 @@ def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[s
         Inertia [kg m²], body frame.
     generators : array_like, shape (m, 3), optional
         Working actuators' torque directions times bounds [N m], body frame.
+    triangles : array_like of int, shape (t, 3), optional
+        Triangles over the axes; None: their convex hull.
 
     Returns
     -------
     SlewTimeFit
         The fit.
     """
-    return SlewTimeFit(angles, axes, times, meta, inertia, generators)
+    return SlewTimeFit(angles, axes, times, meta, inertia, generators, triangles)
 
 
 def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
@@ -493,4 +505,4 @@ def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
     if not isinstance(data, dict) or data.get("format") != FIT_FORMAT:
         raise ValueError(f"{file} is not a slewbench slew-time fit ({FIT_FORMAT!r} expected)")
     return SlewTimeFit(data["angles_rad"], data["axes"], data["times_s"], data.get("meta"), data.get("inertia"),
-                       data.get("torque_generators"))
+                       data.get("torque_generators"), data.get("triangles"))

@@ -5,7 +5,8 @@ small table file (its top-level key ``table``)::
 
     table:
       scenario: cubesat_12u_sun_keep_out.yaml   # relative to this file
-      axes: 40                  # a Fibonacci lattice of 40 axes, or a list of [x, y, z] (body frame)
+      axes: 40                  # about 40 axes, or a list of [x, y, z] (body frame)
+      grid: polytope            # how a number of axes is spread: polytope (default) or fibonacci
       angles_deg: [10, 30, 60, 90, 120, 150, 180]   # or a count: that many from 10 to 180
       objective: min_time       # or min_energy (then duration is required)
       duration: null            # [s], min_energy only
@@ -30,16 +31,21 @@ from typing import Any
 import numpy as np
 
 from scenarios.errors import ScenarioError
-from scenarios.slewtable.grid import fibonacci_axes, held_out_angles, offset_axes
+from scenarios.slewtable.fit import zonotope_facets
+from scenarios.slewtable.grid import fibonacci_axes, held_out_angles, offset_axes, polytope_grid
 
-__all__ = ["DEFAULT_ANGLES", "DEFAULT_AXES", "OBJECTIVES", "TABLE_KEYS", "TableCase", "TableSpec", "angles_from_text",
-           "case_scenario", "check_angles", "check_axes", "parse_table_spec", "table_cases"]
+__all__ = ["DEFAULT_ANGLES", "DEFAULT_AXES", "GRIDS", "OBJECTIVES", "TABLE_KEYS", "TableCase", "TableSpec", "angles_from_text",
+           "case_scenario", "check_angles", "check_axes", "parse_table_spec", "table_cases", "torque_generators"]
 
 OBJECTIVES = ("min_time", "min_energy")
 """The objectives a table computes."""
-TABLE_KEYS = ("scenario", "axes", "angles_deg", "objective", "duration", "held_out", "planner_options", "execution")
+TABLE_KEYS = ("scenario", "axes", "grid", "angles_deg", "objective", "duration", "held_out", "planner_options", "execution")
 """The keys of a table file's ``table`` mapping."""
 DEFAULT_AXES = 40
+GRIDS = ("polytope", "fibonacci")
+"""How a number of axes is spread: along the kinks of the slew time (the torque polytope's faces,
+:func:`scenarios.slewtable.grid.polytope_grid`; needs bounded torques on three independent axes),
+or a Fibonacci lattice (:func:`scenarios.slewtable.grid.fibonacci_axes`)."""
 DEFAULT_ANGLES = (10.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0)
 _EXECUTION_KEYS = ("workers", "scheduler", "case_timeout_s")
 
@@ -75,6 +81,10 @@ class TableSpec:
         A case's time limit [s].
     source : Path or None
         The scenario file.
+    grid : str
+        ``polytope``, ``fibonacci`` or ``list`` (axes given one by one).
+    triangles : numpy.ndarray or None
+        For a ``polytope`` grid, its triangles (vertex indices), kept by the fit; None otherwise.
     """
 
     name: str
@@ -89,6 +99,8 @@ class TableSpec:
     scheduler: str | None = None
     case_timeout_s: float = 600.0
     source: Path | None = None
+    grid: str = "fibonacci"
+    triangles: np.ndarray | None = None
 
     @property
     def held_out_axes(self) -> np.ndarray:
@@ -208,6 +220,40 @@ def check_axes(value: Any, where: str) -> np.ndarray:
     return np.array(axes)
 
 
+def torque_generators(scenario: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+    """The spacecraft's inertia and its working actuators' torque generators.
+
+    Parameters
+    ----------
+    scenario : dict
+        A scenario mapping (plain YAML data).
+
+    Returns
+    -------
+    inertia : numpy.ndarray, shape (3, 3)
+        [kg m²], body frame.
+    generators : numpy.ndarray, shape (m, 3)
+        Each working wheel's axis times its torque bound, each torquer axis times its bound [N m],
+        body frame; empty when an actuator is unbounded (no shape for the fit).
+    """
+    from scenarios.schema.loader import parse_scenario
+    spacecraft = parse_scenario(scenario).problem.spacecraft
+    generators = []
+    wheels = spacecraft.wheels
+    if wheels is not None:
+        for i in range(wheels.count):
+            if i not in wheels.failed:
+                generators.append(wheels.axes[:, i] * wheels.max_torque[i])
+    torquers = spacecraft.torquers
+    if torquers is not None:
+        for i in range(3):
+            generators.append(np.eye(3)[i] * torquers.max_torque[i])
+    g = np.array(generators).reshape(-1, 3)
+    if not np.all(np.isfinite(g)):
+        g = np.zeros((0, 3))
+    return np.asarray(spacecraft.inertia, dtype=float), g
+
+
 def _scenario(path: Path, where: str) -> dict[str, Any]:
     from scenarios.schema.loader import parse_scenario
     from scenarios.schema.read import read_yaml
@@ -275,9 +321,28 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
                 return where, given[where]
         return None
 
-    axes = fibonacci_axes(DEFAULT_AXES)
+    count: int | None = DEFAULT_AXES
+    axes = None
     if (found := pick("axes", "axes")) is not None:
         axes = check_axes(found[1], found[0])
+        count = len(axes) if isinstance(found[1], int) and not isinstance(found[1], bool) else None
+    grid = "polytope"
+    if (found := pick("grid", "grid")) is not None:
+        if found[1] not in GRIDS:
+            raise ScenarioError(found[0], f"expected one of {', '.join(GRIDS)}, got {found[1]!r}")
+        grid = found[1]
+    triangles = None
+    if count is None:
+        grid = "list"
+    elif grid == "polytope":
+        inertia, generators = torque_generators(base)
+        facets = zonotope_facets(generators) if len(generators) else np.zeros((0, 3))
+        if len(facets):
+            axes, triangles = polytope_grid(facets @ inertia, count)
+        else:
+            grid = "fibonacci"
+    if grid == "fibonacci":
+        axes = fibonacci_axes(count)
     angles = list(DEFAULT_ANGLES)
     if (found := pick("angles_deg", "angles")) is not None:
         where, value = found
@@ -328,8 +393,9 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
         timeout = _number(execution["table.execution.case_timeout_s"], "table.execution.case_timeout_s", "seconds")
         if timeout <= 0:
             raise ScenarioError("table.execution.case_timeout_s", f"expected a positive time, got {timeout!r}")
+    assert axes is not None
     spec = TableSpec(str(base.get("name") or source.stem), base, axes, angles, objective, duration, held_out,
-                     options, workers, scheduler, timeout, source)
+                     options, workers, scheduler, timeout, source, grid, triangles)
     table_cases(spec)  # the collocation options and the case scenario are checked now
     return spec
 
