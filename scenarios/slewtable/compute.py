@@ -22,7 +22,12 @@ from typing import Any
 import numpy as np
 
 from scenarios.slewtable.fit import SlewTimeFit
-from scenarios.slewtable.spec import TableCase, TableSpec, table_cases, torque_generators
+from scenarios.slewtable.spec import (
+    TableCase,
+    TableSpec,
+    table_cases,
+    torque_generators,
+)
 
 __all__ = ["PART_NAMES", "SlewTable", "TablePart", "compute_table", "eval_time_us", "fit_entries", "held_out_errors"]
 
@@ -106,6 +111,9 @@ class SlewTable:
         The fit (None when it could not be made: :attr:`fit_note` says why).
     fit_note : str
         Why there is no fit, or which axes were left out of it.
+    fit_quality : dict
+        The fit's errors on the held-out grid (:func:`held_out_errors`) and its evaluation time
+        ``eval_time_us`` [µs per call]; empty without a fit.
     """
 
     spec: TableSpec

@@ -127,7 +127,7 @@ def polytope_grid(facets: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
         index: dict[tuple[int, int, int], int] = {}
 
         def point(p: np.ndarray) -> int:
-            key = tuple(int(round(c)) for c in p / scale * 1e9)
+            key = tuple(round(c) for c in (p / scale * 1e9).tolist())
             if key not in index:
                 index[key] = len(points)
                 points.append(p)

@@ -32,7 +32,12 @@ import numpy as np
 
 from scenarios.errors import ScenarioError
 from scenarios.slewtable.fit import zonotope_facets
-from scenarios.slewtable.grid import fibonacci_axes, held_out_angles, offset_axes, polytope_grid
+from scenarios.slewtable.grid import (
+    fibonacci_axes,
+    held_out_angles,
+    offset_axes,
+    polytope_grid,
+)
 
 __all__ = ["DEFAULT_ANGLES", "DEFAULT_AXES", "GRIDS", "OBJECTIVES", "TABLE_KEYS", "TableCase", "TableSpec", "angles_from_text",
            "case_scenario", "check_angles", "check_axes", "parse_table_spec", "table_cases", "torque_generators"]
@@ -342,7 +347,7 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
         else:
             grid = "fibonacci"
     if grid == "fibonacci":
-        axes = fibonacci_axes(count)
+        axes = fibonacci_axes(count or DEFAULT_AXES)
     angles = list(DEFAULT_ANGLES)
     if (found := pick("angles_deg", "angles")) is not None:
         where, value = found
