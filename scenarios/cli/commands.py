@@ -1,4 +1,4 @@
-"""``slewbench`` command line: run, validate, list, schema, codegen, export, sweep, and ``--version``.
+"""``slewbench`` command line: run, validate, list, schema, codegen, export, sweep, table, and ``--version``.
 
 Exit status (:mod:`scenarios.cli.status`): 0 when the run completed (a failed planner or a
 violated requirement is a row, not an error), 1 under ``run --strict`` when some row is not ``ok``
