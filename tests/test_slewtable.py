@@ -91,6 +91,18 @@ def test_bilimoria_wie_entry_matches_the_published_optimum_and_a_direct_solve(tm
     assert part.plan_time_s[0, 0] > 0
 
 
+def test_min_energy_entry_meets_the_double_integrator_closed_form(tmp_path):
+    # Rest to rest in T about the one working wheel's axis, bounds inactive: ∫u² dt = 12 J² θ² / T³.
+    table = _table(tmp_path, SPHERE_ONE_WHEEL, {"axes": [[1, 0, 0]], "angles_deg": [15, 30], "objective": "min_energy",
+                                                "duration": 20.0, "planner_options": {"multistart": 0}})
+    part = table.parts["table"]
+    assert part.status == [["ok", "ok"]], part.message
+    for k, angle in enumerate((15.0, 30.0)):
+        assert part.objective_value[0, k] == pytest.approx(12 * 2.0 ** 2 * math.radians(angle) ** 2 / 20.0 ** 3, rel=1e-4)
+        assert part.slew_time_s[0, k] == pytest.approx(20.0)
+    assert table.fit is None and "min_energy" in table.fit_note
+
+
 def test_a_failed_solve_is_an_entry_with_its_status(tmp_path):
     # The duration bound 8 s admits 30 deg (6.47 s) but not 90 deg (11.21 s): that entry fails, the
     # table goes on and keeps the planner's message.
