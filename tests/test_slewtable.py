@@ -330,6 +330,17 @@ def test_never_writes_into_a_directory_slewbench_did_not_make(tmp_path, capsys):
     assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
 
 
+def test_never_writes_into_another_kind_of_slewbench_output(tmp_path, capsys):
+    from scenarios.output.directory import claim_output_directory, write_manifest
+    scenario = _write(tmp_path, "box.yaml", UNIT_BOX)
+    run_dir = claim_output_directory(tmp_path / "run", kind="run")
+    (run_dir / "results.json").write_text("{}")
+    write_manifest(run_dir, ["results.json"], complete=True, kind="run")
+    assert main(["table", str(scenario), "--out", str(run_dir), "--axes", "4", "--angles", "90,180"]) == 2
+    assert "holds slewbench run output" in capsys.readouterr().err
+    assert sorted(p.name for p in run_dir.iterdir()) == [".slewbench-output.json", "results.json"]
+
+
 @pytest.mark.slow
 def test_command_writes_the_table_and_resumes_from_its_store(tmp_path, capsys):
     scenario = _write(tmp_path, "box.yaml", UNIT_BOX)
