@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 import timeit
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -185,7 +186,8 @@ def test_fit_round_trips_through_fit_json(tmp_path):
 def test_fit_evaluates_within_ten_microseconds():
     fit = analytic_fit()
     q0, qf = tuple(quat.from_axis_angle([0.3, 0.2, 0.9], 0.7).tolist()), tuple(quat.from_axis_angle([1, 2, 3], 1.1).tolist())
-    per_call = sorted(timeit.repeat(lambda: fit(q0, qf), number=5000, repeat=9))[4] / 5000
+    # CPU time, not wall time: the machine running the tests may be shared
+    per_call = sorted(timeit.repeat(lambda: fit(q0, qf), timer=time.process_time, number=5000, repeat=9))[4] / 5000
     assert per_call <= 10e-6
 
 

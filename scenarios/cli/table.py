@@ -108,9 +108,9 @@ def command_table(args: argparse.Namespace) -> int:
         if quality.get("points"):
             print(f"fit: held-out error max {100 * quality['max_rel_error']:.3g} %, RMS "
                   f"{100 * quality['rms_rel_error']:.3g} % of the slew time ({quality['points']} points); "
-                  f"evaluation {quality['eval_time_us']:.2f} us per call")
+                  f"evaluation {quality['eval_time_us']:.2f} us CPU per call")
         else:
-            print(f"fit: no held-out points (--held-out 0); evaluation {quality['eval_time_us']:.2f} us per call")
+            print(f"fit: no held-out points (--held-out 0); evaluation {quality['eval_time_us']:.2f} us CPU per call")
         if table.fit_note:
             print(f"fit note: {table.fit_note}")
         print(f"use it: from scenarios.slewtable import load_fit; slew_time = load_fit('{directory / 'fit.json'}')")

@@ -211,7 +211,10 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
 
 
 def eval_time_us(fit: SlewTimeFit, repeats: int = 7, number: int = 2000) -> float:
-    """Median over ``repeats`` of the mean time of one ``fit(q0, qf)`` call on tuples [µs].
+    """Median over ``repeats`` of the mean CPU time of one ``fit(q0, qf)`` call on tuples [µs].
+
+    CPU time of this process (``time.process_time``), not wall time: on a shared machine the wall
+    clock counts the time other processes hold the core.
 
     Parameters
     ----------
@@ -235,7 +238,7 @@ def eval_time_us(fit: SlewTimeFit, repeats: int = 7, number: int = 2000) -> floa
         for a, b in pairs:
             fit(a, b)
 
-    times = timeit.repeat(run, number=loops, repeat=repeats)
+    times = timeit.repeat(run, timer=time.process_time, number=loops, repeat=repeats)
     return statistics.median(times) / (loops * len(pairs)) * 1e6
 
 

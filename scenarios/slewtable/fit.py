@@ -259,11 +259,6 @@ class SlewTimeFit:
             return np.ones(len(e))
         return np.max(np.abs(e @ self.facets.T), axis=1)
 
-    def _g_at(self, n: int, k: int, h00: float, h10: float, h01: float, h11: float) -> float:
-        g0, d0 = self._rows[n][k]
-        g1, d1 = self._rows[n][k + 1]
-        return h00 * g0 + h10 * d0 + h01 * g1 + h11 * d1
-
     def axis_angle(self, x: float, y: float, z: float, angle: float) -> float:
         """Slew time about a body axis by an angle (pure Python).
 
@@ -310,9 +305,13 @@ class SlewTimeFit:
             t3 = t2 * t
             h00, h01 = 2.0 * t3 - 3.0 * t2 + 1.0, 3.0 * t2 - 2.0 * t3
             h10, h11 = (t3 - 2.0 * t2 + t) * h, (t3 - t2) * h
-            r0 = self._g_at(i, n, h00, h10, h01, h11)
-            r1 = self._g_at(j, n, h00, h10, h01, h11)
-            r2 = self._g_at(k, n, h00, h10, h01, h11)
+            rows = self._rows
+            (a0, b0), (a1, b1) = rows[i][n], rows[i][n + 1]
+            r0 = h00 * a0 + h10 * b0 + h01 * a1 + h11 * b1
+            (a0, b0), (a1, b1) = rows[j][n], rows[j][n + 1]
+            r1 = h00 * a0 + h10 * b0 + h01 * a1 + h11 * b1
+            (a0, b0), (a1, b1) = rows[k][n], rows[k][n + 1]
+            r2 = h00 * a0 + h10 * b0 + h01 * a1 + h11 * b1
         scale = 1.0
         if self._facets:
             norm = math.sqrt(x * x + y * y + z * z)
