@@ -237,7 +237,10 @@ class SlewTimeFit:
         self._rows = [list(zip(gr.tolist(), sr.tolist())) for gr, sr in zip(g, slopes)]
         self._tri = [(tuple(int(i) for i in tri), tuple(inv.ravel().tolist()))
                      for tri, inv in zip(self.triangles, self.inverses)]
-        self._cells = [[self._tri[i] for i in cell] for cell in _cube_cells(self.inverses)]
+        cells = _cube_cells(self.inverses)
+        self._cells = [[self._tri[i] for i in cell] for cell in cells]
+        widest = max(len(cell) for cell in cells)
+        self._candidates = np.array([cell + [cell[-1]] * (widest - len(cell)) for cell in cells], dtype=int)
 
     # --- evaluation ------------------------------------------------------------------------
 
@@ -357,6 +360,31 @@ class SlewTimeFit:
             return 0.0
         return self.axis_angle(x, y, z, 2.0 * math.atan2(s, w))
 
+    def _locate_many(self, e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Triangle and normalised weights of unit directions (the cube-map candidates, vectorised;
+        every triangle for a direction none of its candidates holds)."""
+        a = np.abs(e)
+        major = np.where((a[:, 0] >= a[:, 1]) & (a[:, 0] >= a[:, 2]), 0, np.where(a[:, 1] >= a[:, 2], 1, 2))
+        rows = np.arange(len(e))
+        m = a[rows, major]
+        sign = e[rows, major] < 0.0
+        others = np.array([[1, 2], [0, 2], [0, 1]])[major]
+        u, v = e[rows, others[:, 0]] / m, e[rows, others[:, 1]] / m
+        i = np.minimum(((u + 1.0) * 0.5 * _CELLS).astype(int), _CELLS - 1)
+        j = np.minimum(((v + 1.0) * 0.5 * _CELLS).astype(int), _CELLS - 1)
+        cell = ((2 * major + sign) * _CELLS + i) * _CELLS + j
+        candidates = self._candidates[cell]  # (n, c)
+        weights = np.einsum("ncij,nj->nci", self.inverses[candidates], e)
+        inside = np.all(weights >= _INSIDE, axis=2)
+        first = np.argmax(inside, axis=1)
+        found = candidates[rows, first]
+        chosen = weights[rows, first]
+        missed = ~inside[rows, first]
+        if np.any(missed):
+            found[missed], chosen[missed] = _locate(self.inverses, e[missed])
+            return found, chosen / chosen.sum(axis=1, keepdims=True)
+        return found, chosen / chosen.sum(axis=1, keepdims=True)
+
     def many_axis_angle(self, axes: ArrayLike, angles: ArrayLike) -> np.ndarray:
         """Slew times about many axes by many angles (vectorised).
 
@@ -375,7 +403,7 @@ class SlewTimeFit:
         e = np.atleast_2d(np.asarray(axes, dtype=float))
         theta = np.atleast_1d(np.asarray(angles, dtype=float))
         e = e / np.linalg.norm(e, axis=1, keepdims=True)
-        found, weights = _locate(self.inverses, e)
+        found, weights = self._locate_many(e)
         vertices = self.triangles[found]  # (n, 3)
         nodes = self.angles
         clipped = np.clip(theta, nodes[0], nodes[-1])
