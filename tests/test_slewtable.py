@@ -343,12 +343,11 @@ def test_never_writes_into_another_kind_of_slewbench_output(tmp_path, capsys):
     assert sorted(p.name for p in run_dir.iterdir()) == [".slewbench-output.json", "results.json"]
 
 
-@pytest.mark.slow
 def test_command_writes_the_table_and_resumes_from_its_store(tmp_path, capsys):
     scenario = _write(tmp_path, "box.yaml", UNIT_BOX)
     out = tmp_path / "out"
-    args = ["table", str(scenario), "--out", str(out), "--axes", "6", "--angles", "90,180", "--held-out", "2",
-            "--workers", "2"]
+    args = ["table", str(scenario), "--out", str(out), "--axes", "6", "--grid", "fibonacci", "--angles", "90,180",
+            "--held-out", "2", "--workers", "2"]
     assert main(args) == 0
     said = capsys.readouterr().out
     assert "12 of 12 entries ok" in said and "held-out error" in said
