@@ -3,7 +3,7 @@
 * No import runs back up. Packages: ``ocp`` < ``planners`` < ``controllers`` < ``scenarios``. Inside
   them the layers of :data:`GROUPS` may import what :data:`ALLOWED` lists (``ocp``: its top-level
   modules < ``dynamics`` < ``geometry``, ``simulation``, ``transcription`` (which imports ``geometry``);
-  ``nlp`` beside them; ``scenarios``: errors < requirements < schema < output < runner < codegen < study < cli < console). Every import counts,
+  ``nlp`` beside them; ``scenarios``: errors < requirements < schema < output < runner < codegen < study < bench, slewtable < cli < console). Every import counts,
   inside functions too, except those under ``if TYPE_CHECKING:``; importing a face counts as
   importing every module it covers. A face may import its own package's modules.
 * A module's ``__all__`` lists only names it defines (faces excepted); no docstring or comment says
@@ -59,13 +59,14 @@ GROUPS: dict[str, tuple[str, ...]] = {
     "scenarios.codegen": ("scenarios.codegen",),
     "scenarios.study": ("scenarios.study",),
     "scenarios.bench": ("scenarios.bench",),
+    "scenarios.slewtable": ("scenarios.slewtable",),
     "scenarios.cli": ("scenarios.cli",),
     "scenarios.console": ("scenarios.console",),
 }
 """Layers inside the packages, by module (or subpackage) name."""
 
 _SCENARIOS = ["scenarios.errors", "scenarios.requirements", "scenarios.schema", "scenarios.output", "scenarios.runner", "scenarios.codegen",
-              "scenarios.study", "scenarios.bench", "scenarios.cli", "scenarios.console"]
+              "scenarios.study", "scenarios.bench", "scenarios.slewtable", "scenarios.cli", "scenarios.console"]
 ALLOWED: dict[str, set[str]] = {
     "ocp": {"ocp"},
     "ocp.dynamics": {"ocp", "ocp.dynamics"},

@@ -1,4 +1,4 @@
-"""``slewbench`` command line: run, validate, list, schema, codegen, export, sweep, and ``--version``.
+"""``slewbench`` command line: run, validate, list, schema, codegen, export, sweep, bench, table, and ``--version``.
 
 Exit status (:mod:`scenarios.cli.status`): 0 when the run completed (a failed planner or a
 violated requirement is a row, not an error), 1 under ``run --strict`` when some row is not ``ok``
@@ -29,6 +29,7 @@ from scenarios.cli.status import (
     EXIT_OK,
 )
 from scenarios.cli.sweep import add_sweep_parser
+from scenarios.cli.table import add_table_parser
 from scenarios.errors import OutputError, ScenarioError
 from scenarios.output.directory import (
     claim_output_directory,
@@ -333,6 +334,7 @@ def build_parser() -> argparse.ArgumentParser:
     schema_parser.set_defaults(handler=command_schema)
     add_sweep_parser(commands)
     add_bench_parser(commands)
+    add_table_parser(commands)
     return parser
 
 

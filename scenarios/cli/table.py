@@ -1,0 +1,144 @@
+"""``slewbench table``: a slew table (minimum time over eigen-axes and angles) and its fit.
+
+Everything that can fail before an entry is computed is checked first (the scenario or table file
+and the options: exit 2 naming the YAML path or option; the output directory: exit 2 if it is not
+slewbench's or holds another kind of output; a Dask scheduler). Entries run on the trade-study
+engine and are stored as they finish, so a table interrupted (exit 130) or run again into the same
+``--out`` computes only the entries it lacks. This module imports only the standard library until
+the command runs.
+"""
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+
+def _terminate(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
+
+
+def _integer(text: str) -> int | str:
+    """``--axes``: a count."""
+    return int(text) if text.strip().isdigit() else text
+
+
+def command_table(args: argparse.Namespace) -> int:
+    """Compute the table of ``args.file`` into ``args.out`` and print its fit's quality.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``table`` arguments (``file``, ``axes``, ``angles``, ``objective``,
+        ``duration``, ``held_out``, ``out``, ``workers``, ``scheduler``, ``no_plots``).
+
+    Returns
+    -------
+    int
+        0 when every entry is stored (entries that failed included), 130 when interrupted.
+
+    Raises
+    ------
+    ScenarioError
+        A bad file or option (exit 2; nothing written).
+    OutputError
+        An output directory slewbench must not write to (exit 2; nothing written).
+    """
+    from scenarios.cli.status import EXIT_INTERRUPTED, EXIT_OK
+    from scenarios.errors import ScenarioError, SweepInterrupted
+    from scenarios.output.directory import new_staging
+    from scenarios.output.names import default_output_directory
+    from scenarios.slewtable.compute import compute_table
+    from scenarios.slewtable.directory import (
+        claim_table_directory,
+        commit_table_outputs,
+    )
+    from scenarios.slewtable.files import write_table_files
+    from scenarios.slewtable.spec import parse_table_spec
+    from scenarios.study.engine import connect_scheduler, start_forkserver
+
+    if isinstance(args.axes, str):
+        raise ScenarioError("--axes", f"expected a number of axes, got {args.axes!r}")
+    if args.workers is not None and not 1 <= args.workers <= 1024:
+        raise ScenarioError("--workers", f"expected 1 to 1024, got {args.workers}")
+    if not args.scheduler:
+        start_forkserver()
+    overrides = {"axes": args.axes, "grid": args.grid, "angles": args.angles, "objective": args.objective,
+                 "duration": args.duration, "held-out": args.held_out, "workers": args.workers,
+                 "scheduler": args.scheduler}
+    spec = parse_table_spec(args.file, overrides)
+    if not args.no_plots:
+        import matplotlib  # noqa: F401  (fail now, not after the entries ran)
+    out = Path(args.out) if args.out else default_output_directory(f"table-{spec.name}")
+    directory = claim_table_directory(out)
+    cluster = connect_scheduler(spec.scheduler, "--scheduler" if args.scheduler else "table.execution.scheduler") \
+        if spec.scheduler else None
+    entries = len(spec.axes) * len(spec.angles_deg) + spec.held_out * max(len(spec.angles_deg) - 1, 0)
+    print(f"{spec.name}: {len(spec.axes)} axes x {len(spec.angles_deg)} angles"
+          + (f" + {spec.held_out} held-out axes x {len(spec.angles_deg) - 1} angles" if spec.held_out else "")
+          + f" = {entries} entries, {spec.objective}, {cluster.address if cluster else 'local process pool'}",
+          flush=True)
+    previous = signal.signal(signal.SIGTERM, _terminate)
+    try:
+        table = compute_table(spec, directory, workers=args.workers, cluster=cluster, progress=True)
+    except (SweepInterrupted, KeyboardInterrupt):
+        print(f"slewbench: table interrupted; finished entries are stored in {directory}. Run the same command "
+              "again to compute the rest.", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        if cluster is not None:
+            cluster.close()
+    staging = new_staging(directory)
+    start = time.perf_counter()
+    write_table_files(table, staging, plots=not args.no_plots)
+    files = commit_table_outputs(directory, staging)
+    part = table.parts["table"]
+    ok = int(part.ok.sum())
+    print(f"computed in {table.wall_time_s:.1f} s ({table.stored} entries already stored); table: {ok} of "
+          f"{part.ok.size} entries ok; files written in {time.perf_counter() - start:.1f} s: {directory}/ "
+          f"({', '.join(sorted(files))})")
+    if table.fit is None:
+        print(f"no fit: {table.fit_note}")
+    else:
+        quality = table.fit_quality
+        if quality.get("points"):
+            print(f"fit: held-out error max {100 * quality['max_rel_error']:.3g} %, RMS "
+                  f"{100 * quality['rms_rel_error']:.3g} % of the slew time ({quality['points']} points); "
+                  f"evaluation {quality['eval_time_us']:.2f} us CPU per call")
+        else:
+            print(f"fit: no held-out points (--held-out 0); evaluation {quality['eval_time_us']:.2f} us CPU per call")
+        if table.fit_note:
+            print(f"fit note: {table.fit_note}")
+        print(f"use it: from scenarios.slewtable import load_fit; slew_time = load_fit('{directory / 'fit.json'}')")
+    return EXIT_OK
+
+
+def add_table_parser(commands: Any) -> None:
+    """Add the ``table`` subcommand to the ``slewbench`` parser.
+
+    Parameters
+    ----------
+    commands : Any
+        The ``argparse`` sub-parsers object of ``slewbench`` (from ``add_subparsers``).
+    """
+    parser = commands.add_parser("table", help="slew table: minimum slew time over eigen-axes and angles, "
+                                               "CSV, NetCDF and a fast fit slew_time(q0, qf)")
+    parser.add_argument("file", help="scenario YAML file, or a table file (top-level key 'table')")
+    parser.add_argument("--axes", type=_integer, help="number of eigen-axes (about; default 40)")
+    parser.add_argument("--grid", help="how the axes are spread: polytope (default: along the actuators' kinks) "
+                                       "or fibonacci")
+    parser.add_argument("--angles", help="slew angles [deg]: a comma-separated list, or a count from 10 to 180 "
+                                         "(default 10,30,60,90,120,150,180)")
+    parser.add_argument("--objective", help="min_time (default) or min_energy (needs --duration)")
+    parser.add_argument("--duration", type=float, help="slew duration for min_energy [s]")
+    parser.add_argument("--held-out", type=int, help="axes of the held-out grid the fit is measured on "
+                                                     "(at the mid angles; 0: none; default 0)")
+    parser.add_argument("--out", help="output directory (default: results/table-<scenario name>)")
+    parser.add_argument("--workers", type=int, help="entries at once (default: one per core)")
+    parser.add_argument("--scheduler", help="Dask scheduler address (tcp://host:port) instead of local processes")
+    parser.add_argument("--no-plots", action="store_true", help="skip agility_envelope.png")
+    parser.set_defaults(handler=command_table)

@@ -1,0 +1,535 @@
+"""The slew table's fit: slew time as a smooth function of the eigen-axis and the angle.
+
+Model. Let ``g(e, θ) = T(e, θ) / √(θ s(e))`` (``T`` the table's slew time [s], ``θ`` the slew
+angle [rad], ``e`` the unit eigen-axis in the body frame) with ``s(e) = ‖J e‖_Z``, the gauge of
+``J e`` in the zonotope ``Z`` of body torques the working actuators can give (wheels' and
+torquers' torque bounds; magnetorquers left out): ``1 / s(e)`` is the largest angular acceleration
+about ``e``, and the eigenaxis bang-bang takes ``T = 2 √(θ s(e))``. Divided by that shape the
+times are nearly constant in ``θ``, so ``g`` is what is interpolated (without torque bounds, or with
+fewer than three independent torque directions, ``s = 1``). Over the sphere the times (and ``g``)
+have kinks where the bounding facet of ``Z`` changes, on great circles; the default grid
+(:func:`scenarios.slewtable.grid.polytope_grid`) puts triangle edges on them. Per axis of the
+table, ``g`` is a monotone-preserving piecewise cubic (PCHIP) in ``θ`` through the table's angles;
+over the sphere the three axes of the triangle that holds ``e`` (the grid's triangles, else the
+axes' convex hull) are blended linearly (barycentric weights of the gnomonic projection,
+continuous across edges). Below the smallest angle ``g`` is held at its value there (``T → 0`` as ``√θ``);
+above the largest it is continued linearly.
+
+Evaluation (:meth:`SlewTimeFit.__call__`) is pure Python on precomputed lists (a cube-map lookup
+finds the candidate triangles), since every NumPy call costs about a microsecond;
+:meth:`SlewTimeFit.slew_time_many` is the vectorised form.
+
+Quaternions are scalar first, body to inertial: the slew from ``q0`` to ``qf`` is the rotation
+``dq = q0⁻¹ ⊗ qf`` (Hamilton product), whose axis is in the body frame and whose angle (the short
+way, in [0, π]) is the table's angle.
+"""
+from __future__ import annotations
+
+import bisect
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = ["FIT_FORMAT", "SlewTimeFit", "fit_table", "load_fit"]
+
+FIT_FORMAT = "slewbench-slew-time-fit/1"
+"""The ``format`` key of ``fit.json``."""
+_CELLS = 12  # cube-map cells per face side
+_SAMPLES = 7  # directions sampled per cell side to list its candidate triangles
+_INSIDE = -1e-9
+
+
+def _hull(axes: np.ndarray) -> np.ndarray:
+    """Triangles (vertex indices) of the axes' convex hull, each facing outward; ValueError when the
+    hull does not hold the origin inside (every direction must meet one triangle)."""
+    from scipy.spatial import ConvexHull, QhullError
+    if len(axes) < 4:
+        raise ValueError(f"a fit over the sphere needs at least 4 axes spanning it, got {len(axes)}")
+    try:
+        hull = ConvexHull(axes)
+    except QhullError as error:
+        raise ValueError(f"the axes do not span the sphere: {str(error).splitlines()[0]}") from None
+    if np.any(hull.equations[:, 3] >= -1e-9):
+        raise ValueError("the axes do not surround the origin (a hemisphere or less): no fit over the sphere")
+    if len(hull.vertices) != len(axes):
+        raise ValueError("some axes are not on the convex hull (not unit vectors, or repeated)")
+    return np.asarray(hull.simplices, dtype=int)
+
+
+def _inverses(axes: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Per triangle, the inverse of the 3x3 matrix whose columns are its vertices."""
+    return np.linalg.inv(np.stack([axes[t].T for t in triangles]))
+
+
+def _locate(inverses: np.ndarray, directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each direction, the triangle holding it and its normalised barycentric weights."""
+    weights = np.einsum("tij,nj->nti", inverses, directions)
+    inside = np.all(weights >= _INSIDE, axis=2)
+    found = np.argmax(inside, axis=1)
+    chosen = weights[np.arange(len(directions)), found]
+    return found, chosen / chosen.sum(axis=1, keepdims=True)
+
+
+def _cube_cells(inverses: np.ndarray) -> list[list[int]]:
+    """Cube-map cell -> the triangles that directions in the cell can fall into (sampled densely
+    on each cell, edges included; the evaluation falls back to every triangle if none holds)."""
+    s = np.linspace(-1.0, 1.0, _CELLS * (_SAMPLES - 1) + 1)
+    cells: list[list[int]] = []
+    for face in range(6):
+        major, sign = face // 2, 1.0 if face % 2 == 0 else -1.0
+        others = [i for i in range(3) if i != major]
+        u, v = np.meshgrid(s, s, indexing="ij")
+        directions = np.empty((u.size, 3))
+        directions[:, major] = sign
+        directions[:, others[0]] = u.ravel()
+        directions[:, others[1]] = v.ravel()
+        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+        found, _ = _locate(inverses, directions)
+        found = found.reshape(u.shape)
+        for i in range(_CELLS):
+            for j in range(_CELLS):
+                block = found[i * (_SAMPLES - 1):(i + 1) * (_SAMPLES - 1) + 1,
+                              j * (_SAMPLES - 1):(j + 1) * (_SAMPLES - 1) + 1]
+                cells.append(sorted({int(t) for t in block.ravel()}))
+    return cells
+
+
+def _cell(x: float, y: float, z: float) -> int:
+    """The cube-map cell of a direction (the same layout as :func:`_cube_cells`)."""
+    ax, ay, az = abs(x), abs(y), abs(z)
+    if ax >= ay and ax >= az:
+        face, m, u, v = (0 if x >= 0.0 else 1), ax, y, z
+    elif ay >= az:
+        face, m, u, v = (2 if y >= 0.0 else 3), ay, x, z
+    else:
+        face, m, u, v = (4 if z >= 0.0 else 5), az, x, y
+    i = int((u / m + 1.0) * 0.5 * _CELLS)
+    j = int((v / m + 1.0) * 0.5 * _CELLS)
+    return (face * _CELLS + (i if i < _CELLS else _CELLS - 1)) * _CELLS + (j if j < _CELLS else _CELLS - 1)
+
+
+def zonotope_facets(generators: ArrayLike) -> np.ndarray:
+    """Facet normals of the torque zonotope ``{Σ u_k G_k : |u_k| <= 1}``, each divided by its support.
+
+    Parameters
+    ----------
+    generators : array_like, shape (m, 3)
+        Each actuator's torque direction times its bound [N m], body frame.
+
+    Returns
+    -------
+    numpy.ndarray, shape (f, 3)
+        Normals ``n / h`` [1/(N m)]: the gauge of a torque ``τ`` is ``max |n/h · τ|``; empty when the
+        generators span fewer than three directions (no finite gauge).
+    """
+    g = np.asarray(generators, dtype=float).reshape(-1, 3)
+    if len(g) < 3 or np.linalg.matrix_rank(g, tol=1e-9 * max(np.max(np.abs(g)), 1e-300)) < 3:
+        return np.zeros((0, 3))
+    facets = []
+    for i in range(len(g)):
+        for j in range(i + 1, len(g)):
+            n = np.cross(g[i], g[j])
+            size = np.linalg.norm(n)
+            if size <= 1e-12 * np.linalg.norm(g[i]) * np.linalg.norm(g[j]):
+                continue
+            n = n / size
+            facets.append(n / np.sum(np.abs(g @ n)))
+    return np.array(facets)
+
+
+def relative_axis_angle(q0: ArrayLike, qf: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """Eigen-axes (body frame of ``q0``) and angles of the slews ``q0 -> qf`` (vectorised).
+
+    Parameters
+    ----------
+    q0, qf : array_like, shape (4,) or (n, 4)
+        Attitude quaternions, scalar first, body to inertial (normalised here).
+
+    Returns
+    -------
+    axes : numpy.ndarray, shape (n, 3)
+        Unit eigen-axes, body frame (``[1, 0, 0]`` where the angle is zero).
+    angles : numpy.ndarray, shape (n,)
+        Slew angles the short way [rad], in [0, π].
+    """
+    a = np.atleast_2d(np.asarray(q0, dtype=float))
+    b = np.atleast_2d(np.asarray(qf, dtype=float))
+    a = a / np.linalg.norm(a, axis=1, keepdims=True)
+    b = b / np.linalg.norm(b, axis=1, keepdims=True)
+    w0, v0 = a[:, :1], -a[:, 1:]
+    w1, v1 = b[:, :1], b[:, 1:]
+    w = w0 * w1 - np.sum(v0 * v1, axis=1, keepdims=True)
+    v = w0 * v1 + w1 * v0 + np.cross(v0, v1)
+    flip = np.where(w < 0.0, -1.0, 1.0)
+    w, v = w * flip, v * flip
+    s = np.linalg.norm(v, axis=1)
+    angles = 2.0 * np.arctan2(s, w[:, 0])
+    axes = np.where(s[:, None] > 0.0, v / np.where(s > 0.0, s, 1.0)[:, None], np.array([1.0, 0.0, 0.0]))
+    return axes, angles
+
+
+class SlewTimeFit:
+    """Slew time [s] between two attitudes from a slew table's fit (module docstring).
+
+    Call it as ``fit(q0, qf)`` (pure Python, a few microseconds), or :meth:`slew_time_many` for arrays.
+
+    Parameters
+    ----------
+    angles : array_like, shape (k,)
+        The table's slew angles [rad], increasing, k >= 2, in (0, π].
+    axes : array_like, shape (n, 3)
+        The table's eigen-axes, body frame (unit vectors spanning the sphere, n >= 4).
+    times : array_like, shape (n, k)
+        Slew time at each axis and angle [s], positive and finite.
+    meta : dict, optional
+        What the fit came from (scenario, objective, errors on held-out points); kept in ``fit.json``.
+    inertia : array_like, shape (3, 3), optional
+        The spacecraft's inertia [kg m²], body frame (for the shape ``s(e)``; with ``generators``).
+    generators : array_like, shape (m, 3), optional
+        The working actuators' torque directions times their bounds [N m], body frame; None or
+        fewer than three independent ones: ``s = 1``.
+    triangles : array_like of int, shape (t, 3), optional
+        Triangles over the axes (vertex indices) that cover the sphere once by central projection
+        (:func:`scenarios.slewtable.grid.polytope_grid`); None: the axes' convex hull.
+
+    Raises
+    ------
+    ValueError
+        Shapes that disagree, angles not increasing in (0, π], times not positive and finite, or
+        axes that do not span the sphere.
+    """
+
+    def __init__(self, angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[str, Any] | None = None,
+                 inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
+                 triangles: ArrayLike | None = None):
+        from scipy.interpolate import PchipInterpolator
+        theta = np.asarray(angles, dtype=float)
+        e = np.asarray(axes, dtype=float)
+        t = np.asarray(times, dtype=float)
+        if theta.ndim != 1 or theta.size < 2 or np.any(np.diff(theta) <= 0) or theta[0] <= 0 or theta[-1] > np.pi + 1e-12:
+            raise ValueError("angles must be at least 2 increasing values in (0, pi] [rad]")
+        if e.ndim != 2 or e.shape[1] != 3 or t.shape != (e.shape[0], theta.size):
+            raise ValueError(f"axes must be (n, 3) and times (n, {theta.size}), got {e.shape} and {t.shape}")
+        if not np.all(np.isfinite(t)) or np.any(t <= 0):
+            raise ValueError("times must be positive and finite")
+        e = e / np.linalg.norm(e, axis=1, keepdims=True)
+        self.angles, self.axes, self.times = theta, e, t
+        self.meta: dict[str, Any] = dict(meta or {})
+        self.triangles = _hull(e) if triangles is None else np.asarray(triangles, dtype=int).reshape(-1, 3)
+        if self.triangles.size and (self.triangles.min() < 0 or self.triangles.max() >= len(e)):
+            raise ValueError("triangles must index the axes")
+        self.inverses = _inverses(e, self.triangles)
+        self.inertia = np.eye(3) if inertia is None else np.asarray(inertia, dtype=float).reshape(3, 3)
+        self.generators = np.zeros((0, 3)) if generators is None else np.asarray(generators, dtype=float).reshape(-1, 3)
+        facets = zonotope_facets(self.generators) if len(self.generators) else np.zeros((0, 3))
+        self.facets = facets @ self.inertia if len(facets) else facets  # n/h · (J e) = (n/h J) · e
+        self._facets = [tuple(f) for f in self.facets.tolist()]
+        g = t / np.sqrt(theta[None, :] * self.shape(e)[:, None])
+        slopes = np.stack([PchipInterpolator(theta, row).derivative()(theta) for row in g])
+        self._g, self._dg = g, slopes
+        # pure-Python tables for __call__
+        self._theta = theta.tolist()
+        self._rows = [list(zip(gr.tolist(), sr.tolist())) for gr, sr in zip(g, slopes)]
+        self._tri = [(tuple(int(i) for i in tri), tuple(inv.ravel().tolist()))
+                     for tri, inv in zip(self.triangles, self.inverses)]
+        cells = _cube_cells(self.inverses)
+        self._cells = [[self._tri[i] for i in cell] for cell in cells]
+        widest = max(len(cell) for cell in cells)
+        self._candidates = np.array([cell + [cell[-1]] * (widest - len(cell)) for cell in cells], dtype=int)
+
+    # --- evaluation ------------------------------------------------------------------------
+
+    def shape(self, axes: ArrayLike) -> np.ndarray:
+        """The shape ``s(e) = ‖J e‖_Z`` of unit axes (module docstring; 1 without torque bounds).
+
+        Parameters
+        ----------
+        axes : array_like, shape (n, 3)
+            Unit eigen-axes, body frame.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+            ``s(e)`` [s² / rad]: ``2 √(θ s)`` is the eigenaxis bang-bang time.
+        """
+        e = np.atleast_2d(np.asarray(axes, dtype=float))
+        if not len(self.facets):
+            return np.ones(len(e))
+        return np.max(np.abs(e @ self.facets.T), axis=1)
+
+    def axis_angle(self, x: float, y: float, z: float, angle: float) -> float:
+        """Slew time about a body axis by an angle (pure Python).
+
+        Parameters
+        ----------
+        x, y, z : float
+            The eigen-axis, body frame (any length > 0).
+        angle : float
+            The slew angle [rad], >= 0.
+
+        Returns
+        -------
+        float
+            The fitted slew time [s] (0 for a zero angle).
+        """
+        if angle <= 0.0:
+            return 0.0
+        found = None
+        for tri in self._cells[_cell(x, y, z)]:
+            m = tri[1]
+            w0 = m[0] * x + m[1] * y + m[2] * z
+            w1 = m[3] * x + m[4] * y + m[5] * z
+            w2 = m[6] * x + m[7] * y + m[8] * z
+            if w0 >= _INSIDE and w1 >= _INSIDE and w2 >= _INSIDE:
+                found = tri
+                break
+        if found is None:  # never seen in tests: the sampled cell lists missed a sliver
+            return float(self.many_axis_angle(np.array([[x, y, z]]), np.array([angle]))[0])
+        s = w0 + w1 + w2
+        i, j, k = found[0]
+        theta = self._theta
+        last = len(theta) - 1
+        if angle <= theta[0]:
+            r0, r1, r2 = self._rows[i][0][0], self._rows[j][0][0], self._rows[k][0][0]
+        elif angle >= theta[last]:
+            d = angle - theta[last]
+            (a0, b0), (a1, b1), (a2, b2) = self._rows[i][last], self._rows[j][last], self._rows[k][last]
+            r0, r1, r2 = a0 + b0 * d, a1 + b1 * d, a2 + b2 * d
+        else:
+            n = bisect.bisect_right(theta, angle) - 1
+            h = theta[n + 1] - theta[n]
+            t = (angle - theta[n]) / h
+            t2 = t * t
+            t3 = t2 * t
+            h00, h01 = 2.0 * t3 - 3.0 * t2 + 1.0, 3.0 * t2 - 2.0 * t3
+            h10, h11 = (t3 - 2.0 * t2 + t) * h, (t3 - t2) * h
+            rows = self._rows
+            (a0, b0), (a1, b1) = rows[i][n], rows[i][n + 1]
+            r0 = h00 * a0 + h10 * b0 + h01 * a1 + h11 * b1
+            (a0, b0), (a1, b1) = rows[j][n], rows[j][n + 1]
+            r1 = h00 * a0 + h10 * b0 + h01 * a1 + h11 * b1
+            (a0, b0), (a1, b1) = rows[k][n], rows[k][n + 1]
+            r2 = h00 * a0 + h10 * b0 + h01 * a1 + h11 * b1
+        scale = 1.0
+        if self._facets:
+            norm = math.sqrt(x * x + y * y + z * z)
+            scale = 0.0
+            for a, b, c in self._facets:
+                v = a * x + b * y + c * z
+                if v < 0.0:
+                    v = -v
+                if v > scale:  # noqa: PLR1730  (max() costs a call in the hot loop)
+                    scale = v
+            scale /= norm
+        return (w0 * r0 + w1 * r1 + w2 * r2) / s * math.sqrt(angle * scale)
+
+    def __call__(self, q0: Any, qf: Any) -> float:
+        """Slew time from attitude ``q0`` to ``qf`` (pure Python).
+
+        Parameters
+        ----------
+        q0, qf : sequence of 4 floats
+            Attitude quaternions, scalar first, body to inertial (unit; tuples or lists are
+            fastest, NumPy arrays are converted).
+
+        Returns
+        -------
+        float
+            The fitted slew time [s] of the rest-to-rest slew ``q0 -> qf``.
+        """
+        if type(q0) is not tuple and type(q0) is not list:
+            q0 = q0.tolist()
+        if type(qf) is not tuple and type(qf) is not list:
+            qf = qf.tolist()
+        a, b, c, d = q0
+        e, f, g, h = qf
+        # dq = conj(q0) ⊗ qf
+        w = a * e + b * f + c * g + d * h
+        x = a * f - b * e - c * h + d * g
+        y = a * g - c * e - d * f + b * h
+        z = a * h - d * e - b * g + c * f
+        if w < 0.0:
+            w, x, y, z = -w, -x, -y, -z
+        s = math.sqrt(x * x + y * y + z * z)
+        if s == 0.0:
+            return 0.0
+        return self.axis_angle(x, y, z, 2.0 * math.atan2(s, w))
+
+    def _locate_many(self, e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Triangle and normalised weights of unit directions (the cube-map candidates, vectorised;
+        every triangle for a direction none of its candidates holds)."""
+        a = np.abs(e)
+        major = np.where((a[:, 0] >= a[:, 1]) & (a[:, 0] >= a[:, 2]), 0, np.where(a[:, 1] >= a[:, 2], 1, 2))
+        rows = np.arange(len(e))
+        m = a[rows, major]
+        sign = e[rows, major] < 0.0
+        others = np.array([[1, 2], [0, 2], [0, 1]])[major]
+        u, v = e[rows, others[:, 0]] / m, e[rows, others[:, 1]] / m
+        i = np.minimum(((u + 1.0) * 0.5 * _CELLS).astype(int), _CELLS - 1)
+        j = np.minimum(((v + 1.0) * 0.5 * _CELLS).astype(int), _CELLS - 1)
+        cell = ((2 * major + sign) * _CELLS + i) * _CELLS + j
+        candidates = self._candidates[cell]  # (n, c)
+        weights = np.einsum("ncij,nj->nci", self.inverses[candidates], e)
+        inside = np.all(weights >= _INSIDE, axis=2)
+        first = np.argmax(inside, axis=1)
+        found = candidates[rows, first]
+        chosen = weights[rows, first]
+        missed = ~inside[rows, first]
+        if np.any(missed):
+            found[missed], chosen[missed] = _locate(self.inverses, e[missed])
+            return found, chosen / chosen.sum(axis=1, keepdims=True)
+        return found, chosen / chosen.sum(axis=1, keepdims=True)
+
+    def many_axis_angle(self, axes: ArrayLike, angles: ArrayLike) -> np.ndarray:
+        """Slew times about many axes by many angles (vectorised).
+
+        Parameters
+        ----------
+        axes : array_like, shape (n, 3)
+            Eigen-axes, body frame (any length > 0).
+        angles : array_like, shape (n,)
+            Slew angles [rad], >= 0.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+            Fitted slew times [s].
+        """
+        e = np.atleast_2d(np.asarray(axes, dtype=float))
+        theta = np.atleast_1d(np.asarray(angles, dtype=float))
+        e = e / np.linalg.norm(e, axis=1, keepdims=True)
+        found, weights = self._locate_many(e)
+        vertices = self.triangles[found]  # (n, 3)
+        nodes = self.angles
+        clipped = np.clip(theta, nodes[0], nodes[-1])
+        n = np.clip(np.searchsorted(nodes, clipped, side="right") - 1, 0, len(nodes) - 2)
+        h = nodes[n + 1] - nodes[n]
+        t = (clipped - nodes[n]) / h
+        t2, t3 = t * t, t * t * t
+        h00, h01 = 2 * t3 - 3 * t2 + 1, 3 * t2 - 2 * t3
+        h10, h11 = (t3 - 2 * t2 + t) * h, (t3 - t2) * h
+        g, dg = self._g[vertices], self._dg[vertices]  # (n, 3, k)
+        nn = n[:, None]
+        inner = (h00[:, None] * np.take_along_axis(g, nn[..., None], 2)[..., 0]
+                 + h10[:, None] * np.take_along_axis(dg, nn[..., None], 2)[..., 0]
+                 + h01[:, None] * np.take_along_axis(g, nn[..., None] + 1, 2)[..., 0]
+                 + h11[:, None] * np.take_along_axis(dg, nn[..., None] + 1, 2)[..., 0])
+        beyond = theta > nodes[-1]
+        inner = np.where(beyond[:, None], g[..., -1] + dg[..., -1] * (theta - nodes[-1])[:, None], inner)
+        blended = np.sum(weights * inner, axis=1)
+        return np.where(theta > 0.0, blended * np.sqrt(np.maximum(theta, 0.0) * self.shape(e)), 0.0)
+
+    def slew_time_many(self, q0: ArrayLike, qf: ArrayLike) -> np.ndarray:
+        """Slew times of many slews (vectorised :meth:`__call__`).
+
+        Parameters
+        ----------
+        q0, qf : array_like, shape (n, 4) or (4,)
+            Attitude quaternions, scalar first, body to inertial (broadcast against each other).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+            Fitted slew times [s].
+        """
+        a, b = np.broadcast_arrays(np.atleast_2d(np.asarray(q0, dtype=float)), np.atleast_2d(np.asarray(qf, dtype=float)))
+        axes, angles = relative_axis_angle(a, b)
+        return self.many_axis_angle(axes, angles)
+
+    # --- storage ---------------------------------------------------------------------------
+
+    def to_dict(self) -> dict[str, Any]:
+        """The fit's parameters as plain data (``fit.json``).
+
+        Returns
+        -------
+        dict
+            ``format``, ``model``, ``angles_rad``, ``axes`` (body frame), ``times_s``,
+            ``g`` (T/√(θ s)) and ``dg_dangle`` (its PCHIP slopes [1/rad]), ``triangles``,
+            ``facets`` (the rows ``a_f`` of ``s(e)`` [s²/rad]),
+            ``inertia`` [kg m²], ``torque_generators`` [N m] and ``meta``.
+        """
+        return {"format": FIT_FORMAT,
+                "model": "T(e, θ) = √(θ s(e)) · g(e, θ), s(e) = max_f |facets_f · e|; g: PCHIP in θ per axis, "
+                         "linear (barycentric, gnomonic) over the triangles",
+                "angles_rad": self.angles.tolist(), "axes": self.axes.tolist(), "times_s": self.times.tolist(),
+                "g": self._g.tolist(), "dg_dangle": self._dg.tolist(), "triangles": self.triangles.tolist(),
+                "facets": self.facets.tolist(), "inertia": self.inertia.tolist(),
+                "torque_generators": self.generators.tolist(), "meta": self.meta}
+
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Write :meth:`to_dict` as JSON.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file to write.
+        """
+        Path(path).write_text(json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n")
+
+    def __repr__(self) -> str:
+        return (f"<SlewTimeFit: {len(self.axes)} axes x {len(self.angles)} angles "
+                f"({np.rad2deg(self.angles[0]):g}..{np.rad2deg(self.angles[-1]):g} deg)>")
+
+
+def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[str, Any] | None = None,
+              inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
+              triangles: ArrayLike | None = None) -> SlewTimeFit:
+    """Fit a slew table (module docstring).
+
+    Parameters
+    ----------
+    angles : array_like, shape (k,)
+        Slew angles [rad], increasing, in (0, π].
+    axes : array_like, shape (n, 3)
+        Eigen-axes, body frame, spanning the sphere.
+    times : array_like, shape (n, k)
+        Slew times [s].
+    meta : dict, optional
+        Kept with the fit.
+    inertia : array_like, shape (3, 3), optional
+        Inertia [kg m²], body frame.
+    generators : array_like, shape (m, 3), optional
+        Working actuators' torque directions times bounds [N m], body frame.
+    triangles : array_like of int, shape (t, 3), optional
+        Triangles over the axes; None: their convex hull.
+
+    Returns
+    -------
+    SlewTimeFit
+        The fit.
+    """
+    return SlewTimeFit(angles, axes, times, meta, inertia, generators, triangles)
+
+
+def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
+    """Read a ``fit.json`` written by ``slewbench table``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``fit.json`` file, or the table's output directory holding it.
+
+    Returns
+    -------
+    SlewTimeFit
+        The fit; call it as ``fit(q0, qf)`` (quaternions scalar first, body to inertial) [s].
+
+    Raises
+    ------
+    ValueError
+        The file is not a slew-time fit of this format.
+    """
+    file = Path(path)
+    if file.is_dir():
+        file = file / "fit.json"
+    data = json.loads(file.read_text())
+    if not isinstance(data, dict) or data.get("format") != FIT_FORMAT:
+        raise ValueError(f"{file} is not a slewbench slew-time fit ({FIT_FORMAT!r} expected)")
+    return SlewTimeFit(data["angles_rad"], data["axes"], data["times_s"], data.get("meta"), data.get("inertia"),
+                       data.get("torque_generators"), data.get("triangles"))
