@@ -44,11 +44,10 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import casadi as ca
 import numpy as np
-import scipy.sparse
 from numpy.typing import NDArray
 
 from ocp.fast_call import BufferedFunction
@@ -59,6 +58,9 @@ from ocp.nlp.second_order import (
     _output,
     second_order_check,
 )
+
+if TYPE_CHECKING:  # imported where a certificate is computed: importing the planners does not load it
+    import scipy.sparse
 
 Array = NDArray[np.float64]
 
@@ -114,6 +116,8 @@ class KKTResiduals:
 def _sparse(function: BufferedFunction, index: int) -> scipy.sparse.csc_matrix:
     """Output ``index`` of the last evaluation as a sparse matrix (a collocation NLP's Jacobian,
     dense, took most of the certificate's time)."""
+    import scipy.sparse
+
     sparsity = function.function.sparsity_out(index)
     colind, row = sparsity.get_ccs()
     return scipy.sparse.csc_matrix((np.array(function.outputs[index], dtype=float), row, colind), shape=sparsity.shape)
