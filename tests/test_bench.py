@@ -15,7 +15,7 @@ import pytest
 from ocp import Spacecraft, Torquers, quat
 from planners import PLANNERS, ManeuverProblem
 from scenarios.bench import SUITE_FILE, load_suite
-from scenarios.bench.leaderboard import BENCH_FILES, certificate_text, gap
+from scenarios.bench.leaderboard import BENCH_FILES, certificate_text, gap, other_planners
 from scenarios.bench.peers import PEERS, PeerUnavailable, load_peer
 from scenarios.bench.suite import OBJECTIVE_METRICS, OPTIMUM_KINDS
 from scenarios.cli.commands import main
@@ -32,6 +32,26 @@ def test_the_index_loads_and_every_problem_is_a_scenario_with_its_planners():
         scenario = load(problem.file)  # an ordinary scenario: `slewbench run` runs it too
         assert sorted({spec.name for spec in scenario.planners}) == sorted(set(problem.planners)), problem.name
         assert all(name in PLANNERS for name in problem.planners)
+
+
+def test_every_planner_that_accepts_a_problem_joins_its_rows_with_its_defaults():
+    """Beside the scenario's rows, every other registered planner whose own check accepts the
+    problem (oracle: ``problem_error`` of each registered planner, asked directly here) runs with
+    its default options, labelled as such; one that refuses the problem does not."""
+    suite = load_suite()
+    for name in ("bilimoria_wie_90", "spin_repoint_min_energy"):
+        scenario = load(suite.problems[name].file)
+        named = {spec.name for spec in scenario.planners}
+        accepting = {planner for planner, cls in PLANNERS.items()
+                     if planner not in named and cls({}).problem_error(scenario.problem) is None}
+        added = other_planners(scenario)
+        assert {spec.name for spec in added} == accepting, name
+        assert all(spec.label == f"{spec.name} (defaults)" for spec in added)
+        assert all(spec.options == PLANNERS[spec.name]({}).options for spec in added)
+    # the spin case starts spinning: a planner that needs a rest start refuses it and is left out
+    spin = load(suite.problems["spin_repoint_min_energy"].file)
+    refusing = {planner for planner, cls in PLANNERS.items() if cls({}).problem_error(spin.problem) is not None}
+    assert refusing and not refusing & {spec.name for spec in other_planners(spin)}
 
 
 def test_every_problem_states_its_source_optimum_and_tolerance():

@@ -146,6 +146,8 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any) -> list[Be
             value = float(row.reference_metrics[metric])
         gap_abs, gap_rel = gap(value, problem.optimum)
         message = row.message
+        if row.planner is not None and row.label == f"{row.planner} (defaults)":  # other_planners
+            message = f"default options (the planner's own objective, not tuned to this problem); {message}"
         free = sorted(getattr(reference, "free_boundary", ()) or ())
         if value is not None and free:
             gap_abs = gap_rel = None
@@ -386,6 +388,38 @@ def _md(text: str) -> str:
     return text.replace("|", "\\|").replace("\n", " ")
 
 
+def other_planners(scenario: Any) -> list[Any]:
+    """Every registered planner that the scenario's rows do not name and that accepts its problem
+    (:meth:`planners.Planner.problem_error` is ``None``), with its default options, labelled
+    ``<name> (defaults)``: the problem's suite entry names the planners its scenario was written
+    for, and the leaderboard runs every planner that can take the problem.
+
+    Parameters
+    ----------
+    scenario : scenarios.schema.loader.Scenario
+        A problem's scenario.
+
+    Returns
+    -------
+    list of scenarios.schema.loader.PlannerSpec
+        In registry order.
+    """
+    from planners import PLANNERS
+    from scenarios.schema.loader import PlannerSpec
+
+    named = {spec.name for spec in scenario.planners}
+    labels = {spec.label for spec in scenario.planners}
+    specs = []
+    for name, cls in PLANNERS.items():
+        label = f"{name} (defaults)"
+        if name in named or label in labels:
+            continue
+        planner = cls({})
+        if planner.problem_error(scenario.problem) is None:
+            specs.append(PlannerSpec(name, label, planner.options, planner))
+    return specs
+
+
 def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Iterable[str] | None = None,
               peers: Iterable[str] = (), progress: Callable[[str], None] | None = None) -> Leaderboard:
     """Run problems of ``suite`` through their planners (and ``peers``) and collect the leaderboard.
@@ -397,7 +431,8 @@ def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Ite
     problems : iterable of str or None, optional
         Names of the problems to run (``None``: all, in the suite's order).
     planners : iterable of str or None, optional
-        Planner registry names to keep of each scenario's rows (``None``: all of them).
+        Planner registry names to keep of each scenario's rows and of :func:`other_planners`
+        (``None``: all of them).
     peers : iterable of str, optional
         Names of :data:`scenarios.bench.peers.PEERS` to run beside them (default none).
     progress : callable or None, optional
@@ -431,7 +466,7 @@ def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Ite
     for i, problem in enumerate(chosen, 1):
         began = time.perf_counter()
         scenario = load(problem.file)
-        specs = [spec for spec in scenario.planners if keep is None or spec.name in keep]
+        specs = [spec for spec in [*scenario.planners, *other_planners(scenario)] if keep is None or spec.name in keep]
         rows: list[BenchRow] = []
         if specs:
             results = run(dataclasses.replace(scenario, planners=specs))
