@@ -238,7 +238,8 @@ def dense_check(problem: ManeuverProblem, reference: CollocationReference, requi
 
     The grid has ``points_per_interval`` equally spaced points per mesh interval, the nodes
     included (at a node the controls are read from both intervals that meet there, saturated at the
-    bounds imposed, :meth:`CollocationReference._state_control`; the states as interpolated). A pointing
+    bounds imposed as the reference gives them,
+    :class:`~planners.collocation.reference.CollocationReference`; the states as interpolated). A pointing
     requirement is broken where its margin (:meth:`~ocp.geometry.PointingConstraint.margins` on the
     reference's normalised attitude) is negative; a bound where it is exceeded by more than
     :data:`BOUND_TOLERANCE` of it.
