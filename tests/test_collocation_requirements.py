@@ -222,10 +222,17 @@ def test_the_actuator_margin_keeps_the_reference_within_its_share_of_the_limits(
     momentum, torque = wheel_demand(problem(0.0), free)
     assert momentum[0] > 0.85 * 20e-3  # not vacuous: margin 0 uses more than 0.8 of the momentum
     momentum, torque = wheel_demand(problem(0.2), margined)
-    # -I dω/dt between the points follows the state polynomial, the planner's controls another
-    # polynomial through the same values: they agree to 1e-4 of the limit here.
     assert np.all(momentum <= 0.8 * 20e-3 * (1 + 1e-6)), momentum
-    assert np.all(torque <= 0.8 * 2e-3 * (1 + 1e-4)), torque
+    # What the reference asks of the wheels (its controls, saturated at the bounds imposed) stays
+    # within 0.8 of the limit everywhere. -I dω/dt between the points follows the state polynomial,
+    # whose derivative is not the saturated control where the bound is active: here 1.2e-3 of
+    # 0.8 x the limit above it (it was within 4e-4 below while the dense check read the controls'
+    # polynomial unsaturated: its overshoot, 1.5e-3, made the planner solve again 2.2e-3 tighter;
+    # now only the wheel momentum's 3.5e-5 does, by 5.3e-5).
+    commanded = np.max(np.abs(margined.control(dense_times(margined))), axis=0)
+    assert np.all(commanded <= 0.8 * 2e-3), commanded
+    assert commanded[0] >= 0.8 * 2e-3 * (1 - 1e-4)  # not vacuous: the torque bound is active
+    assert np.all(torque <= 0.8 * 2e-3 * (1 + 2e-3)), torque
     assert margined.stats["objective"] > free.stats["objective"]
 
 

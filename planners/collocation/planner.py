@@ -262,7 +262,8 @@ class CollocationPlanner(Planner):
     window is a failed reference naming it. After each successful solve the reference is checked
     on :data:`~planners.collocation.requirements.DENSE_POINTS` points per mesh interval against the
     requirements as stated (:func:`~planners.collocation.requirements.dense_check`: pointing
-    margins, the body-rate norm, the actuator limits less ``actuator_margin``); what it breaks is
+    margins, the body-rate norm, the actuator limits less ``actuator_margin``; the controls read
+    saturated at the bounds imposed, as the reference gives them); what it breaks is
     imposed tighter (:meth:`~planners.collocation.requirements.Tightening.after`) and solved again
     from the solution and its multipliers, at most :data:`~planners.collocation.strategy.DENSE_ROUNDS`
     times. A reference that still breaks one keeps its status (it is a solution, only not within
@@ -763,7 +764,7 @@ class CollocationPlanner(Planner):
     def _reference(self, problem: ManeuverProblem, ocp: OptimalControlProblem, params: Array,
                    solved: _Optimum, tightening: Tightening | None = None) -> Reference:
         """The reference (or the failure) of an optimum found by :meth:`_optimum` (with the variable
-        bounds of ``tightening``, :meth:`_variable_bounds`)."""
+        bounds of ``tightening``, :meth:`_variable_bounds`); its controls saturated at those bounds."""
         o, result, transcription = self.options, solved.result, solved.transcription
         solver = solved.solver or o.solver
         stats = result.stats()
@@ -775,7 +776,8 @@ class CollocationPlanner(Planner):
         assert result.x is not None  # success implies a point
         T, states, controls = (v.full() for v in solved.nlp.unpack(result.x, params))
         T = T.item()
-        reference = CollocationReference(problem, transcription, T, states, controls, stats)
+        reference = CollocationReference(problem, transcription, T, states, controls, stats,
+                                         control_bounds=self._variable_bounds(problem, tightening)[2:])
         norm_error = float(np.max(np.abs(np.linalg.norm(states[0:4], axis=0) - 1)))
         # the fixed-direction cones as stated (their angles not tightened), for the cone plots
         fixed = [c for c in self._requirements(problem).pointing if not c.moving]

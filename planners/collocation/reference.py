@@ -2,7 +2,10 @@
 round the keep-out cones they enter).
 
 Between its points the solution is interpolated by the transcription itself
-(``Transcription.interpolate``: Lagrange polynomials for collocation, cubic Hermite for shooting).
+(``Transcription.interpolate``: Lagrange polynomials for collocation, cubic Hermite for shooting);
+the reference's controls are that interpolant saturated at the box bounds the NLP imposed on them at
+the points (a bang-bang control's polynomial overshoots its bound between the points, an artefact of
+the interpolation the solution does not ask for), its states are the interpolant as it is.
 The feed-forward torque is the optimal control expressed for ``I ω̇ = −ω × I ω + u``:
 ``u = τ_actuators − ω × A h_w + τ_environment``, and ``ω̇`` comes from the model, so both agree.
 """
@@ -36,10 +39,16 @@ class CollocationReference(Reference):
         ``[q, ω, h_w]`` and actuator controls, one column per point.
     stats : dict
         Planner statistics.
+    control_bounds : tuple of (nu,) ndarray, optional
+        ``(u_low, u_high)``: the bounds the NLP imposed on the controls at the points (the actuator
+        limits scaled by ``1 − actuator_margin`` and any tightening; ``±inf``: none), in the layout
+        of ``model.control_slices`` [N m, A m^2]. Between the points the interpolated controls are
+        saturated at them (at the points, where the solution meets them, this changes nothing);
+        ``None`` (default): read as interpolated.
     """
 
     def __init__(self, problem: ManeuverProblem, transcription: Transcription, duration: float, states: Array,
-                 controls: Array, stats: dict[str, Any]) -> None:
+                 controls: Array, stats: dict[str, Any], control_bounds: tuple[Array, Array] | None = None) -> None:
         breakpoints, inner = transcription.smoothness(duration)
         super().__init__("collocation", duration, problem.spacecraft.inertia, stats=stats,
                          free_boundary=(), breakpoints=breakpoints, enforced_times=inner)
@@ -47,9 +56,19 @@ class CollocationReference(Reference):
         self.states, self.controls = states, controls
         self.intervals = transcription.intervals
         self.disturbance = problem.model.default_parameters
+        self.control_bounds = control_bounds
+
+    def _interpolated(self, t: Array, left: bool = False) -> tuple[Array, Array]:
+        """States and controls as the transcription interpolates them (controls not saturated)."""
+        return self.transcription.interpolate(self.model, self.states, self.controls, self.duration, t, left)
 
     def _state_control(self, t: Array, left: bool = False) -> tuple[Array, Array]:
-        return self.transcription.interpolate(self.model, self.states, self.controls, self.duration, t, left)
+        """The reference's states and controls: :meth:`_interpolated`, the controls saturated at
+        :attr:`control_bounds` (the states are not: a wheel momentum's overshoot is the solution's)."""
+        x, u = self._interpolated(t, left)
+        if self.control_bounds is not None:
+            u = np.clip(u, *self.control_bounds)
+        return x, u
 
     def control(self, t: float | Array) -> Array:
         """The optimal actuator control.
@@ -162,7 +181,7 @@ def solution_sampler(reference: CollocationReference) -> Callable[[Array], tuple
 
     def sample(times: Array) -> tuple[Array, Array, Array]:
         t = np.clip(np.asarray(times, dtype=float), 0.0, reference.duration)
-        x, u = reference._state_control(t, left=True)
+        x, u = reference._interpolated(t, left=True)  # as solved (IPOPT pushes a seed into its bounds)
         x[:, 0:4] = quat.normalize(x[:, 0:4])  # as Reference.sample does
         torque = model.body_torque.map(t.size)(x.T, u.T, t).full().T
         return x, u, np.abs(torque)

@@ -8,7 +8,12 @@ Between the points the interpolated solution may still cut a cone or overshoot a
 converged reference is checked on a dense grid (:func:`dense_check`, :data:`DENSE_POINTS` points per
 interval) against the requirements **as stated**; the planner tightens what is broken
 (:meth:`Tightening.after`) and solves again from the solution (see
-:class:`~planners.collocation.planner.CollocationPlanner`).
+:class:`~planners.collocation.planner.CollocationPlanner`). The controls are read as the reference
+gives them: the interpolant saturated at the bounds the NLP imposed
+(:class:`~planners.collocation.reference.CollocationReference`), so a bang-bang arc's polynomial,
+which overshoots its bound between the points (by about a third across a switch inside an interval),
+is not taken for a demand of the solution; the states (attitude, rate, wheel momenta) are read as
+interpolated.
 """
 from __future__ import annotations
 
@@ -232,7 +237,9 @@ def dense_check(problem: ManeuverProblem, reference: CollocationReference, requi
     """Check a reference between its points against the requirements as stated.
 
     The grid has ``points_per_interval`` equally spaced points per mesh interval, the nodes
-    included (at a node the controls are read from both intervals that meet there). A pointing
+    included (at a node the controls are read from both intervals that meet there, saturated at the
+    bounds imposed as the reference gives them,
+    :class:`~planners.collocation.reference.CollocationReference`; the states as interpolated). A pointing
     requirement is broken where its margin (:meth:`~ocp.geometry.PointingConstraint.margins` on the
     reference's normalised attitude) is negative; a bound where it is exceeded by more than
     :data:`BOUND_TOLERANCE` of it.
