@@ -24,7 +24,9 @@ import functools
 import io
 import os
 import pickle
+import select
 import signal
+import struct
 import sys
 import time
 import traceback
@@ -40,6 +42,10 @@ PIPE_BYTES = 1 << 20
 """Capacity asked for the pipe to the child (Linux's ``F_SETPIPE_SZ``; 1 MiB is the unprivileged
 limit): a streamed row's series (about 80 kB pickled for the demo scenario, more than the default
 64 kB) is written at once while the child is busy drawing, and the run does not wait for it."""
+FRAME_HEADER = "<Q"
+"""Each message to the child is its pickle's length (8 bytes, little-endian) and the pickle: the
+child reads whole messages from the pipe itself, so that ``select`` tells whether another one
+is waiting (a buffered reader could hold one unseen)."""
 F_SETPIPE_SZ = 1031
 """``fcntl`` command that sets a pipe's capacity (Linux; the constant is not in Python 3.11's ``fcntl``)."""
 STOP_TIMEOUT_S = 5.0
@@ -176,7 +182,8 @@ class Renderer:
         """Pickle ``message`` into the pipe to the child (closing the child on Ctrl-C or SIGTERM).
         Unbuffered: a signal while the pipe is full stops the child at once (no buffered rest to
         flush into a pipe nobody reads)."""
-        data = memoryview(pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL))
+        payload = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+        data = memoryview(struct.pack(FRAME_HEADER, len(payload)) + payload)
         try:
             while data:
                 data = data[os.write(self._fds[0], data):]
@@ -369,6 +376,33 @@ def _exit(code: int) -> None:
     os._exit(code)
 
 
+def _read_exactly(fd: int, size: int) -> bytes | None:
+    """``size`` bytes from ``fd`` (``None`` at the end of the stream before all of them came)."""
+    chunks, left = [], size
+    while left:
+        chunk = os.read(fd, min(left, 1 << 20))
+        if not chunk:
+            return None
+        chunks.append(chunk)
+        left -= len(chunk)
+    return b"".join(chunks)
+
+
+def _receive(fd: int) -> Any:
+    """The next message of :meth:`Renderer._send` (a frame of :data:`FRAME_HEADER`), or ``None``
+    when the parent has closed the pipe."""
+    header = _read_exactly(fd, struct.calcsize(FRAME_HEADER))
+    if header is None:
+        return None
+    payload = _read_exactly(fd, struct.unpack(FRAME_HEADER, header)[0])
+    return None if payload is None else pickle.loads(payload)
+
+
+def _waiting(fd: int) -> bool:
+    """Whether the pipe has something to read now (a message, or its end)."""
+    return bool(select.select([fd], [], [], 0.0)[0])
+
+
 def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
     """The child: import the drawing half, draw what the parent sends, answer, exit.
 
@@ -391,20 +425,22 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
 
         figures: dict[Any, RowFigure] = {}
         drawn: dict[str, bytes] = {}
-        failure = ""
-        with os.fdopen(receive_fd, "rb") as stream:
-            while True:
-                try:
-                    message = pickle.load(stream)
-                except EOFError:  # the parent ended without plots to draw
+        pending: list[tuple[str, Any]] = []  # streamed, not drawn yet
+        failure, final = "", None
+        while final is None:
+            # take every message already sent; wait for one only when there is nothing to draw
+            while final is None and (not pending or _waiting(receive_fd)):
+                message = _receive(receive_fd)
+                if message is None:  # the parent ended without plots to draw
                     _exit(0)
                 if message[0] == "draw":
-                    _, directory, jobs, keep = message
-                    break
-                (name, series), buffer = message[1], io.BytesIO()
-                if failure:
-                    continue
-                try:  # a streamed figure: drawn now, written when the directory is known
+                    final = message
+                else:
+                    pending.append(message[1])
+            if final is None and not failure:  # idle: a streamed figure, drawn into memory
+                name, series = pending.pop(0)
+                buffer = io.BytesIO()
+                try:
                     if isinstance(series, RowSeries):
                         figure = figures.get(series.shape) or figures.setdefault(series.shape,
                                                                                  RowFigure(*series.shape))
@@ -414,12 +450,22 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
                     drawn[name] = buffer.getvalue()
                 except Exception:  # reported with the answer
                     failure = traceback.format_exc()
+            elif final is None:
+                pending.clear()
+        _, directory, jobs, keep = final
         try:
             if failure:
-                raise RuntimeError(f"drawing a streamed row failed: {failure}")
+                raise RuntimeError(f"drawing a streamed figure failed: {failure}")
             for name in keep:
-                (Path(directory) / name).write_bytes(drawn[name])
-            _draw_in_two(jobs, Path(directory), forks, figures)
+                if name in drawn:
+                    (Path(directory) / name).write_bytes(drawn[name])
+            # the streamed figures not drawn yet (all of them, when the run ended before matplotlib
+            # was imported) are drawn with the rest, shared between this process and its fork
+            late = [job for job in pending if job[0] in keep]
+            missing = set(keep) - set(drawn) - {name for name, _ in late}
+            if missing:
+                raise RuntimeError(f"figures to keep that were never streamed: {sorted(missing)}")
+            _draw_in_two(late + jobs, Path(directory), forks, figures)
             reply: tuple[str, str] = ("ok", "")
         except Exception:  # reported to the parent, which draws in its own process and raises there
             reply = ("error", traceback.format_exc())
