@@ -315,7 +315,7 @@ PEER = AcadosBenchPeer()
 # -- the worker side (the interpreter with the acados wheel) --------------------------------------
 def _environment() -> dict[str, str] | None:
     """The environment acados needs, or ``None`` when the process already has it."""
-    import acados  # type: ignore[import-not-found]  # the comma-deps-acados wheel, in its own environment
+    import acados  # the comma-deps-acados wheel, in its own environment
 
     root = os.path.dirname(acados.__file__)
     wanted = {"ACADOS_SOURCE_DIR": acados.DIR, "ACADOS_PYTHON_INTERFACE_PATH": os.path.join(root, "acados_template"),
@@ -361,7 +361,7 @@ class _Worker:
 
     def build(self, data: dict) -> dict:
         import casadi as ca
-        from acados_template import AcadosModel, AcadosOcp, AcadosOcpSolver  # type: ignore[import-not-found]
+        from acados_template import AcadosModel, AcadosOcp, AcadosOcpSolver
 
         self.count += 1
         free = data["objective"] == "min_time"

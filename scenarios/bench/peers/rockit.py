@@ -24,7 +24,7 @@ from scenarios.bench.peers.base import (
 )
 
 try:
-    import rockit  # type: ignore[import-not-found]
+    import rockit
 except ImportError:  # optional: the peer says so through unavailable()
     rockit = None
 
