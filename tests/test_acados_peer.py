@@ -76,3 +76,18 @@ def test_bench_registry_skips_it_with_the_note(monkeypatch):
     assert "target" in acados.PEER.problem_error(
         ManeuverProblem(Spacecraft([1.0, 1.0, 1.0], torquers=Torquers(1.0)), quat.IDENTITY, np.zeros(3), None, 10.0),
         "min_time")
+
+
+def test_worker_output_goes_to_its_log_and_into_the_error(tmp_path, monkeypatch, capfd):
+    # A stand-in interpreter: prints what acados prints on every build (to stdout and stderr), then
+    # dies without answering. The user's terminal sees none of it; the error quotes it.
+    fake = tmp_path / "python"
+    fake.write_text("#!/bin/sh\necho 'Version 3.6.7 currently in use.' >&2\necho 'gcc: fatal error' >&2\nexit 3\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv(acados.ENV_PYTHON, str(fake))
+    with acados.AcadosPeer() as peer, pytest.raises(RuntimeError) as raised:
+        peer.build(bilimoria_wie(), "min_time")
+    message = str(raised.value)
+    assert "exit 3" in message and "gcc: fatal error" in message and "Version 3.6.7" in message
+    out, err = capfd.readouterr()
+    assert "Version 3.6.7" not in out + err and "gcc" not in out + err

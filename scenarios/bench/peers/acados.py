@@ -144,19 +144,35 @@ class AcadosPeer:
         if path is None:
             raise RuntimeError(note)
         self.note = note
+        # What acados, its code generator and gcc print (version warnings on every build) goes to a
+        # log, not to the user's terminal; a failure quotes its end (:meth:`_log_tail`).
+        self._log = tempfile.TemporaryFile(mode="w+b")  # noqa: SIM115 (lives as long as the worker; close())
         self._process = subprocess.Popen([path, os.path.abspath(__file__), "--worker"], stdin=subprocess.PIPE,
-                                         stdout=subprocess.PIPE, text=True, bufsize=1)
+                                         stdout=subprocess.PIPE, stderr=self._log, text=True, bufsize=1)
+
+    def _log_tail(self, size: int = 2000) -> str:
+        """The last ``size`` characters the worker printed (for an error message)."""
+        self._log.flush()
+        self._log.seek(0, os.SEEK_END)
+        end = self._log.tell()
+        self._log.seek(max(0, end - size))
+        text = self._log.read().decode(errors="replace").strip()
+        return f"\nthe worker's last output:\n{text}" if text else ""
 
     def _ask(self, request: dict) -> dict:
         assert self._process.stdin is not None and self._process.stdout is not None
-        self._process.stdin.write(json.dumps(request) + "\n")
-        self._process.stdin.flush()
-        line = self._process.stdout.readline()
+        try:
+            self._process.stdin.write(json.dumps(request) + "\n")
+            self._process.stdin.flush()
+        except BrokenPipeError:  # it ended before reading
+            line = ""
+        else:
+            line = self._process.stdout.readline()
         if not line:
-            raise RuntimeError(f"the acados worker ended (exit {self._process.poll()})")
+            raise RuntimeError(f"the acados worker ended (exit {self._process.wait(timeout=30)}){self._log_tail()}")
         answer = json.loads(line)
         if "error" in answer:
-            raise RuntimeError(f"acados worker: {answer['error']}")
+            raise RuntimeError(f"acados worker: {answer['error']}{self._log_tail()}")
         return answer
 
     def build(self, problem: Any, objective: str, intervals: int = N,
@@ -188,10 +204,14 @@ class AcadosPeer:
 
     def close(self) -> None:
         """End the worker."""
-        if self._process.poll() is None:
-            assert self._process.stdin is not None
-            self._process.stdin.close()
-            self._process.wait(timeout=30)
+        assert self._process.stdin is not None and self._process.stdout is not None
+        try:
+            self._process.stdin.close()  # the worker ends at the end of its input
+        except BrokenPipeError:  # it had ended already
+            pass
+        self._process.wait(timeout=30)
+        self._process.stdout.close()
+        self._log.close()
 
     def __enter__(self) -> AcadosPeer:  # noqa: PYI034 (no Self on Python 3.10)
         return self
