@@ -93,7 +93,12 @@ class Reference(ABC):
     message : str, optional
         Human-readable outcome (solver message, reason of failure).
     stats : mapping or None, optional
-        Solver statistics (iterations, objective, ...), copied into a dict; ``None``: empty.
+        Solver statistics (iterations, objective, ...), copied into a dict; ``None``: empty. Keys
+        that others read: ``certificate`` (:mod:`ocp.nlp.certificate`'s record of an optimum) and
+        ``functional``, the reference metric the plan minimises over its boundary conditions
+        (``"int_u2"``: ``∫‖u‖² dt`` of the control torque on the body); a run cross-checks a
+        direct and an indirect (co-state) optimum of the same functional
+        (:func:`scenarios.runner.run`).
     free_boundary : iterable of str, optional
         Names from :data:`BOUNDARY_CONDITIONS` (``"q0"``, ``"omega0"``, ``"qf"``, ``"omegaf"``)
         that this reference does not meet by construction (e.g. ``{"omega0"}`` when the method

@@ -10,6 +10,12 @@ Then each row's reference and closed loop are scored against every requirement; 
 one is ``violated`` (never ``ok``), its message naming the requirement, the scope, the margin and
 the time, and a planner that does not honour a kind of requirement present says so in its message.
 Statuses rank ``failed`` over ``violated`` over ``ok``.
+
+Optima cross-checked: when a run holds a direct optimum (a reference whose certificate has no
+``method``, e.g. ``collocation``) and an indirect one (a co-state solution, e.g. ``costate_tpbvp``)
+of the same functional (both references' ``stats["functional"]``), each certificate gets the
+relative difference of their values of that reference metric, ``costate_gap``
+(:func:`ocp.nlp.with_costate_gap`), once every row is planned.
 """
 from __future__ import annotations
 
@@ -28,6 +34,7 @@ from ocp import (
     metrics_from_reference,
     metrics_from_simulation,
 )
+from ocp.nlp import with_costate_gap
 from planners import FailedReference, Reference, ReferenceSample
 from scenarios.output.results import Row, RunResults
 from scenarios.requirements.scoring import (
@@ -204,7 +211,43 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
             on_row(row)
         say(f"[{len(rows)}/{len(labels)}] {row.label}: {row.status} ({timing})"
             + (f" - {row.message}" if row.status != "ok" else ""))
+    _cross_check_optima(rows)
     return RunResults(scenario, rows)
+
+
+def _cross_check_optima(rows: list[Row]) -> None:
+    """Set ``costate_gap`` on the certificates of the direct and indirect optima of one functional.
+
+    Each reference counts once (a reference tracked by several controllers is one optimum). A
+    direct optimum's gap is to the best (least) indirect value; an indirect optimum's gap is to the
+    best direct value; both relative to the indirect value: ``|J_direct − J_costate| / |J_costate|``.
+    """
+    found: dict[str, list[tuple[Reference, dict[str, Any], float]]] = {}
+    seen: set[int] = set()
+    for row in rows:
+        reference, metrics = row.reference, row.reference_metrics
+        if reference is None or not reference.ok or metrics is None or id(reference) in seen:
+            continue
+        seen.add(id(reference))
+        functional, record = reference.stats.get("functional"), reference.stats.get("certificate")
+        if not isinstance(functional, str) or not isinstance(record, dict):
+            continue
+        value = metrics.get(functional)
+        if isinstance(value, (int, float)) and np.isfinite(value):
+            found.setdefault(functional, []).append((reference, record, float(value)))
+    for entries in found.values():
+        indirect = [entry for entry in entries if entry[1].get("method") is not None]
+        direct = [entry for entry in entries if entry[1].get("method") is None]
+        if not indirect or not direct:
+            continue
+        costate = min(value for _, _, value in indirect)
+        best_direct = min(value for _, _, value in direct)
+        if costate == 0.0:
+            continue  # no relative gap to a zero functional
+        for reference, record, value in direct:
+            reference.stats["certificate"] = with_costate_gap(record, abs(value - costate) / abs(costate))
+        for reference, record, value in indirect:
+            reference.stats["certificate"] = with_costate_gap(record, abs(best_direct - value) / abs(value))
 
 
 def _plan(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache | None,

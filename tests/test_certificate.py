@@ -251,3 +251,49 @@ def test_the_costate_planners_certificate_is_its_boundary_value_residual(toleran
     assert record["verdict"] == verdict, record
     assert record["kkt_scaled"] >= reference.stats["max_rms_residual"]
     assert record["second_order"].startswith("not checked") and record["switching"] is None
+
+
+def test_summary_line_is_rebuilt_with_the_costate_gap_in_its_place():
+    from ocp.nlp.certificate import necessary_conditions_certificate, with_costate_gap
+    direct = certificate(None, "not checked: no multipliers", seeds=2, seeds_agreed=1)
+    updated = with_costate_gap(direct, 4.9e-6)
+    assert updated["summary"] == "not certified: KKT not computed, SOSC not checked, co-state gap 5e-06, 1/2 seeds"
+    assert direct["costate_gap"] is None and updated["verdict"] == direct["verdict"]  # evidence beside the verdict
+    indirect = with_costate_gap(necessary_conditions_certificate(1e-8, "solve_bvp"), 0.25)
+    assert indirect["summary"] == ("first-order: solve_bvp residual 1e-08 (Pontryagin's necessary conditions), "
+                                   "gap to the direct solution 0.2")
+
+
+def test_a_run_cross_checks_the_direct_and_the_costate_optimum_of_one_functional(tmp_path):
+    # The nano-spacecraft paper's natural-motion problem (the bench's natural_motion_min_energy):
+    # collocation's minimum ∫‖u‖² and the co-state TPBVP's minimum ½∫‖M_c‖² are optima of the same
+    # functional by two methods (direct transcription; Pontryagin's conditions by solve_bvp): their
+    # values agree to a few 1e-6, and each certificate carries that gap. The eigenaxis row, which
+    # minimises nothing, and a minimum-time collocation row (another functional) carry none.
+    import yaml
+
+    import scenarios
+    from scenarios.runner import run
+    data = yaml.safe_load(open("scenarios/bench/problems/natural_motion_min_energy.yaml"))
+    data["planners"] = [{"name": "collocation", "label": "direct"},
+                        {"name": "costate_tpbvp", "label": "indirect"},
+                        {"name": "eigenaxis", "label": "eigenaxis", "options": {"profile": "smooth"}}]
+    path = tmp_path / "cross.yaml"
+    path.write_text(yaml.safe_dump(data))
+    rows = {row.label: row for row in run(scenarios.load(path)).rows}
+    direct, indirect = rows["direct"], rows["indirect"]
+    assert direct.status == indirect.status == "ok"
+    j_direct, j_costate = direct.reference_metrics["int_u2"], indirect.reference_metrics["int_u2"]
+    gap = abs(j_direct - j_costate) / j_costate
+    assert 0.0 < gap < 1e-4  # two methods agree
+    for row in (direct, indirect):
+        assert row.reference.stats["certificate"]["costate_gap"] == pytest.approx(gap, rel=1e-12)
+    assert "co-state gap" in direct.reference.stats["certificate"]["summary"]
+    assert "gap to the direct solution" in indirect.reference.stats["certificate"]["summary"]
+    assert rows["eigenaxis"].reference.stats.get("certificate") is None
+    # another functional: no cross-check
+    data["planners"][0]["options"] = {"objective": "min_l1"}
+    path.write_text(yaml.safe_dump(data))
+    rows = {row.label: row for row in run(scenarios.load(path)).rows}
+    assert rows["direct"].reference.stats["certificate"]["costate_gap"] is None
+    assert rows["indirect"].reference.stats["certificate"]["costate_gap"] is None

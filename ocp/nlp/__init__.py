@@ -17,7 +17,9 @@ from ocp.nlp.certificate import (
                                  kkt_residuals,
                                  necessary_conditions_certificate,
                                  seed_counts,
+                                 summary_line,
                                  switching_agreement,
+                                 with_costate_gap,
 )
 from ocp.nlp.second_order import SecondOrderCheck, second_order_check
 from ocp.nlp.solve import (
@@ -33,7 +35,8 @@ from ocp.nlp.solve import (
 
 __all__ = ["KKTResiduals", "NLPResult", "SecondOrderCheck", "StartResult", "Switching", "certificate", "certify",
            "converged", "kkt_residuals", "necessary_conditions_certificate", "perturbed", "second_order_check", "seed_counts", "solve_multistart",
-           "solver_options", "status_name", "switching_agreement", "warm_start_options"]
+           "solver_options", "status_name", "summary_line", "switching_agreement", "warm_start_options",
+           "with_costate_gap"]
 
 
 def __dir__() -> list[str]:

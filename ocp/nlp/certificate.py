@@ -346,20 +346,68 @@ def certificate(kkt: KKTResiduals | None, second_order: SecondOrderCheck | str |
     sosc = text == "strict local minimum"
     bang_bang = switching is not None and switching.agreement >= switching_threshold
     verdict = "certified" if first_order and (sosc or bang_bang) else "first-order" if first_order else "not certified"
-    parts = [f"KKT {kkt.scaled:.1g}" if kkt is not None else "KKT not computed"]
-    parts.append("SOSC" if sosc else "SOSC " + text.split(":")[0])
-    if switching is not None:
-        parts.append(f"switching {100.0 * switching.agreement:.0f}%")
-    if costate_gap is not None:
-        parts.append(f"co-state gap {costate_gap:.1g}")
-    if seeds is not None:
-        parts.append(f"{seeds_agreed if seeds_agreed is not None else '?'}/{seeds} seeds")
-    return {"kkt_scaled": None if kkt is None else kkt.scaled, "kkt_unscaled": None if kkt is None else kkt.unscaled,
-            "second_order": text, "switching": None if switching is None else switching.agreement,
-            "costate_gap": costate_gap, "seeds": seeds, "seeds_agreed": seeds_agreed, "verdict": verdict,
-            "summary": f"{verdict}: " + ", ".join(parts),
-            "kkt": None if kkt is None else asdict(kkt),
-            "switching_detail": None if switching is None else asdict(switching)}
+    record = {"kkt_scaled": None if kkt is None else kkt.scaled, "kkt_unscaled": None if kkt is None else kkt.unscaled,
+              "second_order": text, "switching": None if switching is None else switching.agreement,
+              "costate_gap": costate_gap, "seeds": seeds, "seeds_agreed": seeds_agreed, "verdict": verdict,
+              "method": None, "summary": "",
+              "kkt": None if kkt is None else asdict(kkt),
+              "switching_detail": None if switching is None else asdict(switching)}
+    record["summary"] = summary_line(record)
+    return record
+
+
+def summary_line(record: dict[str, Any]) -> str:
+    """The one-line ``summary`` of a certificate record, from its other entries.
+
+    Parameters
+    ----------
+    record : dict
+        A record of :func:`certificate` or :func:`necessary_conditions_certificate`.
+
+    Returns
+    -------
+    str
+        ``"<verdict>: KKT ..., SOSC ..., switching ..%, co-state gap .., a/b seeds"`` for a direct
+        solution (the parts it has evidence for); ``"<verdict>: <method> residual ... (Pontryagin's
+        necessary conditions)[, gap to the direct solution ..]"`` for an indirect one.
+    """
+    verdict, gap = record["verdict"], record.get("costate_gap")
+    if record.get("method") is not None:  # an indirect solution
+        return (f"{verdict}: {record['method']} residual {record['kkt_scaled']:.1g} (Pontryagin's necessary "
+                f"conditions)" + ("" if gap is None else f", gap to the direct solution {gap:.1g}"))
+    text = record["second_order"]
+    kkt = record.get("kkt_scaled")
+    parts = [f"KKT {kkt:.1g}" if kkt is not None else "KKT not computed"]
+    parts.append("SOSC" if text == "strict local minimum" else "SOSC " + text.split(":")[0])
+    if record.get("switching") is not None:
+        parts.append(f"switching {100.0 * record['switching']:.0f}%")
+    if gap is not None:
+        parts.append(f"co-state gap {gap:.1g}")
+    if record.get("seeds") is not None:
+        agreed = record.get("seeds_agreed")
+        parts.append(f"{agreed if agreed is not None else '?'}/{record['seeds']} seeds")
+    return f"{verdict}: " + ", ".join(parts)
+
+
+def with_costate_gap(record: dict[str, Any], gap: float) -> dict[str, Any]:
+    """A certificate record with its ``costate_gap`` set and its ``summary`` redone.
+
+    Parameters
+    ----------
+    record : dict
+        A record of :func:`certificate` or :func:`necessary_conditions_certificate`.
+    gap : float
+        The relative difference between the direct and the indirect (co-state) solution's values of
+        the functional both minimise, ``|J_direct − J_costate| / |J_costate|``.
+
+    Returns
+    -------
+    dict
+        A new record (the verdict is unchanged: the gap is evidence shown beside it).
+    """
+    updated = {**record, "costate_gap": float(gap)}
+    updated["summary"] = summary_line(updated)
+    return updated
 
 
 def certify(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array, *, p: Any = None, lbx: Any = -np.inf,
@@ -426,8 +474,9 @@ def necessary_conditions_certificate(residual: float, method: str, *, tolerance:
         The keys of :func:`certificate`; ``verdict`` ``"first-order"`` or ``"not certified"``.
     """
     verdict = "first-order" if residual <= tolerance else "not certified"
-    return {"kkt_scaled": float(residual), "kkt_unscaled": float(residual),
-            "second_order": f"not checked: an indirect solution ({method}), Pontryagin's necessary conditions only",
-            "switching": None, "costate_gap": costate_gap, "seeds": None, "seeds_agreed": None, "verdict": verdict,
-            "summary": f"{verdict}: {method} residual {residual:.1g} (Pontryagin's necessary conditions)",
-            "kkt": None, "switching_detail": None}
+    record = {"kkt_scaled": float(residual), "kkt_unscaled": float(residual),
+              "second_order": f"not checked: an indirect solution ({method}), Pontryagin's necessary conditions only",
+              "switching": None, "costate_gap": costate_gap, "seeds": None, "seeds_agreed": None, "verdict": verdict,
+              "method": method, "summary": "", "kkt": None, "switching_detail": None}
+    record["summary"] = summary_line(record)
+    return record

@@ -333,6 +333,8 @@ class CostateTPBVPPlanner(Planner):
             return FailedReference(self.name, f"{o.objective}: {failure}")
         stats = {"objective_form": o.objective, "t_f": t_f, "nodes": int(solution.x.size),
                  "max_rms_residual": float(np.max(solution.rms_residuals)), "continuation_stages": stages}
+        if o.objective == "min_energy":  # ½∫‖M_c‖²: minimised with ∫‖u‖², the metric int_u2
+            stats["functional"] = "int_u2"
         if system.torque_control and isinstance(system, RigidBodySystem):
             fine = np.linspace(0.0, t_f, 4001)
             reference = CostateReference(system, solution, t_f, "", {})
