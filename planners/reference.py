@@ -95,8 +95,9 @@ class Reference(ABC):
     stats : mapping or None, optional
         Solver statistics (iterations, objective, ...), copied into a dict; ``None``: empty. Keys
         that others read: ``certificate`` (:mod:`ocp.nlp.certificate`'s record of an optimum) and
-        ``functional``, the reference metric the plan minimises over its boundary conditions
-        (``"int_u2"``: ``∫‖u‖² dt`` of the control torque on the body); a run cross-checks a
+        ``functional``, ``{"name": ..., "value": ...}``, the functional the plan minimised and its
+        value by the planner's own quadrature (``"int_actuator_torque_squared"``: ``∫‖τ‖² dt`` of
+        the actuators' torque on a rigid body without actuator states); a run cross-checks a
         direct and an indirect (co-state) optimum of the same functional
         (:func:`scenarios.runner.run`).
     free_boundary : iterable of str, optional

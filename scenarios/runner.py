@@ -13,8 +13,8 @@ Statuses rank ``failed`` over ``violated`` over ``ok``.
 
 Optima cross-checked: when a run holds a direct optimum (a reference whose certificate has no
 ``method``, e.g. ``collocation``) and an indirect one (a co-state solution, e.g. ``costate_tpbvp``)
-of the same functional (both references' ``stats["functional"]``), each certificate gets the
-relative difference of their values of that reference metric, ``costate_gap``
+of the same functional (the ``name`` of both references' ``stats["functional"]``), each
+certificate gets the relative difference of their values of it, ``costate_gap``
 (:func:`ocp.nlp.with_costate_gap`), once every row is planned.
 """
 from __future__ import annotations
@@ -225,16 +225,16 @@ def _cross_check_optima(rows: list[Row]) -> None:
     found: dict[str, list[tuple[Reference, dict[str, Any], float]]] = {}
     seen: set[int] = set()
     for row in rows:
-        reference, metrics = row.reference, row.reference_metrics
-        if reference is None or not reference.ok or metrics is None or id(reference) in seen:
+        reference = row.reference
+        if reference is None or not reference.ok or id(reference) in seen:
             continue
         seen.add(id(reference))
         functional, record = reference.stats.get("functional"), reference.stats.get("certificate")
-        if not isinstance(functional, str) or not isinstance(record, dict):
+        if not isinstance(functional, dict) or not isinstance(record, dict):
             continue
-        value = metrics.get(functional)
-        if isinstance(value, (int, float)) and np.isfinite(value):
-            found.setdefault(functional, []).append((reference, record, float(value)))
+        name, value = functional.get("name"), functional.get("value")
+        if isinstance(name, str) and isinstance(value, (int, float)) and np.isfinite(value):
+            found.setdefault(name, []).append((reference, record, float(value)))
     for entries in found.values():
         indirect = [entry for entry in entries if entry[1].get("method") is not None]
         direct = [entry for entry in entries if entry[1].get("method") is None]

@@ -213,3 +213,21 @@ def test_the_whole_suite_runs_in_five_minutes(tmp_path, capsys):
     suite = load_suite()
     assert {row["problem"] for row in data["rows"]} == set(suite.problems)
     assert elapsed < 300.0
+
+
+def test_a_row_reaches_the_optimum_only_when_ok_and_a_peer_at_the_eigenaxis_saddle_is_noted():
+    from scenarios.bench.leaderboard import EIGENAXIS_NOTE, _note, _peer_row, _reached
+    from scenarios.bench.peers.base import PeerResult
+    problem = load_suite().problems["bilimoria_wie_180"]  # optimum 3.2431, eigenaxis 2 sqrt(pi)
+    assert _reached("ok", 1e-5, problem) is True
+    assert _reached("violated", 1e-5, problem) is False  # within the tolerance, but it breaks a requirement
+    assert _reached("failed", 0.0, problem) is False
+    assert _reached("ok", None, problem) is None
+    at_saddle = _peer_row(problem, "fatrop", PeerResult(2.0 * math.sqrt(math.pi), 0.01, "ok", 3, ""))
+    assert at_saddle.message.startswith(EIGENAXIS_NOTE) and _note(at_saddle).startswith("stopped at the eigenaxis")
+    at_optimum = _peer_row(problem, "fatrop", PeerResult(3.24312, 0.01, "ok", 30, "fatrop: ok"))
+    assert at_optimum.reached and at_optimum.message == "fatrop: ok" and _note(at_optimum) == ""
+    # where the eigenaxis slew is the optimum (the norm-bounded problem), reaching it is no saddle
+    closed = load_suite().problems["norm_bounded_eigenaxis"]
+    row = _peer_row(closed, "fatrop", PeerResult(closed.optimum, 0.01, "ok", 5, ""))
+    assert row.reached and not row.message.startswith(EIGENAXIS_NOTE)

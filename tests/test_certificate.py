@@ -122,6 +122,12 @@ def test_verdicts_from_the_evidence():
     assert certificate(small, "not checked: big", bang)["verdict"] == "certified"
     assert certificate(small, "not checked: big", singular)["verdict"] == "first-order"
     assert certificate(large, "strict local minimum", bang)["verdict"] == "not certified"
+    # the switching evidence never overrules a second-order check that found negative curvature (a
+    # saddle), nor stands in with samples on the side Pontryagin forbids
+    from ocp.nlp.second_order import SecondOrderCheck
+    saddle = SecondOrderCheck(False, 12, -3.0, "negative curvature -3 on the critical cone")
+    assert certificate(small, saddle, bang)["verdict"] == "first-order"
+    assert certificate(small, "not checked: big", Switching(0.92, 0.08, 0.0, 0.0, 1e-3))["verdict"] == "first-order"
     record = certificate(small, "strict local minimum", None, seeds=5, seeds_agreed=4)
     assert record["verdict"] == "certified" and record["summary"] == "certified: KKT 1e-09, SOSC, 4/5 seeds"
     assert json.loads(json.dumps(record)) == record
@@ -283,9 +289,14 @@ def test_a_run_cross_checks_the_direct_and_the_costate_optimum_of_one_functional
     rows = {row.label: row for row in run(scenarios.load(path)).rows}
     direct, indirect = rows["direct"], rows["indirect"]
     assert direct.status == indirect.status == "ok"
-    j_direct, j_costate = direct.reference_metrics["int_u2"], indirect.reference_metrics["int_u2"]
+    j_direct = direct.reference.stats["functional"]["value"]
+    j_costate = indirect.reference.stats["functional"]["value"]
     gap = abs(j_direct - j_costate) / j_costate
     assert 0.0 < gap < 1e-4  # two methods agree
+    # each planner's value of the functional is its reference's ∫‖u‖² (torquers, no environment torque:
+    # the actuators' torque is the body's control torque, measured by the common metric)
+    assert j_direct == pytest.approx(direct.reference_metrics["int_u2"], rel=1e-4)
+    assert j_costate == pytest.approx(indirect.reference_metrics["int_u2"], rel=1e-4)
     for row in (direct, indirect):
         assert row.reference.stats["certificate"]["costate_gap"] == pytest.approx(gap, rel=1e-12)
     assert "co-state gap" in direct.reference.stats["certificate"]["summary"]

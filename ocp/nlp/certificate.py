@@ -34,10 +34,13 @@ Three pieces of evidence, each computed here from the point alone (never from th
 
 :func:`certificate` combines them into the JSON record of ``Reference.stats["certificate"]`` with a
 verdict: ``"certified"`` when the KKT residual (scaled) is at most :data:`KKT_TOLERANCE` and either
-the second-order sufficient conditions hold or, for bang-bang minimum time, the switching agreement
-is at least :data:`SWITCHING_THRESHOLD` (every control at a bound, on the side Pontryagin's minimum
-principle asks, with a switching function clear of zero: strict complementarity on the control
-bounds, which makes the discretised point a vertex, the case ``Z = {0}`` of the second-order check);
+the second-order sufficient conditions hold or, for bang-bang minimum time where the second-order
+check was not made (too many variables), the switching agreement is at least
+:data:`SWITCHING_THRESHOLD` with no sample on the wrong side (the controls at a bound, on the side
+Pontryagin's minimum principle asks, with a switching function clear of zero: strict
+complementarity on the control bounds, which makes the discretised point a vertex, the case
+``Z = {0}`` of the second-order check; a check that was made and found negative curvature is not
+overruled);
 ``"first-order"`` when only the KKT residual is small; ``"not certified"`` otherwise.
 """
 from __future__ import annotations
@@ -344,7 +347,11 @@ def certificate(kkt: KKTResiduals | None, second_order: SecondOrderCheck | str |
     text = _second_order_text(second_order)
     first_order = kkt is not None and kkt.scaled <= kkt_tolerance
     sosc = text == "strict local minimum"
-    bang_bang = switching is not None and switching.agreement >= switching_threshold
+    # The switching evidence stands in for a second-order check that was not made, never for one that
+    # was made and did not certify (negative curvature: a saddle), and only with no sample on the side
+    # Pontryagin forbids.
+    bang_bang = (switching is not None and switching.agreement >= switching_threshold and switching.wrong == 0.0
+                 and text.startswith("not checked"))
     verdict = "certified" if first_order and (sosc or bang_bang) else "first-order" if first_order else "not certified"
     record = {"kkt_scaled": None if kkt is None else kkt.scaled, "kkt_unscaled": None if kkt is None else kkt.unscaled,
               "second_order": text, "switching": None if switching is None else switching.agreement,

@@ -783,8 +783,10 @@ class CollocationPlanner(Planner):
         fixed = [c for c in self._requirements(problem).pointing if not c.moving]
         reference.stats.update(duration=T, max_quaternion_norm_error=norm_error,
                                cones=[(c.boresight, c.directions[0], c.angle, c.keep_out) for c in fixed])
-        if o.objective == "min_energy":  # ∫‖τ‖² of the actuators' torque on the body: the metric int_u2
-            reference.stats["functional"] = "int_u2"
+        if o.objective == "min_energy" and problem.model.nx == 7:
+            # ∫‖τ‖² of the actuators' torque on a rigid body without actuator states (what the
+            # co-state planner's rigid body minimises; wheels add their momentum to the dynamics)
+            reference.stats["functional"] = {"name": "int_actuator_torque_squared", "value": float(result.f)}
         reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {solver}): "
                              f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}")
         if solved.intervals == o.intervals:  # the final mesh: the optimum's certificate (planners.collocation.certificate)

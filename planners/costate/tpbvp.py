@@ -333,13 +333,13 @@ class CostateTPBVPPlanner(Planner):
             return FailedReference(self.name, f"{o.objective}: {failure}")
         stats = {"objective_form": o.objective, "t_f": t_f, "nodes": int(solution.x.size),
                  "max_rms_residual": float(np.max(solution.rms_residuals)), "continuation_stages": stages}
-        if o.objective == "min_energy":  # ½∫‖M_c‖²: minimised with ∫‖u‖², the metric int_u2
-            stats["functional"] = "int_u2"
         if system.torque_control and isinstance(system, RigidBodySystem):
             fine = np.linspace(0.0, t_f, 4001)
             reference = CostateReference(system, solution, t_f, "", {})
             control = reference.sample(fine).torque - system.environment_torque(fine, reference.state_and_costate(fine)[0].T).T
             stats["int_u2"] = float(np.trapezoid(np.sum(control**2, axis=1), fine))
+            if o.objective == "min_energy":  # ½∫‖M_c‖² is minimised with ∫‖M_c‖², the actuators' torque
+                stats["functional"] = {"name": "int_actuator_torque_squared", "value": stats["int_u2"]}
         ends = (solution.y[:, 0], solution.y[:, -1]) + ((solution.p,) if system.free_final_time else ())
         boundary = float(np.max(np.abs(system.boundary(1.0)(*ends)), initial=0.0))
         stats["certificate"] = necessary_conditions_certificate(max(stats["max_rms_residual"], boundary), "solve_bvp")

@@ -154,16 +154,30 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any) -> list[Be
             message = f"leaves {', '.join(free)} free: solves another problem, no gap; {message}"
         rows.append(BenchRow(
             problem.name, row.label, row.planner or "-", "planner", row.status, value, gap_abs, gap_rel,
-            None if gap_abs is None else abs(gap_abs) <= problem.tolerance, row.plan_time_s,
+            _reached(row.status, gap_abs, problem), row.plan_time_s,
             _number((stats or {}).get("iterations")), certificate_text(stats), message))
     return rows
 
 
+def _reached(status: str, gap_abs: float | None, problem: BenchProblem) -> bool | None:
+    """Whether a row reaches the optimum: within the tolerance, and ``ok`` (a row that breaks a
+    requirement or failed never does, however close its value); ``None`` without a gap."""
+    if gap_abs is None:
+        return None
+    return status == "ok" and abs(gap_abs) <= problem.tolerance
+
+
 def _peer_row(problem: BenchProblem, name: str, result: Any) -> BenchRow:
     gap_abs, gap_rel = gap(result.objective, problem.optimum)
+    message = result.message
+    eigenaxis = problem.eigenaxis
+    if (result.objective is not None and eigenaxis is not None and abs(eigenaxis - problem.optimum) > problem.tolerance
+            and abs(result.objective - eigenaxis) <= problem.tolerance):
+        # the peers start from the eigenaxis slew; where that is a stationary point they can stay there
+        message = f"{EIGENAXIS_NOTE}; {message}" if message else EIGENAXIS_NOTE
     return BenchRow(problem.name, f"{name} (peer)", name, "peer", result.status, result.objective, gap_abs, gap_rel,
-                    None if gap_abs is None else abs(gap_abs) <= problem.tolerance, result.solve_time_s,
-                    _number(result.iterations), "-", result.message)
+                    _reached(result.status, gap_abs, problem), result.solve_time_s,
+                    _number(result.iterations), "-", message)
 
 
 @dataclass
@@ -271,7 +285,7 @@ class Leaderboard:
                  "|---|---|---|---|---|---|"]
         for name in dict.fromkeys(row.planner for row in self.rows):
             rows = [row for row in self.rows if row.planner == name]
-            gaps = [abs(row.gap_rel) for row in rows if row.gap_rel is not None]
+            gaps = [abs(row.gap_rel) for row in rows if row.gap_rel is not None and row.status == "ok"]
             times = [row.plan_time_s for row in rows if row.plan_time_s is not None]
             lines.append(f"| {_md(name)} | {rows[0].kind} | {len(rows)} | {sum(1 for row in rows if row.reached)} | "
                          f"{_fmt(_median(gaps), '.2e')} | {_fmt(_median(times), '.3g')} |")
@@ -297,7 +311,7 @@ class Leaderboard:
         drawn = 0
         for k, name in enumerate(names):
             points = [(row.plan_time_s, max(abs(row.gap_rel), GAP_FLOOR)) for row in self.rows
-                      if row.planner == name and row.gap_rel is not None and row.plan_time_s]
+                      if row.planner == name and row.gap_rel is not None and row.plan_time_s and row.status == "ok"]
             if not points:
                 continue
             kind = next(row.kind for row in self.rows if row.planner == name)
@@ -374,11 +388,14 @@ def _fmt(value: float | None, spec: str = ".6g") -> str:
 
 NOTE_CHARS = 100
 """Longest note in the Markdown table (the CSV and JSON keep the whole message)."""
+EIGENAXIS_NOTE = "stopped at the eigenaxis slew's value: the stationary point of its start (the eigenaxis guess)"
+"""The note of a peer whose value is the eigenaxis slew's where that is not the optimum."""
 
 
 def _note(row: BenchRow) -> str:
-    """The row's message when it is not ok or has no gap, shortened; else empty."""
-    if row.status == "ok" and row.gap_abs is not None:
+    """The row's message when it is not ok, has no gap or is a peer stopped at the eigenaxis slew,
+    shortened; else empty."""
+    if row.status == "ok" and row.gap_abs is not None and not row.message.startswith(EIGENAXIS_NOTE):
         return ""
     text = row.message.strip()
     return text if len(text) <= NOTE_CHARS else text[:NOTE_CHARS - 1] + "…"

@@ -319,6 +319,9 @@ class AcadosBenchPeer:
                 build += float(self._worker._ask({"op": "build", **data})["build_s"])
                 answer = self._worker.solve()
             except RuntimeError as error:
+                if self._worker._process.poll() is not None:  # it died: the next problem starts a new one
+                    self._worker.close()
+                    self._worker = None
                 return PeerResult(None, 0.0, "failed", None, str(error), build or None)
             if answer["status"] != "qp_failure":
                 break
@@ -475,18 +478,20 @@ def _serve() -> None:
     answers = os.fdopen(os.dup(1), "w")
     os.dup2(2, 1)
     sys.stdout = sys.stderr
-    for line in sys.stdin:
-        try:
-            request = json.loads(line)
-            op = request.pop("op")
-            answer = worker.build(request) if op == "build" else worker.solve()
-        except Exception as error:  # noqa: BLE001 (any failure is reported to the parent, which raises it)
-            answer = {"error": f"{type(error).__name__}: {error}"}
-        answers.write(json.dumps(answer) + "\n")
-        answers.flush()
     import shutil
 
-    shutil.rmtree(worker.home, ignore_errors=True)  # the generated code and libraries of this run
+    try:
+        for line in sys.stdin:
+            try:
+                request = json.loads(line)
+                op = request.pop("op")
+                answer = worker.build(request) if op == "build" else worker.solve()
+            except Exception as error:  # noqa: BLE001 (any failure is reported to the parent, which raises it)
+                answer = {"error": f"{type(error).__name__}: {error}"}
+            answers.write(json.dumps(answer) + "\n")
+            answers.flush()
+    finally:  # also on Ctrl-C (the terminal sends it to the worker too) or a closed pipe
+        shutil.rmtree(worker.home, ignore_errors=True)  # the generated code and libraries of this run
 
 
 if __name__ == "__main__" and sys.argv[1:] == ["--worker"]:
