@@ -321,35 +321,66 @@ def test_an_l1_transfer_takes_the_adaptive_barrier(monkeypatch, objective, adapt
         assert default.stats["iterations"] < 30  # 63 with the monotone barrier
 
 
-@pytest.mark.parametrize("options, adaptive", [
-    ({"objective": "min_l1"}, True),
-    ({"objective": "weighted", "time_weight": 1.0, "l1_weight": 1.0, "energy_weight": 0.0}, True),  # free final time
-    ({"objective": "weighted", "energy_weight": 1.0, "l1_weight": 0.1}, False),  # 172 iterations against 151
-    ({"objective": "min_energy"}, False),
-    ({"objective": "min_time"}, False),  # adaptive: 5-8 % more instructions on the benchmark cases
-    ({"objective": "min_l1", "solver": "fatrop"}, False),  # transfer is a cold start for FATROP
+KEEP_OUT = [{"boresight": [0, 0, 1], "direction": [0, 1, 0], "angle_deg": 20.0}]
+
+
+@pytest.mark.parametrize("options, barrier", [
+    ({"objective": "min_l1"}, ("adaptive", None)),
+    # free final time with an L1 term: the L1 barrier (the quality-function oracle)
+    ({"objective": "weighted", "time_weight": 1.0, "l1_weight": 1.0, "energy_weight": 0.0}, ("adaptive", None)),
+    ({"objective": "weighted", "energy_weight": 1.0, "l1_weight": 0.1}, (None, None)),  # 172 iterations against 151
+    ({"objective": "min_energy"}, (None, None)),
+    # minimum time: the probing oracle (TRANSFER_MIN_TIME_BARRIER; Bilimoria & Wie 7 iterations against 10)
+    ({"objective": "min_time"}, ("adaptive", "probing")),
+    ({"objective": "min_time", "keep_out": KEEP_OUT}, (None, None)),  # another local minimum on Melton's case
+    ({"objective": "weighted", "time_weight": 1.0, "energy_weight": 1.0}, (None, None)),  # 40 against 23 (two wheels)
+    ({"objective": "min_l1", "solver": "fatrop"}, None),  # transfer is a cold start for FATROP
 ])
-def test_only_the_transfer_of_an_l1_objective_without_energy_is_adaptive(monkeypatch, options, adaptive):
-    # Pins the condition of TRANSFER_L1_BARRIER build by build (the end-to-end test above covers
-    # min_l1 and min_energy only: dropping its energy or L1 test, or leaving out the time-weighted
-    # L1 objective, went unnoticed there): only the full-mesh build started from the coarse optimum
-    # takes the adaptive barrier, and only for an L1 term without an energy term.
+def test_only_the_transfer_of_an_l1_objective_without_energy_or_of_min_time_changes_the_barrier(monkeypatch, options,
+                                                                                              barrier):
+    # Pins the conditions of TRANSFER_L1_BARRIER and TRANSFER_MIN_TIME_BARRIER build by build (the
+    # end-to-end test above covers min_l1 and min_energy only: dropping its energy or L1 test, or
+    # leaving out the time-weighted L1 objective, went unnoticed there): only the full-mesh build
+    # started from the coarse optimum takes another barrier, the adaptive one for an L1 term without
+    # an energy term, the adaptive one with the probing oracle and the affine corrector for minimum
+    # time (no energy or L1 term) without cones.
     from ocp.transcription import base as transcription_base
 
     strategies = {}
     build = transcription_base.Transcription.build
     monkeypatch.setattr(transcription_base.Transcription, "build", lambda self, ocp, solver, extra: strategies.update(
-        {mode: extra.get("ipopt.mu_strategy")}) or build(self, ocp, solver, extra))
+        {mode: (extra.get("ipopt.mu_strategy"), extra.get("ipopt.mu_oracle"))}) or build(self, ocp, solver, extra))
     problem = bounded_single_axis()
     planner = PLANNERS["collocation"]({"intervals": 4, **options})
     ocp = planner._ocp(problem)
     for mode in ("cold", "warm", "near_optimum", "transfer"):
         planner._nlp(problem, ocp, mode)
-    if options.get("solver") == "fatrop":  # near_optimum and transfer are the cold build (a cache hit)
-        assert strategies == {"cold": None, "warm": None}
+    if barrier is None:  # FATROP: near_optimum and transfer are the cold build (a cache hit)
+        assert strategies == {"cold": (None, None), "warm": (None, None)}
     else:
-        expected = "adaptive" if adaptive else None
-        assert strategies == {"cold": None, "warm": None, "near_optimum": None, "transfer": expected}
+        assert strategies == {"cold": (None, None), "warm": (None, None), "near_optimum": (None, None),
+                              "transfer": barrier}
+
+
+def test_the_min_time_transfer_reaches_the_direct_solves_optimum_in_fewer_iterations():
+    # Bilimoria & Wie (published 3.2431): the full mesh from the coarse optimum with the probing
+    # oracle (TRANSFER_MIN_TIME_BARRIER) 7 IPOPT iterations against 10 with the monotone barrier
+    # from 1e-7, to the optimum of the 50-interval solve without the coarse mesh.
+    from planners.collocation import planner as planner_module
+
+    problem = ManeuverProblem(Spacecraft([1.0, 1.0, 1.0], torquers=Torquers(1.0)), quat.IDENTITY, np.zeros(3),
+                              quat.from_axis_angle([1, 0, 0], np.pi), 10.0, omegaf=np.zeros(3))
+    default = PLANNERS["collocation"]({"objective": "min_time"}).plan(problem)
+    direct = PLANNERS["collocation"]({"objective": "min_time", "coarse_intervals": 0}).plan(problem)
+    assert default.ok and direct.ok and "coarse" in default.stats, default.message
+    assert default.duration == pytest.approx(3.2431, abs=2e-4)
+    assert default.stats["objective"] == pytest.approx(direct.stats["objective"], rel=1e-8)
+    monotone = PLANNERS["collocation"]({"objective": "min_time"})
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(planner_module, "TRANSFER_MIN_TIME_BARRIER", {})
+        before = monotone.plan(problem)
+    assert before.stats["objective"] == pytest.approx(default.stats["objective"], rel=1e-8)
+    assert default.stats["iterations"] < before.stats["iterations"]
 
 
 def wheel_slew_30_deg():

@@ -76,6 +76,7 @@ from planners.collocation.strategy import (
     SEED_TOLERANCE,
     TRANSFER_L1_BARRIER,
     TRANSFER_MAX_INTERVALS,
+    TRANSFER_MIN_TIME_BARRIER,
     TRANSFER_WARM_START,
     control_floor,
     merged,
@@ -149,7 +150,8 @@ class CollocationOptions:
         least twice as many ``intervals``, and to the looser tolerance
         :data:`~planners.collocation.strategy.SEED_TOLERANCE`: that optimum is only a seed) and the
         full mesh is solved once from that optimum and its multipliers carried over (IPOPT, its
-        barrier adaptive for an L1 term without an energy term; with ``time_regularization`` the
+        barrier adaptive for an L1 term without an energy term and, with Mehrotra's probing oracle,
+        for minimum time without cones; with ``time_regularization`` the
         regularised optimum, then polished on the full mesh; falling back to that optimum alone
         with the barrier starting at 1e-4, then to the full-mesh solve from the starts); 0 or >=
         ``intervals``: off. Default 8.
@@ -321,7 +323,8 @@ class CollocationPlanner(Planner):
         alone (``cold``), with its multipliers (``warm``, :func:`ocp.nlp.solve.warm_start_options`), near
         the optimum (``near_optimum``: IPOPT's barrier starts at :data:`POLISH_MU_INIT`) or with the
         multipliers of a coarse-mesh optimum (``transfer``: :data:`TRANSFER_WARM_START`, with
-        :data:`TRANSFER_L1_BARRIER` for an L1 objective without an energy term). A fixed final
+        :data:`TRANSFER_L1_BARRIER` for an L1 objective without an energy term and
+        :data:`TRANSFER_MIN_TIME_BARRIER` for minimum time without cones). A fixed final
         time on other than the option's ``intervals`` is the coarse seed: solved to
         :data:`SEED_TOLERANCE` at the least (by FATROP with :data:`SEED_FATROP` where
         :meth:`_seed_solver` chooses it for the ``solver`` option IPOPT; a ``solver: fatrop`` seed
@@ -337,6 +340,8 @@ class CollocationPlanner(Planner):
                  "transfer": warm_start_options(solver, **TRANSFER_WARM_START)}[mode]
         if mode == "transfer" and ocp.l1_weight > 0 and ocp.energy_weight == 0:
             extra = {**(extra or {}), **TRANSFER_L1_BARRIER}
+        elif mode == "transfer" and ocp.free_time and not (ocp.energy_weight or ocp.l1_weight or ocp.cones):
+            extra = {**(extra or {}), **TRANSFER_MIN_TIME_BARRIER}
         if seed_only and solver == "fatrop" and o.solver == "ipopt":  # the IPOPT option's FATROP seed only
             extra = {**(extra or {}), **SEED_FATROP}
         # The extra options in the key: a shared cache also serves planners whose options differ

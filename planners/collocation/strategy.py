@@ -103,6 +103,41 @@ iterates); the pushes of :data:`TRANSFER_WARM_START` still apply. ``weighted`` w
 weights and no energy term (free final time) takes it too: 10 problems, 136 full-mesh iterations
 against 213."""
 
+TRANSFER_MIN_TIME_BARRIER = {"ipopt.mu_strategy": "adaptive", "ipopt.mu_oracle": "probing",
+                             "ipopt.corrector_type": "affine"}
+"""Added to :data:`TRANSFER_WARM_START` for minimum time (a free final time, no energy or L1 term) without
+cones: IPOPT's adaptive barrier with Mehrotra's probing oracle and an affine-scaling corrector step,
+its line search kept. The full-mesh solve from the coarse optimum and its multipliers (measured
+2026-12-02 against the monotone barrier from 1e-7, the same seeds, optima the same to 1e-7
+relative unless said):
+
+- Bilimoria & Wie 7 IPOPT iterations against 10, the full-inertia case 6 against 10, XTE 7
+  against 10; that solve alone (CPU, 15 alternating rounds) 27.4 against 31.0 ms and 25.6 against
+  31.7 ms (0.88x, 0.81x): an iteration costs 26-35 % more (the oracle's and the corrector's extra
+  back-solves); the whole plan 0.98x, 0.90x and 0.96x (21 alternating rounds, load 3.5);
+- the 23 minimum-time cases of ``tests/benchmarks/iteration_counts.py``: 224 full-mesh iterations
+  against 321, more on two (mt11 20 against 19, mt17 17 against 15);
+- the suite's and the scenarios' minimum-time problems without cones (Bilimoria & Wie at 180, 90
+  and 45 deg, the full inertia, XTE, the norm-bounded eigenaxis, ``collocation_min_time.yaml``):
+  66 against 77 (45 deg 25 against 21: 1.7470935 against 1.7470940, where the 50-interval mesh
+  has several minima within 1e-6, direct solves reach 1.7470928 and 1.7470936; the norm-bounded
+  eigenaxis 7 against 5);
+- 15 more on three reaction wheels, with a rate-norm bound (re-solved on the same mesh by this
+  warm start), from a spin with a free final rate and with a per-axis rate box: 144 against 208;
+- ``transcription: multiple_shooting`` on seven of those (Bilimoria & Wie, the full inertia, mt0,
+  mt3, mt5, mt11, mt17): 150 against 179 (B&W 19 against 28; mt0 79 against 78, mt5 18 against
+  17), the same optima to 2e-9.
+
+IPOPT's ``mehrotra_algorithm`` (the same three with the line search off) did as well on the first
+two but took mt0 61 against 51 and mt11 28 against 19; the probing oracle alone 11 and 10
+iterations, the corrector alone 10 and 10. Not with cones: Melton's keep-out case ends at another
+local minimum of the full mesh (2.589954 against 2.589941, 19 iterations either way). Not with an
+energy term: ``time_regularization``'s regularised transfer on two wheels 40 against 23. Not for a
+fixed final time: the spin-like sp4 of ``iteration_counts.py`` 63 against 47. Not on the coarse
+mesh (cold starts): Bilimoria & Wie 117 coarse iterations against 63, and other minima on two of
+23 cases. The adaptive strategy ignores ``mu_init``; the pushes of :data:`TRANSFER_WARM_START`
+still apply."""
+
 AGREE_RTOL = 1e-6
 """Relative agreement of two starts' objectives (:func:`ocp.nlp.solve.solve_multistart`'s
 ``rtol``): what early stopping and ``stats["seeds"]["agreed"]`` count as the same optimum."""

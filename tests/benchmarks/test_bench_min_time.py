@@ -20,8 +20,10 @@ alternates ours (default options, after the build) with acados (RK4 multiple sho
 Hessian SQP, partially condensing HPIPM; min time from the shared guess, min energy from its own
 eigenaxis guess), ROUNDS pairs per case, and prints medians, spreads (min..max), the ratio of the
 medians of the pairwise ratios, SQP/IPOPT iterations, acados's build time and the load (``uptime``).
-acados options: ``regularize_method: PROJECT`` with merit backtracking (17 SQP iterations on
-Bilimoria & Wie); on the full-inertia case that stops at a QP failure in SQP iteration 2 (T driven to
+acados options: ``regularize_method: PROJECT`` with merit backtracking, on Bilimoria & Wie with a
+Levenberg-Marquardt term of 1e-3 (17 SQP iterations; without it, from today's shared guess, it stops
+at a QP failure in SQP iteration 4 at T = 5.081, on main as on this branch, 2026-12-02; MIRROR takes
+32 iterations, MIRROR with 0.1 47, CONVEXIFY fails too); on the full-inertia case that stops at a QP failure in SQP iteration 2 (T driven to
 its lower bound; so do MIRROR, CONVEXIFY, a Levenberg-Marquardt term of 1e-3 and 200 QP
 iterations), and only ``levenberg_marquardt: 0.1`` with MIRROR converges (7.68339, 64 iterations).
 Run it with ``SLEWBENCH_ACADOS_PYTHON`` naming the interpreter that has ``comma-deps-acados``.
@@ -69,6 +71,55 @@ load 9-11), none landed:
 * Condensing each interval's collocation variables (an implicit integrator with sensitivities,
   7-state stages): not built in this session; MUMPS's share (about 50 % with its BLAS) is what it
   could shrink.
+
+Measured 2026-12-02 (issue 30's target: at most 1.0x acados on Bilimoria & Wie; load 7.5-9, other
+helpers running; 9 alternating rounds per run, two runs per version, this branch against the
+previous full-mesh barrier in the same process):
+
+==========================  ==================  ==================  =========================
+case                        ours/acados, now    before (same run)   ours, IPOPT full mesh
+==========================  ==================  ==================  =========================
+B&W 180° min time           2.78, 2.60          2.75, 2.83          7 iterations (10 before)
+full inertia min time       0.65, 0.68          0.71, 0.73          6 iterations (10 before)
+==========================  ==================  ==================  =========================
+
+(medians of the pairwise ratios; spreads 1.8..3.3 and 0.4..0.9; under this load both versions sit
+at 2.6-2.8x on B&W against yesterday's 2.0x at load 6-9; through pytest at load 4.3: 2.59 [2.12..3.32]
+and 0.64 [0.40..0.68].) The FATROP and rockit peers by pytest-benchmark (5 rounds each, one after
+another, not alternating, load 5.5), medians: B&W ours 519 ms, FATROP 293 ms, rockit 684 ms; full
+inertia 221, 509 and 349 ms (ahead of both on the full inertia, of rockit on B&W, behind the FATROP
+peer on B&W as before: 1.49x in docs/performance.rst). The target is not met. What landed:
+the full-mesh solve from the coarse optimum takes IPOPT's adaptive barrier with the probing oracle
+and an affine corrector for minimum time without cones
+(:data:`planners.collocation.strategy.TRANSFER_MIN_TIME_BARRIER`): valgrind (callgrind, deterministic)
+counts 846 M instructions per plan against 898 M on B&W (0.94x) and 458 M against 547 M on the full
+inertia (0.84x); CPU per plan 0.98x, 0.90x and 0.96x on B&W, full inertia and XTE (21 alternating
+rounds, load 3.5). Where B&W's time goes now: the 50-interval solve 322 M of the 846 M (7
+iterations, 46 M each: MUMPS's LDLᵀ front kernels, OpenBLAS and the memset of MUMPS's allocations
+most of it), the two coarse starts most of the rest (the perturbed eigenaxis 39 iterations, the
+spin extremal's 24: two starts must agree, and skipping one gives up a seed planner's start); by
+cProfile the solver calls are 87 % of the plan, the rest spread thin (the certificate 5 ms, the
+spin-extremal seed planner's own solves 9 ms, the seeds 3 ms). Routes measured and not landed:
+
+* the coarse starts' seed duration (the seed planners planned over the eigenaxis bang-coast-bang
+  time instead of the problem's bound): 340 coarse iterations against 407 over six noise seeds on
+  B&W, 73 against 110 on the full inertia, 384 against 439 on XTE, the same optima there; but on
+  the 23 minimum-time cases of ``iteration_counts.py`` another local minimum on two (mt6 11.12078
+  against 10.84442, worse; mt17 10.224 against 10.30048, better): it moves starts between basins;
+* ``coarse_intervals`` 6 (0.87x on B&W) reaches XTE's 29.41862 from one of six noise seeds;
+  4, 5, 10 and 12 cost more;
+* on the coarse mesh: ``mu_init`` 1e-2 or 1e-3 (351 and 358 coarse iterations against 340), the
+  adaptive barrier with the probing oracle and the affine corrector (B&W 117 against 63; other
+  minima on 2 of 23), ``barrier_tol_factor`` 100 and ``mu_linear_decrease_factor`` 0.1 (other
+  minima on mt6 or mt17), ``perturb_always_cd`` and ``kappa_d`` 0 (no change), tolerances 1e-8 and
+  1e-7 (the second-order check of the coarse optimum then fails more often and restarts follow:
+  more time); 1e-9 changes nothing;
+* the full-mesh warm start: ``mu_init`` 1e-9 to 1e-5 with pushes 1e-5 to 1e-2 and multiplier pushes
+  1e-6 to 1e-3: 10 iterations at the least on both cases; ``alpha_for_y`` variants, ``max_soc`` 0,
+  ``tau_min`` 0.9, ``cg-penalty`` line search: 10; IPOPT's ``mehrotra_algorithm`` (no line search)
+  7 and 6, but 61 against 51 and 28 against 19 on mt0 and mt11;
+* MUMPS's QAMD ordering on the full-mesh solve: 309 M against 322 M instructions per solve (0.96x);
+  METIS 1.2x the CPU, AMD and PORD within noise.
 """
 from __future__ import annotations
 
@@ -191,7 +242,8 @@ def test_min_energy_spin_case_build(benchmark):
 
 
 ROUNDS = 9
-ACADOS_OPTIONS = {"bilimoria_wie": {}, "full_inertia": {"levenberg_marquardt": 0.1, "regularize_method": "MIRROR"},
+ACADOS_OPTIONS = {"bilimoria_wie": {"levenberg_marquardt": 1e-3},
+                  "full_inertia": {"levenberg_marquardt": 0.1, "regularize_method": "MIRROR"},
                   "spin_min_energy": {}, "spin_min_energy_best": {}}
 """acados options per case (the module docstring says why)."""
 
