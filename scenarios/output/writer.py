@@ -19,7 +19,7 @@ from scenarios.output.directory import (
     new_staging,
 )
 from scenarios.output.names import row_stems
-from scenarios.output.tables import csv_cell, to_csv, to_json, to_markdown
+from scenarios.output.tables import to_csv, to_json, to_markdown
 
 if TYPE_CHECKING:
     from scenarios.output.results import Row, RunResults
@@ -58,11 +58,14 @@ def write_timeseries(row: Row, path: Path) -> None:
     else:
         ref = np.full((sim.t.size, 10), np.nan)
     table = np.hstack([sim.t[:, None], sim.x, torque, ref])
+    finite = np.isfinite(table).tolist()
     with path.open("w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(header)
-        for line in table:
-            writer.writerow([csv_cell(float(v)) for v in line])
+        # csv_cell of each value, without its checks per cell (every value is a float here): the
+        # repr of a finite value, blank otherwise
+        writer.writerows([repr(v) if ok else "" for v, ok in zip(line, keep)]
+                         for line, keep in zip(table.tolist(), finite))
 
 
 def plot_streamer(scenario: Any, renderer: Any) -> Callable[[Row], None]:
