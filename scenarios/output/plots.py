@@ -393,6 +393,11 @@ class RowFigure:
         artists.extend(self.off_scale.values())
         return artists
 
+    @property
+    def prepared(self) -> bool:
+        """Whether the static part has been drawn (by :meth:`prepare`), for some time limits."""
+        return self._background is not None
+
     def prepare(self, series: RowSeries) -> None:
         """Set a row's curves and limits, and have the static part for its time limits drawn
         (drawn now if it is not yet, else restored): what :meth:`draw` does before the row's own
@@ -516,7 +521,7 @@ def png_bytes(rgba: np.ndarray, dpi: float = DPI, level: int = COMPRESS_LEVEL) -
     return b"".join([PNG_SIGNATURE,
                      _png_chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)),  # 8-bit RGB
                      _png_chunk(b"pHYs", struct.pack(">IIB", per_metre, per_metre, 1)),
-                     _png_chunk(b"IDAT", zlib.compress(lines, level)),
+                     _png_chunk(b"IDAT", zlib.compress(lines.data, level)),
                      _png_chunk(b"IEND", b"")])
 
 
