@@ -125,7 +125,7 @@ def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer:
     streamed to it already (:func:`plot_streamer`) are sent to it and the report is built here
     while it draws; without one (or if it fails), both are made in this process."""
     from scenarios.output.plot_data import plot_jobs
-    from scenarios.output.report.run import run_report
+    from scenarios.output.report.run import run_page
 
     if renderer is not None:
         from scenarios.output.renderer import RenderingFailed
@@ -136,7 +136,7 @@ def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer:
         except RenderingFailed as error:
             print(f"slewbench: {error}; drawing the plots in this process", file=sys.stderr)
             renderer = None
-    (staging / "report.html").write_text(run_report(results), encoding="utf-8")
+    (staging / "report.html").write_bytes(run_page(results).render_bytes())  # run_report's text, as UTF-8
     if renderer is not None:
         try:
             renderer.wait()

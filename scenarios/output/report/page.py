@@ -32,7 +32,8 @@ from ocp.metrics import METRIC_INFO
 from scenarios.output.tables import json_safe
 from scenarios.schema.columns import SCOPES, VECTOR_METRICS, is_requirement_column
 
-__all__ = ["FIGURE_DIGITS", "PLOTLY_CONFIG", "Column", "Page", "column_unit", "figure_array", "figure_arrays", "plotly_js"]
+__all__ = ["FIGURE_DIGITS", "PLOTLY_CONFIG", "Column", "Page", "column_unit", "figure_array", "figure_arrays", "plotly_js",
+           "plotly_js_bytes"]
 
 FIGURE_DIGITS = 7
 """Significant digits of the numbers in a figure's arrays (more than a hover label shows)."""
@@ -43,12 +44,12 @@ _REQUIREMENT_FIELD_UNITS = {"peak_rate": "rad/s", "worst_rate_error": "rad/s", "
 
 
 @cache
-def plotly_js() -> str:
-    """The plotly.js bundle shipped with the ``plotly`` package (read once per process).
+def plotly_js_bytes() -> bytes:
+    """The plotly.js bundle shipped with the ``plotly`` package, as UTF-8 bytes (read once per process).
 
     Returns
     -------
-    str
+    bytes
         The minified script, ready to inline (``</script`` escaped, should it ever occur).
 
     Raises
@@ -60,7 +61,25 @@ def plotly_js() -> str:
     if spec is None or not spec.submodule_search_locations:
         raise ModuleNotFoundError("the HTML report needs the plotly package (pip install plotly)", name="plotly")
     path = Path(next(iter(spec.submodule_search_locations))) / "package_data" / "plotly.min.js"
-    return path.read_text(encoding="utf-8").replace("</script", "<\\/script")
+    text = path.read_bytes()
+    text.decode("utf-8")  # raises if the file is not UTF-8, as reading it as text would
+    return text.replace(b"</script", b"<\\/script")
+
+
+def plotly_js() -> str:
+    """The plotly.js bundle shipped with the ``plotly`` package (:func:`plotly_js_bytes` as text).
+
+    Returns
+    -------
+    str
+        The minified script, ready to inline (``</script`` escaped, should it ever occur).
+
+    Raises
+    ------
+    ModuleNotFoundError
+        When the ``plotly`` package is not installed.
+    """
+    return plotly_js_bytes().decode("utf-8")
 
 
 def column_unit(column: str) -> str:
@@ -391,6 +410,18 @@ class Page:
         Returns
         -------
         str
+            One self-contained document (plotly.js, the data and the script inline):
+            :meth:`render_bytes` as text.
+        """
+        return self.render_bytes().decode("utf-8")
+
+    def render_bytes(self) -> bytes:
+        """The page's HTML as the UTF-8 bytes of its file: plotly.js (most of the page) is copied
+        in as read, never decoded into text and encoded again.
+
+        Returns
+        -------
+        bytes
             One self-contained document (plotly.js, the data and the script inline).
         """
         for key, explorer in self._data["explorers"].items():
@@ -399,14 +430,15 @@ class Page:
         contents = "".join(f'<li><a href="#{ident}">{html.escape(title)}</a></li>' for ident, title in self._sections)
         nav = f'<nav><ul>{contents}</ul></nav>' if self._sections else ""
         data = _json({**self._data, "config": PLOTLY_CONFIG})
-        return "".join([
+        head = "".join([
             "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">",
             "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">",
-            f"<title>{html.escape(self.title)}</title><style>{STYLE}</style>",
-            f"<script>{plotly_js()}</script></head><body>",
-            *self._head, nav, *self._body,
+            f"<title>{html.escape(self.title)}</title><style>{STYLE}</style>", "<script>"])
+        body = "".join([
+            "</script></head><body>", *self._head, nav, *self._body,
             f'<script type="application/json" id="slewbench-data">{data}</script>',
             f"<script>{SCRIPT}</script></body></html>\n"])
+        return b"".join([head.encode("utf-8"), plotly_js_bytes(), body.encode("utf-8")])
 
 
 STYLE = """
