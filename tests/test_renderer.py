@@ -225,12 +225,12 @@ def test_report_html_is_built_while_the_plot_process_draws_and_a_death_meanwhile
         renderer = Renderer.start()
         import scenarios
         import scenarios.output.report.run as report
-        build = report.run_report
+        build = report.run_page  # what the writer builds report.html with
         def killing(results):
             assert renderer._submitted, "report.html built before the figures were sent"
             os.kill(renderer.pid, signal.SIGKILL)
             return build(results)
-        report.run_report = killing
+        report.run_page = killing
         results = scenarios.run(scenarios.load(sys.argv[1]))
         results.write(sys.argv[2], renderer=renderer)
         renderer.close()

@@ -38,9 +38,10 @@ from typing import Any, NamedTuple
 
 SINGLE_THREAD_ENVIRONMENT = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 """Set to 1 in the child before it imports NumPy: drawing needs no BLAS threads."""
-COST = {"row": 1.0, "other": 1.3}
-"""Relative drawing costs (about 0.1 s each on the reference machine) of one row on its figure,
-whose static part is drawn before the fork (:func:`_draw_in_two`), and of any other figure."""
+COST = {"row": 1.0, "other": 2.5}
+"""Relative drawing costs of one row on its figure, whose static part is drawn before the fork
+(:func:`_draw_in_two`), and of any other figure (measured, CPU: a row 0.06-0.11 s; the comparison
+per axis 2.6-3.2 rows, the margins about 2, the sky about 3)."""
 PIPE_BYTES = 1 << 20
 """Capacity asked for the pipe to the child (Linux's ``F_SETPIPE_SZ``; 1 MiB is the unprivileged
 limit): a streamed row's series (about 80 kB pickled for the demo scenario, more than the default
@@ -386,6 +387,20 @@ def _draw_into_memory(jobs: list[Any], figures: dict[Any, Any]) -> dict[str, byt
     return drawn
 
 
+def _prepare_first(pending: list[Any], figures: dict[Any, Any]) -> bool:
+    """If the next figure is a row of a shape without a drawn static part, build its figure and
+    draw that part (:meth:`RowFigure.prepare`) and say so: the row itself and whatever else has come
+    meanwhile can then be shared with a helper, which inherits the static part."""
+    from scenarios.output.plot_data import RowSeries
+    from scenarios.output.plots import RowFigure
+
+    series = pending[0][1] if pending else None
+    if not isinstance(series, RowSeries) or (series.shape in figures and figures[series.shape].prepared):
+        return False
+    figures.setdefault(series.shape, RowFigure(*series.shape)).prepare(series)
+    return True
+
+
 def _share(pending: list[Any], figures: dict[Any, Any]) -> tuple[list[Any], list[Any]]:
     """What the plot process keeps and what a helper draws of the streamed figures not drawn yet:
     shared by :func:`split`, once the static part of every row shape among them is drawn (a
@@ -547,11 +562,13 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
                 pending.extend(undrawn)
                 failure, helper = failure or failed, None
             if final is None and not failure:  # idle: streamed figures, drawn into memory
-                if helper is None and len(pending) > 1 and _thread_count() == 1:
-                    pending, theirs = _share(pending, figures)
-                    if theirs:
-                        helper = _start_helper(theirs, figures, forks, (receive_fd, send_fd))
                 try:
+                    if _prepare_first(pending, figures):
+                        continue  # a new row shape's static part drawn: share what waits now
+                    if helper is None and len(pending) > 1 and _thread_count() == 1:
+                        pending, theirs = _share(pending, figures)
+                        if theirs:
+                            helper = _start_helper(theirs, figures, forks, (receive_fd, send_fd))
                     drawn.update(_draw_into_memory([pending.pop(0)], figures) if pending else {})
                 except Exception:  # reported with the answer
                     failure = traceback.format_exc()
