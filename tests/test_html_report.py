@@ -276,6 +276,28 @@ STUDY = {"study": "html-study-test", "scenario": {k: v for k, v in SCENARIO.item
          "summary": ["cl.final_error_deg", "cl.int_u"]}
 
 
+def test_arrays_rounded_together_are_each_array_rounded_alone(rng):
+    """The report's arrays are rounded in one batch (figure_arrays): each comes back in its own
+    shape, to seven significant digits of its own values (checked against the decimal rounding
+    of Python's formatting), None exactly where it is not finite, as figure_array gives it alone."""
+    from scenarios.output.report.page import FIGURE_DIGITS, figure_array, figure_arrays
+
+    arrays = [rng.normal(size=2) * 10.0 ** rng.integers(-12, 12), np.array([0.0, np.nan, -np.inf, 1e-300]),
+              rng.normal(size=(3, 4)) * 1e5, np.empty(0), np.array(7.0), np.full((2, 2), np.inf),
+              rng.normal(size=61), [1.0, 2.5], np.arange(5)]
+    together = figure_arrays(arrays)
+    assert together == [figure_array(a) for a in arrays]
+    for values, plain in zip(arrays, together):
+        values = np.asarray(values, dtype=float)
+        flat = np.asarray(plain, dtype=object).ravel().tolist() if values.ndim else [plain]
+        assert np.shape(np.asarray(plain, dtype=object)) == values.shape
+        for value, kept in zip(values.ravel().tolist(), flat):
+            if not np.isfinite(value):
+                assert kept is None
+            else:  # within half a unit of the seventh significant digit, and that decimal itself
+                assert kept == pytest.approx(float(f"{value:.{FIGURE_DIGITS}g}"), rel=1e-15, abs=0.0)
+
+
 @pytest.fixture(scope="module")
 def study_out(tmp_path_factory):
     study = json.loads(json.dumps(STUDY))

@@ -300,3 +300,30 @@ def test_a_bad_euler_sequence_names_its_yaml_path(value):
     data["plots"] = {"euler_sequence": value}
     with pytest.raises(ScenarioError, match=r"plots\.euler_sequence: expected an Euler sequence, one of \['321'"):
         parse_scenario(data)
+
+
+def test_png_bytes_is_a_png_of_the_canvas_pixels_with_its_resolution(rng):
+    """The PNG writer (unfiltered lines, one deflate) reads back, through Pillow's own decoder, as the
+    drawn RGB pixels of a figure and a random image (every byte value, no flat areas), with the dpi."""
+    import io
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from scenarios.output.plot_data import DPI
+    from scenarios.output.plots import png_bytes
+
+    figure = Figure(figsize=(3.1, 1.7), dpi=DPI)
+    canvas = FigureCanvasAgg(figure)
+    figure.subplots().plot([0, 1, 2], [2, 0, 1], label="a")
+    canvas.draw()
+    drawn = np.asarray(canvas.buffer_rgba())
+    noise = rng.integers(0, 256, size=(7, 11, 4), dtype=np.uint8)
+    for rgba in (drawn, noise):
+        data = png_bytes(rgba)
+        assert data[:8] == b"\x89PNG\r\n\x1a\n"
+        with Image.open(io.BytesIO(data)) as image:
+            image.load()  # decodes every line and checks the chunks' CRCs
+            assert image.mode == "RGB" and image.size == (rgba.shape[1], rgba.shape[0])
+            assert np.array_equal(np.asarray(image), rgba[..., :3])
+            assert image.info["dpi"] == pytest.approx((DPI, DPI), abs=0.01)

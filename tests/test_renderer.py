@@ -119,6 +119,49 @@ def test_figures_streamed_during_the_run_are_those_drawn_in_process(tmp_path, sc
         np.testing.assert_array_equal(_pixels(tmp_path / "forked" / name), _pixels(tmp_path / "here" / name))
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the plot process exists on Linux only")
+@pytest.mark.parametrize("kill_helper", [False, True])
+def test_figures_streamed_faster_than_drawn_are_shared_with_a_helper(tmp_path, kill_helper):
+    """Figures that wait while the idle plot process draws are shared with a fork of it (a helper,
+    drawing into memory) without waiting for the run's end; what both drew is written, pixel for
+    pixel the figures drawn in process. A helper killed while it draws costs only time: the plot
+    process draws its figures itself."""
+    done = _python("""
+        import sys, os, signal, time
+        from pathlib import Path
+        from scenarios.output.renderer import Renderer
+        renderer = Renderer.start()
+        import scenarios
+        from scenarios.output.plot_data import plot_jobs
+        from scenarios.output.plots import draw_jobs
+        jobs = plot_jobs(scenarios.run(scenarios.load(sys.argv[1])))
+        jobs = [(f"{k}-{name}", series) for k in range(4) for name, series in jobs]
+        for job in jobs:
+            renderer.stream(job, None)
+        children = Path(f"/proc/{renderer.pid}/task/{renderer.pid}/children")
+        deadline, helpers = time.monotonic() + 60.0, []
+        while not helpers and time.monotonic() < deadline:
+            helpers = children.read_text().split()
+            time.sleep(0.002)
+        print("helper", len(helpers))
+        if sys.argv[3] == "True" and helpers:
+            os.kill(int(helpers[0]), signal.SIGKILL)
+        out, here = Path(sys.argv[2]) / "out", Path(sys.argv[2]) / "here"
+        out.mkdir(); here.mkdir()
+        renderer.submit([], out, {name for name, _ in jobs})
+        renderer.wait()
+        draw_jobs(jobs, here)
+        print("jobs", " ".join(sorted(name for name, _ in jobs)))
+    """, str(DEMO), str(tmp_path), str(kill_helper))
+    assert done.returncode == 0, done.stderr
+    helper, jobs = done.stdout.splitlines()
+    assert helper == "helper 1"
+    names = jobs.split()[1:]
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == names
+    for name in names:
+        np.testing.assert_array_equal(_pixels(tmp_path / "out" / name), _pixels(tmp_path / "here" / name))
+
+
 def test_a_plot_process_dying_while_rows_stream_costs_only_time(tmp_path):
     """The plot process killed after the first row was streamed: the later rows are not sent, the
     run draws every figure itself (the streamed one too), says so on one line, and writes
@@ -182,12 +225,12 @@ def test_report_html_is_built_while_the_plot_process_draws_and_a_death_meanwhile
         renderer = Renderer.start()
         import scenarios
         import scenarios.output.report.run as report
-        build = report.run_report
+        build = report.run_page  # what the writer builds report.html with
         def killing(results):
             assert renderer._submitted, "report.html built before the figures were sent"
             os.kill(renderer.pid, signal.SIGKILL)
             return build(results)
-        report.run_report = killing
+        report.run_page = killing
         results = scenarios.run(scenarios.load(sys.argv[1]))
         results.write(sys.argv[2], renderer=renderer)
         renderer.close()

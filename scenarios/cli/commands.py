@@ -43,8 +43,6 @@ from scenarios.runner import run
 from scenarios.schema.labels import row_labels
 from scenarios.schema.loader import load, parse_scenario
 from scenarios.schema.read import read_yaml
-from scenarios.schema.reference import options_text, summary_line
-from scenarios.study.spec import load_study
 
 STUDY_KEY = "study"
 """The top-level key that makes a YAML file a study (the study's name) for ``validate``."""
@@ -66,6 +64,9 @@ def command_list(args: argparse.Namespace) -> int:
         Exit status: 0, or 2 for a name that is neither a planner nor a controller (its close
         matches are listed).
     """
+    # imported here: only this command needs them
+    from scenarios.schema.reference import options_text, summary_line
+
     name = getattr(args, "options", None)
     if name is not None:
         try:
@@ -129,6 +130,9 @@ def command_validate(args: argparse.Namespace) -> int:
     """
     data = read_yaml(args.file)
     if isinstance(data, dict) and STUDY_KEY in data:
+        # a study's parser, imported here: a scenario (and `run`) does not need it
+        from scenarios.study.spec import load_study
+
         study = load_study(args.file)
         points = len({case.point for case in study.cases})
         varied = ", ".join(study.varied_paths) or "nothing"

@@ -26,7 +26,9 @@ the sphere hides behind another as on a drawn 3-D globe.
 """
 from __future__ import annotations
 
+import struct
 import textwrap
+import zlib
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, BinaryIO
@@ -75,7 +77,6 @@ __all__ = [
     "COMPRESS_LEVEL",
     "LABEL_OFFSET_IN",
     "ROW_COLORS",
-    "SAVE",
     "LogTicks",
     "RowFigure",
     "draw_jobs",
@@ -87,6 +88,7 @@ __all__ = [
     "margin_figure",
     "overlay_figure",
     "plot_overlay",
+    "png_bytes",
     "sky_figure",
     "write_plots",
 ]
@@ -109,9 +111,8 @@ KEEP_COLORS = {True: "tab:red", False: "tab:green"}
 """Colour of a keep-out (``True``) and a keep-in (``False``) cone."""
 COMPRESS_LEVEL = 1
 """zlib level of the PNGs: level 1 encodes several times faster than the default 6 for ~20 % more bytes."""
-SAVE: dict[str, Any] = {"dpi": DPI, "format": "png", "pil_kwargs": {"compress_level": COMPRESS_LEVEL}}
-"""``savefig`` options of the figures drawn once (PNG also into a file object, whatever the user's
-``savefig.format``)."""
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+"""The first eight bytes of every PNG file."""
 
 
 class LogTicks(Locator):
@@ -392,6 +393,11 @@ class RowFigure:
         artists.extend(self.off_scale.values())
         return artists
 
+    @property
+    def prepared(self) -> bool:
+        """Whether the static part has been drawn (by :meth:`prepare`), for some time limits."""
+        return self._background is not None
+
     def prepare(self, series: RowSeries) -> None:
         """Set a row's curves and limits, and have the static part for its time limits drawn
         (drawn now if it is not yet, else restored): what :meth:`draw` does before the row's own
@@ -478,13 +484,61 @@ class RowFigure:
         _write_png(self.canvas, path)
 
 
-def _write_png(canvas: FigureCanvasAgg, path: Path | BinaryIO) -> None:
-    """The canvas as it is drawn (no second draw, unlike ``savefig``) as a PNG."""
-    from PIL import Image  # matplotlib's own PNG writer; imported with it
+def _png_chunk(kind: bytes, data: Any) -> bytes:
+    """One PNG chunk: length, type, data and the CRC of type and data."""
+    return (struct.pack(">I", len(data)) + kind + bytes(data)
+            + struct.pack(">I", zlib.crc32(data, zlib.crc32(kind))))
 
-    width, height = canvas.get_width_height()
-    image = Image.frombuffer("RGBA", (width, height), canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert("RGB")
-    image.save(path, format="png", dpi=(DPI, DPI), compress_level=COMPRESS_LEVEL)
+
+def png_bytes(rgba: np.ndarray, dpi: float = DPI, level: int = COMPRESS_LEVEL) -> bytes:
+    """An opaque RGBA image (an Agg canvas' buffer) as an 8-bit RGB PNG file, alpha dropped.
+
+    Every scan line is stored unfiltered (PNG filter type 0) and the whole image deflated at
+    ``level``: Pillow's writer tries all five filters on every line, which costs twice as much as
+    the deflating itself and, on a figure's flat areas and thin lines, saves no bytes (its files
+    are larger here). The pixels are the same as Pillow's ``convert("RGB")`` of the buffer.
+
+    Parameters
+    ----------
+    rgba : numpy.ndarray
+        ``(height, width, 4)`` unsigned bytes (``FigureCanvasAgg.buffer_rgba``); the alpha channel
+        is left out (the figures are drawn on an opaque background).
+    dpi : float, optional
+        Resolution recorded in the file (the ``pHYs`` chunk, in pixels per metre as PNG has it).
+    level : int, optional
+        zlib level (:data:`COMPRESS_LEVEL`).
+
+    Returns
+    -------
+    bytes
+        The PNG file.
+    """
+    height, width = rgba.shape[:2]
+    lines = np.empty((height, 1 + 3 * width), np.uint8)
+    lines[:, 0] = 0  # filter type of each scan line: none
+    np.ndarray((height, width, 3), np.uint8, lines, offset=1, strides=(1 + 3 * width, 3, 1))[...] = rgba[..., :3]
+    per_metre = round(dpi / 0.0254)
+    return b"".join([PNG_SIGNATURE,
+                     _png_chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)),  # 8-bit RGB
+                     _png_chunk(b"pHYs", struct.pack(">IIB", per_metre, per_metre, 1)),
+                     _png_chunk(b"IDAT", zlib.compress(lines.data, level)),
+                     _png_chunk(b"IEND", b"")])
+
+
+def _write_png(canvas: FigureCanvasAgg, path: Path | BinaryIO) -> None:
+    """The canvas as it is drawn (no second draw, unlike ``savefig``) as a PNG (:func:`png_bytes`)."""
+    data = png_bytes(np.asarray(canvas.buffer_rgba()))
+    if isinstance(path, Path):
+        path.write_bytes(data)
+    else:
+        path.write(data)
+
+
+def _draw_png(figure: Figure, path: Path | BinaryIO) -> None:
+    """Draw a figure once on an Agg canvas and write it as a PNG (:func:`_write_png`)."""
+    canvas = FigureCanvasAgg(figure)
+    canvas.draw()
+    _write_png(canvas, path)
 
 
 LEGEND_CHARS = 34
@@ -614,9 +668,7 @@ def draw_overlay(series: OverlaySeries, path: Path | BinaryIO) -> None:
     path : pathlib.Path or binary file
         Where to write the PNG (a file object: into it).
     """
-    canvas = FigureCanvasAgg(overlay_figure(series))
-    canvas.draw()
-    _write_png(canvas, path)  # RGB, one draw
+    _draw_png(overlay_figure(series), path)
 
 
 def _row_color(k: int) -> str:
@@ -757,7 +809,7 @@ def draw_margins(series: MarginSeries, path: Path | BinaryIO) -> None:
     path : pathlib.Path or binary file
         Where to write the PNG (a file object: into it).
     """
-    margin_figure(series).savefig(path, **SAVE)
+    _draw_png(margin_figure(series), path)
 
 
 def _on_map(path: SkyPath) -> tuple[np.ndarray, np.ndarray]:
@@ -839,7 +891,7 @@ def draw_sky(series: SkySeries, path: Path | BinaryIO) -> None:
     path : pathlib.Path or binary file
         Where to write the PNG (a file object: into it).
     """
-    sky_figure(series).savefig(path, **SAVE)
+    _draw_png(sky_figure(series), path)
 
 
 def plot_overlay(results: Any, path: Path) -> None:

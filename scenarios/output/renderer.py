@@ -7,7 +7,10 @@ process first thing, before it imports the model (:mod:`scenarios.console`). The
 drawing half (:mod:`scenarios.output.plots`, which imports matplotlib but not the model) and waits. The run
 sends it each row's figure as soon as the row is done (:meth:`Renderer.stream`), and the figures
 of the whole run (the comparison, the margins, the sky) as soon as the last row is: the child draws
-them into memory while the run goes on. At the end the run sends whatever is left and the directory
+them into memory while the run goes on; when figures wait while it draws (rows done faster than
+they are drawn, the whole run's figures after the last row), a fork of the child (a helper) draws a
+share of them into memory meanwhile, on the static parts the child has drawn already
+(:func:`_start_helper`). At the end the run sends whatever is left and the directory
 to write into (:meth:`Renderer.submit`); the child writes the figures it has drawn, draws the others
 there and answers.
 
@@ -31,13 +34,14 @@ import sys
 import time
 import traceback
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 SINGLE_THREAD_ENVIRONMENT = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 """Set to 1 in the child before it imports NumPy: drawing needs no BLAS threads."""
-COST = {"row": 1.0, "other": 1.3}
-"""Relative drawing costs (about 0.1 s each on the reference machine) of one row on its figure,
-whose static part is drawn before the fork (:func:`_draw_in_two`), and of any other figure."""
+COST = {"row": 1.0, "other": 2.5}
+"""Relative drawing costs of one row on its figure, whose static part is drawn before the fork
+(:func:`_draw_in_two`), and of any other figure (measured, CPU: a row 0.06-0.11 s; the comparison
+per axis 2.6-3.2 rows, the margins about 2, the sky about 3)."""
 PIPE_BYTES = 1 << 20
 """Capacity asked for the pipe to the child (Linux's ``F_SETPIPE_SZ``; 1 MiB is the unprivileged
 limit): a streamed row's series (about 80 kB pickled for the demo scenario, more than the default
@@ -356,6 +360,120 @@ def _draw_in_two(jobs: list[Any], directory: Path, forks: list[int], figures: di
         raise RuntimeError(f"the second drawing process failed (wait status {status})")
 
 
+class _Helper(NamedTuple):
+    """A fork of the plot process drawing streamed figures into memory (:func:`_start_helper`)."""
+
+    pid: int
+    fd: int
+    """The read end of the pipe its answer comes through."""
+    jobs: list[Any]
+    """The figures it draws: (file name, series)."""
+
+
+def _draw_into_memory(jobs: list[Any], figures: dict[Any, Any]) -> dict[str, bytes]:
+    """Draw ``jobs`` into PNG bytes by file name (row figures on ``figures``, by shape)."""
+    from scenarios.output.plot_data import RowSeries
+    from scenarios.output.plots import DRAW, RowFigure
+
+    drawn = {}
+    for name, series in jobs:
+        buffer = io.BytesIO()
+        if isinstance(series, RowSeries):
+            figure = figures.get(series.shape) or figures.setdefault(series.shape, RowFigure(*series.shape))
+            figure.draw(series, buffer)
+        else:
+            DRAW[type(series)](series, buffer)
+        drawn[name] = buffer.getvalue()
+    return drawn
+
+
+def _prepare_first(pending: list[Any], figures: dict[Any, Any]) -> bool:
+    """If the next figure is a row of a shape without a drawn static part, build its figure and
+    draw that part (:meth:`RowFigure.prepare`) and say so: the row itself and whatever else has come
+    meanwhile can then be shared with a helper, which inherits the static part."""
+    from scenarios.output.plot_data import RowSeries
+    from scenarios.output.plots import RowFigure
+
+    series = pending[0][1] if pending else None
+    if not isinstance(series, RowSeries) or (series.shape in figures and figures[series.shape].prepared):
+        return False
+    figures.setdefault(series.shape, RowFigure(*series.shape)).prepare(series)
+    return True
+
+
+def _share(pending: list[Any], figures: dict[Any, Any]) -> tuple[list[Any], list[Any]]:
+    """What the plot process keeps and what a helper draws of the streamed figures not drawn yet:
+    shared by :func:`split`, once the static part of every row shape among them is drawn (a
+    helper inherits it); before that, the helper takes only the figures other than rows, so that
+    no static part is drawn twice."""
+    from scenarios.output.plot_data import RowSeries
+
+    rows = [job for job in pending if isinstance(job[1], RowSeries)]
+    if any(series.shape not in figures or not figures[series.shape].prepared for _, series in rows):
+        return rows, [job for job in pending if not isinstance(job[1], RowSeries)]
+    return split(pending)
+
+
+def _start_helper(jobs: list[Any], figures: dict[Any, Any], forks: list[int], close: tuple[int, ...]) -> _Helper:
+    """Fork a helper that draws ``jobs`` into memory (:func:`_draw_into_memory`, on the figures
+    inherited from ``figures``) and answers through a pipe with ``("ok", {name: bytes})`` or
+    ``("error", traceback)``, then exits. Its pid is in ``forks`` while it runs (:func:`_stop`);
+    ``close``: the plot process's ends of its pipes to the run, which the helper does not use."""
+    read_fd, write_fd = os.pipe()
+    stopping = {signal.SIGINT, signal.SIGTERM}
+    parent = os.getpid()
+    signal.pthread_sigmask(signal.SIG_BLOCK, stopping)  # no stop between the fork and `forks` (_stop)
+    pid = os.fork()
+    if pid == 0:
+        code = 1
+        try:
+            for signum in stopping:
+                signal.signal(signum, signal.SIG_DFL)
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
+            die_with_parent(signal.SIGKILL, parent)
+            for fd in (read_fd, *close):
+                os.close(fd)
+            try:
+                reply: tuple[str, Any] = ("ok", _draw_into_memory(jobs, figures))
+            except Exception:  # noqa: BLE001 (reported to the plot process, which reports it to the run)
+                reply = ("error", traceback.format_exc())
+            with os.fdopen(write_fd, "wb") as stream:
+                pickle.dump(reply, stream, protocol=pickle.HIGHEST_PROTOCOL)
+            code = 0
+        finally:
+            os._exit(code)
+    forks.append(pid)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
+    os.close(write_fd)
+    return _Helper(pid, read_fd, jobs)
+
+
+def _collect(helper: _Helper, forks: list[int]) -> tuple[dict[str, bytes], list[Any], str]:
+    """Wait for a helper's answer and reap it.
+
+    Returns
+    -------
+    drawn : dict
+        PNG bytes by file name.
+    undrawn : list
+        Its jobs, when it ended without answering (killed): to be drawn by the plot process.
+    failure : str
+        The traceback of a drawing that raised (empty if none).
+    """
+    try:
+        with os.fdopen(helper.fd, "rb") as stream:
+            status, detail = pickle.load(stream)
+    except (OSError, EOFError, pickle.UnpicklingError):
+        status, detail = "gone", None
+    os.waitpid(helper.pid, 0)
+    forks.remove(helper.pid)
+    if status == "ok":
+        return detail, [], ""
+    if status == "error":
+        return {}, [], detail
+    return {}, list(helper.jobs), ""
+
+
 def _stop(forks: list[int], signum: int, frame: Any) -> None:
     """The plot process's Ctrl-C and SIGTERM: kill and reap its running fork (``forks``, kept by
     :func:`_draw_in_two`), then exit (no traceback; the parent reports the interruption)."""
@@ -420,12 +538,13 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
         die_with_parent(signal.SIGTERM, parent)
         for name in SINGLE_THREAD_ENVIRONMENT:
             os.environ[name] = "1"
-        from scenarios.output.plot_data import RowSeries
-        from scenarios.output.plots import DRAW, RowFigure  # matplotlib, while the parent runs
+        # matplotlib, while the parent runs
+        from scenarios.output.plots import RowFigure
 
         figures: dict[Any, RowFigure] = {}
         drawn: dict[str, bytes] = {}
         pending: list[tuple[str, Any]] = []  # streamed, not drawn yet
+        helper: _Helper | None = None  # a fork drawing some of them meanwhile
         failure, final = "", None
         while final is None:
             # take every message already sent; wait for one only when there is nothing to draw
@@ -437,17 +556,20 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
                     final = message
                 else:
                     pending.append(message[1])
-            if final is None and not failure:  # idle: a streamed figure, drawn into memory
-                name, series = pending.pop(0)
-                buffer = io.BytesIO()
+            if helper is not None and final is None and _waiting(helper.fd):  # it has answered
+                more, undrawn, failed = _collect(helper, forks)
+                drawn.update(more)
+                pending.extend(undrawn)
+                failure, helper = failure or failed, None
+            if final is None and not failure:  # idle: streamed figures, drawn into memory
                 try:
-                    if isinstance(series, RowSeries):
-                        figure = figures.get(series.shape) or figures.setdefault(series.shape,
-                                                                                 RowFigure(*series.shape))
-                        figure.draw(series, buffer)
-                    else:
-                        DRAW[type(series)](series, buffer)
-                    drawn[name] = buffer.getvalue()
+                    if _prepare_first(pending, figures):
+                        continue  # a new row shape's static part drawn: share what waits now
+                    if helper is None and len(pending) > 1 and _thread_count() == 1:
+                        pending, theirs = _share(pending, figures)
+                        if theirs:
+                            helper = _start_helper(theirs, figures, forks, (receive_fd, send_fd))
+                    drawn.update(_draw_into_memory([pending.pop(0)], figures) if pending else {})
                 except Exception:  # reported with the answer
                     failure = traceback.format_exc()
             elif final is None:
@@ -460,15 +582,29 @@ def _serve(receive_fd: int, send_fd: int, parent: int) -> None:
                 if name in drawn:
                     (Path(directory) / name).write_bytes(drawn[name])
             # the streamed figures not drawn yet (all of them, when the run ended before matplotlib
-            # was imported) are drawn with the rest, shared between this process and its fork
+            # was imported) are drawn with the rest, shared between this process and its fork,
+            # while a helper still draws its share
             late = [job for job in pending if job[0] in keep]
-            missing = set(keep) - set(drawn) - {name for name, _ in late}
+            helping = {name for name, _ in helper.jobs} if helper is not None else set()
+            missing = set(keep) - set(drawn) - {name for name, _ in late} - helping
             if missing:
                 raise RuntimeError(f"figures to keep that were never streamed: {sorted(missing)}")
             _draw_in_two(late + jobs, Path(directory), forks, figures)
+            if helper is not None:
+                more, undrawn, failed = _collect(helper, forks)
+                helper = None
+                if failed:
+                    raise RuntimeError(f"drawing a streamed figure failed: {failed}")
+                more.update(_draw_into_memory([job for job in undrawn if job[0] in keep], figures))
+                for name in keep:
+                    if name in more:
+                        (Path(directory) / name).write_bytes(more[name])
             reply: tuple[str, str] = ("ok", "")
         except Exception:  # reported to the parent, which draws in its own process and raises there
             reply = ("error", traceback.format_exc())
+        if helper is not None:  # not needed any more (this process failed): stopped and reaped
+            os.kill(helper.pid, signal.SIGKILL)
+            _collect(helper, forks)
         with os.fdopen(send_fd, "wb") as stream:
             pickle.dump(reply, stream)
         code = 0

@@ -19,7 +19,7 @@ from scenarios.output.directory import (
     new_staging,
 )
 from scenarios.output.names import row_stems
-from scenarios.output.tables import csv_cell, to_csv, to_json, to_markdown
+from scenarios.output.tables import to_csv, to_json, to_markdown
 
 if TYPE_CHECKING:
     from scenarios.output.results import Row, RunResults
@@ -58,11 +58,14 @@ def write_timeseries(row: Row, path: Path) -> None:
     else:
         ref = np.full((sim.t.size, 10), np.nan)
     table = np.hstack([sim.t[:, None], sim.x, torque, ref])
+    finite = np.isfinite(table).tolist()
     with path.open("w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(header)
-        for line in table:
-            writer.writerow([csv_cell(float(v)) for v in line])
+        # csv_cell of each value, without its checks per cell (every value is a float here): the
+        # repr of a finite value, blank otherwise
+        writer.writerows([repr(v) if ok else "" for v, ok in zip(line, keep)]
+                         for line, keep in zip(table.tolist(), finite))
 
 
 def plot_streamer(scenario: Any, renderer: Any) -> Callable[[Row], None]:
@@ -122,7 +125,7 @@ def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer:
     streamed to it already (:func:`plot_streamer`) are sent to it and the report is built here
     while it draws; without one (or if it fails), both are made in this process."""
     from scenarios.output.plot_data import plot_jobs
-    from scenarios.output.report.run import run_report
+    from scenarios.output.report.run import run_page
 
     if renderer is not None:
         from scenarios.output.renderer import RenderingFailed
@@ -133,7 +136,7 @@ def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer:
         except RenderingFailed as error:
             print(f"slewbench: {error}; drawing the plots in this process", file=sys.stderr)
             renderer = None
-    (staging / "report.html").write_text(run_report(results), encoding="utf-8")
+    (staging / "report.html").write_bytes(run_page(results).render_bytes())  # run_report's text, as UTF-8
     if renderer is not None:
         try:
             renderer.wait()

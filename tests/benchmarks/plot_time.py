@@ -13,6 +13,13 @@ Run: ``python tests/benchmarks/plot_time.py [--base REV] [--pairs N]`` (defaults
 per kind of run, wall and CPU time (user + system of the command): medians, 10th and 90th
 percentiles and the ratio of the medians (target: wall time of the whole command with plots, this
 checkout over the base, at most 1.1; the CPU time is less sensitive to a loaded host).
+
+Measured on 2026-12-02 (``--base 5e90e69 --pairs 12``, load average 4.3-6.8 from other work on the
+two cores): with plots 3.190 s against 3.784 s wall (ratio of the medians 1.186; per pair 1.182,
+10th-90th percentile 1.150-1.447), CPU 2.146 s against 2.495 s (1.163); without plots 1.398 s
+against 1.544 s (1.104; CPU 1.108). Target not met; at the start of that day (before the PNG
+writer, the plot process's helper and the report's batching) 1.337 with plots and 1.186 without
+(10 pairs, load 0.8-5.8). The parts: docs/performance.rst.
 """
 from __future__ import annotations
 

@@ -18,10 +18,11 @@ _HOMES = {"Column": "scenarios.output.report.page",
           "column_unit": "scenarios.output.report.page",
           "margin_figure": "scenarios.output.report.figures",
           "row_figure": "scenarios.output.report.figures",
+          "run_page": "scenarios.output.report.run",
           "run_report": "scenarios.output.report.run",
           "sky_figure": "scenarios.output.report.figures"}
 
-__all__ = ["Column", "Page", "attitude_figure", "column_unit", "margin_figure", "row_figure", "run_report",
+__all__ = ["Column", "Page", "attitude_figure", "column_unit", "margin_figure", "row_figure", "run_page", "run_report",
            "sky_figure"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)

@@ -32,7 +32,8 @@ from ocp.metrics import METRIC_INFO
 from scenarios.output.tables import json_safe
 from scenarios.schema.columns import SCOPES, VECTOR_METRICS, is_requirement_column
 
-__all__ = ["FIGURE_DIGITS", "PLOTLY_CONFIG", "Column", "Page", "column_unit", "figure_array", "plotly_js"]
+__all__ = ["FIGURE_DIGITS", "PLOTLY_CONFIG", "Column", "Page", "column_unit", "figure_array", "figure_arrays", "plotly_js",
+           "plotly_js_bytes"]
 
 FIGURE_DIGITS = 7
 """Significant digits of the numbers in a figure's arrays (more than a hover label shows)."""
@@ -43,12 +44,12 @@ _REQUIREMENT_FIELD_UNITS = {"peak_rate": "rad/s", "worst_rate_error": "rad/s", "
 
 
 @cache
-def plotly_js() -> str:
-    """The plotly.js bundle shipped with the ``plotly`` package (read once per process).
+def plotly_js_bytes() -> bytes:
+    """The plotly.js bundle shipped with the ``plotly`` package, as UTF-8 bytes (read once per process).
 
     Returns
     -------
-    str
+    bytes
         The minified script, ready to inline (``</script`` escaped, should it ever occur).
 
     Raises
@@ -60,7 +61,25 @@ def plotly_js() -> str:
     if spec is None or not spec.submodule_search_locations:
         raise ModuleNotFoundError("the HTML report needs the plotly package (pip install plotly)", name="plotly")
     path = Path(next(iter(spec.submodule_search_locations))) / "package_data" / "plotly.min.js"
-    return path.read_text(encoding="utf-8").replace("</script", "<\\/script")
+    text = path.read_bytes()
+    text.decode("utf-8")  # raises if the file is not UTF-8, as reading it as text would
+    return text.replace(b"</script", b"<\\/script")
+
+
+def plotly_js() -> str:
+    """The plotly.js bundle shipped with the ``plotly`` package (:func:`plotly_js_bytes` as text).
+
+    Returns
+    -------
+    str
+        The minified script, ready to inline (``</script`` escaped, should it ever occur).
+
+    Raises
+    ------
+    ModuleNotFoundError
+        When the ``plotly`` package is not installed.
+    """
+    return plotly_js_bytes().decode("utf-8")
 
 
 def column_unit(column: str) -> str:
@@ -124,6 +143,21 @@ class Column:
     order: tuple[str, ...] = ()
 
 
+def _rounded(array: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``array`` to :data:`FIGURE_DIGITS` significant digits (0 where not finite), and where it is finite."""
+    finite = np.isfinite(array)
+    magnitude = np.where(finite & (array != 0.0), np.abs(array), 1.0)
+    scale = 10.0 ** (FIGURE_DIGITS - 1 - np.floor(np.log10(magnitude)))
+    return np.where(finite, np.round(array * scale) / scale, 0.0), finite
+
+
+def _blank(items: Any, keep: Any) -> Any:
+    """Nested lists with ``None`` where ``keep`` (the same nesting) is false."""
+    if isinstance(items, list):
+        return [_blank(i, k) for i, k in zip(items, keep)]
+    return items if keep else None
+
+
 def figure_array(values: Any) -> list[Any]:
     """A figure's array in plain JSON form: :data:`FIGURE_DIGITS` significant digits, ``None``
     for a non-finite number.
@@ -138,35 +172,67 @@ def figure_array(values: Any) -> list[Any]:
     list
         Nested lists of floats and ``None``.
     """
-    array = np.asarray(values, dtype=float)
-    finite = np.isfinite(array)
-    magnitude = np.where(finite & (array != 0.0), np.abs(array), 1.0)
-    scale = 10.0 ** (FIGURE_DIGITS - 1 - np.floor(np.log10(magnitude)))
-    rounded = np.where(finite, np.round(array * scale) / scale, 0.0)
+    rounded, finite = _rounded(np.asarray(values, dtype=float))
     plain = rounded.tolist()
-    if finite.all():
-        return plain
-    mask = finite.tolist()
-
-    def blank(items: Any, keep: Any) -> Any:
-        if isinstance(items, list):
-            return [blank(i, k) for i, k in zip(items, keep)]
-        return items if keep else None
-    return blank(plain, mask)
+    return plain if finite.all() else _blank(plain, finite.tolist())
 
 
-def _encode(value: Any) -> Any:
-    """JSON form of what ``json`` does not know: NumPy arrays (:func:`figure_array`) and scalars."""
+def figure_arrays(arrays: Sequence[Any]) -> list[list[Any]]:
+    """:func:`figure_array` of each of many arrays, rounded together: the same lists, without
+    NumPy's cost per call (a report's 3-D attitude figures hold thousands of arrays of two points).
+
+    Parameters
+    ----------
+    arrays : sequence of array_like
+        Numbers (each of any shape).
+
+    Returns
+    -------
+    list
+        Per array, nested lists of floats and ``None``.
+    """
+    values = [np.asarray(a, dtype=float) for a in arrays]
+    if not values:
+        return []
+    ends = np.cumsum([a.size for a in values])
+    rounded, finite = _rounded(np.concatenate([a.ravel() for a in values]))
+    missing = np.concatenate([[0], np.cumsum(~finite)])  # non-finite numbers before each position
+    plain = []
+    for a, end, end_missing in zip(values, ends.tolist(), missing[ends].tolist()):
+        start = end - a.size
+        items = rounded[start:end].reshape(a.shape).tolist()
+        plain.append(_blank(items, finite[start:end].reshape(a.shape).tolist()) if end_missing > missing[start]
+                     else items)
+    return plain
+
+
+def _arrays(value: Any, found: dict[int, np.ndarray]) -> None:
+    """The NumPy arrays in nested dicts, lists and tuples, by ``id``."""
     if isinstance(value, np.ndarray):
-        return figure_array(value)
-    if isinstance(value, np.generic):
-        return value.item()
-    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+        found[id(value)] = value
+    elif isinstance(value, dict):
+        for item in value.values():
+            _arrays(item, found)
+    elif isinstance(value, (list, tuple)):
+        for item in value:
+            _arrays(item, found)
 
 
 def _json(value: Any) -> str:
-    """JSON text safe inside a ``<script>`` element (``</`` and ``<!--`` escaped)."""
-    text = json.dumps(value, allow_nan=False, separators=(",", ":"), ensure_ascii=False, default=_encode)
+    """JSON text safe inside a ``<script>`` element (``</`` and ``<!--`` escaped); NumPy arrays as
+    :func:`figure_array` makes them (all rounded at once, :func:`figure_arrays`), NumPy scalars as numbers."""
+    found: dict[int, np.ndarray] = {}
+    _arrays(value, found)  # the arrays stay alive in `value` while it is encoded: their ids are theirs
+    lists = dict(zip(found, figure_arrays(list(found.values()))))
+
+    def encode(item: Any) -> Any:
+        if isinstance(item, np.ndarray):
+            return lists[id(item)]
+        if isinstance(item, np.generic):
+            return item.item()
+        raise TypeError(f"{type(item).__name__} is not JSON serialisable")
+
+    text = json.dumps(value, allow_nan=False, separators=(",", ":"), ensure_ascii=False, default=encode)
     return text.replace("</", "<\\/").replace("<!--", "<\\u0021--")
 
 
@@ -344,6 +410,18 @@ class Page:
         Returns
         -------
         str
+            One self-contained document (plotly.js, the data and the script inline):
+            :meth:`render_bytes` as text.
+        """
+        return self.render_bytes().decode("utf-8")
+
+    def render_bytes(self) -> bytes:
+        """The page's HTML as the UTF-8 bytes of its file: plotly.js (most of the page) is copied
+        in as read, never decoded into text and encoded again.
+
+        Returns
+        -------
+        bytes
             One self-contained document (plotly.js, the data and the script inline).
         """
         for key, explorer in self._data["explorers"].items():
@@ -352,14 +430,15 @@ class Page:
         contents = "".join(f'<li><a href="#{ident}">{html.escape(title)}</a></li>' for ident, title in self._sections)
         nav = f'<nav><ul>{contents}</ul></nav>' if self._sections else ""
         data = _json({**self._data, "config": PLOTLY_CONFIG})
-        return "".join([
+        head = "".join([
             "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">",
             "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">",
-            f"<title>{html.escape(self.title)}</title><style>{STYLE}</style>",
-            f"<script>{plotly_js()}</script></head><body>",
-            *self._head, nav, *self._body,
+            f"<title>{html.escape(self.title)}</title><style>{STYLE}</style>", "<script>"])
+        body = "".join([
+            "</script></head><body>", *self._head, nav, *self._body,
             f'<script type="application/json" id="slewbench-data">{data}</script>',
             f"<script>{SCRIPT}</script></body></html>\n"])
+        return b"".join([head.encode("utf-8"), plotly_js_bytes(), body.encode("utf-8")])
 
 
 STYLE = """

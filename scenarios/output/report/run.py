@@ -32,7 +32,7 @@ from scenarios.schema.columns import is_requirement_column
 if TYPE_CHECKING:
     from scenarios.output.results import RunResults
 
-__all__ = ["STATUS_ORDER", "result_columns", "run_report"]
+__all__ = ["STATUS_ORDER", "result_columns", "run_page", "run_report"]
 
 STATUS_ORDER = ("crashed", "failed", "violated", "ok")
 """A row's statuses from the worst: the order a status column sorts in."""
@@ -79,6 +79,23 @@ def run_report(results: RunResults) -> str:
     str
         A self-contained HTML document.
     """
+    return run_page(results).render()
+
+
+def run_page(results: RunResults) -> Page:
+    """The page of a run's interactive report (:func:`run_report`), to render as text or as the
+    bytes of its file (:meth:`~scenarios.output.report.page.Page.render_bytes`).
+
+    Parameters
+    ----------
+    results : RunResults
+        The run (its rows with their references and simulations, and its scenario).
+
+    Returns
+    -------
+    Page
+        The page, with every section, table and figure.
+    """
     scenario = results.scenario
     flat = [flatten_row(row.to_dict()) for row in results.rows]
     everything = row_columns(requirement_columns([row.to_dict() for row in results.rows]))
@@ -117,4 +134,4 @@ def run_report(results: RunResults) -> str:
         page.section("Attitude in 3-D", "Body axes (x red, y green, z blue) and the constrained sensors' "
                                         "boresights in the inertial frame; drag to turn, use the slider or play.")
         page.choice("attitude", "row", [(row.label, attitude_figure(row, scenario)) for row in simulated])
-    return page.render()
+    return page
