@@ -34,7 +34,6 @@ from typing import Any
 
 import casadi as ca
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 from threadpoolctl import threadpool_limits
 
@@ -107,6 +106,8 @@ def _null_space(A: Array, n: int) -> Array:
     orthonormalised (no full ``Q`` is formed)."""
     if A.shape[0] == 0 or n == 0:
         return np.eye(n)
+    import scipy.linalg  # here, not at the top: it takes 0.16 s to import, and every command imports this module
+
     R, P = scipy.linalg.qr(A, mode="r", pivoting=True)
     diagonal = np.abs(np.diag(R))
     rank = int(np.sum(diagonal > 1e-9 * diagonal[0])) if diagonal[0] > 0 else 0
