@@ -179,6 +179,7 @@ def test_bench_writes_the_leaderboard_with_the_hand_worked_gap(tmp_path, capsys)
 @pytest.mark.parametrize("argv, expected", [
     (["--problems", "no_such_problem"], "--problems: unknown problem 'no_such_problem'"),
     (["--planners", "no_such_planner"], "--planners: unknown planner or peer 'no_such_planner'"),
+    (["--planners", "acados", "--no-peers"], "--planners: names only peers (acados) and --no-peers runs none"),
 ])
 def test_unknown_names_exit_2_before_anything_is_written(tmp_path, capsys, argv, expected):
     out = tmp_path / "board"

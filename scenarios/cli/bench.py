@@ -60,6 +60,9 @@ def command_bench(args: argparse.Namespace) -> int:
             raise ScenarioError("--planners", f"unknown planner or peer {unknown[0]!r}; expected some of planners "
                                               f"{', '.join(PLANNERS)} or peers {', '.join(PEERS)}")
         planners = [name for name in args.planners if name in PLANNERS]
+        if args.no_peers and not planners:
+            raise ScenarioError("--planners", f"names only peers ({', '.join(args.planners)}) and --no-peers runs none: "
+                                              "nothing would run")
         peers = [name for name in peers if name in args.planners]
     out = args.out or default_output_directory(DEFAULT_OUT)
     claim_output_directory(out, kind="bench")  # before running: a long run is never lost at the end
