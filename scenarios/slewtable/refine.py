@@ -192,7 +192,13 @@ class TriangleMesh:
         return list(seen)
 
     def axes(self) -> np.ndarray:
-        """Every vertex, shape (n, 3)."""
+        """Every vertex.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, 3)
+            The unit vectors of :attr:`points`.
+        """
         return np.array(self.points)
 
 
@@ -252,7 +258,14 @@ class RefineResult:
     stopped: str = ""
 
     def summary(self) -> dict[str, Any]:
-        """Plain data for ``fit.json`` (``meta.refinement``): rounds, ``reached``, ``stopped``."""
+        """Plain data for ``fit.json`` (``meta.refinement``).
+
+        Returns
+        -------
+        dict
+            ``rounds``, ``reached``, ``stopped``, ``axes`` (in the fit) and ``check_points``
+            (checked, not in the fit).
+        """
         return {"rounds": self.rounds, "reached": self.reached, "stopped": self.stopped,
                 "axes": len(self.axes), "check_points": len(self.checks)}
 
