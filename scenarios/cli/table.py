@@ -33,7 +33,8 @@ def command_table(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         The parsed ``table`` arguments (``file``, ``axes``, ``angles``, ``objective``,
-        ``duration``, ``held_out``, ``out``, ``workers``, ``scheduler``, ``no_plots``).
+        ``duration``, ``held_out``, ``tolerance``, ``check_angles``, ``max_axes``, ``max_rounds``,
+        ``out``, ``workers``, ``scheduler``, ``no_plots``).
 
     Returns
     -------
@@ -68,7 +69,8 @@ def command_table(args: argparse.Namespace) -> int:
         start_forkserver()
     overrides = {"axes": args.axes, "grid": args.grid, "angles": args.angles, "objective": args.objective,
                  "duration": args.duration, "held-out": args.held_out, "workers": args.workers,
-                 "scheduler": args.scheduler}
+                 "scheduler": args.scheduler, "tolerance": args.tolerance, "check-angles": args.check_angles,
+                 "max-axes": args.max_axes, "max-rounds": args.max_rounds}
     spec = parse_table_spec(args.file, overrides)
     if not args.no_plots:
         import matplotlib  # noqa: F401  (fail now, not after the entries ran)
@@ -79,8 +81,9 @@ def command_table(args: argparse.Namespace) -> int:
     entries = len(spec.axes) * len(spec.angles_deg) + spec.held_out * max(len(spec.angles_deg) - 1, 0)
     print(f"{spec.name}: {len(spec.axes)} axes x {len(spec.angles_deg)} angles"
           + (f" + {spec.held_out} held-out axes x {len(spec.angles_deg) - 1} angles" if spec.held_out else "")
-          + f" = {entries} entries, {spec.objective}, {cluster.address if cluster else 'local process pool'}",
-          flush=True)
+          + f" = {entries} entries, {spec.objective}, {cluster.address if cluster else 'local process pool'}"
+          + (f"; then refined to a tolerance of {spec.refine.tolerance:g} (at most {spec.refine.max_axes} axes, "
+             f"{spec.refine.max_rounds} rounds)" if spec.refine else ""), flush=True)
     previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         table = compute_table(spec, directory, workers=args.workers, cluster=cluster, progress=True)
@@ -101,6 +104,14 @@ def command_table(args: argparse.Namespace) -> int:
     print(f"computed in {table.wall_time_s:.1f} s ({table.stored} entries already stored); table: {ok} of "
           f"{part.ok.size} entries ok; files written in {time.perf_counter() - start:.1f} s: {directory}/ "
           f"({', '.join(sorted(files))})")
+    if table.refinement:
+        refinement = table.refinement
+        for item in refinement["rounds"]:
+            print(f"refinement round {item['round']}: {item['checked']} midpoints checked, largest miss "
+                  f"{100 * item['max_miss']:.3g} %, {item['missed']} over the tolerance, {item['split']} triangles split "
+                  f"(+{item['graded']} to keep the mesh graded), {item['axes']} axes, {item['solves']} entries solved")
+        print(f"refinement: {'reached' if refinement['reached'] else 'NOT reached'} ({refinement['stopped']}); "
+              f"{refinement['axes']} axes in the fit, {refinement['check_points']} check points outside it")
     if table.fit is None:
         print(f"no fit: {table.fit_note}")
     else:
@@ -137,6 +148,13 @@ def add_table_parser(commands: Any) -> None:
     parser.add_argument("--duration", type=float, help="slew duration for min_energy [s]")
     parser.add_argument("--held-out", type=int, help="axes of the held-out grid the fit is measured on "
                                                      "(at the mid angles; 0: none; default 0)")
+    parser.add_argument("--tolerance", type=float,
+                        help="refine the axes until the fit's misses at the triangles' edge midpoints are at most "
+                             "this fraction of the slew time (e.g. 0.01; default: no refinement)")
+    parser.add_argument("--check-angles", help="with --tolerance: the table angles [deg] a midpoint is checked at "
+                                               "first, comma-separated, or 'all' (default)")
+    parser.add_argument("--max-axes", type=int, help="with --tolerance: axes at most (default 2000)")
+    parser.add_argument("--max-rounds", type=int, help="with --tolerance: refinement rounds at most (default 8)")
     parser.add_argument("--out", help="output directory (default: results/table-<scenario name>)")
     parser.add_argument("--workers", type=int, help="entries at once (default: one per core)")
     parser.add_argument("--scheduler", help="Dask scheduler address (tcp://host:port) instead of local processes")

@@ -7,6 +7,10 @@ given (so a table run again into the same directory computes only the entries it
 whose solve fails, or that breaks a requirement, is kept with its status and message; only the
 ``ok`` entries enter the fit (an axis is filled between its ok angles by its own cubic, and an axis
 with fewer than two ok angles is left out of the fit).
+
+With a tolerance (``TableSpec.refine``) the table's axes are then refined where the fit misses
+(:func:`scenarios.slewtable.refine.refine`): each round's entries are one more study through the
+same engine and store, so an interrupted refinement also resumes where it stopped.
 """
 from __future__ import annotations
 
@@ -25,14 +29,16 @@ from scenarios.slewtable.fit import SlewTimeFit
 from scenarios.slewtable.spec import (
     TableCase,
     TableSpec,
+    case_scenario,
     table_cases,
     torque_generators,
 )
 
 __all__ = ["PART_NAMES", "SlewTable", "TablePart", "compute_table", "eval_time_us", "fit_entries", "held_out_errors"]
 
-PART_NAMES = ("table", "held_out")
-"""The two grids of a table: the fitted one and the held-out one."""
+PART_NAMES = ("table", "held_out", "check")
+"""The grids of a table: the fitted one, the held-out one, and the refinement's check points that
+were not split (so not in the fit; empty without refinement)."""
 
 
 @dataclass
@@ -114,6 +120,9 @@ class SlewTable:
     fit_quality : dict
         The fit's errors on the held-out grid (:func:`held_out_errors`) and its evaluation time
         ``eval_time_us`` [µs per call]; empty without a fit.
+    refinement : dict
+        The refinement's figures (:meth:`scenarios.slewtable.refine.RefineResult.summary`, with
+        ``tolerance``); empty without one.
     """
 
     spec: TableSpec
@@ -123,6 +132,7 @@ class SlewTable:
     fit: SlewTimeFit | None = None
     fit_note: str = ""
     fit_quality: dict[str, Any] = field(default_factory=dict)
+    refinement: dict[str, Any] = field(default_factory=dict)
 
 
 def _study(spec: TableSpec, cases: list[TableCase]) -> Any:
@@ -303,33 +313,36 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
     SweepInterrupted
         Interrupted (committed entries stay in the store).
     """
-    from scenarios.study.engine import sweep
     from scenarios.study.store import SweepStore
     cases = table_cases(spec)
-    study = _study(spec, cases)
     start = time.perf_counter()
     store = SweepStore(directory) if directory is not None else None
+    parts = {"table": TablePart.empty(spec.axes, spec.angles_deg),
+             "held_out": TablePart.empty(spec.held_out_axes, spec.held_out_angles_deg),
+             "check": TablePart.empty(np.zeros((0, 3)), spec.angles_deg)}
+    table = SlewTable(spec, parts)
+    run = _Runner(spec, store, workers or spec.workers, cluster, executor, progress)
     try:
-        stored = len(store.keys() & {case.key for case in study.cases}) if store is not None else 0
-        results = sweep(study, executor, workers=workers or spec.workers, store=store, progress=progress,
-                        cluster=cluster)
+        for case, record in zip(cases, run(cases)):
+            _fill(parts[case.part], case, record, spec.objective)
+        inertia, generators = torque_generators(spec.base)
+        triangles = spec.triangles
+        if spec.refine is not None:
+            triangles = _refine(table, run, inertia, generators)
     finally:
         if store is not None:
             store.close()
-    wall = time.perf_counter() - start
-    parts = {"table": TablePart.empty(spec.axes, spec.angles_deg),
-             "held_out": TablePart.empty(spec.held_out_axes, spec.held_out_angles_deg)}
-    for case, study_case in zip(cases, study.cases):
-        _fill(parts[case.part], case, results.records.get(study_case.key), spec.objective)
-    table = SlewTable(spec, parts, wall, stored)
+    table.wall_time_s = time.perf_counter() - start
+    table.stored = run.stored
     if spec.objective != "min_time":
         table.fit_note = "the fit is of minimum-time tables (this table is min_energy at a fixed duration)"
         return table
-    inertia, generators = torque_generators(spec.base)
     meta = {"scenario": spec.name, "objective": spec.objective,
             "from_identity_only": _inertially_dependent(spec.base)}
     meta["grid"] = spec.grid
-    table.fit, table.fit_note = fit_entries(parts["table"], inertia, generators, meta, spec.triangles)
+    if table.refinement:
+        meta["refinement"] = table.refinement
+    table.fit, table.fit_note = fit_entries(parts["table"], inertia, generators, meta, triangles)
     if table.fit is not None:
         quality = held_out_errors(table.fit, parts["held_out"])
         quality["eval_time_us"] = eval_time_us(table.fit)
@@ -337,6 +350,95 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
         table.fit.meta["note"] = table.fit_note
         table.fit_quality = quality
     return table
+
+
+class _Runner:
+    """Runs table entries through the trade-study engine (one study per call), counting those found
+    in the store."""
+
+    def __init__(self, spec: TableSpec, store: Any, workers: int | None, cluster: Any, executor: Executor | None,
+                 progress: bool):
+        self.spec, self.store, self.workers = spec, store, workers
+        self.cluster, self.executor, self.progress = cluster, executor, progress
+        self.stored = 0
+        self.entries = 0
+
+    def __call__(self, cases: list[TableCase]) -> list[dict[str, Any] | None]:
+        from scenarios.study.engine import sweep
+        if not cases:
+            return []
+        study = _study(self.spec, cases)
+        if self.store is not None:
+            self.stored += len(self.store.keys() & {case.key for case in study.cases})
+        results = sweep(study, self.executor, workers=self.workers, store=self.store, progress=self.progress,
+                        cluster=self.cluster)
+        self.entries += len(cases)
+        return [results.records.get(study_case.key) for study_case in study.cases]
+
+
+def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.ndarray) -> np.ndarray:
+    """Refine the table's axes (module docstring); the table part becomes the refined grid, the
+    check points not split become the ``check`` part. Returns the refined triangles."""
+    from scenarios.slewtable.fit import _hull
+    from scenarios.slewtable.refine import refine
+    spec = table.spec
+    assert spec.refine is not None
+    initial = table.parts["table"]
+    angles = np.deg2rad(spec.angles_deg)
+    entries: dict[tuple[tuple[float, ...], int], tuple[TableCase, dict[str, Any] | None]] = {}
+
+    def solve(axes: np.ndarray, angle_indices: list[int]) -> np.ndarray:
+        cases = [TableCase("table", i, k, axis, spec.angles_deg[k], case_scenario(spec, axis, spec.angles_deg[k]))
+                 for i, axis in enumerate(axes) for k in angle_indices]
+        times = np.full((len(axes), len(angle_indices)), np.nan)
+        for case, record in zip(cases, run(cases)):
+            entries[tuple(case.axis.tolist()), case.angle_index] = (case, record)
+            one = TablePart.empty(np.zeros((1, 3)), spec.angles_deg)
+            _fill(one, TableCase("table", 0, case.angle_index, case.axis, case.angle_deg, {}), record, spec.objective)
+            if one.ok[0, case.angle_index]:
+                times[case.axis_index, angle_indices.index(case.angle_index)] = one.slew_time_s[0, case.angle_index]
+        return times
+
+    def predict(axes: np.ndarray, times: np.ndarray, triangles: np.ndarray) -> Any:
+        part = TablePart.empty(axes, spec.angles_deg)
+        part.slew_time_s[:] = times
+        part.status = [["ok" if np.isfinite(v) else "failed" for v in row] for row in times]
+        fit, _ = fit_entries(part, inertia, generators, None, triangles)
+        if fit is None:
+            return None
+        return lambda e, k: fit.many_axis_angle(np.repeat(e, len(k), axis=0), np.tile(angles[k], len(e))
+                                                ).reshape(len(e), len(k))
+
+    triangles = spec.triangles if spec.triangles is not None else _hull(initial.axes)
+    times = np.where(initial.ok, initial.slew_time_s, np.nan)
+    result = refine(initial.axes, triangles, times, solve, predict, spec.refine)
+    refined = TablePart.empty(result.axes, spec.angles_deg)
+    n0 = len(initial.axes)
+    for i, axis in enumerate(result.axes):
+        for k in range(len(spec.angles_deg)):
+            if i < n0:  # the initial axes keep their order and entries
+                _copy_entry(initial, i, refined, i, k)
+            elif (found := entries.get((tuple(axis.tolist()), k))) is not None:
+                _fill(refined, TableCase("table", i, k, axis, spec.angles_deg[k], {}), found[1], spec.objective)
+    checks = TablePart.empty(np.array([c["axis"] for c in result.checks]).reshape(-1, 3), spec.angles_deg)
+    for i, axis in enumerate(checks.axes):
+        for k in range(len(spec.angles_deg)):
+            if (found := entries.get((tuple(axis.tolist()), k))) is not None:
+                _fill(checks, TableCase("check", i, k, axis, spec.angles_deg[k], {}), found[1], spec.objective)
+    table.parts["table"], table.parts["check"] = refined, checks
+    table.refinement = {"tolerance": spec.refine.tolerance,
+                        "check_angles_deg": [spec.angles_deg[k] for k in (spec.refine.check_angles
+                                                                          or range(len(spec.angles_deg)))],
+                        "max_axes": spec.refine.max_axes, "max_rounds": spec.refine.max_rounds,
+                        "initial_axes": n0, **result.summary()}
+    return result.triangles
+
+
+def _copy_entry(source: TablePart, i: int, target: TablePart, j: int, k: int) -> None:
+    for name in ("slew_time_s", "objective_value", "plan_time_s"):
+        getattr(target, name)[j, k] = getattr(source, name)[i, k]
+    target.status[j][k] = source.status[i][k]
+    target.message[j][k] = source.message[i][k]
 
 
 def _inertially_dependent(scenario: dict[str, Any]) -> bool:

@@ -47,6 +47,8 @@ def write_csv(table: SlewTable, path: Path) -> None:
         writer = csv.writer(stream)
         writer.writerow(CSV_COLUMNS)
         for name in PART_NAMES:
+            if name not in table.parts:
+                continue
             part = table.parts[name]
             for i, axis in enumerate(part.axes):
                 for k, angle in enumerate(part.angles_deg):
@@ -89,9 +91,9 @@ def write_netcdf(table: SlewTable, path: Path) -> None:
         nc.status_codes = " ".join(f"{i}={s}" for i, s in enumerate(STATUS_CODES))
         if spec.duration is not None:
             nc.duration_s = float(spec.duration)
-        for name, prefix in (("table", ""), ("held_out", "held_out_")):
-            part = table.parts[name]
-            if name == "held_out" and not len(part.axes):
+        for name, prefix in (("table", ""), ("held_out", "held_out_"), ("check", "check_")):
+            part = table.parts.get(name)
+            if part is None or (name != "table" and not len(part.axes)):
                 continue
             nc.createDimension(f"{prefix}axis", len(part.axes))
             nc.createDimension(f"{prefix}angle", len(part.angles_deg))

@@ -67,17 +67,30 @@ def _inverses(axes: np.ndarray, triangles: np.ndarray) -> np.ndarray:
 
 
 def _locate(inverses: np.ndarray, directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """For each direction, the triangle holding it and its normalised barycentric weights."""
-    weights = np.einsum("tij,nj->nti", inverses, directions)
-    inside = np.all(weights >= _INSIDE, axis=2)
-    found = np.argmax(inside, axis=1)
-    chosen = weights[np.arange(len(directions)), found]
+    """For each direction, the triangle holding it and its normalised barycentric weights (in chunks
+    of directions, so that memory stays bounded on refined meshes)."""
+    found = np.empty(len(directions), dtype=int)
+    chosen = np.empty((len(directions), 3))
+    step = max(1, 2_000_000 // max(len(inverses), 1))
+    for start in range(0, len(directions), step):
+        block = directions[start:start + step]
+        weights = np.einsum("tij,nj->nti", inverses, block)
+        inside = np.all(weights >= _INSIDE, axis=2)
+        first = np.argmax(inside, axis=1)
+        found[start:start + step] = first
+        chosen[start:start + step] = weights[np.arange(len(block)), first]
     return found, chosen / chosen.sum(axis=1, keepdims=True)
 
 
 def _cube_cells(inverses: np.ndarray) -> list[list[int]]:
     """Cube-map cell -> the triangles that directions in the cell can fall into (sampled densely
-    on each cell, edges included; the evaluation falls back to every triangle if none holds)."""
+    on each cell, edges included, among the triangles whose bounding cone meets the cell's; the
+    evaluation falls back to every triangle if none holds)."""
+    vertices = np.linalg.inv(inverses)  # (t, 3, 3): columns are the vertices
+    centres = vertices.sum(axis=2)
+    centres /= np.linalg.norm(centres, axis=1, keepdims=True)
+    radii = np.max(np.arccos(np.clip(np.einsum("ti,tij->tj", centres, vertices)
+                                     / np.linalg.norm(vertices, axis=1), -1.0, 1.0)), axis=1)
     s = np.linspace(-1.0, 1.0, _CELLS * (_SAMPLES - 1) + 1)
     cells: list[list[int]] = []
     for face in range(6):
@@ -89,13 +102,19 @@ def _cube_cells(inverses: np.ndarray) -> list[list[int]]:
         directions[:, others[0]] = u.ravel()
         directions[:, others[1]] = v.ravel()
         directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-        found, _ = _locate(inverses, directions)
-        found = found.reshape(u.shape)
+        cube = directions.reshape(*u.shape, 3)
         for i in range(_CELLS):
             for j in range(_CELLS):
-                block = found[i * (_SAMPLES - 1):(i + 1) * (_SAMPLES - 1) + 1,
-                              j * (_SAMPLES - 1):(j + 1) * (_SAMPLES - 1) + 1]
-                cells.append(sorted({int(t) for t in block.ravel()}))
+                block = cube[i * (_SAMPLES - 1):(i + 1) * (_SAMPLES - 1) + 1,
+                                   j * (_SAMPLES - 1):(j + 1) * (_SAMPLES - 1) + 1].reshape(-1, 3)
+                centre = block.mean(axis=0)
+                centre /= np.linalg.norm(centre)
+                spread = float(np.max(np.arccos(np.clip(block @ centre, -1.0, 1.0))))
+                near = np.nonzero(np.arccos(np.clip(centres @ centre, -1.0, 1.0)) <= radii + spread + 1e-9)[0]
+                if not len(near):
+                    near = np.arange(len(inverses))
+                found, _ = _locate(inverses[near], block)
+                cells.append(sorted({int(t) for t in near[found]}))
     return cells
 
 

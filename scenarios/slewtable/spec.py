@@ -13,6 +13,10 @@ small table file (its top-level key ``table``)::
       held_out: 12              # axes of the held-out lattice (0: none), at the mid angles
       planner_options: {}       # more collocation options (intervals, ...)
       execution: {workers: null, scheduler: null, case_timeout_s: 600}
+      refine: {tolerance: 0.01, check_angles_deg: all, max_axes: 2000, max_rounds: 8}   # optional
+
+``refine`` (or ``--tolerance``) refines the axes where the fit misses
+(:mod:`scenarios.slewtable.refine`).
 
 Every case is the scenario's spacecraft, actuators (failed wheels included), environment and
 pointing and rate requirements, slewing rest to rest from the identity attitude by the angle about
@@ -38,14 +42,20 @@ from scenarios.slewtable.grid import (
     offset_axes,
     polytope_grid,
 )
+from scenarios.slewtable.refine import RefineOptions
 
-__all__ = ["DEFAULT_ANGLES", "DEFAULT_AXES", "GRIDS", "OBJECTIVES", "TABLE_KEYS", "TableCase", "TableSpec", "angles_from_text",
+__all__ = ["DEFAULT_ANGLES", "DEFAULT_AXES", "GRIDS", "OBJECTIVES", "REFINE_KEYS", "TABLE_KEYS", "TableCase", "TableSpec", "angles_from_text",
            "case_scenario", "check_angles", "check_axes", "parse_table_spec", "table_cases", "torque_generators"]
 
 OBJECTIVES = ("min_time", "min_energy")
 """The objectives a table computes."""
-TABLE_KEYS = ("scenario", "axes", "grid", "angles_deg", "objective", "duration", "held_out", "planner_options", "execution")
+TABLE_KEYS = ("scenario", "axes", "grid", "angles_deg", "objective", "duration", "held_out", "planner_options", "execution",
+              "refine")
 """The keys of a table file's ``table`` mapping."""
+REFINE_KEYS = ("tolerance", "check_angles_deg", "max_axes", "max_rounds")
+"""The keys of ``table.refine`` (:class:`scenarios.slewtable.refine.RefineOptions`)."""
+_REFINE_FLAGS = {"tolerance": "tolerance", "check_angles_deg": "check-angles", "max_axes": "max-axes",
+                 "max_rounds": "max-rounds"}
 DEFAULT_AXES = 40
 GRIDS = ("polytope", "fibonacci")
 """How a number of axes is spread: along the kinks of the slew time (the torque polytope's faces,
@@ -90,6 +100,8 @@ class TableSpec:
         ``polytope``, ``fibonacci`` or ``list`` (axes given one by one).
     triangles : numpy.ndarray or None
         For a ``polytope`` grid, its triangles (vertex indices), kept by the fit; None otherwise.
+    refine : RefineOptions or None
+        Refine the axes to a tolerance (:mod:`scenarios.slewtable.refine`); None: the grid as it is.
     """
 
     name: str
@@ -106,6 +118,7 @@ class TableSpec:
     source: Path | None = None
     grid: str = "fibonacci"
     triangles: np.ndarray | None = None
+    refine: RefineOptions | None = None
 
     @property
     def held_out_axes(self) -> np.ndarray:
@@ -399,10 +412,63 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
         if timeout <= 0:
             raise ScenarioError("table.execution.case_timeout_s", f"expected a positive time, got {timeout!r}")
     assert axes is not None
+    refine = _refine_options(given, angles, objective, len(axes))
     spec = TableSpec(str(base.get("name") or source.stem), base, axes, angles, objective, duration, held_out,
-                     options, workers, scheduler, timeout, source, grid, triangles)
+                     options, workers, scheduler, timeout, source, grid, triangles, refine)
     table_cases(spec)  # the collocation options and the case scenario are checked now
     return spec
+
+
+def _refine_options(given: dict[str, Any], angles: list[float], objective: str, axes: int) -> RefineOptions | None:
+    """``table.refine`` and its flags (flags win) -> the refinement's options, None when no tolerance."""
+    section = given.get("table.refine")
+    if section is not None and not isinstance(section, dict):
+        raise ScenarioError("table.refine", f"expected a mapping with keys {', '.join(REFINE_KEYS)}, got {section!r}")
+    values: dict[str, tuple[str, Any]] = {}
+    for key, value in (section or {}).items():
+        if key not in REFINE_KEYS:
+            raise ScenarioError(f"table.refine.{key}", f"unknown key; expected one of {', '.join(REFINE_KEYS)}")
+        values[key] = (f"table.refine.{key}", value)
+    for key, flag in _REFINE_FLAGS.items():
+        if given.get(f"--{flag}") is not None:
+            values[key] = (f"--{flag}", given[f"--{flag}"])
+    if "tolerance" not in values or values["tolerance"][1] is None:
+        others = [where for key, (where, value) in values.items() if key != "tolerance" and value is not None]
+        if others:
+            raise ScenarioError(others[0], "refinement options need a tolerance (--tolerance or table.refine.tolerance)")
+        return None
+    where, value = values["tolerance"]
+    tolerance = _number(value, where, "a tolerance (a fraction of the slew time, e.g. 0.01)")
+    if not 0.0 < tolerance < 1.0:
+        raise ScenarioError(where, f"expected a tolerance above 0 and below 1 (a fraction of the slew time), got {value!r}")
+    if objective != "min_time":
+        raise ScenarioError(where, "refinement is of the fit, which is of min_time tables")
+    check: list[int] | None = None
+    if (found := values.get("check_angles_deg")) is not None and found[1] not in (None, "all"):
+        where, value = found
+        if isinstance(value, str):
+            try:
+                value = [float(p) for p in value.split(",") if p.strip()]
+            except ValueError:
+                raise ScenarioError(where, f"expected 'all' or table angles in degrees, got {value!r}") from None
+        if not isinstance(value, (list, tuple)) or not value:
+            raise ScenarioError(where, f"expected 'all' or a list of the table's angles in degrees, got {value!r}")
+        check = []
+        for v in value:
+            number = _number(v, where, "the table's angles in degrees")
+            near = int(np.argmin([abs(number - a) for a in angles]))
+            if abs(angles[near] - number) > 0.05:
+                raise ScenarioError(where, f"{v!r} is not one of the table's angles "
+                                           f"({', '.join(f'{a:.4g}' for a in angles)} deg)")
+            check.append(near)
+    limits = {}
+    for key, low in (("max_axes", axes), ("max_rounds", 1)):
+        if (found := values.get(key)) is not None and found[1] is not None:
+            where, value = found
+            if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= 100000:
+                raise ScenarioError(where, f"expected a whole number from {low} to 100000, got {value!r}")
+            limits[key] = value
+    return RefineOptions(tolerance, check, **limits)
 
 
 def case_scenario(spec: TableSpec, axis: np.ndarray, angle_deg: float) -> dict[str, Any]:
