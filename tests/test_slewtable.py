@@ -104,6 +104,19 @@ def test_min_energy_entry_meets_the_double_integrator_closed_form(tmp_path):
     assert table.fit is None and "min_energy" in table.fit_note
 
 
+def test_a_window_longer_than_100_s_is_tabulated(tmp_path):
+    # The closed loop that completes each row takes two samples of half the window: with the default
+    # 0.05 s RK4 sub-step a 500 s window was refused (more than 1000 sub-steps per sample). The entry
+    # still meets the double integrator's 12 J² θ² / T³.
+    table = _table(tmp_path, SPHERE_ONE_WHEEL, {"axes": [[1, 0, 0]], "angles_deg": [15, 30], "objective": "min_energy",
+                                                "duration": 500.0, "planner_options": {"multistart": 0}})
+    part = table.parts["table"]
+    assert part.status == [["ok", "ok"]], part.message
+    for k, angle in enumerate((15.0, 30.0)):
+        assert part.objective_value[0, k] == pytest.approx(12 * 2.0 ** 2 * math.radians(angle) ** 2 / 500.0 ** 3,
+                                                           rel=1e-4)
+
+
 def test_a_failed_solve_is_an_entry_with_its_status(tmp_path):
     # The duration bound 8 s admits 30 deg (6.47 s) but not 90 deg (11.21 s): that entry fails, the
     # table goes on and keeps the planner's message.
@@ -293,6 +306,7 @@ def test_netcdf_reads_back_with_dimensions_units_and_attributes(tmp_path):
     (["--objective", "fastest"], "--objective"),
     (["--grid", "icosahedral"], "--grid"),
     (["--held-out", "-1"], "--held-out"),
+    (["--scheduler", "tcp://127.0.0.1:1"], "--scheduler"),  # nobody listens: nothing is claimed
 ])
 def test_bad_options_exit_2_naming_the_option(tmp_path, capsys, flags, where):
     scenario = _write(tmp_path, "box.yaml", UNIT_BOX)

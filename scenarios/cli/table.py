@@ -75,9 +75,15 @@ def command_table(args: argparse.Namespace) -> int:
     if not args.no_plots:
         import matplotlib  # noqa: F401  (fail now, not after the entries ran)
     out = Path(args.out) if args.out else default_output_directory(f"table-{spec.name}")
-    directory = claim_table_directory(out)
+    # the scheduler first: one that cannot be reached exits 2 with nothing written
     cluster = connect_scheduler(spec.scheduler, "--scheduler" if args.scheduler else "table.execution.scheduler") \
         if spec.scheduler else None
+    try:
+        directory = claim_table_directory(out)
+    except BaseException:
+        if cluster is not None:
+            cluster.close()
+        raise
     entries = len(spec.axes) * len(spec.angles_deg) + spec.held_out * max(len(spec.angles_deg) - 1, 0)
     print(f"{spec.name}: {len(spec.axes)} axes x {len(spec.angles_deg)} angles"
           + (f" + {spec.held_out} held-out axes x {len(spec.angles_deg) - 1} angles" if spec.held_out else "")

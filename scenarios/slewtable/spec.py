@@ -22,7 +22,7 @@ Every case is the scenario's spacecraft, actuators (failed wheels included), env
 pointing and rate requirements, slewing rest to rest from the identity attitude by the angle about
 the axis, planned by ``collocation``; nothing is simulated beyond a token closed loop (controller
 ``none``). ``requirements.actuators`` is kept only when the scenario states it (absent, the limits
-are imposed at the collocation points: see :doc:`/guide/slew_table`).
+are the planner's bounds at the collocation points: see :doc:`/guide/slew_table`).
 """
 from __future__ import annotations
 
@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from ocp.simulation.simulator import MAX_SUBSTEPS
 from scenarios.errors import ScenarioError
 from scenarios.slewtable.fit import zonotope_facets
 from scenarios.slewtable.grid import (
@@ -505,7 +506,10 @@ def case_scenario(spec: TableSpec, axis: np.ndarray, angle_deg: float) -> dict[s
     data["planners"] = [{"name": "collocation", "label": "collocation", "options": options}]
     data["controller"] = {"name": "none"}
     window = float(maneuver.get("duration") or 1.0)
-    data["simulation"] = {"sample_time": window / 2.0, "duration": window}
+    # the table reads the plan; the closed loop (no law) only completes the row: two samples, with
+    # RK4 sub-steps long enough for any window (the default 0.05 s allows a 100 s window at most)
+    data["simulation"] = {"sample_time": window / 2.0, "duration": window,
+                          "max_step": max(0.05, window / 2.0 / MAX_SUBSTEPS)}
     requirements = data.get("requirements")
     if isinstance(requirements, dict):
         kept = {k: requirements[k] for k in ("pointing", "rate", "actuators") if k in requirements}
