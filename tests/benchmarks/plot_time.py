@@ -14,12 +14,16 @@ per kind of run, wall and CPU time (user + system of the command): medians, 10th
 percentiles and the ratio of the medians (target: wall time of the whole command with plots, this
 checkout over the base, at most 1.1; the CPU time is less sensitive to a loaded host).
 
-Measured on 2026-12-02 (``--base 5e90e69 --pairs 12``, load average 4.3-6.8 from other work on the
-two cores): with plots 3.190 s against 3.784 s wall (ratio of the medians 1.186; per pair 1.182,
-10th-90th percentile 1.150-1.447), CPU 2.146 s against 2.495 s (1.163); without plots 1.398 s
-against 1.544 s (1.104; CPU 1.108). Target not met; at the start of that day (before the PNG
-writer, the plot process's helper and the report's batching) 1.337 with plots and 1.186 without
-(10 pairs, load 0.8-5.8). The parts: docs/performance.rst.
+Measured on 2026-12-02 on a quiet host (``--base 5e90e69 --pairs 12``, load average 0.4-1.2, twice):
+with plots 1.296 s at the base against 1.233 s (ratio of the medians 0.951; per pair 0.969,
+10th-90th percentile 0.879-1.121), CPU 2.053 s against 2.102 s (1.024); without plots 0.920 (CPU
+0.837); the second run 1.333 s against 1.287 s (0.965; per pair 0.968, 0.806-1.106; CPU 1.052;
+without plots 0.870). Target met. At load 3.1-3.7 (another job on the two cores) 1.083 (per pair
+1.025, CPU 1.071) and 1.161 (per pair 1.016, CPU 1.093): under load the ratio of the medians moves
+more than the per-pair ratio. Earlier that day, before ``scipy.linalg`` was imported lazily and
+at load 4.3-6.8, 1.186; at the start of the day (before the PNG writer, the plot process's helper
+and the report's batching) 1.337 with plots and 1.186 without (10 pairs, load 0.8-5.8). The
+parts: docs/performance.rst.
 """
 from __future__ import annotations
 
