@@ -154,7 +154,7 @@ class FatropPeer:
         elapsed = time.perf_counter() - start
         stats = solution.stats()
         return PeerResult(float(solution.value(cost)), elapsed, "ok", stats.get("iter_count"),
-                          str(stats.get("return_status", "")), build)
+                          f"FATROP: return status {stats.get('return_status', '?')}", build)
 
 
 PEER = FatropPeer()
