@@ -33,6 +33,7 @@ import struct
 import sys
 import time
 import traceback
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -334,23 +335,7 @@ def _draw_in_two(jobs: list[Any], directory: Path, forks: list[int], figures: di
     if not mine or not theirs or _thread_count() != 1:  # a fork copies only the calling thread
         draw_jobs(jobs, directory, figures)
         return
-    stopping = {signal.SIGINT, signal.SIGTERM}
-    parent = os.getpid()
-    signal.pthread_sigmask(signal.SIG_BLOCK, stopping)  # no stop between the fork and `forks` (_stop)
-    pid = os.fork()
-    if pid == 0:
-        code = 1
-        try:
-            for signum in stopping:
-                signal.signal(signum, signal.SIG_DFL)
-            signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
-            die_with_parent(signal.SIGKILL, parent)
-            draw_jobs(theirs, directory, figures)
-            code = 0
-        finally:
-            os._exit(code)
-    forks.append(pid)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
+    pid = _fork(lambda: draw_jobs(theirs, directory, figures), forks)
     try:
         draw_jobs(mine, directory, figures)
     finally:
@@ -420,9 +405,32 @@ def _start_helper(jobs: list[Any], figures: dict[Any, Any], forks: list[int], cl
     ``("error", traceback)``, then exits. Its pid is in ``forks`` while it runs (:func:`_stop`);
     ``close``: the plot process's ends of its pipes to the run, which the helper does not use."""
     read_fd, write_fd = os.pipe()
+
+    def answer() -> None:
+        for fd in (read_fd, *close):
+            os.close(fd)
+        try:
+            reply: tuple[str, Any] = ("ok", _draw_into_memory(jobs, figures))
+        except Exception:  # noqa: BLE001 (reported to the plot process, which reports it to the run)
+            reply = ("error", traceback.format_exc())
+        with os.fdopen(write_fd, "wb") as stream:
+            pickle.dump(reply, stream, protocol=pickle.HIGHEST_PROTOCOL)
+
+    pid = _fork(answer, forks)
+    os.close(write_fd)
+    return _Helper(pid, read_fd, jobs)
+
+
+def _fork(work: Callable[[], None], forks: list[int]) -> int:
+    """Fork a child of the plot process that runs ``work`` and exits (status 0 when it returned, 1
+    when it raised); return its pid, which is in ``forks`` (:func:`_stop`) until the caller reaps it.
+
+    The stop signals are blocked from before the fork until the pid is in ``forks``, so that a stop
+    never misses the child; the child takes their default actions and dies with the plot process.
+    """
     stopping = {signal.SIGINT, signal.SIGTERM}
     parent = os.getpid()
-    signal.pthread_sigmask(signal.SIG_BLOCK, stopping)  # no stop between the fork and `forks` (_stop)
+    signal.pthread_sigmask(signal.SIG_BLOCK, stopping)
     pid = os.fork()
     if pid == 0:
         code = 1
@@ -431,21 +439,13 @@ def _start_helper(jobs: list[Any], figures: dict[Any, Any], forks: list[int], cl
                 signal.signal(signum, signal.SIG_DFL)
             signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
             die_with_parent(signal.SIGKILL, parent)
-            for fd in (read_fd, *close):
-                os.close(fd)
-            try:
-                reply: tuple[str, Any] = ("ok", _draw_into_memory(jobs, figures))
-            except Exception:  # noqa: BLE001 (reported to the plot process, which reports it to the run)
-                reply = ("error", traceback.format_exc())
-            with os.fdopen(write_fd, "wb") as stream:
-                pickle.dump(reply, stream, protocol=pickle.HIGHEST_PROTOCOL)
+            work()
             code = 0
         finally:
             os._exit(code)
     forks.append(pid)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, stopping)
-    os.close(write_fd)
-    return _Helper(pid, read_fd, jobs)
+    return pid
 
 
 def _collect(helper: _Helper, forks: list[int]) -> tuple[dict[str, bytes], list[Any], str]:
