@@ -53,13 +53,10 @@ def command_table(args: argparse.Namespace) -> int:
     from scenarios.output.directory import new_staging
     from scenarios.output.names import default_output_directory
     from scenarios.slewtable.compute import compute_table
-    from scenarios.slewtable.directory import (
-        claim_table_directory,
-        commit_table_outputs,
-    )
     from scenarios.slewtable.files import write_table_files
     from scenarios.slewtable.spec import parse_table_spec
     from scenarios.study.engine import connect_scheduler, start_forkserver
+    from scenarios.study.store import claim_sweep_directory, commit_sweep_outputs
 
     if isinstance(args.axes, str):
         raise ScenarioError("--axes", f"expected a number of axes, got {args.axes!r}")
@@ -79,7 +76,7 @@ def command_table(args: argparse.Namespace) -> int:
     cluster = connect_scheduler(spec.scheduler, "--scheduler" if args.scheduler else "table.execution.scheduler") \
         if spec.scheduler else None
     try:
-        directory = claim_table_directory(out)
+        directory = claim_sweep_directory(out, kind="table")  # the store beside the files
     except BaseException:
         if cluster is not None:
             cluster.close()
@@ -104,7 +101,7 @@ def command_table(args: argparse.Namespace) -> int:
     staging = new_staging(directory)
     start = time.perf_counter()
     write_table_files(table, staging, plots=not args.no_plots)
-    files = commit_table_outputs(directory, staging)
+    files = commit_sweep_outputs(directory, staging, kind="table")
     part = table.parts["table"]
     ok = int(part.ok.sum())
     print(f"computed in {table.wall_time_s:.1f} s ({table.stored} entries already stored); table: {ok} of "

@@ -4,8 +4,7 @@ What lives here: the grid of axes and angles (:mod:`~scenarios.slewtable.grid`),
 computes, read from a scenario or a table file (:mod:`~scenarios.slewtable.spec`), the computation
 through the trade-study engine and its fit (:mod:`~scenarios.slewtable.compute`), the fit itself,
 a callable ``slew_time(q0, qf)`` (:mod:`~scenarios.slewtable.fit`), its adaptive refinement to a
-tolerance (:mod:`~scenarios.slewtable.refine`), the output directory
-(:mod:`~scenarios.slewtable.directory`) and the files (:mod:`~scenarios.slewtable.files`: CSV,
+tolerance (:mod:`~scenarios.slewtable.refine`) and the files (:mod:`~scenarios.slewtable.files`: CSV,
 NetCDF, ``fit.json``, the agility envelope plot).
 
 May import: :mod:`ocp`, :mod:`scenarios.errors`, :mod:`scenarios.schema`, :mod:`scenarios.output`

@@ -15,7 +15,7 @@ read in today's form.
 The directory that holds the store is an output directory slewbench owns
 (:mod:`scenarios.output.directory`): :func:`claim_sweep_directory` claims it with the store's files
 listed in its manifest, and :func:`commit_sweep_outputs` commits a report beside the store without
-ever replacing it.
+ever replacing it (a sweep's directory, or a slew table's: ``kind="table"``).
 """
 from __future__ import annotations
 
@@ -368,7 +368,7 @@ STORE_FILES = (STORE_NAME, f"{STORE_NAME}-wal", f"{STORE_NAME}-shm")
 replaced by a report."""
 
 
-def claim_sweep_directory(path: str | Path) -> Path:
+def claim_sweep_directory(path: str | Path, kind: str = "sweep") -> Path:
     """Claim ``path`` for a sweep (:func:`scenarios.output.directory.claim_output_directory`) and list the
     store's files in its manifest. A ``sweep.sqlite`` already there must be a slewbench store.
 
@@ -376,6 +376,9 @@ def claim_sweep_directory(path: str | Path) -> Path:
     ----------
     path : str or Path
         The output directory (created if absent).
+    kind : str
+        The marker's kind of output: ``"sweep"``, or another command that computes through the study
+        engine into its store (``"table"``, :mod:`scenarios.slewtable`).
 
     Returns
     -------
@@ -388,16 +391,16 @@ def claim_sweep_directory(path: str | Path) -> Path:
         As :func:`~scenarios.output.directory.claim_output_directory`, or for a ``sweep.sqlite`` that is not
         a slewbench sweep store (it is left untouched).
     """
-    directory = claim_output_directory(path, kind="sweep")
+    directory = claim_output_directory(path, kind=kind)
     if (directory / STORE_NAME).exists() and not is_sweep_store(directory):
         raise OutputError(path, f"holds a {STORE_NAME} that is not a slewbench sweep store; nothing was touched")
     manifest = read_manifest(directory) or {"files": [], "complete": False}
     write_manifest(directory, set(manifest["files"]) | set(STORE_FILES), complete=bool(manifest.get("complete")),
-                    kind="sweep")
+                   kind=kind)
     return directory
 
 
-def commit_sweep_outputs(directory: Path, staging: Path) -> list[str]:
+def commit_sweep_outputs(directory: Path, staging: Path, kind: str = "sweep") -> list[str]:
     """Commit a staged report into a sweep directory, the store's files kept out of the commit's reach.
 
     :func:`scenarios.output.directory.commit_outputs` removes listed files the new set lacks; the
@@ -409,6 +412,8 @@ def commit_sweep_outputs(directory: Path, staging: Path) -> list[str]:
         The claimed sweep directory (:func:`claim_sweep_directory`).
     staging : Path
         The staging folder inside it holding the new report's files.
+    kind : str
+        The marker's kind, as claimed.
 
     Returns
     -------
@@ -423,7 +428,7 @@ def commit_sweep_outputs(directory: Path, staging: Path) -> list[str]:
     manifest = read_manifest(directory)
     if manifest is None:
         raise OutputError(directory, f"lost its {MARKER} while running; nothing was replaced")
-    write_manifest(directory, [f for f in manifest["files"] if f not in STORE_FILES], complete=False, kind="sweep")
-    written = commit_outputs(directory, staging, kind="sweep")
-    write_manifest(directory, [*written, *STORE_FILES], complete=True, kind="sweep")
+    write_manifest(directory, [f for f in manifest["files"] if f not in STORE_FILES], complete=False, kind=kind)
+    written = commit_outputs(directory, staging, kind=kind)
+    write_manifest(directory, [*written, *STORE_FILES], complete=True, kind=kind)
     return written
