@@ -21,6 +21,7 @@ from scenarios.slewtable.compute import _Runner
 from scenarios.slewtable.fit import SlewTimeFit, load_fit, zonotope_facets
 from scenarios.slewtable.grid import offset_axes, polytope_grid
 from scenarios.slewtable.refine import RefineOptions, TriangleMesh, refine
+from tests.test_slewtable import UNIT_BOX
 
 INERTIA = np.diag([10.0, 8.0, 6.0])
 ANGLES = np.deg2rad([30.0, 90.0, 180.0])
@@ -195,16 +196,6 @@ def test_refine_refuses_bad_options():
 
 
 # --- the table command with refinement -----------------------------------------------------------
-
-UNIT_BOX = {
-    "name": "bilimoria-wie",
-    "spacecraft": {"inertia": [1.0, 1.0, 1.0], "wheels": None, "torquers": {"max_torque": 1.0}},
-    "maneuver": {"duration": 10.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
-                 "final": {"q": [0, 1, 0, 0], "omega": [0, 0, 0]}},
-    "planners": [{"name": "collocation"}],
-    "controller": {"name": "augmented_quaternion_feedback"},
-}
-
 
 def _box_time(axis: np.ndarray, angle_deg: float) -> float:
     """A slew time with a ridge off the unit box's grid edges (the command's solves replaced)."""
