@@ -4,6 +4,7 @@ and output safety."""
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import math
 import shutil
@@ -15,7 +16,12 @@ import pytest
 from ocp import Spacecraft, Torquers, quat
 from planners import PLANNERS, ManeuverProblem
 from scenarios.bench import SUITE_FILE, load_suite
-from scenarios.bench.leaderboard import BENCH_FILES, certificate_text, gap, other_planners
+from scenarios.bench.leaderboard import (
+    BENCH_FILES,
+    certificate_text,
+    gap,
+    other_planners,
+)
 from scenarios.bench.peers import PEERS, PeerUnavailable, load_peer
 from scenarios.bench.suite import OBJECTIVE_METRICS, OPTIMUM_KINDS
 from scenarios.cli.commands import main
@@ -226,9 +232,66 @@ def test_a_row_reaches_the_optimum_only_when_ok_and_a_peer_at_the_eigenaxis_sadd
     assert _reached("ok", None, problem) is None
     at_saddle = _peer_row(problem, "fatrop", PeerResult(2.0 * math.sqrt(math.pi), 0.01, "ok", 3, ""))
     assert at_saddle.message.startswith(EIGENAXIS_NOTE) and _note(at_saddle).startswith("stopped at the eigenaxis")
-    at_optimum = _peer_row(problem, "fatrop", PeerResult(3.24312, 0.01, "ok", 30, "fatrop: ok"))
-    assert at_optimum.reached and at_optimum.message == "fatrop: ok" and _note(at_optimum) == ""
+    at_optimum = _peer_row(problem, "fatrop", PeerResult(3.24312, 0.01, "ok", 30, "start: ours; fatrop: ok"))
+    assert at_optimum.reached and at_optimum.message == "start: ours; fatrop: ok"
+    assert _note(at_optimum) == "start: ours; fatrop: ok"  # a peer's note names its start, ok or not
+    assert _note(dataclasses.replace(at_optimum, kind="planner")) == ""  # an ok planner row has none
     # where the eigenaxis slew is the optimum (the norm-bounded problem), reaching it is no saddle
     closed = load_suite().problems["norm_bounded_eigenaxis"]
     row = _peer_row(closed, "fatrop", PeerResult(closed.optimum, 0.01, "ok", 5, ""))
     assert row.reached and not row.message.startswith(EIGENAXIS_NOTE)
+
+
+def _suite_problem(name):
+    return load(load_suite().problems[name].file).problem
+
+
+def test_the_peers_start_is_collocations_first_start_seeded_and_perturbed_for_minimum_time():
+    """The bench's peer start (``first_start_guess``) on Bilimoria & Wie 180°: for minimum time the
+    eigenaxis slew's smooth profile over the duration bound (the eigenaxis planner's own sample is
+    the oracle), perturbed at the planner's 3 % (every entry moved, none by more than 5 sigma), and
+    the same on every call whatever numpy's global random state (seed 0 of its own generator); for
+    minimum energy (no perturbation in ``collocation``'s first start) the eigenaxis slew itself."""
+    from scenarios.bench.peers._shooting import N, eigenaxis_guess, first_start_guess
+
+    problem = _suite_problem("bilimoria_wie_180")
+    first = first_start_guess(problem, "min_time")
+    np.random.seed(12345)
+    np.random.rand(100)
+    again = first_start_guess(problem, "min_time")
+    assert np.array_equal(first.states, again.states) and first.duration == again.duration
+    assert first.start == again.start == "start: collocation's first (eigenaxis perturbed 1), T0 9.941 s"
+    smooth = PLANNERS["eigenaxis"]({"profile": "smooth"}).plan(problem)
+    assert smooth.duration == problem.duration == 10.0
+    sample = smooth.sample(np.linspace(0.0, smooth.duration, N + 1))
+    unperturbed = np.vstack([np.asarray(sample.q).T, np.asarray(sample.omega).T])
+    assert first.states.shape == (7, N + 1)
+    sigma = 0.03 * (np.abs(unperturbed) + 1e-3)  # AUTO_FIRST of |value| + the state floor 1e-3
+    moved = np.abs(first.states - unperturbed)
+    assert np.all(moved > 0.0) and np.all(moved < 5.0 * sigma)
+    assert first.duration != 10.0 and abs(first.duration - 10.0) < 5.0 * 0.03 * 10.0
+    # minimum energy: the unperturbed eigenaxis slew over the problem's duration, as the peers had it
+    energy = _suite_problem("natural_motion_min_energy")
+    guess = first_start_guess(energy, "min_energy")
+    states, duration = eigenaxis_guess(energy, "min_energy")
+    assert guess.duration == duration == energy.duration
+    assert np.allclose(guess.states, states, rtol=0.0, atol=1e-12)
+    assert guess.start == "start: collocation's first (eigenaxis), T0 110 s"
+
+
+def test_the_fatrop_peer_leaves_the_bilimoria_wie_saddle_from_the_bench_start():
+    """From the bench's start the FATROP peer reaches Bilimoria & Wie's published 3.2431 (its RK4,
+    N = 50 optimum, within 2e-3); from the eigenaxis bang-bang it stays at that stationary point,
+    2 sqrt(pi) = 3.5449: the bench must not start the peers there."""
+    from scenarios.bench.peers._shooting import eigenaxis_guess
+    from scenarios.bench.peers.fatrop import build_opti
+
+    problem = _suite_problem("bilimoria_wie_180")
+    result = load_peer("fatrop").solve(problem, "min_time")
+    assert result.status == "ok", result.message
+    assert result.objective is not None and result.objective < 3.5
+    assert result.objective == pytest.approx(3.2431, rel=2e-3)
+    assert result.message.startswith("start: collocation's first (eigenaxis perturbed 1)")
+    assert result.extra["start"] == result.message.split("; ")[0]
+    opti, cost = build_opti(problem, *eigenaxis_guess(problem, "min_time"))
+    assert float(opti.solve().value(cost)) == pytest.approx(2.0 * math.sqrt(math.pi), abs=1e-4)

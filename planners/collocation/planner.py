@@ -431,6 +431,42 @@ class CollocationPlanner(Planner):
         starts, fallback, restart, names = self._policy(problem, ocp, transcription, nlp, seeds, labels[:len(seeds)])
         return starts, fallback + alternates, restart, names + labels[len(seeds):]
 
+    def first_start(self, problem: ManeuverProblem) -> tuple[Array, NLP, str]:
+        """The first start of the multistart on the ``intervals`` mesh, for tools that start where
+        this planner starts (the benchmark's peers): the ``warm_start`` planner's reference as a
+        decision vector, as :meth:`plan` seeds it, then as the ``multistart`` policy makes its first
+        start (with ``auto`` and a free final time a copy perturbed by
+        :data:`~planners.collocation.strategy.AUTO_FIRST`; the noise of
+        :func:`ocp.nlp.solve.perturbed` has seed 0, so every call gives the same vector).
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The problem.
+
+        Returns
+        -------
+        tuple
+            The decision vector (the stage-wise layout of :mod:`ocp.transcription.base`), the NLP it
+            belongs to (its ``n_stage_state``, ``n_interval`` and ``free_time`` read the layout) and
+            where the start comes from (e.g. ``"eigenaxis perturbed 1"``).
+
+        Raises
+        ------
+        ValueError
+            The warm-start planner does not plan the problem, or a pointing constraint leaves no
+            cone.
+        """
+        o = self.options
+        ocp = self._ocp(problem)
+        transcription, nlp = self._nlp(problem, ocp)
+        reference = PLANNERS[o.warm_start](o.warm_start_options, cache=self.cache).plan(problem)
+        if not reference.ok:
+            raise ValueError(f"no first start: the warm-start planner {o.warm_start!r} failed ({reference.message})")
+        seeds, _, labels = self._seeds(problem, ocp, transcription, nlp, [reference])
+        starts, _, _, names = self._guesses(problem, ocp, transcription, nlp, seeds, labels=labels[:len(seeds)])
+        return starts[0], nlp, names[0]
+
     def _policy(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
                 seeds: list[Array], labels: list[str]) -> tuple[list[Array], list[Array], float, list[str]]:
         """The ``multistart`` policy of :meth:`_guesses` (the labels of its starts, then of its

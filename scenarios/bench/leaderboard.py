@@ -173,7 +173,8 @@ def _peer_row(problem: BenchProblem, name: str, result: Any) -> BenchRow:
     eigenaxis = problem.eigenaxis
     if (result.objective is not None and eigenaxis is not None and abs(eigenaxis - problem.optimum) > problem.tolerance
             and abs(result.objective - eigenaxis) <= problem.tolerance):
-        # the peers start from the eigenaxis slew; where that is a stationary point they can stay there
+        # where the eigenaxis slew is not the optimum it can be a stationary point (a saddle of
+        # Bilimoria & Wie's slews): a peer that stops there is noted (its message names its start)
         message = f"{EIGENAXIS_NOTE}; {message}" if message else EIGENAXIS_NOTE
     return BenchRow(problem.name, f"{name} (peer)", name, "peer", result.status, result.objective, gap_abs, gap_rel,
                     _reached(result.status, gap_abs, problem), result.solve_time_s,
@@ -388,14 +389,14 @@ def _fmt(value: float | None, spec: str = ".6g") -> str:
 
 NOTE_CHARS = 100
 """Longest note in the Markdown table (the CSV and JSON keep the whole message)."""
-EIGENAXIS_NOTE = "stopped at the eigenaxis slew's value: the stationary point of its start (the eigenaxis guess)"
+EIGENAXIS_NOTE = "stopped at the eigenaxis slew's value (a stationary point)"
 """The note of a peer whose value is the eigenaxis slew's where that is not the optimum."""
 
 
 def _note(row: BenchRow) -> str:
-    """The row's message when it is not ok, has no gap or is a peer stopped at the eigenaxis slew,
+    """The row's message when it is a peer's (it names the peer's start), not ok or has no gap,
     shortened; else empty."""
-    if row.status == "ok" and row.gap_abs is not None and not row.message.startswith(EIGENAXIS_NOTE):
+    if row.kind != "peer" and row.status == "ok" and row.gap_abs is not None:
         return ""
     text = row.message.strip()
     return text if len(text) <= NOTE_CHARS else text[:NOTE_CHARS - 1] + "…"

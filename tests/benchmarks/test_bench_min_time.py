@@ -132,7 +132,7 @@ import pytest
 from ocp import Spacecraft, Torquers, quat
 from ocp.nlp.solve import solver_options
 from planners import PLANNERS, ManeuverProblem
-from planners.collocation.reference import seed_sampler
+from scenarios.bench.peers._shooting import first_start_guess
 
 N = 50
 
@@ -152,16 +152,10 @@ CASES = {"bilimoria_wie": (bilimoria_wie, 3.2431), "full_inertia": (full_inertia
 
 
 def shared_guess(problem):
-    """Node states (7, N + 1) and T of our first start (the perturbed eigenaxis seed), on N intervals."""
-    planner = PLANNERS["collocation"]({"objective": "min_time"})
-    ocp = planner._ocp(problem)
-    transcription, nlp = planner._nlp(problem, ocp)
-    reference = planner._starts(problem)[0]
-    seed = transcription.seed(ocp, nlp, seed_sampler(problem, reference), reference.duration)
-    guess = planner._guesses(problem, ocp, transcription, nlp, [seed])[0][0]
-    ns, nc = nlp.n_stage_state, nlp.n_interval
-    stages = np.concatenate([guess[:(ns + nc) * N].reshape(N, ns + nc)[:, :ns], guess[None, -ns:]])
-    return stages[:, :7].T, float(np.median(stages[:, 7]))
+    """Node states (7, N + 1) and T of our first start (the perturbed eigenaxis seed), on N intervals:
+    the peers' start of ``slewbench bench`` (:func:`scenarios.bench.peers._shooting.first_start_guess`)."""
+    guess = first_start_guess(problem, "min_time", N)
+    return guess.states, guess.duration
 
 
 def peer_fatrop(problem, states, T0):

@@ -22,9 +22,10 @@ JSON request a line (``build``, ``solve``), so that a benchmark can alternate it
 ours. When no interpreter has acados the peer is skipped: :func:`available` says why.
 
 Two faces: :data:`PEER` follows the peers' contract of :mod:`scenarios.bench.peers.base`
-(``unavailable``, ``problem_error``, ``solve`` returning a ``PeerResult``; its guess is the
-eigenaxis slew every peer starts from, and when acados stops at a QP failure it builds once more
-with :data:`FALLBACK_OPTIONS`, both builds counted in the build time); :func:`solve` and
+(``unavailable``, ``problem_error``, ``solve`` returning a ``PeerResult``; its guess is
+``collocation``'s first start that every peer starts from,
+:func:`~scenarios.bench.peers._shooting.first_start_guess`, and when acados stops at a QP failure
+it builds once more with :data:`FALLBACK_OPTIONS`, both builds counted in the build time); :func:`solve` and
 :class:`AcadosPeer` are the dict-level calls the side-by-side benchmarks use (one build, many
 timed solves). ``time_s`` is the solve after the build, guess setting and ``reset`` included,
 measured in the worker [s]; ``status`` is ``"ok"`` or acados's flag named; ``iterations`` its SQP
@@ -286,7 +287,8 @@ class AcadosBenchPeer:
         return box_torque_problem_error(problem, objective)
 
     def solve(self, problem: Any, objective: str) -> Any:
-        """Build (again with :data:`FALLBACK_OPTIONS` after a QP failure) and solve from the eigenaxis slew.
+        """Build (again with :data:`FALLBACK_OPTIONS` after a QP failure) and solve from ``collocation``'s
+        first start (:func:`~scenarios.bench.peers._shooting.first_start_guess`).
 
         Parameters
         ----------
@@ -299,21 +301,22 @@ class AcadosBenchPeer:
         -------
         PeerResult
             The objective reached (``None`` when acados failed), the solve's time in the worker
-            [s], ``"ok"`` or ``"failed"``, the SQP iterations, acados's status, the build time [s];
-            ``extra``: the options of the reported solve and the final time [s].
+            [s], ``"ok"`` or ``"failed"``, the SQP iterations, the start and acados's status, the
+            build time [s]; ``extra``: the options of the reported solve, the final time [s] and the
+            start.
         """
         import atexit
 
-        from scenarios.bench.peers._shooting import eigenaxis_guess
+        from scenarios.bench.peers._shooting import first_start_guess
         from scenarios.bench.peers.base import PeerResult, torque_bounds
 
         if self._worker is None:
             self._worker = AcadosPeer()
             atexit.register(self._worker.close)
-        guess = eigenaxis_guess(problem, objective)
+        guess = first_start_guess(problem, objective, N)
         build, answer, options = 0.0, {}, SOLVER_OPTIONS
         for options in (SOLVER_OPTIONS, FALLBACK_OPTIONS):
-            data = problem_data(problem, objective, N, guess, options)
+            data = problem_data(problem, objective, N, (guess.states, guess.duration), options)
             data["u_max"] = np.asarray(torque_bounds(problem), dtype=float).tolist()  # the actuator margin applied
             try:
                 build += float(self._worker._ask({"op": "build", **data})["build_s"])
@@ -322,13 +325,14 @@ class AcadosBenchPeer:
                 if self._worker._process.poll() is not None:  # it died: the next problem starts a new one
                     self._worker.close()
                     self._worker = None
-                return PeerResult(None, 0.0, "failed", None, str(error), build or None)
+                return PeerResult(None, 0.0, "failed", None, f"{guess.start}; {error}", build or None,
+                                  {"start": guess.start})
             if answer["status"] != "qp_failure":
                 break
         ok = answer["status"] == "ok"
         return PeerResult(answer["objective"] if ok else None, answer["time_s"], "ok" if ok else "failed",
-                          answer["iterations"], f"acados: {answer['status']}", build,
-                          {"options": dict(options), "T": answer["T"]})
+                          answer["iterations"], f"{guess.start}; acados: {answer['status']}", build,
+                          {"options": dict(options), "T": answer["T"], "start": guess.start})
 
 
 PEER = AcadosBenchPeer()

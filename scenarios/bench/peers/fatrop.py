@@ -1,8 +1,8 @@
 """The FATROP peer: a hand-written CasADi Opti multiple shooting (RK4, piecewise-constant torques,
 N = 50, for minimum time T a per-stage state with explicit continuity, stage-wise declaration)
-solved by FATROP with ``structure_detection: auto`` (FATROP ships with CasADi). One solve from the
-eigenaxis slew (:func:`~scenarios.bench.peers._shooting.eigenaxis_guess`) after a first solve
-that pays the build.
+solved by FATROP with ``structure_detection: auto`` (FATROP ships with CasADi). One solve from
+``collocation``'s first start (:func:`~scenarios.bench.peers._shooting.first_start_guess`) after a
+first solve that pays the build.
 """
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ import numpy as np
 from planners.problem import ManeuverProblem
 from scenarios.bench.peers._shooting import (
     N,
-    eigenaxis_guess,
+    first_start_guess,
     rigid_body,
     rk4_step,
     terminal_error,
@@ -122,7 +122,9 @@ class FatropPeer:
         return box_torque_problem_error(problem, objective)
 
     def solve(self, problem: ManeuverProblem, objective: str) -> PeerResult:
-        """Build, solve once (the build), then solve again and time that solve.
+        """Build, solve once (the build), then solve again and time that solve, both from
+        :func:`~scenarios.bench.peers._shooting.first_start_guess` (computed before the build's
+        clock starts: the guess is ours, not the peer's).
 
         Parameters
         ----------
@@ -134,11 +136,12 @@ class FatropPeer:
         Returns
         -------
         PeerResult
-            The objective reached, the second solve's time, the status and iterations.
+            The objective reached, the second solve's time, the status and iterations; the message
+            names the start, ``extra["start"]`` too.
         """
+        guess = first_start_guess(problem, objective)
         start = time.perf_counter()
-        states, T0 = eigenaxis_guess(problem, objective)
-        opti, cost = build_opti(problem, states, T0, objective)
+        opti, cost = build_opti(problem, guess.states, guess.duration, objective)
         try:
             opti.solve()
         except RuntimeError:
@@ -150,11 +153,13 @@ class FatropPeer:
         except RuntimeError as error:
             stats = opti.stats()
             return PeerResult(None, time.perf_counter() - start, "failed", stats.get("iter_count"),
-                              f"FATROP: {stats.get('return_status', error)}", build)
+                              f"{guess.start}; FATROP: {stats.get('return_status', error)}", build,
+                              {"start": guess.start})
         elapsed = time.perf_counter() - start
         stats = solution.stats()
         return PeerResult(float(solution.value(cost)), elapsed, "ok", stats.get("iter_count"),
-                          f"FATROP: return status {stats.get('return_status', '?')}", build)
+                          f"{guess.start}; FATROP: return status {stats.get('return_status', '?')}", build,
+                          {"start": guess.start})
 
 
 PEER = FatropPeer()

@@ -1,6 +1,6 @@
 """The rockit peer: rockit (``rockit-meco``) multiple shooting (RK4, N = 50) solved by IPOPT,
-from the eigenaxis slew (:func:`~scenarios.bench.peers._shooting.eigenaxis_guess`). Optional:
-without rockit installed the peer is skipped with a note.
+from ``collocation``'s first start (:func:`~scenarios.bench.peers._shooting.first_start_guess`).
+Optional: without rockit installed the peer is skipped with a note.
 """
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import numpy as np
 from planners.problem import ManeuverProblem
 from scenarios.bench.peers._shooting import (
     N,
-    eigenaxis_guess,
+    first_start_guess,
     rigid_body,
     terminal_error,
 )
@@ -104,7 +104,9 @@ class RockitPeer:
         return box_torque_problem_error(problem, objective)
 
     def solve(self, problem: ManeuverProblem, objective: str) -> PeerResult:
-        """Build, solve once (the build), then solve again and time that solve.
+        """Build, solve once (the build), then solve again and time that solve, both from
+        :func:`~scenarios.bench.peers._shooting.first_start_guess` (computed before the build's
+        clock starts: the guess is ours, not the peer's).
 
         Parameters
         ----------
@@ -116,11 +118,12 @@ class RockitPeer:
         Returns
         -------
         PeerResult
-            The objective reached, the second solve's time, the status.
+            The objective reached, the second solve's time, the status; the message names the
+            start, ``extra["start"]`` too.
         """
+        guess = first_start_guess(problem, objective)
         start = time.perf_counter()
-        states, T0 = eigenaxis_guess(problem, objective)
-        ocp = build_ocp(problem, states, T0, objective)
+        ocp = build_ocp(problem, guess.states, guess.duration, objective)
         try:
             ocp.solve()
         except RuntimeError:
@@ -130,12 +133,13 @@ class RockitPeer:
         try:
             solution = ocp.solve()
         except RuntimeError as error:
-            return PeerResult(None, time.perf_counter() - start, "failed", None, f"rockit/IPOPT: {error}", build)
+            return PeerResult(None, time.perf_counter() - start, "failed", None, f"{guess.start}; rockit/IPOPT: {error}",
+                              build, {"start": guess.start})
         elapsed = time.perf_counter() - start
         value = float(solution.value(ocp.T)) if objective == "min_time" else float(
             solution.value(ocp.objective))
         stats = solution.stats if isinstance(getattr(solution, "stats", None), dict) else {}
-        return PeerResult(value, elapsed, "ok", stats.get("iter_count"), "", build)
+        return PeerResult(value, elapsed, "ok", stats.get("iter_count"), guess.start, build, {"start": guess.start})
 
 
 PEER = RockitPeer()
