@@ -11,6 +11,9 @@ actuator takes ``u``. The numeric map runs on Python floats (it is called at eve
 :func:`reference_demand` runs a reference's feed-forward torque through a law's own map, sample by
 sample, and gives what it asks of each actuator (commands, and the states they drive, such as the
 wheel momenta): the scenario's actuator requirement scores it against the limits.
+:func:`unrealised_torque` is what those commands leave out of the feed-forward torque: the part no
+working actuator gives (an axis of a failed or missing wheel, the component along the field for
+magnetorquers), which no limit shows.
 """
 from __future__ import annotations
 
@@ -31,7 +34,8 @@ from ocp.fast_call import BufferedFunction, as_floats
 
 Array = NDArray[np.float64]
 
-__all__ = ["Allocation", "Demand", "SymbolicConstants", "demand_limits", "float_rows", "reference_demand"]
+__all__ = ["Allocation", "Demand", "SymbolicConstants", "demand_limits", "float_rows", "reference_demand",
+           "unrealised_torque"]
 
 
 def float_rows(matrix: ArrayLike) -> tuple[tuple[float, ...], ...]:
@@ -488,6 +492,57 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
 
 _CHUNK = 512
 """Samples per call of the accumulated step of :func:`reference_demand`."""
+
+
+def unrealised_torque(model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: ArrayLike, torque: ArrayLike,
+                      demand: dict[str, Demand]) -> Array:
+    """The part of a reference's feed-forward torque that the actuators' commands do not give.
+
+    The commands and states of ``demand`` (:func:`reference_demand`, through a law's allocation)
+    give the body the torque ``τ_a − ω × A h_w``: the actuators' own (``−A g`` of the wheels,
+    ``m × B`` of the magnetorquers at the model's field, the torquers') and the wheels' gyroscopic
+    term at the momenta the wheels have along the reference. What the feed-forward ``u`` asks
+    beyond it, ``u − (τ_a − ω × A h_w)``, no command gives: torque about an axis the working
+    actuators do not span (one wheel, failed wheels without torquers), or along the field for
+    magnetorquers alone. Rounding leaves about 1e-16 of ``|u|`` on a fully actuated spacecraft.
+
+    Parameters
+    ----------
+    model : ocp.AttitudeModel
+        The spacecraft and its environment (the field, for magnetorquers).
+    t : (N,) array_like
+        Sample times [s].
+    q : (N, 4) array_like
+        Reference attitude (scalar first, body to inertial).
+    omega : (N, 3) array_like
+        Reference body rate [rad/s], body axes.
+    torque : (N, 3) array_like
+        Feed-forward torque ``u`` of ``I ω̇ = −ω × I ω + u`` [N m], body axes.
+    demand : dict of str to Demand
+        :func:`reference_demand` of the same samples.
+
+    Returns
+    -------
+    (N, 3) ndarray
+        The unrealised torque [N m], body axes.
+    """
+    spacecraft = model.spacecraft
+    t = np.asarray(t, dtype=float).reshape(-1)
+    n = t.size
+    _, nu = control_layout(spacecraft)
+    u = np.zeros((n, nu))
+    x = np.zeros((n, model.nx))
+    x[:, 0:4] = np.asarray(q, dtype=float).reshape(n, 4)
+    x[:, 4:7] = np.asarray(omega, dtype=float).reshape(n, 3)
+    for block in actuator_blocks(spacecraft):
+        u[:, block.control] = demand[_quantity(block.actuator, False)].values
+        if block.actuator.state_size:
+            x[:, 7:][:, block.state] = demand[_quantity(block.actuator, True)].values
+    given = np.asarray(model.body_torque.map(n)(x.T, u.T, t).full()).T if n else np.zeros((0, 3))
+    if spacecraft.n_wheels:  # the wheel momenta are the first states ([q, ω, h_w, ...])
+        momentum = x[:, 7:7 + spacecraft.n_wheels] @ spacecraft.wheel_axes.T
+        given -= np.cross(x[:, 4:7], momentum)
+    return np.asarray(torque, dtype=float).reshape(n, 3) - given
 
 
 def _demand_step(law: Allocation, spacecraft: Spacecraft, blocks: Sequence[Any], n_states: int) -> ca.Function:

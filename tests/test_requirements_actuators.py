@@ -9,6 +9,11 @@
   ``wheels_only`` law drops it.
 * Magnetorquers: ``m = B × τ / |B|²`` with the field along the reference.
 * The actuator score: demand over limit against ``1 − margin``.
+* The torque the commands leave out (``unrealised_torque``): about an axis no wheel spans, the whole
+  component (hand-worked); zero for torque the wheels give through their gyroscopic term (a torque
+  built from chosen motor torques and momenta); along the field for magnetorquers alone; and a
+  reference that needs it is never ``ok`` (a run on one wheel), while the optimal two-wheel
+  manoeuvre, which needs none, stays ``ok``.
 """
 from __future__ import annotations
 
@@ -17,7 +22,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from controllers import CONTROLLERS
-from controllers.allocation import Demand, reference_demand
+from controllers.allocation import Demand, reference_demand, unrealised_torque
 from ocp import (
     AttitudeModel,
     CircularOrbit,
@@ -148,3 +153,89 @@ def test_ratios_and_the_actuator_score():
     assert not broken.met and broken.detail == "wheels_torque 0.9 x its limit at 0.0 s (allowed 0.8 x)"
     unlimited = Demand("wheels_momentum", np.ones((2, 3)), np.full(3, np.inf))
     assert _actuators(0.5, {"wheels_momentum": unlimited}, t).values == {}
+
+
+def test_torque_about_an_axis_no_wheel_spans_is_unrealised_by_hand():
+    """One wheel on body x, at rest, no momentum: of u = [a, b, c] the wheel gives a; [0, b, c] is left."""
+    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels(axes=np.array([[1.0], [0.0], [0.0]]), max_torque=0.01))
+    model = AttitudeModel(spacecraft)
+    t = np.array([0.0, 1.0, 2.0])
+    u = np.array([[0.001, -0.002, 0.003], [0.0, 0.004, 0.0], [-0.005, 0.0, 0.0]])
+    q, omega = np.tile(quat.IDENTITY, (3, 1)), np.zeros((3, 3))
+    demand = reference_demand(CONTROLLERS["augmented_quaternion_feedback"](), model, t, q, omega, u)
+    missing = unrealised_torque(model, t, q, omega, u, demand)
+    np.testing.assert_allclose(missing, [[0.0, -0.002, 0.003], [0.0, 0.004, 0.0], [0.0, 0.0, 0.0]], atol=1e-15)
+    score = _actuators(1.0, demand, t, [], missing, u)
+    assert not score.met and "given by no working actuator" in score.detail
+    assert score.values["unrealised_torque"] == pytest.approx(0.004, rel=1e-12)  # > |[0, -0.002, 0.003]|
+    assert score.values["unrealised_torque_time_s"] == 1.0
+
+
+def test_torque_two_wheels_give_through_their_momentum_is_realised():
+    """Two wheels (x, y) spinning while the body turns: u = −A g − ω × A h has a z part, which the
+    gyroscopic term gives; built from chosen g and the momenta they integrate to, nothing is left."""
+    axes = np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
+    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels(axes=axes, max_torque=0.01, max_momentum=1.0))
+    model = AttitudeModel(spacecraft)
+    t = np.linspace(0.0, 10.0, 1001)
+    q, omega, _ = motion(t)
+    g = np.stack([0.002 * np.cos(0.5 * t), -0.001 + 0.0 * t], axis=1)
+    h0 = np.array([0.05, -0.03])
+    h = h0 + np.stack([0.004 * np.sin(0.5 * t), -0.001 * t], axis=1)  # ∫ g dt, closed form
+    u = -g @ axes.T - np.cross(omega, h @ axes.T)
+    assert np.max(np.abs(u[:, 2])) > 1e-4  # the z part is not small
+    demand = reference_demand(CONTROLLERS["augmented_quaternion_feedback"](), model, t, q, omega, u, h0)
+    missing = np.linalg.norm(unrealised_torque(model, t, q, omega, u, demand), axis=1)
+    # Heun's momenta against the closed form: O(dt²) (dt = 0.01 s); the missing torque follows them
+    assert np.max(missing) < 1e-3 * np.max(np.abs(u[:, 2]))
+    assert _actuators(1.0, demand, t, [], unrealised_torque(model, t, q, omega, u, demand), u).met
+
+
+def test_magnetorquers_alone_leave_the_torque_along_the_field():
+    orbit = CircularOrbit(altitude=600e3, inclination=np.deg2rad(97.8))
+    field = MAGNETIC_FIELDS["tilted_dipole"].from_options(MAGNETIC_FIELDS["tilted_dipole"].Options(), orbit)
+    spacecraft = Spacecraft(INERTIA, wheels=None, magnetorquers=Magnetorquers(max_dipole=0.2))
+    model = AttitudeModel(spacecraft, Environment(orbit=orbit, magnetic_field=field))
+    t = np.array([0.0, 30.0, 60.0])
+    q = np.stack([quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), a) for a in (0.0, 0.4, 0.9)])
+    u = np.array([[1e-5, 0.0, -2e-5], [0.0, 3e-5, 0.0], [-1e-5, 1e-5, 1e-5]])
+    demand = reference_demand(CONTROLLERS["augmented_quaternion_feedback"](), model, t, q, np.zeros((3, 3)), u)
+    missing = unrealised_torque(model, t, q, np.zeros((3, 3)), u, demand)
+    for k in range(3):
+        b_inertial = np.asarray(field.field_inertial(orbit.position(t[k]), t[k])).ravel()
+        b = quat.rotate(quat.conjugate(q[k]), b_inertial)
+        np.testing.assert_allclose(missing[k], b * u[k].dot(b) / b.dot(b), rtol=1e-9, atol=1e-20)
+
+
+ONE_WHEEL = """
+name: one-wheel
+spacecraft:
+  inertia: [2.0, 2.0, 2.0]
+  wheels: {axes: [[1, 0, 0]], max_torque: 0.1, max_momentum: 10.0}
+maneuver:
+  duration: 60.0
+  initial: {q: [1, 0, 0, 0], omega: [0, 0, 0]}
+  final: {q: [AXIS_Q], omega: [0, 0, 0]}
+planners:
+  - {name: eigenaxis, label: smooth, options: {profile: smooth}}
+controller: {name: augmented_quaternion_feedback, options: {kp: 0.2, kd: 0.8}}
+simulation: {sample_time: 0.5, duration: 80.0}
+"""
+
+
+@pytest.mark.parametrize("target, ok", [("0.7071068, 0, 0.7071068, 0", False), ("0.7071068, 0.7071068, 0, 0", True)])
+def test_a_reference_needing_torque_no_actuator_gives_is_never_ok(tmp_path, target, ok):
+    """90° about y on a spacecraft with one wheel on x (no torque about y: violated) and 90° about x
+    (the wheel's own axis: ok)."""
+    from scenarios.runner import run
+    from scenarios.schema.loader import load
+
+    path = tmp_path / "one_wheel.yaml"
+    path.write_text(ONE_WHEEL.replace("AXIS_Q", target))
+    row = run(load(path)).rows[0]
+    assert (row.status == "ok") == ok, row.message
+    if not ok:
+        assert "given by no working actuator" in row.message
+        # an eigenaxis slew of a sphere about y: all of its torque is about y
+        assert row.requirements["reference"]["actuators"]["unrealised_torque"] == pytest.approx(
+            np.max(np.abs(row.reference.torque(np.linspace(0.0, 60.0, 2001))[:, 1])), rel=1e-2)

@@ -139,6 +139,22 @@ def test_validate_a_scenario_names_its_rows(capsys):
     assert "valid scenario 'eigenaxis-demo'" in out and "3 row(s) (smooth, bang-coast-bang, min-time)" in out
 
 
+def test_run_refuses_a_study_or_table_file_and_names_the_command(tmp_path, capsys, monkeypatch):
+    """Read as a scenario, a study said ``name: required key is missing``."""
+    monkeypatch.chdir(ROOT)
+    out = tmp_path / "out"
+    assert main(["run", "scenarios/study_spin_weight_sample_time.yaml", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "is a study file, not a scenario" in err and "slewbench sweep scenarios/study_spin_weight_sample_time.yaml" in err
+    table = tmp_path / "table.yaml"
+    table.write_text(yaml.safe_dump({"table": {"scenario": str(DEMO), "axes": 6, "angles_deg": [30, 90]}}))
+    assert main(["run", str(table), "--out", str(out)]) == 2
+    assert f"slewbench table {table}" in capsys.readouterr().err
+    assert not out.exists()
+    assert main(["validate", str(table)]) == 0
+    assert "valid slew table 'eigenaxis-demo': " in capsys.readouterr().out
+
+
 # --- the compact table ------------------------------------------------------------------------------
 
 def none_metrics() -> dict:

@@ -195,6 +195,26 @@ def test_fit_round_trips_through_fit_json(tmp_path):
         load_fit(tmp_path / "other.json")
 
 
+@pytest.mark.parametrize("bad, error, words", [
+    ([1.0, 1.0, 0.0, 0.0], ValueError, r"qf must be a unit quaternion .*norm 1\.414"),
+    (np.zeros(4), ValueError, "qf must be a unit quaternion"),
+    ([math.nan, 0.0, 0.0, 1.0], ValueError, "norm nan"),
+    ("abcd", TypeError, "qf must be 4 numbers"),
+    ([1.0, 0.0, 0.0], TypeError, "4 numbers"),
+])
+def test_fit_refuses_what_is_not_a_unit_quaternion(bad, error, words):
+    """Not silently a slew time: a zero quaternion read as the identity gave 0 s, [1, 1, 0, 0] a time."""
+    fit = analytic_fit(20)
+    with pytest.raises(error, match=words):
+        fit([1.0, 0.0, 0.0, 0.0], bad)
+    with pytest.raises(error):
+        fit.slew_time_many(np.array([[1.0, 0.0, 0.0, 0.0]]), np.array([bad], dtype=object if error is TypeError else float))
+    # a quaternion within the scenario files' tolerance (1e-2) is accepted: the relative axis and
+    # angle do not depend on its norm
+    q = quat.from_axis_angle([1, 2, 3], 0.9)
+    assert fit([1.0, 0.0, 0.0, 0.0], 1.005 * q) == pytest.approx(fit([1.0, 0.0, 0.0, 0.0], q), rel=1e-12)
+
+
 @pytest.mark.slow
 def test_fit_evaluates_within_ten_microseconds():
     fit = analytic_fit()

@@ -828,8 +828,15 @@ class CollocationPlanner(Planner):
             # ∫‖τ‖² of the actuators' torque on a rigid body without actuator states (what the
             # co-state planner's rigid body minimises; wheels add their momentum to the dynamics)
             reference.stats["functional"] = {"name": "int_actuator_torque_squared", "value": float(result.f)}
+        coarse = solved.extra.get("coarse")
+        seeded = ""
+        if isinstance(coarse, dict) and "intervals" in coarse:  # the full mesh solved from the coarse optimum
+            seeds = coarse.get("seeds") or {}
+            agreed = (f", {seeds['agreed']} of {seeds['tried']} seeds agreed there"
+                      if "agreed" in seeds and "tried" in seeds else "")
+            seeded = f" (seeded by the N={coarse['intervals']} optimum{agreed})"
         reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {solver}): "
-                             f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}")
+                             f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}{seeded}")
         if solved.intervals == o.intervals:  # the final mesh: the optimum's certificate (planners.collocation.certificate)
             lbx, ubx = transcription.bounds(ocp, solved.nlp, *self._variable_bounds(problem, tightening), problem.duration)
             reference.stats["certificate"] = collocation_certificate(result, transcription, ocp, solved.nlp, params,

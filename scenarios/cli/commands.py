@@ -113,10 +113,11 @@ def command_schema(args: argparse.Namespace) -> int:
 
 
 def command_validate(args: argparse.Namespace) -> int:
-    """``slewbench validate FILE``: load and check a scenario or a study file, print what would run.
+    """``slewbench validate FILE``: load and check a scenario, a study or a slew-table file, print what would run.
 
     A file whose top level has the key ``study`` is a study (:func:`scenarios.study.spec.load_study`:
-    every case is expanded and checked); any other is a scenario.
+    every case is expanded and checked), one with ``table`` a slew table
+    (:func:`scenarios.slewtable.spec.parse_table_spec`); any other is a scenario.
 
     Parameters
     ----------
@@ -138,6 +139,13 @@ def command_validate(args: argparse.Namespace) -> int:
         varied = ", ".join(study.varied_paths) or "nothing"
         print(f"{args.file}: valid study {study.name!r}: {len(study.cases)} cases ({points} grid point(s) x "
               f"{study.samples} sample(s)), varying {varied}; run it with `slewbench sweep {args.file}`")
+        return EXIT_OK
+    if isinstance(data, dict) and "table" in data:
+        from scenarios.slewtable.spec import parse_table_spec
+
+        spec = parse_table_spec(args.file)
+        print(f"{args.file}: valid slew table {spec.name!r}: {len(spec.axes)} axes x {len(spec.angles_deg)} angles, "
+              f"{spec.objective}; run it with `slewbench table {args.file}`")
         return EXIT_OK
     scenario = parse_scenario(data, Path(args.file))
     labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in scenario.controllers])
@@ -308,8 +316,8 @@ def build_parser() -> argparse.ArgumentParser:
                             help="also export the rows into <out>-FORMAT/ (formats: "
                                  f"{', '.join(sorted(EXPORT_FORMATS))}; as `slewbench export` with default options)")
     run_parser.set_defaults(handler=command_run)
-    validate_parser = commands.add_parser("validate", help="check a scenario or study file; print what would run")
-    validate_parser.add_argument("file", help="scenario or study YAML file (a study has the top-level key 'study')")
+    validate_parser = commands.add_parser("validate", help="check a scenario, study or slew-table file; print what would run")
+    validate_parser.add_argument("file", help="scenario, study or slew-table YAML file (a study has the top-level key 'study', a table 'table')")
     validate_parser.set_defaults(handler=command_validate)
     codegen_parser = commands.add_parser("codegen", help="export the controller law, saturation and reference tables as flight C")
     codegen_parser.add_argument("file", help="scenario YAML file")

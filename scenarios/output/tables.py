@@ -382,7 +382,7 @@ def _headline(values: Mapping[str, Any] | None) -> tuple[str, Any]:
         if key in values:
             return words, values[key]
     ratios = [value for key, value in values.items()
-              if not key.endswith("_time_s") and not key.startswith("rate_jump") and value is not None]
+              if not key.endswith("_time_s") and not key.startswith(("rate_jump", "unrealised")) and value is not None]
     return "peak demand / limit", max(ratios) if ratios else None
 
 

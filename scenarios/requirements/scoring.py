@@ -12,8 +12,12 @@ and what breaks it in words. The fields:
   (:func:`controllers.allocation.reference_demand`, through the row's controller's allocation),
   ``<quantity>`` the peak demand over the limit and ``<quantity>_time_s`` when it peaks, then
   ``rate_jump`` [rad/s] and ``rate_jump_time_s``, the largest jump of the reference's body rate
-  (:func:`rate_jumps`: an impulse no finite torque gives; its momentum goes to the wheels); met when
-  every ratio is at most ``1 − margin`` and the rate never jumps;
+  (:func:`rate_jumps`: an impulse no finite torque gives; its momentum goes to the wheels), then
+  ``unrealised_torque`` [N m] and ``unrealised_torque_time_s``, the largest torque the reference asks
+  that the allocation's commands do not give (:func:`controllers.allocation.unrealised_torque`:
+  about an axis no working actuator spans); met when every ratio is at most ``1 − margin``, the
+  rate never jumps and the unrealised torque stays within :data:`UNREALISED_TOLERANCE` of the
+  reference's peak torque;
 * ``rate``: ``peak_rate`` [rad/s] (of ``‖ω‖``), ``peak_time_s``, ``ratio`` (over the bound);
 * ``final`` (closed loop only): ``worst_error_deg`` and ``worst_rate_error`` [rad/s] from
   ``T + after_s`` to the end, and ``from_s``.
@@ -30,7 +34,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from controllers.allocation import Allocation, demand_limits, reference_demand
+from controllers.allocation import (
+    Allocation,
+    demand_limits,
+    reference_demand,
+    unrealised_torque,
+)
 from ocp import Spacecraft, quat
 from ocp.geometry.pointing import PointingConstraint
 from planners import ManeuverProblem, Planner, Reference
@@ -38,7 +47,7 @@ from planners.base import REQUIREMENT_KINDS
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
 __all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "JUMP_TOLERANCE", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
-           "SCOPE_WORDS", "Score", "endpoint_violations", "rate_jumps", "reference_times", "score_closed_loop",
+           "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_TOLERANCE", "Score", "endpoint_violations", "rate_jumps", "reference_times", "score_closed_loop",
            "score_fields", "score_reference", "unhonoured", "violations"]
 
 Array = NDArray[np.float64]
@@ -61,6 +70,17 @@ JUMP_FIELDS = ("rate_jump", "rate_jump_time_s")
 [rad/s] (0 without one) and when it happens [s] (``None`` without one)."""
 JUMP_TOLERANCE = 1e-6
 """A jump of a reference's body rate up to this [rad/s] is rounding, not a jump."""
+UNREALISED_FIELDS = ("unrealised_torque", "unrealised_torque_time_s")
+"""The actuator score's last fields: the largest torque the reference asks that its commands do not
+give (:func:`controllers.allocation.unrealised_torque`) [N m], and when [s]."""
+UNREALISED_TOLERANCE = 1e-2
+"""The unrealised torque breaks the actuator requirement above this fraction of the reference's
+peak torque. A reference that needs torque about an axis no working actuator gives leaves 0.59-1.0
+of it unrealised (eigenaxis and spin-extremal references on one wheel or on two wheels); rounding
+leaves about 1e-16 on a fully actuated spacecraft, and the optimal two-wheel manoeuvre
+(``collocation`` on two wheels, whose z torque is the wheels' gyroscopic term) 2.5e-3: its wheel
+momenta integrated from its saturated torques part from its state polynomial's by that much
+(``scenarios/REPRODUCTION.md``, the saturated controls)."""
 
 _TOLERANCE = 1e-9
 """Relative slack on the ratio and bound checks (rounding, not a margin)."""
@@ -216,7 +236,8 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
 
 
 def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
-               jumps: list[tuple[float, int, Array]] | None = None) -> Score:
+               jumps: list[tuple[float, int, Array]] | None = None, unrealised: Array | None = None,
+               torque: Array | None = None) -> Score:
     values: dict[str, float | None] = {}
     broken = []
     for name, quantity in demand.items():
@@ -240,6 +261,16 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
             jumped = (f"the body rate jumps by {np.linalg.norm(largest[2]):.3g} rad/s at {largest[0]:g} s "
                       f"(an impulse: no finite torque gives it{count})")
             detail = jumped + (f", {detail}" if detail else "")
+    if unrealised is not None and torque is not None:
+        norms = np.linalg.norm(unrealised, axis=1)
+        worst = int(np.argmax(norms)) if norms.size else 0
+        peak = float(norms[worst]) if norms.size else 0.0
+        scale = float(np.max(np.linalg.norm(torque, axis=1), initial=0.0))
+        values.update(zip(UNREALISED_FIELDS, (peak, float(t[worst]) if norms.size else None)))
+        if peak > UNREALISED_TOLERANCE * scale and peak > 0.0:
+            missing = (f"{peak:.3g} N m of the torque asked at {t[worst]:.1f} s ({peak / scale:.0%} of the "
+                       "reference's peak) is given by no working actuator")
+            detail = missing + (f", {detail}" if detail else "")
     return Score("actuators", values, not detail, detail)
 
 
@@ -281,7 +312,9 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
                 steps[index] += jump
         demand = reference_demand(allocation, problem.model, t, sample.q, sample.omega, sample.torque,
                                   problem.wheel_momentum0, jumps=steps)
-        scores["actuators"] = _actuators(requirements.actuators.allowed, demand, t, jumps)
+        unrealised = unrealised_torque(problem.model, t, sample.q, sample.omega, sample.torque, demand)
+        scores["actuators"] = _actuators(requirements.actuators.allowed, demand, t, jumps, unrealised,
+                                         np.asarray(sample.torque, dtype=float))
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, sample.omega)
     return scores
@@ -348,7 +381,8 @@ def score_fields(requirements: Requirements, spacecraft: Spacecraft) -> dict[str
     closed_loop: dict[str, tuple[str, ...]] = dict(pointing)
     if requirements.actuators is not None:
         limited = [name for name, limit in demand_limits(spacecraft).items() if np.any(np.isfinite(limit))]
-        reference["actuators"] = tuple(field for name in limited for field in (name, f"{name}_time_s")) + JUMP_FIELDS
+        reference["actuators"] = (tuple(field for name in limited for field in (name, f"{name}_time_s"))
+                                  + JUMP_FIELDS + UNREALISED_FIELDS)
     if requirements.rate is not None:
         reference["rate"] = closed_loop["rate"] = RATE_FIELDS
     if requirements.final is not None:

@@ -613,6 +613,17 @@ def load(path: str | Path) -> Scenario:
     Raises
     ------
     ScenarioError
-        The file cannot be read or is not a valid scenario (the message names the YAML path).
+        The file cannot be read or is not a valid scenario (the message names the YAML path); a
+        study or slew-table file names the command that runs it.
     """
-    return parse_scenario(read_yaml(path), Path(path))
+    data = read_yaml(path)
+    if isinstance(data, dict):
+        for key, command in OTHER_FILES.items():
+            if key in data:
+                raise ScenarioError(key, f"{path} is a {key} file, not a scenario: run it with "
+                                         f"`slewbench {command} {path}`")
+    return parse_scenario(data, Path(path))
+
+
+OTHER_FILES = {"study": "sweep", "table": "table"}
+"""The top-level key of a file that is not a scenario, and the command that reads it."""

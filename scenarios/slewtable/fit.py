@@ -29,13 +29,14 @@ import bisect
 import json
 import math
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["FIT_FORMAT", "SlewTimeFit", "fit_table", "load_fit"]
+__all__ = ["FIT_FORMAT", "UNIT_TOLERANCE", "SlewTimeFit", "fit_table", "load_fit"]
 
 FIT_FORMAT = "slewbench-slew-time-fit/1"
 """The ``format`` key of ``fit.json``."""
@@ -190,6 +191,32 @@ def relative_axis_angle(q0: ArrayLike, qf: ArrayLike) -> tuple[np.ndarray, np.nd
     angles = 2.0 * np.arctan2(s, w[:, 0])
     axes = np.where(s[:, None] > 0.0, v / np.where(s > 0.0, s, 1.0)[:, None], np.array([1.0, 0.0, 0.0]))
     return axes, angles
+
+
+UNIT_TOLERANCE = 1e-2
+"""How far from 1 a quaternion's norm may be (as a scenario's, ``scenarios.schema``); the fit reads
+the relative rotation's axis and angle, which scaling leaves alone."""
+_UNIT_SQUARED = 2 * UNIT_TOLERANCE + UNIT_TOLERANCE ** 2  # |q|² within it: |q| in [1 − tol, 1 + tol]
+
+
+def _as_list(name: str, value: Any) -> list[float]:
+    """A quaternion argument as a list (NumPy arrays and other sequences), or a ``TypeError``."""
+    try:
+        listed = np.asarray(value, dtype=float).tolist()
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be 4 numbers (scalar first), got {value!r}") from None
+    if not isinstance(listed, list) or len(listed) != 4:
+        raise TypeError(f"{name} must be 4 numbers (scalar first), got {value!r}")
+    return listed
+
+
+def _check_unit(q0: Sequence[float], qf: Sequence[float]) -> None:
+    """The ``ValueError`` for the quaternion of ``q0``, ``qf`` whose norm is off."""
+    for name, q in (("q0", q0), ("qf", qf)):
+        norm = math.sqrt(sum(x * x for x in q))
+        if not abs(norm - 1.0) <= UNIT_TOLERANCE:
+            raise ValueError(f"{name} must be a unit quaternion (norm within {UNIT_TOLERANCE:g} of 1), "
+                             f"got {list(q)} (norm {norm:.6g})")
 
 
 class SlewTimeFit:
@@ -360,13 +387,27 @@ class SlewTimeFit:
         -------
         float
             The fitted slew time [s] of the rest-to-rest slew ``q0 -> qf``.
+
+        Raises
+        ------
+        TypeError
+            ``q0`` or ``qf`` is not 4 numbers.
+        ValueError
+            A norm farther than :data:`UNIT_TOLERANCE` from 1 (a zero or non-finite quaternion).
         """
         if type(q0) is not tuple and type(q0) is not list:
-            q0 = q0.tolist()
+            q0 = _as_list("q0", q0)
         if type(qf) is not tuple and type(qf) is not list:
-            qf = qf.tolist()
-        a, b, c, d = q0
-        e, f, g, h = qf
+            qf = _as_list("qf", qf)
+        try:
+            a, b, c, d = q0
+            e, f, g, h = qf
+            n0 = a * a + b * b + c * c + d * d
+            n1 = e * e + f * f + g * g + h * h
+        except (TypeError, ValueError):
+            raise TypeError(f"q0 and qf must be 4 numbers each (scalar first), got {q0!r} and {qf!r}") from None
+        if not (abs(n0 - 1.0) <= _UNIT_SQUARED and abs(n1 - 1.0) <= _UNIT_SQUARED):  # NaN fails too
+            _check_unit(q0, qf)
         # dq = conj(q0) ⊗ qf
         w = a * e + b * f + c * g + d * h
         x = a * f - b * e - c * h + d * g
@@ -455,8 +496,29 @@ class SlewTimeFit:
         -------
         numpy.ndarray, shape (n,)
             Fitted slew times [s].
+
+        Raises
+        ------
+        TypeError, ValueError
+            As :meth:`__call__`, naming the first bad quaternion.
         """
-        a, b = np.broadcast_arrays(np.atleast_2d(np.asarray(q0, dtype=float)), np.atleast_2d(np.asarray(qf, dtype=float)))
+        arrays = []
+        for name, value in (("q0", q0), ("qf", qf)):
+            try:
+                array = np.atleast_2d(np.asarray(value, dtype=float))
+            except (TypeError, ValueError):
+                raise TypeError(f"{name} must be quaternions of 4 numbers (scalar first), got {value!r}") from None
+            if array.shape[-1] != 4:
+                raise TypeError(f"{name} must be quaternions of 4 numbers (scalar first), got shape {array.shape}")
+            arrays.append(array)
+        a, b = np.broadcast_arrays(*arrays)
+        for name, quaternions in (("q0", a), ("qf", b)):
+            norms = np.linalg.norm(quaternions, axis=-1)
+            bad = ~(np.abs(norms - 1.0) <= UNIT_TOLERANCE)
+            if np.any(bad):
+                row = int(np.argmax(bad))
+                raise ValueError(f"{name}[{row}] must be a unit quaternion (norm within {UNIT_TOLERANCE:g} of 1), "
+                                 f"got {quaternions.reshape(-1, 4)[row].tolist()} (norm {norms.ravel()[row]:.6g})")
         axes, angles = relative_axis_angle(a, b)
         return self.many_axis_angle(axes, angles)
 
