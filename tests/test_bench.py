@@ -182,6 +182,29 @@ def test_bench_writes_the_leaderboard_with_the_hand_worked_gap(tmp_path, capsys)
     assert (out / "gap_vs_time.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_a_row_that_solves_another_problem_has_no_gap(tmp_path, capsys):
+    """A user read costate_tpbvp's fixed 10 s on Bilimoria & Wie as a minimum time 6.76 s from the
+    optimum, and natural motion's impulse as an energy of 0. The rows, by hand: costate_tpbvp and
+    eigenaxis with defaults keep the 10 s bound (fixed-time plans); natural motion's rate steps at
+    its stop (an impulse); collocation at 3.2431 keeps its gap."""
+    out = tmp_path / "board"
+    assert main(["bench", "--problems", "bilimoria_wie_180", "natural_motion_min_energy", "--planners", "collocation",
+                 "costate_tpbvp", "natural_motion", "--out", str(out)]) == 0
+    capsys.readouterr()
+    rows = {(row["problem"], row["label"]): row for row in csv.DictReader((out / "leaderboard.csv").open())}
+    fixed = rows[("bilimoria_wie_180", "costate_tpbvp (defaults)")]
+    assert float(fixed["value"]) == 10.0 and fixed["gap_abs"] == "" and fixed["reached"] == ""
+    assert "keeps the scenario's bound T = 10 s" in fixed["message"]
+    optimal = rows[("bilimoria_wie_180", "collocation")]
+    assert float(optimal["gap_abs"]) == pytest.approx(float(optimal["value"]) - 3.2431, abs=1e-12)
+    impulse = rows[("natural_motion_min_energy", "natural motion")]
+    assert impulse["value"] == "" and impulse["gap_abs"] == "" and impulse["message"].startswith("impulse")
+    summary = (out / "leaderboard.md").read_text().split("## Summary")[1]
+    costate = next(line for line in summary.splitlines() if line.startswith("| costate_tpbvp |"))
+    assert costate.split("|")[5].strip() != "-"  # its median gap: natural motion's energy, not B&W's 10 s
+    assert float(costate.split("|")[5]) < 1e-3
+
+
 @pytest.mark.parametrize("argv, expected", [
     (["--problems", "no_such_problem"], "--problems: unknown problem 'no_such_problem'"),
     (["--planners", "no_such_planner"], "--planners: unknown planner or peer 'no_such_planner'"),

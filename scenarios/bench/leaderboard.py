@@ -8,7 +8,9 @@ and relative), whether it reaches the optimum within the problem's tolerance, th
 the plan time, the solver iterations (``reference.stats["iterations"]``) and the certificate
 (``reference.stats["certificate"]``'s ``summary`` or ``verdict``; ``-`` without one). A reference
 that leaves a boundary condition of the problem free (``Reference.free_boundary``) solves another
-problem: its value is shown, its gap is not.
+problem: its value is shown, its gap is not; so does a minimum-time row that keeps the scenario's
+duration bound (a fixed-time plan) and a minimum-energy row planned over another duration; a
+minimum-energy row whose rate jumps (an impulse) has no value.
 """
 from __future__ import annotations
 
@@ -149,14 +151,43 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any) -> list[Be
         if row.planner is not None and row.label == f"{row.planner} (defaults)":  # other_planners
             message = f"default options (the planner's own objective, not tuned to this problem); {message}"
         free = sorted(getattr(reference, "free_boundary", ()) or ())
+        other = _other_problem(problem, scenario, reference, row)
+        if value is not None and other.startswith("impulse"):
+            value = gap_abs = gap_rel = None
         if value is not None and free:
             gap_abs = gap_rel = None
             message = f"leaves {', '.join(free)} free: solves another problem, no gap; {message}"
+        if other and not (free and not other.startswith("impulse")):
+            gap_abs = gap_rel = None
+            message = f"{other}; {message}"
         rows.append(BenchRow(
             problem.name, row.label, row.planner or "-", "planner", row.status, value, gap_abs, gap_rel,
             _reached(row.status, gap_abs, problem), row.plan_time_s,
             _number((stats or {}).get("iterations")), certificate_text(stats), message))
     return rows
+
+
+def _other_problem(problem: BenchProblem, scenario: Any, reference: Any, row: Any) -> str:
+    """Why a row's value is not the problem's objective ("" when it is): a minimum-time row whose
+    duration is the scenario's bound (a fixed-time plan: the bound is not optimised, so its
+    "time" is the input), a minimum-energy row planned over another duration than the problem's,
+    or a minimum-energy row whose rate jumps (an impulse, whose energy is not finite; the sampled
+    torque misses it)."""
+    duration = getattr(reference, "duration", None)
+    bound = scenario.problem.duration
+    if duration is None:
+        return ""
+    if problem.objective == "min_time" and math.isclose(duration, bound, rel_tol=1e-9):
+        return (f"keeps the scenario's bound T = {bound:g} s (a fixed-time plan, not minimum time): solves "
+                "another problem, no gap")
+    if problem.objective == "min_energy":
+        if not math.isclose(duration, bound, rel_tol=1e-9):
+            return f"plans its own duration T = {duration:.6g} s, not the problem's {bound:g} s: another problem, no gap"
+        actuators = ((row.requirements or {}).get("reference") or {}).get("actuators") or {}
+        if (actuators.get("rate_jump") or 0.0) > 0.0:
+            return ("impulse: its rate jumps (no finite torque gives it), so its energy is not finite; no value "
+                    "or gap")
+    return ""
 
 
 def _reached(status: str, gap_abs: float | None, problem: BenchProblem) -> bool | None:
