@@ -356,6 +356,21 @@ def test_bad_scenario_exits_2_naming_its_path(tmp_path, capsys):
     assert "spacecraft.inertia" in capsys.readouterr().err
 
 
+def test_a_table_files_scenario_errors_name_that_scenario_file(tmp_path, capsys, monkeypatch):
+    """From a table file, the scenario's YAML path alone did not say which file it is in, and a
+    missing scenario was named as written (relative to the table file, not to where one stands)."""
+    bad = dict(UNIT_BOX, spacecraft={"inertia": [1.0, -1.0, 1.0], "torquers": {"max_torque": 1.0}})
+    _write(tmp_path, "bad.yaml", bad)
+    table = _write(tmp_path, "table.yaml", {"table": {"scenario": "bad.yaml", "axes": 6, "angles_deg": [30, 90]}})
+    monkeypatch.chdir(tmp_path.parent)
+    assert main(["table", str(table), "--out", str(tmp_path / "out")]) == 2
+    assert f"{tmp_path / 'bad.yaml'}: spacecraft.inertia" in capsys.readouterr().err
+    _write(tmp_path, "table.yaml", {"table": {"scenario": "nothere.yaml", "axes": 6, "angles_deg": [30, 90]}})
+    assert main(["table", str(table.relative_to(tmp_path.parent)), "--out", str(tmp_path / "out")]) == 2
+    assert f"scenario file not found: {(tmp_path / 'nothere.yaml').resolve()}" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
 def test_never_writes_into_a_directory_slewbench_did_not_make(tmp_path, capsys):
     scenario = _write(tmp_path, "box.yaml", UNIT_BOX)
     mine = tmp_path / "mine"

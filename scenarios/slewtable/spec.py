@@ -276,12 +276,18 @@ def torque_generators(scenario: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]
 def _scenario(path: Path, where: str) -> dict[str, Any]:
     from scenarios.schema.loader import parse_scenario
     from scenarios.schema.read import read_yaml
-    data = read_yaml(path)
+    try:
+        data = read_yaml(path)
+    except ScenarioError as error:  # the path as resolved (relative to the table file), not as written
+        raise ScenarioError(where, error.message.replace(str(path), str(path.resolve()))) from None
     if not isinstance(data, dict):
         raise ScenarioError(where, f"{path} is not a scenario (a mapping)")
     if "study" in data or "table" in data:
         raise ScenarioError(where, f"{path} is a study or table file, not a scenario")
-    parse_scenario(data)  # errors name the scenario's YAML path
+    try:
+        parse_scenario(data)
+    except ScenarioError as error:  # the scenario's YAML path, in the scenario's file
+        raise ScenarioError(f"{path}: {error.path}" if error.path else str(path), error.message) from None
     return data
 
 
