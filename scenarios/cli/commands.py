@@ -409,7 +409,9 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     try:
         return args.handler(args)
     except ScenarioError as error:
-        print(f"slewbench: error in scenario: {error}", file=sys.stderr)
+        # a command-line option's error is named as such, not as the scenario's
+        kind = "option" if error.path.startswith("--") else "scenario"
+        print(f"slewbench: error in {kind}: {error}", file=sys.stderr)
         return EXIT_BAD_SCENARIO
     except OutputError as error:
         given = "--report" if getattr(args, "report", None) else "--out" if getattr(args, "out", None) else None
