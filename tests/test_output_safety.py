@@ -293,3 +293,24 @@ def test_codegen_output_never_replaces_a_runs_results(tmp_path, capsys):
     assert main(["codegen", str(path), "--out", str(out)]) == 2
     assert "directory of its own" in capsys.readouterr().err
     assert snapshot(out) == before
+
+
+@pytest.mark.parametrize("argv", [
+    ["run", "scenarios/eigenaxis_demo.yaml", "--out"],
+    ["bench", "--problems", "bilimoria_wie_45", "--out"],
+    ["sweep", "scenarios/study_spin_monte_carlo.yaml", "--out"],
+    ["sweep", "--report"],
+    ["table", "scenarios/eigenaxis_demo.yaml", "--out"],
+    ["codegen", "scenarios/eigenaxis_demo.yaml", "--out"],
+    ["export", "results/none", "--format", "aem", "--out"],
+])
+def test_an_empty_output_directory_is_refused_not_replaced_by_the_default(argv, tmp_path, monkeypatch, capsys):
+    """``--out ""`` wrote into results/<name> without a word."""
+    root = Path(__file__).resolve().parents[1]
+    monkeypatch.chdir(tmp_path)
+    argv = [str(root / a) if a.startswith("scenarios/") else a for a in argv]
+    with pytest.raises(SystemExit) as stop:
+        main([*argv, ""])
+    assert stop.value.code == 2
+    assert "an empty path: give the output directory" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []  # no results/ made

@@ -11,7 +11,7 @@ import argparse
 import sys
 from typing import Any
 
-from scenarios.cli.status import EXIT_OK
+from scenarios.cli.status import EXIT_OK, directory_argument
 
 __all__ = ["add_bench_parser", "command_bench"]
 
@@ -93,7 +93,7 @@ def add_bench_parser(commands: Any) -> None:
     parser.add_argument("--planners", nargs="+", metavar="NAME",
                         help="only these planners (registry names) and peers (fatrop, rockit, acados) "
                              "(default: every planner row of each problem and every installed peer)")
-    parser.add_argument("--out", help=f"output directory (default: results/{DEFAULT_OUT})")
+    parser.add_argument("--out", type=directory_argument, help=f"output directory (default: results/{DEFAULT_OUT})")
     parser.add_argument("--no-peers", action="store_true", help="run no peer")
     parser.add_argument("--no-plots", action="store_true", help="skip gap_vs_time.png")
     parser.set_defaults(handler=command_bench)

@@ -27,6 +27,7 @@ from scenarios.cli.status import (
     EXIT_INTERRUPTED,
     EXIT_NOT_OK,
     EXIT_OK,
+    directory_argument,
 )
 from scenarios.cli.sweep import add_sweep_parser
 from scenarios.cli.table import add_table_parser
@@ -305,7 +306,7 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True)
     run_parser = commands.add_parser("run", help="plan, simulate and score every planner of a scenario")
     run_parser.add_argument("file", help="scenario YAML file")
-    run_parser.add_argument("--out", help="output directory (default: results/<scenario name>)")
+    run_parser.add_argument("--out", type=directory_argument, help="output directory (default: results/<scenario name>)")
     run_parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots and report.html")
     run_parser.add_argument("--all-metrics", action="store_true",
                             help="show every metric in the table, also those with no value in any row")
@@ -321,14 +322,14 @@ def build_parser() -> argparse.ArgumentParser:
     validate_parser.set_defaults(handler=command_validate)
     codegen_parser = commands.add_parser("codegen", help="export the controller law, saturation and reference tables as flight C")
     codegen_parser.add_argument("file", help="scenario YAML file")
-    codegen_parser.add_argument("--out", required=True, help="output directory (new, empty, or written by slewbench)")
+    codegen_parser.add_argument("--out", required=True, type=directory_argument, help="output directory (new, empty, or written by slewbench)")
     codegen_parser.set_defaults(handler=command_codegen)
     export_parser = commands.add_parser("export", help="write a finished run's rows in another tool's format "
                                                        "(aem: CCSDS attitude ephemeris messages)")
     export_parser.add_argument("run_directory", metavar="RUN_DIR", help="output directory of `slewbench run`")
     export_parser.add_argument("--format", required=True, choices=sorted(EXPORT_FORMATS),
                                help="; ".join(f"{name}: {fmt.description}" for name, fmt in EXPORT_FORMATS.items()))
-    export_parser.add_argument("--out", help="export directory (default: RUN_DIR-FORMAT beside RUN_DIR)")
+    export_parser.add_argument("--out", type=directory_argument, help="export directory (default: RUN_DIR-FORMAT beside RUN_DIR)")
     export_parser.add_argument("--option", action="append", metavar="NAME=VALUE",
                                help="a format option, repeatable (aem: time_system=UTC|TAI|TT|TDB, "
                                     "attitude_type=QUATERNION/ANGVEL|QUATERNION, originator, object_name, object_id)")

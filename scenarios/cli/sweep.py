@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from scenarios.cli.status import EXIT_INTERRUPTED, EXIT_OK
+from scenarios.cli.status import EXIT_INTERRUPTED, EXIT_OK, directory_argument
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, claim_output_directory, written_files
 from scenarios.output.names import default_output_directory
@@ -368,14 +368,14 @@ def add_sweep_parser(commands: Any) -> None:
     """
     parser = commands.add_parser("sweep", help="run a trade study (grid, zip, Monte Carlo) on many cases")
     parser.add_argument("file", nargs="?", help="study YAML file (with --case: the sweep directory)")
-    parser.add_argument("--out", help="output directory (default: results/<study name>)")
+    parser.add_argument("--out", type=directory_argument, help="output directory (default: results/<study name>)")
     parser.add_argument("--workers", type=int, help="cases at once (default: execution.workers, else one per core)")
     parser.add_argument("--scheduler", help="Dask scheduler address (tcp://host:port) instead of local processes")
     parser.add_argument("--resume", action="store_true", help="skip the cases already stored in --out")
     parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots and report.html")
     parser.add_argument("--dry-run", action="store_true",
                         help="check the study and list its cases; run nothing, write nothing")
-    parser.add_argument("--report", metavar="DIR", help="redraw tables and plots of DIR from its store; run nothing")
+    parser.add_argument("--report", metavar="DIR", type=directory_argument, help="redraw tables and plots of DIR from its store; run nothing")
     parser.add_argument("--case", metavar="N", type=int,
                         help="re-run case N of the sweep stored in DIR (given as the first argument) in full, "
                              "writing a run's outputs into --out (default: DIR/cases/N)")

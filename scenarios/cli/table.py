@@ -16,6 +16,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+from scenarios.cli.status import directory_argument
+
 
 def _terminate(signum: int, frame: Any) -> None:
     raise KeyboardInterrupt
@@ -158,7 +160,7 @@ def add_table_parser(commands: Any) -> None:
                                                "first, comma-separated, or 'all' (default)")
     parser.add_argument("--max-axes", type=int, help="with --tolerance: axes at most (default 2000)")
     parser.add_argument("--max-rounds", type=int, help="with --tolerance: refinement rounds at most (default 8)")
-    parser.add_argument("--out", help="output directory (default: results/table-<scenario name>)")
+    parser.add_argument("--out", type=directory_argument, help="output directory (default: results/table-<scenario name>)")
     parser.add_argument("--workers", type=int, help="entries at once (default: one per core)")
     parser.add_argument("--scheduler", help="Dask scheduler address (tcp://host:port) instead of local processes")
     parser.add_argument("--no-plots", action="store_true", help="skip agility_envelope.png")
