@@ -188,3 +188,16 @@ def test_end_points_inside_a_keep_out_fail_every_planner_row_before_planning():
     for row in results.rows:
         assert row.message.startswith("st_sun: the initial attitude already breaks it at 0 s")
         assert row.reference_metrics is None and row.simulation is None and row.plan_time_s == 0.0
+
+
+def test_an_infeasible_row_ranks_between_failed_and_violated():
+    """A user saw ``rows: 3 (1 ok, 2 infeasible)``: infeasible counted after ok, as an unknown status.
+    The eigenaxis demo with its three wheels failed: the trapezoidal and minimum-time profiles find
+    no torque about the slew's axis (infeasible); the smooth one asks it of no actuator (violated)."""
+    data = yaml.safe_load((Path(__file__).resolve().parents[1] / "scenarios" / "eigenaxis_demo.yaml").read_text())
+    data["spacecraft"]["wheels"]["failed"] = [0, 1, 2]
+    results = scenarios.run(scenarios.parse_scenario(data))
+    statuses = [row.status for row in results.rows]
+    assert sorted(statuses) == ["infeasible", "infeasible", "violated"], [row.message for row in results.rows]
+    assert list(results.status_counts()) == ["infeasible", "violated"]
+    assert results.to_terminal().count("rows: 3 (2 infeasible, 1 violated)") == 1

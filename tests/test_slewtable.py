@@ -286,6 +286,7 @@ def _synthetic_table(tmp_path: Path) -> SlewTable:
     part.objective_value[:] = part.slew_time_s
     part.status = [["ok"] * 3 for _ in range(12)]
     part.status[3][1] = "failed"
+    part.status[5][2] = "infeasible"  # was written as "crashed"
     table.fit = fit
     return table
 
@@ -306,6 +307,9 @@ def test_netcdf_reads_back_with_dimensions_units_and_attributes(tmp_path):
         np.testing.assert_allclose(nc.variables["slew_time"][:], table.parts["table"].slew_time_s)
         np.testing.assert_allclose(nc.variables["axis_x"][:], table.spec.axes[:, 0])
         assert nc.variables["status"][3, 1] == STATUS_CODES.index("failed")
+        meanings = nc.variables["status"].flag_meanings.decode().split()
+        assert meanings[nc.variables["status"][5, 2]] == "infeasible"
+        assert meanings[:5] == ["ok", "violated", "failed", "crashed", "missing"]  # the earlier codes kept
         assert nc.variables["held_out_status"][0, 0] == STATUS_CODES.index("missing")
         assert nc.scenario == b"bilimoria-wie" and nc.objective == b"min_time"
         assert json.loads(nc.spacecraft)["inertia"] == [1.0, 1.0, 1.0]

@@ -15,7 +15,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from scenarios.output.provenance import run_provenance
-from scenarios.output.tables import html_table, is_missing, status_line, text_cell
+from scenarios.output.tables import (
+    ROW_STATUSES,
+    html_table,
+    is_missing,
+    status_line,
+    text_cell,
+)
 
 if TYPE_CHECKING:
     import pandas
@@ -189,15 +195,15 @@ class RunResults:
         return _rows_html(self.rows, caption=f"{self.scenario.name}: {status_line(self)}")
 
     def status_counts(self) -> dict[str, int]:
-        """How many rows have each status, in rank order (``failed``, ``violated``, ``ok``, then any other).
+        """How many rows have each status, in rank order (:data:`~scenarios.output.tables.ROW_STATUSES`,
+        then any other).
 
         Returns
         -------
         dict of str to int
             Status -> number of rows (statuses without rows left out).
         """
-        order = ["crashed", "failed", "violated", "ok"]
-        counts = {status: sum(row.status == status for row in self.rows) for status in order}
+        counts = {status: sum(row.status == status for row in self.rows) for status in ROW_STATUSES}
         for row in self.rows:
             counts.setdefault(row.status, sum(other.status == row.status for other in self.rows))
         return {status: count for status, count in counts.items() if count}

@@ -43,6 +43,13 @@ if TYPE_CHECKING:
 IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s")
 """The columns that name a row, before its metrics."""
 
+ROW_STATUSES = ("crashed", "failed", "infeasible", "violated", "ok")
+"""A row's statuses from the worst, the order tables count and sort them in: ``crashed`` (a trade
+study's case that raised), ``failed`` (the planner or the simulation failed, or the end points
+already break a pointing requirement), ``infeasible`` (the planner found the problem cannot be met
+under its bounds: torque about a failed wheel's axis, a keep-out cone over the target, ...),
+``violated`` (a requirement broken) and ``ok``."""
+
 CERTIFICATE_COLUMNS = ("certificate", "certificate_verdict", "certificate_kkt_scaled", "certificate_kkt_unscaled")
 """The columns of a row's certificate (the reference's ``stats["certificate"]``, :mod:`ocp.nlp.certificate`;
 the row's ``certificate`` in its plain form): its summary line, its verdict and its KKT residuals

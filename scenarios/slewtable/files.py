@@ -23,8 +23,9 @@ __all__ = ["CSV_COLUMNS", "STATUS_CODES", "TABLE_FILES", "write_table_files"]
 CSV_COLUMNS = ("grid", "axis_x", "axis_y", "axis_z", "angle_deg", "slew_time_s", "objective", "objective_value",
                "status", "plan_time_s", "message")
 """Columns of ``slew_table.csv`` (axis: unit eigen-axis, body frame)."""
-STATUS_CODES = ("ok", "violated", "failed", "crashed", "missing")
-"""Entry status -> its code in the NetCDF file (the index)."""
+STATUS_CODES = ("ok", "violated", "failed", "crashed", "missing", "infeasible")
+"""Entry status -> its code in the NetCDF file (the index; ``infeasible`` last, so that the earlier
+codes keep their values)."""
 TABLE_FILES = ("slew_table.csv", "slew_table.nc", "fit.json", "agility_envelope.png")
 """The files a table writes (``fit.json`` only when there is a fit)."""
 

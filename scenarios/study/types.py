@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from scenarios.output.tables import html_table
+from scenarios.output.tables import ROW_STATUSES, html_table
 
 
 @dataclass
@@ -175,8 +175,8 @@ def _status_counts(study: Study, records: dict[str, dict[str, Any]]) -> dict[str
     return counts
 
 
-_STATUS_ORDER = ("ok", "violated", "failed", "crashed")
-"""The statuses of a row in the order a study's summary lists them."""
+_STATUS_ORDER = ROW_STATUSES[::-1]
+"""The statuses of a row in the order a study's summary lists them (from ``ok``)."""
 
 
 def _headline(study: Study, records: dict[str, dict[str, Any]]) -> str:

@@ -22,6 +22,7 @@ from scenarios.output.report.figures import (
 from scenarios.output.report.page import Column, Page, column_unit
 from scenarios.output.tables import (
     IDENTITY_COLUMNS,
+    ROW_STATUSES,
     flatten_row,
     is_missing,
     requirement_columns,
@@ -32,10 +33,8 @@ from scenarios.schema.columns import is_requirement_column
 if TYPE_CHECKING:
     from scenarios.output.results import RunResults
 
-__all__ = ["STATUS_ORDER", "result_columns", "run_page", "run_report"]
+__all__ = ["result_columns", "run_page", "run_report"]
 
-STATUS_ORDER = ("crashed", "failed", "violated", "ok")
-"""A row's statuses from the worst: the order a status column sorts in."""
 
 
 def result_columns(names: list[str], rows: list[dict[str, Any]]) -> list[Column]:
@@ -62,7 +61,7 @@ def result_columns(names: list[str], rows: list[dict[str, Any]]) -> list[Column]
         metric = name.split(".")[-1]
         info = METRIC_INFO.get(metric) if name.count(".") == 1 else None
         columns.append(Column(name, column_unit(name), numeric, info.meaning if info else "",
-                              STATUS_ORDER if name == "status" else ()))
+                              ROW_STATUSES if name == "status" else ()))
     return columns
 
 
