@@ -226,3 +226,51 @@ def test_fixed_time_rate_acquisition_with_equal_rates_does_not_raise():
     assert "ZeroDivisionError" not in reference.message, reference.message
     if reference.ok:
         assert np.linalg.norm(reference.sample(np.array([20.0])).omega[-1]) < 0.05
+
+
+XTE = {"inertia": np.diag([5621.0, 4547.0, 2364.0]), "angle": np.deg2rad(150.0), "duration": 60.0}  # Fleming et al. 2008
+
+
+def xte_minimum_energy():
+    """The bench's XTE problem (scenarios/bench/problems/xte_150.yaml) as ``costate_tpbvp``'s default
+    form sees it: rest to rest, 150 deg about the principal axis x in its T = 60 s."""
+    spacecraft = Spacecraft(XTE["inertia"], torquers=Torquers(50.0))
+    qf = quat.from_rotation_vector(np.array([XTE["angle"], 0.0, 0.0]))
+    return ManeuverProblem(spacecraft, q0=quat.IDENTITY, omega0=np.zeros(3), qf=qf, duration=XTE["duration"],
+                           omegaf=np.zeros(3))
+
+
+def test_minimum_energy_about_a_principal_axis_is_the_closed_form_in_seconds():
+    # About a principal axis the slew stays planar (no gyroscopic torque): the double integrator
+    # I_x θ̈ = u, whose rest-to-rest minimum of ∫u² in T is u = I_x (6θ/T²)(1 − 2t/T), ∫u² = 12 I_x² θ²/T³.
+    # XTE's co-states are of size 1e5: unscaled, solve_bvp's tolerance 1e-8 was below their round-off,
+    # every refinement ran to max_nodes (8 s) and the continuation repeated it for 60 to 100 s.
+    import time
+
+    case = xte_minimum_energy()
+    started = time.process_time()
+    reference = PLANNERS["costate_tpbvp"]().plan(case)
+    spent = time.process_time() - started
+    assert reference.ok, reference.message
+    assert spent < 5.0, f"{spent:.1f} s of CPU (0.2 s measured on 2026-12-02)"  # the failure took 100 s
+    inertia, angle, T = XTE["inertia"][0, 0], XTE["angle"], XTE["duration"]
+    assert reference.stats["int_u2"] == pytest.approx(12 * inertia**2 * angle**2 / T**3, rel=1e-6)
+    t = np.linspace(0.0, T, 13)
+    torque = np.zeros((t.size, 3))
+    torque[:, 0] = inertia * 6 * angle / T**2 * (1 - 2 * t / T)
+    np.testing.assert_allclose(reference.torque(t), torque, atol=1e-5 * np.max(np.abs(torque)))
+    assert np.rad2deg(quat.error_angle(reference.q(T), case.qf)) < 1e-6
+
+
+def test_a_refinement_that_cannot_pass_is_one_stage_and_says_so():
+    # A node limit the tolerance cannot be met within: the continuation reaches the target at its
+    # loose tolerance, the one refinement fails, and nothing is retried (the old schedule went back
+    # down the continuation and refined the same target again and again).
+    system = MinimumEnergySystem(xte_minimum_energy(), XTE["duration"])
+    solution, _, continuation, failure = solve(system, 60, 3, 1e-5, 100)
+    assert failure is None and solution is not None, failure
+    solution, t_f, stages, failure = solve(system, 60, 3, 1e-10, 100)
+    assert solution is None and t_f is None
+    assert stages == continuation + 1
+    assert failure is not None and "refining it to tolerance 1e-10 failed" in failure
+    assert "maximum number of mesh nodes" in failure and "not retried" in failure

@@ -13,12 +13,15 @@ The steering forms solve for the minimum time (``final_time: minimum``, default)
 ``final_time: fixed``, minimise the paper's terminal cost at ``t_f = T`` with its transversality
 conditions (eq. 36-38, 51). Gravity gradient enters whenever the scenario has it (eq. 5-8, orbit
 frame from the scenario's orbit). A cold start (eigenaxis slew or straight-line rates) is walked to
-the target by continuation, each solve seeding the next. Torque bounds are not imposed.
+the target by continuation, each solve seeding the next, and the target's solution is refined once
+to the final tolerance, in co-states scaled to order one for ``solve_bvp`` (:func:`solve`). Torque
+bounds are not imposed.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Annotated, Any, Callable, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -158,15 +161,86 @@ class CostateReference(Reference):
         return self.system.sample(t, self.solution.sol(t / self.duration), self.duration)
 
 
+LOOSE_TOLERANCE = 1e-5
+"""``solve_bvp`` tolerance of the continuation stages (a stage only seeds the next)."""
+
+
+def _costate_scale(system: HamiltonianSystem, y: Array) -> float:
+    """The size of the co-states in a start: the largest ``|λ|`` (1 if they are all zero)."""
+    size = float(np.max(np.abs(y[system.n_state:]), initial=0.0))
+    return size if np.isfinite(size) and size > 0.0 else 1.0
+
+
+def _solve_stage(system: HamiltonianSystem, fraction: float, start: tuple[float, Array, Array], tolerance: float,
+                 max_nodes: int) -> Any:
+    """One ``solve_bvp`` call on the problem at ``fraction``, in co-states scaled to order one.
+
+    ``solve_bvp`` measures a residual relative to ``1 + |f|``: a co-state of size 1e5 whose rate is
+    small is held to an absolute tolerance, far below its round-off once the mesh is fine (XTE's
+    minimum energy at ``tol = 1e-8`` added nodes until ``max_nodes``). The co-state equations and the
+    optimal controls are written in ``λ = c λ̃`` with ``c`` the size of the start's co-states; the
+    result is returned in ``λ`` (its ``rms_residuals`` are those of the scaled problem; ``sol`` is
+    ``None`` unless it converged).
+    """
+    from scipy.integrate import (
+        solve_bvp,  # lazily: scipy.integrate pulls in scipy.optimize
+    )
+    from scipy.interpolate import CubicHermiteSpline
+
+    free, n = system.free_final_time, system.n_state
+    t_f, s, y = start
+    scale = np.r_[np.ones(n), np.full(n, _costate_scale(system, y))]
+    column, bc = scale[:, None], system.boundary(fraction)
+
+    def fun(mesh, z, p=None):
+        time = system.final_time(p) if free else t_f
+        return time * system.evaluate(mesh * time, column * z, derivatives=False)[0] / column
+
+    def fun_jac(mesh, z, p=None):
+        time = system.final_time(p) if free else t_f
+        f, jac, f_t = system.evaluate(mesh * time, column * z)
+        assert jac is not None and f_t is not None  # evaluate gives them with derivatives=True
+        jac = time * jac * (scale[None, :, None] / scale[:, None, None])
+        if not free:
+            return jac
+        return jac, ((f + time * mesh * f_t) / column)[:, None, :]
+
+    def boundary(za, zb, p=None):
+        return bc(scale * za, scale * zb, p) if free else bc(scale * za, scale * zb)
+
+    trial = solve_bvp(fun, boundary, s, y / column, p=[t_f] if free else None, fun_jac=fun_jac, tol=tolerance,
+                      max_nodes=max_nodes)
+    trial.y, trial.yp = column * trial.y, column * trial.yp
+    # solve_bvp's own interpolant, in λ (a failed solve may hold non-finite values: no interpolant)
+    trial.sol = CubicHermiteSpline(trial.x, trial.y, trial.yp, axis=1) if trial.status == 0 else None
+    return trial
+
+
+def _solved(trial: Any, free: bool) -> bool:
+    """Whether a ``solve_bvp`` result converged (with a positive ``t_f`` for a free-time form)."""
+    return bool(trial.status == 0 and (not free or trial.p[0] > 0))
+
+
+def _failure(trial: Any) -> str:
+    """Why a ``solve_bvp`` result is not a solution, with its size and residual."""
+    detail = trial.message if trial.status != 0 else f"non-positive t_f = {trial.p[0]:.4g} s"
+    return f"{detail} ({trial.x.size} nodes, max rms residual {float(np.max(trial.rms_residuals)):.2g})"
+
+
 def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, max_nodes: int,
           guess: tuple[float, Array, Array] | None = None,
           min_step: float = 1e-3) -> tuple[Any, float | None, int, str | None]:
-    """Solve the TPBVP of ``system`` by adaptive continuation, starting with steps of ``1/steps``.
+    """Solve the TPBVP of ``system`` by adaptive continuation, starting with steps of ``1/steps``,
+    then refine the solution of the target to ``tolerance``.
 
-    A failed stage is retried with half the step; a successful one lengthens the next by half.
-    Each solution is resampled on ``nodes`` points before it seeds the next stage (``solve_bvp``
-    only ever adds nodes). Intermediate stages use ``max(tolerance, 1e-5)`` and at most
-    ``min(max_nodes, 10 nodes)`` nodes.
+    The continuation stages use the tolerance ``max(tolerance, LOOSE_TOLERANCE)``. A failed stage
+    is retried with half the step; a successful one lengthens the next by half. Each solution is
+    resampled on ``nodes`` points before it seeds the next stage (``solve_bvp`` only ever adds
+    nodes); stages short of the target have at most ``min(max_nodes, 10 nodes)`` nodes. Once the
+    target is solved, one ``solve_bvp`` call refines that solution, on its mesh, to ``tolerance``
+    with at most ``max_nodes`` nodes. A failed refinement ends the solve: the continuation has
+    done its work, and a smaller step would only reach the same target and refine it again. Every
+    stage solves in co-states scaled to order one (``_solve_stage``).
 
     Parameters
     ----------
@@ -178,9 +252,9 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
         The first continuation step is ``1/steps`` (a form that is not ``continued`` solves the
         target at once).
     tolerance : float
-        ``solve_bvp`` residual tolerance of the final stage.
+        ``solve_bvp`` residual tolerance of the solution returned.
     max_nodes : int
-        ``solve_bvp`` node limit of the final stage.
+        ``solve_bvp`` node limit of the stages that solve the target.
     guess : (t_f, s, y) or None, optional
         Replaces the system's own cold start (tests use it to start far away): final time [s],
         scaled mesh (m,) on [0, 1], ``y`` (2n, m).
@@ -190,7 +264,7 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
     Returns
     -------
     solution : object or None
-        The result of the final ``scipy.integrate.solve_bvp`` call, ``None`` on failure.
+        The result of the last ``scipy.integrate.solve_bvp`` call, ``None`` on failure.
     t_f : float or None
         The final time [s], ``None`` on failure.
     stages : int
@@ -198,46 +272,35 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
     message : str or None
         Why it failed, ``None`` on success.
     """
-    from scipy.integrate import (
-        solve_bvp,  # lazily: scipy.integrate pulls in scipy.optimize
-    )
-
     free = system.free_final_time
-    t_f = 0.0
-
-    def fun(s, y, p=None):
-        time = system.final_time(p) if free else t_f
-        return time * system.evaluate(s * time, y, derivatives=False)[0]
-
-    def fun_jac(s, y, p=None):
-        time = system.final_time(p) if free else t_f
-        f, jac, f_t = system.evaluate(s * time, y)
-        assert jac is not None and f_t is not None  # evaluate gives them with derivatives=True
-        if not free:
-            return time * jac
-        return time * jac, (f + time * s * f_t)[:, None, :]
-
-    done, step, stages, start, solution = 0.0, 1.0 / steps if system.continued else 1.0, 0, guess, None
+    loose = max(tolerance, LOOSE_TOLERANCE)
+    done, step, stages, start, solution, t_f = 0.0, 1.0 / steps if system.continued else 1.0, 0, guess, None, 0.0
     while done < 1.0:
         fraction = min(1.0, done + step)
-        t_f, s, y = start if start is not None else system.guess(nodes, fraction)
-        bc = system.boundary(fraction)
-        final = fraction == 1.0  # intermediate stages only seed the next: loose and small
-        trial = solve_bvp(fun, bc if free else (lambda ya, yb: bc(ya, yb)), s, y, p=[t_f] if free else None,
-                          fun_jac=fun_jac, tol=tolerance if final else max(tolerance, 1e-5),
-                          max_nodes=max_nodes if final else min(max_nodes, 10 * nodes))
+        stage_start = start if start is not None else system.guess(nodes, fraction)
+        trial = _solve_stage(system, fraction, stage_start, loose, max_nodes if fraction == 1.0 else min(max_nodes, 10 * nodes))
         stages += 1
-        if trial.status == 0 and (not free or trial.p[0] > 0):
+        if _solved(trial, free):
             solution, done, step = trial, fraction, 1.5 * step
-            t_f = float(trial.p[0]) if free else t_f
+            t_f = float(trial.p[0]) if free else stage_start[0]
             mesh = np.linspace(0.0, 1.0, nodes)
             start = (t_f, mesh, trial.sol(mesh))
             continue
         step /= 2
         if step < min_step:
-            detail = trial.message if trial.status != 0 else f"non-positive t_f = {trial.p[0]:.4g} s"
-            return None, None, stages, f"solve_bvp failed at continuation fraction {fraction:.3f}: {detail}"
-    return solution, t_f, stages, None
+            return None, None, stages, f"solve_bvp failed at continuation fraction {fraction:.3f}: {_failure(trial)}"
+    assert solution is not None  # the loop ends on a solved target
+    if tolerance >= loose:
+        return solution, t_f, stages, None
+    refined = _solve_stage(system, 1.0, (t_f, solution.x, solution.y), tolerance, max_nodes)
+    stages += 1
+    if not _solved(refined, free):
+        return None, None, stages, (
+            f"solve_bvp solved the target at tolerance {loose:g} ({stages - 1} continuation stage(s), "
+            f"{solution.x.size} nodes) but refining it to tolerance {tolerance:g} failed: {_failure(refined)}; "
+            "not retried (a smaller continuation step reaches the same target); a larger tolerance or "
+            "max_nodes may pass")
+    return refined, float(refined.p[0]) if free else t_f, stages, None
 
 
 class CostateTPBVPPlanner(Planner):
