@@ -157,6 +157,16 @@ def _sparse(function: BufferedFunction, index: int) -> scipy.sparse.csc_matrix:
     return scipy.sparse.csc_matrix((np.array(function.outputs[index], dtype=float), row, colind), shape=sparsity.shape)
 
 
+def _triplets(function: BufferedFunction, index: int) -> tuple[NDArray[np.int64], NDArray[np.int64], Array]:
+    """Output ``index`` of the last evaluation as ``(rows, columns, values)`` (index arithmetic on
+    these costs a fraction of SciPy's sparse constructors and slicing)."""
+    sparsity = function.function.sparsity_out(index)
+    colind, row = sparsity.get_ccs()
+    starts = np.asarray(colind, dtype=np.int64)
+    columns = np.repeat(np.arange(sparsity.size2(), dtype=np.int64), starts[1:] - starts[:-1])
+    return np.asarray(row, dtype=np.int64), columns, np.array(function.outputs[index], dtype=float)
+
+
 def _broadcast(bound: Any, like: Array) -> Array:
     """A bound (scalar or array) as a float array shaped like ``like``."""
     return np.broadcast_to(np.asarray(bound, dtype=float), like.shape)
@@ -191,17 +201,17 @@ def _infeasibility(values: Array, low: Array, high: Array) -> float:
     return float(np.max(np.maximum(below, above), initial=0.0))
 
 
-def _inertia(H: scipy.sparse.csc_matrix, A: scipy.sparse.csc_matrix, delta: float) -> Callable[[float], int | str]:
+def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: float) -> Callable[[float], int | str]:
     """A counter of the negative eigenvalues of ``M(s) = H + s I + AᵀA / ε`` from the inertia of
     ``K(s) = [[H + s I, Aᵀ], [A, −ε I]]`` (module docstring): one sparsity and one symbolic
     factorisation for every shift ``s``.
 
     Parameters
     ----------
-    H : (n, n) scipy.sparse.csc_matrix
-        The Hessian of the Lagrangian on the free variables (symmetric).
-    A : (m, n) scipy.sparse.csc_matrix
-        The active rows on them.
+    H : (n, n) scipy.sparse.coo_matrix
+        The Hessian of the Lagrangian on the free variables (symmetric, no duplicate entries).
+    A : (m, n) scipy.sparse.coo_matrix
+        The active rows on them (no duplicate entries).
     delta : float
         The curvature threshold ``δ`` (positive): the guard's scale.
 
@@ -217,7 +227,7 @@ def _inertia(H: scipy.sparse.csc_matrix, A: scipy.sparse.csc_matrix, delta: floa
         / max(1.0, float(abs(H).sum(axis=1).max()))
     # the pattern with its whole diagonal, explicit zeros kept (an entry H_jj = 0, or cancelled by a
     # shift, must stay in it), the shift set in place for each factorisation
-    Hc, Ac = H.tocoo(), A.tocoo()
+    Hc, Ac = H, A
     every = np.arange(n + m)
     K = scipy.sparse.coo_matrix(
         (np.concatenate([Hc.data, Ac.data, Ac.data, np.zeros(n), np.full(m, -epsilon)]),
@@ -307,14 +317,14 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     lam_x = np.asarray(lam_x, dtype=float).ravel()
     lam_g = np.asarray(lam_g, dtype=float).ravel()
     hessian.all_outputs(x, p, 1.0, lam_g)
-    upper = scipy.sparse.triu(_sparse(hessian, h_out), format="csc")  # IPOPT's is upper triangular, FATROP's full
-    H = (upper + scipy.sparse.triu(upper, 1, format="csc").T).tocsc()
+    h_rows, h_columns, h_values = _triplets(hessian, h_out)  # IPOPT's is upper triangular, FATROP's full
     jacobian.all_outputs(x, p)
-    g, J = jacobian.outputs[g_out].copy(), _sparse(jacobian, j_out)
+    g = jacobian.outputs[g_out].copy()
+    j_rows, j_columns, j_values = _triplets(jacobian, j_out)
     grad = gradient.all_outputs(x, p)[f_out].copy()
     g_low, g_high, x_low, x_high = _broadcast(lbg, g), _broadcast(ubg, g), _broadcast(lbx, x), _broadcast(ubx, x)
     # The theorem assumes a KKT point: a stalled solve or multipliers of other signs are not one.
-    terms = [grad, J.T @ lam_g, lam_x]
+    terms = [grad, np.bincount(j_columns, j_values * lam_g[j_rows], minlength=x.size), lam_x]
     moving = x_low != x_high  # a fixed variable's multiplier takes any value
     stationarity = float(np.max(np.abs(sum(terms))[moving], initial=0.0)) \
         / max([1.0] + [float(np.max(np.abs(t), initial=0.0)) for t in terms])
@@ -328,8 +338,21 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     free = np.flatnonzero(~_active(x, x_low, x_high, lam_x, multiplier_tolerance, bound_tolerance))
     if free.size == 0:
         return SecondOrderCheck(True, 0, 0.0, "a vertex: the active bounds fix every variable")
-    H_free = H[free][:, free].tocsc()
-    A = J[np.flatnonzero(rows)][:, free].tocsc()
+    # H and A on the free variables and active rows, H symmetric from its upper triangle
+    position = np.full(x.size, -1)
+    position[free] = np.arange(free.size)
+    keep = (h_rows <= h_columns) & (position[h_rows] >= 0) & (position[h_columns] >= 0)
+    r, c, v = position[h_rows[keep]], position[h_columns[keep]], h_values[keep]
+    off = r != c
+    H_free = scipy.sparse.coo_matrix((np.concatenate([v, v[off]]), (np.concatenate([r, c[off]]),
+                                                                    np.concatenate([c, r[off]]))),
+                                     shape=(free.size, free.size))
+    active = np.flatnonzero(rows)
+    row_position = np.full(g.size, -1)
+    row_position[active] = np.arange(active.size)
+    keep = (row_position[j_rows] >= 0) & (position[j_columns] >= 0)
+    A = scipy.sparse.coo_matrix((j_values[keep], (row_position[j_rows[keep]], position[j_columns[keep]])),
+                                shape=(active.size, free.size))
     delta = curvature_tolerance * max(1.0, float(abs(H_free).sum(axis=1).max()))
     where = f"on {free.size} free variables and {A.shape[0]} active rows"
     count = _inertia(H_free, A, delta)
