@@ -24,8 +24,9 @@ Three pieces of evidence, each computed here from the point alone (never from th
   itself: at an optimum of the collocation problems the gradients are far below 100 and every
   factor is 1 either way). The scaled stationarity equals IPOPT's reported ``inf_du`` at the same
   iterate (tested). Other solvers (FATROP) are taken unscaled: factors 1, ``s_d`` and ``s_c`` kept.
-* **Second order**: :func:`ocp.nlp.second_order.second_order_check` (a strict local minimum, or not
-  certified, or not checked and why).
+* **Second order**: :func:`ocp.nlp.second_order.second_order_check` (a strict local minimum;
+  degenerate, no curvature below ``−δ`` but some near zero; not certified, negative curvature; or
+  not checked and why).
 * **Pontryagin switching** (:func:`switching_agreement`): for bang-bang minimum time, the fraction
   of control samples at a bound whose sign is opposite to the switching function's
   ``σ = ∂H/∂u`` (the Hamiltonian ``H = L + pᵀ f`` is minimised) with ``|σ|`` above a tolerance.
@@ -35,12 +36,13 @@ Three pieces of evidence, each computed here from the point alone (never from th
 :func:`certificate` combines them into the JSON record of ``Reference.stats["certificate"]`` with a
 verdict: ``"certified"`` when the KKT residual (scaled) is at most :data:`KKT_TOLERANCE` and either
 the second-order sufficient conditions hold or, for bang-bang minimum time where the second-order
-check was not made (too many variables), the switching agreement is at least
+check could not be made (a factorisation that failed its accuracy guard, a solver without the
+derivatives) or found the point degenerate (curvature near zero in some direction, none below
+``−δ``: no saddle direction), the switching agreement is at least
 :data:`SWITCHING_THRESHOLD` with no sample on the wrong side (the controls at a bound, on the side
 Pontryagin's minimum principle asks, with a switching function clear of zero: strict
 complementarity on the control bounds, which makes the discretised point a vertex, the case
-``Z = {0}`` of the second-order check; a check that was made and found negative curvature is not
-overruled);
+``Z = {0}`` of the second-order check; a check that found negative curvature is not overruled);
 ``"first-order"`` when only the KKT residual is small; ``"not certified"`` otherwise.
 """
 from __future__ import annotations
@@ -59,6 +61,7 @@ from ocp.nlp.second_order import (
     _broadcast,
     _complementarity,
     _output,
+    _sparse,
     second_order_check,
 )
 
@@ -114,16 +117,6 @@ class KKTResiduals:
     unscaled: float
     scaled: float
     objective_scaling: float
-
-
-def _sparse(function: BufferedFunction, index: int) -> scipy.sparse.csc_matrix:
-    """Output ``index`` of the last evaluation as a sparse matrix (a collocation NLP's Jacobian,
-    dense, took most of the certificate's time)."""
-    import scipy.sparse
-
-    sparsity = function.function.sparsity_out(index)
-    colind, row = sparsity.get_ccs()
-    return scipy.sparse.csc_matrix((np.array(function.outputs[index], dtype=float), row, colind), shape=sparsity.shape)
 
 
 def _scaling(gradient: Array, jacobian: scipy.sparse.csc_matrix, solver_name: str) -> tuple[float, Array]:
@@ -308,8 +301,10 @@ def _second_order_text(check: SecondOrderCheck | str | None) -> str:
         return check
     if check.certified:
         return "strict local minimum"
-    if check.null_dimension < 0:
+    if check.negative_curvatures < 0:
         return "not checked: " + check.message
+    if check.degenerate:
+        return "degenerate: " + check.message
     return "not certified: " + check.message
 
 
@@ -347,11 +342,11 @@ def certificate(kkt: KKTResiduals | None, second_order: SecondOrderCheck | str |
     text = _second_order_text(second_order)
     first_order = kkt is not None and kkt.scaled <= kkt_tolerance
     sosc = text == "strict local minimum"
-    # The switching evidence stands in for a second-order check that was not made, never for one that
-    # was made and did not certify (negative curvature: a saddle), and only with no sample on the side
-    # Pontryagin forbids.
+    # The switching evidence stands in for a second-order check that was not made or found the point
+    # degenerate (no curvature below -δ), never for one that found negative curvature (a saddle), and
+    # only with no sample on the side Pontryagin forbids.
     bang_bang = (switching is not None and switching.agreement >= switching_threshold and switching.wrong == 0.0
-                 and text.startswith("not checked"))
+                 and text.startswith(("not checked", "degenerate")))
     verdict = "certified" if first_order and (sosc or bang_bang) else "first-order" if first_order else "not certified"
     record = {"kkt_scaled": None if kkt is None else kkt.scaled, "kkt_unscaled": None if kkt is None else kkt.unscaled,
               "second_order": text, "switching": None if switching is None else switching.agreement,
@@ -423,8 +418,8 @@ def certify(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array, *, p: Any
             costate_gap: float | None = None, seeds: int | None = None,
             seeds_agreed: int | None = None) -> dict[str, Any]:
     """The certificate of a converged point of ``solver``: its KKT residuals, its second-order check
-    (run here when not given; :func:`~ocp.nlp.second_order.second_order_check` declines NLPs
-    larger than its ``MAX_VARIABLES``) and the given evidence, as :func:`certificate`'s record.
+    (run here when not given, :func:`~ocp.nlp.second_order.second_order_check`) and the given
+    evidence, as :func:`certificate`'s record.
 
     Parameters
     ----------

@@ -15,11 +15,40 @@ which only enlarges ``Z``: positive definiteness on ``Z`` then implies it on the
 the check is conservative. It can report "not certified" at a true minimum (degenerate or singular
 arcs), never "certified" at a saddle: a caller falls back to its other evidence (restarts).
 
-The subspace is the null space of the active rows restricted to the free variables, from a
-column-pivoted QR factorisation of those rows (dense: meant for the small NLPs of a coarse mesh, a
-few hundred variables; on :data:`BLAS_THREADS` BLAS threads).
-``Z = {0}`` (a vertex: as many independent active constraints as variables, e.g. a bang-bang
-optimum) is a strict local minimum by itself.
+How: by inertia, with a sparse LDLᵀ, on NLPs of any size. With ``H`` the Hessian on the free
+variables ``F`` (the strongly active bounds fixed) and ``A`` the active rows on them, the check asks
+whether ``dᵀ H d > δ ‖d‖²`` on ``Z = null(A)``, ``δ`` the curvature threshold
+(``curvature_tolerance × max(1, ‖H‖∞)``). The matrix
+
+    K(s) = [[H + s I, Aᵀ], [A, −ε I]]      (ε = :data:`PENALTY` × max(1, ‖A‖∞)² / max(1, ‖H‖∞))
+
+has, by Haynsworth's inertia additivity over its negative definite block ``−ε I``, the ``m``
+negative eigenvalues of that block plus the inertia of ``M(s) = H + s I + AᵀA / ε``, which on ``Z``
+is ``H + s I``. So ``M(−δ)`` positive definite (``K(−δ)`` of inertia ``(n_F, m, 0)``) proves the
+conditions with curvature above ``δ``. Otherwise the negative eigenvalues of ``M(+δ)`` (those of
+``K(+δ)`` beyond ``m``) bound from above the dimension of the largest subspace of ``Z`` where the
+curvature is below ``−δ``: none proves that no direction of ``Z`` curves below ``−δ`` (a
+*degenerate* point: curvature near zero somewhere, e.g. a weakly active bound left free or a
+singular arc, but no saddle direction beyond ``−δ``); some are evidence of a saddle (as many as the
+directions when ``ε`` is small against ``A``'s singular values, more otherwise). Unlike the
+unregularised ``[[H, Aᵀ], [A, 0]]`` of the inertia theorem (Nocedal & Wright, Lemma 16.3; Gould
+1985), this needs no full row rank of ``A``: a collocation NLP's active rows are dependent at every
+optimum of the bench (one redundant row on Bilimoria & Wie), and a dependent row only adds a
+multiple of another's ``aaᵀ / ε``. ``Z = {0}`` (a vertex, e.g. a bang-bang optimum) makes ``AᵀA``
+positive definite and is certified when ``ε`` is small against ``A``'s least singular value squared
+(7e-12 on the bench's two-wheel minimum time, certified with :data:`PENALTY` 1e-8, not with 1e-6).
+
+CasADi's ``ldl`` factorises ``K`` (``casadi.Linsol``, its AMD ordering) and counts the negative
+pivots; it does not pivot numerically, which the shift and ``ε`` make possible (``H`` has zero
+diagonal entries where the controls enter linearly; without them the factorisation meets zero
+pivots) but not necessarily accurate: a pivot of size ``δ`` grows its neighbours by ``1 / δ``. So
+its backward error is estimated (the residual of one solve with a random right-hand side, relative
+to ``‖K‖∞ ‖x‖∞ + ‖b‖∞``) and the inertia is used only when that error times ``‖K‖∞`` is below
+``δ`` / :data:`GUARD`: the factors are then exact for ``K + E`` with ``‖E‖`` well below ``δ``,
+which moves the curvature found on ``Z`` by at most ``‖E‖ + ‖E‖² / (ε − ‖E‖)``, a fraction of
+``δ`` (an estimate, not a bound: a random right-hand side exposes an inaccurate factorisation with
+probability one, not with a proven margin). A zero pivot or a larger error leaves the point not
+checked.
 
 The theorem assumes a KKT point, so the first-order conditions are verified first (stationarity of
 the Lagrangian ``L = f + lam_gᵀ g + lam_xᵀ x``, CasADi's signs; every multiplier of the sign of the
@@ -29,31 +58,48 @@ convention are reported as not checked, never certified.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
-from threadpoolctl import threadpool_limits
 
 from ocp.fast_call import BufferedFunction
 
+if TYPE_CHECKING:  # imported where a check is made: importing this module does not load SciPy
+    import scipy.sparse
+
 Array = NDArray[np.float64]
 
-BLAS_THREADS = 1
-"""BLAS threads of the dense factorisations here (``threadpoolctl``). A few hundred rows are too
-few to share among threads, and a threaded BLAS waits for cores another process holds: Bilimoria &
-Wie's default minimum time (one check per plan, a 230 x 312 column-pivoted QR) took 500-540 ms per
-plan with NumPy's OpenBLAS on its default 2 threads while another process kept both cores busy,
-against 135-153 ms on one thread; on that QR alone 20.3 against 5.9 ms. Trade studies run several
-planners side by side, which is that situation."""
+CURVATURE_TOLERANCE = 1e-6
+"""Default ``curvature_tolerance``: ``δ = 1e-6 × max(1, ‖H‖∞)``. The accuracy of the unpivoted
+factorisation decides it (its pivots of size ``δ`` grow their neighbours by ``1 / δ``). On the
+collocation optima of the bench problems and Bilimoria & Wie's 8- and 50-interval optimum and
+eigenaxis saddle (13 points, both shifts), the largest ``GUARD`` of 1, 10, 100, 1000 that every
+factorisation passed was at 1e-6 at least 100 (1000 on 11 points); at 1e-7 only 1 on two points
+(norm-bounded eigenaxis, spin repoint); at 1e-8 (the dense check's tolerance before) none on three
+(full inertia, norm-bounded, spin repoint). The least curvature among the certified points that
+are no vertex is 4e-4 (spin repoint, minimum energy), so 1e-6 costs none of them."""
 
-MAX_VARIABLES = 400
-"""Larger NLPs are not checked: the dense factorisation would cost more than the restarts it saves.
-Bilimoria & Wie's minimum time (Radau degree 3), the check against one 5 % restart from the optimum:
-8 intervals (312 variables) 5-15 ms against 23 ms; 12 intervals (464) 44 against 36 ms; 30
-intervals (1148) 242 against 49 ms."""
+PENALTY = 1e-8
+"""``ε = PENALTY × max(1, ‖A‖∞)² / max(1, ‖H‖∞)``: the ``−ε I`` block of the regularised KKT
+matrix. A vertex is certified, and a count is exact, only when ``s² / ε`` exceeds the curvature
+along the directions of ``A``'s small singular values ``s``, which asks for a small ``ε``; the
+elimination's cancellations ask for ``δ ε`` well above the unit roundoff times ``‖A‖²`` (here
+``δ ε = 1e-14 ‖A‖∞²``; ``ε = δ = 1e-8`` met zero pivots on Bilimoria & Wie). Measured on the
+collocation optima of the bench problems and Bilimoria & Wie's 8- and 50-interval optimum and
+eigenaxis saddle, against the dense reduced Hessian's eigenvalues: ``ε`` proportional to ``δ``
+(``10 δ``) left XTE's 8-interval optimum, a vertex with ``s`` down to 7e-5, with 2 to 5 false
+negative curvatures; ``PENALTY = 1e-6`` found 3 and 1 directions below ``±δ`` on the keep-out
+optimum (dense: 2 and 0) and 3 and 2 on the two-wheel vertex (``s = 3e-6``; dense: 0); 1e-8 to
+1e-10 give the dense counts on all 13 points, and at 1e-8 every factorisation passes the guard
+with ``GUARD = 100`` (ten times the margin asked)."""
+
+GUARD = 10.0
+"""The estimated backward error of the factorisation, times ``‖K‖∞``, must be below ``δ / GUARD``
+(see the module docstring)."""
 
 
 @dataclass(frozen=True)
@@ -63,19 +109,28 @@ class SecondOrderCheck:
     Parameters
     ----------
     certified : bool
-        The second-order sufficient conditions hold: a strict local minimum.
-    null_dimension : int
-        Dimension of the subspace ``Z`` of the module docstring (-1: not checked).
-    min_curvature : float
-        Least eigenvalue of ``∇²L`` on ``Z`` (``inf`` when ``Z = {0}``, ``nan`` when not checked).
+        The second-order sufficient conditions hold: a strict local minimum, curvature above
+        ``curvature_threshold`` on ``Z``.
+    negative_curvatures : int
+        When not certified: negative eigenvalues of ``M(+δ) = H + δ I + AᵀA / ε`` (module
+        docstring), an upper bound on the directions of ``Z`` curving below ``−δ``; 0 when
+        certified or degenerate; -1 when not checked.
+    curvature_threshold : float
+        ``δ`` (``nan`` when not checked).
     message : str
         What was found, or why the point was not checked.
     """
 
     certified: bool
-    null_dimension: int
-    min_curvature: float
+    negative_curvatures: int
+    curvature_threshold: float
     message: str
+
+    @property
+    def degenerate(self) -> bool:
+        """Not certified, but no direction of ``Z`` curves below ``−δ``: near-zero curvature, no
+        saddle direction found."""
+        return not self.certified and self.negative_curvatures == 0
 
 
 def _not_checked(message: str) -> SecondOrderCheck:
@@ -92,31 +147,24 @@ def _output(function: ca.Function, names: tuple[str, ...]) -> int:
     raise RuntimeError(f"{function.name()} has none of the outputs {names}")
 
 
-def _dense(function: BufferedFunction, index: int) -> Array:
-    """Output ``index`` of the last evaluation as a dense array."""
+def _sparse(function: BufferedFunction, index: int) -> scipy.sparse.csc_matrix:
+    """Output ``index`` of the last evaluation as a sparse matrix (dense, a collocation NLP's
+    Jacobian took most of a certificate's time)."""
+    import scipy.sparse  # here, not at the top: it takes 0.16 s to import, and every command imports this module
+
     sparsity = function.function.sparsity_out(index)
-    out = np.zeros(sparsity.shape)
-    out[np.asarray(sparsity.row(), dtype=int), np.asarray(sparsity.get_col(), dtype=int)] = function.outputs[index]
-    return out
+    colind, row = sparsity.get_ccs()
+    return scipy.sparse.csc_matrix((np.array(function.outputs[index], dtype=float), row, colind), shape=sparsity.shape)
 
 
-def _null_space(A: Array, n: int) -> Array:
-    """An orthonormal basis of ``{d : A d = 0}`` (``n`` columns of ``A``), through ``A P = Q R``
-    with column pivoting: ``R = [R11 R12]`` of rank ``r``, the basis ``P [-R11⁻¹ R12; I]``
-    orthonormalised (no full ``Q`` is formed)."""
-    if A.shape[0] == 0 or n == 0:
-        return np.eye(n)
-    import scipy.linalg  # here, not at the top: it takes 0.16 s to import, and every command imports this module
-
-    R, P = scipy.linalg.qr(A, mode="r", pivoting=True)
-    diagonal = np.abs(np.diag(R))
-    rank = int(np.sum(diagonal > 1e-9 * diagonal[0])) if diagonal[0] > 0 else 0
-    if rank == n:
-        return np.zeros((n, 0))
-    basis = np.zeros((n, n - rank))
-    basis[P[:rank]] = -scipy.linalg.solve_triangular(R[:rank, :rank], R[:rank, rank:])
-    basis[P[rank:]] = np.eye(n - rank)
-    return np.linalg.qr(basis)[0]
+def _triplets(function: BufferedFunction, index: int) -> tuple[NDArray[np.int64], NDArray[np.int64], Array]:
+    """Output ``index`` of the last evaluation as ``(rows, columns, values)`` (index arithmetic on
+    these costs a fraction of SciPy's sparse constructors and slicing)."""
+    sparsity = function.function.sparsity_out(index)
+    colind, row = sparsity.get_ccs()
+    starts = np.asarray(colind, dtype=np.int64)
+    columns = np.repeat(np.arange(sparsity.size2(), dtype=np.int64), starts[1:] - starts[:-1])
+    return np.asarray(row, dtype=np.int64), columns, np.array(function.outputs[index], dtype=float)
 
 
 def _broadcast(bound: Any, like: Array) -> Array:
@@ -153,10 +201,73 @@ def _infeasibility(values: Array, low: Array, high: Array) -> float:
     return float(np.max(np.maximum(below, above), initial=0.0))
 
 
+def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: float) -> Callable[[float], int | str]:
+    """A counter of the negative eigenvalues of ``M(s) = H + s I + AᵀA / ε`` from the inertia of
+    ``K(s) = [[H + s I, Aᵀ], [A, −ε I]]`` (module docstring): one sparsity and one symbolic
+    factorisation for every shift ``s``.
+
+    Parameters
+    ----------
+    H : (n, n) scipy.sparse.coo_matrix
+        The Hessian of the Lagrangian on the free variables (symmetric, no duplicate entries).
+    A : (m, n) scipy.sparse.coo_matrix
+        The active rows on them (no duplicate entries).
+    delta : float
+        The curvature threshold ``δ`` (positive): the guard's scale.
+
+    Returns
+    -------
+    callable
+        ``count(s)``: the count, or a message (a zero pivot, or a backward error the guard rejects).
+    """
+    import scipy.sparse
+
+    n, m = H.shape[0], A.shape[0]
+    epsilon = PENALTY * max(1.0, float(abs(A).sum(axis=1).max()) if m else 0.0) ** 2 \
+        / max(1.0, float(abs(H).sum(axis=1).max()))
+    # the pattern with its whole diagonal, explicit zeros kept (an entry H_jj = 0, or cancelled by a
+    # shift, must stay in it), the shift set in place for each factorisation
+    Hc, Ac = H, A
+    every = np.arange(n + m)
+    K = scipy.sparse.coo_matrix(
+        (np.concatenate([Hc.data, Ac.data, Ac.data, np.zeros(n), np.full(m, -epsilon)]),
+         (np.concatenate([Hc.row, Ac.row + n, Ac.col, every]), np.concatenate([Hc.col, Ac.col, Ac.row + n, every]))),
+        shape=(n + m, n + m)).tocsc()  # duplicates summed
+    K.sort_indices()
+    columns = np.repeat(every, np.diff(K.indptr))
+    diagonal = np.flatnonzero((K.indices == columns) & (columns < n))  # the diagonal of H in K.data
+    base = K.data[diagonal].copy()
+    sparsity = ca.Sparsity.compressed(np.concatenate([[n + m, n + m], K.indptr, K.indices]).tolist())
+    solver = ca.Linsol("second_order", "ldl", sparsity)
+    rhs = np.random.default_rng(0).standard_normal(n + m)
+    b = ca.DM(rhs)
+
+    def count(shift: float) -> int | str:
+        K.data[diagonal] = base + shift
+        values = ca.DM(sparsity, K.data.tolist())
+        solver.sfact(values)
+        solver.nfact(values)
+        solution = np.asarray(solver.solve(values, b)).ravel()
+        norm = float(abs(K).sum(axis=1).max())
+        with np.errstate(invalid="ignore"):
+            error = float(np.max(np.abs(K @ solution - rhs))) \
+                / (norm * float(np.max(np.abs(solution))) + float(np.max(np.abs(rhs))))
+        rank = int(solver.rank(values))
+        if rank < n + m or not np.isfinite(error):
+            return f"the KKT matrix's LDLᵀ has {n + m - rank} zero pivots ({n} free variables, {m} active rows)"
+        if error * norm > delta / GUARD:
+            return (f"the KKT matrix's LDLᵀ (no pivoting) is not accurate enough: backward error {error:.1g} × ‖K‖ "
+                    f"{norm:.2g} above {1 / GUARD:g} × the curvature threshold {delta:.1g}")
+        return int(solver.neig(values)) - m
+
+    return count
+
+
 def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array, *, p: Any = None,
                        lbx: Any = -np.inf, ubx: Any = np.inf, lbg: Any = -np.inf, ubg: Any = np.inf,
                        multiplier_tolerance: float = 1e-6, bound_tolerance: float = 1e-6,
-                       curvature_tolerance: float = 1e-8, kkt_tolerance: float = 1e-6) -> SecondOrderCheck:
+                       curvature_tolerance: float = CURVATURE_TOLERANCE,
+                       kkt_tolerance: float = 1e-6) -> SecondOrderCheck:
     """Whether a converged point of ``solver`` satisfies the second-order sufficient conditions.
 
     Parameters
@@ -177,7 +288,8 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
         Relative distance to a bound (``× (1 + |bound|)``) within which a value is at it; also the
         largest accepted violation of a bound.
     curvature_tolerance : float
-        The least curvature on ``Z`` must exceed this, relative to the largest (at least 1).
+        The curvature on ``Z`` must exceed ``δ`` = this times ``max(1, ‖H‖∞)`` (``H`` the Hessian
+        of the Lagrangian on the free variables); :data:`CURVATURE_TOLERANCE` says why 1e-6.
     kkt_tolerance : float
         The first-order conditions the theorem assumes must hold to this: the stationarity residual
         ``‖∇f + J_gᵀ lam_g + lam_x‖∞`` relative to the largest of its terms (at least 1), and the
@@ -189,10 +301,9 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     SecondOrderCheck
         ``certified`` only when the conditions provably hold (see the module docstring).
     """
+    import scipy.sparse
+
     x = np.asarray(x, dtype=float).ravel()
-    n = x.size
-    if n > MAX_VARIABLES:
-        return _not_checked(f"{n} variables: more than {MAX_VARIABLES}, not checked")
     try:
         hessian = BufferedFunction(solver.get_function("nlp_hess_l"))
         jacobian = BufferedFunction(solver.get_function("nlp_jac_g"))
@@ -206,14 +317,14 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     lam_x = np.asarray(lam_x, dtype=float).ravel()
     lam_g = np.asarray(lam_g, dtype=float).ravel()
     hessian.all_outputs(x, p, 1.0, lam_g)
-    upper = np.triu(_dense(hessian, h_out))  # IPOPT's is upper triangular, FATROP's full
-    H = upper + np.triu(upper, 1).T
+    h_rows, h_columns, h_values = _triplets(hessian, h_out)  # IPOPT's is upper triangular, FATROP's full
     jacobian.all_outputs(x, p)
-    g, J = jacobian.outputs[g_out].copy(), _dense(jacobian, j_out)
+    g = jacobian.outputs[g_out].copy()
+    j_rows, j_columns, j_values = _triplets(jacobian, j_out)
     grad = gradient.all_outputs(x, p)[f_out].copy()
     g_low, g_high, x_low, x_high = _broadcast(lbg, g), _broadcast(ubg, g), _broadcast(lbx, x), _broadcast(ubx, x)
     # The theorem assumes a KKT point: a stalled solve or multipliers of other signs are not one.
-    terms = [grad, J.T @ lam_g, lam_x]
+    terms = [grad, np.bincount(j_columns, j_values * lam_g[j_rows], minlength=x.size), lam_x]
     moving = x_low != x_high  # a fixed variable's multiplier takes any value
     stationarity = float(np.max(np.abs(sum(terms))[moving], initial=0.0)) \
         / max([1.0] + [float(np.max(np.abs(t), initial=0.0)) for t in terms])
@@ -224,17 +335,38 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
         return _not_checked(f"not a first-order point: stationarity {stationarity:.2g}, complementarity "
                             f"{complementarity:.2g}, infeasibility {infeasibility:.2g}")
     rows = _active(g, g_low, g_high, lam_g, multiplier_tolerance, bound_tolerance)
-    fixed = _active(x, x_low, x_high, lam_x, multiplier_tolerance, bound_tolerance)
-    free = ~fixed
-    A = J[np.ix_(rows, free)]
-    n_free = int(free.sum())
-    with threadpool_limits(limits=BLAS_THREADS, user_api="blas"):
-        Z = _null_space(A, n_free)
-        if Z.shape[1] == 0:
-            return SecondOrderCheck(True, 0, float("inf"), "a vertex: the active constraints fix the point")
-        curvature = np.linalg.eigvalsh(Z.T @ H[np.ix_(free, free)] @ Z)
-    least = float(curvature[0])
-    certified = least > curvature_tolerance * max(1.0, float(np.max(np.abs(curvature))))
-    verdict = "positive definite" if certified else "not positive definite"
-    return SecondOrderCheck(certified, Z.shape[1], least,
-                            f"reduced Hessian on {Z.shape[1]} free directions {verdict} (least eigenvalue {least:.3g})")
+    free = np.flatnonzero(~_active(x, x_low, x_high, lam_x, multiplier_tolerance, bound_tolerance))
+    if free.size == 0:
+        return SecondOrderCheck(True, 0, 0.0, "a vertex: the active bounds fix every variable")
+    # H and A on the free variables and active rows, H symmetric from its upper triangle
+    position = np.full(x.size, -1)
+    position[free] = np.arange(free.size)
+    keep = (h_rows <= h_columns) & (position[h_rows] >= 0) & (position[h_columns] >= 0)
+    r, c, v = position[h_rows[keep]], position[h_columns[keep]], h_values[keep]
+    off = r != c
+    H_free = scipy.sparse.coo_matrix((np.concatenate([v, v[off]]), (np.concatenate([r, c[off]]),
+                                                                    np.concatenate([c, r[off]]))),
+                                     shape=(free.size, free.size))
+    active = np.flatnonzero(rows)
+    row_position = np.full(g.size, -1)
+    row_position[active] = np.arange(active.size)
+    keep = (row_position[j_rows] >= 0) & (position[j_columns] >= 0)
+    A = scipy.sparse.coo_matrix((j_values[keep], (row_position[j_rows[keep]], position[j_columns[keep]])),
+                                shape=(active.size, free.size))
+    delta = curvature_tolerance * max(1.0, float(abs(H_free).sum(axis=1).max()))
+    where = f"on {free.size} free variables and {A.shape[0]} active rows"
+    count = _inertia(H_free, A, delta)
+    below = count(-delta)
+    if isinstance(below, str):
+        return _not_checked(below)
+    if below == 0:
+        return SecondOrderCheck(True, 0, delta, f"curvature above {delta:.1g} {where} (KKT inertia)")
+    beyond = count(delta)
+    if isinstance(beyond, str):  # the count below +δ bounds the one below −δ too
+        return SecondOrderCheck(False, below, delta, f"at most {below} directions of curvature below {delta:.1g} {where} "
+                                                     f"(below −{delta:.1g} not counted: {beyond})")
+    if beyond == 0:
+        return SecondOrderCheck(False, 0, delta, f"at most {below} directions of curvature between "
+                                                 f"−{delta:.1g} and {delta:.1g}, none below, {where} (KKT inertia)")
+    return SecondOrderCheck(False, beyond, delta, f"at most {beyond} directions of curvature below −{delta:.1g} {where} "
+                                                  f"(KKT inertia)")

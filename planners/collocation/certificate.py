@@ -26,7 +26,6 @@ from ocp.nlp.certificate import (
     seed_counts,
     switching_agreement,
 )
-from ocp.nlp.second_order import MAX_VARIABLES, SecondOrderCheck
 from ocp.nlp.solve import NLPResult
 from ocp.transcription import NLP, OptimalControlProblem, Transcription
 from ocp.transcription.radau import RadauCollocation
@@ -143,16 +142,9 @@ def collocation_certificate(result: NLPResult, transcription: Transcription, ocp
     agreement = None
     if ocp.free_time and ocp.energy_weight == 0 and ocp.l1_weight == 0 and isinstance(transcription, RadauCollocation):
         agreement = switching(transcription, ocp.model, nlp, result.x, result.lam_g, lbx, ubx, params)
-    second: SecondOrderCheck | str | None = result.second_order
-    if second is None and result.x.size > MAX_VARIABLES:
-        coarse = stats.get("coarse", {}).get("second_order")
-        also = ""
-        if coarse is not None:
-            also = "; the coarse mesh's optimum: " + ("strict local minimum" if coarse["certified"] else coarse["message"])
-        second = f"not checked: {result.x.size} variables, more than {MAX_VARIABLES}{also}"
     try:
         return certify(nlp.solver, result.x, result.lam_x, result.lam_g, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg,
-                       ubg=nlp.ubg, solver_name=solver, second_order=second, switching=agreement, seeds=tried,
+                       ubg=nlp.ubg, solver_name=solver, second_order=result.second_order, switching=agreement, seeds=tried,
                        seeds_agreed=agreed)
     except RuntimeError as error:  # a solver plugin without nlp_jac_g / nlp_grad_f
         return certificate(None, f"not checked: {str(error).splitlines()[0]}", agreement, seeds=tried,
