@@ -6,7 +6,7 @@ objects (:mod:`~ocp.nlp.solve`); the second-order sufficient conditions at a con
 in the solver's scaling, the second-order check and Pontryagin's switching agreement in one record
 (:mod:`~ocp.nlp.certificate`).
 
-May import: CasADi, NumPy, SciPy, threadpoolctl and the top-level modules of :mod:`ocp`; it knows
+May import: CasADi, NumPy, SciPy and the top-level modules of :mod:`ocp`; it knows
 nothing of attitude, models or transcriptions.
 """
 from ocp.nlp.certificate import (
