@@ -331,6 +331,10 @@ def test_a_file_changed_since_slewbench_wrote_it_is_not_replaced(tmp_path, capsy
     err = capsys.readouterr().err
     assert "changed since slewbench wrote them (results.md)" in err and "nothing was touched" in err
     assert (out / "results.md").read_text() == "my notes"
+    import shutil  # a copy of the directory (new modification times) is still slewbench's: stamps are contents
+    copy = tmp_path / "copy"
     (out / "results.md").unlink()  # gone: nothing to replace, the run goes on
+    shutil.copytree(out, copy, copy_function=shutil.copy)
+    assert main(["run", demo, "--out", str(copy), "--no-plots"]) == 0
     assert main(["run", demo, "--out", str(out), "--no-plots"]) == 0
     assert (out / "results.md").read_text().startswith("#")

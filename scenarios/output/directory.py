@@ -8,7 +8,7 @@ The rules (:doc:`/outputs`, "What slewbench writes, and what it never touches"):
   user's directory, the working directory) is refused with a :class:`OutputError` and left untouched.
 * Inside a marked directory slewbench replaces or removes only files its manifest lists; a file a
   user put there is never touched, and a result name that would land on such a file is an error.
-  The manifest also keeps each committed file's size and modification time (``stamps``): a listed
+  The manifest also keeps each committed file's size and content digest (``stamps``): a listed
   file that has changed since (a user's own figure saved over ``comparison.png``) is no longer
   slewbench's, and a claim or commit that would replace it is refused, naming it.
 * New results are written into a staging folder inside the marked directory, then moved into place
@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import hashlib
 import json
 import os
 import shutil
@@ -53,7 +54,7 @@ def read_manifest(directory: Path) -> dict[str, Any] | None:
     -------
     dict or None
         The manifest (``tool``, ``kind``, ``complete``, ``files``, and ``stamps``: listed file ->
-        ``[size, mtime_ns]`` when committed, an empty mapping in a marker written before stamps),
+        ``[size, digest]`` when committed, an empty mapping in a marker written before stamps),
         or ``None`` when the directory carries no valid marker (missing, unreadable, not
         slewbench's, or naming a file outside it).
     """
@@ -74,19 +75,23 @@ def read_manifest(directory: Path) -> dict[str, Any] | None:
 
 
 def _is_stamp(value: Any) -> bool:
-    return (isinstance(value, list) and len(value) == 2
-            and all(isinstance(v, int) and not isinstance(v, bool) for v in value))
+    return (isinstance(value, list) and len(value) == 2 and isinstance(value[0], int)
+            and not isinstance(value[0], bool) and isinstance(value[1], str))
 
 
-def _stamp(path: Path) -> list[int]:
-    """``[size, mtime_ns]`` of a file (not following a link)."""
-    status = os.lstat(path)
-    return [status.st_size, status.st_mtime_ns]
+def _stamp(path: Path) -> list[Any]:
+    """``[size, digest]`` of a file's content (BLAKE2b, 128 bits): a copy of the directory keeps it,
+    where a modification time would not."""
+    digest = hashlib.blake2b(digest_size=16)
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return [os.lstat(path).st_size, digest.hexdigest()]
 
 
 def changed_files(directory: Path, manifest: dict[str, Any]) -> list[str]:
     """The files the manifest lists with a stamp that have changed since slewbench committed them
-    (size or modification time; or no longer a regular file). A deleted one has not changed: there
+    (size or content; or no longer a regular file). A deleted one has not changed: there
     is nothing to replace.
 
     Parameters
@@ -106,7 +111,7 @@ def changed_files(directory: Path, manifest: dict[str, Any]) -> list[str]:
         path = directory / name
         if not os.path.lexists(path):
             continue
-        if path.is_symlink() or not path.is_file() or _stamp(path) != stamp:
+        if path.is_symlink() or not path.is_file() or os.lstat(path).st_size != stamp[0] or _stamp(path) != stamp:
             changed.append(name)
     return changed
 
@@ -203,7 +208,7 @@ def _abandoned(staging: Path) -> bool:
 
 
 def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: str,
-                   stamps: dict[str, list[int]] | None = None) -> None:
+                   stamps: dict[str, list[Any]] | None = None) -> None:
     """Replace the marker atomically (write a temporary file, then rename it).
 
     Parameters
@@ -217,7 +222,7 @@ def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: 
     kind : str
         What writes there (``"run"``, ``"sweep"``, ``"codegen"``).
     stamps : dict, optional
-        ``[size, mtime_ns]`` of files just committed; ``None``: the current marker's stamps of the
+        ``[size, digest]`` of files just committed; ``None``: the current marker's stamps of the
         files still listed are kept.
     """
     listed = sorted(set(files))
