@@ -314,3 +314,27 @@ def test_an_empty_output_directory_is_refused_not_replaced_by_the_default(argv, 
     assert stop.value.code == 2
     assert "an empty path: give the output directory" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []  # no results/ made
+
+
+def test_a_file_changed_since_slewbench_wrote_it_is_not_replaced(tmp_path, capsys):
+    """A user saved their own figure over a run's output, with the same name; the rerun replaced it
+    (the manifest knew names only). Its stamp (size, mtime) now says it is no longer slewbench's."""
+    demo = str(Path(__file__).resolve().parents[1] / "scenarios" / "eigenaxis_demo.yaml")
+    out = tmp_path / "run"
+    assert main(["run", demo, "--out", str(out), "--no-plots"]) == 0
+    manifest = json.loads((out / MARKER).read_text())
+    assert set(manifest["stamps"]) == set(manifest["files"]) and "results.md" in manifest["stamps"]
+    assert main(["run", demo, "--out", str(out), "--no-plots"]) == 0  # its own files: replaced
+    (out / "results.md").write_text("my notes")
+    capsys.readouterr()
+    assert main(["run", demo, "--out", str(out), "--no-plots"]) == 2
+    err = capsys.readouterr().err
+    assert "changed since slewbench wrote them (results.md)" in err and "nothing was touched" in err
+    assert (out / "results.md").read_text() == "my notes"
+    import shutil  # a copy of the directory (new modification times) is still slewbench's: stamps are contents
+    copy = tmp_path / "copy"
+    (out / "results.md").unlink()  # gone: nothing to replace, the run goes on
+    shutil.copytree(out, copy, copy_function=shutil.copy)
+    assert main(["run", demo, "--out", str(copy), "--no-plots"]) == 0
+    assert main(["run", demo, "--out", str(out), "--no-plots"]) == 0
+    assert (out / "results.md").read_text().startswith("#")

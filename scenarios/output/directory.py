@@ -8,6 +8,9 @@ The rules (:doc:`/outputs`, "What slewbench writes, and what it never touches"):
   user's directory, the working directory) is refused with a :class:`OutputError` and left untouched.
 * Inside a marked directory slewbench replaces or removes only files its manifest lists; a file a
   user put there is never touched, and a result name that would land on such a file is an error.
+  The manifest also keeps each committed file's size and content digest (``stamps``): a listed
+  file that has changed since (a user's own figure saved over ``comparison.png``) is no longer
+  slewbench's, and a claim or commit that would replace it is refused, naming it.
 * New results are written into a staging folder inside the marked directory, then moved into place
   file by file, and the manifest is marked complete last: an interrupted run leaves a manifest that
   says "incomplete", and its staging folder is removed by the next run that writes there.
@@ -18,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import hashlib
 import json
 import os
 import shutil
@@ -29,7 +33,7 @@ from typing import Any
 from scenarios.errors import OutputError
 from scenarios.schema.read import read_bounded
 
-__all__ = ["MARKER", "STAGING_PREFIX", "claim_output_directory", "commit_outputs", "new_staging",
+__all__ = ["MARKER", "STAGING_PREFIX", "changed_files", "claim_output_directory", "commit_outputs", "new_staging",
            "read_manifest", "write_manifest", "written_files"]
 
 MARKER = ".slewbench-output.json"
@@ -49,8 +53,10 @@ def read_manifest(directory: Path) -> dict[str, Any] | None:
     Returns
     -------
     dict or None
-        The manifest (``tool``, ``kind``, ``complete``, ``files``), or ``None`` when the directory
-        carries no valid marker (missing, unreadable, not slewbench's, or naming a file outside it).
+        The manifest (``tool``, ``kind``, ``complete``, ``files``, and ``stamps``: listed file ->
+        ``[size, digest]`` when committed, an empty mapping in a marker written before stamps),
+        or ``None`` when the directory carries no valid marker (missing, unreadable, not
+        slewbench's, or naming a file outside it).
     """
     try:  # never waits: a marker that is a named pipe is no marker
         text = read_bounded(directory / MARKER, MAX_MANIFEST_BYTES)
@@ -61,7 +67,63 @@ def read_manifest(directory: Path) -> dict[str, Any] | None:
         return None
     if not all(isinstance(name, str) and _is_plain_relative(name) for name in manifest["files"]):
         return None  # a manifest naming files outside its directory is not ours to act on
+    stamps = manifest.get("stamps")
+    listed = set(manifest["files"])
+    manifest["stamps"] = ({name: stamp for name, stamp in stamps.items() if name in listed and _is_stamp(stamp)}
+                          if isinstance(stamps, dict) else {})
     return manifest
+
+
+def _is_stamp(value: Any) -> bool:
+    return (isinstance(value, list) and len(value) == 2 and isinstance(value[0], int)
+            and not isinstance(value[0], bool) and isinstance(value[1], str))
+
+
+def _stamp(path: Path) -> list[Any]:
+    """``[size, digest]`` of a file's content (BLAKE2b, 128 bits): a copy of the directory keeps it,
+    where a modification time would not."""
+    digest = hashlib.blake2b(digest_size=16)
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return [os.lstat(path).st_size, digest.hexdigest()]
+
+
+def changed_files(directory: Path, manifest: dict[str, Any]) -> list[str]:
+    """The files the manifest lists with a stamp that have changed since slewbench committed them
+    (size or content; or no longer a regular file). A deleted one has not changed: there
+    is nothing to replace.
+
+    Parameters
+    ----------
+    directory : Path
+        A marked output directory.
+    manifest : dict
+        Its manifest (:func:`read_manifest`).
+
+    Returns
+    -------
+    list of str
+        Relative paths, sorted.
+    """
+    changed = []
+    for name, stamp in sorted(manifest.get("stamps", {}).items()):
+        path = directory / name
+        if not os.path.lexists(path):
+            continue
+        if path.is_symlink() or not path.is_file() or os.lstat(path).st_size != stamp[0] or _stamp(path) != stamp:
+            changed.append(name)
+    return changed
+
+
+def _refuse_changed(path: str | Path, directory: Path, manifest: dict[str, Any], done: str) -> None:
+    for name in manifest.get("stamps", {}):  # a symbolic-link folder first: it says more than "changed"
+        _check_inside(directory, name)
+    changed = changed_files(directory, manifest)
+    if changed:
+        shown = ", ".join(changed[:5]) + (f" and {len(changed) - 5} more" if len(changed) > 5 else "")
+        raise OutputError(path, f"holds files changed since slewbench wrote them ({shown}); {done}: move them "
+                                "or choose another --out")
 
 
 def written_files(directory: Path) -> set[str]:
@@ -145,7 +207,8 @@ def _abandoned(staging: Path) -> bool:
     return False
 
 
-def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: str) -> None:
+def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: str,
+                   stamps: dict[str, list[Any]] | None = None) -> None:
     """Replace the marker atomically (write a temporary file, then rename it).
 
     Parameters
@@ -158,8 +221,15 @@ def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: 
         Whether the set is complete (``False`` while a run commits).
     kind : str
         What writes there (``"run"``, ``"sweep"``, ``"codegen"``).
+    stamps : dict, optional
+        ``[size, digest]`` of files just committed; ``None``: the current marker's stamps of the
+        files still listed are kept.
     """
-    manifest = {"tool": "slewbench", "kind": kind, "complete": complete, "files": sorted(set(files))}
+    listed = sorted(set(files))
+    if stamps is None:
+        stamps = (read_manifest(directory) or {}).get("stamps", {})
+    kept = {name: stamps[name] for name in listed if name in stamps}
+    manifest = {"tool": "slewbench", "kind": kind, "complete": complete, "files": listed, "stamps": kept}
     handle, temporary = tempfile.mkstemp(prefix=".slewbench-manifest-", dir=directory)
     with os.fdopen(handle, "w") as stream:
         json.dump(manifest, stream, indent=1)
@@ -207,6 +277,8 @@ def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
             elif manifest.get("kind", kind) != kind and manifest["files"]:
                 raise OutputError(path, f"holds slewbench {manifest.get('kind')} output; write the {kind} output "
                                         "into a directory of its own, nothing was touched")
+            if manifest is not None:  # before running: a long run is not refused at its end
+                _refuse_changed(path, directory, manifest, "nothing was touched")
             for leftover in directory.glob(f"{STAGING_PREFIX}*"):
                 if leftover.is_dir() and not leftover.is_symlink() and _abandoned(leftover):
                     shutil.rmtree(leftover, ignore_errors=True)
@@ -273,7 +345,8 @@ def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
     if clashes:
         raise OutputError(directory, f"holds files slewbench did not write ({', '.join(clashes[:5])}); "
                                      "nothing was replaced: move them or choose another --out")
-    write_manifest(directory, previous | set(new), complete=False, kind=kind)
+    _refuse_changed(directory, directory, manifest, "nothing was replaced")
+    write_manifest(directory, previous | set(new), complete=False, kind=kind, stamps={})
     for name in new:
         (directory / name).parent.mkdir(parents=True, exist_ok=True)
         os.replace(staging / name, directory / name)
@@ -284,6 +357,6 @@ def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
     for folder in sorted({(directory / name).parent for name in previous - set(new)}, reverse=True):
         if folder != directory and folder.is_dir() and not any(folder.iterdir()):
             folder.rmdir()
-    write_manifest(directory, new, complete=True, kind=kind)
+    write_manifest(directory, new, complete=True, kind=kind, stamps={name: _stamp(directory / name) for name in new})
     shutil.rmtree(staging, ignore_errors=True)
     return new
