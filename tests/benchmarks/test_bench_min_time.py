@@ -25,7 +25,7 @@ Levenberg-Marquardt term of 1e-3 (17 SQP iterations; without it, from today's sh
 at a QP failure in SQP iteration 4 at T = 5.081, on main as on this branch, 2026-12-02; MIRROR takes
 32 iterations, MIRROR with 0.1 47, CONVEXIFY fails too); on the full-inertia case that stops at a QP failure in SQP iteration 2 (T driven to
 its lower bound; so do MIRROR, CONVEXIFY, a Levenberg-Marquardt term of 1e-3 and 200 QP
-iterations), and only ``levenberg_marquardt: 0.1`` with MIRROR converges (7.68339, 64 iterations).
+iterations), and only ``levenberg_marquardt: 0.1`` with MIRROR converges (7.68339, 63-64 iterations).
 Run it with ``SLEWBENCH_ACADOS_PYTHON`` naming the interpreter that has ``comma-deps-acados``.
 
 Measured 2026-12-01 (2 cores shared with other jobs, load average 6-9: absolute times are 2-3x a
@@ -43,8 +43,10 @@ spin min energy, extremal   114 [102..148]   276 [229..410]   0.40 [0.29..0.58] 
 Ours reached 3.243111, 7.682613, 0.093244 (default options on this branch: the eigenaxis-side
 minimum) and 0.018548; acados builds in 5.8-9.1 s (code generation and gcc) against our
 0.2-0.4 s. A second run an hour earlier (load 7-8): 1.98 [1.32..2.25], 0.65 [0.49..0.80], 0.63
-[0.44..0.75]. From the eigenaxis guess of ``slewbench bench`` acados stops at the eigenaxis
-stationary point on B&W (3.5449, 3 SQP iterations), as the FATROP peer does.
+[0.44..0.75]. From the eigenaxis guess ``slewbench bench`` gave the peers until 2026-12-02, acados
+stopped at the eigenaxis stationary point on B&W (3.5449, 3 SQP iterations), as the FATROP peer did;
+the bench now gives them this benchmark's start
+(:func:`scenarios.bench.peers._shooting.first_start_guess`, which ``shared_guess`` calls).
 
 Where our time goes (B&W 180°, default options, after the build; quiet-machine plan 90-118 ms):
 the coarse 8-interval solve (39 IPOPT iterations, 1.2 ms each, about 25 of them near the eigenaxis
@@ -120,6 +122,36 @@ spin-extremal seed planner's own solves 9 ms, the seeds 3 ms). Routes measured a
   7 and 6, but 61 against 51 and 28 against 19 on mt0 and mt11;
 * MUMPS's QAMD ordering on the full-mesh solve: 309 M against 322 M instructions per solve (0.96x);
   METIS 1.2x the CPU, AMD and PORD within noise.
+
+Measured 2026-12-02, later (after the full-mesh second-order check, issue 30 point 3, which adds one
+8 ms check per plan; load 0.4-0.9, the host in a slow phase: acados on B&W 49 ms at 03:14, 63-67 ms
+at 04:13-04:15; 9 alternating rounds per case, median [min..max] of the pairwise ratios):
+
+==========================  ==================  ==================  ==================
+case                        03:14 (before)      04:13               04:15
+==========================  ==================  ==================  ==================
+B&W 180° min time           2.14 [1.53..3.02]   2.32 [1.75..2.65]   2.29 [1.80..2.79]
+full inertia min time       0.63 [0.48..0.70]   0.76 [0.70..0.87]   0.73 [0.54..1.08]
+spin min energy, default    -                   1.03 [0.88..1.17]   0.99 [0.76..1.18]
+spin min energy, extremal   -                   0.95 [0.76..1.08]   0.94 [0.90..1.26]
+==========================  ==================  ==================  ==================
+
+The spin case, the code before the check (434cf58) and now, alternating runs of the side-by-side test
+(same conditions): 0.85 and 0.87 before, 0.94 and 0.91 now; our plan 106 and 114 ms, above the
+issue's 100 ms in this slow phase for both (84 ms the day before). Other linear solvers of this
+CasADi's IPOPT: SPRAL 3.2x the plan time on B&W (OpenMP, one thread or two), MA27 and Pardiso (MKL)
+not available (no HSL, no MKL build). The issue's route, condensing and a Riccati solver: CasADi 3.8's
+``conic("hpipm")`` solves a random stage-wise QP of B&W's condensed size (N = 50, 8 states, 9
+controls: the 3 Radau points' torques, the 21 collocation states eliminated; box bounds on the
+controls) in 9 interior-point iterations and 1.9 ms (its own ``t_proc_solver``; the call with
+its conversions 5-40x that from dense NumPy inputs: pass sparse ``DM``, and ``ca.sparsify`` the
+patterns, or its layout check fails). A lifted SQP (exact Hessian, the interval's collocation
+states condensed per interval, that QP per iteration) from the coarse optimum would cost about
+2.5-3.5 ms per iteration against IPOPT's 5.7 ms on the full mesh; at IPOPT's 7 iterations the full
+mesh would take about 20 instead of 40 ms, the plan about 100 instead of 120 ms on B&W (1.8-1.9x
+acados). Reaching 1.0x asks the coarse multistart (63 IPOPT iterations at 1 ms, two starts) to
+shrink as much, i.e. the same SQP, robust from the eigenaxis saddle, on the coarse mesh too, at
+about 0.2-0.3 ms per iteration: compiled code, not a loop in Python. Not built.
 """
 from __future__ import annotations
 
