@@ -500,8 +500,9 @@ def unrealised_torque(model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: A
 
     The commands and states of ``demand`` (:func:`reference_demand`, through a law's allocation)
     give the body the torque ``τ_a − ω × A h_w``: the actuators' own (``−A g`` of the wheels,
-    ``m × B`` of the magnetorquers at the model's field, the torquers') and the wheels' gyroscopic
-    term at the momenta the wheels have along the reference. What the feed-forward ``u`` asks
+    ``m × B`` of the magnetorquers at the model's field, the torquers') and the gyroscopic term of
+    the momentum the actuators store (``A h_w``, each kind's ``momentum_matrix``) along the
+    reference. What the feed-forward ``u`` asks
     beyond it, ``u − (τ_a − ω × A h_w)``, no command gives: torque about an axis the working
     actuators do not span (one wheel, failed wheels without torquers), or along the field for
     magnetorquers alone. Rounding leaves about 1e-16 of ``|u|`` on a fully actuated spacecraft.
@@ -539,9 +540,11 @@ def unrealised_torque(model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: A
         if block.actuator.state_size:
             x[:, 7:][:, block.state] = demand[_quantity(block.actuator, True)].values
     given = np.asarray(model.body_torque.map(n)(x.T, u.T, t).full()).T if n else np.zeros((0, 3))
-    if spacecraft.n_wheels:  # the wheel momenta are the first states ([q, ω, h_w, ...])
-        momentum = x[:, 7:7 + spacecraft.n_wheels] @ spacecraft.wheel_axes.T
-        given -= np.cross(x[:, 4:7], momentum)
+    momentum = np.zeros((n, 3))  # stored in the actuators' states: the wheels' A h_w (momentum_matrix)
+    for block in actuator_blocks(spacecraft):
+        if block.actuator.state_size:
+            momentum += x[:, 7:][:, block.state] @ np.asarray(block.actuator.momentum_matrix(), dtype=float).T
+    given -= np.cross(x[:, 4:7], momentum)
     return np.asarray(torque, dtype=float).reshape(n, 3) - given
 
 

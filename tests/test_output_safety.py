@@ -15,6 +15,7 @@ import pytest
 import yaml
 
 from scenarios.cli.commands import main
+from scenarios.errors import OutputError
 from scenarios.output.directory import MARKER, STAGING_PREFIX
 from scenarios.output.names import default_output_directory, row_stems
 
@@ -338,3 +339,42 @@ def test_a_file_changed_since_slewbench_wrote_it_is_not_replaced(tmp_path, capsy
     assert main(["run", demo, "--out", str(copy), "--no-plots"]) == 0
     assert main(["run", demo, "--out", str(out), "--no-plots"]) == 0
     assert (out / "results.md").read_text().startswith("#")
+
+
+def test_an_interrupted_commit_keeps_every_file_stamped(tmp_path, monkeypatch):
+    """A commit that stops between its moves left the manifest without stamps, and a user's later
+    edit of a listed file was then replaced. While a commit moves, a file it replaces may hold the
+    old content or the new: both stamps stand, any other content is the user's."""
+    from scenarios.output.directory import claim_output_directory, commit_outputs, new_staging
+
+    out = claim_output_directory(tmp_path / "out")
+    staging = new_staging(out)
+    (staging / "a.txt").write_text("a1")
+    (staging / "b.txt").write_text("b1")
+    commit_outputs(out, staging, kind="run")
+    staging = new_staging(out)
+    (staging / "a.txt").write_text("a2")
+    (staging / "b.txt").write_text("b2")
+    real = os.replace
+    moved = []
+
+    def interrupted(source, target):  # the second move out of staging fails (the marker's writes pass)
+        if STAGING_PREFIX in str(source):
+            if moved:
+                raise OSError(28, "No space left on device")
+            moved.append(target)
+        real(source, target)
+
+    monkeypatch.setattr(os, "replace", interrupted)
+    with pytest.raises(OSError):
+        commit_outputs(out, staging, kind="run")
+    monkeypatch.setattr(os, "replace", real)
+    assert {(out / "a.txt").read_text(), (out / "b.txt").read_text()} == {"a2", "b1"}  # one moved, one not
+    edited = out / ("b.txt" if (out / "a.txt").read_text() == "a2" else "a.txt")
+    edited.write_text("the user's")
+    staging = new_staging(out)
+    (staging / "a.txt").write_text("a3")
+    (staging / "b.txt").write_text("b3")
+    with pytest.raises(OutputError, match=f"changed since slewbench wrote them \\({edited.name}\\)"):
+        commit_outputs(out, staging, kind="run")
+    assert edited.read_text() == "the user's"

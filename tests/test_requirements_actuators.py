@@ -239,3 +239,13 @@ def test_a_reference_needing_torque_no_actuator_gives_is_never_ok(tmp_path, targ
         # an eigenaxis slew of a sphere about y: all of its torque is about y
         assert row.requirements["reference"]["actuators"]["unrealised_torque"] == pytest.approx(
             np.max(np.abs(row.reference.torque(np.linspace(0.0, 60.0, 2001))[:, 1])), rel=1e-2)
+
+
+def test_a_reference_asking_no_torque_is_scored_without_dividing_by_it():
+    """A torque-free reference (u = 0): rounding of the allocation is no demand, a real unrealised
+    torque is one, and the message has no share of a zero peak (it divided by it)."""
+    t = np.array([0.0, 1.0])
+    zero = np.zeros((2, 3))
+    assert _actuators(0.9, {}, t, [], np.array([[1e-18, 0.0, 0.0], [0.0, 0.0, 0.0]]), zero).met
+    score = _actuators(0.9, {}, t, [], np.array([[0.0, 0.0, 0.0], [0.0, 2e-6, 0.0]]), zero)
+    assert not score.met and score.detail.startswith("2e-06 N m of the torque asked at 1 s is given by no")

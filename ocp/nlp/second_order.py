@@ -270,7 +270,8 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
         if not analysed:
             solver.sfact(values)  # the symbolic factorisation (the ordering), once per pattern
             analysed.append(True)
-        solver.nfact(values)
+        solver.nfact(values)  # rank() and neig() read this factorisation
+        # (solve() with DM arguments factorises again in its own memory: the guard's one solve)
         solution = np.asarray(solver.solve(values, b)).ravel()
         norm = float(abs(K).sum(axis=1).max())
         with np.errstate(invalid="ignore"):
@@ -386,9 +387,9 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     if below == 0:
         return SecondOrderCheck(True, 0, delta, f"curvature above {delta:.1g} {where} (KKT inertia)")
     beyond = count(delta)
-    if isinstance(beyond, str):  # the count below +δ bounds the one below −δ too
-        return SecondOrderCheck(False, below, delta, f"at most {below} directions of curvature below {delta:.1g} {where} "
-                                                     f"(below −{delta:.1g} not counted: {beyond})")
+    if isinstance(beyond, str):  # not certified; below −δ unknown: no saddle evidence either
+        return SecondOrderCheck(False, -1, delta, f"at most {below} directions of curvature below {delta:.1g} {where}, "
+                                                  f"below −{delta:.1g} not counted: {beyond}")
     if beyond == 0:
         return SecondOrderCheck(False, 0, delta, f"at most {below} directions of curvature between "
                                                  f"−{delta:.1g} and {delta:.1g}, none below, {where} (KKT inertia)")

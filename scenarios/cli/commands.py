@@ -42,11 +42,8 @@ from scenarios.output.provenance import package_version
 from scenarios.output.writer import plot_streamer
 from scenarios.runner import run
 from scenarios.schema.labels import row_labels
-from scenarios.schema.loader import load, parse_scenario
+from scenarios.schema.loader import OTHER_FILES, load, parse_scenario
 from scenarios.schema.read import read_yaml
-
-STUDY_KEY = "study"
-"""The top-level key that makes a YAML file a study (the study's name) for ``validate``."""
 
 
 def command_list(args: argparse.Namespace) -> int:
@@ -113,6 +110,30 @@ def command_schema(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _validate_study(file: str) -> str:
+    """A study file, every case expanded and checked (its parser imported here: ``run`` needs none)."""
+    from scenarios.study.spec import load_study
+
+    study = load_study(file)
+    points = len({case.point for case in study.cases})
+    varied = ", ".join(study.varied_paths) or "nothing"
+    return (f"{file}: valid study {study.name!r}: {len(study.cases)} cases ({points} grid point(s) x "
+            f"{study.samples} sample(s)), varying {varied}; run it with `slewbench {OTHER_FILES['study']} {file}`")
+
+
+def _validate_table(file: str) -> str:
+    """A slew-table file, checked as ``slewbench table`` would before computing."""
+    from scenarios.slewtable.spec import parse_table_spec
+
+    spec = parse_table_spec(file)
+    return (f"{file}: valid slew table {spec.name!r}: {len(spec.axes)} axes x {len(spec.angles_deg)} angles, "
+            f"{spec.objective}; run it with `slewbench {OTHER_FILES['table']} {file}`")
+
+
+_OTHER_VALIDATORS = {"study": _validate_study, "table": _validate_table}
+"""How ``validate`` checks each kind of ``scenarios.schema.loader.OTHER_FILES`` (keyed the same)."""
+
+
 def command_validate(args: argparse.Namespace) -> int:
     """``slewbench validate FILE``: load and check a scenario, a study or a slew-table file, print what would run.
 
@@ -131,23 +152,10 @@ def command_validate(args: argparse.Namespace) -> int:
         Exit status (0; a bad file raises ``ScenarioError``, which :func:`main` reports with exit 2).
     """
     data = read_yaml(args.file)
-    if isinstance(data, dict) and STUDY_KEY in data:
-        # a study's parser, imported here: a scenario (and `run`) does not need it
-        from scenarios.study.spec import load_study
-
-        study = load_study(args.file)
-        points = len({case.point for case in study.cases})
-        varied = ", ".join(study.varied_paths) or "nothing"
-        print(f"{args.file}: valid study {study.name!r}: {len(study.cases)} cases ({points} grid point(s) x "
-              f"{study.samples} sample(s)), varying {varied}; run it with `slewbench sweep {args.file}`")
-        return EXIT_OK
-    if isinstance(data, dict) and "table" in data:
-        from scenarios.slewtable.spec import parse_table_spec
-
-        spec = parse_table_spec(args.file)
-        print(f"{args.file}: valid slew table {spec.name!r}: {len(spec.axes)} axes x {len(spec.angles_deg)} angles, "
-              f"{spec.objective}; run it with `slewbench table {args.file}`")
-        return EXIT_OK
+    for key in OTHER_FILES:  # a study or a slew table: its own check and summary
+        if isinstance(data, dict) and key in data:
+            print(_OTHER_VALIDATORS[key](args.file))
+            return EXIT_OK
     scenario = parse_scenario(data, Path(args.file))
     labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in scenario.controllers])
     controllers = ", ".join(repr(c.name) for c in scenario.controllers)

@@ -54,7 +54,8 @@ def read_manifest(directory: Path) -> dict[str, Any] | None:
     -------
     dict or None
         The manifest (``tool``, ``kind``, ``complete``, ``files``, and ``stamps``: listed file ->
-        ``[size, digest]`` when committed, an empty mapping in a marker written before stamps),
+        the ``[size, digest]`` pairs its content may have, one once committed, the old and the new
+        one while a commit replaces it; an empty mapping in a marker written before stamps),
         or ``None`` when the directory carries no valid marker (missing, unreadable, not
         slewbench's, or naming a file outside it).
     """
@@ -75,8 +76,10 @@ def read_manifest(directory: Path) -> dict[str, Any] | None:
 
 
 def _is_stamp(value: Any) -> bool:
-    return (isinstance(value, list) and len(value) == 2 and isinstance(value[0], int)
-            and not isinstance(value[0], bool) and isinstance(value[1], str))
+    """A list of ``[size, digest]`` pairs."""
+    return isinstance(value, list) and all(
+        isinstance(pair, list) and len(pair) == 2 and isinstance(pair[0], int) and not isinstance(pair[0], bool)
+        and isinstance(pair[1], str) for pair in value)
 
 
 def _stamp(path: Path) -> list[Any]:
@@ -111,7 +114,7 @@ def changed_files(directory: Path, manifest: dict[str, Any]) -> list[str]:
         path = directory / name
         if not os.path.lexists(path):
             continue
-        if path.is_symlink() or not path.is_file() or os.lstat(path).st_size != stamp[0] or _stamp(path) != stamp:
+        if path.is_symlink() or not path.is_file() or _stamp(path) not in stamp:
             changed.append(name)
     return changed
 
@@ -222,7 +225,8 @@ def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: 
     kind : str
         What writes there (``"run"``, ``"sweep"``, ``"codegen"``).
     stamps : dict, optional
-        ``[size, digest]`` of files just committed; ``None``: the current marker's stamps of the
+        The ``[size, digest]`` pairs of files just committed (a list per file); ``None``: the
+        current marker's stamps of the
         files still listed are kept.
     """
     listed = sorted(set(files))
@@ -346,7 +350,13 @@ def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
         raise OutputError(directory, f"holds files slewbench did not write ({', '.join(clashes[:5])}); "
                                      "nothing was replaced: move them or choose another --out")
     _refuse_changed(directory, directory, manifest, "nothing was replaced")
-    write_manifest(directory, previous | set(new), complete=False, kind=kind, stamps={})
+    # while moving, a file this commit writes may hold its old content or its new one: both are
+    # slewbench's (an interrupted commit leaves every listed file of slewbench's stamped)
+    fresh = {name: _stamp(staging / name) for name in new}
+    stamps = dict(manifest["stamps"])
+    for name, stamp in fresh.items():
+        stamps[name] = [*stamps.get(name, []), stamp]
+    write_manifest(directory, previous | set(new), complete=False, kind=kind, stamps=stamps)
     for name in new:
         (directory / name).parent.mkdir(parents=True, exist_ok=True)
         os.replace(staging / name, directory / name)
@@ -357,6 +367,6 @@ def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
     for folder in sorted({(directory / name).parent for name in previous - set(new)}, reverse=True):
         if folder != directory and folder.is_dir() and not any(folder.iterdir()):
             folder.rmdir()
-    write_manifest(directory, new, complete=True, kind=kind, stamps={name: _stamp(directory / name) for name in new})
+    write_manifest(directory, new, complete=True, kind=kind, stamps={name: [fresh[name]] for name in new})
     shutil.rmtree(staging, ignore_errors=True)
     return new

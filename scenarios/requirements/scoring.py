@@ -47,8 +47,9 @@ from planners.base import REQUIREMENT_KINDS
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
 __all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "JUMP_TOLERANCE", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
-           "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_TOLERANCE", "Score", "endpoint_violations", "rate_jumps", "reference_times", "score_closed_loop",
-           "score_fields", "score_reference", "unhonoured", "violations"]
+           "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
+           "endpoint_violations", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
+           "score_reference", "unhonoured", "violations"]
 
 Array = NDArray[np.float64]
 
@@ -73,6 +74,9 @@ JUMP_TOLERANCE = 1e-6
 UNREALISED_FIELDS = ("unrealised_torque", "unrealised_torque_time_s")
 """The actuator score's last fields: the largest torque the reference asks that its commands do not
 give (:func:`controllers.allocation.unrealised_torque`) [N m], and when [s]."""
+UNREALISED_FLOOR = 1e-12
+"""[N m]: the torque scale of :data:`UNREALISED_TOLERANCE` for a reference that asks no torque (a
+torque-free motion): rounding, not a demand."""
 UNREALISED_TOLERANCE = 1e-2
 """The unrealised torque breaks the actuator requirement above this fraction of the reference's
 peak torque. A reference that needs torque about an axis no working actuator gives leaves 0.59-1.0
@@ -267,9 +271,10 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
         peak = float(norms[worst]) if norms.size else 0.0
         scale = float(np.max(np.linalg.norm(torque, axis=1), initial=0.0))
         values.update(zip(UNREALISED_FIELDS, (peak, float(t[worst]) if norms.size else None)))
-        if peak > UNREALISED_TOLERANCE * scale and peak > 0.0:
-            missing = (f"{peak:.3g} N m of the torque asked at {t[worst]:.1f} s ({peak / scale:.0%} of the "
-                       "reference's peak) is given by no working actuator")
+        # a reference asking no torque is measured against the rounding of its own terms
+        if peak > UNREALISED_TOLERANCE * max(scale, UNREALISED_FLOOR):
+            share = f" ({peak / scale:.0%} of the reference's peak)" if scale > 0.0 else ""
+            missing = f"{peak:.3g} N m of the torque asked at {t[worst]:g} s{share} is given by no working actuator"
             detail = missing + (f", {detail}" if detail else "")
     return Score("actuators", values, not detail, detail)
 
