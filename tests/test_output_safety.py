@@ -345,7 +345,11 @@ def test_an_interrupted_commit_keeps_every_file_stamped(tmp_path, monkeypatch):
     """A commit that stops between its moves left the manifest without stamps, and a user's later
     edit of a listed file was then replaced. While a commit moves, a file it replaces may hold the
     old content or the new: both stamps stand, any other content is the user's."""
-    from scenarios.output.directory import claim_output_directory, commit_outputs, new_staging
+    from scenarios.output.directory import (
+        claim_output_directory,
+        commit_outputs,
+        new_staging,
+    )
 
     out = claim_output_directory(tmp_path / "out")
     staging = new_staging(out)
