@@ -7,7 +7,7 @@
   torque is the inverse dynamics.
 * Two wheels and torquers: what the wheels cannot give goes to the torquers (hand-worked); a
   ``wheels_only`` law drops it.
-* Magnetorquers: ``m = B × τ / |B|²`` with the field along the reference.
+* Magnetorquers: ``m = B × τ / |B|²`` with the field along the reference, leaving the torque along it.
 * The actuator score: demand over limit against ``1 − margin``.
 * The torque the commands leave out (``unrealised_torque``): about an axis no wheel spans, the whole
   component (hand-worked); zero for torque the wheels give through their gyroscopic term (a torque
@@ -133,10 +133,13 @@ def test_magnetorquers_take_the_torque_across_the_field_along_the_reference():
     q = np.stack([quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), a) for a in (0.0, 0.4, 0.9)])
     u = np.array([[1e-5, 0.0, -2e-5], [0.0, 3e-5, 0.0], [-1e-5, 1e-5, 1e-5]])
     demand = reference_demand(CONTROLLERS["augmented_quaternion_feedback"](), model, t, q, np.zeros((3, 3)), u)
+    missing = unrealised_torque(model, t, q, np.zeros((3, 3)), u, demand)
     for k in range(3):
         b_inertial = np.asarray(field.field_inertial(orbit.position(t[k]), t[k])).ravel()
         b = quat.rotate(quat.conjugate(q[k]), b_inertial)
         np.testing.assert_allclose(demand["magnetorquers_dipole"].values[k], np.cross(b, u[k]) / b.dot(b), rtol=1e-9)
+        # what they leave: the torque along the field (m × B has none)
+        np.testing.assert_allclose(missing[k], b * u[k].dot(b) / b.dot(b), rtol=1e-9, atol=1e-20)
 
 
 def test_ratios_and_the_actuator_score():
@@ -189,22 +192,6 @@ def test_torque_two_wheels_give_through_their_momentum_is_realised():
     # Heun's momenta against the closed form: O(dt²) (dt = 0.01 s); the missing torque follows them
     assert np.max(missing) < 1e-3 * np.max(np.abs(u[:, 2]))
     assert _actuators(1.0, demand, t, [], unrealised_torque(model, t, q, omega, u, demand), u).met
-
-
-def test_magnetorquers_alone_leave_the_torque_along_the_field():
-    orbit = CircularOrbit(altitude=600e3, inclination=np.deg2rad(97.8))
-    field = MAGNETIC_FIELDS["tilted_dipole"].from_options(MAGNETIC_FIELDS["tilted_dipole"].Options(), orbit)
-    spacecraft = Spacecraft(INERTIA, wheels=None, magnetorquers=Magnetorquers(max_dipole=0.2))
-    model = AttitudeModel(spacecraft, Environment(orbit=orbit, magnetic_field=field))
-    t = np.array([0.0, 30.0, 60.0])
-    q = np.stack([quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), a) for a in (0.0, 0.4, 0.9)])
-    u = np.array([[1e-5, 0.0, -2e-5], [0.0, 3e-5, 0.0], [-1e-5, 1e-5, 1e-5]])
-    demand = reference_demand(CONTROLLERS["augmented_quaternion_feedback"](), model, t, q, np.zeros((3, 3)), u)
-    missing = unrealised_torque(model, t, q, np.zeros((3, 3)), u, demand)
-    for k in range(3):
-        b_inertial = np.asarray(field.field_inertial(orbit.position(t[k]), t[k])).ravel()
-        b = quat.rotate(quat.conjugate(q[k]), b_inertial)
-        np.testing.assert_allclose(missing[k], b * u[k].dot(b) / b.dot(b), rtol=1e-9, atol=1e-20)
 
 
 ONE_WHEEL = """
