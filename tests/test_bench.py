@@ -265,6 +265,22 @@ def test_a_row_reaches_the_optimum_only_when_ok_and_a_peer_at_the_eigenaxis_sadd
     assert row.reached and not row.message.startswith(EIGENAXIS_NOTE)
 
 
+def test_the_markdown_cuts_a_long_note_in_its_cell_and_gives_it_whole_below_the_table():
+    from scenarios.bench.leaderboard import NOTE_CHARS, Leaderboard, _peer_row
+    from scenarios.bench.peers.base import PeerResult
+    suite = load_suite()
+    problem = suite.problems["bilimoria_wie_180"]
+    long = "start: ours; " + "acados stopped: " + "x" * 150 + " (the end of the note)"
+    rows = [_peer_row(problem, "acados", PeerResult(None, 0.5, "failed", 500, long)),
+            _peer_row(problem, "fatrop", PeerResult(3.24312, 0.01, "ok", 30, "start: ours; fatrop: ok"))]
+    markdown = Leaderboard(suite, [problem], rows).to_markdown()
+    table = [line for line in markdown.splitlines() if line.startswith("| acados (peer)")]
+    assert len(table) == 1 and "(the end of the note)" not in table[0] and table[0].count("x") < NOTE_CHARS
+    assert table[0].rstrip(" |").endswith("… [1]")
+    assert f"[1] {long}" in markdown.splitlines()  # whole, after the table
+    assert "| start: ours; fatrop: ok |" in markdown and "[2]" not in markdown  # a short note stays in its cell
+
+
 def _suite_problem(name):
     return load(load_suite().problems[name].file).problem
 

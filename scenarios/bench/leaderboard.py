@@ -299,13 +299,21 @@ class Leaderboard:
                        f"Source: {problem.source}"), "",
                       "| row | kind | status | value | gap | gap (rel) | plan time [s] | iterations | certificate | note |",
                       "|---|---|---|---|---|---|---|---|---|---|"]
+            whole: list[str] = []  # the notes shortened in the table, in full below it
             for row in (r for r in self.rows if r.problem == problem.name):
                 mark = "" if row.reached is None else (" ✓" if row.reached else "")
+                note = _note(row)
+                if len(note) > NOTE_CHARS:
+                    whole.append(note)
+                    note = f"{note[:NOTE_CHARS - 1]}… [{len(whole)}]"
                 lines.append(
                     f"| {_md(row.label)} | {row.kind} | {row.status} | {_fmt(row.objective)} | {_fmt(row.gap_abs, '+.3g')}"
                     f"{mark} | {_fmt(row.gap_rel, '+.2e')} | {_fmt(row.plan_time_s, '.3g')} | "
-                    f"{'-' if row.iterations is None else row.iterations} | {_md(row.certificate)} | {_md(_note(row))} |")
+                    f"{'-' if row.iterations is None else row.iterations} | {_md(row.certificate)} | {_md(note)} |")
             lines.append("")
+            if whole:
+                lines += [f"[{k}] {_md(note)}" + ("  " if k < len(whole) else "") for k, note in enumerate(whole, 1)]
+                lines.append("")
         if self.notes:
             lines += ["## Notes", ""] + [f"- {_md(note)}" for note in self.notes] + [""]
         return "\n".join(lines)
@@ -419,18 +427,18 @@ def _fmt(value: float | None, spec: str = ".6g") -> str:
 
 
 NOTE_CHARS = 100
-"""Longest note in the Markdown table (the CSV and JSON keep the whole message)."""
+"""Longest note in a Markdown table cell: a longer one is cut there and given whole below the table
+(as are the CSV and JSON)."""
 EIGENAXIS_NOTE = "stopped at the eigenaxis slew's value (a stationary point)"
 """The note of a peer whose value is the eigenaxis slew's where that is not the optimum."""
 
 
 def _note(row: BenchRow) -> str:
-    """The row's message when it is a peer's (it names the peer's start), not ok or has no gap,
-    shortened; else empty."""
+    """The row's message when it is a peer's (it names the peer's start), not ok or has no gap;
+    else empty."""
     if row.kind != "peer" and row.status == "ok" and row.gap_abs is not None:
         return ""
-    text = row.message.strip()
-    return text if len(text) <= NOTE_CHARS else text[:NOTE_CHARS - 1] + "…"
+    return row.message.strip()
 
 
 def _md(text: str) -> str:
