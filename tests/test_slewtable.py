@@ -324,6 +324,8 @@ def test_netcdf_reads_back_with_dimensions_units_and_attributes(tmp_path):
 @pytest.mark.parametrize(("flags", "where"), [
     (["--angles", "0,90"], "--angles"),
     (["--angles", "ten"], "--angles"),
+    (["--angles", "-10,90"], "(0, 180] degrees, got [-10.0, 90.0]"),  # checked, not read as an option
+    (["--check-angles", "-5", "--tolerance", "0.01"], "--check-angles"),
     (["--axes", "many"], "--axes"),
     (["--duration", "5"], "--duration"),
     (["--objective", "min_energy"], "--duration"),

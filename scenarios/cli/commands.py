@@ -27,6 +27,7 @@ from scenarios.cli.status import (
     EXIT_INTERRUPTED,
     EXIT_NOT_OK,
     EXIT_OK,
+    attached_values,
     directory_argument,
 )
 from scenarios.cli.sweep import add_sweep_parser
@@ -408,7 +409,7 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         Exit status: 0 done, 2 bad scenario file or output location (the message names its path),
         1 internal error or interrupted, or a row not ok under ``run --strict``.
     """
-    args = build_parser().parse_args(argv)
+    args = build_parser().parse_args(attached_values(sys.argv[1:] if argv is None else list(argv)))
     args.interruption = Interruption()
     args.renderer = renderer
     # Ctrl-C too: CasADi turns a KeyboardInterrupt raised inside IPOPT into a failed solve, and the
@@ -434,7 +435,7 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         print("slewbench: interrupted; results not written or marked incomplete in the output manifest",
               file=sys.stderr)
         return EXIT_INTERNAL
-    except Exception:
+    except Exception:  # noqa: BLE001 (the last resort: any bug is reported as one, with its traceback)
         traceback.print_exc()
         print("slewbench: internal error (this is a bug; please report it with the scenario file)", file=sys.stderr)
         return EXIT_INTERNAL

@@ -1,14 +1,15 @@
-"""The exit statuses of the ``slewbench`` command line, one set for every command, and the check of
-the directory arguments every command shares.
+"""The exit statuses of the ``slewbench`` command line, one set for every command, and the argument
+handling every command shares (directory arguments, values that start with a minus sign).
 
 May import: nothing of slewbench.
 """
 from __future__ import annotations
 
 import argparse
+import re
 
 __all__ = ["EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_NOT_OK", "EXIT_OK",
-           "directory_argument"]
+           "attached_values", "directory_argument"]
 
 EXIT_OK = 0
 """The command completed (a run's failed and violated rows included: they are results), unless
@@ -49,3 +50,35 @@ def directory_argument(text: str) -> str:
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path: give the output directory")
     return text
+
+
+_NUMBERS = re.compile(r"-\.?\d[\d.eE+\-]*(,[\d.eE+\-]*)*")
+"""A number or comma-separated list of numbers whose first one is negative."""
+
+
+def attached_values(argv: list[str]) -> list[str]:
+    """The arguments with an option's value that starts with a minus sign attached to it.
+
+    ``argparse`` reads ``--angles -10,90`` as two options (it takes a lone negative number such as
+    ``-10`` as a value, not a list), and stops with "expected one argument" instead of checking
+    the value. Such a value becomes ``--angles=-10,90``, which the option then checks.
+
+    Parameters
+    ----------
+    argv : list of str
+        The arguments, without the program name.
+
+    Returns
+    -------
+    list of str
+        The same arguments, each long option (``--name`` without ``=``) followed by a number or a
+        comma-separated list of numbers that starts with a minus sign joined to it by ``=``.
+    """
+    out: list[str] = []
+    for argument in argv:
+        if (out and out[-1].startswith("--") and "=" not in out[-1] and len(out[-1]) > 2
+                and _NUMBERS.fullmatch(argument)):
+            out[-1] = f"{out[-1]}={argument}"
+        else:
+            out.append(argument)
+    return out
