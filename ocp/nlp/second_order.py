@@ -61,6 +61,7 @@ from __future__ import annotations
 import contextlib
 import io
 import sys
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -102,6 +103,8 @@ with ``GUARD = 100`` (ten times the margin asked)."""
 
 ZERO_PIVOT_WARNING = "LDL factorization has zeros in D"
 """CasADi's ``ldl`` warning on a zero pivot, which the check reports in its message instead."""
+_STDERR_LOCK = threading.Lock()
+"""Held while ``sys.stderr`` is swapped: two threads swapping it at once could leave it swapped."""
 
 GUARD = 10.0
 """The estimated backward error of the factorisation, times ``‖K‖∞``, must be below ``δ / GUARD``
@@ -279,7 +282,7 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
         # rank() and neig() read this factorisation; a zero pivot is reported here, so CasADi's
         # warning about it (written through Python's sys.stderr) is held back, anything else passed on
         held = io.StringIO()
-        with contextlib.redirect_stderr(held):
+        with _STDERR_LOCK, contextlib.redirect_stderr(held):  # sys.stderr is the process's: one thread at a time
             solver.nfact(values)
             rank = int(solver.rank(values))
         other = [line for line in held.getvalue().splitlines() if ZERO_PIVOT_WARNING not in line]
