@@ -145,13 +145,32 @@ not available (no HSL, no MKL build). The issue's route, condensing and a Riccat
 controls: the 3 Radau points' torques, the 21 collocation states eliminated; box bounds on the
 controls) in 9 interior-point iterations and 1.9 ms (its own ``t_proc_solver``; the call with
 its conversions 5-40x that from dense NumPy inputs: pass sparse ``DM``, and ``ca.sparsify`` the
-patterns, or its layout check fails). A lifted SQP (exact Hessian, the interval's collocation
-states condensed per interval, that QP per iteration) from the coarse optimum would cost about
-2.5-3.5 ms per iteration against IPOPT's 5.7 ms on the full mesh; at IPOPT's 7 iterations the full
-mesh would take about 20 instead of 40 ms, the plan about 100 instead of 120 ms on B&W (1.8-1.9x
-acados). Reaching 1.0x asks the coarse multistart (63 IPOPT iterations at 1 ms, two starts) to
-shrink as much, i.e. the same SQP, robust from the eigenaxis saddle, on the coarse mesh too, at
-about 0.2-0.3 ms per iteration: compiled code, not a loop in Python. Not built.
+patterns, or its layout check fails).
+
+That route, measured (a scratch prototype, 2026-12-02, not landed): a lifted SQP on the 50-interval
+mesh from the coarse optimum and its multipliers (the interval's 21 collocation states eliminated
+through the linearised collocation equations, NumPy's batched solves; the exact Hessian of the
+Lagrangian condensed onto stages of 8 states, T among them, and 9 controls; HPIPM through
+``casadi.conic``, its ``speed`` mode; the collocation multipliers recovered from stationarity in the
+eliminated variables). Every stage's condensed Hessian is indefinite (least eigenvalues -0.033 to
+-0.036 on B&W; HPIPM fails and the SQP diverges on them as they are), so each 17x17 block is
+projected onto eigenvalues of at least 1e-8 (1e-4 takes 12 iterations; a shift of 0.05 I, 40 and
+T still 3.2440). Then full steps reach IPOPT's optimum in 3 iterations on B&W (T 3.2431108304,
++3.6e-9 relative: IPOPT's point violates its constraints by 9.6e-9) and 4 on the full inertia
+(+4.4e-9), and the planner's certificate on the SQP's point and recovered multipliers says strict
+local minimum, switching functions as IPOPT's (99.1 % and 97.6 %). HPIPM's default ``robust`` mode
+stops at T 3.2431112 (1.3e-7 worse) with stationarity stuck at 1.2e-9: a landing needs the full
+NLP's KKT test. Its cost per SQP iteration (CPU, 21 alternating rounds, load 3-5, medians): the
+HPIPM call 5.1-5.5 ms (2.8-3.6 ms of it HPIPM itself, 9-12 interior-point iterations, 70 % in
+BLASFEO's generic 4x4 kernels), the condensing 2.0-2.3 ms, the eigenvalue projection 1.7-1.8 ms,
+the derivatives 0.4 ms, the rest 0.7 ms. The solve took 0.65x [0.53..0.85] and 0.70x
+[0.54..0.85] IPOPT's on B&W (29-33 against 42-51 ms) and 0.98x [0.69..1.46] on the full inertia:
+about 0.9x of the plan on B&W, nothing on the full inertia. With the condensing and projection
+compiled (about 4-5 ms per iteration) the B&W plan would still be about 75 ms, about 1.45x acados
+on a quiet host: the two coarse starts that must agree (about 45 ms), the certificate (10 ms) and
+Python stay. CasADi's ``qrqp`` and OSQP on the same QPs: no convergence in 1000 and 100000
+iterations; the condensing in CasADi SX: 8.7-11 ms per mapped call interpreted, 1.45 ms compiled
+after a 38 s gcc build.
 """
 from __future__ import annotations
 
