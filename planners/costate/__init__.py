@@ -5,7 +5,8 @@ systems' common contract and the rigid body's (:mod:`~planners.costate.hamiltoni
 problem forms of sections 3 and 6 (:mod:`~planners.costate.systems`).
 
 May import: :mod:`ocp` and the contract modules of :mod:`planners` (``base``, ``problem``,
-``reference``) and :mod:`planners.eigenaxis` (its cold-start guess).
+``reference``), :mod:`planners.eigenaxis` (the cold start from rest) and :mod:`planners.torque_free`
+(the cold start from a spin).
 """
 from planners.costate.hamiltonian import HamiltonianSystem, RigidBodySystem
 from planners.costate.systems import (

@@ -89,6 +89,8 @@ class HamiltonianSystem(ABC):
     * :meth:`sample` turns ``y`` at times ``t`` into a :class:`ReferenceSample`.
     * Forms whose control is a torque (``torque_control``) also give :meth:`feedback_torque`, the
       optimal control as a function of an estimated co-state (Vepa eq. 42).
+    * :meth:`fallback` may give the same problem with another cold start, solved when this one's
+      continuation fails.
 
     Parameters
     ----------
@@ -105,6 +107,18 @@ class HamiltonianSystem(ABC):
     continued = True
     """Solved by continuation in the target (a fixed-time steering form is not: it is singular for
     the nearby targets it can reach early, and its guess is already in the right basin)."""
+    cold_start = "own"
+    """What the cold start of :meth:`guess` is, for the reference's message and statistics."""
+
+    def fallback(self) -> HamiltonianSystem | None:
+        """The same problem with another cold start and continuation, tried when this one fails.
+
+        Returns
+        -------
+        HamiltonianSystem or None
+            A system whose :meth:`boundary` at fraction 1 is this one's; ``None`` (default): none.
+        """
+        return None
 
     def free_boundary(self) -> frozenset[str]:
         """Boundary conditions of the problem this form leaves free or only penalises.

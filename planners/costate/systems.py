@@ -19,14 +19,32 @@ from planners.costate.hamiltonian import (
 )
 from planners.problem import Array, ManeuverProblem
 from planners.reference import ReferenceSample, inverse_dynamics_torque
+from planners.torque_free import TorqueFreeMotion
 
-__all__ = ["AttitudeAcquisitionSystem", "MinimumEnergySystem", "RateAcquisitionSystem"]
+__all__ = ["SPIN_MESH_ANGLE", "AttitudeAcquisitionSystem", "MinimumEnergySystem", "RateAcquisitionSystem"]
+
+SPIN_MESH_ANGLE = 0.1
+"""rad: the coarsest mesh of a spinning cold start, one interval per this angle turned. On the spin
+re-pointing problem (40 rad in 200 s) the stages at tolerance 1e-5 end on 700 to 1200 nodes; from
+60 nodes (the default) solve_bvp cannot add them within a stage's limit."""
 
 class MinimumEnergySystem(RigidBodySystem):
     """``min ½∫‖M_c‖² dt``, ``u = M_c = −I⁻¹ λ_ω``; ``x(0)``, ``q(t_f) = q_f`` and ``ω(t_f) = ω_f``
     fixed (``λ_ω(t_f) = 0`` when the final rate is free). Only three attitude conditions are
     independent (``q`` stays unit), so the gauge ``λ_q(t_f)·q(t_f) = 0`` closes the set.
-    Continuation moves the target along the slerp from ``q0``.
+
+    Two cold starts (``coast``), each with its continuation of the target:
+
+    * the eigenaxis slew (default): the target moves along the slerp from ``q0``;
+    * the torque-free coast from ``x(0)``, for a spinning start (``ω0 ≠ 0``), with zero co-states:
+      the exact solution (without environment torques) for the target it ends at, ``(q_c(T),
+      ω_c(T))``, from which the target attitude moves along the slerp (and a fixed final rate
+      along the line). It is the :meth:`fallback` of the eigenaxis start from a spin, whose
+      rest-to-rest guess can fail at the first stage (the spin re-pointing benchmark: ω0 = 0.2
+      rad/s for 200 s); a continuation of ``ω0`` from zero meets turning points of the solution
+      path there instead. The eigenaxis start stays first: where both solve they can reach
+      different extremals (a 0.1 rad/s spin brought to rest in 120 s: 0.0201 from the eigenaxis
+      start, as collocation, 0.0682 from the coast).
 
     Parameters
     ----------
@@ -34,9 +52,34 @@ class MinimumEnergySystem(RigidBodySystem):
         The manoeuvre; it needs a target attitude.
     t_f : float
         The manoeuvre time T [s].
+    coast : bool, optional
+        Start from the torque-free coast (default ``False``: the eigenaxis slew); ``ValueError``
+        from rest, where the coast is rest.
     """
 
     free_final_time = False
+
+    def __init__(self, problem: ManeuverProblem, t_f: float, coast: bool = False) -> None:
+        super().__init__(problem, t_f)
+        spinning = bool(np.any(problem.omega0 != 0))
+        if coast and not spinning:
+            raise ValueError("the torque-free coast is a cold start from a spin; maneuver.initial.omega is zero")
+        self.coast = TorqueFreeMotion(problem.q0, problem.omega0, self.inertia, 0.0) if coast else None
+        """The torque-free motion from ``x(0)`` of the coast start; ``None`` for the eigenaxis start."""
+        self.cold_start = "torque-free coast" if coast else "eigenaxis slew"
+
+    def fallback(self) -> MinimumEnergySystem | None:
+        """The coast start, for the eigenaxis start from a spin.
+
+        Returns
+        -------
+        MinimumEnergySystem or None
+            The problem with the torque-free coast as its cold start when this one starts from the
+            eigenaxis slew and ``ω0 ≠ 0``; otherwise ``None``.
+        """
+        if self.coast is not None or not np.any(self.problem.omega0 != 0):
+            return None
+        return MinimumEnergySystem(self.problem, self.t_f_fixed, coast=True)
 
     def torque(self, u: Any) -> Any:
         return u
@@ -50,25 +93,56 @@ class MinimumEnergySystem(RigidBodySystem):
     def boundary(self, fraction: float) -> Callable[..., Array]:
         p = self.problem
         assert p.qf is not None  # the min_energy form is built for a target attitude only
-        x0, target = p.initial_state[:7], quat.slerp(p.q0, p.qf, fraction)
+        x0, final_rate = p.initial_state[:7], p.omegaf
+        if self.coast is None:
+            target = quat.slerp(p.q0, p.qf, fraction)
+        else:
+            q_coast, omega_coast, _ = self.coast(np.array([self.t_f_fixed]))
+            target = quat.slerp(q_coast[0], p.qf, fraction)
+            if final_rate is not None:
+                final_rate = omega_coast[0] + fraction * (final_rate - omega_coast[0])
 
         def bc(ya, yb, t_f=None):
-            final_rate = yb[4:7] - p.omegaf if p.omegaf is not None else yb[11:14]
+            rate = yb[4:7] - final_rate if final_rate is not None else yb[11:14]
             miss = quat.product(quat.conjugate(target), yb[0:4])[1:]
-            return np.concatenate([ya[0:7] - x0, miss, [yb[7:11] @ yb[0:4]], final_rate])
+            return np.concatenate([ya[0:7] - x0, miss, [yb[7:11] @ yb[0:4]], rate])
         return bc
 
     def guess(self, nodes: int, fraction: float) -> tuple[float, Array, Array]:
+        """The eigenaxis slew, or the torque-free coast (``coast``) with zero co-states on at least
+        one node per :data:`SPIN_MESH_ANGLE` of the angle it turns (the 40 rad of the spin
+        re-pointing problem need 400).
+
+        Parameters
+        ----------
+        nodes : int
+            The least number of mesh points.
+        fraction : float
+            Continuation fraction in (0, 1] (the coast does not depend on it).
+
+        Returns
+        -------
+        t_f : float
+            T [s].
+        s : (m,) ndarray
+            Scaled mesh on [0, 1], ``m >= nodes``.
+        y : (14, m) ndarray
+            States and co-states on the mesh.
+        """
+        T = self.t_f_fixed
+        if self.coast is not None:
+            s = np.linspace(0.0, 1.0, nodes)
+            turned = float(np.trapezoid(np.linalg.norm(self.coast(s * T)[1], axis=1), s * T))
+            s = np.linspace(0.0, 1.0, max(nodes, int(np.ceil(turned / SPIN_MESH_ANGLE)) + 1))
+            q, omega, _ = self.coast(s * T)
+            return T, s, np.vstack([q.T, omega.T, np.zeros((7, s.size))])
         from planners.eigenaxis import EigenaxisPlanner
 
-        T = self.t_f_fixed
         s = np.linspace(0.0, 1.0, nodes)
         sample = EigenaxisPlanner().plan(self.problem).sample(s * T)
         x = np.vstack([sample.q.T, sample.omega.T])
         gravity = self.environment_torque(s * T, x)
         return T, s, np.vstack([x, np.zeros((4, nodes)), -self.inertia @ (sample.torque.T - gravity)])
-
-
 
 
 class RateAcquisitionSystem(RigidBodySystem):

@@ -12,8 +12,8 @@ Problem forms (``objective``; the Hamiltonian systems are in :mod:`planners.cost
 The steering forms solve for the minimum time (``final_time: minimum``, default) or, with
 ``final_time: fixed``, minimise the paper's terminal cost at ``t_f = T`` with its transversality
 conditions (eq. 36-38, 51). Gravity gradient enters whenever the scenario has it (eq. 5-8, orbit
-frame from the scenario's orbit). A cold start (eigenaxis slew or straight-line rates) is walked to
-the target by continuation, each solve seeding the next, and the target's solution is refined once
+frame from the scenario's orbit). A cold start (eigenaxis slew, the torque-free coast of a spinning
+start, or straight-line rates) is walked to the target by continuation, each solve seeding the next, and the target's solution is refined once
 to the final tolerance, in co-states scaled to order one for ``solve_bvp`` (:func:`solve`). Torque
 bounds are not imposed.
 """
@@ -235,8 +235,10 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
 
     The continuation stages use the tolerance ``max(tolerance, LOOSE_TOLERANCE)``. A failed stage
     is retried with half the step; a successful one lengthens the next by half. Each solution is
-    resampled on ``nodes`` points before it seeds the next stage (``solve_bvp`` only ever adds
-    nodes); stages short of the target have at most ``min(max_nodes, 10 nodes)`` nodes. Once the
+    resampled on ``m`` points before it seeds the next stage (``solve_bvp`` only ever adds nodes),
+    ``m = nodes`` unless the cold start (``guess`` or the system's) has more points, whose number
+    it then is (a spinning start's mesh, :meth:`~planners.costate.systems.MinimumEnergySystem.guess`); stages short of the
+    target have at most ``min(max_nodes, max(10 nodes, 3 m))`` nodes. Once the
     target is solved, one ``solve_bvp`` call refines that solution, on its mesh, to ``tolerance``
     with at most ``max_nodes`` nodes. A failed refinement ends the solve: the continuation has
     done its work, and a smaller step would only reach the same target and refine it again. Every
@@ -247,7 +249,7 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
     system : HamiltonianSystem
         The problem form.
     nodes : int
-        Mesh points each stage starts from.
+        Mesh points each stage starts from (at least; see above).
     steps : int
         The first continuation step is ``1/steps`` (a form that is not ``continued`` solves the
         target at once).
@@ -275,15 +277,19 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
     free = system.free_final_time
     loose = max(tolerance, LOOSE_TOLERANCE)
     done, step, stages, start, solution, t_f = 0.0, 1.0 / steps if system.continued else 1.0, 0, guess, None, 0.0
+    mesh_size = nodes if guess is None else max(nodes, guess[1].size)
     while done < 1.0:
         fraction = min(1.0, done + step)
         stage_start = start if start is not None else system.guess(nodes, fraction)
-        trial = _solve_stage(system, fraction, stage_start, loose, max_nodes if fraction == 1.0 else min(max_nodes, 10 * nodes))
+        if solution is None:  # a cold start finer than nodes (a spinning start) sets the mesh
+            mesh_size = max(nodes, stage_start[1].size)
+        limit = max_nodes if fraction == 1.0 else min(max_nodes, max(10 * nodes, 3 * mesh_size))
+        trial = _solve_stage(system, fraction, stage_start, loose, limit)
         stages += 1
         if _solved(trial, free):
             solution, done, step = trial, fraction, 1.5 * step
             t_f = float(trial.p[0]) if free else stage_start[0]
-            mesh = np.linspace(0.0, 1.0, nodes)
+            mesh = np.linspace(0.0, 1.0, mesh_size)
             start = (t_f, mesh, trial.sol(mesh))
             continue
         step /= 2
@@ -348,7 +354,9 @@ class CostateTPBVPPlanner(Planner):
             ``solve_bvp`` residual tolerance of the final stage, in (0, 1) (default 1e-8).
         max_nodes : int
             ``solve_bvp`` node limit of the final stage, 10 to 100000 and at least ``nodes``
-            (default 5000).
+            (default 20000: the spin re-pointing benchmark's refinement to 1e-8 ends on about 7500
+            nodes, its fast rotation needing a fine mesh everywhere; the rest-to-rest suite
+            problems end below 5000, so the limit does not change them).
         """
 
         objective: Literal["min_energy", "rate_acquisition", "attitude_acquisition"] = "min_energy"
@@ -360,7 +368,7 @@ class CostateTPBVPPlanner(Planner):
         continuation_steps: Annotated[int, Range(ge=1, le=100)] = 3                              # first step 1/continuation_steps, then adaptive
         nodes: Annotated[int, Range(ge=5, le=5000)] = 60                                          # mesh each stage starts from
         tolerance: Annotated[float, Range(gt=0.0, lt=1.0)] = 1e-8                                  # solve_bvp residual tolerance
-        max_nodes: Annotated[int, Range(ge=10, le=100000)] = 5000
+        max_nodes: Annotated[int, Range(ge=10, le=100000)] = 20000
 
         def __post_init__(self) -> None:
             if self.max_nodes < self.nodes:
@@ -392,10 +400,17 @@ class CostateTPBVPPlanner(Planner):
         if not isinstance(system, HamiltonianSystem):
             return FailedReference(self.name, str(system))
         solution, t_f, stages, failure = solve(system, o.nodes, o.continuation_steps, o.tolerance, o.max_nodes)
+        fallback, first = (system.fallback() if failure else None), system.cold_start
+        if fallback is not None:  # the same problem from another cold start
+            solution, t_f, more, second = solve(fallback, o.nodes, o.continuation_steps, o.tolerance, o.max_nodes)
+            failure = None if second is None else f"from the {first}: {failure}; from the {fallback.cold_start}: {second}"
+            stages, system = stages + more, fallback
         if failure or solution is None or t_f is None:
             return FailedReference(self.name, f"{o.objective}: {failure}")
         stats = {"objective_form": o.objective, "t_f": t_f, "nodes": int(solution.x.size),
                  "max_rms_residual": float(np.max(solution.rms_residuals)), "continuation_stages": stages}
+        if fallback is not None:
+            stats["cold_start"] = fallback.cold_start
         if system.torque_control and isinstance(system, RigidBodySystem):
             fine = np.linspace(0.0, t_f, 4001)
             reference = CostateReference(system, solution, t_f, "", {})
@@ -410,6 +425,7 @@ class CostateTPBVPPlanner(Planner):
         timing = "minimum time" if system.free_final_time else "fixed time"
         reference.message = (f"{o.objective} ({timing}) t_f = {t_f:.6g} s"
                              + (f", ∫‖M_c‖² = {stats['int_u2']:.6g}" if "int_u2" in stats else "")
-                             + f" on {solution.x.size} nodes (solve_bvp)")
+                             + f" on {solution.x.size} nodes (solve_bvp"
+                             + (f", from the {system.cold_start}: the {first} failed)" if fallback else ")"))
         return reference
 
