@@ -103,6 +103,22 @@ def test_a_user_file_named_like_a_result_is_never_overwritten(tmp_path, capsys):
     assert (out / "results.json").read_text() == "user data"
 
 
+def test_a_user_file_among_the_files_a_run_would_write_is_refused_before_planning(tmp_path, capsys):
+    # a figure the earlier run (no plots) did not write, whose name the user then took
+    path = scenario(tmp_path)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    capsys.readouterr()
+    (out / "smooth.png").write_text("user figure")
+    assert main(["run", str(path), "--out", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert "[1/" not in captured.out and "rows:" not in captured.out  # nothing was planned, no table printed
+    assert "smooth.png" in captured.err and "did not write" in captured.err
+    assert (out / "smooth.png").read_text() == "user figure"
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0  # a run that does not write it goes on
+    assert (out / "smooth.png").read_text() == "user figure"
+
+
 def test_an_empty_directory_is_claimed_and_stale_results_are_removed(tmp_path):
     out = tmp_path / "out"
     out.mkdir()

@@ -40,7 +40,7 @@ from scenarios.output.directory import (
 from scenarios.output.export import EXPORT_FORMATS, default_export_directory, export_run
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
-from scenarios.output.writer import plot_streamer
+from scenarios.output.writer import plot_streamer, run_files
 from scenarios.runner import run
 from scenarios.schema.labels import row_labels
 from scenarios.schema.loader import OTHER_FILES, load, parse_scenario
@@ -188,7 +188,8 @@ def command_run(args: argparse.Namespace) -> int:
     exports = getattr(args, "export", None) or []
     for name in exports:  # before planning: an export the run cannot give is refused first
         _check_run_export(name, scenario.epoch)
-    claim_output_directory(out)  # before planning: a long run is never lost at the end
+    # before planning: a long run is never lost at the end (a user's file among the run's is refused now)
+    claim_output_directory(out, expected=run_files(scenario, plots=not args.no_plots))
     for name in exports:
         claim_output_directory(default_export_directory(out, name), kind="export")
     start = time.perf_counter()

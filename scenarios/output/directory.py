@@ -240,7 +240,7 @@ def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: 
     os.replace(temporary, directory / MARKER)
 
 
-def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
+def claim_output_directory(path: str | Path, kind: str = "run", expected: Iterable[str] = ()) -> Path:
     """Make ``path`` a slewbench output directory, or refuse without touching anything.
 
     Accepted: a path that does not exist (it is created, with missing parents, and marked), an
@@ -254,6 +254,10 @@ def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
         The output directory.
     kind : str, optional
         What writes there (``"run"``, ``"sweep"``, ``"codegen"``), recorded in the manifest.
+    expected : iterable of str, optional
+        Files (relative paths) the command may write: one that exists in a marked directory
+        without its manifest listing it (a user's file) is refused now, before the command's
+        work, rather than at its commit (:func:`commit_outputs`).
 
     Returns
     -------
@@ -264,7 +268,8 @@ def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
     ------
     OutputError
         For a regular file, a non-empty directory without the marker, a parent that is a file,
-        a name too long for the file system, or a location that cannot be written.
+        a name too long for the file system, a location that cannot be written, or an
+        ``expected`` file that slewbench did not write.
     """
     directory = Path(path).expanduser().absolute()
     try:
@@ -283,6 +288,13 @@ def claim_output_directory(path: str | Path, kind: str = "run") -> Path:
                                         "into a directory of its own, nothing was touched")
             if manifest is not None:  # before running: a long run is not refused at its end
                 _refuse_changed(path, directory, manifest, "nothing was touched")
+                listed = set(manifest["files"])
+                foreign = [name for name in dict.fromkeys(expected)
+                           if name not in listed and os.path.lexists(directory / name)]
+                if foreign:
+                    shown = ", ".join(foreign[:5]) + (f" and {len(foreign) - 5} more" if len(foreign) > 5 else "")
+                    raise OutputError(path, f"holds files slewbench did not write ({shown}) that this {kind} would "
+                                            "write; nothing was touched: move them or choose another --out")
             for leftover in directory.glob(f"{STAGING_PREFIX}*"):
                 if leftover.is_dir() and not leftover.is_symlink() and _abandoned(leftover):
                     shutil.rmtree(leftover, ignore_errors=True)

@@ -23,8 +23,9 @@ from scenarios.output.tables import to_csv, to_json, to_markdown
 
 if TYPE_CHECKING:
     from scenarios.output.results import Row, RunResults
+    from scenarios.schema.loader import Scenario
 
-__all__ = ["plot_streamer", "write_results", "write_timeseries"]
+__all__ = ["plot_streamer", "run_files", "write_results", "write_timeseries"]
 
 
 def write_timeseries(row: Row, path: Path) -> None:
@@ -146,6 +147,37 @@ def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer:
     from scenarios.output.plots import draw_jobs
 
     draw_jobs(plot_jobs(results, stems), staging)
+
+
+def run_files(scenario: Scenario, plots: bool = True) -> list[str]:
+    """The files a run of ``scenario`` may write (:func:`write_results`), known before it plans:
+    what :func:`~scenarios.output.directory.claim_output_directory` checks up front.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario about to run (its rows' labels give the file stems).
+    plots : bool, optional
+        With the PNG figures and ``report.html``.
+
+    Returns
+    -------
+    list of str
+        Relative paths: the tables, a time series per row and, with ``plots``, a figure per row,
+        ``margins.png``, ``sky.png``, ``comparison.png`` and ``report.html`` (a superset: a row
+        without a simulation has no time series or figure, a run without pointing requirements
+        no margins or sky figure).
+    """
+    from scenarios.output.plot_data import COMPARISON_FILE, MARGINS_FILE, SKY_FILE
+    from scenarios.schema.labels import row_labels
+
+    labels = [label for label, _, _ in row_labels([spec.label for spec in scenario.planners],
+                                                  [spec.label for spec in scenario.controllers])]
+    stems = row_stems(labels)
+    files = ["results.json", "results.csv", "results.md", *(f"timeseries/{stem}.csv" for stem in stems)]
+    if plots:
+        files += [*(f"{stem}.png" for stem in stems), MARGINS_FILE, SKY_FILE, COMPARISON_FILE, "report.html"]
+    return files
 
 
 def write_results(results: RunResults, directory: str | Path, plots: bool = True, renderer: Any = None) -> Path:
