@@ -155,6 +155,20 @@ def test_run_refuses_a_study_or_table_file_and_names_the_command(tmp_path, capsy
     assert "valid slew table 'eigenaxis-demo': " in capsys.readouterr().out
 
 
+def test_a_study_without_its_study_key_is_named_as_such_not_as_a_scenario_missing_name(tmp_path, capsys):
+    # read as a scenario it said only "name: required key is missing", without the file
+    lost = tmp_path / "lost.yaml"
+    lost.write_text(yaml.safe_dump({"scenario": str(DEMO), "grid": {"simulation.sample_time": [0.5, 1.0]}}))
+    for argv in (["run", str(lost), "--out", str(tmp_path / "out")], ["validate", str(lost)]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert f"{lost} is not a scenario" in err and "`study: NAME`" in err and "slewbench sweep" in err, err
+        assert "name: required key is missing" not in err
+    assert main(["sweep", str(lost), "--out", str(tmp_path / "out")]) == 2
+    assert capsys.readouterr().err.startswith(f"slewbench: error in study file: {lost}: study: required key")
+    assert not (tmp_path / "out").exists()
+
+
 # --- the compact table ------------------------------------------------------------------------------
 
 def none_metrics() -> dict:

@@ -116,7 +116,7 @@ def check(mutation, folder):
     assert status in (0, 2), (mutation, status, error)
     assert sorted(p.name for p in folder.iterdir()) in (["study.yaml"], ["out", "study.yaml"]), mutation
     if status == 2:
-        assert error.startswith(("slewbench: error in scenario: ", "slewbench: output error: ")), (mutation, error)
+        assert error.startswith(("slewbench: error in study file: ", "slewbench: output error: ")), (mutation, error)
         named = error.split(": ", 2)[-1]
         assert ": " in named or "study file" in named or "given a study" in named, (mutation, error)
         assert len(error) < 3000 and not out.exists(), (mutation, error)

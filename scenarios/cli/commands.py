@@ -43,7 +43,7 @@ from scenarios.output.provenance import package_version
 from scenarios.output.writer import plot_streamer, run_files
 from scenarios.runner import run
 from scenarios.schema.labels import row_labels
-from scenarios.schema.loader import OTHER_FILES, load, parse_scenario
+from scenarios.schema.loader import OTHER_FILES, load, parse_scenario, refuse_unmarked_base
 from scenarios.schema.read import read_yaml
 
 
@@ -133,6 +133,9 @@ def _validate_table(file: str) -> str:
 
 _OTHER_VALIDATORS = {"study": _validate_study, "table": _validate_table}
 """How ``validate`` checks each kind of ``scenarios.schema.loader.OTHER_FILES`` (keyed the same)."""
+_COMMAND_FILES = {"sweep": "study file"}
+"""What a command's file is called in its errors (``error in <kind>:``) where it is not a scenario;
+``validate`` sets ``file_kind`` on its arguments once it knows."""
 
 
 def command_validate(args: argparse.Namespace) -> int:
@@ -155,8 +158,10 @@ def command_validate(args: argparse.Namespace) -> int:
     data = read_yaml(args.file)
     for key in OTHER_FILES:  # a study or a slew table: its own check and summary
         if isinstance(data, dict) and key in data:
+            args.file_kind = f"{key} file"  # how main() names its errors
             print(_OTHER_VALIDATORS[key](args.file))
             return EXIT_OK
+    refuse_unmarked_base(data, args.file)
     scenario = parse_scenario(data, Path(args.file))
     labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in scenario.controllers])
     controllers = ", ".join(repr(c.name) for c in scenario.controllers)
@@ -420,8 +425,9 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     try:
         return args.handler(args)
     except ScenarioError as error:
-        # a command-line option's error is named as such, not as the scenario's
-        kind = "option" if error.path.startswith("--") else "scenario"
+        # a command-line option's error is named as such, not as the scenario's; a study's as the study's
+        kind = "option" if error.path.startswith("--") else getattr(args, "file_kind", None) or \
+            _COMMAND_FILES.get(args.command, "scenario")
         print(f"slewbench: error in {kind}: {error}", file=sys.stderr)
         return EXIT_BAD_SCENARIO
     except OutputError as error:

@@ -622,8 +622,34 @@ def load(path: str | Path) -> Scenario:
             if key in data:
                 raise ScenarioError(key, f"{path} is a {key} file, not a scenario: run it with "
                                          f"`slewbench {command} {path}`")
+    refuse_unmarked_base(data, path)
     return parse_scenario(data, Path(path))
 
 
 OTHER_FILES = {"study": "sweep", "table": "table"}
 """The top-level key of a file that is not a scenario, and the command that reads it."""
+BASE_KEY = "scenario"
+"""The top-level key of a study file that holds (or names) its base scenario; no scenario has it."""
+
+
+def refuse_unmarked_base(data: Any, path: str | Path) -> None:
+    """Refuse a file with a base scenario (:data:`BASE_KEY`) but none of :data:`OTHER_FILES`'s keys:
+    a study that lost its ``study:`` line, which read as a scenario would only say that ``name``
+    is missing.
+
+    Parameters
+    ----------
+    data : Any
+        The file's YAML data.
+    path : str or Path
+        The file, named in the message.
+
+    Raises
+    ------
+    ScenarioError
+        At the top level, naming what a study file needs and the command that runs it.
+    """
+    if isinstance(data, dict) and BASE_KEY in data and not any(key in data for key in OTHER_FILES):
+        raise ScenarioError("", f"{path} is not a scenario (no scenario has a top-level `{BASE_KEY}:` key); a study "
+                                f"file has one and `study: NAME` too, which this one lacks (studies run with "
+                                f"`slewbench {OTHER_FILES['study']}`)")
