@@ -59,6 +59,27 @@ class CostateCarrier(Protocol):
         ...
 
 
+def minimises_time(planner: type, options: Any) -> bool:
+    """Whether a planner chooses its references' duration by minimising time (a free final time),
+    rather than planning over the scenario's ``T`` or a duration of its own that it does not
+    minimise.
+
+    Parameters
+    ----------
+    planner : type
+        A planner class; it says so through a class method ``minimises_time(options)``.
+    options : object
+        The planner's parsed ``Options``.
+
+    Returns
+    -------
+    bool
+        ``True`` when it does (``False`` for planners without the class method).
+    """
+    check = getattr(planner, "minimises_time", None)
+    return bool(check(options)) if callable(check) else False
+
+
 def offers_costates(planner: type, options: Any) -> bool:
     """Whether a planner returns :class:`CostateCarrier` references whose control is a torque.
 

@@ -14,7 +14,7 @@ acceleration ``α`` is chosen with the coast rate ``w`` such that every axis res
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Callable, Literal
+from typing import Annotated, Any, Callable, Literal
 
 import casadi as ca
 import numpy as np
@@ -290,6 +290,22 @@ class EigenaxisPlanner(Planner):
     example_options = ({"profile": "smooth"}, {"profile": "trapezoidal"}, {"profile": "min_time"})
     closed_form = True
     cheap = True
+
+    @classmethod
+    def minimises_time(cls, options: Any) -> bool:
+        """Whether the duration is minimised (:func:`planners.capabilities.minimises_time`).
+
+        Parameters
+        ----------
+        options : Options or any
+            The planner's options.
+
+        Returns
+        -------
+        bool
+            True for the ``min_time`` profile (the fastest bang-coast-bang about the eigenaxis).
+        """
+        return getattr(options, "profile", None) == "min_time"
 
     @dataclass(frozen=True)
     class Options:

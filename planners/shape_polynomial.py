@@ -213,6 +213,23 @@ class ShapePolynomialPlanner(Planner):
     name = "shape_polynomial"
     example_options = ({"terms": 2}, {"terms": 2, "duration": "scenario", "cost": "torque"})
 
+    @classmethod
+    def minimises_time(cls, options: Any) -> bool:
+        """Whether the duration is minimised (:func:`planners.capabilities.minimises_time`).
+
+        Parameters
+        ----------
+        options : Options or any
+            The planner's options.
+
+        Returns
+        -------
+        bool
+            True with ``duration: rate_limit`` (the shortest ``t_f`` within the rate bound, over the
+            shapes tried); the paper's minimum-time choice within its polynomial family.
+        """
+        return getattr(options, "duration", None) == "rate_limit"
+
     @dataclass(frozen=True)
     class Options:
         """Options of ``shape_polynomial`` (YAML ``planner.options``).

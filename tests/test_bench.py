@@ -242,7 +242,42 @@ def test_a_failed_row_has_no_other_problem_note():
     scenario = load(problem.file)
     failed = FailedReference("costate_tpbvp", "solve_bvp failed")
     assert failed.duration == 0.0  # a failed plan's duration: not "its own duration" of another problem
-    assert _other_problem(problem, scenario, failed, None) == ""
+    assert _other_problem(problem, scenario, failed, None, False) == ""
+
+
+@pytest.mark.parametrize("name, options, expected", [
+    ("collocation", {"objective": "min_time"}, True),
+    ("collocation", {"objective": "weighted", "time_weight": 1.0, "energy_weight": 1.0}, True),
+    ("collocation", {}, False),  # minimum energy over the scenario's T
+    ("eigenaxis", {"profile": "min_time"}, True),
+    ("eigenaxis", {}, False),
+    ("costate_tpbvp", {"objective": "rate_acquisition"}, True),
+    ("costate_tpbvp", {"objective": "rate_acquisition", "final_time": "fixed"}, False),
+    ("costate_tpbvp", {}, False),
+    ("shape_polynomial", {}, True),  # duration: rate_limit, the shortest t_f within the rate bound
+    ("shape_polynomial", {"duration": "scenario"}, False),
+    ("spin_extremal", {}, False),  # no class method: does not minimise time
+])
+def test_which_planners_minimise_time(name, options, expected):
+    from planners.capabilities import minimises_time
+    planner = PLANNERS[name](options)
+    assert minimises_time(type(planner), planner.options) is expected
+
+
+def test_a_minimum_time_gap_is_for_planners_that_minimise_time_whatever_their_duration():
+    # the rule read the duration before: a minimum-time plan ending exactly at the bound lost its
+    # gap, and a plan of its own duration that minimises nothing kept one
+    from types import SimpleNamespace
+
+    from scenarios.bench.leaderboard import _other_problem
+    problem = load_suite().problems["bilimoria_wie_180"]
+    scenario = load(problem.file)
+    bound = scenario.problem.duration
+    at_bound, own = SimpleNamespace(duration=bound, ok=True), SimpleNamespace(duration=4.0, ok=True)
+    assert _other_problem(problem, scenario, at_bound, None, True) == ""
+    assert _other_problem(problem, scenario, own, None, True) == ""
+    assert "a fixed-time plan" in _other_problem(problem, scenario, at_bound, None, False)
+    assert "without minimising it" in _other_problem(problem, scenario, own, None, False)
 
 
 def test_bench_never_touches_what_slewbench_did_not_write(tmp_path, capsys):

@@ -22,7 +22,7 @@ option).
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 
@@ -281,6 +281,23 @@ class CollocationPlanner(Planner):
 
     class Options(CollocationOptions):
         __doc__ = CollocationOptions.__doc__
+
+    @classmethod
+    def minimises_time(cls, options: Any) -> bool:
+        """Whether the final time is free and minimised (:func:`planners.capabilities.minimises_time`).
+
+        Parameters
+        ----------
+        options : Options or any
+            The planner's options.
+
+        Returns
+        -------
+        bool
+            True for ``min_time`` and for ``weighted`` with a positive ``time_weight``.
+        """
+        objective = getattr(options, "objective", None)
+        return objective == "min_time" or (objective == "weighted" and getattr(options, "time_weight", 0.0) > 0)
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
         error = super().problem_error(problem)

@@ -375,6 +375,23 @@ class CostateTPBVPPlanner(Planner):
                 raise InvalidOption("max_nodes", f"must be at least nodes ({self.nodes}), got {self.max_nodes}")
 
     @classmethod
+    def minimises_time(cls, options: Any) -> bool:
+        """Whether the final time is free and minimised (:func:`planners.capabilities.minimises_time`).
+
+        Parameters
+        ----------
+        options : Options or any
+            The planner's options.
+
+        Returns
+        -------
+        bool
+            True for the steering forms with ``final_time`` ``minimum`` (their default).
+        """
+        objective = getattr(options, "objective", None)
+        return objective in ("rate_acquisition", "attitude_acquisition") and getattr(options, "final_time", None) != "fixed"
+
+    @classmethod
     def offers_costates(cls, options: Any) -> bool:
         """Whether references carry co-states with a torque control (``planners.capabilities``).
 

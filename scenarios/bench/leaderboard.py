@@ -137,10 +137,18 @@ def _number(value: Any) -> int | None:
     return int(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
 
 
-def _planner_rows(problem: BenchProblem, scenario: Any, results: Any) -> list[BenchRow]:
+def _planner_rows(problem: BenchProblem, scenario: Any, results: Any, specs: list[Any]) -> list[BenchRow]:
+    from planners import PLANNERS
+    from planners.capabilities import minimises_time
+    from scenarios.schema.labels import row_labels
+
     metric = OBJECTIVE_METRICS[problem.objective][0]
+    # each row's planner spec, in the runner's row order (``specs`` is what it ran)
+    planner_of = [i for _, i, _ in row_labels([spec.label for spec in specs], [c.label for c in scenario.controllers])]
     rows = []
-    for row in results.rows:
+    for row, i in zip(results.rows, planner_of):
+        spec = specs[i] if i is not None else None
+        timed = spec is not None and minimises_time(PLANNERS[spec.name], spec.options)
         reference = row.reference
         stats = getattr(reference, "stats", None) if reference is not None else None
         value = None
@@ -151,7 +159,7 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any) -> list[Be
         if row.planner is not None and row.label == f"{row.planner} (defaults)":  # other_planners
             message = f"default options (the planner's own objective, not tuned to this problem); {message}"
         free = sorted(getattr(reference, "free_boundary", ()) or ())
-        other = _other_problem(problem, scenario, reference, row)
+        other = _other_problem(problem, scenario, reference, row, timed)
         if value is not None and other.startswith("impulse"):
             value = gap_abs = gap_rel = None
         if value is not None and free:
@@ -167,18 +175,21 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any) -> list[Be
     return rows
 
 
-def _other_problem(problem: BenchProblem, scenario: Any, reference: Any, row: Any) -> str:
-    """Why a row's value is not the problem's objective ("" when it is): a minimum-time row whose
-    duration is the scenario's bound (a fixed-time plan: the bound is not optimised, so its
-    "time" is the input), a minimum-energy row planned over another duration than the problem's,
-    or a minimum-energy row whose rate jumps (an impulse, whose energy is not finite; the sampled
-    torque misses it)."""
+def _other_problem(problem: BenchProblem, scenario: Any, reference: Any, row: Any, minimises_time: bool) -> str:
+    """Why a row's value is not the problem's objective ("" when it is): a minimum-time row from a
+    planner that does not minimise time (``minimises_time``, :func:`planners.capabilities.minimises_time`:
+    it plans over the scenario's bound or a duration of its own, so its "time" is an input), a
+    minimum-energy row planned over another duration than the problem's, or a minimum-energy row
+    whose rate jumps (an impulse, whose energy is not finite; the sampled torque misses it)."""
     duration = getattr(reference, "duration", None)
     bound = scenario.problem.duration
     if duration is None or not getattr(reference, "ok", False):  # a failed plan solved nothing
         return ""
-    if problem.objective == "min_time" and math.isclose(duration, bound, rel_tol=1e-9):
-        return (f"keeps the scenario's bound T = {bound:g} s (a fixed-time plan, not minimum time): solves "
+    if problem.objective == "min_time" and not minimises_time:
+        if math.isclose(duration, bound, rel_tol=1e-9):
+            return (f"keeps the scenario's bound T = {bound:g} s (a fixed-time plan, not minimum time): solves "
+                    "another problem, no gap")
+        return (f"plans its own duration T = {duration:.6g} s without minimising it (not minimum time): solves "
                 "another problem, no gap")
     if problem.objective == "min_energy":
         if not math.isclose(duration, bound, rel_tol=1e-9):
@@ -533,7 +544,7 @@ def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Ite
                 except Exception:  # noqa: BLE001, S110 (the timed plan below records a crash as a failed row)
                     pass
             results = run(dataclasses.replace(scenario, planners=specs))
-            rows += _planner_rows(problem, scenario, results)
+            rows += _planner_rows(problem, scenario, results, specs)
         for name, peer in loaded.items() if problem.peers else ():
             reason = peer.problem_error(scenario.problem, problem.objective)
             if reason is not None:
