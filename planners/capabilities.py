@@ -76,8 +76,7 @@ def minimises_time(planner: type, options: Any) -> bool:
     bool
         ``True`` when it does (``False`` for planners without the class method).
     """
-    check = getattr(planner, "minimises_time", None)
-    return bool(check(options)) if callable(check) else False
+    return _declared(planner, "minimises_time", options)
 
 
 def offers_costates(planner: type, options: Any) -> bool:
@@ -95,5 +94,10 @@ def offers_costates(planner: type, options: Any) -> bool:
     bool
         ``True`` when it does (``False`` for planners without the class method).
     """
-    check = getattr(planner, "offers_costates", None)
+    return _declared(planner, "offers_costates", options)
+
+
+def _declared(planner: type, capability: str, options: Any) -> bool:
+    """What the planner's class method ``capability(options)`` says; ``False`` without one."""
+    check = getattr(planner, capability, None)
     return bool(check(options)) if callable(check) else False
