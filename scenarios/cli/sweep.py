@@ -10,6 +10,7 @@ full disk). An interrupted sweep exits 130 and says how to resume.
 from __future__ import annotations
 
 import argparse
+import shlex
 import shutil
 import signal
 import sqlite3
@@ -309,10 +310,37 @@ def _list_cases(study: Study) -> None:
         print(f"  ... and {len(study.cases) - DRY_RUN_SHOWN} more")
 
 
+def resume_command(args: argparse.Namespace, out: Path) -> str:
+    """The command that resumes an interrupted sweep: the study file, ``--out``, ``--resume`` and the
+    options the user gave that change how it runs (``--workers``, ``--scheduler``, ``--no-plots``),
+    each argument quoted for a POSIX shell (a path with a space).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``sweep`` arguments.
+    out : Path
+        The sweep's directory.
+
+    Returns
+    -------
+    str
+        ``slewbench sweep FILE --out DIR --resume [--workers N] [--scheduler ADDRESS] [--no-plots]``.
+    """
+    words = ["slewbench", "sweep", str(args.file), "--out", str(out), "--resume"]
+    if args.workers is not None:
+        words += ["--workers", str(args.workers)]
+    if args.scheduler:
+        words += ["--scheduler", args.scheduler]
+    if args.no_plots:
+        words.append("--no-plots")
+    return shlex.join(words)
+
+
 def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster | None) -> int:
     from scenarios.study.engine import sweep
     from scenarios.study.report import robustness_tables
-    from scenarios.study.robustness import robustness_lines
+    from scenarios.study.robustness import crashed_counts, robustness_lines
     from scenarios.study.store import STORE_NAME, SweepStore
 
     out, store = _open(out, study)
@@ -328,33 +356,36 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
         if isinstance(stop, KeyboardInterrupt):
             with SweepStore(out, create=False) as stored:
                 stop = SweepInterrupted(len({case.key for case in study.cases} - stored.keys()), len(study.cases))
-        resume = f"slewbench sweep {args.file} --out {out} --resume"
+        resume = resume_command(args, out)
         print(f"slewbench: sweep {'stopped: ' + stop.reason if stop.reason else 'interrupted'}; {stop.missing} of "
               f"{stop.total} cases are missing (finished cases are stored in {out / STORE_NAME}). Resume with:\n"
               f"  {resume}", file=sys.stderr)
         return EXIT_INTERRUPTED
     except (sqlite3.Error, OSError) as error:  # the store could not take a case (a full disk)
         raise OutputError(out, f"the sweep store could not be written ({error}); the cases stored so far are "
-                               f"kept: free some space and resume with `slewbench sweep {args.file} --out {out} "
-                               "--resume`") from None
+                               f"kept: free some space and resume with `{resume_command(args, out)}`") from None
     finally:
         signal.signal(signal.SIGTERM, previous)
     earlier = written_files(out)
     files = results.write(out, plots=not args.no_plots)
-    crashed = sum(record["status"] == "crashed" for record in results.records.values())
-    not_ok = sum(any(r["status"] != "ok" for r in record["rows"]) for record in results.records.values())
+    records = results.records.values()
+    crashed = sum(record["status"] == "crashed" for record in records)
+    not_ok = sum(record["status"] != "crashed" and any(r["status"] != "ok" for r in record["rows"])
+                 for record in records)
     ran = len(study.cases) - done
+    others = f"{not_ok} other{' has' if not_ok == 1 else 's have'} a row not ok"  # crashed cases are not counted again
     print(f"{ran} case{'s' if ran != 1 else ''} run in {time.perf_counter() - start:.1f} s"
           + (f" ({done} already stored, {len(study.cases)} in all)" if done else "")
-          + f"; {not_ok} with a row not ok, {crashed} crashed; wrote {out}/ ({', '.join(files)})")
+          + f"; of the {len(records)} cases stored, {crashed} crashed and {others}; wrote {out}/ ({', '.join(files)})")
     _say_removed(out, earlier)
-    tables = robustness_tables(study, results.table()[1])
+    rows = results.table()[1]
+    tables = robustness_tables(study, rows)
     if tables is not None:
         proportions, _, worst = tables
         print("robustness (fraction of the completed cases, Wilson 95 % interval; robustness.csv, "
               "sensitivity.csv, worst_cases.csv):")
-        print("\n".join(robustness_lines(proportions, worst)))
-        print(f"re-run a case in full: slewbench sweep {out} --case N")
+        print("\n".join(robustness_lines(proportions, worst, crashed_counts(study, rows))))
+        print(f"re-run a case in full: slewbench sweep {shlex.quote(str(out))} --case N")
     return EXIT_OK
 
 

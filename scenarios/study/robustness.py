@@ -32,7 +32,8 @@ from scenarios.schema.study import CASE_SEED
 from scenarios.study.report import PROPORTION_STATISTICS, group_rows, proportion
 from scenarios.study.types import Study
 
-__all__ = ["EVERY_REQUIREMENT", "SENSITIVITY_STATISTICS", "WORST_COLUMNS", "criterion_text", "parameter_columns",
+__all__ = ["EVERY_REQUIREMENT", "SENSITIVITY_STATISTICS", "WORST_COLUMNS", "crashed_counts", "criterion_text",
+           "parameter_columns",
            "proportion_table", "robustness_lines", "robustness_markdown", "sensitivity_table", "spearman",
            "worst_table"]
 
@@ -342,8 +343,29 @@ def robustness_markdown(study: Study, rows: list[dict[str, Any]],
     return "\n".join(out)
 
 
+def crashed_counts(study: Study, rows: list[dict[str, Any]]) -> dict[tuple[str, ...], int]:
+    """The ``crashed`` rows of each group of the robustness tables.
+
+    Parameters
+    ----------
+    study : Study
+        The study (its grid paths and samples).
+    rows : list of dict
+        The ``cases.csv`` rows.
+
+    Returns
+    -------
+    dict
+        The group's key values, as :func:`scenarios.study.report.group_rows` keys them (JSON text)
+        -> its rows whose status is ``crashed``.
+    """
+    _, groups = group_rows(study, rows)
+    return {group: sum(r["status"] == "crashed" for r in members) for group, members in groups.items()}
+
+
 def robustness_lines(proportions: tuple[list[str], list[dict[str, Any]]],
-                     worst: tuple[list[str], list[dict[str, Any]]]) -> list[str]:
+                     worst: tuple[list[str], list[dict[str, Any]]],
+                     crashed: dict[tuple[str, ...], int] | None = None) -> list[str]:
     """The robustness summary ``slewbench sweep`` prints: per group, each criterion's fraction with
     its Wilson interval, and the worst cases of each summary metric by id.
 
@@ -351,11 +373,15 @@ def robustness_lines(proportions: tuple[list[str], list[dict[str, Any]]],
     ----------
     proportions, worst : (list of str, list of dict)
         :func:`proportion_table` and :func:`worst_table`.
+    crashed : dict or None, optional
+        :func:`crashed_counts` of the same rows, to count the crashed cases of a group that has
+        no completed case; None: they are not counted.
 
     Returns
     -------
     list of str
         One line per group and criterion (``  fast: every requirement 98/100 = 0.98 [0.930, 0.994]``),
+        one line for a group without a completed case (``  30.0, smooth: no completed case (3 crashed)``),
         then one per group and metric (``  fast: worst cl.int_u: case 17, 3, 55``).
     """
     columns, table = proportions
@@ -365,8 +391,14 @@ def robustness_lines(proportions: tuple[list[str], list[dict[str, Any]]],
         return ", ".join(text_cell(line.get(k)) for k in keys)
 
     lines = []
+    empty: set[tuple[str, ...]] = set()
     for line in table:
         if line["fraction_met"] is None:
+            key = tuple(json.dumps(line.get(k)) for k in keys)
+            if key not in empty:  # one line per group, not per criterion
+                empty.add(key)
+                count = None if crashed is None else crashed.get(key)
+                lines.append(f"  {group(line)}: no completed case" + ("" if count is None else f" ({count} crashed)"))
             continue
         lines.append(f"  {group(line)}: {line['criterion']} {line['met']}/{line['completed']} = "
                      f"{line['fraction_met']:.3g} [{line['wilson_low']:.3f}, {line['wilson_high']:.3f}]")

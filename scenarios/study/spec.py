@@ -489,16 +489,75 @@ def _read(key: Key, value: Any, path: str) -> Any:
     return key.read(Node(value, path))  # type: ignore[misc]
 
 
+CASE_VALUE_CHARS = 80
+"""Most characters of one varied value in the message on a bad case (:func:`_shown_value`)."""
+CASE_VALUES_CHARS = 300
+"""Most characters of the varied values listed in the message on a bad case; the others are counted."""
+
+
+def _shown_value(value: Any, limit: int = CASE_VALUE_CHARS) -> str:
+    """A varied value as an error message shows it: numbers to 6 significant digits, a vector or
+    matrix (recorded as JSON text, :func:`_recorded`) element by element, and at most ``limit``
+    characters, a cut value ending in ``...`` inside its brackets or quotes, so that it cannot be
+    read as running into the next value."""
+    if isinstance(value, str) and value.startswith("["):
+        try:
+            value = json.loads(value)
+        except ValueError:
+            pass
+    return _compact(value, max(limit, 8))
+
+
+def _compact(value: Any, limit: int) -> str:
+    """:func:`_shown_value` of a parsed value."""
+    if isinstance(value, float):
+        text = f"{value:.6g}"
+        text += "" if any(c in text for c in ".enia") else ".0"  # 30.0 stays a float; not nan, inf
+    elif isinstance(value, (list, tuple, dict)):
+        items = list(value.items()) if isinstance(value, dict) else list(value)
+        opening, closing = ("{", "}") if isinstance(value, dict) else ("[", "]")
+        parts: list[str] = []
+        used = 2
+        for index, item in enumerate(items):
+            room = limit - used - (5 if index < len(items) - 1 else 0)  # and the ", ..." of a cut
+            # a nested list is cut to the room left, a number or a key is shown whole or not at all
+            if isinstance(value, dict):
+                key = f"{_compact(item[0], limit)}: "
+                part = key + _compact(item[1], max(room - len(key), 8))
+            else:
+                part = _compact(item, max(room, 8))
+            if len(part) > room:
+                parts.append("...")
+                break
+            parts.append(part)
+            used += len(part) + 2
+        return opening + ", ".join(parts) + closing
+    elif isinstance(value, str):
+        text = json.dumps(value)
+        if len(text) > limit:
+            kept = limit - 5
+            while kept > 0 and len(json.dumps(value[:kept])) > limit - 3:  # escapes are longer
+                kept -= 1
+            text = f"{json.dumps(value[:kept])[:-1]}...\""
+    else:
+        text = json.dumps(value) if value is None or isinstance(value, bool) else str(value)
+    return text if len(text) <= limit else f"{text[:limit - 3]}..."
+
+
 def _case_error(case: Case, error: ScenarioError) -> ScenarioError:
-    """The loader's error on a case, naming the case, its varied values (cut short) and the study
-    entry that set the offending path."""
+    """The loader's error on a case, naming the case, its varied values (each cut short and marked
+    so, at most :data:`CASE_VALUES_CHARS` of them in all) and the study entry that set the
+    offending path."""
     entries = [p for p in case.varied if error.path.startswith(p) or p.startswith(error.path)]
     shown: list[str] = []
-    for path, value in case.varied.items():
-        if sum(len(part) for part in shown) > 240:
-            shown.append(f"... ({len(case.varied)} values)")
+    used = 0
+    for number, (path, value) in enumerate(case.varied.items()):
+        part = f"{_cut(path)}={_shown_value(value)}"
+        if shown and used + len(part) > CASE_VALUES_CHARS:
+            shown.append(f"... {len(case.varied) - number} more of {len(case.varied)} values")
             break
-        shown.append(f"{_cut(path)}={json.dumps(value)[:40]}")
+        shown.append(part)
+        used += len(part) + 2
     culprit = f" (set by {', '.join(_cut(p) for p in entries[:3])})" if entries else ""
     return ScenarioError(f"case {case.index} [{', '.join(shown)}]: {error.path}{culprit}", error.message)
 
