@@ -117,6 +117,11 @@ def test_a_user_file_among_the_files_a_run_would_write_is_refused_before_plannin
     assert (out / "smooth.png").read_text() == "user figure"
     assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0  # a run that does not write it goes on
     assert (out / "smooth.png").read_text() == "user figure"
+    # a figure this run does not draw (no pointing requirement: no sky or margins figure) is no clash
+    (out / "smooth.png").unlink()
+    (out / "sky.png").write_text("my photo")
+    assert main(["run", str(path), "--out", str(out)]) == 0
+    assert (out / "sky.png").read_text() == "my photo" and (out / "smooth.png").is_file()
 
 
 def test_an_empty_directory_is_claimed_and_stale_results_are_removed(tmp_path):

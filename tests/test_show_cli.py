@@ -155,6 +155,20 @@ def test_run_refuses_a_study_or_table_file_and_names_the_command(tmp_path, capsy
     assert "valid slew table 'eigenaxis-demo': " in capsys.readouterr().out
 
 
+@pytest.mark.parametrize("argv, expected", [
+    (["table", "t.yaml", "--angles", "-10,90"], ["table", "t.yaml", "--angles=-10,90"]),
+    (["sweep", "s.yaml", "--case", "-1"], ["sweep", "s.yaml", "--case=-1"]),
+    (["run", "--no-plots", "-1"], ["run", "--no-plots", "-1"]),  # a flag takes no value: -1 is the file
+    (["run", "--strict", "-2.5,3"], ["run", "--strict", "-2.5,3"]),
+    (["table", "t.yaml", "--angles", "-10", "--", "--out", "-3"], ["table", "t.yaml", "--angles=-10", "--", "--out", "-3"]),
+    (["export", "d", "--option", "x=-5"], ["export", "d", "--option", "x=-5"]),  # not a number list
+])
+def test_only_an_option_that_takes_a_value_gets_a_negative_value_attached(argv, expected):
+    from scenarios.cli.commands import build_parser
+    from scenarios.cli.status import attached_values
+    assert attached_values(argv, build_parser()) == expected
+
+
 def test_a_study_without_its_study_key_is_named_as_such_not_as_a_scenario_missing_name(tmp_path, capsys):
     # read as a scenario it said only "name: required key is missing", without the file
     lost = tmp_path / "lost.yaml"
@@ -162,7 +176,7 @@ def test_a_study_without_its_study_key_is_named_as_such_not_as_a_scenario_missin
     for argv in (["run", str(lost), "--out", str(tmp_path / "out")], ["validate", str(lost)]):
         assert main(argv) == 2
         err = capsys.readouterr().err
-        assert f"{lost} is not a scenario" in err and "`study: NAME`" in err and "slewbench sweep" in err, err
+        assert f"{lost} reads as a study file without its `study: NAME` key" in err and "slewbench sweep" in err, err
         assert "name: required key is missing" not in err
     assert main(["sweep", str(lost), "--out", str(tmp_path / "out")]) == 2
     assert capsys.readouterr().err.startswith(f"slewbench: error in study file: {lost}: study: required key")

@@ -325,7 +325,7 @@ def test_netcdf_reads_back_with_dimensions_units_and_attributes(tmp_path):
     (["--angles", "0,90"], "--angles"),
     (["--angles", "ten"], "--angles"),
     (["--angles", "-10,90"], "(0, 180] degrees, got [-10.0, 90.0]"),  # checked, not read as an option
-    (["--check-angles", "-5", "--tolerance", "0.01"], "--check-angles"),
+    (["--check-angles", "-5,30", "--tolerance", "0.01"], "--check-angles"),  # a list: argparse read it as an option
     (["--axes", "many"], "--axes"),
     (["--duration", "5"], "--duration"),
     (["--objective", "min_energy"], "--duration"),

@@ -102,9 +102,11 @@ optimum (dense: 2 and 0) and 3 and 2 on the two-wheel vertex (``s = 3e-6``; dens
 with ``GUARD = 100`` (ten times the margin asked)."""
 
 ZERO_PIVOT_WARNING = "LDL factorization has zeros in D"
-"""CasADi's ``ldl`` warning on a zero pivot, which the check reports in its message instead."""
-_STDERR_LOCK = threading.Lock()
-"""Held while ``sys.stderr`` is swapped: two threads swapping it at once could leave it swapped."""
+"""CasADi's ``ldl`` warning on a zero pivot, which the check reports in its message instead. It is
+held back in the main thread only, where ``sys.stderr`` (the process's) is swapped for the
+factorisation's fraction of a millisecond and what else was written then is passed on; a line
+another thread writes while it is swapped comes out later, or, in a race with the read of the
+swapped stream, not at all. In other threads the warning is let through."""
 
 GUARD = 10.0
 """The estimated backward error of the factorisation, times ``‖K‖∞``, must be below ``δ / GUARD``
@@ -282,7 +284,8 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
         # rank() and neig() read this factorisation; a zero pivot is reported here, so CasADi's
         # warning about it (written through Python's sys.stderr) is held back, anything else passed on
         held = io.StringIO()
-        with _STDERR_LOCK, contextlib.redirect_stderr(held):  # sys.stderr is the process's: one thread at a time
+        main = threading.current_thread() is threading.main_thread()  # sys.stderr is the process's
+        with contextlib.redirect_stderr(held) if main else contextlib.nullcontext():
             solver.nfact(values)
             rank = int(solver.rank(values))
         other = [line for line in held.getvalue().splitlines() if ZERO_PIVOT_WARNING not in line]

@@ -309,6 +309,14 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
     return refined, float(refined.p[0]) if free else t_f, stages, None
 
 
+COAST_NODE_FACTOR = 25
+"""Nodes the torque-free-coast fallback of a spinning start may use, per node of its coarsest mesh
+(one per :data:`~planners.costate.systems.SPIN_MESH_ANGLE` turned), when that exceeds
+``max_nodes``: the spin re-pointing benchmark's refinement to 1e-8 ends on 7651 nodes from 401 (its
+fast rotation needs a fine mesh everywhere), above the default ``max_nodes`` 5000, which keeps the
+cost of a failing refinement elsewhere (XTE at tolerance 1e-13: 3-4 s against 15 s with 20000)."""
+
+
 class CostateTPBVPPlanner(Planner):
     """Indirect (co-state) planner; see the module docstring."""
 
@@ -354,9 +362,8 @@ class CostateTPBVPPlanner(Planner):
             ``solve_bvp`` residual tolerance of the final stage, in (0, 1) (default 1e-8).
         max_nodes : int
             ``solve_bvp`` node limit of the final stage, 10 to 100000 and at least ``nodes``
-            (default 20000: the spin re-pointing benchmark's refinement to 1e-8 ends on about 7500
-            nodes, its fast rotation needing a fine mesh everywhere; the rest-to-rest suite
-            problems end below 5000, so the limit does not change them).
+            (default 5000). A spinning start's torque-free-coast fallback may use up to
+            :data:`COAST_NODE_FACTOR` times its coarsest mesh, if that is more.
         """
 
         objective: Literal["min_energy", "rate_acquisition", "attitude_acquisition"] = "min_energy"
@@ -368,7 +375,7 @@ class CostateTPBVPPlanner(Planner):
         continuation_steps: Annotated[int, Range(ge=1, le=100)] = 3                              # first step 1/continuation_steps, then adaptive
         nodes: Annotated[int, Range(ge=5, le=5000)] = 60                                          # mesh each stage starts from
         tolerance: Annotated[float, Range(gt=0.0, lt=1.0)] = 1e-8                                  # solve_bvp residual tolerance
-        max_nodes: Annotated[int, Range(ge=10, le=100000)] = 20000
+        max_nodes: Annotated[int, Range(ge=10, le=100000)] = 5000
 
         def __post_init__(self) -> None:
             if self.max_nodes < self.nodes:
@@ -418,8 +425,9 @@ class CostateTPBVPPlanner(Planner):
             return FailedReference(self.name, str(system))
         solution, t_f, stages, failure = solve(system, o.nodes, o.continuation_steps, o.tolerance, o.max_nodes)
         fallback, first = (system.fallback() if failure else None), system.cold_start
-        if fallback is not None:  # the same problem from another cold start
-            solution, t_f, more, second = solve(fallback, o.nodes, o.continuation_steps, o.tolerance, o.max_nodes)
+        if fallback is not None:  # the same problem from another cold start, on its own (finer) mesh
+            limit = max(o.max_nodes, COAST_NODE_FACTOR * fallback.guess(o.nodes, 1.0)[1].size)
+            solution, t_f, more, second = solve(fallback, o.nodes, o.continuation_steps, o.tolerance, limit)
             failure = None if second is None else f"from the {first}: {failure}; from the {fallback.cold_start}: {second}"
             stages, system = stages + more, fallback
         if failure or solution is None or t_f is None:

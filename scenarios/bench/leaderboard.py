@@ -67,7 +67,8 @@ class BenchRow:
     reached : bool or None
         ``|gap_abs| <= tolerance``.
     plan_time_s : float or None
-        Plan time [s]: the second of two plans (a peer's solves), the first paying the build.
+        Plan time [s]: the second of two plans (a peer's solves), the first paying the build and
+        first-call costs.
     iterations : int or None
         Solver iterations, when the planner or peer reports them.
     certificate : str
@@ -301,7 +302,7 @@ class Leaderboard:
                   f"{len(self.rows)} row(s) in {self.wall_time_s:.1f} s."), "",
                  ("Gap: value − optimum (the objective's unit) and relative to the optimum; ✓ within the problem's "
                   "tolerance. Plan time: the second of two plans (a peer's solves), the first paying the "
-                  "build."), ""]
+                  "build and first-call costs."), ""]
         lines += self._summary()
         for problem in self.problems:
             lines += [f"## {problem.name}: {problem.title}", "",

@@ -43,7 +43,12 @@ from scenarios.output.provenance import package_version
 from scenarios.output.writer import plot_streamer, run_files
 from scenarios.runner import run
 from scenarios.schema.labels import row_labels
-from scenarios.schema.loader import OTHER_FILES, load, parse_scenario, refuse_unmarked_base
+from scenarios.schema.loader import (
+    OTHER_FILES,
+    load,
+    parse_scenario,
+    refuse_unmarked_base,
+)
 from scenarios.schema.read import read_yaml
 
 
@@ -415,7 +420,8 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         Exit status: 0 done, 2 bad scenario file or output location (the message names its path),
         1 internal error or interrupted, or a row not ok under ``run --strict``.
     """
-    args = build_parser().parse_args(attached_values(sys.argv[1:] if argv is None else list(argv)))
+    parser = build_parser()
+    args = parser.parse_args(attached_values(sys.argv[1:] if argv is None else list(argv), parser))
     args.interruption = Interruption()
     args.renderer = renderer
     # Ctrl-C too: CasADi turns a KeyboardInterrupt raised inside IPOPT into a failed solve, and the

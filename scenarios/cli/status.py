@@ -56,7 +56,7 @@ _NUMBERS = re.compile(r"-\.?\d[\d.eE+\-]*(,[\d.eE+\-]*)*")
 """A number or comma-separated list of numbers whose first one is negative."""
 
 
-def attached_values(argv: list[str]) -> list[str]:
+def attached_values(argv: list[str], parser: argparse.ArgumentParser) -> list[str]:
     """The arguments with an option's value that starts with a minus sign attached to it.
 
     ``argparse`` reads ``--angles -10,90`` as two options (it takes a lone negative number such as
@@ -67,18 +67,36 @@ def attached_values(argv: list[str]) -> list[str]:
     ----------
     argv : list of str
         The arguments, without the program name.
+    parser : argparse.ArgumentParser
+        The parser they are for: only its long options that take a value (its sub-commands'
+        included) are joined to what follows them; a flag (``--no-plots -1``, ``-1`` a file) is not.
 
     Returns
     -------
     list of str
-        The same arguments, each long option (``--name`` without ``=``) followed by a number or a
-        comma-separated list of numbers that starts with a minus sign joined to it by ``=``.
+        The same arguments, each long option that takes a value, written without ``=`` and
+        followed by a number or a comma-separated list of numbers that starts with a minus sign,
+        joined to it by ``=``; nothing after ``--``.
     """
+    valued = _valued_options(parser)
     out: list[str] = []
-    for argument in argv:
-        if (out and out[-1].startswith("--") and "=" not in out[-1] and len(out[-1]) > 2
-                and _NUMBERS.fullmatch(argument)):
+    for index, argument in enumerate(argv):
+        if argument == "--":  # the rest is positional
+            return out + argv[index:]
+        if out and out[-1] in valued and _NUMBERS.fullmatch(argument):
             out[-1] = f"{out[-1]}={argument}"
         else:
             out.append(argument)
     return out
+
+
+def _valued_options(parser: argparse.ArgumentParser) -> set[str]:
+    """The long option strings of ``parser`` and its sub-commands that take a value."""
+    found: set[str] = set()
+    for action in parser._actions:  # argparse has no public list of a parser's actions
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices.values():
+                found |= _valued_options(sub)
+        elif action.nargs != 0:
+            found.update(option for option in action.option_strings if option.startswith("--"))
+    return found

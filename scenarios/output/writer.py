@@ -150,8 +150,8 @@ def _write_plots(results: RunResults, staging: Path, stems: list[str], renderer:
 
 
 def run_files(scenario: Scenario, plots: bool = True) -> list[str]:
-    """The files a run of ``scenario`` may write (:func:`write_results`), known before it plans:
-    what :func:`~scenarios.output.directory.claim_output_directory` checks up front.
+    """The files a run of ``scenario`` writes (:func:`write_results`) when its rows simulate, known
+    before it plans: what :func:`~scenarios.output.directory.claim_output_directory` checks up front.
 
     Parameters
     ----------
@@ -164,11 +164,11 @@ def run_files(scenario: Scenario, plots: bool = True) -> list[str]:
     -------
     list of str
         Relative paths: the tables, a time series per row and, with ``plots``, a figure per row,
-        ``margins.png``, ``sky.png``, ``comparison.png`` and ``report.html`` (a superset: a row
-        without a simulation has no time series or figure, a run without pointing requirements
-        no margins or sky figure).
+        ``comparison.png`` and ``report.html`` (a row whose plan fails has no time series or
+        figure). The pointing figures, drawn only where the scenario or a planner's reference has
+        cones, are left to the check at the commit (:func:`~scenarios.output.directory.commit_outputs`).
     """
-    from scenarios.output.plot_data import COMPARISON_FILE, MARGINS_FILE, SKY_FILE
+    from scenarios.output.plot_data import COMPARISON_FILE
     from scenarios.schema.labels import row_labels
 
     labels = [label for label, _, _ in row_labels([spec.label for spec in scenario.planners],
@@ -176,7 +176,7 @@ def run_files(scenario: Scenario, plots: bool = True) -> list[str]:
     stems = row_stems(labels)
     files = ["results.json", "results.csv", "results.md", *(f"timeseries/{stem}.csv" for stem in stems)]
     if plots:
-        files += [*(f"{stem}.png" for stem in stems), MARGINS_FILE, SKY_FILE, COMPARISON_FILE, "report.html"]
+        files += [*(f"{stem}.png" for stem in stems), COMPARISON_FILE, "report.html"]
     return files
 
 

@@ -650,6 +650,6 @@ def refuse_unmarked_base(data: Any, path: str | Path) -> None:
         At the top level, naming what a study file needs and the command that runs it.
     """
     if isinstance(data, dict) and BASE_KEY in data and not any(key in data for key in OTHER_FILES):
-        raise ScenarioError("", f"{path} is not a scenario (no scenario has a top-level `{BASE_KEY}:` key); a study "
-                                f"file has one and `study: NAME` too, which this one lacks (studies run with "
-                                f"`slewbench {OTHER_FILES['study']}`)")
+        raise ScenarioError("", f"{path} reads as a study file without its `study: NAME` key: a top-level "
+                                f"`{BASE_KEY}:` is a study's base scenario (no scenario has one); add the key and run "
+                                f"it with `slewbench {OTHER_FILES['study']}`")
