@@ -4,6 +4,8 @@
 its YAML path; :class:`OutputError` an output location slewbench must not or cannot write to, at
 that location (it is not a :class:`ScenarioError`: the scenario may be right). Both end the command
 line with exit status 2. :class:`SweepInterrupted` is a study stopped before every case finished.
+:class:`CaseTimeout`, a case out of time in a sweep's worker, is the one exception here not derived
+from :class:`~ocp.errors.SlewbenchError` (it derives from :class:`BaseException`).
 Imports only :mod:`ocp.errors`.
 """
 from __future__ import annotations
@@ -59,8 +61,14 @@ class OutputError(SlewbenchError):
         self.message = message
 
 
-class CaseTimeout(SlewbenchError):
-    """Raised inside a worker when a case exceeds its time limit."""
+class CaseTimeout(BaseException):
+    """Raised inside a worker when a case exceeds its time limit.
+
+    Derived from :class:`BaseException`, like :class:`KeyboardInterrupt`, not from
+    :class:`~ocp.errors.SlewbenchError`: a handler of any error (``except Exception``, which turns
+    a planner's exception into a failed row) must not catch the end of the case's time, or the case
+    would go on and a row would be stored as the planner's failure.
+    """
 
 
 class SweepInterrupted(SlewbenchError):

@@ -341,16 +341,19 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
     from scenarios.study.engine import sweep
     from scenarios.study.report import robustness_tables
     from scenarios.study.robustness import crashed_counts, robustness_lines
-    from scenarios.study.store import STORE_NAME, SweepStore
+    from scenarios.study.store import STORE_NAME, SweepStore, resume_counts
 
     out, store = _open(out, study)
     start = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         with store:
-            done = len(store.keys() & {case.key for case in study.cases})
-            print(f"{study.name}: {len(study.cases)} cases" + (f", {done} already stored" if done else "")
+            counts = resume_counts(store, (case.key for case in study.cases))  # crashed cases run again
+            done = counts.kept
+            print(f"{study.name}: {len(study.cases)} cases" + counts.describe()
                   + f", {cluster.address if cluster else 'local process pool'}", flush=True)
+            for note in counts.notes():  # stored cases of an earlier version of the study
+                print(note, flush=True)
             results = sweep(study, workers=args.workers, store=store, progress=True, cluster=cluster)
     except (SweepInterrupted, KeyboardInterrupt) as stop:  # KeyboardInterrupt: before the sweep took over
         if isinstance(stop, KeyboardInterrupt):
@@ -402,7 +405,8 @@ def add_sweep_parser(commands: Any) -> None:
     parser.add_argument("--out", type=directory_argument, help="output directory (default: results/<study name>)")
     parser.add_argument("--workers", type=int, help="cases at once (default: execution.workers, else one per core)")
     parser.add_argument("--scheduler", help="Dask scheduler address (tcp://host:port) instead of local processes")
-    parser.add_argument("--resume", action="store_true", help="skip the cases already stored in --out")
+    parser.add_argument("--resume", action="store_true",
+                        help="skip the cases already stored in --out; crashed cases run again")
     parser.add_argument("--no-plots", action="store_true", help="skip the PNG plots and report.html")
     parser.add_argument("--dry-run", action="store_true",
                         help="check the study and list its cases; run nothing, write nothing")

@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ocp.errors import excerpt
+from ocp.errors import SlewbenchError, excerpt
 from scenarios.errors import ScenarioError, SweepInterrupted
 from scenarios.schema.study import scheduler_address
 from scenarios.study.spec import load_study, parse_study
@@ -92,7 +92,8 @@ class SweepResults:
         Case key -> ``{"status", "rows", "elapsed_s", "attempts"}`` as stored
         (:meth:`scenarios.study.store.SweepStore.records`; ``rows`` as
         :meth:`scenarios.output.results.Row.to_dict` gives them): the cases run by this call and
-        those found in the store.
+        those of the study found in the store (:func:`sweep` leaves out the cases stored for
+        another study).
     workers : dict
         Worker (``host:pid``) -> solvers it built, for the workers of this call.
     cpu_s : dict
@@ -188,6 +189,19 @@ class SweepResults:
         return sweep_repr_html(self.study, self.records)
 
 
+UNGUARDED = ("the local sweep workers died while they started, before any case. Usually the script that calls "
+             "scenarios.sweep() calls it at its top level: each worker process imports the script again and would "
+             "start a sweep of its own. Put the call under `if __name__ == \"__main__\":` in the script (see "
+             "'From Python' in the guide's Trade studies page).")
+"""What a sweep says when its local workers die while they start (the usual cause named)."""
+
+
+class WorkersCannotStart(SlewbenchError, RuntimeError):
+    """The local workers of a sweep died while they started, before any case: a new pool would fail
+    the same way, so the sweep stops (usually a script that calls :func:`sweep` outside
+    ``if __name__ == "__main__":``; the message says)."""
+
+
 def start_forkserver() -> multiprocessing.context.BaseContext:
     """Start (once per process) the server that local workers fork from, importing :data:`PRELOAD`.
 
@@ -199,7 +213,19 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
     -------
     multiprocessing.context.BaseContext
         The ``forkserver`` context that local pools use.
+
+    Raises
+    ------
+    SystemExit
+        When called in a process that is starting (a worker importing the caller's script because
+        the script calls :func:`sweep` outside ``if __name__ == "__main__":``): that worker ends,
+        and the sweep that started it raises :class:`WorkersCannotStart`.
     """
+    if getattr(multiprocessing.current_process(), "_inheriting", False):  # multiprocessing's own test
+        # this process is a worker importing the caller's script: it cannot start one, and ends
+        # quietly (the sweep that started it says why, once, as WorkersCannotStart)
+        raise SystemExit("slewbench: a local sweep was started while a worker process imported the main script; put "
+                         "the call of scenarios.sweep() under `if __name__ == \"__main__\":` in the script")
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(list(PRELOAD))
     from multiprocessing import forkserver
@@ -254,6 +280,10 @@ class _LocalPool:
                 process.kill()
         self.executor.shutdown(wait=False, cancel_futures=True)
 
+    def claimed(self) -> int:
+        """Workers that started (claimed their slot: their initializer ran)."""
+        return sum(self.slots[at] != 0 for at in range(0, len(self.slots), SLOT_FIELDS))
+
     def culprits(self) -> set[int]:
         """Workers that ended by themselves (not stopped by the pool or by :meth:`kill`)."""
         import signal
@@ -291,16 +321,22 @@ class _Engine:
         self.executor: Executor = self.pool.executor if self.pool is not None else executor  # type: ignore[assignment]
         self.timeout = study.execution.case_timeout_s
         self.limit = self.timeout * _TIMEOUT_GRACE + 5.0
-        self.records: dict[str, dict[str, Any]] = dict(store.records()) if store is not None else {}
+        stored = store.records() if store is not None else {}
+        # this study's stored cases only (a resumed study may have changed); a crashed one runs again
+        self.records: dict[str, dict[str, Any]] = {case.key: stored[case.key] for case in study.cases
+                                                   if case.key in stored}
+        self.starts: dict[str, int] = collections.Counter()  # times started (stored as attempts)
         self.cases: dict[str, Case] = {}
         for case in study.cases:
-            if case.key not in self.records:
+            record = self.records.get(case.key)
+            if record is None or record["status"] == "crashed":
                 self.cases.setdefault(case.key, case)
+                self.starts[case.key] = int(record["attempts"] or 0) if record is not None else 0
+        self.finished: set[str] = set()  # cases recorded by this run
         self.pending = collections.deque(self.cases)
         self.suspects: collections.deque[str] = collections.deque()  # run alone, one at a time
         self.singles: collections.deque[str] = collections.deque()  # cases of a failed chunk, one per task
         self.in_flight: dict[Future, _Batch] = {}
-        self.starts: dict[str, int] = collections.Counter()  # times started (stored as attempts)
         self.deaths: dict[str, int] = collections.Counter()  # worker deaths charged (against retries)
         self.shared: dict[str, int] = collections.Counter()  # deaths shared with others, charged if it dies alone
         self.worker_builds: dict[str, int] = {}
@@ -371,6 +407,7 @@ class _Engine:
         """Keep a finished case's record and queue it for the store (``text``: its rows encoded)."""
         attempts = max(self.starts[key], 1)
         self.records[key] = {"status": status, "rows": rows, "elapsed_s": elapsed, "attempts": attempts}
+        self.finished.add(key)
         batch.append((key, status, encode_rows(rows) if text is None else text, elapsed, attempts))
         self.failures += any(row["status"] != "ok" for row in rows)
 
@@ -436,7 +473,7 @@ class _Engine:
         if broken:
             self._pool_broke()
         for key in list(self.shared):
-            if key in self.records:
+            if key in self.finished:
                 del self.shared[key]
 
     def _requeue(self, batches: list[_Batch], started: set[int], keep: set[str]) -> None:
@@ -464,6 +501,8 @@ class _Engine:
         assert self.pool is not None
         running, started = self.pool.running(), self.pool.started()
         self.pool.kill()
+        if not self.pool.claimed():  # every worker died before it could start: so would a new pool's
+            raise WorkersCannotStart(UNGUARDED)
         culprits = self.pool.culprits()
         batches = list(self.in_flight.values())
         self.in_flight.clear()
@@ -770,7 +809,11 @@ def sweep(study: Study | dict[str, Any] | str | os.PathLike[str], executor: Exec
         Cases run at once, 1 to 1024 (None: the study's ``execution.workers``, else one per core;
         on Dask, the cluster's worker threads).
     store : SweepStore or None, optional
-        Where finished cases are committed (and skipped when already there); None: memory only.
+        Where finished cases are committed; None: memory only. A case stored there is skipped, but
+        a ``crashed`` one (it raised, ran out of time or killed its worker: an outcome of the
+        execution, not of the physics) runs again and its record is replaced; its ``attempts``
+        go on counting. Stored cases that are not the study's are left alone and out of the
+        results (:func:`scenarios.study.store.resume_counts` counts them).
     progress : bool, optional
         Show a progress bar (only when stderr is a terminal).
     task : callable, optional
@@ -792,6 +835,9 @@ def sweep(study: Study | dict[str, Any] | str | os.PathLike[str], executor: Exec
         workers for :data:`WORKER_WAIT_S`: committed cases stay in the store.
     ScenarioError
         A bad study, or a scheduler that cannot be used (:func:`connect_scheduler`).
+    WorkersCannotStart
+        The local workers died while they started, before any case (a script calling this
+        function outside ``if __name__ == "__main__":``: the message says so).
     TypeError, ValueError
         An argument of the wrong type or out of range, named in the message.
     """

@@ -4,8 +4,8 @@ Every finished case is one row, keyed by the hash of its resolved scenario and t
 (:func:`scenarios.study.types.case_key`); the cases that finish together are committed in one
 transaction (:meth:`SweepStore.put_many`) before the sweep reports them done. A process killed at
 any moment leaves every committed case readable and no half-written one, so ``--resume`` re-runs
-only what is missing, and a case stored twice (a retry that raced a resume) replaces itself, never
-duplicates.
+only what is missing and the ``crashed`` cases (:func:`resume_counts`), and a case stored twice (a
+crashed case run again, a retry that raced a resume) replaces itself, never duplicates.
 
 A case's rows are stored in their plain form (:meth:`scenarios.output.results.Row.to_dict`),
 non-finite numbers as JSON ``null`` (:func:`scenarios.output.tables.json_safe`). A store written by
@@ -27,7 +27,7 @@ import stat
 import time
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from ocp.errors import excerpt
 from scenarios.errors import OutputError
@@ -359,8 +359,79 @@ class SweepStore:
             records[key] = {"status": status, "rows": decoded, "elapsed_s": elapsed, "attempts": attempts}
         return records
 
+    def statuses(self) -> dict[str, str]:
+        """The status of each stored case (its rows not read).
+
+        Returns
+        -------
+        dict
+            Case key -> ``ok`` or ``crashed``.
+        """
+        return dict(self._db.execute("SELECT key, status FROM cases"))
+
     def __len__(self) -> int:
         return int(self._db.execute("SELECT COUNT(*) FROM cases").fetchone()[0])
+
+
+class ResumeCounts(NamedTuple):
+    """What a store holds of a study's cases (:func:`resume_counts`)."""
+
+    kept: int
+    """Cases of the study stored and not ``crashed``: a resumed sweep skips them."""
+    crashed: int
+    """Cases of the study stored ``crashed``: a resumed sweep runs them again, replacing them."""
+    other: int
+    """Stored cases that are not the study's (the study file changed since): kept in the store,
+    left out of the results and outputs."""
+
+    def describe(self) -> str:
+        """The counts for the line a resumed sweep starts with (empty when nothing is stored).
+
+        Returns
+        -------
+        str
+            For example ``, 4 already stored, 2 crashed cases run again``.
+        """
+        parts = [f"{self.kept} already stored"] if self.kept else []
+        if self.crashed:
+            parts.append(f"{self.crashed} crashed case{'s' if self.crashed != 1 else ''} run again")
+        return "".join(f", {part}" for part in parts)
+
+    def notes(self) -> list[str]:
+        """What a resumed sweep says of the stored cases that are not the study's.
+
+        Returns
+        -------
+        list of str
+            One line when there are such cases, for example ``note: 182 stored cases are not this
+            study's (the study changed?): kept in the store, left out of the outputs``; else none.
+        """
+        if not self.other:
+            return []
+        return [(f"note: {self.other} stored case{'s are' if self.other != 1 else ' is'} not this study's (the study "
+                 "changed?): kept in the store, left out of the outputs")]
+
+
+def resume_counts(store: SweepStore, keys: Iterable[str]) -> ResumeCounts:
+    """Count what ``store`` holds of the cases ``keys`` (a study's), as a resumed sweep treats them.
+
+    Parameters
+    ----------
+    store : SweepStore
+        The open store.
+    keys : iterable of str
+        The keys of the study's cases (``Case.key``).
+
+    Returns
+    -------
+    ResumeCounts
+        The study's cases stored (skipped), stored ``crashed`` (run again), and the stored cases
+        that are not the study's.
+    """
+    statuses, wanted = store.statuses(), set(keys)
+    kept = sum(statuses[key] != "crashed" for key in wanted & statuses.keys())
+    crashed = sum(statuses[key] == "crashed" for key in wanted & statuses.keys())
+    return ResumeCounts(kept, crashed, len(statuses.keys() - wanted))
 
 
 STORE_FILES = (STORE_NAME, f"{STORE_NAME}-wal", f"{STORE_NAME}-shm")

@@ -209,8 +209,32 @@ def _on_alarm(signum: int, frame: Any) -> None:
     raise CaseTimeout
 
 
+def timed_out_message(timeout_s: float) -> str:
+    """The message of a case's ``crashed`` rows when it ran out of time (its record keeps how long it ran).
+
+    Parameters
+    ----------
+    timeout_s : float
+        The study's ``case_timeout_s`` [s].
+
+    Returns
+    -------
+    str
+        ``timed out after <limit> s (case_timeout_s)``.
+    """
+    return f"timed out after {timeout_s:g} s (case_timeout_s)"
+
+
 def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     """Run one case.
+
+    The time limit is kept twice. Where a signal can be used (the main thread of a local worker), an
+    alarm raises :class:`~scenarios.errors.CaseTimeout` when the limit is reached; it derives from
+    :class:`BaseException`, so that no handler of the code run catches it. And a case whose
+    measured time exceeds the limit is a timed-out ``crashed`` case whatever it returned: a case in
+    a thread (a Dask worker's), where there is no alarm, or one whose C code swallowed the alarm's
+    exception (a CasADi call it interrupted failed with CasADi's own ``NotImplementedError``).
+    Ctrl-C (:class:`KeyboardInterrupt`) is not caught: it stops the worker.
 
     Parameters
     ----------
@@ -221,9 +245,9 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``key``, ``status`` (``ok``: the runner finished, whatever its rows say; ``crashed``: the
-        case raised or ran out of time), ``rows`` (:meth:`scenarios.output.results.Row.to_dict`
-        of each row), ``elapsed_s`` (wall time [s]),
+        ``key``, ``status`` (``ok``: the runner finished within the time limit, whatever its rows
+        say; ``crashed``: the case raised or ran out of time), ``rows``
+        (:meth:`scenarios.output.results.Row.to_dict` of each row), ``elapsed_s`` (wall time [s]),
         ``cpu_s`` (CPU time of the case [s]), ``worker_cpu_s`` (CPU time of the worker process
         since it started [s]), ``worker`` (host:pid) and ``cache_builds`` (solvers built by this
         worker so far).
@@ -234,26 +258,32 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     cache, simulators, lock = worker_state()
     data, timeout = payload["scenario"], float(payload["timeout_s"])
     alarm = threading.current_thread() is threading.main_thread() and hasattr(signal, "setitimer")
+    timed_out = False
     with lock:
         start, cpu_start = time.perf_counter(), time.process_time()
         previous = signal.signal(signal.SIGALRM, _on_alarm) if alarm else None
         try:
-            if alarm:
-                signal.setitimer(signal.ITIMER_REAL, timeout)
-            scenario = parse_scenario(data)
-            results = run(scenario, cache=cache, simulators=simulators)
-            status, rows = "ok", [row.to_dict() for row in results.rows]
+            try:
+                if alarm:
+                    signal.setitimer(signal.ITIMER_REAL, timeout)
+                scenario = parse_scenario(data)
+                results = run(scenario, cache=cache, simulators=simulators)
+                status, rows = "ok", [row.to_dict() for row in results.rows]
+            finally:  # disarmed first: an alarm due now is raised here, inside the outer try
+                if alarm:
+                    signal.setitimer(signal.ITIMER_REAL, 0.0)
         except CaseTimeout:
-            status, rows = "crashed", crashed_rows(data, f"timed out after {timeout:g} s (case_timeout_s)")
+            timed_out = True
         except Exception as error:  # a case that raises is a row, the sweep goes on
             detail = traceback.format_exc(limit=-3).strip().splitlines()
             where = next((line.strip() for line in reversed(detail) if line.strip().startswith("File")), "")
             status, rows = "crashed", crashed_rows(data, f"{type(error).__name__}: {error} ({where})"[:1000])
         finally:
             if alarm:
-                signal.setitimer(signal.ITIMER_REAL, 0.0)
                 signal.signal(signal.SIGALRM, previous)
         elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu_start
+        if timed_out or elapsed > timeout:  # out of time, whether or not the alarm's exception got through
+            status, rows = "crashed", crashed_rows(data, timed_out_message(timeout))
     return {"key": payload["key"], "status": status, "rows": rows, "elapsed_s": elapsed, "cpu_s": cpu,
             "worker_cpu_s": time.process_time(),
             "worker": f"{socket.gethostname()}:{os.getpid()}", "cache_builds": cache.builds}
