@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ocp.errors import SlewbenchError
 
-__all__ = ["CaseTimeout", "OutputError", "ScenarioError", "SweepInterrupted"]
+__all__ = ["CaseTimeout", "OutputError", "ScenarioError", "SweepInterrupted", "WorkersCannotStart"]
 
 MAX_PATH_CHARS = 300
 """Characters of a path shown in an error's text (the attribute keeps it whole)."""
@@ -69,6 +69,12 @@ class CaseTimeout(BaseException):
     a planner's exception into a failed row) must not catch the end of the case's time, or the case
     would go on and a row would be stored as the planner's failure.
     """
+
+
+class WorkersCannotStart(SlewbenchError, RuntimeError):
+    """The local workers of a sweep died while they started, before any case: a new pool would fail
+    the same way, so the sweep stops (usually a script that calls :func:`scenarios.sweep` outside
+    ``if __name__ == "__main__":``; the message says)."""
 
 
 class SweepInterrupted(SlewbenchError):

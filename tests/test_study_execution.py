@@ -214,7 +214,7 @@ def test_cli_resume_says_what_it_runs_again_and_what_is_not_the_studys(tmp_path,
     assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--no-plots", "--resume"]) == 0
     said = capsys.readouterr().out
     assert "cli-resume: 3 cases, 2 already stored, 1 crashed case run again, local process pool" in said, said
-    assert "1 case run in" in said and "(2 already stored, 3 in all); 0 with a row not ok, 0 crashed" in said, said
+    assert "1 case run in" in said and "(2 already stored, 3 in all); of the 3 cases stored, 0 crashed and 0 others have a row not ok" in said, said
     assert "not this study's" not in said
     with SweepStore(out) as store:
         assert set(store.statuses().values()) == {"ok"} and store.records()[keys[40.0]]["attempts"] == 2
@@ -228,7 +228,7 @@ def test_cli_resume_says_what_it_runs_again_and_what_is_not_the_studys(tmp_path,
     assert "cli-resume: 4 cases, 2 already stored, local process pool\n" in said, said
     assert ("note: 1 stored case is not this study's (the study changed?): kept in the store, left out of the "
             "outputs") in said, said
-    assert "(2 already stored, 4 in all); 0 with a row not ok, 0 crashed" in said, said
+    assert "(2 already stored, 4 in all); of the 4 cases stored, 0 crashed and 0 others have a row not ok" in said, said
     with (out / "cases.csv").open() as stream:
         durations = sorted({float(row["maneuver.duration"]) for row in csv.DictReader(stream)})
     assert durations == [30.0, 40.0, 60.0, 70.0]

@@ -204,7 +204,7 @@ def test_a_worker_reuses_simulators_only_where_a_fresh_one_gives_the_same_rows()
     assert cache.hits == 3
 
 
-def test_resume_skips_stored_cases_and_a_raising_case_is_a_crashed_row(tmp_path, monkeypatch):
+def test_resume_skips_stored_cases_runs_a_crashed_one_again_and_a_raising_case_is_a_crashed_row(tmp_path, monkeypatch):
     study = parse_study(study_data(grid={"maneuver.duration": [30.0, 40.0, 50.0]}))
     original = runner.run
 
@@ -223,7 +223,10 @@ def test_resume_skips_stored_cases_and_a_raising_case_is_a_crashed_row(tmp_path,
     with SweepStore(tmp_path) as store:
         second = sweep(study, executor, store=store)
         assert len(store) == 3
-    assert executor.submitted == 0 and second.records == first.records
+    key = next(key for key, record in first.records.items() if record["status"] == "crashed")
+    assert executor.submitted == 1  # the crashed case runs again (and crashes again here): no other
+    assert second.records[key]["status"] == "crashed" and second.records[key]["attempts"] == 2
+    assert {k: r for k, r in second.records.items() if k != key} == {k: r for k, r in first.records.items() if k != key}
 
 
 def test_worker_keeps_one_solver_cache_so_a_collocation_nlp_is_built_once_per_worker():

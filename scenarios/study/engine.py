@@ -44,8 +44,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ocp.errors import SlewbenchError, excerpt
-from scenarios.errors import ScenarioError, SweepInterrupted
+from ocp.errors import excerpt
+from scenarios.errors import ScenarioError, SweepInterrupted, WorkersCannotStart
 from scenarios.schema.study import scheduler_address
 from scenarios.study.spec import load_study, parse_study
 from scenarios.study.store import SweepStore, encode_rows
@@ -194,12 +194,6 @@ UNGUARDED = ("the local sweep workers died while they started, before any case. 
              "start a sweep of its own. Put the call under `if __name__ == \"__main__\":` in the script (see "
              "'From Python' in the guide's Trade studies page).")
 """What a sweep says when its local workers die while they start (the usual cause named)."""
-
-
-class WorkersCannotStart(SlewbenchError, RuntimeError):
-    """The local workers of a sweep died while they started, before any case: a new pool would fail
-    the same way, so the sweep stops (usually a script that calls :func:`sweep` outside
-    ``if __name__ == "__main__":``; the message says)."""
 
 
 def start_forkserver() -> multiprocessing.context.BaseContext:
