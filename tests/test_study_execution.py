@@ -232,6 +232,9 @@ def test_cli_resume_says_what_it_runs_again_and_what_is_not_the_studys(tmp_path,
     with (out / "cases.csv").open() as stream:
         durations = sorted({float(row["maneuver.duration"]) for row in csv.DictReader(stream)})
     assert durations == [30.0, 40.0, 60.0, 70.0]
+    # the redrawn report counts this study's cases (the 50 s one is the earlier study's)
+    assert main(["sweep", "--report", str(out), "--no-plots"]) == 0
+    assert "from 4 stored case(s); 0 missing" in capsys.readouterr().out
 
 
 # --- a sweep started by an unguarded script ------------------------------------------------------

@@ -41,7 +41,8 @@ def stored_results(directory: str | Path) -> tuple[SweepResults, str]:
     -------
     results : SweepResults
         The stored study (parsed with the stored version, so its cases have the stored keys) and
-        every stored record.
+        the stored records of its cases (a store resumed with a changed study also holds the
+        earlier study's cases, which are left out).
     version : str
         The version of slewbench that stored it.
 
@@ -66,7 +67,8 @@ def stored_results(directory: str | Path) -> tuple[SweepResults, str]:
         study = parse_study(data, version=version)
     except ScenarioError as error:
         raise OutputError(out, f"the study stored in it is not valid ({error}); it cannot be read") from None
-    return SweepResults(study, records), version
+    keys = {case.key for case in study.cases}
+    return SweepResults(study, {key: record for key, record in records.items() if key in keys}), version
 
 
 def rerun_case(results: SweepResults, index: int, progress: Any = None) -> RunResults:
