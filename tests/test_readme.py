@@ -199,7 +199,8 @@ def test_mypy_command():
 def test_python_block(index, monkeypatch, capsys):
     monkeypatch.chdir(ROOT)
     source, body = PYTHON[index]
-    exec(compile(body, f"{source} python block {index}", "exec", dont_inherit=True), {"__name__": "readme"})
+    # run as a script's main module: a block guarded by ``if __name__ == "__main__":`` runs
+    exec(compile(body, f"{source} python block {index}", "exec", dont_inherit=True), {"__name__": "__main__"})
     assert capsys.readouterr().out.strip()  # every block prints its result
 
 
