@@ -374,6 +374,7 @@ BAD = {
                                   "under the Earth's surface"),
     "perigee by altitude": (with_orbit({"type": "keplerian", "altitude_km": 300, "eccentricity": 0.1}),
                             "orbit.altitude_km", "under the Earth's surface"),
+    "circular under the surface": (with_orbit({"altitude_km": -100}), "orbit.altitude_km", "positive"),
     "both a and altitude": (with_orbit({"type": "keplerian", "altitude_km": 300, "semi_major_axis_km": 7000}),
                             "orbit.semi_major_axis_km", "exactly one"),
     "two anomalies": (with_orbit({**BASE["orbit"], "mean_anomaly_deg": 3.0}), "orbit.true_anomaly_deg",

@@ -271,7 +271,8 @@ class CircularOrbit(OrbitKind):
         Attributes
         ----------
         altitude_km : float
-            Height of the circular orbit above the equatorial radius (6378.137 km) [km].
+            Height of the circular orbit above the equatorial radius (6378.137 km) [km], positive
+            (an orbit under the surface is an error, as a Keplerian orbit's perigee there is).
         inclination_deg : float
             Inclination of the orbit plane to the equator [deg].
         raan_deg : float
@@ -280,7 +281,7 @@ class CircularOrbit(OrbitKind):
             Argument of latitude at t = 0, from the ascending node [deg].
         """
 
-        altitude_km: Annotated[float, Range()]
+        altitude_km: Annotated[float, Range(gt=0.0)]
         inclination_deg: Annotated[float, Range()] = 0.0
         raan_deg: Annotated[float, Range()] = 0.0
         arg_latitude_deg: Annotated[float, Range()] = 0.0
