@@ -154,6 +154,11 @@ BAD = {
                                           "simulation.sensors.star_tracker.outages_s[0]"),
     "the attitude noise twice": (("sensor_noise", "attitude_deg"), 0.01, "simulation.sensor_noise.attitude_deg"),
     "an unknown estimator": (("estimator", "type"), "ukf", "simulation.estimator.type"),
+    # the example has no magnetic field model: a magnetometer would measure nothing
+    "a magnetometer without a field": (("sensors", "magnetometer"), {"noise_T": 1e-7},
+                                       "simulation.sensors.magnetometer: a magnetometer needs a magnetic field"),
+    "a magnetometer's noise without a field": (("sensor_noise", "magnetic_field"), 1e-7,
+                                               "simulation.sensor_noise.magnetic_field: a magnetometer needs"),
 }
 
 

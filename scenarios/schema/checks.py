@@ -35,6 +35,36 @@ def check_row_labels(planners: list[PlannerSpec], controllers: list[ControllerSp
     row_labels([planner.label for planner in planners], [controller.label for controller in controllers])
 
 
+def check_magnetometer(problem: ManeuverProblem, simulation: SimulationSpec) -> None:
+    """Refuse a magnetometer without a magnetic field to measure (no ``environment.magnetic_field``
+    or no orbit): it would measure nothing and the run would go on as if it were not there.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre, with its environment.
+    simulation : SimulationSpec
+        Its sensors (``sensors.magnetometer``) and noise (``sensor_noise.magnetic_field``).
+
+    Raises
+    ------
+    ScenarioError
+        At the magnetometer's key.
+    """
+    sensors = simulation.sensors
+    if sensors is not None and sensors.magnetometer is not None:
+        where = "simulation.sensors.magnetometer"
+    elif simulation.noise.field_std > 0:
+        where = "simulation.sensor_noise.magnetic_field"
+    else:
+        return
+    environment = problem.environment
+    if environment.magnetic_field is None or environment.orbit is None:
+        missing = "environment.magnetic_field" if environment.magnetic_field is None else "an orbit (orbit:)"
+        raise ScenarioError(where, f"a magnetometer needs a magnetic field to measure, and the scenario has no "
+                                   f"{missing}; give one or remove the magnetometer")
+
+
 def check_work(problem: ManeuverProblem, simulation: SimulationSpec) -> None:
     """Refuse a closed-loop window with more samples than ``simulation.max_samples`` (the run
     would take too long or exhaust memory); the runner checks again once a planner has chosen

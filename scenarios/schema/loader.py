@@ -34,7 +34,7 @@ from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem, Planner
 from scenarios.errors import ScenarioError
 from scenarios.requirements.spec import Requirements, Sensor
-from scenarios.schema.checks import check_compatibility, check_row_labels, check_work
+from scenarios.schema.checks import check_compatibility, check_magnetometer, check_row_labels, check_work
 from scenarios.schema.estimation import ESTIMATOR, SENSORS, parse_sensor_suite
 from scenarios.schema.keys import (
     Described,
@@ -575,6 +575,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     problem = _with_requirements(problem, requirements, constraints)
     truth = parse_truth(truth_node, problem.model)
     check_work(problem, simulation)
+    check_magnetometer(problem, simulation)
     check_row_labels(planners, controllers)
     check_compatibility(problem, planners, controllers, simulation)
     return Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch,
