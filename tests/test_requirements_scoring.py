@@ -138,6 +138,10 @@ def test_the_rate_by_closed_form():
     assert not score.met and "1.26 x the 0.25 rad/s bound" in score.detail
     relaxed = Requirements(rate=RateRequirement(0.32))
     assert scored(relaxed, problem_with(relaxed), UniformTurn())["rate"].met
+    # a bound broken by 1e-5 relative reads as broken, not as "1 x" the bound
+    tight = Requirements(rate=RateRequirement(RATE / (1 + 1e-5)))
+    score = scored(tight, problem_with(tight), UniformTurn())["rate"]
+    assert not score.met and "1.00001 x the" in score.detail, score.detail
 
 
 def test_the_final_error_and_rate_from_t_plus_after():

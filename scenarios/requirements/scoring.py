@@ -90,6 +90,16 @@ _TOLERANCE = 1e-9
 """Relative slack on the ratio and bound checks (rounding, not a margin)."""
 
 
+def _over(value: float, bound: float) -> str:
+    """``value`` (above ``bound``) with 3 significant digits, or as many more as it takes to read
+    above the bound as written (``1.00001`` over 1, not ``1``), 12 at most."""
+    for digits in range(3, 13):
+        text = f"{value:.{digits}g}"
+        if float(text) > float(f"{bound:.{digits}g}"):
+            return text
+    return f"{value:.12g}"
+
+
 @dataclass(frozen=True)
 class Score:
     """How one scope of a row meets one requirement.
@@ -162,7 +172,7 @@ def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
     values: dict[str, float | None] = dict(zip(RATE_FIELDS, (peak, float(t[worst]), ratio)))
     met = ratio <= 1.0 + _TOLERANCE
     return Score("rate", values, met, "" if met else f"peak rate {peak:.4g} rad/s at {t[worst]:.1f} s, "
-                                                     f"{ratio:.3g} x the {requirement.max_rate:g} rad/s bound")
+                                                     f"{_over(ratio, 1.0)} x the {requirement.max_rate:g} rad/s bound")
 
 
 def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, problem: ManeuverProblem,
@@ -179,15 +189,15 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
         worst = int(np.argmax(errors))
         values["worst_error_deg"] = float(errors[worst])
         if requirement.error_deg is not None and errors[worst] > requirement.error_deg * (1 + _TOLERANCE):
-            problems.append(f"error {errors[worst]:.3g} deg at {t[inside][worst]:.1f} s over "
-                            f"{requirement.error_deg:g} deg")
+            problems.append(f"error {_over(errors[worst], requirement.error_deg)} deg at {t[inside][worst]:.1f} s "
+                            f"over {requirement.error_deg:g} deg")
     if problem.omegaf is not None:
         rates = np.linalg.norm(omega[inside] - problem.omegaf, axis=1)
         worst = int(np.argmax(rates))
         values["worst_rate_error"] = float(rates[worst])
         if requirement.rate is not None and rates[worst] > requirement.rate * (1 + _TOLERANCE):
-            problems.append(f"rate error {rates[worst]:.3g} rad/s at {t[inside][worst]:.1f} s over "
-                            f"{requirement.rate:g} rad/s")
+            problems.append(f"rate error {_over(rates[worst], requirement.rate)} rad/s at {t[inside][worst]:.1f} s "
+                            f"over {requirement.rate:g} rad/s")
     return Score("final", values, not problems, (", ".join(problems) + f" (from {start:g} s)") if problems else "")
 
 
@@ -254,7 +264,7 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
         values[name] = ratio
         values[f"{name}_time_s"] = float(t[worst]) if peaks.size else None
         if ratio > margin_allowed * (1 + _TOLERANCE):
-            broken.append(f"{name} {ratio:.3g} x its limit at {t[worst]:.1f} s")
+            broken.append(f"{name} {_over(ratio, margin_allowed)} x its limit at {t[worst]:.1f} s")
     detail = ", ".join(broken) + f" (allowed {margin_allowed:.3g} x)" if broken else ""
     if jumps is not None:
         largest = max(jumps, key=lambda jump: float(np.linalg.norm(jump[2])), default=None)
