@@ -216,7 +216,8 @@ def _bounds(positive: bool = False, non_negative: bool = False, minimum: float |
 
 
 def number(name: str, meaning: str, *, unit: str = "", default: Any = REQUIRED, positive: bool = False,
-           non_negative: bool = False, maximum: float | None = None, nullable: bool = False) -> Key:
+           non_negative: bool = False, maximum: float | None = None, nullable: bool = False,
+           minimum: float | None = None) -> Key:
     """A finite number (``null`` too when ``nullable``).
 
     Parameters
@@ -233,6 +234,8 @@ def number(name: str, meaning: str, *, unit: str = "", default: Any = REQUIRED, 
         Inclusive upper bound.
     nullable : bool, optional
         Accept ``null`` (read as ``None``).
+    minimum : float or None, optional
+        Inclusive lower bound.
 
     Returns
     -------
@@ -241,12 +244,12 @@ def number(name: str, meaning: str, *, unit: str = "", default: Any = REQUIRED, 
     """
     if nullable:
         def read(node: Node) -> Any:
-            return node.optional_number(positive, non_negative, maximum)
+            return node.optional_number(positive, non_negative, maximum, minimum)
     else:
         def read(node: Node) -> Any:
-            return node.number(positive, non_negative, maximum)
+            return node.number(positive, non_negative, maximum, minimum)
     return Key(name, "number or null" if nullable else "number", meaning, read, unit, default,
-               _bounds(positive, non_negative, maximum=maximum))
+               _bounds(positive, non_negative, minimum=minimum, maximum=maximum))
 
 
 def integer(name: str, meaning: str, *, default: Any = REQUIRED, minimum: int | None = None,

@@ -155,7 +155,8 @@ class Node:
         """
         return self.value is None or (isinstance(self.value, str) and self.value.lower() == "none")
 
-    def number(self, positive: bool = False, non_negative: bool = False, maximum: float | None = None) -> float:
+    def number(self, positive: bool = False, non_negative: bool = False, maximum: float | None = None,
+               minimum: float | None = None) -> float:
         """The value as a finite number (booleans are not numbers).
 
         Parameters
@@ -166,6 +167,8 @@ class Node:
             Require ``>= 0``.
         maximum : float or None, optional
             Upper bound (inclusive); ``None``: none.
+        minimum : float or None, optional
+            Lower bound (inclusive); ``None``: none.
 
         Returns
         -------
@@ -185,25 +188,27 @@ class Node:
             raise self.error(f"expected a non-negative number, got {excerpt(self.value)}")
         if maximum is not None and self.value > maximum:
             raise self.error(f"expected a number <= {maximum:g}, got {excerpt(self.value)}")
+        if minimum is not None and self.value < minimum:
+            raise self.error(f"expected a number >= {minimum:g}, got {excerpt(self.value)}")
         return float(self.value)
 
     def optional_number(self, positive: bool = False, non_negative: bool = False,
-                        maximum: float | None = None) -> float | None:
+                        maximum: float | None = None, minimum: float | None = None) -> float | None:
         """:meth:`number`, or ``None`` for a null value.
 
         Parameters
         ----------
         positive, non_negative : bool, optional
             Require ``> 0`` or ``>= 0``.
-        maximum : float or None, optional
-            Upper bound (inclusive); ``None``: none.
+        maximum, minimum : float or None, optional
+            Inclusive bounds; ``None``: none.
 
         Returns
         -------
         float or None
             The number, or ``None``.
         """
-        return None if self.is_null() else self.number(positive, non_negative, maximum)
+        return None if self.is_null() else self.number(positive, non_negative, maximum, minimum)
 
     def integer(self, minimum: int | None = None, maximum: int | None = None) -> int:
         """The value as an integer (not a float, not a boolean).

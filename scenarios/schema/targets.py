@@ -135,9 +135,10 @@ def axis_angle_quaternion(axis: ArrayLike, angle_deg: float) -> Array:
 # --- directions a target or a secondary axis is turned to ----------------------------------------
 
 GROUND = Section((
-    number("lat_deg", "Geodetic latitude (WGS-84).", unit="deg"),
-    number("lon_deg", "Longitude, east positive.", unit="deg"),
-    number("alt_m", "Height above the WGS-84 ellipsoid.", unit="m", default=0.0),
+    number("lat_deg", "Geodetic latitude (WGS-84).", unit="deg", minimum=-90.0, maximum=90.0),
+    number("lon_deg", "Longitude, east positive.", unit="deg", minimum=-180.0, maximum=360.0),
+    number("alt_m", "Height above the WGS-84 ellipsoid (under 100 km below it: the deepest point of the "
+           "Earth is 11 km down).", unit="m", default=0.0, minimum=-1e5, maximum=1e8),
 ), "A point on the ground; needs the epoch (the Earth's orientation) and the orbit.")
 
 _ONE_DIRECTION = Described("absent (the mapping has one of inertial, lvlh, rtn, ground)")
@@ -176,10 +177,6 @@ def _ground(node: Node, context: AttitudeContext, t: float) -> Array:
                                   "top-level `epoch:` (UTC, e.g. 2027-03-20T12:00:00Z)")
     if context.geometry.orbit is None:
         raise ScenarioError(path, "a ground point needs an orbit (the spacecraft's position): give `orbit:`")
-    if not -90.0 <= values["lat_deg"] <= 90.0:
-        raise ScenarioError(f"{path}.lat_deg", f"expected a latitude in [-90, 90] deg, got {values['lat_deg']:g}")
-    if not -1e5 < values["alt_m"] < 1e8:
-        raise ScenarioError(f"{path}.alt_m", f"expected a height in (-1e5, 1e8) m, got {values['alt_m']:g}")
     direction, elevation = ground_point(context.geometry, np.deg2rad(values["lat_deg"]),
                                         np.deg2rad(values["lon_deg"]), values["alt_m"], t)
     if elevation < 0.0:
