@@ -84,6 +84,8 @@ BAD = {
                                "requirements.pointing.st.keep_out", ["'velocity'", "orbit"]),
     "unknown direction": (changed(requirements__pointing__st=pointing(keep_out="sunn")),
                           "requirements.pointing.st.keep_out", ["'sunn'", "'earth_limb'", "inertial"]),
+    "a target's frame": (changed(requirements__pointing__st=pointing(keep_out={"lvlh": [0, 0, 1]})),
+                         "requirements.pointing.st.keep_out", ["{inertial: [x, y, z]}", "'lvlh'", "attitude targets"]),
     "zero inertial direction": (changed(requirements__pointing__st=pointing(keep_out={"inertial": [0, 0, 0]})),
                                 "requirements.pointing.st.keep_out.inertial", ["cannot be zero"]),
     "both keep_out and keep_in": (changed(requirements__pointing__st=pointing(keep_in="sun")),

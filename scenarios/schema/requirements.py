@@ -250,6 +250,10 @@ def _direction(node: Node, geometry: Geometry) -> Direction:
     """A direction: a registered kind's name or ``{inertial: [x, y, z]}``, checked against what the
     scenario gives (epoch, orbit)."""
     if isinstance(node.value, dict):
+        if "inertial" not in node.value and len(node.value) == 1:  # a frame a target takes (lvlh, ground, ...)
+            raise node.error(f"a requirement's direction is a name of {sorted(DIRECTIONS)} or {{inertial: [x, y, z]}}, "
+                             f"got {{{excerpt(next(iter(node.value)))}: ...}} (the lvlh, rtn and ground frames are "
+                             "for the manoeuvre's attitude targets, not for requirements)")
         vector_ = INERTIAL_DIRECTION.read(node)["inertial"]
         if not np.linalg.norm(vector_) > 1e-12:
             raise ScenarioError(f"{node.path}.inertial", f"a direction cannot be zero, got {vector_.tolist()}")
