@@ -494,6 +494,8 @@ def test_schema_keys_select_what_they_name():
     assert re.findall(r"^planners\[i\]\.options\.\w+$", selected, re.MULTILINE) == \
         ["planners[i].options.torque_fraction"] * having
     assert "controller.options.gain" in schema_text("controllers.bdot")
+    # a registered controller without options is a part of its own (it was "not a key", its close match itself)
+    assert schema_text("controller.none").startswith("Controller options: none") and "it has none" in schema_text("controller.none")
     assert "execution.retries" in schema_text("study.execution") and "maneuver" not in schema_text("study.execution")
     scenario_part = schema_text("scenario")
     assert "simulation.compile" in scenario_part and "planners[i].options.intervals" in scenario_part

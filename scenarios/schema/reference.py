@@ -463,8 +463,9 @@ def schema_text(key: str | None = None) -> str:
     wanted = None if key is None else _normal(key)
     lines: list[str] = []
     for part in parts:
-        entries = part.entries if wanted is None or part.key == wanted else tuple(_selected(part, wanted))
-        if not entries and (wanted is not None or not part.intro):
+        named = wanted is not None and part.key == wanted  # the part itself (a controller without options too)
+        entries = part.entries if wanted is None or named else tuple(_selected(part, wanted))
+        if not entries and not named and (wanted is not None or not part.intro):
             continue
         title = f"{part.group}: {_plain(part.title)}"
         lines += [title, "=" * len(title)] + textwrap.wrap(_plain(_one_line(part.intro)), 100) + [""]
