@@ -84,6 +84,10 @@ BAD = {
                                "requirements.pointing.st.keep_out", ["'velocity'", "orbit"]),
     "unknown direction": (changed(requirements__pointing__st=pointing(keep_out="sunn")),
                           "requirements.pointing.st.keep_out", ["'sunn'", "'earth_limb'", "inertial"]),
+    # 170 deg from the limb seen from 500 km (the Earth's apparent radius 68.0 deg): a 238 deg cone
+    "a limb keep-out covering the sky": (changed(orbit={"altitude_km": 500.0},
+                                                 requirements__pointing__st=pointing(keep_out="earth_limb", angle_deg=170)),
+                                         "requirements.pointing.st.angle_deg", ["238 deg half-angle", "whole sky"]),
     "a target's frame": (changed(requirements__pointing__st=pointing(keep_out={"lvlh": [0, 0, 1]})),
                          "requirements.pointing.st.keep_out", ["{inertial: [x, y, z]}", "'lvlh'", "attitude targets"]),
     "zero inertial direction": (changed(requirements__pointing__st=pointing(keep_out={"inertial": [0, 0, 0]})),

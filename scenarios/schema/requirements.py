@@ -299,6 +299,16 @@ def _pointing(node: Node, name: str, sensors: dict[str, Sensor], geometry: Geome
         constraint = requirement.constraint(geometry, span.table)
     except ModelError as error:
         raise direction_node.error(error.message) from None
+    if keep_out and constraint.growth is not None:  # a cone widened by the Earth's disc may cover the sky
+        end = span.run if window[1] is None else window[1]
+        inside = (constraint.times >= window[0] - 1e-9) & (constraint.times <= end + 1e-9)
+        widest = float(np.max(constraint.growth[inside], initial=0.0)) + requirement.angle
+        if widest >= np.pi:
+            raise ScenarioError(f"{node.path}.angle_deg",
+                                f"{angle:g} deg from the limb, with the Earth's apparent radius up to "
+                                f"{np.rad2deg(widest) - angle:.4g} deg, is a keep-out cone of "
+                                f"{np.rad2deg(widest):.4g} deg half-angle: it covers the whole sky, so no attitude "
+                                "meets it; lower it")
     return requirement, constraint
 
 
