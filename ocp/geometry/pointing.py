@@ -6,7 +6,9 @@ boresight, the cone's half-angle, and the direction it is measured from, tabulat
 workbench:
 
 * scoring (NumPy): :meth:`PointingConstraint.margins` and :meth:`PointingConstraint.score` on any
-  sampled motion (a reference on its grid, a closed loop on its samples);
+  sampled motion (a reference on its dense grid); :meth:`PointingConstraint.score_between_samples`
+  on a motion known by its attitude and body rate at coarse samples (a closed loop), between which
+  the attitude is interpolated (:func:`hermite_attitudes`);
 * planning (CasADi): :meth:`PointingConstraint.expression` is the constraint ``g(q, t) <= 0`` a
   transcription imposes at its points (a moving direction is interpolated in time, as the IGRF
   field is).
@@ -32,7 +34,60 @@ from ocp import quat_casadi as qc
 
 Array = NDArray[np.float64]
 
-__all__ = ["PointingConstraint", "PointingScore", "violation_intervals"]
+__all__ = ["FINE_STEP", "REFINE_LEVELS", "REFINE_POINTS", "PointingConstraint", "PointingScore", "hermite_attitudes",
+           "violation_intervals"]
+
+FINE_STEP = np.deg2rad(0.05)
+"""[rad]: the largest rotation of the attitude between two points of the sub-grid on which
+:meth:`PointingConstraint.score_between_samples` evaluates the margin (each sample interval is cut
+into as many equal steps as its faster end's rate needs, at least 4)."""
+REFINE_POINTS = 17
+"""Points of each zoom of :meth:`PointingConstraint.score_between_samples`'s search for a minimum
+inside a sub-grid step (each zoom narrows the bracket to two of its steps: 8 times)."""
+REFINE_LEVELS = 6
+"""Zooms of that search: the bracket ends ``8**6 ≈ 2.6e5`` times narrower than a sub-grid step."""
+
+
+def hermite_attitudes(t: ArrayLike, q: ArrayLike, omega: ArrayLike, times: ArrayLike) -> Array:
+    """The attitude between samples: a cubic Hermite in the quaternion through the samples, with the
+    slopes ``q̇ = ½ q ⊗ [0, ω]`` of the body rates at both ends of each interval, normalised.
+
+    Over an interval of length ``h`` its error is ``O(h⁴)`` where the motion is smooth inside the
+    interval (a zero-order hold changes the torque only at the samples: the attitude and the rate
+    are continuous across them). The samples are made sign-continuous first (``q`` and ``−q`` are one
+    attitude).
+
+    Parameters
+    ----------
+    t : (N,) array_like
+        Increasing sample times [s], N >= 1.
+    q : (N, 4) array_like
+        Attitude at ``t`` (scalar first, body to inertial).
+    omega : (N, 3) array_like
+        Body rate at ``t`` [rad/s], body axes.
+    times : (M,) array_like
+        Where to evaluate [s], inside ``[t[0], t[-1]]`` (clipped to it).
+
+    Returns
+    -------
+    (M, 4) ndarray
+        Unit quaternions at ``times``; the samples themselves (normalised) at the sample times.
+    """
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    q = quat.continuous(np.atleast_2d(np.asarray(q, dtype=float)))
+    omega = np.atleast_2d(np.asarray(omega, dtype=float))
+    at = np.clip(np.atleast_1d(np.asarray(times, dtype=float)), t[0], t[-1])
+    if len(t) == 1:
+        return np.repeat(quat.normalize(q), len(at), axis=0)
+    k = np.clip(np.searchsorted(t, at, side="right") - 1, 0, len(t) - 2)
+    h = t[k + 1] - t[k]
+    s = (np.divide(at - t[k], h, out=np.zeros_like(h), where=h > 0.0))[:, None]  # a repeated time: its sample
+    slope = quat.kinematics(q, omega)
+    s2, s3 = s * s, s * s * s
+    value = ((2 * s3 - 3 * s2 + 1) * q[k] + (s3 - 2 * s2 + s) * h[:, None] * slope[k]
+             + (3 * s2 - 2 * s3) * q[k + 1] + (s3 - s2) * h[:, None] * slope[k + 1])
+    return np.asarray(value / np.linalg.norm(value, axis=1, keepdims=True), dtype=float)
+
 
 
 class PointingScore(NamedTuple):
@@ -41,11 +96,12 @@ class PointingScore(NamedTuple):
     Attributes
     ----------
     min_margin_deg : float or None
-        Smallest margin over the samples inside the window [deg], negative when violated;
-        ``None`` when no sample lies in the window.
+        Smallest margin over the points scored inside the window [deg] (the samples, or a
+        sub-grid between them: :meth:`PointingConstraint.score_between_samples`), negative when
+        violated; ``None`` when no point lies in the window.
     time_in_violation_s : float
         Time spent with a negative margin inside the window [s] (zero crossings interpolated
-        linearly between samples).
+        linearly between the points scored).
     first_violation_s : float or None
         First time the margin goes negative inside the window [s] (interpolated); ``None`` if never.
     min_margin_time_s : float or None
@@ -59,7 +115,7 @@ class PointingScore(NamedTuple):
 
     @property
     def met(self) -> bool:
-        """Whether no sample inside the window has a negative margin."""
+        """Whether no point scored inside the window has a negative margin."""
         return self.min_margin_deg is None or self.min_margin_deg >= 0.0
 
 
@@ -80,25 +136,19 @@ def violation_intervals(t: Array, margin: Array) -> list[tuple[float, float]]:
     """
     t, margin = np.asarray(t, dtype=float), np.asarray(margin, dtype=float)
     bad = margin < 0.0  # NaN compares False
-    intervals: list[tuple[float, float]] = []
-    k, n = 0, len(t)
-    while k < n:
-        if not bad[k]:
-            k += 1
-            continue
-        j = k
-        while j + 1 < n and bad[j + 1]:
-            j += 1
-        start, end = t[k], t[j]
-        if k > 0 and np.isfinite(margin[k - 1]):  # crossing into violation between k-1 and k
-            m0, m1 = margin[k - 1], margin[k]
-            start = t[k - 1] + (t[k] - t[k - 1]) * m0 / (m0 - m1)
-        if j + 1 < n and np.isfinite(margin[j + 1]):  # crossing out between j and j+1
-            m0, m1 = margin[j], margin[j + 1]
-            end = t[j] + (t[j + 1] - t[j]) * m0 / (m0 - m1)
-        intervals.append((float(start), float(end)))
-        k = j + 1
-    return intervals
+    edges = np.diff(np.concatenate([[0], bad.astype(np.int8), [0]]))
+    first, last = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1  # each run of bad samples
+    start, end = t[first], t[last]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        before = np.maximum(first - 1, 0)  # crossing into violation between first-1 and first
+        into = (first > 0) & np.isfinite(margin[before])
+        m0, m1 = margin[before], margin[first]
+        start = np.where(into, t[before] + (t[first] - t[before]) * m0 / (m0 - m1), start)
+        after = np.minimum(last + 1, len(t) - 1)  # crossing out between last and last+1
+        out = (last + 1 < len(t)) & np.isfinite(margin[after])
+        m0, m1 = margin[last], margin[after]
+        end = np.where(out, t[last] + (t[after] - t[last]) * m0 / (m0 - m1), end)
+    return [(float(a), float(b)) for a, b in zip(start, end)]
 
 
 @dataclass(frozen=True, eq=False)
@@ -325,6 +375,110 @@ class PointingConstraint:
         intervals = violation_intervals(t, margin)
         return PointingScore(float(np.rad2deg(margin[worst])), float(sum(b - a for a, b in intervals)),
                              intervals[0][0] if intervals else None, float(t[worst]))
+
+    def score_between_samples(self, t: ArrayLike, q: ArrayLike, omega: ArrayLike) -> PointingScore:
+        """Score a motion known at samples by its attitude and body rate, between the samples too.
+
+        The attitude between samples is the cubic Hermite of :func:`hermite_attitudes`. The margin
+        is evaluated on a sub-grid of each sample interval, cut into equal steps over which the
+        attitude turns at most :data:`FINE_STEP` (at least 4), plus the window's ends. Every
+        sub-grid step whose margin could dip, between its ends, below the smallest margin found, or
+        below zero where neither end is negative (by a Lipschitz bound: the mean of its ends less half
+        the step times a bound on the margin's rate, 1.5 times the faster sample's ``‖ω‖`` plus the
+        direction's and the limit's rates) is searched for its minimum (up to :data:`REFINE_LEVELS`
+        zooms of :data:`REFINE_POINTS` points, each while the bound still allows something lower);
+        the minima found join the sub-grid. The smallest margin and its time, and the violations (zero crossings interpolated
+        linearly between the points), are then those of :meth:`score` on the points.
+
+        Parameters
+        ----------
+        t : (N,) array_like
+            Increasing sample times [s].
+        q : (N, 4) array_like
+            Attitude at ``t`` (scalar first, body to inertial).
+        omega : (N, 3) array_like
+            Body rate at ``t`` [rad/s], body axes.
+
+        Returns
+        -------
+        PointingScore
+            As :meth:`score`, of the interpolated motion.
+        """
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        q = np.atleast_2d(np.asarray(q, dtype=float))
+        omega = np.atleast_2d(np.asarray(omega, dtype=float))
+        if len(t) < 2:
+            return self.score(t, q)
+        h = np.diff(t)
+        norms = np.linalg.norm(omega, axis=1)
+        rate = np.maximum(norms[:-1], norms[1:])  # per sample interval
+        steps = np.maximum(4, np.ceil(rate * h / FINE_STEP)).astype(int)
+        offset = np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)
+        fine = np.repeat(t[:-1], steps) + np.repeat(h, steps) * offset / np.repeat(steps, steps)
+        ends = [edge for edge in self.window if t[0] < edge < t[-1]]
+        fine = np.unique(np.concatenate([fine, [t[-1]], ends]))
+        margin = self.margins(fine, hermite_attitudes(t, q, omega, fine))
+        if not np.any(np.isfinite(margin)):
+            return PointingScore(None, 0.0, None, None)
+        # the sub-grid steps that may hide, between their ends, a margin below the smallest found or
+        # below zero where neither end is: a Lipschitz bound of the margin over the step
+        interval = np.clip(np.searchsorted(t, fine[:-1], side="right") - 1, 0, len(t) - 2)
+        speed = 1.5 * rate[interval] + self._drift
+        floor = 0.5 * (margin[:-1] + margin[1:]) - 0.5 * speed * np.diff(fine)
+        with np.errstate(invalid="ignore"):
+            suspect = np.flatnonzero(self._suspect(floor, np.fmin(margin[:-1], margin[1:]), float(np.nanmin(margin))))
+        if suspect.size:
+            found_t, found_m = self._zoom(t, q, omega, fine[suspect], fine[suspect + 1], speed[suspect],
+                                          float(np.nanmin(margin)))
+            order = np.argsort(np.concatenate([fine, found_t]), kind="stable")
+            fine = np.concatenate([fine, found_t])[order]
+            margin = np.concatenate([margin, found_m])[order]
+        worst = int(np.nanargmin(margin))
+        intervals = violation_intervals(fine, margin)
+        return PointingScore(float(np.rad2deg(margin[worst])), float(sum(b - a for a, b in intervals)),
+                             intervals[0][0] if intervals else None, float(fine[worst]))
+
+    @staticmethod
+    def _suspect(floor: Array, lowest_end: Array, smallest: float) -> NDArray[np.bool_]:
+        """Which brackets may hold a margin below ``smallest`` (the smallest found), or below zero
+        where none of their points found is, given the bound ``floor`` on their margin (NaN: no)."""
+        return (floor < smallest) | ((lowest_end >= 0.0) & (floor < 0.0))
+
+    def _zoom(self, t: Array, q: Array, omega: Array, start: Array, end: Array, speed: Array,
+              smallest: float) -> tuple[Array, Array]:
+        """The smallest margin of the interpolated motion in each ``[start, end]`` and its time (all the
+        brackets at once, each narrowed :data:`REFINE_LEVELS` times to two of its
+        :data:`REFINE_POINTS` points about its smallest; a bracket whose bound (its best margin less
+        ``speed`` [rad/s] times its new step) leaves nothing to find stops narrowing)."""
+        fraction = np.linspace(0.0, 1.0, REFINE_POINTS)
+        found_t, found_m = np.empty(len(start)), np.empty(len(start))
+        alive = np.arange(len(start))
+        for _ in range(REFINE_LEVELS):
+            points = start[:, None] + (end - start)[:, None] * fraction
+            margin = self.margins(points.ravel(), hermite_attitudes(t, q, omega, points.ravel())).reshape(points.shape)
+            rows = np.arange(len(alive))
+            best = np.argmin(margin, axis=1)
+            found_t[alive], found_m[alive] = points[rows, best], margin[rows, best]
+            smallest = min(smallest, float(np.min(margin)))
+            step = (end - start) / (REFINE_POINTS - 1)
+            keep = self._suspect(margin[rows, best] - speed * step, margin[rows, best], smallest)
+            start = points[rows, np.maximum(best - 1, 0)][keep]
+            end = points[rows, np.minimum(best + 1, REFINE_POINTS - 1)][keep]
+            alive, speed = alive[keep], speed[keep]
+            if not alive.size:
+                break
+        return found_t, found_m
+
+    @cached_property
+    def _drift(self) -> float:
+        """A bound on how fast the margin moves with the attitude held [rad/s]: the direction's
+        largest angular rate between table rows plus the limit's."""
+        if not self.moving:
+            return 0.0
+        dt = np.diff(self.times)
+        turn = np.arccos(np.clip(np.einsum("ij,ij->i", self.directions[:-1], self.directions[1:]), -1.0, 1.0))
+        growth = np.abs(np.diff(np.asarray(self.growth)))
+        return float(np.max((turn + growth) / dt))
 
     # ------------------------------------------------------------------ symbolic
     @cached_property

@@ -4,8 +4,8 @@ What lives here: the requirement objects a scenario's ``spacecraft.sensors`` and
 build (:mod:`~scenarios.requirements.spec`: sensors, pointing cones about a registered direction or
 an inertial vector, the actuator margin, the body-rate limit, the final error) and the scoring of a
 row against them (:mod:`~scenarios.requirements.scoring`: the reference on its dense sampling, its
-actuator demand through the row's controller's allocation, the closed loop on its samples, the end
-points before planning). The schema reads them (:mod:`scenarios.schema.requirements`), the runner
+actuator demand through the row's controller's allocation, the closed loop on its samples and its
+pointing between them, the end points before planning). The schema reads them (:mod:`scenarios.schema.requirements`), the runner
 turns the scores into statuses and messages.
 
 May import: :mod:`ocp`, :mod:`planners`, :mod:`controllers` and :mod:`scenarios.errors`; nothing else

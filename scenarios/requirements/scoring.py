@@ -1,5 +1,6 @@
 """Scoring a row against every requirement: the reference on its own dense sampling, the closed loop
-on its samples, and the end points of the manoeuvre before anything is planned.
+on its samples (its pointing between them too), and the end points of the manoeuvre before anything
+is planned.
 
 One :class:`Score` per requirement and scope (``reference``, ``closed_loop``): the numbers that go
 into the result columns ``ref.req.<name>.<field>`` and ``cl.req.<name>.<field>``, whether it is met,
@@ -7,7 +8,9 @@ and what breaks it in words. The fields:
 
 * a pointing requirement: ``min_margin_deg`` (negative when violated), ``time_in_violation_s``,
   ``first_violation_s`` (null if never), ``min_margin_time_s``
-  (:meth:`ocp.geometry.pointing.PointingConstraint.score`);
+  (:meth:`ocp.geometry.pointing.PointingConstraint.score` on the reference's samples;
+  :meth:`~ocp.geometry.pointing.PointingConstraint.score_between_samples` on the closed loop's
+  attitude interpolated between its samples with its body rates);
 * ``actuators`` (reference only): for each actuator quantity with a limit
   (:func:`controllers.allocation.reference_demand`, through the row's controller's allocation),
   ``<quantity>`` the peak demand over the limit and ``<quantity>_time_s`` when it peaks, then
@@ -151,8 +154,8 @@ def reference_times(duration: float, run_end: float, sample_time: float, points:
     return times
 
 
-def _pointing(constraint: PointingConstraint, t: Array, q: Array) -> Score:
-    score = constraint.score(t, q)
+def _pointing(constraint: PointingConstraint, t: Array, q: Array, omega: Array | None = None) -> Score:
+    score = constraint.score(t, q) if omega is None else constraint.score_between_samples(t, q, omega)
     values: dict[str, float | None] = dict(zip(POINTING_FIELDS, (score.min_margin_deg, score.time_in_violation_s,
                                                                  score.first_violation_s, score.min_margin_time_s)))
     if score.met:
@@ -337,7 +340,10 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
 
 def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: ArrayLike, q: ArrayLike,
                       omega: ArrayLike, end_of_manoeuvre: float) -> dict[str, Score]:
-    """Score a closed-loop run (its samples) against every requirement that applies to it.
+    """Score a closed-loop run against every requirement that applies to it: the rate and final
+    requirements on its samples, the pointing requirements between them too (the attitude
+    interpolated with the body rates,
+    :meth:`ocp.geometry.pointing.PointingConstraint.score_between_samples`).
 
     Parameters
     ----------
@@ -364,7 +370,7 @@ def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: A
     t = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
     omega = np.asarray(omega, dtype=float)
-    scores = {constraint.name: _pointing(constraint, t, q) for constraint in problem.pointing}
+    scores = {constraint.name: _pointing(constraint, t, q, omega) for constraint in problem.pointing}
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, omega)
     if requirements.final is not None:

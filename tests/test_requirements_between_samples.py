@@ -1,0 +1,119 @@
+"""A closed loop's pointing requirement scored between its samples, not only on them.
+
+Oracle: a body turning at a constant rate w about the inertial z axis points its body x axis at
+azimuth φ(t) = w (t − t*) in the xy-plane; its angle θ to a fixed direction at elevation e above
+the inertial x axis obeys cos θ = cos e cos φ (closed form). Past a keep-out cone of half-angle
+α > e the margin θ − α is smallest, e − α, at t*; it is negative while
+|φ| < arccos(cos α / cos e). Sampled every second at 0.05 rad/s with t* half-way between two
+samples, every sample is 1.4 deg off the direction, clear of a 0.7 deg cone that the motion enters
+for 0.4 s between them.
+
+The 12U CubeSat case (``scenarios/cubesat_12u_sun_keep_out.yaml``) with a 0.7 deg Sun keep-out,
+which the eigenaxis reference crosses for about 0.34 s around 29.8 s, tracked by a closed loop
+sampled every second: the loop follows the reference to about 0.001 deg, so its margin and its
+time inside must be the reference's (scored on 2001 points over its 60 s), although each of its
+samples lies outside the cone.
+"""
+from __future__ import annotations
+
+import copy
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+import scenarios
+from ocp import Spacecraft, quat
+from ocp.geometry.directions import Geometry
+from planners import ManeuverProblem
+from scenarios.requirements.scoring import score_closed_loop
+from scenarios.requirements.spec import (
+    Direction,
+    PointingRequirement,
+    Requirements,
+    Sensor,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+SUN_SCENARIO = ROOT / "scenarios" / "cubesat_12u_sun_keep_out.yaml"
+
+RATE = 0.05  # rad/s about z
+PASS = 4.5  # s: body x at azimuth 0, half-way between the samples 4 and 5 s
+CONE = math.radians(0.7)
+
+
+def turning(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Attitude and body rate of the constant-rate turn at ``t``."""
+    half = 0.5 * RATE * (t - PASS)
+    q = np.stack([np.cos(half), np.zeros_like(t), np.zeros_like(t), np.sin(half)], axis=-1)
+    return q, np.tile([0.0, 0.0, RATE], (t.size, 1))
+
+
+@pytest.mark.parametrize("elevation_deg", [0.3, 0.0])
+def test_a_cone_entered_between_samples_by_closed_form(elevation_deg: float) -> None:
+    e = math.radians(elevation_deg)
+    direction = [math.cos(e), 0.0, math.sin(e)]
+    requirement = PointingRequirement("x_out", Sensor("x_axis", [1.0, 0.0, 0.0]), True, CONE, Direction(None, direction))
+    requirements = Requirements((requirement,))
+    problem = ManeuverProblem(Spacecraft(np.diag([2.0, 3.0, 4.0])), quat.IDENTITY, np.zeros(3), None, 10.0,
+                              pointing=(requirement.constraint(Geometry(None, None), 10.0),))
+    t = np.arange(0.0, 10.5, 1.0)
+    q, omega = turning(t)
+    sampled = np.arccos(math.cos(e) * np.cos(RATE * (t - PASS))) - CONE  # the closed form on the samples
+    assert np.min(sampled) > math.radians(0.7)  # every sample is well clear of the cone
+
+    score = score_closed_loop(requirements, problem, t, q, omega, 10.0)["x_out"]
+
+    half_width = math.acos(math.cos(CONE) / math.cos(e)) / RATE  # s either side of PASS inside the cone
+    assert not score.met
+    assert score.values["min_margin_deg"] == pytest.approx(math.degrees(e - CONE), abs=1e-6)
+    assert score.values["min_margin_time_s"] == pytest.approx(PASS, abs=1e-3)
+    assert score.values["time_in_violation_s"] == pytest.approx(2.0 * half_width, abs=2e-4)
+    assert score.values["first_violation_s"] == pytest.approx(PASS - half_width, abs=2e-4)
+
+
+def test_a_cone_missed_between_samples_keeps_its_true_margin() -> None:
+    """A 0.2 deg cone about a direction 0.3 deg above the path: met, with margin 0.1 deg at PASS
+    (the samples alone say 1.25 deg)."""
+    e = math.radians(0.3)
+    cone = math.radians(0.2)
+    requirement = PointingRequirement("x_out", Sensor("x_axis", [1.0, 0.0, 0.0]), True, cone,
+                                      Direction(None, [math.cos(e), 0.0, math.sin(e)]))
+    requirements = Requirements((requirement,))
+    problem = ManeuverProblem(Spacecraft(np.diag([2.0, 3.0, 4.0])), quat.IDENTITY, np.zeros(3), None, 10.0,
+                              pointing=(requirement.constraint(Geometry(None, None), 10.0),))
+    t = np.arange(0.0, 10.5, 1.0)
+    score = score_closed_loop(requirements, problem, t, *turning(t), 10.0)["x_out"]
+    assert score.met
+    assert score.values["min_margin_deg"] == pytest.approx(0.1, abs=1e-6)
+    assert score.values["min_margin_time_s"] == pytest.approx(PASS, abs=1e-3)
+    assert score.values["time_in_violation_s"] == 0.0 and score.values["first_violation_s"] is None
+
+
+@pytest.fixture(scope="module")
+def sun_pass_sampled_every_second():
+    data = yaml.safe_load(SUN_SCENARIO.read_text())
+    data = copy.deepcopy(data)
+    data["planners"] = [{"name": "eigenaxis"}]
+    data["simulation"]["sample_time"] = 1.0
+    data["requirements"] = {"pointing": {"st_sun": {"sensor": "star_tracker", "keep_out": "sun", "angle_deg": 0.7}}}
+    scenario = scenarios.parse_scenario(data)
+    return scenario, scenarios.run(scenario).rows[0]
+
+
+def test_a_closed_loop_sampled_every_second_is_scored_as_the_reference_it_tracks(sun_pass_sampled_every_second):
+    scenario, row = sun_pass_sampled_every_second
+    constraint = scenario.problem.pointing[0]
+    on_samples = constraint.margins(row.simulation.t, row.simulation.q)
+    assert np.nanmin(on_samples) > 0.0  # every sample of the loop is outside the cone
+    reference = row.requirements["reference"]["st_sun"]
+    closed_loop = row.requirements["closed_loop"]["st_sun"]
+    assert reference["min_margin_deg"] < -0.4
+    assert closed_loop["min_margin_deg"] < 0.0
+    assert closed_loop["min_margin_deg"] == pytest.approx(reference["min_margin_deg"], abs=0.01)
+    assert closed_loop["min_margin_time_s"] == pytest.approx(reference["min_margin_time_s"], abs=0.05)
+    assert closed_loop["time_in_violation_s"] == pytest.approx(reference["time_in_violation_s"], abs=0.01)
+    assert closed_loop["first_violation_s"] == pytest.approx(reference["first_violation_s"], abs=0.01)
+    assert row.status == "violated" and "st_sun (closed loop): min margin -0.41" in row.message
