@@ -117,3 +117,82 @@ def test_a_closed_loop_sampled_every_second_is_scored_as_the_reference_it_tracks
     assert closed_loop["time_in_violation_s"] == pytest.approx(reference["time_in_violation_s"], abs=0.01)
     assert closed_loop["first_violation_s"] == pytest.approx(reference["first_violation_s"], abs=0.01)
     assert row.status == "violated" and "st_sun (closed loop): min margin -0.41" in row.message
+
+
+def test_the_interpolated_attitude_off_an_eigenaxis_with_the_samples_signs_flipped() -> None:
+    """A constant body rate about a body axis that is no inertial axis, from an attitude that is not
+    the identity: q(t) = q0 ⊗ [cos(|ω| t / 2), sin(|ω| t / 2) ω̂] (closed form, body rates). The
+    samples' signs alternate (q and -q are one attitude). A slope from inertial rates
+    (½ [0, ω] ⊗ q) is 0.1 deg and more off here, at mid-interval."""
+    from ocp.geometry.pointing import hermite_attitudes
+
+    axis = np.array([1.0, 2.0, 3.0]) / math.sqrt(14.0)
+    rate = 0.05
+    q0 = quat.from_axis_angle(np.array([0.3, -1.0, 0.5]) / np.linalg.norm([0.3, -1.0, 0.5]), 1.1)
+
+    def exact(times: np.ndarray) -> np.ndarray:
+        half = 0.5 * rate * times
+        turn = np.column_stack([np.cos(half), np.sin(half)[:, None] * axis])
+        return np.stack([quat.product(q0, r) for r in turn])
+
+    t = np.arange(0.0, 20.5, 1.0)
+    q = exact(t) * np.where(np.arange(t.size) % 2, -1.0, 1.0)[:, None]
+    omega = np.tile(rate * axis, (t.size, 1))
+    middle = t[:-1] + 0.5
+    error = np.degrees(quat.error_angle(hermite_attitudes(t, q, omega, middle), exact(middle)))
+    assert np.max(error) < 1e-5
+
+
+def test_a_violation_narrower_than_the_sub_grid_step_is_found_by_the_search() -> None:
+    """A 0.01 deg cone about a direction 0.005 deg off the path, passed exactly half-way between two
+    points of the sub-grid (58 steps per 1 s sample interval at 0.05 rad/s): on the sub-grid the
+    boresight stays 0.025 deg off (clear of the cone); the true margin is -0.005 deg (closed form)."""
+    steps = math.ceil(RATE * 1.0 / math.radians(0.05))
+    passing = 4.0 + (steps // 2 + 0.5) / steps
+    e, cone = math.radians(0.005), math.radians(0.01)
+    requirement = PointingRequirement("x_out", Sensor("x_axis", [1.0, 0.0, 0.0]), True, cone,
+                                      Direction(None, [math.cos(e), 0.0, math.sin(e)]))
+    problem = ManeuverProblem(Spacecraft(np.diag([2.0, 3.0, 4.0])), quat.IDENTITY, np.zeros(3), None, 10.0,
+                              pointing=(requirement.constraint(Geometry(None, None), 10.0),))
+    t = np.arange(0.0, 10.5, 1.0)
+    half = 0.5 * RATE * (t - passing)
+    q = np.stack([np.cos(half), np.zeros_like(t), np.zeros_like(t), np.sin(half)], axis=-1)
+    omega = np.tile([0.0, 0.0, RATE], (t.size, 1))
+    score = score_closed_loop(Requirements((requirement,)), problem, t, q, omega, 10.0)["x_out"]
+    assert not score.met
+    assert score.values["min_margin_deg"] == pytest.approx(math.degrees(e - cone), abs=1e-7)
+    assert score.values["min_margin_time_s"] == pytest.approx(passing, abs=1e-4)
+
+
+def test_a_long_fast_run_far_from_the_cone_costs_a_bounded_search(monkeypatch) -> None:
+    """15 000 one-second samples of a 0.2 rad/s tumble about z, the keep-out direction on the z
+    axis (the x boresight stays 90 deg from it, margin 80 deg): no interval can hide a violation, and
+    the bound cannot exclude a lower margin anywhere (it is constant), so each interval gets the
+    coarse steps and only the deepest few steps are searched (the fine sub-grid of every interval
+    and its search evaluated 3.6e8 margins: 4 s and 0.9 GB at 15 000 samples)."""
+    from ocp.geometry.pointing import (
+        COARSE_STEPS,
+        MIN_SEARCHES,
+        REFINE_LEVELS,
+        REFINE_POINTS,
+        PointingConstraint,
+    )
+
+    requirement = PointingRequirement("x_out", Sensor("x_axis", [1.0, 0.0, 0.0]), True, math.radians(10.0),
+                                      Direction(None, [0.0, 0.0, 1.0]))
+    constraint = requirement.constraint(Geometry(None, None), 15000.0)
+    t = np.arange(0.0, 15000.0)
+    half = 0.1 * t
+    q = np.stack([np.cos(half), np.zeros_like(t), np.zeros_like(t), np.sin(half)], axis=-1)
+    omega = np.tile([0.0, 0.0, 0.2], (t.size, 1))
+    evaluated = []
+    original = PointingConstraint.margins
+
+    def counted(self, times, attitudes):
+        evaluated.append(len(np.atleast_1d(times)))
+        return original(self, times, attitudes)
+
+    monkeypatch.setattr(PointingConstraint, "margins", counted)
+    score = constraint.score_between_samples(t, q, omega)
+    assert score.met and score.min_margin_deg == pytest.approx(80.0, abs=1e-6)
+    assert sum(evaluated) <= (COARSE_STEPS + 1) * t.size + MIN_SEARCHES * REFINE_POINTS * REFINE_LEVELS

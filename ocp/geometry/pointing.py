@@ -34,13 +34,21 @@ from ocp import quat_casadi as qc
 
 Array = NDArray[np.float64]
 
-__all__ = ["FINE_STEP", "REFINE_LEVELS", "REFINE_POINTS", "PointingConstraint", "PointingScore", "hermite_attitudes",
-           "violation_intervals"]
+__all__ = ["COARSE_STEPS", "FINE_STEP", "MIN_SEARCHES", "REFINE_LEVELS", "REFINE_POINTS", "PointingConstraint",
+           "PointingScore", "hermite_attitudes", "violation_intervals"]
 
 FINE_STEP = np.deg2rad(0.05)
 """[rad]: the largest rotation of the attitude between two points of the sub-grid on which
 :meth:`PointingConstraint.score_between_samples` evaluates the margin (each sample interval is cut
 into as many equal steps as its faster end's rate needs, at least 4)."""
+COARSE_STEPS = 16
+"""Steps of a sample interval that may hide a lower margin but no violation (by the bound of
+:meth:`PointingConstraint.score_between_samples`): the smallest margin there is searched further
+(:data:`MIN_SEARCHES`), not the whole interval at :data:`FINE_STEP`."""
+MIN_SEARCHES = 64
+"""Sub-grid steps searched for a lower margin, the deepest by the bound first (every step that may
+hide a violation is searched): the cost stays bounded when the bound cannot exclude much (a
+boresight circling at a constant angle to the direction)."""
 REFINE_POINTS = 17
 """Points of each zoom of :meth:`PointingConstraint.score_between_samples`'s search for a minimum
 inside a sub-grid step (each zoom narrows the bracket to two of its steps: 8 times)."""
@@ -379,16 +387,21 @@ class PointingConstraint:
     def score_between_samples(self, t: ArrayLike, q: ArrayLike, omega: ArrayLike) -> PointingScore:
         """Score a motion known at samples by its attitude and body rate, between the samples too.
 
-        The attitude between samples is the cubic Hermite of :func:`hermite_attitudes`. The margin
-        is evaluated on a sub-grid of each sample interval, cut into equal steps over which the
-        attitude turns at most :data:`FINE_STEP` (at least 4), plus the window's ends. Every
-        sub-grid step whose margin could dip, between its ends, below the smallest margin found, or
-        below zero where neither end is negative (by a Lipschitz bound: the mean of its ends less half
-        the step times a bound on the margin's rate, 1.5 times the faster sample's ``‖ω‖`` plus the
-        direction's and the limit's rates) is searched for its minimum (up to :data:`REFINE_LEVELS`
-        zooms of :data:`REFINE_POINTS` points, each while the bound still allows something lower);
-        the minima found join the sub-grid. The smallest margin and its time, and the violations (zero crossings interpolated
-        linearly between the points), are then those of :meth:`score` on the points.
+        The attitude between samples is the cubic Hermite of :func:`hermite_attitudes`. A bound says
+        where to look: over a stretch of length ``Δ`` the margin stays above the mean of its ends
+        less ``½ Δ`` times a bound on its rate (1.5 times the larger of the faster sample's ``‖ω‖``
+        and the mean rate of the turn between the samples, plus the direction's and the limit's
+        rates). A sample interval that may hide a violation by it, or has one at an end, is cut into
+        equal steps over which the attitude turns at most :data:`FINE_STEP` (at least 4); one that
+        may only hide a lower margin into at most :data:`COARSE_STEPS`; the others keep their
+        samples alone. Every step that may hide a violation between two clear points, and the
+        :data:`MIN_SEARCHES` steps that may hide the lowest margins, are searched for their minimum
+        (up to :data:`REFINE_LEVELS` zooms of :data:`REFINE_POINTS` points, each while the bound
+        still allows something lower); the minima found join the points. The smallest margin and
+        its time, and the violations (zero crossings interpolated linearly between the points), are
+        then those of :meth:`score` on the points. A violation is never missed where the samples
+        agree with their rates; a positive least margin is exact where the search reaches it, else
+        within the bound over a step.
 
         Parameters
         ----------
@@ -411,22 +424,42 @@ class PointingConstraint:
             return self.score(t, q)
         h = np.diff(t)
         norms = np.linalg.norm(omega, axis=1)
-        rate = np.maximum(norms[:-1], norms[1:])  # per sample interval
-        steps = np.maximum(4, np.ceil(rate * h / FINE_STEP)).astype(int)
+        # per sample interval: the faster end's rate, or the mean rate of the turn between the samples
+        # when that is more (samples whose rates do not match their attitudes: the Hermite still turns)
+        quat_ = quat.continuous(q)
+        chord = 2.0 * np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", quat_[:-1], quat_[1:])), 0.0, 1.0))
+        rate = np.maximum(np.maximum(norms[:-1], norms[1:]),
+                          np.divide(chord, h, out=np.zeros_like(h), where=h > 0.0))
+        # by the same bound over each sample interval: those that may hide a violation, or have one at
+        # an end (its crossings are located on the sub-grid), are cut into the fine sub-grid; those
+        # that may only hide a lower margin into at most COARSE_STEPS steps; the others keep their
+        # samples alone (a long fast run far from the cone costs its samples)
+        at_samples = self.margins(t, q)
+        if not np.any(np.isfinite(at_samples)):
+            return PointingScore(None, 0.0, None, None)
+        lowest = np.fmin(at_samples[:-1], at_samples[1:])
+        with np.errstate(invalid="ignore"):
+            reach = 0.5 * (at_samples[:-1] + at_samples[1:]) - 0.5 * (1.5 * rate + self._drift) * h
+            violation = ((lowest >= 0.0) & (reach < 0.0)) | (lowest < 0.0)
+            deeper = reach < float(np.nanmin(at_samples))
+        fine_steps = np.maximum(4, np.ceil(rate * h / FINE_STEP))
+        steps = np.where(violation, fine_steps, np.where(deeper, np.minimum(COARSE_STEPS, fine_steps), 1)).astype(int)
         offset = np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)
         fine = np.repeat(t[:-1], steps) + np.repeat(h, steps) * offset / np.repeat(steps, steps)
         ends = [edge for edge in self.window if t[0] < edge < t[-1]]
         fine = np.unique(np.concatenate([fine, [t[-1]], ends]))
         margin = self.margins(fine, hermite_attitudes(t, q, omega, fine))
-        if not np.any(np.isfinite(margin)):
-            return PointingScore(None, 0.0, None, None)
         # the sub-grid steps that may hide, between their ends, a margin below the smallest found or
         # below zero where neither end is: a Lipschitz bound of the margin over the step
         interval = np.clip(np.searchsorted(t, fine[:-1], side="right") - 1, 0, len(t) - 2)
         speed = 1.5 * rate[interval] + self._drift
         floor = 0.5 * (margin[:-1] + margin[1:]) - 0.5 * speed * np.diff(fine)
         with np.errstate(invalid="ignore"):
-            suspect = np.flatnonzero(self._suspect(floor, np.fmin(margin[:-1], margin[1:]), float(np.nanmin(margin))))
+            ends_low = np.fmin(margin[:-1], margin[1:])
+            hidden = np.flatnonzero((ends_low >= 0.0) & (floor < 0.0))  # a violation between two clear points
+            lower = np.flatnonzero(floor < float(np.nanmin(margin)))  # a lower margin: the deepest few only
+            lower = lower[np.argsort(floor[lower], kind="stable")[:MIN_SEARCHES]]
+            suspect = np.union1d(hidden, lower)
         if suspect.size:
             found_t, found_m = self._zoom(t, q, omega, fine[suspect], fine[suspect + 1], speed[suspect],
                                           float(np.nanmin(margin)))
