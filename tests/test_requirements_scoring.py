@@ -205,3 +205,15 @@ def test_requirement_names_are_distinct_and_not_reserved():
         Requirements((PointingRequirement("rate", X_AXIS, True, 0.5, direction),))
     assert Requirements((PointingRequirement("a", X_AXIS, True, 0.5, direction),),
                         rate=RateRequirement(1.0)).names == ("a", "rate")
+
+
+def test_a_broken_bound_and_its_value_are_written_to_the_same_digits():
+    from scenarios.requirements.scoring import _over
+    assert _over(1.0000073, 1.0) == ("1.00001", "1")
+    assert _over(0.1234568, 0.1234567) == ("0.1234568", "0.1234567")
+    assert _over(2.5, 1.0) == ("2.5", "1")
+    rng = np.random.default_rng(3)
+    for bound in rng.uniform(1e-3, 10.0, 200):
+        for excess in (1e-9, 1e-6, 1e-3, 0.5):
+            shown, limit = _over(bound * (1 + excess), bound)
+            assert float(shown) > float(limit)  # as written, the value reads above its bound

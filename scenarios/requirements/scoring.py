@@ -93,14 +93,14 @@ _TOLERANCE = 1e-9
 """Relative slack on the ratio and bound checks (rounding, not a margin)."""
 
 
-def _over(value: float, bound: float) -> str:
-    """``value`` (above ``bound``) with 3 significant digits, or as many more as it takes to read
-    above the bound as written (``1.00001`` over 1, not ``1``), 12 at most."""
+def _over(value: float, bound: float) -> tuple[str, str]:
+    """``value`` (above ``bound``) and ``bound``, with 3 significant digits or as many more as it
+    takes for the value to read above the bound (``1.00001`` over 1, not ``1``), 12 at most."""
     for digits in range(3, 13):
-        text = f"{value:.{digits}g}"
-        if float(text) > float(f"{bound:.{digits}g}"):
-            return text
-    return f"{value:.12g}"
+        shown, limit = f"{value:.{digits}g}", f"{bound:.{digits}g}"
+        if float(shown) > float(limit):
+            return shown, limit
+    return f"{value:.12g}", f"{bound:.12g}"
 
 
 @dataclass(frozen=True)
@@ -175,7 +175,7 @@ def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
     values: dict[str, float | None] = dict(zip(RATE_FIELDS, (peak, float(t[worst]), ratio)))
     met = ratio <= 1.0 + _TOLERANCE
     return Score("rate", values, met, "" if met else f"peak rate {peak:.4g} rad/s at {t[worst]:.1f} s, "
-                                                     f"{_over(ratio, 1.0)} x the {requirement.max_rate:g} rad/s bound")
+                                                     f"{_over(ratio, 1.0)[0]} x the {requirement.max_rate:g} rad/s bound")
 
 
 def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, problem: ManeuverProblem,
@@ -192,15 +192,15 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
         worst = int(np.argmax(errors))
         values["worst_error_deg"] = float(errors[worst])
         if requirement.error_deg is not None and errors[worst] > requirement.error_deg * (1 + _TOLERANCE):
-            problems.append(f"error {_over(errors[worst], requirement.error_deg)} deg at {t[inside][worst]:.1f} s "
-                            f"over {requirement.error_deg:g} deg")
+            shown, limit = _over(errors[worst], requirement.error_deg)
+            problems.append(f"error {shown} deg at {t[inside][worst]:.1f} s over {limit} deg")
     if problem.omegaf is not None:
         rates = np.linalg.norm(omega[inside] - problem.omegaf, axis=1)
         worst = int(np.argmax(rates))
         values["worst_rate_error"] = float(rates[worst])
         if requirement.rate is not None and rates[worst] > requirement.rate * (1 + _TOLERANCE):
-            problems.append(f"rate error {_over(rates[worst], requirement.rate)} rad/s at {t[inside][worst]:.1f} s "
-                            f"over {requirement.rate:g} rad/s")
+            shown, limit = _over(rates[worst], requirement.rate)
+            problems.append(f"rate error {shown} rad/s at {t[inside][worst]:.1f} s over {limit} rad/s")
     return Score("final", values, not problems, (", ".join(problems) + f" (from {start:g} s)") if problems else "")
 
 
@@ -257,6 +257,7 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
                torque: Array | None = None) -> Score:
     values: dict[str, float | None] = {}
     broken = []
+    allowed = f"{margin_allowed:.3g}"  # with the digits the most precise ratio shown needs
     for name, quantity in demand.items():
         if not quantity.limited:
             continue
@@ -267,8 +268,10 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
         values[name] = ratio
         values[f"{name}_time_s"] = float(t[worst]) if peaks.size else None
         if ratio > margin_allowed * (1 + _TOLERANCE):
-            broken.append(f"{name} {_over(ratio, margin_allowed)} x its limit at {t[worst]:.1f} s")
-    detail = ", ".join(broken) + f" (allowed {margin_allowed:.3g} x)" if broken else ""
+            shown, limit = _over(ratio, margin_allowed)
+            allowed = max(allowed, limit, key=len)
+            broken.append(f"{name} {shown} x its limit at {t[worst]:.1f} s")
+    detail = ", ".join(broken) + f" (allowed {allowed} x)" if broken else ""
     if jumps is not None:
         largest = max(jumps, key=lambda jump: float(np.linalg.norm(jump[2])), default=None)
         values.update(zip(JUMP_FIELDS, (0.0, None) if largest is None

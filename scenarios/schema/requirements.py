@@ -250,7 +250,7 @@ def _direction(node: Node, geometry: Geometry) -> Direction:
     """A direction: a registered kind's name or ``{inertial: [x, y, z]}``, checked against what the
     scenario gives (epoch, orbit)."""
     if isinstance(node.value, dict):
-        if "inertial" not in node.value and len(node.value) == 1:  # a frame a target takes (lvlh, ground, ...)
+        if len(node.value) == 1 and next(iter(node.value)) in ("lvlh", "rtn", "ground"):  # a target's frame
             raise node.error(f"a requirement's direction is a name of {sorted(DIRECTIONS)} or {{inertial: [x, y, z]}}, "
                              f"got {{{excerpt(next(iter(node.value)))}: ...}} (the lvlh, rtn and ground frames are "
                              "for the manoeuvre's attitude targets, not for requirements)")
@@ -299,10 +299,10 @@ def _pointing(node: Node, name: str, sensors: dict[str, Sensor], geometry: Geome
         constraint = requirement.constraint(geometry, span.table)
     except ModelError as error:
         raise direction_node.error(error.message) from None
-    if keep_out and constraint.growth is not None:  # a cone widened by the Earth's disc may cover the sky
+    if keep_out:  # a cone widened by the Earth's disc may cover the sky
         end = span.run if window[1] is None else window[1]
-        inside = (constraint.times >= window[0] - 1e-9) & (constraint.times <= end + 1e-9)
-        widest = float(np.max(constraint.growth[inside], initial=0.0)) + requirement.angle
+        inside = constraint.times[(constraint.times > window[0]) & (constraint.times < end)]
+        widest = float(np.max(constraint.limit(np.concatenate([[window[0], end], inside]))))
         if widest >= np.pi:
             raise ScenarioError(f"{node.path}.angle_deg",
                                 f"{angle:g} deg from the limb, with the Earth's apparent radius up to "
