@@ -11,7 +11,7 @@ import subprocess
 import sys
 import textwrap
 import time
-from concurrent.futures import Executor, Future, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -25,6 +25,7 @@ from scenarios.study.engine import sweep
 from scenarios.study.spec import load_study, parse_study
 from scenarios.study.store import SweepStore, resume_counts
 from scenarios.study.worker import crashed_rows, run_case
+from tests.test_sweep import InlineExecutor
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -45,22 +46,6 @@ def payload(timeout_s, duration=30.0):
     scenario = copy.deepcopy(BASE)
     scenario["maneuver"]["duration"] = duration
     return {"key": "k", "index": 0, "scenario": scenario, "timeout_s": timeout_s}
-
-
-class InlineExecutor(Executor):
-    """Runs each task at submission, in this thread (so a test's monkeypatching applies)."""
-
-    def __init__(self):
-        self.submitted = 0
-
-    def submit(self, fn, *args, **kwargs):
-        self.submitted += 1
-        future = Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except BaseException as error:  # noqa: BLE001 - handed to the caller like any executor
-            future.set_exception(error)
-        return future
 
 
 # --- the time limit ------------------------------------------------------------------------------
