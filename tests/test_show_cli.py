@@ -248,3 +248,40 @@ def test_console_script_version(tmp_path):
     completed = subprocess.run([sys.executable, "-m", "scenarios.console", "--version"], capture_output=True,
                                text=True, timeout=120, cwd=ROOT)
     assert completed.returncode == 0 and completed.stdout.strip() == f"slewbench {source_version()}"
+
+
+def test_validate_a_scenario_says_what_every_row_is_scored_against(tmp_path, capsys):
+    """The requirements in words (the margin 0.25 is 75 % of each limit; the window, the final bounds),
+    the truth model's keys and the sensors: a user sees what a run will hold each row to."""
+    data = yaml.safe_load(DEMO.read_text())
+    data["spacecraft"]["sensors"] = {"camera": {"boresight": [0, 0, 1]}}
+    data["requirements"] = {
+        "pointing": {"cam_sun": {"sensor": "camera", "keep_out": {"inertial": [0, 1, 0]}, "angle_deg": 20, "window": [5, 40]},
+                     "cam_in": {"sensor": "camera", "keep_in": {"inertial": [0, 0, 1]}, "angle_deg": 170}},
+        "actuators": {"margin": 0.25}, "rate": {"max": 0.3},
+        "final": {"after_s": 4, "error_deg": 0.5, "rate": 0.002}}
+    data["truth"] = {"spacecraft": {"inertia": [1.1, 1.2, 1.3]}}
+    data["simulation"].pop("sensor_noise", None)  # the declared sensors give the noise
+    data["simulation"]["sensors"] = {"gyro": {"arw_deg_per_sqrt_h": 0.01},
+                                     "star_tracker": {"noise_arcsec": [5, 5, 40], "outages_s": [[10, 12.5]]}}
+    data["simulation"]["estimator"] = {"type": "mekf", "initial_attitude_sigma_deg": 0.1,
+                                       "initial_bias_sigma_deg_per_h": 5.0}
+    path = tmp_path / "scored.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))  # the requirements in the order written
+    assert main(["validate", str(path)]) == 0
+    lines = capsys.readouterr().out.splitlines()[1:]
+    assert lines == [
+        "  requirement cam_sun: camera keep-out 20 deg about inertial [0, 1, 0] from 5 s to 40 s",
+        "  requirement cam_in: camera keep-in 170 deg about inertial [0, 0, 1]",
+        "  requirement actuators: the reference's demand at most 75 % of each actuator limit",
+        "  requirement rate: ‖ω‖ at most 0.3 rad/s (reference and closed loop)",
+        ("  requirement final: error to the target at most 0.5 deg, ‖ω − ω_f‖ at most 0.002 rad/s in the closed "
+         "loop from T + 4 s to the end of the run"),
+        "  truth (the closed loop's plant differs from the design in): truth.spacecraft.inertia",
+        "  sensors: gyro, star tracker (outages 10-12.5 s); estimator: MEKF"]
+
+
+def test_validate_without_requirements_says_the_actuator_limits_alone_are_scored(capsys):
+    assert main(["validate", str(DEMO)]) == 0
+    assert capsys.readouterr().out.splitlines()[1:] == [
+        "  requirements: the actuators' limits only (no requirements section)"]

@@ -173,7 +173,39 @@ def command_validate(args: argparse.Namespace) -> int:
     print(f"{args.file}: valid scenario {scenario.name!r} with {len(scenario.planners)} planner(s) and "
           f"controller{'s' if len(scenario.controllers) > 1 else ''} {controllers}: {len(labels)} row(s) "
           f"({', '.join(label.label for label in labels)})")
+    for line in _scenario_details(scenario):
+        print("  " + line)
     return EXIT_OK
+
+
+def _leaf_paths(value: Any, prefix: str) -> list[str]:
+    """The dotted paths of a mapping's leaves (``truth.wheels.friction.coulomb``)."""
+    if not isinstance(value, dict) or not value:
+        return [prefix]
+    return [path for key, item in value.items() for path in _leaf_paths(item, f"{prefix}.{key}")]
+
+
+def _scenario_details(scenario: Any) -> list[str]:
+    """What ``validate`` says beyond the rows: every requirement each row is scored against, the
+    truth model's keys (where the plant differs from the design) and the sensors and estimator in
+    the loop."""
+    lines = [f"requirement {line}" for line in scenario.requirements.describe()]
+    if not lines:
+        lines.append("requirements: the actuators' limits only (no requirements section)")
+    truth = scenario.data.get("truth") if isinstance(scenario.data, dict) else None
+    if scenario.truth is not None and isinstance(truth, dict):
+        lines.append("truth (the closed loop's plant differs from the design in): "
+                     + ", ".join(_leaf_paths(truth, "truth")))
+    sensors = scenario.simulation.sensors
+    if sensors is not None:
+        parts = [name for name, present in (("gyro", sensors.gyro), ("star tracker", sensors.star_tracker),
+                                            ("magnetometer", sensors.magnetometer)) if present is not None]
+        if sensors.star_tracker is not None and sensors.star_tracker.outages:
+            parts[parts.index("star tracker")] += " (outages " + ", ".join(
+                f"{a:g}-{b:g} s" for a, b in sensors.star_tracker.outages) + ")"
+        estimator = "MEKF" if sensors.estimator is not None else "none"
+        lines.append(f"sensors: {', '.join(parts) or 'none'}; estimator: {estimator}")
+    return lines
 
 
 def command_run(args: argparse.Namespace) -> int:

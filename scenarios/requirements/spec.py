@@ -149,6 +149,24 @@ class PointingRequirement:
     direction: Direction
     window: tuple[float, float | None] = (0.0, None)
 
+    def describe(self) -> str:
+        """The requirement in words (``star_tracker keep-out 30 deg about sun``, its window when it
+        is not the whole run), for messages and ``slewbench validate``.
+
+        Returns
+        -------
+        str
+        """
+        words = self._cone()
+        if self.window != (0.0, None):
+            end = "the end" if self.window[1] is None else f"{self.window[1]:g} s"
+            words += f" from {self.window[0]:g} s to {end}"
+        return words
+
+    def _cone(self) -> str:
+        return (f"{self.sensor.name} {'keep-out' if self.keep_out else 'keep-in'} {np.rad2deg(self.angle):g} deg "
+                f"about {self.direction.describe()}")
+
     def constraint(self, geometry: Geometry, duration: float) -> PointingConstraint:
         """This requirement made concrete for a run: its direction tabulated over ``[0, duration]``.
 
@@ -172,9 +190,7 @@ class PointingRequirement:
         times, directions, growth = self.direction.table(geometry, duration)
         end = np.inf if self.window[1] is None else float(self.window[1])
         return PointingConstraint(self.name, self.sensor.boresight, self.keep_out, self.angle, times, directions,
-                                  growth, (float(self.window[0]), end),
-                                  description=f"{self.sensor.name} {'keep-out' if self.keep_out else 'keep-in'} "
-                                              f"{np.rad2deg(self.angle):g} deg about {self.direction.describe()}")
+                                  growth, (float(self.window[0]), end), description=self._cone())
 
 
 @dataclass(frozen=True)
@@ -202,6 +218,15 @@ class ActuatorRequirement:
         """The largest demand-to-limit ratio allowed, ``1 − margin``."""
         return 1.0 - self.margin
 
+    def describe(self) -> str:
+        """The requirement in words, for ``slewbench validate``.
+
+        Returns
+        -------
+        str
+        """
+        return f"the reference's demand at most {100.0 * self.allowed:g} % of each actuator limit"
+
 
 @dataclass(frozen=True)
 class RateRequirement:
@@ -218,6 +243,15 @@ class RateRequirement:
     def __post_init__(self) -> None:
         if not (np.isfinite(self.max_rate) and self.max_rate > 0.0):
             raise ValueError(f"the rate bound must be positive, got {self.max_rate!r}")
+
+    def describe(self) -> str:
+        """The requirement in words, for ``slewbench validate``.
+
+        Returns
+        -------
+        str
+        """
+        return f"‖ω‖ at most {self.max_rate:g} rad/s (reference and closed loop)"
 
 
 @dataclass(frozen=True)
@@ -238,6 +272,18 @@ class FinalRequirement:
     after_s: float
     error_deg: float | None = None
     rate: float | None = None
+
+    def describe(self) -> str:
+        """The requirement in words, for ``slewbench validate``.
+
+        Returns
+        -------
+        str
+        """
+        bounds = ([] if self.error_deg is None else [f"error to the target at most {self.error_deg:g} deg"]) \
+            + ([] if self.rate is None else [f"‖ω − ω_f‖ at most {self.rate:g} rad/s"])
+        return (", ".join(bounds) or "no bound (scored, never broken)") \
+            + f" in the closed loop from T + {self.after_s:g} s to the end of the run"
 
 
 @dataclass(frozen=True)
@@ -285,3 +331,18 @@ class Requirements:
 
     def __bool__(self) -> bool:
         return bool(self._names)
+
+    def describe(self) -> list[str]:
+        """One line per requirement, ``name: words``, in the order of :attr:`names` (the actuator
+        requirement every scenario carries unstated, margin 0, left out), for ``slewbench validate``.
+
+        Returns
+        -------
+        list of str
+        """
+        lines = [f"{requirement.name}: {requirement.describe()}" for requirement in self.pointing]
+        if self.actuators is not None and self.actuators.stated:
+            lines.append(f"actuators: {self.actuators.describe()}")
+        lines += [f"{name}: {getattr(self, name).describe()}" for name in ("rate", "final")
+                  if getattr(self, name) is not None]
+        return lines
