@@ -96,7 +96,9 @@ METRIC_INFO: dict[str, MetricInfo] = {
         "rad/s", "‖ω(t_N)‖, the body rate at the last sample."),
     "energy_ratio": MetricInfo(
         "–", "½ ω(t_N)ᵀ I ω(t_N) / ½ ω(t_0)ᵀ I ω(t_0), the body's rotational kinetic energy at the end over "
-        "that at the start (wheels excluded); null when the initial energy is zero."),
+        "that at the start (wheels excluded); null when the motion starts at rest (an initial energy at most "
+        "1e-12 of the largest along the motion: a rest-to-rest reference's rounding residue, 1e-17 rad/s, is "
+        "rest)."),
     "fine_settling_time_s": MetricInfo(
         "s", "As ``settling_time_s`` with the band ``simulation.fine_settling_tolerance_deg``; null when it "
         "is not set."),
@@ -120,6 +122,10 @@ DEFAULT_SETTLING_TOLERANCE_DEG = 0.5
 """deg, error band about the target attitude for ``settling_time_s``."""
 DEFAULT_DETUMBLE_TOLERANCE = 0.01
 """rad/s, bound on every body-rate component for ``detumble_time_s``."""
+REST_ENERGY_RTOL = 1e-12
+"""``energy_ratio`` is null when the initial kinetic energy is at most this fraction of the largest
+along the motion (a rate 1e-6 of the peak rate): a start at rest, whose rounding residue (a
+rest-to-rest reference's 1e-17 rad/s) would otherwise give a ratio of two rounding errors."""
 
 
 def detumble_time(t: NDArray, omega: NDArray, tolerance: float = DEFAULT_DETUMBLE_TOLERANCE) -> float | None:
@@ -321,9 +327,10 @@ def compute_metrics(
         metrics["final_knowledge_error_deg"] = float(knowledge[-1])
         metrics["max_knowledge_error_deg"] = float(np.max(knowledge))
     if inertia is not None:
-        omega_ends = np.asarray(omega, dtype=float)[[0, -1]]
-        energy = 0.5 * np.einsum("ni,ij,nj->n", omega_ends, np.asarray(inertia, dtype=float), omega_ends)
-        metrics["energy_ratio"] = float(energy[1] / energy[0]) if energy[0] > 0 else None
+        rates = np.asarray(omega, dtype=float)
+        energy = 0.5 * np.einsum("ni,ij,nj->n", rates, np.asarray(inertia, dtype=float), rates)
+        at_rest = energy[0] <= REST_ENERGY_RTOL * float(np.max(energy))  # rounding residue is rest
+        metrics["energy_ratio"] = None if at_rest else float(energy[-1] / energy[0])
     if reference_q is not None:
         tracking = np.rad2deg(quat.error_angle(q, reference_q))
         metrics["rms_error_deg"] = float(np.sqrt(np.mean(tracking**2)))

@@ -200,3 +200,17 @@ def test_dipole_integral_is_a_hold_integral_of_the_euclidean_norm():
     expected = sum(d * math.sqrt(a * a + b * b + c * c) for d, (a, b, c) in zip(dt, dipole))
     metrics = compute_metrics(T_GRID, np.tile(quat.IDENTITY, (5, 1)), OMEGA, HELD, None, dipole=dipole)
     assert metrics["int_dipole"] == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("residue, expected", [(1e-17, None), (0.0, None), (1e-3, 0.5 * 2.0 * 0.02**2 / (0.5 * 2.0 * 1e-3**2))])
+def test_energy_ratio_is_null_for_a_start_at_rest_up_to_rounding(residue, expected):
+    """A rest-to-rest reference starts at 1e-17 rad/s (rounding): E_T/E_0 would divide two rounding
+    errors (the README's eigenaxis row showed 4.956). A real 1e-3 rad/s start keeps its ratio."""
+    t = np.linspace(0.0, 4.0, 5)
+    omega = np.array([[residue, 0, 0], [0.02, 0, 0], [0.05, 0, 0], [0.02, 0, 0], [0.02, 0, 0]])
+    q = np.tile([1.0, 0, 0, 0], (5, 1))
+    metrics = compute_metrics(t, q, omega, np.zeros((4, 3)), None, inertia=np.diag([2.0, 3.0, 4.0]))
+    if expected is None:
+        assert metrics["energy_ratio"] is None
+    else:
+        assert metrics["energy_ratio"] == pytest.approx(expected, rel=1e-12)  # ω_T²/ω_0² = 400
