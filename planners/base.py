@@ -67,7 +67,7 @@ class Planner(Configurable, ABC):
       trajectory optimisation), so ``collocation`` plans it as a start by default
       (``seed_planners: auto``) wherever :meth:`problem_error` accepts the problem.
     * ``honours`` names the scenario requirements (:data:`REQUIREMENT_KINDS`) the planner imposes
-      on its references: ``"pointing"`` (``problem.pointing``, every window and moving direction
+      on its references (:meth:`honoured`: with given options): ``"pointing"`` (``problem.pointing``, every window and moving direction
       included), ``"actuators"`` (the actuators' limits tightened by ``problem.actuator_margin``),
       ``"rate"`` (``problem.max_rate``). A planner that honours a kind imposes it and checks its
       reference densely (not only at its own points); a reference that still misses returns as a
@@ -105,7 +105,25 @@ class Planner(Configurable, ABC):
     """Whether it plans in milliseconds, so that ``collocation`` seeds from it by default."""
 
     honours: ClassVar[frozenset[str]] = frozenset()
-    """The requirement kinds (of :data:`REQUIREMENT_KINDS`) the planner imposes on its references."""
+    """The requirement kinds (of :data:`REQUIREMENT_KINDS`) the planner imposes on its references
+    whatever its options (:meth:`honoured` adds those some options impose)."""
+
+    @classmethod
+    def honoured(cls, options: Any) -> frozenset[str]:
+        """The requirement kinds the planner imposes with these options: :attr:`honours`, and in a
+        subclass whose options decide (``shape_polynomial``'s ``duration: rate_limit``) those too.
+
+        Parameters
+        ----------
+        options : Options
+            The planner's parsed options.
+
+        Returns
+        -------
+        frozenset of str
+            Kinds of :data:`REQUIREMENT_KINDS`.
+        """
+        return cls.honours
 
     def __init__(self, options: Mapping[str, Any] | Any | None = None, path: str = "options",
                  cache: SolverCache | None = None) -> None:

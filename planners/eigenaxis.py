@@ -1,10 +1,14 @@
 """Eigenaxis slew: rotation about the fixed Euler axis of ``q0* ⊗ qf``, with three angle profiles.
 
 * ``smooth``: quintic θ(t) over the scenario's T with zero angular acceleration at both ends and
-  the boundary rates projected on the axis (rest-to-rest when they are zero).
+  the boundary rates projected on the axis (rest-to-rest when they are zero); ``infeasible`` if its
+  peak rate (15 Θ / (8 T) from rest to rest) exceeds the rate bound.
 * ``trapezoidal``: bang-coast-bang over the scenario's T, rest to rest, with the largest
   acceleration the torque bounds allow; ``infeasible`` if T is shorter than the minimum time.
 * ``min_time``: the fastest bang-coast-bang under the torque and optional rate bounds.
+
+Every profile honours the rate bound (option ``max_rate``, else ``maneuver.max_rate``): the body
+rate is ``‖ω‖ = |θ̇|``.
 
 The body rate is ``ω = e θ̇`` and the feed-forward torque the inverse dynamics
 ``I ω̇ + ω × I ω = I e θ̈ + θ̇² e × I e``; the second term is not zero off a principal axis, so the
@@ -138,12 +142,21 @@ class QuinticProfile(AngleProfile):
                 [1, T, T**2, T**3, T**4, T**5], [0, 1, 2 * T, 3 * T**2, 4 * T**3, 5 * T**4],
                 [0, 0, 2, 6 * T, 12 * T**2, 20 * T**3]]
         coefficients = np.linalg.solve(np.array(rows, float), [0, rate0, 0, angle, rate_end, 0])
+        self.duration = float(duration)
         self.position = np.polynomial.Polynomial(coefficients)
         self.rate = self.position.deriv()
         self.acceleration = self.rate.deriv()
 
     def __call__(self, t: Array) -> tuple[Array, Array, Array]:
         return self.position(t), self.rate(t), self.acceleration(t)
+
+    def peak_rate(self) -> float:
+        """``max |θ̇|`` over ``[0, T]`` [rad/s]: at an end or where ``θ̈ = 0`` (the quartic's
+        stationary points, roots of the cubic ``θ̈``)."""
+        candidates = [0.0, self.duration]
+        candidates += [float(r.real) for r in self.acceleration.roots()
+                       if abs(r.imag) <= 1e-9 * max(1.0, abs(r)) and 0.0 <= r.real <= self.duration]
+        return float(np.max(np.abs(self.rate(np.array(candidates)))))
 
     def symbolic(self, t: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX]:
         def horner(polynomial: np.polynomial.Polynomial) -> ca.SX:
@@ -290,6 +303,7 @@ class EigenaxisPlanner(Planner):
     example_options = ({"profile": "smooth"}, {"profile": "trapezoidal"}, {"profile": "min_time"})
     closed_form = True
     cheap = True
+    honours = frozenset({"rate"})  # every profile: ‖ω‖ = |θ̇|, at most the rate bound or infeasible
 
     @classmethod
     def minimises_time(cls, options: Any) -> bool:
@@ -319,8 +333,10 @@ class EigenaxisPlanner(Planner):
             the largest acceleration the torque bounds allow (``infeasible`` if T is below the
             minimum time); ``min_time`` the fastest bang-coast-bang (its own duration).
         max_rate : float or None
-            Bound on the coast rate about the axis [rad/s] for the bang profiles; ``None``
-            (default): the problem's ``maneuver.max_rate`` (if any).
+            Bound on the body rate [rad/s] (``‖ω‖ = |θ̇|`` about the axis): the bang profiles coast
+            at most at it; the quintic, whose peak rate is fixed by T, is ``infeasible`` above it.
+            It tightens the problem's bound (``maneuver.max_rate``, or ``requirements.rate.max``),
+            never loosens it; ``None`` (default): the problem's (if any).
         torque_fraction : float
             Share of the actuators' per-axis torque bound the bang profiles may use, in (0, 1];
             default 1.
@@ -330,18 +346,33 @@ class EigenaxisPlanner(Planner):
         max_rate: Annotated[float | None, Range(gt=0.0)] = None       # rad/s about the axis; default: the problem's max_rate
         torque_fraction: Annotated[float, Range(gt=0.0, le=1.0)] = 1.0        # share of the actuator bound the bang profiles may use
 
+    def _rate_source(self, problem: ManeuverProblem) -> str:
+        """Where the rate bound comes from, in a message."""
+        option = self.options.max_rate
+        return "option max_rate" if option is not None and (problem.max_rate is None or option < problem.max_rate) \
+            else "maneuver.max_rate or requirements.rate.max"
+
     def _plan(self, problem: ManeuverProblem) -> Reference:
         assert problem.qf is not None  # problem_error (the default) refuses a free attitude
         rotvec = quat.to_rotation_vector(quat.error(problem.qf, problem.q0))
         angle = float(np.linalg.norm(rotvec))
         axis = rotvec / angle if angle > 1e-12 else np.array([1.0, 0.0, 0.0])
         inertia = problem.spacecraft.inertia
+        bounds = [b for b in (self.options.max_rate, problem.max_rate) if b is not None]
+        max_rate = min(bounds) if bounds else None  # the option tightens the problem's bound, never loosens it
         if self.options.profile == "smooth":
             rate_end = 0.0 if problem.omegaf is None else float(axis @ problem.omegaf)
             quintic = QuinticProfile(angle, problem.duration, float(axis @ problem.omega0), rate_end)
+            peak = quintic.peak_rate()
+            if max_rate is not None and peak > max_rate * (1 + 1e-12):
+                # |θ̇| of a rest-to-rest quintic peaks at 15 Θ / (8 T), mid-slew
+                at_rest = float(axis @ problem.omega0) == 0.0 and rate_end == 0.0
+                longer = f"; T >= {15 * angle / (8 * max_rate):.4g} s keeps it within" if at_rest else ""
+                return FailedReference(self.name, f"the quintic over T = {problem.duration:g} s peaks at {peak:.4g} "
+                                       f"rad/s, above the rate bound {max_rate:g} rad/s ({self._rate_source(problem)}){longer}",
+                                       "infeasible")
             return EigenaxisReference(problem.q0, axis, quintic, problem.duration, inertia,
                                       f"quintic, {np.rad2deg(angle):.2f} deg about {np.round(axis, 4).tolist()}", problem)
-        max_rate = self.options.max_rate if self.options.max_rate is not None else problem.max_rate
         bounds = self.options.torque_fraction * problem.torque_limit
         accel_axis = inertia @ axis
         gyro = np.abs(np.cross(axis, accel_axis))
@@ -384,8 +415,11 @@ class EigenaxisPlanner(Planner):
             return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,
                                       f"minimum time {profile.duration:.3f} s, coast rate {best_rate:.4g} rad/s", problem)
         if problem.duration < minimum_time * (1 - 1e-12):
+            bounds_words = "the torque bounds"
+            if max_rate is not None and best_rate >= max_rate * (1 - 1e-9):  # the rate bound caps the coast
+                bounds_words += f" and the rate bound {max_rate:g} rad/s ({self._rate_source(problem)})"
             return FailedReference(self.name, f"T = {problem.duration:g} s is shorter than the minimum "
-                                   f"bang-coast-bang time {minimum_time:.4g} s under the torque bounds", "infeasible")
+                                   f"bang-coast-bang time {minimum_time:.4g} s under {bounds_words}", "infeasible")
         # Fixed T: the slowest coast rate w with w (T − w/α(w)) = Θ.
         def covered(w: float) -> float:
             alpha = acceleration(w)

@@ -249,8 +249,9 @@ class ShapePolynomialPlanner(Planner):
             ``rate_limit`` (default; rest-to-rest only): the shortest t_f with ``‖ω‖ <= max_rate``,
             the paper's choice; ``scenario``: the scenario's T.
         max_rate : float or None
-            Rate bound [rad/s] for ``duration: rate_limit``; ``None`` (default): the problem's
-            ``maneuver.max_rate``.
+            Rate bound [rad/s] for ``duration: rate_limit``; it tightens the problem's bound
+            (``maneuver.max_rate``, or ``requirements.rate.max``), never loosens it; ``None``
+            (default): the problem's.
         """
 
         terms: Annotated[int | None, Range(ge=1, le=12)] = None                                    # N; None tries 1..max_terms
@@ -258,6 +259,22 @@ class ShapePolynomialPlanner(Planner):
         cost: Literal["path", "torque"] = "path"
         duration: Literal["rate_limit", "scenario"] = "rate_limit"
         max_rate: Annotated[float | None, Range(gt=0.0)] = None                               # rad/s; default: the problem's max_rate
+
+    @classmethod
+    def honoured(cls, options: Any) -> frozenset[str]:
+        """The rate bound with ``duration: rate_limit`` (t_f is chosen so that ``‖ω‖`` peaks at it,
+        2001 points in τ); nothing over the scenario's T.
+
+        Parameters
+        ----------
+        options : Options
+            The planner's options.
+
+        Returns
+        -------
+        frozenset of str
+        """
+        return frozenset({"rate"}) if getattr(options, "duration", None) == "rate_limit" else frozenset()
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
         """Why the shape polynomials cannot take ``problem``.
@@ -283,7 +300,8 @@ class ShapePolynomialPlanner(Planner):
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         o = self.options
-        max_rate = o.max_rate if o.max_rate is not None else problem.max_rate
+        bounds = [b for b in (o.max_rate, problem.max_rate) if b is not None]
+        max_rate = min(bounds) if bounds else None  # the option tightens the problem's bound, never loosens it
         if o.duration == "rate_limit" and max_rate is None:
             return FailedReference(self.name, "duration: rate_limit needs max_rate (option or maneuver.max_rate)")
         omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf

@@ -78,3 +78,46 @@ def test_too_short_a_duration_is_infeasible_not_an_exception():
     assert "minimum" in reference.message
     with pytest.raises(RuntimeError):
         reference.q(1.0)
+
+
+def test_the_quintic_honours_the_rate_bound_or_is_infeasible():
+    """From rest to rest the quintic's |θ̇| peaks at 15 Θ / (8 T) mid-slew (θ = Θ (10 s³ − 15 s⁴ + 6 s⁵),
+    s = t / T): a bound just above it is met, one just below makes the row infeasible, naming the
+    bound's source and the T that would do (the smooth profile ignored maneuver.max_rate)."""
+    spacecraft = Spacecraft([19.5, 19.0, 12.6], torquers=Torquers(max_torque=0.1))
+    angle, T = 2.0, 100.0
+    peak = 15 * angle / (8 * T)
+    for bound, met in ((peak * 1.001, True), (peak * 0.999, False)):
+        problem = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.from_axis_angle([0, 0, 1], angle), T,
+                                  omegaf=np.zeros(3), max_rate=bound)
+        reference = PLANNERS["eigenaxis"]({"profile": "smooth"}).plan(problem)
+        if met:
+            assert reference.status == "ok", reference.message
+            rates = np.linalg.norm(reference.sample(np.linspace(0, T, 20001)).omega, axis=1)
+            assert np.max(rates) == pytest.approx(peak, rel=1e-9) and np.argmax(rates) == 10000
+        else:
+            assert reference.status == "infeasible"
+            assert f"peaks at {peak:.4g} rad/s" in reference.message and "(maneuver.max_rate or requirements.rate.max)" in reference.message
+            assert f"T >= {15 * angle / (8 * bound):.4g} s keeps it within" in reference.message
+    option = PLANNERS["eigenaxis"]({"profile": "smooth", "max_rate": peak / 2}).plan(problem)
+    assert option.status == "infeasible" and "(option max_rate)" in option.message
+
+
+def test_quintic_peak_rate_against_dense_sampling(rng):
+    from planners.eigenaxis import QuinticProfile
+    for _ in range(100):
+        duration = rng.uniform(1.0, 200.0)
+        profile = QuinticProfile(rng.uniform(0.1, 3.0), duration, rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05))
+        dense = np.max(np.abs(profile.rate(np.linspace(0.0, duration, 200001))))
+        assert profile.peak_rate() == pytest.approx(dense, rel=1e-9)
+
+
+def test_a_duration_too_short_under_the_rate_bound_names_it():
+    spacecraft = Spacecraft([19.5, 19.0, 12.6], torquers=Torquers(max_torque=0.1))
+    # torques alone: 2 sqrt(Θ J / u) = 35.0 s; at 0.01 rad/s the coast makes it Θ/w + w J/u = 160 s
+    problem = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.from_axis_angle([0, 0, 1], 1.57), 120.0,
+                              max_rate=0.01)
+    reference = PLANNERS["eigenaxis"]({"profile": "trapezoidal"}).plan(problem)
+    assert reference.status == "infeasible"
+    assert f"time {1.57 / 0.01 + 0.01 * 12.6 / 0.1:.4g} s under the torque bounds and the rate bound 0.01 rad/s " \
+           "(maneuver.max_rate or requirements.rate.max)" in reference.message

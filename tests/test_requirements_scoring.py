@@ -190,8 +190,14 @@ def test_messages_name_requirement_and_scope_and_what_a_planner_does_not_honour(
     scores = {"reference": scored(requirements, problem, UniformTurn())}
     assert violations(scores) == ["x_out (reference): min margin -30 deg at 5.0 s, 3.3 s inside"]
     eigenaxis = PLANNERS["eigenaxis"]()
-    assert unhonoured(requirements, eigenaxis) == ("eigenaxis does not honour the pointing and rate requirements "
-                                                   "(scored only)")
+    assert unhonoured(requirements, eigenaxis) == "eigenaxis does not honour the pointing requirement (scored only)"
+    natural = PLANNERS["natural_motion"]()
+    assert unhonoured(requirements, natural) == ("natural_motion does not honour the pointing and rate requirements "
+                                                 "(scored only)")
+    # shape_polynomial's options decide: t_f from the rate bound, or the scenario's T regardless of it
+    assert unhonoured(Requirements(rate=RateRequirement(1.0)), PLANNERS["shape_polynomial"]()) == ""
+    assert unhonoured(Requirements(rate=RateRequirement(1.0)), PLANNERS["shape_polynomial"]({"duration": "scenario"})) \
+        == "shape_polynomial does not honour the rate requirement (scored only)"
     assert unhonoured(requirements, None) == ""
     assert unhonoured(Requirements(), eigenaxis) == ""
 

@@ -281,7 +281,29 @@ def test_validate_a_scenario_says_what_every_row_is_scored_against(tmp_path, cap
         "  sensors: gyro, star tracker (outages 10-12.5 s); estimator: MEKF"]
 
 
-def test_validate_without_requirements_says_the_actuator_limits_alone_are_scored(capsys):
+def test_validate_without_requirements_says_the_actuator_limits_alone_are_scored(tmp_path, capsys):
     assert main(["validate", str(DEMO)]) == 0
     assert capsys.readouterr().out.splitlines()[1:] == [
-        "  requirements: the actuators' limits only (no requirements section)"]
+        "  requirement actuators: the reference's demand at most 100 % of each actuator limit (every scenario's, "
+        "unstated)"]
+    data = yaml.safe_load(DEMO.read_text())
+    data["requirements"] = None  # not even the actuators' limits
+    path = tmp_path / "unscored.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["validate", str(path)]) == 0
+    assert capsys.readouterr().out.splitlines()[1:] == [
+        "  requirements: none (requirements: null): no row is scored against any, the actuators' limits included"]
+
+
+def test_validate_says_when_the_end_points_already_break_a_requirement(tmp_path, capsys):
+    """``run`` fails every row before planning when the initial or target attitude breaks a pointing
+    requirement; validate says so at once (the demo starts at identity: body z on inertial z)."""
+    data = yaml.safe_load(DEMO.read_text())
+    data["spacecraft"]["sensors"] = {"camera": {"boresight": [0, 0, 1]}}
+    data["requirements"] = {"pointing": {"cam": {"sensor": "camera", "keep_out": {"inertial": [0, 0, 1]},
+                                                 "angle_deg": 20}}}
+    path = tmp_path / "broken_ends.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["validate", str(path)]) == 0
+    broken = [line for line in capsys.readouterr().out.splitlines() if "every row fails before planning" in line]
+    assert len(broken) == 1 and "cam" in broken[0] and "initial attitude already breaks it" in broken[0]

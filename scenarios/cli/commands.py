@@ -189,9 +189,19 @@ def _scenario_details(scenario: Any) -> list[str]:
     """What ``validate`` says beyond the rows: every requirement each row is scored against, the
     truth model's keys (where the plant differs from the design) and the sensors and estimator in
     the loop."""
-    lines = [f"requirement {line}" for line in scenario.requirements.describe()]
-    if not lines:
-        lines.append("requirements: the actuators' limits only (no requirements section)")
+    from scenarios.requirements.scoring import endpoint_violations
+
+    requirements = scenario.requirements
+    if requirements.actuators is None:
+        lines = ["requirements: none (requirements: null): no row is scored against any, the actuators' limits "
+                 "included"]
+    else:
+        lines = [f"requirement {line}" for line in requirements.describe()]
+        if not requirements.actuators.stated:
+            lines.append("requirement actuators: the reference's demand at most 100 % of each actuator limit "
+                         "(every scenario's, unstated)")
+    lines += [f"every row fails before planning: {broken}" for broken in
+              (endpoint_violations(scenario.problem) if requirements else [])]
     truth = scenario.data.get("truth") if isinstance(scenario.data, dict) else None
     if scenario.truth is not None and isinstance(truth, dict):
         lines.append("truth (the closed loop's plant differs from the design in): "

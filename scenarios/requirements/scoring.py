@@ -486,8 +486,9 @@ def unhonoured(requirements: Requirements, planner: Planner | None) -> str:
     if planner is None:
         return ""
     implicit = requirements.actuators is not None and not requirements.actuators.stated
+    honoured = type(planner).honoured(planner.options)
     missing: Sequence[str] = [kind for kind in REQUIREMENT_KINDS if kind in requirements.kinds
-                              and kind not in planner.honours and not (kind == "actuators" and implicit)]
+                              and kind not in honoured and not (kind == "actuators" and implicit)]
     if not missing:
         return ""
     words = missing[0] if len(missing) == 1 else ", ".join(missing[:-1]) + " and " + missing[-1]
