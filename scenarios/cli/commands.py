@@ -193,8 +193,8 @@ def _scenario_details(scenario: Any) -> list[str]:
 
     requirements = scenario.requirements
     if requirements.actuators is None:
-        lines = ["requirements: none (requirements: null): no row is scored against any, the actuators' limits "
-                 "included"]
+        lines = [("requirements: none (requirements: null): no row is scored against any, the actuators' limits "
+                  "included")]
     else:
         lines = [f"requirement {line}" for line in requirements.describe()]
         if not requirements.actuators.stated:
