@@ -151,3 +151,17 @@ def test_auto_seeds_only_where_the_starts_are_solved_on_the_coarse_mesh():
     reference = direct.plan(problem)
     assert round(reference.stats["objective"], 6) == 0.093244
     assert reference.stats["seeds"]["tried"] == 1
+
+
+def test_a_start_that_only_the_rate_bound_stops_is_planned_without_it():
+    """The eigenaxis quintic over 100 s peaks at 15 Θ / (8 T) = 0.0375 rad/s, above max_rate 0.03:
+    as a row it is infeasible, but as collocation's warm start it seeds the NLP that imposes the
+    bound (no seed planner takes this non-principal inertia, so without it there is no start)."""
+    spacecraft = Spacecraft([[10, 0.5, 0.2], [0.5, 8, 0.3], [0.2, 0.3, 6]], torquers=Torquers(0.1))
+    problem = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.from_axis_angle([1, 1, 0], 2.0), 100.0,
+                              omegaf=np.zeros(3), max_rate=0.03)
+    assert PLANNERS["eigenaxis"]().plan(problem).status == "infeasible"
+    reference = PLANNERS["collocation"]({"objective": "min_energy"}).plan(problem)
+    assert reference.ok, reference.message
+    rates = np.linalg.norm(reference.sample(np.linspace(0.0, 100.0, 4001)).omega, axis=1)
+    assert 0.029 < np.max(rates) <= 0.03 * (1 + 1e-6)  # the bound is active and held
