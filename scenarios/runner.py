@@ -78,6 +78,11 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
     finally:
         row.simulate_time_s = time.perf_counter() - start
     row.simulation = result
+    if reference is not None and duration < reference.duration * (1 - 1e-9):
+        row.message = "; ".join([part for part in (row.message,) if part] + [
+            f"the closed loop stops at {duration:g} s (simulation.duration), before the reference ends at "
+            f"T = {reference.duration:.4g} s: its closed-loop metrics cover {100 * duration / reference.duration:.3g} % "
+            f"of the manoeuvre"])
     row.closed_loop_metrics = metrics_from_simulation(
         result, problem.qf, problem.omegaf, reference=reference, plan_time_s=row.plan_time_s,
         duration_s=reference.duration if reference else None,

@@ -208,3 +208,16 @@ def test_an_infeasible_row_ranks_between_failed_and_violated():
     assert sorted(statuses) == ["infeasible", "infeasible", "violated"], [row.message for row in results.rows]
     assert list(results.status_counts()) == ["infeasible", "violated"]
     assert results.to_terminal().count("rows: 3 (2 infeasible, 1 violated)") == 1
+
+
+def test_a_closed_loop_window_shorter_than_the_reference_is_said():
+    """A 30 s window on a 60 s slew: the closed loop stops mid-manoeuvre, and the row says so (it
+    was "ok" with a 74 deg final error and nothing in the message)."""
+    data = copy.deepcopy(BASE)
+    del data["requirements"]
+    data["simulation"]["duration"] = 30.0
+    row = scenarios.run(scenarios.parse_scenario(data)).rows[0]
+    assert row.message.endswith("the closed loop stops at 30 s (simulation.duration), before the reference ends at "
+                                "T = 60 s: its closed-loop metrics cover 50 % of the manoeuvre")
+    data["simulation"]["duration"] = 60.0  # the whole manoeuvre: nothing to say
+    assert "closed loop stops" not in scenarios.run(scenarios.parse_scenario(data)).rows[0].message
