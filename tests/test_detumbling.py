@@ -232,3 +232,31 @@ def test_closed_loop_function_agrees_with_the_python_loop(law, saturation):
     assert np.mean(python.saturated) > 0.1
     np.testing.assert_allclose(casadi.x, python.x, rtol=0, atol=1e-10)
     np.testing.assert_allclose(casadi.applied_u, python.applied_u, rtol=0, atol=1e-10)
+
+
+def test_tdfc_mean_power_over_a_hold_and_its_sampled_stability_limit():
+    """Held over a sample ``T``, TDFC's dipole ``m_k = −K (B_k − B_(k−τ))`` gives the mean power
+    ``−(K |B_⊥|² / T) [cos ωτ − cos ω(τ+T) + cos ωT − 1]`` (quadrature here), which changes sign at
+    ``|ω| = π/3`` for τ = 2 s and T = 1 s, not at the continuous law's ``π/τ = 1.57`` rad/s: a
+    closed loop spinning at 1.0 rad/s loses energy, at 1.1 rad/s gains it."""
+    from scipy.integrate import quad
+
+    gain, tau, hold = 1.0e3, 2.0, 1.0
+    axis, b0 = np.array([1.0, 0.0, 0.0]), np.array([1e-5, 3e-5, -2e-5])
+    normal = b0 - (b0 @ axis) * axis
+    for rate in (0.5, 1.0, np.pi / 3, 1.1, 1.4):
+        omega = rate * axis
+        field = lambda t: Rotation.from_rotvec(-omega * t).apply(b0)  # noqa: E731
+        dipole = -gain * (field(0.0) - field(-tau))
+        mean = quad(lambda s: omega @ np.cross(dipole, field(s)), 0.0, hold, epsabs=1e-13 * gain * (normal @ normal),
+                    epsrel=1e-12)[0] / hold
+        closed = -gain * (normal @ normal) / hold * (np.cos(rate * tau) - np.cos(rate * (tau + hold))
+                                                       + np.cos(rate * hold) - 1.0)
+        assert mean == pytest.approx(closed, rel=1e-9, abs=1e-12 * gain * (normal @ normal))
+    simulator = Simulator(ukube_model(), hold, max_step=0.02)
+    ratios = {}
+    for rate in (1.0, 1.1):
+        result = simulator.run(TDFC({"gain": gain, "delay": tau}), np.r_[quat.IDENTITY, rate, 0.0, 0.0], 1000.0)
+        energy = kinetic_energy(result.omega)
+        ratios[rate] = energy[-1] / energy[0]
+    assert ratios[1.0] < 1.0 < ratios[1.1], ratios
