@@ -244,12 +244,16 @@ def test_tdfc_mean_power_over_a_hold_and_its_sampled_stability_limit():
     gain, tau, hold = 1.0e3, 2.0, 1.0
     axis, b0 = np.array([1.0, 0.0, 0.0]), np.array([1e-5, 3e-5, -2e-5])
     normal = b0 - (b0 @ axis) * axis
-    for rate in (0.5, 1.0, np.pi / 3, 1.1, 1.4):
-        omega = rate * axis
-        field = lambda t: Rotation.from_rotvec(-omega * t).apply(b0)  # noqa: E731
+    def mean_power(omega: np.ndarray) -> float:
+        def field(t: float) -> np.ndarray:
+            return Rotation.from_rotvec(-omega * t).apply(b0)
+
         dipole = -gain * (field(0.0) - field(-tau))
-        mean = quad(lambda s: omega @ np.cross(dipole, field(s)), 0.0, hold, epsabs=1e-13 * gain * (normal @ normal),
+        return quad(lambda s: omega @ np.cross(dipole, field(s)), 0.0, hold, epsabs=1e-13 * gain * (normal @ normal),
                     epsrel=1e-12)[0] / hold
+
+    for rate in (0.5, 1.0, np.pi / 3, 1.1, 1.4):
+        mean = mean_power(rate * axis)
         closed = -gain * (normal @ normal) / hold * (np.cos(rate * tau) - np.cos(rate * (tau + hold))
                                                        + np.cos(rate * hold) - 1.0)
         assert mean == pytest.approx(closed, rel=1e-9, abs=1e-12 * gain * (normal @ normal))
