@@ -45,6 +45,7 @@ from scenarios.runner import run
 from scenarios.schema.labels import row_labels
 from scenarios.schema.loader import (
     OTHER_FILES,
+    Scenario,
     load,
     parse_scenario,
     refuse_unmarked_base,
@@ -185,7 +186,7 @@ def _leaf_paths(value: Any, prefix: str) -> list[str]:
     return [path for key, item in value.items() for path in _leaf_paths(item, f"{prefix}.{key}")]
 
 
-def _scenario_details(scenario: Any) -> list[str]:
+def _scenario_details(scenario: Scenario) -> list[str]:
     """What ``validate`` says beyond the rows: every requirement each row is scored against, the
     truth model's keys (where the plant differs from the design) and the sensors and estimator in
     the loop."""
@@ -202,7 +203,7 @@ def _scenario_details(scenario: Any) -> list[str]:
                          "(every scenario's, unstated)")
     lines += [f"every row fails before planning: {broken}" for broken in
               (endpoint_violations(scenario.problem) if requirements else [])]
-    truth = scenario.data.get("truth") if isinstance(scenario.data, dict) else None
+    truth = (scenario.data or {}).get("truth")
     if scenario.truth is not None and isinstance(truth, dict):
         lines.append("truth (the closed loop's plant differs from the design in): "
                      + ", ".join(_leaf_paths(truth, "truth")))
