@@ -151,8 +151,14 @@ class QuinticProfile(AngleProfile):
         return self.position(t), self.rate(t), self.acceleration(t)
 
     def peak_rate(self) -> float:
-        """``max |θ̇|`` over ``[0, T]`` [rad/s]: at an end or where ``θ̈ = 0`` (the quartic's
-        stationary points, roots of the cubic ``θ̈``)."""
+        """The peak rate of the profile.
+
+        Returns
+        -------
+        float
+            ``max |θ̇|`` over ``[0, T]`` [rad/s]: at an end or where ``θ̈ = 0`` (the quartic's
+            stationary points, roots of the cubic ``θ̈``).
+        """
         candidates = [0.0, self.duration]
         candidates += [float(r.real) for r in self.acceleration.roots()
                        if abs(r.imag) <= 1e-9 * max(1.0, abs(r)) and 0.0 <= r.real <= self.duration]
