@@ -95,8 +95,10 @@ class TwoWheelLaw(Controller):
 
     def initial_state_error(self, spacecraft: Spacecraft, omega0: Array, wheel_momentum0: Array,
                             omegaf: Array | None) -> tuple[str, str] | None:
-        """Refuse a non-zero total angular momentum or a final rate: the laws need ``I ω0 + A h_w0 = 0``
-        (the unactuated rate stays zero only then) and end at rest.
+        """Refuse momentum in a failed wheel, a non-zero total angular momentum or a final rate: the
+        laws need ``I ω0 + A h_w0 = 0`` (the unactuated rate stays zero only then), no momentum in a
+        failed wheel (none can take it out: the body would keep ``I ω = −a h`` to hold the total
+        at zero, a spin that never ends) and end at rest.
 
         Parameters
         ----------
@@ -112,13 +114,23 @@ class TwoWheelLaw(Controller):
         Returns
         -------
         tuple of 2 str or None
-            ``("initial.omega" or "final.omega", message)``, or ``None`` when the state is accepted.
+            ``(key, message)`` with the key under ``maneuver`` (``"initial.wheel_momentum"``,
+            ``"initial.omega"`` or ``"final.omega"``), or ``None`` when the state is accepted.
         """
-        momentum = spacecraft.inertia @ omega0 + spacecraft.wheel_axes @ wheel_momentum0
         scale = max(float(np.abs(spacecraft.inertia).max()) * 1e-9, 1e-12)
+        wheels = spacecraft.wheels
+        if wheels is not None:
+            failed = [i for i in range(wheels.count) if not wheels.working[i] and abs(wheel_momentum0[i]) > scale]
+            if failed:
+                held = [float(wheel_momentum0[i]) for i in failed]
+                return ("initial.wheel_momentum", (
+                    f"controller {self.name} needs zero momentum in a failed wheel (spacecraft.wheels.failed): "
+                    f"wheel(s) {failed} hold {held} N m s, which no torque removes, so the body would spin on "
+                    f"forever to keep the total momentum"))
+        momentum = spacecraft.inertia @ omega0 + spacecraft.wheel_axes @ wheel_momentum0
         if float(np.linalg.norm(momentum)) > scale:
-            return ("initial.omega", f"controller {self.name} needs zero total angular momentum I ω + A h_w, got "
-                                     f"{np.round(momentum, 9).tolist()} N m s (initial.omega, initial.wheel_momentum)")
+            return ("initial.omega", (f"controller {self.name} needs zero total angular momentum I ω + A h_w, got "
+                                      f"{np.round(momentum, 9).tolist()} N m s (initial.omega, initial.wheel_momentum)"))
         if omegaf is not None and float(np.linalg.norm(omegaf)) > 0.0:
             return ("final.omega", f"controller {self.name} regulates to rest; final.omega must be zero or null")
         return None
