@@ -144,6 +144,15 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
             if timing:
                 raise ScenarioError(f"{controller.path}.options.{timing[0]}",
                                     f"{timing[1]} (simulation.sample_time is {simulation.sample_time:g} s)")
+            # The run's length where the load knows it: simulation.duration, else in regulation the
+            # manoeuvre's (with planners the window also covers the reference, known after planning).
+            window = (("simulation.duration", simulation.duration) if simulation.duration is not None
+                      else ("maneuver.duration", problem.duration) if not planners else None)
+            run_length_error = getattr(law, "run_length_error", None)  # a law that needs a long enough run
+            length = run_length_error(window[1]) if window is not None and callable(run_length_error) else None
+            if length and window is not None:
+                raise ScenarioError(f"{controller.path}.options.{length[0]}",
+                                    f"{length[1]} ({window[0]} is {window[1]:g} s)")
         if not planners and problem.qf is None and law.needs_target_attitude:
             raise ScenarioError("maneuver.final.q", f"regulation (no planners) with controller {controller.name!r} "
                                 "needs a target attitude; only laws that need none (e.g. bdot, tdfc, none) "
