@@ -7,7 +7,8 @@ import pytest
 
 import scenarios
 from controllers import CONTROLLERS
-from ocp import ReactionWheels, Spacecraft
+from ocp import ReactionWheels, Simulator, Spacecraft, quat
+from planners import ManeuverProblem
 from scenarios.errors import ScenarioError
 from scenarios.schema.read import read_yaml
 
@@ -39,3 +40,38 @@ def test_every_law_refuses_failed_wheel_momentum_and_takes_a_balanced_working_on
     assert refused is not None and refused[0] == "initial.wheel_momentum" and "[2]" in refused[1]
     # the same spin stored in a working wheel is the laws' zero-momentum case: accepted
     assert law.initial_state_error(spacecraft, np.array([0.01, 0.0, 0.0]), np.array([-0.4045, 0.0, 0.0]), None) is None
+
+
+def simulate(name, q0, duration=600.0):
+    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(max_torque=0.02, failed=[2]))
+    problem = ManeuverProblem(spacecraft, q0, np.zeros(3), quat.IDENTITY, duration, omegaf=np.zeros(3))
+    return Simulator(problem.model, 1.0).run(CONTROLLERS[name](), problem.initial_state, duration,
+                                             target=(problem.qf, problem.omegaf))
+
+
+@pytest.mark.parametrize("name", LAWS)
+def test_an_error_about_the_unactuated_axis_is_outside_the_laws_domain(name):
+    # 90 deg about z (the failed wheel's axis): q1 = q2 = 0, the singular ratios 0/0; from rest each
+    # law gives no torque at all, while 1e-6 rad off that axis it turns the body (the paper's Ω)
+    about_z = quat.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.pi / 2)
+    stuck = simulate(name, about_z)
+    assert np.all(stuck.omega == 0.0)
+    assert np.rad2deg(quat.error_angle(stuck.q[-1], quat.IDENTITY)) == pytest.approx(90.0, abs=1e-9)
+    nudged = simulate(name, quat.product(about_z, quat.from_rotation_vector(np.array([1e-6, 0.0, 0.0]))))
+    assert np.max(np.abs(nudged.omega)) > 1e-4
+    law = CONTROLLERS[name]()
+    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(max_torque=0.02, failed=[2]))
+    refused = law.initial_attitude_error(spacecraft, about_z, quat.IDENTITY)
+    assert refused is not None and refused[0] == "initial.q" and "90 deg" in refused[1]
+    assert law.initial_attitude_error(spacecraft, nudged.q[0], quat.IDENTITY) is None
+    assert law.initial_attitude_error(spacecraft, quat.IDENTITY, quat.IDENTITY) is None  # at the target
+
+
+def test_the_loader_refuses_a_start_about_the_unactuated_axis_unless_perturbed():
+    data = regulation({"q": [0, 0, 1, 0]})  # scalar last: 180 deg about z, the failed wheel's axis
+    with pytest.raises(ScenarioError, match="q1² \\+ q2² ≠ 0") as error:
+        scenarios.parse_scenario(data)
+    assert error.value.path == "maneuver.initial.q"
+    # the simulated start is what counts: perturbed off the axis, it is in the domain
+    data["simulation"]["initial_attitude_error_deg"] = [1.0, -1.0, 0.5]
+    scenarios.parse_scenario(data)

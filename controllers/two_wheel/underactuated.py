@@ -22,7 +22,7 @@ import casadi as ca
 import numpy as np
 
 from controllers.base import Array, Controller
-from ocp import Command, Measurement, Spacecraft
+from ocp import Command, Measurement, Spacecraft, quat
 from ocp.dynamics.layout import split_measurement
 
 PRINCIPAL_TOLERANCE = 1e-9
@@ -134,6 +134,42 @@ class TwoWheelLaw(Controller):
         if omegaf is not None and float(np.linalg.norm(omegaf)) > 0.0:
             return ("final.omega", f"controller {self.name} regulates to rest; final.omega must be zero or null")
         return None
+
+    def initial_attitude_error(self, spacecraft: Spacecraft, q0: Array, qf: Array | None) -> tuple[str, str] | None:
+        """Refuse an initial attitude outside the laws' domain ``Ω = {q1² + q2² ≠ 0}`` (paper section
+        III.C: "the initial condition must be chosen in the manifold Ω").
+
+        With the attitude error purely about the unactuated axis (``q1 = q2 = 0``, ``q3 ≠ 0``; e.g.
+        180° about it) the singular ratios are ``0/0``, taken as their limit 0: the desired rates
+        are zero, and from rest the laws give no torque at all, for ever.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The spacecraft (its control frame).
+        q0 : (4,) ndarray
+            The simulated initial attitude, scalar first, body to inertial.
+        qf : (4,) ndarray or None
+            The target attitude; ``None``: the identity.
+
+        Returns
+        -------
+        tuple of 2 str or None
+            ``("initial.q", message)``, or ``None`` when the attitude is in ``Ω`` (or at the target).
+        """
+        frame = self.control_frame(spacecraft)
+        if isinstance(frame, str):
+            return None  # environment_error refuses the spacecraft
+        error = quat.product(quat.conjugate(quat.IDENTITY if qf is None else qf), q0)
+        q1, q2, q3 = frame @ error[1:]
+        if q1 * q1 + q2 * q2 > 1e-24 or abs(q3) <= 1e-12:  # in Ω (to rounding), or at the target
+            return None
+        angle = float(np.rad2deg(quat.error_angle(q0, quat.IDENTITY if qf is None else qf)))
+        return ("initial.q", (
+            f"controller {self.name} is defined for attitude errors with q1² + q2² ≠ 0 (Horri & Palmer, section "
+            f"III.C): the initial error is a {angle:.6g} deg rotation about the unactuated axis "
+            f"{np.round(frame[2], 6).tolist()}, where the desired rates are 0/0 and the law gives no torque from "
+            f"rest; start off that axis (e.g. simulation.initial_attitude_error_deg)"))
 
     def control_frame(self, spacecraft: Spacecraft) -> Array | str:
         """The control frame (see :func:`control_frame`); a test may override it.

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ocp import quat
 from ocp.simulation.simulator import SUBSTEPS_PER_SAMPLE
 from planners import ManeuverProblem
 from scenarios.errors import ScenarioError
@@ -137,6 +138,11 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
         if momentum0 is None:  # ManeuverProblem fills it in; its field's type still admits None
             momentum0 = np.zeros(problem.spacecraft.n_wheels)
         state = law.initial_state_error(problem.spacecraft, problem.omega0, momentum0, problem.omegaf)
+        attitude_error = getattr(law, "initial_attitude_error", None)  # a law defined on part of the attitudes
+        if not state and callable(attitude_error):
+            q0 = problem.q0 if simulation is None else quat.product(
+                problem.q0, quat.from_rotation_vector(simulation.initial_attitude_error))  # as simulated
+            state = attitude_error(problem.spacecraft, q0, problem.qf)
         if state:
             raise ScenarioError(f"maneuver.{state[0]}", f"{state[1]} ({controller.path} is {controller.name!r})")
         if simulation is not None:
