@@ -352,6 +352,31 @@ class EigenaxisPlanner(Planner):
         max_rate: Annotated[float | None, Range(gt=0.0)] = None       # rad/s about the axis; default: the problem's max_rate
         torque_fraction: Annotated[float, Range(gt=0.0, le=1.0)] = 1.0        # share of the actuator bound the bang profiles may use
 
+    def problem_error(self, problem: ManeuverProblem) -> str | None:
+        """Why an eigenaxis slew cannot take ``problem``.
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The problem to plan.
+
+        Returns
+        -------
+        str or None
+            The reason (no target attitude; for the bang profiles, ``trapezoidal`` and ``min_time``,
+            an actuator torquing the body without a torque bound: their acceleration is the largest
+            the bounds allow, unbounded there, and ``min_time``'s duration would be zero), or ``None``.
+        """
+        if self.options.profile != "smooth":
+            boxes = [(actuator, actuator.body_torque_box()) for actuator in problem.spacecraft.actuators]
+            unbounded = [actuator for actuator, box in boxes if box is not None and not np.all(np.isfinite(box))]
+            if unbounded:
+                names = ", ".join(f"spacecraft.{a.name}" + (".max_torque" if hasattr(a, "max_torque") else "")
+                                  for a in unbounded)
+                return (f"profile {self.options.profile} needs a torque bound on every actuator ({names}): it "
+                        f"accelerates at the largest rate the bounds allow, unbounded without them")
+        return super().problem_error(problem)
+
     def _rate_source(self, problem: ManeuverProblem) -> str:
         """Where the rate bound comes from, in a message."""
         option = self.options.max_rate

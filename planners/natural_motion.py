@@ -155,8 +155,11 @@ class NaturalMotionPlanner(Planner):
         Attributes
         ----------
         stop_time : float
-            Time at the end of T spent stopping [s], non-negative (default 10 s, the paper's last
-            10 s of 110 s); the arc lasts ``T − stop_time``.
+            Time at the end of T spent stopping [s], positive (default 10 s, the paper's last
+            10 s of 110 s); the arc lasts ``T − stop_time``. Zero is refused: the arc would end at
+            T still turning, so the reference would not end at rest (``ω(T)`` is the arc's rate),
+            and the stop, a rate step at T itself, would be outside the breakpoints a reference
+            may declare (inside ``(0, T)``), unseen by the scoring.
         stop : {"step", "smooth"}
             ``step`` (default, the paper): the rate reference drops to zero at the end of the arc;
             ``smooth``: a cubic deceleration along the final body rate over ``stop_time`` (the
@@ -170,7 +173,7 @@ class NaturalMotionPlanner(Planner):
             then perturbed ones.
         """
 
-        stop_time: Annotated[float, Range(ge=0.0)] = 10.0                     # s at the end of T spent stopping
+        stop_time: Annotated[float, Range(gt=0.0)] = 10.0                     # s at the end of T spent stopping (> 0: ends at rest)
         stop: Literal["step", "smooth"] = "step"    # rate reference to zero at once (paper) or a cubic
         rk4_steps: Annotated[int, Range(ge=4, le=5000)] = 60                         # RK4 steps of the asymmetric shooting (refined x4 as needed)
         starts: Annotated[int, Range(ge=1, le=50)] = 3                             # IPOPT starts (short, long way round, perturbed)

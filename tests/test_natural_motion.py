@@ -5,9 +5,11 @@ from scipy.integrate import solve_ivp
 
 from controllers import CONTROLLERS
 from ocp import ReactionWheels, Simulator, Spacecraft, metrics_from_simulation, quat
+from ocp.errors import OptionsError
 from planners import PLANNERS, ManeuverProblem
 from planners.natural_motion import NaturalMotionReference
 from planners.torque_free import asymmetric_rates
+from scenarios.requirements.scoring import rate_jumps
 
 UKUBE1 = np.array([0.0109, 0.05, 0.05])  # nano-spacecraft paper, section III
 
@@ -112,3 +114,30 @@ def test_non_principal_inertia_is_planned_in_principal_axes(rng):
                       atol=1e-14, t_eval=arc)
     assert np.max(quat.error_angle(reference.q(arc), truth.y[:4].T)) < 1e-8
     np.testing.assert_allclose(reference.omega(arc), truth.y[4:].T, atol=1e-10)
+
+
+@pytest.mark.parametrize("stop", ["step", "smooth"])
+def test_a_stop_of_zero_seconds_is_refused(stop):
+    # Without a stop the arc ends at T still turning: ω(T) ≠ 0 although the reference claims to end at
+    # rest, and the stop (a rate step at T itself) is no breakpoint inside (0, T) the scoring could see.
+    with pytest.raises(OptionsError, match=r"planners\[0\]\.options\.stop_time.*> 0"):
+        PLANNERS["natural_motion"]({"stop_time": 0.0, "stop": stop}, path="planners[0].options")
+
+
+@pytest.mark.parametrize("stop", ["step", "smooth"])
+def test_a_short_stop_ends_at_rest_and_is_scored(stop):
+    problem = paper_problem()
+    reference = PLANNERS["natural_motion"]({"stop_time": 1e-6, "stop": stop}).plan(problem)
+    assert reference.status == "ok", reference.message
+    assert np.all(reference.omega(np.array([110.0])) == 0.0)
+    arc_end = reference.omega(np.array([110.0 - 2e-6]))[0]  # the arc's rate just before the stop
+    assert np.linalg.norm(arc_end) > 1e-3
+    t = np.linspace(0.0, 110.0, 1101)
+    jumps = rate_jumps(t, reference.omega(t), problem.omega0, reference)
+    if stop == "step":  # no finite torque stops the body at once: an impulse the scoring reports
+        assert len(jumps) == 1 and jumps[0][0] == pytest.approx(110.0 - 1e-6)
+        np.testing.assert_allclose(jumps[0][2], -arc_end, atol=1e-6)
+    else:  # the cubic's peak deceleration 1.5 ω/stop_time at mid-stop, a torque the actuators are scored on
+        assert jumps == []
+        mid = reference.torque(np.array([110.0 - 0.5e-6]))[0]
+        assert np.linalg.norm(mid) > 0.99 * np.linalg.norm(UKUBE1 * 1.5 * arc_end / 1e-6)

@@ -76,7 +76,8 @@ class TDFC(MagneticController):
             K_t [A m²/T]: dipole per unit change of the body-frame field over the delay. The paper
             gives no value; the default is the one of ``scenarios/nano_detumble.yaml``.
         delay : float, > 0 and <= 1e5
-            τ [s], a whole multiple of ``simulation.sample_time`` (else an error at
+            τ [s], a whole multiple of ``simulation.sample_time`` and shorter than the run
+            (``simulation.duration``, else in regulation ``maneuver.duration``; else an error at
             ``options.delay``). Default 2 s, the paper's. The law removes energy only while
             ``|ω| τ < π`` (module docstring).
         """
@@ -101,6 +102,25 @@ class TDFC(MagneticController):
             delay_samples(self.options.delay, sample_time)
         except ValueError as error:
             return "delay", str(error)
+        return None
+
+    def run_length_error(self, duration: float) -> tuple[str, str] | None:
+        """Refuse a delay not shorter than the run: ``m = 0`` until a reading ``τ`` old exists, so the
+        law would never act.
+
+        Parameters
+        ----------
+        duration : float
+            Length of the closed-loop run [s].
+
+        Returns
+        -------
+        tuple of 2 str or None
+            ``("delay", message)``, or ``None`` when ``τ`` is shorter than the run.
+        """
+        if self.options.delay >= duration:
+            return "delay", (f"the delay {self.options.delay:g} s is not shorter than the run ({duration:g} s): "
+                             f"the dipole is zero until a field reading that old exists, so the law never acts")
         return None
 
     def reset(self, spacecraft: Spacecraft, sample_time: float, target: Any = None) -> None:

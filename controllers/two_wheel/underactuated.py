@@ -22,7 +22,7 @@ import casadi as ca
 import numpy as np
 
 from controllers.base import Array, Controller
-from ocp import Command, Measurement, Spacecraft
+from ocp import Command, Measurement, Spacecraft, quat
 from ocp.dynamics.layout import split_measurement
 
 PRINCIPAL_TOLERANCE = 1e-9
@@ -95,8 +95,10 @@ class TwoWheelLaw(Controller):
 
     def initial_state_error(self, spacecraft: Spacecraft, omega0: Array, wheel_momentum0: Array,
                             omegaf: Array | None) -> tuple[str, str] | None:
-        """Refuse a non-zero total angular momentum or a final rate: the laws need ``I ω0 + A h_w0 = 0``
-        (the unactuated rate stays zero only then) and end at rest.
+        """Refuse momentum in a failed wheel, a non-zero total angular momentum or a final rate: the
+        laws need ``I ω0 + A h_w0 = 0`` (the unactuated rate stays zero only then), no momentum in a
+        failed wheel (none can take it out: the body would keep ``I ω = −a h`` to hold the total
+        at zero, a spin that never ends) and end at rest.
 
         Parameters
         ----------
@@ -112,16 +114,62 @@ class TwoWheelLaw(Controller):
         Returns
         -------
         tuple of 2 str or None
-            ``("initial.omega" or "final.omega", message)``, or ``None`` when the state is accepted.
+            ``(key, message)`` with the key under ``maneuver`` (``"initial.wheel_momentum"``,
+            ``"initial.omega"`` or ``"final.omega"``), or ``None`` when the state is accepted.
         """
-        momentum = spacecraft.inertia @ omega0 + spacecraft.wheel_axes @ wheel_momentum0
         scale = max(float(np.abs(spacecraft.inertia).max()) * 1e-9, 1e-12)
+        wheels = spacecraft.wheels
+        if wheels is not None:
+            failed = [i for i in range(wheels.count) if not wheels.working[i] and abs(wheel_momentum0[i]) > scale]
+            if failed:
+                held = [float(wheel_momentum0[i]) for i in failed]
+                return ("initial.wheel_momentum", (
+                    f"controller {self.name} needs zero momentum in a failed wheel (spacecraft.wheels.failed): "
+                    f"wheel(s) {failed} hold {held} N m s, which no torque removes, so the body would spin on "
+                    f"forever to keep the total momentum"))
+        momentum = spacecraft.inertia @ omega0 + spacecraft.wheel_axes @ wheel_momentum0
         if float(np.linalg.norm(momentum)) > scale:
-            return ("initial.omega", f"controller {self.name} needs zero total angular momentum I ω + A h_w, got "
-                                     f"{np.round(momentum, 9).tolist()} N m s (initial.omega, initial.wheel_momentum)")
+            return ("initial.omega", (f"controller {self.name} needs zero total angular momentum I ω + A h_w, got "
+                                      f"{np.round(momentum, 9).tolist()} N m s (initial.omega, initial.wheel_momentum)"))
         if omegaf is not None and float(np.linalg.norm(omegaf)) > 0.0:
             return ("final.omega", f"controller {self.name} regulates to rest; final.omega must be zero or null")
         return None
+
+    def initial_attitude_error(self, spacecraft: Spacecraft, q0: Array, qf: Array | None) -> tuple[str, str] | None:
+        """Refuse an initial attitude outside the laws' domain ``Ω = {q1² + q2² ≠ 0}`` (paper section
+        III.C: "the initial condition must be chosen in the manifold Ω").
+
+        With the attitude error purely about the unactuated axis (``q1 = q2 = 0``, ``q3 ≠ 0``; e.g.
+        180° about it) the singular ratios are ``0/0``, taken as their limit 0: the desired rates
+        are zero, and from rest the laws give no torque at all, for ever.
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+            The spacecraft (its control frame).
+        q0 : (4,) ndarray
+            The simulated initial attitude, scalar first, body to inertial.
+        qf : (4,) ndarray or None
+            The target attitude; ``None``: the identity.
+
+        Returns
+        -------
+        tuple of 2 str or None
+            ``("initial.q", message)``, or ``None`` when the attitude is in ``Ω`` (or at the target).
+        """
+        frame = self.control_frame(spacecraft)
+        if isinstance(frame, str):
+            return None  # environment_error refuses the spacecraft
+        error = quat.product(quat.conjugate(quat.IDENTITY if qf is None else qf), q0)
+        q1, q2, q3 = frame @ error[1:]
+        if q1 * q1 + q2 * q2 > 1e-24 or abs(q3) <= 1e-12:  # in Ω (to rounding), or at the target
+            return None
+        angle = float(np.rad2deg(quat.error_angle(q0, quat.IDENTITY if qf is None else qf)))
+        return ("initial.q", (
+            f"controller {self.name} is defined for attitude errors with q1² + q2² ≠ 0 (Horri & Palmer, section "
+            f"III.C): the initial error is a {angle:.6g} deg rotation about the unactuated axis "
+            f"{np.round(frame[2], 6).tolist()}, where the desired rates are 0/0 and the law gives no torque from "
+            f"rest; start off that axis (e.g. simulation.initial_attitude_error_deg)"))
 
     def control_frame(self, spacecraft: Spacecraft) -> Array | str:
         """The control frame (see :func:`control_frame`); a test may override it.

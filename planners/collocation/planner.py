@@ -300,9 +300,35 @@ class CollocationPlanner(Planner):
         return objective == "min_time" or (objective == "weighted" and getattr(options, "time_weight", 0.0) > 0)
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
+        """Why collocation cannot take ``problem``.
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The problem to plan.
+
+        Returns
+        -------
+        str or None
+            The reason (no target attitude; an objective that minimises time without an energy
+            term, on an actuator whose control has no bound: the optimum is then a rest-to-rest
+            slew in no time, or impulses with an L1 term; a transcription that cannot impose the
+            pointing or rate requirements), or ``None``.
+        """
         error = super().problem_error(problem)
+        o = self.options
+        energy = o.objective == "min_energy" or (o.objective == "weighted" and o.energy_weight > 0)
+        if error is None and self.minimises_time(o) and not energy:
+            unbounded = [actuator for actuator in problem.spacecraft.actuators
+                         if not all(np.all(np.isfinite(bound)) for bound in actuator.control_bounds())]
+            if unbounded:
+                names = ", ".join(f"spacecraft.{a.name}" + next((f".{key}" for key in ("max_torque", "max_dipole")
+                                                                 if hasattr(a, key)), "") for a in unbounded)
+                what = f"objective {o.objective}" + (" with time_weight and no energy_weight"
+                                                      if o.objective == "weighted" else "")
+                return (f"{what} minimises time: it needs a bound on every actuator's control ({names}); without "
+                        f"one the optimal torque is unbounded, an impulse (min_time: a slew in no time)")
         if error is None and (problem.pointing or problem.max_rate is not None):
-            o = self.options
             l1 = o.objective == "min_l1" or (o.objective == "weighted" and o.l1_weight > 0)
             refused = TRANSCRIPTIONS[o.transcription].problem_error(l1, True)
             if refused:
