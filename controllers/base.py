@@ -185,6 +185,41 @@ class Controller(Allocation, Configurable, ABC):
         """
         return None
 
+    def initial_attitude_error(self, spacecraft: Spacecraft, q0: Array, qf: Array | None) -> tuple[str, str] | None:
+        """Why the law cannot start from an attitude (a law defined on part of the attitudes: the
+        two-wheel laws' ``q1² + q2² ≠ 0``).
+
+        Parameters
+        ----------
+        spacecraft : Spacecraft
+        q0 : (4,) ndarray
+            The simulated initial attitude (``simulation.initial_attitude_error_deg`` applied),
+            scalar first, body to inertial.
+        qf : (4,) ndarray or None
+            The target attitude; ``None``: free.
+
+        Returns
+        -------
+        (str, str) or None
+            ``(YAML key under maneuver, message)``, or ``None`` when the law can (most laws).
+        """
+        return None
+
+    def run_length_error(self, duration: float) -> tuple[str, str] | None:
+        """Why an option does not fit a run of this length (``tdfc``'s delay, which must be shorter).
+
+        Parameters
+        ----------
+        duration : float
+            Length of the closed-loop run [s].
+
+        Returns
+        -------
+        (str, str) or None
+            ``(option name, message)``, or ``None`` when every option fits (most laws).
+        """
+        return None
+
     def sample_time_error(self, sample_time: float) -> tuple[str, str] | None:
         """Why an option does not fit the sample time.
 

@@ -138,11 +138,10 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
         if momentum0 is None:  # ManeuverProblem fills it in; its field's type still admits None
             momentum0 = np.zeros(problem.spacecraft.n_wheels)
         state = law.initial_state_error(problem.spacecraft, problem.omega0, momentum0, problem.omegaf)
-        attitude_error = getattr(law, "initial_attitude_error", None)  # a law defined on part of the attitudes
-        if not state and callable(attitude_error):
+        if not state:  # a law defined on part of the attitudes
             q0 = problem.q0 if simulation is None else quat.product(
                 problem.q0, quat.from_rotation_vector(simulation.initial_attitude_error))  # as simulated
-            state = attitude_error(problem.spacecraft, q0, problem.qf)
+            state = law.initial_attitude_error(problem.spacecraft, q0, problem.qf)
         if state:
             raise ScenarioError(f"maneuver.{state[0]}", f"{state[1]} ({controller.path} is {controller.name!r})")
         if simulation is not None:
@@ -154,8 +153,7 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
             # manoeuvre's (with planners the window also covers the reference, known after planning).
             window = (("simulation.duration", simulation.duration) if simulation.duration is not None
                       else ("maneuver.duration", problem.duration) if not planners else None)
-            run_length_error = getattr(law, "run_length_error", None)  # a law that needs a long enough run
-            length = run_length_error(window[1]) if window is not None and callable(run_length_error) else None
+            length = law.run_length_error(window[1]) if window is not None else None
             if length and window is not None:
                 raise ScenarioError(f"{controller.path}.options.{length[0]}",
                                     f"{length[1]} ({window[0]} is {window[1]:g} s)")
