@@ -279,7 +279,9 @@ class EigenaxisReference(Reference):
 
     def __init__(self, q0: Array, axis: Array, profile: AngleProfile, duration: float, inertia: Array, message: str,
                  problem: ManeuverProblem | None = None) -> None:
-        switches = [profile.ramp, profile.ramp + profile.coast] if isinstance(profile, BangCoastBangProfile) else []
+        switches = []
+        if isinstance(profile, BangCoastBangProfile):  # a coast of rounding length is a triangle: one switch
+            switches = [profile.ramp] + ([profile.ramp + profile.coast] if profile.coast > 1e-12 * duration else [])
         super().__init__("eigenaxis", duration, inertia, message=message,
                          free_boundary=() if problem is None else unmet_rates(problem, axis, profile),
                          breakpoints=[t for t in switches if 0.0 < t < duration])

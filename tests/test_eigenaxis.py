@@ -121,3 +121,18 @@ def test_a_duration_too_short_under_the_rate_bound_names_it():
     assert reference.status == "infeasible"
     assert f"time {1.57 / 0.01 + 0.01 * 12.6 / 0.1:.4g} s under the torque bounds and the rate bound 0.01 rad/s " \
            "(maneuver.max_rate or requirements.rate.max)" in reference.message
+
+
+def test_a_triangle_profile_has_one_switch_and_a_coast_two():
+    """Minimum time without a rate bound is a triangle, one switch at T/2 = sqrt(Θ J / u); a rate bound
+    adds a coast between two switches (the triangle's coast of 1e-16 s made a second breakpoint
+    8.9e-16 s after the first, and a 4100-node flight table)."""
+    spacecraft = Spacecraft([2.0, 2.0, 2.0], torquers=Torquers(max_torque=0.5))
+    target = quat.from_axis_angle([1, 0, 0], np.pi)
+    triangle = PLANNERS["eigenaxis"]({"profile": "min_time"}).plan(
+        ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), target, 20.0, omegaf=np.zeros(3)))
+    assert triangle.breakpoints == pytest.approx([np.sqrt(np.pi * 2.0 / 0.5)], rel=1e-12)
+    coast = PLANNERS["eigenaxis"]({"profile": "min_time"}).plan(
+        ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), target, 20.0, omegaf=np.zeros(3), max_rate=0.5))
+    ramp = 0.5 / (0.5 / 2.0)  # w / α, α = u / J
+    assert coast.breakpoints == pytest.approx([ramp, np.pi / 0.5], rel=1e-12)  # the coast ends at Θ / w
