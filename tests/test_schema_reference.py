@@ -32,7 +32,13 @@ from planners import PLANNERS
 from scenarios.errors import ScenarioError
 from scenarios.schema.node import Node
 from scenarios.schema.read import parse_yaml_text
-from scenarios.schema.reference import Entry, reference_parts, schema_rst, schema_text
+from scenarios.schema.reference import (
+    Entry,
+    reference_parts,
+    schema_rst,
+    schema_text,
+    summary_line,
+)
 from scenarios.schema.study import VALUE_GENERATORS
 from scenarios.study.spec import parse_study
 
@@ -502,6 +508,48 @@ def test_schema_keys_select_what_they_name():
     assert "execution.workers" not in scenario_part
     with pytest.raises(ScenarioError, match="close matches: simulation.sensor_noise.seed, study.monte_carlo.seed"):
         schema_text("seed")
+
+
+def test_every_study_path_the_reference_prints_selects_its_entry():
+    """``slewbench schema`` prints a study entry under its YAML path (``grid.<path>.linspace``,
+    ``monte_carlo.samples``): that path, typed back, selects it, as ``study.<key>`` does."""
+    printed = [entry.path for entry in entries("Study file")]
+    assert "grid.<path>.linspace" in printed and "monte_carlo.samples" in printed
+    for path in printed:
+        if path == "scenario":  # the study's base scenario: ``scenario`` names every scenario key
+            continue
+        assert path in schema_text(path).splitlines(), path
+    assert "grid.<path>.linspace" in schema_text("grid.linspace").splitlines()  # the key without study.
+    assert "scenario" in schema_text("study.scenario").splitlines()
+    assert "Study file" not in schema_text("scenario")
+    for key in ("grid.<path>.linspace", "monte_carlo.samples"):
+        completed = run_schema(key)
+        assert completed.returncode == 0 and key in completed.stdout.splitlines(), completed.stderr
+
+
+def test_slewbench_schema_table_says_where_the_slew_table_keys_are():
+    for key in ("table", "table.axes"):
+        completed = run_schema(key)
+        assert completed.returncode == 2 and "Traceback" not in completed.stderr
+        assert "slewbench table" in completed.stderr and "slew_table" in completed.stderr
+
+
+class _Documented:
+    """Solved with ``scipy.integrate.solve_bvp`` about :class:`~ocp.quat.Axis` (*Space Mechanics*,
+    :math:`\\omega` and :func:`ocp.quat.error`), with ``q0* ⊗ qf``. The second sentence."""
+
+
+def test_summary_lines_are_plain_text_for_the_terminal():
+    assert summary_line(_Documented, module_first=False) == \
+        "Solved with scipy.integrate.solve_bvp about Axis (Space Mechanics, omega and ocp.quat.error), with q0* ⊗ qf."
+    registered = [*PLANNERS.values(), *CONTROLLERS.values()]
+    for cls in registered:
+        line = summary_line(cls)
+        assert not re.search(r"``|:[a-z]+:`|(?<![\w*])\*\w", line), (cls, line)
+    listing = subprocess.run([sys.executable, "-m", "scenarios.cli", "list"], capture_output=True, text=True,
+                             timeout=300, cwd=ROOT, check=True).stdout
+    assert "``" not in listing and ":class:" not in listing
+    assert "q0* ⊗ qf" in listing  # a conjugate's star is not emphasis
 
 
 # --- validated once -------------------------------------------------------------------------------

@@ -13,9 +13,12 @@ Keys (for :func:`schema_text`): a scenario key is its YAML path without list ind
 ``planners.<planner>.<option>`` (``planners.collocation.intervals``), a controller's
 ``controller.<controller>.<option>``, a field model's ``environment.magnetic_field.<model>.<option>``;
 ``scenario`` selects every scenario key; study keys start with ``study.`` (``study.execution.workers``,
-``study.grid.linspace``, ``study.monte_carlo.dispersions.normal``). A key selects the entries it
-names and every entry below it; ``planners.options.intervals`` (the YAML path) selects that option
-of every planner that has it.
+``study.grid.linspace``, ``study.monte_carlo.dispersions.normal``), and may also be written as the
+reference prints their YAML path (``execution.workers``, ``grid.<path>.linspace``,
+``monte_carlo.dispersions.<path>.normal``) or without ``study.`` (``grid.linspace``). A key selects
+the entries it names and every entry below it; ``planners.options.intervals`` (the YAML path)
+selects that option of every planner that has it. A slew-table file's keys (``table``) are read by
+:mod:`scenarios.slewtable` and are not part of this reference: :func:`schema_text` says so.
 """
 from __future__ import annotations
 
@@ -177,7 +180,8 @@ def _walk(section: Section, path: str, name: str, aliases: tuple[str, ...] = ())
 
 
 def summary_line(cls: type, module_first: bool = True) -> str:
-    """The first sentence of a registered class's docs, as ``slewbench list`` shows it.
+    """The first sentence of a registered class's docs, as ``slewbench list`` shows it: plain text
+    for a terminal.
 
     Parameters
     ----------
@@ -190,8 +194,14 @@ def summary_line(cls: type, module_first: bool = True) -> str:
     Returns
     -------
     str
-        The sentence, ending with a full stop.
+        The sentence, ending with a full stop, without reStructuredText markup: inline literals
+        and emphasis lose their marks, a role keeps its text (the last dotted name after ``~``).
     """
+    return _plain(_summary_rst(cls, module_first))
+
+
+def _summary_rst(cls: type, module_first: bool = True) -> str:
+    """:func:`summary_line` as reStructuredText (the schema page's part introductions)."""
     module_doc = sys.modules[cls.__module__].__doc__ if module_first else None
     doc = (module_doc or inspect.getdoc(cls) or "").strip()
     paragraph = " ".join(doc.split("\n\n")[0].split())
@@ -204,9 +214,13 @@ def _option_entry(option: OptionEntry, path: str, key: str, aliases: tuple[str, 
                  _bounds(option.bounds, option.choices), option.meaning, aliases)
 
 
+_SCENARIO_KEY = "scenario"
+"""The key of the part that holds every scenario key (``slewbench schema scenario``)."""
+
+
 def _scenario_parts() -> list[Part]:
     group = "Scenario file"
-    parts = [Part("scenario", group, "Top-level keys", SCENARIO.meaning + " Its keys:",
+    parts = [Part(_SCENARIO_KEY, group, "Top-level keys", SCENARIO.meaning + " Its keys:",
                   tuple(_key_entry(key, key.name, key.name, (f"scenario.{key.name}",)) for key in SCENARIO.keys))]
     for key in SCENARIO.keys:
         if key.section is None or key.name == "controllers":
@@ -229,7 +243,7 @@ def _registry_parts() -> list[Part]:
                                       (f"planners.options.{option.name}", f"scenario.planners.{name}.{option.name}"))
                         for option in option_entries(planner.Options))
         parts.append(Part(f"planners.{name}", "Planner options", _literal(name),
-                          f"{summary_line(planner)} Options under ``planners[i].options`` when ``planners[i].name`` is "
+                          f"{_summary_rst(planner)} Options under ``planners[i].options`` when ``planners[i].name`` is "
                           f"{_literal(name)}" + (":" if entries else "; it has none."), entries))
     for name, controller in CONTROLLERS.items():
         entries = tuple(_option_entry(option, f"controller.options.{option.name}", f"controller.{name}.{option.name}",
@@ -238,7 +252,7 @@ def _registry_parts() -> list[Part]:
                                        f"scenario.controller.{name}.{option.name}"))
                         for option in option_entries(controller.Options))
         parts.append(Part(f"controller.{name}", "Controller options", _literal(name),
-                          f"{summary_line(controller)} Options under ``controller.options`` (or "
+                          f"{_summary_rst(controller)} Options under ``controller.options`` (or "
                           f"``controllers[i].options``) when its ``name`` is {_literal(name)}"
                           + (":" if entries else "; it has none."), entries))
     for name, kind in ORBITS.items():
@@ -247,7 +261,7 @@ def _registry_parts() -> list[Part]:
                                    (f"orbit.{key.name}", f"scenario.{base}.{key.name}"))
                         for key in option_keys(kind.Options))
         parts.append(Part(base, "Orbit kinds", _literal(name),
-                          f"{summary_line(kind, module_first=False)} Keys next to ``type: {name}`` in ``orbit``:",
+                          f"{_summary_rst(kind, module_first=False)} Keys next to ``type: {name}`` in ``orbit``:",
                           entries))
     for name, model in MAGNETIC_FIELDS.items():
         base = f"environment.magnetic_field.{name}"
@@ -255,7 +269,7 @@ def _registry_parts() -> list[Part]:
                                    (f"environment.magnetic_field.{key.name}", f"scenario.{base}.{key.name}"))
                         for key in option_keys(model.Options))
         parts.append(Part(base, "Magnetic field models", _literal(name),
-                          f"{summary_line(model, module_first=False)} Keys next to ``model: {name}`` in "
+                          f"{_summary_rst(model, module_first=False)} Keys next to ``model: {name}`` in "
                           "``environment.magnetic_field`` "
                           f"(``magnetic_field: {name}`` takes the defaults):", entries))
     return parts
@@ -325,7 +339,8 @@ not listed here is an error, and every listed default is the one applied. A path
 degrees, ``_km`` in kilometres, ``_s`` in seconds); the loader converts them to SI. Unknown and
 duplicate keys are errors. ``slewbench schema KEY`` prints the entries below a key, for example
 ``slewbench schema maneuver``, ``slewbench schema planners.collocation`` or
-``slewbench schema study.execution``."""
+``slewbench schema study.execution``. A slew-table file (top-level key ``table``) is read by
+``slewbench table``, not by this schema: its keys are in the slew-table guide."""
 
 _GROUPS = {
     "Scenario file": "The keys of a scenario file, by section.",
@@ -396,14 +411,19 @@ def schema_rst() -> str:
 # --- terminal ----------------------------------------------------------------------------------------
 
 _ROLE = re.compile(r":[a-z:]+:`~?([^`<]*?)(?:\s*<[^>]*>)?`")
+_LITERAL = re.compile(r"``(.+?)``")
+_EMPHASIS = re.compile(r"(?<![\w*\\])(\*\*?)(?=\S)(.+?)(?<=\S)\1(?![\w*])")
+"""``*emphasis*`` or ``**strong**`` as reStructuredText recognises it: its marks next to the words."""
 
 
 def _plain(text: str) -> str:
-    """reStructuredText reduced to plain words for a terminal."""
+    """reStructuredText reduced to plain words for a terminal: ``x`` and *x* give x,
+    :math:`x` gives x, :class:`~a.b.C` gives C."""
     def role(match: re.Match[str]) -> str:
         target = match.group(1)
         return target.rsplit(".", 1)[-1] if match.group(0).startswith(":") and "`~" in match.group(0) else target
-    return re.sub(r"``(.+?)``", r"\1", _ROLE.sub(role, text)).replace("\\", "")
+    pieces = _LITERAL.split(_ROLE.sub(role, text))  # odd pieces: the literals' contents, kept as they are
+    return "".join(piece if i % 2 else _EMPHASIS.sub(r"\2", piece) for i, piece in enumerate(pieces)).replace("\\", "")
 
 
 def _normal(key: str) -> str:
@@ -411,7 +431,14 @@ def _normal(key: str) -> str:
 
 
 def _names(entry: Entry) -> tuple[str, ...]:
-    return (entry.key, _normal(entry.path) if not entry.key.startswith("study.") else entry.key) + entry.aliases
+    """The keys that select ``entry``: its key, its YAML path without indices and its aliases; a
+    study entry also by its path as the reference prints it (``grid.<path>.linspace``,
+    ``monte_carlo.samples``) and by its key without ``study.`` (``grid.linspace``), except the
+    study's ``scenario``: that name selects the scenario file's keys."""
+    if not entry.key.startswith("study."):
+        return (entry.key, _normal(entry.path)) + entry.aliases
+    bare = (_normal(entry.path),) + tuple(name.removeprefix("study.") for name in (entry.key,) + entry.aliases)
+    return (entry.key,) + entry.aliases + tuple(name for name in bare if name != _SCENARIO_KEY)
 
 
 def _selected(part: Part, key: str) -> list[Entry]:
@@ -438,6 +465,10 @@ def _entry_text(entry: Entry) -> list[str]:
         textwrap.wrap(_plain(_one_line(entry.meaning)), 96, initial_indent="    ", subsequent_indent="    ")
 
 
+_TABLE_KEY = "table"
+"""The top-level key of a slew-table file, whose keys this reference does not hold."""
+
+
 def schema_text(key: str | None = None) -> str:
     """The reference, or the part of it under ``key``, as plain text for a terminal.
 
@@ -457,7 +488,8 @@ def schema_text(key: str | None = None) -> str:
     Raises
     ------
     ScenarioError
-        At ``key`` when it selects nothing; the message lists close matches.
+        At ``key`` when it selects nothing; the message lists close matches, or, for ``table``
+        and the keys under it, says where a slew-table file's keys are described.
     """
     parts = reference_parts()
     wanted = None if key is None else _normal(key)
@@ -471,6 +503,9 @@ def schema_text(key: str | None = None) -> str:
         lines += [title, "=" * len(title)] + textwrap.wrap(_plain(_one_line(part.intro)), 100) + [""]
         for entry in entries:
             lines += _entry_text(entry) + [""]
+    if not lines and (wanted == _TABLE_KEY or (wanted or "").startswith(_TABLE_KEY + ".")):
+        raise ScenarioError("", f"{excerpt(key)}: a slew-table file's keys are read by `slewbench table`, not by the "
+                                "scenario and study schema; the slew-table guide describes them (docs/guide/slew_table.rst)")
     if not lines:
         matches = _close_matches(wanted or "", parts)
         raise ScenarioError("", f"{excerpt(key)} is not a key of the scenario or study schema"  # quoted, bounded
@@ -510,7 +545,7 @@ def options_text(name: str) -> str:
         part = parts.get(prefix + name)
         if part is None:
             continue
-        lines += [f"{name} ({kind}): {_plain(summary_line(registry[name]))}"]
+        lines += [f"{name} ({kind}): {summary_line(registry[name])}"]
         if not part.entries:
             lines += ["  no options", ""]
             continue
