@@ -64,7 +64,7 @@ class AugmentedQuaternionFeedback(Controller):
         Parameters
         ----------
         kp : float or (3, 3) nested list
-            Attitude gain ``K``: a scalar [1/s^2] times the inertia (default 0.06, the spin
+            Attitude gain ``K``: a scalar [1/s²] times the inertia (default 0.06, the spin
             paper's "medium" gains), or a full matrix [N m] whose symmetric part is positive
             semi-definite.
         kd : float or (3, 3) nested list

@@ -344,7 +344,7 @@ def _euler(node: Node, context: AttitudeContext, t: float) -> Array:
 _ONE_FORM = Described("absent (the mapping has exactly one form)")
 
 ATTITUDE_FORMS: dict[str, AttitudeForm] = {form.name: form for form in (
-    AttitudeForm(custom("quaternion", "A quaternion, ``frame`` to body (scalar first unless "
+    AttitudeForm(custom("quaternion", "A quaternion, body to ``frame`` (``v_frame = R(q) v_body``; scalar first unless "
                         "``maneuver.quaternion_order: scalar_last``).", "list of 4 numbers", None,
                         default=_ONE_FORM, bounds="norm within 1e-2 of 1 (normalised)"), True, _quaternion),
     AttitudeForm(custom("axis_angle", "A rotation about an axis, from ``frame`` to the body.", "mapping", None,
