@@ -27,15 +27,15 @@ import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ocp import AttitudeModel, Command, Measurement, Spacecraft
+from ocp import AttitudeModel, Command, Measurement, Spacecraft, quat
 from ocp.dynamics.actuator_kinds import Actuator
 from ocp.dynamics.layout import actuator_blocks, control_layout, split_measurement
 from ocp.fast_call import BufferedFunction, as_floats
 
 Array = NDArray[np.float64]
 
-__all__ = ["Allocation", "Demand", "SymbolicConstants", "demand_limits", "float_rows", "reference_demand",
-           "unrealised_torque"]
+__all__ = ["MAX_SUBSTEPS", "SUBSTEP_ANGLE", "Allocation", "Demand", "SymbolicConstants", "demand_limits", "float_rows",
+           "reference_demand", "unrealised_torque"]
 
 
 def float_rows(matrix: ArrayLike) -> tuple[tuple[float, ...], ...]:
@@ -378,7 +378,7 @@ def demand_limits(spacecraft: Spacecraft) -> dict[str, Array]:
 
 def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: ArrayLike,
                      torque: ArrayLike, state0: ArrayLike | None = None,
-                     jumps: ArrayLike | None = None) -> dict[str, Demand]:
+                     jumps: ArrayLike | None = None, torque_after: ArrayLike | None = None) -> dict[str, Demand]:
     """What a reference asks of each actuator through a law's own allocation (module docstring).
 
     At each sample the feed-forward torque goes through the law's map (its flags included, except
@@ -386,17 +386,34 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     reference demands, whether the law computes it, adds it in its allocation or neglects it; the
     map on CasADi expressions, :meth:`Allocation.allocate_symbolic`, which the symbolic-law tests
     hold equal to :meth:`Allocation.allocate`) with the reference's rate, the actuators' states
-    and the field along the reference (zero without a field model); the states (the wheel
-    momenta, ``ḣ_w = g``) are integrated from ``state0`` by Heun's method (trapezoids, the rate
-    at the end predicted by an Euler step), and the commands reported are those at the states
-    reported. The law itself is not changed (a copy is prepared for the spacecraft).
+    and the field along the reference (zero without a field model); the commands reported are
+    those at the states reported. The law itself is not changed (a copy is prepared for the
+    spacecraft). The states, whatever the samples' spacing:
+
+    * when the working wheels span three axes and are the only actuators with states, they take
+      the whole torque, ``A ḣ_w = −(u + ω × A h_w)``: with ``u`` the inverse dynamics of the motion
+      (:class:`planners.Reference`'s contract) the total angular momentum, the body's and the
+      wheels', is conserved in the inertial frame, and the momenta are its closed form,
+      ``A h_w(t) = R(q)ᵀ R(q₀) (I ω₀ + A h_w0) − I ω(t)`` (``h_w`` moves along ``A⁺``'s range only:
+      a failed wheel keeps its momentum, redundant wheels their null-space part). Exact at any
+      spacing: no step of the motion is integrated, a jump of the torque (a bang, the end of a
+      reference) leaves no error, and ``torque`` is not read for the states;
+    * otherwise (fewer than three independent working axes, or other actuator states) the states
+      are integrated by the classical Runge-Kutta method, each interval between samples cut into
+      sub-steps over which the body turns at most :data:`SUBSTEP_ANGLE` (the wheels' gyroscopic
+      term turns their momenta with the body: a step of one sample interval becomes unstable once
+      the body turns about a radian in it), with the inputs interpolated linearly between the
+      samples, the torque from its value just after the interval's start (``torque_after``) to its
+      value at its end. Between samples the motion is known through that interpolation only: the
+      samples must resolve the rate's own changes (the sub-steps resolve the rotation).
 
     A jump of the reference's body rate (``jumps``: a rate the reference starts at that is not the
     spacecraft's, a step such as natural motion's stop) is no torque the feed-forward holds: the
     body's momentum changes at once by ``I Δω``, and the working wheels take it up at once,
-    ``Δh_w = −A⁺ I Δω`` (the total angular momentum is conserved across it); what they cannot take
-    (fewer than three independent axes) leaves no state. The impulse itself is no finite demand:
-    the caller reports the jumps (:mod:`scenarios.requirements.scoring` breaks the actuator
+    ``Δh_w = −A⁺ I Δω`` (the total angular momentum is conserved across it: the closed form
+    takes up every jump of ``ω`` between samples by itself, and reads row 0 only); what they cannot
+    take (fewer than three independent axes) leaves no state. The impulse itself is no finite
+    demand: the caller reports the jumps (:mod:`scenarios.requirements.scoring` breaks the actuator
     requirement on one).
 
     Parameters
@@ -412,13 +429,17 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     omega : (N, 3) array_like
         Reference body rate [rad/s], body axes.
     torque : (N, 3) array_like
-        Feed-forward torque ``u`` of ``I ω̇ = −ω × I ω + u`` [N m], body axes.
+        Feed-forward torque ``u`` of ``I ω̇ = −ω × I ω + u`` [N m], body axes (its value at the
+        sample: the commands reported read it).
     state0 : (nx - 7,) array_like or None, optional
         The actuators' states at ``t[0]`` (the initial wheel momenta [N m s]); ``None``: zero.
     jumps : (N, 3) array_like or None, optional
         Jumps of the body rate [rad/s], body axes, arriving at each sample: row 0 from the
         spacecraft's rate at ``t[0]`` to the reference's, row k between ``t[k-1]`` and ``t[k]``;
         ``None``: none.
+    torque_after : (N, 3) array_like or None, optional
+        The feed-forward torque just after each sample [N m], body axes, where it jumps there
+        (a reference's end T: zero after it), for the integrated states; ``None``: ``torque``.
 
     Returns
     -------
@@ -448,36 +469,32 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
         x = np.hstack([q, omega, np.zeros((n, model.nx - 7))])
         fields = np.asarray(model.field_body.map(n)(x.T, t).full()).T
     inputs = np.hstack([torque, q, omega, fields])  # (N, 13): what the map reads at each sample
-    key = ("reference_demand", type(law).__module__, type(law).__qualname__, law.gyroscopic_compensation,
-           law.wheels_only, _CHUNK)
-    chunk = BufferedFunction(model.solver_cache.get(key, lambda: _demand_step(law, spacecraft, blocks, n_states)
-                                                    .mapaccum("reference_demand", _CHUNK)))
-    # (the law's map depends on its class, its flags and the spacecraft: the key and the model)
-    states = np.zeros((n, n_states))
-    if n_states and state0 is not None:
-        states[0] = np.asarray(state0, dtype=float).reshape(n_states)
-    commands = np.zeros((n, law._nu))
-    padded = -(-n // _CHUNK) * _CHUNK  # whole chunks: the last input repeated, with steps of zero length
-    now = np.vstack([inputs, np.repeat(inputs[-1:], padded - n, axis=0)]) if n else inputs
-    then = np.vstack([now[1:], now[-1:]]) if n else now
-    dt = np.zeros(padded)
-    dt[:n - 1] = np.diff(t)
-    kicks = np.zeros((padded, n_states))  # the states' jumps at each sample: the wheels take up the rate's
+    kicks = np.zeros((n, n_states))  # the states' jumps at each sample: the wheels take up the rate's
     if jumps is not None and n and law._working_axes is not None:
         wheels = next(block for block in blocks if block.actuator.block == "wheels")
         momentum = np.asarray(jumps, dtype=float).reshape(n, 3) @ np.asarray(spacecraft.inertia, dtype=float).T
-        kicks[:n, wheels.state] = -momentum @ law._wheel_pinv.T  # Δh_w = −A⁺ I Δω
-    state = states[0] if n else np.zeros(n_states)
-    for start in range(0, padded, _CHUNK):  # one call per chunk of samples
-        stop = start + _CHUNK
-        flat = chunk.all_outputs(state, now[start:stop].ravel(), then[start:stop].ravel(), dt[start:stop],
-                                 kicks[start:stop].ravel())
-        ahead, asked = flat[0].reshape(_CHUNK, n_states).T, flat[1].reshape(_CHUNK, law._nu).T  # column-major
-        within = min(stop, n) - start
-        commands[start:start + within] = asked[:, :within].T
-        states[start + 1:min(stop + 1, n)] = ahead[:, :min(stop + 1, n) - start - 1].T
-        state = ahead[:, -1].copy()
-    states += kicks[:n]  # each sample's state after its jump (the step from it started there)
+        kicks[:, wheels.state] = -momentum @ law._wheel_pinv.T  # Δh_w = −A⁺ I Δω
+    start = np.zeros(n_states) if state0 is None else np.asarray(state0, dtype=float).reshape(n_states)
+    # (the law's map depends on its class, its flags and the spacecraft: the key and the model)
+    key = (type(law).__module__, type(law).__qualname__, law.gyroscopic_compensation, law.wheels_only, _CHUNK)
+    if n == 0 or n_states == 0:
+        states = np.zeros((n, n_states))
+    elif _conserving(law, blocks):
+        states = _momentum_by_conservation(law, spacecraft, q, omega, start + kicks[0])
+    else:
+        after = inputs.copy()
+        if torque_after is not None:
+            after[:, 0:3] = np.asarray(torque_after, dtype=float).reshape(n, 3)
+        step = BufferedFunction(model.solver_cache.get(("reference_demand_step", *key), lambda: _demand_step(
+            law, spacecraft, blocks, n_states).mapaccum("reference_demand", _CHUNK)))
+        states = _integrated_states(step, t, after, inputs, start, kicks)
+    command = BufferedFunction(model.solver_cache.get(("reference_demand_command", *key), lambda: _demand_command(
+        law, spacecraft, n_states).map(_CHUNK)))
+    commands = np.zeros((n, law._nu))
+    for first in range(0, n, _CHUNK):  # one call per chunk of samples (the last padded with its last)
+        rows = np.arange(first, first + _CHUNK).clip(max=n - 1)
+        commands[first:first + _CHUNK] = command(states[rows].ravel(), inputs[rows].ravel()).reshape(
+            _CHUNK, law._nu)[:min(_CHUNK, n - first)]  # column-major: a row per sample
     limits = demand_limits(spacecraft)
     demand: dict[str, Demand] = {}
     for block in blocks:
@@ -491,7 +508,85 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
 
 
 _CHUNK = 512
-"""Samples per call of the accumulated step of :func:`reference_demand`."""
+"""Samples (or sub-steps) per call of the mapped map and the accumulated step of :func:`reference_demand`."""
+
+SUBSTEP_ANGLE = 0.05
+"""[rad]: the most the body turns (``|ω| Δt``, the larger rate of the interval's ends) in one step
+of :func:`reference_demand`'s integrated states. The classical Runge-Kutta step of a rotation by
+``θ`` (the wheels' gyroscopic term) errs by ``θ⁵/120``: 5e-8 of the momentum per radian turned
+(Heun's method on whole sample intervals, as before, multiplied it by ``(1 + θ⁴/4)^½`` a step:
+1.3e249 times the wheels' limit in a 140 s run spinning at 20 rad/s)."""
+
+
+MAX_SUBSTEPS = 5_000_000
+"""The most sub-steps :func:`reference_demand` integrates (about 5 s; 250 000 rad turned): the
+states of the samples after them are nan (not computed), never an under-resolved number."""
+
+
+def _conserving(law: Allocation, blocks: Sequence[Any]) -> bool:
+    """Whether the actuators' states are the wheel momenta alone and the working wheels span three
+    axes (they take every torque: the total angular momentum is conserved)."""
+    stateful = [block.actuator.block for block in blocks if block.actuator.state_size]
+    return (stateful == ["wheels"] and law._working_axes is not None
+            and int(np.linalg.matrix_rank(law._working_axes)) == 3)
+
+
+def _momentum_by_conservation(law: Allocation, spacecraft: Spacecraft, q: Array, omega: Array, start: Array) -> Array:
+    """The wheel momenta along the motion by the conservation of the total angular momentum (working
+    wheels spanning three axes, :func:`reference_demand`): ``A h_w = R(q)ᵀ R(q₀) (I ω₀ + A h₀) − I ω``,
+    ``h_w = h₀ + A⁺ (A h_w − A h₀)``; ``start`` is ``h₀`` after the jump at the first sample."""
+    inertia = np.asarray(spacecraft.inertia, dtype=float)
+    axes = np.asarray(spacecraft.wheel_axes, dtype=float)
+    attitude = quat.normalize(q)
+    total = quat.rotate(attitude[0], inertia @ omega[0] + axes @ start)  # inertial: constant
+    stored = quat.rotate_inverse(attitude, total) - omega @ inertia.T  # A h_w, body axes
+    return np.asarray(start + (stored - axes @ start) @ law._wheel_pinv.T, dtype=np.float64)
+
+
+def _integrated_states(step: BufferedFunction, t: Array, after: Array, inputs: Array, start: Array,
+                       kicks: Array) -> Array:
+    """The actuators' states at the samples by Runge-Kutta sub-steps (:func:`reference_demand`): each
+    interval cut into ``m`` equal sub-steps, ``m`` the least that keeps ``|ω| Δt / m`` within
+    :data:`SUBSTEP_ANGLE`; the inputs interpolated linearly from ``after`` (the interval's start,
+    the torque just after it) to ``inputs`` (its end); the jump ``kicks[k]`` at sample k. The
+    samples past :data:`MAX_SUBSTEPS` sub-steps (or past a rate that is not finite) are nan: a
+    demand not computed, which the scorer breaks the requirement on."""
+    n, n_states = kicks.shape
+    states = np.full((n, n_states), np.nan)
+    states[0] = start
+    if n > 1:
+        dt = np.diff(t)
+        turn = dt * np.maximum(np.linalg.norm(inputs[:-1, 7:10], axis=1), np.linalg.norm(inputs[1:, 7:10], axis=1))
+        counts = np.full(n - 1, np.inf)  # a rate that is not finite: no sub-step resolves it
+        finite = np.isfinite(turn)
+        counts[finite] = np.maximum(np.ceil(turn[finite] / SUBSTEP_ANGLE - 1e-9), 1.0)
+        within = int(np.searchsorted(np.cumsum(counts), MAX_SUBSTEPS, side="right"))  # whole intervals in the budget
+        counts = counts[:within].astype(np.int64)
+        interval = np.repeat(np.arange(within), counts)
+        firsts = np.cumsum(counts) - counts
+        index = np.arange(interval.size) - firsts[interval]  # the sub-step within its interval
+        ends = np.zeros((-(-interval.size // _CHUNK) * _CHUNK, n_states))
+        jumps = np.zeros((_CHUNK, n_states))
+        state = start
+        for first in range(0, interval.size, _CHUNK):  # one call per chunk of sub-steps
+            which = interval[first:first + _CHUNK]
+            size = which.size
+            parts = counts[which].astype(float)[:, None]
+            begin, end = after[which], inputs[which + 1]
+            now = np.tile(end[-1], (_CHUNK, 1))  # whole chunks: the last sub-step's end held, zero lengths
+            then = now.copy()
+            now[:size] = begin + index[first:first + size, None] / parts * (end - begin)
+            then[:size] = begin + (index[first:first + size, None] + 1.0) / parts * (end - begin)
+            lengths = np.zeros(_CHUNK)
+            lengths[:size] = dt[which] / parts[:, 0]
+            jumps[:] = 0.0
+            starting = index[first:first + size] == 0
+            jumps[:size][starting] = kicks[which[starting]]
+            ends[first:first + _CHUNK] = step(state, now.ravel(), then.ravel(), lengths, jumps.ravel()).reshape(
+                _CHUNK, n_states)  # column-major: a row per sub-step
+            state = ends[first + _CHUNK - 1].copy()
+        states[1:within + 1] = ends[firsts + counts - 1]
+    return states + kicks  # each sample's state after its jump (the step from it started there)
 
 
 def unrealised_torque(model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: ArrayLike, torque: ArrayLike,
@@ -548,20 +643,25 @@ def unrealised_torque(model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: A
     return np.asarray(torque, dtype=float).reshape(n, 3) - given
 
 
+def _demand_command(law: Allocation, spacecraft: Spacecraft, n_states: int) -> ca.Function:
+    """``command(state, inputs) -> u``: the law's map at a sample, ``inputs`` = [τ, q, ω, b]."""
+    inputs = ca.SX.sym("inputs", 13)
+    state = ca.SX.sym("state", n_states)
+    measurement = ca.vertcat(inputs[3:7], inputs[7:10], state[:spacecraft.n_wheels], inputs[10:13])  # [q, ω, h_w, b]
+    return ca.Function("demand_command", [state, inputs], [law.allocate_symbolic(inputs[0:3], measurement)])
+
+
 def _demand_step(law: Allocation, spacecraft: Spacecraft, blocks: Sequence[Any], n_states: int) -> ca.Function:
-    """``step(state_k, inputs_k, inputs_k+1, dt, kick_k) -> (state_k+1, u_k)``: the state's jump
-    ``kick_k`` at sample k (the wheels taking up a jump of the rate), the command ``u_k`` of the
-    law's map there and Heun's step of the actuators' states; ``inputs`` = [τ, q, ω, b]."""
+    """``step(state_k, inputs_k, inputs_k+1, dt, kick_k) -> state_k+1``: the state's jump ``kick_k``
+    at step k (the wheels taking up a jump of the rate), then the classical Runge-Kutta step of the
+    actuators' states under the law's map, the inputs linear over the step; ``inputs`` = [τ, q, ω, b]."""
     inputs = ca.SX.sym("inputs", 13)
     state = ca.SX.sym("state", n_states)
     n_w = spacecraft.n_wheels
 
-    def command(at: ca.SX, states: ca.SX) -> ca.SX:
-        measurement = ca.vertcat(at[3:7], at[7:10], states[:n_w], at[10:13])  # y = [q, ω, h_w, b]
-        return law.allocate_symbolic(at[0:3], measurement)
-
     def rate(at: ca.SX, states: ca.SX) -> ca.SX:
-        u = command(at, states)
+        measurement = ca.vertcat(at[3:7], at[7:10], states[:n_w], at[10:13])  # y = [q, ω, h_w, b]
+        u = law.allocate_symbolic(at[0:3], measurement)
         parts = [block.actuator.state_rate(u[block.control], states[block.state]) for block in blocks
                  if block.actuator.state_size]
         return ca.vertcat(*parts) if parts else ca.SX(0, 1)
@@ -570,6 +670,10 @@ def _demand_step(law: Allocation, spacecraft: Spacecraft, blocks: Sequence[Any],
     dt = ca.SX.sym("dt")
     kick = ca.SX.sym("kick", n_states)
     kicked = state + kick
-    before = rate(inputs, kicked)
-    following = kicked + 0.5 * dt * (before + rate(after, kicked + dt * before))
-    return ca.Function("demand_step", [state, inputs, after, dt, kick], [following, command(inputs, kicked)])
+    middle = 0.5 * (inputs + after)  # the inputs are linear over the step
+    k1 = rate(inputs, kicked)
+    k2 = rate(middle, kicked + 0.5 * dt * k1)
+    k3 = rate(middle, kicked + 0.5 * dt * k2)
+    k4 = rate(after, kicked + dt * k3)
+    following = kicked + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+    return ca.Function("demand_step", [state, inputs, after, dt, kick], [following])

@@ -189,7 +189,8 @@ def test_torque_two_wheels_give_through_their_momentum_is_realised():
     assert np.max(np.abs(u[:, 2])) > 1e-4  # the z part is not small
     demand = reference_demand(CONTROLLERS["augmented_quaternion_feedback"](), model, t, q, omega, u, h0)
     missing = np.linalg.norm(unrealised_torque(model, t, q, omega, u, demand), axis=1)
-    # Heun's momenta against the closed form: O(dt²) (dt = 0.01 s); the missing torque follows them
+    # the integrated momenta (two wheels: Runge-Kutta on inputs linear between samples) against the
+    # closed form: O(dt²) (dt = 0.01 s); the missing torque follows them
     assert np.max(missing) < 1e-3 * np.max(np.abs(u[:, 2]))
     assert _actuators(1.0, demand, t, [], unrealised_torque(model, t, q, omega, u, demand), u).met
 

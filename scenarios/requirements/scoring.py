@@ -20,7 +20,9 @@ and what breaks it in words. The fields:
   that the allocation's commands do not give (:func:`controllers.allocation.unrealised_torque`:
   about an axis no working actuator spans); met when every ratio is at most ``1 − margin``, the
   rate never jumps and the unrealised torque stays within :data:`UNREALISED_TOLERANCE` of the
-  reference's peak torque;
+  reference's peak torque; a demand or unrealised torque that is not finite (nan, inf) is no
+  number met: its field is null, its time the first sample where it is not finite, and the
+  requirement broken;
 * ``rate``: ``peak_rate`` [rad/s] (of ``‖ω‖``), ``peak_time_s``, ``ratio`` (over the bound);
 * ``final`` (closed loop only): ``worst_error_deg`` and ``worst_rate_error`` [rad/s] from
   ``T + after_s`` to the end, and ``from_s``.
@@ -257,11 +259,19 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
                torque: Array | None = None) -> Score:
     values: dict[str, float | None] = {}
     broken = []
+    unscored = []
     allowed = f"{margin_allowed:.3g}"  # with the digits the most precise ratio shown needs
     for name, quantity in demand.items():
         if not quantity.limited:
             continue
         ratios = quantity.ratios()
+        unknown = ~np.all(np.isfinite(quantity.values), axis=1)
+        if np.any(unknown):  # a demand that cannot be computed is no demand met
+            first = int(np.argmax(unknown))
+            values[name] = None
+            values[f"{name}_time_s"] = float(t[first])
+            unscored.append(f"{name} is not finite (nan or inf) from {t[first]:.1f} s: the demand cannot be scored")
+            continue
         peaks = np.max(ratios, axis=1) if ratios.size else np.zeros(len(t))
         worst = int(np.argmax(peaks)) if peaks.size else 0
         ratio = float(peaks[worst]) if peaks.size else 0.0
@@ -271,7 +281,7 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
             shown, limit = _over(ratio, margin_allowed)
             allowed = max(allowed, limit, key=len)
             broken.append(f"{name} {shown} x its limit at {t[worst]:.1f} s")
-    detail = ", ".join(broken) + f" (allowed {allowed} x)" if broken else ""
+    detail = ", ".join(unscored + ([", ".join(broken) + f" (allowed {allowed} x)"] if broken else []))
     if jumps is not None:
         largest = max(jumps, key=lambda jump: float(np.linalg.norm(jump[2])), default=None)
         values.update(zip(JUMP_FIELDS, (0.0, None) if largest is None
@@ -287,8 +297,14 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
         peak = float(norms[worst]) if norms.size else 0.0
         scale = float(np.max(np.linalg.norm(torque, axis=1), initial=0.0))
         values.update(zip(UNREALISED_FIELDS, (peak, float(t[worst]) if norms.size else None)))
+        unknown = ~np.isfinite(norms)
+        if np.any(unknown):
+            first = int(np.argmax(unknown))
+            values.update(zip(UNREALISED_FIELDS, (None, float(t[first]))))
+            missing = f"the unrealised torque is not finite (nan or inf) from {t[first]:g} s: it cannot be scored"
+            detail = missing + (f", {detail}" if detail else "")
         # a reference asking no torque is measured against the rounding of its own terms
-        if peak > UNREALISED_TOLERANCE * max(scale, UNREALISED_FLOOR):
+        elif peak > UNREALISED_TOLERANCE * max(scale, UNREALISED_FLOOR):
             share = f" ({peak / scale:.0%} of the reference's peak)" if scale > 0.0 else ""
             missing = f"{peak:.3g} N m of the torque asked at {t[worst]:g} s{share} is given by no working actuator"
             detail = missing + (f", {detail}" if detail else "")
@@ -331,8 +347,10 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         for _, index, jump in jumps:
             if index < t.size:
                 steps[index] += jump
+        # the sample at T holds the torque's value there; the reference coasts torque-free after it
+        after = np.where((t >= reference.duration)[:, None], 0.0, sample.torque) if reference is not None else None
         demand = reference_demand(allocation, problem.model, t, sample.q, sample.omega, sample.torque,
-                                  problem.wheel_momentum0, jumps=steps)
+                                  problem.wheel_momentum0, jumps=steps, torque_after=after)
         unrealised = unrealised_torque(problem.model, t, sample.q, sample.omega, sample.torque, demand)
         scores["actuators"] = _actuators(requirements.actuators.allowed, demand, t, jumps, unrealised,
                                          np.asarray(sample.torque, dtype=float))
