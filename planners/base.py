@@ -21,6 +21,7 @@ import copy
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any, ClassVar
 
 from ocp import SolverCache
@@ -203,6 +204,29 @@ class Planner(Configurable, ABC):
         error = self.problem_error(problem)
         reference = FailedReference(self.name, error) if error else self._plan(problem)
         reference.plan_time_s = time.perf_counter() - start
+        return reference
+
+    def plan_start(self, problem: ManeuverProblem) -> Reference:
+        """Plan a reference that starts another method (a warm start, a cold start, a seed): on
+        ``problem``, or, where that fails and the problem bounds the rate, on the problem without
+        the bound (a start need not meet it: the method it starts imposes it; the eigenaxis quintic
+        faster than ``max_rate`` is infeasible as a row, not as a start).
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The slew to plan.
+
+        Returns
+        -------
+        Reference
+            As :meth:`plan`; the failure on ``problem`` when both fail.
+        """
+        reference = self.plan(problem)
+        if not reference.ok and problem.max_rate is not None:
+            unbounded = self.plan(replace(problem, max_rate=None))
+            if unbounded.ok:
+                return unbounded
         return reference
 
     @abstractmethod

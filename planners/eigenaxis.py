@@ -383,7 +383,7 @@ class EigenaxisPlanner(Planner):
         """Where the rate bound comes from, in a message."""
         option = self.options.max_rate
         return "option max_rate" if option is not None and (problem.max_rate is None or option < problem.max_rate) \
-            else "maneuver.max_rate or requirements.rate.max"
+            else "the problem's: maneuver.max_rate, else requirements.rate.max"
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         assert problem.qf is not None  # problem_error (the default) refuses a free attitude
@@ -391,8 +391,7 @@ class EigenaxisPlanner(Planner):
         angle = float(np.linalg.norm(rotvec))
         axis = rotvec / angle if angle > 1e-12 else np.array([1.0, 0.0, 0.0])
         inertia = problem.spacecraft.inertia
-        bounds = [b for b in (self.options.max_rate, problem.max_rate) if b is not None]
-        max_rate = min(bounds) if bounds else None  # the option tightens the problem's bound, never loosens it
+        max_rate = problem.rate_bound(self.options.max_rate)
         if self.options.profile == "smooth":
             rate_end = 0.0 if problem.omegaf is None else float(axis @ problem.omegaf)
             quintic = QuinticProfile(angle, problem.duration, float(axis @ problem.omega0), rate_end)

@@ -95,6 +95,23 @@ class ManeuverProblem:
                                                      and 0.0 <= self.actuator_margin < 1.0):
             raise ValueError(f"actuator_margin must lie in [0, 1) or be None, got {self.actuator_margin!r}")
 
+    def rate_bound(self, option: float | None) -> float | None:
+        """The rate bound a planner imposes: its own ``max_rate`` option tightens the problem's
+        (``maneuver.max_rate``, else ``requirements.rate.max``), never loosens it.
+
+        Parameters
+        ----------
+        option : float or None
+            The planner's option [rad/s]; ``None``: the problem's bound.
+
+        Returns
+        -------
+        float or None
+            The smaller of the two [rad/s]; ``None`` without either.
+        """
+        bounds = [bound for bound in (option, self.max_rate) if bound is not None]
+        return min(bounds) if bounds else None
+
     @property
     def torque_limit(self) -> Array:
         """(3,) ndarray: per-body-axis torque bound [N m] of the actuators (``Spacecraft.body_torque_limit``)."""

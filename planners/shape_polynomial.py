@@ -292,7 +292,7 @@ class ShapePolynomialPlanner(Planner):
         """
         o = self.options
         if o.duration == "rate_limit":
-            if (o.max_rate if o.max_rate is not None else problem.max_rate) is None:
+            if problem.rate_bound(o.max_rate) is None:
                 return "duration: rate_limit needs max_rate (option or maneuver.max_rate)"
             if np.any(problem.omega0) or (problem.omegaf is not None and np.any(problem.omegaf)):
                 return "duration: rate_limit is for rest-to-rest slews; use duration: scenario"
@@ -300,8 +300,7 @@ class ShapePolynomialPlanner(Planner):
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         o = self.options
-        bounds = [b for b in (o.max_rate, problem.max_rate) if b is not None]
-        max_rate = min(bounds) if bounds else None  # the option tightens the problem's bound, never loosens it
+        max_rate = problem.rate_bound(o.max_rate)
         if o.duration == "rate_limit" and max_rate is None:
             return FailedReference(self.name, "duration: rate_limit needs max_rate (option or maneuver.max_rate)")
         omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf

@@ -97,7 +97,7 @@ def test_the_quintic_honours_the_rate_bound_or_is_infeasible():
             assert np.max(rates) == pytest.approx(peak, rel=1e-9) and np.argmax(rates) == 10000
         else:
             assert reference.status == "infeasible"
-            assert f"peaks at {peak:.4g} rad/s" in reference.message and "(maneuver.max_rate or requirements.rate.max)" in reference.message
+            assert f"peaks at {peak:.4g} rad/s" in reference.message and "(the problem's: maneuver.max_rate, else requirements.rate.max)" in reference.message
             assert f"T >= {15 * angle / (8 * bound):.4g} s keeps it within" in reference.message
     option = PLANNERS["eigenaxis"]({"profile": "smooth", "max_rate": peak / 2}).plan(problem)
     assert option.status == "infeasible" and "(option max_rate)" in option.message
@@ -120,7 +120,7 @@ def test_a_duration_too_short_under_the_rate_bound_names_it():
     reference = PLANNERS["eigenaxis"]({"profile": "trapezoidal"}).plan(problem)
     assert reference.status == "infeasible"
     assert f"time {1.57 / 0.01 + 0.01 * 12.6 / 0.1:.4g} s under the torque bounds and the rate bound 0.01 rad/s " \
-           "(maneuver.max_rate or requirements.rate.max)" in reference.message
+           "(the problem's: maneuver.max_rate, else requirements.rate.max)" in reference.message
 
 
 def test_a_triangle_profile_has_one_switch_and_a_coast_two():

@@ -449,7 +449,7 @@ class CollocationPlanner(Planner):
         requested += [(name, None) for name in self._seed_names(problem)]
         for name, options in requested:
             try:
-                reference = self._start(name, options, problem)
+                reference = PLANNERS[name](options, cache=self.cache).plan_start(problem)
             except Exception as error:  # noqa: BLE001 (a seed is optional: its crash is recorded, not raised)
                 if failures is not None:
                     failures.append(f"{name}: raised {type(error).__name__}: {error}")
@@ -459,18 +459,6 @@ class CollocationPlanner(Planner):
             elif failures is not None:
                 failures.append(f"{name}: {reference.message}")
         return starts
-
-    def _start(self, name: str, options: Any, problem: ManeuverProblem) -> Reference:
-        """The reference of planner ``name`` as a start: planned on ``problem``, or, where the rate
-        bound alone stops it (a quintic eigenaxis slew faster than ``max_rate``), without the bound
-        (the NLP imposes it; a start need not meet it)."""
-        planner = PLANNERS[name](options, cache=self.cache)
-        reference = planner.plan(problem)
-        if not reference.ok and problem.max_rate is not None:
-            unbounded = planner.plan(replace(problem, max_rate=None))
-            if unbounded.ok:
-                return unbounded
-        return reference
 
     def _guesses(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
                  seeds: list[Array], alternates: list[Array] | None = None,
@@ -515,7 +503,7 @@ class CollocationPlanner(Planner):
         o = self.options
         ocp = self._ocp(problem)
         transcription, nlp = self._nlp(problem, ocp)
-        reference = self._start(o.warm_start, o.warm_start_options, problem)
+        reference = PLANNERS[o.warm_start](o.warm_start_options, cache=self.cache).plan_start(problem)
         if not reference.ok:
             raise ValueError(f"no first start: the warm-start planner {o.warm_start!r} failed ({reference.message})")
         seeds, _, labels = self._seeds(problem, ocp, transcription, nlp, [reference])

@@ -139,7 +139,7 @@ class MinimumEnergySystem(RigidBodySystem):
         from planners.eigenaxis import EigenaxisPlanner
 
         s = np.linspace(0.0, 1.0, nodes)
-        sample = EigenaxisPlanner().plan(self.problem).sample(s * T)
+        sample = EigenaxisPlanner().plan_start(self.problem).sample(s * T)
         x = np.vstack([sample.q.T, sample.omega.T])
         gravity = self.environment_torque(s * T, x)
         return T, s, np.vstack([x, np.zeros((4, nodes)), -self.inertia @ (sample.torque.T - gravity)])

@@ -65,7 +65,7 @@ def _rate_acquisition(problem: ManeuverProblem, o, build: bool = True) -> Hamilt
 
 
 def _attitude_acquisition(problem: ManeuverProblem, o, build: bool = True) -> HamiltonianSystem | str | None:
-    max_rate = o.max_rate if o.max_rate is not None else problem.max_rate
+    max_rate = problem.rate_bound(o.max_rate)
     if max_rate is None:
         return "objective attitude_acquisition needs a rate bound (options.max_rate or maneuver.max_rate)"
     if problem.qf is None:

@@ -105,7 +105,7 @@ def eigenaxis_guess(problem: ManeuverProblem, objective: str) -> tuple[np.ndarra
     from planners import PLANNERS
 
     profile = "min_time" if objective == "min_time" else "smooth"
-    reference = PLANNERS["eigenaxis"]({"profile": profile}).plan(problem)
+    reference = PLANNERS["eigenaxis"]({"profile": profile}).plan_start(problem)
     duration = reference.duration if objective == "min_time" else problem.duration
     t = np.linspace(0.0, duration, N + 1)
     sample = reference.sample(t)
