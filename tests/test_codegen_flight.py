@@ -105,7 +105,7 @@ class Built:
         c_table = Table.in_dll(self.lib, self.interface["tables"][label]["table"])
         times = np.ctypeslib.as_array(c_table.times, (c_table.n,)).copy()
         rows = np.ctypeslib.as_array(c_table.rows, (c_table.n * ROW,)).reshape(c_table.n, ROW).copy()
-        return c_table, ReferenceTable(times, rows)
+        return c_table, ReferenceTable(times, rows, self.interface["tables"][label]["duration_s"])
 
     def row(self, c_table, t):
         out = (ctypes.c_double * ROW)()
@@ -156,7 +156,8 @@ def test_step_equals_the_python_law_then_the_simulators_saturation(name, tmp_pat
             params.reference = ctypes.pointer(table[0])
         state = built.init()
         np.testing.assert_array_equal(state.z[:built.nz], controller.state_vector())
-        end = spec.sample_time * 40 if reference is None else reference.duration - spec.sample_time
+        # past T (the coast) and past the table's end (the last row held, in C as in TableReference)
+        end = spec.sample_time * 40 if table is None else table[1].end + 5 * spec.sample_time
         for t in np.sort(rng.uniform(0.0, end, 12)):
             measurement = Measurement(float(t), quat.random_unit(rng), rng.normal(0, 0.05, 3),
                                       rng.uniform(-1.2, 1.2, spacecraft.n_wheels) * h_scale,
@@ -209,8 +210,10 @@ def test_c_tables_equal_the_python_interpolation_and_state_their_error_honestly(
     for label, description in built.interface["tables"].items():
         c_table, table = built.table(label)
         reference = planners[label].planner.plan(scenario.problem)
-        duration = reference.duration
-        assert table.times[0] == 0.0 and table.times[-1] == duration
+        duration = table.end  # the closed-loop window and one sample: the coast after T
+        window = scenario.simulation.duration or max(scenario.problem.duration, reference.duration)
+        assert table.times[0] == 0.0 and duration == window + scenario.simulation.sample_time
+        assert table.manoeuvre_duration == reference.duration == description["duration_s"]
         times = np.concatenate([rng.uniform(0, duration, 200), table.times, [-1.0, duration + 5.0]])
         python = interpolate(table.times, table.rows, times)
         c_rows = np.array([built.row(c_table, t) for t in times])

@@ -8,7 +8,8 @@ stage and every planner row's reference as a table, behind a flight interface
   the C templates (``templates/``: the wrapper, the worked example, the Makefile) filled in.
 
 May import: :mod:`ocp`, :mod:`planners`, :mod:`controllers`, :mod:`scenarios.errors`,
-:mod:`scenarios.schema`, :mod:`scenarios.output` and :mod:`scenarios.runner`. The names below are
+:mod:`scenarios.requirements`, :mod:`scenarios.schema`, :mod:`scenarios.output` and
+:mod:`scenarios.runner`. The names below are
 imported on first use (CasADi's code generator is only for this command).
 """
 from __future__ import annotations

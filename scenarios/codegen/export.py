@@ -12,13 +12,22 @@ user's files are never touched) receives:
   interpolation, :func:`~scenarios.codegen.tables.segment_function`) and, for closed-form rows,
   ``slewbench_reference_<row>(t) -> row``;
 * ``slewbench_tables.c`` / ``.h``: every planned row's reference as a table
-  (:func:`~scenarios.codegen.tables.tabulate`), ``slewbench_table_<row>``;
+  (:func:`~scenarios.codegen.tables.tabulate`), ``slewbench_table_<row>``, through the scenario's
+  closed-loop window and one sample (after T: the reference's torque-free coast, what the Python
+  closed loop tracks there; past the table's end the last row is held);
 * ``slewbench_step.c`` / ``.h``: the flight interface ``slewbench_step(t, measurement, params,
   command, state)`` over them (static work arrays, no allocation), with the ``slewbench_params``
   struct and its default initializer;
 * ``example.c`` (a worked use), ``Makefile`` (``make``: ``lib<stem>.so`` and ``example``; ``make
-  float``: single precision), ``README.md`` (the interface and each table's error) and
-  ``interface.json`` (the functions, their inputs and outputs, the layouts, the tables).
+  float``: single precision), ``README.md`` (the interface, each table's error and span, the
+  requirements each row breaks) and ``interface.json`` (the functions, their inputs and outputs,
+  the layouts, the tables).
+
+Each planned row is planned, sampled and scored against the scenario's requirements as ``slewbench
+run`` does (:func:`scenarios.runner.run`'s reference path,
+:func:`scenarios.requirements.scoring.score_reference`); a row that breaks one is still exported,
+with what it breaks (:attr:`CodegenReport.violations`), and ``SLEWBENCH_PARAMS_DEFAULT`` tracks the
+first exported row that meets them (the first exported row when none does, said so).
 """
 from __future__ import annotations
 
@@ -37,6 +46,7 @@ from controllers.allocation import SymbolicConstants
 from ocp.dynamics.actuators import ActuatorModel
 from ocp.dynamics.layout import REFERENCE_FIELDS, control_layout, reference_rows
 from scenarios.codegen.tables import (
+    ReferenceTable,
     TableError,
     TableTolerance,
     angle_text,
@@ -51,6 +61,8 @@ from scenarios.output.directory import (
 )
 from scenarios.output.names import row_stems
 from scenarios.output.provenance import package_version
+from scenarios.requirements.scoring import score_reference, violations
+from scenarios.runner import _plan, _window
 from scenarios.schema.loader import Scenario
 
 
@@ -70,6 +82,14 @@ class CodegenReport:
         Planner rows exported as tables (label -> the table's error against the reference).
     skipped : dict of str to str, optional
         Planner rows not exported (label -> reason: the plan failed).
+    violations : dict of str to list of str, optional
+        Exported rows whose reference breaks the scenario's requirements, scored as ``slewbench run``
+        scores it (:func:`scenarios.requirements.scoring.score_reference`): label -> what breaks,
+        one sentence per requirement.
+    default : str or None, optional
+        The row whose table ``SLEWBENCH_PARAMS_DEFAULT`` tracks (``None``: regulation).
+    default_reason : str, optional
+        Why that row (or regulation), in words.
     """
 
     directory: Path
@@ -77,6 +97,28 @@ class CodegenReport:
     functions: list[str] = field(default_factory=list)
     tables: dict[str, TableError] = field(default_factory=dict)
     skipped: dict[str, str] = field(default_factory=dict)
+    violations: dict[str, list[str]] = field(default_factory=dict)
+    default: str | None = None
+    default_reason: str = ""
+
+    def summary(self) -> list[str]:
+        """What ``slewbench codegen`` prints: the files, the functions, each table's error (naming
+        the quantities that miss their tolerance), a warning per row that breaks the requirements,
+        the skipped rows and the default reference.
+
+        Returns
+        -------
+        list of str
+            One line each.
+        """
+        lines = [f"wrote {self.directory}/: " + ", ".join(f"{name} ({size} bytes)" for name, size in self.files.items()),
+                 "functions: " + ", ".join(self.functions)]
+        lines += [f"  table of row {label!r}: {error.summary()}" for label, error in self.tables.items()]
+        lines += [f"  warning: row {label!r} breaks the scenario's requirements: {'; '.join(broken)}"
+                  for label, broken in self.violations.items()]
+        lines += [f"  no C reference for row {label!r}: {reason}" for label, reason in self.skipped.items()]
+        lines.append(f"default reference (SLEWBENCH_PARAMS_DEFAULT): {self.default_reason}")
+        return lines
 
 
 def c_identifier(text: str) -> str:
@@ -229,7 +271,7 @@ def _tables_files(tables: dict[str, tuple[str, Any]]) -> tuple[str, str]:
               "#ifndef SLEWBENCH_TABLES_H", "#define SLEWBENCH_TABLES_H", '#include "slewbench_step.h"', ""]
     source = ['/* slewbench_tables.c: generated by slewbench codegen. */', '#include "slewbench_tables.h"', ""]
     for label, (name, table) in tables.items():
-        header.append(f"/* row {label!r}: {table.times.size} nodes over [0, {table.times[-1]!r}] s */")
+        header.append(f"/* row {label!r}: {_table_words(table)} */")
         header.append(f"extern const slewbench_table {name};")
         source.append(f"static const double {name}_times[{table.times.size}] = {{ {_c_numbers(table.times)} }};")
         source.append(f"static const double {name}_rows[{table.rows.size}] = {{ {_c_numbers(table.rows)} }};")
@@ -239,9 +281,24 @@ def _tables_files(tables: dict[str, tuple[str, Any]]) -> tuple[str, str]:
     return "\n".join(header), "\n".join(source)
 
 
+def _table_words(table: ReferenceTable) -> str:
+    """What a table covers and what it gives past its end, in words (plain numbers)."""
+    duration, end = table.manoeuvre_duration, table.end
+    words = f"{table.times.size} nodes over [0, {end:g}] s"
+    if end > duration:
+        words += f": the manoeuvre to T = {duration:g} s, then its torque-free coast"
+    last = table.rows[-1]
+    rate = float(np.linalg.norm(last[4:7]))
+    words += f"; after {end:g} s it holds its last row"
+    if rate > 0.0:
+        words += f" (omega {rate:.3g} rad/s with q fixed: no motion)"
+    return words
+
+
 def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str, Any]],
             errors: dict[str, TableError], skipped: dict[str, str], tolerance: TableTolerance,
-            parameters: list[tuple[str, list[int], list[str]]], law_reads: set[str], reads_rows: bool) -> str:
+            parameters: list[tuple[str, list[int], list[str]]], law_reads: set[str], reads_rows: bool,
+            violations_by_row: dict[str, list[str]], default_reason: str) -> str:
     lines = [f"# C export of scenario `{scenario.name}` (slewbench codegen)", "",
              "Build: `make` (the library `lib" + stem + ".so` and `./example`), `make float` (single precision).",
              "", "## Flight interface (`slewbench_step.h`)", "",
@@ -285,15 +342,49 @@ def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str
              "reference's own points (collocation's nodes) and its breakpoints (doubled: left and right limits)."),
              "", ("Error against the continuous reference, largest over seven points of every interval "
              "(s = 1/8, ..., 7/8 of its length; the midpoint is where a smooth reference's error peaks):"), "",
-             "| row | table | nodes | attitude | rate [rad/s] | omega_dot [rad/s^2] | torque [N m] | tolerances met |",
-             "|---|---|---|---|---|---|---|---|"]
+             ("| row | table | nodes | span [s] | attitude | rate [rad/s] | omega_dot [rad/s^2] | torque [N m] | "
+              "tolerances met |"),
+             "|---|---|---|---|---|---|---|---|---|"]
     for label, (name, table) in tables.items():
         e = errors[label]
-        lines.append(f"| {label} | `{name}` | {table.times.size} | {angle_text(e.attitude_rad)} | {e.rate:.3g} | "
-                     f"{e.acceleration:.3g} | {e.torque:.3g} | {'yes' if e.met else 'NO'} |")
+        met = "yes" if e.met else "NO: " + ", ".join(e.failed)
+        lines.append(f"| {label} | `{name}` | {table.times.size} | 0 to {table.end:g} (T = {table.manoeuvre_duration:g}) | "
+                     f"{angle_text(e.attitude_rad)} | {e.rate:.3g} | {e.acceleration:.3g} | {e.torque:.3g} | {met} |")
     for label, reason in skipped.items():
-        lines.append(f"| {label} | not exported: {reason} | | | | | | |")
+        lines.append(f"| {label} | not exported: {reason} | | | | | | | |")
+    lines += ["", ("Span: each table runs through the scenario's closed-loop window and one sample (every time "
+                   "`slewbench_step` reads in the simulated run); after the reference's T it holds the reference's "
+                   "torque-free coast (torque zero), the motion the Python closed loop tracks there. Past the "
+                   "table's end `slewbench_reference_row` holds the last row (`t` is clamped): for a reference "
+                   "still rotating at the end that is no motion (q fixed, omega not zero); regenerate with a longer "
+                   "`simulation.duration` to track it longer.")]
+    lines += ["", "## Requirements and the default reference", "",
+              ("Each exported row's reference is scored against the scenario's requirements as `slewbench run` "
+               "scores it (the reference on its own sampling, through the closed-loop window)."), ""]
+    for label in tables:
+        broken = violations_by_row.get(label)
+        lines.append(f"- {label}: " + ("breaks " + "; ".join(broken) if broken else "meets them"))
+    lines += ["", f"`SLEWBENCH_PARAMS_DEFAULT`: {default_reason}"]
     return "\n".join(lines) + "\n"
+
+
+def _default_row(labels: list[str], broken: dict[str, list[str]], tracks: bool) -> tuple[str | None, str]:
+    """The row ``SLEWBENCH_PARAMS_DEFAULT`` tracks, and why: the first exported row that meets the
+    requirements; the first exported row when none does; none (regulation) when the law reads no
+    reference or no row is exported."""
+    if not tracks:
+        return None, "regulation to the target (the law reads no reference)"
+    if not labels:
+        return None, "regulation to the target (no row was exported)"
+    ok = [label for label in labels if label not in broken]
+    if not ok:
+        return labels[0], (f"track row {labels[0]!r}, the first exported row; WARNING: every exported row breaks "
+                           "the scenario's requirements")
+    if ok[0] == labels[0]:
+        return ok[0], f"track row {ok[0]!r}, the first exported row (it meets the scenario's requirements)"
+    before = ", ".join(repr(label) for label in labels[:labels.index(ok[0])])
+    return ok[0], (f"track row {ok[0]!r}, the first exported row that meets the scenario's requirements "
+                   f"({before} break{'s' if labels.index(ok[0]) == 1 else ''} them)")
 
 
 def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | None = None) -> CodegenReport:
@@ -385,19 +476,29 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
     tables: dict[str, tuple[str, Any]] = {}
     stems = row_stems([p.label for p in scenario.planners])
     for planner_spec, row in zip(scenario.planners, stems):
-        reference = planner_spec.planner.plan(problem)
+        # the reference as `slewbench run` plans and samples it for its scores
+        reference, _, sampled = _plan(scenario, planner_spec, None, scoring=True)
         if not reference.ok:
             report.skipped[planner_spec.label] = f"the plan {reference.status}: {reference.message}"
             continue
-        table, error = tabulate(reference, tolerance)
+        assert sampled is not None  # scoring=True samples it
+        scores = score_reference(scenario.requirements, problem, *sampled, laws[0], reference)
+        broken = violations({"reference": scores})
+        if broken:
+            report.violations[planner_spec.label] = broken
+        # through every time the closed loop reads: its window, then the reference one sample ahead
+        table, error = tabulate(reference, tolerance, _window(scenario, reference) + spec.sample_time)
         table_name = _unique(f"slewbench_table_{c_identifier(row)}", taken)
         tables[planner_spec.label] = (table_name, table)
         report.tables[planner_spec.label] = error
         interface["tables"][planner_spec.label] = {
             "table": table_name, "nodes": int(table.times.size), "duration_s": reference.duration,
+            "end_s": table.end, "after_end": "holds the last row",
+            "requirements_met": not broken, "violations": broken,
             "error": {"attitude_rad": error.attitude_rad, "rate_rad_s": error.rate,
                       "omega_dot_rad_s2": error.acceleration, "torque_N_m": error.torque,
-                      "points_checked": error.points, "tolerances_met": error.met}}
+                      "points_checked": error.points, "tolerances_met": error.met,
+                      "tolerances_failed": list(error.failed)}}
         evaluator = reference.symbolic_evaluator() if planner_spec.planner.closed_form else None
         if evaluator is not None:
             name = _unique(f"slewbench_reference_{c_identifier(row)}", taken)
@@ -405,8 +506,8 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
             interface["references"][planner_spec.label] = {"function": name, "duration_s": reference.duration,
                                                            "output": "row [q, omega, omega_dot, torque] (13)"}
     tracks = bool(getattr(laws[0], "tracks_reference", False) or getattr(laws[0], "needs_reference", False))
-    first = next(iter(tables.values()), None)
-    default_reference = first[0] if tracks and first is not None else None
+    report.default, report.default_reason = _default_row(list(tables), report.violations, tracks)
+    default_reference = None if report.default is None else tables[report.default][0]
     target = reference_rows(None, [0.0], (problem.qf, problem.omegaf))[0]
     slices, nu = control_layout(spacecraft)
     u_layout = "[" + ", ".join(f"{key} ({s.stop - s.start})" for key, s in slices.items()) + "]"
@@ -426,8 +527,8 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
               "N_WHEELS": str(spacecraft.n_wheels), "NU": str(nu), "NZ": str(int(np.size(z0))),
               "U_LAYOUT": u_layout, "SAMPLE_TIME": repr(float(spec.sample_time)),
               "DEFAULT_REFERENCE": "0" if default_reference is None else f"&{default_reference}",
-              "DEFAULT_REFERENCE_TEXT": ("regulation to the target (no table)" if default_reference is None else
-                                         f"track the first planned row's table, {default_reference}"),
+              "DEFAULT_REFERENCE_TEXT": (report.default_reason + ("" if default_reference is None else
+                                                                  f", {default_reference}")).replace("*/", "* /"),
               "TARGET": _c_numbers(target), "GENERATED": stem, "LAW": step_law,
               "SZ_ARG": str(max(1, *work[0])), "SZ_RES": str(max(1, *work[1])),
               "SZ_IW": str(max(1, *work[2])), "SZ_W": str(max(1, *work[3])),
@@ -440,7 +541,8 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
               "TRACKS": "1" if tracks else "0"}
     interface["skipped"] = dict(report.skipped)
     interface["step"] = {"law": step_law, "saturation": "slewbench_saturate", "segment": "slewbench_segment",
-                         "default_reference": default_reference, "target": target.tolist()}
+                         "default_reference": default_reference, "default_row": report.default,
+                         "default_reason": report.default_reason, "target": target.tolist()}
     tables_h, tables_c = _tables_files(tables)
     staging = new_staging(directory)
     try:
@@ -452,7 +554,8 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
                  "example.c": _template("example.c.in", values), "Makefile": _template("Makefile.in", values),
                  "slewbench_tables.h": tables_h, "slewbench_tables.c": tables_c,
                  "README.md": _readme(scenario, stem, step_law, tables, report.tables, report.skipped, tolerance,
-                                      readers, law_reads[step_law], reads_rows[step_law]),
+                                      readers, law_reads[step_law], reads_rows[step_law], report.violations,
+                                      report.default_reason),
                  "interface.json": json.dumps(interface, indent=1) + "\n"}
         for name, text in texts.items():
             (staging / name).write_text(text)

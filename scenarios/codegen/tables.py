@@ -1,11 +1,21 @@
 """Any planner's reference as a table, and the one interpolation that reads it in Python and in C.
 
 A table holds rows ``[q*, ω*, ω̇*, τ*]`` (13 numbers, :data:`~ocp.dynamics.layout.REFERENCE_FIELDS`)
-at increasing times ``t_0 = 0 < … < t_{N-1} = T``. Its nodes are a uniform grid, refined by halving
-until the interpolation meets the tolerances inside every interval (or the node count
-reaches its cap, which the table then says), together with the reference's own points
-(``Reference.enforced_times``: collocation's nodes) and its ``breakpoints``, where the node is
-doubled (the left and the right limits at the same time) so that a jump of ``ω̇`` is not smeared.
+at increasing times ``t_0 = 0 < … < t_{N-1} = t_end``. ``t_end`` is the reference's duration ``T``,
+or later (``tabulate(..., end=)``: ``slewbench codegen`` tabulates through the closed-loop window
+and one sample, all the times the loop reads): after ``T`` the table holds what the reference gives
+there, its torque-free coast (:meth:`planners.reference.Reference.sample`: ``ω̇ = −I⁻¹ ω × I ω``,
+torque zero). Past ``t_end`` the interpolation holds the last row (``t`` is clamped), in Python as
+in C; :class:`TableReference` does the same.
+
+The manoeuvre ``[0, T]`` and the coast ``[T, t_end]`` are tabulated apart, each on a uniform grid
+refined by halving (from 32 intervals over the manoeuvre, from one over the coast) until the
+interpolation meets the tolerances inside every interval (or the grid reaches its cap, which the
+table then says). The manoeuvre's grid holds the reference's own points (``Reference.enforced_times``:
+collocation's nodes) and its ``breakpoints``, where the node is doubled (the left and the right
+limits at the same time) so that a jump of ``ω̇`` is not smeared. The coast starts at the next
+double after ``T`` (``T`` itself is the manoeuvre's last node: at ``T`` the table gives what the
+reference gives at ``T``, the manoeuvre's torque, and from the next double on the coast's).
 
 Interpolation (:func:`interpolate` in NumPy, :func:`segment_function` in CasADi, generated as C):
 with ``k`` the last node such that ``t_k ≤ t`` (``t`` clamped to ``[t_0, t_{N-1}]``, ``k`` at most
@@ -40,7 +50,10 @@ CHECK_POINTS = np.arange(1, 8) / 8.0
 where a smooth function's interpolation error peaks, and six more points, for the intervals that
 hold a kink of the reference that is no declared breakpoint (a switch inside an interval)."""
 
-__all__ = ["ReferenceTable", "TableError", "TableReference", "TableTolerance", "interpolate", "segment_function", "tabulate"]
+QUANTITIES = ("attitude", "rate", "omega_dot", "torque")
+"""The quantities a table's error is stated for, in :class:`TableError`'s order."""
+
+__all__ = ["QUANTITIES", "ReferenceTable", "TableError", "TableReference", "TableTolerance", "interpolate", "segment_function", "tabulate"]
 
 
 @dataclass(frozen=True)
@@ -58,8 +71,8 @@ class TableTolerance:
         Largest error of ``ω̇*`` and ``τ*`` (linearly interpolated), each relative to its own
         largest component (default 1e-3).
     max_intervals : int, optional
-        Cap on the uniform grid's intervals (default 4096); a table that reaches it without meeting
-        the tolerances says so (:attr:`TableError.met`).
+        Cap on each uniform grid's intervals (the manoeuvre's and the coast's; default 4096); a
+        table that reaches it without meeting the tolerances says so (:attr:`TableError.met`).
     """
 
     attitude_rad: float = 1e-6
@@ -86,6 +99,12 @@ class TableError:
         Times checked.
     met : bool
         Whether the tolerances were met.
+    failed : tuple of str, optional
+        The quantities over their tolerance, among :data:`QUANTITIES` (empty when ``met``).
+    allowed : tuple of float, optional
+        The largest error each quantity of :data:`QUANTITIES` may have (the relative tolerances
+        times their scale): attitude [rad], rate [rad/s], ``ω̇`` [rad/s^2], torque [N m]; empty
+        when not known.
     """
 
     attitude_rad: float
@@ -94,6 +113,26 @@ class TableError:
     torque: float
     points: int
     met: bool
+    failed: tuple[str, ...] = ()
+    allowed: tuple[float, ...] = ()
+
+    def summary(self) -> str:
+        """The four errors in one line, and which quantities miss their tolerance.
+
+        Returns
+        -------
+        str
+            ``attitude error 3.1e-08 rad, rate 2e-09 rad/s, omega_dot 1e-05 rad/s^2, torque 1e-05 N m``,
+            then `` (tolerances NOT met: omega_dot over 3.4e-06 rad/s^2)`` when some are not met.
+        """
+        text = (f"attitude error {self.attitude_rad:.2g} rad, rate {self.rate:.2g} rad/s, "
+                f"omega_dot {self.acceleration:.2g} rad/s^2, torque {self.torque:.2g} N m")
+        if self.met:
+            return text
+        limits = dict(zip(QUANTITIES, self.allowed))
+        units = dict(zip(QUANTITIES, ("rad", "rad/s", "rad/s^2", "N m")))
+        failed = [name + (f" over {limits[name]:.2g} {units[name]}" if name in limits else "") for name in self.failed]
+        return text + f" (tolerances NOT met: {', '.join(failed) or 'see README.md'})"
 
 
 @dataclass(frozen=True)
@@ -107,10 +146,24 @@ class ReferenceTable:
     rows : (N, 13) ndarray
         ``[q (4, scalar first, body to inertial; signs continuous), ω (3) rad/s, ω̇ (3) rad/s^2,
         τ (3) N m]`` at the nodes, body axes.
+    duration : float or None, optional
+        The tabulated reference's duration ``T`` [s]; after it the rows are the reference's
+        torque-free coast. ``None`` (default): the last node's time.
     """
 
     times: Array
     rows: Array
+    duration: float | None = None
+
+    @property
+    def end(self) -> float:
+        """The last node's time [s]: past it the interpolation holds the last row."""
+        return float(self.times[-1])
+
+    @property
+    def manoeuvre_duration(self) -> float:
+        """The tabulated reference's duration ``T`` [s] (:attr:`duration`, else :attr:`end`)."""
+        return self.end if self.duration is None else float(self.duration)
 
     def evaluate(self, t: ArrayLike) -> Array:
         """The interpolated rows (:func:`interpolate`).
@@ -234,14 +287,15 @@ def _rows(reference: Reference, times: Array) -> Array:
     return np.concatenate([sample.q, sample.omega, sample.omega_dot, sample.torque], axis=1)
 
 
-def _nodes(reference: Reference, intervals: int) -> tuple[Array, Array]:
-    """Times and rows: a uniform grid, the reference's own points, breakpoints doubled."""
-    duration = reference.duration
-    own = [] if reference.enforced_times is None else list(reference.enforced_times)
-    breaks = [b for b in reference.breakpoints if 0.0 < b < duration]
-    fixed = np.unique(np.clip(np.asarray([0.0, duration, *own, *breaks], dtype=float), 0.0, duration))
-    grid = np.linspace(0.0, duration, intervals + 1)
-    gap = 1e-9 * max(duration, 1e-300)
+def _nodes(reference: Reference, intervals: int, start: float = 0.0, stop: float | None = None) -> tuple[Array, Array]:
+    """Times and rows over ``[start, stop]``: a uniform grid, the reference's own points and its
+    breakpoints doubled (those inside the span); ``stop`` defaults to the reference's duration."""
+    stop = reference.duration if stop is None else stop
+    own = [] if reference.enforced_times is None else [t for t in reference.enforced_times if start <= t <= stop]
+    breaks = [b for b in reference.breakpoints if start < b < stop]
+    fixed = np.unique(np.clip(np.asarray([start, stop, *own, *breaks], dtype=float), start, stop))
+    grid = np.linspace(start, stop, intervals + 1)
+    gap = 1e-9 * max(stop - start, abs(stop), 1e-300)
     near = np.min(np.abs(grid[:, None] - fixed[None, :]), axis=1) <= gap
     times = np.unique(np.concatenate([fixed, grid[~near]]))
     rows = _rows(reference, times)
@@ -256,23 +310,28 @@ def _nodes(reference: Reference, intervals: int) -> tuple[Array, Array]:
     return times, rows
 
 
-def table_error(reference: Reference, table: ReferenceTable, tolerance: TableTolerance) -> TableError:
-    """A table's error against its reference at :data:`CHECK_POINTS` of every interval.
+def _scales(rows: Array) -> list[float]:
+    """The largest component of ``ω``, ``ω̇`` and ``τ`` in ``rows``."""
+    return [float(np.max(np.abs(rows[:, a:b]))) for a, b in ((4, 7), (7, 10), (10, 13))]
 
-    Parameters
-    ----------
-    reference : Reference
-        The continuous reference.
-    table : ReferenceTable
-        Its table.
-    tolerance : TableTolerance
-        What the table must meet.
 
-    Returns
-    -------
-    TableError
-        The largest errors and whether they meet ``tolerance``.
-    """
+def _refined(reference: Reference, tolerance: TableTolerance, start: float, stop: float, intervals: int,
+             floor: list[float] | None = None) -> ReferenceTable:
+    """The smallest uniform refinement of ``[start, stop]`` (from ``intervals``, halving) whose error
+    meets ``tolerance``, relative to the larger of its own scales and ``floor``; the finest allowed
+    if none does."""
+    while True:
+        times, rows = _nodes(reference, intervals, start, stop)
+        table = ReferenceTable(times, rows)
+        scales = _scales(rows) if floor is None else [max(a, b) for a, b in zip(_scales(rows), floor)]
+        if _error(reference, table, tolerance, scales).met or 2 * intervals > tolerance.max_intervals:
+            return table
+        intervals *= 2
+
+
+def _error(reference: Reference, table: ReferenceTable, tolerance: TableTolerance,
+           scales: list[float]) -> TableError:
+    """:func:`table_error` with the scales of the relative tolerances given."""
     times = table.times
     h = np.diff(times)
     inside = h > 0
@@ -281,14 +340,34 @@ def table_error(reference: Reference, table: ReferenceTable, tolerance: TableTol
     got = table.evaluate(mid)
     angle = float(np.max(quat.error_angle(got[:, 0:4], exact[:, 0:4])))
     errors = [float(np.max(np.abs(got[:, a:b] - exact[:, a:b]))) for a, b in ((4, 7), (7, 10), (10, 13))]
-    all_rows = table.rows
-    scale = [float(np.max(np.abs(all_rows[:, a:b]))) for a, b in ((4, 7), (7, 10), (10, 13))]
-    met = (angle <= tolerance.attitude_rad and errors[0] <= tolerance.rate * scale[0] + 1e-15
-           and all(e <= tolerance.linear * s + 1e-15 for e, s in zip(errors[1:], scale[1:])))
-    return TableError(angle, errors[0], errors[1], errors[2], int(mid.size), bool(met))
+    allowed = (tolerance.attitude_rad, tolerance.rate * scales[0] + 1e-15, tolerance.linear * scales[1] + 1e-15,
+               tolerance.linear * scales[2] + 1e-15)
+    failed = tuple(name for name, error, limit in zip(QUANTITIES, [angle, *errors], allowed) if error > limit)
+    return TableError(angle, errors[0], errors[1], errors[2], int(mid.size), not failed, failed, allowed)
 
 
-def tabulate(reference: Reference, tolerance: TableTolerance | None = None) -> tuple[ReferenceTable, TableError]:
+def table_error(reference: Reference, table: ReferenceTable, tolerance: TableTolerance) -> TableError:
+    """A table's error against its reference at :data:`CHECK_POINTS` of every interval.
+
+    Parameters
+    ----------
+    reference : Reference
+        The continuous reference (after its duration: its torque-free coast).
+    table : ReferenceTable
+        Its table.
+    tolerance : TableTolerance
+        What the table must meet (the relative ones against the table's largest components).
+
+    Returns
+    -------
+    TableError
+        The largest errors, whether they meet ``tolerance`` and which do not.
+    """
+    return _error(reference, table, tolerance, _scales(table.rows))
+
+
+def tabulate(reference: Reference, tolerance: TableTolerance | None = None,
+             end: float | None = None) -> tuple[ReferenceTable, TableError]:
     """A reference as a table meeting ``tolerance`` inside every interval (module docstring).
 
     Parameters
@@ -297,23 +376,33 @@ def tabulate(reference: Reference, tolerance: TableTolerance | None = None) -> t
         A planned reference (``status == "ok"``).
     tolerance : TableTolerance or None, optional
         What the table must meet; ``None``: the defaults.
+    end : float or None, optional
+        The table's last time [s]; after the reference's duration ``T`` the rows are its
+        torque-free coast (:meth:`~planners.reference.Reference.sample`). ``None`` or at most ``T``:
+        the table ends at ``T``.
 
     Returns
     -------
     table : ReferenceTable
-        The smallest uniform refinement (from 32 intervals, halving) that meets ``tolerance``, with
-        the reference's own points and breakpoints; the finest allowed if none does.
+        The manoeuvre ``[0, T]`` as the smallest uniform refinement (from 32 intervals, halving)
+        that meets ``tolerance``, with the reference's own points and breakpoints; then, when
+        ``end > T``, the coast from the next double after ``T`` to ``end``, refined the same way
+        from one interval; each the finest allowed if none meets ``tolerance``.
     error : TableError
         Its error against ``reference`` at :data:`CHECK_POINTS` of every interval.
     """
     tolerance = tolerance or TableTolerance()
-    intervals = 32
-    while True:
-        table = ReferenceTable(*_nodes(reference, intervals))
-        error = table_error(reference, table, tolerance)
-        if error.met or 2 * intervals > tolerance.max_intervals:
-            return table, error
-        intervals *= 2
+    duration = reference.duration
+    manoeuvre = _refined(reference, tolerance, 0.0, duration, 32)
+    times, rows = manoeuvre.times, manoeuvre.rows
+    if end is not None and end > duration:
+        after = float(np.nextafter(duration, np.inf))
+        coast = _refined(reference, tolerance, after, max(float(end), after), 1, _scales(rows))
+        times = np.concatenate([times, coast.times])
+        rows = np.concatenate([rows, coast.rows])
+        rows[:, 0:4] = quat.continuous(rows[:, 0:4])
+    table = ReferenceTable(times, rows, duration)
+    return table, table_error(reference, table, tolerance)
 
 
 def angle_text(radians: float) -> str:
@@ -332,22 +421,50 @@ def angle_text(radians: float) -> str:
 
 class TableReference(Reference):
     """A table read as a :class:`~planners.reference.Reference`, to run the Python closed loop on
-    exactly what the C reads.
+    exactly what the C reads, at every time: the table's interpolation (:func:`interpolate`) on its
+    whole span, the coast after ``T`` included, and its last row held past its end, as
+    ``slewbench_reference_row`` in C (not the torque-free continuation other references give after
+    their duration).
 
     Parameters
     ----------
     table : ReferenceTable
         The table.
     inertia : (3, 3) array_like
-        Body inertia [kg m^2], body axes (for the torque-free continuation after the table's end).
+        Body inertia [kg m^2], body axes.
     planner : str, optional
         The planner that made the tabulated reference.
+
+    Notes
+    -----
+    Its :attr:`duration` is the tabulated reference's ``T`` (:attr:`ReferenceTable.manoeuvre_duration`),
+    so that the closed loop's window and metrics are those of the reference.
     """
 
     def __init__(self, table: ReferenceTable, inertia: ArrayLike, planner: str = "table") -> None:
-        super().__init__(planner, float(table.times[-1]), inertia)
+        super().__init__(planner, table.manoeuvre_duration, inertia)
         self.table = table
 
     def _evaluate(self, t: Array) -> ReferenceSample:
         rows = self.table.evaluate(t)
         return ReferenceSample(rows[:, 0:4], rows[:, 4:7], rows[:, 7:10], rows[:, 10:13])
+
+    def sample(self, t: ArrayLike) -> ReferenceSample:
+        """The table's rows at ``t``, at any time (clamped to the table, as the C clamps it).
+
+        Parameters
+        ----------
+        t : float or array_like
+            Time [s] or array of times (flattened if not 1-D).
+
+        Returns
+        -------
+        ReferenceSample
+            ``q`` (4,), ``omega``, ``omega_dot``, ``torque`` (3,) for a scalar ``t``; ``(N, 4)`` and
+            ``(N, 3)`` for ``N`` times.
+        """
+        times = np.atleast_1d(np.asarray(t, dtype=float)).ravel()
+        sample = self._checked(times)
+        if np.ndim(t) == 0:
+            return ReferenceSample(*(a[0] for a in sample))
+        return sample
