@@ -56,8 +56,21 @@ _SCORE_REQUIREMENTS = True
 ``tests/benchmarks/test_bench_requirements.py``)."""
 
 
-def _window(scenario: Scenario, reference: Reference | None) -> float:
-    """The closed-loop window [s]: ``simulation.duration``, else the manoeuvre's or the reference's if longer."""
+def closed_loop_window(scenario: Scenario, reference: Reference | None) -> float:
+    """The length of a row's closed loop (and of its flight tables, ``slewbench codegen``).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario (its ``simulation.duration`` and ``maneuver.duration``).
+    reference : planners.Reference or None
+        The row's reference; ``None`` in regulation.
+
+    Returns
+    -------
+    float
+        [s]: ``simulation.duration``, else the manoeuvre's duration or the reference's if longer.
+    """
     return scenario.simulation.duration or max(scenario.problem.duration, reference.duration if reference else 0.0)
 
 
@@ -65,7 +78,7 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
               controller_spec: ControllerSpec | None = None) -> None:
     problem = scenario.problem
     spec = controller_spec or scenario.controller
-    duration = _window(scenario, reference)
+    duration = closed_loop_window(scenario, reference)
     controller = spec.controller
     start = time.perf_counter()
     try:
@@ -79,10 +92,10 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
         row.simulate_time_s = time.perf_counter() - start
     row.simulation = result
     if reference is not None and duration < reference.duration * (1 - 1e-9):
-        row.message = "; ".join([part for part in (row.message,) if part] + [
-            f"the closed loop stops at {duration:g} s (simulation.duration), before the reference ends at "
-            f"T = {reference.duration:.4g} s: its closed-loop metrics cover {100 * duration / reference.duration:.3g} % "
-            f"of the manoeuvre"])
+        cut = (f"the closed loop stops at {duration:g} s (simulation.duration), before the reference ends at "
+               f"T = {reference.duration:.4g} s: its closed-loop metrics cover {100 * duration / reference.duration:.3g} "
+               f"% of the manoeuvre")
+        row.message = f"{row.message}; {cut}" if row.message else cut
     row.closed_loop_metrics = metrics_from_simulation(
         result, problem.qf, problem.omegaf, reference=reference, plan_time_s=row.plan_time_s,
         duration_s=reference.duration if reference else None,
@@ -190,7 +203,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
             if broken_ends:  # no planner can meet them: nothing is planned
                 references.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends)), None, None))
             if i not in references:  # planned once, tracked by every controller
-                references[i] = _plan(scenario, planner_spec, cache, scoring)
+                references[i] = plan_row(scenario, planner_spec, cache, scoring)
             reference, reference_metrics, sampled = references[i]
             row = Row(label, planner_spec.name, reference.status, reference.message,
                       reference.plan_time_s, None if reference_metrics is None else dict(reference_metrics), None,
@@ -255,21 +268,38 @@ def _cross_check_optima(rows: list[Row]) -> None:
             reference.stats["certificate"] = with_costate_gap(record, abs(best_direct - value) / abs(value))
 
 
-def _plan(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache | None,
-          scoring: bool = False) -> tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]:
-    """A planner's reference (a failed one when it raises), the reference's metrics (None when
-    failed) and, when ``scoring``, its times and sample for the requirements (one sampling serves
-    both: the metrics' uniform times come first)."""
+def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache | None,
+             scoring: bool = False) -> tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]:
+    """Plan one row's reference as :func:`run` does (``slewbench codegen`` plans its rows so too).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario.
+    planner_spec : PlannerSpec
+        The row's planner.
+    cache : ocp.SolverCache or None
+        Where the planner keeps what it builds; ``None``: the model's own cache.
+    scoring : bool, optional
+        Also sample the reference for the requirements.
+
+    Returns
+    -------
+    tuple
+        The reference (a failed one when the planner raises), its metrics (``None`` when failed)
+        and, with ``scoring``, its times and sample for the requirements (one sampling serves both:
+        the metrics' uniform times come first), else ``None``.
+    """
     spec = scenario.simulation
     planner = planner_spec.planner.with_cache(cache)
     try:
         reference = planner.plan(scenario.problem)
-    except Exception as error:  # a planner bug must not lose the other rows
+    except Exception as error:  # noqa: BLE001 (a planner bug must not lose the other rows)
         traceback.print_exc()
         reference = FailedReference(planner_spec.name, f"planner raised {type(error).__name__}: {error}")
     if not reference.ok:
         return reference, None, None
-    times = (reference_times(reference.duration, _window(scenario, reference), spec.sample_time, REFERENCE_POINTS)
+    times = (reference_times(reference.duration, closed_loop_window(scenario, reference), spec.sample_time, REFERENCE_POINTS)
              if scoring else np.linspace(0.0, reference.duration, REFERENCE_POINTS))
     sample = reference.sample(times)
     metrics = metrics_from_reference(

@@ -284,15 +284,22 @@ def test_validate_a_scenario_says_what_every_row_is_scored_against(tmp_path, cap
 def test_validate_without_requirements_says_the_actuator_limits_alone_are_scored(tmp_path, capsys):
     assert main(["validate", str(DEMO)]) == 0
     assert capsys.readouterr().out.splitlines()[1:] == [
-        "  requirement actuators: the reference's demand at most 100 % of each actuator limit (every scenario's, "
-        "unstated)"]
+        ("  requirement actuators: the reference's demand at most 100 % of each actuator limit (every scenario's, "
+         "unstated)"), ("  sensor noise (simulation.sensor_noise, 1 sigma per axis): attitude 0.005 deg, rate 1e-05 rad/s, "
+                     "seed 1")]
     data = yaml.safe_load(DEMO.read_text())
+    del data["simulation"]["sensor_noise"]
     data["requirements"] = None  # not even the actuators' limits
     path = tmp_path / "unscored.yaml"
     path.write_text(yaml.safe_dump(data))
     assert main(["validate", str(path)]) == 0
+    assert capsys.readouterr().out.splitlines()[1:] == ["  requirements: none (requirements: null)"]
+    data["requirements"] = {"actuators": None, "rate": {"max": 0.02}}  # the actuators off, the rate scored
+    path.write_text(yaml.safe_dump(data))
+    assert main(["validate", str(path)]) == 0
     assert capsys.readouterr().out.splitlines()[1:] == [
-        "  requirements: none (requirements: null): no row is scored against any, the actuators' limits included"]
+        "  requirement rate: ‖ω‖ at most 0.02 rad/s (reference and closed loop)",
+        "  requirement actuators: off (requirements.actuators: null)"]
 
 
 def test_validate_says_when_the_end_points_already_break_a_requirement(tmp_path, capsys):
@@ -305,5 +312,6 @@ def test_validate_says_when_the_end_points_already_break_a_requirement(tmp_path,
     path = tmp_path / "broken_ends.yaml"
     path.write_text(yaml.safe_dump(data))
     assert main(["validate", str(path)]) == 0
-    broken = [line for line in capsys.readouterr().out.splitlines() if "every row fails before planning" in line]
+    broken = [line for line in capsys.readouterr().out.splitlines()
+              if "every planner's row fails before planning" in line]
     assert len(broken) == 1 and "cam" in broken[0] and "initial attitude already breaks it" in broken[0]

@@ -17,6 +17,8 @@ import traceback
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from controllers import CONTROLLERS
 from planners import PLANNERS
 from scenarios.cli.bench import add_bench_parser
@@ -187,22 +189,22 @@ def _leaf_paths(value: Any, prefix: str) -> list[str]:
 
 
 def _scenario_details(scenario: Scenario) -> list[str]:
-    """What ``validate`` says beyond the rows: every requirement each row is scored against, the
-    truth model's keys (where the plant differs from the design) and the sensors and estimator in
-    the loop."""
+    """What ``validate`` says beyond the rows: every requirement the rows are scored against, end
+    points that already break one, the truth model's keys (where the plant differs from the
+    design), the sensors and estimator in the loop and the sensor noise."""
     from scenarios.requirements.scoring import endpoint_violations
 
     requirements = scenario.requirements
+    lines = [f"requirement {line}" for line in requirements.describe()]
     if requirements.actuators is None:
-        lines = [("requirements: none (requirements: null): no row is scored against any, the actuators' limits "
-                  "included")]
-    else:
-        lines = [f"requirement {line}" for line in requirements.describe()]
-        if not requirements.actuators.stated:
-            lines.append("requirement actuators: the reference's demand at most 100 % of each actuator limit "
-                         "(every scenario's, unstated)")
-    lines += [f"every row fails before planning: {broken}" for broken in
-              (endpoint_violations(scenario.problem) if requirements else [])]
+        lines.append("requirements: none (requirements: null)" if not requirements else
+                     "requirement actuators: off (requirements.actuators: null)")
+    elif not requirements.actuators.stated and scenario.planners:
+        lines.append("requirement actuators: the reference's demand at most 100 % of each actuator limit "
+                     "(every scenario's, unstated)")
+    if requirements and scenario.planners:
+        lines += [f"every planner's row fails before planning: {broken}"
+                  for broken in endpoint_violations(scenario.problem)]
     truth = (scenario.data or {}).get("truth")
     if scenario.truth is not None and isinstance(truth, dict):
         lines.append("truth (the closed loop's plant differs from the design in): "
@@ -216,6 +218,12 @@ def _scenario_details(scenario: Scenario) -> list[str]:
                 f"{a:g}-{b:g} s" for a, b in sensors.star_tracker.outages) + ")"
         estimator = "MEKF" if sensors.estimator is not None else "none"
         lines.append(f"sensors: {', '.join(parts) or 'none'}; estimator: {estimator}")
+    noise = scenario.simulation.noise
+    stds = [f"{name} {value:.6g} {unit}" for name, value, unit in (
+        ("attitude", float(np.rad2deg(noise.attitude_std)), "deg"), ("rate", noise.rate_std, "rad/s"),
+        ("magnetic field", noise.field_std, "T")) if value]
+    if stds:
+        lines.append(f"sensor noise (simulation.sensor_noise, 1 sigma per axis): {', '.join(stds)}, seed {noise.seed}")
     return lines
 
 
@@ -341,13 +349,8 @@ def command_codegen(args: argparse.Namespace) -> int:
 
     scenario = load(args.file)
     report = generate(scenario, args.out)
-    print(f"wrote {report.directory}/: " + ", ".join(f"{name} ({size} bytes)" for name, size in report.files.items()))
-    print("functions: " + ", ".join(report.functions))
-    for label, error in report.tables.items():
-        print(f"  table of row {label!r}: attitude error {error.attitude_rad:.2g} rad, rate {error.rate:.2g} rad/s, "
-              f"torque {error.torque:.2g} N m" + ("" if error.met else " (tolerances NOT met: see README.md)"))
-    for label, reason in report.skipped.items():
-        print(f"  no C reference for row {label!r}: {reason}")
+    for line in report.summary():
+        print(line)
     print(f"build: make -C {report.directory}")
     return EXIT_OK
 

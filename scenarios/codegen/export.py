@@ -62,7 +62,7 @@ from scenarios.output.directory import (
 from scenarios.output.names import row_stems
 from scenarios.output.provenance import package_version
 from scenarios.requirements.scoring import score_reference, violations
-from scenarios.runner import _plan, _window
+from scenarios.runner import closed_loop_window, plan_row
 from scenarios.schema.loader import Scenario
 
 
@@ -477,7 +477,7 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
     stems = row_stems([p.label for p in scenario.planners])
     for planner_spec, row in zip(scenario.planners, stems):
         # the reference as `slewbench run` plans and samples it for its scores
-        reference, _, sampled = _plan(scenario, planner_spec, None, scoring=True)
+        reference, _, sampled = plan_row(scenario, planner_spec, None, scoring=True)
         if not reference.ok:
             report.skipped[planner_spec.label] = f"the plan {reference.status}: {reference.message}"
             continue
@@ -487,7 +487,7 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
         if broken:
             report.violations[planner_spec.label] = broken
         # through every time the closed loop reads: its window, then the reference one sample ahead
-        table, error = tabulate(reference, tolerance, _window(scenario, reference) + spec.sample_time)
+        table, error = tabulate(reference, tolerance, closed_loop_window(scenario, reference) + spec.sample_time)
         table_name = _unique(f"slewbench_table_{c_identifier(row)}", taken)
         tables[planner_spec.label] = (table_name, table)
         report.tables[planner_spec.label] = error
