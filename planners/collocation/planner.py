@@ -310,24 +310,24 @@ class CollocationPlanner(Planner):
         Returns
         -------
         str or None
-            The reason (no target attitude; an objective that minimises time without an energy
-            term, on an actuator whose control has no bound: the optimum is then a rest-to-rest
-            slew in no time, or impulses with an L1 term; a transcription that cannot impose the
-            pointing or rate requirements), or ``None``.
+            The reason (no target attitude; an objective without an energy term (time or L1
+            alone) on an actuator whose control has no bound: the optimum is then impulses, a
+            rest-to-rest slew in no time; a transcription that cannot impose the pointing or rate
+            requirements), or ``None``.
         """
         error = super().problem_error(problem)
         o = self.options
         energy = o.objective == "min_energy" or (o.objective == "weighted" and o.energy_weight > 0)
-        if error is None and self.minimises_time(o) and not energy:
+        if error is None and not energy:  # time or an L1 term alone: the optimum rides the control bounds
             unbounded = [actuator for actuator in problem.spacecraft.actuators
                          if not all(np.all(np.isfinite(bound)) for bound in actuator.control_bounds())]
             if unbounded:
                 names = ", ".join(f"spacecraft.{a.name}" + next((f".{key}" for key in ("max_torque", "max_dipole")
                                                                  if hasattr(a, key)), "") for a in unbounded)
-                what = f"objective {o.objective}" + (" with time_weight and no energy_weight"
-                                                      if o.objective == "weighted" else "")
-                return (f"{what} minimises time: it needs a bound on every actuator's control ({names}); without "
-                        f"one the optimal torque is unbounded, an impulse (min_time: a slew in no time)")
+                what = f"objective {o.objective}" + (" without energy_weight" if o.objective == "weighted" else "")
+                return (f"{what} needs a bound on every actuator's control ({names}): without an energy term the "
+                        f"optimal torque is unbounded, impulses (min_time: a slew in no time; min_l1: the torque "
+                        f"grows with the mesh)")
         if error is None and (problem.pointing or problem.max_rate is not None):
             l1 = o.objective == "min_l1" or (o.objective == "weighted" and o.l1_weight > 0)
             refused = TRANSCRIPTIONS[o.transcription].problem_error(l1, True)
