@@ -185,9 +185,10 @@ class Controller(Allocation, Configurable, ABC):
         """
         return None
 
-    def initial_attitude_error(self, spacecraft: Spacecraft, q0: Array, qf: Array | None) -> tuple[str, str] | None:
-        """Why the law cannot start from an attitude (a law defined on part of the attitudes: the
-        two-wheel laws' ``q1² + q2² ≠ 0``).
+    def initial_attitude_error(self, spacecraft: Spacecraft, q0: Array, omega0: Array,
+                               qf: Array | None) -> tuple[str, str] | None:
+        """Why the law cannot start from an attitude and rate (a law defined on part of the
+        attitudes: the two-wheel laws' ``q1² + q2² ≠ 0`` from rest).
 
         Parameters
         ----------
@@ -195,6 +196,9 @@ class Controller(Allocation, Configurable, ABC):
         q0 : (4,) ndarray
             The simulated initial attitude (``simulation.initial_attitude_error_deg`` applied),
             scalar first, body to inertial.
+        omega0 : (3,) ndarray
+            The simulated initial body rate (``simulation.initial_rate_error`` added) [rad/s],
+            body axes.
         qf : (4,) ndarray or None
             The target attitude; ``None``: free.
 

@@ -61,10 +61,21 @@ def test_an_error_about_the_unactuated_axis_is_outside_the_laws_domain(name):
     assert np.max(np.abs(nudged.omega)) > 1e-4
     law = CONTROLLERS[name]()
     spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(max_torque=0.02, failed=[2]))
-    refused = law.initial_attitude_error(spacecraft, about_z, quat.IDENTITY)
+    rest = np.zeros(3)
+    refused = law.initial_attitude_error(spacecraft, about_z, rest, quat.IDENTITY)
     assert refused is not None and refused[0] == "initial.q" and "90 deg" in refused[1]
-    assert law.initial_attitude_error(spacecraft, nudged.q[0], quat.IDENTITY) is None
-    assert law.initial_attitude_error(spacecraft, quat.IDENTITY, quat.IDENTITY) is None  # at the target
+    assert law.initial_attitude_error(spacecraft, nudged.q[0], rest, quat.IDENTITY) is None
+    assert law.initial_attitude_error(spacecraft, quat.IDENTITY, rest, quat.IDENTITY) is None  # at the target
+    # turning about an actuated axis (x), the body leaves the set at once: accepted
+    assert law.initial_attitude_error(spacecraft, about_z, np.array([0.005, 0.0, 0.0]), quat.IDENTITY) is None
+
+
+def test_a_start_about_the_unactuated_axis_that_turns_about_an_actuated_one_runs():
+    """90 deg about z with ω0 = 0.005 rad/s about x held by the x wheel (zero total momentum): the
+    body leaves q1 = q2 = 0 at once and every law turns it (a reviewer's case, refused before)."""
+    data = regulation({"q": [0.0, 0.0, 0.70710678, 0.70710678], "omega": [0.005, 0.0, 0.0],
+                       "wheel_momentum": [-INERTIA[0] * 0.005, 0.0, 0.0]})
+    scenarios.parse_scenario(data)  # accepted (it raised ScenarioError at maneuver.initial.q)
 
 
 def test_the_loader_refuses_a_start_about_the_unactuated_axis_unless_perturbed():

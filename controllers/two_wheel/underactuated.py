@@ -135,13 +135,15 @@ class TwoWheelLaw(Controller):
             return ("final.omega", f"controller {self.name} regulates to rest; final.omega must be zero or null")
         return None
 
-    def initial_attitude_error(self, spacecraft: Spacecraft, q0: Array, qf: Array | None) -> tuple[str, str] | None:
+    def initial_attitude_error(self, spacecraft: Spacecraft, q0: Array, omega0: Array,
+                               qf: Array | None) -> tuple[str, str] | None:
         """Refuse an initial attitude outside the laws' domain ``Ω = {q1² + q2² ≠ 0}`` (paper section
         III.C: "the initial condition must be chosen in the manifold Ω").
 
         With the attitude error purely about the unactuated axis (``q1 = q2 = 0``, ``q3 ≠ 0``; e.g.
         180° about it) the singular ratios are ``0/0``, taken as their limit 0: the desired rates
-        are zero, and from rest the laws give no torque at all, for ever.
+        are zero, and from rest the laws give no torque at all, for ever. A start turning about an
+        actuated axis leaves that set at once, and is accepted.
 
         Parameters
         ----------
@@ -149,6 +151,8 @@ class TwoWheelLaw(Controller):
             The spacecraft (its control frame).
         q0 : (4,) ndarray
             The simulated initial attitude, scalar first, body to inertial.
+        omega0 : (3,) ndarray
+            The simulated initial body rate [rad/s], body axes.
         qf : (4,) ndarray or None
             The target attitude; ``None``: the identity.
 
@@ -163,6 +167,8 @@ class TwoWheelLaw(Controller):
         error = quat.product(quat.conjugate(quat.IDENTITY if qf is None else qf), q0)
         q1, q2, q3 = frame @ error[1:]
         if q1 * q1 + q2 * q2 > 1e-24 or abs(q3) <= 1e-12:  # in Ω (to rounding), or at the target
+            return None
+        if float(np.linalg.norm((frame @ omega0)[:2])) > 1e-12:  # turning about an actuated axis: leaves it
             return None
         angle = float(np.rad2deg(quat.error_angle(q0, quat.IDENTITY if qf is None else qf)))
         return ("initial.q", (

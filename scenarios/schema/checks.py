@@ -8,7 +8,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ocp import quat
 from ocp.simulation.simulator import SUBSTEPS_PER_SAMPLE
 from planners import ManeuverProblem
 from scenarios.errors import ScenarioError
@@ -138,10 +137,9 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
         if momentum0 is None:  # ManeuverProblem fills it in; its field's type still admits None
             momentum0 = np.zeros(problem.spacecraft.n_wheels)
         state = law.initial_state_error(problem.spacecraft, problem.omega0, momentum0, problem.omegaf)
-        if not state:  # a law defined on part of the attitudes
-            q0 = problem.q0 if simulation is None else quat.product(
-                problem.q0, quat.from_rotation_vector(simulation.initial_attitude_error))  # as simulated
-            state = law.initial_attitude_error(problem.spacecraft, q0, problem.qf)
+        if not state:  # a law defined on part of the attitudes, from the start as simulated
+            start = problem.initial_state if simulation is None else simulation.true_initial_state(problem)
+            state = law.initial_attitude_error(problem.spacecraft, start[:4], start[4:7], problem.qf)
         if state:
             raise ScenarioError(f"maneuver.{state[0]}", f"{state[1]} ({controller.path} is {controller.name!r})")
         if simulation is not None:

@@ -34,7 +34,12 @@ from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem, Planner
 from scenarios.errors import ScenarioError
 from scenarios.requirements.spec import Requirements, Sensor
-from scenarios.schema.checks import check_compatibility, check_magnetometer, check_row_labels, check_work
+from scenarios.schema.checks import (
+    check_compatibility,
+    check_magnetometer,
+    check_row_labels,
+    check_work,
+)
 from scenarios.schema.estimation import ESTIMATOR, SENSORS, parse_sensor_suite
 from scenarios.schema.keys import (
     Described,
@@ -184,6 +189,22 @@ class SimulationSpec:
     max_samples: int = MAX_SAMPLES
     sensors: SensorSuite | None = None
 
+    def true_initial_state(self, problem: ManeuverProblem) -> np.ndarray:
+        """The simulated initial state of ``problem``: its own with the configured errors applied.
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The manoeuvre.
+
+        Returns
+        -------
+        (7 + n_w,) ndarray
+            ``[q0 ⊗ exp(initial_attitude_error / 2), ω0 + initial_rate_error, h_w0]``.
+        """
+        q0 = quat.product(problem.q0, quat.from_rotation_vector(self.initial_attitude_error))
+        return np.concatenate([q0, problem.omega0 + self.initial_rate_error, problem.wheel_momentum0])
+
 
 @dataclass
 class Scenario:
@@ -250,10 +271,9 @@ class Scenario:
 
     @property
     def true_initial_state(self) -> np.ndarray:
-        """The simulated initial state: the manoeuvre's with the configured errors applied."""
-        p = self.problem
-        q0 = quat.product(p.q0, quat.from_rotation_vector(self.simulation.initial_attitude_error))
-        return np.concatenate([q0, p.omega0 + self.simulation.initial_rate_error, p.wheel_momentum0])
+        """The simulated initial state: the manoeuvre's with the configured errors applied
+        (:meth:`SimulationSpec.true_initial_state`)."""
+        return self.simulation.true_initial_state(self.problem)
 
 
 def _table_window(problem: ManeuverProblem, simulation: SimulationSpec, planners: list) -> float:
