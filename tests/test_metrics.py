@@ -202,7 +202,11 @@ def test_dipole_integral_is_a_hold_integral_of_the_euclidean_norm():
     assert metrics["int_dipole"] == pytest.approx(expected, rel=1e-12)
 
 
-@pytest.mark.parametrize("residue, expected", [(1e-17, None), (0.0, None), (1e-3, 0.5 * 2.0 * 0.02**2 / (0.5 * 2.0 * 1e-3**2))])
+@pytest.mark.parametrize("residue, expected", [
+    (1e-17, None), (0.0, None),
+    (1e-8, None),            # E_0 / max E = (1e-8 / 0.05)² = 4e-14, below 1e-12: rest
+    (5e-7, (0.02 / 5e-7) ** 2),  # 1e-10, above it: a (slow) spin, its ratio kept
+    (1e-3, (0.02 / 1e-3) ** 2)])
 def test_energy_ratio_is_null_for_a_start_at_rest_up_to_rounding(residue, expected):
     """A rest-to-rest reference starts at 1e-17 rad/s (rounding): E_T/E_0 would divide two rounding
     errors (the README's eigenaxis row showed 4.956). A real 1e-3 rad/s start keeps its ratio."""
@@ -213,4 +217,4 @@ def test_energy_ratio_is_null_for_a_start_at_rest_up_to_rounding(residue, expect
     if expected is None:
         assert metrics["energy_ratio"] is None
     else:
-        assert metrics["energy_ratio"] == pytest.approx(expected, rel=1e-12)  # ω_T²/ω_0² = 400
+        assert metrics["energy_ratio"] == pytest.approx(expected, rel=1e-12)  # ω_T²/ω_0² (same axis)
