@@ -95,6 +95,47 @@ class ManeuverProblem:
                                                      and 0.0 <= self.actuator_margin < 1.0):
             raise ValueError(f"actuator_margin must lie in [0, 1) or be None, got {self.actuator_margin!r}")
 
+    def unreachable(self) -> str | None:
+        """Why no motion reaches the target, by conservation of angular momentum alone: with wheels
+        as the only actuators, no external torque (no torquers, magnetorquers, gravity gradient or
+        disturbance) and zero total momentum ``I ω0 + A h_w0``, the body's rate is
+        ``ω = −I⁻¹ A h_w``: with one working wheel axis ``a`` it turns about the fixed body axis
+        ``I⁻¹ a`` only, with none it stays at rest. (Two or more working wheel axes reach every
+        attitude; a non-zero momentum drifts: not decided here.)
+
+        Returns
+        -------
+        str or None
+            The reason, or ``None`` when the target may be reachable (or is free).
+        """
+        sc = self.spacecraft
+        environment = self.environment
+        if self.qf is None or sc.torquers is not None or sc.magnetorquers is not None or (
+                environment is not None and (environment.gravity_gradient or np.any(environment.disturbance_torque))):
+            return None
+        failed = set(sc.wheels.failed) if sc.wheels is not None else set()
+        working = sc.wheel_axes[:, [i for i in range(sc.n_wheels) if i not in failed]]
+        if working.shape[1] and np.linalg.matrix_rank(working, tol=1e-9) >= 2:
+            return None
+        momentum = sc.inertia @ self.omega0 + sc.wheel_axes @ self.wheel_momentum0
+        if float(np.linalg.norm(momentum)) > 1e-12 * max(1.0, float(np.max(np.abs(sc.inertia)))):
+            return None
+        from ocp import quat
+
+        turn = quat.to_rotation_vector(quat.error(self.qf, self.q0))  # body axes, q0 to qf
+        if not working.shape[1]:
+            return None if float(np.linalg.norm(turn)) <= 1e-9 else (
+                "no working actuator and no momentum: the body stays at rest and cannot reach the target")
+        axis = np.linalg.solve(sc.inertia, working[:, 0])
+        axis /= np.linalg.norm(axis)
+        off = float(np.linalg.norm(np.cross(turn, axis)))
+        final = self.omegaf if self.omegaf is not None else np.zeros(3)
+        if off <= 1e-6 * max(1.0, float(np.linalg.norm(turn))) and np.linalg.norm(np.cross(final, axis)) <= 1e-12:
+            return None
+        return (f"one working wheel axis {np.round(working[:, 0], 4).tolist()} and zero total momentum: the body "
+                f"can only turn about the body axis I⁻¹a = {np.round(axis, 4).tolist()}, and the slew is "
+                f"{np.rad2deg(np.linalg.norm(turn)):.4g} deg about {np.round(turn / np.linalg.norm(turn), 4).tolist()}")
+
     def rate_bound(self, option: float | None) -> float | None:
         """The rate bound a planner imposes: its own ``max_rate`` option tightens the problem's
         (``maneuver.max_rate``, else ``requirements.rate.max``), never loosens it.

@@ -315,7 +315,7 @@ class CollocationPlanner(Planner):
             rest-to-rest slew in no time; a transcription that cannot impose the pointing or rate
             requirements), or ``None``.
         """
-        error = super().problem_error(problem)
+        error = super().problem_error(problem) or problem.unreachable()
         o = self.options
         energy = o.objective == "min_energy" or (o.objective == "weighted" and o.energy_weight > 0)
         if error is None and not energy:  # time or an L1 term alone: the optimum rides the control bounds
