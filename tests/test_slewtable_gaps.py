@@ -127,6 +127,22 @@ def test_fit_entries_keeps_every_axis_and_says_how_many_entries_are_not_ok():
     assert none is None and "1 axis (4 or more" in note
 
 
+def test_held_out_errors_compare_only_where_the_fit_has_a_time(tmp_path):
+    """A NaN from a gap made the held-out maximum NaN (and fit.json unwritable)."""
+    from scenarios.slewtable.compute import held_out_errors
+    fit = _fit({(0, 1): "failed"})
+    held = TablePart.empty(np.array([[0.1, 0.2, 0.97], [1.0, -1.0, -1.0] / np.sqrt(3.0)]), [60.0, 150.0])
+    for i, axis in enumerate(held.axes):
+        for k, angle in enumerate(held.angles_deg):
+            held.status[i][k] = "ok"
+            held.slew_time_s[i, k] = 1.01 * bang_bang(axis, math.radians(angle))  # 1 % off the table
+    quality = held_out_errors(fit, held)
+    assert quality["points"] == 3 and quality["no_value"] == 1  # near +z at 60 deg: the gap
+    assert quality["max_rel_error"] == pytest.approx(1.0 - 1.0 / 1.01, rel=1e-9)
+    fit.meta["held_out"] = quality
+    fit.save(tmp_path / "fit.json")
+
+
 # --- past the largest angle --------------------------------------------------------------------
 
 def test_no_time_past_the_tables_largest_angle_unless_it_is_180_deg():

@@ -226,7 +226,7 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
     if bad:
         infeasible = sum(s == "infeasible" for row in status for s in row)
         notes.append(f"{_plural(bad, 'entry', 'entries')} not ok ({infeasible} infeasible): the fit gives NaN in the "
-                     "cells around them (inf at an infeasible one), not a time")
+                     f"cells around {'it' if bad == 1 else 'them'} (inf at an infeasible one), not a time")
     if len(part.axes) < 4:
         return None, "; ".join([*notes, (f"no fit over the sphere: {_plural(len(part.axes), 'axis', 'axes')} "
                                          "(4 or more spanning the sphere needed)")])
@@ -289,20 +289,29 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart) -> dict[str, Any]:
     -------
     dict
         ``points`` (ok entries compared), ``max_rel_error`` and ``rms_rel_error`` (fractions of the
-        slew time; None without points), ``worst`` (axis, angle [deg], table and fitted times [s]).
+        slew time; None without points), ``worst`` (axis, angle [deg], table and fitted times [s]),
+        ``no_value`` (ok entries where the fit has no time, in a cell around an entry that is not
+        ok: not compared).
     """
     ok = part.ok
+    none: dict[str, Any] = {"points": 0, "max_rel_error": None, "rms_rel_error": None, "worst": None, "no_value": 0}
     if not ok.any():
-        return {"points": 0, "max_rel_error": None, "rms_rel_error": None, "worst": None}
+        return none
     i, k = np.nonzero(ok)
     truth = part.slew_time_s[i, k]
     angles = np.deg2rad(np.asarray(part.angles_deg))[k]
     estimate = fit.many_axis_angle(part.axes[i], angles)
+    finite = np.isfinite(estimate)
+    if not finite.all():
+        i, k, truth, estimate = i[finite], k[finite], truth[finite], estimate[finite]
+    none["no_value"] = int((~finite).sum())
+    if not finite.any():
+        return none
     rel = np.abs(estimate / truth - 1.0)
     w = int(np.argmax(rel))
     return {"points": len(rel), "max_rel_error": float(rel.max()), "rms_rel_error": float(np.sqrt(np.mean(rel ** 2))),
             "worst": {"axis": part.axes[i[w]].tolist(), "angle_deg": float(part.angles_deg[k[w]]),
-                      "table_s": float(truth[w]), "fit_s": float(estimate[w])}}
+                      "table_s": float(truth[w]), "fit_s": float(estimate[w])}, "no_value": none["no_value"]}
 
 
 def compute_table(spec: TableSpec, directory: str | Path | None = None, *, workers: int | None = None,
@@ -368,6 +377,10 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
     table.fit, table.fit_note = fit_entries(parts["table"], inertia, generators, meta, triangles)
     if table.fit is not None:
         quality = held_out_errors(table.fit, parts["held_out"])
+        if quality["no_value"]:
+            missed = (f"{_plural(quality['no_value'], 'ok held-out entry', 'ok held-out entries')} where the fit "
+                      "has no time (not compared)")
+            table.fit_note = "; ".join([*filter(None, [table.fit_note]), missed])
         quality["eval_time_us"] = eval_time_us(table.fit)
         table.fit.meta["held_out"] = quality
         table.fit.meta["note"] = table.fit_note
