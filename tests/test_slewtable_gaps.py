@@ -104,11 +104,13 @@ def test_a_fit_with_gaps_round_trips_through_fit_json(tmp_path):
         np.testing.assert_array_equal(_both(loaded, axis, angle), _both(fit, axis, angle))
 
 
-def test_a_fit_json_that_filled_entries_is_refused(tmp_path):
+@pytest.mark.parametrize("note", ["1 entries not ok filled along their axis",
+                                  "1 of 6 axes left out (fewer than 2 ok angles)"])
+def test_a_fit_json_that_filled_entries_is_refused(tmp_path, note):
     """fit.json written before the gaps: its times hold fills the table did not find."""
     data = _fit({}).to_dict()
     del data["status"]
-    data["meta"]["note"] = "1 entries not ok filled along their axis"
+    data["meta"]["note"] = note
     (tmp_path / "fit.json").write_text(json.dumps(data))
     with pytest.raises(ValueError, match="filled the entries that are not ok"):
         load_fit(tmp_path / "fit.json")

@@ -730,10 +730,12 @@ def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
     data = json.loads(file.read_text())
     if not isinstance(data, dict) or data.get("format") != FIT_FORMAT:
         raise ValueError(f"{file} is not a slewbench slew-time fit ({FIT_FORMAT!r} expected)")
-    if "status" not in data and "not ok filled" in str((data.get("meta") or {}).get("note", "")):
+    note = str((data.get("meta") or {}).get("note", ""))
+    if "status" not in data and ("not ok filled" in note or "axes left out" in note):
         raise ValueError(f"{file} was written by an earlier slewbench that filled the entries that are not ok "
-                         "with times the table did not find; run `slewbench table` again into the same --out "
-                         "(the entries are stored: nothing is solved again) to write the fit with its gaps")
+                         "(or covered axes it left out) with times the table did not find; run `slewbench table` "
+                         "again into the same --out (the entries are stored: nothing is solved again) to write "
+                         "the fit with its gaps")
     times = np.array(data["times_s"], dtype=float)  # null (an entry not ok) -> NaN
     return SlewTimeFit(data["angles_rad"], data["axes"], times, data.get("meta"), data.get("inertia"),
                        data.get("torque_generators"), data.get("triangles"), data.get("status"))
