@@ -260,7 +260,9 @@ def test_fit_on_the_polytope_grid_follows_kinks_that_a_lattice_misses():
     assert errors["polytope"] <= 0.01 < errors["fibonacci"]
 
 
-def test_fit_entries_leaves_out_axes_without_two_ok_angles():
+def test_fit_entries_keeps_entries_that_are_not_ok_as_gaps():
+    """Not filled along the axis, nor the axis left out (its neighbours' times then covered it):
+    the fit has no time in the cells that use such an entry (tests/test_slewtable_gaps.py)."""
     fit = analytic_fit(12)
     part = TablePart.empty(fit.axes, list(np.rad2deg(fit.angles)))
     part.slew_time_s[:] = fit.times
@@ -269,8 +271,12 @@ def test_fit_entries_leaves_out_axes_without_two_ok_angles():
     part.status[1][2] = "failed"
     part.slew_time_s[1, 2] = np.nan
     refit, note = fit_entries(part, INERTIA, np.eye(3))
-    assert refit is not None and len(refit.axes) == len(fit.axes) - 1
-    assert "1 of 12 axes left out" in note and "1 entries not ok filled" in note
+    assert refit is not None and len(refit.axes) == len(fit.axes)
+    assert "8 entries not ok (0 infeasible)" in note
+    assert np.isnan(refit.axis_angle(*fit.axes[0], fit.angles[3]))
+    assert np.isnan(refit.axis_angle(*fit.axes[1], 0.5 * (fit.angles[1] + fit.angles[2])))
+    far = -fit.axes[0]  # the cells there use neither axis 0 nor axis 1
+    assert refit.axis_angle(*far, 2.0) == pytest.approx(fit.axis_angle(*far, 2.0), rel=1e-12)
 
 
 # --- files -------------------------------------------------------------------------------------

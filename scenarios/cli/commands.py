@@ -135,8 +135,14 @@ def _validate_table(file: str) -> str:
     from scenarios.slewtable.spec import parse_table_spec
 
     spec = parse_table_spec(file)
-    return (f"{file}: valid slew table {spec.name!r}: {len(spec.axes)} axes x {len(spec.angles_deg)} angles, "
-            f"{spec.objective}; run it with `slewbench {OTHER_FILES['table']} {file}`")
+    axes = "1 axis" if len(spec.axes) == 1 else f"{len(spec.axes)} axes"
+    mids = len(spec.held_out_angles_deg)
+    held_out = (f" + a held-out grid of {spec.held_out} ax{'i' if spec.held_out == 1 else 'e'}s x {mids} "
+                f"angle{'' if mids == 1 else 's'}" if spec.held_out else ", no held-out grid")
+    refine = (f"; refined to a tolerance of {spec.refine.tolerance:g} (at most {spec.refine.max_axes} axes, "
+              f"{spec.refine.max_rounds} rounds)" if spec.refine is not None else "; no refinement")
+    return (f"{file}: valid slew table {spec.name!r}: {axes} x {len(spec.angles_deg)} angles{held_out}, "
+            f"{spec.objective}{refine}; run it with `slewbench {OTHER_FILES['table']} {file}`")
 
 
 _OTHER_VALIDATORS = {"study": _validate_study, "table": _validate_table}

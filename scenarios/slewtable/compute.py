@@ -5,8 +5,11 @@ table's then the held-out grid's) and run by :func:`scenarios.study.sweep`: on t
 pool or a Dask cluster, each finished case committed to the crash-safe store when a directory is
 given (so a table run again into the same directory computes only the entries it lacks). An entry
 whose solve fails, or that breaks a requirement, is kept with its status and message; only the
-``ok`` entries enter the fit (an axis is filled between its ok angles by its own cubic, and an axis
-with fewer than two ok angles is left out of the fit).
+``ok`` entries are interpolated: the fit keeps every axis with its entries' statuses and has no value
+(NaN) in the cells around an entry that is not ``ok`` (``inf`` at an ``infeasible`` one), rather than
+a time the table did not find. An entry whose start or target attitude already breaks a pointing
+requirement (the run's row is ``failed``: "no reference can meet it") is proven impossible: the
+table records it ``infeasible``.
 
 With a tolerance (``TableSpec.refine``) the table's axes are then refined where the fit misses
 (:func:`scenarios.slewtable.refine.refine`): each round's entries are one more study through the
@@ -59,7 +62,7 @@ class TablePart:
     plan_time_s : numpy.ndarray, shape (n, k)
         The planner's wall time [s] (NaN where none).
     status : list of list of str
-        Each entry's status (``ok``, ``violated``, ``failed``, ``crashed``, ``missing``).
+        Each entry's status (``ok``, ``violated``, ``infeasible``, ``failed``, ``crashed``, ``missing``).
     message : list of list of str
         Each entry's message.
     """
@@ -146,12 +149,29 @@ def _study(spec: TableSpec, cases: list[TableCase]) -> Any:
                  study_cases, {"table": spec.name})
 
 
+def _proven_infeasible(scenario: dict[str, Any]) -> bool:
+    """Whether the entry's start or target attitude already breaks a pointing requirement (then no
+    slew can meet it: the run's row is ``failed`` without planning)."""
+    from scenarios.errors import ScenarioError
+    from scenarios.requirements.scoring import endpoint_violations
+    from scenarios.schema.loader import parse_scenario
+    if not scenario:
+        return False
+    try:
+        problem = parse_scenario(scenario).problem
+    except ScenarioError:
+        return False
+    return bool(endpoint_violations(problem))
+
+
 def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objective: str) -> None:
     i, k = case.axis_index, case.angle_index
     if record is None or not record.get("rows"):
         return
     row = record["rows"][0]
     part.status[i][k] = str(row.get("status"))
+    if part.status[i][k] == "failed" and _proven_infeasible(case.scenario):
+        part.status[i][k] = "infeasible"
     part.message[i][k] = str(row.get("message") or "")
     if row.get("plan_time_s") is not None:
         part.plan_time_s[i, k] = float(row["plan_time_s"])
@@ -164,10 +184,15 @@ def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objec
             part.objective_value[i, k] = float(value)
 
 
+def _plural(count: int, word: str, words: str | None = None) -> str:
+    """``1 axis``, ``2 axes``."""
+    return f"{count} {word if count == 1 else (words or word + 's')}"
+
+
 def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: np.ndarray | None = None,
                 meta: dict[str, Any] | None = None, triangles: np.ndarray | None = None
                 ) -> tuple[SlewTimeFit | None, str]:
-    """Fit a grid's ``ok`` entries (module docstring).
+    """Fit a grid's ``ok`` entries; the others are kept as gaps (module docstring).
 
     Parameters
     ----------
@@ -180,48 +205,44 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
     meta : dict, optional
         Kept with the fit.
     triangles : numpy.ndarray, shape (t, 3), optional
-        The grid's triangles (:func:`scenarios.slewtable.grid.polytope_grid`), used when every axis
-        enters the fit; otherwise (or None) the convex hull of the axes that do.
+        The grid's triangles (:func:`scenarios.slewtable.grid.polytope_grid`); None: the convex hull
+        of the axes.
 
     Returns
     -------
     fit : SlewTimeFit or None
-        None when no fit can be made.
+        None when no fit can be made (fewer than 4 axes, axes that do not span the sphere, or no
+        ``ok`` entry).
     note : str
-        Why not, or which axes were left out or filled ("" when every entry is ok).
+        Why not, or how many entries are not ok and where the fit has no value ("" when every
+        entry is ok).
     """
-    from scipy.interpolate import PchipInterpolator
     angles = np.deg2rad(part.angles_deg)
     ok = part.ok
-    keep, rows, filled = [], [], 0
-    for i in range(len(part.axes)):
-        good = ok[i]
-        if good.sum() < 2:
-            continue
-        times = part.slew_time_s[i].copy()
-        if not good.all():
-            g = times[good] / np.sqrt(angles[good])
-            times[~good] = PchipInterpolator(angles[good], g, extrapolate=True)(angles[~good]) * np.sqrt(angles[~good])
-            filled += int((~good).sum())
-        keep.append(i)
-        rows.append(times)
+    status = [[s if good else ("missing" if s == "ok" else s) for s, good in zip(row, flags)]
+              for row, flags in zip(part.status, ok.tolist())]  # "ok" without a finite time is not ok
     notes = []
-    if len(keep) < len(part.axes):
-        notes.append(f"{len(part.axes) - len(keep)} of {len(part.axes)} axes left out (fewer than 2 ok angles)")
-    if filled:
-        notes.append(f"{filled} entries not ok filled along their axis")
-    if len(keep) < 4:
-        return None, "; ".join([*notes, f"no fit over the sphere: {len(keep)} axes with ok entries (4 or more needed)"])
+    bad = int((~ok).sum())
+    if bad:
+        infeasible = sum(s == "infeasible" for row in status for s in row)
+        notes.append(f"{_plural(bad, 'entry', 'entries')} not ok ({infeasible} infeasible): the fit gives NaN in the "
+                     f"cells around {'it' if bad == 1 else 'them'} (inf at an infeasible one), not a time")
+    if len(part.axes) < 4:
+        return None, "; ".join([*notes, (f"no fit over the sphere: {_plural(len(part.axes), 'axis', 'axes')} "
+                                         "(4 or more spanning the sphere needed)")])
+    if not ok.any():
+        return None, "; ".join([*notes, "no fit: no entry is ok"])
     try:
-        use = triangles if triangles is not None and len(keep) == len(part.axes) else None
-        fit = SlewTimeFit(angles, part.axes[keep], np.array(rows), meta, inertia, generators, use)
+        fit = SlewTimeFit(angles, part.axes, np.where(ok, part.slew_time_s, np.nan), meta, inertia, generators,
+                          triangles, status)
     except ValueError as error:
         return None, "; ".join([*notes, f"no fit: {error}"])
     return fit, "; ".join(notes)
 
 
 def eval_time_us(fit: SlewTimeFit, repeats: int = 7, number: int = 2000) -> float:
-    """Median over ``repeats`` of the mean CPU time of one ``fit(q0, qf)`` call on tuples [µs].
+    """Median over ``repeats`` of the mean CPU time of one ``fit(q0, qf)`` call on tuples [µs]
+    (64 random attitude pairs; ``q0`` the identity for a fit of slews from the identity only).
 
     CPU time of this process (``time.process_time``), not wall time: on a shared machine the wall
     clock counts the time other processes hold the core.
@@ -241,7 +262,9 @@ def eval_time_us(fit: SlewTimeFit, repeats: int = 7, number: int = 2000) -> floa
     rng = np.random.default_rng(0)
     q = rng.normal(size=(64, 4))
     q /= np.linalg.norm(q, axis=1, keepdims=True)
-    pairs = [(tuple(q[i].tolist()), tuple(q[(i + 1) % 64].tolist())) for i in range(64)]
+    identity = bool(fit.meta.get("from_identity_only"))  # then every slew starts at the identity
+    pairs = [((1.0, 0.0, 0.0, 0.0) if identity else tuple(q[i].tolist()), tuple(q[(i + 1) % 64].tolist()))
+             for i in range(64)]
     loops = max(1, number // 64)
 
     def run() -> None:
@@ -266,20 +289,29 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart) -> dict[str, Any]:
     -------
     dict
         ``points`` (ok entries compared), ``max_rel_error`` and ``rms_rel_error`` (fractions of the
-        slew time; None without points), ``worst`` (axis, angle [deg], table and fitted times [s]).
+        slew time; None without points), ``worst`` (axis, angle [deg], table and fitted times [s]),
+        ``no_value`` (ok entries where the fit has no time, in a cell around an entry that is not
+        ok: not compared).
     """
     ok = part.ok
+    none: dict[str, Any] = {"points": 0, "max_rel_error": None, "rms_rel_error": None, "worst": None, "no_value": 0}
     if not ok.any():
-        return {"points": 0, "max_rel_error": None, "rms_rel_error": None, "worst": None}
+        return none
     i, k = np.nonzero(ok)
     truth = part.slew_time_s[i, k]
     angles = np.deg2rad(np.asarray(part.angles_deg))[k]
     estimate = fit.many_axis_angle(part.axes[i], angles)
+    finite = np.isfinite(estimate)
+    if not finite.all():
+        i, k, truth, estimate = i[finite], k[finite], truth[finite], estimate[finite]
+    none["no_value"] = int((~finite).sum())
+    if not finite.any():
+        return none
     rel = np.abs(estimate / truth - 1.0)
     w = int(np.argmax(rel))
     return {"points": len(rel), "max_rel_error": float(rel.max()), "rms_rel_error": float(np.sqrt(np.mean(rel ** 2))),
             "worst": {"axis": part.axes[i[w]].tolist(), "angle_deg": float(part.angles_deg[k[w]]),
-                      "table_s": float(truth[w]), "fit_s": float(estimate[w])}}
+                      "table_s": float(truth[w]), "fit_s": float(estimate[w])}, "no_value": none["no_value"]}
 
 
 def compute_table(spec: TableSpec, directory: str | Path | None = None, *, workers: int | None = None,
@@ -345,6 +377,10 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
     table.fit, table.fit_note = fit_entries(parts["table"], inertia, generators, meta, triangles)
     if table.fit is not None:
         quality = held_out_errors(table.fit, parts["held_out"])
+        if quality["no_value"]:
+            missed = (f"{_plural(quality['no_value'], 'ok held-out entry', 'ok held-out entries')} where the fit "
+                      "has no time (not compared)")
+            table.fit_note = "; ".join([*filter(None, [table.fit_note]), missed])
         quality["eval_time_us"] = eval_time_us(table.fit)
         table.fit.meta["held_out"] = quality
         table.fit.meta["note"] = table.fit_note
@@ -394,7 +430,8 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
         for case, record in zip(cases, run(cases)):
             entries[tuple(case.axis.tolist()), case.angle_index] = (case, record)
             one = TablePart.empty(np.zeros((1, 3)), spec.angles_deg)
-            _fill(one, TableCase("table", 0, case.angle_index, case.axis, case.angle_deg, {}), record, spec.objective)
+            _fill(one, TableCase("table", 0, case.angle_index, case.axis, case.angle_deg, case.scenario), record,
+                  spec.objective)
             if one.ok[0, case.angle_index]:
                 times[case.axis_index, angle_indices.index(case.angle_index)] = one.slew_time_s[0, case.angle_index]
         return times
@@ -419,12 +456,14 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
             if i < n0:  # the initial axes keep their order and entries
                 _copy_entry(initial, i, refined, i, k)
             elif (found := entries.get((tuple(axis.tolist()), k))) is not None:
-                _fill(refined, TableCase("table", i, k, axis, spec.angles_deg[k], {}), found[1], spec.objective)
+                _fill(refined, TableCase("table", i, k, axis, spec.angles_deg[k], found[0].scenario), found[1],
+                      spec.objective)
     checks = TablePart.empty(np.array([c["axis"] for c in result.checks]).reshape(-1, 3), spec.angles_deg)
     for i, axis in enumerate(checks.axes):
         for k in range(len(spec.angles_deg)):
             if (found := entries.get((tuple(axis.tolist()), k))) is not None:
-                _fill(checks, TableCase("check", i, k, axis, spec.angles_deg[k], {}), found[1], spec.objective)
+                _fill(checks, TableCase("check", i, k, axis, spec.angles_deg[k], found[0].scenario), found[1],
+                      spec.objective)
     table.parts["table"], table.parts["check"] = refined, checks
     table.refinement = {"tolerance": spec.refine.tolerance,
                         "check_angles_deg": [spec.angles_deg[k] for k in (spec.refine.check_angles

@@ -164,7 +164,8 @@ def write_plot(table: SlewTable, path: Path) -> None:
     left.set_ylabel(f"{'minimum ' if table.spec.objective == 'min_time' else ''}slew time [s]")
     left.set_title(f"{table.spec.name}: {table.spec.objective}, {len(part.axes)} axes")
     left.grid(True, alpha=0.3)
-    left.legend(fontsize=8, loc="upper left")
+    if left.get_legend_handles_labels()[0]:  # none when no entry is ok and there is no fit
+        left.legend(fontsize=8, loc="upper left")
     k = len(angles) - 1
     axes = part.axes
     lon = np.rad2deg(np.arctan2(axes[:, 1], axes[:, 0]))

@@ -13,7 +13,12 @@ table, ``g`` is a monotone-preserving piecewise cubic (PCHIP) in ``θ`` through 
 over the sphere the three axes of the triangle that holds ``e`` (the grid's triangles, else the
 axes' convex hull) are blended linearly (barycentric weights of the gnomonic projection,
 continuous across edges). Below the smallest angle ``g`` is held at its value there (``T → 0`` as ``√θ``);
-above the largest it is continued linearly.
+above the largest there is no value (NaN), unless the largest is 180°, which covers every slew.
+
+Entries that are not ``ok`` (``status``) are not interpolated: the fit is NaN in every cell (a
+triangle of axes between two table angles) that has one with a non-zero weight, and ``inf`` where
+every entry it uses is ``infeasible`` (at such an entry itself). A table of slews from the identity
+only (``meta.from_identity_only``) refuses any other start attitude.
 
 Evaluation (:meth:`SlewTimeFit.__call__`) is pure Python on precomputed lists (a cube-map lookup
 finds the candidate triangles), since every NumPy call costs about a microsecond;
@@ -36,13 +41,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["FIT_FORMAT", "UNIT_TOLERANCE", "SlewTimeFit", "fit_table", "load_fit"]
+__all__ = ["FIT_FORMAT", "IDENTITY_TOLERANCE", "UNIT_TOLERANCE", "SlewTimeFit", "fit_table", "load_fit"]
 
 FIT_FORMAT = "slewbench-slew-time-fit/1"
 """The ``format`` key of ``fit.json``."""
 _CELLS = 12  # cube-map cells per face side
 _SAMPLES = 7  # directions sampled per cell side to list its candidate triangles
 _INSIDE = -1e-9
+_UNUSED = 1e-9  # a barycentric weight at most this fraction of their sum: the vertex is not used
+_OK, _INFEASIBLE, _UNKNOWN = 0, 1, 2  # entry codes: ok, proven infeasible, anything else not ok
 
 
 def _hull(axes: np.ndarray) -> np.ndarray:
@@ -199,6 +206,19 @@ the relative rotation's axis and angle, which scaling leaves alone."""
 _UNIT_SQUARED = 2 * UNIT_TOLERANCE + UNIT_TOLERANCE ** 2  # |q|² within it: |q| in [1 − tol, 1 + tol]
 
 
+IDENTITY_TOLERANCE = 1e-6
+"""How far a start attitude ``q0`` may turn from the identity [rad] for a fit of slews from the
+identity only (``meta.from_identity_only``: with pointing requirements or environment torques the
+slew time depends on the start attitude, and the table holds slews from the identity)."""
+
+
+def _identity_error(name: str, q: Any, angle: float) -> ValueError:
+    return ValueError(f"{name} must be the identity attitude (within {IDENTITY_TOLERANCE:g} rad): this fit's "
+                      "table holds slews from the identity only (meta.from_identity_only: pointing requirements "
+                      "or environment torques make the slew time depend on the start attitude, not only on the "
+                      f"rotation), got {list(q)} ({angle:.6g} rad from the identity)")
+
+
 def _as_list(name: str, value: Any) -> list[float]:
     """A quaternion argument as a list (NumPy arrays and other sequences), or a ``TypeError``."""
     try:
@@ -231,9 +251,11 @@ class SlewTimeFit:
     axes : array_like, shape (n, 3)
         The table's eigen-axes, body frame (unit vectors spanning the sphere, n >= 4).
     times : array_like, shape (n, k)
-        Slew time at each axis and angle [s], positive and finite.
+        Slew time at each axis and angle [s], positive and finite where the entry is ``ok`` (NaN
+        elsewhere).
     meta : dict, optional
         What the fit came from (scenario, objective, errors on held-out points); kept in ``fit.json``.
+        ``meta["from_identity_only"]`` true: the start attitude must be the identity.
     inertia : array_like, shape (3, 3), optional
         The spacecraft's inertia [kg m²], body frame (for the shape ``s(e)``; with ``generators``).
     generators : array_like, shape (m, 3), optional
@@ -242,17 +264,21 @@ class SlewTimeFit:
     triangles : array_like of int, shape (t, 3), optional
         Triangles over the axes (vertex indices) that cover the sphere once by central projection
         (:func:`scenarios.slewtable.grid.polytope_grid`); None: the axes' convex hull.
+    status : array_like of str, shape (n, k), optional
+        Each entry's status in the table (``ok``, ``infeasible``, ``failed``, ...); None: all
+        ``ok``. The fit is NaN in the cells that use an entry that is not ``ok``, ``inf`` where
+        every entry used is ``infeasible`` (module docstring).
 
     Raises
     ------
     ValueError
-        Shapes that disagree, angles not increasing in (0, π], times not positive and finite, or
-        axes that do not span the sphere.
+        Shapes that disagree, angles not increasing in (0, π], times of ``ok`` entries not positive
+        and finite, no ``ok`` entry, or axes that do not span the sphere.
     """
 
     def __init__(self, angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[str, Any] | None = None,
                  inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
-                 triangles: ArrayLike | None = None):
+                 triangles: ArrayLike | None = None, status: ArrayLike | None = None):
         from scipy.interpolate import PchipInterpolator
         theta = np.asarray(angles, dtype=float)
         e = np.asarray(axes, dtype=float)
@@ -261,11 +287,23 @@ class SlewTimeFit:
             raise ValueError("angles must be at least 2 increasing values in (0, pi] [rad]")
         if e.ndim != 2 or e.shape[1] != 3 or t.shape != (e.shape[0], theta.size):
             raise ValueError(f"axes must be (n, 3) and times (n, {theta.size}), got {e.shape} and {t.shape}")
-        if not np.all(np.isfinite(t)) or np.any(t <= 0):
-            raise ValueError("times must be positive and finite")
+        states = np.full(t.shape, "ok", dtype=object) if status is None else np.asarray(status, dtype=object)
+        if states.shape != t.shape:
+            raise ValueError(f"status must be (n, k) like times, got {states.shape} and {t.shape}")
+        ok = states == "ok"
+        if not np.all(np.isfinite(t[ok])) or np.any(t[ok] <= 0):
+            raise ValueError("times of ok entries must be positive and finite")
+        if not ok.any():
+            raise ValueError("no ok entry to fit")
         e = e / np.linalg.norm(e, axis=1, keepdims=True)
-        self.angles, self.axes, self.times = theta, e, t
+        t = np.where(ok, t, np.nan)
+        self.angles, self.axes, self.times, self.status = theta, e, t, states
+        codes = np.where(ok, _OK, np.where(states == "infeasible", _INFEASIBLE, _UNKNOWN))
+        self._codes = codes.tolist()
         self.meta: dict[str, Any] = dict(meta or {})
+        self._identity_only = bool(self.meta.get("from_identity_only"))
+        self._identity_vsq = math.sin(IDENTITY_TOLERANCE / 2.0) ** 2  # |vector part|² / |q|² at the tolerance
+        self._top = math.pi if theta[-1] >= math.pi - 1e-9 else float(theta[-1])  # beyond it: NaN
         self.triangles = _hull(e) if triangles is None else np.asarray(triangles, dtype=int).reshape(-1, 3)
         if self.triangles.size and (self.triangles.min() < 0 or self.triangles.max() >= len(e)):
             raise ValueError("triangles must index the axes")
@@ -276,7 +314,20 @@ class SlewTimeFit:
         self.facets = facets @ self.inertia if len(facets) else facets  # n/h · (J e) = (n/h J) · e
         self._facets = [tuple(f) for f in self.facets.tolist()]
         g = t / np.sqrt(theta[None, :] * self.shape(e)[:, None])
-        slopes = np.stack([PchipInterpolator(theta, row).derivative()(theta) for row in g])
+        slopes = np.full(g.shape, np.nan)
+        for row, good in zip(range(len(g)), ok):  # PCHIP over each run of ok angles, alone
+            start = 0
+            while start < len(theta):
+                if not good[start]:
+                    start += 1
+                    continue
+                stop = start
+                while stop + 1 < len(theta) and good[stop + 1]:
+                    stop += 1
+                run = slice(start, stop + 1)
+                slopes[row, run] = (PchipInterpolator(theta[run], g[row, run]).derivative()(theta[run])
+                                    if stop > start else 0.0)
+                start = stop + 1
         self._g, self._dg = g, slopes
         # pure-Python tables for __call__
         self._theta = theta.tolist()
@@ -321,7 +372,8 @@ class SlewTimeFit:
         Returns
         -------
         float
-            The fitted slew time [s] (0 for a zero angle).
+            The fitted slew time [s] (0 for a zero angle; NaN and ``inf`` as :meth:`__call__`).
+            The start attitude is the identity.
         """
         if angle <= 0.0:
             return 0.0
@@ -343,9 +395,9 @@ class SlewTimeFit:
         if angle <= theta[0]:
             r0, r1, r2 = self._rows[i][0][0], self._rows[j][0][0], self._rows[k][0][0]
         elif angle >= theta[last]:
-            d = angle - theta[last]
-            (a0, b0), (a1, b1), (a2, b2) = self._rows[i][last], self._rows[j][last], self._rows[k][last]
-            r0, r1, r2 = a0 + b0 * d, a1 + b1 * d, a2 + b2 * d
+            if angle > self._top:  # no extrapolation past the table's largest angle
+                return math.nan
+            r0, r1, r2 = self._rows[i][last][0], self._rows[j][last][0], self._rows[k][last][0]
         else:
             n = bisect.bisect_right(theta, angle) - 1
             h = theta[n + 1] - theta[n]
@@ -372,7 +424,43 @@ class SlewTimeFit:
                 if v > scale:  # noqa: PLR1730  (max() costs a call in the hot loop)
                     scale = v
             scale /= norm
-        return (w0 * r0 + w1 * r1 + w2 * r2) / s * math.sqrt(angle * scale)
+        blend = (w0 * r0 + w1 * r1 + w2 * r2) / s
+        if blend != blend:  # noqa: PLR0124  (NaN: an entry that is not ok in the cell; isnan costs a call)
+            blend = self._gap(found[0], w0 / s, w1 / s, w2 / s, angle)
+        return blend * math.sqrt(angle * scale)
+
+    def _gap(self, vertices: tuple[int, ...], w0: float, w1: float, w2: float, angle: float) -> float:
+        """The blended ``g`` of a cell holding an entry that is not ok (normalised weights): NaN if
+        an entry used (non-zero weight) is not ok, inf if every one used is infeasible, else the
+        blend of the entries used alone (a point on a table angle or a triangle's edge)."""
+        theta = self._theta
+        last = len(theta) - 1
+        if angle <= theta[0]:
+            nodes, t = [0], 0.0
+        elif angle >= theta[last]:
+            nodes, t = [last], 0.0
+        else:
+            n = bisect.bisect_right(theta, angle) - 1
+            t = (angle - theta[n]) / (theta[n + 1] - theta[n])
+            nodes = [n] if t == 0.0 else [n, n + 1]
+        used = [(v, w) for v, w in zip(vertices, (w0, w1, w2)) if w > _UNUSED]
+        codes = [self._codes[v][n] for v, _ in used for n in nodes]
+        if any(codes):
+            return math.inf if all(c == _INFEASIBLE for c in codes) else math.nan
+        total = 0.0
+        for v, w in used:
+            row = self._rows[v]
+            if len(nodes) == 1:
+                r = row[nodes[0]][0]
+            else:
+                n = nodes[0]
+                h = theta[n + 1] - theta[n]
+                t2, t3 = t * t, t * t * t
+                (a0, b0), (a1, b1) = row[n], row[n + 1]
+                r = ((2.0 * t3 - 3.0 * t2 + 1.0) * a0 + (t3 - 2.0 * t2 + t) * h * b0
+                     + (3.0 * t2 - 2.0 * t3) * a1 + (t3 - t2) * h * b1)
+            total += w * r
+        return total / sum(w for _, w in used)
 
     def __call__(self, q0: Any, qf: Any) -> float:
         """Slew time from attitude ``q0`` to ``qf`` (pure Python).
@@ -386,14 +474,18 @@ class SlewTimeFit:
         Returns
         -------
         float
-            The fitted slew time [s] of the rest-to-rest slew ``q0 -> qf``.
+            The fitted slew time [s] of the rest-to-rest slew ``q0 -> qf``; NaN where the fit has no
+            value (a cell with an entry that is not ``ok``, or an angle past the table's largest),
+            ``inf`` at an ``infeasible`` entry (module docstring).
 
         Raises
         ------
         TypeError
             ``q0`` or ``qf`` is not 4 numbers.
         ValueError
-            A norm farther than :data:`UNIT_TOLERANCE` from 1 (a zero or non-finite quaternion).
+            A norm farther than :data:`UNIT_TOLERANCE` from 1 (a zero or non-finite quaternion), or
+            ``q0`` farther than :data:`IDENTITY_TOLERANCE` from the identity for a table of slews
+            from the identity only (``meta.from_identity_only``).
         """
         if type(q0) is not tuple and type(q0) is not list:
             q0 = _as_list("q0", q0)
@@ -408,6 +500,8 @@ class SlewTimeFit:
             raise TypeError(f"q0 and qf must be 4 numbers each (scalar first), got {q0!r} and {qf!r}") from None
         if not (abs(n0 - 1.0) <= _UNIT_SQUARED and abs(n1 - 1.0) <= _UNIT_SQUARED):  # NaN fails too
             _check_unit(q0, qf)
+        if self._identity_only and b * b + c * c + d * d > self._identity_vsq * n0:
+            raise _identity_error("q0", q0, 2.0 * math.atan2(math.sqrt(b * b + c * c + d * d), abs(a)))
         # dq = conj(q0) ⊗ qf
         w = a * e + b * f + c * g + d * h
         x = a * f - b * e - c * h + d * g
@@ -458,7 +552,7 @@ class SlewTimeFit:
         Returns
         -------
         numpy.ndarray, shape (n,)
-            Fitted slew times [s].
+            Fitted slew times [s] (NaN and ``inf`` as :meth:`__call__`).
         """
         e = np.atleast_2d(np.asarray(axes, dtype=float))
         theta = np.atleast_1d(np.asarray(angles, dtype=float))
@@ -479,10 +573,16 @@ class SlewTimeFit:
                  + h10[:, None] * np.take_along_axis(dg, nn[..., None], 2)[..., 0]
                  + h01[:, None] * np.take_along_axis(g, nn[..., None] + 1, 2)[..., 0]
                  + h11[:, None] * np.take_along_axis(dg, nn[..., None] + 1, 2)[..., 0])
-        beyond = theta > nodes[-1]
-        inner = np.where(beyond[:, None], g[..., -1] + dg[..., -1] * (theta - nodes[-1])[:, None], inner)
-        blended = np.sum(weights * inner, axis=1)
-        return np.where(theta > 0.0, blended * np.sqrt(np.maximum(theta, 0.0) * self.shape(e)), 0.0)
+        inner = np.where((theta >= nodes[-1])[:, None], g[..., -1], inner)
+        with np.errstate(invalid="ignore"):
+            blended = np.sum(weights * inner, axis=1)
+        gaps = np.nonzero(np.isnan(blended) & (theta <= self._top) & (theta > 0.0))[0]
+        for row in gaps.tolist():  # an entry that is not ok in the cell: as the scalar call
+            w = weights[row].tolist()
+            blended[row] = self._gap(tuple(vertices[row].tolist()), w[0], w[1], w[2], float(theta[row]))
+        blended[theta > self._top] = np.nan  # no extrapolation past the table's largest angle
+        with np.errstate(invalid="ignore"):
+            return np.where(theta > 0.0, blended * np.sqrt(np.maximum(theta, 0.0) * self.shape(e)), 0.0)
 
     def slew_time_many(self, q0: ArrayLike, qf: ArrayLike) -> np.ndarray:
         """Slew times of many slews (vectorised :meth:`__call__`).
@@ -495,7 +595,7 @@ class SlewTimeFit:
         Returns
         -------
         numpy.ndarray, shape (n,)
-            Fitted slew times [s].
+            Fitted slew times [s] (NaN and ``inf`` as :meth:`__call__`).
 
         Raises
         ------
@@ -519,6 +619,14 @@ class SlewTimeFit:
                 row = int(np.argmax(bad))
                 raise ValueError(f"{name}[{row}] must be a unit quaternion (norm within {UNIT_TOLERANCE:g} of 1), "
                                  f"got {quaternions.reshape(-1, 4)[row].tolist()} (norm {norms.ravel()[row]:.6g})")
+        if self._identity_only:
+            vector = np.sum(a[..., 1:] ** 2, axis=-1)
+            bad = vector > self._identity_vsq * np.sum(a ** 2, axis=-1)
+            if np.any(bad):
+                row = int(np.argmax(bad.ravel()))
+                q = a.reshape(-1, 4)[row]
+                raise _identity_error(f"q0[{row}]", q.tolist(), 2.0 * math.atan2(math.sqrt(float(vector.ravel()[row])),
+                                                                                abs(float(q[0]))))
         axes, angles = relative_axis_angle(a, b)
         return self.many_axis_angle(axes, angles)
 
@@ -530,16 +638,18 @@ class SlewTimeFit:
         Returns
         -------
         dict
-            ``format``, ``model``, ``angles_rad``, ``axes`` (body frame), ``times_s``,
-            ``g`` (T/√(θ s)) and ``dg_dangle`` (its PCHIP slopes [1/rad]), ``triangles``,
+            ``format``, ``model``, ``angles_rad``, ``axes`` (body frame), ``times_s`` (null where
+            the entry is not ok), ``status`` (each entry's), ``g`` (T/√(θ s)) and ``dg_dangle``
+            (its PCHIP slopes [1/rad], over each run of ok angles), ``triangles``,
             ``facets`` (the rows ``a_f`` of ``s(e)`` [s²/rad]),
             ``inertia`` [kg m²], ``torque_generators`` [N m] and ``meta``.
         """
         return {"format": FIT_FORMAT,
                 "model": "T(e, θ) = √(θ s(e)) · g(e, θ), s(e) = max_f |facets_f · e|; g: PCHIP in θ per axis, "
                          "linear (barycentric, gnomonic) over the triangles",
-                "angles_rad": self.angles.tolist(), "axes": self.axes.tolist(), "times_s": self.times.tolist(),
-                "g": self._g.tolist(), "dg_dangle": self._dg.tolist(), "triangles": self.triangles.tolist(),
+                "angles_rad": self.angles.tolist(), "axes": self.axes.tolist(), "times_s": _plain(self.times),
+                "status": self.status.tolist(),
+                "g": _plain(self._g), "dg_dangle": _plain(self._dg), "triangles": self.triangles.tolist(),
                 "facets": self.facets.tolist(), "inertia": self.inertia.tolist(),
                 "torque_generators": self.generators.tolist(), "meta": self.meta}
 
@@ -558,9 +668,14 @@ class SlewTimeFit:
                 f"({np.rad2deg(self.angles[0]):g}..{np.rad2deg(self.angles[-1]):g} deg)>")
 
 
+def _plain(values: np.ndarray) -> list[Any]:
+    """An array as nested lists with None for NaN (JSON has no NaN)."""
+    return [[v if math.isfinite(v) else None for v in row] for row in values.tolist()]
+
+
 def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[str, Any] | None = None,
               inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
-              triangles: ArrayLike | None = None) -> SlewTimeFit:
+              triangles: ArrayLike | None = None, status: ArrayLike | None = None) -> SlewTimeFit:
     """Fit a slew table (module docstring).
 
     Parameters
@@ -579,13 +694,15 @@ def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[s
         Working actuators' torque directions times bounds [N m], body frame.
     triangles : array_like of int, shape (t, 3), optional
         Triangles over the axes; None: their convex hull.
+    status : array_like of str, shape (n, k), optional
+        Each entry's status; None: all ``ok``.
 
     Returns
     -------
     SlewTimeFit
         The fit.
     """
-    return SlewTimeFit(angles, axes, times, meta, inertia, generators, triangles)
+    return SlewTimeFit(angles, axes, times, meta, inertia, generators, triangles, status)
 
 
 def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
@@ -604,7 +721,8 @@ def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
     Raises
     ------
     ValueError
-        The file is not a slew-time fit of this format.
+        The file is not a slew-time fit of this format, or one that filled entries that were not
+        ``ok`` (written before the fit kept them as gaps).
     """
     file = Path(path)
     if file.is_dir():
@@ -612,5 +730,12 @@ def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
     data = json.loads(file.read_text())
     if not isinstance(data, dict) or data.get("format") != FIT_FORMAT:
         raise ValueError(f"{file} is not a slewbench slew-time fit ({FIT_FORMAT!r} expected)")
-    return SlewTimeFit(data["angles_rad"], data["axes"], data["times_s"], data.get("meta"), data.get("inertia"),
-                       data.get("torque_generators"), data.get("triangles"))
+    note = str((data.get("meta") or {}).get("note", ""))
+    if "status" not in data and ("not ok filled" in note or "axes left out" in note):
+        raise ValueError(f"{file} was written by an earlier slewbench that filled the entries that are not ok "
+                         "(or covered axes it left out) with times the table did not find; run `slewbench table` "
+                         "again into the same --out (the entries are stored: nothing is solved again) to write "
+                         "the fit with its gaps")
+    times = np.array(data["times_s"], dtype=float)  # null (an entry not ok) -> NaN
+    return SlewTimeFit(data["angles_rad"], data["axes"], times, data.get("meta"), data.get("inertia"),
+                       data.get("torque_generators"), data.get("triangles"), data.get("status"))

@@ -7,7 +7,7 @@ of other axes) are the roots of a forest of spherical triangles (:class:`Triangl
    known yet, the midpoint (on the great circle, so that a child never crosses a kink its parent
    did not) is solved at the *check angles* and the current fit predicts it there; the point's
    *miss* is the largest ``|predicted / solved - 1|`` over those angles (an entry that is not
-   ``ok`` counts as a miss: the fit cannot vouch for it).
+   ``ok``, or where the fit has no value, counts as a miss: the fit cannot vouch for it).
 2. *Split.* An active triangle whose largest edge-midpoint miss is over the tolerance is cut in
    four at its edge midpoints (as is one whose three midpoints are known at every angle already:
    the data costs nothing more). Neighbours are then cut too until no triangle has an edge
@@ -339,7 +339,8 @@ def refine(axes: Any, triangles: Any, times: Any, solve: Solver, predict: Callab
         truth = np.array([rows[p][check] for p in points])
         estimate = fit(np.array([mesh.points[p] for p in points]), check)
         with np.errstate(invalid="ignore", divide="ignore"):
-            miss = np.where(np.isfinite(truth), np.abs(estimate / truth - 1.0), np.inf).max(axis=1)
+            miss = np.where(np.isfinite(truth) & np.isfinite(estimate), np.abs(estimate / truth - 1.0),
+                            np.inf).max(axis=1)
         by_point = dict(zip(points, miss.tolist()))
         # 2. split
         scores = []

@@ -219,7 +219,7 @@ def check_axes(value: Any, where: str) -> np.ndarray:
     Raises
     ------
     ScenarioError
-        Anything else (a zero vector included).
+        Anything else (a zero vector or a direction given twice included).
     """
     if isinstance(value, int) and not isinstance(value, bool):
         if not 1 <= value <= 10000:
@@ -227,7 +227,7 @@ def check_axes(value: Any, where: str) -> np.ndarray:
         return fibonacci_axes(value)
     if not isinstance(value, (list, tuple)) or not value:
         raise ScenarioError(where, f"expected a number of axes or a list of [x, y, z] axes, got {value!r}")
-    axes = []
+    axes: list[np.ndarray] = []
     for i, item in enumerate(value):
         if not isinstance(item, (list, tuple)) or len(item) != 3:
             raise ScenarioError(f"{where}[{i}]", f"expected 3 numbers (a body axis), got {item!r}")
@@ -235,7 +235,12 @@ def check_axes(value: Any, where: str) -> np.ndarray:
         size = float(np.linalg.norm(vector))
         if size == 0.0:
             raise ScenarioError(f"{where}[{i}]", "a zero vector has no direction")
-        axes.append(vector / size)
+        unit = vector / size
+        for j, other in enumerate(axes):
+            if np.linalg.norm(unit - other) <= 1e-9:
+                raise ScenarioError(f"{where}[{i}]", f"repeats the direction of {where}[{j}] ({value[j]!r}): "
+                                                     "each axis once")
+        axes.append(unit)
     return np.array(axes)
 
 
@@ -392,6 +397,8 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
         if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 10000:
             raise ScenarioError(found[0], f"expected a number of held-out axes from 0 to 10000, got {value!r}")
         held_out = value
+        if held_out:
+            _check_held_out(found[0], axes, objective)
     options: dict[str, Any] = {}
     if (found := pick("planner_options", "planner-options")) is not None:
         if not isinstance(found[1], dict):
@@ -424,6 +431,22 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
                      options, workers, scheduler, timeout, source, grid, triangles, refine)
     table_cases(spec)  # the collocation options and the case scenario are checked now
     return spec
+
+
+def _check_held_out(where: str, axes: np.ndarray | None, objective: str) -> None:
+    """A held-out grid measures the fit: refuse one when the table can have no fit (fewer than 4
+    axes, axes that do not span the sphere, or a min_energy table)."""
+    from scenarios.slewtable.fit import _hull
+    if objective != "min_time":
+        raise ScenarioError(where, "a held-out grid measures the fit, which is of min_time tables: "
+                                   "use 0 for a min_energy table")
+    assert axes is not None
+    try:
+        _hull(axes)
+    except ValueError as error:
+        count = "1 axis gives" if len(axes) == 1 else f"{len(axes)} axes give"
+        raise ScenarioError(where, f"a held-out grid measures the fit, and {count} no fit over the sphere "
+                                   f"({error}): use 0") from None
 
 
 def _refine_options(given: dict[str, Any], angles: list[float], objective: str, axes: int) -> RefineOptions | None:
