@@ -117,7 +117,7 @@ class ManeuverProblem:
         working = sc.wheel_axes[:, [i for i in range(sc.n_wheels) if i not in failed]]
         if working.shape[1] and np.linalg.matrix_rank(working, tol=1e-9) >= 2:
             return None
-        momentum = sc.inertia @ self.omega0 + sc.wheel_axes @ self.wheel_momentum0
+        momentum = sc.inertia @ self.omega0 + sc.wheel_axes @ self.initial_state[7:]  # I ω0 + A h_w0
         if float(np.linalg.norm(momentum)) > 1e-12 * max(1.0, float(np.max(np.abs(sc.inertia)))):
             return None
         from ocp import quat
