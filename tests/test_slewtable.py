@@ -333,6 +333,7 @@ def test_netcdf_reads_back_with_dimensions_units_and_attributes(tmp_path):
     (["--angles", "-10,90"], "(0, 180] degrees, got [-10.0, 90.0]"),  # checked, not read as an option
     (["--check-angles", "-5,30", "--tolerance", "0.01"], "--check-angles"),  # a list: argparse read it as an option
     (["--axes", "many"], "--axes"),
+    (["--axes", "-1"], "--axes: expected a number of axes from 1 to 10000, got -1"),  # as the YAML form says
     (["--duration", "5"], "--duration"),
     (["--objective", "min_energy"], "--duration"),
     (["--objective", "fastest"], "--objective"),
@@ -417,3 +418,10 @@ def test_command_writes_the_table_and_resumes_from_its_store(tmp_path, capsys):
     assert fit.meta["held_out"]["points"] == 2
     assert main(args) == 0
     assert "(14 entries already stored)" in capsys.readouterr().out
+
+
+def test_a_bad_table_file_is_named_as_one(tmp_path, capsys):
+    table = tmp_path / "table.yaml"
+    table.write_text("table: {scenario: nowhere.yaml, axes: 6, angles_deg: [30, 90]}\n")
+    assert main(["table", str(table), "--out", str(tmp_path / "out")]) == 2
+    assert capsys.readouterr().err.startswith("slewbench: error in table file: table.scenario: ")

@@ -147,7 +147,7 @@ def _validate_table(file: str) -> str:
 
 _OTHER_VALIDATORS = {"study": _validate_study, "table": _validate_table}
 """How ``validate`` checks each kind of ``scenarios.schema.loader.OTHER_FILES`` (keyed the same)."""
-_COMMAND_FILES = {"sweep": "study file"}
+_COMMAND_FILES = {"sweep": "study file", "table": "table file"}
 """What a command's file is called in its errors (``error in <kind>:``) where it is not a scenario;
 ``validate`` sets ``file_kind`` on its arguments once it knows."""
 

@@ -24,8 +24,16 @@ def _terminate(signum: int, frame: Any) -> None:
 
 
 def _integer(text: str) -> int | str:
-    """``--axes``: a count."""
-    return int(text) if text.strip().isdigit() else text
+    """``--axes``: a count (an integer of any sign: the table spec says which it takes)."""
+    try:
+        return int(text)
+    except ValueError:
+        return text
+
+
+def _count(number: int, one: str, many: str | None = None) -> str:
+    """``1 axis``, ``2 axes``."""
+    return f"{number} {one if number == 1 else (many or one + 's')}"
 
 
 def command_table(args: argparse.Namespace) -> int:
@@ -84,8 +92,9 @@ def command_table(args: argparse.Namespace) -> int:
             cluster.close()
         raise
     entries = len(spec.axes) * len(spec.angles_deg) + spec.held_out * max(len(spec.angles_deg) - 1, 0)
-    print(f"{spec.name}: {len(spec.axes)} axes x {len(spec.angles_deg)} angles"
-          + (f" + {spec.held_out} held-out axes x {len(spec.angles_deg) - 1} angles" if spec.held_out else "")
+    print(f"{spec.name}: {_count(len(spec.axes), 'axis', 'axes')} x {_count(len(spec.angles_deg), 'angle')}"
+          + (f" + {_count(spec.held_out, 'held-out axis', 'held-out axes')} x "
+             f"{_count(len(spec.angles_deg) - 1, 'angle')}" if spec.held_out else "")
           + f" = {entries} entries, {spec.objective}, {cluster.address if cluster else 'local process pool'}"
           + (f"; then refined to a tolerance of {spec.refine.tolerance:g} (at most {spec.refine.max_axes} axes, "
              f"{spec.refine.max_rounds} rounds)" if spec.refine else ""), flush=True)
@@ -126,7 +135,8 @@ def command_table(args: argparse.Namespace) -> int:
                   f"{100 * quality['rms_rel_error']:.3g} % of the slew time ({quality['points']} points); "
                   f"evaluation {quality['eval_time_us']:.2f} us CPU per call")
         else:
-            print(f"fit: no held-out points (--held-out 0); evaluation {quality['eval_time_us']:.2f} us CPU per call")
+            why = "--held-out 0" if not spec.held_out else "every held-out point in a gap of the table"
+            print(f"fit: no held-out points ({why}); evaluation {quality['eval_time_us']:.2f} us CPU per call")
         if table.fit_note:
             print(f"fit note: {table.fit_note}")
         print(f"use it: from scenarios.slewtable import load_fit; slew_time = load_fit('{directory / 'fit.json'}')")
