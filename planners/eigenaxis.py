@@ -17,8 +17,9 @@ acceleration ``α`` is chosen with the coast rate ``w`` such that every axis res
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Annotated, Any, Callable, Literal
+from typing import Annotated, Any, Literal
 
 import casadi as ca
 import numpy as np
@@ -26,7 +27,7 @@ import numpy as np
 from ocp import quat, quat_casadi
 from ocp.options import Range
 from planners.base import Planner
-from planners.problem import Array, ManeuverProblem
+from planners.problem import Array, ManeuverProblem, bound_keys
 from planners.reference import (
     FailedReference,
     Reference,
@@ -373,8 +374,7 @@ class EigenaxisPlanner(Planner):
             boxes = [(actuator, actuator.body_torque_box()) for actuator in problem.spacecraft.actuators]
             unbounded = [actuator for actuator, box in boxes if box is not None and not np.all(np.isfinite(box))]
             if unbounded:
-                names = ", ".join(f"spacecraft.{a.name}" + (".max_torque" if hasattr(a, "max_torque") else "")
-                                  for a in unbounded)
+                names = bound_keys(unbounded)
                 return (f"profile {self.options.profile} needs a torque bound on every actuator ({names}): it "
                         f"accelerates at the largest rate the bounds allow, unbounded without them")
         return super().problem_error(problem)

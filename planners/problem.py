@@ -169,6 +169,24 @@ class ManeuverProblem:
         return np.concatenate([self.q0, self.omega0, self.wheel_momentum0])
 
 
+def bound_keys(actuators: list) -> str:
+    """The scenario keys that would bound these actuators, for a message
+    (``spacecraft.wheels.max_torque, spacecraft.magnetorquers.max_dipole``).
+
+    Parameters
+    ----------
+    actuators : list of ocp actuators
+        Wheels, torquers, magnetorquers (their ``name``).
+
+    Returns
+    -------
+    str
+        The keys, comma-separated.
+    """
+    return ", ".join(f"spacecraft.{actuator.name}" + next((f".{key}" for key in ("max_torque", "max_dipole")
+                                                           if hasattr(actuator, key)), "") for actuator in actuators)
+
+
 def _vector(name: str, value: ArrayLike, size: int) -> Array:
     """``value`` as a finite float vector of ``size`` entries, or a ``ValueError`` naming ``name``."""
     try:

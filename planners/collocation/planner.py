@@ -82,7 +82,7 @@ from planners.collocation.strategy import (
     merged,
     seed_record,
 )
-from planners.problem import Array, ManeuverProblem
+from planners.problem import Array, ManeuverProblem, bound_keys
 from planners.reference import FailedReference, Reference
 from planners.registry import PLANNERS
 
@@ -322,8 +322,7 @@ class CollocationPlanner(Planner):
             unbounded = [actuator for actuator in problem.spacecraft.actuators
                          if not all(np.all(np.isfinite(bound)) for bound in actuator.control_bounds())]
             if unbounded:
-                names = ", ".join(f"spacecraft.{a.name}" + next((f".{key}" for key in ("max_torque", "max_dipole")
-                                                                 if hasattr(a, key)), "") for a in unbounded)
+                names = bound_keys(unbounded)
                 what = f"objective {o.objective}" + (" without energy_weight" if o.objective == "weighted" else "")
                 return (f"{what} needs a bound on every actuator's control ({names}): without an energy term the "
                         f"optimal torque is unbounded, impulses (min_time: a slew in no time; min_l1: the torque "
