@@ -49,6 +49,7 @@ _CELLS = 12  # cube-map cells per face side
 _SAMPLES = 7  # directions sampled per cell side to list its candidate triangles
 _INSIDE = -1e-9
 _UNUSED = 1e-9  # a barycentric weight at most this fraction of their sum: the vertex is not used
+_ANGLE_SLACK = 1e-12  # rad: an angle this far past the table's largest is that angle (quaternion rounding)
 _OK, _INFEASIBLE, _UNKNOWN = 0, 1, 2  # entry codes: ok, proven infeasible, anything else not ok
 
 
@@ -395,7 +396,7 @@ class SlewTimeFit:
         if angle <= theta[0]:
             r0, r1, r2 = self._rows[i][0][0], self._rows[j][0][0], self._rows[k][0][0]
         elif angle >= theta[last]:
-            if angle > self._top:  # no extrapolation past the table's largest angle
+            if angle > self._top + _ANGLE_SLACK:  # no extrapolation past the table's largest angle
                 return math.nan
             r0, r1, r2 = self._rows[i][last][0], self._rows[j][last][0], self._rows[k][last][0]
         else:
@@ -442,7 +443,14 @@ class SlewTimeFit:
         else:
             n = bisect.bisect_right(theta, angle) - 1
             t = (angle - theta[n]) / (theta[n + 1] - theta[n])
-            nodes = [n] if t == 0.0 else [n, n + 1]
+            # a table angle recovered from quaternions lands a few ulps off it: a node whose Hermite
+            # weight is rounding is not used (its entry may be a gap while the angle's own is not)
+            if t <= _UNUSED:
+                nodes, t = [n], 0.0
+            elif t >= 1.0 - _UNUSED:
+                nodes, t = [n + 1], 0.0
+            else:
+                nodes = [n, n + 1]
         used = [(v, w) for v, w in zip(vertices, (w0, w1, w2)) if w > _UNUSED]
         codes = [self._codes[v][n] for v, _ in used for n in nodes]
         if any(codes):
@@ -576,11 +584,11 @@ class SlewTimeFit:
         inner = np.where((theta >= nodes[-1])[:, None], g[..., -1], inner)
         with np.errstate(invalid="ignore"):
             blended = np.sum(weights * inner, axis=1)
-        gaps = np.nonzero(np.isnan(blended) & (theta <= self._top) & (theta > 0.0))[0]
+        gaps = np.nonzero(np.isnan(blended) & (theta <= self._top + _ANGLE_SLACK) & (theta > 0.0))[0]
         for row in gaps.tolist():  # an entry that is not ok in the cell: as the scalar call
             w = weights[row].tolist()
             blended[row] = self._gap(tuple(vertices[row].tolist()), w[0], w[1], w[2], float(theta[row]))
-        blended[theta > self._top] = np.nan  # no extrapolation past the table's largest angle
+        blended[theta > self._top + _ANGLE_SLACK] = np.nan  # no extrapolation past the table's largest angle
         with np.errstate(invalid="ignore"):
             return np.where(theta > 0.0, blended * np.sqrt(np.maximum(theta, 0.0) * self.shape(e)), 0.0)
 
