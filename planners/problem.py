@@ -97,11 +97,11 @@ class ManeuverProblem:
 
     def unreachable(self) -> str | None:
         """Why no motion reaches the target, by conservation of angular momentum alone: with wheels
-        as the only actuators, no external torque (no torquers, magnetorquers, gravity gradient or
-        disturbance) and zero total momentum ``I ω0 + A h_w0``, the body's rate is
-        ``ω = −I⁻¹ A h_w``: with one working wheel axis ``a`` it turns about the fixed body axis
-        ``I⁻¹ a`` only, with none it stays at rest. (Two or more working wheel axes reach every
-        attitude; a non-zero momentum drifts: not decided here.)
+        as the only actuators, no external torque (no other actuator kind, gravity gradient or
+        disturbance), zero total momentum ``I ω0 + A h_w0`` and none in the failed wheels, the
+        body's rate is ``ω = −I⁻¹ a h``: with one working wheel axis ``a`` it turns about the fixed
+        body axis ``I⁻¹ a`` only, with none it stays at rest. (Two or more working wheel axes reach
+        every attitude; a drift, or momentum kept in a failed wheel, is not decided here.)
 
         Returns
         -------
@@ -110,16 +110,18 @@ class ManeuverProblem:
         """
         sc = self.spacecraft
         environment = self.environment
-        if self.qf is None or sc.torquers is not None or sc.magnetorquers is not None or (
+        if self.qf is None or any(actuator.block != "wheels" for actuator in sc.actuators) or (
                 environment is not None and (environment.gravity_gradient or np.any(environment.disturbance_torque))):
-            return None
+            return None  # another actuator kind (any registered one) or an external torque: not decided here
         failed = set(sc.wheels.failed) if sc.wheels is not None else set()
         working = sc.wheel_axes[:, [i for i in range(sc.n_wheels) if i not in failed]]
         if working.shape[1] and np.linalg.matrix_rank(working, tol=1e-9) >= 2:
             return None
+        scale = 1e-12 * max(1.0, float(np.max(np.abs(sc.inertia))))
+        held = sc.wheel_axes[:, sorted(failed)] @ self.initial_state[7:][sorted(failed)]  # momentum failed wheels keep
         momentum = sc.inertia @ self.omega0 + sc.wheel_axes @ self.initial_state[7:]  # I ω0 + A h_w0
-        if float(np.linalg.norm(momentum)) > 1e-12 * max(1.0, float(np.max(np.abs(sc.inertia)))):
-            return None
+        if float(np.linalg.norm(momentum)) > scale or float(np.linalg.norm(held)) > scale:
+            return None  # a drift (or a failed wheel's momentum, which turns the body too): not decided here
         from ocp import quat
 
         turn = quat.to_rotation_vector(quat.error(self.qf, self.q0))  # body axes, q0 to qf

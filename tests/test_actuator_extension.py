@@ -150,3 +150,18 @@ def test_a_kind_cannot_take_a_registered_name_or_block(thrusters):
 
     with pytest.raises(ValueError, match="taken by Magnetorquers"):
         actuator_kind(Impostor)
+
+
+def test_a_spacecraft_with_only_the_new_kind_is_planned_not_refused(thrusters):
+    """The momentum-conservation check (ManeuverProblem.unreachable) knows wheels only: any other
+    kind decides nothing there (it read torquers and magnetorquers by name, and refused every slew
+    of a thruster-only spacecraft as 'no working actuator'). The couple 2 f (arm × direction) =
+    0.2 N m about x, I_x = 2: bang-bang 2 sqrt(θ I_x / u) = 6.3246 s for 1 rad."""
+    from planners import PLANNERS, ManeuverProblem
+
+    problem = ManeuverProblem(_spacecraft(with_wheels=False), quat.IDENTITY, np.zeros(3),
+                              quat.from_axis_angle([1.0, 0.0, 0.0], 1.0), 20.0, omegaf=np.zeros(3))
+    assert problem.unreachable() is None
+    reference = PLANNERS["collocation"]({"objective": "min_time"}).plan(problem)
+    assert reference.ok, reference.message
+    assert reference.duration == pytest.approx(2.0 * np.sqrt(1.0 * 2.0 / 0.2), rel=1e-6)

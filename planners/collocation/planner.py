@@ -315,7 +315,7 @@ class CollocationPlanner(Planner):
             rest-to-rest slew in no time; a transcription that cannot impose the pointing or rate
             requirements), or ``None``.
         """
-        error = super().problem_error(problem) or problem.unreachable()
+        error = super().problem_error(problem)
         o = self.options
         energy = o.objective == "min_energy" or (o.objective == "weighted" and o.energy_weight > 0)
         if error is None and not energy:  # time or an L1 term alone: the optimum rides the control bounds
@@ -607,6 +607,9 @@ class CollocationPlanner(Planner):
         return o.solver
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
+        unreachable = problem.unreachable()  # proven by momentum conservation: no solve can reach it
+        if unreachable:
+            return FailedReference(self.name, unreachable, "infeasible")
         try:
             ocp = self._ocp(problem)
         except ValueError as error:
