@@ -368,10 +368,11 @@ def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str
     return "\n".join(lines) + "\n"
 
 
-def _default_row(labels: list[str], broken: dict[str, list[str]], tracks: bool) -> tuple[str | None, str]:
+def _default_row(labels: list[str], broken: dict[str, list[str]], tracks: bool,
+                 scored: bool = True) -> tuple[str | None, str]:
     """The row ``SLEWBENCH_PARAMS_DEFAULT`` tracks, and why: the first exported row that meets the
     requirements; the first exported row when none does; none (regulation) when the law reads no
-    reference or no row is exported."""
+    reference or no row is exported; ``scored``: the scenario has requirements to meet."""
     if not tracks:
         return None, "regulation to the target (the law reads no reference)"
     if not labels:
@@ -381,7 +382,8 @@ def _default_row(labels: list[str], broken: dict[str, list[str]], tracks: bool) 
         return labels[0], (f"track row {labels[0]!r}, the first exported row; WARNING: every exported row breaks "
                            "the scenario's requirements")
     if ok[0] == labels[0]:
-        return ok[0], f"track row {ok[0]!r}, the first exported row (it meets the scenario's requirements)"
+        return ok[0], (f"track row {ok[0]!r}, the first exported row "
+                       + ("(it meets the scenario's requirements)" if scored else "(requirements: null: none to meet)"))
     before = ", ".join(repr(label) for label in labels[:labels.index(ok[0])])
     return ok[0], (f"track row {ok[0]!r}, the first exported row that meets the scenario's requirements "
                    f"({before} break{'s' if labels.index(ok[0]) == 1 else ''} them)")
@@ -506,7 +508,8 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
             interface["references"][planner_spec.label] = {"function": name, "duration_s": reference.duration,
                                                            "output": "row [q, omega, omega_dot, torque] (13)"}
     tracks = bool(getattr(laws[0], "tracks_reference", False) or getattr(laws[0], "needs_reference", False))
-    report.default, report.default_reason = _default_row(list(tables), report.violations, tracks)
+    report.default, report.default_reason = _default_row(list(tables), report.violations, tracks,
+                                                               bool(scenario.requirements))
     default_reference = None if report.default is None else tables[report.default][0]
     target = reference_rows(None, [0.0], (problem.qf, problem.omegaf))[0]
     slices, nu = control_layout(spacecraft)

@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from controllers.allocation import (
+    MAX_SUBSTEPS,
     Allocation,
     demand_limits,
     reference_demand,
@@ -270,7 +271,9 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
             first = int(np.argmax(unknown))
             values[name] = None
             values[f"{name}_time_s"] = float(t[first])
-            unscored.append(f"{name} is not finite (nan or inf) from {t[first]:.1f} s: the demand cannot be scored")
+            unscored.append(f"{name} is not finite (nan or inf) from {t[first]:.1f} s: the demand cannot be scored "
+                            f"(a reference rate that is not finite, or past the {MAX_SUBSTEPS:,} integration sub-steps "
+                            f"the demand may take)")
             continue
         peaks = np.max(ratios, axis=1) if ratios.size else np.zeros(len(t))
         worst = int(np.argmax(peaks)) if peaks.size else 0
