@@ -479,7 +479,7 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     key = (type(law).__module__, type(law).__qualname__, law.gyroscopic_compensation, law.wheels_only, _CHUNK)
     if n == 0 or n_states == 0:
         states = np.zeros((n, n_states))
-    elif _conserving(law, blocks):
+    elif _conserving(law, blocks, model):
         states = _momentum_by_conservation(law, spacecraft, q, omega, start + kicks[0])
     else:
         after = inputs.copy()
@@ -523,12 +523,16 @@ MAX_SUBSTEPS = 5_000_000
 states of the samples after them are nan (not computed), never an under-resolved number."""
 
 
-def _conserving(law: Allocation, blocks: Sequence[Any]) -> bool:
-    """Whether the actuators' states are the wheel momenta alone and the working wheels span three
-    axes (they take every torque: the total angular momentum is conserved)."""
-    stateful = [block.actuator.block for block in blocks if block.actuator.state_size]
-    return (stateful == ["wheels"] and law._working_axes is not None
-            and int(np.linalg.matrix_rank(law._working_axes)) == 3)
+def _conserving(law: Allocation, blocks: Sequence[Any], model: AttitudeModel) -> bool:
+    """Whether the total angular momentum is conserved along the reference: the wheels are the only
+    actuators (a torquer's or magnetorquer's share of the torque is external), their working axes
+    span three (they take every torque) and the environment adds no torque (gravity gradient, a
+    constant disturbance)."""
+    environment = model.environment
+    external = environment is not None and (environment.gravity_gradient
+                                            or bool(np.any(environment.disturbance_torque)))
+    return (not external and [block.actuator.block for block in blocks] == ["wheels"]
+            and law._working_axes is not None and int(np.linalg.matrix_rank(law._working_axes)) == 3)
 
 
 def _momentum_by_conservation(law: Allocation, spacecraft: Spacecraft, q: Array, omega: Array, start: Array) -> Array:

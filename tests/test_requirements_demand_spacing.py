@@ -218,3 +218,21 @@ def test_a_rotation_past_the_substep_budget_is_no_number_on_two_wheels(monkeypat
     assert np.all(np.isnan(h[~resolved]))
     score = _actuators(1.0, demand, t)
     assert not score.met and "wheels_momentum is not finite (nan or inf) from 105.0 s" in score.detail
+
+
+def test_an_external_torque_is_taken_by_the_wheels_not_conserved_away():
+    """Held at rest against a constant disturbance τ_d, the reference asks the actuators for −τ_d:
+    three body-axis wheels store h(t) = τ_d t (A ḣ = τ_d). The total momentum is not conserved, so
+    the closed form (which would say 0) must not be used there."""
+    from ocp import Environment
+
+    disturbance = np.array([1e-3, -2e-3, 5e-4])
+    spacecraft = Spacecraft([10.0, 8.0, 6.0], wheels=ReactionWheels.from_body_axes(max_torque=0.05, max_momentum=2.0))
+    model = AttitudeModel(spacecraft, Environment(disturbance_torque=disturbance))
+    law = CONTROLLERS["augmented_quaternion_feedback"]()
+    law.reset(spacecraft, 1.0)
+    t = np.linspace(0.0, 100.0, 11)
+    q = np.tile(quat.IDENTITY, (t.size, 1))
+    demand = reference_demand(law, model, t, q, np.zeros((t.size, 3)), np.tile(-disturbance, (t.size, 1)),
+                              np.zeros(3))
+    np.testing.assert_allclose(demand["wheels_momentum"].values, np.outer(t, disturbance), rtol=1e-9, atol=1e-12)
