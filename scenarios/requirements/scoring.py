@@ -350,16 +350,32 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         for _, index, jump in jumps:
             if index < t.size:
                 steps[index] += jump
+        # The actuators' share: the reference's torque u (of I ω̇ = −ω × I ω + u, the environment
+        # it models inside) less the environment's torque along it (a planner that models none, such
+        # as eigenaxis, leaves the actuators a disturbance to cancel; one that does, its own model).
+        environment = _environment_torque(problem, t, sample.q, sample.omega)
+        torque = np.asarray(sample.torque, dtype=float) - environment
         # the sample at T holds the torque's value there; the reference coasts torque-free after it
-        after = np.where((t >= reference.duration)[:, None], 0.0, sample.torque) if reference is not None else None
-        demand = reference_demand(allocation, problem.model, t, sample.q, sample.omega, sample.torque,
+        after = (np.where((t >= reference.duration)[:, None], 0.0, sample.torque) - environment
+                 if reference is not None else None)
+        demand = reference_demand(allocation, problem.model, t, sample.q, sample.omega, torque,
                                   problem.wheel_momentum0, jumps=steps, torque_after=after)
-        unrealised = unrealised_torque(problem.model, t, sample.q, sample.omega, sample.torque, demand)
-        scores["actuators"] = _actuators(requirements.actuators.allowed, demand, t, jumps, unrealised,
-                                         np.asarray(sample.torque, dtype=float))
+        unrealised = unrealised_torque(problem.model, t, sample.q, sample.omega, torque, demand)
+        scores["actuators"] = _actuators(requirements.actuators.allowed, demand, t, jumps, unrealised, torque)
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, sample.omega)
     return scores
+
+
+def _environment_torque(problem: ManeuverProblem, t: Array, q: Array, omega: Array) -> Array:
+    """The environment's torque [N m], body axes, along a sampled motion (gravity gradient and the
+    constant disturbance of ``problem.model``; zeros without them)."""
+    environment = problem.environment
+    if environment is None or not (environment.gravity_gradient or np.any(environment.disturbance_torque)):
+        return np.zeros((t.size, 3))
+    model = problem.model
+    x = np.hstack([q, omega, np.zeros((t.size, model.nx - 7))])
+    return np.asarray(model.environment_torque.map(t.size)(x.T, t, model.default_parameters).full()).T
 
 
 def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: ArrayLike, q: ArrayLike,
