@@ -399,7 +399,7 @@ class EigenaxisPlanner(Planner):
             if max_rate is not None and peak > max_rate * (1 + 1e-12):
                 # |θ̇| of a rest-to-rest quintic peaks at 15 Θ / (8 T), mid-slew
                 at_rest = float(axis @ problem.omega0) == 0.0 and rate_end == 0.0
-                longer = f"; T >= {15 * angle / (8 * max_rate):.4g} s keeps it within" if at_rest else ""
+                longer = f"; T >= {15 * angle / (8 * max_rate):.8g} s keeps it within" if at_rest else ""
                 return FailedReference(self.name, f"the quintic over T = {problem.duration:g} s peaks at {peak:.4g} "
                                        f"rad/s, above the rate bound {max_rate:g} rad/s ({self._rate_source(problem)}){longer}",
                                        "infeasible")

@@ -45,6 +45,10 @@ from planners.torque_free import (
     symmetry_axis,
 )
 
+STOP_RESOLUTION = 1e-9
+"""The shortest ``stop_time`` as a fraction of T: below it ``T − stop_time`` is T to rounding (1e-15 s
+stops in a 120 s slew vanished and the row was ok while the reference ended turning)."""
+
 
 class NaturalMotionReference(Reference):
     """Torque-free arc on ``[0, arc]`` from ``q0`` with ``ω(0) = omega0``, then the stop.
@@ -190,12 +194,15 @@ class NaturalMotionPlanner(Planner):
         -------
         str or None
             The reason (no target attitude, a non-zero final rate: it ends at rest, or a
-            ``stop_time`` that leaves no arc), or ``None``.
+            ``stop_time`` that leaves no arc, or one too short for T to resolve), or ``None``.
         """
         if problem.omegaf is not None and np.any(problem.omegaf != 0):
             return "natural_motion ends at rest: maneuver.final.omega must be zero or null"
         if problem.duration <= self.options.stop_time:
             return f"stop_time {self.options.stop_time} s leaves no arc in T = {problem.duration} s"
+        if self.options.stop_time < STOP_RESOLUTION * problem.duration:  # T − stop_time rounds to T
+            return (f"stop_time {self.options.stop_time:g} s is below {STOP_RESOLUTION:g} of T = {problem.duration:g} s: "
+                    f"the stop would vanish in rounding and the reference end at T still turning")
         return super().problem_error(problem)
 
     def _plan(self, problem: ManeuverProblem) -> Reference:

@@ -132,11 +132,14 @@ class ManeuverProblem:
         axis /= np.linalg.norm(axis)
         off = float(np.linalg.norm(np.cross(turn, axis)))
         final = self.omegaf if self.omegaf is not None else np.zeros(3)
-        if off <= 1e-6 * max(1.0, float(np.linalg.norm(turn))) and np.linalg.norm(np.cross(final, axis)) <= 1e-12:
+        along = off <= 1e-6 * max(1.0, float(np.linalg.norm(turn)))
+        if along and np.linalg.norm(np.cross(final, axis)) <= 1e-12:
             return None
+        what = (f"the slew is {np.rad2deg(np.linalg.norm(turn)):.4g} deg about "
+                f"{np.round(turn / np.linalg.norm(turn), 4).tolist()}" if not along else
+                f"the final rate {np.round(final, 6).tolist()} rad/s is not about it (maneuver.final.omega)")
         return (f"one working wheel axis {np.round(working[:, 0], 4).tolist()} and zero total momentum: the body "
-                f"can only turn about the body axis I⁻¹a = {np.round(axis, 4).tolist()}, and the slew is "
-                f"{np.rad2deg(np.linalg.norm(turn)):.4g} deg about {np.round(turn / np.linalg.norm(turn), 4).tolist()}")
+                f"can only turn about the body axis I⁻¹a = {np.round(axis, 4).tolist()}, and {what}")
 
     def rate_bound(self, option: float | None) -> float | None:
         """The rate bound a planner imposes: its own ``max_rate`` option tightens the problem's

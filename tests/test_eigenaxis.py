@@ -98,7 +98,7 @@ def test_the_quintic_honours_the_rate_bound_or_is_infeasible():
         else:
             assert reference.status == "infeasible"
             assert f"peaks at {peak:.4g} rad/s" in reference.message and "(the problem's: maneuver.max_rate, else requirements.rate.max)" in reference.message
-            assert f"T >= {15 * angle / (8 * bound):.4g} s keeps it within" in reference.message
+            assert f"T >= {15 * angle / (8 * bound):.8g} s keeps it within" in reference.message
     option = PLANNERS["eigenaxis"]({"profile": "smooth", "max_rate": peak / 2}).plan(problem)
     assert option.status == "infeasible" and "(option max_rate)" in option.message
 

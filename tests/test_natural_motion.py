@@ -141,3 +141,11 @@ def test_a_short_stop_ends_at_rest_and_is_scored(stop):
         assert jumps == []
         mid = reference.torque(np.array([110.0 - 0.5e-6]))[0]
         assert np.linalg.norm(mid) > 0.99 * np.linalg.norm(UKUBE1 * 1.5 * arc_end / 1e-6)
+
+
+@pytest.mark.parametrize("stop_time", [1e-15, 1e-300])
+def test_a_stop_too_short_for_T_to_resolve_is_refused(stop_time):
+    """110 s − 1e-15 s is 110 s in doubles: the stop vanished and the row was ok while the reference
+    ended turning (as with stop_time 0, refused by the option's range)."""
+    reference = PLANNERS["natural_motion"]({"stop_time": stop_time}).plan(paper_problem())
+    assert reference.status == "failed" and "below 1e-09 of T = 110 s" in reference.message

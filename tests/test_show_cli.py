@@ -315,3 +315,14 @@ def test_validate_says_when_the_end_points_already_break_a_requirement(tmp_path,
     broken = [line for line in capsys.readouterr().out.splitlines()
               if "every planner's row fails before planning" in line]
     assert len(broken) == 1 and "cam" in broken[0] and "initial attitude already breaks it" in broken[0]
+
+
+def test_validate_says_when_a_boundary_rate_breaks_the_rate_requirement(tmp_path, capsys):
+    data = yaml.safe_load(DEMO.read_text())
+    data["maneuver"]["initial"]["omega"] = [0.03, 0.04, 0.0]  # 0.05 rad/s
+    data["requirements"] = {"rate": {"max": 0.01}}
+    path = tmp_path / "spinning.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["validate", str(path)]) == 0
+    assert ("  every row breaks the rate requirement: maneuver.initial.omega has ‖ω‖ = 0.05 rad/s, above 0.01 rad/s"
+            in capsys.readouterr().out.splitlines())

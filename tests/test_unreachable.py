@@ -82,3 +82,13 @@ def test_what_it_does_not_decide(change):
     problem = ManeuverProblem(spacecraft, quat.IDENTITY, omega0, quat.from_axis_angle(WHEEL, 1.0), 60.0,
                               wheel_momentum0=h0)
     assert problem.unreachable() is None
+
+
+def test_a_final_rate_off_the_axis_is_named():
+    """About the reachable axis, but ending with a rate off it: the reason is the final rate."""
+    spacecraft = one_wheel(np.diag([2.0, 2.0, 2.0]))
+    problem = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.from_axis_angle(WHEEL, 1.0), 30.0,
+                              omegaf=np.array([0.0, 1e-3, 0.0]))
+    reason = problem.unreachable()
+    assert reason is not None and reason.endswith("the final rate [0.0, 0.001, 0.0] rad/s is not about it "
+                                                  "(maneuver.final.omega)")

@@ -383,7 +383,7 @@ def _default_row(labels: list[str], broken: dict[str, list[str]], tracks: bool,
                            "the scenario's requirements")
     if ok[0] == labels[0]:
         return ok[0], (f"track row {ok[0]!r}, the first exported row "
-                       + ("(it meets the scenario's requirements)" if scored else "(requirements: null: none to meet)"))
+                       + ("(it meets the scenario's requirements)" if scored else "(the scenario states no requirement to meet)"))
     before = ", ".join(repr(label) for label in labels[:labels.index(ok[0])])
     return ok[0], (f"track row {ok[0]!r}, the first exported row that meets the scenario's requirements "
                    f"({before} break{'s' if labels.index(ok[0]) == 1 else ''} them)")
