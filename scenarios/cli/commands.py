@@ -2,7 +2,7 @@
 
 Exit status (:mod:`scenarios.cli.status`): 0 when the run completed (a failed planner or a
 violated requirement is a row, not an error), 1 under ``run --strict`` when some row is not ``ok``
-(the results are written all the same), 2 for a bad scenario file or an output location slewbench
+(the results are written all the same) or under ``table --strict`` when some entry is not, 2 for a bad scenario file or an output location slewbench
 must not or cannot write to, 1 for an internal error.
 """
 from __future__ import annotations
@@ -378,7 +378,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="slewbench", description="Spacecraft attitude manoeuvre planning workbench",
         epilog=f"exit status: {EXIT_OK} done (failed and violated rows are results); {EXIT_NOT_OK} a row not ok "
-               f"under run --strict; {EXIT_BAD_SCENARIO} bad scenario or study file, or output location; "
+               f"under run --strict (an entry under table --strict); {EXIT_BAD_SCENARIO} bad scenario or study file, "
+               "or output location; "
                f"{EXIT_INTERNAL} internal error or interrupted run; {EXIT_INTERRUPTED} interrupted sweep")
     parser.add_argument("--version", action="version", version=f"slewbench {package_version()}")
     commands = parser.add_subparsers(dest="command", required=True)
@@ -476,7 +477,8 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     -------
     int
         Exit status: 0 done, 2 bad scenario file or output location (the message names its path),
-        1 internal error or interrupted, or a row not ok under ``run --strict``.
+        1 internal error or interrupted, or a row not ok under ``run --strict`` (an entry under
+        ``table --strict``).
     """
     parser = build_parser()
     args = parser.parse_args(attached_values(sys.argv[1:] if argv is None else list(argv), parser))

@@ -12,13 +12,15 @@ __all__ = ["EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_INTERNAL", "EXIT_INTERR
            "attached_values", "directory_argument"]
 
 EXIT_OK = 0
-"""The command completed (a run's failed and violated rows included: they are results), unless
-``run --strict`` found a row that is not ok."""
+"""The command completed (a run's failed and violated rows, a table's entries that are not ok
+included: they are results), unless ``run --strict`` found a row, or ``table --strict`` an entry,
+that is not ok."""
 EXIT_INTERNAL = 1
 """An internal error (a bug), or a run interrupted by Ctrl-C or SIGTERM."""
 EXIT_NOT_OK = 1
 """``slewbench run --strict``: the run completed and wrote its results, and some row is not ``ok``
-(``violated`` or ``failed``): for users' continuous integration."""
+(``violated`` or ``failed``); ``slewbench table --strict``: the table's files are written, and some
+entry of the table or of its held-out grid is not ``ok``: for users' continuous integration."""
 EXIT_BAD_SCENARIO = 2
 """A bad scenario or study file (or key of ``slewbench schema``): nothing was written."""
 EXIT_BAD_OUTPUT = 2

@@ -16,7 +16,13 @@ import time
 from pathlib import Path
 from typing import Any
 
-from scenarios.cli.status import directory_argument
+from scenarios.cli.status import (
+    EXIT_BAD_SCENARIO,
+    EXIT_INTERRUPTED,
+    EXIT_NOT_OK,
+    EXIT_OK,
+    directory_argument,
+)
 
 
 def _terminate(signum: int, frame: Any) -> None:
@@ -44,12 +50,14 @@ def command_table(args: argparse.Namespace) -> int:
     args : argparse.Namespace
         The parsed ``table`` arguments (``file``, ``axes``, ``angles``, ``objective``,
         ``duration``, ``held_out``, ``tolerance``, ``check_angles``, ``max_axes``, ``max_rounds``,
-        ``out``, ``workers``, ``scheduler``, ``no_plots``).
+        ``out``, ``workers``, ``scheduler``, ``no_plots``, ``strict``).
 
     Returns
     -------
     int
-        0 when every entry is stored (entries that failed included), 130 when interrupted.
+        0 when every entry is stored (entries that are not ok included: they are results); 1 with
+        ``strict`` when an entry of the table or of its held-out grid is not ``ok`` (the files are
+        written first); 130 when interrupted.
 
     Raises
     ------
@@ -58,26 +66,20 @@ def command_table(args: argparse.Namespace) -> int:
     OutputError
         An output directory slewbench must not write to (exit 2; nothing written).
     """
-    from scenarios.cli.status import EXIT_INTERRUPTED, EXIT_OK
-    from scenarios.errors import ScenarioError, SweepInterrupted
+    from scenarios.errors import SweepInterrupted
     from scenarios.output.directory import new_staging
     from scenarios.output.names import default_output_directory
+    from scenarios.schema.table import TABLE_FLAGS
     from scenarios.slewtable.compute import compute_table
     from scenarios.slewtable.files import write_table_files
     from scenarios.slewtable.spec import parse_table_spec
     from scenarios.study.engine import connect_scheduler, start_forkserver
     from scenarios.study.store import claim_sweep_directory, commit_sweep_outputs
 
-    if isinstance(args.axes, str):
-        raise ScenarioError("--axes", f"expected a number of axes, got {args.axes!r}")
-    if args.workers is not None and not 1 <= args.workers <= 1024:
-        raise ScenarioError("--workers", f"expected 1 to 1024, got {args.workers}")
     if not args.scheduler:
         start_forkserver()
-    overrides = {"axes": args.axes, "grid": args.grid, "angles": args.angles, "objective": args.objective,
-                 "duration": args.duration, "held-out": args.held_out, "workers": args.workers,
-                 "scheduler": args.scheduler, "tolerance": args.tolerance, "check-angles": args.check_angles,
-                 "max-axes": args.max_axes, "max-rounds": args.max_rounds}
+    # every flag of the table's keys (the key's reader checks its value, naming the flag)
+    overrides = {flag[2:]: getattr(args, flag[2:].replace("-", "_")) for flag in TABLE_FLAGS.values()}
     spec = parse_table_spec(args.file, overrides)
     if not args.no_plots:
         import matplotlib  # noqa: F401  (fail now, not after the entries ran)
@@ -140,7 +142,29 @@ def command_table(args: argparse.Namespace) -> int:
         if table.fit_note:
             print(f"fit note: {table.fit_note}")
         print(f"use it: from scenarios.slewtable import load_fit; slew_time = load_fit('{directory / 'fit.json'}')")
+    not_ok = _not_ok(table)
+    if args.strict and not_ok:
+        print(f"slewbench: --strict: {not_ok} not ok", file=sys.stderr)
+        return EXIT_NOT_OK
     return EXIT_OK
+
+
+def _not_ok(table: Any) -> str:
+    """The entries of the table and of its held-out grid whose status is not ``ok``, counted by
+    status (``3 of 14 table entries (2 failed, 1 infeasible)``); empty when every entry is ok. A
+    refinement's check points that were not split are not entries of the table."""
+    counts = []
+    for name, words in (("table", "table"), ("held_out", "held-out")):
+        part = table.parts.get(name)
+        if part is None or not part.ok.size:
+            continue
+        statuses = [status if good else ("missing" if status == "ok" else status)
+                    for row, flags in zip(part.status, part.ok.tolist()) for status, good in zip(row, flags)]
+        bad = [status for status in statuses if status != "ok"]
+        if bad:
+            kinds = ", ".join(f"{bad.count(kind)} {kind}" for kind in dict.fromkeys(bad))
+            counts.append(f"{len(bad)} of {len(statuses)} {words} entries ({kinds})")
+    return "; ".join(counts)
 
 
 def add_table_parser(commands: Any) -> None:
@@ -151,8 +175,14 @@ def add_table_parser(commands: Any) -> None:
     commands : Any
         The ``argparse`` sub-parsers object of ``slewbench`` (from ``add_subparsers``).
     """
-    parser = commands.add_parser("table", help="slew table: minimum slew time over eigen-axes and angles, "
-                                               "CSV, NetCDF and a fast fit slew_time(q0, qf)")
+    parser = commands.add_parser(
+        "table", help="slew table: minimum slew time over eigen-axes and angles, CSV, NetCDF and a fast fit "
+                      "slew_time(q0, qf)",
+        epilog=f"exit status: {EXIT_OK} done (entries that failed or are not ok are results, stored with their "
+               f"status); {EXIT_NOT_OK} under --strict, an entry of the table or its held-out grid not ok; "
+               f"{EXIT_BAD_SCENARIO} bad scenario or table file, option, or output location (nothing written); "
+               f"{EXIT_INTERRUPTED} interrupted (the finished entries are stored: run it again). The table file's "
+               "keys: slewbench schema table")
     parser.add_argument("file", help="scenario YAML file, or a table file (top-level key 'table')")
     parser.add_argument("--axes", type=_integer, help="number of eigen-axes (about; default 40)")
     parser.add_argument("--grid", help="how the axes are spread: polytope (default: along the actuators' kinks) "
@@ -174,4 +204,7 @@ def add_table_parser(commands: Any) -> None:
     parser.add_argument("--workers", type=int, help="entries at once (default: one per core)")
     parser.add_argument("--scheduler", help="Dask scheduler address (tcp://host:port) instead of local processes")
     parser.add_argument("--no-plots", action="store_true", help="skip agility_envelope.png")
+    parser.add_argument("--strict", action="store_true",
+                        help=f"exit {EXIT_NOT_OK} when any entry of the table or its held-out grid is not ok (failed, "
+                             "violated, infeasible, crashed), after writing the files (for continuous integration)")
     parser.set_defaults(handler=command_table)

@@ -1,4 +1,4 @@
-"""The scenario and study schema: reading YAML safely, values that name their path, the keys of every
+"""The scenario, study and slew-table schema: reading YAML safely, values that name their path, the keys of every
 section, the checks, and the schema reference generated from the keys.
 
 What lives here: bounded, duplicate-refusing YAML reading (:mod:`~scenarios.schema.read`), typed
@@ -11,8 +11,8 @@ angle, Euler angles, pointing targets, orbit frames; :mod:`~scenarios.schema.tar
 and controller labels name the rows (:mod:`~scenarios.schema.labels`), the names of the metric
 columns (:mod:`~scenarios.schema.columns`), the checks of a parsed scenario as a whole
 (:mod:`~scenarios.schema.checks`), the study file's keys, value generators and distributions
-(:mod:`~scenarios.schema.study`), and the reference of them all (:mod:`~scenarios.schema.reference`:
-``slewbench schema``).
+(:mod:`~scenarios.schema.study`), the slew-table file's keys (:mod:`~scenarios.schema.table`), and the
+reference of them all (:mod:`~scenarios.schema.reference`: ``slewbench schema``).
 
 May import: :mod:`ocp`, :mod:`planners`, :mod:`controllers`, :mod:`scenarios.errors` and
 :mod:`scenarios.requirements`; nothing else of :mod:`scenarios`. Its names are imported on first use.

@@ -1,8 +1,9 @@
-"""The scenario and study schema reference, generated from the keys the parsers read.
+"""The scenario, study and slew-table schema reference, generated from the keys the parsers read.
 
 Every entry comes from what validates it: the :class:`~scenarios.schema.keys.Key` declarations of
-the scenario sections (:mod:`scenarios.schema.loader`, :mod:`scenarios.schema.model`) and of the
-study file (:mod:`scenarios.schema.study`, with its value generators and distributions), the typed
+the scenario sections (:mod:`scenarios.schema.loader`, :mod:`scenarios.schema.model`), of the
+study file (:mod:`scenarios.schema.study`, with its value generators and distributions) and of the
+slew-table file (:mod:`scenarios.schema.table`, with the flags of ``slewbench table``), the typed
 ``Options`` dataclasses of the registered planners, controllers and magnetic field models. Each
 entry gives the YAML path as errors name it, the type, unit, default, range or choices and the
 meaning. :func:`schema_rst` renders the whole reference as a reStructuredText page,
@@ -17,11 +18,12 @@ Keys (for :func:`schema_text`): a scenario key is its YAML path without list ind
 reference prints their YAML path (``execution.workers``, ``grid.<path>.linspace``,
 ``monte_carlo.dispersions.<path>.normal``) or without ``study.`` (``grid.linspace``). A key selects
 the entries it names and every entry below it; ``planners.options.intervals`` (the YAML path)
-selects that option of every planner that has it. A slew-table file's keys (``table``) are read by
-:mod:`scenarios.slewtable` and are not part of this reference: :func:`schema_text` says so.
+selects that option of every planner that has it. A slew-table file's keys start with ``table.``
+(``table.refine.tolerance``); ``table`` selects them all.
 """
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import inspect
 import re
@@ -59,6 +61,7 @@ from scenarios.schema.study import (
     STUDY,
     VALUE_GENERATORS,
 )
+from scenarios.schema.table import TABLE, TABLE_FILE, TABLE_FLAGS
 
 __all__ = ["Entry", "Part", "options_text", "reference_parts", "schema_rst", "schema_text", "summary_line"]
 
@@ -317,6 +320,34 @@ def _study_parts() -> list[Part]:
     ]
 
 
+_TABLE_KEY = "table"
+"""The top-level key of a slew-table file (``slewbench schema table``)."""
+
+
+def _flagged(entry: Entry) -> Entry:
+    """A slew-table entry with the ``slewbench table`` flag that sets it (:data:`TABLE_FLAGS`)."""
+    flag = TABLE_FLAGS.get(entry.path.removeprefix(f"{_TABLE_KEY}."))
+    if flag is None:
+        return entry
+    return dataclasses.replace(entry, meaning=f"{entry.meaning} Flag: ``{flag}`` (wins over the file).")
+
+
+def _table_parts() -> list[Part]:
+    group = "Slew-table file"
+    top = TABLE_FILE[_TABLE_KEY]
+    root = Part(_TABLE_KEY, group, "``table``", TABLE_FILE.meaning + " Its keys:",
+                (_key_entry(top, _TABLE_KEY, _TABLE_KEY),) + tuple(
+                    _flagged(_key_entry(key, f"{_TABLE_KEY}.{key.name}", f"{_TABLE_KEY}.{key.name}"))
+                    for key in TABLE.keys))
+    parts = [root]
+    for key in TABLE.keys:
+        if key.section is not None:
+            path = f"{_TABLE_KEY}.{key.name}"
+            parts.append(Part(path, group, _literal(path), key.section.meaning,
+                              tuple(_flagged(entry) for entry in _walk(key.section, path, path))))
+    return parts
+
+
 def reference_parts() -> list[Part]:
     """Every part of the reference, built from the keys and registries as they are now.
 
@@ -324,23 +355,22 @@ def reference_parts() -> list[Part]:
     -------
     list of Part
         The scenario file's sections, every registered planner's, controller's and field
-        model's options, then the study file's sections.
+        model's options, the study file's sections, then the slew-table file's.
     """
-    return _scenario_parts() + _registry_parts() + _study_parts()
+    return _scenario_parts() + _registry_parts() + _study_parts() + _table_parts()
 
 
 # --- reStructuredText ------------------------------------------------------------------------------
 
 _INTRO = """\
-Every key a scenario or study file accepts, generated from the code that reads it: a key that is
-not listed here is an error, and every listed default is the one applied. A path such as
+Every key a scenario, study or slew-table file accepts, generated from the code that reads it: a
+key that is not listed here is an error, and every listed default is the one applied. A path such as
 ``planners[i].options.weight`` is how errors name the key; ``[i]`` stands for any list index and
 ``<path>`` for a scenario path of a study. Units are those written in the file (``_deg`` keys in
 degrees, ``_km`` in kilometres, ``_s`` in seconds); the loader converts them to SI. Unknown and
 duplicate keys are errors. ``slewbench schema KEY`` prints the entries below a key, for example
-``slewbench schema maneuver``, ``slewbench schema planners.collocation`` or
-``slewbench schema study.execution``. A slew-table file (top-level key ``table``) is read by
-``slewbench table``, not by this schema: its keys are in the slew-table guide."""
+``slewbench schema maneuver``, ``slewbench schema planners.collocation``,
+``slewbench schema study.execution`` or ``slewbench schema table.refine``."""
 
 _GROUPS = {
     "Scenario file": "The keys of a scenario file, by section.",
@@ -350,6 +380,7 @@ _GROUPS = {
     "Orbit kinds": "The kinds of ``orbit`` (``ORBITS``, by ``orbit.type``) and their keys.",
     "Magnetic field models": "The models of ``environment.magnetic_field`` (``MAGNETIC_FIELDS``) and their options.",
     "Study file": "The keys of a trade-study file (``slewbench sweep``).",
+    "Slew-table file": "The keys of a slew-table file (``slewbench table``), and the flags that set them.",
 }
 
 
@@ -392,11 +423,12 @@ def schema_rst() -> str:
     Returns
     -------
     str
-        A page titled "Scenario and study schema": one section per group (scenario file,
-        planner, controller and field model options, study file), one subsection with a table
+        A page titled "Scenario, study and slew-table schema": one section per group (scenario
+        file, planner, controller and field model options, study file, slew-table file), one
+        subsection with a table
         per part; each part has the label ``schema-<key>`` (``schema-planners-collocation``).
     """
-    lines = _heading("Scenario and study schema", "=") + [_INTRO, ""]
+    lines = _heading("Scenario, study and slew-table schema", "=") + [_INTRO, ""]
     group = None
     for part in reference_parts():
         if part.group != group:
@@ -465,10 +497,6 @@ def _entry_text(entry: Entry) -> list[str]:
         textwrap.wrap(_plain(_one_line(entry.meaning)), 96, initial_indent="    ", subsequent_indent="    ")
 
 
-_TABLE_KEY = "table"
-"""The top-level key of a slew-table file, whose keys this reference does not hold."""
-
-
 def schema_text(key: str | None = None) -> str:
     """The reference, or the part of it under ``key``, as plain text for a terminal.
 
@@ -476,7 +504,7 @@ def schema_text(key: str | None = None) -> str:
     ----------
     key : str or None, optional
         A key as the module docstring spells it (``maneuver``, ``simulation.sensor_noise.seed``,
-        ``planners.collocation``, ``study.execution``; list indices such as ``[0]`` are
+        ``planners.collocation``, ``study.execution``, ``table.refine``; list indices such as ``[0]`` are
         ignored); ``None`` (default): everything.
 
     Returns
@@ -488,8 +516,7 @@ def schema_text(key: str | None = None) -> str:
     Raises
     ------
     ScenarioError
-        At ``key`` when it selects nothing; the message lists close matches, or, for ``table``
-        and the keys under it, says where a slew-table file's keys are described.
+        At ``key`` when it selects nothing; the message lists close matches.
     """
     parts = reference_parts()
     wanted = None if key is None else _normal(key)
@@ -503,12 +530,9 @@ def schema_text(key: str | None = None) -> str:
         lines += [title, "=" * len(title)] + textwrap.wrap(_plain(_one_line(part.intro)), 100) + [""]
         for entry in entries:
             lines += _entry_text(entry) + [""]
-    if not lines and (wanted == _TABLE_KEY or (wanted or "").startswith(_TABLE_KEY + ".")):
-        raise ScenarioError("", f"{excerpt(key)}: a slew-table file's keys are read by `slewbench table`, not by the "
-                                "scenario and study schema; the slew-table guide describes them (docs/guide/slew_table.rst)")
     if not lines:
         matches = _close_matches(wanted or "", parts)
-        raise ScenarioError("", f"{excerpt(key)} is not a key of the scenario or study schema"  # quoted, bounded
+        raise ScenarioError("", f"{excerpt(key)} is not a key of the scenario, study or slew-table schema"  # quoted, bounded
                             + (f"; close matches: {', '.join(matches)}" if matches else ""))
     return "\n".join(lines).rstrip() + "\n"
 

@@ -34,6 +34,8 @@ from typing import Any
 
 import numpy as np
 
+from scenarios.schema.table import TABLE_REFINE
+
 __all__ = ["RefineOptions", "RefineResult", "Solver", "TriangleMesh", "refine"]
 
 Solver = Callable[[np.ndarray, list[int]], np.ndarray]
@@ -214,15 +216,16 @@ class RefineOptions:
         Indices of the table's angles a midpoint is checked at first; None: every angle.
     max_axes : int
         The refined table's axes at most (a round that would pass it splits only its worst
-        triangles, then the refinement stops).
+        triangles, then the refinement stops); default ``table.refine.max_axes``'s
+        (:data:`scenarios.schema.table.TABLE_REFINE`).
     max_rounds : int
-        Rounds at most.
+        Rounds at most; default ``table.refine.max_rounds``'s.
     """
 
     tolerance: float
     check_angles: list[int] | None = None
-    max_axes: int = 2000
-    max_rounds: int = 8
+    max_axes: int = TABLE_REFINE["max_axes"].default
+    max_rounds: int = TABLE_REFINE["max_rounds"].default
 
 
 @dataclass

@@ -5,17 +5,15 @@ small table file (its top-level key ``table``)::
 
     table:
       scenario: cubesat_12u_sun_keep_out.yaml   # relative to this file
-      axes: 40                  # about 40 axes, or a list of [x, y, z] (body frame)
-      grid: polytope            # how a number of axes is spread: polytope (default) or fibonacci
-      angles_deg: [10, 30, 60, 90, 120, 150, 180]   # or a count: that many from 10 to 180
-      objective: min_time       # or min_energy (then duration is required)
-      duration: null            # [s], min_energy only
-      held_out: 12              # axes of the held-out lattice (0: none), at the mid angles
-      planner_options: {}       # more collocation options (intervals, ...)
-      execution: {workers: null, scheduler: null, case_timeout_s: 600}
-      refine: {tolerance: 0.01, check_angles_deg: all, max_axes: 2000, max_rounds: 8}   # optional
+      axes: 40
+      angles_deg: [10, 30, 60, 90, 120, 150, 180]
+      held_out: 12
+      refine: {tolerance: 0.01}
 
-``refine`` (or ``--tolerance``) refines the axes where the fit misses
+Its keys, with their types, units, defaults and ranges, and the flags that set them, are declared
+once in :mod:`scenarios.schema.table` and read through those declarations here; the schema
+reference lists the same (``slewbench schema table``). This module adds the checks across keys and
+builds the grid. ``refine`` (or ``--tolerance``) refines the axes where the fit misses
 (:mod:`scenarios.slewtable.refine`).
 
 Every case is the scenario's spacecraft, actuators (failed wheels included), environment and
@@ -28,7 +26,7 @@ from __future__ import annotations
 
 import copy
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +34,14 @@ import numpy as np
 
 from ocp.simulation.simulator import MAX_SUBSTEPS
 from scenarios.errors import ScenarioError
+from scenarios.schema.node import Node
+from scenarios.schema.table import (
+    MAX_REFINE,
+    TABLE_FILE,
+    TABLE_FLAGS,
+    TableValue,
+    read_table,
+)
 from scenarios.slewtable.fit import zonotope_facets
 from scenarios.slewtable.grid import (
     fibonacci_axes,
@@ -45,25 +51,7 @@ from scenarios.slewtable.grid import (
 )
 from scenarios.slewtable.refine import RefineOptions
 
-__all__ = ["DEFAULT_ANGLES", "DEFAULT_AXES", "GRIDS", "OBJECTIVES", "REFINE_KEYS", "TABLE_KEYS", "TableCase", "TableSpec", "angles_from_text",
-           "case_scenario", "check_angles", "check_axes", "parse_table_spec", "table_cases", "torque_generators"]
-
-OBJECTIVES = ("min_time", "min_energy")
-"""The objectives a table computes."""
-TABLE_KEYS = ("scenario", "axes", "grid", "angles_deg", "objective", "duration", "held_out", "planner_options", "execution",
-              "refine")
-"""The keys of a table file's ``table`` mapping."""
-REFINE_KEYS = ("tolerance", "check_angles_deg", "max_axes", "max_rounds")
-"""The keys of ``table.refine`` (:class:`scenarios.slewtable.refine.RefineOptions`)."""
-_REFINE_FLAGS = {"tolerance": "tolerance", "check_angles_deg": "check-angles", "max_axes": "max-axes",
-                 "max_rounds": "max-rounds"}
-DEFAULT_AXES = 40
-GRIDS = ("polytope", "fibonacci")
-"""How a number of axes is spread: along the kinks of the slew time (the torque polytope's faces,
-:func:`scenarios.slewtable.grid.polytope_grid`; needs bounded torques on three independent axes),
-or a Fibonacci lattice (:func:`scenarios.slewtable.grid.fibonacci_axes`)."""
-DEFAULT_ANGLES = (10.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0)
-_EXECUTION_KEYS = ("workers", "scheduler", "case_timeout_s")
+__all__ = ["TableCase", "TableSpec", "case_scenario", "parse_table_spec", "table_cases", "torque_generators"]
 
 
 @dataclass
@@ -109,17 +97,17 @@ class TableSpec:
     base: dict[str, Any]
     axes: np.ndarray
     angles_deg: list[float]
-    objective: str = "min_time"
-    duration: float | None = None
-    held_out: int = 0
-    planner_options: dict[str, Any] = field(default_factory=dict)
-    workers: int | None = None
-    scheduler: str | None = None
-    case_timeout_s: float = 600.0
-    source: Path | None = None
-    grid: str = "fibonacci"
-    triangles: np.ndarray | None = None
-    refine: RefineOptions | None = None
+    objective: str
+    duration: float | None
+    held_out: int
+    planner_options: dict[str, Any]
+    workers: int | None
+    scheduler: str | None
+    case_timeout_s: float
+    source: Path | None
+    grid: str
+    triangles: np.ndarray | None
+    refine: RefineOptions | None
 
     @property
     def held_out_axes(self) -> np.ndarray:
@@ -130,118 +118,6 @@ class TableSpec:
     def held_out_angles_deg(self) -> list[float]:
         """The held-out angles [deg]: midpoints of :attr:`angles_deg`."""
         return held_out_angles(self.angles_deg) if self.held_out else []
-
-
-def _number(value: Any, where: str, what: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ScenarioError(where, f"expected {what}, got {value!r}")
-    return float(value)
-
-
-def angles_from_text(text: str, where: str = "--angles") -> list[float]:
-    """Read ``--angles``: a comma-separated list [deg], or a count (that many from 10 to 180 deg).
-
-    Parameters
-    ----------
-    text : str
-        ``"10,45,90,180"`` or ``"8"``.
-    where : str, optional
-        The option's name, for messages.
-
-    Returns
-    -------
-    list of float
-        The angles [deg], checked (:func:`check_angles`).
-
-    Raises
-    ------
-    ScenarioError
-        Not numbers, or angles out of range.
-    """
-    parts = [p.strip() for p in str(text).split(",") if p.strip()]
-    try:
-        values = [float(p) for p in parts]
-    except ValueError:
-        raise ScenarioError(where, f"expected a count or a comma-separated list of angles in degrees, got {text!r}") from None
-    if len(parts) == 1 and parts[0].isdigit():
-        count = int(parts[0])
-        if count < 2:
-            raise ScenarioError(where, f"expected a count of at least 2 angles, got {count}")
-        return check_angles(list(np.linspace(10.0, 180.0, count)), where)
-    return check_angles(values, where)
-
-
-def check_angles(values: Any, where: str) -> list[float]:
-    """Angles [deg]: at least 2 distinct values in (0, 180], returned sorted.
-
-    Parameters
-    ----------
-    values : Any
-        A list of numbers.
-    where : str
-        The option or YAML path, for messages.
-
-    Returns
-    -------
-    list of float
-        Sorted angles [deg].
-
-    Raises
-    ------
-    ScenarioError
-        Anything else.
-    """
-    if not isinstance(values, (list, tuple)) or len(values) < 2:
-        raise ScenarioError(where, f"expected at least 2 angles in degrees, got {values!r}")
-    angles = sorted(_number(v, where, "angles in degrees") for v in values)
-    if angles[0] <= 0.0 or angles[-1] > 180.0:
-        raise ScenarioError(where, f"angles must be in (0, 180] degrees, got {values!r}")
-    if len(set(angles)) != len(angles):
-        raise ScenarioError(where, f"angles must be distinct, got {values!r}")
-    return angles
-
-
-def check_axes(value: Any, where: str) -> np.ndarray:
-    """Eigen-axes: a count (a Fibonacci lattice, 1 to 10000) or a list of body vectors.
-
-    Parameters
-    ----------
-    value : Any
-        An int or a list of 3-number lists.
-    where : str
-        The option or YAML path, for messages.
-
-    Returns
-    -------
-    numpy.ndarray, shape (n, 3)
-        Unit axes, body frame.
-
-    Raises
-    ------
-    ScenarioError
-        Anything else (a zero vector or a direction given twice included).
-    """
-    if isinstance(value, int) and not isinstance(value, bool):
-        if not 1 <= value <= 10000:
-            raise ScenarioError(where, f"expected a number of axes from 1 to 10000, got {value}")
-        return fibonacci_axes(value)
-    if not isinstance(value, (list, tuple)) or not value:
-        raise ScenarioError(where, f"expected a number of axes or a list of [x, y, z] axes, got {value!r}")
-    axes: list[np.ndarray] = []
-    for i, item in enumerate(value):
-        if not isinstance(item, (list, tuple)) or len(item) != 3:
-            raise ScenarioError(f"{where}[{i}]", f"expected 3 numbers (a body axis), got {item!r}")
-        vector = np.array([_number(v, f"{where}[{i}]", "3 numbers (a body axis)") for v in item])
-        size = float(np.linalg.norm(vector))
-        if size == 0.0:
-            raise ScenarioError(f"{where}[{i}]", "a zero vector has no direction")
-        unit = vector / size
-        for j, other in enumerate(axes):
-            if np.linalg.norm(unit - other) <= 1e-9:
-                raise ScenarioError(f"{where}[{i}]", f"repeats the direction of {where}[{j}] ({value[j]!r}): "
-                                                     "each axis once")
-        axes.append(unit)
-    return np.array(axes)
 
 
 def torque_generators(scenario: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
@@ -302,11 +178,12 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
     Parameters
     ----------
     file : str or Path
-        A scenario YAML file, or a table file (top-level key ``table``; module docstring).
+        A scenario YAML file, or a table file (top-level key ``table``; its keys are
+        :data:`scenarios.schema.table.TABLE`).
     overrides : dict, optional
-        Command-line flag without its dashes (``axes``, ``angles`` (text), ``objective``,
-        ``duration``, ``held-out``, ``workers``, ``scheduler``) -> value (None: not given); they
-        win over the table file's.
+        Command-line flag without its dashes (``axes``, ``angles`` (text), ``held-out``, ...: the
+        flags of :data:`scenarios.schema.table.TABLE_FLAGS`) -> value (None: not given); they win
+        over the table file's.
 
     Returns
     -------
@@ -317,120 +194,63 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
     ------
     ScenarioError
         A bad file or option, named by its YAML path or option (exit 2 on the command line).
+    ValueError
+        An override that is not a flag of ``TABLE_FLAGS``.
     """
     from scenarios.schema.read import read_yaml
+    flags = {f"--{name}": value for name, value in (overrides or {}).items()}
+    unknown = sorted(set(flags) - set(TABLE_FLAGS.values()))
+    if unknown:
+        raise ValueError(f"unknown table override(s) {', '.join(unknown)}; expected flags of TABLE_FLAGS without dashes: "
+                         f"{', '.join(flag[2:] for flag in TABLE_FLAGS.values())}")
     path = Path(file)
     data = read_yaml(path)
-    given: dict[str, Any] = {}
     if isinstance(data, dict) and "table" in data:
-        extra = sorted(set(data) - {"table"})
-        if extra:
-            raise ScenarioError(extra[0], "unknown key in a table file (expected only 'table')")
-        table = data["table"]
-        if not isinstance(table, dict):
-            raise ScenarioError("table", f"expected a mapping with keys {', '.join(TABLE_KEYS)}, got {table!r}")
-        for key in table:
-            if key not in TABLE_KEYS:
-                raise ScenarioError(f"table.{key}", f"unknown key; expected one of {', '.join(TABLE_KEYS)}")
-        if not isinstance(table.get("scenario"), str):
-            raise ScenarioError("table.scenario", f"expected the scenario file's path, got {table.get('scenario')!r}")
-        source = path.parent / table["scenario"]
-        base = _scenario(source, "table.scenario")
-        given = {f"table.{k}": v for k, v in table.items() if k != "scenario"}
+        root = Node(data)
+        table = TABLE_FILE["table"].node(root).mapping()
+        root.finish()  # a table file holds only ``table``
+        values = read_table(table, flags)
+        source = path.parent / values["scenario"].value
+        base = _scenario(source, values["scenario"].where)
     else:
+        values = read_table(Node({}, "table"), flags, skip=("scenario",))
         source = path
         base = _scenario(path, str(path))
-    overrides = overrides or {}
-    for flag, value in overrides.items():
-        if value is not None:
-            given[f"--{flag}"] = value
 
-    def pick(key: str, flag: str) -> tuple[str, Any] | None:
-        for where in (f"--{flag}", f"table.{key}"):
-            if where in given:
-                return where, given[where]
-        return None
+    def value(name: str) -> Any:
+        return values[name].value
 
-    count: int | None = DEFAULT_AXES
-    axes = None
-    if (found := pick("axes", "axes")) is not None:
-        axes = check_axes(found[1], found[0])
-        count = len(axes) if isinstance(found[1], int) and not isinstance(found[1], bool) else None
-    grid = "polytope"
-    if (found := pick("grid", "grid")) is not None:
-        if found[1] not in GRIDS:
-            raise ScenarioError(found[0], f"expected one of {', '.join(GRIDS)}, got {found[1]!r}")
-        grid = found[1]
-    triangles = None
-    if count is None:
-        grid = "list"
-    elif grid == "polytope":
+    axes, grid, triangles = _grid(values["axes"], value("grid"), base)
+    angles = value("angles_deg")
+    objective = value("objective")
+    duration = values["duration"]
+    if duration.value is not None and objective != "min_energy":
+        raise ScenarioError(duration.where, "a duration is for objective min_energy (min_time finds it)")
+    if objective == "min_energy" and duration.value is None:
+        raise ScenarioError("--duration", "objective min_energy needs the slew duration (--duration T or table.duration)")
+    held_out = value("held_out")
+    if held_out:
+        _check_held_out(values["held_out"].where, axes, objective)
+    refine = _refine_options(values, angles, objective, len(axes))
+    spec = TableSpec(str(base.get("name") or source.stem), base, axes, angles, objective, duration.value, held_out,
+                     value("planner_options"), value("execution.workers"), value("execution.scheduler"),
+                     value("execution.case_timeout_s"), source, grid, triangles, refine)
+    table_cases(spec)  # the collocation options and the case scenario are checked now
+    return spec
+
+
+def _grid(axes: TableValue, grid: str, base: dict[str, Any]) -> tuple[np.ndarray, str, np.ndarray | None]:
+    """The table's axes, how they were made (``grid``, or ``list`` for axes given one by one) and,
+    for a polytope grid, its triangles."""
+    if not isinstance(axes.value, int):
+        return axes.value, "list", None
+    if grid == "polytope":
         inertia, generators = torque_generators(base)
         facets = zonotope_facets(generators) if len(generators) else np.zeros((0, 3))
         if len(facets):
-            axes, triangles = polytope_grid(facets @ inertia, count)
-        else:
-            grid = "fibonacci"
-    if grid == "fibonacci":
-        axes = fibonacci_axes(count or DEFAULT_AXES)
-    angles = list(DEFAULT_ANGLES)
-    if (found := pick("angles_deg", "angles")) is not None:
-        where, value = found
-        angles = angles_from_text(value, where) if isinstance(value, str) else check_angles(value, where)
-    objective = "min_time"
-    if (found := pick("objective", "objective")) is not None:
-        if found[1] not in OBJECTIVES:
-            raise ScenarioError(found[0], f"expected one of {', '.join(OBJECTIVES)}, got {found[1]!r}")
-        objective = found[1]
-    duration = None
-    if (found := pick("duration", "duration")) is not None and found[1] is not None:
-        duration = _number(found[1], found[0], "a duration in seconds")
-        if duration <= 0.0:
-            raise ScenarioError(found[0], f"expected a positive duration in seconds, got {found[1]!r}")
-        if objective != "min_energy":
-            raise ScenarioError(found[0], "a duration is for objective min_energy (min_time finds it)")
-    if objective == "min_energy" and duration is None:
-        raise ScenarioError("--duration", "objective min_energy needs the slew duration (--duration T or table.duration)")
-    held_out = 0
-    if (found := pick("held_out", "held-out")) is not None:
-        value = found[1]
-        if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 10000:
-            raise ScenarioError(found[0], f"expected a number of held-out axes from 0 to 10000, got {value!r}")
-        held_out = value
-        if held_out:
-            _check_held_out(found[0], axes, objective)
-    options: dict[str, Any] = {}
-    if (found := pick("planner_options", "planner-options")) is not None:
-        if not isinstance(found[1], dict):
-            raise ScenarioError(found[0], f"expected a mapping of collocation options, got {found[1]!r}")
-        if "objective" in found[1]:
-            raise ScenarioError(f"{found[0]}.objective", "give the objective as table.objective")
-        options = dict(found[1])
-    execution: dict[str, Any] = {}
-    if (found := pick("execution", "execution")) is not None:
-        if not isinstance(found[1], dict):
-            raise ScenarioError(found[0], f"expected a mapping with keys {', '.join(_EXECUTION_KEYS)}")
-        for key in found[1]:
-            if key not in _EXECUTION_KEYS:
-                raise ScenarioError(f"{found[0]}.{key}", f"unknown key; expected one of {', '.join(_EXECUTION_KEYS)}")
-        execution = {f"table.execution.{k}": v for k, v in found[1].items()}
-    workers = overrides.get("workers")
-    if workers is None and execution.get("table.execution.workers") is not None:
-        workers = execution["table.execution.workers"]
-        if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 1024:
-            raise ScenarioError("table.execution.workers", f"expected 1 to 1024, got {workers!r}")
-    scheduler = overrides.get("scheduler") or execution.get("table.execution.scheduler")
-    timeout = 600.0
-    if execution.get("table.execution.case_timeout_s") is not None:
-        timeout = _number(execution["table.execution.case_timeout_s"], "table.execution.case_timeout_s", "seconds")
-        if timeout <= 0:
-            raise ScenarioError("table.execution.case_timeout_s", f"expected a positive time, got {timeout!r}")
-    assert axes is not None
-    refine = _refine_options(given, angles, objective, len(axes))
-    spec = TableSpec(str(base.get("name") or source.stem), base, axes, angles, objective, duration, held_out,
-                     options, workers, scheduler, timeout, source, grid, triangles, refine)
-    table_cases(spec)  # the collocation options and the case scenario are checked now
-    return spec
+            vertices, triangles = polytope_grid(facets @ inertia, axes.value)
+            return vertices, grid, triangles
+    return fibonacci_axes(axes.value), "fibonacci", None
 
 
 def _check_held_out(where: str, axes: np.ndarray | None, objective: str) -> None:
@@ -449,56 +269,32 @@ def _check_held_out(where: str, axes: np.ndarray | None, objective: str) -> None
                                    f"({error}): use 0") from None
 
 
-def _refine_options(given: dict[str, Any], angles: list[float], objective: str, axes: int) -> RefineOptions | None:
-    """``table.refine`` and its flags (flags win) -> the refinement's options, None when no tolerance."""
-    section = given.get("table.refine")
-    if section is not None and not isinstance(section, dict):
-        raise ScenarioError("table.refine", f"expected a mapping with keys {', '.join(REFINE_KEYS)}, got {section!r}")
-    values: dict[str, tuple[str, Any]] = {}
-    for key, value in (section or {}).items():
-        if key not in REFINE_KEYS:
-            raise ScenarioError(f"table.refine.{key}", f"unknown key; expected one of {', '.join(REFINE_KEYS)}")
-        values[key] = (f"table.refine.{key}", value)
-    for key, flag in _REFINE_FLAGS.items():
-        if given.get(f"--{flag}") is not None:
-            values[key] = (f"--{flag}", given[f"--{flag}"])
-    if "tolerance" not in values or values["tolerance"][1] is None:
-        others = [where for key, (where, value) in values.items() if key != "tolerance" and value is not None]
+def _refine_options(values: dict[str, TableValue], angles: list[float], objective: str,
+                    axes: int) -> RefineOptions | None:
+    """``table.refine`` and its flags (read) -> the refinement's options, None when no tolerance."""
+    tolerance = values["refine.tolerance"]
+    if tolerance.value is None:
+        others = [item.where for name, item in values.items()
+                  if name.startswith("refine.") and name != "refine.tolerance" and item.given]
         if others:
             raise ScenarioError(others[0], "refinement options need a tolerance (--tolerance or table.refine.tolerance)")
         return None
-    where, value = values["tolerance"]
-    tolerance = _number(value, where, "a tolerance (a fraction of the slew time, e.g. 0.01)")
-    if not 0.0 < tolerance < 1.0:
-        raise ScenarioError(where, f"expected a tolerance above 0 and below 1 (a fraction of the slew time), got {value!r}")
     if objective != "min_time":
-        raise ScenarioError(where, "refinement is of the fit, which is of min_time tables")
+        raise ScenarioError(tolerance.where, "refinement is of the fit, which is of min_time tables")
     check: list[int] | None = None
-    if (found := values.get("check_angles_deg")) is not None and found[1] not in (None, "all"):
-        where, value = found
-        if isinstance(value, str):
-            try:
-                value = [float(p) for p in value.split(",") if p.strip()]
-            except ValueError:
-                raise ScenarioError(where, f"expected 'all' or table angles in degrees, got {value!r}") from None
-        if not isinstance(value, (list, tuple)) or not value:
-            raise ScenarioError(where, f"expected 'all' or a list of the table's angles in degrees, got {value!r}")
+    chosen = values["refine.check_angles_deg"]
+    if chosen.value is not None:
         check = []
-        for v in value:
-            number = _number(v, where, "the table's angles in degrees")
+        for number in chosen.value:
             near = int(np.argmin([abs(number - a) for a in angles]))
             if abs(angles[near] - number) > 0.05:
-                raise ScenarioError(where, f"{v!r} is not one of the table's angles "
-                                           f"({', '.join(f'{a:.4g}' for a in angles)} deg)")
+                raise ScenarioError(chosen.where, f"{number:g} is not one of the table's angles "
+                                                  f"({', '.join(f'{a:.4g}' for a in angles)} deg)")
             check.append(near)
-    limits = {}
-    for key, low in (("max_axes", axes), ("max_rounds", 1)):
-        if (found := values.get(key)) is not None and found[1] is not None:
-            where, value = found
-            if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= 100000:
-                raise ScenarioError(where, f"expected a whole number from {low} to 100000, got {value!r}")
-            limits[key] = value
-    return RefineOptions(tolerance, check, **limits)
+    budget = values["refine.max_axes"]
+    if budget.given and budget.value < axes:
+        raise ScenarioError(budget.where, f"expected a whole number from {axes} to {MAX_REFINE}, got {budget.value!r}")
+    return RefineOptions(tolerance.value, check, budget.value, values["refine.max_rounds"].value)
 
 
 def case_scenario(spec: TableSpec, axis: np.ndarray, angle_deg: float) -> dict[str, Any]:
