@@ -377,9 +377,12 @@ def build_parser() -> argparse.ArgumentParser:
     """
     parser = argparse.ArgumentParser(
         prog="slewbench", description="Spacecraft attitude manoeuvre planning workbench",
-        epilog=f"exit status: {EXIT_OK} done (failed and violated rows are results); {EXIT_NOT_OK} a row not ok "
-               f"under run --strict; {EXIT_BAD_SCENARIO} bad scenario or study file, or output location; "
-               f"{EXIT_INTERNAL} internal error or interrupted run; {EXIT_INTERRUPTED} interrupted sweep")
+        epilog=f"exit status: {EXIT_OK} done (failed and violated rows are results); {EXIT_BAD_SCENARIO} bad "
+               f"scenario or study file, or output location (nothing written); {EXIT_INTERNAL} internal error "
+               f"(a traceback on stderr) or run interrupted (Ctrl-C, SIGTERM); {EXIT_INTERRUPTED} interrupted "
+               f"sweep or table (run it again to finish). Only run --strict also exits {EXIT_NOT_OK}, for a "
+               f"completed run with a row not ok (results written; stderr says 'slewbench: --strict: N of M rows "
+               f"not ok'): there, {EXIT_NOT_OK} does not tell a bug from a row not ok; stderr does")
     parser.add_argument("--version", action="version", version=f"slewbench {package_version()}")
     commands = parser.add_subparsers(dest="command", required=True)
     run_parser = commands.add_parser("run", help="plan, simulate and score every planner of a scenario")
