@@ -40,17 +40,21 @@ class MetricInfo(NamedTuple):
 
 METRIC_INFO: dict[str, MetricInfo] = {
     "int_u2": MetricInfo(
-        "N² m² s", "∫ ‖u‖₂² dt over the window: the control effort."),
+        "N² m² s", "∫ ‖u‖₂² dt over the window: the control effort; +inf for a reference whose body rate "
+        "jumps (an impulse, whose square has no finite integral: shown as missing in the tables)."),
     "int_u": MetricInfo(
-        "N m s", "∫ ‖u‖₂ dt, the integrated torque (Euclidean norm, not the sum of the axes)."),
+        "N m s", "∫ ‖u‖₂ dt, the integrated torque (Euclidean norm, not the sum of the axes); a reference's "
+        "rate jumps Δω add their angular impulses ‖I Δω‖ (the torque of a jump is I Δω δ(t − t_j))."),
     "int_abs_u": MetricInfo(
         "N m s", "[∫ |u_x| dt, ∫ |u_y| dt, ∫ |u_z| dt], one integral per body axis (a list of three; "
-        "the CSV tables split it into ``_x``, ``_y``, ``_z`` columns)."),
+        "the CSV tables split it into ``_x``, ``_y``, ``_z`` columns); a reference's rate jumps add "
+        "|(I Δω)_i| (as ``int_u``)."),
     "peak_body_torque": MetricInfo(
         "N m", "max over the samples and the body axes of |u_i|, u the control torque on the rigid body of "
         "I ω̇ = −ω × I ω + u: a reference's feed-forward torque (I ω̇ + ω × I ω); in closed loop the applied "
         "actuator torque less the wheels' gyroscopic torque, τ_act − ω × A h_w at each sample (the u the "
-        "allocation realised, so that reference and closed loop compare); 0 without any torque sample."),
+        "allocation realised, so that reference and closed loop compare); 0 without any torque sample; +inf "
+        "for a reference whose body rate jumps (an impulse; shown as missing in the tables)."),
     "peak_actuator_torque": MetricInfo(
         "N m", "Closed loop: max over the samples and the body axes of |τ_act,i|, τ_act the actuators' "
         "applied torque on the body (wheels −A g, magnetorquers m × B, torquers); null for a reference "
@@ -117,7 +121,16 @@ METRIC_INFO: dict[str, MetricInfo] = {
 ``int_u2``, ``int_u`` and ``int_abs_u`` is the torque given to :func:`compute_metrics` (body axes): a
 reference's feed-forward torque, or in closed loop the applied actuator torque held over each
 sample; the peaks name what they measure. t_0 … t_N are the sample times of the scored window. A
-metric that does not apply is null (``None``)."""
+metric that does not apply is null (``None``). A reference whose body rate jumps (natural motion's
+step stop, a start away from the manoeuvre's initial rate it does not declare free) asks an
+impulse ``I Δω δ(t − t_j)`` at each jump, which no sampling sees: :func:`compute_metrics` adds it
+(``impulses``), so ``int_u2`` and ``peak_body_torque`` are +inf (:data:`IMPULSE_INFINITE`) and
+``int_u``, ``int_abs_u`` include ``‖I Δω‖``, ``|(I Δω)_i|``."""
+IMPULSE_INFINITE: tuple[str, ...] = ("int_u2", "peak_body_torque")
+"""The metrics that are +inf for a motion with an impulse (:func:`compute_metrics`'s ``impulses``):
+∫ ‖u‖² dt and the peak of a Dirac torque. :func:`metric_violations` takes +inf there as physical when
+``int_u`` is finite and both are +inf (an impulse's; a torque sample that is not finite makes ``int_u``
+so too)."""
 DEFAULT_SETTLING_TOLERANCE_DEG = 0.5
 """deg, error band about the target attitude for ``settling_time_s``."""
 DEFAULT_DETUMBLE_TOLERANCE = 0.01
@@ -220,11 +233,14 @@ def compute_metrics(
     actuator_torque: ArrayLike | None = None,
     wheel_torque: ArrayLike | None = None,
     known_q: ArrayLike | None = None,
+    impulses: ArrayLike | None = None,
 ) -> dict[str, Any]:
     """Metrics of a motion sampled at times ``t`` (definitions: :data:`METRIC_INFO`).
 
     Integrals of a quantity given once per interval (N values) use the zero-order hold
-    ``Σ_k (t_k+1 − t_k) f_k``; given at the N+1 sample times, trapezoids.
+    ``Σ_k (t_k+1 − t_k) f_k``; given at the N+1 sample times, trapezoids. ``impulses`` (a
+    reference's rate jumps) add Dirac torques no sample sees: ``int_u2`` and ``peak_body_torque``
+    become +inf, ``int_u`` and ``int_abs_u`` gain ``Σ_j ‖p_j‖`` and ``Σ_j |p_j,i|``.
 
     Parameters
     ----------
@@ -279,6 +295,9 @@ def compute_metrics(
     known_q : (N, 4) array_like or None, optional
         The attitude the controller was given at ``t_0 … t_(N−1)`` (scalar first, body to
         inertial), for ``final_knowledge_error_deg`` and ``max_knowledge_error_deg``; ``None``: null.
+    impulses : (K, 3) array_like or None, optional
+        Angular impulses ``p_j = I Δω_j`` [N m s], body axes, of Dirac torques ``p_j δ(t − t_j)``
+        (a reference's rate jumps); a zero impulse is none; ``None`` (default) or empty: none.
 
     Returns
     -------
@@ -337,6 +356,14 @@ def compute_metrics(
         metrics["max_error_deg"] = float(np.max(tracking))
     if wheel_momentum is not None and np.size(wheel_momentum):
         metrics["peak_wheel_momentum"] = float(np.max(np.abs(wheel_momentum)))
+    if impulses is not None and np.size(impulses):
+        kicks = np.asarray(impulses, dtype=float).reshape(-1, 3)
+        kicks = kicks[np.linalg.norm(kicks, axis=1) > 0.0]
+        if kicks.size:  # a Dirac torque: its square has no finite integral, its peak no bound
+            metrics["int_u"] += float(np.sum(np.linalg.norm(kicks, axis=1)))
+            metrics["int_abs_u"] = [value + float(extra) for value, extra in
+                                    zip(metrics["int_abs_u"], np.sum(np.abs(kicks), axis=0))]
+            metrics.update(dict.fromkeys(IMPULSE_INFINITE, float("inf")))
     return metrics
 
 
@@ -425,9 +452,12 @@ def metrics_from_reference(
     inertia: ArrayLike | None = None,
     detumble_tolerance: float = DEFAULT_DETUMBLE_TOLERANCE,
     sample: Any = None,
+    rate_jumps: ArrayLike | None = None,
 ) -> dict[str, Any]:
     """Metrics of a reference's own motion and feed-forward torque over ``[0, duration]``,
-    sampled on ``points`` uniform times (trapezoidal integrals), by :func:`compute_metrics`.
+    sampled on ``points`` uniform times (trapezoidal integrals), by :func:`compute_metrics`; the
+    jumps of its body rate (``rate_jumps``) are impulses ``I Δω`` no sample sees
+    (``int_u2`` and ``peak_body_torque`` +inf, ``int_u`` and ``int_abs_u`` include them).
 
     Parameters
     ----------
@@ -453,6 +483,10 @@ def metrics_from_reference(
     sample : planners.reference.ReferenceSample or None, optional
         The reference already sampled at those ``points`` uniform times (its ``q``, ``omega`` and
         ``torque`` rows), by a caller that needs them too; ``None`` (default): sampled here.
+    rate_jumps : (K, 3) array_like or None, optional
+        The jumps ``Δω = ω⁺ − ω⁻`` [rad/s], body axes, of the reference's body rate
+        (:func:`scenarios.requirements.scoring.rate_jumps` finds them, as the runner does);
+        needs ``inertia``. ``None`` (default): the reference's rate does not jump.
 
     Returns
     -------
@@ -463,18 +497,26 @@ def metrics_from_reference(
     t = np.linspace(0.0, reference.duration, points)
     if sample is None:
         sample = reference.sample(t)
+    impulses = None
+    if rate_jumps is not None and np.size(rate_jumps):
+        if inertia is None:
+            raise ValueError("metrics_from_reference: rate_jumps needs the inertia (an impulse is I Δω)")
+        impulses = np.asarray(rate_jumps, dtype=float).reshape(-1, 3) @ np.asarray(inertia, dtype=float).T
     return compute_metrics(
         t, sample.q, sample.omega, sample.torque, target_q, target_omega,
         plan_time_s=reference.plan_time_s, duration_s=reference.duration,
         settling_tolerance_deg=settling_tolerance_deg, initial_omega=initial_omega,
         fine_settling_tolerance_deg=fine_settling_tolerance_deg, inertia=inertia, detumble_tolerance=detumble_tolerance,
+        impulses=impulses,
     )
 
 
 def metric_violations(metrics: dict[str, Any] | None) -> list[str]:
     """The metrics whose values physics forbids: every metric is a norm, an integral of a norm,
     an angle, a time or a fraction, so a value must be finite and non-negative (fractions at most
-    1, a manoeuvre's duration positive). A row with a violation is not "ok".
+    1, a manoeuvre's duration positive). A row with a violation is not "ok". The one exception is
+    an impulse's: +inf in every key of :data:`IMPULSE_INFINITE` beside a finite ``int_u``
+    (:func:`compute_metrics`).
 
     Parameters
     ----------
@@ -488,12 +530,18 @@ def metric_violations(metrics: dict[str, Any] | None) -> list[str]:
         ``"key = value"`` for each offending metric; empty when all are physical.
     """
     problems = []
+    given = metrics or {}
+    int_u = given.get("int_u")
+    impulsive = (isinstance(int_u, (int, float)) and bool(np.isfinite(int_u))
+                 and all(given.get(key) == float("inf") for key in IMPULSE_INFINITE))
     for key, value in (metrics or {}).items():
         values = value if isinstance(value, (list, tuple)) else [value]
         for item in values:
             if item is None:
                 continue
             number = float(item)
+            if impulsive and key in IMPULSE_INFINITE and number == float("inf"):
+                continue
             bad = (not np.isfinite(number) or number < 0.0
                    or (key.endswith("fraction") and number > 1.0) or (key == "duration_s" and number == 0.0))
             if bad:

@@ -42,6 +42,7 @@ from scenarios.requirements.scoring import (
     SCOPE_WORDS,
     Score,
     endpoint_violations,
+    rate_jumps,
     reference_times,
     score_closed_loop,
     score_reference,
@@ -302,11 +303,15 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
     times = (reference_times(reference.duration, closed_loop_window(scenario, reference), spec.sample_time, REFERENCE_POINTS)
              if scoring else np.linspace(0.0, reference.duration, REFERENCE_POINTS))
     sample = reference.sample(times)
+    uniform = ReferenceSample(*(values[:REFERENCE_POINTS] for values in sample))
+    # the rate's jumps are impulses no sample sees: the metrics add them (int_u2 and the peak torque +inf)
+    jumps = [jump for _, _, jump in rate_jumps(times[:REFERENCE_POINTS], uniform.omega, scenario.problem.omega0,
+                                                reference)]
     metrics = metrics_from_reference(
         reference, scenario.problem.qf, scenario.problem.omegaf, points=REFERENCE_POINTS,
         settling_tolerance_deg=spec.settling_tolerance_deg,
         fine_settling_tolerance_deg=spec.fine_settling_tolerance_deg,
         inertia=scenario.problem.spacecraft.inertia, detumble_tolerance=spec.detumble_tolerance,
         initial_omega=scenario.problem.omega0,
-        sample=ReferenceSample(*(values[:REFERENCE_POINTS] for values in sample)))
+        sample=uniform, rate_jumps=jumps or None)
     return reference, metrics, (times, sample) if scoring else None

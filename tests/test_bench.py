@@ -10,6 +10,7 @@ import math
 import shutil
 import time
 
+import casadi
 import numpy as np
 import pytest
 
@@ -178,7 +179,11 @@ def test_bench_writes_the_leaderboard_with_the_hand_worked_gap(tmp_path, capsys)
     assert len(data["rows"]) == len(rows) == 2
     text = (out / "leaderboard.md").read_text()
     assert "## bilimoria_wie_90" in text and "+0.0855" in text
-    assert "| eigenaxis | planner | 1 | 0 | 3.53e-02 |" in text  # the summary: one row, not at the optimum
+    assert "| eigenaxis | planner | 1 | 1 | 0 | 3.53e-02 |" in text  # the summary: one row with a gap, not at the optimum
+    assert text.index("| eigenaxis | planner |") < text.index("| fatrop | peer |")  # planners, then peers
+    assert "optimum 2.42112 ± 0.0002" in text  # the optimum with the digits of its tolerance
+    assert eigenaxis["plan_status"] == eigenaxis["status"] == "ok"
+    assert data["environment"]["peers"] == {"fatrop": f"FATROP plugin of CasADi {casadi.CasadiMeta.version()}"}
     assert (out / "gap_vs_time.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
@@ -201,8 +206,10 @@ def test_a_row_that_solves_another_problem_has_no_gap(tmp_path, capsys):
     assert impulse["value"] == "" and impulse["gap_abs"] == "" and impulse["message"].startswith("impulse")
     summary = (out / "leaderboard.md").read_text().split("## Summary")[1]
     costate = next(line for line in summary.splitlines() if line.startswith("| costate_tpbvp |"))
-    assert costate.split("|")[5].strip() != "-"  # its median gap: natural motion's energy, not B&W's 10 s
-    assert float(costate.split("|")[5]) < 1e-3
+    # 2 rows, 1 with a gap (natural motion's energy, not B&W's 10 s): its median |gap|
+    assert [cell.strip() for cell in costate.split("|")[3:5]] == ["2", "1"]
+    assert costate.split("|")[6].strip() != "-" and float(costate.split("|")[6]) < 1e-3
+    assert "median \\|gap\\| (rel)" in summary
 
 
 @pytest.mark.parametrize("argv, expected", [
@@ -397,3 +404,36 @@ def test_the_fatrop_peer_leaves_the_bilimoria_wie_saddle_from_the_bench_start():
     assert result.extra["start"] == result.message.split("; ")[0]
     opti, cost = build_opti(problem, *eigenaxis_guess(problem, "min_time"))
     assert float(opti.solve().value(cost)) == pytest.approx(2.0 * math.sqrt(math.pi), abs=1e-4)
+
+
+def test_the_plan_is_ranked_and_the_closed_loop_shown_beside_it(tmp_path, capsys):
+    """keep_out_melton_scaled: collocation's minimum-time plan keeps the cone (+0.0091 deg) within the
+    tolerance of the optimum; its tracking controller dips 0.0009 deg into the cone in closed loop.
+    The plan reaches the optimum; the run's status stays violated, with the closed loop's reason."""
+    out = tmp_path / "board"
+    assert main(["bench", "--problems", "keep_out_melton_scaled", "--planners", "collocation", "eigenaxis",
+                 "--no-plots", "--out", str(out)]) == 0
+    capsys.readouterr()
+    rows = {row["label"]: row for row in csv.DictReader((out / "leaderboard.csv").open())}
+    plan = rows["collocation"]
+    assert plan["plan_status"] == "ok" and plan["reached"] == "True"
+    assert abs(float(plan["gap_abs"])) <= 1e-3
+    assert plan["status"] == "violated" and "cone (closed loop)" in plan["message"]
+    assert "cone (reference)" not in plan["message"]
+    eigenaxis = rows["eigenaxis"]  # through the cone's centre: the plan itself breaks it
+    assert eigenaxis["plan_status"] == "violated" and eigenaxis["reached"] == "False"
+    text = (out / "leaderboard.md").read_text()
+    assert "| collocation | planner | ok | violated | 2.58994 |" in text
+    assert "| collocation | planner | 1 | 1 | 1 |" in text
+
+
+@pytest.mark.parametrize("value, tolerance, expected", [
+    (11.21, 1e-4, "11.2100"),          # down to the tolerance's digit, zeros kept
+    (2.5897, 1e-3, "2.5897"),          # never fewer digits than the value as stated
+    (5.8467e-8, 3e-12, "5.8467e-08"),
+    (136.64, 0.05, "136.64"),
+])
+def test_the_optimum_is_printed_with_the_digits_of_its_tolerance(value, tolerance, expected):
+    from scenarios.bench.leaderboard import _with_tolerance
+
+    assert _with_tolerance(value, tolerance) == expected

@@ -4,8 +4,10 @@ installed peers, then tabulated against the best known optimum.
 
 Per row: the objective value (the reference metric of the problem's objective, :data:`~scenarios.bench.suite.OBJECTIVE_METRICS`,
 the same measure for every planner), its gap to the optimum (absolute, in the objective's unit,
-and relative), whether it reaches the optimum within the problem's tolerance, the row's status,
-the plan time, the solver iterations (``reference.stats["iterations"]``) and the certificate
+and relative), whether the plan reaches the optimum within the problem's tolerance (judged on the
+plan: its reference planned and meeting every requirement the reference is scored against,
+``plan_status``), the row's status (the run's, its closed loop included), the plan time, the
+solver iterations (``reference.stats["iterations"]``) and the certificate
 (``reference.stats["certificate"]``'s ``summary`` or ``verdict``; ``-`` without one). A reference
 that leaves a boundary condition of the problem free (``Reference.free_boundary``) solves another
 problem: its value is shown, its gap is not; so does a minimum-time row that keeps the scenario's
@@ -57,7 +59,8 @@ class BenchRow:
     kind : str
         ``"planner"`` or ``"peer"``.
     status : str
-        The row's status (``ok``, ``violated``, ``failed``; a peer's ``ok`` or ``failed``).
+        The row's status as the run gives it, its closed loop included (``ok``, ``violated``,
+        ``failed``; a peer's ``ok`` or ``failed``).
     objective : float or None
         The objective value in the problem's unit; ``None`` without a reference.
     gap_abs : float or None
@@ -65,7 +68,7 @@ class BenchRow:
     gap_rel : float or None
         ``gap_abs / optimum``.
     reached : bool or None
-        ``|gap_abs| <= tolerance``.
+        ``|gap_abs| <= tolerance`` and ``plan_status`` ``ok``.
     plan_time_s : float or None
         Plan time [s]: the second of two plans (a peer's solves), the first paying the build and
         first-call costs.
@@ -75,6 +78,12 @@ class BenchRow:
         The certificate's summary or verdict, ``-`` without one.
     message : str
         The row's message, or why its gap is not shown.
+    plan_status : str
+        The plan's own status: the planner's when it gave no reference (``failed``, ``infeasible``),
+        ``failed`` when its reference metrics are not physical, ``violated`` when the reference
+        breaks a requirement (scored as the run scores it), else ``ok``; a peer's is its status. The closed loop does not enter it: the bench
+        ranks plans, and a tracking controller that dips into a keep-out cone the plan keeps
+        shows in ``status``.
     """
 
     problem: str
@@ -90,6 +99,11 @@ class BenchRow:
     iterations: int | None
     certificate: str
     message: str = ""
+    plan_status: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.plan_status:
+            self.plan_status = self.status
 
 
 def gap(value: float | None, optimum: float) -> tuple[float | None, float | None]:
@@ -144,10 +158,14 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any, specs: lis
     from scenarios.schema.labels import row_labels
 
     metric = OBJECTIVE_METRICS[problem.objective][0]
-    # each row's planner spec, in the runner's row order (``specs`` is what it ran)
-    planner_of = [i for _, i, _ in row_labels([spec.label for spec in specs], [c.label for c in scenario.controllers])]
+    # each row's planner spec and controller, in the runner's row order (``specs`` is what it ran)
+    labels = row_labels([spec.label for spec in specs], [c.label for c in scenario.controllers])
+    planner_of = [i for _, i, _ in labels]
+    plans: dict[int, str] = {}  # a reference tracked by several controllers is one plan
     rows = []
-    for row, i in zip(results.rows, planner_of):
+    for row, i, (_, _, j) in zip(results.rows, planner_of, labels):
+        if id(row.reference) not in plans:
+            plans[id(row.reference)] = _plan_status(scenario, row, scenario.controllers[j].controller)
         spec = specs[i] if i is not None else None
         timed = spec is not None and minimises_time(PLANNERS[spec.name], spec.options)
         reference = row.reference
@@ -171,9 +189,31 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any, specs: lis
             message = f"{other}; {message}"
         rows.append(BenchRow(
             problem.name, row.label, row.planner or "-", "planner", row.status, value, gap_abs, gap_rel,
-            _reached(row.status, gap_abs, problem), row.plan_time_s,
-            _number((stats or {}).get("iterations")), certificate_text(stats), message))
+            _reached(plans[id(row.reference)], gap_abs, problem), row.plan_time_s,
+            _number((stats or {}).get("iterations")), certificate_text(stats), message, plans[id(row.reference)]))
     return rows
+
+
+def _plan_status(scenario: Any, row: Any, controller: Any) -> str:
+    """A planner row's plan status (:class:`BenchRow`'s ``plan_status``): its reference scored against
+    the scenario's requirements as :func:`scenarios.runner.run` scores it (the same times, the row's
+    controller's allocation for the actuator demand), without the closed loop."""
+    from ocp import metric_violations
+    from scenarios.requirements.scoring import reference_times, score_reference
+    from scenarios.runner import closed_loop_window
+
+    reference = row.reference
+    if reference is None or not reference.ok:  # the planner's own status (failed, infeasible)
+        return str(getattr(reference, "status", None) or "failed")
+    if row.reference_metrics is None or metric_violations(row.reference_metrics):
+        return "failed"
+    if not scenario.requirements:
+        return "ok"
+    times = reference_times(reference.duration, closed_loop_window(scenario, reference),
+                            scenario.simulation.sample_time)
+    scores = score_reference(scenario.requirements, scenario.problem, times, reference.sample(times), controller,
+                             reference)
+    return "ok" if all(score.met for score in scores.values()) else "violated"
 
 
 def _other_problem(problem: BenchProblem, scenario: Any, reference: Any, row: Any, minimises_time: bool) -> str:
@@ -203,8 +243,9 @@ def _other_problem(problem: BenchProblem, scenario: Any, reference: Any, row: An
 
 
 def _reached(status: str, gap_abs: float | None, problem: BenchProblem) -> bool | None:
-    """Whether a row reaches the optimum: within the tolerance, and ``ok`` (a row that breaks a
-    requirement or failed never does, however close its value); ``None`` without a gap."""
+    """Whether a row reaches the optimum: within the tolerance, and its plan ``ok`` (``status`` is the
+    plan's status: a plan that breaks a requirement or failed never does, however close its value);
+    ``None`` without a gap."""
     if gap_abs is None:
         return None
     return status == "ok" and abs(gap_abs) <= problem.tolerance
@@ -242,6 +283,8 @@ class Leaderboard:
         Wall time of the whole run [s].
     date : str
         When it ran (UTC, ISO 8601).
+    peer_versions : dict of str to str
+        The version of each peer that ran (its tool's, as the peer's ``version()`` gives it).
     """
 
     suite: Suite
@@ -250,6 +293,7 @@ class Leaderboard:
     notes: list[str] = field(default_factory=list)
     wall_time_s: float = 0.0
     date: str = ""
+    peer_versions: dict[str, str] = field(default_factory=dict)
 
     def to_json(self) -> dict[str, Any]:
         """The leaderboard as JSON-ready data: suite version, provenance, problems, rows, notes.
@@ -257,10 +301,11 @@ class Leaderboard:
         Returns
         -------
         dict
-            ``suite_version``, ``slewbench``, ``date``, ``environment`` (versions and platform),
-            ``wall_time_s``, ``problems`` (metadata), ``rows``, ``notes``.
+            ``suite_version``, ``slewbench``, ``date``, ``environment`` (versions and platform, with
+            ``peers``: the version of each peer that ran), ``wall_time_s``, ``problems`` (metadata),
+            ``rows``, ``notes``.
         """
-        env = environment()
+        env = {**environment(), "peers": dict(self.peer_versions)}
         return {"suite_version": self.suite.version, "slewbench": env["slewbench"], "date": self.date,
                 "platform": env["platform"], "environment": env, "wall_time_s": self.wall_time_s,
                 "problems": [problem.metadata() for problem in self.problems],
@@ -278,12 +323,13 @@ class Leaderboard:
         stream = io.StringIO()
         writer = csv.writer(stream, lineterminator="\n")
         writer.writerow(["problem", "objective", "unit", "optimum", "tolerance", "label", "planner", "kind", "status",
-                         "value", "gap_abs", "gap_rel", "reached", "plan_time_s", "iterations", "certificate",
-                         "message"])
+                         "plan_status", "value", "gap_abs", "gap_rel", "reached", "plan_time_s", "iterations",
+                         "certificate", "message"])
         for row in self.rows:
             problem = problems[row.problem]
             writer.writerow([row.problem, problem.objective, problem.unit, repr(problem.optimum), repr(problem.tolerance),
-                             row.label, row.planner, row.kind, row.status, _csv(row.objective), _csv(row.gap_abs),
+                             row.label, row.planner, row.kind, row.status, row.plan_status, _csv(row.objective),
+                             _csv(row.gap_abs),
                              _csv(row.gap_rel), "" if row.reached is None else row.reached, _csv(row.plan_time_s),
                              "" if row.iterations is None else row.iterations, row.certificate, row.message])
         return stream.getvalue()
@@ -301,17 +347,21 @@ class Leaderboard:
                  (f"slewbench {env['slewbench']}, {self.date}, {env['platform']}; {len(self.problems)} problem(s), "
                   f"{len(self.rows)} row(s) in {self.wall_time_s:.1f} s."), "",
                  ("Gap: value − optimum (the objective's unit) and relative to the optimum; ✓ within the problem's "
-                  "tolerance. Plan time: the second of two plans (a peer's solves), the first paying the "
-                  "build and first-call costs."), ""]
+                  "tolerance with the plan ok. Plan: the plan's own status (its reference against the requirements); "
+                  "status: the run's, its closed loop included (the bench ranks plans: a tracking controller's "
+                  "violation shows there, not in the ✓). Plan time: the second of two plans (a peer's solves), the "
+                  "first paying the build and first-call costs."), ""]
         lines += self._summary()
         for problem in self.problems:
             lines += [f"## {problem.name}: {problem.title}", "",
-                      (f"{problem.objective} [{problem.unit}]; optimum {problem.optimum:.6g} ± {problem.tolerance:.2g} "
+                      (f"{problem.objective} [{problem.unit}]; optimum {_with_tolerance(problem.optimum, problem.tolerance)} "
+                       f"± {problem.tolerance:.2g} "
                        f"({problem.optimum_kind.replace('_', ' ')}: {problem.optimum_source}); eigenaxis "
                        f"{'-' if problem.eigenaxis is None else f'{problem.eigenaxis:.6g}'} ({problem.eigenaxis_source}). "
                        f"Source: {problem.source}"), "",
-                      "| row | kind | status | value | gap | gap (rel) | plan time [s] | iterations | certificate | note |",
-                      "|---|---|---|---|---|---|---|---|---|---|"]
+                      ("| row | kind | plan | status | value | gap | gap (rel) | plan time [s] | iterations | "
+                       "certificate | note |"),
+                      "|---|---|---|---|---|---|---|---|---|---|---|"]
             whole: list[str] = []  # the notes shortened in the table, in full below it
             for row in (r for r in self.rows if r.problem == problem.name):
                 mark = "" if row.reached is None else (" ✓" if row.reached else "")
@@ -320,7 +370,8 @@ class Leaderboard:
                     whole.append(note)
                     note = f"{note[:NOTE_CHARS - 1]}… [{len(whole)}]"
                 lines.append(
-                    f"| {_md(row.label)} | {row.kind} | {row.status} | {_fmt(row.objective)} | {_fmt(row.gap_abs, '+.3g')}"
+                    f"| {_md(row.label)} | {row.kind} | {row.plan_status} | {row.status} | {_fmt(row.objective)} | "
+                    f"{_fmt(row.gap_abs, '+.3g')}"
                     f"{mark} | {_fmt(row.gap_rel, '+.2e')} | {_fmt(row.plan_time_s, '.3g')} | "
                     f"{'-' if row.iterations is None else row.iterations} | {_md(row.certificate)} | {_md(note)} |")
             lines.append("")
@@ -332,16 +383,21 @@ class Leaderboard:
         return "\n".join(lines)
 
     def _summary(self) -> list[str]:
-        """Markdown lines: per planner or peer, its rows, how many reach the optimum, the median
-        relative gap of those with a gap and the median plan time."""
-        lines = ["## Summary", "", "| planner | kind | rows | at the optimum | median gap (rel) | median plan time [s] |",
-                 "|---|---|---|---|---|---|"]
-        for name in dict.fromkeys(row.planner for row in self.rows):
+        """Markdown lines: per planner, then per peer (each in order of first appearance), its rows,
+        those with a gap (the others solve another problem or failed), how many reach the optimum,
+        the median absolute relative gap of the plans ok with a gap and the median plan time."""
+        lines = ["## Summary", "",
+                 ("| planner | kind | rows | rows with a gap | at the optimum | median \\|gap\\| (rel) | "
+                  "median plan time [s] |"), "|---|---|---|---|---|---|---|"]
+        names = dict.fromkeys(row.planner for row in sorted(self.rows, key=lambda row: row.kind != "planner"))
+        for name in names:
             rows = [row for row in self.rows if row.planner == name]
-            gaps = [abs(row.gap_rel) for row in rows if row.gap_rel is not None and row.status == "ok"]
+            gapped = [row for row in rows if row.gap_rel is not None]
+            gaps = [abs(row.gap_rel) for row in gapped if row.gap_rel is not None and row.plan_status == "ok"]
             times = [row.plan_time_s for row in rows if row.plan_time_s is not None]
-            lines.append(f"| {_md(name)} | {rows[0].kind} | {len(rows)} | {sum(1 for row in rows if row.reached)} | "
-                         f"{_fmt(_median(gaps), '.2e')} | {_fmt(_median(times), '.3g')} |")
+            lines.append(f"| {_md(name)} | {rows[0].kind} | {len(rows)} | {len(gapped)} | "
+                         f"{sum(1 for row in rows if row.reached)} | {_fmt(_median(gaps), '.2e')} | "
+                         f"{_fmt(_median(times), '.3g')} |")
         return lines + [""]
 
     def plot(self, path: Path) -> None:
@@ -439,6 +495,18 @@ def _fmt(value: float | None, spec: str = ".6g") -> str:
     return "-" if value is None else format(value, spec)
 
 
+def _with_tolerance(value: float, tolerance: float) -> str:
+    """``value`` with the significant digits down to its tolerance's leading digit, trailing zeros
+    kept, and never fewer than the value as stated has (11.21 ± 1e-4 reads ``11.2100``, 2.5897 ±
+    1e-3 ``2.5897``, 5.8467e-8 ± 3e-12 ``5.8467e-08``); 6 without a positive tolerance or for a
+    zero value."""
+    if not (tolerance > 0.0 and value != 0.0 and math.isfinite(value)):
+        return f"{value:.6g}"
+    stated = len(repr(abs(value)).split("e")[0].replace(".", "").lstrip("0"))  # the value's own digits
+    digits = math.floor(math.log10(abs(value))) - math.floor(math.log10(tolerance)) + 1
+    return f"{value:#.{min(max(digits, stated, 1), 17)}g}"
+
+
 NOTE_CHARS = 100
 """Longest note in a Markdown table cell: a longer one is cut there and given whole below the table
 (as are the CSV and JSON)."""
@@ -532,6 +600,7 @@ def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Ite
             loaded[name] = load_peer(name, PEERS)
         except PeerUnavailable as error:
             board.notes.append(str(error))
+    ran: set[str] = set()
     start = time.perf_counter()
     for i, problem in enumerate(chosen, 1):
         began = time.perf_counter()
@@ -558,6 +627,7 @@ def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Ite
 
                 result = PeerResult(None, 0.0, "failed", None, f"{type(error).__name__}: {error}")
             rows.append(_peer_row(problem, name, result))
+            ran.add(name)
         if not rows:
             board.notes.append(f"{problem.name}: no planner or peer selected applies")
         board.rows += rows
@@ -565,4 +635,16 @@ def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Ite
         say(f"[{i}/{len(chosen)}] {problem.name}: {len(rows)} row(s), {reached} at the optimum, "
             f"{time.perf_counter() - began:.1f} s")
     board.wall_time_s = time.perf_counter() - start
+    board.peer_versions = {name: _peer_version(peer) for name, peer in loaded.items() if name in ran}
     return board
+
+
+def _peer_version(peer: Any) -> str:
+    """A peer's version (its ``version()``), or why it is not known."""
+    version = getattr(peer, "version", None)
+    if not callable(version):
+        return "unknown (the peer has no version())"
+    try:
+        return str(version())
+    except Exception as error:  # noqa: BLE001 (a version query must not lose the leaderboard)
+        return f"unknown ({type(error).__name__}: {error})"

@@ -377,10 +377,12 @@ def build_parser() -> argparse.ArgumentParser:
     """
     parser = argparse.ArgumentParser(
         prog="slewbench", description="Spacecraft attitude manoeuvre planning workbench",
-        epilog=f"exit status: {EXIT_OK} done (failed and violated rows are results); {EXIT_NOT_OK} a row not ok "
-               f"under run --strict (an entry under table --strict); {EXIT_BAD_SCENARIO} bad scenario or study file, "
-               "or output location; "
-               f"{EXIT_INTERNAL} internal error or interrupted run; {EXIT_INTERRUPTED} interrupted sweep")
+        epilog=f"exit status: {EXIT_OK} done (failed and violated rows are results); {EXIT_BAD_SCENARIO} bad "
+               f"scenario, study or table file, or output location (nothing written); {EXIT_INTERNAL} internal "
+               f"error (a traceback on stderr) or run interrupted (Ctrl-C, SIGTERM); {EXIT_INTERRUPTED} "
+               f"interrupted sweep or table (run it again to finish). Under run --strict or table --strict, "
+               f"{EXIT_NOT_OK} also for a completed run with a row (or table entry) not ok: its files are "
+               f"written and stderr says so ('slewbench: --strict: N of M ... not ok')")
     parser.add_argument("--version", action="version", version=f"slewbench {package_version()}")
     commands = parser.add_subparsers(dest="command", required=True)
     run_parser = commands.add_parser("run", help="plan, simulate and score every planner of a scenario")

@@ -74,6 +74,16 @@ class Peer(Protocol):
         """
         ...
 
+    def version(self) -> str:
+        """The version of the tool the peer drives (recorded in ``leaderboard.json``).
+
+        Returns
+        -------
+        str
+            Its distribution and version, for example ``"FATROP plugin of CasADi 3.8.2"``.
+        """
+        ...
+
     def problem_error(self, problem: ManeuverProblem, objective: str) -> str | None:
         """Why the peer cannot express ``problem`` with ``objective`` (``None``: it can).
 

@@ -104,6 +104,16 @@ class FatropPeer:
         """
         return None if ca.has_nlpsol("fatrop") else "this CasADi has no FATROP plugin"
 
+    def version(self) -> str:
+        """FATROP's: the plugin of the CasADi it ships with.
+
+        Returns
+        -------
+        str
+            ``"FATROP plugin of CasADi <version>"``.
+        """
+        return f"FATROP plugin of CasADi {ca.CasadiMeta.version()}"
+
     def problem_error(self, problem: ManeuverProblem, objective: str) -> str | None:
         """Why the peer cannot express the problem (``None``: it can).
 

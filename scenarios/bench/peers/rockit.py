@@ -86,6 +86,22 @@ class RockitPeer:
         """
         return None if rockit is not None else "rockit (pip install rockit-meco) is not installed"
 
+    def version(self) -> str:
+        """The tools that solve: rockit's distribution and the CasADi whose IPOPT it calls.
+
+        Returns
+        -------
+        str
+            ``"rockit-meco <version>, IPOPT of CasADi <version>"``.
+        """
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            own = version("rockit-meco")
+        except PackageNotFoundError:
+            own = getattr(rockit, "__version__", "unknown")
+        return f"rockit-meco {own}, IPOPT of CasADi {ca.CasadiMeta.version()}"
+
     def problem_error(self, problem: ManeuverProblem, objective: str) -> str | None:
         """Why the peer cannot express the problem (``None``: it can).
 
