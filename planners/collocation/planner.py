@@ -162,8 +162,11 @@ class CollocationOptions:
         ``None``: none. The problem's ``max_rate`` (``maneuver.max_rate``, ``requirements.rate``)
         is a bound on the norm ‖ω‖, honoured besides it.
     keep_out, keep_in : list of dict
-        Cones ``{boresight (body), direction (inertial), angle_deg}`` over the whole run, honoured
-        as the problem's pointing constraints are (named ``keep_out[i]``, ``keep_in[i]``).
+        Cones ``{boresight (body), direction (inertial), angle_deg}`` over the whole run: constraints
+        of this planner's problem, imposed and checked densely as the problem's pointing constraints
+        are (named ``keep_out[i]``, ``keep_in[i]`` in ``stats["dense_check"]``), but no requirement
+        of a scenario: no row is scored against them (a mission's cone belongs in the scenario's
+        ``requirements.pointing``, which every row is scored by and this planner imposes too).
     cone_margin_deg : float
         Every cone (these and the problem's) is imposed this much tighter [deg] at first, so that
         it holds between the points; the dense check tightens further where needed.

@@ -41,7 +41,8 @@ class Requirements:
     ----------
     pointing : tuple of PointingConstraint
         The problem's pointing requirements, then the planner's own ``keep_out`` and ``keep_in``
-        cones (named ``keep_out[i]``, ``keep_in[i]``).
+        cones (named ``keep_out[i]``, ``keep_in[i]``): the planner holds its reference to them all;
+        a scenario scores its rows against the former only.
     max_rate : float or None
         Bound on the body-rate norm ``‖ω‖`` [rad/s] (``ManeuverProblem.max_rate``); ``None``: none.
     actuator_margin : float or None

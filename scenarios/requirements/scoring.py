@@ -1,16 +1,16 @@
 """Scoring a row against every requirement: the reference on its own dense sampling, the closed loop
-on its samples (its pointing between them too), and the end points of the manoeuvre before anything
-is planned.
+on its samples (between the samples too: the pointing of both, the closed loop's final error), and
+the end points of the manoeuvre before anything is planned.
 
 One :class:`Score` per requirement and scope (``reference``, ``closed_loop``): the numbers that go
 into the result columns ``ref.req.<name>.<field>`` and ``cl.req.<name>.<field>``, whether it is met,
 and what breaks it in words. The fields:
 
 * a pointing requirement: ``min_margin_deg`` (negative when violated), ``time_in_violation_s``,
-  ``first_violation_s`` (null if never), ``min_margin_time_s``
-  (:meth:`ocp.geometry.pointing.PointingConstraint.score` on the reference's samples;
-  :meth:`~ocp.geometry.pointing.PointingConstraint.score_between_samples` on the closed loop's
-  attitude interpolated between its samples with its body rates);
+  ``first_violation_s`` (null if never), ``min_margin_time_s``, in both scopes by one machinery:
+  :meth:`~ocp.geometry.pointing.PointingConstraint.score_between_samples` on the attitude
+  interpolated between the samples with the body rates (the reference's own rates; the window's
+  edges are points of it, the reference sampled there exactly, the closed loop interpolated);
 * ``actuators`` (reference only): for each actuator quantity with a limit
   (:func:`controllers.allocation.reference_demand`, through the row's controller's allocation),
   ``<quantity>`` the peak demand over the limit and ``<quantity>_time_s`` when it peaks, then
@@ -24,8 +24,9 @@ and what breaks it in words. The fields:
   number met: its field is null, its time the first sample where it is not finite, and the
   requirement broken;
 * ``rate``: ``peak_rate`` [rad/s] (of ``‖ω‖``), ``peak_time_s``, ``ratio`` (over the bound);
-* ``final`` (closed loop only): ``worst_error_deg`` and ``worst_rate_error`` [rad/s] from
-  ``T + after_s`` to the end, and ``from_s``.
+* ``final`` (closed loop only): ``worst_error_deg`` from ``T + after_s`` to the end, between the
+  samples too (:func:`worst_error_between_samples`, on the attitude interpolated as for pointing),
+  ``worst_rate_error`` [rad/s] over the samples from then on, and ``from_s``.
 
 The runner (:mod:`scenarios.runner`) glues this to the rows and turns the scores into statuses and
 messages (:func:`violations`, :func:`unhonoured`).
@@ -47,7 +48,14 @@ from controllers.allocation import (
     unrealised_torque,
 )
 from ocp import Spacecraft, quat
-from ocp.geometry.pointing import PointingConstraint
+from ocp.geometry.pointing import (
+    FINE_STEP,
+    MIN_SEARCHES,
+    REFINE_LEVELS,
+    REFINE_POINTS,
+    PointingConstraint,
+    hermite_attitudes,
+)
 from planners import ManeuverProblem, Planner, Reference
 from planners.base import REQUIREMENT_KINDS
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
@@ -55,7 +63,7 @@ from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requi
 __all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "JUMP_TOLERANCE", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
            "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
            "endpoint_violations", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
-           "score_reference", "unhonoured", "violations"]
+           "score_reference", "unhonoured", "violations", "worst_error_between_samples"]
 
 Array = NDArray[np.float64]
 
@@ -157,8 +165,8 @@ def reference_times(duration: float, run_end: float, sample_time: float, points:
     return times
 
 
-def _pointing(constraint: PointingConstraint, t: Array, q: Array, omega: Array | None = None) -> Score:
-    score = constraint.score(t, q) if omega is None else constraint.score_between_samples(t, q, omega)
+def _pointing(constraint: PointingConstraint, t: Array, q: Array, omega: Array) -> Score:
+    score = constraint.score_between_samples(t, q, omega)
     values: dict[str, float | None] = dict(zip(POINTING_FIELDS, (score.min_margin_deg, score.time_in_violation_s,
                                                                  score.first_violation_s, score.min_margin_time_s)))
     if score.met:
@@ -168,6 +176,28 @@ def _pointing(constraint: PointingConstraint, t: Array, q: Array, omega: Array |
     return Score(constraint.name, values, False,
                  f"min margin {score.min_margin_deg:.3g} deg at {score.min_margin_time_s:.1f} s, "
                  f"{score.time_in_violation_s:.1f} s {where}")
+
+
+def _with_edges(problem: ManeuverProblem, t: Array, sample: Any,
+                reference: Reference | None) -> tuple[Array, Array, Array]:
+    """The reference's times, attitudes and rates for its pointing scores: its samples, and the
+    reference sampled exactly where the interpolation between them cannot stand for it: the edges
+    of every pointing window inside the samples' span, and either side of each breakpoint (where its
+    rate may jump: the Hermite between samples across a jump would use the wrong slopes)."""
+    q, omega = np.asarray(sample.q, dtype=float), np.asarray(sample.omega, dtype=float)
+    if reference is None or not problem.pointing or t.size < 2:
+        return t, q, omega
+    extra = [edge for constraint in problem.pointing for edge in constraint.window]
+    instant = 1e-9 * max(reference.duration, 1.0)
+    extra += [time + side for time in reference.breakpoints for side in (-instant, instant)]
+    added = np.unique(np.asarray(extra, dtype=float))
+    added = added[(added > t[0]) & (added < t[-1]) & ~np.isin(added, t)]
+    if not added.size:
+        return t, q, omega
+    more = reference.sample(added)
+    order = np.argsort(np.concatenate([t, added]), kind="stable")
+    return (np.concatenate([t, added])[order], np.concatenate([q, np.atleast_2d(more.q)])[order],
+            np.concatenate([omega, np.atleast_2d(more.omega)])[order])
 
 
 def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
@@ -181,6 +211,102 @@ def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
                                                      f"{_over(ratio, 1.0)[0]} x the {requirement.max_rate:g} rad/s bound")
 
 
+def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, target: ArrayLike,
+                                start: float, limit: float | None = None) -> tuple[float, float]:
+    """The largest error angle to a fixed attitude from ``start`` on, between the samples too.
+
+    The attitude between samples is that of the pointing scores
+    (:func:`ocp.geometry.pointing.hermite_attitudes`: a cubic Hermite in the quaternion with the
+    slopes of the body rates), and it is searched as
+    :meth:`ocp.geometry.pointing.PointingConstraint.score_between_samples` searches the margin: the
+    error angle moves no faster than the attitude turns, bounded over a sample interval by 1.5 times
+    the larger of its faster end's ``‖ω‖`` and the mean rate of the turn between its samples. A
+    sample interval whose bound (the mean of its ends plus half its length times the rate bound)
+    may hide more than the largest error at the samples is cut into equal steps over which the
+    attitude turns at most :data:`~ocp.geometry.pointing.FINE_STEP` (at least 4); each step whose
+    bound may hide more than the largest found (the
+    :data:`~ocp.geometry.pointing.MIN_SEARCHES` highest bounds, and every step that may hide an
+    error above ``limit`` while none is found) is zoomed
+    (:data:`~ocp.geometry.pointing.REFINE_LEVELS` times to two of its
+    :data:`~ocp.geometry.pointing.REFINE_POINTS` points about its largest, while its bound still
+    allows more). ``start`` itself is a point when it falls between samples. An error above
+    ``limit`` is never missed where the samples agree with their rates; the largest error is exact
+    where the search reaches it, else within the bound over a step (a turn of
+    :data:`~ocp.geometry.pointing.FINE_STEP`: 0.0375° at most).
+
+    Parameters
+    ----------
+    t : (N,) array_like
+        Increasing sample times [s].
+    q : (N, 4) array_like
+        Attitude at ``t`` (scalar first, body to inertial).
+    omega : (N, 3) array_like
+        Body rate at ``t`` [rad/s], body axes.
+    target : (4,) array_like
+        The attitude the error is measured to.
+    start : float
+        From when [s] (at most ``t[-1]``).
+    limit : float or None, optional
+        The bound on the error [rad] whose breaking must not be missed; ``None``: the largest
+        error only.
+
+    Returns
+    -------
+    (float, float)
+        The largest error angle [rad] and its time [s].
+    """
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    q = quat.continuous(np.atleast_2d(np.asarray(q, dtype=float)))
+    omega = np.atleast_2d(np.asarray(omega, dtype=float))
+    first = int(np.searchsorted(t, start - 1e-9, side="left"))
+    if first >= len(t):
+        raise ValueError(f"no sample from {start:g} s on (the samples end at {t[-1]:g} s)")
+    lead = max(first - 1, 0)  # the interval holding start, when start falls between samples
+    t, q, omega = t[lead:], q[lead:], omega[lead:]
+    start = max(float(start), float(t[0]))
+    at_samples = quat.error_angle(q, target)
+    if len(t) < 2:
+        return float(at_samples[0]), float(t[0])
+    h = np.diff(t)
+    chord = 2.0 * np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", q[:-1], q[1:])), 0.0, 1.0))
+    norms = np.linalg.norm(omega, axis=1)
+    speed = 1.5 * np.maximum(np.maximum(norms[:-1], norms[1:]), np.divide(chord, h, out=np.zeros_like(h), where=h > 0.0))
+    inside = t >= start - 1e-9
+    largest = float(np.max(at_samples[inside])) if np.any(inside) else -np.inf
+    reach = 0.5 * (at_samples[:-1] + at_samples[1:]) + 0.5 * speed * h
+    steps = np.where(reach > largest, np.maximum(4, np.ceil(speed / 1.5 * h / FINE_STEP)), 1).astype(int)
+    offset = np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)
+    fine = np.repeat(t[:-1], steps) + np.repeat(h, steps) * offset / np.repeat(steps, steps)
+    fine = np.unique(np.concatenate([fine[fine > start], [start, t[-1]]]))
+    error = quat.error_angle(hermite_attitudes(t, q, omega, fine), target)
+    step_speed = speed[np.clip(np.searchsorted(t, fine[:-1], side="right") - 1, 0, len(t) - 2)]
+    bound = 0.5 * (error[:-1] + error[1:]) + 0.5 * step_speed * np.diff(fine)
+    worst = int(np.argmax(error))
+    best_t, best = float(fine[worst]), float(error[worst])
+    suspect = np.flatnonzero(bound > best)
+    deepest = suspect[np.argsort(-bound[suspect], kind="stable")[:MIN_SEARCHES]]
+    over = np.flatnonzero(bound > limit) if limit is not None and best <= limit else suspect[:0]
+    suspect = np.union1d(deepest, over)
+    low, high, rate = fine[suspect], fine[suspect + 1], step_speed[suspect]
+    fraction = np.linspace(0.0, 1.0, REFINE_POINTS)
+    for _ in range(REFINE_LEVELS):
+        if not low.size:
+            break
+        points = low[:, None] + (high - low)[:, None] * fraction
+        values = quat.error_angle(hermite_attitudes(t, q, omega, points.ravel()), target).reshape(points.shape)
+        top = np.argmax(values, axis=1)
+        rows = np.arange(len(low))
+        if float(np.max(values)) > best:
+            where = np.unravel_index(int(np.argmax(values)), values.shape)
+            best, best_t = float(values[where]), float(points[where])
+        step = (high - low) / (REFINE_POINTS - 1)
+        keep = values[rows, top] + rate * step > best
+        low = points[rows, np.maximum(top - 1, 0)][keep]
+        high = points[rows, np.minimum(top + 1, REFINE_POINTS - 1)][keep]
+        rate = rate[keep]
+    return best, best_t
+
+
 def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, problem: ManeuverProblem,
            end_of_manoeuvre: float) -> Score:
     start = end_of_manoeuvre + requirement.after_s
@@ -191,12 +317,13 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
                                              "simulation.duration")
     problems = []
     if problem.qf is not None:
-        errors = np.rad2deg(quat.error_angle(q[inside], problem.qf))
-        worst = int(np.argmax(errors))
-        values["worst_error_deg"] = float(errors[worst])
-        if requirement.error_deg is not None and errors[worst] > requirement.error_deg * (1 + _TOLERANCE):
-            shown, limit = _over(errors[worst], requirement.error_deg)
-            problems.append(f"error {shown} deg at {t[inside][worst]:.1f} s over {limit} deg")
+        bound = None if requirement.error_deg is None else float(np.deg2rad(requirement.error_deg))
+        worst_error, when = worst_error_between_samples(t, q, omega, problem.qf, start, bound)
+        worst_deg = float(np.rad2deg(worst_error))
+        values["worst_error_deg"] = worst_deg
+        if requirement.error_deg is not None and worst_deg > requirement.error_deg * (1 + _TOLERANCE):
+            shown, limit = _over(worst_deg, requirement.error_deg)
+            problems.append(f"error {shown} deg at {when:.1f} s over {limit} deg")
     if problem.omegaf is not None:
         rates = np.linalg.norm(omega[inside] - problem.omegaf, axis=1)
         worst = int(np.argmax(rates))
@@ -318,6 +445,11 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
                     allocation: Allocation | None, reference: Reference | None = None) -> dict[str, Score]:
     """Score a reference, sampled densely, against every requirement that applies to it.
 
+    The pointing requirements are scored between the samples too, as the closed loop's are
+    (:meth:`~ocp.geometry.pointing.PointingConstraint.score_between_samples` with the reference's
+    rates), the reference sampled exactly at the edges of their windows and either side of its
+    breakpoints; the actuator and rate requirements at the samples.
+
     Parameters
     ----------
     requirements : Requirements
@@ -333,8 +465,9 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         The row's controller, whose allocation the actuator demand goes through; ``None``: the
         actuator requirement is not scored.
     reference : planners.Reference or None, optional
-        The reference sampled, for the jumps of its rate at its breakpoints (:func:`rate_jumps`);
-        ``None``: only a jump at the start (against the manoeuvre's initial rate) is found.
+        The reference sampled, for the jumps of its rate at its breakpoints (:func:`rate_jumps`) and
+        its attitude at the windows' edges; ``None``: only a jump at the start (against the
+        manoeuvre's initial rate) is found, and the edges are interpolated between the samples.
 
     Returns
     -------
@@ -343,7 +476,8 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         is scored in closed loop only).
     """
     t = np.asarray(times, dtype=float)
-    scores = {constraint.name: _pointing(constraint, t, sample.q) for constraint in problem.pointing}
+    edged = _with_edges(problem, t, sample, reference)
+    scores = {constraint.name: _pointing(constraint, *edged) for constraint in problem.pointing}
     if requirements.actuators is not None and allocation is not None:
         jumps = rate_jumps(t, sample.omega, problem.omega0, reference)
         steps = np.zeros((t.size, 3))
@@ -380,10 +514,11 @@ def _environment_torque(problem: ManeuverProblem, t: Array, q: Array, omega: Arr
 
 def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: ArrayLike, q: ArrayLike,
                       omega: ArrayLike, end_of_manoeuvre: float) -> dict[str, Score]:
-    """Score a closed-loop run against every requirement that applies to it: the rate and final
-    requirements on its samples, the pointing requirements between them too (the attitude
-    interpolated with the body rates,
-    :meth:`ocp.geometry.pointing.PointingConstraint.score_between_samples`).
+    """Score a closed-loop run against every requirement that applies to it: the rate requirement
+    and the final rate error on its samples, the pointing requirements and the final error angle
+    between them too (the attitude interpolated with the body rates,
+    :meth:`ocp.geometry.pointing.PointingConstraint.score_between_samples`,
+    :func:`worst_error_between_samples`; a window's edges and ``T + after_s`` are points of it).
 
     Parameters
     ----------

@@ -173,9 +173,11 @@ REQUIREMENT_RATE = Section((
 REQUIREMENT_FINAL = Section((
     number("after_s", "From ``T + after_s`` (T: the reference's duration) to the end of the run; the run must "
            "reach it (``simulation.duration``).", unit="s", default=0.0, non_negative=True),
-    number("error_deg", "Bound on the error angle to ``maneuver.final.q``; ``null``: none.", unit="deg",
+    number("error_deg", "Bound on the error angle to ``maneuver.final.q``, scored between the closed loop's "
+           "samples too (the attitude interpolated as for pointing); ``null``: none.", unit="deg",
            default=None, positive=True, maximum=180.0, nullable=True),
-    number("rate", "Bound on ‖ω − ω_f‖ (``maneuver.final.omega``); ``null``: none.", unit="rad/s", default=None,
+    number("rate", "Bound on ‖ω − ω_f‖ (``maneuver.final.omega``), scored at the closed loop's samples only; "
+           "``null``: none.", unit="rad/s", default=None,
            positive=True, nullable=True),
 ), "The closed loop's final error and rate.")
 
@@ -186,7 +188,8 @@ REQUIREMENTS = Section((
     custom("actuators", "The reference's demand on the actuators. Absent: required with margin 0 (the "
            "actuators' limits are the scenario's: a reference that asks more than they give is never ok), and "
            "named in a row's note only when broken (``{}`` states it: named wherever a planner does not honour "
-           "it); ``null``: not required (scored only by the closed loop's saturation).", "mapping or null",
+           "it); ``null``: not required: no actuator demand is scored and no row is violated for it (the closed "
+           "loop's saturation is reported as a metric, ``cl.saturation_fraction``, never scored).", "mapping or null",
            _actuators, default=Described("margin 0, unstated"), section=REQUIREMENT_ACTUATORS),
     mapping("rate", "A body-rate limit; absent or ``null``: none.", REQUIREMENT_RATE, default=None, null="none"),
     mapping("final", "The closed loop's final error and rate; absent or ``null``: none.", REQUIREMENT_FINAL,
