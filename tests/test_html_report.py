@@ -76,6 +76,14 @@ def trace_x(trace: dict) -> np.ndarray:
     return trace["x0"] + trace["dx"] * np.arange(len(trace["y"]))
 
 
+def closed_loop_trace(figure: dict, label: str) -> dict:
+    """The margin figure's closed-loop curve of a row (named ``"<label>: min ..."``)."""
+    found = [trace for trace in figure["data"] if trace.get("name", "").startswith(f"{label}: ")
+             and trace.get("mode") == "lines"]
+    assert len(found) == 1, [trace.get("name") for trace in figure["data"]]
+    return found[0]
+
+
 def trace_y(trace: dict) -> np.ndarray:
     return np.array([np.nan if v is None else v for v in trace["y"]], dtype=float)
 
@@ -163,27 +171,31 @@ def test_margin_trace_equals_the_margin_of_the_simulated_attitude(run_results, r
         # PointingConstraint takes the angle by arccos, whose rounding error is eps/θ: 4e-8 deg where
         # the boresight passes 3e-7 rad from the direction (the middle of this slew)
         np.testing.assert_allclose(np.degrees(constraint.margins(sim.t, sim.q)), full, rtol=0, atol=1e-7)
-        for trace in figure["data"]:
-            if trace.get("name") == row.label:
-                break
-        else:
-            raise AssertionError(f"no margin trace for {row.label}")
+        trace = closed_loop_trace(figure, row.label)
         x, y = trace_x(trace), trace_y(trace)
-        assert len(y) <= 1000 < len(sim.t)  # decimated
+        assert len(y) <= 1001 < len(sim.t)  # decimated (and the scored minimum)
+        record = row.requirements["closed_loop"]["cam_keep_out"]
+        worst, when = record["min_margin_deg"], record["min_margin_time_s"]
+        # the score takes the margin between samples too: the boresight passes through the keep-out
+        # direction between two samples (the samples' least margin is 1.7e-5 deg above), where the
+        # margin is the cone's -half-angle
+        assert worst < full.min() and worst == pytest.approx(-CONE_DEG, abs=1e-6)
+        # that scored point is a point of the curve, at its time; the others are samples
+        scored = np.flatnonzero(np.isclose(x, when, rtol=5e-7, atol=0) & np.isclose(y, worst, rtol=5e-7, atol=0))
+        assert scored.size == 1
+        x, y = np.delete(x, scored), np.delete(y, scored)
         index = np.searchsorted(sim.t, x)
         np.testing.assert_allclose(sim.t[index], x, rtol=1e-9, atol=1e-9)
         # 7 significant digits are written (a relative difference below 5e-7) of PointingConstraint's
         # margins (1e-7 deg from the oracle, above)
         np.testing.assert_allclose(y, np.degrees(constraint.margins(sim.t, sim.q))[index], rtol=5e-7, atol=0)
         np.testing.assert_allclose(y, full[index], rtol=5e-7, atol=1e-7)
-        worst = row.requirements["closed_loop"]["cam_keep_out"]["min_margin_deg"]
-        assert worst < 0
         assert y.min() == pytest.approx(full.min(), rel=5e-7, abs=1e-7)
-        # the score takes the margin between samples too: the boresight passes through the keep-out
-        # direction between two samples (the samples' least margin is 1.7e-5 deg above), where the
-        # margin is the cone's -half-angle
-        assert worst < full.min() and worst == pytest.approx(-CONE_DEG, abs=1e-6)
-    reference = [trace for trace in figure["data"] if trace.get("name", "").endswith(" ref")]
+        # the legend gives the table's minimum, and the marker sits on it
+        assert trace["name"] == f"{row.label}: min {worst:+.4g}° at {when:.4g} s"
+        marker = next(t for t in figure["data"] if t.get("name") == f"{row.label} minimum")
+        assert marker["x"] == [pytest.approx(when, rel=5e-7)] and marker["y"] == [pytest.approx(worst, rel=5e-7)]
+    reference = [trace for trace in figure["data"] if " ref: min " in trace.get("name", "")]
     assert len(reference) == 2
     zero = [trace for trace in figure["data"] if trace.get("name", "").startswith("zero")]
     assert zero and set(zero[0]["y"]) == {0.0}
@@ -193,8 +205,11 @@ def test_a_margin_outside_its_window_is_not_drawn(run_results):
     """A requirement that applies from 10 s to 40 s: no point of its margin outside, a break at each end."""
     windowed = dataclasses.replace(run_results.scenario.problem.pointing[0], window=(10.0, 40.0))
     figure = json.loads(json.dumps(margin_figure(windowed, run_results.rows), default=lambda a: a.tolist()))
-    trace = next(trace for trace in figure["data"] if trace.get("name") == run_results.rows[0].label)
+    trace = closed_loop_trace(figure, run_results.rows[0].label)
     x, y = trace_x(trace), trace_y(trace)
+    scored = run_results.rows[0].requirements["closed_loop"]["cam_keep_out"]["min_margin_time_s"]
+    keep = ~np.isclose(x, scored, rtol=0, atol=1e-9)  # the scored minimum (of the whole run) is put in
+    x, y = x[keep], y[keep]
     drawn = np.isfinite(y)
     assert 10.0 - 1e-9 <= x[drawn].min() < 10.1 and 39.9 < x[drawn].max() <= 40.0 + 1e-9
     assert np.all(np.isnan(y[~drawn]) | ~np.isfinite(x[~drawn]))  # outside: gaps only
@@ -448,3 +463,42 @@ def driver_values(driver, table: str, column: str) -> list:
         "var spec = window.slewbench.data.tables[arguments[0]];"
         "var j = spec.columns.map(function (c) { return c.key; }).indexOf(arguments[1]);"
         "return spec.rows.map(function (row) { return row[j]; });", table, column)
+
+
+OVERLAPS = """
+function box(e) { var r = e.getBoundingClientRect(); return [r.left, r.top, r.right, r.bottom]; }
+function meet(a, b) { return a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3]; }
+var out = [];
+document.querySelectorAll('.sb-figure').forEach(function (figure) {
+  var title = figure.querySelector('.gtitle'), bar = figure.querySelector('.modebar');
+  if (title && bar && meet(box(title), box(bar))) { out.push(figure.id + ': the title under the mode bar'); }
+  if (title && box(title)[0] < box(figure)[0] - 1) { out.push(figure.id + ': the title runs off the figure'); }
+  figure.querySelectorAll('.updatemenu-button').forEach(function (button) {
+    figure.querySelectorAll('.slider-label').forEach(function (label) {
+      if (meet(box(button), box(label))) { out.push(figure.id + ': a button over the slider label ' + label.textContent); }
+    });
+  });
+  var slider = figure.querySelector('.slider-container');
+  if (slider && box(slider)[3] > box(figure)[3] + 1) { out.push(figure.id + ': the slider runs below the figure'); }
+});
+return out;
+"""
+
+
+@needs_browser
+@pytest.mark.parametrize("width", [1400, 800])
+def test_titles_clear_the_mode_bar_and_the_buttons_clear_the_slider(browser, run_html, tmp_path, width):
+    """At a wide and a narrow window: no figure's title lies under plotly's mode bar (top right) or
+    runs off the figure, the 3-D view's play and pause buttons cover none of its slider's labels, and
+    the slider lies within the figure's element."""
+    page = tmp_path / "report.html"
+    page.write_text(run_html, encoding="utf-8")
+    browser.set_window_size(width, 1000)
+    try:
+        open_page(browser, page)
+        time.sleep(0.5)
+        assert browser.execute_script("return document.querySelectorAll('.sb-figure .modebar').length") >= 4
+        assert browser.execute_script("return document.querySelectorAll('#attitude .slider-label').length") >= 5
+        assert browser.execute_script(OVERLAPS) == []
+    finally:
+        browser.set_window_size(1400, 1000)

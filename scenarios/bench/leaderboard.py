@@ -402,7 +402,8 @@ class Leaderboard:
 
     def plot(self, path: Path) -> None:
         """Relative gap against plan time, one marker per planner or peer, log axes; rows without a
-        gap are left out, gaps below :data:`GAP_FLOOR` drawn at it.
+        gap are left out, gaps below :data:`GAP_FLOOR` drawn at it. Each planner or peer keeps its
+        colour and marker from run to run (``_plot_style``); the legend is beside the axes.
 
         Parameters
         ----------
@@ -412,21 +413,22 @@ class Leaderboard:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
 
-        figure = Figure(figsize=(7.0, 4.8), dpi=110)
+        figure = Figure(figsize=(9.0, 4.8), dpi=110)
         canvas = FigureCanvasAgg(figure)
         axis = figure.add_subplot(1, 1, 1)
-        markers = "osD^v<>pPX*h"
-        names = sorted({row.planner for row in self.rows})
+        figure.subplots_adjust(left=0.09, right=0.7, top=0.92, bottom=0.11)
+        kinds = {row.planner: row.kind for row in self.rows}
         drawn = 0
-        for k, name in enumerate(names):
+        for name in sorted(kinds, key=lambda planner: (kinds[planner] == "peer", planner)):  # planners, then peers
             points = [(row.plan_time_s, max(abs(row.gap_rel), GAP_FLOOR)) for row in self.rows
                       if row.planner == name and row.gap_rel is not None and row.plan_time_s and row.status == "ok"]
             if not points:
                 continue
-            kind = next(row.kind for row in self.rows if row.planner == name)
+            kind = kinds[name]
             x, y = zip(*points)
-            axis.scatter(x, y, marker=markers[k % len(markers)], label=f"{name}{' (peer)' if kind == 'peer' else ''}",
-                         facecolors="none" if kind == "peer" else None, color=f"C{k % 10}")
+            style = _plot_style(name, kind)
+            axis.scatter(x, y, marker=style["marker"], label=f"{name}{' (peer)' if kind == 'peer' else ''}",
+                         facecolors="none" if kind == "peer" else style["color"], edgecolors=style["color"])
             drawn += 1
         axis.set_xscale("log")
         axis.set_yscale("log")
@@ -435,8 +437,7 @@ class Leaderboard:
         axis.set_title(f"slewbench bench, suite version {self.suite.version}")
         axis.grid(True, which="major", alpha=0.3)
         if drawn:
-            axis.legend(fontsize="small", loc="best")
-        figure.tight_layout()
+            axis.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
         canvas.print_png(str(path))
 
     def write(self, out: str | Path, plots: bool = True) -> list[str]:
@@ -469,6 +470,41 @@ class Leaderboard:
         if plots:
             self.plot(staging / "gap_vs_time.png")
         return commit_outputs(directory, staging, "bench")
+
+
+_PLOT_MARKERS = "osD^v<>pPX*h"
+"""Markers of the planners and peers in ``gap_vs_time.png``, in ``_plot_style``'s order."""
+
+
+def _plot_style(name: str, kind: str) -> dict[str, str]:
+    """The colour and marker of a planner or peer in ``gap_vs_time.png``, the same in every run: by
+    its place in :data:`planners.PLANNERS` (a planner) or after them in
+    :data:`scenarios.bench.peers.PEERS` (a peer, drawn hollow); a name in neither takes one from
+    a checksum of its name.
+
+    Parameters
+    ----------
+    name : str
+        The planner's registry name or the peer's name.
+    kind : str
+        ``"planner"`` or ``"peer"``.
+
+    Returns
+    -------
+    dict
+        ``color`` (a matplotlib ``"C<n>"`` colour) and ``marker``.
+    """
+    import zlib
+
+    from planners import PLANNERS
+    from scenarios.bench.peers import PEERS
+
+    known = list(PLANNERS) + list(PEERS)
+    if name in (PEERS if kind == "peer" else PLANNERS):
+        index = len(PLANNERS) + list(PEERS).index(name) if kind == "peer" else list(PLANNERS).index(name)
+    else:
+        index = len(known) + zlib.crc32(name.encode()) % len(_PLOT_MARKERS)
+    return {"color": f"C{index % 10}", "marker": _PLOT_MARKERS[index % len(_PLOT_MARKERS)]}
 
 
 def _json_default(value: Any) -> Any:

@@ -234,6 +234,38 @@ LIMITED_PANELS = ("torque", "wheel_torque", "wheel_momentum", "wheel_speed", "di
 """Panels of the per-row figure that can carry actuator limit lines (keys of :attr:`RowSeries.limits`)."""
 
 
+def knowledge_series(sim: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """The attitude the controller was given at each sample and its error, with a star tracker in
+    the loop (the attitude behind ``final_knowledge_error_deg`` and ``max_knowledge_error_deg``,
+    :func:`ocp.metrics.metrics_from_simulation`).
+
+    Parameters
+    ----------
+    sim : ocp.SimulationResult
+        The closed-loop run (its ``sensors`` and ``sensor_state``).
+
+    Returns
+    -------
+    (known, error) or None
+        ``known`` (N+1, 4): the attitude given at ``t_0 … t_(N−1)`` (the MEKF's estimate, or the
+        last star tracker reading; scalar first, body to inertial), NaN at the final time;
+        ``error`` (N+1,): its angle from the true attitude [deg], NaN at the final time. ``None``
+        without a star tracker.
+    """
+    from ocp import quat
+    from ocp.metrics import _known_attitude
+
+    given = _known_attitude(sim)
+    if given is None:
+        return None
+    given = np.asarray(given, dtype=float)
+    known = np.full((sim.t.size, 4), np.nan)
+    known[:given.shape[0]] = given
+    error = np.full(sim.t.size, np.nan)
+    error[:given.shape[0]] = np.rad2deg(quat.error_angle(given, np.asarray(sim.q)[:given.shape[0]]))
+    return known, error
+
+
 @dataclass
 class RowSeries:
     """The curves of one row's figure: body torque, rate, quaternion, Euler angles, error angles,
@@ -281,6 +313,9 @@ class RowSeries:
         Euler angles [deg] of ``euler_sequence`` (:func:`euler_angles`), in its order.
     euler_sequence : str, optional
         Their sequence (default :data:`EULER_SEQUENCE`).
+    knowledge : Curve, optional
+        The knowledge error [deg]: the angle of the attitude the controller was given from the
+        true one (:func:`knowledge_series`), with a star tracker in the loop.
     """
 
     n_wheels: int
@@ -304,18 +339,19 @@ class RowSeries:
     limits: dict[str, tuple[float, ...]] = field(default_factory=dict)
     euler: list[Curve] = field(default_factory=list)
     euler_sequence: str = EULER_SEQUENCE
+    knowledge: Curve | None = None
 
     @property
     def shape(self) -> RowShape:
         """``(n_wheels, with_reference, with_target, failed, wheel_axis, wheel speed panel, dipole
-        panel, limit styles, Euler sequence)``, the arguments of
+        panel, limit styles, Euler sequence, knowledge error)``, the arguments of
         :class:`scenarios.output.plots.RowFigure`: rows of one shape share a figure. A limit style
         is ``(panel, common)``: ``common`` when every limit of the panel is the same (one black pair
         of lines), else one pair per curve."""
         styles = tuple((panel, _common(values)) for panel, values in self.limits.items()
                        if np.any(np.isfinite(values)))
         return (self.n_wheels, self.with_reference, self.with_target, tuple(self.failed), tuple(self.wheel_axis),
-                bool(self.wheel_speed), bool(self.dipole), styles, self.euler_sequence)
+                bool(self.wheel_speed), bool(self.dipole), styles, self.euler_sequence, self.knowledge is not None)
 
 
 def _common(values: tuple[float, ...]) -> bool:
@@ -426,6 +462,10 @@ def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = E
     if not with_reference and not with_target:  # rate regulation (detumbling): the rate converges
         series.rate_norm = curve(DEG_PER_RAD * np.maximum(np.linalg.norm(sim.omega, axis=1), FLOOR_RATE))
         series.rate_max = curve(DEG_PER_RAD * np.maximum(np.abs(sim.omega).max(axis=1), FLOOR_RATE))
+    knowledge = knowledge_series(sim)
+    if knowledge is not None:
+        given = np.isfinite(knowledge[1])
+        series.knowledge = decimate(t[given], np.maximum(knowledge[1][given], FLOOR_DEG), columns)
     return series
 
 
@@ -455,6 +495,10 @@ class OverlaySeries:
     finals : list of str, optional
         Per row, its final values in words (the legend gives them, so that rows whose curves lie
         on one another are told apart).
+    statuses : list of str, optional
+        Per row, its status (``ok``, ``violated``, ``failed``; :class:`scenarios.output.results.Row`).
+    breaches : list of str, optional
+        Per row, what it breaks in words (:func:`breach_text`; empty when nothing is recorded).
     """
 
     title: str
@@ -465,6 +509,33 @@ class OverlaySeries:
     rate: list[list[Curve]] = field(default_factory=list)
     wheel_momentum: list[list[Curve]] = field(default_factory=list)
     finals: list[str] = field(default_factory=list)
+    statuses: list[str] = field(default_factory=list)
+    breaches: list[str] = field(default_factory=list)
+
+
+def breach_text(row: Any) -> str:
+    """What a row breaks, from its requirement records: each pointing requirement the reference or
+    the closed loop spends time in violation of, and that time.
+
+    Parameters
+    ----------
+    row : scenarios.output.results.Row
+        The row (its ``requirements``).
+
+    Returns
+    -------
+    str
+        For example ``"st_sun violated ref 16.9 s, cl 24.1 s"``, several joined by ``"; "``;
+        empty when no pointing violation is recorded (the row's message says the rest).
+    """
+    found: dict[str, list[str]] = {}
+    for scope, records in (getattr(row, "requirements", None) or {}).items():
+        for name, record in (records or {}).items():
+            inside = record.get("time_in_violation_s") if isinstance(record, dict) else None
+            margin = record.get("min_margin_deg") if isinstance(record, dict) else None
+            if inside is not None and margin is not None and margin < 0:
+                found.setdefault(name, []).append(f"{'cl' if scope == 'closed_loop' else 'ref'} {inside:.3g} s")
+    return "; ".join(f"{name} violated {', '.join(times)}" for name, times in found.items())
 
 
 def overlay_series(results: Any) -> OverlaySeries:
@@ -506,6 +577,9 @@ def overlay_series(results: Any) -> OverlaySeries:
             return decimate(t, values, columns)
 
         series.labels.append(row.label)
+        status = getattr(row, "status", "ok")
+        series.statuses.append(status)
+        series.breaches.append(breach_text(row) if status != "ok" else "")
         series.torque.append(curve(held(np.linalg.norm(sim.applied_torque, axis=1))))
         series.error.append(curve(np.maximum(error, FLOOR_DEG)))
         series.rate.append([curve(DEG_PER_RAD * sim.omega[:, i]) for i in range(3)])
@@ -670,7 +744,16 @@ class MarginPanel:
         Per row (in :attr:`MarginSeries.labels` order), the margin [deg] (``angle − limit`` for a
         keep-out, ``limit − angle`` for a keep-in; negative when violated, NaN outside the window).
     worst_reference, worst_closed_loop : list of float or None
-        Per row, the smallest margin over all samples [deg] (before decimation).
+        Per row, the smallest margin [deg]: the scored one (the row's requirement record,
+        ``min_margin_deg``, the value the results table gives: the scoring evaluates the margin
+        between the samples too) when the row has it, else the smallest over the drawn samples.
+    lowest_reference, lowest_closed_loop : list of (float, float) or None
+        Per row, where that smallest margin lies: its time [s] and the margin [deg] (the scored
+        ``min_margin_time_s`` and ``min_margin_deg``, else the lowest sample). The scored point is
+        also a point of the row's curve (inserted at its time), so that a dip the samples miss, a
+        violation between two samples, is drawn.
+    scored_reference, scored_closed_loop : list of bool
+        Per row, whether the minimum is the scored one (``False``: the samples' own).
     """
 
     title: str
@@ -679,6 +762,10 @@ class MarginPanel:
     closed_loop: list[Curve | None]
     worst_reference: list[float | None]
     worst_closed_loop: list[float | None]
+    lowest_reference: list[tuple[float, float] | None] = field(default_factory=list)
+    lowest_closed_loop: list[tuple[float, float] | None] = field(default_factory=list)
+    scored_reference: list[bool] = field(default_factory=list)
+    scored_closed_loop: list[bool] = field(default_factory=list)
 
 
 @dataclass
@@ -707,8 +794,65 @@ def _worst(margin: np.ndarray) -> float | None:
     return float(np.nanmin(margin)) if np.any(np.isfinite(margin)) else None
 
 
+def scored_minimum(row: Any, scope: str, name: str) -> tuple[float, float | None] | None:
+    """A row's scored minimum margin of a pointing requirement: the value of its results table.
+
+    Parameters
+    ----------
+    row : scenarios.output.results.Row
+        The row (its ``requirements``: scores by scope, requirement name and field,
+        :mod:`scenarios.requirements.scoring`).
+    scope : str
+        ``"reference"`` or ``"closed_loop"``.
+    name : str
+        The requirement's name.
+
+    Returns
+    -------
+    (float, float or None) or None
+        ``min_margin_deg`` [deg] and ``min_margin_time_s`` [s] (``None`` when not recorded);
+        ``None`` when the row has no finite scored minimum for it.
+    """
+    records = getattr(row, "requirements", None) or {}
+    record = (records.get(scope) or {}).get(name) or {}
+    margin, when = record.get("min_margin_deg"), record.get("min_margin_time_s")
+    if margin is None or not np.isfinite(margin):
+        return None
+    return float(margin), (float(when) if when is not None and np.isfinite(when) else None)
+
+
+def with_point(curve: Curve, when: float, value: float) -> Curve:
+    """A curve with one more point, at its time (a point already at that time is replaced).
+
+    Parameters
+    ----------
+    curve : Curve
+        Increasing times [s] (NaN at a gap) and values.
+    when, value : float
+        The point.
+
+    Returns
+    -------
+    Curve
+        The times and values with the point in time order.
+    """
+    t, values = curve
+    ordered = np.maximum.accumulate(np.where(np.isnan(t), -np.inf, t))  # a gap (NaN) sorts with the time before it
+    at = int(np.searchsorted(ordered, when))
+    if at < t.size and t[at] == when:
+        values = values.copy()
+        values[at] = value
+        return t, values
+    return np.insert(t, at, when), np.insert(values, at, value)
+
+
 def margin_series(results: Any, constraints: list[Any] | None = None, sampled: list[Motion] | None = None) -> MarginSeries:
     """The pointing-margin figure's curves.
+
+    Each curve is the margin at the row's samples; where the row's requirement record gives the
+    scored minimum (:func:`scored_minimum`, evaluated by the scoring between the samples too) and
+    its time, that point is put into the curve and is the minimum the legend gives, so that the
+    figure shows the table's number, and a violation between two samples.
 
     Parameters
     ----------
@@ -726,22 +870,40 @@ def margin_series(results: Any, constraints: list[Any] | None = None, sampled: l
     """
     constraints = pointing_constraints(results) if constraints is None else constraints
     rows = motions(results) if sampled is None else sampled
+    by_label = {row.label: row for row in results.rows}
     columns = panel_columns(MARGIN_WIDTH_IN, MARGIN_MARGINS)
-    end = max([results.scenario.problem.duration]
-              + [float(m[0][-1]) for motion in rows for m in (motion.reference, motion.closed_loop) if m is not None])
+    ends = [float(m[0][-1]) for motion in rows for m in (motion.reference, motion.closed_loop) if m is not None]
+    end = max(ends) if ends else float(results.scenario.problem.duration)  # the run, not a duration bound
     panels = []
     for constraint in constraints:
         panel = MarginPanel(requirement_text(constraint), constraint.window, [], [], [], [])
         for motion in rows:
-            for curves, worst, attitude in ((panel.reference, panel.worst_reference, motion.reference),
-                                            (panel.closed_loop, panel.worst_closed_loop, motion.closed_loop)):
+            row = by_label.get(motion.label)
+            for scope, curves, worst, lowest, scored, attitude in (
+                    ("reference", panel.reference, panel.worst_reference, panel.lowest_reference,
+                     panel.scored_reference, motion.reference),
+                    ("closed_loop", panel.closed_loop, panel.worst_closed_loop, panel.lowest_closed_loop,
+                     panel.scored_closed_loop, motion.closed_loop)):
                 if attitude is None:
                     curves.append(None)
                     worst.append(None)
+                    lowest.append(None)
+                    scored.append(False)
                     continue
                 margin = np.rad2deg(constraint.margins(*attitude))
-                curves.append(decimate(attitude[0], margin, columns))
-                worst.append(_worst(margin))
+                curve = decimate(attitude[0], margin, columns)
+                record = scored_minimum(row, scope, constraint.name) if row is not None else None
+                point: tuple[float, float] | None = None
+                if record is not None and record[1] is not None:
+                    point = (record[1], record[0])
+                    curve = with_point(curve, *point)
+                elif record is None and np.any(np.isfinite(margin)):
+                    at = int(np.nanargmin(margin))
+                    point = (float(attitude[0][at]), float(margin[at]))
+                curves.append(curve)
+                worst.append(record[0] if record is not None else _worst(margin))
+                lowest.append(point)
+                scored.append(record is not None)
         panels.append(panel)
     return MarginSeries(f"{results.scenario.name}: pointing margins (negative: violated); solid closed loop, "
                         "dashed reference", [motion.label for motion in rows], end, panels)

@@ -19,7 +19,9 @@ legends, axis labels): lines and grids cost little. So it is kept cheap:
 
 The pointing figures are drawn only for runs with pointing requirements. The margin against time
 uses a symmetric logarithmic value axis, linear within the smallest margin any row reaches: a
-dip of a fraction of a degree below zero shows as plainly as a pass at tens of degrees. The sky
+dip of a fraction of a degree below zero shows as plainly as a pass at tens of degrees. Each
+curve's minimum is the scored one (the results table's, evaluated between the samples too), marked
+at its time and drawn as a point of the curve, so that a violation the samples miss still shows. The sky
 map is Mollweide's equal-area projection of the whole sphere: every direction a boresight or a
 cone can take is on one flat picture, areas (the cones) keep their proportions, and no part of
 the sphere hides behind another as on a drawn 3-D globe.
@@ -37,6 +39,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.ticker import (
     FixedLocator,
     FuncFormatter,
@@ -258,7 +261,8 @@ def wheel_colors(n_wheels: int, wheel_axis: tuple[int, ...]) -> list[str]:
 class RowFigure:
     """The per-row figure, built once and redrawn for each row of the same shape (module docstring).
 
-    Panels, top to bottom: body torque, body rate, quaternion, Euler angles, error angles; with
+    Panels, top to bottom: body torque, body rate, quaternion, Euler angles, error angles (with an
+    estimator in the loop, the knowledge error too); with
     wheels their motor torques and momenta, and speeds when their spin inertia is known; with
     magnetorquers their dipole. Every per-axis curve takes its axis' colour (:data:`AXIS_COLORS`).
     Actuator limits are dotted ``±`` lines (one black pair when every curve of the panel has the
@@ -286,13 +290,17 @@ class RowFigure:
     euler_sequence : str, optional
         The Euler angles' sequence (:func:`euler_names`); default
         :data:`scenarios.output.plot_data.EULER_SEQUENCE`.
+    knowledge : bool, optional
+        Draw the knowledge error (the attitude the controller was given, from the true one) on the
+        error panel.
     """
 
     def __init__(self, n_wheels: int, with_reference: bool, with_target: bool, failed: tuple[int, ...] = (),
                  wheel_axis: tuple[int, ...] = (), wheel_speed: bool = False, dipole: bool = False,
-                 limited: tuple[tuple[str, bool], ...] = (), euler_sequence: str = EULER_SEQUENCE):
+                 limited: tuple[tuple[str, bool], ...] = (), euler_sequence: str = EULER_SEQUENCE,
+                 knowledge: bool = False):
         self.shape: RowShape = (n_wheels, with_reference, with_target, tuple(failed), tuple(wheel_axis),
-                                wheel_speed, dipole, tuple(limited), euler_sequence)
+                                wheel_speed, dipole, tuple(limited), euler_sequence, knowledge)
         names = ["torque", "rate", "quaternion", "euler", "error"]
         names += ["wheel_torque", "wheel_momentum"] if n_wheels else []
         names += ["wheel_speed"] if n_wheels and wheel_speed else []
@@ -335,6 +343,7 @@ class RowFigure:
         _log_axis(error)
         self.to_target = line(error, color="k", label="to target") if with_target else None
         self.to_reference = line(error, color="tab:orange", label="to reference") if with_reference else None
+        self.knowledge = line(error, color="tab:purple", lw=1, label="knowledge") if knowledge else None
         self.rate_norm = self.rate_max = None
         if not with_reference and not with_target:  # rate regulation (detumbling): the rate converges
             self.rate_norm = line(error, color="k", label="‖ω‖")
@@ -378,7 +387,8 @@ class RowFigure:
             if any(not item.get_label().startswith("_") for item in axis.get_lines()):
                 # beside the panel: static (drawn once), and never over a curve
                 axis.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, borderaxespad=0.0)
-        self.title = self.figure.suptitle("")
+        # from a fixed distance below the top edge: its lines (at most TITLE_LINES) stay above the first panel
+        self.title = self.figure.suptitle("", y=1.0 - TITLE_GAP_IN / figsize[1], va="top", fontsize=TITLE_FONT)
         _time_axis(axes[-1])
         self._background: tuple[tuple[float, float], Any] | None = None
 
@@ -419,7 +429,8 @@ class RowFigure:
             for items, curves in zip(self.reference, series.reference):
                 pairs.extend(zip(items, curves))
         for item, curve in ((self.to_reference, series.to_reference), (self.to_target, series.to_target),
-                            (self.rate_norm, series.rate_norm), (self.rate_max, series.rate_max)):
+                            (self.rate_norm, series.rate_norm), (self.rate_max, series.rate_max),
+                            (self.knowledge, series.knowledge)):
             if item is not None and curve is not None:
                 pairs.append((item, curve))
         for item, curve in pairs:
@@ -451,7 +462,7 @@ class RowFigure:
             else:
                 common = any(index is None for panel, index, _, _ in self.limit_lines if panel == name)
                 note.set_text(f"{'limit' if common else 'limits up to'} ±{limit:.3g} beyond the view")
-        self.title.set_text("\n".join(textwrap.wrap(series.title, TITLE_CHARS)))
+        self.title.set_text("\n".join(textwrap.wrap(series.title, TITLE_CHARS, max_lines=TITLE_LINES, placeholder=" …")))
         time_limits = tuple(self.axes[-1].get_xlim())
         canvas, dynamic = self.canvas, self._dynamic()
         if self._background is None or self._background[0] != time_limits:
@@ -545,15 +556,41 @@ LEGEND_CHARS = 34
 """Longest line of a row's label in the comparison figure's legend (a longer label is wrapped)."""
 TITLE_CHARS = 100
 """Longest line of a row figure's title (a longer one is wrapped)."""
+TITLE_LINES = 2
+"""Most lines of a row figure's title (a longer one is cut, ``…``): they fit above the first panel."""
+TITLE_FONT = 11.0
+"""Font size of a row figure's title [pt]."""
+TITLE_GAP_IN = 0.08
+"""Space above a row figure's title [in]: with :data:`TITLE_LINES` lines of :data:`TITLE_FONT` it ends
+above the first panel (:data:`scenarios.output.plot_data.ROW_EDGES_IN` below the top)."""
 LINE_STYLES = ("-", "--", "-.", ":")
 """Line styles of the rows in the comparison figure, in turn with :data:`ROW_COLORS`: rows whose curves
 lie on one another still show (a dashed line over a solid one)."""
 
 
-def _row_style(k: int) -> dict[str, Any]:
+STATUS_MARKERS = {"violated": {"marker": "X", "markevery": 0.12, "ms": 6},
+                  "failed": {"marker": "o", "markevery": 0.12, "ms": 6, "markerfacecolor": "none"},
+                  "crashed": {"marker": "o", "markevery": 0.12, "ms": 6, "markerfacecolor": "none"}}
+"""Markers along the error curve (and the legend's line) of a row that is not ok in the comparison
+figure (its legend says the status)."""
+
+
+def _row_style(k: int, status: str = "ok") -> dict[str, Any]:
     """Colour, line style and width of row ``k`` in the comparison figure (the first rows widest, so
-    that a later row drawn over them leaves their edges in view)."""
-    return {"color": _row_color(k), "linestyle": LINE_STYLES[k % len(LINE_STYLES)], "lw": max(1.0, 2.2 - 0.4 * k)}
+    that a later row drawn over them leaves their edges in view), with the markers of its status
+    (:data:`STATUS_MARKERS`) when ``status`` is given."""
+    return {"color": _row_color(k), "linestyle": LINE_STYLES[k % len(LINE_STYLES)], "lw": max(1.0, 2.2 - 0.4 * k),
+            **STATUS_MARKERS.get(status, {})}
+
+
+def _legend_text(label: str, status: str, breach: str, final: str) -> str:
+    """A row's entry in the comparison figure's legend: its label, its status when not ok (what it
+    breaks), its final values."""
+    lines = textwrap.wrap(label, LEGEND_CHARS)
+    if status != "ok":
+        lines += textwrap.wrap(status.upper() + (": " + breach if breach else ""), LEGEND_CHARS,
+                               initial_indent="  ", subsequent_indent="    ")
+    return "\n".join(lines + (["  " + part for part in final.split(", ")] if final else []))
 
 
 def _grid_lines(axis: Any, which: str, values: Any = ()) -> LineCollection:
@@ -574,8 +611,10 @@ def _set_grid_lines(lines: LineCollection, which: str, values: Any) -> None:
 def overlay_figure(series: OverlaySeries) -> Figure:
     """The rows overlaid: per body axis (columns x, y, z) the body rate and the wheels' momentum
     in body axes, the three axes of a quantity on one value scale; below, the torque norm and the
-    error to the target (logarithmic). Each row has its colour and line style; the legend, beside
-    the panels, gives each row's final values. (The torque per axis, with the actuators' limits,
+    error to the target (logarithmic). Each row has its colour and line style, and a row that is
+    not ok markers along its error curve (:data:`STATUS_MARKERS`); the legend, beside the panels, gives
+    each row's status when not ok (and the pointing violations its records give) and its final
+    values. (The torque per axis, with the actuators' limits,
     is in each row's figure.)
 
     Parameters
@@ -604,10 +643,10 @@ def overlay_figure(series: OverlaySeries) -> Figure:
     error = figure.add_subplot(lower[0, 1], sharex=norm)
     _log_axis(error)
     handles = []
+    statuses = series.statuses or ["ok"] * len(series.labels)
     for k, (torque, curve) in enumerate(zip(series.torque, series.error)):
-        style = _row_style(k)
-        norm.plot(*torque, drawstyle="steps-post", **style)
-        handles.append(error.plot(*curve, **style)[0])
+        norm.plot(*torque, drawstyle="steps-post", **_row_style(k))
+        handles.append(error.plot(*curve, **_row_style(k, statuses[k]))[0])
     _label(norm, "‖u‖ (N m)")
     _label(error, series.error_label)
     for axis in (norm, error):
@@ -648,9 +687,9 @@ def overlay_figure(series: OverlaySeries) -> Figure:
             axis.yaxis.set_major_locator(NullLocator())
             _grid_lines(axis, "y", values)
     if handles:
-        texts = ["\n".join(textwrap.wrap(label, LEGEND_CHARS))
-                 + ("\n  " + "\n  ".join(final.split(", ")) if final else "")
-                 for label, final in zip(series.labels, series.finals or [""] * len(series.labels))]
+        count = len(series.labels)
+        texts = [_legend_text(label, status, breach, final) for label, status, breach, final in
+                 zip(series.labels, statuses, series.breaches or [""] * count, series.finals or [""] * count)]
         figure.legend(handles, texts, loc="upper left",
                       bbox_to_anchor=(OVERLAY_MARGINS["right"] + 0.01, 1 - top / height),
                       fontsize=8, borderaxespad=0.0, handlelength=3.0, labelspacing=0.9)
@@ -684,7 +723,7 @@ def _nice_up(value: float) -> float:
 LIMIT_VIEW_FACTOR = 3.0
 """A panel's view is widened to its actuator limits when they are at most this many times its
 largest value; beyond, the curves keep the view and a note gives the limit."""
-MARGIN_LINEAR_DEG = (0.01, 1.0)
+MARGIN_LINEAR_DEG = (1e-4, 1.0)
 """Bounds of the linear part of the margin axis [deg] (:func:`margin_axis`)."""
 MARGIN_PAD = 0.08
 """Room left below the lowest and above the highest margin, as a fraction of the axis (in its scale)."""
@@ -732,22 +771,47 @@ def margin_axis(axis: Any, low: float, high: float, closest: float) -> None:
     axis.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
 
 
+MINIMUM_MARKER = "v"
+"""Marker of each curve's minimum margin in the margin figure (filled for the closed loop, open for
+the reference)."""
+
+
+def _minimum_text(worst: float | None, lowest: tuple[float, float] | None, scored: bool) -> str:
+    """A legend's account of a curve's minimum margin."""
+    if worst is None:
+        return "no sample in the window"
+    when = f" at {lowest[0]:.4g} s" if lowest is not None else ""
+    return f"min {worst:+.4g}°{when}" + ("" if scored else " (samples)")
+
+
 def _margin_panel(axis: Any, panel: MarginPanel, series: MarginSeries) -> None:
     """One requirement's panel of :func:`margin_figure`."""
     drawn: list[np.ndarray] = []
     handles = []
+    marked = False
     for k, label in enumerate(series.labels):
         color = _row_color(k)
-        for curve, worst, style, name in ((panel.reference[k], panel.worst_reference[k], "--", "reference"),
-                                          (panel.closed_loop[k], panel.worst_closed_loop[k], "-", "closed loop")):
+        for curve, worst, lowest, scored, style, name in (
+                (panel.reference[k], panel.worst_reference[k], _at(panel.lowest_reference, k),
+                 _at(panel.scored_reference, k, False), "--", "reference"),
+                (panel.closed_loop[k], panel.worst_closed_loop[k], _at(panel.lowest_closed_loop, k),
+                 _at(panel.scored_closed_loop, k, False), "-", "closed loop")):
             if curve is None:
                 continue
             t, margin = curve
-            minimum = "no sample in the window" if worst is None else f"min {worst:+.3g}°"
             handles.append(axis.plot(t, margin, style, color=color, lw=1.4 if style == "-" else 1.1,
-                                     label=f"{label}, {name}: {minimum}")[0])
+                                     label=f"{label}, {name}: {_minimum_text(worst, lowest, scored)}")[0])
             axis.fill_between(t, margin, 0.0, where=margin < 0, interpolate=True, color=color, alpha=0.35, lw=0)
             drawn.append(margin)
+            if lowest is not None:
+                axis.plot([lowest[0]], [lowest[1]], MINIMUM_MARKER, color=color, ms=7, zorder=5,
+                          markerfacecolor=color if name == "closed loop" else "white", markeredgewidth=1.2,
+                          label=f"_minimum {k} {name}")
+                drawn.append(np.array([lowest[1]]))
+                marked = True
+    if marked:
+        handles.append(Line2D([], [], linestyle="none", marker=MINIMUM_MARKER, color="0.3", ms=7,
+                              label="each curve's minimum (the results table's)"))
     values = np.concatenate(drawn) if drawn else np.array([np.nan])
     closest = [abs(w) for w in panel.worst_reference + panel.worst_closed_loop if w is not None]
     finite = values[np.isfinite(values)]
@@ -766,6 +830,11 @@ def _margin_panel(axis: Any, panel: MarginPanel, series: MarginSeries) -> None:
     axis.set_ylabel("margin (deg)")
     axis.grid(alpha=0.3)
     axis.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, borderaxespad=0.0)
+
+
+def _at(values: list[Any], k: int, default: Any = None) -> Any:
+    """``values[k]``, or ``default`` past its end."""
+    return values[k] if k < len(values) else default
 
 
 def margin_figure(series: MarginSeries) -> Figure:

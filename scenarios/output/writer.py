@@ -19,6 +19,7 @@ from scenarios.output.directory import (
     new_staging,
 )
 from scenarios.output.names import row_stems
+from scenarios.output.plot_data import knowledge_series
 from scenarios.output.tables import to_csv, to_json, to_markdown
 
 if TYPE_CHECKING:
@@ -34,7 +35,9 @@ def write_timeseries(row: Row, path: Path) -> None:
     Columns: ``t`` [s], ``q0..q3`` (body to inertial, scalar first), ``omega_x..z`` [rad/s, body],
     ``h_w0..`` [N m s], ``u_x..z`` the applied body torque [N m, body] held from ``t`` (blank on
     the last line), ``ref_q0..3``, ``ref_omega_x..z`` [rad/s] and ``ref_omega_dot_x..z`` [rad/s², reference
-    body axes] (blank without a reference).
+    body axes] (blank without a reference); with a star tracker in the loop (an estimator), then
+    ``known_q0..3``, the attitude the controller was given at ``t``, and ``knowledge_error_deg``,
+    its angle from the true attitude [deg] (:func:`scenarios.output.plot_data.knowledge_series`; blank on the last line).
     Non-finite values are blank (:func:`scenarios.output.tables.csv_cell`).
 
     Parameters
@@ -59,6 +62,11 @@ def write_timeseries(row: Row, path: Path) -> None:
     else:
         ref = np.full((sim.t.size, 10), np.nan)
     table = np.hstack([sim.t[:, None], sim.x, torque, ref])
+    knowledge = knowledge_series(sim)
+    if knowledge is not None:
+        known, error = knowledge
+        header += ["known_q0", "known_q1", "known_q2", "known_q3", "knowledge_error_deg"]
+        table = np.hstack([table, known, error[:, None]])
     finite = np.isfinite(table).tolist()
     with path.open("w", newline="") as handle:
         writer = csv.writer(handle)

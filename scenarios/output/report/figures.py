@@ -19,6 +19,7 @@ rates deg/s, torque N m, momentum N m s; frames as :doc:`/architecture` defines 
 """
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 from typing import Any
 
@@ -26,15 +27,29 @@ import numpy as np
 
 from ocp import quat
 from ocp.geometry.pointing import PointingConstraint
-from scenarios.output.plot_data import decimate, held
+from scenarios.output.plot_data import (
+    decimate,
+    held,
+    knowledge_series,
+    scored_minimum,
+    with_point,
+)
 
 __all__ = ["AXIS_COLOURS", "MAX_POINTS", "abscissa", "attitude_figure", "margin_figure", "radec", "row_figure", "sky_figure",
-           "thin"]
+           "thin", "title_layout"]
 
 MAX_POINTS = 1000
 """Most points of one trace (a time series or a track)."""
 FRAMES = 100
 """Most time steps of the 3-D view's slider."""
+SLIDER_START = 0.17
+"""Where the 3-D view's time slider starts (a fraction of the plot's width): its play and pause
+buttons sit left of it."""
+SLIDER_PX = 90
+"""Room below the 3-D view for its time slider (value, rail, tick labels) [px]."""
+ATTITUDE_PX = 770
+"""Height of the 3-D view [px], title and slider included (its page element has it too, so that
+the page does not move when another row is shown)."""
 AXIS_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")
 """Body axes x, y, z (and a wheel along one of them)."""
 _OTHER_COLOURS = ("#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf", "#ff7f0e")
@@ -44,6 +59,40 @@ _ROW_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"
 _LIMIT = {"color": "#b00", "dash": "dot", "width": 1.2}
 _FLOOR_DEG = 1e-9
 """Smallest error angle on the logarithmic axis [deg]."""
+
+
+TITLE_CHARS = 80
+"""Longest line of a figure's title (a longer one is wrapped): at 14 px it fits the plot of an
+800 px wide page."""
+MODEBAR_PX = 42
+"""Height kept free above a figure's title for plotly's mode bar (its buttons, top right) [px]."""
+TITLE_LINE_PX = 19
+"""Height of one line of a figure's title [px]."""
+
+
+def title_layout(text: str, plot_height: float) -> tuple[dict[str, Any], int]:
+    """A figure's title below the mode bar, left-aligned and wrapped, and the top margin it needs.
+
+    Parameters
+    ----------
+    text : str
+        The title.
+    plot_height : float
+        The figure's height without the top margin [px] (the title is placed in the container's
+        coordinates, a fraction of the whole height).
+
+    Returns
+    -------
+    title : dict
+        The layout's ``title``: wrapped at :data:`TITLE_CHARS` (``<br>``), its top
+        :data:`MODEBAR_PX` below the figure's, so that the mode bar never covers it.
+    top : int
+        The top margin [px]: the mode bar's room, the title's lines and a gap.
+    """
+    lines = textwrap.wrap(text, TITLE_CHARS) or [""]
+    top = MODEBAR_PX + TITLE_LINE_PX * len(lines) + 12
+    return ({"text": "<br>".join(lines), "font": {"size": 14}, "x": 0.0, "xref": "paper", "xanchor": "left",
+             "y": 1.0 - MODEBAR_PX / (plot_height + top), "yref": "container", "yanchor": "top"}, top)
 
 
 def thin(t: np.ndarray, *values: np.ndarray) -> np.ndarray:
@@ -107,9 +156,13 @@ def abscissa(x: np.ndarray) -> dict[str, Any]:
 
 
 def _trace(t: np.ndarray, values: np.ndarray, name: str, panel: int, colour: str, *, dash: str = "solid",
-           group: str | None = None, legend: bool = True, shape: str = "linear", unit: str = "") -> dict[str, Any]:
+           group: str | None = None, legend: bool = True, shape: str = "linear", unit: str = "",
+           point: tuple[float, float] | None = None) -> dict[str, Any]:
+    """A time-series trace, thinned (:func:`thin`); ``point``: a (time, value) put into it at its time."""
     index = thin(t, values)
     x, y = _gapped(t, index, values)
+    if point is not None:
+        x, y = with_point((x, y), *point)
     return {"type": "scatter", "mode": "lines", "name": name, **abscissa(x), "y": y, "xaxis": f"x{panel}",
             "yaxis": f"y{panel}", "legend": f"legend{panel}" if panel > 1 else "legend",
             "legendgroup": group or name, "showlegend": legend,
@@ -161,7 +214,9 @@ def row_figure(row: Any, scenario: Any) -> dict[str, Any]:
     """One simulated row against time (module docstring).
 
     Panels: the error angle to the reference (orange) and to the target (black) [deg, log] (in
-    regulation without a target attitude, ``‖ω‖`` [deg/s, log]); the body rate per body axis and
+    regulation without a target attitude, ``‖ω‖`` [deg/s, log]), and with a star tracker in the
+    loop the knowledge error (purple: the attitude the controller was given, from the true one,
+    :func:`scenarios.output.plot_data.knowledge_series`); the body rate per body axis and
     its norm [deg/s]; the actuators' applied torque per body axis [N m] (held over each sample);
     the wheels' momenta [N m s] when there are wheels. The reference is dashed; dotted limits: the
     actuators' body-torque box (``Spacecraft.body_torque_limit``), each wheel's momentum limit,
@@ -204,6 +259,11 @@ def row_figure(row: Any, scenario: Any) -> dict[str, Any]:
         error_title = ("‖ω‖", "deg/s")
         data.append(_trace(t, np.maximum(np.rad2deg(np.linalg.norm(sim.omega, axis=1)), _FLOOR_DEG), "‖ω‖", 1,
                            "#222222", unit="deg/s"))
+    knowledge = knowledge_series(sim)
+    if knowledge is not None:
+        given = np.isfinite(knowledge[1])
+        data.append(_trace(t[given], np.maximum(knowledge[1][given], _FLOOR_DEG), "knowledge error", 1,
+                           "#9467bd", unit="deg"))
     omega = np.rad2deg(sim.omega)
     for i, axis in enumerate("xyz"):
         data.append(_trace(t, omega[:, i], f"ω{axis}", 2, AXIS_COLOURS[i], group=f"rate {axis}", unit="deg/s"))
@@ -248,11 +308,10 @@ def row_figure(row: Any, scenario: Any) -> dict[str, Any]:
         titles.append(("wheel momentum", "N m s"))
         log.append(False)
     controller = f", {row.controller}" if row.controller else ""
-    layout: dict[str, Any] = {
-        "title": {"text": f"{row.label} ({row.planner or 'regulation'}{controller}): solid closed loop, "
-                          "dashed reference", "font": {"size": 14}},
-        "height": 200 * len(titles) + 90, "margin": {"l": 70, "r": 170, "t": 50, "b": 45},
-        "hovermode": "x unified"}
+    title, top = title_layout(f"{row.label} ({row.planner or 'regulation'}{controller}): solid closed loop, "
+                              "dashed reference", 200 * len(titles) + 40)
+    layout: dict[str, Any] = {"title": title, "height": 200 * len(titles) + 40 + top,
+                              "margin": {"l": 70, "r": 170, "t": top, "b": 45}, "hovermode": "x unified"}
     _panels(layout, titles, log)
     return {"data": data, "layout": layout}
 
@@ -276,7 +335,11 @@ def margin_figure(constraint: PointingConstraint, rows: Sequence[Any]) -> dict[s
     dict
         A plotly figure: per row the closed loop's margin (solid) and its reference's (dashed),
         :meth:`~ocp.geometry.pointing.PointingConstraint.margins` in degrees at the simulation's
-        samples (decimated; gaps outside the window); negative is violated.
+        samples (decimated; gaps outside the window); negative is violated. Each curve's legend
+        gives its minimum: the scored one of the row's requirement record (the results table's,
+        :func:`scenarios.output.plot_data.scored_minimum`: evaluated between the samples too),
+        which is also a point of the curve, at its time, and marked (▼); without a record, the
+        samples' own.
     """
     data: list[dict[str, Any]] = []
     end = 0.0
@@ -285,17 +348,37 @@ def margin_figure(constraint: PointingConstraint, rows: Sequence[Any]) -> dict[s
         t = np.asarray(sim.t, dtype=float)
         end = max(end, float(t[-1]))
         colour = _ROW_COLOURS[k % len(_ROW_COLOURS)]
-        data.append(_trace(t, np.rad2deg(constraint.margins(t, sim.q)), row.label, 1, colour, group=row.label,
-                           unit="deg"))
+        curves = [("closed_loop", sim.q, row.label, "solid")]
         if row.reference is not None:
-            data.append(_trace(t, np.rad2deg(constraint.margins(t, row.reference.q(t))), f"{row.label} ref", 1,
-                               colour, dash="dash", group=row.label, legend=False, unit="deg"))
+            curves.append(("reference", row.reference.q(t), f"{row.label} ref", "dash"))
+        for scope, q, name, dash in curves:
+            margin = np.rad2deg(constraint.margins(t, q))
+            record = scored_minimum(row, scope, constraint.name)
+            point: tuple[float, float] | None = None
+            if record is not None and record[1] is not None:
+                point = (record[1], record[0])
+            trace = _trace(t, margin, name, 1, colour, dash=dash, group=row.label, unit="deg", point=point)
+            if record is None and np.any(np.isfinite(margin)):
+                at = int(np.nanargmin(margin))
+                point = (float(t[at]), float(margin[at]))
+            worst = record[0] if record is not None else (point[1] if point is not None else None)
+            if worst is not None:
+                trace["name"] = (f"{name}: min {worst:+.4g}°" + (f" at {point[0]:.4g} s" if point is not None else "")
+                                 + ("" if record is not None else " (samples)"))
+            data.append(trace)
+            if point is not None:
+                data.append({"type": "scatter", "mode": "markers", "name": f"{name} minimum", "x": [point[0]],
+                             "y": [point[1]], "legendgroup": row.label, "showlegend": False,
+                             "marker": {"symbol": "triangle-down" if dash == "solid" else "triangle-down-open",
+                                        "size": 10, "color": colour},
+                             "hovertemplate": f"min %{{y:.4g}} deg at %{{x:.4g}} s<extra>{name}</extra>"})
     data.append({"type": "scatter", "mode": "lines", "name": "zero (violated below)", "x": [0.0, end], "y": [0.0, 0.0],
                  "line": _LIMIT, "hoverinfo": "skip"})
-    layout = {"title": {"text": f"{constraint.name}: {constraint.description}: margin (solid closed loop, dashed "
-                                "reference)", "font": {"size": 14}},
-              "height": 380, "margin": {"l": 70, "r": 30, "t": 50, "b": 45}, "hovermode": "x unified",
-              "xaxis": {"title": {"text": "time (s)"}}, "yaxis": {"title": {"text": "margin (deg)"}}}
+    title, top = title_layout(f"{constraint.name}: {constraint.description}: margin (solid closed loop, dashed "
+                              "reference; ▼ each curve's minimum, the results table's)", 330)
+    layout = {"title": title, "height": 330 + top, "margin": {"l": 70, "r": 30, "t": top, "b": 45},
+              "hovermode": "x unified", "xaxis": {"title": {"text": "time (s)"}},
+              "yaxis": {"title": {"text": "margin (deg)"}}}
     return {"data": data, "layout": layout}
 
 
@@ -431,9 +514,10 @@ def sky_figure(constraint: PointingConstraint, rows: Sequence[Any], frame: str) 
                  "line": {"color": colour, "width": 1},
                  "hovertemplate": "RA %{text:.2f} deg, Dec %{y:.2f} deg<br>t %{customdata:.1f} s<extra>direction</extra>"})
     ticks = np.arange(np.ceil((centre - 180.0) / 30.0) * 30.0, centre + 180.0 + 1e-9, 30.0)
-    layout = {"title": {"text": f"{constraint.name}: {constraint.description}: boresight on the celestial sphere "
-                                f"({frame})", "font": {"size": 14}},
-              "height": 470, "margin": {"l": 70, "r": 30, "t": 50, "b": 45}, "hovermode": "closest",
+    title, top = title_layout(f"{constraint.name}: {constraint.description}: boresight on the celestial sphere "
+                              f"({frame})", 420)
+    layout = {"title": title, "height": 420 + top, "margin": {"l": 70, "r": 30, "t": top, "b": 45},
+              "hovermode": "closest",
               "xaxis": {"title": {"text": "right ascension (deg), increasing to the left"},
                         "range": [centre + 180.0, centre - 180.0], "tickvals": ticks,
                         "ticktext": [f"{v % 360:g}" for v in ticks]},
@@ -519,20 +603,23 @@ def attitude_figure(row: Any, scenario: Any) -> dict[str, Any]:
     frames = [{"name": f"{t[k]:.6g}", "data": [{c: trace[c] for c in coordinates} for trace in moving(int(k))],
                "traces": animated} for k in steps]
     immediate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True}, "transition": {"duration": 0}}
+    # the buttons left of the slider, level with its rail: never over its tick labels
     slider = {"active": 0, "currentvalue": {"prefix": "t = ", "suffix": " s"}, "pad": {"t": 10},
+              "x": SLIDER_START, "len": 1.0 - SLIDER_START, "xanchor": "left", "y": 0.0, "yanchor": "top",
               "steps": [{"label": f"{t[k]:.4g}", "method": "animate", "args": [[f"{t[k]:.6g}"], immediate]}
                         for k in steps]}
-    play = {"type": "buttons", "showactive": False, "x": 0.0, "y": 0.0, "xanchor": "left", "yanchor": "top",
-            "direction": "left", "pad": {"t": 45},
+    play = {"type": "buttons", "showactive": False, "x": SLIDER_START, "y": 0.0, "xanchor": "right", "yanchor": "top",
+            "direction": "left", "pad": {"t": 40, "r": 10},
             "buttons": [{"label": "play", "method": "animate",
                          "args": [None, {"frame": {"duration": 80, "redraw": True}, "fromcurrent": True,
                                          "transition": {"duration": 0}}]},
                         {"label": "pause", "method": "animate", "args": [[None], immediate]}]}
     frame = scenario.frame
     span = [-1.35, 1.35]
-    layout = {"title": {"text": f"{row.label}: attitude in the {frame} frame (body axes, boresights, "
-                                "pointing directions and cones)", "font": {"size": 14}},
-              "height": 640, "margin": {"l": 10, "r": 10, "t": 50, "b": 10},
+    title, top = title_layout(f"{row.label}: attitude in the {frame} frame (body axes, boresights, "
+                              "pointing directions and cones)", ATTITUDE_PX)
+    title["y"] = 1.0 - MODEBAR_PX / ATTITUDE_PX  # the whole height is fixed
+    layout = {"title": title, "height": ATTITUDE_PX, "margin": {"l": 10, "r": 10, "t": top, "b": SLIDER_PX},
               "scene": {"aspectmode": "cube", "xaxis": {"range": span, "title": {"text": "X"}},
                         "yaxis": {"range": span, "title": {"text": "Y"}},
                         "zaxis": {"range": span, "title": {"text": "Z"}}},

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from ocp.metrics import METRIC_INFO
+from scenarios.output.report.figures import ATTITUDE_PX
 from scenarios.output.tables import json_safe
 from scenarios.schema.columns import SCOPES, VECTOR_METRICS, is_requirement_column
 
@@ -457,9 +458,9 @@ nav ul{list-style:none;padding:0;display:flex;flex-wrap:wrap;gap:.4em 1.2em}nav 
 .status-ok{background:#e3f4e3}.status-violated{background:#fff1d6}.status-failed{background:#fbdcdc}
 .status-crashed{background:#e9c4c4}
 .sb-pager{margin:.3em 0;font-size:13px}.sb-pager button{margin-right:.3em}.sb-pager input{margin-left:1em}
-.sb-figure{width:100%;min-height:300px}.sb-3d{height:640px}
+.sb-figure{width:100%;min-height:300px}.sb-3d{height:{attitude}px}
 p.controls{margin:.5em 0;font-size:14px}
-"""
+""".replace("{attitude}", str(ATTITUDE_PX))  # the 3-D view's height (its figure's)
 """The page's style sheet."""
 
 SCRIPT = r"""
