@@ -59,7 +59,7 @@ def test_cases_that_collapse_to_one_simulation_count_once(tmp_path, capsys):
 
 
 def test_a_resumed_sweep_marks_the_directory_incomplete_until_its_tables_are_written(tmp_path, monkeypatch, capsys):
-    import scenarios.study.engine as engine
+    from scenarios.study import engine
     out = tmp_path / "out"
     first = write(tmp_path, {"study": "grow", "grid": {"controller.options.kp": [0.2, 0.3]}})
     assert main(["sweep", str(first), "--out", str(out), "--workers", "1", "--no-plots"]) == 0
