@@ -32,10 +32,18 @@ class MetricInfo(NamedTuple):
         SI unit of the value (``–`` for a ratio).
     meaning : str
         Its definition as :func:`compute_metrics` computes it (reStructuredText inline markup).
+    null_worst_when : str or None
+        For a time whose null can mean "never" (the motion is still outside the band at the last
+        sample): the key of the metric whose value shows that this one applies to the motion
+        (``final_error_deg`` for ``settling_time_s``: a final attitude is set). When that key has
+        a value and this one is null, the null is the worst outcome, later than any time: the
+        trade-study tables count it as never reached, +inf (:mod:`scenarios.study.report`).
+        None (the default): a null only means that the metric does not apply.
     """
 
     unit: str
     meaning: str
+    null_worst_when: str | None = None
 
 
 METRIC_INFO: dict[str, MetricInfo] = {
@@ -76,7 +84,7 @@ METRIC_INFO: dict[str, MetricInfo] = {
     "settling_time_s": MetricInfo(
         "s", "t_(j+1) for the last sample j whose error angle to ``q_f`` exceeds the band "
         "(``simulation.settling_tolerance_deg``, default 0.5°); 0 if no sample does; null if the last "
-        "sample does, or when the final attitude is free."),
+        "sample does, or when the final attitude is free.", null_worst_when="final_error_deg"),
     "saturation_fraction": MetricInfo(
         "–", "Closed loop: fraction of the held intervals in which any actuator was at its limit (a wheel "
         "torque clipped by its torque or momentum limit or at its torque limit, a dipole or torquer axis "

@@ -57,6 +57,39 @@ _SCORE_REQUIREMENTS = True
 ``tests/benchmarks/test_bench_requirements.py``)."""
 
 
+def final_accuracy_note(ends: list[tuple[float | None, float]], rows: int) -> str | None:
+    """The note a run or a sweep prints when its scenario states no ``requirements.final``.
+
+    A row's status reflects the requirements: without a final one, a closed loop that never
+    performs the slew is ``ok``. This note says so and counts the rows that end outside their
+    settling band.
+
+    Parameters
+    ----------
+    ends : list of (float or None, float)
+        For each row of a scenario without ``requirements.final``: its closed loop's
+        ``final_error_deg`` (None without a closed loop or a final attitude) and the scenario's
+        ``simulation.settling_tolerance_deg`` [deg].
+    rows : int
+        All the rows of the run or the sweep.
+
+    Returns
+    -------
+    str or None
+        ``note: no requirements.final: rows are ok whatever their final error; 22 of 24 rows end
+        more than 0.1 deg off the target (up to 90 deg)``; None when no such row ends outside its
+        band.
+    """
+    off = [(error, band) for error, band in ends if error is not None and error > band]
+    if not off:
+        return None
+    bands = {band for _, band in off}
+    band = f"{bands.pop():g} deg" if len(bands) == 1 else "their settling band"
+    return (f"note: no requirements.final: rows are ok whatever their final error; {len(off)} of {rows} "
+            f"row{'s' if rows != 1 else ''} end{'s' if len(off) == 1 else ''} more than {band} (simulation.settling_tolerance_deg) off the target "
+            f"(up to {max(error for error, _ in off):.3g} deg)")
+
+
 def closed_loop_window(scenario: Scenario, reference: Reference | None) -> float:
     """The length of a row's closed loop (and of its flight tables, ``slewbench codegen``).
 

@@ -43,7 +43,7 @@ from scenarios.output.export import EXPORT_FORMATS, default_export_directory, ex
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
 from scenarios.output.writer import plot_streamer, run_files
-from scenarios.runner import run
+from scenarios.runner import final_accuracy_note, run
 from scenarios.schema.labels import row_labels
 from scenarios.schema.loader import (
     OTHER_FILES,
@@ -278,6 +278,12 @@ def command_run(args: argparse.Namespace) -> int:
     interruption.check()
     print()
     print(results.to_terminal(all_metrics=getattr(args, "all_metrics", False)))
+    if scenario.requirements.final is None:  # status reflects requirements: say what it does not check
+        note = final_accuracy_note([((row.closed_loop_metrics or {}).get("final_error_deg"),
+                                     scenario.simulation.settling_tolerance_deg) for row in results.rows],
+                                   len(results.rows))
+        if note:
+            print(note)
     earlier = written_files(out)
     results.write(out, plots=not args.no_plots, renderer=renderer)
     print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"

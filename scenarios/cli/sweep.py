@@ -24,6 +24,7 @@ from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, claim_output_directory, written_files
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
+from scenarios.output.tables import is_missing
 
 if TYPE_CHECKING:  # the trade-study machinery is imported by the handlers: `slewbench run` does not load it
     from scenarios.study.engine import DaskCluster
@@ -172,7 +173,12 @@ def _checking(name: str) -> Any:
 
 def _output(args: argparse.Namespace, study: Study) -> Path:
     """The output directory, checked without writing anything."""
-    from scenarios.study.store import EARLIER_FORMATS, STORE_NAME, store_format
+    from scenarios.study.store import (
+        EARLIER_FORMATS,
+        STORE_NAME,
+        store_format,
+        stored_study_name,
+    )
 
     out = Path(args.out) if args.out else default_output_directory(study.name)
     try:
@@ -187,6 +193,12 @@ def _output(args: argparse.Namespace, study: Study) -> Path:
     if stored and not args.resume:
         raise OutputError(out, f"already holds a sweep ({STORE_NAME}); pass --resume to continue it, "
                                "--report to redraw it, or choose another --out")
+    if stored:
+        other = stored_study_name(out)
+        if other is not None and other != study.name:  # a store recording no study: nothing to compare
+            raise OutputError(out, f"holds the sweep of study {other!r}, not {study.name!r}: --resume continues the "
+                                   "same study (its `study:` name), whose stored cases it keeps; choose another "
+                                   "--out (nothing was touched)")
     return out
 
 
@@ -217,11 +229,13 @@ def _undo(out: Path, missing: Path | None, empty: bool) -> None:
 def _open(out: Path, study: Study) -> tuple[Path, SweepStore]:
     """Claim the directory and open the store with the study in it; on failure (a full disk), undo."""
     from scenarios.study.report import resolved_study
-    from scenarios.study.store import SweepStore, claim_sweep_directory
+    from scenarios.study.store import SweepStore, claim_sweep_directory, mark_incomplete
 
     missing, empty = _created(Path(out).absolute())
     try:
         directory = claim_sweep_directory(out)
+        # the tables there (a resumed sweep's) stop describing the store from here: incomplete until rewritten
+        mark_incomplete(directory)
         store = SweepStore(directory)
         try:
             store.set_meta("study", resolved_study(study))
@@ -276,7 +290,12 @@ def command_sweep(args: argparse.Namespace) -> int:
     if not scheduler:
         start_forkserver()  # local workers' imports run while the study is expanded and checked
     name = Path(args.file).stem
-    study = load_study(args.file, progress=_checking(name))
+    try:
+        study = load_study(args.file, progress=_checking(name))
+    except KeyboardInterrupt:  # an interrupted sweep exits 130, in its checking phase too
+        print("slewbench: sweep interrupted while its cases were checked; nothing was run or written",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
     if args.dry_run:
         _list_cases(study)
         return EXIT_OK
@@ -339,7 +358,7 @@ def resume_command(args: argparse.Namespace, out: Path) -> str:
 
 def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster | None) -> int:
     from scenarios.study.engine import sweep
-    from scenarios.study.report import robustness_tables
+    from scenarios.study.report import collapse_note, robustness_tables
     from scenarios.study.robustness import crashed_counts, robustness_lines
     from scenarios.study.store import STORE_NAME, SweepStore, resume_counts
 
@@ -370,7 +389,13 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
     finally:
         signal.signal(signal.SIGTERM, previous)
     earlier = written_files(out)
-    files = results.write(out, plots=not args.no_plots)
+    try:
+        files = results.write(out, plots=not args.no_plots)
+    except KeyboardInterrupt:
+        print(f"slewbench: sweep interrupted while its tables were written; every case is stored in "
+              f"{out / STORE_NAME} and the directory is marked incomplete. Write them with:\n"
+              f"  {shlex.join(['slewbench', 'sweep', '--report', str(out)])}", file=sys.stderr)
+        return EXIT_INTERRUPTED
     records = results.records.values()
     crashed = sum(record["status"] == "crashed" for record in records)
     not_ok = sum(record["status"] != "crashed" and any(r["status"] != "ok" for r in record["rows"])
@@ -382,6 +407,9 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
           + f"; of the {len(records)} cases stored, {crashed} crashed and {others}; wrote {out}/ ({', '.join(files)})")
     _say_removed(out, earlier)
     rows = results.table()[1]
+    for said in (collapse_note(study), _final_note(study, rows)):
+        if said:
+            print(said)
     tables = robustness_tables(study, rows)
     if tables is not None:
         proportions, _, worst = tables
@@ -390,6 +418,22 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
         print("\n".join(robustness_lines(proportions, worst, crashed_counts(study, rows))))
         print(f"re-run a case in full: slewbench sweep {shlex.quote(str(out))} --case N")
     return EXIT_OK
+
+
+def _final_note(study: Study, rows: list[dict[str, Any]]) -> str | None:
+    """:func:`scenarios.runner.final_accuracy_note` of the rows whose case states no ``requirements.final``."""
+    from ocp.metrics import DEFAULT_SETTLING_TOLERANCE_DEG
+    from scenarios.runner import final_accuracy_note
+
+    cases = {case.index: case.scenario for case in study.cases}
+    ends = []
+    for row in rows:
+        scenario = cases[row["case"]]
+        if (scenario.get("requirements") or {}).get("final") is None:
+            band = (scenario.get("simulation") or {}).get("settling_tolerance_deg", DEFAULT_SETTLING_TOLERANCE_DEG)
+            error = row.get("cl.final_error_deg")
+            ends.append((None if is_missing(error) else error, float(band)))
+    return final_accuracy_note(ends, len(rows))
 
 
 def add_sweep_parser(commands: Any) -> None:

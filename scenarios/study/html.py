@@ -43,9 +43,10 @@ ROBUSTNESS_SECTIONS = (
     ("Robustness", ("Fraction of the completed cases meeting every requirement and each threshold of "
                     "robustness.thresholds, with the Wilson 95 % interval (robustness.csv).")),
     ("Sensitivity", ("Spearman rank correlation of each summary metric with each dispersed parameter, a vector per "
-                     "component, over the rows where the metric has a value (sensitivity.csv).")),
-    ("Worst cases", ("The largest values of each summary metric (smallest for an at_least threshold), by case id; "
-                     "re-run one in full with slewbench sweep DIR --case N (worst_cases.csv).")),
+                     "component, over the rows where the metric has a value, a case that never settled ranked "
+                     "after every settled one (sensitivity.csv).")),
+    ("Worst cases", ("The largest values of each summary metric (smallest for an at_least threshold), by case id "
+                     "(inf: the case never settled); re-run one in full with slewbench sweep DIR --case N (worst_cases.csv).")),
 )
 """Titles and explanations of the robustness sections, in the order of the robustness tables."""
 _COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f")
@@ -156,6 +157,13 @@ def histogram_figure(column: str, rows: list[dict[str, Any]], labels: list[str])
     return {"data": data, "layout": layout}
 
 
+def _columns(names: list[str], rows: list[dict[str, Any]]) -> list[Column]:
+    """:func:`~scenarios.output.report.run.result_columns`, a statistic written ``inf`` (a case that never
+    settled, :data:`scenarios.study.report.INFINITY_TEXT`) keeping its column numeric."""
+    from scenarios.study.report import INFINITY_TEXT
+    return result_columns(names, [{k: None if v == INFINITY_TEXT else v for k, v in row.items()} for row in rows])
+
+
 def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
                  summary: tuple[list[str], list[dict[str, Any]]],
                  requirements: tuple[list[str], list[dict[str, Any]]], missing: int,
@@ -200,13 +208,15 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
                                                                                      "worst")):
             if table:
                 page.section(title, text)
-                page.table(key, result_columns(keys, table), [[row.get(c) for c in keys] for row in table])
+                page.table(key, _columns(keys, table), [[row.get(c) for c in keys] for row in table])
     metric = summary[0].index("metric") + 1
     summary_names = [*summary[0][:metric], "unit", *summary[0][metric:]]
     summary_rows = [{**row, "unit": column_unit(row["metric"])} for row in summary[1]]
-    page.section("Summary", "Statistics of each summary metric per planner row over the cases where it has a value "
-                            "(std: sample standard deviation; p5, p95: linear percentiles; failures: rows not ok).")
-    page.table("summary", result_columns(summary_names, summary_rows),
+    page.section("Summary", "Statistics of each summary metric per planner row (count: rows with a value; never: rows "
+                            "that never reached one, a case that never settled; no_value: the other rows). mean and "
+                            "std (sample standard deviation) are over the count rows; median, p5, p95 (linear "
+                            "percentiles), min and max over those and the never rows as inf; failures: rows not ok.")
+    page.table("summary", _columns(summary_names, summary_rows),
                [[row.get(c) for c in summary_names] for row in summary_rows])
     if study.summary and rows:
         page.section("Distributions", "Cases per bin of each summary metric, one curve per planner row.")

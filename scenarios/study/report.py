@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import yaml
 
+from ocp.metrics import METRIC_INFO
 from scenarios.output.directory import (
     new_staging,
 )
@@ -38,7 +39,8 @@ from scenarios.study.types import Study
 if TYPE_CHECKING:  # the engine imports this module lazily
     from scenarios.study.engine import SweepResults
 
-STATISTICS = ("count", "failures", "mean", "std", "median", "p5", "p95", "min", "max")
+STATISTICS = ("count", "never", "no_value", "failures", "mean", "std", "median", "p5", "p95", "min", "max")
+"""The columns of ``summary.csv`` after the grouping keys and ``metric`` (:func:`summary_table`)."""
 PROPORTION_STATISTICS = ("completed", "met", "fraction_met", "wilson_low", "wilson_high")
 """The columns of ``requirements.csv`` (and ``robustness.csv``) after the grouping keys: rows that
 completed (not ``crashed``), those meeting the criterion (``ok``: every requirement), their fraction
@@ -86,11 +88,99 @@ def _number(value: Any) -> float | None:
     return float(value)
 
 
+def never_witness(column: str) -> str | None:
+    """The column whose value makes a null of ``column`` mean "never reached" (the worst outcome).
+
+    A metric column ``ref.<key>`` or ``cl.<key>`` whose :class:`ocp.metrics.MetricInfo` declares
+    ``null_worst_when`` (``settling_time_s``: ``final_error_deg``) has as witness the same scope's
+    column of that key: a row with a final error and without a settling time never settled.
+
+    Parameters
+    ----------
+    column : str
+        A ``cases.csv`` column.
+
+    Returns
+    -------
+    str or None
+        The witness column (``cl.final_error_deg`` for ``cl.settling_time_s``); None for a column
+        whose null only means that it does not apply.
+    """
+    scope, _, key = column.partition(".")
+    info = METRIC_INFO.get(key)
+    return None if info is None or info.null_worst_when is None else f"{scope}.{info.null_worst_when}"
+
+
+def metric_values(column: str, rows: list[dict[str, Any]]) -> np.ndarray:
+    """A metric column's values as the study's statistics, rankings and correlations take them.
+
+    Parameters
+    ----------
+    column : str
+        A ``cases.csv`` column.
+    rows : list of dict
+        The ``cases.csv`` rows (:func:`case_table`).
+
+    Returns
+    -------
+    (len(rows),) ndarray
+        The row's number; +inf where the metric never reached its value (a null of a metric that
+        declares ``null_worst_when``, :func:`never_witness`, in a row where the witness has a
+        value: a case that never settled); NaN where the row has no value (the metric does not
+        apply, a failed planner, a crashed case).
+    """
+    witness = never_witness(column)
+    values = np.full(len(rows), math.nan)
+    for k, row in enumerate(rows):
+        value = _number(row.get(column))
+        if value is not None:
+            values[k] = value
+        elif witness is not None and _number(row.get(witness)) is not None:
+            values[k] = math.inf
+    return values
+
+
+def percentile(values: np.ndarray, q: float) -> float:
+    """The linear percentile ``q`` of ``values``, which may hold +inf (a case that never settled).
+
+    As ``numpy.percentile`` (linear interpolation between the two nearest ordered values); a
+    percentile that interpolates towards +inf is +inf.
+
+    Parameters
+    ----------
+    values : (n,) ndarray
+        Finite numbers and +inf, n >= 1.
+    q : float
+        The percentile, 0 to 100.
+
+    Returns
+    -------
+    float
+    """
+    if np.isfinite(values).all():
+        return float(np.percentile(values, q))
+    ordered = np.sort(values)
+    position = q / 100.0 * (ordered.size - 1)
+    low = math.floor(position)
+    fraction = position - low
+    if fraction == 0.0 or low + 1 >= ordered.size:
+        return float(ordered[low])
+    if math.isinf(ordered[low + 1]):
+        return math.inf
+    return float(ordered[low] + (ordered[low + 1] - ordered[low]) * fraction)
+
+
 def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
     """Statistics of each summary metric per planner row label (and grid point under Monte Carlo).
 
-    ``count`` is the number of rows, ``failures`` those whose status is not ``ok``; the
-    statistics are over the rows where the metric has a value (p5, p95: linear percentiles).
+    ``count`` is the number of rows where the metric has a value, ``never`` those where it never
+    reached one (a settling time whose motion still ends outside the band: :func:`metric_values`;
+    None for a metric whose null only means that it does not apply), ``no_value`` the other rows
+    (the metric does not apply, a failed planner, a crashed case); the three add up to the group's
+    rows. ``failures`` are the rows whose status is not ``ok``. ``mean`` and ``std`` are over the
+    ``count`` rows with a value; ``median``, ``p5``, ``p95`` (linear percentiles), ``min`` and
+    ``max`` are over those and the ``never`` rows taken as +inf (:func:`percentile`), so that a
+    percentile reached by cases that never settled is +inf.
 
     Parameters
     ----------
@@ -102,27 +192,57 @@ def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], 
     Returns
     -------
     columns : list of str
-        The grouping keys, ``metric`` and the statistics.
+        The grouping keys, ``metric`` and :data:`STATISTICS`.
     rows : list of dict
-        One per group and summary metric; a statistic without values is None.
+        One per group and summary metric; a statistic without values is None, an infinite one
+        ``math.inf`` (written ``inf``: :func:`shown_infinity`).
     """
     keys, groups = group_rows(study, rows)
     columns = [*keys, "metric", *STATISTICS]
     table = []
     for members in groups.values():
         for metric in study.summary:
-            values = np.array([v for v in (_number(r.get(metric)) for r in members) if v is not None])
+            values = metric_values(metric, members)
+            finite = values[np.isfinite(values)]
+            ranked = values[~np.isnan(values)]
+            never = int(np.isinf(values).sum())
             line = {k: members[0].get(k) for k in keys}
-            line.update(metric=metric, count=len(members), failures=sum(r["status"] != "ok" for r in members))
-            if values.size:
-                p5, p95 = np.percentile(values, (5, 95))
-                stats: tuple = (values.mean(), values.std(ddof=1) if values.size > 1 else 0.0, np.median(values),
-                                p5, p95, values.min(), values.max())
+            line.update(metric=metric, count=int(finite.size), never=never if never_witness(metric) else None,
+                        no_value=int(np.isnan(values).sum()), failures=sum(r["status"] != "ok" for r in members))
+            mean = std = None
+            if finite.size:
+                mean, std = float(finite.mean()), float(finite.std(ddof=1)) if finite.size > 1 else 0.0
+            line.update(mean=mean, std=std)
+            if ranked.size:
+                line.update(median=percentile(ranked, 50.0), p5=percentile(ranked, 5.0), p95=percentile(ranked, 95.0),
+                            min=float(ranked.min()), max=float(ranked.max()))
             else:
-                stats = (None,) * 7
-            line.update({name: None if v is None else float(v) for name, v in zip(STATISTICS[2:], stats)})
+                line.update(dict.fromkeys(("median", "p5", "p95", "min", "max")))
             table.append(line)
     return columns, table
+
+
+INFINITY_TEXT = "inf"
+"""How the written tables (CSV, Markdown, ``report.html``) show a statistic or a worst value that is
++inf (a case that never settled), where the one rule for non-finite values
+(:mod:`scenarios.output.tables`) would leave the cell empty, as if there were no value."""
+
+
+def shown_infinity(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The rows with +inf written as :data:`INFINITY_TEXT` (pandas reads it back as ``inf``).
+
+    Parameters
+    ----------
+    rows : list of dict
+        Table rows.
+
+    Returns
+    -------
+    list of dict
+        Copies of the rows that hold +inf, the others as they are.
+    """
+    return [{k: INFINITY_TEXT if isinstance(v, float) and v == math.inf else v for k, v in row.items()}
+            if any(isinstance(v, float) and v == math.inf for v in row.values()) else row for row in rows]
 
 
 def wilson_interval(successes: int, trials: int, z: float = WILSON_Z) -> tuple[float, float] | None:
@@ -177,6 +297,57 @@ def proportion(met: int, completed: int) -> dict[str, Any]:
             "wilson_high": None if interval is None else interval[1]}
 
 
+def distinct_rows(study: Study, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The rows of the study's distinct cases: of cases that share a store key (the same scenario:
+    a degenerate dispersion such as ``uniform: [a, a]``, a grid value given twice), the first.
+
+    Cases with one key are one simulation, stored once: counting each as a sample would count one
+    deterministic outcome several times and narrow the Wilson interval without information. The
+    proportions (``requirements.csv``, ``robustness.csv``) are over these rows.
+
+    Parameters
+    ----------
+    study : Study
+        The expanded study (its cases' keys).
+    rows : list of dict
+        The ``cases.csv`` rows (:func:`case_table`).
+
+    Returns
+    -------
+    list of dict
+        The rows whose case is the first of its key (all rows when every case has its own key; a
+        row without a case of the study is kept).
+    """
+    keys = {case.index: case.key for case in study.cases}
+    first: dict[str, int] = {}
+    for case in study.cases:
+        first.setdefault(case.key, case.index)
+    if len(first) == len(keys):
+        return rows
+    return [row for row in rows if row.get("case") not in keys or first[keys[row["case"]]] == row["case"]]
+
+
+def collapse_note(study: Study) -> str | None:
+    """What the outputs say of a study whose cases collapse to fewer distinct ones (:func:`distinct_rows`).
+
+    Parameters
+    ----------
+    study : Study
+        The expanded study.
+
+    Returns
+    -------
+    str or None
+        ``note: the 20 cases are 1 distinct case ...``; None when every case has its own key.
+    """
+    distinct = len({case.key for case in study.cases})
+    if distinct == len(study.cases):
+        return None
+    return (f"note: the {len(study.cases)} cases are {distinct} distinct case{'s' if distinct != 1 else ''} (cases with "
+            "the same scenario share one store key and one simulation: a dispersion that draws one value, a "
+            "repeated grid value); the proportions and their Wilson intervals count each distinct case once")
+
+
 def group_rows(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], dict[tuple, list[dict[str, Any]]]]:
     """The grouping keys of the study's tables and the rows of each group.
 
@@ -207,7 +378,7 @@ def requirement_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[st
     that meet every requirement (status ``ok``) and its Wilson 95 % interval (:func:`wilson_interval`).
 
     A completed case is one whose row is not ``crashed``; a ``failed`` or ``violated`` row completed
-    and does not meet them.
+    and does not meet them. Cases that share a store key count once (:func:`distinct_rows`).
 
     Parameters
     ----------
@@ -223,7 +394,7 @@ def requirement_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[st
     rows : list of dict
         One per group; the fraction and the interval are None without completed cases.
     """
-    keys, groups = group_rows(study, rows)
+    keys, groups = group_rows(study, distinct_rows(study, rows))
     table = []
     for members in groups.values():
         completed = [r for r in members if r["status"] != "crashed"]
@@ -240,12 +411,15 @@ def _table_lines(columns: list[str], rows: list[dict[str, Any]]) -> list[str]:
 
 def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], missing: int,
               requirements: tuple[list[str], list[dict[str, Any]]] | None = None, robustness: str = "") -> str:
+    note = collapse_note(study)
     out = [f"# {study.name}", "", (f"{len(study.cases)} cases ({missing} missing), "
                                    f"{study.samples} Monte Carlo sample(s) per grid point, slewbench "
-                                   f"{package_version()}."), ""]
+                                   f"{package_version()}."), "", *([note, ""] if note else [])]
     out += _table_lines(columns, rows)
     out += ["", ("Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s. "
-                 "std is the sample standard deviation; p5 and p95 are linear percentiles."), ""]
+                 "count: rows with a value; never: rows that never reached one (a case that never settled); "
+                 "no_value: the other rows. mean and std (sample standard deviation) are over the count rows; "
+                 "median, p5, p95 (linear percentiles), min and max over those and the never rows as inf."), ""]
     if requirements is not None:
         out += ["## Cases meeting every requirement", "",
                 "Rows whose status is ok among the completed ones (not crashed), with the Wilson 95 % interval.", ""]
@@ -339,8 +513,11 @@ def write_report(results: SweepResults, directory: str | Path, plots: bool = Tru
     directory = claim_sweep_directory(directory)
     columns, rows = case_table(study, results.records)
     summary_columns, summary = summary_table(study, rows)
+    summary = shown_infinity(summary)  # +inf (never settled) written "inf", not an empty cell
     requirements = requirement_table(study, rows)
     robustness = robustness_tables(study, rows)
+    if robustness is not None:
+        robustness = tuple((names, shown_infinity(table)) for names, table in robustness)  # type: ignore[assignment]
     markdown = ""
     if robustness is not None:
         from scenarios.study.robustness import robustness_markdown

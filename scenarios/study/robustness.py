@@ -10,14 +10,20 @@ as ``summary.csv`` groups them), written as ``robustness.csv``, ``sensitivity.cs
   requirement (status ``ok``, as ``requirements.csv``) and, for each ``robustness.thresholds``
   entry, whose metric is at most (or at least) its bound, each with its Wilson 95 % interval
   (:func:`scenarios.study.report.wilson_interval`). A completed row without a value (a failed
-  planner) does not meet a threshold.
+  planner) does not meet a threshold. Cases that share a store key (the same scenario) count once
+  (:func:`scenarios.study.report.distinct_rows`).
 * :func:`sensitivity_table`: Spearman's rank correlation of each summary metric with each dispersed
-  parameter over the rows where the metric has a value; a dispersed vector (or matrix) gives one
-  parameter per component (``spacecraft.inertia[1]``), and components that do not vary are left
-  out. Ties get their average rank.
+  parameter over the rows where the metric has a value or never reached one (a case that never
+  settled ranks after every settled one, ties averaged: :func:`scenarios.study.report.metric_values`);
+  a dispersed vector (or matrix) gives one parameter per component (``spacecraft.inertia[1]``), and
+  components that do not vary are left out. Ties get their average rank.
 * :func:`worst_table`: the ``robustness.worst`` cases with the largest value of each summary metric
   (the smallest for a metric with an ``at_least`` threshold), by case id, with their seeds, to be
-  re-run in full with ``slewbench sweep DIR --case N``.
+  re-run in full with ``slewbench sweep DIR --case N``; a case that never settled is +inf, the
+  largest.
+
+A threshold on a metric counts a case that never reached it as +inf too (it does not meet an
+``at_most`` bound).
 """
 from __future__ import annotations
 
@@ -27,9 +33,16 @@ from typing import Any
 
 import numpy as np
 
-from scenarios.output.tables import is_missing, text_cell
+from scenarios.output.tables import text_cell
 from scenarios.schema.study import CASE_SEED
-from scenarios.study.report import PROPORTION_STATISTICS, group_rows, proportion
+from scenarios.study.report import (
+    INFINITY_TEXT,
+    PROPORTION_STATISTICS,
+    distinct_rows,
+    group_rows,
+    metric_values,
+    proportion,
+)
 from scenarios.study.types import Study
 
 __all__ = ["EVERY_REQUIREMENT", "SENSITIVITY_STATISTICS", "WORST_COLUMNS", "crashed_counts", "criterion_text",
@@ -41,7 +54,8 @@ EVERY_REQUIREMENT = "every requirement"
 """The criterion of the rows whose status is ``ok``."""
 SENSITIVITY_STATISTICS = ("cases", "spearman_rho")
 """The columns of ``sensitivity.csv`` after the grouping keys, ``metric`` and ``parameter``: the rows
-with a value of the metric, and their rank correlation (None when either side does not vary)."""
+with a value of the metric or that never reached one (+inf, the largest rank), and their rank
+correlation (None when either side does not vary)."""
 WORST_COLUMNS = ("metric", "rank", "case", "seed", "value", "status")
 """The columns of ``worst_cases.csv`` after the grouping keys."""
 MIN_CASES = 3
@@ -70,13 +84,6 @@ def criterion_text(metric: str, sense: str, bound: float) -> str:
     return f"{metric} {'<=' if sense == 'at_most' else '>='} {bound:g}"
 
 
-def _number(value: Any) -> float:
-    """A metric value as a float; NaN when missing or not a number."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or is_missing(value):
-        return math.nan
-    return float(value)
-
-
 def proportion_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
     """Per group: the fraction of completed cases meeting every requirement, then each threshold.
 
@@ -95,16 +102,16 @@ def proportion_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str
         One per group and criterion (:data:`EVERY_REQUIREMENT` first); the fraction and its
         interval are None without completed cases.
     """
-    keys, groups = group_rows(study, rows)
+    keys, groups = group_rows(study, distinct_rows(study, rows))  # a case shared by several counts once
     table = []
     for members in groups.values():
         completed = [r for r in members if r["status"] != "crashed"]
         criteria = [(EVERY_REQUIREMENT, sum(r["status"] == "ok" for r in completed))]
         for metric, (sense, bound) in study.thresholds.items():
-            values = np.array([_number(r.get(metric)) for r in completed])
+            values = metric_values(metric, completed)  # +inf: never settled; NaN: no value
             with np.errstate(invalid="ignore"):
                 meets = values <= bound if sense == "at_most" else values >= bound
-            criteria.append((criterion_text(metric, sense, bound), int(np.sum(meets & np.isfinite(values)))))
+            criteria.append((criterion_text(metric, sense, bound), int(np.sum(meets & ~np.isnan(values)))))
         for criterion, met in criteria:
             line = {k: members[0].get(k) for k in keys}
             line.update(criterion=criterion, **proportion(met, len(completed)))
@@ -184,7 +191,8 @@ def spearman(x: np.ndarray, y: np.ndarray) -> float | None:
     Parameters
     ----------
     x, y : (n,) ndarray
-        Paired values; pairs with a non-finite value are left out.
+        Paired values; pairs with a NaN (no value) are left out, +inf ranks after every finite
+        value (a case that never settled), several +inf tie.
 
     Returns
     -------
@@ -193,7 +201,7 @@ def spearman(x: np.ndarray, y: np.ndarray) -> float | None:
         not vary.
     """
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-    keep = np.isfinite(x) & np.isfinite(y)
+    keep = ~np.isnan(x) & ~np.isnan(y)
     if keep.sum() < MIN_CASES:
         return None
     rx, ry = _ranks(x[keep]), _ranks(y[keep])
@@ -229,11 +237,11 @@ def sensitivity_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[st
     for members in groups.values():
         index = np.array([position[id(r)] for r in members], dtype=int)
         for metric in study.summary:
-            values = np.array([_number(r.get(metric)) for r in members])
+            values = metric_values(metric, members)  # never settled: +inf, the largest rank
             for name, column in parameters:
                 line = {k: members[0].get(k) for k in keys}
                 line.update(metric=metric, parameter=name,
-                            cases=int(np.sum(np.isfinite(values) & np.isfinite(column[index]))),
+                            cases=int(np.sum(~np.isnan(values) & np.isfinite(column[index]))),
                             spearman_rho=spearman(column[index], values))
                 table.append(line)
     return [*keys, "metric", "parameter", *SENSITIVITY_STATISTICS], table
@@ -254,16 +262,18 @@ def worst_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], li
     columns : list of str
         The grouping keys and :data:`WORST_COLUMNS`.
     rows : list of dict
-        Per group and metric, ranks 1 to ``worst`` among the rows with a value: the largest values
-        first (the smallest for a metric with an ``at_least`` threshold); ties in case order. A
-        metric with one value in every row of the group lists none.
+        Per group and metric, ranks 1 to ``worst`` among the rows with a value or that never
+        reached one (``value`` +inf: a case that never settled,
+        :func:`scenarios.study.report.metric_values`): the largest values first (the smallest for a
+        metric with an ``at_least`` threshold); ties in case order. A metric with one value in
+        every row of the group lists none.
     """
     keys, groups = group_rows(study, rows)
     table = []
     for members in groups.values():
         for metric in study.summary:
             least = study.thresholds.get(metric, ("at_most", 0.0))[0] == "at_least"
-            valued = [(v, r) for v, r in ((_number(r.get(metric)), r) for r in members) if math.isfinite(v)]
+            valued = [(float(v), r) for v, r in zip(metric_values(metric, members), members) if not math.isnan(v)]
             if len({v for v, _ in valued}) < 2:
                 continue  # one value in every row: no case is worse than another
             valued.sort(key=lambda pair: pair[0] if least else -pair[0])  # stable: ties keep case order
@@ -334,11 +344,12 @@ def robustness_markdown(study: Study, rows: list[dict[str, Any]],
             entry[line["parameter"]] = line["spearman_rho"]
         out += ["## Sensitivity", "", ("Spearman rank correlation of each summary metric (rows) with each dispersed "
                                        "parameter (columns; a vector per component), over the rows where the metric "
-                                       "has a value; empty: the metric does not vary."), ""]
+                                       "has a value, a case that never settled ranked after every settled one; "
+                                       "empty: the metric does not vary."), ""]
         out += _lines([*keys, "metric", *parameters], list(wide.values())) + [""]
     if worst[1]:
         out += ["## Worst cases", "", (f"The {study.worst} largest values of each summary metric (smallest for "
-                                       "an at_least threshold), by case id."), ""]
+                                       "an at_least threshold), by case id; inf: the case never settled."), ""]
         out += _lines(*worst) + [""]
     return "\n".join(out)
 
@@ -382,7 +393,8 @@ def robustness_lines(proportions: tuple[list[str], list[dict[str, Any]]],
     list of str
         One line per group and criterion (``  fast: every requirement 98/100 = 0.98 [0.930, 0.994]``),
         one line for a group without a completed case (``  30.0, smooth: no completed case (3 crashed)``),
-        then one per group and metric (``  fast: worst cl.int_u: case 17, 3, 55``).
+        then one per group and metric (``  fast: worst cl.int_u: case 17, 3, 55``; a case that never
+        settled is marked, ``case 4 (never), 8``).
     """
     columns, table = proportions
     keys = columns[:columns.index("criterion")]
@@ -404,6 +416,7 @@ def robustness_lines(proportions: tuple[list[str], list[dict[str, Any]]],
                      f"{line['fraction_met']:.3g} [{line['wilson_low']:.3f}, {line['wilson_high']:.3f}]")
     listed: dict[tuple[str, str], list[str]] = {}
     for line in worst[1]:
-        listed.setdefault((group(line), line["metric"]), []).append(str(line["case"]))
+        never = line["value"] == math.inf or line["value"] == INFINITY_TEXT
+        listed.setdefault((group(line), line["metric"]), []).append(f"{line['case']}{' (never)' if never else ''}")
     lines += [f"  {name}: worst {metric}: case {', '.join(cases)}" for (name, metric), cases in listed.items()]
     return lines

@@ -288,6 +288,10 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
     dispersions: list[tuple[_Varied, Dispersion]] = []
     if mc is not None:
         node = mc["dispersions"]
+        if not node.value:  # every sample would be the same case: one simulation counted as many
+            raise node.error("give at least one dispersion (scenario path -> distribution); without one every "
+                             "Monte Carlo sample is the same case, one simulation counted as independent samples. "
+                             "To run the scenario once, drop monte_carlo")
         for path in node.value:
             entry = node.get(path)
             varied = _Varied(path, entry.path, parse_path(path, entry.path))

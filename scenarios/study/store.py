@@ -503,3 +503,52 @@ def commit_sweep_outputs(directory: Path, staging: Path, kind: str = "sweep") ->
     written = commit_outputs(directory, staging, kind=kind)
     write_manifest(directory, [*written, *STORE_FILES], complete=True, kind=kind)
     return written
+
+
+def mark_incomplete(directory: Path, kind: str = "sweep") -> None:
+    """Mark a claimed sweep directory's outputs incomplete: its tables stop describing the store
+    (a sweep starts or resumes: cases are added, a changed study's stored with it) until
+    :func:`commit_sweep_outputs` writes them again and marks them complete.
+
+    Parameters
+    ----------
+    directory : Path
+        The claimed sweep directory (:func:`claim_sweep_directory`).
+    kind : str
+        The marker's kind, as claimed.
+
+    Raises
+    ------
+    OutputError
+        The directory carries no slewbench marker.
+    """
+    manifest = read_manifest(directory)
+    if manifest is None:
+        raise OutputError(directory, f"lost its {MARKER}; nothing was replaced")
+    if manifest.get("complete"):
+        write_manifest(directory, manifest["files"], complete=False, kind=kind)
+
+
+def stored_study_name(directory: Path) -> str | None:
+    """The name (``study:``) of the study whose sweep ``directory`` stores, read without writing.
+
+    Parameters
+    ----------
+    directory : Path
+        A directory holding a sweep store.
+
+    Returns
+    -------
+    str or None
+        The stored study's name; None when the store cannot be read as a sweep store or records no
+        named study (the checks that open it then say what is wrong).
+    """
+    try:
+        with contextlib.closing(sqlite3.connect((Path(directory) / STORE_NAME).absolute().as_uri() + "?mode=ro",
+                                                uri=True, timeout=30.0)) as db:
+            found = db.execute("SELECT value FROM meta WHERE name = 'study'").fetchone()
+        study = json.loads(found[0]) if found is not None else None
+    except (sqlite3.Error, TypeError, ValueError):
+        return None
+    name = study.get("study") if isinstance(study, dict) else None
+    return name if isinstance(name, str) else None
