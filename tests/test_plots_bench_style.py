@@ -89,3 +89,15 @@ def test_a_name_outside_the_registries_has_a_fixed_style(kind):
     from scenarios.bench.leaderboard import _plot_style
 
     assert _plot_style("not_registered", kind) == _plot_style("not_registered", kind)
+
+
+def test_the_plot_draws_the_rows_whose_plan_is_ok(tmp_path, monkeypatch):
+    """The gap is judged on the plan: a row whose plan keeps every requirement but whose closed loop
+    breaks one (keep_out_melton_scaled's collocation) is drawn; a row whose plan breaks one is not."""
+    planners = list(PLANNERS)
+    tracked_badly = BenchRow("p", planners[0], planners[0], "planner", "violated", 1.0, 1e-4, 1e-4, True, 0.1, None,
+                             "-", "", "ok")
+    plan_broken = BenchRow("p", planners[1], planners[1], "planner", "violated", 1.0, 1e-4, 1e-4, False, 0.1, None,
+                           "-", "", "violated")
+    labels = set(styles(drawn(Leaderboard(load_suite(), [], [tracked_badly, plan_broken]), tmp_path, monkeypatch)))
+    assert labels == {planners[0]}

@@ -225,3 +225,11 @@ def test_a_broken_bound_and_its_value_are_written_to_the_same_digits():
         for excess in (1e-9, 1e-6, 1e-3, 0.5):
             shown, limit = _over(bound * (1 + excess), bound)
             assert float(shown) > float(limit)  # as written, the value reads above its bound
+
+
+@pytest.mark.parametrize(("seconds", "text"), [(0.0093, "0.0093"), (0.0, "0.0"), (3.3, "3.3"), (0.1, "0.1")])
+def test_a_short_violation_is_never_printed_as_zero_seconds(seconds, text):
+    """keep_out_melton_scaled's closed loop was inside its cone for 9.3 ms, printed "0.0 s inside"."""
+    from scenarios.requirements.scoring import _seconds
+
+    assert _seconds(seconds) == text

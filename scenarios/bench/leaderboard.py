@@ -421,7 +421,7 @@ class Leaderboard:
         drawn = 0
         for name in sorted(kinds, key=lambda planner: (kinds[planner] == "peer", planner)):  # planners, then peers
             points = [(row.plan_time_s, max(abs(row.gap_rel), GAP_FLOOR)) for row in self.rows
-                      if row.planner == name and row.gap_rel is not None and row.plan_time_s and row.status == "ok"]
+                      if row.planner == name and row.gap_rel is not None and row.plan_time_s and row.plan_status == "ok"]
             if not points:
                 continue
             kind = kinds[name]

@@ -174,8 +174,14 @@ def _pointing(constraint: PointingConstraint, t: Array, q: Array, omega: Array) 
     assert score.min_margin_deg is not None and score.min_margin_time_s is not None
     where = "inside" if constraint.keep_out else "outside"
     return Score(constraint.name, values, False,
-                 f"min margin {score.min_margin_deg:.3g} deg at {score.min_margin_time_s:.1f} s, "
-                 f"{score.time_in_violation_s:.1f} s {where}")
+                 f"min margin {score.min_margin_deg:.3g} deg at {_seconds(score.min_margin_time_s)} s, "
+                 f"{_seconds(score.time_in_violation_s)} s {where}")
+
+
+def _seconds(value: float) -> str:
+    """A time in a message: one decimal, or two significant digits below 0.1 s (a 9 ms violation
+    reads ``0.0093 s``, never ``0.0 s``)."""
+    return f"{value:.1f}" if value == 0.0 or abs(value) >= 0.1 else f"{value:.2g}"
 
 
 def _with_edges(problem: ManeuverProblem, t: Array, sample: Any,
