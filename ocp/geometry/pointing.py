@@ -34,8 +34,18 @@ from ocp import quat_casadi as qc
 
 Array = NDArray[np.float64]
 
-__all__ = ["COARSE_STEPS", "FINE_STEP", "MIN_SEARCHES", "REFINE_LEVELS", "REFINE_POINTS", "PointingConstraint",
-           "PointingScore", "hermite_attitudes", "violation_intervals"]
+__all__ = [
+    "COARSE_STEPS",
+    "FINE_STEP",
+    "MIN_SEARCHES",
+    "REFINE_LEVELS",
+    "REFINE_POINTS",
+    "HermiteMotion",
+    "PointingConstraint",
+    "PointingScore",
+    "hermite_attitudes",
+    "violation_intervals",
+]
 
 FINE_STEP = np.deg2rad(0.05)
 """[rad]: the largest rotation of the attitude between two points of the sub-grid on which
@@ -63,7 +73,7 @@ def hermite_attitudes(t: ArrayLike, q: ArrayLike, omega: ArrayLike, times: Array
     Over an interval of length ``h`` its error is ``O(h⁴)`` where the motion is smooth inside the
     interval (a zero-order hold changes the torque only at the samples: the attitude and the rate
     are continuous across them). The samples are made sign-continuous first (``q`` and ``−q`` are one
-    attitude).
+    attitude). To evaluate one motion many times, build :class:`HermiteMotion` once.
 
     Parameters
     ----------
@@ -81,21 +91,53 @@ def hermite_attitudes(t: ArrayLike, q: ArrayLike, omega: ArrayLike, times: Array
     (M, 4) ndarray
         Unit quaternions at ``times``; the samples themselves (normalised) at the sample times.
     """
-    t = np.atleast_1d(np.asarray(t, dtype=float))
-    q = quat.continuous(np.atleast_2d(np.asarray(q, dtype=float)))
-    omega = np.atleast_2d(np.asarray(omega, dtype=float))
-    at = np.clip(np.atleast_1d(np.asarray(times, dtype=float)), t[0], t[-1])
-    if len(t) == 1:
-        return np.repeat(quat.normalize(q), len(at), axis=0)
-    k = np.clip(np.searchsorted(t, at, side="right") - 1, 0, len(t) - 2)
-    h = t[k + 1] - t[k]
-    s = (np.divide(at - t[k], h, out=np.zeros_like(h), where=h > 0.0))[:, None]  # a repeated time: its sample
-    slope = quat.kinematics(q, omega)
-    s2, s3 = s * s, s * s * s
-    value = ((2 * s3 - 3 * s2 + 1) * q[k] + (s3 - 2 * s2 + s) * h[:, None] * slope[k]
-             + (3 * s2 - 2 * s3) * q[k + 1] + (s3 - s2) * h[:, None] * slope[k + 1])
-    return np.asarray(value / np.linalg.norm(value, axis=1, keepdims=True), dtype=float)
+    return HermiteMotion(t, q, omega).attitudes(times)
 
+
+class HermiteMotion:
+    """A motion known at samples by its attitude and body rate, interpolated as
+    :func:`hermite_attitudes` does; the sign-continuous samples and their slopes are computed once.
+
+    Parameters
+    ----------
+    t : (N,) array_like
+        Increasing sample times [s], N >= 1.
+    q : (N, 4) array_like
+        Attitude at ``t`` (scalar first, body to inertial).
+    omega : (N, 3) array_like
+        Body rate at ``t`` [rad/s], body axes.
+    """
+
+    def __init__(self, t: ArrayLike, q: ArrayLike, omega: ArrayLike) -> None:
+        self.t = np.atleast_1d(np.asarray(t, dtype=float))
+        self.q = quat.continuous(np.atleast_2d(np.asarray(q, dtype=float)))
+        self.omega = np.atleast_2d(np.asarray(omega, dtype=float))
+        self.slope = quat.kinematics(self.q, self.omega)
+
+    def attitudes(self, times: ArrayLike) -> Array:
+        """The interpolated attitude.
+
+        Parameters
+        ----------
+        times : (M,) array_like
+            Where to evaluate [s], inside ``[t[0], t[-1]]`` (clipped to it).
+
+        Returns
+        -------
+        (M, 4) ndarray
+            Unit quaternions at ``times`` (scalar first, body to inertial).
+        """
+        t, q, slope = self.t, self.q, self.slope
+        at = np.clip(np.atleast_1d(np.asarray(times, dtype=float)), t[0], t[-1])
+        if len(t) == 1:
+            return np.repeat(quat.normalize(q), len(at), axis=0)
+        k = np.clip(np.searchsorted(t, at, side="right") - 1, 0, len(t) - 2)
+        h = t[k + 1] - t[k]
+        s = (np.divide(at - t[k], h, out=np.zeros_like(h), where=h > 0.0))[:, None]  # a repeated time: its sample
+        s2, s3 = s * s, s * s * s
+        value = ((2 * s3 - 3 * s2 + 1) * q[k] + (s3 - 2 * s2 + s) * h[:, None] * slope[k]
+                 + (3 * s2 - 2 * s3) * q[k + 1] + (s3 - s2) * h[:, None] * slope[k + 1])
+        return np.asarray(value / np.linalg.norm(value, axis=1, keepdims=True), dtype=float)
 
 
 class PointingScore(NamedTuple):
@@ -448,7 +490,8 @@ class PointingConstraint:
         fine = np.repeat(t[:-1], steps) + np.repeat(h, steps) * offset / np.repeat(steps, steps)
         ends = [edge for edge in self.window if t[0] < edge < t[-1]]
         fine = np.unique(np.concatenate([fine, [t[-1]], ends]))
-        margin = self.margins(fine, hermite_attitudes(t, q, omega, fine))
+        motion = HermiteMotion(t, quat_, omega)
+        margin = self.margins(fine, motion.attitudes(fine))
         # the sub-grid steps that may hide, between their ends, a margin below the smallest found or
         # below zero where neither end is: a Lipschitz bound of the margin over the step
         interval = np.clip(np.searchsorted(t, fine[:-1], side="right") - 1, 0, len(t) - 2)
@@ -461,7 +504,7 @@ class PointingConstraint:
             lower = lower[np.argsort(floor[lower], kind="stable")[:MIN_SEARCHES]]
             suspect = np.union1d(hidden, lower)
         if suspect.size:
-            found_t, found_m = self._zoom(t, q, omega, fine[suspect], fine[suspect + 1], speed[suspect],
+            found_t, found_m = self._zoom(motion, fine[suspect], fine[suspect + 1], speed[suspect],
                                           float(np.nanmin(margin)))
             order = np.argsort(np.concatenate([fine, found_t]), kind="stable")
             fine = np.concatenate([fine, found_t])[order]
@@ -477,7 +520,7 @@ class PointingConstraint:
         where none of their points found is, given the bound ``floor`` on their margin (NaN: no)."""
         return (floor < smallest) | ((lowest_end >= 0.0) & (floor < 0.0))
 
-    def _zoom(self, t: Array, q: Array, omega: Array, start: Array, end: Array, speed: Array,
+    def _zoom(self, motion: HermiteMotion, start: Array, end: Array, speed: Array,
               smallest: float) -> tuple[Array, Array]:
         """The smallest margin of the interpolated motion in each ``[start, end]`` and its time (all the
         brackets at once, each narrowed :data:`REFINE_LEVELS` times to two of its
@@ -488,7 +531,7 @@ class PointingConstraint:
         alive = np.arange(len(start))
         for _ in range(REFINE_LEVELS):
             points = start[:, None] + (end - start)[:, None] * fraction
-            margin = self.margins(points.ravel(), hermite_attitudes(t, q, omega, points.ravel())).reshape(points.shape)
+            margin = self.margins(points.ravel(), motion.attitudes(points.ravel())).reshape(points.shape)
             rows = np.arange(len(alive))
             best = np.argmin(margin, axis=1)
             found_t[alive], found_m[alive] = points[rows, best], margin[rows, best]

@@ -53,8 +53,8 @@ from ocp.geometry.pointing import (
     MIN_SEARCHES,
     REFINE_LEVELS,
     REFINE_POINTS,
+    HermiteMotion,
     PointingConstraint,
-    hermite_attitudes,
 )
 from planners import ManeuverProblem, Planner, Reference
 from planners.base import REQUIREMENT_KINDS
@@ -284,7 +284,8 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
     offset = np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)
     fine = np.repeat(t[:-1], steps) + np.repeat(h, steps) * offset / np.repeat(steps, steps)
     fine = np.unique(np.concatenate([fine[fine > start], [start, t[-1]]]))
-    error = quat.error_angle(hermite_attitudes(t, q, omega, fine), target)
+    motion = HermiteMotion(t, q, omega)
+    error = quat.error_angle(motion.attitudes(fine), target)
     step_speed = speed[np.clip(np.searchsorted(t, fine[:-1], side="right") - 1, 0, len(t) - 2)]
     bound = 0.5 * (error[:-1] + error[1:]) + 0.5 * step_speed * np.diff(fine)
     worst = int(np.argmax(error))
@@ -299,7 +300,7 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
         if not low.size:
             break
         points = low[:, None] + (high - low)[:, None] * fraction
-        values = quat.error_angle(hermite_attitudes(t, q, omega, points.ravel()), target).reshape(points.shape)
+        values = quat.error_angle(motion.attitudes(points.ravel()), target).reshape(points.shape)
         top = np.argmax(values, axis=1)
         rows = np.arange(len(low))
         if float(np.max(values)) > best:
