@@ -132,3 +132,19 @@ def test_pyramid_row_meets_the_actuators_and_the_closed_loop_does_not_saturate()
     assert np.abs(_allocated_wheel_torques(row.reference)).max() <= 0.95 * G_MAX * (1 + 1e-6)
     assert row.closed_loop_metrics["saturation_fraction"] == 0.0  # was 0.26 (0.24 without the margin)
     assert row.closed_loop_metrics["final_error_deg"] < 1e-3
+
+
+def test_torquers_beside_three_wheels_are_not_planned():
+    """The allocation never asks torquers beside wheels spanning three axes, so the plan does not
+    use them: 120 deg in 120 s is the wheels' alone (torquers at 0), 90 s is below the wheels'
+    minimum time (92.57 s) and infeasible, saying why (before, the plan used the torquers and
+    asked the wheels 2 x their limit through A⁺)."""
+    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(max_torque=G_MAX, max_momentum=H_MAX),
+                            torquers=Torquers(0.01))
+    problem = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), TARGET, 120.0, omegaf=np.zeros(3))
+    reference = PLANNERS["collocation"]({"intervals": 20}).plan(problem)
+    assert reference.status == "ok"
+    assert np.abs(reference._state_control(np.linspace(0.0, 120.0, 2001))[1][:, 3:]).max() <= 1e-12
+    short = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), TARGET, 90.0, omegaf=np.zeros(3))
+    failed = PLANNERS["collocation"]({"intervals": 20}).plan(short)
+    assert failed.status != "ok" and "allocation" in failed.message

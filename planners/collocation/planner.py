@@ -698,7 +698,10 @@ class CollocationPlanner(Planner):
     def _failure_hint(problem: ManeuverProblem, ocp: OptimalControlProblem, statuses: list[str]) -> str:
         """What to try when no start converged, by what the problem asks: the cones (more starts or
         intervals), the rate bound and the actuator margin (looser, or a longer duration); more
-        iterations when the solver ran out of them."""
+        iterations when the solver ran out of them; the allocation imposed on the controls said."""
+        allocated = "" if allocation_constraints(problem.spacecraft) is None else (
+            "; the controls follow the controllers' allocation (wheel torques g = −A⁺ τ; torquers and "
+            "magnetorquers only for what the wheels cannot give: nothing beside wheels spanning three axes)")
         tries = []
         if "Maximum_Iterations_Exceeded" in statuses:
             tries.append("a larger max_iterations")
@@ -711,8 +714,8 @@ class CollocationPlanner(Planner):
             tries.append(f"a smaller requirements.actuators.margin than {problem.actuator_margin:g} (the reference "
                          f"may use {100.0 * (1.0 - problem.actuator_margin):.3g} % of each actuator limit)")
         if not tries:
-            return ""
-        return " (try " + "; ".join(tries) + "; or a longer duration)"
+            return f" (try a longer duration{allocated})" if allocated else ""
+        return " (try " + "; ".join(tries) + f"; or a longer duration{allocated})"
 
     @staticmethod
     def _dense_stats(requirements: Requirements, tightening: Tightening, check: DenseCheck,
