@@ -12,8 +12,12 @@ rate is ``‖ω‖ = |θ̇|``.
 
 The body rate is ``ω = e θ̇`` and the feed-forward torque the inverse dynamics
 ``I ω̇ + ω × I ω = I e θ̈ + θ̇² e × I e``; the second term is not zero off a principal axis, so the
-acceleration ``α`` is chosen with the coast rate ``w`` such that every axis respects its bound:
-``|(I e)_i| α + w² |(e × I e)_i| <= u_i``.
+acceleration ``α`` is chosen with the coast rate ``w`` such that every actuator respects its bound
+through the controllers' allocation (``Spacecraft.allocation_rows``: ``|M τ| <= L`` row by row, a
+row per working wheel ``(A⁺)_i`` with its ``max_torque``, and the torquers' rows for what the wheels
+cannot give): ``|(M I e)_j| α + w² |(M (e × I e))_j| <= f L_j`` (``f`` the ``torque_fraction``).
+With wheels along the body axes ``M`` is the identity: the per-axis bound ``|(I e)_i| α + w² |(e ×
+I e)_i| <= u_i``.
 """
 from __future__ import annotations
 
@@ -347,8 +351,8 @@ class EigenaxisPlanner(Planner):
             It tightens the problem's bound (``maneuver.max_rate``, or ``requirements.rate.max``),
             never loosens it; ``None`` (default): the problem's (if any).
         torque_fraction : float
-            Share of the actuators' per-axis torque bound the bang profiles may use, in (0, 1];
-            default 1.
+            Share of each actuator's torque bound (each wheel's ``max_torque`` through ``g = −A⁺ τ``,
+            the torquers' per axis) the bang profiles may use, in (0, 1]; default 1.
         """
 
         profile: Literal["smooth", "trapezoidal", "min_time"] = "smooth"
@@ -405,12 +409,20 @@ class EigenaxisPlanner(Planner):
                                        "infeasible")
             return EigenaxisReference(problem.q0, axis, quintic, problem.duration, inertia,
                                       f"quintic, {np.rad2deg(angle):.2f} deg about {np.round(axis, 4).tolist()}", problem)
-        bounds = self.options.torque_fraction * problem.torque_limit
-        accel_axis = inertia @ axis
-        gyro = np.abs(np.cross(axis, accel_axis))
+        # The torque I e θ̈ + θ̇² e × I e through the controllers' allocation: |M τ| <= L row by row
+        # (Spacecraft.allocation_rows; with wheels along the body axes, M = 1 and L their limits).
+        rows, limits = problem.spacecraft.allocation_rows()
+        bounds = self.options.torque_fraction * limits
+        accel_axis = rows @ (inertia @ axis)
+        gyro = np.abs(rows @ np.cross(axis, inertia @ axis))
+        # A row no actuator gives (limit 0, a projector's): its rounding is no demand on it.
+        given = limits > 0
+        scale = np.linalg.norm(rows, axis=1)
+        gyro[~given & (gyro <= 1e-12 * scale * np.linalg.norm(np.cross(axis, inertia @ axis)))] = 0.0
+        accel_axis[~given & (np.abs(accel_axis) <= 1e-12 * scale * np.linalg.norm(inertia @ axis))] = 0.0
 
         def acceleration(coast_rate: float) -> float:
-            """Largest α with every axis within its bound while coasting at ``coast_rate``."""
+            """Largest α with every row within its bound while coasting at ``coast_rate``."""
             margin = bounds - coast_rate**2 * gyro
             active = np.abs(accel_axis) > 1e-12 * np.max(np.abs(accel_axis))
             if np.any(margin < 0) or np.any(margin[active] <= 0):

@@ -183,3 +183,86 @@ class Spacecraft:
                     limit += box
             self._cache["torque_limit"] = limit
         return self._cache["torque_limit"].copy()
+
+    def allocation_rows(self) -> tuple[Array, Array]:
+        """The body torques the controllers' allocation realises within the actuators' limits, as
+        ``|M τ| <= L`` row by row.
+
+        The allocation (``controllers.allocation``) gives the working wheels ``g = −A⁺ τ`` (``A⁺``
+        the pseudo-inverse of the working wheels' axes): a row ``(A⁺)_i`` with the limit
+        ``g_max,i`` per working wheel. What the wheels cannot give, ``(1 − A A⁺) τ`` (none when the
+        working wheels span three axes), goes to the actuator kind of lowest
+        :attr:`~ocp.dynamics.actuator_kinds.Actuator.residual_rank` (torquers, else magnetorquers;
+        all of ``τ`` without wheels): rows of that projector with the kind's per-axis
+        :meth:`~ocp.dynamics.actuator_kinds.Actuator.body_torque_box` as limits (torquers: their
+        ``max_torque``). A direction no actuator realises (failed or missing wheels without
+        torquers; magnetorquers, whose torque depends on the field and are counted as giving none,
+        as in :meth:`body_torque_limit`) gets rows with the limit 0.
+
+        Unlike :meth:`body_torque_limit` (a per-axis box every corner of which is realised, so
+        conservative for a skewed wheel array such as a four-wheel pyramid), these rows describe
+        the realised set exactly; with wheels along the three body axes the two agree (``M`` the
+        identity, ``L`` the wheels' limits).
+
+        Returns
+        -------
+        M : (m, 3) ndarray
+            Rows, body axes.
+        L : (m,) ndarray
+            Their limits [N m], ``inf`` for an unlimited actuator, 0 for a direction no actuator
+            gives. Copies (computed once per spacecraft).
+        """
+        if "allocation_rows" not in self._cache:
+            rows, limits = [], []
+            given = np.zeros((3, 3))  # the projector on what the working wheels give: A A⁺
+            wheels = self.wheels
+            if wheels is not None and np.any(wheels.working):
+                working = wheels.axes * wheels.working  # failed wheels: zero columns, as the allocation
+                pinv = np.linalg.pinv(working)
+                rows.append(pinv[wheels.working])
+                limits.append(wheels.max_torque[wheels.working])
+                left, singular, _ = np.linalg.svd(working)
+                rank = int(np.sum(singular > 1e-9 * singular.max()))
+                given = left[:, :rank] @ left[:, :rank].T
+            residual = np.eye(3) - given
+            if np.linalg.matrix_rank(residual, tol=1e-9) > 0:
+                ranked = [(a.residual_rank, i, a) for i, a in enumerate(self.actuators) if a.residual_rank is not None]
+                sink = min(ranked)[2] if ranked else None
+                box = None if sink is None else sink.body_torque_box()
+                rows.append(residual)
+                limits.append(np.zeros(3) if box is None else np.asarray(box, dtype=float))
+            self._cache["allocation_rows"] = (np.vstack(rows) if rows else np.zeros((0, 3)),
+                                              np.concatenate(limits) if limits else np.zeros(0))
+        matrix, bound = self._cache["allocation_rows"]
+        return matrix.copy(), bound.copy()
+
+    def torque_along(self, direction: ArrayLike) -> float:
+        """The largest body torque along a direction that the actuators give through the
+        controllers' allocation within their limits (:meth:`allocation_rows`).
+
+        Parameters
+        ----------
+        direction : (3,) array_like
+            A non-zero direction, body axes (normalised here).
+
+        Returns
+        -------
+        float
+            ``s`` [N m]: ``s d̂`` is realised, any larger multiple is not (``min_j L_j / |M_j d̂|``;
+            a four-wheel pyramid: ``min_i g_max,i / |(A⁺ d̂)_i|``); 0 when an actuator that the
+            direction needs gives nothing, ``inf`` when every actuator it needs is unlimited.
+
+        Raises
+        ------
+        ValueError
+            For a zero or non-finite direction.
+        """
+        d = np.asarray(direction, dtype=float).reshape(3)
+        norm = float(np.linalg.norm(d))
+        if not (np.isfinite(norm) and norm > 0):
+            raise ValueError(f"direction must be a finite non-zero 3-vector, got {d.tolist()}")
+        matrix, bound = self.allocation_rows()
+        demand = np.abs(matrix @ (d / norm))
+        demand[demand <= 1e-12 * np.linalg.norm(matrix, axis=1)] = 0.0  # rounding of exact zeros
+        used = demand > 0
+        return float(np.min(bound[used] / demand[used], initial=np.inf))

@@ -5,6 +5,7 @@ side (its own cones from YAML, the endpoints checked against the pointing constr
 bounds from the spacecraft; :mod:`~planners.collocation.problem`), the reference of a solution and
 seeds from other references, bent round keep-out cones (:mod:`~planners.collocation.reference`),
 the requirements it honours and their dense check (:mod:`~planners.collocation.requirements`),
+the controllers' allocation imposed on its controls (:mod:`~planners.collocation.allocation`),
 the search strategy's tuned constants (:mod:`~planners.collocation.strategy`) and the certificate of
 an optimum, with the co-states in the collocation multipliers (:mod:`~planners.collocation.certificate`).
 

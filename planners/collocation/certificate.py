@@ -140,7 +140,10 @@ def collocation_certificate(result: NLPResult, transcription: Transcription, ocp
     if result.x is None or result.lam_x is None or result.lam_g is None:
         return certificate(None, "not checked: no multipliers", seeds=tried, seeds_agreed=agreed)
     agreement = None
-    if ocp.free_time and ocp.energy_weight == 0 and ocp.l1_weight == 0 and isinstance(transcription, RadauCollocation):
+    # Pontryagin's sign(u) = −sign(σ) per control holds for independent box-bounded controls, not
+    # with the allocation's equalities among them (planners.collocation.allocation)
+    if (ocp.free_time and ocp.energy_weight == 0 and ocp.l1_weight == 0 and isinstance(transcription, RadauCollocation)
+            and getattr(transcription, "allocation_rows", None) is None):
         agreement = switching(transcription, ocp.model, nlp, result.x, result.lam_g, lbx, ubx, params)
     try:
         return certify(nlp.solver, result.x, result.lam_x, result.lam_g, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg,

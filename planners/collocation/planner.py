@@ -4,7 +4,13 @@ Objectives: ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt
 ``min_time`` (free T, the scenario's T is the upper bound), and ``weighted``
 (``energy_weight``, ``l1_weight``, ``time_weight``). τ is the actuators' body torque.
 Constraints: actuator bounds (wheel torques, dipoles, torquers), wheel momentum bounds, a body-rate
-bound ``max_rate`` (option, per axis), fixed or free final rate, keep-out / keep-in cones (options).
+bound ``max_rate`` (option, per axis), fixed or free final rate, keep-out / keep-in cones (options),
+and the controllers' allocation on the controls (:mod:`planners.collocation.allocation`): the wheel
+torques are the min-norm allocation ``g = −A⁺ τ`` of their own body torque (no component in the null
+space of the working wheels' axes, so their bounds bound ``A⁺ τ`` as the closed loop and the
+actuator requirement read it), and the torquers give only what the wheels cannot. Nothing is added
+where the allocation is the identity (wheels along three independent axes, torquers alone): those
+NLPs are unchanged.
 It honours every requirement of the problem (:attr:`CollocationPlanner.honours`): the pointing
 constraints ``problem.pointing`` (moving directions and windows included), the actuator limits
 tightened by ``problem.actuator_margin`` and the body-rate norm ``‖ω‖ <= problem.max_rate``; each
@@ -26,6 +32,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 
+from ocp.dynamics.layout import actuator_blocks
 from ocp.errors import InvalidOption, OptionsError
 from ocp.nlp.solve import (
     NLPResult,
@@ -43,6 +50,11 @@ from ocp.transcription import (
 )
 from ocp.transcription.mesh_transfer import transfer_multipliers
 from planners.base import Planner
+from planners.collocation.allocation import (
+    allocation_constraints,
+    allocation_error,
+    with_allocation,
+)
 from planners.collocation.certificate import collocation_certificate
 from planners.collocation.problem import (
     endpoint_cone_error,
@@ -316,7 +328,8 @@ class CollocationPlanner(Planner):
             The reason (no target attitude; an objective without an energy term (time or L1
             alone) on an actuator whose control has no bound: the optimum is then impulses, a
             rest-to-rest slew in no time; a transcription that cannot impose the pointing or rate
-            requirements), or ``None``.
+            requirements, or the controllers' allocation on the controls,
+            :func:`~planners.collocation.allocation.allocation_error`), or ``None``.
         """
         error = super().problem_error(problem)
         o = self.options
@@ -330,6 +343,10 @@ class CollocationPlanner(Planner):
                 return (f"{what} needs a bound on every actuator's control ({names}): without an energy term the "
                         f"optimal torque is unbounded, impulses (min_time: a slew in no time; min_l1: the torque "
                         f"grows with the mesh)")
+        if error is None:
+            error = allocation_error(problem.spacecraft, o.transcription)
+            if error is not None:
+                return f"options.transcription: {error}"
         if error is None and (problem.pointing or problem.max_rate is not None):
             l1 = o.objective == "min_l1" or (o.objective == "weighted" and o.l1_weight > 0)
             refused = TRANSCRIPTIONS[o.transcription].problem_error(l1, True)
@@ -399,6 +416,9 @@ class CollocationPlanner(Planner):
             # the transcription is built here, once per entry (its constructor is not free)
             same = intervals == o.intervals
             transcription = TRANSCRIPTIONS[o.transcription].from_options(o if same else replace(o, intervals=intervals))
+            rows = allocation_constraints(problem.spacecraft)  # the controls as the allocation gives them
+            if rows is not None:
+                transcription = with_allocation(transcription, rows)
             return transcription, transcription.build(ocp, solver, solver_options(solver, tolerance, o.max_iterations, extra))
 
         # The model's numbers are baked into the graph: a shared cache needs them in the key.
@@ -681,7 +701,10 @@ class CollocationPlanner(Planner):
     def _failure_hint(problem: ManeuverProblem, ocp: OptimalControlProblem, statuses: list[str]) -> str:
         """What to try when no start converged, by what the problem asks: the cones (more starts or
         intervals), the rate bound and the actuator margin (looser, or a longer duration); more
-        iterations when the solver ran out of them."""
+        iterations when the solver ran out of them; the allocation imposed on the controls said."""
+        allocated = "" if allocation_constraints(problem.spacecraft) is None else (
+            "; the controls follow the controllers' allocation (wheel torques g = −A⁺ τ; torquers and "
+            "magnetorquers only for what the wheels cannot give: nothing beside wheels spanning three axes)")
         tries = []
         if "Maximum_Iterations_Exceeded" in statuses:
             tries.append("a larger max_iterations")
@@ -694,8 +717,8 @@ class CollocationPlanner(Planner):
             tries.append(f"a smaller requirements.actuators.margin than {problem.actuator_margin:g} (the reference "
                          f"may use {100.0 * (1.0 - problem.actuator_margin):.3g} % of each actuator limit)")
         if not tries:
-            return ""
-        return " (try " + "; ".join(tries) + "; or a longer duration)"
+            return f" (try a longer duration{allocated})" if allocated else ""
+        return " (try " + "; ".join(tries) + f"; or a longer duration{allocated})"
 
     @staticmethod
     def _dense_stats(requirements: Requirements, tightening: Tightening, check: DenseCheck,
@@ -865,8 +888,12 @@ class CollocationPlanner(Planner):
         assert result.x is not None  # success implies a point
         T, states, controls = (v.full() for v in solved.nlp.unpack(result.x, params))
         T = T.item()
+        rows = allocation_constraints(problem.spacecraft)
+        scaled = () if rows is None else tuple(block.control for block in actuator_blocks(problem.spacecraft)
+                                               if np.any(rows[:, block.control]))
         reference = CollocationReference(problem, transcription, T, states, controls, stats,
-                                         control_bounds=self._variable_bounds(problem, tightening)[2:])
+                                         control_bounds=self._variable_bounds(problem, tightening)[2:],
+                                         scaled_blocks=scaled)
         norm_error = float(np.max(np.abs(np.linalg.norm(states[0:4], axis=0) - 1)))
         # the fixed-direction cones as stated (their angles not tightened), for the cone plots
         fixed = [c for c in self._requirements(problem).pointing if not c.moving]

@@ -51,10 +51,18 @@ class CollocationReference(Reference):
         of ``model.control_slices`` [N m, A m^2]. Between the points the interpolated controls are
         saturated at them (at the points, where the solution meets them, this changes nothing);
         ``None`` (default): read as interpolated.
+    scaled_blocks : tuple of slice, optional
+        Blocks of the controls saturated as a whole, scaled down until each entry is within its
+        bound (their direction kept), instead of clipped entry by entry: the blocks on which the
+        planner imposed the controllers' allocation (:mod:`planners.collocation.allocation`), whose
+        equalities a clip would break between the points (a pyramid's wheel torques clipped to
+        their bounds leave the row space of the axes: 1.0008 times the limit through ``A⁺``);
+        default none.
     """
 
     def __init__(self, problem: ManeuverProblem, transcription: Transcription, duration: float, states: Array,
-                 controls: Array, stats: dict[str, Any], control_bounds: tuple[Array, Array] | None = None) -> None:
+                 controls: Array, stats: dict[str, Any], control_bounds: tuple[Array, Array] | None = None,
+                 scaled_blocks: tuple[slice, ...] = ()) -> None:
         breakpoints, inner = transcription.smoothness(duration)
         super().__init__("collocation", duration, problem.spacecraft.inertia, stats=stats,
                          free_boundary=(), breakpoints=breakpoints, enforced_times=inner)
@@ -63,6 +71,7 @@ class CollocationReference(Reference):
         self.intervals = transcription.intervals
         self.disturbance = problem.model.default_parameters
         self.control_bounds = control_bounds
+        self.scaled_blocks = scaled_blocks
 
     def _interpolated(self, t: Array, left: bool = False) -> tuple[Array, Array]:
         """States and controls as the transcription interpolates them (controls not saturated)."""
@@ -70,10 +79,17 @@ class CollocationReference(Reference):
 
     def _state_control(self, t: Array, left: bool = False) -> tuple[Array, Array]:
         """The reference's states and controls: :meth:`_interpolated`, the controls saturated at
-        :attr:`control_bounds` (the states are not: a wheel momentum's overshoot is the solution's)."""
+        :attr:`control_bounds` (the :attr:`scaled_blocks` scaled as a whole, the others clipped; the
+        states are not: a wheel momentum's overshoot is the solution's)."""
         x, u = self._interpolated(t, left)
         if self.control_bounds is not None:
-            u = np.clip(u, *self.control_bounds)
+            low, high = self.control_bounds
+            for block in self.scaled_blocks:  # scaled as a whole: the allocation's equalities kept
+                values = u[:, block]
+                bound = np.where(values > 0, high[block], -low[block])
+                ratio = np.divide(np.abs(values), bound, out=np.zeros_like(values), where=bound > 0)
+                u[:, block] = values / np.maximum(ratio.max(axis=1, initial=1.0), 1.0)[:, None]
+            u = np.clip(u, low, high)
         return x, u
 
     def control(self, t: float | Array) -> Array:

@@ -1,0 +1,211 @@
+"""The controllers' allocation imposed on ``collocation``'s controls, so that the plan is what the
+closed loop realises.
+
+Every controller maps a body torque onto the actuators the same way (``controllers.allocation``):
+the working wheels take ``g = −A⁺ τ`` (``A⁺`` the pseudo-inverse of the working wheels' axes), and
+what they cannot give, ``(1 − A A⁺) τ``, goes to the actuator kind of lowest
+:attr:`~ocp.dynamics.actuator_kinds.Actuator.residual_rank` (the torquers, else the magnetorquers);
+the scenario's actuator requirement scores a reference's torque through that map. The NLP's
+controls are the actuators' own commands, so without more it may plan wheel torques that the
+allocation never gives: on a skewed array (a four-wheel pyramid) a wheel torque pattern with a
+component in the null space of ``A`` reaches torques whose min-norm allocation exceeds the limits
+(the fresh-eyes user's pyramid slew: planned within 0.0100000094 N m, scored 1.31 times the limit
+at t = 0, the closed loop saturating 24 % of the time).
+
+:func:`allocation_constraints` gives the linear equalities ``E u = 0`` that make the controls the
+allocation of their own body torque:
+
+* the working wheels' torques lie in the row space of their axes (``g = A⁺ A g``: no component
+  in the null space of ``A``; failed wheels are held at 0 by their bounds). With these the wheel
+  torques are the min-norm allocation of their body torque, so their bounds bound ``A⁺ τ``, and
+  the wheel momenta, ``ḣ = g``, follow from those torques as in the closed loop;
+* the actuator that takes the residual gives no torque in the wheels' span (the wheels would take
+  it): none at all when the working wheels span three axes; a kind whose torque depends on the
+  state (magnetorquers, ``m × B``) is held at zero when the wheels span three axes, and is not
+  constrained beside fewer (its share would depend on the field: not imposed);
+* another kind with a ``residual_rank`` (magnetorquers beside torquers) is never commanded by the
+  allocation: held at zero.
+
+With wheels along the three body axes alone (or any array whose working axes are three
+independent ones, with nothing beside them) ``E`` is empty and the NLP is the one without it.
+
+:func:`with_allocation` adds ``E u = 0`` at a transcription's control points as equality path
+constraints (:data:`CONTROL_POINTS`: Radau collocation's points; a transcription without an entry,
+such as ``multiple_shooting``, whose control at t = 0 belongs to no interval's constraints, is
+refused where ``E`` is not empty, :func:`allocation_error`).
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ocp import Spacecraft
+from ocp.dynamics.layout import actuator_blocks
+from ocp.transcription import OptimalControlProblem, RadauCollocation, Transcription
+from ocp.transcription.problem import Interval
+from planners.problem import Array
+
+__all__ = ["CONTROL_POINTS", "allocation_constraints", "allocation_error", "with_allocation"]
+
+RANK_TOLERANCE = 1e-9
+"""Singular values of the working wheels' axes below this fraction of the largest count as zero."""
+
+
+def _constant_jacobian(actuator: Any) -> Array | None:
+    """``∂τ/∂u`` of a kind's body torque when it depends on its control alone, linearly; ``None``
+    otherwise (the field, the state)."""
+    u = ca.SX.sym("u", actuator.control_size)
+    state = ca.SX.sym("state", actuator.state_size)
+    field = ca.SX.sym("field", 3)
+    torque = actuator.body_torque(u, state, field)
+    if torque is None:
+        return None
+    jacobian = ca.jacobian(torque, u)
+    if ca.depends_on(jacobian, ca.vertcat(u, state, field)):
+        return None
+    return np.asarray(ca.evalf(jacobian), dtype=float)
+
+
+def allocation_constraints(spacecraft: Spacecraft) -> Array | None:
+    """The rows ``E`` of ``E u = 0`` that make the controls the allocation of their body torque.
+
+    Parameters
+    ----------
+    spacecraft : Spacecraft
+        Its actuators and their layout in ``u`` (:func:`ocp.dynamics.layout.actuator_blocks`).
+
+    Returns
+    -------
+    (k, nu) ndarray or None
+        Orthonormal rows per block (module docstring); ``None`` when nothing is to be imposed
+        (``k = 0``).
+    """
+    blocks = actuator_blocks(spacecraft)
+    nu = sum(block.actuator.control_size for block in blocks)
+    rows: list[Array] = []
+    span = np.zeros((3, 0))  # orthonormal basis of the working wheels' span
+    wheels = spacecraft.wheels
+    if wheels is not None and np.any(wheels.working):
+        block = next(block for block in blocks if block.actuator is wheels)
+        index = np.flatnonzero(wheels.working)
+        left, singular, right = np.linalg.svd(wheels.axes[:, index])
+        rank = int(np.sum(singular > RANK_TOLERANCE * singular.max()))
+        span = left[:, :rank]
+        for null in right[rank:]:  # the null space of the working axes
+            row = np.zeros(nu)
+            row[np.arange(nu)[block.control][index]] = null
+            rows.append(row)
+    ranked = [(a.residual_rank, i, a) for i, a in enumerate(spacecraft.actuators) if a.residual_rank is not None]
+    sink = min(ranked)[2] if ranked else None
+    for block in blocks:
+        actuator = block.actuator
+        if actuator is wheels or actuator.residual_rank is None:
+            continue
+        identity = np.eye(nu)[block.control]
+        if actuator is not sink:
+            rows.extend(identity)  # never commanded
+            continue
+        if span.shape[1] == 0:
+            continue  # no wheels: the sink takes every torque
+        if span.shape[1] == 3:
+            rows.extend(identity)  # the wheels take every torque
+            continue
+        jacobian = _constant_jacobian(actuator)
+        if jacobian is None:
+            continue  # its share depends on the field: not imposed (module docstring)
+        within = span.T @ jacobian  # its torque in the wheels' span
+        _, singular, right = np.linalg.svd(within)
+        rank = int(np.sum(singular > RANK_TOLERANCE * max(float(singular.max(initial=0.0)), 1e-300)))
+        for direction in right[:rank]:
+            row = np.zeros(nu)
+            row[block.control] = direction
+            rows.append(row)
+    return np.vstack(rows) if rows else None
+
+
+def _radau_controls(transcription: RadauCollocation, problem: OptimalControlProblem, s: Any,
+                    c: Any) -> list[tuple[Any, float]]:
+    """Radau collocation's controls, one per collocation point, and their positions in the interval."""
+    model, d = problem.model, transcription.degree
+    start = model.nx * d
+    controls = ca.reshape(c[start:start + model.nu * d], model.nu, d)
+    return [(controls[:, j], float(transcription.tau[j + 1])) for j in range(d)]
+
+
+CONTROL_POINTS: dict[str, Callable[..., list[tuple[Any, float]]]] = {"collocation": _radau_controls}
+"""Per transcription (its ``name``): ``points(transcription, problem, s, c)``, the controls an
+interval's variables hold (with their positions in the interval, fractions in [0, 1]), each once
+over the mesh, every control of the solution among them."""
+
+
+def allocation_error(spacecraft: Spacecraft, transcription: str) -> str | None:
+    """Why a transcription cannot impose the allocation on this spacecraft's controls.
+
+    Parameters
+    ----------
+    spacecraft : Spacecraft
+        The actuators.
+    transcription : str
+        The transcription's name (``options.transcription``).
+
+    Returns
+    -------
+    str or None
+        The reason, or ``None`` (nothing to impose, or the transcription can).
+    """
+    if transcription in CONTROL_POINTS or allocation_constraints(spacecraft) is None:
+        return None
+    return (f"{transcription} cannot impose the controllers' allocation (g = −A⁺ τ, wheels first) on these "
+            f"actuators' controls, which the plan must follow to be what the closed loop realises (a skewed or "
+            f"redundant wheel array, or other actuators beside wheels); use transcription: collocation")
+
+
+def with_allocation(transcription: Transcription, rows: Array) -> Transcription:
+    """The transcription with ``rows @ u = 0`` imposed at each of its control points.
+
+    Parameters
+    ----------
+    transcription : Transcription
+        A transcription with an entry in :data:`CONTROL_POINTS`.
+    rows : (k, nu) ndarray
+        :func:`allocation_constraints`.
+
+    Returns
+    -------
+    Transcription
+        An instance of a subclass of its class, the same configuration, whose interval has the
+        equalities after its own path constraints (their positions after its own).
+    """
+    points = CONTROL_POINTS[transcription.name]
+    base = type(transcription)
+    matrix = ca.DM(rows)
+
+    class Allocated(base):  # type: ignore[valid-type,misc]
+        allocation_rows = rows
+
+        def interval(self, problem: OptimalControlProblem) -> Interval:
+            inner = super().interval(problem)
+            s, c = ca.SX.sym("s", inner.n_state), ca.SX.sym("c", inner.n_interval)
+            t0, h, dist = ca.SX.sym("t0"), ca.SX.sym("h"), ca.SX.sym("d", 3)
+            following, path, cost = inner.function(s, c, t0, h, dist)
+            controls = points(self, problem, s, c)
+            extra = [ca.mtimes(matrix, u) for u, _ in controls]
+            function = ca.Function(inner.function.name(), [s, c, t0, h, dist],
+                                   [following, ca.vertcat(path, *extra), cost])
+            zeros = np.zeros(rows.shape[0] * len(controls))
+            self._allocation_positions = np.repeat([position for _, position in controls], rows.shape[0])
+            self._inner_interval = inner
+            return Interval(function, inner.n_state, inner.n_interval, np.concatenate([inner.path_lower, zeros]),
+                            np.concatenate([inner.path_upper, zeros]))
+
+        def positions(self, problem: OptimalControlProblem, interval: Interval) -> tuple[Array, Array]:
+            c_position, path_position = super().positions(problem, self._inner_interval)
+            return c_position, np.concatenate([path_position, self._allocation_positions])
+
+    Allocated.__name__ = Allocated.__qualname__ = f"{base.__name__}WithAllocation"
+    allocated = object.__new__(Allocated)
+    allocated.__dict__.update(transcription.__dict__)
+    return allocated
