@@ -226,7 +226,7 @@ MUTATIONS: list[Mutation] = [
              "np.where(decelerating, self.angle - 0.5 * a * late**2, 0.5 * a * ramp**2 + w * (t - 0.5 * ramp)))",
              (L + "planners.py",)),
     Mutation("eigenaxis-torque-fraction-ignored", "planners/eigenaxis.py",
-             "bounds = self.options.torque_fraction * problem.torque_limit", "bounds = problem.torque_limit",
+             "bounds = self.options.torque_fraction * limits", "bounds = limits",
              (L + "planners.py",)),
     Mutation("reference-gyroscopic-sign", "planners/reference.py",
              "return omega_dot @ inertia.T + np.cross(omega, omega @ inertia.T)",
