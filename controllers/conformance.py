@@ -80,6 +80,12 @@ from ocp.errors import OptionsError
 from ocp.options import Range, numeric_leaves, option_fields
 from planners import PLANNERS, ManeuverProblem, Reference
 
+__all__ = ["ALLOCATION_TOLERANCE", "CHECKS", "CONVERGED", "HOLD_FOR_ALLOCATION", "INERTIA", "INITIAL_ERROR_DEG",
+           "OPTIONS_PATH", "REFERENCE_PLANNERS", "SYMBOLIC_TOLERANCE", "Plant", "accepted_plants", "check_allocation",
+           "check_at_rest", "check_closed_loop", "check_commands", "check_controller", "check_double_cover",
+           "check_options", "check_pure", "check_symbolic", "checked_command", "describe_options", "kinetic_energy",
+           "option_variants", "sample_time_for", "standard_plants"]
+
 Array = NDArray[np.float64]
 
 REFERENCE_PLANNERS: tuple[tuple[str, Mapping[str, Any]], ...] = (

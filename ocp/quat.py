@@ -12,7 +12,13 @@ from numpy.typing import ArrayLike, NDArray
 
 Array = NDArray[np.float64]
 
+__all__ = ["EULER_SEQUENCES", "IDENTITY", "UNIT_NORM_TOLERANCE", "conjugate", "continuous", "error", "error_angle",
+           "from_axis_angle", "from_euler", "from_rotation_matrix", "from_rotation_vector", "from_scalar_last",
+           "kinematics", "normalize", "product", "random_unit", "rotate", "rotate_inverse", "rotation_matrix",
+           "sequence_axes", "slerp", "to_euler", "to_rotation_vector", "to_scalar_last", "unit_norm_error"]
+
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+"""(4,) ndarray: the identity rotation, scalar first (body axes aligned with the inertial ones)."""
 
 UNIT_NORM_TOLERANCE = 1e-2
 """How far from 1 the norm of a quaternion given as input may be (:func:`unit_norm_error`): room

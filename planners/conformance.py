@@ -26,6 +26,10 @@ from planners.problem import Array, ManeuverProblem
 from planners.reference import Reference, inverse_dynamics_torque
 from planners.torque_free import REST_RATE
 
+__all__ = ["ATTITUDE_TOLERANCE", "CHECKS", "FINITE_SAMPLES", "NORM_TOLERANCE", "RATE_TOLERANCE", "RELATIVE_TOLERANCE",
+           "check_after_end", "check_boundary", "check_dynamics", "check_finite", "check_kinematics", "check_reference",
+           "check_times", "check_vectorised", "finite_check_times", "standard_problems"]
+
 ATTITUDE_TOLERANCE = 2e-5
 """rad: boundary attitudes (about 1e-3 deg, what the shooting planners guarantee)."""
 RATE_TOLERANCE = 1e-7
@@ -127,7 +131,11 @@ def check_finite(reference: Reference) -> None:
     times = finite_check_times(reference)
     # [0, T] first: the continuation after T starts from the state at T, which must be finite.
     for part in (times[times <= T], times[times > T]):
-        sample = reference.sample(part)
+        try:
+            sample = reference.sample(part)
+        except (TypeError, ValueError) as error:  # the contract's shape checks (Reference.sample)
+            raise ConformanceError(f"{reference.planner}: sampling at {part.size} times on [{part[0]:g}, {part[-1]:g}] "
+                                   f"s: {error}") from error
         for name, values in zip(("q", "ω", "ω̇", "torque"), sample):
             bad = ~np.all(np.isfinite(values), axis=1)
             if np.any(bad):

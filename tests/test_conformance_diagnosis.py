@@ -95,6 +95,12 @@ def test_the_norm_tolerance_is_the_stated_one():
     check_reference(PROBLEM, Broken(lambda t, q, w, wd, u: ReferenceSample(scale * q, w, wd, u)))
 
 
+def test_a_wrong_shape_is_a_conformance_error():
+    # Was a bare ValueError out of check_reference (Reference.sample's own words, kept).
+    with pytest.raises(PlannerConformanceError, match=r"returned omega of shape \(2001,\); expected \(2001, 3\)"):
+        check_reference(PROBLEM, Broken(lambda t, q, w, wd, u: ReferenceSample(q, np.linalg.norm(w, axis=1), wd, u)))
+
+
 def test_a_value_non_finite_only_when_sampled_alone_is_named_so():
     with pytest.raises(PlannerConformanceError, match=r"non-finite torque at t = 0 s when sampled alone"):
         check_reference(PROBLEM, Broken(_nan_torque_alone))
