@@ -11,6 +11,7 @@ May import: :mod:`ocp` and :mod:`planners`; never :mod:`scenarios`.
 from controllers.base import Controller, gain_matrix
 from controllers.detumbling.bdot import BDot
 from controllers.detumbling.tdfc import TDFC
+from controllers.errors import ConformanceError
 from controllers.none import NoControl
 from controllers.tracking.augmented_quaternion_feedback import (
     AugmentedQuaternionFeedback,
@@ -22,13 +23,15 @@ from controllers.two_wheel.gain_scheduled_min_norm import GainScheduledMinNorm
 from controllers.two_wheel.min_norm import MinNorm
 from controllers.two_wheel.singular_rate_tracking import SingularRateTracking
 from controllers.two_wheel.singular_zero_momentum import SingularZeroMomentum
+from planners.registry import Registry
 
-CONTROLLERS: dict[str, type[Controller]] = {
+CONTROLLERS: Registry[type[Controller]] = Registry("controller", {
     cls.name: cls for cls in (AugmentedQuaternionFeedback, BDot, CostateFeedback, EigenaxisPD, MRPFeedback, NoControl, TDFC,
                               SingularZeroMomentum, SingularRateTracking, MinNorm, GainScheduledMinNorm)
-}
+})
 
-__all__ = ["CONTROLLERS", "TDFC", "AugmentedQuaternionFeedback", "BDot", "Controller", "CostateFeedback", "EigenaxisPD",
+__all__ = ["CONTROLLERS", "TDFC", "AugmentedQuaternionFeedback", "BDot", "ConformanceError", "Controller", "CostateFeedback",
+           "EigenaxisPD",
            "GainScheduledMinNorm", "MRPFeedback", "MinNorm", "NoControl", "SingularRateTracking", "SingularZeroMomentum", "gain_matrix"]
 
 

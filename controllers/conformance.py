@@ -16,6 +16,10 @@ their oracles:
   NaN, a wrong literal and an unknown key are refused naming the option's path; so is a
   combination ``__post_init__`` refuses (an :class:`~ocp.errors.InvalidOption`, not a bare
   ``ValueError``). Oracle: the declared ranges themselves.
+* ``commands``: ``__call__`` returns a :class:`~ocp.Command` whose fields fit the spacecraft, with
+  finite numbers, at random states and with no error at all (a ``0/0`` at the target); every
+  other check calls the law the same way (:func:`checked_command`). Oracle: the spacecraft's
+  actuators.
 * ``symbolic``: ``__call__`` and :meth:`~controllers.base.Controller.symbolic_law` agree to 1e-12 at
   random states over successive samples (state updates included); a law without a symbolic form
   says why. Oracle: the two implementations of one law.
@@ -75,6 +79,12 @@ from ocp.dynamics.layout import measurement_vector
 from ocp.errors import OptionsError
 from ocp.options import Range, numeric_leaves, option_fields
 from planners import PLANNERS, ManeuverProblem, Reference
+
+__all__ = ["ALLOCATION_TOLERANCE", "CHECKS", "CONVERGED", "HOLD_FOR_ALLOCATION", "INERTIA", "INITIAL_ERROR_DEG",
+           "OPTIONS_PATH", "REFERENCE_PLANNERS", "SYMBOLIC_TOLERANCE", "Plant", "accepted_plants", "check_allocation",
+           "check_at_rest", "check_closed_loop", "check_commands", "check_controller", "check_double_cover",
+           "check_options", "check_pure", "check_symbolic", "checked_command", "describe_options", "kinetic_energy",
+           "option_variants", "sample_time_for", "standard_plants"]
 
 Array = NDArray[np.float64]
 
@@ -389,6 +399,91 @@ def _label(controller: Controller) -> str:
     return f"{controller.name} ({describe_options(changed)})"
 
 
+def _raised_in_allocate(error: BaseException) -> bool:
+    """Whether ``error`` was raised inside :meth:`Controller.allocate` (the law passed it a bad torque)."""
+    frames = []
+    traceback = error.__traceback__
+    while traceback is not None:
+        frames.append(traceback.tb_frame.f_code)
+        traceback = traceback.tb_next
+    return any(code.co_name in ("allocate", "_allocate") and code.co_filename.replace("\\", "/").endswith(
+        "controllers/allocation.py") for code in frames)
+
+
+def checked_command(controller: Controller, t: float, measurement: Measurement, reference: Any,
+                    where: str = "") -> Command:
+    """Call the law once and check what it returns: a :class:`~ocp.Command` whose fields fit
+    the spacecraft of its last ``reset`` and hold finite numbers.
+
+    Every check calls the law through this, so that a wrong type, a wrong shape or a NaN is named
+    as such, not as whatever it breaks further on (a disagreement, a reset that seems not to
+    clear the state, a Python error in the actuator model).
+
+    Parameters
+    ----------
+    controller : Controller
+        The law, after ``reset``.
+    t : float
+        Sample instant [s].
+    measurement : Measurement
+        The sample's measurement.
+    reference : Reference or None
+        What the law tracks (``None``: regulation to its target).
+    where : str, optional
+        Where it runs (plant, mode), for the message.
+
+    Returns
+    -------
+    Command
+        The law's command.
+
+    Raises
+    ------
+    ConformanceError
+        If the law raises (its exception chained), returns something other than a ``Command``,
+        or a field of it has the wrong shape or a non-finite value.
+    """
+    label = f"{_label(controller)}{where}"
+    try:
+        command = controller(t, measurement, reference)
+    except ConformanceError:
+        raise
+    except Exception as error:
+        hint = ("; the law's call to Controller.allocate(u, measurement) failed: u must be the rigid-body torque, "
+                "3 numbers [N m] in body axes" if _raised_in_allocate(error) else "")
+        raise ConformanceError(f"{label}: __call__ raised {type(error).__name__}: {error} at t = {t:g} s{hint}") \
+            from error
+    if not isinstance(command, Command):
+        raise ConformanceError(
+            f"{label}: __call__ returned {type(command).__name__} at t = {t:g} s; it must return an ocp.Command "
+            f"(Controller.allocate(u, measurement) maps a rigid-body torque u to one; or Command(wheel_torque=..., "
+            f"dipole=..., torque=...))")
+    spacecraft = controller.spacecraft
+    n_wheels = 0 if spacecraft is None else spacecraft.n_wheels
+    fields: list[tuple[str, Any, int | None]] = [("wheel_torque", command.wheel_torque, n_wheels),
+                                                  ("dipole", command.dipole, 3), ("torque", command.torque, 3)]
+    fields += [(f"other[{name!r}]", value, None) for name, value in (command.other or {}).items()]
+    for field, value, size in fields:
+        if value is None:
+            continue
+        try:
+            array = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise ConformanceError(f"{label}: Command.{field} at t = {t:g} s is {type(value).__name__}, "
+                                   f"not numbers") from None
+        if size is not None and array.shape != (size,):
+            raise ConformanceError(
+                f"{label}: Command.{field} at t = {t:g} s has shape {array.shape}; expected ({size},)"
+                + (" (one torque per wheel, N m)" if field == "wheel_torque" else " (body axes)"))
+        if not np.all(np.isfinite(array)):
+            raise ConformanceError(
+                f"{label}: non-finite command at t = {t:g} s: Command.{field} = {array.tolist()} (measured "
+                f"q = {np.round(measurement.q, 6).tolist()}, ω = {np.round(measurement.omega, 6).tolist()} rad/s); "
+                f"a law must give finite numbers at every state (a division by a vanishing norm, 0/0 at the "
+                f"target, an arcsin outside [-1, 1])")
+    return command
+
+
 @dataclass
 class _Mode:
     """One way of running a law on a plant: regulation (``reference`` None) or tracking."""
@@ -477,7 +572,8 @@ def _commands(controller: Controller, mode: _Mode, sample_time: float, measureme
     controller.reset(mode.plant.problem.spacecraft, sample_time,
                      target=mode.target if target is None else target)
     reference = mode.reference if reference is None else reference
-    return [controller.command_vector(controller(m.t, m, reference)) for m in measurements]
+    where = f" on {mode.plant_name} ({mode.name})"
+    return [controller.command_vector(checked_command(controller, m.t, m, reference, where)) for m in measurements]
 
 
 def _sequence(rng: np.random.Generator, controller: Controller, mode: _Mode, sample_time: float,
@@ -583,6 +679,53 @@ def check_options(controller: Controller) -> None:
                         f"__post_init__ must raise ocp.errors.InvalidOption(option, message), not ValueError") from None
 
 
+def check_commands(controller: Controller, seed: int = 6) -> None:
+    """The law returns a :class:`~ocp.Command` that fits the spacecraft, with finite numbers.
+
+    Run before the checks that compare commands: a NaN reads there as a disagreement or as a
+    state that ``reset`` does not clear, and a wrong return as a Python error deep in the
+    actuator model. On every standard plant the law accepts, in each of its modes: three
+    successive samples at random states, then samples with no error at all (at the target at
+    rest in regulation, on the reference when tracking), where a ``0/0`` hides.
+
+    Parameters
+    ----------
+    controller : Controller
+        The law, with the options to check.
+    seed : int, optional
+        Seed of the random states.
+
+    Raises
+    ------
+    ConformanceError
+        If the law raises, returns another type, a field of the wrong shape (a 4-vector body
+        torque, one wheel torque too many) or a non-finite value; the message names the plant,
+        the mode and the time.
+    """
+    rng = np.random.default_rng(seed)
+    for plant_name, plant in accepted_plants(controller).items():
+        for mode in _modes(controller, plant):
+            law = _fresh(controller)
+            sample_time = sample_time_for(law, plant.sample_time)
+            law.reset(plant.problem.spacecraft, sample_time, target=mode.target)
+            where = f" on {plant_name} ({mode.name})"
+            for measurement in _sequence(rng, law, mode, sample_time, 3):
+                checked_command(law, measurement.t, measurement, mode.reference, where)
+            law.reset(plant.problem.spacecraft, sample_time, target=mode.target)
+            wheels = np.zeros(plant.problem.spacecraft.n_wheels)
+            field = np.array([2e-5, -1e-5, 3e-5]) if plant.problem.environment.magnetic_field is not None else None
+            for t in _times(mode, rng, sample_time, 2):
+                if mode.reference is not None:
+                    state = mode.reference.sample(float(t))
+                    q, omega = np.array(state.q), np.array(state.omega)
+                else:
+                    q, omega = (plant.qf if mode.target[0] is None else mode.target[0]).copy(), np.zeros(3)
+                exact = Measurement(float(t), q, omega, wheels.copy(), None if field is None else field.copy())
+                if law.needs_field_rate and field is not None:
+                    exact.field_rate_inertial = np.zeros(3)
+                checked_command(law, float(t), exact, mode.reference, f"{where}, with no error")
+
+
 def check_symbolic(controller: Controller, seed: int = 1) -> None:
     """The numeric law (``__call__``) and its symbolic form agree at random states.
 
@@ -631,7 +774,8 @@ def check_symbolic(controller: Controller, seed: int = 1) -> None:
                 t = measurement.t
                 rows = law.reference_rows(mode.reference, np.array([t, t + sample_time])).ravel()
                 u, z_next = (v.full().ravel() for v in symbolic.function(t, measurement_vector(measurement), z, rows))
-                expected = law.command_vector(law(t, measurement, mode.reference))
+                expected = law.command_vector(checked_command(law, t, measurement, mode.reference,
+                                                              f" on {plant_name}, {mode.name}, sample {k}"))
                 scale = max(1.0, float(np.max(np.abs(expected), initial=0.0)))
                 if not np.allclose(u, expected, rtol=0.0, atol=SYMBOLIC_TOLERANCE * scale):
                     raise ConformanceError(
@@ -686,8 +830,9 @@ def check_pure(controller: Controller, seed: int = 2) -> None:
         other.reset(mode.plant.problem.spacecraft, sample_time, target=mode.target)
         interleaved = []
         for mine, theirs in zip(sequence, others):
-            interleaved.append(law.command_vector(law(mine.t, mine, mode.reference)))
-            other(theirs.t, theirs, mode.reference)
+            where = f" on {mode.plant_name} ({mode.name})"
+            interleaved.append(law.command_vector(checked_command(law, mine.t, mine, mode.reference, where)))
+            checked_command(other, theirs.t, theirs, mode.reference, where)
         if not np.array_equal(np.array(first), np.array(interleaved)):
             raise ConformanceError(f"{_label(law)} ({mode.name}): run beside another instance it gives other commands "
                                    f"than alone; keep the law's state on the instance (not on the class or the module)")
@@ -801,7 +946,8 @@ def check_allocation(controller: Controller, seed: int = 4) -> None:
             sample_time = sample_time_for(law, plant.sample_time)
             law.reset(plant.problem.spacecraft, sample_time, target=mode.target)
             for measurement in _sequence(rng, law, mode, sample_time, 3):
-                _check_command_fits(law, plant_name, plant, law(measurement.t, measurement, mode.reference))
+                _check_command_fits(law, plant_name, plant, checked_command(
+                    law, measurement.t, measurement, mode.reference, f" on {plant_name} ({mode.name})"))
     full = {name: plant for name, plant in plants.items() if plant.three_axis}
     if not controller.gyroscopic_compensation or controller.wheels_only or not full:
         return
@@ -825,7 +971,8 @@ def check_allocation(controller: Controller, seed: int = 4) -> None:
                 law = _fresh(controller)
                 law.reset(spacecraft, sample_time_for(law, HOLD_FOR_ALLOCATION), target=mode.target)
                 hold = law.sample_time
-                command = law(t, Measurement(t, q.copy(), omega.copy(), h.copy(), field), mode.reference)
+                command = checked_command(law, t, Measurement(t, q.copy(), omega.copy(), h.copy(), field),
+                                          mode.reference, f" on {plant_name} ({mode.name})")
                 if all(getattr(command, f) is None for f in ("wheel_torque", "dipole", "torque")):
                     return   # a law that commands nothing allocates nothing
                 after = _after_hold(plant, x, _applied(plant, command, x, hold), t, hold)
@@ -979,6 +1126,7 @@ def check_closed_loop(controller: Controller) -> None:
 
 CHECKS: dict[str, Callable[[Controller], None]] = {
     "options": check_options,
+    "commands": check_commands,
     "symbolic": check_symbolic,
     "pure": check_pure,
     "double_cover": check_double_cover,
@@ -986,7 +1134,8 @@ CHECKS: dict[str, Callable[[Controller], None]] = {
     "at_rest": check_at_rest,
     "closed_loop": check_closed_loop,
 }
-"""Every check, by name: ``check(controller)`` raises :class:`ConformanceError`."""
+"""Every check, by name, in the order :func:`check_controller` runs them (``commands`` before those
+that compare commands): ``check(controller)`` raises :class:`ConformanceError`."""
 
 
 def check_controller(controller: Controller) -> None:

@@ -12,4 +12,10 @@ __all__ = ["ConformanceError"]
 
 
 class ConformanceError(SlewbenchError, AssertionError):
-    """A controller breaks the controller contract; the message says what to fix."""
+    """A controller breaks the controller contract (:func:`controllers.conformance.check_controller`);
+    the message says what to fix.
+
+    A planner's reference that breaks the planner contract raises
+    :class:`planners.ConformanceError` instead, a class of its own (each package's errors import
+    only :mod:`ocp.errors`); catch both as ``AssertionError`` or :class:`~ocp.errors.SlewbenchError`.
+    """

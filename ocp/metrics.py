@@ -375,6 +375,25 @@ def compute_metrics(
     return metrics
 
 
+def _check_targets(function: str, target_q: Any, target_omega: Any) -> None:
+    """TypeError/ValueError naming ``target_q`` or ``target_omega`` when it is not what the metric
+    functions take (a problem instead of its ``qf``, a 3-vector instead of a quaternion)."""
+    for name, value, size, what in (("target_q", target_q, 4, "the final attitude, a quaternion scalar first"),
+                                    ("target_omega", target_omega, 3, "the final body rate [rad/s]")):
+        if value is None:
+            continue
+        if not isinstance(value, (list, tuple, np.ndarray)):
+            raise TypeError(f"{function}: {name} must be {size} numbers ({what}) or None, got {type(value).__name__}"
+                            + (" (pass problem.qf and problem.omegaf)" if hasattr(value, "qf") else ""))
+        try:
+            array = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise TypeError(f"{function}: {name} must be {size} numbers ({what}) or None, got {value!r:.80}") from None
+        if array.shape != (size,) or not np.all(np.isfinite(array)):
+            raise ValueError(f"{function}: {name} must be {size} finite numbers ({what}) or None, got shape "
+                             f"{array.shape}: {array.tolist()}")
+
+
 def metrics_from_simulation(
     result: Any,
     target_q: ArrayLike | None,
@@ -422,7 +441,17 @@ def metrics_from_simulation(
     -------
     dict of str to float, list of float or None
         Every key of :data:`METRIC_KEYS` (``initial_rate_error`` is null in closed loop).
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming the argument: a ``result`` that is not a simulation result, a ``target_q`` that is
+        not 4 numbers (a problem, a 3-vector), a ``target_omega`` that is not 3.
     """
+    if not all(hasattr(result, name) for name in ("t", "q", "omega", "applied_u", "model")):
+        raise TypeError(f"metrics_from_simulation: result must be an ocp.SimulationResult (Simulator.run), got "
+                        f"{type(result).__name__}")
+    _check_targets("metrics_from_simulation", target_q, target_omega)
     slices = result.model.control_slices
     dipole = result.applied_u[:, slices["dipole"]] if "dipole" in slices else None
     wheel_torque = result.applied_u[:, slices["wheels"]] if "wheels" in slices else None
@@ -501,7 +530,16 @@ def metrics_from_reference(
     dict of str to float, list of float or None
         Every key of :data:`METRIC_KEYS`; the closed-loop-only ones (tracking errors,
         saturation, wheel momentum, peak actuator and wheel torques, dipole) are null.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming the argument: a ``reference`` without ``sample(t)`` and ``duration``, a
+        ``target_q`` that is not 4 numbers (a problem, a 3-vector), a ``target_omega`` that is not 3.
     """
+    if not (callable(getattr(reference, "sample", None)) and hasattr(reference, "duration")):
+        raise TypeError(f"metrics_from_reference: reference must be a planners.Reference, got {type(reference).__name__}")
+    _check_targets("metrics_from_reference", target_q, target_omega)
     t = np.linspace(0.0, reference.duration, points)
     if sample is None:
         sample = reference.sample(t)

@@ -12,7 +12,46 @@ from numpy.typing import ArrayLike, NDArray
 
 Array = NDArray[np.float64]
 
+__all__ = ["EULER_SEQUENCES", "IDENTITY", "UNIT_NORM_TOLERANCE", "conjugate", "continuous", "error", "error_angle",
+           "from_axis_angle", "from_euler", "from_rotation_matrix", "from_rotation_vector", "from_scalar_last",
+           "kinematics", "normalize", "product", "random_unit", "rotate", "rotate_inverse", "rotation_matrix",
+           "sequence_axes", "slerp", "to_euler", "to_rotation_vector", "to_scalar_last", "unit_norm_error"]
+
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+"""(4,) ndarray: the identity rotation, scalar first (body axes aligned with the inertial ones)."""
+
+UNIT_NORM_TOLERANCE = 1e-2
+"""How far from 1 the norm of a quaternion given as input may be (:func:`unit_norm_error`): room
+for values typed with a few digits, none for a quaternion that is not a rotation (``[2, 0, 0, 0]``)."""
+
+
+def unit_norm_error(q: ArrayLike, tolerance: float = UNIT_NORM_TOLERANCE) -> str | None:
+    """Why ``q`` is not a unit quaternion given as input (the check of the YAML loader and of
+    ``planners.ManeuverProblem``), or ``None``.
+
+    Parameters
+    ----------
+    q : (4,) array_like
+        Quaternion, scalar first.
+    tolerance : float, optional
+        Largest ``|‖q‖ − 1|`` accepted (default :data:`UNIT_NORM_TOLERANCE`).
+
+    Returns
+    -------
+    str or None
+        ``"a quaternion cannot be zero"``, ``"a quaternion must be finite"`` or ``"a quaternion
+        must have unit norm (got norm 2; tolerance 1e-2)"``; ``None`` when its norm is within
+        ``tolerance`` of 1 (the caller then normalises it).
+    """
+    norm = float(np.linalg.norm(np.asarray(q, dtype=float)))
+    if not np.isfinite(norm):
+        return "a quaternion must be finite"
+    if norm == 0.0:
+        return "a quaternion cannot be zero"
+    if abs(norm - 1.0) > tolerance:
+        mantissa, exponent = f"{tolerance:.0e}".split("e")
+        return f"a quaternion must have unit norm (got norm {norm:.6g}; tolerance {mantissa}e{int(exponent)})"
+    return None
 
 
 def product(p: ArrayLike, q: ArrayLike) -> Array:
@@ -520,8 +559,9 @@ def from_euler(angles: ArrayLike, sequence: str = "321") -> Array:
     Returns
     -------
     (..., 4) ndarray
-        Unit quaternion(s), scalar first, reference frame to body (body to reference: ``v_ref =
-        R(q) v_B``), with the sign chosen so that ``q0 >= 0``.
+        Unit quaternion(s), scalar first, rotating body vectors into the reference frame
+        (``v_ref = R(q) v_B``, as everywhere in this module), with the sign chosen so that
+        ``q0 >= 0``.
 
     Raises
     ------

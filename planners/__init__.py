@@ -15,6 +15,7 @@ from planners.base import Planner
 from planners.collocation.planner import CollocationPlanner
 from planners.costate.tpbvp import CostateTPBVPPlanner
 from planners.eigenaxis import EigenaxisPlanner
+from planners.errors import ConformanceError, UnknownNameError
 from planners.natural_motion import NaturalMotionPlanner
 from planners.problem import ManeuverProblem
 from planners.reference import (
@@ -31,8 +32,8 @@ from planners.spin_extremal import SpinExtremalPlanner
 PLANNERS.update({cls.name: cls for cls in (CollocationPlanner, CostateTPBVPPlanner, EigenaxisPlanner,
                                             NaturalMotionPlanner, ShapePolynomialPlanner, SpinExtremalPlanner)})
 
-__all__ = ["BOUNDARY_CONDITIONS", "FailedReference", "ManeuverProblem", "PLANNERS", "Planner", "Reference", "ReferenceSample",
-           "inverse_dynamics_torque"]
+__all__ = ["BOUNDARY_CONDITIONS", "PLANNERS", "ConformanceError", "FailedReference", "ManeuverProblem", "Planner",
+           "Reference", "ReferenceSample", "UnknownNameError", "inverse_dynamics_torque"]
 
 
 def __dir__() -> list[str]:

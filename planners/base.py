@@ -199,7 +199,15 @@ class Planner(Configurable, ABC):
             The reference motion, with ``plan_time_s`` set to the wall time [s]; a
             :class:`FailedReference` (status ``"failed"`` or ``"infeasible"``) when
             :meth:`problem_error` refuses the problem or the method fails numerically.
+
+        Raises
+        ------
+        TypeError
+            If ``problem`` is not a :class:`ManeuverProblem`.
         """
+        if not isinstance(problem, ManeuverProblem):
+            raise TypeError(f"{type(self).__name__}.plan(problem): problem must be a planners.ManeuverProblem, got "
+                            f"{type(problem).__name__}")
         start = time.perf_counter()
         error = self.problem_error(problem)
         reference = FailedReference(self.name, error) if error else self._plan(problem)

@@ -7,9 +7,11 @@ and standard problems to plan for them.
 with a message that says what is wrong and what to do about it; a new planner can be checked by
 hand with :func:`check_reference`.
 
-Oracles: finite differences of the reference's own ``q`` and ``ω`` (kinematics, rate derivative,
-inverse dynamics), point-wise evaluation (vectorisation) and an independent numerical integration
-of the torque-free Euler and kinematic equations (continuation after T).
+Oracles: finite values and unit quaternions on a dense grid (first: a NaN would read as another
+defect in the later checks), finite differences of the reference's own ``q`` and ``ω``
+(kinematics, rate derivative, inverse dynamics), point-wise evaluation (vectorisation) and an
+independent numerical integration of the torque-free Euler and kinematic equations (continuation
+after T).
 """
 from __future__ import annotations
 
@@ -24,12 +26,22 @@ from planners.problem import Array, ManeuverProblem
 from planners.reference import Reference, inverse_dynamics_torque
 from planners.torque_free import REST_RATE
 
+__all__ = ["ATTITUDE_TOLERANCE", "CHECKS", "FINITE_SAMPLES", "NORM_TOLERANCE", "RATE_TOLERANCE", "RELATIVE_TOLERANCE",
+           "check_after_end", "check_boundary", "check_dynamics", "check_finite", "check_kinematics", "check_reference",
+           "check_times", "check_vectorised", "finite_check_times", "standard_problems"]
+
 ATTITUDE_TOLERANCE = 2e-5
 """rad: boundary attitudes (about 1e-3 deg, what the shooting planners guarantee)."""
 RATE_TOLERANCE = 1e-7
 """rad/s: boundary rates, plus ``RELATIVE_TOLERANCE`` times the reference's peak rate."""
 RELATIVE_TOLERANCE = 1e-5
 """Finite-difference checks, relative to the scale of the compared quantity."""
+NORM_TOLERANCE = 1e-6
+"""``|‖q‖ − 1|`` allowed of the reference's quaternions: far above rounding and the drift of an
+integration that does not renormalise, far below a scaled quaternion (``1.01 q``)."""
+FINITE_SAMPLES = 2001
+"""Times on ``[0, T]`` where :func:`check_finite` samples the reference (uniform, plus its
+breakpoints and enforced times): a step of T/2000, so a defect lasting T/1000 shows."""
 
 
 def standard_problems() -> dict[str, ManeuverProblem]:
@@ -67,6 +79,80 @@ def standard_problems() -> dict[str, ManeuverProblem]:
 def _fix_free(condition: str) -> str:
     return (f"meet it, or, if the method cannot, declare it on the reference: "
             f"Reference(..., free_boundary={{'{condition}'}}) (metrics then report the mismatch)")
+
+
+def finite_check_times(reference: Reference, points: int = FINITE_SAMPLES) -> Array:
+    """Where :func:`check_finite` samples: ``points`` uniform times on ``[0, T]``, the declared
+    breakpoints and enforced times (the reference's own grid) inside it, and a few after T.
+
+    Parameters
+    ----------
+    reference : Reference
+        The reference to sample.
+    points : int, optional
+        Uniform times on ``[0, T]`` (default :data:`FINITE_SAMPLES`).
+
+    Returns
+    -------
+    (M,) ndarray
+        Sorted times [s].
+    """
+    T = reference.duration
+    own = [reference.breakpoints]
+    if reference.enforced_times is not None:
+        own.append(reference.enforced_times)
+    inside = np.concatenate(own)
+    inside = inside[(inside >= 0.0) & (inside <= T)]
+    return np.unique(np.concatenate([np.linspace(0.0, T, points), inside, T * np.array([1.05, 1.3, 2.0])]))
+
+
+def check_finite(reference: Reference) -> None:
+    """Every quantity is finite and every ``q`` a unit quaternion, on a dense grid of ``[0, T]``
+    (:func:`finite_check_times`) and after T.
+
+    Run first: the other checks difference, normalise and compare the same numbers, and a NaN
+    there reads as another defect.
+
+    Parameters
+    ----------
+    reference : Reference
+        A reference with status ``"ok"``.
+
+    Raises
+    ------
+    ConformanceError
+        At the first time where ``q``, ``ω``, ``ω̇`` or the torque is not finite, or where
+        ``|‖q‖ − 1|`` exceeds :data:`NORM_TOLERANCE`.
+    """
+    T = reference.duration
+    if not (np.isfinite(T) and T > 0.0):
+        raise ConformanceError(f"{reference.planner}: the reference's duration is {T!r} s; it must be a finite "
+                               f"positive number of seconds")
+    times = finite_check_times(reference)
+    # [0, T] first: the continuation after T starts from the state at T, which must be finite.
+    for part in (times[times <= T], times[times > T]):
+        try:
+            sample = reference.sample(part)
+        except (TypeError, ValueError) as error:  # the contract's shape checks (Reference.sample)
+            raise ConformanceError(f"{reference.planner}: sampling at {part.size} times on [{part[0]:g}, {part[-1]:g}] "
+                                   f"s: {error}") from error
+        for name, values in zip(("q", "ω", "ω̇", "torque"), sample):
+            bad = ~np.all(np.isfinite(values), axis=1)
+            if np.any(bad):
+                k = int(np.argmax(bad))
+                raise ConformanceError(
+                    f"{reference.planner}: non-finite {name} at t = {part[k]:.6g} s ({part[k] / T:.4g} T): "
+                    f"{values[k].tolist()} ({int(np.sum(bad))} of {part.size} times sampled on "
+                    f"[{part[0]:g}, {part[-1]:g}] s); every quantity of a reference must be finite at every time "
+                    f"(a division by a vanishing norm, an arccos or sqrt outside its domain, an interpolant "
+                    f"evaluated off its grid)")
+        deviation = np.abs(np.linalg.norm(sample.q, axis=1) - 1.0)
+        if np.max(deviation) > NORM_TOLERANCE:
+            k = int(np.argmax(deviation))
+            raise ConformanceError(
+                f"{reference.planner}: q at t = {part[k]:.6g} s has norm {np.linalg.norm(sample.q[k]):.9g}, not 1 "
+                f"(|‖q‖ − 1| = {deviation[k]:.3g} > {NORM_TOLERANCE:g}); a reference's q must be a unit "
+                f"quaternion at every time: normalise it (ocp.quat.normalize)")
 
 
 def check_boundary(problem: ManeuverProblem, reference: Reference) -> None:
@@ -247,6 +333,12 @@ def check_vectorised(reference: Reference) -> None:
     for k, t in enumerate(times):
         alone = reference.sample(float(t))
         for name, a, b in zip(together._fields, together, alone):
+            if np.shape(b) == np.shape(a[k]) and np.all(np.isfinite(a[k])) and not np.all(np.isfinite(b)):
+                raise ConformanceError(
+                    f"{reference.planner}: non-finite {name} at t = {t:g} s when sampled alone: "
+                    f"{np.asarray(b).tolist()} (finite, {np.asarray(a[k]).round(9).tolist()}, among {times.size} "
+                    f"times); _evaluate must give finite values for an array of one time too, each time "
+                    f"independently of the others")
             if np.shape(b) != np.shape(a[k]) or not np.allclose(a[k], b, rtol=1e-9, atol=1e-12 * (1 + np.max(np.abs(a)))):
                 raise ConformanceError(
                     f"{reference.planner}: sample(t) for an array of times differs from sample(t) at t = {t:g} s "
@@ -305,13 +397,16 @@ def check_after_end(reference: Reference, horizon: float | None = None) -> None:
 
 
 CHECKS: dict[str, Callable[[ManeuverProblem, Reference], None]] = {
+    "finite": lambda problem, reference: check_finite(reference),
     "boundary": check_boundary,
     "kinematics": lambda problem, reference: check_kinematics(reference),
     "dynamics": lambda problem, reference: check_dynamics(reference),
     "vectorised": lambda problem, reference: check_vectorised(reference),
     "after_end": lambda problem, reference: check_after_end(reference),
 }
-"""Every check, by name: ``check(problem, reference)`` raises :class:`ConformanceError`."""
+"""Every check, by name, in the order :func:`check_reference` runs them (``finite`` first: a NaN
+would read as another defect in the others): ``check(problem, reference)`` raises
+:class:`ConformanceError`."""
 
 
 def check_reference(problem: ManeuverProblem, reference: Reference) -> None:

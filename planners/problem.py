@@ -9,7 +9,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ocp import AttitudeModel, Environment, Spacecraft
+from ocp import AttitudeModel, Environment, Spacecraft, quat
 from ocp.geometry import PointingConstraint
 
 Array = NDArray[np.float64]
@@ -20,19 +20,22 @@ Array = NDArray[np.float64]
 class ManeuverProblem:
     """A slew to plan: the spacecraft, its environment and the boundary conditions.
 
-    Inputs are checked and normalised on construction (a ``ValueError`` or ``TypeError`` names the
-    field): quaternions become unit float arrays, vectors float arrays of the right size.
+    Inputs are checked on construction (a ``ValueError`` or ``TypeError`` names the field):
+    quaternions must have unit norm within ``ocp.quat.UNIT_NORM_TOLERANCE`` (1e-2, the YAML
+    loader's tolerance; ``[2, 0, 0, 0]`` is refused, not normalised) and are then normalised to
+    unit float arrays; vectors become float arrays of the right size.
 
     Parameters
     ----------
     spacecraft : ocp.Spacecraft
         The body (inertia, actuators: wheels, torquers, magnetorquers).
     q0 : (4,) array_like
-        Initial attitude quaternion, scalar first, body to inertial (normalised here).
+        Initial attitude quaternion, scalar first, body to inertial: unit norm within 1e-2
+        (``ocp.quat.unit_norm_error``), normalised here.
     omega0 : (3,) array_like
         Initial body rate [rad/s], body axes.
     qf : (4,) array_like or None
-        Target attitude, scalar first, body to inertial (normalised here). ``None`` leaves the final
+        Target attitude, scalar first, body to inertial: unit norm within 1e-2, normalised here. ``None`` leaves the final
         attitude free, which only suits planners that accept it in :meth:`Planner.problem_error`
         (the default refuses it).
     duration : float
@@ -122,8 +125,6 @@ class ManeuverProblem:
         momentum = sc.inertia @ self.omega0 + sc.wheel_axes @ self.initial_state[7:]  # I ω0 + A h_w0
         if float(np.linalg.norm(momentum)) > scale or float(np.linalg.norm(held)) > scale:
             return None  # a drift (or a failed wheel's momentum, which turns the body too): not decided here
-        from ocp import quat
-
         turn = quat.to_rotation_vector(quat.error(self.qf, self.q0))  # body axes, q0 to qf
         if not working.shape[1]:
             return None if float(np.linalg.norm(turn)) <= 1e-9 else (
@@ -204,8 +205,11 @@ def _vector(name: str, value: ArrayLike, size: int) -> Array:
 
 
 def _quaternion(name: str, value: ArrayLike) -> Array:
-    """A unit quaternion from ``value`` (normalised), or a ``ValueError`` for a zero one."""
+    """A unit quaternion from ``value`` (normalised), or a ``ValueError`` naming ``name`` for one
+    whose norm is not within ``ocp.quat.UNIT_NORM_TOLERANCE`` of 1 (the YAML loader's check)."""
     q = _vector(name, value, 4)
-    if not np.linalg.norm(q) > 1e-6:
-        raise ValueError(f"{name} must be a non-zero quaternion [q0, q1, q2, q3] (scalar first), got {q.tolist()}")
+    reason = quat.unit_norm_error(q)
+    if reason is not None:
+        raise ValueError(f"{name} must be a unit quaternion [q0, q1, q2, q3] (scalar first): {reason}; "
+                         f"got {q.tolist()}")
     return q / np.linalg.norm(q)

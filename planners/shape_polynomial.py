@@ -36,6 +36,10 @@ from planners.reference import (
 )
 
 QUADRATURE_POINTS = 41  # uniform grid of the torque cost
+NO_RATE_BOUND = ("duration: rate_limit (the default, the paper's minimum time) needs a rate bound: the option max_rate, "
+                 "maneuver.max_rate or ManeuverProblem(..., max_rate=...); or plan over the problem's own duration "
+                 "with duration: scenario (options {'duration': 'scenario'})")
+"""Why the default ``duration: rate_limit`` refuses a problem without a rate bound."""
 GAUSS_POINTS = 16       # Gauss-Legendre points of the path cost (exact for degree 31)
 
 
@@ -293,7 +297,7 @@ class ShapePolynomialPlanner(Planner):
         o = self.options
         if o.duration == "rate_limit":
             if problem.rate_bound(o.max_rate) is None:
-                return "duration: rate_limit needs max_rate (option or maneuver.max_rate)"
+                return NO_RATE_BOUND
             if np.any(problem.omega0) or (problem.omegaf is not None and np.any(problem.omegaf)):
                 return "duration: rate_limit is for rest-to-rest slews; use duration: scenario"
         return super().problem_error(problem)
@@ -302,7 +306,7 @@ class ShapePolynomialPlanner(Planner):
         o = self.options
         max_rate = problem.rate_bound(o.max_rate)
         if o.duration == "rate_limit" and max_rate is None:
-            return FailedReference(self.name, "duration: rate_limit needs max_rate (option or maneuver.max_rate)")
+            return FailedReference(self.name, NO_RATE_BOUND)
         omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf
         rest_to_rest = not np.any(problem.omega0) and not np.any(omegaf)
         if o.duration == "rate_limit" and not rest_to_rest:

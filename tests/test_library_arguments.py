@@ -1,6 +1,8 @@
 """Public constructors and functions check their arguments (issue 11, section 3): each call below
 used to return garbage (a NaN quaternion, a non-unit quaternion, a negative time grid) or fail deep
 inside NumPy; now it raises ValueError/TypeError naming the argument and what was expected."""
+import re
+
 import numpy as np
 import pytest
 
@@ -21,15 +23,18 @@ SPACECRAFT = Spacecraft([2.0, 3.0, 4.0], wheels=ReactionWheels.from_body_axes(ma
 
 
 def problem(**changes):
-    arguments = dict(spacecraft=SPACECRAFT, q0=quat.IDENTITY, omega0=np.zeros(3),
-                     qf=quat.from_axis_angle([0, 0, 1], 0.5), duration=30.0)
+    arguments = {"spacecraft": SPACECRAFT, "q0": quat.IDENTITY, "omega0": np.zeros(3),
+                 "qf": quat.from_axis_angle([0, 0, 1], 0.5), "duration": 30.0}
     arguments.update(changes)
     return ManeuverProblem(**arguments)
 
 
 @pytest.mark.parametrize("changes, words", [
-    ({"q0": [0, 0, 0, 0]}, "q0 must be a non-zero quaternion"),
-    ({"qf": [0, 0, 0, 0]}, "qf must be a non-zero quaternion"),
+    ({"q0": [0, 0, 0, 0]}, r"q0 must be a unit quaternion .*: a quaternion cannot be zero"),
+    ({"qf": [0, 0, 0, 0]}, r"qf must be a unit quaternion .*: a quaternion cannot be zero"),
+    # Was normalised silently, while the YAML loader refuses it with the same words.
+    ({"q0": [2, 0, 0, 0]}, r"q0 must be a unit quaternion .*unit norm \(got norm 2; tolerance 1e-2\)"),
+    ({"qf": [1.01241, 0, 0, 0]}, r"qf must be a unit quaternion .*unit norm \(got norm 1.01241; tolerance 1e-2\)"),
     ({"q0": [1, 0, 0]}, "q0 must be 4 finite numbers"),
     ({"q0": [np.nan, 0, 0, 1]}, "q0 must be 4 finite numbers"),
     ({"omega0": [0, 0]}, "omega0 must be 3 finite numbers"),
@@ -133,3 +138,102 @@ def test_library_options_are_validated_like_yaml():
     options = PLANNERS["eigenaxis"].Options(torque_fraction=-1.0)  # built by hand, bypassing YAML
     with pytest.raises(OptionsError, match="torque_fraction"):
         PLANNERS["eigenaxis"](options)
+
+
+# --- a fresh-eyes user's calls (2026-12-02): raw errors from deep inside, now named at the entry ---
+
+@pytest.mark.parametrize("registry, name, words", [
+    (PLANNERS, "eigenaxiz", (r"unknown planner 'eigenaxiz'; registered: \['collocation', .*'eigenaxis'.*\] "
+                             r"\(did you mean 'eigenaxis'\?\)")),
+    (CONTROLLERS, "pd", r"unknown controller 'pd'; registered: \['augmented_quaternion_feedback', .*\]"),
+], ids=["planners", "controllers"])
+def test_an_unknown_registry_name_lists_the_registered_ones(registry, name, words):
+    from planners.errors import UnknownNameError
+    with pytest.raises(KeyError) as caught:  # a KeyError still, as a dictionary's
+        registry[name]
+    assert isinstance(caught.value, UnknownNameError)
+    assert re.fullmatch(words, str(caught.value))  # plain text, not the quoted repr of a bare KeyError
+    assert name not in registry and registry.get(name) is None
+
+
+@pytest.mark.parametrize("argument", ["abc", None, SPACECRAFT])
+def test_plan_refuses_what_is_not_a_problem(argument):
+    with pytest.raises(TypeError, match=r"EigenaxisPlanner.plan\(problem\): problem must be a planners.ManeuverProblem"):
+        PLANNERS["eigenaxis"]().plan(argument)
+
+
+@pytest.mark.parametrize("call, error, words", [
+    (lambda s, x: s.run(CONTROLLERS["none"](), x, 10.0, reference="eigenaxis"), TypeError,
+     r"reference must be a planners.Reference .*got str \(a planner's name\? plan it first"),
+    (lambda s, x: s.run(CONTROLLERS["none"](), x, 10.0, target=([1, 0, 0], None)), ValueError,
+     r"target\[0\] \(q_f\) must be 4 finite numbers .*got shape \(3,\)"),
+    (lambda s, x: s.run(CONTROLLERS["none"](), x, 10.0, target=(quat.IDENTITY, [0, 0])), ValueError,
+     r"target\[1\] \(omega_f\) must be 3 finite numbers"),
+    (lambda s, x: s.run(CONTROLLERS["none"](), x, 10.0, target=quat.IDENTITY), ValueError,
+     r"target must be a pair \(q_f, omega_f\)"),
+    (lambda s, x: s.run(CONTROLLERS["none"], x, 10.0), TypeError,
+     r"controller must be a controller instance, got the class NoControl; instantiate it"),
+])
+def test_simulator_run_names_a_wrong_reference_or_target(call, error, words):
+    simulator = Simulator(AttitudeModel(SPACECRAFT), sample_time=1.0)
+    x0 = np.concatenate([quat.IDENTITY, np.zeros(6)])
+    with pytest.raises(error, match=words):
+        call(simulator, x0)
+
+
+def test_metric_functions_name_a_wrong_target():
+    from ocp import metrics_from_reference, metrics_from_simulation
+    slew = problem(omegaf=np.zeros(3))
+    reference = PLANNERS["eigenaxis"]().plan(slew)
+    result = Simulator(slew.model, sample_time=1.0).run(CONTROLLERS["none"](), slew.initial_state, 3.0)
+    with pytest.raises(TypeError, match=r"metrics_from_reference: target_q must be 4 numbers .*got ManeuverProblem "
+                                        r"\(pass problem.qf and problem.omegaf\)"):
+        metrics_from_reference(reference, slew)
+    with pytest.raises(ValueError, match=r"metrics_from_simulation: target_q must be 4 finite numbers .*shape \(3,\)"):
+        metrics_from_simulation(result, [1, 0, 0])
+    with pytest.raises(ValueError, match=r"metrics_from_reference: target_omega must be 3 finite numbers"):
+        metrics_from_reference(reference, slew.qf, [0.0, 0.0])
+    with pytest.raises(TypeError, match=r"metrics_from_reference: reference must be a planners.Reference, got str"):
+        metrics_from_reference("eigenaxis", slew.qf)
+    with pytest.raises(TypeError, match=r"metrics_from_simulation: result must be an ocp.SimulationResult"):
+        metrics_from_simulation(reference, slew.qf)
+    # What they take still works.
+    assert metrics_from_reference(reference, slew.qf, slew.omegaf)["final_error_deg"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_non_finite_inertia_is_called_non_finite():
+    with pytest.raises(ModelError, match=r"inertia: the inertia must be finite, got \[\[nan, 0.0, 0.0\]"):
+        Spacecraft([np.nan, 1.0, 1.0])
+    with pytest.raises(ModelError, match=r"inertia: expected 3 principal moments or a 3x3 matrix, got shape \(2,\)"):
+        Spacecraft([1.0, 2.0])
+
+
+def test_the_yaml_and_the_library_refuse_one_non_unit_quaternion_alike():
+    from scenarios.errors import ScenarioError
+    from scenarios.schema import parse_yaml_text
+    text = ("name: q\nspacecraft: {inertia: [2, 3, 4], wheels: {max_torque: 0.1}}\n"
+            "maneuver: {duration: 30, initial: {q: [1, 0, 0, 0], omega: [0, 0, 0]}, final: {q: [1.01241, 0, 0, 0]}}\n"
+            "planners: [{name: eigenaxis}]\ncontroller: {name: none}\n")
+    import scenarios
+    with pytest.raises(ScenarioError) as yaml_error:
+        scenarios.parse_scenario(parse_yaml_text(text))
+    with pytest.raises(ValueError) as library_error:
+        problem(qf=[1.01241, 0, 0, 0])
+    reason = quat.unit_norm_error([1.01241, 0, 0, 0])
+    assert reason == "a quaternion must have unit norm (got norm 1.01241; tolerance 1e-2)"
+    assert reason in str(yaml_error.value) and reason in str(library_error.value)
+    assert quat.unit_norm_error([1.0 + 0.9 * quat.UNIT_NORM_TOLERANCE, 0, 0, 0]) is None
+    q = problem(q0=[1.005, 0, 0, 0]).q0  # within the tolerance: normalised, as documented
+    assert np.linalg.norm(q) == pytest.approx(1.0, abs=1e-15)
+
+
+def test_shape_polynomial_says_how_to_plan_without_a_rate_bound():
+    # Its default, duration: rate_limit (the paper's minimum time), needs a rate bound; it cannot
+    # fall back to the problem's duration by itself, because whether it minimises time and honours
+    # the rate bound are read from its options alone (planners.capabilities). The refusal says both ways out.
+    slew = problem(omegaf=np.zeros(3))
+    reason = PLANNERS["shape_polynomial"]().problem_error(slew)
+    assert "needs a rate bound" in reason and "ManeuverProblem(..., max_rate=...)" in reason
+    assert "options {'duration': 'scenario'}" in reason
+    assert PLANNERS["shape_polynomial"]({"duration": "scenario", "terms": 1}).plan(slew).ok
+    assert PLANNERS["shape_polynomial"]({"terms": 1}).plan(problem(omegaf=np.zeros(3), max_rate=0.05)).ok

@@ -88,8 +88,10 @@ class Spacecraft:
             raise ModelError("inertia", "expected 3 principal moments or a 3x3 matrix of numbers") from None
         if inertia.shape == (3,):
             inertia = np.diag(inertia)
-        if inertia.shape != (3, 3) or not np.all(np.isfinite(inertia)):
+        if inertia.shape != (3, 3):
             raise ModelError("inertia", f"expected 3 principal moments or a 3x3 matrix, got shape {inertia.shape}")
+        if not np.all(np.isfinite(inertia)):
+            raise ModelError("inertia", f"the inertia must be finite, got {inertia.tolist()}")
         scale = np.max(np.abs(inertia))
         if scale == 0 or np.max(np.abs(inertia - inertia.T)) > 1e-9 * scale:
             raise ModelError("inertia", "the inertia matrix must be symmetric and non-zero")

@@ -609,8 +609,13 @@ class Simulator:
         SimulationError
             When the state becomes non-finite or the run exceeds the work limits.
         ValueError
-            A sensor declared twice (in ``sensors`` and with a non-zero deviation in ``noise``).
+            A sensor declared twice (in ``sensors`` and with a non-zero deviation in ``noise``), or
+            a ``target`` of the wrong shape.
+        TypeError
+            A controller class instead of an instance, or a ``reference`` without ``sample(t)``
+            (a planner's name instead of its reference).
         """
+        _check_run_arguments(controller, reference, target)
         model = self.model
         x = np.asarray(x0, dtype=float).copy()
         if x.shape != (model.nx,) or not np.all(np.isfinite(x)):
@@ -845,3 +850,35 @@ class Simulator:
         served = GridSampledReference(reference, grid)
         self._last_grid = (reference, grid, served)
         return served
+
+
+def _check_run_arguments(controller: Any, reference: Any, target: Any) -> None:
+    """TypeError/ValueError naming the argument of :meth:`Simulator.run` that is not what it takes."""
+    if isinstance(controller, type):
+        raise TypeError(f"controller must be a controller instance, got the class {controller.__name__}; "
+                        f"instantiate it: {controller.__name__}() or {controller.__name__}(options)")
+    if not callable(getattr(controller, "reset", None)) or not callable(controller):
+        raise TypeError(f"controller must be a controllers.Controller (reset and __call__), got {type(controller).__name__}")
+    if reference is not None and not callable(getattr(reference, "sample", None)):
+        hint = (f" (a planner's name? plan it first: PLANNERS[{reference!r}]().plan(problem))"
+                if isinstance(reference, str) else "")
+        raise TypeError(f"reference must be a planners.Reference (anything with sample(t)) or None, got "
+                        f"{type(reference).__name__}{hint}")
+    if target is None:
+        return
+    if not isinstance(target, (tuple, list)) or len(target) != 2:
+        raise ValueError(f"target must be a pair (q_f, omega_f): the final attitude (4 numbers, scalar first, or None) "
+                         f"and body rate (3 numbers in rad/s, or None), got {type(target).__name__} {target!r:.80}")
+    for index, (name, size, what) in enumerate((("q_f", 4, "a quaternion, scalar first"), ("omega_f", 3, "rad/s"))):
+        value = target[index]
+        if value is None:
+            continue
+        try:
+            array = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"target[{index}] ({name}) must be {size} numbers ({what}) or None, got {value!r:.80}") from None
+        if array.shape != (size,) or not np.all(np.isfinite(array)):
+            raise ValueError(f"target[{index}] ({name}) must be {size} finite numbers ({what}) or None, got shape "
+                             f"{array.shape}: {array.tolist()}")
+        if size == 4 and not np.linalg.norm(array) > 0.0:
+            raise ValueError(f"target[0] (q_f) must be a non-zero quaternion, got {array.tolist()}")
