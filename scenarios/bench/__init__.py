@@ -5,7 +5,8 @@ files in ``problems/``), the leaderboard that ``slewbench bench`` writes from ru
 (:mod:`scenarios.bench.peers`).
 
 May import: :mod:`ocp`, :mod:`planners`, :mod:`scenarios.errors`, :mod:`scenarios.schema`,
-:mod:`scenarios.output`, :mod:`scenarios.runner` and :mod:`scenarios.bench` itself. Its names
+:mod:`scenarios.output`, :mod:`scenarios.requirements` (a plan's own status), :mod:`scenarios.runner` and
+:mod:`scenarios.bench` itself. Its names
 are imported on first use.
 """
 from __future__ import annotations

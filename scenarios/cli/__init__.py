@@ -4,8 +4,8 @@ What lives here: the parser, the single-scenario commands and ``schema``
 (:mod:`~scenarios.cli.commands`) and the study commands (:mod:`~scenarios.cli.sweep`). ``python -m scenarios.cli`` runs it in one process;
 the console script (:mod:`scenarios.console`) starts the plot process first.
 
-May import: everything of :mod:`scenarios`, and :mod:`planners` and :mod:`controllers` (their
-registries); nothing imports it but the console script.
+May import: everything of :mod:`scenarios`, :mod:`planners` and :mod:`controllers` (their
+registries) and :mod:`ocp.metrics` (the metric table); nothing imports it but the console script.
 """
 from __future__ import annotations
 

@@ -40,6 +40,11 @@ if TYPE_CHECKING:
 
     from scenarios.output.results import RunResults
 
+__all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "IDENTITY_COLUMNS", "ROW_STATUSES", "csv_cell", "csv_text",
+           "data_frame", "flatten_row", "html_table", "is_missing", "json_safe", "numeric_columns",
+           "requirement_columns", "row_columns", "status_line", "text_cell", "to_csv", "to_dataframe", "to_json",
+           "to_markdown", "to_terminal"]
+
 IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s")
 """The columns that name a row, before its metrics."""
 

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ocp import quat
 from ocp.errors import excerpt
 from scenarios.errors import ScenarioError
 
@@ -338,9 +339,7 @@ class Node:
             Not 4 numbers, zero, or a norm farther than 1e-2 from 1.
         """
         q = self.vector(4)
-        norm = float(np.linalg.norm(q))
-        if norm == 0.0:
-            raise self.error("a quaternion cannot be zero")
-        if abs(norm - 1.0) > 1e-2:
-            raise self.error(f"a quaternion must have unit norm (got norm {norm:.6g}; tolerance 1e-2)")
-        return q / norm
+        problem = quat.unit_norm_error(q)
+        if problem is not None:
+            raise self.error(problem)
+        return q / float(np.linalg.norm(q))
