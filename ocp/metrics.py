@@ -33,12 +33,14 @@ class MetricInfo(NamedTuple):
     meaning : str
         Its definition as :func:`compute_metrics` computes it (reStructuredText inline markup).
     null_worst_when : str or None
-        For a time whose null can mean "never" (the motion is still outside the band at the last
-        sample): the key of the metric whose value shows that this one applies to the motion
-        (``final_error_deg`` for ``settling_time_s``: a final attitude is set). When that key has
-        a value and this one is null, the null is the worst outcome, later than any time: the
-        trade-study tables count it as never reached, +inf (:mod:`scenarios.study.report`).
-        None (the default): a null only means that the metric does not apply.
+        For a metric whose null can mean +inf, the worst outcome: a time never reached (the motion
+        is still outside the band at the last sample) or an effort without a finite value (a
+        reference's impulse, written null in the files): the key of the metric whose value shows
+        that this one applies to the motion (``final_error_deg`` for ``settling_time_s``: a final
+        attitude is set; ``int_u`` for ``int_u2`` and ``peak_body_torque``: a torque was
+        integrated). When that key has a value and this one is null, the trade-study tables count
+        it as never reached, +inf (:mod:`scenarios.study.report`). None (the default): a null only
+        means that the metric does not apply.
     """
 
     unit: str
@@ -49,7 +51,8 @@ class MetricInfo(NamedTuple):
 METRIC_INFO: dict[str, MetricInfo] = {
     "int_u2": MetricInfo(
         "N² m² s", "∫ ‖u‖₂² dt over the window: the control effort; +inf for a reference whose body rate "
-        "jumps (an impulse, whose square has no finite integral: shown as missing in the tables)."),
+        "jumps (an impulse, whose square has no finite integral: shown as missing in the tables).",
+        null_worst_when="int_u"),
     "int_u": MetricInfo(
         "N m s", "∫ ‖u‖₂ dt, the integrated torque (Euclidean norm, not the sum of the axes); a reference's "
         "rate jumps Δω add their angular impulses ‖I Δω‖ (the torque of a jump is I Δω δ(t − t_j))."),
@@ -62,7 +65,8 @@ METRIC_INFO: dict[str, MetricInfo] = {
         "I ω̇ = −ω × I ω + u: a reference's feed-forward torque (I ω̇ + ω × I ω); in closed loop the applied "
         "actuator torque less the wheels' gyroscopic torque, τ_act − ω × A h_w at each sample (the u the "
         "allocation realised, so that reference and closed loop compare); 0 without any torque sample; +inf "
-        "for a reference whose body rate jumps (an impulse; shown as missing in the tables)."),
+        "for a reference whose body rate jumps (an impulse; shown as missing in the tables).",
+        null_worst_when="int_u"),
     "peak_actuator_torque": MetricInfo(
         "N m", "Closed loop: max over the samples and the body axes of |τ_act,i|, τ_act the actuators' "
         "applied torque on the body (wheels −A g, magnetorquers m × B, torquers); null for a reference "

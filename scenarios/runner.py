@@ -38,6 +38,7 @@ from ocp.nlp import with_costate_gap
 from planners import FailedReference, Reference, ReferenceSample
 from scenarios.output.results import Row, RunResults
 from scenarios.requirements.scoring import (
+    JUMP_TOLERANCE,
     REFERENCE_POINTS,
     SCOPE_WORDS,
     Score,
@@ -337,9 +338,14 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
              if scoring else np.linspace(0.0, reference.duration, REFERENCE_POINTS))
     sample = reference.sample(times)
     uniform = ReferenceSample(*(values[:REFERENCE_POINTS] for values in sample))
-    # the rate's jumps are impulses no sample sees: the metrics add them (int_u2 and the peak torque +inf)
+    # the rate's jumps are impulses no sample sees: the metrics add them (int_u2 and the peak torque +inf),
+    # a start the reference declares free included (the actuator requirement exempts it: initial_rate_error
+    # reports it; but the manoeuvre from its ω0 needs that impulse all the same)
     jumps = [jump for _, _, jump in rate_jumps(times[:REFERENCE_POINTS], uniform.omega, scenario.problem.omega0,
                                                 reference)]
+    start = uniform.omega[0] - np.asarray(scenario.problem.omega0, dtype=float)
+    if "omega0" in reference.free_boundary and np.linalg.norm(start) > JUMP_TOLERANCE:
+        jumps.insert(0, start)
     metrics = metrics_from_reference(
         reference, scenario.problem.qf, scenario.problem.omegaf, points=REFERENCE_POINTS,
         settling_tolerance_deg=spec.settling_tolerance_deg,

@@ -136,3 +136,17 @@ def test_percentile_towards_inf():
     assert percentile(values, 50.0) == 2.0 and percentile(values, 75.0) == math.inf
     finite = np.array([3.0, 1.0, 7.0, 2.0])
     assert percentile(finite, 95.0) == np.percentile(finite, 95.0)
+
+
+def test_an_impulsive_reference_counts_as_infinite_effort_not_as_no_value():
+    """A reference whose rate jumps has ``int_u`` (its impulses) and no finite ``int_u2`` nor peak
+    torque (written null in the files): the study takes those nulls as +inf, the worst effort; a
+    failed planner's row (no ``int_u`` either) has no value."""
+    from scenarios.study.report import metric_values
+
+    rows = [{"ref.int_u": 8.06e-4, "ref.int_u2": None, "ref.peak_body_torque": None},   # impulses
+            {"ref.int_u": 2.2e-3, "ref.int_u2": 5.85e-8, "ref.peak_body_torque": 1e-4},  # a smooth plan
+            {"ref.int_u": None, "ref.int_u2": None, "ref.peak_body_torque": None}]      # failed
+    for column, finite in (("ref.int_u2", 5.85e-8), ("ref.peak_body_torque", 1e-4)):
+        values = metric_values(column, rows)
+        assert values[0] == math.inf and values[1] == finite and math.isnan(values[2])

@@ -235,8 +235,10 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
     error above ``limit`` while none is found) is zoomed
     (:data:`~ocp.geometry.pointing.REFINE_LEVELS` times to two of its
     :data:`~ocp.geometry.pointing.REFINE_POINTS` points about its largest, while its bound still
-    allows more). ``start`` itself is a point when it falls between samples. An error above
-    ``limit`` is never missed where the samples agree with their rates; the largest error is exact
+    allows more). ``start`` itself is a point when it falls between samples. An error of the
+    interpolated motion above ``limit`` is never missed where the samples agree with their rates
+    (the true motion differs from it by the interpolation's O(h⁴): with samples far apart next to
+    the motion's own time scale, sample more finely); the largest error is exact
     where the search reaches it, else within the bound over a step (a turn of
     :data:`~ocp.geometry.pointing.FINE_STEP`: 0.0375° at most).
 

@@ -1,4 +1,14 @@
-"""What scoring every requirement costs (issue 27): at most 10 % of a run's wall time.
+"""What scoring every requirement costs: at most as much again as the run without it (budget
+OVERHEAD_BUDGET).
+
+Issue 27 set 10 % of a run's wall time, met while every requirement was scored at the samples
+alone. Scoring between the samples (the closed loop's pointing, then the reference's pointing and
+both scopes' final error: a narrow cone crossed between two samples was missed and the row ok) and
+the reference demand's RK4 sub-steps cost more: measured side by side on 2026-12-02, +56..60 % on
+191ba78 and +75..78 % with the reference scored between samples (CPU of one pointing score of the
+12U CubeSat's reference 0.53-0.61 ms at the samples, 4.30-4.68 ms between them). The 10 % target
+is not held; this budget catches a further regression. Most of the between-samples search's time
+is NumPy's per-call overhead on short arrays (profile: ``ocp.geometry.pointing``'s zooms).
 
 The 12U CubeSat Sun keep-out scenario without its collocation row (the fast planners, where scoring
 weighs most), with three pointing requirements (the star tracker off the Sun and the Moon, an
@@ -14,7 +24,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-import pytest
 import yaml
 
 import scenarios
@@ -22,6 +31,8 @@ from scenarios import runner
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "cubesat_12u_sun_keep_out.yaml"
 ROUNDS = 15
+OVERHEAD_BUDGET = 1.0
+"""Largest accepted ratio of the run with scoring to the run without it, less one."""
 
 
 def three_pointing_requirements() -> scenarios.Scenario:
@@ -47,12 +58,7 @@ def timed(scenario: scenarios.Scenario, scoring: bool) -> float:
     return elapsed
 
 
-@pytest.mark.xfail(strict=False, reason=(
-    "not met since the between-samples scoring and the reference demand's RK4 sub-steps: 2026-12-02, "
-    "side by side, +56..60 % at 191ba78 and +75..78 % with the reference scored between its samples "
-    "(HermiteMotion built once per score); the between-samples search's per-call NumPy overhead is most "
-    "of it"))
-def test_scoring_every_requirement_costs_at_most_10_percent(benchmark):
+def test_scoring_every_requirement_costs_at_most_the_budget(benchmark):
     scenario = three_pointing_requirements()
     assert len(scenario.problem.pointing) == 3
     scenarios.run(scenario)  # warm the caches (CasADi builds, the shape polynomials' NLPs) for both alike
@@ -68,4 +74,4 @@ def test_scoring_every_requirement_costs_at_most_10_percent(benchmark):
     print(f"\nscoring on: median {median_on:.3f} s (min {min(on):.3f}, max {max(on):.3f}); "
           f"off: median {median_off:.3f} s (min {min(off):.3f}, max {max(off):.3f}); overhead (median of the "
           f"pairs' ratios) {overhead:+.1%}, of the medians {median_on / median_off - 1:+.1%}")
-    assert overhead < 0.10
+    assert overhead < OVERHEAD_BUDGET
