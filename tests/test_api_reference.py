@@ -50,13 +50,15 @@ def _resolves(target: str) -> bool:
     if target in documented():
         return True
     parent, _, member = target.rpartition(".")
-    if parent in documented():  # a member of a documented class (autodoc's members: True)
+    if parent in documented():  # an own member of a documented class (autodoc's members: True)
         module_name, _, class_name = parent.rpartition(".")
         try:
             owner = getattr(importlib.import_module(module_name), class_name)
         except (ImportError, AttributeError, ValueError):
             return False
-        return inspect.isclass(owner) and hasattr(owner, member)
+        # autodoc documents a class's own members, not those it inherits (Orbit.lvlh_matrix has an
+        # anchor, CircularOrbit.lvlh_matrix none)
+        return inspect.isclass(owner) and member in vars(owner)
     return False
 
 

@@ -104,6 +104,14 @@ def test_pyramid_plan_is_within_the_limits_through_A_plus_and_a_restriction(monk
     assert free.status == "ok"
     assert np.abs(_allocated_wheel_torques(free)).max() > 1.2 * G_MAX  # 1.31 x: the user's finding
     assert reference.stats["objective"] >= free.stats["objective"]  # 0.0179384 >= 0.0157292
+    # the plan pickles (a reference keeps its transcription, here a class made for these rows) and
+    # comes back sampling the same motion
+    import pickle
+
+    back = pickle.loads(pickle.dumps(reference))
+    times = np.linspace(0.0, 90.0, 37)
+    assert np.array_equal(back.sample(times).torque, reference.sample(times).torque)
+    assert type(back.transcription).__name__ == type(reference.transcription).__name__
 
 
 SCENARIO = """

@@ -171,6 +171,9 @@ def test_plan_refuses_what_is_not_a_problem(argument):
      r"target\[1\] \(omega_f\) must be 3 finite numbers"),
     (lambda s, x: s.run(CONTROLLERS["none"](), x, 10.0, target=quat.IDENTITY), ValueError,
      r"target must be a pair \(q_f, omega_f\)"),
+    # a scaled target changes a law's gains (the error quaternion scales): refused as ManeuverProblem does
+    (lambda s, x: s.run(CONTROLLERS["none"](), x, 10.0, target=(2 * quat.IDENTITY, None)), ValueError,
+     r"target\[0\] \(q_f\): a quaternion must have unit norm \(got norm 2; tolerance 1e-2\)"),
     (lambda s, x: s.run(CONTROLLERS["none"], x, 10.0), TypeError,
      r"controller must be a controller instance, got the class NoControl; instantiate it"),
 ])

@@ -169,7 +169,9 @@ class Spacecraft:
         limit; for wheels the box ``|τ_i| <= b_i`` is the largest (smallest bound, then by sum)
         box whose every corner the working wheels realise through ``g = -A⁺ τ`` within their
         torque limits, found by a small linear programme; axes the wheels cannot reach get 0.
-        Magnetorquers are not included: their torque depends on the field.
+        Magnetorquers are not included: their torque depends on the field. Torquers beside wheels
+        that span three axes are counted though the controllers' allocation never asks them
+        (:meth:`allocation_rows` is the realised set: eigenaxis and collocation plan with it).
 
         Returns
         -------
@@ -201,10 +203,11 @@ class Spacecraft:
         torquers; magnetorquers, whose torque depends on the field and are counted as giving none,
         as in :meth:`body_torque_limit`) gets rows with the limit 0.
 
-        Unlike :meth:`body_torque_limit` (a per-axis box every corner of which is realised, so
-        conservative for a skewed wheel array such as a four-wheel pyramid), these rows describe
-        the realised set exactly; with wheels along the three body axes the two agree (``M`` the
-        identity, ``L`` the wheels' limits).
+        Unlike :meth:`body_torque_limit` (the sum of each actuator's per-axis box: conservative for
+        a skewed wheel array such as a four-wheel pyramid, and optimistic with torquers beside
+        wheels that span three axes, which the allocation never asks), these rows describe the
+        realised set exactly; with wheels along the three body axes and nothing else the two agree
+        (``M`` the identity, ``L`` the wheels' limits).
 
         Returns
         -------

@@ -880,5 +880,5 @@ def _check_run_arguments(controller: Any, reference: Any, target: Any) -> None:
         if array.shape != (size,) or not np.all(np.isfinite(array)):
             raise ValueError(f"target[{index}] ({name}) must be {size} finite numbers ({what}) or None, got shape "
                              f"{array.shape}: {array.tolist()}")
-        if size == 4 and not np.linalg.norm(array) > 0.0:
-            raise ValueError(f"target[0] (q_f) must be a non-zero quaternion, got {array.tolist()}")
+        if size == 4 and (problem := quat.unit_norm_error(array)) is not None:
+            raise ValueError(f"target[0] (q_f): {problem}, got {array.tolist()}")

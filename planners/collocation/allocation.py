@@ -205,7 +205,20 @@ def with_allocation(transcription: Transcription, rows: Array) -> Transcription:
             c_position, path_position = super().positions(problem, self._inner_interval)
             return c_position, np.concatenate([path_position, self._allocation_positions])
 
+        def __reduce__(self) -> tuple[Any, ...]:
+            # a class made here has no importable name: pickle (a plan's reference keeps its
+            # transcription) rebuilds it from its base class, its rows and its state
+            return _rebuilt, (base, rows, dict(self.__dict__))
+
     Allocated.__name__ = Allocated.__qualname__ = f"{base.__name__}WithAllocation"
     allocated = object.__new__(Allocated)
     allocated.__dict__.update(transcription.__dict__)
+    return allocated
+
+
+def _rebuilt(base: type, rows: Array, state: dict[str, Any]) -> Transcription:
+    """A pickled :func:`with_allocation` transcription, made again from its base class, its rows
+    and its state."""
+    allocated = with_allocation(object.__new__(base), rows)
+    allocated.__dict__.update(state)
     return allocated
