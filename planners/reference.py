@@ -237,6 +237,8 @@ class Reference(ABC):
 
         Raises
         ------
+        ValueError
+            If a time is not finite (NaN or infinite).
         TypeError, ValueError
             If :meth:`_evaluate` breaks the contract (not a ``ReferenceSample``, wrong shapes).
         RuntimeError
@@ -245,6 +247,10 @@ class Reference(ABC):
         times = np.atleast_1d(np.asarray(t, dtype=float))
         if times.ndim != 1:
             times = times.ravel()
+        if not np.isfinite(times).all():
+            bad = times[~np.isfinite(times)]
+            raise ValueError(f"reference times must be finite [s]; got {bad[:3].tolist()}"
+                             f"{' and more' if bad.size > 3 else ''} among {times.size}")
         inside = self._checked(np.clip(times, 0.0, self.duration))
         after = times > self.duration
         if np.any(after):

@@ -437,3 +437,31 @@ def test_the_optimum_is_printed_with_the_digits_of_its_tolerance(value, toleranc
     from scenarios.bench.leaderboard import _with_tolerance
 
     assert _with_tolerance(value, tolerance) == expected
+
+
+def test_each_row_s_plan_is_scored_through_its_own_controller(monkeypatch):
+    """A reference tracked by two controllers is scored once per controller (the actuator demand goes
+    through that controller's allocation); before, every row took the first controller's status."""
+    import scenarios.bench.leaderboard as leaderboard
+    from scenarios import run
+    from scenarios.schema.loader import ControllerSpec
+
+    problem = load_suite().problems["bilimoria_wie_180"]
+    scenario = load(problem.file)
+    first = scenario.controllers[0]
+    second = ControllerSpec(first.name, first.options, label="second")
+    specs = [spec for spec in scenario.planners if spec.name == "eigenaxis"][:1]
+    scenario = dataclasses.replace(scenario, planners=specs, controllers=[first, second])
+    results = run(scenario)
+    calls = []
+
+    def status(scenario, row, controller):
+        calls.append((id(row.reference), id(controller)))
+        return "ok" if controller is first.controller else "violated"
+
+    monkeypatch.setattr(leaderboard, "_plan_status", status)
+    rows = leaderboard._planner_rows(problem, scenario, results, specs)
+    assert [row.plan_status for row in rows] == ["ok", "violated"]
+    assert calls == [(id(results.rows[0].reference), id(first.controller)),
+                     (id(results.rows[0].reference), id(second.controller))]
+    assert results.rows[0].reference is results.rows[1].reference  # one plan, two controllers

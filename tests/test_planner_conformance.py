@@ -64,6 +64,17 @@ def test_conformance(name, index, key, check):
     CHECKS[check](PROBLEMS[key], reference)
 
 
+@pytest.mark.parametrize("name,index", VARIANTS, ids=[_variant_id(*v) for v in VARIANTS])
+def test_a_non_finite_time_is_refused_not_answered_with_nan(name, index):
+    # Before: sample(nan) returned NaN quantities silently and sample(inf) raised an IndexError
+    # from the torque-free continuation's chunk table.
+    reference = planned(name, index, _accepted(name, index)[0])
+    for bad in (np.nan, np.inf, [0.0, np.nan], [0.5 * reference.duration, -np.inf]):
+        with pytest.raises(ValueError, match="reference times must be finite"):
+            reference.sample(bad)
+    assert np.isfinite(reference.sample([0.0, 2.0 * reference.duration]).q).all()
+
+
 def test_the_spin_extremal_declares_its_initial_rates_and_the_metrics_report_them():
     # Biggs & Horri: the body spins about roll at rest transversally; the extremal starts with
     # transverse rates of its own (free parameters of the method).

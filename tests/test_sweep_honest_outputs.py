@@ -113,6 +113,32 @@ def test_ctrl_c_while_the_cases_are_checked_exits_130(tmp_path, monkeypatch, cap
     assert not (tmp_path / "out").exists()
 
 
+def test_ctrl_c_while_connecting_to_a_scheduler_exits_130(tmp_path, monkeypatch, capsys):
+    # Before: the KeyboardInterrupt reached main's catch-all for a run and exited 1.
+    from scenarios.study import engine
+
+    def connecting(address, where):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(engine, "connect_scheduler", connecting)
+    path = write(tmp_path, {"study": "connecting", "grid": {"controller.options.kp": [0.2]}})
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out"), "--scheduler", "tcp://10.0.0.7:8786"]) == 130
+    assert "interrupted while it connected to the Dask scheduler tcp://10.0.0.7:8786" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_finished_sweep_leaves_no_sqlite_side_files(tmp_path):
+    # Before: sweep.sqlite-wal and sweep.sqlite-shm stayed beside the store after every sweep (the
+    # report's read-only reader re-made them on a WAL database).
+    path = write(tmp_path, {"study": "tidy", "grid": {"controller.options.kp": [0.2]}})
+    out = tmp_path / "out"
+    assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--no-plots"]) == 0
+    names = {p.name for p in out.iterdir()}
+    assert "sweep.sqlite" in names and not names & {"sweep.sqlite-wal", "sweep.sqlite-shm"}, names
+    assert main(["sweep", "--report", str(out)]) == 0
+    assert not {p.name for p in out.iterdir()} & {"sweep.sqlite-wal", "sweep.sqlite-shm"}
+
+
 def test_the_final_accuracy_note_counts_the_rows_outside_their_band():
     assert final_accuracy_note([(0.05, 0.1), (None, 0.1)], 2) is None
     note = final_accuracy_note([(0.05, 0.1), (45.0, 0.1), (89.7, 0.1), (None, 0.1)], 4)

@@ -161,11 +161,14 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any, specs: lis
     # each row's planner spec and controller, in the runner's row order (``specs`` is what it ran)
     labels = row_labels([spec.label for spec in specs], [c.label for c in scenario.controllers])
     planner_of = [i for _, i, _ in labels]
-    plans: dict[int, str] = {}  # a reference tracked by several controllers is one plan
+    # a reference tracked by several controllers is one plan, scored through each row's controller's
+    # allocation (the actuator demand differs between allocations), as the runner scores it
+    plans: dict[tuple[int, int], str] = {}
     rows = []
     for row, i, (_, _, j) in zip(results.rows, planner_of, labels):
-        if id(row.reference) not in plans:
-            plans[id(row.reference)] = _plan_status(scenario, row, scenario.controllers[j].controller)
+        plan = (id(row.reference), j)
+        if plan not in plans:
+            plans[plan] = _plan_status(scenario, row, scenario.controllers[j].controller)
         spec = specs[i] if i is not None else None
         timed = spec is not None and minimises_time(PLANNERS[spec.name], spec.options)
         reference = row.reference
@@ -189,8 +192,8 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any, specs: lis
             message = f"{other}; {message}"
         rows.append(BenchRow(
             problem.name, row.label, row.planner or "-", "planner", row.status, value, gap_abs, gap_rel,
-            _reached(plans[id(row.reference)], gap_abs, problem), row.plan_time_s,
-            _number((stats or {}).get("iterations")), certificate_text(stats), message, plans[id(row.reference)]))
+            _reached(plans[plan], gap_abs, problem), row.plan_time_s,
+            _number((stats or {}).get("iterations")), certificate_text(stats), message, plans[plan]))
     return rows
 
 

@@ -304,7 +304,12 @@ def command_sweep(args: argparse.Namespace) -> int:
     if not args.no_plots:
         import scenarios.study.plots  # noqa: F401  (fail now, not after the cases ran)
     out = _output(args, study)
-    cluster: DaskCluster | None = connect_scheduler(scheduler, where) if scheduler else None
+    try:
+        cluster: DaskCluster | None = connect_scheduler(scheduler, where) if scheduler else None
+    except KeyboardInterrupt:  # an interrupted sweep exits 130, while it connects too
+        print(f"slewbench: sweep interrupted while it connected to the Dask scheduler {scheduler}; nothing was run "
+              "or written", file=sys.stderr)
+        return EXIT_INTERRUPTED
     try:
         return _run(args, study, out, cluster)
     finally:

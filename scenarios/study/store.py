@@ -200,7 +200,15 @@ class SweepStore:
             raise ValueError(f"{self.path} holds {stored!r}, not a {FORMAT!r} store")
 
     def close(self) -> None:
-        """Close the connection (committed cases are already on disk)."""
+        """Close the connection (committed cases are already on disk).
+
+        The store leaves write-ahead logging on the way out: its ``-wal`` and ``-shm`` files are
+        folded into the database and removed, and a later read-only reader (the report) does not
+        make them again. If another connection still holds the store (a second writer), it stays in
+        WAL mode and that connection's close tidies up.
+        """
+        with contextlib.suppress(sqlite3.Error):
+            self._db.execute("PRAGMA journal_mode=DELETE")
         self._db.close()
 
     def __enter__(self) -> SweepStore:
