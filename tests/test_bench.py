@@ -442,8 +442,8 @@ def test_the_optimum_is_printed_with_the_digits_of_its_tolerance(value, toleranc
 def test_each_row_s_plan_is_scored_through_its_own_controller(monkeypatch):
     """A reference tracked by two controllers is scored once per controller (the actuator demand goes
     through that controller's allocation); before, every row took the first controller's status."""
-    import scenarios.bench.leaderboard as leaderboard
     from scenarios import run
+    from scenarios.bench import leaderboard
     from scenarios.schema.loader import ControllerSpec
 
     problem = load_suite().problems["bilimoria_wie_180"]
