@@ -247,3 +247,140 @@ def test_grid_points_with_samples_count_their_failed_rows_and_group_the_box_plot
     (panel,) = [a for a in box.axes if a.get_ylabel()]
     groups = [t.get_text() for t in panel.get_xticklabels()]
     assert len(groups) == 8 and groups[0] == "smooth\nmaneuver duration 30 s, simulation sample time 0.5 s"
+
+
+# --- cases that never settled (+inf, as the summary table counts them) -----------------------------
+
+NEVER = None
+"""A settling time that was never reached: null, while the final error has a value."""
+SETTLING = {("smooth", 30.0): [3.0, 1.0, NEVER, 5.0, 2.0],  # 1 of 5 never: median of [1, 2, 3, 5, inf] = 3
+            ("smooth", 40.0): [4.0, 6.0, 8.0, 10.0, 12.0],
+            ("spin", 30.0): [NEVER, 7.0, NEVER, NEVER, 9.0],  # 3 of 5 never: median +inf
+            ("spin", 40.0): [2.0, 2.0, "failed", 2.0, 2.0]}
+"""Settling times [s] of 5 Monte Carlo samples per (planner, maneuver duration); ``"failed"``: a failed row."""
+
+
+def never_study():
+    """2 durations x 5 samples, settling times from :data:`SETTLING`; ∫‖u‖ = 1 + sample."""
+    parsed = study(grid={"maneuver.duration": [30.0, 40.0]},
+                   monte_carlo={"samples": 5, "seed": 4, "dispersions": {
+                       "simulation.initial_attitude_error_deg": {"normal": {"mean": [0, 0, 0], "std": [1, 1, 1]}}}},
+                   summary=["cl.final_error_deg", "cl.settling_time_s"])
+    sample = {}
+    for case in parsed.cases:
+        duration = case.varied["maneuver.duration"]
+        sample[case.index] = sum(other.varied["maneuver.duration"] == duration
+                                 for other in parsed.cases if other.index < case.index)
+
+    def values(case, label):
+        k = sample[case.index]
+        settling = SETTLING[(label, case.varied["maneuver.duration"])][k]
+        if settling == "failed":
+            return "failed", {}
+        return "ok", {"cl.final_error_deg": 0.1 + k, "cl.settling_time_s": settling, "cl.int_u": 1.0 + k}
+
+    return parsed, rows_of(parsed, values), sample
+
+
+def test_a_median_that_never_settled_is_marked_at_the_top_and_the_band_reaches_it():
+    from scenarios.study.report import summary_table
+
+    parsed, rows, _ = never_study()
+    figure = built(parsed, rows)["metrics_vs_maneuver.duration.png"]
+    (panel,) = [a for a in figure.axes if a.get_ylabel() == "closed-loop settling time (s)"]
+    smooth, spin = [line for line in panel.get_lines() if line.get_marker() == "o"]
+    # medians by hand: [1, 2, 3, 5, inf] -> 3; [4 .. 12] -> 8; [7, 9, inf, inf, inf] -> inf; [2, 2, 2, 2] -> 2
+    assert list(smooth.get_ydata()) == [3.0, 8.0]
+    assert list(spin.get_ydata()) == [math.inf, 2.0]
+    (never,) = [line for line in panel.get_lines() if line.get_marker() == "^"]
+    assert list(never.get_xdata()) == [30.0] and never.get_color() == spin.get_color()
+    texts = [t.get_text() for t in figure.legends[0].get_texts()]
+    assert "median never reached (did not settle)" in texts and "failed row (no value)" in texts
+    (failed,) = [line for line in panel.get_lines() if line.get_marker() == "x"]
+    assert list(failed.get_xdata()) == [40.0]
+    # 5-95 % bands: smooth at 30 from 1 + 0.2 (2 - 1) = 1.2 to +inf (the top edge), at 40 from 4.4 to 11.6;
+    # spin at 30 from 7 + 0.2 (9 - 7) = 7.4 to the top edge
+    top = panel.get_ylim()[1]
+    assert top > 12.0
+    bands = [collection.get_paths()[0].vertices for collection in panel.collections]
+    for vertices, corners in zip(bands, ([(30.0, 1.2), (30.0, top), (40.0, 4.4), (40.0, 11.6)],
+                                         [(30.0, 7.4), (30.0, top), (40.0, 2.0)])):
+        for corner in corners:
+            assert np.isclose(vertices, corner).all(axis=1).any(), corner
+    # the summary table has the same medians
+    _, summary = summary_table(parsed, rows)
+    medians = {(line["label"], line["maneuver.duration"]): line["median"] for line in summary
+               if line["metric"] == "cl.settling_time_s"}
+    assert [medians[("smooth", x)] for x in (30.0, 40.0)] == list(smooth.get_ydata())
+    assert [medians[("spin", x)] for x in (30.0, 40.0)] == list(spin.get_ydata())
+
+
+def test_cdfs_box_plots_scatter_and_pareto_count_the_cases_that_never_settled():
+    parsed, rows, sample = never_study()
+    made = built(parsed, rows)
+    (cdf,) = [a for a in made["cdf.png"].axes if a.get_xlabel() == "closed-loop settling time (s)"]
+    labels = {line.get_label(): line for line in cdf.get_lines()}
+    assert set(labels) == {"smooth, maneuver duration 30 s (1 never settled)", "smooth, maneuver duration 40 s",
+                           "spin, maneuver duration 30 s (3 never settled)",
+                           "spin, maneuver duration 40 s (1 without a value)"}
+    spin = labels["spin, maneuver duration 30 s (3 never settled)"]
+    assert list(spin.get_xdata()) == [7.0, 9.0] and list(spin.get_ydata()) == [0.2, 0.4]  # of 5 cases
+    assert {t.get_text() for t in cdf.get_legend().get_texts()} == {
+        "smooth, maneuver duration 30 s (1 never settled)", "spin, maneuver duration 30 s (3 never settled)",
+        "spin, maneuver duration 40 s (1 without a value)"}
+
+    (box,) = [a for a in made["boxplots.png"].axes if a.get_ylabel() == "closed-loop settling time (s)"]
+    assert [t.get_text() for t in box.get_xticklabels()] == [
+        "smooth\nmaneuver duration 30 s\n1 of 5 never settled", "spin\nmaneuver duration 30 s\n3 of 5 never settled",
+        "smooth\nmaneuver duration 40 s", "spin\nmaneuver duration 40 s"]
+    (never,) = [line for line in box.get_lines() if line.get_marker() == "^"]
+    assert list(never.get_xdata()) == [2]  # spin at 30 s: median +inf
+    flat = [line for line in box.get_lines() if len(line.get_ydata()) == 2 and line.get_ydata()[0] == line.get_ydata()[1]]
+    assert any(list(line.get_ydata()) == [3.0, 3.0] and np.mean(line.get_xdata()) == 1 for line in flat)  # smooth 30
+
+    figure = made["scatter_simulation.initial_attitude_error_deg.png"]
+    (scatter,) = [a for a in figure.axes if a.get_ylabel() == "closed-loop settling time (s)"]
+    norm = {case.index: math.sqrt(sum(v * v for v in case.scenario["simulation"]["initial_attitude_error_deg"]))
+            for case in parsed.cases}
+    unsettled = {label: sorted(norm[case.index] for case in parsed.cases
+                               if SETTLING[(label, case.varied["maneuver.duration"])][sample[case.index]] is NEVER)
+                 for label in ("smooth", "spin")}
+    assert [len(found) for found in unsettled.values()] == [1, 3]
+    colour = {"smooth": "C0", "spin": "C1"}
+    marks = {line.get_color(): sorted(line.get_xdata()) for line in scatter.get_lines() if line.get_marker() == "^"}
+    assert marks == {colour[label]: found for label, found in unsettled.items()}
+    assert "case never settled" in [t.get_text() for t in figure.legends[0].get_texts()]
+
+    pareto = made["pareto.png"]
+    notes = {a.get_title(): [t.get_text() for t in a.texts] for a in pareto.axes if a.get_xlabel()}
+    assert notes == {"maneuver duration 30 s": ["never settled: smooth: 1, spin: 3"],
+                     "maneuver duration 40 s": ["no value: spin: 1"]}
+
+
+def test_a_heat_map_cell_whose_median_never_settled_is_hatched_and_counted():
+    parsed = study(grid={"maneuver.duration": [30.0, 40.0], "simulation.sample_time": [0.5, 1.0]},
+                   monte_carlo={"samples": 3, "seed": 2, "dispersions": {
+                       "simulation.initial_attitude_error_deg": {"normal": {"mean": [0, 0, 0], "std": [1, 1, 1]}}}},
+                   summary=["cl.settling_time_s"])
+    spin = {(30.0, 0.5): [NEVER, NEVER, NEVER], (40.0, 0.5): [NEVER, 5.0, NEVER],
+            (30.0, 1.0): [2.0, 4.0, NEVER], (40.0, 1.0): [1.0, 2.0, 3.0]}  # medians: inf, inf, 4, 2
+    seen: dict = {}
+
+    def values(case, label):
+        point = (case.varied["maneuver.duration"], case.varied["simulation.sample_time"])
+        k = seen.setdefault((label, point), [])
+        k.append(case.index)
+        settling = spin[point][len(k) - 1] if label == "spin" else 10.0 + len(k)
+        return "ok", {"cl.final_error_deg": 0.2, "cl.settling_time_s": settling}
+
+    made = built(parsed, rows_of(parsed, values))
+    figure = made["heatmap_cl.settling_time_s.png"]
+    panel = next(a for a in figure.axes if a.get_title() == "spin")
+    texts = {(round(t.get_position()[0]), round(t.get_position()[1]), t.get_text()) for t in panel.texts}
+    assert {(0, 0, "never\n3 of 3"), (1, 0, "never\n2 of 3"), (0, 1, "4"), (1, 1, "2")} <= texts
+    assert (0, 1, "never 1") in {(round(t.get_position()[0] + 0.45), round(t.get_position()[1] - 0.45), t.get_text())
+                                 for t in panel.texts}
+    hatched = sorted((p.get_x(), p.get_y()) for p in panel.patches if isinstance(p, Rectangle) and p.get_hatch() == "//")
+    assert hatched == [(-0.5, -0.5), (0.5, -0.5)]
+    image = next(a for a in panel.get_children() if isinstance(a, AxesImage))
+    assert (image.norm.vmin, image.norm.vmax) == (2.0, 12.0)  # finite medians only: spin 2, 4; smooth 12

@@ -9,7 +9,13 @@ Every axis names its quantity in words with its unit: a metric or requirement co
 :func:`parameter_quantity` (the schema's unit of the key; the angle in degrees for a grid of
 ``axis_angle`` quaternions). A quantity spanning :data:`DECADES` decades or more is drawn on a
 logarithmic axis. Rows whose status is ``failed`` or ``crashed`` have no value and are marked (×,
-hatched cells); ``violated`` rows completed and are drawn."""
+hatched cells); ``violated`` rows completed and are drawn.
+
+The values and statistics are the summary table's (:mod:`scenarios.study.report`): a metric's values
+by :func:`~scenarios.study.report.metric_values`, so that a case that never settled counts as +inf,
+and medians and percentiles by :func:`~scenarios.study.report.percentile` over them. A median,
+percentile or case at +inf is drawn at the top edge of its panel (▲, a band or box reaching the
+edge), a heat-map cell whose median is +inf is hatched and says ``never`` with its count."""
 from __future__ import annotations
 
 import functools
@@ -34,12 +40,12 @@ import numpy as np
 
 from scenarios.output.names import row_stems
 from scenarios.output.plot_data import axis_label, column_quantity
-from scenarios.output.tables import is_missing
 from scenarios.study.paths import Step, get_path, parse_path
+from scenarios.study.report import metric_values, percentile
 from scenarios.study.types import Study
 
-__all__ = ["DECADES", "PARETO_AXES", "PLOTTED_STATUSES", "RECORDED", "figures", "parameter_quantity", "pareto_front",
-           "spans_decades", "write_plots"]
+__all__ = ["DECADES", "INFINITE_WORDS", "PARETO_AXES", "PLOTTED_STATUSES", "RECORDED", "figures", "parameter_quantity",
+           "pareto_front", "spans_decades", "write_plots"]
 
 PARETO_AXES = ("cl.int_u", "cl.settling_time_s")
 """The two metrics of the Pareto fronts (both to be minimised)."""
@@ -58,6 +64,17 @@ MAX_ANNOTATED_CELLS = 64
 """Heat map panels with at most this many cells print each cell's value."""
 FAILED_MARK: dict[str, Any] = {"marker": "x", "linestyle": "none", "markersize": 7, "markeredgewidth": 1.6}
 """How a grid point or case with a failed row is marked (at the bottom of the panel, in the planner's colour)."""
+NEVER_MARK: dict[str, Any] = {"marker": "^", "linestyle": "none", "markersize": 8, "markeredgewidth": 1.2}
+"""How a median or case at +inf (never settled) is marked (at the top of the panel, in the planner's colour)."""
+EDGE = 0.97
+"""Height of a +inf mark, as a fraction of the panel (0: bottom, 1: top)."""
+INFINITE_WORDS: dict[str, tuple[str, str]] = {
+    "settling_time_s": ("never settled", "median never reached (did not settle)"),
+    "int_u2": ("+inf (an impulse)", "median +inf (an impulse)"),
+    "peak_body_torque": ("+inf (an impulse)", "median +inf (an impulse)"),
+}
+"""What +inf means for a metric key whose null counts as +inf (:func:`scenarios.study.report.never_witness`):
+key -> (words for the cases, for a median) in the plots' labels; any other key: ``+inf``."""
 UNKNOWN_UNIT = "YAML units"
 """The unit given to a varied path the schema does not describe."""
 DPI = 110
@@ -65,33 +82,35 @@ DPI = 110
 
 # --- values -----------------------------------------------------------------------------------------
 
-def _value(row: dict[str, Any], key: str) -> float:
-    """A plotted value: NaN when missing or non-finite (the tables' rule) or when the row did not complete."""
-    value = row.get(key)
-    if (row.get("status") not in PLOTTED_STATUSES or isinstance(value, bool) or not isinstance(value, (int, float))
-            or is_missing(value)):
-        return math.nan
-    return float(value)
-
-
 def _failed(row: dict[str, Any]) -> bool:
     return row.get("status") not in PLOTTED_STATUSES
+
+
+def _values(metric: str, rows: list[dict[str, Any]]) -> np.ndarray:
+    """A metric's plotted values: the summary table's (:func:`scenarios.study.report.metric_values`:
+    +inf where a case never settled, NaN without a value), NaN where the row did not complete (it is
+    marked instead)."""
+    values = metric_values(metric, rows)
+    values[np.array([_failed(row) for row in rows], dtype=bool)] = math.nan
+    return values
+
+
+def _statistic(values: Any, q: float) -> float:
+    """The summary table's percentile ``q`` (:func:`scenarios.study.report.percentile`) of the values
+    that are not NaN, +inf included; NaN when there are none."""
+    array = np.asarray(values, dtype=float).ravel()
+    ranked = array[~np.isnan(array)]
+    return percentile(ranked, q) if ranked.size else math.nan
+
+
+def _infinite_words(metric: str) -> tuple[str, str]:
+    """What +inf means for ``metric``: words for the cases, words for a median (:data:`INFINITE_WORDS`)."""
+    return INFINITE_WORDS.get(metric.rpartition(".")[2], ("+inf", "median +inf"))
 
 
 def _finite(values: Any) -> np.ndarray:
     array = np.asarray(values, dtype=float).ravel()
     return array[np.isfinite(array)]
-
-
-def _median(values: Any) -> float:
-    """Median of the finite values; NaN when there are none (without NumPy's all-NaN warning)."""
-    finite = _finite(values)
-    return float(np.median(finite)) if finite.size else math.nan
-
-
-def _percentile(values: Any, q: float) -> float:
-    finite = _finite(values)
-    return float(np.percentile(finite, q)) if finite.size else math.nan
 
 
 def spans_decades(values: Any) -> bool:
@@ -132,7 +151,7 @@ def _numeric_axes(study: Study, rows: list[dict[str, Any]]) -> list[tuple[str, l
 def _with_values(study: Study, rows: list[dict[str, Any]]) -> list[str]:
     """The summary metrics that have a value in some row (a metric that does not apply to any row,
     such as a reference's peak actuator torque, has no panel)."""
-    return [metric for metric in study.summary if np.isfinite([_value(r, metric) for r in rows]).any()]
+    return [metric for metric in study.summary if (~np.isnan(_values(metric, rows))).any()]
 
 
 # --- axis names -------------------------------------------------------------------------------------
@@ -305,14 +324,39 @@ def _mark_failed(axis: Any, xs: list[float], color: Any) -> None:
                   clip_on=False, **FAILED_MARK)
 
 
+def _mark_never(axis: Any, xs: list[float], color: Any) -> None:
+    """▲ at the top of the panel at each x whose median (or case) is +inf: it never settled."""
+    if xs:
+        axis.plot(xs, [EDGE] * len(xs), color=color,
+                  transform=blended_transform_factory(axis.transData, axis.transAxes),
+                  clip_on=False, **NEVER_MARK)
+
+
+def _top_edge(axis: Any, values: Any) -> float:
+    """Fix the y limits around the finite ``values`` (on the axis' scale, set before), with room above
+    them, and return the upper one: where a band or box reaching +inf ends."""
+    finite = _finite(values)
+    low, high = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+    if axis.get_yscale() == "log":
+        pad = (high / low) ** 0.05
+        low, high = low / pad, high * pad ** 3
+    else:
+        pad = 0.05 * (high - low) or 0.5 * abs(high) or 0.5
+        low, high = low - pad, high + 3 * pad
+    axis.set_ylim(low, high)
+    return high
+
+
 def _legend(figure: Figure, colors: dict[str, Any], failed: bool, extra: list[Any] | None = None,
-            style: str = "o-") -> None:
-    """The planners' colours (and the failed mark) beside the panels."""
+            style: str = "o-", never: list[str] | None = None) -> None:
+    """The planners' colours (the failed mark, and the +inf mark with each of the ``never`` texts)
+    beside the panels."""
     line: Any = style[1:] or "none"
     handles = [Line2D([], [], color=color, marker=style[0], linestyle=line, label=label)
                for label, color in colors.items()]
     if failed:
         handles.append(Line2D([], [], color="0.3", label="failed row (no value)", **FAILED_MARK))
+    handles += [Line2D([], [], color="0.3", label=text, **NEVER_MARK) for text in dict.fromkeys(never or [])]
     handles += extra or []
     figure.legend(handles=handles, loc="outside right upper", fontsize=8)
 
@@ -328,28 +372,38 @@ def _lines(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figu
     for (path, xs), stem in zip(axes_1d, row_stems([path for path, _ in axes_1d])):
         figure, axes = _grid(len(metrics))
         any_failed = False
+        never: list[str] = []
         for axis, metric in zip(axes, metrics):
             drawn: list[float] = []
+            bands = []
             for label in labels:
                 groups = [[r for r in rows if r["label"] == label and r[path] == x] for x in xs]
-                values = [[_value(r, metric) for r in group] for group in groups]
-                median = [_median(v) for v in values]
-                axis.plot(xs, median, "o-", color=colors[label], ms=4)
+                values = [_values(metric, group) for group in groups]
+                median = [_statistic(v, 50.0) for v in values]
+                axis.plot(xs, median, "o-", color=colors[label], ms=4)  # +inf: no point, a mark at the top
                 drawn += median
+                unsettled = [x for x, value in zip(xs, median) if value == math.inf]
+                _mark_never(axis, unsettled, colors[label])
+                if unsettled:
+                    never.append(_infinite_words(metric)[1])
                 if spread:
-                    low, high = [_percentile(v, 5) for v in values], [_percentile(v, 95) for v in values]
-                    axis.fill_between(xs, low, high, color=colors[label], alpha=0.15, lw=0)
+                    low, high = [_statistic(v, 5.0) for v in values], [_statistic(v, 95.0) for v in values]
+                    bands.append((colors[label], low, high))
                     drawn += low + high
                 failed = [x for x, group in zip(xs, groups) if any(_failed(r) for r in group)]
                 _mark_failed(axis, failed, colors[label])
                 any_failed |= bool(failed)
             _scale(axis, "x", xs)
             _scale(axis, "y", drawn)
+            top = _top_edge(axis, drawn) if math.inf in drawn else math.inf
+            for color, low, high in bands:  # a percentile at +inf: the band reaches the top edge
+                axis.fill_between(xs, np.minimum(low, top), np.minimum(high, top), color=color, alpha=0.15, lw=0)
             axis.set_xlabel(axis_label(*parameter_quantity(study, path)))
             axis.set_ylabel(_metric_label(metric))
             axis.grid(alpha=0.3)
-        _legend(figure, colors, any_failed)
-        _title(figure, f"{study.name}: median over the other parameters and samples (band 5-95 %)"
+        _legend(figure, colors, any_failed, never=never)
+        infinite = "; a case that never settled counts as +inf: ▲ and a band at the top edge" if never else ""
+        _title(figure, f"{study.name}: median over the other parameters and samples (band 5-95 %{infinite})"
                if spread else study.name)
         yield f"metrics_vs_{stem}.png", figure
 
@@ -368,32 +422,48 @@ def _heat_maps(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, 
     for row in rows:
         cells[(row["label"], row[px], row[py])].append(row)
     for metric, stem in zip(study.summary, row_stems(study.summary)):
-        grids = {label: np.array([[_median([_value(r, metric) for r in cells[(label, x, y)]]) for x in xs] for y in ys])
+        values = {key: _values(metric, members) for key, members in cells.items()}
+        grids = {label: np.array([[_statistic(values[(label, x, y)], 50.0) for x in xs] for y in ys])
                  for label in labels}
-        finite = _finite(np.concatenate([grid.ravel() for grid in grids.values()]))
-        if not finite.size:
+        medians = np.concatenate([grid.ravel() for grid in grids.values()])
+        if np.isnan(medians).all():
             continue
+        finite = _finite(medians)
+        if not finite.size:  # every median +inf: a scale for the colour bar only
+            finite = np.array([0.0, 1.0])
         norm = (LogNorm(finite.min(), finite.max()) if spans_decades(finite)
                 else Normalize(finite.min(), finite.max() if finite.max() > finite.min() else finite.min() + 1.0))
         figure, axes = _grid(len(labels), 4.6, 3.9)
         image = None
         for axis, label in zip(axes, labels):
             grid = grids[label]
-            image = axis.imshow(grid, origin="lower", aspect="auto", cmap="viridis", norm=norm)
+            image = axis.imshow(np.where(np.isinf(grid), math.nan, grid), origin="lower", aspect="auto", cmap="viridis",
+                                norm=norm)
             for j, y in enumerate(ys):
                 for i, x in enumerate(xs):
                     members = cells[(label, x, y)]
                     failures = sum(_failed(r) for r in members)
-                    if not np.isfinite(grid[j, i]):
+                    unsettled = int(np.isinf(values[(label, x, y)]).sum())
+                    if np.isnan(grid[j, i]):
                         axis.add_patch(Rectangle((i - 0.5, j - 0.5), 1, 1, facecolor="0.92", edgecolor="0.45",
                                                  hatch="xx", lw=0))
                         axis.text(i, j, "failed" if failures else "no value", ha="center", va="center", fontsize=7,
                                   color="0.25")
                         continue
-                    if grid.size <= MAX_ANNOTATED_CELLS:
-                        shade = image.cmap(image.norm(grid[j, i]))
-                        axis.text(i, j, _cell_text(grid[j, i]), ha="center", va="center", fontsize=7,
-                                  color="k" if 0.299 * shade[0] + 0.587 * shade[1] + 0.114 * shade[2] > 0.5 else "w")
+                    if grid[j, i] == math.inf:  # most cases never settled: the median is +inf
+                        axis.add_patch(Rectangle((i - 0.5, j - 0.5), 1, 1, facecolor="0.8", edgecolor="0.35",
+                                                 hatch="//", lw=0))
+                        axis.text(i, j, f"never\n{unsettled} of {len(members)}", ha="center", va="center",
+                                  fontsize=7, color="k", fontweight="bold")
+                    else:
+                        if grid.size <= MAX_ANNOTATED_CELLS:
+                            shade = image.cmap(image.norm(grid[j, i]))
+                            axis.text(i, j, _cell_text(grid[j, i]), ha="center", va="center", fontsize=7,
+                                      color="k" if 0.299 * shade[0] + 0.587 * shade[1] + 0.114 * shade[2] > 0.5
+                                      else "w")
+                        if unsettled:
+                            axis.text(i - 0.45, j + 0.45, f"never {unsettled}", ha="left", va="top", fontsize=7,
+                                      color="tab:red", fontweight="bold")
                     if failures:
                         axis.text(i + 0.45, j + 0.45, f"× {failures}", ha="right", va="top", fontsize=7,
                                   color="tab:red", fontweight="bold")
@@ -404,8 +474,10 @@ def _heat_maps(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, 
             axis.set_title(label)
         assert image is not None  # one panel per planner, at least one
         figure.colorbar(image, ax=axes, label=_metric_label(metric))
+        never = (f"; never n: cases at +inf ({_infinite_words(metric)[0]}), a cell hatched // when they make "
+                 "the median" if any(np.isinf(v).any() for v in values.values()) else "")
         _title(figure, f"{study.name}: median per grid point (one colour scale for every planner; "
-                       "× n: rows that failed; hatched: no value)")
+                       f"× n: rows that failed; hatched ×: no value{never})")
         yield f"heatmap_{stem}.png", figure
 
 
@@ -436,39 +508,83 @@ def _monte_carlo(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str
     groups, note = _sample_groups(study, rows)
     colors = _colors(_labels(rows))
     figure, axes = _grid(len(metrics))
+    never: list[str] = []
     for axis, metric in zip(axes, metrics):
-        data = [_finite([_value(r, metric) for r in members]) for _, _, members in groups]
-        positions = [k + 1 for k, values in enumerate(data) if values.size]
-        if positions:
-            axis.boxplot([data[k - 1] for k in positions], positions=positions, showfliers=True)
-        axis.set_xticks(range(1, len(groups) + 1), [name for name, _, _ in groups], rotation=20, fontsize=7,
-                        ha="right")
+        data = [_values(metric, members) for _, _, members in groups]
+        boxes = {k + 1: _box(values) for k, values in enumerate(data) if (~np.isnan(values)).any()}
+        shown = np.concatenate([[b[s] for s in BOX_STATISTICS] + list(b["fliers"]) for b in boxes.values()] or [[]])
+        _scale(axis, "y", shown)
+        if math.inf in shown:  # a percentile at +inf: the box or whisker reaches the top edge
+            top = _top_edge(axis, shown)
+            for position, box in boxes.items():
+                box.update({s: min(box[s], top) for s in BOX_STATISTICS})
+                if box["med"] == top:
+                    _mark_never(axis, [position], colors[groups[position - 1][1]])
+                    never.append(_infinite_words(metric)[1])
+        if boxes:
+            axis.bxp(list(boxes.values()), positions=list(boxes), showfliers=True)
+        words = _infinite_words(metric)[0]
+        names = [name + (f"\n{int(np.isinf(values).sum())} of {values.size} {words}" if np.isinf(values).any() else "")
+                 for (name, _, _), values in zip(groups, data)]
+        axis.set_xticks(range(1, len(groups) + 1), names, rotation=20, fontsize=7, ha="right")
         axis.set_xlim(0.5, len(groups) + 0.5)
-        _scale(axis, "y", np.concatenate(data) if data else [])
         axis.set_ylabel(_metric_label(metric))
         axis.grid(alpha=0.3)
-    _title(figure, f"{study.name}: {study.samples} Monte Carlo samples per grid point{note}")
+    if never:
+        figure.legend(handles=[Line2D([], [], color="0.3", label=text, **NEVER_MARK) for text in dict.fromkeys(never)],
+                      loc="outside right upper", fontsize=8)
+    _title(figure, f"{study.name}: {study.samples} Monte Carlo samples per grid point{note} (box 25-75 %, whiskers "
+                   "5-95 %, as the summary's p5 and p95" + ("; a case that never settled counts as +inf: a box or "
+                                                            "whisker at the top edge reaches it)" if never else ")"))
     yield "boxplots.png", figure
     figure, axes = _grid(len(metrics))
     for axis, metric in zip(axes, metrics):
+        words = _infinite_words(metric)[0]
+        counted: list[Any] = []
         for name, label, members in groups:
-            values = np.sort(_finite([_value(r, metric) for r in members]))
-            if values.size:  # over every case of the group: failed ones keep the curve below 1
-                fraction = np.arange(1, values.size + 1) / len(members)
-                axis.step(values, fraction, where="post", color=colors[label],
-                          label=name.replace("\n", ", ") + (f" ({len(members) - values.size} without a value)"
-                                                             if values.size < len(members) else ""))
-        _scale(axis, "x", np.concatenate([_finite([_value(r, metric) for r in m]) for _, _, m in groups]))
+            values = _values(metric, members)
+            finite = np.sort(values[np.isfinite(values)])
+            counts = [f"{n} {text}" for n, text in ((int(np.isinf(values).sum()), words),
+                                                    (int(np.isnan(values).sum()), "without a value")) if n]
+            text = name.replace("\n", ", ") + (f" ({', '.join(counts)})" if counts else "")
+            if finite.size:  # over every case of the group: failed and unsettled ones keep the curve below 1
+                fraction = np.arange(1, finite.size + 1) / len(members)
+                curve = axis.step(finite, fraction, where="post", color=colors[label], label=text)
+            elif np.isinf(values).any():  # no case settled: no curve, the legend says why
+                curve = axis.plot([], [], color=colors[label], label=text)
+            else:
+                continue
+            counted += curve if counts else []
+        _scale(axis, "x", np.concatenate([_finite(_values(metric, m)) for _, _, m in groups]))
         axis.set_xlabel(_metric_label(metric))
         axis.set_ylabel("fraction of cases ≤ x (–)")
         axis.set_ylim(0.0, 1.02)
         axis.grid(alpha=0.3)
-    handles, texts = axes[0].get_legend_handles_labels()
-    figure.legend(handles, texts, loc="outside right upper", fontsize=8)
-    _title(figure, f"{study.name}: empirical CDFs over every case (a failed case has no value){note}")
+        if counted:  # the groups whose curve stops below 1, and why
+            axis.legend(handles=counted, loc="lower right", fontsize=6)
+    plain = list(dict.fromkeys((name.replace("\n", ", "), label) for name, label, _ in groups))
+    figure.legend(handles=[Line2D([], [], color=colors[label], label=name) for name, label in plain],
+                  loc="outside right upper", fontsize=8)
+    _title(figure, f"{study.name}: empirical CDFs over every case (a failed case has no value, one that never "
+                   f"settled is +inf: both keep the curve below 1){note}")
     yield "cdf.png", figure
     yield from _scatter(study, rows, metrics, colors)
     yield from _sensitivity(study, rows)
+
+
+BOX_STATISTICS = ("whislo", "q1", "med", "q3", "whishi")
+"""The statistics of a box, at the percentiles :data:`BOX_PERCENTILES`."""
+BOX_PERCENTILES = (5.0, 25.0, 50.0, 75.0, 95.0)
+
+
+def _box(values: np.ndarray) -> dict[str, Any]:
+    """A box of ``Axes.bxp`` from values that are not all NaN: whiskers at 5 and 95 %, box 25-75 %, median,
+    as the summary table (:func:`_statistic`), +inf included; fliers: the finite values beyond the whiskers."""
+    ranked = values[~np.isnan(values)]
+    box: dict[str, Any] = {s: _statistic(ranked, q) for s, q in zip(BOX_STATISTICS, BOX_PERCENTILES)}
+    finite = ranked[np.isfinite(ranked)]
+    box["fliers"] = finite[(finite < box["whislo"]) | (finite > box["whishi"])]
+    return box
 
 
 def _sensitivity(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figure]]:
@@ -537,20 +653,25 @@ def _scatter(study: Study, rows: list[dict[str, Any]], metrics: list[str],
         name, unit = parameter_quantity(study, path)
         figure, axes = _grid(len(metrics))
         any_failed = False
+        never: list[str] = []
         for axis, metric in zip(axes, metrics):
-            ys = np.array([_value(r, metric) for r in rows])
+            ys = _values(metric, rows)
             for label, color in colors.items():
                 mine = np.array([r["label"] == label for r in rows])
-                axis.plot(xs[mine], ys[mine], ".", color=color, ms=4, alpha=0.6)
+                axis.plot(xs[mine], ys[mine], ".", color=color, ms=4, alpha=0.6)  # +inf: a mark at the top instead
                 failed = mine & np.array([_failed(r) for r in rows])
                 _mark_failed(axis, list(xs[failed]), color)
                 any_failed |= bool(failed.any())
+                unsettled = mine & np.isinf(ys)
+                _mark_never(axis, list(xs[unsettled]), color)
+                if unsettled.any():
+                    never.append(f"case {_infinite_words(metric)[0]}")
             _scale(axis, "x", xs)
             _scale(axis, "y", ys)
             axis.set_xlabel(axis_label(f"‖{name}‖" if vector else name, unit))
             axis.set_ylabel(_metric_label(metric))
             axis.grid(alpha=0.3)
-        _legend(figure, colors, any_failed, style=".")
+        _legend(figure, colors, any_failed, style=".", never=never)
         _title(figure, f"{study.name}: each case against {'the norm of ' if vector else ''}{name}")
         yield f"scatter_{stem}.png", figure
 
@@ -586,26 +707,33 @@ def _pareto(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Fig
     points: dict[str, list[dict[str, Any]]] = {}
     for row in rows:
         points.setdefault(json.dumps([row.get(p) for p in study.grid_paths]), []).append(row)
-    usable = [(key, members) for key, members in points.items()
-              if np.isfinite([[_value(r, x_key), _value(r, y_key)] for r in members]).all(axis=1).any()]
+    drawn = {key: np.c_[_values(x_key, members), _values(y_key, members)] for key, members in points.items()}
+    usable = [(key, members) for key, members in points.items()  # a finite point, or one at the top edge
+              if (np.isfinite(drawn[key][:, 0]) & ~np.isnan(drawn[key][:, 1])).any()]
     if not usable:
         return
     shown = usable[:MAX_PARETO_PANELS]
     figure, axes = _grid(len(shown), 4.6, 3.6)
+    words = _infinite_words(y_key)[0]
+    any_never = False
     for axis, (key, members) in zip(axes, shown):
-        missing = []
+        notes: dict[str, list[str]] = {"no value": [], words: []}
         for label in labels:
-            mine = np.array([[_value(r, x_key), _value(r, y_key)] for r in members
-                             if r["label"] == label]).reshape(-1, 2)
+            mine = drawn[key][np.array([r["label"] == label for r in members])]
             axis.plot(mine[:, 0], mine[:, 1], "o", color=colors[label], ms=5 if study.samples == 1 else 3,
                       alpha=1.0 if study.samples == 1 else 0.5)
-            lacking = int(np.sum(~np.isfinite(mine).all(axis=1)))
-            if lacking:
-                missing.append(f"{label}: {lacking}" if study.samples > 1 else label)
-        if missing:  # a row that failed, or did not settle: no point
-            axis.text(0.98, 0.02, "no value: " + ", ".join(missing), transform=axis.transAxes, ha="right",
-                      va="bottom", fontsize=7, color="0.3")
-        every = np.array([[_value(r, x_key), _value(r, y_key)] for r in members])
+            unsettled = np.isfinite(mine[:, 0]) & np.isinf(mine[:, 1])  # +inf settling time: at the top edge
+            _mark_never(axis, list(mine[unsettled, 0]), colors[label])
+            any_never |= bool(unsettled.any())
+            for text, count in (("no value", int(np.sum(~np.isfinite(mine).all(axis=1) & ~unsettled))),
+                                (words, int(unsettled.sum()))):
+                if count:
+                    notes[text].append(f"{label}: {count}" if study.samples > 1 else label)
+        lines = [f"{text}: " + ", ".join(found) for text, found in notes.items() if found]
+        if lines:  # a row that failed (no point), or one that never settled (at the top edge, on no front)
+            axis.text(0.98, 0.02, "\n".join(lines), transform=axis.transAxes, ha="right", va="bottom", fontsize=7,
+                      color="0.3")
+        every = drawn[key]
         front = pareto_front(every)
         axis.step(front[:, 0], front[:, 1], where="post", color="k", lw=1.2)
         axis.plot(front[:, 0], front[:, 1], "o", mfc="none", mec="k", ms=9)
@@ -617,7 +745,7 @@ def _pareto(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Fig
             axis.set_title(_point_text(study, dict(zip(study.grid_paths, json.loads(key)))), fontsize=8)
         axis.grid(alpha=0.3)
     front_handle = Line2D([], [], color="k", marker="o", mfc="none", ms=9, label="Pareto front")
-    _legend(figure, colors, False, [front_handle], style="o")
+    _legend(figure, colors, False, [front_handle], style="o", never=[f"case {words} (on no front)"] if any_never else [])
     more = f" (the first {len(shown)} of {len(usable)} grid points)" if len(shown) < len(usable) else ""
     _title(figure, f"{study.name}: every case and the Pareto front "
            + ("of each grid point, all planners together" if study.grid_paths else "of all planners together") + more)
