@@ -90,7 +90,9 @@ class Actuator(ABC):
     """Its torque depends on the geomagnetic field (given to :meth:`body_torque`)."""
     residual_rank: ClassVar[int | None] = None
     """When not ``None``, the kind realises any body torque and the allocation may send it what
-    the wheels cannot give (:meth:`take_residual`); the lowest rank present takes it."""
+    the wheels cannot give (:meth:`take_residual`); the lowest rank present takes it
+    (:attr:`Spacecraft.residual_actuator <ocp.dynamics.spacecraft.Spacecraft.residual_actuator>`,
+    the one place that reads the ranks)."""
 
     @property
     @abstractmethod

@@ -162,6 +162,46 @@ class Spacecraft:
         """True when the body axes are principal axes (diagonal inertia)."""
         return bool(np.allclose(self.inertia, np.diag(np.diag(self.inertia)), rtol=0, atol=1e-12 * np.max(self.inertia)))
 
+    @property
+    def residual_actuator(self) -> Actuator | None:
+        """The actuator the allocation sends what the working wheels cannot give (all of the torque
+        without working wheels): the one whose kind has the lowest
+        :attr:`~ocp.dynamics.actuator_kinds.Actuator.residual_rank` (the torquers, else the
+        magnetorquers; on equal ranks the first in :attr:`actuators`), or ``None`` when no kind
+        has a rank.
+
+        This is the one statement of the rule: the controllers' allocation
+        (``controllers.allocation``), the collocation planner's allocation constraints
+        (``planners.collocation.allocation``) and :meth:`allocation_rows` read it here.
+
+        Returns
+        -------
+        Actuator or None
+        """
+        ranked = [(actuator.residual_rank, index) for index, actuator in enumerate(self.actuators)
+                  if actuator.residual_rank is not None]
+        return self.actuators[min(ranked)[1]] if ranked else None
+
+    def wheel_span(self) -> Array:
+        """An orthonormal basis of the body torques the working wheels give (the range of their
+        axes; singular values below ``1e-9`` of the largest count as zero).
+
+        Returns
+        -------
+        (3, r) ndarray
+            ``r`` columns, body axes: 3 when the working wheels span three axes, 0 without
+            working wheels. The projector ``A A⁺`` of the allocation is ``S Sᵀ``; what the wheels
+            leave to :attr:`residual_actuator` is ``(1 − S Sᵀ) τ``. A copy.
+        """
+        if "wheel_span" not in self._cache:
+            wheels = self.wheels
+            span = np.zeros((3, 0))
+            if wheels is not None and np.any(wheels.working):
+                left, singular, _ = np.linalg.svd(wheels.axes[:, wheels.working])
+                span = left[:, :int(np.sum(singular > 1e-9 * singular.max()))]
+            self._cache["wheel_span"] = span
+        return self._cache["wheel_span"].copy()
+
     def body_torque_limit(self) -> Array:
         """Per-body-axis torque bound that the actuators can apply simultaneously on all axes.
 
@@ -219,20 +259,16 @@ class Spacecraft:
         """
         if "allocation_rows" not in self._cache:
             rows, limits = [], []
-            given = np.zeros((3, 3))  # the projector on what the working wheels give: A A⁺
             wheels = self.wheels
             if wheels is not None and np.any(wheels.working):
                 working = wheels.axes * wheels.working  # failed wheels: zero columns, as the allocation
                 pinv = np.linalg.pinv(working)
                 rows.append(pinv[wheels.working])
                 limits.append(wheels.max_torque[wheels.working])
-                left, singular, _ = np.linalg.svd(working)
-                rank = int(np.sum(singular > 1e-9 * singular.max()))
-                given = left[:, :rank] @ left[:, :rank].T
-            residual = np.eye(3) - given
-            if np.linalg.matrix_rank(residual, tol=1e-9) > 0:
-                ranked = [(a.residual_rank, i, a) for i, a in enumerate(self.actuators) if a.residual_rank is not None]
-                sink = min(ranked)[2] if ranked else None
+            span = self.wheel_span()
+            if span.shape[1] < 3:
+                residual = np.eye(3) - span @ span.T  # what the working wheels do not give: 1 − A A⁺
+                sink = self.residual_actuator
                 box = None if sink is None else sink.body_torque_box()
                 rows.append(residual)
                 limits.append(np.zeros(3) if box is None else np.asarray(box, dtype=float))
