@@ -80,9 +80,12 @@ def test_torquers_beside_wheels_count_only_where_the_allocation_asks_them():
 def test_pyramid_with_two_failed_wheels_gives_z():
     """Wheels 1 and 3 of the 45-deg-azimuth pyramid left: ``a1 + a3 = (0, 0, 2s)``, so z gets
     ``2 s g_max`` and x, y nothing alone (their directions need the failed wheels)."""
-    failed = Spacecraft(INERTIA, wheels=ReactionWheels(PYRAMID_30, max_torque=G_MAX, failed=[0, 2]))
-    assert failed.torque_along([0, 0, 1]) == pytest.approx(2 * S * G_MAX, rel=1e-12)
-    np.testing.assert_allclose(failed.body_torque_limit(), [0.0, 0.0, 2 * S * G_MAX], rtol=1e-12)
+    for elevation in (BETA, np.arcsin(1 / np.sqrt(3))):  # 30 deg; the (±1, ±1, 1)/√3 pyramid, whose
+        c, s = np.cos(elevation), np.sin(elevation)       # projector leaves rounding where zeros are
+        axes = np.vstack([c * np.cos(PHI), c * np.sin(PHI), s * np.ones(4)])
+        failed = Spacecraft(INERTIA, wheels=ReactionWheels(axes, max_torque=G_MAX, failed=[0, 2]))
+        assert failed.torque_along([0, 0, 1]) == pytest.approx(2 * s * G_MAX, rel=1e-12)
+        np.testing.assert_allclose(failed.body_torque_limit(), [0.0, 0.0, 2 * s * G_MAX], rtol=1e-12)
 
 
 def test_costate_steering_torque_defaults_to_the_box():
