@@ -2,7 +2,8 @@
 every controller through :class:`Allocation`.
 
 Wheels take ``τ_w = u + ω × A h_w`` through ``g = −A⁺ τ_w`` (working wheels only); what the wheels
-cannot give (fewer than three independent axes) goes to the actuator whose kind has the lowest
+cannot give (fewer than three independent axes) goes to
+:attr:`~ocp.dynamics.spacecraft.Spacecraft.residual_actuator`, the actuator whose kind has the lowest
 :attr:`~ocp.dynamics.actuator_kinds.Actuator.residual_rank`: the torquers if there are any, else the
 magnetorquers as ``m = B × τ / |B|²`` (the component of τ perpendicular to B). Without wheels that
 actuator takes ``u``. The numeric map runs on Python floats (it is called at every sample);
@@ -199,9 +200,9 @@ class Allocation:
             self._pinv_rows = float_rows(self._wheel_pinv)
             self._axes_cols = float_rows(spacecraft.wheel_axes.T)
             self._working_cols = float_rows(self._working_axes.T)
-        ranked = [(a.residual_rank, i, a) for i, a in enumerate(spacecraft.actuators) if a.residual_rank is not None]
-        self._sink: Actuator | None = None if self.wheels_only or not ranked else min(ranked)[2]
-        """The actuator that takes what the wheels cannot give (torquers, else magnetorquers), if any."""
+        self._sink: Actuator | None = None if self.wheels_only else spacecraft.residual_actuator
+        """The actuator that takes what the wheels cannot give (``Spacecraft.residual_actuator``:
+        torquers, else magnetorquers), if any."""
 
     def allocate(self, torque: ArrayLike, measurement: Measurement, rate: ArrayLike | None = None,
                  wheel_momentum: ArrayLike | None = None) -> Command:

@@ -260,6 +260,31 @@ def unmet_rates(problem: ManeuverProblem, axis: Array, profile: AngleProfile) ->
     return unmet
 
 
+def _unbounded_about_the_axis(problem: ManeuverProblem) -> list[Any]:
+    """The actuators without a torque bound that alone bound the torque ``I e α`` about the slew
+    axis ``e`` through the controllers' allocation (``Spacecraft.allocation_rows``): every row that
+    torque loads has an infinite limit. Empty when a bounded row limits it, or there is no rotation."""
+    assert problem.qf is not None
+    rotvec = quat.to_rotation_vector(quat.error(problem.qf, problem.q0))
+    angle = float(np.linalg.norm(rotvec))
+    if angle < 1e-12:
+        return []
+    spacecraft = problem.spacecraft
+    rows, limits = spacecraft.allocation_rows()
+    torque = spacecraft.inertia @ (rotvec / angle)
+    loaded = np.abs(rows @ torque) > 1e-12 * np.linalg.norm(rows, axis=1) * np.linalg.norm(torque)
+    if not np.any(loaded) or np.any(np.isfinite(limits[loaded])):
+        return []
+    wheels = spacecraft.wheels
+    n_wheel_rows = 0 if wheels is None else int(np.count_nonzero(wheels.working))
+    owners = [wheels] * n_wheel_rows + [spacecraft.residual_actuator] * (len(limits) - n_wheel_rows)
+    named: list[Any] = []
+    for owner, on in zip(owners, loaded):
+        if on and not any(owner is other for other in named):
+            named.append(owner)
+    return named
+
+
 class EigenaxisReference(Reference):
     """``q(t) = q0 ⊗ [cos θ/2, e sin θ/2]``, ``ω = e θ̇`` (body axes), torque ``I e θ̈ + θ̇² e × I e``.
 
@@ -371,16 +396,19 @@ class EigenaxisPlanner(Planner):
         -------
         str or None
             The reason (no target attitude; for the bang profiles, ``trapezoidal`` and ``min_time``,
-            an actuator torquing the body without a torque bound: their acceleration is the largest
-            the bounds allow, unbounded there, and ``min_time``'s duration would be zero), or ``None``.
+            a torque about the slew axis that the controllers' allocation gives to actuators
+            without a torque bound alone: their acceleration is the largest the bounds allow,
+            unbounded there, and ``min_time``'s duration would be zero), or ``None``. Unbounded
+            torquers beside wheels that span three axes are no reason (the allocation never asks
+            them), nor beside fewer where the wheels' bound also limits the torque about the axis.
         """
-        if self.options.profile != "smooth":
-            boxes = [(actuator, actuator.body_torque_box()) for actuator in problem.spacecraft.actuators]
-            unbounded = [actuator for actuator, box in boxes if box is not None and not np.all(np.isfinite(box))]
+        if self.options.profile != "smooth" and problem.qf is not None:
+            unbounded = _unbounded_about_the_axis(problem)
             if unbounded:
                 names = bound_keys(unbounded)
-                return (f"profile {self.options.profile} needs a torque bound on every actuator ({names}): it "
-                        f"accelerates at the largest rate the bounds allow, unbounded without them")
+                return (f"profile {self.options.profile} needs a torque bound on the actuators the controllers' "
+                        f"allocation gives the torque about the slew axis ({names}): it accelerates at the largest "
+                        f"rate the bounds allow, unbounded without them")
         return super().problem_error(problem)
 
     def _rate_source(self, problem: ManeuverProblem) -> str:

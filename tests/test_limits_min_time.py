@@ -35,10 +35,29 @@ def test_eigenaxis_bang_profiles_refuse_unbounded_wheels(profile):
     assert planner.problem_error(problem(BOUNDED)) is None
 
 
-def test_eigenaxis_names_the_unbounded_torquers_and_keeps_the_quintic():
-    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(max_torque=0.1), torquers=Torquers())
-    error = PLANNERS["eigenaxis"]({"profile": "min_time"}).problem_error(problem(spacecraft))
+def test_eigenaxis_unbounded_torquers_count_only_where_the_allocation_gives_them_the_torque():
+    """Beside three body-axis wheels the allocation never asks the torquers: their missing bound is
+    no reason, and the min time about a principal axis is the wheels' closed form 2 sqrt(Θ I / g).
+    Beside two wheels (x, y) a slew about z puts all its torque on the unbounded torquers: refused,
+    naming them; about x the wheel bounds it (the same closed form); about a generic axis the
+    wheels' rows bound it too."""
+    planner = PLANNERS["eigenaxis"]({"profile": "min_time"})
+    about = {axis: quat.from_axis_angle(np.eye(3)[i], np.deg2rad(60.0)) for i, axis in enumerate("xyz")}
+    three = Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(max_torque=0.1), torquers=Torquers())
+    for axis, i in (("x", 0), ("z", 2)):
+        slew = ManeuverProblem(three, quat.IDENTITY, np.zeros(3), about[axis], 120.0, omegaf=np.zeros(3))
+        assert planner.problem_error(slew) is None
+        assert planner.plan(slew).duration == pytest.approx(2 * np.sqrt(np.deg2rad(60.0) * INERTIA[i, i] / 0.1),
+                                                            rel=1e-9)
+    two = Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(2, max_torque=0.1), torquers=Torquers())
+    error = planner.problem_error(ManeuverProblem(two, quat.IDENTITY, np.zeros(3), about["z"], 120.0,
+                                                  omegaf=np.zeros(3)))
     assert error is not None and "spacecraft.torquers.max_torque" in error and "wheels" not in error
+    slew = ManeuverProblem(two, quat.IDENTITY, np.zeros(3), about["x"], 120.0, omegaf=np.zeros(3))
+    assert planner.problem_error(slew) is None
+    assert planner.plan(slew).duration == pytest.approx(2 * np.sqrt(np.deg2rad(60.0) * INERTIA[0, 0] / 0.1), rel=1e-9)
+    generic = planner.plan(problem(two))
+    assert generic.status == "ok" and 0 < generic.duration < np.inf
     # the quintic's T is the scenario's: it needs no torque bound
     assert PLANNERS["eigenaxis"]({"profile": "smooth"}).problem_error(problem(UNBOUNDED)) is None
 

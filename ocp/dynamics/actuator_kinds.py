@@ -8,8 +8,8 @@ YAML loader) can point at the input that caused it.
 An actuator kind is one :class:`Actuator` subclass registered with :func:`actuator_kind`: it
 holds the kind's numbers and says everything the rest of the workbench needs of it, its block of
 the control vector ``u`` and of the state ``x``, its bounds, its torque on the body and the rate
-of its states, how a command is saturated (numerically and on CasADi expressions), its share of
-the body torque box and whether the allocation may send it the residual torque. The model, the
+of its states, how a command is saturated (numerically and on CasADi expressions), its own
+body torque box and whether the allocation may send it the residual torque. The model, the
 saturation, the layouts, the collocation bounds and the closed loop iterate over
 :attr:`~ocp.dynamics.spacecraft.Spacecraft.actuators`; none of them names a kind.
 """
@@ -90,7 +90,9 @@ class Actuator(ABC):
     """Its torque depends on the geomagnetic field (given to :meth:`body_torque`)."""
     residual_rank: ClassVar[int | None] = None
     """When not ``None``, the kind realises any body torque and the allocation may send it what
-    the wheels cannot give (:meth:`take_residual`); the lowest rank present takes it."""
+    the wheels cannot give (:meth:`take_residual`); the lowest rank present takes it
+    (:attr:`Spacecraft.residual_actuator <ocp.dynamics.spacecraft.Spacecraft.residual_actuator>`,
+    the one place that reads the ranks)."""
 
     @property
     @abstractmethod
@@ -217,13 +219,17 @@ class Actuator(ABC):
         """
 
     def body_torque_box(self) -> Array | None:
-        """The kind's share of :meth:`Spacecraft.body_torque_limit` (none by default).
+        """The kind's own per-axis torque box (none by default): the limits of the residual's rows
+        in :meth:`Spacecraft.allocation_rows <ocp.dynamics.spacecraft.Spacecraft.allocation_rows>`
+        when the kind takes the residual, whose box
+        (:meth:`Spacecraft.body_torque_limit <ocp.dynamics.spacecraft.Spacecraft.body_torque_limit>`)
+        counts the kind only where the allocation asks it.
 
         Returns
         -------
         (3,) ndarray or None
             Per-body-axis torque bound [N m] the kind can apply on all axes at once; ``None``:
-            the kind adds none (e.g. its torque depends on the field).
+            the kind gives none (e.g. its torque depends on the field).
         """
         return None
 

@@ -162,16 +162,61 @@ class Spacecraft:
         """True when the body axes are principal axes (diagonal inertia)."""
         return bool(np.allclose(self.inertia, np.diag(np.diag(self.inertia)), rtol=0, atol=1e-12 * np.max(self.inertia)))
 
-    def body_torque_limit(self) -> Array:
-        """Per-body-axis torque bound that the actuators can apply simultaneously on all axes.
+    @property
+    def residual_actuator(self) -> Actuator | None:
+        """The actuator the allocation sends what the working wheels cannot give (all of the torque
+        without working wheels): the one whose kind has the lowest
+        :attr:`~ocp.dynamics.actuator_kinds.Actuator.residual_rank` (the torquers, else the
+        magnetorquers; on equal ranks the first in :attr:`actuators`), or ``None`` when no kind
+        has a rank.
 
-        The sum of the actuators' :meth:`Actuator.body_torque_box`: torquers add their per-axis
-        limit; for wheels the box ``|τ_i| <= b_i`` is the largest (smallest bound, then by sum)
-        box whose every corner the working wheels realise through ``g = -A⁺ τ`` within their
-        torque limits, found by a small linear programme; axes the wheels cannot reach get 0.
-        Magnetorquers are not included: their torque depends on the field. Torquers beside wheels
-        that span three axes are counted though the controllers' allocation never asks them
-        (:meth:`allocation_rows` is the realised set: eigenaxis and collocation plan with it).
+        This is the one statement of the rule: the controllers' allocation
+        (``controllers.allocation``), the collocation planner's allocation constraints
+        (``planners.collocation.allocation``) and :meth:`allocation_rows` read it here.
+
+        Returns
+        -------
+        Actuator or None
+        """
+        ranked = [(actuator.residual_rank, index) for index, actuator in enumerate(self.actuators)
+                  if actuator.residual_rank is not None]
+        return self.actuators[min(ranked)[1]] if ranked else None
+
+    def wheel_span(self) -> Array:
+        """An orthonormal basis of the body torques the working wheels give (the range of their
+        axes; singular values below ``1e-9`` of the largest count as zero).
+
+        Returns
+        -------
+        (3, r) ndarray
+            ``r`` columns, body axes: 3 when the working wheels span three axes, 0 without
+            working wheels. The projector ``A A⁺`` of the allocation is ``S Sᵀ``; what the wheels
+            leave to :attr:`residual_actuator` is ``(1 − S Sᵀ) τ``. A copy.
+        """
+        if "wheel_span" not in self._cache:
+            wheels = self.wheels
+            span = np.zeros((3, 0))
+            if wheels is not None and np.any(wheels.working):
+                left, singular, _ = np.linalg.svd(wheels.axes[:, wheels.working])
+                span = left[:, :int(np.sum(singular > 1e-9 * singular.max()))]
+            self._cache["wheel_span"] = span
+        return self._cache["wheel_span"].copy()
+
+    def body_torque_limit(self) -> Array:
+        """Per-body-axis torque bound that the controllers' allocation gives simultaneously on all
+        axes: the largest box ``|τ_i| <= b_i`` every corner of which it realises.
+
+        The box lies inside the set the allocation realises, ``|M τ| <= L``
+        (:meth:`allocation_rows`): the largest common bound first, then, no axis below it, the
+        largest sum (a small linear programme; per row when each row bounds one axis, as with
+        wheels along the body axes or torquers alone). An axis that a row with the limit 0 touches
+        (a direction no actuator gives: failed or missing wheels without torquers, magnetorquers,
+        whose torque depends on the field) gets 0; an axis no finite limit bounds, ``inf``.
+        Torquers beside wheels that span three axes add nothing: the allocation never asks them.
+
+        The box is conservative where the realised set is no box (a skewed wheel array, such as a
+        four-wheel pyramid: along a single body axis the wheels give more,
+        :meth:`torque_along`); :meth:`torque_box_is_exact` tells which.
 
         Returns
         -------
@@ -180,13 +225,21 @@ class Spacecraft:
             (computed once per spacecraft).
         """
         if "torque_limit" not in self._cache:
-            limit = np.zeros(3)
-            for actuator in self.actuators:
-                box = actuator.body_torque_box()
-                if box is not None:
-                    limit += box
-            self._cache["torque_limit"] = limit
+            self._cache["torque_limit"] = _largest_box(*self.allocation_rows())
         return self._cache["torque_limit"].copy()
+
+    def torque_box_is_exact(self) -> bool:
+        """Whether :meth:`body_torque_limit` is the whole set the allocation realises (each row of
+        :meth:`allocation_rows` bounds one body axis), rather than a box inside it.
+
+        Returns
+        -------
+        bool
+            ``True``: a torque is realised exactly when each component is within the box (wheels
+            along the body axes, torquers); ``False``: the box is conservative.
+        """
+        matrix, _ = self.allocation_rows()
+        return bool(np.all(np.sum(_significant(matrix), axis=1) <= 1))
 
     def allocation_rows(self) -> tuple[Array, Array]:
         """The body torques the controllers' allocation realises within the actuators' limits, as
@@ -219,20 +272,17 @@ class Spacecraft:
         """
         if "allocation_rows" not in self._cache:
             rows, limits = [], []
-            given = np.zeros((3, 3))  # the projector on what the working wheels give: A A⁺
             wheels = self.wheels
             if wheels is not None and np.any(wheels.working):
                 working = wheels.axes * wheels.working  # failed wheels: zero columns, as the allocation
                 pinv = np.linalg.pinv(working)
                 rows.append(pinv[wheels.working])
                 limits.append(wheels.max_torque[wheels.working])
-                left, singular, _ = np.linalg.svd(working)
-                rank = int(np.sum(singular > 1e-9 * singular.max()))
-                given = left[:, :rank] @ left[:, :rank].T
-            residual = np.eye(3) - given
-            if np.linalg.matrix_rank(residual, tol=1e-9) > 0:
-                ranked = [(a.residual_rank, i, a) for i, a in enumerate(self.actuators) if a.residual_rank is not None]
-                sink = min(ranked)[2] if ranked else None
+            span = self.wheel_span()
+            if span.shape[1] < 3:
+                residual = np.eye(3) - span @ span.T  # what the working wheels do not give: 1 − A A⁺
+                residual[np.abs(residual) <= 1e-12] = 0.0  # rounding of exact zeros (entries within ±1)
+                sink = self.residual_actuator
                 box = None if sink is None else sink.body_torque_box()
                 rows.append(residual)
                 limits.append(np.zeros(3) if box is None else np.asarray(box, dtype=float))
@@ -271,3 +321,43 @@ class Spacecraft:
         demand[demand <= 1e-12 * np.linalg.norm(matrix, axis=1)] = 0.0  # rounding of exact zeros
         used = demand > 0
         return float(np.min(bound[used] / demand[used], initial=np.inf))
+
+
+def _significant(matrix: Array) -> NDArray[np.bool_]:
+    """The entries of each row above rounding (``1e-12`` of the row's norm)."""
+    magnitude = np.abs(matrix)
+    return magnitude > 1e-12 * np.linalg.norm(matrix, axis=1, keepdims=True)
+
+
+def _largest_box(matrix: Array, bound: Array) -> Array:
+    """The largest box ``|τ_i| <= b_i`` within ``|M τ| <= L`` (see :meth:`Spacecraft.body_torque_limit`)."""
+    demand = np.where(_significant(matrix), np.abs(matrix), 0.0)
+    closed = np.any(demand[bound == 0] > 0, axis=0)  # touched by a direction no actuator gives
+    finite = np.isfinite(bound) & (bound > 0)
+    demand, limit = demand[finite][:, ~closed], bound[finite]
+    box = np.zeros(3)
+    free = np.flatnonzero(~closed)
+    bounded = np.any(demand > 0, axis=0)
+    box[free[~bounded]] = np.inf
+    demand = demand[:, bounded]
+    used = np.any(demand > 0, axis=1)
+    demand, limit = demand[used], limit[used]
+    if not demand.size:
+        return box
+    if np.all(np.sum(demand > 0, axis=1) == 1):  # each row bounds one axis: the tightest row per axis
+        ratios = np.where(demand > 0, limit[:, None] / np.where(demand > 0, demand, 1.0), np.inf)
+        box[free[bounded]] = ratios.min(axis=0)
+        return box
+    from scipy.optimize import (
+        linprog,  # lazily: scipy.optimize dominates the import of slewbench
+    )
+
+    # Lexicographic: the largest bound common to every axis, then the largest sum with no axis
+    # below it, so that no axis is sacrificed for the others.
+    n = demand.shape[1]
+    common = float(np.min(limit / demand.sum(axis=1)))  # every corner of this cube is within every row
+    result = linprog(c=-np.ones(n), A_ub=demand, b_ub=limit, bounds=[(common * (1 - 1e-9), None)] * n)
+    # the cube unless an axis really grows (not the rounding that the 1e-9 slack lets trade between axes)
+    grows = result.success and float(result.x.sum()) > common * n * (1 + 1e-6)
+    box[free[bounded]] = result.x if grows else common
+    return box

@@ -3,8 +3,9 @@ closed loop realises.
 
 Every controller maps a body torque onto the actuators the same way (``controllers.allocation``):
 the working wheels take ``g = −A⁺ τ`` (``A⁺`` the pseudo-inverse of the working wheels' axes), and
-what they cannot give, ``(1 − A A⁺) τ``, goes to the actuator kind of lowest
-:attr:`~ocp.dynamics.actuator_kinds.Actuator.residual_rank` (the torquers, else the magnetorquers);
+what they cannot give, ``(1 − A A⁺) τ``, goes to
+:attr:`~ocp.dynamics.spacecraft.Spacecraft.residual_actuator` (the kind of lowest
+:attr:`~ocp.dynamics.actuator_kinds.Actuator.residual_rank`: the torquers, else the magnetorquers);
 the scenario's actuator requirement scores a reference's torque through that map. The NLP's
 controls are the actuators' own commands, so without more it may plan wheel torques that the
 allocation never gives: on a skewed array (a four-wheel pyramid) a wheel torque pattern with a
@@ -21,8 +22,12 @@ allocation of their own body torque:
   the wheel momenta, ``ḣ = g``, follow from those torques as in the closed loop;
 * the actuator that takes the residual gives no torque in the wheels' span (the wheels would take
   it): none at all when the working wheels span three axes; a kind whose torque depends on the
-  state (magnetorquers, ``m × B``) is held at zero when the wheels span three axes, and is not
-  constrained beside fewer (its share would depend on the field: not imposed);
+  state (magnetorquers, ``m × B``) is held at zero when the wheels span three axes. Beside wheels
+  that span one or two axes such a kind is refused (:func:`allocation_error`): the allocation
+  sends it ``r = (1 − A A⁺) τ`` and it gives ``r − (r·B̂) B̂`` only, so the closed loop realises
+  ``τ − (r·B̂) B̂``; a plan is that only where its ``m × B`` has no part in the wheels' span (then
+  ``r = m × B``, across the field), a condition on the attitude through the field that linear rows
+  on the controls cannot state;
 * another kind with a ``residual_rank`` (magnetorquers beside torquers) is never commanded by the
   allocation: held at zero.
 
@@ -51,7 +56,8 @@ from planners.problem import Array
 __all__ = ["CONTROL_POINTS", "allocation_constraints", "allocation_error", "with_allocation"]
 
 RANK_TOLERANCE = 1e-9
-"""Singular values of the working wheels' axes below this fraction of the largest count as zero."""
+"""Singular values of the residual actuator's torque within the wheels' span below this fraction of
+the largest count as zero (the wheels' own span: ``Spacecraft.wheel_span``, the same fraction)."""
 
 
 def _constant_jacobian(actuator: Any) -> Array | None:
@@ -86,20 +92,17 @@ def allocation_constraints(spacecraft: Spacecraft) -> Array | None:
     blocks = actuator_blocks(spacecraft)
     nu = sum(block.actuator.control_size for block in blocks)
     rows: list[Array] = []
-    span = np.zeros((3, 0))  # orthonormal basis of the working wheels' span
+    span = spacecraft.wheel_span()  # orthonormal basis of what the working wheels give
     wheels = spacecraft.wheels
     if wheels is not None and np.any(wheels.working):
         block = next(block for block in blocks if block.actuator is wheels)
         index = np.flatnonzero(wheels.working)
-        left, singular, right = np.linalg.svd(wheels.axes[:, index])
-        rank = int(np.sum(singular > RANK_TOLERANCE * singular.max()))
-        span = left[:, :rank]
-        for null in right[rank:]:  # the null space of the working axes
+        _, _, right = np.linalg.svd(wheels.axes[:, index])
+        for null in right[span.shape[1]:]:  # the null space of the working axes
             row = np.zeros(nu)
             row[np.arange(nu)[block.control][index]] = null
             rows.append(row)
-    ranked = [(a.residual_rank, i, a) for i, a in enumerate(spacecraft.actuators) if a.residual_rank is not None]
-    sink = min(ranked)[2] if ranked else None
+    sink = spacecraft.residual_actuator
     for block in blocks:
         actuator = block.actuator
         if actuator is wheels or actuator.residual_rank is None:
@@ -115,7 +118,7 @@ def allocation_constraints(spacecraft: Spacecraft) -> Array | None:
             continue
         jacobian = _constant_jacobian(actuator)
         if jacobian is None:
-            continue  # its share depends on the field: not imposed (module docstring)
+            continue  # its share depends on the field: refused by allocation_error (module docstring)
         within = span.T @ jacobian  # its torque in the wheels' span
         _, singular, right = np.linalg.svd(within)
         rank = int(np.sum(singular > RANK_TOLERANCE * max(float(singular.max(initial=0.0)), 1e-300)))
@@ -154,8 +157,19 @@ def allocation_error(spacecraft: Spacecraft, transcription: str) -> str | None:
     Returns
     -------
     str or None
-        The reason, or ``None`` (nothing to impose, or the transcription can).
+        The reason, or ``None`` (nothing to impose, or the transcription can). Whatever the
+        transcription: a residual actuator whose torque depends on the field beside working
+        wheels that span one or two axes (module docstring).
     """
+    sink = spacecraft.residual_actuator
+    given = spacecraft.wheel_span().shape[1]
+    if sink is not None and 0 < given < 3 and _constant_jacobian(sink) is None:
+        return (f"the controllers' allocation sends what the {given} working wheel axes cannot give to the "
+                f"{sink.name}, whose torque depends on the field ({type(sink).__name__}: m × B, across the field); "
+                f"the allocation realises only the part of that residual across the field, so a plan that uses the "
+                f"{sink.name} is not what the closed loop realises, and collocation cannot impose it on its controls "
+                f"(it is a condition on the attitude through the field); give the spacecraft torquers, three "
+                f"independent working wheels, or the {sink.name} without wheels")
     if transcription in CONTROL_POINTS or allocation_constraints(spacecraft) is None:
         return None
     return (f"{transcription} cannot impose the controllers' allocation (g = −A⁺ τ, wheels first) on these "

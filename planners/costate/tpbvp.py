@@ -344,7 +344,11 @@ class CostateTPBVPPlanner(Planner):
             Diagonal of ``W`` (eq. 34), positive (default ``[1, 1, 1]``; rate acquisition).
         steering_torque : list of 3 float or None
             ``τ``, the steering torque per body axis [N m], positive; ``None`` (default): the
-            actuators' per-axis limits (rate acquisition).
+            largest per-axis box the controllers' allocation realises at every corner
+            (``Spacecraft.body_torque_limit``: ``diag(τ) W u`` with ``‖u‖ = 1`` and ``W <= 1``
+            stays within it, whatever the direction ``u`` turns to; conservative for a skewed
+            wheel array, which gives more along a single axis; torquers beside wheels that span
+            three axes add nothing, the allocation never asks them) (rate acquisition).
         terminal_weight : float
             ``Q_f = terminal_weight · I`` of the terminal cost with ``final_time: fixed`` (on the
             rate for rate acquisition, on the quaternion for attitude acquisition), positive

@@ -434,7 +434,9 @@ def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = E
     slices, _ = control_layout(spacecraft)
     wheels, magnetorquers = spacecraft.wheels, spacecraft.magnetorquers
     if magnetorquers is None and (wheels is not None or spacecraft.torquers is not None):
-        # the body box of the wheels and torquers (magnetorquers' torque depends on the field)
+        # the largest per-axis box the allocation realises at every corner (Spacecraft.body_torque_limit):
+        # the whole realised set for wheels along the body axes or torquers, a conservative box inside it
+        # for a skewed wheel array (Spacecraft.torque_box_is_exact); magnetorquers' torque depends on the field
         series.limits["torque"] = _limits(spacecraft.body_torque_limit())
     if wheels is not None:
         series.failed, series.wheel_axis = tuple(wheels.failed), wheel_axes(wheels.axes)

@@ -185,6 +185,40 @@ def _limit(t: np.ndarray, level: float, name: str, panel: int, both: bool, colou
             "hoverinfo": "skip"}
 
 
+def _torque_limit_lines(spacecraft: Any) -> list[tuple[float, str, str | None]]:
+    """The dotted limits of the torque panel: the largest per-axis box the controllers' allocation
+    realises at every corner (``Spacecraft.body_torque_limit``).
+
+    Where that box is the whole realised set (wheels along the body axes, torquers) a torque is
+    realised exactly when each component is within it, and the lines are labelled ``limit``.
+    Where it is not (a skewed wheel array: a four-wheel pyramid gives more along a single body
+    axis, ``Spacecraft.torque_along``, than on every axis at once) they are labelled ``per-axis
+    box ... (conservative)``: within them the torque is surely realised, beyond them not surely
+    unrealised.
+
+    Parameters
+    ----------
+    spacecraft : ocp.Spacecraft
+        The actuators.
+
+    Returns
+    -------
+    list of (float, str, str or None)
+        Per line: its level [N m] (drawn at ``±``), its legend name, its colour (``None``: the
+        common one); one line when the three bounds are equal, else one per axis with a finite
+        positive bound.
+    """
+    limits = spacecraft.body_torque_limit()
+    exact = spacecraft.torque_box_is_exact()
+    finite = [float(v) for v in limits if np.isfinite(v) and v > 0]
+    if len(finite) == 3 and np.ptp(finite) <= 1e-12 * max(finite):
+        name = f"limit ±{finite[0]:.3g} N m" if exact else f"per-axis box ±{finite[0]:.3g} N m (conservative)"
+        return [(finite[0], name, None)]
+    return [(float(limits[i]), f"τ{axis} limit ±{limits[i]:.3g}" if exact
+             else f"τ{axis} box ±{limits[i]:.3g} (conservative)", AXIS_COLOURS[i])
+            for i, axis in enumerate("xyz") if np.isfinite(limits[i]) and limits[i] > 0]
+
+
 def _panels(layout: dict[str, Any], titles: Sequence[tuple[str, str]], log: Sequence[bool]) -> None:
     """Stacked panels sharing the time axis, each with its legend at its right."""
     n, gap = len(titles), 0.05
@@ -219,7 +253,8 @@ def row_figure(row: Any, scenario: Any) -> dict[str, Any]:
     :func:`scenarios.output.plot_data.knowledge_series`); the body rate per body axis and
     its norm [deg/s]; the actuators' applied torque per body axis [N m] (held over each sample);
     the wheels' momenta [N m s] when there are wheels. The reference is dashed; dotted limits: the
-    actuators' body-torque box (``Spacecraft.body_torque_limit``), each wheel's momentum limit,
+    per-axis torque box of the controllers' allocation (``Spacecraft.body_torque_limit``, labelled
+    conservative where the realised set is no box), each wheel's momentum limit,
     ``requirements.rate`` on ``‖ω‖`` and ``requirements.final`` on the error after ``T + after_s``.
 
     Parameters
@@ -275,20 +310,13 @@ def row_figure(row: Any, scenario: Any) -> dict[str, Any]:
         bound = float(np.rad2deg(requirements.rate.max_rate))
         data.append(_limit(t, bound, f"‖ω‖ ≤ {bound:.3g} deg/s", 2, False))
     torque = held(np.asarray(sim.applied_torque, dtype=float))
-    limits = spacecraft.body_torque_limit()
     for i, axis in enumerate("xyz"):
         data.append(_trace(t, torque[:, i], f"τ{axis}", 3, AXIS_COLOURS[i], group=f"torque {axis}", shape="hv",
                            unit="N m"))
         if reference is not None:
             data.append(_trace(t, reference.torque[:, i], f"τ{axis} ref", 3, AXIS_COLOURS[i], dash="dash",
                                group=f"torque {axis}", legend=False, unit="N m"))
-    finite = [float(v) for v in limits if np.isfinite(v) and v > 0]
-    if len(finite) == 3 and np.ptp(finite) <= 1e-12 * max(finite):
-        data.append(_limit(t, finite[0], f"limit ±{finite[0]:.3g} N m", 3, True))
-    else:
-        for i, axis in enumerate("xyz"):
-            if np.isfinite(limits[i]) and limits[i] > 0:
-                data.append(_limit(t, float(limits[i]), f"τ{axis} limit ±{limits[i]:.3g}", 3, True, AXIS_COLOURS[i]))
+    data.extend(_limit(t, level, name, 3, True, colour) for level, name, colour in _torque_limit_lines(spacecraft))
     titles = [error_title, ("body rate", "deg/s"), ("applied torque", "N m")]
     log = [True, False, False]
     if n_wheels:
