@@ -450,6 +450,7 @@ def test_every_entry_has_a_meaning_and_unit_suffixes_agree_with_units():
 # --- the page and the command ---------------------------------------------------------------------
 
 def test_the_rst_page_builds_with_sphinx_without_warnings(tmp_path):
+    pytest.importorskip("sphinx", reason="the docs extra (pip install '.[docs]')")
     source = tmp_path / "source"
     source.mkdir()
     (source / "conf.py").write_text('project = "schema"\nextensions = []\n')
