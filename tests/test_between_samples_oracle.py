@@ -224,3 +224,20 @@ def test_a_final_error_peaking_between_samples_by_closed_form() -> None:
     worst, when = worst_error_between_samples(t, q, omega, quat.IDENTITY, 4.1)
     assert worst == pytest.approx(RATE * 0.4, abs=1e-9)
     assert when == pytest.approx(4.1, abs=1e-9)
+
+
+def test_a_window_between_two_samples_is_scored_by_closed_form() -> None:
+    """A 0.01 rad keep-out about the x axis whose window, [4.25, 4.28] s, lies between the samples
+    4 and 5 s: the boresight at azimuth RATE (t − 4.3) is inside the cone throughout it, deepest
+    at 4.28 s (margin 0.001 − 0.01 rad). No sample lies in the window (fcaf45b scored no point)."""
+    t = np.arange(0.0, 10.5, 1.0)
+    q, omega = turning(t, 4.3)
+    constraint = PointingConstraint("short", [1.0, 0.0, 0.0], True, 0.01, directions=[[1.0, 0.0, 0.0]],
+                                    window=(4.25, 4.28))
+    assert np.all(np.isnan(constraint.margins(t, q)))
+    score = constraint.score_between_samples(t, q, omega)
+    assert not score.met
+    assert score.min_margin_deg == pytest.approx(math.degrees(RATE * 0.02 - 0.01), abs=1e-9)
+    assert score.min_margin_time_s == pytest.approx(4.28, abs=1e-12)
+    assert score.first_violation_s == pytest.approx(4.25, abs=1e-12)
+    assert score.time_in_violation_s == pytest.approx(0.03, abs=1e-9)
