@@ -21,6 +21,7 @@ negative when the constraint is broken. A constraint applies only inside its win
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any, NamedTuple
@@ -36,34 +37,54 @@ Array = NDArray[np.float64]
 
 __all__ = [
     "COARSE_STEPS",
+    "DEGENERATE_NORM",
     "FINE_STEP",
+    "GROUP_REACH",
     "MIN_SEARCHES",
     "REFINE_LEVELS",
     "REFINE_POINTS",
+    "SAMPLE_GROUP",
     "HermiteMotion",
     "PointingConstraint",
     "PointingScore",
     "hermite_attitudes",
+    "search_between_samples",
     "violation_intervals",
 ]
 
 FINE_STEP = np.deg2rad(0.05)
 """[rad]: the largest rotation of the attitude between two points of the sub-grid on which
-:meth:`PointingConstraint.score_between_samples` evaluates the margin (each sample interval is cut
-into as many equal steps as its faster end's rate needs, at least 4)."""
+:func:`search_between_samples` evaluates (each sample interval that may hide a crossing of the
+threshold is cut into as many equal steps as its faster end's rate needs, at least 4)."""
 COARSE_STEPS = 16
-"""Steps of a sample interval that may hide a lower margin but no violation (by the bound of
-:meth:`PointingConstraint.score_between_samples`): the smallest margin there is searched further
+"""Steps of a sample interval that may hide a lower value but no crossing of the threshold (by the
+bound of :func:`search_between_samples`): the smallest value there is searched further
 (:data:`MIN_SEARCHES`), not the whole interval at :data:`FINE_STEP`."""
 MIN_SEARCHES = 64
-"""Sub-grid steps searched for a lower margin, the deepest by the bound first (every step that may
-hide a violation is searched): the cost stays bounded when the bound cannot exclude much (a
-boresight circling at a constant angle to the direction)."""
-REFINE_POINTS = 17
-"""Points of each zoom of :meth:`PointingConstraint.score_between_samples`'s search for a minimum
-inside a sub-grid step (each zoom narrows the bracket to two of its steps: 8 times)."""
-REFINE_LEVELS = 6
-"""Zooms of that search: the bracket ends ``8**6 ≈ 2.6e5`` times narrower than a sub-grid step."""
+"""Brackets searched for a lower value at each zoom, the deepest by the bound first (every bracket
+that may hide a crossing of the threshold is searched): the cost stays bounded when the bound
+cannot exclude much (a boresight circling at a constant angle to the direction)."""
+REFINE_POINTS = 65
+"""Points of each zoom of :func:`search_between_samples` (the ends and 63 new ones: each zoom cuts a
+bracket into 64 parts; one searched for a lower value goes on by the two about its least point,
+one that may hide a crossing by every part the bound cannot clear)."""
+REFINE_LEVELS = 3
+"""Zooms of that search: a bracket ends ``32**3 ≈ 3.3e4`` (a lower value) or ``64**3 ≈ 2.6e5``
+(a crossing) times narrower than a sub-grid step."""
+SAMPLE_GROUP = 16
+"""Samples of which :func:`search_between_samples` evaluates one first (fewer where the bound sums
+to :data:`GROUP_REACH` over fewer): a group whose bound can neither cross the threshold nor go
+below the least value found is not evaluated inside (a long run densely sampled far from the cone
+costs a sixteenth of its samples)."""
+GROUP_REACH = np.deg2rad(2.0)
+"""[rad]: the most the bound may move the value over a group of samples evaluated first (a
+group that may cross the threshold is cut into the fine sub-grid: at most this over
+:data:`FINE_STEP`, or 4 steps a sample interval)."""
+DEGENERATE_NORM = 0.1
+"""The interpolant's unnormalised norm below which an interval's rate is not bounded from its
+polynomial (:attr:`HermiteMotion.rate_bound`): samples that disagree with their rates by about a
+half turn, whose interpolant passes near zero; 1.5 times :attr:`HermiteMotion.turn_rate` is
+used there."""
 
 
 def hermite_attitudes(t: ArrayLike, q: ArrayLike, omega: ArrayLike, times: ArrayLike) -> Array:
@@ -113,6 +134,13 @@ class HermiteMotion:
         self.q = quat.continuous(np.atleast_2d(np.asarray(q, dtype=float)))
         self.omega = np.atleast_2d(np.asarray(omega, dtype=float))
         self.slope = quat.kinematics(self.q, self.omega)
+        h = np.diff(self.t)
+        self._inverse_h = np.divide(1.0, h, out=np.zeros_like(h), where=h > 0.0)  # a repeated time: its sample
+        start, end = h[:, None] * self.slope[:-1], h[:, None] * self.slope[1:]
+        q0, q1 = self.q[:-1], self.q[1:]
+        # p(s) = c0 + c1 s + c2 s² + c3 s³ on each interval (K, power, component): the Hermite basis expanded
+        self._cubic = np.stack([q0, start, -3.0 * q0 - 2.0 * start + 3.0 * q1 - end,
+                                2.0 * q0 + start - 2.0 * q1 + end], axis=1)
 
     def attitudes(self, times: ArrayLike) -> Array:
         """The interpolated attitude.
@@ -127,17 +155,219 @@ class HermiteMotion:
         (M, 4) ndarray
             Unit quaternions at ``times`` (scalar first, body to inertial).
         """
-        t, q, slope = self.t, self.q, self.slope
+        t = self.t
         at = np.clip(np.atleast_1d(np.asarray(times, dtype=float)), t[0], t[-1])
         if len(t) == 1:
-            return np.repeat(quat.normalize(q), len(at), axis=0)
+            return np.repeat(self.unit, len(at), axis=0)
         k = np.clip(np.searchsorted(t, at, side="right") - 1, 0, len(t) - 2)
-        h = t[k + 1] - t[k]
-        s = (np.divide(at - t[k], h, out=np.zeros_like(h), where=h > 0.0))[:, None]  # a repeated time: its sample
-        s2, s3 = s * s, s * s * s
-        value = ((2 * s3 - 3 * s2 + 1) * q[k] + (s3 - 2 * s2 + s) * h[:, None] * slope[k]
-                 + (3 * s2 - 2 * s3) * q[k + 1] + (s3 - s2) * h[:, None] * slope[k + 1])
-        return np.asarray(value / np.linalg.norm(value, axis=1, keepdims=True), dtype=float)
+        s = ((at - t[k]) * self._inverse_h[k])[:, None]
+        c = self._cubic[k]
+        value = ((c[:, 3] * s + c[:, 2]) * s + c[:, 1]) * s + c[:, 0]
+        return np.asarray(value / np.sqrt(np.einsum("ij,ij->i", value, value))[:, None], dtype=float)
+
+    def interval(self, times: ArrayLike) -> NDArray[np.intp]:
+        """The sample interval holding each time (the later one at a sample; clipped to the span).
+
+        Parameters
+        ----------
+        times : (M,) array_like
+            Times [s].
+
+        Returns
+        -------
+        (M,) ndarray of int
+            Indices into :attr:`turn_rate` and :attr:`rate_bound`, in ``[0, N − 2]``.
+        """
+        at = np.atleast_1d(np.asarray(times, dtype=float))
+        return np.clip(np.searchsorted(self.t, at, side="right") - 1, 0, max(len(self.t) - 2, 0))
+
+    @cached_property
+    def turn_rate(self) -> Array:
+        """Per sample interval [rad/s]: the larger of its faster end's ``‖ω‖`` and the mean rate of
+        the turn between its samples (samples whose rates do not match their attitudes: the
+        interpolant still turns); what sizes the sub-grid of :func:`search_between_samples`."""
+        h = np.diff(self.t)
+        norms = np.linalg.norm(self.omega, axis=1)
+        chord = 2.0 * np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", self.q[:-1], self.q[1:])), 0.0, 1.0))
+        return np.maximum(np.maximum(norms[:-1], norms[1:]), np.divide(chord, h, out=np.zeros_like(h), where=h > 0.0))
+
+    @cached_property
+    def unit(self) -> Array:
+        """(N, 4): the samples normalised (the interpolant at the sample times)."""
+        return np.asarray(quat.normalize(self.q), dtype=float)
+
+    @cached_property
+    def rate_bound(self) -> Array:
+        """Per sample interval [rad/s]: an upper bound on the interpolated attitude's angular rate.
+
+        The interpolant is ``r = p / |p|`` with ``p(s) = c0 + c1 s + c2 s² + c3 s³`` the cubic of
+        :meth:`attitudes` at ``s = (t − t_k) / h``; its rate is ``2 |ṙ| <= 2 max|p'| / (h min|p|)``
+        over the interval, with ``max|p'|`` at most the largest norm of the control points
+        ``c1, c1 + c2, c1 + 2 c2 + 3 c3`` of ``p'`` as a quadratic Bézier curve (it stays in their
+        convex hull) and
+        ``min|p| >= (|p(0)| + |p(1)| − max|p'|) / 2`` (each end less the way ``p`` can go): a bound,
+        not an estimate, where that ``min|p|`` exceeds :data:`DEGENERATE_NORM`; elsewhere (samples
+        a large part of a turn apart, or that disagree with their rates) 1.5 times
+        :attr:`turn_rate`. 0 on an interval of zero length.
+        """
+        q, h = self.q, np.diff(self.t)
+        if len(q) < 2:
+            return np.zeros(0)
+        c1, c2, c3 = self._cubic[:, 1], self._cubic[:, 2], self._cubic[:, 3]
+        control = np.stack([c1, c1 + c2, c1 + 2.0 * c2 + 3.0 * c3])  # p' as a quadratic Bézier curve
+        slope_high = np.sqrt(np.max(np.einsum("ikj,ikj->ik", control, control), axis=0))
+        ends = np.sqrt(np.einsum("ij,ij->i", q, q))
+        low = 0.5 * (ends[:-1] + ends[1:] - slope_high)
+        sound = low > DEGENERATE_NORM
+        bound = np.divide(2.0 * slope_high, h * np.where(sound, low, 1.0), out=np.zeros_like(h), where=h > 0.0)
+        return np.where(sound, bound, 1.5 * self.turn_rate)
+
+
+def _may_cross(start: Array, end: Array, reach: Array, threshold: float, smallest: float) -> NDArray[np.bool_]:
+    """Which brackets (values at their ends, ``reach``: their rate bound times their length) may go
+    from one side of ``threshold`` to the other, or below ``smallest`` (NaN: no)."""
+    mean, slack = 0.5 * (start + end), 0.5 * reach
+    straddle = (np.fmin(start, end) < threshold) & (np.fmax(start, end) >= threshold)
+    return straddle | ((mean - slack < threshold) & (mean + slack >= threshold)) | (mean - slack < smallest)
+
+
+def search_between_samples(motion: HermiteMotion, value: Callable[[Array, Array], Array], threshold: float = -np.inf,
+                           drift: float = 0.0, edges: Sequence[float] = ()) -> tuple[Array, Array]:
+    """The points where a function of the interpolated motion is evaluated to find its least value
+    and every crossing of a threshold between the samples (a keep-out's margin below 0, the final
+    error above its bound: one search for both).
+
+    ``value(times, attitudes)`` must change no faster than ``motion.rate_bound + drift`` (per sample
+    interval; NaN marks times where it does not apply). Between two points it then stays above the
+    mean of their values less half the integral of that rate between them (the bound), and below
+    the mean plus as much. All in array operations over every interval at once:
+
+    1. the heads are evaluated: every :data:`SAMPLE_GROUP`-th sample, the ``edges`` inside the
+       samples' span, and each sample where the bound's integral passes a multiple of
+       :data:`GROUP_REACH`;
+    2. a group between two heads whose bound lets it cross ``threshold`` (or has its heads on both
+       sides) has each of its sample intervals cut into equal steps over which the attitude turns at
+       most :data:`FINE_STEP` (by :attr:`HermiteMotion.turn_rate`, at least 4: its crossings are
+       located on them); one that may only hide a value below the least found, into at most
+       :data:`COARSE_STEPS`; the others stay one bracket, their samples not evaluated (a densely
+       sampled reference far from the cone costs a sixteenth of its samples);
+    3. :data:`REFINE_LEVELS` times, every bracket whose bound falls below ``threshold`` while
+       neither end does, and the :data:`MIN_SEARCHES` whose bounds fall deepest below the least
+       value found, are cut by :data:`REFINE_POINTS` points; the next brackets are all the parts of
+       the former (a branch and bound: no part the bound cannot clear is dropped) and the two parts
+       about the least point of the latter.
+
+    A crossing of the threshold is never missed unless it goes less deep than the bound over the
+    last brackets (``64**-3`` of a sub-grid step); a region between two points on the far side of
+    the threshold may hide a return shorter than a sub-grid step (its time is counted on the far
+    side). The least value is exact where the search reaches it, else within the bound over a step.
+
+    Parameters
+    ----------
+    motion : HermiteMotion
+        The motion (its samples' times span the search).
+    value : callable
+        ``value(times, attitudes) -> values``: (M,) times [s] and (M, 4) interpolated attitudes to
+        (M,) values.
+    threshold : float, optional
+        The value below which a crossing must not be missed; ``-inf`` (default): the least value only.
+    drift : float, optional
+        What the value's rate may add to the attitude's [per s] (a moving direction's rate).
+    edges : sequence of float, optional
+        Times [s] that are points of the search when inside the samples' span (a window's edges).
+
+    Returns
+    -------
+    (times, values) : ((P,) ndarray, (P,) ndarray)
+        Every point evaluated, in time order (the samples and edges first among them).
+    """
+    t = motion.t
+    inner = [float(edge) for edge in edges if t[0] < edge < t[-1]]
+    knots = np.unique(np.concatenate([t, inner])) if inner else np.unique(t)
+    count = len(knots)
+    # the samples' attitudes are the samples (normalised); an edge between them is interpolated
+    attitudes = motion.unit if count == len(t) else motion.attitudes(knots)
+    if count < 2:
+        return knots, np.asarray(value(knots, attitudes), dtype=float)
+    interval = motion.interval(knots[:-1])
+    h = np.diff(knots)
+    speed = motion.rate_bound[interval] + drift  # per step between knots
+    # the heads of groups of knot steps, evaluated first: every SAMPLE_GROUP-th knot, the edges, and
+    # each knot where the bound's sum over the steps passes a multiple of GROUP_REACH
+    turned = np.concatenate([[0.0], np.cumsum(speed * h)]) // GROUP_REACH
+    head = np.zeros(count, dtype=bool)
+    head[::SAMPLE_GROUP] = head[-1] = True
+    head[1:] |= turned[1:] != turned[:-1]
+    head[np.searchsorted(knots, inner)] = True
+    heads = np.flatnonzero(head)
+    at_heads = np.asarray(value(knots[heads], attitudes[heads]), dtype=float)
+    if not np.any(np.isfinite(at_heads)):
+        return knots[heads], at_heads
+    sizes = np.diff(heads)
+    reach = np.add.reduceat(speed * h, heads[:-1])  # the bound's integral over each group
+    with np.errstate(invalid="ignore"):
+        crossing = _may_cross(at_heads[:-1], at_heads[1:], reach, threshold, -np.inf)
+        deeper = _may_cross(at_heads[:-1], at_heads[1:], reach, -np.inf, float(np.nanmin(at_heads)))
+    # a group that may cross the threshold: its knot steps cut into the fine sub-grid; one that may
+    # hide a lower value: into at most COARSE_STEPS; the others keep their heads alone (one bracket)
+    fine_steps = np.maximum(4, np.ceil(motion.turn_rate[interval] * h / FINE_STEP)).astype(int)
+    cut = np.where(np.repeat(crossing, sizes), fine_steps, np.minimum(COARSE_STEPS, fine_steps))
+    opened = np.repeat(crossing | deeper, sizes)
+    steps = np.where(opened, cut, head[:-1])
+    rate = np.where(opened, speed, np.repeat(reach / np.diff(knots[heads]), sizes))  # a group kept whole: its mean
+    total = int(steps.sum())
+    offset = np.arange(total) - np.repeat(np.cumsum(steps) - steps, steps)
+    grid = np.append(np.repeat(knots[:-1], steps) + np.repeat(h / np.maximum(cut, 1), steps) * offset, knots[-1])
+    rate = np.repeat(rate, steps)
+    known = np.append(np.repeat(head[:-1], steps) & (offset == 0), True)
+    values = np.empty(total + 1)
+    values[known] = at_heads
+    new = ~known
+    if np.any(new):
+        values[new] = value(grid[new], motion.attitudes(grid[new]))
+    found_t, found_v = [grid], [values]
+    # brackets: the sub-grid's steps, then the parts of those the bound cannot clear
+    low, high, at_low, at_high = grid[:-1], grid[1:], values[:-1], values[1:]
+    smallest = float(np.nanmin(values))
+    near = np.ones(len(low), dtype=bool)  # a candidate for a lower value (else only for a crossing)
+    fraction = np.linspace(0.0, 1.0, REFINE_POINTS)[1:-1]
+    part = np.arange(REFINE_POINTS - 1)
+    for _ in range(REFINE_LEVELS):
+        with np.errstate(invalid="ignore"):
+            floor = 0.5 * (at_low + at_high) - 0.5 * rate * (high - low)
+            hidden = (np.fmin(at_low, at_high) >= threshold) & (floor < threshold)
+            lower = np.flatnonzero(near & (floor < smallest))
+        if lower.size > MIN_SEARCHES:
+            lower = lower[np.argsort(floor[lower], kind="stable")[:MIN_SEARCHES]]
+        pick = hidden.copy()
+        pick[lower] = True
+        if not np.any(pick):
+            break
+        whole = hidden[pick]
+        low, high, at_low, at_high, rate = low[pick], high[pick], at_low[pick], at_high[pick], rate[pick]
+        points = low[:, None] + (high - low)[:, None] * fraction
+        flat = points.ravel()
+        inside_values = np.asarray(value(flat, motion.attitudes(flat)), dtype=float)
+        found_t.append(flat)
+        found_v.append(inside_values)
+        inside_values = inside_values.reshape(points.shape)
+        smallest = min(smallest, float(np.nanmin(inside_values)))
+        ends_t = np.column_stack([low, points, high])
+        ends_v = np.column_stack([at_low, inside_values, at_high])
+        # a bracket searched for a lower value goes on by the two parts about its least point; one
+        # that may hide a crossing by all its parts (the next bound clears most)
+        best = np.argmin(np.where(np.isnan(ends_v), np.inf, ends_v), axis=1)[:, None]
+        near = ((part == best) | (part == best - 1)).ravel()
+        keep = near | np.repeat(whole, REFINE_POINTS - 1)
+        low, high = ends_t[:, :-1].ravel()[keep], ends_t[:, 1:].ravel()[keep]
+        at_low, at_high = ends_v[:, :-1].ravel()[keep], ends_v[:, 1:].ravel()[keep]
+        rate = np.repeat(rate, REFINE_POINTS - 1)[keep]
+        near = near[keep]
+    if len(found_t) == 1:
+        return grid, values
+    times, values = np.concatenate(found_t), np.concatenate(found_v)
+    order = np.argsort(times, kind="stable")
+    return times[order], values[order]
 
 
 class PointingScore(NamedTuple):
@@ -325,8 +555,21 @@ class PointingConstraint:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         if not self.moving:
             return np.repeat(self.directions, len(t), axis=0)
-        d = np.stack([np.interp(t, self.times, self.directions[:, i]) for i in range(3)], axis=-1)
-        return d / np.linalg.norm(d, axis=1, keepdims=True)
+        d = self._table_at(t)[:, :3]
+        return np.asarray(d / np.sqrt(np.einsum("ij,ij->i", d, d))[:, None], dtype=float)
+
+    def _table_at(self, t: Array) -> Array:
+        """(N, 4): the direction (not normalised) and the growth at ``t``, interpolated linearly
+        between the table's rows (one lookup for both) and held beyond them."""
+        row = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.times) - 2)
+        weight = np.clip((t - self.times[row]) * self._table_slopes[1][row], 0.0, 1.0)[:, None]
+        return np.asarray(self._table_slopes[0][row] + weight * self._table_slopes[2][row], dtype=float)
+
+    @cached_property
+    def _table_slopes(self) -> tuple[Array, Array, Array]:
+        """The moving table's rows (direction, growth), 1 / their steps, and their differences."""
+        rows = np.column_stack([self.directions, np.asarray(self.growth)])
+        return rows, 1.0 / np.diff(self.times), np.diff(rows, axis=0)
 
     def limit(self, t: ArrayLike) -> Array:
         """The cone's half-angle at times ``t``.
@@ -345,7 +588,7 @@ class PointingConstraint:
         growth = self.growth if self.growth is not None else np.zeros(1)
         if not self.moving:
             return np.full(len(t), self.angle + float(growth[0]))
-        return self.angle + np.interp(t, self.times, growth)
+        return np.asarray(self.angle + self._table_at(t)[:, 3], dtype=float)
 
     def angles(self, t: ArrayLike, q: ArrayLike) -> Array:
         """Angle between the boresight and the direction [rad].
@@ -362,11 +605,38 @@ class PointingConstraint:
         (N,) ndarray
             Angles in [0, π] [rad].
         """
-        q = np.atleast_2d(np.asarray(q, dtype=float))
-        pointing = quat.rotate(q, self.boresight)
-        pointing = pointing / np.linalg.norm(pointing, axis=-1, keepdims=True)
-        cosine = np.einsum("ij,ij->i", np.atleast_2d(pointing), self.direction(t))
-        return np.arccos(np.clip(cosine, -1.0, 1.0))
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        return self._angles(t, np.atleast_2d(np.asarray(q, dtype=float)), self._table_at(t) if self.moving else None)
+
+    def _angles(self, t: Array, q: Array, table: Array | None) -> Array:
+        """:meth:`angles`, with the table looked up at ``t`` (``None``: a fixed direction)."""
+        # R(q) b |q|² as a quadratic form of q (one array op), over |q|²: the attitude of q / |q|
+        pointing = np.einsum("mij,mj->mi", (q @ self._rotation_form).reshape(len(q), 3, 4), q)
+        if table is None:
+            cosine = pointing @ self.directions[0] / np.einsum("ij,ij->i", q, q)
+        else:
+            direction = table[:, :3]
+            cosine = np.einsum("ij,ij->i", pointing, direction) / (
+                np.einsum("ij,ij->i", q, q) * np.sqrt(np.einsum("ij,ij->i", direction, direction)))
+        return np.asarray(np.arccos(np.clip(cosine, -1.0, 1.0)), dtype=float)
+
+    @cached_property
+    def _rotation_form(self) -> Array:
+        """(4, 12): ``A_i`` with ``(R(q) b)_i |q|² = qᵀ A_i q`` for the boresight ``b`` and any ``q``
+        (``(q0² − |v|²) b + 2 (v·b) v + 2 q0 v × b``), as ``[A_0 | A_1 | A_2]`` (row: ``q``'s index)."""
+        b = self.boresight
+        form = np.zeros((3, 4, 4))
+        for i in range(3):
+            form[i, 0, 0] = b[i]
+            for j in range(3):
+                form[i, 1 + j, 1 + j] -= b[i]
+                form[i, 1 + i, 1 + j] += b[j]
+                form[i, 1 + j, 1 + i] += b[j]
+                for k in range(3):
+                    cross = float(np.cross(np.eye(3)[j], np.eye(3)[k])[i]) * b[k]  # ε_ijk b_k
+                    form[i, 0, 1 + j] += cross
+                    form[i, 1 + j, 0] += cross
+        return np.ascontiguousarray(form.transpose(1, 0, 2).reshape(4, 12))
 
     def in_window(self, t: ArrayLike) -> NDArray[np.bool_]:
         """Whether each time lies in the window (inclusive).
@@ -399,9 +669,14 @@ class PointingConstraint:
             ``θ − limit`` (keep-out) or ``limit − θ`` (keep-in) [rad].
         """
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        excess = self.angles(t, q) - self.limit(t)
+        q = np.atleast_2d(np.asarray(q, dtype=float))
+        if self.moving:
+            table = self._table_at(t)  # one lookup for the direction and the limit
+            excess = self._angles(t, q, table) - (self.angle + table[:, 3])
+        else:
+            excess = self._angles(t, q, None) - self.limit(t)[0]
         margin = excess if self.keep_out else -excess
-        return np.where(self.in_window(t), margin, np.nan)
+        return np.where((t >= self.window[0]) & (t <= self.window[1]), margin, np.nan)
 
     def score(self, t: ArrayLike, q: ArrayLike) -> PointingScore:
         """Score a sampled motion against the constraint.
@@ -426,24 +701,21 @@ class PointingConstraint:
         return PointingScore(float(np.rad2deg(margin[worst])), float(sum(b - a for a, b in intervals)),
                              intervals[0][0] if intervals else None, float(t[worst]))
 
-    def score_between_samples(self, t: ArrayLike, q: ArrayLike, omega: ArrayLike) -> PointingScore:
+    def score_between_samples(self, t: ArrayLike, q: ArrayLike, omega: ArrayLike,
+                              motion: HermiteMotion | None = None) -> PointingScore:
         """Score a motion known at samples by its attitude and body rate, between the samples too.
 
-        The attitude between samples is the cubic Hermite of :func:`hermite_attitudes`. A bound says
-        where to look: over a stretch of length ``Δ`` the margin stays above the mean of its ends
-        less ``½ Δ`` times a bound on its rate (1.5 times the larger of the faster sample's ``‖ω‖``
-        and the mean rate of the turn between the samples, plus the direction's and the limit's
-        rates). A sample interval that may hide a violation by it, or has one at an end, is cut into
-        equal steps over which the attitude turns at most :data:`FINE_STEP` (at least 4); one that
-        may only hide a lower margin into at most :data:`COARSE_STEPS`; the others keep their
-        samples alone. Every step that may hide a violation between two clear points, and the
-        :data:`MIN_SEARCHES` steps that may hide the lowest margins, are searched for their minimum
-        (up to :data:`REFINE_LEVELS` zooms of :data:`REFINE_POINTS` points, each while the bound
-        still allows something lower); the minima found join the points. The smallest margin and
-        its time, and the violations (zero crossings interpolated linearly between the points), are
-        then those of :meth:`score` on the points. A violation is never missed where the samples
-        agree with their rates; a positive least margin is exact where the search reaches it, else
-        within the bound over a step.
+        The attitude between samples is the cubic Hermite of :func:`hermite_attitudes`, searched by
+        :func:`search_between_samples` for the least margin and every crossing of 0: the margin
+        changes no faster than the interpolant turns (:attr:`HermiteMotion.rate_bound`) plus the
+        direction's and the limit's rates (:attr:`drift`); the window's edges are points of it.
+        The smallest margin and its time, and the violations (zero crossings interpolated linearly
+        between the points), are then those of :meth:`score` on the points searched. A violation of
+        the interpolated motion is never missed unless less deep than the bound over the search's
+        last brackets (about ``1e-9`` rad at the 12U CubeSat's rates); the true motion differs from
+        the interpolated one by the interpolation's O(h⁴) where the samples agree with their rates.
+        A positive least margin is exact where the search reaches it, else within the bound over a
+        step.
 
         Parameters
         ----------
@@ -453,6 +725,9 @@ class PointingConstraint:
             Attitude at ``t`` (scalar first, body to inertial).
         omega : (N, 3) array_like
             Body rate at ``t`` [rad/s], body axes.
+        motion : HermiteMotion or None, optional
+            ``HermiteMotion(t, q, omega)`` when already built (a row's requirements share one);
+            ``None``: built here.
 
         Returns
         -------
@@ -460,101 +735,28 @@ class PointingConstraint:
             As :meth:`score`, of the interpolated motion.
         """
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        q = np.atleast_2d(np.asarray(q, dtype=float))
-        omega = np.atleast_2d(np.asarray(omega, dtype=float))
         if len(t) < 2:
-            return self.score(t, q)
-        h = np.diff(t)
-        norms = np.linalg.norm(omega, axis=1)
-        # per sample interval: the faster end's rate, or the mean rate of the turn between the samples
-        # when that is more (samples whose rates do not match their attitudes: the Hermite still turns)
-        quat_ = quat.continuous(q)
-        chord = 2.0 * np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", quat_[:-1], quat_[1:])), 0.0, 1.0))
-        rate = np.maximum(np.maximum(norms[:-1], norms[1:]),
-                          np.divide(chord, h, out=np.zeros_like(h), where=h > 0.0))
-        # by the same bound over each sample interval: those that may hide a violation, or have one at
-        # an end (its crossings are located on the sub-grid), are cut into the fine sub-grid; those
-        # that may only hide a lower margin into at most COARSE_STEPS steps; the others keep their
-        # samples alone (a long fast run far from the cone costs its samples)
-        at_samples = self.margins(t, q)
-        if not np.any(np.isfinite(at_samples)):
+            return self.score(t, np.atleast_2d(np.asarray(q, dtype=float)))
+        moving = HermiteMotion(t, q, omega) if motion is None else motion
+        times, margin = search_between_samples(moving, self.margins, 0.0, self.drift, self.window)
+        if not np.any(np.isfinite(margin)):
             return PointingScore(None, 0.0, None, None)
-        lowest = np.fmin(at_samples[:-1], at_samples[1:])
-        with np.errstate(invalid="ignore"):
-            reach = 0.5 * (at_samples[:-1] + at_samples[1:]) - 0.5 * (1.5 * rate + self._drift) * h
-            violation = ((lowest >= 0.0) & (reach < 0.0)) | (lowest < 0.0)
-            deeper = reach < float(np.nanmin(at_samples))
-        fine_steps = np.maximum(4, np.ceil(rate * h / FINE_STEP))
-        steps = np.where(violation, fine_steps, np.where(deeper, np.minimum(COARSE_STEPS, fine_steps), 1)).astype(int)
-        offset = np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)
-        fine = np.repeat(t[:-1], steps) + np.repeat(h, steps) * offset / np.repeat(steps, steps)
-        ends = [edge for edge in self.window if t[0] < edge < t[-1]]
-        fine = np.unique(np.concatenate([fine, [t[-1]], ends]))
-        motion = HermiteMotion(t, quat_, omega)
-        margin = self.margins(fine, motion.attitudes(fine))
-        # the sub-grid steps that may hide, between their ends, a margin below the smallest found or
-        # below zero where neither end is: a Lipschitz bound of the margin over the step
-        interval = np.clip(np.searchsorted(t, fine[:-1], side="right") - 1, 0, len(t) - 2)
-        speed = 1.5 * rate[interval] + self._drift
-        floor = 0.5 * (margin[:-1] + margin[1:]) - 0.5 * speed * np.diff(fine)
-        with np.errstate(invalid="ignore"):
-            ends_low = np.fmin(margin[:-1], margin[1:])
-            hidden = np.flatnonzero((ends_low >= 0.0) & (floor < 0.0))  # a violation between two clear points
-            lower = np.flatnonzero(floor < float(np.nanmin(margin)))  # a lower margin: the deepest few only
-            lower = lower[np.argsort(floor[lower], kind="stable")[:MIN_SEARCHES]]
-            suspect = np.union1d(hidden, lower)
-        if suspect.size:
-            found_t, found_m = self._zoom(motion, fine[suspect], fine[suspect + 1], speed[suspect],
-                                          float(np.nanmin(margin)))
-            order = np.argsort(np.concatenate([fine, found_t]), kind="stable")
-            fine = np.concatenate([fine, found_t])[order]
-            margin = np.concatenate([margin, found_m])[order]
         worst = int(np.nanargmin(margin))
-        intervals = violation_intervals(fine, margin)
+        intervals = violation_intervals(times, margin)
         return PointingScore(float(np.rad2deg(margin[worst])), float(sum(b - a for a, b in intervals)),
-                             intervals[0][0] if intervals else None, float(fine[worst]))
-
-    @staticmethod
-    def _suspect(floor: Array, lowest_end: Array, smallest: float) -> NDArray[np.bool_]:
-        """Which brackets may hold a margin below ``smallest`` (the smallest found), or below zero
-        where none of their points found is, given the bound ``floor`` on their margin (NaN: no)."""
-        return (floor < smallest) | ((lowest_end >= 0.0) & (floor < 0.0))
-
-    def _zoom(self, motion: HermiteMotion, start: Array, end: Array, speed: Array,
-              smallest: float) -> tuple[Array, Array]:
-        """The smallest margin of the interpolated motion in each ``[start, end]`` and its time (all the
-        brackets at once, each narrowed :data:`REFINE_LEVELS` times to two of its
-        :data:`REFINE_POINTS` points about its smallest; a bracket whose bound (its best margin less
-        ``speed`` [rad/s] times its new step) leaves nothing to find stops narrowing)."""
-        fraction = np.linspace(0.0, 1.0, REFINE_POINTS)
-        found_t, found_m = np.empty(len(start)), np.empty(len(start))
-        alive = np.arange(len(start))
-        for _ in range(REFINE_LEVELS):
-            points = start[:, None] + (end - start)[:, None] * fraction
-            margin = self.margins(points.ravel(), motion.attitudes(points.ravel())).reshape(points.shape)
-            rows = np.arange(len(alive))
-            best = np.argmin(margin, axis=1)
-            found_t[alive], found_m[alive] = points[rows, best], margin[rows, best]
-            smallest = min(smallest, float(np.min(margin)))
-            step = (end - start) / (REFINE_POINTS - 1)
-            keep = self._suspect(margin[rows, best] - speed * step, margin[rows, best], smallest)
-            start = points[rows, np.maximum(best - 1, 0)][keep]
-            end = points[rows, np.minimum(best + 1, REFINE_POINTS - 1)][keep]
-            alive, speed = alive[keep], speed[keep]
-            if not alive.size:
-                break
-        return found_t, found_m
+                             intervals[0][0] if intervals else None, float(times[worst]))
 
     @cached_property
-    def _drift(self) -> float:
+    def drift(self) -> float:
         """A bound on how fast the margin moves with the attitude held [rad/s]: the direction's
-        largest angular rate between table rows plus the limit's."""
+        largest angular rate between table rows (``2 tan(φ/2) / Δt`` for a turn ``φ`` over ``Δt``:
+        the normalised linear interpolation turns fastest mid-row) plus the limit's."""
         if not self.moving:
             return 0.0
         dt = np.diff(self.times)
         turn = np.arccos(np.clip(np.einsum("ij,ij->i", self.directions[:-1], self.directions[1:]), -1.0, 1.0))
         growth = np.abs(np.diff(np.asarray(self.growth)))
-        return float(np.max((turn + growth) / dt))
+        return float(np.max((2.0 * np.tan(0.5 * turn) + growth) / dt))
 
     # ------------------------------------------------------------------ symbolic
     @cached_property

@@ -49,12 +49,9 @@ from controllers.allocation import (
 )
 from ocp import Spacecraft, quat
 from ocp.geometry.pointing import (
-    FINE_STEP,
-    MIN_SEARCHES,
-    REFINE_LEVELS,
-    REFINE_POINTS,
     HermiteMotion,
     PointingConstraint,
+    search_between_samples,
 )
 from planners import ManeuverProblem, Planner, Reference
 from planners.base import REQUIREMENT_KINDS
@@ -165,8 +162,8 @@ def reference_times(duration: float, run_end: float, sample_time: float, points:
     return times
 
 
-def _pointing(constraint: PointingConstraint, t: Array, q: Array, omega: Array) -> Score:
-    score = constraint.score_between_samples(t, q, omega)
+def _pointing(constraint: PointingConstraint, t: Array, q: Array, omega: Array, motion: HermiteMotion) -> Score:
+    score = constraint.score_between_samples(t, q, omega, motion)
     values: dict[str, float | None] = dict(zip(POINTING_FIELDS, (score.min_margin_deg, score.time_in_violation_s,
                                                                  score.first_violation_s, score.min_margin_time_s)))
     if score.met:
@@ -218,29 +215,21 @@ def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
 
 
 def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, target: ArrayLike,
-                                start: float, limit: float | None = None) -> tuple[float, float]:
+                                start: float, limit: float | None = None,
+                                motion: HermiteMotion | None = None) -> tuple[float, float]:
     """The largest error angle to a fixed attitude from ``start`` on, between the samples too.
 
     The attitude between samples is that of the pointing scores
     (:func:`ocp.geometry.pointing.hermite_attitudes`: a cubic Hermite in the quaternion with the
-    slopes of the body rates), and it is searched as
-    :meth:`ocp.geometry.pointing.PointingConstraint.score_between_samples` searches the margin: the
-    error angle moves no faster than the attitude turns, bounded over a sample interval by 1.5 times
-    the larger of its faster end's ``‖ω‖`` and the mean rate of the turn between its samples. A
-    sample interval whose bound (the mean of its ends plus half its length times the rate bound)
-    may hide more than the largest error at the samples is cut into equal steps over which the
-    attitude turns at most :data:`~ocp.geometry.pointing.FINE_STEP` (at least 4); each step whose
-    bound may hide more than the largest found (the
-    :data:`~ocp.geometry.pointing.MIN_SEARCHES` highest bounds, and every step that may hide an
-    error above ``limit`` while none is found) is zoomed
-    (:data:`~ocp.geometry.pointing.REFINE_LEVELS` times to two of its
-    :data:`~ocp.geometry.pointing.REFINE_POINTS` points about its largest, while its bound still
-    allows more). ``start`` itself is a point when it falls between samples. An error of the
-    interpolated motion above ``limit`` is never missed where the samples agree with their rates
-    (the true motion differs from it by the interpolation's O(h⁴): with samples far apart next to
-    the motion's own time scale, sample more finely); the largest error is exact
-    where the search reaches it, else within the bound over a step (a turn of
-    :data:`~ocp.geometry.pointing.FINE_STEP`: 0.0375° at most).
+    slopes of the body rates), searched by the pointing scores' search
+    (:func:`ocp.geometry.pointing.search_between_samples`) for the least of minus the error angle,
+    whose threshold is ``−limit``: the error angle moves no faster than the interpolant turns
+    (:attr:`~ocp.geometry.pointing.HermiteMotion.rate_bound`), and ``start`` is a point of it when
+    it falls between samples. An error of the interpolated motion above ``limit`` is never missed
+    unless it rises less above than the bound over the search's last brackets (the true motion
+    differs from the interpolated one by the interpolation's O(h⁴): with samples far apart next to
+    the motion's own time scale, sample more finely); the largest error is exact where the search
+    reaches it, else within the bound over a step.
 
     Parameters
     ----------
@@ -257,6 +246,9 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
     limit : float or None, optional
         The bound on the error [rad] whose breaking must not be missed; ``None``: the largest
         error only.
+    motion : HermiteMotion or None, optional
+        ``HermiteMotion(t, q, omega)`` when already built (a row's pointing scores share it);
+        ``None``: built here.
 
     Returns
     -------
@@ -264,60 +256,22 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
         The largest error angle [rad] and its time [s].
     """
     t = np.atleast_1d(np.asarray(t, dtype=float))
-    q = quat.continuous(np.atleast_2d(np.asarray(q, dtype=float)))
-    omega = np.atleast_2d(np.asarray(omega, dtype=float))
-    first = int(np.searchsorted(t, start - 1e-9, side="left"))
-    if first >= len(t):
+    if not t[-1] >= start - 1e-9:
         raise ValueError(f"no sample from {start:g} s on (the samples end at {t[-1]:g} s)")
-    lead = max(first - 1, 0)  # the interval holding start, when start falls between samples
-    t, q, omega = t[lead:], q[lead:], omega[lead:]
-    start = max(float(start), float(t[0]))
-    at_samples = quat.error_angle(q, target)
-    if len(t) < 2:
-        return float(at_samples[0]), float(t[0])
-    h = np.diff(t)
-    chord = 2.0 * np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", q[:-1], q[1:])), 0.0, 1.0))
-    norms = np.linalg.norm(omega, axis=1)
-    speed = 1.5 * np.maximum(np.maximum(norms[:-1], norms[1:]), np.divide(chord, h, out=np.zeros_like(h), where=h > 0.0))
-    inside = t >= start - 1e-9
-    largest = float(np.max(at_samples[inside])) if np.any(inside) else -np.inf
-    reach = 0.5 * (at_samples[:-1] + at_samples[1:]) + 0.5 * speed * h
-    steps = np.where(reach > largest, np.maximum(4, np.ceil(speed / 1.5 * h / FINE_STEP)), 1).astype(int)
-    offset = np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)
-    fine = np.repeat(t[:-1], steps) + np.repeat(h, steps) * offset / np.repeat(steps, steps)
-    fine = np.unique(np.concatenate([fine[fine > start], [start, t[-1]]]))
-    motion = HermiteMotion(t, q, omega)
-    error = quat.error_angle(motion.attitudes(fine), target)
-    step_speed = speed[np.clip(np.searchsorted(t, fine[:-1], side="right") - 1, 0, len(t) - 2)]
-    bound = 0.5 * (error[:-1] + error[1:]) + 0.5 * step_speed * np.diff(fine)
-    worst = int(np.argmax(error))
-    best_t, best = float(fine[worst]), float(error[worst])
-    suspect = np.flatnonzero(bound > best)
-    deepest = suspect[np.argsort(-bound[suspect], kind="stable")[:MIN_SEARCHES]]
-    over = np.flatnonzero(bound > limit) if limit is not None and best <= limit else suspect[:0]
-    suspect = np.union1d(deepest, over)
-    low, high, rate = fine[suspect], fine[suspect + 1], step_speed[suspect]
-    fraction = np.linspace(0.0, 1.0, REFINE_POINTS)
-    for _ in range(REFINE_LEVELS):
-        if not low.size:
-            break
-        points = low[:, None] + (high - low)[:, None] * fraction
-        values = quat.error_angle(motion.attitudes(points.ravel()), target).reshape(points.shape)
-        top = np.argmax(values, axis=1)
-        rows = np.arange(len(low))
-        if float(np.max(values)) > best:
-            where = np.unravel_index(int(np.argmax(values)), values.shape)
-            best, best_t = float(values[where]), float(points[where])
-        step = (high - low) / (REFINE_POINTS - 1)
-        keep = values[rows, top] + rate * step > best
-        low = points[rows, np.maximum(top - 1, 0)][keep]
-        high = points[rows, np.minimum(top + 1, REFINE_POINTS - 1)][keep]
-        rate = rate[keep]
-    return best, best_t
+    target = np.asarray(target, dtype=float)
+    moving = HermiteMotion(t, q, omega) if motion is None else motion
+
+    def less_error(times: Array, attitudes: Array) -> Array:
+        return np.where(times >= start - 1e-9, -quat.error_angle(attitudes, target), np.nan)
+
+    times, values = search_between_samples(moving, less_error, -np.inf if limit is None else -float(limit),
+                                           edges=(float(start),))
+    worst = int(np.nanargmin(values))
+    return float(-values[worst]), float(times[worst])
 
 
 def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, problem: ManeuverProblem,
-           end_of_manoeuvre: float) -> Score:
+           end_of_manoeuvre: float, motion: HermiteMotion | None = None) -> Score:
     start = end_of_manoeuvre + requirement.after_s
     inside = t >= start - 1e-9
     values: dict[str, float | None] = dict(zip(FINAL_FIELDS, (None, None, start)))
@@ -327,7 +281,7 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
     problems = []
     if problem.qf is not None:
         bound = None if requirement.error_deg is None else float(np.deg2rad(requirement.error_deg))
-        worst_error, when = worst_error_between_samples(t, q, omega, problem.qf, start, bound)
+        worst_error, when = worst_error_between_samples(t, q, omega, problem.qf, start, bound, motion)
         worst_deg = float(np.rad2deg(worst_error))
         values["worst_error_deg"] = worst_deg
         if requirement.error_deg is not None and worst_deg > requirement.error_deg * (1 + _TOLERANCE):
@@ -486,7 +440,10 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
     """
     t = np.asarray(times, dtype=float)
     edged = _with_edges(problem, t, sample, reference)
-    scores = {constraint.name: _pointing(constraint, *edged) for constraint in problem.pointing}
+    scores: dict[str, Score] = {}
+    if problem.pointing:
+        motion = HermiteMotion(*edged)  # one interpolant for the row's pointing requirements
+        scores.update((constraint.name, _pointing(constraint, *edged, motion)) for constraint in problem.pointing)
     if requirements.actuators is not None and allocation is not None:
         jumps = rate_jumps(t, sample.omega, problem.omega0, reference)
         steps = np.zeros((t.size, 3))
@@ -554,11 +511,12 @@ def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: A
     t = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
     omega = np.asarray(omega, dtype=float)
-    scores = {constraint.name: _pointing(constraint, t, q, omega) for constraint in problem.pointing}
+    motion = HermiteMotion(t, q, omega)  # one interpolant for the row's requirements
+    scores = {constraint.name: _pointing(constraint, t, q, omega, motion) for constraint in problem.pointing}
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, omega)
     if requirements.final is not None:
-        scores["final"] = _final(requirements.final, t, q, omega, problem, end_of_manoeuvre)
+        scores["final"] = _final(requirements.final, t, q, omega, problem, end_of_manoeuvre, motion)
     return scores
 
 

@@ -1,14 +1,21 @@
-"""What scoring every requirement costs: at most as much again as the run without it (budget
+"""What scoring every requirement costs: at most 75 % of the run without it (budget
 OVERHEAD_BUDGET).
 
 Issue 27 set 10 % of a run's wall time, met while every requirement was scored at the samples
 alone. Scoring between the samples (the closed loop's pointing, then the reference's pointing and
 both scopes' final error: a narrow cone crossed between two samples was missed and the row ok) and
-the reference demand's RK4 sub-steps cost more: measured side by side on 2026-12-02, +56..60 % on
-191ba78 and +75..78 % with the reference scored between samples (CPU of one pointing score of the
-12U CubeSat's reference 0.53-0.61 ms at the samples, 4.30-4.68 ms between them). The 10 % target
-is not held; this budget catches a further regression. Most of the between-samples search's time
-is NumPy's per-call overhead on short arrays (profile: ``ocp.geometry.pointing``'s zooms).
+the reference demand's RK4 sub-steps cost more: +56..60 % on 191ba78, +69..89 % on fcaf45b. The
+search between samples was then rebuilt (``ocp.geometry.pointing.search_between_samples``: one
+search for the pointing margins and the final error, all intervals at once, a rate bound of the
+interpolant that is a bound, samples evaluated by groups of 16 where the bound clears a group, one
+interpolant per row). Measured on 2026-12-02, this benchmark run alternately in two worktrees
+(load 2.6-7 on 2 cores; overhead = median of the pairs' ratios, wall): +43.6, +47.0, +59.8, +42.8,
++52.2, +49.7 % (median 48 %) against +74.1, +69.3, +68.7, +89.2, +75.7 % on fcaf45b (median 74 %);
+CPU, 32 pairs each: +52.3 % against +67.7 %. The pointing scores' CPU per run 37 ms against 73 ms;
+the rest of the scoring, about 42 ms a run (the environment's torque along the reference, the
+actuator demand and its unrealised torque), is not the search's. The 10 % target is not held. The
+budget is about 1.5 times the measured median (1.25 times the largest run): a return to fcaf45b's
+search fails it in about half the runs, anything slower always.
 
 The 12U CubeSat Sun keep-out scenario without its collocation row (the fast planners, where scoring
 weighs most), with three pointing requirements (the star tracker off the Sun and the Moon, an
@@ -31,7 +38,7 @@ from scenarios import runner
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "cubesat_12u_sun_keep_out.yaml"
 ROUNDS = 15
-OVERHEAD_BUDGET = 1.0
+OVERHEAD_BUDGET = 0.75
 """Largest accepted ratio of the run with scoring to the run without it, less one."""
 
 
