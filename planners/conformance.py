@@ -9,7 +9,8 @@ hand with :func:`check_reference`.
 
 Oracles: finite values and unit quaternions on a dense grid (first: a NaN would read as another
 defect in the later checks), finite differences of the reference's own ``q`` and ``ω``
-(kinematics, rate derivative, inverse dynamics), point-wise evaluation (vectorisation) and an
+(kinematics, rate derivative, inverse dynamics), one-sided differences of ``ω`` at 0 and T against
+the reference's own ``ω̇`` (a rate step at an end), point-wise evaluation (vectorisation) and an
 independent numerical integration of the torque-free Euler and kinematic equations (continuation
 after T).
 """
@@ -27,8 +28,9 @@ from planners.reference import Reference, inverse_dynamics_torque
 from planners.torque_free import REST_RATE
 
 __all__ = ["ATTITUDE_TOLERANCE", "CHECKS", "FINITE_SAMPLES", "NORM_TOLERANCE", "RATE_TOLERANCE", "RELATIVE_TOLERANCE",
-           "check_after_end", "check_boundary", "check_dynamics", "check_finite", "check_kinematics", "check_reference",
-           "check_times", "check_vectorised", "finite_check_times", "standard_problems"]
+           "check_after_end", "check_boundary", "check_dynamics", "check_ends", "check_finite", "check_kinematics",
+           "check_reference", "check_times", "check_vectorised", "declared_ends", "finite_check_times",
+           "standard_problems"]
 
 ATTITUDE_TOLERANCE = 2e-5
 """rad: boundary attitudes (about 1e-3 deg, what the shooting planners guarantee)."""
@@ -155,9 +157,29 @@ def check_finite(reference: Reference) -> None:
                 f"quaternion at every time: normalise it (ocp.quat.normalize)")
 
 
+def declared_ends(reference: Reference) -> tuple[bool, bool]:
+    """Whether the reference declares a rate step at 0 and at T (a breakpoint there).
+
+    Parameters
+    ----------
+    reference : Reference
+        The reference.
+
+    Returns
+    -------
+    at_start, at_end : bool
+        A breakpoint at 0; a breakpoint at T (within 1e-12 T).
+    """
+    T, points = reference.duration, reference.breakpoints
+    slack = 1e-12 * max(abs(T), 1.0)
+    return bool(np.any(np.abs(points) <= slack)), bool(np.any(np.abs(points - T) <= slack))
+
+
 def check_boundary(problem: ManeuverProblem, reference: Reference) -> None:
     """``q(0) = q0``, ``ω(0) = ω0``, ``q(T) = qf``, ``ω(T) = ωf`` (when fixed), except those the
-    reference declares in ``free_boundary``.
+    reference declares in ``free_boundary``, and ``ω(0) = ω0`` when it declares a rate step at 0
+    (a breakpoint at 0: its sample at 0 is then the right limit, the step an impulse the scoring
+    counts).
 
     Parameters
     ----------
@@ -178,8 +200,9 @@ def check_boundary(problem: ManeuverProblem, reference: Reference) -> None:
     checks = [("q0", "q(0)", start.q, problem.q0, True), ("omega0", "ω(0)", start.omega, problem.omega0, False),
               ("qf", f"q(T = {T:g} s)", end.q, problem.qf, True),
               ("omegaf", f"ω(T = {T:g} s)", end.omega, problem.omegaf, False)]
+    stepped = {"omega0"} if declared_ends(reference)[0] else set()
     for condition, label, value, wanted, attitude in checks:
-        if wanted is None or condition in reference.free_boundary:
+        if wanted is None or condition in reference.free_boundary or condition in stepped:
             continue
         if attitude:
             error = float(quat.error_angle(value, wanted))
@@ -192,6 +215,47 @@ def check_boundary(problem: ManeuverProblem, reference: Reference) -> None:
                 f"{reference.planner}: {label} = {np.round(value, 6).tolist()} but the problem asks "
                 f"{condition} = {np.round(wanted, 6).tolist()} (error {error:.3g} {unit} > {tolerance:.2g}); "
                 + _fix_free(condition))
+
+
+def check_ends(reference: Reference) -> None:
+    """No undeclared rate step at 0 or T: ``ω`` at each end against ``ω`` an instant inside.
+
+    The instant is the scoring's, ``h = 1e-9 max(T, 1 s)``
+    (:func:`scenarios.requirements.scoring.rate_jumps`); a change of ``ω`` over it beyond
+    ``2 h max|ω̇|`` (the reference's own ``ω̇`` at both times) and the boundary tolerance
+    (:data:`RATE_TOLERANCE` plus :data:`RELATIVE_TOLERANCE` times the peak rate) is a step. The
+    central differences of the other checks stay inside ``[0.02 T, 0.98 T]``, and
+    :func:`check_boundary` compares the values at 0 and T alone: a reference whose rate is
+    pinned to ``ω0`` at the instant 0 and is something else from ``0⁺`` passes both.
+
+    Parameters
+    ----------
+    reference : Reference
+        A reference with status ``"ok"``.
+
+    Raises
+    ------
+    ConformanceError
+        At an end without a declared breakpoint where ``ω`` steps.
+    """
+    T = reference.duration
+    h = 1e-9 * max(T, 1.0)
+    peak = float(np.max(np.linalg.norm(reference.omega(np.linspace(0.0, T, 201)), axis=1)))
+    tolerance = RATE_TOLERANCE + RELATIVE_TOLERANCE * peak
+    declared = declared_ends(reference)
+    for (end, inside), skip, label, index in zip(((0.0, h), (T, T - h)), declared, ("0", "T"), ("0.0", "T")):
+        if skip:
+            continue
+        sample = reference.sample(np.array([end, inside]))
+        change = float(np.linalg.norm(sample.omega[1] - sample.omega[0]))
+        explained = 2.0 * h * float(np.max(np.abs(sample.omega_dot)))
+        if change > tolerance + explained:
+            raise ConformanceError(
+                f"{reference.planner}: ω steps at t = {label}: ω({end:g} s) = {np.round(sample.omega[0], 9).tolist()} "
+                f"but ω({inside:.9g} s) = {np.round(sample.omega[1], 9).tolist()} (a change of {change:.3g} rad/s in "
+                f"{h:.3g} s, beyond {tolerance:.2g} rad/s and the {explained:.3g} rad/s its ω̇ explains); a step is "
+                f"an impulse I Δω no actuator gives. Remove it, or declare it: Reference(..., breakpoints=[{index}, ...]) "
+                f"(the sample at 0 is then the right limit, the one at T the rate after the step)")
 
 
 def check_times(reference: Reference, points: int = 41) -> tuple[Array, float]:
@@ -399,6 +463,7 @@ def check_after_end(reference: Reference, horizon: float | None = None) -> None:
 CHECKS: dict[str, Callable[[ManeuverProblem, Reference], None]] = {
     "finite": lambda problem, reference: check_finite(reference),
     "boundary": check_boundary,
+    "ends": lambda problem, reference: check_ends(reference),
     "kinematics": lambda problem, reference: check_kinematics(reference),
     "dynamics": lambda problem, reference: check_dynamics(reference),
     "vectorised": lambda problem, reference: check_vectorised(reference),

@@ -106,8 +106,13 @@ class Reference(ABC):
         chooses its own initial rate); the conformance test skips them and the metrics report the
         mismatch (``initial_rate_error``, ``final_error_deg``, ``final_rate_error``). Default: none.
     breakpoints : array_like, optional
-        Times [s] inside ``(0, T)`` where ``ω`` or ``ω̇`` may jump (switches of a bang-coast-bang
-        profile, the end of an arc); finite-difference checks stay away from them. Default: none.
+        Times [s] in ``[0, T]`` where ``ω`` or ``ω̇`` may jump (switches of a bang-coast-bang
+        profile, the end of an arc); finite-difference checks stay away from them. A breakpoint at
+        0 or T declares a rate step at that end (a method whose rate is the control): the sample at
+        0 is then the right limit ``ω(0⁺)``, the step from the manoeuvre's ``ω0`` an impulse the
+        scoring counts, and the sample at T the rate after the step, from which the reference
+        coasts (it still meets ``ωf`` unless declared free; the actuator requirement sees that step
+        where it samples after T). Default: none.
     enforced_times : array_like or None, optional
         For a method that imposes the dynamics at discrete points only (direct collocation): those
         times [s]. Between them the reference interpolates, and ``q̇ = ½ q ⊗ [0, ω]`` and the

@@ -17,7 +17,13 @@ import numpy as np
 import pytest
 
 from ocp import metrics_from_reference, quat
-from planners import PLANNERS, ManeuverProblem, Reference
+from planners import (
+    PLANNERS,
+    ManeuverProblem,
+    Reference,
+    ReferenceSample,
+    inverse_dynamics_torque,
+)
 from planners.conformance import CHECKS, check_reference, standard_problems
 from planners.errors import ConformanceError
 
@@ -130,7 +136,6 @@ def _flip_torque(s):
 
 
 def _flip_acceleration(s):  # the shape polynomials' ω̇ sign flip, torque recomputed from it
-    from planners import inverse_dynamics_torque
     return s._replace(omega_dot=-s.omega_dot, torque=inverse_dynamics_torque(INERTIA, s.omega, -s.omega_dot))
 
 
@@ -172,3 +177,62 @@ def test_a_planner_that_misses_the_final_rate_fails():
         CHECKS[check](problem, reference)  # a consistent motion ...
     with pytest.raises(ConformanceError, match=r"ω\(T"):
         check_reference(problem, reference)  # ... to the wrong final rate
+
+
+class PinnedEnds(Reference):
+    """A constant body rate ``c`` on ``(0, T)`` (exact kinematics and inverse dynamics inside),
+    sampled as ``ω0 = 0`` at the instants 0 and T (``pinned``): the co-state attitude
+    acquisition's old rest-to-rest reference, whose steps between 0 and ``c`` hid at 0⁺ and T⁻."""
+
+    RATE = np.array([6e-4, -8e-4, 5e-4])  # rad/s
+
+    def __init__(self, duration: float, pinned: tuple[bool, bool], breakpoints=()) -> None:
+        super().__init__("pinned_ends", duration, PROBLEMS["non_principal"].spacecraft.inertia,
+                         breakpoints=breakpoints)
+        self.pinned = pinned
+
+    def _evaluate(self, t):
+        q = quat.product(quat.IDENTITY, quat.from_rotation_vector(np.outer(t, self.RATE)))
+        omega = np.tile(self.RATE, (t.size, 1))
+        rest = (self.pinned[0] & (t <= 0.0)) | (self.pinned[1] & (t >= self.duration))
+        omega[rest] = 0.0
+        omega_dot = np.zeros_like(omega)
+        return ReferenceSample(q, omega, omega_dot, inverse_dynamics_torque(self.inertia, omega, omega_dot))
+
+
+def _pinned_problem(duration: float) -> ManeuverProblem:
+    qf = quat.from_rotation_vector(duration * PinnedEnds.RATE)
+    return ManeuverProblem(PROBLEMS["non_principal"].spacecraft, quat.IDENTITY, np.zeros(3), qf, duration,
+                           omegaf=np.zeros(3))
+
+
+@pytest.mark.parametrize("pinned, breakpoints, where", [
+    ((True, True), (), "t = 0"),
+    ((False, True), (0.0,), "t = T"),  # the start declared, the stop hidden at T⁻
+])
+def test_a_rate_step_hidden_at_an_end_fails_only_the_ends_check(pinned, breakpoints, where):
+    T = 500.0
+    problem, reference = _pinned_problem(T), PinnedEnds(T, pinned, breakpoints)
+    step = float(np.linalg.norm(PinnedEnds.RATE))
+    assert np.linalg.norm(reference.omega(1e-9 * T) - reference.omega(0.0)) == pytest.approx(step if pinned[0] else 0.0)
+    for name, check in CHECKS.items():
+        if name != "ends":
+            check(problem, reference)  # the motion is consistent inside and meets every boundary value ...
+    with pytest.raises(ConformanceError, match=f"ω steps at {where}"):
+        CHECKS["ends"](problem, reference)  # ... but the rate steps by |c| = 1.1e-3 rad/s at an end
+    with pytest.raises(ConformanceError, match="steps"):
+        check_reference(problem, reference)
+
+
+def test_declared_steps_at_both_ends_pass_and_are_impulses_the_scoring_counts():
+    # The honest form: breakpoints at 0 and T, ω(0) the right limit, ω(T) = ωf after the stop.
+    from scenarios.requirements.scoring import rate_jumps
+
+    T = 500.0
+    problem, reference = _pinned_problem(T), PinnedEnds(T, (False, True), (0.0, T))
+    check_reference(problem, reference)
+    t = np.concatenate([np.linspace(0.0, T, 2001), [T + 1.0]])  # the scoring samples past T (closed-loop tail)
+    jumps = rate_jumps(t, reference.omega(t), problem.omega0, reference)
+    assert [time for time, _, _ in jumps] == [0.0, T]
+    np.testing.assert_allclose(jumps[0][2], PinnedEnds.RATE, atol=1e-15)
+    np.testing.assert_allclose(jumps[1][2], -PinnedEnds.RATE, atol=1e-15)

@@ -87,8 +87,8 @@ fig.tight_layout()
 # ================================ =================================== ==================================
 # co-state t_f                     "about the same" as 733.3 s         750.93 s = θ/ω_max
 # shape-based t_f, N = 1           733.3 s, "the lowest for all N"     901.8 s; the best is N = 5, 882.3 s
-# reference torque, co-state       of the order of the gravity         peak 7.2e-7 N m
-#                                  gradient
+# reference torque, co-state       of the order of the gravity         peak 7.2e-7 N m between its
+#                                  gradient                            rate steps (impulses: +inf)
 # reference torque, shape-based    "much larger"                       peak 2.7e-5 N m (N = 1),
 #                                                                      1.0e-4 N m (N = 5)
 # ================================ =================================== ==================================
@@ -109,20 +109,22 @@ with pd.option_context("display.float_format", "{:.4g}".format):
     print(pd.DataFrame(table).T.to_string())
 
 # %%
-# ``REPRODUCTION.md`` records a closed-loop ∫‖u‖ dt of 6.0e-3 (co-state), 7.5e-3 (N = 5) and
-# 6.1e-3 N m s (N = 1), and for the co-state path a 2.2e-3 N m torque peak and 0.029° of peak
-# tracking error caused by its rate steps at both ends (ω jumps between 0 and ω_max; the impulsive
-# torque is not in the reference's torque history, nor in the paper's Fig. 11). The law's
-# feed-forward puts each step into one 1 s hold, and the steps make up most of the co-state row's
-# ∫‖u‖: the co-state path is the fastest and, by a small margin over N = 1, also the cheapest in
-# closed loop. (Before that feed-forward the record read 6.7e-3 and 7.7e-3 N m s, 4.6e-4 N m and
-# 0.26°, and the co-state path was not the cheapest.)
+# The co-state rate is the control, of norm ω_max on all of (0, t_f): it steps from rest to ω_max
+# at the start and back at t_f (nor are those impulses in the paper's Fig. 11). The reference
+# declares both steps (breakpoints at 0 and t_f; its ω at 0 is the rate after the step), so its
+# reference peak body torque above is +inf, each step an impulse of 2.63e-3 N m s, and the row
+# breaks the actuator requirement. ``REPRODUCTION.md`` records a closed-loop ∫‖u‖ dt of 6.3e-3
+# (co-state), 7.5e-3 (N = 5) and 6.1e-3 N m s (N = 1): the law's feed-forward puts the stop into
+# the last 1 s hold (a 2.2e-3 N m torque peak), the feedback alone takes up the start (0.21° of
+# peak tracking error), and the co-state path is the fastest but not the cheapest in closed loop.
+# (While the reference's first sample read ω = 0, hiding the start step, the feed-forward spun the
+# body up in the first hold: 6.0e-3 N m s and 0.029°.)
 #
 # Figs. 9-13: quaternions, rates and reference torques
 # ----------------------------------------------------
 # The co-state path (solid) against the shape-based N = 1 polynomial (dashed); the reference
-# torques on a logarithmic scale (the co-state's rate steps at both ends are not in its torque
-# history).
+# torques on a logarithmic scale (the co-state's rate steps at both ends are impulses, not in its
+# torque history).
 fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
 for label, style in (("co-state min time", "-"), ("shape-based N=1", "--")):
     reference = acquisition[label].reference

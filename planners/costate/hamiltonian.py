@@ -131,6 +131,21 @@ class HamiltonianSystem(ABC):
         """
         return frozenset()
 
+    def breakpoints(self, t_f: float) -> Array:
+        """Times where the reference's rate may jump (``planners.Reference.breakpoints``).
+
+        Parameters
+        ----------
+        t_f : float
+            The solved final time [s].
+
+        Returns
+        -------
+        (K,) ndarray
+            Times [s] in ``[0, t_f]``; none by default (the torque forms integrate a bounded ``ω̇``).
+        """
+        return np.zeros(0)
+
     def __init__(self, problem: ManeuverProblem, t_f: float) -> None:
         self.problem, self.t_f_fixed = problem, t_f
         self.inertia = problem.spacecraft.inertia

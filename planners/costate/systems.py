@@ -282,8 +282,15 @@ class AttitudeAcquisitionSystem(HamiltonianSystem):
     ``λ̇_q = −½ Ω(ω)ᵀ λ_q`` (eq. 49). With ``minimum_time`` the target is met exactly and ``t_f`` is
     free (``H(t_f) = −1``, gauge ``λ_q·q = 0``, which the flow conserves); otherwise ``t_f = T`` with
     ``λ_q(t_f) = Q_f (q(t_f) − q_d)`` (eq. 51). The optimum is the constant-rate eigenaxis rotation
-    (a geodesic of the unit sphere); the rate steps from 0 to ``ω_max`` at the start and back at the
-    end, where the reference is at rest (the impulsive torque of those steps is not in the reference).
+    (a geodesic of the unit sphere).
+
+    The form is kinematic: the rate is the control and ``‖ω‖ = ω_max`` on all of ``(0, t_f)``, so
+    the paper's solution cannot meet the manoeuvre's rates ``ω0`` and ``ω_f`` (leaving their
+    tracking to the controller, section 6). The reference steps at both ends, and says so: its
+    breakpoints are ``0`` and ``t_f`` (:meth:`breakpoints`); its sample at 0 is the right limit
+    ``ω(0⁺) = ω_max u(0)``, so the jump from the manoeuvre's ``ω0`` is an impulse ``I Δω`` the
+    scoring sees, and its sample at ``t_f`` is ``ω_f`` (rest when the final rate is free), after the
+    stop, from which the reference coasts torque-free.
 
     Parameters
     ----------
@@ -313,18 +320,32 @@ class AttitudeAcquisitionSystem(HamiltonianSystem):
         self.rate = ca.Function("rate", [t, y], [rate, ca.mtimes(ca.jacobian(rate, y), self.rhs(t, y))])
 
     def free_boundary(self) -> frozenset[str]:
-        """The rate starts and ends at rest (non-zero boundary rates are not met); with a fixed
-        time the final attitude is a terminal cost.
+        """With a fixed time the final attitude is a terminal cost. The rates are not free: the
+        reference meets them across the jumps at its :meth:`breakpoints`, impulses the scoring
+        counts (a free ``ω0`` would exempt the start from the actuator requirement).
 
         Returns
         -------
         frozenset of str
-            ``"omega0"``/``"omegaf"`` when non-zero, plus ``"qf"`` for the fixed-time form.
+            ``{"qf"}`` for the fixed-time form, empty for the minimum-time one.
         """
-        p = self.problem
-        free = {name for name, rate in (("omega0", p.omega0), ("omegaf", p.omegaf))
-                if rate is not None and np.any(rate != 0)}
-        return frozenset(free | (set() if self.free_final_time else {"qf"}))
+        return frozenset() if self.free_final_time else frozenset({"qf"})
+
+    def breakpoints(self, t_f: float) -> Array:
+        """Both ends: the rate steps from ``ω0`` to ``ω_max u(0)`` at 0 and from ``ω_max u(t_f)`` to
+        ``ω_f`` at ``t_f`` (the control ``‖ω‖ = ω_max`` holds on the open interval only).
+
+        Parameters
+        ----------
+        t_f : float
+            The solved final time [s].
+
+        Returns
+        -------
+        (2,) ndarray
+            ``[0, t_f]`` [s].
+        """
+        return np.array([0.0, t_f])
 
     def equations(self, t: Any, y: Any, u: Any) -> tuple[Any, Any, Any]:
         q, lam_q = y[0:4], y[4:8]
@@ -362,9 +383,30 @@ class AttitudeAcquisitionSystem(HamiltonianSystem):
         return t_f, s, np.vstack([q.T, lam_q])
 
     def sample(self, t: Array, y: Array, t_f: float) -> ReferenceSample:
+        """The control rate ``ω_max u`` on ``[0, t_f)`` (the right limit at 0), and at ``t_f`` the
+        final rate ``ω_f`` (zero when free) with its torque-free ``ω̇``, where the coast after
+        ``t_f`` starts (see the class docstring).
+
+        Parameters
+        ----------
+        t : (N,) ndarray
+            Times [s] in ``[0, t_f]``.
+        y : (8, N) ndarray
+            ``[q, λ_q]`` at ``t``.
+        t_f : float
+            The final time [s].
+
+        Returns
+        -------
+        ReferenceSample
+            ``q``, ``ω``, ``ω̇`` and the inverse-dynamics torque at ``t``.
+        """
         rate, rate_dot = (a.full() for a in self.rate.map(t.size)(t, y))
-        at_rest = (t <= 0.0) | (t >= t_f)
-        rate[:, at_rest], rate_dot[:, at_rest] = 0.0, 0.0
+        end = t >= t_f
+        if np.any(end):
+            final = np.zeros(3) if self.problem.omegaf is None else np.asarray(self.problem.omegaf, dtype=float)
+            rate[:, end] = final[:, None]
+            rate_dot[:, end] = -np.linalg.solve(self.inertia, np.cross(final, self.inertia @ final))[:, None]
         omega, omega_dot = rate.T, rate_dot.T
         return ReferenceSample(quat.normalize(y[0:4].T), omega, omega_dot,
                                inverse_dynamics_torque(self.inertia, omega, omega_dot))

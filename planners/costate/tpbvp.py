@@ -90,7 +90,9 @@ FORMS: dict[str, Callable[..., HamiltonianSystem | str | None]] = {
 class CostateReference(Reference):
     """States and co-states from ``solve_bvp``'s C¹ interpolant on ``[0, t_f]``.
 
-    Declares the boundary conditions its form leaves free (``HamiltonianSystem.free_boundary``).
+    Declares the boundary conditions its form leaves free (``HamiltonianSystem.free_boundary``)
+    and the times where its rate jumps (``HamiltonianSystem.breakpoints``: the ends of attitude
+    acquisition, whose rate is the control).
 
     Parameters
     ----------
@@ -110,7 +112,7 @@ class CostateReference(Reference):
     def __init__(self, system: HamiltonianSystem, solution: Any, duration: float, message: str,
                  stats: dict[str, Any]) -> None:
         super().__init__("costate_tpbvp", duration, system.inertia, message=message, stats=stats,
-                         free_boundary=system.free_boundary())
+                         free_boundary=system.free_boundary(), breakpoints=system.breakpoints(duration))
         self.system, self.solution = system, solution
 
     def state_and_costate(self, t: ArrayLike) -> tuple[Array, Array]:
