@@ -282,11 +282,9 @@ def test_vepa_acquisition_row_counts_the_start_impulse():
     assert row.status != "ok"
 
 
-@pytest.mark.xfail(strict=True, reason="scenarios.runner's reference metrics look for rate jumps on [0, T] only "
-                                       "(scoring.rate_jumps takes breakpoints strictly inside the samples), so the "
-                                       "declared stop at T is not in int_u; the actuator requirement, which samples "
-                                       "past T, sees it")
 def test_vepa_acquisition_row_counts_the_stop_impulse_too():
+    # the reference's metrics sample [0, T]: the declared stop at T (a breakpoint at the last sample)
+    # is an impulse too, so int_u holds both ends' ||I dw|| beside the rate-as-control path's own
     case, row = _vepa_costate_row()
     assert row.reference_metrics["int_u"] > 2 * _start_impulse(case)
 

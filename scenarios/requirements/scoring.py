@@ -332,7 +332,9 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
     if np.linalg.norm(start) > JUMP_TOLERANCE and not declared:
         found.append((float(t[0]), 0, start))
     breakpoints = np.array([] if reference is None else reference.breakpoints, dtype=float)
-    breakpoints = breakpoints[(breakpoints > t[0]) & (breakpoints < t[-1])]
+    # a breakpoint at the last sample too (a stop at T sampled up to T: the reference's metrics); the
+    # sample after it is then the torque-free coast from the final state
+    breakpoints = breakpoints[(breakpoints > t[0]) & (breakpoints <= t[-1])]
     if breakpoints.size:
         assert reference is not None
         instant = 1e-9 * max(reference.duration, 1.0)
