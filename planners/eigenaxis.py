@@ -5,19 +5,24 @@
   peak rate (15 Θ / (8 T) from rest to rest) exceeds the rate bound.
 * ``trapezoidal``: bang-coast-bang over the scenario's T, rest to rest, with the largest
   acceleration the torque bounds allow; ``infeasible`` if T is shorter than the minimum time.
-* ``min_time``: the fastest bang-coast-bang under the torque and optional rate bounds.
+* ``min_time``: the fastest bang-coast-bang under the torque, wheel-momentum and optional rate
+  bounds.
 
 Every profile honours the rate bound (option ``max_rate``, else ``maneuver.max_rate``): the body
 rate is ``‖ω‖ = |θ̇|``.
 
-The body rate is ``ω = e θ̇`` and the feed-forward torque the inverse dynamics
-``I ω̇ + ω × I ω = I e θ̈ + θ̇² e × I e``; the second term is not zero off a principal axis, so the
-acceleration ``α`` is chosen with the coast rate ``w`` such that every actuator respects its bound
-through the controllers' allocation (``Spacecraft.allocation_rows``: ``|M τ| <= L`` row by row, a
-row per working wheel ``(A⁺)_i`` with its ``max_torque``, and the torquers' rows for what the wheels
-cannot give): ``|(M I e)_j| α + w² |(M (e × I e))_j| <= f L_j`` (``f`` the ``torque_fraction``).
-With wheels along the body axes ``M`` is the identity: the per-axis bound ``|(I e)_i| α + w² |(e ×
-I e)_i| <= u_i``.
+The body rate is ``ω = e θ̇`` and the feed-forward torque the rigid body's inverse dynamics
+``I ω̇ + ω × I ω = I e θ̈ + θ̇² e × I e`` (:class:`planners.Reference`'s contract). What the
+actuators must give is ``I ω̇ + ω × H``, ``H = I ω + A h_w`` the total angular momentum in body
+axes: the bang profiles choose the acceleration ``α`` and the coast rate ``w`` so that every row
+of the controllers' allocation (``Spacecraft.allocation_rows``: ``|M τ| <= L``, a row per working
+wheel ``(A⁺)_i`` with its ``max_torque``, and the torquers' rows for what the wheels cannot give)
+stays within ``f L`` (``f`` the ``torque_fraction``), and the working wheels' momenta within their
+``max_momentum``, along the whole profile (:class:`WheelBudget`). With wheels spanning three
+axes ``H`` is conserved and turns about ``e`` in the body (closed form; no gyroscopic term at all
+from rest with no stored momentum); without working wheels it is the rigid body's; with wheels
+spanning fewer axes beside torquers the demand is integrated and the profile stretched until it
+holds.
 """
 from __future__ import annotations
 
@@ -334,6 +339,231 @@ class EigenaxisReference(Reference):
         return ca.Function("reference", [t], [ca.vertcat(q, omega, omega_dot, torque)], ["t"], ["row"])
 
 
+def sinusoid_peak(const: Array, cos: Array, sin: Array, span: float) -> Array:
+    """``max |k + c cos θ + s sin θ|`` over ``θ ∈ [0, span]``, row by row (``span <= π``).
+
+    The extrema are at the ends or where the derivative vanishes, ``θ = atan2(s, c) (+ π)``.
+
+    Parameters
+    ----------
+    const, cos, sin : (m,) ndarray
+        ``k``, ``c`` and ``s`` per row.
+    span : float
+        The interval's length [rad], in ``[0, π]``.
+
+    Returns
+    -------
+    (m,) ndarray
+        The peak per row.
+    """
+    stationary = np.arctan2(sin, cos) % (2 * np.pi)
+    candidates = [np.zeros_like(cos), np.full_like(cos, span)]
+    for theta in (stationary, (stationary + np.pi) % (2 * np.pi)):
+        candidates.append(np.where(theta <= span, theta, 0.0))
+    return np.max([np.abs(const + cos * np.cos(t) + sin * np.sin(t)) for t in candidates], axis=0)
+
+
+class WheelBudget:
+    """What a rest-to-rest bang-coast-bang about a fixed axis asks of each allocation row.
+
+    The body torque the actuators must give is ``τ = I ω̇ + ω × H`` with ``H = I ω + A h_w`` the
+    total angular momentum, body axes (body and wheels, failed wheels' momentum included); the
+    allocation (:meth:`ocp.Spacecraft.allocation_rows`) gives the working wheels ``g = −A⁺ τ`` and
+    the rest, ``(1 − A A⁺) τ``, to the torquers. With ``ω = e θ̇`` each row ``j`` is bounded, for
+    ``|θ̈| <= α`` and ``|θ̇| <= w``, by ``|a_j| α + c_j w + g_j w² <= f L_j``:
+
+    * working wheels spanning three axes (torquers beside them are never asked): nothing torques
+      the spacecraft from outside, ``H`` is constant in inertial axes and turns about ``e`` in the
+      body, ``H(θ) = R_e(−θ) H_0``, so ``τ = I e θ̈ + θ̇ e × H(θ)`` (the body's ``ω × I ω`` is part of
+      ``ω × H``): ``a = M I e``, ``g = 0`` and ``c_j`` the peak of ``|M_j e × H(θ)|`` over the
+      rotation ``θ ∈ [0, Θ]`` (a sinusoid in θ: :func:`sinusoid_peak`). Exact when ``H_0 = 0``
+      (``|a_j| α <= f L_j``: the wheels' torque is ``A⁺ I e θ̈``); with stored momentum, sound
+      (``θ̇ <= w`` and the peak over the rotation taken together). The working wheels' momenta,
+      ``h_w(θ) = h_w0 + A⁺ (H(θ) − H_0) − A⁺ I e θ̇``, bound the coast rate the same way (exact
+      with ``H_0 = 0``: ``w <= h_max,i / |(A⁺ I e)_i|``).
+    * no working wheel (torquers only, or every wheel failed): ``A h_w`` is the failed wheels'
+      constant ``W_0`` and ``τ = I e θ̈ + θ̇² e × I e + θ̇ e × W_0``: ``a = M I e``,
+      ``g = |M (e × I e)|``, ``c = |M (e × W_0)|``; exact when ``W_0 = 0`` (one of the two bangs
+      adds the gyroscopic term at the coast rate).
+    * wheels spanning fewer than three axes (beside torquers, which change ``H``): the rows of the
+      first case are an estimate, not a bound (:attr:`exact` is False): :meth:`integrated_ratios`
+      measures the profile's demand, and the planner shrinks the budget until it holds.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre: the spacecraft and the initial wheel momenta (a non-zero initial rate, which
+        the bang profiles do not meet, is taken up by the wheels as the allocation does,
+        ``Δ(A h_w) = A A⁺ I ω_0``).
+    axis : (3,) ndarray
+        Unit Euler axis ``e``, body axes.
+    angle : float
+        Θ [rad], in ``[0, π]``.
+    fraction : float
+        ``f``, the share of each torque bound the profile may use.
+    scale : float, optional
+        A further factor on the torque bounds (the planner's shrinking; default 1).
+
+    Attributes
+    ----------
+    bounds : (m,) ndarray
+        ``f L`` (times ``scale``) [N m].
+    accel, quadratic, linear : (m,) ndarray
+        ``M I e`` (signed), ``g`` and ``c`` per row.
+    exact : bool
+        Whether the rows bound the demand (False: wheels spanning fewer than three axes).
+    torque_rate_cap : float
+        The largest coast rate at which the rate terms alone stay within the bounds [rad/s].
+    momentum_rate_cap : float
+        The largest coast rate the wheels' momentum bounds allow [rad/s] (``inf`` without one; 0
+        when the rotation itself breaks it; an estimate when :attr:`exact` is False).
+    uncounted : str
+        For messages: what gives no torque off the working wheels' span (empty when every row has
+        a bound).
+    """
+
+    def __init__(self, problem: ManeuverProblem, axis: Array, angle: float, fraction: float,
+                 scale: float = 1.0) -> None:
+        spacecraft = problem.spacecraft
+        inertia = spacecraft.inertia
+        rows, limits = spacecraft.allocation_rows()
+        self.problem, self.axis, self.angle, self.rows = problem, axis, angle, rows
+        self.limits = limits
+        self.bounds = fraction * scale * limits
+        wheels = spacecraft.wheels
+        axes = spacecraft.wheel_axes
+        h0 = np.asarray(problem.initial_state[7:], dtype=float)
+        self.working = np.zeros(0, bool) if wheels is None else wheels.working
+        working_axes = axes * self.working
+        self.pinv = np.linalg.pinv(working_axes)[self.working] if np.any(self.working) else np.zeros((0, 3))
+        self.projector = working_axes @ np.linalg.pinv(working_axes) if np.any(self.working) else np.zeros((3, 3))
+        momentum0 = axes @ h0 + self.projector @ inertia @ problem.omega0  # A h_w at the start of the profile
+        self.wheel_momentum0 = momentum0
+        self.h0 = h0[self.working] + self.pinv @ inertia @ problem.omega0
+        self.h_max = np.zeros(0) if wheels is None else wheels.max_momentum[self.working]
+        inertia_axis = inertia @ axis
+        self.exact = bool(np.allclose(self.projector, np.eye(3), atol=1e-9)) or not np.any(self.working)
+        self.accel = rows @ inertia_axis
+        if np.any(self.working):  # H conserved, turning about e (an estimate when not exact)
+            parallel = axis * (axis @ momentum0)
+            self.quadratic = np.zeros(len(rows))
+            self.linear = sinusoid_peak(np.zeros(len(rows)), rows @ np.cross(axis, momentum0),
+                                        rows @ (momentum0 - parallel), angle)
+            across = momentum0 - parallel  # h_w(θ) = h0 + A⁺((cos θ − 1) H⊥ − sin θ e × H0) − A⁺ I e θ̇
+            peak = sinusoid_peak(self.h0 - self.pinv @ across, self.pinv @ across,
+                                 -self.pinv @ np.cross(axis, momentum0).astype(float), angle)
+            per_rate = np.abs(self.pinv @ inertia_axis)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                caps = np.where(per_rate > 1e-12 * np.linalg.norm(inertia_axis),
+                                (self.h_max - peak) / per_rate, np.where(peak <= self.h_max, np.inf, 0.0))
+            self.momentum_rate_cap = float(max(np.min(caps, initial=np.inf), 0.0))
+        else:
+            self.quadratic = np.abs(rows @ np.cross(axis, inertia_axis))
+            self.linear = np.abs(rows @ np.cross(axis, momentum0))
+            self.momentum_rate_cap = np.inf
+        # A row no actuator gives (limit 0, a projector's): its rounding is no demand on it.
+        given = limits > 0
+        scale_rows = np.linalg.norm(rows, axis=1)
+        for values, size in ((self.accel, np.linalg.norm(inertia_axis)),
+                             (self.quadratic, np.linalg.norm(np.cross(axis, inertia_axis))),
+                             (self.linear, np.linalg.norm(momentum0))):
+            values[~given & (np.abs(values) <= 1e-12 * scale_rows * size)] = 0.0
+        self.accel[np.abs(self.accel) <= 1e-12 * np.max(np.abs(self.accel), initial=0.0)] = 0.0
+        self.torque_rate_cap = float(min((_positive_root(g, c, b) for g, c, b in
+                                          zip(self.quadratic, self.linear, self.bounds)), default=np.inf))
+        sink = [a.name for a in spacecraft.actuators if a.residual_rank is not None]
+        self.uncounted = "" if np.all(limits > 0) else (
+            " (off the working wheels' span only magnetorquers act, whose torque depends on the field and "
+            "is never along it: the eigenaxis budget counts them as none)" if "magnetorquers" in sink
+            and "torquers" not in sink else " (off the working wheels' span no actuator gives torque)")
+
+    def margin(self, coast_rate: float) -> Array:
+        """What is left of each row's bound for the acceleration.
+
+        Parameters
+        ----------
+        coast_rate : float
+            ``w`` [rad/s].
+
+        Returns
+        -------
+        (m,) ndarray
+            ``f L − c w − g w²`` per row, what is left for ``|a| α`` [N m].
+        """
+        return self.bounds - coast_rate * self.linear - coast_rate**2 * self.quadratic
+
+    def integrated_ratios(self, profile: BangCoastBangProfile, step_angle: float = 0.002) -> tuple[float, float]:
+        """The profile's peak demand on the allocation rows and the working wheels' momenta, by
+        integration of ``d(A h_w)/dt = −A A⁺ τ``, ``τ = I e θ̈ + θ̇² e × I e + θ̇ e × A h_w``.
+
+        Classical Runge-Kutta on each phase, in steps over which the body turns at most
+        ``step_angle``; the demand is read at the steps' ends.
+
+        Parameters
+        ----------
+        profile : BangCoastBangProfile
+            The rest-to-rest profile about :attr:`axis`.
+        step_angle : float, optional
+            The most the body turns in a step [rad].
+
+        Returns
+        -------
+        torque_ratio, momentum_ratio : float
+            ``max |M τ| / (f L)`` (scaled bounds: :attr:`bounds`; ``inf`` where a row of bound 0 is
+            asked more than rounding) and ``max |h_w| / h_max`` over the working wheels (0 without
+            a bound).
+        """
+        axis, inertia = self.axis, self.problem.spacecraft.inertia
+        inertia_axis = inertia @ axis
+        spin = np.cross(axis, inertia_axis)
+        phases = [(profile.ramp, profile.alpha), (profile.coast, 0.0), (profile.ramp, -profile.alpha)]
+        momentum = self.wheel_momentum0.copy()
+        start, rate0 = 0.0, 0.0
+        torques, momenta = [], []
+
+        def torque(rate: float, accel: float, w: Array) -> Array:
+            return inertia_axis * accel + rate**2 * spin + rate * np.cross(axis, w)
+
+        for length, accel in phases:
+            if length <= 0:
+                continue
+            peak_rate = max(abs(rate0), abs(rate0 + accel * length))
+            steps = max(8, int(np.ceil(peak_rate * length / step_angle)))
+            dt = length / steps
+            torques.append(torque(rate0, accel, momentum))
+            for k in range(steps):
+                r0 = rate0 + accel * k * dt
+                r1, r2 = r0 + 0.5 * accel * dt, r0 + accel * dt
+                k1 = -self.projector @ torque(r0, accel, momentum)
+                k2 = -self.projector @ torque(r1, accel, momentum + 0.5 * dt * k1)
+                k3 = -self.projector @ torque(r1, accel, momentum + 0.5 * dt * k2)
+                k4 = -self.projector @ torque(r2, accel, momentum + dt * k3)
+                momentum = momentum + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+                torques.append(torque(r2, accel, momentum))
+                momenta.append(momentum)
+            rate0 = rate0 + accel * length
+            start += length
+        demand = np.abs(np.array(torques) @ self.rows.T)
+        size = np.linalg.norm(self.rows, axis=1) * np.max(np.linalg.norm(torques, axis=1))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(self.bounds > 0, demand / self.bounds, np.where(demand > 1e-9 * size, np.inf, 0.0))
+        h = self.h0 + (np.array(momenta) - self.wheel_momentum0) @ self.pinv.T if momenta else np.zeros((1, 0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            h_ratio = np.where(np.isfinite(self.h_max), np.abs(h) / self.h_max, 0.0)
+        return float(np.max(ratio, initial=0.0)), float(np.max(h_ratio, initial=0.0))
+
+
+def _positive_root(quadratic: float, linear: float, bound: float) -> float:
+    """The largest ``w >= 0`` with ``g w² + c w <= b`` (``inf`` when neither term grows)."""
+    if quadratic <= 0 and linear <= 0:
+        return np.inf
+    if bound <= 0:
+        return 0.0
+    if quadratic <= 0:
+        return bound / linear
+    return float(2 * bound / (linear + np.sqrt(linear**2 + 4 * quadratic * bound)))
+
+
 class EigenaxisPlanner(Planner):
     """Eigenaxis slew planner; see the module docstring for the profiles."""
 
@@ -377,7 +607,8 @@ class EigenaxisPlanner(Planner):
             never loosens it; ``None`` (default): the problem's (if any).
         torque_fraction : float
             Share of each actuator's torque bound (each wheel's ``max_torque`` through ``g = −A⁺ τ``,
-            the torquers' per axis) the bang profiles may use, in (0, 1]; default 1.
+            the torquers' per axis) the bang profiles may use, in (0, 1]; default 1. The wheels'
+            ``max_momentum`` caps the coast rate whole.
         """
 
         profile: Literal["smooth", "trapezoidal", "min_time"] = "smooth"
@@ -437,59 +668,116 @@ class EigenaxisPlanner(Planner):
                                        "infeasible")
             return EigenaxisReference(problem.q0, axis, quintic, problem.duration, inertia,
                                       f"quintic, {np.rad2deg(angle):.2f} deg about {np.round(axis, 4).tolist()}", problem)
-        # The torque I e θ̈ + θ̇² e × I e through the controllers' allocation: |M τ| <= L row by row
-        # (Spacecraft.allocation_rows; with wheels along the body axes, M = 1 and L their limits).
-        rows, limits = problem.spacecraft.allocation_rows()
-        bounds = self.options.torque_fraction * limits
-        accel_axis = rows @ (inertia @ axis)
-        gyro = np.abs(rows @ np.cross(axis, inertia @ axis))
-        # A row no actuator gives (limit 0, a projector's): its rounding is no demand on it.
-        given = limits > 0
-        scale = np.linalg.norm(rows, axis=1)
-        gyro[~given & (gyro <= 1e-12 * scale * np.linalg.norm(np.cross(axis, inertia @ axis)))] = 0.0
-        accel_axis[~given & (np.abs(accel_axis) <= 1e-12 * scale * np.linalg.norm(inertia @ axis))] = 0.0
+        if angle < 1e-12:
+            return EigenaxisReference(problem.q0, axis, BangCoastBangProfile(0.0, 1.0, 0.0), problem.duration if self.options.profile
+                                      == "trapezoidal" else 0.0, inertia, "no rotation needed", problem)
+        budget = WheelBudget(problem, axis, angle, self.options.torque_fraction)
+        if budget.exact:
+            return self._bang(problem, axis, angle, max_rate, budget, self.options.profile)
+        # Wheels spanning fewer than three axes (beside torquers): the wheels' momentum moves with
+        # what the torquers give, not as a conserved total, and the budget is an estimate. Plan the
+        # fastest profile under it, measure its demand through the allocation by integration, and
+        # stretch it in time by k (α/k², w/k): from zero initial wheel momentum every torque then
+        # scales by 1/k² and every momentum by 1/k exactly, so one stretch meets the worst bound.
+        fastest = self._bang(problem, axis, angle, max_rate, budget, "min_time")
+        if not isinstance(fastest, EigenaxisReference):
+            return fastest
+        profile = fastest.profile
+        assert isinstance(profile, BangCoastBangProfile)
+        stretched = 1.0
+        for _ in range(20):
+            torque_ratio, momentum_ratio = budget.integrated_ratios(profile)
+            if not (np.isfinite(torque_ratio) and np.isfinite(momentum_ratio)):
+                return FailedReference(self.name, f"the profile about {axis.round(4).tolist()} asks a torque off the "
+                                       f"working wheels' span{budget.uncounted}", "infeasible")
+            stretch = max(np.sqrt(torque_ratio), momentum_ratio)
+            if stretch <= 1 + 1e-9:
+                break
+            stretch *= 1 + 1e-9
+            stretched *= stretch
+            profile = BangCoastBangProfile(angle, profile.alpha / stretch**2, profile.rate_max / stretch)
+        else:
+            return FailedReference(self.name, "the bang-coast-bang profile's demand, measured by integration, "
+                                   "stayed above the bounds after 20 stretches", "infeasible")
+        # Without torquers nothing torques the spacecraft from outside (H conserved: the budget was
+        # exact); with them an unstretched profile is feasible but not proven the fastest.
+        torquers = bool(np.any(budget.limits[len(budget.h0):] > 0))
+        words = "verified by integration through the allocation: the working wheels span fewer than three axes"
+        if stretched > 1:
+            words += f"; stretched {stretched:.4g} x in time to meet the bounds, feasible, not the minimum time"
+        elif torquers:
+            words += "; feasible, not proven the minimum time (the torquers change the total momentum)"
+        if self.options.profile == "min_time":
+            return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,
+                                      f"minimum time {profile.duration:.3f} s, coast rate {profile.rate_max:.4g} "
+                                      f"rad/s ({words})", problem)
+        if problem.duration < profile.duration * (1 - 1e-12):
+            return FailedReference(self.name, f"T = {problem.duration:g} s is shorter than the fastest bang-coast-bang "
+                                   f"this planner verifies, {profile.duration:.4g} s ({words})", "infeasible")
+        stretch = problem.duration / profile.duration
+        slower = BangCoastBangProfile(angle, profile.alpha / stretch**2, profile.rate_max / stretch)
+        if max(budget.integrated_ratios(slower)) > 1 + 1e-9:
+            return FailedReference(self.name, f"the bang-coast-bang over T = {problem.duration:g} s, stretched from "
+                                   f"the fastest verified one ({profile.duration:.4g} s), exceeds a bound", "infeasible")
+        slower.coast = problem.duration - 2 * slower.ramp
+        slower.duration = problem.duration
+        return EigenaxisReference(problem.q0, axis, slower, problem.duration, inertia,
+                                  f"bang-coast-bang, coast rate {slower.rate_max:.4g} rad/s (the fastest verified "
+                                  f"profile stretched to T; {words})", problem)
+
+    def _bang(self, problem: ManeuverProblem, axis: Array, angle: float, max_rate: float | None,
+              budget: WheelBudget, profile_name: str) -> Reference:
+        """The bang-coast-bang profile ``profile_name`` (``trapezoidal`` or ``min_time``) under ``budget``."""
+        inertia = problem.spacecraft.inertia
+        accel_axis, quadratic, linear = budget.accel, budget.quadratic, budget.linear
+        active = np.abs(accel_axis) > 0
 
         def acceleration(coast_rate: float) -> float:
             """Largest α with every row within its bound while coasting at ``coast_rate``."""
-            margin = bounds - coast_rate**2 * gyro
-            active = np.abs(accel_axis) > 1e-12 * np.max(np.abs(accel_axis))
+            margin = budget.margin(coast_rate)
             if np.any(margin < 0) or np.any(margin[active] <= 0):
                 return 0.0
             return float(np.min(margin[active] / np.abs(accel_axis[active])))
 
-        if angle < 1e-12:
-            profile = BangCoastBangProfile(0.0, 1.0, 0.0)
-            return EigenaxisReference(problem.q0, axis, profile, problem.duration if self.options.profile
-                                      == "trapezoidal" else 0.0, inertia, "no rotation needed", problem)
-        if acceleration(0.0) <= 0:
-            return FailedReference(self.name, f"the actuators give no torque about the axis {axis.round(4).tolist()}",
-                                   "infeasible")
-        rate_cap = max_rate if max_rate is not None else np.inf
-        if np.any(gyro > 0):
-            rate_cap = min(rate_cap, float(np.sqrt(np.min(bounds[gyro > 0] / gyro[gyro > 0]))))
+        if not np.any(active) or acceleration(0.0) <= 0:
+            return FailedReference(self.name, f"the actuators give no torque about the axis {axis.round(4).tolist()}"
+                                   f"{budget.uncounted}", "infeasible")
+        momentum_cap = budget.momentum_rate_cap
+        rate_cap = min(max_rate if max_rate is not None else np.inf, budget.torque_rate_cap, momentum_cap)
+        if rate_cap <= 0:
+            why = ("the stored momentum, turning in the body with the rotation, takes a working wheel beyond "
+                   "its max_momentum" if momentum_cap <= 0 else
+                   f"the gyroscopic torque of any rate asks what the actuators cannot give{budget.uncounted}")
+            return FailedReference(self.name, f"no rotation about the axis {axis.round(4).tolist()} is feasible: "
+                                   f"{why}", "infeasible")
 
         def slew_time(coast_rate: float) -> float:
             alpha = acceleration(coast_rate)
-            if alpha <= 0:
+            if alpha <= 0 or coast_rate <= 0:
                 return np.inf
             return angle / coast_rate + coast_rate / alpha if coast_rate**2 / alpha <= angle else 2 * np.sqrt(angle / alpha)
 
-        # With no gyroscopic term the optimum is the triangle w = sqrt(Θ α); else a bounded 1-D search.
+        # With no rate-dependent term the optimum is the triangle w = sqrt(Θ α); else a bounded 1-D search.
         peak = np.sqrt(angle * acceleration(0.0))
-        if np.all(gyro == 0) or not np.isfinite(rate_cap):
+        if (np.all(quadratic == 0) and np.all(linear == 0)) or not np.isfinite(rate_cap):
             best_rate = min(peak, rate_cap)
         else:
             best_rate = golden_section_minimum(slew_time, 1e-9 * peak, min(peak, rate_cap), 1e-12 * peak)
         best_rate = min(best_rate, np.sqrt(angle * acceleration(best_rate)))  # a triangle never coasts faster
         minimum_time = slew_time(best_rate)
-        if self.options.profile == "min_time":
+        momentum_words = (", capped by the wheels' momentum bound" if np.isfinite(momentum_cap)
+                          and best_rate >= momentum_cap * (1 - 1e-9) else "")
+        if profile_name == "min_time":
             profile = BangCoastBangProfile(angle, acceleration(best_rate), best_rate)
             return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,
-                                      f"minimum time {profile.duration:.3f} s, coast rate {best_rate:.4g} rad/s", problem)
+                                      f"minimum time {profile.duration:.3f} s, coast rate {best_rate:.4g} rad/s"
+                                      f"{momentum_words}", problem)
         if problem.duration < minimum_time * (1 - 1e-12):
             bounds_words = "the torque bounds"
             if max_rate is not None and best_rate >= max_rate * (1 - 1e-9):  # the rate bound caps the coast
                 bounds_words += f" and the rate bound {max_rate:g} rad/s ({self._rate_source(problem)})"
+            if momentum_words:
+                bounds_words += " and the wheels' momentum bound"
             return FailedReference(self.name, f"T = {problem.duration:g} s is shorter than the minimum "
                                    f"bang-coast-bang time {minimum_time:.4g} s under {bounds_words}", "infeasible")
         # Fixed T: the slowest coast rate w with w (T − w/α(w)) = Θ.

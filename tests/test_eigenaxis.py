@@ -40,7 +40,12 @@ def test_feedforward_torque_is_the_inverse_dynamics_of_the_attitude(profile, rng
     t = np.linspace(0.03, 0.97, 37) * reference.duration
     omega_fd, torque_fd = finite_difference_torque(reference, spacecraft.inertia, t)
     sample = reference.sample(t)
-    np.testing.assert_allclose(sample.omega, omega_fd, atol=1e-8)
+    # ω by central differences of q is O(h²) only where θ̇ is smooth: not within h = 1e-3 s of a
+    # switch (the apex of a triangle profile, at T/2, is one of the samples)
+    switches = np.asarray(reference.breakpoints, dtype=float).reshape(-1)
+    away = np.min(np.abs(t[:, None] - switches[None, :]), axis=1, initial=np.inf) > 2e-3
+    assert away.mean() > 0.9
+    np.testing.assert_allclose(sample.omega[away], omega_fd[away], atol=1e-8)
     scale = np.max(np.abs(sample.torque))
     smooth = np.all(np.abs(sample.torque - torque_fd) < 1e-5 * scale, axis=1)
     assert smooth.mean() > 0.9  # only samples within h of a switch may differ
@@ -66,7 +71,9 @@ def test_bang_coast_bang_respects_torque_and_rate_bounds_off_axis(rng):
     for profile in ("trapezoidal", "min_time"):
         reference = PLANNERS["eigenaxis"]({"profile": profile}).plan(problem)
         sample = reference.sample(np.linspace(0, reference.duration, 20001))
-        assert np.max(np.abs(sample.torque)) <= 0.05 * (1 + 1e-9)
+        # wheels along the body axes, from rest at zero momentum: the total momentum stays zero and
+        # the wheels' torque is −I ω̇ (the body's ω × I ω is their own −ω × A h_w)
+        assert np.max(np.abs(sample.omega_dot @ spacecraft.inertia.T)) <= 0.05 * (1 + 1e-9)
         assert np.max(np.linalg.norm(sample.omega, axis=1)) <= 0.02 * (1 + 1e-9)
 
 
