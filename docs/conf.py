@@ -9,7 +9,8 @@ Before the build, this file writes the pages that the code produces (all of them
 * ``reference/schema.rst``: the scenario schema, from ``scenarios.schema.reference.schema_rst()``;
 * ``api/``: one page per package and subpackage, documenting exactly the names of its ``__all__``;
 * ``_generated/*.inc``: fragments included by the hand-written pages: the metric table (from
-  ``ocp.metrics.METRIC_INFO``) and the file layouts and names of the outputs (from
+  ``ocp.metrics.METRIC_INFO``), the requirement fields' table (from
+  ``scenarios.requirements.fields.REQUIREMENT_FIELDS``) and the file layouts and names of the outputs (from
   ``scenarios.output`` and ``scenarios.study``).
 
 Nothing here reaches the network: no intersphinx, no remote images.
@@ -296,6 +297,21 @@ def write_metric_table() -> None:
     _write(DOCS / "_generated" / "metric_table.inc", "\n".join(lines) + "\n")
 
 
+def write_requirement_field_table() -> None:
+    """``_generated/requirement_fields.inc``: a list table of
+    ``scenarios.requirements.fields.REQUIREMENT_FIELDS`` (a pointing requirement's fields under
+    ``<name>``, the others under the requirement's own name)."""
+    from scenarios.requirements.fields import REQUIREMENT_FIELDS
+
+    lines = [".. list-table::", "   :header-rows: 1", "   :widths: 28 8 8 56", "",
+             "   * - field", "     - unit", "     - scopes", "     - definition"]
+    for info in REQUIREMENT_FIELDS:
+        name = "<name>" if info.requirement == "pointing" else info.requirement
+        lines += [f"   * - ``{name}.{info.field}``", f"     - {info.unit}",
+                  f"     - {', '.join(info.scopes)}", f"     - {_escape_bars(info.meaning)}"]
+    _write(DOCS / "_generated" / "requirement_fields.inc", "\n".join(lines) + "\n")
+
+
 # -- the outputs ------------------------------------------------------------------------------------
 
 def _timeseries_header() -> list[str]:
@@ -341,6 +357,7 @@ def write_output_fragments() -> None:
 write_schema_reference()
 write_api_pages()
 write_metric_table()
+write_requirement_field_table()
 write_output_fragments()
 
 

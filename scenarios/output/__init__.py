@@ -14,7 +14,8 @@ run into other tools' formats (:mod:`~scenarios.output.export`, the ``EXPORT_FOR
 CCSDS attitude ephemeris messages in :mod:`~scenarios.output.aem`; a reference as Basilisk's
 ``waypointReference`` data file in :mod:`~scenarios.output.basilisk`).
 
-May import: :mod:`ocp`, :mod:`planners` (types), :mod:`scenarios.errors` and
+May import: :mod:`ocp`, :mod:`planners` (types), :mod:`scenarios.errors`,
+:mod:`scenarios.requirements.fields` (the requirement fields' units and words: plain data) and
 :mod:`scenarios.schema`. :mod:`~scenarios.output.plots` and :mod:`~scenarios.output.renderer` import
 no model (the plot process starts before it is loaded), so this face imports its names on first
 use.

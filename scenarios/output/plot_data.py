@@ -18,6 +18,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from scenarios.requirements.fields import field_info
+
 DPI = 90
 """Resolution of every PNG [dots per inch]."""
 ROW_WIDTH_IN = 10.0
@@ -1207,13 +1209,6 @@ METRIC_NAMES = {"int_u2": "∫‖u‖² dt", "int_u": "∫‖u‖ dt", "int_abs_
                 "int_dipole": "∫‖m‖ dt", "rms_error_deg": "RMS error", "duration_s": "manoeuvre time",
                 "plan_time_s": "plan time"}
 """Metrics whose key does not read as words (the others: the key without its unit suffix, spaced)."""
-REQUIREMENT_FIELDS = {"min_margin_deg": ("min margin", "deg"), "time_in_violation_s": ("time in violation", "s"),
-                      "first_violation_s": ("first violation", "s"), "min_margin_time_s": ("time of min margin", "s"),
-                      "peak_rate": ("peak rate", "rad/s"), "peak_time_s": ("time of peak rate", "s"),
-                      "ratio": ("peak rate / bound", "–"), "worst_error_deg": ("worst final error", "deg"),
-                      "worst_rate_error": ("worst final rate error", "rad/s"), "from_s": ("final window start", "s")}
-"""Words and unit of each requirement field (the requirements' columns, ``<scope>.req.<name>.<field>``); the
-``actuators`` fields are ``<quantity>`` (peak demand over the limit, –) and ``<quantity>_time_s``."""
 
 
 def _words(key: str) -> str:
@@ -1236,13 +1231,14 @@ def column_quantity(column: str) -> tuple[str, str]:
         For example ``"closed-loop final error"``, ``"reference ∫‖u‖ dt"``, ``"closed-loop st_sun:
         min margin"``.
     unit : str
-        Its unit (:data:`ocp.metrics.METRIC_INFO`, or the requirement field's): ``"deg"``,
+        Its unit (:data:`ocp.metrics.METRIC_INFO`, or the requirement field's,
+        :func:`~scenarios.requirements.fields.field_info`): ``"deg"``,
         ``"N m s"``, ``"–"`` for a ratio.
 
     Raises
     ------
     KeyError
-        A column that is none of these.
+        A column that is none of these (a requirement column whose requirement has no such field too).
     """
     from ocp.metrics import METRIC_INFO  # the metric table (plain data)
 
@@ -1253,14 +1249,9 @@ def column_quantity(column: str) -> tuple[str, str]:
         raise KeyError(f"not a result column: {column!r}")
     prefix = SCOPE_NAMES[scope]
     if rest.startswith("req."):
-        _, name, field_name = rest.split(".", 2)
-        if field_name in REQUIREMENT_FIELDS:
-            words, unit = REQUIREMENT_FIELDS[field_name]
-        elif field_name.endswith("_time_s"):
-            words, unit = f"time of peak {field_name[:-len('_time_s')].replace('_', ' ')}", "s"
-        else:
-            words, unit = f"peak {field_name.replace('_', ' ')} / limit", "–"
-        return f"{prefix} {name}: {words}", unit
+        name = rest.split(".")[1]
+        info = field_info(column)  # the requirement fields' one declaration; KeyError for no such field
+        return f"{prefix} {name}: {info.words}", info.unit
     key, axis = rest, ""
     if key not in METRIC_INFO and key[-2:] in ("_x", "_y", "_z") and key[:-2] in METRIC_INFO:
         key, axis = key[:-2], key[-1]

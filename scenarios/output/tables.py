@@ -25,6 +25,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
+from scenarios.requirements.fields import field_info
 from scenarios.schema.columns import (
     AXES,
     REQUIREMENT_MARK,
@@ -42,8 +43,8 @@ if TYPE_CHECKING:
 
 __all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "IDENTITY_COLUMNS", "ROW_STATUSES", "csv_cell", "csv_text",
            "data_frame", "flatten_row", "html_table", "is_missing", "json_safe", "numeric_columns",
-           "requirement_columns", "row_columns", "status_line", "text_cell", "to_csv", "to_dataframe", "to_json",
-           "to_markdown", "to_terminal"]
+           "requirement_columns", "requirement_units", "row_columns", "status_line", "text_cell", "to_csv",
+           "to_dataframe", "to_json", "to_markdown", "to_terminal"]
 
 IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s")
 """The columns that name a row, before its metrics."""
@@ -431,6 +432,46 @@ def status_line(results: RunResults) -> str:
     return f"rows: {len(results.rows)} (" + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")"
 
 
+def requirement_units(columns: Iterable[str]) -> str:
+    """The units of some requirement columns, in words (the units line of ``results.md``).
+
+    Each field's unit is its declaration's (:func:`scenarios.requirements.fields.field_info`); the
+    fields named ``*_deg`` in degrees and ``*_s`` in seconds are said once by their suffix, the
+    others by name under their unit, a ratio with what it divides.
+
+    Parameters
+    ----------
+    columns : iterable of str
+        Requirement columns (``ref.req.<name>.<field>``, ``cl.req.<name>.<field>``).
+
+    Returns
+    -------
+    str
+        For example ``requirement fields: *_deg deg, *_s s; rad/s: peak_rate; ratios (–): ratio
+        (peak rate / bound)``; empty for no column.
+    """
+    suffixes: dict[str, None] = {}
+    named: dict[str, dict[str, None]] = {}
+    for column in columns:
+        field = column.split(".")[-1]
+        try:
+            info = field_info(column)
+        except KeyError:  # a field the declaration lacks (tests/test_requirement_fields.py holds it complete)
+            named.setdefault("no declared unit", {}).setdefault(field)
+            continue
+        suffix = {"deg": "_deg", "s": "_s"}.get(info.unit)
+        if suffix is not None and field.endswith(suffix):
+            suffixes.setdefault(f"*{suffix} {info.unit}")
+        elif info.unit == "–":
+            named.setdefault("ratios", {}).setdefault(f"{field} ({info.words})")
+        else:
+            named.setdefault(info.unit, {}).setdefault(field)
+    ratios = named.pop("ratios", {})
+    parts = ([", ".join(suffixes)] if suffixes else []) + [f"{unit}: {', '.join(fields)}" for unit, fields in named.items()]
+    parts += [f"ratios (–): {', '.join(ratios)}"] if ratios else []
+    return "requirement fields: " + "; ".join(parts) if parts else ""
+
+
 def to_markdown(results: RunResults) -> str:
     """``results.md``: one column per row (planner), one line per metric, then the messages.
 
@@ -448,8 +489,9 @@ def to_markdown(results: RunResults) -> str:
     out = [f"# {results.scenario.name}", "", "| metric | " + " | ".join(labels) + " |",
            "|---|" + "---|" * len(labels)]
     out += [f"| {name} | " + " | ".join(cells) + " |" for name, cells in _metric_lines(results)]
-    out += ["", ("Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s; "
-                 "actuator requirement fields: peak demand over the limit."), "", status_line(results), ""]
+    units = "Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s"
+    fields = requirement_units(requirement_columns([{"requirements": row.requirements} for row in results.rows]))
+    out += ["", f"{units}. {fields[:1].upper()}{fields[1:]}." if fields else f"{units}.", "", status_line(results), ""]
     out += [f"- **{row.label}** ({row.planner or 'regulation'}, {row.controller or '-'}): {row.message}"
             for row in results.rows]
     return "\n".join(out) + "\n"

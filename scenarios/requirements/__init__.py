@@ -5,7 +5,8 @@ build (:mod:`~scenarios.requirements.spec`: sensors, pointing cones about a regi
 an inertial vector, the actuator margin, the body-rate limit, the final error) and the scoring of a
 row against them (:mod:`~scenarios.requirements.scoring`: the reference on its dense sampling, its
 actuator demand through the row's controller's allocation, the closed loop on its samples and its
-pointing between them, the end points before planning). The schema reads them (:mod:`scenarios.schema.requirements`), the runner
+pointing between them, the end points before planning), and what each field of a score holds: its
+unit, words and definition (:mod:`~scenarios.requirements.fields`, plain data). The schema reads them (:mod:`scenarios.schema.requirements`), the runner
 turns the scores into statuses and messages.
 
 May import: :mod:`ocp`, :mod:`planners`, :mod:`controllers` and :mod:`scenarios.errors`; nothing else
@@ -21,12 +22,16 @@ _HOMES = {"ActuatorRequirement": "scenarios.requirements.spec",
           "PointingRequirement": "scenarios.requirements.spec",
           "RateRequirement": "scenarios.requirements.spec",
           "Requirements": "scenarios.requirements.spec",
+          "REQUIREMENT_FIELDS": "scenarios.requirements.fields",
+          "RequirementField": "scenarios.requirements.fields",
           "Score": "scenarios.requirements.scoring",
           "Sensor": "scenarios.requirements.spec",
+          "field_info": "scenarios.requirements.fields",
           "score_closed_loop": "scenarios.requirements.scoring",
           "score_reference": "scenarios.requirements.scoring"}
 
-__all__ = ["ActuatorRequirement", "Direction", "FinalRequirement", "PointingRequirement", "RateRequirement",
-           "Requirements", "Score", "Sensor", "score_closed_loop", "score_reference"]
+__all__ = ["REQUIREMENT_FIELDS", "ActuatorRequirement", "Direction", "FinalRequirement", "PointingRequirement",
+           "RateRequirement", "RequirementField", "Requirements", "Score", "Sensor", "field_info", "score_closed_loop",
+           "score_reference"]
 
 __getattr__, __dir__ = lazy_face(__name__, _HOMES)

@@ -5,7 +5,8 @@ that draws the tables and figures (:mod:`~scenarios.output.report.page`), a run'
 (:mod:`~scenarios.output.report.figures`) and a run's report (:mod:`~scenarios.output.report.run`).
 A trade study's report (:mod:`scenarios.study.html`) is built on the same page.
 
-May import: :mod:`ocp`, :mod:`scenarios.schema` and :mod:`scenarios.output`. plotly.js comes from the
+May import: :mod:`ocp`, :mod:`scenarios.requirements.fields` (the requirement fields' units),
+:mod:`scenarios.schema` and :mod:`scenarios.output`. plotly.js comes from the
 ``plotly`` package's files (the package itself is not imported).
 """
 from __future__ import annotations

@@ -13,7 +13,7 @@ columns of a table chosen by the reader), and renders one HTML file:
 * a small script (:data:`SCRIPT`) draws the tables and figures when the page loads.
 
 Units: whatever the caller gives; :func:`column_unit` gives those of a run's and a study's result
-columns (:data:`ocp.metrics.METRIC_INFO`, the requirement fields).
+columns (:data:`ocp.metrics.METRIC_INFO`, the requirement fields' :func:`~scenarios.requirements.fields.field_info`).
 """
 from __future__ import annotations
 
@@ -31,6 +31,7 @@ import numpy as np
 from ocp.metrics import METRIC_INFO
 from scenarios.output.report.figures import ATTITUDE_PX
 from scenarios.output.tables import json_safe
+from scenarios.requirements.fields import field_info
 from scenarios.schema.columns import SCOPES, VECTOR_METRICS, is_requirement_column
 
 __all__ = ["FIGURE_DIGITS", "PLOTLY_CONFIG", "Column", "Page", "column_unit", "figure_array", "figure_arrays", "plotly_js",
@@ -41,7 +42,6 @@ FIGURE_DIGITS = 7
 PLOTLY_CONFIG = {"displaylogo": False, "responsive": True, "scrollZoom": False,
                  "toImageButtonOptions": {"format": "png", "scale": 2}}
 """plotly.js's configuration of every figure of a page (the mode bar: zoom, pan, PNG export)."""
-_REQUIREMENT_FIELD_UNITS = {"peak_rate": "rad/s", "worst_rate_error": "rad/s", "ratio": "–"}
 
 
 @cache
@@ -95,19 +95,17 @@ def column_unit(column: str) -> str:
     Returns
     -------
     str
-        The metric's unit from :data:`ocp.metrics.METRIC_INFO`; for a requirement field ``deg``
-        (``*_deg``), ``s`` (``*_s``), ``rad/s`` (``peak_rate``, ``worst_rate_error``) or ``–``
-        (ratios: ``ratio`` and an actuator's demand over its limit); ``s`` for ``plan_time_s``;
-        empty for any other column.
+        The metric's unit from :data:`ocp.metrics.METRIC_INFO`; a requirement field's from
+        :func:`~scenarios.requirements.fields.field_info` (``–`` for a ratio: ``ratio`` and an
+        actuator's demand over its limit); ``s`` for ``plan_time_s``; empty for any other column
+        (a requirement column whose requirement has no such field too).
     """
     parts = column.split(".")
     if is_requirement_column(column):
-        name = parts[3]
-        if name.endswith("_deg"):
-            return "deg"
-        if name.endswith("_s"):
-            return "s"
-        return _REQUIREMENT_FIELD_UNITS.get(name, "–")
+        try:
+            return field_info(column).unit
+        except KeyError:
+            return ""
     if len(parts) == 2 and parts[0] in {prefix for _, prefix in SCOPES}:
         key = parts[1]
         base = key[:-2]
