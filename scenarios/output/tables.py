@@ -394,8 +394,8 @@ def _headline(values: Mapping[str, Any] | None) -> tuple[str, Any]:
     for key, words in _HEADLINES:
         if key in values:
             return words, values[key]
-    ratios = [value for key, value in values.items()
-              if not key.endswith("_time_s") and not key.startswith(("rate_jump", "unrealised")) and value is not None]
+    ratios = [value for key, value in values.items()  # the demand ratios, by their declared unit
+              if value is not None and field_info(f"actuators.{key}").unit == "–"]
     return "peak demand / limit", max(ratios) if ratios else None
 
 
