@@ -305,3 +305,19 @@ def test_a_refused_clash_restores_the_registry(monkeypatch: pytest.MonkeyPatch, 
         plugins.load_plugins()
     assert dict(PLANNERS) == before and list(PLANNERS) == list(before)
     assert all(PLANNERS[name] is before[name] for name in before)
+
+
+@pytest.mark.xfail(strict=True, reason="a local sweep's workers (scenarios/study/worker.py, run_case) do not load "
+                                       "plugins: every case crashes with 'unknown planner'; one call of "
+                                       "load_plugins() before parse_scenario there fixes it")
+def test_a_sweep_runs_its_cases_with_the_plugin_planner(tmp_path: Path) -> None:
+    (tmp_path / "local_cubic.py").write_text(CUBIC)
+    scenario = "\n".join("  " + line for line in SCENARIO.replace("name: cubic-slew-demo", "name: cubic-study")
+                         .splitlines())
+    (tmp_path / "study.yaml").write_text(f"study: cubic-study\nscenario:\n{scenario}\n"
+                                         "grid:\n  maneuver.duration: [100.0, 120.0]\n")
+    done = slewbench(["sweep", "study.yaml", "--out", "sweep", "--no-plots", "--workers", "2"], tmp_path,
+                     plugins=str(tmp_path / "local_cubic.py"))
+    assert done.returncode == 0, done.stderr
+    cases = (tmp_path / "sweep" / "cases.csv").read_text().splitlines()[1:]
+    assert len(cases) == 2 and all(",cubic_slew,augmented_quaternion_feedback,ok," in case for case in cases), cases
