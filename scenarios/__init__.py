@@ -26,11 +26,14 @@ Subpackages, from the bottom up (each may import only those before it, and :mod:
 
 The names below are imported on first use (PEP 562, :func:`scenarios._faces.lazy_face`), so that
 ``import scenarios`` costs nothing until one is used: the command line starts its plot process
-before it loads the model (:mod:`scenarios.console`).
+before it loads the model (:mod:`scenarios.console`). The first use of one that reads a file also loads the installed
+plugins (:func:`scenarios.schema.plugins.load_plugins`: the ``slewbench.plugins`` entry points and
+``SLEWBENCH_PLUGINS``), once.
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import importlib
+from typing import TYPE_CHECKING, Any
 
 from scenarios._faces import lazy_face
 
@@ -53,4 +56,32 @@ _HOMES = {"Scenario": "scenarios.schema.loader", "load": "scenarios.schema.loade
 __all__ = ["OutputError", "Row", "RunResults", "Scenario", "ScenarioError", "Study", "SweepInterrupted", "SweepResults",
            "load", "load_study", "parse_study", "parse_scenario", "run", "sweep"]
 
-__getattr__, __dir__ = lazy_face(__name__, _HOMES)
+_face_getattr, __dir__ = lazy_face(__name__, _HOMES)
+_READERS = frozenset({"load", "parse_scenario", "load_study", "parse_study", "run", "sweep"})
+"""The names whose first use loads the plugins: those that read registry names from a file."""
+_plugins_loaded = False
+"""Whether the face has loaded the plugins (a failed load leaves it ``False``: the next use tries again)."""
+
+
+def __getattr__(name: str) -> Any:
+    """A public name, from its home (:func:`scenarios._faces.lazy_face`), after loading the plugins once.
+
+    Plugins (:mod:`scenarios.schema.plugins`) load on first use of a name that reads a scenario or
+    study (``load``, ``parse_scenario``, ``load_study``, ``parse_study``, ``run``, ``sweep``), so
+    that a file naming a plugin's planner loads from Python as from the command line.
+
+    Parameters
+    ----------
+    name : str
+        The attribute asked for.
+
+    Returns
+    -------
+    Any
+        The public name, or the submodule ``name``.
+    """
+    global _plugins_loaded
+    if name in _READERS and not _plugins_loaded:
+        importlib.import_module("scenarios.schema.plugins").load_plugins()
+        _plugins_loaded = True
+    return _face_getattr(name)

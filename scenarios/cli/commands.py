@@ -2,8 +2,9 @@
 
 Exit status (:mod:`scenarios.cli.status`): 0 when the run completed (a failed planner or a
 violated requirement is a row, not an error), 1 under ``run --strict`` when some row is not ``ok``
-(the results are written all the same) or under ``table --strict`` when some entry is not, 2 for a bad scenario file or an output location slewbench
-must not or cannot write to, 1 for an internal error.
+(the results are written all the same) or under ``table --strict`` when some entry is not, 2 for a bad scenario file, a
+plugin that fails to load or takes a registered name (:mod:`scenarios.schema.plugins`), or an output location
+slewbench must not or cannot write to, 1 for an internal error.
 """
 from __future__ import annotations
 
@@ -52,12 +53,14 @@ from scenarios.schema.loader import (
     parse_scenario,
     refuse_unmarked_base,
 )
+from scenarios.schema.plugins import PluginError, load_plugins, loaded_plugins, provider
 from scenarios.schema.read import read_yaml
 
 
 def command_list(args: argparse.Namespace) -> int:
     """``slewbench list [--options NAME]``: print the registered planners and controllers, one line
-    each, or the options of one of them.
+    each (a plugin's marked with the plugin), and the plugins loaded with what each registered, or
+    the options of one of them.
 
     Parameters
     ----------
@@ -85,12 +88,24 @@ def command_list(args: argparse.Namespace) -> int:
         return EXIT_OK
     print("planners:")
     for name, planner in PLANNERS.items():
-        print(f"  {name:32s} {summary_line(planner)}")
+        print(f"  {name:32s} {summary_line(planner)}{_from_plugin('planner', name)}")
     print("controllers:")
     for name, controller in CONTROLLERS.items():
-        print(f"  {name:32s} {summary_line(controller)}")
+        print(f"  {name:32s} {summary_line(controller)}{_from_plugin('controller', name)}")
+    plugins = loaded_plugins()
+    if plugins:
+        print("plugins:")
+        for plugin in plugins:
+            provided = "; ".join(f"{kind} {', '.join(names)}" for kind, names in plugin.provided.items())
+            print(f"  {plugin.label}: {provided or 'registered nothing'}")
     print("(slewbench list --options NAME: the options of one, with type, unit, default and range)")
     return EXIT_OK
+
+
+def _from_plugin(kind: str, name: str) -> str:
+    """`` [plugin: <label>]`` after a name a plugin provided, else nothing."""
+    label = provider(kind, name)
+    return f" [plugin: {label}]" if label else ""
 
 
 def command_schema(args: argparse.Namespace) -> int:
@@ -388,7 +403,10 @@ def build_parser() -> argparse.ArgumentParser:
                f"error (a traceback on stderr) or run interrupted (Ctrl-C, SIGTERM); {EXIT_INTERRUPTED} "
                f"interrupted sweep or table (run it again to finish). Under run --strict or table --strict, "
                f"{EXIT_NOT_OK} also for a completed run with a row (or table entry) not ok: its files are "
-               f"written and stderr says so ('slewbench: --strict: N of M ... not ok')")
+               f"written and stderr says so ('slewbench: --strict: N of M ... not ok'). Plugins: the "
+               f"'slewbench.plugins' entry points of installed distributions and the modules or .py files of "
+               f"SLEWBENCH_PLUGINS (comma-separated) load at start; one that fails or takes a registered name: "
+               f"exit {EXIT_BAD_SCENARIO}")
     parser.add_argument("--version", action="version", version=f"slewbench {package_version()}")
     commands = parser.add_subparsers(dest="command", required=True)
     run_parser = commands.add_parser("run", help="plan, simulate and score every planner of a scenario")
@@ -421,7 +439,8 @@ def build_parser() -> argparse.ArgumentParser:
                                help="a format option, repeatable (aem: time_system=UTC|TAI|TT|TDB, "
                                     "attitude_type=QUATERNION/ANGVEL|QUATERNION, originator, object_name, object_id)")
     export_parser.set_defaults(handler=command_export)
-    list_parser = commands.add_parser("list", help="registered planners and controllers")
+    list_parser = commands.add_parser("list", help="registered planners and controllers, and the plugins that "
+                                                   "provided any (slewbench.plugins entry points, SLEWBENCH_PLUGINS)")
     list_parser.add_argument("--options", metavar="NAME",
                              help="the options of planner or controller NAME: type, unit, default and range")
     list_parser.set_defaults(handler=command_list)
@@ -484,7 +503,8 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     Returns
     -------
     int
-        Exit status: 0 done, 2 bad scenario file or output location (the message names its path),
+        Exit status: 0 done, 2 bad scenario file or output location (the message names its path) or
+        a plugin that fails to load or takes a registered name (the message names the plugin),
         1 internal error or interrupted, or a row not ok under ``run --strict`` (an entry under
         ``table --strict``).
     """
@@ -497,7 +517,11 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     previous = ({signum: signal.signal(signum, args.interruption) for signum in (signal.SIGTERM, signal.SIGINT)}
                 if threading.current_thread() is threading.main_thread() else None)
     try:
+        load_plugins()  # the slewbench.plugins entry points and SLEWBENCH_PLUGINS, before any name is read
         return args.handler(args)
+    except PluginError as error:
+        print(f"slewbench: plugin error: {error}", file=sys.stderr)
+        return EXIT_BAD_SCENARIO
     except ScenarioError as error:
         # a command-line option's error is named as such, not as the scenario's; a study's as the study's
         kind = "option" if error.path.startswith("--") else getattr(args, "file_kind", None) or \
