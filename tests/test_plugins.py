@@ -307,9 +307,6 @@ def test_a_refused_clash_restores_the_registry(monkeypatch: pytest.MonkeyPatch, 
     assert all(PLANNERS[name] is before[name] for name in before)
 
 
-@pytest.mark.xfail(strict=True, reason="a local sweep's workers (scenarios/study/worker.py, run_case) do not load "
-                                       "plugins: every case crashes with 'unknown planner'; one call of "
-                                       "load_plugins() before parse_scenario there fixes it")
 def test_a_sweep_runs_its_cases_with_the_plugin_planner(tmp_path: Path) -> None:
     (tmp_path / "local_cubic.py").write_text(CUBIC)
     scenario = "\n".join("  " + line for line in SCENARIO.replace("name: cubic-slew-demo", "name: cubic-study")

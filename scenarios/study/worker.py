@@ -159,6 +159,16 @@ class RecentCache(SolverCache):
         return value
 
 
+_PLUGINS_LOADED = False
+"""Whether this worker process has loaded the plugins (:func:`scenarios.schema.plugins.load_plugins`,
+once per process: its scan of the entry points costs about 2 ms)."""
+
+
+def _plugins_loaded() -> None:
+    global _PLUGINS_LOADED
+    _PLUGINS_LOADED = True
+
+
 @functools.cache
 def worker_state() -> tuple[SolverCache, RecentCache, threading.Lock]:
     """This process's caches and case lock (created on first use, kept for its life).
@@ -254,6 +264,7 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     """
     from scenarios.runner import run
     from scenarios.schema.loader import parse_scenario
+    from scenarios.schema.plugins import load_plugins
 
     cache, simulators, lock = worker_state()
     data, timeout = payload["scenario"], float(payload["timeout_s"])
@@ -266,6 +277,9 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
             try:
                 if alarm:
                     signal.setitimer(signal.ITIMER_REAL, timeout)
+                if not _PLUGINS_LOADED:  # a fork server's worker does not inherit the parent's registries
+                    load_plugins()
+                    _plugins_loaded()
                 scenario = parse_scenario(data)
                 results = run(scenario, cache=cache, simulators=simulators)
                 status, rows = "ok", [row.to_dict() for row in results.rows]
