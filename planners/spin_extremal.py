@@ -19,7 +19,7 @@ A vectorised multi-start over branches of ``K T``, over ``β`` and over ``c`` se
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Annotated, Any
 
 import casadi as ca
@@ -199,7 +199,8 @@ class SpinExtremalReference(Reference):
     them would fix ``r`` and ``β`` and leave ``c`` alone to reach a three-dimensional target; with
     the body at rest transversally, ``r = 0`` and the extremal is the free spin ``E1(v t)``), so
     ``omega0`` and ``omegaf`` are declared free; ``qf`` too when ``J1`` is only a weighted cost
-    (``weight > 0``) or the parameters are fixed.
+    (``weight > 0``) or the parameters are fixed. ``omegaf`` is free in the problem too: the planner
+    refuses a problem that fixes a final rate (:meth:`SpinExtremalPlanner.problem_error`).
 
     Parameters
     ----------
@@ -283,12 +284,49 @@ class SpinExtremalPlanner(Planner):
         Returns
         -------
         str or None
-            The reason (no target, non-principal inertia), or ``None``.
+            The reason (no target, non-principal inertia, a fixed final rate), or ``None``.
+
+        Notes
+        -----
+        A fixed final rate is refused: the extremal ends at ``ω*(T) = [v, r sin θ(T), r cos θ(T)]``,
+        set by the parameters that reach the attitude. Meeting ``ωf`` needs ``r = |ωf⊥|``; with
+        ``ωf⊥ = 0`` (a body brought to rest, or left spinning about roll) that is ``r = 0``, the free
+        spin ``E1(v t)``, which re-points nothing; otherwise ``r`` and ``θ(T)`` fixed leave one
+        parameter for a three-dimensional attitude. The reference would end turning at ``r`` and
+        coast on after ``T`` (:meth:`~planners.reference.Reference.sample`), the closed loop with it
+        (a rest-to-rest 100 deg slew of a wheeled pyramid ended 75 deg off its target 100 s after T).
+        The method is for a spinning body whose final rate is free (``maneuver.final.omega: null``).
         """
         if not problem.spacecraft.is_principal:
             return ("the spin extremals need a principal-axis (diagonal) inertia; "
                     "rotate the problem into principal axes first")
+        if problem.omegaf is not None:
+            return ("the spin extremals cannot meet a fixed final rate (maneuver.final.omega = "
+                    f"{np.array2string(np.asarray(problem.omegaf), precision=4)} rad/s): they end at "
+                    "omega*(T) = [v, r sin theta(T), r cos theta(T)] set by the parameters that reach the attitude, "
+                    "still turning at r > 0 whenever they re-point the body, and coast on after T; set "
+                    "maneuver.final.omega: null (a spinning body's free final rate, the method's problem) or "
+                    "use another planner")
         return super().problem_error(problem)
+
+    def plan_start(self, problem: ManeuverProblem) -> Reference:
+        """The extremal as a start for another method: on ``problem`` with its final rate freed.
+
+        A start need not meet the final rate (the method it starts imposes it), so a problem that
+        fixes one, which :meth:`problem_error` refuses as a row, still gets the extremal (the same
+        one: the optimisation never reads ``omegaf``), e.g. as ``collocation``'s ``warm_start``.
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The slew to plan.
+
+        Returns
+        -------
+        Reference
+            As :meth:`~planners.base.Planner.plan_start` on ``problem`` with ``omegaf = None``.
+        """
+        return super().plan_start(problem if problem.omegaf is None else replace(problem, omegaf=None))
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         moments = np.diag(problem.spacecraft.inertia).copy()

@@ -27,7 +27,8 @@ Each planned row is planned, sampled and scored against the scenario's requireme
 run`` does (:func:`scenarios.runner.run`'s reference path,
 :func:`scenarios.requirements.scoring.score_reference`); a row that breaks one is still exported,
 with what it breaks (:attr:`CodegenReport.violations`), and ``SLEWBENCH_PARAMS_DEFAULT`` tracks the
-first exported row that meets them (the first exported row when none does, said so).
+first exported row that meets them and whose table meets its tolerances (when none does both, the
+next best, with a warning saying what it misses).
 """
 from __future__ import annotations
 
@@ -339,9 +340,12 @@ def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str
              "tolerances hold inside every interval (attitude "
              f"{tolerance.attitude_rad:g} rad, rate {tolerance.rate:g} and omega_dot/torque {tolerance.linear:g} "
              f"relative to their largest component, at most {tolerance.max_intervals} intervals), with the "
-             "reference's own points (collocation's nodes) and its breakpoints (doubled: left and right limits)."),
+             "reference's own points (collocation's nodes) and its breakpoints (a node one double before each for the "
+             "left limit, one double after it for the right limit, and the breakpoint's own node with the side of the "
+             "jump the reference gives there)."),
              "", ("Error against the continuous reference, largest over seven points of every interval "
-             "(s = 1/8, ..., 7/8 of its length; the midpoint is where a smooth reference's error peaks):"), "",
+             "(s = 1/8, ..., 7/8 of its length; the midpoint is where a smooth reference's error peaks) and at "
+             "every node (a breakpoint's included):"), "",
              ("| row | table | nodes | span [s] | attitude | rate [rad/s] | omega_dot [rad/s^2] | torque [N m] | "
               "tolerances met |"),
              "|---|---|---|---|---|---|---|---|---|"]
@@ -369,24 +373,36 @@ def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str
 
 
 def _default_row(labels: list[str], broken: dict[str, list[str]], tracks: bool,
-                 scored: bool = True) -> tuple[str | None, str]:
+                 scored: bool = True, missed: dict[str, tuple[str, ...]] | None = None) -> tuple[str | None, str]:
     """The row ``SLEWBENCH_PARAMS_DEFAULT`` tracks, and why: the first exported row that meets the
-    requirements; the first exported row when none does; none (regulation) when the law reads no
-    reference or no row is exported; ``scored``: the scenario has requirements to meet."""
+    requirements and whose table meets its tolerances; else the first that meets the requirements,
+    else the first whose table meets its tolerances, else the first exported row (each with a
+    warning saying what it misses); none (regulation) when the law reads no reference or no row is
+    exported. ``scored``: the scenario has requirements to meet; ``missed``: label -> the quantities
+    its table misses (:attr:`TableError.failed`), absent or empty when met."""
     if not tracks:
         return None, "regulation to the target (the law reads no reference)"
     if not labels:
         return None, "regulation to the target (no row was exported)"
+    missed = missed or {}
     ok = [label for label in labels if label not in broken]
-    if not ok:
-        return labels[0], (f"track row {labels[0]!r}, the first exported row; WARNING: every exported row breaks "
-                           "the scenario's requirements")
-    if ok[0] == labels[0]:
-        return ok[0], (f"track row {ok[0]!r}, the first exported row "
-                       + ("(it meets the scenario's requirements)" if scored else "(the scenario states no requirement to meet)"))
-    before = ", ".join(repr(label) for label in labels[:labels.index(ok[0])])
-    return ok[0], (f"track row {ok[0]!r}, the first exported row that meets the scenario's requirements "
-                   f"({before} break{'s' if labels.index(ok[0]) == 1 else ''} them)")
+    exact = [label for label in labels if not missed.get(label)]
+    good = [label for label in ok if label in exact]
+    pick = (good or ok or exact or labels)[0]
+    wants = (["that meets the scenario's requirements"] if ok and scored else []) + \
+        (["whose table meets its tolerances"] if pick in exact else [])
+    text = f"track row {pick!r}, the first exported row" + (" " + " and ".join(wants) if wants else "")
+    if not scored:
+        text += " (the scenario states no requirement to meet)"
+    before = labels[:labels.index(pick)]
+    skipped = [f"{label!r} " + ("breaks the requirements" if label in broken and ok else
+                                f"misses its table's tolerances ({', '.join(missed[label])})") for label in before]
+    if skipped:
+        text += f" ({'; '.join(skipped)})"
+    warnings = ([] if ok else ["every exported row breaks the scenario's requirements"]) + \
+        ([] if pick in exact else [f"its table misses its tolerances ({', '.join(missed[pick])}), as does every "
+                                   + ("exported row's" if not ok else "table of a row that meets the requirements")])
+    return pick, text + "".join(f"; WARNING: {warning}" for warning in warnings)
 
 
 def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | None = None) -> CodegenReport:
@@ -509,7 +525,8 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
                                                            "output": "row [q, omega, omega_dot, torque] (13)"}
     tracks = bool(getattr(laws[0], "tracks_reference", False) or getattr(laws[0], "needs_reference", False))
     report.default, report.default_reason = _default_row(list(tables), report.violations, tracks,
-                                                               bool(scenario.requirements))
+                                                         bool(scenario.requirements),
+                                                         {label: error.failed for label, error in report.tables.items()})
     default_reference = None if report.default is None else tables[report.default][0]
     target = reference_rows(None, [0.0], (problem.qf, problem.omegaf))[0]
     slices, nu = control_layout(spacecraft)

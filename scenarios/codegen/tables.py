@@ -12,10 +12,15 @@ The manoeuvre ``[0, T]`` and the coast ``[T, t_end]`` are tabulated apart, each 
 refined by halving (from 32 intervals over the manoeuvre, from one over the coast) until the
 interpolation meets the tolerances inside every interval (or the grid reaches its cap, which the
 table then says). The manoeuvre's grid holds the reference's own points (``Reference.enforced_times``:
-collocation's nodes) and its ``breakpoints``, where the node is doubled (the left and the right
-limits at the same time) so that a jump of ``ω̇`` is not smeared. The coast starts at the next
-double after ``T`` (``T`` itself is the manoeuvre's last node: at ``T`` the table gives what the
-reference gives at ``T``, the manoeuvre's torque, and from the next double on the coast's).
+collocation's nodes) and its ``breakpoints``, each with a node one double before it (the left
+limit) and one double after it (the right limit), so that a jump of ``ω`` or ``ω̇`` is not smeared;
+at the breakpoint itself the node holds what the reference gives there (one side of the jump, by the
+reference's own convention: ``natural_motion``'s step stop gives the arc's rate at the stop time),
+so the table and the reference agree at that time too (a closed loop sampled on the breakpoint, or
+one sample before it with the hold-averaged feed-forward, reads the same row in C as in Python).
+The coast starts at the next double after ``T`` (``T`` itself is the manoeuvre's last node: at ``T``
+the table gives what the reference gives at ``T``, the manoeuvre's torque, and from the next double
+on the coast's).
 
 Interpolation (:func:`interpolate` in NumPy, :func:`segment_function` in CasADi, generated as C):
 with ``k`` the last node such that ``t_k ≤ t`` (``t`` clamped to ``[t_0, t_{N-1}]``, ``k`` at most
@@ -29,7 +34,8 @@ with ``k`` the last node such that ``t_k ≤ t`` (``t`` clamped to ``[t_0, t_{N-
 The table states its error against the continuous reference (:class:`TableError`), the largest over
 seven points of every interval (:data:`CHECK_POINTS`): the midpoint, where the Hermite and the linear
 interpolation errors of a smooth function peak, and six more for a kink inside an interval (a switch
-that is not a declared breakpoint). The tolerances are checked on the same points.
+that is not a declared breakpoint), and at every node (the breakpoints' included, where the side of
+a jump the table gives is checked). The tolerances are checked on the same points.
 """
 from __future__ import annotations
 
@@ -142,7 +148,7 @@ class ReferenceTable:
     Parameters
     ----------
     times : (N,) ndarray
-        Node times [s], non-decreasing (a time appears twice at a breakpoint), ``N ≥ 2``.
+        Node times [s], non-decreasing (``tabulate`` gives increasing ones), ``N ≥ 2``.
     rows : (N, 13) ndarray
         ``[q (4, scalar first, body to inertial; signs continuous), ω (3) rad/s, ω̇ (3) rad/s^2,
         τ (3) N m]`` at the nodes, body axes.
@@ -289,7 +295,8 @@ def _rows(reference: Reference, times: Array) -> Array:
 
 def _nodes(reference: Reference, intervals: int, start: float = 0.0, stop: float | None = None) -> tuple[Array, Array]:
     """Times and rows over ``[start, stop]``: a uniform grid, the reference's own points and its
-    breakpoints doubled (those inside the span); ``stop`` defaults to the reference's duration."""
+    breakpoints, each flanked by the doubles next to it (those inside the span); ``stop`` defaults
+    to the reference's duration."""
     stop = reference.duration if stop is None else stop
     own = [] if reference.enforced_times is None else [t for t in reference.enforced_times if start <= t <= stop]
     breaks = [b for b in reference.breakpoints if start < b < stop]
@@ -298,14 +305,12 @@ def _nodes(reference: Reference, intervals: int, start: float = 0.0, stop: float
     gap = 1e-9 * max(stop - start, abs(stop), 1e-300)
     near = np.min(np.abs(grid[:, None] - fixed[None, :]), axis=1) <= gap
     times = np.unique(np.concatenate([fixed, grid[~near]]))
+    if breaks:  # the left limit one double before each breakpoint and the right limit one double after it
+        at = np.asarray(breaks, dtype=float)
+        times = np.unique(np.concatenate([times, np.nextafter(at, -np.inf), np.nextafter(at, np.inf)]))
+    # at a breakpoint itself the node holds what the reference gives there (one side of the jump, the
+    # reference's own convention), so that the table and the reference agree at that time too
     rows = _rows(reference, times)
-    if breaks:  # the left limit at each breakpoint, then the right limit
-        at = np.searchsorted(times, breaks)
-        left = _rows(reference, np.nextafter(np.asarray(breaks), -np.inf))
-        right = _rows(reference, np.nextafter(np.asarray(breaks), np.inf))
-        rows[at] = right
-        times = np.insert(times, at, breaks)
-        rows = np.insert(rows, at, left, axis=0)
     rows[:, 0:4] = quat.continuous(quat.normalize(rows[:, 0:4]))
     return times, rows
 
@@ -335,7 +340,8 @@ def _error(reference: Reference, table: ReferenceTable, tolerance: TableToleranc
     times = table.times
     h = np.diff(times)
     inside = h > 0
-    mid = (times[:-1][inside, None] + CHECK_POINTS[None, :] * h[inside, None]).ravel()
+    # the nodes too: at a breakpoint's node the reference gives one side of its jump, which the table must give
+    mid = np.concatenate([(times[:-1][inside, None] + CHECK_POINTS[None, :] * h[inside, None]).ravel(), times])
     exact = _rows(reference, mid)
     got = table.evaluate(mid)
     angle = float(np.max(quat.error_angle(got[:, 0:4], exact[:, 0:4])))
