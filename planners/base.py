@@ -66,7 +66,9 @@ class Planner(Configurable, ABC):
       :meth:`Reference.symbolic_evaluator` (``slewbench codegen`` exports them as C).
     * ``cheap``: it plans in milliseconds (a closed form or a small parameter search, not a
       trajectory optimisation), so ``collocation`` plans it as a start by default
-      (``seed_planners: auto``) wherever :meth:`problem_error` accepts the problem.
+      (``seed_planners: auto``) wherever :meth:`start_error` accepts the problem (by default
+      where :meth:`problem_error` does; a planner whose start may leave out a condition the
+      method it starts imposes says so there).
     * ``honours`` names the scenario requirements (:data:`REQUIREMENT_KINDS`) the planner imposes
       on its references (:meth:`honoured`: with given options): ``"pointing"`` (``problem.pointing``, every window and moving direction
       included), ``"actuators"`` (the actuators' limits tightened by ``problem.actuator_margin``),
@@ -184,6 +186,25 @@ class Planner(Configurable, ABC):
         if problem.qf is None:
             return f"planner {self.name} needs a target attitude (maneuver.final.q)"
         return None
+
+    def start_error(self, problem: ManeuverProblem) -> str | None:
+        """Why this planner cannot give a start (a warm start, a seed) for ``problem``.
+
+        A start need not meet every condition of the problem: the method it starts imposes them.
+        The default is :meth:`problem_error`; a planner that refuses a problem as a row but still
+        plans a useful start for it (:meth:`plan_start`) overrides both.
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The problem another method will solve from the start.
+
+        Returns
+        -------
+        str or None
+            The reason; ``None`` if :meth:`plan_start` can plan a start for it.
+        """
+        return self.problem_error(problem)
 
     def plan(self, problem: ManeuverProblem) -> Reference:
         """Plan the manoeuvre.

@@ -309,6 +309,22 @@ class SpinExtremalPlanner(Planner):
                     "use another planner")
         return super().problem_error(problem)
 
+    def start_error(self, problem: ManeuverProblem) -> str | None:
+        """Why the extremal cannot start another method on ``problem``: as :meth:`problem_error`
+        with the final rate freed (the method it starts imposes that rate).
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The problem another method will solve from the start.
+
+        Returns
+        -------
+        str or None
+            The reason, or ``None``.
+        """
+        return self.problem_error(problem if problem.omegaf is None else replace(problem, omegaf=None))
+
     def plan_start(self, problem: ManeuverProblem) -> Reference:
         """The extremal as a start for another method: on ``problem`` with its final rate freed.
 

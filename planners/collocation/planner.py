@@ -134,7 +134,7 @@ class CollocationOptions:
         Further planners whose references are starts, each solved after the warm start; the best
         converged optimum is kept. ``auto`` (default): every registered planner that plans in
         milliseconds (:attr:`~planners.base.Planner.cheap`: ``eigenaxis``, ``spin_extremal``)
-        and accepts the problem (:meth:`~planners.base.Planner.problem_error`), besides the warm
+        and can start it (:meth:`~planners.base.Planner.start_error`), besides the warm
         start, in name order, with its default options; only where the starts are solved on the
         coarse mesh (``coarse_intervals``: ``multistart: auto``, and no cones at a fixed final
         time), none elsewhere. On the spin paper's minimum energy ``spin_extremal``'s start
@@ -455,7 +455,7 @@ class CollocationPlanner(Planner):
             if name in (self.name, o.warm_start) or not cls.cheap:
                 continue
             try:
-                refused = cls(None, cache=self.cache).problem_error(problem)
+                refused = cls(None, cache=self.cache).start_error(problem)
             except Exception as error:  # noqa: BLE001 (a planner that cannot judge the problem is no seed)
                 refused = str(error)
             if refused is None:
