@@ -14,13 +14,15 @@ sample, and gives what it asks of each actuator (commands, and the states they d
 wheel momenta): the scenario's actuator requirement scores it against the limits.
 :func:`unrealised_torque` is what those commands leave out of the feed-forward torque: the part no
 working actuator gives (an axis of a failed or missing wheel, the component along the field for
-magnetorquers), which no limit shows.
+magnetorquers), which no limit shows. Both evaluate all samples as one batch: the law's map and the
+model's functions mapped over chunks of samples (:func:`model_rows`), the same expressions as
+per sample.
 """
 from __future__ import annotations
 
 import copy
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -28,7 +30,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ocp import AttitudeModel, Command, Measurement, Spacecraft, quat
+from ocp import AttitudeModel, Command, Measurement, SolverCache, Spacecraft, quat
 from ocp.dynamics.actuator_kinds import Actuator
 from ocp.dynamics.layout import actuator_blocks, control_layout, split_measurement
 from ocp.fast_call import BufferedFunction, as_floats
@@ -36,7 +38,7 @@ from ocp.fast_call import BufferedFunction, as_floats
 Array = NDArray[np.float64]
 
 __all__ = ["MAX_SUBSTEPS", "SUBSTEP_ANGLE", "Allocation", "Demand", "SymbolicConstants", "demand_limits", "float_rows",
-           "reference_demand", "unrealised_torque"]
+           "model_rows", "reference_demand", "unrealised_torque"]
 
 
 def float_rows(matrix: ArrayLike) -> tuple[tuple[float, ...], ...]:
@@ -470,8 +472,7 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     n_states = sum(block.actuator.state_size for block in blocks)
     fields = np.zeros((n, 3))
     if model.field_body is not None and n:
-        x = np.hstack([q, omega, np.zeros((n, model.nx - 7))])
-        fields = np.asarray(model.field_body.map(n)(x.T, t).full()).T
+        fields = model_rows(model, "field_body", np.hstack([q, omega, np.zeros((n, model.nx - 7))]), t[:, None])
     inputs = np.hstack([torque, q, omega, fields])  # (N, 13): what the map reads at each sample
     kicks = np.zeros((n, n_states))  # the states' jumps at each sample: the wheels take up the rate's
     if jumps is not None and n and law._working_axes is not None:
@@ -492,13 +493,9 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
         step = BufferedFunction(model.solver_cache.get(("reference_demand_step", *key), lambda: _demand_step(
             law, spacecraft, blocks, n_states).mapaccum("reference_demand", _CHUNK)))
         states = _integrated_states(step, t, after, inputs, start, kicks)
-    command = BufferedFunction(model.solver_cache.get(("reference_demand_command", *key), lambda: _demand_command(
-        law, spacecraft, n_states).map(_CHUNK)))
-    commands = np.zeros((n, law._nu))
-    for first in range(0, n, _CHUNK):  # one call per chunk of samples (the last padded with its last)
-        rows = np.arange(first, first + _CHUNK).clip(max=n - 1)
-        commands[first:first + _CHUNK] = command(states[rows].ravel(), inputs[rows].ravel()).reshape(
-            _CHUNK, law._nu)[:min(_CHUNK, n - first)]  # column-major: a row per sample
+    commands = (_mapped_rows(model.solver_cache, ("reference_demand_command", *key),
+                             lambda: _demand_command(law, spacecraft, n_states), states, inputs)
+                if n else np.zeros((0, law._nu)))
     limits = demand_limits(spacecraft)
     demand: dict[str, Demand] = {}
     for block in blocks:
@@ -512,7 +509,57 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
 
 
 _CHUNK = 512
-"""Samples (or sub-steps) per call of the mapped map and the accumulated step of :func:`reference_demand`."""
+"""Samples (or sub-steps) per call of the mapped map and the accumulated step of :func:`reference_demand`,
+and of :func:`model_rows`."""
+
+
+def _mapped_rows(cache: SolverCache, key: tuple[Hashable, ...], build: Callable[[], ca.Function], *inputs: Array) -> Array:
+    """The first output of ``build()`` at each of N samples, by chunks of :data:`_CHUNK` samples
+    through its map (cached under ``key``) and reusable buffers: no map is built per call and no
+    matrix converted to CasADi's (which cost more than the evaluation itself). ``inputs``: (N, k_i)
+    rows, or (1, k_i) for a value shared by every sample. Returns (N, m)."""
+    n = max((rows.shape[0] for rows in inputs if rows.shape[0] != 1), default=1)
+    mapped = BufferedFunction(cache.get((*key, "rows", _CHUNK), lambda: build().map(_CHUNK)))
+    width = mapped.outputs[0].size // _CHUNK
+    out = np.empty((n, width))
+    for first in range(0, n, _CHUNK):  # the last chunk padded with the last sample
+        rows = np.arange(first, first + _CHUNK).clip(max=n - 1)
+        flat = [np.broadcast_to(values, (_CHUNK, values.shape[1])).ravel() if values.shape[0] == 1
+                else values[rows].ravel() for values in inputs]
+        out[first:first + _CHUNK] = mapped(*flat).reshape(_CHUNK, width)[:min(_CHUNK, n - first)]  # a row per sample
+    return out
+
+
+def model_rows(model: AttitudeModel, name: str, *inputs: ArrayLike) -> Array:
+    """One of a model's CasADi functions at each of N samples (``environment_torque``,
+    ``body_torque``, ``field_body``, ...), as a batch: the function's own expression evaluated by
+    chunks through a cached map (:data:`_CHUNK` samples a call) and reusable buffers.
+
+    Parameters
+    ----------
+    model : ocp.AttitudeModel
+        The model (its ``solver_cache`` keeps the map).
+    name : str
+        The attribute of ``model`` holding the function (dense inputs).
+    *inputs : array_like
+        The function's inputs in order: (N, k_i) rows, one per sample, or (k_i,) for a value
+        shared by every sample (a scalar input's N values as an (N, 1) column).
+
+    Returns
+    -------
+    (N, m) ndarray
+        The function's first output at each sample.
+    """
+    function = getattr(model, name)
+    if not isinstance(function, ca.Function):
+        raise TypeError(f"model.{name} is no CasADi function")
+    rows = [np.atleast_2d(np.asarray(values, dtype=float)) for values in inputs]
+    n = max((values.shape[0] for values in rows if values.shape[0] != 1), default=1)
+    if any(values.shape[0] not in (1, n) for values in rows):
+        raise ValueError(f"model_rows({name}): inputs of {[values.shape[0] for values in rows]} rows")
+    if n == 0:
+        return np.zeros((0, function.nnz_out(0)))
+    return _mapped_rows(model.solver_cache, ("model_rows", name), lambda: function, *rows)
 
 SUBSTEP_ANGLE = 0.05
 """[rad]: the most the body turns (``|ω| Δt``, the larger rate of the interval's ends) in one step
@@ -573,25 +620,27 @@ def _integrated_states(step: BufferedFunction, t: Array, after: Array, inputs: A
         interval = np.repeat(np.arange(within), counts)
         firsts = np.cumsum(counts) - counts
         index = np.arange(interval.size) - firsts[interval]  # the sub-step within its interval
-        ends = np.zeros((-(-interval.size // _CHUNK) * _CHUNK, n_states))
-        jumps = np.zeros((_CHUNK, n_states))
+        total = -(-interval.size // _CHUNK) * _CHUNK  # whole chunks: the last sub-step's end held, zero lengths
+        size = interval.size
+        now = np.empty((total, inputs.shape[1]))
+        if size:
+            now[size:] = inputs[interval[-1] + 1]
+        then = now.copy()
+        parts = counts[interval].astype(float)[:, None]
+        begin, end = after[interval], inputs[interval + 1]
+        now[:size] = begin + index[:, None] / parts * (end - begin)  # every sub-step's inputs at once
+        then[:size] = begin + (index[:, None] + 1.0) / parts * (end - begin)
+        lengths = np.zeros(total)
+        lengths[:size] = dt[interval] / parts[:, 0]
+        jumps = np.zeros((total, n_states))
+        starting = index == 0
+        jumps[:size][starting] = kicks[interval[starting]]
+        ends = np.zeros((total, n_states))
         state = start
-        for first in range(0, interval.size, _CHUNK):  # one call per chunk of sub-steps
-            which = interval[first:first + _CHUNK]
-            size = which.size
-            parts = counts[which].astype(float)[:, None]
-            begin, end = after[which], inputs[which + 1]
-            now = np.tile(end[-1], (_CHUNK, 1))  # whole chunks: the last sub-step's end held, zero lengths
-            then = now.copy()
-            now[:size] = begin + index[first:first + size, None] / parts * (end - begin)
-            then[:size] = begin + (index[first:first + size, None] + 1.0) / parts * (end - begin)
-            lengths = np.zeros(_CHUNK)
-            lengths[:size] = dt[which] / parts[:, 0]
-            jumps[:] = 0.0
-            starting = index[first:first + size] == 0
-            jumps[:size][starting] = kicks[which[starting]]
-            ends[first:first + _CHUNK] = step(state, now.ravel(), then.ravel(), lengths, jumps.ravel()).reshape(
-                _CHUNK, n_states)  # column-major: a row per sub-step
+        for first in range(0, total, _CHUNK):  # one call per chunk of sub-steps
+            chunk = slice(first, first + _CHUNK)
+            ends[chunk] = step(state, now[chunk].ravel(), then[chunk].ravel(), lengths[chunk],
+                               jumps[chunk].ravel()).reshape(_CHUNK, n_states)  # column-major: a row per sub-step
             state = ends[first + _CHUNK - 1].copy()
         states[1:within + 1] = ends[firsts + counts - 1]
     return states + kicks  # each sample's state after its jump (the step from it started there)
@@ -642,7 +691,7 @@ def unrealised_torque(model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: A
         u[:, block.control] = demand[_quantity(block.actuator, False)].values
         if block.actuator.state_size:
             x[:, 7:][:, block.state] = demand[_quantity(block.actuator, True)].values
-    given = np.asarray(model.body_torque.map(n)(x.T, u.T, t).full()).T if n else np.zeros((0, 3))
+    given = model_rows(model, "body_torque", x, u, t[:, None]) if n else np.zeros((0, 3))
     momentum = np.zeros((n, 3))  # stored in the actuators' states: the wheels' A h_w (momentum_matrix)
     for block in actuator_blocks(spacecraft):
         if block.actuator.state_size:

@@ -44,6 +44,7 @@ from controllers.allocation import (
     MAX_SUBSTEPS,
     Allocation,
     demand_limits,
+    model_rows,
     reference_demand,
     unrealised_torque,
 )
@@ -477,7 +478,7 @@ def _environment_torque(problem: ManeuverProblem, t: Array, q: Array, omega: Arr
         return np.zeros((t.size, 3))
     model = problem.model
     x = np.hstack([q, omega, np.zeros((t.size, model.nx - 7))])
-    return np.asarray(model.environment_torque.map(t.size)(x.T, t, model.default_parameters).full()).T
+    return model_rows(model, "environment_torque", x, t[:, None], np.asarray(model.default_parameters, dtype=float).ravel())
 
 
 def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: ArrayLike, q: ArrayLike,
