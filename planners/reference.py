@@ -54,6 +54,10 @@ class ReferenceSample(NamedTuple):
 BOUNDARY_CONDITIONS = ("q0", "omega0", "qf", "omegaf")
 """Names of the boundary conditions a reference may leave free (:attr:`Reference.free_boundary`)."""
 
+JUMP_TOLERANCE = 1e-6
+"""A change of a reference's body rate [rad/s] over an instant up to this is rounding, not a jump
+(an impulse): the conformance check of the ends and the requirement scoring both use it."""
+
 _FIELD_WIDTHS = (("q", 4), ("omega", 3), ("omega_dot", 3), ("torque", 3))
 
 

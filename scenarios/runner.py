@@ -36,9 +36,9 @@ from ocp import (
 )
 from ocp.nlp import with_costate_gap
 from planners import FailedReference, Reference, ReferenceSample
+from planners.reference import JUMP_TOLERANCE
 from scenarios.output.results import Row, RunResults
 from scenarios.requirements.scoring import (
-    JUMP_TOLERANCE,
     REFERENCE_POINTS,
     SCOPE_WORDS,
     Score,

@@ -56,9 +56,10 @@ from ocp.geometry.pointing import (
 )
 from planners import ManeuverProblem, Planner, Reference
 from planners.base import REQUIREMENT_KINDS
+from planners.reference import JUMP_TOLERANCE
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
-__all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "JUMP_TOLERANCE", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
+__all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
            "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
            "endpoint_violations", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
            "score_reference", "unhonoured", "violations", "worst_error_between_samples"]
@@ -81,8 +82,6 @@ FINAL_FIELDS = ("worst_error_deg", "worst_rate_error", "from_s")
 JUMP_FIELDS = ("rate_jump", "rate_jump_time_s")
 """The actuator score's fields after its quantities': the largest jump of the reference's body rate
 [rad/s] (0 without one) and when it happens [s] (``None`` without one)."""
-JUMP_TOLERANCE = 1e-6
-"""A jump of a reference's body rate up to this [rad/s] is rounding, not a jump."""
 UNREALISED_FIELDS = ("unrealised_torque", "unrealised_torque_time_s")
 """The actuator score's last fields: the largest torque the reference asks that its commands do not
 give (:func:`controllers.allocation.unrealised_torque`) [N m], and when [s]."""
@@ -307,7 +306,7 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
     tracking error the closed loop absorbs, reported as ``ref.initial_rate_error`` and scored in the
     closed loop, not an actuator demand of the reference; and across each of the reference's
     breakpoints (:attr:`planners.Reference.breakpoints`, where ``ω`` may jump: natural motion's step
-    stop). A change of more than :data:`JUMP_TOLERANCE` across a breakpoint, beyond what ``ω̇``
+    stop). A change of more than :data:`~planners.reference.JUMP_TOLERANCE` across a breakpoint, beyond what ``ω̇``
     explains over the instant either side sampled, is a jump.
 
     Parameters
@@ -344,7 +343,10 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
         slopes = np.max(np.abs(np.stack(np.split(around.omega_dot, 2))), axis=(0, 2))
         for time, jump, slope in zip(breakpoints, after - before, slopes):
             if np.linalg.norm(jump) > JUMP_TOLERANCE + 2.0 * instant * slope:  # beyond what ω̇ explains
-                found.append((float(time), int(np.searchsorted(t, time, side="right")), jump))
+                # the first sample after the jump; a step at T is in the sample at T already (its
+                # contract: the rate after the step, Reference's breakpoints)
+                side = "left" if time >= reference.duration else "right"
+                found.append((float(time), int(np.searchsorted(t, time, side=side)), jump))
     return found
 
 
