@@ -4,7 +4,8 @@ the end points of the manoeuvre before anything is planned.
 
 One :class:`Score` per requirement and scope (``reference``, ``closed_loop``): the numbers that go
 into the result columns ``ref.req.<name>.<field>`` and ``cl.req.<name>.<field>``, whether it is met,
-and what breaks it in words. The fields:
+and what breaks it in words. The fields (their units, words and definitions are declared once in
+:mod:`scenarios.requirements.fields`, which the tables, the report, the plots and the docs read):
 
 * a pointing requirement: ``min_margin_deg`` (negative when violated), ``time_in_violation_s``,
   ``first_violation_s`` (null if never), ``min_margin_time_s``, in both scopes by one machinery:
