@@ -318,3 +318,47 @@ def test_a_sweep_runs_its_cases_with_the_plugin_planner(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     cases = (tmp_path / "sweep" / "cases.csv").read_text().splitlines()[1:]
     assert len(cases) == 2 and all(",cubic_slew,augmented_quaternion_feedback,ok," in case for case in cases), cases
+
+
+def test_a_plugin_file_named_after_a_package_does_not_replace_it(tmp_path: Path) -> None:
+    # Before: controllers.py was imported as the module `controllers`, replacing slewbench's package:
+    # an ImportError traceback and "internal error", exit 1.
+    (tmp_path / "plug").mkdir()  # not the working directory, which `python -m` puts on the path
+    (tmp_path / "plug" / "controllers.py").write_text(CUBIC)
+    done = slewbench(["list"], tmp_path, plugins="./plug/controllers.py")
+    assert done.returncode == 0, done.stderr
+    assert "cubic_slew" in done.stdout and "Traceback" not in done.stderr
+
+
+def test_a_plugin_that_calls_sys_exit_is_a_plugin_error(tmp_path: Path) -> None:
+    (tmp_path / "quits.py").write_text("import sys\nsys.exit(3)\n")
+    done = slewbench(["list"], tmp_path, plugins="./quits.py")
+    assert done.returncode == 2, (done.returncode, done.stderr)
+    assert "plugin SLEWBENCH_PLUGINS file ./quits.py failed to load: SystemExit: 3" in done.stderr
+
+
+def test_a_file_the_script_imported_is_not_loaded_twice(tmp_path: Path) -> None:
+    # Before: the variable's file ran again as a second module, whose registration clashed with the
+    # script's own import ("already provided by slewbench").
+    (tmp_path / "cubic_slew.py").write_text(CUBIC)
+    (tmp_path / "cubic.yaml").write_text(SCENARIO)
+    code = ("import sys; sys.path.insert(0, '.'); import cubic_slew, scenarios\n"
+            "print(scenarios.load('cubic.yaml').planners[0].name)\n")
+    done = slewbench([], tmp_path, plugins="./cubic_slew.py", code=code)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "cubic_slew"
+
+
+def test_a_second_thread_waits_for_the_plugins(tmp_path: Path) -> None:
+    # Before: the second thread found the loading flag set, loaded nothing and went on before the
+    # plugin had registered its planner ("unknown planner 'cubic_slew'").
+    (tmp_path / "slow_cubic.py").write_text("import time\ntime.sleep(1.0)\n" + CUBIC)
+    (tmp_path / "cubic.yaml").write_text(SCENARIO)
+    code = ("import threading, scenarios\nout = {}\n"
+            "def go(k):\n    try:\n        out[k] = scenarios.load('cubic.yaml').planners[0].name\n"
+            "    except Exception as error:\n        out[k] = repr(error)\n"
+            "threads = [threading.Thread(target=go, args=(k,)) for k in (0, 1)]\n"
+            "[t.start() for t in threads]; [t.join() for t in threads]\nprint(sorted(out.values()))\n")
+    done = slewbench([], tmp_path, plugins="./slow_cubic.py", code=code)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "['cubic_slew', 'cubic_slew']", done.stdout

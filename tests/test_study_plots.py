@@ -32,7 +32,7 @@ BASE = {
     "name": "tiny",
     "spacecraft": {"inertia": [2.0, 3.0, 4.0], "wheels": {"max_torque": 0.05}},
     "maneuver": {"duration": 30.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
-                 "final": {"q": [0.9238795, 0.3826834, 0, 0], "omega": [0, 0, 0]}},
+                 "final": {"q": [0.9238795, 0.3826834, 0, 0], "omega": None}},  # spin extremals: free final rate
     "planners": [{"name": "eigenaxis", "label": "smooth"},
                  {"name": "spin_extremal", "label": "spin", "options": {"weight": 0.01}}],
     "controller": {"name": "augmented_quaternion_feedback", "options": {"kp": 0.2, "kd": 0.6}},

@@ -31,6 +31,7 @@ import importlib
 import importlib.util
 import os
 import sys
+import threading
 from collections.abc import Callable, MutableMapping
 from dataclasses import dataclass, field
 from importlib import metadata
@@ -75,8 +76,12 @@ class LoadedPlugin:
 
 _LOADED: dict[str, LoadedPlugin] = {}
 """Plugin key (``entry point <name>=<value>`` or ``SLEWBENCH_PLUGINS <entry>``) -> what it loaded."""
+_LOCK = threading.RLock()
+"""Held while plugins load: another thread waits for them; the loading thread may re-enter (a plugin
+that uses the library face) and gets nothing more to load."""
 _LOADING = False
-"""Set while plugins load: a plugin that uses the library face does not start loading again."""
+"""Set while plugins load in the thread holding :data:`_LOCK`: a plugin that uses the library face
+does not start loading again."""
 
 
 def registries() -> dict[str, MutableMapping[str, Any]]:
@@ -114,12 +119,24 @@ def _environment_entries() -> list[str]:
     return [entry.strip() for entry in os.environ.get(ENVIRONMENT_VARIABLE, "").split(",") if entry.strip()]
 
 
+FILE_MODULE_PREFIX = "slewbench_plugin_"
+"""A plugin file ``x.py`` is imported as the module ``slewbench_plugin_x``: a file named after a
+module already imported (``controllers.py``, ``yaml.py``) must not replace it."""
+
+
 def _import_file(path: str) -> ModuleType:
-    """Import a ``.py`` file as a module named after its stem (and keep it in ``sys.modules``)."""
+    """Import a ``.py`` file as the module :data:`FILE_MODULE_PREFIX` + its stem (kept in
+    ``sys.modules``); a module already imported from that very file (the user's script imported it)
+    is that module, not a second copy whose registrations would clash with the first's."""
     file = Path(path).expanduser()
     if not file.is_file():
         raise FileNotFoundError(f"no file {str(file)!r}")
-    name = file.stem
+    resolved = file.resolve()
+    for module in list(sys.modules.values()):
+        origin = getattr(module, "__file__", None)
+        if origin is not None and Path(origin).resolve() == resolved:
+            return module
+    name = FILE_MODULE_PREFIX + file.stem
     spec = importlib.util.spec_from_file_location(name, file)
     if spec is None or spec.loader is None:
         raise ImportError(f"cannot import {str(file)!r} as a module")
@@ -159,6 +176,16 @@ def _import_hint(label: str, error: BaseException) -> str:
     return ""
 
 
+_PACKAGES = ("ocp", "planners", "controllers", "scenarios")
+
+
+def _owner(value: Any) -> str:
+    """Who registered a name no plugin provided: slewbench, or the code of this process (a script
+    that registered before the plugins loaded), by the module of the registered class."""
+    module = str(getattr(value, "__module__", "") or "")
+    return "slewbench" if module.split(".")[0] in _PACKAGES else f"code in this process ({module or 'unknown module'})"
+
+
 def _load_one(label: str, load: Callable[[], Any], kinds: dict[str, MutableMapping[str, Any]]) -> LoadedPlugin:
     """Load one plugin, compare the registries before and after, and undo it on failure or a clash."""
     before = {kind: dict(registry) for kind, registry in kinds.items()}
@@ -178,11 +205,11 @@ def _load_one(label: str, load: Callable[[], Any], kinds: dict[str, MutableMappi
                             f"or a function of no arguments that registers it")
         if callable(loaded) and not isinstance(loaded, ModuleType):
             loaded()  # an entry point naming a function: it registers when called
-    except Exception as error:  # any failure of a user's code is reported as the plugin's
+    except (Exception, SystemExit) as error:  # any failure of a user's code (sys.exit too) is the plugin's
         undo()
         raise PluginError(f"plugin {label} failed to load: {type(error).__name__}: {error}"
                           f"{_import_hint(label, error)}") from error
-    clashes = [f"{kind} {name!r} (already provided by {provider(kind, name) or 'slewbench'})"
+    clashes = [f"{kind} {name!r} (already provided by {provider(kind, name) or _owner(value)})"
                for kind, registry in kinds.items() for name, value in before[kind].items()
                if name not in registry or registry[name] is not value]
     if clashes:
@@ -218,18 +245,19 @@ def load_plugins() -> list[LoadedPlugin]:
         those after it are not.
     """
     global _LOADING
-    if _LOADING:
-        return []
-    _LOADING = True
-    try:
-        kinds = registries()
-        done = []
-        for key, label, load in _pending():
-            _LOADED[key] = plugin = _load_one(label, load, kinds)
-            done.append(plugin)
-        return done
-    finally:
-        _LOADING = False
+    with _LOCK:  # another thread waits until the plugins are registered
+        if _LOADING:
+            return []
+        _LOADING = True
+        try:
+            kinds = registries()
+            done = []
+            for key, label, load in _pending():
+                _LOADED[key] = plugin = _load_one(label, load, kinds)
+                done.append(plugin)
+            return done
+        finally:
+            _LOADING = False
 
 
 def loaded_plugins() -> list[LoadedPlugin]:

@@ -206,7 +206,8 @@ def summary_line(cls: type, module_first: bool = True) -> str:
 def _summary_rst(cls: type, module_first: bool = True) -> str:
     """:func:`summary_line` as reStructuredText (the schema page's part introductions)."""
     module_doc = sys.modules[cls.__module__].__doc__ if module_first else None
-    doc = (module_doc or inspect.getdoc(cls) or "").strip()
+    own = cls.__dict__.get("__doc__")  # not the base class's (a plugin's class without a docstring)
+    doc = (module_doc or (inspect.cleandoc(own) if own else "") or "(no description: its class has no docstring)").strip()
     paragraph = " ".join(doc.split("\n\n")[0].split())
     sentence = re.match(r"(.+?[.:])\s+(?=[A-Z*`])", paragraph)  # not at "eq. 38"
     return (sentence.group(1) if sentence else paragraph).rstrip(".:") + "."
