@@ -114,7 +114,7 @@ _ACTUATORS = (
         "when it is not finite.", ("ref",)),
     RequirementField(
         "actuators", "unrealised_torque_time_s", "s", "time of unrealised torque",
-        "When that torque is asked.", ("ref",)),
+        "When that torque is asked; null when every torque asked is given.", ("ref",)),
 )
 _RATE = (
     RequirementField("rate", "peak_rate", "rad/s", "peak rate",

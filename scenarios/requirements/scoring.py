@@ -395,7 +395,7 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
         worst = int(np.argmax(norms)) if norms.size else 0
         peak = float(norms[worst]) if norms.size else 0.0
         scale = float(np.max(np.linalg.norm(torque, axis=1), initial=0.0))
-        values.update(zip(UNREALISED_FIELDS, (peak, float(t[worst]) if norms.size else None)))
+        values.update(zip(UNREALISED_FIELDS, (peak, float(t[worst]) if norms.size and peak > 0.0 else None)))
         unknown = ~np.isfinite(norms)
         if np.any(unknown):
             first = int(np.argmax(unknown))
