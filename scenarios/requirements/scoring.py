@@ -346,8 +346,9 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
             if np.linalg.norm(jump) > JUMP_TOLERANCE + 2.0 * instant * slope:  # beyond what ω̇ explains
                 # the first sample after the jump; a step at T is in the sample at T already (its
                 # contract: the rate after the step, Reference's breakpoints)
-                side = "left" if time >= reference.duration else "right"
-                found.append((float(time), int(np.searchsorted(t, time, side=side)), jump))
+                index = np.searchsorted(t, time, side="left") if time >= reference.duration else \
+                    np.searchsorted(t, time, side="right")
+                found.append((float(time), int(index), jump))
     return found
 
 
