@@ -469,8 +469,8 @@ class WheelBudget:
                              (self.linear, np.linalg.norm(momentum0))):
             values[~given & (np.abs(values) <= 1e-12 * scale_rows * size)] = 0.0
         self.accel[np.abs(self.accel) <= 1e-12 * np.max(np.abs(self.accel), initial=0.0)] = 0.0
-        self.torque_rate_cap = float(min((_positive_root(g, c, b) for g, c, b in
-                                          zip(self.quadratic, self.linear, self.bounds)), default=np.inf))
+        self.torque_rate_cap = _smallest_cap(*(_positive_root(g, c, b) for g, c, b in
+                                               zip(self.quadratic, self.linear, self.bounds)))
         sink = [a.name for a in spacecraft.actuators if a.residual_rank is not None]
         self.uncounted = "" if np.all(limits > 0) else (
             " (off the working wheels' span only magnetorquers act, whose torque depends on the field and "
@@ -554,14 +554,27 @@ class WheelBudget:
 
 
 def _positive_root(quadratic: float, linear: float, bound: float) -> float:
-    """The largest ``w >= 0`` with ``g w² + c w <= b`` (``inf`` when neither term grows)."""
-    if quadratic <= 0 and linear <= 0:
+    """The largest ``w >= 0`` with ``g w² + c w <= b`` (``inf`` when neither term grows or the
+    bound is infinite: an unlimited actuator caps no rate)."""
+    if (quadratic <= 0 and linear <= 0) or bound == np.inf:
         return np.inf
     if bound <= 0:
         return 0.0
     if quadratic <= 0:
         return bound / linear
     return float(2 * bound / (linear + np.sqrt(linear**2 + 4 * quadratic * bound)))
+
+
+def _smallest_cap(*caps: float) -> float:
+    """The smallest of rate caps, each ``>= 0`` or ``inf`` (``inf`` for none).
+
+    Python's ``min`` keeps or drops a NaN by its position, losing the real cap; a NaN here is a
+    bug upstream, so it is refused rather than compared.
+    """
+    values = np.asarray(caps, dtype=float)
+    if np.any(np.isnan(values)):
+        raise AssertionError(f"a rate cap is NaN: {values.tolist()}")
+    return float(np.min(values, initial=np.inf))
 
 
 class EigenaxisPlanner(Planner):
@@ -743,7 +756,7 @@ class EigenaxisPlanner(Planner):
             return FailedReference(self.name, f"the actuators give no torque about the axis {axis.round(4).tolist()}"
                                    f"{budget.uncounted}", "infeasible")
         momentum_cap = budget.momentum_rate_cap
-        rate_cap = min(max_rate if max_rate is not None else np.inf, budget.torque_rate_cap, momentum_cap)
+        rate_cap = _smallest_cap(max_rate if max_rate is not None else np.inf, budget.torque_rate_cap, momentum_cap)
         if rate_cap <= 0:
             why = ("the stored momentum, turning in the body with the rotation, takes a working wheel beyond "
                    "its max_momentum" if momentum_cap <= 0 else
@@ -760,7 +773,7 @@ class EigenaxisPlanner(Planner):
         # With no rate-dependent term the optimum is the triangle w = sqrt(Θ α); else a bounded 1-D search.
         peak = np.sqrt(angle * acceleration(0.0))
         if (np.all(quadratic == 0) and np.all(linear == 0)) or not np.isfinite(rate_cap):
-            best_rate = min(peak, rate_cap)
+            best_rate = _smallest_cap(peak, rate_cap)
         else:
             best_rate = golden_section_minimum(slew_time, 1e-9 * peak, min(peak, rate_cap), 1e-12 * peak)
         best_rate = min(best_rate, np.sqrt(angle * acceleration(best_rate)))  # a triangle never coasts faster
