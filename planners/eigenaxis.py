@@ -356,11 +356,31 @@ def sinusoid_peak(const: Array, cos: Array, sin: Array, span: float) -> Array:
     (m,) ndarray
         The peak per row.
     """
+    return np.maximum(sinusoid_max(const, cos, sin, span), sinusoid_max(-const, -cos, -sin, span))
+
+
+def sinusoid_max(const: Array, cos: Array, sin: Array, span: float) -> Array:
+    """``max (k + c cos θ + s sin θ)`` (signed) over ``θ ∈ [0, span]``, row by row (``span <= π``).
+
+    The extrema are at the ends or where the derivative vanishes, ``θ = atan2(s, c) (+ π)``.
+
+    Parameters
+    ----------
+    const, cos, sin : (m,) ndarray
+        ``k``, ``c`` and ``s`` per row.
+    span : float
+        The interval's length [rad], in ``[0, π]``.
+
+    Returns
+    -------
+    (m,) ndarray
+        The maximum per row.
+    """
     stationary = np.arctan2(sin, cos) % (2 * np.pi)
     candidates = [np.zeros_like(cos), np.full_like(cos, span)]
     for theta in (stationary, (stationary + np.pi) % (2 * np.pi)):
         candidates.append(np.where(theta <= span, theta, 0.0))
-    return np.max([np.abs(const + cos * np.cos(t) + sin * np.sin(t)) for t in candidates], axis=0)
+    return np.max([const + cos * np.cos(t) + sin * np.sin(t) for t in candidates], axis=0)
 
 
 class WheelBudget:
@@ -379,8 +399,13 @@ class WheelBudget:
       rotation ``θ ∈ [0, Θ]`` (a sinusoid in θ: :func:`sinusoid_peak`). Exact when ``H_0 = 0``
       (``|a_j| α <= f L_j``: the wheels' torque is ``A⁺ I e θ̈``); with stored momentum, sound
       (``θ̇ <= w`` and the peak over the rotation taken together). The working wheels' momenta,
-      ``h_w(θ) = h_w0 + A⁺ (H(θ) − H_0) − A⁺ I e θ̇``, bound the coast rate the same way (exact
-      with ``H_0 = 0``: ``w <= h_max,i / |(A⁺ I e)_i|``).
+      ``h_w = s(θ) − p θ̇`` with ``s(θ) = h_w0 + A⁺ (H(θ) − H_0)`` and ``p = A⁺ I e``, bound the
+      coast rate: ``θ̇`` runs over ``[0, w]`` (rest to rest), so each wheel needs
+      ``|s_i(θ)| <= h_max,i`` and ``s_i(θ) − p_i w`` within ``±h_max,i`` on the side ``p_i``
+      pushes it, ``w <= (h_max,i − max_θ (−sign(p_i) s_i(θ))) / |p_i|``. Exact with ``H_0 = 0``
+      (``s_i = h_w0,i``, a null-space bias included: ``w <= (h_max,i + sign(p_i) h_w0,i) / |p_i|``);
+      with stored momentum, sound and conservative where it takes every θ with every
+      ``θ̇ ∈ [0, w]`` (the coast rate is reached only mid-slew, rest only at the ends).
     * no working wheel (torquers only, or every wheel failed): ``A h_w`` is the failed wheels'
       constant ``W_0`` and ``τ = I e θ̈ + θ̇² e × I e + θ̇ e × W_0``: ``a = M I e``,
       ``g = |M (e × I e)|``, ``c = |M (e × W_0)|``; exact when ``W_0 = 0`` (one of the two bangs
@@ -449,13 +474,19 @@ class WheelBudget:
             self.quadratic = np.zeros(len(rows))
             self.linear = sinusoid_peak(np.zeros(len(rows)), rows @ np.cross(axis, momentum0),
                                         rows @ (momentum0 - parallel), angle)
-            across = momentum0 - parallel  # h_w(θ) = h0 + A⁺((cos θ − 1) H⊥ − sin θ e × H0) − A⁺ I e θ̇
-            peak = sinusoid_peak(self.h0 - self.pinv @ across, self.pinv @ across,
-                                 -self.pinv @ np.cross(axis, momentum0).astype(float), angle)
-            per_rate = np.abs(self.pinv @ inertia_axis)
+            # h_w(θ, θ̇) = s(θ) − p θ̇, s(θ) = h0 + A⁺((cos θ − 1) H⊥ − sin θ e × H0), p = A⁺ I e, and
+            # θ̇ in [0, w] (rest to rest): |s_i| <= h_max and s_i − p_i w on the side p_i pushes to.
+            across = momentum0 - parallel
+            stored = (self.h0 - self.pinv @ across, self.pinv @ across,
+                      -self.pinv @ np.cross(axis, momentum0).astype(float))
+            peak = sinusoid_peak(*stored, angle)
+            per_rate = self.pinv @ inertia_axis
+            side = np.sign(per_rate)
+            toward = sinusoid_max(*(-side * term for term in stored), angle)  # max over θ of −sign(p_i) s_i(θ)
             with np.errstate(divide="ignore", invalid="ignore"):
-                caps = np.where(per_rate > 1e-12 * np.linalg.norm(inertia_axis),
-                                (self.h_max - peak) / per_rate, np.where(peak <= self.h_max, np.inf, 0.0))
+                caps = np.where(peak > self.h_max, 0.0,
+                                np.where(np.abs(per_rate) > 1e-12 * np.linalg.norm(inertia_axis),
+                                         (self.h_max - toward) / np.abs(per_rate), np.inf))
             self.momentum_rate_cap = float(max(np.min(caps, initial=np.inf), 0.0))
         else:
             self.quadratic = np.abs(rows @ np.cross(axis, inertia_axis))
