@@ -412,7 +412,8 @@ class WheelBudget:
       adds the gyroscopic term at the coast rate).
     * wheels spanning fewer than three axes (beside torquers, which change ``H``): the rows of the
       first case are an estimate, not a bound (:attr:`exact` is False): :meth:`integrated_ratios`
-      measures the profile's demand, and the planner shrinks the budget until it holds.
+      measures the profile's demand, and the planner stretches the profile until it holds (a
+      momentum cap of 0 from the estimate refuses nothing: the measurement decides).
 
     Parameters
     ----------
@@ -477,12 +478,12 @@ class WheelBudget:
             # h_w(θ, θ̇) = s(θ) − p θ̇, s(θ) = h0 + A⁺((cos θ − 1) H⊥ − sin θ e × H0), p = A⁺ I e, and
             # θ̇ in [0, w] (rest to rest): |s_i| <= h_max and s_i − p_i w on the side p_i pushes to.
             across = momentum0 - parallel
-            stored = (self.h0 - self.pinv @ across, self.pinv @ across,
-                      -self.pinv @ np.cross(axis, momentum0).astype(float))
-            peak = sinusoid_peak(*stored, angle)
+            const, cos = self.h0 - self.pinv @ across, self.pinv @ across
+            sin = -self.pinv @ np.cross(axis, momentum0).astype(float)
+            peak = sinusoid_peak(const, cos, sin, angle)
             per_rate = self.pinv @ inertia_axis
             side = np.sign(per_rate)
-            toward = sinusoid_max(*(-side * term for term in stored), angle)  # max over θ of −sign(p_i) s_i(θ)
+            toward = sinusoid_max(-side * const, -side * cos, -side * sin, angle)  # max over θ of −sign(p_i) s_i(θ)
             with np.errstate(divide="ignore", invalid="ignore"):
                 caps = np.where(peak > self.h_max, 0.0,
                                 np.where(np.abs(per_rate) > 1e-12 * np.linalg.norm(inertia_axis),
@@ -726,23 +727,54 @@ class EigenaxisPlanner(Planner):
         fastest = self._bang(problem, axis, angle, max_rate, budget, "min_time")
         if not isinstance(fastest, EigenaxisReference):
             return fastest
-        profile = fastest.profile
-        assert isinstance(profile, BangCoastBangProfile)
+        base = fastest.profile
+        assert isinstance(base, BangCoastBangProfile)
+
+        def stretched_by(k: float) -> BangCoastBangProfile:
+            return BangCoastBangProfile(angle, base.alpha / k**2, base.rate_max / k)
+
+        def excess(k: float, step_angle: float = 0.002) -> float:
+            """``max(sqrt(torque ratio), momentum ratio)`` of the profile stretched ``k`` x (inf off the span)."""
+            torque_ratio, momentum_ratio = budget.integrated_ratios(stretched_by(k), step_angle)
+            return max(np.sqrt(torque_ratio), momentum_ratio)
+
+        off_span = FailedReference(self.name, f"the profile about {axis.round(4).tolist()} asks a torque off the "
+                                   f"working wheels' span{budget.uncounted}", "infeasible")
         stretched = 1.0
-        for _ in range(20):
-            torque_ratio, momentum_ratio = budget.integrated_ratios(profile)
-            if not (np.isfinite(torque_ratio) and np.isfinite(momentum_ratio)):
-                return FailedReference(self.name, f"the profile about {axis.round(4).tolist()} asks a torque off the "
-                                       f"working wheels' span{budget.uncounted}", "infeasible")
-            stretch = max(np.sqrt(torque_ratio), momentum_ratio)
+        for _ in range(8):
+            stretch = excess(stretched)
+            if not np.isfinite(stretch):
+                return off_span
             if stretch <= 1 + 1e-9:
                 break
-            stretch *= 1 + 1e-9
-            stretched *= stretch
-            profile = BangCoastBangProfile(angle, profile.alpha / stretch**2, profile.rate_max / stretch)
+            stretched *= stretch * (1 + 1e-9)
         else:
-            return FailedReference(self.name, "the bang-coast-bang profile's demand, measured by integration, "
-                                   "stayed above the bounds after 20 stretches", "infeasible")
+            # Stored momentum: the wheels' momenta have a part the rotation itself moves, which no
+            # stretch scales down, and the stretches above converge slowly. Bracket and bisect (on
+            # coarser steps), then verify on the fine ones.
+            low, high = stretched, 2 * stretched
+            while (stretch := excess(high, 0.01)) > 1:
+                if not np.isfinite(stretch):
+                    return off_span
+                if high > 1e6 * stretched:
+                    return FailedReference(self.name, f"the bang-coast-bang profile's demand, measured by integration, "
+                                           f"stays {stretch:.4g} x a bound even {high:.3g} x slower than the fastest "
+                                           f"under the estimate (the stored momentum, moved by the rotation itself, "
+                                           f"takes a working wheel beyond its max_momentum)", "infeasible")
+                low, high = high, 4 * high
+            while high > low * (1 + 1e-4):
+                middle = 0.5 * (low + high)
+                low, high = (low, middle) if excess(middle, 0.01) <= 1 else (middle, high)
+            for _ in range(8):
+                stretch = excess(high)
+                if stretch <= 1 + 1e-9:
+                    break
+                high *= max(stretch, 1 + 1e-6)
+            else:
+                return FailedReference(self.name, "the bang-coast-bang profile's demand, measured by integration, "
+                                       "stayed above the bounds after the stretches", "infeasible")
+            stretched = high
+        profile = stretched_by(stretched)
         # Without torquers nothing torques the spacecraft from outside (H conserved: the budget was
         # exact); with them an unstretched profile is feasible but not proven the fastest.
         torquers = bool(np.any(budget.limits[len(budget.h0):] > 0))
@@ -787,6 +819,8 @@ class EigenaxisPlanner(Planner):
             return FailedReference(self.name, f"the actuators give no torque about the axis {axis.round(4).tolist()}"
                                    f"{budget.uncounted}", "infeasible")
         momentum_cap = budget.momentum_rate_cap
+        if not budget.exact and momentum_cap <= 0:  # an estimate (H not conserved): the integration decides
+            momentum_cap = np.inf
         rate_cap = _smallest_cap(max_rate if max_rate is not None else np.inf, budget.torque_rate_cap, momentum_cap)
         if rate_cap <= 0:
             why = ("the stored momentum, turning in the body with the rotation, takes a working wheel beyond "
