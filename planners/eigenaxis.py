@@ -779,7 +779,7 @@ class EigenaxisPlanner(Planner):
         # exact); with them an unstretched profile is feasible but not proven the fastest.
         torquers = bool(np.any(budget.limits[len(budget.h0):] > 0))
         words = "verified by integration through the allocation: the working wheels span fewer than three axes"
-        if stretched > 1:
+        if stretched > 1 + 1e-6:  # not the rounding margin of the verification
             words += f"; stretched {stretched:.4g} x in time to meet the bounds, feasible, not the minimum time"
         elif torquers:
             words += "; feasible, not proven the minimum time (the torquers change the total momentum)"

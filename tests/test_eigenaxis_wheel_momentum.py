@@ -356,3 +356,22 @@ def test_two_wheels_with_stored_momentum_are_measured_not_refused_by_the_estimat
         assert quat.error_angle(q_end, problem.qf) < 1e-6 and np.linalg.norm(omega_end) < 1e-8
         if profile == "min_time":  # the stretch stops at a bound (within the bisection's 1e-4)
             assert max(peak_g / G_MAX, peak_h / H_MAX, np.max(torquer) / 0.002) >= 1 - 1e-3
+
+
+def test_a_rounding_stretch_is_not_reported_as_one_x(monkeypatch):
+    """A first measurement 5e-9 above the bound stretches the profile by 1 + 6e-9: no "stretched
+    1 x in time" in the message (pyr_mtq.yaml's carried axis, whose estimate holds)."""
+    axes = pyramid(54.7356)
+    wheels = ReactionWheels(axes, max_torque=G_MAX, max_momentum=H_MAX, failed=[0, 2])
+    problem = problem_for(wheels, [0, 1, 1], 90.0, duration=300.0, magnetorquers=Magnetorquers(1.0))
+    measured = WheelBudget.integrated_ratios
+    calls = []
+
+    def first_just_above(self, profile, step_angle=0.002):
+        calls.append(profile)
+        return (1.0, 1 + 5e-9) if len(calls) == 1 else measured(self, profile, step_angle)
+
+    monkeypatch.setattr(WheelBudget, "integrated_ratios", first_just_above)
+    reference = plan(problem, "min_time")
+    assert reference.status == "ok", reference.message
+    assert len(calls) >= 2 and "stretched" not in reference.message, reference.message
