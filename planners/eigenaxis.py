@@ -356,11 +356,31 @@ def sinusoid_peak(const: Array, cos: Array, sin: Array, span: float) -> Array:
     (m,) ndarray
         The peak per row.
     """
+    return np.maximum(sinusoid_max(const, cos, sin, span), sinusoid_max(-const, -cos, -sin, span))
+
+
+def sinusoid_max(const: Array, cos: Array, sin: Array, span: float) -> Array:
+    """``max (k + c cos θ + s sin θ)`` (signed) over ``θ ∈ [0, span]``, row by row (``span <= π``).
+
+    The extrema are at the ends or where the derivative vanishes, ``θ = atan2(s, c) (+ π)``.
+
+    Parameters
+    ----------
+    const, cos, sin : (m,) ndarray
+        ``k``, ``c`` and ``s`` per row.
+    span : float
+        The interval's length [rad], in ``[0, π]``.
+
+    Returns
+    -------
+    (m,) ndarray
+        The maximum per row.
+    """
     stationary = np.arctan2(sin, cos) % (2 * np.pi)
     candidates = [np.zeros_like(cos), np.full_like(cos, span)]
     for theta in (stationary, (stationary + np.pi) % (2 * np.pi)):
         candidates.append(np.where(theta <= span, theta, 0.0))
-    return np.max([np.abs(const + cos * np.cos(t) + sin * np.sin(t)) for t in candidates], axis=0)
+    return np.max([const + cos * np.cos(t) + sin * np.sin(t) for t in candidates], axis=0)
 
 
 class WheelBudget:
@@ -379,15 +399,21 @@ class WheelBudget:
       rotation ``θ ∈ [0, Θ]`` (a sinusoid in θ: :func:`sinusoid_peak`). Exact when ``H_0 = 0``
       (``|a_j| α <= f L_j``: the wheels' torque is ``A⁺ I e θ̈``); with stored momentum, sound
       (``θ̇ <= w`` and the peak over the rotation taken together). The working wheels' momenta,
-      ``h_w(θ) = h_w0 + A⁺ (H(θ) − H_0) − A⁺ I e θ̇``, bound the coast rate the same way (exact
-      with ``H_0 = 0``: ``w <= h_max,i / |(A⁺ I e)_i|``).
+      ``h_w = s(θ) − p θ̇`` with ``s(θ) = h_w0 + A⁺ (H(θ) − H_0)`` and ``p = A⁺ I e``, bound the
+      coast rate: ``θ̇`` runs over ``[0, w]`` (rest to rest), so each wheel needs
+      ``|s_i(θ)| <= h_max,i`` and ``s_i(θ) − p_i w`` within ``±h_max,i`` on the side ``p_i``
+      pushes it, ``w <= (h_max,i − max_θ (−sign(p_i) s_i(θ))) / |p_i|``. Exact with ``H_0 = 0``
+      (``s_i = h_w0,i``, a null-space bias included: ``w <= (h_max,i + sign(p_i) h_w0,i) / |p_i|``);
+      with stored momentum, sound and conservative where it takes every θ with every
+      ``θ̇ ∈ [0, w]`` (the coast rate is reached only mid-slew, rest only at the ends).
     * no working wheel (torquers only, or every wheel failed): ``A h_w`` is the failed wheels'
       constant ``W_0`` and ``τ = I e θ̈ + θ̇² e × I e + θ̇ e × W_0``: ``a = M I e``,
       ``g = |M (e × I e)|``, ``c = |M (e × W_0)|``; exact when ``W_0 = 0`` (one of the two bangs
       adds the gyroscopic term at the coast rate).
     * wheels spanning fewer than three axes (beside torquers, which change ``H``): the rows of the
       first case are an estimate, not a bound (:attr:`exact` is False): :meth:`integrated_ratios`
-      measures the profile's demand, and the planner shrinks the budget until it holds.
+      measures the profile's demand, and the planner stretches the profile until it holds (a
+      momentum cap of 0 from the estimate refuses nothing: the measurement decides).
 
     Parameters
     ----------
@@ -449,13 +475,19 @@ class WheelBudget:
             self.quadratic = np.zeros(len(rows))
             self.linear = sinusoid_peak(np.zeros(len(rows)), rows @ np.cross(axis, momentum0),
                                         rows @ (momentum0 - parallel), angle)
-            across = momentum0 - parallel  # h_w(θ) = h0 + A⁺((cos θ − 1) H⊥ − sin θ e × H0) − A⁺ I e θ̇
-            peak = sinusoid_peak(self.h0 - self.pinv @ across, self.pinv @ across,
-                                 -self.pinv @ np.cross(axis, momentum0).astype(float), angle)
-            per_rate = np.abs(self.pinv @ inertia_axis)
+            # h_w(θ, θ̇) = s(θ) − p θ̇, s(θ) = h0 + A⁺((cos θ − 1) H⊥ − sin θ e × H0), p = A⁺ I e, and
+            # θ̇ in [0, w] (rest to rest): |s_i| <= h_max and s_i − p_i w on the side p_i pushes to.
+            across = momentum0 - parallel
+            const, cos = self.h0 - self.pinv @ across, self.pinv @ across
+            sin = -self.pinv @ np.cross(axis, momentum0).astype(float)
+            peak = sinusoid_peak(const, cos, sin, angle)
+            per_rate = self.pinv @ inertia_axis
+            side = np.sign(per_rate)
+            toward = sinusoid_max(-side * const, -side * cos, -side * sin, angle)  # max over θ of −sign(p_i) s_i(θ)
             with np.errstate(divide="ignore", invalid="ignore"):
-                caps = np.where(per_rate > 1e-12 * np.linalg.norm(inertia_axis),
-                                (self.h_max - peak) / per_rate, np.where(peak <= self.h_max, np.inf, 0.0))
+                caps = np.where(peak > self.h_max, 0.0,
+                                np.where(np.abs(per_rate) > 1e-12 * np.linalg.norm(inertia_axis),
+                                         (self.h_max - toward) / np.abs(per_rate), np.inf))
             self.momentum_rate_cap = float(max(np.min(caps, initial=np.inf), 0.0))
         else:
             self.quadratic = np.abs(rows @ np.cross(axis, inertia_axis))
@@ -469,8 +501,8 @@ class WheelBudget:
                              (self.linear, np.linalg.norm(momentum0))):
             values[~given & (np.abs(values) <= 1e-12 * scale_rows * size)] = 0.0
         self.accel[np.abs(self.accel) <= 1e-12 * np.max(np.abs(self.accel), initial=0.0)] = 0.0
-        self.torque_rate_cap = float(min((_positive_root(g, c, b) for g, c, b in
-                                          zip(self.quadratic, self.linear, self.bounds)), default=np.inf))
+        self.torque_rate_cap = _smallest_cap(*(_positive_root(g, c, b) for g, c, b in
+                                               zip(self.quadratic, self.linear, self.bounds)))
         sink = [a.name for a in spacecraft.actuators if a.residual_rank is not None]
         self.uncounted = "" if np.all(limits > 0) else (
             " (off the working wheels' span only magnetorquers act, whose torque depends on the field and "
@@ -554,14 +586,27 @@ class WheelBudget:
 
 
 def _positive_root(quadratic: float, linear: float, bound: float) -> float:
-    """The largest ``w >= 0`` with ``g w² + c w <= b`` (``inf`` when neither term grows)."""
-    if quadratic <= 0 and linear <= 0:
+    """The largest ``w >= 0`` with ``g w² + c w <= b`` (``inf`` when neither term grows or the
+    bound is infinite: an unlimited actuator caps no rate)."""
+    if (quadratic <= 0 and linear <= 0) or bound == np.inf:
         return np.inf
     if bound <= 0:
         return 0.0
     if quadratic <= 0:
         return bound / linear
     return float(2 * bound / (linear + np.sqrt(linear**2 + 4 * quadratic * bound)))
+
+
+def _smallest_cap(*caps: float) -> float:
+    """The smallest of rate caps, each ``>= 0`` or ``inf`` (``inf`` for none).
+
+    Python's ``min`` keeps or drops a NaN by its position, losing the real cap; a NaN here is a
+    bug upstream, so it is refused rather than compared.
+    """
+    values = np.asarray(caps, dtype=float)
+    if np.any(np.isnan(values)):
+        raise AssertionError(f"a rate cap is NaN: {values.tolist()}")
+    return float(np.min(values, initial=np.inf))
 
 
 class EigenaxisPlanner(Planner):
@@ -682,28 +727,59 @@ class EigenaxisPlanner(Planner):
         fastest = self._bang(problem, axis, angle, max_rate, budget, "min_time")
         if not isinstance(fastest, EigenaxisReference):
             return fastest
-        profile = fastest.profile
-        assert isinstance(profile, BangCoastBangProfile)
+        base = fastest.profile
+        assert isinstance(base, BangCoastBangProfile)
+
+        def stretched_by(k: float) -> BangCoastBangProfile:
+            return BangCoastBangProfile(angle, base.alpha / k**2, base.rate_max / k)
+
+        def excess(k: float, step_angle: float = 0.002) -> float:
+            """``max(sqrt(torque ratio), momentum ratio)`` of the profile stretched ``k`` x (inf off the span)."""
+            torque_ratio, momentum_ratio = budget.integrated_ratios(stretched_by(k), step_angle)
+            return max(np.sqrt(torque_ratio), momentum_ratio)
+
+        off_span = FailedReference(self.name, f"the profile about {axis.round(4).tolist()} asks a torque off the "
+                                   f"working wheels' span{budget.uncounted}", "infeasible")
         stretched = 1.0
-        for _ in range(20):
-            torque_ratio, momentum_ratio = budget.integrated_ratios(profile)
-            if not (np.isfinite(torque_ratio) and np.isfinite(momentum_ratio)):
-                return FailedReference(self.name, f"the profile about {axis.round(4).tolist()} asks a torque off the "
-                                       f"working wheels' span{budget.uncounted}", "infeasible")
-            stretch = max(np.sqrt(torque_ratio), momentum_ratio)
+        for _ in range(8):
+            stretch = excess(stretched)
+            if not np.isfinite(stretch):
+                return off_span
             if stretch <= 1 + 1e-9:
                 break
-            stretch *= 1 + 1e-9
-            stretched *= stretch
-            profile = BangCoastBangProfile(angle, profile.alpha / stretch**2, profile.rate_max / stretch)
+            stretched *= stretch * (1 + 1e-9)
         else:
-            return FailedReference(self.name, "the bang-coast-bang profile's demand, measured by integration, "
-                                   "stayed above the bounds after 20 stretches", "infeasible")
+            # Stored momentum: the wheels' momenta have a part the rotation itself moves, which no
+            # stretch scales down, and the stretches above converge slowly. Bracket and bisect (on
+            # coarser steps), then verify on the fine ones.
+            low, high = stretched, 2 * stretched
+            while (stretch := excess(high, 0.01)) > 1:
+                if not np.isfinite(stretch):
+                    return off_span
+                if high > 1e6 * stretched:
+                    return FailedReference(self.name, f"the bang-coast-bang profile's demand, measured by integration, "
+                                           f"stays {stretch:.4g} x a bound even {high:.3g} x slower than the fastest "
+                                           f"under the estimate (the stored momentum, moved by the rotation itself, "
+                                           f"takes a working wheel beyond its max_momentum)", "infeasible")
+                low, high = high, 4 * high
+            while high > low * (1 + 1e-4):
+                middle = 0.5 * (low + high)
+                low, high = (low, middle) if excess(middle, 0.01) <= 1 else (middle, high)
+            for _ in range(8):
+                stretch = excess(high)
+                if stretch <= 1 + 1e-9:
+                    break
+                high *= max(stretch, 1 + 1e-6)
+            else:
+                return FailedReference(self.name, "the bang-coast-bang profile's demand, measured by integration, "
+                                       "stayed above the bounds after the stretches", "infeasible")
+            stretched = high
+        profile = stretched_by(stretched)
         # Without torquers nothing torques the spacecraft from outside (H conserved: the budget was
         # exact); with them an unstretched profile is feasible but not proven the fastest.
         torquers = bool(np.any(budget.limits[len(budget.h0):] > 0))
         words = "verified by integration through the allocation: the working wheels span fewer than three axes"
-        if stretched > 1:
+        if stretched > 1 + 1e-6:  # not the rounding margin of the verification
             words += f"; stretched {stretched:.4g} x in time to meet the bounds, feasible, not the minimum time"
         elif torquers:
             words += "; feasible, not proven the minimum time (the torquers change the total momentum)"
@@ -743,7 +819,9 @@ class EigenaxisPlanner(Planner):
             return FailedReference(self.name, f"the actuators give no torque about the axis {axis.round(4).tolist()}"
                                    f"{budget.uncounted}", "infeasible")
         momentum_cap = budget.momentum_rate_cap
-        rate_cap = min(max_rate if max_rate is not None else np.inf, budget.torque_rate_cap, momentum_cap)
+        if not budget.exact and momentum_cap <= 0:  # an estimate (H not conserved): the integration decides
+            momentum_cap = np.inf
+        rate_cap = _smallest_cap(max_rate if max_rate is not None else np.inf, budget.torque_rate_cap, momentum_cap)
         if rate_cap <= 0:
             why = ("the stored momentum, turning in the body with the rotation, takes a working wheel beyond "
                    "its max_momentum" if momentum_cap <= 0 else
@@ -760,7 +838,7 @@ class EigenaxisPlanner(Planner):
         # With no rate-dependent term the optimum is the triangle w = sqrt(Θ α); else a bounded 1-D search.
         peak = np.sqrt(angle * acceleration(0.0))
         if (np.all(quadratic == 0) and np.all(linear == 0)) or not np.isfinite(rate_cap):
-            best_rate = min(peak, rate_cap)
+            best_rate = _smallest_cap(peak, rate_cap)
         else:
             best_rate = golden_section_minimum(slew_time, 1e-9 * peak, min(peak, rate_cap), 1e-12 * peak)
         best_rate = min(best_rate, np.sqrt(angle * acceleration(best_rate)))  # a triangle never coasts faster

@@ -43,11 +43,15 @@ def plan(problem, profile, **options):
     return PLANNERS["eigenaxis"]({"profile": profile, **options}).plan(problem)
 
 
-def closed_form_time(axes, working, axis, angle, g_max, h_max=np.inf):
+def closed_form_time(axes, working, axis, angle, g_max, h_max=np.inf, bias=None):
     """Bang-coast-bang from rest with zero total momentum: α = g_max / max|A⁺ I e|, the coast rate
-    at most h_max / max|A⁺ I e| (the wheels' momentum ``−A⁺ I e θ̇``)."""
-    per_unit = np.abs(np.linalg.pinv(axes[:, working]) @ (INERTIA @ axis))
-    alpha, w_max = g_max / per_unit.max(), h_max / per_unit.max()
+    at most h_max / max|A⁺ I e| (the wheels' momentum ``−A⁺ I e θ̇``); with a null-space ``bias``
+    (the working wheels' momenta, ``A b = 0``) each wheel's momentum ``b_i − p_i θ̇``,
+    ``p = A⁺ I e``, ``θ̇`` in [0, w], gives ``w <= (h_max + sign(p_i) b_i) / |p_i|``."""
+    signed = np.linalg.pinv(axes[:, working]) @ (INERTIA @ axis)
+    per_unit = np.abs(signed)
+    bias = np.zeros(len(signed)) if bias is None else np.asarray(bias, float)
+    alpha, w_max = g_max / per_unit.max(), np.min((h_max + np.sign(signed) * bias) / per_unit)
     if angle <= w_max**2 / alpha:
         return 2 * np.sqrt(angle / alpha)
     return angle / w_max + w_max / alpha
@@ -271,3 +275,103 @@ def test_torquers_alone_keep_the_rigid_body_budget():
     assert budget.exact and np.all(budget.linear == 0)
     profile = reference.profile
     assert isinstance(profile, BangCoastBangProfile)
+
+
+def test_a_null_space_bias_caps_the_coast_by_the_signed_momentum():
+    """Total momentum zero, wheel momenta b = 0.02367 [−1, 1, −1, 1] (a pyramid's null space): each
+    wheel's momentum is b_i − p_i θ̇ with θ̇ in [0, w], so the cap is (h_max + sign(p_i) b_i) / |p_i|,
+    not (h_max − |b_i|) / |p_i|: the bound |b_i| + |p_i| w planned 134.899 s "capped by the wheels'
+    momentum bound" at h / h_max 0.73 against the closed form's 70.289 s. The planned profile is the
+    closed form, and solve_ivp of it reaches both the torque and the momentum bound."""
+    axes = pyramid(54.7356)
+    working = np.ones(4, bool)
+    wheels = ReactionWheels(axes, max_torque=G_MAX, max_momentum=H_MAX)
+    axis = np.array([-0.12444036, 0.76206052, 0.63543557])
+    axis /= np.linalg.norm(axis)
+    bias = 0.02367028 * np.array([-1.0, 1.0, -1.0, 1.0])
+    assert np.allclose(axes @ bias, 0.0, atol=1e-15)
+    problem = problem_for(wheels, axis, 100.16211850693114, h0=bias)
+    expected = closed_form_time(axes, working, axis, np.radians(100.16211850693114), G_MAX, H_MAX, bias)
+    assert expected == pytest.approx(70.289, abs=1e-3)
+    fastest = plan(problem, "min_time")
+    assert fastest.status == "ok", fastest.message
+    assert fastest.duration == pytest.approx(expected, rel=1e-9)
+    assert "capped by the wheels' momentum bound" in fastest.message
+    peak_g, peak_h, q_end, omega_end, _ = simulate(fastest, axes, working, bias)
+    assert peak_g == pytest.approx(G_MAX, rel=1e-6) and peak_h == pytest.approx(H_MAX, rel=1e-6)
+    assert quat.error_angle(q_end, problem.qf) < 1e-6 and np.linalg.norm(omega_end) < 1e-8
+    fixed = plan(problem_for(wheels, axis, 100.16211850693114, duration=1.01 * expected, h0=bias), "trapezoidal")
+    assert fixed.status == "ok", fixed.message
+    short = plan(problem_for(wheels, axis, 100.16211850693114, duration=0.99 * expected, h0=bias), "trapezoidal")
+    assert short.status == "infeasible" and "momentum" in short.message
+
+
+def test_null_space_biases_give_the_closed_form_and_stored_momentum_stays_within_the_bound(rng):
+    """Random axes, angles and null-space biases on the full pyramid: min_time is the closed form
+    to 1e-9. Random stored momenta (H ≠ 0, a wheel failed): solve_ivp keeps every working wheel
+    within max_momentum (the bound is sound there, conservative where it pairs every θ with
+    every θ̇ in [0, w])."""
+    axes = pyramid(54.7356)
+    null = np.array([1.0, -1.0, 1.0, -1.0])
+    wheels = ReactionWheels(axes, max_torque=G_MAX, max_momentum=H_MAX)
+    for _ in range(15):
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        angle = rng.uniform(60.0, 170.0)
+        bias = rng.uniform(-0.03, 0.03) * null
+        reference = plan(problem_for(wheels, axis, angle, h0=bias), "min_time")
+        assert reference.status == "ok", reference.message
+        expected = closed_form_time(axes, np.ones(4, bool), axis, np.radians(angle), G_MAX, H_MAX, bias)
+        assert reference.duration == pytest.approx(expected, rel=1e-9)
+    for _ in range(4):
+        failed = int(rng.integers(4))
+        wheels = ReactionWheels(axes, max_torque=G_MAX, max_momentum=H_MAX, failed=[failed])
+        h0 = rng.uniform(-0.02, 0.02, 4)
+        axis = rng.normal(size=3)
+        problem = problem_for(wheels, axis, rng.uniform(40.0, 170.0), h0=h0)
+        reference = plan(problem, "min_time")
+        assert reference.status == "ok", reference.message
+        peak_g, peak_h, q_end, _, _ = simulate(reference, axes, wheels.working, h0)
+        assert peak_g <= G_MAX * (1 + 1e-6) and peak_h <= H_MAX * (1 + 1e-6), (peak_g, peak_h)
+        assert quat.error_angle(q_end, problem.qf) < 1e-6
+
+
+def test_two_wheels_with_stored_momentum_are_measured_not_refused_by_the_estimate():
+    """Wheels 1 and 3 failed, torquers 0.002 N m, stored momentum, 81.47 deg: the conserved-H
+    estimate of the wheels' momentum (an estimate: the torquers change H) exceeded max_momentum
+    and refused "no rotation ... is feasible" before the integration ran. Measured by integration
+    and stretched, the profile is feasible: solve_ivp of it keeps every bound and reaches the
+    target."""
+    axes = pyramid(54.7356)
+    wheels = ReactionWheels(axes, max_torque=G_MAX, max_momentum=H_MAX, failed=[1, 3])
+    h0 = np.array([0.0265, 0.0469, 0.0019, -0.0095])
+    problem = problem_for(wheels, [0.9518, 0.1937, -0.238], 81.47, duration=400.0, h0=h0, torquers=Torquers(0.002))
+    for profile in ("min_time", "trapezoidal"):
+        reference = plan(problem, profile)
+        assert reference.status == "ok", reference.message
+        assert "verified by integration" in reference.message
+        peak_g, peak_h, q_end, omega_end, torquer = simulate(reference, axes, wheels.working, h0, True)
+        assert peak_g <= G_MAX * (1 + 1e-6) and peak_h <= H_MAX * (1 + 1e-6), (peak_g, peak_h)
+        assert np.max(torquer) <= 0.002 * (1 + 1e-6)
+        assert quat.error_angle(q_end, problem.qf) < 1e-6 and np.linalg.norm(omega_end) < 1e-8
+        if profile == "min_time":  # the stretch stops at a bound (within the bisection's 1e-4)
+            assert max(peak_g / G_MAX, peak_h / H_MAX, np.max(torquer) / 0.002) >= 1 - 1e-3
+
+
+def test_a_rounding_stretch_is_not_reported_as_one_x(monkeypatch):
+    """A first measurement 5e-9 above the bound stretches the profile by 1 + 6e-9: no "stretched
+    1 x in time" in the message (pyr_mtq.yaml's carried axis, whose estimate holds)."""
+    axes = pyramid(54.7356)
+    wheels = ReactionWheels(axes, max_torque=G_MAX, max_momentum=H_MAX, failed=[0, 2])
+    problem = problem_for(wheels, [0, 1, 1], 90.0, duration=300.0, magnetorquers=Magnetorquers(1.0))
+    measured = WheelBudget.integrated_ratios
+    calls = []
+
+    def first_just_above(self, profile, step_angle=0.002):
+        calls.append(profile)
+        return (1.0, 1 + 5e-9) if len(calls) == 1 else measured(self, profile, step_angle)
+
+    monkeypatch.setattr(WheelBudget, "integrated_ratios", first_just_above)
+    reference = plan(problem, "min_time")
+    assert reference.status == "ok", reference.message
+    assert len(calls) >= 2 and "stretched" not in reference.message, reference.message

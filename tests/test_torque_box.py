@@ -19,9 +19,11 @@ import itertools
 import numpy as np
 import pytest
 
-from ocp import Magnetorquers, Measurement, ReactionWheels, Spacecraft, Torquers
+from ocp import Magnetorquers, Measurement, ReactionWheels, Spacecraft, Torquers, quat
 from planners import PLANNERS, ManeuverProblem
 from planners.costate.tpbvp import FORMS
+from scenarios.output.plot_data import WHEELS_TORQUE_NOTE
+from scenarios.output.plots import RowFigure
 from scenarios.output.report.figures import _torque_limit_lines
 from tests.test_allocation_rule import FixedTorque
 
@@ -110,8 +112,41 @@ def test_figure_limit_lines_say_conservative_where_the_box_is_not_the_set():
     (level, name, colour), = _torque_limit_lines(_pyramid())
     assert level == pytest.approx(CUBE, rel=1e-7) and "conservative" in name and colour is None
     (level, name, _), = _torque_limit_lines(Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(max_torque=0.1)))
-    assert level == 0.1 and name == "limit ±0.1 N m"
+    assert level == 0.1 and name == "limit ±0.1 N m" + WHEELS_TORQUE_NOTE
     lines = _torque_limit_lines(Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(2, max_torque=G_MAX),
                                            torquers=Torquers(0.02)))
-    assert [(level, name) for level, name, _ in lines] == [(G_MAX, "τx limit ±0.01"), (G_MAX, "τy limit ±0.01"),
-                                                           (0.02, "τz limit ±0.02")]
+    assert [(level, name) for level, name, _ in lines] == [
+        (G_MAX, "τx limit ±0.01" + WHEELS_TORQUE_NOTE), (G_MAX, "τy limit ±0.01" + WHEELS_TORQUE_NOTE),
+        (0.02, "τz limit ±0.02" + WHEELS_TORQUE_NOTE)]
+
+
+def test_the_torque_limit_label_says_it_does_not_bound_the_wheels_reference():
+    """With three body-axis wheels (box exact), a non-principal inertia and a minimum-time eigenaxis
+    slew from rest, the reference's rigid-body torque I ω̇ + ω × I ω crosses the line (1.045, 0.888,
+    1.142 x) while the wheels' torque I ω̇ + ω × H (H = 0) stays within it: the label says the line is
+    the solid curves' only. With torquers alone the two torques are one, within the line: no note."""
+    inertia = np.array([[20.0, 1.5, -1.0], [1.5, 17.0, 0.8], [-1.0, 0.8, 14.0]])
+    axis = np.array([0.6, -0.3, 0.74]) / np.linalg.norm([0.6, -0.3, 0.74])
+    for spacecraft, wheels in ((Spacecraft(inertia, wheels=ReactionWheels.from_body_axes(max_torque=0.05,
+                                                                                          max_momentum=5.0)), True),
+                               (Spacecraft(inertia, torquers=Torquers(0.05)), False)):
+        problem = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.from_axis_angle(axis, np.radians(150)),
+                                  400.0, omegaf=np.zeros(3))
+        reference = PLANNERS["eigenaxis"]({"profile": "min_time"}).plan(problem)
+        assert reference.status == "ok", reference.message
+        t = np.unique(np.concatenate([np.linspace(0.0, reference.duration, 20001),
+                                      np.asarray(reference.breakpoints) + 1e-9]))
+        sample = reference.sample(np.minimum(t, reference.duration))
+        rigid = sample.omega_dot @ inertia.T + np.cross(sample.omega, sample.omega @ inertia.T)
+        (level, name, _), = _torque_limit_lines(spacecraft)
+        assert level == 0.05
+        if wheels:  # H = 0: the wheels give I ω̇, within the line; the reference's torque is not
+            assert np.max(np.abs(sample.omega_dot @ inertia.T)) <= 0.05 * (1 + 1e-9)
+            assert np.max(np.abs(rigid)) / 0.05 == pytest.approx(1.142, abs=1e-3)
+            assert name == "limit ±0.05 N m" + WHEELS_TORQUE_NOTE and "solid only" in name
+        else:
+            assert np.max(np.abs(rigid)) <= 0.05 * (1 + 1e-6)
+            assert name == "limit ±0.05 N m"
+        figure = RowFigure(3 if wheels else 0, True, True, limited=(("torque", True),))
+        labels = [line.get_label().replace("\n", " ") for line in figure.panels["torque"].get_lines()]
+        assert ("±limit" + WHEELS_TORQUE_NOTE if wheels else "±limit") in labels

@@ -371,6 +371,36 @@ def _limits(values: Any, keep: Any = True) -> tuple[float, ...]:
     return tuple(float(v) for v in np.where(usable, values, np.nan))
 
 
+WHEELS_TORQUE_NOTE = " (solid only; wheels bound Iω̇+ω×H)"
+"""Appended to the body-torque limit's label with wheels (:func:`torque_limit_label`)."""
+
+
+def torque_limit_label(label: str, wheels: bool) -> str:
+    """The legend label of the body-torque panel's limit lines, shared by the run figures.
+
+    The lines are the per-axis box of the actuators' torque on the body (``−A g`` of the wheels
+    plus the torquers'; ``Spacecraft.body_torque_limit``), the solid curves. The dashed reference
+    is the rigid body's ``I ω̇ + ω × I ω`` (:class:`planners.Reference`); wheels give
+    ``I ω̇ + ω × H``, ``H`` with the wheels' momentum, so with wheels the reference may cross the
+    lines while every wheel is within its own limit (three body-axis wheels, a non-principal
+    inertia, a minimum-time eigenaxis slew from rest: the reference 1.14 x the line, the wheels
+    at 1.00). Without wheels the two are the same torque and the lines bound both.
+
+    Parameters
+    ----------
+    label : str
+        The label without the note, e.g. ``"limit ±0.05 N m"``.
+    wheels : bool
+        Whether the spacecraft has reaction wheels (failed ones included: their momentum is in ``H``).
+
+    Returns
+    -------
+    str
+        ``label``, with :data:`WHEELS_TORQUE_NOTE` when ``wheels``.
+    """
+    return label + WHEELS_TORQUE_NOTE if wheels else label
+
+
 def wheel_axes(axes: np.ndarray) -> tuple[int, ...]:
     """The body axis each wheel spins about, when it lies along one.
 
@@ -438,7 +468,8 @@ def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = E
     if magnetorquers is None and (wheels is not None or spacecraft.torquers is not None):
         # the largest per-axis box the allocation realises at every corner (Spacecraft.body_torque_limit):
         # the whole realised set for wheels along the body axes or torquers, a conservative box inside it
-        # for a skewed wheel array (Spacecraft.torque_box_is_exact); magnetorquers' torque depends on the field
+        # for a skewed wheel array (Spacecraft.torque_box_is_exact); magnetorquers' torque depends on the field.
+        # It bounds the solid applied torque; with wheels not the dashed reference (torque_limit_label).
         series.limits["torque"] = _limits(spacecraft.body_torque_limit())
     if wheels is not None:
         series.failed, series.wheel_axis = tuple(wheels.failed), wheel_axes(wheels.axes)

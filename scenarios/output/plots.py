@@ -74,6 +74,7 @@ from scenarios.output.plot_data import (
     overlay_series,
     plot_jobs,
     row_figure_layout,
+    torque_limit_label,
 )
 
 __all__ = [
@@ -258,6 +259,10 @@ def wheel_colors(n_wheels: int, wheel_axis: tuple[int, ...]) -> list[str]:
     return colors
 
 
+ROW_LEGEND_CHARS = 20
+"""Longest line of a label in the row figure's legends (the body-torque limit's with wheels is wrapped)."""
+
+
 class RowFigure:
     """The per-row figure, built once and redrawn for each row of the same shape (module docstring).
 
@@ -266,7 +271,9 @@ class RowFigure:
     wheels their motor torques and momenta, and speeds when their spin inertia is known; with
     magnetorquers their dipole. Every per-axis curve takes its axis' colour (:data:`AXIS_COLORS`).
     Actuator limits are dotted ``±`` lines (one black pair when every curve of the panel has the
-    same limit, else one pair per curve in its colour); failed wheels are grey, dotted and marked
+    same limit, else one pair per curve in its colour; the body torque's bound the solid applied
+    torque, and with wheels not the dashed reference, as their label says:
+    :func:`~scenarios.output.plot_data.torque_limit_label`); failed wheels are grey, dotted and marked
     in the legend. The panels share one time axis, its ticks on the last panel.
 
     Parameters
@@ -366,6 +373,8 @@ class RowFigure:
                 color = "k" if index is None else (axis_colors if name in ("torque", "dipole") else colors)[index]
                 for sign in (1.0, -1.0):
                     label = ("±limit" if common else "±limit (per curve)") if sign > 0 and index in (None, 0) else None
+                    if label and name == "torque":
+                        label = textwrap.fill(torque_limit_label(label, n_wheels > 0), ROW_LEGEND_CHARS)
                     self.limit_lines.append((name, index, sign, line(panel[name], linestyle=":", color=color,
                                                                      lw=1.3, label=label or "_limit")))
             self.off_scale[name] = panel[name].text(0.995, 0.96, "", transform=panel[name].transAxes, ha="right",

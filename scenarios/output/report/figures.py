@@ -32,6 +32,7 @@ from scenarios.output.plot_data import (
     held,
     knowledge_series,
     scored_minimum,
+    torque_limit_label,
     with_point,
 )
 
@@ -194,7 +195,8 @@ def _torque_limit_lines(spacecraft: Any) -> list[tuple[float, str, str | None]]:
     Where it is not (a skewed wheel array: a four-wheel pyramid gives more along a single body
     axis, ``Spacecraft.torque_along``, than on every axis at once) they are labelled ``per-axis
     box ... (conservative)``: within them the torque is surely realised, beyond them not surely
-    unrealised.
+    unrealised. They bound the solid curves, the actuators' torque on the body; with wheels the
+    label says they do not bound the dashed reference (:func:`~scenarios.output.plot_data.torque_limit_label`).
 
     Parameters
     ----------
@@ -210,12 +212,14 @@ def _torque_limit_lines(spacecraft: Any) -> list[tuple[float, str, str | None]]:
     """
     limits = spacecraft.body_torque_limit()
     exact = spacecraft.torque_box_is_exact()
+    wheels = spacecraft.wheels is not None
     finite = [float(v) for v in limits if np.isfinite(v) and v > 0]
     if len(finite) == 3 and np.ptp(finite) <= 1e-12 * max(finite):
         name = f"limit ±{finite[0]:.3g} N m" if exact else f"per-axis box ±{finite[0]:.3g} N m (conservative)"
-        return [(finite[0], name, None)]
-    return [(float(limits[i]), f"τ{axis} limit ±{limits[i]:.3g}" if exact
-             else f"τ{axis} box ±{limits[i]:.3g} (conservative)", AXIS_COLOURS[i])
+        return [(finite[0], torque_limit_label(name, wheels), None)]
+    return [(float(limits[i]), torque_limit_label(f"τ{axis} limit ±{limits[i]:.3g}" if exact
+                                                  else f"τ{axis} box ±{limits[i]:.3g} (conservative)", wheels),
+             AXIS_COLOURS[i])
             for i, axis in enumerate("xyz") if np.isfinite(limits[i]) and limits[i] > 0]
 
 
@@ -254,7 +258,8 @@ def row_figure(row: Any, scenario: Any) -> dict[str, Any]:
     its norm [deg/s]; the actuators' applied torque per body axis [N m] (held over each sample);
     the wheels' momenta [N m s] when there are wheels. The reference is dashed; dotted limits: the
     per-axis torque box of the controllers' allocation (``Spacecraft.body_torque_limit``, labelled
-    conservative where the realised set is no box), each wheel's momentum limit,
+    conservative where the realised set is no box; it bounds the solid applied torque, and with
+    wheels not the dashed reference ``I ω̇ + ω × I ω``, as its label says), each wheel's momentum limit,
     ``requirements.rate`` on ``‖ω‖`` and ``requirements.final`` on the error after ``T + after_s``.
 
     Parameters
