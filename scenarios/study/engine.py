@@ -30,6 +30,7 @@ import multiprocessing
 import os
 import statistics
 import sys
+import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import (
@@ -64,6 +65,7 @@ if TYPE_CHECKING:
     import pandas
 
 _POLL_S = 0.5
+MANAGER_JOIN_S = 10.0  # the longest a killed local pool's manager thread is waited for
 _TIMEOUT_GRACE = 1.25  # the driver gives up on a case at this multiple of case_timeout_s (+ 5 s)
 HANDSHAKE_TIMEOUT_S = 10.0
 """How long a Dask scheduler's address has to answer as a Dask scheduler [s]."""
@@ -267,12 +269,19 @@ class _LocalPool:
         return found
 
     def kill(self) -> None:
-        """Stop now, including a worker stuck in C code (it cannot be interrupted)."""
+        """Stop now, including a worker stuck in C code (it cannot be interrupted), and wait for the
+        pool's manager thread to end (its workers are dead: it ends at once), so that none of the
+        pool's threads or pipes outlives the sweep: CPython 3.11's exit hook of ``concurrent.futures``
+        could otherwise wake a manager thread whose pipe it was closing at the same moment
+        ("Exception ignored ... OSError: [Errno 9] Bad file descriptor" after a sweep's error)."""
         for process in list(self.processes.values()):
             if process.is_alive():
                 self.ours.add(process.pid)
                 process.kill()
         self.executor.shutdown(wait=False, cancel_futures=True)
+        manager = getattr(self.executor, "_executor_manager_thread", None)  # private, stable since 3.9
+        if manager is not None and manager is not threading.current_thread():
+            manager.join(timeout=MANAGER_JOIN_S)
 
     def claimed(self) -> int:
         """Workers that started (claimed their slot: their initializer ran)."""
