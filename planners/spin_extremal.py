@@ -342,7 +342,12 @@ class SpinExtremalPlanner(Planner):
         Reference
             As :meth:`~planners.base.Planner.plan_start` on ``problem`` with ``omegaf = None``.
         """
-        return super().plan_start(problem if problem.omegaf is None else replace(problem, omegaf=None))
+        if problem.omegaf is None:
+            return super().plan_start(problem)
+        # the freed problem is a new ManeuverProblem with a model of its own: build into this
+        # problem's cache, or every start would build the extremal's NLP again (25 ms a plan)
+        planner = self.with_cache(self.solver_cache(problem))
+        return super(SpinExtremalPlanner, planner).plan_start(replace(problem, omegaf=None))
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         moments = np.diag(problem.spacecraft.inertia).copy()
