@@ -347,7 +347,7 @@ class SpinExtremalPlanner(Planner):
         # the freed problem is a new ManeuverProblem with a model of its own: build into this
         # problem's cache, or every start would build the extremal's NLP again (25 ms a plan)
         planner = self.with_cache(self.solver_cache(problem))
-        return super(SpinExtremalPlanner, planner).plan_start(replace(problem, omegaf=None))
+        return Planner.plan_start(planner, replace(problem, omegaf=None))
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         moments = np.diag(problem.spacecraft.inertia).copy()
