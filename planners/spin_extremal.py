@@ -310,18 +310,18 @@ class SpinExtremalPlanner(Planner):
         return super().problem_error(problem)
 
     def start_error(self, problem: ManeuverProblem) -> str | None:
-        """Why the extremal cannot start another method on ``problem``: as :meth:`problem_error`
-        with the final rate freed (the method it starts imposes that rate).
+        """:meth:`problem_error` on ``problem`` with its final rate freed: a fixed ``omegaf``, which
+        refuses the extremal as a row, does not refuse it as a start (:meth:`plan_start` frees it too).
 
         Parameters
         ----------
         problem : ManeuverProblem
-            The problem another method will solve from the start.
+            As :meth:`Planner.start_error <planners.base.Planner.start_error>`.
 
         Returns
         -------
         str or None
-            The reason, or ``None``.
+            As :meth:`Planner.start_error <planners.base.Planner.start_error>`.
         """
         return self.problem_error(problem if problem.omegaf is None else replace(problem, omegaf=None))
 
