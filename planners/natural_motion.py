@@ -161,9 +161,10 @@ class NaturalMotionPlanner(Planner):
         stop_time : float
             Time at the end of T spent stopping [s], positive (default 10 s, the paper's last
             10 s of 110 s); the arc lasts ``T − stop_time``. Zero is refused: the arc would end at
-            T still turning, so the reference would not end at rest (``ω(T)`` is the arc's rate),
-            and the stop, a rate step at T itself, would be outside the breakpoints a reference
-            may declare (inside ``(0, T)``), unseen by the scoring.
+            T still turning, so ``ω(T)`` would be the arc's rate, not rest (the reference's one
+            breakpoint is the end of the arc, which it declares only inside ``(0, T)``), and a stop
+            at T itself, a rate step declared at a breakpoint at T, would be the arc's whole
+            momentum as one impulse.
         stop : {"step", "smooth"}
             ``step`` (default, the paper): the rate reference drops to zero at the end of the arc;
             ``smooth``: a cubic deceleration along the final body rate over ``stop_time`` (the
