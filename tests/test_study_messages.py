@@ -189,8 +189,13 @@ def test_the_summary_shows_a_group_whose_every_case_crashed(tmp_path, monkeypatc
         "monte_carlo": {"samples": 3, "seed": 5, "dispersions": {
             "simulation.initial_attitude_error_deg": {"normal": {"mean": [0, 0, 0], "std": [1, 1, 1]}}}}}))
     out = tmp_path / "out"
-    assert main(["sweep", str(study), "--out", str(out), "--workers", "1", "--no-plots"]) == 0
-    said = capsys.readouterr().out
+    # crashed cases: the tables are written, and the sweep exits 1 saying so (docs/guide/studies.rst)
+    assert main(["sweep", str(study), "--out", str(out), "--workers", "1", "--no-plots"]) == 1
+    captured = capsys.readouterr()
+    said = captured.out
+    assert captured.err.startswith("slewbench: 3 of 6 cases crashed (raised, ran out of case_timeout_s or killed "
+                                   "their worker)"), captured.err
+    assert "\n  3 cases: RuntimeError: planner exploded (" in captured.err, captured.err
     assert re.search(r"; of the 6 cases stored, 3 crashed and 1 others? ha(s|ve) a row not ok; wrote ", said), said
     lines = said.splitlines()
     for label in ("smooth", "fast"):

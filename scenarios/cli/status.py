@@ -8,19 +8,23 @@ from __future__ import annotations
 import argparse
 import re
 
-__all__ = ["EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_NOT_OK", "EXIT_OK",
-           "attached_values", "directory_argument"]
+__all__ = ["EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_CRASHED", "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_NOT_OK",
+           "EXIT_OK", "attached_values", "directory_argument"]
 
 EXIT_OK = 0
 """The command completed (a run's failed and violated rows, a table's entries that are not ok
 included: they are results), unless ``run --strict`` found a row, or ``table --strict`` an entry,
-that is not ok."""
+that is not ok, or a sweep's cases crashed (:data:`EXIT_CRASHED`)."""
 EXIT_INTERNAL = 1
 """An internal error (a bug), or a run interrupted by Ctrl-C or SIGTERM."""
 EXIT_NOT_OK = 1
 """``slewbench run --strict``: the run completed and wrote its results, and some row is not ``ok``
 (``violated`` or ``failed``); ``slewbench table --strict``: the table's files are written, and some
 entry of the table or of its held-out grid is not ``ok``: for users' continuous integration."""
+EXIT_CRASHED = 1
+"""``slewbench sweep``: every case ran and the tables are written, but some cases crashed (raised,
+ran out of ``case_timeout_s`` or killed their worker): they have no result, and ``--resume`` runs
+them again. A numerical failure is a ``failed`` row, a result: it does not set this status."""
 EXIT_BAD_SCENARIO = 2
 """A bad scenario or study file (or key of ``slewbench schema``): nothing was written."""
 EXIT_BAD_OUTPUT = 2

@@ -5,7 +5,9 @@ passes: the study and every case (exit 2), the options, the output directory (ex
 slewbench's, already holds a sweep and ``--resume`` was not given, or holds a sweep of an earlier
 slewbench, which ``--report`` still redraws), and a Dask scheduler (it must answer as one and have
 workers). A directory this command created is removed again if the sweep cannot start in it (a
-full disk). An interrupted sweep exits 130 and says how to resume.
+full disk). An interrupted sweep exits 130 and says how to resume; one whose cases crashed (raised,
+ran out of time or killed their worker) writes its tables, then exits 1 saying how many crashed,
+why, and how to run them again.
 """
 from __future__ import annotations
 
@@ -19,7 +21,12 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from scenarios.cli.status import EXIT_INTERRUPTED, EXIT_OK, directory_argument
+from scenarios.cli.status import (
+    EXIT_CRASHED,
+    EXIT_INTERRUPTED,
+    EXIT_OK,
+    directory_argument,
+)
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, claim_output_directory, written_files
 from scenarios.output.names import default_output_directory
@@ -264,8 +271,9 @@ def command_sweep(args: argparse.Namespace) -> int:
     Returns
     -------
     int
-        The exit status: 0 when every case is stored (failed rows included), 130 when the sweep
-        was interrupted (or its Dask cluster lost every worker).
+        The exit status: 0 when every case is stored and none crashed (failed rows included: they
+        are results), 1 when some crashed (:data:`~scenarios.cli.status.EXIT_CRASHED`; the tables
+        are written), 130 when the sweep was interrupted (or its Dask cluster lost every worker).
 
     Raises
     ------
@@ -422,7 +430,51 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
               "sensitivity.csv, worst_cases.csv):")
         print("\n".join(robustness_lines(proportions, worst, crashed_counts(study, rows))))
         print(f"re-run a case in full: slewbench sweep {shlex.quote(str(out))} --case N")
+    if crashed:
+        print(crashed_message(list(records), len(study.cases), resume_command(args, out)), file=sys.stderr)
+        return EXIT_CRASHED
     return EXIT_OK
+
+
+CRASH_REASONS_SHOWN = 3
+"""Distinct reasons a sweep's closing message gives for its crashed cases (the most frequent first)."""
+
+
+def crashed_message(records: list[dict[str, Any]], total: int, resume: str) -> str:
+    """What a sweep whose cases crashed says last (on standard error): how many, why, and how to run
+    them again.
+
+    Parameters
+    ----------
+    records : list of dict
+        The stored records of the study's cases (``status``, ``rows``), crashed ones among them.
+    total : int
+        The study's number of cases.
+    resume : str
+        The command that runs the crashed cases again (:func:`resume_command`).
+
+    Returns
+    -------
+    str
+        ``slewbench: N of M cases crashed ...``, the :data:`CRASH_REASONS_SHOWN` most frequent
+        messages of their rows with their counts, and ``resume``.
+    """
+    reasons: dict[str, int] = {}
+    crashed = 0
+    for record in records:
+        if record["status"] == "crashed":
+            crashed += 1
+            message = next((str(row.get("message") or "") for row in record["rows"]), "") or "no message"
+            reasons[message] = reasons.get(message, 0) + 1
+    ranked = sorted(reasons.items(), key=lambda item: -item[1])  # stable: equal counts in the order stored
+    lines = [(f"slewbench: {crashed} of {total} case{'s' if total != 1 else ''} crashed (raised, ran out of "
+              "case_timeout_s or killed their worker): they have no result (status crashed in cases.csv; the "
+              "statistics and plots leave them out). Why:")]
+    lines += [f"  {count} case{'s' if count != 1 else ''}: {reason}" for reason, count in ranked[:CRASH_REASONS_SHOWN]]
+    if len(ranked) > CRASH_REASONS_SHOWN:
+        lines.append(f"  ... and {len(ranked) - CRASH_REASONS_SHOWN} other reason(s) (cases.csv, status crashed)")
+    lines += ["Run them again (the cases already stored are kept) with:", f"  {resume}"]
+    return "\n".join(lines)
 
 
 def _final_note(study: Study, rows: list[dict[str, Any]]) -> str | None:

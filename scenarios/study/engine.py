@@ -48,6 +48,7 @@ from typing import TYPE_CHECKING, Any
 from ocp.errors import excerpt
 from scenarios.errors import ScenarioError, SweepInterrupted, WorkersCannotStart
 from scenarios.schema.study import scheduler_address
+from scenarios.study.server import SAFE_PATH, SAFE_PATH_MARK
 from scenarios.study.spec import load_study, parse_study
 from scenarios.study.store import SweepStore, encode_rows
 from scenarios.study.types import Case, Study
@@ -204,6 +205,9 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
     It returns at once: the server imports while the caller goes on (the CLI calls this before it
     expands the study), and the first worker waits until the imports are done. The server dies
     with this process (:data:`scenarios.study.worker.PARENT_ENVIRONMENT`), and the workers with it.
+    It starts in Python's safe-path mode, so that a module in the current directory named as one of
+    slewbench's packages (a user's ``controllers.py``) does not replace it in the workers
+    (:mod:`scenarios.study.server`).
 
     Returns
     -------
@@ -225,15 +229,20 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(list(PRELOAD))
     from multiprocessing import forkserver
-    previous = os.environ.get(PARENT_ENVIRONMENT)
-    os.environ[PARENT_ENVIRONMENT] = str(os.getpid())  # seen by the server only: it starts now, if not yet
+    # seen by the server only (it starts now, if not yet): the sweep it dies with, and safe-path mode
+    # (the current directory off its sys.path; scenarios.study.server puts the environment back)
+    server_environment = {PARENT_ENVIRONMENT: str(os.getpid()), SAFE_PATH: os.environ.get(SAFE_PATH) or "1",
+                          SAFE_PATH_MARK: "kept" if os.environ.get(SAFE_PATH) else "added"}
+    previous = {name: os.environ.get(name) for name in server_environment}
+    os.environ.update(server_environment)
     try:
         forkserver.ensure_running()
     finally:
-        if previous is None:
-            os.environ.pop(PARENT_ENVIRONMENT, None)
-        else:
-            os.environ[PARENT_ENVIRONMENT] = previous
+        for name, value in previous.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
     return context
 
 

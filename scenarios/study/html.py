@@ -29,6 +29,7 @@ from scenarios.output.tables import IDENTITY_COLUMNS, is_missing
 from scenarios.schema.keys import Section
 from scenarios.schema.loader import SCENARIO
 from scenarios.study.paths import parse_path
+from scenarios.study.report import metric_values
 from scenarios.study.types import Study
 
 __all__ = ["LOG_SPAN", "PAGE_SIZE", "ROBUSTNESS_SECTIONS", "histogram_figure", "path_unit", "study_report"]
@@ -98,8 +99,10 @@ def _vector(value: Any) -> Any:
 
 
 def _values(rows: list[dict[str, Any]], column: str, label: str) -> np.ndarray:
-    return np.array([row[column] for row in rows if row.get("label") == label and isinstance(row.get(column), (int, float))
-                     and not isinstance(row.get(column), bool) and not is_missing(row.get(column))], dtype=float)
+    """The finite values of ``column`` in the rows of ``label`` that count in the summary's statistics
+    (:func:`scenarios.study.report.metric_values` with ``counted_only``: a failed row is left out)."""
+    values = metric_values(column, [row for row in rows if row.get("label") == label], counted_only=True)
+    return values[np.isfinite(values)]
 
 
 def _edges(values: np.ndarray, log: bool) -> np.ndarray:
@@ -128,7 +131,8 @@ def histogram_figure(column: str, rows: list[dict[str, Any]], labels: list[str])
     -------
     dict
         A plotly figure: per label, the count of its cases in each of :data:`BINS` bins over its
-        own range (so that rows whose values lie decades apart are each resolved), drawn as a
+        own range (the rows ``ok`` or ``violated`` with a finite value, as the summary's statistics
+        take them) (so that rows whose values lie decades apart are each resolved), drawn as a
         closed step curve; the axis is logarithmic, and the bins log-spaced, when every value is
         positive and they span more than :data:`LOG_SPAN`.
     """
@@ -213,9 +217,11 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
     summary_names = [*summary[0][:metric], "unit", *summary[0][metric:]]
     summary_rows = [{**row, "unit": column_unit(row["metric"])} for row in summary[1]]
     page.section("Summary", "Statistics of each summary metric per planner row (count: rows with a value; never: rows "
-                            "that never reached one, a case that never settled; no_value: the other rows). mean and "
-                            "std (sample standard deviation) are over the count rows; median, p5, p95 (linear "
-                            "percentiles), min and max over those and the never rows as inf; failures: rows not ok.")
+                            "that never reached one, a case that never settled; no_value: the other rows). Only rows ok "
+                            "or violated count, as in the plots: excluded counts the failed, infeasible and crashed "
+                            "ones, left out whatever their values. mean and std (sample standard deviation) are over "
+                            "the count rows; median, p5, p95 (linear percentiles), min and max over those and the "
+                            "never rows as inf; failures: rows not ok.")
     page.table("summary", _columns(summary_names, summary_rows),
                [[row.get(c) for c in summary_names] for row in summary_rows])
     if study.summary and rows:

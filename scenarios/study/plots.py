@@ -41,7 +41,7 @@ import numpy as np
 from scenarios.output.names import row_stems
 from scenarios.output.plot_data import axis_label, column_quantity
 from scenarios.study.paths import Step, get_path, parse_path
-from scenarios.study.report import metric_values, percentile
+from scenarios.study.report import COUNTED_STATUSES, counted, metric_values, percentile
 from scenarios.study.types import Study
 
 __all__ = ["DECADES", "INFINITE_WORDS", "PARETO_AXES", "PLOTTED_STATUSES", "RECORDED", "figures", "parameter_quantity",
@@ -49,9 +49,10 @@ __all__ = ["DECADES", "INFINITE_WORDS", "PARETO_AXES", "PLOTTED_STATUSES", "RECO
 
 PARETO_AXES = ("cl.int_u", "cl.settling_time_s")
 """The two metrics of the Pareto fronts (both to be minimised)."""
-PLOTTED_STATUSES = ("ok", "violated")
+PLOTTED_STATUSES = COUNTED_STATUSES
 """Statuses of the rows whose metrics are drawn: the motion completed (a broken requirement is a result
-and its metrics stand); ``failed`` and ``crashed`` rows are marked instead."""
+and its metrics stand); ``failed``, ``infeasible`` and ``crashed`` rows are marked instead. The
+summary's statistics take the same rows (:data:`scenarios.study.report.COUNTED_STATUSES`)."""
 DECADES = 2.0
 """A quantity whose positive values span this many decades or more (largest over smallest >= 100)
 is drawn on a logarithmic axis."""
@@ -83,16 +84,14 @@ DPI = 110
 # --- values -----------------------------------------------------------------------------------------
 
 def _failed(row: dict[str, Any]) -> bool:
-    return row.get("status") not in PLOTTED_STATUSES
+    return not counted(row)
 
 
 def _values(metric: str, rows: list[dict[str, Any]]) -> np.ndarray:
-    """A metric's plotted values: the summary table's (:func:`scenarios.study.report.metric_values`:
-    +inf where a case never settled, NaN without a value), NaN where the row did not complete (it is
-    marked instead)."""
-    values = metric_values(metric, rows)
-    values[np.array([_failed(row) for row in rows], dtype=bool)] = math.nan
-    return values
+    """A metric's plotted values: the summary table's (:func:`scenarios.study.report.metric_values`
+    with ``counted_only``: +inf where a case never settled, NaN without a value and where the row
+    did not complete, which is marked instead)."""
+    return metric_values(metric, rows, counted_only=True)
 
 
 def _statistic(values: Any, q: float) -> float:

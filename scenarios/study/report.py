@@ -39,8 +39,15 @@ from scenarios.study.types import Study
 if TYPE_CHECKING:  # the engine imports this module lazily
     from scenarios.study.engine import SweepResults
 
-STATISTICS = ("count", "never", "no_value", "failures", "mean", "std", "median", "p5", "p95", "min", "max")
+STATISTICS = ("count", "never", "no_value", "excluded", "failures", "mean", "std", "median", "p5", "p95", "min",
+              "max")
 """The columns of ``summary.csv`` after the grouping keys and ``metric`` (:func:`summary_table`)."""
+COUNTED_STATUSES = ("ok", "violated")
+"""Statuses of the rows whose metric values the study's statistics (``summary.csv``) and plots take:
+the motion completed (a broken requirement is a result, and its metrics stand). A ``failed`` row (a
+failed planner or simulation, metrics that are not physical), an ``infeasible`` one and a
+``crashed`` one are left out whatever values they carry (:func:`metric_values` with
+``counted_only``), and ``summary.csv`` counts them (``excluded``)."""
 PROPORTION_STATISTICS = ("completed", "met", "fraction_met", "wilson_low", "wilson_high")
 """The columns of ``requirements.csv`` (and ``robustness.csv``) after the grouping keys: rows that
 completed (not ``crashed``), those meeting the criterion (``ok``: every requirement), their fraction
@@ -111,7 +118,23 @@ def never_witness(column: str) -> str | None:
     return None if info is None or info.null_worst_when is None else f"{scope}.{info.null_worst_when}"
 
 
-def metric_values(column: str, rows: list[dict[str, Any]]) -> np.ndarray:
+def counted(row: dict[str, Any]) -> bool:
+    """Whether a row's metric values count in the study's statistics and plots (:data:`COUNTED_STATUSES`).
+
+    Parameters
+    ----------
+    row : dict
+        A ``cases.csv`` row (:func:`case_table`).
+
+    Returns
+    -------
+    bool
+        True for a row ``ok`` or ``violated``.
+    """
+    return row.get("status") in COUNTED_STATUSES
+
+
+def metric_values(column: str, rows: list[dict[str, Any]], counted_only: bool = False) -> np.ndarray:
     """A metric column's values as the study's statistics, rankings and correlations take them.
 
     Parameters
@@ -120,6 +143,9 @@ def metric_values(column: str, rows: list[dict[str, Any]]) -> np.ndarray:
         A ``cases.csv`` column.
     rows : list of dict
         The ``cases.csv`` rows (:func:`case_table`).
+    counted_only : bool, optional
+        NaN also in every row that does not count (:func:`counted`: ``failed``, ``infeasible``,
+        ``crashed``), whatever its value: the values of ``summary.csv`` and of the plots.
 
     Returns
     -------
@@ -127,11 +153,13 @@ def metric_values(column: str, rows: list[dict[str, Any]]) -> np.ndarray:
         The row's number; +inf where the metric never reached its value (a null of a metric that
         declares ``null_worst_when``, :func:`never_witness`, in a row where the witness has a
         value: a case that never settled); NaN where the row has no value (the metric does not
-        apply, a failed planner, a crashed case).
+        apply, a failed planner, a crashed case) or, with ``counted_only``, does not count.
     """
     witness = never_witness(column)
     values = np.full(len(rows), math.nan)
     for k, row in enumerate(rows):
+        if counted_only and not counted(row):
+            continue
         value = _number(row.get(column))
         if value is not None:
             values[k] = value
@@ -173,14 +201,17 @@ def percentile(values: np.ndarray, q: float) -> float:
 def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
     """Statistics of each summary metric per planner row label (and grid point under Monte Carlo).
 
-    ``count`` is the number of rows where the metric has a value, ``never`` those where it never
-    reached one (a settling time whose motion still ends outside the band: :func:`metric_values`;
-    None for a metric whose null only means that it does not apply), ``no_value`` the other rows
-    (the metric does not apply, a failed planner, a crashed case); the three add up to the group's
-    rows. ``failures`` are the rows whose status is not ``ok``. ``mean`` and ``std`` are over the
-    ``count`` rows with a value; ``median``, ``p5``, ``p95`` (linear percentiles), ``min`` and
-    ``max`` are over those and the ``never`` rows taken as +inf (:func:`percentile`), so that a
-    percentile reached by cases that never settled is +inf.
+    The statistics take the rows that count (:data:`COUNTED_STATUSES`, ``ok`` and ``violated``),
+    as the plots do: the values are :func:`metric_values` with ``counted_only``. ``count`` is the
+    number of rows where the metric has a value, ``never`` those where it never reached one (a
+    settling time whose motion still ends outside the band; None for a metric whose null only
+    means that it does not apply), ``no_value`` the other rows (the metric does not apply, or the
+    row does not count); the three add up to the group's rows. ``excluded`` counts the rows left
+    out because they do not count (``failed``, ``infeasible``, ``crashed``: part of ``no_value``,
+    whatever values they carry), ``failures`` the rows whose status is not ``ok``. ``mean`` and
+    ``std`` are over the ``count`` rows with a value; ``median``, ``p5``, ``p95`` (linear
+    percentiles), ``min`` and ``max`` are over those and the ``never`` rows taken as +inf
+    (:func:`percentile`), so that a percentile reached by cases that never settled is +inf.
 
     Parameters
     ----------
@@ -202,13 +233,14 @@ def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], 
     table = []
     for members in groups.values():
         for metric in study.summary:
-            values = metric_values(metric, members)
+            values = metric_values(metric, members, counted_only=True)
             finite = values[np.isfinite(values)]
             ranked = values[~np.isnan(values)]
             never = int(np.isinf(values).sum())
             line = {k: members[0].get(k) for k in keys}
             line.update(metric=metric, count=int(finite.size), never=never if never_witness(metric) else None,
-                        no_value=int(np.isnan(values).sum()), failures=sum(r["status"] != "ok" for r in members))
+                        no_value=int(np.isnan(values).sum()), excluded=sum(not counted(r) for r in members),
+                        failures=sum(r["status"] != "ok" for r in members))
             mean = std = None
             if finite.size:
                 mean, std = float(finite.mean()), float(finite.std(ddof=1)) if finite.size > 1 else 0.0
@@ -417,9 +449,12 @@ def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], miss
                                    f"{package_version()}."), "", *([note, ""] if note else [])]
     out += _table_lines(columns, rows)
     out += ["", ("Units: torque N m, integrals N m s (int_u2: N² m² s), angles deg, times s, rates rad/s. "
+                 "The statistics take the rows ok or violated, as the plots do: a failed, infeasible or crashed "
+                 "row is left out whatever values it has (excluded counts them). "
                  "count: rows with a value; never: rows that never reached one (a case that never settled); "
-                 "no_value: the other rows. mean and std (sample standard deviation) are over the count rows; "
-                 "median, p5, p95 (linear percentiles), min and max over those and the never rows as inf."), ""]
+                 "no_value: the other rows (excluded ones included). mean and std (sample standard deviation) are "
+                 "over the count rows; median, p5, p95 (linear percentiles), min and max over those and the never "
+                 "rows as inf; failures: rows not ok."), ""]
     if requirements is not None:
         out += ["## Cases meeting every requirement", "",
                 "Rows whose status is ok among the completed ones (not crashed), with the Wilson 95 % interval.", ""]

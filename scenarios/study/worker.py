@@ -34,10 +34,12 @@ from scenarios.study.store import encode_rows
 
 V = TypeVar("V")
 
-PRELOAD = ("scenarios.study.worker", "scenarios.runner", "scipy.integrate", "scipy.optimize", "scipy.special")
-"""Modules imported once by the process that local workers fork from: the workbench, and the SciPy
-modules that planners import lazily on their first case (about 0.6 s that every fresh worker would
-otherwise pay; with 40 cases of 0.13 s that alone was a 12 % overhead)."""
+PRELOAD = ("scenarios.study.server", "scenarios.study.worker", "scenarios.runner", "scipy.integrate", "scipy.optimize",
+           "scipy.special")
+"""Modules imported once by the process that local workers fork from: first
+:mod:`scenarios.study.server` (the current directory off its import path), then the workbench, and
+the SciPy modules that planners import lazily on their first case (about 0.6 s that every fresh
+worker would otherwise pay; with 40 cases of 0.13 s that alone was a 12 % overhead)."""
 
 PARENT_ENVIRONMENT = "SLEWBENCH_SWEEP_PARENT"
 """Environment variable holding the process id of a sweep that starts local workers
