@@ -209,6 +209,29 @@ class Transcription(ABC):
             States ``(n, nx)`` and controls ``(n, nu)``.
         """
 
+    def interval_index(self, duration: float, t: Array, left: bool = False) -> NDArray[np.int_]:
+        """The mesh interval that holds each time (a uniform mesh of :attr:`intervals`).
+
+        Parameters
+        ----------
+        duration : float
+            T [s].
+        t : (n,) ndarray
+            Times in ``[0, duration]`` [s].
+        left : bool, optional
+            As in :meth:`interpolate`: interval ``k`` holds ``[t_k, t_(k+1))`` (``False``, default)
+            or ``(t_k, t_(k+1)]`` (``True``); a time within 1e-9 of an interval's length of a node
+            counts as the node.
+
+        Returns
+        -------
+        (n,) ndarray of int
+            Interval indices in ``0 … N − 1``.
+        """
+        s = np.asarray(t, dtype=float) * self.intervals / duration
+        k = np.ceil(s - 1e-9).astype(int) - 1 if left else np.floor(s + 1e-9).astype(int)
+        return np.clip(k, 0, self.intervals - 1)
+
     @abstractmethod
     def smoothness(self, duration: float) -> tuple[Array, Array]:
         """Where an interpolated solution over ``[0, duration]`` may kink and where it is exact.

@@ -205,14 +205,12 @@ class RadauCollocation(Transcription):
 
     def interpolate(self, model: AttitudeModel, states: Array, controls: Array, duration: float,
                     t: Array, left: bool = False) -> tuple[Array, Array]:
-        N, d, h = self.intervals, self.degree, duration / self.intervals
-        s = np.asarray(t, dtype=float) / h
-        # Interval k holds t in [t_k, t_{k+1}) (left: in (t_k, t_{k+1}]), nodes within 1e-9 h rounded
-        # to the node. The control polynomial
-        # passes through τ_1 … τ_d = 1 only: its value at τ = 0 is an extrapolation, while the left
-        # limit at a node is the decision variable of the ending interval's point τ_d = 1.
-        k = np.clip(np.ceil(s - 1e-9).astype(int) - 1 if left else np.floor(s + 1e-9).astype(int), 0, N - 1)
-        tau = s - k
+        N, d = self.intervals, self.degree
+        # The control polynomial passes through τ_1 … τ_d = 1 only: its value at τ = 0 is an
+        # extrapolation, while the left limit at a node is the decision variable of the ending
+        # interval's point τ_d = 1 (``interval_index``'s ``left``).
+        k = self.interval_index(duration, t, left)
+        tau = np.asarray(t, dtype=float) * N / duration - k
         X = states.reshape(model.nx, N, d + 1)
         U = controls[:model.nu * d, :].reshape(d, model.nu, N).transpose(1, 2, 0)
         x = np.einsum("tik,tk->ti", X[:, k, :].transpose(1, 0, 2), lagrange(self.tau, tau))
