@@ -18,6 +18,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from ocp import quat
 from ocp.dynamics.model import AttitudeModel
 from ocp.nlp.certificate import (
     Switching,
@@ -29,7 +30,8 @@ from ocp.nlp.certificate import (
 from ocp.nlp.solve import NLPResult
 from ocp.transcription import NLP, OptimalControlProblem, Transcription
 from ocp.transcription.radau import RadauCollocation
-from planners.problem import Array
+from planners.problem import Array, ManeuverProblem
+from planners.reference import Reference
 
 
 def radau_points(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array,
@@ -152,3 +154,106 @@ def collocation_certificate(result: NLPResult, transcription: Transcription, ocp
     except RuntimeError as error:  # a solver plugin without nlp_jac_g / nlp_grad_f
         return certificate(None, f"not checked: {str(error).splitlines()[0]}", agreement, seeds=tried,
                            seeds_agreed=agreed)
+
+
+def start_violations(problem: ManeuverProblem, reference: Reference, bounds: tuple[Array, Array, Array, Array],
+                     max_rate: float | None, pointing: tuple, points: int,
+                     tolerance: float, boundary_tolerance: float) -> dict[str, float] | str:
+    """How far another planner's reference breaks a collocation problem's constraints: whether it
+    is a feasible motion whose duration bounds that problem's minimum time.
+
+    The reference is read at ``points`` equally spaced times over its own duration. Its body
+    torque is given to the working wheels as the controllers' allocation gives it (``g = −A⁺ τ``
+    over the working wheels, their momenta from the conserved total), or to the torquers alone;
+    the states and controls are checked against the variable bounds ``bounds`` (relative excess
+    above ``tolerance``), the body-rate norm against ``max_rate``, the pointing constraints'
+    margins (not below 0) and the boundary conditions (initial state, final attitude up to sign,
+    final rate when fixed; absolute ``boundary_tolerance``). The dynamics hold by construction
+    (a reference's torque is its inverse dynamics), so a reference that breaks none of these is a
+    feasible slew of the problem.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre.
+    reference : Reference
+        The other planner's reference (its own ``duration``).
+    bounds : tuple of ndarray
+        ``(x_low, x_high, u_low, u_high)`` per point, as the NLP imposes them
+        (:func:`~planners.collocation.problem.variable_bounds`).
+    max_rate : float or None
+        Body-rate norm bound [rad/s]; ``None``: none.
+    pointing : tuple of PointingConstraint
+        The pointing constraints (their ``margins``, negative inside a keep-out cone).
+    points : int
+        Times checked.
+    tolerance : float
+        Relative excess over a bound that counts as broken.
+    boundary_tolerance : float
+        Absolute miss of a boundary condition that counts as broken.
+
+    Returns
+    -------
+    dict or str
+        The broken constraints and by how much (relative excess, rad of pointing margin, absolute
+        boundary miss); empty when the reference is feasible. A string says why it cannot be
+        checked (actuators other than wheels or torquers alone, environment torques, stored
+        momentum with torquers: the actuators' share of the torque is not read from the
+        reference alone).
+    """
+    model, spacecraft, environment = problem.model, problem.spacecraft, problem.environment
+    blocks = set(model.control_slices)
+    if blocks - {"wheels"} and blocks - {"torquers"}:
+        return f"not checked: actuators {sorted(blocks)} (wheels alone or torquers alone are read)"
+    if environment.gravity_gradient or environment.magnetic_field is not None or np.any(environment.disturbance_torque):
+        return "not checked: environment torques"
+    t = np.linspace(0.0, float(reference.duration), max(int(points), 2))
+    sample = reference.sample(t)
+    x = np.zeros((t.size, model.nx))
+    u = np.zeros((t.size, model.nu))
+    x[:, 0:4], x[:, 4:7] = sample.q, sample.omega
+    if "wheels" in blocks:
+        wheels = spacecraft.wheels
+        assert wheels is not None  # a wheels block
+        axes = spacecraft.wheel_axes
+        pinv = np.linalg.pinv(axes * wheels.working)  # rows of the failed wheels zero
+        momentum0 = np.asarray(problem.wheel_momentum0, dtype=float)
+        total = quat.rotate(problem.q0, spacecraft.inertia @ problem.omega0 + axes @ momentum0)
+        wheel_total = quat.rotate_inverse(sample.q, np.broadcast_to(total, sample.q.shape[:-1] + (3,))) - sample.omega @ spacecraft.inertia.T
+        x[:, 7:] = wheel_total @ pinv.T
+        demand = sample.torque + np.cross(sample.omega, x[:, 7:] @ axes.T)
+        u[:, model.control_slices["wheels"]] = -demand @ pinv.T
+        # what the working wheels cannot give (off their span) and the stored momentum they miss
+        missed = np.max(np.abs(demand + u[:, model.control_slices["wheels"]] @ axes.T), initial=0.0)
+        if missed > boundary_tolerance:
+            return {"torque off the working wheels' span": float(missed)}
+    else:
+        u[:, model.control_slices["torquers"]] = sample.torque
+    broken: dict[str, float] = {}
+    x_low, x_high, u_low, u_high = bounds
+    for name, values, low, high in (("states", x, x_low, x_high), ("controls", u, u_low, u_high)):
+        scale = np.maximum(np.abs(low), np.abs(high))
+        scale = np.where(scale > 0, scale, 1.0)  # a zero bound (a failed wheel): absolute excess
+        with np.errstate(invalid="ignore"):
+            excess = np.maximum(values - high, low - values) / scale  # nan where both bounds are infinite
+        worst = float(np.max(np.nan_to_num(excess, nan=-np.inf), initial=-np.inf))
+        if worst > tolerance:
+            broken[name] = worst
+    if max_rate is not None:
+        rate_excess = float(np.max(np.linalg.norm(sample.omega, axis=1))) / max_rate - 1.0
+        if rate_excess > tolerance:
+            broken["rate"] = rate_excess
+    for constraint in pointing:
+        margin = constraint.margins(t, sample.q)
+        if np.any(np.isfinite(margin)) and float(np.nanmin(margin)) < 0.0:
+            broken[constraint.name] = -float(np.nanmin(margin))
+    assert problem.qf is not None  # collocation refuses a free attitude (Planner.problem_error)
+    misses = {"initial state": float(np.max(np.abs(x[0, :7] - problem.initial_state[:7]))),
+              "final attitude": float(min(np.max(np.abs(sample.q[-1] - problem.qf)),
+                                          np.max(np.abs(sample.q[-1] + problem.qf))))}
+    if model.n_wheels:
+        misses["initial wheel momentum"] = float(np.max(np.abs(x[0, 7:] - np.asarray(problem.wheel_momentum0, dtype=float))))
+    if problem.omegaf is not None:
+        misses["final rate"] = float(np.max(np.abs(sample.omega[-1] - problem.omegaf)))
+    broken.update({name: miss for name, miss in misses.items() if miss > boundary_tolerance})
+    return broken

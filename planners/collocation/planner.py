@@ -55,7 +55,7 @@ from planners.collocation.allocation import (
     allocation_error,
     with_allocation,
 )
-from planners.collocation.certificate import collocation_certificate
+from planners.collocation.certificate import collocation_certificate, start_violations
 from planners.collocation.problem import (
     endpoint_cone_error,
     parse_cone,
@@ -69,6 +69,7 @@ from planners.collocation.reference import (
     solution_sampler,
 )
 from planners.collocation.requirements import (
+    BOUND_TOLERANCE,
     DENSE_POINTS,
     DenseCheck,
     Requirements,
@@ -83,6 +84,8 @@ from planners.collocation.strategy import (
     AUTO_RESTART,
     DENSE_ROUNDS,
     POLISH_MU_INIT,
+    SEED_BOUND_ATOL,
+    SEED_BOUND_RTOL,
     SEED_CONE_PAD,
     SEED_FATROP,
     SEED_TOLERANCE,
@@ -659,7 +662,98 @@ class CollocationPlanner(Planner):
         params = np.concatenate([problem.initial_state, problem.qf, omegaf, [problem.duration],
                                  problem.model.default_parameters])
         solved = self._optimum(problem, ocp, starts, params, self.options.intervals)
-        return self._honoured(problem, params, solved, self._reference(problem, ocp, params, solved))
+        reference = self._honoured(problem, params, solved, self._reference(problem, ocp, params, solved))
+        if ocp.free_time and not (ocp.energy_weight or ocp.l1_weight) and isinstance(reference, CollocationReference):
+            reference = self._seed_bound(problem, ocp, params, starts, reference)
+        return reference
+
+    def _bound_candidates(self, problem: ManeuverProblem, starts: list[Reference]) -> list[tuple[str, Reference]]:
+        """The motions whose durations may bound the minimum time (:meth:`_seed_bound`): the starts
+        at their own durations and ``eigenaxis``'s ``min_time`` profile under the bounds the NLP
+        imposes (``torque_fraction`` ``1 − actuator_margin``; with a margin, the coast rate capped
+        at ``1 − actuator_margin`` of the full-limit profile's, so that the wheel momenta, in
+        proportion to the rate, keep the margin too), each labelled."""
+        candidates = [(f"start {reference.planner}", reference) for reference in starts]
+        keep = 1.0 - (problem.actuator_margin or 0.0)
+        options: dict[str, Any] = {"profile": "min_time", "torque_fraction": keep}
+        try:
+            eigenaxis = PLANNERS["eigenaxis"](options, cache=self.cache).plan_start(problem)
+            rate = getattr(getattr(eigenaxis, "profile", None), "rate_max", None)
+            if eigenaxis.ok and keep < 1.0 and rate is not None and np.isfinite(rate) and rate > 0:
+                eigenaxis = PLANNERS["eigenaxis"]({**options, "max_rate": keep * float(rate)},
+                                                  cache=self.cache).plan_start(problem)
+        except Exception:  # noqa: BLE001 (a candidate is optional: none from a planner that cannot plan it)
+            return candidates
+        if eigenaxis.ok:
+            candidates.append(("eigenaxis min_time", eigenaxis))
+        return candidates
+
+    def _seed_bound(self, problem: ManeuverProblem, ocp: OptimalControlProblem, params: Array,
+                    starts: list[Reference], reference: CollocationReference) -> CollocationReference:
+        """A minimum time no slower than a feasible candidate's (:meth:`_bound_candidates`).
+
+        A candidate faster than ``reference`` (by more than :data:`SEED_BOUND_RTOL`) is checked
+        against the problem's constraints as the NLP imposes them before any dense tightening
+        (:func:`~planners.collocation.certificate.start_violations`: the variable bounds, the
+        rate norm, the pointing requirements as stated, the boundary conditions); a feasible one is
+        a slew of the problem and its duration an upper bound of the minimum time. Then the
+        problem is solved once more from the fastest feasible candidate at its own duration (and
+        checked densely, :meth:`_honoured`), and the faster converged reference kept. If the one
+        kept is still slower than that candidate, its message and certificate say so. Without a
+        faster candidate nothing is solved: ``stats["seed_bound"]`` records the check."""
+        o = self.options
+        T = float(reference.duration)
+        record: dict[str, Any] = {"rtol": SEED_BOUND_RTOL, "candidates": [], "resolved": False, "bound_s": None}
+        best: tuple[str, Reference] | None = None
+        requirements = self._requirements(problem)
+        bounds = self._variable_bounds(problem)
+        for label, candidate in self._bound_candidates(problem, starts):
+            entry: dict[str, Any] = {"from": label, "duration_s": float(candidate.duration)}
+            record["candidates"].append(entry)
+            if not candidate.duration < T * (1.0 - SEED_BOUND_RTOL):
+                entry["checked"] = "not faster"
+                continue
+            broken = start_violations(problem, candidate, bounds, ocp.max_rate, requirements.pointing,
+                                      DENSE_POINTS * o.intervals + 1, BOUND_TOLERANCE, SEED_BOUND_ATOL)
+            entry["checked"] = broken if isinstance(broken, str) else ("feasible" if not broken else "infeasible")
+            if isinstance(broken, dict) and broken:
+                entry["violations"] = broken
+            if broken == {} and (best is None or candidate.duration < best[1].duration):
+                best = (label, candidate)
+        reference.stats["seed_bound"] = record
+        if best is None:
+            return reference
+        label, candidate = best
+        record["bound_s"], record["bound_from"], record["resolved"] = float(candidate.duration), label, True
+        transcription, nlp = self._nlp(problem, ocp)
+        lbx, ubx = transcription.bounds(ocp, nlp, *bounds, problem.duration)
+        seed = transcription.seed(ocp, nlp, seed_sampler(problem, candidate), candidate.duration)
+        result = solve_multistart(nlp.solver, [seed], p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg, agree=1)
+        again = _Optimum(result, {}, transcription, nlp, o.intervals)
+        other = self._honoured(problem, params, again, self._reference(problem, ocp, params, again))
+        record["resolve"] = {"status": result.status, "iterations": result.iterations, "time_s": result.time_s,
+                             "duration_s": float(other.duration) if other.ok else None}
+        if isinstance(other, CollocationReference) and other.duration < T:
+            other.stats["seeds"] = reference.stats.get("seeds")
+            other.stats["seed_bound"] = record
+            other.message += f" (solved again from {label}'s feasible {candidate.duration:.6g} s: {T:.6g} s before)"
+            reference, T = other, float(other.duration)
+        record["kept_s"] = T
+        record["met"] = T <= candidate.duration * (1.0 + SEED_BOUND_RTOL)
+        if not record["met"]:
+            dense = reference.stats.get("dense_check") or {}
+            tightened = {name: float(dense[key]) for name, key in (("actuators", "actuator_tightening"),
+                                                                   ("rate", "rate_tightening")) if dense.get(key)}
+            why = ("; the dense check tightened the bounds at the points: " + ", ".join(
+                f"{name} {100.0 * value:.3g} %" for name, value in tightened.items())) if tightened else ""
+            note = (f"slower than a feasible slew of this problem, {label} in {candidate.duration:.6g} s "
+                    f"(+{100.0 * (T / candidate.duration - 1.0):.3g} %{why}): not the best known")
+            reference.message += f"; {note}"
+            certificate = reference.stats.get("certificate")
+            if isinstance(certificate, dict):
+                certificate["seed_bound"] = note
+                certificate["summary"] = f"{certificate.get('summary', '')}; {note}"
+        return reference
 
     def _honoured(self, problem: ManeuverProblem, params: Array, solved: _Optimum, reference: Reference) -> Reference:
         """``reference`` checked densely against the requirements, and solved again tighter while it
@@ -670,6 +764,7 @@ class CollocationPlanner(Planner):
         tightening = Tightening.initial(requirements, float(np.deg2rad(self.options.cone_margin_deg)))
         check = dense_check(problem, reference, requirements)
         first_seeds = reference.stats.get("seeds")
+        first, first_f = reference, float(solved.result.f)
         rounds: list[dict] = []
         stopped = ""
         while not check.met and len(rounds) < DENSE_ROUNDS:
@@ -690,6 +785,11 @@ class CollocationPlanner(Planner):
             check = dense_check(problem, reference, requirements)
         if first_seeds is not None:  # the tightened solves start from the first one's optimum
             reference.stats["seeds"] = first_seeds
+        if rounds and reference is not first:  # the message names the last solve: say where it started
+            origin = f"T = {first.duration:.6g} s" if self._ocp(problem).free_time else f"objective {first_f:.6g}"
+            starts = (f"; its multistart: {first_seeds.get('tried')} starts, {first_seeds.get('agreed')} agreed, "
+                      f"best from {first_seeds.get('best_from')}") if isinstance(first_seeds, dict) else ""
+            reference.message += (f" (the dense check's tightened solve from the optimum at {origin}{starts})")
         reference.stats["dense_check"] = self._dense_stats(requirements, tightening, check, rounds)
         if not check.met:
             reference.message += (f"; still breaks {check.summary()} between the mesh points after "

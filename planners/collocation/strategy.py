@@ -240,3 +240,10 @@ between the mesh points (:mod:`planners.collocation.requirements`)."""
 SEED_CONE_PAD = float(np.deg2rad(2.0))
 """How far outside a keep-out cone a start that enters it is bent [rad]
 (:func:`planners.collocation.reference.cone_avoiding_sampler`)."""
+SEED_BOUND_RTOL = 1e-6
+"""Relative gap by which a minimum time counts as slower than a feasible start's own duration
+(:meth:`planners.collocation.planner.CollocationPlanner._seed_bound`): the same as
+:data:`AGREE_RTOL`, what the multistart counts as the same optimum."""
+SEED_BOUND_ATOL = 1e-6
+"""Absolute tolerance of the boundary conditions of a start checked as an upper bound (unit
+quaternion, rad/s, N m s): a start that misses its target by more is no feasible slew."""
