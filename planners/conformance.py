@@ -108,7 +108,7 @@ def finite_check_times(reference: Reference, points: int = FINITE_SAMPLES) -> Ar
     return np.unique(np.concatenate([np.linspace(0.0, T, points), inside, T * np.array([1.05, 1.3, 2.0])]))
 
 
-def check_finite(reference: Reference) -> None:
+def check_finite(reference: Reference, points: int = FINITE_SAMPLES) -> None:
     """Every quantity is finite and every ``q`` a unit quaternion, on a dense grid of ``[0, T]``
     (:func:`finite_check_times`) and after T.
 
@@ -119,6 +119,9 @@ def check_finite(reference: Reference) -> None:
     ----------
     reference : Reference
         A reference with status ``"ok"``.
+    points : int, optional
+        Uniform times on ``[0, T]`` (default :data:`FINITE_SAMPLES`; a caller that screens many
+        references, such as collocation's seeds, takes fewer).
 
     Raises
     ------
@@ -130,7 +133,7 @@ def check_finite(reference: Reference) -> None:
     if not (np.isfinite(T) and T > 0.0):
         raise ConformanceError(f"{reference.planner}: the reference's duration is {T!r} s; it must be a finite "
                                f"positive number of seconds")
-    times = finite_check_times(reference)
+    times = finite_check_times(reference, points)
     # [0, T] first: the continuation after T starts from the state at T, which must be finite.
     for part in (times[times <= T], times[times > T]):
         try:

@@ -10,7 +10,7 @@ the search strategy's tuned constants (:mod:`~planners.collocation.strategy`) an
 an optimum, with the co-states in the collocation multipliers (:mod:`~planners.collocation.certificate`).
 
 May import: :mod:`ocp` (transcriptions and the NLP core) and the contract modules of
-:mod:`planners` (``base``, ``problem``, ``reference``); other planners only through the
+:mod:`planners` (``base``, ``problem``, ``reference``, ``conformance``); other planners only through the
 ``PLANNERS`` registry (:mod:`planners.registry`), to seed from their references.
 """
 from planners.collocation.planner import CollocationOptions, CollocationPlanner

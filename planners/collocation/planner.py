@@ -97,10 +97,17 @@ from planners.collocation.strategy import (
     merged,
     seed_record,
 )
+from planners.conformance import check_finite
+from planners.errors import ConformanceError
 from planners.problem import Array, ManeuverProblem, bound_keys
 from planners.reference import FailedReference, Reference
 from planners.registry import PLANNERS
 
+SEED_CHECK_POINTS = 129
+"""Uniform times on ``[0, T]`` (with the reference's own breakpoints and enforced times) on which a
+start reference must be finite before it seeds a solve (:meth:`CollocationPlanner._starts`): a
+seed planner registered by a plugin whose reference turns NaN mid-slew was handed to the solver,
+which then never returned."""
 MAX_RK4_STEPS = 1000
 """Largest ``intervals × substeps`` of ``multiple_shooting``: the NLP build expands every RK4 step
 (10 × 100 and 50 × 20 steps built in 20 s on a shared machine, 200 × 100 ran over 120 s; the
@@ -467,8 +474,10 @@ class CollocationPlanner(Planner):
 
     def _starts(self, problem: ManeuverProblem, failures: list[str] | None = None) -> list[Reference]:
         """The references of the warm start and the seed planners (:meth:`_seed_names`) that
-        planned; a planner that fails or raises is skipped, its ``planner: message`` appended to
-        ``failures`` when given."""
+        planned; a planner that fails or raises, or whose reference is not finite on
+        :data:`SEED_CHECK_POINTS` times or raises when sampled
+        (:func:`planners.conformance.check_finite`), is skipped, its ``planner: message`` appended
+        to ``failures`` when given."""
         starts = []
         requested = [(self.options.warm_start, self.options.warm_start_options)]
         requested += [(name, None) for name in self._seed_names(problem)]
@@ -479,10 +488,21 @@ class CollocationPlanner(Planner):
                 if failures is not None:
                     failures.append(f"{name}: raised {type(error).__name__}: {error}")
                 continue
-            if reference.ok:
-                starts.append(reference)
-            elif failures is not None:
-                failures.append(f"{name}: {reference.message}")
+            if not reference.ok:
+                if failures is not None:
+                    failures.append(f"{name}: {reference.message}")
+                continue
+            try:  # a seed with a NaN would reach the solver (a plugin's reference, say), where it can hang
+                check_finite(reference, SEED_CHECK_POINTS)
+            except ConformanceError as error:
+                if failures is not None:
+                    failures.append(f"{name}: {error}")
+                continue
+            except Exception as error:  # noqa: BLE001 (its sampling raised: recorded, as a planner's crash above)
+                if failures is not None:
+                    failures.append(f"{name}: sampling its reference raised {type(error).__name__}: {error}")
+                continue
+            starts.append(reference)
         return starts
 
     def _guesses(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
@@ -881,6 +901,10 @@ class CollocationPlanner(Planner):
                 (labels if central else alternate_labels).append(f"{reference.planner} other side")
                 alternates.append(transcription.seed(ocp, nlp, sample, duration))
                 alternate_labels.append(f"{reference.planner} unbent")
+        for vector, label in zip(seeds + alternates, labels + alternate_labels):
+            if not np.all(np.isfinite(vector)):  # the solver would never return (see SEED_CHECK_POINTS)
+                raise ValueError(f"collocation: the start from {label} is not finite at "
+                                 f"{int(np.sum(~np.isfinite(vector)))} of its {vector.size} entries")
         return seeds, alternates, labels + alternate_labels
 
     def _optimum(self, problem: ManeuverProblem, ocp: OptimalControlProblem, starts: list[Reference], params: Array,
