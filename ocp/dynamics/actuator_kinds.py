@@ -507,6 +507,25 @@ class ReactionWheels(Actuator):
         return mask
 
     @property
+    def pseudo_inverse(self) -> Array:
+        """``A⁺`` of the working wheels: the minimum-norm wheel torques of a body torque in their span.
+
+        Returns
+        -------
+        (n, 3) ndarray
+            Rows per wheel, failed ones included: the pseudo-inverse of the axes with the failed
+            wheels' columns zeroed, and those wheels' rows set to exact zeros (the SVD leaves
+            rounding there, 1e-19 N m asked of a failed wheel). The controllers' allocation
+            ``g = −A⁺ τ`` and every planner mapping a body torque or momentum to wheels use it.
+        """
+        working = self.working
+        inverse: Array = np.zeros((self.count, 3))
+        if np.any(working):
+            inverse = np.asarray(np.linalg.pinv(self.axes * working), dtype=float)
+        inverse[~working] = 0.0
+        return inverse
+
+    @property
     def control_size(self) -> int:
         """``n``: one motor torque per wheel, failed ones included."""
         return self.count

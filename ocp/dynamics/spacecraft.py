@@ -274,9 +274,7 @@ class Spacecraft:
             rows, limits = [], []
             wheels = self.wheels
             if wheels is not None and np.any(wheels.working):
-                working = wheels.axes * wheels.working  # failed wheels: zero columns, as the allocation
-                pinv = np.linalg.pinv(working)
-                rows.append(pinv[wheels.working])
+                rows.append(wheels.pseudo_inverse[wheels.working])  # as the allocation
                 limits.append(wheels.max_torque[wheels.working])
             span = self.wheel_span()
             if span.shape[1] < 3:

@@ -18,7 +18,6 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from ocp import quat
 from ocp.dynamics.model import AttitudeModel
 from ocp.nlp.certificate import (
     Switching,
@@ -30,6 +29,7 @@ from ocp.nlp.certificate import (
 from ocp.nlp.solve import NLPResult
 from ocp.transcription import NLP, OptimalControlProblem, Transcription
 from ocp.transcription.radau import RadauCollocation
+from planners.collocation.reference import states_controls
 from planners.problem import Array, ManeuverProblem
 from planners.reference import Reference
 
@@ -208,27 +208,13 @@ def start_violations(problem: ManeuverProblem, reference: Reference, bounds: tup
     if environment.gravity_gradient or environment.magnetic_field is not None or np.any(environment.disturbance_torque):
         return "not checked: environment torques"
     t = np.linspace(0.0, float(reference.duration), max(int(points), 2))
-    sample = reference.sample(t)
-    x = np.zeros((t.size, model.nx))
-    u = np.zeros((t.size, model.nu))
-    x[:, 0:4], x[:, 4:7] = sample.q, sample.omega
+    x, u, sample = states_controls(problem, reference, t)
     if "wheels" in blocks:
-        wheels = spacecraft.wheels
-        assert wheels is not None  # a wheels block
-        axes = spacecraft.wheel_axes
-        pinv = np.linalg.pinv(axes * wheels.working)  # rows of the failed wheels zero
-        momentum0 = np.asarray(problem.wheel_momentum0, dtype=float)
-        total = quat.rotate(problem.q0, spacecraft.inertia @ problem.omega0 + axes @ momentum0)
-        wheel_total = quat.rotate_inverse(sample.q, np.broadcast_to(total, sample.q.shape[:-1] + (3,))) - sample.omega @ spacecraft.inertia.T
-        x[:, 7:] = wheel_total @ pinv.T
-        demand = sample.torque + np.cross(sample.omega, x[:, 7:] @ axes.T)
-        u[:, model.control_slices["wheels"]] = -demand @ pinv.T
         # what the working wheels cannot give (off their span) and the stored momentum they miss
-        missed = np.max(np.abs(demand + u[:, model.control_slices["wheels"]] @ axes.T), initial=0.0)
+        demand = sample.torque + np.cross(sample.omega, x[:, 7:] @ spacecraft.wheel_axes.T)
+        missed = np.max(np.abs(demand + u[:, model.control_slices["wheels"]] @ spacecraft.wheel_axes.T), initial=0.0)
         if missed > boundary_tolerance:
             return {"torque off the working wheels' span": float(missed)}
-    else:
-        u[:, model.control_slices["torquers"]] = sample.torque
     broken: dict[str, float] = {}
     x_low, x_high, u_low, u_high = bounds
     for name, values, low, high in (("states", x, x_low, x_high), ("controls", u, u_low, u_high)):

@@ -197,9 +197,32 @@ class CollocationReference(Reference):
         return ReferenceSample(quat.normalize(x[:, 0:4]), omega, x_dot[:, 4:7], torque)
 
 
-def _seed_states_controls(problem: ManeuverProblem, reference: Reference, times: Array):
-    """States and actuator controls along a reference: wheel momenta from conservation of the total
-    momentum, controls by mapping the reference torque to the actuators."""
+def states_controls(problem: ManeuverProblem, reference: Reference, times: Array) -> tuple[Array, Array, ReferenceSample]:
+    """The model's states and actuator controls along another planner's reference.
+
+    Wheel momenta from the conservation of the total momentum (the stored momentum of
+    ``problem.wheel_momentum0`` included), the wheel torques ``g = −A⁺ (u + ω × A h_w)`` for the
+    reference's torque ``u`` (:attr:`~ocp.ReactionWheels.pseudo_inverse`: a failed wheel is given
+    nothing), or the torquers' torque ``u``; other actuators' controls zero.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre (model, spacecraft, initial state and wheel momentum).
+    reference : Reference
+        The reference.
+    times : (n,) ndarray
+        Times [s].
+
+    Returns
+    -------
+    x : (n, nx) ndarray
+        ``[q, ω, h_w]`` per time.
+    u : (n, nu) ndarray
+        Controls in the layout of ``model.control_slices``.
+    sample : ReferenceSample
+        The reference at ``times``.
+    """
     sample = reference.sample(times)
     spacecraft, model = problem.spacecraft, problem.model
     axes = spacecraft.wheel_axes
@@ -208,15 +231,17 @@ def _seed_states_controls(problem: ManeuverProblem, reference: Reference, times:
     u = np.zeros((times.size, model.nu))
     body_momentum = sample.omega @ spacecraft.inertia.T
     if model.n_wheels:
+        wheels = spacecraft.wheels
+        assert wheels is not None  # n_wheels > 0
         wheel_momentum = cast(Array, problem.wheel_momentum0)  # zeros when not given (ManeuverProblem)
         total = quat.rotate(problem.q0, spacecraft.inertia @ problem.omega0 + axes @ wheel_momentum)
         wheel_total = quat.rotate_inverse(sample.q, np.broadcast_to(total, sample.q.shape[:-1] + (3,))) - body_momentum
-        x[:, 7:] = wheel_total @ np.linalg.pinv(axes).T
+        x[:, 7:] = wheel_total @ wheels.pseudo_inverse.T
         wheel_torque = sample.torque + np.cross(sample.omega, x[:, 7:] @ axes.T)
-        u[:, model.control_slices["wheels"]] = -wheel_torque @ np.linalg.pinv(axes).T
+        u[:, model.control_slices["wheels"]] = -wheel_torque @ wheels.pseudo_inverse.T
     elif "torquers" in model.control_slices:
         u[:, model.control_slices["torquers"]] = sample.torque
-    return x, u, sample.torque
+    return x, u, sample
 
 
 def seed_sampler(problem: ManeuverProblem, reference: Reference) -> Callable[[Array], tuple[Array, Array, Array]]:
@@ -237,8 +262,8 @@ def seed_sampler(problem: ManeuverProblem, reference: Reference) -> Callable[[Ar
     """
 
     def sample(times: Array) -> tuple[Array, Array, Array]:
-        x, u, torque = _seed_states_controls(problem, reference, times)
-        return x, u, np.abs(torque)
+        x, u, sample = states_controls(problem, reference, times)
+        return x, u, np.abs(sample.torque)
 
     return sample
 
