@@ -340,41 +340,46 @@ class EigenaxisReference(Reference):
 
 
 def sinusoid_peak(const: Array, cos: Array, sin: Array, span: float) -> Array:
-    """``max |k + c cos θ + s sin θ|`` over ``θ ∈ [0, span]``, row by row (``span <= π``).
+    """``max |k + c cos θ + s sin θ|`` over ``θ ∈ [0, span]``, row by row: the magnitude's peak.
 
-    The extrema are at the ends or where the derivative vanishes, ``θ = atan2(s, c) (+ π)``.
+    The larger of the signed maxima of the sinusoid and of its negative (:func:`sinusoid_max` on
+    ``(k, c, s)`` and on ``(−k, −c, −s)``); the budget bounds a torque or a momentum of either sign
+    by it.
 
     Parameters
     ----------
     const, cos, sin : (m,) ndarray
-        ``k``, ``c`` and ``s`` per row.
+        The sinusoid's ``k``, ``c`` and ``s`` per row, as :func:`sinusoid_max` takes them.
     span : float
         The interval's length [rad], in ``[0, π]``.
 
     Returns
     -------
     (m,) ndarray
-        The peak per row.
+        The peak magnitude per row, ``>= 0``.
     """
     return np.maximum(sinusoid_max(const, cos, sin, span), sinusoid_max(-const, -cos, -sin, span))
 
 
 def sinusoid_max(const: Array, cos: Array, sin: Array, span: float) -> Array:
-    """``max (k + c cos θ + s sin θ)`` (signed) over ``θ ∈ [0, span]``, row by row (``span <= π``).
+    """``max (k + c cos θ + s sin θ)`` over ``θ ∈ [0, span]``, row by row: the signed maximum.
 
-    The extrema are at the ends or where the derivative vanishes, ``θ = atan2(s, c) (+ π)``.
+    Exact, not sampled: a smooth function's maximum on a closed interval is at an end or where its
+    derivative ``s cos θ − c sin θ`` vanishes, ``θ = atan2(s, c)`` and ``atan2(s, c) + π`` (mod
+    ``2π``), the two counted where they fall within the span. The budget reads it for a wheel's
+    momentum pushed to one side (:class:`WheelBudget`).
 
     Parameters
     ----------
     const, cos, sin : (m,) ndarray
-        ``k``, ``c`` and ``s`` per row.
+        ``k`` (constant), ``c`` (of ``cos θ``) and ``s`` (of ``sin θ``) per row.
     span : float
-        The interval's length [rad], in ``[0, π]``.
+        The interval's length [rad], in ``[0, π]`` (θ from 0).
 
     Returns
     -------
     (m,) ndarray
-        The maximum per row.
+        The maximum per row, of its sign (negative when the sinusoid stays below zero).
     """
     stationary = np.arctan2(sin, cos) % (2 * np.pi)
     candidates = [np.zeros_like(cos), np.full_like(cos, span)]

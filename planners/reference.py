@@ -58,6 +58,11 @@ JUMP_TOLERANCE = 1e-6
 """A change of a reference's body rate [rad/s] over an instant up to this is rounding, not a jump
 (an impulse): the conformance check of the ends and the requirement scoring both use it."""
 
+BREAKPOINT_INSTANT = 1e-9
+"""Either side of a breakpoint ``b`` a reference is sampled at ``b ± δ``, ``δ`` this times
+``max(T, 1 s)`` (:meth:`Reference.breakpoint_sides`): far enough for rounding to tell the sides
+apart, near enough that what changes smoothly changes by ``δ`` times its rate only."""
+
 _FIELD_WIDTHS = (("q", 4), ("omega", 3), ("omega_dot", 3), ("torque", 3))
 
 
@@ -157,6 +162,7 @@ class Reference(ABC):
         self.enforced_times: Array | None = (None if enforced_times is None
                                              else np.sort(np.asarray(enforced_times, dtype=float).ravel()))
         self._coast: TorqueFreeMotion | None = None
+        self._sides: tuple[bytes, Array, ReferenceSample] | None = None
 
     @property
     def ok(self) -> bool:
@@ -272,6 +278,39 @@ class Reference(ABC):
         if np.ndim(t) == 0:
             return ReferenceSample(*(a[0] for a in inside))
         return inside
+
+    def breakpoint_sides(self) -> tuple[Array, ReferenceSample]:
+        """The reference an instant before and an instant after each of its :attr:`breakpoints`.
+
+        Where ``ω`` or ``ω̇`` may jump, a sample on either side stands for the one-sided limits: the
+        requirement scoring reads them for the jumps of the rate
+        (:func:`scenarios.requirements.scoring.rate_jumps`), for the attitude between its samples and
+        for the actuator demand (which it integrates up to each side, never across a switch). They
+        are sampled once per reference and kept (computed again only if the breakpoints or the
+        duration change).
+
+        Returns
+        -------
+        times : (2K,) ndarray
+            ``b − δ`` for each of the ``K`` breakpoints ``b`` in order, then ``b + δ`` for each
+            [s], ``δ`` = :data:`BREAKPOINT_INSTANT` ``× max(T, 1 s)``; outside ``[0, T]`` the
+            reference's continuation (:meth:`sample`).
+        sample : ReferenceSample
+            The reference at ``times``: ``(2K, 4)`` and ``(2K, 3)`` arrays (empty without
+            breakpoints). Kept by the reference, so read-only (copy them to change them).
+        """
+        key = np.append(self.breakpoints, self.duration).tobytes()
+        cached = getattr(self, "_sides", None)
+        if cached is not None and cached[0] == key:
+            return cached[1], cached[2]
+        instant = BREAKPOINT_INSTANT * max(self.duration, 1.0)
+        times = np.concatenate([self.breakpoints - instant, self.breakpoints + instant])
+        sample = (self.sample(times) if times.size else
+                  ReferenceSample(*(np.zeros((0, width)) for _, width in _FIELD_WIDTHS)))
+        for array in (times, *sample):
+            array.flags.writeable = False  # kept: read, never changed
+        self._sides = (key, times, sample)
+        return times, sample
 
     def q(self, t: ArrayLike) -> Array:
         """Attitude quaternion(s) at ``t`` (see :meth:`sample`).

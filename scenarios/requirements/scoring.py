@@ -13,7 +13,9 @@ and what breaks it in words. The fields (their units, words and definitions are 
   interpolated between the samples with the body rates (the reference's own rates; the window's
   edges are points of it, the reference sampled there exactly, the closed loop interpolated);
 * ``actuators`` (reference only): for each actuator quantity with a limit
-  (:func:`controllers.allocation.reference_demand`, through the row's controller's allocation),
+  (:func:`controllers.allocation.reference_demand`, through the row's controller's allocation, at
+  the samples and either side of each of the reference's breakpoints: the integrated demand never
+  interpolates across a switch, and a bang's peak at its end is read there),
   ``<quantity>`` the peak demand over the limit and ``<quantity>_time_s`` when it peaks, then
   ``rate_jump`` [rad/s] and ``rate_jump_time_s``, the largest jump of the reference's body rate
   (:func:`rate_jumps`: an impulse no finite torque gives; its momentum goes to the wheels), then
@@ -57,7 +59,7 @@ from ocp.geometry.pointing import (
 )
 from planners import ManeuverProblem, Planner, Reference
 from planners.base import REQUIREMENT_KINDS
-from planners.reference import JUMP_TOLERANCE
+from planners.reference import BREAKPOINT_INSTANT, JUMP_TOLERANCE
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
 __all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
@@ -182,26 +184,50 @@ def _seconds(value: float) -> str:
     return f"{value:.1f}" if value == 0.0 or abs(value) >= 0.1 else f"{value:.2g}"
 
 
+def _inserted(t: Array, columns: Sequence[Array], times: Array, values: Sequence[Array]) -> tuple[Array, list[Array]]:
+    """``t`` and its columns (rows per time) with the rows of ``values`` at ``times`` inserted, in
+    time order: those strictly inside ``t``'s span, on no sample and on no earlier one of ``times``."""
+    times = np.asarray(times, dtype=float)
+    _, first = np.unique(times, return_index=True)
+    keep = np.zeros(times.size, bool)
+    keep[first] = True
+    keep &= (times > t[0]) & (times < t[-1]) & ~np.isin(times, t)
+    if not np.any(keep):
+        return t, [np.asarray(column, dtype=float) for column in columns]
+    merged = np.concatenate([t, times[keep]])
+    order = np.argsort(merged, kind="stable")
+    return merged[order], [np.concatenate([np.asarray(column, dtype=float), np.atleast_2d(value)[keep]])[order]
+                           for column, value in zip(columns, values)]
+
+
+def _sides(reference: Reference) -> tuple[Array, tuple[Array, Array, Array]]:
+    """The times either side of a reference's breakpoints and its attitude, rate and torque there
+    (:meth:`planners.Reference.breakpoint_sides`, sampled once per reference)."""
+    times, sample = reference.breakpoint_sides()
+    return times, (sample.q, sample.omega, sample.torque)
+
+
 def _with_edges(problem: ManeuverProblem, t: Array, sample: Any,
                 reference: Reference | None) -> tuple[Array, Array, Array]:
     """The reference's times, attitudes and rates for its pointing scores: its samples, and the
     reference sampled exactly where the interpolation between them cannot stand for it: the edges
     of every pointing window inside the samples' span, and either side of each breakpoint (where its
-    rate may jump: the Hermite between samples across a jump would use the wrong slopes)."""
+    rate may jump: the Hermite between samples across a jump would use the wrong slopes;
+    :meth:`planners.Reference.breakpoint_sides`, sampled once per reference)."""
     q, omega = np.asarray(sample.q, dtype=float), np.asarray(sample.omega, dtype=float)
     if reference is None or not problem.pointing or t.size < 2:
         return t, q, omega
-    extra = [edge for constraint in problem.pointing for edge in constraint.window]
-    instant = 1e-9 * max(reference.duration, 1.0)
-    extra += [time + side for time in reference.breakpoints for side in (-instant, instant)]
-    added = np.unique(np.asarray(extra, dtype=float))
-    added = added[(added > t[0]) & (added < t[-1]) & ~np.isin(added, t)]
-    if not added.size:
+    edges = np.unique(np.asarray([edge for constraint in problem.pointing for edge in constraint.window], dtype=float))
+    edges = edges[(edges > t[0]) & (edges < t[-1]) & ~np.isin(edges, t)]
+    sides, at_sides = reference.breakpoint_sides()
+    times = np.concatenate([edges, sides])
+    if not times.size:
         return t, q, omega
-    more = reference.sample(added)
-    order = np.argsort(np.concatenate([t, added]), kind="stable")
-    return (np.concatenate([t, added])[order], np.concatenate([q, np.atleast_2d(more.q)])[order],
-            np.concatenate([omega, np.atleast_2d(more.omega)])[order])
+    more = reference.sample(edges) if edges.size else None
+    quaternions = np.concatenate([np.zeros((0, 4)) if more is None else more.q, at_sides.q])
+    rates = np.concatenate([np.zeros((0, 3)) if more is None else more.omega, at_sides.omega])
+    merged, (q, omega) = _inserted(t, (q, omega), times, (quaternions, rates))
+    return merged, q, omega
 
 
 def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
@@ -335,14 +361,14 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
     breakpoints = np.array([] if reference is None else reference.breakpoints, dtype=float)
     # a breakpoint at the last sample too (a stop at T sampled up to T: the reference's metrics); the
     # sample after it is then the torque-free coast from the final state
-    breakpoints = breakpoints[(breakpoints > t[0]) & (breakpoints <= t[-1])]
-    if breakpoints.size:
+    inside = (breakpoints > t[0]) & (breakpoints <= t[-1])
+    if np.any(inside):
         assert reference is not None
-        instant = 1e-9 * max(reference.duration, 1.0)
-        around = reference.sample(np.concatenate([breakpoints - instant, breakpoints + instant]))  # one call
-        before, after = np.split(around.omega, 2)
-        slopes = np.max(np.abs(np.stack(np.split(around.omega_dot, 2))), axis=(0, 2))
-        for time, jump, slope in zip(breakpoints, after - before, slopes):
+        _, around = reference.breakpoint_sides()  # sampled once per reference
+        instant = BREAKPOINT_INSTANT * max(reference.duration, 1.0)
+        before, after = (side[inside] for side in np.split(around.omega, 2))
+        slopes = np.max(np.abs(np.stack([side[inside] for side in np.split(around.omega_dot, 2)])), axis=(0, 2))
+        for time, jump, slope in zip(breakpoints[inside], after - before, slopes):
             if np.linalg.norm(jump) > JUMP_TOLERANCE + 2.0 * instant * slope:  # beyond what ω̇ explains
                 # the first sample after the jump; a step at T is in the sample at T already (its
                 # contract: the rate after the step, Reference's breakpoints)
@@ -418,7 +444,10 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
     The pointing requirements are scored between the samples too, as the closed loop's are
     (:meth:`~ocp.geometry.pointing.PointingConstraint.score_between_samples` with the reference's
     rates), the reference sampled exactly at the edges of their windows and either side of its
-    breakpoints; the actuator and rate requirements at the samples.
+    breakpoints; the actuator requirement at the samples and either side of the breakpoints (where
+    the torque or the rate may jump: the demand, integrated with its inputs linear between samples,
+    would smear a switch over the interval across it; :meth:`planners.Reference.breakpoint_sides`,
+    sampled once per reference), the rate requirement at the samples.
 
     Parameters
     ----------
@@ -452,23 +481,31 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         motion = HermiteMotion(*edged)  # one interpolant for the row's pointing requirements
         scores.update((constraint.name, _pointing(constraint, *edged, motion)) for constraint in problem.pointing)
     if requirements.actuators is not None and allocation is not None:
-        jumps = rate_jumps(t, sample.omega, problem.omega0, reference)
-        steps = np.zeros((t.size, 3))
+        # The demand on the samples and either side of each breakpoint: where the torque (or the
+        # rate) may jump, the demand's integration interpolates its inputs linearly between samples
+        # and would smear a switch over the interval across it (the wheels' momentum read past its
+        # true peak, or short of it), and the peaks of a bang profile sit at its switches.
+        columns = (sample.q, sample.omega, sample.torque)
+        demand_t, (q, omega, reference_torque) = (
+            (t, [np.asarray(column, dtype=float) for column in columns]) if reference is None or t.size < 2
+            else _inserted(t, columns, *_sides(reference)))
+        jumps = rate_jumps(demand_t, omega, problem.omega0, reference)
+        steps = np.zeros((demand_t.size, 3))
         for _, index, jump in jumps:
-            if index < t.size:
+            if index < demand_t.size:
                 steps[index] += jump
         # The actuators' share: the reference's torque u (of I ω̇ = −ω × I ω + u, the environment
         # it models inside) less the environment's torque along it (a planner that models none, such
         # as eigenaxis, leaves the actuators a disturbance to cancel; one that does, its own model).
-        environment = _environment_torque(problem, t, sample.q, sample.omega)
-        torque = np.asarray(sample.torque, dtype=float) - environment
+        environment = _environment_torque(problem, demand_t, q, omega)
+        torque = reference_torque - environment
         # the sample at T holds the torque's value there; the reference coasts torque-free after it
-        after = (np.where((t >= reference.duration)[:, None], 0.0, sample.torque) - environment
+        after = (np.where((demand_t >= reference.duration)[:, None], 0.0, reference_torque) - environment
                  if reference is not None else None)
-        demand = reference_demand(allocation, problem.model, t, sample.q, sample.omega, torque,
+        demand = reference_demand(allocation, problem.model, demand_t, q, omega, torque,
                                   problem.wheel_momentum0, jumps=steps, torque_after=after)
-        unrealised = unrealised_torque(problem.model, t, sample.q, sample.omega, torque, demand)
-        scores["actuators"] = _actuators(requirements.actuators.allowed, demand, t, jumps, unrealised, torque)
+        unrealised = unrealised_torque(problem.model, demand_t, q, omega, torque, demand)
+        scores["actuators"] = _actuators(requirements.actuators.allowed, demand, demand_t, jumps, unrealised, torque)
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, sample.omega)
     return scores
