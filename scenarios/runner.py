@@ -35,6 +35,7 @@ from ocp import (
     metrics_from_simulation,
 )
 from ocp.nlp import with_costate_gap
+from ocp.simulation.simulator import law_raised
 from planners import FailedReference, Reference, ReferenceSample
 from planners.reference import JUMP_TOLERANCE
 from scenarios.output.results import Row, RunResults
@@ -122,6 +123,13 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
                                sensors=scenario.simulation.sensors)
     except SimulationError as error:
         row.status, row.message = "failed", f"simulation: {error}"
+        return
+    except Exception as error:
+        where = law_raised(error)
+        if where is None:  # the simulator's own code: an internal error
+            raise
+        traceback.print_exc()  # the law's bug fails its row, not the others
+        row.status, row.message = "failed", f"simulation: {where[0]} raised {type(error).__name__} at t = {where[1]:g} s: {error}"
         return
     finally:
         row.simulate_time_s = time.perf_counter() - start
@@ -321,7 +329,8 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
     Returns
     -------
     tuple
-        The reference (a failed one when the planner raises), its metrics (``None`` when failed)
+        The reference (a failed one, naming the planner, when the planner raises or its reference
+        raises or is not finite where it is sampled), its metrics (``None`` when failed)
         and, with ``scoring``, its times and sample for the requirements (one sampling serves both:
         the metrics' uniform times come first), else ``None``.
     """
@@ -336,7 +345,12 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
         return reference, None, None
     times = (reference_times(reference.duration, closed_loop_window(scenario, reference), spec.sample_time, REFERENCE_POINTS)
              if scoring else np.linspace(0.0, reference.duration, REFERENCE_POINTS))
-    sample = reference.sample(times)
+    sample = _sampled(reference, times)
+    if isinstance(sample, str):  # the planner's reference cannot be sampled: its row fails, the others run
+        failed = FailedReference(planner_spec.name, f"{planner_spec.name}: {sample}", duration=reference.duration,
+                                 stats=reference.stats)
+        failed.plan_time_s = reference.plan_time_s
+        return failed, None, None
     uniform = ReferenceSample(*(values[:REFERENCE_POINTS] for values in sample))
     # the rate's jumps are impulses no sample sees: the metrics add them (int_u2 and the peak torque +inf),
     # a start the reference declares free included (the actuator requirement exempts it: initial_rate_error
@@ -354,3 +368,42 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
         initial_omega=scenario.problem.omega0,
         sample=uniform, rate_jumps=jumps or None)
     return reference, metrics, (times, sample) if scoring else None
+
+
+def _first_non_finite(times: np.ndarray, sample: ReferenceSample) -> str | None:
+    """Where a sample first holds a value that is not finite (nan, inf), naming the quantity."""
+    if all(np.isfinite(values.sum()) for values in sample):  # the usual case, fast (an overflow looks below)
+        return None
+    bad = np.zeros(times.size, dtype=bool)
+    for values in sample:
+        bad |= ~np.all(np.isfinite(values), axis=1)
+    if not np.any(bad):
+        return None
+    k = int(np.argmax(bad))
+    fields = [name for name, values in zip(("q", "omega", "omega_dot", "torque"), sample)
+              if not np.all(np.isfinite(values[k]))]
+    return (f"its reference is not finite at t = {times[k]:.4g} s ({', '.join(fields)}; {int(np.sum(bad))} of "
+            f"{times.size} times sampled on [{times[0]:g}, {times[-1]:g}] s)")
+
+
+def _sampled(reference: Reference, times: np.ndarray) -> ReferenceSample | str:
+    """A planner's reference sampled at ``times`` once it is planned, or why it cannot be used.
+
+    The reference's ``_evaluate`` is the planner's code: an exception it raises, or a value that is
+    not finite, fails the planner's row (the traceback on stderr), not the run; the closed loop,
+    the metrics and the scores would otherwise meet the NaN (or the exception) far from its cause.
+    """
+    try:
+        sample = reference.sample(times)
+    except Exception as error:  # noqa: BLE001 (a planner bug must not lose the other rows)
+        # the coast after T starts from the state at T, and raises on a NaN there: find the first within [0, T]
+        within = times[times <= reference.duration]
+        try:
+            located = _first_non_finite(within, reference.sample(within))
+        except Exception:  # noqa: BLE001 (the same defect: reported below)
+            located = None
+        if located is not None:
+            return located
+        traceback.print_exc()
+        return f"sampling its reference raised {type(error).__name__}: {error}"
+    return _first_non_finite(times, sample) or sample

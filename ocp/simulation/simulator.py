@@ -607,7 +607,11 @@ class Simulator:
         Raises
         ------
         SimulationError
-            When the state becomes non-finite or the run exceeds the work limits.
+            When the state becomes non-finite (a non-finite command named as the controller's), or
+            the run exceeds the work limits.
+        Exception
+            Whatever the controller's law raises, unchanged; :func:`law_raised` tells it apart
+            and says which controller raised it and when.
         ValueError
             A sensor declared twice (in ``sensors`` and with a non-zero deviation in ``noise``), or
             a ``target`` of the wrong shape.
@@ -679,7 +683,11 @@ class Simulator:
                                            times_list[k + 1] - t_k)
             if field_rate is not None:
                 measurement.field_rate_inertial = field_rate(t_k).copy()
-            command = controller(t_k, measurement, reference)
+            try:
+                command = controller(t_k, measurement, reference)
+            except Exception as error:  # the law's own code: marked for law_raised, re-raised unchanged
+                setattr(error, _LAW_RAISED, (_controller_name(controller), t_k))
+                raise
             fill_command(command, commanded[k])
             dt = times_list[k + 1] - t_k
             u, at_limit = apply(command, states[k][7:], dt)
@@ -692,7 +700,7 @@ class Simulator:
             evaluate()
             x_next = x_out.tolist()  # the quaternion re-normalised by the step function
             if not math.isfinite(sum(x_next)) and not np.isfinite(x_out).all():  # the sum can overflow
-                raise SimulationError(self._divergence(times, k))
+                raise SimulationError(self._divergence(times, k, commanded, controller))
             x_in[:] = x_out
             states.append(x_next)
         result = self._result(times, np.array(states), commanded, np.array(applied).reshape(n_samples, model.nu),
@@ -724,7 +732,15 @@ class Simulator:
                                 saturated, path)
 
     @staticmethod
-    def _divergence(times: Array, k: int) -> str:
+    def _divergence(times: Array, k: int, commanded: Array, controller: Any) -> str:
+        """Why the state is not finite after sample ``k``: the law's command when it was not
+        finite (named as ``controllers.conformance.checked_command`` names it), else the step."""
+        bad = ~np.all(np.isfinite(commanded[:k + 1]), axis=1)
+        if np.any(bad):
+            j = int(np.argmax(bad))
+            return (f"{_controller_name(controller)} returned a non-finite command at t = {times[j]:g} s: "
+                    f"u = {commanded[j].tolist()}; a law must give finite numbers at every state (a division by "
+                    f"a vanishing norm, 0/0 at the target, an arcsin outside [-1, 1])")
         return (f"the state became non-finite between t = {times[k]:g} s and {times[k + 1]:g} s; "
                 "reduce max_step or check the controller's gains")
 
@@ -831,7 +847,7 @@ class Simulator:
                 break
         finite = np.isfinite(states).all(axis=1)
         if not finite.all():
-            raise SimulationError(self._divergence(times, int(np.argmin(finite)) - 1))
+            raise SimulationError(self._divergence(times, int(np.argmin(finite)) - 1, commanded, controller))
         return SimulationResult(self.simulated, self.sample_time, times, states, commanded, applied, torque,
                                 saturated.astype(bool), path, sensor_states, sensors)
 
@@ -850,6 +866,37 @@ class Simulator:
         served = GridSampledReference(reference, grid)
         self._last_grid = (reference, grid, served)
         return served
+
+
+_LAW_RAISED = "_slewbench_law_raised"
+"""The attribute :meth:`Simulator.run` sets on an exception a controller's law raised."""
+
+
+def law_raised(error: BaseException) -> tuple[str, float] | None:
+    """Whether ``error`` came out of a controller's law in :meth:`Simulator.run`, and where.
+
+    A caller running several laws (``slewbench run``) fails the row of a law that raises and runs
+    the others, while an exception of the simulator's own code stays an internal error.
+
+    Parameters
+    ----------
+    error : BaseException
+        An exception :meth:`Simulator.run` raised.
+
+    Returns
+    -------
+    tuple of (str, float) or None
+        The controller's registry name (its class's name when it has none) and the sample time
+        [s] of the call that raised; None when the law did not raise ``error``.
+    """
+    where = getattr(error, _LAW_RAISED, None)
+    return where if isinstance(where, tuple) else None
+
+
+def _controller_name(controller: Any) -> str:
+    """A controller's registry name (its class's name when it has none), for messages."""
+    name = getattr(controller, "name", None)
+    return name if isinstance(name, str) and name else type(controller).__name__
 
 
 def _check_run_arguments(controller: Any, reference: Any, target: Any) -> None:

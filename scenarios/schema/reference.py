@@ -192,7 +192,10 @@ def summary_line(cls: type, module_first: bool = True) -> str:
         A planner, controller or field model class.
     module_first : bool, optional
         Take the sentence from the class's module docstring when it has one (one module per
-        planner or controller); else from the class docstring.
+        planner or controller); else from the class docstring. A class with a docstring of its
+        own whose module registers several planners and controllers (a plugin's module) takes its
+        own, as does a class whose module is not in ``sys.modules`` (loaded from a file by a
+        plugin).
 
     Returns
     -------
@@ -205,8 +208,11 @@ def summary_line(cls: type, module_first: bool = True) -> str:
 
 def _summary_rst(cls: type, module_first: bool = True) -> str:
     """:func:`summary_line` as reStructuredText (the schema page's part introductions)."""
-    module_doc = sys.modules[cls.__module__].__doc__ if module_first else None
     own = cls.__dict__.get("__doc__")  # not the base class's (a plugin's class without a docstring)
+    module = sys.modules.get(cls.__module__)  # absent: a plugin's file loaded without sys.modules
+    shared = own and sum(registered.__module__ == cls.__module__
+                         for registered in (*PLANNERS.values(), *CONTROLLERS.values())) > 1
+    module_doc = module.__doc__ if module_first and module is not None and not shared else None
     doc = (module_doc or (inspect.cleandoc(own) if own else "") or "(no description: its class has no docstring)").strip()
     paragraph = " ".join(doc.split("\n\n")[0].split())
     sentence = re.match(r"(.+?[.:])\s+(?=[A-Z*`])", paragraph)  # not at "eq. 38"
