@@ -47,6 +47,19 @@ def test_a_rate_step_is_kept_on_both_sides_and_the_breakpoint_holds_the_referenc
     assert error.rate <= 1e-15
 
 
+def test_a_stop_at_t_keeps_its_left_limit():
+    # A declared step to rest at T itself (a co-state minimum-time stop, Vepa's acquisition): the
+    # table held no node one double before T, so its last interval blended the turning rate into
+    # rest, ran to the 4096-interval cap and missed its tolerances (rate error 7.7e-4 rad/s).
+    T = 100.0
+    reference = StepAt(T, T, left=False)  # at T the right side: at rest
+    table, error = tabulate(reference)
+    assert error.met, error
+    times = np.array([T - 1.0, np.nextafter(T, -np.inf), T])
+    np.testing.assert_allclose(table.evaluate(times)[:, 4:7], [BEFORE, BEFORE, AFTER], rtol=0, atol=1e-15)
+    assert table.times.size < 100  # no refinement forced by a smeared step
+
+
 def test_the_coast_after_t_starts_with_the_coasts_own_torque():
     """A reference ending while it turns, torque non-zero at T (a constant ω̇ about a principal
     axis: τ = I ω̇): after T the reference coasts torque-free (τ = 0, ω constant about the principal

@@ -295,8 +295,8 @@ def _rows(reference: Reference, times: Array) -> Array:
 
 def _nodes(reference: Reference, intervals: int, start: float = 0.0, stop: float | None = None) -> tuple[Array, Array]:
     """Times and rows over ``[start, stop]``: a uniform grid, the reference's own points and its
-    breakpoints, each flanked by the doubles next to it (those inside the span); ``stop`` defaults
-    to the reference's duration."""
+    breakpoints, each flanked by the doubles next to it (those inside the span, a breakpoint at
+    ``start`` or ``stop`` included); ``stop`` defaults to the reference's duration."""
     stop = reference.duration if stop is None else stop
     own = [] if reference.enforced_times is None else [t for t in reference.enforced_times if start <= t <= stop]
     breaks = [b for b in reference.breakpoints if start < b < stop]
@@ -305,9 +305,12 @@ def _nodes(reference: Reference, intervals: int, start: float = 0.0, stop: float
     gap = 1e-9 * max(stop - start, abs(stop), 1e-300)
     near = np.min(np.abs(grid[:, None] - fixed[None, :]), axis=1) <= gap
     times = np.unique(np.concatenate([fixed, grid[~near]]))
-    if breaks:  # the left limit one double before each breakpoint and the right limit one double after it
-        at = np.asarray(breaks, dtype=float)
-        times = np.unique(np.concatenate([times, np.nextafter(at, -np.inf), np.nextafter(at, np.inf)]))
+    # the left limit one double before each breakpoint and the right limit one double after it, those
+    # inside the span: a step at ``stop`` (a stop at T) keeps its left limit, one at ``start`` its right
+    at = np.asarray([b for b in reference.breakpoints if start <= b <= stop], dtype=float)
+    if at.size:
+        times = np.unique(np.concatenate([times, np.nextafter(at[at > start], -np.inf),
+                                          np.nextafter(at[at < stop], np.inf)]))
     # at a breakpoint itself the node holds what the reference gives there (one side of the jump, the
     # reference's own convention), so that the table and the reference agree at that time too
     rows = _rows(reference, times)
