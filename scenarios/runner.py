@@ -37,6 +37,8 @@ from ocp import (
 from ocp.nlp import with_costate_gap
 from ocp.simulation.simulator import law_raised
 from planners import FailedReference, Reference, ReferenceSample
+from planners.conformance import check_boundary
+from planners.errors import ConformanceError
 from planners.reference import JUMP_TOLERANCE
 from scenarios.output.results import Row, RunResults
 from scenarios.requirements.scoring import (
@@ -329,8 +331,10 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
     Returns
     -------
     tuple
-        The reference (a failed one, naming the planner, when the planner raises or its reference
-        raises or is not finite where it is sampled), its metrics (``None`` when failed)
+        The reference (a failed one, naming the planner, when the planner raises, its reference
+        raises or is not finite where it is sampled, or it misses a boundary condition of the
+        manoeuvre that it does not declare free, :func:`planners.conformance.check_boundary`), its
+        metrics (``None`` when failed)
         and, with ``scoring``, its times and sample for the requirements (one sampling serves both:
         the metrics' uniform times come first), else ``None``.
     """
@@ -349,6 +353,13 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
     if isinstance(sample, str):  # the planner's reference cannot be sampled: its row fails, the others run
         failed = FailedReference(planner_spec.name, f"{planner_spec.name}: {sample}", duration=reference.duration,
                                  stats=reference.stats)
+        failed.plan_time_s = reference.plan_time_s
+        return failed, None, None
+    try:  # a reference that misses its manoeuvre's ends is a planner defect, not a motion to score
+        check_boundary(scenario.problem, reference)
+    except ConformanceError as error:
+        failed = FailedReference(planner_spec.name, f"{error} (its reference does not perform the manoeuvre)",
+                                 duration=reference.duration, stats=reference.stats)
         failed.plan_time_s = reference.plan_time_s
         return failed, None, None
     uniform = ReferenceSample(*(values[:REFERENCE_POINTS] for values in sample))

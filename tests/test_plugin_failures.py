@@ -50,9 +50,10 @@ class _CubicReference(Reference):
 
     def _evaluate(self, t: np.ndarray) -> ReferenceSample:
         s = t / self.duration
-        theta = self.angle * (3 * s**2 - 2 * s**3)
-        omega = (self.angle * (6 * s - 6 * s**2) / self.duration)[:, None] * self.axis
-        omega_dot = (self.angle * (6 - 12 * s) / self.duration**2)[:, None] * self.axis
+        scale = 0.9 if self.defect == "short" else 1.0  # "short": 90 % of the angle, at rest at T
+        theta = scale * self.angle * (3 * s**2 - 2 * s**3)
+        omega = (scale * self.angle * (6 * s - 6 * s**2) / self.duration)[:, None] * self.axis
+        omega_dot = (scale * self.angle * (6 - 12 * s) / self.duration**2)[:, None] * self.axis
         q = quat.product(self.q0, quat.from_axis_angle(self.axis, theta))
         torque = inverse_dynamics_torque(self.inertia, omega, omega_dot)
         if self.defect == "nan_late":  # q is NaN after T/2, so at T too (the coast after T starts there)
@@ -71,7 +72,7 @@ class _CubicPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
-        defect: Literal["none", "nan_late", "nan_mid", "raise"] = "none"
+        defect: Literal["none", "nan_late", "nan_mid", "raise", "short"] = "none"
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         return _CubicReference(problem, self.options.defect)
@@ -166,6 +167,25 @@ def test_a_planner_whose_reference_is_nan_or_raises_fails_its_rows_only(register
     assert "RuntimeError: simulated crash inside _evaluate" in captured.err  # the planner's traceback is shown
     assert main(["run", str(path), "--out", str(tmp_path / "strict"), "--no-plots", "--strict"]) == 1
     assert (tmp_path / "strict" / "results.json").exists()
+
+
+def test_a_reference_that_misses_the_target_fails_its_row_without_a_final_requirement(registered: None,
+                                                                                     tmp_path: Path) -> None:
+    # The scenario has no requirements.final: the 10 % short slew (81 of 90 deg, a 9 deg miss at rest:
+    # the oracle is the construction) used to be "ok" with ref.final_error_deg 9; a planner whose
+    # reference does not perform its manoeuvre is a planner defect (planners.conformance.check_boundary)
+    path = _scenario(tmp_path, planners="""\
+  - {name: test_cubic, label: good}
+  - {name: test_cubic, label: short, options: {defect: short}}""", controllers="""\
+  - {name: test_pd, label: pd}""")
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    rows = _rows(out)
+    assert rows["good"]["status"] == "ok"
+    assert rows["short"]["status"] == "failed"
+    message = rows["short"]["message"]
+    assert message.startswith("test_cubic: q(T = 60 s) = ") and "but the problem asks qf = " in message
+    assert "(error 0.157 rad > 2e-05)" in message  # 9 deg
 
 
 def test_a_law_that_raises_or_returns_nan_fails_its_rows_only(registered: None, tmp_path: Path,
