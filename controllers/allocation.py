@@ -195,10 +195,9 @@ class Allocation:
         self._working_cols: tuple[tuple[float, ...], ...] = ()
         if wheels is not None and np.any(wheels.working):
             self._working_axes = wheels.axes * wheels.working
-            self._wheel_pinv = np.asarray(np.linalg.pinv(self._working_axes), dtype=np.float64)
             # a failed wheel's row is zero, not the SVD's round-off (1e-17): asked nothing, it scores 0 x
             # its zero limit instead of inf x
-            self._wheel_pinv[~wheels.working] = 0.0
+            self._wheel_pinv = wheels.pseudo_inverse
             self._pinv_rows = float_rows(self._wheel_pinv)
             self._axes_cols = float_rows(spacecraft.wheel_axes.T)
             self._working_cols = float_rows(self._working_axes.T)

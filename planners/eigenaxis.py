@@ -466,7 +466,7 @@ class WheelBudget:
         h0 = np.asarray(problem.initial_state[7:], dtype=float)
         self.working = np.zeros(0, bool) if wheels is None else wheels.working
         working_axes = axes * self.working
-        self.pinv = np.linalg.pinv(working_axes)[self.working] if np.any(self.working) else np.zeros((0, 3))
+        self.pinv = np.zeros((0, 3)) if wheels is None else wheels.pseudo_inverse[self.working]
         self.projector = working_axes @ np.linalg.pinv(working_axes) if np.any(self.working) else np.zeros((3, 3))
         momentum0 = axes @ h0 + self.projector @ inertia @ problem.omega0  # A h_w at the start of the profile
         self.wheel_momentum0 = momentum0
