@@ -13,7 +13,7 @@ bound of their settling times; it is our addition, the paper offers no such comp
 
 The shipped ``horri_palmer_two_wheels.yaml`` runs as it is (nothing reduced). Readings the paper
 forced on us (``scenarios/REPRODUCTION.md``): the printed initial quaternion has norm 0.894 and is
-normalised (a 45.55° error); the paper's three-wheel phase before t0 = 500 s is not given, so the
+normalised (a 45.57° error); the paper's three-wheel phase before t0 = 500 s is not given, so the
 two-wheel phase starts here at t = 0 from rest; a1 = a2 = 0.025 saturate the singular terms of all
 four laws; K is in N m s/rad (eq. 31's units; read in 1/s as eq. 14 writes it, the loop diverges
 under the 1 s hold). Eq. 25 is printed with the wrong sign (it raises V); the corrected law is used.
@@ -62,7 +62,8 @@ laws = {row.label.split(" / ")[1]: row for row in results.rows}
 # (the state at t0) and its final time a like-for-like comparison is impossible. With the paper's
 # gains the high-gain mode of eq. 30 never engages (‖u_hg‖∞ >= 0.275 N m along the run, far above
 # ε = 0.02 N m), so the gain-scheduled law is the plain min-norm law row for row; where the paper
-# reports a 41 % shorter fine settling time, ours is 14 % (959 s against 1111 s for snlc), and to
+# reports a 41 % shorter fine settling time than the zero-momentum law's (1748.4 s against
+# 2956.5 s), ours is 12 % (959 s against 1085 s; 14 % against snlc's 1111 s), and to
 # 0.5° the min-norm laws are slower, chattering on the hold while q3 decays through the saturated
 # singular term (``REPRODUCTION.md``: the min-norm law reaches 0.5° at 13,000 s in a 40,000 s run).
 # ``REPRODUCTION.md`` records the same times and integrals as this run.
