@@ -110,8 +110,8 @@ def test_laws_settle_slower_than_the_minimum_time():
     spec = scenario.planners[0]
     reference = PLANNERS[spec.name](spec.options).plan(problem)
     assert reference.ok, reference.message
-    # Flown open loop with its bang-bang control clipped to the limit between the collocation points,
-    # the plan ends within the 0.5 deg of the comparison at T.
+    # Flown open loop with its bang-bang control saturated at the limit between the collocation points
+    # (each interval's impulse kept), the plan ends within the 0.5 deg of the comparison at T (0.006 deg).
     check_two_wheel_solution(problem, reference, angle_deg=0.5, rate=1e-3)
     t_min = reference.duration
     assert t_min == pytest.approx(136.64, abs=0.01)  # the minimum (see the test above)

@@ -14,7 +14,7 @@ rad/s). So in an interval where a control entry leaves its bounds, the entry is 
 constant that gives the saturated control the interval's impulse of the unsaturated one,
 ``∫ clip(p + c) dt = ∫ p dt`` (:attr:`CollocationReference.impulse_offsets`; the integral lies within
 the bounds times h, the Radau quadrature of values within them, so such a ``c`` exists): flown open
-loop the slews end 0.0099° and 0.0067° from their targets. Entries within their bounds are read
+loop the slews end 0.0099° and 0.0068° from their targets. Entries within their bounds are read
 unchanged, and the blocks scaled as a whole (below) are not shifted.
 
 The feed-forward torque is the optimal control expressed for ``I ω̇ = −ω × I ω + u``:
