@@ -17,7 +17,8 @@ actuators must give is ``I ω̇ + ω × H``, ``H = I ω + A h_w`` the total angu
 axes: the bang profiles choose the acceleration ``α`` and the coast rate ``w`` so that every row
 of the controllers' allocation (``Spacecraft.allocation_rows``: ``|M τ| <= L``, a row per working
 wheel ``(A⁺)_i`` with its ``max_torque``, and the torquers' rows for what the wheels cannot give)
-stays within ``f L`` (``f`` the ``torque_fraction``), and the working wheels' momenta within their
+stays within ``f L`` (``f`` the ``torque_fraction`` times ``1 − actuator_margin``, the scenario's
+actuator requirement), and the working wheels' momenta within ``1 − actuator_margin`` of their
 ``max_momentum``, along the whole profile (:class:`WheelBudget`). With wheels spanning three
 axes ``H`` is conserved and turns about ``e`` in the body (closed form; no gyroscopic term at all
 from rest with no stored momentum); without working wheels it is the rigid body's; with wheels
@@ -434,6 +435,8 @@ class WheelBudget:
         ``f``, the share of each torque bound the profile may use.
     scale : float, optional
         A further factor on the torque bounds (the planner's shrinking; default 1).
+    momentum_fraction : float, optional
+        The share of each working wheel's ``max_momentum`` the profile may use (default 1).
 
     Attributes
     ----------
@@ -454,7 +457,7 @@ class WheelBudget:
     """
 
     def __init__(self, problem: ManeuverProblem, axis: Array, angle: float, fraction: float,
-                 scale: float = 1.0) -> None:
+                 scale: float = 1.0, momentum_fraction: float = 1.0) -> None:
         spacecraft = problem.spacecraft
         inertia = spacecraft.inertia
         rows, limits = spacecraft.allocation_rows()
@@ -471,7 +474,7 @@ class WheelBudget:
         momentum0 = axes @ h0 + self.projector @ inertia @ problem.omega0  # A h_w at the start of the profile
         self.wheel_momentum0 = momentum0
         self.h0 = h0[self.working] + self.pinv @ inertia @ problem.omega0
-        self.h_max = np.zeros(0) if wheels is None else wheels.max_momentum[self.working]
+        self.h_max = np.zeros(0) if wheels is None else momentum_fraction * wheels.max_momentum[self.working]
         inertia_axis = inertia @ axis
         self.exact = bool(np.allclose(self.projector, np.eye(3), atol=1e-9)) or not np.any(self.working)
         self.accel = rows @ inertia_axis
@@ -624,6 +627,23 @@ class EigenaxisPlanner(Planner):
     honours = frozenset({"rate"})  # every profile: ‖ω‖ = |θ̇|, at most the rate bound or infeasible
 
     @classmethod
+    def honoured(cls, options: Any) -> frozenset[str]:
+        """The rate bound with every profile; the actuator requirement with the bang profiles
+        (``trapezoidal`` and ``min_time`` plan within ``1 − actuator_margin`` of every torque and
+        momentum limit, :class:`WheelBudget`); the quintic's torque is fixed by T.
+
+        Parameters
+        ----------
+        options : Options
+            The planner's options.
+
+        Returns
+        -------
+        frozenset of str
+        """
+        return cls.honours | ({"actuators"} if getattr(options, "profile", "smooth") != "smooth" else frozenset())
+
+    @classmethod
     def minimises_time(cls, options: Any) -> bool:
         """Whether the duration is minimised (:func:`planners.capabilities.minimises_time`).
 
@@ -658,7 +678,9 @@ class EigenaxisPlanner(Planner):
         torque_fraction : float
             Share of each actuator's torque bound (each wheel's ``max_torque`` through ``g = −A⁺ τ``,
             the torquers' per axis) the bang profiles may use, in (0, 1]; default 1. The wheels'
-            ``max_momentum`` caps the coast rate whole.
+            ``max_momentum`` caps the coast rate whole. With an actuator requirement
+            (``requirements.actuators.margin``) the bang profiles keep ``1 − margin`` of every
+            torque and momentum limit, and this share applies within it.
         """
 
         profile: Literal["smooth", "trapezoidal", "min_time"] = "smooth"
@@ -721,7 +743,8 @@ class EigenaxisPlanner(Planner):
         if angle < 1e-12:
             return EigenaxisReference(problem.q0, axis, BangCoastBangProfile(0.0, 1.0, 0.0), problem.duration if self.options.profile
                                       == "trapezoidal" else 0.0, inertia, "no rotation needed", problem)
-        budget = WheelBudget(problem, axis, angle, self.options.torque_fraction)
+        keep = 1.0 - (problem.actuator_margin or 0.0)  # the actuator requirement's share of each limit
+        budget = WheelBudget(problem, axis, angle, self.options.torque_fraction * keep, momentum_fraction=keep)
         if budget.exact:
             return self._bang(problem, axis, angle, max_rate, budget, self.options.profile)
         # Wheels spanning fewer than three axes (beside torquers): the wheels' momentum moves with

@@ -689,19 +689,12 @@ class CollocationPlanner(Planner):
 
     def _bound_candidates(self, problem: ManeuverProblem, starts: list[Reference]) -> list[tuple[str, Reference]]:
         """The motions whose durations may bound the minimum time (:meth:`_seed_bound`): the starts
-        at their own durations and ``eigenaxis``'s ``min_time`` profile under the bounds the NLP
-        imposes (``torque_fraction`` ``1 − actuator_margin``; with a margin, the coast rate capped
-        at ``1 − actuator_margin`` of the full-limit profile's, so that the wheel momenta, in
-        proportion to the rate, keep the margin too), each labelled."""
+        at their own durations and ``eigenaxis``'s ``min_time`` profile (within the bounds the NLP
+        imposes: it keeps the problem's ``actuator_margin`` of every torque and momentum limit),
+        each labelled."""
         candidates = [(f"start {reference.planner}", reference) for reference in starts]
-        keep = 1.0 - (problem.actuator_margin or 0.0)
-        options: dict[str, Any] = {"profile": "min_time", "torque_fraction": keep}
         try:
-            eigenaxis = PLANNERS["eigenaxis"](options, cache=self.cache).plan_start(problem)
-            rate = getattr(getattr(eigenaxis, "profile", None), "rate_max", None)
-            if eigenaxis.ok and keep < 1.0 and rate is not None and np.isfinite(rate) and rate > 0:
-                eigenaxis = PLANNERS["eigenaxis"]({**options, "max_rate": keep * float(rate)},
-                                                  cache=self.cache).plan_start(problem)
+            eigenaxis = PLANNERS["eigenaxis"]({"profile": "min_time"}, cache=self.cache).plan_start(problem)
         except Exception:  # noqa: BLE001 (a candidate is optional: none from a planner that cannot plan it)
             return candidates
         if eigenaxis.ok:
