@@ -78,7 +78,8 @@ def test_threshold_fractions_count_by_hand():
                          "robustness": {"thresholds": {"cl.final_error_deg": 0.1, "cl.int_u": {"at_least": 0.15}}}})
     rows = _rows([0.05, 0.1, 0.2, None, None], ["ok", "ok", "violated", "failed", "crashed"])
     columns, table = proportion_table(study, rows)
-    assert columns == ["label", "criterion", "completed", "met", "fraction_met", "wilson_low", "wilson_high"]
+    assert columns == ["label", "criterion", "completed", "excluded", "met", "fraction_met", "wilson_low", "wilson_high"]
+    assert {line["excluded"] for line in table} == {2}  # the failed and the crashed rows
     found = {line["criterion"]: (line["completed"], line["met"], line["fraction_met"]) for line in table}
     assert found == {"every requirement": (4, 2, 0.5), "cl.final_error_deg <= 0.1": (4, 2, 0.5),
                      "cl.int_u >= 0.15": (4, 1, 0.25)}

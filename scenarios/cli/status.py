@@ -24,7 +24,9 @@ entry of the table or of its held-out grid is not ``ok``: for users' continuous 
 EXIT_CRASHED = 1
 """``slewbench sweep``: every case ran and the tables are written, but some cases crashed (raised,
 ran out of ``case_timeout_s`` or killed their worker): they have no result, and ``--resume`` runs
-them again. A numerical failure is a ``failed`` row, a result: it does not set this status."""
+them again. ``slewbench table`` alike: its files are written, some entries crashed, and the same
+command run again into the same ``--out`` computes them again. A numerical failure is a ``failed``
+row (entry), a result: it does not set this status."""
 EXIT_BAD_SCENARIO = 2
 """A bad scenario or study file (or key of ``slewbench schema``): nothing was written."""
 EXIT_BAD_OUTPUT = 2

@@ -4,12 +4,15 @@ Everything that can fail before an entry is computed is checked first (the scena
 and the options: exit 2 naming the YAML path or option; the output directory: exit 2 if it is not
 slewbench's or holds another kind of output; a Dask scheduler). Entries run on the trade-study
 engine and are stored as they finish, so a table interrupted (exit 130) or run again into the same
-``--out`` computes only the entries it lacks. This module imports only the standard library until
-the command runs.
+``--out`` computes only the entries it lacks. A table whose entries crashed (raised, ran out of
+``case_timeout_s`` or killed their worker) writes its files, then exits 1 (as ``slewbench sweep``)
+saying how many crashed, why, and the command that runs them again. This module imports only the
+standard library until the command runs.
 """
 from __future__ import annotations
 
 import argparse
+import shlex
 import signal
 import sys
 import time
@@ -18,6 +21,7 @@ from typing import Any
 
 from scenarios.cli.status import (
     EXIT_BAD_SCENARIO,
+    EXIT_CRASHED,
     EXIT_INTERRUPTED,
     EXIT_NOT_OK,
     EXIT_OK,
@@ -55,9 +59,10 @@ def command_table(args: argparse.Namespace) -> int:
     Returns
     -------
     int
-        0 when every entry is stored (entries that are not ok included: they are results); 1 with
-        ``strict`` when an entry of the table or of its held-out grid is not ``ok`` (the files are
-        written first); 130 when interrupted.
+        0 when every entry is stored (entries that are not ok included: they are results); 1 when
+        entries crashed (:data:`~scenarios.cli.status.EXIT_CRASHED`: they have no result; the
+        files are written first), or with ``strict`` when an entry of the table or of its held-out
+        grid is not ``ok`` (the files are written first); 130 when interrupted.
 
     Raises
     ------
@@ -115,10 +120,9 @@ def command_table(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     write_table_files(table, staging, plots=not args.no_plots)
     files = commit_sweep_outputs(directory, staging, kind="table")
-    part = table.parts["table"]
-    ok = int(part.ok.sum())
-    print(f"computed in {table.wall_time_s:.1f} s ({table.stored} entries already stored); table: {ok} of "
-          f"{part.ok.size} entries ok; files written in {time.perf_counter() - start:.1f} s: {directory}/ "
+    rerun = f", {_count(table.rerun, 'crashed one')} run again" if table.rerun else ""
+    print(f"computed in {table.wall_time_s:.1f} s ({table.stored} entries already stored{rerun}); table: "
+          f"{entry_counts(table)}; files written in {time.perf_counter() - start:.1f} s: {directory}/ "
           f"({', '.join(sorted(files))})")
     if table.refinement:
         refinement = table.refinement
@@ -145,8 +149,121 @@ def command_table(args: argparse.Namespace) -> int:
     not_ok = _not_ok(table)
     if args.strict and not_ok:
         print(f"slewbench: --strict: {not_ok} not ok", file=sys.stderr)
-        return EXIT_NOT_OK
-    return EXIT_OK
+    crashed = crashed_message(table, rerun_command(args, directory))
+    if crashed:
+        print(crashed, file=sys.stderr)
+        return EXIT_CRASHED
+    return EXIT_NOT_OK if args.strict and not_ok else EXIT_OK
+
+
+def entry_counts(table: Any) -> str:
+    """What the summary line says of the table's entries: how many are ok, the others by status,
+    and how many of the ok ones are not the best known (:attr:`scenarios.slewtable.compute.TablePart.best_known`
+    false; they are fitted); the held-out grid's flagged entries too.
+
+    Parameters
+    ----------
+    table : SlewTable
+        The computed table.
+
+    Returns
+    -------
+    str
+        ``3 of 4 entries ok (1 crashed)``, ``8 of 8 entries ok, 4 of them not the best known (slower
+        than a feasible slew the planner knows: best_known false in slew_table.csv; fitted, their time
+        achievable)``.
+    """
+    part = table.parts["table"]
+    ok = part.ok
+    text = f"{int(ok.sum())} of {ok.size} entries ok"
+    others = [status for row, flags in zip(part.status, ok.tolist()) for status, good in zip(row, flags)
+              if not good]
+    others = ["missing" if status == "ok" else status for status in others]  # ok without a finite time
+    if others:
+        text += " (" + ", ".join(f"{others.count(kind)} {kind}" for kind in dict.fromkeys(others)) + ")"
+    slower = int(part.not_best_known.sum())
+    held = table.parts.get("held_out")
+    held_slower = 0 if held is None else int(held.not_best_known.sum())
+    if slower or held_slower:
+        where = (f", {slower} of them not the best known" if slower else "") + \
+            (f"; {_count(held_slower, 'ok held-out entry', 'ok held-out entries')} not the best known"
+             if held_slower else "")
+        text += (f"{where} (slower than a feasible slew the planner knows: best_known false in slew_table.csv"
+                 + ("; fitted, their time achievable)" if slower else ")"))
+    return text
+
+
+CRASH_REASONS_SHOWN = 3
+"""Distinct reasons the closing message gives for the crashed entries (the most frequent first),
+as ``slewbench sweep`` gives for its cases."""
+
+
+def crashed_message(table: Any, command: str) -> str:
+    """What a table whose entries crashed says last (on standard error): how many, why, and how to
+    run them again.
+
+    Parameters
+    ----------
+    table : SlewTable
+        The computed table (every grid: the table's, the held-out one, a refinement's check points).
+    command : str
+        The command that runs the crashed entries again (:func:`rerun_command`).
+
+    Returns
+    -------
+    str
+        ``slewbench: N of M entries crashed ...``, the :data:`CRASH_REASONS_SHOWN` most frequent
+        messages with their counts, and ``command``; empty when no entry crashed.
+    """
+    reasons: dict[str, int] = {}
+    total = 0
+    for part in table.parts.values():
+        for statuses, messages in zip(part.status, part.message):
+            total += len(statuses)
+            for status, message in zip(statuses, messages):
+                if status == "crashed":
+                    reasons[message or "no message"] = reasons.get(message or "no message", 0) + 1
+    crashed = sum(reasons.values())
+    if not crashed:
+        return ""
+    ranked = sorted(reasons.items(), key=lambda item: -item[1])  # stable: equal counts in the order met
+    lines = [(f"slewbench: {crashed} of {_count(total, 'entry', 'entries')} crashed (raised, ran out of case_timeout_s "
+              "or killed their worker): they have no result (status crashed in slew_table.csv; the fit has no time "
+              "around them). Why:")]
+    lines += [f"  {_count(count, 'entry', 'entries')}: {reason}" for reason, count in ranked[:CRASH_REASONS_SHOWN]]
+    if len(ranked) > CRASH_REASONS_SHOWN:
+        lines.append(f"  ... and {len(ranked) - CRASH_REASONS_SHOWN} other reason(s) (slew_table.csv, status crashed)")
+    lines += ["Run them again (the entries already stored are kept) with:", f"  {command}"]
+    return "\n".join(lines)
+
+
+def rerun_command(args: argparse.Namespace, out: Path) -> str:
+    """The command that computes a table's missing and crashed entries again: the same file, the
+    flags the user gave that set the table's keys (so that it asks for the same entries),
+    ``--out`` the table's directory, ``--no-plots`` and ``--strict`` as given, each argument quoted
+    for a POSIX shell.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``table`` arguments.
+    out : Path
+        The table's directory.
+
+    Returns
+    -------
+    str
+        ``slewbench table FILE [flags] --out DIR [--no-plots] [--strict]``.
+    """
+    from scenarios.schema.table import TABLE_FLAGS
+    words = ["slewbench", "table", str(args.file)]
+    for flag in TABLE_FLAGS.values():
+        value = getattr(args, flag[2:].replace("-", "_"), None)
+        if value is not None:
+            words += [flag, str(value)]
+    words += ["--out", str(out)]
+    words += [flag for flag, given in (("--no-plots", args.no_plots), ("--strict", args.strict)) if given]
+    return shlex.join(words)
 
 
 def _not_ok(table: Any) -> str:
@@ -179,7 +296,8 @@ def add_table_parser(commands: Any) -> None:
         "table", help="slew table: minimum slew time over eigen-axes and angles, CSV, NetCDF and a fast fit "
                       "slew_time(q0, qf)",
         epilog=f"exit status: {EXIT_OK} done (entries that failed or are not ok are results, stored with their "
-               f"status); {EXIT_NOT_OK} under --strict, an entry of the table or its held-out grid not ok; "
+               f"status); {EXIT_CRASHED} entries crashed (no result: the files are written, the message says the "
+               f"command that runs them again), or under --strict, an entry of the table or its held-out grid not ok; "
                f"{EXIT_BAD_SCENARIO} bad scenario or table file, option, or output location (nothing written); "
                f"{EXIT_INTERRUPTED} interrupted (the finished entries are stored: run it again). The table file's "
                "keys: slewbench schema table")

@@ -9,7 +9,10 @@ whose solve fails, or that breaks a requirement, is kept with its status and mes
 (NaN) in the cells around an entry that is not ``ok`` (``inf`` at an ``infeasible`` one), rather than
 a time the table did not find. An entry whose start or target attitude already breaks a pointing
 requirement (the run's row is ``failed``: "no reference can meet it") is proven impossible: the
-table records it ``infeasible``.
+table records it ``infeasible``. A ``min_time`` entry that the planner found slower than a
+feasible slew of the same problem it knows (its certificate's ``seed_bound`` note: "not the best
+known") stays ``ok`` and is fitted (its time is achieved by its own reference), and is marked
+(:attr:`TablePart.best_known` false; the fit's note counts them).
 
 With a tolerance (``TableSpec.refine``) the table's axes are then refined where the fit misses
 (:func:`scenarios.slewtable.refine.refine`): each round's entries are one more study through the
@@ -37,7 +40,8 @@ from scenarios.slewtable.spec import (
     torque_generators,
 )
 
-__all__ = ["PART_NAMES", "SlewTable", "TablePart", "compute_table", "eval_time_us", "fit_entries", "held_out_errors"]
+__all__ = ["PART_NAMES", "SlewTable", "TablePart", "compute_table", "eval_time_us", "fit_entries", "held_out_errors",
+           "slower_than_known"]
 
 PART_NAMES = ("table", "held_out", "check")
 """The grids of a table: the fitted one, the held-out one, and the refinement's check points that
@@ -65,6 +69,11 @@ class TablePart:
         Each entry's status (``ok``, ``violated``, ``infeasible``, ``failed``, ``crashed``, ``missing``).
     message : list of list of str
         Each entry's message.
+    best_known : list of list of (bool or None), optional
+        For a ``min_time`` entry with a slew time: False where the planner knows a faster
+        feasible slew of the same problem (:func:`slower_than_known`; the message names it), True
+        where it knows none; None where the question does not apply (no slew time, or a
+        ``min_energy`` table). Default: None everywhere.
     """
 
     axes: np.ndarray
@@ -74,6 +83,11 @@ class TablePart:
     plan_time_s: np.ndarray
     status: list[list[str]]
     message: list[list[str]]
+    best_known: list[list[bool | None]] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if not self.best_known:
+            self.best_known = [[None] * len(row) for row in self.status]
 
     @classmethod
     def empty(cls, axes: np.ndarray, angles_deg: list[float]) -> TablePart:
@@ -96,6 +110,13 @@ class TablePart:
                    [["missing"] * shape[1] for _ in range(shape[0])], [[""] * shape[1] for _ in range(shape[0])])
 
     @property
+    def not_best_known(self) -> np.ndarray:
+        """Where an entry is ``ok`` and the planner knows a faster feasible slew, shape (n, k): it is
+        fitted, its time an achievable one, not the best known."""
+        return self.ok & np.array([[flag is False for flag in row] for row in self.best_known],
+                                  dtype=bool).reshape(self.slew_time_s.shape)
+
+    @property
     def ok(self) -> np.ndarray:
         """Where an entry is ``ok`` with a finite slew time, shape (n, k)."""
         return np.array([[s == "ok" for s in row] for row in self.status], dtype=bool).reshape(
@@ -115,7 +136,9 @@ class SlewTable:
     wall_time_s : float
         Wall time of the computation [s] (entries found in the store cost nothing).
     stored : int
-        Entries found already computed in the store.
+        Entries found already computed in the store (not ``crashed``: those run again).
+    rerun : int
+        Entries found ``crashed`` in the store, run again.
     fit : SlewTimeFit or None
         The fit (None when it could not be made: :attr:`fit_note` says why).
     fit_note : str
@@ -132,6 +155,7 @@ class SlewTable:
     parts: dict[str, TablePart]
     wall_time_s: float = 0.0
     stored: int = 0
+    rerun: int = 0
     fit: SlewTimeFit | None = None
     fit_note: str = ""
     fit_quality: dict[str, Any] = field(default_factory=dict)
@@ -164,6 +188,26 @@ def _proven_infeasible(scenario: dict[str, Any]) -> bool:
     return bool(endpoint_violations(problem))
 
 
+def slower_than_known(row: dict[str, Any]) -> str:
+    """What says that a planned row's minimum time is slower than a feasible slew its planner knows.
+
+    Parameters
+    ----------
+    row : dict
+        A run's row as the engine stores it (:meth:`scenarios.output.results.Row.to_dict`).
+
+    Returns
+    -------
+    str
+        The certificate's ``seed_bound`` note (``collocation``'s "slower than a feasible slew of
+        this problem, ...: not the best known", :mod:`planners.collocation.planner`), which the
+        row's message also ends with; empty when the row has none.
+    """
+    certificate = row.get("certificate")
+    note = certificate.get("seed_bound") if isinstance(certificate, dict) else None
+    return note if isinstance(note, str) else ""
+
+
 def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objective: str) -> None:
     i, k = case.axis_index, case.angle_index
     if record is None or not record.get("rows"):
@@ -182,6 +226,8 @@ def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objec
         value = duration if objective == "min_time" else reference.get("int_u2")
         if value is not None:
             part.objective_value[i, k] = float(value)
+        if objective == "min_time" and np.isfinite(part.slew_time_s[i, k]):
+            part.best_known[i][k] = not slower_than_known(row)
 
 
 def _plural(count: int, word: str, words: str | None = None) -> str:
@@ -214,8 +260,9 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
         None when no fit can be made (fewer than 4 axes, axes that do not span the sphere, or no
         ``ok`` entry).
     note : str
-        Why not, or how many entries are not ok and where the fit has no value ("" when every
-        entry is ok).
+        Why not, or how many entries are not ok and where the fit has no value, and how many
+        fitted entries are not the best known (:attr:`TablePart.not_best_known`: fitted, their
+        time an achievable one) ("" when every entry is ok and none is flagged).
     """
     angles = np.deg2rad(part.angles_deg)
     ok = part.ok
@@ -237,6 +284,10 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
                           triangles, status)
     except ValueError as error:
         return None, "; ".join([*notes, f"no fit: {error}"])
+    slower = int(part.not_best_known.sum())
+    if slower:
+        notes.append(f"{_plural(slower, 'fitted entry', 'fitted entries')} slower than a feasible slew the planner "
+                     "knows (best_known false: the fit's time there is achievable, not the best known)")
     return fit, "; ".join(notes)
 
 
@@ -365,7 +416,7 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
         if store is not None:
             store.close()
     table.wall_time_s = time.perf_counter() - start
-    table.stored = run.stored
+    table.stored, table.rerun = run.stored, run.rerun
     if spec.objective != "min_time":
         table.fit_note = "the fit is of minimum-time tables (this table is min_energy at a fixed duration)"
         return table
@@ -390,22 +441,26 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
 
 class _Runner:
     """Runs table entries through the trade-study engine (one study per call), counting those found
-    in the store."""
+    in the store (``stored``) and those found ``crashed`` there, run again (``rerun``)."""
 
     def __init__(self, spec: TableSpec, store: Any, workers: int | None, cluster: Any, executor: Executor | None,
                  progress: bool):
         self.spec, self.store, self.workers = spec, store, workers
         self.cluster, self.executor, self.progress = cluster, executor, progress
         self.stored = 0
+        self.rerun = 0
         self.entries = 0
 
     def __call__(self, cases: list[TableCase]) -> list[dict[str, Any] | None]:
         from scenarios.study.engine import sweep
+        from scenarios.study.store import resume_counts
         if not cases:
             return []
         study = _study(self.spec, cases)
-        if self.store is not None:
-            self.stored += len(self.store.keys() & {case.key for case in study.cases})
+        if self.store is not None:  # a crashed entry is not kept: the engine runs it again
+            counts = resume_counts(self.store, {case.key for case in study.cases})
+            self.stored += counts.kept
+            self.rerun += counts.crashed
         results = sweep(study, self.executor, workers=self.workers, store=self.store, progress=self.progress,
                         cluster=self.cluster)
         self.entries += len(cases)
@@ -478,6 +533,7 @@ def _copy_entry(source: TablePart, i: int, target: TablePart, j: int, k: int) ->
         getattr(target, name)[j, k] = getattr(source, name)[i, k]
     target.status[j][k] = source.status[i][k]
     target.message[j][k] = source.message[i][k]
+    target.best_known[j][k] = source.best_known[i][k]
 
 
 def _inertially_dependent(scenario: dict[str, Any]) -> bool:

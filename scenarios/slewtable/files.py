@@ -5,7 +5,9 @@ dependency): self-describing (every variable has ``units`` and ``long_name``; th
 name the scenario, the spacecraft, the objective, slewbench's version and the date) and read by
 xarray, netCDF4, MATLAB's ``ncread``, NCO and Panoply alike. Its dimensions are ``axis`` x ``angle``
 (and ``held_out_axis`` x ``held_out_angle`` for the held-out grid); a status is a byte with CF
-``flag_values`` / ``flag_meanings``.
+``flag_values`` / ``flag_meanings``, and so is ``best_known`` (0 where the planner knows a faster
+feasible slew of the entry's problem, 1 where it knows none, the fill value where the question does
+not apply: :attr:`scenarios.slewtable.compute.TablePart.best_known`).
 """
 from __future__ import annotations
 
@@ -18,11 +20,15 @@ import numpy as np
 
 from scenarios.slewtable.compute import PART_NAMES, SlewTable, TablePart
 
-__all__ = ["CSV_COLUMNS", "STATUS_CODES", "TABLE_FILES", "write_table_files"]
+__all__ = ["BEST_KNOWN_FILL", "CSV_COLUMNS", "STATUS_CODES", "TABLE_FILES", "best_known_text", "write_table_files"]
 
 CSV_COLUMNS = ("grid", "axis_x", "axis_y", "axis_z", "angle_deg", "slew_time_s", "objective", "objective_value",
-               "status", "plan_time_s", "message")
-"""Columns of ``slew_table.csv`` (axis: unit eigen-axis, body frame)."""
+               "status", "best_known", "plan_time_s", "message")
+"""Columns of ``slew_table.csv`` (axis: unit eigen-axis, body frame; ``best_known``:
+:func:`best_known_text`)."""
+BEST_KNOWN_FILL = -1
+"""The fill value of ``best_known`` in ``slew_table.nc``: the question does not apply (no slew time,
+or a ``min_energy`` table)."""
 STATUS_CODES = ("ok", "violated", "failed", "crashed", "missing", "infeasible")
 """Entry status -> its code in the NetCDF file (the index; ``infeasible`` last, so that the earlier
 codes keep their values)."""
@@ -32,6 +38,25 @@ TABLE_FILES = ("slew_table.csv", "slew_table.nc", "fit.json", "agility_envelope.
 
 def _cell(value: float) -> str:
     return "" if not np.isfinite(value) else repr(float(value))
+
+
+def best_known_text(flag: bool | None) -> str:
+    """An entry's ``best_known`` cell in ``slew_table.csv``.
+
+    Parameters
+    ----------
+    flag : bool or None
+        :attr:`scenarios.slewtable.compute.TablePart.best_known` of the entry.
+
+    Returns
+    -------
+    str
+        ``false``: the planner knows a faster feasible slew of the entry's problem (its message
+        says "not the best known" and names it; an ``ok`` entry is fitted all the same, its time
+        achievable); ``true``: it knows none; empty: the question does not apply (no slew time, or
+        a ``min_energy`` table).
+    """
+    return "" if flag is None else ("true" if flag else "false")
 
 
 def write_csv(table: SlewTable, path: Path) -> None:
@@ -56,7 +81,8 @@ def write_csv(table: SlewTable, path: Path) -> None:
                     writer.writerow([name, *(repr(float(a)) for a in axis), repr(float(angle)),
                                      _cell(part.slew_time_s[i, k]), table.spec.objective,
                                      _cell(part.objective_value[i, k]), part.status[i][k],
-                                     _cell(part.plan_time_s[i, k]), part.message[i][k]])
+                                     best_known_text(part.best_known[i][k]), _cell(part.plan_time_s[i, k]),
+                                     part.message[i][k]])
 
 
 def write_netcdf(table: SlewTable, path: Path) -> None:
@@ -118,6 +144,15 @@ def write_netcdf(table: SlewTable, path: Path) -> None:
             v.long_name = "entry status"
             v.flag_values = np.arange(len(STATUS_CODES), dtype=np.int8)
             v.flag_meanings = " ".join(STATUS_CODES)
+            v = nc.createVariable(f"{prefix}best_known", "b", dims)
+            v[:] = np.array([[BEST_KNOWN_FILL if flag is None else int(flag) for flag in row] for row in part.best_known],
+                            dtype=np.int8).reshape(part.slew_time_s.shape)
+            v.units = "1"
+            v.long_name = ("whether the planner knows no faster feasible slew of the entry's problem (0: it knows "
+                           "one, named in the entry's message; the entry keeps its own, achievable time)")
+            v._FillValue = np.int8(BEST_KNOWN_FILL)
+            v.flag_values = np.array([0, 1], dtype=np.int8)
+            v.flag_meanings = "false true"
 
 
 def _data(nc: Any, name: str, dims: tuple[str, str], values: np.ndarray, units: str, long_name: str) -> None:

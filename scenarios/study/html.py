@@ -42,12 +42,15 @@ BINS = 40
 """Bins of a histogram."""
 ROBUSTNESS_SECTIONS = (
     ("Robustness", ("Fraction of the completed cases meeting every requirement and each threshold of "
-                    "robustness.thresholds, with the Wilson 95 % interval (robustness.csv).")),
+                    "robustness.thresholds, with the Wilson 95 % interval (robustness.csv). As in the summary, only "
+                    "rows ok or violated count: a failed or infeasible row is completed and meets no threshold "
+                    "whatever its values; excluded: the rows left out (failed, infeasible, crashed).")),
     ("Sensitivity", ("Spearman rank correlation of each summary metric with each dispersed parameter, a vector per "
-                     "component, over the rows where the metric has a value, a case that never settled ranked "
-                     "after every settled one (sensitivity.csv).")),
-    ("Worst cases", ("The largest values of each summary metric (smallest for an at_least threshold), by case id "
-                     "(inf: the case never settled); re-run one in full with slewbench sweep DIR --case N (worst_cases.csv).")),
+                     "component, over the rows ok or violated where the metric has a value, a case that never "
+                     "settled ranked after every settled one; excluded: the rows left out (sensitivity.csv).")),
+    ("Worst cases", ("The largest values of each summary metric (smallest for an at_least threshold) among the rows "
+                     "ok or violated, by case id (inf: the case never settled; excluded: the rows left out); re-run "
+                     "one in full with slewbench sweep DIR --case N (worst_cases.csv).")),
 )
 """Titles and explanations of the robustness sections, in the order of the robustness tables."""
 _COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f")

@@ -9,9 +9,10 @@ as ``summary.csv`` groups them), written as ``robustness.csv``, ``sensitivity.cs
 * :func:`proportion_table`: the fraction of the completed cases (not ``crashed``) that meet every
   requirement (status ``ok``, as ``requirements.csv``) and, for each ``robustness.thresholds``
   entry, whose metric is at most (or at least) its bound, each with its Wilson 95 % interval
-  (:func:`scenarios.study.report.wilson_interval`). A completed row without a value (a failed
-  planner) does not meet a threshold. Cases that share a store key (the same scenario) count once
-  (:func:`scenarios.study.report.distinct_rows`).
+  (:func:`scenarios.study.report.wilson_interval`). A completed row without a value does not meet
+  a threshold, and neither does a ``failed`` or ``infeasible`` one whatever values it carries (it
+  counts as completed and meets no criterion). Cases that share a store key (the same scenario)
+  count once (:func:`scenarios.study.report.distinct_rows`).
 * :func:`sensitivity_table`: Spearman's rank correlation of each summary metric with each dispersed
   parameter over the rows where the metric has a value or never reached one (a case that never
   settled ranks after every settled one, ties averaged: :func:`scenarios.study.report.metric_values`);
@@ -21,6 +22,13 @@ as ``summary.csv`` groups them), written as ``robustness.csv``, ``sensitivity.cs
   (the smallest for a metric with an ``at_least`` threshold), by case id, with their seeds, to be
   re-run in full with ``slewbench sweep DIR --case N``; a case that never settled is +inf, the
   largest.
+
+The three take a row's metric values as ``summary.csv`` and the plots do: only from the rows that
+count (:func:`scenarios.study.report.counted`, ``ok`` and ``violated``; a ``failed``,
+``infeasible`` or ``crashed`` row is left out whatever values it carries,
+:func:`scenarios.study.report.metric_values` with ``counted_only``), and each table has the
+column ``excluded``: the group's rows left out so (the ``excluded`` of ``summary.csv``). The rows
+not ok are listed by case id in ``summary.md``.
 
 A threshold on a metric counts a case that never reached it as +inf too (it does not meet an
 ``at_most`` bound).
@@ -38,6 +46,7 @@ from scenarios.schema.study import CASE_SEED
 from scenarios.study.report import (
     INFINITY_TEXT,
     PROPORTION_STATISTICS,
+    counted,
     distinct_rows,
     group_rows,
     metric_values,
@@ -45,19 +54,26 @@ from scenarios.study.report import (
 )
 from scenarios.study.types import Study
 
-__all__ = ["EVERY_REQUIREMENT", "SENSITIVITY_STATISTICS", "WORST_COLUMNS", "crashed_counts", "criterion_text",
-           "parameter_columns",
+__all__ = ["EVERY_REQUIREMENT", "ROBUSTNESS_STATISTICS", "SENSITIVITY_STATISTICS", "WORST_COLUMNS", "crashed_counts",
+           "criterion_text", "excluded_count", "parameter_columns",
            "proportion_table", "robustness_lines", "robustness_markdown", "sensitivity_table", "spearman",
            "worst_table"]
 
 EVERY_REQUIREMENT = "every requirement"
 """The criterion of the rows whose status is ``ok``."""
-SENSITIVITY_STATISTICS = ("cases", "spearman_rho")
+ROBUSTNESS_STATISTICS = (PROPORTION_STATISTICS[0], "excluded", *PROPORTION_STATISTICS[1:])
+"""The columns of ``robustness.csv`` after the grouping keys and ``criterion``: those of
+``requirements.csv`` (:data:`~scenarios.study.report.PROPORTION_STATISTICS`) with ``excluded``
+after ``completed`` (:func:`excluded_count`: the ``failed`` and ``infeasible`` ones among them
+are completed and meet no criterion)."""
+SENSITIVITY_STATISTICS = ("cases", "excluded", "spearman_rho")
 """The columns of ``sensitivity.csv`` after the grouping keys, ``metric`` and ``parameter``: the rows
-with a value of the metric or that never reached one (+inf, the largest rank), and their rank
-correlation (None when either side does not vary)."""
-WORST_COLUMNS = ("metric", "rank", "case", "seed", "value", "status")
-"""The columns of ``worst_cases.csv`` after the grouping keys."""
+that count with a value of the metric or that never reached one (+inf, the largest rank), the
+group's rows left out (:func:`excluded_count`), and the rank correlation (None when either side
+does not vary)."""
+WORST_COLUMNS = ("metric", "rank", "case", "seed", "value", "status", "excluded")
+"""The columns of ``worst_cases.csv`` after the grouping keys (``excluded``: the group's rows left
+out of the ranking, :func:`excluded_count`)."""
 MIN_CASES = 3
 """Fewest rows a rank correlation is computed from."""
 NOT_OK_LISTED = 20
@@ -84,6 +100,23 @@ def criterion_text(metric: str, sense: str, bound: float) -> str:
     return f"{metric} {'<=' if sense == 'at_most' else '>='} {bound:g}"
 
 
+def excluded_count(rows: list[dict[str, Any]]) -> int:
+    """The rows whose metric values the robustness tables leave out, as ``summary.csv`` does.
+
+    Parameters
+    ----------
+    rows : list of dict
+        A group's ``cases.csv`` rows.
+
+    Returns
+    -------
+    int
+        The rows that do not count (:func:`scenarios.study.report.counted`: ``failed``,
+        ``infeasible``, ``crashed``), whatever values they carry.
+    """
+    return sum(not counted(row) for row in rows)
+
+
 def proportion_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
     """Per group: the fraction of completed cases meeting every requirement, then each threshold.
 
@@ -97,10 +130,12 @@ def proportion_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str
     Returns
     -------
     columns : list of str
-        The grouping keys, ``criterion`` and :data:`~scenarios.study.report.PROPORTION_STATISTICS`.
+        The grouping keys, ``criterion`` and :data:`ROBUSTNESS_STATISTICS`.
     rows : list of dict
         One per group and criterion (:data:`EVERY_REQUIREMENT` first); the fraction and its
-        interval are None without completed cases.
+        interval are None without completed cases. A threshold is met only by a row that counts
+        (``ok`` or ``violated``): a ``failed`` or ``infeasible`` row is completed and meets none,
+        whatever its values; ``excluded`` counts the group's rows left out so (crashed ones too).
     """
     keys, groups = group_rows(study, distinct_rows(study, rows))  # a case shared by several counts once
     table = []
@@ -108,15 +143,17 @@ def proportion_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str
         completed = [r for r in members if r["status"] != "crashed"]
         criteria = [(EVERY_REQUIREMENT, sum(r["status"] == "ok" for r in completed))]
         for metric, (sense, bound) in study.thresholds.items():
-            values = metric_values(metric, completed)  # +inf: never settled; NaN: no value
+            # +inf: never settled; NaN: no value, or a row that does not count (it meets nothing)
+            values = metric_values(metric, completed, counted_only=True)
             with np.errstate(invalid="ignore"):
                 meets = values <= bound if sense == "at_most" else values >= bound
             criteria.append((criterion_text(metric, sense, bound), int(np.sum(meets & ~np.isnan(values)))))
+        excluded = excluded_count(members)
         for criterion, met in criteria:
             line = {k: members[0].get(k) for k in keys}
-            line.update(criterion=criterion, **proportion(met, len(completed)))
+            line.update(criterion=criterion, **proportion(met, len(completed)), excluded=excluded)
             table.append(line)
-    return [*keys, "criterion", *PROPORTION_STATISTICS], table
+    return [*keys, "criterion", *ROBUSTNESS_STATISTICS], table
 
 
 def _components(value: Any) -> list[float] | None:
@@ -228,7 +265,8 @@ def sensitivity_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[st
         The grouping keys, ``metric``, ``parameter`` and :data:`SENSITIVITY_STATISTICS`.
     rows : list of dict
         One per group, summary metric and parameter (:func:`parameter_columns`); empty without
-        dispersed parameters.
+        dispersed parameters. Over the rows that count (``ok``, ``violated``: the values of
+        ``summary.csv``); ``excluded`` counts the group's others.
     """
     keys, groups = group_rows(study, rows)
     table = []
@@ -236,12 +274,14 @@ def sensitivity_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[st
     position = {id(row): k for k, row in enumerate(rows)}
     for members in groups.values():
         index = np.array([position[id(r)] for r in members], dtype=int)
+        excluded = excluded_count(members)
         for metric in study.summary:
-            values = metric_values(metric, members)  # never settled: +inf, the largest rank
+            # never settled: +inf, the largest rank; a row that does not count: NaN, left out
+            values = metric_values(metric, members, counted_only=True)
             for name, column in parameters:
                 line = {k: members[0].get(k) for k in keys}
                 line.update(metric=metric, parameter=name,
-                            cases=int(np.sum(~np.isnan(values) & np.isfinite(column[index]))),
+                            cases=int(np.sum(~np.isnan(values) & np.isfinite(column[index]))), excluded=excluded,
                             spearman_rho=spearman(column[index], values))
                 table.append(line)
     return [*keys, "metric", "parameter", *SENSITIVITY_STATISTICS], table
@@ -262,25 +302,29 @@ def worst_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], li
     columns : list of str
         The grouping keys and :data:`WORST_COLUMNS`.
     rows : list of dict
-        Per group and metric, ranks 1 to ``worst`` among the rows with a value or that never
-        reached one (``value`` +inf: a case that never settled,
-        :func:`scenarios.study.report.metric_values`): the largest values first (the smallest for a
-        metric with an ``at_least`` threshold); ties in case order. A metric with one value in
-        every row of the group lists none.
+        Per group and metric, ranks 1 to ``worst`` among the rows that count (``ok``,
+        ``violated``: the values of ``summary.csv``) with a value or that never reached one
+        (``value`` +inf: a case that never settled, :func:`scenarios.study.report.metric_values`):
+        the largest values first (the smallest for a metric with an ``at_least`` threshold); ties
+        in case order; ``excluded``: the group's rows left out (``failed``, ``infeasible``,
+        ``crashed``, whatever their values). A metric with one value in every row of the group
+        lists none.
     """
     keys, groups = group_rows(study, rows)
     table = []
     for members in groups.values():
+        excluded = excluded_count(members)
         for metric in study.summary:
             least = study.thresholds.get(metric, ("at_most", 0.0))[0] == "at_least"
-            valued = [(float(v), r) for v, r in zip(metric_values(metric, members), members) if not math.isnan(v)]
+            values = metric_values(metric, members, counted_only=True)
+            valued = [(float(v), r) for v, r in zip(values, members) if not math.isnan(v)]
             if len({v for v, _ in valued}) < 2:
                 continue  # one value in every row: no case is worse than another
             valued.sort(key=lambda pair: pair[0] if least else -pair[0])  # stable: ties keep case order
             for rank, (value, row) in enumerate(valued[:study.worst], start=1):
                 line = {k: members[0].get(k) for k in keys}
                 line.update(metric=metric, rank=rank, case=row["case"], seed=row.get("seed"), value=value,
-                            status=row["status"])
+                            status=row["status"], excluded=excluded)
                 table.append(line)
     return [*keys, *WORST_COLUMNS], table
 
@@ -328,7 +372,9 @@ def robustness_markdown(study: Study, rows: list[dict[str, Any]],
     """
     out = ["## Robustness", "",
            ("Fraction of the completed cases (not crashed) meeting every requirement (status ok) and each "
-            "threshold of `robustness.thresholds`, with the Wilson 95 % interval."), ""]
+            "threshold of `robustness.thresholds`, with the Wilson 95 % interval. As in the summary, only rows ok or "
+            "violated count: a failed or infeasible row meets no threshold whatever its values, and the sensitivity "
+            "and worst cases leave it out; excluded counts the rows left out (failed, infeasible, crashed)."), ""]
     out += _lines(*proportions) + [""]
     not_ok = _not_ok(study, rows)
     if not_ok:
@@ -343,13 +389,14 @@ def robustness_markdown(study: Study, rows: list[dict[str, Any]],
                                     {**{k: line.get(k) for k in keys}, "metric": line["metric"]})
             entry[line["parameter"]] = line["spearman_rho"]
         out += ["## Sensitivity", "", ("Spearman rank correlation of each summary metric (rows) with each dispersed "
-                                       "parameter (columns; a vector per component), over the rows where the metric "
-                                       "has a value, a case that never settled ranked after every settled one; "
-                                       "empty: the metric does not vary."), ""]
+                                       "parameter (columns; a vector per component), over the rows ok or violated "
+                                       "where the metric has a value, a case that never settled ranked after every "
+                                       "settled one; empty: the metric does not vary."), ""]
         out += _lines([*keys, "metric", *parameters], list(wide.values())) + [""]
     if worst[1]:
         out += ["## Worst cases", "", (f"The {study.worst} largest values of each summary metric (smallest for "
-                                       "an at_least threshold), by case id; inf: the case never settled."), ""]
+                                       "an at_least threshold) among the rows ok or violated, by case id; inf: the "
+                                       "case never settled."), ""]
         out += _lines(*worst) + [""]
     return "\n".join(out)
 
