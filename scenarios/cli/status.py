@@ -8,8 +8,8 @@ from __future__ import annotations
 import argparse
 import re
 
-__all__ = ["EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_CRASHED", "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_NOT_OK",
-           "EXIT_OK", "attached_values", "directory_argument"]
+__all__ = ["CRASH_REASONS_SHOWN", "EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_CRASHED", "EXIT_INTERNAL",
+           "EXIT_INTERRUPTED", "EXIT_NOT_OK", "EXIT_OK", "attached_values", "crash_report", "directory_argument"]
 
 EXIT_OK = 0
 """The command completed (a run's failed and violated rows, a table's entries that are not ok
@@ -33,6 +33,56 @@ EXIT_BAD_OUTPUT = 2
 """An output location slewbench must not or cannot write to: nothing was touched."""
 EXIT_INTERRUPTED = 130
 """A sweep stopped before every case finished (rerun it with ``--resume``)."""
+
+
+CRASH_REASONS_SHOWN = 3
+"""Distinct reasons the closing message of a sweep or a table gives for its crashed cases or
+entries (the most frequent first)."""
+
+
+def crash_report(reasons: list[str], total: int, noun: tuple[str, str], where: str, consequence: str,
+                 command: str) -> str:
+    """What a command whose cases crashed says last (on standard error): how many, why, and how to
+    run them again (:data:`EXIT_CRASHED`).
+
+    Parameters
+    ----------
+    reasons : list of str
+        One message per crashed case, in the order met (an empty one reads "no message").
+    total : int
+        The number of cases.
+    noun : tuple of str
+        The case's name, singular and plural (``("case", "cases")``, ``("entry", "entries")``).
+    where : str
+        The file whose ``status`` column shows them crashed (``cases.csv``).
+    consequence : str
+        What their missing results mean for the outputs.
+    command : str
+        The command that runs them again.
+
+    Returns
+    -------
+    str
+        ``slewbench: N of M <nouns> crashed ...``, the :data:`CRASH_REASONS_SHOWN` most frequent
+        reasons with their counts, and ``command``; empty when none crashed.
+    """
+    if not reasons:
+        return ""
+    counts: dict[str, int] = {}
+    for reason in reasons:
+        counts[reason or "no message"] = counts.get(reason or "no message", 0) + 1
+    ranked = sorted(counts.items(), key=lambda item: -item[1])  # stable: equal counts in the order met
+
+    def many(count: int) -> str:
+        return f"{count} {noun[0] if count == 1 else noun[1]}"
+
+    lines = [(f"slewbench: {len(reasons)} of {many(total)} crashed (raised, ran out of case_timeout_s or killed "
+              f"their worker): they have no result (status crashed in {where}; {consequence}). Why:")]
+    lines += [f"  {many(count)}: {reason}" for reason, count in ranked[:CRASH_REASONS_SHOWN]]
+    if len(ranked) > CRASH_REASONS_SHOWN:
+        lines.append(f"  ... and {len(ranked) - CRASH_REASONS_SHOWN} other reason(s) ({where}, status crashed)")
+    lines += [f"Run them again (the {noun[1]} already stored are kept) with:", f"  {command}"]
+    return "\n".join(lines)
 
 
 def directory_argument(text: str) -> str:

@@ -25,6 +25,7 @@ from scenarios.cli.status import (
     EXIT_CRASHED,
     EXIT_INTERRUPTED,
     EXIT_OK,
+    crash_report,
     directory_argument,
 )
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
@@ -436,13 +437,8 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
     return EXIT_OK
 
 
-CRASH_REASONS_SHOWN = 3
-"""Distinct reasons a sweep's closing message gives for its crashed cases (the most frequent first)."""
-
-
 def crashed_message(records: list[dict[str, Any]], total: int, resume: str) -> str:
-    """What a sweep whose cases crashed says last (on standard error): how many, why, and how to run
-    them again.
+    """What a sweep whose cases crashed says last (:func:`~scenarios.cli.status.crash_report`).
 
     Parameters
     ----------
@@ -456,25 +452,12 @@ def crashed_message(records: list[dict[str, Any]], total: int, resume: str) -> s
     Returns
     -------
     str
-        ``slewbench: N of M cases crashed ...``, the :data:`CRASH_REASONS_SHOWN` most frequent
-        messages of their rows with their counts, and ``resume``.
+        The message, each crashed case's reason its first row's message.
     """
-    reasons: dict[str, int] = {}
-    crashed = 0
-    for record in records:
-        if record["status"] == "crashed":
-            crashed += 1
-            message = next((str(row.get("message") or "") for row in record["rows"]), "") or "no message"
-            reasons[message] = reasons.get(message, 0) + 1
-    ranked = sorted(reasons.items(), key=lambda item: -item[1])  # stable: equal counts in the order stored
-    lines = [(f"slewbench: {crashed} of {total} case{'s' if total != 1 else ''} crashed (raised, ran out of "
-              "case_timeout_s or killed their worker): they have no result (status crashed in cases.csv; the "
-              "statistics and plots leave them out). Why:")]
-    lines += [f"  {count} case{'s' if count != 1 else ''}: {reason}" for reason, count in ranked[:CRASH_REASONS_SHOWN]]
-    if len(ranked) > CRASH_REASONS_SHOWN:
-        lines.append(f"  ... and {len(ranked) - CRASH_REASONS_SHOWN} other reason(s) (cases.csv, status crashed)")
-    lines += ["Run them again (the cases already stored are kept) with:", f"  {resume}"]
-    return "\n".join(lines)
+    reasons = [next((str(row.get("message") or "") for row in record["rows"]), "")
+               for record in records if record["status"] == "crashed"]
+    return crash_report(reasons, total, ("case", "cases"), "cases.csv", "the statistics and plots leave them out",
+                        resume)
 
 
 def _final_note(study: Study, rows: list[dict[str, Any]]) -> str | None:

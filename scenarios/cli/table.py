@@ -25,6 +25,7 @@ from scenarios.cli.status import (
     EXIT_INTERRUPTED,
     EXIT_NOT_OK,
     EXIT_OK,
+    crash_report,
     directory_argument,
 )
 
@@ -193,14 +194,8 @@ def entry_counts(table: Any) -> str:
     return text
 
 
-CRASH_REASONS_SHOWN = 3
-"""Distinct reasons the closing message gives for the crashed entries (the most frequent first),
-as ``slewbench sweep`` gives for its cases."""
-
-
 def crashed_message(table: Any, command: str) -> str:
-    """What a table whose entries crashed says last (on standard error): how many, why, and how to
-    run them again.
+    """What a table whose entries crashed says last (:func:`~scenarios.cli.status.crash_report`).
 
     Parameters
     ----------
@@ -212,29 +207,15 @@ def crashed_message(table: Any, command: str) -> str:
     Returns
     -------
     str
-        ``slewbench: N of M entries crashed ...``, the :data:`CRASH_REASONS_SHOWN` most frequent
-        messages with their counts, and ``command``; empty when no entry crashed.
+        The message; empty when no entry crashed.
     """
-    reasons: dict[str, int] = {}
-    total = 0
+    reasons, total = [], 0
     for part in table.parts.values():
         for statuses, messages in zip(part.status, part.message):
             total += len(statuses)
-            for status, message in zip(statuses, messages):
-                if status == "crashed":
-                    reasons[message or "no message"] = reasons.get(message or "no message", 0) + 1
-    crashed = sum(reasons.values())
-    if not crashed:
-        return ""
-    ranked = sorted(reasons.items(), key=lambda item: -item[1])  # stable: equal counts in the order met
-    lines = [(f"slewbench: {crashed} of {_count(total, 'entry', 'entries')} crashed (raised, ran out of case_timeout_s "
-              "or killed their worker): they have no result (status crashed in slew_table.csv; the fit has no time "
-              "around them). Why:")]
-    lines += [f"  {_count(count, 'entry', 'entries')}: {reason}" for reason, count in ranked[:CRASH_REASONS_SHOWN]]
-    if len(ranked) > CRASH_REASONS_SHOWN:
-        lines.append(f"  ... and {len(ranked) - CRASH_REASONS_SHOWN} other reason(s) (slew_table.csv, status crashed)")
-    lines += ["Run them again (the entries already stored are kept) with:", f"  {command}"]
-    return "\n".join(lines)
+            reasons += [message for status, message in zip(statuses, messages) if status == "crashed"]
+    return crash_report(reasons, total, ("entry", "entries"), "slew_table.csv", "the fit has no time around them",
+                        command)
 
 
 def rerun_command(args: argparse.Namespace, out: Path) -> str:
