@@ -32,20 +32,21 @@ def bilimoria_wie_problem():
 
 
 def feasible_eigenaxis(problem):
-    """The eigenaxis bang-coast-bang within the margin, and its duration checked here: torques by
-    ``torque_fraction``, and the coast rate lowered so that the working wheels' momenta (the
-    conserved zero total: ``h = −A_w⁺ I ω``) stay within (1 − margin) of their bound."""
+    """The eigenaxis bang-coast-bang within the margin (the planner keeps ``1 − actuator_margin``
+    of every limit), checked here: the working wheels' torques ``g = −A_w⁺ I ω̇`` and momenta (the
+    conserved zero total: ``h = −A_w⁺ I ω``) within (1 − margin) of their bounds."""
     keep = 1.0 - MARGIN
-    first = PLANNERS["eigenaxis"]({"profile": "min_time", "torque_fraction": keep}).plan(problem)
-    rate = first.profile.rate_max
-    slew = PLANNERS["eigenaxis"]({"profile": "min_time", "torque_fraction": keep, "max_rate": keep * rate}).plan(problem)
+    slew = PLANNERS["eigenaxis"]({"profile": "min_time"}).plan(problem)
     assert slew.ok, slew.message
     t = np.linspace(0.0, slew.duration, 2001)
-    omega = slew.sample(t).omega
+    sample = slew.sample(t)
     working = AXES.copy()
     working[:, 0] = 0.0
-    momenta = -(omega @ INERTIA.T) @ np.linalg.pinv(working).T
+    inverse = np.linalg.pinv(working)
+    momenta = -(sample.omega @ INERTIA.T) @ inverse.T
+    torques = -(sample.omega_dot @ INERTIA.T) @ inverse.T  # I ω̇ + ω × H with H = 0: no gyroscopic term
     assert np.max(np.abs(momenta)) <= keep * MAX_MOMENTUM * (1 + 1e-9)
+    assert np.max(np.abs(torques)) <= keep * 0.01 * (1 + 1e-9)
     return slew
 
 
@@ -67,11 +68,14 @@ def test_minimum_time_is_not_silently_slower_than_a_feasible_eigenaxis_slew():
 def test_the_full_limit_eigenaxis_is_no_bound_under_a_margin():
     # The eigenaxis at the full limits (74.6 s) uses the whole momentum: not a slew of the problem
     # with a 5 % margin, so its duration bounds nothing; the derated one is feasible.
+    from dataclasses import replace
+
     from planners.collocation.certificate import start_violations
     from planners.collocation.problem import variable_bounds
     problem = pyramid_problem()
     bounds = variable_bounds(problem, None, 1.0 - MARGIN)
-    full = PLANNERS["eigenaxis"]({"profile": "min_time"}).plan(problem)
+    full = PLANNERS["eigenaxis"]({"profile": "min_time"}).plan(replace(problem, actuator_margin=None))
+    assert full.duration == pytest.approx(74.61, abs=0.01)
     broken = start_violations(problem, full, bounds, None, (), 1001, 1e-6, 1e-6)
     assert broken["states"] == pytest.approx(1.0 / (1.0 - MARGIN) - 1.0, rel=1e-3)
     assert start_violations(problem, feasible_eigenaxis(problem), bounds, None, (), 1001, 1e-6, 1e-6) == {}
