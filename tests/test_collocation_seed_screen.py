@@ -39,7 +39,9 @@ class _CycloidReference(Reference):
         omega, omega_dot = rate[:, None] * self.axis, acc[:, None] * self.axis
         if self.defect == "nan":
             q = np.where((t > 0.5 * self.duration)[:, None], np.nan, q)
-        elif np.any(t > 0.5 * self.duration):
+        elif self.defect == "nan_window":  # between the screening's 129 points, on collocation points
+            q = np.where(((t > 0.517 * self.duration) & (t < 0.522 * self.duration))[:, None], np.nan, q)
+        elif self.defect == "raise" and np.any(t > 0.5 * self.duration):
             raise RuntimeError("simulated crash inside _evaluate")
         return ReferenceSample(q, omega, omega_dot, inverse_dynamics_torque(self.inertia, omega, omega_dot))
 
@@ -70,7 +72,8 @@ def clean():
 
 
 @pytest.mark.parametrize("defect, reason", [("nan", "non-finite q at t = "),
-                                            ("raise", "sampling its reference raised RuntimeError")])
+                                            ("raise", "sampling its reference raised RuntimeError"),
+                                            ("nan_window", "intervals is not finite at ")])
 def test_a_bad_seed_is_skipped_and_named(monkeypatch, clean, defect, reason):
     monkeypatch.setitem(PLANNERS, "bad_seed", _bad_seed_planner(defect))
     planner = PLANNERS["collocation"]({"intervals": 30})
@@ -80,3 +83,17 @@ def test_a_bad_seed_is_skipped_and_named(monkeypatch, clean, defect, reason):
     skipped = reference.stats["seeds"]["skipped"]
     assert any(entry.startswith("bad_seed: ") and reason in entry for entry in skipped), skipped
     assert reference.stats["objective"] == pytest.approx(clean.stats["objective"], rel=1e-6)
+
+
+def test_a_candidate_with_a_nan_is_no_feasible_slew():
+    # start_violations compares each sample with the bounds; a NaN compares false with all of them
+    # and read as feasible (a faster candidate would then seed a solve from a NaN)
+    from planners.collocation.certificate import start_violations
+    from planners.collocation.problem import variable_bounds
+
+    problem = _problem()
+    reference = _CycloidReference(problem, "nan_window")
+    broken = start_violations(problem, reference, variable_bounds(problem, None, 1.0), None, (), 601, 1e-6, 1e-6)
+    assert broken.get("not finite", 0) > 0, broken
+    clean = _CycloidReference(problem, "none")
+    assert start_violations(problem, clean, variable_bounds(problem, None, 1.0), None, (), 601, 1e-6, 1e-6) == {}

@@ -196,7 +196,8 @@ def start_violations(problem: ManeuverProblem, reference: Reference, bounds: tup
     -------
     dict or str
         The broken constraints and by how much (relative excess, rad of pointing margin, absolute
-        boundary miss); empty when the reference is feasible. A string says why it cannot be
+        boundary miss; ``"not finite"``: how many times hold a NaN or an infinity); empty when the
+        reference is feasible. A string says why it cannot be
         checked (actuators other than wheels or torquers alone, environment torques, stored
         momentum with torquers: the actuators' share of the torque is not read from the
         reference alone).
@@ -209,6 +210,10 @@ def start_violations(problem: ManeuverProblem, reference: Reference, bounds: tup
         return "not checked: environment torques"
     t = np.linspace(0.0, float(reference.duration), max(int(points), 2))
     x, u, sample = states_controls(problem, reference, t)
+    bad = ~(np.all(np.isfinite(x), axis=1) & np.all(np.isfinite(u), axis=1)
+            & np.all(np.isfinite(sample.torque), axis=1))
+    if np.any(bad):  # a NaN compares false with every bound: it would read as feasible
+        return {"not finite": float(np.sum(bad))}
     if "wheels" in blocks:
         # what the working wheels cannot give (off their span) and the stored momentum they miss
         demand = sample.torque + np.cross(sample.omega, x[:, 7:] @ spacecraft.wheel_axes.T)

@@ -671,7 +671,10 @@ class CollocationPlanner(Planner):
                                               + "; ".join(failures) + ")")
         reference = self._plan_from(problem, starts)
         if isinstance(reference.stats.get("seeds"), dict):  # the seed planners that failed or raised
-            reference.stats["seeds"]["skipped"] = failures
+            coarse = reference.stats.get("coarse")
+            dropped = [*(coarse.get("seeds_dropped", []) if isinstance(coarse, dict) else []),
+                       *reference.stats.get("seeds_dropped", [])]
+            reference.stats["seeds"]["skipped"] = failures + dropped
         return reference
 
     def _plan_from(self, problem: ManeuverProblem, starts: list[Reference]) -> Reference:
@@ -862,9 +865,14 @@ class CollocationPlanner(Planner):
         return _Optimum(result, {}, transcription, nlp, solved.intervals, None, solved.solver)
 
     def _seeds(self, problem: ManeuverProblem, ocp: OptimalControlProblem, transcription: Transcription, nlp: NLP,
-               starts: list[Reference]) -> tuple[list[Array], list[Array], list[str]]:
+               starts: list[Reference], dropped: list[str] | None = None) -> tuple[list[Array], list[Array], list[str]]:
         """The decision vectors of the start references, alternates tried only if none converges,
         and where each comes from (the planner's name, one per start then per alternate).
+
+        A vector that is not finite (a start reference NaN at a point of this mesh that
+        :meth:`_starts`'s screening did not sample) is left out, ``"label: why"`` appended to
+        ``dropped`` (a ``ValueError`` when none is left, or without ``dropped``): the solver would
+        not return from it.
 
         A start whose boresight enters a keep-out cone is bent round it
         (:func:`~planners.collocation.reference.cone_avoiding_sampler`, :data:`SEED_CONE_PAD`
@@ -894,10 +902,21 @@ class CollocationPlanner(Planner):
                 (labels if central else alternate_labels).append(f"{reference.planner} other side")
                 alternates.append(transcription.seed(ocp, nlp, sample, duration))
                 alternate_labels.append(f"{reference.planner} unbent")
-        for vector, label in zip(seeds + alternates, labels + alternate_labels):
-            if not np.all(np.isfinite(vector)):  # the solver would never return (see SEED_CHECK_POINTS)
-                raise ValueError(f"collocation: the start from {label} is not finite at "
-                                 f"{int(np.sum(~np.isfinite(vector)))} of its {vector.size} entries")
+        def finite(vectors: list[Array], names: list[str]) -> tuple[list[Array], list[str]]:
+            kept = [(vector, name) for vector, name in zip(vectors, names) if np.all(np.isfinite(vector))]
+            for vector, name in zip(vectors, names):
+                if not np.all(np.isfinite(vector)):
+                    why = (f"{name}: its start on {transcription.intervals} intervals is not finite at "
+                           f"{int(np.sum(~np.isfinite(vector)))} of {vector.size} entries")
+                    if dropped is None:
+                        raise ValueError(f"collocation: {why}")
+                    dropped.append(why)
+            return [vector for vector, _ in kept], [name for _, name in kept]
+
+        seeds, labels = finite(seeds, labels)
+        alternates, alternate_labels = finite(alternates, alternate_labels)
+        if not seeds:
+            raise ValueError("collocation: no start is finite (" + "; ".join(dropped or []) + ")")
         return seeds, alternates, labels + alternate_labels
 
     def _optimum(self, problem: ManeuverProblem, ocp: OptimalControlProblem, starts: list[Reference], params: Array,
@@ -910,7 +929,8 @@ class CollocationPlanner(Planner):
         mode: _Mode = "warm" if o.time_regularization else "transfer" if coarse_first else "cold"
         transcription, nlp = self._nlp(problem, ocp, mode, intervals, solver)
         bounds = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
-        result, extra, regularized = None, {}, None
+        result, regularized = None, None
+        extra: dict[str, Any] = {}
         if coarse_first:
             # On a coarse mesh, where an iteration costs a fraction: the escape from stationary
             # points and its confirmation (free T), or the long way from a far seed (fixed T); its
@@ -941,7 +961,10 @@ class CollocationPlanner(Planner):
                     result = polish if result is None else merged(result, polish)
                     extra.update(more)
         if result is None or not result.success:
-            seeds, alternates, labels = self._seeds(problem, ocp, transcription, nlp, starts)
+            dropped: list[str] = []
+            seeds, alternates, labels = self._seeds(problem, ocp, transcription, nlp, starts, dropped)
+            if dropped:
+                extra["seeds_dropped"] = dropped
             fine, more, regularized = self._solve(problem, ocp, seeds, params, bounds, intervals, solver=solver,
                                                   alternates=alternates, labels=labels)
             result = fine if result is None else merged(result, fine)
