@@ -15,14 +15,18 @@ constant that gives the saturated control the interval's impulse of the unsatura
 ``∫ clip(p + c) dt = ∫ p dt`` (:attr:`CollocationReference.impulse_offsets`; the integral lies within
 the bounds times h, the Radau quadrature of values within them, so such a ``c`` exists): flown open
 loop the slews end 0.0099° and 0.0068° from their targets. Entries within their bounds are read
-unchanged, and the blocks scaled as a whole (below) are not shifted.
+unchanged. The blocks scaled as a whole (below: a redundant or skewed wheel array, on which the
+allocation is imposed) are not shifted: there the clip's loss remains (a four-wheel pyramid's
+minimum time flown open loop: 0.40°). For a magnetorquer the entry is the dipole: its integral is
+kept, the torque's ``∫ m × B`` only to first order in the field's turn over the interval.
 
 The feed-forward torque is the optimal control expressed for ``I ω̇ = −ω × I ω + u``:
 ``u = τ_actuators − ω × A h_w + τ_environment``, and ``ω̇`` comes from the model under the
 saturated control, so torque and ``ω̇`` agree with each other. Where the saturation acts they do not
 agree with the time derivative of the interpolated ``ω`` inside the interval (the polynomial's
-overshoot is not flown); at the points they agree (the solution meets its bounds there), and over
-each interval the impulses do.
+overshoot is not flown); at the points they agree (the solution meets its bounds there) except in
+the shifted intervals, whose points are therefore no enforced times
+(:attr:`CollocationReference.enforced_times`), and over each interval the impulses agree.
 """
 from __future__ import annotations
 
@@ -97,6 +101,31 @@ class CollocationReference(Reference):
     def _interpolated(self, t: Array, left: bool = False) -> tuple[Array, Array]:
         """States and controls as the transcription interpolates them (controls not saturated)."""
         return self.transcription.interpolate(self.model, self.states, self.controls, self.duration, t, left)
+
+    @property
+    def enforced_times(self) -> Array | None:
+        """The times where the dynamics are imposed and the reference reads them as solved: the
+        transcription's points, less those of the intervals whose controls
+        :attr:`impulse_offsets` shifts (there the control flown is not the solution's at the
+        points, so ``ω̇`` is not the derivative of the interpolated ``ω``).
+
+        Returns
+        -------
+        (n,) ndarray or None
+            Times [s], sorted.
+        """
+        times = self._enforced_times
+        if times is None or self.control_bounds is None or times.size == 0:
+            return times
+        shifted = np.any(self.impulse_offsets != 0.0, axis=1)
+        if not np.any(shifted):
+            return times
+        # a point at a node τ_d = 1 belongs to the interval it ends (the Radau point of that interval)
+        return times[~shifted[self.transcription.interval_index(self.duration, times, left=True)]]
+
+    @enforced_times.setter
+    def enforced_times(self, times: Array | None) -> None:
+        self._enforced_times = times
 
     @property
     def impulse_offsets(self) -> Array:
