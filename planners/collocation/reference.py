@@ -230,7 +230,7 @@ def states_controls(problem: ManeuverProblem, reference: Reference, times: Array
     """The model's states and actuator controls along another planner's reference.
 
     Wheel momenta from the conservation of the total momentum (the stored momentum of
-    ``problem.wheel_momentum0`` included), the wheel torques ``g = −A⁺ (u + ω × A h_w)`` for the
+    ``problem.wheel_momentum0`` included; a failed wheel keeps its own), the wheel torques ``g = −A⁺ (u + ω × A h_w)`` for the
     reference's torque ``u`` (:attr:`~ocp.ReactionWheels.pseudo_inverse`: a failed wheel is given
     nothing), or the torquers' torque ``u``; other actuators' controls zero.
 
@@ -264,8 +264,10 @@ def states_controls(problem: ManeuverProblem, reference: Reference, times: Array
         assert wheels is not None  # n_wheels > 0
         wheel_momentum = cast(Array, problem.wheel_momentum0)  # zeros when not given (ManeuverProblem)
         total = quat.rotate(problem.q0, spacecraft.inertia @ problem.omega0 + axes @ wheel_momentum)
-        wheel_total = quat.rotate_inverse(sample.q, np.broadcast_to(total, sample.q.shape[:-1] + (3,))) - body_momentum
-        x[:, 7:] = wheel_total @ wheels.pseudo_inverse.T
+        held = np.where(wheels.working, 0.0, wheel_momentum)  # a failed wheel keeps its momentum (no torque)
+        wheel_total = (quat.rotate_inverse(sample.q, np.broadcast_to(total, sample.q.shape[:-1] + (3,)))
+                       - body_momentum - axes @ held)
+        x[:, 7:] = wheel_total @ wheels.pseudo_inverse.T + held
         wheel_torque = sample.torque + np.cross(sample.omega, x[:, 7:] @ axes.T)
         u[:, model.control_slices["wheels"]] = -wheel_torque @ wheels.pseudo_inverse.T
     elif "torquers" in model.control_slices:
