@@ -53,6 +53,14 @@ IMPULSE_BISECTIONS = 60
 """Bisection steps for each offset (the bracket, a few times the bound, halved 60 times)."""
 
 
+def _scaled(values: Array, low: Array, high: Array) -> Array:
+    """A block of controls (rows per time, ``(..., nb)``) scaled down as a whole until each entry is
+    within its bound, its direction kept."""
+    bound = np.where(values > 0, high, -low)
+    ratio = np.divide(np.abs(values), bound, out=np.zeros_like(values), where=bound > 0)
+    return values / np.maximum(ratio.max(axis=-1, initial=1.0), 1.0)[..., None]
+
+
 class CollocationReference(Reference):
     """Evaluates the optimal states and controls of a transcribed problem.
 
@@ -184,10 +192,7 @@ class CollocationReference(Reference):
             low, high = self.control_bounds
             u = u + self.impulse_offsets[self.transcription.interval_index(self.duration, t, left)]
             for block in self.scaled_blocks:  # scaled as a whole: the allocation's equalities kept
-                values = u[:, block]
-                bound = np.where(values > 0, high[block], -low[block])
-                ratio = np.divide(np.abs(values), bound, out=np.zeros_like(values), where=bound > 0)
-                u[:, block] = values / np.maximum(ratio.max(axis=1, initial=1.0), 1.0)[:, None]
+                u[:, block] = _scaled(u[:, block], low[block], high[block])
             u = np.clip(u, low, high)
         return x, u
 
