@@ -66,12 +66,21 @@ class ProbeEigenaxis(PLANNERS["eigenaxis"]):
 PLANNERS[ProbeEigenaxis.name] = ProbeEigenaxis
 with open(f"probe-{os.getpid()}.json", "w") as handle:  # relative: the process's working directory
     json.dump({"cwd": os.getcwd(), "sys_path": sys.path, "controllers": controllers.__file__,
-               "environment": {name: os.environ.get(name) for name in ("PYTHONSAFEPATH", "SLEWBENCH_SAFE_PATH")}},
+               "environment": {name: os.environ.get(name) for name in ("PYTHONSAFEPATH", "SLEWBENCH_SAFE_PATH",
+                                                                      "PYTHONPATH", "SLEWBENCH_USER_PYTHONPATH")}},
               handle)
 """
 
 LAUNCHER = """\
 import sys
+from scenarios.console import main
+if __name__ == '__main__':
+    sys.exit(main())
+"""
+
+CHECKOUT_LAUNCHER = """\
+import sys
+sys.path.insert(0, ROOT)  # a checkout put first by the script itself (a notebook's sys.path.insert)
 from scenarios.console import main
 if __name__ == '__main__':
     sys.exit(main())
@@ -92,13 +101,15 @@ def user_directory(tmp_path: Path, planner: str, timeout: float, shadows: bool =
     return user
 
 
-def slewbench(tmp_path: Path, user: Path, *args: str) -> subprocess.Popen[str]:
+def slewbench(tmp_path: Path, user: Path, *args: str, checkout_first: bool = False) -> subprocess.Popen[str]:
     launcher = tmp_path / "bin" / "slewbench_console.py"
     launcher.parent.mkdir(exist_ok=True)
-    launcher.write_text(LAUNCHER)
+    launcher.write_text(CHECKOUT_LAUNCHER.replace("ROOT", repr(str(ROOT))) if checkout_first else LAUNCHER)
     env = {key: value for key, value in os.environ.items()
            if key not in ("PYTHONPATH", "PYTHONSAFEPATH", "SLEWBENCH_PLUGINS", "SLEWBENCH_SAFE_PATH")}
-    env.update(PYTHONPATH=str(ROOT), MPLBACKEND="Agg", SLEWBENCH_PLUGINS="./probe_plugin.py")
+    env.update(MPLBACKEND="Agg", SLEWBENCH_PLUGINS="./probe_plugin.py")
+    if not checkout_first:
+        env["PYTHONPATH"] = str(ROOT)
     return subprocess.Popen([sys.executable, str(launcher), *args], cwd=user, env=env, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 
@@ -127,7 +138,26 @@ def test_a_local_sweep_imports_slewbench_not_the_users_files_of_the_same_name(tm
     for pid, probe in probes.items():
         if pid != process.pid:  # a worker: no current directory on its path, the environment put back
             assert "" not in probe["sys_path"] and str(user) not in probe["sys_path"], probe["sys_path"]
-            assert probe["environment"] == {"PYTHONSAFEPATH": None, "SLEWBENCH_SAFE_PATH": None}, probe
+            assert probe["environment"] == {"PYTHONSAFEPATH": None, "SLEWBENCH_SAFE_PATH": None,
+                                            "PYTHONPATH": str(ROOT), "SLEWBENCH_USER_PYTHONPATH": None}, probe
+
+
+def test_the_workers_run_the_workbench_the_sweep_runs(tmp_path: Path) -> None:
+    # The sweep's process finds this checkout first by its own sys.path (no PYTHONPATH), while
+    # another copy may be installed: the server (safe-path mode) imported the installed one, and
+    # the workers ran other code than the sweep (a reviewer, 2026-12-02: main's runner in a
+    # worktree's sweep). Now the server is given the sweep's sys.path.
+    user = user_directory(tmp_path, "probe_eigenaxis", 600.0)
+    process = slewbench(tmp_path, user, "sweep", "study.yaml", "--out", "out", "--no-plots", checkout_first=True)
+    stdout, stderr = process.communicate(timeout=120)
+    assert process.returncode == EXIT_OK, stdout + stderr
+    probes = {int(p.stem.split("-")[1]): json.loads(p.read_text()) for p in user.glob("probe-*.json")}
+    workers = {pid: probe for pid, probe in probes.items() if pid != process.pid}
+    assert workers, sorted(probes)
+    for pid, probe in probes.items():
+        assert Path(probe["controllers"]).resolve() == ROOT / "controllers" / "__init__.py", (pid, probe)
+    for probe in workers.values():  # the user's environment put back: no PYTHONPATH
+        assert probe["environment"]["PYTHONPATH"] is None and "" not in probe["sys_path"], probe
 
 
 def test_a_sweep_whose_cases_crashed_says_so_and_exits_nonzero(tmp_path: Path) -> None:
@@ -162,6 +192,16 @@ def test_the_fork_server_module_takes_the_current_directory_off_its_path(monkeyp
     monkeypatch.setenv("PYTHONSAFEPATH", "1")
     server.isolate_import_path()
     assert sys.path == ["/somewhere"] and os.environ["PYTHONSAFEPATH"] == "1"
+    monkeypatch.setattr(sys, "path", ["", "/somewhere"])  # the user's PYTHONPATH put back, or none
+    monkeypatch.setenv("SLEWBENCH_SAFE_PATH", "kept")
+    monkeypatch.setenv("PYTHONPATH", "/the/sweeps/sys/path")
+    monkeypatch.setenv("SLEWBENCH_USER_PYTHONPATH", "/users/own")
+    server.isolate_import_path()
+    assert os.environ["PYTHONPATH"] == "/users/own" and "SLEWBENCH_USER_PYTHONPATH" not in os.environ
+    monkeypatch.setenv("SLEWBENCH_SAFE_PATH", "kept")
+    monkeypatch.setenv("SLEWBENCH_USER_PYTHONPATH", server.UNSET)
+    server.isolate_import_path()
+    assert "PYTHONPATH" not in os.environ
     monkeypatch.setattr(sys, "path", ["", "/somewhere"])
     server.isolate_import_path()  # not the server (no mark): nothing changes
     assert sys.path == ["", "/somewhere"] and os.environ["PYTHONSAFEPATH"] == "1"

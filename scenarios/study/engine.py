@@ -48,7 +48,7 @@ from typing import TYPE_CHECKING, Any
 from ocp.errors import excerpt
 from scenarios.errors import ScenarioError, SweepInterrupted, WorkersCannotStart
 from scenarios.schema.study import scheduler_address
-from scenarios.study.server import SAFE_PATH, SAFE_PATH_MARK
+from scenarios.study.server import SAFE_PATH, SAFE_PATH_MARK, UNSET, USER_PYTHONPATH
 from scenarios.study.spec import load_study, parse_study
 from scenarios.study.store import SweepStore, encode_rows
 from scenarios.study.types import Case, Study
@@ -231,8 +231,12 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
     from multiprocessing import forkserver
     # seen by the server only (it starts now, if not yet): the sweep it dies with, and safe-path mode
     # (the current directory off its sys.path; scenarios.study.server puts the environment back)
+    # and this process's import path as its PYTHONPATH (the cwd's '' left out), so that the server
+    # imports the workbench this process runs (a checkout on sys.path, not another copy installed)
     server_environment = {PARENT_ENVIRONMENT: str(os.getpid()), SAFE_PATH: os.environ.get(SAFE_PATH) or "1",
-                          SAFE_PATH_MARK: "kept" if os.environ.get(SAFE_PATH) else "added"}
+                          SAFE_PATH_MARK: "kept" if os.environ.get(SAFE_PATH) else "added",
+                          "PYTHONPATH": os.pathsep.join(entry for entry in sys.path if entry),
+                          USER_PYTHONPATH: os.environ.get("PYTHONPATH", UNSET)}
     previous = {name: os.environ.get(name) for name in server_environment}
     os.environ.update(server_environment)
     try:

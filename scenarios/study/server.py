@@ -13,7 +13,10 @@ does not exist (Python 3.10: the packages the workbench imports after this modul
 the sweep's own process finds them; a ``scenarios.py`` there still shadows the package this module
 is in).
 
-The workers themselves take the sweep's ``sys.path`` and working directory when they start
+The server is also given the sweep's own ``sys.path`` as its ``PYTHONPATH`` (``''``, the current
+directory, left out): it imports the workbench the sweep runs (a checkout the sweep found first, a
+notebook's ``sys.path.insert``), not another copy installed. The workers themselves take the
+sweep's ``sys.path`` and working directory when they start
 (``multiprocessing``'s own preparation): a plugin module found by the sweep's process
 (``SLEWBENCH_PLUGINS``, an entry point) is found by its workers, and relative paths resolve as
 they do in the sweep. What this module changes in the server's environment is put back before
@@ -26,7 +29,7 @@ from __future__ import annotations
 import os
 import sys
 
-__all__ = ["SAFE_PATH", "SAFE_PATH_MARK", "isolate_import_path"]
+__all__ = ["SAFE_PATH", "SAFE_PATH_MARK", "UNSET", "USER_PYTHONPATH", "isolate_import_path"]
 
 SAFE_PATH = "PYTHONSAFEPATH"
 """Python's environment variable of safe-path mode (``-P``): no directory of the script or of
@@ -34,6 +37,13 @@ SAFE_PATH = "PYTHONSAFEPATH"
 SAFE_PATH_MARK = "SLEWBENCH_SAFE_PATH"
 """Set while a sweep starts its fork server: ``added`` when the sweep set :data:`SAFE_PATH` for it
 (it is taken out of the server's environment again), ``kept`` when the user had set it."""
+
+
+USER_PYTHONPATH = "SLEWBENCH_USER_PYTHONPATH"
+"""Set while a sweep starts its fork server: the user's ``PYTHONPATH`` (or :data:`UNSET`), which the
+server puts back (the sweep gives the server its own ``sys.path`` as ``PYTHONPATH``)."""
+UNSET = "<unset>"
+"""The value of :data:`USER_PYTHONPATH` when the user had no ``PYTHONPATH``."""
 
 
 def isolate_import_path() -> None:
@@ -47,6 +57,11 @@ def isolate_import_path() -> None:
         return
     if mark == "added":
         os.environ.pop(SAFE_PATH, None)
+    user = os.environ.pop(USER_PYTHONPATH, UNSET)
+    if user == UNSET:
+        os.environ.pop("PYTHONPATH", None)
+    else:
+        os.environ["PYTHONPATH"] = user
     sys.path[:] = [entry for entry in sys.path if entry != ""]
 
 
