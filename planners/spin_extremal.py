@@ -18,6 +18,7 @@ A vectorised multi-start over branches of ``K T``, over ``β`` and over ``c`` se
 """
 from __future__ import annotations
 
+import copy
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from typing import Annotated, Any
@@ -31,6 +32,7 @@ from ocp.errors import InvalidOption
 from ocp.nlp.solve import solve_multistart, solver_options
 from ocp.options import Range
 from planners.base import Planner
+from planners.conformance import ATTITUDE_TOLERANCE
 from planners.problem import Array, ManeuverProblem
 from planners.reference import FailedReference, Reference, ReferenceSample
 
@@ -245,6 +247,8 @@ class SpinExtremalPlanner(Planner):
     name = "spin_extremal"
     example_options = ({}, {"weight": 0.1})
     cheap = True
+    _start = False
+    """Set on the copy :meth:`plan_start` plans with: a start that misses the target is returned."""
 
     @dataclass(frozen=True)
     class Options:
@@ -342,12 +346,16 @@ class SpinExtremalPlanner(Planner):
         Reference
             As :meth:`~planners.base.Planner.plan_start` on ``problem`` with ``omegaf = None``.
         """
-        if problem.omegaf is None:
-            return super().plan_start(problem)
-        # the freed problem is a new ManeuverProblem with a model of its own: build into this
-        # problem's cache, or every start would build the extremal's NLP again (25 ms a plan)
-        planner = self.with_cache(self.solver_cache(problem))
-        return Planner.plan_start(planner, replace(problem, omegaf=None))
+        # a start that misses the target (a local minimum of J1) still starts the other method
+        # well: it is returned, not refused as a row's would be (_plan)
+        planner = copy.copy(self)  # with_cache may return self: the flag is the copy's alone
+        if problem.omegaf is not None:
+            # the freed problem is a new ManeuverProblem with a model of its own: build into this
+            # problem's cache, or every start would build the extremal's NLP again (25 ms a plan)
+            planner.cache = self.solver_cache(problem)
+            problem = replace(problem, omegaf=None)
+        planner._start = True
+        return Planner.plan_start(planner, problem)
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         moments = np.diag(problem.spacecraft.inertia).copy()
@@ -376,6 +384,11 @@ class SpinExtremalPlanner(Planner):
         message = (f"r={params.r:.6g} c={params.c:.4g} beta={params.beta:.6g}; J1={stats['J1']:.3g} "
                    f"J2={stats['J2']:.4g}; torque amplitudes {np.array2string(amplitudes, precision=4)} N m")
         soft_target = self.options.weight > 0 or self.options.parameters is not None
+        miss = float(quat.error_angle(q_end, target))
+        if not soft_target and miss > ATTITUDE_TOLERANCE and not self._start:  # a condition, not a cost: a local minimum
+            return FailedReference(self.name, f"the best of {self.options.starts} starts ends {np.rad2deg(miss):.3g} deg "
+                                   f"from the target (J1 = {stats['J1']:.3g}, a local minimum of the attitude cost); "
+                                   f"raise planners[].options.starts (up to 50)", stats=stats)
         free = ("omega0", "omegaf") + (("qf",) if soft_target else ())
         return SpinExtremalReference(problem.q0, v, params, T, moments, message, stats, free)
 
