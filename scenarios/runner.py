@@ -131,7 +131,8 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
         if where is None:  # the simulator's own code: an internal error
             raise
         traceback.print_exc()  # the law's bug fails its row, not the others
-        row.status, row.message = "failed", f"simulation: {where[0]} raised {type(error).__name__} at t = {where[1]:g} s: {error}"
+        when = "in reset" if where[1] is None else f"at t = {where[1]:g} s"
+        row.status, row.message = "failed", f"simulation: {where[0]} raised {type(error).__name__} {when}: {error}"
         return
     finally:
         row.simulate_time_s = time.perf_counter() - start

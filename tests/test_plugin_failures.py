@@ -87,10 +87,12 @@ class _PD(Controller):
     class Options:
         kp: Annotated[float, Range(ge=0.0)] = 0.5
         kd: Annotated[float, Range(ge=0.0)] = 1.0
-        defect: Literal["none", "nan", "raise"] = "none"
+        defect: Literal["none", "nan", "raise", "reset", "array"] = "none"
 
     def reset(self, spacecraft: Any, sample_time: float, target: Any = None) -> None:
         super().reset(spacecraft, sample_time, target)
+        if self.options.defect == "reset":
+            raise KeyError("simulated crash in reset")
         self.K = self.options.kp * spacecraft.inertia
         self.D = self.options.kd * spacecraft.inertia
 
@@ -102,6 +104,8 @@ class _PD(Controller):
             u = u * np.nan
         if t >= 20.0 and self.options.defect == "raise":
             raise ValueError("simulated crash in the law")
+        if self.options.defect == "array":
+            return u  # a torque array, not a Command
         return self.allocate(u, measurement)
 
     def symbolic_error(self) -> str | None:
@@ -186,6 +190,24 @@ def test_a_reference_that_misses_the_target_fails_its_row_without_a_final_requir
     message = rows["short"]["message"]
     assert message.startswith("test_cubic: q(T = 60 s) = ") and "but the problem asks qf = " in message
     assert "(error 0.157 rad > 2e-05)" in message  # 9 deg
+
+
+def test_a_law_whose_reset_raises_or_that_returns_no_command_fails_its_rows_only(registered: None,
+                                                                                 tmp_path: Path) -> None:
+    # before: "internal error", exit 1, nothing written (a reviewer, 2026-12-02)
+    path = _scenario(tmp_path, planners="""\
+  - {name: test_cubic, label: cubic}""", controllers="""\
+  - {name: test_pd, label: reset, options: {defect: reset}}
+  - {name: test_pd, label: array, options: {defect: array}}
+  - {name: test_pd, label: pd}""")
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    rows = _rows(out)
+    assert rows["cubic / pd"]["status"] == "ok"
+    assert rows["cubic / reset"]["message"] == "simulation: test_pd raised KeyError in reset: 'simulated crash in reset'"
+    assert rows["cubic / array"]["message"].startswith(
+        "simulation: test_pd raised TypeError at t = 0 s: the law returned ndarray, not an ocp.Command")
+    assert rows["cubic / reset"]["status"] == rows["cubic / array"]["status"] == "failed"
 
 
 def test_a_law_that_raises_or_returns_nan_fails_its_rows_only(registered: None, tmp_path: Path,

@@ -650,7 +650,11 @@ class Simulator:
             raise SimulationError(f"the magnetic field is tabulated up to t = {valid_until:g} s, the run lasts "
                                   f"{duration:g} s; lengthen environment.magnetic_field.span_s")
         field_rate = self._field_rate_numeric if getattr(controller, "needs_field_rate", False) else None
-        controller.reset(model.spacecraft, self.sample_time, target=target)  # the design, also with a plant
+        try:
+            controller.reset(model.spacecraft, self.sample_time, target=target)  # the design, also with a plant
+        except Exception as error:  # the law's own code, as below: marked (no sample time), re-raised
+            setattr(error, _LAW_RAISED, (_controller_name(controller), None))
+            raise
         plant_noise = None if plant is None else plant.draw_noise(noise.seed, n_samples)
         if self._symbolic(controller):
             return self._run_symbolic(controller, x, times, p, noise, rng, reference, field_rng, sensors, plant_noise)
@@ -685,6 +689,9 @@ class Simulator:
                 measurement.field_rate_inertial = field_rate(t_k).copy()
             try:
                 command = controller(t_k, measurement, reference)
+                if not isinstance(command, Command):
+                    raise TypeError(f"the law returned {type(command).__name__}, not an ocp.Command "
+                                    f"(Controller.allocate(torque, measurement) makes one from a body torque)")
             except Exception as error:  # the law's own code: marked for law_raised, re-raised unchanged
                 setattr(error, _LAW_RAISED, (_controller_name(controller), t_k))
                 raise
@@ -872,7 +879,7 @@ _LAW_RAISED = "_slewbench_law_raised"
 """The attribute :meth:`Simulator.run` sets on an exception a controller's law raised."""
 
 
-def law_raised(error: BaseException) -> tuple[str, float] | None:
+def law_raised(error: BaseException) -> tuple[str, float | None] | None:
     """Whether ``error`` came out of a controller's law in :meth:`Simulator.run`, and where.
 
     A caller running several laws (``slewbench run``) fails the row of a law that raises and runs
@@ -885,9 +892,10 @@ def law_raised(error: BaseException) -> tuple[str, float] | None:
 
     Returns
     -------
-    tuple of (str, float) or None
+    tuple of (str, float or None) or None
         The controller's registry name (its class's name when it has none) and the sample time
-        [s] of the call that raised; None when the law did not raise ``error``.
+        [s] of the call that raised (None: its ``reset``; a call that returned no ``Command``
+        raises a ``TypeError`` there); None when the law did not raise ``error``.
     """
     where = getattr(error, _LAW_RAISED, None)
     return where if isinstance(where, tuple) else None
