@@ -173,6 +173,10 @@ def test_a_sweep_whose_cases_crashed_says_so_and_exits_nonzero(tmp_path: Path) -
     assert resume in stderr, stderr
     found = rows(user / "out" / "cases.csv")  # the tables are written all the same
     assert [r["status"] for r in found] == ["crashed", "crashed"], found
+    report = slewbench(tmp_path, user, "sweep", "--report", "out", "--no-plots")  # a redraw says so too
+    stdout, stderr = report.communicate(timeout=120)
+    assert report.returncode == EXIT_OK, stdout + stderr
+    assert "from 2 stored case(s) (2 crashed: no result; `--resume` runs them again); 0 missing" in stdout, stdout
 
 
 def test_the_fork_server_module_takes_the_current_directory_off_its_path(monkeypatch) -> None:

@@ -68,7 +68,10 @@ def command_report(args: argparse.Namespace) -> int:
     results, _ = stored_results(out)
     earlier = written_files(out)
     files = results.write(out, plots=not args.no_plots)
-    print(f"redrew {out}/ ({', '.join(files)}) from {len(results.records)} stored case(s); {results.missing} missing")
+    crashed = sum(record.get("status") == "crashed" for record in results.records.values())
+    print(f"redrew {out}/ ({', '.join(files)}) from {len(results.records)} stored case(s)"
+          + (f" ({crashed} crashed: no result; `--resume` runs them again)" if crashed else "")
+          + f"; {results.missing} missing")
     _say_removed(out, earlier)
     return EXIT_OK
 
