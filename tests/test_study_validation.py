@@ -263,3 +263,16 @@ def test_the_documented_example_studies_expand_as_before():
     strata = np.floor(stats.norm.cdf(errors / 1.0) * 1000).astype(int)  # one sample per stratum and axis
     assert all(sorted(strata[:, k]) == list(range(1000)) for k in range(3))
     assert math.isclose(float(np.std(errors)), 1.0, rel_tol=0.05)
+
+
+def test_an_initial_attitude_error_too_large_to_rotate_by_is_refused_by_its_reader():
+    # hypothesis (2026-12-02): [0, 0, 7.7e155] deg overflowed the rotation vector's norm (inf: a NaN
+    # attitude), which the whole loader refused at maneuver.initial.q (a two-wheel law's check) and the
+    # study's per-key reader let through
+    data = copy.deepcopy(BASE)
+    data.setdefault("simulation", {})["initial_attitude_error_deg"] = [0.0, 0.0, 7.682108069077478e155]
+    with pytest.raises(ScenarioError) as error:
+        scenarios.parse_scenario(data)
+    assert error.value.path == "simulation.initial_attitude_error_deg"
+    data["simulation"]["initial_attitude_error_deg"] = [0.0, 0.0, 370.0]  # a turn and 10 deg: accepted
+    scenarios.parse_scenario(data)

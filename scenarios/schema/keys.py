@@ -24,6 +24,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal, Union
 
+import numpy as np
+
 from ocp.errors import excerpt
 from ocp.options import Range, numeric_leaves, option_fields
 from scenarios.schema.node import Node
@@ -331,8 +333,8 @@ def choice(name: str, meaning: str, choices: tuple[str, ...] | Mapping[str, Any]
 
 
 def vector(name: str, meaning: str, size: int, *, unit: str = "", default: Any = REQUIRED,
-           nullable: bool = False) -> Key:
-    """A list of ``size`` finite numbers.
+           nullable: bool = False, magnitude: float | None = None) -> Key:
+    """A list of ``size`` finite numbers (each at most ``magnitude`` in absolute value).
 
     Parameters
     ----------
@@ -346,19 +348,22 @@ def vector(name: str, meaning: str, size: int, *, unit: str = "", default: Any =
         Value when missing.
     nullable : bool, optional
         Accept ``null`` (read as ``None``).
+    magnitude : float or None, optional
+        The largest absolute value of an entry; ``None`` (default): any finite number.
 
     Returns
     -------
     Key
         Reading a ``(size,)`` float array (or ``None``).
     """
-    if nullable:
-        def read(node: Node) -> Any:
-            return node.optional_vector(size)
-    else:
-        def read(node: Node) -> Any:
-            return node.vector(size)
-    return Key(name, f"list of {size} numbers" + (" or null" if nullable else ""), meaning, read, unit, default)
+    def read(node: Node) -> Any:
+        value = node.optional_vector(size) if nullable else node.vector(size)
+        if magnitude is not None and value is not None and np.any(np.abs(value) > magnitude):
+            raise node.error(f"expected entries within ±{magnitude:g}, got {np.asarray(value).tolist()}")
+        return value
+
+    return Key(name, f"list of {size} numbers" + (" or null" if nullable else ""), meaning, read, unit, default,
+               bounds="" if magnitude is None else f"each within ±{magnitude:g}")
 
 
 def quaternion(name: str, meaning: str, *, nullable: bool = False) -> Key:

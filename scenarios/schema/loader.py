@@ -396,7 +396,7 @@ SIMULATION = Section((
            "reference continues as the torque-free motion of its final state.", unit="s", default=None,
            positive=True, nullable=True),
     vector("initial_attitude_error_deg", "Rotation vector applied to the true initial attitude, body axes.", 3,
-           unit="deg", default=[0.0, 0.0, 0.0]),
+           unit="deg", default=[0.0, 0.0, 0.0], magnitude=1e6),
     vector("initial_rate_error", "Added to the true initial body rate, body frame.", 3, unit="rad/s",
            default=[0.0, 0.0, 0.0]),
     mapping("sensor_noise", "Measurement noise.", SENSOR_NOISE, default={}),
