@@ -108,7 +108,7 @@ def finite_check_times(reference: Reference, points: int = FINITE_SAMPLES) -> Ar
     return np.unique(np.concatenate([np.linspace(0.0, T, points), inside, T * np.array([1.05, 1.3, 2.0])]))
 
 
-def check_finite(reference: Reference, points: int = FINITE_SAMPLES) -> None:
+def check_finite(reference: Reference, points: int = FINITE_SAMPLES, after_end: bool = True) -> None:
     """Every quantity is finite and every ``q`` a unit quaternion, on a dense grid of ``[0, T]``
     (:func:`finite_check_times`) and after T.
 
@@ -122,6 +122,9 @@ def check_finite(reference: Reference, points: int = FINITE_SAMPLES) -> None:
     points : int, optional
         Uniform times on ``[0, T]`` (default :data:`FINITE_SAMPLES`; a caller that screens many
         references, such as collocation's seeds, takes fewer).
+    after_end : bool, optional
+        Also sample the continuation after T (default; a start for another method is read on
+        ``[0, T]`` only, and its torque-free coast after T is integrated numerically).
 
     Raises
     ------
@@ -135,7 +138,7 @@ def check_finite(reference: Reference, points: int = FINITE_SAMPLES) -> None:
                                f"positive number of seconds")
     times = finite_check_times(reference, points)
     # [0, T] first: the continuation after T starts from the state at T, which must be finite.
-    for part in (times[times <= T], times[times > T]):
+    for part in (times[times <= T], times[times > T]) if after_end else (times[times <= T],):
         try:
             sample = reference.sample(part)
         except (TypeError, ValueError) as error:  # the contract's shape checks (Reference.sample)

@@ -43,6 +43,8 @@ class _CycloidReference(Reference):
             q = np.where(((t > 0.517 * self.duration) & (t < 0.522 * self.duration))[:, None], np.nan, q)
         elif self.defect == "raise" and np.any(t > 0.5 * self.duration):
             raise RuntimeError("simulated crash inside _evaluate")
+        elif self.defect == "after_end" and np.any(t > self.duration):
+            raise RuntimeError("sampled after T")
         return ReferenceSample(q, omega, omega_dot, inverse_dynamics_torque(self.inertia, omega, omega_dot))
 
 
@@ -97,3 +99,12 @@ def test_a_candidate_with_a_nan_is_no_feasible_slew():
     assert broken.get("not finite", 0) > 0, broken
     clean = _CycloidReference(problem, "none")
     assert start_violations(problem, clean, variable_bounds(problem, None, 1.0), None, (), 601, 1e-6, 1e-6) == {}
+
+
+def test_a_start_is_read_on_its_duration_only(monkeypatch):
+    # The screening samples [0, T], where a start is read: sampling after T integrated the torque-free
+    # coast of every start (scipy, per start) and tripled the spin case's plan time (73 -> 200 ms)
+    monkeypatch.setitem(PLANNERS, "bad_seed", _bad_seed_planner("after_end"))
+    reference = PLANNERS["collocation"]({"intervals": 30}).plan(_problem())
+    assert reference.ok, reference.message
+    assert not any(entry.startswith("bad_seed") for entry in reference.stats["seeds"]["skipped"])

@@ -493,7 +493,7 @@ class CollocationPlanner(Planner):
                     failures.append(f"{name}: {reference.message}")
                 continue
             try:  # a seed with a NaN would reach the solver (a plugin's reference, say), where it can hang
-                check_finite(reference, SEED_CHECK_POINTS)
+                check_finite(reference, SEED_CHECK_POINTS, after_end=False)
             except ConformanceError as error:
                 if failures is not None:
                     failures.append(f"{name}: {error}")
