@@ -28,7 +28,7 @@ from scenarios.study.report import (
     robustness_tables,
     summary_table,
 )
-from tests.test_study_summary_failed import BASE, InlineExecutor
+from tests.test_study_summary_failed import BASE, InlineExecutor, task_for
 
 # per case: (row status, cl.int_u, cl.settling_time_s, cl.final_error_deg). Case 3 (failed) and case 5
 # (infeasible) carry values that would meet the settling threshold and rank first; case 4 crashed.
@@ -36,20 +36,6 @@ GIVEN: list[tuple[str, float | None, float | None, float | None]] = [
     ("ok", 1.0, 10.0, 0.01), ("violated", 2.0, None, 2.0), ("ok", 4.0, 20.0, 0.02),
     ("failed", 100.0, 5.0, 5.0), ("crashed", None, None, None), ("infeasible", 0.5, 5.0, 0.01)]
 KD = "controller.options.kd"
-
-
-def task_for(study: scenarios.Study) -> Any:
-    by_key = {case.key: GIVEN[case.index] for case in study.cases}
-
-    def task(payload: dict[str, Any]) -> dict[str, Any]:
-        status, int_u, settling, error = by_key[payload["key"]]
-        closed = None if int_u is None else {"int_u": int_u, "settling_time_s": settling, "final_error_deg": error}
-        row = {"label": "smooth", "planner": "eigenaxis", "controller": "augmented_quaternion_feedback",
-               "status": status, "message": "timed out" if status == "crashed" else "",
-               "plan_time_s": None if status == "crashed" else 0.1, "reference": None, "closed_loop": closed}
-        return {"key": payload["key"], "status": "crashed" if status == "crashed" else "ok", "rows": [row],
-                "elapsed_s": 0.0, "cpu_s": 0.0, "worker_cpu_s": 0.0, "worker": "here:0", "cache_builds": 0}
-    return task
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +46,7 @@ def swept(tmp_path_factory: pytest.TempPathFactory) -> tuple[scenarios.Study, An
         "summary": ["cl.int_u", "cl.settling_time_s"],
         "robustness": {"thresholds": {"cl.settling_time_s": 12.0, "cl.int_u": {"at_least": 1.5}}, "worst": 2}})
     assert [case.index for case in study.cases] == list(range(len(GIVEN)))
-    results = scenarios.sweep(study, InlineExecutor(), workers=1, task=task_for(study))
+    results = scenarios.sweep(study, InlineExecutor(), workers=1, task=task_for(study, GIVEN))
     out = tmp_path_factory.mktemp("robust-failed") / "out"
     results.write(out, plots=False)
     return study, results, out

@@ -53,8 +53,9 @@ class InlineExecutor(Executor):
         return future
 
 
-def task_for(study: scenarios.Study) -> Any:
-    by_key = {case.key: GIVEN[case.index] for case in study.cases}
+def task_for(study: scenarios.Study, given: list[tuple[str, float | None, float | None, float | None]] = GIVEN) -> Any:
+    """A sweep task returning, for case i, one row with ``given[i]``'s status and closed-loop metrics."""
+    by_key = {case.key: given[case.index] for case in study.cases}
 
     def task(payload: dict[str, Any]) -> dict[str, Any]:
         status, int_u, settling, error = by_key[payload["key"]]
