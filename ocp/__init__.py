@@ -49,6 +49,7 @@ from ocp.metrics import (
                         metric_violations,
                         metrics_from_reference,
                         metrics_from_simulation,
+                        target_motion,
 )
 from ocp.simulation.simulator import SensorNoise, SimulationResult, Simulator
 
@@ -57,7 +58,7 @@ __all__ = [
     "InvalidOption", "KeplerianOrbit", "METRIC_KEYS", "Magnetorquers", "Measurement", "ModelError", "OptionsError",
     "ReactionWheels", "SensorNoise", "SimulationError", "SimulationResult", "Simulator", "SlewbenchError",
     "SolverCache", "Spacecraft", "TLEOrbit", "TiltedDipole", "Torquers", "compute_metrics", "gravity_gradient_torque",
-    "metric_violations", "metrics_from_reference", "metrics_from_simulation",
+    "metric_violations", "metrics_from_reference", "metrics_from_simulation", "target_motion",
 ]
 
 

@@ -76,9 +76,12 @@ METRIC_INFO: dict[str, MetricInfo] = {
         "with ``spacecraft.wheels.max_torque``); null without wheels and for a reference."),
     "final_error_deg": MetricInfo(
         "deg", "Error angle 2 acos|q_e0| (``q_e = q_f* ⊗ q``) between the attitude at the last sample and "
-        "the target ``q_f``; null when the final attitude is free."),
+        "the target ``q_f``; in closed loop, where the manoeuvre ends turning (``ω_f ≠ 0``), the "
+        "target after T is the reference's own motion from ``(q_f, ω_f)`` (``ocp.metrics.target_motion``); "
+        "null when the final attitude is free."),
     "final_rate_error": MetricInfo(
-        "rad/s", "‖ω(t_N) − ω_f‖ at the last sample; null when the final rate is free."),
+        "rad/s", "‖ω(t_N) − ω_f‖ at the last sample (``ω_f`` the target's rate there, as for "
+        "``final_error_deg``); null when the final rate is free."),
     "rms_error_deg": MetricInfo(
         "deg", "Closed loop with a reference: √(mean over the samples of e_k²), e_k the error angle between "
         "the attitude and the reference attitude at t_k; null for a reference and in regulation."),
@@ -86,7 +89,8 @@ METRIC_INFO: dict[str, MetricInfo] = {
         "deg", "Closed loop with a reference: max over the samples of e_k (as for ``rms_error_deg``); null for a "
         "reference and in regulation."),
     "settling_time_s": MetricInfo(
-        "s", "t_(j+1) for the last sample j whose error angle to ``q_f`` exceeds the band "
+        "s", "t_(j+1) for the last sample j whose error angle to ``q_f`` (the target, as for "
+        "``final_error_deg``) exceeds the band "
         "(``simulation.settling_tolerance_deg``, default 0.5°); 0 if no sample does; null if the last "
         "sample does, or when the final attitude is free.", null_worst_when="final_error_deg"),
     "saturation_fraction": MetricInfo(
@@ -266,10 +270,12 @@ def compute_metrics(
         Torque of the integrals ``int_u2``, ``int_u``, ``int_abs_u`` [N m], body axes: held over
         each interval (closed loop: the applied actuator torque, zero-order hold), or sampled at
         ``t`` (a reference's feed-forward, trapezoids).
-    target_q : (4,) array_like or None
-        The manoeuvre's final attitude; ``None``: free (attitude metrics null).
-    target_omega : (3,) array_like or None, optional
-        The manoeuvre's final body rate [rad/s]; ``None``: free (``final_rate_error`` null).
+    target_q : (4,) or (N+1, 4) array_like or None
+        The manoeuvre's final attitude, or the target's attitude at each of ``t`` (a target that
+        moves: :func:`target_motion`); ``None``: free (attitude metrics null).
+    target_omega : (3,) or (N+1, 3) array_like or None, optional
+        The manoeuvre's final body rate [rad/s], or the target's at each of ``t``; ``None``: free
+        (``final_rate_error`` null).
     reference_q : (N+1, 4) array_like or None, optional
         Reference attitude at ``t`` for ``rms_error_deg`` and ``max_error_deg`` (closed loop).
     wheel_momentum : (N+1, n_w) array_like or None, optional
@@ -332,7 +338,7 @@ def compute_metrics(
         "peak_wheel_torque": _peak(wheel_torque, None),
         "final_error_deg": None if error_to_target is None else float(error_to_target[-1]),
         "final_rate_error": None if target_omega is None
-        else float(np.linalg.norm(np.asarray(omega)[-1] - np.asarray(target_omega, dtype=float))),
+        else float(np.linalg.norm(np.asarray(omega)[-1] - np.asarray(target_omega, dtype=float).reshape(-1, 3)[-1])),
         "rms_error_deg": None,
         "max_error_deg": None,
         "settling_time_s": settling,
@@ -377,6 +383,51 @@ def compute_metrics(
                                     zip(metrics["int_abs_u"], np.sum(np.abs(kicks), axis=0))]
             metrics.update(dict.fromkeys(IMPULSE_INFINITE, float("inf")))
     return metrics
+
+
+def target_motion(target_q: ArrayLike | None, target_omega: ArrayLike | None, reference: Any,
+                  t: ArrayLike) -> tuple[NDArray | None, NDArray | None]:
+    """Where the manoeuvre's target is at each time: the attitude and body rate the final-state
+    metrics and the ``final`` requirement measure a motion against.
+
+    A manoeuvre that ends at rest (``ω_f = 0`` or free) has a fixed target: ``q_f`` (and ``ω_f``)
+    at every time. One that ends turning (``ω_f ≠ 0``) cannot be held at ``q_f``: after its end
+    ``T`` the target is where its final state goes, the reference's own motion after ``T`` (its
+    torque-free coast from ``(q_f, ω_f)``, which the closed loop tracks; the runner fails a
+    reference that misses ``(q_f, ω_f)`` at ``T``); until ``T`` it is ``(q_f, ω_f)``.
+    Without a reference (regulation) the target is fixed.
+
+    Parameters
+    ----------
+    target_q : (4,) array_like or None
+        ``q_f`` (scalar first, body to inertial); ``None``: free.
+    target_omega : (3,) array_like or None
+        ``ω_f`` [rad/s], body axes; ``None``: free.
+    reference : planners.Reference or None
+        The row's reference (``sample(t)`` and ``duration``); ``None``: regulation.
+    t : (N,) array_like
+        Times [s].
+
+    Returns
+    -------
+    q : (N, 4) ndarray or None
+        The target attitude at ``t`` (``None`` when ``q_f`` is free).
+    omega : (N, 3) ndarray or None
+        The target body rate at ``t`` [rad/s], body axes of the target attitude (``None`` when
+        ``ω_f`` is free).
+    """
+    t = np.asarray(t, dtype=float)
+    q = None if target_q is None else np.tile(np.asarray(target_q, dtype=float), (t.size, 1))
+    omega = None if target_omega is None else np.tile(np.asarray(target_omega, dtype=float), (t.size, 1))
+    if omega is None or reference is None or not np.any(omega[:1] != 0.0):
+        return q, omega
+    after = t > reference.duration
+    if np.any(after):
+        coast = reference.sample(t[after])
+        if q is not None:
+            q[after] = coast.q
+        omega[after] = coast.omega
+    return q, omega
 
 
 def _check_targets(function: str, target_q: Any, target_omega: Any) -> None:
@@ -428,8 +479,10 @@ def metrics_from_simulation(
     target_omega : (3,) array_like or None, optional
         The manoeuvre's final body rate [rad/s]; ``None``: free.
     reference : object or None, optional
-        Anything with a vectorised ``q(t)`` (a planner's reference): gives ``rms_error_deg`` and
-        ``max_error_deg``; ``None`` (regulation): those are null.
+        A planner's reference (vectorised ``q(t)``, ``sample(t)``, ``duration``): gives
+        ``rms_error_deg`` and ``max_error_deg``, and the target's motion after ``T`` when the
+        manoeuvre ends turning (:func:`target_motion`); ``None`` (regulation): those are null and
+        the target is fixed.
     plan_time_s : float or None, optional
         Wall time of the planner [s].
     duration_s : float or None, optional
@@ -456,6 +509,7 @@ def metrics_from_simulation(
         raise TypeError(f"metrics_from_simulation: result must be an ocp.SimulationResult (Simulator.run), got "
                         f"{type(result).__name__}")
     _check_targets("metrics_from_simulation", target_q, target_omega)
+    target_q, target_omega = target_motion(target_q, target_omega, reference, result.t)
     slices = result.model.control_slices
     dipole = result.applied_u[:, slices["dipole"]] if "dipole" in slices else None
     wheel_torque = result.applied_u[:, slices["wheels"]] if "wheels" in slices else None

@@ -417,7 +417,8 @@ def wheel_axes(axes: np.ndarray) -> tuple[int, ...]:
     return tuple(int(np.argmax(np.abs(a))) if np.max(np.abs(a)) > 1 - 1e-9 else -1 for a in np.asarray(axes).T)
 
 
-def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = EULER_SEQUENCE) -> RowSeries:
+def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = EULER_SEQUENCE,
+               target_omega: Any = None) -> RowSeries:
     """The curves of a simulated row, decimated to the per-row figure's panels.
 
     Parameters
@@ -430,6 +431,10 @@ def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = E
         The simulated spacecraft: its actuators fix the actuator panels and their limit lines.
     euler_sequence : str, optional
         The Euler angles' sequence (:func:`euler_angles`); default :data:`EULER_SEQUENCE`.
+    target_omega : (3,) array_like or None, optional
+        The manoeuvre's final body rate [rad/s]: where it is not zero the error to the target is
+        measured, after ``T``, to where the target has turned (:func:`ocp.metrics.target_motion`,
+        as the metrics do).
 
     Returns
     -------
@@ -437,7 +442,7 @@ def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = E
         What :class:`scenarios.output.plots.RowFigure` draws.
     """
     # the model's helpers, in the process that ran it (module docstring)
-    from ocp import quat
+    from ocp import quat, target_motion
     from ocp.dynamics.layout import control_layout
 
     sim = row.simulation
@@ -493,7 +498,9 @@ def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = E
                                  for values in (ref.torque, DEG_PER_RAD * ref.omega, ref_q, ref_euler))
         series.to_reference = curve(np.maximum(np.rad2deg(quat.error_angle(sim.q, ref.q)), FLOOR_DEG))
     if with_target:
-        series.to_target = curve(np.maximum(np.rad2deg(quat.error_angle(sim.q, target_q)), FLOOR_DEG))
+        targets = target_motion(target_q, target_omega, row.reference, t)[0]
+        assert targets is not None  # with_target
+        series.to_target = curve(np.maximum(np.rad2deg(quat.error_angle(sim.q, targets)), FLOOR_DEG))
     if not with_reference and not with_target:  # rate regulation (detumbling): the rate converges
         series.rate_norm = curve(DEG_PER_RAD * np.maximum(np.linalg.norm(sim.omega, axis=1), FLOOR_RATE))
         series.rate_max = curve(DEG_PER_RAD * np.maximum(np.abs(sim.omega).max(axis=1), FLOOR_RATE))
@@ -587,7 +594,7 @@ def overlay_series(results: Any) -> OverlaySeries:
         What :func:`scenarios.output.plots.draw_overlay` draws.
     """
     # the model's helpers, in the process that ran it (module docstring)
-    from ocp import quat
+    from ocp import quat, target_motion
 
     problem = results.scenario.problem
     target_q, target_omega = problem.qf, problem.omegaf
@@ -601,10 +608,11 @@ def overlay_series(results: Any) -> OverlaySeries:
         if row.simulation is None:
             continue
         sim = row.simulation
-        if target_q is not None:
-            error = np.rad2deg(quat.error_angle(sim.q, target_q))
-        elif target_omega is not None:
-            error = DEG_PER_RAD * np.linalg.norm(sim.omega - target_omega, axis=1)
+        targets, target_rates = target_motion(target_q, target_omega, row.reference, sim.t)  # as the metrics
+        if targets is not None:
+            error = np.rad2deg(quat.error_angle(sim.q, targets))
+        elif target_rates is not None:
+            error = DEG_PER_RAD * np.linalg.norm(sim.omega - target_rates, axis=1)
         else:
             error = DEG_PER_RAD * np.linalg.norm(sim.omega, axis=1)
 
@@ -1187,7 +1195,8 @@ def row_job(row: Any, stem: str, scenario: Any, euler_sequence: str | None = Non
     if row.simulation is None:
         return None
     problem = scenario.problem
-    return f"{stem}.png", row_series(row, problem.qf, problem.spacecraft, _euler_sequence(scenario, euler_sequence))
+    return f"{stem}.png", row_series(row, problem.qf, problem.spacecraft, _euler_sequence(scenario, euler_sequence),
+                                        problem.omegaf)
 
 
 def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str | None = None,

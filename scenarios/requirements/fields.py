@@ -126,11 +126,13 @@ _RATE = (
 _FINAL = (
     RequirementField(
         "final", "worst_error_deg", "deg", "worst final error",
-        "From ``T + after_s`` to the end: the largest error angle to ``maneuver.final.q``, between the "
-        "samples too (the attitude interpolated as for pointing).", ("cl",)),
+        "From ``T + after_s`` to the end: the largest error angle to ``maneuver.final.q`` (where the "
+        "manoeuvre ends turning, to the target's motion after T: ``ocp.metrics.target_motion``), between "
+        "the samples too (the attitude interpolated as for pointing).", ("cl",)),
     RequirementField(
         "final", "worst_rate_error", "rad/s", "worst final rate error",
-        "From ``T + after_s`` to the end: the largest ‖ω − ω_f‖ (**at the samples only**).", ("cl",)),
+        "From ``T + after_s`` to the end: the largest ‖ω − ω_f‖ (ω_f the target's rate, as for the "
+        "error; **at the samples only**).", ("cl",)),
     RequirementField(
         "final", "from_s", "s", "final window start",
         "Where that stretch starts, ``T + after_s`` (T: the reference's duration).", ("cl",)),

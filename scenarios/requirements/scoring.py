@@ -29,7 +29,9 @@ and what breaks it in words. The fields (their units, words and definitions are 
 * ``rate``: ``peak_rate`` [rad/s] (of ``‖ω‖``), ``peak_time_s``, ``ratio`` (over the bound);
 * ``final`` (closed loop only): ``worst_error_deg`` from ``T + after_s`` to the end, between the
   samples too (:func:`worst_error_between_samples`, on the attitude interpolated as for pointing),
-  ``worst_rate_error`` [rad/s] over the samples from then on, and ``from_s``.
+  ``worst_rate_error`` [rad/s] over the samples from then on, and ``from_s``; to ``(q_f, ω_f)``,
+  or, where the manoeuvre ends turning (``ω_f ≠ 0``), to where its final state goes after ``T``
+  (:func:`ocp.metrics.target_motion`: the reference's own coast, which the closed loop tracks).
 
 The runner (:mod:`scenarios.runner`) glues this to the rows and turns the scores into statuses and
 messages (:func:`violations`, :func:`unhonoured`).
@@ -51,7 +53,7 @@ from controllers.allocation import (
     reference_demand,
     unrealised_torque,
 )
-from ocp import Spacecraft, quat
+from ocp import Spacecraft, quat, target_motion
 from ocp.geometry.pointing import (
     HermiteMotion,
     PointingConstraint,
@@ -298,7 +300,7 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
 
 
 def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, problem: ManeuverProblem,
-           end_of_manoeuvre: float, motion: HermiteMotion | None = None) -> Score:
+           end_of_manoeuvre: float, motion: HermiteMotion | None = None, reference: Reference | None = None) -> Score:
     start = end_of_manoeuvre + requirement.after_s
     inside = t >= start - 1e-9
     values: dict[str, float | None] = dict(zip(FINAL_FIELDS, (None, None, start)))
@@ -306,16 +308,23 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
         return Score("final", values, False, f"no closed-loop sample from {start:g} s (T + after_s) on; lengthen "
                                              "simulation.duration")
     problems = []
+    target_q, target_omega = target_motion(problem.qf, problem.omegaf, reference, t)
     if problem.qf is not None:
         bound = None if requirement.error_deg is None else float(np.deg2rad(requirement.error_deg))
-        worst_error, when = worst_error_between_samples(t, q, omega, problem.qf, start, bound, motion)
+        if target_q is not None and target_omega is not None and np.any(target_q != problem.qf):  # turning
+            # the error's own motion, q_e = q_target* ⊗ q with body rate ω − R(q_e)ᵀ ω_target, to the identity
+            relative = quat.error(q, target_q, shortest=False)
+            relative_rate = omega - quat.rotate_inverse(relative, target_omega)
+            worst_error, when = worst_error_between_samples(t, relative, relative_rate, quat.IDENTITY, start, bound)
+        else:
+            worst_error, when = worst_error_between_samples(t, q, omega, problem.qf, start, bound, motion)
         worst_deg = float(np.rad2deg(worst_error))
         values["worst_error_deg"] = worst_deg
         if requirement.error_deg is not None and worst_deg > requirement.error_deg * (1 + _TOLERANCE):
             shown, limit = _over(worst_deg, requirement.error_deg)
             problems.append(f"error {shown} deg at {when:.1f} s over {limit} deg")
-    if problem.omegaf is not None:
-        rates = np.linalg.norm(omega[inside] - problem.omegaf, axis=1)
+    if target_omega is not None:
+        rates = np.linalg.norm(omega[inside] - target_omega[inside], axis=1)
         worst = int(np.argmax(rates))
         values["worst_rate_error"] = float(rates[worst])
         if requirement.rate is not None and rates[worst] > requirement.rate * (1 + _TOLERANCE):
@@ -523,7 +532,7 @@ def _environment_torque(problem: ManeuverProblem, t: Array, q: Array, omega: Arr
 
 
 def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: ArrayLike, q: ArrayLike,
-                      omega: ArrayLike, end_of_manoeuvre: float) -> dict[str, Score]:
+                      omega: ArrayLike, end_of_manoeuvre: float, reference: Reference | None = None) -> dict[str, Score]:
     """Score a closed-loop run against every requirement that applies to it: the rate requirement
     and the final rate error on its samples, the pointing requirements and the final error angle
     between them too (the attitude interpolated with the body rates,
@@ -545,6 +554,11 @@ def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: A
     end_of_manoeuvre : float
         T [s]: the reference's duration, the manoeuvre's in regulation (``final`` starts
         ``after_s`` later).
+    reference : planners.Reference or None, optional
+        The row's reference: where the manoeuvre ends turning (``ω_f ≠ 0``), ``final`` measures
+        the error and the rate error to the target's motion after ``T``
+        (:func:`ocp.metrics.target_motion`: the reference's own coast from ``(q_f, ω_f)``);
+        ``None`` (regulation): to ``(q_f, ω_f)``.
 
     Returns
     -------
@@ -560,7 +574,7 @@ def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: A
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, omega)
     if requirements.final is not None:
-        scores["final"] = _final(requirements.final, t, q, omega, problem, end_of_manoeuvre, motion)
+        scores["final"] = _final(requirements.final, t, q, omega, problem, end_of_manoeuvre, motion, reference)
     return scores
 
 
