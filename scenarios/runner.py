@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from controllers.allocation import demand_limits
 from ocp import (
     SimulationError,
     Simulator,
@@ -223,6 +224,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     model = scenario.problem.model
 
     plant = scenario.truth  # the truth model the closed loop integrates (None: the design model)
+    # the actuator requirement holds for the wheels flown: the lesser of the design's and the plant's limits
+    plant_limits = None if plant is None else demand_limits(plant.model.spacecraft)
 
     def build() -> Simulator:
         return Simulator(model, spec.sample_time, spec.integrator, max_step=spec.max_step,
@@ -258,7 +261,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
                 _check_physical(row, "reference", row.reference_metrics)
                 if sampled is not None:
                     scores["reference"] = score_reference(scenario.requirements, scenario.problem, *sampled,
-                                                          controllers[j].controller, reference)
+                                                          controllers[j].controller, reference, plant_limits)
                 _simulate(scenario, simulator, reference, row, controllers[j])
             timing = (f"planned in {(row.plan_time_s or 0.0) * 1e3:.1f} ms, "
                       f"simulated in {row.simulate_time_s:.2f} s")

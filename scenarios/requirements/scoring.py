@@ -38,6 +38,7 @@ messages (:func:`violations`, :func:`unhonoured`).
 """
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -389,7 +390,7 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
 
 def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
                jumps: list[tuple[float, int, Array]] | None = None, unrealised: Array | None = None,
-               torque: Array | None = None) -> Score:
+               torque: Array | None = None, plant_limited: Sequence[str] = ()) -> Score:
     values: dict[str, float | None] = {}
     broken = []
     unscored = []
@@ -415,7 +416,8 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
         if ratio > margin_allowed * (1 + _TOLERANCE):
             shown, limit = _over(ratio, margin_allowed)
             allowed = max(allowed, limit, key=len)
-            broken.append(f"{name} {shown} x its limit at {t[worst]:.1f} s")
+            whose = " (the truth model's, below the design's)" if name in plant_limited else ""
+            broken.append(f"{name} {shown} x its limit{whose} at {t[worst]:.1f} s")
     detail = ", ".join(unscored + ([", ".join(broken) + f" (allowed {allowed} x)"] if broken else []))
     if jumps is not None:
         largest = max(jumps, key=lambda jump: float(np.linalg.norm(jump[2])), default=None)
@@ -447,7 +449,8 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
 
 
 def score_reference(requirements: Requirements, problem: ManeuverProblem, times: ArrayLike, sample: Any,
-                    allocation: Allocation | None, reference: Reference | None = None) -> dict[str, Score]:
+                    allocation: Allocation | None, reference: Reference | None = None,
+                    plant_limits: Mapping[str, Array] | None = None) -> dict[str, Score]:
     """Score a reference, sampled densely, against every requirement that applies to it.
 
     The pointing requirements are scored between the samples too, as the closed loop's are
@@ -476,6 +479,11 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         The reference sampled, for the jumps of its rate at its breakpoints (:func:`rate_jumps`) and
         its attitude at the windows' edges; ``None``: only a jump at the start (against the
         manoeuvre's initial rate) is found, and the edges are interpolated between the samples.
+    plant_limits : mapping of str to ndarray or None, optional
+        The limits of the plant the closed loop flies where it is not the design
+        (:func:`controllers.allocation.demand_limits` of a truth model's spacecraft): each
+        quantity is scored against the lesser of the design's limit and the plant's, element by
+        element, and the message says where the plant's is the lesser; ``None``: the design's.
 
     Returns
     -------
@@ -514,7 +522,15 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         demand = reference_demand(allocation, problem.model, demand_t, q, omega, torque,
                                   problem.wheel_momentum0, jumps=steps, torque_after=after)
         unrealised = unrealised_torque(problem.model, demand_t, q, omega, torque, demand)
-        scores["actuators"] = _actuators(requirements.actuators.allowed, demand, demand_t, jumps, unrealised, torque)
+        lower = []  # the quantities whose plant limits are below the design's
+        if plant_limits is not None:
+            for name, quantity in list(demand.items()):
+                limit = np.minimum(quantity.limit, np.asarray(plant_limits.get(name, quantity.limit), dtype=float))
+                if np.any(limit < quantity.limit):
+                    lower.append(name)
+                    demand[name] = dataclasses.replace(quantity, limit=limit)
+        scores["actuators"] = _actuators(requirements.actuators.allowed, demand, demand_t, jumps, unrealised, torque,
+                                         lower)
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, sample.omega)
     return scores

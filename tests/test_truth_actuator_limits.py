@@ -1,0 +1,66 @@
+"""The actuator requirement holds for the wheels flown: with a truth model, the lesser of the design's
+and the truth's limits.
+
+A fresh-eyes engineer signing off a pyramid slew (2026-12-02) found a row "ok" whose reference asked
+107 % of the truth wheels' momentum (``truth.wheels.max_momentum``) under a 20 % margin, the closed
+loop saturating 11 % of the time: the requirement read the design's limits only.
+
+Oracle: the demand does not depend on the limits (the same reference, the same allocation), so with
+one limit for every wheel each ratio scales exactly by design limit / truth limit; the design-only
+scenario's ratio is the reference.
+"""
+import pytest
+
+import scenarios
+
+DESIGN_MOMENTUM, DESIGN_TORQUE = 4.0, 0.1
+
+
+def _run(truth_wheels=None):
+    data = {
+        "name": "truth-limits",
+        "spacecraft": {"inertia": [19.5, 19.0, 12.6],
+                       "wheels": {"max_torque": DESIGN_TORQUE, "max_momentum": DESIGN_MOMENTUM}},
+        "maneuver": {"duration": 120.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
+                     "final": {"q": [0.7071068, 0.4082483, 0.4082483, 0.4082483], "omega": [0, 0, 0]}},
+        "planners": [{"name": "eigenaxis", "options": {"profile": "smooth"}}],
+        "controller": {"name": "augmented_quaternion_feedback", "options": {"kp": 0.06, "kd": 0.48}},
+        "simulation": {"sample_time": 0.5, "duration": 140.0},
+        "requirements": {"actuators": {"margin": 0.2}},
+    }
+    if truth_wheels is not None:
+        data["truth"] = {"wheels": truth_wheels}
+    (row,) = scenarios.run(scenarios.parse_scenario(data)).rows
+    return row
+
+
+@pytest.fixture(scope="module")
+def design():
+    row = _run()
+    assert row.status == "ok", row.message
+    return row.requirements["reference"]["actuators"]
+
+
+def test_a_truth_wheel_below_the_demand_breaks_the_requirement(design):
+    ratio = design["wheels_momentum"]
+    truth = 0.9 * ratio * DESIGN_MOMENTUM  # the reference asks 1.11x the truth's momentum limit
+    row = _run({"max_momentum": truth})
+    scored = row.requirements["reference"]["actuators"]
+    assert scored["wheels_momentum"] == pytest.approx(ratio * DESIGN_MOMENTUM / truth, rel=1e-9)
+    assert scored["wheels_torque"] == pytest.approx(design["wheels_torque"], rel=1e-12)  # design torque kept
+    assert row.status == "violated"
+    assert "wheels_momentum" in row.message and "truth model's" in row.message
+
+
+def test_a_truth_torque_limit_scales_the_torque_ratio(design):
+    truth = 0.5 * DESIGN_TORQUE
+    row = _run({"max_torque": truth})
+    scored = row.requirements["reference"]["actuators"]
+    assert scored["wheels_torque"] == pytest.approx(design["wheels_torque"] * 2.0, rel=1e-9)
+    assert scored["wheels_momentum"] == pytest.approx(design["wheels_momentum"], rel=1e-12)
+
+
+def test_truth_limits_above_the_design_change_nothing(design):
+    row = _run({"max_torque": 2 * DESIGN_TORQUE, "max_momentum": 2 * DESIGN_MOMENTUM})
+    assert row.requirements["reference"]["actuators"] == design
+    assert row.status == "ok", row.message
