@@ -198,3 +198,33 @@ def test_knowledge_error_metrics(example):
     assert metrics["silent"]["max_knowledge_error_deg"] == 0.0
     assert 0.0 < metrics["mekf"]["final_knowledge_error_deg"] <= metrics["mekf"]["max_knowledge_error_deg"] < 0.2
     assert metrics["gyro only"]["final_knowledge_error_deg"] is None
+
+
+def _with_declared_tracker(boresight_declared, boresight_simulated):
+    data = yaml.safe_load(EXAMPLE.read_text())
+    data["spacecraft"]["sensors"] = {"star_tracker": {"boresight": boresight_declared}}
+    tracker = data["simulation"]["sensors"]["star_tracker"]
+    if boresight_simulated is None:
+        tracker.pop("boresight", None)
+    else:
+        tracker["boresight"] = boresight_simulated
+    return data
+
+
+def test_the_star_tracker_has_one_boresight(tmp_path):
+    """``simulation.sensors.star_tracker`` takes ``spacecraft.sensors.star_tracker``'s boresight (the one
+    the pointing requirements read) when it gives none, and may not give another: a fresh-eyes
+    engineer (2026-12-02) had a keep-out on one boresight and the noise model on another, both
+    accepted without a word."""
+    from scenarios import parse_scenario
+
+    declared = parse_scenario(_with_declared_tracker([1.0, 0.0, 0.0], None)).simulation.sensors.star_tracker
+    np.testing.assert_allclose(declared.boresight / np.linalg.norm(declared.boresight), [1.0, 0.0, 0.0])
+    same = parse_scenario(_with_declared_tracker([1.0, 1.0, 0.0], [0.7071, 0.7071, 0.0])).simulation.sensors
+    np.testing.assert_allclose(same.star_tracker.boresight / np.linalg.norm(same.star_tracker.boresight),
+                               [2 ** -0.5, 2 ** -0.5, 0.0])
+    alone = load(EXAMPLE).simulation.sensors.star_tracker  # no declared sensor: its own, or body z
+    np.testing.assert_allclose(alone.boresight, [0.0, 0.0, 1.0])
+    status, error = validate(tmp_path, _with_declared_tracker([1.0, 0.0, 0.0], [0.0, 0.0, 1.0]))
+    assert status == 2, error
+    assert "simulation.sensors.star_tracker.boresight" in error and "90 deg" in error and "Traceback" not in error

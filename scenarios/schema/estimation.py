@@ -11,6 +11,7 @@ import math
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ocp.estimation import Gyro, Magnetometer, Mekf, SensorSuite, StarTracker
 from scenarios.errors import ScenarioError
@@ -23,6 +24,9 @@ ARCSEC = math.pi / 180.0 / 3600.0
 """One arcsecond in rad."""
 SQRT_HOUR = 60.0
 """√(1 h) in √s."""
+BORESIGHT_AGREEMENT_DEG = 0.01
+"""``simulation.sensors.star_tracker.boresight`` given beside ``spacecraft.sensors.star_tracker`` must be
+within this angle of it [deg] (the same direction, up to numbers written to four digits)."""
 
 
 def _non_negative_vector(node: Node) -> np.ndarray:
@@ -36,7 +40,9 @@ def _vector3(node: Node) -> np.ndarray:
     return node.vector(3)
 
 
-def _boresight(node: Node) -> np.ndarray:
+def _boresight(node: Node) -> np.ndarray | None:
+    if node.value is None:
+        return None
     values = node.vector(3)
     if not np.linalg.norm(values) > 0:
         raise node.error(f"a boresight cannot be zero, got {values.tolist()}; give its direction in body axes")
@@ -69,7 +75,9 @@ STAR_TRACKER = Section((
            nullable=True),
     custom("outages_s", "Windows ``[t0, t1]`` without updates.", "list of [t0, t1]", _outages, unit="s", default=[]),
     custom("boresight", "The sensor's z axis in body axes (its x and y: the body's, turned by the shortest "
-           "rotation taking body z there).", "list of 3 numbers", _boresight, default=[0.0, 0.0, 1.0]),
+           "rotation taking body z there). Absent or ``null``: the boresight of ``spacecraft.sensors.star_tracker`` "
+           "when the spacecraft declares that sensor (the one its pointing requirements read), else body z; "
+           "given beside it, it must be the same direction.", "list of 3 numbers or null", _boresight, default=None),
 ), "A star tracker; it replaces ``sensor_noise.attitude_deg``.")
 
 MAGNETOMETER = Section((
@@ -98,7 +106,7 @@ ESTIMATOR = Section((
 
 
 def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any] | None,
-                       noise: dict[str, Any], path: str) -> SensorSuite | None:
+                       noise: dict[str, Any], path: str, tracker_boresight: ArrayLike | None = None) -> SensorSuite | None:
     """The :class:`~ocp.estimation.SensorSuite` of ``simulation.sensors`` and ``simulation.estimator``.
 
     Parameters
@@ -111,6 +119,10 @@ def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any]
         ``simulation.sensor_noise``'s values (a sensor given there and here is refused).
     path : str
         YAML path of the simulation mapping.
+    tracker_boresight : (3,) array_like or None, optional
+        The boresight of ``spacecraft.sensors.star_tracker`` (body axes) when the spacecraft
+        declares it: the star tracker's unless its own ``boresight`` is given, which must then be
+        the same direction; ``None``: body z by default.
 
     Returns
     -------
@@ -120,7 +132,8 @@ def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any]
     Raises
     ------
     ScenarioError
-        A sensor given twice, or an estimator without a gyro or a star tracker.
+        A sensor given twice, an estimator without a gyro or a star tracker, or a star tracker
+        boresight that is not the declared one.
     """
     sensors = sensors or {}
     gyro = tracker = magnetometer = None
@@ -131,8 +144,21 @@ def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any]
                     bias=values["bias_deg_per_h"] * DEG_PER_H)
     if sensors.get("star_tracker") is not None:
         values = sensors["star_tracker"]
+        boresight = values["boresight"]
+        if boresight is None:
+            boresight = (np.array([0.0, 0.0, 1.0]) if tracker_boresight is None
+                         else np.asarray(tracker_boresight, dtype=float))
+        elif tracker_boresight is not None:
+            given, stated = boresight / np.linalg.norm(boresight), np.asarray(tracker_boresight, dtype=float)
+            stated = stated / np.linalg.norm(stated)
+            apart = math.degrees(math.atan2(float(np.linalg.norm(np.cross(given, stated))), float(given @ stated)))
+            if apart > BORESIGHT_AGREEMENT_DEG:
+                raise ScenarioError(f"{path}.sensors.star_tracker.boresight",
+                                    f"{boresight.tolist()} is {apart:.3g} deg from spacecraft.sensors.star_tracker's "
+                                    f"boresight {stated.tolist()}: one sensor has one boresight (remove this key, "
+                                    f"which then takes the spacecraft's, or make them agree)")
         tracker = StarTracker(noise=values["noise_arcsec"] * ARCSEC, rate=values["rate_hz"],
-                              outages=values["outages_s"], boresight=values["boresight"])
+                              outages=values["outages_s"], boresight=boresight)
     if sensors.get("magnetometer") is not None:
         values = sensors["magnetometer"]
         magnetometer = Magnetometer(noise=values["noise_T"], bias=values["bias_T"])
