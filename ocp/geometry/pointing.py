@@ -195,6 +195,17 @@ class HermiteMotion:
         return np.maximum(np.maximum(norms[:-1], norms[1:]), np.divide(chord, h, out=np.zeros_like(h), where=h > 0.0))
 
     @cached_property
+    def increasing(self) -> bool:
+        """Whether the sample times increase strictly (no repeated time)."""
+        return bool(np.all(self.t[1:] > self.t[:-1]))
+
+    @cached_property
+    def sample_steps(self) -> tuple[Array, Array, Array]:
+        """The steps between the samples as :func:`search_between_samples` cuts them: their lengths,
+        :attr:`rate_bound` and the sub-grid steps of at most :data:`FINE_STEP` (at least 4)."""
+        return _knot_steps(self, self.t)
+
+    @cached_property
     def unit(self) -> Array:
         """(N, 4): the samples normalised (the interpolant at the sample times)."""
         return np.asarray(quat.normalize(self.q), dtype=float)
@@ -349,15 +360,17 @@ def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], thr
     t = motion.t
     inner = [float(edge) for edge in edges if t[0] < edge < t[-1]]
     # the samples increase (repeats allowed): np.unique only where an edge is inserted or a time repeats
-    knots = np.unique(np.concatenate([t, inner])) if inner or not np.all(t[1:] > t[:-1]) else t
+    own = not inner and motion.increasing
+    knots = t if own else np.unique(np.concatenate([t, inner]))
     count = len(knots)
     # the samples' attitudes are the samples (normalised); an edge between them is interpolated
     attitudes = motion.unit if count == len(t) else motion.attitudes(knots)
     if count < 2:
         return knots, np.asarray(value(knots, attitudes), dtype=float)
-    interval = motion.interval(knots[:-1])
-    h = np.diff(knots)
-    speed = motion.rate_bound[interval] + drift  # per step between knots
+    # the knots' steps, their bound and their fine steps: the motion's own (built once for a row's
+    # searches) when the knots are its samples
+    h, bound, fine_steps = motion.sample_steps if own else _knot_steps(motion, knots)
+    speed = bound + drift  # per step between knots
     # the heads of groups of knot steps, evaluated first: every SAMPLE_GROUP-th knot, the edges, and
     # each knot where the bound's sum over the steps passes a multiple of GROUP_REACH
     turned = np.concatenate([[0.0], np.cumsum(speed * h)]) // GROUP_REACH
@@ -376,7 +389,6 @@ def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], thr
         deeper = _may_cross(at_heads[:-1], at_heads[1:], reach, -np.inf, float(np.nanmin(at_heads)))
     # a group that may cross the threshold: its knot steps cut into the fine sub-grid; one that may
     # hide a lower value: into at most COARSE_STEPS; the others keep their heads alone (one bracket)
-    fine_steps = np.maximum(4, np.ceil(motion.turn_rate[interval] * h / FINE_STEP)).astype(int)
     cut = np.where(np.repeat(crossing, sizes), fine_steps, np.minimum(COARSE_STEPS, fine_steps))
     opened = np.repeat(crossing | deeper, sizes)
     steps = np.where(opened, cut, head[:-1])
@@ -392,6 +404,16 @@ def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], thr
     if np.any(new):
         values[new] = value(grid[new], motion.attitudes(grid[new]))
     return grid, values, rate
+
+
+def _knot_steps(motion: HermiteMotion, knots: Array) -> tuple[Array, Array, Array]:
+    """Per step between increasing ``knots``: its length, the interpolant's rate bound
+    (:attr:`HermiteMotion.rate_bound` of the sample interval holding it) and the sub-grid steps
+    over which the attitude turns at most :data:`FINE_STEP` (by :attr:`HermiteMotion.turn_rate`,
+    at least 4)."""
+    interval = motion.interval(knots[:-1])
+    h = np.diff(knots)
+    return h, motion.rate_bound[interval], np.maximum(4, np.ceil(motion.turn_rate[interval] * h / FINE_STEP)).astype(int)
 
 
 def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence[tuple[Array, Array, Array]],
