@@ -8,7 +8,8 @@ workbench:
 * scoring (NumPy): :meth:`PointingConstraint.margins` and :meth:`PointingConstraint.score` on any
   sampled motion (a reference on its dense grid); :meth:`PointingConstraint.score_between_samples`
   on a motion known by its attitude and body rate at coarse samples (a closed loop), between which
-  the attitude is interpolated (:func:`hermite_attitudes`);
+  the attitude is interpolated (:func:`hermite_attitudes`); :func:`scores_between_samples` scores
+  several constraints on one such motion together (each as alone);
 * planning (CasADi): :meth:`PointingConstraint.expression` is the constraint ``g(q, t) <= 0`` a
   transcription imposes at its points (a moving direction is interpolated in time, as the IGRF
   field is).
