@@ -196,3 +196,50 @@ def test_a_long_fast_run_far_from_the_cone_costs_a_bounded_search(monkeypatch) -
     score = constraint.score_between_samples(t, q, omega)
     assert score.met and score.min_margin_deg == pytest.approx(80.0, abs=1e-6)
     assert sum(evaluated) <= (COARSE_STEPS + 1) * t.size + MIN_SEARCHES * REFINE_POINTS * REFINE_LEVELS
+
+
+def test_a_rows_pointing_searches_together_are_each_the_search_alone() -> None:
+    """``scores_between_samples`` runs a row's searches through the zooms together (one array of
+    brackets tagged by search); every search must still evaluate exactly the points, and find exactly
+    the values, it finds alone: a cone crossed between the samples (the zooms' branch and bound), a
+    keep-in, a window inside the run (its edges: other knots), a window past the run (no point: no
+    zoom), and two tumbles far from their cones whose lower-value candidates each exceed
+    MIN_SEARCHES (the cap is per search: one shared by the searches would drop some of each)."""
+    from ocp.geometry.pointing import (
+        MIN_SEARCHES,
+        HermiteMotion,
+        PointingConstraint,
+        scores_between_samples,
+        search_between_samples,
+        searches_between_samples,
+    )
+
+    t = np.arange(0.0, 400.0, 0.5)
+    half = 0.5 * 0.2 * t  # a 0.2 rad/s tumble about z, a slow nod about x on top
+    nod = 0.5 * 0.01 * np.sin(0.05 * t)
+    q = np.stack([np.cos(half) * np.cos(nod), np.cos(half) * np.sin(nod), -np.sin(half) * np.sin(nod),
+                  np.sin(half) * np.cos(nod)], axis=-1)
+    omega = np.column_stack([0.01 * 0.025 * np.cos(0.05 * t) * np.ones_like(t), np.zeros_like(t), np.full(t.size, 0.2)])
+    constraints = [
+        PointingConstraint("crossed", [1.0, 0.0, 0.0], True, math.radians(2.0), directions=[[1.0, 0.0, 0.0]]),
+        PointingConstraint("kept_in", [0.0, 0.0, 1.0], False, math.radians(0.5), directions=[[0.0, 0.0, 1.0]]),
+        PointingConstraint("windowed", [0.0, 1.0, 0.0], True, math.radians(5.0), directions=[[0.0, 1.0, 0.0]],
+                           window=(33.3, 77.7)),
+        PointingConstraint("after", [1.0, 0.0, 0.0], True, math.radians(5.0), window=(500.0, 600.0)),
+        PointingConstraint("tumble_a", [1.0, 0.0, 0.0], True, math.radians(10.0), directions=[[0.0, 0.0, 1.0]]),
+        PointingConstraint("tumble_b", [0.0, 1.0, 0.0], True, math.radians(20.0), directions=[[0.0, 0.0, -1.0]]),
+    ]
+    motion = HermiteMotion(t, q, omega)
+    searches = [(constraint.margins, 0.0, constraint.drift, constraint.window) for constraint in constraints]
+    together = searches_between_samples(motion, searches)
+    alone = [search_between_samples(motion, *search) for search in searches]
+    for (times, values), (times_alone, values_alone) in zip(together, alone, strict=True):
+        np.testing.assert_array_equal(times, times_alone)
+        np.testing.assert_array_equal(values, values_alone)
+    scores = scores_between_samples(constraints, t, q, omega, motion)
+    assert scores == [constraint.score_between_samples(t, q, omega, motion) for constraint in constraints]
+    assert not scores[0].met and scores[1].met is False and scores[3].min_margin_deg is None
+    # the tumbles: more lower-value candidates than MIN_SEARCHES each (what the per-search cap is for)
+    for constraint in constraints[4:]:
+        values = constraint.margins(t, motion.unit)
+        assert np.sum(values[:-1] - 0.5 * motion.rate_bound * np.diff(t) < np.min(values)) > MIN_SEARCHES

@@ -8,7 +8,8 @@ workbench:
 * scoring (NumPy): :meth:`PointingConstraint.margins` and :meth:`PointingConstraint.score` on any
   sampled motion (a reference on its dense grid); :meth:`PointingConstraint.score_between_samples`
   on a motion known by its attitude and body rate at coarse samples (a closed loop), between which
-  the attitude is interpolated (:func:`hermite_attitudes`);
+  the attitude is interpolated (:func:`hermite_attitudes`); :func:`scores_between_samples` scores
+  several constraints on one such motion together (each as alone);
 * planning (CasADi): :meth:`PointingConstraint.expression` is the constraint ``g(q, t) <= 0`` a
   transcription imposes at its points (a moving direction is interpolated in time, as the IGRF
   field is).
@@ -48,7 +49,9 @@ __all__ = [
     "PointingConstraint",
     "PointingScore",
     "hermite_attitudes",
+    "scores_between_samples",
     "search_between_samples",
+    "searches_between_samples",
     "violation_intervals",
 ]
 
@@ -156,10 +159,11 @@ class HermiteMotion:
             Unit quaternions at ``times`` (scalar first, body to inertial).
         """
         t = self.t
-        at = np.clip(np.atleast_1d(np.asarray(times, dtype=float)), t[0], t[-1])
+        # np.minimum / np.maximum rather than np.clip: the same values, without np.clip's per-call overhead
+        at = np.minimum(np.maximum(np.atleast_1d(np.asarray(times, dtype=float)), t[0]), t[-1])
         if len(t) == 1:
             return np.repeat(self.unit, len(at), axis=0)
-        k = np.clip(np.searchsorted(t, at, side="right") - 1, 0, len(t) - 2)
+        k = np.minimum(np.maximum(np.searchsorted(t, at, side="right") - 1, 0), len(t) - 2)
         s = ((at - t[k]) * self._inverse_h[k])[:, None]
         c = self._cubic[k]
         value = ((c[:, 3] * s + c[:, 2]) * s + c[:, 1]) * s + c[:, 0]
@@ -179,7 +183,7 @@ class HermiteMotion:
             Indices into :attr:`turn_rate` and :attr:`rate_bound`, in ``[0, N − 2]``.
         """
         at = np.atleast_1d(np.asarray(times, dtype=float))
-        return np.clip(np.searchsorted(self.t, at, side="right") - 1, 0, max(len(self.t) - 2, 0))
+        return np.minimum(np.maximum(np.searchsorted(self.t, at, side="right") - 1, 0), max(len(self.t) - 2, 0))
 
     @cached_property
     def turn_rate(self) -> Array:
@@ -190,6 +194,17 @@ class HermiteMotion:
         norms = np.linalg.norm(self.omega, axis=1)
         chord = 2.0 * np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", self.q[:-1], self.q[1:])), 0.0, 1.0))
         return np.maximum(np.maximum(norms[:-1], norms[1:]), np.divide(chord, h, out=np.zeros_like(h), where=h > 0.0))
+
+    @cached_property
+    def increasing(self) -> bool:
+        """Whether the sample times increase strictly (no repeated time)."""
+        return bool(np.all(self.t[1:] > self.t[:-1]))
+
+    @cached_property
+    def sample_steps(self) -> tuple[Array, Array, Array]:
+        """The steps between the samples as :func:`search_between_samples` cuts them: their lengths,
+        :attr:`rate_bound` and the sub-grid steps of at most :data:`FINE_STEP` (at least 4)."""
+        return _knot_steps(self, self.t)
 
     @cached_property
     def unit(self) -> Array:
@@ -281,17 +296,82 @@ def search_between_samples(motion: HermiteMotion, value: Callable[[Array, Array]
     (times, values) : ((P,) ndarray, (P,) ndarray)
         Every point evaluated, in time order (the samples and edges first among them).
     """
+    return searches_between_samples(motion, [(value, threshold, drift, edges)])[0]
+
+
+SearchSpec = tuple[Callable[[Array, Array], Array], float, float, Sequence[float]]
+"""One search of :func:`searches_between_samples`: ``(value, threshold, drift, edges)`` as the
+arguments of :func:`search_between_samples`."""
+
+
+def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpec]) -> list[tuple[Array, Array]]:
+    """Several searches of :func:`search_between_samples` on one motion (a row's pointing
+    requirements), each exactly as alone: the same points, the same values.
+
+    Each search's samples and sub-grid are found on its own; its refinement brackets then go
+    through the zooms together with the others' (one array per zoom, each bracket tagged with its
+    search; the least value, the threshold and the :data:`MIN_SEARCHES` deepest brackets counted
+    per search), the attitudes of every zoom's points interpolated in one call: the array
+    operations of the zooms are paid once for all the searches, not once for each.
+
+    Parameters
+    ----------
+    motion : HermiteMotion
+        The motion (its samples' times span the searches).
+    searches : sequence of (value, threshold, drift, edges)
+        Each as the arguments of :func:`search_between_samples`.
+
+    Returns
+    -------
+    list of (times, values)
+        Per search, as :func:`search_between_samples` returns.
+    """
+    results: list[tuple[Array, Array] | None] = [None] * len(searches)
+    found_t: list[list[Array]] = []
+    found_v: list[list[Array]] = []
+    active: list[int] = []  # the searches whose sub-grid goes on into the zooms, in order
+    brackets: list[tuple[Array, Array, Array]] = []
+    for index, (value, threshold, drift, edges) in enumerate(searches):
+        opened = _sub_grid(motion, value, threshold, drift, edges)
+        if len(opened) == 2:
+            results[index] = opened
+            continue
+        grid, values, rate = opened
+        active.append(index)
+        found_t.append([grid])
+        found_v.append([values])
+        brackets.append((grid, values, rate))
+    if active:
+        _zoom(motion, [searches[index] for index in active], brackets, found_t, found_v)
+        for slot, index in enumerate(active):
+            if len(found_t[slot]) == 1:
+                results[index] = (found_t[slot][0], found_v[slot][0])
+                continue
+            times, values = np.concatenate(found_t[slot]), np.concatenate(found_v[slot])
+            order = np.argsort(times, kind="stable")
+            results[index] = (times[order], values[order])
+    return [result for result in results if result is not None]
+
+
+def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], threshold: float, drift: float,
+              edges: Sequence[float]) -> tuple[Array, Array] | tuple[Array, Array, Array]:
+    """Steps 1 and 2 of :func:`search_between_samples`: the heads, then the sub-grid, its values and
+    the bound's rate on each of its steps; or the final ``(times, values)`` when nothing is left to
+    zoom into (fewer than two knots, no head inside the value's domain)."""
     t = motion.t
     inner = [float(edge) for edge in edges if t[0] < edge < t[-1]]
-    knots = np.unique(np.concatenate([t, inner])) if inner else np.unique(t)
+    # the samples increase (repeats allowed): np.unique only where an edge is inserted or a time repeats
+    own = not inner and motion.increasing
+    knots = t if own else np.unique(np.concatenate([t, inner]))
     count = len(knots)
     # the samples' attitudes are the samples (normalised); an edge between them is interpolated
     attitudes = motion.unit if count == len(t) else motion.attitudes(knots)
     if count < 2:
         return knots, np.asarray(value(knots, attitudes), dtype=float)
-    interval = motion.interval(knots[:-1])
-    h = np.diff(knots)
-    speed = motion.rate_bound[interval] + drift  # per step between knots
+    # the knots' steps, their bound and their fine steps: the motion's own (built once for a row's
+    # searches) when the knots are its samples
+    h, bound, fine_steps = motion.sample_steps if own else _knot_steps(motion, knots)
+    speed = bound + drift  # per step between knots
     # the heads of groups of knot steps, evaluated first: every SAMPLE_GROUP-th knot, the edges, and
     # each knot where the bound's sum over the steps passes a multiple of GROUP_REACH
     turned = np.concatenate([[0.0], np.cumsum(speed * h)]) // GROUP_REACH
@@ -310,7 +390,6 @@ def search_between_samples(motion: HermiteMotion, value: Callable[[Array, Array]
         deeper = _may_cross(at_heads[:-1], at_heads[1:], reach, -np.inf, float(np.nanmin(at_heads)))
     # a group that may cross the threshold: its knot steps cut into the fine sub-grid; one that may
     # hide a lower value: into at most COARSE_STEPS; the others keep their heads alone (one bracket)
-    fine_steps = np.maximum(4, np.ceil(motion.turn_rate[interval] * h / FINE_STEP)).astype(int)
     cut = np.where(np.repeat(crossing, sizes), fine_steps, np.minimum(COARSE_STEPS, fine_steps))
     opened = np.repeat(crossing | deeper, sizes)
     steps = np.where(opened, cut, head[:-1])
@@ -325,33 +404,68 @@ def search_between_samples(motion: HermiteMotion, value: Callable[[Array, Array]
     new = ~known
     if np.any(new):
         values[new] = value(grid[new], motion.attitudes(grid[new]))
-    found_t, found_v = [grid], [values]
-    # brackets: the sub-grid's steps, then the parts of those the bound cannot clear
-    low, high, at_low, at_high = grid[:-1], grid[1:], values[:-1], values[1:]
-    smallest = float(np.nanmin(values))
+    return grid, values, rate
+
+
+def _knot_steps(motion: HermiteMotion, knots: Array) -> tuple[Array, Array, Array]:
+    """Per step between increasing ``knots``: its length, the interpolant's rate bound
+    (:attr:`HermiteMotion.rate_bound` of the sample interval holding it) and the sub-grid steps
+    over which the attitude turns at most :data:`FINE_STEP` (by :attr:`HermiteMotion.turn_rate`,
+    at least 4)."""
+    interval = motion.interval(knots[:-1])
+    h = np.diff(knots)
+    return h, motion.rate_bound[interval], np.maximum(4, np.ceil(motion.turn_rate[interval] * h / FINE_STEP)).astype(int)
+
+
+def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence[tuple[Array, Array, Array]],
+          found_t: list[list[Array]], found_v: list[list[Array]]) -> None:
+    """Step 3 of :func:`search_between_samples` for several searches at once: the brackets of every
+    search in one array (``owner``: the search of each, in order), the least value, the threshold
+    and the :data:`MIN_SEARCHES` deepest brackets per search; the points of each zoom appended to
+    that search's ``found_t`` and ``found_v``."""
+    count = len(grids)
+    owner = np.repeat(np.arange(count), [len(grid) - 1 for grid, _, _ in grids])
+    low = np.concatenate([grid[:-1] for grid, _, _ in grids])
+    high = np.concatenate([grid[1:] for grid, _, _ in grids])
+    at_low = np.concatenate([values[:-1] for _, values, _ in grids])
+    at_high = np.concatenate([values[1:] for _, values, _ in grids])
+    rate = np.concatenate([rate for _, _, rate in grids])
+    thresholds = np.array([float(search[1]) for search in searches])
+    smallest = [float(np.nanmin(values)) for _, values, _ in grids]
     near = np.ones(len(low), dtype=bool)  # a candidate for a lower value (else only for a crossing)
     fraction = np.linspace(0.0, 1.0, REFINE_POINTS)[1:-1]
     part = np.arange(REFINE_POINTS - 1)
+    inside_count = REFINE_POINTS - 2
     for _ in range(REFINE_LEVELS):
+        threshold = thresholds[owner]
         with np.errstate(invalid="ignore"):
             floor = 0.5 * (at_low + at_high) - 0.5 * rate * (high - low)
             hidden = (np.fmin(at_low, at_high) >= threshold) & (floor < threshold)
-            lower = np.flatnonzero(near & (floor < smallest))
-        if lower.size > MIN_SEARCHES:
-            lower = lower[np.argsort(floor[lower], kind="stable")[:MIN_SEARCHES]]
+            lower = np.flatnonzero(near & (floor < np.asarray(smallest)[owner]))
+        if lower.size > MIN_SEARCHES:  # per search, the MIN_SEARCHES deepest (ties: the earlier)
+            ranked = lower[np.lexsort((floor[lower], owner[lower]))]
+            first = np.searchsorted(owner[ranked], owner[ranked], side="left")
+            lower = ranked[np.arange(ranked.size) - first < MIN_SEARCHES]
         pick = hidden.copy()
         pick[lower] = True
         if not np.any(pick):
             break
         whole = hidden[pick]
         low, high, at_low, at_high, rate = low[pick], high[pick], at_low[pick], at_high[pick], rate[pick]
+        owner = owner[pick]
         points = low[:, None] + (high - low)[:, None] * fraction
         flat = points.ravel()
-        inside_values = np.asarray(value(flat, motion.attitudes(flat)), dtype=float)
-        found_t.append(flat)
-        found_v.append(inside_values)
+        attitudes = motion.attitudes(flat)  # every search's points in one call
+        inside_values = np.empty(flat.size)
+        bounds = np.searchsorted(owner, np.arange(count + 1)) * inside_count  # each search's points: one run
+        for slot in np.flatnonzero(np.diff(bounds)).tolist():
+            span = slice(bounds[slot], bounds[slot + 1])
+            mine = np.asarray(searches[slot][0](flat[span], attitudes[span]), dtype=np.float64)
+            inside_values[span] = mine
+            found_t[slot].append(flat[span])
+            found_v[slot].append(mine)
+            smallest[slot] = min(smallest[slot], float(np.nanmin(mine)))
         inside_values = inside_values.reshape(points.shape)
-        smallest = min(smallest, float(np.nanmin(inside_values)))
         ends_t = np.column_stack([low, points, high])
         ends_v = np.column_stack([at_low, inside_values, at_high])
         # a bracket searched for a lower value goes on by the two parts about its least point; one
@@ -362,12 +476,8 @@ def search_between_samples(motion: HermiteMotion, value: Callable[[Array, Array]
         low, high = ends_t[:, :-1].ravel()[keep], ends_t[:, 1:].ravel()[keep]
         at_low, at_high = ends_v[:, :-1].ravel()[keep], ends_v[:, 1:].ravel()[keep]
         rate = np.repeat(rate, REFINE_POINTS - 1)[keep]
+        owner = np.repeat(owner, REFINE_POINTS - 1)[keep]
         near = near[keep]
-    if len(found_t) == 1:
-        return grid, values
-    times, values = np.concatenate(found_t), np.concatenate(found_v)
-    order = np.argsort(times, kind="stable")
-    return times[order], values[order]
 
 
 class PointingScore(NamedTuple):
@@ -561,8 +671,8 @@ class PointingConstraint:
     def _table_at(self, t: Array) -> Array:
         """(N, 4): the direction (not normalised) and the growth at ``t``, interpolated linearly
         between the table's rows (one lookup for both) and held beyond them."""
-        row = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.times) - 2)
-        weight = np.clip((t - self.times[row]) * self._table_slopes[1][row], 0.0, 1.0)[:, None]
+        row = np.minimum(np.maximum(np.searchsorted(self.times, t, side="right") - 1, 0), len(self.times) - 2)
+        weight = np.minimum(np.maximum((t - self.times[row]) * self._table_slopes[1][row], 0.0), 1.0)[:, None]
         return np.asarray(self._table_slopes[0][row] + weight * self._table_slopes[2][row], dtype=float)
 
     @cached_property
@@ -618,7 +728,7 @@ class PointingConstraint:
             direction = table[:, :3]
             cosine = np.einsum("ij,ij->i", pointing, direction) / (
                 np.einsum("ij,ij->i", q, q) * np.sqrt(np.einsum("ij,ij->i", direction, direction)))
-        return np.asarray(np.arccos(np.clip(cosine, -1.0, 1.0)), dtype=float)
+        return np.asarray(np.arccos(np.minimum(np.maximum(cosine, -1.0), 1.0)), dtype=float)
 
     @cached_property
     def _rotation_form(self) -> Array:
@@ -734,11 +844,10 @@ class PointingConstraint:
         PointingScore
             As :meth:`score`, of the interpolated motion.
         """
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        if len(t) < 2:
-            return self.score(t, np.atleast_2d(np.asarray(q, dtype=float)))
-        moving = HermiteMotion(t, q, omega) if motion is None else motion
-        times, margin = search_between_samples(moving, self.margins, 0.0, self.drift, self.window)
+        return scores_between_samples([self], t, q, omega, motion)[0]
+
+    def _scored(self, times: Array, margin: Array) -> PointingScore:
+        """The score of the margins at the points searched (:meth:`score_between_samples`)."""
         if not np.any(np.isfinite(margin)):
             return PointingScore(None, 0.0, None, None)
         worst = int(np.nanargmin(margin))
@@ -814,3 +923,36 @@ class PointingConstraint:
         bool
         """
         return self.window[0] <= end and self.window[1] >= start
+
+
+def scores_between_samples(constraints: Sequence[PointingConstraint], t: ArrayLike, q: ArrayLike, omega: ArrayLike,
+                           motion: HermiteMotion | None = None) -> list[PointingScore]:
+    """:meth:`PointingConstraint.score_between_samples` of several constraints on one motion (a
+    row's pointing requirements): their searches go through :func:`searches_between_samples`
+    together, each score exactly that of the constraint alone.
+
+    Parameters
+    ----------
+    constraints : sequence of PointingConstraint
+        The constraints.
+    t : (N,) array_like
+        Increasing sample times [s].
+    q : (N, 4) array_like
+        Attitude at ``t`` (scalar first, body to inertial).
+    omega : (N, 3) array_like
+        Body rate at ``t`` [rad/s], body axes.
+    motion : HermiteMotion or None, optional
+        ``HermiteMotion(t, q, omega)`` when already built; ``None``: built here.
+
+    Returns
+    -------
+    list of PointingScore
+        One per constraint, in order.
+    """
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    if len(t) < 2:
+        return [constraint.score(t, np.atleast_2d(np.asarray(q, dtype=float))) for constraint in constraints]
+    moving = HermiteMotion(t, q, omega) if motion is None else motion
+    found = searches_between_samples(moving, [(constraint.margins, 0.0, constraint.drift, constraint.window)
+                                              for constraint in constraints])
+    return [constraint._scored(times, margin) for constraint, (times, margin) in zip(constraints, found)]

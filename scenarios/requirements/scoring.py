@@ -58,6 +58,8 @@ from ocp import Spacecraft, quat, target_motion
 from ocp.geometry.pointing import (
     HermiteMotion,
     PointingConstraint,
+    PointingScore,
+    scores_between_samples,
     search_between_samples,
 )
 from planners import ManeuverProblem, Planner, Reference
@@ -168,8 +170,15 @@ def reference_times(duration: float, run_end: float, sample_time: float, points:
     return times
 
 
-def _pointing(constraint: PointingConstraint, t: Array, q: Array, omega: Array, motion: HermiteMotion) -> Score:
-    score = constraint.score_between_samples(t, q, omega, motion)
+def _pointing_scores(constraints: Sequence[PointingConstraint], t: Array, q: Array, omega: Array,
+                     motion: HermiteMotion) -> dict[str, Score]:
+    """The pointing requirements' scores on one motion, their searches between the samples together
+    (:func:`ocp.geometry.pointing.scores_between_samples`: each as the constraint's alone)."""
+    return {constraint.name: _pointing(constraint, score)
+            for constraint, score in zip(constraints, scores_between_samples(constraints, t, q, omega, motion))}
+
+
+def _pointing(constraint: PointingConstraint, score: PointingScore) -> Score:
     values: dict[str, float | None] = dict(zip(POINTING_FIELDS, (score.min_margin_deg, score.time_in_violation_s,
                                                                  score.first_violation_s, score.min_margin_time_s)))
     if score.met:
@@ -496,7 +505,7 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
     scores: dict[str, Score] = {}
     if problem.pointing:
         motion = HermiteMotion(*edged)  # one interpolant for the row's pointing requirements
-        scores.update((constraint.name, _pointing(constraint, *edged, motion)) for constraint in problem.pointing)
+        scores.update(_pointing_scores(problem.pointing, *edged, motion))
     if requirements.actuators is not None and allocation is not None:
         # The demand on the samples and either side of each breakpoint: where the torque (or the
         # rate) may jump, the demand's integration interpolates its inputs linearly between samples
@@ -586,7 +595,7 @@ def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: A
     q = np.asarray(q, dtype=float)
     omega = np.asarray(omega, dtype=float)
     motion = HermiteMotion(t, q, omega)  # one interpolant for the row's requirements
-    scores = {constraint.name: _pointing(constraint, t, q, omega, motion) for constraint in problem.pointing}
+    scores = _pointing_scores(problem.pointing, t, q, omega, motion)
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, omega)
     if requirements.final is not None:

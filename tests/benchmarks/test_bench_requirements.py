@@ -25,7 +25,12 @@ bc355f1 (median 53 %); CPU, 40 pairs each, two processes taking turns pair by pa
 not held (what is left: the pointing search, about 30 ms, and the demand's Runge-Kutta
 sub-steps). The budget is 1.25 times the largest run (1.7 times the median). Estimated, not
 measured: fcaf45b's search back (36 ms more a run, at about 185 ms a run without scoring) gives
-about +58 %, failing it about half the time; bc355f1's runs pass it.
+about +58 %, failing it about half the time; bc355f1's runs pass it. A row's pointing searches then
+went through their zooms together (``ocp.geometry.pointing.scores_between_samples``, each search's
+points those alone; the steps between the samples computed once per motion): the 18 pointing
+scores 17.3 against 24.2 ms CPU a run on 03fa46d (paired ratio 0.78), the scores bit for bit those
+of 03fa46d; measured under load 5-8 on 2 cores, the benchmark's overhead did not resolve the
+difference (docs/performance.rst).
 
 The 12U CubeSat Sun keep-out scenario without its collocation row (the fast planners, where scoring
 weighs most), with three pointing requirements (the star tracker off the Sun and the Moon, an
