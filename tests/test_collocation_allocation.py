@@ -15,7 +15,7 @@ import pytest
 import planners.collocation.planner as collocation_planner
 import scenarios
 from ocp import Magnetorquers, ReactionWheels, Spacecraft, Torquers, quat
-from ocp.transcription import RadauCollocation
+from ocp.transcription import MultipleShooting, RadauCollocation
 from planners import PLANNERS, ManeuverProblem
 from planners.collocation.allocation import allocation_constraints
 from scenarios.schema import parse_yaml_text
@@ -83,12 +83,16 @@ def test_three_body_axis_wheels_build_the_plain_transcription():
     assert type(transcription) is not RadauCollocation and isinstance(transcription, RadauCollocation)
 
 
-def test_multiple_shooting_is_refused_where_the_allocation_adds_constraints():
-    planner = PLANNERS["collocation"]({"transcription": "multiple_shooting"})
-    error = planner.problem_error(_problem(_pyramid()))
-    assert error is not None and "allocation" in error and "transcription: collocation" in error
+def test_multiple_shooting_imposes_the_allocation_where_it_adds_constraints():
+    """Once refused on the pyramid; its plan is checked in ``tests/test_allocation_shooting.py``."""
+    planner = PLANNERS["collocation"]({"transcription": "multiple_shooting", "intervals": 10})
+    assert planner.problem_error(_problem(_pyramid())) is None
+    transcription, _ = planner._nlp(_problem(_pyramid()), planner._ocp(_problem(_pyramid())))
+    assert type(transcription) is not MultipleShooting and isinstance(transcription, MultipleShooting)
     body = Spacecraft(INERTIA, wheels=ReactionWheels.from_body_axes(max_torque=G_MAX, max_momentum=H_MAX))
     assert planner.problem_error(_problem(body)) is None
+    transcription, _ = planner._nlp(_problem(body), planner._ocp(_problem(body)))
+    assert type(transcription) is MultipleShooting
 
 
 def test_pyramid_plan_is_within_the_limits_through_A_plus_and_a_restriction(monkeypatch):

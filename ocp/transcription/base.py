@@ -13,8 +13,10 @@ structure-exploiting solvers need it (FATROP's ``structure_detection: auto``):
   model state at the mesh point, plus what the transcription carries across intervals, plus
   ``T`` when the final time is free: ``T_{k+1} = T_k`` is then an explicit continuity condition)
   and the interval's own variables ``c_k``;
-* constraints ``[gap_0, path_0, x_0 − x0, gap_1, path_1, …, terminal]`` with
-  ``gap_k = s_{k+1} − F(s_k, c_k)`` (explicit continuity) and the interval's path constraints.
+* constraints ``[gap_0, path_0, x_0 − x0, initial, gap_1, path_1, …, terminal]`` with
+  ``gap_k = s_{k+1} − F(s_k, c_k)`` (explicit continuity), the interval's path constraints and the
+  transcription's affine equalities on ``s_0`` (:meth:`Transcription.initial_equalities`, none
+  by default: multiple shooting's ``u_0`` under the controllers' allocation).
 
 Parameters ``p = [x0 (nx), qf (4), ωf (3), T, disturbance (3)]``: boundary values and T are not
 baked into the graph, so a built solver is reused across plans.
@@ -248,6 +250,65 @@ class Transcription(ABC):
             times where the dynamics are imposed.
         """
 
+    def control_points(self, problem: OptimalControlProblem, s: Any, c: Any) -> list[tuple[Any, float]] | None:
+        """The controls one interval's variables hold, with their positions in the interval.
+
+        Together with :meth:`initial_controls` they are every control the solution uses, each once
+        over the mesh (what the transcription interpolates between is among them), so that a
+        constraint imposed on each of them holds for every control of the solution.
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise.
+        s, c : CasADi expression
+            A stage state ``s_k`` (without T) and the interval's own variables ``c_k``.
+
+        Returns
+        -------
+        list of (CasADi expression (nu,), float) or None
+            ``(u, position)`` pairs, positions as fractions of the interval in [0, 1]; ``None``
+            (the default) when the transcription does not say.
+        """
+        return None
+
+    def initial_controls(self, problem: OptimalControlProblem, s: Any) -> list[Any]:
+        """The controls the first stage state holds that no interval's :meth:`control_points` hold.
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise.
+        s : CasADi expression
+            The stage state ``s_0`` (without T).
+
+        Returns
+        -------
+        list of CasADi expression (nu,)
+            By default none (every control lies in the intervals' own variables).
+        """
+        return []
+
+    def initial_equalities(self, problem: OptimalControlProblem, s: Any) -> Any:
+        """Equalities on the first stage state besides ``x_0 = x0``, affine in ``s_0``.
+
+        :meth:`build` places them after the initial condition (the rows between the first block and
+        the second, which :mod:`ocp.transcription.mesh_transfer` carries as they are).
+
+        Parameters
+        ----------
+        problem : OptimalControlProblem
+            What to optimise.
+        s : casadi.SX
+            The stage state ``s_0`` (without T).
+
+        Returns
+        -------
+        (k,) casadi.SX
+            Expressions held at 0; by default none.
+        """
+        return ca.SX.zeros(0, 1)
+
     def positions(self, problem: OptimalControlProblem, interval: Interval) -> tuple[Array, Array]:
         """Where the entries of ``c_k`` and of the path constraints sit in their interval.
 
@@ -344,6 +405,13 @@ class Transcription(ABC):
         n_terminal = stages.n_terminal
         lbg = np.concatenate([stage_low, np.zeros(nx), np.tile(stage_low, N - 1), np.zeros(n_terminal)])
         ubg = np.concatenate([stage_high, np.zeros(nx), np.tile(stage_high, N - 1), np.zeros(n_terminal)])
+        g, jac_g, hess_lag = stages.g, stages.jac_g, stages.hess_lag
+        initial = self._initial_rows(problem, ns0, stages.w.numel())
+        if initial is not None:  # after the initial condition: [gap_0, path_0, x_0 − x0, these, gap_1, …]
+            at = ns + interval.path_lower.size + nx
+            g, jac_g, hess_lag = _insert_affine_rows(stages.w, stages.p, g, jac_g, hess_lag, at, *initial)
+            lbg = np.concatenate([lbg[:at], np.zeros(initial[0].shape[0]), lbg[at:]])
+            ubg = np.concatenate([ubg[:at], np.zeros(initial[0].shape[0]), ubg[at:]])
         states, controls = self.split(stages.S[:ns0, :], stages.C)
         unpack = ca.Function("unpack", [stages.w, stages.p], [stages.T, states, controls])
         opts = dict(options)
@@ -352,8 +420,8 @@ class Transcription(ABC):
             opts["equality"] = [bool(v) for v in (lbg == ubg)]
         else:
             # the block-assembled derivatives (ocp.transcription.stagewise), not CasADi's of the whole graph
-            opts.update(jac_g=stages.jac_g, hess_lag=stages.hess_lag)
-        nlp = {"x": stages.w, "p": stages.p, "f": stages.f, "g": stages.g}
+            opts.update(jac_g=jac_g, hess_lag=hess_lag)
+        nlp = {"x": stages.w, "p": stages.p, "f": stages.f, "g": g}
         nlp_solver = ca.nlpsol(f"{self.name}_{solver}", solver, nlp, opts)
         c_position, path_position = self.positions(problem, interval)
         if c_position.shape != (nc,) or path_position.shape != interval.path_lower.shape:
@@ -366,6 +434,21 @@ class Transcription(ABC):
                   # T's continuity T_{k+1} = T_k (free T): a running sum of O(1/N) terms, not scaled
                   "gap_step_scaled": np.append(scaled, np.zeros(ns - ns0, dtype=bool))}
         return NLP(nlp_solver, stages.w.numel(), unpack, lbg, ubg, problem.free_time, ns, nc, layout)
+
+    def _initial_rows(self, problem: OptimalControlProblem, ns0: int, nw: int) -> tuple[Array, Array] | None:
+        """:meth:`initial_equalities` as ``(J, b)``, the rows ``J w + b`` on the decision vector
+        (``s_0`` is its first entries), or ``None`` when there are none."""
+        s = ca.SX.sym("s0", ns0)
+        rows = ca.SX(self.initial_equalities(problem, s))
+        if rows.numel() == 0:
+            return None
+        jacobian = ca.jacobian(rows, s)
+        if ca.depends_on(jacobian, s):
+            raise AssertionError(f"{self.name}: initial_equalities() must be affine in s_0")
+        J = np.zeros((rows.numel(), nw))
+        J[:, :ns0] = np.asarray(ca.evalf(jacobian), dtype=float)
+        b = np.asarray(ca.evalf(ca.substitute(rows, s, ca.SX.zeros(ns0))), dtype=float).ravel()
+        return J, b
 
     def bounds(self, problem: OptimalControlProblem, nlp: NLP, x_low: Array, x_high: Array, u_low: Array,
                u_high: Array, duration: float) -> tuple[Array, Array]:
@@ -422,3 +505,23 @@ class Transcription(ABC):
             S = np.vstack([S, np.full((1, S.shape[1]), duration)])
         N = self.intervals
         return np.concatenate([np.vstack([S[:, :N], C]).T.ravel(), S[:, N]])
+
+
+def _insert_affine_rows(w: Any, p: Any, g: Any, jac_g: ca.Function, hess_lag: ca.Function, at: int, J: Array,
+                        b: Array) -> tuple[Any, ca.Function, ca.Function]:
+    """``g`` with the rows ``J w + b`` inserted before its entry ``at``, and the derivative functions
+    of :mod:`ocp.transcription.stagewise` with them: their Jacobian rows are ``J``, and affine rows add
+    nothing to the Lagrangian's Hessian (their multipliers are dropped before the stage-wise one)."""
+    rows = ca.mtimes(ca.DM(ca.sparsify(ca.DM(J))), w) + ca.DM(b)
+    g_new = ca.vertcat(g[:at], rows, g[at:])
+    value, jacobian = jac_g(w, p)
+    jacobian = ca.vertcat(jacobian[:at, :], ca.MX(ca.sparsify(ca.DM(J))), jacobian[at:, :])
+    jac_new = ca.Function("nlp_jac_g", [w, p], [ca.vertcat(value[:at], rows, value[at:]), jacobian],
+                          ["x", "p"], ["g", "jac_g_x"])
+    lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", g_new.numel())
+    k = J.shape[0]
+    hess_new = ca.Function("nlp_hess_l", [w, p, lam_f, lam_g],
+                           [hess_lag(w, p, lam_f, ca.vertcat(lam_g[:at], lam_g[at + k:]))],
+                           ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"])
+    # MX wrappers of the expanded stage-wise functions: expanding them again took 2.2 s per build
+    return g_new, jac_new, hess_new

@@ -4,9 +4,12 @@ Controls are piecewise linear and continuous. To keep the stage-wise structure (
 state carries the control at the mesh point, ``s_k = [x_k, u_k]``, and the interval's variable is
 the next control, ``c_k = u_{k+1}``; the gap conditions are ``x_{k+1} = Φ(x_k, u_k, u_{k+1})``
 (``substeps`` RK4 steps, the running cost integrated as an extra state by the same RK4) and
-``u_{k+1} = c_k``. Path constraints (cones, the rate norm) hold at the end of every RK4 step, at its
-time (the initial state is given). The interval is expanded to SX (one compact function mapped over
-the mesh). States between nodes: cubic Hermite with the model's derivatives.
+``u_{k+1} = c_k``. The controls are ``u_0`` (the first stage state's) and the interval variables
+``c_0 … c_{N−1}`` (:meth:`MultipleShooting.initial_controls`, :meth:`MultipleShooting.control_points`):
+a linear condition on each of them holds on every interval's linear control. Path constraints
+(cones, the rate norm) hold at the end of every RK4 step, at its time (the initial state is
+given). The interval is expanded to SX (one compact function mapped over the mesh). States between
+nodes: cubic Hermite with the model's derivatives.
 """
 from __future__ import annotations
 
@@ -52,6 +55,15 @@ class MultipleShooting(Transcription):
 
     def state_of(self, s: Any) -> Any:
         return s[:self._nx]
+
+    def control_points(self, problem: OptimalControlProblem, s: Any, c: Any) -> list[tuple[Any, float]]:
+        # c_k = u_{k+1}, the control at the interval's end: u_1 … u_N over the mesh (the stage
+        # states' copies equal them through the gaps); u_0 is the first stage state's
+        return [(c, 1.0)]
+
+    def initial_controls(self, problem: OptimalControlProblem, s: Any) -> list[Any]:
+        # u_0, in s_0 = [x_0, u_0]: no interval's own variable
+        return [s[problem.model.nx:]]
 
     def interval(self, problem: OptimalControlProblem) -> Interval:
         model, M = problem.model, self.substeps

@@ -34,10 +34,16 @@ allocation of their own body torque:
 With wheels along the three body axes alone (or any array whose working axes are three
 independent ones, with nothing beside them) ``E`` is empty and the NLP is the one without it.
 
-:func:`with_allocation` adds ``E u = 0`` at a transcription's control points as equality path
-constraints (:data:`CONTROL_POINTS`: Radau collocation's points; a transcription without an entry,
-such as ``multiple_shooting``, whose control at t = 0 belongs to no interval's constraints, is
-refused where ``E`` is not empty, :func:`allocation_error`).
+:func:`with_allocation` adds ``E u = 0`` at every control a transcription uses: at the controls
+one interval's variables hold (:meth:`~ocp.transcription.base.Transcription.control_points`; for
+Radau collocation, whose module does not yet provide them, :data:`CONTROL_POINTS`: its collocation
+points) as equality path constraints, and at the controls the first stage state alone holds
+(:meth:`~ocp.transcription.base.Transcription.initial_controls`: multiple shooting's ``u_0``) as
+equalities after the initial condition
+(:meth:`~ocp.transcription.base.Transcription.initial_equalities`). Multiple shooting's controls
+are linear between ``u_k`` and ``u_{k+1}``, so ``E u = 0`` at the nodes holds on the whole of each
+interval (at every RK4 stage). A transcription that says neither is refused where ``E`` is not
+empty (:func:`allocation_error`).
 """
 from __future__ import annotations
 
@@ -49,7 +55,12 @@ import numpy as np
 
 from ocp import Spacecraft
 from ocp.dynamics.layout import actuator_blocks
-from ocp.transcription import OptimalControlProblem, RadauCollocation, Transcription
+from ocp.transcription import (
+    TRANSCRIPTIONS,
+    OptimalControlProblem,
+    RadauCollocation,
+    Transcription,
+)
 from ocp.transcription.problem import Interval
 from planners.problem import Array
 
@@ -139,9 +150,25 @@ def _radau_controls(transcription: RadauCollocation, problem: OptimalControlProb
 
 
 CONTROL_POINTS: dict[str, Callable[..., list[tuple[Any, float]]]] = {"collocation": _radau_controls}
-"""Per transcription (its ``name``): ``points(transcription, problem, s, c)``, the controls an
-interval's variables hold (with their positions in the interval, fractions in [0, 1]), each once
-over the mesh, every control of the solution among them."""
+"""Per transcription (its ``name``) whose class does not provide
+:meth:`~ocp.transcription.base.Transcription.control_points`: ``points(transcription, problem, s, c)``,
+the same list."""
+
+
+def _control_points(transcription: Transcription, problem: OptimalControlProblem, s: Any,
+                    c: Any) -> list[tuple[Any, float]] | None:
+    """The controls one interval's variables hold (the transcription's own, else :data:`CONTROL_POINTS`)."""
+    points = transcription.control_points(problem, s, c)
+    if points is None and transcription.name in CONTROL_POINTS:
+        points = CONTROL_POINTS[transcription.name](transcription, problem, s, c)
+    return points
+
+
+def _describes_controls(transcription: str) -> bool:
+    """Whether the registered transcription says where its controls are (module docstring)."""
+    cls = TRANSCRIPTIONS.get(transcription)
+    return transcription in CONTROL_POINTS or (
+        cls is not None and cls.control_points is not Transcription.control_points)
 
 
 def allocation_error(spacecraft: Spacecraft, transcription: str) -> str | None:
@@ -157,9 +184,10 @@ def allocation_error(spacecraft: Spacecraft, transcription: str) -> str | None:
     Returns
     -------
     str or None
-        The reason, or ``None`` (nothing to impose, or the transcription can). Whatever the
-        transcription: a residual actuator whose torque depends on the field beside working
-        wheels that span one or two axes (module docstring).
+        The reason, or ``None`` (nothing to impose, or the transcription can: ``collocation`` and
+        ``multiple_shooting`` both can). Whatever the transcription: a residual actuator whose
+        torque depends on the field beside working wheels that span one or two axes (module
+        docstring).
     """
     sink = spacecraft.residual_actuator
     given = spacecraft.wheel_span().shape[1]
@@ -170,11 +198,12 @@ def allocation_error(spacecraft: Spacecraft, transcription: str) -> str | None:
                 f"{sink.name} is not what the closed loop realises, and collocation cannot impose it on its controls "
                 f"(it is a condition on the attitude through the field); give the spacecraft torquers, three "
                 f"independent working wheels, or the {sink.name} without wheels")
-    if transcription in CONTROL_POINTS or allocation_constraints(spacecraft) is None:
+    if _describes_controls(transcription) or allocation_constraints(spacecraft) is None:
         return None
     return (f"{transcription} cannot impose the controllers' allocation (g = −A⁺ τ, wheels first) on these "
             f"actuators' controls, which the plan must follow to be what the closed loop realises (a skewed or "
-            f"redundant wheel array, or other actuators beside wheels); use transcription: collocation")
+            f"redundant wheel array, or other actuators beside wheels); use transcription: collocation or "
+            f"multiple_shooting")
 
 
 def with_allocation(transcription: Transcription, rows: Array) -> Transcription:
@@ -183,7 +212,9 @@ def with_allocation(transcription: Transcription, rows: Array) -> Transcription:
     Parameters
     ----------
     transcription : Transcription
-        A transcription with an entry in :data:`CONTROL_POINTS`.
+        A transcription that says where its controls are
+        (:meth:`~ocp.transcription.base.Transcription.control_points`, or an entry in
+        :data:`CONTROL_POINTS`).
     rows : (k, nu) ndarray
         :func:`allocation_constraints`.
 
@@ -191,9 +222,10 @@ def with_allocation(transcription: Transcription, rows: Array) -> Transcription:
     -------
     Transcription
         An instance of a subclass of its class, the same configuration, whose interval has the
-        equalities after its own path constraints (their positions after its own).
+        equalities after its own path constraints (their positions after its own), and whose first
+        stage state has them on its :meth:`~ocp.transcription.base.Transcription.initial_controls`
+        after the initial condition.
     """
-    points = CONTROL_POINTS[transcription.name]
     base = type(transcription)
     matrix = ca.DM(rows)
 
@@ -205,7 +237,9 @@ def with_allocation(transcription: Transcription, rows: Array) -> Transcription:
             s, c = ca.SX.sym("s", inner.n_state), ca.SX.sym("c", inner.n_interval)
             t0, h, dist = ca.SX.sym("t0"), ca.SX.sym("h"), ca.SX.sym("d", 3)
             following, path, cost = inner.function(s, c, t0, h, dist)
-            controls = points(self, problem, s, c)
+            controls = _control_points(self, problem, s, c)
+            if controls is None:
+                raise ValueError(f"{self.name} does not say where its controls are: the allocation cannot be imposed")
             extra = [ca.mtimes(matrix, u) for u, _ in controls]
             function = ca.Function(inner.function.name(), [s, c, t0, h, dist],
                                    [following, ca.vertcat(path, *extra), cost])
@@ -214,6 +248,10 @@ def with_allocation(transcription: Transcription, rows: Array) -> Transcription:
             self._inner_interval = inner
             return Interval(function, inner.n_state, inner.n_interval, np.concatenate([inner.path_lower, zeros]),
                             np.concatenate([inner.path_upper, zeros]))
+
+        def initial_equalities(self, problem: OptimalControlProblem, s: Any) -> Any:
+            own = super().initial_equalities(problem, s)
+            return ca.vertcat(own, *(ca.mtimes(matrix, u) for u in self.initial_controls(problem, s)))
 
         def positions(self, problem: OptimalControlProblem, interval: Interval) -> tuple[Array, Array]:
             c_position, path_position = super().positions(problem, self._inner_interval)
