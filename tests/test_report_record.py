@@ -26,7 +26,9 @@ SCENARIO = {
                  "final": {"q": [0.70710678, 0, 0, 0.70710678], "omega": [0, 0, 0]}},  # 90 deg about z
     "planners": [{"name": "eigenaxis", "label": "smooth", "options": {"profile": "smooth"}}],
     "controller": {"name": "augmented_quaternion_feedback"},
-    "truth": {"spacecraft": {"inertia": [10.5, 8.7, 6.2]}, "wheels": {"max_torque": 0.045}},
+    "environment": {"disturbance_torque": [1e-6, 0.0, 0.0]},
+    "truth": {"spacecraft": {"inertia": [10.5, 8.7, 6.2]}, "wheels": {"max_torque": 0.045, "torque_noise": 1e-5},
+              "disturbance": {"constant": [2e-6, 0.0, 0.0]}},
     "simulation": {"sample_time": 0.2, "duration": 70.0, "sensor_noise": {"seed": SEED},
                    "sensors": {"gyro": {"arw_deg_per_sqrt_h": 0.02},
                                "star_tracker": {"noise_arcsec": [6, 6, 40]}},
@@ -79,7 +81,9 @@ def test_the_provenance_names_the_version_the_date_and_the_seed(results, page):
 def test_the_plant_shows_each_truth_key_beside_the_design(page):
     rows = {row["truth key"]: (row["design model"], row["truth model"]) for row in table(embedded(page), "plant")}
     assert rows == {"truth.spacecraft.inertia": ("[10.0, 9.0, 6.0]", "[10.5, 8.7, 6.2]"),
-                    "truth.wheels.max_torque": ("0.05", "0.045")}
+                    "truth.wheels.max_torque": ("0.05", "0.045"),
+                    "truth.wheels.torque_noise": ("-", "1e-05"),  # the design model has no torque noise
+                    "truth.disturbance.constant": ("[1e-06, 0.0, 0.0]", "[2e-06, 0.0, 0.0]")}
     assert "truth model that differs from the design model" in page
 
 
@@ -109,7 +113,7 @@ def test_each_bound_is_shown_with_the_value_achieved_and_the_verdict(results, pa
 
 
 def test_a_run_on_the_design_model_says_so():
-    plain = {key: value for key, value in SCENARIO.items() if key != "truth"}
+    plain = {key: value for key, value in SCENARIO.items() if key not in ("truth", "environment")}
     plain["simulation"] = {"sample_time": 0.5, "duration": 60.0}
     plain["requirements"] = {}
     page = run_report(scenarios.run(scenarios.parse_scenario(plain)))

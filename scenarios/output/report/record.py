@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from scenarios.requirements.spec import Requirements
     from scenarios.schema.loader import Scenario
 
-__all__ = ["BOUNDS", "BROKEN", "UNREALISED_SHARE", "Bound", "add_record", "plant_entries", "provenance_entries", "requirement_lines",
+__all__ = ["BOUNDS", "BROKEN", "DESIGN_KEYS", "UNREALISED_SHARE", "Bound", "add_record", "plant_entries", "provenance_entries", "requirement_lines",
            "sensor_entries"]
 
 BROKEN = "{name} ({scope}): "
@@ -76,6 +76,10 @@ def _final(requirement: Any, fields: dict[str, Any]) -> list[Bound]:
     return [(name, "from_s", "≤", "none (scored only)" if bound is None else bound)
             for name, bound in (("worst_error_deg", requirement.error_deg), ("worst_rate_error", requirement.rate))]
 
+
+DESIGN_KEYS = {"disturbance.constant": "environment.disturbance_torque"}
+"""The design model's key of a ``truth:`` key that is not ``spacecraft.<key>`` or ``<key>`` (without
+the ``truth.`` prefix)."""
 
 BOUNDS: dict[str, Callable[[Any, dict[str, Any]], list[Bound]]] = {
     "pointing": _pointing, "actuators": _actuators, "rate": _rate, "final": _final}
@@ -147,10 +151,11 @@ def plant_entries(scenario: Scenario) -> list[tuple[str, str, str]]:
     -------
     list of (str, str, str)
         ``(truth key, design value, truth value)`` per key of the scenario's ``truth:`` section as
-        written (the design value: the scenario's at ``spacecraft.<key>`` or ``<key>`` for
-        ``truth.spacecraft.<key>``, ``spacecraft.<key>`` for any other, ``-`` when the design states
-        none); for a scenario built without its data, the truth model's fields that are set, with
-        ``-`` for the design. Empty without a truth model.
+        written (the design value: the scenario's at ``spacecraft.<key>`` for ``truth.spacecraft.<key>``
+        and ``truth.wheels.<key>`` (``spacecraft.wheels.<key>``), at :data:`DESIGN_KEYS`' key for
+        those it names, ``-`` when the scenario states none: a default, or an effect the design
+        model does not have); for a scenario built without its data, the truth model's fields that
+        are set, with ``-`` for the design. Empty without a truth model.
     """
     truth = scenario.truth
     if truth is None:
@@ -162,7 +167,7 @@ def plant_entries(scenario: Scenario) -> list[tuple[str, str, str]]:
                 if getattr(truth.truth, item.name) is not None and getattr(truth.truth, item.name) != ()]
     entries = []
     for path, value in _flat(data["truth"], ""):
-        candidates = [path, f"spacecraft.{path.removeprefix('spacecraft.')}"]
+        candidates = [DESIGN_KEYS[path]] if path in DESIGN_KEYS else [path, f"spacecraft.{path.removeprefix('spacecraft.')}"]
         design = next((found for found in (_at(data, c) for c in candidates) if found[0]), (False, None))
         entries.append((f"truth.{path}", _text(design[1]) if design[0] else "-", _text(value)))
     return entries
@@ -280,18 +285,20 @@ def add_record(page: Page, results: RunResults) -> None:
     """
     scenario = results.scenario
     page.section("Provenance", "What ran, when, and with which seeds (as results.json's provenance).")
-    page.table("provenance", [Column("entry"), Column("value")], provenance_entries(results))
+    page.table("provenance", [Column("entry"), Column("value")], provenance_entries(results), wrap=True)
     plant = plant_entries(scenario)
     if plant:
         page.section("Plant", "The closed loop integrates a truth model that differs from the design model the "
-                              "planners and controllers use, in these keys of the scenario's truth section:")
-        page.table("plant", [Column("truth key"), Column("design model"), Column("truth model")], plant)
+                              "planners and controllers use, in these keys of the scenario's truth section (design "
+                              "model: the scenario's value at the same key; -: none stated, a default or an effect "
+                              "the design model does not have):")
+        page.table("plant", [Column("truth key"), Column("design model"), Column("truth model")], plant, wrap=True)
     else:
         page.section("Plant", "The closed loop integrates the design model (the scenario has no truth section).")
     sentence, sensors = sensor_entries(scenario)
     page.section("Sensors and estimator", sentence)
     if sensors:
-        page.table("sensors", [Column("setting"), Column("value")], sensors)
+        page.table("sensors", [Column("setting"), Column("value")], sensors, wrap=True)
     words = _requirement_words(scenario.requirements)
     if not words:
         page.section("Requirements", "The scenario states no requirements.")
@@ -299,10 +306,11 @@ def add_record(page: Page, results: RunResults) -> None:
     page.section("Requirements", "Each requirement as stated, then per row and scope its bounded quantities: the "
                                  "bound, the value achieved, when (for the final requirement: its window's start), "
                                  "whether it is within the bound, and the run's verdict on the whole requirement.")
-    page.table("requirements", [Column("requirement"), Column("kind"), Column("bound")], words)
+    page.table("requirements", [Column("requirement"), Column("kind"), Column("bound")], words, wrap=True)
     lines = requirement_lines(results)
     if lines:
         page.table("requirement-scores",
                    [Column("row"), Column("scope"), Column("requirement"), Column("quantity"), Column("unit"),
                     Column("required"), Column("achieved", numeric=True), Column("at", "s", numeric=True),
-                    Column("within bound", order=("no", "yes")), Column("verdict", order=("broken", "met"))], lines)
+                    Column("within bound", order=("no", "yes")), Column("verdict", order=("broken", "met"))], lines,
+                   wrap=True)
