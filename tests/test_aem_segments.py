@@ -123,3 +123,28 @@ def test_jump_starts_from_samples_and_from_a_recorded_time():
     assert rate_jump_starts(t, small, omega_dot, [4.0]) == [9]
     assert rate_jump_starts(t, small, omega_dot, [4.2]) == [9]
     assert rate_jump_starts(t, small, omega_dot, [0.0, 11.0, float("nan")]) == []
+
+
+def test_segments_of_aem_text_and_a_segment_of_one_sample():
+    """A stop at the last sample interval (natural motion stopped at T between samples) leaves a
+    one-line segment: both readers read it, its span is its one time tag."""
+    from scenarios.output.aem import aem_text
+
+    t = np.arange(6) * 0.5
+    q = np.tile([1.0, 0.0, 0.0, 0.0], (6, 1))
+    omega = np.zeros((6, 3))
+    omega[:5, 2] = 0.01  # at rest from the last sample on
+    text = aem_text("2027-03-20T12:00:00Z", t, q, omega, object_name="x", segment_starts=[5])
+    first, second = read_aem(text).segments
+    assert (len(first.epochs), len(second.epochs)) == (5, 1)
+    assert second.metadata["START_TIME"] == second.metadata["STOP_TIME"] == second.epochs[0] \
+        == "2027-03-20T12:00:02.500000000"
+    np.testing.assert_array_equal(np.radians(first.values[-1, 4:]), [0.0, 0.0, 0.01])
+    np.testing.assert_array_equal(second.values[0, 4:], [0.0, 0.0, 0.0])
+    ndm = pytest.importorskip("ccsds_ndm", reason="ccsds-ndm-py (the `test` extra) reads AEMs independently")
+    message = ndm.from_str(text)
+    message.validate()
+    assert [len(s.data.attitude_states_epochs) for s in message.segments] == [5, 1]
+    for bad in ([0], [6]):
+        with pytest.raises(ValueError, match="segment starts"):
+            aem_text("2027-03-20T12:00:00Z", t, q, omega, object_name="x", segment_starts=bad)
