@@ -16,7 +16,9 @@ Content, without a browser (oracles independent of the page's code):
 
 In a real headless browser (Debian's Chromium driven by Selenium, ``tests/browser.py``; skipped with
 the reason when the browser, its driver or Selenium is missing; ``.ci/run`` installs them): the page loads with no error
-in the browser's console, every figure is drawn (SVG or canvas), the tables sort on a header click
+in the browser's console, every figure is drawn (SVG or canvas), the sign-off record's requirement
+table shows the scenario's rate bound beside each row's peak rate (the simulated ‖ω‖'s maximum,
+computed here), the tables sort on a header click
 (the order read back from the page), the study's paged table sorts over all its rows and filters,
 and a screenshot is a real picture.
 """
@@ -408,7 +410,7 @@ def check_screenshot(driver, path: Path) -> None:
 
 
 @needs_browser
-def test_the_run_report_in_a_browser(browser, run_html, tmp_path):
+def test_the_run_report_in_a_browser(browser, run_results, run_html, tmp_path):
     page = tmp_path / "report.html"
     page.write_text(run_html, encoding="utf-8")
     log = open_page(browser, page)
@@ -423,6 +425,15 @@ def test_the_run_report_in_a_browser(browser, run_html, tmp_path):
     assert click_header(browser, "rows", column) == "descending"
     assert column_order(browser, "rows", column) == sorted(values, reverse=True)
     assert column_order(browser, "rows", "label") in (["smooth", "bang-bang"], ["bang-bang", "smooth"])
+    # the sign-off record is drawn: the rate bound of the scenario beside each row's peak rate
+    cells = browser.execute_script(
+        "return Array.from(document.querySelectorAll('#requirement-scores tbody tr')).map("
+        "function (tr) { return Array.from(tr.cells).map(function (td) { return td.textContent; }); });")
+    rates = [cells_ for cells_ in cells if cells_[1:4] == ["closed loop", "rate", "peak_rate"]]
+    assert [cells_[0] for cells_ in rates] == ["smooth", "bang-bang"] and all(c[5] == "≤ 0.05" for c in rates)
+    for cells_, row in zip(rates, run_results.rows):
+        peak = np.max(np.linalg.norm(row.simulation.omega, axis=1))
+        assert float(cells_[6]) == pytest.approx(peak, rel=1e-3)  # shown with 4 significant digits
     # the second row's 3-D view replaces the first without an error
     from selenium.webdriver.support.ui import Select
 

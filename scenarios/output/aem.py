@@ -25,26 +25,40 @@ The conventions of the standard, and how slewbench's map onto them:
 * **Sign.** ``q`` and ``-q`` are one attitude; the series is written without sign jumps
   (:func:`ocp.quat.continuous`), so that a reader's interpolation between samples is meaningful.
 * **Interpolation.** ``QUATERNION``: ``LINEAR``, degree 1; ``QUATERNION/ANGVEL``: ``HERMITE``,
-  degree 3 (the rates are the derivatives at the nodes). The whole span is usable.
+  degree 3 (the rates are the derivatives at the nodes). Each segment's whole span is usable.
+* **Rate jumps.** A reference whose body rate jumps (natural motion's step stop: an impulse, which
+  no consumer's interpolation may smooth over) is written as one segment per stretch between its
+  jumps (:func:`rate_jump_starts`): a segment ends at the last sample before a jump, with the rate
+  on that side, and the next starts at the first sample after it, with the rate on its side; the
+  interval between them belongs to no segment, so a reader interpolates across no jump (the
+  standard's segments: each metadata block with its own ``START_TIME``/``STOP_TIME`` and
+  ``USEABLE_START_TIME``/``USEABLE_STOP_TIME``, 4.2.2).
+* **Traceability.** The header comments of an export name the run's slewbench version and date,
+  the run directory (a trade study's case: ``<sweep>/cases/<N>``), every provenance entry of
+  ``results.json`` but the scenario (seeds included) and the scenario's ``truth:`` section as run
+  (a Monte Carlo case's dispersed values), one key per line.
 
-:func:`aem_text` writes one message (one segment), :func:`read_aem` reads a KVN AEM (any number
-of segments; the data of the quaternion types) and :func:`time_tags` gives the time tags.
+:func:`aem_text` writes one message (one segment, or one per stretch between the given segment
+starts), :func:`read_aem` reads a KVN AEM (any number of segments; the data of the quaternion
+types) and :func:`time_tags` gives the time tags.
 """
 from __future__ import annotations
 
 import datetime
+import json
 import re
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp.dynamics.ephemeris import parse_utc, tdb_julian_date
 from ocp.quat import continuous
+from planners.reference import JUMP_TOLERANCE
 from scenarios.errors import ScenarioError
 
 if TYPE_CHECKING:
@@ -59,6 +73,8 @@ __all__ = [
     "aem_text",
     "check_aem_export",
     "format_number",
+    "provenance_comments",
+    "rate_jump_starts",
     "read_aem",
     "time_tags",
     "write_aem_files",
@@ -165,8 +181,10 @@ def _comment(text: str) -> list[str]:
 def aem_text(epoch: datetime.datetime | str | None, t: ArrayLike, q: ArrayLike, omega: ArrayLike | None = None, *,
              object_name: str, object_id: str = "UNKNOWN", originator: str = "SLEWBENCH",
              time_system: str = "UTC", created: datetime.datetime | None = None,
-             header_comments: Sequence[str] = (), comments: Sequence[str] = ()) -> str:
-    """One AEM (KVN, version 2.0, one segment) of an attitude history.
+             header_comments: Sequence[str] = (), comments: Sequence[str] = (),
+             segment_starts: Sequence[int] = ()) -> str:
+    """One AEM (KVN, version 2.0) of an attitude history: one segment, or one per stretch between
+    ``segment_starts``.
 
     Parameters
     ----------
@@ -188,7 +206,13 @@ def aem_text(epoch: datetime.datetime | str | None, t: ArrayLike, q: ArrayLike, 
     created : datetime.datetime, optional
         ``CREATION_DATE`` (UTC; default now).
     header_comments, comments : sequence of str, optional
-        ``COMMENT`` lines after the version line and at the start of the metadata.
+        ``COMMENT`` lines after the version line and at the start of each segment's metadata.
+    segment_starts : sequence of int, optional
+        Indices of the samples that start a new segment (in ``1 .. N-1``; a rate jump between
+        sample ``k - 1`` and sample ``k``, :func:`rate_jump_starts`): each segment has its own
+        metadata, whose ``START_TIME``, ``USEABLE_START_TIME``, ``USEABLE_STOP_TIME`` and
+        ``STOP_TIME`` are its first and last samples' (a comment says why it ends or starts there).
+        Empty (default): one segment.
 
     Returns
     -------
@@ -200,7 +224,8 @@ def aem_text(epoch: datetime.datetime | str | None, t: ArrayLike, q: ArrayLike, 
     ScenarioError
         Without an epoch (at ``epoch``).
     ValueError
-        Fewer than two samples, times not increasing, shapes that disagree or non-finite values.
+        Fewer than two samples, times not increasing, shapes that disagree, non-finite values or a
+        segment start outside ``1 .. N-1``.
     """
     if epoch is None:
         raise ScenarioError("epoch", "no epoch: the times are not absolute and the inertial frame is not the GCRF; a "
@@ -236,19 +261,135 @@ def aem_text(epoch: datetime.datetime | str | None, t: ArrayLike, q: ArrayLike, 
     for text in header_comments:
         lines += _comment(text)
     lines += [f"CREATION_DATE = {created.strftime('%Y-%m-%dT%H:%M:%S')}",
-              f"ORIGINATOR = {_kvn_text(originator)}", "", "META_START"]
-    for text in comments:
-        lines += _comment(text)
-    lines += [f"OBJECT_NAME = {_kvn_text(object_name)}", f"OBJECT_ID = {_kvn_text(object_id)}",
-              "CENTER_NAME = EARTH", f"REF_FRAME_A = {INERTIAL_FRAME}", f"REF_FRAME_B = {BODY_FRAME}",
-              f"TIME_SYSTEM = {time_system}", f"START_TIME = {tags[0]}", f"USEABLE_START_TIME = {tags[0]}",
-              f"USEABLE_STOP_TIME = {tags[-1]}", f"STOP_TIME = {tags[-1]}", f"ATTITUDE_TYPE = {attitude_type}"]
-    if omega is not None:
-        lines.append(f"ANGVEL_FRAME = {BODY_FRAME}")
-    lines += [f"INTERPOLATION_METHOD = {method}", f"INTERPOLATION_DEGREE = {degree}", "META_STOP", "", "DATA_START"]
-    lines += [" ".join([tag, *(format_number(v) for v in row)]) for tag, row in zip(tags, data)]
-    lines += ["DATA_STOP", ""]
+              f"ORIGINATOR = {_kvn_text(originator)}", ""]
+    starts = sorted({int(k) for k in segment_starts})
+    if starts and not (starts[0] >= 1 and starts[-1] <= t.size - 1):
+        raise ValueError(f"segment starts must lie in 1 .. {t.size - 1}, got {starts}")
+    bounds = list(zip([0, *starts], [*starts, t.size]))
+    for number, (first, stop) in enumerate(bounds, start=1):
+        lines.append("META_START")
+        for text in comments:
+            lines += _comment(text)
+        if len(bounds) > 1:
+            why = [f"the body rate jumps between {t[first - 1]:.9g} s and {t[first]:.9g} s"] if first > 0 else []
+            why += [f"the body rate jumps between {t[stop - 1]:.9g} s and {t[stop]:.9g} s"] if stop < t.size else []
+            lines += _comment(f"segment {number} of {len(bounds)}, t = {t[first]:.9g} s to {t[stop - 1]:.9g} s: "
+                              + " and ".join(why) + " (no interpolation across a jump)")
+        lines += [f"OBJECT_NAME = {_kvn_text(object_name)}", f"OBJECT_ID = {_kvn_text(object_id)}",
+                  "CENTER_NAME = EARTH", f"REF_FRAME_A = {INERTIAL_FRAME}", f"REF_FRAME_B = {BODY_FRAME}",
+                  f"TIME_SYSTEM = {time_system}", f"START_TIME = {tags[first]}",
+                  f"USEABLE_START_TIME = {tags[first]}", f"USEABLE_STOP_TIME = {tags[stop - 1]}",
+                  f"STOP_TIME = {tags[stop - 1]}", f"ATTITUDE_TYPE = {attitude_type}"]
+        if omega is not None:
+            lines.append(f"ANGVEL_FRAME = {BODY_FRAME}")
+        lines += [f"INTERPOLATION_METHOD = {method}", f"INTERPOLATION_DEGREE = {degree}", "META_STOP", "",
+                  "DATA_START"]
+        lines += [" ".join([tag, *(format_number(v) for v in row)])
+                  for tag, row in zip(tags[first:stop], data[first:stop])]
+        lines += ["DATA_STOP", ""]
     return "\n".join(lines)
+
+
+def rate_jump_starts(t: ArrayLike, omega: ArrayLike, omega_dot: ArrayLike | None = None,
+                     jump_times: Sequence[float] = ()) -> list[int]:
+    """Where a sampled body rate jumps: the indices of the first samples after each jump.
+
+    Between samples ``k`` and ``k + 1`` (``h`` apart) the rate jumps when it changes by more than
+    :data:`~planners.reference.JUMP_TOLERANCE` plus twice what its derivative explains over the
+    step, ``2 h max(‖ω̇_k‖, ‖ω̇_{k+1}‖)`` (the derivative where it is not finite: the larger of
+    the neighbouring steps' ``‖Δω‖ / h``). A smooth rate changes by at most ``h`` times its
+    largest derivative over the step, which differs from the ends' by ``O(h²)``; a jump smaller
+    than what the derivative explains over a step cannot be told from the samples, hence
+    ``jump_times`` (a run's recorded ``rate_jump_time_s``): a jump at ``t_k`` itself splits on the
+    side of the larger change.
+
+    Parameters
+    ----------
+    t : (N,) array_like
+        Increasing sample times [s].
+    omega : (N, 3) array_like
+        Body rate at ``t`` [rad/s].
+    omega_dot : (N, 3) array_like, optional
+        Its derivative [rad/s²] (NaN where not known); ``None``: not known.
+    jump_times : sequence of float, optional
+        Times [s] of jumps known otherwise; those outside ``(t[0], t[-1]]`` are ignored.
+
+    Returns
+    -------
+    list of int
+        Increasing indices in ``1 .. N-1``: a segment starts at each.
+    """
+    t = np.asarray(t, dtype=float).reshape(-1)
+    omega = np.asarray(omega, dtype=float).reshape(t.size, 3)
+    if t.size < 2:
+        return []
+    h = np.diff(t)
+    change = np.linalg.norm(np.diff(omega, axis=0), axis=1)
+    quotient = change / h
+    derivative = (np.full(t.size, np.nan) if omega_dot is None
+                  else np.linalg.norm(np.asarray(omega_dot, dtype=float).reshape(t.size, 3), axis=1))
+    left = np.concatenate([[0.0], quotient[:-1]])  # the step before each step
+    right = np.concatenate([quotient[1:], [0.0]])  # the step after
+    neighbours = np.maximum(left, right)
+    slope_start = np.where(np.isfinite(derivative[:-1]), derivative[:-1], neighbours)
+    slope_end = np.where(np.isfinite(derivative[1:]), derivative[1:], neighbours)
+    explained = JUMP_TOLERANCE + 2.0 * h * np.maximum(slope_start, slope_end)
+    starts = {int(k) + 1 for k in np.flatnonzero(change > explained)}
+    for time in jump_times:
+        if time is None or not np.isfinite(time) or not t[0] < time <= t[-1]:
+            continue
+        k = int(np.searchsorted(t, time, side="left"))  # t[k-1] < time <= t[k]
+        if np.isclose(t[k], time, rtol=0.0, atol=1e-9) and k + 1 < t.size and change[k] > change[k - 1]:
+            k += 1  # the sample at the jump holds the rate before it
+        starts.add(k)
+    return sorted(starts)
+
+
+def provenance_comments(provenance: dict[str, Any], directory: Path | None = None) -> list[str]:
+    """Comment lines that make an export traceable to its run (and a trade study's case).
+
+    Parameters
+    ----------
+    provenance : dict
+        ``results.json``'s ``provenance`` (:func:`~scenarios.output.provenance.run_provenance`).
+    directory : Path, optional
+        The run directory (a study's case re-run in full: ``<sweep>/cases/<N>``).
+
+    Returns
+    -------
+    list of str
+        ``run directory <path>``; ``provenance <entry> = <value>`` per entry but the scenario's
+        data (nested ones dotted: ``seeds.simulation.sensor_noise.seed``); ``truth.<key> =
+        <value>`` per key of the scenario's ``truth:`` section as run (a Monte Carlo case's
+        dispersed values; a matrix ``truth.<key>[i]`` one row a line), or a line saying the plant
+        is the design model.
+    """
+    lines = [] if directory is None else [f"run directory {directory}"]
+    for key, value in _leaves(provenance, ""):
+        if key != "scenario" and not key.startswith("scenario."):
+            lines.append(f"provenance {key} = {_json_text(value)}")
+    scenario = provenance.get("scenario")
+    if isinstance(scenario, dict):
+        truth = scenario.get("truth")
+        if isinstance(truth, dict) and truth:
+            for key, value in _leaves(truth, ""):  # a matrix one row a line, under a comment line's length
+                rows = value if isinstance(value, list) and value and all(isinstance(v, list) for v in value) else None
+                lines += ([f"truth.{key} = {_json_text(value)}"] if rows is None
+                          else [f"truth.{key}[{i}] = {_json_text(item)}" for i, item in enumerate(rows)])
+        else:
+            lines.append("no truth section: the closed loop integrated the design model")
+    return lines
+
+
+def _leaves(value: Any, path: str) -> list[tuple[str, Any]]:
+    """``(dotted path, value)`` of the leaves of nested dicts (lists are leaves)."""
+    if isinstance(value, dict) and value:
+        return [leaf for key, item in value.items() for leaf in _leaves(item, f"{path}.{key}" if path else str(key))]
+    return [(path, value)]
+
+
+def _json_text(value: Any) -> str:
+    return value if isinstance(value, str) else json.dumps(value, default=str)
 
 
 @dataclass(frozen=True)
@@ -424,7 +565,9 @@ def check_aem_export(run: RunRecord, options: AemOptions) -> None:
 
 
 def write_aem_files(run: RunRecord, directory: Path, options: AemOptions) -> list[str]:
-    """The ``aem`` export: ``<row>.closed_loop.aem`` and ``<row>.reference.aem`` per simulated row.
+    """The ``aem`` export: ``<row>.closed_loop.aem`` and ``<row>.reference.aem`` per simulated row,
+    traceable to the run (:func:`provenance_comments`), a reference split at its rate jumps
+    (:func:`rate_jump_starts`, with the row's recorded ``rate_jump_time_s``).
 
     Parameters
     ----------
@@ -448,6 +591,7 @@ def write_aem_files(run: RunRecord, directory: Path, options: AemOptions) -> lis
     check_aem_export(run, options)
     notes = []
     produced = f"slewbench {run.provenance.get('slewbench', '?')}, run finished {run.provenance.get('date_utc', '?')}"
+    traced = provenance_comments(run.provenance, run.directory)
     for row in run.rows:
         if row.timeseries is None:
             notes.append(f"row {row.label!r}: not simulated ({row.status}), no attitude history to export")
@@ -460,15 +604,19 @@ def write_aem_files(run: RunRecord, directory: Path, options: AemOptions) -> lis
             if np.all(np.isnan(q)):
                 notes.append(f"row {row.label!r}: no reference (regulation mode), no reference AEM")
                 continue
+            # the reference's rate may jump (an impulse); the closed loop's, integrated under finite torques, does not
+            starts = (rate_jump_starts(series["t"], omega, series["ref_omega_dot"], row.rate_jump_times)
+                      if scope == "reference" and np.all(np.isfinite(omega)) else [])
             try:
                 text = aem_text(run.epoch, series["t"], q,
                                 omega if options.attitude_type == "QUATERNION/ANGVEL" else None,
                                 object_name=options.object_name or run.scenario, object_id=options.object_id,
                                 originator=options.originator, time_system=options.time_system,
-                                header_comments=[f"{produced}: scenario {run.scenario}"],
+                                header_comments=[f"{produced}: scenario {run.scenario}", *traced],
                                 comments=[f"row {row.label} ({pair}), status {row.status}: {words} attitude",
                                           (f"quaternion from GCRF to SC_BODY_1 (slewbench's body-to-inertial q), "
-                                           f"t = 0 at {run.epoch}")])
+                                           f"t = 0 at {run.epoch}")],
+                                segment_starts=starts)
             except ValueError as error:
                 notes.append(f"row {row.label!r}: {words} not exported: {error}")
                 continue

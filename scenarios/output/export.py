@@ -59,6 +59,9 @@ class RunRow:
         The row's file stem (:func:`~scenarios.output.names.row_stems`).
     timeseries : Path or None
         Its ``timeseries/<stem>.csv``; ``None`` when the row was not simulated.
+    rate_jump_times : tuple of float, optional
+        When its reference's body rate jumps, as its scores record it (the largest jump's
+        ``requirements.reference.actuators.rate_jump_time_s``); empty: none recorded.
     """
 
     label: str
@@ -67,6 +70,7 @@ class RunRow:
     status: str
     stem: str
     timeseries: Path | None
+    rate_jump_times: tuple[float, ...] = ()
 
     def series(self) -> dict[str, Array]:
         """The row's time series as arrays (blank cells NaN).
@@ -165,9 +169,18 @@ def read_run(directory: str | Path) -> RunRecord:
         name = f"timeseries/{stem}.csv"
         series = path / name if name in manifest["files"] and (path / name).is_file() else None
         rows.append(RunRow(row["label"], row.get("planner"), row.get("controller"), row.get("status", ""), stem,
-                           series))
+                           series, _rate_jump_times(row)))
     return RunRecord(path.absolute(), str(data.get("scenario", "")), str(data.get("frame", "")), data.get("epoch"),
                      rows, data.get("provenance") or {})
+
+
+def _rate_jump_times(row: Any) -> tuple[float, ...]:
+    """The recorded time of a ``results.json`` row's largest reference rate jump (none when absent)."""
+    try:
+        time = row["requirements"]["reference"]["actuators"]["rate_jump_time_s"]
+    except (KeyError, TypeError):
+        return ()
+    return (float(time),) if isinstance(time, (int, float)) and not isinstance(time, bool) else ()
 
 
 @dataclass(frozen=True)

@@ -2,10 +2,12 @@
 
 What lives here: the page itself, with plotly.js inline, the data as one JSON document and the script
 that draws the tables and figures (:mod:`~scenarios.output.report.page`), a run's interactive figures
-(:mod:`~scenarios.output.report.figures`) and a run's report (:mod:`~scenarios.output.report.run`).
+(:mod:`~scenarios.output.report.figures`), a run's sign-off record (:mod:`~scenarios.output.report.record`)
+and a run's report (:mod:`~scenarios.output.report.run`).
 A trade study's report (:mod:`scenarios.study.html`) is built on the same page.
 
-May import: :mod:`ocp`, :mod:`scenarios.requirements.fields` (the requirement fields' units),
+May import: :mod:`ocp`, :mod:`planners` (the jump tolerance of a reference's rate),
+:mod:`scenarios.requirements.fields` (the requirement fields' units),
 :mod:`scenarios.schema` and :mod:`scenarios.output`. plotly.js comes from the
 ``plotly`` package's files (the package itself is not imported).
 """

@@ -288,7 +288,7 @@ class Page:
         self._body.append(f"<p>{html.escape(text)}</p>")
 
     def table(self, key: str, columns: Sequence[Column], rows: Sequence[Sequence[Any]],
-              page_size: int | None = None, caption: str = "") -> str:
+              page_size: int | None = None, caption: str = "", wrap: bool = False) -> str:
         """A sortable table: a click on a header sorts by that column, a second click reverses.
 
         Parameters
@@ -304,6 +304,9 @@ class Page:
             Rows shown at once, with page buttons and a filter box; ``None``: all rows.
         caption : str, optional
             A line above the table.
+        wrap : bool, optional
+            Text cells shown whole, wrapped over lines (a record's words); by default a long text
+            is cut on one line, whole when the pointer rests on it.
 
         Returns
         -------
@@ -319,7 +322,7 @@ class Page:
             "rows": json_safe([list(row) for row in rows]), "page_size": page_size}
         if caption:
             self._body.append(f'<p class="caption">{html.escape(caption)}</p>')
-        self._body.append(f'<div class="sb-table" id="{ident}"></div>')
+        self._body.append(f'<div class="sb-table{" sb-wrap" if wrap else ""}" id="{ident}"></div>')
         return ident
 
     def figure(self, key: str, figure: dict[str, Any], caption: str = "") -> str:
@@ -449,6 +452,7 @@ nav ul{list-style:none;padding:0;display:flex;flex-wrap:wrap;gap:.4em 1.2em}nav 
 .sb-table table{border-collapse:collapse;font-size:12.5px;white-space:nowrap}
 .sb-table th,.sb-table td{border:1px solid #ddd;padding:2px 6px;text-align:right}
 .sb-table td.text{text-align:left;max-width:28em;overflow:hidden;text-overflow:ellipsis}
+.sb-wrap td.text{max-width:48em;white-space:normal;overflow-wrap:anywhere}
 .sb-table th{background:#f3f3f3;cursor:pointer;user-select:none;position:sticky;top:0;vertical-align:bottom}
 .sb-table th .unit{display:block;font-weight:normal;color:#666;font-size:11px}
 .sb-table th[aria-sort=ascending]::after{content:" \\25B2"}.sb-table th[aria-sort=descending]::after{content:" \\25BC"}

@@ -1,6 +1,9 @@
 """A run's ``report.html``: its rows as a sortable table and its figures, interactive.
 
-The page (:class:`~scenarios.output.report.page.Page`) holds, in order: the rows table (identity,
+The page (:class:`~scenarios.output.report.page.Page`) holds, in order: the sign-off record
+(:func:`~scenarios.output.report.record.add_record`: the provenance, the plant (design and truth
+model), the sensors and estimator, and the requirements with, per row, their bounds, the values
+achieved and the verdicts), the rows table (identity,
 status and message, then the requirement and the metric columns of ``results.csv`` with their
 units; columns without a value in any row left out), each simulated row against time
 (:func:`~scenarios.output.report.figures.row_figure`), each pointing requirement's margin
@@ -20,6 +23,7 @@ from scenarios.output.report.figures import (
     sky_figure,
 )
 from scenarios.output.report.page import Column, Page, column_unit
+from scenarios.output.report.record import add_record
 from scenarios.output.tables import (
     IDENTITY_COLUMNS,
     ROW_STATUSES,
@@ -108,6 +112,7 @@ def run_page(results: RunResults) -> Page:
     if scenario.source is not None:
         lines.append(f"Scenario file: {scenario.source.name}")
     page = Page(f"{scenario.name}: slewbench run", lines)
+    add_record(page, results)
     page.section("Rows", "One row per planner and controller; click a header to sort (again to reverse). "
                          "ref.* columns score the reference, cl.* the closed loop; req.<name>.<field> columns "
                          "score the requirements. Missing values: -.")
