@@ -478,6 +478,9 @@ class _Expansion:
         seeds = [int(child.generate_state(1)[0]) for child in children[:n]]
         draws = self._draws(seeds, children)
         study.parameters = {name: draw for name, draw, _ in self.drawn}
+        names = list(study.parameters)
+        drawn_rows = [dict(zip(names, row)) for row in np.column_stack([v for _, _, v in self.drawn]).tolist()] \
+            if names else [{} for _ in range(n)]
         radix = [axis.length for axis in self.axes]
         template = _KeyTemplate.make(study.base, [item for axis in self.axes for item in axis.varied]
                                      + [item for item, _ in self.dispersions], self.version)
@@ -509,7 +512,7 @@ class _Expansion:
                     else:
                         drawn.append((item, value))
                 case = Case(index, seeds[index], point, case_varied, with_values(study.base, case_updates),
-                            drawn={name: float(values[index]) for name, _, values in self.drawn})
+                            drawn=drawn_rows[index])
                 self._check(case, case_class, positions, drawn)
                 case.key = case_key(case.scenario, self.version) if template is None else \
                     template.key([value for _, value, _ in case_updates])
