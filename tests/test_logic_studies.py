@@ -151,7 +151,7 @@ def test_summary_statistics_per_grid_point_against_hand_worked_values(tmp_path):
     """Two grid points, four Monte Carlo samples each; the values of ``cl.int_u`` are given, one row
     failed without a value. Hand-worked (sample std, linear percentiles):
     point 1 [1, 2, 4, 10]: mean 4.25, std sqrt(48.75/3), median 3, p5 1.15, p95 9.1;
-    point 2 [3, -, 5, 6]:  count 3 (rows with a value), no_value 1, failures 1, mean 14/3, std sqrt(14/3/2),
+    point 2 [3, -, 5, 6]:  count 3 (rows with a value), no_value 1, not_ok 1, mean 14/3, std sqrt(14/3/2),
     median 5, p5 3.2, p95 5.9."""
     study = scenarios.parse_study(study_data(
         grid={"maneuver.duration": [30.0, 40.0]}, summary=["cl.int_u"],
@@ -164,9 +164,9 @@ def test_summary_statistics_per_grid_point_against_hand_worked_values(tmp_path):
         lines = list(csv.DictReader(handle))
     assert len(lines) == 2
     by_point = {float(line["maneuver.duration"]): line for line in lines}
-    expected = {30.0: {"count": 4, "failures": 0, "mean": 4.25, "std": np.sqrt(48.75 / 3), "median": 3.0,
+    expected = {30.0: {"count": 4, "not_ok": 0, "mean": 4.25, "std": np.sqrt(48.75 / 3), "median": 3.0,
                        "p5": 1.15, "p95": 9.1, "min": 1.0, "max": 10.0},
-                40.0: {"count": 3, "no_value": 1, "failures": 1, "mean": 14 / 3, "std": np.sqrt(14 / 3 / 2),
+                40.0: {"count": 3, "no_value": 1, "not_ok": 1, "mean": 14 / 3, "std": np.sqrt(14 / 3 / 2),
                        "median": 5.0, "p5": 3.2, "p95": 5.9, "min": 3.0, "max": 6.0}}
     for duration, stats in expected.items():
         line = by_point[duration]

@@ -77,7 +77,7 @@ def test_a_sweep_stores_the_requirement_columns_and_reports_the_fraction_met(tmp
     results.write(tmp_path / "out", plots=False)
     summary = list(csv.DictReader(io.StringIO((tmp_path / "out" / "summary.csv").read_text())))
     margins = next(line for line in summary if line["metric"] == "ref.req.st.min_margin_deg")
-    assert float(margins["min"]) == pytest.approx(-30.0, abs=1e-6) and margins["failures"] == "1"
+    assert float(margins["min"]) == pytest.approx(-30.0, abs=1e-6) and margins["not_ok"] == "1"
     written = list(csv.DictReader(io.StringIO((tmp_path / "out" / "requirements.csv").read_text())))
     assert written[0]["met"] == "2" and written[0]["completed"] == "3"
     assert "## Cases meeting every requirement" in (tmp_path / "out" / "summary.md").read_text()

@@ -131,24 +131,38 @@ def test_sensitivity_csv_equals_scipy_on_the_stored_cases(swept):
     _, out = swept
     cases = pd.read_csv(out / "cases.csv")
     sensitivity = pd.read_csv(out / "sensitivity.csv")
-    # a vector per component; the component that is not dispersed (std 0) and the case seed are left out
+    # one parameter per drawn quantity: a vector per component (the one not dispersed, std 0, and the case
+    # seed left out), the whole-inertia scale ONE factor although it multiplies 3 moments
     assert set(sensitivity["parameter"]) == {"simulation.initial_attitude_error_deg[0]",
-                                             "simulation.initial_attitude_error_deg[1]", "spacecraft.inertia[0]",
-                                             "spacecraft.inertia[1]", "spacecraft.inertia[2]",
+                                             "simulation.initial_attitude_error_deg[1]", "spacecraft.inertia",
                                              "controller.options.kd"}
-    assert len(sensitivity) == 2 * len(SUMMARY) * 6
+    assert dict(zip(sensitivity["parameter"], sensitivity["draw"])) == {
+        "simulation.initial_attitude_error_deg[0]": "value", "simulation.initial_attitude_error_deg[1]": "value",
+        "spacecraft.inertia": "scale", "controller.options.kd": "value"}
+    assert len(sensitivity) == 2 * len(SUMMARY) * 4
     for _, line in sensitivity.iterrows():
         group = cases[cases["label"] == line["label"]]
         path, _, index = line["parameter"].partition("[")
+        # the scale's ranks are those of any (positive) moment it multiplies, read back from cases.csv
         x = np.array([_component(v, int(index[:-1]) if index else 0) for v in group[path]])
         y = group[line["metric"]].to_numpy(dtype=float)
-        expected = spearmanr(x, y).statistic
+        expected = spearmanr(x, y)
         assert line["cases"] == 10
-        assert line["spearman_rho"] == pytest.approx(expected, abs=1e-12), (line["label"], line["metric"], path)
+        assert line["spearman_rho"] == pytest.approx(expected.statistic, abs=1e-12), (line["label"], line["metric"], path)
+        assert line["p_value"] == pytest.approx(expected.pvalue, rel=1e-9, abs=1e-15), (line["label"], line["metric"])
+        assert line["rho_low"] <= line["spearman_rho"] <= line["rho_high"]
+    # Holm within each label: the adjusted p-values, by scipy's multiple-test-free arithmetic by hand
+    for _, group in sensitivity.groupby("label"):
+        p = group["p_value"].to_numpy()
+        order = np.argsort(p, kind="stable")
+        adjusted = np.maximum.accumulate(np.minimum(1.0, (len(p) - np.arange(len(p))) * p[order]))
+        np.testing.assert_allclose(group["p_holm"].to_numpy()[order], adjusted, rtol=1e-12)
+        assert (group["significant"] == (group["p_holm"] <= 0.05)).all()
     # the smooth row's reference is one quintic profile whatever the inertia, so its torque (I times the
     # angular acceleration) and the closed loop's effort rank with the inertia scale: the table is not noise
-    rho = sensitivity.set_index(["label", "metric", "parameter"])["spearman_rho"]
-    assert rho["smooth", "cl.int_u", "spacecraft.inertia[0]"] > 0.9
+    rho = sensitivity.set_index(["label", "metric", "parameter"])
+    assert rho.loc[("smooth", "cl.int_u", "spacecraft.inertia"), "spearman_rho"] > 0.9
+    assert bool(rho.loc[("smooth", "cl.int_u", "spacecraft.inertia"), "significant"])
 
 
 # --- worst cases ----------------------------------------------------------------------------------

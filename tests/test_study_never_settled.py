@@ -90,7 +90,7 @@ def test_summary_counts_never_settled_cases_and_takes_them_as_inf(tmp_path):
     max inf."""
     _, out = study_results(tmp_path)
     line = next(r for r in read(out / "summary.csv") if r["metric"] == "cl.settling_time_s")
-    assert (line["count"], line["never"], line["no_value"], line["failures"]) == ("3", "2", "1", "2")
+    assert (line["count"], line["never"], line["no_value"], line["not_ok"]) == ("3", "2", "1", "2")
     assert float(line["mean"]) == pytest.approx(70 / 3, rel=1e-12)
     assert float(line["std"]) == pytest.approx(math.sqrt(700 / 3), rel=1e-12)
     assert float(line["median"]) == 40.0 and float(line["p5"]) == pytest.approx(12.0, rel=1e-12)

@@ -89,14 +89,14 @@ def test_the_summary_leaves_out_rows_that_did_not_complete_and_counts_them(swept
     """cl.int_u over the rows ok or violated, [1, 2, 4]: mean 7/3; deviations -4/3, -1/3, 5/3,
     squares 42/9, over n - 1 = 2: variance 7/3; median 2; p5 at position 0.1: 1.1; p95 at 1.9: 3.8;
     min 1, max 4. Left out: the failed (100), the crashed and the infeasible (50) rows: no_value 3,
-    excluded 3; failures (rows not ok) 4."""
+    excluded 3; not_ok (rows not ok) 4."""
     _, _, out = swept
     line = summary_lines(out)["cl.int_u"]
     assert float(line["mean"]) == pytest.approx(7 / 3, rel=1e-12), line
     assert float(line["std"]) == pytest.approx(math.sqrt(7 / 3), rel=1e-12)
     assert float(line["median"]) == 2.0 and float(line["min"]) == 1.0 and float(line["max"]) == 4.0
     assert float(line["p5"]) == pytest.approx(1.1, rel=1e-12) and float(line["p95"]) == pytest.approx(3.8, rel=1e-12)
-    assert (line["count"], line["never"], line["no_value"], line.get("excluded"), line["failures"]) == \
+    assert (line["count"], line["never"], line["no_value"], line.get("excluded"), line["not_ok"]) == \
         ("3", "", "3", "3", "4"), line
 
 

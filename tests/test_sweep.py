@@ -320,7 +320,7 @@ def test_cli_outputs_summary_statistics_and_report_redraw(tmp_path):
         line = summary[(summary["maneuver.duration"] == duration) & (summary["label"] == label)
                        & (summary["metric"] == "cl.int_u")].iloc[0]
         values = group["cl.int_u"].to_numpy()
-        assert line["count"] == 3 and line["failures"] == 0
+        assert line["count"] == 3 and line["not_ok"] == 0
         assert line["mean"] == pytest.approx(values.mean()) and line["std"] == pytest.approx(values.std(ddof=1))
         assert line["p95"] == pytest.approx(np.percentile(values, 95)) and line["max"] == pytest.approx(values.max())
     for name in ("summary.md", "study.yaml", "plots/metrics_vs_maneuver.duration.png", "plots/boxplots.png",

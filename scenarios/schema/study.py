@@ -57,14 +57,17 @@ __all__ = [
     "INDEPENDENT_KEYS",
     "MAX_CASES",
     "MAX_CASE_TIMEOUT_S",
+    "MAX_PRINCIPAL_AXES_DEG",
     "MAX_SEED",
     "MAX_VALUES",
     "MAX_VARIED",
     "MAX_WORST",
     "MONTE_CARLO",
+    "PRINCIPAL",
     "ROBUSTNESS",
     "SCHEDULER_SCHEMES",
     "STUDY",
+    "SYMMETRIC_KEYS",
     "THRESHOLD",
     "THRESHOLD_SENSES",
     "VALUE_GENERATORS",
@@ -74,6 +77,7 @@ __all__ = [
     "grid_values",
     "independent_key",
     "scheduler_address",
+    "symmetric_key",
     "takes_integers",
 ]
 
@@ -241,9 +245,10 @@ class Distribution:
     Parameters
     ----------
     argument : Key
-        Reads the argument into ``(a, b, vector)``: two ``(n,)`` arrays of parameters (in the
-        units of the scenario key dispersed) and whether the value is a list of ``n`` numbers;
-        its ``name`` is the distribution's.
+        Reads the argument into ``(a, b, shape)``: two ``(n,)`` arrays of parameters (in the
+        units of the scenario key dispersed, flattened row by row) and the shape of the value:
+        ``()`` a number, ``(n,)`` a list of ``n`` numbers, ``(rows, columns)`` a matrix; its
+        ``name`` is the distribution's.
     inverse_cdf : callable
         ``inverse_cdf(unit, a, b) -> draws``: unit samples in [0, 1) turned into draws, each
         ``(n,)`` array.
@@ -258,46 +263,63 @@ class Distribution:
         return self.argument.name
 
 
-def _numbers(first: Node, second: Node) -> tuple[np.ndarray, np.ndarray, bool]:
-    vector = isinstance(first.value, list)
-    a = first.vector() if vector else np.atleast_1d(first.number())
-    b = second.vector(a.size) if vector else np.atleast_1d(second.number())
-    return a, b, vector
+def _parameter(node: Node) -> np.ndarray:
+    """A distribution's parameter: a number, a list of numbers or a matrix (a list of equal-length
+    lists of numbers, such as a 3x3 tensor), as a 0-, 1- or 2-d array of finite floats."""
+    if isinstance(node.value, list) and node.value and all(isinstance(row, list) for row in node.value):
+        rows = [Node(row, f"{node.path}[{i}]").vector() for i, row in enumerate(node.value)]
+        if len({row.size for row in rows}) != 1:
+            raise node.error(f"expected a matrix (rows of equal length), got rows of {[row.size for row in rows]} "
+                             "numbers")
+        return np.array(rows)
+    return node.vector() if isinstance(node.value, list) else np.asarray(node.number(), dtype=float)
 
 
-_PARAMETER = "number or list of numbers"
+def _numbers(first: Node, second: Node) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
+    a = _parameter(first)
+    b = _parameter(second)
+    if b.shape != a.shape:
+        def shape(x: np.ndarray) -> str:
+            return "a number" if x.ndim == 0 else " x ".join(map(str, x.shape))
+        raise second.error(f"expected the shape of {first.path.rsplit('.', 1)[-1]} ({shape(a)}), got {shape(b)}")
+    return a.ravel(), b.ravel(), a.shape
+
+
+_PARAMETER = "number, list of numbers or matrix"
 
 NORMAL = Section((
-    custom("mean", "Mean of each component (a list: the value is a vector).", _PARAMETER, None),
+    custom("mean", "Mean of each component (a list: the value is a vector; a list of lists: a matrix, element by "
+           "element).", _PARAMETER, None),
     custom("std", "Standard deviation of each component (as many as ``mean``).", _PARAMETER, None,
            bounds=">= 0"),
 ), "A normal distribution per component.")
 
 UNIFORM = Section((
-    custom("low", "Low bound of each component (a list: the value is a vector).", _PARAMETER, None),
+    custom("low", "Low bound of each component (a list: the value is a vector; a list of lists: a matrix, element "
+           "by element).", _PARAMETER, None),
     custom("high", "High bound of each component (as many as ``low``).", _PARAMETER, None, bounds=">= low"),
 ), "A uniform distribution per component, written ``[low, high]`` or ``{low, high}``.")
 
 
-def _normal(node: Node) -> tuple[np.ndarray, np.ndarray, bool]:
+def _normal(node: Node) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
     values = NORMAL.read(node)
-    a, b, vector = _numbers(values["mean"], values["std"])
+    a, b, shape = _numbers(values["mean"], values["std"])
     if np.any(b < 0):
-        raise values["std"].error(f"a standard deviation cannot be negative, got {values['std'].value!r}")
-    return a, b, vector
+        raise values["std"].error(f"a standard deviation cannot be negative, got {excerpt(values['std'].value)}")
+    return a, b, shape
 
 
-def _uniform(node: Node) -> tuple[np.ndarray, np.ndarray, bool]:
+def _uniform(node: Node) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
     if isinstance(node.value, list):
         if len(node.value) != 2:
-            raise node.error(f"expected [low, high], got {node.value!r:.80}")
-        a, b, vector = _numbers(Node(node.value[0], f"{node.path}[0]"), Node(node.value[1], f"{node.path}[1]"))
+            raise node.error(f"expected [low, high], got {excerpt(node.value)}")
+        a, b, shape = _numbers(Node(node.value[0], f"{node.path}[0]"), Node(node.value[1], f"{node.path}[1]"))
     else:
         values = UNIFORM.read(node)
-        a, b, vector = _numbers(values["low"], values["high"])
+        a, b, shape = _numbers(values["low"], values["high"])
     if np.any(b < a):
-        raise node.error(f"expected low <= high, got {node.value!r:.80}")
-    return a, b, vector
+        raise node.error(f"expected low <= high, got {excerpt(node.value)}")
+    return a, b, shape
 
 
 _EPS = 1e-12  # keeps the normal's inverse CDF finite at u = 0
@@ -333,8 +355,55 @@ CASE_SEED = custom("case_seed", "The case's own seed (for ``simulation.sensor_no
                    "``case_seed``.", "the word case_seed", None)
 """The dispersion that sets a case's own seed."""
 
+SYMMETRIC_KEYS = ("spacecraft.inertia", "truth.spacecraft.inertia")
+"""Scenario keys holding a symmetric 3x3 tensor (or its 3 principal moments). A study that varies
+one element ``<key>[i][j]`` sets ``<key>[j][i]`` to the same value; a matrix-shaped dispersion of
+the key draws the upper triangle and mirrors it (its parameters must be symmetric); and the key
+takes the ``principal`` dispersion (:data:`PRINCIPAL`)."""
+
+
+def symmetric_key(steps: Sequence[Step]) -> bool:
+    """Whether ``steps`` names one of :data:`SYMMETRIC_KEYS` (the whole key, no index).
+
+    Parameters
+    ----------
+    steps : sequence of Step
+        The parsed scenario path.
+
+    Returns
+    -------
+    bool
+    """
+    return all(isinstance(step, str) for step in steps) and ".".join(map(str, steps)) in SYMMETRIC_KEYS
+
+
+MAX_PRINCIPAL_AXES_DEG = 180.0
+"""Largest rotation of the principal axes a ``principal.axes_deg`` draw may reach [deg] (a uniform
+bound; a normal draw beyond it is refused at its case)."""
+
+PRINCIPAL = Section((
+    custom("moments_scale", "Factor on each principal moment of the base tensor: ``{<distribution>: <argument>}`` "
+           "of a number (one factor for the three) or of 3 numbers, the moment about the principal axis nearest "
+           "body axis x, y, z; absent: 1.", "{distribution: argument}", None, default=None, bounds="> 0"),
+    custom("axes_deg", "Rotation vector (body frame) turning the base tensor's principal axes: "
+           "``{<distribution>: <argument>}`` of 3 numbers, the rotation's angle their norm; absent: none.",
+           "{distribution: argument}", None, unit="deg", default=None),
+), "Dispersion of an inertia tensor in its principal frame: the case's tensor is "
+   "``R V diag(s m) Vᵀ Rᵀ`` with ``V diag(m) Vᵀ`` the base tensor (its eigendecomposition), ``s`` the moment "
+   "factors and ``R`` the rotation of ``axes_deg``: symmetric, positive definite while the factors are "
+   "positive, with the principal axes turned by exactly the rotation's angle.")
+"""The ``principal`` dispersion of a key of :data:`SYMMETRIC_KEYS`: ``{principal: {moments_scale:
+<distribution>, axes_deg: <distribution>}}``."""
+
 DISPERSION = custom("<path>", "A scenario path and how it is dispersed: ``{<distribution>: <argument>}`` (the draw "
-                    "is the value), ``{scale|offset: {<distribution>: <argument>}}``, or ``case_seed``.",
+                    "is the value), ``{scale|offset: {<distribution>: <argument>}}``, ``case_seed``, or, for an "
+                    "inertia tensor (``spacecraft.inertia``, ``truth.spacecraft.inertia``), ``{principal: "
+                    "{moments_scale: <distribution>, axes_deg: <distribution>}}``: its principal moments scaled "
+                    "and its principal axes rotated, the tensor kept symmetric and positive definite. A matrix "
+                    "parameter (a 3x3 ``low``, ``high``, ``mean`` or ``std``) disperses a matrix element by "
+                    "element; for an inertia tensor it must be symmetric, and the draw of element ``[i][j]`` is "
+                    "that of ``[j][i]`` too. Dispersing (or varying) one product of inertia "
+                    "``<tensor>[i][j]`` sets ``[j][i]`` to the same value.",
                     "mapping or the word case_seed", None)
 """A ``monte_carlo.dispersions`` entry, keyed by the scenario path it disperses."""
 

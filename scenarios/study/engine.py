@@ -359,7 +359,7 @@ class _Engine:
         self.cpu_s: dict[str, float] = {}
         self.worker_cpu_s: dict[str, float] = {}
         self.elapsed: collections.deque[float] = collections.deque(maxlen=64)
-        self.failures = 0
+        self.not_ok = 0
         self.no_workers_since: float | None = None
         self.next_cluster_check = 0.0
         self.bar = None
@@ -425,7 +425,7 @@ class _Engine:
         self.records[key] = {"status": status, "rows": rows, "elapsed_s": elapsed, "attempts": attempts}
         self.finished.add(key)
         batch.append((key, status, encode_rows(rows) if text is None else text, elapsed, attempts))
-        self.failures += any(row["status"] != "ok" for row in rows)
+        self.not_ok += any(row["status"] != "ok" for row in rows)
 
     def _commit(self, batch: list[tuple[str, str, str, float | None, int]]) -> None:
         """Commit finished cases in one transaction, then report them (a case shown done is stored)."""
@@ -434,7 +434,7 @@ class _Engine:
         if self.store is not None:
             self.store.put_encoded(batch)
         if self.bar is not None:
-            self.bar.set_postfix(failures=self.failures, refresh=False)
+            self.bar.set_postfix(not_ok=self.not_ok, refresh=False)
             self.bar.update(len(batch))
 
     def _crash(self, key: str, message: str, batch: list) -> None:

@@ -45,9 +45,12 @@ ROBUSTNESS_SECTIONS = (
                     "robustness.thresholds, with the Wilson 95 % interval (robustness.csv). As in the summary, only "
                     "rows ok or violated count: a failed or infeasible row is completed and meets no threshold "
                     "whatever its values; excluded: the rows left out (failed, infeasible, crashed).")),
-    ("Sensitivity", ("Spearman rank correlation of each summary metric with each dispersed parameter, a vector per "
-                     "component, over the rows ok or violated where the metric has a value, a case that never "
-                     "settled ranked after every settled one; excluded: the rows left out (sensitivity.csv).")),
+    ("Sensitivity", ("Spearman rank correlation of each summary metric with each drawn quantity (one per number a "
+                     "dispersion draws: a whole-tensor scale is one factor; draw: value, scale, offset or principal), "
+                     "over the rows ok or violated where the metric has a value, a case that never settled ranked "
+                     "after every settled one; excluded: the rows left out. rho_low, rho_high: its 95 % interval; "
+                     "p_value: two-sided (exact up to 8 cases, else the t approximation); p_holm: adjusted over the "
+                     "group's correlations, and significant when at most 0.05 (sensitivity.csv).")),
     ("Worst cases", ("The largest values of each summary metric (smallest for an at_least threshold) among the rows "
                      "ok or violated, by case id (inf: the case never settled; excluded: the rows left out); re-run "
                      "one in full with slewbench sweep DIR --case N (worst_cases.csv).")),
@@ -224,7 +227,8 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
                             "or violated count, as in the plots: excluded counts the failed, infeasible and crashed "
                             "ones, left out whatever their values. mean and std (sample standard deviation) are over "
                             "the count rows; median, p5, p95 (linear percentiles), min and max over those and the "
-                            "never rows as inf; failures: rows not ok.")
+                            "never rows as inf; not_ok: rows whose status is not ok (violated, failed, infeasible or "
+                            "crashed).")
     page.table("summary", _columns(summary_names, summary_rows),
                [[row.get(c) for c in summary_names] for row in summary_rows])
     if study.summary and rows:

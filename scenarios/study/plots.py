@@ -588,7 +588,8 @@ def _box(values: np.ndarray) -> dict[str, Any]:
 
 def _sensitivity(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figure]]:
     """The rank correlations of ``sensitivity.csv`` as one heat map per group (at most
-    :data:`MAX_GROUPS`): summary metrics down, dispersed parameter components across, -1 to 1."""
+    :data:`MAX_GROUPS`): summary metrics down, the drawn quantities
+    (:func:`scenarios.study.robustness.parameter_columns`) across, -1 to 1."""
     from scenarios.study.robustness import sensitivity_table
 
     columns, table = sensitivity_table(study, rows)
@@ -612,13 +613,13 @@ def _sensitivity(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str
             for (i, j), value in np.ndenumerate(matrix):
                 axis.text(j, i, "–" if math.isnan(value) else f"{value:.2f}", ha="center", va="center", fontsize=7,
                           color="white" if abs(value) > 0.6 else "black")  # NaN > 0.6 is False: black
-        axis.set_xticks(range(len(parameters)), [textwrap.shorten(q, 40) for q in parameters], rotation=30,
+        axis.set_xticks(range(len(parameters)), [q if len(q) <= 40 else f"…{q[-39:]}" for q in parameters], rotation=30,
                         ha="right", fontsize=7)
         axis.set_yticks(range(len(metrics)), metrics, fontsize=7)
         axis.set_title(name, fontsize=9)
     figure.colorbar(images[0], ax=axes, label="Spearman rank correlation (–)")
     more = f" (the first {len(shown)} of {len(groups)} groups)" if len(shown) < len(groups) else ""
-    _title(figure, f"{study.name}: rank correlation of each summary metric with each dispersed parameter "
+    _title(figure, f"{study.name}: rank correlation of each summary metric with each drawn quantity "
                    f"(sensitivity.csv; –: the metric does not vary){more}")
     yield "sensitivity.png", figure
 

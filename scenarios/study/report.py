@@ -39,7 +39,7 @@ from scenarios.study.types import Study
 if TYPE_CHECKING:  # the engine imports this module lazily
     from scenarios.study.engine import SweepResults
 
-STATISTICS = ("count", "never", "no_value", "excluded", "failures", "mean", "std", "median", "p5", "p95", "min",
+STATISTICS = ("count", "never", "no_value", "excluded", "not_ok", "mean", "std", "median", "p5", "p95", "min",
               "max")
 """The columns of ``summary.csv`` after the grouping keys and ``metric`` (:func:`summary_table`)."""
 COUNTED_STATUSES = ("ok", "violated")
@@ -208,7 +208,8 @@ def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], 
     means that it does not apply), ``no_value`` the other rows (the metric does not apply, or the
     row does not count); the three add up to the group's rows. ``excluded`` counts the rows left
     out because they do not count (``failed``, ``infeasible``, ``crashed``: part of ``no_value``,
-    whatever values they carry), ``failures`` the rows whose status is not ``ok``. ``mean`` and
+    whatever values they carry), ``not_ok`` the rows whose status is not ``ok`` (``violated``, ``failed``,
+    ``infeasible``, ``crashed``). ``mean`` and
     ``std`` are over the ``count`` rows with a value; ``median``, ``p5``, ``p95`` (linear
     percentiles), ``min`` and ``max`` are over those and the ``never`` rows taken as +inf
     (:func:`percentile`), so that a percentile reached by cases that never settled is +inf.
@@ -240,7 +241,7 @@ def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], 
             line = {k: members[0].get(k) for k in keys}
             line.update(metric=metric, count=int(finite.size), never=never if never_witness(metric) else None,
                         no_value=int(np.isnan(values).sum()), excluded=sum(not counted(r) for r in members),
-                        failures=sum(r["status"] != "ok" for r in members))
+                        not_ok=sum(r["status"] != "ok" for r in members))
             mean = std = None
             if finite.size:
                 mean, std = float(finite.mean()), float(finite.std(ddof=1)) if finite.size > 1 else 0.0
@@ -454,7 +455,7 @@ def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], miss
                  "count: rows with a value; never: rows that never reached one (a case that never settled); "
                  "no_value: the other rows (excluded ones included). mean and std (sample standard deviation) are "
                  "over the count rows; median, p5, p95 (linear percentiles), min and max over those and the never "
-                 "rows as inf; failures: rows not ok."), ""]
+                 "rows as inf; not_ok: rows whose status is not ok (violated, failed, infeasible or crashed)."), ""]
     if requirements is not None:
         out += ["## Cases meeting every requirement", "",
                 "Rows whose status is ok among the completed ones (not crashed), with the Wilson 95 % interval.", ""]

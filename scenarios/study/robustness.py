@@ -15,9 +15,12 @@ as ``summary.csv`` groups them), written as ``robustness.csv``, ``sensitivity.cs
   count once (:func:`scenarios.study.report.distinct_rows`).
 * :func:`sensitivity_table`: Spearman's rank correlation of each summary metric with each dispersed
   parameter over the rows where the metric has a value or never reached one (a case that never
-  settled ranks after every settled one, ties averaged: :func:`scenarios.study.report.metric_values`);
-  a dispersed vector (or matrix) gives one parameter per component (``spacecraft.inertia[1]``), and
-  components that do not vary are left out. Ties get their average rank.
+  settled ranks after every settled one, ties averaged: :func:`scenarios.study.report.metric_values`)
+  with its p-value, 95 % interval and Holm-adjusted p-value over the group's correlations
+  (:func:`rank_significance`, :func:`holm`). The parameters are the drawn quantities
+  (:func:`parameter_columns`): one per number a dispersion draws (a whole-tensor ``scale`` is one
+  factor; a vector gives one per component, ``simulation.initial_rate_error[1]``), not per element
+  of the value it sets; quantities that do not vary are left out. Ties get their average rank.
 * :func:`worst_table`: the ``robustness.worst`` cases with the largest value of each summary metric
   (the smallest for a metric with an ``at_least`` threshold), by case id, with their seeds, to be
   re-run in full with ``slewbench sweep DIR --case N``; a case that never settled is +inf, the
@@ -35,6 +38,7 @@ A threshold on a metric counts a case that never reached it as +inf too (it does
 """
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from typing import Any
@@ -42,10 +46,10 @@ from typing import Any
 import numpy as np
 
 from scenarios.output.tables import text_cell
-from scenarios.schema.study import CASE_SEED
 from scenarios.study.report import (
     INFINITY_TEXT,
     PROPORTION_STATISTICS,
+    WILSON_Z,
     counted,
     distinct_rows,
     group_rows,
@@ -55,8 +59,8 @@ from scenarios.study.report import (
 from scenarios.study.types import Study
 
 __all__ = ["EVERY_REQUIREMENT", "ROBUSTNESS_STATISTICS", "SENSITIVITY_STATISTICS", "WORST_COLUMNS", "crashed_counts",
-           "criterion_text", "excluded_count", "parameter_columns",
-           "proportion_table", "robustness_lines", "robustness_markdown", "sensitivity_table", "spearman",
+           "criterion_text", "excluded_count", "holm", "parameter_columns",
+           "proportion_table", "rank_significance", "robustness_lines", "robustness_markdown", "sensitivity_table", "spearman",
            "worst_table"]
 
 EVERY_REQUIREMENT = "every requirement"
@@ -66,11 +70,20 @@ ROBUSTNESS_STATISTICS = (PROPORTION_STATISTICS[0], "excluded", *PROPORTION_STATI
 ``requirements.csv`` (:data:`~scenarios.study.report.PROPORTION_STATISTICS`) with ``excluded``
 after ``completed`` (:func:`excluded_count`: the ``failed`` and ``infeasible`` ones among them
 are completed and meet no criterion)."""
-SENSITIVITY_STATISTICS = ("cases", "excluded", "spearman_rho")
-"""The columns of ``sensitivity.csv`` after the grouping keys, ``metric`` and ``parameter``: the rows
-that count with a value of the metric or that never reached one (+inf, the largest rank), the
-group's rows left out (:func:`excluded_count`), and the rank correlation (None when either side
-does not vary)."""
+SENSITIVITY_STATISTICS = ("cases", "excluded", "spearman_rho", "rho_low", "rho_high", "p_value", "p_holm",
+                          "significant")
+"""The columns of ``sensitivity.csv`` after the grouping keys, ``metric``, ``parameter`` and ``draw``:
+the rows that count with a value of the metric or that never reached one (+inf, the largest rank),
+the group's rows left out (:func:`excluded_count`), the rank correlation (None when either side
+does not vary), its 95 % interval and two-sided p-value (:func:`rank_significance`), the p-value
+adjusted over the group's correlations (:func:`holm`) and whether that is at most
+:data:`SIGNIFICANCE`."""
+SIGNIFICANCE = 0.05
+"""The level of ``significant`` in ``sensitivity.csv``: Holm-adjusted p-value at most this."""
+EXACT_CASES = 8
+"""Up to this many cases a rank correlation's p-value is exact (its ``n!`` pairings enumerated)."""
+SMALL_SAMPLE = 30
+"""Below this many cases ``summary.md`` says how large a rank correlation must be to be significant."""
 WORST_COLUMNS = ("metric", "rank", "case", "seed", "value", "status", "excluded")
 """The columns of ``worst_cases.csv`` after the grouping keys (``excluded``: the group's rows left
 out of the ranking, :func:`excluded_count`)."""
@@ -156,54 +169,38 @@ def proportion_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str
     return [*keys, "criterion", *ROBUSTNESS_STATISTICS], table
 
 
-def _components(value: Any) -> list[float] | None:
-    """A dispersed value's numbers: one for a scalar, each component of a vector or matrix recorded
-    as JSON text (row by row); None when it holds anything else."""
-    if isinstance(value, str):
-        try:
-            value = json.loads(value)
-        except ValueError:
-            return None
-    if isinstance(value, bool):
-        return None
-    if isinstance(value, (int, float)):
-        return [float(value)]
-    try:
-        array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        return None
-    return [float(v) for v in array.ravel()] if array.size else None
+def parameter_columns(study: Study, rows: list[dict[str, Any]]) -> list[tuple[str, str, np.ndarray]]:
+    """The drawn quantities of the dispersions as numbers, one column per quantity drawn.
 
-
-def parameter_columns(study: Study, rows: list[dict[str, Any]]) -> list[tuple[str, np.ndarray]]:
-    """The dispersed parameters as numbers: one column per scalar path, one per component of a vector
-    (``simulation.initial_rate_error[0]``) or matrix (``spacecraft.inertia[4]``, row by row).
+    A dispersion gives one parameter per number it draws (:attr:`Study.parameters
+    <scenarios.study.types.Study.parameters>`), not per element of the value it sets: a
+    whole-tensor ``scale`` is one factor, however many elements it multiplies; a vector gives one
+    per component (``simulation.initial_rate_error[0]``), a matrix one per independent element
+    (``truth.spacecraft.inertia[0][1]``, the upper triangle of a symmetric tensor), a ``principal``
+    dispersion its moment factors and rotation components.
 
     Parameters
     ----------
     study : Study
-        The study (its dispersed paths and their dispersions; ``case_seed`` ones are not parameters).
+        The expanded study (its cases' draws; ``case_seed`` draws none).
     rows : list of dict
         The ``cases.csv`` rows.
 
     Returns
     -------
-    list of (str, ndarray)
-        The parameter's name and its value in each row (NaN where a row has none); parameters that
-        take one value in every row are left out.
+    list of (str, str, ndarray)
+        The parameter's name, what the number is (``value``, ``scale``, ``offset``,
+        ``principal``) and its value in each row (NaN for a row of no case of the study);
+        parameters that take one value in every row are left out.
     """
-    dispersions = (study.raw.get("monte_carlo") or {}).get("dispersions") or {}
+    drawn = {case.index: case.drawn for case in study.cases}
     columns = []
-    for path in study.mc_paths:
-        if dispersions.get(path) == CASE_SEED.name:
-            continue
-        parsed = [_components(row.get(path)) for row in rows]
-        size = max((len(p) for p in parsed if p is not None), default=0)
-        for k in range(size):
-            values = np.array([p[k] if p is not None and len(p) == size else math.nan for p in parsed])
-            finite = values[np.isfinite(values)]
-            if finite.size and np.ptp(finite) > 0:
-                columns.append((path if size == 1 else f"{path}[{k}]", values))
+    for name, draw in study.parameters.items():
+        values = np.array([drawn.get(row["case"], {}).get(name, math.nan) if isinstance(row.get("case"), int)
+                           else math.nan for row in rows], dtype=float)
+        finite = values[np.isfinite(values)]
+        if finite.size and np.ptp(finite) > 0:
+            columns.append((name, draw, values))
     return columns
 
 
@@ -249,6 +246,87 @@ def spearman(x: np.ndarray, y: np.ndarray) -> float | None:
     return max(-1.0, min(1.0, float(np.dot(rx, ry)) / scale))
 
 
+def _exact_p(x: np.ndarray, y: np.ndarray) -> float:
+    """The exact two-sided permutation p-value of Spearman's rho: the fraction of the ``n!``
+    pairings of the ranks whose correlation is at least as large in magnitude."""
+    rx, ry = _ranks(x), _ranks(y)
+    rx, ry = rx - rx.mean(), ry - ry.mean()
+    scale = math.sqrt(float(np.dot(rx, rx)) * float(np.dot(ry, ry)))
+    pairings = np.array(list(itertools.permutations(range(x.size))))
+    rhos = np.abs(ry[pairings] @ rx) / scale
+    return float(np.mean(rhos >= abs(float(np.dot(rx, ry))) / scale - 1e-12))
+
+
+def rank_significance(rho: float | None, n: int, x: np.ndarray | None = None,
+                      y: np.ndarray | None = None) -> dict[str, float | None]:
+    """The significance of a rank correlation ``rho`` over ``n`` pairs.
+
+    The p-value is two-sided, of the hypothesis that the two do not rank together: exact over
+    :data:`EXACT_CASES` pairs or fewer when the pairs ``x``, ``y`` are given (every pairing of their
+    ranks enumerated: 3 cases ranked perfectly have p = 1/3), else from the t distribution with
+    ``n - 2`` degrees of freedom of ``rho sqrt((n - 2) / (1 - rho²))`` (as ``scipy.stats.spearmanr``),
+    a perfect ranking taking ``2 / n!``, its exact value without ties. The 95 % interval is
+    Fisher's ``tanh(atanh(rho) ± 1.96 se)`` with the Bonett-Wright standard error for Spearman's
+    rho, ``se = sqrt((1 + rho²/2) / (n - 3))``.
+
+    Parameters
+    ----------
+    rho : float or None
+        The rank correlation (None: none, then every statistic is None).
+    n : int
+        The pairs it is over.
+    x, y : (n,) ndarray or None, optional
+        The pairs themselves (no NaN), for the exact p-value of a few cases.
+
+    Returns
+    -------
+    dict
+        ``p_value`` (None below :data:`MIN_CASES` pairs), ``rho_low`` and ``rho_high`` (None below
+        4 pairs).
+    """
+    from scipy.special import stdtr  # lazily: only a study's report needs it
+
+    out: dict[str, float | None] = {"rho_low": None, "rho_high": None, "p_value": None}
+    if rho is None or n < MIN_CASES:
+        return out
+    if n <= EXACT_CASES and x is not None and y is not None:
+        out["p_value"] = _exact_p(x, y)
+    elif abs(rho) >= 1.0:
+        out["p_value"] = 2.0 / math.factorial(n)
+    else:
+        t = abs(rho) * math.sqrt((n - 2) / (1.0 - rho * rho))
+        out["p_value"] = float(min(1.0, 2.0 * stdtr(n - 2, -t)))
+    if n >= 4:
+        z = math.atanh(max(-1.0 + 1e-15, min(1.0 - 1e-15, rho)))
+        half = WILSON_Z * math.sqrt((1.0 + rho * rho / 2.0) / (n - 3))
+        out["rho_low"], out["rho_high"] = math.tanh(z - half), math.tanh(z + half)
+    return out
+
+
+def holm(p_values: list[float | None]) -> list[float | None]:
+    """Holm's step-down adjustment of a family of p-values (None left out of the family).
+
+    Parameters
+    ----------
+    p_values : list of float or None
+        The family's p-values.
+
+    Returns
+    -------
+    list of float or None
+        Each adjusted p-value, ``max over j <= k of min(1, (m - j + 1) p_(j))`` for the k-th smallest
+        of the ``m`` given: at most 0.05 controls the chance of any false finding in the family at
+        5 %.
+    """
+    given = sorted((p, k) for k, p in enumerate(p_values) if p is not None)
+    out: list[float | None] = [None] * len(p_values)
+    running = 0.0
+    for rank, (p, k) in enumerate(given):
+        running = max(running, min(1.0, (len(given) - rank) * p))
+        out[k] = running
+    return out
+
+
 def sensitivity_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
     """Spearman's rank correlation of each summary metric with each dispersed parameter, per group.
 
@@ -262,11 +340,14 @@ def sensitivity_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[st
     Returns
     -------
     columns : list of str
-        The grouping keys, ``metric``, ``parameter`` and :data:`SENSITIVITY_STATISTICS`.
+        The grouping keys, ``metric``, ``parameter``, ``draw`` and :data:`SENSITIVITY_STATISTICS`.
     rows : list of dict
-        One per group, summary metric and parameter (:func:`parameter_columns`); empty without
-        dispersed parameters. Over the rows that count (``ok``, ``violated``: the values of
-        ``summary.csv``); ``excluded`` counts the group's others.
+        One per group, summary metric and drawn quantity (:func:`parameter_columns`); empty
+        without dispersed parameters. Over the rows that count (``ok``, ``violated``: the values of
+        ``summary.csv``); ``excluded`` counts the group's others. Each correlation has its
+        p-value and 95 % interval (:func:`rank_significance`); ``p_holm`` is its p-value adjusted
+        over the group's correlations (:func:`holm`) and ``significant`` whether that is at most
+        :data:`SIGNIFICANCE`.
     """
     keys, groups = group_rows(study, rows)
     table = []
@@ -275,16 +356,23 @@ def sensitivity_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[st
     for members in groups.values():
         index = np.array([position[id(r)] for r in members], dtype=int)
         excluded = excluded_count(members)
+        lines = []
         for metric in study.summary:
             # never settled: +inf, the largest rank; a row that does not count: NaN, left out
             values = metric_values(metric, members, counted_only=True)
-            for name, column in parameters:
+            for name, draw, column in parameters:
                 line = {k: members[0].get(k) for k in keys}
-                line.update(metric=metric, parameter=name,
-                            cases=int(np.sum(~np.isnan(values) & np.isfinite(column[index]))), excluded=excluded,
-                            spearman_rho=spearman(column[index], values))
-                table.append(line)
-    return [*keys, "metric", "parameter", *SENSITIVITY_STATISTICS], table
+                cases = int(np.sum(~np.isnan(values) & ~np.isnan(column[index])))
+                rho = spearman(column[index], values)
+                keep = ~np.isnan(values) & ~np.isnan(column[index])
+                line.update(metric=metric, parameter=name, draw=draw, cases=cases, excluded=excluded,
+                            spearman_rho=rho, **rank_significance(rho, cases, column[index][keep], values[keep]))
+                lines.append(line)
+        for line, adjusted in zip(lines, holm([line["p_value"] for line in lines])):
+            line["p_holm"] = adjusted
+            line["significant"] = None if adjusted is None else adjusted <= SIGNIFICANCE
+        table += lines
+    return [*keys, "metric", "parameter", "draw", *SENSITIVITY_STATISTICS], table
 
 
 def worst_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
@@ -381,24 +469,62 @@ def robustness_markdown(study: Study, rows: list[dict[str, Any]],
         out += ["Rows not ok, by case id (re-run one in full with `slewbench sweep DIR --case N`):", "", *not_ok, ""]
     columns, table = sensitivity
     if table:
-        parameters = list(dict.fromkeys(line["parameter"] for line in table))
+        headers = list(dict.fromkeys(f"{line['parameter']} ({line['draw']})" for line in table))
         keys = columns[:columns.index("metric")]
         wide: dict[tuple, dict[str, Any]] = {}
         for line in table:
             entry = wide.setdefault(tuple(json.dumps(line.get(k)) for k in keys) + (line["metric"],),
                                     {**{k: line.get(k) for k in keys}, "metric": line["metric"]})
-            entry[line["parameter"]] = line["spearman_rho"]
-        out += ["## Sensitivity", "", ("Spearman rank correlation of each summary metric (rows) with each dispersed "
-                                       "parameter (columns; a vector per component), over the rows ok or violated "
-                                       "where the metric has a value, a case that never settled ranked after every "
-                                       "settled one; empty: the metric does not vary."), ""]
-        out += _lines([*keys, "metric", *parameters], list(wide.values())) + [""]
+            entry[f"{line['parameter']} ({line['draw']})"] = _correlation_cell(line)
+        out += ["## Sensitivity", "", ("Spearman rank correlation of each summary metric (rows) with each drawn "
+                                       "quantity (columns: one per number a dispersion draws, a whole-tensor scale "
+                                       "one factor; its kind after the name), over the rows ok or violated where the "
+                                       "metric has a value, a case that never settled ranked after every settled "
+                                       "one; empty: the metric does not vary. In brackets the two-sided p-value "
+                                       "(exact up to 8 cases, else the t approximation); * : significant at 5 % after Holm's correction over the "
+                                       "group's correlations (sensitivity.csv: the 95 % intervals, p_holm). A "
+                                       "correlation without * may be chance at this many cases."),
+                ""]
+        out += _small_sample_notes(keys, table)
+        out += _lines([*keys, "metric", *headers], list(wide.values())) + [""]
     if worst[1]:
         out += ["## Worst cases", "", (f"The {study.worst} largest values of each summary metric (smallest for "
                                        "an at_least threshold) among the rows ok or violated, by case id; inf: the "
                                        "case never settled."), ""]
         out += _lines(*worst) + [""]
     return "\n".join(out)
+
+
+def _correlation_cell(line: dict[str, Any]) -> str | None:
+    """A correlation as ``summary.md`` shows it: ``-0.962 (p 2e-09) *``."""
+    rho = line.get("spearman_rho")
+    if rho is None or rho == "":
+        return None
+    p = line.get("p_value")
+    return f"{rho:.3g}" + ("" if p is None else f" (p {p:.2g})") + (" *" if line.get("significant") else "")
+
+
+def _small_sample_notes(keys: list[str], table: list[dict[str, Any]]) -> list[str]:
+    """A note per group with fewer than :data:`SMALL_SAMPLE` cases: the smallest rank correlation
+    significant at 5 % with that many (before the correction for the number of correlations)."""
+    from scipy.special import stdtrit  # lazily: only a study's report needs it
+
+    notes = []
+    seen: set[tuple[str, ...]] = set()
+    for line in table:
+        group = tuple(json.dumps(line.get(k)) for k in keys)
+        n = int(line.get("cases") or 0)
+        if group in seen or not MIN_CASES <= n < SMALL_SAMPLE:
+            continue
+        seen.add(group)
+        t = float(stdtrit(n - 2, 1.0 - SIGNIFICANCE / 2.0))
+        family = sum(1 for other in table if tuple(json.dumps(other.get(k)) for k in keys) == group
+                     and other.get("p_value") is not None)
+        name = ", ".join(text_cell(line.get(k)) for k in keys)
+        notes.append(f"Note ({name}): only {n} cases. A rank correlation must exceed about "
+                     f"{t / math.sqrt(n - 2 + t * t):.2f} in magnitude to be significant at 5 % on its own, more after "
+                     f"the correction for the {family} correlations; a larger sample narrows the intervals.")
+    return notes + ([""] if notes else [])
 
 
 def crashed_counts(study: Study, rows: list[dict[str, Any]]) -> dict[tuple[str, ...], int]:

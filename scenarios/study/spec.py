@@ -46,6 +46,7 @@ from scenarios.schema.study import (
     STUDY,
     grid_values,
     independent_key,
+    symmetric_key,
     takes_integers,
 )
 from scenarios.study.dispersions import Dispersion, draw_unit, parse_dispersion
@@ -70,6 +71,11 @@ class _Varied:
     entry: str  # the study entry, for messages (grid.<path>, zip.<path>, monte_carlo.dispersions.<path>)
     steps: list[Step]
     independent: Key | None = None  # the key's reader checks each value (INDEPENDENT_KEYS)
+    mirror: list[Step] | None = None  # a product of inertia's twin [j][i], set to the same value
+
+    def targets(self) -> list[list[Step]]:
+        """The paths a value of this entry is set at: its own, and its mirror's."""
+        return [self.steps] if self.mirror is None else [self.steps, self.mirror]
 
 
 @dataclass
@@ -135,10 +141,11 @@ class _KeyTemplate:
 
     @classmethod
     def make(cls, base: dict[str, Any], varied: list[_Varied], version: str) -> _KeyTemplate | None:
-        if any(a is not b and a.steps[:len(b.steps)] == b.steps for a in varied for b in varied):
+        targets = [(steps, item.entry) for item in varied for steps in item.targets()]  # as the cases' updates
+        if any(a is not b and a[:len(b)] == b for a, _ in targets for b, _ in targets):
             return None
-        marks = [f"\x00slewbench-varied-{index}\x00" for index in range(len(varied))]
-        data = with_values(base, [(item.steps, mark, item.entry) for item, mark in zip(varied, marks)])
+        marks = [f"\x00slewbench-varied-{index}\x00" for index in range(len(targets))]
+        data = with_values(base, [(steps, mark, entry) for (steps, entry), mark in zip(targets, marks)])
         text = case_text(data, version)
         found = []
         for index, mark in enumerate(marks):
@@ -180,10 +187,46 @@ def _register(varied: _Varied, seen: list[_Varied]) -> None:
     for earlier in seen:
         if earlier.steps == varied.steps:
             raise ScenarioError(varied.entry, f"this path is also in {_describe(earlier)}; vary it in one place")
-        if earlier.steps[:len(varied.steps)] == varied.steps:
+        if varied.steps in earlier.targets()[1:] or earlier.steps in varied.targets()[1:]:
+            raise ScenarioError(varied.entry, f"{_cut(earlier.path)} (varied by {_describe(earlier)}) is the same "
+                                              "product of inertia: varying [i][j] sets [j][i] too; vary it in one place")
+        inner, outer = sorted((earlier.steps, varied.steps), key=len, reverse=True)
+        if symmetric_key(outer) and inner[:len(outer)] == outer:
+            raise ScenarioError(varied.entry, f"{_cut(earlier.path)} (varied by {_describe(earlier)}) is the same "
+                                              "inertia tensor; vary it in one place (the whole tensor, or its elements)")
+        if any(target[:len(varied.steps)] == varied.steps for target in earlier.targets()):
             raise ScenarioError(varied.entry, f"it replaces {_cut(earlier.path)} (varied by {_describe(earlier)}) "
                                               "as a whole; vary it in one place")
     seen.append(varied)
+
+
+def _mirror(steps: list[Step], base: dict[str, Any], where: str) -> list[Step] | None:
+    """The twin ``<tensor>[j][i]`` of a path to a product of inertia ``<tensor>[i][j]`` (a key of
+    :data:`~scenarios.schema.study.SYMMETRIC_KEYS`), which the study sets to the same value so that
+    the tensor stays symmetric; None for any other path (a moment ``[i][i]`` included).
+
+    Raises
+    ------
+    ScenarioError
+        At ``where``: an element of a tensor the base scenario gives as 3 principal moments, or a
+        whole row of a 3x3 tensor (it would break its symmetry).
+    """
+    for length in (len(steps) - 2, len(steps) - 1):
+        if length < 1 or not symmetric_key(steps[:length]) or not all(isinstance(s, int) for s in steps[length:]):
+            continue
+        key = ".".join(map(str, steps[:length]))
+        tensor = get_path(base, steps[:length], where)
+        if not (isinstance(tensor, list) and len(tensor) == 3 and all(isinstance(row, list) for row in tensor)):
+            if length == len(steps) - 2:
+                raise ScenarioError(where, f"{key} holds 3 principal moments in the base scenario; give it as the 3x3 "
+                                           "tensor (zero products of inertia) to vary its products of inertia")
+            return None  # a principal moment of the 3 numbers
+        if length == len(steps) - 1:
+            raise ScenarioError(where, f"{_cut(key)}[{steps[-1]}] is a row of a symmetric tensor; vary the whole "
+                                       f"tensor or its elements {key}[i][j] (each also sets [j][i])")
+        i, j = (int(step) % 3 for step in steps[length:] if isinstance(step, int))
+        return None if i == j else [*steps[:length], j, i]
+    return None
 
 
 def _axes(root: Node, base: dict[str, Any], seen: list[_Varied]) -> list[_Axis]:
@@ -196,8 +239,9 @@ def _axes(root: Node, base: dict[str, Any], seen: list[_Varied]) -> list[_Axis]:
         for path in node.value:
             entry = node.get(path)
             varied = _Varied(path, entry.path, parse_path(path, entry.path))
-            _register(varied, seen)
+            varied.mirror = _mirror(varied.steps, base, entry.path)
             get_parent_ok(base, varied.steps, entry.path)
+            _register(varied, seen)
             values, recorded = grid_values(entry, base)
             if section == "grid":
                 axes.append(_Axis([varied], [values], [recorded], len(values)))
@@ -295,8 +339,9 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
         for path in node.value:
             entry = node.get(path)
             varied = _Varied(path, entry.path, parse_path(path, entry.path))
-            _register(varied, seen)
+            varied.mirror = _mirror(varied.steps, base, entry.path)
             get_parent_ok(base, varied.steps, entry.path)
+            _register(varied, seen)
             dispersion = parse_dispersion(entry, base, varied.steps)
             if dispersion.kind == CASE_SEED.name and takes_integers(varied.steps, base) is False:
                 raise entry.error(f"case_seed sets an integer (the case's seed); {_cut(path)} does not take one "
@@ -386,7 +431,9 @@ class _Expansion:
         return found
 
     def _draws(self, seeds: list[int], children: list[np.random.SeedSequence]) -> list[list[Any]]:
-        """Per dispersion, the value of every case (in case order), drawn as case by case."""
+        """Per dispersion, the value of every case (in case order), drawn as case by case; the drawn
+        quantities (:meth:`scenarios.study.dispersions.Dispersion.drawn`) go into ``self.drawn``."""
+        self.drawn: list[tuple[str, str, np.ndarray]] = []  # (parameter, draw, values per case)
         if not self.dispersions:
             return []
         study, n = self.study, self.total
@@ -403,8 +450,15 @@ class _Expansion:
         column = 0
         for varied, dispersion in self.dispersions:
             base = get_path(study.base, varied.steps, varied.entry) if dispersion.needs_base else None
-            values = dispersion.values(units[:, column:column + dispersion.dimension], seeds, base)
+            own = units[:, column:column + dispersion.dimension]
+            values = dispersion.values(own, seeds, base)
             column += dispersion.dimension
+            refused = dispersion.refused(own)
+            if refused is not None:
+                raise ScenarioError(varied.entry, f"case {refused[0]}: {refused[1]}")
+            names, drawn = dispersion.drawn(own)
+            draw = {"set": "value"}.get(dispersion.combine, dispersion.combine)
+            self.drawn += [(varied.path + name, draw, drawn[:, k]) for k, name in enumerate(names)]
             if isinstance(values, np.ndarray):
                 finite = np.isfinite(values.reshape(n, -1)).all(axis=1)
                 if not finite.all():
@@ -423,6 +477,10 @@ class _Expansion:
         children = np.random.SeedSequence(study.seed).spawn(n + self.points)
         seeds = [int(child.generate_state(1)[0]) for child in children[:n]]
         draws = self._draws(seeds, children)
+        study.parameters = {name: draw for name, draw, _ in self.drawn}
+        names = list(study.parameters)
+        drawn_rows = [dict(zip(names, row)) for row in np.column_stack([v for _, _, v in self.drawn]).tolist()] \
+            if names else [{} for _ in range(n)]
         radix = [axis.length for axis in self.axes]
         template = _KeyTemplate.make(study.base, [item for axis in self.axes for item in axis.varied]
                                      + [item for item, _ in self.dispersions], self.version)
@@ -437,7 +495,7 @@ class _Expansion:
             for axis, position in zip(self.axes, positions):
                 independent = True
                 for item, values, recorded in zip(axis.varied, axis.values, axis.recorded):
-                    updates.append((item.steps, values[position], item.entry))
+                    updates += [(steps, values[position], item.entry) for steps in item.targets()]
                     varied[item.path] = recorded[position]
                     independent &= item.independent is not None
                 grid_class.append(-1 if independent else position)
@@ -447,13 +505,14 @@ class _Expansion:
                 case_class, drawn = tuple(grid_class), []
                 for (item, _), column in zip(self.dispersions, draws):
                     value = column[index]
-                    case_updates.append((item.steps, value, item.entry))
+                    case_updates += [(steps, value, item.entry) for steps in item.targets()]
                     case_varied[item.path] = _recorded(value)
                     if item.independent is None:
                         case_class += (index,)
                     else:
                         drawn.append((item, value))
-                case = Case(index, seeds[index], point, case_varied, with_values(study.base, case_updates))
+                case = Case(index, seeds[index], point, case_varied, with_values(study.base, case_updates),
+                            drawn=drawn_rows[index])
                 self._check(case, case_class, positions, drawn)
                 case.key = case_key(case.scenario, self.version) if template is None else \
                     template.key([value for _, value, _ in case_updates])

@@ -57,6 +57,10 @@ class Case:
         The resolved scenario mapping (plain YAML data), as a worker receives it.
     key : str
         The store key (:func:`case_key`); empty until the study is expanded.
+    drawn : dict
+        Parameter -> the number the case drew for it (:attr:`Study.parameters`): the drawn
+        quantities of its Monte Carlo dispersions, one per independent component (a whole-tensor
+        ``scale`` is one factor, however many elements it multiplies).
     """
 
     index: int
@@ -65,6 +69,7 @@ class Case:
     varied: dict[str, Any]
     scenario: dict[str, Any]
     key: str = ""
+    drawn: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass
@@ -102,6 +107,14 @@ class Study:
         (``robustness.thresholds``): the robustness table's criteria beside every requirement.
     worst : int
         Worst cases listed per planner row and summary metric (``robustness.worst``).
+    parameters : dict
+        The drawn quantities of the Monte Carlo dispersions (each case's are in
+        :attr:`Case.drawn`), in order: parameter -> what the number is, ``value`` (the drawn value),
+        ``scale`` (a factor on the base value), ``offset`` (added to it) or ``principal`` (a
+        principal moment's factor, a component of the principal axes' rotation [deg]). The
+        parameter is the dispersed path, with the component for a vector (``[k]``) or matrix
+        (``[i][j]``) and ``.principal.moments_scale[k]`` or ``.principal.axes_deg[k]`` for a
+        ``principal`` dispersion; ``case_seed`` draws none.
     """
 
     name: str
@@ -118,6 +131,7 @@ class Study:
     raw: dict[str, Any] = field(default_factory=dict)
     thresholds: dict[str, tuple[str, float]] = field(default_factory=dict)
     worst: int = 5
+    parameters: dict[str, str] = field(default_factory=dict)
 
     @property
     def varied_paths(self) -> list[str]:

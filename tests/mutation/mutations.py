@@ -54,9 +54,9 @@ MUTATIONS: list[Mutation] = [
     Mutation("study-summary-p95-nearest", "scenarios/study/report.py",
              "return float(np.percentile(values, q))",
              "return float(np.percentile(values, q, method='nearest'))", (L + "studies.py",)),
-    Mutation("study-summary-failures-crashed-only", "scenarios/study/report.py",
-             'failures=sum(r["status"] != "ok" for r in members)',
-             'failures=sum(r["status"] == "crashed" for r in members)', (L + "studies.py",)),
+    Mutation("study-summary-not-ok-crashed-only", "scenarios/study/report.py",
+             'not_ok=sum(r["status"] != "ok" for r in members)',
+             'not_ok=sum(r["status"] == "crashed" for r in members)', (L + "studies.py",)),
     Mutation("study-store-keeps-the-first", "scenarios/study/store.py",
              "INSERT OR REPLACE INTO cases", "INSERT OR IGNORE INTO cases", (L + "studies.py",)),
     # --- detumbling --------------------------------------------------------------------------------
