@@ -76,12 +76,13 @@ METRIC_INFO: dict[str, MetricInfo] = {
         "with ``spacecraft.wheels.max_torque``); null without wheels and for a reference."),
     "final_error_deg": MetricInfo(
         "deg", "Error angle 2 acos|q_e0| (``q_e = q_f* ⊗ q``) between the attitude at the last sample and "
-        "the target ``q_f``; in closed loop, where the manoeuvre ends turning (``ω_f ≠ 0``), the "
+        "the target ``q_f``; in closed loop, where the manoeuvre ends turning (``ω_f ≠ 0``, or free "
+        "and the reference's ``ω(T)`` not zero), the "
         "target after T is the reference's own motion from ``(q_f, ω_f)`` (``ocp.metrics.target_motion``); "
         "null when the final attitude is free."),
     "final_rate_error": MetricInfo(
         "rad/s", "‖ω(t_N) − ω_f‖ at the last sample (``ω_f`` the target's rate there, as for "
-        "``final_error_deg``); null when the final rate is free."),
+        "``final_error_deg``, in the body's axes); null when the final rate is free."),
     "rms_error_deg": MetricInfo(
         "deg", "Closed loop with a reference: √(mean over the samples of e_k²), e_k the error angle between "
         "the attitude and the reference attitude at t_k; null for a reference and in regulation."),
@@ -338,7 +339,10 @@ def compute_metrics(
         "peak_wheel_torque": _peak(wheel_torque, None),
         "final_error_deg": None if error_to_target is None else float(error_to_target[-1]),
         "final_rate_error": None if target_omega is None
-        else float(np.linalg.norm(np.asarray(omega)[-1] - np.asarray(target_omega, dtype=float).reshape(-1, 3)[-1])),
+        else float(rate_error(np.asarray(q)[-1:], np.asarray(omega)[-1:],
+                              None if target_q is None or np.ndim(target_q) == 1 else np.asarray(target_q)[-1:],
+                              np.asarray(target_omega, dtype=float).reshape(-1, 3)[-1:]
+                              if np.ndim(target_omega) == 2 else target_omega)[0]),
         "rms_error_deg": None,
         "max_error_deg": None,
         "settling_time_s": settling,
@@ -390,12 +394,12 @@ def target_motion(target_q: ArrayLike | None, target_omega: ArrayLike | None, re
     """Where the manoeuvre's target is at each time: the attitude and body rate the final-state
     metrics and the ``final`` requirement measure a motion against.
 
-    A manoeuvre that ends at rest (``ω_f = 0`` or free) has a fixed target: ``q_f`` (and ``ω_f``)
-    at every time. One that ends turning (``ω_f ≠ 0``) cannot be held at ``q_f``: after its end
-    ``T`` the target is where its final state goes, the reference's own motion after ``T`` (its
-    torque-free coast from ``(q_f, ω_f)``, which the closed loop tracks; the runner fails a
-    reference that misses ``(q_f, ω_f)`` at ``T``); until ``T`` it is ``(q_f, ω_f)``.
-    Without a reference (regulation) the target is fixed.
+    A manoeuvre that ends at rest has a fixed target: ``q_f`` (and ``ω_f``) at every time. One that
+    ends turning (``ω_f ≠ 0``, or a free ``ω_f`` where the reference's own ``ω(T)`` is not zero)
+    cannot be held at ``q_f``: after its end ``T`` the target is where its final state goes, the
+    reference's own motion after ``T`` (its torque-free coast from ``(q_f, ω(T))``, which the
+    closed loop tracks; the runner fails a reference that misses ``q_f`` or a given ``ω_f`` at
+    ``T``); until ``T`` it is ``(q_f, ω_f)``. Without a reference (regulation) the target is fixed.
 
     Parameters
     ----------
@@ -419,15 +423,68 @@ def target_motion(target_q: ArrayLike | None, target_omega: ArrayLike | None, re
     t = np.asarray(t, dtype=float)
     q = None if target_q is None else np.tile(np.asarray(target_q, dtype=float), (t.size, 1))
     omega = None if target_omega is None else np.tile(np.asarray(target_omega, dtype=float), (t.size, 1))
-    if omega is None or reference is None or not np.any(omega[:1] != 0.0):
+    if not turning(target_omega, reference):
         return q, omega
     after = t > reference.duration
     if np.any(after):
         coast = reference.sample(t[after])
         if q is not None:
             q[after] = coast.q
-        omega[after] = coast.omega
+        if omega is not None:
+            omega[after] = coast.omega
     return q, omega
+
+
+def turning(target_omega: ArrayLike | None, reference: Any) -> bool:
+    """Whether a manoeuvre ends turning, so that its target moves after ``T``
+    (:func:`target_motion`): ``ω_f`` given and not zero, or free and the reference's ``ω(T)`` not
+    zero; never without a reference.
+
+    Parameters
+    ----------
+    target_omega : (3,) array_like or None
+        ``ω_f`` [rad/s]; ``None``: free.
+    reference : planners.Reference or None
+        The row's reference; ``None``: regulation.
+
+    Returns
+    -------
+    bool
+    """
+    if reference is None:
+        return False
+    if target_omega is not None:
+        return bool(np.any(np.asarray(target_omega, dtype=float) != 0.0))
+    return bool(np.any(reference.sample(np.array([reference.duration])).omega != 0.0))
+
+
+def rate_error(q: ArrayLike, omega: ArrayLike, target_q: ArrayLike | None, target_omega: ArrayLike) -> NDArray:
+    """``‖ω − ω_t‖`` with the target's rate in the body's axes, ``ω_t`` turned by ``R(q_e)ᵀ``
+    (``q_e = q_t* ⊗ q``) when the target's attitude is given per sample (a target that turns,
+    :func:`target_motion`); as it is otherwise (a fixed target: at rest, or a rate alone).
+
+    Parameters
+    ----------
+    q : (N, 4) array_like
+        The attitude (scalar first, body to inertial).
+    omega : (N, 3) array_like
+        The body rate [rad/s], body axes.
+    target_q : (4,) or (N, 4) array_like or None
+        The target's attitude, fixed or per sample; ``None``: free.
+    target_omega : (3,) or (N, 3) array_like
+        The target's body rate [rad/s], in its own body axes.
+
+    Returns
+    -------
+    (N,) ndarray
+        The rate error [rad/s].
+    """
+    omega = np.atleast_2d(np.asarray(omega, dtype=float))
+    target = np.asarray(target_omega, dtype=float)
+    if target_q is not None and np.ndim(target_q) == 2 and np.ndim(target) == 2:
+        target = quat.rotate_inverse(quat.error(np.atleast_2d(np.asarray(q, dtype=float)), target_q,
+                                                shortest=False), target)
+    return np.asarray(np.linalg.norm(omega - target, axis=-1))
 
 
 def _check_targets(function: str, target_q: Any, target_omega: Any) -> None:

@@ -26,7 +26,6 @@ from typing import Any
 
 import numpy as np
 
-from controllers.allocation import demand_limits
 from ocp import (
     SimulationError,
     Simulator,
@@ -47,6 +46,7 @@ from scenarios.requirements.scoring import (
     SCOPE_WORDS,
     Score,
     endpoint_violations,
+    plant_limits,
     rate_jumps,
     reference_times,
     score_closed_loop,
@@ -225,7 +225,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
 
     plant = scenario.truth  # the truth model the closed loop integrates (None: the design model)
     # the actuator requirement holds for the wheels flown: the lesser of the design's and the plant's limits
-    plant_limits = None if plant is None else demand_limits(plant.model.spacecraft)
+    flown_limits = plant_limits(plant)
 
     def build() -> Simulator:
         return Simulator(model, spec.sample_time, spec.integrator, max_step=spec.max_step,
@@ -261,7 +261,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
                 _check_physical(row, "reference", row.reference_metrics)
                 if sampled is not None:
                     scores["reference"] = score_reference(scenario.requirements, scenario.problem, *sampled,
-                                                          controllers[j].controller, reference, plant_limits)
+                                                          controllers[j].controller, reference, flown_limits)
                 _simulate(scenario, simulator, reference, row, controllers[j])
             timing = (f"planned in {(row.plan_time_s or 0.0) * 1e3:.1f} ms, "
                       f"simulated in {row.simulate_time_s:.2f} s")

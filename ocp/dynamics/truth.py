@@ -327,6 +327,12 @@ class TruthPlant:
         given = self.truth.constant_disturbance
         return self.design.default_parameters if given is None else given.copy()
 
+    @property
+    def wheel_max_speed(self) -> Array | None:
+        """Each wheel's speed limit relative to the body [rad/s] (``truth.wheels.max_speed_rpm``);
+        ``None``: none."""
+        return None if self._max_speed is None else np.array(self._max_speed, dtype=float)
+
     def wheel_speed(self, x: Any) -> Any:
         """Each wheel's speed relative to the body, ``Ω = h_w / J_s − Aᵀ ω`` (truth axes).
 

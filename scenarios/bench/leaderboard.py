@@ -202,7 +202,11 @@ def _plan_status(scenario: Any, row: Any, controller: Any) -> str:
     the scenario's requirements as :func:`scenarios.runner.run` scores it (the same times, the row's
     controller's allocation for the actuator demand), without the closed loop."""
     from ocp import metric_violations
-    from scenarios.requirements.scoring import reference_times, score_reference
+    from scenarios.requirements.scoring import (
+        plant_limits,
+        reference_times,
+        score_reference,
+    )
     from scenarios.runner import closed_loop_window
 
     reference = row.reference
@@ -215,7 +219,7 @@ def _plan_status(scenario: Any, row: Any, controller: Any) -> str:
     times = reference_times(reference.duration, closed_loop_window(scenario, reference),
                             scenario.simulation.sample_time)
     scores = score_reference(scenario.requirements, scenario.problem, times, reference.sample(times), controller,
-                             reference)
+                             reference, plant_limits(scenario.truth))
     return "ok" if all(score.met for score in scores.values()) else "violated"
 
 

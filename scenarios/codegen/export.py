@@ -62,7 +62,7 @@ from scenarios.output.directory import (
 )
 from scenarios.output.names import row_stems
 from scenarios.output.provenance import package_version
-from scenarios.requirements.scoring import score_reference, violations
+from scenarios.requirements.scoring import plant_limits, score_reference, violations
 from scenarios.runner import closed_loop_window, plan_row
 from scenarios.schema.loader import Scenario
 
@@ -500,7 +500,8 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
             report.skipped[planner_spec.label] = f"the plan {reference.status}: {reference.message}"
             continue
         assert sampled is not None  # scoring=True samples it
-        scores = score_reference(scenario.requirements, problem, *sampled, laws[0], reference)
+        scores = score_reference(scenario.requirements, problem, *sampled, laws[0], reference,
+                                 plant_limits(scenario.truth))
         broken = violations({"reference": scores})
         if broken:
             report.violations[planner_spec.label] = broken

@@ -55,6 +55,7 @@ from controllers.allocation import (
     unrealised_torque,
 )
 from ocp import Spacecraft, quat, target_motion
+from ocp.dynamics.truth import TruthPlant
 from ocp.geometry.pointing import (
     HermiteMotion,
     PointingConstraint,
@@ -62,6 +63,7 @@ from ocp.geometry.pointing import (
     scores_between_samples,
     search_between_samples,
 )
+from ocp.metrics import rate_error, turning
 from planners import ManeuverProblem, Planner, Reference
 from planners.base import REQUIREMENT_KINDS
 from planners.reference import BREAKPOINT_INSTANT, JUMP_TOLERANCE
@@ -69,7 +71,7 @@ from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requi
 
 __all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
            "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
-           "endpoint_violations", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
+           "endpoint_violations", "plant_limits", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
            "score_reference", "unhonoured", "violations", "worst_error_between_samples"]
 
 Array = NDArray[np.float64]
@@ -318,13 +320,20 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
         return Score("final", values, False, f"no closed-loop sample from {start:g} s (T + after_s) on; lengthen "
                                              "simulation.duration")
     problems = []
-    target_q, target_omega = target_motion(problem.qf, problem.omegaf, reference, t)
+    moving = turning(problem.omegaf, reference)
+    if moving:  # the target is the reference's own motion: the plan until T, its coast after (target_motion)
+        assert reference is not None  # turning() needs one
+        own = reference.sample(t)  # at every sample: an interval across T interpolates it consistently
+        target_q: Array | None = own.q
+        target_omega: Array | None = own.omega
+    else:
+        target_q, target_omega = target_motion(problem.qf, problem.omegaf, reference, t)
     if problem.qf is not None:
         bound = None if requirement.error_deg is None else float(np.deg2rad(requirement.error_deg))
-        if target_q is not None and target_omega is not None and np.any(target_q != problem.qf):  # turning
+        if moving:
             # the error's own motion, q_e = q_target* ⊗ q with body rate ω − R(q_e)ᵀ ω_target, to the identity
-            relative = quat.error(q, target_q, shortest=False)
-            relative_rate = omega - quat.rotate_inverse(relative, target_omega)
+            relative = quat.error(q, own.q, shortest=False)
+            relative_rate = omega - quat.rotate_inverse(relative, own.omega)
             worst_error, when = worst_error_between_samples(t, relative, relative_rate, quat.IDENTITY, start, bound)
         else:
             worst_error, when = worst_error_between_samples(t, q, omega, problem.qf, start, bound, motion)
@@ -333,8 +342,10 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
         if requirement.error_deg is not None and worst_deg > requirement.error_deg * (1 + _TOLERANCE):
             shown, limit = _over(worst_deg, requirement.error_deg)
             problems.append(f"error {shown} deg at {when:.1f} s over {limit} deg")
-    if target_omega is not None:
-        rates = np.linalg.norm(omega[inside] - target_omega[inside], axis=1)
+    if problem.omegaf is not None:
+        assert target_omega is not None  # omega_f given
+        rates = rate_error(q[inside], omega[inside], target_q[inside] if moving and target_q is not None else None,
+                           target_omega[inside])
         worst = int(np.argmax(rates))
         values["worst_rate_error"] = float(rates[worst])
         if requirement.rate is not None and rates[worst] > requirement.rate * (1 + _TOLERANCE):
@@ -399,7 +410,7 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
 
 def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
                jumps: list[tuple[float, int, Array]] | None = None, unrealised: Array | None = None,
-               torque: Array | None = None, plant_limited: Sequence[str] = ()) -> Score:
+               torque: Array | None = None, plant_limited: Mapping[str, Array] | None = None) -> Score:
     values: dict[str, float | None] = {}
     broken = []
     unscored = []
@@ -425,7 +436,9 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
         if ratio > margin_allowed * (1 + _TOLERANCE):
             shown, limit = _over(ratio, margin_allowed)
             allowed = max(allowed, limit, key=len)
-            whose = " (the truth model's, below the design's)" if name in plant_limited else ""
+            element = int(np.argmax(ratios[worst])) if ratios.size else 0  # the element at the peak
+            lowered = (plant_limited or {}).get(name)
+            whose = " (the truth model's, below the design's)" if lowered is not None and lowered[element] else ""
             broken.append(f"{name} {shown} x its limit{whose} at {t[worst]:.1f} s")
     detail = ", ".join(unscored + ([", ".join(broken) + f" (allowed {allowed} x)"] if broken else []))
     if jumps is not None:
@@ -455,6 +468,34 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
             missing = f"{peak:.3g} N m of the torque asked at {t[worst]:g} s{share} is given by no working actuator"
             detail = missing + (f", {detail}" if detail else "")
     return Score("actuators", values, not detail, detail)
+
+
+def plant_limits(plant: TruthPlant | None) -> dict[str, Array] | None:
+    """The actuator limits of the plant the closed loop flies, for :func:`score_reference`'s
+    ``plant_limits``: :func:`controllers.allocation.demand_limits` of a truth model's spacecraft (its
+    wheels' ``max_torque`` and ``max_momentum``), the wheels' momentum limit lowered to
+    ``J_s Ω_max`` where the truth has a speed limit (``truth.wheels.max_speed_rpm``: the wheel's
+    speed relative to the body is ``h / J_s − aᵀω``; the body rate's share ``J_s aᵀω`` is left out,
+    small beside ``J_s Ω_max`` for a wheel that can store the slew's momentum at all).
+
+    Parameters
+    ----------
+    plant : ocp.dynamics.truth.TruthPlant or None
+        The scenario's truth model (``Scenario.truth``); ``None``: the design model is flown.
+
+    Returns
+    -------
+    dict of str to ndarray or None
+        :attr:`controllers.allocation.Demand.limit` by quantity name; ``None`` without a truth model.
+    """
+    if plant is None:
+        return None
+    limits = demand_limits(plant.model.spacecraft)
+    wheels = plant.model.spacecraft.wheels
+    speed = plant.wheel_max_speed
+    if speed is not None and wheels is not None and wheels.spin_inertia is not None and "wheels_momentum" in limits:
+        limits["wheels_momentum"] = np.minimum(limits["wheels_momentum"], np.asarray(wheels.spin_inertia) * speed)
+    return limits
 
 
 def score_reference(requirements: Requirements, problem: ManeuverProblem, times: ArrayLike, sample: Any,
@@ -490,7 +531,7 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         manoeuvre's initial rate) is found, and the edges are interpolated between the samples.
     plant_limits : mapping of str to ndarray or None, optional
         The limits of the plant the closed loop flies where it is not the design
-        (:func:`controllers.allocation.demand_limits` of a truth model's spacecraft): each
+        (:func:`plant_limits` of the scenario's truth model): each
         quantity is scored against the lesser of the design's limit and the plant's, element by
         element, and the message says where the plant's is the lesser; ``None``: the design's.
 
@@ -531,12 +572,12 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         demand = reference_demand(allocation, problem.model, demand_t, q, omega, torque,
                                   problem.wheel_momentum0, jumps=steps, torque_after=after)
         unrealised = unrealised_torque(problem.model, demand_t, q, omega, torque, demand)
-        lower = []  # the quantities whose plant limits are below the design's
+        lower: dict[str, Array] = {}  # per quantity, the elements whose plant limit is below the design's
         if plant_limits is not None:
             for name, quantity in list(demand.items()):
                 limit = np.minimum(quantity.limit, np.asarray(plant_limits.get(name, quantity.limit), dtype=float))
                 if np.any(limit < quantity.limit):
-                    lower.append(name)
+                    lower[name] = limit < quantity.limit
                     demand[name] = dataclasses.replace(quantity, limit=limit)
         scores["actuators"] = _actuators(requirements.actuators.allowed, demand, demand_t, jumps, unrealised, torque,
                                          lower)
@@ -603,7 +644,8 @@ def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: A
     return scores
 
 
-def score_fields(requirements: Requirements, spacecraft: Spacecraft) -> dict[str, dict[str, tuple[str, ...]]]:
+def score_fields(requirements: Requirements, spacecraft: Spacecraft,
+                 plant: TruthPlant | None = None) -> dict[str, dict[str, tuple[str, ...]]]:
     """The fields a row's scores may hold, by scope and requirement: the result columns
     ``ref.req.<name>.<field>`` and ``cl.req.<name>.<field>`` a scenario can give.
 
@@ -614,6 +656,8 @@ def score_fields(requirements: Requirements, spacecraft: Spacecraft) -> dict[str
     spacecraft : ocp.Spacecraft
         Its spacecraft (the actuator requirement has a field per limited actuator quantity,
         :func:`controllers.allocation.demand_limits`, and its time).
+    plant : ocp.dynamics.truth.TruthPlant or None, optional
+        Its truth model: a quantity limited there only has its fields too (:func:`plant_limits`).
 
     Returns
     -------
@@ -626,7 +670,9 @@ def score_fields(requirements: Requirements, spacecraft: Spacecraft) -> dict[str
     reference: dict[str, tuple[str, ...]] = dict(pointing)
     closed_loop: dict[str, tuple[str, ...]] = dict(pointing)
     if requirements.actuators is not None:
-        limited = [name for name, limit in demand_limits(spacecraft).items() if np.any(np.isfinite(limit))]
+        flown = plant_limits(plant) or {}
+        limited = [name for name, limit in demand_limits(spacecraft).items()
+                   if np.any(np.isfinite(np.minimum(limit, flown.get(name, limit))))]
         reference["actuators"] = (tuple(field for name in limited for field in (name, f"{name}_time_s"))
                                   + JUMP_FIELDS + UNREALISED_FIELDS)
     if requirements.rate is not None:

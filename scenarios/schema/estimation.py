@@ -157,6 +157,7 @@ def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any]
                                     f"{boresight.tolist()} is {apart:.3g} deg from spacecraft.sensors.star_tracker's "
                                     f"boresight {stated.tolist()}: one sensor has one boresight (remove this key, "
                                     f"which then takes the spacecraft's, or make them agree)")
+            boresight = stated  # the declared direction, not its rounding here
         tracker = StarTracker(noise=values["noise_arcsec"] * ARCSEC, rate=values["rate_hz"],
                               outages=values["outages_s"], boresight=boresight)
     if sensors.get("magnetometer") is not None:

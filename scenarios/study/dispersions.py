@@ -76,16 +76,45 @@ class Draw:
         return len(self.independent)
 
     def names(self) -> list[str]:
-        """The independent components as suffixes of a path: ``""``, ``[k]`` or ``[i][j]``."""
+        """The independent components as suffixes of a path.
+
+        Returns
+        -------
+        list of str
+            ``""`` (a scalar), ``[k]`` or ``[i][j]`` per independent component (a symmetric
+            matrix's upper triangle).
+        """
         return ["".join(f"[{i}]" for i in index) for index in self.independent]
 
     def components(self, units: np.ndarray) -> np.ndarray:
-        """The drawn components: ``(cases, dimension)`` from unit samples of that shape."""
+        """The drawn independent components.
+
+        Parameters
+        ----------
+        units : (cases, dimension) ndarray
+            Unit samples in [0, 1), one column per independent component.
+
+        Returns
+        -------
+        (cases, dimension) ndarray
+            The components drawn from the distribution by its inverse CDF.
+        """
         flat = [int(np.ravel_multi_index(index, self.shape)) if self.shape else 0 for index in self.independent]
         return DISTRIBUTIONS[self.kind].inverse_cdf(units, self.a[flat], self.b[flat])
 
     def values(self, units: np.ndarray) -> np.ndarray:
-        """The drawn values, ``(cases,) + shape`` (a symmetric matrix mirrored)."""
+        """The drawn values, a symmetric matrix mirrored from its upper triangle.
+
+        Parameters
+        ----------
+        units : (cases, dimension) ndarray
+            Unit samples in [0, 1), one column per independent component.
+
+        Returns
+        -------
+        (cases,) + shape ndarray
+            One drawn value (scalar, vector or matrix) per case.
+        """
         components = self.components(units)
         out = np.empty((units.shape[0], max(1, math.prod(self.shape))))
         for column, index in enumerate(self.independent):
@@ -272,8 +301,19 @@ class Dispersion:
         return 0.5 * (tensor + tensor.transpose(0, 2, 1))  # symmetric to the last bit
 
     def refused(self, units: np.ndarray) -> tuple[int, str] | None:
-        """The first case whose draw the dispersion refuses, and why (a ``principal.axes_deg``
-        rotation beyond :data:`~scenarios.schema.study.MAX_PRINCIPAL_AXES_DEG`); None if none."""
+        """The first case whose draw the dispersion refuses, and why.
+
+        Parameters
+        ----------
+        units : (cases, dimension) ndarray
+            The cases' unit samples.
+
+        Returns
+        -------
+        (int, str) or None
+            The case's index and the reason (a ``principal.axes_deg`` rotation beyond
+            :data:`~scenarios.schema.study.MAX_PRINCIPAL_AXES_DEG`); ``None`` if none is refused.
+        """
         if "axes_deg" not in self.draws or self.combine != PRINCIPAL_NAME:
             return None
         with np.errstate(all="ignore"):

@@ -365,7 +365,7 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
 
 def _requirement_columns(scenario: Scenario) -> list[str]:
     """The requirement columns a case's rows can give (``ref.req.<name>.<field>``, ``cl.req...``)."""
-    fields = score_fields(scenario.requirements, scenario.problem.spacecraft)
+    fields = score_fields(scenario.requirements, scenario.problem.spacecraft, scenario.truth)
     return [f"{prefix}.{REQUIREMENT_MARK}.{name}.{field}" for scope, prefix in SCOPES
             for name, names in fields[scope].items() for field in names]
 

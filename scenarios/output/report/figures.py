@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from ocp import quat
+from ocp import quat, target_motion
 from ocp.geometry.pointing import PointingConstraint
 from scenarios.output.plot_data import (
     decimate,
@@ -289,7 +289,9 @@ def row_figure(row: Any, scenario: Any) -> dict[str, Any]:
             data.append(_trace(t, np.maximum(np.rad2deg(quat.error_angle(sim.q, reference.q)), _FLOOR_DEG),
                                "to reference", 1, "#ff7f0e", unit="deg"))
         if target is not None:
-            data.append(_trace(t, np.maximum(np.rad2deg(quat.error_angle(sim.q, target)), _FLOOR_DEG),
+            moving = target_motion(target, problem.omegaf, row.reference, t)[0]  # as the metrics measure it
+            assert moving is not None  # q_f given
+            data.append(_trace(t, np.maximum(np.rad2deg(quat.error_angle(sim.q, moving)), _FLOOR_DEG),
                                "to target", 1, "#222222", unit="deg"))
         final = requirements.final
         if final is not None and final.error_deg is not None:
