@@ -38,6 +38,8 @@ ROOT = Path(__file__).resolve().parents[1]
 class Reference:
     """A made-up reference (only drawing is tested): attitude about z, its rate and torque."""
 
+    duration = 1e9  # s: longer than any run drawn here (the target is q_f throughout)
+
     def __init__(self, scale):
         self.scale = scale
 
@@ -143,6 +145,8 @@ def slew_about_y(samples=301, flip_after=200):
     omega = np.stack([0 * t, rate, 0 * t], axis=1)
 
     class Reference:
+        duration = 1e9  # s: longer than the run (the target is q_f throughout)
+
         def sample(self, times):
             return ReferenceSample(reference_q, np.stack([0 * t, np.gradient(angle, t), 0 * t], axis=1), 0 * omega,
                                    0 * omega)
