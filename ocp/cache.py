@@ -5,30 +5,63 @@ Building a CasADi NLP or integrator costs far more than solving it once it exist
 model's numbers baked into the graph, the transcription, the mesh, the solver options): problems
 that differ only in parameters (boundary values, T) reuse the entry. A trade study gives one cache
 to each worker process, so a collocation NLP is built once per worker and structure.
+
+Threads: a CasADi ``Function`` is not safe to call from two threads at once (two threads calling
+one IPOPT solver crash the process), so a cache keeps **one set of entries per thread**: a thread
+never receives an object that another thread built. Threads may share a cache (and a planner); each
+thread builds a structure once, the first time it meets it, and its plans then run concurrently
+with the other threads'. A thread's entries go when the thread ends.
 """
 from __future__ import annotations
 
+import threading
+import weakref
 from collections.abc import Callable, Hashable
 from typing import Any, TypeVar
 
 V = TypeVar("V")
 
 
+class _Entries:
+    """One thread's entries (held weakly by the cache, strongly by the thread's local storage)."""
+
+    __slots__ = ("__weakref__", "items")
+
+    def __init__(self) -> None:
+        self.items: dict[Hashable, Any] = {}
+
+
 class SolverCache:
-    """Built objects keyed by a hashable description of their structure.
+    """Built objects keyed by a hashable description of their structure, one set per thread.
+
+    A look-up from a thread sees only the entries that thread built: a built solver is never
+    called from two threads at once (CasADi functions are not thread-safe), whichever threads
+    share the cache. A pickled cache holds the entries of the thread that pickles it.
 
     Attributes
     ----------
     builds : int
-        How many entries were built (cache misses).
+        How many entries were built (cache misses), over all threads.
     hits : int
-        How many look-ups found an existing entry.
+        How many look-ups found an existing entry, over all threads.
     """
 
     def __init__(self) -> None:
-        self._entries: dict[Hashable, Any] = {}
+        self._lock = threading.Lock()  # guards the counters and the set of threads' entries
+        self._local = threading.local()  # .entries: this thread's _Entries
+        self._all: weakref.WeakSet[_Entries] = weakref.WeakSet()  # every live thread's entries
         self.builds = 0
         self.hits = 0
+
+    @property
+    def _entries(self) -> dict[Hashable, Any]:
+        """The calling thread's entries (created on its first look-up)."""
+        entries: _Entries | None = getattr(self._local, "entries", None)
+        if entries is None:
+            entries = self._local.entries = _Entries()
+            with self._lock:
+                self._all.add(entries)
+        return entries.items
 
     def get(self, key: Hashable, build: Callable[[], V]) -> V:
         """The entry for ``key``, built by ``build()`` the first time.
@@ -44,19 +77,35 @@ class SolverCache:
         Returns
         -------
         object
-            The cached or newly built object (the same object on every hit: do not mutate it).
+            The cached or newly built object (the same object on every hit from this thread: do
+            not mutate it, and do not hand it to another thread).
         """
-        if key in self._entries:
-            self.hits += 1
-            return self._entries[key]
+        entries = self._entries
+        if key in entries:
+            with self._lock:
+                self.hits += 1
+            return entries[key]
         value = build()
-        self._entries[key] = value
-        self.builds += 1
+        entries[key] = value
+        with self._lock:
+            self.builds += 1
         return value
 
     def __len__(self) -> int:
-        return len(self._entries)
+        """The number of entries, over all live threads."""
+        with self._lock:
+            return sum(len(entries.items) for entries in self._all)
 
     def clear(self) -> None:
-        """Drop every entry (the counters are kept)."""
-        self._entries.clear()
+        """Drop every entry of every thread (the counters are kept)."""
+        with self._lock:
+            for entries in list(self._all):
+                entries.items.clear()
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {"entries": dict(self._entries), "builds": self.builds, "hits": self.hits}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__()  # type: ignore[misc]
+        self._entries.update(state["entries"])
+        self.builds, self.hits = state["builds"], state["hits"]

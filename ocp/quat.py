@@ -18,7 +18,9 @@ __all__ = ["EULER_SEQUENCES", "IDENTITY", "UNIT_NORM_TOLERANCE", "conjugate", "c
            "sequence_axes", "slerp", "to_euler", "to_rotation_vector", "to_scalar_last", "unit_norm_error"]
 
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
-"""(4,) ndarray: the identity rotation, scalar first (body axes aligned with the inertial ones)."""
+"""(4,) ndarray: the identity rotation, scalar first (body axes aligned with the inertial ones);
+read-only (a module constant)."""
+IDENTITY.setflags(write=False)
 
 UNIT_NORM_TOLERANCE = 1e-2
 """How far from 1 the norm of a quaternion given as input may be (:func:`unit_norm_error`): room

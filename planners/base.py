@@ -219,7 +219,9 @@ class Planner(Configurable, ABC):
         Reference
             The reference motion, with ``plan_time_s`` set to the wall time [s]; a
             :class:`FailedReference` (status ``"failed"`` or ``"infeasible"``) when
-            :meth:`problem_error` refuses the problem or the method fails numerically.
+            :meth:`problem_error` refuses the problem or the method fails numerically (an
+            ``OverflowError`` or ``FloatingPointError`` of the method, e.g. for ``T = 1e300`` s,
+            gives a failed reference too).
 
         Raises
         ------
@@ -231,7 +233,14 @@ class Planner(Configurable, ABC):
                             f"{type(problem).__name__}")
         start = time.perf_counter()
         error = self.problem_error(problem)
-        reference = FailedReference(self.name, error) if error else self._plan(problem)
+        if error:
+            reference: Reference = FailedReference(self.name, error)
+        else:
+            try:
+                reference = self._plan(problem)
+            except (OverflowError, FloatingPointError) as failure:  # a numerical failure: a failed row, not a crash
+                reference = FailedReference(self.name, f"numerical failure: {type(failure).__name__}: {failure} "
+                                                       f"(duration {problem.duration:g} s)")
         reference.plan_time_s = time.perf_counter() - start
         return reference
 

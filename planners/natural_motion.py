@@ -91,7 +91,7 @@ class NaturalMotionReference(Reference):
 
             solution = solve_ivp(lambda s, q: quat.kinematics(q, asymmetric_rates(s, omega0, moments)), (0, arc),
                                  quat.IDENTITY, method="DOP853", rtol=1e-12, atol=1e-13, dense_output=True)
-            self._relative = lambda t: quat.normalize(solution.sol(t).T)
+            self._relative = _Relative(solution.sol)
         q_end, self.omega_end = self._arc(np.array([arc]))
         self.q_end, self.omega_end = q_end[0], self.omega_end[0]
 
@@ -119,6 +119,17 @@ class NaturalMotionReference(Reference):
         torque = np.zeros_like(omega)
         torque[after] = inverse_dynamics_torque(self.inertia, omega[after], omega_dot[after])
         return ReferenceSample(q, omega, omega_dot, torque)
+
+
+class _Relative:
+    """The asymmetric body's attitude relative to its start, ``t -> q_rel(t)`` (normalised dense
+    output of the integration): a module-level callable so that a reference pickles."""
+
+    def __init__(self, dense: Any) -> None:
+        self.dense = dense
+
+    def __call__(self, t: Array) -> Array:
+        return quat.normalize(self.dense(t).T)
 
 
 class RotatedReference(Reference):

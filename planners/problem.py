@@ -23,7 +23,9 @@ class ManeuverProblem:
     Inputs are checked on construction (a ``ValueError`` or ``TypeError`` names the field):
     quaternions must have unit norm within ``ocp.quat.UNIT_NORM_TOLERANCE`` (1e-2, the YAML
     loader's tolerance; ``[2, 0, 0, 0]`` is refused, not normalised) and are then normalised to
-    unit float arrays; vectors become float arrays of the right size.
+    unit float arrays; vectors become float arrays of the right size. Every array is stored as a
+    read-only copy: a later change to the caller's arrays does not reach the problem (build a new
+    problem for other values).
 
     Parameters
     ----------
@@ -39,7 +41,8 @@ class ManeuverProblem:
         attitude free, which only suits planners that accept it in :meth:`Planner.problem_error`
         (the default refuses it).
     duration : float
-        Manoeuvre time T [s], finite and positive; minimum-time planners take it as an initial guess
+        Manoeuvre time T [s], finite and positive (a Python or numpy integer or float, not a bool;
+        stored as a float); minimum-time planners take it as an initial guess
         or bound and return their own duration.
     omegaf : (3,) array_like or None, optional
         Target body rate [rad/s], body axes. ``None`` (default) leaves the final rate free.
@@ -86,17 +89,20 @@ class ManeuverProblem:
             object.__setattr__(self, "omegaf", _vector("omegaf", self.omegaf, 3))
         momentum = np.zeros(self.spacecraft.n_wheels) if self.wheel_momentum0 is None else self.wheel_momentum0
         object.__setattr__(self, "wheel_momentum0", _vector("wheel_momentum0", momentum, self.spacecraft.n_wheels))
-        if not isinstance(self.duration, (int, float, np.floating)) or not np.isfinite(self.duration) or not self.duration > 0:
+        if not _real(self.duration) or not np.isfinite(self.duration) or not self.duration > 0:
             raise ValueError(f"duration must be a finite positive number of seconds, got {self.duration!r}")
-        if self.max_rate is not None and (not isinstance(self.max_rate, (int, float, np.floating))
-                                          or not np.isfinite(self.max_rate) or not self.max_rate > 0):
-            raise ValueError(f"max_rate must be a finite positive rate (rad/s) or None, got {self.max_rate!r}")
+        object.__setattr__(self, "duration", float(self.duration))
+        if self.max_rate is not None:
+            if not _real(self.max_rate) or not np.isfinite(self.max_rate) or not self.max_rate > 0:
+                raise ValueError(f"max_rate must be a finite positive rate (rad/s) or None, got {self.max_rate!r}")
+            object.__setattr__(self, "max_rate", float(self.max_rate))
         object.__setattr__(self, "pointing", tuple(self.pointing))
         if not all(isinstance(c, PointingConstraint) for c in self.pointing):
             raise TypeError("pointing must hold ocp.geometry.PointingConstraint objects")
-        if self.actuator_margin is not None and not (isinstance(self.actuator_margin, (int, float, np.floating))
-                                                     and 0.0 <= self.actuator_margin < 1.0):
-            raise ValueError(f"actuator_margin must lie in [0, 1) or be None, got {self.actuator_margin!r}")
+        if self.actuator_margin is not None:
+            if not (_real(self.actuator_margin) and 0.0 <= self.actuator_margin < 1.0):
+                raise ValueError(f"actuator_margin must lie in [0, 1) or be None, got {self.actuator_margin!r}")
+            object.__setattr__(self, "actuator_margin", float(self.actuator_margin))
 
     def unreachable(self) -> str | None:
         """Why no motion reaches the target, by conservation of angular momentum alone: with wheels
@@ -193,14 +199,21 @@ def bound_keys(actuators: list) -> str:
                                                            if hasattr(actuator, key)), "") for actuator in actuators)
 
 
+def _real(value: object) -> bool:
+    """Whether ``value`` is a real number: a Python or numpy integer or float, not a bool (``True``
+    is no duration)."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
 def _vector(name: str, value: ArrayLike, size: int) -> Array:
     """``value`` as a finite float vector of ``size`` entries, or a ``ValueError`` naming ``name``."""
     try:
-        array = np.asarray(value, dtype=float)
+        array = np.array(value, dtype=float)  # a private copy: the caller's array is not kept
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be {size} numbers, got {value!r}") from None
     if array.shape != (size,) or not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must be {size} finite numbers, got shape {array.shape}: {array.tolist()}")
+    array.setflags(write=False)
     return array
 
 
@@ -212,4 +225,6 @@ def _quaternion(name: str, value: ArrayLike) -> Array:
     if reason is not None:
         raise ValueError(f"{name} must be a unit quaternion [q0, q1, q2, q3] (scalar first): {reason}; "
                          f"got {q.tolist()}")
-    return q / np.linalg.norm(q)
+    unit = q / np.linalg.norm(q)
+    unit.setflags(write=False)
+    return unit

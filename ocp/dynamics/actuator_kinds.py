@@ -52,15 +52,22 @@ def casadi_number(value: Any) -> Any:
 
 
 def _limit_vector(value: ArrayLike | None, size: int, field_name: str) -> Array:
-    """Per-element positive limit; ``None`` means unlimited (inf)."""
+    """Per-element positive limit; ``None`` means unlimited (inf). A read-only copy."""
     if value is None:
-        return np.full(size, np.inf)
+        return _frozen(np.full(size, np.inf))
     array = np.broadcast_to(np.asarray(value, dtype=float), (size,)).copy() if np.ndim(value) == 0 \
-        else np.asarray(value, dtype=float)
+        else np.array(value, dtype=float)
     if array.shape != (size,):
         raise ModelError(field_name, f"expected a scalar or {size} values, got shape {array.shape}")
     if np.any(~(array > 0)):
         raise ModelError(field_name, f"limits must be positive, got {array.tolist()}")
+    return _frozen(array)
+
+
+def _frozen(array: Array) -> Array:
+    """``array`` (a private copy made by the caller), made read-only: an actuator's numbers do not
+    change after the checks of its construction."""
+    array.setflags(write=False)
     return array
 
 
@@ -463,7 +470,7 @@ class ReactionWheels(Actuator):
         if np.any(norms < 1e-9):
             raise ModelError("axes", "a wheel axis is the zero vector")
         n = axes.shape[1]
-        object.__setattr__(self, "axes", axes / norms)
+        object.__setattr__(self, "axes", _frozen(axes / norms))
         object.__setattr__(self, "max_torque", _limit_vector(self.max_torque, n, "max_torque"))
         object.__setattr__(self, "max_momentum", _limit_vector(self.max_momentum, n, "max_momentum"))
         if self.spin_inertia is not None:

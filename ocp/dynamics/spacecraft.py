@@ -29,7 +29,9 @@ _Instance = TypeVar("_Instance", bound=Actuator)
 
 @dataclass(frozen=True, init=False)
 class Spacecraft:
-    """Rigid spacecraft with its actuators. ``inertia`` holds the (3, 3) matrix after construction.
+    """Rigid spacecraft with its actuators. ``inertia`` holds the (3, 3) matrix after construction:
+    a read-only copy of the given array (a later change to the caller's array does not reach the
+    spacecraft; build a new spacecraft for another inertia).
 
     Parameters
     ----------
@@ -83,7 +85,7 @@ class Spacecraft:
 
     def __post_init__(self) -> None:
         try:
-            inertia = np.asarray(self.inertia, dtype=float)
+            inertia = np.array(self.inertia, dtype=float)  # a private copy: the caller's array is not kept
         except (TypeError, ValueError):
             raise ModelError("inertia", "expected 3 principal moments or a 3x3 matrix of numbers") from None
         if inertia.shape == (3,):
@@ -103,6 +105,7 @@ class Spacecraft:
                 "inertia",
                 f"principal moments {moments.tolist()} violate the triangle inequality I1 + I2 >= I3",
             )
+        inertia.setflags(write=False)  # read-only: an edit in place would bypass these checks
         object.__setattr__(self, "inertia", inertia)
 
     def actuator(self, name: str) -> Actuator | None:

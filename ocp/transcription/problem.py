@@ -156,6 +156,9 @@ class NLP:
         Size of an interval's own variables ``c_k``.
     layout : dict
         Transcription-specific notes on the layout (may be empty).
+
+    The arrays (``lbg``, ``ubg``, those in ``layout``) are made read-only here: an NLP is shared
+    by every plan of its cache entry.
     """
 
     solver: ca.Function
@@ -167,6 +170,12 @@ class NLP:
     n_stage_state: int
     n_interval: int
     layout: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        # A built NLP is shared by every plan of its cache entry: its arrays are read-only.
+        for value in (self.lbg, self.ubg, *self.layout.values()):
+            if isinstance(value, np.ndarray):
+                value.setflags(write=False)
 
 
 @dataclass

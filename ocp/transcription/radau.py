@@ -107,6 +107,8 @@ class RadauCollocation(Transcription):
         self.quadrature = radau_weights(degree)
         midpoints = 0.5 * (tau[:-1] + tau[1:])
         self.midpoint_weights = lagrange(tau, midpoints)
+        for table in (self.tau, self.derivative, self.quadrature, self.midpoint_weights):
+            table.setflags(write=False)  # shared by every plan of a cached transcription: read-only
 
     @classmethod
     def from_options(cls, options: Any) -> RadauCollocation:

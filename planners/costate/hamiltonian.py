@@ -158,6 +158,13 @@ class HamiltonianSystem(ABC):
                                        [rhs, ca.densify(ca.jacobian(rhs, y)), ca.densify(ca.jacobian(rhs, t))])
         self._mapped: dict[tuple[int, bool], BufferedFunction] = {}
 
+    def __getstate__(self) -> dict[str, Any]:
+        """The state to pickle: without the mapped functions' call buffers (capsules), which are
+        rebuilt on first use."""
+        state = self.__dict__.copy()
+        state["_mapped"] = {}
+        return state
+
     @abstractmethod
     def equations(self, t: Any, y: Any, u: Any) -> tuple[Any, Any, Any]:
         """The Hamiltonian system as CasADi expressions, in real time.

@@ -21,7 +21,7 @@ from planners.problem import Array, ManeuverProblem
 from planners.reference import ReferenceSample, inverse_dynamics_torque
 from planners.torque_free import TorqueFreeMotion
 
-__all__ = ["SPIN_MESH_ANGLE", "AttitudeAcquisitionSystem", "MinimumEnergySystem", "RateAcquisitionSystem"]
+__all__ = ["SPIN_MESH_ANGLE", "AttitudeAcquisitionSystem", "ColdStartError", "MinimumEnergySystem", "RateAcquisitionSystem"]
 
 SPIN_MESH_ANGLE = 0.1
 """rad: the coarsest mesh of a spinning cold start, one interval per this angle turned. On the spin
@@ -128,6 +128,11 @@ class MinimumEnergySystem(RigidBodySystem):
             Scaled mesh on [0, 1], ``m >= nodes``.
         y : (14, m) ndarray
             States and co-states on the mesh.
+
+        Raises
+        ------
+        ColdStartError
+            When the eigenaxis slew fails (a numerical failure such as ``T = 1e300`` s).
         """
         T = self.t_f_fixed
         if self.coast is not None:
@@ -139,10 +144,18 @@ class MinimumEnergySystem(RigidBodySystem):
         from planners.eigenaxis import EigenaxisPlanner
 
         s = np.linspace(0.0, 1.0, nodes)
-        sample = EigenaxisPlanner().plan_start(self.problem).sample(s * T)
+        start = EigenaxisPlanner().plan_start(self.problem)
+        if not start.ok:
+            raise ColdStartError(f"the eigenaxis cold start failed: {start.message}")
+        sample = start.sample(s * T)
         x = np.vstack([sample.q.T, sample.omega.T])
         gravity = self.environment_torque(s * T, x)
         return T, s, np.vstack([x, np.zeros((4, nodes)), -self.inertia @ (sample.torque.T - gravity)])
+
+
+class ColdStartError(RuntimeError):
+    """A cold start (:meth:`MinimumEnergySystem.guess`) could not be built; the planner returns a
+    failed reference with this message."""
 
 
 class RateAcquisitionSystem(RigidBodySystem):

@@ -33,6 +33,7 @@ from planners.base import Planner
 from planners.costate.hamiltonian import HamiltonianSystem, RigidBodySystem
 from planners.costate.systems import (
     AttitudeAcquisitionSystem,
+    ColdStartError,
     MinimumEnergySystem,
     RateAcquisitionSystem,
 )
@@ -429,7 +430,10 @@ class CostateTPBVPPlanner(Planner):
         system = FORMS[o.objective](problem, o)
         if not isinstance(system, HamiltonianSystem):
             return FailedReference(self.name, str(system))
-        solution, t_f, stages, failure = solve(system, o.nodes, o.continuation_steps, o.tolerance, o.max_nodes)
+        try:
+            solution, t_f, stages, failure = solve(system, o.nodes, o.continuation_steps, o.tolerance, o.max_nodes)
+        except ColdStartError as error:
+            return FailedReference(self.name, f"{o.objective}: {error}")
         fallback, first = (system.fallback() if failure else None), system.cold_start
         if fallback is not None:  # the same problem from another cold start, on its own (finer) mesh
             limit = max(o.max_nodes, COAST_NODE_FACTOR * fallback.guess(o.nodes, 1.0)[1].size)
