@@ -137,6 +137,10 @@ def test_segments_of_aem_text_and_a_segment_of_one_sample():
     text = aem_text("2027-03-20T12:00:00Z", t, q, omega, object_name="x", segment_starts=[5])
     first, second = read_aem(text).segments
     assert (len(first.epochs), len(second.epochs)) == (5, 1)
+    # degree + 1 lines to interpolate over: the 5-line segment keeps degree 3, the one line has none
+    assert first.metadata["INTERPOLATION_DEGREE"] == "3" and "INTERPOLATION_DEGREE" not in second.metadata
+    split = read_aem(aem_text("2027-03-20T12:00:00Z", t, q, omega, object_name="x", segment_starts=[4])).segments
+    assert [segment.metadata["INTERPOLATION_DEGREE"] for segment in split] == ["3", "1"]  # 4 lines, 2
     assert second.metadata["START_TIME"] == second.metadata["STOP_TIME"] == second.epochs[0] \
         == "2027-03-20T12:00:02.500000000"
     np.testing.assert_array_equal(np.radians(first.values[-1, 4:]), [0.0, 0.0, 0.01])

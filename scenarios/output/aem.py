@@ -25,7 +25,9 @@ The conventions of the standard, and how slewbench's map onto them:
 * **Sign.** ``q`` and ``-q`` are one attitude; the series is written without sign jumps
   (:func:`ocp.quat.continuous`), so that a reader's interpolation between samples is meaningful.
 * **Interpolation.** ``QUATERNION``: ``LINEAR``, degree 1; ``QUATERNION/ANGVEL``: ``HERMITE``,
-  degree 3 (the rates are the derivatives at the nodes). Each segment's whole span is usable.
+  degree 3 (the rates are the derivatives at the nodes); a segment of fewer than degree + 1 lines
+  declares degree lines − 1 (a reader such as Orekit interpolates over degree + 1 lines), one of a
+  single line no interpolation. Each segment's whole span is usable.
 * **Rate jumps.** A reference whose body rate jumps (natural motion's step stop: an impulse, which
   no consumer's interpolation may smooth over) is written as one segment per stretch between its
   jumps (:func:`rate_jump_starts`): a segment ends at the last sample before a jump, with the rate
@@ -282,8 +284,12 @@ def aem_text(epoch: datetime.datetime | str | None, t: ArrayLike, q: ArrayLike, 
                   f"STOP_TIME = {tags[stop - 1]}", f"ATTITUDE_TYPE = {attitude_type}"]
         if omega is not None:
             lines.append(f"ANGVEL_FRAME = {BODY_FRAME}")
-        lines += [f"INTERPOLATION_METHOD = {method}", f"INTERPOLATION_DEGREE = {degree}", "META_STOP", "",
-                  "DATA_START"]
+        # a reader interpolating over degree + 1 lines (Orekit's tabulated provider) needs that many
+        # in the segment: a short segment declares a lower degree, one line none (nothing to interpolate)
+        usable = min(degree, stop - first - 1)
+        if usable >= 1:
+            lines += [f"INTERPOLATION_METHOD = {method}", f"INTERPOLATION_DEGREE = {usable}"]
+        lines += ["META_STOP", "", "DATA_START"]
         lines += [" ".join([tag, *(format_number(v) for v in row)])
                   for tag, row in zip(tags[first:stop], data[first:stop])]
         lines += ["DATA_STOP", ""]
