@@ -82,6 +82,13 @@ SIGNIFICANCE = 0.05
 """The level of ``significant`` in ``sensitivity.csv``: Holm-adjusted p-value at most this."""
 EXACT_CASES = 8
 """Up to this many cases a rank correlation's p-value is exact (its ``n!`` pairings enumerated)."""
+PERMUTATION_CASES = 50
+"""Below this many cases (and above :data:`EXACT_CASES`) the p-value is a permutation test's over
+:data:`PERMUTATIONS` random pairings (the t distribution's approximation underestimates it by
+1.2-4 times at 9 cases, a reviewer's enumeration of all 9! pairings); from it on, the t distribution."""
+PERMUTATIONS = 20000
+"""Random pairings of the permutation test (fixed seed: the same study gives the same p-values);
+its p-value ``(1 + k) / (1 + PERMUTATIONS)`` is never below ``5e-5``."""
 SMALL_SAMPLE = 30
 """Below this many cases ``summary.md`` says how large a rank correlation must be to be significant."""
 WORST_COLUMNS = ("metric", "rank", "case", "seed", "value", "status", "excluded")
@@ -257,13 +264,62 @@ def _exact_p(x: np.ndarray, y: np.ndarray) -> float:
     return float(np.mean(rhos >= abs(float(np.dot(rx, ry))) / scale - 1e-12))
 
 
+def _permutation_p(x: np.ndarray, y: np.ndarray) -> float:
+    """The two-sided permutation p-value of Spearman's rho over :data:`PERMUTATIONS` random
+    pairings of the ranks, ``(1 + k) / (1 + PERMUTATIONS)`` with ``k`` the pairings at least as
+    correlated in magnitude (seeded: reproducible)."""
+    rx, ry = _ranks(x), _ranks(y)
+    rx, ry = rx - rx.mean(), ry - ry.mean()
+    scale = math.sqrt(float(np.dot(rx, rx)) * float(np.dot(ry, ry)))
+    pairings = np.random.default_rng(0).permuted(np.tile(np.arange(x.size), (PERMUTATIONS, 1)), axis=1)
+    rhos = np.abs(ry[pairings] @ rx) / scale
+    hits = int(np.sum(rhos >= abs(float(np.dot(rx, ry))) / scale - 1e-12))
+    return (1.0 + hits) / (1.0 + PERMUTATIONS)
+
+
+def critical_rho(n: int) -> float | None:
+    """The least magnitude of a rank correlation over ``n`` untied pairs whose two-sided p-value
+    (as :func:`rank_significance` computes it) is at most :data:`SIGNIFICANCE`.
+
+    Parameters
+    ----------
+    n : int
+        The number of pairs.
+
+    Returns
+    -------
+    float or None
+        That magnitude; ``None`` when no correlation over ``n`` pairs can be significant (up to 4
+        pairs: a perfect ranking has p = 2/n!, at least 1/12).
+    """
+    from scipy.special import stdtrit  # lazily: only a study's report needs it
+
+    if n < MIN_CASES:
+        return None
+    ranks = np.arange(n, dtype=float) - (n - 1) / 2.0
+    scale = float(np.dot(ranks, ranks))
+    if n < PERMUTATION_CASES:
+        pairings = (np.array(list(itertools.permutations(range(n)))) if n <= EXACT_CASES else
+                    np.random.default_rng(0).permuted(np.tile(np.arange(n), (PERMUTATIONS, 1)), axis=1))
+        null = np.sort(np.abs(ranks[pairings] @ ranks) / scale)[::-1]
+        offset = 0 if n <= EXACT_CASES else 1  # the permutation test counts the observed pairing
+        for value in np.unique(null)[::-1]:
+            if (offset + np.sum(null >= value - 1e-12)) / (offset + null.size) > SIGNIFICANCE:
+                larger = null[null > value + 1e-12]
+                return float(larger.min()) if larger.size else None
+        return None
+    t = float(stdtrit(n - 2, 1.0 - SIGNIFICANCE / 2.0))
+    return t / math.sqrt(n - 2 + t * t)
+
+
 def rank_significance(rho: float | None, n: int, x: np.ndarray | None = None,
                       y: np.ndarray | None = None) -> dict[str, float | None]:
     """The significance of a rank correlation ``rho`` over ``n`` pairs.
 
     The p-value is two-sided, of the hypothesis that the two do not rank together: exact over
     :data:`EXACT_CASES` pairs or fewer when the pairs ``x``, ``y`` are given (every pairing of their
-    ranks enumerated: 3 cases ranked perfectly have p = 1/3), else from the t distribution with
+    ranks enumerated: 3 cases ranked perfectly have p = 1/3), a permutation test's below
+    :data:`PERMUTATION_CASES` pairs (:data:`PERMUTATIONS` random pairings), else from the t distribution with
     ``n - 2`` degrees of freedom of ``rho sqrt((n - 2) / (1 - rho²))`` (as ``scipy.stats.spearmanr``),
     a perfect ranking taking ``2 / n!``, its exact value without ties. The 95 % interval is
     Fisher's ``tanh(atanh(rho) ± 1.96 se)`` with the Bonett-Wright standard error for Spearman's
@@ -291,6 +347,8 @@ def rank_significance(rho: float | None, n: int, x: np.ndarray | None = None,
         return out
     if n <= EXACT_CASES and x is not None and y is not None:
         out["p_value"] = _exact_p(x, y)
+    elif n < PERMUTATION_CASES and x is not None and y is not None:
+        out["p_value"] = _permutation_p(x, y)
     elif abs(rho) >= 1.0:
         out["p_value"] = 2.0 / math.factorial(n)
     else:
@@ -507,8 +565,6 @@ def _correlation_cell(line: dict[str, Any]) -> str | None:
 def _small_sample_notes(keys: list[str], table: list[dict[str, Any]]) -> list[str]:
     """A note per group with fewer than :data:`SMALL_SAMPLE` cases: the smallest rank correlation
     significant at 5 % with that many (before the correction for the number of correlations)."""
-    from scipy.special import stdtrit  # lazily: only a study's report needs it
-
     notes = []
     seen: set[tuple[str, ...]] = set()
     for line in table:
@@ -517,13 +573,18 @@ def _small_sample_notes(keys: list[str], table: list[dict[str, Any]]) -> list[st
         if group in seen or not MIN_CASES <= n < SMALL_SAMPLE:
             continue
         seen.add(group)
-        t = float(stdtrit(n - 2, 1.0 - SIGNIFICANCE / 2.0))
+        critical = critical_rho(n)
         family = sum(1 for other in table if tuple(json.dumps(other.get(k)) for k in keys) == group
                      and other.get("p_value") is not None)
         name = ", ".join(text_cell(line.get(k)) for k in keys)
-        notes.append(f"Note ({name}): only {n} cases. A rank correlation must exceed about "
-                     f"{t / math.sqrt(n - 2 + t * t):.2f} in magnitude to be significant at 5 % on its own, more after "
-                     f"the correction for the {family} correlations; a larger sample narrows the intervals.")
+        plural = "correlation" if family == 1 else "correlations"
+        if critical is None:
+            notes.append(f"Note ({name}): only {n} cases. No rank correlation over so few can be significant at 5 %; "
+                         f"a larger sample narrows the intervals.")
+        else:
+            notes.append(f"Note ({name}): only {n} cases. A rank correlation must reach about {critical:.2f} in "
+                         f"magnitude to be significant at 5 % on its own, more after the correction for the {family} "
+                         f"{plural}; a larger sample narrows the intervals.")
     return notes + ([""] if notes else [])
 
 
