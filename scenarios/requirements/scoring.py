@@ -476,7 +476,10 @@ def plant_limits(plant: TruthPlant | None) -> dict[str, Array] | None:
     wheels' ``max_torque`` and ``max_momentum``), the wheels' momentum limit lowered to
     ``J_s Ω_max`` where the truth has a speed limit (``truth.wheels.max_speed_rpm``: the wheel's
     speed relative to the body is ``h / J_s − aᵀω``; the body rate's share ``J_s aᵀω`` is left out,
-    small beside ``J_s Ω_max`` for a wheel that can store the slew's momentum at all).
+    small beside ``J_s Ω_max`` for a wheel that can store the slew's momentum at all), and the
+    magnetorquers' dipole scaled by ``1 + e`` per body axis where the truth has a scale error
+    (``truth.magnetorquers.scale_error``: the delivered dipole is ``(1 + e)`` times the saturated
+    command, so a negative error lowers what the plant can deliver).
 
     Parameters
     ----------
@@ -495,6 +498,10 @@ def plant_limits(plant: TruthPlant | None) -> dict[str, Array] | None:
     speed = plant.wheel_max_speed
     if speed is not None and wheels is not None and wheels.spin_inertia is not None and "wheels_momentum" in limits:
         limits["wheels_momentum"] = np.minimum(limits["wheels_momentum"], np.asarray(wheels.spin_inertia) * speed)
+    scale = plant.truth.dipole_scale_error
+    if scale is not None and "magnetorquers_dipole" in limits:
+        # the plant delivers (1 + e) times the saturated command: at most (1 + e) times the design's dipole
+        limits["magnetorquers_dipole"] = limits["magnetorquers_dipole"] * (1.0 + np.asarray(scale, dtype=float))
     return limits
 
 
