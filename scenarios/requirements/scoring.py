@@ -72,7 +72,8 @@ from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requi
 __all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
            "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
            "endpoint_violations", "plant_limits", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
-           "score_reference", "unhonoured", "violations", "worst_error_between_samples"]
+           "score_reference", "tracking_loss", "unhonoured", "violations",
+           "worst_error_between_samples"]
 
 Array = NDArray[np.float64]
 
@@ -735,10 +736,41 @@ def violations(scores: Mapping[str, Mapping[str, Score]]) -> list[str]:
     Returns
     -------
     list of str
-        ``"<name> (<scope>): <detail>"`` per broken requirement, reference first.
+        ``"<name> (<scope>): <detail>"`` per broken requirement, reference first; a pointing
+        requirement the reference meets and the closed loop breaks says how much of the
+        reference's margin the tracking took (:func:`tracking_loss`).
     """
     return [f"{name} ({SCOPE_WORDS[scope]}): {score.detail}"
+            + (tracking_loss(scores["reference"][name], score) if scope == "closed_loop" and name in scores.get(
+                "reference", {}) else "")
             for scope in SCOPE_WORDS for name, score in scores.get(scope, {}).items() if not score.met]
+
+
+def tracking_loss(reference: Score, closed_loop: Score) -> str:
+    """Why a closed loop breaks a pointing requirement its reference meets, in words.
+
+    The reference clears the cone by its minimum margin ``m_r``; the closed loop ends at ``m_c < 0``:
+    the tracking took ``m_r − m_c`` of the reference's margin. A reference planned that much
+    further from the cone (collocation's ``cone_margin_deg``, 0.01° by default) or tighter tracking
+    leaves room; the hint is the measured loss, not a guarantee (another reference is tracked
+    differently).
+
+    Parameters
+    ----------
+    reference, closed_loop : Score
+        One pointing requirement's scores on the reference and on the closed loop.
+
+    Returns
+    -------
+    str
+        ``" (the reference clears it by 0.01 deg; the tracking took 0.2 deg: ...)"``, or ``""``
+        unless the reference meets it, the closed loop breaks it and both have a margin [deg].
+    """
+    kept, lost = reference.values.get("min_margin_deg"), closed_loop.values.get("min_margin_deg")
+    if not reference.met or closed_loop.met or kept is None or lost is None:
+        return ""
+    return (f" (the reference clears it by {kept:.3g} deg; the tracking took {kept - lost:.3g} deg: plan at least "
+            "that far from it, collocation's cone_margin_deg, or track tighter)")
 
 
 def unhonoured(requirements: Requirements, planner: Planner | None) -> str:
