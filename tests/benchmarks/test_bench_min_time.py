@@ -171,6 +171,25 @@ on a quiet host: the two coarse starts that must agree (about 45 ms), the certif
 Python stay. CasADi's ``qrqp`` and OSQP on the same QPs: no convergence in 1000 and 100000
 iterations; the condensing in CasADi SX: 8.7-11 ms per mapped call interpreted, 1.45 ms compiled
 after a 38 s gcc build.
+
+The same condensing by CasADi's own route, measured (a scratch prototype, 2026-12-02 21:00-22:00,
+not landed; CPU, alternating, load 4.4-5.7): one Radau interval (degree 3, our time grid) as
+``F(x_k, u_k, h)`` solving its 21 collocation equations by ``rootfinder`` (derivatives by the
+implicit function theorem) reproduces our discretisation (gaps 1.3e-15 at our optimum; IPOPT on the
+multiple shooting over F from our coarse optimum and multipliers: 3.24311081862251 in 7 iterations,
+as ours). But its derivatives cost more than our whole iteration: the 50-interval solve 149.7 ms
+against our 49.3 (3.13x [2.61..3.77]; the Hessian 7.5 and the Jacobian 5.3 ms an iteration, against
+0.26 ms of evaluations in ours), 1.48x compiled (gcc -O1, a 109 s build), while IPOPT and MUMPS on
+the condensed problem take 3.2 ms an iteration against our 6.6. ``sqpmethod`` with HPIPM (N 50,
+nx 8, nu 9): ``regularize`` 100 iterations without converging (T 3.243715); ``eigen-clip`` and
+``eigen-reflect`` stop after iteration 0 or 1 (as with ``qrqp``: the convexification, not the QP
+solver); no convexification diverges. The FATROP NLP solver refuses a ``rootfinder`` gap ("gap-closing
+constraints must be like this: x_{k+1}-F(xk,uk)"; with an RK4 F it reaches acados's 3.2433928). On
+the 8-interval mesh the condensed starts cost 3.3-3.5x ours each and both reach another minimum on
+B&W 180° (3.274627, 1 % worse; B&W 90° from the eigenaxis start too): the coarse phase's interior
+collocation points are what brings our starts to the best basin. Even with the fine phase at zero
+the plan would be 0.69x of today's: the two coarse starts alone (49 % of the plan) take 1.0-1.5x
+acados's whole time.
 """
 from __future__ import annotations
 
