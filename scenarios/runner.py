@@ -41,6 +41,7 @@ from planners.conformance import check_boundary
 from planners.errors import ConformanceError
 from planners.reference import JUMP_TOLERANCE
 from scenarios.output.results import Row, RunResults
+from scenarios.requirements.fields import VERDICT
 from scenarios.requirements.scoring import (
     REFERENCE_POINTS,
     SCOPE_WORDS,
@@ -153,9 +154,10 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
 
 
 def _judge(row: Row, scores: dict[str, dict[str, Score]], note: str) -> None:
-    """Put a row's requirement scores on it: a row that breaks one is ``violated`` unless it already
-    failed; the message names what breaks (first), then the row's own message and ``note``."""
-    row.requirements = {scope: {name: dict(score.values) for name, score in scores[scope].items()}
+    """Put a row's requirement scores on it, each with its verdict first (the field ``met``, a bool:
+    :data:`~scenarios.requirements.fields.VERDICT`): a row that breaks one is ``violated`` unless it
+    already failed; the message names what breaks (first), then the row's own message and ``note``."""
+    row.requirements = {scope: {name: {VERDICT: bool(score.met), **score.values} for name, score in scores[scope].items()}
                         for scope in SCOPE_WORDS if scope in scores} or None
     broken = violations(scores)
     if broken and row.status == "ok":

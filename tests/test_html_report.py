@@ -344,6 +344,8 @@ def test_the_study_cases_table_equals_cases_csv(study_out):
                 assert text == "", column
             elif isinstance(value, list):  # a dispersed vector
                 assert value == json.loads(text), column
+            elif isinstance(value, bool):  # a requirement's verdict
+                assert str(value) == text, column
             elif isinstance(value, (int, float)):
                 assert value == float(text), column
             else:

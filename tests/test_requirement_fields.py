@@ -29,6 +29,7 @@ from scenarios.output.tables import (
 from scenarios.requirements.fields import (
     QUANTITY,
     REQUIREMENT_FIELDS,
+    VERDICT,
     field_info,
     requirement_kind,
 )
@@ -89,18 +90,19 @@ def test_every_field_the_scorer_emits_is_declared(every_kind):
         assert column.split(".")[0] in info.scopes, column  # the declaration says which scopes give it
     # the scorer's own list of the columns a scenario can give (a study's summary keys): the same
     expected = score_fields(scenario.requirements, scenario.problem.spacecraft)
+    # (and each requirement's verdict, ``met``, which the runner stores with the scores)
     assert set(columns) == {f"{prefix}.req.{name}.{field}" for scope, prefix in (("reference", "ref"), ("closed_loop", "cl"))
-                            for name, fields in expected[scope].items() for field in fields}
+                            for name, fields in expected[scope].items() for field in (VERDICT, *fields)}
 
 
 def test_the_declaration_names_the_scorers_fields_and_the_reserved_names():
     by_kind: dict[str, list[str]] = {}
     for info in REQUIREMENT_FIELDS:
         by_kind.setdefault(info.requirement, []).append(info.field)
-    assert tuple(by_kind["pointing"]) == POINTING_FIELDS
-    assert tuple(by_kind["rate"]) == RATE_FIELDS
-    assert tuple(by_kind["final"]) == FINAL_FIELDS
-    assert tuple(by_kind["actuators"]) == (QUANTITY, f"{QUANTITY}_time_s") + JUMP_FIELDS + UNREALISED_FIELDS
+    assert tuple(by_kind["pointing"]) == (VERDICT, *POINTING_FIELDS)
+    assert tuple(by_kind["rate"]) == (VERDICT, *RATE_FIELDS)
+    assert tuple(by_kind["final"]) == (VERDICT, *FINAL_FIELDS)
+    assert tuple(by_kind["actuators"]) == (VERDICT, QUANTITY, f"{QUANTITY}_time_s") + JUMP_FIELDS + UNREALISED_FIELDS
     assert set(by_kind) - {"pointing"} == set(RESERVED_NAMES)
     assert {requirement_kind(name) for name in RESERVED_NAMES} == set(RESERVED_NAMES)
     for info in REQUIREMENT_FIELDS:
@@ -190,4 +192,5 @@ def test_field_info_reads_columns_names_and_bare_fields():
                   "", "a.b.c"):
         with pytest.raises(KeyError):
             field_info(wrong)
-    assert len(REQUIREMENT_FIELDS) == 4 + 6 + 3 + 3  # pointing, actuators (two patterns), rate, final
+    # pointing, actuators (two patterns), rate, final, each with its verdict
+    assert len(REQUIREMENT_FIELDS) == (1 + 4) + (1 + 6) + (1 + 3) + (1 + 3)

@@ -129,7 +129,8 @@ def test_the_fields_a_study_checks_its_summary_against_are_those_a_run_gives():
     assert row.requirements is not None
     for scope in ("reference", "closed_loop"):
         given = {name: tuple(values) for name, values in row.requirements[scope].items()}
-        assert given == fields[scope], scope
+        # each score starts with its verdict, which the study's columns add to the scorer's fields
+        assert given == {name: ("met", *names) for name, names in fields[scope].items()}, scope
 
 
 def test_rate_jumps_are_taken_up_by_the_wheels_as_momentum_conservation_says():
@@ -412,5 +413,5 @@ def test_a_study_sweeping_the_angle_and_the_epoch_runs_and_reports_each_case(tmp
     assert june_40["status"] == "failed" and "target attitude already breaks it" in june_40["message"]
     assert float(by_case[("2027-03-20T12:00:00Z", "20")]["ref.req.st_sun.min_margin_deg"]) < -19.0
     summary = (tmp_path / "out" / "requirements.csv").read_text().splitlines()
-    assert summary[0] == "label,completed,met,fraction_met,wilson_low,wilson_high"
-    assert summary[1].startswith("eigenaxis,4,1,0.25,")
+    assert summary[0] == "label,criterion,completed,scored,met,fraction_met,wilson_low,wilson_high"
+    assert summary[1].startswith("eigenaxis,every requirement,4,4,1,0.25,")

@@ -99,15 +99,16 @@ def test_the_requirement_columns_in_every_table(crossing, tmp_path):
     assert data["frame"] == "inertial (no epoch)" and data["epoch"] is None
     scores = data["rows"][0]["requirements"]
     assert set(scores) == {"reference", "closed_loop"}
-    assert list(scores["reference"]["st"]) == ["min_margin_deg", "time_in_violation_s", "first_violation_s",
+    assert list(scores["reference"]["st"]) == ["met", "min_margin_deg", "time_in_violation_s", "first_violation_s",
                                                "min_margin_time_s"]
+    assert (scores["reference"]["st"]["met"], scores["closed_loop"]["st"]["met"]) == (False, False)  # bools
     lines = list(csv.DictReader(io.StringIO(crossing.to_csv())))
     header = crossing.to_csv().splitlines()[0].split(",")
     req = [c for c in header if ".req." in c]
-    pointing = ("min_margin_deg", "time_in_violation_s", "first_violation_s", "min_margin_time_s")
+    pointing = ("met", "min_margin_deg", "time_in_violation_s", "first_violation_s", "min_margin_time_s")
     # the actuator requirement every scenario carries (margin 0) is scored on the reference only
     assert req == ([f"ref.req.st.{field}" for field in pointing]
-                   + [f"ref.req.actuators.{field}" for field in ("wheels_torque", "wheels_torque_time_s",
+                   + [f"ref.req.actuators.{field}" for field in ("met", "wheels_torque", "wheels_torque_time_s",
                                                                  "wheels_momentum", "wheels_momentum_time_s",
                                                                  "rate_jump", "rate_jump_time_s",
                                                                  "unrealised_torque", "unrealised_torque_time_s")]
@@ -115,7 +116,7 @@ def test_the_requirement_columns_in_every_table(crossing, tmp_path):
     assert header.index(req[0]) > header.index("cl.initial_rate_error")  # after the metric columns
     assert float(lines[0]["ref.req.st.min_margin_deg"]) == scores["reference"]["st"]["min_margin_deg"]
     frame = crossing.to_dataframe()
-    assert all(frame[c].dtype == "float64" for c in req)
+    assert all(frame[c].dtype == ("boolean" if c.endswith(".met") else "float64") for c in req)
     markdown = crossing.to_markdown()
     assert "| ref.req.st.min_margin_deg | -30 |" in markdown and "rows: 1 (1 violated)" in markdown
     terminal = crossing.to_terminal()

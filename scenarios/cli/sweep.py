@@ -375,7 +375,12 @@ def resume_command(args: argparse.Namespace, out: Path) -> str:
 
 def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster | None) -> int:
     from scenarios.study.engine import sweep
-    from scenarios.study.report import collapse_note, robustness_tables
+    from scenarios.study.report import (
+        collapse_note,
+        requirement_lines,
+        requirement_table,
+        robustness_tables,
+    )
     from scenarios.study.robustness import crashed_counts, robustness_lines
     from scenarios.study.store import STORE_NAME, SweepStore, resume_counts
 
@@ -427,6 +432,8 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
     for said in (collapse_note(study), _final_note(study, rows)):
         if said:
             print(said)
+    print("requirements (cases meeting each, of those scored; requirements.csv):")
+    print("\n".join(requirement_lines(requirement_table(study, rows))))
     tables = robustness_tables(study, rows)
     if tables is not None:
         proportions, _, worst = tables

@@ -81,8 +81,8 @@ class Row:
         Controller registry name.
     requirements : dict or None, optional
         The requirement scores by scope (``reference``, ``closed_loop``), then requirement name,
-        then field (:mod:`scenarios.requirements.scoring`); ``None`` when the scenario has no
-        requirements.
+        then field (:mod:`scenarios.requirements.scoring`), the verdict ``met`` (a bool) first;
+        ``None`` when the scenario has no requirements.
     """
 
     label: str

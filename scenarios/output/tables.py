@@ -25,7 +25,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from scenarios.requirements.fields import field_info
+from scenarios.requirements.fields import field_info, is_verdict_column
 from scenarios.schema.columns import (
     AXES,
     REQUIREMENT_MARK,
@@ -139,9 +139,10 @@ def numeric_columns(requirements: Sequence[str] = ()) -> list[str]:
     -------
     list of str
         ``plan_time_s``, every metric column, the certificate's KKT residuals and the requirement
-        columns given.
+        columns given but the verdicts (``<scope>.req.<name>.met``: bools).
     """
-    return ["plan_time_s", *metric_columns(), *CERTIFICATE_NUMBERS, *requirements]
+    return ["plan_time_s", *metric_columns(), *CERTIFICATE_NUMBERS,
+            *(column for column in requirements if not is_verdict_column(column))]
 
 
 def flatten_row(row: Mapping[str, Any]) -> dict[str, Any]:
@@ -257,7 +258,10 @@ def data_frame(columns: Sequence[str], records: Iterable[Mapping[str, Any]], num
         The lines.
     numeric : iterable of str
         The columns that hold numbers (never ``None`` in the DataFrame); the requirement columns
-        (:func:`~scenarios.schema.columns.is_requirement_column`) are numeric too.
+        (:func:`~scenarios.schema.columns.is_requirement_column`) are numeric too, but for the
+        verdicts (``<scope>.req.<name>.met``,
+        :func:`~scenarios.requirements.fields.is_verdict_column`): pandas' nullable ``boolean``,
+        ``<NA>`` where missing, never a float to average.
 
     Returns
     -------
@@ -273,11 +277,14 @@ def data_frame(columns: Sequence[str], records: Iterable[Mapping[str, Any]], num
         import pandas
     except ImportError:
         raise ImportError("to_dataframe needs pandas: pip install pandas") from None
-    numbers = (set(numeric) | {column for column in columns if is_requirement_column(column)}) & set(columns)
+    verdicts = {column for column in columns if is_verdict_column(column)}
+    numbers = (set(numeric) | {column for column in columns if is_requirement_column(column)}) & set(columns) - verdicts
     lines = [{column: (math.nan if is_missing(record.get(column)) else record.get(column)) if column in numbers
+              else (None if is_missing(record.get(column)) else record.get(column)) if column in verdicts
               else record.get(column) for column in columns} for record in records]
     frame = pandas.DataFrame(lines, columns=list(columns))
-    return frame.astype({column: float for column in columns if column in numbers})
+    return frame.astype({column: float if column in numbers else "boolean"
+                         for column in columns if column in numbers or column in verdicts})
 
 
 def to_json(results: RunResults) -> str:
@@ -329,7 +336,8 @@ def to_dataframe(results: RunResults) -> pandas.DataFrame:
     pandas.DataFrame
         One line per row, the columns of :func:`row_columns` (with the rows' requirement
         columns); ``plan_time_s``, the metric and the requirement columns are float, NaN where
-        missing or non-finite.
+        missing or non-finite, but the verdicts (``<scope>.req.<name>.met``): pandas' nullable
+        ``boolean``.
 
     Raises
     ------

@@ -17,6 +17,11 @@ The actuator requirement's fields per actuator quantity (``wheels_torque``, ``wh
 :func:`controllers.allocation.demand_limits`) are declared once for all quantities, as the patterns
 ``<quantity>`` and ``<quantity>_time_s``.
 
+Every requirement's score also carries its verdict in that scope, the field :data:`VERDICT`
+(``met``, a bool: ``ref.req.<name>.met``, ``cl.req.<name>.met``; :data:`VERDICT_UNIT` its unit): the
+scoring's own, which the report's sign-off record and a study's counts read, never the row's message.
+It is a verdict, not a measurement: no table averages it (a study counts it, ``requirements.csv``).
+
 Plain data, importing nothing of slewbench: the plot process (:mod:`scenarios.output.plots`)
 reads it without loading the model.
 """
@@ -24,10 +29,18 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-__all__ = ["QUANTITY", "REQUIREMENT_FIELDS", "RequirementField", "field_info", "requirement_kind"]
+__all__ = ["QUANTITY", "REQUIREMENT_FIELDS", "VERDICT", "VERDICT_UNIT", "RequirementField", "field_info",
+           "is_verdict_column", "requirement_kind"]
 
 QUANTITY = "<quantity>"
 """The placeholder of an actuator quantity's name in the patterns of :data:`REQUIREMENT_FIELDS`."""
+
+VERDICT = "met"
+"""The field of a requirement's verdict in a scope (``ref.req.<name>.met``): true when the requirement
+holds there (:attr:`scenarios.requirements.scoring.Score.met`), a bool, never a number."""
+VERDICT_UNIT = "true/false"
+"""The unit of :data:`VERDICT`: the readers that format a number by its unit (``–`` a ratio) leave it
+alone."""
 
 _SCOPE_PREFIXES = ("ref", "cl")
 """The scope prefixes of the requirement columns (:data:`scenarios.schema.columns.SCOPES`)."""
@@ -54,6 +67,8 @@ class RequirementField:
         Its definition, for the documentation (reStructuredText inline markup).
     scopes : tuple of str
         The prefixes of the scopes that give it: ``ref`` (the reference), ``cl`` (the closed loop).
+
+    Unit ``–`` is a ratio, :data:`VERDICT_UNIT` the verdict (a bool); every other unit a number's.
     """
 
     requirement: str
@@ -138,9 +153,41 @@ _FINAL = (
         "Where that stretch starts, ``T + after_s`` (T: the reference's duration).", ("cl",)),
 )
 
-REQUIREMENT_FIELDS: tuple[RequirementField, ...] = _POINTING + _ACTUATORS + _RATE + _FINAL
-"""Every requirement field, by requirement kind in column order (the actuator quantities' fields as
-the patterns ``<quantity>`` and ``<quantity>_time_s``)."""
+
+
+def _verdict(kind: str, scopes: tuple[str, ...]) -> tuple[RequirementField]:
+    """The verdict field (:data:`VERDICT`) of a requirement kind, first among its fields."""
+    return (RequirementField(
+        kind, VERDICT, VERDICT_UNIT, "met",
+        "Whether the requirement holds in that scope (``true``, ``false``): the scoring's verdict on the whole "
+        "requirement, on which the row's status (``violated`` when one is ``false``) and the report's "
+        "sign-off record rest; in a study, counted per requirement and scope (``requirements.csv``), never "
+        "averaged.", scopes),)
+
+
+REQUIREMENT_FIELDS: tuple[RequirementField, ...] = (
+    _verdict("pointing", ("ref", "cl")) + _POINTING + _verdict("actuators", ("ref",)) + _ACTUATORS
+    + _verdict("rate", ("ref", "cl")) + _RATE + _verdict("final", ("cl",)) + _FINAL)
+"""Every requirement field, by requirement kind in column order, each kind's verdict (:data:`VERDICT`)
+first (the actuator quantities' fields as the patterns ``<quantity>`` and ``<quantity>_time_s``)."""
+
+
+def is_verdict_column(column: str) -> bool:
+    """Whether a column is a requirement's verdict: ``ref.req.<name>.met`` or ``cl.req.<name>.met``.
+
+    Parameters
+    ----------
+    column : str
+        A column name.
+
+    Returns
+    -------
+    bool
+        True for a requirement column (``<scope>.req.<name>.<field>``) whose field is :data:`VERDICT`.
+    """
+    parts = column.split(".")
+    return (len(parts) == 4 and parts[0] in _SCOPE_PREFIXES and parts[1] == "req" and bool(parts[2])
+            and parts[3] == VERDICT)
 
 
 def requirement_kind(name: str) -> str:

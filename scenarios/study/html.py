@@ -3,7 +3,8 @@
 Built on the run report's page (:class:`scenarios.output.report.page.Page`): plotly.js inline, the
 tables' values exactly as in the CSV files, opening offline. In order:
 
-* the fraction of cases meeting every requirement per planner (``requirements.csv``);
+* the fraction of cases meeting every requirement per planner, then each requirement in each scope
+  (``requirements.csv``);
 * for a Monte Carlo study, the robustness tables (:mod:`scenarios.study.robustness`): the
   fractions meeting every requirement and each threshold, the rank correlations and the worst cases;
 * the summary statistics (``summary.csv``), with each metric's unit;
@@ -209,8 +210,10 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
               f"{len(rows)} rows; slewbench {package_version()}."),
              "Varied: " + (", ".join(varied) if varied else "nothing") + "."]
     page = Page(f"{study.name}: slewbench trade study", lines)
-    page.section("Cases meeting every requirement",
-                 "Rows whose status is ok among the completed ones (not crashed), with the Wilson 95 % interval.")
+    page.section("Cases meeting the requirements",
+                 "every requirement: rows whose status is ok among the completed ones (not crashed); then each "
+                 "requirement in each scope, by its verdict (met): the rows where it is met among those scored "
+                 "there. With the Wilson 95 % interval of the fraction.")
     page.table("requirements", result_columns(requirements[0], requirements[1]),
                [[row.get(c) for c in requirements[0]] for row in requirements[1]])
     if robustness is not None:

@@ -1,8 +1,9 @@
 """Tables and files of a trade study: ``cases.csv`` (one row per case and planner),
 ``summary.csv`` / ``summary.md`` (statistics per planner, and per grid point when there is
 Monte Carlo), ``requirements.csv`` (per planner, the fraction of cases that meet every requirement,
-with its Wilson interval; also in ``summary.md``), for a Monte Carlo study the robustness tables
-``robustness.csv``, ``sensitivity.csv`` and ``worst_cases.csv`` (:mod:`scenarios.study.robustness`;
+then of those scored that meet each requirement in each scope by its verdict ``met``, each with its
+Wilson interval: :func:`requirement_table`; also in ``summary.md`` and printed by ``slewbench
+sweep``), for a Monte Carlo study the robustness tables ``robustness.csv``, ``sensitivity.csv`` and ``worst_cases.csv`` (:mod:`scenarios.study.robustness`;
 also in ``summary.md``), the resolved ``study.yaml``, the plots
 (:mod:`scenarios.study.plots`) and the interactive ``report.html`` (:mod:`scenarios.study.html`).
 
@@ -33,6 +34,8 @@ from scenarios.output.tables import (
     row_columns,
     text_cell,
 )
+from scenarios.requirements.fields import VERDICT
+from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES
 from scenarios.study.store import claim_sweep_directory, commit_sweep_outputs
 from scenarios.study.types import Study
 
@@ -49,9 +52,15 @@ failed planner or simulation, metrics that are not physical), an ``infeasible`` 
 ``crashed`` one are left out whatever values they carry (:func:`metric_values` with
 ``counted_only``), and ``summary.csv`` counts them (``excluded``)."""
 PROPORTION_STATISTICS = ("completed", "met", "fraction_met", "wilson_low", "wilson_high")
-"""The columns of ``requirements.csv`` (and ``robustness.csv``) after the grouping keys: rows that
-completed (not ``crashed``), those meeting the criterion (``ok``: every requirement), their fraction
-and its Wilson 95 % interval (:func:`proportion`)."""
+"""The statistics of a proportion (:func:`proportion`): rows that completed (not ``crashed``), those
+meeting the criterion, their fraction and its Wilson 95 % interval; ``robustness.csv`` adds
+``excluded``, ``requirements.csv`` ``scored`` (:data:`REQUIREMENT_STATISTICS`)."""
+REQUIREMENT_STATISTICS = ("completed", "scored", *PROPORTION_STATISTICS[1:])
+"""The columns of ``requirements.csv`` after the grouping keys and ``criterion``
+(:func:`requirement_table`): the rows that completed (not ``crashed``), those scored against the
+criterion, those meeting it, the fraction of the scored ones and its Wilson 95 % interval."""
+EVERY_REQUIREMENT = "every requirement"
+"""The criterion of the rows whose status is ``ok`` (``requirements.csv``, ``robustness.csv``)."""
 WILSON_Z = 1.959963984540054
 """The standard normal quantile of 97.5 %: a two-sided 95 % interval."""
 _DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml's emitter when built: same text, 3x faster
@@ -406,12 +415,61 @@ def group_rows(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], dic
     return keys, groups
 
 
-def requirement_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
-    """Per planner row label (and grid point under Monte Carlo): the fraction of the completed cases
-    that meet every requirement (status ``ok``) and its Wilson 95 % interval (:func:`wilson_interval`).
+def requirement_criterion(name: str, scope: str) -> str:
+    """How ``requirements.csv`` names one requirement in one scope: ``st_sun (closed loop)``.
 
-    A completed case is one whose row is not ``crashed``; a ``failed`` or ``violated`` row completed
-    and does not meet them. Cases that share a store key count once (:func:`distinct_rows`).
+    Parameters
+    ----------
+    name : str
+        The requirement's name (a pointing requirement's, ``actuators``, ``rate``, ``final``).
+    scope : str
+        ``reference`` or ``closed_loop``.
+
+    Returns
+    -------
+    str
+        The name and the scope in words, as a row's message names a broken requirement.
+    """
+    return f"{name} ({scope.replace('_', ' ')})"
+
+
+def requirement_verdicts(rows: list[dict[str, Any]]) -> list[tuple[str, str]]:
+    """The verdict columns of some ``cases.csv`` rows: per requirement, in the order the rows first
+    give them, its reference's then its closed loop's.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The ``cases.csv`` rows (:func:`case_table`).
+
+    Returns
+    -------
+    list of (str, str)
+        ``(criterion, column)``: :func:`requirement_criterion` and ``<scope>.req.<name>.met``.
+    """
+    names: dict[str, None] = {}
+    for row in rows:
+        for column in row:
+            parts = column.split(".")
+            if len(parts) == 4 and parts[1] == REQUIREMENT_MARK and parts[3] == VERDICT:
+                names.setdefault(parts[2])
+    present = {column for row in rows for column, value in row.items() if isinstance(value, bool)}
+    return [(requirement_criterion(name, scope), column) for name in names for scope, prefix in SCOPES
+            if (column := f"{prefix}.{REQUIREMENT_MARK}.{name}.{VERDICT}") in present]
+
+
+def requirement_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
+    """Per planner row label (and grid point under Monte Carlo): how many cases meet every requirement,
+    then each requirement in each scope, with the fraction and its Wilson 95 % interval
+    (:func:`wilson_interval`).
+
+    The first criterion, :data:`EVERY_REQUIREMENT`, is met by a row whose status is ``ok``, among the
+    completed rows (not ``crashed``: a ``failed`` or ``violated`` row completed and does not meet it).
+    Then one criterion per requirement and scope (:func:`requirement_criterion`,
+    ``st_sun (closed loop)``), read from the verdict the scoring stored with the row's scores (the
+    column ``<scope>.req.<name>.met``, never the message): ``scored`` counts the rows with that verdict
+    (a row whose planner failed has no score; a crashed case none), ``met`` those where it is true, and
+    the fraction is of the scored rows. Cases that share a store key count once (:func:`distinct_rows`).
 
     Parameters
     ----------
@@ -423,18 +481,57 @@ def requirement_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[st
     Returns
     -------
     columns : list of str
-        The grouping keys and :data:`PROPORTION_STATISTICS`.
+        The grouping keys, ``criterion`` and :data:`REQUIREMENT_STATISTICS`.
     rows : list of dict
-        One per group; the fraction and the interval are None without completed cases.
+        One per group and criterion (:data:`EVERY_REQUIREMENT` first); the fraction and the
+        interval are None without a completed (scored) row.
     """
-    keys, groups = group_rows(study, distinct_rows(study, rows))
+    distinct = distinct_rows(study, rows)
+    verdicts = requirement_verdicts(distinct)
+    keys, groups = group_rows(study, distinct)
     table = []
     for members in groups.values():
         completed = [r for r in members if r["status"] != "crashed"]
-        line = {k: members[0].get(k) for k in keys}
-        line.update(proportion(sum(r["status"] == "ok" for r in completed), len(completed)))
-        table.append(line)
-    return [*keys, *PROPORTION_STATISTICS], table
+        criteria = [(EVERY_REQUIREMENT, len(completed), sum(r["status"] == "ok" for r in completed))]
+        for criterion, column in verdicts:
+            scored = [r[column] for r in completed if isinstance(r.get(column), bool)]
+            criteria.append((criterion, len(scored), sum(scored)))
+        for criterion, scored_count, met in criteria:
+            line = {k: members[0].get(k) for k in keys}
+            line.update(criterion=criterion, **proportion(met, scored_count))
+            line.update(completed=len(completed), scored=scored_count)
+            table.append(line)
+    return [*keys, "criterion", *REQUIREMENT_STATISTICS], table
+
+
+def requirement_lines(requirements: tuple[list[str], list[dict[str, Any]]]) -> list[str]:
+    """The requirement counts ``slewbench sweep`` prints, one line per group and criterion.
+
+    Parameters
+    ----------
+    requirements : (list of str, list of dict)
+        :func:`requirement_table`.
+
+    Returns
+    -------
+    list of str
+        ``  eigenaxis: st_sun (closed loop) met in 13 of 16 cases`` (``, 2 not scored`` when some
+        completed rows have no verdict; ``no case scored`` without one, ``no completed case``
+        when every case crashed).
+    """
+    columns, table = requirements
+    keys = columns[:columns.index("criterion")]
+    lines = []
+    for line in table:
+        group = ", ".join(text_cell(line.get(k)) for k in keys)
+        if not line["scored"]:
+            lines.append(f"  {group}: {line['criterion']}: "
+                         + (f"no case scored ({line['completed']} completed)" if line["completed"] else "no completed case"))
+            continue
+        unscored = line["completed"] - line["scored"]
+        lines.append(f"  {group}: {line['criterion']} met in {line['met']} of {line['scored']} case"
+                     f"{'s' if line['scored'] != 1 else ''}" + (f", {unscored} not scored" if unscored else ""))
+    return lines
 
 
 def _table_lines(columns: list[str], rows: list[dict[str, Any]]) -> list[str]:
@@ -457,8 +554,10 @@ def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], miss
                  "over the count rows; median, p5, p95 (linear percentiles), min and max over those and the never "
                  "rows as inf; not_ok: rows whose status is not ok (violated, failed, infeasible or crashed)."), ""]
     if requirements is not None:
-        out += ["## Cases meeting every requirement", "",
-                "Rows whose status is ok among the completed ones (not crashed), with the Wilson 95 % interval.", ""]
+        out += ["## Cases meeting the requirements", "",
+                ("every requirement: rows whose status is ok among the completed ones (not crashed); then each "
+                 "requirement in each scope, by its verdict (met): the rows where it is met among those scored "
+                 "there. With the Wilson 95 % interval of the fraction."), ""]
         out += _table_lines(*requirements) + [""]
     if robustness:
         out += [robustness]

@@ -47,6 +47,7 @@ import numpy as np
 
 from scenarios.output.tables import text_cell
 from scenarios.study.report import (
+    EVERY_REQUIREMENT,
     INFINITY_TEXT,
     PROPORTION_STATISTICS,
     WILSON_Z,
@@ -63,11 +64,9 @@ __all__ = ["EVERY_REQUIREMENT", "ROBUSTNESS_STATISTICS", "SENSITIVITY_STATISTICS
            "proportion_table", "rank_significance", "robustness_lines", "robustness_markdown", "sensitivity_table", "spearman",
            "worst_table"]
 
-EVERY_REQUIREMENT = "every requirement"
-"""The criterion of the rows whose status is ``ok``."""
 ROBUSTNESS_STATISTICS = (PROPORTION_STATISTICS[0], "excluded", *PROPORTION_STATISTICS[1:])
-"""The columns of ``robustness.csv`` after the grouping keys and ``criterion``: those of
-``requirements.csv`` (:data:`~scenarios.study.report.PROPORTION_STATISTICS`) with ``excluded``
+"""The columns of ``robustness.csv`` after the grouping keys and ``criterion``: a proportion's
+(:data:`~scenarios.study.report.PROPORTION_STATISTICS`) with ``excluded``
 after ``completed`` (:func:`excluded_count`: the ``failed`` and ``infeasible`` ones among them
 are completed and meet no criterion)."""
 SENSITIVITY_STATISTICS = ("cases", "excluded", "spearman_rho", "rho_low", "rho_high", "p_value", "p_holm",

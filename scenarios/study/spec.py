@@ -33,6 +33,7 @@ import numpy as np
 from ocp.errors import excerpt
 from scenarios.errors import ScenarioError
 from scenarios.output.provenance import package_version
+from scenarios.requirements.fields import VERDICT, is_verdict_column
 from scenarios.requirements.scoring import score_fields
 from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES, is_requirement_column
 from scenarios.schema.keys import Key
@@ -364,16 +365,22 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
 
 
 def _requirement_columns(scenario: Scenario) -> list[str]:
-    """The requirement columns a case's rows can give (``ref.req.<name>.<field>``, ``cl.req...``)."""
+    """The requirement columns a case's rows can give (``ref.req.<name>.<field>``, ``cl.req...``), each
+    requirement's verdict (:data:`~scenarios.requirements.fields.VERDICT`) first, as the runner stores it."""
     fields = score_fields(scenario.requirements, scenario.problem.spacecraft, scenario.truth)
     return [f"{prefix}.{REQUIREMENT_MARK}.{name}.{field}" for scope, prefix in SCOPES
-            for name, names in fields[scope].items() for field in names]
+            for name, names in fields[scope].items() for field in (VERDICT, *names)]
 
 
 def _check_summary(summary: list[tuple[str, str]], columns: dict[str, None]) -> None:
     """Refuse a summary entry (or threshold), given as ``(where, column)``, naming a requirement
-    column that no case gives (a typo would summarise nothing, silently)."""
+    column that no case gives (a typo would summarise nothing, silently), or a requirement's verdict
+    (a bool: its statistics would be empty; ``requirements.csv`` counts it)."""
     for where, column in summary:
+        if is_verdict_column(column):
+            raise ScenarioError(where, f"{column!r} is a requirement's verdict (true or false), not a number to "
+                                       f"summarise or bound: requirements.csv counts the cases that meet each "
+                                       f"requirement in each scope; name one of its numbers instead")
         if not is_requirement_column(column) or column in columns:
             continue
         prefix, _, name, field = column.split(".")

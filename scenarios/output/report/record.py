@@ -10,10 +10,11 @@ beside ``spacecraft.wheels.X``, ``truth.spacecraft.X`` beside ``spacecraft.X``);
 ``simulation.estimator`` and ``simulation.sensor_noise`` as written; the requirements are each
 requirement's own words (``describe()``), and per row and scope each bounded field of its score
 (:data:`BOUNDS`) with its unit from :func:`~scenarios.requirements.fields.field_info`, the bound, the
-value achieved and the run's verdict on the requirement in that scope (broken when the row's message
-names it in the words of :func:`~scenarios.requirements.scoring.violations`, :data:`BROKEN`; this
-module may not import the scoring, which loads the model: ``tests/test_report_record.py`` checks that
-the words and the bound of the unrealised torque, :data:`UNREALISED_SHARE`, are the scoring's).
+value achieved and the run's verdict on the requirement in that scope: the score's own verdict, its
+field ``met`` (:data:`~scenarios.requirements.fields.VERDICT`, the scoring's
+:attr:`~scenarios.requirements.scoring.Score.met`), never read from the row's message. This module
+may not import the scoring, which loads the model: ``tests/test_report_record.py`` checks that the
+bound of the unrealised torque, :data:`UNREALISED_SHARE`, is the scoring's.
 """
 from __future__ import annotations
 
@@ -27,19 +28,16 @@ import numpy as np
 from planners.reference import JUMP_TOLERANCE
 from scenarios.output.provenance import run_provenance
 from scenarios.output.report.page import Column, Page
-from scenarios.requirements.fields import field_info, requirement_kind
+from scenarios.requirements.fields import VERDICT, field_info, requirement_kind
 
 if TYPE_CHECKING:
     from scenarios.output.results import Row, RunResults
     from scenarios.requirements.spec import Requirements
     from scenarios.schema.loader import Scenario
 
-__all__ = ["BOUNDS", "BROKEN", "DESIGN_KEYS", "UNREALISED_SHARE", "Bound", "add_record", "plant_entries", "provenance_entries", "requirement_lines",
+__all__ = ["BOUNDS", "DESIGN_KEYS", "UNREALISED_SHARE", "Bound", "add_record", "plant_entries", "provenance_entries", "requirement_lines",
            "sensor_entries"]
 
-BROKEN = "{name} ({scope}): "
-"""How a row's message starts the part that names a broken requirement (``scope`` in words: ``reference``,
-``closed loop``), as :func:`~scenarios.requirements.scoring.violations` writes it."""
 UNREALISED_SHARE = 0.01
 """The unrealised torque allowed, as a share of the reference's peak torque
 (:data:`~scenarios.requirements.scoring.UNREALISED_TOLERANCE`)."""
@@ -56,7 +54,7 @@ def _pointing(requirement: Any, fields: dict[str, Any]) -> list[Bound]:
 def _actuators(requirement: Any, fields: dict[str, Any]) -> list[Bound]:
     bounds: list[Bound] = []
     for name in fields:
-        if name.endswith("_time_s"):
+        if name.endswith("_time_s") or name == VERDICT:
             continue
         if name == "rate_jump":
             bounds.append((name, "rate_jump_time_s", "≤", JUMP_TOLERANCE))
@@ -218,10 +216,13 @@ def _scope_words(scope: str) -> str:
     return scope.replace("_", " ")
 
 
-def _broken(row: Row, scope: str, name: str) -> bool:
-    """Whether the row's message names requirement ``name`` broken in ``scope`` (:data:`BROKEN`)."""
-    prefix = BROKEN.format(name=name, scope=_scope_words(scope))
-    return any(part.startswith(prefix) for part in row.message.split("; "))
+def _verdict(row: Row, scope: str, name: str, fields: dict[str, Any]) -> str:
+    """``met`` or ``broken``: the score's verdict (its field :data:`~scenarios.requirements.fields.VERDICT`)."""
+    met = fields.get(VERDICT)
+    if not isinstance(met, bool):
+        raise TypeError(f"row {row.label!r}: the {_scope_words(scope)} score of requirement {name!r} has no verdict "
+                         f"(its field {VERDICT!r} is {met!r}, not true or false): the runner stores one with every score")
+    return "met" if met else "broken"
 
 
 def requirement_lines(results: RunResults) -> list[list[Any]]:
@@ -241,7 +242,12 @@ def requirement_lines(results: RunResults) -> list[list[Any]]:
         requirement its window's start), whether the value is within the bound (``yes``, ``no``;
         ``-`` for a bound in words or a value missing; a plain comparison, without the scoring's
         rounding slack of 1e-9 relative) and the verdict ``met`` or ``broken`` (the run's, on the
-        whole requirement in that scope). Rows without scores give none.
+        whole requirement in that scope: the score's field ``met``). Rows without scores give none.
+
+    Raises
+    ------
+    TypeError
+        A score without its verdict (``met`` missing or not a bool).
     """
     lines = []
     requirements = results.scenario.requirements
@@ -251,7 +257,7 @@ def requirement_lines(results: RunResults) -> list[list[Any]]:
                 requirement = _requirement(requirements, name)
                 if requirement is None:
                     continue
-                verdict = "broken" if _broken(row, scope, name) else "met"
+                verdict = _verdict(row, scope, name, fields)
                 for field, when, relation, bound in BOUNDS[requirement_kind(name)](requirement, fields):
                     value = fields.get(field)
                     numeric = isinstance(bound, (int, float))
