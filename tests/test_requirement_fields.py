@@ -90,9 +90,9 @@ def test_every_field_the_scorer_emits_is_declared(every_kind):
         assert column.split(".")[0] in info.scopes, column  # the declaration says which scopes give it
     # the scorer's own list of the columns a scenario can give (a study's summary keys): the same
     expected = score_fields(scenario.requirements, scenario.problem.spacecraft)
-    # (and each requirement's verdict, ``met``, which the runner stores with the scores)
     assert set(columns) == {f"{prefix}.req.{name}.{field}" for scope, prefix in (("reference", "ref"), ("closed_loop", "cl"))
-                            for name, fields in expected[scope].items() for field in (VERDICT, *fields)}
+                            for name, fields in expected[scope].items() for field in fields}
+    assert all(fields[0] == VERDICT for scope in expected.values() for fields in scope.values())  # the runner's order
 
 
 def test_the_declaration_names_the_scorers_fields_and_the_reserved_names():

@@ -67,6 +67,7 @@ from ocp.metrics import rate_error, turning
 from planners import ManeuverProblem, Planner, Reference
 from planners.base import REQUIREMENT_KINDS
 from planners.reference import BREAKPOINT_INSTANT, JUMP_TOLERANCE
+from scenarios.requirements.fields import VERDICT
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
 __all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
@@ -670,9 +671,10 @@ def score_fields(requirements: Requirements, spacecraft: Spacecraft,
     Returns
     -------
     dict
-        Scope (``reference``, ``closed_loop``) -> requirement name -> fields, in column order:
-        pointing and rate in both scopes, ``actuators`` in the reference only, ``final`` in the
-        closed loop only.
+        Scope (``reference``, ``closed_loop``) -> requirement name -> fields, in column order,
+        each requirement's verdict first (:data:`~scenarios.requirements.fields.VERDICT`, as the
+        runner stores the scores): pointing and rate in both scopes, ``actuators`` in the
+        reference only, ``final`` in the closed loop only.
     """
     pointing = {requirement.name: POINTING_FIELDS for requirement in requirements.pointing}
     reference: dict[str, tuple[str, ...]] = dict(pointing)
@@ -687,7 +689,8 @@ def score_fields(requirements: Requirements, spacecraft: Spacecraft,
         reference["rate"] = closed_loop["rate"] = RATE_FIELDS
     if requirements.final is not None:
         closed_loop["final"] = FINAL_FIELDS
-    return {"reference": reference, "closed_loop": closed_loop}
+    return {scope: {name: (VERDICT, *names) for name, names in fields.items()}
+            for scope, fields in (("reference", reference), ("closed_loop", closed_loop))}
 
 
 def endpoint_violations(problem: ManeuverProblem) -> list[str]:

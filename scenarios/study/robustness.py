@@ -59,7 +59,7 @@ from scenarios.study.report import (
 )
 from scenarios.study.types import Study
 
-__all__ = ["EVERY_REQUIREMENT", "ROBUSTNESS_STATISTICS", "SENSITIVITY_STATISTICS", "WORST_COLUMNS", "crashed_counts",
+__all__ = ["ROBUSTNESS_STATISTICS", "SENSITIVITY_STATISTICS", "WORST_COLUMNS", "crashed_counts",
            "criterion_text", "excluded_count", "holm", "parameter_columns",
            "proportion_table", "rank_significance", "robustness_lines", "robustness_markdown", "sensitivity_table", "spearman",
            "worst_table"]
@@ -151,7 +151,7 @@ def proportion_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str
     columns : list of str
         The grouping keys, ``criterion`` and :data:`ROBUSTNESS_STATISTICS`.
     rows : list of dict
-        One per group and criterion (:data:`EVERY_REQUIREMENT` first); the fraction and its
+        One per group and criterion (:data:`scenarios.study.report.EVERY_REQUIREMENT` first); the fraction and its
         interval are None without completed cases. A threshold is met only by a row that counts
         (``ok`` or ``violated``): a ``failed`` or ``infeasible`` row is completed and meets none,
         whatever its values; ``excluded`` counts the group's rows left out so (crashed ones too).

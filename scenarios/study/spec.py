@@ -33,7 +33,7 @@ import numpy as np
 from ocp.errors import excerpt
 from scenarios.errors import ScenarioError
 from scenarios.output.provenance import package_version
-from scenarios.requirements.fields import VERDICT, is_verdict_column
+from scenarios.requirements.fields import is_verdict_column
 from scenarios.requirements.scoring import score_fields
 from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES, is_requirement_column
 from scenarios.schema.keys import Key
@@ -366,10 +366,10 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
 
 def _requirement_columns(scenario: Scenario) -> list[str]:
     """The requirement columns a case's rows can give (``ref.req.<name>.<field>``, ``cl.req...``), each
-    requirement's verdict (:data:`~scenarios.requirements.fields.VERDICT`) first, as the runner stores it."""
+    requirement's verdict first (:func:`~scenarios.requirements.scoring.score_fields`)."""
     fields = score_fields(scenario.requirements, scenario.problem.spacecraft, scenario.truth)
     return [f"{prefix}.{REQUIREMENT_MARK}.{name}.{field}" for scope, prefix in SCOPES
-            for name, names in fields[scope].items() for field in (VERDICT, *names)]
+            for name, names in fields[scope].items() for field in names]
 
 
 def _check_summary(summary: list[tuple[str, str]], columns: dict[str, None]) -> None:
