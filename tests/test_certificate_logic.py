@@ -1,0 +1,82 @@
+"""The certificate's scaled KKT error and the Radau points' times, against IPOPT's published rules
+and the published Radau IIA nodes.
+
+Oracles: Wächter & Biegler (2006), eq. (5) and section 3.8, with IPOPT's defaults: the overall error
+``max(‖∇f + Jᵀλ + z‖∞ / s_d, ‖c‖∞, ‖complementarity‖∞ / s_c)`` with
+``s_d = max(s_max, (‖λ‖₁ + ‖z‖₁) / (m + n)) / s_max``, ``s_max = 100``; the gradient-based scaling
+``s = min(1, 100 / ‖∇‖∞)`` of the objective and of each constraint row (``nlp_scaling_max_gradient``),
+worked by hand on small NLPs; IPOPT's own reported dual infeasibility (``inf_du``, scaled) where the
+objective scaling is 1; the Radau IIA nodes of degree 3, ``(4 ∓ √6) / 10`` and 1."""
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from ocp.nlp.certificate import kkt_residuals
+from ocp.nlp.solve import solver_options
+
+
+def small_nlp(f, g=None, n=2, max_iterations=200):
+    x = ca.SX.sym("x", n)
+    problem = {"x": x, "f": f(x)}
+    if g is not None:
+        problem["g"] = g(x)
+    return ca.nlpsol("s", "ipopt", problem, solver_options("ipopt", 1e-12, max_iterations))
+
+
+def test_large_multipliers_divide_the_stationarity_by_s_d_by_hand():
+    # min x² + y² on x + y = 1, at (0.6, 0.5) with λ = −500: ∇f + λ ∇g = (1.2 − 500, 1 − 500), so the
+    # stationarity is 499; ∇f and ∇g are below 100 (no scaling); s_d = max(100, 500 / 1) / 100 = 5
+    solver = small_nlp(lambda x: x[0] ** 2 + x[1] ** 2, lambda x: x[0] + x[1])
+    kkt = kkt_residuals(solver, [0.6, 0.5], [0.0, 0.0], [-500.0], lbg=1.0, ubg=1.0)
+    assert kkt.stationarity == pytest.approx(499.0) and kkt.feasibility == pytest.approx(0.1)
+    assert kkt.objective_scaling == 1.0
+    assert kkt.scaled == pytest.approx(499.0 / 5.0, rel=1e-12)
+    # small multipliers: s_d = 1, the scaled error is the stationarity itself
+    small = kkt_residuals(solver, [0.6, 0.5], [0.0, 0.0], [-1.0], lbg=1.0, ubg=1.0)
+    assert small.scaled == pytest.approx(0.2, rel=1e-12)
+
+
+def test_a_steep_constraint_row_is_scaled_once_by_hand():
+    # g = 300 (x + y) = 300: its gradient 300 gives the row the scale 100 / 300; at (0.5, 0.6) it is
+    # 330, 30 over, so the scaled violation is 10; the objective x² + y² (gradient 1.2) is not scaled
+    solver = small_nlp(lambda x: x[0] ** 2 + x[1] ** 2, lambda x: 300 * (x[0] + x[1]))
+    kkt = kkt_residuals(solver, [0.5, 0.6], [0.0, 0.0], [0.0], lbg=300.0, ubg=300.0)
+    assert kkt.feasibility == pytest.approx(30.0)
+    assert kkt.feasibility_scaled == pytest.approx(10.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("iterations", [1, 2])
+def test_small_gradients_leave_the_objective_unscaled_as_ipopt_reports(iterations):
+    # ∇f = (0.2, 0.3) at the start, far below 100: IPOPT's s_f is 1 (it never scales up), and its
+    # reported inf_du is the unscaled stationarity at the point and multipliers it returns
+    def f(x):
+        return 0.05 * (x[0] ** 2 + x[1] ** 2) + 0.001 * x[0] ** 4
+
+    solver = small_nlp(f, lambda x: ca.vertcat(x[0] + x[1], x[0] - x[1] ** 2), max_iterations=iterations)
+    x0 = np.array([2.0, 3.0])
+    bounds = {"lbx": [-5.0, -5.0], "ubx": [5.0, 0.9], "lbg": [1.0, -0.2], "ubg": [1.0, -0.2]}
+    solution = solver(x0=x0, **bounds)
+    reported = solver.stats()["iterations"]["inf_du"][-1]
+    kkt = kkt_residuals(solver, solution["x"].full(), solution["lam_x"].full(), solution["lam_g"].full(),
+                        scaling_point=x0, **bounds)
+    assert kkt.objective_scaling == 1.0
+    assert reported > 1e-6  # far from converged: the comparison is not between two roundings
+    assert kkt.stationarity_scaled == pytest.approx(reported, rel=1e-6)
+
+
+def test_the_radau_points_times_are_the_published_nodes():
+    from planners.collocation.certificate import radau_points
+    from tests.test_certificate import bilimoria_wie_solution
+
+    problem, solved, params, _, _ = bilimoria_wie_solution({"objective": "min_time", "intervals": 4})
+    transcription = solved.transcription
+    assert transcription.degree == 3
+    _, _, _, t = radau_points(transcription, problem.model, solved.nlp, solved.result.x, solved.result.lam_g)
+    T = float(solved.nlp.unpack(solved.result.x, params)[0])
+    nodes = np.array([(4.0 - math.sqrt(6.0)) / 10.0, (4.0 + math.sqrt(6.0)) / 10.0, 1.0])
+    expected = ((np.arange(4)[:, None] + nodes[None, :]) / 4 * T).ravel()
+    np.testing.assert_allclose(t, expected, rtol=1e-12)
