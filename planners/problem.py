@@ -60,8 +60,11 @@ class ManeuverProblem:
         run) for planners that honour them (:attr:`planners.base.Planner.honours`); default none.
     actuator_margin : float or None, optional
         The actuator requirement: a reference may ask at most ``(1 - actuator_margin)`` of each
-        actuator limit (torque, momentum, dipole), in [0, 1). ``None`` (default): no requirement
-        beyond the limits themselves.
+        actuator limit (torque, momentum, dipole), in [0, 1). ``0`` (default, as a scenario without
+        ``requirements.actuators``): the limits themselves, held between a planner's points too by
+        the planners that check densely (``collocation``). ``None``: no actuator requirement: the
+        limits are imposed where a planner imposes them (its mesh points) and not checked between
+        them, where a reference can exceed them (a wheel's momentum by 0.5 % on a minimum-time slew).
     """
 
     spacecraft: Spacecraft
@@ -74,7 +77,7 @@ class ManeuverProblem:
     wheel_momentum0: Array | None = None
     max_rate: float | None = None
     pointing: tuple[PointingConstraint, ...] = ()
-    actuator_margin: float | None = None
+    actuator_margin: float | None = 0.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.spacecraft, Spacecraft):
