@@ -3,8 +3,8 @@ within an exclusion angle of the body (``simulation.sensors.star_tracker.exclusi
 
 Oracles independent of the code under test: the boresight turned to inertial by SciPy's rotation
 of the simulated true attitude, the Sun's direction from the JPL ephemeris (``sun_position``, not
-the direction tables the tracker uses), and for a uniform slew past a fixed direction the window
-in closed form.
+the direction tables the tracker uses), nadir of a circular orbit and the Earth's apparent radius
+by hand, and for a uniform slew past a fixed direction the window in closed form.
 """
 from __future__ import annotations
 
@@ -103,6 +103,27 @@ def test_blinded_samples_are_those_with_the_sun_inside_the_cone(blinded_example)
     metrics = metrics_from_simulation(result, scenario.problem.qf, reference=reference)
     assert metrics["star_tracker_blinded_s"] == pytest.approx(float(np.count_nonzero(inside)) * 1.0)
     assert metrics["star_tracker_blinded_updates"] == np.count_nonzero(inside & due)
+
+
+def test_the_earth_limb_cone_is_the_half_angle_plus_the_earths_apparent_radius(blinded_example):
+    """A 500 km circular orbit at 51.6° (ascending node on x, at t = 0): the position by hand,
+    nadir, and the cone 20° + asin(R / r) about it (the boresight within 20° of the limb)."""
+    _, reference = blinded_example
+    data = scenario_data({"earth_limb": 20}, epoch=None)
+    data["orbit"] = {"altitude_km": 500.0, "inclination_deg": 51.6}
+    scenario = parse_scenario(data)
+    result = simulate(scenario, reference, python_loop=True)
+    t = result.t[:-1]
+    mu, radius = 3.986004418e14, 6378137.0  # m³/s², m (WGS-84)
+    a, inclination = radius + 500e3, math.radians(51.6)
+    u = math.sqrt(mu / a**3) * t
+    nadir = -np.stack([np.cos(u), np.sin(u) * math.cos(inclination), np.sin(u) * math.sin(inclination)], axis=1)
+    boresight = Rotation.from_quat(result.q[:-1][:, [1, 2, 3, 0]]).apply([0.0, 0.0, 1.0])
+    angle = np.degrees(np.arccos(np.clip(np.sum(boresight * nadir, axis=1), -1.0, 1.0)))
+    cone = 20.0 + math.degrees(math.asin(radius / a))  # 88.02°
+    assert np.min(np.abs(angle - cone)) > 1e-4  # no sample on the edge
+    assert 10 <= np.count_nonzero(angle < cone) <= angle.size - 10
+    np.testing.assert_array_equal(result.blinded != 0, angle < cone)
 
 
 def test_without_the_exclusion_nothing_is_blinded(blinded_example):
