@@ -19,6 +19,7 @@ METRIC_KEYS: tuple[str, ...] = (
     "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
     "fine_settling_time_s", "initial_rate_error",
     "final_knowledge_error_deg", "max_knowledge_error_deg",
+    "star_tracker_blinded_s", "star_tracker_blinded_updates",
 )
 """Every key :func:`compute_metrics` returns; definitions and units in :data:`METRIC_INFO`."""
 
@@ -133,6 +134,13 @@ METRIC_INFO: dict[str, MetricInfo] = {
     "max_knowledge_error_deg": MetricInfo(
         "deg", "As ``final_knowledge_error_deg``, its maximum over the samples t_0 … t_(N−1); null without a "
         "star tracker."),
+    "star_tracker_blinded_s": MetricInfo(
+        "s", "Closed loop with a star tracker that has exclusions (``simulation.sensors.star_tracker."
+        "exclusion_deg``): the time its boresight spent inside an exclusion cone, Σ (t_(k+1) − t_k) over the "
+        "samples t_k where the true attitude put it there; null otherwise."),
+    "star_tracker_blinded_updates": MetricInfo(
+        "count", "As ``star_tracker_blinded_s``: the updates due by the tracker's rate and outages that an "
+        "exclusion dropped (the estimator only propagated); null without exclusions."),
 }
 """Unit and definition of every key of :data:`METRIC_KEYS`, in the same order. ``u`` in the integrals
 ``int_u2``, ``int_u`` and ``int_abs_u`` is the torque given to :func:`compute_metrics` (body axes): a
@@ -251,6 +259,8 @@ def compute_metrics(
     wheel_torque: ArrayLike | None = None,
     known_q: ArrayLike | None = None,
     impulses: ArrayLike | None = None,
+    blinded: ArrayLike | None = None,
+    due: ArrayLike | None = None,
 ) -> dict[str, Any]:
     """Metrics of a motion sampled at times ``t`` (definitions: :data:`METRIC_INFO`).
 
@@ -317,6 +327,12 @@ def compute_metrics(
     impulses : (K, 3) array_like or None, optional
         Angular impulses ``p_j = I Δω_j`` [N m s], body axes, of Dirac torques ``p_j δ(t − t_j)``
         (a reference's rate jumps); a zero impulse is none; ``None`` (default) or empty: none.
+    blinded : (N,) array_like of bool or None, optional
+        Whether the star tracker's boresight was inside an exclusion at ``t_0 … t_(N−1)``, for
+        ``star_tracker_blinded_s``; ``None`` (default): null.
+    due : (N,) array_like of bool or None, optional
+        Whether an update was due then (rate and outages), for ``star_tracker_blinded_updates``
+        with ``blinded``; ``None``: every sample.
 
     Returns
     -------
@@ -361,7 +377,14 @@ def compute_metrics(
         "energy_ratio": None,
         "final_knowledge_error_deg": None,
         "max_knowledge_error_deg": None,
+        "star_tracker_blinded_s": None,
+        "star_tracker_blinded_updates": None,
     }
+    if blinded is not None:
+        inside = np.asarray(blinded, dtype=bool)
+        metrics["star_tracker_blinded_s"] = float(np.sum(np.diff(t)[:inside.size][inside]))
+        scheduled = np.ones(inside.size, dtype=bool) if due is None else np.asarray(due, dtype=bool)
+        metrics["star_tracker_blinded_updates"] = int(np.count_nonzero(inside & scheduled))
     if known_q is not None:
         known = np.asarray(known_q, dtype=float)
         knowledge = np.rad2deg(quat.error_angle(known, q[:known.shape[0]]))
@@ -525,7 +548,8 @@ def metrics_from_simulation(
     ``I ω̇ = −ω × I ω + u`` the allocation realised), ``peak_wheel_torque`` the applied wheel
     motor torques; the dipole (with magnetorquers) is the applied one; ``inertia`` is the
     spacecraft's; with a star tracker among the run's sensors, the attitude the controller was
-    given is ``result.sensor_state``'s (``known_q``).
+    given is ``result.sensor_state``'s (``known_q``), and with its exclusions the samples they
+    blinded are ``result.blinded``'s (``star_tracker_blinded_s``, ``star_tracker_blinded_updates``).
 
     Parameters
     ----------
@@ -581,8 +605,17 @@ def metrics_from_simulation(
         fine_settling_tolerance_deg=fine_settling_tolerance_deg, dipole=dipole,
         inertia=result.model.spacecraft.inertia, detumble_tolerance=detumble_tolerance,
         body_torque=body_torque, actuator_torque=result.applied_torque, wheel_torque=wheel_torque,
-        known_q=_known_attitude(result),
+        known_q=_known_attitude(result), **_blinding(result),
     )
+
+
+def _blinding(result: Any) -> dict[str, Any]:
+    """``blinded`` and ``due`` of :func:`compute_metrics` when the run's star tracker has exclusions."""
+    sensors = getattr(result, "sensors", None)
+    tracker = getattr(sensors, "star_tracker", None)
+    if tracker is None or not getattr(tracker, "exclusions", ()) or getattr(result, "blinded", None) is None:
+        return {}
+    return {"blinded": result.blinded != 0, "due": tracker.available(np.asarray(result.t)[:-1])}
 
 
 def _known_attitude(result: Any) -> NDArray | None:

@@ -11,6 +11,7 @@ from scipy.stats import chi2
 
 from ocp import quat
 from ocp.estimation import (
+    SENSOR_STATE_SIZE,
     Gyro,
     Mekf,
     SensorSuite,
@@ -183,8 +184,8 @@ def test_gyro_allan_variance_shows_its_arw_and_rrw():
 @pytest.mark.parametrize("estimator", [True, False])
 def test_the_casadi_step_is_the_numpy_step(estimator):
     suite = SensorSuite(SUITE.gyro, SUITE.star_tracker, None, SUITE.estimator if estimator else None)
-    s_sym, q_sym, w_sym = ca.SX.sym("s", 35), ca.SX.sym("q", 4), ca.SX.sym("w", 3)
-    n_sym, dt_sym = ca.SX.sym("n", 10), ca.SX.sym("dt")
+    s_sym, q_sym, w_sym = ca.SX.sym("s", SENSOR_STATE_SIZE), ca.SX.sym("q", 4), ca.SX.sym("w", 3)
+    n_sym, dt_sym = ca.SX.sym("n", suite.noise_size), ca.SX.sym("dt")
     outputs = sensor_step_symbolic(suite, s_sym, q_sym, w_sym, None, n_sym, dt_sym)
     function = ca.Function("step", [s_sym, q_sym, w_sym, n_sym, dt_sym], [outputs[0], outputs[1], outputs[3]])
     times = np.arange(301.0)

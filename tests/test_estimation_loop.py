@@ -13,7 +13,14 @@ import yaml
 
 from controllers import CONTROLLERS
 from ocp import SensorNoise, Simulator, quat
-from ocp.estimation import Gyro, Magnetometer, SensorSuite, StarTracker, sensor_step
+from ocp.estimation import (
+    SENSOR_STATE_SIZE,
+    Gyro,
+    Magnetometer,
+    SensorSuite,
+    StarTracker,
+    sensor_step,
+)
 from planners import PLANNERS
 from scenarios.cli.commands import main
 from scenarios.schema.loader import load
@@ -73,7 +80,7 @@ def test_silent_sensors_leave_the_results_bit_for_bit(example):
         sensed = run(scenario, reference, silent, noise=SensorNoise(seed=3), python_loop=python_loop)
         np.testing.assert_array_equal(sensed.x, plain.x)
         np.testing.assert_array_equal(sensed.commanded_u, plain.commanded_u)
-        assert plain.sensor_state is None and sensed.sensor_state.shape == (plain.t.size, 35)
+        assert plain.sensor_state is None and sensed.sensor_state.shape == (plain.t.size, SENSOR_STATE_SIZE)
 
 
 def test_a_magnetometer_without_bias_is_sensor_noise_field_noise():

@@ -72,7 +72,8 @@ def test_every_key_is_tested_here():
               "final_error_deg", "final_rate_error", "rms_error_deg",
               "max_error_deg", "settling_time_s", "saturation_fraction", "peak_wheel_momentum", "plan_time_s",
               "duration_s", "initial_rate_error", "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
-              "fine_settling_time_s", "final_knowledge_error_deg", "max_knowledge_error_deg"}
+              "fine_settling_time_s", "final_knowledge_error_deg", "max_knowledge_error_deg",
+              "star_tracker_blinded_s", "star_tracker_blinded_updates"}
     assert set(METRIC_KEYS) == tested
 
 
@@ -89,6 +90,20 @@ def test_knowledge_error_by_hand():
     assert metrics["max_knowledge_error_deg"] == pytest.approx(0.3, rel=1e-9)
     none = compute_metrics(t, q, np.zeros((4, 3)), np.zeros((3, 3)), None)
     assert none["final_knowledge_error_deg"] is None and none["max_knowledge_error_deg"] is None
+
+
+def test_star_tracker_blinding_by_hand():
+    """Samples 1 s, 1.5 s, 0.5 s, 2 s long; the boresight inside an exclusion at t_1 and t_2
+    (1.5 + 0.5 = 2 s), an update due at t_0 and t_2 only: one update dropped; null without."""
+    t = np.array([0.0, 1.0, 2.5, 3.0, 5.0])
+    q = np.tile(quat.IDENTITY, (5, 1))
+    blinded, due = [False, True, True, False], [True, False, True, True]
+    metrics = compute_metrics(t, q, np.zeros((5, 3)), np.zeros((4, 3)), None, blinded=blinded, due=due)
+    assert metrics["star_tracker_blinded_s"] == 2.0 and metrics["star_tracker_blinded_updates"] == 1
+    every = compute_metrics(t, q, np.zeros((5, 3)), np.zeros((4, 3)), None, blinded=blinded)
+    assert every["star_tracker_blinded_updates"] == 2
+    none = compute_metrics(t, q, np.zeros((5, 3)), np.zeros((4, 3)), None)
+    assert none["star_tracker_blinded_s"] is None and none["star_tracker_blinded_updates"] is None
 
 
 def test_zero_order_hold_integrals(metrics):

@@ -126,7 +126,8 @@ simulation:
   sample_time: 0.5
   sensors:
     gyro: {arw_deg_per_sqrt_h: 0.01, rrw_deg_per_h_per_sqrt_h: 0.1, bias_deg_per_h: [1.0, 0, 0]}
-    star_tracker: {noise_arcsec: [5, 5, 40], rate_hz: 1.0, outages_s: [[5, 8]], boresight: [0, 1, 0]}
+    star_tracker: {noise_arcsec: [5, 5, 40], rate_hz: 1.0, outages_s: [[5, 8]], boresight: [0, 1, 0],
+                   exclusion_deg: {earth: 60, earth_limb: 20, velocity: 5}}
     magnetometer: {noise_T: 1.0e-8, bias_T: [1.0e-7, 0, 0]}
   estimator: {type: mekf, initial_attitude_sigma_deg: 0.1, initial_bias_sigma_deg_per_h: 5.0}
 """
@@ -169,13 +170,17 @@ ATTITUDES = [  # (maneuver.initial.q, maneuver.final.q) set into MAXIMAL_A: ever
 
 
 def maximal_scenarios() -> list[dict]:
-    """MAXIMAL_A, MAXIMAL_B and MAXIMAL_A with each pair of :data:`ATTITUDES`."""
+    """MAXIMAL_A, MAXIMAL_B, MAXIMAL_B with an epoch and the star tracker's exclusions that need it,
+    and MAXIMAL_A with each pair of :data:`ATTITUDES`."""
     data = [parse_yaml_text(MAXIMAL_A), parse_yaml_text(MAXIMAL_B)]
+    with_epoch = copy.deepcopy(data[1])
+    with_epoch["epoch"] = "2025-01-01T00:00:00Z"
+    with_epoch["simulation"]["sensors"]["star_tracker"]["exclusion_deg"].update(sun=30, moon=10)
     for initial, final in ATTITUDES:
         variant = copy.deepcopy(data[0])
         variant["maneuver"]["initial"]["q"], variant["maneuver"]["final"]["q"] = initial, final
         data.append(variant)
-    return data
+    return data[:2] + [with_epoch] + data[2:]
 
 
 MAXIMAL_STUDY = """

@@ -1,7 +1,7 @@
 """Attitude sensors and the attitude estimator of the closed loop.
 
 What lives here: the sensor models, a Farrenkopf gyro (angle and rate random walk, bias), a star
-tracker (per-axis noise in its own frame, rate, outages) and a magnetometer bias
+tracker (per-axis noise in its own frame, rate, outages, exclusion cones about bright bodies) and a magnetometer bias
 (:mod:`~ocp.estimation.sensors`); the multiplicative extended Kalman filter, gyro propagation and
 star tracker updates, in NumPy and CasADi (:mod:`~ocp.estimation.mekf`); and both as one step of
 the closed loop with its noise drawn in advance (:mod:`~ocp.estimation.loop`), which
@@ -11,6 +11,7 @@ May import: NumPy, CasADi, :mod:`ocp.dynamics` and the top-level modules of :mod
 :mod:`ocp.simulation`, :mod:`ocp.geometry`, :mod:`ocp.transcription` or :mod:`ocp.nlp`.
 """
 from ocp.estimation.loop import (
+    BLINDED,
     SENSOR_NOISE_SIZE,
     SENSOR_STATE_SIZE,
     SensorSuite,
@@ -26,9 +27,9 @@ from ocp.estimation.mekf import (
     update,
     update_symbolic,
 )
-from ocp.estimation.sensors import Gyro, Magnetometer, StarTracker
+from ocp.estimation.sensors import Exclusion, Gyro, Magnetometer, StarTracker
 
-__all__ = ["SENSOR_NOISE_SIZE", "SENSOR_STATE_SIZE", "Gyro", "Magnetometer", "Mekf", "SensorSuite", "StarTracker",
+__all__ = ["BLINDED", "SENSOR_NOISE_SIZE", "SENSOR_STATE_SIZE", "Exclusion", "Gyro", "Magnetometer", "Mekf", "SensorSuite", "StarTracker",
            "draw_sensor_noise", "initial_sensor_state", "propagate", "propagate_symbolic", "sensor_step",
            "sensor_step_symbolic", "update", "update_symbolic"]
 

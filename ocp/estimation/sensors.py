@@ -10,12 +10,15 @@ bias walks ``β_{k+1} = β_k + σ_u √Δt N_u`` (rate random walk, RRW) and the
 (``σ_v`` the angle random walk, ARW: the gyro's white rate noise; ``N_u``, ``N_v`` standard
 normal 3-vectors). Its Allan variance is ``σ_v² / τ + σ_u² τ / 3``. The star tracker measures
 ``q ⊗ exp(v / 2)``, ``v`` a rotation vector with independent per-axis noise in the sensor frame,
-at its own rate and outside its outage windows. The magnetometer adds a constant bias to the
+at its own rate and outside its outage windows, and gives nothing while its boresight lies within an
+exclusion half-angle of a bright body (:class:`Exclusion`: the Sun, the Earth's limb, the Moon),
+tested at each sample from the true attitude. The magnetometer adds a constant bias to the
 field reading and white noise (``ocp.simulation.SensorNoise.field_std``'s stream).
 """
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -93,6 +96,75 @@ def _sensor_to_body(boresight: Array) -> Array:
     return np.eye(3) + kx + kx @ kx / (1.0 + c)
 
 
+DirectionTable = Callable[[Any], tuple[Any, Any]]
+"""``times (N,) -> (directions (N, 3), growth (N,))``: a body's unit vectors (inertial) and the
+widening of a cone about it [rad] (its apparent radius; zeros for a point), as
+``ocp.geometry.directions.DirectionKind.table`` gives with its geometry bound."""
+
+
+@dataclass(frozen=True)
+class Exclusion:
+    """A bright body the star tracker cannot look near: no attitude while the angle between its
+    boresight (inertial, from the true attitude) and the body's direction is below the half-angle
+    (plus the body's apparent radius, the table's growth).
+
+    Parameters
+    ----------
+    name : str
+        The body, for messages and metrics (``"sun"``, ``"earth_limb"``, ``"moon"`` ...).
+    half_angle : float
+        Exclusion half-angle [rad], in [0, π].
+    directions : callable or (3,) array_like
+        The body's direction at given times (:data:`DirectionTable`), or one fixed inertial
+        direction (a 3-vector, not necessarily unit).
+    """
+
+    name: str
+    half_angle: float
+    directions: DirectionTable | Array
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"an exclusion's name must be a non-empty string, got {self.name!r}")
+        angle = self.half_angle
+        if (not isinstance(angle, (int, float)) or isinstance(angle, bool) or not math.isfinite(angle)
+                or not 0.0 <= angle <= math.pi):
+            raise ValueError(f"the {self.name} exclusion half-angle must be in [0, pi] rad, got {angle!r}")
+        object.__setattr__(self, "half_angle", float(angle))
+        if not callable(self.directions):
+            direction = _vector(f"the {self.name} exclusion direction", self.directions)
+            if not np.linalg.norm(direction) > 0:
+                raise ValueError(f"the {self.name} exclusion direction cannot be zero")
+            object.__setattr__(self, "directions", direction / np.linalg.norm(direction))
+
+    def table(self, times: Array) -> tuple[Array, Array]:
+        """The body's direction and the cosine of the exclusion cone's half-angle at given times.
+
+        Parameters
+        ----------
+        times : (N,) ndarray
+            Sample instants [s].
+
+        Returns
+        -------
+        directions : (N, 3) ndarray
+            Unit vectors, inertial frame.
+        cosines : (N,) ndarray
+            ``cos(min(half_angle + growth, π))``: the boresight is excluded where its dot product
+            with the direction exceeds it.
+        """
+        times = np.asarray(times, dtype=float)
+        if callable(self.directions):
+            directions, growth = self.directions(times)
+            directions = np.asarray(directions, dtype=float).reshape(times.size, 3)
+            growth = np.broadcast_to(np.asarray(growth, dtype=float), (times.size,))
+        else:
+            directions = np.tile(self.directions, (times.size, 1))
+            growth = np.zeros(times.size)
+        directions = directions / np.linalg.norm(directions, axis=1, keepdims=True)
+        return directions, np.cos(np.minimum(self.half_angle + growth, math.pi))
+
+
 @dataclass(frozen=True)
 class StarTracker:
     """A star tracker: attitude with per-axis noise in its own frame, at a rate, with outages.
@@ -106,19 +178,31 @@ class StarTracker:
         Updates per second [Hz]; ``None``: every sample. An update falls on a sample when the
         count ``floor(t rate)`` has advanced since the previous sample (and on the first sample).
     outages : tuple of (float, float), optional
-        Windows ``[t0, t1)`` [s] without updates (sun blinding, slews).
+        Windows ``[t0, t1)`` [s] without updates, whatever the attitude (for blinding by a body at a
+        known attitude, ``exclusions`` follows the attitude).
     boresight : (3,) array_like, optional
         The sensor's z axis in body axes (default ``[0, 0, 1]``); its x and y axes are the body's
         turned by the shortest rotation taking body z to the boresight.
+    exclusions : tuple of Exclusion, optional
+        Bright bodies that blind it: an update due at a sample is dropped when the true attitude
+        puts the boresight inside one's cone (tested in the closed loop, both paths).
     """
 
     noise: Array
     rate: float | None = None
     outages: tuple[tuple[float, float], ...] = ()
     boresight: Array = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    exclusions: tuple[Exclusion, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "noise", _vector("noise", self.noise, non_negative=True))
+        exclusions = tuple(self.exclusions)
+        if not all(isinstance(item, Exclusion) for item in exclusions):
+            raise ValueError(f"exclusions must be Exclusion instances, got {self.exclusions!r}")
+        names = [item.name for item in exclusions]
+        if len(set(names)) != len(names):
+            raise ValueError(f"exclusion names must be distinct, got {names}")
+        object.__setattr__(self, "exclusions", exclusions)
         if self.rate is not None and (not isinstance(self.rate, (int, float)) or not math.isfinite(self.rate)
                                       or not self.rate > 0):
             raise ValueError(f"rate must be a finite positive number of Hz or None, got {self.rate!r}")
@@ -154,7 +238,8 @@ class StarTracker:
         Returns
         -------
         (N,) bool ndarray
-            True where the tracker gives an attitude.
+            True where an update is due (rate and outages; the exclusions, which depend on the
+            attitude, are tested in the closed loop).
         """
         times = np.asarray(times, dtype=float)
         if self.rate is None:
@@ -165,6 +250,27 @@ class StarTracker:
         for a, b in self.outages:
             due &= ~((times >= a) & (times < b))
         return due
+
+    def exclusion_rows(self, times: Array) -> Array:
+        """The exclusions' directions and cone cosines at the samples, for the closed loop.
+
+        Parameters
+        ----------
+        times : (N,) ndarray
+            Sample instants [s].
+
+        Returns
+        -------
+        (N, 4 E) ndarray
+            Per exclusion (in order) its unit direction (3, inertial) and the cosine of its cone's
+            half-angle (1) (:meth:`Exclusion.table`); no columns without exclusions.
+        """
+        times = np.asarray(times, dtype=float)
+        rows = np.zeros((times.size, 4 * len(self.exclusions)))
+        for i, exclusion in enumerate(self.exclusions):
+            directions, cosines = exclusion.table(times)
+            rows[:, 4 * i:4 * i + 3], rows[:, 4 * i + 3] = directions, cosines
+        return rows
 
 
 @dataclass(frozen=True)

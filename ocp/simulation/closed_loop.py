@@ -29,7 +29,6 @@ from ocp.dynamics.layout import REFERENCE_FIELDS
 from ocp.dynamics.model import AttitudeModel
 from ocp.dynamics.truth import TruthPlant
 from ocp.estimation import (
-    SENSOR_NOISE_SIZE,
     SENSOR_STATE_SIZE,
     SensorSuite,
     sensor_step_symbolic,
@@ -188,7 +187,8 @@ class ClosedLoop:
     nz : int
         Size of the law's state ``z``.
     noise_size : int
-        Noise numbers per sample: 9, and 10 more with sensors.
+        Noise numbers per sample: 9, and ``sensors.noise_size`` more with sensors (10, and 4 per
+        star tracker exclusion: the body's direction and its cone's cosine at the sample).
     """
 
     def __init__(self, model: AttitudeModel, step: ca.Function, actuators: ActuatorModel, law: ca.Function,
@@ -200,7 +200,7 @@ class ClosedLoop:
         nx, nz = model.nx, law.nnz_in(2)
         self.nz = nz
         ns = 0 if sensors is None else SENSOR_STATE_SIZE
-        self.noise_size = NOISE_SIZE + (0 if sensors is None else SENSOR_NOISE_SIZE)
+        self.noise_size = NOISE_SIZE + (0 if sensors is None else sensors.noise_size)
         acc = ca.SX.sym("xz", nx + nz + ns)
         t, dt = ca.SX.sym("t"), ca.SX.sym("dt")
         noise = ca.SX.sym("noise", self.noise_size)
@@ -254,7 +254,7 @@ class ClosedLoop:
         -------
         BufferedFunction
             ``run(xz0, t (N), dt (N), [noise (9N or 19N)], [r (26N)], p, [plant_noise (n_w N)]) ->
-            (xz (N(nx+nz[+35])), u_cmd, u_app, saturated, torque)``: the noise and reference inputs
+            (xz (N(nx+nz[+36])), u_cmd, u_app, saturated, torque)``: the noise and reference inputs
             exist only when the loop uses them (:attr:`shape`, :attr:`plant_noise_size`), and every
             input and output has its exact size, so that the function is evaluated through
             reusable buffers.
@@ -291,7 +291,7 @@ class ClosedLoop:
         ----------
         run : BufferedFunction
             The result of :meth:`run_function` for N = ``times.size - 1`` samples.
-        xz0 : (nx + nz [+ 35],) ndarray
+        xz0 : (nx + nz [+ 36],) ndarray
             Initial state ``x`` (quaternion, body rate [rad/s], wheel momenta [N m s]), law
             state ``z`` and, with sensors, their state ``s``.
         times : (N + 1,) ndarray

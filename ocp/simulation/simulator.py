@@ -40,6 +40,7 @@ from ocp.dynamics.model import AttitudeModel
 from ocp.dynamics.truth import TruthPlant
 from ocp.errors import CompilerUnavailable, SimulationError
 from ocp.estimation import (
+    BLINDED,
     SENSOR_STATE_SIZE,
     SensorSuite,
     draw_sensor_noise,
@@ -217,12 +218,13 @@ class SimulationResult:
     path : str
         How it was computed: ``"python"`` (loop), ``"interpreted"`` or ``"compiled"`` (one
         CasADi function).
-    sensor_state : (N+1, 35) ndarray or None
+    sensor_state : (N+1, 36) ndarray or None
         With a :class:`~ocp.estimation.SensorSuite`, its state (:mod:`ocp.estimation.loop`): the
         initial one, then the one after each sample ``k``, which holds what the controller was
         given at ``t_k``: the attitude estimate ``q̂`` (the MEKF's; without it the last star
         tracker reading), the bias estimate [rad/s] and the MEKF covariance's upper triangle,
-        and the gyro's true bias [rad/s] and last reading; ``None`` without sensors.
+        the gyro's true bias [rad/s] and last reading, and which star tracker exclusions held
+        its boresight at ``t_k`` (:attr:`blinded`); ``None`` without sensors.
     sensors : SensorSuite or None
         The sensors of the run (``None``: none).
     """
@@ -238,6 +240,15 @@ class SimulationResult:
     path: str = "python"
     sensor_state: Array | None = None
     sensors: SensorSuite | None = None
+
+    @property
+    def blinded(self) -> NDArray[np.int64] | None:
+        """(N,) bits per sample ``t_k``: bit i set when the true attitude put the star tracker's
+        boresight inside its exclusion i (``sensors.star_tracker.exclusions[i]``), so that an update
+        due then was dropped; ``None`` without a star tracker."""
+        if self.sensors is None or self.sensors.star_tracker is None or self.sensor_state is None:
+            return None
+        return np.rint(self.sensor_state[1:, BLINDED]).astype(np.int64)
 
     @property
     def q(self) -> Array:

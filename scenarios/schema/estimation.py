@@ -8,12 +8,14 @@ Every error names the YAML path, the value and what was expected.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ocp.estimation import Gyro, Magnetometer, Mekf, SensorSuite, StarTracker
+from ocp.estimation import Exclusion, Gyro, Magnetometer, Mekf, SensorSuite, StarTracker
+from ocp.geometry.directions import DIRECTIONS, Geometry
 from scenarios.errors import ScenarioError
 from scenarios.schema.keys import Section, choice, custom, mapping, number
 from scenarios.schema.node import Node
@@ -68,6 +70,18 @@ GYRO = Section((
            default=[0.0, 0.0, 0.0]),
 ), "A rate gyro (Farrenkopf's model: angle and rate random walk, bias); it replaces ``sensor_noise.rate``.")
 
+EXCLUSION = Section(tuple(
+    number(name, f"Half-angle about the ``{name}`` direction (as pointing requirements mean it"
+           f"{'; needs the epoch' if kind.needs_epoch else ''}{'; needs the orbit' if kind.needs_orbit else ''}); "
+           "``null``: none.", unit="deg", default=None, non_negative=True, maximum=180.0, nullable=True)
+    for name, kind in DIRECTIONS.items()
+), "The star tracker's exclusion cones, by the direction names pointing requirements use "
+   "(``ocp.geometry.directions.DIRECTIONS``).")
+
+def _exclusions(node: Node) -> dict[str, Any]:
+    return EXCLUSION.read(Node({}, node.path) if node.is_null() else node)
+
+
 STAR_TRACKER = Section((
     custom("noise_arcsec", "Standard deviation of the attitude error about the sensor's x, y (cross-boresight) "
            "and z (boresight) axes.", "list of 3 numbers", _non_negative_vector, unit="arcsec"),
@@ -78,6 +92,11 @@ STAR_TRACKER = Section((
            "rotation taking body z there). Absent or ``null``: the boresight of ``spacecraft.sensors.star_tracker`` "
            "when the spacecraft declares that sensor (the one its pointing requirements read), else body z; "
            "given beside it, it must be the same direction.", "list of 3 numbers or null", _boresight, default=None),
+    custom("exclusion_deg", "Exclusion half-angles about bright bodies: an update due at a sample is dropped "
+           "when the true attitude puts the boresight within that angle of the body (of the Earth's limb for "
+           "``earth_limb``); the MEKF then only propagates. The sensor's only source of blinding: a pointing "
+           "requirement keeping the tracker off a body is scored, not applied to the sensor. Absent or "
+           "``null``: none.", "mapping or null", _exclusions, unit="deg", default={}, section=EXCLUSION),
 ), "A star tracker; it replaces ``sensor_noise.attitude_deg``.")
 
 MAGNETOMETER = Section((
@@ -106,7 +125,8 @@ ESTIMATOR = Section((
 
 
 def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any] | None,
-                       noise: dict[str, Any], path: str, tracker_boresight: ArrayLike | None = None) -> SensorSuite | None:
+                       noise: dict[str, Any], path: str, tracker_boresight: ArrayLike | None = None,
+                       geometry: Geometry | None = None) -> SensorSuite | None:
     """The :class:`~ocp.estimation.SensorSuite` of ``simulation.sensors`` and ``simulation.estimator``.
 
     Parameters
@@ -123,6 +143,9 @@ def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any]
         The boresight of ``spacecraft.sensors.star_tracker`` (body axes) when the spacecraft
         declares it: the star tracker's unless its own ``boresight`` is given, which must then be
         the same direction; ``None``: body z by default.
+    geometry : Geometry or None, optional
+        The scenario's epoch and orbit, for the star tracker's exclusions (``None``: none known,
+        so an exclusion is refused).
 
     Returns
     -------
@@ -132,8 +155,9 @@ def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any]
     Raises
     ------
     ScenarioError
-        A sensor given twice, an estimator without a gyro or a star tracker, or a star tracker
-        boresight that is not the declared one.
+        A sensor given twice, an estimator without a gyro or a star tracker, a star tracker
+        boresight that is not the declared one, or an exclusion about a body whose direction needs
+        an epoch or an orbit the scenario does not give.
     """
     sensors = sensors or {}
     gyro = tracker = magnetometer = None
@@ -158,8 +182,10 @@ def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any]
                                     f"boresight {stated.tolist()}: one sensor has one boresight (remove this key, "
                                     f"which then takes the spacecraft's, or make them agree)")
             boresight = stated  # the declared direction, not its rounding here
+        exclusions = tuple(_exclusion(name, angle, geometry, f"{path}.sensors.star_tracker.exclusion_deg.{name}")
+                           for name, angle in values["exclusion_deg"].items() if angle is not None)
         tracker = StarTracker(noise=values["noise_arcsec"] * ARCSEC, rate=values["rate_hz"],
-                              outages=values["outages_s"], boresight=boresight)
+                              outages=values["outages_s"], boresight=boresight, exclusions=exclusions)
     if sensors.get("magnetometer") is not None:
         values = sensors["magnetometer"]
         magnetometer = Magnetometer(noise=values["noise_T"], bias=values["bias_T"])
@@ -181,3 +207,37 @@ def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any]
     if gyro is None and tracker is None and magnetometer is None:
         return None
     return SensorSuite(gyro, tracker, magnetometer, mekf)
+
+
+def _exclusion(name: str, angle_deg: float, geometry: Geometry | None, path: str) -> Exclusion:
+    """The star tracker's exclusion about the direction ``name`` (a :data:`DIRECTIONS` kind),
+    tabulated from ``geometry`` at the run's samples."""
+    kind = DIRECTIONS[name]
+    for needed, what, hint in ((kind.needs_epoch, "epoch", "the scenario's `epoch` (a UTC date-time)"),
+                               (kind.needs_orbit, "orbit", "an orbit (`orbit` or `environment.orbit`)")):
+        if needed and (geometry is None or getattr(geometry, what) is None):
+            raise ScenarioError(path, f"an exclusion about {name} needs the {name} direction, which needs {hint}, "
+                                      f"and none is given; give it or remove this exclusion")
+    assert geometry is not None
+    return Exclusion(name, math.radians(angle_deg), BodyDirection(name, geometry))
+
+
+@dataclass(frozen=True)
+class BodyDirection:
+    """A direction kind's table with its geometry bound: the :data:`~ocp.estimation.sensors.DirectionTable`
+    of a star tracker exclusion (compared by value: the kind and the geometry).
+
+    Parameters
+    ----------
+    kind : str
+        A name in :data:`~ocp.geometry.directions.DIRECTIONS`.
+    geometry : Geometry
+        The scenario's epoch and orbit.
+    """
+
+    kind: str
+    geometry: Geometry
+
+    def __call__(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The direction (N, 3) and its cone's growth (N,) [rad] at ``times`` [s]."""
+        return DIRECTIONS[self.kind].table(self.geometry, np.asarray(times, dtype=float))

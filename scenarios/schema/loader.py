@@ -531,7 +531,8 @@ def _parse_controllers(root: Node) -> list[ControllerSpec]:
     return specs
 
 
-def _parse_simulation(values: dict[str, Any], path: str, sensors: dict[str, Sensor] | None = None) -> SimulationSpec:
+def _parse_simulation(values: dict[str, Any], path: str, sensors: dict[str, Sensor] | None = None,
+                      geometry: Geometry | None = None) -> SimulationSpec:
     noise = values["sensor_noise"]
     spec = SimulationSpec(
         sample_time=values["sample_time"], duration=values["duration"],
@@ -544,7 +545,8 @@ def _parse_simulation(values: dict[str, Any], path: str, sensors: dict[str, Sens
         fine_settling_tolerance_deg=values["fine_settling_tolerance_deg"],
         detumble_tolerance=values["detumble_tolerance"], max_samples=values["max_samples"], compile=values["compile"],
         sensors=parse_sensor_suite(values["sensors"], values["estimator"], noise, path,
-                                   (sensors or {})["star_tracker"].boresight if "star_tracker" in (sensors or {}) else None),
+                                   (sensors or {})["star_tracker"].boresight if "star_tracker" in (sensors or {}) else None,
+                                   geometry),
     )
     if spec.integrator == "rk4" and math.ceil(spec.sample_time / spec.max_step - 1e-9) > MAX_SUBSTEPS:
         raise ScenarioError(f"{path}.max_step", f"{spec.max_step:g} s gives more than {MAX_SUBSTEPS} RK4 "
@@ -581,7 +583,8 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     problem = _parse_problem(SCENARIO["maneuver"].value(root), spacecraft, environment, sensors, epoch)
     planners = _parse_planners(SCENARIO["planners"].value(root))
     controllers = _parse_controllers(root)
-    simulation = _parse_simulation(SCENARIO["simulation"].value(root), "simulation", sensors)
+    simulation = _parse_simulation(SCENARIO["simulation"].value(root), "simulation", sensors,
+                                   Geometry(epoch, environment.orbit))
     plots = SCENARIO["plots"].value(root)
     requirements_node = SCENARIO["requirements"].value(root)
     truth_node = SCENARIO["truth"].value(root)

@@ -1,0 +1,238 @@
+"""A star tracker blinded by a bright body: no update while the TRUE attitude puts its boresight
+within an exclusion angle of the body (``simulation.sensors.star_tracker.exclusion_deg``).
+
+Oracles independent of the code under test: the boresight turned to inertial by SciPy's rotation
+of the simulated true attitude, the Sun's direction from the JPL ephemeris (``sun_position``, not
+the direction tables the tracker uses), nadir of a circular orbit and the Earth's apparent radius
+by hand, and for a uniform slew past a fixed direction the window in closed form.
+"""
+from __future__ import annotations
+
+import copy
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from scipy.spatial.transform import Rotation
+
+from controllers import CONTROLLERS
+from ocp import Simulator
+from ocp.dynamics.ephemeris import sun_position
+from ocp.estimation import (
+    BLINDED,
+    Exclusion,
+    Gyro,
+    Mekf,
+    SensorSuite,
+    StarTracker,
+    draw_sensor_noise,
+    initial_sensor_state,
+    sensor_step,
+)
+from ocp.estimation.mekf import unpack
+from ocp.metrics import metrics_from_simulation
+from planners import PLANNERS
+from scenarios.errors import ScenarioError
+from scenarios.schema.loader import parse_scenario
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "scenarios" / "spin_repoint_estimator.yaml"
+EPOCH = "2025-06-21T00:00:00Z"  # the Sun near the inertial y-z plane the boresight sweeps as body x spins
+HALF_ANGLE_DEG = 30.0
+
+
+def scenario_data(exclusion: dict | None = None, epoch: str | None = EPOCH) -> dict:
+    data = yaml.safe_load(EXAMPLE.read_text())
+    if epoch is not None:
+        data["epoch"] = epoch
+    if exclusion is not None:
+        data["simulation"]["sensors"]["star_tracker"]["exclusion_deg"] = exclusion
+    return data
+
+
+@pytest.fixture(scope="module")
+def blinded_example():
+    scenario = parse_scenario(scenario_data({"sun": HALF_ANGLE_DEG}))
+    spec = scenario.planners[0]
+    return scenario, PLANNERS[spec.name](spec.options).plan(scenario.problem)
+
+
+def simulate(scenario, reference, sensors=None, duration=120.0, **options):
+    spec, problem = scenario.simulation, scenario.problem
+    simulator = Simulator(problem.model, spec.sample_time, spec.integrator, max_step=spec.max_step, **options)
+    controller = CONTROLLERS[scenario.controller.name](scenario.controller.options)
+    return simulator.run(controller, scenario.true_initial_state, duration, reference=reference,
+                         target=(problem.qf, problem.omegaf), noise=spec.noise,
+                         sensors=spec.sensors if sensors is None else sensors)
+
+
+def sun_angle_deg(result) -> np.ndarray:
+    """Angle between the boresight (body z) and the Sun at each sample t_0 .. t_(N-1), by hand."""
+    t = result.t[:-1]
+    sun = sun_position(EPOCH, t)
+    sun = sun / np.linalg.norm(sun, axis=1, keepdims=True)
+    q = result.q[:-1]
+    boresight = Rotation.from_quat(q[:, [1, 2, 3, 0]]).apply([0.0, 0.0, 1.0])  # SciPy: scalar last
+    return np.degrees(np.arccos(np.clip(np.sum(boresight * sun, axis=1), -1.0, 1.0)))
+
+
+def attitude_variance(result) -> np.ndarray:
+    """Trace of the MEKF covariance's attitude block after each sample [rad²]."""
+    return np.array([np.trace(unpack(row[10:31])[0:3, 0:3]) for row in result.sensor_state[1:]])
+
+
+def test_blinded_samples_are_those_with_the_sun_inside_the_cone(blinded_example):
+    scenario, reference = blinded_example
+    result = simulate(scenario, reference, python_loop=True)
+    angle = sun_angle_deg(result)
+    inside = angle < HALF_ANGLE_DEG
+    assert np.min(np.abs(angle - HALF_ANGLE_DEG)) > 1e-3  # no sample on the edge: the match is exact
+    assert 5 <= np.count_nonzero(inside) <= inside.size - 20  # the spin sweeps the boresight past the Sun
+    np.testing.assert_array_equal(result.blinded != 0, inside)
+    # the MEKF only propagates there: its attitude variance grows at every blinded sample and falls
+    # at the first update after one (the tracker is due every sample but in its 50-60 s outage)
+    variance = attitude_variance(result)
+    due = scenario.simulation.sensors.star_tracker.available(result.t[:-1])
+    for k in np.flatnonzero(inside):
+        assert variance[k] > variance[k - 1], k
+        after = k + 1
+        if after < inside.size and not inside[after] and due[after]:
+            assert variance[after] < variance[k], after
+    metrics = metrics_from_simulation(result, scenario.problem.qf, reference=reference)
+    assert metrics["star_tracker_blinded_s"] == pytest.approx(float(np.count_nonzero(inside)) * 1.0)
+    assert metrics["star_tracker_blinded_updates"] == np.count_nonzero(inside & due)
+
+
+def test_the_earth_limb_cone_is_the_half_angle_plus_the_earths_apparent_radius(blinded_example):
+    """A 500 km circular orbit at 51.6° (ascending node on x, at t = 0): the position by hand,
+    nadir, and the cone 20° + asin(R / r) about it (the boresight within 20° of the limb)."""
+    _, reference = blinded_example
+    data = scenario_data({"earth_limb": 20}, epoch=None)
+    data["orbit"] = {"altitude_km": 500.0, "inclination_deg": 51.6}
+    scenario = parse_scenario(data)
+    result = simulate(scenario, reference, python_loop=True)
+    t = result.t[:-1]
+    mu, radius = 3.986004418e14, 6378137.0  # m³/s², m (WGS-84)
+    a, inclination = radius + 500e3, math.radians(51.6)
+    u = math.sqrt(mu / a**3) * t
+    nadir = -np.stack([np.cos(u), np.sin(u) * math.cos(inclination), np.sin(u) * math.sin(inclination)], axis=1)
+    boresight = Rotation.from_quat(result.q[:-1][:, [1, 2, 3, 0]]).apply([0.0, 0.0, 1.0])
+    angle = np.degrees(np.arccos(np.clip(np.sum(boresight * nadir, axis=1), -1.0, 1.0)))
+    cone = 20.0 + math.degrees(math.asin(radius / a))  # 88.02°
+    assert np.min(np.abs(angle - cone)) > 1e-4  # no sample on the edge
+    assert 10 <= np.count_nonzero(angle < cone) <= angle.size - 10
+    np.testing.assert_array_equal(result.blinded != 0, angle < cone)
+
+
+def test_without_the_exclusion_nothing_is_blinded(blinded_example):
+    scenario, reference = blinded_example
+    plain = parse_scenario(scenario_data()).simulation.sensors
+    assert plain.star_tracker.exclusions == () and plain.noise_size == 10
+    result = simulate(scenario, reference, sensors=plain, python_loop=True)
+    assert not np.any(result.blinded)
+    metrics = metrics_from_simulation(result, scenario.problem.qf, reference=reference)
+    assert metrics["star_tracker_blinded_s"] is None and metrics["star_tracker_blinded_updates"] is None
+
+
+def test_python_interpreted_and_compiled_loops_blind_the_same_samples(blinded_example, tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    scenario, reference = blinded_example
+    python = simulate(scenario, reference, duration=200.0, python_loop=True)
+    interpreted = simulate(scenario, reference, duration=200.0)
+    compiled = simulate(scenario, reference, duration=200.0, compile=True)
+    assert (python.path, interpreted.path) == ("python", "interpreted") and compiled.path in ("compiled", "interpreted")
+    assert np.count_nonzero(python.blinded) >= 10
+    for other in (interpreted, compiled):
+        np.testing.assert_array_equal(other.blinded, python.blinded)
+        np.testing.assert_allclose(other.sensor_state, python.sensor_state, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(other.x, python.x, rtol=0, atol=1e-9)
+
+
+SLEW_RATE = 0.01  # rad/s about body x = inertial x: body z goes to (0, -sin θ, cos θ), θ = SLEW_RATE t
+DIRECTION = np.array([0.0, -1.0, 0.0])  # the boresight meets it at θ = 90°
+
+
+def slew_attitude(t: float) -> np.ndarray:
+    return np.array([math.cos(0.5 * SLEW_RATE * t), math.sin(0.5 * SLEW_RATE * t), 0.0, 0.0])
+
+
+def run_slew(exclusions: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The NumPy sensor step over a uniform slew (300 samples of 1 s): the exclusion bits, the
+    MEKF's attitude variance and its attitude error [deg] after each sample."""
+    gyro = Gyro(arw=math.radians(1.0) / 60.0, rrw=math.radians(1.0) / 3600.0 / 60.0,
+                bias=np.radians([0.1, -0.05, 0.08]) / 3600.0)
+    tracker = StarTracker(noise=np.radians([5.0, 5.0, 40.0]) / 3600.0, exclusions=exclusions)
+    suite = SensorSuite(gyro, tracker, None, Mekf(math.radians(0.1), math.radians(5.0) / 3600.0))
+    times = np.arange(301.0)
+    noise = draw_sensor_noise(suite, 11, times)
+    s = initial_sensor_state(suite, slew_attitude(0.0), 11)
+    bits, variance, error = [], [], []
+    for k in range(300):
+        q = slew_attitude(times[k])
+        q_hat, _, _, s = sensor_step(suite, s, q, np.array([SLEW_RATE, 0.0, 0.0]), None, noise[k], 1.0)
+        bits.append(s[BLINDED])
+        variance.append(np.trace(unpack(s[10:31])[0:3, 0:3]))
+        error.append(np.degrees((Rotation.from_quat(q[[1, 2, 3, 0]]).inv()
+                                 * Rotation.from_quat(q_hat[[1, 2, 3, 0]])).magnitude()))
+    return np.array(bits), np.array(variance), np.array(error)
+
+
+def test_a_slew_past_a_body_blinds_the_closed_form_window_and_the_estimate_drifts():
+    """Blinded while θ = 0.01 t is within 30° of 90°: 60° < θ < 120°, t in (104.7, 209.4) s. The
+    MEKF then propagates on a 1 deg/√h gyro: its variance grows at every blinded sample and its
+    error, tens of arcsec while updated, grows past five times the unblinded run's."""
+    bits, variance, error = run_slew((Exclusion("sun", math.radians(30.0), DIRECTION),))
+    t = np.arange(300.0)
+    window = (t > math.radians(60.0) / SLEW_RATE) & (t < math.radians(120.0) / SLEW_RATE)
+    np.testing.assert_array_equal(bits != 0, window)
+    inside = np.flatnonzero(window)
+    assert np.all(np.diff(variance[inside]) > 0) and variance[inside[0]] > variance[inside[0] - 1]
+    assert variance[inside[-1] + 1] < 0.01 * variance[inside[-1]]  # the first update after it
+    clear_bits, clear_variance, clear_error = run_slew(())
+    assert not np.any(clear_bits)
+    assert np.max(clear_variance[inside]) < 0.01 * variance[inside[-1]]
+    # gyro-only over the 104 s window: σ ≈ ARW √t = 1/60 deg/√s × √104 s ≈ 0.17 deg per axis
+    assert error[inside[-1]] > 5.0 * np.max(clear_error[inside])
+    assert error[inside[-1]] < 4.0 * np.degrees(math.sqrt(variance[inside[-1]]))  # and as the filter says
+    # updated every sample, the error stays within 4 σ of the tracker's noise (5, 5, 40 arcsec)
+    assert np.max(clear_error[50:]) < 4.0 * math.sqrt(5.0**2 + 5.0**2 + 40.0**2) / 3600.0
+
+
+def test_an_exclusion_adds_the_bodys_growth_to_its_half_angle():
+    """A table with growth (the Earth's apparent radius for ``earth_limb``): the cone's cosine is
+    cos(half-angle + growth), capped at π."""
+    exclusion = Exclusion("earth_limb", math.radians(20.0),
+                          lambda times: (np.tile([0.0, 0.0, 2.0], (len(times), 1)), np.radians([60.0, 170.0])))
+    directions, cosines = exclusion.table(np.array([0.0, 1.0]))
+    np.testing.assert_allclose(directions, [[0, 0, 1], [0, 0, 1]])
+    np.testing.assert_allclose(cosines, [math.cos(math.radians(80.0)), -1.0], atol=1e-15)
+
+
+BAD = {
+    "a negative angle": ({"sun": -5}, EPOCH, "simulation.sensors.star_tracker.exclusion_deg.sun", "non-negative"),
+    "over 180 deg": ({"moon": 190}, EPOCH, "simulation.sensors.star_tracker.exclusion_deg.moon", "<= 180"),
+    "not a number": ({"sun": "wide"}, EPOCH, "simulation.sensors.star_tracker.exclusion_deg.sun", "number"),
+    "an unknown body": ({"jupiter": 5}, EPOCH, "simulation.sensors.star_tracker.exclusion_deg.jupiter",
+                        "unknown key; expected one of ['earth', 'earth_limb', 'moon', 'sun', 'velocity']"),
+    "not a mapping": ([30], EPOCH, "simulation.sensors.star_tracker.exclusion_deg", "mapping"),
+    "the Sun without an epoch": ({"sun": 30}, None, "simulation.sensors.star_tracker.exclusion_deg.sun", "epoch"),
+    "the Earth's limb without an orbit": ({"earth_limb": 20}, EPOCH,
+                                          "simulation.sensors.star_tracker.exclusion_deg.earth_limb", "orbit"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_exclusions_name_the_yaml_path(case):
+    exclusion, epoch, path, words = BAD[case]
+    with pytest.raises(ScenarioError) as raised:
+        parse_scenario(copy.deepcopy(scenario_data(exclusion, epoch)))
+    assert path in str(raised.value) and words in str(raised.value)
+
+
+def test_the_tracker_refuses_bad_exclusions_in_python():
+    with pytest.raises(ValueError, match="half-angle"):
+        Exclusion("sun", 4.0, DIRECTION)
+    with pytest.raises(ValueError, match="distinct"):
+        StarTracker(noise=[1e-5] * 3, exclusions=(Exclusion("sun", 0.5, DIRECTION),) * 2)
