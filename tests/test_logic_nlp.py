@@ -49,15 +49,18 @@ def test_stalled_infeasible_does_not_beat_a_worse_converged_start():
     assert result.success and result.f == 5.0 and result.best_start == 1
 
 
-@pytest.mark.parametrize("statuses, expected", [
-    (["Infeasible_Problem_Detected", "Maximum_Iterations_Exceeded"], "failed"),
-    (["Maximum_Iterations_Exceeded", "Restoration_Failed"], "failed"),
-    (["Infeasible_Problem_Detected", "Restoration_Failed"], "infeasible"),
-    (["Infeasible_Problem_Detected"], "infeasible"),
+@pytest.mark.parametrize("statuses, local", [
+    (["Infeasible_Problem_Detected", "Maximum_Iterations_Exceeded"], False),
+    (["Maximum_Iterations_Exceeded", "Restoration_Failed"], False),
+    (["Infeasible_Problem_Detected", "Restoration_Failed"], True),
+    (["Infeasible_Problem_Detected"], True),
 ])
-def test_infeasible_only_when_every_start_is(statuses, expected):
+def test_locally_infeasible_starts_fail_and_say_so_but_prove_nothing(statuses, local):
+    # IPOPT's infeasibility is local: collocation's minimum energy over XTE at 1.001 T* ended so from
+    # both starts (a fresh-eyes check, 2026-12-02) where the stretched minimum-time optimum is feasible
     result, _ = solve([(s, False, 1.0, [1.0]) for s in statuses])
-    assert not result.success and result.status == expected
+    assert not result.success and result.status == "failed"
+    assert ("every start locally infeasible: not a proof" in result.message) is local, result.message
 
 
 def test_one_infeasible_start_beside_a_converged_one_is_ok():

@@ -10,9 +10,12 @@ A start has **converged** when the solver reports success (IPOPT ``Solve_Succeed
 ``[lbg, ubg]``) is at most ``feasibility_tolerance``: the step has fallen below machine precision
 at a feasible point (e.g. a zero-cost optimum), so no further progress is possible. Every other
 outcome (maximum iterations, restoration failure, infeasibility, evaluation errors) is not
-converged, whatever its violation. Among converged starts the lowest objective wins. A result
-whose starts all ended ``Infeasible_Problem_Detected`` / ``Restoration_Failed`` is
-``"infeasible"``, otherwise an unconverged result is ``"failed"``.
+converged, whatever its violation. Among converged starts the lowest objective wins. An
+unconverged result is ``"failed"``, also when every start ended ``Infeasible_Problem_Detected`` /
+``Restoration_Failed`` (its message then says so): IPOPT's infeasibility is local, found from a
+start, not a proof (collocation's minimum energy over XTE at 1.001 T* ended so from both its
+starts, where four starts reach a feasible optimum), and ``"infeasible"`` is a planner's status for
+a problem it shows cannot be met.
 
 IPOPT's ``Solved_To_Acceptable_Level`` means that its *acceptable* tolerances (overall error 1e-6,
 constraint violation and complementarity 1e-2, dual infeasibility 1e10, by default) held for 15
@@ -121,7 +124,8 @@ class NLPResult:
     success : bool
         A start converged (see the module's status policy).
     status : str
-        ``"ok"``, ``"failed"`` or ``"infeasible"`` (the planners' statuses).
+        ``"ok"`` or ``"failed"`` (the planners' statuses; never ``"infeasible"``: the module's
+        status policy).
     message : str
         A human-readable summary.
     iterations : int
@@ -444,9 +448,10 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
     iterations = sum(s.iterations for s in starts)
     statuses = [s.status for s in starts]
     if best_index is None:
-        status = "infeasible" if statuses and all(s in INFEASIBLE for s in statuses) else "failed"
         message = f"no start converged: {sorted(set(statuses))}"
-        return NLPResult(None, np.inf, None, False, status, message, iterations, total, None, starts)
+        if statuses and all(s in INFEASIBLE for s in statuses):
+            message += " (every start locally infeasible: not a proof, another start may find a feasible point)"
+        return NLPResult(None, np.inf, None, False, "failed", message, iterations, total, None, starts)
     message = f"objective {best_f:.8g} from start {best_index} of {len(starts)} tried ({statuses[best_index]})"
     if best_index in checks:
         message += f"; second order: {checks[best_index].message}"

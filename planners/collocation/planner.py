@@ -35,6 +35,7 @@ import numpy as np
 from ocp.dynamics.layout import actuator_blocks
 from ocp.errors import InvalidOption, OptionsError
 from ocp.nlp.solve import (
+    INFEASIBLE,
     NLPResult,
     perturbed,
     solve_multistart,
@@ -824,6 +825,8 @@ class CollocationPlanner(Planner):
         tries = []
         if "Maximum_Iterations_Exceeded" in statuses:
             tries.append("a larger max_iterations")
+        if statuses and all(status in INFEASIBLE for status in statuses) and not ocp.cones:
+            tries.append("more starts, multistart: 4 (IPOPT's infeasibility is local)")
         if ocp.cones:
             tries.append("multistart: 4 or more intervals (pointing constraints)")
         if problem.max_rate is not None:
