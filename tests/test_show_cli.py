@@ -263,7 +263,9 @@ def test_validate_a_scenario_says_what_every_row_is_scored_against(tmp_path, cap
     data["truth"] = {"spacecraft": {"inertia": [1.1, 1.2, 1.3]}}
     data["simulation"].pop("sensor_noise", None)  # the declared sensors give the noise
     data["simulation"]["sensors"] = {"gyro": {"arw_deg_per_sqrt_h": 0.01},
-                                     "star_tracker": {"noise_arcsec": [5, 5, 40], "outages_s": [[10, 12.5]]}}
+                                     "star_tracker": {"noise_arcsec": [5, 5, 40], "outages_s": [[10, 12.5]],
+                                                      "exclusion_deg": {"sun": 30, "moon": 12.5}}}
+    data["epoch"] = "2027-03-20T12:00:00Z"  # the Sun's and the Moon's directions
     data["simulation"]["estimator"] = {"type": "mekf", "initial_attitude_sigma_deg": 0.1,
                                        "initial_bias_sigma_deg_per_h": 5.0}
     path = tmp_path / "scored.yaml"
@@ -278,7 +280,8 @@ def test_validate_a_scenario_says_what_every_row_is_scored_against(tmp_path, cap
         ("  requirement final: error to the target at most 0.5 deg, ‖ω − ω_f‖ at most 0.002 rad/s in the closed "
          "loop from T + 4 s to the end of the run"),
         "  truth (the closed loop's plant differs from the design in): truth.spacecraft.inertia",
-        "  sensors: gyro, star tracker (outages 10-12.5 s); estimator: MEKF"]
+        ("  sensors: gyro, star tracker (outages 10-12.5 s; blinded within 30 deg of the sun, 12.5 deg of the "
+         "moon); estimator: MEKF")]
 
 
 def test_validate_without_requirements_says_the_actuator_limits_alone_are_scored(tmp_path, capsys):

@@ -240,9 +240,12 @@ def _scenario_details(scenario: Scenario) -> list[str]:
     if sensors is not None:
         parts = [name for name, present in (("gyro", sensors.gyro), ("star tracker", sensors.star_tracker),
                                             ("magnetometer", sensors.magnetometer)) if present is not None]
-        if sensors.star_tracker is not None and sensors.star_tracker.outages:
-            parts[parts.index("star tracker")] += " (outages " + ", ".join(
-                f"{a:g}-{b:g} s" for a, b in sensors.star_tracker.outages) + ")"
+        tracker = sensors.star_tracker
+        if tracker is not None and (tracker.outages or tracker.exclusions):
+            parts[parts.index("star tracker")] += " (" + "; ".join(
+                ([("outages " + ", ".join(f"{a:g}-{b:g} s" for a, b in tracker.outages))] if tracker.outages else [])
+                + ([("blinded within " + ", ".join(f"{np.rad2deg(item.half_angle):g} deg of the {item.name}"
+                                                   for item in tracker.exclusions))] if tracker.exclusions else [])) + ")"
         estimator = "MEKF" if sensors.estimator is not None else "none"
         lines.append(f"sensors: {', '.join(parts) or 'none'}; estimator: {estimator}")
     noise = scenario.simulation.noise
