@@ -40,9 +40,13 @@ check could not be made (a factorisation that failed its accuracy guard, a solve
 derivatives) or found the point degenerate (curvature near zero in some direction, none below
 ``−δ``: no saddle direction), the switching agreement is at least
 :data:`SWITCHING_THRESHOLD` with no sample on the wrong side (the controls at a bound, on the side
-Pontryagin's minimum principle asks, with a switching function clear of zero: strict
-complementarity on the control bounds, which makes the discretised point a vertex, the case
-``Z = {0}`` of the second-order check; a check that found negative curvature is not overruled);
+Pontryagin's minimum principle asks, with a switching function clear of zero; a check that found
+negative curvature is not overruled). That second way is weaker than the second-order
+sufficient conditions: strict complementarity on every control bound would make the discretised
+point a vertex (the case ``Z = {0}`` of the second-order check, which it then certifies itself),
+but a degenerate check has found a few directions of near-zero curvature (on fine meshes, the
+controls of the intervals that hold a switch, free between their bounds), where neither sign is
+proven; the summary says which way was taken (``SOSC degenerate, switching 98%``).
 ``"first-order"`` when only the KKT residual is small; ``"not certified"`` otherwise.
 """
 from __future__ import annotations
