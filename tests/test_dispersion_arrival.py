@@ -177,8 +177,7 @@ SENSORS["simulation"]["sensors"] = {
 SENSORS["simulation"]["estimator"] = {"type": "mekf", "initial_attitude_sigma_deg": 0.1,
                                       "initial_bias_sigma_deg_per_h": 5.0}
 SENSORS["epoch"] = "2025-03-20T12:00:00Z"  # the Sun's and the Moon's exclusions need it
-SENSORS["simulation"]["sensors"]["star_tracker"]["exclusion_deg"] = {"sun": 30.0, "moon": 10.0, "earth": 70.0,
-                                                                     "earth_limb": 20.0, "velocity": 5.0}
+SENSORS["simulation"]["sensors"]["star_tracker"]["exclusion_deg"] = {"sun": 30.0, "moon": 10.0, "earth_limb": 20.0}
 
 TRUTH = copy.deepcopy(FULL)  # every truth key set, so that each can change (tests/test_truth_study.py has its own)
 TRUTH["spacecraft"]["wheels"]["spin_inertia"] = 2e-4
@@ -305,7 +304,7 @@ ARRIVALS: dict[str, Arrival] = {
                                                          "simulation", base="sensors"),
     **{f"simulation.sensors.star_tracker.exclusion_deg.{_body}": arrival(
         f"simulation.sensors.star_tracker.exclusion_deg.{_body}", 12.5, "simulation", base="sensors")
-       for _body in ("sun", "moon", "earth", "earth_limb", "velocity")},
+       for _body in ("sun", "moon", "earth_limb")},
     "simulation.sensors.magnetometer.noise_T": arrival("simulation.sensors.magnetometer.noise_T", 2e-8, "simulation",
                                                        base="sensors"),
     "simulation.sensors.magnetometer.bias_T": arrival("simulation.sensors.magnetometer.bias_T", [2e-7, 0.0, 0.0],

@@ -127,7 +127,7 @@ simulation:
   sensors:
     gyro: {arw_deg_per_sqrt_h: 0.01, rrw_deg_per_h_per_sqrt_h: 0.1, bias_deg_per_h: [1.0, 0, 0]}
     star_tracker: {noise_arcsec: [5, 5, 40], rate_hz: 1.0, outages_s: [[5, 8]], boresight: [0, 1, 0],
-                   exclusion_deg: {earth: 60, earth_limb: 20, velocity: 5}}
+                   exclusion_deg: {earth_limb: 20}}
     magnetometer: {noise_T: 1.0e-8, bias_T: [1.0e-7, 0, 0]}
   estimator: {type: mekf, initial_attitude_sigma_deg: 0.1, initial_bias_sigma_deg_per_h: 5.0}
 """

@@ -215,7 +215,9 @@ BAD = {
     "over 180 deg": ({"moon": 190}, EPOCH, "simulation.sensors.star_tracker.exclusion_deg.moon", "<= 180"),
     "not a number": ({"sun": "wide"}, EPOCH, "simulation.sensors.star_tracker.exclusion_deg.sun", "number"),
     "an unknown body": ({"jupiter": 5}, EPOCH, "simulation.sensors.star_tracker.exclusion_deg.jupiter",
-                        "unknown key; expected one of ['earth', 'earth_limb', 'moon', 'sun', 'velocity']"),
+                        "unknown key; expected one of ['earth_limb', 'moon', 'sun']"),
+    "a cone about nadir": ({"earth": 30}, EPOCH, "simulation.sensors.star_tracker.exclusion_deg.earth",
+                           "expected one of ['earth_limb', 'moon', 'sun']"),  # 30 deg of nadir: on the disc, unblinded
     "not a mapping": ([30], EPOCH, "simulation.sensors.star_tracker.exclusion_deg", "mapping"),
     "the Sun without an epoch": ({"sun": 30}, None, "simulation.sensors.star_tracker.exclusion_deg.sun", "epoch"),
     "the Earth's limb without an orbit": ({"earth_limb": 20}, EPOCH,

@@ -826,7 +826,7 @@ class CollocationPlanner(Planner):
         if "Maximum_Iterations_Exceeded" in statuses:
             tries.append("a larger max_iterations")
         if statuses and all(status in INFEASIBLE for status in statuses) and not ocp.cones:
-            tries.append("more starts, multistart: 4 (IPOPT's infeasibility is local)")
+            tries.append("more starts, a larger multistart (IPOPT's infeasibility is local)")
         if ocp.cones:
             tries.append("multistart: 4 or more intervals (pointing constraints)")
         if problem.max_rate is not None:

@@ -772,8 +772,8 @@ def tracking_loss(reference: Score, closed_loop: Score) -> str:
     kept, lost = reference.values.get("min_margin_deg"), closed_loop.values.get("min_margin_deg")
     if not reference.met or closed_loop.met or kept is None or lost is None:
         return ""
-    return (f" (the reference clears it by {kept:.3g} deg; the tracking took {kept - lost:.3g} deg: plan at least "
-            "that far from it, collocation's cone_margin_deg, or track tighter)")
+    return (f" (the reference clears it by {kept:.3g} deg; the tracking took {kept - lost:.3g} deg: plan with at "
+            "least that margin to the cone's edge, collocation's cone_margin_deg, or track tighter)")
 
 
 def unhonoured(requirements: Requirements, planner: Planner | None) -> str:

@@ -70,13 +70,20 @@ GYRO = Section((
            default=[0.0, 0.0, 0.0]),
 ), "A rate gyro (Farrenkopf's model: angle and rate random walk, bias); it replaces ``sensor_noise.rate``.")
 
+BRIGHT_BODIES = ("sun", "moon", "earth_limb")
+"""The directions a star tracker's exclusion may be about: the bright bodies. The Earth is
+``earth_limb`` (its apparent radius added to the angle): a cone about nadir (``earth``) narrower
+than that radius, 68° at 500 km, would leave the tracker updating on the Earth's disc; ``velocity``
+is no body."""
+
 EXCLUSION = Section(tuple(
     number(name, f"Half-angle about the ``{name}`` direction (as pointing requirements mean it"
-           f"{'; needs the epoch' if kind.needs_epoch else ''}{'; needs the orbit' if kind.needs_orbit else ''}); "
-           "``null``: none.", unit="deg", default=None, non_negative=True, maximum=180.0, nullable=True)
-    for name, kind in DIRECTIONS.items()
-), "The star tracker's exclusion cones, by the direction names pointing requirements use "
-   "(``ocp.geometry.directions.DIRECTIONS``).")
+           f"{'; needs the epoch' if DIRECTIONS[name].needs_epoch else ''}"
+           f"{'; needs the orbit' if DIRECTIONS[name].needs_orbit else ''}); ``null``: none.",
+           unit="deg", default=None, non_negative=True, maximum=180.0, nullable=True)
+    for name in BRIGHT_BODIES
+), "The star tracker's exclusion cones about the bright bodies (the Earth as ``earth_limb``: its apparent "
+   "radius added, so that the whole disc blinds; a cone about nadir would leave the tracker updating on it).")
 
 def _exclusions(node: Node) -> dict[str, Any]:
     return EXCLUSION.read(Node({}, node.path) if node.is_null() else node)
