@@ -11,6 +11,11 @@ one IPOPT solver crash the process), so a cache keeps **one set of entries per t
 never receives an object that another thread built. Threads may share a cache (and a planner); each
 thread builds a structure once, the first time it meets it, and its plans then run concurrently
 with the other threads'. A thread's entries go when the thread ends.
+
+Pickling: a cache pickles (and deep-copies) empty. Its entries are built solvers, megabytes each
+(a model's cache after one 50-interval collocation plan pickles to 14 MB, after a multiple-shooting
+plan to 330 MB), which the receiving process builds again faster than it would receive them; so a
+reference, which keeps its model and with it the model's cache, pickles to kilobytes.
 """
 from __future__ import annotations
 
@@ -36,7 +41,7 @@ class SolverCache:
 
     A look-up from a thread sees only the entries that thread built: a built solver is never
     called from two threads at once (CasADi functions are not thread-safe), whichever threads
-    share the cache. A pickled cache holds the entries of the thread that pickles it.
+    share the cache. A pickled or deep-copied cache is a new, empty one (the module docstring).
 
     Attributes
     ----------
@@ -103,9 +108,7 @@ class SolverCache:
                 entries.items.clear()
 
     def __getstate__(self) -> dict[str, Any]:
-        return {"entries": dict(self._entries), "builds": self.builds, "hits": self.hits}
+        return {}  # a new, empty cache on the other side (the module docstring)
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__init__()  # type: ignore[misc]
-        self._entries.update(state["entries"])
-        self.builds, self.hits = state["builds"], state["hits"]
