@@ -9,8 +9,10 @@ by hand, and for a uniform slew past a fixed direction the window in closed form
 from __future__ import annotations
 
 import copy
+import csv
 import math
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -19,7 +21,7 @@ from scipy.spatial.transform import Rotation
 
 from controllers import CONTROLLERS
 from ocp import Simulator
-from ocp.dynamics.ephemeris import sun_position
+from ocp.dynamics.ephemeris import moon_position, sun_position
 from ocp.estimation import (
     BLINDED,
     Exclusion,
@@ -35,6 +37,7 @@ from ocp.estimation.mekf import unpack
 from ocp.metrics import metrics_from_simulation
 from planners import PLANNERS
 from scenarios.errors import ScenarioError
+from scenarios.output.writer import write_timeseries
 from scenarios.schema.loader import parse_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -148,6 +151,78 @@ def test_python_interpreted_and_compiled_loops_blind_the_same_samples(blinded_ex
         np.testing.assert_array_equal(other.blinded, python.blinded)
         np.testing.assert_allclose(other.sensor_state, python.sensor_state, rtol=0, atol=1e-9)
         np.testing.assert_allclose(other.x, python.x, rtol=0, atol=1e-9)
+
+
+OBLIQUE = [0.6, 0.64, -0.48]  # a unit vector off every body axis
+
+
+def to_inertial(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Body vectors ``v`` turned to inertial by scalar-first Hamilton quaternions ``q`` (body to
+    inertial), ``q ⊗ (0, v) ⊗ q*`` written out: ``v + 2 w (r × v) + 2 r × (r × v)``."""
+    w, r = q[:, :1], q[:, 1:]
+    c = np.cross(r, v)
+    return v + 2.0 * w * c + 2.0 * np.cross(r, c)
+
+
+def body_angle_deg(result, boresight, position) -> np.ndarray:
+    """Angle between ``boresight`` (body axes) and a body (``position(EPOCH, t)``, geocentric) at
+    each sample t_0 .. t_(N-1), by hand."""
+    t = result.t[:-1]
+    body = position(EPOCH, t)
+    body = body / np.linalg.norm(body, axis=1, keepdims=True)
+    b = np.tile(np.asarray(boresight, dtype=float) / np.linalg.norm(boresight), (t.size, 1))
+    return np.degrees(np.arccos(np.clip(np.sum(to_inertial(result.q[:-1], b) * body, axis=1), -1.0, 1.0)))
+
+
+def with_boresight(exclusion: dict, boresight: list) -> dict:
+    data = scenario_data(exclusion)
+    data["simulation"]["sensors"]["star_tracker"]["boresight"] = boresight
+    return data
+
+
+@pytest.mark.parametrize("boresight", [[0.0, 1.0, 0.0], OBLIQUE], ids=["body y", "oblique"])
+def test_a_boresight_off_body_z_is_blinded_where_it_is_near_the_sun(blinded_example, boresight, tmp_path,
+                                                                    monkeypatch):
+    """The Python loop and the compiled closed loop blind the samples where the boresight, turned
+    by the true attitude, is within 30° of the Sun, and not those of body z."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    _, reference = blinded_example
+    scenario = parse_scenario(with_boresight({"sun": HALF_ANGLE_DEG}, boresight))
+    python = simulate(scenario, reference, python_loop=True)
+    compiled = simulate(scenario, reference, compile=True)
+    assert compiled.path in ("compiled", "interpreted")
+    angle = body_angle_deg(python, boresight, sun_position)
+    inside = angle < HALF_ANGLE_DEG
+    assert np.min(np.abs(angle - HALF_ANGLE_DEG)) > 1e-3  # no sample on the edge
+    assert 5 <= np.count_nonzero(inside) <= inside.size - 20
+    body_z = body_angle_deg(python, [0.0, 0.0, 1.0], sun_position) < HALF_ANGLE_DEG
+    assert np.count_nonzero(body_z != inside) >= 5  # the boresight matters
+    np.testing.assert_array_equal(python.blinded, inside.astype(np.int64))
+    np.testing.assert_array_equal(compiled.blinded, inside.astype(np.int64))
+    np.testing.assert_allclose(compiled.x, python.x, rtol=0, atol=1e-9)
+
+
+def test_the_timeseries_has_the_blinded_bits_in_the_order_written(blinded_example, tmp_path):
+    """``exclusion_deg: {moon: 25, sun: 30}``: bit 0 is the Moon's, bit 1 the Sun's, in
+    ``SimulationResult.blinded`` and in the ``blinded`` column of the time series (integers, blank
+    at the final time)."""
+    _, reference = blinded_example
+    scenario = parse_scenario(with_boresight({"moon": 25.0, "sun": HALF_ANGLE_DEG}, OBLIQUE))
+    result = simulate(scenario, reference, python_loop=True)
+    moon, sun = body_angle_deg(result, OBLIQUE, moon_position), body_angle_deg(result, OBLIQUE, sun_position)
+    assert np.min(np.abs(moon - 25.0)) > 1e-3 and np.min(np.abs(sun - HALF_ANGLE_DEG)) > 1e-3
+    moon_bit, sun_bit = moon < 25.0, sun < HALF_ANGLE_DEG
+    assert np.any(moon_bit & ~sun_bit) and np.any(sun_bit & ~moon_bit)  # the bits tell them apart
+    expected = 1 * moon_bit + 2 * sun_bit
+    np.testing.assert_array_equal(result.blinded, expected)
+    path = tmp_path / "row.csv"
+    write_timeseries(SimpleNamespace(label="row", simulation=result, reference=reference), path)  # type: ignore[arg-type]
+    with path.open(newline="") as handle:
+        lines = list(csv.reader(handle))
+    assert lines[0][-6:] == ["known_q0", "known_q1", "known_q2", "known_q3", "knowledge_error_deg", "blinded"]
+    assert [line[-1] for line in lines[1:]] == [str(bit) for bit in expected] + [""]
+    assert all(len(line) == len(lines[0]) for line in lines)
+    assert float(lines[1 + np.argmax(sun_bit)][0]) == result.t[np.argmax(sun_bit)]  # the bits at their times
 
 
 SLEW_RATE = 0.01  # rad/s about body x = inertial x: body z goes to (0, -sin θ, cos θ), θ = SLEW_RATE t

@@ -18,6 +18,7 @@ field reading and white noise (``ocp.simulation.SensorNoise.field_std``'s stream
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -37,8 +38,13 @@ def _vector(name: str, value: Any, non_negative: bool = False) -> Array:
     return array
 
 
+def _real(value: Any) -> bool:
+    """Whether ``value`` is a real number: a Python or NumPy integer or float, not a bool."""
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
 def _non_negative(name: str, value: Any) -> float:
-    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value) or value < 0:
+    if not _real(value) or not math.isfinite(value) or value < 0:
         raise ValueError(f"{name} must be a finite non-negative number, got {value!r}")
     return float(value)
 
@@ -127,8 +133,10 @@ class Exclusion:
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"an exclusion's name must be a non-empty string, got {self.name!r}")
         angle = self.half_angle
-        if (not isinstance(angle, (int, float)) or isinstance(angle, bool) or not math.isfinite(angle)
-                or not 0.0 <= angle <= math.pi):
+        if not _real(angle):
+            raise ValueError(f"the {self.name} exclusion half-angle must be a number of rad in [0, pi], "
+                             f"got {angle!r} ({type(angle).__name__})")
+        if not (math.isfinite(angle) and 0.0 <= angle <= math.pi):
             raise ValueError(f"the {self.name} exclusion half-angle must be in [0, pi] rad, got {angle!r}")
         object.__setattr__(self, "half_angle", float(angle))
         if not callable(self.directions):
@@ -196,16 +204,23 @@ class StarTracker:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "noise", _vector("noise", self.noise, non_negative=True))
-        exclusions = tuple(self.exclusions)
+        if isinstance(self.exclusions, Exclusion):
+            raise ValueError(f"exclusions must be a tuple of Exclusion, got a single one ({self.exclusions.name!r}); "
+                             f"write exclusions=(Exclusion(...),)")
+        try:
+            exclusions = tuple(self.exclusions)
+        except TypeError:
+            raise ValueError(f"exclusions must be a tuple of Exclusion, got {self.exclusions!r:.80}") from None
         if not all(isinstance(item, Exclusion) for item in exclusions):
-            raise ValueError(f"exclusions must be Exclusion instances, got {self.exclusions!r}")
+            raise ValueError(f"exclusions must be Exclusion instances, got {self.exclusions!r:.80}")
         names = [item.name for item in exclusions]
         if len(set(names)) != len(names):
             raise ValueError(f"exclusion names must be distinct, got {names}")
         object.__setattr__(self, "exclusions", exclusions)
-        if self.rate is not None and (not isinstance(self.rate, (int, float)) or not math.isfinite(self.rate)
-                                      or not self.rate > 0):
-            raise ValueError(f"rate must be a finite positive number of Hz or None, got {self.rate!r}")
+        if self.rate is not None:
+            if not _real(self.rate) or not math.isfinite(self.rate) or not self.rate > 0:
+                raise ValueError(f"rate must be a finite positive number of Hz or None, got {self.rate!r}")
+            object.__setattr__(self, "rate", float(self.rate))
         windows = tuple((float(a), float(b)) for a, b in self.outages)
         for a, b in windows:
             if not (math.isfinite(a) and math.isfinite(b) and b > a):

@@ -253,8 +253,10 @@ class ClosedLoop:
         Returns
         -------
         BufferedFunction
-            ``run(xz0, t (N), dt (N), [noise (9N or 19N)], [r (26N)], p, [plant_noise (n_w N)]) ->
-            (xz (N(nx+nz[+36])), u_cmd, u_app, saturated, torque)``: the noise and reference inputs
+            ``run(xz0, t (N), dt (N), [noise (noise_size N)], [r (26N)], p, [plant_noise (n_w N)]) ->
+            (xz (N(nx+nz[+36])), u_cmd, u_app, saturated, torque)``, with :attr:`noise_size` 9, or
+            19 + 4 E with sensors (E the star tracker's exclusions) and 36 the sensor state
+            (:data:`~ocp.estimation.SENSOR_STATE_SIZE`): the noise and reference inputs
             exist only when the loop uses them (:attr:`shape`, :attr:`plant_noise_size`), and every
             input and output has its exact size, so that the function is evaluated through
             reusable buffers.
@@ -296,10 +298,10 @@ class ClosedLoop:
             state ``z`` and, with sensors, their state ``s``.
         times : (N + 1,) ndarray
             Sample times [s]; the control computed at ``times[k]`` is held until ``times[k + 1]``.
-        noise : (N, 9) or (N, 19) ndarray or None
-            Sensor noise per sample (:func:`draw_noise`, then with sensors
-            :func:`ocp.estimation.draw_sensor_noise`); required when ``shape.noisy``, otherwise
-            ignored.
+        noise : (N, noise_size) ndarray or None
+            Sensor noise per sample, :attr:`noise_size` numbers: the 9 of :func:`draw_noise`, then with
+            sensors the ``10 + 4 E`` of :func:`ocp.estimation.draw_sensor_noise` (E the star tracker's
+            exclusions), 19 + 4 E in all; required when ``shape.noisy``, otherwise ignored.
         rows : (N, 26) ndarray or None
             Reference rows at ``t_k`` and ``t_k + T_s`` per sample (:mod:`ocp.dynamics.layout`); required
             when ``shape.uses_reference``, otherwise ignored.
@@ -312,8 +314,8 @@ class ClosedLoop:
 
         Returns
         -------
-        xz : (N, nx + nz) ndarray
-            States ``[x; z]`` after each sample.
+        xz : (N, nx + nz [+ 36]) ndarray
+            States ``[x; z]`` after each sample, and with sensors their state ``s``.
         u_cmd, u_app : (N, nu) ndarray
             Commanded and applied (saturated) controls.
         saturated : (N,) ndarray
@@ -326,7 +328,7 @@ class ClosedLoop:
         if self.shape.noisy:
             if noise is None:
                 raise ValueError(f"this closed loop takes sensor noise: pass the (N, {self.noise_size}) noise")
-            args.append(noise.ravel())  # (N, 9) row-major is the (9, N) column-major input
+            args.append(noise.ravel())  # (N, noise_size) row-major is the (noise_size, N) column-major input
         if self.shape.uses_reference:
             if rows is None:
                 raise ValueError("this closed loop reads a reference: pass the (N, 26) rows")

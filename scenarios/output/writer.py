@@ -7,7 +7,7 @@ from __future__ import annotations
 import csv
 import shutil
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -37,8 +37,10 @@ def write_timeseries(row: Row, path: Path) -> None:
     the last line), ``ref_q0..3``, ``ref_omega_x..z`` [rad/s] and ``ref_omega_dot_x..z`` [rad/s², reference
     body axes] (blank without a reference); with a star tracker in the loop (an estimator), then
     ``known_q0..3``, the attitude the controller was given at ``t``, and ``knowledge_error_deg``,
-    its angle from the true attitude [deg] (:func:`scenarios.output.plot_data.knowledge_series`; blank on the last line).
-    Non-finite values are blank (:func:`scenarios.output.tables.csv_cell`).
+    its angle from the true attitude [deg] (:func:`scenarios.output.plot_data.knowledge_series`; blank on the last line),
+    and ``blinded``, which of the star tracker's exclusions held its boresight at ``t`` (an integer:
+    bit i for the i-th of ``exclusion_deg``, 0 for none; :attr:`ocp.SimulationResult.blinded`;
+    blank on the last line). Non-finite values are blank (:func:`scenarios.output.tables.csv_cell`).
 
     Parameters
     ----------
@@ -68,13 +70,19 @@ def write_timeseries(row: Row, path: Path) -> None:
         header += ["known_q0", "known_q1", "known_q2", "known_q3", "knowledge_error_deg"]
         table = np.hstack([table, known, error[:, None]])
     finite = np.isfinite(table).tolist()
+    # csv_cell of each value, without its checks per cell (every value is a float here): the repr
+    # of a finite value, blank otherwise
+    lines: Iterator[list[str]] = ([repr(v) if ok else "" for v, ok in zip(line, keep)]
+                                  for line, keep in zip(table.tolist(), finite))
+    blinded = getattr(sim, "blinded", None)  # None without a star tracker
+    if blinded is not None:  # the bits as integers, at t_0 ... t_(N-1): none at the final time
+        header.append("blinded")
+        bits = [str(int(bit)) for bit in blinded] + [""] * (sim.t.size - len(blinded))
+        lines = (line + [bit] for line, bit in zip(lines, bits))
     with path.open("w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(header)
-        # csv_cell of each value, without its checks per cell (every value is a float here): the
-        # repr of a finite value, blank otherwise
-        writer.writerows([repr(v) if ok else "" for v, ok in zip(line, keep)]
-                         for line, keep in zip(table.tolist(), finite))
+        writer.writerows(lines)
 
 
 def plot_streamer(scenario: Any, renderer: Any) -> Callable[[Row], None]:

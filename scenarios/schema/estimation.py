@@ -85,8 +85,15 @@ EXCLUSION = Section(tuple(
 ), "The star tracker's exclusion cones about the bright bodies (the Earth as ``earth_limb``: its apparent "
    "radius added, so that the whole disc blinds; a cone about nadir would leave the tracker updating on it).")
 
+
 def _exclusions(node: Node) -> dict[str, Any]:
-    return EXCLUSION.read(Node({}, node.path) if node.is_null() else node)
+    """The half-angles in the order the mapping writes them (the exclusions', their bits', the
+    messages' and the summary's order), the bodies not written after them."""
+    if node.is_null():
+        return EXCLUSION.read(Node({}, node.path))
+    written = list(node.mapping().value)
+    keys = sorted(EXCLUSION.keys, key=lambda key: written.index(key.name) if key.name in written else len(written))
+    return Section(tuple(keys), EXCLUSION.meaning).read(node)
 
 
 STAR_TRACKER = Section((
@@ -101,7 +108,8 @@ STAR_TRACKER = Section((
            "given beside it, it must be the same direction.", "list of 3 numbers or null", _boresight, default=None),
     custom("exclusion_deg", "Exclusion half-angles about bright bodies: an update due at a sample is dropped "
            "when the true attitude puts the boresight within that angle of the body (of the Earth's limb for "
-           "``earth_limb``); the MEKF then only propagates. The sensor's only source of blinding: a pointing "
+           "``earth_limb``); the MEKF then only propagates. In the order written: the i-th is bit i of the "
+           "``blinded`` time-series column. The sensor's only source of blinding: a pointing "
            "requirement keeping the tracker off a body is scored, not applied to the sensor. Absent or "
            "``null``: none.", "mapping or null", _exclusions, unit="deg", default={}, section=EXCLUSION),
 ), "A star tracker; it replaces ``sensor_noise.attitude_deg``.")
