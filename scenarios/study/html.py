@@ -4,7 +4,8 @@ Built on the run report's page (:class:`scenarios.output.report.page.Page`): plo
 tables' values exactly as in the CSV files, opening offline. In order:
 
 * the fraction of cases meeting every requirement per planner, then each requirement in each scope
-  (``requirements.csv``);
+  (``requirements.csv``), with a note when some cases were scored before per-requirement verdicts
+  were stored (:func:`scenarios.study.report.verdict_note`);
 * for a Monte Carlo study, the robustness tables (:mod:`scenarios.study.robustness`): the
   fractions meeting every requirement and each threshold, the rank correlations and the worst cases;
 * the summary statistics (``summary.csv``), with each metric's unit;
@@ -30,7 +31,7 @@ from scenarios.output.tables import IDENTITY_COLUMNS, is_missing
 from scenarios.schema.keys import Section
 from scenarios.schema.loader import SCENARIO
 from scenarios.study.paths import parse_path
-from scenarios.study.report import metric_values
+from scenarios.study.report import REQUIREMENT_TEXT, metric_values, verdict_note
 from scenarios.study.types import Study
 
 __all__ = ["LOG_SPAN", "PAGE_SIZE", "ROBUSTNESS_SECTIONS", "histogram_figure", "path_unit", "study_report"]
@@ -210,12 +211,11 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
               f"{len(rows)} rows; slewbench {package_version()}."),
              "Varied: " + (", ".join(varied) if varied else "nothing") + "."]
     page = Page(f"{study.name}: slewbench trade study", lines)
-    page.section("Cases meeting the requirements",
-                 "every requirement: rows whose status is ok among the completed ones (not crashed); then each "
-                 "requirement in each scope, by its verdict (met): the rows where it is met among those scored "
-                 "there. With the Wilson 95 % interval of the fraction.")
-    page.table("requirements", result_columns(requirements[0], requirements[1]),
-               [[row.get(c) for c in requirements[0]] for row in requirements[1]])
+    page.section("Cases meeting the requirements", REQUIREMENT_TEXT)
+    note = verdict_note(requirements)
+    if note:
+        page.text(note)
+    page.table("requirements", result_columns(requirements[0], requirements[1]), [[row.get(c) for c in requirements[0]] for row in requirements[1]])
     if robustness is not None:
         for (title, text), (keys, table), key in zip(ROBUSTNESS_SECTIONS, robustness, ("robustness", "sensitivity",
                                                                                      "worst")):
@@ -232,8 +232,7 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
                             "the count rows; median, p5, p95 (linear percentiles), min and max over those and the "
                             "never rows as inf; not_ok: rows whose status is not ok (violated, failed, infeasible or "
                             "crashed).")
-    page.table("summary", _columns(summary_names, summary_rows),
-               [[row.get(c) for c in summary_names] for row in summary_rows])
+    page.table("summary", _columns(summary_names, summary_rows), [[row.get(c) for c in summary_names] for row in summary_rows])
     if study.summary and rows:
         page.section("Distributions", "Cases per bin of each summary metric, one curve per planner row.")
         for k, column in enumerate(study.summary):
