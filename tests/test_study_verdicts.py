@@ -1,10 +1,12 @@
 """A study's per-requirement counts (``requirements.csv``) take a verdict only from a row that counts
 (``ok`` or ``violated``), as the summary and the robustness tables take a row's values; a store
-written before verdicts were stored says so instead of printing nothing.
+written before verdicts were stored says so instead of printing nothing; ``report.html`` shows a
+bool as the CSV files write it.
 
 Before: a ``failed`` row's stored verdict ``True`` counted as met (``st (reference)`` met in 5 of
 6 below instead of 4 of 4) and an ``infeasible`` row's ``False`` as broken; rows with requirement scores
-but no ``.met`` gave no per-requirement line at all. Oracles: counts by hand from the given rows.
+but no ``.met`` gave no per-requirement line at all; the HTML cells of a verdict read ``true`` /
+``false`` where ``cases.csv`` reads ``True`` / ``False``. Oracles: counts by hand from the given rows.
 """
 from __future__ import annotations
 
@@ -154,3 +156,20 @@ def test_a_partly_resumed_store_counts_the_verdicts_it_has() -> None:
 
     fresh = requirement_table(study(), dotted(ROWS))
     assert verdict_note(fresh) is None
+
+
+def html_table(page: str, key: str) -> dict[str, Any]:
+    start = page.index(f'"{key}":{{"columns"') + len(key) + 3
+    return json.JSONDecoder().raw_decode(page, start)[0]
+
+
+def test_the_html_report_shows_a_bool_as_the_csv_files() -> None:
+    rows = [{"case": k, **line} for k, line in enumerate(dotted(ROWS))]
+    names = ["case", "label", "status", "ref.req.st.met", "cl.req.st.met"]
+    page = study_report(study(), (names, rows), summary_table(study(), rows), requirement_table(study(), rows), 0)
+    cases = html_table(page, "cases")
+    keys = [column["key"] for column in cases["columns"]]
+    shown = [line[keys.index("cl.req.st.met")] for line in cases["rows"]]
+    written = list(csv.DictReader(io.StringIO(csv_text(names, rows))))
+    assert [line["cl.req.st.met"] for line in written] == ["True", "False", "False", "True", "False", "", ""]
+    assert shown == ["True", "False", "False", "True", "False", None, None]
