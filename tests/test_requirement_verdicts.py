@@ -184,8 +184,8 @@ def test_a_study_counts_the_cases_meeting_each_requirement_in_each_scope(tmp_pat
     assert inside == [True, False, False, True]
     assert [row["cl.req.st.met"] for row in rows] == [not flag for flag in inside]
     req_columns, table = requirement_table(study, rows)
-    assert req_columns == ["label", "criterion", "completed", "scored", "met", "fraction_met", "wilson_low",
-                           "wilson_high"]
+    assert req_columns == ["label", "criterion", "completed", "excluded", "scored", "not_scored",
+                           "no_verdict", "met", "fraction_met", "wilson_low", "wilson_high"]
     lines = {line["criterion"]: line for line in table}
     assert list(lines) == ["every requirement", "st (reference)", "st (closed loop)", "actuators (reference)"]
     assert (lines["every requirement"]["met"], lines["every requirement"]["completed"]) == (2, 4)
@@ -203,7 +203,7 @@ def test_a_study_counts_the_cases_meeting_each_requirement_in_each_scope(tmp_pat
     cases = list(csv.DictReader(io.StringIO((tmp_path / "out" / "cases.csv").read_text())))
     assert [line["cl.req.st.met"] for line in cases] == ["False", "True", "True", "False"]
     summary = (tmp_path / "out" / "summary.md").read_text()
-    assert "| eigenaxis | st (closed loop) | 4 | 4 | 2 | 0.5 |" in summary
+    assert "| eigenaxis | st (closed loop) | 4 | 0 | 4 | 0 | 0 | 2 | 0.5 |" in summary
 
 
 def test_unscored_rows_are_counted_apart_and_a_verdict_is_no_summary_metric():
@@ -211,13 +211,16 @@ def test_unscored_rows_are_counted_apart_and_a_verdict_is_no_summary_metric():
     rows = [{"label": "eigenaxis", "status": "ok", "ref.req.st.met": True, "cl.req.st.met": True},
             {"label": "eigenaxis", "status": "violated", "ref.req.st.met": True, "cl.req.st.met": False},
             {"label": "eigenaxis", "status": "failed", "ref.req.st.met": True, "cl.req.st.met": None},
-            {"label": "eigenaxis", "status": "crashed"}]
+            {"label": "eigenaxis", "status": "crashed"},
+            {"label": "eigenaxis", "status": "ok", "ref.req.st.met": True}]  # no closed loop scored
     columns, table = requirement_table(study, rows)
     lines = {line["criterion"]: line for line in table}
+    # the failed row's verdicts do not count (tests/test_study_verdicts.py); it and the crashed one are left out
     assert (lines["st (closed loop)"]["completed"], lines["st (closed loop)"]["scored"],
-            lines["st (closed loop)"]["met"]) == (3, 2, 1)
+            lines["st (closed loop)"]["met"], lines["st (closed loop)"]["not_scored"]) == (4, 2, 1, 1)
     assert (lines["st (reference)"]["scored"], lines["st (reference)"]["met"]) == (3, 3)
-    assert "  eigenaxis: st (closed loop) met in 1 of 2 cases, 1 not scored" in study_lines((columns, table))
+    assert ("  eigenaxis: st (closed loop) met in 1 of 2 cases, 1 not scored, 2 left out (failed, infeasible or "
+            "crashed)") in study_lines((columns, table))
     crashed = requirement_table(study, [{"label": "eigenaxis", "status": "crashed"}])
     assert study_lines(crashed) == ["  eigenaxis: every requirement: no completed case"]
     with pytest.raises(scenarios.ScenarioError, match=r"summary\[0\].*verdict"):

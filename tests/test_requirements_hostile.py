@@ -412,5 +412,8 @@ def test_a_study_sweeping_the_angle_and_the_epoch_runs_and_reports_each_case(tmp
     assert june_40["status"] == "failed" and "target attitude already breaks it" in june_40["message"]
     assert float(by_case[("2027-03-20T12:00:00Z", "20")]["ref.req.st_sun.min_margin_deg"]) < -19.0
     summary = (tmp_path / "out" / "requirements.csv").read_text().splitlines()
-    assert summary[0] == "label,criterion,completed,scored,met,fraction_met,wilson_low,wilson_high"
-    assert summary[1].startswith("eigenaxis,every requirement,4,4,1,0.25,")
+    assert by_case[("2027-03-20T12:00:00Z", "40")]["status"] == "violated"
+    assert summary[0] == ("label,criterion,completed,excluded,scored,not_scored,no_verdict,met,fraction_met,"
+                          "wilson_low,wilson_high")
+    # the failed June row is completed (it does not meet every requirement) and left out of the verdicts
+    assert summary[1].startswith("eigenaxis,every requirement,4,1,4,0,0,1,0.25,")

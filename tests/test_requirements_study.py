@@ -66,8 +66,8 @@ def test_a_sweep_stores_the_requirement_columns_and_reports_the_fraction_met(tmp
     frame = results.to_dataframe()
     assert frame["cl.req.st.min_margin_deg"].dtype == "float64"
     req_columns, table = requirement_table(study, rows)
-    assert req_columns == ["label", "criterion", "completed", "scored", "met", "fraction_met", "wilson_low",
-                           "wilson_high"]
+    assert req_columns == ["label", "criterion", "completed", "excluded", "scored", "not_scored",
+                           "no_verdict", "met", "fraction_met", "wilson_low", "wilson_high"]
     line = table[0]
     assert line["criterion"] == "every requirement"
     # 2 of 3: centre (2/3 + z²/6) / (1 + z²/3), half z/(1 + z²/3) sqrt(2/27 + z²/36)

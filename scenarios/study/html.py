@@ -1,10 +1,11 @@
 """A trade study's ``report.html``: its tables, sortable, and the distributions of its summary metrics.
 
 Built on the run report's page (:class:`scenarios.output.report.page.Page`): plotly.js inline, the
-tables' values exactly as in the CSV files, opening offline. In order:
+tables' values exactly as in the CSV files (a bool ``True`` or ``False``), opening offline. In order:
 
 * the fraction of cases meeting every requirement per planner, then each requirement in each scope
-  (``requirements.csv``);
+  (``requirements.csv``), with a note when some cases were scored before per-requirement verdicts
+  were stored (:func:`scenarios.study.report.verdict_note`);
 * for a Monte Carlo study, the robustness tables (:mod:`scenarios.study.robustness`): the
   fractions meeting every requirement and each threshold, the rank correlations and the worst cases;
 * the summary statistics (``summary.csv``), with each metric's unit;
@@ -26,11 +27,11 @@ import numpy as np
 from scenarios.output.provenance import package_version
 from scenarios.output.report.page import Column, Page, column_unit
 from scenarios.output.report.run import result_columns
-from scenarios.output.tables import IDENTITY_COLUMNS, is_missing
+from scenarios.output.tables import IDENTITY_COLUMNS, is_missing, text_cell
 from scenarios.schema.keys import Section
 from scenarios.schema.loader import SCENARIO
 from scenarios.study.paths import parse_path
-from scenarios.study.report import metric_values
+from scenarios.study.report import REQUIREMENT_TEXT, metric_values, verdict_note
 from scenarios.study.types import Study
 
 __all__ = ["LOG_SPAN", "PAGE_SIZE", "ROBUSTNESS_SECTIONS", "histogram_figure", "path_unit", "study_report"]
@@ -175,6 +176,14 @@ def _columns(names: list[str], rows: list[dict[str, Any]]) -> list[Column]:
     return result_columns(names, [{k: None if v == INFINITY_TEXT else v for k, v in row.items()} for row in rows])
 
 
+def _cells(names: list[str], rows: list[dict[str, Any]]) -> list[list[Any]]:
+    """The values of a table's cells: a bool (a verdict ``<scope>.req.<name>.met``, ``significant``)
+    as the CSV files and ``summary.md`` write it (:func:`~scenarios.output.tables.text_cell`:
+    ``True``, ``False``), every other value as it is (the page formats numbers)."""
+    return [[text_cell(value) if isinstance(value := row.get(name), bool) else value for name in names]
+            for row in rows]
+
+
 def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
                  summary: tuple[list[str], list[dict[str, Any]]],
                  requirements: tuple[list[str], list[dict[str, Any]]], missing: int,
@@ -210,18 +219,17 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
               f"{len(rows)} rows; slewbench {package_version()}."),
              "Varied: " + (", ".join(varied) if varied else "nothing") + "."]
     page = Page(f"{study.name}: slewbench trade study", lines)
-    page.section("Cases meeting the requirements",
-                 "every requirement: rows whose status is ok among the completed ones (not crashed); then each "
-                 "requirement in each scope, by its verdict (met): the rows where it is met among those scored "
-                 "there. With the Wilson 95 % interval of the fraction.")
-    page.table("requirements", result_columns(requirements[0], requirements[1]),
-               [[row.get(c) for c in requirements[0]] for row in requirements[1]])
+    page.section("Cases meeting the requirements", REQUIREMENT_TEXT)
+    note = verdict_note(requirements)
+    if note:
+        page.text(note)
+    page.table("requirements", result_columns(requirements[0], requirements[1]), _cells(*requirements))
     if robustness is not None:
         for (title, text), (keys, table), key in zip(ROBUSTNESS_SECTIONS, robustness, ("robustness", "sensitivity",
                                                                                      "worst")):
             if table:
                 page.section(title, text)
-                page.table(key, _columns(keys, table), [[row.get(c) for c in keys] for row in table])
+                page.table(key, _columns(keys, table), _cells(keys, table))
     metric = summary[0].index("metric") + 1
     summary_names = [*summary[0][:metric], "unit", *summary[0][metric:]]
     summary_rows = [{**row, "unit": column_unit(row["metric"])} for row in summary[1]]
@@ -232,8 +240,7 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
                             "the count rows; median, p5, p95 (linear percentiles), min and max over those and the "
                             "never rows as inf; not_ok: rows whose status is not ok (violated, failed, infeasible or "
                             "crashed).")
-    page.table("summary", _columns(summary_names, summary_rows),
-               [[row.get(c) for c in summary_names] for row in summary_rows])
+    page.table("summary", _columns(summary_names, summary_rows), _cells(summary_names, summary_rows))
     if study.summary and rows:
         page.section("Distributions", "Cases per bin of each summary metric, one curve per planner row.")
         for k, column in enumerate(study.summary):
@@ -252,5 +259,5 @@ def study_report(study: Study, cases: tuple[list[str], list[dict[str, Any]]],
     page.section("Cases", "One row per case and planner, as in cases.csv; click a header to sort, type to filter.")
     columns = [Column(c.key, path_unit(c.key) if c.key in varied else c.unit, c.numeric, c.meaning, c.order)
                for c in result_columns(shown, rows)]
-    page.table("cases", columns, [[row.get(name) for name in shown] for row in rows], page_size=PAGE_SIZE)
+    page.table("cases", columns, _cells(shown, rows), page_size=PAGE_SIZE)
     return page.render()

@@ -1,9 +1,9 @@
 """Tables and files of a trade study: ``cases.csv`` (one row per case and planner),
 ``summary.csv`` / ``summary.md`` (statistics per planner, and per grid point when there is
 Monte Carlo), ``requirements.csv`` (per planner, the fraction of cases that meet every requirement,
-then of those scored that meet each requirement in each scope by its verdict ``met``, each with its
-Wilson interval: :func:`requirement_table`; also in ``summary.md`` and printed by ``slewbench
-sweep``), for a Monte Carlo study the robustness tables ``robustness.csv``, ``sensitivity.csv`` and ``worst_cases.csv`` (:mod:`scenarios.study.robustness`;
+then of those scored that meet each requirement in each scope by its verdict ``met`` (from the rows
+that count only: ``ok`` or ``violated``), each with its Wilson interval: :func:`requirement_table`;
+also in ``summary.md`` and printed by ``slewbench sweep``), for a Monte Carlo study the robustness tables ``robustness.csv``, ``sensitivity.csv`` and ``worst_cases.csv`` (:mod:`scenarios.study.robustness`;
 also in ``summary.md``), the resolved ``study.yaml``, the plots
 (:mod:`scenarios.study.plots`) and the interactive ``report.html`` (:mod:`scenarios.study.html`).
 
@@ -34,8 +34,8 @@ from scenarios.output.tables import (
     row_columns,
     text_cell,
 )
-from scenarios.requirements.fields import VERDICT
-from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES
+from scenarios.requirements.fields import VERDICT, is_verdict_column
+from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES, is_requirement_column
 from scenarios.study.store import claim_sweep_directory, commit_sweep_outputs
 from scenarios.study.types import Study
 
@@ -54,11 +54,15 @@ failed planner or simulation, metrics that are not physical), an ``infeasible`` 
 PROPORTION_STATISTICS = ("completed", "met", "fraction_met", "wilson_low", "wilson_high")
 """The statistics of a proportion (:func:`proportion`): rows that completed (not ``crashed``), those
 meeting the criterion, their fraction and its Wilson 95 % interval; ``robustness.csv`` adds
-``excluded``, ``requirements.csv`` ``scored`` (:data:`REQUIREMENT_STATISTICS`)."""
-REQUIREMENT_STATISTICS = ("completed", "scored", *PROPORTION_STATISTICS[1:])
+``excluded``, ``requirements.csv`` ``excluded``, ``scored``, ``not_scored`` and ``no_verdict``
+(:data:`REQUIREMENT_STATISTICS`)."""
+REQUIREMENT_STATISTICS = ("completed", "excluded", "scored", "not_scored", "no_verdict", *PROPORTION_STATISTICS[1:])
 """The columns of ``requirements.csv`` after the grouping keys and ``criterion``
-(:func:`requirement_table`): the rows that completed (not ``crashed``), those scored against the
-criterion, those meeting it, the fraction of the scored ones and its Wilson 95 % interval."""
+(:func:`requirement_table`): the rows that completed (not ``crashed``), the group's rows left out
+because they do not count (:func:`excluded_count`: ``failed``, ``infeasible``, ``crashed``, as in
+``robustness.csv``), those scored against the criterion, the rows that count without a score of it,
+those scored before per-requirement verdicts were stored (no verdict to count), those meeting it,
+the fraction of the scored ones and its Wilson 95 % interval."""
 EVERY_REQUIREMENT = "every requirement"
 """The criterion of the rows whose status is ``ok`` (``requirements.csv``, ``robustness.csv``)."""
 WILSON_Z = 1.959963984540054
@@ -141,6 +145,24 @@ def counted(row: dict[str, Any]) -> bool:
         True for a row ``ok`` or ``violated``.
     """
     return row.get("status") in COUNTED_STATUSES
+
+
+def excluded_count(rows: list[dict[str, Any]]) -> int:
+    """The rows whose values the study's tables leave out (``excluded`` in ``summary.csv``,
+    ``requirements.csv`` and the robustness tables).
+
+    Parameters
+    ----------
+    rows : list of dict
+        A group's ``cases.csv`` rows.
+
+    Returns
+    -------
+    int
+        The rows that do not count (:func:`counted`: ``failed``, ``infeasible``, ``crashed``),
+        whatever values they carry.
+    """
+    return sum(not counted(row) for row in rows)
 
 
 def metric_values(column: str, rows: list[dict[str, Any]], counted_only: bool = False) -> np.ndarray:
@@ -249,7 +271,7 @@ def summary_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], 
             never = int(np.isinf(values).sum())
             line = {k: members[0].get(k) for k in keys}
             line.update(metric=metric, count=int(finite.size), never=never if never_witness(metric) else None,
-                        no_value=int(np.isnan(values).sum()), excluded=sum(not counted(r) for r in members),
+                        no_value=int(np.isnan(values).sum()), excluded=excluded_count(members),
                         not_ok=sum(r["status"] != "ok" for r in members))
             mean = std = None
             if finite.size:
@@ -434,8 +456,8 @@ def requirement_criterion(name: str, scope: str) -> str:
 
 
 def requirement_verdicts(rows: list[dict[str, Any]]) -> list[tuple[str, str]]:
-    """The verdict columns of some ``cases.csv`` rows: per requirement, in the order the rows first
-    give them, its reference's then its closed loop's.
+    """The verdict columns of the requirements some ``cases.csv`` rows were scored against: per
+    requirement, in the order the rows first give them, its reference's then its closed loop's.
 
     Parameters
     ----------
@@ -445,17 +467,28 @@ def requirement_verdicts(rows: list[dict[str, Any]]) -> list[tuple[str, str]]:
     Returns
     -------
     list of (str, str)
-        ``(criterion, column)``: :func:`requirement_criterion` and ``<scope>.req.<name>.met``.
+        ``(criterion, column)``: :func:`requirement_criterion` and ``<scope>.req.<name>.met``, for
+        each requirement and scope with a requirement column in some row
+        (:func:`~scenarios.schema.columns.is_requirement_column`), whether or not the verdict
+        itself was stored (a store written before verdicts were has the scores only).
     """
     names: dict[str, None] = {}
-    for row in rows:
-        for column in row:
-            parts = column.split(".")
-            if len(parts) == 4 and parts[1] == REQUIREMENT_MARK and parts[3] == VERDICT:
-                names.setdefault(parts[2])
-    present = {column for row in rows for column, value in row.items() if isinstance(value, bool)}
-    return [(requirement_criterion(name, scope), column) for name in names for scope, prefix in SCOPES
-            if (column := f"{prefix}.{REQUIREMENT_MARK}.{name}.{VERDICT}") in present]
+    scoped: set[tuple[str, str]] = set()
+    for column in dict.fromkeys(column for row in rows for column in row):  # in the order first given
+        if is_requirement_column(column):
+            prefix, _, name, _ = column.split(".")
+            names.setdefault(name)
+            scoped.add((prefix, name))
+    return [(requirement_criterion(name, scope), f"{prefix}.{REQUIREMENT_MARK}.{name}.{VERDICT}")
+            for name in names for scope, prefix in SCOPES if (prefix, name) in scoped]
+
+
+def _scored_without_verdict(row: dict[str, Any], verdict_of: dict[str, str]) -> set[str]:
+    """The verdict columns a row lacks although it carries a value of that requirement's score in
+    that scope (``verdict_of``: each score column's verdict column): the row was scored before
+    per-requirement verdicts were stored."""
+    scored = {verdict_of[column] for column, value in row.items() if column in verdict_of and not is_missing(value)}
+    return {column for column in scored if not isinstance(row.get(column), bool)}
 
 
 def requirement_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
@@ -464,12 +497,19 @@ def requirement_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[st
     (:func:`wilson_interval`).
 
     The first criterion, :data:`EVERY_REQUIREMENT`, is met by a row whose status is ``ok``, among the
-    completed rows (not ``crashed``: a ``failed`` or ``violated`` row completed and does not meet it).
-    Then one criterion per requirement and scope (:func:`requirement_criterion`,
-    ``st_sun (closed loop)``), read from the verdict the scoring stored with the row's scores (the
-    column ``<scope>.req.<name>.met``, never the message): ``scored`` counts the rows with that verdict
-    (a row whose planner failed has no score; a crashed case none), ``met`` those where it is true, and
-    the fraction is of the scored rows. Cases that share a store key count once (:func:`distinct_rows`).
+    completed rows (not ``crashed``: a ``failed``, ``infeasible`` or ``violated`` row completed and
+    does not meet it), as in ``robustness.csv``. Then one criterion per requirement and scope
+    (:func:`requirement_criterion`, ``st_sun (closed loop)``), read from the verdict the scoring
+    stored with the row's scores (the column ``<scope>.req.<name>.met``, never the message), and
+    only from the rows that count (:func:`counted`: ``ok`` or ``violated``, as the summary's
+    statistics and the robustness tables take them; a ``failed`` row may carry a verdict on a
+    motion that is not physical, and is left out whatever it carries). ``scored`` counts the rows
+    that count with that verdict, ``met`` those where it is true, and the fraction is of the
+    scored rows; ``not_scored`` counts the rows that count without a score of it (no closed loop),
+    ``no_verdict`` those with its score but no verdict (a store written before verdicts were
+    stored: re-run those cases to count them). ``excluded`` is the group's rows that do not count
+    (:func:`excluded_count`: ``failed``, ``infeasible``, ``crashed``), the ``excluded`` of
+    ``robustness.csv``. Cases that share a store key count once (:func:`distinct_rows`).
 
     Parameters
     ----------
@@ -483,25 +523,63 @@ def requirement_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[st
     columns : list of str
         The grouping keys, ``criterion`` and :data:`REQUIREMENT_STATISTICS`.
     rows : list of dict
-        One per group and criterion (:data:`EVERY_REQUIREMENT` first); the fraction and the
-        interval are None without a completed (scored) row.
+        One per group and criterion (:data:`EVERY_REQUIREMENT` first, whose ``scored`` is
+        ``completed`` and ``not_scored`` and ``no_verdict`` 0); the fraction and the interval are
+        None without a completed (scored) row.
     """
     distinct = distinct_rows(study, rows)
     verdicts = requirement_verdicts(distinct)
     keys, groups = group_rows(study, distinct)
+    verdict_of = {column: f"{column.rsplit('.', 1)[0]}.{VERDICT}" for column in set().union(*distinct)
+                  if is_requirement_column(column) and not is_verdict_column(column)}
     table = []
     for members in groups.values():
         completed = [r for r in members if r["status"] != "crashed"]
-        criteria = [(EVERY_REQUIREMENT, len(completed), sum(r["status"] == "ok" for r in completed))]
+        counting = [r for r in members if counted(r)]
+        stale = [_scored_without_verdict(r, verdict_of) for r in counting]
+        criteria = [(EVERY_REQUIREMENT, len(completed), 0, 0, sum(r["status"] == "ok" for r in completed))]
         for criterion, column in verdicts:
-            scored = [r[column] for r in completed if isinstance(r.get(column), bool)]
-            criteria.append((criterion, len(scored), sum(scored)))
-        for criterion, scored_count, met in criteria:
+            scored = [r[column] for r in counting if isinstance(r.get(column), bool)]
+            no_verdict = sum(column in missing for missing in stale)
+            criteria.append((criterion, len(scored), len(counting) - len(scored) - no_verdict, no_verdict,
+                             sum(scored)))
+        for criterion, scored_count, not_scored, no_verdict, met in criteria:
             line = {k: members[0].get(k) for k in keys}
             line.update(criterion=criterion, **proportion(met, scored_count))
-            line.update(completed=len(completed), scored=scored_count)
+            line.update(completed=len(completed), excluded=excluded_count(members), scored=scored_count,
+                        not_scored=not_scored, no_verdict=no_verdict)
             table.append(line)
     return [*keys, "criterion", *REQUIREMENT_STATISTICS], table
+
+
+NO_VERDICT_TEXT = "scored before per-requirement verdicts were stored"
+"""What the outputs say of rows whose requirement scores have no verdict (``no_verdict`` in
+``requirements.csv``: a store written by an earlier slewbench)."""
+RERUN_TEXT = ("re-run the cases to count them (the study into a new directory: a resumed sweep keeps the "
+              "stored cases)")
+"""How to count the verdicts of those rows."""
+
+
+def verdict_note(requirements: tuple[list[str], list[dict[str, Any]]]) -> str | None:
+    """What ``summary.md`` and ``report.html`` say when some rows' requirements could not be counted
+    one by one, because they were scored before per-requirement verdicts were stored.
+
+    Parameters
+    ----------
+    requirements : (list of str, list of dict)
+        :func:`requirement_table`.
+
+    Returns
+    -------
+    str or None
+        ``note: ...`` naming the criteria with ``no_verdict`` rows and what to do; None when every
+        scored row has its verdicts.
+    """
+    criteria = list(dict.fromkeys(line["criterion"] for line in requirements[1] if line.get("no_verdict")))
+    if not criteria:
+        return None
+    return (f"note: some cases were {NO_VERDICT_TEXT} (no_verdict), so {', '.join(criteria)} "
+            f"{'is' if len(criteria) == 1 else 'are'} not counted in them: {RERUN_TEXT}")
 
 
 def requirement_lines(requirements: tuple[list[str], list[dict[str, Any]]]) -> list[str]:
@@ -515,23 +593,46 @@ def requirement_lines(requirements: tuple[list[str], list[dict[str, Any]]]) -> l
     Returns
     -------
     list of str
-        ``  eigenaxis: st_sun (closed loop) met in 13 of 16 cases`` (``, 2 not scored`` when some
-        completed rows have no verdict; ``no case scored`` without one, ``no completed case``
-        when every case crashed).
+        ``  eigenaxis: st_sun (closed loop) met in 13 of 16 cases``, then, for one requirement in one
+        scope, ``, 2 not scored`` (rows that count without its score), ``, 1 left out (failed,
+        infeasible or crashed)`` and ``, 3 scored before per-requirement verdicts were stored; re-run
+        the cases ...`` when there are such rows; without a scored row ``no case scored (4
+        completed, 1 left out: ...)``, or ``not counted: 4 cases scored before per-requirement
+        verdicts were stored; re-run the cases ...``; ``no completed case`` when every case crashed.
     """
     columns, table = requirements
     keys = columns[:columns.index("criterion")]
     lines = []
     for line in table:
         group = ", ".join(text_cell(line.get(k)) for k in keys)
-        if not line["scored"]:
-            lines.append(f"  {group}: {line['criterion']}: "
-                         + (f"no case scored ({line['completed']} completed)" if line["completed"] else "no completed case"))
+        head = f"  {group}: {line['criterion']}"
+        if not line["completed"]:
+            lines.append(f"{head}: no completed case")
             continue
-        unscored = line["completed"] - line["scored"]
-        lines.append(f"  {group}: {line['criterion']} met in {line['met']} of {line['scored']} case"
-                     f"{'s' if line['scored'] != 1 else ''}" + (f", {unscored} not scored" if unscored else ""))
+        stale, left = line["no_verdict"], line["excluded"] if line["criterion"] != EVERY_REQUIREMENT else 0
+        if not line["scored"]:
+            if stale:
+                lines.append(f"{head}: not counted: {stale} case{'s' if stale != 1 else ''} {NO_VERDICT_TEXT}; "
+                             f"{RERUN_TEXT}")
+            else:
+                lines.append(f"{head}: no case scored ({line['completed']} completed"
+                             + (f", {left} left out: failed, infeasible or crashed" if left else "") + ")")
+            continue
+        parts = [f"{line['not_scored']} not scored"] if line["not_scored"] else []
+        parts += [f"{left} left out (failed, infeasible or crashed)"] if left else []
+        parts += [f"{stale} {NO_VERDICT_TEXT}"] if stale else []
+        lines.append(f"{head} met in {line['met']} of {line['scored']} case{'s' if line['scored'] != 1 else ''}"
+                     + "".join(f", {part}" for part in parts) + (f"; {RERUN_TEXT}" if stale else ""))
     return lines
+
+
+REQUIREMENT_TEXT = ("every requirement: rows whose status is ok among the completed ones (not crashed); then each "
+                    "requirement in each scope, by its verdict (met), from the rows ok or violated only, as in the "
+                    "summary: the rows where it is met among those scored there. excluded: the rows left out "
+                    "(failed, infeasible, crashed) whatever verdicts they carry; not_scored: rows ok or violated "
+                    f"without its score; no_verdict: rows {NO_VERDICT_TEXT}. With the Wilson 95 % interval of the "
+                    "fraction.")
+"""The explanation of the requirements table in ``summary.md`` and ``report.html``."""
 
 
 def _table_lines(columns: list[str], rows: list[dict[str, Any]]) -> list[str]:
@@ -554,10 +655,8 @@ def _markdown(study: Study, columns: list[str], rows: list[dict[str, Any]], miss
                  "over the count rows; median, p5, p95 (linear percentiles), min and max over those and the never "
                  "rows as inf; not_ok: rows whose status is not ok (violated, failed, infeasible or crashed)."), ""]
     if requirements is not None:
-        out += ["## Cases meeting the requirements", "",
-                ("every requirement: rows whose status is ok among the completed ones (not crashed); then each "
-                 "requirement in each scope, by its verdict (met): the rows where it is met among those scored "
-                 "there. With the Wilson 95 % interval of the fraction."), ""]
+        note = verdict_note(requirements)
+        out += ["## Cases meeting the requirements", "", REQUIREMENT_TEXT, "", *([note, ""] if note else [])]
         out += _table_lines(*requirements) + [""]
     if robustness:
         out += [robustness]

@@ -51,8 +51,8 @@ from scenarios.study.report import (
     INFINITY_TEXT,
     PROPORTION_STATISTICS,
     WILSON_Z,
-    counted,
     distinct_rows,
+    excluded_count,
     group_rows,
     metric_values,
     proportion,
@@ -60,21 +60,21 @@ from scenarios.study.report import (
 from scenarios.study.types import Study
 
 __all__ = ["ROBUSTNESS_STATISTICS", "SENSITIVITY_STATISTICS", "WORST_COLUMNS", "crashed_counts",
-           "criterion_text", "excluded_count", "holm", "parameter_columns",
+           "criterion_text", "holm", "parameter_columns",
            "proportion_table", "rank_significance", "robustness_lines", "robustness_markdown", "sensitivity_table", "spearman",
            "worst_table"]
 
 ROBUSTNESS_STATISTICS = (PROPORTION_STATISTICS[0], "excluded", *PROPORTION_STATISTICS[1:])
 """The columns of ``robustness.csv`` after the grouping keys and ``criterion``: a proportion's
-(:data:`~scenarios.study.report.PROPORTION_STATISTICS`) with ``excluded``
-after ``completed`` (:func:`excluded_count`: the ``failed`` and ``infeasible`` ones among them
-are completed and meet no criterion)."""
+(:data:`~scenarios.study.report.PROPORTION_STATISTICS`) with ``excluded`` after ``completed``
+(:func:`~scenarios.study.report.excluded_count`: the ``failed`` and ``infeasible`` ones among
+them are completed and meet no criterion)."""
 SENSITIVITY_STATISTICS = ("cases", "excluded", "spearman_rho", "rho_low", "rho_high", "p_value", "p_holm",
                           "significant")
 """The columns of ``sensitivity.csv`` after the grouping keys, ``metric``, ``parameter`` and ``draw``:
 the rows that count with a value of the metric or that never reached one (+inf, the largest rank),
-the group's rows left out (:func:`excluded_count`), the rank correlation (None when either side
-does not vary), its 95 % interval and two-sided p-value (:func:`rank_significance`), the p-value
+the group's rows left out (:func:`~scenarios.study.report.excluded_count`), the rank correlation
+(None when either side does not vary), its 95 % interval and two-sided p-value (:func:`rank_significance`), the p-value
 adjusted over the group's correlations (:func:`holm`) and whether that is at most
 :data:`SIGNIFICANCE`."""
 SIGNIFICANCE = 0.05
@@ -92,7 +92,7 @@ SMALL_SAMPLE = 30
 """Below this many cases ``summary.md`` says how large a rank correlation must be to be significant."""
 WORST_COLUMNS = ("metric", "rank", "case", "seed", "value", "status", "excluded")
 """The columns of ``worst_cases.csv`` after the grouping keys (``excluded``: the group's rows left
-out of the ranking, :func:`excluded_count`)."""
+out of the ranking, :func:`~scenarios.study.report.excluded_count`)."""
 MIN_CASES = 3
 """Fewest rows a rank correlation is computed from."""
 NOT_OK_LISTED = 20
@@ -117,23 +117,6 @@ def criterion_text(metric: str, sense: str, bound: float) -> str:
         The metric, ``<=`` or ``>=``, and the bound (``%g``).
     """
     return f"{metric} {'<=' if sense == 'at_most' else '>='} {bound:g}"
-
-
-def excluded_count(rows: list[dict[str, Any]]) -> int:
-    """The rows whose metric values the robustness tables leave out, as ``summary.csv`` does.
-
-    Parameters
-    ----------
-    rows : list of dict
-        A group's ``cases.csv`` rows.
-
-    Returns
-    -------
-    int
-        The rows that do not count (:func:`scenarios.study.report.counted`: ``failed``,
-        ``infeasible``, ``crashed``), whatever values they carry.
-    """
-    return sum(not counted(row) for row in rows)
 
 
 def proportion_table(study: Study, rows: list[dict[str, Any]]) -> tuple[list[str], list[dict[str, Any]]]:
