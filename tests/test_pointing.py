@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from ocp.geometry import PointingConstraint, PointingScore, violation_intervals
+from ocp.geometry.pointing import FINE_STEP, HermiteMotion
 
 W = 0.1          # rad/s, the sweep rate
 ALPHA = 0.3      # rad, the cone's half-angle
@@ -194,3 +195,20 @@ def test_the_casadi_expression_of_a_fixed_direction():
     for q in sweep(T[::50]):
         expected = (rotation_by_hand(q) @ [1.0, 0.0, 0.0]) @ Y[0] - np.cos(ALPHA + 0.05)
         assert float(g(q)) == pytest.approx(expected, abs=1e-14)
+
+
+@pytest.mark.parametrize("times", [[0.0, 1.0, 1.001, 3.0], [0.0, 1.0, 1.0, 2.5]], ids=["increasing", "repeated"])
+def test_a_motions_sample_steps_by_hand(times):
+    """The steps between a motion's samples as the search cuts them, per step: its length, the rate
+    bound of the sample interval holding it (at a repeated time the later interval, as
+    ``HermiteMotion.interval`` says) and ``max(4, ceil(turn rate x length / FINE_STEP))``, written out
+    step by step here."""
+    t = np.asarray(times)
+    rates = np.array([[0.0, 0.0, 0.1], [0.0, 0.02, 0.1], [0.01, 0.0, 0.2], [0.0, 0.0, 0.05]])
+    motion = HermiteMotion(t, sweep(t), rates)
+    h, bound, fine = motion.sample_steps
+    for k in range(len(t) - 1):
+        holding = max(i for i in range(len(t) - 1) if t[i] <= t[k])  # the later interval at a repeat
+        assert h[k] == t[k + 1] - t[k]
+        assert bound[k] == motion.rate_bound[holding]
+        assert fine[k] == max(4, int(np.ceil(motion.turn_rate[holding] * (t[k + 1] - t[k]) / FINE_STEP)))

@@ -163,11 +163,22 @@ class HermiteMotion:
         at = np.minimum(np.maximum(np.atleast_1d(np.asarray(times, dtype=float)), t[0]), t[-1])
         if len(t) == 1:
             return np.repeat(self.unit, len(at), axis=0)
-        k = np.minimum(np.maximum(np.searchsorted(t, at, side="right") - 1, 0), len(t) - 2)
-        s = ((at - t[k]) * self._inverse_h[k])[:, None]
+        k = t.searchsorted(at, side="right")
+        k -= 1
+        np.minimum(np.maximum(k, 0, out=k), len(t) - 2, out=k)
+        s = at - t[k]
+        s *= self._inverse_h[k]
+        s = s[:, None]
         c = self._cubic[k]
-        value = ((c[:, 3] * s + c[:, 2]) * s + c[:, 1]) * s + c[:, 0]
-        return np.asarray(value / np.sqrt(np.einsum("ij,ij->i", value, value))[:, None], dtype=float)
+        # Horner in place: ((c3 s + c2) s + c1) s + c0, the same operations and values, fewer temporaries
+        value = c[:, 3] * s
+        value += c[:, 2]
+        value *= s
+        value += c[:, 1]
+        value *= s
+        value += c[:, 0]
+        value /= np.sqrt(np.einsum("ij,ij->i", value, value))[:, None]
+        return value
 
     def interval(self, times: ArrayLike) -> NDArray[np.intp]:
         """The sample interval holding each time (the later one at a sample; clipped to the span).
@@ -191,8 +202,9 @@ class HermiteMotion:
         the turn between its samples (samples whose rates do not match their attitudes: the
         interpolant still turns); what sizes the sub-grid of :func:`search_between_samples`."""
         h = np.diff(self.t)
-        norms = np.linalg.norm(self.omega, axis=1)
-        chord = 2.0 * np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", self.q[:-1], self.q[1:])), 0.0, 1.0))
+        norms = np.sqrt(np.add.reduce(self.omega * self.omega, axis=1))  # np.linalg.norm's own sum, without its overhead
+        cosine = np.abs(np.einsum("ij,ij->i", self.q[:-1], self.q[1:]))
+        chord = 2.0 * np.arccos(np.minimum(np.maximum(cosine, 0.0, out=cosine), 1.0, out=cosine), out=cosine)
         return np.maximum(np.maximum(norms[:-1], norms[1:]), np.divide(chord, h, out=np.zeros_like(h), where=h > 0.0))
 
     @cached_property
@@ -204,7 +216,11 @@ class HermiteMotion:
     def sample_steps(self) -> tuple[Array, Array, Array]:
         """The steps between the samples as :func:`search_between_samples` cuts them: their lengths,
         :attr:`rate_bound` and the sub-grid steps of at most :data:`FINE_STEP` (at least 4)."""
-        return _knot_steps(self, self.t)
+        if not self.increasing:  # a repeated time: the lookup of _knot_steps picks the later interval
+            return _knot_steps(self, self.t)
+        # strictly increasing samples: each step is its own sample interval, as _knot_steps finds it
+        h = np.diff(self.t)
+        return h, self.rate_bound, np.maximum(4, np.ceil(self.turn_rate * h / FINE_STEP)).astype(int)
 
     @cached_property
     def unit(self) -> Array:
@@ -374,7 +390,8 @@ def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], thr
     speed = bound + drift  # per step between knots
     # the heads of groups of knot steps, evaluated first: every SAMPLE_GROUP-th knot, the edges, and
     # each knot where the bound's sum over the steps passes a multiple of GROUP_REACH
-    turned = np.concatenate([[0.0], np.cumsum(speed * h)]) // GROUP_REACH
+    moved = speed * h  # the bound's integral over each knot step
+    turned = np.concatenate([[0.0], np.cumsum(moved)]) // GROUP_REACH
     head = np.zeros(count, dtype=bool)
     head[::SAMPLE_GROUP] = head[-1] = True
     head[1:] |= turned[1:] != turned[:-1]
@@ -384,7 +401,7 @@ def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], thr
     if not np.any(np.isfinite(at_heads)):
         return knots[heads], at_heads
     sizes = np.diff(heads)
-    reach = np.add.reduceat(speed * h, heads[:-1])  # the bound's integral over each group
+    reach = np.add.reduceat(moved, heads[:-1])  # the bound's integral over each group
     with np.errstate(invalid="ignore"):
         crossing = _may_cross(at_heads[:-1], at_heads[1:], reach, threshold, -np.inf)
         deeper = _may_cross(at_heads[:-1], at_heads[1:], reach, -np.inf, float(np.nanmin(at_heads)))
@@ -671,9 +688,18 @@ class PointingConstraint:
     def _table_at(self, t: Array) -> Array:
         """(N, 4): the direction (not normalised) and the growth at ``t``, interpolated linearly
         between the table's rows (one lookup for both) and held beyond them."""
-        row = np.minimum(np.maximum(np.searchsorted(self.times, t, side="right") - 1, 0), len(self.times) - 2)
-        weight = np.minimum(np.maximum((t - self.times[row]) * self._table_slopes[1][row], 0.0), 1.0)[:, None]
-        return np.asarray(self._table_slopes[0][row] + weight * self._table_slopes[2][row], dtype=float)
+        times = self.times
+        rows, inverse_steps, differences = self._table_slopes
+        row = times.searchsorted(t, side="right")
+        row -= 1
+        np.minimum(np.maximum(row, 0, out=row), len(times) - 2, out=row)
+        weight = t - times[row]
+        weight *= inverse_steps[row]
+        np.minimum(np.maximum(weight, 0.0, out=weight), 1.0, out=weight)
+        table = differences[row]  # in place, fewer temporaries: the same operations, the same values
+        table *= weight[:, None]
+        table += rows[row]
+        return table
 
     @cached_property
     def _table_slopes(self) -> tuple[Array, Array, Array]:
@@ -723,12 +749,16 @@ class PointingConstraint:
         # R(q) b |q|² as a quadratic form of q (one array op), over |q|²: the attitude of q / |q|
         pointing = np.einsum("mij,mj->mi", (q @ self._rotation_form).reshape(len(q), 3, 4), q)
         if table is None:
-            cosine = pointing @ self.directions[0] / np.einsum("ij,ij->i", q, q)
+            cosine = pointing @ self.directions[0]
+            cosine /= np.einsum("ij,ij->i", q, q)
         else:
             direction = table[:, :3]
-            cosine = np.einsum("ij,ij->i", pointing, direction) / (
-                np.einsum("ij,ij->i", q, q) * np.sqrt(np.einsum("ij,ij->i", direction, direction)))
-        return np.asarray(np.arccos(np.minimum(np.maximum(cosine, -1.0), 1.0)), dtype=float)
+            scale = np.sqrt(np.einsum("ij,ij->i", direction, direction))
+            scale *= np.einsum("ij,ij->i", q, q)
+            cosine = np.einsum("ij,ij->i", pointing, direction)
+            cosine /= scale
+        # in place: the same operations, the same values, fewer temporaries
+        return np.arccos(np.minimum(np.maximum(cosine, -1.0, out=cosine), 1.0, out=cosine), out=cosine)
 
     @cached_property
     def _rotation_form(self) -> Array:
@@ -782,11 +812,19 @@ class PointingConstraint:
         q = np.atleast_2d(np.asarray(q, dtype=float))
         if self.moving:
             table = self._table_at(t)  # one lookup for the direction and the limit
-            excess = self._angles(t, q, table) - (self.angle + table[:, 3])
+            limit = table[:, 3]
+            limit += self.angle
         else:
-            excess = self._angles(t, q, None) - self.limit(t)[0]
-        margin = excess if self.keep_out else -excess
-        return np.where((t >= self.window[0]) & (t <= self.window[1]), margin, np.nan)
+            table, limit = None, self.limit(t[:1])[0]
+        margin = self._angles(t, q, table)  # in place from here: the same operations, the same values
+        margin -= limit
+        if not self.keep_out:
+            np.negative(margin, out=margin)
+        start, end = self.window
+        inside = t >= start
+        inside &= t <= end
+        margin[~inside] = np.nan
+        return margin
 
     def score(self, t: ArrayLike, q: ArrayLike) -> PointingScore:
         """Score a sampled motion against the constraint.

@@ -2,35 +2,24 @@
 OVERHEAD_BUDGET).
 
 Issue 27 set 10 % of a run's wall time, met while every requirement was scored at the samples
-alone. Scoring between the samples (the closed loop's pointing, then the reference's pointing and
-both scopes' final error: a narrow cone crossed between two samples was missed and the row ok) and
-the reference demand's RK4 sub-steps cost more: +56..60 % on 191ba78, +69..89 % on fcaf45b. The
-search between samples was then rebuilt (``ocp.geometry.pointing.search_between_samples``: one
-search for the pointing margins and the final error, all intervals at once, a rate bound of the
-interpolant that is a bound, samples evaluated by groups of 16 where the bound clears a group, one
-interpolant per row). Measured on 2026-12-02, this benchmark run alternately in two worktrees
-(load 2.6-7 on 2 cores; overhead = median of the pairs' ratios, wall): +43.6, +47.0, +59.8, +42.8,
-+52.2, +49.7 % (median 48 %) against +74.1, +69.3, +68.7, +89.2, +75.7 % on fcaf45b (median 74 %);
-CPU, 32 pairs each: +52.3 % against +67.7 %. The pointing scores' CPU per run 37 ms against 73 ms;
-the rest of the scoring, about 42 ms a run (the environment's torque along the reference, the
-actuator demand and its unrealised torque), is not the search's. Those three then went through a
-model's functions mapped over chunks of 512 samples, built once per model, with reusable buffers
-(``controllers.allocation.model_rows``: building ``map(N)`` per call and converting the matrices
-to CasADi's cost more than the evaluation): their CPU a run 14-15 ms against 33-36 ms on bc355f1
-(the demand alone 9 against 10-11 ms), the scores bit for bit those of bc355f1. Measured on
-2026-12-02 (load 2.5-10 on 2 cores), this benchmark run alternately in two worktrees: +38.1, +35.9,
-+48.0, +34.0, +36.6, +35.6 % (median 36 %) against +42.4, +57.0, +49.8, +56.9, +49.3, +56.7 % on
-bc355f1 (median 53 %); CPU, 40 pairs each, two processes taking turns pair by pair: +38.5 % (pairs
-+7.5..+74.2 %) against +50.4 %; the scoring's CPU 71 ms a run against 95 ms. The 10 % target is
-not held (what is left: the pointing search, about 30 ms, and the demand's Runge-Kutta
-sub-steps). The budget is 1.25 times the largest run (1.7 times the median). Estimated, not
-measured: fcaf45b's search back (36 ms more a run, at about 185 ms a run without scoring) gives
-about +58 %, failing it about half the time; bc355f1's runs pass it. A row's pointing searches then
-went through their zooms together (``ocp.geometry.pointing.scores_between_samples``, each search's
-points those alone; the steps between the samples computed once per motion): the 18 pointing
-scores 17.3 against 24.2 ms CPU a run on 03fa46d (paired ratio 0.78), the scores bit for bit those
-of 03fa46d; measured under load 5-8 on 2 cores, the benchmark's overhead did not resolve the
-difference (docs/performance.rst).
+alone. Scoring between the samples (pointing, final error) and the demand's Runge-Kutta sub-steps
+took it to +69..89 % (fcaf45b); one search over all intervals with a true rate bound, the models'
+mapped functions built once, and a row's searches zoomed together brought it to about +30 %
+(03fa46d: +29 %, median of 4 runs). History and profiles: docs/performance.rst
+("Scoring requirements between the samples").
+
+Measured on 2026-12-03 (load 3.4-8 on 2 cores), against 60119e1: this benchmark run alternately on
+both (15 pairs a run, wall): +28.2, +19.1, +26.9, +26.9 % (median 26.9 %) against +20.1, +18.8,
++23.9, +25.5 % on 60119e1 (median 22.0 %): not resolved. CPU, four alternate processes of 10 pairs
+each: overhead +23.0, +19.0, +20.4, +18.5 % against +26.6, +14.4, +19.3, +25.0 %; the scoring
+calls' own CPU 46-55 ms a run against 51-66 ms. The pointing scores alone (one process taking
+60119e1's module and this one in turn, 100 and 150 pairs): paired ratio 0.966 and 0.972, the 18
+scores bit for bit. The 10 % target is not met; the scoring's CPU a run (about 50 ms) is the
+pointing searches about 20 ms (NumPy call overhead: some 90 margin evaluations of 60-1300 points,
+35 array operations each), the actuator demand about 12 ms, the environment's torque about 6 ms and
+the unrealised torque about 2.4 ms (CasADi evaluation through
+``controllers.allocation.model_rows``), the interpolants about 2.5 ms. The budget (1.25 times the
+largest run seen before the last changes) guards against the search's old cost returning.
 
 The 12U CubeSat Sun keep-out scenario without its collocation row (the fast planners, where scoring
 weighs most), with three pointing requirements (the star tracker off the Sun and the Moon, an
