@@ -71,13 +71,16 @@ def product(p: ArrayLike, q: ArrayLike) -> Array:
     (..., 4) ndarray
         The product, scalar first.
     """
-    p = np.asarray(p, dtype=float)
-    q = np.asarray(q, dtype=float)
-    p0, pv = p[..., :1], p[..., 1:]
-    q0, qv = q[..., :1], q[..., 1:]
-    scalar = p0 * q0 - np.sum(pv * qv, axis=-1, keepdims=True)
-    vector = p0 * qv + q0 * pv + np.cross(pv, qv)
-    return np.concatenate([scalar, vector], axis=-1)
+    p, q = np.broadcast_arrays(np.asarray(p, dtype=float), np.asarray(q, dtype=float))
+    p0, p1, p2, p3 = (p[..., i] for i in range(4))
+    q0, q1, q2, q3 = (q[..., i] for i in range(4))
+    out = np.empty(p.shape)
+    # written out (np.cross costs more than the product): p0 q0 - pv·qv, p0 qv + q0 pv + pv × qv
+    out[..., 0] = p0 * q0 - (p1 * q1 + p2 * q2 + p3 * q3)
+    out[..., 1] = p0 * q1 + q0 * p1 + (p2 * q3 - p3 * q2)
+    out[..., 2] = p0 * q2 + q0 * p2 + (p3 * q1 - p1 * q3)
+    out[..., 3] = p0 * q3 + q0 * p3 + (p1 * q2 - p2 * q1)
+    return out
 
 
 def conjugate(q: ArrayLike) -> Array:
