@@ -237,3 +237,40 @@ def test_a_reference_asking_no_torque_is_scored_without_dividing_by_it():
     assert _actuators(0.9, {}, t, [], np.array([[1e-18, 0.0, 0.0], [0.0, 0.0, 0.0]]), zero).met
     score = _actuators(0.9, {}, t, [], np.array([[0.0, 0.0, 0.0], [0.0, 2e-6, 0.0]]), zero)
     assert not score.met and score.detail.startswith("2e-06 N m of the torque asked at 1 s is given by no")
+
+
+SPINNING = """
+name: spinning
+spacecraft:
+  inertia: [10.0, 10.0, 10.0]
+  wheels: {max_torque: 0.1, max_momentum: 1.0}
+maneuver:
+  duration: 200.0
+  initial: {q: [1, 0, 0, 0], omega: [SPIN, 0, 0]}
+  final: {q: [0.7071068, 0, 0, 0.7071068], omega: [0, 0, 0]}
+planners:
+  - {name: eigenaxis, label: smooth, options: {profile: smooth}}
+controller: {name: augmented_quaternion_feedback, options: {kp: 0.5, kd: 3.0}}
+simulation: {sample_time: 0.5, duration: 260.0}
+"""
+
+
+@pytest.mark.parametrize("spin, ok", [(0.2, False), (0.05, True)])
+def test_a_free_start_from_a_spin_counts_the_spins_momentum_in_the_wheels(tmp_path, spin, ok):
+    """A user's case: an eigenaxis slew (a declared free start: it starts at rest) of a sphere
+    spinning at ``spin`` about x. No external torque acts, so the total angular momentum stays
+    I ω₀ = 10 spin N m s along inertial x; along a reference at rest at both ends the body-axis
+    wheels hold all of it, on x at the start and on -y at the end (90° about z): a peak of
+    10 spin per wheel, beside the slew's own I ω_ref about z (0.147 N m s, 1.875 × 90° / 200 s for
+    the quintic). At 0.2 rad/s that is 2 N m s against 1: no wheel can bring the body to rest
+    (it was scored 0.147, the slew's alone, and ok)."""
+    from scenarios.runner import run
+    from scenarios.schema.loader import load
+
+    path = tmp_path / "spinning.yaml"
+    path.write_text(SPINNING.replace("SPIN", str(spin)))
+    row = run(load(path)).rows[0]
+    assert row.requirements["reference"]["actuators"]["wheels_momentum"] == pytest.approx(10 * spin / 1.0, rel=1e-6)
+    assert (row.status == "ok") == ok, row.message
+    if not ok:
+        assert "wheels_momentum 2 x its limit" in row.message

@@ -363,7 +363,8 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
     ``omega0`` free (:attr:`planners.Reference.free_boundary`: natural motion's spin-up, the spin
     extremals' transverse rates, an eigenaxis slew from a spinning state): that start is an initial
     tracking error the closed loop absorbs, reported as ``ref.initial_rate_error`` and scored in the
-    closed loop, not an actuator demand of the reference; and across each of the reference's
+    closed loop, not an impulse the reference asks for (the momentum it carries still counts in the
+    wheels': :func:`score_reference`); and across each of the reference's
     breakpoints (:attr:`planners.Reference.breakpoints`, where ``ω`` may jump: natural motion's step
     stop). A change of more than :data:`~planners.reference.JUMP_TOLERANCE` across a breakpoint, beyond what ``ω̇``
     explains over the instant either side sampled, is a jump.
@@ -570,6 +571,13 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         for _, index, jump in jumps:
             if index < demand_t.size:
                 steps[index] += jump
+        if demand_t.size and not any(index == 0 for _, index, _ in jumps):
+            # A declared free start (rate_jumps) is no torque demand, but the momentum it carries is:
+            # the total angular momentum is the spacecraft's own at t = 0, I ω₀ + A h₀, whatever rate
+            # the reference starts from, so the wheels take up I (ω₀ − ω_ref(0)) however the closed
+            # loop absorbs the difference (a body spinning with more momentum than the wheels hold
+            # cannot be brought to rest by them).
+            steps[0] += omega[0] - np.asarray(problem.omega0, dtype=float)
         # The actuators' share: the reference's torque u (of I ω̇ = −ω × I ω + u, the environment
         # it models inside) less the environment's torque along it (a planner that models none, such
         # as eigenaxis, leaves the actuators a disturbance to cancel; one that does, its own model).
