@@ -3,7 +3,10 @@ and the published Radau IIA nodes.
 
 Oracles: Wächter & Biegler (2006), eq. (5) and section 3.8, with IPOPT's defaults: the overall error
 ``max(‖∇f + Jᵀλ + z‖∞ / s_d, ‖c‖∞, ‖complementarity‖∞ / s_c)`` with
-``s_d = max(s_max, (‖λ‖₁ + ‖z‖₁) / (m + n)) / s_max``, ``s_max = 100``; the gradient-based scaling
+``s_d = max(s_max, (‖λ‖₁ + ‖z‖₁) / (m + n_b)) / s_max``, ``s_max = 100``, ``m`` the constraint rows
+and ``n_b`` the finite bounds of the variables that are not fixed, a variable's lower and upper
+bound counted apart (``ocp.nlp.certificate.kkt_residuals``; the paper's ``n`` bounds every variable
+once); the gradient-based scaling
 ``s = min(1, 100 / ‖∇‖∞)`` of the objective and of each constraint row (``nlp_scaling_max_gradient``),
 worked by hand on small NLPs; IPOPT's own reported dual infeasibility (``inf_du``, scaled) where the
 objective scaling is 1; the Radau IIA nodes of degree 3, ``(4 ∓ √6) / 10`` and 1."""
@@ -38,6 +41,18 @@ def test_large_multipliers_divide_the_stationarity_by_s_d_by_hand():
     # small multipliers: s_d = 1, the scaled error is the stationarity itself
     small = kkt_residuals(solver, [0.6, 0.5], [0.0, 0.0], [-1.0], lbg=1.0, ubg=1.0)
     assert small.scaled == pytest.approx(0.2, rel=1e-12)
+
+
+def test_s_d_counts_the_rows_and_the_finite_bounds_of_the_moving_variables_by_hand():
+    # The NLP above with a third variable w fixed at 0 (lbx = ubx: no multiplier of its own in IPOPT,
+    # which removes it), x in [−10, 10] and y unbounded: m = 1 row, n_b = 2 finite bounds (x's two),
+    # so s_d = max(100, 500 / 3) / 100 = 5 / 3 and the scaled error 499 × 3 / 5 = 299.4 (with m + n =
+    # 4 it would be 499 / 1.25; counting w's bounds too, m + 4 = 5, 499 / 1).
+    solver = small_nlp(lambda x: x[0] ** 2 + x[1] ** 2, lambda x: x[0] + x[1], n=3)
+    kkt = kkt_residuals(solver, [0.6, 0.5, 0.0], [0.0, 0.0, 0.0], [-500.0], lbg=1.0, ubg=1.0,
+                        lbx=[-10.0, -np.inf, 0.0], ubx=[10.0, np.inf, 0.0])
+    assert kkt.stationarity == pytest.approx(499.0) and kkt.objective_scaling == 1.0
+    assert kkt.scaled == pytest.approx(499.0 * 3.0 / 5.0, rel=1e-12)
 
 
 def test_a_steep_constraint_row_is_scaled_once_by_hand():

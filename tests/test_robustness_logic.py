@@ -3,7 +3,9 @@ adjustment worked by hand, exact p-values by enumerating every pairing with SciP
 the permutation test against the exact enumeration of 9! pairings, the t approximation against
 ``scipy.stats.spearmanr``'s p-value, Fisher's interval with the Bonett-Wright standard error from the
 published formula, and the critical correlations against Zar's table (Biostatistical Analysis,
-table B.20: two-tailed 5 %, n = 6 to 12: 0.886, 0.786, 0.738, 0.683, 0.648, 0.618, 0.587)."""
+table B.20: two-tailed 5 %, n = 6 to 12: 0.886, 0.786, 0.738, 0.683, 0.648, 0.618, 0.587), and
+the permutation range's critical correlation by Phipson & Smyth's rule worked by hand on 40
+constructed pairings."""
 import itertools
 import math
 
@@ -84,17 +86,41 @@ def test_critical_correlations_are_zars_table():
     assert critical_rho(4) is None and critical_rho(5) == 1.0
 
 
-def test_the_critical_correlation_of_the_permutation_range_counts_the_observed_pairing():
-    """From 9 to 49 cases the p-value is Phipson & Smyth's (2010) (1 + b) / (1 + m) over the seeded
-    random pairings (the observed one counted, so never 0): critical_rho(n) is the least null value
-    whose p by that rule is at most 5 %. Recomputed here from the same seeded draws (the rule is the
-    oracle; at n = 25 it differs by one step of rho from the rule b / m)."""
-    n = 25
-    ranks = np.arange(n, dtype=float) - (n - 1) / 2.0
-    pairings = np.random.default_rng(0).permuted(np.tile(np.arange(n), (PERMUTATIONS, 1)), axis=1)
-    null = np.abs(ranks[pairings] @ ranks) / (ranks @ ranks)
-    values = np.unique(null)
-    p = np.array([(1 + np.sum(null >= v - 1e-12)) / (1 + PERMUTATIONS) for v in values])
-    assert critical_rho(n) == pytest.approx(values[p <= SIGNIFICANCE].min(), abs=1e-12)
-    plain = np.array([np.sum(null >= v - 1e-12) / PERMUTATIONS for v in values])
-    assert values[plain <= SIGNIFICANCE].min() < critical_rho(n)  # the rule matters at this n
+class _Pairings:
+    """Stands in for ``np.random.default_rng(0)``: its ``permuted`` returns the pairings given."""
+
+    def __init__(self, pairings: list[tuple[int, ...]]) -> None:
+        self.pairings = np.array(pairings)
+
+    def permuted(self, tiled: np.ndarray, axis: int) -> np.ndarray:
+        assert axis == 1 and tiled.shape == self.pairings.shape  # PERMUTATIONS rows of the n ranks
+        return self.pairings.copy()
+
+
+# Nine ranks: a pairing's rho is 1 − 6 Σd² / (9 (9² − 1)) = 1 − Σd² / 120.
+_SWAP_01 = (1, 0, 2, 3, 4, 5, 6, 7, 8)  # Σd² = 2: rho = 59/60
+_SWAP_02 = (2, 1, 0, 3, 4, 5, 6, 7, 8)  # Σd² = 8: rho = 14/15
+_REVERSED = tuple(range(8, -1, -1))  # rho = −1, as extreme as the identity two-sided
+_UNRELATED = (0, 2, 6, 8, 7, 5, 4, 3, 1)  # d = 0 1 4 5 3 0 2 4 7, Σd² = 120: rho = 0
+
+
+@pytest.mark.parametrize("first, second, expected", [(_SWAP_01, _SWAP_02, 59.0 / 60.0), (_REVERSED, _SWAP_02, 1.0)])
+def test_the_critical_correlation_of_the_permutation_range_counts_the_observed_pairing(monkeypatch, first, second,
+                                                                                         expected):
+    """From 9 to 49 cases the p-value is Phipson & Smyth's (2010) ``(1 + b) / (1 + m)``, ``b`` of
+    the ``m`` random pairings at least as extreme (the observed one counted, so never 0), and
+    critical_rho(n) the least null magnitude whose p is at most 5 %. By hand with m = 40 constructed
+    pairings of 9 ranks: one of magnitude ``|rho1|``, one of 14/15, 38 of 0. ``|rho1|`` has
+    p = (1 + 1) / 41 = 0.049, 14/15 has (1 + 2) / 41 = 0.073: the critical value is ``|rho1|``.
+    The rule ``b / m`` would give 2/40 = 0.05 at 14/15 and return 14/15; a one-sided count (rho1 =
+    −1 taken as less extreme than 14/15) would too."""
+    from scenarios.study import robustness
+
+    assert SIGNIFICANCE == 0.05  # the hand computation's level
+    pairings = [first, second] + [_UNRELATED] * 38
+    monkeypatch.setattr(robustness, "PERMUTATIONS", len(pairings))
+    monkeypatch.setattr(np.random, "default_rng", lambda seed: _Pairings(pairings))
+    assert critical_rho(9) == pytest.approx(expected, abs=1e-12)
+    # a second pairing as extreme as the first: 3/41 > 5 % already at the largest, nothing significant
+    pairings = [first, first, second] + [_UNRELATED] * 37
+    assert critical_rho(9) is None

@@ -154,7 +154,7 @@ def dense_reduced_curvatures(solver, x, lam_x, lam_g, *, p=None, lbx=-np.inf, ub
                              tolerance=1e-6, scale=1e-6):
     """The eigenvalues of ∇²L on Z (the module's subspace: strongly active rows and bounds, multiplier
     above ``tolerance``), densely: an SVD null space of the active rows on the free variables, and the
-    threshold δ = ``scale`` × max(1, ‖H_FF‖∞). Independent of the module's linear algebra."""
+    threshold δ = ``scale`` × ‖H_FF‖∞ (× 1 when H_FF = 0). Independent of the module's linear algebra."""
     import scipy.linalg
 
     p = np.zeros(solver.nnz_in("p")) if p is None else p
@@ -174,7 +174,8 @@ def dense_reduced_curvatures(solver, x, lam_x, lam_g, *, p=None, lbx=-np.inf, ub
     A = J[np.ix_(strongly_active(g, lbg, ubg, lam_g), free)]
     H_free = H[np.ix_(free, free)]
     Z = scipy.linalg.null_space(A) if A.shape[0] else np.eye(int(free.sum()))
-    return np.linalg.eigvalsh(Z.T @ H_free @ Z), scale * max(1.0, float(np.max(np.sum(np.abs(H_free), axis=1))))
+    norm = float(np.max(np.sum(np.abs(H_free), axis=1)))
+    return np.linalg.eigvalsh(Z.T @ H_free @ Z), scale * (norm if norm > 0.0 else 1.0)
 
 
 def bilimoria_wie_coarse(perturbation):
@@ -285,7 +286,8 @@ def test_a_problem_without_the_solver_derivatives_is_not_checked():
     assert not check.certified and "no derivatives" in check.message and "more" not in check.message
 
 
-def random_qp(seed, negative, n=60, fixed=8, equalities=20, active=6, inactive=5, duplicate=False, vertex=False):
+def random_qp(seed, negative, n=60, fixed=8, equalities=20, active=6, inactive=5, duplicate=False, vertex=False,
+              scale=1.0):
     """A sparse random QP and a KKT point of it whose Hessian has ``negative`` negative eigenvalues on
     the null space Z of its strongly active rows and bounds, by construction: ``fixed`` variables at
     a bound with a multiplier pushing against it (the Hessian there strongly negative: it must not
@@ -295,7 +297,8 @@ def random_qp(seed, negative, n=60, fixed=8, equalities=20, active=6, inactive=5
     Hessian on the free variables is ``Z Λ Zᵀ + Y B Yᵀ + Z C Yᵀ + Y Cᵀ Zᵀ`` with ``Y`` the range of
     the active rows' transpose and ``Λ`` the chosen eigenvalues (magnitudes 0.1 to 10), ``B`` and
     ``C`` random (indefinite: only Z's block decides). ``duplicate``: an active row repeated (the rows
-    dependent); ``vertex``: as many active rows as free variables (Z = {0}), the Hessian indefinite."""
+    dependent); ``vertex``: as many active rows as free variables (Z = {0}), the Hessian indefinite;
+    ``scale``: the objective and so the multipliers times this (the same point, the same curvature signs)."""
     import scipy.linalg
     import scipy.sparse
 
@@ -342,11 +345,11 @@ def random_qp(seed, negative, n=60, fixed=8, equalities=20, active=6, inactive=5
     lbg[rows:], ubg[rows:] = g[rows:] - 1.0, g[rows:] + 1.0
     c = -(H @ x + A.T @ lam_g + lam_x)  # stationarity: ∇f + Aᵀ λ_g + λ_x = 0
     variables = ca.SX.sym("x", n)
-    f = 0.5 * ca.dot(variables, ca.mtimes(ca.DM(H), variables)) + ca.dot(ca.DM(c), variables)
+    f = scale * (0.5 * ca.dot(variables, ca.mtimes(ca.DM(H), variables)) + ca.dot(ca.DM(c), variables))
     solver = ca.nlpsol("qp", "ipopt", {"x": variables, "f": f, "g": ca.mtimes(ca.DM(A), variables)},
                        solver_options("ipopt", 1e-12, 200))
     bounds = {"lbx": low, "ubx": high, "lbg": lbg, "ubg": ubg}
-    return solver, x, lam_x, lam_g, bounds, k
+    return solver, x, scale * lam_x, scale * lam_g, bounds, k
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -439,3 +442,74 @@ def test_the_check_agrees_with_the_dense_reduced_hessian_on_coarse_optima(name, 
     assert check.certified == bool(np.sum(curvatures <= delta) == 0), (check.message, curvatures[:4])
     if not check.certified:
         assert check.negative_curvatures == np.sum(curvatures < -delta), (check.message, curvatures[:4])
+
+
+@pytest.mark.parametrize("negative", [0, 1, 4])
+def test_the_verdict_does_not_depend_on_the_objective_scale(negative):
+    # Scaling f by c > 0 scales ∇²L and the multipliers by c and keeps the point, Z and the signs of
+    # the curvatures on Z: a strict minimum stays one. The QP's curvatures on Z, 0.1 to 10 in
+    # magnitude, become 1e-8 to 1e-6 at c = 1e-7, below an absolute threshold 1e-6 (the multipliers'
+    # tolerance scaled alike, so that the same bounds and rows are strongly active).
+    c = 1e-7
+    solver, x, lam_x, lam_g, bounds, k = random_qp(0, negative, scale=c)
+    check = second_order_check(solver, x, lam_x, lam_g, multiplier_tolerance=1e-6 * c, **bounds)
+    assert check.certified is (negative == 0), check.message
+    assert check.negative_curvatures == negative, check.message
+    unit = second_order_check(*random_qp(0, negative)[:4], **bounds)
+    assert check.curvature_threshold == pytest.approx(c * unit.curvature_threshold, rel=1e-9)
+
+
+@pytest.mark.parametrize("c", [1.0, 1e-9])
+def test_a_zero_curvature_direction_stays_degenerate_at_any_objective_scale(c):
+    # min c ((x + y)² + z²) on x + y + z = 0 at 0: ∇²f = 2c [[1, 1, 0], [1, 1, 0], [0, 0, 1]], Z the
+    # plane d₁ + d₂ + d₃ = 0, which holds d = (1, −1, 0) of curvature exactly 0 (and (1, 1, −2) of
+    # curvature 12 c / 6 = 2c): positive semidefinite, no saddle, no strict minimum.
+    solver = nlp(lambda x: c * ((x[0] + x[1]) ** 2 + x[2] ** 2), lambda x: x[0] + x[1] + x[2], n=3)
+    check = second_order_check(solver, np.zeros(3), np.zeros(3), np.zeros(1), lbg=0.0, ubg=0.0)
+    assert not check.certified and check.degenerate and check.negative_curvatures == 0, check.message
+    assert check.curvature_threshold == pytest.approx(1e-6 * 4.0 * c)  # 1e-6 ‖∇²f‖∞, ‖∇²f‖∞ = 4c
+    # ∇²L = 0 (f = c (x + y), on x + y = 0 with λ = −c): every curvature on Z is 0, none above any δ
+    solver = nlp(lambda x: c * (x[0] + x[1]), lambda x: x[0] + x[1])
+    zero = second_order_check(solver, np.zeros(2), np.zeros(2), np.array([-c]), lbg=0.0, ubg=0.0)
+    assert not zero.certified and zero.degenerate, zero.message
+    assert zero.curvature_threshold == pytest.approx(1e-6)  # ‖∇²L‖∞ = 0: the tolerance itself
+
+
+def test_the_natural_motion_minimum_energy_optimum_is_certified_below_the_first_threshold():
+    # The bench's natural-motion minimum-energy problem (UKube-1, J = [0.0109, 0.05, 0.05] kg m²,
+    # 110 s, objective 5.8e-8): ∇²L on the free variables is not small (‖H‖∞ = 2.25, the controls'
+    # energy), but its curvature on Z spans 1.7e-9 to 0.044 (dense eigenvalues: a strict minimum).
+    # At δ = 1e-6 ‖H‖∞ the point is degenerate (the dense count of curvatures below δ, none below
+    # −δ); the refinement certifies it at a threshold below the least curvature, 7.7e-10 ‖H‖∞.
+    from scenarios.bench import load_suite
+    from scenarios.schema.loader import load
+
+    problem = load(load_suite().problems["natural_motion_min_energy"].file).problem
+    planner = PLANNERS["collocation"]({"objective": "min_energy"})
+    ocp = planner._ocp(problem)
+    params = np.concatenate([problem.initial_state, problem.qf, problem.omegaf, [problem.duration],
+                             problem.model.default_parameters])
+    solved = planner._optimum(problem, ocp, planner._starts(problem), params, planner.options.intervals)
+    lbx, ubx = solved.transcription.bounds(ocp, solved.nlp, *planner._variable_bounds(problem), problem.duration)
+    result = solved.result
+    assert result.f == pytest.approx(5.85e-8, rel=1e-2)
+    bounds = {"p": params, "lbx": lbx, "ubx": ubx, "lbg": solved.nlp.lbg, "ubg": solved.nlp.ubg}
+    check = second_order_check(solved.nlp.solver, result.x, result.lam_x, result.lam_g, **bounds)
+    curvatures, delta = dense_reduced_curvatures(solved.nlp.solver, result.x, result.lam_x, result.lam_g, **bounds)
+    assert delta == pytest.approx(2.25e-6, rel=1e-2) and 1e-9 < curvatures[0] < 1e-3 * delta
+    assert check.certified, check.message
+    assert 1e-10 * delta < check.curvature_threshold < curvatures[0]
+    assert f"{np.sum(curvatures <= delta)} directions between" in check.message
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_a_tiny_curvature_is_refined_to_its_sign(sign):
+    # f = x² ± 1.5e-9 y² at 0: ∇²f = diag(2, ±3e-9), ‖∇²f‖∞ = 2, so δ = 2e-6 leaves y between ±δ
+    # (degenerate). Refined (δ / √10, δ / 10, ...), +3e-9 is certified below 3e-9; −3e-9 stays
+    # below every threshold: degenerate, never certified (and no saddle beyond −2e-6 either).
+    solver = nlp(lambda x: x[0] ** 2 + sign * 1.5e-9 * x[1] ** 2)
+    check = second_order_check(solver, np.zeros(2), np.zeros(2), np.zeros(0))
+    if sign > 0:
+        assert check.certified and 2e-10 <= check.curvature_threshold < 3e-9, check.message
+    else:
+        assert not check.certified and check.degenerate and check.curvature_threshold == pytest.approx(2e-6)

@@ -17,7 +17,8 @@ Three pieces of evidence, each computed here from the point alone (never from th
   is ``s_i`` times row ``i``'s. IPOPT's overall error, which its ``tol`` bounds, divides the
   stationarity by ``s_d = max(100, (‖ỹ‖₁ + ‖z̃‖₁)/(m + n_b)) / 100`` and the complementarity by
   ``s_c = max(100, ‖z̃‖₁/n_b) / 100`` (Wächter & Biegler 2006, eq. 5; ``ỹ, z̃`` the scaled constraint
-  and bound multipliers, ``n_b`` the finite bounds). The solver's statistics keep only the
+  and bound multipliers, ``n_b`` the finite bounds of the variables that are not fixed, lower and
+  upper counted apart). The solver's statistics keep only the
   iterations' ``inf_du`` (the scaled stationarity) and ``inf_pr`` (unscaled), of the last start
   solved, which need not be the point certified; so the factors are computed here the way IPOPT
   does, at ``scaling_point`` (IPOPT's own starting point when the caller has it, else the point

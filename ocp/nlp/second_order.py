@@ -18,11 +18,13 @@ arcs), never "certified" at a saddle: a caller falls back to its other evidence 
 How: by inertia, with a sparse LDLᵀ, on NLPs of any size. With ``H`` the Hessian on the free
 variables ``F`` (the strongly active bounds fixed) and ``A`` the active rows on them, the check asks
 whether ``dᵀ H d > δ ‖d‖²`` on ``Z = null(A)``, ``δ`` the curvature threshold
-(``curvature_tolerance × max(1, ‖H‖∞)``). The matrix
+(``curvature_tolerance × ‖H‖∞``, ``H``'s own scale: see :data:`CURVATURE_TOLERANCE`). The matrix
 
-    K(s) = [[H + s I, Aᵀ], [A, −ε I]]      (ε = :data:`PENALTY` × max(1, ‖A‖∞)² / max(1, ‖H‖∞))
+    K(s) = [[H + s I, Aᵀ], [A, −ε I]]      (ε = :data:`PENALTY` × max(1, ‖A‖∞)² / ‖H‖∞)
 
-has, by Haynsworth's inertia additivity over its negative definite block ``−ε I``, the ``m``
+(factorised normalised, as ``S K(s) S = [[H / η + (s / η) I, Aᵀ], [A, −η ε I]]`` with ``η = ‖H‖∞``
+and ``S = diag(I / √η, √η I)``: a congruence, so the same inertia by Sylvester's law) has, by
+Haynsworth's inertia additivity over its negative definite block ``−ε I``, the ``m``
 negative eigenvalues of that block plus the inertia of ``M(s) = H + s I + AᵀA / ε``, which on ``Z``
 is ``H + s I``. So ``M(−δ)`` positive definite (``K(−δ)`` of inertia ``(n_F, m, 0)``) proves the
 conditions with curvature above ``δ``. Otherwise the negative eigenvalues of ``M(+δ)`` (those of
@@ -38,17 +40,22 @@ multiple of another's ``aaᵀ / ε``. ``Z = {0}`` (a vertex, e.g. a bang-bang op
 positive definite and is certified when ``ε`` is small against ``A``'s least singular value squared
 (7e-12 on the bench's two-wheel minimum time, certified with :data:`PENALTY` 1e-8, not with 1e-6).
 
-CasADi's ``ldl`` factorises ``K`` (``casadi.Linsol``, its AMD ordering) and counts the negative
-pivots; it does not pivot numerically, which the shift and ``ε`` make possible (``H`` has zero
-diagonal entries where the controls enter linearly; without them the factorisation meets zero
-pivots) but not necessarily accurate: a pivot of size ``δ`` grows its neighbours by ``1 / δ``. So
-its backward error is estimated (the residual of one solve with a random right-hand side, relative
-to ``‖K‖∞ ‖x‖∞ + ‖b‖∞``) and the inertia is used only when that error times ``‖K‖∞`` is below
-``δ`` / :data:`GUARD`: the factors are then exact for ``K + E`` with ``‖E‖`` well below ``δ``,
-which moves the curvature found on ``Z`` by at most ``‖E‖ + ‖E‖² / (ε − ‖E‖)``, a fraction of
-``δ`` (an estimate, not a bound: a random right-hand side exposes an inaccurate factorisation with
-probability one, not with a proven margin). A zero pivot or a larger error leaves the point not
-checked.
+CasADi's ``ldl`` factorises the normalised ``K̃ = S K S`` (``casadi.Linsol``, its AMD ordering)
+and counts the negative pivots; it does not pivot numerically, which the shift and ``ε`` make
+possible (``H`` has zero diagonal entries where the controls enter linearly; without them the
+factorisation meets zero pivots) but not necessarily accurate: a pivot of size ``δ / η`` grows its
+neighbours by ``η / δ``. So its backward error is estimated (the residual of one solve with a
+random right-hand side, relative to ``‖K̃‖∞ ‖x‖∞ + ‖b‖∞``) and the inertia is used only when that
+error times ``‖K̃‖∞`` is below ``(δ / η)`` / :data:`GUARD` (``curvature_tolerance / GUARD``): the
+factors are then exact for ``K̃ + E`` with ``‖E‖`` well below ``δ / η``, which moves the curvature
+of ``H / η`` found on ``Z`` by at most ``‖E‖ + ‖E‖² / (η ε − ‖E‖)``, a fraction of ``δ / η`` (of
+``δ`` for ``H``'s) (an estimate, not a bound: a random right-hand side exposes an inaccurate
+factorisation with probability one, not with a proven margin). A zero pivot or a larger error
+leaves the point not checked. Normalised because that error is normwise: with ``H`` unscaled,
+``‖K‖∞`` is ``A``'s where ``‖H‖∞`` is much smaller, and an error of ``A``'s size is set against a
+threshold of ``H``'s (Bilimoria & Wie's 50-interval optimum, ``‖H‖∞ = 0.045``, ``δ = 4.5e-8``:
+backward error 3e-10 × ``‖K‖`` 21, above ``δ`` / 10, not checked; normalised, it passes with
+``GUARD`` 1000 and is certified).
 
 The theorem assumes a KKT point, so the first-order conditions are verified first (stationarity of
 the Lagrangian ``L = f + lam_gᵀ g + lam_xᵀ x``, CasADi's signs; every multiplier of the sign of the
@@ -78,17 +85,43 @@ if TYPE_CHECKING:  # imported where a check is made: importing this module does 
 Array = NDArray[np.float64]
 
 CURVATURE_TOLERANCE = 1e-6
-"""Default ``curvature_tolerance``: ``δ = 1e-6 × max(1, ‖H‖∞)``. The accuracy of the unpivoted
-factorisation decides it (its pivots of size ``δ`` grow their neighbours by ``1 / δ``). On the
-collocation optima of the bench problems and Bilimoria & Wie's 8- and 50-interval optimum and
-eigenaxis saddle (13 points, both shifts), the largest ``GUARD`` of 1, 10, 100, 1000 that every
+"""Default ``curvature_tolerance``: ``δ = 1e-6 × ‖H‖∞`` (``‖H‖∞`` taken as 1 when ``H = 0``, where
+every curvature on ``Z`` is zero: degenerate unless ``Z = {0}``).
+
+Relative to ``H``'s own scale, without a floor, because the factorisation's accuracy is relative:
+multiplying the objective (and with it ``H`` and the multipliers) by ``c > 0`` multiplies ``δ`` by
+``c`` and ``ε`` by ``1 / c``, which makes ``K(±δ)`` the congruent ``S K S`` of the unscaled one
+(``S = diag(√c I, I / √c)``): the same inertia, and factors that Gaussian elimination, invariant
+under diagonal scaling, computes as the scaled ones up to the rounding of the scaling, so the
+verdict does not change, as the second-order conditions do not (the guard's normwise error is the
+one quantity not exactly invariant). The former floor ``δ = 1e-6 × max(1, ‖H‖∞)`` was
+absolute below ``‖H‖∞ = 1``: a QP's curvatures 1e-8 to 1e-6 (its objective times 1e-7) were
+"degenerate" against it. A small ``‖H‖∞`` lowers ``δ``; a ``δ`` below what the factorisation
+resolves on a point is refused by the guard (not checked), never certified. A curvature small
+against ``‖H‖∞`` itself is the refinement's (:data:`FINEST_CURVATURE_TOLERANCE`): on the bench's
+natural-motion minimum energy (``‖H‖∞ = 2.25``, the controls' energy, not small though the
+objective is 5.8e-8) the curvature on ``Z`` goes down to 1.7e-9 = 7.7e-10 ``‖H‖∞`` (dense
+eigenvalues, all positive; 15 below ``δ``): degenerate at ``δ``, certified at ``3.2e-10 ‖H‖∞``.
+
+The accuracy of the unpivoted factorisation decides the tolerance (its pivots of size ``δ`` grow
+their neighbours by ``1 / δ``). On the collocation optima of the bench problems and Bilimoria &
+Wie's 8- and 50-interval optimum and eigenaxis saddle (13 points, both shifts), the largest ``GUARD`` of 1, 10, 100, 1000 that every
 factorisation passed was at 1e-6 at least 100 (1000 on 11 points); at 1e-7 only 1 on two points
 (norm-bounded eigenaxis, spin repoint); at 1e-8 (the dense check's tolerance before) none on three
 (full inertia, norm-bounded, spin repoint). The least curvature among the certified points that
-are no vertex is 4e-4 (spin repoint, minimum energy), so 1e-6 costs none of them."""
+are no vertex is 4e-4 (spin repoint, minimum energy), so 1e-6 costs none of them. (Measured with
+``δ = 1e-6 × max(1, ‖H‖∞)`` and ``K`` not normalised. Relative to ``‖H‖∞`` and normalised, on 23
+points (the tests' 12 coarse optima and saddles, Bilimoria & Wie's 50-interval optimum and saddle,
+the bench's natural motion, spin repoint, two-wheel, keep-out, norm-bounded, 90°, full inertia,
+XTE and VEPA optima) the factorisations at ``±δ`` pass ``GUARD`` 100, 1000 on 19; ``δ`` is smaller where
+``‖H‖∞ < 1``: 0.22 to 0.27 on Bilimoria & Wie's 8 intervals, 0.04 on 50, 0.62 norm-bounded, 0.05
+at 90°, 0.47 full inertia. The verdicts are the same but natural motion's, certified by the
+refinement; the saddles count more directions below the smaller ``−δ``: 22 and 72 on Bilimoria &
+Wie's 8 and 50 intervals, against 20 and 28, as many as the dense eigenvalues.)"""
 
 PENALTY = 1e-8
-"""``ε = PENALTY × max(1, ‖A‖∞)² / max(1, ‖H‖∞)``: the ``−ε I`` block of the regularised KKT
+"""``ε = PENALTY × max(1, ‖A‖∞)² / ‖H‖∞`` (``‖H‖∞`` as in :data:`CURVATURE_TOLERANCE`, so
+``δ ε`` does not depend on ``H``'s scale): the ``−ε I`` block of the regularised KKT
 matrix. A vertex is certified, and a count is exact, only when ``s² / ε`` exceeds the curvature
 along the directions of ``A``'s small singular values ``s``, which asks for a small ``ε``; the
 elimination's cancellations ask for ``δ ε`` well above the unit roundoff times ``‖A‖²`` (here
@@ -109,8 +142,21 @@ another thread writes while it is swapped comes out later, or, in a race with th
 swapped stream, not at all. In other threads the warning is let through."""
 
 GUARD = 10.0
-"""The estimated backward error of the factorisation, times ``‖K‖∞``, must be below ``δ / GUARD``
-(see the module docstring)."""
+"""The estimated backward error of the factorisation, times ``‖K̃‖∞`` (the normalised matrix), must
+be below ``δ / (‖H‖∞ GUARD)`` (see the module docstring)."""
+
+FINEST_CURVATURE_TOLERANCE = 1e-10
+"""A point degenerate at ``δ`` (no curvature below ``−δ``, some between ``±δ``) is checked again at
+``δ / REFINEMENT``, ``δ / REFINEMENT²``, ... down to this times ``‖H‖∞``, and certified at the first
+threshold where no curvature on ``Z`` is below it, as long as the factorisation passes the guard
+there: the floor is the factorisation's measured accuracy on the point, not a fixed one. A zero
+curvature stays below every threshold and the point degenerate; the floor, six orders of magnitude
+above the unit roundoff, keeps the Hessian's own rounding (its entries a few roundoffs off) out of
+it. The bench's natural-motion minimum energy (least curvature 7.7e-10 ``‖H‖∞``) is certified at
+``3.2e-10 ‖H‖∞``; the guard refused ``1e-10 ‖H‖∞`` there."""
+
+REFINEMENT = 10.0 ** 0.5
+"""The ratio of successive thresholds of a degenerate point's refinement (one factorisation each)."""
 
 
 @dataclass(frozen=True)
@@ -235,9 +281,11 @@ def _linsol(size: int, indptr: Any, indices: Any) -> tuple[ca.Sparsity, ca.Linso
     return found
 
 
-def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: float) -> Callable[[float], int | str]:
+def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: float,
+             scale: float) -> Callable[[float], int | str]:
     """A counter of the negative eigenvalues of ``M(s) = H + s I + AᵀA / ε`` from the inertia of
-    ``K(s) = [[H + s I, Aᵀ], [A, −ε I]]`` (module docstring): one sparsity and one symbolic
+    ``K(s) = [[H + s I, Aᵀ], [A, −ε I]]`` (module docstring), factorised normalised, as
+    ``[[H / η + (s / η) I, Aᵀ], [A, −η ε I]]`` (``η`` = ``scale``): one sparsity and one symbolic
     factorisation for every shift ``s``.
 
     Parameters
@@ -248,6 +296,8 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
         The active rows on them (no duplicate entries).
     delta : float
         The curvature threshold ``δ`` (positive): the guard's scale.
+    scale : float
+        ``H``'s scale ``η``, positive (``‖H‖∞``, 1 for a zero ``H``).
 
     Returns
     -------
@@ -257,14 +307,13 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
     import scipy.sparse
 
     n, m = H.shape[0], A.shape[0]
-    epsilon = PENALTY * max(1.0, float(abs(A).sum(axis=1).max()) if m else 0.0) ** 2 \
-        / max(1.0, float(abs(H).sum(axis=1).max()))
+    epsilon = PENALTY * max(1.0, float(abs(A).sum(axis=1).max()) if m else 0.0) ** 2  # η ε
     # the pattern with its whole diagonal, explicit zeros kept (an entry H_jj = 0, or cancelled by a
     # shift, must stay in it), the shift set in place for each factorisation
     Hc, Ac = H, A
     every = np.arange(n + m)
     K = scipy.sparse.coo_matrix(
-        (np.concatenate([Hc.data, Ac.data, Ac.data, np.zeros(n), np.full(m, -epsilon)]),
+        (np.concatenate([Hc.data / scale, Ac.data, Ac.data, np.zeros(n), np.full(m, -epsilon)]),
          (np.concatenate([Hc.row, Ac.row + n, Ac.col, every]), np.concatenate([Hc.col, Ac.col, Ac.row + n, every]))),
         shape=(n + m, n + m)).tocsc()  # duplicates summed
     K.sort_indices()
@@ -276,7 +325,7 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
     b = ca.DM(rhs)
 
     def count(shift: float) -> int | str:
-        K.data[diagonal] = base + shift
+        K.data[diagonal] = base + shift / scale
         values = ca.DM(sparsity, K.data.tolist())
         if not analysed:
             solver.sfact(values)  # the symbolic factorisation (the ordering), once per pattern
@@ -301,9 +350,9 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
                 / (norm * float(np.max(np.abs(solution))) + float(np.max(np.abs(rhs))))
         if not np.isfinite(error):
             return f"the KKT matrix's LDLᵀ has zero pivots ({n} free variables, {m} active rows): a non-finite solve"
-        if error * norm > delta / GUARD:
+        if error * norm > delta / scale / GUARD:
             return (f"the KKT matrix's LDLᵀ (no pivoting) is not accurate enough: backward error {error:.1g} × ‖K‖ "
-                    f"{norm:.2g} above {1 / GUARD:g} × the curvature threshold {delta:.1g}")
+                    f"{norm:.2g} above {1 / GUARD:g} × the curvature threshold {delta:.1g} / ‖H‖∞ {scale:.2g}")
         return int(solver.neig(values)) - m
 
     return count
@@ -334,8 +383,9 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
         Relative distance to a bound (``× (1 + |bound|)``) within which a value is at it; also the
         largest accepted violation of a bound.
     curvature_tolerance : float
-        The curvature on ``Z`` must exceed ``δ`` = this times ``max(1, ‖H‖∞)`` (``H`` the Hessian
-        of the Lagrangian on the free variables); :data:`CURVATURE_TOLERANCE` says why 1e-6.
+        The curvature on ``Z`` must exceed ``δ`` = this times ``‖H‖∞`` (``H`` the Hessian of the
+        Lagrangian on the free variables; 1 when it is zero); :data:`CURVATURE_TOLERANCE` says why
+        relative to ``‖H‖∞`` and why 1e-6.
     kkt_tolerance : float
         The first-order conditions the theorem assumes must hold to this: the stationarity residual
         ``‖∇f + J_gᵀ lam_g + lam_x‖∞`` relative to the largest of its terms (at least 1), and the
@@ -399,9 +449,11 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     keep = (row_position[j_rows] >= 0) & (position[j_columns] >= 0)
     A = scipy.sparse.coo_matrix((j_values[keep], (row_position[j_rows[keep]], position[j_columns[keep]])),
                                 shape=(active.size, free.size))
-    delta = curvature_tolerance * max(1.0, float(abs(H_free).sum(axis=1).max()))
+    scale = float(abs(H_free).sum(axis=1).max())  # ‖H‖∞, its own scale, however small
+    scale = scale if scale > 0.0 else 1.0  # H = 0: every curvature on Z is 0, below any δ > 0
+    delta = curvature_tolerance * scale
     where = f"on {free.size} free variables and {A.shape[0]} active rows"
-    count = _inertia(H_free, A, delta)
+    count = _inertia(H_free, A, delta, scale)
     below = count(-delta)
     if isinstance(below, str):
         return _not_checked(below)
@@ -411,7 +463,16 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     if isinstance(beyond, str):  # not certified; below −δ unknown: no saddle evidence either
         return SecondOrderCheck(False, -1, delta, f"at most {below} directions of curvature below {delta:.1g} {where}, "
                                                   f"below −{delta:.1g} not counted: {beyond}")
-    if beyond == 0:
+    if beyond == 0:  # degenerate at δ: are the near-zero curvatures positive, where the factorisation resolves them?
+        finer = delta
+        while finer / REFINEMENT >= FINEST_CURVATURE_TOLERANCE * scale:
+            finer /= REFINEMENT
+            refined = count(-finer)
+            if isinstance(refined, str):  # beyond the factorisation's accuracy: no certificate
+                break
+            if refined == 0:
+                return SecondOrderCheck(True, 0, finer, f"curvature above {finer:.1g} {where} (KKT inertia; "
+                                                        f"{below} directions between −{delta:.1g} and {delta:.1g})")
         return SecondOrderCheck(False, 0, delta, f"at most {below} directions of curvature between "
                                                  f"−{delta:.1g} and {delta:.1g}, none below, {where} (KKT inertia)")
     return SecondOrderCheck(False, beyond, delta, f"at most {beyond} directions of curvature below −{delta:.1g} {where} "

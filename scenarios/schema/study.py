@@ -28,7 +28,14 @@ from ocp.errors import excerpt
 from ocp.options import option_fields
 from planners import PLANNERS
 from scenarios.errors import ScenarioError
+from scenarios.requirements.fields import (
+    REQUIREMENT_FIELDS,
+    VERDICT,
+    is_verdict_column,
+    requirement_kind,
+)
 from scenarios.schema.columns import (
+    REQUIREMENT_MARK,
     VECTOR_METRICS,
     is_requirement_column,
     metric_columns,
@@ -516,8 +523,23 @@ EXECUTION = Section((
 ), "How the cases run.")
 
 
-def _metric_column(metric: str, where: str) -> str:
-    """``metric`` when it names a metric column or a requirement column, else an error at ``where``."""
+_UNSET = object()
+
+
+def _metric_column(metric: str, where: str, bound: object = _UNSET) -> str:
+    """``metric`` when it names a metric column or a requirement column that holds a number, else an
+    error at ``where`` (``bound``: the threshold's value given for it, named in the error)."""
+    if isinstance(metric, str) and is_verdict_column(metric):
+        prefix, _, name, _ = metric.split(".")
+        kind = requirement_kind(name)
+        numbers = [f"{prefix}.{REQUIREMENT_MARK}.{name}.{declared.field}" for declared in REQUIREMENT_FIELDS
+                   if declared.requirement == kind and declared.field != VERDICT and prefix in declared.scopes]
+        given = "" if bound is _UNSET else f" (given the bound {excerpt(bound)})"
+        raise ScenarioError(where, f"{metric!r} is whether requirement {name!r} is met in the "
+                                   f"{'reference' if prefix == 'ref' else 'closed loop'}, true or false (its verdict: "
+                                   f"requirements.csv counts the cases that meet it), not a number to "
+                                   f"{'summarise' if bound is _UNSET else 'bound'}{given}; expected a number "
+                                   f"column such as {', '.join(numbers)}")
     if not isinstance(metric, str) or metric not in metric_columns() and not is_requirement_column(metric):
         scalars = [key for key in METRIC_KEYS if key != "plan_time_s" and key not in VECTOR_METRICS]
         vectors = ", ".join(f"cl.{key}_x" for key in VECTOR_METRICS)
@@ -545,7 +567,7 @@ def _thresholds(node: Node) -> dict[str, tuple[str, float]]:
     mapped = _entries(node)
     for metric in mapped.value:
         entry = mapped.get(metric)
-        _metric_column(metric, entry.path)
+        _metric_column(metric, entry.path, entry.value)
         if isinstance(entry.value, dict):
             if len(entry.value) != 1 or next(iter(entry.value)) not in THRESHOLD_SENSES:
                 raise entry.error(f"expected a number (the metric at most it) or {{at_most: number}} or "

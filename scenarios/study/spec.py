@@ -33,7 +33,6 @@ import numpy as np
 from ocp.errors import excerpt
 from scenarios.errors import ScenarioError
 from scenarios.output.provenance import package_version
-from scenarios.requirements.fields import is_verdict_column
 from scenarios.requirements.scoring import score_fields
 from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES, is_requirement_column
 from scenarios.schema.keys import Key
@@ -374,13 +373,9 @@ def _requirement_columns(scenario: Scenario) -> list[str]:
 
 def _check_summary(summary: list[tuple[str, str]], columns: dict[str, None]) -> None:
     """Refuse a summary entry (or threshold), given as ``(where, column)``, naming a requirement
-    column that no case gives (a typo would summarise nothing, silently), or a requirement's verdict
-    (a bool: its statistics would be empty; ``requirements.csv`` counts it)."""
+    column that no case gives (a typo would summarise nothing, silently; a requirement's verdict, a
+    bool, is refused where the study's YAML is read)."""
     for where, column in summary:
-        if is_verdict_column(column):
-            raise ScenarioError(where, f"{column!r} is a requirement's verdict (true or false), not a number to "
-                                       f"summarise or bound: requirements.csv counts the cases that meet each "
-                                       f"requirement in each scope; name one of its numbers instead")
         if not is_requirement_column(column) or column in columns:
             continue
         prefix, _, name, field = column.split(".")
