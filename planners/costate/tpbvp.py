@@ -19,6 +19,7 @@ bounds are not imposed.
 """
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
@@ -230,9 +231,26 @@ def _failure(trial: Any) -> str:
     return f"{detail} ({trial.x.size} nodes, max rms residual {float(np.max(trial.rms_residuals)):.2g})"
 
 
+OUT_OF_TIME = "time limit reached"
+"""How the message of a solve stopped by its ``deadline`` begins."""
+
+
+def _out_of_time(deadline: float | None) -> bool:
+    """Whether ``time.monotonic()`` has passed ``deadline`` (never when it is ``None``)."""
+    return deadline is not None and time.monotonic() >= deadline
+
+
+def _stopped(stages: int, done: float, trial: Any) -> str:
+    """The message of a continuation stopped by its deadline: the calls made, the fraction solved
+    and the last failure, if the last call failed."""
+    last = f"; the last stage failed: {_failure(trial)}" if trial is not None and trial.status != 0 else ""
+    return (f"{OUT_OF_TIME} after {stages} solve_bvp call(s), the continuation solved up to fraction "
+            f"{done:.3f}{last}")
+
+
 def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, max_nodes: int,
           guess: tuple[float, Array, Array] | None = None,
-          min_step: float = 1e-3) -> tuple[Any, float | None, int, str | None]:
+          min_step: float = 1e-3, deadline: float | None = None) -> tuple[Any, float | None, int, str | None]:
     """Solve the TPBVP of ``system`` by adaptive continuation, starting with steps of ``1/steps``,
     then refine the solution of the target to ``tolerance``.
 
@@ -265,6 +283,10 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
         scaled mesh (m,) on [0, 1], ``y`` (2n, m).
     min_step : float, optional
         Smallest continuation step before giving up (default 1e-3).
+    deadline : float or None, optional
+        ``time.monotonic()`` [s] after which no further ``solve_bvp`` call starts (a call under
+        way is not interrupted); the solve then fails with a message beginning with
+        :data:`OUT_OF_TIME` and saying how far the continuation got. ``None`` (default): no limit.
 
     Returns
     -------
@@ -281,8 +303,11 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
     loose = max(tolerance, LOOSE_TOLERANCE)
     done, step, stages, start, solution, t_f = 0.0, 1.0 / steps if system.continued else 1.0, 0, guess, None, 0.0
     mesh_size = nodes if guess is None else max(nodes, guess[1].size)
+    trial: Any = None
     while done < 1.0:
         fraction = min(1.0, done + step)
+        if _out_of_time(deadline):
+            return None, None, stages, _stopped(stages, done, trial)
         stage_start = start if start is not None else system.guess(nodes, fraction)
         if solution is None:  # a cold start finer than nodes (a spinning start) sets the mesh
             mesh_size = max(nodes, stage_start[1].size)
@@ -301,6 +326,9 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
     assert solution is not None  # the loop ends on a solved target
     if tolerance >= loose:
         return solution, t_f, stages, None
+    if _out_of_time(deadline):
+        return None, None, stages, (f"{OUT_OF_TIME} before refining the target's solution to tolerance {tolerance:g} "
+                                    f"({stages} solve_bvp call(s), {solution.x.size} nodes at tolerance {loose:g})")
     refined = _solve_stage(system, 1.0, (t_f, solution.x, solution.y), tolerance, max_nodes)
     stages += 1
     if not _solved(refined, free):
@@ -371,6 +399,14 @@ class CostateTPBVPPlanner(Planner):
             ``solve_bvp`` node limit of the final stage, 10 to 100000 and at least ``nodes``
             (default 5000). A spinning start's torque-free-coast fallback may use up to
             :data:`COAST_NODE_FACTOR` times its coarsest mesh, if that is more.
+        time_limit : float or None
+            Wall-clock budget of one plan [s], positive, or ``None`` for none (default 120): no
+            further ``solve_bvp`` call starts once it is spent (one under way is not interrupted, so
+            a plan can overrun it by one call), and the plan fails with a message naming this
+            option, the calls made and the continuation fraction reached; the torque-free-coast
+            fallback of a spinning start is not tried when the eigenaxis start has spent it. A fast
+            spin's continuation can crawl for minutes before failing (1 rad/s for 200 s: 101-192 s,
+            2 rad/s: 534 s, measured 2026-12-03); the spin re-pointing benchmark succeeds in 19-43 s.
         """
 
         objective: Literal["min_energy", "rate_acquisition", "attitude_acquisition"] = "min_energy"
@@ -383,6 +419,7 @@ class CostateTPBVPPlanner(Planner):
         nodes: Annotated[int, Range(ge=5, le=5000)] = 60                                          # mesh each stage starts from
         tolerance: Annotated[float, Range(gt=0.0, lt=1.0)] = 1e-8                                  # solve_bvp residual tolerance
         max_nodes: Annotated[int, Range(ge=10, le=100000)] = 5000
+        time_limit: Annotated[float | None, Range(gt=0.0)] = 120.0                                 # s of wall clock per plan; None: none
 
         def __post_init__(self) -> None:
             if self.max_nodes < self.nodes:
@@ -430,17 +467,26 @@ class CostateTPBVPPlanner(Planner):
         system = FORMS[o.objective](problem, o)
         if not isinstance(system, HamiltonianSystem):
             return FailedReference(self.name, str(system))
+        deadline = None if o.time_limit is None else time.monotonic() + o.time_limit
         try:
-            solution, t_f, stages, failure = solve(system, o.nodes, o.continuation_steps, o.tolerance, o.max_nodes)
+            solution, t_f, stages, failure = solve(system, o.nodes, o.continuation_steps, o.tolerance, o.max_nodes,
+                                                   deadline=deadline)
         except ColdStartError as error:
             return FailedReference(self.name, f"{o.objective}: {error}")
         fallback, first = (system.fallback() if failure else None), system.cold_start
-        if fallback is not None:  # the same problem from another cold start, on its own (finer) mesh
+        if fallback is not None and _out_of_time(deadline):  # no time left for the other cold start
+            failure = f"from the {first}: {failure}; the {fallback.cold_start} was not tried ({OUT_OF_TIME})"
+            fallback = None
+        elif fallback is not None:  # the same problem from another cold start, on its own (finer) mesh
             limit = max(o.max_nodes, COAST_NODE_FACTOR * fallback.guess(o.nodes, 1.0)[1].size)
-            solution, t_f, more, second = solve(fallback, o.nodes, o.continuation_steps, o.tolerance, limit)
+            solution, t_f, more, second = solve(fallback, o.nodes, o.continuation_steps, o.tolerance, limit,
+                                                deadline=deadline)
             failure = None if second is None else f"from the {first}: {failure}; from the {fallback.cold_start}: {second}"
             stages, system = stages + more, fallback
         if failure or solution is None or t_f is None:
+            if failure and OUT_OF_TIME in failure:
+                failure += (f" (options.time_limit = {o.time_limit:g} s: a larger time_limit, or null for none, "
+                            "lets the solver go on)")
             return FailedReference(self.name, f"{o.objective}: {failure}")
         stats = {"objective_form": o.objective, "t_f": t_f, "nodes": int(solution.x.size),
                  "max_rms_residual": float(np.max(solution.rms_residuals)), "continuation_stages": stages}
