@@ -102,3 +102,62 @@ def test_a_unit_mix_up_rate_is_searched_within_the_work_limit(monkeypatch) -> No
     assert found.missable_s > 0.0
     assert sum(evaluated) <= t.size + 1 + pointing.MAX_SUB_GRID * (1 + pointing.REFINE_LEVELS)
     assert np.all(np.diff(times) >= 0.0) and -np.nanmin(values) <= math.pi + 1e-12
+
+
+HAND = """
+name: hand-colloc
+spacecraft: {inertia: [10.0, 10.0, 10.0], wheels: {max_torque: 0.1, max_momentum: 2.0}}
+maneuver:
+  duration: 15.0
+  initial: {q: [1, 0, 0, 0], omega: [0, 0, 0]}
+  final: {q: [0.7071067811865476, 0, 0, 0.7071067811865476], omega: [0, 0, 0]}
+planners: [{name: collocation, options: {objective: min_time}}]
+controller: {name: augmented_quaternion_feedback, options: {kp: 0.5, kd: 3.0}}
+"""
+
+
+def test_a_min_time_bound_below_the_minimum_time_says_so_and_names_a_feasible_duration() -> None:
+    """A 10 kg m² sphere on three orthogonal wheels of 0.1 N m turned 90 deg at rest: the body's
+    angular momentum changes no faster than the wheels' torque, √3 · 0.1 N m, and its rate is at
+    most that momentum over 10 kg m², so a rest-to-rest turn by θ takes at least
+    2 √(θ J / (√3 u)) = 19.05 s. Under a 15 s bound the solve must fail (not ok), and its message
+    must say that maneuver.duration bounds the free final time and may be below the minimum time,
+    and name the eigenaxis bang-bang slew, 2 √(θ J / u) = 25.066 s, as a feasible duration."""
+    import yaml
+
+    from planners import PLANNERS
+    from scenarios.schema.loader import parse_scenario
+
+    problem = parse_scenario(yaml.safe_load(HAND)).problem
+    theta, inertia, torque = math.pi / 2.0, 10.0, 0.1
+    assert 2.0 * math.sqrt(theta * inertia / (math.sqrt(3.0) * torque)) > problem.duration  # provably below
+    reference = PLANNERS["collocation"]({"objective": "min_time", "intervals": 10, "coarse_intervals": 0,
+                                        "max_iterations": 150}).plan(problem)
+    assert not reference.ok
+    message = reference.message
+    assert "the final time is free and maneuver.duration = 15 s bounds it" in message
+    assert "may be below the minimum time" in message
+    eigenaxis = 2.0 * math.sqrt(theta * inertia / torque)
+    assert f"eigenaxis min_time is a feasible slew of this problem in {eigenaxis:.6g} s" in message
+    assert message.index("maneuver.duration = 15 s") < message.index("try ")  # the bound first
+
+
+def test_the_feasible_duration_named_is_that_of_the_problems_own_rate_bound() -> None:
+    """The same manoeuvre with its body rate bounded by 0.1 rad/s, below the bang-bang slew's
+    coast rate √(θ u / J) = 0.125 rad/s: the eigenaxis slew then coasts at the bound, in
+    θ / ω + ω J / u = 15.708 + 10 = 25.708 s (accelerating and braking at u / J), and that, not the
+    unbounded 25.066 s, is the feasible duration named."""
+    import yaml
+
+    from planners import PLANNERS
+    from scenarios.schema.loader import parse_scenario
+
+    data = yaml.safe_load(HAND)
+    data["maneuver"]["max_rate"] = 0.1
+    problem = parse_scenario(data).problem
+    assert math.sqrt(math.pi / 2.0 * 0.1 / 10.0) > 0.1
+    reference = PLANNERS["collocation"]({"objective": "min_time", "intervals": 10, "coarse_intervals": 0,
+                                        "max_iterations": 150}).plan(problem)
+    assert not reference.ok
+    assert "maneuver.duration = 15 s bounds it" in reference.message
+    assert f"a feasible slew of this problem in {math.pi / 2.0 / 0.1 + 0.1 * 10.0 / 0.1:.6g} s" in reference.message
