@@ -41,6 +41,7 @@ __all__ = [
     "DEGENERATE_NORM",
     "FINE_STEP",
     "GROUP_REACH",
+    "MAX_SUB_GRID",
     "MIN_SEARCHES",
     "REFINE_LEVELS",
     "REFINE_POINTS",
@@ -48,6 +49,7 @@ __all__ = [
     "HermiteMotion",
     "PointingConstraint",
     "PointingScore",
+    "Searched",
     "hermite_attitudes",
     "scores_between_samples",
     "search_between_samples",
@@ -83,6 +85,13 @@ GROUP_REACH = np.deg2rad(2.0)
 """[rad]: the most the bound may move the value over a group of samples evaluated first (a
 group that may cross the threshold is cut into the fine sub-grid: at most this over
 :data:`FINE_STEP`, or 4 steps a sample interval)."""
+MAX_SUB_GRID = 2_000_000
+"""The work limit of :func:`search_between_samples`: the points of its sub-grid, and of each zoom's
+brackets that may hide a crossing. A search whose sub-grid at :data:`FINE_STEP` would exceed it (a
+motion that turns more than about ``MAX_SUB_GRID * FINE_STEP`` = 1745 rad near the threshold: 40 s
+at 44 rad/s) is cut coarser, every step in the same ratio, to at most this many points, and each of
+its zooms goes on by its deepest such brackets only: a crossing shorter than the longest step of
+that sub-grid (:attr:`Searched.missable_s`) may then be missed. Below it, the search is unchanged."""
 DEGENERATE_NORM = 0.1
 """The interpolant's unnormalised norm below which an interval's rate is not bounded from its
 polynomial (:attr:`HermiteMotion.rate_bound`): samples that disagree with their rates by about a
@@ -263,7 +272,7 @@ def _may_cross(start: Array, end: Array, reach: Array, threshold: float, smalles
 
 
 def search_between_samples(motion: HermiteMotion, value: Callable[[Array, Array], Array], threshold: float = -np.inf,
-                           drift: float = 0.0, edges: Sequence[float] = ()) -> tuple[Array, Array]:
+                           drift: float = 0.0, edges: Sequence[float] = ()) -> Searched:
     """The points where a function of the interpolated motion is evaluated to find its least value
     and every crossing of a threshold between the samples (a keep-out's margin below 0, the final
     error above its bound: one search for both).
@@ -307,10 +316,14 @@ def search_between_samples(motion: HermiteMotion, value: Callable[[Array, Array]
     edges : sequence of float, optional
         Times [s] that are points of the search when inside the samples' span (a window's edges).
 
+    The work is limited (:data:`MAX_SUB_GRID`): beyond it the sub-grid is coarser, and the result
+    says so (:attr:`Searched.missable_s`).
+
     Returns
     -------
-    (times, values) : ((P,) ndarray, (P,) ndarray)
-        Every point evaluated, in time order (the samples and edges first among them).
+    Searched
+        ``(times, values)``: every point evaluated, in time order (the samples and edges first
+        among them); with :attr:`~Searched.missable_s`.
     """
     return searches_between_samples(motion, [(value, threshold, drift, edges)])[0]
 
@@ -320,7 +333,27 @@ SearchSpec = tuple[Callable[[Array, Array], Array], float, float, Sequence[float
 arguments of :func:`search_between_samples`."""
 
 
-def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpec]) -> list[tuple[Array, Array]]:
+class Searched(tuple[Array, Array]):
+    """``(times, values)``: the points a search between samples evaluated and their values, in time
+    order; and :attr:`missable_s`.
+
+    Attributes
+    ----------
+    missable_s : float
+        [s]: 0 when the search ran in full; else (its sub-grid cut coarser by the work limit,
+        :data:`MAX_SUB_GRID`) the longest step of its sub-grid: a crossing of the threshold shorter
+        than it may be missed.
+    """
+
+    missable_s: float
+
+    def __new__(cls, times: Array, values: Array, missable_s: float = 0.0) -> Searched:
+        found = super().__new__(cls, (times, values))
+        found.missable_s = float(missable_s)
+        return found
+
+
+def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpec]) -> list[Searched]:
     """Several searches of :func:`search_between_samples` on one motion (a row's pointing
     requirements), each exactly as alone: the same points, the same values.
 
@@ -339,10 +372,11 @@ def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpe
 
     Returns
     -------
-    list of (times, values)
+    list of Searched
         Per search, as :func:`search_between_samples` returns.
     """
-    results: list[tuple[Array, Array] | None] = [None] * len(searches)
+    results: list[Searched | None] = [None] * len(searches)
+    missable: list[float] = []
     found_t: list[list[Array]] = []
     found_v: list[list[Array]] = []
     active: list[int] = []  # the searches whose sub-grid goes on into the zooms, in order
@@ -350,30 +384,32 @@ def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpe
     for index, (value, threshold, drift, edges) in enumerate(searches):
         opened = _sub_grid(motion, value, threshold, drift, edges)
         if len(opened) == 2:
-            results[index] = opened
+            results[index] = Searched(*opened)
             continue
-        grid, values, rate = opened
+        grid, values, rate, longest = opened
+        missable.append(longest)
         active.append(index)
         found_t.append([grid])
         found_v.append([values])
         brackets.append((grid, values, rate))
     if active:
-        _zoom(motion, [searches[index] for index in active], brackets, found_t, found_v)
+        _zoom(motion, [searches[index] for index in active], brackets, found_t, found_v, missable)
         for slot, index in enumerate(active):
             if len(found_t[slot]) == 1:
-                results[index] = (found_t[slot][0], found_v[slot][0])
+                results[index] = Searched(found_t[slot][0], found_v[slot][0], missable[slot])
                 continue
             times, values = np.concatenate(found_t[slot]), np.concatenate(found_v[slot])
             order = np.argsort(times, kind="stable")
-            results[index] = (times[order], values[order])
+            results[index] = Searched(times[order], values[order], missable[slot])
     return [result for result in results if result is not None]
 
 
 def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], threshold: float, drift: float,
-              edges: Sequence[float]) -> tuple[Array, Array] | tuple[Array, Array, Array]:
-    """Steps 1 and 2 of :func:`search_between_samples`: the heads, then the sub-grid, its values and
-    the bound's rate on each of its steps; or the final ``(times, values)`` when nothing is left to
-    zoom into (fewer than two knots, no head inside the value's domain)."""
+              edges: Sequence[float]) -> tuple[Array, Array] | tuple[Array, Array, Array, float]:
+    """Steps 1 and 2 of :func:`search_between_samples`: the heads, then the sub-grid, its values,
+    the bound's rate on each of its steps and its longest step [s] when the work limit cut it coarser
+    (:data:`MAX_SUB_GRID`; else 0); or the final ``(times, values)`` when nothing is left to zoom
+    into (fewer than two knots, no head inside the value's domain)."""
     t = motion.t
     inner = [float(edge) for edge in edges if t[0] < edge < t[-1]]
     # the samples increase (repeats allowed): np.unique only where an edge is inserted or a time repeats
@@ -412,6 +448,13 @@ def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], thr
     steps = np.where(opened, cut, head[:-1])
     rate = np.where(opened, speed, np.repeat(reach / np.diff(knots[heads]), sizes))  # a group kept whole: its mean
     total = int(steps.sum())
+    longest = 0.0
+    if total > MAX_SUB_GRID:  # the work limit: every opened step coarser in one ratio, at least one step each
+        ratio = (MAX_SUB_GRID - len(steps)) / total
+        cut = np.maximum(1, np.floor(cut * ratio)).astype(int)
+        steps = np.where(opened, cut, head[:-1])
+        total = int(steps.sum())
+        longest = float(np.max(np.where(opened, h / cut, 0.0)))
     offset = np.arange(total) - np.repeat(np.cumsum(steps) - steps, steps)
     grid = np.append(np.repeat(knots[:-1], steps) + np.repeat(h / np.maximum(cut, 1), steps) * offset, knots[-1])
     rate = np.repeat(rate, steps)
@@ -421,7 +464,7 @@ def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], thr
     new = ~known
     if np.any(new):
         values[new] = value(grid[new], motion.attitudes(grid[new]))
-    return grid, values, rate
+    return grid, values, rate, longest
 
 
 def _knot_steps(motion: HermiteMotion, knots: Array) -> tuple[Array, Array, Array]:
@@ -435,11 +478,13 @@ def _knot_steps(motion: HermiteMotion, knots: Array) -> tuple[Array, Array, Arra
 
 
 def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence[tuple[Array, Array, Array]],
-          found_t: list[list[Array]], found_v: list[list[Array]]) -> None:
+          found_t: list[list[Array]], found_v: list[list[Array]], missable: Sequence[float]) -> None:
     """Step 3 of :func:`search_between_samples` for several searches at once: the brackets of every
     search in one array (``owner``: the search of each, in order), the least value, the threshold
     and the :data:`MIN_SEARCHES` deepest brackets per search; the points of each zoom appended to
-    that search's ``found_t`` and ``found_v``."""
+    that search's ``found_t`` and ``found_v``. A search whose sub-grid the work limit cut
+    (``missable`` > 0) zooms into its deepest brackets that may hide a crossing only, at most
+    :data:`MAX_SUB_GRID` points a zoom."""
     count = len(grids)
     owner = np.repeat(np.arange(count), [len(grid) - 1 for grid, _, _ in grids])
     low = np.concatenate([grid[:-1] for grid, _, _ in grids])
@@ -463,6 +508,11 @@ def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence
             ranked = lower[np.lexsort((floor[lower], owner[lower]))]
             first = np.searchsorted(owner[ranked], owner[ranked], side="left")
             lower = ranked[np.arange(ranked.size) - first < MIN_SEARCHES]
+        for slot in np.flatnonzero(np.asarray(missable) > 0.0).tolist():  # the work limit, per search
+            may_hide = np.flatnonzero(hidden & (owner == slot))
+            allowed = max(MAX_SUB_GRID // inside_count - MIN_SEARCHES, 0)
+            if may_hide.size > allowed:
+                hidden[may_hide[np.argsort((floor - threshold)[may_hide], kind="stable")[allowed:]]] = False
         pick = hidden.copy()
         pick[lower] = True
         if not np.any(pick):
@@ -513,12 +563,17 @@ class PointingScore(NamedTuple):
         First time the margin goes negative inside the window [s] (interpolated); ``None`` if never.
     min_margin_time_s : float or None
         Time of the smallest margin [s].
+    missable_s : float
+        [s]: 0, or when the search between the samples was cut coarser by its work limit
+        (:data:`MAX_SUB_GRID`, :attr:`Searched.missable_s`) the longest step of its sub-grid: a
+        violation shorter than it may be missed.
     """
 
     min_margin_deg: float | None
     time_in_violation_s: float
     first_violation_s: float | None
     min_margin_time_s: float | None
+    missable_s: float = 0.0
 
     @property
     def met(self) -> bool:
@@ -884,14 +939,14 @@ class PointingConstraint:
         """
         return scores_between_samples([self], t, q, omega, motion)[0]
 
-    def _scored(self, times: Array, margin: Array) -> PointingScore:
+    def _scored(self, times: Array, margin: Array, missable_s: float = 0.0) -> PointingScore:
         """The score of the margins at the points searched (:meth:`score_between_samples`)."""
         if not np.any(np.isfinite(margin)):
-            return PointingScore(None, 0.0, None, None)
+            return PointingScore(None, 0.0, None, None, missable_s)
         worst = int(np.nanargmin(margin))
         intervals = violation_intervals(times, margin)
         return PointingScore(float(np.rad2deg(margin[worst])), float(sum(b - a for a, b in intervals)),
-                             intervals[0][0] if intervals else None, float(times[worst]))
+                             intervals[0][0] if intervals else None, float(times[worst]), missable_s)
 
     @cached_property
     def drift(self) -> float:
@@ -993,4 +1048,4 @@ def scores_between_samples(constraints: Sequence[PointingConstraint], t: ArrayLi
     moving = HermiteMotion(t, q, omega) if motion is None else motion
     found = searches_between_samples(moving, [(constraint.margins, 0.0, constraint.drift, constraint.window)
                                               for constraint in constraints])
-    return [constraint._scored(times, margin) for constraint, (times, margin) in zip(constraints, found)]
+    return [constraint._scored(search[0], search[1], search.missable_s) for constraint, search in zip(constraints, found)]

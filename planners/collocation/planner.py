@@ -814,6 +814,42 @@ class CollocationPlanner(Planner):
                                    f"cone_margin_deg or a longer duration)")
         return reference
 
+    def _time_bound_note(self, problem: ManeuverProblem, ocp: OptimalControlProblem, result: NLPResult) -> str:
+        """When no start converged on a free final time and some ended locally infeasible or at the
+        final time's bound: that ``maneuver.duration`` bounds the final time and may be below the
+        minimum time (local infeasibility is no proof), and the duration of a feasible slew of the
+        problem when one is known (``eigenaxis``'s ``min_time``, checked against the problem's
+        constraints as :meth:`_seed_bound` checks it, the final time's bound aside: an upper bound
+        of the minimum time, so a ``maneuver.duration`` at least that admits a slew). Else empty."""
+        if not ocp.free_time:
+            return ""
+        bound = float(problem.duration)
+        infeasible = sum(start.status in INFEASIBLE for start in result.starts)
+        plain = not (ocp.energy_weight or ocp.l1_weight)  # the objective is the final time
+        at_bound = sum(plain and start.status not in INFEASIBLE and np.isfinite(start.f)
+                       and start.f >= bound * (1.0 - 1e-6) for start in result.starts)
+        if not infeasible and not at_bound:
+            return ""
+        ended = " and ".join(part for part in (f"{infeasible} ended locally infeasible" if infeasible else "",
+                                               f"{at_bound} stopped at T = {bound:g} s" if at_bound else "") if part)
+        note = (f"the final time is free and maneuver.duration = {bound:g} s bounds it; of {len(result.starts)} "
+                f"starts {ended}: the bound may be below the minimum time, which local infeasibility does not prove")
+        bounds = self._variable_bounds(problem)
+        pointing = self._requirements(problem).pointing
+        known = []
+        for label, candidate in self._bound_candidates(problem, []):
+            if candidate.duration <= bound:
+                continue  # no longer than the bound: it says nothing of the bound
+            broken = start_violations(problem, candidate, bounds, ocp.max_rate, pointing,
+                                      DENSE_POINTS * self.options.intervals + 1, BOUND_TOLERANCE, SEED_BOUND_ATOL)
+            if broken == {}:
+                known.append((float(candidate.duration), label))
+        if known:
+            duration, label = min(known)
+            note += (f"; {label} is a feasible slew of this problem in {duration:.6g} s, so a maneuver.duration "
+                     f"of at least that admits one")
+        return note
+
     @staticmethod
     def _failure_hint(problem: ManeuverProblem, ocp: OptimalControlProblem, statuses: list[str]) -> str:
         """What to try when no start converged, by what the problem asks: the cones (more starts or
@@ -1025,7 +1061,9 @@ class CollocationPlanner(Planner):
         stats = result.stats()
         stats.update(solved.extra, transcription=transcription.name, intervals=solved.intervals, solver=solver)
         if not result.success:
-            hint = self._failure_hint(problem, ocp, result.statuses)
+            hint, note = self._failure_hint(problem, ocp, result.statuses), self._time_bound_note(problem, ocp, result)
+            if note:  # first: what the starts' ends say, then what to try
+                hint = f" ({note}; {hint[2:-1]})" if hint else f" ({note})"
             return FailedReference(self.name, f"{solver} did not converge from any start: "
                                    f"{sorted(set(result.statuses))}{hint}", result.status, stats=stats)
         assert result.x is not None  # success implies a point
