@@ -156,14 +156,18 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
 def _judge(row: Row, scores: dict[str, dict[str, Score]], note: str) -> None:
     """Put a row's requirement scores on it, each with its verdict first (the field ``met``, a bool:
     :data:`~scenarios.requirements.fields.VERDICT`): a row that breaks one is ``violated`` unless it
-    already failed; the message names what breaks (first), then the row's own message and ``note``."""
+    already failed; the message names what breaks (first), then the row's own message, the caveats of
+    requirements met (a score's detail where it is met) and ``note``."""
     row.requirements = {scope: {name: {VERDICT: bool(score.met), **score.values} for name, score in scores[scope].items()}
                         for scope in SCOPE_WORDS if scope in scores} or None
     broken = violations(scores)
     if broken and row.status == "ok":
         row.status = "violated"
     own = [row.message] if row.message else []
-    parts = (own + broken if row.status != "violated" else broken + own) + ([note] if note else [])
+    # a requirement met with a caveat of its scoring (a search between samples at its work limit)
+    caveats = [f"{name} ({SCOPE_WORDS[scope]}) met, but {score.detail}" for scope in SCOPE_WORDS
+               for name, score in scores.get(scope, {}).items() if score.met and score.detail]
+    parts = (own + broken if row.status != "violated" else broken + own) + caveats + ([note] if note else [])
     row.message = "; ".join(parts)
 
 

@@ -104,6 +104,29 @@ def test_a_unit_mix_up_rate_is_searched_within_the_work_limit(monkeypatch) -> No
     assert np.all(np.diff(times) >= 0.0) and -np.nanmin(values) <= math.pi + 1e-12
 
 
+@pytest.mark.parametrize("alpha_deg, met", [(10.0, False), (4.0, True)])
+def test_a_limited_search_is_said_in_the_row_met_or_not(monkeypatch, alpha_deg, met) -> None:
+    """The limited search of the first test reaches the user: its caveat is the score's detail (after
+    what breaks it, or alone when the cone is met: α = 4° < e = 5° is never entered) and the row's
+    message."""
+    from scenarios.output.results import Row
+    from scenarios.requirements.scoring import _pointing
+    from scenarios.runner import _judge
+
+    monkeypatch.setattr(pointing, "MAX_SUB_GRID", 20_000)
+    t, q, omega = spin(10.0, 0.01)
+    requirement = PointingRequirement("x_out", Sensor("x_axis", np.array([1.0, 0.0, 0.0])), True,
+                                      math.radians(alpha_deg), Direction(None, np.array([math.cos(E), 0.0, math.sin(E)])))
+    constraint = requirement.constraint(Geometry(None, None), 10.0)
+    score = _pointing(constraint, constraint.score_between_samples(t, q, omega))
+    assert score.met == met
+    assert "work limit" in score.detail and "may be missed" in score.detail
+    row = Row("spin", "eigenaxis", "ok", "", None, None, None)
+    _judge(row, {"reference": {"x_out": score}}, "")
+    assert row.status == ("ok" if met else "violated")
+    assert "work limit" in row.message and (("met, but" in row.message) == met)
+
+
 HAND = """
 name: hand-colloc
 spacecraft: {inertia: [10.0, 10.0, 10.0], wheels: {max_torque: 0.1, max_momentum: 2.0}}

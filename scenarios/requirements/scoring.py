@@ -57,6 +57,7 @@ from controllers.allocation import (
 from ocp import Spacecraft, quat, target_motion
 from ocp.dynamics.truth import TruthPlant
 from ocp.geometry.pointing import (
+    MAX_SUB_GRID,
     HermiteMotion,
     PointingConstraint,
     PointingScore,
@@ -136,7 +137,9 @@ class Score:
     met : bool
         Whether the requirement holds.
     detail : str
-        What breaks it, in words (empty when met): ``min margin -0.19 deg at 31.2 s, 3.2 s inside``.
+        What breaks it, in words: ``min margin -0.19 deg at 31.2 s, 3.2 s inside``; when met, empty
+        or a caveat of the scoring (the row's message shows it): ``the search between samples
+        reached its work limit ...``.
     """
 
     name: str
@@ -185,13 +188,15 @@ def _pointing_scores(constraints: Sequence[PointingConstraint], t: Array, q: Arr
 def _pointing(constraint: PointingConstraint, score: PointingScore) -> Score:
     values: dict[str, float | None] = dict(zip(POINTING_FIELDS, (score.min_margin_deg, score.time_in_violation_s,
                                                                  score.first_violation_s, score.min_margin_time_s)))
+    limited = (f"; the search between samples reached its work limit ({MAX_SUB_GRID:,} points): a violation "
+               f"shorter than {score.missable_s:.2g} s may be missed") if score.missable_s else ""
     if score.met:
-        return Score(constraint.name, values, True)
+        return Score(constraint.name, values, True, limited[2:])
     assert score.min_margin_deg is not None and score.min_margin_time_s is not None
     where = "inside" if constraint.keep_out else "outside"
     return Score(constraint.name, values, False,
                  f"min margin {score.min_margin_deg:.3g} deg at {_seconds(score.min_margin_time_s)} s, "
-                 f"{_seconds(score.time_in_violation_s)} s {where}")
+                 f"{_seconds(score.time_in_violation_s)} s {where}{limited}")
 
 
 def _seconds(value: float) -> str:
