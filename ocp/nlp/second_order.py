@@ -153,7 +153,8 @@ there: the floor is the factorisation's measured accuracy on the point, not a fi
 curvature stays below every threshold and the point degenerate; the floor, six orders of magnitude
 above the unit roundoff, keeps the Hessian's own rounding (its entries a few roundoffs off) out of
 it. The bench's natural-motion minimum energy (least curvature 7.7e-10 ``‖H‖∞``) is certified at
-``3.2e-10 ‖H‖∞``; the guard refused ``1e-10 ‖H‖∞`` there."""
+``3.2e-10 ‖H‖∞``, its factorisation passing the guard at that threshold (the guard is applied at
+each threshold tried, not at ``δ`` alone)."""
 
 REFINEMENT = 10.0 ** 0.5
 """The ratio of successive thresholds of a degenerate point's refinement (one factorisation each)."""
@@ -295,7 +296,7 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
     A : (m, n) scipy.sparse.coo_matrix
         The active rows on them (no duplicate entries).
     delta : float
-        The curvature threshold ``δ`` (positive): the guard's scale.
+        The curvature threshold ``δ`` (positive): the guard's scale at ``s = 0`` (otherwise ``|s|``).
     scale : float
         ``H``'s scale ``η``, positive (``‖H‖∞``, 1 for a zero ``H``).
 
@@ -350,9 +351,12 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
                 / (norm * float(np.max(np.abs(solution))) + float(np.max(np.abs(rhs))))
         if not np.isfinite(error):
             return f"the KKT matrix's LDLᵀ has zero pivots ({n} free variables, {m} active rows): a non-finite solve"
-        if error * norm > delta / scale / GUARD:
+        # the guard at this factorisation's own threshold |shift| (δ, or a refinement's finer one), so
+        # that its error cannot move a curvature across the threshold it certifies
+        threshold = abs(shift) if shift else delta
+        if error * norm > threshold / scale / GUARD:
             return (f"the KKT matrix's LDLᵀ (no pivoting) is not accurate enough: backward error {error:.1g} × ‖K‖ "
-                    f"{norm:.2g} above {1 / GUARD:g} × the curvature threshold {delta:.1g} / ‖H‖∞ {scale:.2g}")
+                    f"{norm:.2g} above {1 / GUARD:g} × the curvature threshold {threshold:.1g} / ‖H‖∞ {scale:.2g}")
         return int(solver.neig(values)) - m
 
     return count
@@ -465,7 +469,8 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
                                                   f"below −{delta:.1g} not counted: {beyond}")
     if beyond == 0:  # degenerate at δ: are the near-zero curvatures positive, where the factorisation resolves them?
         finer = delta
-        while finer / REFINEMENT >= FINEST_CURVATURE_TOLERANCE * scale:
+        # (the floor itself included: REFINEMENT² is 10 only to rounding)
+        while finer / REFINEMENT >= FINEST_CURVATURE_TOLERANCE * scale * (1.0 - 1e-9):
             finer /= REFINEMENT
             refined = count(-finer)
             if isinstance(refined, str):  # beyond the factorisation's accuracy: no certificate
