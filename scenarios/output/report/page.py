@@ -299,7 +299,8 @@ class Page:
             The columns.
         rows : sequence of sequences
             One value per column for each row: numbers (non-finite ones shown as missing), text,
-            ``None`` (missing) or lists of numbers.
+            bools (shown ``True``/``False``, as ``results.csv`` writes them), ``None`` (missing) or
+            lists of numbers.
         page_size : int, optional
             Rows shown at once, with page buttons and a filter box; ``None``: all rows.
         caption : str, optional
@@ -482,6 +483,7 @@ SCRIPT = r"""
   function shown(v) {
     if (missing(v)) { return "-"; }
     if (typeof v === "number") { return number(v); }
+    if (typeof v === "boolean") { return v ? "True" : "False"; }  // as results.csv and results.md write it
     if (Array.isArray(v)) { return "[" + v.map(shown).join(", ") + "]"; }
     return String(v);
   }
