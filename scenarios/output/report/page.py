@@ -31,8 +31,8 @@ import numpy as np
 from ocp.metrics import METRIC_INFO
 from scenarios.output.report.figures import ATTITUDE_PX
 from scenarios.output.tables import json_safe
-from scenarios.requirements.fields import field_info
-from scenarios.schema.columns import SCOPES, VECTOR_METRICS, is_requirement_column
+from scenarios.requirements.fields import field_info, is_requirement_column
+from scenarios.schema.columns import SCOPES, VECTOR_METRICS
 
 __all__ = ["FIGURE_DIGITS", "PLOTLY_CONFIG", "Column", "Page", "column_unit", "figure_array", "figure_arrays", "plotly_js",
            "plotly_js_bytes"]
