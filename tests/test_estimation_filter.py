@@ -212,3 +212,24 @@ def test_star_tracker_noise_is_per_sensor_axis():
     np.testing.assert_allclose(np.diag(tracker.covariance), [100.0, 1.0, 1.0], atol=1e-12)
     draws = draw_sensor_noise(SensorSuite(star_tracker=tracker), 1, np.arange(20001.0))[:, 6:9]
     np.testing.assert_allclose(draws.std(axis=0), [10.0, 1.0, 1.0], rtol=0.03)
+
+
+@pytest.mark.parametrize("outages, words", [
+    ((10, 20), "got a single window (10, 20); write outages=((10, 20),)"),
+    ([10.0, 20.0], "got a single window (10.0, 20.0)"),
+    (((1.0, 2.0, 3.0),), "an outage must be a window (t0, t1) of two numbers of s, got (1.0, 2.0, 3.0)"),
+    (((1.0, "2"),), "an outage must be a window (t0, t1) of two numbers of s, got (1.0, '2')"),
+    ((5.0,), "an outage must be a window (t0, t1) of two numbers of s, got 5.0"),
+    (7.0, "outages must be a tuple of (t0, t1) windows in s, got 7.0"),
+])
+def test_star_tracker_refuses_outages_that_are_not_windows_in_words(outages, words):
+    """A single window (or anything but a tuple of pairs of numbers) is a ValueError that says what
+    was expected, as a single Exclusion is, not a raw unpacking TypeError."""
+    with pytest.raises(ValueError) as raised:
+        StarTracker(noise=[1e-5] * 3, outages=outages)
+    assert words in str(raised.value)
+
+
+def test_star_tracker_takes_windows_as_lists_and_arrays():
+    assert StarTracker(noise=[1e-5] * 3, outages=[[1, 2], [3, 4.5]]).outages == ((1.0, 2.0), (3.0, 4.5))
+    assert StarTracker(noise=[1e-5] * 3, outages=np.array([[1.0, 2.0]])).outages == ((1.0, 2.0),)

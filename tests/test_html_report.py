@@ -44,6 +44,7 @@ from scenarios.output.report.run import run_report
 from scenarios.output.writer import write_results
 from scenarios.study.engine import sweep
 from tests.browser import chromium, errors_in, needs_browser, open_page
+
 KEEP_OUT = np.array([-1.0, 1.0, 0.0]) / np.sqrt(2.0)
 """The camera's keep-out direction: where its boresight (body y) points half-way through the slew."""
 CONE_DEG = 20.0
@@ -444,6 +445,33 @@ def test_the_run_report_in_a_browser(browser, run_results, run_html, tmp_path):
     assert "bang-bang" in browser.execute_script("return document.querySelector('#attitude .gtitle').textContent")
     assert not errors_in(browser.get_log("browser"))
     check_screenshot(browser, tmp_path / "run.png")
+
+
+@needs_browser
+def test_the_run_reports_verdicts_read_as_in_results_csv(browser, run_results, run_html, tmp_path):
+    """The per-requirement verdicts (``<scope>.req.<name>.met``, bools) are shown in the page's rows
+    table as ``results.csv`` writes them (``True``/``False``, read back by the ``csv`` module), not as
+    JSON's ``true``/``false``."""
+    write_results(run_results, tmp_path / "run", plots=False)
+    with open(tmp_path / "run" / "results.csv", newline="", encoding="utf-8") as handle:
+        csv_rows = list(csv.DictReader(handle))
+    verdicts = [column for column in csv_rows[0] if column.count(".") == 3 and column.endswith(".met")]
+    assert {"ref.req.cam_keep_out.met", "cl.req.cam_keep_out.met", "cl.req.rate.met"} <= set(verdicts)
+    page = tmp_path / "report.html"
+    page.write_text(run_html, encoding="utf-8")
+    open_page(browser, page)
+    cells = browser.execute_script(
+        "var keys = window.slewbench.data.tables.rows.columns.map(function (c) { return c.key; });"
+        "return Array.prototype.map.call(document.querySelectorAll('#rows tbody tr'), function (tr) {"
+        "  var out = {}; Array.prototype.forEach.call(tr.cells, function (td, j) { out[keys[j]] = td.textContent; });"
+        "  return [Number(tr.dataset.row), out]; });")
+    assert len(cells) == len(csv_rows) == 2
+    shown = set()
+    for index, texts in cells:
+        for column in verdicts:
+            assert texts[column] == csv_rows[index][column], (index, column)
+            shown.add(texts[column])
+    assert shown == {"True", "False"}  # both verdicts occur (the keep-out is broken, not every requirement)
 
 
 @needs_browser

@@ -32,8 +32,10 @@ from scenarios.requirements.fields import (
     VERDICT,
     VERDICT_UNIT,
     field_info,
+    is_requirement_column,
     is_verdict_column,
 )
+from scenarios.schema import columns as schema_columns
 from scenarios.study.engine import sweep
 from scenarios.study.report import requirement_lines as study_lines
 from scenarios.study.report import requirement_table
@@ -242,3 +244,25 @@ def test_the_sweep_prints_the_counts(tmp_path, capsys):
                                             "  eigenaxis: st (reference) met in 2 of 2 cases",
                                             "  eigenaxis: st (closed loop) met in 1 of 2 cases",
                                             "  eigenaxis: actuators (reference) met in 2 of 2 cases"]
+
+
+REQUIREMENT_COLUMNS = ["ref.req.st.min_margin_deg", "cl.req.st.met", "ref.req.actuators.wheels_torque_time_s",
+                       "ref.req.rate.met", "cl.req.final.worst_error_deg"]
+"""Requirement columns, written out by hand: ``<ref|cl>.req.<name>.<field>``."""
+OTHER_COLUMNS = ["status", "plan_time_s", "ref.final_error_deg", "cl.int_abs_u_x", "ref.req.st", "xx.req.st.met",
+                 "cl.reqs.st.met", "cl.req..met", "cl.req.st.", "cl.req.st.met.x", "req.st.met", "cl.met.st.req"]
+"""Columns that are no requirement's: metrics, identity columns, and near misses of the pattern."""
+
+
+def test_one_helper_tells_a_requirement_column_and_its_verdict():
+    assert all(is_requirement_column(column) for column in REQUIREMENT_COLUMNS)
+    assert not any(is_requirement_column(column) for column in OTHER_COLUMNS)
+    assert [c for c in REQUIREMENT_COLUMNS + OTHER_COLUMNS if is_verdict_column(c)] == ["cl.req.st.met",
+                                                                                        "ref.req.rate.met"]
+    # the columns' naming the schema builds them by (prefixes, mark) is the one the helpers read
+    for _, prefix in schema_columns.SCOPES:
+        column = f"{prefix}.{schema_columns.REQUIREMENT_MARK}.st.{VERDICT}"
+        assert is_requirement_column(column) and is_verdict_column(column)
+    assert not is_requirement_column(f"{schema_columns.SCOPES[0][1]}.{schema_columns.REQUIREMENT_MARK}x.st.met")
+    # one way to ask: the schema's names keep no helper of their own
+    assert not hasattr(schema_columns, "is_requirement_column")

@@ -129,6 +129,38 @@ def test_the_earth_limb_cone_is_the_half_angle_plus_the_earths_apparent_radius(b
     np.testing.assert_array_equal(result.blinded != 0, angle < cone)
 
 
+def test_the_sun_blinds_the_tracker_in_eclipse_too(blinded_example):
+    """The Sun's exclusion makes no shadow test (conservative: a real tracker is not blinded by an
+    eclipsed Sun). A 500 km circular orbit at 51.6° with its node at RAAN 270° starts on the
+    night side: the spacecraft is in the Earth's cylindrical shadow (by hand: behind the Earth from
+    the Sun, nearer the Sun line than the Earth's radius) at every sample, and the tracker is
+    blinded exactly where the boresight is within 30° of the Sun seen from there."""
+    _, reference = blinded_example
+    data = scenario_data({"sun": HALF_ANGLE_DEG})
+    data["orbit"] = {"altitude_km": 500.0, "inclination_deg": 51.6, "raan_deg": 270.0}
+    scenario = parse_scenario(data)
+    result = simulate(scenario, reference, python_loop=True)
+    t = result.t[:-1]
+    mu, radius = 3.986004418e14, 6378137.0  # m³/s², m (WGS-84)
+    a, inclination = radius + 500e3, math.radians(51.6)
+    u = math.sqrt(mu / a**3) * t
+    # (cos u, sin u cos i, sin u sin i) turned 270° about z: (x, y, z) -> (y, -x, z)
+    position = a * np.stack([np.sin(u) * math.cos(inclination), -np.cos(u), np.sin(u) * math.sin(inclination)],
+                            axis=1)
+    sun = sun_position(EPOCH, t)
+    sun_unit = sun / np.linalg.norm(sun, axis=1, keepdims=True)
+    along = np.sum(position * sun_unit, axis=1)
+    off_axis = np.linalg.norm(position - along[:, None] * sun_unit, axis=1)
+    assert np.all(along < 0) and np.all(off_axis < radius)  # in the umbra's cylinder throughout
+    seen = sun - position
+    seen /= np.linalg.norm(seen, axis=1, keepdims=True)
+    boresight = Rotation.from_quat(result.q[:-1][:, [1, 2, 3, 0]]).apply([0.0, 0.0, 1.0])
+    angle = np.degrees(np.arccos(np.clip(np.sum(boresight * seen, axis=1), -1.0, 1.0)))
+    assert np.min(np.abs(angle - HALF_ANGLE_DEG)) > 1e-3  # no sample on the edge
+    assert 5 <= np.count_nonzero(angle < HALF_ANGLE_DEG) <= angle.size - 20
+    np.testing.assert_array_equal(result.blinded != 0, angle < HALF_ANGLE_DEG)
+
+
 def test_without_the_exclusion_nothing_is_blinded(blinded_example):
     scenario, reference = blinded_example
     plain = parse_scenario(scenario_data()).simulation.sensors

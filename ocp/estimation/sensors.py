@@ -173,6 +173,29 @@ class Exclusion:
         return directions, np.cos(np.minimum(self.half_angle + growth, math.pi))
 
 
+def _windows(outages: Any) -> tuple[tuple[float, float], ...]:
+    """The outage windows as float pairs, or a ValueError saying what was expected (a single
+    window, ``(10, 20)``, is refused in words, as a single :class:`Exclusion` is)."""
+    try:
+        windows = tuple(outages)
+    except TypeError:
+        raise ValueError(f"outages must be a tuple of (t0, t1) windows in s, got {outages!r:.80}") from None
+    if len(windows) == 2 and all(_real(t) for t in windows):
+        raise ValueError(f"outages must be a tuple of (t0, t1) windows, got a single window {windows!r}; "
+                         f"write outages=(({windows[0]!r}, {windows[1]!r}),)")
+    pairs = []
+    for window in windows:
+        try:
+            pair = tuple(window)
+        except TypeError:
+            pair = ()
+        if len(pair) != 2 or not all(_real(t) for t in pair):
+            raise ValueError(f"an outage must be a window (t0, t1) of two numbers of s, got {window!r:.80} "
+                             f"in outages={outages!r:.80}")
+        pairs.append((float(pair[0]), float(pair[1])))
+    return tuple(pairs)
+
+
 @dataclass(frozen=True)
 class StarTracker:
     """A star tracker: attitude with per-axis noise in its own frame, at a rate, with outages.
@@ -221,7 +244,7 @@ class StarTracker:
             if not _real(self.rate) or not math.isfinite(self.rate) or not self.rate > 0:
                 raise ValueError(f"rate must be a finite positive number of Hz or None, got {self.rate!r}")
             object.__setattr__(self, "rate", float(self.rate))
-        windows = tuple((float(a), float(b)) for a, b in self.outages)
+        windows = _windows(self.outages)
         for a, b in windows:
             if not (math.isfinite(a) and math.isfinite(b) and b > a):
                 raise ValueError(f"an outage must be [t0, t1] with t0 < t1 (s), got {[a, b]}")

@@ -25,14 +25,17 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from scenarios.requirements.fields import field_info, is_verdict_column
+from scenarios.requirements.fields import (
+    field_info,
+    is_requirement_column,
+    is_verdict_column,
+)
 from scenarios.schema.columns import (
     AXES,
     REQUIREMENT_MARK,
     SCOPES,
     SCORED_METRICS,
     VECTOR_METRICS,
-    is_requirement_column,
     metric_columns,
 )
 
@@ -258,7 +261,7 @@ def data_frame(columns: Sequence[str], records: Iterable[Mapping[str, Any]], num
         The lines.
     numeric : iterable of str
         The columns that hold numbers (never ``None`` in the DataFrame); the requirement columns
-        (:func:`~scenarios.schema.columns.is_requirement_column`) are numeric too, but for the
+        (:func:`~scenarios.requirements.fields.is_requirement_column`) are numeric too, but for the
         verdicts (``<scope>.req.<name>.met``,
         :func:`~scenarios.requirements.fields.is_verdict_column`): pandas' nullable ``boolean``,
         ``<NA>`` where missing, never a float to average.

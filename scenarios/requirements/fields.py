@@ -30,7 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 __all__ = ["QUANTITY", "REQUIREMENT_FIELDS", "VERDICT", "VERDICT_UNIT", "RequirementField", "field_info",
-           "is_verdict_column", "requirement_kind"]
+           "is_requirement_column", "is_verdict_column", "requirement_kind"]
 
 QUANTITY = "<quantity>"
 """The placeholder of an actuator quantity's name in the patterns of :data:`REQUIREMENT_FIELDS`."""
@@ -44,6 +44,9 @@ alone."""
 
 _SCOPE_PREFIXES = ("ref", "cl")
 """The scope prefixes of the requirement columns (:data:`scenarios.schema.columns.SCOPES`)."""
+_MARK = "req"
+"""The segment after the scope prefix of a requirement column
+(:data:`scenarios.schema.columns.REQUIREMENT_MARK`)."""
 _KINDS_BY_NAME = {"actuators": "actuators", "rate": "rate", "final": "final"}
 """The requirement names that are not a pointing requirement's, and their kind (the same word)."""
 
@@ -172,6 +175,24 @@ REQUIREMENT_FIELDS: tuple[RequirementField, ...] = (
 first (the actuator quantities' fields as the patterns ``<quantity>`` and ``<quantity>_time_s``)."""
 
 
+def is_requirement_column(column: str) -> bool:
+    """Whether a column holds a requirement score (``ref.req.<name>.<field>``, ``cl.req.<name>.<field>``).
+
+    Parameters
+    ----------
+    column : str
+        A column name.
+
+    Returns
+    -------
+    bool
+        True for ``<prefix>.req.<name>.<field>`` with a scope prefix and non-empty name and field
+        (a verdict, :func:`is_verdict_column`, too).
+    """
+    parts = column.split(".")
+    return len(parts) == 4 and parts[0] in _SCOPE_PREFIXES and parts[1] == _MARK and all(parts[2:])
+
+
 def is_verdict_column(column: str) -> bool:
     """Whether a column is a requirement's verdict: ``ref.req.<name>.met`` or ``cl.req.<name>.met``.
 
@@ -185,9 +206,7 @@ def is_verdict_column(column: str) -> bool:
     bool
         True for a requirement column (``<scope>.req.<name>.<field>``) whose field is :data:`VERDICT`.
     """
-    parts = column.split(".")
-    return (len(parts) == 4 and parts[0] in _SCOPE_PREFIXES and parts[1] == "req" and bool(parts[2])
-            and parts[3] == VERDICT)
+    return is_requirement_column(column) and column.rsplit(".", 1)[1] == VERDICT
 
 
 def requirement_kind(name: str) -> str:
@@ -244,7 +263,7 @@ def field_info(column_or_field: str) -> RequirementField:
         requirement has no peak rate), or the text is no requirement field.
     """
     parts = column_or_field.split(".")
-    if len(parts) == 4 and parts[0] in _SCOPE_PREFIXES and parts[1] == "req":
+    if len(parts) == 4 and parts[0] in _SCOPE_PREFIXES and parts[1] == _MARK:
         name, field = parts[2], parts[3]
     elif len(parts) == 2:
         name, field = parts

@@ -4,7 +4,8 @@ columns ``ref.req.<name>.<field>`` and ``cl.req.<name>.<field>``.
 One naming for a row's metrics wherever they appear flat: a run's ``results.csv`` and DataFrame, a
 trade study's ``cases.csv``, DataFrame and ``summary:`` keys. It lives in the schema because a study's
 ``summary:`` keys are validated against it when the study is read; the tables
-(:mod:`scenarios.output.tables`) flatten rows by it.
+(:mod:`scenarios.output.tables`) flatten rows by it. Whether a column is a requirement's is asked
+of :func:`scenarios.requirements.fields.is_requirement_column`.
 
 May import: :mod:`ocp.metrics`; nothing else of slewbench.
 """
@@ -12,8 +13,7 @@ from __future__ import annotations
 
 from ocp.metrics import METRIC_KEYS
 
-__all__ = ["AXES", "REQUIREMENT_MARK", "SCOPES", "SCORED_METRICS", "VECTOR_METRICS", "is_requirement_column",
-           "metric_columns"]
+__all__ = ["AXES", "REQUIREMENT_MARK", "SCOPES", "SCORED_METRICS", "VECTOR_METRICS", "metric_columns"]
 
 SCOPES = (("reference", "ref"), ("closed_loop", "cl"))
 """(key of the nested row, prefix of its flat columns) for the reference's and the closed loop's metrics."""
@@ -25,24 +25,6 @@ SCORED_METRICS = tuple(key for key in METRIC_KEYS if key != "plan_time_s")
 """The metrics of a row's columns (``plan_time_s`` is a column that names the row, not a score)."""
 REQUIREMENT_MARK = "req"
 """The segment after the scope prefix of a requirement column (``ref.req.<name>.<field>``)."""
-
-
-def is_requirement_column(column: str) -> bool:
-    """Whether a column holds a requirement score (``ref.req.<name>.<field>``, ``cl.req.<name>.<field>``).
-
-    Parameters
-    ----------
-    column : str
-        A column name.
-
-    Returns
-    -------
-    bool
-        True for ``<prefix>.req.<name>.<field>`` with a scope prefix and non-empty name and field.
-    """
-    parts = column.split(".")
-    return (len(parts) == 4 and parts[1] == REQUIREMENT_MARK and parts[0] in {p for _, p in SCOPES}
-            and all(parts[2:]))
 
 
 def metric_columns(vectors: bool = True) -> list[str]:

@@ -108,8 +108,9 @@ STAR_TRACKER = Section((
            "given beside it, it must be the same direction.", "list of 3 numbers or null", _boresight, default=None),
     custom("exclusion_deg", "Exclusion half-angles about bright bodies: an update due at a sample is dropped "
            "when the true attitude puts the boresight within that angle of the body (of the Earth's limb for "
-           "``earth_limb``); the MEKF then only propagates. In the order written: the i-th is bit i of the "
-           "``blinded`` time-series column. The sensor's only source of blinding: a pointing "
+           "``earth_limb``); the MEKF then only propagates. The Sun's holds in eclipse too (no shadow test; "
+           "conservative: a real tracker is not blinded by an eclipsed Sun). In the order written: the i-th is "
+           "bit i of the ``blinded`` time-series column. The sensor's only source of blinding: a pointing "
            "requirement keeping the tracker off a body is scored, not applied to the sensor. Absent or "
            "``null``: none.", "mapping or null", _exclusions, unit="deg", default={}, section=EXCLUSION),
 ), "A star tracker; it replaces ``sensor_noise.attitude_deg``.")

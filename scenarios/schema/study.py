@@ -31,13 +31,13 @@ from scenarios.errors import ScenarioError
 from scenarios.requirements.fields import (
     REQUIREMENT_FIELDS,
     VERDICT,
+    is_requirement_column,
     is_verdict_column,
     requirement_kind,
 )
 from scenarios.schema.columns import (
     REQUIREMENT_MARK,
     VECTOR_METRICS,
-    is_requirement_column,
     metric_columns,
 )
 from scenarios.schema.keys import (

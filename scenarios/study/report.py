@@ -34,8 +34,12 @@ from scenarios.output.tables import (
     row_columns,
     text_cell,
 )
-from scenarios.requirements.fields import VERDICT, is_verdict_column
-from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES, is_requirement_column
+from scenarios.requirements.fields import (
+    VERDICT,
+    is_requirement_column,
+    is_verdict_column,
+)
+from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES
 from scenarios.study.store import claim_sweep_directory, commit_sweep_outputs
 from scenarios.study.types import Study
 
@@ -469,7 +473,7 @@ def requirement_verdicts(rows: list[dict[str, Any]]) -> list[tuple[str, str]]:
     list of (str, str)
         ``(criterion, column)``: :func:`requirement_criterion` and ``<scope>.req.<name>.met``, for
         each requirement and scope with a requirement column in some row
-        (:func:`~scenarios.schema.columns.is_requirement_column`), whether or not the verdict
+        (:func:`~scenarios.requirements.fields.is_requirement_column`), whether or not the verdict
         itself was stored (a store written before verdicts were has the scores only).
     """
     names: dict[str, None] = {}

@@ -33,8 +33,9 @@ import numpy as np
 from ocp.errors import excerpt
 from scenarios.errors import ScenarioError
 from scenarios.output.provenance import package_version
+from scenarios.requirements.fields import is_requirement_column
 from scenarios.requirements.scoring import score_fields
-from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES, is_requirement_column
+from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES
 from scenarios.schema.keys import Key
 from scenarios.schema.loader import Scenario, parse_scenario
 from scenarios.schema.node import Node

@@ -31,8 +31,8 @@ import numpy as np
 from ocp.metrics import METRIC_INFO
 from scenarios.output.report.figures import ATTITUDE_PX
 from scenarios.output.tables import json_safe
-from scenarios.requirements.fields import field_info
-from scenarios.schema.columns import SCOPES, VECTOR_METRICS, is_requirement_column
+from scenarios.requirements.fields import field_info, is_requirement_column
+from scenarios.schema.columns import SCOPES, VECTOR_METRICS
 
 __all__ = ["FIGURE_DIGITS", "PLOTLY_CONFIG", "Column", "Page", "column_unit", "figure_array", "figure_arrays", "plotly_js",
            "plotly_js_bytes"]
@@ -299,7 +299,8 @@ class Page:
             The columns.
         rows : sequence of sequences
             One value per column for each row: numbers (non-finite ones shown as missing), text,
-            ``None`` (missing) or lists of numbers.
+            bools (shown ``True``/``False``, as ``results.csv`` writes them), ``None`` (missing) or
+            lists of numbers.
         page_size : int, optional
             Rows shown at once, with page buttons and a filter box; ``None``: all rows.
         caption : str, optional
@@ -482,6 +483,7 @@ SCRIPT = r"""
   function shown(v) {
     if (missing(v)) { return "-"; }
     if (typeof v === "number") { return number(v); }
+    if (typeof v === "boolean") { return v ? "True" : "False"; }  // as results.csv and results.md write it
     if (Array.isArray(v)) { return "[" + v.map(shown).join(", ") + "]"; }
     return String(v);
   }

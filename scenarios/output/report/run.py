@@ -32,7 +32,7 @@ from scenarios.output.tables import (
     requirement_columns,
     row_columns,
 )
-from scenarios.schema.columns import is_requirement_column
+from scenarios.requirements.fields import is_requirement_column
 
 if TYPE_CHECKING:
     from scenarios.output.results import RunResults
