@@ -37,3 +37,13 @@ def test_a_summary_verdict_names_the_path_and_the_requirements_numbers(column, n
     message = _error(summary=["cl.rms_error_deg", column])
     assert message.startswith(f"summary[1]: {column!r} is whether requirement"), message
     assert "not a number to summarise" in message and number in message and "given the bound" not in message
+
+
+@pytest.mark.parametrize("column, kind, scope", [("ref.req.final.met", "final", "reference"),
+                                                 ("cl.req.actuators.met", "actuators", "closed loop")])
+def test_a_verdict_of_a_scope_that_never_scores_the_requirement_says_so(column, kind, scope):
+    # a final requirement is scored in the closed loop only, the actuators in the reference only: no
+    # number columns to offer there (the message listed none: "such as " and nothing)
+    message = _error(robustness={"thresholds": {column: True}})
+    assert f"({kind}) is not scored in the {scope}" in message and "(given the bound True)" in message
+    assert not message.rstrip().endswith("such as")

@@ -535,6 +535,11 @@ def _metric_column(metric: str, where: str, bound: object = _UNSET) -> str:
         numbers = [f"{prefix}.{REQUIREMENT_MARK}.{name}.{declared.field}" for declared in REQUIREMENT_FIELDS
                    if declared.requirement == kind and declared.field != VERDICT and prefix in declared.scopes]
         given = "" if bound is _UNSET else f" (given the bound {excerpt(bound)})"
+        scope = "reference" if prefix == "ref" else "closed loop"
+        if not numbers:  # a kind of requirement never scored in this scope (final in the reference)
+            raise ScenarioError(where, f"{metric!r}: requirement {name!r} ({kind}) is not scored in the {scope}, so it has no "
+                                       f"verdict there{given}; expected a number column such as a metric "
+                                       f"(cl.final_error_deg) or a requirement's field in a scope that scores it")
         raise ScenarioError(where, f"{metric!r} is whether requirement {name!r} is met in the "
                                    f"{'reference' if prefix == 'ref' else 'closed loop'}, true or false (its verdict: "
                                    f"requirements.csv counts the cases that meet it), not a number to "
