@@ -72,3 +72,50 @@ def test_a_max_step_the_user_set_is_still_blamed_on_max_step():
     error = _error(parse_scenario, data)
     assert error.path == "simulation.max_step", str(error)
     assert "0.001" in error.message and "5" in error.message
+
+
+# --- slewbench table: the work it is asked for (report D5) ---
+
+def _table_scenario(tmp_path):
+    import yaml
+    path = tmp_path / "tiny.yaml"
+    path.write_text(yaml.safe_dump(copy.deepcopy(BASE)))
+    return path
+
+
+def test_a_bare_angle_count_over_the_entry_limit_is_refused_before_anything_is_written(tmp_path, capsys):
+    """``--angles 90`` is 90 angles: 30 axes x 90 = 2700 solves, over the default 2000."""
+    from scenarios.cli.commands import main
+    out = tmp_path / "out"
+    status = main(["table", str(_table_scenario(tmp_path)), "--grid", "fibonacci", "--axes", "30", "--angles", "90",
+                   "--out", str(out), "--no-plots"])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert "30 axes x 90 angles = 2700 entries, more than 2000" in err
+    assert "not 90 deg" in err and "--max-entries 2700" in err
+    assert not out.exists()
+
+
+def test_max_entries_sets_the_limit_and_a_list_of_angles_gets_no_count_hint(tmp_path, capsys):
+    from scenarios.cli.commands import main
+    out = tmp_path / "out"
+    status = main(["table", str(_table_scenario(tmp_path)), "--grid", "fibonacci", "--axes", "10", "--angles", "30,90",
+                   "--max-entries", "19", "--out", str(out), "--no-plots"])
+    err = capsys.readouterr().err
+    assert status == 2 and "10 axes x 2 angles = 20 entries, more than 19" in err, err
+    assert "means" not in err and not out.exists()
+    assert main(["table", str(_table_scenario(tmp_path)), "--max-entries", "0", "--out", str(out)]) == 2
+    assert "--max-entries: expected a positive number" in capsys.readouterr().err
+
+
+def test_a_polytope_grid_says_how_many_axes_it_has_when_not_the_count_asked(tmp_path, capsys):
+    """Three body-axis wheels of one torque: the torque polytope is a cube, whose 8 vertices and 6
+    face centres are the fewest axes its grid has."""
+    from scenarios.cli.commands import main
+    status = main(["table", str(_table_scenario(tmp_path)), "--axes", "4", "--angles", "30,90", "--max-entries", "1",
+                   "--out", str(tmp_path / "out"), "--no-plots"])
+    captured = capsys.readouterr()
+    assert status == 2
+    assert "4 axes asked for, the polytope grid has 14" in captured.out, captured.out
+    assert "--grid fibonacci gives exactly 4" in captured.out
+    assert "14 axes x 2 angles = 28 entries" in captured.err
