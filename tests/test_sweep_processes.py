@@ -129,3 +129,72 @@ def test_sigterm_then_sigkill_then_resume_equals_an_uninterrupted_run(tmp_path):
     reference = pd.read_csv(tmp_path / "reference" / "cases.csv")
     assert len(resumed) == 20 and not resumed.duplicated(["case", "label"]).any()
     pd.testing.assert_frame_equal(comparable(resumed), comparable(reference))
+
+
+def _session(sid: int) -> list[int]:
+    """Processes (not zombies) of the session ``sid``."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+        except OSError:  # ended meanwhile
+            continue
+        fields = stat[stat.rindex(")") + 2:].split()  # state, ppid, pgrp, session, ...
+        if int(fields[3]) == sid and fields[0] != "Z":
+            found.append(int(entry.name))
+    return found
+
+
+def _forkserver_importing(sweep_pid: int) -> bool:
+    """Whether a child of the sweep is the fork server of its workers and has set up its SIGINT
+    disposition (caught: Python's KeyboardInterrupt; or ignored): it imports the model now."""
+    for entry in Path(f"/proc/{sweep_pid}/task").iterdir():
+        for child in (entry / "children").read_text().split():
+            with contextlib.suppress(OSError, ValueError):
+                if b"forkserver" in Path(f"/proc/{child}/cmdline").read_bytes():
+                    status = dict(line.split(":\t", 1) for line in Path(f"/proc/{child}/status").read_text().splitlines()
+                                  if ":\t" in line)
+                    sigint = 1 << (signal.SIGINT - 1)
+                    return bool((int(status["SigCgt"], 16) | int(status["SigIgn"], 16)) & sigint)
+    return False
+
+
+def test_ctrl_c_while_the_workers_import_ends_the_sweep_without_a_traceback_or_a_process_left(tmp_path):
+    """Ctrl-C in a terminal reaches the whole foreground process group, the fork server of the
+    local workers too, which then imports the model (seen: its KeyboardInterrupt traceback mixed
+    into the sweep's "interrupted" message). The interrupt is sent as soon as the server's Python
+    runs; 3000 Monte Carlo cases keep the sweep checking them meanwhile (several seconds), as the
+    user's 40 cases of a heavier study did."""
+    (tmp_path / "base.yaml").write_text(yaml.safe_dump(BASE))
+    path = tmp_path / "study.yaml"
+    path.write_text(yaml.safe_dump({"study": "interrupted", "scenario": "base.yaml", "monte_carlo": {
+        "samples": 3000, "seed": 1, "dispersions": {
+            "simulation.initial_attitude_error_deg": {"normal": {"mean": [0, 0, 0], "std": [1, 1, 1]}}}}}))
+    command = [sys.executable, "-c", "import sys, scenarios.console; sys.exit(scenarios.console.main())",
+               "sweep", str(path), "--out", str(tmp_path / "out"), "--workers", "2", "--no-plots"]
+    process = subprocess.Popen(command, cwd=ROOT, start_new_session=True, text=True, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    try:
+        start = time.monotonic()
+        while not _forkserver_importing(process.pid):
+            assert process.poll() is None, process.communicate()
+            assert time.monotonic() - start < 20, "no fork server was started"
+            time.sleep(0.005)
+        os.killpg(process.pid, signal.SIGINT)  # what Ctrl-C does
+        stdout, stderr = process.communicate(timeout=20)
+        deadline = time.monotonic() + 5
+        while _session(process.pid) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        left = _session(process.pid)
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait(timeout=10)
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)  # whatever the sweep left behind
+    assert "Traceback" not in stderr, stderr
+    assert process.returncode == 130, (stdout, stderr)
+    assert "interrupted while its cases were checked" in stderr, "not interrupted where the test means to"
+    assert not left, f"processes left behind: {left}"

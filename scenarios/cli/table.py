@@ -17,7 +17,7 @@ import signal
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from scenarios.cli.status import (
     EXIT_BAD_SCENARIO,
@@ -28,6 +28,9 @@ from scenarios.cli.status import (
     crash_report,
     directory_argument,
 )
+
+if TYPE_CHECKING:
+    from scenarios.slewtable.spec import TableSpec
 
 
 def _terminate(signum: int, frame: Any) -> None:
@@ -45,6 +48,35 @@ def _integer(text: str) -> int | str:
 def _count(number: int, one: str, many: str | None = None) -> str:
     """``1 axis``, ``2 axes``."""
     return f"{number} {one if number == 1 else (many or one + 's')}"
+
+
+MAX_ENTRIES = 2000
+"""Most entries (axes x angles, and the held-out grid's) ``table`` computes without ``--max-entries``:
+at 1 to 90 s of collocation each, 2000 entries are hours on a few cores."""
+
+
+def _check_work(spec: TableSpec, entries: int, args: argparse.Namespace) -> None:
+    """Say how many axes the grid has when it is not the number asked for, and refuse more than
+    ``--max-entries`` (default :data:`MAX_ENTRIES`) entries, naming the count and how to go on."""
+    if spec.axes_asked is not None and spec.axes_asked != len(spec.axes):
+        print(f"{spec.name}: {_count(spec.axes_asked, 'axis', 'axes')} asked for, the {spec.grid} grid has "
+              f"{len(spec.axes)}: every vertex and face centre of the torque polytope, its faces subdivided evenly "
+              f"(so its counts come in steps); --grid fibonacci gives exactly {spec.axes_asked}", flush=True)
+    from scenarios.errors import ScenarioError
+    if args.max_entries is not None and args.max_entries < 1:
+        raise ScenarioError("--max-entries", f"expected a positive number of entries, got {args.max_entries}")
+    limit = MAX_ENTRIES if args.max_entries is None else args.max_entries
+    if entries <= limit:
+        return
+    angles = str(args.angles or "").strip()
+    bare = f"; --angles {angles} means {angles} angles spread from 10 to 180 deg, not {angles} deg (angles in " \
+           f"degrees are a comma-separated list, e.g. --angles 30,90)" if angles.isdigit() else ""
+    raise ScenarioError("--max-entries", f"{_count(len(spec.axes), 'axis', 'axes')} x "
+                                         f"{_count(len(spec.angles_deg), 'angle')}"
+                        + (f" + the held-out grid's {spec.held_out * max(len(spec.angles_deg) - 1, 0)}"
+                           if spec.held_out else "")
+                        + f" = {entries} entries, more than {limit} (each a collocation solve: seconds to minutes){bare}; "
+                        f"to compute them all, give --max-entries {entries}")
 
 
 def command_table(args: argparse.Namespace) -> int:
@@ -90,6 +122,8 @@ def command_table(args: argparse.Namespace) -> int:
     if not args.no_plots:
         import matplotlib  # noqa: F401  (fail now, not after the entries ran)
     out = Path(args.out) if args.out else default_output_directory(f"table-{spec.name}")
+    entries = len(spec.axes) * len(spec.angles_deg) + spec.held_out * max(len(spec.angles_deg) - 1, 0)
+    _check_work(spec, entries, args)
     # the scheduler first: one that cannot be reached exits 2 with nothing written
     cluster = connect_scheduler(spec.scheduler, "--scheduler" if args.scheduler else "table.execution.scheduler") \
         if spec.scheduler else None
@@ -99,7 +133,6 @@ def command_table(args: argparse.Namespace) -> int:
         if cluster is not None:
             cluster.close()
         raise
-    entries = len(spec.axes) * len(spec.angles_deg) + spec.held_out * max(len(spec.angles_deg) - 1, 0)
     print(f"{spec.name}: {_count(len(spec.axes), 'axis', 'axes')} x {_count(len(spec.angles_deg), 'angle')}"
           + (f" + {_count(spec.held_out, 'held-out axis', 'held-out axes')} x "
              f"{_count(len(spec.angles_deg) - 1, 'angle')}" if spec.held_out else "")
@@ -283,11 +316,15 @@ def add_table_parser(commands: Any) -> None:
                f"{EXIT_INTERRUPTED} interrupted (the finished entries are stored: run it again). The table file's "
                "keys: slewbench schema table")
     parser.add_argument("file", help="scenario YAML file, or a table file (top-level key 'table')")
-    parser.add_argument("--axes", type=_integer, help="number of eigen-axes (about; default 40)")
+    parser.add_argument("--axes", type=_integer, help="number of eigen-axes (default 40; a polytope grid takes the "
+                                                      "nearest count it makes, at least its vertices and face "
+                                                      "centres, and says so; fibonacci: exactly)")
     parser.add_argument("--grid", help="how the axes are spread: polytope (default: along the actuators' kinks) "
                                        "or fibonacci")
-    parser.add_argument("--angles", help="slew angles [deg]: a comma-separated list, or a count from 10 to 180 "
-                                         "(default 10,30,60,90,120,150,180)")
+    parser.add_argument("--angles", help="slew angles [deg]: a comma-separated list (e.g. 30,90), or N, a count: "
+                                         "N angles spread from 10 to 180 deg (default 10,30,60,90,120,150,180)")
+    parser.add_argument("--max-entries", type=int,
+                        help=f"most entries (axes x angles) to compute; more are refused (default {MAX_ENTRIES})")
     parser.add_argument("--objective", help="min_time (default) or min_energy (needs --duration)")
     parser.add_argument("--duration", type=float, help="slew duration for min_energy [s]")
     parser.add_argument("--held-out", type=int, help="axes of the held-out grid the fit is measured on "

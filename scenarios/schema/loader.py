@@ -532,7 +532,7 @@ def _parse_controllers(root: Node) -> list[ControllerSpec]:
 
 
 def _parse_simulation(values: dict[str, Any], path: str, sensors: dict[str, Sensor] | None = None,
-                      geometry: Geometry | None = None) -> SimulationSpec:
+                      geometry: Geometry | None = None, max_step_given: bool = True) -> SimulationSpec:
     noise = values["sensor_noise"]
     spec = SimulationSpec(
         sample_time=values["sample_time"], duration=values["duration"],
@@ -549,6 +549,11 @@ def _parse_simulation(values: dict[str, Any], path: str, sensors: dict[str, Sens
                                    geometry),
     )
     if spec.integrator == "rk4" and math.ceil(spec.sample_time / spec.max_step - 1e-9) > MAX_SUBSTEPS:
+        if not max_step_given:  # the sample time the user set is what is too long for the default step
+            raise ScenarioError(f"{path}.sample_time", f"{spec.sample_time:g} s needs more than {MAX_SUBSTEPS} RK4 "
+                                f"sub-steps of the default {path}.max_step ({spec.max_step:g} s); lower sample_time "
+                                f"to at most {spec.max_step * MAX_SUBSTEPS:g} s, or set {path}.max_step to at "
+                                f"least {spec.sample_time / MAX_SUBSTEPS:g} s")
         raise ScenarioError(f"{path}.max_step", f"{spec.max_step:g} s gives more than {MAX_SUBSTEPS} RK4 "
                             f"sub-steps per {spec.sample_time:g} s sample; raise it to at least "
                             f"{spec.sample_time / MAX_SUBSTEPS:g} s")
@@ -583,8 +588,10 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     problem = _parse_problem(SCENARIO["maneuver"].value(root), spacecraft, environment, sensors, epoch)
     planners = _parse_planners(SCENARIO["planners"].value(root))
     controllers = _parse_controllers(root)
+    given = root.value.get("simulation")
     simulation = _parse_simulation(SCENARIO["simulation"].value(root), "simulation", sensors,
-                                   Geometry(epoch, environment.orbit))
+                                   Geometry(epoch, environment.orbit),
+                                   max_step_given=isinstance(given, dict) and given.get("max_step") is not None)
     plots = SCENARIO["plots"].value(root)
     requirements_node = SCENARIO["requirements"].value(root)
     truth_node = SCENARIO["truth"].value(root)

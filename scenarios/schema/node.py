@@ -305,8 +305,10 @@ class Node:
             raise self.error(f"expected {expected}{' or a number' if allow_scalar else ''}, got {excerpt(self.value)}")
         if size is not None and len(self.value) != size:
             raise self.error(f"expected {size} numbers, got {len(self.value)}")
-        if not all(_is_finite(v) for v in self.value):
-            raise self.error("expected finite numbers")
+        bad = next((i for i, v in enumerate(self.value) if not _is_finite(v)), None)
+        if bad is not None:
+            raise self.error(f"expected finite numbers, got {excerpt(self.value[bad])} at [{bad}] of "
+                             f"{excerpt(self.value)}")
         array = np.asarray(self.value, dtype=float)
         return array
 

@@ -135,7 +135,8 @@ def _spaced(kind: str) -> Callable[[Node], tuple[float, float, int]]:
     def read(node: Node) -> tuple[float, float, int]:
         start, stop, count = node.vector(3)
         if count != int(count) or not 1 <= count <= MAX_VALUES:
-            raise ScenarioError(f"{node.path}[2]", f"expected a count from 1 to {MAX_VALUES}, got {count}")
+            raise ScenarioError(f"{node.path}[2]", f"expected a count from 1 to {MAX_VALUES}, got "
+                                                   f"{excerpt(node.value[2])}")  # as written (0, not 0.0)
         if kind == "geomspace" and (start <= 0 or stop <= 0):
             raise node.error("geomspace needs positive bounds")
         return float(start), float(stop), int(count)

@@ -91,6 +91,10 @@ class TableSpec:
         For a ``polytope`` grid, its triangles (vertex indices), kept by the fit; None otherwise.
     refine : RefineOptions or None
         Refine the axes to a tolerance (:mod:`scenarios.slewtable.refine`); None: the grid as it is.
+    axes_asked : int or None
+        The number of axes asked for (``axes`` / ``--axes``); a ``polytope`` grid may have more
+        (at least its vertices and face centres), a ``fibonacci`` grid has exactly that many; None
+        when the axes were listed.
     """
 
     name: str
@@ -108,6 +112,7 @@ class TableSpec:
     grid: str
     triangles: np.ndarray | None
     refine: RefineOptions | None
+    axes_asked: int | None = None
 
     @property
     def held_out_axes(self) -> np.ndarray:
@@ -234,7 +239,8 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
     refine = _refine_options(values, angles, objective, len(axes))
     spec = TableSpec(str(base.get("name") or source.stem), base, axes, angles, objective, duration.value, held_out,
                      value("planner_options"), value("execution.workers"), value("execution.scheduler"),
-                     value("execution.case_timeout_s"), source, grid, triangles, refine)
+                     value("execution.case_timeout_s"), source, grid, triangles, refine,
+                     values["axes"].value if isinstance(values["axes"].value, int) else None)
     table_cases(spec)  # the collocation options and the case scenario are checked now
     return spec
 

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ocp.errors import excerpt
+from scenarios.errors import ScenarioError
 from scenarios.schema.node import Node
 from scenarios.schema.study import (
     CASE_SEED,
@@ -35,7 +36,7 @@ from scenarios.schema.study import (
     SYMMETRIC_KEYS,
     symmetric_key,
 )
-from scenarios.study.paths import Step, get_path
+from scenarios.study.paths import Step, _describe, get_path
 
 PRINCIPAL_NAME = "principal"
 """The dispersion form of :data:`~scenarios.schema.study.PRINCIPAL`."""
@@ -402,6 +403,17 @@ def _principal(node: Node, base_value: Any, steps: list[Step]) -> Dispersion:
     return Dispersion(PRINCIPAL_NAME, PRINCIPAL_NAME, draws)
 
 
+def _base_value(base: dict[str, Any], steps: list[Step], where: str, combine: str) -> Any:
+    """The base scenario's value that ``combine`` (``scale``, ``offset``, ``principal``) acts on; if
+    the base scenario lacks it, an error that says how to fix that."""
+    try:
+        return get_path(base, steps, where)
+    except ScenarioError as error:
+        raise ScenarioError(error.path, f"{error.message}; {combine} acts on the base scenario's value: add "
+                                        f"{_describe(steps)} to the base scenario (or draw the value itself, "
+                                        f"without {combine})") from None
+
+
 def parse_dispersion(node: Node, base: dict[str, Any], steps: list[Step]) -> Dispersion:
     """Parse the dispersion at ``node`` for the scenario path ``steps`` of ``base``.
 
@@ -431,14 +443,14 @@ def parse_dispersion(node: Node, base: dict[str, Any], steps: list[Step]) -> Dis
         return Dispersion(CASE_SEED.name, "set")
     symmetric = symmetric_key(steps)
     if isinstance(node.value, dict) and len(node.value) == 1 and next(iter(node.value)) == PRINCIPAL_NAME:
-        return _principal(node.get(PRINCIPAL_NAME), get_path(base, steps, node.path), steps)
+        return _principal(node.get(PRINCIPAL_NAME), _base_value(base, steps, node.path, PRINCIPAL_NAME), steps)
     combine = "set"
     if isinstance(node.value, dict) and len(node.value) == 1 and next(iter(node.value)) in COMBINATIONS:
         combine = next(iter(node.value))
         node = COMBINATIONS[combine][0].value(node)
     draw = _distribution(node, symmetric)
     if combine != "set":
-        base_value = get_path(base, steps, node.path)
+        base_value = _base_value(base, steps, node.path, combine)
         try:
             array = np.asarray(base_value, dtype=float)
         except (TypeError, ValueError):

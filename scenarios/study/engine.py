@@ -24,15 +24,17 @@ progress) is kept small, so that it keeps up with many workers.
 from __future__ import annotations
 
 import collections
+import contextlib
 import json
 import math
 import multiprocessing
 import os
+import signal
 import statistics
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from concurrent.futures import (
     FIRST_COMPLETED,
     Executor,
@@ -228,7 +230,7 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
                          "the call of scenarios.sweep() under `if __name__ == \"__main__\":` in the script")
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(list(PRELOAD))
-    from multiprocessing import forkserver
+    from multiprocessing import forkserver, resource_tracker
     # seen by the server only (it starts now, if not yet): the sweep it dies with, and safe-path mode
     # (the current directory off its sys.path; scenarios.study.server puts the environment back)
     # and this process's import path as its PYTHONPATH (the cwd's '' left out), so that the server
@@ -240,7 +242,9 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
     previous = {name: os.environ.get(name) for name in server_environment}
     os.environ.update(server_environment)
     try:
-        forkserver.ensure_running()
+        resource_tracker.ensure_running()  # first: starting it unblocks SIGINT (it blocks it around its own start)
+        with _sigint_blocked():
+            forkserver.ensure_running()
     finally:
         for name, value in previous.items():
             if value is None:
@@ -248,6 +252,30 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
             else:
                 os.environ[name] = value
     return context
+
+
+@contextlib.contextmanager
+def _sigint_blocked() -> Iterator[None]:
+    """Block Ctrl-C (SIGINT) in this thread while it starts the fork server, which inherits the block.
+
+    Ctrl-C reaches the whole foreground process group, the server too, which imports the model for
+    seconds after it starts: its KeyboardInterrupt traceback was printed into the sweep's
+    "interrupted" message. The server starts with SIGINT blocked (a new process inherits the mask
+    of the thread that started it), sets it to be ignored once it has imported
+    :mod:`scenarios.study.worker` (a Ctrl-C pending meanwhile is then discarded), and only then
+    unblocks it; its workers inherit the ignoring: the sweep stops them itself
+    (:meth:`_LocalPool.kill`; they also die with it). This process's handler is not touched, so its
+    own Ctrl-C is not lost: its other threads take it, or this one once unblocked. Outside the main
+    thread the server is started as it is (Python runs signal handlers in the main thread only).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
 class _LocalPool:
@@ -302,7 +330,6 @@ class _LocalPool:
 
     def culprits(self) -> set[int]:
         """Workers that ended by themselves (not stopped by the pool or by :meth:`kill`)."""
-        import signal
         found = set()
         for process in list(self.processes.values()):
             process.join(timeout=5.0)

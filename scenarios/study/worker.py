@@ -48,6 +48,10 @@ imports this module (the server local workers fork from) dies with it."""
 
 if os.environ.get(PARENT_ENVIRONMENT) == str(os.getppid()):  # the fork server of a sweep: dies with it
     die_with_parent(signal.SIGKILL, os.getppid())
+    # started with Ctrl-C blocked (scenarios.study.engine._sigint_blocked): ignored from now on,
+    # here and in the workers (the sweep stops them), a pending one discarded, then unblocked
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 SLOT_FIELDS = 4
 """Numbers per worker in a local pool's slot table: the worker's process id, the index + 1 of the
