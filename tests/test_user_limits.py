@@ -184,3 +184,33 @@ def test_the_feasible_duration_named_is_that_of_the_problems_own_rate_bound() ->
     assert not reference.ok
     assert "maneuver.duration = 15 s bounds it" in reference.message
     assert f"a feasible slew of this problem in {math.pi / 2.0 / 0.1 + 0.1 * 10.0 / 0.1:.6g} s" in reference.message
+
+
+def test_a_long_graze_of_a_cone_edge_zooms_within_the_work_limit(monkeypatch) -> None:
+    """A reviewer's case: a boresight 30° from the spin axis (1 rad/s about inertial z) keeps 30° from a
+    keep-out direction along z, a cone of 29.99°: the margin is 0.01° throughout (closed form). The
+    sub-grid fits the limit, but every bracket of it may hide a crossing, and the zooms into them
+    went on without a limit (43 million points, out of memory, for 10 min of such a spin). With a
+    limit of 1e5 (the sub-grid of 50 rad of turn, 5.7e4 points, fits it; its zooms do not): each zoom stays within it, the search says how
+    long a violation it may have missed, and the margin is still the closed form's."""
+    limit = 100_000
+    monkeypatch.setattr(pointing, "MAX_SUB_GRID", limit)
+    beta = math.radians(30.0)
+    t = np.arange(0.0, 50.0 + 0.05, 0.1)
+    q = np.stack([np.cos(t / 2), 0 * t, 0 * t, np.sin(t / 2)], axis=-1)
+    omega = np.tile([0.0, 0.0, 1.0], (t.size, 1))
+    requirement = PointingRequirement("z_out", Sensor("b", np.array([math.sin(beta), 0.0, math.cos(beta)])), True,
+                                      beta - math.radians(0.01), Direction(None, np.array([0.0, 0.0, 1.0])))
+    constraint = requirement.constraint(Geometry(None, None), 50.0)
+    evaluated = []
+    original = pointing.PointingConstraint.margins
+
+    def counted(self, times, attitudes):
+        evaluated.append(len(np.atleast_1d(times)))
+        return original(self, times, attitudes)
+
+    monkeypatch.setattr(pointing.PointingConstraint, "margins", counted)
+    score = constraint.score_between_samples(t, q, omega)
+    assert score.met and score.min_margin_deg == pytest.approx(0.01, abs=1e-9)
+    assert score.missable_s > 0.0
+    assert max(evaluated) <= limit + t.size

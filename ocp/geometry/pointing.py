@@ -91,7 +91,9 @@ brackets that may hide a crossing. A search whose sub-grid at :data:`FINE_STEP` 
 motion that turns more than about ``MAX_SUB_GRID * FINE_STEP`` = 1745 rad near the threshold: 40 s
 at 44 rad/s) is cut coarser, every step in the same ratio, to at most this many points, and each of
 its zooms goes on by its deepest such brackets only: a crossing shorter than the longest step of
-that sub-grid (:attr:`Searched.missable_s`) may then be missed. Below it, the search is unchanged."""
+that sub-grid (:attr:`Searched.missable_s`) may then be missed. A zoom of any search past it (a long
+motion grazing the threshold: a 1 rad/s spin 0.01° from a cone's edge for 10 min) goes on by its
+deepest brackets too, ``missable_s`` the longest left unsearched. Below it, the search is unchanged."""
 DEGENERATE_NORM = 0.1
 """The interpolant's unnormalised norm below which an interval's rate is not bounded from its
 polynomial (:attr:`HermiteMotion.rate_bound`): samples that disagree with their rates by about a
@@ -478,13 +480,13 @@ def _knot_steps(motion: HermiteMotion, knots: Array) -> tuple[Array, Array, Arra
 
 
 def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence[tuple[Array, Array, Array]],
-          found_t: list[list[Array]], found_v: list[list[Array]], missable: Sequence[float]) -> None:
+          found_t: list[list[Array]], found_v: list[list[Array]], missable: list[float]) -> None:
     """Step 3 of :func:`search_between_samples` for several searches at once: the brackets of every
     search in one array (``owner``: the search of each, in order), the least value, the threshold
     and the :data:`MIN_SEARCHES` deepest brackets per search; the points of each zoom appended to
-    that search's ``found_t`` and ``found_v``. A search whose sub-grid the work limit cut
-    (``missable`` > 0) zooms into its deepest brackets that may hide a crossing only, at most
-    :data:`MAX_SUB_GRID` points a zoom."""
+    that search's ``found_t`` and ``found_v``. Every search zooms into at most :data:`MAX_SUB_GRID`
+    points a zoom: past that, into its deepest brackets that may hide a crossing only, its
+    ``missable`` raised (in place) to the longest bracket left unsearched."""
     count = len(grids)
     owner = np.repeat(np.arange(count), [len(grid) - 1 for grid, _, _ in grids])
     low = np.concatenate([grid[:-1] for grid, _, _ in grids])
@@ -508,11 +510,14 @@ def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence
             ranked = lower[np.lexsort((floor[lower], owner[lower]))]
             first = np.searchsorted(owner[ranked], owner[ranked], side="left")
             lower = ranked[np.arange(ranked.size) - first < MIN_SEARCHES]
-        for slot in np.flatnonzero(np.asarray(missable) > 0.0).tolist():  # the work limit, per search
+        allowed = max(MAX_SUB_GRID // inside_count - MIN_SEARCHES, 0)
+        for slot in np.unique(owner[hidden]).tolist():  # the work limit, per search and zoom
             may_hide = np.flatnonzero(hidden & (owner == slot))
-            allowed = max(MAX_SUB_GRID // inside_count - MIN_SEARCHES, 0)
             if may_hide.size > allowed:
-                hidden[may_hide[np.argsort((floor - threshold)[may_hide], kind="stable")[allowed:]]] = False
+                dropped = may_hide[np.argsort((floor - threshold)[may_hide], kind="stable")[allowed:]]
+                hidden[dropped] = False
+                # a bracket left unsearched may hide a violation as long as itself
+                missable[slot] = max(missable[slot], float(np.max(high[dropped] - low[dropped])))
         pick = hidden.copy()
         pick[lower] = True
         if not np.any(pick):
