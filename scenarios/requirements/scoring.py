@@ -264,7 +264,8 @@ def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
 
 def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, target: ArrayLike,
                                 start: float, limit: float | None = None,
-                                motion: HermiteMotion | None = None) -> tuple[float, float]:
+                                motion: HermiteMotion | None = None,
+                                missed: list[float] | None = None) -> tuple[float, float]:
     """The largest error angle to a fixed attitude from ``start`` on, between the samples too.
 
     The attitude between samples is that of the pointing scores
@@ -276,8 +277,10 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
     it falls between samples. An error of the interpolated motion above ``limit`` is never missed
     unless it rises less above than the bound over the search's last brackets (the true motion
     differs from the interpolated one by the interpolation's O(h⁴): with samples far apart next to
-    the motion's own time scale, sample more finely); the largest error is exact where the search
-    reaches it, else within the bound over a step.
+    the motion's own time scale, sample more finely), or shorter than the search's ``missable_s``
+    where it reached its work limit (:data:`~ocp.geometry.pointing.MAX_SUB_GRID`; ``missed``
+    receives it); the largest error is exact where the search reaches it, else within the bound over
+    a step.
 
     Parameters
     ----------
@@ -297,6 +300,9 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
     motion : HermiteMotion or None, optional
         ``HermiteMotion(t, q, omega)`` when already built (a row's pointing scores share it);
         ``None``: built here.
+    missed : list of float or None, optional
+        Receives the search's ``missable_s`` [s] (0 for a full search; else a breach shorter than it
+        may be missed); ``None``: not kept.
 
     Returns
     -------
@@ -312,9 +318,12 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
     def less_error(times: Array, attitudes: Array) -> Array:
         return np.where(times >= start - 1e-9, -quat.error_angle(attitudes, target), np.nan)
 
-    times, values = search_between_samples(moving, less_error, -np.inf if limit is None else -float(limit),
-                                           edges=(float(start),))
+    found = search_between_samples(moving, less_error, -np.inf if limit is None else -float(limit),
+                                   edges=(float(start),))
+    times, values = found
     worst = int(np.nanargmin(values))
+    if missed is not None:
+        missed.append(found.missable_s)
     return float(-values[worst]), float(times[worst])
 
 
@@ -327,6 +336,7 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
         return Score("final", values, False, f"no closed-loop sample from {start:g} s (T + after_s) on; lengthen "
                                              "simulation.duration")
     problems = []
+    missed: list[float] = []  # the error search's missable_s
     moving = turning(problem.omegaf, reference)
     if moving:  # the target is the reference's own motion: the plan until T, its coast after (target_motion)
         assert reference is not None  # turning() needs one
@@ -341,9 +351,10 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
             # the error's own motion, q_e = q_target* ⊗ q with body rate ω − R(q_e)ᵀ ω_target, to the identity
             relative = quat.error(q, own.q, shortest=False)
             relative_rate = omega - quat.rotate_inverse(relative, own.omega)
-            worst_error, when = worst_error_between_samples(t, relative, relative_rate, quat.IDENTITY, start, bound)
+            worst_error, when = worst_error_between_samples(t, relative, relative_rate, quat.IDENTITY, start, bound,
+                                                            missed=missed)
         else:
-            worst_error, when = worst_error_between_samples(t, q, omega, problem.qf, start, bound, motion)
+            worst_error, when = worst_error_between_samples(t, q, omega, problem.qf, start, bound, motion, missed)
         worst_deg = float(np.rad2deg(worst_error))
         values["worst_error_deg"] = worst_deg
         if requirement.error_deg is not None and worst_deg > requirement.error_deg * (1 + _TOLERANCE):
@@ -358,7 +369,10 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
         if requirement.rate is not None and rates[worst] > requirement.rate * (1 + _TOLERANCE):
             shown, limit = _over(rates[worst], requirement.rate)
             problems.append(f"rate error {shown} rad/s at {t[inside][worst]:.1f} s over {limit} rad/s")
-    return Score("final", values, not problems, (", ".join(problems) + f" (from {start:g} s)") if problems else "")
+    limited = [f"the error's search between samples reached its work limit ({MAX_SUB_GRID:,} points): an error "
+               f"over the bound shorter than {max(missed):.2g} s may be missed"] if missed and max(missed) > 0 else []
+    detail = (", ".join(problems) + f" (from {start:g} s)") if problems else ""
+    return Score("final", values, not problems, "; ".join([detail, *limited]) if detail else "; ".join(limited))
 
 
 def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference | None = None) -> list[tuple[float, int, Array]]:
