@@ -243,3 +243,25 @@ def test_a_unit_mix_up_rate_runs_and_its_final_error_search_says_it_was_limited(
     assert row.status == "violated" and not row.requirements["closed_loop"]["final"]["met"]
     assert "final (closed loop)" in row.message
     assert "the error's search between samples reached its work limit" in row.message, row.message
+
+
+def test_a_feasible_slew_within_the_bound_is_said_so_not_that_the_bound_may_be_too_low() -> None:
+    """A reviewer's case: the same sphere under a 30 s bound, with a start ended locally infeasible.
+    The eigenaxis bang-bang slew, 2 √(θ J / u) = 25.066 s (by hand), is feasible within 30 s: the
+    bound is provably not below the minimum time, and the note must say that instead."""
+    from types import SimpleNamespace
+
+    import yaml
+
+    from planners import PLANNERS
+    from planners.collocation.planner import INFEASIBLE
+    from scenarios.schema.loader import parse_scenario
+
+    data = yaml.safe_load(HAND)
+    data["maneuver"]["duration"] = 30.0
+    problem = parse_scenario(data).problem
+    planner = PLANNERS["collocation"]({"objective": "min_time"})
+    failed = SimpleNamespace(starts=[SimpleNamespace(status=sorted(INFEASIBLE)[0], f=float("nan"))])
+    note = planner._time_bound_note(problem, planner._ocp(problem), failed)
+    assert "may be below the minimum time" not in note
+    assert "within the bound" in note and f"{2.0 * math.sqrt(math.pi / 2.0 * 10.0 / 0.1):.6g} s" in note, note

@@ -820,14 +820,17 @@ class CollocationPlanner(Planner):
         minimum time (local infeasibility is no proof), and the duration of a feasible slew of the
         problem when one is known (``eigenaxis``'s ``min_time``, checked against the problem's
         constraints as :meth:`_seed_bound` checks it, the final time's bound aside: an upper bound
-        of the minimum time, so a ``maneuver.duration`` at least that admits a slew). Else empty."""
+        of the minimum time, so a ``maneuver.duration`` at least that admits a slew). When such a
+        slew fits within the bound, that instead: the bound is then not below the minimum time.
+        Else empty."""
         if not ocp.free_time:
             return ""
         bound = float(problem.duration)
         infeasible = sum(start.status in INFEASIBLE for start in result.starts)
         plain = not (ocp.energy_weight or ocp.l1_weight)  # the objective is the final time
+        weight = float(ocp.time_weight) if ocp.time_weight else 1.0  # f = time_weight T
         at_bound = sum(plain and start.status not in INFEASIBLE and np.isfinite(start.f)
-                       and start.f >= bound * (1.0 - 1e-6) for start in result.starts)
+                       and start.f >= weight * bound * (1.0 - 1e-6) for start in result.starts)
         if not infeasible and not at_bound:
             return ""
         ended = " and ".join(part for part in (f"{infeasible} ended locally infeasible" if infeasible else "",
@@ -836,14 +839,17 @@ class CollocationPlanner(Planner):
                 f"starts {ended}: the bound may be below the minimum time, which local infeasibility does not prove")
         bounds = self._variable_bounds(problem)
         pointing = self._requirements(problem).pointing
-        known = []
+        known, within = [], []
         for label, candidate in self._bound_candidates(problem, []):
-            if candidate.duration <= bound:
-                continue  # no longer than the bound: it says nothing of the bound
             broken = start_violations(problem, candidate, bounds, ocp.max_rate, pointing,
                                       DENSE_POINTS * self.options.intervals + 1, BOUND_TOLERANCE, SEED_BOUND_ATOL)
             if broken == {}:
-                known.append((float(candidate.duration), label))
+                (within if candidate.duration <= bound else known).append((float(candidate.duration), label))
+        if within:  # a feasible slew fits: the bound is not below the minimum time
+            duration, label = min(within)
+            return (f"the final time is free and maneuver.duration = {bound:g} s bounds it; of {len(result.starts)} "
+                    f"starts {ended}, but {label} is a feasible slew of this problem in {duration:.6g} s, within "
+                    f"the bound: the starts failed for another reason")
         if known:
             duration, label = min(known)
             note += (f"; {label} is a feasible slew of this problem in {duration:.6g} s, so a maneuver.duration "
