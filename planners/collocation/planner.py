@@ -839,7 +839,8 @@ class CollocationPlanner(Planner):
                 f"starts {ended}: the bound may be below the minimum time, which local infeasibility does not prove")
         bounds = self._variable_bounds(problem)
         pointing = self._requirements(problem).pointing
-        known, within = [], []
+        known: list[tuple[float, str]] = []
+        within: list[tuple[float, str]] = []
         for label, candidate in self._bound_candidates(problem, []):
             broken = start_violations(problem, candidate, bounds, ocp.max_rate, pointing,
                                       DENSE_POINTS * self.options.intervals + 1, BOUND_TOLERANCE, SEED_BOUND_ATOL)
