@@ -108,6 +108,20 @@ def test_blinded_samples_are_those_with_the_sun_inside_the_cone(blinded_example)
     assert metrics["star_tracker_blinded_updates"] == np.count_nonzero(inside & due)
 
 
+EARTH_RADIUS = 6378137.0  # m (WGS-84)
+
+
+def circular_orbit(t: np.ndarray, altitude: float, inclination_deg: float, raan_deg: float) -> tuple[np.ndarray, float]:
+    """By hand: the inertial position [m] of a circular orbit at ``t`` [s] (at its ascending node at
+    t = 0), and its radius [m]: r (cos u, sin u cos i, sin u sin i) turned by the RAAN about z."""
+    a = EARTH_RADIUS + altitude
+    u = math.sqrt(3.986004418e14 / a**3) * t  # μ [m³/s²]
+    inclination, raan = math.radians(inclination_deg), math.radians(raan_deg)
+    x, y, z = np.cos(u), np.sin(u) * math.cos(inclination), np.sin(u) * math.sin(inclination)
+    return a * np.stack([x * math.cos(raan) - y * math.sin(raan), x * math.sin(raan) + y * math.cos(raan), z],
+                        axis=1), a
+
+
 def test_the_earth_limb_cone_is_the_half_angle_plus_the_earths_apparent_radius(blinded_example):
     """A 500 km circular orbit at 51.6° (ascending node on x, at t = 0): the position by hand,
     nadir, and the cone 20° + asin(R / r) about it (the boresight within 20° of the limb)."""
@@ -117,13 +131,11 @@ def test_the_earth_limb_cone_is_the_half_angle_plus_the_earths_apparent_radius(b
     scenario = parse_scenario(data)
     result = simulate(scenario, reference, python_loop=True)
     t = result.t[:-1]
-    mu, radius = 3.986004418e14, 6378137.0  # m³/s², m (WGS-84)
-    a, inclination = radius + 500e3, math.radians(51.6)
-    u = math.sqrt(mu / a**3) * t
-    nadir = -np.stack([np.cos(u), np.sin(u) * math.cos(inclination), np.sin(u) * math.sin(inclination)], axis=1)
+    position, a = circular_orbit(t, 500e3, 51.6, 0.0)
+    nadir = -position / a
     boresight = Rotation.from_quat(result.q[:-1][:, [1, 2, 3, 0]]).apply([0.0, 0.0, 1.0])
     angle = np.degrees(np.arccos(np.clip(np.sum(boresight * nadir, axis=1), -1.0, 1.0)))
-    cone = 20.0 + math.degrees(math.asin(radius / a))  # 88.02°
+    cone = 20.0 + math.degrees(math.asin(EARTH_RADIUS / a))  # 88.02°
     assert np.min(np.abs(angle - cone)) > 1e-4  # no sample on the edge
     assert 10 <= np.count_nonzero(angle < cone) <= angle.size - 10
     np.testing.assert_array_equal(result.blinded != 0, angle < cone)
@@ -141,17 +153,12 @@ def test_the_sun_blinds_the_tracker_in_eclipse_too(blinded_example):
     scenario = parse_scenario(data)
     result = simulate(scenario, reference, python_loop=True)
     t = result.t[:-1]
-    mu, radius = 3.986004418e14, 6378137.0  # m³/s², m (WGS-84)
-    a, inclination = radius + 500e3, math.radians(51.6)
-    u = math.sqrt(mu / a**3) * t
-    # (cos u, sin u cos i, sin u sin i) turned 270° about z: (x, y, z) -> (y, -x, z)
-    position = a * np.stack([np.sin(u) * math.cos(inclination), -np.cos(u), np.sin(u) * math.sin(inclination)],
-                            axis=1)
+    position, _ = circular_orbit(t, 500e3, 51.6, 270.0)
     sun = sun_position(EPOCH, t)
     sun_unit = sun / np.linalg.norm(sun, axis=1, keepdims=True)
     along = np.sum(position * sun_unit, axis=1)
     off_axis = np.linalg.norm(position - along[:, None] * sun_unit, axis=1)
-    assert np.all(along < 0) and np.all(off_axis < radius)  # in the umbra's cylinder throughout
+    assert np.all(along < 0) and np.all(off_axis < EARTH_RADIUS)  # in the umbra's cylinder throughout
     seen = sun - position
     seen /= np.linalg.norm(seen, axis=1, keepdims=True)
     boresight = Rotation.from_quat(result.q[:-1][:, [1, 2, 3, 0]]).apply([0.0, 0.0, 1.0])

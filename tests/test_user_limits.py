@@ -45,6 +45,19 @@ def keep_out(duration: float) -> pointing.PointingConstraint:
     return requirement.constraint(Geometry(None, None), duration)
 
 
+def counted_margins(monkeypatch) -> list[int]:
+    """The number of points of each margin evaluation of the pointing searches, from now on."""
+    evaluated: list[int] = []
+    original = pointing.PointingConstraint.margins
+
+    def counted(self, times, attitudes):
+        evaluated.append(len(np.atleast_1d(times)))
+        return original(self, times, attitudes)
+
+    monkeypatch.setattr(pointing.PointingConstraint, "margins", counted)
+    return evaluated
+
+
 def test_a_search_past_its_work_limit_is_coarser_says_so_and_still_finds_long_violations(monkeypatch) -> None:
     """10 s of a 50 rad/s spin sampled every 10 ms: its sub-grid at FINE_STEP would hold 8.2e4
     points near the cone. Under a work limit of 2e4 it is cut coarser (4x): the search evaluates
@@ -57,14 +70,7 @@ def test_a_search_past_its_work_limit_is_coarser_says_so_and_still_finds_long_vi
     monkeypatch.setattr(pointing, "MAX_SUB_GRID", limit)
     t, q, omega = spin(10.0, 0.01)
     constraint = keep_out(10.0)
-    evaluated = []
-    original = pointing.PointingConstraint.margins
-
-    def counted(self, times, attitudes):
-        evaluated.append(len(np.atleast_1d(times)))
-        return original(self, times, attitudes)
-
-    monkeypatch.setattr(pointing.PointingConstraint, "margins", counted)
+    evaluated = counted_margins(monkeypatch)
     score = constraint.score_between_samples(t, q, omega)
     inside, first = inside_time(10.0)
     assert score.missable_s > 0.0
@@ -202,14 +208,7 @@ def test_a_long_graze_of_a_cone_edge_zooms_within_the_work_limit(monkeypatch) ->
     requirement = PointingRequirement("z_out", Sensor("b", np.array([math.sin(beta), 0.0, math.cos(beta)])), True,
                                       beta - math.radians(0.01), Direction(None, np.array([0.0, 0.0, 1.0])))
     constraint = requirement.constraint(Geometry(None, None), 50.0)
-    evaluated = []
-    original = pointing.PointingConstraint.margins
-
-    def counted(self, times, attitudes):
-        evaluated.append(len(np.atleast_1d(times)))
-        return original(self, times, attitudes)
-
-    monkeypatch.setattr(pointing.PointingConstraint, "margins", counted)
+    evaluated = counted_margins(monkeypatch)
     score = constraint.score_between_samples(t, q, omega)
     assert score.met and score.min_margin_deg == pytest.approx(0.01, abs=1e-9)
     assert score.missable_s > 0.0

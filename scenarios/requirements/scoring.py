@@ -188,15 +188,22 @@ def _pointing_scores(constraints: Sequence[PointingConstraint], t: Array, q: Arr
 def _pointing(constraint: PointingConstraint, score: PointingScore) -> Score:
     values: dict[str, float | None] = dict(zip(POINTING_FIELDS, (score.min_margin_deg, score.time_in_violation_s,
                                                                  score.first_violation_s, score.min_margin_time_s)))
-    limited = (f"; the search between samples reached its work limit ({MAX_SUB_GRID:,} points): a violation "
-               f"shorter than {score.missable_s:.2g} s may be missed") if score.missable_s else ""
+    caveat = _limited("the search between samples", "a violation", score.missable_s)
     if score.met:
-        return Score(constraint.name, values, True, limited[2:])
+        return Score(constraint.name, values, True, caveat)
     assert score.min_margin_deg is not None and score.min_margin_time_s is not None
     where = "inside" if constraint.keep_out else "outside"
-    return Score(constraint.name, values, False,
-                 f"min margin {score.min_margin_deg:.3g} deg at {_seconds(score.min_margin_time_s)} s, "
-                 f"{_seconds(score.time_in_violation_s)} s {where}{limited}")
+    broken = (f"min margin {score.min_margin_deg:.3g} deg at {_seconds(score.min_margin_time_s)} s, "
+              f"{_seconds(score.time_in_violation_s)} s {where}")
+    return Score(constraint.name, values, False, "; ".join(filter(None, (broken, caveat))))
+
+
+def _limited(search: str, breach: str, missable_s: float) -> str:
+    """The caveat of a search between samples that reached its work limit (``missable_s`` > 0: a
+    breach shorter than that may be missed, :data:`~ocp.geometry.pointing.MAX_SUB_GRID`); empty
+    for a full search."""
+    return (f"{search} reached its work limit ({MAX_SUB_GRID:,} points): {breach} shorter than "
+            f"{missable_s:.2g} s may be missed") if missable_s > 0 else ""
 
 
 def _seconds(value: float) -> str:
@@ -264,8 +271,7 @@ def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
 
 def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, target: ArrayLike,
                                 start: float, limit: float | None = None,
-                                motion: HermiteMotion | None = None,
-                                missed: list[float] | None = None) -> tuple[float, float]:
+                                motion: HermiteMotion | None = None) -> tuple[float, float]:
     """The largest error angle to a fixed attitude from ``start`` on, between the samples too.
 
     The attitude between samples is that of the pointing scores
@@ -278,9 +284,9 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
     unless it rises less above than the bound over the search's last brackets (the true motion
     differs from the interpolated one by the interpolation's O(h⁴): with samples far apart next to
     the motion's own time scale, sample more finely), or shorter than the search's ``missable_s``
-    where it reached its work limit (:data:`~ocp.geometry.pointing.MAX_SUB_GRID`; ``missed``
-    receives it); the largest error is exact where the search reaches it, else within the bound over
-    a step.
+    where it reached its work limit (:data:`~ocp.geometry.pointing.MAX_SUB_GRID`; the final
+    requirement's score says so); the largest error is exact where the search reaches it, else
+    within the bound over a step.
 
     Parameters
     ----------
@@ -300,15 +306,19 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
     motion : HermiteMotion or None, optional
         ``HermiteMotion(t, q, omega)`` when already built (a row's pointing scores share it);
         ``None``: built here.
-    missed : list of float or None, optional
-        Receives the search's ``missable_s`` [s] (0 for a full search; else a breach shorter than it
-        may be missed); ``None``: not kept.
 
     Returns
     -------
     (float, float)
         The largest error angle [rad] and its time [s].
     """
+    worst, when, _ = _worst_error(t, q, omega, target, start, limit, motion)
+    return worst, when
+
+
+def _worst_error(t: ArrayLike, q: ArrayLike, omega: ArrayLike, target: ArrayLike, start: float,
+                 limit: float | None, motion: HermiteMotion | None) -> tuple[float, float, float]:
+    """:func:`worst_error_between_samples` and its search's ``missable_s`` [s]."""
     t = np.atleast_1d(np.asarray(t, dtype=float))
     if not t[-1] >= start - 1e-9:
         raise ValueError(f"no sample from {start:g} s on (the samples end at {t[-1]:g} s)")
@@ -322,9 +332,7 @@ def worst_error_between_samples(t: ArrayLike, q: ArrayLike, omega: ArrayLike, ta
                                    edges=(float(start),))
     times, values = found
     worst = int(np.nanargmin(values))
-    if missed is not None:
-        missed.append(found.missable_s)
-    return float(-values[worst]), float(times[worst])
+    return float(-values[worst]), float(times[worst]), found.missable_s
 
 
 def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, problem: ManeuverProblem,
@@ -336,7 +344,7 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
         return Score("final", values, False, f"no closed-loop sample from {start:g} s (T + after_s) on; lengthen "
                                              "simulation.duration")
     problems = []
-    missed: list[float] = []  # the error search's missable_s
+    missable_s = 0.0  # the error search's (a breach shorter than it may be missed)
     moving = turning(problem.omegaf, reference)
     if moving:  # the target is the reference's own motion: the plan until T, its coast after (target_motion)
         assert reference is not None  # turning() needs one
@@ -351,10 +359,9 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
             # the error's own motion, q_e = q_target* ⊗ q with body rate ω − R(q_e)ᵀ ω_target, to the identity
             relative = quat.error(q, own.q, shortest=False)
             relative_rate = omega - quat.rotate_inverse(relative, own.omega)
-            worst_error, when = worst_error_between_samples(t, relative, relative_rate, quat.IDENTITY, start, bound,
-                                                            missed=missed)
+            worst_error, when, missable_s = _worst_error(t, relative, relative_rate, quat.IDENTITY, start, bound, None)
         else:
-            worst_error, when = worst_error_between_samples(t, q, omega, problem.qf, start, bound, motion, missed)
+            worst_error, when, missable_s = _worst_error(t, q, omega, problem.qf, start, bound, motion)
         worst_deg = float(np.rad2deg(worst_error))
         values["worst_error_deg"] = worst_deg
         if requirement.error_deg is not None and worst_deg > requirement.error_deg * (1 + _TOLERANCE):
@@ -369,10 +376,9 @@ def _final(requirement: FinalRequirement, t: Array, q: Array, omega: Array, prob
         if requirement.rate is not None and rates[worst] > requirement.rate * (1 + _TOLERANCE):
             shown, limit = _over(rates[worst], requirement.rate)
             problems.append(f"rate error {shown} rad/s at {t[inside][worst]:.1f} s over {limit} rad/s")
-    limited = [f"the error's search between samples reached its work limit ({MAX_SUB_GRID:,} points): an error "
-               f"over the bound shorter than {max(missed):.2g} s may be missed"] if missed and max(missed) > 0 else []
-    detail = (", ".join(problems) + f" (from {start:g} s)") if problems else ""
-    return Score("final", values, not problems, "; ".join([detail, *limited]) if detail else "; ".join(limited))
+    broken = (", ".join(problems) + f" (from {start:g} s)") if problems else ""
+    caveat = _limited("the error's search between samples", "an error over the bound", missable_s)
+    return Score("final", values, not problems, "; ".join(filter(None, (broken, caveat))))
 
 
 def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference | None = None) -> list[tuple[float, int, Array]]:
