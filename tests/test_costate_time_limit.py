@@ -63,8 +63,10 @@ def test_a_fast_spin_fails_within_its_time_limit():
     assert OUT_OF_TIME in reference.message and "options.time_limit = 2 s" in reference.message
 
 
-def test_the_time_limit_is_positive_or_null():
+def test_the_time_limit_is_in_its_range_or_null():
     assert PLANNERS["costate_tpbvp"]({"time_limit": None}).options.time_limit is None
     assert PLANNERS["costate_tpbvp"]().options.time_limit == 120.0
-    with pytest.raises(OptionsError, match=r"options.time_limit: expected a finite number > 0, got 0"):
+    with pytest.raises(OptionsError, match=r"options.time_limit: expected a finite number > 0 and <= 86400, got 0"):
         PLANNERS["costate_tpbvp"]({"time_limit": 0})
+    with pytest.raises(OptionsError, match=r"options.time_limit: expected a finite number > 0 and <= 86400, got 1000000"):
+        PLANNERS["costate_tpbvp"]({"time_limit": 1e6})

@@ -318,8 +318,8 @@ def search_between_samples(motion: HermiteMotion, value: Callable[[Array, Array]
     edges : sequence of float, optional
         Times [s] that are points of the search when inside the samples' span (a window's edges).
 
-    The work is limited (:data:`MAX_SUB_GRID`): beyond it the sub-grid is coarser, and the result
-    says so (:attr:`Searched.missable_s`).
+    The work is limited (:data:`MAX_SUB_GRID`): beyond it the sub-grid is coarser or a zoom leaves
+    its shallowest brackets, and the result says so (:attr:`Searched.missable_s`).
 
     Returns
     -------
@@ -342,9 +342,9 @@ class Searched(tuple[Array, Array]):
     Attributes
     ----------
     missable_s : float
-        [s]: 0 when the search ran in full; else (its sub-grid cut coarser by the work limit,
-        :data:`MAX_SUB_GRID`) the longest step of its sub-grid: a crossing of the threshold shorter
-        than it may be missed.
+        [s]: 0 when the search ran in full; else (the work limit, :data:`MAX_SUB_GRID`, reached)
+        the longest step of its sub-grid cut coarser or bracket a zoom left unsearched: a crossing
+        of the threshold shorter than it may be missed.
     """
 
     missable_s: float
@@ -569,9 +569,9 @@ class PointingScore(NamedTuple):
     min_margin_time_s : float or None
         Time of the smallest margin [s].
     missable_s : float
-        [s]: 0, or when the search between the samples was cut coarser by its work limit
-        (:data:`MAX_SUB_GRID`, :attr:`Searched.missable_s`) the longest step of its sub-grid: a
-        violation shorter than it may be missed.
+        [s]: 0, or when the search between the samples reached its work limit
+        (:data:`MAX_SUB_GRID`) its :attr:`Searched.missable_s`: a violation shorter than it may be
+        missed.
     """
 
     min_margin_deg: float | None

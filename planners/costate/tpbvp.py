@@ -400,7 +400,7 @@ class CostateTPBVPPlanner(Planner):
             (default 5000). A spinning start's torque-free-coast fallback may use up to
             :data:`COAST_NODE_FACTOR` times its coarsest mesh, if that is more.
         time_limit : float or None
-            Wall-clock budget of one plan [s], positive, or ``None`` for none (default 120): no
+            Wall-clock budget of one plan [s], above 0 and at most 86400, or ``None`` for none (default 120): no
             further ``solve_bvp`` call starts once it is spent (one under way is not interrupted, so
             a plan can overrun it by one call), and the plan fails with a message naming this
             option, the calls made and the continuation fraction reached; the torque-free-coast
@@ -419,7 +419,7 @@ class CostateTPBVPPlanner(Planner):
         nodes: Annotated[int, Range(ge=5, le=5000)] = 60                                          # mesh each stage starts from
         tolerance: Annotated[float, Range(gt=0.0, lt=1.0)] = 1e-8                                  # solve_bvp residual tolerance
         max_nodes: Annotated[int, Range(ge=10, le=100000)] = 5000
-        time_limit: Annotated[float | None, Range(gt=0.0)] = 120.0                                 # s of wall clock per plan; None: none
+        time_limit: Annotated[float | None, Range(gt=0.0, le=86400.0)] = 120.0                                # s of wall clock per plan; None: none
 
         def __post_init__(self) -> None:
             if self.max_nodes < self.nodes:
