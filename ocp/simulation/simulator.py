@@ -48,6 +48,7 @@ from ocp.estimation import (
     sensor_step,
 )
 from ocp.fast_call import BufferedFunction
+from ocp.options import is_real
 from ocp.simulation.closed_loop import ClosedLoop, draw_noise
 from ocp.simulation.compiled import compile_function, notice
 
@@ -185,7 +186,7 @@ class SensorNoise:
     def __post_init__(self) -> None:
         for name in ("attitude_std", "rate_std", "field_std"):
             value = getattr(self, name)
-            if not _real(value) or not math.isfinite(value) or value < 0:
+            if not is_real(value) or not math.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite non-negative standard deviation, got {value!r}")
         if not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool) or self.seed < 0:
             raise ValueError(f"seed must be a non-negative integer, got {self.seed!r}")
@@ -507,7 +508,7 @@ class Simulator:
         if not isinstance(model, AttitudeModel):
             raise TypeError(f"model must be an ocp.AttitudeModel, got {type(model).__name__}")
         for name, value in (("sample_time", sample_time), ("max_step", max_step), ("rtol", rtol), ("atol", atol)):
-            if not _real(value) or not math.isfinite(value) or not value > 0:
+            if not is_real(value) or not math.isfinite(value) or not value > 0:
                 raise ValueError(f"{name} must be a finite positive number of seconds, got {value!r}")
         sample_time, max_step, rtol, atol = float(sample_time), float(max_step), float(rtol), float(atol)
         if integrator not in INTEGRATORS:
@@ -645,7 +646,7 @@ class Simulator:
         p = default if parameters is None else np.asarray(parameters, dtype=float)
         if p.shape != (3,) or not np.all(np.isfinite(p)):
             raise ValueError(f"parameters must be a finite 3-vector disturbance torque (N m), got {p}")
-        if not _real(duration) or not math.isfinite(duration) or not duration > 0:
+        if not is_real(duration) or not math.isfinite(duration) or not duration > 0:
             raise ValueError(f"duration must be a finite positive number of seconds, got {duration!r}")
         duration = float(duration)
         n_samples = max(1, math.ceil(duration / self.sample_time - 1e-9))
@@ -970,7 +971,3 @@ def _check_run_arguments(controller: Any, reference: Any, target: Any) -> None:
         if size == 4 and (problem := quat.unit_norm_error(array)) is not None:
             raise ValueError(f"target[0] (q_f): {problem}, got {array.tolist()}")
 
-
-def _real(value: object) -> bool:
-    """Whether ``value`` is a real number: a Python or numpy integer or float, not a bool."""
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
