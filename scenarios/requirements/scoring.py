@@ -450,8 +450,9 @@ def start_torque(spacecraft: Spacecraft, t: Array, q: Array, step: ArrayLike,
     torque impulse. It is asked as the least constant torque that gives it by the end of the
     manoeuvre, ``j / T`` in the inertial frame (``j = R(q(0)) J``), in body axes ``R(q(t))ᵀ j / T``
     from 0 to T and nothing after, on top of the reference's torque: through the allocation,
-    torquers asked it alone need ``|J_i| / T`` of their limit on body axis ``i`` (the time they need
-    at their limit over T), wheels take what turns into their span, and what no working actuator
+    torquers asked nothing else are asked ``|J_i| / (T τ_max,i)`` of their limit on body axis ``i``
+    at t = 0 (the time they need at their limit to remove it, over T), wheels take what turns into
+    their span, and what no working actuator
     spans is unrealised torque (:func:`controllers.allocation.unrealised_torque`), which breaks the
     actuator requirement.
 
