@@ -104,3 +104,25 @@ def test_the_start_torque_by_hand():
     wheels = Spacecraft(inertia, wheels=ReactionWheels.from_body_axes(max_torque=0.1))
     torque, impulse = start_torque(wheels, t, q, step, 10.0)
     assert np.all(torque == 0.0) and np.all(impulse == 0.0)
+
+
+def test_the_spin_papers_eigenaxis_slew_on_torquers_asks_them_to_despin(tmp_path):
+    """The spin paper's body (I = [19.5, 19, 12.6] kg m^2) spinning at 0.2 rad/s about x, an eigenaxis
+    slew from rest (180° about y in 200 s) on 0.1 N m torquers (the guide's example): they must
+    remove 19.5 x 0.2 = 3.9 N m s, asked as 3.9 / 200 = 0.0195 N m about x at t = 0, 0.195 of their
+    limit (above the slew's own peak, 0.086)."""
+    from scenarios.runner import run
+    from scenarios.schema.loader import load
+
+    path = tmp_path / "despin.yaml"
+    path.write_text(SPHERE.replace("[10.0, 10.0, 10.0]", "[19.5, 19.0, 12.6]")
+                    .replace("  wheels: {axes: [[1, 0, 0], [0, 1, 0], [0, 0, 1]], failed: [FAILED], max_torque: 0.1, "
+                             "max_momentum: 1.0}\n", "  wheels: none\n")
+                    .replace("TORQUERS", "torquers: {max_torque: 0.1}").replace("SPIN", "0.2, 0, 0")
+                    .replace("[0.7071068, 0, 0, 0.7071068]", "[0, 0, 1, 0]"))
+    assert "wheels: none" in path.read_text() and "[0, 0, 1, 0]" in path.read_text()
+    row = run(load(path)).rows[0]
+    score = row.requirements["reference"]["actuators"]
+    assert score["torquers_torque"] == pytest.approx(19.5 * 0.2 / 200.0 / 0.1, rel=1e-9)
+    assert score["torquers_torque_time_s"] == 0.0
+    assert row.status == "ok", row.message
