@@ -22,6 +22,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import numbers
 import types
 import typing
 from dataclasses import dataclass
@@ -88,6 +89,22 @@ class Range:
 
 
 NUMERIC = (int, float)
+
+
+def is_real(value: object) -> bool:
+    """Whether ``value`` is a real number: a Python or NumPy integer or float (any
+    :class:`numbers.Real`), not a bool (``True`` is no duration); finiteness is the caller's check.
+
+    Parameters
+    ----------
+    value : object
+        Anything.
+
+    Returns
+    -------
+    bool
+    """
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 def _split(annotation: Any) -> tuple[Any, Range | None]:

@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp import AttitudeModel, Environment, Spacecraft, quat
 from ocp.geometry import PointingConstraint
+from ocp.options import is_real
 
 Array = NDArray[np.float64]
 
@@ -92,18 +93,18 @@ class ManeuverProblem:
             object.__setattr__(self, "omegaf", _vector("omegaf", self.omegaf, 3))
         momentum = np.zeros(self.spacecraft.n_wheels) if self.wheel_momentum0 is None else self.wheel_momentum0
         object.__setattr__(self, "wheel_momentum0", _vector("wheel_momentum0", momentum, self.spacecraft.n_wheels))
-        if not _real(self.duration) or not np.isfinite(self.duration) or not self.duration > 0:
+        if not is_real(self.duration) or not np.isfinite(self.duration) or not self.duration > 0:
             raise ValueError(f"duration must be a finite positive number of seconds, got {self.duration!r}")
         object.__setattr__(self, "duration", float(self.duration))
         if self.max_rate is not None:
-            if not _real(self.max_rate) or not np.isfinite(self.max_rate) or not self.max_rate > 0:
+            if not is_real(self.max_rate) or not np.isfinite(self.max_rate) or not self.max_rate > 0:
                 raise ValueError(f"max_rate must be a finite positive rate (rad/s) or None, got {self.max_rate!r}")
             object.__setattr__(self, "max_rate", float(self.max_rate))
         object.__setattr__(self, "pointing", tuple(self.pointing))
         if not all(isinstance(c, PointingConstraint) for c in self.pointing):
             raise TypeError("pointing must hold ocp.geometry.PointingConstraint objects")
         if self.actuator_margin is not None:
-            if not (_real(self.actuator_margin) and 0.0 <= self.actuator_margin < 1.0):
+            if not (is_real(self.actuator_margin) and 0.0 <= self.actuator_margin < 1.0):
                 raise ValueError(f"actuator_margin must lie in [0, 1) or be None, got {self.actuator_margin!r}")
             object.__setattr__(self, "actuator_margin", float(self.actuator_margin))
 
@@ -200,12 +201,6 @@ def bound_keys(actuators: list) -> str:
     """
     return ", ".join(f"spacecraft.{actuator.name}" + next((f".{key}" for key in ("max_torque", "max_dipole")
                                                            if hasattr(actuator, key)), "") for actuator in actuators)
-
-
-def _real(value: object) -> bool:
-    """Whether ``value`` is a real number: a Python or numpy integer or float, not a bool (``True``
-    is no duration)."""
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
 
 
 def _vector(name: str, value: ArrayLike, size: int) -> Array:

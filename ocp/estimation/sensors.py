@@ -18,13 +18,14 @@ field reading and white noise (``ocp.simulation.SensorNoise.field_std``'s stream
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from ocp.options import is_real
 
 Array = NDArray[np.float64]
 
@@ -38,13 +39,8 @@ def _vector(name: str, value: Any, non_negative: bool = False) -> Array:
     return array
 
 
-def _real(value: Any) -> bool:
-    """Whether ``value`` is a real number: a Python or NumPy integer or float, not a bool."""
-    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
-
-
 def _non_negative(name: str, value: Any) -> float:
-    if not _real(value) or not math.isfinite(value) or value < 0:
+    if not is_real(value) or not math.isfinite(value) or value < 0:
         raise ValueError(f"{name} must be a finite non-negative number, got {value!r}")
     return float(value)
 
@@ -133,7 +129,7 @@ class Exclusion:
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"an exclusion's name must be a non-empty string, got {self.name!r}")
         angle = self.half_angle
-        if not _real(angle):
+        if not is_real(angle):
             raise ValueError(f"the {self.name} exclusion half-angle must be a number of rad in [0, pi], "
                              f"got {angle!r} ({type(angle).__name__})")
         if not (math.isfinite(angle) and 0.0 <= angle <= math.pi):
@@ -180,7 +176,7 @@ def _windows(outages: Any) -> tuple[tuple[float, float], ...]:
         windows = tuple(outages)
     except TypeError:
         raise ValueError(f"outages must be a tuple of (t0, t1) windows in s, got {outages!r:.80}") from None
-    if len(windows) == 2 and all(_real(t) for t in windows):
+    if len(windows) == 2 and all(is_real(t) for t in windows):
         raise ValueError(f"outages must be a tuple of (t0, t1) windows, got a single window {windows!r}; "
                          f"write outages=(({windows[0]!r}, {windows[1]!r}),)")
     pairs = []
@@ -189,7 +185,7 @@ def _windows(outages: Any) -> tuple[tuple[float, float], ...]:
             pair = tuple(window)
         except TypeError:
             pair = ()
-        if len(pair) != 2 or not all(_real(t) for t in pair):
+        if len(pair) != 2 or not all(is_real(t) for t in pair):
             raise ValueError(f"an outage must be a window (t0, t1) of two numbers of s, got {window!r:.80} "
                              f"in outages={outages!r:.80}")
         pairs.append((float(pair[0]), float(pair[1])))
@@ -241,7 +237,7 @@ class StarTracker:
             raise ValueError(f"exclusion names must be distinct, got {names}")
         object.__setattr__(self, "exclusions", exclusions)
         if self.rate is not None:
-            if not _real(self.rate) or not math.isfinite(self.rate) or not self.rate > 0:
+            if not is_real(self.rate) or not math.isfinite(self.rate) or not self.rate > 0:
                 raise ValueError(f"rate must be a finite positive number of Hz or None, got {self.rate!r}")
             object.__setattr__(self, "rate", float(self.rate))
         windows = _windows(self.outages)

@@ -48,6 +48,7 @@ from ocp.estimation import (
     sensor_step,
 )
 from ocp.fast_call import BufferedFunction
+from ocp.options import is_real
 from ocp.simulation.closed_loop import ClosedLoop, draw_noise
 from ocp.simulation.compiled import compile_function, notice
 
@@ -185,7 +186,7 @@ class SensorNoise:
     def __post_init__(self) -> None:
         for name in ("attitude_std", "rate_std", "field_std"):
             value = getattr(self, name)
-            if not _real(value) or not math.isfinite(value) or value < 0:
+            if not is_real(value) or not math.isfinite(value) or value < 0:
                 raise ValueError(f"{name} must be a finite non-negative standard deviation, got {value!r}")
         if not isinstance(self.seed, (int, np.integer)) or isinstance(self.seed, bool) or self.seed < 0:
             raise ValueError(f"seed must be a non-negative integer, got {self.seed!r}")
@@ -507,7 +508,7 @@ class Simulator:
         if not isinstance(model, AttitudeModel):
             raise TypeError(f"model must be an ocp.AttitudeModel, got {type(model).__name__}")
         for name, value in (("sample_time", sample_time), ("max_step", max_step), ("rtol", rtol), ("atol", atol)):
-            if not _real(value) or not math.isfinite(value) or not value > 0:
+            if not is_real(value) or not math.isfinite(value) or not value > 0:
                 raise ValueError(f"{name} must be a finite positive number of seconds, got {value!r}")
         sample_time, max_step, rtol, atol = float(sample_time), float(max_step), float(rtol), float(atol)
         if integrator not in INTEGRATORS:
@@ -535,6 +536,7 @@ class Simulator:
         self._field_rate_numeric = (None if model.field_rate_inertial is None
                                     else BufferedFunction(model.field_rate_inertial))
         self.integrator = integrator
+        self._tolerances = (rtol, atol) if integrator == "cvodes" else None  # what the step bakes in besides substeps
         self.compile = compile
         self.python_loop = python_loop
         self._loops: dict[Any, tuple[ClosedLoop, ca.Function, str]] = {}
@@ -644,7 +646,7 @@ class Simulator:
         p = default if parameters is None else np.asarray(parameters, dtype=float)
         if p.shape != (3,) or not np.all(np.isfinite(p)):
             raise ValueError(f"parameters must be a finite 3-vector disturbance torque (N m), got {p}")
-        if not _real(duration) or not math.isfinite(duration) or not duration > 0:
+        if not is_real(duration) or not math.isfinite(duration) or not duration > 0:
             raise ValueError(f"duration must be a finite positive number of seconds, got {duration!r}")
         duration = float(duration)
         n_samples = max(1, math.ceil(duration / self.sample_time - 1e-9))
@@ -775,7 +777,10 @@ class Simulator:
                              sensors: SensorSuite | None = None) -> tuple[ClosedLoop, ca.Function, str]:
         """The one-sample closed-loop function of a symbolic law.
 
-        Builds are kept per law (``Controller.symbolic_key``) and noise shape.
+        Builds are kept per law (``Controller.symbolic_key``), noise shape and sensors, in the
+        model's :class:`~ocp.SolverCache` (``model.solver_cache``): every simulator of the model
+        shares them, so a scenario run again builds no closed loop (the last :attr:`MAX_BUILDS`
+        are also kept by the simulator itself).
 
         Parameters
         ----------
@@ -795,30 +800,44 @@ class Simulator:
         path : str
             ``"interpreted"`` or ``"compiled"``.
         """
-        loop_key = (self._loop_key(controller, noise), None if sensors is None else sensors.key)
+        loop_key = self._structure(controller, noise, sensors)
         if loop_key not in self._loops:
             if len(self._loops) >= self.MAX_BUILDS:
                 self._loops.clear()
                 self._runs.clear()
-            law = controller.symbolic_law()
-            loop = ClosedLoop(self.model, self._step, self.actuators, law.function,
-                              noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0, sensors, plant=self.plant)
+            cache = self.model.solver_cache  # shared by the simulators of this model (and its runs)
+
+            def build() -> ClosedLoop:
+                return ClosedLoop(self.model, self._step, self.actuators, controller.symbolic_law().function,
+                                  noise.attitude_std > 0, noise.rate_std > 0, noise.field_std > 0, sensors,
+                                  plant=self.plant)
+
+            loop = cache.get(loop_key, build)
             sample, path = loop.sample, "interpreted"
             if self.compile:
-                try:
-                    sample, path = compile_function(loop.sample), "compiled"
+                try:  # a failed build raises out of the cache: nothing is stored, the next run tries again
+                    sample, path = cache.get((*loop_key, "compiled"), lambda: compile_function(loop.sample)), "compiled"
                 except CompilerUnavailable as error:
                     notice(f"{error}; the closed loop runs interpreted")
             self._loops[loop_key] = (loop, sample, path)
         return self._loops[loop_key]
 
-    def _chunk_function(self, loop: ClosedLoop, sample: ca.Function, size: int) -> BufferedFunction:
+    def _chunk_function(self, loop_key: tuple, path: str, loop: ClosedLoop, sample: ca.Function,
+                        size: int) -> BufferedFunction:
         """``sample`` accumulated over ``size`` samples (``mapaccum`` unrolls its calls, so long runs
-        go in chunks of at most :attr:`CHUNK` samples)."""
-        key = (id(loop), size)
+        go in chunks of at most :attr:`CHUNK` samples), cached as the loop is (:meth:`closed_loop_function`)."""
+        key = (*loop_key, path, size)
         if key not in self._runs:
-            self._runs[key] = loop.run_function(sample, size)
+            self._runs[key] = self.model.solver_cache.get(key, lambda: loop.run_function(sample, size))
         return self._runs[key]
+
+    def _structure(self, controller: Any, noise: SensorNoise, sensors: SensorSuite | None) -> tuple:
+        """What a closed-loop build bakes in, the key of :meth:`closed_loop_function`'s builds in
+        the model's :class:`~ocp.SolverCache` (the model's numbers are its own): the plant's
+        numbers, the hold's integrator and sub-steps (the step integrates its dynamics), the law, which noises
+        the loop takes and the sensors' models."""
+        return ("closed_loop", None if self.plant is None else self.plant.fingerprint, self.integrator, self.substeps,
+                self._tolerances, self._loop_key(controller, noise), None if sensors is None else sensors.key)
 
     @staticmethod
     def _loop_key(controller: Any, noise: SensorNoise) -> tuple:
@@ -831,6 +850,7 @@ class Simulator:
                       plant_noise: Array | None = None) -> SimulationResult:
         n_samples = times.size - 1
         loop, sample, path = self.closed_loop_function(controller, noise, sensors)
+        loop_key = self._structure(controller, noise, sensors)
         rows = None
         if loop.shape.uses_reference:
             grid = times[:-1]
@@ -854,7 +874,7 @@ class Simulator:
         states[0] = x0
         for start in range(0, n_samples, self.CHUNK):
             stop = min(start + self.CHUNK, n_samples)
-            run = self._chunk_function(loop, sample, stop - start)
+            run = self._chunk_function(loop_key, path, loop, sample, stop - start)
             chunk = loop.evaluate(run, xz, times[start:stop + 1], None if drawn is None else drawn[start:stop],
                                   None if rows is None else rows[start:stop], p,
                                   None if plant_noise is None else plant_noise[start:stop])
@@ -951,7 +971,3 @@ def _check_run_arguments(controller: Any, reference: Any, target: Any) -> None:
         if size == 4 and (problem := quat.unit_norm_error(array)) is not None:
             raise ValueError(f"target[0] (q_f): {problem}, got {array.tolist()}")
 
-
-def _real(value: object) -> bool:
-    """Whether ``value`` is a real number: a Python or numpy integer or float, not a bool."""
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))

@@ -106,7 +106,9 @@ _ACTUATORS = (
         "Peak demand over the limit, through the row's controller's allocation: ``wheels_torque`` (motor "
         "torque over ``max_torque``), ``wheels_momentum`` (over ``max_momentum``), ``magnetorquers_dipole`` "
         "(over ``max_dipole``), ``torquers_torque`` (over ``max_torque``), the largest over the elements and "
-        "samples; only quantities with a limit. Met at most ``1 − margin``; null when the demand is not "
+        "samples; only quantities with a limit; a declared free start's momentum the wheels cannot take is "
+        "asked too, as a constant torque over the manoeuvre (:func:`~scenarios.requirements.scoring.start_torque`). "
+        "Met at most ``1 − margin``; null when the demand is not "
         "finite (nan, inf), which breaks the requirement.", ("ref",)),
     RequirementField(
         "actuators", f"{QUANTITY}_time_s", "s", "time of peak {quantity}",
@@ -127,7 +129,9 @@ _ACTUATORS = (
         "The largest torque the reference asks that the allocation's commands do not give "
         "(:func:`~controllers.allocation.unrealised_torque`): torque about an axis no working actuator spans "
         "(one wheel, failed wheels without torquers; along the field for magnetorquers alone), which no "
-        "limit shows, since nothing is commanded for it. Above 1 % of the reference's peak torque "
+        "limit shows, since nothing is commanded for it; with the torque that removes a declared free "
+        "start's momentum the wheels cannot take over the manoeuvre "
+        "(:func:`~scenarios.requirements.scoring.start_torque`). Above 1 % of the reference's peak torque "
         "(:data:`~scenarios.requirements.scoring.UNREALISED_TOLERANCE`) it breaks the requirement; null "
         "when it is not finite.", ("ref",)),
     RequirementField(

@@ -15,7 +15,8 @@ and what breaks it in words. The fields (their units, words and definitions are 
 * ``actuators`` (reference only): for each actuator quantity with a limit
   (:func:`controllers.allocation.reference_demand`, through the row's controller's allocation, at
   the samples and either side of each of the reference's breakpoints: the integrated demand never
-  interpolates across a switch, and a bang's peak at its end is read there),
+  interpolates across a switch, and a bang's peak at its end is read there; a declared free start's
+  momentum the wheels cannot take asked on top, :func:`start_torque`),
   ``<quantity>`` the peak demand over the limit and ``<quantity>_time_s`` when it peaks, then
   ``rate_jump`` [rad/s] and ``rate_jump_time_s``, the largest jump of the reference's body rate
   (:func:`rate_jumps`: an impulse no finite torque gives; its momentum goes to the wheels), then
@@ -74,7 +75,7 @@ from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requi
 __all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
            "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
            "endpoint_violations", "plant_limits", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
-           "score_reference", "tracking_loss", "unhonoured", "violations",
+           "score_reference", "start_torque", "tracking_loss", "unhonoured", "violations",
            "worst_error_between_samples"]
 
 Array = NDArray[np.float64]
@@ -436,9 +437,66 @@ def rate_jumps(t: Array, omega: Array, omega0: ArrayLike, reference: Reference |
     return found
 
 
+def start_torque(spacecraft: Spacecraft, t: Array, q: Array, step: ArrayLike,
+                 duration: float) -> tuple[Array, Array]:
+    """The torque that removes, over the manoeuvre, the momentum of a declared free start that the
+    working wheels cannot take.
+
+    A reference that starts at ``ω_ref(0)`` while the spacecraft turns at ``ω₀`` (a declared free
+    start, :func:`rate_jumps`) leaves the body ``I (ω_ref(0) − ω₀)`` of momentum to gain. The
+    working wheels take its part within their span at once (:func:`controllers.allocation.reference_demand`'s
+    jumps); the rest, ``J = (1 − S Sᵀ) I (ω_ref(0) − ω₀)`` (``S`` the wheels' span,
+    :meth:`ocp.Spacecraft.wheel_span`; all of it without wheels), only an external torque gives: a
+    torque impulse. It is asked as the least constant torque that gives it by the end of the
+    manoeuvre, ``j / T`` in the inertial frame (``j = R(q(0)) J``), in body axes ``R(q(t))ᵀ j / T``
+    from 0 to T and nothing after, on top of the reference's torque: through the allocation,
+    torquers asked nothing else are asked ``|J_i| / (T τ_max,i)`` of their limit on body axis ``i``
+    at t = 0 (the time they need at their limit to remove it, over T), wheels take what turns into
+    their span, and what no working actuator
+    spans is unrealised torque (:func:`controllers.allocation.unrealised_torque`), which breaks the
+    actuator requirement.
+
+    Parameters
+    ----------
+    spacecraft : ocp.Spacecraft
+        The spacecraft (its inertia [kg m^2] and working wheels).
+    t : (N,) ndarray
+        Sample times [s], from 0.
+    q : (N, 4) ndarray
+        The reference's attitude at ``t`` (scalar first, body to inertial).
+    step : (3,) array_like
+        ``ω_ref(0) − ω₀`` [rad/s], body axes.
+    duration : float
+        The manoeuvre's T [s] (positive).
+
+    Returns
+    -------
+    torque : (N, 3) ndarray
+        The torque [N m], body axes, at ``t`` (its value up to T at a sample at T; zero after).
+    impulse : (3,) ndarray
+        ``J`` [N m s], body axes at t = 0; zeros (and no torque) when the working wheels span three
+        axes or its rate ``‖I⁻¹ J‖`` is within :data:`~planners.reference.JUMP_TOLERANCE`.
+    """
+    t = np.asarray(t, dtype=float).reshape(-1)
+    torque = np.zeros((t.size, 3))
+    span = spacecraft.wheel_span()
+    if span.shape[1] == 3 or not t.size:
+        return torque, np.zeros(3)
+    inertia = np.asarray(spacecraft.inertia, dtype=float)
+    impulse = (np.eye(3) - span @ span.T) @ inertia @ np.asarray(step, dtype=float).reshape(3)
+    if np.linalg.norm(np.linalg.solve(inertia, impulse)) <= JUMP_TOLERANCE:
+        return torque, np.zeros(3)
+    inertial = quat.rotate(np.asarray(q, dtype=float)[0], impulse) / duration
+    during = t <= duration
+    torque[during] = quat.rotate_inverse(np.asarray(q, dtype=float).reshape(-1, 4)[during],
+                                         np.tile(inertial, (int(np.sum(during)), 1)))
+    return torque, impulse
+
+
 def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
                jumps: list[tuple[float, int, Array]] | None = None, unrealised: Array | None = None,
-               torque: Array | None = None, plant_limited: Mapping[str, Array] | None = None) -> Score:
+               torque: Array | None = None, plant_limited: Mapping[str, Array] | None = None,
+               impulse: Array | None = None, duration: float | None = None) -> Score:
     values: dict[str, float | None] = {}
     broken = []
     unscored = []
@@ -495,6 +553,10 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
             share = f" ({peak / scale:.0%} of the reference's peak)" if scale > 0.0 else ""
             missing = f"{peak:.3g} N m of the torque asked at {t[worst]:g} s{share} is given by no working actuator"
             detail = missing + (f", {detail}" if detail else "")
+    if detail and impulse is not None and duration is not None and np.any(impulse):
+        size = float(np.linalg.norm(impulse))
+        detail += (f" (with the free start's momentum the wheels cannot take, {size:.3g} N m s, removed at "
+                   f"{size / duration:.3g} N m over the {duration:g} s manoeuvre)")
     return Score("actuators", values, not detail, detail)
 
 
@@ -596,21 +658,32 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         for _, index, jump in jumps:
             if index < demand_t.size:
                 steps[index] += jump
+        start = np.zeros((demand_t.size, 3))
+        impulse = np.zeros(3)
         if demand_t.size and not any(index == 0 for _, index, _ in jumps):
             # A declared free start (rate_jumps) is no torque demand, but the momentum it carries is:
             # the total angular momentum is the spacecraft's own at t = 0, I ω₀ + A h₀, whatever rate
             # the reference starts from, so the wheels take up I (ω₀ − ω_ref(0)) however the closed
             # loop absorbs the difference (a body spinning with more momentum than the wheels hold
-            # cannot be brought to rest by them).
+            # cannot be brought to rest by them); what they cannot take the other actuators remove
+            # over the manoeuvre (start_torque).
             steps[0] += omega[0] - np.asarray(problem.omega0, dtype=float)
+            if reference is not None:
+                start, impulse = start_torque(problem.model.spacecraft, demand_t, q, steps[0], reference.duration)
         # The actuators' share: the reference's torque u (of I ω̇ = −ω × I ω + u, the environment
         # it models inside) less the environment's torque along it (a planner that models none, such
-        # as eigenaxis, leaves the actuators a disturbance to cancel; one that does, its own model).
+        # as eigenaxis, leaves the actuators a disturbance to cancel; one that does, its own model),
+        # and the torque that removes a free start's momentum the wheels cannot take.
         environment = _environment_torque(problem, demand_t, q, omega)
         torque = reference_torque - environment
-        # the sample at T holds the torque's value there; the reference coasts torque-free after it
-        after = (np.where((demand_t >= reference.duration)[:, None], 0.0, reference_torque) - environment
-                 if reference is not None else None)
+        after = None
+        if reference is not None:
+            # the sample at T holds the torque's value there; the reference coasts torque-free after it
+            coasting = (demand_t >= reference.duration)[:, None]
+            after = np.where(coasting, 0.0, reference_torque) - environment
+            if np.any(impulse):
+                torque = torque + start
+                after = after + np.where(coasting, 0.0, start)
         demand = reference_demand(allocation, problem.model, demand_t, q, omega, torque,
                                   problem.wheel_momentum0, jumps=steps, torque_after=after)
         unrealised = unrealised_torque(problem.model, demand_t, q, omega, torque, demand)
@@ -622,7 +695,7 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
                     lower[name] = limit < quantity.limit
                     demand[name] = dataclasses.replace(quantity, limit=limit)
         scores["actuators"] = _actuators(requirements.actuators.allowed, demand, demand_t, jumps, unrealised, torque,
-                                         lower)
+                                         lower, impulse, None if reference is None else reference.duration)
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, sample.omega)
     return scores
