@@ -868,5 +868,13 @@ MUTATIONS: list[Mutation] = [
              "due = np.concatenate([[True], count[1:] > count[:-1]])",
              "due = np.concatenate([[True], count[1:] >= count[:-1]])",
              ("tests/test_estimation_filter.py::test_star_tracker_schedule_rate_and_outages",)),
+    Mutation("aem-jump-allowance-from-the-gentler-neighbour", "scenarios/output/aem.py",
+             "    neighbours = np.maximum(left, right)\n", "    neighbours = np.minimum(left, right)\n",
+             ("tests/test_aem_segments.py::test_jump_starts_from_samples_and_from_a_recorded_time",
+              "tests/test_aem_logic.py")),
+    Mutation("aem-closed-loop-split-at-its-rate-changes", "scenarios/output/aem.py",
+             'if scope == "reference" and np.all(np.isfinite(omega)) else [])',
+             'if np.all(np.isfinite(omega)) else [])',
+             ("tests/test_aem_segments.py::test_a_rate_that_does_not_jump_stays_one_segment",)),
 ]
 """Every mutation of the check, by area."""
