@@ -72,3 +72,22 @@ def test_the_guard_is_applied_at_each_threshold_the_refinement_tries(monkeypatch
     found = check(f)
     assert not found.certified and found.degenerate, found.message
     assert found.curvature_threshold == pytest.approx(delta, rel=1e-8)
+
+
+def test_a_strongly_active_bound_at_zero_is_near_within_its_tolerance():
+    """min x² − y² + y with y ≥ 0, at (0, 1e-9): an interior-point solver stops that far inside its
+    bound. The bound's multiplier −1 (strongly active) fixes y: f = x² + y − y² ≥ 0 nearby, a strict
+    minimum with curvature 2 along x. A bound at 0 is near within 1e-6 (1 + |0|), not within
+    1e-6 × |0| = 0: read as free, y's curvature −2 would show."""
+    found = second_order_check(nlp(lambda x: x[0] ** 2 - x[1] ** 2 + x[1]), np.array([0.0, 1e-9]),
+                               np.array([0.0, -1.0]), np.zeros(0), lbx=[-1, 0], ubx=[1, 1])
+    assert found.certified and found.negative_curvatures == 0, found.message
+
+
+def test_a_fixed_variables_multiplier_is_not_asked_to_balance_its_gradient():
+    """min (x − 1)² + y² with x fixed at 0 (equal bounds), its multiplier reported 0: a fixed
+    variable's multiplier takes any value, so the gradient 2 along x is no stationarity residual;
+    y is free with curvature 2: certified."""
+    found = second_order_check(nlp(lambda x: (x[0] - 1.0) ** 2 + x[1] ** 2), np.zeros(2), np.zeros(2), np.zeros(0),
+                               lbx=[0.0, -1.0], ubx=[0.0, 1.0])
+    assert found.certified and found.negative_curvatures == 0, found.message

@@ -876,5 +876,27 @@ MUTATIONS: list[Mutation] = [
              'if scope == "reference" and np.all(np.isfinite(omega)) else [])',
              'if np.all(np.isfinite(omega)) else [])',
              ("tests/test_aem_segments.py::test_a_rate_that_does_not_jump_stays_one_segment",)),
+    # more of the second-order check, the free start's declaration, the ephemeris's time argument
+    Mutation("second-order-nearness-of-a-zero-bound-absolute", "ocp/nlp/second_order.py",
+             "near_low = np.isfinite(low) & (values - low <= bound_tolerance * (1.0 + np.abs(low)))",
+             "near_low = np.isfinite(low) & (values - low <= bound_tolerance * np.abs(low))",
+             ("tests/test_second_order.py::test_a_weakly_active_bound_is_left_free",
+              "tests/test_mutants_second_order.py::test_a_strongly_active_bound_at_zero_is_near_within_its_tolerance")),
+    Mutation("second-order-stationarity-of-fixed-variables", "ocp/nlp/second_order.py",
+             "stationarity = float(np.max(np.abs(sum(terms))[moving], initial=0.0)) \\",
+             "stationarity = float(np.max(np.abs(sum(terms)), initial=0.0)) \\",
+             ("tests/test_mutants_second_order.py::test_a_fixed_variables_multiplier_is_not_asked_to_balance_its_gradient",)),
+    Mutation("free-start-declared-by-the-final-rate", "scenarios/requirements/scoring.py",
+             'declared = reference is not None and "omega0" in reference.free_boundary',
+             'declared = reference is not None and "omegaf" in reference.free_boundary',
+             ("tests/test_requirements_hostile.py::test_a_reference_that_jumps_its_rate_is_never_ok",)),
+    Mutation("ephemeris-tdb-without-the-day-fraction", "ocp/dynamics/ephemeris.py",
+             "day_fraction = np.mod(tt2 + 0.5, 1.0)", "day_fraction = np.zeros_like(tt2)",
+             ("tests/test_ephemeris.py",),
+             equivalent="ERFA's dtdb uses the day fraction only in its topocentric terms, each a multiple of "
+                        "the observer's distances u, v from the Earth's axis and equator plane: 0 at the geocentre"),
+    Mutation("aem-number-writes-negative-zero", "scenarios/output/aem.py",
+             'return f"{float(value) + 0.0:.15E}"', 'return f"{float(value):.15E}"',
+             ("tests/test_aem.py",)),
 ]
 """Every mutation of the check, by area."""
