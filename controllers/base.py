@@ -71,8 +71,12 @@ class Controller(Allocation, Configurable, ABC):
     * ``needs_reference``: the law cannot regulate (``reference=None``) and raises ``ValueError``
       there; the scenario loader rejects regulation mode for it.
     * ``tracks_reference``: given a reference, the law follows it (``augmented_quaternion_feedback``;
-      implied by ``needs_reference``); otherwise it regulates to the target whatever the reference
-      (``eigenaxis_pd``, the two-wheel laws, the detumbling laws).
+      implied by ``needs_reference``); otherwise (the default) it regulates to the target whatever
+      the reference (``eigenaxis_pd``, the two-wheel laws, the detumbling laws). A law that reads
+      the reference (``τ*``, ``q*``, ``ω*`` from ``reference_rows``) must declare it: the
+      conformance checks then run it along a reference, and
+      :func:`~controllers.conformance.check_ignores_reference` fails a law that reads the
+      reference without declaring it.
     * ``needs_target_attitude``: in regulation mode the law needs ``maneuver.final.q``. Laws that
       regulate the rate alone (detumbling: ``bdot``, ``tdfc``; ``none``) set it to ``False`` and
       then accept a free final attitude (``q: null``).

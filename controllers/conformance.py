@@ -9,7 +9,8 @@ what is wrong and what to do about it; a user's law is checked with :func:`check
 
 A law is run on each standard plant it accepts (``environment_error`` is ``None``), in regulation
 to the target (unless it ``needs_reference``) and, if it ``tracks_reference``, along a planned
-reference (the first of :data:`REFERENCE_PLANNERS` that it and the plant accept). The checks and
+reference (the first of :data:`REFERENCE_PLANNERS` that it and the plant accept); a law that
+declares neither must show that it ignores the reference (``ignores_reference``). The checks and
 their oracles:
 
 * ``options``: every numeric option declares a :class:`~ocp.options.Range`; a value outside it,
@@ -23,6 +24,12 @@ their oracles:
 * ``symbolic``: ``__call__`` and :meth:`~controllers.base.Controller.symbolic_law` agree to 1e-12 at
   random states over successive samples (state updates included); a law without a symbolic form
   says why. Oracle: the two implementations of one law.
+* ``ignores_reference``: a law that declares neither ``tracks_reference`` nor ``needs_reference``
+  regulates to the target whatever the reference: given a planned reference, ``__call__`` and the
+  symbolic law (the reference's rows in ``r``) command what they command in regulation to the same
+  target, over successive samples at random states. Oracle: the law's own regulation commands (a
+  law that reads the reference must declare ``tracks_reference``, which the other checks then
+  test along a reference).
 * ``pure``: same inputs, same command, bit for bit; ``reset`` clears the state; two instances run
   interleaved give what each gives alone (no state shared through the class or a module); the
   measurement and the reference are left as they were.
@@ -83,8 +90,8 @@ from planners import PLANNERS, ManeuverProblem, Reference
 __all__ = ["ALLOCATION_TOLERANCE", "CHECKS", "CONVERGED", "HOLD_FOR_ALLOCATION", "INERTIA", "INITIAL_ERROR_DEG",
            "OPTIONS_PATH", "REFERENCE_PLANNERS", "SYMBOLIC_TOLERANCE", "Plant", "accepted_plants", "check_allocation",
            "check_at_rest", "check_closed_loop", "check_commands", "check_controller", "check_double_cover",
-           "check_options", "check_pure", "check_symbolic", "checked_command", "describe_options", "kinetic_energy",
-           "option_variants", "sample_time_for", "standard_plants"]
+           "check_ignores_reference", "check_options", "check_pure", "check_symbolic", "checked_command",
+           "describe_options", "kinetic_energy", "option_variants", "sample_time_for", "standard_plants"]
 
 Array = NDArray[np.float64]
 
@@ -726,6 +733,13 @@ def check_commands(controller: Controller, seed: int = 6) -> None:
                 checked_command(law, float(t), exact, mode.reference, f"{where}, with no error")
 
 
+def _agree(value: Array, expected: Array) -> bool:
+    """Whether two commands (or two law states) are one, to :data:`SYMBOLIC_TOLERANCE` of the
+    expected one's size (at least 1)."""
+    scale = max(1.0, float(np.max(np.abs(expected), initial=0.0)))
+    return bool(np.allclose(value, expected, rtol=0.0, atol=SYMBOLIC_TOLERANCE * scale))
+
+
 def check_symbolic(controller: Controller, seed: int = 1) -> None:
     """The numeric law (``__call__``) and its symbolic form agree at random states.
 
@@ -776,18 +790,90 @@ def check_symbolic(controller: Controller, seed: int = 1) -> None:
                 u, z_next = (v.full().ravel() for v in symbolic.function(t, measurement_vector(measurement), z, rows))
                 expected = law.command_vector(checked_command(law, t, measurement, mode.reference,
                                                               f" on {plant_name}, {mode.name}, sample {k}"))
-                scale = max(1.0, float(np.max(np.abs(expected), initial=0.0)))
-                if not np.allclose(u, expected, rtol=0.0, atol=SYMBOLIC_TOLERANCE * scale):
+                if not _agree(u, expected):
                     raise ConformanceError(
                         f"{_label(law)} on {plant_name}, {mode.name}, sample {k}: the symbolic law gives u = "
                         f"{np.round(u, 12).tolist()} but __call__ gives {np.round(expected, 12).tolist()}; _law must "
                         f"compute what __call__ computes, for every option")
                 state = law.state_vector()
-                if not np.allclose(z_next, state, rtol=0.0, atol=SYMBOLIC_TOLERANCE * max(1.0, float(np.max(np.abs(state), initial=0.0)))):
+                if not _agree(z_next, state):
                     raise ConformanceError(
                         f"{_label(law)} on {plant_name}, {mode.name}, sample {k}: z_next = {np.round(z_next, 12).tolist()} "
                         f"but state_vector() after __call__ is {np.round(state, 12).tolist()}")
                 z = z_next
+
+
+def check_ignores_reference(controller: Controller, seed: int = 7) -> None:
+    """A law that does not declare ``tracks_reference`` ignores the reference.
+
+    ``tracks_reference = False`` (the default) declares that the law regulates to the target
+    whatever the reference; the other checks then run it in regulation alone, so a law that reads
+    the reference without declaring it would have its tracking unchecked (and the simulator, which
+    gives every law the reference, would run it). On every standard plant the law accepts where a
+    reference is planned (:data:`REFERENCE_PLANNERS`), over four successive samples at random
+    states inside the reference: ``__call__`` given the reference commands what it commands in
+    regulation to the same target, and so does the symbolic law given the reference's rows ``r``
+    instead of the target's (its ``u`` and ``z_next``). Laws that declare ``tracks_reference`` or
+    ``needs_reference`` are not checked here (the other checks run them along a reference).
+
+    Parameters
+    ----------
+    controller : Controller
+        The law, with the options to check.
+    seed : int, optional
+        Seed of the random states.
+
+    Raises
+    ------
+    ConformanceError
+        If a command (or the symbolic law's state update) with the reference differs from the
+        one in regulation by more than :data:`SYMBOLIC_TOLERANCE` of its size (plant, sample, both
+        values), naming the law and saying to declare ``tracks_reference = True``.
+    """
+    if controller.tracks_reference or controller.needs_reference:
+        return
+    rng = np.random.default_rng(seed)
+    meaning = ("tracks_reference = False declares that the law regulates to the target whatever the reference; "
+               "if it follows a reference, set tracks_reference = True on the class (the checks then run it "
+               "along a reference too)")
+    for plant_name, plant in accepted_plants(controller).items():
+        reference = _reference(controller, plant)
+        if reference is None:
+            continue
+        regulation = _modes(controller, plant)[0]
+        tracking = dataclasses.replace(regulation, name="given a reference", reference=reference)
+        law = _fresh(controller)
+        sample_time = sample_time_for(law, plant.sample_time)
+        sequence = _sequence(rng, law, tracking, sample_time, 4)
+        given = _commands(law, tracking, sample_time, sequence)
+        regulated = _commands(law, regulation, sample_time, sequence)
+        for k, (measurement, u, expected) in enumerate(zip(sequence, given, regulated)):
+            if not _agree(u, expected):
+                raise ConformanceError(
+                    f"{_label(law)} on {plant_name}, sample {k} (t = {measurement.t:g} s): __call__ gives u = "
+                    f"{np.round(u, 12).tolist()} along a planned reference ({reference.planner}) but "
+                    f"{np.round(expected, 12).tolist()} regulating to the same target: the law reads the reference. "
+                    f"{meaning}")
+        if law.symbolic_error() is not None:
+            continue
+        law.reset(plant.problem.spacecraft, sample_time, target=regulation.target)
+        symbolic = law.symbolic_law()
+        z_given = z_regulated = symbolic.state0
+        for k, measurement in enumerate(sequence):
+            t, y = measurement.t, measurement_vector(measurement)
+            times = np.array([t, t + sample_time])
+            u, z_given = (v.full().ravel() for v in symbolic.function(
+                t, y, z_given, law.reference_rows(reference, times).ravel()))
+            expected, z_regulated = (v.full().ravel() for v in symbolic.function(
+                t, y, z_regulated, law.reference_rows(None, times).ravel()))
+            for what, value, wanted in (("u", u, expected), ("z_next", z_given, z_regulated)):
+                if not _agree(value, wanted):
+                    raise ConformanceError(
+                        f"{_label(law)} on {plant_name}, sample {k} (t = {t:g} s): the symbolic law gives {what} = "
+                        f"{np.round(value, 12).tolist()} with a planned reference's rows r ({reference.planner}) but "
+                        f"{np.round(wanted, 12).tolist()} with the target's, while __call__ ignores the reference; "
+                        f"the simulator gives the law the reference in r: _law must compute what __call__ computes. "
+                        f"{meaning}")
 
 
 def check_pure(controller: Controller, seed: int = 2) -> None:
@@ -1128,6 +1214,7 @@ CHECKS: dict[str, Callable[[Controller], None]] = {
     "options": check_options,
     "commands": check_commands,
     "symbolic": check_symbolic,
+    "ignores_reference": check_ignores_reference,
     "pure": check_pure,
     "double_cover": check_double_cover,
     "allocation": check_allocation,
