@@ -11,6 +11,16 @@ one is ``violated`` (never ``ok``), its message naming the requirement, the scop
 the time, and a planner that does not honour a kind of requirement present says so in its message.
 Statuses rank ``failed`` over ``violated`` over ``ok``.
 
+References reused (a trade study's worker, which passes ``references``): a row whose planning
+inputs are identical to an earlier case's (:func:`planning_key`: the planner's class, registry name
+and validated options, and every field of the :class:`~planners.ManeuverProblem`) gets that case's
+reference instead of planning again: a Monte Carlo that disperses only the truth plant
+(``truth.*``) plans once per worker. Only a successful reference is kept (a failed plan, e.g. one
+stopped by a time limit, is planned again in every case), and each row gets its own copy (its
+statistics are written on by the cross-check below). The reused row's ``plan_time_s`` is the wall
+time of the plan that made the reference (the planner's cost), not the nothing the case spent on
+it; the case's own ``elapsed_s`` (:func:`scenarios.study.worker.run_case`) shows the saving.
+
 Optima cross-checked: when a run holds a direct optimum (a reference whose certificate has no
 ``method``, e.g. ``collocation``) and an indirect one (a co-state solution, e.g. ``costate_tpbvp``)
 of the same functional (the ``name`` of both references' ``stats["functional"]``), each
@@ -19,6 +29,10 @@ certificate gets the relative difference of their values of it, ``costate_gap``
 """
 from __future__ import annotations
 
+import copy
+import dataclasses
+import enum
+import hashlib
 import time
 import traceback
 from collections.abc import Callable
@@ -181,7 +195,7 @@ def _check_physical(row: Row, scope: str, metrics: dict[str, Any] | None) -> Non
 
 def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         cache: SolverCache | None = None, simulators: SolverCache | None = None,
-        on_row: Callable[[Row], None] | None = None) -> RunResults:
+        on_row: Callable[[Row], None] | None = None, references: SolverCache | None = None) -> RunResults:
     """Plan, simulate and score every planner of ``scenario``.
 
     The scenario's validated planner and controller instances serve every row (their options are
@@ -200,6 +214,11 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     on_row : receives each row as soon as it is done (scored and judged), before its progress
         line: ``slewbench run`` sends its figure to the plot process
         (:func:`scenarios.output.writer.plot_streamer`).
+    references : SolverCache or None
+        Successful references kept across runs, keyed by :func:`planning_key`: a row whose planner
+        and problem have the key of a kept reference reuses it (a copy) instead of planning;
+        anything with SolverCache's ``get`` (a trade-study worker passes a bounded one). None
+        (default): every row is planned.
 
     Returns
     -------
@@ -222,9 +241,10 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         raise TypeError(f"on_row must be callable or None, got {type(on_row).__name__}")
     if cache is not None and not isinstance(cache, SolverCache):
         raise TypeError(f"cache must be an ocp.SolverCache or None, got {type(cache).__name__}")
-    if simulators is not None and not callable(getattr(simulators, "get", None)):
-        raise TypeError(f"simulators must have SolverCache's get (an ocp.SolverCache) or be None, got "
-                        f"{type(simulators).__name__}")
+    for name, given in (("simulators", simulators), ("references", references)):
+        if given is not None and not callable(getattr(given, "get", None)):
+            raise TypeError(f"{name} must have SolverCache's get (an ocp.SolverCache) or be None, got "
+                            f"{type(given).__name__}")
     say = progress or (lambda line: None)
     spec = scenario.simulation
     model = scenario.problem.model
@@ -242,7 +262,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
          spec.integrator, spec.max_step, spec.max_samples, spec.compile), build)
     controllers = scenario.controllers
     labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in controllers])
-    references: dict[int, tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]] = {}
+    planned: dict[int, tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]] = {}
     scoring = _SCORE_REQUIREMENTS and bool(scenario.requirements)
     broken_ends = endpoint_violations(scenario.problem) if scoring else []
     rows: list[Row] = []
@@ -256,10 +276,10 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         else:
             planner_spec = scenario.planners[i]
             if broken_ends:  # no planner can meet them: nothing is planned
-                references.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends)), None, None))
-            if i not in references:  # planned once, tracked by every controller
-                references[i] = plan_row(scenario, planner_spec, cache, scoring)
-            reference, reference_metrics, sampled = references[i]
+                planned.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends)), None, None))
+            if i not in planned:  # planned once, tracked by every controller
+                planned[i] = plan_row(scenario, planner_spec, cache, scoring, kept=references)
+            reference, reference_metrics, sampled = planned[i]
             row = Row(label, planner_spec.name, reference.status, reference.message,
                       reference.plan_time_s, None if reference_metrics is None else dict(reference_metrics), None,
                       reference, controller=controllers[j].name)
@@ -324,7 +344,8 @@ def _cross_check_optima(rows: list[Row]) -> None:
 
 
 def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache | None,
-             scoring: bool = False) -> tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]:
+             scoring: bool = False, kept: SolverCache | None = None
+             ) -> tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]:
     """Plan one row's reference as :func:`run` does (``slewbench codegen`` plans its rows so too).
 
     Parameters
@@ -337,6 +358,10 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
         Where the planner keeps what it builds; ``None``: the model's own cache.
     scoring : bool, optional
         Also sample the reference for the requirements.
+    kept : SolverCache or None, optional
+        Successful references by :func:`planning_key` (:func:`run`'s ``references``): a copy of
+        the one kept for this planner and problem is used instead of planning, and a new
+        successful one is kept. None (default): planned.
 
     Returns
     -------
@@ -350,11 +375,11 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
     """
     spec = scenario.simulation
     planner = planner_spec.planner.with_cache(cache)
-    try:
-        reference = planner.plan(scenario.problem)
-    except Exception as error:  # noqa: BLE001 (a planner bug must not lose the other rows)
-        traceback.print_exc()
-        reference = FailedReference(planner_spec.name, f"planner raised {type(error).__name__}: {error}")
+    key = None if kept is None else planning_key(planner, scenario.problem)
+    if kept is None or key is None:
+        reference = _plan(planner, planner_spec.name, scenario.problem)
+    else:
+        reference = _kept_or_planned(kept, key, planner, planner_spec.name, scenario.problem)
     if not reference.ok:
         return reference, None, None
     times = (reference_times(reference.duration, closed_loop_window(scenario, reference), spec.sample_time, REFERENCE_POINTS)
@@ -389,6 +414,114 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
         initial_omega=scenario.problem.omega0,
         sample=uniform, rate_jumps=jumps or None)
     return reference, metrics, (times, sample) if scoring else None
+
+
+class _NotKept(Exception):
+    """Carries a failed reference out of a cache's ``build``, so that the cache does not keep it."""
+
+    def __init__(self, reference: Reference) -> None:
+        super().__init__(reference.message)
+        self.reference = reference
+
+
+def _plan(planner: Any, name: str, problem: Any) -> Reference:
+    """``planner.plan(problem)``; a planner that raises gives a failed reference naming it."""
+    try:
+        return planner.plan(problem)
+    except Exception as error:  # noqa: BLE001 (a planner bug must not lose the other rows)
+        traceback.print_exc()
+        return FailedReference(name, f"planner raised {type(error).__name__}: {error}")
+
+
+def _kept_or_planned(kept: SolverCache, key: tuple[Any, ...], planner: Any, name: str, problem: Any) -> Reference:
+    """A copy of the reference ``kept`` holds under ``key``, else one planned now (kept if it
+    succeeded). The copy has its own ``stats`` (:func:`_cross_check_optima` writes there)."""
+    def build() -> Reference:
+        reference = _plan(planner, name, problem)
+        if not reference.ok:  # a failure may be the machine's (a time limit): planned again next time
+            raise _NotKept(reference)
+        return reference
+
+    try:
+        original = kept.get(key, build)
+    except _NotKept as failure:
+        return failure.reference
+    reference = copy.copy(original)
+    reference.stats = dict(original.stats)  # the run replaces entries (the certificate), never edits one
+    return reference
+
+
+class _Unkeyable(Exception):
+    """A planning input that :func:`planning_key` cannot state exactly."""
+
+
+def _exact(value: Any) -> Any:
+    """``value`` as nested tuples of type tags, exact numbers (a float's hex, an array's bytes) and
+    text; :class:`_Unkeyable` for anything else (a callable, an object of unknown kind).
+
+    A dataclass is its qualified type and its compared fields (those excluded from equality,
+    ``compare=False``, are caches of the others, as for :attr:`ocp.AttitudeModel.fingerprint`).
+    """
+    if value is None or isinstance(value, (bool, np.bool_)):
+        return None if value is None else ("b", bool(value))
+    if isinstance(value, (int, np.integer)):
+        return ("i", int(value))
+    if isinstance(value, (float, np.floating)):
+        return ("f", float(value).hex())
+    if isinstance(value, str):
+        return ("s", value)
+    if isinstance(value, enum.Enum):
+        return ("e", f"{type(value).__module__}.{type(value).__qualname__}", value.name)
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind not in "biuf":
+            raise _Unkeyable(f"an array of dtype {value.dtype}")
+        return ("a", value.dtype.str, value.shape, np.ascontiguousarray(value).tobytes())
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return (f"{type(value).__module__}.{type(value).__qualname__}",
+                tuple((f.name, _exact(getattr(value, f.name))) for f in dataclasses.fields(value) if f.compare))
+    if isinstance(value, (list, tuple)):
+        return (type(value).__name__, tuple(_exact(item) for item in value))
+    if isinstance(value, dict):
+        return ("d", tuple(sorted(((_exact(k), _exact(v)) for k, v in value.items()), key=repr)))
+    if isinstance(value, (set, frozenset)):
+        return ("set", tuple(sorted((_exact(item) for item in value), key=repr)))
+    raise _Unkeyable(f"a {type(value).__module__}.{type(value).__qualname__}")
+
+
+def planning_key(planner: Any, problem: Any) -> tuple[Any, ...] | None:
+    """What a plan depends on, hashed: two plans with the same key give the same reference.
+
+    A planner is deterministic (its multistarts' random starts are seeded; a time limit can only
+    make it fail, and a failed reference is never reused), so its reference is fixed by its class,
+    its instance's state (its registry name and validated options; not the solver cache it builds
+    into, which changes how fast it plans, not what) and the problem it is given: every field of
+    the :class:`~planners.ManeuverProblem` (spacecraft, environment, boundary conditions,
+    duration, rate bound, pointing constraints with their direction tables, actuator margin),
+    whether or not the planner reads it. Numbers are compared exactly (bit for bit). The class's
+    ``plan`` and ``_plan`` are in the key as objects: a method replaced at run time (a test's
+    monkeypatch) makes another key.
+
+    Parameters
+    ----------
+    planner : planners.Planner
+        The row's planner (its options validated).
+    problem : planners.ManeuverProblem
+        The manoeuvre it plans.
+
+    Returns
+    -------
+    tuple or None
+        The SHA-256 hex digest of the inputs, then the class's ``plan`` and ``_plan``; ``None``
+        when an input cannot be stated exactly (an option or a field holding a callable or an
+        object of unknown kind): the row is then always planned.
+    """
+    kind = type(planner)
+    state = {name: value for name, value in vars(planner).items() if name != "cache"}
+    try:
+        text = repr((f"{kind.__module__}.{kind.__qualname__}", _exact(state), _exact(problem)))
+    except _Unkeyable:
+        return None
+    return hashlib.sha256(text.encode()).hexdigest(), kind.plan, getattr(kind, "_plan", None)
 
 
 def _first_non_finite(times: np.ndarray, sample: ReferenceSample) -> str | None:

@@ -176,7 +176,7 @@ def _plugins_loaded() -> None:
 
 
 @functools.cache
-def worker_state() -> tuple[SolverCache, RecentCache, threading.Lock]:
+def worker_state() -> tuple[SolverCache, RecentCache, threading.Lock, RecentCache]:
     """This process's caches and case lock (created on first use, kept for its life).
 
     Returns
@@ -187,8 +187,11 @@ def worker_state() -> tuple[SolverCache, RecentCache, threading.Lock]:
         The last simulators built (:func:`scenarios.runner.run`'s ``simulators``).
     lock : threading.Lock
         Held while a case runs, so that a process runs one case at a time.
+    references : RecentCache
+        The last successful references planned (:func:`scenarios.runner.run`'s ``references``):
+        a case whose planner and design problem are an earlier case's reuses its reference.
     """
-    return SolverCache(), RecentCache(), threading.Lock()
+    return SolverCache(), RecentCache(), threading.Lock(), RecentCache(size=8)
 
 
 def _labels(entries: list[Any]) -> list[str]:
@@ -272,7 +275,7 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     from scenarios.schema.loader import parse_scenario
     from scenarios.schema.plugins import load_plugins
 
-    cache, simulators, lock = worker_state()
+    cache, simulators, lock, references = worker_state()
     data, timeout = payload["scenario"], float(payload["timeout_s"])
     alarm = threading.current_thread() is threading.main_thread() and hasattr(signal, "setitimer")
     timed_out = False
@@ -287,7 +290,7 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
                     load_plugins()
                     _plugins_loaded()
                 scenario = parse_scenario(data)
-                results = run(scenario, cache=cache, simulators=simulators)
+                results = run(scenario, cache=cache, simulators=simulators, references=references)
                 status, rows = "ok", [row.to_dict() for row in results.rows]
             finally:  # disarmed first: an alarm due now is raised here, inside the outer try
                 if alarm:
@@ -304,6 +307,7 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
         elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu_start
         if timed_out or elapsed > timeout:  # out of time, whether or not the alarm's exception got through
             status, rows = "crashed", crashed_rows(data, timed_out_message(timeout))
+            references.clear()  # a plan the alarm cut short is not to be reused (none should be kept)
     return {"key": payload["key"], "status": status, "rows": rows, "elapsed_s": elapsed, "cpu_s": cpu,
             "worker_cpu_s": time.process_time(),
             "worker": f"{socket.gethostname()}:{os.getpid()}", "cache_builds": cache.builds}
