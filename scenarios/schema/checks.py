@@ -97,6 +97,65 @@ def check_work(problem: ManeuverProblem, simulation: SimulationSpec) -> None:
                             f"{SUBSTEPS_PER_SAMPLE * simulation.max_samples} sub-steps; raise max_step or "
                             "simulation.max_samples")
 
+def _check_actuated(problem: ManeuverProblem, controller: ControllerSpec) -> None:
+    """Refuse a law that steers the attitude (to a target or along a reference) on a spacecraft
+    without a working actuator: every wheel failed (or none) and no torquers or magnetorquers. A
+    law that steers nothing (``none``: a torque-free run) or only damps the rate (``bdot``,
+    ``tdfc``, which check their magnetorquers in ``environment_error``) is left alone."""
+    law = controller.controller
+    if not (law.needs_target_attitude or law.needs_reference or law.tracks_reference):
+        return
+    spacecraft = problem.spacecraft
+    if spacecraft.wheel_span().shape[1] > 0 or spacecraft.residual_actuator is not None:
+        return
+    wheels = spacecraft.wheels
+    steer = (f"{controller.path}.name {controller.name!r} has nothing to steer with: the spacecraft has no "
+             "working actuator (no spacecraft.torquers or spacecraft.magnetorquers either)")
+    if wheels is None or wheels.count == 0:
+        raise ScenarioError("spacecraft.wheels", f"null (no wheels): {steer}; give actuators, or use controller "
+                                                 "'none' for a torque-free run")
+    failed = [int(index) for index in np.flatnonzero(~wheels.working)]
+    raise ScenarioError("spacecraft.wheels.failed",
+                        f"{failed}: every one of the {wheels.count} wheels is failed, so {steer}; leave at least one "
+                        "wheel working or add actuators, or use controller 'none' for a torque-free run")
+
+
+def rate_bound_notes(problem: ManeuverProblem, simulation: SimulationSpec, max_rate: float) -> list[str]:
+    """What ``slewbench validate`` notes about a boundary rate above the rate requirement: every
+    row then breaks it (a unit slip, deg/s typed as rad/s, shows here).
+
+    The rates checked are ``maneuver.initial.omega`` and ``maneuver.final.omega`` (every row's
+    reference and closed loop start or end there) and the closed loop's true initial rate
+    ``maneuver.initial.omega + simulation.initial_rate_error`` (every row's closed loop starts
+    there), each noted once.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre: ``omega0`` and ``omegaf`` [rad/s], body axes (``omegaf`` ``None``: free).
+    simulation : SimulationSpec
+        Its ``initial_rate_error`` [rad/s], body axes.
+    max_rate : float
+        The bound on ``‖ω‖`` of ``requirements.rate.max`` [rad/s].
+
+    Returns
+    -------
+    list of str
+        One line per rate above the bound (empty when none is).
+    """
+    notes = []
+    for where, rate in (("initial", problem.omega0), ("final", problem.omegaf)):
+        if rate is not None and float(np.linalg.norm(rate)) > max_rate:
+            notes.append(f"every row breaks the rate requirement: maneuver.{where}.omega has ‖ω‖ = "
+                         f"{float(np.linalg.norm(rate)):.4g} rad/s, above {max_rate:g} rad/s")
+    true_rate = float(np.linalg.norm(problem.omega0 + simulation.initial_rate_error))
+    if np.any(simulation.initial_rate_error) and true_rate > max_rate >= float(np.linalg.norm(problem.omega0)):
+        notes.append(f"every row's closed loop breaks the rate requirement: simulation.initial_rate_error "
+                     f"{simulation.initial_rate_error.tolist()} starts it at ‖ω‖ = {true_rate:.4g} rad/s "
+                     f"(maneuver.initial.omega plus the error), above {max_rate:g} rad/s (the key is in rad/s)")
+    return notes
+
+
 def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
                         controllers: list[ControllerSpec] | ControllerSpec,
                         simulation: SimulationSpec | None = None) -> None:
@@ -117,7 +176,8 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
     ------
     ScenarioError
         At ``planners[i]`` (``problem_error``), ``<controller path>.name`` (environment, planner or
-        reference needed), ``maneuver.<key>`` (initial or final state),
+        reference needed), ``spacecraft.wheels.failed`` (a law that steers the attitude on a
+        spacecraft without a working actuator), ``maneuver.<key>`` (initial or final state),
         ``<controller path>.options.<option>`` (sample time) or ``maneuver.final.q`` (a target
         attitude needed in regulation mode).
     """
@@ -133,6 +193,7 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
         error = law.environment_error(problem.spacecraft, problem.environment)
         if error:
             raise ScenarioError(where, error)
+        _check_actuated(problem, controller)
         momentum0 = problem.wheel_momentum0
         if momentum0 is None:  # ManeuverProblem fills it in; its field's type still admits None
             momentum0 = np.zeros(problem.spacecraft.n_wheels)

@@ -26,13 +26,13 @@ from typing import Any, Literal, Union
 
 import numpy as np
 
+from ocp import quat
 from ocp.errors import excerpt
 from ocp.options import Range, numeric_leaves, option_fields
 from scenarios.schema.node import Node
 
-__all__ = ["REQUIRED", "Described", "Key", "OptionEntry", "Section", "boolean", "choice", "custom", "integer",
-           "mapping",
-           "number", "option_entries", "option_keys", "quaternion", "text", "vector"]
+__all__ = ["QUATERNION_BOUNDS", "REQUIRED", "Described", "Key", "OptionEntry", "Section", "boolean", "choice", "custom",
+           "integer", "mapping", "number", "option_entries", "option_keys", "quaternion", "text", "vector"]
 
 
 class _Required:
@@ -366,6 +366,10 @@ def vector(name: str, meaning: str, size: int, *, unit: str = "", default: Any =
                bounds="" if magnitude is None else f"each within ±{magnitude:g}")
 
 
+QUATERNION_BOUNDS = f"norm within {quat.UNIT_NORM_TOLERANCE:g} of 1 (``ocp.quat.UNIT_NORM_TOLERANCE``); normalised"
+"""The range the reference states for a quaternion (:meth:`~scenarios.schema.node.Node.quaternion`)."""
+
+
 def quaternion(name: str, meaning: str, *, nullable: bool = False) -> Key:
     """A required unit quaternion, normalised (``null`` too when ``nullable``).
 
@@ -384,7 +388,7 @@ def quaternion(name: str, meaning: str, *, nullable: bool = False) -> Key:
     def read(node: Node) -> Any:
         return None if nullable and node.is_null() else node.quaternion()
     return Key(name, "list of 4 numbers" + (" or null" if nullable else ""), meaning, read,
-               bounds="norm within 1e-2 of 1 (normalised)")
+               bounds=QUATERNION_BOUNDS)
 
 
 def mapping(name: str, meaning: str, section: Section, *, default: Any = REQUIRED, null: str = "error") -> Key:

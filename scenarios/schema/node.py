@@ -115,12 +115,48 @@ class Node:
         self._read.add(key)
         if key not in self.value:
             if required or default is ...:
-                given = [k for k in self.value if isinstance(k, str) and k not in self._read]
-                close = difflib.get_close_matches(key, given, n=1, cutoff=0.7)
+                close = self._given_like(key)
                 raise ScenarioError(self._child_path(key), "required key is missing" + (
-                    f"; {close[0]!r} is given: a misspelling of {key!r}?" if close else ""))
+                    f"; {close!r} is given: a misspelling of {key!r}?" if close else ""))
             return Node(default, self._child_path(key))
         return Node(self.value[key], self._child_path(key))
+
+    def _given_like(self, key: str) -> str | None:
+        """A key given but not read that looks like a misspelling of ``key``, or ``None``."""
+        given = [k for k in self.value if isinstance(k, str) and k not in self._read]
+        close = difflib.get_close_matches(key, given, n=1, cutoff=0.7)
+        return close[0] if close else None
+
+    def exactly_one(self, names: tuple[str, ...], given: list[str], what: str = "") -> ScenarioError:
+        """The error for a mapping that gives ``given`` where exactly one of ``names`` is wanted.
+
+        With none given, a key of the mapping that looks like a misspelling of one of ``names``
+        (``keepout`` for ``keep_out``) is named at its own path, as :meth:`get` names one for a
+        required key; otherwise the error is at this node.
+
+        Parameters
+        ----------
+        names : tuple of str
+            The keys of which exactly one must be given.
+        given : list of str
+            Those the mapping gives (not exactly one).
+        what : str, optional
+            Words after the list of names (what each one takes).
+
+        Returns
+        -------
+        ScenarioError
+            The error (to raise).
+        """
+        listed = ", ".join(names[:-1]) + f" and {names[-1]}" if len(names) > 1 else names[0]
+        wanted = f"give exactly one of {listed}{what}"
+        if not given and isinstance(self.value, dict):
+            for name in names:
+                close = self._given_like(name)
+                if close is not None:
+                    return ScenarioError(self._child_path(close),
+                                         f"unknown key {close!r}: a misspelling of {name!r}? ({wanted})")
+        return self.error(f"{wanted}; got {', '.join(given) if given else 'none of them'}")
 
     def finish(self) -> None:
         """Reject keys that were not read."""
@@ -333,15 +369,22 @@ class Node:
         Returns
         -------
         (4,) ndarray
-            The quaternion normalised (its norm must be within 1e-2 of 1).
+            The quaternion normalised (its norm must be within ``ocp.quat.UNIT_NORM_TOLERANCE`` of
+            1, the library's tolerance too).
 
         Raises
         ------
         ScenarioError
-            Not 4 numbers, zero, or a norm farther than 1e-2 from 1.
+            Not 4 numbers, zero, or a norm farther than ``ocp.quat.UNIT_NORM_TOLERANCE`` from 1
+            (the message shows the value, its norm and the normalised quaternion to write).
         """
         q = self.vector(4)
         problem = quat.unit_norm_error(q)
         if problem is not None:
-            raise self.error(problem)
+            hint = ""
+            norm = float(np.linalg.norm(q))
+            if np.isfinite(norm) and norm > 0.0:
+                hint = (f"; normalise it (q / ‖q‖ = {[round(float(v), 7) for v in q / norm]}) if it is the "
+                        "attitude you mean, or check it for a typo")
+            raise self.error(f"{problem} for {excerpt(self.value)}{hint}")
         return q / float(np.linalg.norm(q))

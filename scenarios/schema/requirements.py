@@ -283,7 +283,7 @@ def _pointing(node: Node, name: str, sensors: dict[str, Sensor], geometry: Geome
                                 f"{sorted(sensors) if sensors else 'none (declare it there)'}")
     out_node, in_node = POINTING["keep_out"].value(node), POINTING["keep_in"].value(node)
     if out_node.is_null() == in_node.is_null():
-        raise node.error("give exactly one of keep_out and keep_in")
+        raise node.exactly_one(("keep_out", "keep_in"), [key for key in ("keep_out", "keep_in") if key in node])
     keep_out = not out_node.is_null()
     direction_node = out_node if keep_out else in_node
     direction = _direction(direction_node, geometry)

@@ -40,6 +40,7 @@ from ocp.geometry.targets import ATTITUDE_FRAMES, ground_point, two_vector_attit
 from scenarios.errors import ScenarioError
 from scenarios.requirements.spec import Sensor
 from scenarios.schema.keys import (
+    QUATERNION_BOUNDS,
     Described,
     Key,
     Section,
@@ -245,8 +246,8 @@ def _body_axis(node: Node, keys: tuple[str, str], sensors: dict[str, Sensor]) ->
     """A body axis given as a sensor's name or a vector (``keys``: the two names); ``(unit axis, path)``."""
     sensor_key, vector_key = keys
     if (sensor_key in node) == (vector_key in node):
-        raise node.error(f"give exactly one of {sensor_key} (a name under spacecraft.sensors) and {vector_key} "
-                         "(3 numbers, body axes)")
+        raise node.exactly_one(keys, [key for key in keys if key in node],
+                               f" ({sensor_key}: a name under spacecraft.sensors, {vector_key}: 3 numbers, body axes)")
     if sensor_key in node:
         name_node = node.get(sensor_key)
         name = name_node.string()
@@ -346,7 +347,7 @@ _ONE_FORM = Described("absent (the mapping has exactly one form)")
 ATTITUDE_FORMS: dict[str, AttitudeForm] = {form.name: form for form in (
     AttitudeForm(custom("quaternion", "A quaternion, body to ``frame`` (``v_frame = R(q) v_body``; scalar first unless "
                         "``maneuver.quaternion_order: scalar_last``).", "list of 4 numbers", None,
-                        default=_ONE_FORM, bounds="norm within 1e-2 of 1 (normalised)"), True, _quaternion),
+                        default=_ONE_FORM, bounds=QUATERNION_BOUNDS), True, _quaternion),
     AttitudeForm(custom("axis_angle", "A rotation about an axis, from ``frame`` to the body.", "mapping", None,
                         default=_ONE_FORM, section=AXIS_ANGLE), True, _axis_angle),
     AttitudeForm(custom("euler", "Euler angles from ``frame`` to the body.", "mapping", None, default=_ONE_FORM,
@@ -400,8 +401,7 @@ def parse_attitude(node: Node, context: AttitudeContext) -> Array:
         return _quaternion(node, context, context.time)
     given = [name for name in ATTITUDE_FORMS if name in node]
     if len(given) != 1:
-        raise node.error(f"give exactly one of {', '.join(ATTITUDE_FORMS)}; got "
-                         f"{', '.join(given) if given else 'none'}")
+        raise node.exactly_one(tuple(ATTITUDE_FORMS), given)
     form = ATTITUDE_FORMS[given[0]]
     frame_node = ATTITUDE["frame"].node(node)
     frame = frame_node.string(_FRAME_CHOICES)
