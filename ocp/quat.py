@@ -22,9 +22,12 @@ IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
 read-only (a module constant)."""
 IDENTITY.setflags(write=False)
 
-UNIT_NORM_TOLERANCE = 1e-2
-"""How far from 1 the norm of a quaternion given as input may be (:func:`unit_norm_error`): room
-for values typed with a few digits, none for a quaternion that is not a rotation (``[2, 0, 0, 0]``)."""
+UNIT_NORM_TOLERANCE = 1e-3
+"""How far from 1 the norm of a quaternion given as input may be (:func:`unit_norm_error`; the
+scenario loader and ``planners.ManeuverProblem``): any unit quaternion rounded to 3 decimals passes
+(each entry off by at most 5e-4, so the norm by at most ``sqrt(4) * 5e-4 = 1e-3``), such as
+``[0.707, 0.707, 0, 0]``; a typo such as ``[0.7, 0, 0.5, 0.5]`` (norm 0.995) is refused, and so is a
+quaternion that is not a rotation (``[2, 0, 0, 0]``)."""
 
 
 def unit_norm_error(q: ArrayLike, tolerance: float = UNIT_NORM_TOLERANCE) -> str | None:
@@ -42,7 +45,7 @@ def unit_norm_error(q: ArrayLike, tolerance: float = UNIT_NORM_TOLERANCE) -> str
     -------
     str or None
         ``"a quaternion cannot be zero"``, ``"a quaternion must be finite"`` or ``"a quaternion
-        must have unit norm (got norm 2; tolerance 1e-2)"``; ``None`` when its norm is within
+        must have unit norm (got norm 2; tolerance 1e-3)"``; ``None`` when its norm is within
         ``tolerance`` of 1 (the caller then normalises it).
     """
     norm = float(np.linalg.norm(np.asarray(q, dtype=float)))

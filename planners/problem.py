@@ -22,7 +22,7 @@ class ManeuverProblem:
     """A slew to plan: the spacecraft, its environment and the boundary conditions.
 
     Inputs are checked on construction (a ``ValueError`` or ``TypeError`` names the field):
-    quaternions must have unit norm within ``ocp.quat.UNIT_NORM_TOLERANCE`` (1e-2, the YAML
+    quaternions must have unit norm within ``ocp.quat.UNIT_NORM_TOLERANCE`` (1e-3, the YAML
     loader's tolerance; ``[2, 0, 0, 0]`` is refused, not normalised) and are then normalised to
     unit float arrays; vectors become float arrays of the right size. Every array is stored as a
     read-only copy: a later change to the caller's arrays does not reach the problem (build a new
@@ -33,12 +33,12 @@ class ManeuverProblem:
     spacecraft : ocp.Spacecraft
         The body (inertia, actuators: wheels, torquers, magnetorquers).
     q0 : (4,) array_like
-        Initial attitude quaternion, scalar first, body to inertial: unit norm within 1e-2
+        Initial attitude quaternion, scalar first, body to inertial: unit norm within 1e-3
         (``ocp.quat.unit_norm_error``), normalised here.
     omega0 : (3,) array_like
         Initial body rate [rad/s], body axes.
     qf : (4,) array_like or None
-        Target attitude, scalar first, body to inertial: unit norm within 1e-2, normalised here. ``None`` leaves the final
+        Target attitude, scalar first, body to inertial: unit norm within 1e-3, normalised here. ``None`` leaves the final
         attitude free, which only suits planners that accept it in :meth:`Planner.problem_error`
         (the default refuses it).
     duration : float

@@ -169,3 +169,25 @@ def test_a_detumbling_study_with_failed_wheels_and_magnetorquers_is_accepted():
     data = read_yaml(SCENARIOS / "nano_detumble.yaml")
     data["spacecraft"]["wheels"] = {"failed": [0, 1, 2]}
     parse_scenario(data)
+
+
+# -- with ocp.quat.UNIT_NORM_TOLERANCE 1e-3 and validate printing rate_bound_notes ---------------------
+
+
+@pytest.mark.parametrize("q", [[0.7071, 0.7071, 0, 0], [0.707, 0.707, 0, 0], [0.707, 0, 0.5, 0.5],
+                               [0.5, 0.5, 0.5, 0.5], [0.7071068, 0, 0.5, 0.5]])
+def test_a_quaternion_typed_with_3_or_more_decimals_is_accepted(q):
+    parse_scenario(small(maneuver__final__q=q))
+
+
+def test_a_quaternion_of_norm_0995_is_refused_with_its_norm_and_a_hint():
+    error = refused(small(maneuver__final__q=[0.7, 0, 0.5, 0.5]))
+    assert error.path == "maneuver.final.q", error
+    assert "got norm 0.994987" in error.message and "tolerance 1e-3" in error.message, error  # sqrt(0.99)
+    assert "[0.7, 0, 0.5, 0.5]" in error.message and "normalise it" in error.message, error
+
+
+def test_validate_notes_an_initial_rate_error_in_deg_per_s(tmp_path):
+    status, out, error = validate(tmp_path, small(simulation__initial_rate_error=[1, 0, 0]))
+    assert status == 0, error
+    assert "  every row's closed loop breaks the rate requirement: simulation.initial_rate_error [1.0, 0.0, 0.0]" in out

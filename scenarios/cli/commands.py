@@ -214,6 +214,7 @@ def _scenario_details(scenario: Scenario) -> list[str]:
     points that already break one, the truth model's keys (where the plant differs from the
     design), the sensors and estimator in the loop and the sensor noise."""
     from scenarios.requirements.scoring import endpoint_violations
+    from scenarios.schema.checks import rate_bound_notes
 
     requirements = scenario.requirements
     lines = [f"requirement {line}" for line in requirements.describe()]
@@ -227,11 +228,7 @@ def _scenario_details(scenario: Scenario) -> list[str]:
         lines += [f"every planner's row fails before planning: {broken}"
                   for broken in endpoint_violations(scenario.problem)]
     if requirements.rate is not None:  # a boundary rate above the bound: every row breaks it
-        problem = scenario.problem
-        for where, rate in (("initial", problem.omega0), ("final", problem.omegaf)):
-            if rate is not None and float(np.linalg.norm(rate)) > requirements.rate.max_rate:
-                lines.append(f"every row breaks the rate requirement: maneuver.{where}.omega has ‖ω‖ = "
-                             f"{float(np.linalg.norm(rate)):.4g} rad/s, above {requirements.rate.max_rate:g} rad/s")
+        lines += rate_bound_notes(scenario.problem, scenario.simulation, requirements.rate.max_rate)
     truth = (scenario.data or {}).get("truth")
     if scenario.truth is not None and isinstance(truth, dict):
         lines.append("truth (the closed loop's plant differs from the design in): "
