@@ -63,7 +63,12 @@ class Planner(Configurable, ABC):
       derivative of its ``omega`` and its torque the inverse dynamics ``I ω̇ + ω × I ω``.
     * ``example_options`` lists option sets for the conformance test.
     * ``closed_form``: its references are closed-form expressions of time and implement
-      :meth:`Reference.symbolic_evaluator` (``slewbench codegen`` exports them as C).
+      :meth:`Reference.symbolic_evaluator`, every one of them (not ``None``), equal to
+      :meth:`Reference.sample` at ``t`` clamped to ``[0, T]``: ``slewbench codegen`` exports them as
+      C on this declaration alone, and the ``closed_form`` conformance check
+      (:func:`planners.conformance.check_closed_form`) compares the two. Without the declaration a
+      reference may still offer an evaluator (one a planner of several kinds of reference
+      inherits); it is neither exported nor checked.
     * ``cheap``: it plans in milliseconds (a closed form or a small parameter search, not a
       trajectory optimisation), so ``collocation`` plans it as a start by default
       (``seed_planners: auto``) wherever :meth:`start_error` accepts the problem (by default
@@ -102,7 +107,9 @@ class Planner(Configurable, ABC):
     the conformance test (tests/test_planner_conformance.py) plans the standard problems with each."""
 
     closed_form: ClassVar[bool] = False
-    """Whether its references implement :meth:`Reference.symbolic_evaluator`."""
+    """Whether every reference it returns implements :meth:`Reference.symbolic_evaluator`, equal to
+    its ``sample`` (``t`` clamped to ``[0, T]``): ``slewbench codegen`` exports the evaluator as C
+    for a planner that declares it, and only then; the conformance check verifies it."""
 
     cheap: ClassVar[bool] = False
     """Whether it plans in milliseconds, so that ``collocation`` seeds from it by default."""

@@ -12,25 +12,36 @@ defect in the later checks), finite differences of the reference's own ``q`` and
 (kinematics, rate derivative, inverse dynamics), one-sided differences of ``ω`` at 0 and T against
 the reference's own ``ω̇`` (a rate step at an end), point-wise evaluation (vectorisation) and an
 independent numerical integration of the torque-free Euler and kinematic equations (continuation
-after T).
+after T), and, for a planner that declares ``closed_form``, the reference's own ``sample`` against
+the symbolic evaluator that ``slewbench codegen`` exports as C.
 """
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Protocol
 
+import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from ocp import CircularOrbit, Environment, ReactionWheels, Spacecraft, Torquers, quat
+from ocp.dynamics.layout import REFERENCE_FIELDS
+from planners.base import Planner
 from planners.errors import ConformanceError
 from planners.problem import Array, ManeuverProblem
-from planners.reference import JUMP_TOLERANCE, Reference, inverse_dynamics_torque
+from planners.reference import (
+    BREAKPOINT_INSTANT,
+    JUMP_TOLERANCE,
+    Reference,
+    inverse_dynamics_torque,
+)
+from planners.registry import PLANNERS
 from planners.torque_free import REST_RATE
 
-__all__ = ["ATTITUDE_TOLERANCE", "CHECKS", "FINITE_SAMPLES", "NORM_TOLERANCE", "RATE_TOLERANCE", "RELATIVE_TOLERANCE",
-           "check_after_end", "check_boundary", "check_dynamics", "check_ends", "check_finite", "check_kinematics",
-           "check_reference", "check_times", "check_vectorised", "declared_ends", "finite_check_times",
-           "standard_problems"]
+__all__ = ["ATTITUDE_TOLERANCE", "CHECKS", "CLOSED_FORM_TOLERANCE", "FINITE_SAMPLES", "NORM_TOLERANCE", "RATE_TOLERANCE",
+           "RELATIVE_TOLERANCE", "Check", "check_after_end", "check_boundary", "check_closed_form", "check_dynamics",
+           "check_ends", "check_finite", "check_kinematics", "check_reference", "check_times", "check_vectorised",
+           "closed_form_check_times", "declares_closed_form", "declared_ends", "finite_check_times", "standard_problems"]
 
 ATTITUDE_TOLERANCE = 2e-5
 """rad: boundary attitudes (about 1e-3 deg, what the shooting planners guarantee)."""
@@ -44,6 +55,9 @@ integration that does not renormalise, far below a scaled quaternion (``1.01 q``
 FINITE_SAMPLES = 2001
 """Times on ``[0, T]`` where :func:`check_finite` samples the reference (uniform, plus its
 breakpoints and enforced times): a step of T/2000, so a defect lasting T/1000 shows."""
+CLOSED_FORM_TOLERANCE = 1e-12
+"""The symbolic evaluator against ``sample`` (:func:`check_closed_form`), relative to each field's
+scale (its largest magnitude on the grid): a few hundred roundings, far below any slip of a term."""
 
 
 def standard_problems() -> dict[str, ManeuverProblem]:
@@ -466,21 +480,185 @@ def check_after_end(reference: Reference, horizon: float | None = None) -> None:
             f"final state (Reference.sample does this when _evaluate only covers [0, T]): " + "; ".join(problems))
 
 
-CHECKS: dict[str, Callable[[ManeuverProblem, Reference], None]] = {
-    "finite": lambda problem, reference: check_finite(reference),
-    "boundary": check_boundary,
-    "ends": lambda problem, reference: check_ends(reference),
-    "kinematics": lambda problem, reference: check_kinematics(reference),
-    "dynamics": lambda problem, reference: check_dynamics(reference),
-    "vectorised": lambda problem, reference: check_vectorised(reference),
-    "after_end": lambda problem, reference: check_after_end(reference),
+def declares_closed_form(reference: Reference, planner: Planner | type[Planner] | None = None) -> bool | None:
+    """Whether the planner of ``reference`` declares ``closed_form`` (:attr:`Planner.closed_form`),
+    the declaration ``slewbench codegen`` trusts to export its references' symbolic evaluator.
+
+    Parameters
+    ----------
+    reference : Reference
+        The reference.
+    planner : Planner, Planner subclass or None, optional
+        The planner that made it; ``None`` (default): the planner registered in
+        ``planners.PLANNERS`` under the reference's ``planner`` name.
+
+    Returns
+    -------
+    bool or None
+        The declaration; ``None`` when ``planner`` is not given and no planner is registered under
+        that name (a plugin checked before it is registered).
+    """
+    if planner is None:
+        planner = PLANNERS.get(reference.planner)
+        if planner is None:
+            return None
+    return bool(planner.closed_form)
+
+
+def closed_form_check_times(reference: Reference) -> Array:
+    """Where :func:`check_closed_form` compares: the grid of :func:`finite_check_times` (uniform on
+    ``[0, T]``, the breakpoints and enforced times, after T), and the neighbourhood of each
+    breakpoint and of both ends, before 0 included.
+
+    Parameters
+    ----------
+    reference : Reference
+        The reference to sample.
+
+    Returns
+    -------
+    (M,) ndarray
+        Sorted times [s]: around each breakpoint ``b`` and at 0 and T, ``b + k`` for ``k`` in
+        ``0, ±δ, ±1e-6 T, ±1e-3 T``, ``δ`` = :data:`~planners.reference.BREAKPOINT_INSTANT` ``× max(T, 1 s)``
+        (the instant the scoring samples either side of a switch), and ``−0.05 T``.
+    """
+    T = reference.duration
+    instant = BREAKPOINT_INSTANT * max(T, 1.0)
+    offsets = np.array([0.0, instant, 1e-6 * T, 1e-3 * T])
+    offsets = np.concatenate([-offsets[1:], offsets])
+    centres = np.concatenate([reference.breakpoints, [0.0, T]])
+    near = (centres[:, None] + offsets[None, :]).ravel()
+    return np.unique(np.concatenate([finite_check_times(reference), near, [-0.05 * T]]))
+
+
+def _numbers(values: Array) -> str:
+    return "[" + ", ".join(f"{value:.15g}" for value in np.asarray(values, dtype=float).ravel()) + "]"
+
+
+def check_closed_form(reference: Reference, planner: Planner | type[Planner] | None = None) -> None:
+    """For a planner that declares ``closed_form``: its reference's symbolic evaluator (what
+    ``slewbench codegen`` exports as C) gives what :meth:`Reference.sample` gives.
+
+    ``reference.symbolic_evaluator()`` must be a CasADi function of one scalar time [s] to one
+    column of :data:`~ocp.dynamics.layout.REFERENCE_FIELDS` (13) numbers
+    ``[q, ω, ω̇, torque]``; at every time of :func:`closed_form_check_times` it must agree with
+    ``sample`` at that time clamped to ``[0, T]`` (the evaluator's contract: before 0 and after T
+    it holds the row at the end, as the exported table does; ``q`` with ``sample``'s sign), to
+    :data:`CLOSED_FORM_TOLERANCE` of each field's scale. A planner that does not declare
+    ``closed_form`` is not asked: codegen exports no evaluator of its references. When the
+    declaration is unknown (``planner`` not given and none registered under the reference's name)
+    an evaluator the reference offers is checked.
+
+    Parameters
+    ----------
+    reference : Reference
+        A reference with status ``"ok"``.
+    planner : Planner, Planner subclass or None, optional
+        The planner that made it (:func:`declares_closed_form`); ``None`` (default): the one
+        registered under the reference's name.
+
+    Raises
+    ------
+    ConformanceError
+        If a declaring planner's reference offers no evaluator, or one of another signature, or if
+        the evaluator fails or differs from ``sample``, naming the time, the field and both values.
+    """
+    declared = declares_closed_form(reference, planner)
+    if declared is False:
+        return
+    name = reference.planner
+    evaluator = reference.symbolic_evaluator()
+    if evaluator is None:
+        if declared:
+            raise ConformanceError(
+                f"{name}: the planner declares closed_form but its reference's symbolic_evaluator() returns None; "
+                f"implement Reference.symbolic_evaluator (a casadi.Function of t to the 13-row [q, ω, ω̇, torque]), "
+                f"or do not declare closed_form (slewbench codegen then exports the reference as a table only)")
+        return
+    wanted = f"one input of shape (1, 1) (t [s]) and one output of shape ({REFERENCE_FIELDS}, 1)"
+    if not isinstance(evaluator, ca.Function):
+        raise ConformanceError(f"{name}: symbolic_evaluator() returned a {type(evaluator).__name__}; it must be a "
+                               f"casadi.Function with {wanted}")
+    shapes = ([evaluator.size_in(k) for k in range(evaluator.n_in())],
+              [evaluator.size_out(k) for k in range(evaluator.n_out())])
+    if shapes != ([(1, 1)], [(REFERENCE_FIELDS, 1)]):
+        raise ConformanceError(f"{name}: symbolic_evaluator() takes inputs of shapes {shapes[0]} and gives outputs of "
+                               f"shapes {shapes[1]}; slewbench codegen exports a function with {wanted} "
+                               f"(the row [q (4), ω (3), ω̇ (3), torque (3)])")
+    T = reference.duration
+    times = closed_form_check_times(reference)
+    try:
+        rows = np.asarray(evaluator.map(times.size)(ca.DM(times).T)).T
+    except RuntimeError as failure:
+        raise ConformanceError(f"{name}: evaluating symbolic_evaluator() at {times.size} times on [{times[0]:g}, "
+                               f"{times[-1]:g}] s failed: {failure}") from failure
+    expected = reference.sample(np.clip(times, 0.0, T))
+    start = 0
+    for field, values in zip(("q", "ω", "ω̇", "torque"), expected):
+        width = values.shape[1]
+        symbolic = rows[:, start:start + width]
+        start += width
+        scale = max(float(np.max(np.abs(values))), np.finfo(float).tiny)
+        tolerance = CLOSED_FORM_TOLERANCE * scale
+        error = np.max(np.abs(symbolic - values), axis=1)
+        bad = ~(error <= tolerance)  # NaN is bad
+        if np.any(bad):
+            k = int(np.argmax(np.where(bad, np.nan_to_num(error, nan=np.inf), -1.0)))
+            t = times[k]
+            where = "before 0, clamped to 0" if t < 0 else "after T, clamped to T" if t > T else f"{t / T:.6g} T"
+            raise ConformanceError(
+                f"{name}: the symbolic evaluator (exported as C by slewbench codegen, the planner declaring closed_form) "
+                f"differs from sample() at t = {float(t)!r} s ({where}) in {field}: symbolic_evaluator gives "
+                f"{_numbers(symbolic[k])} but sample gives {_numbers(values[k])} (error {error[k]:.3g} > "
+                f"{tolerance:.3g}, {CLOSED_FORM_TOLERANCE:g} of the field's scale {scale:.3g}; {int(np.sum(bad))} of "
+                f"{times.size} times); the symbolic evaluator must compute what _evaluate computes, with t clamped to "
+                f"[0, T]")
+
+
+class Check(Protocol):
+    """A check of :data:`CHECKS`: ``check(problem, reference, planner=None)`` raises
+    :class:`ConformanceError`; ``planner`` is the planner that made the reference (``None``: the one
+    registered under its name), which only the checks of a planner's declarations read."""
+
+    def __call__(self, problem: ManeuverProblem, reference: Reference,
+                 planner: Planner | type[Planner] | None = None) -> None:
+        """Raise :class:`ConformanceError` if ``reference`` breaks the check."""
+        ...
+
+
+def _reference_only(check: Callable[[Reference], None]) -> Check:
+    """A check of the reference alone, in the signature of :data:`CHECKS`."""
+    def run(problem: ManeuverProblem, reference: Reference, planner: Planner | type[Planner] | None = None) -> None:
+        check(reference)
+    return run
+
+
+def _boundary(problem: ManeuverProblem, reference: Reference, planner: Planner | type[Planner] | None = None) -> None:
+    check_boundary(problem, reference)
+
+
+def _closed_form(problem: ManeuverProblem, reference: Reference,
+                 planner: Planner | type[Planner] | None = None) -> None:
+    check_closed_form(reference, planner)
+
+
+CHECKS: dict[str, Check] = {
+    "finite": _reference_only(check_finite),
+    "boundary": _boundary,
+    "ends": _reference_only(check_ends),
+    "kinematics": _reference_only(check_kinematics),
+    "dynamics": _reference_only(check_dynamics),
+    "vectorised": _reference_only(check_vectorised),
+    "after_end": _reference_only(check_after_end),
+    "closed_form": _closed_form,
 }
 """Every check, by name, in the order :func:`check_reference` runs them (``finite`` first: a NaN
-would read as another defect in the others): ``check(problem, reference)`` raises
-:class:`ConformanceError`."""
+would read as another defect in the others): ``check(problem, reference, planner=None)`` raises
+:class:`ConformanceError` (:class:`Check`)."""
 
 
-def check_reference(problem: ManeuverProblem, reference: Reference) -> None:
+def check_reference(problem: ManeuverProblem, reference: Reference,
+                    planner: Planner | type[Planner] | None = None) -> None:
     """Run every check of :data:`CHECKS` on a reference planned for ``problem``.
 
     Parameters
@@ -489,6 +667,10 @@ def check_reference(problem: ManeuverProblem, reference: Reference) -> None:
         The planned problem.
     reference : Reference
         The planner's reference for it (a status other than ``"ok"`` fails at once).
+    planner : Planner, Planner subclass or None, optional
+        The planner that made it, whose declarations (``closed_form``) the checks verify;
+        ``None`` (default): the planner registered under the reference's name, if any (pass it
+        for a planner not registered yet).
 
     Raises
     ------
@@ -498,4 +680,4 @@ def check_reference(problem: ManeuverProblem, reference: Reference) -> None:
     if not reference.ok:
         raise ConformanceError(f"{reference.planner}: status {reference.status!r}: {reference.message}")
     for check in CHECKS.values():
-        check(problem, reference)
+        check(problem, reference, planner)
