@@ -60,11 +60,11 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ocp.fast_call import BufferedFunction
 from ocp.nlp.second_order import (
     SecondOrderCheck,
     _broadcast,
     _complementarity,
+    _derivative,
     _output,
     _sparse,
     second_order_check,
@@ -171,8 +171,8 @@ def kkt_residuals(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array, *, 
     lam_x = np.asarray(lam_x, dtype=float).ravel()
     lam_g = np.asarray(lam_g, dtype=float).ravel()
     p = np.zeros(solver.nnz_in("p")) if p is None else p
-    jacobian = BufferedFunction(solver.get_function("nlp_jac_g"))
-    gradient = BufferedFunction(solver.get_function("nlp_grad_f"))
+    jacobian = _derivative(solver, "nlp_jac_g")
+    gradient = _derivative(solver, "nlp_grad_f")
     g_out, j_out = _output(jacobian.function, ("g",)), _output(jacobian.function, ("jac_g_x",))
     f_out = _output(gradient.function, ("grad_f_x",))
     if scaling_point is not None:
