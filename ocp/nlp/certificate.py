@@ -134,7 +134,8 @@ def _scaling(gradient: Array, jacobian: scipy.sparse.csc_matrix, solver_name: st
     if solver_name != "ipopt":
         return 1.0, np.ones(jacobian.shape[0])
     s_f = float(np.clip(MAX_GRADIENT / max(float(np.max(np.abs(gradient), initial=0.0)), 1e-300), MIN_SCALING, 1.0))
-    rows = abs(jacobian).max(axis=1).toarray().ravel() if jacobian.shape[1] else np.zeros(jacobian.shape[0])
+    rows = np.zeros(jacobian.shape[0])  # per row, the largest |entry| (a row without entries: 0)
+    np.maximum.at(rows, jacobian.indices, np.abs(jacobian.data))  # CSC: indices are the entries' rows
     s_g = np.clip(MAX_GRADIENT / np.maximum(rows, 1e-300), MIN_SCALING, 1.0)
     return s_f, s_g
 
