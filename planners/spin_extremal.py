@@ -11,10 +11,11 @@ because in the frame turning with θ about the roll axis the rate is the constan
 (invisible for the paper's c ≈ 0); ``q2, q3`` are eq. 11 with the + sign. Any initial attitude is
 reached by ``q(t) = q0 ⊗ q*(t)``. The feed-forward torque is eq. 31 (checked against inverse dynamics).
 
-The parameters ``(r, c, β)`` minimise ``J = J1 + k J2`` (eq. 34) with IPOPT:
+The parameters ``(r, c, β)`` minimise ``J = J1 + k J2`` (eq. 34) by IPOPT's iterations (taken in NumPy
+where they are plain Newton steps, IPOPT itself elsewhere: :class:`NewtonFirst`):
 ``J1 = min(‖q(T) − q_f‖², ‖q(T) + q_f‖²)`` (eq. 30 made invariant to ``q_f ~ −q_f``) and ``J2 = ∫‖u‖² dt`` in closed form (eq. 33 corrected:
 its ``u2`` factor must be ``(α − v δ2)`` as in eq. 31, and its first term's brackets are misplaced).
-A vectorised multi-start over branches of ``K T``, over ``β`` and over ``c`` seeds IPOPT.
+A vectorised multi-start over branches of ``K T``, over ``β`` and over ``c`` seeds them.
 """
 from __future__ import annotations
 
