@@ -11,17 +11,18 @@ because in the frame turning with θ about the roll axis the rate is the constan
 (invisible for the paper's c ≈ 0); ``q2, q3`` are eq. 11 with the + sign. Any initial attitude is
 reached by ``q(t) = q0 ⊗ q*(t)``. The feed-forward torque is eq. 31 (checked against inverse dynamics).
 
-The parameters ``(r, c, β)`` minimise ``J = J1 + k J2`` (eq. 34) with IPOPT:
+The parameters ``(r, c, β)`` minimise ``J = J1 + k J2`` (eq. 34) by IPOPT's iterations (taken in NumPy
+where they are plain Newton steps, IPOPT itself elsewhere: :class:`NewtonFirst`):
 ``J1 = min(‖q(T) − q_f‖², ‖q(T) + q_f‖²)`` (eq. 30 made invariant to ``q_f ~ −q_f``) and ``J2 = ∫‖u‖² dt`` in closed form (eq. 33 corrected:
 its ``u2`` factor must be ``(α − v δ2)`` as in eq. 31, and its first term's brackets are misplaced).
-A vectorised multi-start over branches of ``K T``, over ``β`` and over ``c`` seeds IPOPT.
+A vectorised multi-start over branches of ``K T``, over ``β`` and over ``c`` seeds them.
 """
 from __future__ import annotations
 
 import copy
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
-from typing import Annotated, Any
+from typing import Annotated, Any, cast
 
 import casadi as ca
 import numpy as np
@@ -29,6 +30,7 @@ import numpy as np
 from ocp import quat
 from ocp.dynamics.spin_closed_form import extremal_quaternion
 from ocp.errors import InvalidOption
+from ocp.fast_call import BufferedFunction
 from ocp.nlp.solve import solve_multistart, solver_options
 from ocp.options import Range
 from planners.base import Planner
@@ -149,6 +151,34 @@ def energy_cost(v: Any, r: Any, c: Any, beta: Any, duration: Any, moments: Any, 
             + 0.5 * I3**2 * r**2 * (alpha + v * d3) ** 2 * (duration - cos2))
 
 
+TOLERANCE = 1e-12
+"""IPOPT's ``tol`` on the parameters' optimisation (its scaled gradient at the optimum)."""
+MAX_ITERATIONS = 200
+"""IPOPT's iteration limit there."""
+NEWTON_ITERATIONS = 50
+"""Newton steps at most before the start is handed to IPOPT (:class:`NewtonFirst`)."""
+DEFINITE = 1e-8
+"""A Hessian whose least eigenvalue is above this times its largest is positive definite for
+IPOPT's factorisation too (:class:`NewtonFirst`)."""
+SINGULAR = 1e-12
+"""One whose least eigenvalue is at most this times its largest is not (it is singular, or
+indefinite, to rounding: Bilimoria & Wie's, 0 at every iterate, which IPOPT perturbs); between the
+two the start is left to IPOPT."""
+DEGENERATE_ITERATIONS = 3
+"""IPOPT's ``degen_iters_max``: perturbed iterations from the start after which it perturbs every
+later one without trying ``δ = 0``."""
+
+
+def _objective(x: ca.SX, p: ca.SX) -> ca.SX:
+    """``J = J1 + k J2`` of (r, c, β) = ``x`` with parameters ``p`` = [v, T, I1, I2, I3, q_target (4), k]."""
+    r, c, beta = x[0], x[1], x[2]
+    v, duration, moments, target, weight = p[0], p[1], (p[2], p[3], p[4]), p[5:9], p[9]
+    q_end = ca.vertcat(*extremal_quaternion(duration, v, r, c, beta, math=ca))
+    j1 = ca.fmin(ca.sumsqr(q_end - target), ca.sumsqr(q_end + target))
+    j2 = energy_cost(v, r, c, beta, duration, moments, math=ca)
+    return j1 + weight * j2
+
+
 def build_solver() -> ca.Function:
     """IPOPT on (r, c, β) with parameters [v, T, I1, I2, I3, q_target (4), k].
 
@@ -161,17 +191,148 @@ def build_solver() -> ca.Function:
     casadi.Function
         The ``nlpsol`` function.
     """
-    x = ca.SX.sym("x", 3)
-    p = ca.SX.sym("p", 10)
-    r, c, beta = x[0], x[1], x[2]
-    v, duration, moments, target, weight = p[0], p[1], (p[2], p[3], p[4]), p[5:9], p[9]
-    q_end = ca.vertcat(*extremal_quaternion(duration, v, r, c, beta, math=ca))
-    j1 = ca.fmin(ca.sumsqr(q_end - target), ca.sumsqr(q_end + target))
-    j2 = energy_cost(v, r, c, beta, duration, moments, math=ca)
+    x, p = ca.SX.sym("x", 3), ca.SX.sym("p", 10)
     # Unbounded: (−r, β + π) is the same extremal, so r >= 0 is restored afterwards instead of
     # being a bound whose barrier would cost IPOPT iterations. J1 is written as eq. 30's sum of
     # squares: the equal 2 − 2|q·q_f| cancels at the optimum and leaves IPOPT a noisy gradient.
-    return ca.nlpsol("spin_extremal", "ipopt", {"x": x, "p": p, "f": j1 + weight * j2}, solver_options("ipopt", 1e-12, 200))
+    return ca.nlpsol("spin_extremal", "ipopt", {"x": x, "p": p, "f": _objective(x, p)},
+                     solver_options("ipopt", TOLERANCE, MAX_ITERATIONS))
+
+
+def build_derivatives() -> ca.Function:
+    """``(x, p) -> (J, ∇J, ∇²J)`` of :func:`build_solver`'s objective (the Hessian dense, 3 x 3).
+
+    Returns
+    -------
+    casadi.Function
+        The objective, its gradient and its Hessian in (r, c, β).
+    """
+    x, p = ca.SX.sym("x", 3), ca.SX.sym("p", 10)
+    f = _objective(x, p)
+    hessian, gradient = ca.hessian(f, x)
+    return ca.Function("spin_extremal_derivatives", [x, p], [f, gradient, ca.densify(hessian)])
+
+
+class NewtonFirst:
+    """IPOPT's iterations on (r, c, β) taken as the Newton steps they are, IPOPT itself otherwise.
+
+    On this unconstrained problem IPOPT's step solves ``(∇²J + δ I) d = −∇J`` with IPOPT's
+    inertia correction ``δ`` (0 when the Hessian is positive definite; else, as IPOPT's
+    ``PDPerturbationHandler``, 1e-4 the first time, then a third of the last ``δ``, raised 100-fold
+    then 8-fold until the matrix is positive definite; after :data:`DEGENERATE_ITERATIONS`
+    perturbed iterations from the start, every later one is perturbed so without trying 0, and once
+    ``δ = 0`` has worked it is always tried first). The step is taken in full when it meets the
+    Armijo condition (``η_φ = 1e-8``; no barrier and no filter entries without constraints). IPOPT
+    stops when the gradient, scaled by its gradient-based factor ``min(1, 100 / ‖∇J(x0)‖∞)``, is
+    within :data:`TOLERANCE`, or when a step is below ``10 ε`` of every ``1 + |x_i|``
+    (``Search_Direction_Becomes_Too_Small``). Here those steps are taken in NumPy, without IPOPT's
+    fixed cost of about 1-2 ms a solve. A start where this would guess what IPOPT's factorisation
+    decides (a least eigenvalue of the perturbed Hessian between :data:`SINGULAR` and
+    :data:`DEFINITE` times the largest), where the Armijo condition refuses the full step (IPOPT
+    backtracks) or that takes :data:`NEWTON_ITERATIONS` steps is solved by IPOPT from its
+    beginning. Called and read as the ``nlpsol`` function it stands for (``solver(x0=..., p=...)``,
+    :meth:`stats`), for :func:`~ocp.nlp.solve.solve_multistart`.
+
+    Parameters
+    ----------
+    derivatives : casadi.Function
+        :func:`build_derivatives`.
+    ipopt : casadi.Function
+        :func:`build_solver`.
+    """
+
+    def __init__(self, derivatives: ca.Function, ipopt: ca.Function) -> None:
+        self.derivatives = BufferedFunction(derivatives)
+        self.ipopt = ipopt
+        self._stats: dict[str, Any] = {}
+
+    def stats(self) -> dict[str, Any]:
+        """The last call's statistics, as ``nlpsol``'s ``stats()``.
+
+        Returns
+        -------
+        dict
+            ``return_status``, ``success`` and ``iter_count`` after the Newton steps; IPOPT's own
+            after a call it solved.
+        """
+        return self._stats
+
+    def _evaluate(self, x: Array) -> tuple[float, Array, Array]:
+        f, gradient, hessian = self.derivatives.all_outputs(x)
+        return float(f[0]), gradient.copy(), hessian.reshape(3, 3).copy()
+
+    @staticmethod
+    def _definite(eigenvalues: np.ndarray, shift: float) -> bool | None:
+        """Whether ``∇²J + shift I`` is positive definite as IPOPT's factorisation finds it;
+        ``None`` where its rounding would decide."""
+        least = eigenvalues[0] + shift
+        largest = max(abs(eigenvalues[-1] + shift), abs(least))
+        if least > DEFINITE * largest:
+            return True
+        if least <= SINGULAR * largest:
+            return False
+        return None
+
+    def _newton(self, x: Array) -> tuple[Array, float, int, str] | None:
+        """The point, J, the steps and IPOPT's status there; ``None`` where IPOPT would not step so."""
+        f, gradient, hessian = self._evaluate(x)
+        largest = float(np.max(np.abs(gradient)))
+        scale = 100.0 / largest if largest > 100.0 else 1.0  # IPOPT's nlp_scaling_max_gradient
+        last = 0.0  # IPOPT's delta_x_last
+        degenerate: bool | None = None  # IPOPT's hess_degenerate (None: not yet determined)
+        perturbed = 0
+        for k in range(NEWTON_ITERATIONS + 1):
+            if not (np.isfinite(f) and np.all(np.isfinite(gradient)) and np.all(np.isfinite(hessian))):
+                return None
+            if scale * float(np.max(np.abs(gradient))) <= TOLERANCE:
+                return x, f, k, "Solve_Succeeded"
+            if k == NEWTON_ITERATIONS:
+                return None
+            eigenvalues = np.linalg.eigvalsh(hessian)
+            shift = 0.0
+            if not degenerate:
+                definite = self._definite(eigenvalues, 0.0)
+                if definite is None:
+                    return None
+                if definite and degenerate is None:
+                    degenerate = False
+            if degenerate or not definite:
+                shift = 1e-4 if last == 0.0 else max(1e-20, last / 3.0)
+                while True:
+                    definite = self._definite(eigenvalues, shift)
+                    if definite is None or shift > 1e20:
+                        return None
+                    if definite:
+                        break
+                    shift *= 100.0 if last == 0.0 or 1e5 * last < shift else 8.0
+                last = shift
+                if degenerate is None:
+                    perturbed += 1
+                    degenerate = True if perturbed >= DEGENERATE_ITERATIONS else None
+            step = -np.linalg.solve(hessian + shift * np.eye(3), gradient)
+            if not np.all(np.isfinite(step)):
+                return None
+            if float(np.max(np.abs(step) / (1.0 + np.abs(x)))) < 10.0 * np.finfo(float).eps:
+                return x, f, k, "Search_Direction_Becomes_Too_Small"
+            trial = x + step
+            f_trial, gradient_trial, hessian_trial = self._evaluate(trial)
+            if not f_trial <= f + 1e-8 * float(gradient @ step):  # Armijo refuses the full step (or NaN)
+                return None
+            x, f, gradient, hessian = trial, f_trial, gradient_trial, hessian_trial
+        return None
+
+    def __call__(self, *, x0: Any, p: Any, **arguments: Any) -> dict[str, Any]:
+        self.derivatives.inputs[1][:] = np.asarray(p, dtype=float).ravel()
+        found = self._newton(np.asarray(x0, dtype=float).ravel().copy())
+        if found is None:
+            solution = self.ipopt(x0=x0, p=p, **arguments)
+            self._stats = self.ipopt.stats()
+            return solution
+        x, f, steps, status = found
+        self._stats = {"return_status": status, "success": status == "Solve_Succeeded", "iter_count": steps}
+        empty = ca.DM(0, 1)
+        return {"x": ca.DM(x), "f": ca.DM(f), "g": empty, "lam_x": ca.DM.zeros(3), "lam_g": empty,
+                "lam_p": ca.DM.zeros(10)}
 
 
 @dataclass(frozen=True)
@@ -367,8 +528,10 @@ class SpinExtremalPlanner(Planner):
             params = SpinParameters(*self.options.parameters)
             stats: dict[str, Any] = {"fixed_parameters": True}
         else:
-            params, stats = self._optimise(self.solver_cache(problem).get(("spin_extremal",), build_solver),
-                                           v, T, moments, target)
+            cache = self.solver_cache(problem)
+            solver = NewtonFirst(cache.get(("spin_extremal", "derivatives"), build_derivatives),
+                                 cache.get(("spin_extremal",), build_solver))
+            params, stats = self._optimise(solver, v, T, moments, target)
             if params is None:
                 return FailedReference(self.name, stats["message"], stats=stats)
         with np.errstate(all="ignore"):  # a non-finite closed form is refused just below
@@ -403,11 +566,12 @@ class SpinExtremalPlanner(Planner):
         cost = attitude_cost(q_end, target) + self.options.weight * energy_cost(v, r, c, beta, T, moments)
         return np.column_stack([r, c, beta])[np.argsort(cost)[: self.options.starts]]
 
-    def _optimise(self, solver: ca.Function, v: float, T: float, moments: Array, target: Array):
+    def _optimise(self, solver: NewtonFirst | ca.Function, v: float, T: float, moments: Array, target: Array):
         parameters = np.r_[v, T, moments, target, self.options.weight]
         # Every start is a different branch of K T by design: all are tried (agree = 0). Branches that
         # all reach the target (J1 = 0 to rounding) differ in energy: J2 breaks the tie, not rounding.
-        result = solve_multistart(solver, self._seeds(v, T, moments, target), p=parameters, agree=0,
+        # NewtonFirst is called and read as the nlpsol function it stands for
+        result = solve_multistart(cast(ca.Function, solver), self._seeds(v, T, moments, target), p=parameters, agree=0,
                                   tie_break=lambda x: float(energy_cost(v, x[0], x[1], x[2], T, moments)))
         stats = result.stats()
         if result.x is None:

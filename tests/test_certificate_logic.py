@@ -6,7 +6,9 @@ Oracles: Wächter & Biegler (2006), eq. (5) and section 3.8, with IPOPT's defaul
 ``s_d = max(s_max, (‖λ‖₁ + ‖z‖₁) / (m + n_b)) / s_max``, ``s_max = 100``, ``m`` the constraint rows
 and ``n_b`` the finite bounds of the variables that are not fixed, a variable's lower and upper
 bound counted apart (``ocp.nlp.certificate.kkt_residuals``; the paper's ``n`` bounds every variable
-once); the gradient-based scaling
+once; IPOPT's own computation adds the multipliers of the inequality rows' slack bounds and their
+count, ``‖v‖₁`` and ``n_v``, to both sums, ``s_c = max(s_max, (‖z‖₁ + ‖v‖₁) / (n_b + n_v)) / s_max``);
+the gradient-based scaling
 ``s = min(1, 100 / ‖∇‖∞)`` of the objective and of each constraint row (``nlp_scaling_max_gradient``),
 worked by hand on small NLPs; IPOPT's own reported dual infeasibility (``inf_du``, scaled) where the
 objective scaling is 1; the Radau IIA nodes of degree 3, ``(4 ∓ √6) / 10`` and 1."""
@@ -53,6 +55,35 @@ def test_s_d_counts_the_rows_and_the_finite_bounds_of_the_moving_variables_by_ha
                         lbx=[-10.0, -np.inf, 0.0], ubx=[10.0, np.inf, 0.0])
     assert kkt.stationarity == pytest.approx(499.0) and kkt.objective_scaling == 1.0
     assert kkt.scaled == pytest.approx(499.0 * 3.0 / 5.0, rel=1e-12)
+
+
+def test_an_inequality_rows_slack_bounds_count_in_s_d_by_hand():
+    # min x² + y² on 1 <= x + y <= 3, at (0.5, 0.5) with λ = −500 (the lower bound's): the
+    # stationarity is |1 − 500| = 499, no scaling (gradients 1). IPOPT writes the row as
+    # x + y − s = 0 with 1 <= s <= 3: its slack-bound multipliers v_L = 500, v_U = 0 (v_U − v_L = λ)
+    # count in s_d beside λ, and its two finite bounds beside the row: s_d = max(100, (500 + 500) /
+    # (1 + 2)) / 100 = 10 / 3, the scaled error 499 × 0.3 = 149.7 (without them 500 / 1: 499 / 5)
+    solver = small_nlp(lambda x: x[0] ** 2 + x[1] ** 2, lambda x: x[0] + x[1])
+    kkt = kkt_residuals(solver, [0.5, 0.5], [0.0, 0.0], [-500.0], lbg=1.0, ubg=3.0)
+    assert kkt.stationarity == pytest.approx(499.0) and kkt.objective_scaling == 1.0
+    assert kkt.complementarity == 0.0 and kkt.feasibility == 0.0
+    assert kkt.scaled == pytest.approx(499.0 * 0.3, rel=1e-12)
+    # an equality row has no slack: s_d = max(100, 500 / 1) / 100 = 5, as before
+    equality = kkt_residuals(solver, [0.5, 0.5], [0.0, 0.0], [-500.0], lbg=1.0, ubg=1.0)
+    assert equality.scaled == pytest.approx(499.0 / 5.0, rel=1e-12)
+
+
+def test_an_inequality_rows_slack_bound_multipliers_divide_the_complementarity_by_hand():
+    # min 500 (x² + y²) on 1 <= x + y <= 3 at (0.5005, 0.5005), λ = −500.5: stationary
+    # (∇f = 500.5 each), the row 0.001 inside its lower bound, so the complementarity is
+    # 500.5 × 0.001 = 0.5005. Scaled at x0 = 0 (∇f = 0: s_f = 1). No variable bounds: s_c comes from
+    # the slack's alone, max(100, (500.5 + 0) / 2) / 100 = 2.5025, and the error is 0.5005 / 2.5025 =
+    # 0.2 (without them s_c = 1: 0.5005); s_d = max(100, 1001 / 3) / 100 leaves the stationarity ~0
+    solver = small_nlp(lambda x: 500 * (x[0] ** 2 + x[1] ** 2), lambda x: x[0] + x[1])
+    kkt = kkt_residuals(solver, [0.5005, 0.5005], [0.0, 0.0], [-500.5], lbg=1.0, ubg=3.0, scaling_point=[0.0, 0.0])
+    assert kkt.objective_scaling == 1.0 and kkt.stationarity < 1e-9
+    assert kkt.complementarity == pytest.approx(0.5005, rel=1e-9)
+    assert kkt.scaled == pytest.approx(0.2, rel=1e-9)
 
 
 def test_a_steep_constraint_row_is_scaled_once_by_hand():

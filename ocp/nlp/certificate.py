@@ -15,10 +15,15 @@ Three pieces of evidence, each computed here from the point alone (never from th
   scaled. In the scaled problem the multipliers become ``s_f λ / s_i`` and ``s_f z``, so its
   stationarity and complementarity are ``s_f`` times the unscaled ones and its constraint violation
   is ``s_i`` times row ``i``'s. IPOPT's overall error, which its ``tol`` bounds, divides the
-  stationarity by ``s_d = max(100, (‖ỹ‖₁ + ‖z̃‖₁)/(m + n_b)) / 100`` and the complementarity by
-  ``s_c = max(100, ‖z̃‖₁/n_b) / 100`` (Wächter & Biegler 2006, eq. 5; ``ỹ, z̃`` the scaled constraint
-  and bound multipliers, ``n_b`` the finite bounds of the variables that are not fixed, lower and
-  upper counted apart). The solver's statistics keep only the
+  stationarity by ``s_d = max(100, (‖ỹ‖₁ + ‖z̃‖₁ + ‖ṽ‖₁)/(m + n_b + n_v)) / 100`` and the
+  complementarity by ``s_c = max(100, (‖z̃‖₁ + ‖ṽ‖₁)/(n_b + n_v)) / 100`` (Wächter & Biegler
+  2006, eq. 5, as IPOPT computes it; ``ỹ, z̃`` the scaled constraint and bound multipliers, ``n_b``
+  the finite bounds of the variables that are not fixed, lower and upper counted apart). IPOPT
+  writes an inequality row as ``g(x) − s = 0`` with its bounds on the slack ``s``: their
+  multipliers ``ṽ`` (``n_v`` the finite bounds of the inequality rows, ``lbg < ubg``, lower and
+  upper counted apart) count in both sums. At a KKT point the slack's stationarity makes them the
+  row's multiplier split by sign (``ṽ_U − ṽ_L = ỹ``, one of them zero where the row is at a bound),
+  which is how they are read here from ``lam_g``. The solver's statistics keep only the
   iterations' ``inf_du`` (the scaled stationarity) and ``inf_pr`` (unscaled), of the last start
   solved, which need not be the point certified; so the factors are computed here the way IPOPT
   does, at ``scaling_point`` (IPOPT's own starting point when the caller has it, else the point
@@ -60,11 +65,11 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ocp.fast_call import BufferedFunction
 from ocp.nlp.second_order import (
     SecondOrderCheck,
     _broadcast,
     _complementarity,
+    _derivative,
     _output,
     _sparse,
     second_order_check,
@@ -129,7 +134,8 @@ def _scaling(gradient: Array, jacobian: scipy.sparse.csc_matrix, solver_name: st
     if solver_name != "ipopt":
         return 1.0, np.ones(jacobian.shape[0])
     s_f = float(np.clip(MAX_GRADIENT / max(float(np.max(np.abs(gradient), initial=0.0)), 1e-300), MIN_SCALING, 1.0))
-    rows = abs(jacobian).max(axis=1).toarray().ravel() if jacobian.shape[1] else np.zeros(jacobian.shape[0])
+    rows = np.zeros(jacobian.shape[0])  # per row, the largest |entry| (a row without entries: 0)
+    np.maximum.at(rows, jacobian.indices, np.abs(jacobian.data))  # CSC: indices are the entries' rows
     s_g = np.clip(MAX_GRADIENT / np.maximum(rows, 1e-300), MIN_SCALING, 1.0)
     return s_f, s_g
 
@@ -171,8 +177,8 @@ def kkt_residuals(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array, *, 
     lam_x = np.asarray(lam_x, dtype=float).ravel()
     lam_g = np.asarray(lam_g, dtype=float).ravel()
     p = np.zeros(solver.nnz_in("p")) if p is None else p
-    jacobian = BufferedFunction(solver.get_function("nlp_jac_g"))
-    gradient = BufferedFunction(solver.get_function("nlp_grad_f"))
+    jacobian = _derivative(solver, "nlp_jac_g")
+    gradient = _derivative(solver, "nlp_grad_f")
     g_out, j_out = _output(jacobian.function, ("g",)), _output(jacobian.function, ("jac_g_x",))
     f_out = _output(gradient.function, ("grad_f_x",))
     if scaling_point is not None:
@@ -193,10 +199,16 @@ def kkt_residuals(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array, *, 
     complementarity = max(_complementarity(g, g_low, g_high, lam_g), _complementarity(x, x_low, x_high, lam_x))
     # the scaled multipliers ỹ = s_f λ / s_i, z̃ = s_f z, and IPOPT's s_d, s_c
     bounded = int(np.sum(np.isfinite(x_low) & moving) + np.sum(np.isfinite(x_high) & moving))
-    y_norm = float(np.sum(np.abs(s_f * lam_g / s_g)))
+    y_scaled = s_f * lam_g / s_g
+    y_norm = float(np.sum(np.abs(y_scaled)))
     z_norm = float(np.sum(np.abs(s_f * lam_x[moving])))
-    s_d = max(S_MAX, (y_norm + z_norm) / max(g.size + bounded, 1)) / S_MAX
-    s_c = max(S_MAX, z_norm / max(bounded, 1)) / S_MAX
+    # the slack bounds of the inequality rows and their multipliers, the row's split by sign (docstring)
+    inequality = g_low != g_high
+    slack_low, slack_high = inequality & np.isfinite(g_low), inequality & np.isfinite(g_high)
+    v_norm = float(np.sum(np.maximum(-y_scaled, 0.0)[slack_low]) + np.sum(np.maximum(y_scaled, 0.0)[slack_high]))
+    slack_bounds = int(np.sum(slack_low) + np.sum(slack_high))
+    s_d = max(S_MAX, (y_norm + z_norm + v_norm) / max(g.size + bounded + slack_bounds, 1)) / S_MAX
+    s_c = max(S_MAX, (z_norm + v_norm) / max(bounded + slack_bounds, 1)) / S_MAX
     stationarity_scaled = s_f * stationarity
     complementarity_scaled = s_f * complementarity
     return KKTResiduals(stationarity, feasibility, complementarity, stationarity_scaled, feasibility_scaled,

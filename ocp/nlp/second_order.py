@@ -69,6 +69,7 @@ import contextlib
 import io
 import sys
 import threading
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -205,24 +206,75 @@ def _output(function: ca.Function, names: tuple[str, ...]) -> int:
     raise RuntimeError(f"{function.name()} has none of the outputs {names}")
 
 
+_FUNCTIONS = threading.local()
+"""Per thread: ``.by_solver``, a solver's derivative functions with their buffers
+(:func:`_derivative`), kept while the solver lives (CasADi functions are not thread-safe, and the
+buffers are overwritten by every evaluation); ``.patterns``, per buffered function and output, its
+pattern (:func:`_pattern`)."""
+_Pattern = tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], tuple[int, int]]
+
+
+def _local_table(name: str) -> weakref.WeakKeyDictionary:
+    """This thread's weak table ``name`` of :data:`_FUNCTIONS` (created on its first use)."""
+    table = getattr(_FUNCTIONS, name, None)
+    if table is None:
+        table = weakref.WeakKeyDictionary()
+        setattr(_FUNCTIONS, name, table)
+    return table
+
+
+def _derivative(solver: ca.Function, name: str) -> BufferedFunction:
+    """``solver.get_function(name)`` with its buffers, built once per solver and thread (a
+    certificate evaluates the same NLP's derivatives again and again: fetching the functions,
+    allocating their buffers and reading their patterns took about a tenth of a 50-interval
+    collocation NLP's certificate)."""
+    table = _local_table("by_solver")
+    functions: dict[str, BufferedFunction] | None = table.get(solver)
+    if functions is None:
+        functions = table[solver] = {}
+    found = functions.get(name)
+    if found is None:
+        found = functions[name] = BufferedFunction(solver.get_function(name))
+    return found
+
+
+def _pattern(function: BufferedFunction, index: int) -> _Pattern:
+    """Output ``index``'s compressed-column pattern: row indices, column indices, column pointers
+    and shape (read once per function and output)."""
+    table = _local_table("patterns")
+    patterns: dict[int, _Pattern] | None = table.get(function)
+    if patterns is None:
+        patterns = table[function] = {}
+    found = patterns.get(index)
+    if found is None:
+        sparsity = function.function.sparsity_out(index)
+        colind, row = sparsity.get_ccs()
+        starts = np.asarray(colind, dtype=np.int64)
+        columns = np.repeat(np.arange(sparsity.size2(), dtype=np.int64), starts[1:] - starts[:-1])
+        rows = np.asarray(row, dtype=np.int64)
+        for array in (rows, columns, starts):
+            array.setflags(write=False)  # shared by every evaluation
+        found = patterns[index] = (rows, columns, starts, sparsity.shape)
+    return found
+
+
 def _sparse(function: BufferedFunction, index: int) -> scipy.sparse.csc_matrix:
     """Output ``index`` of the last evaluation as a sparse matrix (dense, a collocation NLP's
     Jacobian took most of a certificate's time)."""
     import scipy.sparse  # here, not at the top: it takes 0.16 s to import, and every command imports this module
 
-    sparsity = function.function.sparsity_out(index)
-    colind, row = sparsity.get_ccs()
-    return scipy.sparse.csc_matrix((np.array(function.outputs[index], dtype=float), row, colind), shape=sparsity.shape)
+    rows, _, starts, shape = _pattern(function, index)
+    # its own index arrays: SciPy may sort or deduplicate a matrix's indices in place
+    return scipy.sparse.csc_matrix((np.array(function.outputs[index], dtype=float), rows.copy(), starts.copy()),
+                                   shape=shape)
 
 
 def _triplets(function: BufferedFunction, index: int) -> tuple[NDArray[np.int64], NDArray[np.int64], Array]:
     """Output ``index`` of the last evaluation as ``(rows, columns, values)`` (index arithmetic on
-    these costs a fraction of SciPy's sparse constructors and slicing)."""
-    sparsity = function.function.sparsity_out(index)
-    colind, row = sparsity.get_ccs()
-    starts = np.asarray(colind, dtype=np.int64)
-    columns = np.repeat(np.arange(sparsity.size2(), dtype=np.int64), starts[1:] - starts[:-1])
-    return np.asarray(row, dtype=np.int64), columns, np.array(function.outputs[index], dtype=float)
+    these costs a fraction of SciPy's sparse constructors and slicing; the indices are shared,
+    read-only)."""
+    rows, columns, _, _ = _pattern(function, index)
+    return rows, columns, np.array(function.outputs[index], dtype=float)
 
 
 def _broadcast(bound: Any, like: Array) -> Array:
@@ -282,6 +334,13 @@ def _linsol(size: int, indptr: Any, indices: Any) -> tuple[ca.Sparsity, ca.Linso
     return found
 
 
+def _infinity_norm(rows: NDArray[np.integer], values: Array, size: int) -> float:
+    """``‖M‖∞`` of a sparse matrix from its entries' rows and values in storage order (a COO matrix's,
+    or a CSC matrix's indices and data): the row sums of ``|M|`` added in that order, as SciPy's
+    ``abs(M).sum(axis=1)`` adds them (a product with ones), without its conversions."""
+    return float(np.max(np.bincount(rows, np.abs(values), minlength=size)))
+
+
 def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: float,
              scale: float) -> Callable[[float], int | str]:
     """A counter of the negative eigenvalues of ``M(s) = H + s I + AᵀA / ε`` from the inertia of
@@ -308,7 +367,7 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
     import scipy.sparse
 
     n, m = H.shape[0], A.shape[0]
-    epsilon = PENALTY * max(1.0, float(abs(A).sum(axis=1).max()) if m else 0.0) ** 2  # η ε
+    epsilon = PENALTY * max(1.0, _infinity_norm(A.row, A.data, m) if m else 0.0) ** 2  # η ε
     # the pattern with its whole diagonal, explicit zeros kept (an entry H_jj = 0, or cancelled by a
     # shift, must stay in it), the shift set in place for each factorisation
     Hc, Ac = H, A
@@ -323,7 +382,7 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
     base = K.data[diagonal].copy()
     sparsity, solver, analysed = _linsol(n + m, K.indptr, K.indices)
     rhs = np.random.default_rng(0).standard_normal(n + m)
-    b = ca.DM(rhs)
+    b = ca.DM(rhs.tolist())  # (from a list: a third faster than from the array, the same numbers)
 
     def count(shift: float) -> int | str:
         K.data[diagonal] = base + shift / scale
@@ -345,7 +404,7 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
             return f"the KKT matrix's LDLᵀ has {n + m - rank} zero pivots ({n} free variables, {m} active rows)"
         # (solve() with DM arguments factorises again in its own memory: the guard's one solve)
         solution = np.asarray(solver.solve(values, b)).ravel()
-        norm = float(abs(K).sum(axis=1).max())
+        norm = _infinity_norm(K.indices, K.data, n + m)
         with np.errstate(invalid="ignore"):
             error = float(np.max(np.abs(K @ solution - rhs))) \
                 / (norm * float(np.max(np.abs(solution))) + float(np.max(np.abs(rhs))))
@@ -405,9 +464,9 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
 
     x = np.asarray(x, dtype=float).ravel()
     try:
-        hessian = BufferedFunction(solver.get_function("nlp_hess_l"))
-        jacobian = BufferedFunction(solver.get_function("nlp_jac_g"))
-        gradient = BufferedFunction(solver.get_function("nlp_grad_f"))
+        hessian = _derivative(solver, "nlp_hess_l")
+        jacobian = _derivative(solver, "nlp_jac_g")
+        gradient = _derivative(solver, "nlp_grad_f")
         h_out = _output(hessian.function, ("triu_hess_gamma_x_x", "hess_gamma_x_x"))
         g_out, j_out = _output(jacobian.function, ("g",)), _output(jacobian.function, ("jac_g_x",))
         f_out = _output(gradient.function, ("grad_f_x",))
@@ -453,7 +512,7 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     keep = (row_position[j_rows] >= 0) & (position[j_columns] >= 0)
     A = scipy.sparse.coo_matrix((j_values[keep], (row_position[j_rows[keep]], position[j_columns[keep]])),
                                 shape=(active.size, free.size))
-    scale = float(abs(H_free).sum(axis=1).max())  # ‖H‖∞, its own scale, however small
+    scale = _infinity_norm(H_free.row, H_free.data, free.size)  # ‖H‖∞, its own scale, however small
     scale = scale if scale > 0.0 else 1.0  # H = 0: every curvature on Z is 0, below any δ > 0
     delta = curvature_tolerance * scale
     where = f"on {free.size} free variables and {A.shape[0]} active rows"

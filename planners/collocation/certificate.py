@@ -74,6 +74,13 @@ def radau_points(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP
     return x, u, p, times if T is None else times * T
 
 
+def _control_jacobian(model: AttitudeModel) -> ca.Function:
+    """``∂f/∂u (x, u, t, d)`` of the model's dynamics (built once per model and point count, in its
+    ``solver_cache``, by :func:`switching`)."""
+    xs, us, ts, ds = ca.SX.sym("x", model.nx), ca.SX.sym("u", model.nu), ca.SX.sym("t"), ca.SX.sym("d", 3)
+    return ca.Function("f_u", [xs, us, ts, ds], [ca.jacobian(model.rhs(xs, us, ts, ds), us)])
+
+
 def switching(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array, lam_g: Array,
               lbx: Array, ubx: Array, params: Array, costate_sign: float = 1.0) -> Switching:
     """Pontryagin's switching agreement of a minimum-time collocation solution.
@@ -103,9 +110,9 @@ def switching(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w
     offset = nlp.n_stage_state + nx * d
     low = np.asarray(lbx, dtype=float)[:nz * N].reshape(N, nz)[:, offset:offset + nu * d].reshape(N * d, nu)
     high = np.asarray(ubx, dtype=float)[:nz * N].reshape(N, nz)[:, offset:offset + nu * d].reshape(N * d, nu)
-    xs, us, ts, ds = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("t"), ca.SX.sym("d", 3)
-    jacobian = ca.Function("f_u", [xs, us, ts, ds], [ca.jacobian(model.rhs(xs, us, ts, ds), us)])
-    f_u = np.asarray(jacobian.map(x.shape[0])(x.T, u.T, t[None, :], np.tile(params[-3:], (x.shape[0], 1)).T))
+    f_u = np.asarray(model.solver_cache.get(("collocation", "switching f_u", x.shape[0]),
+                                            lambda: _control_jacobian(model).map(x.shape[0]))(
+        x.T, u.T, t[None, :], np.tile(params[-3:], (x.shape[0], 1)).T))
     f_u = f_u.reshape(nx, x.shape[0], nu).transpose(1, 0, 2)  # (points, nx, nu)
     sigma = costate_sign * np.einsum("ki,kij->kj", p, f_u)
     return switching_agreement(u, low, high, sigma)

@@ -47,10 +47,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, cast
 
+import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
 from ocp import quat
+from ocp.dynamics.model import AttitudeModel
 from ocp.geometry import PointingConstraint
 from ocp.transcription.base import Transcription
 from planners.collocation.allocation import allocation_constraints
@@ -398,18 +400,39 @@ class CollocationReference(Reference):
     def _rhs(self, x: Array, u: Array, t: Array) -> Array:
         n = x.shape[0]
         times = np.broadcast_to(t, (n,))
-        return self.model.rhs.map(n)(x.T, u.T, times, np.tile(self.disturbance[:, None], n)).full().T
+        return _mapped(self.model, "rhs", n)(x.T, u.T, times, np.tile(self.disturbance[:, None], n)).full().T
 
     def _evaluate(self, t: Array) -> ReferenceSample:
         x, u = self._state_control(t)
         n = t.size
         x_dot = self._rhs(x, u, t)
-        actuator = self.model.body_torque.map(n)(x.T, u.T, t).full().T
-        environment = self.model.environment_torque.map(n)(x.T, t, np.tile(self.disturbance[:, None], n)).full().T
+        actuator = _mapped(self.model, "body_torque", n)(x.T, u.T, t).full().T
+        environment = _mapped(self.model, "environment_torque", n)(x.T, t, np.tile(self.disturbance[:, None], n)).full().T
         omega = x[:, 4:7]
         wheel_momentum = x[:, 7:] @ self.model.spacecraft.wheel_axes.T
         torque = actuator - np.cross(omega, wheel_momentum) + environment
         return ReferenceSample(quat.normalize(x[:, 0:4]), omega, x_dot[:, 4:7], torque)
+
+
+def _mapped(model: AttitudeModel, name: str, n: int) -> ca.Function:
+    """The model's function ``name`` (``rhs``, ``body_torque``, ``environment_torque``) mapped over
+    ``n`` points, built once per model and ``n`` (in its ``solver_cache``).
+
+    Parameters
+    ----------
+    model : ocp.AttitudeModel
+        The model.
+    name : str
+        Its ``casadi.Function`` attribute.
+    n : int
+        Points (columns) per call.
+
+    Returns
+    -------
+    casadi.Function
+        ``getattr(model, name).map(n)``.
+    """
+    return model.solver_cache.get(("collocation", "map", name, n), lambda: getattr(model, name).map(n))
 
 
 def states_controls(problem: ManeuverProblem, reference: Reference, times: Array) -> tuple[Array, Array, ReferenceSample]:
@@ -517,7 +540,7 @@ def solution_sampler(reference: CollocationReference) -> Callable[[Array], tuple
         t = np.clip(np.asarray(times, dtype=float), 0.0, reference.duration)
         x, u = reference._interpolated(t, left=True)  # as solved (IPOPT pushes a seed into its bounds)
         x[:, 0:4] = quat.normalize(x[:, 0:4])  # as Reference.sample does
-        torque = model.body_torque.map(t.size)(x.T, u.T, t).full().T
+        torque = _mapped(model, "body_torque", t.size)(x.T, u.T, t).full().T
         return x, u, np.abs(torque)
 
     return sample

@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ocp import quat
 from ocp.dynamics.layout import actuator_blocks
 from ocp.geometry import PointingConstraint
 from planners.collocation.problem import variable_bounds
@@ -261,22 +262,24 @@ def dense_check(problem: ManeuverProblem, reference: CollocationReference, requi
     DenseCheck
     """
     t = np.linspace(0.0, reference.duration, points_per_interval * reference.intervals + 1)
-    sample = reference.sample(t)
+    # the states as the reference samples them (its q normalised, its ω), without the torques and
+    # rates of change that sample() would compute for nothing here
+    x_right, u_right = reference._state_control(t)
+    q, omega = quat.normalize(x_right[:, 0:4]), x_right[:, 4:7]
     margins: dict[str, float | None] = {}
     violations: dict[str, float] = {}
     for constraint in requirements.pointing:
-        margin = constraint.margins(t, sample.q)
+        margin = constraint.margins(t, q)
         least = float(np.rad2deg(np.nanmin(margin))) if np.any(np.isfinite(margin)) else None
         margins[constraint.name] = least
         if least is not None and least < 0.0:
             violations[constraint.name] = -least
     if requirements.max_rate is not None:
-        excess = float(np.max(np.linalg.norm(sample.omega, axis=1))) / requirements.max_rate - 1.0
+        excess = float(np.max(np.linalg.norm(omega, axis=1))) / requirements.max_rate - 1.0
         if excess > BOUND_TOLERANCE:
             violations["rate"] = excess
     if requirements.actuator_margin is not None:
         _, x_high, _, u_high = variable_bounds(problem, None, requirements.actuator_scale)
-        x_right, u_right = reference._state_control(t)
         x_left, u_left = reference._state_control(t, left=True)
         controls = np.maximum(np.abs(u_right), np.abs(u_left))
         states = np.maximum(np.abs(x_right), np.abs(x_left))

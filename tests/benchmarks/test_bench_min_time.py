@@ -202,6 +202,26 @@ the spin-extremal seed planner 5.6 ms (IPOPT on its 3 variables: 2-3 ms per 4-it
 solver's fixed cost). On the coarse mesh, ``hessian_approximation: limited-memory`` stops at 500
 iterations on the perturbed start (748 ms); ``first_hessian_perturbation`` 0.01 and
 ``mumps_mem_percent`` 5 leave the iteration counts as they are and the times within the noise.
+
+Measured 2026-12-03 08:35 UTC, the work around the solver calls cut (load 4.8-6.6, other jobs
+running; 15 alternating pairs in one run: this code and main's in two persistent processes taking
+turns, CPU per plan after the build, median [min..max]): B&W 127.2 [116.4..169.3] ms on main against
+113.7 [109.7..150.4] ms, pairwise ratio 0.90 [0.72..1.05]; full inertia 76.5 [73.6..96.2] against
+65.7 [63.4..86.8] ms, 0.86 [0.81..0.96] (wall 0.90 and 0.86, spreads 0.6-2.0 under this load).
+A second run at 08:44 (load 4.2-4.5): 109.2 against 98.3 ms, 0.90 [0.84..0.95], and 66.6 against
+57.8 ms, 0.87 [0.84..0.91]: about 10 ms a plan on B&W, 9 on the full inertia. The same optima bit for bit (3.2431108186225095, 7.682613330242696), certificates, seeds,
+starts and iteration counts; ``iteration_counts.py``: the 41 cases' iteration counts identical, three
+spin-like objectives apart in the 15th digit (the spin-extremal seed ends within 1e-12 of IPOPT's
+point). What was cut: the spin-extremal seed's three IPOPT solves on (r, c, β), taken as the Newton
+steps IPOPT takes there (its inertia correction mirrored; IPOPT itself from a start where its
+factorisation would decide; the planner on the spin paper's case 8.8 against 2.5-3.5 ms CPU), the
+dense check's full sample (torques and rates of change computed for nothing), the mapped model
+functions and the switching check's control Jacobian built once per model and point count, the
+derivative functions, buffers and sparsity patterns of the second-order check and the KKT residuals
+fetched once per solver, their norms and row maxima without SciPy's conversions. Side by side with
+acados on B&W right after (9 rounds each, wall, load 4.6-4.7): this code 1.77 [1.35..2.11] and 1.76
+[1.40..2.29] (ours 295 and 201 ms, acados 169 and 114 ms), main's between them 1.96 [1.45..2.06] (224
+against 121 ms). Issue 30's 1.0x is not met: the solver calls are most of the plan.
 """
 from __future__ import annotations
 
