@@ -106,3 +106,69 @@ def test_ctrl_c_lost_while_the_cases_are_checked_still_stops_the_sweep(tmp_path,
     assert stderr.strip() == "slewbench: sweep interrupted while its cases were checked; nothing was run or written"
     assert not (tmp_path / "out").exists()
 
+
+def test_ctrl_c_while_a_worker_starts_stops_it_silently(tmp_path):
+    """A Ctrl-C while the pool waits for a worker that the fork server has not forked yet (it still
+    imports) cut the worker's start short: the pool did not know that worker, the server forked it
+    later, and it failed on the stopped pool's queues with a traceback (or stayed, waiting). Here a
+    module preloaded last keeps the server importing for 8 s; the sweep is called from Python, whose
+    process goes on after the interrupt."""
+    (tmp_path / "slow_preload.py").write_text("import pathlib, time\npathlib.Path('importing').touch()\n"
+                                              "time.sleep(8)\npathlib.Path('imported').touch()\n")
+    study = write_study(tmp_path)
+    process = start(tmp_path, f"""
+        import gc, os, pathlib, sys, time
+        sys.path.insert(0, "{tmp_path}")
+        import scenarios.study.engine as engine
+        from scenarios.errors import SweepInterrupted
+        engine.PRELOAD = (*engine.PRELOAD, "slow_preload")
+        try:
+            engine.sweep("{study}", workers=1)
+        except (SweepInterrupted, KeyboardInterrupt) as stop:
+            print("interrupted", type(stop).__name__, flush=True)
+        interrupted = time.monotonic()
+        gc.collect()  # the stopped pool's queues and semaphores go
+        time.sleep(10)  # the server would have forked the worker by now
+        print("imported" if pathlib.Path("imported").exists() else "not imported", flush=True)
+        """)
+    with session_of(process):
+        wait_for(tmp_path / "importing", process)
+        time.sleep(0.3)  # the sweep waits for its first worker
+        os.killpg(process.pid, signal.SIGINT)
+        time.sleep(1.0)
+        running = [pid for pid in _session(process.pid) if b"forkserver" in _command_line(pid)]  # server, workers
+        stdout, stderr = process.communicate(timeout=60)
+        left = left_behind(process)
+    assert "interrupted" in stdout, (stdout, stderr)
+    assert "Traceback" not in stderr, stderr
+    assert not running, f"still running 1 s after Ctrl-C: {running}"
+    assert stdout.split()[-1] == "imported" and stdout.split()[-2] == "not", \
+        "the fork server went on importing after Ctrl-C"
+    assert not left, f"processes left behind: {left}"
+
+
+def test_ctrl_c_stops_the_compiler_a_worker_started(tmp_path):
+    """The workers ignore Ctrl-C (the sweep stops them); a C compiler one of them started inherited
+    the ignoring (SIG_IGN survives exec) and compiled on, alone, after the sweep had stopped. The
+    compiler here is a stand-in that runs for a minute unless a signal stops it."""
+    compiler = tmp_path / "slowcc"
+    compiler.write_text(f"#!/bin/sh\necho $$ > {tmp_path}/compiling\nexec sleep 60\n")
+    compiler.chmod(0o755)
+    scenario = {**BASE, "simulation": {**BASE["simulation"], "compile": True}}
+    study = write_study(tmp_path, scenario, durations=(30.0,))
+    process = start(tmp_path, f"""
+        import sys
+        from scenarios.cli.commands import main
+        sys.exit(main(["sweep", "{study}", "--out", "out", "--workers", "1", "--no-plots"]))
+        """, env={"CC": str(compiler), "XDG_CACHE_HOME": str(tmp_path / "cache")})
+    with session_of(process):
+        wait_for(tmp_path / "compiling", process)
+        time.sleep(0.2)  # the stand-in has become `sleep`
+        pid = int((tmp_path / "compiling").read_text())
+        os.killpg(process.pid, signal.SIGINT)
+        stdout, stderr = process.communicate(timeout=60)
+        left = left_behind(process)
+    assert process.returncode == 130, (stdout, stderr)
+    assert "Traceback" not in stderr, stderr
+    assert pid not in left, "the compiler ran on after Ctrl-C"
+    assert not left, f"processes left behind: {left}"
