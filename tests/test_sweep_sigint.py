@@ -111,10 +111,10 @@ def test_ctrl_c_while_a_worker_starts_stops_it_silently(tmp_path):
     """A Ctrl-C while the pool waits for a worker that the fork server has not forked yet (it still
     imports) cut the worker's start short: the pool did not know that worker, the server forked it
     later, and it failed on the stopped pool's queues with a traceback (or stayed, waiting). Here a
-    module preloaded last keeps the server importing for 8 s; the sweep is called from Python, whose
+    module preloaded last keeps the server importing for 4 s; the sweep is called from Python, whose
     process goes on after the interrupt."""
     (tmp_path / "slow_preload.py").write_text("import pathlib, time\npathlib.Path('importing').touch()\n"
-                                              "time.sleep(8)\npathlib.Path('imported').touch()\n")
+                                              "time.sleep(4)\npathlib.Path('imported').touch()\n")
     study = write_study(tmp_path)
     process = start(tmp_path, f"""
         import gc, os, pathlib, sys, time
@@ -128,7 +128,7 @@ def test_ctrl_c_while_a_worker_starts_stops_it_silently(tmp_path):
             print("interrupted", type(stop).__name__, flush=True)
         interrupted = time.monotonic()
         gc.collect()  # the stopped pool's queues and semaphores go
-        time.sleep(10)  # the server would have forked the worker by now
+        time.sleep(6)  # the server would have forked the worker by now
         print("imported" if pathlib.Path("imported").exists() else "not imported", flush=True)
         """)
     with session_of(process):
@@ -170,5 +170,22 @@ def test_ctrl_c_stops_the_compiler_a_worker_started(tmp_path):
         left = left_behind(process)
     assert process.returncode == 130, (stdout, stderr)
     assert "Traceback" not in stderr, stderr
+    assert "runs interpreted" not in stderr, "a compiler stopped by Ctrl-C was reported as a failed build"
     assert pid not in left, "the compiler ran on after Ctrl-C"
     assert not left, f"processes left behind: {left}"
+
+
+def test_a_compiler_stopped_by_ctrl_c_stops_its_caller(tmp_path, monkeypatch):
+    """A compiler that Ctrl-C ended is not a failed build (reported, and the closed loop run
+    interpreted): the caller stops as it would have (a sweep's worker, which ignores Ctrl-C itself)."""
+    import casadi as ca
+
+    from ocp.simulation.compiled import compile_function
+
+    compiler = tmp_path / "interruptedcc"
+    compiler.write_text("#!/bin/sh\nkill -INT $$\nsleep 60\n")  # what Ctrl-C does to a compiler
+    compiler.chmod(0o755)
+    monkeypatch.setenv("CC", str(compiler))
+    x = ca.SX.sym("x")
+    with pytest.raises(KeyboardInterrupt):
+        compile_function(ca.Function("twice", [x], [2 * x]), tmp_path / "cache")
