@@ -517,9 +517,9 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         Exit status: 0 done, 2 bad scenario file or output location (the message names its path) or
         a plugin that fails to load or takes a registered name (the message names the plugin),
         1 internal error or interrupted, or a row not ok under ``run --strict`` (an entry under
-        ``table --strict``), 130 an interrupted sweep or table (an error raised after Ctrl-C or
-        SIGTERM counts as the interruption: C code such as CasADi's turns a ``KeyboardInterrupt``
-        into one).
+        ``table --strict``), 130 an interrupted sweep or a table interrupted while it computes
+        (an error raised after Ctrl-C or SIGTERM counts as the interruption: C code such as
+        CasADi's turns a ``KeyboardInterrupt`` into one).
     """
     parser = build_parser()
     args = parser.parse_args(attached_values(sys.argv[1:] if argv is None else list(argv), parser))
