@@ -147,9 +147,11 @@ def test_ctrl_c_while_a_worker_starts_stops_it_silently(tmp_path):
     assert not left, f"processes left behind: {left}"
 
 
-def test_ctrl_c_stops_the_compiler_a_worker_started(tmp_path):
+@pytest.mark.parametrize("stop", ["Ctrl-C", "SIGTERM to the sweep"])
+def test_ctrl_c_stops_the_compiler_a_worker_started(tmp_path, stop):
     """The workers ignore Ctrl-C (the sweep stops them); a C compiler one of them started inherited
-    the ignoring (SIG_IGN survives exec) and compiled on, alone, after the sweep had stopped. The
+    the ignoring (SIG_IGN survives exec) and compiled on, alone, after the sweep had stopped; so it
+    did when only the sweep was stopped (SIGTERM), which kills its workers, not their children. The
     compiler here is a stand-in that runs for a minute unless a signal stops it."""
     compiler = tmp_path / "slowcc"
     compiler.write_text(f"#!/bin/sh\necho $$ > {tmp_path}/compiling\nexec sleep 60\n")
@@ -165,7 +167,10 @@ def test_ctrl_c_stops_the_compiler_a_worker_started(tmp_path):
         wait_for(tmp_path / "compiling", process)
         time.sleep(0.2)  # the stand-in has become `sleep`
         pid = int((tmp_path / "compiling").read_text())
-        os.killpg(process.pid, signal.SIGINT)
+        if stop == "Ctrl-C":
+            os.killpg(process.pid, signal.SIGINT)
+        else:
+            os.kill(process.pid, signal.SIGTERM)
         stdout, stderr = process.communicate(timeout=60)
         left = left_behind(process)
     assert process.returncode == 130, (stdout, stderr)

@@ -303,6 +303,27 @@ def _sigint_blocked() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
+def _descendants(pid: int) -> list[int]:
+    """The processes that process ``pid`` started, and theirs, now (Linux's ``/proc``; elsewhere none)."""
+    found: list[int] = []
+    parents = [pid]
+    while parents:
+        parent = parents.pop()
+        try:
+            tasks = os.listdir(f"/proc/{parent}/task")
+        except OSError:  # ended, or no /proc
+            continue
+        for task in tasks:
+            try:
+                with open(f"/proc/{parent}/task/{task}/children") as listed:
+                    children = [int(child) for child in listed.read().split()]
+            except OSError:
+                continue
+            found += children
+            parents += children
+    return found
+
+
 class _LocalPool:
     """A process pool forked from the server, with its slot table (module docstring)."""
 
@@ -335,15 +356,20 @@ class _LocalPool:
         return found
 
     def kill(self) -> None:
-        """Stop now, including a worker stuck in C code (it cannot be interrupted), and wait for the
+        """Stop now, including a worker stuck in C code (it cannot be interrupted) and the processes
+        a worker started (a C compiler, :mod:`ocp.simulation.compiled`), and wait for the
         pool's manager thread to end (its workers are dead: it ends at once), so that none of the
         pool's threads or pipes outlives the sweep: CPython 3.11's exit hook of ``concurrent.futures``
         could otherwise wake a manager thread whose pipe it was closing at the same moment
         ("Exception ignored ... OSError: [Errno 9] Bad file descriptor" after a sweep's error)."""
         for process in list(self.processes.values()):
             if process.is_alive():
+                started = _descendants(process.pid)  # a C compiler it runs: it would go on alone
                 self.ours.add(process.pid)
                 process.kill()
+                for pid in started:
+                    with contextlib.suppress(ProcessLookupError):
+                        os.kill(pid, signal.SIGKILL)
         self.executor.shutdown(wait=False, cancel_futures=True)
         manager = getattr(self.executor, "_executor_manager_thread", None)  # private, stable since 3.9
         if manager is not None and manager is not threading.current_thread():
