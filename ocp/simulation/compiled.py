@@ -12,6 +12,7 @@ from __future__ import annotations
 import hashlib
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -73,6 +74,9 @@ def compile_function(function: ca.Function, directory: Path | None = None) -> ca
     ------
     CompilerUnavailable
         No compiler found, or the build failed (its message says why).
+    KeyboardInterrupt
+        Ctrl-C stopped the compiler (it takes Ctrl-C's default action, also where the caller ignores
+        Ctrl-C: a trade study's worker).
     """
     compiler = find_compiler()
     if compiler is None:
@@ -94,6 +98,8 @@ def compile_function(function: ca.Function, directory: Path | None = None) -> ca
                 partial = Path(build) / library.name
                 completed = subprocess.run([compiler, *CFLAGS, str(c_file), "-o", str(partial), "-lm"],
                                            capture_output=True, text=True, check=False)
+                if completed.returncode == -signal.SIGINT:  # Ctrl-C stopped the compiler: stop the caller too
+                    raise KeyboardInterrupt
                 if completed.returncode != 0:
                     raise CompilerUnavailable(f"{Path(compiler).name} failed: {completed.stderr.strip()[:300]}")
                 os.replace(partial, library)  # atomic: a concurrent build of the same code is harmless

@@ -489,6 +489,14 @@ class Interruption:
             raise KeyboardInterrupt
 
 
+def _interrupted(args: argparse.Namespace) -> int:
+    """Say that the command was interrupted, in one line; its exit status (the command's
+    ``interrupted_status``: :data:`~scenarios.cli.status.EXIT_INTERRUPTED` for a sweep, else
+    :data:`~scenarios.cli.status.EXIT_INTERNAL`)."""
+    print("slewbench: interrupted; results not written or marked incomplete in the output manifest", file=sys.stderr)
+    return int(getattr(args, "interrupted_status", EXIT_INTERNAL))
+
+
 def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     """Run the ``slewbench`` command line.
 
@@ -506,7 +514,9 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         Exit status: 0 done, 2 bad scenario file or output location (the message names its path) or
         a plugin that fails to load or takes a registered name (the message names the plugin),
         1 internal error or interrupted, or a row not ok under ``run --strict`` (an entry under
-        ``table --strict``).
+        ``table --strict``), 130 an interrupted sweep or a table interrupted while it computes
+        (an error raised after Ctrl-C or SIGTERM counts as the interruption: C code such as
+        CasADi's turns a ``KeyboardInterrupt`` into one).
     """
     parser = build_parser()
     args = parser.parse_args(attached_values(sys.argv[1:] if argv is None else list(argv), parser))
@@ -517,8 +527,13 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     previous = ({signum: signal.signal(signum, args.interruption) for signum in (signal.SIGTERM, signal.SIGINT)}
                 if threading.current_thread() is threading.main_thread() else None)
     try:
-        load_plugins()  # the slewbench.plugins entry points and SLEWBENCH_PLUGINS, before any name is read
-        return args.handler(args)
+        try:
+            load_plugins()  # the slewbench.plugins entry points and SLEWBENCH_PLUGINS, before any name is read
+            return args.handler(args)
+        except Exception:
+            if args.interruption.signalled:  # a Ctrl-C that C code (CasADi) turned into an error: not a bad file, no bug
+                raise KeyboardInterrupt from None
+            raise
     except PluginError as error:
         print(f"slewbench: plugin error: {error}", file=sys.stderr)
         return EXIT_BAD_SCENARIO
@@ -537,9 +552,7 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_OK
     except KeyboardInterrupt:
-        print("slewbench: interrupted; results not written or marked incomplete in the output manifest",
-              file=sys.stderr)
-        return EXIT_INTERNAL
+        return _interrupted(args)
     except Exception:  # noqa: BLE001 (the last resort: any bug is reported as one, with its traceback)
         traceback.print_exc()
         print("slewbench: internal error (this is a bug; please report it with the scenario file)", file=sys.stderr)

@@ -43,6 +43,16 @@ def _terminate(signum: int, frame: Any) -> None:
     raise KeyboardInterrupt
 
 
+def _check_interrupted(args: argparse.Namespace) -> None:
+    """Raise ``KeyboardInterrupt`` if Ctrl-C or SIGTERM came (``args.interruption``, set by
+    :func:`scenarios.cli.commands.main`), also one whose ``KeyboardInterrupt`` was lost on the way:
+    raised inside CasADi while the study's cases were checked, it was swallowed or turned into
+    another error, and the sweep ran on."""
+    interruption = getattr(args, "interruption", None)
+    if interruption is not None:
+        interruption.check()
+
+
 def command_report(args: argparse.Namespace) -> int:
     """Redraw tables and plots of ``args.report`` from its store, without running anything.
 
@@ -238,7 +248,8 @@ def _undo(out: Path, missing: Path | None, empty: bool) -> None:
 
 
 def _open(out: Path, study: Study) -> tuple[Path, SweepStore]:
-    """Claim the directory and open the store with the study in it; on failure (a full disk), undo."""
+    """Claim the directory and open the store with the study in it; on failure (a full disk) or
+    Ctrl-C, undo."""
     from scenarios.study.report import resolved_study
     from scenarios.study.store import SweepStore, claim_sweep_directory, mark_incomplete
 
@@ -254,7 +265,7 @@ def _open(out: Path, study: Study) -> tuple[Path, SweepStore]:
         except BaseException:
             store.close()
             raise
-    except OutputError:
+    except (OutputError, KeyboardInterrupt):
         _undo(Path(out).absolute(), missing, empty)
         raise
     except (OSError, ValueError, sqlite3.Error) as error:  # sqlite3.Error, or a store of another format
@@ -303,7 +314,12 @@ def command_sweep(args: argparse.Namespace) -> int:
         start_forkserver()  # local workers' imports run while the study is expanded and checked
     name = Path(args.file).stem
     try:
-        study = load_study(args.file, progress=_checking(name))
+        try:
+            study = load_study(args.file, progress=_checking(name))
+        except Exception:
+            _check_interrupted(args)  # a Ctrl-C that CasADi turned into an error while a case was checked
+            raise
+        _check_interrupted(args)  # one that CasADi swallowed
     except KeyboardInterrupt:  # an interrupted sweep exits 130, in its checking phase too
         print("slewbench: sweep interrupted while its cases were checked; nothing was run or written",
               file=sys.stderr)
@@ -384,11 +400,17 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
     from scenarios.study.robustness import crashed_counts, robustness_lines
     from scenarios.study.store import STORE_NAME, SweepStore, resume_counts
 
-    out, store = _open(out, study)
-    start = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _terminate)
     try:
+        out, store = _open(out, study)
+    except KeyboardInterrupt:
+        signal.signal(signal.SIGTERM, previous)
+        print("slewbench: sweep interrupted before its first case; nothing was run", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    start = time.perf_counter()
+    try:
         with store:
+            _check_interrupted(args)
             counts = resume_counts(store, (case.key for case in study.cases))  # crashed cases run again
             done = counts.kept
             print(f"{study.name}: {len(study.cases)} cases" + counts.describe()
@@ -396,6 +418,7 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
             for note in counts.notes():  # stored cases of an earlier version of the study
                 print(note, flush=True)
             results = sweep(study, workers=args.workers, store=store, progress=True, cluster=cluster)
+        _check_interrupted(args)  # a Ctrl-C lost on the way: the sweep's tables are not written
     except (SweepInterrupted, KeyboardInterrupt) as stop:  # KeyboardInterrupt: before the sweep took over
         if isinstance(stop, KeyboardInterrupt):
             with SweepStore(out, create=False) as stored:
@@ -508,4 +531,4 @@ def add_sweep_parser(commands: Any) -> None:
     parser.add_argument("--case", metavar="N", type=int,
                         help="re-run case N of the sweep stored in DIR (given as the first argument) in full, "
                              "writing a run's outputs into --out (default: DIR/cases/N)")
-    parser.set_defaults(handler=command_sweep)
+    parser.set_defaults(handler=command_sweep, interrupted_status=EXIT_INTERRUPTED)

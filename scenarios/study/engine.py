@@ -23,6 +23,7 @@ progress) is kept small, so that it keeps up with many workers.
 """
 from __future__ import annotations
 
+import atexit
 import collections
 import contextlib
 import json
@@ -251,7 +252,31 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
                 os.environ.pop(name, None)
             else:
                 os.environ[name] = value
+    if not _STOP_AT_EXIT:
+        atexit.register(_stop_forkserver, os.getpid())
+        _STOP_AT_EXIT.append(True)
     return context
+
+
+_STOP_AT_EXIT: list[bool] = []  # whether _stop_forkserver is registered to run at this process's exit
+
+
+def _stop_forkserver(owner: int | None = None) -> None:
+    """Kill the fork server of this process's local workers, if it runs, and with it every worker
+    it forked, one still starting included (they die with it from their fork on:
+    :data:`scenarios.study.worker.PARENT_ENVIRONMENT`).
+
+    A sweep that stops before its end calls it, and the process that started the server at its
+    exit (``owner``, its process id: a process forked from it does nothing), so that a server
+    still importing, with Ctrl-C blocked, does not outlive a sweep interrupted before its first
+    case. The next :func:`start_forkserver` starts a new server (``multiprocessing`` finds this
+    one dead).
+    """
+    from multiprocessing import forkserver
+    pid = getattr(forkserver._forkserver, "_forkserver_pid", None)  # private, stable since 3.4
+    if pid and owner in (None, os.getpid()):
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
 
 
 @contextlib.contextmanager
@@ -261,10 +286,10 @@ def _sigint_blocked() -> Iterator[None]:
     Ctrl-C reaches the whole foreground process group, the server too, which imports the model for
     seconds after it starts: its KeyboardInterrupt traceback was printed into the sweep's
     "interrupted" message. The server starts with SIGINT blocked (a new process inherits the mask
-    of the thread that started it), sets it to be ignored once it has imported
-    :mod:`scenarios.study.worker` (a Ctrl-C pending meanwhile is then discarded), and only then
-    unblocks it; its workers inherit the ignoring: the sweep stops them itself
-    (:meth:`_LocalPool.kill`; they also die with it). This process's handler is not touched, so its
+    of the thread that started it), catches and ignores it once it has imported
+    :mod:`scenarios.study.worker` (a Ctrl-C pending meanwhile included), and only then unblocks
+    it; its workers inherit the handler: the sweep stops them itself (:meth:`_LocalPool.kill`,
+    :func:`_stop_forkserver`; they also die with it). This process's handler is not touched, so its
     own Ctrl-C is not lost: its other threads take it, or this one once unblocked. Outside the main
     thread the server is started as it is (Python runs signal handlers in the main thread only).
     """
@@ -276,6 +301,27 @@ def _sigint_blocked() -> Iterator[None]:
         yield
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+
+def _descendants(pid: int) -> list[int]:
+    """The processes that process ``pid`` started, and theirs, now (Linux's ``/proc``; elsewhere none)."""
+    found: list[int] = []
+    parents = [pid]
+    while parents:
+        parent = parents.pop()
+        try:
+            tasks = os.listdir(f"/proc/{parent}/task")
+        except OSError:  # ended, or no /proc
+            continue
+        for task in tasks:
+            try:
+                with open(f"/proc/{parent}/task/{task}/children") as listed:
+                    children = [int(child) for child in listed.read().split()]
+            except OSError:
+                continue
+            found += children
+            parents += children
+    return found
 
 
 class _LocalPool:
@@ -310,15 +356,20 @@ class _LocalPool:
         return found
 
     def kill(self) -> None:
-        """Stop now, including a worker stuck in C code (it cannot be interrupted), and wait for the
+        """Stop now, including a worker stuck in C code (it cannot be interrupted) and the processes
+        a worker started (a C compiler, :mod:`ocp.simulation.compiled`), and wait for the
         pool's manager thread to end (its workers are dead: it ends at once), so that none of the
         pool's threads or pipes outlives the sweep: CPython 3.11's exit hook of ``concurrent.futures``
         could otherwise wake a manager thread whose pipe it was closing at the same moment
         ("Exception ignored ... OSError: [Errno 9] Bad file descriptor" after a sweep's error)."""
         for process in list(self.processes.values()):
             if process.is_alive():
+                started = _descendants(process.pid)  # a C compiler it runs: it would go on alone
                 self.ours.add(process.pid)
                 process.kill()
+                for pid in started:
+                    with contextlib.suppress(ProcessLookupError):
+                        os.kill(pid, signal.SIGKILL)
         self.executor.shutdown(wait=False, cancel_futures=True)
         manager = getattr(self.executor, "_executor_manager_thread", None)  # private, stable since 3.9
         if manager is not None and manager is not threading.current_thread():
@@ -643,15 +694,21 @@ class _Engine:
                 self._collect(done)
                 self._check_cluster()
                 self._check_time()
+        except BaseException:
+            if self.pool is not None:
+                # stopped before its end (Ctrl-C, an error): every worker now, also one the pool was
+                # still starting (a Ctrl-C during its start left it out of the pool's processes; it
+                # would start after the sweep and fail on the pool's queues, with a traceback)
+                self.pool.kill()
+                _stop_forkserver()
+            raise
+        else:
+            if self.pool is not None:
+                self.executor.shutdown(wait=True)
         finally:
             if self.bar is not None:
                 self.bar.close()
-            if self.pool is not None:
-                if self.in_flight:
-                    self.pool.kill()
-                else:
-                    self.executor.shutdown(wait=True)
-            else:
+            if self.pool is None:
                 for future in self.in_flight:
                     future.cancel()
 

@@ -46,11 +46,36 @@ PARENT_ENVIRONMENT = "SLEWBENCH_SWEEP_PARENT"
 (:func:`scenarios.study.engine.start_forkserver` sets it): a direct child of that process which
 imports this module (the server local workers fork from) dies with it."""
 
+
+def _ignore_interrupt(signum: int, frame: Any) -> None:
+    """Ctrl-C in the fork server and its workers: nothing (the sweep stops them itself)."""
+
+
+_forker: dict[str, int] = {}  # the process id of the process forking now (in the fork server's family)
+
+
+def _before_fork() -> None:
+    _forker["pid"] = os.getpid()
+
+
+def _die_with_server(server: int) -> None:
+    """In a process just forked: if the fork server ``server`` forked it (a worker), die with the
+    server from now on (a process a worker forks is left alone)."""
+    if _forker.get("pid") == server:
+        die_with_parent(signal.SIGKILL, server)
+
+
 if os.environ.get(PARENT_ENVIRONMENT) == str(os.getppid()):  # the fork server of a sweep: dies with it
     die_with_parent(signal.SIGKILL, os.getppid())
-    # started with Ctrl-C blocked (scenarios.study.engine._sigint_blocked): ignored from now on,
-    # here and in the workers (the sweep stops them), a pending one discarded, then unblocked
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # every worker dies with the server from its fork on, also one still starting (its own
+    # scenarios.study.worker.start_local_worker has not run yet), so that killing the server
+    # (scenarios.study.engine._stop_forkserver) stops every worker, silently
+    os.register_at_fork(before=_before_fork, after_in_child=functools.partial(_die_with_server, os.getpid()))
+    # started with Ctrl-C blocked (scenarios.study.engine._sigint_blocked): caught and ignored from
+    # now on, here and in the workers (the sweep stops them), a pending one included, then unblocked.
+    # Caught, not SIG_IGN: a process that a worker starts (the C compiler of ocp.simulation.compiled)
+    # takes Ctrl-C's default action again (an ignored signal stays ignored across exec)
+    signal.signal(signal.SIGINT, _ignore_interrupt)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 SLOT_FIELDS = 4
