@@ -8,8 +8,9 @@
 * ``min_time``: the fastest bang-coast-bang under the torque, wheel-momentum and optional rate
   bounds.
 
-Every profile honours the rate bound (option ``max_rate``, else ``maneuver.max_rate``): the body
-rate is ``‖ω‖ = |θ̇|``.
+Every profile honours the rate bound (option ``max_rate``, else ``maneuver.max_rate``, the rate
+requirement ``rate_margin`` lower: :meth:`~planners.problem.ManeuverProblem.rate_bound`): the
+body rate is ``‖ω‖ = |θ̇|``.
 
 The body rate is ``ω = e θ̇`` and the feed-forward torque the rigid body's inverse dynamics
 ``I ω̇ + ω × I ω = I e θ̈ + θ̇² e × I e`` (:class:`planners.Reference`'s contract). What the
@@ -24,6 +25,10 @@ axes ``H`` is conserved and turns about ``e`` in the body (closed form; no gyros
 from rest with no stored momentum); without working wheels it is the rigid body's; with wheels
 spanning fewer axes beside torquers the demand is integrated and the profile stretched until it
 holds.
+The environment's torque (gravity gradient, a constant disturbance) is not in this planner's
+model, but the actuators must cancel it: a bound of it along the slew
+(:meth:`~planners.problem.ManeuverProblem.environment_torque_bound`) is kept from every row's bound
+(:attr:`WheelBudget.reserve`); the momentum it adds to the wheels is not reserved.
 """
 from __future__ import annotations
 

@@ -13,7 +13,9 @@ where the allocation is the identity (wheels along three independent axes, torqu
 NLPs are unchanged.
 It honours every requirement of the problem (:attr:`CollocationPlanner.honours`): the pointing
 constraints ``problem.pointing`` (moving directions and windows included), the actuator limits
-tightened by ``problem.actuator_margin`` and the body-rate norm ``‖ω‖ <= problem.max_rate``; each
+tightened by ``problem.actuator_margin`` (the environment's torque is in its model: they bound the
+actuators' own torque, what the scenario's actuator requirement measures) and the body-rate norm
+``‖ω‖ <= problem.rate_bound(None)`` (the rate requirement ``rate_margin`` lower at first); each
 converged reference is checked against them between its points and solved again tighter where it
 breaks one (:mod:`planners.collocation.requirements`; see :meth:`CollocationPlanner.plan`).
 The transcription (``collocation``: Legendre-Gauss-Radau, or ``multiple_shooting``) comes from
