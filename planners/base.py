@@ -268,8 +268,8 @@ class Planner(Configurable, ABC):
             As :meth:`plan`; the failure on ``problem`` when both fail.
         """
         reference = self.plan(problem)
-        if not reference.ok and problem.max_rate is not None:
-            unbounded = self.plan(replace(problem, max_rate=None))
+        if not reference.ok and problem.rate_bound(None) is not None:
+            unbounded = self.plan(replace(problem, max_rate=None, rate_requirement=None))
             if unbounded.ok:
                 return unbounded
         return reference

@@ -8,8 +8,9 @@
 * ``min_time``: the fastest bang-coast-bang under the torque, wheel-momentum and optional rate
   bounds.
 
-Every profile honours the rate bound (option ``max_rate``, else ``maneuver.max_rate``): the body
-rate is ``‖ω‖ = |θ̇|``.
+Every profile honours the rate bound (option ``max_rate``, else ``maneuver.max_rate``, the rate
+requirement ``rate_margin`` lower: :meth:`~planners.problem.ManeuverProblem.rate_bound`): the
+body rate is ``‖ω‖ = |θ̇|``.
 
 The body rate is ``ω = e θ̇`` and the feed-forward torque the rigid body's inverse dynamics
 ``I ω̇ + ω × I ω = I e θ̈ + θ̇² e × I e`` (:class:`planners.Reference`'s contract). What the
@@ -24,6 +25,10 @@ axes ``H`` is conserved and turns about ``e`` in the body (closed form; no gyros
 from rest with no stored momentum); without working wheels it is the rigid body's; with wheels
 spanning fewer axes beside torquers the demand is integrated and the profile stretched until it
 holds.
+The environment's torque (gravity gradient, a constant disturbance) is not in this planner's
+model, but the actuators must cancel it: a bound of it along the slew
+(:meth:`~planners.problem.ManeuverProblem.environment_torque_bound`) is kept from every row's bound
+(:attr:`WheelBudget.reserve`); the momentum it adds to the wheels is not reserved.
 """
 from __future__ import annotations
 
@@ -441,7 +446,12 @@ class WheelBudget:
     Attributes
     ----------
     bounds : (m,) ndarray
-        ``f L`` (times ``scale``) [N m].
+        ``f L`` (times ``scale``) less :attr:`reserve` [N m].
+    reserve : (m,) ndarray
+        Per bounded row, a bound of ``|M_i τ_env|`` over the slew [N m]: the environment's torque
+        (:meth:`~planners.problem.ManeuverProblem.environment_torque_bound`, ``|M_i d| + ‖M_i‖ g``
+        for the constant disturbance ``d`` and the gravity gradient's bound ``g``), which the
+        actuators must cancel besides the motion's own torque; 0 without one.
     accel, quadratic, linear : (m,) ndarray
         ``M I e`` (signed), ``g`` and ``c`` per row.
     exact : bool
@@ -463,7 +473,12 @@ class WheelBudget:
         rows, limits = spacecraft.allocation_rows()
         self.problem, self.axis, self.angle, self.rows = problem, axis, angle, rows
         self.limits = limits
-        self.bounds = fraction * scale * limits
+        # The actuators give the motion's torque less the environment's, which this planner does not
+        # model: each bounded row keeps a bound of |M_i τ_env| in reserve (ManeuverProblem.environment_torque_bound).
+        disturbance, gravity_gradient = problem.environment_torque_bound(problem.duration)
+        self.reserve = np.where(limits > 0, np.abs(rows @ disturbance) + gravity_gradient * np.linalg.norm(rows, axis=1),
+                                0.0)
+        self.bounds = fraction * scale * limits - self.reserve
         wheels = spacecraft.wheels
         axes = spacecraft.wheel_axes
         h0 = np.asarray(problem.initial_state[7:], dtype=float)
@@ -516,6 +531,9 @@ class WheelBudget:
             " (off the working wheels' span only magnetorquers act, whose torque depends on the field and "
             "is never along it: the eigenaxis budget counts them as none)" if "magnetorquers" in sink
             and "torquers" not in sink else " (off the working wheels' span no actuator gives torque)")
+        if np.any((self.bounds <= 0) & (limits > 0)):
+            self.uncounted += (f" (the environment's torque, up to {np.max(self.reserve):.3g} N m on an allocation "
+                               f"row, takes all of an actuator's share of its bound)")
 
     def margin(self, coast_rate: float) -> Array:
         """What is left of each row's bound for the acceleration.
@@ -675,16 +693,25 @@ class EigenaxisPlanner(Planner):
             at most at it; the quintic, whose peak rate is fixed by T, is ``infeasible`` above it.
             It tightens the problem's bound (``maneuver.max_rate``, or ``requirements.rate.max``),
             never loosens it; ``None`` (default): the problem's (if any).
+        rate_margin : float
+            The rate requirement (``requirements.rate.max``, ``ManeuverProblem.rate_requirement``)
+            is planned this fraction lower, in [0, 1) (default 0.01): a zero-order-hold closed loop
+            tracking a coast at the bound overshoots it (by 0.03-0.04 % with a perfect plant);
+            ``maneuver.max_rate`` and the option ``max_rate`` are imposed as given
+            (:meth:`~planners.problem.ManeuverProblem.rate_bound`).
         torque_fraction : float
             Share of each actuator's torque bound (each wheel's ``max_torque`` through ``g = −A⁺ τ``,
             the torquers' per axis) the bang profiles may use, in (0, 1]; default 1. The wheels'
             ``max_momentum`` caps the coast rate whole. With an actuator requirement
             (``requirements.actuators.margin``) the bang profiles keep ``1 − margin`` of every
-            torque and momentum limit, and this share applies within it.
+            torque and momentum limit, and this share applies within it. With an environment
+            torque (gravity gradient, a constant disturbance), which this planner does not model, a
+            bound of it is kept from each torque bound besides (:class:`WheelBudget`).
         """
 
         profile: Literal["smooth", "trapezoidal", "min_time"] = "smooth"
         max_rate: Annotated[float | None, Range(gt=0.0)] = None       # rad/s about the axis; default: the problem's max_rate
+        rate_margin: Annotated[float, Range(ge=0.0, lt=1.0)] = 0.01   # the rate requirement is planned this fraction lower
         torque_fraction: Annotated[float, Range(gt=0.0, le=1.0)] = 1.0        # share of the actuator bound the bang profiles may use
 
     def problem_error(self, problem: ManeuverProblem) -> str | None:
@@ -717,6 +744,9 @@ class EigenaxisPlanner(Planner):
     def _rate_source(self, problem: ManeuverProblem) -> str:
         """Where the rate bound comes from, in a message."""
         option = self.options.max_rate
+        bound, stated = problem.rate_bound(option, self.options.rate_margin), problem.rate_bound(option)
+        if bound is not None and stated is not None and bound < stated:  # the rate requirement, less the margin
+            return f"requirements.rate.max less rate_margin {self.options.rate_margin:g}"
         return "option max_rate" if option is not None and (problem.max_rate is None or option < problem.max_rate) \
             else "the problem's: maneuver.max_rate, else requirements.rate.max"
 
@@ -726,7 +756,7 @@ class EigenaxisPlanner(Planner):
         angle = float(np.linalg.norm(rotvec))
         axis = rotvec / angle if angle > 1e-12 else np.array([1.0, 0.0, 0.0])
         inertia = problem.spacecraft.inertia
-        max_rate = problem.rate_bound(self.options.max_rate)
+        max_rate = problem.rate_bound(self.options.max_rate, self.options.rate_margin)
         if self.options.profile == "smooth":
             rate_end = 0.0 if problem.omegaf is None else float(axis @ problem.omegaf)
             quintic = QuinticProfile(angle, problem.duration, float(axis @ problem.omega0), rate_end)
@@ -873,11 +903,13 @@ class EigenaxisPlanner(Planner):
         minimum_time = slew_time(best_rate)
         momentum_words = (", capped by the wheels' momentum bound" if np.isfinite(momentum_cap)
                           and best_rate >= momentum_cap * (1 - 1e-9) else "")
+        reserve_words = "" if not np.any(budget.reserve > 0) else (
+            f", up to {np.max(budget.reserve):.3g} N m of the torque bounds kept for the environment's torque")
         if profile_name == "min_time":
             profile = BangCoastBangProfile(angle, acceleration(best_rate), best_rate)
             return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,
                                       f"minimum time {profile.duration:.3f} s, coast rate {best_rate:.4g} rad/s"
-                                      f"{momentum_words}", problem)
+                                      f"{momentum_words}{reserve_words}", problem)
         if problem.duration < minimum_time * (1 - 1e-12):
             bounds_words = "the torque bounds"
             if max_rate is not None and best_rate >= max_rate * (1 - 1e-9):  # the rate bound caps the coast
@@ -896,4 +928,4 @@ class EigenaxisPlanner(Planner):
         profile.coast = problem.duration - 2 * profile.ramp  # exact T despite root tolerance
         profile.duration = problem.duration
         return EigenaxisReference(problem.q0, axis, profile, problem.duration, inertia,
-                                  f"bang-coast-bang, coast rate {coast_rate:.4g} rad/s", problem)
+                                  f"bang-coast-bang, coast rate {coast_rate:.4g} rad/s{reserve_words}", problem)

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from functools import cached_property
 
+import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -14,6 +15,9 @@ from ocp.geometry import PointingConstraint
 from ocp.options import is_real
 
 Array = NDArray[np.float64]
+
+RADIUS_STEP = 5.0
+"""Largest spacing [s] of the orbit's samples in :meth:`ManeuverProblem.environment_torque_bound`."""
 
 
 
@@ -55,7 +59,7 @@ class ManeuverProblem:
         Stored as an array after construction.
     max_rate : float or None, optional
         Bound on the body rate norm [rad/s] for planners that honour it (``maneuver.max_rate``,
-        ``requirements.rate``); ``None`` (default): no bound.
+        ``requirements.rate``); ``None`` (default): no bound. Imposed as given (a planning bound).
     pointing : tuple of ocp.geometry.PointingConstraint, optional
         Pointing requirements (keep-out and keep-in cones, their directions tabulated along the
         run) for planners that honour them (:attr:`planners.base.Planner.honours`); default none.
@@ -66,6 +70,12 @@ class ManeuverProblem:
         the planners that check densely (``collocation``). ``None``: no actuator requirement: the
         limits are imposed where a planner imposes them (its mesh points) and not checked between
         them, where a reference can exceed them (a wheel's momentum by 0.5 % on a minimum-time slew).
+    rate_requirement : float or None, optional
+        The rate requirement the closed loop is scored against (``requirements.rate.max``) [rad/s],
+        at least ``max_rate`` when both are given; ``None`` (default): none. Planners that honour
+        the rate plan at most ``1 − rate_margin`` of it (their option, :meth:`rate_bound`): a
+        zero-order-hold closed loop tracking a coast at the bound overshoots it (by 0.03-0.04 %
+        with a perfect plant).
     """
 
     spacecraft: Spacecraft
@@ -79,6 +89,7 @@ class ManeuverProblem:
     max_rate: float | None = None
     pointing: tuple[PointingConstraint, ...] = ()
     actuator_margin: float | None = 0.0
+    rate_requirement: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.spacecraft, Spacecraft):
@@ -100,6 +111,11 @@ class ManeuverProblem:
             if not is_real(self.max_rate) or not np.isfinite(self.max_rate) or not self.max_rate > 0:
                 raise ValueError(f"max_rate must be a finite positive rate (rad/s) or None, got {self.max_rate!r}")
             object.__setattr__(self, "max_rate", float(self.max_rate))
+        if self.rate_requirement is not None:
+            if not (_real(self.rate_requirement) and np.isfinite(self.rate_requirement) and self.rate_requirement > 0):
+                raise ValueError(f"rate_requirement must be a finite positive rate (rad/s) or None, got "
+                                 f"{self.rate_requirement!r}")
+            object.__setattr__(self, "rate_requirement", float(self.rate_requirement))
         object.__setattr__(self, "pointing", tuple(self.pointing))
         if not all(isinstance(c, PointingConstraint) for c in self.pointing):
             raise TypeError("pointing must hold ocp.geometry.PointingConstraint objects")
@@ -152,22 +168,77 @@ class ManeuverProblem:
         return (f"one working wheel axis {np.round(working[:, 0], 4).tolist()} and zero total momentum: the body "
                 f"can only turn about the body axis I⁻¹a = {np.round(axis, 4).tolist()}, and {what}")
 
-    def rate_bound(self, option: float | None) -> float | None:
+    def rate_bound(self, option: float | None, margin: float = 0.0) -> float | None:
         """The rate bound a planner imposes: its own ``max_rate`` option tightens the problem's
-        (``maneuver.max_rate``, else ``requirements.rate.max``), never loosens it.
+        (``maneuver.max_rate``, else ``requirements.rate.max``), never loosens it, and the rate
+        requirement (:attr:`rate_requirement`) is kept ``margin`` below: a closed loop tracking
+        a reference that coasts exactly at the requirement overshoots it.
 
         Parameters
         ----------
         option : float or None
             The planner's option [rad/s]; ``None``: the problem's bound.
+        margin : float, optional
+            The planner's ``rate_margin``, a fraction in [0, 1) of :attr:`rate_requirement`
+            (default 0: the requirement itself).
 
         Returns
         -------
         float or None
-            The smaller of the two [rad/s]; ``None`` without either.
+            The smallest of the option, ``max_rate`` and ``(1 − margin)`` times the requirement
+            [rad/s]; ``None`` without any.
         """
-        bounds = [bound for bound in (option, self.max_rate) if bound is not None]
+        required = None if self.rate_requirement is None else self.rate_requirement * (1.0 - margin)
+        bounds = [bound for bound in (option, self.max_rate, required) if bound is not None]
         return min(bounds) if bounds else None
+
+    def environment_torque_bound(self, duration: float) -> tuple[Array, float]:
+        """A bound on the environment's torque from t = 0 over ``duration``, for planners that do
+        not model it (what the actuators must give is the motion's torque less it).
+
+        The constant disturbance (``environment.disturbance_torque``) is returned as it is, in body
+        axes. The gravity gradient, ``3 μ / r³ r̂ × I r̂`` in body axes, is bounded in norm by
+        ``3 μ / r³ (I_max − I_min) / 2`` whatever the attitude (``I_max``, ``I_min`` the extreme
+        principal moments; the bound is reached with ``r̂`` halfway between their axes), ``3 n²
+        (I_max − I_min) / 2`` on a circular orbit of mean motion ``n``. ``r`` is the least radius
+        over ``[0, max(duration, P)]``, ``P = 2π √(r_max³ / μ)`` at least one orbital period (so
+        that any slew shorter than either is covered, its duration not yet known): the orbit
+        sampled at most every :data:`RADIUS_STEP` seconds, less what the radius can lose between
+        two samples, ``(|ṙ| + r̈ Δ/2) Δ/2`` with ``|r̈| <= μ / r² + v² / r`` (two-body gravity and
+        the turning velocity) taken 10 % larger.
+
+        Parameters
+        ----------
+        duration : float
+            The time from t = 0 the bound must cover [s].
+
+        Returns
+        -------
+        disturbance : (3,) ndarray
+            The constant disturbance torque [N m], body axes (zeros without one).
+        gravity_gradient : float
+            Bound on the gravity gradient's norm [N m] (0 without it).
+        """
+        environment = self.environment
+        disturbance = np.array(environment.disturbance_torque, dtype=float)
+        orbit = environment.orbit
+        if not environment.gravity_gradient or orbit is None:
+            return disturbance, 0.0
+        mu = float(orbit.mu)
+        window = max(float(duration), 2.0 * np.pi * np.sqrt(float(orbit.max_radius) ** 3 / mu))
+        samples = int(np.ceil(window / RADIUS_STEP)) + 1
+        step = window / (samples - 1)
+        times = ca.DM(np.linspace(0.0, window, samples)).T
+        position = np.asarray(orbit.position(times), dtype=float).reshape(3, samples)
+        velocity = np.asarray(orbit.velocity(times), dtype=float).reshape(3, samples)
+        radius = np.linalg.norm(position, axis=0)
+        speed = np.linalg.norm(velocity, axis=0)
+        radial = np.abs(np.sum(position * velocity, axis=0)) / radius
+        least = float(np.min(radius))
+        curvature = 1.1 * (mu / least**2 + float(np.max(speed)) ** 2 / least)
+        least -= (float(np.max(radial)) + 0.5 * curvature * step) * 0.5 * step
+        moments = np.linalg.eigvalsh(np.asarray(self.spacecraft.inertia, dtype=float))
+        return disturbance, float(3.0 * mu / least**3 * (moments[-1] - moments[0]) / 2.0)
 
     @property
     def torque_limit(self) -> Array:

@@ -256,6 +256,12 @@ class ShapePolynomialPlanner(Planner):
             Rate bound [rad/s] for ``duration: rate_limit``; it tightens the problem's bound
             (``maneuver.max_rate``, or ``requirements.rate.max``), never loosens it; ``None``
             (default): the problem's.
+        rate_margin : float
+            The rate requirement (``requirements.rate.max``, ``ManeuverProblem.rate_requirement``)
+            is planned this fraction lower with ``duration: rate_limit``, in [0, 1) (default 0.01):
+            a zero-order-hold closed loop tracking a reference at the bound overshoots it;
+            ``maneuver.max_rate`` and the option ``max_rate`` are imposed as given (the paper's
+            minimum time, :meth:`~planners.problem.ManeuverProblem.rate_bound`).
         """
 
         terms: Annotated[int | None, Range(ge=1, le=12)] = None                                    # N; None tries 1..max_terms
@@ -263,6 +269,7 @@ class ShapePolynomialPlanner(Planner):
         cost: Literal["path", "torque"] = "path"
         duration: Literal["rate_limit", "scenario"] = "rate_limit"
         max_rate: Annotated[float | None, Range(gt=0.0)] = None                               # rad/s; default: the problem's max_rate
+        rate_margin: Annotated[float, Range(ge=0.0, lt=1.0)] = 0.01                           # the rate requirement is planned this fraction lower
 
     @classmethod
     def honoured(cls, options: Any) -> frozenset[str]:
@@ -296,7 +303,7 @@ class ShapePolynomialPlanner(Planner):
         """
         o = self.options
         if o.duration == "rate_limit":
-            if problem.rate_bound(o.max_rate) is None:
+            if problem.rate_bound(o.max_rate, o.rate_margin) is None:
                 return NO_RATE_BOUND
             if np.any(problem.omega0) or (problem.omegaf is not None and np.any(problem.omegaf)):
                 return "duration: rate_limit is for rest-to-rest slews; use duration: scenario"
@@ -304,7 +311,7 @@ class ShapePolynomialPlanner(Planner):
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         o = self.options
-        max_rate = problem.rate_bound(o.max_rate)
+        max_rate = problem.rate_bound(o.max_rate, o.rate_margin)
         if o.duration == "rate_limit" and max_rate is None:
             return FailedReference(self.name, NO_RATE_BOUND)
         omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf

@@ -13,7 +13,9 @@ where the allocation is the identity (wheels along three independent axes, torqu
 NLPs are unchanged.
 It honours every requirement of the problem (:attr:`CollocationPlanner.honours`): the pointing
 constraints ``problem.pointing`` (moving directions and windows included), the actuator limits
-tightened by ``problem.actuator_margin`` and the body-rate norm ``‖ω‖ <= problem.max_rate``; each
+tightened by ``problem.actuator_margin`` (the environment's torque is in its model: they bound the
+actuators' own torque, what the scenario's actuator requirement measures) and the body-rate norm
+``‖ω‖ <= problem.rate_bound(None)`` (the rate requirement ``rate_margin`` lower at first); each
 converged reference is checked against them between its points and solved again tighter where it
 breaks one (:mod:`planners.collocation.requirements`; see :meth:`CollocationPlanner.plan`).
 The transcription (``collocation``: Legendre-Gauss-Radau, or ``multiple_shooting``) comes from
@@ -193,6 +195,12 @@ class CollocationOptions:
     cone_margin_deg : float
         Every cone (these and the problem's) is imposed this much tighter [deg] at first, so that
         it holds between the points; the dense check tightens further where needed.
+    rate_margin : float
+        The rate requirement (``requirements.rate.max``, ``ManeuverProblem.rate_requirement``) is
+        imposed this fraction lower, in [0, 1) (default 0.01), so that the closed loop tracking the
+        reference stays within it (a zero-order-hold loop overshoots a coast at the bound by
+        0.03-0.04 %, with a perfect plant); ``maneuver.max_rate`` is imposed as given
+        (:meth:`~planners.problem.ManeuverProblem.rate_bound`).
     tolerance : float
         Solver tolerance (scaled KKT error); the coarse seed of a fixed final time
         (``coarse_intervals``) is solved to 1e-5 at the tightest
@@ -222,6 +230,7 @@ class CollocationOptions:
     keep_in: list[dict] = field(default_factory=list)
     cone_margin_deg: Annotated[float, Range(ge=0.0, lt=90.0)] = 0.01            # cones are imposed this much tighter, so that they
                                              # hold between the points where they are imposed
+    rate_margin: Annotated[float, Range(ge=0.0, lt=1.0)] = 0.01  # the rate requirement is imposed this fraction lower
     tolerance: Annotated[float, Range(gt=0.0, lt=1.0)] = 1e-10
     max_iterations: Annotated[int, Range(ge=1, le=100000)] = 500
 
@@ -358,7 +367,7 @@ class CollocationPlanner(Planner):
             error = allocation_error(problem.spacecraft, o.transcription)
             if error is not None:
                 return f"options.transcription: {error}"
-        if error is None and (problem.pointing or problem.max_rate is not None):
+        if error is None and (problem.pointing or problem.rate_bound(None) is not None):
             l1 = o.objective == "min_l1" or (o.objective == "weighted" and o.l1_weight > 0)
             refused = TRANSCRIPTIONS[o.transcription].problem_error(l1, True)
             if refused:
@@ -370,7 +379,7 @@ class CollocationPlanner(Planner):
         o = self.options
         cones = tuple(parse_cone(c, True, where=f"keep_out[{i}]") for i, c in enumerate(o.keep_out))
         cones += tuple(parse_cone(c, False, where=f"keep_in[{i}]") for i, c in enumerate(o.keep_in))
-        return Requirements(tuple(problem.pointing) + cones, problem.max_rate, problem.actuator_margin)
+        return Requirements(tuple(problem.pointing) + cones, problem.rate_bound(None), problem.actuator_margin)
 
     def _ocp(self, problem: ManeuverProblem, tightening: Tightening | None = None) -> OptimalControlProblem:
         """The optimal-control problem, its requirements imposed with ``tightening`` (default the
@@ -382,7 +391,8 @@ class CollocationPlanner(Planner):
         free_time = weights[2] > 0
         requirements = self._requirements(problem)
         if tightening is None:
-            tightening = Tightening.initial(requirements, float(np.deg2rad(o.cone_margin_deg)))
+            tightening = Tightening.initial(requirements, float(np.deg2rad(o.cone_margin_deg)),
+                                            problem.rate_bound(None, o.rate_margin))
         cones = imposed_pointing(requirements, tightening, None if free_time else problem.duration / o.intervals,
                                  problem.duration)
         max_rate = None if requirements.max_rate is None else requirements.max_rate * (1.0 - tightening.rate)
@@ -778,7 +788,8 @@ class CollocationPlanner(Planner):
         requirements = self._requirements(problem)
         if not requirements.any or not isinstance(reference, CollocationReference):
             return reference
-        tightening = Tightening.initial(requirements, float(np.deg2rad(self.options.cone_margin_deg)))
+        tightening = Tightening.initial(requirements, float(np.deg2rad(self.options.cone_margin_deg)),
+                                        problem.rate_bound(None, self.options.rate_margin))
         check = dense_check(problem, reference, requirements)
         first_seeds = reference.stats.get("seeds")
         first, first_f = reference, float(solved.result.f)
@@ -872,8 +883,8 @@ class CollocationPlanner(Planner):
             tries.append("more starts, a larger multistart (IPOPT's infeasibility is local)")
         if ocp.cones:
             tries.append("multistart: 4 or more intervals (pointing constraints)")
-        if problem.max_rate is not None:
-            tries.append(f"a larger rate bound than {problem.max_rate:g} rad/s (requirements.rate.max, "
+        if problem.rate_bound(None) is not None:
+            tries.append(f"a larger rate bound than {problem.rate_bound(None):g} rad/s (requirements.rate.max, "
                          "maneuver.max_rate)")
         if problem.actuator_margin:
             tries.append(f"a smaller requirements.actuators.margin than {problem.actuator_margin:g} (the reference "

@@ -45,7 +45,10 @@ class Requirements:
         cones (named ``keep_out[i]``, ``keep_in[i]``): the planner holds its reference to them all;
         a scenario scores its rows against the former only.
     max_rate : float or None
-        Bound on the body-rate norm ``‖ω‖`` [rad/s] (``ManeuverProblem.max_rate``); ``None``: none.
+        Bound on the body-rate norm ``‖ω‖`` [rad/s] (``ManeuverProblem.rate_bound(None)``: the
+        lesser of ``max_rate`` and ``rate_requirement``), as stated; ``None``: none. The planner
+        imposes it ``rate_margin`` lower where it is the rate requirement
+        (:meth:`Tightening.initial`).
     actuator_margin : float or None
         The reference may ask at most ``1 − actuator_margin`` of every actuator limit (torques,
         dipoles, wheel momenta); ``None``: no actuator requirement (the limits are still imposed at
@@ -88,8 +91,9 @@ class Tightening:
     actuators: float = 0.0
 
     @classmethod
-    def initial(cls, requirements: Requirements, cone_margin: float) -> Tightening:
-        """The first solve's tightening: the cones by ``cone_margin``, nothing else.
+    def initial(cls, requirements: Requirements, cone_margin: float, rate_bound: float | None = None) -> Tightening:
+        """The first solve's tightening: the cones by ``cone_margin``, the rate-norm bound down to
+        ``rate_bound``, the actuators not.
 
         Parameters
         ----------
@@ -97,12 +101,19 @@ class Tightening:
             What is required.
         cone_margin : float
             ``cone_margin_deg`` [rad].
+        rate_bound : float or None, optional
+            The rate-norm bound to impose first [rad/s], at most :attr:`Requirements.max_rate`
+            (``ManeuverProblem.rate_bound`` with the planner's ``rate_margin``); ``None``
+            (default): the requirement's own.
 
         Returns
         -------
         Tightening
         """
-        return cls((cone_margin,) * len(requirements.pointing))
+        rate = 0.0
+        if rate_bound is not None and requirements.max_rate is not None:
+            rate = max(0.0, 1.0 - rate_bound / requirements.max_rate)
+        return cls((cone_margin,) * len(requirements.pointing), rate=rate)
 
     def after(self, check: DenseCheck, requirements: Requirements) -> Tightening:
         """The tightening for the next solve, after a dense check found violations.
