@@ -397,12 +397,17 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
 
     * when the working wheels span three axes and are the only actuators with states, they take
       the whole torque, ``A ḣ_w = −(u + ω × A h_w)``: with ``u`` the inverse dynamics of the motion
-      (:class:`planners.Reference`'s contract) the total angular momentum, the body's and the
-      wheels', is conserved in the inertial frame, and the momenta are its closed form,
-      ``A h_w(t) = R(q)ᵀ R(q₀) (I ω₀ + A h_w0) − I ω(t)`` (``h_w`` moves along ``A⁺``'s range only:
-      a failed wheel keeps its momentum, redundant wheels their null-space part). Exact at any
-      spacing: no step of the motion is integrated, a jump of the torque (a bang, the end of a
-      reference) leaves no error, and ``torque`` is not read for the states;
+      (:class:`planners.Reference`'s contract) less the environment's torque ``τ_e`` of ``model``
+      (gravity gradient, constant disturbance; the actuators' share) the total angular momentum,
+      the body's and the wheels', changes in the inertial frame by the environment's impulse
+      alone, and the momenta are its closed form,
+      ``A h_w(t) = R(q)ᵀ (R(q₀) (I ω₀ + A h_w0) + ∫₀ᵗ R(q) τ_e dt) − I ω(t)`` (``h_w`` moves along
+      ``A⁺``'s range only: a failed wheel keeps its momentum, redundant wheels their null-space
+      part; the impulse by the trapezoidal rule on the samples, where ``τ_e`` is smooth). Exact at
+      any spacing without an environment torque: no step of the motion is integrated, a jump of
+      the torque (a bang, the end of a reference) leaves no error, and ``torque`` is not read for
+      the states (integrating it would read a reference's torque where it is not its motion's
+      inverse dynamics, between a collocation reference's points, 0.1 % of a wheel's limit);
     * otherwise (fewer than three independent working axes, or other actuator states) the states
       are integrated by the classical Runge-Kutta method, each interval between samples cut into
       sub-steps over which the body turns at most :data:`SUBSTEP_ANGLE` (the wheels' gyroscopic
@@ -484,7 +489,8 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     if n == 0 or n_states == 0:
         states = np.zeros((n, n_states))
     elif _conserving(law, blocks, model):
-        states = _momentum_by_conservation(law, spacecraft, q, omega, start + kicks[0])
+        states = _momentum_by_conservation(law, spacecraft, q, omega, start + kicks[0],
+                                           _environment_impulse(model, t, q, omega))
     else:
         after = inputs.copy()
         if torque_after is not None:
@@ -574,25 +580,38 @@ states of the samples after them are nan (not computed), never an under-resolved
 
 
 def _conserving(law: Allocation, blocks: Sequence[Any], model: AttitudeModel) -> bool:
-    """Whether the total angular momentum is conserved along the reference: the wheels are the only
-    actuators (a torquer's or magnetorquer's share of the torque is external), their working axes
-    span three (they take every torque) and the environment adds no torque (gravity gradient, a
-    constant disturbance)."""
-    environment = model.environment
-    external = environment is not None and (environment.gravity_gradient
-                                            or bool(np.any(environment.disturbance_torque)))
-    return (not external and [block.actuator.block for block in blocks] == ["wheels"]
+    """Whether the total angular momentum changes along the reference by the environment's impulse
+    alone: the wheels are the only actuators (a torquer's or magnetorquer's share of the torque is
+    external) and their working axes span three (they take every torque)."""
+    return ([block.actuator.block for block in blocks] == ["wheels"]
             and law._working_axes is not None and int(np.linalg.matrix_rank(law._working_axes)) == 3)
 
 
-def _momentum_by_conservation(law: Allocation, spacecraft: Spacecraft, q: Array, omega: Array, start: Array) -> Array:
-    """The wheel momenta along the motion by the conservation of the total angular momentum (working
-    wheels spanning three axes, :func:`reference_demand`): ``A h_w = R(q)ᵀ R(q₀) (I ω₀ + A h₀) − I ω``,
+def _environment_impulse(model: AttitudeModel, t: Array, q: Array, omega: Array) -> Array:
+    """``∫₀ᵗ R(q) τ_e dt`` [N m s], inertial axes, at each sample: the environment's torque of
+    ``model`` (gravity gradient, constant disturbance) along the motion, by the trapezoidal rule;
+    zeros without one."""
+    environment = model.environment
+    if environment is None or not (environment.gravity_gradient or np.any(environment.disturbance_torque)):
+        return np.zeros((t.size, 3))
+    x = np.hstack([q, omega, np.zeros((t.size, model.nx - 7))])
+    torque = model_rows(model, "environment_torque", x, t[:, None],
+                        np.asarray(model.default_parameters, dtype=float).ravel())
+    inertial = quat.rotate(quat.normalize(q), torque)
+    steps = 0.5 * (inertial[1:] + inertial[:-1]) * np.diff(t)[:, None]
+    return np.vstack([np.zeros((1, 3)), np.cumsum(steps, axis=0)])
+
+
+def _momentum_by_conservation(law: Allocation, spacecraft: Spacecraft, q: Array, omega: Array, start: Array,
+                              impulse: Array) -> Array:
+    """The wheel momenta along the motion by the balance of the total angular momentum (working
+    wheels spanning three axes, :func:`reference_demand`): ``A h_w = R(q)ᵀ (R(q₀) (I ω₀ + A h₀) + J) − I ω``,
+    ``J`` the environment's ``impulse`` (inertial, :func:`_environment_impulse`),
     ``h_w = h₀ + A⁺ (A h_w − A h₀)``; ``start`` is ``h₀`` after the jump at the first sample."""
     inertia = np.asarray(spacecraft.inertia, dtype=float)
     axes = np.asarray(spacecraft.wheel_axes, dtype=float)
     attitude = quat.normalize(q)
-    total = quat.rotate(attitude[0], inertia @ omega[0] + axes @ start)  # inertial: constant
+    total = quat.rotate(attitude[0], inertia @ omega[0] + axes @ start) + impulse  # inertial
     stored = quat.rotate_inverse(attitude, total) - omega @ inertia.T  # A h_w, body axes
     return np.asarray(start + (stored - axes @ start) @ law._wheel_pinv.T, dtype=np.float64)
 

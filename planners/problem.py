@@ -112,7 +112,7 @@ class ManeuverProblem:
                 raise ValueError(f"max_rate must be a finite positive rate (rad/s) or None, got {self.max_rate!r}")
             object.__setattr__(self, "max_rate", float(self.max_rate))
         if self.rate_requirement is not None:
-            if not (_real(self.rate_requirement) and np.isfinite(self.rate_requirement) and self.rate_requirement > 0):
+            if not (is_real(self.rate_requirement) and np.isfinite(self.rate_requirement) and self.rate_requirement > 0):
                 raise ValueError(f"rate_requirement must be a finite positive rate (rad/s) or None, got "
                                  f"{self.rate_requirement!r}")
             object.__setattr__(self, "rate_requirement", float(self.rate_requirement))

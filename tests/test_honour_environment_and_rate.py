@@ -148,9 +148,6 @@ COLLOCATION = {"name": "collocation", "label": "colloc-mt",
                "options": {"objective": "min_time", "warm_start_options": {"profile": "min_time"}}}
 
 
-@pytest.mark.xfail(strict=True, reason="the scorer integrates a collocation reference's torque for the wheel "
-                   "momentum when the environment has a torque (0.901 with gravity gradient off too); the fix is "
-                   "in controllers/allocation.py (the closed form with the environment's impulse)")
 def test_collocation_min_time_with_gravity_gradient_is_scored_within_the_actuator_requirement():
     data = copy.deepcopy(SCENARIO)
     data["planners"] = [COLLOCATION]
@@ -163,8 +160,6 @@ def test_collocation_min_time_with_gravity_gradient_is_scored_within_the_actuato
     assert abs(duration - duration_off) <= 1e-3 * duration_off
 
 
-@pytest.mark.xfail(strict=True, reason="needs the loader to pass requirements.rate.max as the problem's "
-                   "rate_requirement (scenarios/schema/loader.py)")
 def test_the_closed_loop_of_the_users_min_time_stays_within_the_rate_requirement():
     data = copy.deepcopy(SCENARIO)
     data["environment"]["gravity_gradient"] = False  # the user's cmt2: 1.0004 x the bound before

@@ -626,7 +626,9 @@ def _with_requirements(problem: ManeuverProblem, requirements: Requirements,
                                 f"({requirements.rate.max_rate:g} rad/s): the planners would plan past the "
                                 "requirement; lower it or leave it out (the requirement's bound then applies)")
     margin = None if requirements.actuators is None else requirements.actuators.margin
-    return dataclasses.replace(problem, pointing=constraints, actuator_margin=margin, max_rate=max_rate)
+    required = None if requirements.rate is None else requirements.rate.max_rate  # planned rate_margin below
+    return dataclasses.replace(problem, pointing=constraints, actuator_margin=margin, max_rate=max_rate,
+                               rate_requirement=required)
 
 
 def load(path: str | Path) -> Scenario:
