@@ -66,9 +66,9 @@ METRIC_INFO: dict[str, MetricInfo] = {
         "the CSV tables split it into ``_x``, ``_y``, ``_z`` columns); a reference's rate jumps add "
         "|(I Δω)_i| (as ``int_u``)."),
     "int_actuator_torque": MetricInfo(
-        "N m s", "Closed loop: ∫ ‖τ_act‖₂ dt, τ_act the actuators' applied torque on the body (wheels −A g, "
-        "magnetorquers m × B, torquers; as ``peak_actuator_torque``), zero-order hold: what the actuators "
-        "did. Without wheels it equals ``int_u``; with wheels τ_act = u + ω × A h_w differs from ``int_u``'s "
+        "N m s", "Closed loop: ∫ ‖τ_act‖₂ dt, τ_act the actuators' applied torque on the body (wheels "
+        "−A g, magnetorquers m × B, torquers; as ``peak_actuator_torque``), zero-order hold: what the "
+        "actuators did. Without wheels it equals ``int_u``; with wheels τ_act = u + ω × A h_w differs from ``int_u``'s "
         "u by the wheels' gyroscopic torque (with the total momentum zero, −ω × A h_w = ω × I ω: the "
         "body's own gyroscopic torque, which a reference's feed-forward and ``int_u`` contain and the "
         "wheels' motor torques do not supply); null for a reference."),
@@ -157,8 +157,9 @@ METRIC_INFO: dict[str, MetricInfo] = {
 ``int_u2``, ``int_u`` and ``int_abs_u`` is the torque given to :func:`compute_metrics` (body axes),
 the control torque on the rigid body in both scopes, as for ``peak_body_torque``: a reference's
 feed-forward torque, or in closed loop the applied actuator torque less the wheels' gyroscopic
-torque, held over each sample; ``int_actuator_torque`` and the other peaks name what they measure. t_0 … t_N are the sample times of the scored window. A
-metric that does not apply is null (``None``). A reference whose body rate jumps (natural motion's
+torque, held over each sample; ``int_actuator_torque`` and the other peaks name what they
+measure. t_0 … t_N are the sample times of the scored window. A metric that does not apply is
+null (``None``). A reference whose body rate jumps (natural motion's
 step stop, a start away from the manoeuvre's initial rate it does not declare free) asks an
 impulse ``I Δω δ(t − t_j)`` at each jump, which no sampling sees: :func:`compute_metrics` adds it
 (``impulses``), so ``int_u2`` and ``peak_body_torque`` are +inf (:data:`IMPULSE_INFINITE`) and
@@ -563,10 +564,11 @@ def metrics_from_simulation(
     own): the applied actuator torque held over each sample less the wheels' gyroscopic torque
     ``ω × A h_w`` at the start of the sample (without wheels, the applied torque itself).
     ``int_actuator_torque`` and ``peak_actuator_torque`` take the applied actuator torque,
-    ``peak_wheel_torque`` the applied wheel motor torques; the dipole (with magnetorquers) is the applied one; ``inertia`` is the
-    spacecraft's; with a star tracker among the run's sensors, the attitude the controller was
-    given is ``result.sensor_state``'s (``known_q``), and with its exclusions the samples they
-    blinded are ``result.blinded``'s (``star_tracker_blinded_s``, ``star_tracker_blinded_updates``).
+    ``peak_wheel_torque`` the applied wheel motor torques; the dipole (with magnetorquers) is the
+    applied one; ``inertia`` is the spacecraft's; with a star tracker among the run's sensors,
+    the attitude the controller was given is ``result.sensor_state``'s (``known_q``), and with its
+    exclusions the samples they blinded are ``result.blinded``'s (``star_tracker_blinded_s``,
+    ``star_tracker_blinded_updates``).
 
     Parameters
     ----------

@@ -68,7 +68,8 @@ def metrics():
 
 
 def test_every_key_is_tested_here():
-    tested = {"int_u2", "int_u", "int_abs_u", "int_actuator_torque", "peak_body_torque", "peak_actuator_torque", "peak_wheel_torque",
+    tested = {"int_u2", "int_u", "int_abs_u", "int_actuator_torque", "peak_body_torque", "peak_actuator_torque",
+              "peak_wheel_torque",
               "final_error_deg", "final_rate_error", "rms_error_deg",
               "max_error_deg", "settling_time_s", "saturation_fraction", "peak_wheel_momentum", "plan_time_s",
               "duration_s", "initial_rate_error", "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",

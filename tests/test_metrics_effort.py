@@ -45,9 +45,10 @@ def tracked_slew(axis: np.ndarray, angle: float) -> scenarios.Row:
 
 
 def quintic_integrals(axis: np.ndarray, angle: float, points: int = 200001) -> tuple[float, float]:
-    """∫‖u‖ dt and ∫‖I ω̇‖ dt of the quintic θ(t) = θ_f (10 s³ − 15 s⁴ + 6 s⁵), s = t/T, about the
-    fixed ``axis`` e: ω = θ̇ e, u = I ω̇ + ω × I ω = θ̈ I e + θ̇² e × I e, by trapezoids on a fine
-    grid; ∫‖I ω̇‖ dt = ‖I e‖ ∫|θ̈| dt = ‖I e‖ · 2 max θ̇ = ‖I e‖ 15 θ_f / (4 T) in closed form."""
+    """∫‖u‖ dt and ∫‖I ω̇‖ dt of the quintic θ(t) = θ_f (10 s³ − 15 s⁴ + 6 s⁵), s = t/T,
+    about the fixed ``axis`` e: ω = θ̇ e, u = I ω̇ + ω × I ω = θ̈ I e + θ̇² e × I e, by
+    trapezoids on a fine grid; ∫‖I ω̇‖ dt = ‖I e‖ ∫|θ̈| dt = ‖I e‖ · 2 max θ̇
+    = ‖I e‖ 15 θ_f / (4 T) in closed form."""
     s = np.linspace(0.0, 1.0, points)
     rate = angle / SLEW_T * (30 * s**2 - 60 * s**3 + 30 * s**4)
     acceleration = angle / SLEW_T**2 * (60 * s - 180 * s**2 + 120 * s**3)
