@@ -12,7 +12,8 @@ from numpy.typing import ArrayLike, NDArray
 from ocp import quat
 
 METRIC_KEYS: tuple[str, ...] = (
-    "int_u2", "int_u", "int_abs_u", "peak_body_torque", "peak_actuator_torque", "peak_wheel_torque",
+    "int_u2", "int_u", "int_abs_u", "int_actuator_torque", "peak_body_torque", "peak_actuator_torque",
+    "peak_wheel_torque",
     "final_error_deg", "final_rate_error",
     "rms_error_deg", "max_error_deg", "settling_time_s", "saturation_fraction",
     "peak_wheel_momentum", "plan_time_s", "duration_s",
@@ -51,7 +52,10 @@ class MetricInfo(NamedTuple):
 
 METRIC_INFO: dict[str, MetricInfo] = {
     "int_u2": MetricInfo(
-        "N² m² s", "∫ ‖u‖₂² dt over the window: the control effort; +inf for a reference whose body rate "
+        "N² m² s", "∫ ‖u‖₂² dt over the window: the control effort, u the control torque on the rigid body "
+        "(as ``peak_body_torque``: a reference's feed-forward torque; in closed loop the applied actuator "
+        "torque less the wheels' gyroscopic torque, so that a tracked reference's closed loop approaches the "
+        "reference's value); +inf for a reference whose body rate "
         "jumps (an impulse, whose square has no finite integral: shown as missing in the tables).",
         null_worst_when="int_u"),
     "int_u": MetricInfo(
@@ -61,6 +65,13 @@ METRIC_INFO: dict[str, MetricInfo] = {
         "N m s", "[∫ |u_x| dt, ∫ |u_y| dt, ∫ |u_z| dt], one integral per body axis (a list of three; "
         "the CSV tables split it into ``_x``, ``_y``, ``_z`` columns); a reference's rate jumps add "
         "|(I Δω)_i| (as ``int_u``)."),
+    "int_actuator_torque": MetricInfo(
+        "N m s", "Closed loop: ∫ ‖τ_act‖₂ dt, τ_act the actuators' applied torque on the body (wheels "
+        "−A g, magnetorquers m × B, torquers; as ``peak_actuator_torque``), zero-order hold: what the "
+        "actuators did. Without wheels it equals ``int_u``; with wheels τ_act = u + ω × A h_w differs from ``int_u``'s "
+        "u by the wheels' gyroscopic torque (with the total momentum zero, −ω × A h_w = ω × I ω: the "
+        "body's own gyroscopic torque, which a reference's feed-forward and ``int_u`` contain and the "
+        "wheels' motor torques do not supply); null for a reference."),
     "peak_body_torque": MetricInfo(
         "N m", "max over the samples and the body axes of |u_i|, u the control torque on the rigid body of "
         "I ω̇ = −ω × I ω + u: a reference's feed-forward torque (I ω̇ + ω × I ω); in closed loop the applied "
@@ -143,10 +154,12 @@ METRIC_INFO: dict[str, MetricInfo] = {
         "exclusion dropped (the estimator only propagated); null without exclusions."),
 }
 """Unit and definition of every key of :data:`METRIC_KEYS`, in the same order. ``u`` in the integrals
-``int_u2``, ``int_u`` and ``int_abs_u`` is the torque given to :func:`compute_metrics` (body axes): a
-reference's feed-forward torque, or in closed loop the applied actuator torque held over each
-sample; the peaks name what they measure. t_0 … t_N are the sample times of the scored window. A
-metric that does not apply is null (``None``). A reference whose body rate jumps (natural motion's
+``int_u2``, ``int_u`` and ``int_abs_u`` is the torque given to :func:`compute_metrics` (body axes),
+the control torque on the rigid body in both scopes, as for ``peak_body_torque``: a reference's
+feed-forward torque, or in closed loop the applied actuator torque less the wheels' gyroscopic
+torque, held over each sample; ``int_actuator_torque`` and the other peaks name what they
+measure. t_0 … t_N are the sample times of the scored window. A metric that does not apply is
+null (``None``). A reference whose body rate jumps (natural motion's
 step stop, a start away from the manoeuvre's initial rate it does not declare free) asks an
 impulse ``I Δω δ(t − t_j)`` at each jump, which no sampling sees: :func:`compute_metrics` adds it
 (``impulses``), so ``int_u2`` and ``peak_body_torque`` are +inf (:data:`IMPULSE_INFINITE`) and
@@ -278,9 +291,10 @@ def compute_metrics(
     omega : (N+1, 3) array_like
         Body rate with respect to the inertial frame at ``t`` [rad/s], body axes.
     torque : (N, 3) or (N+1, 3) array_like
-        Torque of the integrals ``int_u2``, ``int_u``, ``int_abs_u`` [N m], body axes: held over
-        each interval (closed loop: the applied actuator torque, zero-order hold), or sampled at
-        ``t`` (a reference's feed-forward, trapezoids).
+        Torque of the integrals ``int_u2``, ``int_u``, ``int_abs_u`` [N m], body axes, the control
+        torque on the rigid body: held over each interval (closed loop: the applied actuator
+        torque less the wheels' gyroscopic torque, zero-order hold), or sampled at ``t`` (a
+        reference's feed-forward, trapezoids).
     target_q : (4,) or (N+1, 4) array_like or None
         The manoeuvre's final attitude, or the target's attitude at each of ``t`` (a target that
         moves: :func:`target_motion`); ``None``: free (attitude metrics null).
@@ -315,10 +329,10 @@ def compute_metrics(
         :data:`DEFAULT_DETUMBLE_TOLERANCE`).
     body_torque : (N, 3) or (N+1, 3) array_like or None, optional
         The control torque on the rigid body ``u`` of ``I ω̇ = −ω × I ω + u`` [N m], body axes,
-        for ``peak_body_torque``; ``None``: ``torque`` (a reference's feed-forward is that torque).
+        for ``peak_body_torque``; ``None`` (default): ``torque``, which is that torque.
     actuator_torque : (N, 3) array_like or None, optional
-        The actuators' applied torque on the body [N m], body axes, for ``peak_actuator_torque``;
-        ``None``: null (a reference).
+        The actuators' applied torque on the body [N m], body axes, held over each interval, for
+        ``int_actuator_torque`` and ``peak_actuator_torque``; ``None``: null (a reference).
     wheel_torque : (N, n_w) array_like or None, optional
         Applied wheel motor torques [N m] for ``peak_wheel_torque``; ``None`` or empty: null.
     known_q : (N, 4) array_like or None, optional
@@ -350,6 +364,8 @@ def compute_metrics(
         "int_u2": float(_integrate(t, norms**2)),
         "int_u": float(_integrate(t, norms)),
         "int_abs_u": [float(v) for v in _integrate(t, np.abs(torque))],
+        "int_actuator_torque": None if actuator_torque is None
+        else float(_integrate(t, np.linalg.norm(np.asarray(actuator_torque, dtype=float), axis=1))),
         "peak_body_torque": _peak(torque if body_torque is None else body_torque, 0.0),
         "peak_actuator_torque": _peak(actuator_torque, None),
         "peak_wheel_torque": _peak(wheel_torque, None),
@@ -542,14 +558,17 @@ def metrics_from_simulation(
 ) -> dict[str, Any]:
     """Closed-loop metrics of a simulation, by :func:`compute_metrics`.
 
-    The integrals' torque is the applied actuator torque held over each sample, and so is
-    ``peak_actuator_torque``'s; ``peak_body_torque`` takes that torque less the wheels'
-    gyroscopic torque ``ω × A h_w`` at the start of each sample (the ``u`` of
-    ``I ω̇ = −ω × I ω + u`` the allocation realised), ``peak_wheel_torque`` the applied wheel
-    motor torques; the dipole (with magnetorquers) is the applied one; ``inertia`` is the
-    spacecraft's; with a star tracker among the run's sensors, the attitude the controller was
-    given is ``result.sensor_state``'s (``known_q``), and with its exclusions the samples they
-    blinded are ``result.blinded``'s (``star_tracker_blinded_s``, ``star_tracker_blinded_updates``).
+    The torque of ``int_u2``, ``int_u``, ``int_abs_u`` and ``peak_body_torque`` is the control
+    torque on the rigid body, the ``u`` of ``I ω̇ = −ω × I ω + u`` the allocation realised, as a
+    reference's feed-forward is (so that a tracked reference's closed-loop integrals approach its
+    own): the applied actuator torque held over each sample less the wheels' gyroscopic torque
+    ``ω × A h_w`` at the start of the sample (without wheels, the applied torque itself).
+    ``int_actuator_torque`` and ``peak_actuator_torque`` take the applied actuator torque,
+    ``peak_wheel_torque`` the applied wheel motor torques; the dipole (with magnetorquers) is the
+    applied one; ``inertia`` is the spacecraft's; with a star tracker among the run's sensors,
+    the attitude the controller was given is ``result.sensor_state``'s (``known_q``), and with its
+    exclusions the samples they blinded are ``result.blinded``'s (``star_tracker_blinded_s``,
+    ``star_tracker_blinded_updates``).
 
     Parameters
     ----------
@@ -594,19 +613,45 @@ def metrics_from_simulation(
     slices = result.model.control_slices
     dipole = result.applied_u[:, slices["dipole"]] if "dipole" in slices else None
     wheel_torque = result.applied_u[:, slices["wheels"]] if "wheels" in slices else None
-    stored = result.wheel_momentum[:-1] @ result.model.spacecraft.wheel_axes.T  # A h_w, body axes
-    body_torque = result.applied_torque - np.cross(result.omega[:-1], stored)
     return compute_metrics(
-        result.t, result.q, result.omega, result.applied_torque, target_q, target_omega,
+        result.t, result.q, result.omega, _rigid_body_torque(result), target_q, target_omega,
         reference_q=None if reference is None else reference.q(result.t),
         wheel_momentum=result.wheel_momentum if result.wheel_momentum.shape[1] else None,
         saturated=result.saturated, plan_time_s=plan_time_s, duration_s=duration_s,
         settling_tolerance_deg=settling_tolerance_deg,
         fine_settling_tolerance_deg=fine_settling_tolerance_deg, dipole=dipole,
         inertia=result.model.spacecraft.inertia, detumble_tolerance=detumble_tolerance,
-        body_torque=body_torque, actuator_torque=result.applied_torque, wheel_torque=wheel_torque,
+        actuator_torque=result.applied_torque, wheel_torque=wheel_torque,
         known_q=_known_attitude(result), **_blinding(result),
     )
+
+
+def _rigid_body_torque(result: Any) -> NDArray:
+    """The control torque on the rigid body that a closed loop realised, held over each sample:
+    the ``u`` of ``I ω̇ = −ω × I ω + u``, comparable with a reference's feed-forward torque.
+
+    With wheels the actuators' torque on the body ``τ_act`` (``−A g``, plus magnetorquers and
+    torquers) is not that ``u``: the body with its wheels obeys
+    ``I ω̇ = −ω × (I ω + A h_w) + τ_act``, so ``u = τ_act − ω × A h_w``, taken at the start of each
+    sample (the hold's ``ω_k`` and ``h_w,k``). Without wheels ``u`` is ``τ_act`` itself (the same
+    array, no arithmetic).
+
+    Parameters
+    ----------
+    result : ocp.simulation.simulator.SimulationResult
+        The simulated run: ``omega`` (N+1, 3) [rad/s] and ``wheel_momentum`` (N+1, n_w) [N m s] at
+        the sample times, ``applied_torque`` (N, 3) [N m] held over each sample, body axes, and
+        its ``model``'s wheel axes ``A`` (3, n_w).
+
+    Returns
+    -------
+    (N, 3) ndarray
+        ``u`` [N m], body axes, one row per held sample.
+    """
+    if not result.wheel_momentum.shape[1]:
+        return np.asarray(result.applied_torque)
+    stored = result.wheel_momentum[:-1] @ result.model.spacecraft.wheel_axes.T  # A h_w, body axes
+    return np.asarray(result.applied_torque - np.cross(result.omega[:-1], stored))
 
 
 def _blinding(result: Any) -> dict[str, Any]:

@@ -68,7 +68,8 @@ def metrics():
 
 
 def test_every_key_is_tested_here():
-    tested = {"int_u2", "int_u", "int_abs_u", "peak_body_torque", "peak_actuator_torque", "peak_wheel_torque",
+    tested = {"int_u2", "int_u", "int_abs_u", "int_actuator_torque", "peak_body_torque", "peak_actuator_torque",
+              "peak_wheel_torque",
               "final_error_deg", "final_rate_error", "rms_error_deg",
               "max_error_deg", "settling_time_s", "saturation_fraction", "peak_wheel_momentum", "plan_time_s",
               "duration_s", "initial_rate_error", "detumble_time_s", "int_dipole", "final_rate", "energy_ratio",
@@ -107,13 +108,19 @@ def test_star_tracker_blinding_by_hand():
 
 
 def test_zero_order_hold_integrals(metrics):
+    """The integrals of the body torque: HELD less ω × A h_w at the start of each sample; only the
+    first sample turns, ω = [0.02, 0, 0] with h_w = [0, 0.1, 0] on body-axis wheels: ω × A h_w =
+    [0, 0, 0.002]. ``int_actuator_torque`` integrates HELD itself."""
     dt = [1.0, 1.5, 0.5, 2.0]
-    int_u2 = sum(d * (a * a + b * b + c * c) for d, (a, b, c) in zip(dt, HELD))
-    int_u = sum(d * math.sqrt(a * a + b * b + c * c) for d, (a, b, c) in zip(dt, HELD))
-    int_abs = [sum(d * abs(row[i]) for d, row in zip(dt, HELD)) for i in range(3)]
+    body = [(0.03, -0.04, -0.002)] + [tuple(row) for row in HELD[1:]]
+    int_u2 = sum(d * (a * a + b * b + c * c) for d, (a, b, c) in zip(dt, body))
+    int_u = sum(d * math.sqrt(a * a + b * b + c * c) for d, (a, b, c) in zip(dt, body))
+    int_abs = [sum(d * abs(row[i]) for d, row in zip(dt, body)) for i in range(3)]
     assert metrics["int_u2"] == pytest.approx(int_u2, rel=1e-12)
     assert metrics["int_u"] == pytest.approx(int_u, rel=1e-12)
     assert metrics["int_abs_u"] == pytest.approx(int_abs, rel=1e-12)
+    applied = sum(d * math.sqrt(a * a + b * b + c * c) for d, (a, b, c) in zip(dt, HELD))
+    assert metrics["int_actuator_torque"] == pytest.approx(applied, rel=1e-12)
     assert metrics["peak_actuator_torque"] == pytest.approx(0.05, rel=1e-12)  # |−0.05|, a negative component
 
 
@@ -139,9 +146,10 @@ def test_tracking_errors(metrics):
     assert metrics["max_error_deg"] == pytest.approx(3.0, rel=1e-9)
 
 
-def test_peak_body_and_wheel_torques_by_hand():
-    """Two wheels on x and y holding momentum: the body torque is the applied actuator torque less
-    ω × A h_w at the start of each sample, the wheel torque the applied motor torque."""
+def test_body_and_wheel_torques_by_hand():
+    """Two wheels on x and y holding momentum: the body torque, of the peak and the integrals, is
+    the applied actuator torque less ω × A h_w at the start of each sample, the wheel torque the
+    applied motor torque."""
     axes = np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
     spacecraft = Spacecraft([2.0, 3.0, 4.0], wheels=ReactionWheels(axes=axes, max_torque=0.1))
     t = np.array([0.0, 1.0, 3.0])
@@ -156,6 +164,10 @@ def test_peak_body_and_wheel_torques_by_hand():
     # sample 0: ω × A h = [0, 0, 0.5] × [0.2, −0.1, 0] = [0.05, 0.1, 0]; u = [−0.06, −0.08, 0]
     # sample 1: [0.1, 0, 0] × [0, 0.3, 0] = [0, 0, 0.03]; u = [−0.004, −0.003, −0.03]
     assert metrics["peak_body_torque"] == pytest.approx(0.08, rel=1e-12)
+    assert metrics["int_u"] == pytest.approx(1.0 * 0.1 + 2.0 * math.sqrt(0.004**2 + 0.003**2 + 0.03**2), rel=1e-12)
+    assert metrics["int_abs_u"] == pytest.approx([0.06 + 2 * 0.004, 0.08 + 2 * 0.003, 2 * 0.03], rel=1e-12)
+    assert metrics["int_u2"] == pytest.approx(0.01 + 2.0 * (0.004**2 + 0.003**2 + 0.03**2), rel=1e-12)
+    assert metrics["int_actuator_torque"] == pytest.approx(math.sqrt(0.01**2 + 0.02**2) + 2.0 * 0.005, rel=1e-12)
     assert metrics["peak_actuator_torque"] == pytest.approx(0.02, rel=1e-12)
     assert metrics["peak_wheel_torque"] == pytest.approx(0.02, rel=1e-12)
 
@@ -192,6 +204,7 @@ def test_reference_integrals_against_closed_forms():
     assert metrics["int_abs_u"] == pytest.approx([a * T**2 / 2, abs(b) * T, 0.0], rel=1e-9)
     assert metrics["peak_body_torque"] == pytest.approx(max(a * T, abs(b)))
     assert metrics["peak_actuator_torque"] is None and metrics["peak_wheel_torque"] is None  # closed loop only
+    assert metrics["int_actuator_torque"] is None
     assert metrics["final_rate_error"] == pytest.approx(0.1)
     assert metrics["initial_rate_error"] == pytest.approx(0.05)  # ‖[0, −0.03, 0.04]‖
     assert metrics["duration_s"] == T and metrics["final_error_deg"] is None
