@@ -196,7 +196,7 @@ def test_min_norm_spends_less_than_snlc_with_the_same_gains():
     _, mn = run("min_norm", options, duration=3000.0)
     m_snlc, m_mn = (metrics_from_simulation(r, problem.qf, problem.omegaf) for r in (snlc, mn))
     assert m_snlc["final_error_deg"] < 0.01 and m_mn["final_error_deg"] < 0.01
-    assert m_mn["int_u"] < 0.9 * m_snlc["int_u"]
+    assert m_mn["int_actuator_torque"] < 0.9 * m_snlc["int_actuator_torque"]  # the paper's u: the wheels' torque
 
 
 class PrintedSign(MinNorm):

@@ -79,7 +79,7 @@ for law, row in laws.items():
     table[law] = {"22.96° [s]": metrics["settling_time_s"], "16.22° [s]": fine,
                   "0.5° [s]": "not within 10,000 s" if half_degree is None else half_degree,
                   "∫‖u‖ to 16.22° [N m s]": to_fine["int_u"],
-                  "∫‖u‖ 0-10,000 s [N m s]": metrics["int_u"]}
+                  "∫‖u‖ 0-10,000 s [N m s]": metrics["int_actuator_torque"]}  # u: the wheels' torque
 with pd.option_context("display.float_format", "{:.4g}".format):
     print(pd.DataFrame(table).T.to_string())
 

@@ -45,10 +45,13 @@ for row in rows.values():
 # [0.1013, 0.1252, 0.0973] N m s, so the natural motion saves 82 % of the total torque.
 #
 # What reproduces is the ranking: the natural motion needs the least torque, and less than a
-# smooth eigenaxis reference tracked by the same law. **Discrepancy recorded**: our totals are 16
-# (natural motion) and 37 (PD law) times smaller than the paper's, whose gains, sample time, noise
-# and perturbations are not given, so its magnitudes cannot be reproduced; the saving is 59 % in
-# ``REPRODUCTION.md`` (paper 82 %). A physical floor limits it for a rest-to-rest slew: any such
+# smooth eigenaxis reference tracked by the same law. **Discrepancy recorded**: our totals are 24
+# (natural motion) and 35 (PD law) times smaller than the paper's, whose gains, sample time, noise
+# and perturbations are not given, so its magnitudes cannot be reproduced; the saving is 74 % in
+# ``REPRODUCTION.md`` (paper 82 %). ``int_abs_u`` is the control torque on the rigid body in both
+# scopes (``docs/metrics.rst``); in the wheels' own torque, which leaves out the gyroscopic torque
+# their stored momentum supplies, the saving is 59 % (which of the two the paper integrates is not
+# established). A physical floor limits it for a rest-to-rest slew: any such
 # manoeuvre must spin up and stop, so a natural arc saves only the mid-course torque (the
 # momentum to give the body at the start is printed below).
 paper = {"natural motion": [0.0195, 0.0152, 0.0243], "eigenaxis_pd": [0.1013, 0.1252, 0.0973]}
@@ -68,8 +71,8 @@ spin_up = natural_reference.inertia @ natural_reference.omega(0.0)
 print(f"spin-up momentum of the natural arc |I ω*(0)| = {np.linalg.norm(spin_up):.2e} N m s")
 
 # %%
-# ``REPRODUCTION.md`` records, for the natural motion, ∫|u| = [0.00036, 0.00157, 0.00171] N m s
-# (Σ 0.0036, a 59 % saving) and a torque that peaks at 1.24e-3 N m while the body spins up (paper:
+# ``REPRODUCTION.md`` records, for the natural motion, ∫|u| = [0.00036, 0.00100, 0.00111] N m s
+# (Σ 0.0025, a 74 % saving; the wheels' torque [0.00036, 0.00157, 0.00171], Σ 0.0036, 59 %) and a torque that peaks at 1.24e-3 N m while the body spins up (paper:
 # "of the order of 1e-3 N m"), and once more, 7.7e-3 N m for a single sample, at 100 s, where the
 # reference's rate steps to zero (``stop: step``) and the hold-compensated feed-forward puts that
 # step into one 0.1 s hold (its values before that feed-forward, Σ 0.0039 and a 1.3e-3 N m peak,

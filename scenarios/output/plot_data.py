@@ -1246,7 +1246,7 @@ def plot_jobs(results: Any, stems: list[str] | None = None, euler_sequence: str 
 SCOPE_NAMES = {"ref": "reference", "cl": "closed-loop"}
 """How a column's scope prefix (``ref.``, ``cl.``) reads on an axis."""
 METRIC_NAMES = {"int_u2": "∫‖u‖² dt", "int_u": "∫‖u‖ dt", "int_abs_u": "∫|u_i| dt",
-                "int_dipole": "∫‖m‖ dt", "rms_error_deg": "RMS error", "duration_s": "manoeuvre time",
+                "int_dipole": "∫‖m‖ dt", "int_actuator_torque": "∫‖τ_act‖ dt", "rms_error_deg": "RMS error", "duration_s": "manoeuvre time",
                 "plan_time_s": "plan time"}
 """Metrics whose key does not read as words (the others: the key without its unit suffix, spaced)."""
 
