@@ -27,6 +27,7 @@ import atexit
 import collections
 import contextlib
 import json
+import logging
 import math
 import multiprocessing
 import os
@@ -754,9 +755,20 @@ def _identity(address: str, timeout_s: float) -> dict[str, Any]:
         pool.shutdown(wait=False)
 
 
+def _drop(record: logging.LogRecord) -> bool:
+    """A logging filter that passes nothing."""
+    return False
+
+
 @dataclass
 class DaskCluster:
-    """A Dask cluster the sweep connected to (:func:`connect_scheduler`).
+    """A Dask cluster the sweep connected to (:func:`connect_scheduler`), and a context manager
+    that closes its client on leaving the block.
+
+    Close the client before the cluster's scheduler stops (``with LocalCluster(...) as cluster,
+    connect_scheduler(cluster.scheduler_address) as dask:`` closes ``dask`` first): a client whose
+    scheduler went away tries to reconnect in the background and Dask logs ``Failed to reconnect
+    to scheduler ...`` as an error.
 
     Parameters
     ----------
@@ -786,8 +798,27 @@ class DaskCluster:
         return sum(int(worker.get("nthreads", 1)) for worker in info.get("workers", {}).values())
 
     def close(self) -> None:
-        """Close the client (the cluster goes on)."""
-        self.client.close()
+        """Close the client (the cluster goes on); closing it again does nothing. A client whose
+        scheduler already went away is closed without Dask's reconnection error in the log."""
+        if self.client.status == "closed":
+            return
+        if self.client.status != "connecting":
+            self.client.close()
+            return
+        # the scheduler is gone and the client is retrying it: its giving up is no news here (for
+        # the moment of the close, the filter holds back any other client's records too)
+        logger = logging.getLogger("distributed.client")
+        logger.addFilter(_drop)
+        try:
+            self.client.close()
+        finally:
+            logger.removeFilter(_drop)
+
+    def __enter__(self) -> DaskCluster:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
 
 
 def connect_scheduler(address: str, where: str = "execution.scheduler", wait_s: float | None = None) -> DaskCluster:
@@ -807,7 +838,7 @@ def connect_scheduler(address: str, where: str = "execution.scheduler", wait_s: 
     Returns
     -------
     DaskCluster
-        The connected client.
+        The connected client: close it with ``close()``, or connect in a ``with`` block.
 
     Raises
     ------
