@@ -37,13 +37,14 @@ from scenarios.cli.sweep import add_sweep_parser
 from scenarios.cli.table import add_table_parser
 from scenarios.errors import OutputError, ScenarioError
 from scenarios.output.directory import (
+    check_output_directory,
     claim_output_directory,
     written_files,
 )
 from scenarios.output.export import EXPORT_FORMATS, default_export_directory, export_run
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
-from scenarios.output.writer import plot_streamer, run_files
+from scenarios.output.writer import check_run_directory, plot_streamer, run_files
 from scenarios.runner import final_accuracy_note, run
 from scenarios.schema.labels import row_labels
 from scenarios.schema.loader import (
@@ -276,8 +277,12 @@ def command_run(args: argparse.Namespace) -> int:
     exports = getattr(args, "export", None) or []
     for name in exports:  # before planning: an export the run cannot give is refused first
         _check_run_export(name, scenario.epoch)
-    # before planning: a long run is never lost at the end (a user's file among the run's is refused now)
-    claim_output_directory(out, expected=run_files(scenario, plots=not args.no_plots))
+    # before planning: a long run is never lost at the end (a user's file among the run's, or another
+    # scenario's run, is refused now); every directory is checked before any is claimed
+    check_run_directory(out, scenario.name, run_files(scenario, plots=not args.no_plots))
+    for name in exports:
+        check_output_directory(default_export_directory(out, name), kind="export")
+    claim_output_directory(out)
     for name in exports:
         claim_output_directory(default_export_directory(out, name), kind="export")
     start = time.perf_counter()
