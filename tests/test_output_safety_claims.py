@@ -140,3 +140,23 @@ def test_the_library_refuses_to_write_a_run_over_another_scenarios(tmp_path):
     with pytest.raises(OutputError, match="'first', not 'second'"):
         other.write(out, plots=False)
     assert snapshot(out) == before
+
+
+def test_a_stored_case_is_not_rerun_over_another_scenarios_run(tmp_path, capsys):
+    from tests.test_study_plots_progress import STUDY
+
+    study = tmp_path / "study.yaml"
+    study.write_text(STUDY)  # its cases' scenario is named "tiny"
+    swept = tmp_path / "swept"
+    assert main(["sweep", str(study), "--out", str(swept), "--no-plots", "--workers", "1"]) == 0
+    other = tmp_path / "other"
+    assert main(["run", str(scenario(tmp_path, name="other")), "--out", str(other), "--no-plots"]) == 0
+    before = snapshot(other)
+    capsys.readouterr()
+    assert main(["sweep", str(swept), "--case", "1", "--out", str(other), "--no-plots"]) == 2
+    captured = capsys.readouterr()
+    assert "'other', not 'tiny'" in captured.err
+    assert "case 1" not in captured.out  # refused before the case re-ran
+    assert snapshot(other) == before
+    assert main(["sweep", str(swept), "--case", "1", "--out", str(tmp_path / "case1"), "--no-plots"]) == 0
+    assert main(["sweep", str(swept), "--case", "2", "--out", str(tmp_path / "case1"), "--no-plots"]) == 0
