@@ -51,7 +51,8 @@ def test_a_foreign_export_directory_leaves_the_run_directory_unmade(tmp_path, ca
     (foreign / "x").write_text("keep")
     assert main(["run", str(path), "--out", str(tmp_path / "sl4"), "--no-plots", "--export", "aem"]) == 2
     error = capsys.readouterr().err
-    assert "sl4-aem" in error and "nothing was touched" in error
+    assert "sl4-aem" in error and "nothing was touched" in error and "`--export aem` writes" in error
+    assert "output error: --out" not in error  # the export directory is not the one given as --out
     assert not (tmp_path / "sl4").exists()
     assert snapshot(foreign) == {"x": b"keep"} and sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml", "sl4-aem"]
 
