@@ -37,13 +37,14 @@ from scenarios.cli.sweep import add_sweep_parser
 from scenarios.cli.table import add_table_parser
 from scenarios.errors import OutputError, ScenarioError
 from scenarios.output.directory import (
+    check_output_directory,
     claim_output_directory,
     written_files,
 )
 from scenarios.output.export import EXPORT_FORMATS, default_export_directory, export_run
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
-from scenarios.output.writer import plot_streamer, run_files
+from scenarios.output.writer import check_run_directory, plot_streamer, run_files
 from scenarios.runner import final_accuracy_note, run
 from scenarios.schema.labels import row_labels
 from scenarios.schema.loader import (
@@ -276,8 +277,16 @@ def command_run(args: argparse.Namespace) -> int:
     exports = getattr(args, "export", None) or []
     for name in exports:  # before planning: an export the run cannot give is refused first
         _check_run_export(name, scenario.epoch)
-    # before planning: a long run is never lost at the end (a user's file among the run's is refused now)
-    claim_output_directory(out, expected=run_files(scenario, plots=not args.no_plots))
+    # before planning: a long run is never lost at the end (a user's file among the run's, or another
+    # scenario's run, is refused now); every directory is checked before any is claimed
+    check_run_directory(out, scenario.name, run_files(scenario, plots=not args.no_plots))
+    for name in exports:
+        try:
+            check_output_directory(default_export_directory(out, name), kind="export")
+        except OutputError as error:
+            raise OutputError(error.path, f"{error.message} (`--export {name}` writes beside the run, into "
+                                          f"<out>-{name}: move that directory or choose another --out)") from None
+    claim_output_directory(out)
     for name in exports:
         claim_output_directory(default_export_directory(out, name), kind="export")
     start = time.perf_counter()
@@ -497,6 +506,15 @@ def _interrupted(args: argparse.Namespace) -> int:
     return int(getattr(args, "interrupted_status", EXIT_INTERNAL))
 
 
+def _names(given: str, path: Path) -> bool:
+    """Whether ``path`` is the directory given on the command line, or inside it."""
+    try:
+        directory, path = Path(given).expanduser().absolute(), path.expanduser().absolute()
+    except (RuntimeError, OSError, ValueError):  # a ~user that does not exist: named as given
+        return True
+    return path == directory or directory in path.parents
+
+
 def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     """Run the ``slewbench`` command line.
 
@@ -545,7 +563,8 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         return EXIT_BAD_SCENARIO
     except OutputError as error:
         given = "--report" if getattr(args, "report", None) else "--out" if getattr(args, "out", None) else None
-        where = f"{given} " if given else ""  # the default results/<name> was not given as --out
+        # not for the default results/<name>, nor for another directory (run --export's <out>-<format>)
+        where = f"{given} " if given and _names(getattr(args, given[2:]), error.path) else ""
         print(f"slewbench: output error: {where}{error}", file=sys.stderr)
         return EXIT_BAD_OUTPUT
     except BrokenPipeError:  # `slewbench list | head`: the reader has gone; nothing is lost

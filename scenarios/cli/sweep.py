@@ -33,6 +33,7 @@ from scenarios.output.directory import MARKER, claim_output_directory, written_f
 from scenarios.output.names import default_output_directory
 from scenarios.output.provenance import package_version
 from scenarios.output.tables import is_missing
+from scenarios.output.writer import check_run_directory
 
 if TYPE_CHECKING:  # the trade-study machinery is imported by the handlers: `slewbench run` does not load it
     from scenarios.study.engine import DaskCluster
@@ -132,7 +133,9 @@ def command_case(args: argparse.Namespace) -> int:
         raise ScenarioError("--case", f"expected a case of the study, 0 to {len(cases) - 1}, got {args.case}")
     case = cases[args.case]
     out = Path(args.out) if args.out else directory / CASE_FOLDER / str(args.case)
-    claim_output_directory(out)  # before running: a long case is never lost at the end
+    # before running: a long case is never lost at the end (a directory holding another scenario's run is refused)
+    check_run_directory(out, str(case.scenario.get("name", "")))
+    claim_output_directory(out)
     varied = ", ".join(f"{path}={value}" for path, value in case.varied.items())
     print(f"{results.study.name}: case {case.index} (grid point {case.point}, seed {case.seed})"
           + (f": {varied}" if varied else ""), flush=True)

@@ -20,6 +20,7 @@ The rules (:doc:`/outputs`, "What slewbench writes, and what it never touches"):
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import hashlib
 import json
@@ -33,8 +34,8 @@ from typing import Any
 from scenarios.errors import OutputError
 from scenarios.schema.read import read_bounded
 
-__all__ = ["MARKER", "STAGING_PREFIX", "changed_files", "claim_output_directory", "commit_outputs", "new_staging",
-           "read_manifest", "write_manifest", "written_files"]
+__all__ = ["MARKER", "STAGING_PREFIX", "changed_files", "check_output_directory", "claim_output_directory",
+           "commit_outputs", "new_staging", "read_manifest", "write_manifest", "written_files"]
 
 MARKER = ".slewbench-output.json"
 STAGING_PREFIX = ".slewbench-staging-"
@@ -240,11 +241,76 @@ def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: 
     os.replace(temporary, directory / MARKER)
 
 
+def check_output_directory(path: str | Path, kind: str = "run", expected: Iterable[str] = ()) -> Path:
+    """Every check :func:`claim_output_directory` makes, writing nothing: a command that writes into
+    more than one directory (``run --export``) checks each before it claims any, so that a refusal
+    leaves every one of them as it was.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output directory.
+    kind : str, optional
+        What writes there (``"run"``, ``"sweep"``, ``"codegen"``).
+    expected : iterable of str, optional
+        Files (relative paths) the command may write (as :func:`claim_output_directory`).
+
+    Returns
+    -------
+    Path
+        The absolute directory.
+
+    Raises
+    ------
+    OutputError
+        As :func:`claim_output_directory`; a location the process has no write permission for too
+        (the claim's probe file finds what the permissions do not show).
+    """
+    directory = Path(path).expanduser().absolute()
+    try:
+        if directory.is_symlink() or (directory.exists() and not directory.is_dir()):
+            raise OutputError(path, "exists and is not a directory; slewbench writes only into a new, "
+                                    "empty or slewbench-made directory")
+        if directory.is_dir():
+            manifest = read_manifest(directory)
+            if manifest is None and any(directory.iterdir()):
+                raise OutputError(path, f"is a directory that slewbench did not create (no {MARKER} in it) and is "
+                                        "not empty; choose a new or empty directory, nothing was touched")
+            if manifest is not None and manifest.get("kind", kind) != kind and manifest["files"]:
+                raise OutputError(path, f"holds slewbench {manifest.get('kind')} output; write the {kind} output "
+                                        "into a directory of its own, nothing was touched")
+            if manifest is not None:  # before running: a long run is not refused at its end
+                _refuse_changed(path, directory, manifest, "nothing was touched")
+                listed = set(manifest["files"])
+                foreign = [name for name in dict.fromkeys(expected)
+                           if name not in listed and os.path.lexists(directory / name)]
+                if foreign:
+                    shown = ", ".join(foreign[:5]) + (f" and {len(foreign) - 5} more" if len(foreign) > 5 else "")
+                    raise OutputError(path, f"holds files slewbench did not write ({shown}) that this {kind} would "
+                                            "write; nothing was touched: move them or choose another --out")
+            writable = directory
+        else:
+            writable = next(parent for parent in directory.parents if parent.exists())
+            if not writable.is_dir():
+                raise OutputError(path, f"its parent {writable} is not a directory")
+            longest = os.pathconf(writable, "PC_NAME_MAX")
+            if any(len(os.fsencode(part)) > longest for part in directory.relative_to(writable).parts):
+                raise OutputError(path, f"cannot be written: {os.strerror(errno.ENAMETOOLONG)}")
+        if not os.access(writable, os.W_OK | os.X_OK):
+            raise OutputError(path, f"cannot be written: no permission to write in {writable}, nothing was touched")
+    except OutputError:
+        raise
+    except OSError as error:
+        raise OutputError(path, f"cannot be written: {error.strerror or error}") from None
+    return directory
+
+
 def claim_output_directory(path: str | Path, kind: str = "run", expected: Iterable[str] = ()) -> Path:
     """Make ``path`` a slewbench output directory, or refuse without touching anything.
 
     Accepted: a path that does not exist (it is created, with missing parents, and marked), an
-    empty directory (marked), or a directory that already carries slewbench's marker. Leftover
+    empty directory (marked), or a directory that already carries slewbench's marker
+    (:func:`check_output_directory` checks all this first). Leftover
     staging folders of an interrupted run inside a marked directory are removed. Writability is
     checked with a probe file, so that a run never fails at its end for want of permission.
 
@@ -271,45 +337,19 @@ def claim_output_directory(path: str | Path, kind: str = "run", expected: Iterab
         a name too long for the file system, a location that cannot be written, or an
         ``expected`` file that slewbench did not write.
     """
-    directory = Path(path).expanduser().absolute()
+    directory = check_output_directory(path, kind, expected)
     try:
-        if directory.is_symlink() or (directory.exists() and not directory.is_dir()):
-            raise OutputError(path, "exists and is not a directory; slewbench writes only into a new, "
-                                    "empty or slewbench-made directory")
         if directory.is_dir():
-            manifest = read_manifest(directory)
-            if manifest is None and any(directory.iterdir()):
-                raise OutputError(path, f"is a directory that slewbench did not create (no {MARKER} in it) and is "
-                                        "not empty; choose a new or empty directory, nothing was touched")
-            if manifest is None:
+            if read_manifest(directory) is None:  # an empty directory
                 write_manifest(directory, [], complete=False, kind=kind)
-            elif manifest.get("kind", kind) != kind and manifest["files"]:
-                raise OutputError(path, f"holds slewbench {manifest.get('kind')} output; write the {kind} output "
-                                        "into a directory of its own, nothing was touched")
-            if manifest is not None:  # before running: a long run is not refused at its end
-                _refuse_changed(path, directory, manifest, "nothing was touched")
-                listed = set(manifest["files"])
-                foreign = [name for name in dict.fromkeys(expected)
-                           if name not in listed and os.path.lexists(directory / name)]
-                if foreign:
-                    shown = ", ".join(foreign[:5]) + (f" and {len(foreign) - 5} more" if len(foreign) > 5 else "")
-                    raise OutputError(path, f"holds files slewbench did not write ({shown}) that this {kind} would "
-                                            "write; nothing was touched: move them or choose another --out")
             for leftover in directory.glob(f"{STAGING_PREFIX}*"):
                 if leftover.is_dir() and not leftover.is_symlink() and _abandoned(leftover):
                     shutil.rmtree(leftover, ignore_errors=True)
         else:
-            for parent in directory.parents:
-                if parent.exists():
-                    if not parent.is_dir():
-                        raise OutputError(path, f"its parent {parent} is not a directory")
-                    break
             directory.mkdir(parents=True)
             write_manifest(directory, [], complete=False, kind=kind)
         probe = tempfile.NamedTemporaryFile(prefix=".slewbench-probe-", dir=directory)
         probe.close()
-    except OutputError:
-        raise
     except OSError as error:
         raise OutputError(path, f"cannot be written: {error.strerror or error}") from None
     return directory

@@ -5,6 +5,7 @@ row, the figures and the interactive report, staged and committed together
 from __future__ import annotations
 
 import csv
+import json
 import shutil
 import sys
 from collections.abc import Callable, Iterator
@@ -13,10 +14,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from scenarios.errors import OutputError
 from scenarios.output.directory import (
+    check_output_directory,
     claim_output_directory,
     commit_outputs,
     new_staging,
+    read_manifest,
 )
 from scenarios.output.names import row_stems
 from scenarios.output.plot_data import knowledge_series
@@ -26,7 +30,7 @@ if TYPE_CHECKING:
     from scenarios.output.results import Row, RunResults
     from scenarios.schema.loader import Scenario
 
-__all__ = ["plot_streamer", "run_files", "write_results", "write_timeseries"]
+__all__ = ["check_run_directory", "plot_streamer", "run_files", "write_results", "write_timeseries"]
 
 
 def write_timeseries(row: Row, path: Path) -> None:
@@ -196,12 +200,73 @@ def run_files(scenario: Scenario, plots: bool = True) -> list[str]:
     return files
 
 
+def _written_scenario(directory: str | Path) -> str | None:
+    """The name of the scenario whose run ``directory`` holds: the ``scenario`` of the
+    ``results.json`` its run manifest lists.
+
+    Parameters
+    ----------
+    directory : str or Path
+        An output directory (need not exist).
+
+    Returns
+    -------
+    str or None
+        The scenario's name; ``None`` when the directory holds no run's ``results.json``
+        slewbench wrote, or one that does not name its scenario.
+    """
+    path = Path(directory).expanduser()
+    manifest = read_manifest(path) if path.is_dir() else None
+    if manifest is None or manifest.get("kind", "run") != "run" or "results.json" not in manifest["files"]:
+        return None
+    try:
+        name = json.loads((path / "results.json").read_text()).get("scenario")
+    except (OSError, ValueError, AttributeError):
+        return None
+    return name if isinstance(name, str) else None
+
+
+def check_run_directory(directory: str | Path, scenario: str, expected: list[str] | None = None) -> Path:
+    """Every check a run's output directory must pass before the run plans, writing nothing: those
+    of :func:`~scenarios.output.directory.check_output_directory`, and that the directory holds no
+    run of another scenario (a run replaces only an earlier run of its own scenario, :doc:`/outputs`).
+
+    Parameters
+    ----------
+    directory : str or Path
+        The run's output directory.
+    scenario : str
+        The name of the scenario about to run.
+    expected : list of str, optional
+        The files the run may write (:func:`run_files`).
+
+    Returns
+    -------
+    Path
+        The absolute directory.
+
+    Raises
+    ------
+    OutputError
+        The directory is not slewbench's to write, or holds the run of another scenario (its
+        ``results.json`` names it).
+    """
+    target = check_output_directory(directory, "run", expected or ())
+    earlier = _written_scenario(target)
+    if earlier is not None and earlier != scenario:
+        raise OutputError(directory, f"holds the run of scenario {earlier!r}, not {scenario!r}: a run replaces only an "
+                                     "earlier run of its own scenario; choose another --out, or delete that run "
+                                     "first (nothing was touched)")
+    return target
+
+
 def write_results(results: RunResults, directory: str | Path, plots: bool = True, renderer: Any = None) -> Path:
     """Write ``results.json/csv/md``, ``timeseries/<row>.csv``, the PNG plots and ``report.html``
     into ``directory``.
 
-    The directory is claimed first (:func:`claim_output_directory`); the files are staged inside
-    it and committed together (:func:`commit_outputs`).
+    The directory is checked (:func:`check_run_directory`: a directory holding the run of another
+    scenario is refused) and claimed first (:func:`claim_output_directory`); the files are staged
+    inside it and committed together (:func:`commit_outputs`).
 
     Parameters
     ----------
@@ -220,7 +285,13 @@ def write_results(results: RunResults, directory: str | Path, plots: bool = True
     -------
     Path
         The absolute output directory.
+
+    Raises
+    ------
+    OutputError
+        The directory is not slewbench's to write, or holds the run of another scenario.
     """
+    check_run_directory(directory, results.scenario.name)
     target = claim_output_directory(directory)
     staging = new_staging(target)
     try:

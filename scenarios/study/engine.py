@@ -85,6 +85,9 @@ MAX_CHUNK = 64
 """Most cases in one task."""
 MAX_WORKERS = 1024
 """Most cases run at once."""
+PROGRESS_LINE_S = 30.0
+"""Where standard error is not a terminal (continuous integration, ``nohup``, a notebook), the longest
+time between two of the sweep's progress lines [s] (:class:`_Progress`)."""
 
 
 @dataclass
@@ -399,6 +402,64 @@ class _Batch:
     started: float | None = None
 
 
+def _duration(seconds: float) -> str:
+    """``45s``, ``2m10s``, ``1h02m05s``."""
+    whole = int(seconds)
+    hours, minutes, rest = whole // 3600, whole // 60 % 60, whole % 60
+    return f"{hours}h{minutes:02d}m{rest:02d}s" if hours else f"{minutes}m{rest:02d}s" if minutes else f"{rest}s"
+
+
+class _Progress:
+    """A sweep's progress on standard error: tqdm's bar (with the time left) on a terminal; elsewhere
+    a plain line, ``NAME: 12/40 cases done, 3 not ok (1 crashed), 2m10s elapsed``, at most every
+    :data:`PROGRESS_LINE_S` (also while no case finishes) and once at the end, so that a long
+    sweep under continuous integration or ``nohup`` can be told from a hung one."""
+
+    def __init__(self, name: str, total: int, clock: Callable[[], float] = time.monotonic):
+        self.name, self.total, self.clock = name, total, clock
+        self.done = self.not_ok = self.crashed = 0
+        self.started = self.said = clock()
+        self.bar: Any = None
+        if sys.stderr.isatty():
+            from tqdm import tqdm
+            self.bar = tqdm(total=total, unit="case", desc=name[:40], dynamic_ncols=True, file=sys.stderr,
+                            mininterval=0.5)
+            if not (self.bar.ncols or 0) > 0:  # a terminal reporting no size (0 x 0):
+                self.bar.dynamic_ncols, self.bar.ncols, self.bar.nrows = False, 80, None  # tqdm would draw nothing
+
+    def line(self) -> str:
+        """What the progress line says now."""
+        counts = f", {self.not_ok} not ok" if self.not_ok else ""
+        counts += f" ({self.crashed} crashed)" if self.crashed else ""
+        return (f"{self.name}: {self.done}/{self.total} cases done{counts}, "
+                f"{_duration(self.clock() - self.started)} elapsed")
+
+    def update(self, done: int, not_ok: int, crashed: int) -> None:
+        """Cases stored: ``done`` more; ``not_ok`` and ``crashed`` cases so far."""
+        self.done += done
+        self.not_ok, self.crashed = not_ok, crashed
+        if self.bar is not None:
+            self.bar.set_postfix(not_ok=not_ok, refresh=False)
+            self.bar.update(done)
+        self.poll()
+
+    def poll(self) -> None:
+        """Off a terminal, say where the sweep is if the last line is :data:`PROGRESS_LINE_S` old."""
+        if self.bar is None and self.clock() - self.said >= PROGRESS_LINE_S:
+            self._say()
+
+    def close(self) -> None:
+        """Close the bar, or say the last line (none for a sweep with nothing to run)."""
+        if self.bar is not None:
+            self.bar.close()
+        elif self.total:
+            self._say()
+
+    def _say(self) -> None:
+        self.said = self.clock()
+        print(self.line(), file=sys.stderr, flush=True)
+
+
 class _Engine:
     """The submit / collect loop; see the module docstring for the failure rules."""
 
@@ -439,15 +500,10 @@ class _Engine:
         self.worker_cpu_s: dict[str, float] = {}
         self.elapsed: collections.deque[float] = collections.deque(maxlen=64)
         self.not_ok = 0
+        self.crashed = 0
         self.no_workers_since: float | None = None
         self.next_cluster_check = 0.0
-        self.bar = None
-        if progress:
-            from tqdm import tqdm
-            self.bar = tqdm(total=len(self.cases), unit="case", desc=study.name[:40], dynamic_ncols=True,
-                            disable=not sys.stderr.isatty(), file=sys.stderr, mininterval=0.5)
-            if not self.bar.disable and not (self.bar.ncols or 0) > 0:  # a terminal reporting no size (0 x 0):
-                self.bar.dynamic_ncols, self.bar.ncols, self.bar.nrows = False, 80, None  # tqdm would draw nothing
+        self.progress = _Progress(study.name, len(self.cases)) if progress else None
 
     # --- submitting ---------------------------------------------------------------------------
 
@@ -505,6 +561,7 @@ class _Engine:
         self.finished.add(key)
         batch.append((key, status, encode_rows(rows) if text is None else text, elapsed, attempts))
         self.not_ok += any(row["status"] != "ok" for row in rows)
+        self.crashed += status == "crashed"
 
     def _commit(self, batch: list[tuple[str, str, str, float | None, int]]) -> None:
         """Commit finished cases in one transaction, then report them (a case shown done is stored)."""
@@ -512,9 +569,8 @@ class _Engine:
             return
         if self.store is not None:
             self.store.put_encoded(batch)
-        if self.bar is not None:
-            self.bar.set_postfix(not_ok=self.not_ok, refresh=False)
-            self.bar.update(len(batch))
+        if self.progress is not None:
+            self.progress.update(len(batch), self.not_ok, self.crashed)
 
     def _crash(self, key: str, message: str, batch: list) -> None:
         self._record(key, "crashed", crashed_rows(self.cases[key].scenario, message), None, batch)
@@ -695,6 +751,8 @@ class _Engine:
                 self._collect(done)
                 self._check_cluster()
                 self._check_time()
+                if self.progress is not None:
+                    self.progress.poll()
         except BaseException:
             if self.pool is not None:
                 # stopped before its end (Ctrl-C, an error): every worker now, also one the pool was
@@ -707,8 +765,8 @@ class _Engine:
             if self.pool is not None:
                 self.executor.shutdown(wait=True)
         finally:
-            if self.bar is not None:
-                self.bar.close()
+            if self.progress is not None:
+                self.progress.close()
             if self.pool is None:
                 for future in self.in_flight:
                     future.cancel()
@@ -946,7 +1004,8 @@ def sweep(study: Study | dict[str, Any] | str | os.PathLike[str], executor: Exec
         go on counting. Stored cases that are not the study's are left alone and out of the
         results (:func:`scenarios.study.store.resume_counts` counts them).
     progress : bool, optional
-        Show a progress bar (only when stderr is a terminal).
+        Show the progress on stderr: a bar on a terminal, else a line at most every
+        :data:`PROGRESS_LINE_S` and one at the end.
     task : callable, optional
         The worker function, payload dict -> result dict (:func:`scenarios.study.worker.run_case`;
         tests replace it). On a local pool it must be importable by the worker processes.
