@@ -491,8 +491,8 @@ class Simulator:
     MAX_BUILDS = 16
     """Closed loops kept per simulator (one per law and noise shape)."""
     MODEL_BUILDS = 64
-    """Closed-loop builds (loops, compiled twins, run functions; about four per law) kept per model
-    and thread, the most recently used (:attr:`loop_cache`)."""
+    """Closed-loop builds kept per model and thread, the most recently used (:attr:`loop_cache`): two
+    to four per law (its loop, the loop's compiled twin, a run function per chunk size)."""
     CHUNK = 1000
     """Samples per accumulated call of the closed-loop function (its build unrolls them)."""
 
