@@ -16,6 +16,10 @@ Pickling: a cache pickles (and deep-copies) empty. Its entries are built solvers
 (a model's cache after one 50-interval collocation plan pickles to 14 MB, after a multiple-shooting
 plan to 330 MB), which the receiving process builds again faster than it would receive them; so a
 reference, which keeps its model and with it the model's cache, pickles to kilobytes.
+
+Bounds: a :class:`SolverCache` keeps every entry, for structures that are few (a study's NLPs).
+Where a long-lived process meets an open-ended number of structures (a gain swept in a study: one
+closed loop per law), a :class:`RecentCache` keeps only the most recently used entries.
 """
 from __future__ import annotations
 
@@ -112,3 +116,38 @@ class SolverCache:
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__init__()  # type: ignore[misc]
+
+
+class RecentCache(SolverCache):
+    """A :class:`SolverCache` that keeps only its most recently used entries (per thread, as a
+    :class:`SolverCache` keeps them).
+
+    A look-up, hit or build, makes its entry the most recent; past ``size`` entries, a thread's
+    least recently used one is dropped (it is built again if met again). A study worker keeps its
+    simulators in one, and a model its closed loops (:meth:`ocp.Simulator.closed_loop_function`),
+    so that a study varying the model or the law does not pile them up. A pickled or deep-copied
+    cache is a new, empty one of the same size.
+
+    Parameters
+    ----------
+    size : int, optional
+        Entries kept per thread (at least 1).
+    """
+
+    def __init__(self, size: int = 4) -> None:
+        super().__init__()
+        self.size = max(1, int(size))
+
+    def get(self, key: Hashable, build: Callable[[], V]) -> V:
+        value = super().get(key, build)
+        entries = self._entries
+        entries[key] = entries.pop(key)  # the most recent last
+        while len(entries) > self.size:
+            del entries[next(iter(entries))]
+        return value
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {"size": self.size}  # empty, of the same size
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(state["size"])  # type: ignore[misc]

@@ -15,9 +15,10 @@ References reused (a trade study's worker, which passes ``references``): a row w
 inputs are identical to an earlier case's (:func:`planning_key`: the planner's class, registry name
 and validated options, and every field of the :class:`~planners.ManeuverProblem`) gets that case's
 reference instead of planning again: a Monte Carlo that disperses only the truth plant
-(``truth.*``) plans once per worker. Only a successful reference is kept (a failed plan, e.g. one
-stopped by a time limit, is planned again in every case), and each row gets its own copy (its
-statistics are written on by the cross-check below). The reused row's ``plan_time_s`` is the wall
+(``truth.*``) plans once per worker thread: the store, a :class:`~ocp.SolverCache`, keeps each
+thread's entries apart, so a Dask worker with two threads plans twice. Only a successful reference
+is kept (a failed plan, e.g. one stopped by a time limit, is planned again in every case), and each
+row gets its own copy (its statistics are written on by the cross-check below). The reused row's ``plan_time_s`` is the wall
 time of the plan that made the reference (the planner's cost), not the nothing the case spent on
 it; the case's own ``elapsed_s`` (:func:`scenarios.study.worker.run_case`) shows the saving.
 

@@ -38,12 +38,13 @@ simulation: {sample_time: 0.5, duration: 260.0}
 """
 
 
-def _row(tmp_path, failed: str = "0", torquers: str = "", spin: str = "0.05, 0, 0"):
+def _row(tmp_path, failed: str = "0", torquers: str = "", spin: str = "0.05, 0, 0", max_momentum: str = "1.0"):
     from scenarios.runner import run
     from scenarios.schema.loader import load
 
     path = tmp_path / "free_start.yaml"
-    path.write_text(SPHERE.replace("FAILED", failed).replace("TORQUERS", torquers).replace("SPIN", spin))
+    path.write_text(SPHERE.replace("FAILED", failed).replace("TORQUERS", torquers).replace("SPIN", spin)
+                    .replace("max_momentum: 1.0", f"max_momentum: {max_momentum}"))
     return run(load(path)).rows[0]
 
 
@@ -71,6 +72,34 @@ def test_a_torquer_on_the_spin_axis_is_counted_for_it(tmp_path, limit, ratio):
     assert score["torquers_torque_time_s"] == 0.0
     assert score["unrealised_torque"] < 1e-15
     assert (row.status == "ok") == (ratio <= 1.0), row.message
+
+
+FREE = "(with the free start's momentum the wheels cannot take"
+
+
+def test_the_free_start_is_named_by_the_unrealised_torque_it_asks_not_by_the_slews_wheel_momentum(tmp_path):
+    """A slower spin (0.01 rad/s: 0.1 N m s, 0.1 / 200 = 5e-4 N m unrealised at t = 0) and 0.1 N m s
+    wheels: the z wheel's momentum, the slew's own (I times the quintic's peak rate, 10 x 1.875
+    (π/2) / 200 = 0.1473 N m s at 100 s, 1.47 x its limit; the y wheel's share of the start, at
+    most 0.1 x 0.5 of the first test's, stays below), is broken without the free start's part in it."""
+    row = _row(tmp_path, spin="0.01, 0, 0", max_momentum="0.1")
+    score = row.requirements["reference"]["actuators"]
+    assert score["unrealised_torque"] == pytest.approx(10 * 0.01 / 200.0, rel=1e-9)
+    assert score["wheels_momentum"] == pytest.approx(10 * 1.875 * (np.pi / 2) / 200.0 / 0.1, rel=1e-6)
+    assert score["wheels_momentum_time_s"] == pytest.approx(100.0)
+    assert row.status == "violated"
+    unrealised, wheels = row.message.split(", wheels_momentum ")
+    assert unrealised.endswith(f"is given by no working actuator {FREE}, 0.1 N m s, removed at 0.0005 N m over the "
+                               "200 s manoeuvre)"), row.message
+    assert FREE not in wheels and row.message.count(FREE) == 1, row.message
+
+
+def test_the_free_start_is_named_by_the_torquers_demand_it_asks(tmp_path):
+    row = _row(tmp_path, torquers="torquers: {max_torque: 0.002}")
+    assert row.status == "violated"
+    assert (f"torquers_torque 1.25 x its limit at 0.0 s {FREE}, 0.5 N m s, removed at 0.0025 N m over the 200 s "
+            "manoeuvre) (allowed 1 x)") in row.message, row.message
+    assert row.message.count(FREE) == 1, row.message
 
 
 def test_a_spin_within_the_wheels_span_goes_to_the_wheels_at_once(tmp_path):

@@ -165,7 +165,8 @@ def test_a_worker_reuses_simulators_only_where_a_fresh_one_gives_the_same_rows()
     """Cases that share a worker's simulators (same model and settings; the gain, target and
     sensor noise vary, and the inertia in the last grid value) give exactly the rows of a run with
     a new simulator per case; the worker's cache keeps only its last few simulators."""
-    from scenarios.study.worker import RecentCache, worker_state
+    from ocp.cache import RecentCache
+    from scenarios.study.worker import worker_state
 
     data = study_data(grid={"controller.options.kp": [0.2, 0.3],
                             "maneuver.final.q": {"axis_angle": {"axis": [0, 1, 0], "angle_deg": [20, 40]}},

@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp import quat
+from ocp.cache import RecentCache
 from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
 from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.layout import actuator_blocks, reference_rows
@@ -488,7 +489,10 @@ class Simulator:
     """
 
     MAX_BUILDS = 16
-    """Closed-loop builds kept per simulator (one per law and noise shape)."""
+    """Closed loops kept per simulator (one per law and noise shape)."""
+    MODEL_BUILDS = 64
+    """Closed-loop builds kept per model and thread, the most recently used (:attr:`loop_cache`): two
+    to four per law (its loop, the loop's compiled twin, a run function per chunk size)."""
     CHUNK = 1000
     """Samples per accumulated call of the closed-loop function (its build unrolls them)."""
 
@@ -540,7 +544,6 @@ class Simulator:
         self.compile = compile
         self.python_loop = python_loop
         self._loops: dict[Any, tuple[ClosedLoop, ca.Function, str]] = {}
-        self._runs: dict[Any, BufferedFunction] = {}
         self._last_grid: tuple[Any, Array, GridSampledReference] | None = None
         self._torque_map: tuple[int, ca.Function] | None = None
 
@@ -777,10 +780,11 @@ class Simulator:
                              sensors: SensorSuite | None = None) -> tuple[ClosedLoop, ca.Function, str]:
         """The one-sample closed-loop function of a symbolic law.
 
-        Builds are kept per law (``Controller.symbolic_key``), noise shape and sensors, in the
-        model's :class:`~ocp.SolverCache` (``model.solver_cache``): every simulator of the model
-        shares them, so a scenario run again builds no closed loop (the last :attr:`MAX_BUILDS`
-        are also kept by the simulator itself).
+        Builds are kept per law (``Controller.symbolic_key``), noise shape, sensors and what the
+        hold bakes in (:meth:`_structure`), in the model's :attr:`loop_cache`: every simulator of
+        the model shares them, so a scenario run again builds no closed loop, while a long-lived
+        process that meets law after law (a gain swept in a study) keeps only the most recent
+        (the last :attr:`MAX_BUILDS` are also kept by the simulator itself).
 
         Parameters
         ----------
@@ -804,8 +808,7 @@ class Simulator:
         if loop_key not in self._loops:
             if len(self._loops) >= self.MAX_BUILDS:
                 self._loops.clear()
-                self._runs.clear()
-            cache = self.model.solver_cache  # shared by the simulators of this model (and its runs)
+            cache = self.loop_cache  # shared by the simulators of this model (and its runs)
 
             def build() -> ClosedLoop:
                 return ClosedLoop(self.model, self._step, self.actuators, controller.symbolic_law().function,
@@ -826,14 +829,26 @@ class Simulator:
                         size: int) -> BufferedFunction:
         """``sample`` accumulated over ``size`` samples (``mapaccum`` unrolls its calls, so long runs
         go in chunks of at most :attr:`CHUNK` samples), cached as the loop is (:meth:`closed_loop_function`)."""
-        key = (*loop_key, path, size)
-        if key not in self._runs:
-            self._runs[key] = self.model.solver_cache.get(key, lambda: loop.run_function(sample, size))
-        return self._runs[key]
+        return self.loop_cache.get((*loop_key, path, size), lambda: loop.run_function(sample, size))
+
+    @property
+    def loop_cache(self) -> RecentCache:
+        """The model's closed-loop builds (:meth:`closed_loop_function`), shared by its simulators.
+
+        A :class:`~ocp.cache.RecentCache` of :attr:`MODEL_BUILDS` entries, itself kept in the
+        model's :class:`~ocp.SolverCache` (``model.solver_cache``): one per thread, and gone
+        when the model's cache is pickled or cleared.
+
+        Returns
+        -------
+        RecentCache
+            The calling thread's store of this simulator's model.
+        """
+        return self.model.solver_cache.get(("closed_loops",), lambda: RecentCache(self.MODEL_BUILDS))
 
     def _structure(self, controller: Any, noise: SensorNoise, sensors: SensorSuite | None) -> tuple:
         """What a closed-loop build bakes in, the key of :meth:`closed_loop_function`'s builds in
-        the model's :class:`~ocp.SolverCache` (the model's numbers are its own): the plant's
+        the model's :attr:`loop_cache` (the model's numbers are its own): the plant's
         numbers, the hold's integrator and sub-steps (the step integrates its dynamics), the law, which noises
         the loop takes and the sensors' models."""
         return ("closed_loop", None if self.plant is None else self.plant.fingerprint, self.integrator, self.substeps,

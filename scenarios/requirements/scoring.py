@@ -501,6 +501,13 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
     broken = []
     unscored = []
     allowed = f"{margin_allowed:.3g}"  # with the digits the most precise ratio shown needs
+    free = ""  # what a part the free start's momentum asks for says of it
+    if impulse is not None and duration is not None and np.any(impulse):
+        size = float(np.linalg.norm(impulse))
+        free = (f" (with the free start's momentum the wheels cannot take, {size:.3g} N m s, removed at "
+                f"{size / duration:.3g} N m over the {duration:g} s manoeuvre)")
+    # that momentum is asked, up to the duration, of the actuators that store none (Demand.name)
+    stores = {name.removesuffix("_momentum") for name in demand if name.endswith("_momentum")}
     for name, quantity in demand.items():
         if not quantity.limited:
             continue
@@ -525,7 +532,8 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
             element = int(np.argmax(ratios[worst])) if ratios.size else 0  # the element at the peak
             lowered = (plant_limited or {}).get(name)
             whose = " (the truth model's, below the design's)" if lowered is not None and lowered[element] else ""
-            broken.append(f"{name} {shown} x its limit{whose} at {t[worst]:.1f} s")
+            removes = free and name.rsplit("_", 1)[0] not in stores and duration is not None and t[worst] <= duration
+            broken.append(f"{name} {shown} x its limit{whose} at {t[worst]:.1f} s{free if removes else ''}")
     detail = ", ".join(unscored + ([", ".join(broken) + f" (allowed {allowed} x)"] if broken else []))
     if jumps is not None:
         largest = max(jumps, key=lambda jump: float(np.linalg.norm(jump[2])), default=None)
@@ -552,11 +560,8 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
         elif peak > UNREALISED_TOLERANCE * max(scale, UNREALISED_FLOOR):
             share = f" ({peak / scale:.0%} of the reference's peak)" if scale > 0.0 else ""
             missing = f"{peak:.3g} N m of the torque asked at {t[worst]:g} s{share} is given by no working actuator"
-            detail = missing + (f", {detail}" if detail else "")
-    if detail and impulse is not None and duration is not None and np.any(impulse):
-        size = float(np.linalg.norm(impulse))
-        detail += (f" (with the free start's momentum the wheels cannot take, {size:.3g} N m s, removed at "
-                   f"{size / duration:.3g} N m over the {duration:g} s manoeuvre)")
+            during = duration is not None and t[worst] <= duration
+            detail = missing + (free if during else "") + (f", {detail}" if detail else "")
     return Score("actuators", values, not detail, detail)
 
 

@@ -3,9 +3,10 @@
 A worker receives plain data (the case's scenario mapping, parsed here with
 :func:`scenarios.parse_scenario`), never CasADi objects, and returns a dict of plain values. Each
 worker process keeps one :class:`ocp.SolverCache` for its whole life, so a collocation NLP is
-built once per worker and structure; a process-wide lock runs one case at a time per process
-(IPOPT's linear solvers are not thread-safe), so a Dask worker should be started with
-``--nthreads 1`` and as many processes as cores.
+built once per worker thread and structure (a cache keeps each thread's builds apart); a
+process-wide lock runs one case at a time per process (IPOPT's linear solvers are not
+thread-safe), so a Dask worker should be started with ``--nthreads 1`` and as many processes as
+cores.
 
 Cases come several to a task (:func:`run_chunk`), each encoding its rows as the store keeps them.
 In a local pool's worker each case is tracked (:func:`tracked_case`): the worker writes the case it
@@ -22,17 +23,16 @@ import socket
 import threading
 import time
 import traceback
-from collections.abc import Callable, Hashable
-from typing import Any, TypeVar
+from collections.abc import Callable
+from typing import Any
 
 from ocp import SolverCache
+from ocp.cache import RecentCache
 from scenarios.errors import CaseTimeout
 from scenarios.output.renderer import die_with_parent
 from scenarios.output.results import Row
 from scenarios.schema.labels import row_labels
 from scenarios.study.store import encode_rows
-
-V = TypeVar("V")
 
 PRELOAD = ("scenarios.study.server", "scenarios.study.worker", "scenarios.runner", "scipy.integrate", "scipy.optimize",
            "scipy.special")
@@ -165,31 +165,6 @@ def run_chunk(task: Callable[[dict[str, Any]], dict[str, Any]], payloads: list[d
     return results
 
 
-class RecentCache(SolverCache):
-    """A :class:`~ocp.SolverCache` that keeps only its most recently used entries.
-
-    A worker keeps its simulators in one: a simulator (with its closed-loop functions) serves
-    every case of the same model and simulation settings, and a study that varies the model
-    (dispersed inertia) does not pile them up.
-
-    Parameters
-    ----------
-    size : int, optional
-        Entries kept (at least 1).
-    """
-
-    def __init__(self, size: int = 4) -> None:
-        super().__init__()
-        self.size = max(1, int(size))
-
-    def get(self, key: Hashable, build: Callable[[], V]) -> V:
-        value = super().get(key, build)
-        self._entries[key] = self._entries.pop(key)  # the most recent last
-        while len(self._entries) > self.size:
-            del self._entries[next(iter(self._entries))]
-        return value
-
-
 _PLUGINS_LOADED = False
 """Whether this worker process has loaded the plugins (:func:`scenarios.schema.plugins.load_plugins`,
 once per process: its scan of the entry points costs about 2 ms)."""
@@ -214,7 +189,10 @@ def worker_state() -> tuple[SolverCache, RecentCache, threading.Lock, RecentCach
         Held while a case runs, so that a process runs one case at a time.
     references : RecentCache
         The last successful references planned (:func:`scenarios.runner.run`'s ``references``):
-        a case whose planner and design problem are an earlier case's reuses its reference.
+        a case whose planner and design problem are an earlier case's, run by the same thread,
+        reuses its reference. Like every :class:`~ocp.SolverCache`, the three caches keep each
+        thread's entries apart: a worker plans a reference, and builds a solver or simulator, once
+        per thread that meets it (once per worker started with ``--nthreads 1``).
     """
     return SolverCache(), RecentCache(), threading.Lock(), RecentCache(size=8)
 

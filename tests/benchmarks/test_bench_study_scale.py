@@ -28,11 +28,11 @@ import yaml
 
 import scenarios
 from ocp import SolverCache
+from ocp.cache import RecentCache
 from scenarios.schema.read import read_yaml
 from scenarios.study.engine import start_forkserver, sweep
 from scenarios.study.spec import load_study
 from scenarios.study.store import SweepStore, claim_sweep_directory
-from scenarios.study.worker import RecentCache
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = 1000

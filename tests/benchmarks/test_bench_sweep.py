@@ -29,12 +29,12 @@ import yaml
 
 import scenarios
 from ocp import SolverCache
+from ocp.cache import RecentCache
 from scenarios.cli.commands import main
 from scenarios.schema.read import read_yaml
 from scenarios.study.engine import start_forkserver, sweep
 from scenarios.study.spec import load_study, parse_study
 from scenarios.study.store import SweepStore, claim_sweep_directory
-from scenarios.study.worker import RecentCache
 
 DEMO = Path(__file__).resolve().parents[2] / "scenarios" / "eigenaxis_demo.yaml"
 
