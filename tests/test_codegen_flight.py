@@ -381,6 +381,7 @@ def test_the_c_templates_ship_as_package_data():
     """The templates are read with importlib.resources: the wheel must hold them (pyproject's
     package-data patterns of the scenarios package match every one)."""
     import fnmatch
+
     import tomllib
 
     root = Path(__file__).resolve().parents[1]

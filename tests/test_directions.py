@@ -16,8 +16,15 @@ import pytest
 from ocp.dynamics.ephemeris import moon_position, sun_position
 from ocp.dynamics.orbits import MU_EARTH, CircularOrbit
 from ocp.errors import ModelError
-from ocp.geometry import (DIRECTIONS, INTERPOLATION_TOLERANCE, DirectionKind, Geometry, PointingConstraint,
-                          direction_kind, direction_table)
+from ocp.geometry import (
+    DIRECTIONS,
+    INTERPOLATION_TOLERANCE,
+    DirectionKind,
+    Geometry,
+    PointingConstraint,
+    direction_kind,
+    direction_table,
+)
 
 R_EARTH = 6378137.0  # m, WGS-84 equatorial radius, written here
 EPOCH = datetime.datetime(2025, 6, 1, 3, 0)

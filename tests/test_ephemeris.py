@@ -13,8 +13,14 @@ import erfa
 import numpy as np
 import pytest
 
-from ocp.dynamics.ephemeris import (EPHEMERIS_RANGE, check_epoch, moon_position, parse_utc, sun_position,
-                                    tdb_julian_date)
+from ocp.dynamics.ephemeris import (
+    EPHEMERIS_RANGE,
+    check_epoch,
+    moon_position,
+    parse_utc,
+    sun_position,
+    tdb_julian_date,
+)
 from ocp.errors import ModelError
 
 AU = 1.495978707e11  # m, IAU 2012

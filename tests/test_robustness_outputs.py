@@ -321,9 +321,9 @@ def test_the_sensitivity_heat_map_draws_the_table(swept):
 
 
 def test_the_sweep_prints_each_criterion_and_the_worst_cases(swept):
-    from scenarios.study.robustness import robustness_lines
-    from scenarios.study.rerun import stored_results
     from scenarios.study.report import robustness_tables
+    from scenarios.study.rerun import stored_results
+    from scenarios.study.robustness import robustness_lines
 
     _, out = swept
     results, _ = stored_results(out)

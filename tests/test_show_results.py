@@ -19,7 +19,15 @@ import numpy as np
 import pytest
 
 import scenarios
-from ocp import AttitudeModel, Magnetorquers, ReactionWheels, SimulationResult, Spacecraft, Torquers, quat
+from ocp import (
+    AttitudeModel,
+    Magnetorquers,
+    ReactionWheels,
+    SimulationResult,
+    Spacecraft,
+    Torquers,
+    quat,
+)
 from planners import FailedReference
 from scenarios.output.provenance import package_version
 from scenarios.output.results import Row, RunResults

@@ -12,14 +12,13 @@ from concurrent.futures import Executor, Future, ThreadPoolExecutor
 import numpy as np
 import pandas as pd
 import pytest
-
-from scenarios.output.tables import flatten_row
 import yaml
 
 import scenarios
 from scenarios import runner
 from scenarios.cli.commands import main
 from scenarios.output.directory import claim_output_directory
+from scenarios.output.tables import flatten_row
 from scenarios.study.engine import sweep
 from scenarios.study.spec import parse_study
 from scenarios.study.store import SweepStore
