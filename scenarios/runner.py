@@ -218,10 +218,9 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         (:func:`scenarios.output.writer.plot_streamer`).
     references : SolverCache or None
         Successful references kept across runs, keyed by :func:`planning_key`: a row whose planner
-        and problem have the key of a kept reference reuses it (a copy) instead of planning (its
-        ``plan_reused`` is True);
-        anything with SolverCache's ``get`` (a trade-study worker passes a bounded one). None
-        (default): every row is planned.
+        and problem have the key of a kept reference reuses it (a copy) instead of planning, and
+        its ``plan_reused`` is True; anything with SolverCache's ``get`` (a trade-study worker
+        passes a bounded one). None (default): every row is planned.
 
     Returns
     -------
