@@ -69,6 +69,15 @@ class Planner(Configurable, ABC):
       (:func:`planners.conformance.check_closed_form`) compares the two. Without the declaration a
       reference may still offer an evaluator (one a planner of several kinds of reference
       inherits); it is neither exported nor checked.
+    * ``deterministic`` (default True): a plan depends only on the planner's class, its options and
+      the problem: planned again, by a fresh instance, with its solver cache empty or full, the
+      same problem gives the same reference, bit for bit (a multistart seeds its random starts; a
+      time limit may only make it fail). A trade study's worker reuses a reference for a case whose
+      planning inputs are an earlier case's (:func:`scenarios.runner.planning_key`) on this
+      declaration alone; the ``deterministic`` conformance check
+      (:func:`planners.conformance.check_deterministic`) plans one problem twice and compares. A
+      planner whose plans may differ (an unseeded random start, a result that depends on the wall
+      clock or on what its cache held) declares ``deterministic = False``: every row is then planned.
     * ``cheap``: it plans in milliseconds (a closed form or a small parameter search, not a
       trajectory optimisation), so ``collocation`` plans it as a start by default
       (``seed_planners: auto``) wherever :meth:`start_error` accepts the problem (by default
@@ -110,6 +119,11 @@ class Planner(Configurable, ABC):
     """Whether every reference it returns implements :meth:`Reference.symbolic_evaluator`, equal to
     its ``sample`` (``t`` clamped to ``[0, T]``): ``slewbench codegen`` exports the evaluator as C
     for a planner that declares it, and only then; the conformance check verifies it."""
+
+    deterministic: ClassVar[bool] = True
+    """Whether a plan is fixed by the class, its options and the problem, bit for bit: a trade study
+    reuses a reference of identical planning inputs only for a planner that declares it; the
+    conformance check verifies it."""
 
     cheap: ClassVar[bool] = False
     """Whether it plans in milliseconds, so that ``collocation`` seeds from it by default."""

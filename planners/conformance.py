@@ -12,8 +12,10 @@ defect in the later checks), finite differences of the reference's own ``q`` and
 (kinematics, rate derivative, inverse dynamics), one-sided differences of ``ω`` at 0 and T against
 the reference's own ``ω̇`` (a rate step at an end), point-wise evaluation (vectorisation) and an
 independent numerical integration of the torque-free Euler and kinematic equations (continuation
-after T), and, for a planner that declares ``closed_form``, the reference's own ``sample`` against
-the symbolic evaluator that ``slewbench codegen`` exports as C.
+after T), for a planner that declares ``closed_form``, the reference's own ``sample`` against
+the symbolic evaluator that ``slewbench codegen`` exports as C, and, for a planner that declares
+``deterministic`` (the default), a second plan of one problem by a fresh instance against the first,
+bit for bit (what a trade study's reuse of references relies on).
 """
 from __future__ import annotations
 
@@ -38,10 +40,11 @@ from planners.reference import (
 from planners.registry import PLANNERS
 from planners.torque_free import REST_RATE
 
-__all__ = ["ATTITUDE_TOLERANCE", "CHECKS", "CLOSED_FORM_TOLERANCE", "FINITE_SAMPLES", "NORM_TOLERANCE", "RATE_TOLERANCE",
-           "RELATIVE_TOLERANCE", "Check", "check_after_end", "check_boundary", "check_closed_form", "check_dynamics",
-           "check_ends", "check_finite", "check_kinematics", "check_reference", "check_times", "check_vectorised",
-           "closed_form_check_times", "declares_closed_form", "declared_ends", "finite_check_times", "standard_problems"]
+__all__ = ["ATTITUDE_TOLERANCE", "CHECKS", "CLOSED_FORM_TOLERANCE", "DETERMINISM_PROBLEMS", "FINITE_SAMPLES",
+           "NORM_TOLERANCE", "RATE_TOLERANCE", "RELATIVE_TOLERANCE", "Check", "check_after_end", "check_boundary",
+           "check_closed_form", "check_deterministic", "check_dynamics", "check_ends", "check_finite",
+           "check_kinematics", "check_reference", "check_times", "check_vectorised", "closed_form_check_times",
+           "declares_closed_form", "declared_ends", "determinism_problem", "finite_check_times", "standard_problems"]
 
 ATTITUDE_TOLERANCE = 2e-5
 """rad: boundary attitudes (about 1e-3 deg, what the shooting planners guarantee)."""
@@ -58,6 +61,10 @@ breakpoints and enforced times): a step of T/2000, so a defect lasting T/1000 sh
 CLOSED_FORM_TOLERANCE = 1e-12
 """The symbolic evaluator against ``sample`` (:func:`check_closed_form`), relative to each field's
 scale (its largest magnitude on the grid): a few hundred roundings, far below any slip of a term."""
+DETERMINISM_PROBLEMS = ("rest_to_rest", "non_principal", "rate_to_rate", "gravity_gradient", "spinning")
+"""The :func:`standard_problems` from the cheapest to plan to the dearest (measured on the built-in
+planners: the spinning body and the gravity gradient cost the shooting and co-state methods the
+most): :func:`check_deterministic` plans the first one a planner accepts."""
 
 
 def standard_problems() -> dict[str, ManeuverProblem]:
@@ -615,6 +622,120 @@ def check_closed_form(reference: Reference, planner: Planner | type[Planner] | N
                 f"[0, T]")
 
 
+def determinism_problem(planner: Planner) -> tuple[str, ManeuverProblem] | None:
+    """The problem :func:`check_deterministic` plans: the first of :data:`DETERMINISM_PROBLEMS` (the
+    cheapest standard problem) that ``planner`` accepts (``problem_error`` is ``None``).
+
+    Parameters
+    ----------
+    planner : Planner
+        The planner, its options given.
+
+    Returns
+    -------
+    (str, ManeuverProblem) or None
+        The standard problem's name and the problem; ``None`` when it accepts none.
+    """
+    problems = standard_problems()
+    for name in DETERMINISM_PROBLEMS:
+        if planner.problem_error(problems[name]) is None:
+            return name, problems[name]
+    return None
+
+
+def _exact_numbers(values: Array) -> str:
+    """Numbers as Python writes them back exactly (two that differ in the last bit read differently)."""
+    return "[" + ", ".join(repr(float(value)) for value in np.asarray(values, dtype=float).ravel()) + "]"
+
+
+def _fresh(planner: Planner | type[Planner]) -> Planner:
+    """A new instance of ``planner``'s class with its options and solver cache (a class: the
+    default options, the model's own cache)."""
+    if isinstance(planner, type):
+        return planner(None)
+    return type(planner)(planner.options, cache=planner.cache)
+
+
+def check_deterministic(planner: Planner | type[Planner], problem: ManeuverProblem | None = None,
+                        reference: Reference | None = None) -> None:
+    """For a planner that declares ``deterministic`` (:attr:`Planner.deterministic`, the default):
+    two plans of one problem give the same reference, bit for bit.
+
+    A trade study's worker reuses a reference for a case whose planner, options and problem are an
+    earlier case's (:func:`scenarios.runner.planning_key`) on this declaration alone. The check plans
+    one problem twice, each time with a fresh instance of the planner's class with its options,
+    building into the planner's solver cache (its own, else the problem model's): the first plan
+    builds what it needs and the second finds it built, as a worker's later case does. By default
+    the problem is the cheapest standard problem the planner accepts (:func:`determinism_problem`);
+    a reference the planner already made for ``problem`` may stand for the first plan (what
+    :data:`CHECKS` does, so that only one more plan is made, into a cache already built). Both
+    references' duration, breakpoints, declared free boundary conditions and ``sample`` at the times
+    of :func:`finite_check_times` on ``[0, T]`` (after T the reference coasts from its state at T)
+    must be identical, every bit. A planner that declares ``deterministic = False`` is not asked
+    (its references are never reused), nor one whose plan fails (a failed reference is never
+    reused).
+
+    Parameters
+    ----------
+    planner : Planner or Planner subclass
+        The planner (its options and cache used) or its class (the default options).
+    problem : ManeuverProblem or None, optional
+        The problem to plan; ``None`` (default): :func:`determinism_problem`.
+    reference : Reference or None, optional
+        The first plan: ``planner``'s reference for ``problem`` (with ``problem`` only); ``None``
+        (default): planned here.
+
+    Raises
+    ------
+    ConformanceError
+        If the two references differ, naming the first difference and telling to declare
+        ``deterministic = False``.
+    ValueError
+        A ``reference`` without its ``problem``.
+    """
+    if not planner.deterministic:
+        return
+    if problem is None:
+        if reference is not None:
+            raise ValueError("check_deterministic: a reference needs the problem it was planned for")
+        chosen = determinism_problem(_fresh(planner))
+        if chosen is None:
+            return
+        where, problem = chosen
+        where = f"the standard problem {where!r}"
+    else:
+        where = f"a problem of T = {problem.duration:g} s"
+    first = reference if reference is not None else _fresh(planner).plan(problem)
+    if not first.ok:
+        return
+    second = _fresh(planner).plan(problem)
+    if not second.ok:
+        return
+    name = planner.name
+    fix = ("a planner whose plans of one problem may differ (an unseeded random start, a result that depends on "
+           "the clock or on what its solver cache held) must declare deterministic = False (a class attribute), so "
+           "that a trade study plans every case instead of reusing an earlier case's reference")
+    for label, a, b in (("duration", np.float64(first.duration), np.float64(second.duration)),
+                        ("breakpoints", first.breakpoints, second.breakpoints)):
+        if np.shape(a) != np.shape(b) or np.asarray(a).tobytes() != np.asarray(b).tobytes():
+            raise ConformanceError(f"{name}: planned twice on {where} by fresh instances, its references' {label} "
+                                   f"differ: {np.asarray(a).tolist()!r} then {np.asarray(b).tolist()!r}; {fix}")
+    if first.free_boundary != second.free_boundary:
+        raise ConformanceError(f"{name}: planned twice on {where} by fresh instances, its references declare "
+                               f"free {sorted(first.free_boundary)} then {sorted(second.free_boundary)}; {fix}")
+    times = finite_check_times(first)
+    times = times[times <= first.duration]  # after T: the torque-free coast of the state at T, compared there
+    for field, a, b in zip(("q", "ω", "ω̇", "torque"), first.sample(times), second.sample(times)):
+        a, b = (np.ascontiguousarray(values, dtype=np.float64) for values in (a, b))
+        same = np.all(a.view(np.int64) == b.view(np.int64), axis=1)  # bit for bit: -0.0 is not 0.0, NaN is NaN
+        if not np.all(same):
+            k = int(np.argmin(same))
+            raise ConformanceError(
+                f"{name}: planned twice on {where} by fresh instances, its references differ in {field} at "
+                f"t = {float(times[k])!r} s: {_exact_numbers(a[k])} then {_exact_numbers(b[k])} "
+                f"({int(np.sum(~same))} of {times.size} times differ); {fix}")
+
+
 class Check(Protocol):
     """A check of :data:`CHECKS`: ``check(problem, reference, planner=None)`` raises
     :class:`ConformanceError`; ``planner`` is the planner that made the reference (``None``: the one
@@ -642,6 +763,33 @@ def _closed_form(problem: ManeuverProblem, reference: Reference,
     check_closed_form(reference, planner)
 
 
+_DETERMINISTIC: set[tuple[object, ...]] = set()
+"""The planners (class, its plan methods, options) found deterministic in this process."""
+
+
+def _deterministic(problem: ManeuverProblem, reference: Reference,
+                   planner: Planner | type[Planner] | None = None) -> None:
+    """:func:`check_deterministic` of the planner that made ``reference``, once per planner class
+    and options in a process (determinism is the planner's, not one reference's). Given the planner
+    (an instance: its options), ``reference`` is the first plan of ``problem`` and one more is
+    made; else the class registered under the reference's name (none: nothing to check) is
+    checked with its default options on its own problem (the reference's options are unknown)."""
+    if planner is None:
+        planner = PLANNERS.get(reference.planner)
+        if planner is None:
+            return
+    kind = planner if isinstance(planner, type) else type(planner)
+    options = None if isinstance(planner, type) else planner.options
+    key = (kind, kind.plan, getattr(kind, "_plan", None), repr(options))
+    if key in _DETERMINISTIC:
+        return
+    if isinstance(planner, type):
+        check_deterministic(planner)
+    else:
+        check_deterministic(planner, problem, reference)
+    _DETERMINISTIC.add(key)
+
+
 CHECKS: dict[str, Check] = {
     "finite": _reference_only(check_finite),
     "boundary": _boundary,
@@ -651,10 +799,13 @@ CHECKS: dict[str, Check] = {
     "vectorised": _reference_only(check_vectorised),
     "after_end": _reference_only(check_after_end),
     "closed_form": _closed_form,
+    "deterministic": _deterministic,
 }
 """Every check, by name, in the order :func:`check_reference` runs them (``finite`` first: a NaN
 would read as another defect in the others): ``check(problem, reference, planner=None)`` raises
-:class:`ConformanceError` (:class:`Check`)."""
+:class:`ConformanceError` (:class:`Check`). ``deterministic`` plans the problem once more (given
+the planner; else the registered class's own problem, :func:`check_deterministic`), once per planner
+class and options in a process."""
 
 
 def check_reference(problem: ManeuverProblem, reference: Reference,
@@ -668,9 +819,9 @@ def check_reference(problem: ManeuverProblem, reference: Reference,
     reference : Reference
         The planner's reference for it (a status other than ``"ok"`` fails at once).
     planner : Planner, Planner subclass or None, optional
-        The planner that made it, whose declarations (``closed_form``) the checks verify;
-        ``None`` (default): the planner registered under the reference's name, if any (pass it
-        for a planner not registered yet).
+        The planner that made it, whose declarations (``closed_form``, ``deterministic``) the checks
+        verify; ``None`` (default): the planner registered under the reference's name, if any, with
+        its default options (pass it for a planner not registered yet, or to check its options).
 
     Raises
     ------

@@ -18,9 +18,11 @@ reference instead of planning again: a Monte Carlo that disperses only the truth
 (``truth.*``) plans once per worker thread: the store, a :class:`~ocp.SolverCache`, keeps each
 thread's entries apart, so a Dask worker with two threads plans twice. Only a successful reference
 is kept (a failed plan, e.g. one stopped by a time limit, is planned again in every case), and each
-row gets its own copy (its statistics are written on by the cross-check below). The reused row's ``plan_time_s`` is the wall
-time of the plan that made the reference (the planner's cost), not the nothing the case spent on
-it; the case's own ``elapsed_s`` (:func:`scenarios.study.worker.run_case`) shows the saving.
+row gets its own copy (its statistics are written on by the cross-check below). The reused row's
+``plan_reused`` is True and its ``plan_time_s`` the wall time of the plan that made the reference
+(the planner's cost), not the nothing the case spent on it; the case's own ``elapsed_s``
+(:func:`scenarios.study.worker.run_case`) shows the saving. A planner that declares
+``deterministic = False`` has no key: its rows are always planned.
 
 Optima cross-checked: when a run holds a direct optimum (a reference whose certificate has no
 ``method``, e.g. ``collocation``) and an indirect one (a co-state solution, e.g. ``costate_tpbvp``)
@@ -217,9 +219,9 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
         (:func:`scenarios.output.writer.plot_streamer`).
     references : SolverCache or None
         Successful references kept across runs, keyed by :func:`planning_key`: a row whose planner
-        and problem have the key of a kept reference reuses it (a copy) instead of planning;
-        anything with SolverCache's ``get`` (a trade-study worker passes a bounded one). None
-        (default): every row is planned.
+        and problem have the key of a kept reference reuses it (a copy) instead of planning, and
+        its ``plan_reused`` is True; anything with SolverCache's ``get`` (a trade-study worker
+        passes a bounded one). None (default): every row is planned.
 
     Returns
     -------
@@ -264,6 +266,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     controllers = scenario.controllers
     labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in controllers])
     planned: dict[int, tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]] = {}
+    kept = None if references is None else _Watched(references)
+    reused: dict[int, bool] = {}
     scoring = _SCORE_REQUIREMENTS and bool(scenario.requirements)
     broken_ends = endpoint_violations(scenario.problem) if scoring else []
     rows: list[Row] = []
@@ -279,11 +283,14 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
             if broken_ends:  # no planner can meet them: nothing is planned
                 planned.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends)), None, None))
             if i not in planned:  # planned once, tracked by every controller
-                planned[i] = plan_row(scenario, planner_spec, cache, scoring, kept=references)
+                if kept is not None:
+                    kept.reused = False
+                planned[i] = plan_row(scenario, planner_spec, cache, scoring, kept=kept)
+                reused[i] = kept is not None and kept.reused
             reference, reference_metrics, sampled = planned[i]
             row = Row(label, planner_spec.name, reference.status, reference.message,
                       reference.plan_time_s, None if reference_metrics is None else dict(reference_metrics), None,
-                      reference, controller=controllers[j].name)
+                      reference, controller=controllers[j].name, plan_reused=reused.get(i, False))
             if reference.ok:
                 _check_physical(row, "reference", row.reference_metrics)
                 if sampled is not None:
@@ -345,7 +352,7 @@ def _cross_check_optima(rows: list[Row]) -> None:
 
 
 def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache | None,
-             scoring: bool = False, kept: SolverCache | None = None
+             scoring: bool = False, kept: Any = None
              ) -> tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]:
     """Plan one row's reference as :func:`run` does (``slewbench codegen`` plans its rows so too).
 
@@ -360,9 +367,9 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
     scoring : bool, optional
         Also sample the reference for the requirements.
     kept : SolverCache or None, optional
-        Successful references by :func:`planning_key` (:func:`run`'s ``references``): a copy of
-        the one kept for this planner and problem is used instead of planning, and a new
-        successful one is kept. None (default): planned.
+        Successful references by :func:`planning_key` (:func:`run`'s ``references``, anything with
+        SolverCache's ``get``): a copy of the one kept for this planner and problem is used
+        instead of planning, and a new successful one is kept. None (default): planned.
 
     Returns
     -------
@@ -417,6 +424,27 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
     return reference, metrics, (times, sample) if scoring else None
 
 
+class _Watched:
+    """:func:`run`'s ``references`` noting whether a ``get`` found its entry (``reused``: nothing
+    was built), for the row's ``plan_reused``."""
+
+    def __init__(self, kept: Any) -> None:
+        self.kept, self.reused = kept, False
+
+    def get(self, key: Any, build: Callable[[], Any]) -> Any:
+        """``kept.get(key, build)``, setting ``reused`` when ``build`` was not called."""
+        built = False
+
+        def building() -> Any:
+            nonlocal built
+            built = True
+            return build()
+
+        value = self.kept.get(key, building)
+        self.reused = not built
+        return value
+
+
 class _NotKept(Exception):
     """Carries a failed reference out of a cache's ``build``, so that the cache does not keep it."""
 
@@ -434,7 +462,7 @@ def _plan(planner: Any, name: str, problem: Any) -> Reference:
         return FailedReference(name, f"planner raised {type(error).__name__}: {error}")
 
 
-def _kept_or_planned(kept: SolverCache, key: tuple[Any, ...], planner: Any, name: str, problem: Any) -> Reference:
+def _kept_or_planned(kept: Any, key: tuple[Any, ...], planner: Any, name: str, problem: Any) -> Reference:
     """A copy of the reference ``kept`` holds under ``key``, else one planned now (kept if it
     succeeded). The copy has its own ``stats`` (:func:`_cross_check_optima` writes there)."""
     def build() -> Reference:
@@ -492,8 +520,10 @@ def _exact(value: Any) -> Any:
 def planning_key(planner: Any, problem: Any) -> tuple[Any, ...] | None:
     """What a plan depends on, hashed: two plans with the same key give the same reference.
 
-    A planner is deterministic (its multistarts' random starts are seeded; a time limit can only
-    make it fail, and a failed reference is never reused), so its reference is fixed by its class,
+    A planner that declares ``deterministic`` (:attr:`planners.Planner.deterministic`, the default;
+    the built-in planners do: their multistarts' random starts are seeded, a time limit can only
+    make them fail, and a failed reference is never reused; the conformance check
+    :func:`planners.conformance.check_deterministic` verifies it) has its reference fixed by its class,
     its instance's state (its registry name and validated options; not the solver cache it builds
     into, which changes how fast it plans, not what) and the problem it is given: every field of
     the :class:`~planners.ManeuverProblem` (spacecraft, environment, boundary conditions,
@@ -513,10 +543,13 @@ def planning_key(planner: Any, problem: Any) -> tuple[Any, ...] | None:
     -------
     tuple or None
         The SHA-256 hex digest of the inputs, then the class's ``plan`` and ``_plan``; ``None``
-        when an input cannot be stated exactly (an option or a field holding a callable or an
-        object of unknown kind): the row is then always planned.
+        when the planner declares ``deterministic = False`` or an input cannot be stated exactly
+        (an option or a field holding a callable or an object of unknown kind): the row is then
+        always planned.
     """
     kind = type(planner)
+    if not getattr(kind, "deterministic", True):
+        return None
     state = {name: value for name, value in vars(planner).items() if name != "cache"}
     try:
         text = repr((f"{kind.__module__}.{kind.__qualname__}", _exact(state), _exact(problem)))

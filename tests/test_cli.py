@@ -53,8 +53,9 @@ def test_run_end_to_end_through_the_console_entry_point(tmp_path):
     results = json.loads((out / "results.json").read_text())
     assert results["scenario"] == "small" and [r["label"] for r in results["rows"]] == ["smooth", "fast"]
     for row in results["rows"]:
-        assert set(row) == {"label", "planner", "controller", "status", "message", "plan_time_s", "reference",
-                            "closed_loop", "requirements", "certificate"}
+        assert set(row) == {"label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused",
+                            "reference", "closed_loop", "requirements", "certificate"}
+        assert row["plan_reused"] is False  # a run plans every row
         assert row["controller"] == "augmented_quaternion_feedback"
         assert set(row["reference"]) == set(METRIC_KEYS) == set(row["closed_loop"])
         assert row["closed_loop"]["final_error_deg"] < 0.05

@@ -67,7 +67,8 @@ def test_conformance(name, index, key, check):
         assert reference.ok, f"{reference.status}: {reference.message}"  # the problem of the default suite
     elif not reference.ok:
         pytest.skip(f"numerical failure, reported as a row: {reference.message}")
-    CHECKS[check](PROBLEMS[key], reference)
+    # the planner with its options: the checks of its declarations (deterministic plans with them)
+    CHECKS[check](PROBLEMS[key], reference, PLANNERS[name](PLANNERS[name].example_options[index]))
 
 
 @pytest.mark.parametrize("name,index", VARIANTS, ids=[_variant_id(*v) for v in VARIANTS])

@@ -37,9 +37,9 @@ BASE = {
     "controller": {"name": "augmented_quaternion_feedback", "options": {"kp": 0.2, "kd": 0.6}},
     "simulation": {"sample_time": 1.0, "duration": 35.0},
 }
-ROW_KEYS = {"label", "planner", "controller", "status", "message", "plan_time_s", "reference", "closed_loop",
-            "requirements", "certificate"}
-IDENTITY = ["label", "planner", "controller", "status", "message", "plan_time_s"]
+ROW_KEYS = {"label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused", "reference",
+            "closed_loop", "requirements", "certificate"}
+IDENTITY = ["label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused"]
 CERTIFICATE = ["certificate", "certificate_verdict", "certificate_kkt_scaled", "certificate_kkt_unscaled"]
 
 

@@ -20,6 +20,7 @@ from scenarios.cli.commands import main
 from scenarios.output.directory import claim_output_directory
 from scenarios.output.tables import flatten_row
 from scenarios.study.engine import sweep
+from scenarios.study.rerun import PROCESS_COLUMNS
 from scenarios.study.spec import parse_study
 from scenarios.study.store import SweepStore
 from scenarios.study.worker import run_case
@@ -57,8 +58,9 @@ class InlineExecutor(Executor):
 
 
 def comparable(frame):
-    """The table without wall-clock columns."""
-    return frame.drop(columns=["plan_time_s"]).reset_index(drop=True)
+    """The table without the columns that describe the process, not the case (the wall-clock plan
+    time; whether a worker reused a reference, which depends on which worker ran which case)."""
+    return frame.drop(columns=list(PROCESS_COLUMNS)).reset_index(drop=True)
 
 
 # --- expansion -------------------------------------------------------------------------------

@@ -158,7 +158,7 @@ def command_case(args: argparse.Namespace) -> int:
             print(f"  {line}")
     else:
         print(f"the re-run's rows equal the stored case's ({len(rerun.rows)} row(s), every metric and requirement "
-              "column; planning times aside)")
+              "column; planning times and reuse aside)")
     return EXIT_OK
 
 

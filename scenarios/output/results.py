@@ -83,6 +83,11 @@ class Row:
         The requirement scores by scope (``reference``, ``closed_loop``), then requirement name,
         then field (:mod:`scenarios.requirements.scoring`), the verdict ``met`` (a bool) first;
         ``None`` when the scenario has no requirements.
+    plan_reused : bool, optional
+        Whether the row's reference was not planned for it but reused from an earlier run's
+        identical planning inputs (a trade study's worker, :func:`scenarios.runner.run`'s
+        ``references``); its ``plan_time_s`` is then that earlier plan's. Default False (planned
+        for the row, or no planner: regulation mode, a crashed case).
     """
 
     label: str
@@ -97,6 +102,7 @@ class Row:
     simulate_time_s: float = 0.0
     controller: str | None = None
     requirements: dict[str, dict[str, dict[str, Any]]] | None = None
+    plan_reused: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         """The row's plain, nested form: a ``results.json`` row and a trade study's stored row.
@@ -108,7 +114,7 @@ class Row:
         -------
         dict
             ``label``, ``planner``, ``controller``, ``status``, ``message``, ``plan_time_s``,
-            ``reference`` and ``closed_loop`` (the two metric dicts, or ``None``) and
+            ``plan_reused``, ``reference`` and ``closed_loop`` (the two metric dicts, or ``None``) and
             ``requirements`` (the requirement scores by scope, name and field, or ``None``) and
             ``certificate`` (the reference's ``stats["certificate"]``, :mod:`ocp.nlp.certificate`,
             or ``None``: no reference, or a planner that writes none).
@@ -116,7 +122,7 @@ class Row:
         certificate = None if self.reference is None else self.reference.stats.get("certificate")
         return {"label": self.label, "planner": self.planner, "controller": self.controller,
                 "status": self.status, "message": self.message,
-                "plan_time_s": self.plan_time_s, "reference": self.reference_metrics,
+                "plan_time_s": self.plan_time_s, "plan_reused": self.plan_reused, "reference": self.reference_metrics,
                 "closed_loop": self.closed_loop_metrics, "requirements": self.requirements,
                 "certificate": None if certificate is None else dict(certificate)}
 

@@ -44,13 +44,19 @@ if TYPE_CHECKING:
 
     from scenarios.output.results import RunResults
 
-__all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "IDENTITY_COLUMNS", "ROW_STATUSES", "csv_cell", "csv_text",
+__all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTITY_COLUMNS", "ROW_STATUSES", "csv_cell", "csv_text",
            "data_frame", "flatten_row", "html_table", "is_missing", "json_safe", "numeric_columns",
            "requirement_columns", "requirement_units", "row_columns", "status_line", "text_cell", "to_csv",
            "to_dataframe", "to_json", "to_markdown", "to_terminal"]
 
-IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s")
-"""The columns that name a row, before its metrics."""
+IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused")
+"""The columns that name a row and say how its reference was had, before its metrics: ``plan_time_s``
+the planner's wall time [s], ``plan_reused`` whether the reference was reused from an earlier case of
+identical planning inputs (:func:`scenarios.runner.run`'s ``references``; then ``plan_time_s`` is that
+plan's), True or False, missing in the rows of a sweep stored before the column existed."""
+FLAG_COLUMNS = ("plan_reused",)
+"""The columns of :data:`IDENTITY_COLUMNS` that hold a bool: pandas' nullable ``boolean`` in a
+DataFrame (``<NA>`` where missing)."""
 
 ROW_STATUSES = ("crashed", "failed", "infeasible", "violated", "ok")
 """A row's statuses from the worst, the order tables count and sort them in: ``crashed`` (a trade
@@ -123,8 +129,8 @@ def row_columns(requirements: Sequence[str] = ()) -> list[str]:
     Returns
     -------
     list of str
-        ``label, planner, controller, status, message, plan_time_s, ref.int_u2, ..., certificate, ...,
-        ref.req...``.
+        ``label, planner, controller, status, message, plan_time_s, plan_reused, ref.int_u2, ...,
+        certificate, ..., ref.req...``.
     """
     return [*IDENTITY_COLUMNS, *metric_columns(), *CERTIFICATE_COLUMNS, *requirements]
 
@@ -264,7 +270,7 @@ def data_frame(columns: Sequence[str], records: Iterable[Mapping[str, Any]], num
         (:func:`~scenarios.requirements.fields.is_requirement_column`) are numeric too, but for the
         verdicts (``<scope>.req.<name>.met``,
         :func:`~scenarios.requirements.fields.is_verdict_column`): pandas' nullable ``boolean``,
-        ``<NA>`` where missing, never a float to average.
+        ``<NA>`` where missing, never a float to average; so are :data:`FLAG_COLUMNS`.
 
     Returns
     -------
@@ -280,7 +286,7 @@ def data_frame(columns: Sequence[str], records: Iterable[Mapping[str, Any]], num
         import pandas
     except ImportError:
         raise ImportError("to_dataframe needs pandas: pip install pandas") from None
-    verdicts = {column for column in columns if is_verdict_column(column)}
+    verdicts = {column for column in columns if is_verdict_column(column) or column in FLAG_COLUMNS}
     numbers = (set(numeric) | {column for column in columns if is_requirement_column(column)}) & set(columns) - verdicts
     lines = [{column: (math.nan if is_missing(record.get(column)) else record.get(column)) if column in numbers
               else (None if is_missing(record.get(column)) else record.get(column)) if column in verdicts
@@ -339,8 +345,8 @@ def to_dataframe(results: RunResults) -> pandas.DataFrame:
     pandas.DataFrame
         One line per row, the columns of :func:`row_columns` (with the rows' requirement
         columns); ``plan_time_s``, the metric and the requirement columns are float, NaN where
-        missing or non-finite, but the verdicts (``<scope>.req.<name>.met``): pandas' nullable
-        ``boolean``.
+        missing or non-finite, but the verdicts (``<scope>.req.<name>.met``) and ``plan_reused``:
+        pandas' nullable ``boolean``.
 
     Raises
     ------

@@ -5,8 +5,9 @@
 and returns the full :class:`~scenarios.output.results.RunResults` (references, simulations, time
 series: what ``slewbench run`` writes), and :func:`row_differences` compares its rows with the stored
 ones column by column (``slewbench sweep DIR --case N`` prints it). A case run again by the same
-slewbench gives the stored rows exactly: a worker's solver and simulator caches do not change a
-result.
+slewbench gives the stored rows exactly: a worker's solver, simulator and reference caches do not
+change a result (a reused reference is the one a fresh plan gives, for a planner that declares
+``deterministic``).
 """
 from __future__ import annotations
 
@@ -23,10 +24,12 @@ from scenarios.study.engine import SweepResults
 from scenarios.study.spec import parse_study
 from scenarios.study.store import STORE_NAME, SweepStore, is_sweep_store
 
-__all__ = ["TIMING_COLUMNS", "rerun_case", "row_differences", "stored_results"]
+__all__ = ["PROCESS_COLUMNS", "rerun_case", "row_differences", "stored_results"]
 
-TIMING_COLUMNS = ("plan_time_s",)
-"""Columns that measure the computer, not the case: left out of :func:`row_differences`."""
+PROCESS_COLUMNS = ("plan_time_s", "plan_reused")
+"""Columns that describe how the process computed the row, not the case: the planner's wall time,
+and whether the worker reused an earlier case's reference (a re-run plans afresh, to the same
+reference); left out of :func:`row_differences`."""
 
 
 def stored_results(directory: str | Path) -> tuple[SweepResults, str]:
@@ -125,7 +128,7 @@ def row_differences(stored: list[dict[str, Any]], rerun: RunResults) -> list[str
     -------
     list of str
         ``"<label>: <column> stored <value>, now <value>"`` per differing column (the status, the
-        message and every metric and requirement column, exactly; :data:`TIMING_COLUMNS` left
+        message and every metric and requirement column, exactly; :data:`PROCESS_COLUMNS` left
         out); empty when they agree. A different number or order of rows is one line.
     """
     now = [flatten_row(row.to_dict()) for row in rerun.rows]
@@ -135,7 +138,7 @@ def row_differences(stored: list[dict[str, Any]], rerun: RunResults) -> list[str
     differences = []
     for old, new in zip(before, now):
         for column in dict.fromkeys([*old, *new]):
-            if column in TIMING_COLUMNS or _same(old.get(column), new.get(column)):
+            if column in PROCESS_COLUMNS or _same(old.get(column), new.get(column)):
                 continue
             differences.append(f"{old.get('label')}: {column} stored {old.get(column)!r}, now {new.get(column)!r}")
     return differences
