@@ -355,7 +355,7 @@ MUTATIONS: list[Mutation] = [
              "    tolerance = JUMP_TOLERANCE + 1e-5 * float(np.max(np.abs(reference.sample(np.array([0.0, T])).omega)))\n",
              ("tests/test_mutants_jumps.py", "tests/test_planner_conformance.py",)),
     Mutation("plan-start-retries-with-the-bound", "planners/base.py",
-             "            unbounded = self.plan(replace(problem, max_rate=None))",
+             "            unbounded = self.plan(replace(problem, max_rate=None, rate_requirement=None))",
              "            unbounded = self.plan(problem)",
              ("tests/test_collocation_seeds.py", "tests/test_spin_extremal_final_rate.py")),
     Mutation("plan-start-keeps-the-failure", "planners/base.py",
