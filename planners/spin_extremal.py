@@ -216,8 +216,8 @@ def build_derivatives() -> ca.Function:
 class NewtonFirst:
     """IPOPT's iterations on (r, c, β) taken as the Newton steps they are, IPOPT itself otherwise.
 
-    On this unconstrained problem IPOPT's step solves ``(∇²J + δ I) d = −∇J`` with IPOPT's
-    inertia correction ``δ`` (0 when the Hessian is positive definite; else, as IPOPT's
+    On this unconstrained problem IPOPT's step solves ``(s ∇²J + δ I) d = −s ∇J`` (``s`` its
+    gradient-based scaling of the objective, below) with IPOPT's inertia correction ``δ`` (0 when the Hessian is positive definite; else, as IPOPT's
     ``PDPerturbationHandler``, 1e-4 the first time, then a third of the last ``δ``, raised 100-fold
     then 8-fold until the matrix is positive definite; after :data:`DEGENERATE_ITERATIONS`
     perturbed iterations from the start, every later one is perturbed so without trying 0, and once
@@ -288,7 +288,7 @@ class NewtonFirst:
                 return x, f, k, "Solve_Succeeded"
             if k == NEWTON_ITERATIONS:
                 return None
-            eigenvalues = np.linalg.eigvalsh(hessian)
+            eigenvalues = np.linalg.eigvalsh(scale * hessian)  # IPOPT perturbs the scaled problem's Hessian
             shift = 0.0
             if not degenerate:
                 definite = self._definite(eigenvalues, 0.0)
@@ -309,7 +309,7 @@ class NewtonFirst:
                 if degenerate is None:
                     perturbed += 1
                     degenerate = True if perturbed >= DEGENERATE_ITERATIONS else None
-            step = -np.linalg.solve(hessian + shift * np.eye(3), gradient)
+            step = -np.linalg.solve(scale * hessian + shift * np.eye(3), scale * gradient)
             if not np.all(np.isfinite(step)):
                 return None
             if float(np.max(np.abs(step) / (1.0 + np.abs(x)))) < 10.0 * np.finfo(float).eps:
