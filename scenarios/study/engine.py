@@ -248,8 +248,12 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
     os.environ.update(server_environment)
     try:
         resource_tracker.ensure_running()  # first: starting it unblocks SIGINT (it blocks it around its own start)
+        running = _forkserver_pid()
         with _sigint_blocked():
             forkserver.ensure_running()
+        started = _forkserver_pid()
+        if started is not None and started != running:  # started now, by slewbench: it stops it
+            _STARTED.add(started)
     finally:
         for name, value in previous.items():
             if value is None:
@@ -263,6 +267,13 @@ def start_forkserver() -> multiprocessing.context.BaseContext:
 
 
 _STOP_AT_EXIT: list[bool] = []  # whether _stop_forkserver is registered to run at this process's exit
+_STARTED: set[int] = set()  # process ids of the fork servers start_forkserver started (not the user's own)
+
+
+def _forkserver_pid() -> int | None:
+    """The process id of this process's ``multiprocessing`` fork server, if one was started."""
+    from multiprocessing import forkserver
+    return getattr(forkserver._forkserver, "_forkserver_pid", None)  # private, stable since 3.4
 
 
 def _stop_forkserver(owner: int | None = None) -> None:
@@ -274,11 +285,11 @@ def _stop_forkserver(owner: int | None = None) -> None:
     exit (``owner``, its process id: a process forked from it does nothing), so that a server
     still importing, with Ctrl-C blocked, does not outlive a sweep interrupted before its first
     case. The next :func:`start_forkserver` starts a new server (``multiprocessing`` finds this
-    one dead).
+    one dead). A server slewbench did not start (the caller's program started it for pools of its
+    own before its first sweep) is left alone.
     """
-    from multiprocessing import forkserver
-    pid = getattr(forkserver._forkserver, "_forkserver_pid", None)  # private, stable since 3.4
-    if pid and owner in (None, os.getpid()):
+    pid = _forkserver_pid()
+    if pid in _STARTED and owner in (None, os.getpid()):
         with contextlib.suppress(ProcessLookupError):
             os.kill(pid, signal.SIGKILL)
 
