@@ -12,7 +12,7 @@ import signal
 import sys
 from typing import Any
 
-from scenarios.cli.status import EXIT_INTERNAL, EXIT_INTERRUPTED
+from scenarios.cli.status import interrupted_status
 from scenarios.output.renderer import Renderer
 
 
@@ -51,8 +51,8 @@ def main(argv: list[str] | None = None) -> int:
     Returns
     -------
     int
-        The exit status of :func:`scenarios.cli.commands.main` (if interrupted before it started: 130
-        for a sweep, 1 otherwise, as :mod:`scenarios.cli.status` declares).
+        The exit status of :func:`scenarios.cli.commands.main` (if interrupted before it started:
+        :func:`scenarios.cli.status.interrupted_status`).
     """
     argv = sys.argv[1:] if argv is None else list(argv)
     renderer = Renderer.start() if draws_plots(argv) else None
@@ -67,7 +67,7 @@ def main(argv: list[str] | None = None) -> int:
             )
         except KeyboardInterrupt:  # Ctrl-C or SIGTERM while the model loads: nothing written yet
             print("slewbench: interrupted; nothing written", file=sys.stderr)
-            return EXIT_INTERRUPTED if argv[:1] == ["sweep"] else EXIT_INTERNAL  # as documented (status.py)
+            return interrupted_status(argv[0] if argv else None)
         return command_line(argv, renderer=renderer)  # handles SIGTERM itself from here on
     finally:
         if previous is not None:

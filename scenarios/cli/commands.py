@@ -32,6 +32,7 @@ from scenarios.cli.status import (
     EXIT_OK,
     attached_values,
     directory_argument,
+    interrupted_status,
 )
 from scenarios.cli.sweep import add_sweep_parser
 from scenarios.cli.table import add_table_parser
@@ -499,11 +500,10 @@ class Interruption:
 
 
 def _interrupted(args: argparse.Namespace) -> int:
-    """Say that the command was interrupted, in one line; its exit status (the command's
-    ``interrupted_status``: :data:`~scenarios.cli.status.EXIT_INTERRUPTED` for a sweep, else
-    :data:`~scenarios.cli.status.EXIT_INTERNAL`)."""
+    """Say that the command was interrupted, in one line; its exit status
+    (:func:`~scenarios.cli.status.interrupted_status`)."""
     print("slewbench: interrupted; results not written or marked incomplete in the output manifest", file=sys.stderr)
-    return int(getattr(args, "interrupted_status", EXIT_INTERNAL))
+    return interrupted_status(getattr(args, "command", None))
 
 
 def _names(given: str, path: Path) -> bool:

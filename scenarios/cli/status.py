@@ -9,7 +9,8 @@ import argparse
 import re
 
 __all__ = ["CRASH_REASONS_SHOWN", "EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_CRASHED", "EXIT_INTERNAL",
-           "EXIT_INTERRUPTED", "EXIT_NOT_OK", "EXIT_OK", "attached_values", "crash_report", "directory_argument"]
+           "EXIT_INTERRUPTED", "EXIT_NOT_OK", "EXIT_OK", "INTERRUPTED_STATUS", "attached_values", "crash_report",
+           "directory_argument", "interrupted_status"]
 
 EXIT_OK = 0
 """The command completed (a run's failed and violated rows, a table's entries that are not ok
@@ -32,7 +33,27 @@ EXIT_BAD_SCENARIO = 2
 EXIT_BAD_OUTPUT = 2
 """An output location slewbench must not or cannot write to: nothing was touched."""
 EXIT_INTERRUPTED = 130
-"""A sweep stopped before every case finished (rerun it with ``--resume``)."""
+"""A sweep stopped before every case finished (rerun it with ``--resume``), or a slew table before
+every entry did (run the same command again into the same ``--out``)."""
+INTERRUPTED_STATUS = {"sweep": EXIT_INTERRUPTED, "table": EXIT_INTERRUPTED}
+"""The exit status of a command interrupted by Ctrl-C or SIGTERM, for the commands whose work is kept
+and resumed; any other command's is :data:`EXIT_INTERNAL` (:func:`interrupted_status`)."""
+
+
+def interrupted_status(command: str | None) -> int:
+    """The exit status of ``command`` (``sweep``, ``run``, …) interrupted by Ctrl-C or SIGTERM.
+
+    Parameters
+    ----------
+    command : str or None
+        The command's name (the first argument of ``slewbench``); ``None`` when none was given.
+
+    Returns
+    -------
+    int
+        :data:`EXIT_INTERRUPTED` for a command in :data:`INTERRUPTED_STATUS`, else :data:`EXIT_INTERNAL`.
+    """
+    return INTERRUPTED_STATUS.get(command or "", EXIT_INTERNAL)
 
 
 CRASH_REASONS_SHOWN = 3

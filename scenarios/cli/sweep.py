@@ -534,4 +534,4 @@ def add_sweep_parser(commands: Any) -> None:
     parser.add_argument("--case", metavar="N", type=int,
                         help="re-run case N of the sweep stored in DIR (given as the first argument) in full, "
                              "writing a run's outputs into --out (default: DIR/cases/N)")
-    parser.set_defaults(handler=command_sweep, interrupted_status=EXIT_INTERRUPTED)
+    parser.set_defaults(handler=command_sweep)
