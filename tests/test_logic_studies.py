@@ -4,7 +4,6 @@ store key depends on, the summary statistics of a small table worked out by hand
 stored twice."""
 import copy
 import csv
-from concurrent.futures import Executor, Future
 
 import numpy as np
 import pytest
@@ -12,6 +11,7 @@ from scipy.stats import norm
 
 import scenarios
 from scenarios.study import SweepStore
+from tests.test_sweep import InlineExecutor
 
 BASE = {
     "name": "tiny",
@@ -28,16 +28,6 @@ def study_data(**parts):
     return {"study": "logic", "scenario": copy.deepcopy(BASE), **parts}
 
 
-class InlineExecutor(Executor):
-    """Runs each task at submission, in this thread."""
-
-    def submit(self, fn, *args, **kwargs):
-        future = Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except BaseException as error:  # noqa: BLE001 - handed to the caller like any executor
-            future.set_exception(error)
-        return future
 
 
 def row(value, status="ok"):

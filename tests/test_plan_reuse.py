@@ -14,7 +14,6 @@ import json
 import math
 import shutil
 import sqlite3
-from concurrent.futures import Executor, Future
 
 import numpy as np
 import pandas as pd
@@ -36,6 +35,7 @@ from scenarios.study.rerun import (
     stored_results,
 )
 from scenarios.study.spec import parse_study
+from tests.test_sweep import InlineExecutor
 
 BASE = {
     "name": "plan-reuse",
@@ -50,16 +50,6 @@ BASE = {
 }
 
 
-class InlineExecutor(Executor):
-    """Runs each task at submission, in this thread: one worker, the test's monkeypatching applied."""
-
-    def submit(self, fn, *args, **kwargs):
-        future = Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except BaseException as error:  # noqa: BLE001 - handed to the caller like any executor
-            future.set_exception(error)
-        return future
 
 
 @pytest.fixture

@@ -11,7 +11,6 @@ from __future__ import annotations
 import copy
 import re
 import warnings
-from concurrent.futures import Executor, Future
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -31,6 +30,7 @@ from scenarios.study.engine import sweep
 from scenarios.study.plots import figures
 from scenarios.study.report import case_table
 from scenarios.study.spec import parse_study
+from tests.test_sweep import InlineExecutor
 
 ROOT = Path(__file__).resolve().parents[1] / "scenarios"
 SHIPPED = sorted(p.name for p in ROOT.glob("*.yaml") if not p.name.startswith("study_"))
@@ -132,16 +132,6 @@ def test_every_axis_of_every_other_shipped_scenario_has_a_unit_and_no_yaml_path(
     check_run(name)
 
 
-class InlineExecutor(Executor):
-    """Runs each case at submission, in this process."""
-
-    def submit(self, fn, *args, **kwargs):
-        future = Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except BaseException as error:  # noqa: BLE001 - handed to the caller like any executor
-            future.set_exception(error)
-        return future
 
 
 def small(data):

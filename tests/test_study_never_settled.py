@@ -6,7 +6,6 @@ worked out by hand below, Spearman's rho from ``scipy.stats.spearmanr``."""
 import copy
 import csv
 import math
-from concurrent.futures import Executor, Future
 
 import numpy as np
 import pytest
@@ -16,6 +15,7 @@ import scenarios
 from ocp.metrics import METRIC_INFO
 from scenarios.study.report import never_witness, percentile
 from scenarios.study.robustness import robustness_lines
+from tests.test_sweep import InlineExecutor
 
 BASE = {
     "name": "tiny",
@@ -28,16 +28,6 @@ BASE = {
 }
 
 
-class InlineExecutor(Executor):
-    """Runs each task at submission, in this thread."""
-
-    def submit(self, fn, *args, **kwargs):
-        future = Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except BaseException as error:  # noqa: BLE001 - handed to the caller like any executor
-            future.set_exception(error)
-        return future
 
 
 # per case: (settling time, final error, row status); case 2 and 5 end outside the band (a final

@@ -12,7 +12,6 @@ from __future__ import annotations
 import copy
 import csv
 import math
-from concurrent.futures import Executor, Future
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +20,7 @@ import pytest
 
 import scenarios
 from scenarios.study.html import histogram_figure
+from tests.test_sweep import InlineExecutor
 
 BASE = {
     "name": "tiny",
@@ -41,16 +41,6 @@ GIVEN: list[tuple[str, float | None, float | None, float | None]] = [
     ("failed", 100.0, None, 5.0), ("crashed", None, None, None), ("infeasible", 50.0, 5.0, 0.01)]
 
 
-class InlineExecutor(Executor):
-    """Runs each task at submission, in this thread."""
-
-    def submit(self, fn: Any, *args: Any, **kwargs: Any) -> Future[Any]:
-        future: Future[Any] = Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except BaseException as error:  # noqa: BLE001 - handed to the caller like any executor
-            future.set_exception(error)
-        return future
 
 
 def task_for(study: scenarios.Study, given: list[tuple[str, float | None, float | None, float | None]] = GIVEN) -> Any:
