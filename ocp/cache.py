@@ -20,15 +20,83 @@ reference, which keeps its model and with it the model's cache, pickles to kilob
 Bounds: a :class:`SolverCache` keeps every entry, for structures that are few (a study's NLPs).
 Where a long-lived process meets an open-ended number of structures (a gain swept in a study: one
 closed loop per law), a :class:`RecentCache` keeps only the most recently used entries.
+
+Keys: :func:`exact_key` states a value (a dataclass tree of numbers, arrays and text) exactly, so
+that two different values never make the same key; the model's fingerprint and a study's planning
+key are built with it.
 """
 from __future__ import annotations
 
+import dataclasses
+import enum
 import threading
 import weakref
 from collections.abc import Callable, Hashable
 from typing import Any, TypeVar
 
+import numpy as np
+
 V = TypeVar("V")
+
+
+class Unkeyable(TypeError):
+    """A value that :func:`exact_key` cannot state exactly (a callable, an object of unknown kind)."""
+
+
+def exact_key(value: Any) -> Any:
+    """``value`` as nested tuples of type tags, exact numbers and text: equal results for equal
+    values, different results for different ones.
+
+    Numbers are exact (a float as its hex, an array as its dtype, shape and bytes), so two values
+    that differ anywhere, however deep (an array inside a dict inside a dataclass) or however little
+    (one bit of one float), give different results; a list and a tuple of the same items differ. A
+    dataclass is its qualified type and its compared fields (those excluded from equality,
+    ``compare=False``, are caches of the others, as ``Spacecraft._cache``); a dict and a set are
+    sorted.
+
+    Parameters
+    ----------
+    value : object
+        None, a bool, int, float (or their NumPy scalars), str, enum member, numeric ndarray,
+        dataclass instance, list, tuple, dict, set or frozenset of these.
+
+    Returns
+    -------
+    object
+        A hashable tree of tuples, strings, ints and bytes whose ``repr`` is as exact as itself.
+
+    Raises
+    ------
+    Unkeyable
+        For anything else (a callable, an object of unknown kind, an array of objects): such a
+        value has no exact statement, and a key must never make it equal to another. The caller
+        decides what then follows (a planning key is then ``None``; a model's fingerprint is then
+        its own alone).
+    """
+    if value is None or isinstance(value, (bool, np.bool_)):
+        return None if value is None else ("b", bool(value))
+    if isinstance(value, (int, np.integer)):
+        return ("i", int(value))
+    if isinstance(value, (float, np.floating)):
+        return ("f", float(value).hex())
+    if isinstance(value, str):
+        return ("s", value)
+    if isinstance(value, enum.Enum):
+        return ("e", f"{type(value).__module__}.{type(value).__qualname__}", value.name)
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind not in "biuf":
+            raise Unkeyable(f"an array of dtype {value.dtype}")
+        return ("a", value.dtype.str, value.shape, np.ascontiguousarray(value).tobytes())
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return (f"{type(value).__module__}.{type(value).__qualname__}",
+                tuple((f.name, exact_key(getattr(value, f.name))) for f in dataclasses.fields(value) if f.compare))
+    if isinstance(value, (list, tuple)):
+        return (type(value).__name__, tuple(exact_key(item) for item in value))
+    if isinstance(value, dict):
+        return ("d", tuple(sorted(((exact_key(k), exact_key(v)) for k, v in value.items()), key=repr)))
+    if isinstance(value, (set, frozenset)):
+        return ("set", tuple(sorted((exact_key(item) for item in value), key=repr)))
+    raise Unkeyable(f"a {type(value).__module__}.{type(value).__qualname__}")
 
 
 class _Entries:

@@ -33,8 +33,6 @@ certificate gets the relative difference of their values of it, ``costate_gap``
 from __future__ import annotations
 
 import copy
-import dataclasses
-import enum
 import hashlib
 import time
 import traceback
@@ -51,6 +49,7 @@ from ocp import (
     metrics_from_reference,
     metrics_from_simulation,
 )
+from ocp.cache import Unkeyable, exact_key
 from ocp.nlp import with_costate_gap
 from ocp.simulation.simulator import law_raised
 from planners import FailedReference, Reference, ReferenceSample
@@ -480,43 +479,6 @@ def _kept_or_planned(kept: Any, key: tuple[Any, ...], planner: Any, name: str, p
     return reference
 
 
-class _Unkeyable(Exception):
-    """A planning input that :func:`planning_key` cannot state exactly."""
-
-
-def _exact(value: Any) -> Any:
-    """``value`` as nested tuples of type tags, exact numbers (a float's hex, an array's bytes) and
-    text; :class:`_Unkeyable` for anything else (a callable, an object of unknown kind).
-
-    A dataclass is its qualified type and its compared fields (those excluded from equality,
-    ``compare=False``, are caches of the others, as for :attr:`ocp.AttitudeModel.fingerprint`).
-    """
-    if value is None or isinstance(value, (bool, np.bool_)):
-        return None if value is None else ("b", bool(value))
-    if isinstance(value, (int, np.integer)):
-        return ("i", int(value))
-    if isinstance(value, (float, np.floating)):
-        return ("f", float(value).hex())
-    if isinstance(value, str):
-        return ("s", value)
-    if isinstance(value, enum.Enum):
-        return ("e", f"{type(value).__module__}.{type(value).__qualname__}", value.name)
-    if isinstance(value, np.ndarray):
-        if value.dtype.kind not in "biuf":
-            raise _Unkeyable(f"an array of dtype {value.dtype}")
-        return ("a", value.dtype.str, value.shape, np.ascontiguousarray(value).tobytes())
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return (f"{type(value).__module__}.{type(value).__qualname__}",
-                tuple((f.name, _exact(getattr(value, f.name))) for f in dataclasses.fields(value) if f.compare))
-    if isinstance(value, (list, tuple)):
-        return (type(value).__name__, tuple(_exact(item) for item in value))
-    if isinstance(value, dict):
-        return ("d", tuple(sorted(((_exact(k), _exact(v)) for k, v in value.items()), key=repr)))
-    if isinstance(value, (set, frozenset)):
-        return ("set", tuple(sorted((_exact(item) for item in value), key=repr)))
-    raise _Unkeyable(f"a {type(value).__module__}.{type(value).__qualname__}")
-
-
 def planning_key(planner: Any, problem: Any) -> tuple[Any, ...] | None:
     """What a plan depends on, hashed: two plans with the same key give the same reference.
 
@@ -528,7 +490,8 @@ def planning_key(planner: Any, problem: Any) -> tuple[Any, ...] | None:
     into, which changes how fast it plans, not what) and the problem it is given: every field of
     the :class:`~planners.ManeuverProblem` (spacecraft, environment, boundary conditions,
     duration, rate bound, pointing constraints with their direction tables, actuator margin),
-    whether or not the planner reads it. Numbers are compared exactly (bit for bit). The class's
+    whether or not the planner reads it, stated by :func:`ocp.cache.exact_key`: numbers are compared
+    exactly (bit for bit), however deep they sit. The class's
     ``plan`` and ``_plan`` are in the key as objects: a method replaced at run time (a test's
     monkeypatch) makes another key.
 
@@ -552,8 +515,8 @@ def planning_key(planner: Any, problem: Any) -> tuple[Any, ...] | None:
         return None
     state = {name: value for name, value in vars(planner).items() if name != "cache"}
     try:
-        text = repr((f"{kind.__module__}.{kind.__qualname__}", _exact(state), _exact(problem)))
-    except _Unkeyable:
+        text = repr((f"{kind.__module__}.{kind.__qualname__}", exact_key(state), exact_key(problem)))
+    except Unkeyable:
         return None
     return hashlib.sha256(text.encode()).hexdigest(), kind.plan, getattr(kind, "_plan", None)
 

@@ -6,7 +6,13 @@ identical models key their solvers differently (a needless rebuild per run).
 """
 from __future__ import annotations
 
-from ocp import AttitudeModel, ReactionWheels, Spacecraft
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ocp import AttitudeModel, CircularOrbit, Environment, ReactionWheels, Spacecraft
 
 
 def _spacecraft(moments: list[float]) -> Spacecraft:
@@ -22,3 +28,50 @@ def test_fingerprint_does_not_depend_on_the_spacecraft_memo() -> None:
 
 def test_fingerprint_still_tells_different_spacecraft_apart() -> None:
     assert AttitudeModel(_spacecraft([1.0, 2.0, 2.5])).fingerprint != AttitudeModel(_spacecraft([1.0, 2.0, 2.6])).fingerprint
+
+
+# --- every number exactly, however deep; an object it cannot state is equal to no other ----------
+
+@dataclass(frozen=True)
+class _TableField:
+    """A field model holding its numbers in a dict: a nested value the fingerprint must read exactly."""
+
+    coefficients: dict[str, np.ndarray]
+
+    def field_inertial(self, position: Any, t: Any) -> Any:
+        return ca.DM(self.coefficients["b"])
+
+
+class _OpaqueField:
+    """A field model that is no dataclass, with a repr that drops its number."""
+
+    def __init__(self, strength: float) -> None:
+        self.strength = strength
+
+    def field_inertial(self, position: Any, t: Any) -> Any:
+        return ca.DM([self.strength, 0.0, 0.0])
+
+    def __repr__(self) -> str:
+        return "_OpaqueField()"
+
+
+def _model(field: Any) -> AttitudeModel:
+    environment = Environment(orbit=CircularOrbit(altitude=500e3), magnetic_field=field)
+    return AttitudeModel(_spacecraft([1.0, 2.0, 2.5]), environment)
+
+
+def test_fingerprint_tells_apart_models_that_differ_only_deep_in_a_nested_value() -> None:
+    b = np.array([2e-5, -1e-5, 3e-5])
+    nudged = b.copy()
+    nudged[1] = np.nextafter(nudged[1], 0.0)  # one bit of one number inside a dict inside the field
+    assert _model(_TableField({"b": b})).fingerprint != _model(_TableField({"b": nudged})).fingerprint
+    assert _model(_TableField({"b": b})).fingerprint == _model(_TableField({"b": b.copy()})).fingerprint
+
+
+def test_an_object_the_fingerprint_cannot_state_makes_the_model_equal_to_no_other() -> None:
+    """As documented (AttitudeModel.fingerprint): its own fingerprint, never another model's."""
+    assert _model(_OpaqueField(2e-5)).fingerprint != _model(_OpaqueField(3e-5)).fingerprint
+    same = _OpaqueField(2e-5)
+    assert _model(same).fingerprint != _model(same).fingerprint
+    model = _model(same)
+    assert model.fingerprint == model.fingerprint  # a model agrees with itself

@@ -14,8 +14,8 @@ torque on the body, the momentum its states store (``A h_w``) and their rates (`
 """
 from __future__ import annotations
 
-import dataclasses
 import hashlib
+import uuid
 from typing import Any
 
 import casadi as ca
@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp import quat
 from ocp import quat_casadi as qc
-from ocp.cache import SolverCache
+from ocp.cache import SolverCache, Unkeyable, exact_key
 from ocp.dynamics.environment import Environment, gravity_gradient_torque
 from ocp.dynamics.layout import actuator_blocks, control_layout
 from ocp.dynamics.spacecraft import Spacecraft
@@ -98,7 +98,12 @@ class AttitudeModel:
     @property
     def fingerprint(self) -> str:
         """A hash of every number and choice of the spacecraft and environment that the symbolic
-        graph bakes in: two models with equal fingerprints build identical functions."""
+        graph bakes in: two models with equal fingerprints build identical functions.
+
+        Numbers are stated exactly (:func:`~ocp.cache.exact_key`): models that differ in one bit of
+        one number have different fingerprints. A spacecraft or environment holding an object that
+        cannot be stated exactly (not a dataclass of numbers, arrays and text) gets a fingerprint of
+        its own, equal to no other model's (its solvers are then not shared)."""
         if self._fingerprint is None:
             description = repr((_plain(self.spacecraft), _plain(self.environment)))
             self._fingerprint = hashlib.sha256(description.encode()).hexdigest()
@@ -282,16 +287,14 @@ class AttitudeModel:
 
 
 def _plain(value: Any) -> Any:
-    """A dataclass tree as nested tuples of plain numbers and strings (for :attr:`AttitudeModel.fingerprint`).
+    """``value`` as the model's fingerprint states it: :func:`~ocp.cache.exact_key` (exact numbers,
+    compared dataclass fields), or, for a value it cannot state exactly (an object of unknown kind),
+    a token drawn afresh on each call, equal to no other: a fingerprint holding one is that model's
+    alone, and shares no built solver with another model rather than share one by accident.
 
-    Fields excluded from equality (``compare=False``, e.g. ``Spacecraft._cache``) are not part of
-    what the value describes and are skipped.
+    Also the walker of :meth:`controllers.Controller.symbolic_key`.
     """
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return (type(value).__name__,) + tuple((f.name, _plain(getattr(value, f.name)))
-                                               for f in dataclasses.fields(value) if f.compare)
-    if isinstance(value, np.ndarray):
-        return ("array", value.shape, tuple(float(v) for v in value.ravel()))
-    if isinstance(value, (list, tuple)):
-        return tuple(_plain(v) for v in value)
-    return value
+    try:
+        return exact_key(value)
+    except Unkeyable:
+        return ("unkeyable", uuid.uuid4().hex)
