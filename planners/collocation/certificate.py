@@ -29,7 +29,7 @@ from ocp.nlp.certificate import (
 from ocp.nlp.solve import NLPResult
 from ocp.transcription import NLP, OptimalControlProblem, Transcription
 from ocp.transcription.radau import RadauCollocation
-from planners.collocation.reference import states_controls
+from planners.collocation.reference import _mapped, states_controls
 from planners.problem import Array, ManeuverProblem
 from planners.reference import Reference
 
@@ -75,8 +75,8 @@ def radau_points(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP
 
 
 def _control_jacobian(model: AttitudeModel) -> ca.Function:
-    """``∂f/∂u (x, u, t, d)`` of the model's dynamics (built once per model and point count, in its
-    ``solver_cache``, by :func:`switching`)."""
+    """``∂f/∂u (x, u, t, d)`` of the model's dynamics (mapped over the points and kept with the
+    model's recent maps by :func:`switching`)."""
     xs, us, ts, ds = ca.SX.sym("x", model.nx), ca.SX.sym("u", model.nu), ca.SX.sym("t"), ca.SX.sym("d", 3)
     return ca.Function("f_u", [xs, us, ts, ds], [ca.jacobian(model.rhs(xs, us, ts, ds), us)])
 
@@ -110,8 +110,7 @@ def switching(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w
     offset = nlp.n_stage_state + nx * d
     low = np.asarray(lbx, dtype=float)[:nz * N].reshape(N, nz)[:, offset:offset + nu * d].reshape(N * d, nu)
     high = np.asarray(ubx, dtype=float)[:nz * N].reshape(N, nz)[:, offset:offset + nu * d].reshape(N * d, nu)
-    f_u = np.asarray(model.solver_cache.get(("collocation", "switching f_u", x.shape[0]),
-                                            lambda: _control_jacobian(model).map(x.shape[0]))(
+    f_u = np.asarray(_mapped(model, "switching f_u", x.shape[0], lambda: _control_jacobian(model))(
         x.T, u.T, t[None, :], np.tile(params[-3:], (x.shape[0], 1)).T))
     f_u = f_u.reshape(nx, x.shape[0], nu).transpose(1, 0, 2)  # (points, nx, nu)
     sigma = costate_sign * np.einsum("ki,kij->kj", p, f_u)

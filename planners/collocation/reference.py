@@ -52,6 +52,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ocp import quat
+from ocp.cache import RecentCache
 from ocp.dynamics.model import AttitudeModel
 from ocp.geometry import PointingConstraint
 from ocp.transcription.base import Transcription
@@ -414,25 +415,36 @@ class CollocationReference(Reference):
         return ReferenceSample(quat.normalize(x[:, 0:4]), omega, x_dot[:, 4:7], torque)
 
 
-def _mapped(model: AttitudeModel, name: str, n: int) -> ca.Function:
-    """The model's function ``name`` (``rhs``, ``body_torque``, ``environment_torque``) mapped over
-    ``n`` points, built once per model and ``n`` (in its ``solver_cache``).
+MAPS_KEPT = 8
+"""Mapped functions a model keeps for the collocation reference and its certificate (one per
+function and sample count), the most recently used (:class:`~ocp.cache.RecentCache`): a study
+meeting many sample counts keeps this many, not one per count."""
+
+
+def _mapped(model: AttitudeModel, name: str, n: int, build: Callable[[], ca.Function] | None = None) -> ca.Function:
+    """The model's function ``name`` (``rhs``, ``body_torque``, ``environment_torque``), or
+    ``build()``, mapped over ``n`` points; kept with the model's :data:`MAPS_KEPT` most recently
+    used maps (in its ``solver_cache``).
 
     Parameters
     ----------
     model : ocp.AttitudeModel
         The model.
     name : str
-        Its ``casadi.Function`` attribute.
+        Its ``casadi.Function`` attribute, or the name the map of ``build()`` is kept under.
     n : int
         Points (columns) per call.
+    build : callable, optional
+        Builds the function to map (called only when its map is not kept); ``None``: the model's
+        attribute ``name``.
 
     Returns
     -------
     casadi.Function
-        ``getattr(model, name).map(n)``.
+        The function mapped over ``n`` points.
     """
-    return model.solver_cache.get(("collocation", "map", name, n), lambda: getattr(model, name).map(n))
+    maps = model.solver_cache.get(("collocation", "maps"), lambda: RecentCache(MAPS_KEPT))
+    return maps.get((name, n), lambda: (getattr(model, name) if build is None else build()).map(n))
 
 
 def states_controls(problem: ManeuverProblem, reference: Reference, times: Array) -> tuple[Array, Array, ReferenceSample]:
