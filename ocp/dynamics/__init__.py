@@ -18,15 +18,42 @@ loop integrates beside the design model (:mod:`~ocp.dynamics.truth`).
 May import: NumPy, CasADi, ppigrf, pyerfa, sgp4, jplephem with de421 and the top-level modules of :mod:`ocp` (``quat``,
 ``quat_casadi``, ``cache``, ``fast_call``, ``errors``); never the other subpackages of ``ocp``.
 """
-from ocp.dynamics.actuator_kinds import ACTUATOR_KINDS, Actuator, Magnetorquers, ReactionWheels, Torquers, actuator_kind
+from ocp.dynamics.actuator_kinds import (
+    ACTUATOR_KINDS,
+    Actuator,
+    Magnetorquers,
+    ReactionWheels,
+    Torquers,
+    actuator_kind,
+)
 from ocp.dynamics.actuators import ActuatorModel, Command, Measurement
-from ocp.dynamics.environment import (MAGNETIC_FIELDS, Environment, FieldModel, MagneticField, TiltedDipole,
-                                      gravity_gradient_torque)
-from ocp.dynamics.ephemeris import EPHEMERIS_RANGE, check_epoch, moon_position, parse_utc, sun_position, tdb_julian_date
+from ocp.dynamics.environment import (
+    MAGNETIC_FIELDS,
+    Environment,
+    FieldModel,
+    MagneticField,
+    TiltedDipole,
+    gravity_gradient_torque,
+)
+from ocp.dynamics.ephemeris import (
+    EPHEMERIS_RANGE,
+    check_epoch,
+    moon_position,
+    parse_utc,
+    sun_position,
+    tdb_julian_date,
+)
 from ocp.dynamics.igrf import IGRFField
 from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.model import AttitudeModel
-from ocp.dynamics.orbits import ORBITS, CircularOrbit, KeplerianOrbit, Orbit, OrbitKind, TLEOrbit
+from ocp.dynamics.orbits import (
+    ORBITS,
+    CircularOrbit,
+    KeplerianOrbit,
+    Orbit,
+    OrbitKind,
+    TLEOrbit,
+)
 from ocp.dynamics.spacecraft import Spacecraft
 from ocp.dynamics.truth import PeriodicTorque, Truth, TruthPlant
 
