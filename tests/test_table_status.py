@@ -80,7 +80,7 @@ def test_a_table_whose_entries_crashed_writes_its_files_and_exits_1(tmp_path: Pa
     lines = captured.err.strip().splitlines()
     # off a terminal the engine's progress line comes first (at most every 30 s, and at the end)
     progress = [line for line in lines if line.startswith("table bilimoria-wie: ")]
-    assert progress and progress[-1].startswith("table bilimoria-wie: 2/2 cases done, 2 not ok (2 crashed), "), captured.err
+    assert progress and progress[-1].startswith("table bilimoria-wie: 2/2 entries done, 2 not ok (2 crashed), "), captured.err
     last = lines[lines.index(progress[-1]) + 1:]
     assert last[0].startswith("slewbench: 2 of 2 entries crashed"), captured.err
     # each entry timed out: by the worker's own alarm, or (under load, the alarm not reached in time) by

@@ -170,7 +170,7 @@ def _study(spec: TableSpec, cases: list[TableCase]) -> Any:
                         case.scenario, case_key(case.scenario, version)) for index, case in enumerate(cases)]
     execution = Execution(spec.workers, spec.scheduler, spec.case_timeout_s, 1)
     return Study(f"table {spec.name}", spec.source, spec.base, ["maneuver.final.q"], [], 1, None, 0, [], execution,
-                 study_cases, {"table": spec.name})
+                 study_cases, {"table": spec.name}, units=("entry", "entries"))
 
 
 def _proven_infeasible(scenario: dict[str, Any]) -> bool:

@@ -424,16 +424,18 @@ class _Progress:
     """A sweep's progress on standard error: tqdm's bar (with the time left) on a terminal; elsewhere
     a plain line, ``NAME: 12/40 cases done, 3 not ok (1 crashed), 2m10s elapsed``, at most every
     :data:`PROGRESS_LINE_S` (also while no case finishes) and once at the end, so that a long
-    sweep under continuous integration or ``nohup`` can be told from a hung one."""
+    sweep under continuous integration or ``nohup`` can be told from a hung one. ``units``: what
+    one case and several are called (:attr:`~scenarios.study.types.Study.units`)."""
 
-    def __init__(self, name: str, total: int, clock: Callable[[], float] = time.monotonic):
-        self.name, self.total, self.clock = name, total, clock
+    def __init__(self, name: str, total: int, clock: Callable[[], float] = time.monotonic,
+                 units: tuple[str, str] = ("case", "cases")):
+        self.name, self.total, self.clock, self.units = name, total, clock, units
         self.done = self.not_ok = self.crashed = 0
         self.started = self.said = clock()
         self.bar: Any = None
         if sys.stderr.isatty():
             from tqdm import tqdm
-            self.bar = tqdm(total=total, unit="case", desc=name[:40], dynamic_ncols=True, file=sys.stderr,
+            self.bar = tqdm(total=total, unit=units[0], desc=name[:40], dynamic_ncols=True, file=sys.stderr,
                             mininterval=0.5)
             if not (self.bar.ncols or 0) > 0:  # a terminal reporting no size (0 x 0):
                 self.bar.dynamic_ncols, self.bar.ncols, self.bar.nrows = False, 80, None  # tqdm would draw nothing
@@ -442,7 +444,7 @@ class _Progress:
         """What the progress line says now."""
         counts = f", {self.not_ok} not ok" if self.not_ok else ""
         counts += f" ({self.crashed} crashed)" if self.crashed else ""
-        return (f"{self.name}: {self.done}/{self.total} cases done{counts}, "
+        return (f"{self.name}: {self.done}/{self.total} {self.units[1]} done{counts}, "
                 f"{_duration(self.clock() - self.started)} elapsed")
 
     def update(self, done: int, not_ok: int, crashed: int) -> None:
@@ -514,7 +516,7 @@ class _Engine:
         self.crashed = 0
         self.no_workers_since: float | None = None
         self.next_cluster_check = 0.0
-        self.progress = _Progress(study.name, len(self.cases)) if progress else None
+        self.progress = _Progress(study.name, len(self.cases), units=study.units) if progress else None
 
     # --- submitting ---------------------------------------------------------------------------
 

@@ -115,6 +115,9 @@ class Study:
         parameter is the dispersed path, with the component for a vector (``[k]``) or matrix
         (``[i][j]``) and ``.principal.moments_scale[k]`` or ``.principal.axes_deg[k]`` for a
         ``principal`` dispersion; ``case_seed`` draws none.
+    units : tuple of str
+        What one case and several are called in the progress of a sweep: ``("case", "cases")``;
+        a slew table's study, one case per table entry, says ``("entry", "entries")``.
     """
 
     name: str
@@ -132,6 +135,7 @@ class Study:
     thresholds: dict[str, tuple[str, float]] = field(default_factory=dict)
     worst: int = 5
     parameters: dict[str, str] = field(default_factory=dict)
+    units: tuple[str, str] = ("case", "cases")
 
     @property
     def varied_paths(self) -> list[str]:
