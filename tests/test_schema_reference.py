@@ -39,7 +39,7 @@ from scenarios.schema.reference import (
     schema_text,
     summary_line,
 )
-from scenarios.schema.study import VALUE_GENERATORS
+from scenarios.schema.study import PRINCIPAL, PRINCIPAL_DISPERSION, VALUE_GENERATORS
 from scenarios.study.spec import parse_study
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -196,6 +196,7 @@ scenario:
   controller: {name: augmented_quaternion_feedback}
   simulation: {sample_time: 0.5, initial_attitude_error_deg: [0, 0, 0], initial_rate_error: [0, 0, 0],
                sensor_noise: {seed: 0}}
+  truth: {spacecraft: {inertia: [2.0, 3.0, 4.0]}}
 grid:
   maneuver.duration: [30.0, 40.0]
   planners[label=fast].options.torque_fraction: {linspace: [0.5, 1.0, 2]}
@@ -211,6 +212,8 @@ monte_carlo:
     simulation.initial_attitude_error_deg: {normal: {mean: [0, 0, 0], std: [1, 1, 1]}}
     simulation.initial_rate_error: {uniform: {low: [0, 0, 0], high: [1.0e-4, 1.0e-4, 1.0e-4]}}
     spacecraft.inertia: {scale: {uniform: [0.9, 1.1]}}
+    truth.spacecraft.inertia: {principal: {moments_scale: {uniform: [0.95, 1.05]},
+                                           axes_deg: {normal: {mean: [0, 0, 0], std: [1, 1, 1]}}}}
     spacecraft.wheels.max_torque: {offset: {normal: {mean: 0.0, std: 1.0e-4}}}
     simulation.sensor_noise.seed: case_seed
 summary: [cl.int_u, ref.final_error_deg]
@@ -304,7 +307,7 @@ def test_every_key_the_scenario_parser_reads_is_documented(keys_read):
 def study_path(path: str, varied: list[str]) -> str:
     """A study path as the reference writes it: the scenario path of a grid, zip or dispersion
     entry as ``<path>`` (zip entries as grid's), a generator inside ``axis_angle.angle_deg`` as a
-    generator, a distribution inside ``scale`` or ``offset`` as a distribution."""
+    generator, a distribution inside ``scale``, ``offset`` or a key of ``principal`` as a distribution."""
     if path.startswith("robustness.thresholds."):  # keyed by a metric column, which has dots of its own
         sense = path.rsplit(".", 1)[-1]
         return "robustness.thresholds.<name>" + (f".{sense}" if sense in ("at_most", "at_least") else "")
@@ -313,6 +316,8 @@ def study_path(path: str, varied: list[str]) -> str:
             if path == f"{scope}.{scenario}" or path.startswith(f"{scope}.{scenario}."):
                 path = ("grid" if scope == "zip" else scope) + ".<path>" + path[len(f"{scope}.{scenario}"):]
                 path = re.sub(r"\.axis_angle\.angle_deg\.(?=\w+$)", ".", path)
+                path = re.sub(rf"\.{PRINCIPAL_DISPERSION.name}\.({'|'.join(key.name for key in PRINCIPAL.keys)})\."
+                              r"(?=\w)", ".", path)  # a distribution inside principal's keys: as a distribution
                 return re.sub(r"\.(scale|offset)\.(?=\w)", ".", path)
     return path
 

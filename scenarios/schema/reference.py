@@ -57,6 +57,8 @@ from scenarios.schema.study import (
     EXECUTION,
     GRID_ENTRY,
     MONTE_CARLO,
+    PRINCIPAL,
+    PRINCIPAL_DISPERSION,
     ROBUSTNESS,
     STUDY,
     VALUE_GENERATORS,
@@ -307,6 +309,10 @@ def _study_parts() -> list[Part]:
                            f"study.monte_carlo.dispersions.{name}")
     for name, (key, _) in COMBINATIONS.items():
         forms.append(_key_entry(key, f"{dispersions}.{name}", f"study.monte_carlo.dispersions.{name}", form=True))
+    principal = PRINCIPAL_DISPERSION.name
+    forms.append(_key_entry(PRINCIPAL_DISPERSION, f"{dispersions}.{principal}",
+                            f"study.monte_carlo.dispersions.{principal}", form=True))
+    forms += _walk(PRINCIPAL, f"{dispersions}.{principal}", f"study.monte_carlo.dispersions.{principal}")
     forms.append(_key_entry(CASE_SEED, f"{dispersions}: {CASE_SEED.name}",
                             f"study.monte_carlo.dispersions.{CASE_SEED.name}", form=True))
     return [

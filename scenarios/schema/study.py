@@ -71,6 +71,7 @@ __all__ = [
     "MAX_WORST",
     "MONTE_CARLO",
     "PRINCIPAL",
+    "PRINCIPAL_DISPERSION",
     "ROBUSTNESS",
     "SCHEDULER_SCHEMES",
     "STUDY",
@@ -392,16 +393,26 @@ bound; a normal draw beyond it is refused at its case)."""
 PRINCIPAL = Section((
     custom("moments_scale", "Factor on each principal moment of the base tensor: ``{<distribution>: <argument>}`` "
            "of a number (one factor for the three) or of 3 numbers, the moment about the principal axis nearest "
-           "body axis x, y, z; absent: 1.", "{distribution: argument}", None, default=None, bounds="> 0"),
+           "body axis x, y, z; absent: 1.", "{distribution: argument}", None, default=None,
+           bounds="> 0, the scaled moments meeting the triangle inequality (a uniform's bounds)"),
     custom("axes_deg", "Rotation vector (body frame) turning the base tensor's principal axes: "
            "``{<distribution>: <argument>}`` of 3 numbers, the rotation's angle their norm; absent: none.",
-           "{distribution: argument}", None, unit="deg", default=None),
+           "{distribution: argument}", None, unit="deg", default=None,
+           bounds=f"angle <= {MAX_PRINCIPAL_AXES_DEG:g} (a uniform's corners; a normal draw beyond it refuses "
+                  "its case)"),
 ), "Dispersion of an inertia tensor in its principal frame: the case's tensor is "
    "``R V diag(s m) Vᵀ Rᵀ`` with ``V diag(m) Vᵀ`` the base tensor (its eigendecomposition), ``s`` the moment "
    "factors and ``R`` the rotation of ``axes_deg``: symmetric, positive definite while the factors are "
    "positive, with the principal axes turned by exactly the rotation's angle.")
+"""The keys of the ``principal`` dispersion (:data:`PRINCIPAL_DISPERSION`)."""
+
+PRINCIPAL_DISPERSION = custom(
+    "principal", "For an inertia tensor (" + ", ".join(f"``{key}``" for key in SYMMETRIC_KEYS) + ") only: its "
+    "principal moments scaled and its principal axes rotated, ``{principal: {moments_scale: <distribution>, "
+    "axes_deg: <distribution>}}`` (at least one of the two). " + PRINCIPAL.meaning,
+    "mapping {moments_scale, axes_deg}", None, section=PRINCIPAL)
 """The ``principal`` dispersion of a key of :data:`SYMMETRIC_KEYS`: ``{principal: {moments_scale:
-<distribution>, axes_deg: <distribution>}}``."""
+<distribution>, axes_deg: <distribution>}}``, its keys :data:`PRINCIPAL`."""
 
 DISPERSION = custom("<path>", "A scenario path and how it is dispersed: ``{<distribution>: <argument>}`` (the draw "
                     "is the value), ``{scale|offset: {<distribution>: <argument>}}``, ``case_seed``, or, for an "

@@ -33,13 +33,14 @@ from scenarios.schema.study import (
     DISTRIBUTIONS,
     MAX_PRINCIPAL_AXES_DEG,
     PRINCIPAL,
+    PRINCIPAL_DISPERSION,
     SYMMETRIC_KEYS,
     symmetric_key,
 )
 from scenarios.study.paths import Step, _describe, get_path
 
-PRINCIPAL_NAME = "principal"
-"""The dispersion form of :data:`~scenarios.schema.study.PRINCIPAL`."""
+PRINCIPAL_NAME = PRINCIPAL_DISPERSION.name
+"""The dispersion form of :data:`~scenarios.schema.study.PRINCIPAL_DISPERSION`."""
 
 
 @dataclass
