@@ -723,8 +723,10 @@ class EigenaxisPlanner(Planner):
             never loosens it; ``None`` (default): the problem's (if any).
         rate_margin : float
             The rate requirement (``requirements.rate.max``, ``ManeuverProblem.rate_requirement``)
-            is planned this fraction lower, in [0, 1) (default 0.01): a zero-order-hold closed loop
-            tracking a coast at the bound overshoots it (by 0.03-0.04 % with a perfect plant);
+            is planned this fraction lower, in [0, 1) (default 0.01), with every profile: a
+            zero-order-hold closed loop tracking a coast at the bound overshoots it (by 0.03-0.04 %
+            with a perfect plant), and one tracking the quintic's smooth peak at the bound too, less
+            (2.4e-5 of it at 0.5 s samples);
             ``maneuver.max_rate`` and the option ``max_rate`` are imposed as given
             (:meth:`~planners.problem.ManeuverProblem.rate_bound`).
         torque_fraction : float
