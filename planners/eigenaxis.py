@@ -449,6 +449,9 @@ class WheelBudget:
     horizon : float or None, optional
         The slew's duration [s] over which the momentum the environment's torque adds to the
         wheels is reserved (:attr:`momentum_reserve`); ``None`` (default): the problem's T.
+    environment : tuple of ((3,) ndarray, float) or None, optional
+        ``problem.environment_torque_bound(problem.duration)`` when already computed (a planner
+        sizing several budgets of one problem); ``None`` (default): computed here.
 
     Attributes
     ----------
@@ -479,7 +482,8 @@ class WheelBudget:
     """
 
     def __init__(self, problem: ManeuverProblem, axis: Array, angle: float, fraction: float,
-                 scale: float = 1.0, momentum_fraction: float = 1.0, horizon: float | None = None) -> None:
+                 scale: float = 1.0, momentum_fraction: float = 1.0, horizon: float | None = None,
+                 environment: tuple[Array, float] | None = None) -> None:
         spacecraft = problem.spacecraft
         inertia = spacecraft.inertia
         rows, limits = spacecraft.allocation_rows()
@@ -487,7 +491,8 @@ class WheelBudget:
         self.limits = limits
         # The actuators give the motion's torque less the environment's, which this planner does not
         # model: each bounded row keeps a bound of |M_i τ_env| in reserve (ManeuverProblem.environment_torque_bound).
-        disturbance, gravity_gradient = problem.environment_torque_bound(problem.duration)
+        disturbance, gravity_gradient = (problem.environment_torque_bound(problem.duration) if environment is None
+                                          else environment)
         self.reserve = np.where(limits > 0, np.abs(rows @ disturbance) + gravity_gradient * np.linalg.norm(rows, axis=1),
                                 0.0)
         self.bounds = fraction * scale * limits - self.reserve
@@ -653,13 +658,14 @@ def _smallest_cap(*caps: float) -> float:
     return float(np.min(values, initial=np.inf))
 
 
-def _environment_loads_the_wheels(problem: ManeuverProblem) -> bool:
-    """Whether the environment has a torque (gravity gradient, a constant disturbance) and a wheel a
-    momentum bound: then the momentum the environment adds over the slew is reserved from it."""
+def _environment_loads_the_wheels(problem: ManeuverProblem, environment: tuple[Array, float]) -> bool:
+    """Whether the environment has a torque (``environment``: the constant disturbance and the
+    gravity gradient's bound) and a working wheel a momentum bound: then the momentum the
+    environment adds over the slew is reserved from it."""
     wheels = problem.spacecraft.wheels
     if wheels is None or not np.any(np.isfinite(wheels.max_momentum[wheels.working])):
         return False
-    disturbance, gravity_gradient = problem.environment_torque_bound(problem.duration)
+    disturbance, gravity_gradient = environment
     return gravity_gradient > 0 or bool(np.any(disturbance != 0))
 
 
@@ -804,14 +810,15 @@ class EigenaxisPlanner(Planner):
         if angle < 1e-12:
             return EigenaxisReference(problem.q0, axis, BangCoastBangProfile(0.0, 1.0, 0.0), problem.duration if self.options.profile
                                       == "trapezoidal" else 0.0, inertia, "no rotation needed", problem)
-        if self.options.profile != "min_time" or not _environment_loads_the_wheels(problem):
-            return self._plan_bang(problem, axis, angle, max_rate, problem.duration)
+        environment = problem.environment_torque_bound(problem.duration)  # one bound for every budget
+        if self.options.profile != "min_time" or not _environment_loads_the_wheels(problem, environment):
+            return self._plan_bang(problem, axis, angle, max_rate, problem.duration, environment)
         # min_time with an environment torque on wheels with a momentum bound: the momentum it adds
         # over the slew is reserved over the slew's own duration, which grows with the reserve. From
         # no reserve the durations increase to the least horizon that covers its own slew.
         horizon = 0.0
         for _ in range(100):
-            reference = self._plan_bang(problem, axis, angle, max_rate, horizon)
+            reference = self._plan_bang(problem, axis, angle, max_rate, horizon, environment)
             if not reference.ok or reference.duration <= horizon:
                 return reference
             horizon = reference.duration * (1 + 1e-6)
@@ -819,13 +826,14 @@ class EigenaxisPlanner(Planner):
                                f"environment's torque over it, past {horizon:.4g} s after 100 passes", "infeasible")
 
     def _plan_bang(self, problem: ManeuverProblem, axis: Array, angle: float, max_rate: float | None,
-                   horizon: float) -> Reference:
+                   horizon: float, environment: tuple[Array, float] | None = None) -> Reference:
         """The bang profiles (``trapezoidal``, ``min_time``) of a rotation ``angle`` > 0 about
-        ``axis``, the environment's momentum reserved over ``horizon`` [s] (:class:`WheelBudget`)."""
+        ``axis``, the environment's momentum reserved over ``horizon`` [s] (:class:`WheelBudget`, with
+        ``environment`` its torque bound when already computed)."""
         inertia = problem.spacecraft.inertia
         keep = 1.0 - (problem.actuator_margin or 0.0)  # the actuator requirement's share of each limit
         budget = WheelBudget(problem, axis, angle, self.options.torque_fraction * keep, momentum_fraction=keep,
-                             horizon=horizon)
+                             horizon=horizon, environment=environment)
         if budget.exact:
             return self._bang(problem, axis, angle, max_rate, budget, self.options.profile)
         # Wheels spanning fewer than three axes (beside torquers): the wheels' momentum moves with
