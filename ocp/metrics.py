@@ -116,8 +116,10 @@ METRIC_INFO: dict[str, MetricInfo] = {
     "plan_time_s": MetricInfo(
         "s", "Wall time of the planner's ``plan``; null in regulation (no planner)."),
     "duration_s": MetricInfo(
-        "s", "The reference's manoeuvre time T (chosen by the planner when the time is free); null in "
-        "regulation."),
+        "s", "The reference's manoeuvre time T (chosen by the planner when the time is free), in closed loop "
+        "too: ``cl.duration_s`` is the T the closed loop tracked, not the simulated horizon (the run's last "
+        "sample: ``simulation.duration``, else the longer of ``maneuver.duration`` and T; the row's message says "
+        "when the run stops before T); null in regulation."),
     "detumble_time_s": MetricInfo(
         "s", "t_(j+1) for the last sample j where max_i |ω_i| ≥ ``simulation.detumble_tolerance`` "
         "(default 0.01 rad/s), i.e. the first sample time after which the rate stays below it to the end; "
@@ -310,7 +312,7 @@ def compute_metrics(
     plan_time_s : float or None, optional
         Wall time of the planner [s], copied to ``plan_time_s``.
     duration_s : float or None, optional
-        The manoeuvre time T [s], copied to ``duration_s``.
+        The manoeuvre time T [s], the reference's, copied to ``duration_s``.
     settling_tolerance_deg : float, optional
         Band about ``target_q`` for ``settling_time_s`` [deg] (default
         :data:`DEFAULT_SETTLING_TOLERANCE_DEG`).
@@ -586,7 +588,8 @@ def metrics_from_simulation(
     plan_time_s : float or None, optional
         Wall time of the planner [s].
     duration_s : float or None, optional
-        The manoeuvre time T [s].
+        The manoeuvre time T [s]: the tracked reference's ``duration`` (not the simulated horizon,
+        ``result.t[-1]``); ``None`` in regulation.
     settling_tolerance_deg : float, optional
         Band for ``settling_time_s`` [deg].
     fine_settling_tolerance_deg : float or None, optional

@@ -28,7 +28,11 @@ holds.
 The environment's torque (gravity gradient, a constant disturbance) is not in this planner's
 model, but the actuators must cancel it: a bound of it along the slew
 (:meth:`~planners.problem.ManeuverProblem.environment_torque_bound`) is kept from every row's bound
-(:attr:`WheelBudget.reserve`); the momentum it adds to the wheels is not reserved.
+(:attr:`WheelBudget.reserve`), and the momentum it adds to the wheels over the slew, at most
+``(|(A⁺)_i d| + ‖(A⁺)_i‖ g) T`` per working wheel (``d`` the constant disturbance, ``g`` the
+gravity gradient's bound), from every working wheel's momentum bound
+(:attr:`WheelBudget.momentum_reserve`): ``T`` the scenario's for ``trapezoidal``, the slew's own
+for ``min_time`` (iterated from no reserve up to the least duration that covers its own slew).
 """
 from __future__ import annotations
 
@@ -442,6 +446,12 @@ class WheelBudget:
         A further factor on the torque bounds (the planner's shrinking; default 1).
     momentum_fraction : float, optional
         The share of each working wheel's ``max_momentum`` the profile may use (default 1).
+    horizon : float or None, optional
+        The slew's duration [s] over which the momentum the environment's torque adds to the
+        wheels is reserved (:attr:`momentum_reserve`); ``None`` (default): the problem's T.
+    environment : tuple of ((3,) ndarray, float) or None, optional
+        ``problem.environment_torque_bound(problem.duration)`` when already computed (a planner
+        sizing several budgets of one problem); ``None`` (default): computed here.
 
     Attributes
     ----------
@@ -452,6 +462,11 @@ class WheelBudget:
         (:meth:`~planners.problem.ManeuverProblem.environment_torque_bound`, ``|M_i d| + ‖M_i‖ g``
         for the constant disturbance ``d`` and the gravity gradient's bound ``g``), which the
         actuators must cancel besides the motion's own torque; 0 without one.
+    momentum_reserve : (n,) ndarray
+        Per working wheel, a bound of the momentum the environment's torque adds to it over the
+        slew, ``(|(A⁺)_i d| + ‖(A⁺)_i‖ g) T`` [N m s] (``T`` the ``horizon``): the wheels absorb
+        the torque the actuators cancel, so the profile's own momentum keeps within ``h_max`` less
+        it; 0 without an environment torque.
     accel, quadratic, linear : (m,) ndarray
         ``M I e`` (signed), ``g`` and ``c`` per row.
     exact : bool
@@ -467,7 +482,8 @@ class WheelBudget:
     """
 
     def __init__(self, problem: ManeuverProblem, axis: Array, angle: float, fraction: float,
-                 scale: float = 1.0, momentum_fraction: float = 1.0) -> None:
+                 scale: float = 1.0, momentum_fraction: float = 1.0, horizon: float | None = None,
+                 environment: tuple[Array, float] | None = None) -> None:
         spacecraft = problem.spacecraft
         inertia = spacecraft.inertia
         rows, limits = spacecraft.allocation_rows()
@@ -475,7 +491,8 @@ class WheelBudget:
         self.limits = limits
         # The actuators give the motion's torque less the environment's, which this planner does not
         # model: each bounded row keeps a bound of |M_i τ_env| in reserve (ManeuverProblem.environment_torque_bound).
-        disturbance, gravity_gradient = problem.environment_torque_bound(problem.duration)
+        disturbance, gravity_gradient = (problem.environment_torque_bound(problem.duration) if environment is None
+                                          else environment)
         self.reserve = np.where(limits > 0, np.abs(rows @ disturbance) + gravity_gradient * np.linalg.norm(rows, axis=1),
                                 0.0)
         self.bounds = fraction * scale * limits - self.reserve
@@ -489,7 +506,13 @@ class WheelBudget:
         momentum0 = axes @ h0 + self.projector @ inertia @ problem.omega0  # A h_w at the start of the profile
         self.wheel_momentum0 = momentum0
         self.h0 = h0[self.working] + self.pinv @ inertia @ problem.omega0
-        self.h_max = np.zeros(0) if wheels is None else momentum_fraction * wheels.max_momentum[self.working]
+        # The environment's torque, cancelled by the actuators, goes into the wheels' momentum: at most
+        # (|(A⁺)_i d| + ‖(A⁺)_i‖ g) T over the slew, kept from each working wheel's bound.
+        self.horizon = problem.duration if horizon is None else float(horizon)
+        self.momentum_reserve = (np.abs(self.pinv @ disturbance)
+                                 + gravity_gradient * np.linalg.norm(self.pinv, axis=1)) * self.horizon
+        self.h_max = np.zeros(0) if wheels is None else (momentum_fraction * wheels.max_momentum[self.working]
+                                                         - self.momentum_reserve)
         inertia_axis = inertia @ axis
         self.exact = bool(np.allclose(self.projector, np.eye(3), atol=1e-9)) or not np.any(self.working)
         self.accel = rows @ inertia_axis
@@ -606,8 +629,8 @@ class WheelBudget:
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.where(self.bounds > 0, demand / self.bounds, np.where(demand > 1e-9 * size, np.inf, 0.0))
         h = self.h0 + (np.array(momenta) - self.wheel_momentum0) @ self.pinv.T if momenta else np.zeros((1, 0))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            h_ratio = np.where(np.isfinite(self.h_max), np.abs(h) / self.h_max, 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):  # a bound the reserve takes whole: no momentum fits
+            h_ratio = np.where(~np.isfinite(self.h_max), 0.0, np.where(self.h_max > 0, np.abs(h) / self.h_max, np.inf))
         return float(np.max(ratio, initial=0.0)), float(np.max(h_ratio, initial=0.0))
 
 
@@ -633,6 +656,17 @@ def _smallest_cap(*caps: float) -> float:
     if np.any(np.isnan(values)):
         raise AssertionError(f"a rate cap is NaN: {values.tolist()}")
     return float(np.min(values, initial=np.inf))
+
+
+def _environment_loads_the_wheels(problem: ManeuverProblem, environment: tuple[Array, float]) -> bool:
+    """Whether the environment has a torque (``environment``: the constant disturbance and the
+    gravity gradient's bound) and a working wheel a momentum bound: then the momentum the
+    environment adds over the slew is reserved from it."""
+    wheels = problem.spacecraft.wheels
+    if wheels is None or not np.any(np.isfinite(wheels.max_momentum[wheels.working])):
+        return False
+    disturbance, gravity_gradient = environment
+    return gravity_gradient > 0 or bool(np.any(disturbance != 0))
 
 
 class EigenaxisPlanner(Planner):
@@ -695,8 +729,10 @@ class EigenaxisPlanner(Planner):
             never loosens it; ``None`` (default): the problem's (if any).
         rate_margin : float
             The rate requirement (``requirements.rate.max``, ``ManeuverProblem.rate_requirement``)
-            is planned this fraction lower, in [0, 1) (default 0.01): a zero-order-hold closed loop
-            tracking a coast at the bound overshoots it (by 0.03-0.04 % with a perfect plant);
+            is planned this fraction lower, in [0, 1) (default 0.01), with every profile: a
+            zero-order-hold closed loop tracking a coast at the bound overshoots it (by 0.03-0.04 %
+            with a perfect plant), and one tracking the quintic's smooth peak at the bound too, less
+            (2.4e-5 of it at 0.5 s samples);
             ``maneuver.max_rate`` and the option ``max_rate`` are imposed as given
             (:meth:`~planners.problem.ManeuverProblem.rate_bound`).
         torque_fraction : float
@@ -706,7 +742,8 @@ class EigenaxisPlanner(Planner):
             (``requirements.actuators.margin``) the bang profiles keep ``1 − margin`` of every
             torque and momentum limit, and this share applies within it. With an environment
             torque (gravity gradient, a constant disturbance), which this planner does not model, a
-            bound of it is kept from each torque bound besides (:class:`WheelBudget`).
+            bound of it is kept from each torque bound besides, and of the momentum it adds over
+            the slew from each wheel's momentum bound (:class:`WheelBudget`).
         """
 
         profile: Literal["smooth", "trapezoidal", "min_time"] = "smooth"
@@ -773,8 +810,30 @@ class EigenaxisPlanner(Planner):
         if angle < 1e-12:
             return EigenaxisReference(problem.q0, axis, BangCoastBangProfile(0.0, 1.0, 0.0), problem.duration if self.options.profile
                                       == "trapezoidal" else 0.0, inertia, "no rotation needed", problem)
+        environment = problem.environment_torque_bound(problem.duration)  # one bound for every budget
+        if self.options.profile != "min_time" or not _environment_loads_the_wheels(problem, environment):
+            return self._plan_bang(problem, axis, angle, max_rate, problem.duration, environment)
+        # min_time with an environment torque on wheels with a momentum bound: the momentum it adds
+        # over the slew is reserved over the slew's own duration, which grows with the reserve. From
+        # no reserve the durations increase to the least horizon that covers its own slew.
+        horizon = 0.0
+        for _ in range(100):
+            reference = self._plan_bang(problem, axis, angle, max_rate, horizon, environment)
+            if not reference.ok or reference.duration <= horizon:
+                return reference
+            horizon = reference.duration * (1 + 1e-6)
+        return FailedReference(self.name, f"the minimum time grows with the wheels' momentum reserved for the "
+                               f"environment's torque over it, past {horizon:.4g} s after 100 passes", "infeasible")
+
+    def _plan_bang(self, problem: ManeuverProblem, axis: Array, angle: float, max_rate: float | None,
+                   horizon: float, environment: tuple[Array, float] | None = None) -> Reference:
+        """The bang profiles (``trapezoidal``, ``min_time``) of a rotation ``angle`` > 0 about
+        ``axis``, the environment's momentum reserved over ``horizon`` [s] (:class:`WheelBudget`, with
+        ``environment`` its torque bound when already computed)."""
+        inertia = problem.spacecraft.inertia
         keep = 1.0 - (problem.actuator_margin or 0.0)  # the actuator requirement's share of each limit
-        budget = WheelBudget(problem, axis, angle, self.options.torque_fraction * keep, momentum_fraction=keep)
+        budget = WheelBudget(problem, axis, angle, self.options.torque_fraction * keep, momentum_fraction=keep,
+                             horizon=horizon, environment=environment)
         if budget.exact:
             return self._bang(problem, axis, angle, max_rate, budget, self.options.profile)
         # Wheels spanning fewer than three axes (beside torquers): the wheels' momentum moves with
@@ -882,7 +941,10 @@ class EigenaxisPlanner(Planner):
         rate_cap = _smallest_cap(max_rate if max_rate is not None else np.inf, budget.torque_rate_cap, momentum_cap)
         if rate_cap <= 0:
             why = ("the stored momentum, turning in the body with the rotation, takes a working wheel beyond "
-                   "its max_momentum" if momentum_cap <= 0 else
+                   "its max_momentum" + (f" less the {np.max(budget.momentum_reserve):.3g} N m s the environment's "
+                                         f"torque may add over {budget.horizon:.4g} s"
+                                         if np.any(budget.momentum_reserve > 0) else "")
+                   if momentum_cap <= 0 else
                    f"the gyroscopic torque of any rate asks what the actuators cannot give{budget.uncounted}")
             return FailedReference(self.name, f"no rotation about the axis {axis.round(4).tolist()} is feasible: "
                                    f"{why}", "infeasible")
@@ -905,6 +967,9 @@ class EigenaxisPlanner(Planner):
                           and best_rate >= momentum_cap * (1 - 1e-9) else "")
         reserve_words = "" if not np.any(budget.reserve > 0) else (
             f", up to {np.max(budget.reserve):.3g} N m of the torque bounds kept for the environment's torque")
+        if np.any(budget.momentum_reserve > 0) and np.any(np.isfinite(budget.h_max)):
+            reserve_words += (f", up to {np.max(budget.momentum_reserve):.3g} N m s of the wheels' momentum bounds "
+                              f"for what it adds over {budget.horizon:.4g} s")
         if profile_name == "min_time":
             profile = BangCoastBangProfile(angle, acceleration(best_rate), best_rate)
             return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,

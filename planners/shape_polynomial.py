@@ -259,7 +259,9 @@ class ShapePolynomialPlanner(Planner):
         rate_margin : float
             The rate requirement (``requirements.rate.max``, ``ManeuverProblem.rate_requirement``)
             is planned this fraction lower with ``duration: rate_limit``, in [0, 1) (default 0.01):
-            a zero-order-hold closed loop tracking a reference at the bound overshoots it;
+            a zero-order-hold closed loop tracking a reference at the bound overshoots it, a smooth
+            peak as this polynomial's too (by 8e-6 of it at 0.1 s samples with unsaturated wheels,
+            by 1-2 % where its torques saturate them);
             ``maneuver.max_rate`` and the option ``max_rate`` are imposed as given (the paper's
             minimum time, :meth:`~planners.problem.ManeuverProblem.rate_bound`).
         """

@@ -67,9 +67,10 @@ def _rate_acquisition(problem: ManeuverProblem, o, build: bool = True) -> Hamilt
 
 
 def _attitude_acquisition(problem: ManeuverProblem, o, build: bool = True) -> HamiltonianSystem | str | None:
-    max_rate = problem.rate_bound(o.max_rate)
+    max_rate = problem.rate_bound(o.max_rate, o.rate_margin)
     if max_rate is None:
-        return "objective attitude_acquisition needs a rate bound (options.max_rate or maneuver.max_rate)"
+        return ("objective attitude_acquisition needs a rate bound (options.max_rate, maneuver.max_rate or "
+                "requirements.rate.max)")
     if problem.qf is None:
         return "objective attitude_acquisition needs a target attitude (maneuver.final.q)"
     if not build:
@@ -340,6 +341,40 @@ def solve(system: HamiltonianSystem, nodes: int, steps: int, tolerance: float, m
     return refined, float(refined.p[0]) if free else t_f, stages, None
 
 
+RATE_CHECK_POINTS = 2001
+"""Samples over ``[0, t_f]`` (with the breakpoints' sides) on which :func:`rate_excess` checks the rate."""
+
+
+def rate_excess(reference: Reference, bound: float) -> str:
+    """Where a reference's body rate exceeds a bound, in words; empty when it keeps it.
+
+    Sampled on :data:`RATE_CHECK_POINTS` times over ``[0, duration]`` and either side of its
+    breakpoints within it (:meth:`~planners.Reference.breakpoint_sides`: where the rate may jump),
+    within a relative ``1e-9`` (rounding).
+
+    Parameters
+    ----------
+    reference : Reference
+        The planned reference.
+    bound : float
+        The rate bound [rad/s], on ``‖ω‖``.
+
+    Returns
+    -------
+    str
+        ``"its rate reaches ... rad/s at ... s, above the rate bound ... rad/s"``, or ``""``.
+    """
+    t = np.linspace(0.0, reference.duration, RATE_CHECK_POINTS)
+    sides, at_sides = reference.breakpoint_sides()
+    inside = (sides >= 0.0) & (sides <= reference.duration)
+    times = np.concatenate([t, sides[inside]])
+    norms = np.linalg.norm(np.vstack([reference.sample(t).omega, at_sides.omega[inside]]), axis=1)
+    worst = int(np.argmax(norms))
+    if norms[worst] <= bound * (1 + 1e-9):
+        return ""
+    return f"its rate reaches {norms[worst]:.6g} rad/s at {times[worst]:.6g} s, above the rate bound {bound:g} rad/s"
+
+
 COAST_NODE_FACTOR = 25
 """Nodes the torque-free-coast fallback of a spinning start may use, per node of its coarsest mesh
 (one per :data:`~planners.costate.systems.SPIN_MESH_ANGLE` turned), when that exceeds
@@ -387,7 +422,15 @@ class CostateTPBVPPlanner(Planner):
             is no running cost, so the co-state equations and boundary conditions are homogeneous
             in λ and the weight only scales the co-states.
         max_rate : float or None
-            ``ω_max`` of attitude acquisition [rad/s]; ``None`` (default): ``maneuver.max_rate``.
+            ``ω_max`` of attitude acquisition [rad/s]: it tightens the problem's bound
+            (``maneuver.max_rate``, else ``requirements.rate.max``), never loosens it; ``None``
+            (default): the problem's (:meth:`~planners.problem.ManeuverProblem.rate_bound`).
+        rate_margin : float
+            Attitude acquisition plans the rate requirement (``requirements.rate.max``,
+            ``ManeuverProblem.rate_requirement``) this fraction lower, in [0, 1) (default 0.01), as
+            ``eigenaxis``'s: its rate is ``ω_max`` on all of ``(0, t_f)``, and a closed loop tracking a
+            rate at the bound overshoots it; ``maneuver.max_rate`` (the paper's bound) and the
+            option ``max_rate`` are imposed as given.
         continuation_steps : int
             The first continuation step is ``1/continuation_steps`` of the way from the cold start
             to the target, then adaptive; 1 to 100 (default 3).
@@ -414,7 +457,8 @@ class CostateTPBVPPlanner(Planner):
         weighting: Annotated[tuple[float, float, float], Range(gt=0.0, size=3)] = (1.0, 1.0, 1.0)                # diagonal of W (eq. 34)
         steering_torque: Annotated[list[float] | None, Range(gt=0.0, size=3)] = None              # N m per axis; default the actuator limits
         terminal_weight: Annotated[float, Range(gt=0.0)] = 100.0                           # Q_f = terminal_weight · I (final_time: fixed)
-        max_rate: Annotated[float | None, Range(gt=0.0)] = None                            # rad/s; default maneuver.max_rate
+        max_rate: Annotated[float | None, Range(gt=0.0)] = None                            # rad/s; default the problem's bound
+        rate_margin: Annotated[float, Range(ge=0.0, lt=1.0)] = 0.01                         # the rate requirement is planned this fraction lower
         continuation_steps: Annotated[int, Range(ge=1, le=100)] = 3                              # first step 1/continuation_steps, then adaptive
         nodes: Annotated[int, Range(ge=5, le=5000)] = 60                                          # mesh each stage starts from
         tolerance: Annotated[float, Range(gt=0.0, lt=1.0)] = 1e-8                                  # solve_bvp residual tolerance
@@ -441,6 +485,24 @@ class CostateTPBVPPlanner(Planner):
         """
         objective = getattr(options, "objective", None)
         return objective in ("rate_acquisition", "attitude_acquisition") and getattr(options, "final_time", None) != "fixed"
+
+    @classmethod
+    def honoured(cls, options: Any) -> frozenset[str]:
+        """The rate requirement with ``attitude_acquisition``: its rate, the control, has the norm
+        ``ω_max`` (the rate bound, :meth:`~planners.problem.ManeuverProblem.rate_bound`) on all of
+        ``(0, t_f)`` and the target rate at ``t_f``; a reference above the bound is ``infeasible``
+        (:func:`rate_excess`). The torque forms impose no rate bound.
+
+        Parameters
+        ----------
+        options : Options
+            The planner's options.
+
+        Returns
+        -------
+        frozenset of str
+        """
+        return frozenset({"rate"}) if getattr(options, "objective", None) == "attitude_acquisition" else frozenset()
 
     @classmethod
     def offers_costates(cls, options: Any) -> bool:
@@ -503,6 +565,10 @@ class CostateTPBVPPlanner(Planner):
         boundary = float(np.max(np.abs(system.boundary(1.0)(*ends)), initial=0.0))
         stats["certificate"] = necessary_conditions_certificate(max(stats["max_rms_residual"], boundary), "solve_bvp")
         reference = CostateReference(system, solution, t_f, "", stats)
+        if isinstance(system, AttitudeAcquisitionSystem):
+            excess = rate_excess(reference, system.max_rate)
+            if excess:
+                return FailedReference(self.name, f"{o.objective}: {excess}", "infeasible")
         timing = "minimum time" if system.free_final_time else "fixed time"
         reference.message = (f"{o.objective} ({timing}) t_f = {t_f:.6g} s"
                              + (f", ∫‖M_c‖² = {stats['int_u2']:.6g}" if "int_u2" in stats else "")

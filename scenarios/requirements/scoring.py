@@ -496,7 +496,17 @@ def start_torque(spacecraft: Spacecraft, t: Array, q: Array, step: ArrayLike,
 def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
                jumps: list[tuple[float, int, Array]] | None = None, unrealised: Array | None = None,
                torque: Array | None = None, plant_limited: Mapping[str, Array] | None = None,
-               impulse: Array | None = None, duration: float | None = None) -> Score:
+               impulse: Array | None = None, duration: float | None = None,
+               unstarted: Mapping[str, Array] | None = None, start_momentum: float = 0.0) -> Score:
+    """The actuator requirement's score of a reference's demand (:func:`score_reference`).
+
+    A quantity whose element at the peak (a wheel) is broken only with a declared free start (its
+    peak ratio in ``unstarted``, the demand as if the spacecraft started at the reference's rate,
+    within the allowed) is said to be the free start's:
+    ``(the free start's momentum, J N m s, takes it there: r x without it)``, ``J``
+    the momentum ``‖I (ω_ref(0) − ω₀)‖`` the actuators take up (the wheels, at once where they
+    span it and as the body turns where the other actuators remove it, :func:`start_torque`).
+    """
     values: dict[str, float | None] = {}
     broken = []
     unscored = []
@@ -533,7 +543,13 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
             lowered = (plant_limited or {}).get(name)
             whose = " (the truth model's, below the design's)" if lowered is not None and lowered[element] else ""
             removes = free and name.rsplit("_", 1)[0] not in stores and duration is not None and t[worst] <= duration
-            broken.append(f"{name} {shown} x its limit{whose} at {t[worst]:.1f} s{free if removes else ''}")
+            cause = free if removes else ""
+            alone = (unstarted or {}).get(name)
+            before = None if alone is None or element >= alone.size else float(alone[element])
+            if not cause and before is not None and before <= margin_allowed * (1 + _TOLERANCE):
+                cause = (f" (the free start's momentum, {start_momentum:.3g} N m s, takes it there: "
+                         f"{before:.3g} x without it)")
+            broken.append(f"{name} {shown} x its limit{whose} at {t[worst]:.1f} s{cause}")
     detail = ", ".join(unscored + ([", ".join(broken) + f" (allowed {allowed} x)"] if broken else []))
     if jumps is not None:
         largest = max(jumps, key=lambda jump: float(np.linalg.norm(jump[2])), default=None)
@@ -691,6 +707,17 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
                 after = after + np.where(coasting, 0.0, start)
         demand = reference_demand(allocation, problem.model, demand_t, q, omega, torque,
                                   problem.wheel_momentum0, jumps=steps, torque_after=after)
+        unstarted: dict[str, Array] = {}  # with a free start, each element's peak ratio as if it started at ω_ref(0)
+        if demand_t.size and np.any(steps[0]) and not any(index == 0 for _, index, _ in jumps):
+            free_steps = steps.copy()
+            free_steps[0] -= omega[0] - np.asarray(problem.omega0, dtype=float)
+            alone = reference_demand(allocation, problem.model, demand_t, q, omega, reference_torque - environment,
+                                     problem.wheel_momentum0, jumps=free_steps,
+                                     torque_after=None if reference is None else
+                                     np.where((demand_t >= reference.duration)[:, None], 0.0, reference_torque)
+                                     - environment)
+            unstarted = {name: np.max(quantity.ratios(), axis=0) for name, quantity in alone.items()
+                         if quantity.limited and quantity.ratios().size and np.all(np.isfinite(quantity.values))}
         unrealised = unrealised_torque(problem.model, demand_t, q, omega, torque, demand)
         lower: dict[str, Array] = {}  # per quantity, the elements whose plant limit is below the design's
         if plant_limits is not None:
@@ -700,7 +727,9 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
                     lower[name] = limit < quantity.limit
                     demand[name] = dataclasses.replace(quantity, limit=limit)
         scores["actuators"] = _actuators(requirements.actuators.allowed, demand, demand_t, jumps, unrealised, torque,
-                                         lower, impulse, None if reference is None else reference.duration)
+                                         lower, impulse, None if reference is None else reference.duration,
+                                         unstarted, float(np.linalg.norm(problem.spacecraft.inertia @ steps[0]))
+                                         if unstarted else 0.0)
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, sample.omega)
     return scores
