@@ -276,20 +276,32 @@ class Scenario:
         return self.simulation.true_initial_state(self.problem)
 
 
-def _table_window(problem: ManeuverProblem, simulation: SimulationSpec, planners: list) -> float:
+def _table_window(duration: float, run: float | None, planned: bool) -> float:
     """How far what follows the run is tabulated (a field, a direction): the closed-loop window
-    (twice the maneuver's when planners may return longer references) plus one minute [s]."""
-    return max(problem.duration * (2.0 if planners else 1.0), simulation.duration or 0.0) + 60.0
+    (twice the maneuver's when planners may return longer references) plus one minute [s]
+    (:func:`~scenarios.schema.requirements.check_ephemeris` clips it to the ephemeris' end)."""
+    return max(duration * (2.0 if planned else 1.0), run or 0.0) + 60.0
 
 
-def _fit_field_span(problem: ManeuverProblem, simulation: SimulationSpec, planners: list) -> ManeuverProblem:
+def _run_span(root: Node) -> RunSpan:
+    """The run's lengths, read before the sections that consume the ephemeris (an attitude
+    target, a sensor's exclusion cone, a requirement's direction) so that one check covers them."""
+    duration = MANEUVER["duration"].value(SCENARIO["maneuver"].value(root))
+    simulation = SCENARIO["simulation"].node(root)
+    run = SIMULATION["duration"].value(simulation) if isinstance(simulation.value, dict) else None
+    planners = SCENARIO["planners"].node(root).value
+    table = _table_window(duration, run, isinstance(planners, list) and len(planners) > 0)
+    return RunSpan(duration, run or duration, run is not None, table)
+
+
+def _fit_field_span(problem: ManeuverProblem, window: float) -> ManeuverProblem:
     """Give a field whose extent follows the run (``for_window``: an IGRF table without ``span_s``)
-    the tabulated window (:func:`_table_window`)."""
+    the tabulated window [s]."""
     field_model = problem.environment.magnetic_field
     for_window = getattr(field_model, "for_window", None)
     if for_window is None:
         return problem
-    fitted = for_window(_table_window(problem, simulation, planners))
+    fitted = for_window(window)
     if fitted is field_model:
         return problem
     environment = dataclasses.replace(problem.environment, magnetic_field=fitted)
@@ -585,6 +597,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     epoch = SCENARIO["epoch"].value(root)
     spacecraft, sensors = parse_spacecraft(SCENARIO["spacecraft"].value(root))
     environment = parse_environment(SCENARIO["orbit"].value(root), SCENARIO["environment"].value(root), epoch)
+    span = check_ephemeris(epoch, _run_span(root))  # before every consumer of the ephemeris
     problem = _parse_problem(SCENARIO["maneuver"].value(root), spacecraft, environment, sensors, epoch)
     planners = _parse_planners(SCENARIO["planners"].value(root))
     controllers = _parse_controllers(root)
@@ -596,11 +609,8 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     requirements_node = SCENARIO["requirements"].value(root)
     truth_node = SCENARIO["truth"].value(root)
     root.finish()
-    problem = _fit_field_span(problem, simulation, planners)
-    span = RunSpan(problem.duration, simulation.duration or problem.duration, simulation.duration is not None,
-                   _table_window(problem, simulation, planners))
+    problem = _fit_field_span(problem, span.table)
     _check_orbit_window(environment.orbit, span.table)
-    check_ephemeris(epoch, span)
     requirements, constraints = parse_requirements(requirements_node, sensors, Geometry(epoch, environment.orbit),
                                                    span, problem.qf is None, problem.omegaf is None)
     problem = _with_requirements(problem, requirements, constraints)
