@@ -104,7 +104,8 @@ METRIC_INFO: dict[str, MetricInfo] = {
     "settling_time_s": MetricInfo(
         "s", "t_(j+1) for the last sample j whose error angle to ``q_f`` (the target, as for "
         "``final_error_deg``) exceeds the band "
-        "(``simulation.settling_tolerance_deg``, default 0.5°); 0 if no sample does; null if the last "
+        "(``simulation.settling_tolerance_deg``; unset, ``requirements.final.error_deg`` when stated, else "
+        "0.5°); 0 if no sample does; null if the last "
         "sample does, or when the final attitude is free.", null_worst_when="final_error_deg"),
     "saturation_fraction": MetricInfo(
         "–", "Closed loop: fraction of the held intervals in which any actuator was at its limit (a wheel "

@@ -982,7 +982,8 @@ class EigenaxisPlanner(Planner):
             if momentum_words:
                 bounds_words += " and the wheels' momentum bound"
             return FailedReference(self.name, f"T = {problem.duration:g} s is shorter than the minimum "
-                                   f"bang-coast-bang time {minimum_time:.4g} s under {bounds_words}", "infeasible")
+                                   f"bang-coast-bang time {minimum_time:.4g} s under {bounds_words}, for its slew of "
+                                   f"{np.rad2deg(angle):.4g} deg to the final attitude", "infeasible")
         # Fixed T: the slowest coast rate w with w (T − w/α(w)) = Θ.
         def covered(w: float) -> float:
             alpha = acceleration(w)

@@ -99,8 +99,16 @@ def test_export_command_with_options_and_a_rerun_into_its_own_directory(run_dire
     assert segment.epochs[0] == "2027-03-20T12:01:09.184000000"  # TT = UTC + 37 s + 32.184 s
 
 
+def test_export_in_gps_time(run_directory, tmp_path):
+    out = tmp_path / "gps"
+    assert main(["export", str(run_directory), "--format", "aem", "--out", str(out), "--option", "time_system=GPS"]) == 0
+    segment, = read_aem((out / "smooth.reference.aem").read_text()).segments
+    assert segment.metadata["TIME_SYSTEM"] == "GPS"
+    assert segment.epochs[0] == "2027-03-20T12:00:18.000000000"  # GPS = TAI - 19 s = UTC + 37 s - 19 s
+
+
 @pytest.mark.parametrize("argv, fragment", [
-    (["--option", "time_system=GPS"], "time_system"),
+    (["--option", "time_system=GLONASS"], "time_system"),
     (["--option", "colour=red"], "NAME one of time_system"),
     (["--option", "attitude_type=EULER_ANGLE"], "attitude_type"),
 ])

@@ -101,14 +101,15 @@ def test_each_bound_is_shown_with_the_value_achieved_and_the_verdict(results, pa
     lines = {(row["scope"], row["requirement"], row["quantity"]): row for row in table(data, "requirement-scores")}
     simulation = results.rows[0].simulation
     rate = lines[("closed loop", "rate", "peak_rate")]
-    assert (rate["required"], rate["unit"], rate["within bound"], rate["verdict"]) == ("≤ 0.09", "rad/s", "yes", "met")
+    assert (rate["required"], rate["unit"], rate["this quantity within its bound"],
+            rate["requirement (all its quantities)"]) == ("≤ 0.09", "rad/s", "yes", "met")
     assert rate["achieved"] == pytest.approx(np.max(np.linalg.norm(simulation.omega, axis=1)), rel=1e-12)
     final = lines[("closed loop", "final", "worst_error_deg")]
-    assert (final["required"], final["unit"], final["within bound"], final["verdict"]) == ("≤ 1e-09", "deg", "no",
-                                                                                          "broken")
+    assert (final["required"], final["unit"], final["this quantity within its bound"],
+            final["requirement (all its quantities)"]) == ("≤ 1e-09", "deg", "no", "broken")
     assert final["achieved"] > 1e-9
     torque = lines[("reference", "actuators", "wheels_torque")]
-    assert (torque["required"], torque["unit"], torque["verdict"]) == ("≤ 0.8", "–", "met")
+    assert (torque["required"], torque["unit"], torque["requirement (all its quantities)"]) == ("≤ 0.8", "–", "met")
     assert results.rows[0].status == "violated"
 
 

@@ -193,4 +193,4 @@ def test_field_info_reads_columns_names_and_bare_fields():
         with pytest.raises(KeyError):
             field_info(wrong)
     # pointing, actuators (two patterns), rate, final, each with its verdict
-    assert len(REQUIREMENT_FIELDS) == (1 + 4) + (1 + 6) + (1 + 3) + (1 + 3)
+    assert len(REQUIREMENT_FIELDS) == (1 + 4) + (1 + 7) + (1 + 3) + (1 + 3)

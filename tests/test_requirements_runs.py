@@ -111,7 +111,8 @@ def test_the_requirement_columns_in_every_table(crossing, tmp_path):
                    + [f"ref.req.actuators.{field}" for field in ("met", "wheels_torque", "wheels_torque_time_s",
                                                                  "wheels_momentum", "wheels_momentum_time_s",
                                                                  "rate_jump", "rate_jump_time_s",
-                                                                 "unrealised_torque", "unrealised_torque_time_s")]
+                                                                 "unrealised_torque", "unrealised_torque_time_s",
+                                                                 "unrealised_torque_allowed")]
                    + [f"cl.req.st.{field}" for field in pointing])
     assert header.index(req[0]) > header.index("cl.initial_rate_error")  # after the metric columns
     assert float(lines[0]["ref.req.st.min_margin_deg"]) == scores["reference"]["st"]["min_margin_deg"]

@@ -2,7 +2,7 @@
 
 Exit status (:mod:`scenarios.cli.status`): 0 when the run completed (a failed planner or a
 violated requirement is a row, not an error), 1 under ``run --strict`` when some row is not ``ok``
-(the results are written all the same) or under ``table --strict`` when some entry is not, 2 for a bad scenario file, a
+(the results are written all the same), under ``validate --strict`` when a scenario cannot have an ok row, or under ``table --strict`` when some entry is not, 2 for a bad scenario file, a
 plugin that fails to load or takes a registered name (:mod:`scenarios.schema.plugins`), or an output location
 slewbench must not or cannot write to, 1 for an internal error.
 """
@@ -179,12 +179,14 @@ def command_validate(args: argparse.Namespace) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        ``file``: the scenario or study YAML path.
+        ``file``: the scenario, study or slew-table YAML path; ``strict`` (optional): exit 1 when
+        the scenario cannot have an ok row.
 
     Returns
     -------
     int
-        Exit status (0; a bad file raises ``ScenarioError``, which :func:`main` reports with exit 2).
+        Exit status: 0; 1 with ``strict`` when a scenario's notes say every row must fail
+        (:func:`_doomed_notes`); a bad file raises ``ScenarioError``, which :func:`main` reports with exit 2.
     """
     data = read_yaml(args.file)
     for key in OTHER_FILES:  # a study or a slew table: its own check and summary
@@ -201,6 +203,11 @@ def command_validate(args: argparse.Namespace) -> int:
           f"({', '.join(label.label for label in labels)})")
     for line in _scenario_details(scenario):
         print("  " + line)
+    doomed = _doomed_notes(scenario)
+    if getattr(args, "strict", False) and doomed:
+        print(f"slewbench: --strict: no row can be ok ({len(doomed)} note(s) above say every row must fail)",
+              file=sys.stderr)
+        return EXIT_NOT_OK
     return EXIT_OK
 
 
@@ -211,13 +218,38 @@ def _leaf_paths(value: Any, prefix: str) -> list[str]:
     return [path for key, item in value.items() for path in _leaf_paths(item, f"{prefix}.{key}")]
 
 
+def _doomed_notes(scenario: Scenario) -> list[str]:
+    """``validate``'s notes that every row must fail (``validate --strict`` exits 1 on any): an end
+    point that already breaks a requirement (every planner's row fails before planning), a boundary
+    rate above the rate requirement (every row breaks it).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The loaded scenario.
+
+    Returns
+    -------
+    list of str
+        One line per such finding (empty when a row may succeed).
+    """
+    from scenarios.requirements.scoring import endpoint_violations
+    from scenarios.schema.checks import rate_bound_notes
+
+    requirements = scenario.requirements
+    lines = []
+    if requirements and scenario.planners:
+        lines += [f"every planner's row fails before planning: {broken}"
+                  for broken in endpoint_violations(scenario.problem)]
+    if requirements.rate is not None:  # a boundary rate above the bound: every row breaks it
+        lines += rate_bound_notes(scenario.problem, scenario.simulation, requirements.rate.max_rate)
+    return lines
+
+
 def _scenario_details(scenario: Scenario) -> list[str]:
     """What ``validate`` says beyond the rows: every requirement the rows are scored against, end
     points that already break one, the truth model's keys (where the plant differs from the
     design), the sensors and estimator in the loop and the sensor noise."""
-    from scenarios.requirements.scoring import endpoint_violations
-    from scenarios.schema.checks import rate_bound_notes
-
     requirements = scenario.requirements
     lines = [f"requirement {line}" for line in requirements.describe()]
     if requirements.actuators is None:
@@ -226,11 +258,7 @@ def _scenario_details(scenario: Scenario) -> list[str]:
     elif not requirements.actuators.stated and scenario.planners:
         lines.append("requirement actuators: the reference's demand at most 100 % of each actuator limit "
                      "(every scenario's, unstated)")
-    if requirements and scenario.planners:
-        lines += [f"every planner's row fails before planning: {broken}"
-                  for broken in endpoint_violations(scenario.problem)]
-    if requirements.rate is not None:  # a boundary rate above the bound: every row breaks it
-        lines += rate_bound_notes(scenario.problem, scenario.simulation, requirements.rate.max_rate)
+    lines += _doomed_notes(scenario)
     truth = (scenario.data or {}).get("truth")
     if scenario.truth is not None and isinstance(truth, dict):
         lines.append("truth (the closed loop's plant differs from the design in): "
@@ -413,7 +441,8 @@ def build_parser() -> argparse.ArgumentParser:
                f"error (a traceback on stderr) or run interrupted (Ctrl-C, SIGTERM); {EXIT_INTERRUPTED} "
                f"interrupted sweep or table (run it again to finish). Under run --strict or table --strict, "
                f"{EXIT_NOT_OK} also for a completed run with a row (or table entry) not ok: its files are "
-               f"written and stderr says so ('slewbench: --strict: N of M ... not ok'). Plugins: the "
+               f"written and stderr says so ('slewbench: --strict: N of M ... not ok'); under validate --strict, "
+               f"{EXIT_NOT_OK} for a scenario whose notes say every row must fail. Plugins: the "
                f"'slewbench.plugins' entry points of installed distributions and the modules or .py files of "
                f"SLEWBENCH_PLUGINS (comma-separated) load at start; one that fails or takes a registered name: "
                f"exit {EXIT_BAD_SCENARIO}")
@@ -434,6 +463,9 @@ def build_parser() -> argparse.ArgumentParser:
     run_parser.set_defaults(handler=command_run)
     validate_parser = commands.add_parser("validate", help="check a scenario, study or slew-table file; print what would run")
     validate_parser.add_argument("file", help="scenario, study or slew-table YAML file (a study has the top-level key 'study', a table 'table')")
+    validate_parser.add_argument("--strict", action="store_true",
+                                 help=f"exit {EXIT_NOT_OK} when a scenario cannot have an ok row (a note says every "
+                                      "row must fail), after printing the check (for continuous integration)")
     validate_parser.set_defaults(handler=command_validate)
     codegen_parser = commands.add_parser("codegen", help="export the controller law, saturation and reference tables as flight C")
     codegen_parser.add_argument("file", help="scenario YAML file")
@@ -532,7 +564,7 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         Exit status: 0 done, 2 bad scenario file or output location (the message names its path) or
         a plugin that fails to load or takes a registered name (the message names the plugin),
         1 internal error or interrupted, or a row not ok under ``run --strict`` (an entry under
-        ``table --strict``), 130 an interrupted sweep or a table interrupted while it computes
+        ``table --strict``; a scenario that cannot have an ok row under ``validate --strict``), 130 an interrupted sweep or a table interrupted while it computes
         (an error raised after Ctrl-C or SIGTERM counts as the interruption: C code such as
         CasADi's turns a ``KeyboardInterrupt`` into one).
     """

@@ -506,7 +506,7 @@ def _final_note(study: Study, rows: list[dict[str, Any]]) -> str | None:
     for row in rows:
         scenario = cases[row["case"]]
         if (scenario.get("requirements") or {}).get("final") is None:
-            band = (scenario.get("simulation") or {}).get("settling_tolerance_deg", DEFAULT_SETTLING_TOLERANCE_DEG)
+            band = (scenario.get("simulation") or {}).get("settling_tolerance_deg") or DEFAULT_SETTLING_TOLERANCE_DEG
             error = row.get("cl.final_error_deg")
             ends.append((None if is_missing(error) else error, float(band)))
     return final_accuracy_note(ends, len(rows))

@@ -15,7 +15,7 @@ The conventions of the standard, and how slewbench's map onto them:
   (``ANGVEL_FRAME = SC_BODY_1``) and in **deg/s** (4.2.4.6).
 * **Time.** Time tags are absolute: ``epoch + t`` (``t`` elapsed SI seconds, leap seconds
   counted) in the chosen ``TIME_SYSTEM`` (:data:`TIME_SYSTEMS`): UTC (a leap second is written
-  ``23:59:60``, 4.2.4.7.3), TAI, TT or TDB, through ERFA, with nanosecond digits. A run without
+  ``23:59:60``, 4.2.4.7.3), TAI, TT, TDB or GPS (TAI − 19 s), through ERFA, with nanosecond digits. A run without
   an ``epoch`` has no absolute time and no GCRF; it is refused (:class:`~scenarios.errors.ScenarioError`
   naming ``epoch``), never given an invented date.
 * **Numbers.** 16 significant digits (``d.dddddddddddddddE±xx``, the most 6.8.4 allows):
@@ -86,8 +86,11 @@ Array = NDArray[np.float64]
 
 AEM_VERSION = "2.0"
 """``CCSDS_AEM_VERS`` written: CCSDS 504.0-B-2."""
-TIME_SYSTEMS = ("UTC", "TAI", "TT", "TDB")
+TIME_SYSTEMS = ("UTC", "TAI", "TT", "TDB", "GPS")
 """``TIME_SYSTEM`` values slewbench writes (SANA time systems)."""
+_TAI_OFFSET_S = {"TAI": 0.0, "TT": 32.184, "GPS": -19.0}
+"""Time scales a constant offset from TAI [s] (TT = TAI + 32.184 s, GPS = TAI - 19 s exactly);
+UTC and TDB are converted by ERFA."""
 ATTITUDE_TYPES = {"QUATERNION": ("LINEAR", 1), "QUATERNION/ANGVEL": ("HERMITE", 3)}
 """``ATTITUDE_TYPE`` values slewbench writes, with the interpolation method and degree declared."""
 INERTIAL_FRAME = "GCRF"
@@ -136,8 +139,8 @@ def time_tags(epoch: datetime.datetime | str, t: ArrayLike, time_system: str = "
             day1, day2 = np.full(t.shape, float(tai1)), float(tai2) + t / _SECONDS_PER_DAY
             if time_system == "UTC":
                 day1, day2 = erfa.taiutc(day1, day2)
-            elif time_system == "TT":
-                day1, day2 = erfa.taitt(day1, day2)
+            else:
+                day2 = day2 + _TAI_OFFSET_S[time_system] / _SECONDS_PER_DAY
         years, months, days, hmsf = erfa.d2dtf(time_system, TIME_DIGITS, day1, day2)
     return [f"{y:04d}-{mo:02d}-{d:02d}T{c['h']:02d}:{c['m']:02d}:{c['s']:02d}.{c['f']:0{TIME_DIGITS}d}"
             for y, mo, d, c in zip(years, months, days, hmsf)]
@@ -523,7 +526,7 @@ class AemOptions:
     Parameters
     ----------
     time_system : str, optional
-        ``TIME_SYSTEM``: ``UTC`` (default), ``TAI``, ``TT`` or ``TDB``.
+        ``TIME_SYSTEM``: ``UTC`` (default), ``TAI``, ``TT``, ``TDB`` or ``GPS`` (TAI − 19 s).
     attitude_type : str, optional
         ``QUATERNION/ANGVEL`` (default: quaternion and body rate) or ``QUATERNION``.
     originator : str, optional

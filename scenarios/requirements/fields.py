@@ -137,6 +137,10 @@ _ACTUATORS = (
     RequirementField(
         "actuators", "unrealised_torque_time_s", "s", "time of unrealised torque",
         "When that torque is asked; null when every torque asked is given.", ("ref",)),
+    RequirementField(
+        "actuators", "unrealised_torque_allowed", "N m", "unrealised torque allowed",
+        "The most ``unrealised_torque`` may be: 1 % of the reference's peak torque (at least 1e-14 N m, "
+        "rounding for a reference that asks no torque); null when that peak is not finite.", ("ref",)),
 )
 _RATE = (
     RequirementField("rate", "peak_rate", "rad/s", "peak rate",

@@ -22,7 +22,7 @@ and what breaks it in words. The fields (their units, words and definitions are 
   (:func:`rate_jumps`: an impulse no finite torque gives; its momentum goes to the wheels), then
   ``unrealised_torque`` [N m] and ``unrealised_torque_time_s``, the largest torque the reference asks
   that the allocation's commands do not give (:func:`controllers.allocation.unrealised_torque`:
-  about an axis no working actuator spans); met when every ratio is at most ``1 − margin``, the
+  about an axis no working actuator spans), and ``unrealised_torque_allowed`` [N m], its bound; met when every ratio is at most ``1 − margin``, the
   rate never jumps and the unrealised torque stays within :data:`UNREALISED_TOLERANCE` of the
   reference's peak torque; a demand or unrealised torque that is not finite (nan, inf) is no
   number met: its field is null, its time the first sample where it is not finite, and the
@@ -96,9 +96,10 @@ FINAL_FIELDS = ("worst_error_deg", "worst_rate_error", "from_s")
 JUMP_FIELDS = ("rate_jump", "rate_jump_time_s")
 """The actuator score's fields after its quantities': the largest jump of the reference's body rate
 [rad/s] (0 without one) and when it happens [s] (``None`` without one)."""
-UNREALISED_FIELDS = ("unrealised_torque", "unrealised_torque_time_s")
+UNREALISED_FIELDS = ("unrealised_torque", "unrealised_torque_time_s", "unrealised_torque_allowed")
 """The actuator score's last fields: the largest torque the reference asks that its commands do not
-give (:func:`controllers.allocation.unrealised_torque`) [N m], and when [s]."""
+give (:func:`controllers.allocation.unrealised_torque`) [N m], when [s], and the most it may be
+[N m] (:data:`UNREALISED_TOLERANCE` of the reference's peak torque)."""
 UNREALISED_FLOOR = 1e-12
 """[N m]: the torque scale of :data:`UNREALISED_TOLERANCE` for a reference that asks no torque (a
 torque-free motion): rounding, not a demand."""
@@ -565,15 +566,17 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
         worst = int(np.argmax(norms)) if norms.size else 0
         peak = float(norms[worst]) if norms.size else 0.0
         scale = float(np.max(np.linalg.norm(torque, axis=1), initial=0.0))
-        values.update(zip(UNREALISED_FIELDS, (peak, float(t[worst]) if norms.size and peak > 0.0 else None)))
+        allowed_torque = UNREALISED_TOLERANCE * max(scale, UNREALISED_FLOOR)
+        values.update(zip(UNREALISED_FIELDS, (peak, float(t[worst]) if norms.size and peak > 0.0 else None,
+                                              allowed_torque if np.isfinite(allowed_torque) else None)))
         unknown = ~np.isfinite(norms)
         if np.any(unknown):
             first = int(np.argmax(unknown))
-            values.update(zip(UNREALISED_FIELDS, (None, float(t[first]))))
+            values.update(zip(UNREALISED_FIELDS[:2], (None, float(t[first]))))
             missing = f"the unrealised torque is not finite (nan or inf) from {t[first]:g} s: it cannot be scored"
             detail = missing + (f", {detail}" if detail else "")
         # a reference asking no torque is measured against the rounding of its own terms
-        elif peak > UNREALISED_TOLERANCE * max(scale, UNREALISED_FLOOR):
+        elif peak > allowed_torque:
             share = f" ({peak / scale:.0%} of the reference's peak)" if scale > 0.0 else ""
             missing = f"{peak:.3g} N m of the torque asked at {t[worst]:g} s{share} is given by no working actuator"
             during = duration is not None and t[worst] <= duration

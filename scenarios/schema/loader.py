@@ -30,6 +30,7 @@ from ocp.dynamics.truth import TruthPlant
 from ocp.errors import OptionsError, excerpt
 from ocp.estimation import SensorSuite
 from ocp.geometry.directions import Geometry
+from ocp.metrics import DEFAULT_SETTLING_TOLERANCE_DEG
 from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem, Planner
 from scenarios.errors import ScenarioError
@@ -163,7 +164,8 @@ class SimulationSpec:
         Longest RK4 sub-step [s].
     settling_tolerance_deg, fine_settling_tolerance_deg : float, float or None
         Attitude-error tolerances [deg] of ``settling_time_s`` and ``fine_settling_time_s``
-        (``None``: no fine criterion).
+        (``None``: no fine criterion). The loader gives the first ``requirements.final.error_deg``
+        when the key is unset and the scenario states that requirement.
     detumble_tolerance : float
         Rate bound [rad/s] of ``detumble_time_s``.
     compile : bool
@@ -276,20 +278,32 @@ class Scenario:
         return self.simulation.true_initial_state(self.problem)
 
 
-def _table_window(problem: ManeuverProblem, simulation: SimulationSpec, planners: list) -> float:
+def _table_window(duration: float, run: float | None, planned: bool) -> float:
     """How far what follows the run is tabulated (a field, a direction): the closed-loop window
-    (twice the maneuver's when planners may return longer references) plus one minute [s]."""
-    return max(problem.duration * (2.0 if planners else 1.0), simulation.duration or 0.0) + 60.0
+    (twice the maneuver's when planners may return longer references) plus one minute [s]
+    (:func:`~scenarios.schema.requirements.check_ephemeris` clips it to the ephemeris' end)."""
+    return max(duration * (2.0 if planned else 1.0), run or 0.0) + 60.0
 
 
-def _fit_field_span(problem: ManeuverProblem, simulation: SimulationSpec, planners: list) -> ManeuverProblem:
+def _run_span(root: Node) -> RunSpan:
+    """The run's lengths, read before the sections that consume the ephemeris (an attitude
+    target, a sensor's exclusion cone, a requirement's direction) so that one check covers them."""
+    duration = MANEUVER["duration"].value(SCENARIO["maneuver"].value(root))
+    simulation = SCENARIO["simulation"].node(root)
+    run = SIMULATION["duration"].value(simulation) if isinstance(simulation.value, dict) else None
+    planners = SCENARIO["planners"].node(root).value
+    table = _table_window(duration, run, isinstance(planners, list) and len(planners) > 0)
+    return RunSpan(duration, run or duration, run is not None, table)
+
+
+def _fit_field_span(problem: ManeuverProblem, window: float) -> ManeuverProblem:
     """Give a field whose extent follows the run (``for_window``: an IGRF table without ``span_s``)
-    the tabulated window (:func:`_table_window`)."""
+    the tabulated window [s]."""
     field_model = problem.environment.magnetic_field
     for_window = getattr(field_model, "for_window", None)
     if for_window is None:
         return problem
-    fitted = for_window(_table_window(problem, simulation, planners))
+    fitted = for_window(window)
     if fitted is field_model:
         return problem
     environment = dataclasses.replace(problem.environment, magnetic_field=fitted)
@@ -407,8 +421,10 @@ SIMULATION = Section((
     choice("integrator", "Integrator of the closed loop.", ("rk4", "cvodes"), default="rk4"),
     number("max_step", f"Longest RK4 sub-step (at most {MAX_SUBSTEPS} sub-steps per sample).", unit="s",
            default=0.05, positive=True),
-    number("settling_tolerance_deg", "Attitude-error tolerance of the metric ``settling_time_s``.", unit="deg",
-           default=0.5, positive=True, maximum=180.0),
+    number("settling_tolerance_deg", "Attitude-error tolerance of the metric ``settling_time_s``. ``null`` (the "
+           "default): ``requirements.final.error_deg`` when the scenario states it (a row that misses the "
+           f"requirement has not settled), else {DEFAULT_SETTLING_TOLERANCE_DEG:g}.", unit="deg", default=None,
+           positive=True, maximum=180.0, nullable=True),
     number("fine_settling_tolerance_deg", "A second, finer tolerance (metric ``fine_settling_time_s``); "
            "``null``: none.", unit="deg", default=None, positive=True, maximum=180.0, nullable=True),
     number("detumble_tolerance", "Rate bound of the metric ``detumble_time_s``.", unit="rad/s", default=0.01,
@@ -541,7 +557,8 @@ def _parse_simulation(values: dict[str, Any], path: str, sensors: dict[str, Sens
         noise=SensorNoise(attitude_std=np.deg2rad(noise["attitude_deg"]), rate_std=noise["rate"],
                           seed=noise["seed"], field_std=noise["magnetic_field"]),
         integrator=values["integrator"], max_step=values["max_step"],
-        settling_tolerance_deg=values["settling_tolerance_deg"],
+        settling_tolerance_deg=(DEFAULT_SETTLING_TOLERANCE_DEG if values["settling_tolerance_deg"] is None
+                                else values["settling_tolerance_deg"]),  # requirements.final's: _settling_band
         fine_settling_tolerance_deg=values["fine_settling_tolerance_deg"],
         detumble_tolerance=values["detumble_tolerance"], max_samples=values["max_samples"], compile=values["compile"],
         sensors=parse_sensor_suite(values["sensors"], values["estimator"], noise, path,
@@ -585,6 +602,7 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     epoch = SCENARIO["epoch"].value(root)
     spacecraft, sensors = parse_spacecraft(SCENARIO["spacecraft"].value(root))
     environment = parse_environment(SCENARIO["orbit"].value(root), SCENARIO["environment"].value(root), epoch)
+    span = check_ephemeris(epoch, _run_span(root))  # before every consumer of the ephemeris
     problem = _parse_problem(SCENARIO["maneuver"].value(root), spacecraft, environment, sensors, epoch)
     planners = _parse_planners(SCENARIO["planners"].value(root))
     controllers = _parse_controllers(root)
@@ -596,14 +614,13 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     requirements_node = SCENARIO["requirements"].value(root)
     truth_node = SCENARIO["truth"].value(root)
     root.finish()
-    problem = _fit_field_span(problem, simulation, planners)
-    span = RunSpan(problem.duration, simulation.duration or problem.duration, simulation.duration is not None,
-                   _table_window(problem, simulation, planners))
+    problem = _fit_field_span(problem, span.table)
     _check_orbit_window(environment.orbit, span.table)
-    check_ephemeris(epoch, span)
     requirements, constraints = parse_requirements(requirements_node, sensors, Geometry(epoch, environment.orbit),
                                                    span, problem.qf is None, problem.omegaf is None)
     problem = _with_requirements(problem, requirements, constraints)
+    simulation = _settling_band(simulation, requirements, isinstance(given, dict)
+                                and given.get("settling_tolerance_deg") is not None)
     truth = parse_truth(truth_node, problem.model)
     check_work(problem, simulation)
     check_magnetometer(problem, simulation)
@@ -611,6 +628,15 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     check_compatibility(problem, planners, controllers, simulation)
     return Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch,
                     euler_sequence=plots["euler_sequence"], data=copy.deepcopy(data), truth=truth)
+
+
+def _settling_band(simulation: SimulationSpec, requirements: Requirements, given: bool) -> SimulationSpec:
+    """``settling_time_s``'s band: ``simulation.settling_tolerance_deg`` when given, else
+    ``requirements.final.error_deg`` when stated (else the default the simulation already has)."""
+    final = requirements.final
+    if given or final is None or final.error_deg is None:
+        return simulation
+    return dataclasses.replace(simulation, settling_tolerance_deg=float(final.error_deg))
 
 
 def _with_requirements(problem: ManeuverProblem, requirements: Requirements,

@@ -178,7 +178,8 @@ def read_yaml(path: str | Path) -> Any:
     Numbers such as ``6e5`` are read as numbers; a missing or unreadable file, a named pipe, a
     file larger than :data:`MAX_FILE_BYTES`, text that is not YAML, a duplicate key, or alias
     expansion beyond :data:`MAX_NODES` values is a :class:`ScenarioError`. Nothing here waits for
-    a writer (:func:`read_bounded`).
+    a writer (:func:`read_bounded`). So is an empty file (nothing but blank lines and comments):
+    every file slewbench reads is a mapping.
 
     Parameters
     ----------
@@ -188,7 +189,7 @@ def read_yaml(path: str | Path) -> Any:
     Returns
     -------
     object
-        The parsed data (mappings, lists, numbers, strings).
+        The parsed data (mappings, lists, numbers, strings), never ``None``.
     """
     path = Path(path)
     try:
@@ -202,4 +203,8 @@ def read_yaml(path: str | Path) -> Any:
     except (OSError, UnicodeDecodeError) as error:
         reason = error.strerror if isinstance(error, OSError) and error.strerror else error
         raise ScenarioError("", f"cannot read {path}: {reason}") from None
-    return parse_yaml_text(text, path)
+    parsed = parse_yaml_text(text, path)
+    if parsed is None:
+        raise ScenarioError(str(path), "the file is empty (nothing but blank lines or comments); expected a mapping "
+                                       "of keys")
+    return parsed

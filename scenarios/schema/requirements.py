@@ -10,6 +10,7 @@ ephemeris does not cover, a window outside the run or reversed.
 """
 from __future__ import annotations
 
+import dataclasses
 import datetime
 import re
 from dataclasses import dataclass
@@ -240,7 +241,7 @@ class RunSpan:
         Whether ``simulation.duration`` is given.
     table : float
         How far directions are tabulated [s] (the run, with room for a planner's longer
-        reference).
+        reference; near the ephemeris' end, clipped to it: :func:`check_ephemeris`).
     """
 
     manoeuvre: float
@@ -393,28 +394,51 @@ def parse_requirements(node: Node, sensors: dict[str, Sensor], geometry: Geometr
     return requirements, tuple(constraints)
 
 
-def check_ephemeris(epoch: datetime.datetime | None, span: RunSpan) -> None:
-    """Refuse an epoch whose run leaves the ephemeris.
+def check_ephemeris(epoch: datetime.datetime | None, span: RunSpan) -> RunSpan:
+    """Refuse an epoch whose run leaves the ephemeris; clip the tabulated window to it.
+
+    Every consumer of the ephemeris (a pointing requirement's direction, an attitude target's, a
+    sensor's exclusion cone) reads it inside ``span.table`` from the epoch, so this one check, made
+    before any of them, covers them all. When the run itself fits but the tabulation window (the
+    room left for a longer reference) would leave the ephemeris, the window is clipped to the
+    ephemeris' end: a reference running past it sees the directions held at their last value.
 
     Parameters
     ----------
     epoch : datetime.datetime or None
-        The scenario's epoch (``None``: nothing to check).
+        The scenario's epoch, UTC (``None``: nothing to check).
     span : RunSpan
-        The run (its tabulated length).
+        The run and its tabulated length.
+
+    Returns
+    -------
+    RunSpan
+        ``span``, its ``table`` clipped to the ephemeris' end when that is shorter (never below
+        ``span.run``).
 
     Raises
     ------
     ScenarioError
-        At ``epoch``.
+        At ``epoch``, naming the epoch, the run (``simulation.duration``, else ``maneuver.duration``)
+        and the limit it crosses: the epoch before the ephemeris' start or after its end, or the run
+        ending after it.
     """
     if epoch is None:
-        return
-    try:
-        check_epoch(epoch, span.table)
-    except ModelError:  # the epoch is parsed and the span finite: the range is what it leaves
-        low, high = EPHEMERIS_RANGE
-        raise ScenarioError("epoch", f"the ephemeris (JPL DE421) covers {low:%Y-%m-%d} to {high:%Y-%m-%d} UTC; "
-                            f"{epoch.isoformat()}Z is outside it, or the directions tabulated from it over "
-                            f"{span.table:g} s (the run of {span.run:g} s, with room for a longer reference) "
-                            "leave it") from None
+        return span
+    low, high = EPHEMERIS_RANGE
+    covers = f"the ephemeris (JPL DE421) covers {low:%Y-%m-%d} to {high:%Y-%m-%d} UTC"
+    run = ("simulation.duration" if span.run_given else "maneuver.duration") + f" = {span.run:g} s"
+    if epoch < low or epoch >= high:
+        side = f"before its start, {low:%Y-%m-%d}" if epoch < low else f"after its end, {high:%Y-%m-%d}"
+        raise ScenarioError("epoch", f"{covers}; the epoch {epoch.isoformat()}Z is {side} (the run: {run})")
+    room = (high - epoch).total_seconds()
+    if span.run > room:
+        end = epoch + datetime.timedelta(seconds=span.run)
+        latest = high - datetime.timedelta(seconds=span.run)
+        raise ScenarioError("epoch", f"{covers}; the run from {epoch.isoformat()}Z ({run}) ends at "
+                            f"{end.isoformat()}Z, after its end: start it at {latest.isoformat()}Z or earlier, "
+                            "or shorten it")
+    if span.table > room:
+        span = dataclasses.replace(span, table=room)
+    check_epoch(epoch, span.table)  # the same limits, as the ephemeris module states them
+    return span

@@ -37,7 +37,7 @@ from scenarios.requirements.fields import is_requirement_column
 from scenarios.requirements.scoring import score_fields
 from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES
 from scenarios.schema.keys import Key
-from scenarios.schema.loader import Scenario, parse_scenario
+from scenarios.schema.loader import OTHER_FILES, Scenario, parse_scenario
 from scenarios.schema.node import Node
 from scenarios.schema.read import read_yaml
 from scenarios.schema.study import (
@@ -628,6 +628,19 @@ def _case_error(case: Case, error: ScenarioError) -> ScenarioError:
     return ScenarioError(f"case {case.index} [{', '.join(shown)}]: {error.path}{culprit}", error.message)
 
 
+def _refuse_other_file(data: Any, path: Path) -> None:
+    """A scenario or slew-table file given where a study is expected: name the command that runs it
+    (the mirror of :func:`scenarios.schema.loader.load`'s message for a study given to ``run``)."""
+    if not isinstance(data, dict) or "study" in data:
+        return
+    for key, command in OTHER_FILES.items():
+        if key in data:
+            raise ScenarioError("", f"this is a {key} file, not a study: run it with `slewbench {command} {path}`")
+    if "maneuver" in data:  # every scenario has one; no study has it at the top level
+        raise ScenarioError("", f"this is a scenario file, not a study: run it with `slewbench run {path}` "
+                                "(a study names it under `scenario:`)")
+
+
 def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None] | None = None) -> Study:
     """Read, expand and check a study file.
 
@@ -655,9 +668,12 @@ def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None
         raise TypeError(f"path must be a str or os.PathLike, got {type(path).__name__}")
     path = Path(path)
     try:
-        return parse_study(read_yaml(path), path, progress=progress)
+        data = read_yaml(path)
+        _refuse_other_file(data, path)
+        return parse_study(data, path, progress=progress)
     except ScenarioError as error:
         if error.message.startswith(f"scenario file not found: {path}"):
             raise ScenarioError("", f"study file not found: {path}") from None
-        raise ScenarioError(f"{path}: {error.path}" if error.path else str(path), error.message) from None
+        where = f"{path}: {error.path}" if error.path and error.path != str(path) else str(path)
+        raise ScenarioError(where, error.message) from None
 

@@ -54,13 +54,14 @@ def _pointing(requirement: Any, fields: dict[str, Any]) -> list[Bound]:
 def _actuators(requirement: Any, fields: dict[str, Any]) -> list[Bound]:
     bounds: list[Bound] = []
     for name in fields:
-        if name.endswith("_time_s") or name == VERDICT:
+        if name.endswith("_time_s") or name in (VERDICT, "unrealised_torque_allowed"):
             continue
         if name == "rate_jump":
             bounds.append((name, "rate_jump_time_s", "≤", JUMP_TOLERANCE))
-        elif name == "unrealised_torque":
-            bounds.append((name, "unrealised_torque_time_s", "≤",
-                           f"{UNREALISED_SHARE:.0%} of the reference's peak torque"))
+        elif name == "unrealised_torque":  # the score's bound; in words for a run scored without it
+            allowed = fields.get("unrealised_torque_allowed")
+            bounds.append((name, "unrealised_torque_time_s", "≤", allowed if isinstance(allowed, (int, float))
+                           else f"{UNREALISED_SHARE:.0%} of the reference's peak torque"))
         elif field_info(f"actuators.{name}").unit == "–":  # an actuator quantity's demand over its limit
             bounds.append((name, f"{name}_time_s", "≤", requirement.allowed))
     return bounds
@@ -239,10 +240,11 @@ def requirement_lines(results: RunResults) -> list[list[Any]]:
         ``[row, scope, requirement, field, unit, relation and bound, achieved, at [s], within bound,
         verdict]``: the bounded fields of :data:`BOUNDS`, the unit from
         :func:`~scenarios.requirements.fields.field_info`, when (the field's time; for the final
-        requirement its window's start), whether the value is within the bound (``yes``, ``no``;
+        requirement its window's start), whether this quantity is within its bound (``yes``, ``no``;
         ``-`` for a bound in words or a value missing; a plain comparison, without the scoring's
         rounding slack of 1e-9 relative) and the verdict ``met`` or ``broken`` (the run's, on the
-        whole requirement in that scope: the score's field ``met``). Rows without scores give none.
+        whole requirement in that scope, all its quantities: the score's field ``met``; the same on
+        each of its lines). Rows without scores give none.
 
     Raises
     ------
@@ -311,12 +313,16 @@ def add_record(page: Page, results: RunResults) -> None:
         return
     page.section("Requirements", "Each requirement as stated, then per row and scope its bounded quantities: the "
                                  "bound, the value achieved, when (for the final requirement: its window's start), "
-                                 "whether it is within the bound, and the run's verdict on the whole requirement.")
+                                 "whether this quantity is within its bound, and the run's verdict on the whole "
+                                 "requirement in that scope, all its quantities together: a requirement is broken "
+                                 "when any one of them is, so a quantity within its bound may sit on a line whose "
+                                 "requirement is broken by another.")
     page.table("requirements", [Column("requirement"), Column("kind"), Column("bound")], words, wrap=True)
     lines = requirement_lines(results)
     if lines:
         page.table("requirement-scores",
                    [Column("row"), Column("scope"), Column("requirement"), Column("quantity"), Column("unit"),
                     Column("required"), Column("achieved", numeric=True), Column("at", "s", numeric=True),
-                    Column("within bound", order=("no", "yes")), Column("verdict", order=("broken", "met"))], lines,
+                    Column("this quantity within its bound", order=("no", "yes")),
+                    Column("requirement (all its quantities)", order=("broken", "met"))], lines,
                    wrap=True)
