@@ -35,10 +35,15 @@ from scenarios.output.directory import (
 )
 from scenarios.output.provenance import environment, utc_stamp
 
-__all__ = ["BENCH_FILES", "BenchRow", "Leaderboard", "certificate_text", "gap", "run_bench"]
+__all__ = ["BENCH_FILES", "ROWS_SCHEMA", "BenchRow", "Leaderboard", "certificate_text", "gap", "run_bench"]
 
 BENCH_FILES = ("leaderboard.md", "leaderboard.csv", "leaderboard.json", "gap_vs_time.png")
 """What ``slewbench bench`` writes (the plot only with plots on)."""
+
+ROWS_SCHEMA = 2
+"""The version of ``leaderboard.json``'s row keys: 2 names the objective ``objective`` and its value
+``value`` (as the CSV does) and adds ``plan_cpu_s``; a file without ``rows_schema`` (version 1) has
+the value in ``objective``."""
 
 GAP_FLOOR = 1e-9
 """Relative gaps below this are drawn at it on the log axis of the plot."""
@@ -61,10 +66,10 @@ class BenchRow:
     status : str
         The row's status as the run gives it, its closed loop included (``ok``, ``violated``,
         ``failed``; a peer's ``ok`` or ``failed``).
-    objective : float or None
-        The objective value in the problem's unit; ``None`` without a reference.
+    value : float or None
+        The objective's value in the problem's unit; ``None`` without a reference.
     gap_abs : float or None
-        ``objective − optimum`` in the problem's unit; ``None`` when not comparable.
+        ``value − optimum`` in the problem's unit; ``None`` when not comparable.
     gap_rel : float or None
         ``gap_abs / optimum``.
     reached : bool or None
@@ -87,6 +92,9 @@ class BenchRow:
     plan_cpu_s : float or None
         CPU time of the same plan [s] (``time.process_time`` of this process, every thread of it:
         a loaded machine does not inflate it as it does the wall time); ``None`` where not measured.
+    objective : str
+        The problem's objective, by name (``min_time``, ``min_energy``), as in ``problems`` and the
+        CSV.
     """
 
     problem: str
@@ -94,7 +102,7 @@ class BenchRow:
     planner: str
     kind: str
     status: str
-    objective: float | None
+    value: float | None
     gap_abs: float | None
     gap_rel: float | None
     reached: bool | None
@@ -104,6 +112,7 @@ class BenchRow:
     message: str = ""
     plan_status: str = ""
     plan_cpu_s: float | None = None
+    objective: str = ""
 
     def __post_init__(self) -> None:
         if not self.plan_status:
@@ -199,7 +208,7 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any, specs: lis
             problem.name, row.label, row.planner or "-", "planner", row.status, value, gap_abs, gap_rel,
             _reached(plans[plan], gap_abs, problem), row.plan_time_s,
             _number((stats or {}).get("iterations")), certificate_text(stats), message, plans[plan],
-            (cpu or {}).get(id(reference))))
+            (cpu or {}).get(id(reference)), problem.objective))
     return rows
 
 
@@ -313,7 +322,8 @@ def _peer_row(problem: BenchProblem, name: str, result: Any) -> BenchRow:
         message = f"{EIGENAXIS_NOTE}; {message}" if message else EIGENAXIS_NOTE
     return BenchRow(problem.name, f"{name} (peer)", name, "peer", result.status, result.objective, gap_abs, gap_rel,
                     _reached(result.status, gap_abs, problem), result.solve_time_s,
-                    _number(result.iterations), "-", message, plan_cpu_s=getattr(result, "solve_cpu_s", None))
+                    _number(result.iterations), "-", message, plan_cpu_s=getattr(result, "solve_cpu_s", None),
+                    objective=problem.objective)
 
 
 @dataclass
@@ -354,10 +364,12 @@ class Leaderboard:
         dict
             ``suite_version``, ``slewbench``, ``date``, ``environment`` (versions and platform, with
             ``peers``: the version of each peer that ran), ``wall_time_s``, ``problems`` (metadata),
-            ``rows``, ``notes``.
+            ``rows``, ``notes``, ``rows_schema`` (:data:`ROWS_SCHEMA`). A row's ``objective`` is the
+            objective's name and ``value`` its value, as in ``problems`` and the CSV.
         """
         env = {**environment(), "peers": dict(self.peer_versions)}
-        return {"suite_version": self.suite.version, "slewbench": env["slewbench"], "date": self.date,
+        return {"suite_version": self.suite.version, "rows_schema": ROWS_SCHEMA, "slewbench": env["slewbench"],
+                "date": self.date,
                 "platform": env["platform"], "environment": env, "wall_time_s": self.wall_time_s,
                 "problems": [problem.metadata() for problem in self.problems],
                 "rows": [dataclasses.asdict(row) for row in self.rows], "notes": list(self.notes)}
@@ -379,7 +391,7 @@ class Leaderboard:
         for row in self.rows:
             problem = problems[row.problem]
             writer.writerow([row.problem, problem.objective, problem.unit, repr(problem.optimum), repr(problem.tolerance),
-                             row.label, row.planner, row.kind, row.status, row.plan_status, _csv(row.objective),
+                             row.label, row.planner, row.kind, row.status, row.plan_status, _csv(row.value),
                              _csv(row.gap_abs),
                              _csv(row.gap_rel), "" if row.reached is None else row.reached, _csv(row.plan_time_s),
                              _csv(row.plan_cpu_s), "" if row.iterations is None else row.iterations, row.certificate, row.message])
@@ -422,7 +434,7 @@ class Leaderboard:
                     whole.append(note)
                     note = f"{note[:NOTE_CHARS - 1]}… [{len(whole)}]"
                 lines.append(
-                    f"| {_md(row.label)} | {row.kind} | {row.plan_status} | {row.status} | {_fmt(row.objective)} | "
+                    f"| {_md(row.label)} | {row.kind} | {row.plan_status} | {row.status} | {_fmt(row.value)} | "
                     f"{_fmt(row.gap_abs, '+.3g')}"
                     f"{mark} | {_fmt(row.gap_rel, '+.2e')} | {_fmt(row.plan_cpu_s, '.3g')} | {_fmt(row.plan_time_s, '.3g')} | "
                     f"{'-' if row.iterations is None else row.iterations} | {_md(row.certificate)} | {_md(note)} |")
