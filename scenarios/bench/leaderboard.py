@@ -374,6 +374,25 @@ class Leaderboard:
                 "problems": [problem.metadata() for problem in self.problems],
                 "rows": [dataclasses.asdict(row) for row in self.rows], "notes": list(self.notes)}
 
+    def reached_text(self) -> str:
+        """How many rows reach their problem's optimum, by the kind of that optimum.
+
+        Returns
+        -------
+        str
+            ``"3 at the optimum (2 published, 1 best known)"``: the kinds (``published``,
+            ``best known``, ``closed form``, the suite's ``optimum.kind``) in the order the rows meet
+            them; ``"0 at the optimum"`` when no row reaches one.
+        """
+        kinds = {problem.name: problem.optimum_kind.replace("_", " ") for problem in self.problems}
+        counts: dict[str, int] = {}
+        for row in self.rows:
+            if row.reached:
+                counts[kinds[row.problem]] = counts.get(kinds[row.problem], 0) + 1
+        total = sum(counts.values())
+        return f"{total} at the optimum" + (f" ({', '.join(f'{n} {kind}' for kind, n in counts.items())})"
+                                            if total else "")
+
     def to_csv(self) -> str:
         """One line per row, with the problem's objective, unit, optimum and tolerance.
 

@@ -70,8 +70,7 @@ def command_bench(args: argparse.Namespace) -> int:
           + (f", peers {', '.join(peers)}" if peers else ", no peers"), flush=True)
     board = run_bench(suite, problems, planners, peers, progress=lambda line: print(line, flush=True))
     files = board.write(out, plots=not args.no_plots)
-    reached = sum(1 for row in board.rows if row.reached)
-    print(f"{len(board.rows)} row(s), {reached} at the best known optimum, in {board.wall_time_s:.1f} s")
+    print(f"{len(board.rows)} row(s), {board.reached_text()}, in {board.wall_time_s:.1f} s")
     for note in board.notes:
         print(f"note: {note}")
     print(f"wrote {out}/ ({', '.join(sorted(files))})")
