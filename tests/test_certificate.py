@@ -119,7 +119,7 @@ def test_verdicts_from_the_evidence():
     large = KKTResiduals(*[1e-3] * 8, 1.0)
     bang = Switching(0.97, 0.0, 0.01, 0.02, 1e-3)
     singular = Switching(1 / 3, 0.0, 0.0, 2 / 3, 1e-3)
-    assert certificate(small, "not checked: big", bang)["verdict"] == "certified"
+    assert certificate(small, "not checked: big", bang)["verdict"] == "first-order, bang-bang"
     assert certificate(small, "not checked: big", singular)["verdict"] == "first-order"
     assert certificate(large, "strict local minimum", bang)["verdict"] == "not certified"
     # the switching evidence never overrules a second-order check that found negative curvature (a
@@ -128,11 +128,11 @@ def test_verdicts_from_the_evidence():
     saddle = SecondOrderCheck(False, 12, 1e-6, "at most 12 directions of curvature below -1e-06")
     assert certificate(small, saddle, bang)["verdict"] == "first-order"
     # a degenerate point (curvature near zero somewhere, none below -δ) is no saddle: the switching
-    # evidence stands in there, and only there with bang-bang controls
+    # evidence stands in there, and only there with bang-bang controls, as its own verdict, not "certified"
     degenerate = SecondOrderCheck(False, 0, 1e-6, "at most 1 directions of curvature between -1e-06 and 1e-06")
     record = certificate(small, degenerate, bang)
-    assert record["verdict"] == "certified" and record["second_order"].startswith("degenerate: ")
-    assert record["summary"].startswith("certified: KKT 1e-09, SOSC degenerate, switching 97%")
+    assert record["verdict"] == "first-order, bang-bang" and record["second_order"].startswith("degenerate: ")
+    assert record["summary"].startswith("first-order, bang-bang: KKT 1e-09, SOSC degenerate, switching 97%")
     assert certificate(small, degenerate, singular)["verdict"] == "first-order"
     assert certificate(small, degenerate, None)["verdict"] == "first-order"
     assert certificate(small, SecondOrderCheck(True, 0, 1e-6, "curvature above 1e-06"), None)["verdict"] == "certified"

@@ -20,7 +20,8 @@ from scenarios.bench.suite import load_suite
 
 
 def bench_row(planner: str, kind: str, gap_rel: float, time_s: float) -> BenchRow:
-    return BenchRow("p", planner, planner, kind, "ok", 1.0 + gap_rel, gap_rel, gap_rel, False, time_s, None, "-")
+    return BenchRow("p", planner, planner, kind, "ok", 1.0 + gap_rel, gap_rel, gap_rel, False, time_s, None, "-",
+                    plan_cpu_s=time_s)
 
 
 def drawn(board: Leaderboard, tmp_path: Path, monkeypatch) -> matplotlib.figure.Figure:
@@ -96,8 +97,8 @@ def test_the_plot_draws_the_rows_whose_plan_is_ok(tmp_path, monkeypatch):
     breaks one (keep_out_melton_scaled's collocation) is drawn; a row whose plan breaks one is not."""
     planners = list(PLANNERS)
     tracked_badly = BenchRow("p", planners[0], planners[0], "planner", "violated", 1.0, 1e-4, 1e-4, True, 0.1, None,
-                             "-", "", "ok")
+                             "-", "", "ok", plan_cpu_s=0.1)
     plan_broken = BenchRow("p", planners[1], planners[1], "planner", "violated", 1.0, 1e-4, 1e-4, False, 0.1, None,
-                           "-", "", "violated")
+                           "-", "", "violated", plan_cpu_s=0.1)
     labels = set(styles(drawn(Leaderboard(load_suite(), [], [tracked_badly, plan_broken]), tmp_path, monkeypatch)))
     assert labels == {planners[0]}

@@ -40,20 +40,20 @@ Three pieces of evidence, each computed here from the point alone (never from th
   :mod:`planners.collocation.certificate`).
 
 :func:`certificate` combines them into the JSON record of ``Reference.stats["certificate"]`` with a
-verdict: ``"certified"`` when the KKT residual (scaled) is at most :data:`KKT_TOLERANCE` and either
-the second-order sufficient conditions hold or, for bang-bang minimum time where the second-order
-check could not be made (a factorisation that failed its accuracy guard, a solver without the
-derivatives) or found the point degenerate (curvature near zero in some direction, none below
-``−δ``: no saddle direction), the switching agreement is at least
-:data:`SWITCHING_THRESHOLD` with no sample on the wrong side (the controls at a bound, on the side
-Pontryagin's minimum principle asks, with a switching function clear of zero; a check that found
-negative curvature is not overruled). That second way is weaker than the second-order
-sufficient conditions: strict complementarity on every control bound would make the discretised
-point a vertex (the case ``Z = {0}`` of the second-order check, which it then certifies itself),
-but a degenerate check has found a few directions of near-zero curvature (on fine meshes, the
-controls of the intervals that hold a switch, free between their bounds), where neither sign is
-proven; the summary says which way was taken (``SOSC degenerate, switching 98%``).
-``"first-order"`` when only the KKT residual is small; ``"not certified"`` otherwise.
+verdict: ``"certified"`` when the KKT residual (scaled) is at most
+:data:`KKT_TOLERANCE` and the second-order sufficient conditions hold (a strict local minimum of the
+discretised problem). ``"first-order, bang-bang"`` when the KKT residual is as small and, for
+bang-bang minimum time where the second-order check could not be made (a factorisation that failed
+its accuracy guard, a solver without the derivatives) or found the point degenerate (curvature near
+zero in some direction, none below ``−δ``: no saddle direction), the switching agreement is at
+least :data:`SWITCHING_THRESHOLD` with no sample on the wrong side (the controls at a bound, on the
+side Pontryagin's minimum principle asks, with a switching function clear of zero; a check that
+found negative curvature is not overruled). That is not ``"certified"``: Pontryagin's sign
+condition is a necessary condition, and a degenerate check has found a few directions of near-zero
+curvature (on fine meshes, the controls of the intervals that hold a switch, free between their
+bounds) where neither sign is proven; the summary says what was found (``SOSC degenerate,
+switching 98%``). ``"first-order"`` when only the KKT residual is small; ``"not certified"``
+otherwise.
 """
 from __future__ import annotations
 
@@ -353,8 +353,10 @@ def certificate(kkt: KKTResiduals | None, second_order: SecondOrderCheck | str |
     -------
     dict
         ``kkt_scaled``, ``kkt_unscaled``, ``second_order``, ``switching``, ``costate_gap``,
-        ``seeds``, ``seeds_agreed``, ``verdict`` (``"certified"``, ``"first-order"`` or ``"not
-        certified"``), ``summary`` (one line) and ``kkt`` (the residuals by kind).
+        ``seeds``, ``seeds_agreed``, ``verdict`` (``"certified"`` with the second-order sufficient
+        conditions only, ``"first-order, bang-bang"`` with the switching evidence in their place,
+        ``"first-order"`` or ``"not certified"``), ``summary`` (one line) and ``kkt`` (the residuals
+        by kind).
     """
     text = _second_order_text(second_order)
     first_order = kkt is not None and kkt.scaled <= kkt_tolerance
@@ -364,7 +366,10 @@ def certificate(kkt: KKTResiduals | None, second_order: SecondOrderCheck | str |
     # only with no sample on the side Pontryagin forbids.
     bang_bang = (switching is not None and switching.agreement >= switching_threshold and switching.wrong == 0.0
                  and text.startswith(("not checked", "degenerate")))
-    verdict = "certified" if first_order and (sosc or bang_bang) else "first-order" if first_order else "not certified"
+    # Only the second-order sufficient conditions certify; the switching evidence, a necessary
+    # condition, reads as its own verdict, never as "certified".
+    verdict = ("certified" if first_order and sosc else "first-order, bang-bang" if first_order and bang_bang
+               else "first-order" if first_order else "not certified")
     record = {"kkt_scaled": None if kkt is None else kkt.scaled, "kkt_unscaled": None if kkt is None else kkt.unscaled,
               "second_order": text, "switching": None if switching is None else switching.agreement,
               "costate_gap": costate_gap, "seeds": seeds, "seeds_agreed": seeds_agreed, "verdict": verdict,

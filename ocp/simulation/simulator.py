@@ -970,8 +970,13 @@ def _check_run_arguments(controller: Any, reference: Any, target: Any) -> None:
     if target is None:
         return
     if not isinstance(target, (tuple, list)) or len(target) != 2:
+        # the type and length, not the value: an object's repr (a whole ManeuverProblem) says nothing more
+        got = (f"a {type(target).__name__} of {len(target)} items" if isinstance(target, (tuple, list))
+               else f"type {type(target).__name__}")
+        hint = ("; pass its (qf, omegaf): target=(problem.qf, problem.omegaf)"
+                if hasattr(target, "qf") and hasattr(target, "omegaf") else "")
         raise ValueError(f"target must be a pair (q_f, omega_f): the final attitude (4 numbers, scalar first, or None) "
-                         f"and body rate (3 numbers in rad/s, or None), got {type(target).__name__} {target!r:.80}")
+                         f"and body rate (3 numbers in rad/s, or None), got {got}{hint}")
     for index, (name, size, what) in enumerate((("q_f", 4, "a quaternion, scalar first"), ("omega_f", 3, "rad/s"))):
         value = target[index]
         if value is None:

@@ -6,7 +6,7 @@ Per row: the objective value (the reference metric of the problem's objective, :
 the same measure for every planner), its gap to the optimum (absolute, in the objective's unit,
 and relative), whether the plan reaches the optimum within the problem's tolerance (judged on the
 plan: its reference planned and meeting every requirement the reference is scored against,
-``plan_status``), the row's status (the run's, its closed loop included), the plan time, the
+``plan_status``), the row's status (the run's, its closed loop included), the plan time (CPU and wall), the
 solver iterations (``reference.stats["iterations"]``) and the certificate
 (``reference.stats["certificate"]``'s ``summary`` or ``verdict``; ``-`` without one). A reference
 that leaves a boundary condition of the problem free (``Reference.free_boundary``) solves another
@@ -35,10 +35,15 @@ from scenarios.output.directory import (
 )
 from scenarios.output.provenance import environment, utc_stamp
 
-__all__ = ["BENCH_FILES", "BenchRow", "Leaderboard", "certificate_text", "gap", "run_bench"]
+__all__ = ["BENCH_FILES", "ROWS_SCHEMA", "BenchRow", "Leaderboard", "certificate_text", "gap", "run_bench"]
 
 BENCH_FILES = ("leaderboard.md", "leaderboard.csv", "leaderboard.json", "gap_vs_time.png")
 """What ``slewbench bench`` writes (the plot only with plots on)."""
+
+ROWS_SCHEMA = 2
+"""The version of ``leaderboard.json``'s row keys: 2 names the objective ``objective`` and its value
+``value`` (as the CSV does) and adds ``plan_cpu_s``; a file without ``rows_schema`` (version 1) has
+the value in ``objective``."""
 
 GAP_FLOOR = 1e-9
 """Relative gaps below this are drawn at it on the log axis of the plot."""
@@ -61,17 +66,17 @@ class BenchRow:
     status : str
         The row's status as the run gives it, its closed loop included (``ok``, ``violated``,
         ``failed``; a peer's ``ok`` or ``failed``).
-    objective : float or None
-        The objective value in the problem's unit; ``None`` without a reference.
+    value : float or None
+        The objective's value in the problem's unit; ``None`` without a reference.
     gap_abs : float or None
-        ``objective − optimum`` in the problem's unit; ``None`` when not comparable.
+        ``value − optimum`` in the problem's unit; ``None`` when not comparable.
     gap_rel : float or None
         ``gap_abs / optimum``.
     reached : bool or None
         ``|gap_abs| <= tolerance`` and ``plan_status`` ``ok``.
     plan_time_s : float or None
-        Plan time [s]: the second of two plans (a peer's solves), the first paying the build and
-        first-call costs.
+        Plan wall time [s] (``time.perf_counter``): the second of two plans (a peer's solves), the
+        first paying the build and first-call costs.
     iterations : int or None
         Solver iterations, when the planner or peer reports them.
     certificate : str
@@ -84,6 +89,12 @@ class BenchRow:
         breaks a requirement (scored as the run scores it), else ``ok``; a peer's is its status. The closed loop does not enter it: the bench
         ranks plans, and a tracking controller that dips into a keep-out cone the plan keeps
         shows in ``status``.
+    plan_cpu_s : float or None
+        CPU time of the same plan [s] (``time.process_time`` of this process, every thread of it:
+        a loaded machine does not inflate it as it does the wall time); ``None`` where not measured.
+    objective : str
+        The problem's objective, by name (``min_time``, ``min_energy``), as in ``problems`` and the
+        CSV.
     """
 
     problem: str
@@ -91,7 +102,7 @@ class BenchRow:
     planner: str
     kind: str
     status: str
-    objective: float | None
+    value: float | None
     gap_abs: float | None
     gap_rel: float | None
     reached: bool | None
@@ -100,6 +111,8 @@ class BenchRow:
     certificate: str
     message: str = ""
     plan_status: str = ""
+    plan_cpu_s: float | None = None
+    objective: str = ""
 
     def __post_init__(self) -> None:
         if not self.plan_status:
@@ -152,7 +165,8 @@ def _number(value: Any) -> int | None:
     return int(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
 
 
-def _planner_rows(problem: BenchProblem, scenario: Any, results: Any, specs: list[Any]) -> list[BenchRow]:
+def _planner_rows(problem: BenchProblem, scenario: Any, results: Any, specs: list[Any],
+                  cpu: dict[int, float] | None = None) -> list[BenchRow]:
     from planners import PLANNERS
     from planners.capabilities import minimises_time
     from scenarios.schema.labels import row_labels
@@ -193,8 +207,47 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any, specs: lis
         rows.append(BenchRow(
             problem.name, row.label, row.planner or "-", "planner", row.status, value, gap_abs, gap_rel,
             _reached(plans[plan], gap_abs, problem), row.plan_time_s,
-            _number((stats or {}).get("iterations")), certificate_text(stats), message, plans[plan]))
+            _number((stats or {}).get("iterations")), certificate_text(stats), message, plans[plan],
+            (cpu or {}).get(id(reference)), problem.objective))
     return rows
+
+
+def _cpu_timed(planners: Iterable[Any], cpu: dict[int, float]) -> Callable[[], None]:
+    """Time each planner's :meth:`~planners.Planner.plan` in CPU (``time.process_time``) while the
+    run plans: ``cpu[id(reference)]`` is the CPU time of the plan that returned ``reference``. The
+    planners' ``plan`` is wrapped on the instances only; the returned function unwraps them.
+
+    Parameters
+    ----------
+    planners : iterable of Planner
+        The planner instances the run will call.
+    cpu : dict of int to float
+        Filled with the CPU time [s] of each plan, by the reference's ``id``.
+
+    Returns
+    -------
+    callable
+        Restores the planners' own ``plan``.
+    """
+    wrapped = []
+    for planner in planners:
+        if "plan" in vars(planner):  # the same instance twice: wrapped once
+            continue
+        plan = planner.plan
+
+        def timed(problem: Any, _plan: Callable[[Any], Any] = plan) -> Any:
+            began = time.process_time()
+            reference = _plan(problem)
+            cpu[id(reference)] = time.process_time() - began
+            return reference
+
+        planner.plan = timed
+        wrapped.append(planner)
+
+    def restore() -> None:
+        for planner in wrapped:
+            vars(planner).pop("plan", None)
+    return restore
 
 
 def _plan_status(scenario: Any, row: Any, controller: Any) -> str:
@@ -269,7 +322,8 @@ def _peer_row(problem: BenchProblem, name: str, result: Any) -> BenchRow:
         message = f"{EIGENAXIS_NOTE}; {message}" if message else EIGENAXIS_NOTE
     return BenchRow(problem.name, f"{name} (peer)", name, "peer", result.status, result.objective, gap_abs, gap_rel,
                     _reached(result.status, gap_abs, problem), result.solve_time_s,
-                    _number(result.iterations), "-", message)
+                    _number(result.iterations), "-", message, plan_cpu_s=getattr(result, "solve_cpu_s", None),
+                    objective=problem.objective)
 
 
 @dataclass
@@ -310,13 +364,34 @@ class Leaderboard:
         dict
             ``suite_version``, ``slewbench``, ``date``, ``environment`` (versions and platform, with
             ``peers``: the version of each peer that ran), ``wall_time_s``, ``problems`` (metadata),
-            ``rows``, ``notes``.
+            ``rows``, ``notes``, ``rows_schema`` (:data:`ROWS_SCHEMA`). A row's ``objective`` is the
+            objective's name and ``value`` its value, as in ``problems`` and the CSV.
         """
         env = {**environment(), "peers": dict(self.peer_versions)}
-        return {"suite_version": self.suite.version, "slewbench": env["slewbench"], "date": self.date,
+        return {"suite_version": self.suite.version, "rows_schema": ROWS_SCHEMA, "slewbench": env["slewbench"],
+                "date": self.date,
                 "platform": env["platform"], "environment": env, "wall_time_s": self.wall_time_s,
                 "problems": [problem.metadata() for problem in self.problems],
                 "rows": [dataclasses.asdict(row) for row in self.rows], "notes": list(self.notes)}
+
+    def reached_text(self) -> str:
+        """How many rows reach their problem's optimum, by the kind of that optimum.
+
+        Returns
+        -------
+        str
+            ``"3 at the optimum (2 published, 1 best known)"``: the kinds (``published``,
+            ``best known``, ``closed form``, the suite's ``optimum.kind``) in the order the rows meet
+            them; ``"0 at the optimum"`` when no row reaches one.
+        """
+        kinds = {problem.name: problem.optimum_kind.replace("_", " ") for problem in self.problems}
+        counts: dict[str, int] = {}
+        for row in self.rows:
+            if row.reached:
+                counts[kinds[row.problem]] = counts.get(kinds[row.problem], 0) + 1
+        total = sum(counts.values())
+        return f"{total} at the optimum" + (f" ({', '.join(f'{n} {kind}' for kind, n in counts.items())})"
+                                            if total else "")
 
     def to_csv(self) -> str:
         """One line per row, with the problem's objective, unit, optimum and tolerance.
@@ -330,15 +405,15 @@ class Leaderboard:
         stream = io.StringIO()
         writer = csv.writer(stream, lineterminator="\n")
         writer.writerow(["problem", "objective", "unit", "optimum", "tolerance", "label", "planner", "kind", "status",
-                         "plan_status", "value", "gap_abs", "gap_rel", "reached", "plan_time_s", "iterations",
-                         "certificate", "message"])
+                         "plan_status", "value", "gap_abs", "gap_rel", "reached", "plan_time_s", "plan_cpu_s",
+                         "iterations", "certificate", "message"])
         for row in self.rows:
             problem = problems[row.problem]
             writer.writerow([row.problem, problem.objective, problem.unit, repr(problem.optimum), repr(problem.tolerance),
-                             row.label, row.planner, row.kind, row.status, row.plan_status, _csv(row.objective),
+                             row.label, row.planner, row.kind, row.status, row.plan_status, _csv(row.value),
                              _csv(row.gap_abs),
                              _csv(row.gap_rel), "" if row.reached is None else row.reached, _csv(row.plan_time_s),
-                             "" if row.iterations is None else row.iterations, row.certificate, row.message])
+                             _csv(row.plan_cpu_s), "" if row.iterations is None else row.iterations, row.certificate, row.message])
         return stream.getvalue()
 
     def to_markdown(self) -> str:
@@ -357,7 +432,8 @@ class Leaderboard:
                   "tolerance with the plan ok. Plan: the plan's own status (its reference against the requirements); "
                   "status: the run's, its closed loop included (the bench ranks plans: a tracking controller's "
                   "violation shows there, not in the ✓). Plan time: the second of two plans (a peer's solves), the "
-                  "first paying the build and first-call costs."), ""]
+                  "first paying the build and first-call costs; CPU: the process's CPU time (time.process_time), "
+                  "wall: the elapsed time (time.perf_counter), which a loaded machine inflates."), ""]
         lines += self._summary()
         for problem in self.problems:
             lines += [f"## {problem.name}: {problem.title}", "",
@@ -366,9 +442,9 @@ class Leaderboard:
                        f"({problem.optimum_kind.replace('_', ' ')}: {problem.optimum_source}); eigenaxis "
                        f"{'-' if problem.eigenaxis is None else f'{problem.eigenaxis:.6g}'} ({problem.eigenaxis_source}). "
                        f"Source: {problem.source}"), "",
-                      ("| row | kind | plan | status | value | gap | gap (rel) | plan time [s] | iterations | "
-                       "certificate | note |"),
-                      "|---|---|---|---|---|---|---|---|---|---|---|"]
+                      ("| row | kind | plan | status | value | gap | gap (rel) | plan CPU [s] | plan wall [s] | "
+                       "iterations | certificate | note |"),
+                      "|---|---|---|---|---|---|---|---|---|---|---|---|"]
             whole: list[str] = []  # the notes shortened in the table, in full below it
             for row in (r for r in self.rows if r.problem == problem.name):
                 mark = "" if row.reached is None else (" ✓" if row.reached else "")
@@ -377,9 +453,9 @@ class Leaderboard:
                     whole.append(note)
                     note = f"{note[:NOTE_CHARS - 1]}… [{len(whole)}]"
                 lines.append(
-                    f"| {_md(row.label)} | {row.kind} | {row.plan_status} | {row.status} | {_fmt(row.objective)} | "
+                    f"| {_md(row.label)} | {row.kind} | {row.plan_status} | {row.status} | {_fmt(row.value)} | "
                     f"{_fmt(row.gap_abs, '+.3g')}"
-                    f"{mark} | {_fmt(row.gap_rel, '+.2e')} | {_fmt(row.plan_time_s, '.3g')} | "
+                    f"{mark} | {_fmt(row.gap_rel, '+.2e')} | {_fmt(row.plan_cpu_s, '.3g')} | {_fmt(row.plan_time_s, '.3g')} | "
                     f"{'-' if row.iterations is None else row.iterations} | {_md(row.certificate)} | {_md(note)} |")
             lines.append("")
             if whole:
@@ -392,24 +468,26 @@ class Leaderboard:
     def _summary(self) -> list[str]:
         """Markdown lines: per planner, then per peer (each in order of first appearance), its rows,
         those with a gap (the others solve another problem or failed), how many reach the optimum,
-        the median absolute relative gap of the plans ok with a gap and the median plan time."""
+        the median absolute relative gap of the plans ok with a gap and the median plan time, CPU
+        and wall."""
         lines = ["## Summary", "",
                  ("| planner | kind | rows | rows with a gap | at the optimum | median \\|gap\\| (rel) | "
-                  "median plan time [s] |"), "|---|---|---|---|---|---|---|"]
+                  "median plan CPU [s] | median plan wall [s] |"), "|---|---|---|---|---|---|---|---|"]
         names = dict.fromkeys(row.planner for row in sorted(self.rows, key=lambda row: row.kind != "planner"))
         for name in names:
             rows = [row for row in self.rows if row.planner == name]
             gapped = [row for row in rows if row.gap_rel is not None]
             gaps = [abs(row.gap_rel) for row in gapped if row.gap_rel is not None and row.plan_status == "ok"]
             times = [row.plan_time_s for row in rows if row.plan_time_s is not None]
+            cpus = [row.plan_cpu_s for row in rows if row.plan_cpu_s is not None]
             lines.append(f"| {_md(name)} | {rows[0].kind} | {len(rows)} | {len(gapped)} | "
                          f"{sum(1 for row in rows if row.reached)} | {_fmt(_median(gaps), '.2e')} | "
-                         f"{_fmt(_median(times), '.3g')} |")
+                         f"{_fmt(_median(cpus), '.3g')} | {_fmt(_median(times), '.3g')} |")
         return lines + [""]
 
     def plot(self, path: Path) -> None:
-        """Relative gap against plan time, one marker per planner or peer, log axes; rows without a
-        gap are left out, gaps below :data:`GAP_FLOOR` drawn at it. Each planner or peer keeps its
+        """Relative gap against plan CPU time, one marker per planner or peer, log axes; rows without a
+        gap or a CPU time are left out, gaps below :data:`GAP_FLOOR` drawn at it. Each planner or peer keeps its
         colour and marker from run to run (``_plot_style``); the legend is beside the axes.
 
         Parameters
@@ -427,8 +505,8 @@ class Leaderboard:
         kinds = {row.planner: row.kind for row in self.rows}
         drawn = 0
         for name in sorted(kinds, key=lambda planner: (kinds[planner] == "peer", planner)):  # planners, then peers
-            points = [(row.plan_time_s, max(abs(row.gap_rel), GAP_FLOOR)) for row in self.rows
-                      if row.planner == name and row.gap_rel is not None and row.plan_time_s and row.plan_status == "ok"]
+            points = [(row.plan_cpu_s, max(abs(row.gap_rel), GAP_FLOOR)) for row in self.rows
+                      if row.planner == name and row.gap_rel is not None and row.plan_cpu_s and row.plan_status == "ok"]
             if not points:
                 continue
             kind = kinds[name]
@@ -439,7 +517,7 @@ class Leaderboard:
             drawn += 1
         axis.set_xscale("log")
         axis.set_yscale("log")
-        axis.set_xlabel("plan time [s]")
+        axis.set_xlabel("plan CPU time [s]")
         axis.set_ylabel(f"relative gap |J − J*| / J* [-] (floor {GAP_FLOOR:g})")
         axis.set_title(f"slewbench bench, suite version {self.suite.version}")
         axis.grid(True, which="major", alpha=0.3)
@@ -656,8 +734,13 @@ def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Ite
                     spec.planner.plan(scenario.problem)
                 except Exception:  # noqa: BLE001, S110 (the timed plan below records a crash as a failed row)
                     pass
-            results = run(dataclasses.replace(scenario, planners=specs))
-            rows += _planner_rows(problem, scenario, results, specs)
+            cpu: dict[int, float] = {}
+            restore = _cpu_timed([spec.planner for spec in specs], cpu)
+            try:
+                results = run(dataclasses.replace(scenario, planners=specs))
+            finally:
+                restore()
+            rows += _planner_rows(problem, scenario, results, specs, cpu)
         for name, peer in loaded.items() if problem.peers else ():
             reason = peer.problem_error(scenario.problem, problem.objective)
             if reason is not None:

@@ -40,6 +40,7 @@ def command_bench(args: argparse.Namespace) -> int:
         The output directory is not slewbench's, or holds another command's output (exit 2).
     """
     from planners import PLANNERS
+    from planners.errors import UnknownNameError
     from scenarios.bench import load_suite
     from scenarios.bench.leaderboard import run_bench
     from scenarios.bench.peers import PEERS
@@ -51,14 +52,13 @@ def command_bench(args: argparse.Namespace) -> int:
     problems = args.problems or list(suite.problems)
     unknown = [name for name in problems if name not in suite.problems]
     if unknown:
-        raise ScenarioError("--problems", f"unknown problem {unknown[0]!r}; expected some of {', '.join(suite.problems)}")
+        raise ScenarioError("--problems", str(UnknownNameError("problem", unknown[0], suite.problems)))
     peers = [] if args.no_peers else list(PEERS)
     planners = None
     if args.planners:
         unknown = [name for name in args.planners if name not in PLANNERS and name not in PEERS]
         if unknown:
-            raise ScenarioError("--planners", f"unknown planner or peer {unknown[0]!r}; expected some of planners "
-                                              f"{', '.join(PLANNERS)} or peers {', '.join(PEERS)}")
+            raise ScenarioError("--planners", str(UnknownNameError("planner or peer", unknown[0], [*PLANNERS, *PEERS])))
         planners = [name for name in args.planners if name in PLANNERS]
         if args.no_peers and not planners:
             raise ScenarioError("--planners", f"names only peers ({', '.join(args.planners)}) and --no-peers runs none: "
@@ -70,8 +70,7 @@ def command_bench(args: argparse.Namespace) -> int:
           + (f", peers {', '.join(peers)}" if peers else ", no peers"), flush=True)
     board = run_bench(suite, problems, planners, peers, progress=lambda line: print(line, flush=True))
     files = board.write(out, plots=not args.no_plots)
-    reached = sum(1 for row in board.rows if row.reached)
-    print(f"{len(board.rows)} row(s), {reached} at the best known optimum, in {board.wall_time_s:.1f} s")
+    print(f"{len(board.rows)} row(s), {board.reached_text()}, in {board.wall_time_s:.1f} s")
     for note in board.notes:
         print(f"note: {note}")
     print(f"wrote {out}/ ({', '.join(sorted(files))})")

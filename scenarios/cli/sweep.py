@@ -328,7 +328,7 @@ def command_sweep(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return EXIT_INTERRUPTED
     if args.dry_run:
-        _list_cases(study)
+        _list_cases(study, args.workers or study.execution.workers or _local_workers())
         return EXIT_OK
     where = "--scheduler" if scheduler else "execution.scheduler"
     scheduler = scheduler or study.execution.scheduler
@@ -352,11 +352,24 @@ DRY_RUN_SHOWN = 50
 """Cases ``sweep --dry-run`` lists one per line (the others are counted)."""
 
 
-def _list_cases(study: Study) -> None:
-    """Print what ``sweep`` would run: the checked cases and their varied values (nothing written)."""
+def _local_workers() -> int:
+    """The workers of a local pool by default (one per core available)."""
+    from scenarios.study.engine import default_workers
+
+    return default_workers()
+
+
+def _list_cases(study: Study, workers: int) -> None:
+    """Print what ``sweep`` would run: the checked cases and their varied values (nothing written),
+    and for a large study how to estimate its time (:func:`scenarios.study.spec.size_note`)."""
+    from scenarios.study.spec import size_note
+
     varied = [*study.grid_paths, *study.mc_paths]
     print(f"{study.name}: {len(study.cases)} cases, checked; nothing run, nothing written"
           + (f"; varying {', '.join(varied)}" if varied else ""))
+    note = size_note(study, workers)
+    if note:
+        print(note)
     for case in study.cases[:DRY_RUN_SHOWN]:
         values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
         print(f"  case {case.index} (grid point {case.point}, seed {case.seed}, key {case.key[:12]})"
@@ -401,6 +414,7 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
         robustness_tables,
     )
     from scenarios.study.robustness import crashed_counts, robustness_lines
+    from scenarios.study.spec import size_note
     from scenarios.study.store import STORE_NAME, SweepStore, resume_counts
 
     previous = signal.signal(signal.SIGTERM, _terminate)
@@ -420,6 +434,10 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
                   + f", {cluster.address if cluster else 'local process pool'}", flush=True)
             for note in counts.notes():  # stored cases of an earlier version of the study
                 print(note, flush=True)
+            size = size_note(study, args.workers or (cluster.workers() if cluster else None)
+                             or study.execution.workers or _local_workers())
+            if size:
+                print(size, flush=True)
             results = sweep(study, workers=args.workers, store=store, progress=True, cluster=cluster)
         _check_interrupted(args)  # a Ctrl-C lost on the way: the sweep's tables are not written
     except (SweepInterrupted, KeyboardInterrupt) as stop:  # KeyboardInterrupt: before the sweep took over

@@ -33,6 +33,7 @@ from ocp.geometry.directions import Geometry
 from ocp.metrics import DEFAULT_SETTLING_TOLERANCE_DEG
 from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem, Planner
+from planners.errors import UnknownNameError
 from scenarios.errors import ScenarioError
 from scenarios.requirements.spec import Requirements, Sensor
 from scenarios.schema.checks import (
@@ -339,8 +340,8 @@ def _label(node: Node) -> str | None:
 def _registered(registry: dict[str, Any], kind: str) -> Any:
     def read(node: Node) -> str:
         name = node.string()
-        if name not in registry:
-            raise node.error(f"unknown {kind} {name!r}; registered: {sorted(registry)}")
+        if name not in registry:  # the registries' own message, with its "did you mean"
+            raise node.error(str(UnknownNameError(kind, name, registry)))
         return name
     return read
 

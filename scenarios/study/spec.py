@@ -23,6 +23,7 @@ import hashlib
 import json
 import math
 import os
+import shlex
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -639,6 +640,43 @@ def _refuse_other_file(data: Any, path: Path) -> None:
     if "maneuver" in data:  # every scenario has one; no study has it at the top level
         raise ScenarioError("", f"this is a scenario file, not a study: run it with `slewbench run {path}` "
                                 "(a study names it under `scenario:`)")
+
+
+LARGE_STUDY = 1000
+"""Cases above which ``sweep`` and ``sweep --dry-run`` say how to estimate the run time
+(:func:`size_note`); a study of any size up to :data:`~scenarios.schema.study.MAX_CASES` runs."""
+
+
+def size_note(study: Study, workers: int) -> str | None:
+    """What to know of a large study before it runs: its case count, the worker time at 1 s a case
+    and how to time one of its cases. Never a refusal.
+
+    Parameters
+    ----------
+    study : Study
+        The study.
+    workers : int
+        The workers it runs on (at least 1).
+
+    Returns
+    -------
+    str or None
+        ``note: ...`` for a study of more than :data:`LARGE_STUDY` cases, else ``None``.
+    """
+    cases, workers = len(study.cases), max(int(workers), 1)
+    if cases <= LARGE_STUDY:
+        return None
+    scenario = study.raw.get("scenario") if isinstance(study.raw, dict) else None
+    if isinstance(scenario, str):
+        base = Path(scenario) if study.source is None else Path(study.source).parent / scenario
+        timing = f"slewbench run {shlex.quote(str(base))} --no-plots"
+    else:
+        timing = "slewbench run on its base scenario with --no-plots"
+    hours = cases / 3600.0
+    return (f"note: {cases} cases is a large study (over {LARGE_STUDY}): at 1 s a case that is {hours:.1f} h of "
+            f"worker time, {hours / workers:.1f} h on {workers} worker{'s' if workers != 1 else ''}. To estimate "
+            f"it, time one case ({timing} prints its plan and simulation times) and multiply by {cases} / "
+            f"{workers}; once cases finish, the progress bar shows the time left.")
 
 
 def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None] | None = None) -> Study:

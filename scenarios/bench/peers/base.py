@@ -48,6 +48,9 @@ class PeerResult:
         Wall time of the peer's build [s], when measured.
     extra : dict, optional
         Anything else the peer reports (JSON-serialisable).
+    solve_cpu_s : float or None, optional
+        CPU time of the same solve [s] (``time.process_time`` of the process that solved it), when
+        measured.
     """
 
     objective: float | None
@@ -57,6 +60,7 @@ class PeerResult:
     message: str = ""
     build_time_s: float | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    solve_cpu_s: float | None = None
 
 
 class Peer(Protocol):

@@ -145,17 +145,17 @@ class RockitPeer:
         except RuntimeError:
             pass
         build = time.perf_counter() - start
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.process_time()
         try:
             solution = ocp.solve()
         except RuntimeError as error:
             return PeerResult(None, time.perf_counter() - start, "failed", None, f"{guess.start}; rockit/IPOPT: {error}",
-                              build, {"start": guess.start})
-        elapsed = time.perf_counter() - start
+                              build, {"start": guess.start}, time.process_time() - cpu)
+        elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu
         value = float(solution.value(ocp.T)) if objective == "min_time" else float(
             solution.value(ocp.objective))
         stats = solution.stats if isinstance(getattr(solution, "stats", None), dict) else {}
-        return PeerResult(value, elapsed, "ok", stats.get("iter_count"), guess.start, build, {"start": guess.start})
+        return PeerResult(value, elapsed, "ok", stats.get("iter_count"), guess.start, build, {"start": guess.start}, cpu)
 
 
 PEER = RockitPeer()

@@ -1,0 +1,48 @@
+"""A large study is announced with its case count and how to estimate its time, in ``--dry-run``
+and when the sweep starts; it is never refused (docs/guide/studies.rst).
+
+Oracle: the case count of the grid by hand (1001 Monte Carlo samples of one grid point), the worker time at 1 s a
+case (1001 s = 0.278 h, 0.139 h on 2 workers), and a small study (10 cases) that gets no note.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from scenarios.cli import main
+from scenarios.study.spec import LARGE_STUDY, load_study, size_note
+
+BASE = Path("scenarios/eigenaxis_demo.yaml").resolve()
+
+
+def study_file(tmp_path: Path, cases: int) -> Path:
+    path = tmp_path / f"s{cases}.yaml"
+    path.write_text(f"study: s{cases}\nscenario: {BASE}\nmonte_carlo: {{samples: {cases}, seed: 1, dispersions: "
+                    "{simulation.sensor_noise.seed: case_seed}}\n")
+    return path
+
+
+def test_a_large_dry_run_prints_the_count_and_how_to_estimate_its_time(tmp_path, capsys):
+    assert LARGE_STUDY == 1000
+    assert main(["sweep", str(study_file(tmp_path, 1001)), "--dry-run", "--workers", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "s1001: 1001 cases, checked; nothing run, nothing written" in out
+    assert ("note: 1001 cases is a large study (over 1000): at 1 s a case that is 0.3 h of worker time, 0.1 h on 2 "
+            "workers") in out, out
+    assert f"slewbench run {BASE} --no-plots" in out and "multiply by 1001 / 2" in out
+
+
+def test_a_small_study_gets_no_note(tmp_path, capsys):
+    assert main(["sweep", str(study_file(tmp_path, 10)), "--dry-run"]) == 0
+    assert "note:" not in capsys.readouterr().out
+    assert size_note(load_study(study_file(tmp_path, 10)), 1) is None
+
+
+def test_the_sweep_says_it_when_it_starts_and_runs_the_study(tmp_path, capsys, monkeypatch):
+    import scenarios.study.spec as spec
+    monkeypatch.setattr(spec, "LARGE_STUDY", 1)  # two cases stand for a large study: the note, then the run
+    assert main(["sweep", str(study_file(tmp_path, 2)), "--out", str(tmp_path / "sweep"), "--workers", "1",
+                 "--no-plots"]) == 0
+    out = capsys.readouterr().out
+    first = out.splitlines()
+    assert first[0].startswith("s2: 2 cases") and first[1].startswith("note: 2 cases is a large study (over 1)")
+    assert "2 cases run in" in out
