@@ -270,7 +270,7 @@ def test_validate_says_the_held_out_grid_and_the_refinement(tmp_path, capsys):
                                                      "refine": {"tolerance": 0.02, "max_rounds": 2}}})
     assert main(["validate", str(full)]) == 0
     said = capsys.readouterr().out
-    assert "6 axes x 2 angles + a held-out grid of 3 axes x 1 angle" in said, said
+    assert "6 axes x 2 angles + a held-out grid of 3 axes x 3 angles" in said, said
     assert "refined to a tolerance of 0.02 (at most 2000 axes, 2 rounds)" in said, said
 
 
