@@ -327,7 +327,7 @@ def add_table_parser(commands: Any) -> None:
     parser.add_argument("--objective", help="min_time (default) or min_energy (needs --duration)")
     parser.add_argument("--duration", type=float, help="slew duration for min_energy [s]")
     parser.add_argument("--held-out", type=int, help="axes of the held-out grid the fit is measured on "
-                                                     "(at the mid angles; 0: none; default 0)")
+                                                     "(at every table angle and the midpoints; 0: none; default 0)")
     parser.add_argument("--tolerance", type=float,
                         help="refine the axes until the fit's misses at the triangles' edge midpoints are at most "
                              "this fraction of the slew time (e.g. 0.01; default: no refinement)")
