@@ -304,7 +304,7 @@ def test_netcdf_reads_back_with_dimensions_units_and_attributes(tmp_path):
     assert written == ["slew_table.csv", "slew_table.nc", "fit.json"]
     with netcdf_file(tmp_path / "slew_table.nc", "r", mmap=False) as nc:
         assert nc.dimensions["axis"] == 12 and nc.dimensions["angle"] == 3
-        assert nc.dimensions["held_out_axis"] == 4 and nc.dimensions["held_out_angle"] == 2
+        assert nc.dimensions["held_out_axis"] == 4 and nc.dimensions["held_out_angle"] == 5
         time_var = nc.variables["slew_time"]
         assert time_var.dimensions == ("axis", "angle")
         assert time_var.units == b"s" and time_var.long_name
@@ -322,7 +322,7 @@ def test_netcdf_reads_back_with_dimensions_units_and_attributes(tmp_path):
         assert nc.slewbench_version and nc.date_created
     rows = (tmp_path / "slew_table.csv").read_text().splitlines()
     assert rows[0].startswith("grid,axis_x,axis_y,axis_z,angle_deg,slew_time_s,objective")
-    assert len(rows) == 1 + 12 * 3 + 4 * 2
+    assert len(rows) == 1 + 12 * 3 + 4 * 5  # held-out: the 3 table angles and their 2 midpoints
 
 
 # --- the command line ----------------------------------------------------------------------------
@@ -413,11 +413,15 @@ def test_command_writes_the_table_and_resumes_from_its_store(tmp_path, capsys):
     assert main(args) == 0
     said = capsys.readouterr().out
     assert "12 of 12 entries ok" in said and "held-out error" in said
+    # the output names the held-out set: 2 axes at both table angles and their midpoint
+    assert "held-out points: 2 axes not in the table, at the table's angles (90, 180 deg) and their midpoints " \
+           "(135 deg)" in said, said
     assert {"slew_table.csv", "slew_table.nc", "fit.json", "agility_envelope.png"} <= {p.name for p in out.iterdir()}
     fit = load_fit(out / "fit.json")
-    assert fit.meta["held_out"]["points"] == 2
+    assert fit.meta["held_out"]["points"] == 6
+    assert fit.meta["held_out"]["held_out"]["table_angles_deg"] == [90.0, 180.0]
     assert main(args) == 0
-    assert "(14 entries already stored)" in capsys.readouterr().out
+    assert "(18 entries already stored)" in capsys.readouterr().out
 
 
 def test_a_bad_table_file_is_named_as_one(tmp_path, capsys):

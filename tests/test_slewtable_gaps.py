@@ -270,7 +270,7 @@ def test_validate_says_the_held_out_grid_and_the_refinement(tmp_path, capsys):
                                                      "refine": {"tolerance": 0.02, "max_rounds": 2}}})
     assert main(["validate", str(full)]) == 0
     said = capsys.readouterr().out
-    assert "6 axes x 2 angles + a held-out grid of 3 axes x 1 angle" in said, said
+    assert "6 axes x 2 angles + a held-out grid of 3 axes x 3 angles" in said, said
     assert "refined to a tolerance of 0.02 (at most 2000 axes, 2 rounds)" in said, said
 
 
@@ -301,3 +301,16 @@ def test_the_tables_own_angles_have_a_time_whatever_the_rounding():
     top = _fit({}, angles_deg=[30.0, 90.0])  # at the largest angle (not 180): a time, not "past it"
     for axis in axes[:50]:
         assert all(math.isfinite(v) for v in _both(top, axis, 90.0)), axis
+
+
+def test_sequences_of_numpy_scalars_give_the_floats_answer_and_text_is_refused():
+    """Tuples of NumPy scalars took the pure-Python path with NumPy arithmetic (twice the cost);
+    they are converted to floats first: the same answer, bit for bit, as floats; text is not a number."""
+    fit = _fit({})
+    qf = quat.from_axis_angle([0.3, -0.5, 0.8], 1.2)
+    expected = fit(I, tuple(qf.tolist()))
+    assert expected == pytest.approx(bang_bang([0.3, -0.5, 0.8], 1.2), rel=1e-12)
+    assert fit(tuple(np.array(I)), tuple(qf)) == expected  # tuples of numpy.float64
+    assert fit((1, 0, 0, 0), list(qf.astype(np.float32).astype(float))) == pytest.approx(expected, rel=1e-7)
+    with pytest.raises(TypeError, match="4 numbers"):
+        fit(("1", "0", "0", "0"), tuple(qf.tolist()))

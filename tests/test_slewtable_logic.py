@@ -1,5 +1,5 @@
-"""The slew table's grids against what they are by construction: the held-out angles halfway between
-each pair of neighbouring table angles (hand-worked), and the Fibonacci lattice's points at the
+"""The slew table's grids against what they are by construction: the held-out angles are the table's
+angles and the midpoints of each pair of neighbours (hand-worked), and the Fibonacci lattice's points at the
 middle heights of n bands of equal area (Archimedes' hat-box theorem: equal heights are equal areas
 on the sphere; González 2010, Math. Geosci. 42, 49), none at a pole, mirror-symmetric in z."""
 import numpy as np
@@ -8,10 +8,12 @@ import pytest
 from scenarios.slewtable.grid import GOLDEN_ANGLE, fibonacci_axes, held_out_angles
 
 
-def test_held_out_angles_lie_halfway_between_each_pair_of_neighbours():
-    assert held_out_angles([10.0, 30.0, 60.0, 90.0, 180.0]) == [20.0, 45.0, 75.0, 135.0]
-    assert held_out_angles([45.0, 90.0]) == [67.5]
-    assert held_out_angles([90.0]) == []
+def test_held_out_angles_are_the_table_angles_and_their_midpoints():
+    # the table's angles themselves (the largest, 180, most of all) are held-out angles: a held-out
+    # axis there measures the fit between axes, which the midpoints alone never isolate
+    assert held_out_angles([10.0, 30.0, 60.0, 90.0, 180.0]) == [10.0, 20.0, 30.0, 45.0, 60.0, 75.0, 90.0, 135.0, 180.0]
+    assert held_out_angles([45.0, 90.0]) == [45.0, 67.5, 90.0]
+    assert held_out_angles([90.0]) == [90.0]
 
 
 @pytest.mark.parametrize("n", [1, 2, 7, 50])

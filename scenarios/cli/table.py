@@ -73,7 +73,7 @@ def _check_work(spec: TableSpec, entries: int, args: argparse.Namespace) -> None
            f"degrees are a comma-separated list, e.g. --angles 30,90)" if angles.isdigit() else ""
     raise ScenarioError("--max-entries", f"{_count(len(spec.axes), 'axis', 'axes')} x "
                                          f"{_count(len(spec.angles_deg), 'angle')}"
-                        + (f" + the held-out grid's {spec.held_out * max(len(spec.angles_deg) - 1, 0)}"
+                        + (f" + the held-out grid's {spec.held_out * len(spec.held_out_angles_deg)}"
                            if spec.held_out else "")
                         + f" = {entries} entries, more than {limit} (each a collocation solve: seconds to minutes){bare}; "
                         f"to compute them all, give --max-entries {entries}")
@@ -108,7 +108,7 @@ def command_table(args: argparse.Namespace) -> int:
     from scenarios.output.directory import new_staging
     from scenarios.output.names import default_output_directory
     from scenarios.schema.table import TABLE_FLAGS
-    from scenarios.slewtable.compute import compute_table
+    from scenarios.slewtable.compute import compute_table, quality_lines
     from scenarios.slewtable.files import write_table_files
     from scenarios.slewtable.spec import parse_table_spec
     from scenarios.study.engine import connect_scheduler, start_forkserver
@@ -122,7 +122,7 @@ def command_table(args: argparse.Namespace) -> int:
     if not args.no_plots:
         import matplotlib  # noqa: F401  (fail now, not after the entries ran)
     out = Path(args.out) if args.out else default_output_directory(f"table-{spec.name}")
-    entries = len(spec.axes) * len(spec.angles_deg) + spec.held_out * max(len(spec.angles_deg) - 1, 0)
+    entries = len(spec.axes) * len(spec.angles_deg) + spec.held_out * len(spec.held_out_angles_deg)
     _check_work(spec, entries, args)
     # the scheduler first: one that cannot be reached exits 2 with nothing written
     cluster = connect_scheduler(spec.scheduler, "--scheduler" if args.scheduler else "table.execution.scheduler") \
@@ -135,7 +135,7 @@ def command_table(args: argparse.Namespace) -> int:
         raise
     print(f"{spec.name}: {_count(len(spec.axes), 'axis', 'axes')} x {_count(len(spec.angles_deg), 'angle')}"
           + (f" + {_count(spec.held_out, 'held-out axis', 'held-out axes')} x "
-             f"{_count(len(spec.angles_deg) - 1, 'angle')}" if spec.held_out else "")
+             f"{_count(len(spec.held_out_angles_deg), 'angle')} (the table's and their midpoints)" if spec.held_out else "")
           + f" = {entries} entries, {spec.objective}, {cluster.address if cluster else 'local process pool'}"
           + (f"; then refined to a tolerance of {spec.refine.tolerance:g} (at most {spec.refine.max_axes} axes, "
              f"{spec.refine.max_rounds} rounds)" if spec.refine else ""), flush=True)
@@ -170,13 +170,12 @@ def command_table(args: argparse.Namespace) -> int:
         print(f"no fit: {table.fit_note}")
     else:
         quality = table.fit_quality
-        if quality.get("points"):
-            print(f"fit: held-out error max {100 * quality['max_rel_error']:.3g} %, RMS "
-                  f"{100 * quality['rms_rel_error']:.3g} % of the slew time ({quality['points']} points); "
-                  f"evaluation {quality['eval_time_us']:.2f} us CPU per call")
-        else:
+        lines = quality_lines(quality)
+        if not quality.get("points"):
             why = "--held-out 0" if not spec.held_out else "every held-out point in a gap of the table"
-            print(f"fit: no held-out points ({why}); evaluation {quality['eval_time_us']:.2f} us CPU per call")
+            lines[0] = lines[0].replace("no held-out points", f"no held-out points ({why})")
+        for line in lines:
+            print(line)
         if table.fit_note:
             print(f"fit note: {table.fit_note}")
         print(f"use it: from scenarios.slewtable import load_fit; slew_time = load_fit('{directory / 'fit.json'}')")
@@ -328,7 +327,7 @@ def add_table_parser(commands: Any) -> None:
     parser.add_argument("--objective", help="min_time (default) or min_energy (needs --duration)")
     parser.add_argument("--duration", type=float, help="slew duration for min_energy [s]")
     parser.add_argument("--held-out", type=int, help="axes of the held-out grid the fit is measured on "
-                                                     "(at the mid angles; 0: none; default 0)")
+                                                     "(at every table angle and the midpoints; 0: none; default 0)")
     parser.add_argument("--tolerance", type=float,
                         help="refine the axes until the fit's misses at the triangles' edge midpoints are at most "
                              "this fraction of the slew time (e.g. 0.01; default: no refinement)")

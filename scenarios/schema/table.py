@@ -237,7 +237,8 @@ TABLE = Section((
     number("duration", "The slew duration of a ``min_energy`` table (required there; ``min_time`` finds it).",
            unit="s", default=None, positive=True, nullable=True),
     integer("held_out", "Axes of the held-out grid the fit's error is measured on (a Fibonacci lattice turned by "
-            "1 rad, at the midpoints of ``angles_deg``); 0: none. A ``min_time`` table of axes that span the "
+            "1 rad, at every angle of ``angles_deg`` and the midpoints between them); 0: none. A ``min_time`` "
+            "table of axes that span the "
             "sphere only.", default=0, minimum=0, maximum=MAX_AXES),
     custom("planner_options", "More options of the ``collocation`` planner (its options in this reference, under "
            "Planner options), checked as a scenario's; not ``objective``.", "mapping", _planner_options, default={}),

@@ -40,8 +40,8 @@ from scenarios.slewtable.spec import (
     torque_generators,
 )
 
-__all__ = ["PART_NAMES", "SlewTable", "TablePart", "compute_table", "eval_time_us", "fit_entries", "held_out_errors",
-           "slower_than_known"]
+__all__ = ["FIT_TARGET", "PART_NAMES", "SlewTable", "TablePart", "compute_table", "eval_time_us", "fit_entries",
+           "held_out_errors", "quality_lines", "slower_than_known"]
 
 PART_NAMES = ("table", "held_out", "check")
 """The grids of a table: the fitted one, the held-out one, and the refinement's check points that
@@ -326,31 +326,58 @@ def eval_time_us(fit: SlewTimeFit, repeats: int = 7, number: int = 2000) -> floa
     return statistics.median(times) / (loops * len(pairs)) * 1e6
 
 
-def held_out_errors(fit: SlewTimeFit, part: TablePart) -> dict[str, Any]:
-    """The fit's relative error on a held-out grid's ``ok`` entries.
+FIT_TARGET = 0.01
+"""The fit's target: its error on held-out points at most this fraction of the slew time (issue 30)."""
+
+
+def held_out_errors(fit: SlewTimeFit, part: TablePart, table_angles_deg: list[float] | None = None) -> dict[str, Any]:
+    """The fit's signed relative error ``fit / truth - 1`` on a held-out grid's ``ok`` entries.
 
     Parameters
     ----------
     fit : SlewTimeFit
         The fit.
     part : TablePart
-        The held-out grid.
+        The held-out grid (axes not in the table, at the table's angles and their midpoints:
+        :func:`scenarios.slewtable.grid.held_out_angles`).
+    table_angles_deg : list of float, optional
+        The table's angles [deg]: each held-out angle is reported as ``table`` (the fit interpolates
+        over axes only) or ``midpoint`` (over axes and angles). None: every one is ``midpoint``
+        unless it is the fit's own angle.
 
     Returns
     -------
     dict
-        ``points`` (ok entries compared), ``max_rel_error`` and ``rms_rel_error`` (fractions of the
-        slew time; None without points), ``worst`` (axis, angle [deg], table and fitted times [s]),
-        ``no_value`` (ok entries where the fit has no time, in a cell around an entry that is not
-        ok: not compared).
+        ``points`` (ok entries compared); ``max_over_error`` (the largest over-estimate, ``fit``
+        above the solve, a fraction of the solved slew time, >= 0), ``max_under_error`` (the
+        largest under-estimate, >= 0), ``max_rel_error`` (the larger of the two) and
+        ``rms_rel_error`` (None without points); ``target`` (:data:`FIT_TARGET`) and ``target_met``
+        (``max_rel_error <= target``; None without points); ``worst`` (axis, angle [deg], solved
+        and fitted times [s], signed error) and ``worst_under`` (the same at the largest
+        under-estimate, None without one); ``by_angle`` (per held-out angle [deg]: ``kind``,
+        ``points``, ``max_over_error``, ``max_under_error``); ``held_out`` (what the set is:
+        ``axes``, ``angles_deg``, ``table_angles_deg``, ``midpoint_angles_deg``); ``no_value`` (ok
+        entries where the fit has no time, in a cell around an entry that is not ok: not compared).
     """
+    fitted = np.rad2deg(fit.angles).tolist()
+    table_angles = [float(a) for a in (fitted if table_angles_deg is None else table_angles_deg)]
+
+    def on_table(angle: float) -> bool:
+        return any(abs(angle - a) <= 1e-9 * max(1.0, abs(a)) for a in table_angles)
+
+    kinds = ["table" if on_table(float(a)) else "midpoint" for a in part.angles_deg]
+    described = {"axes": len(part.axes), "angles_deg": [float(a) for a in part.angles_deg],
+                 "table_angles_deg": [float(a) for a, kind in zip(part.angles_deg, kinds) if kind == "table"],
+                 "midpoint_angles_deg": [float(a) for a, kind in zip(part.angles_deg, kinds) if kind == "midpoint"]}
+    none: dict[str, Any] = {"points": 0, "max_rel_error": None, "max_over_error": None, "max_under_error": None,
+                            "rms_rel_error": None, "target": FIT_TARGET, "target_met": None, "worst": None,
+                            "worst_under": None, "by_angle": [], "held_out": described, "no_value": 0}
     ok = part.ok
-    none: dict[str, Any] = {"points": 0, "max_rel_error": None, "rms_rel_error": None, "worst": None, "no_value": 0}
     if not ok.any():
         return none
     i, k = np.nonzero(ok)
     truth = part.slew_time_s[i, k]
-    angles = np.deg2rad(np.asarray(part.angles_deg))[k]
+    angles = np.deg2rad(np.asarray(part.angles_deg, dtype=float))[k]
     estimate = fit.many_axis_angle(part.axes[i], angles)
     finite = np.isfinite(estimate)
     if not finite.all():
@@ -358,11 +385,66 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart) -> dict[str, Any]:
     none["no_value"] = int((~finite).sum())
     if not finite.any():
         return none
-    rel = np.abs(estimate / truth - 1.0)
-    w = int(np.argmax(rel))
-    return {"points": len(rel), "max_rel_error": float(rel.max()), "rms_rel_error": float(np.sqrt(np.mean(rel ** 2))),
-            "worst": {"axis": part.axes[i[w]].tolist(), "angle_deg": float(part.angles_deg[k[w]]),
-                      "table_s": float(truth[w]), "fit_s": float(estimate[w])}, "no_value": none["no_value"]}
+    signed = estimate / truth - 1.0
+    over, under = max(float(signed.max()), 0.0), max(float(-signed.min()), 0.0)
+
+    def point(w: int) -> dict[str, Any]:
+        return {"axis": part.axes[i[w]].tolist(), "angle_deg": float(part.angles_deg[k[w]]), "table_s": float(truth[w]),
+                "fit_s": float(estimate[w]), "error": float(signed[w])}
+
+    by_angle = []
+    for column, angle in enumerate(part.angles_deg):
+        here = signed[k == column]
+        if len(here):
+            by_angle.append({"angle_deg": float(angle), "kind": kinds[column], "points": len(here),
+                             "max_over_error": max(float(here.max()), 0.0),
+                             "max_under_error": max(float(-here.min()), 0.0)})
+    largest = max(over, under)
+    return {"points": len(signed), "max_rel_error": largest, "max_over_error": over, "max_under_error": under,
+            "rms_rel_error": float(np.sqrt(np.mean(signed ** 2))), "target": FIT_TARGET,
+            "target_met": bool(largest <= FIT_TARGET), "worst": point(int(np.argmax(np.abs(signed)))),
+            "worst_under": point(int(np.argmin(signed))) if under > 0.0 else None, "by_angle": by_angle,
+            "held_out": described, "no_value": none["no_value"]}
+
+
+def quality_lines(quality: dict[str, Any]) -> list[str]:
+    """What the command says of a fit's held-out errors (:func:`held_out_errors`), naming the set.
+
+    Parameters
+    ----------
+    quality : dict
+        :func:`held_out_errors`'s result, with ``eval_time_us``.
+
+    Returns
+    -------
+    list of str
+        The lines: the signed errors and the target's verdict, then what the held-out set is and
+        the errors at each held-out angle.
+    """
+    evaluation = f"evaluation {quality['eval_time_us']:.2f} us CPU per call"
+    if not quality.get("points"):
+        return [f"fit: no held-out points; {evaluation}"]
+    held = quality["held_out"]
+    verdict = "met" if quality["target_met"] else "NOT met"
+    degrees = ", ".join(f"{a:g}" for a in held["table_angles_deg"])
+    mids = ", ".join(f"{a:g}" for a in held["midpoint_angles_deg"])
+    angles = f"at the table's angles ({degrees} deg)" + (f" and their midpoints ({mids} deg)" if mids else "")
+    worst = quality["worst"]
+    lines = [f"fit: held-out error from {_signed(-quality['max_under_error'])} % (largest under-estimate) to "
+             f"{_signed(quality['max_over_error'])} % (largest over-estimate), RMS {100 * quality['rms_rel_error']:.3g} "
+             f"% of the slew time ({quality['points']} points); target {100 * quality['target']:g} %: {verdict} "
+             f"(worst {100 * worst['error']:+.3g} % at {worst['angle_deg']:g} deg about "
+             f"[{', '.join(f'{v:.3f}' for v in worst['axis'])}]); {evaluation}",
+             f"fit: held-out points: {held['axes']} axes not in the table, {angles}"]
+    lines.append("fit: held-out error by angle: " + "; ".join(
+        f"{item['angle_deg']:g} deg ({item['kind']}) {_signed(-item['max_under_error'])} to "
+        f"{_signed(item['max_over_error'])} %" for item in quality["by_angle"]))
+    return lines
+
+
+def _signed(fraction: float) -> str:
+    """A signed fraction in percent (``0`` without a sign: none)."""
+    return "0" if fraction == 0.0 else f"{100 * fraction:+.3g}"
 
 
 def compute_table(spec: TableSpec, directory: str | Path | None = None, *, workers: int | None = None,
@@ -427,7 +509,7 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
         meta["refinement"] = table.refinement
     table.fit, table.fit_note = fit_entries(parts["table"], inertia, generators, meta, triangles)
     if table.fit is not None:
-        quality = held_out_errors(table.fit, parts["held_out"])
+        quality = held_out_errors(table.fit, parts["held_out"], spec.angles_deg)
         if quality["no_value"]:
             missed = (f"{_plural(quality['no_value'], 'ok held-out entry', 'ok held-out entries')} where the fit "
                       "has no time (not compared)")

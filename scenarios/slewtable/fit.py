@@ -231,6 +231,18 @@ def _as_list(name: str, value: Any) -> list[float]:
     return listed
 
 
+def _floats(name: str, q: Sequence[Any]) -> list[float]:
+    """A quaternion's 4 numbers (NumPy scalars, ints) as Python floats, or a ``TypeError`` (text is
+    not a number, though ``float`` reads it)."""
+    a, b, c, d = q
+    if isinstance(a, _TEXT) or isinstance(b, _TEXT) or isinstance(c, _TEXT) or isinstance(d, _TEXT):
+        raise TypeError(f"{name} must be 4 numbers (scalar first), got {q!r}")
+    return [float(a), float(b), float(c), float(d)]
+
+
+_TEXT = (str, bytes)
+
+
 def _check_unit(q0: Sequence[float], qf: Sequence[float]) -> None:
     """The ``ValueError`` for the quaternion of ``q0``, ``qf`` whose norm is off."""
     for name, q in (("q0", q0), ("qf", qf)):
@@ -476,8 +488,9 @@ class SlewTimeFit:
         Parameters
         ----------
         q0, qf : sequence of 4 floats
-            Attitude quaternions, scalar first, body to inertial (unit; tuples or lists are
-            fastest, NumPy arrays are converted).
+            Attitude quaternions, scalar first, body to inertial (unit; tuples or lists of
+            Python floats are fastest; NumPy arrays, and sequences of NumPy scalars or ints,
+            are converted first).
 
         Returns
         -------
@@ -502,6 +515,9 @@ class SlewTimeFit:
         try:
             a, b, c, d = q0
             e, f, g, h = qf
+            if type(a) is not float or type(e) is not float:  # e.g. NumPy scalars: ~10x a float per operation
+                a, b, c, d = _floats("q0", q0)
+                e, f, g, h = _floats("qf", qf)
             n0 = a * a + b * b + c * c + d * d
             n1 = e * e + f * f + g * g + h * h
         except (TypeError, ValueError):

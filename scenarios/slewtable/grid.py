@@ -2,7 +2,9 @@
 
 Axes are a Fibonacci (golden-angle spiral) lattice: ``n`` nearly uniform points, each the centre of
 an equal-area band. The held-out grid used to measure the fit is the same lattice of another size
-turned by an irrational angle about z, so that none of its points is a table point.
+turned by an irrational angle about z, so that none of its axes is a table axis; it is solved at
+every table angle (the largest included: what a scheduler asks most) and at the midpoints between
+them (:func:`held_out_angles`), so that it measures the fit between axes and between angles.
 """
 from __future__ import annotations
 
@@ -58,7 +60,11 @@ def offset_axes(n: int) -> np.ndarray:
 
 
 def held_out_angles(angles_deg: list[float]) -> list[float]:
-    """Midpoints between consecutive table angles, where the fit in angle is least certain [deg].
+    """The held-out grid's angles: every table angle and the midpoints between consecutive ones [deg].
+
+    At a table angle the fit interpolates over axes only (the table's entries at that angle), at a
+    midpoint over axes and angles; a held-out axis is not a table axis, so both are measured, and
+    the largest angle (the slews a scheduler meets most) among them.
 
     Parameters
     ----------
@@ -68,9 +74,10 @@ def held_out_angles(angles_deg: list[float]) -> list[float]:
     Returns
     -------
     list of float
-        The midpoints [deg].
+        The table's angles and their midpoints, increasing [deg] (``2 k - 1`` of them for ``k`` angles).
     """
-    return [0.5 * (a + b) for a, b in itertools.pairwise(angles_deg)]
+    mids = [0.5 * (a + b) for a, b in itertools.pairwise(angles_deg)]
+    return sorted([float(a) for a in angles_deg] + mids)
 
 
 def polytope_grid(facets: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:

@@ -19,7 +19,7 @@ builds the grid. ``refine`` (or ``--tolerance``) refines the axes where the fit 
 Every case is the scenario's spacecraft, actuators (failed wheels included), environment and
 pointing and rate requirements, slewing rest to rest from the identity attitude by the angle about
 the axis, planned by ``collocation``; nothing is simulated beyond a token closed loop (controller
-``none``). ``requirements.actuators`` is kept only when the scenario states it (absent, the limits
+``none``, two samples of the numeric integrator, whose build does not depend on the entry). ``requirements.actuators`` is kept only when the scenario states it (absent, the limits
 are the planner's bounds at the collocation points: see :doc:`/guide/slew_table`).
 """
 from __future__ import annotations
@@ -74,7 +74,8 @@ class TableSpec:
         Slew duration [s] for ``min_energy``; None for ``min_time`` (the scenario's
         ``maneuver.duration`` is the upper bound).
     held_out : int
-        Axes of the held-out lattice (at the midpoints of ``angles_deg``); 0: none.
+        Axes of the held-out lattice (at every angle of ``angles_deg`` and the midpoints between
+        them, :func:`scenarios.slewtable.grid.held_out_angles`); 0: none.
     planner_options : dict
         More ``collocation`` options.
     workers : int or None
@@ -121,7 +122,7 @@ class TableSpec:
 
     @property
     def held_out_angles_deg(self) -> list[float]:
-        """The held-out angles [deg]: midpoints of :attr:`angles_deg`."""
+        """The held-out angles [deg]: every angle of :attr:`angles_deg` and the midpoints between them."""
         return held_out_angles(self.angles_deg) if self.held_out else []
 
 
@@ -337,9 +338,11 @@ def case_scenario(spec: TableSpec, axis: np.ndarray, angle_deg: float) -> dict[s
     data["planners"] = [{"name": "collocation", "label": "collocation", "options": options}]
     data["controller"] = {"name": "none"}
     window = float(maneuver.get("duration") or 1.0)
-    # the table reads the plan; the closed loop (no law) only completes the row: two samples, with
-    # RK4 sub-steps long enough for any window (the default 0.05 s allows a 100 s window at most)
-    data["simulation"] = {"sample_time": window / 2.0, "duration": window,
+    # the table reads the plan; the closed loop (no law) only completes the row: two samples of the
+    # numeric (CVODES) step, built once per worker. The RK4 default runs the loop as one CasADi function
+    # that bakes in the law's target, so each entry (a new target) built its own: about 5 s of an
+    # entry's 6 s, for a loop nothing reads. The sub-step bound is checked for either integrator
+    data["simulation"] = {"sample_time": window / 2.0, "duration": window, "integrator": "cvodes",
                           "max_step": max(0.05, window / 2.0 / MAX_SUBSTEPS)}
     requirements = data.get("requirements")
     if isinstance(requirements, dict):
