@@ -137,7 +137,7 @@ MUTATIONS: list[Mutation] = [
     Mutation("nlp-acceptable-not-continued", "ocp/nlp/solve.py",
              "if ok and status in ACCEPTABLE:", "if False:", (L + "nlp.py",)),
     Mutation("nlp-continuation-from-the-guess", "ocp/nlp/solve.py",
-             'again = solver(x0=solution["x"],', "again = solver(x0=np.clip(np.asarray(guess, dtype=float), low, high),",
+             'again, stats = call(x0=solution["x"],', "again, stats = call(x0=np.clip(np.asarray(guess, dtype=float), low, high),",
              (L + "nlp.py",)),
     # --- Radau collocation --------------------------------------------------------------------------
     Mutation("radau-dynamics-at-the-previous-point-time", "ocp/transcription/radau.py",
