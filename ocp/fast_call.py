@@ -119,6 +119,32 @@ def buffered(function: ca.Function) -> BufferedFunction:
     return found
 
 
+def matrices(function: ca.Function, *args: ArrayLike | float) -> list[NDArray[np.float64]]:
+    """Every output of ``function`` for the given inputs as a 2-D array of its own, as
+    ``[out.full() for out in function(*args)]`` gives them (C order), through the function's
+    buffers (:func:`buffered`) where its inputs and outputs are all dense.
+
+    Parameters
+    ----------
+    function : casadi.Function
+        The function.
+    *args : array_like or float
+        Its inputs in order (flattened column-major where buffered).
+
+    Returns
+    -------
+    list of ndarray
+        One ``(size1_out(i), size2_out(i))`` array per output.
+    """
+    if not all(function.sparsity_out(i).is_dense() for i in range(function.n_out())) \
+            or not all(function.sparsity_in(i).is_dense() for i in range(function.n_in())):
+        plain: Any = function  # CasADi's stubs take no NumPy arrays here; its call does
+        return [np.asarray(out.full(), dtype=float) for out in plain.call(list(args))]
+    outputs = buffered(function).all_outputs(*(np.asarray(arg, dtype=float).ravel(order="F") for arg in args))
+    return [np.array(flat.reshape(function.sparsity_out(i).shape, order="F"), order="C")
+            for i, flat in enumerate(outputs)]
+
+
 def as_floats(values: ArrayLike) -> list[float]:
     """A short vector as a list of Python floats, for per-sample code.
 

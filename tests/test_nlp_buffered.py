@@ -1,5 +1,6 @@
 """The multistart calls an ``nlpsol`` function through CasADi's buffers (:func:`ocp.fast_call.buffered`):
-the same evaluation as a plain call, without converting its vectors to CasADi matrices and back.
+the same evaluation as a plain call, without converting its vectors to CasADi matrices and back;
+:func:`ocp.fast_call.matrices` reads any function's outputs so.
 
 Oracles: the plain call of the same solver from the same start (its point, multipliers, status and
 iteration count, bit for bit), IPOPT's own failure with ``error_on_fail``.
@@ -12,7 +13,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from ocp.fast_call import buffered
+from ocp.fast_call import buffered, matrices
 from ocp.nlp.solve import solve_multistart, solver_options
 
 
@@ -87,3 +88,19 @@ def in_a_thread(function):
     thread.start()
     thread.join()
     return found[0]
+
+
+def test_matrices_are_the_plain_call_s_outputs_each_its_own():
+    a, b = ca.SX.sym("a", 3, 2), ca.SX.sym("b", 2)
+    dense = ca.Function("dense", [a, b], [ca.mtimes(a, b), a.T, ca.sumsqr(b)])
+    sparse = ca.Function("sparse", [b], [ca.sparsify(ca.vertcat(b[0], 0, b[1])), 2 * b])
+    A, B = np.arange(6.0).reshape(3, 2) / 7.0, np.array([0.3, -1.1])
+    for function, args in ((dense, (A, B)), (sparse, (B,))):
+        expected = [out.full() for out in function.call(list(args))]
+        first = matrices(function, *args)
+        assert [m.shape for m in first] == [e.shape for e in expected]
+        for mine, theirs in zip(first, expected):
+            assert np.array_equal(mine, theirs) and mine.flags["C_CONTIGUOUS"]
+        again = [m.copy() for m in first]
+        matrices(function, *(2.0 * np.asarray(arg) for arg in args))  # overwrites the buffers, not the results
+        assert all(np.array_equal(m, c) for m, c in zip(first, again))
