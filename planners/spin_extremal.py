@@ -30,7 +30,7 @@ import numpy as np
 from ocp import quat
 from ocp.dynamics.spin_closed_form import extremal_quaternion
 from ocp.errors import InvalidOption
-from ocp.fast_call import BufferedFunction
+from ocp.fast_call import buffered
 from ocp.nlp.solve import solve_multistart, solver_options
 from ocp.options import Range
 from planners.base import Planner
@@ -242,7 +242,7 @@ class NewtonFirst:
     """
 
     def __init__(self, derivatives: ca.Function, ipopt: ca.Function) -> None:
-        self.derivatives = BufferedFunction(derivatives)
+        self.derivatives = buffered(derivatives)  # its buffers made once per function and thread
         self.ipopt = ipopt
         self._stats: dict[str, Any] = {}
 

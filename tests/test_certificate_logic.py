@@ -126,3 +126,29 @@ def test_the_radau_points_times_are_the_published_nodes():
     nodes = np.array([(4.0 - math.sqrt(6.0)) / 10.0, (4.0 + math.sqrt(6.0)) / 10.0, 1.0])
     expected = ((np.arange(4)[:, None] + nodes[None, :]) / 4 * T).ravel()
     np.testing.assert_allclose(t, expected, rtol=1e-12)
+
+
+def test_the_derivatives_are_read_again_at_another_point_parameter_or_multiplier():
+    # min (x − p)² + (y − p)² on x y = 1 (a parameter p; the second-order check also reads the
+    # Hessian of the Lagrangian, which the multiplier of x y = 1 enters): a certificate's KKT
+    # residuals and second-order check may reuse one evaluation of the derivatives only at the same
+    # point, parameter and multipliers. Each case by hand: ∇f = 2 (x − p, y − p), ∇g = (y, x).
+    from ocp.nlp.certificate import certify
+    from ocp.nlp.second_order import second_order_check
+
+    x, p = ca.SX.sym("x", 2), ca.SX.sym("p")
+    solver = ca.nlpsol("s", "ipopt", {"x": x, "p": p, "f": (x[0] - p) ** 2 + (x[1] - p) ** 2, "g": x[0] * x[1]},
+                       solver_options("ipopt", 1e-12, 100))
+    at_one = {"lbg": 1.0, "ubg": 1.0}
+    assert kkt_residuals(solver, [1.0, 1.0], [0.0, 0.0], [0.0], p=1.0, **at_one).stationarity == 0.0
+    assert kkt_residuals(solver, [1.0, 1.0], [0.0, 0.0], [0.0], p=0.0, **at_one).stationarity == 2.0
+    assert kkt_residuals(solver, [2.0, 0.5], [0.0, 0.0], [0.0], p=0.0, **at_one).stationarity == 4.0
+    # at (1, 1) the multiplier λ = 2 (p − 1) makes it stationary; along the tangent (1, −1) the
+    # Hessian 2 I + λ [[0, 1], [1, 0]] curves 4 − 2 λ: 2 > 0 at p = 1.5 (λ = 1), a strict minimum;
+    # 0 at p = 2 (λ = 2), degenerate
+    record = certify(solver, [1.0, 1.0], [0.0, 0.0], [1.0], p=1.5, **at_one)
+    assert record["kkt_unscaled"] == 0.0 and record["second_order"] == "strict local minimum"
+    degenerate = second_order_check(solver, [1.0, 1.0], [0.0, 0.0], [2.0], p=2.0, **at_one)
+    assert not degenerate.certified and degenerate.degenerate
+    record = certify(solver, [1.0, 1.0], [0.0, 0.0], [1.0], p=1.5, **at_one)
+    assert record["second_order"] == "strict local minimum"

@@ -6,6 +6,7 @@ conservation and a numerical derivative of ω, not the planner's controls), the 
 the unconstrained optimum for the non-vacuity of each case, and CasADi's own derivatives of the
 whole NLP.
 """
+import copy
 import time
 
 import numpy as np
@@ -14,6 +15,7 @@ import pytest
 from ocp import ReactionWheels, Spacecraft, Torquers, quat
 from ocp.geometry import PointingConstraint
 from planners import PLANNERS, ManeuverProblem
+from planners.collocation.requirements import DENSE_POINTS, Requirements, dense_check
 
 
 def angle(u, v):
@@ -250,6 +252,59 @@ def test_the_rate_requirement_bounds_the_norm_everywhere():
     norms = np.linalg.norm(reference.omega(dense_times(reference)), axis=1)
     assert np.max(norms) <= 0.04 * (1 + 1e-6), np.max(norms)
     assert np.max(norms) > 0.04 * (1 - 1e-3)  # the bound is active: a norm, not a box
+
+
+# --------------------------------------------------------------------------- what the dense check reads
+@pytest.fixture(scope="module")
+def bang_bang():
+    """Bilimoria & Wie's minimum time on 20 intervals: torques on their bounds, a polynomial that
+    overshoots them between the points, controls saturated at the limits themselves."""
+    problem = ManeuverProblem(Spacecraft(np.eye(3), torquers=Torquers(1.0)), quat.IDENTITY, np.zeros(3),
+                              quat.from_axis_angle([1, 0, 0], np.pi), 10.0, omegaf=np.zeros(3), actuator_margin=0.0)
+    reference = PLANNERS["collocation"]({"objective": "min_time", "intervals": 20}).plan(problem)
+    assert reference.ok, reference.message
+    return problem, reference
+
+
+def sampled_torque_peak(reference):
+    """The largest |torque| the reference gives on the dense check's grid, read from both sides of
+    each node (its controls as a user reads them)."""
+    t = np.linspace(0.0, reference.duration, DENSE_POINTS * reference.intervals + 1)
+    return max(float(np.max(np.abs(reference._state_control(t, left=left)[1]))) for left in (False, True))
+
+
+def test_controls_saturated_within_their_limits_are_met_unsampled(bang_bang, monkeypatch):
+    problem, reference = bang_bang
+    t = np.linspace(0.0, reference.duration, DENSE_POINTS * reference.intervals + 1)
+    assert np.max(np.abs(reference._interpolated(t)[1])) > 1.05  # not vacuous: the polynomial overshoots
+    assert sampled_torque_peak(reference) <= 1.0  # what a full sample finds: nothing above the limit
+    requirements = Requirements(actuator_margin=0.0)
+
+    def unread(*args, **kwargs):
+        raise AssertionError("sampled")
+
+    monkeypatch.setattr(reference, "_state_control", unread)
+    monkeypatch.setattr(reference, "_interpolated", unread)
+    check = dense_check(problem, reference, requirements)
+    assert check.met and check.violations == {} and check.margins_deg == {}
+    assert check.points == DENSE_POINTS * reference.intervals + 1
+
+
+def test_controls_saturated_beyond_their_limits_are_sampled(bang_bang):
+    # the same motion held to 90 % of the torque limit (actuator margin 0.1), or read with its
+    # saturation bounds twice the limits: the dense check must find what a full sample finds
+    problem, reference = bang_bang
+    check = dense_check(problem, reference, Requirements(actuator_margin=0.1))
+    peak = sampled_torque_peak(reference)
+    assert check.violations == pytest.approx({"actuators.torquers": peak / 0.9 - 1.0}, rel=1e-12)
+    assert check.violations["actuators.torquers"] > 0.1
+    wide = copy.copy(reference)
+    wide.control_bounds = tuple(2.0 * bound for bound in reference.control_bounds)
+    wide._impulse_offsets = wide._impulse_residuals = None  # found again for the wider bounds
+    check = dense_check(problem, wide, Requirements(actuator_margin=0.0))
+    peak = sampled_torque_peak(wide)
+    assert peak > 1.05  # not vacuous: the wider saturation lets the overshoot through
+    assert check.violations == pytest.approx({"actuators.torquers": peak - 1.0}, rel=1e-12)
 
 
 # --------------------------------------------------------------------------- failures and derivatives

@@ -59,7 +59,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -70,13 +70,11 @@ from ocp.nlp.second_order import (
     _broadcast,
     _complementarity,
     _derivative,
+    _evaluated,
     _output,
-    _sparse,
+    _triplets,
     second_order_check,
 )
-
-if TYPE_CHECKING:  # imported where a certificate is computed: importing the planners does not load it
-    import scipy.sparse
 
 Array = NDArray[np.float64]
 
@@ -129,13 +127,16 @@ class KKTResiduals:
     objective_scaling: float
 
 
-def _scaling(gradient: Array, jacobian: scipy.sparse.csc_matrix, solver_name: str) -> tuple[float, Array]:
-    """IPOPT's gradient-based factors ``(s_f, s_i)`` from the gradient and Jacobian at its scaling point."""
+def _scaling(gradient: Array, jacobian: tuple[NDArray[np.integer], Array, int],
+             solver_name: str) -> tuple[float, Array]:
+    """IPOPT's gradient-based factors ``(s_f, s_i)`` from the gradient and the Jacobian (its entries'
+    rows, their values and its number of rows) at its scaling point."""
+    entry_rows, values, size = jacobian
     if solver_name != "ipopt":
-        return 1.0, np.ones(jacobian.shape[0])
+        return 1.0, np.ones(size)
     s_f = float(np.clip(MAX_GRADIENT / max(float(np.max(np.abs(gradient), initial=0.0)), 1e-300), MIN_SCALING, 1.0))
-    rows = np.zeros(jacobian.shape[0])  # per row, the largest |entry| (a row without entries: 0)
-    np.maximum.at(rows, jacobian.indices, np.abs(jacobian.data))  # CSC: indices are the entries' rows
+    rows = np.zeros(size)  # per row, the largest |entry| (a row without entries: 0)
+    np.maximum.at(rows, entry_rows, np.abs(values))
     s_g = np.clip(MAX_GRADIENT / np.maximum(rows, 1e-300), MIN_SCALING, 1.0)
     return s_f, s_g
 
@@ -182,17 +183,21 @@ def kkt_residuals(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array, *, 
     g_out, j_out = _output(jacobian.function, ("g",)), _output(jacobian.function, ("jac_g_x",))
     f_out = _output(gradient.function, ("grad_f_x",))
     if scaling_point is not None:
-        jacobian.all_outputs(np.asarray(scaling_point, dtype=float).ravel(), p)
-        grad0 = gradient.all_outputs(np.asarray(scaling_point, dtype=float).ravel(), p)[f_out].copy()
-        s_f, s_g = _scaling(grad0, _sparse(jacobian, j_out), solver_name)
-    jacobian.all_outputs(x, p)
-    g, J = jacobian.outputs[g_out].copy(), _sparse(jacobian, j_out)
-    grad = gradient.all_outputs(x, p)[f_out].copy()
+        point = np.asarray(scaling_point, dtype=float).ravel()
+        _evaluated(jacobian, point, p)
+        j_rows, _, j_values = _triplets(jacobian, j_out)
+        grad0 = _evaluated(gradient, point, p)[f_out].copy()
+        s_f, s_g = _scaling(grad0, (j_rows, j_values, jacobian.function.size1_out(j_out)), solver_name)
+    g = _evaluated(jacobian, x, p)[g_out].copy()
+    j_rows, j_columns, j_values = _triplets(jacobian, j_out)
+    grad = _evaluated(gradient, x, p)[f_out].copy()
     if scaling_point is None:
-        s_f, s_g = _scaling(grad, J, solver_name)
+        s_f, s_g = _scaling(grad, (j_rows, j_values, g.size), solver_name)
     g_low, g_high, x_low, x_high = _broadcast(lbg, g), _broadcast(ubg, g), _broadcast(lbx, x), _broadcast(ubx, x)
     moving = x_low != x_high
-    stationarity = float(np.max(np.abs(grad + J.T @ lam_g + lam_x)[moving], initial=0.0))
+    # Jᵀ lam_g column by column in storage order, as SciPy's product adds it
+    jt_lam = np.bincount(j_columns, j_values * lam_g[j_rows], minlength=x.size)
+    stationarity = float(np.max(np.abs(grad + jt_lam + lam_x)[moving], initial=0.0))
     g_excess, x_excess = _excess(g, g_low, g_high), _excess(x, x_low, x_high)
     feasibility = float(max(np.max(g_excess, initial=0.0), np.max(x_excess, initial=0.0)))
     feasibility_scaled = float(max(np.max(s_g * g_excess, initial=0.0), np.max(x_excess, initial=0.0)))

@@ -66,22 +66,20 @@ convention are reported as not checked, never certified.
 from __future__ import annotations
 
 import contextlib
+import functools
 import io
 import sys
 import threading
 import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
 from ocp.fast_call import BufferedFunction
-
-if TYPE_CHECKING:  # imported where a check is made: importing this module does not load SciPy
-    import scipy.sparse
 
 Array = NDArray[np.float64]
 
@@ -212,6 +210,8 @@ _FUNCTIONS = threading.local()
 buffers are overwritten by every evaluation); ``.patterns``, per buffered function and output, its
 pattern (:func:`_pattern`)."""
 _Pattern = tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], tuple[int, int]]
+_Triplets = tuple[NDArray[np.integer], NDArray[np.integer], Array, tuple[int, int]]
+"""A sparse matrix as ``(rows, columns, values, shape)``, its entries in storage order."""
 
 
 def _local_table(name: str) -> weakref.WeakKeyDictionary:
@@ -238,6 +238,22 @@ def _derivative(solver: ca.Function, name: str) -> BufferedFunction:
     return found
 
 
+def _evaluated(function: BufferedFunction, *args: Any) -> list[Array]:
+    """``function.all_outputs(*args)``, not evaluated again where its last evaluation through here
+    had these very inputs (a certificate's KKT residuals and second-order check read the same
+    derivatives at the same point); the inputs are compared number for number (a NaN never
+    matches)."""
+    table = _local_table("evaluated")
+    inputs = [np.array(arg, dtype=float).ravel() for arg in args]
+    last: list[Array] | None = table.get(function)
+    if last is not None and len(last) == len(inputs) \
+            and all(np.array_equal(old, new) for old, new in zip(last, inputs)):
+        return function.outputs
+    outputs = function.all_outputs(*inputs)
+    table[function] = inputs
+    return outputs
+
+
 def _pattern(function: BufferedFunction, index: int) -> _Pattern:
     """Output ``index``'s compressed-column pattern: row indices, column indices, column pointers
     and shape (read once per function and output)."""
@@ -256,17 +272,6 @@ def _pattern(function: BufferedFunction, index: int) -> _Pattern:
             array.setflags(write=False)  # shared by every evaluation
         found = patterns[index] = (rows, columns, starts, sparsity.shape)
     return found
-
-
-def _sparse(function: BufferedFunction, index: int) -> scipy.sparse.csc_matrix:
-    """Output ``index`` of the last evaluation as a sparse matrix (dense, a collocation NLP's
-    Jacobian took most of a certificate's time)."""
-    import scipy.sparse  # here, not at the top: it takes 0.16 s to import, and every command imports this module
-
-    rows, _, starts, shape = _pattern(function, index)
-    # its own index arrays: SciPy may sort or deduplicate a matrix's indices in place
-    return scipy.sparse.csc_matrix((np.array(function.outputs[index], dtype=float), rows.copy(), starts.copy()),
-                                   shape=shape)
 
 
 def _triplets(function: BufferedFunction, index: int) -> tuple[NDArray[np.int64], NDArray[np.int64], Array]:
@@ -334,6 +339,16 @@ def _linsol(size: int, indptr: Any, indices: Any) -> tuple[ca.Sparsity, ca.Linso
     return found
 
 
+@functools.lru_cache(maxsize=_MAX_LINSOLS)
+def _random_rhs(size: int) -> tuple[Array, ca.DM]:
+    """The guard's right-hand side of ``size`` standard normal numbers (seed 0), as an array (read
+    only) and as CasADi's matrix, made once per size (a 50-interval collocation KKT matrix's took
+    about a tenth of a check)."""
+    rhs = np.random.default_rng(0).standard_normal(size)
+    rhs.setflags(write=False)
+    return rhs, ca.DM(rhs.tolist())  # (from a list: a third faster than from the array, the same numbers)
+
+
 def _infinity_norm(rows: NDArray[np.integer], values: Array, size: int) -> float:
     """``‖M‖∞`` of a sparse matrix from its entries' rows and values in storage order (a COO matrix's,
     or a CSC matrix's indices and data): the row sums of ``|M|`` added in that order, as SciPy's
@@ -341,8 +356,7 @@ def _infinity_norm(rows: NDArray[np.integer], values: Array, size: int) -> float
     return float(np.max(np.bincount(rows, np.abs(values), minlength=size)))
 
 
-def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: float,
-             scale: float) -> Callable[[float], int | str]:
+def _inertia(H: _Triplets, A: _Triplets, delta: float, scale: float) -> Callable[[float], int | str]:
     """A counter of the negative eigenvalues of ``M(s) = H + s I + AᵀA / ε`` from the inertia of
     ``K(s) = [[H + s I, Aᵀ], [A, −ε I]]`` (module docstring), factorised normalised, as
     ``[[H / η + (s / η) I, Aᵀ], [A, −η ε I]]`` (``η`` = ``scale``): one sparsity and one symbolic
@@ -350,9 +364,9 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
 
     Parameters
     ----------
-    H : (n, n) scipy.sparse.coo_matrix
+    H : (rows, columns, values, (n, n))
         The Hessian of the Lagrangian on the free variables (symmetric, no duplicate entries).
-    A : (m, n) scipy.sparse.coo_matrix
+    A : (rows, columns, values, (m, n))
         The active rows on them (no duplicate entries).
     delta : float
         The curvature threshold ``δ`` (positive): the guard's scale at ``s = 0`` (otherwise ``|s|``).
@@ -366,23 +380,22 @@ def _inertia(H: scipy.sparse.coo_matrix, A: scipy.sparse.coo_matrix, delta: floa
     """
     import scipy.sparse
 
-    n, m = H.shape[0], A.shape[0]
-    epsilon = PENALTY * max(1.0, _infinity_norm(A.row, A.data, m) if m else 0.0) ** 2  # η ε
+    (h_rows, h_columns, h_values, (n, _)), (a_rows, a_columns, a_values, (m, _)) = H, A
+    epsilon = PENALTY * max(1.0, _infinity_norm(a_rows, a_values, m) if m else 0.0) ** 2  # η ε
     # the pattern with its whole diagonal, explicit zeros kept (an entry H_jj = 0, or cancelled by a
     # shift, must stay in it), the shift set in place for each factorisation
-    Hc, Ac = H, A
     every = np.arange(n + m)
     K = scipy.sparse.coo_matrix(
-        (np.concatenate([Hc.data / scale, Ac.data, Ac.data, np.zeros(n), np.full(m, -epsilon)]),
-         (np.concatenate([Hc.row, Ac.row + n, Ac.col, every]), np.concatenate([Hc.col, Ac.col, Ac.row + n, every]))),
+        (np.concatenate([h_values / scale, a_values, a_values, np.zeros(n), np.full(m, -epsilon)]),
+         (np.concatenate([h_rows, a_rows + n, a_columns, every]),
+          np.concatenate([h_columns, a_columns, a_rows + n, every]))),
         shape=(n + m, n + m)).tocsc()  # duplicates summed
     K.sort_indices()
     columns = np.repeat(every, np.diff(K.indptr))
     diagonal = np.flatnonzero((K.indices == columns) & (columns < n))  # the diagonal of H in K.data
     base = K.data[diagonal].copy()
     sparsity, solver, analysed = _linsol(n + m, K.indptr, K.indices)
-    rhs = np.random.default_rng(0).standard_normal(n + m)
-    b = ca.DM(rhs.tolist())  # (from a list: a third faster than from the array, the same numbers)
+    rhs, b = _random_rhs(n + m)
 
     def count(shift: float) -> int | str:
         K.data[diagonal] = base + shift / scale
@@ -460,8 +473,6 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     SecondOrderCheck
         ``certified`` only when the conditions provably hold (see the module docstring).
     """
-    import scipy.sparse
-
     x = np.asarray(x, dtype=float).ravel()
     try:
         hessian = _derivative(solver, "nlp_hess_l")
@@ -475,12 +486,11 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     p = np.zeros(solver.nnz_in("p")) if p is None else p
     lam_x = np.asarray(lam_x, dtype=float).ravel()
     lam_g = np.asarray(lam_g, dtype=float).ravel()
-    hessian.all_outputs(x, p, 1.0, lam_g)
+    _evaluated(hessian, x, p, 1.0, lam_g)
     h_rows, h_columns, h_values = _triplets(hessian, h_out)  # IPOPT's is upper triangular, FATROP's full
-    jacobian.all_outputs(x, p)
-    g = jacobian.outputs[g_out].copy()
+    g = _evaluated(jacobian, x, p)[g_out].copy()
     j_rows, j_columns, j_values = _triplets(jacobian, j_out)
-    grad = gradient.all_outputs(x, p)[f_out].copy()
+    grad = _evaluated(gradient, x, p)[f_out].copy()
     g_low, g_high, x_low, x_high = _broadcast(lbg, g), _broadcast(ubg, g), _broadcast(lbx, x), _broadcast(ubx, x)
     # The theorem assumes a KKT point: a stalled solve or multipliers of other signs are not one.
     terms = [grad, np.bincount(j_columns, j_values * lam_g[j_rows], minlength=x.size), lam_x]
@@ -503,19 +513,17 @@ def second_order_check(solver: ca.Function, x: Array, lam_x: Array, lam_g: Array
     keep = (h_rows <= h_columns) & (position[h_rows] >= 0) & (position[h_columns] >= 0)
     r, c, v = position[h_rows[keep]], position[h_columns[keep]], h_values[keep]
     off = r != c
-    H_free = scipy.sparse.coo_matrix((np.concatenate([v, v[off]]), (np.concatenate([r, c[off]]),
-                                                                    np.concatenate([c, r[off]]))),
-                                     shape=(free.size, free.size))
+    H_free = (np.concatenate([r, c[off]]), np.concatenate([c, r[off]]), np.concatenate([v, v[off]]),
+              (free.size, free.size))
     active = np.flatnonzero(rows)
     row_position = np.full(g.size, -1)
     row_position[active] = np.arange(active.size)
     keep = (row_position[j_rows] >= 0) & (position[j_columns] >= 0)
-    A = scipy.sparse.coo_matrix((j_values[keep], (row_position[j_rows[keep]], position[j_columns[keep]])),
-                                shape=(active.size, free.size))
-    scale = _infinity_norm(H_free.row, H_free.data, free.size)  # ‖H‖∞, its own scale, however small
+    A = (row_position[j_rows[keep]], position[j_columns[keep]], j_values[keep], (active.size, free.size))
+    scale = _infinity_norm(H_free[0], H_free[2], free.size)  # ‖H‖∞, its own scale, however small
     scale = scale if scale > 0.0 else 1.0  # H = 0: every curvature on Z is 0, below any δ > 0
     delta = curvature_tolerance * scale
-    where = f"on {free.size} free variables and {A.shape[0]} active rows"
+    where = f"on {free.size} free variables and {active.size} active rows"
     count = _inertia(H_free, A, delta, scale)
     below = count(-delta)
     if isinstance(below, str):

@@ -76,6 +76,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ocp.fast_call import buffered
 from ocp.nlp.second_order import SecondOrderCheck, second_order_check
 
 Array = NDArray[np.float64]
@@ -379,6 +380,7 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
     starts: list[StartResult] = []
     objectives: list[float] = []
     begin = time.perf_counter()
+    call = _caller(solver)
 
     def agreeing() -> int:
         return sum(abs(value - best_f) <= atol + rtol * abs(best_f) for value in objectives)
@@ -405,21 +407,19 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
 
     for index, guess in enumerate(candidates()):
         tic = time.perf_counter()
-        solution = solver(x0=np.clip(np.asarray(guess, dtype=float), low, high), **args)
-        stats = solver.stats()
+        solution, stats = call(x0=np.clip(np.asarray(guess, dtype=float), low, high), **args)
         status = status_name(stats)
-        g = solution["g"].full().ravel()
+        g = solution["g"]
         excess = violation(g, g_low, g_high)
-        f = float(solution["f"])
+        f = float(solution["f"][0])
         ok = bool(np.isfinite(f)) and converged(status, bool(stats.get("success", False)), excess,
                                                  feasibility_tolerance)
         iterations = int(stats.get("iter_count", 0))
         if ok and status in ACCEPTABLE:  # stopped at the acceptable level: continued once
-            again = solver(x0=solution["x"], **{**args, "lam_x0": solution["lam_x"], "lam_g0": solution["lam_g"]})
-            stats = solver.stats()
+            again, stats = call(x0=solution["x"], **{**args, "lam_x0": solution["lam_x"], "lam_g0": solution["lam_g"]})
             iterations += int(stats.get("iter_count", 0))
-            g_again = again["g"].full().ravel()
-            excess_again, f_again = violation(g_again, g_low, g_high), float(again["f"])
+            g_again = again["g"]
+            excess_again, f_again = violation(g_again, g_low, g_high), float(again["f"][0])
             if np.isfinite(f_again) and converged(status_name(stats), bool(stats.get("success", False)),
                                                   excess_again, feasibility_tolerance):
                 solution, status, g, excess, f = again, status_name(stats), g_again, excess_again, f_again
@@ -430,12 +430,12 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         objectives.append(f)
         if tie_break is None:
             if f < best_f:
-                best = {key: solution[key].full().ravel() for key in ("x", "lam_x", "lam_g")}
+                best = {key: solution[key] for key in ("x", "lam_x", "lam_g")}
                 best["g"], best_f, best_index = g, f, index
         else:
             # Judged against the least objective, not the start kept so far: tolerance chains
             # (a ≈ b ≈ c, a ≉ c) would otherwise drift away from it, and the order would decide.
-            point = {key: solution[key].full().ravel() for key in ("x", "lam_x", "lam_g")}
+            point = {key: solution[key] for key in ("x", "lam_x", "lam_g")}
             tie = float(tie_break(point["x"]))
             ranked.append((np.inf if np.isnan(tie) else tie, f, index, {**point, "g": g}))
             least = min(entry[1] for entry in ranked)
@@ -457,6 +457,39 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         message += f"; second order: {checks[best_index].message}"
     return NLPResult(best["x"], best_f, best["g"], True, "ok", message, iterations, total, best_index, starts,
                      best["lam_x"], best["lam_g"], checks.get(best_index))
+
+
+def _caller(solver: Any) -> Callable[..., tuple[dict[str, Array], Mapping[str, Any]]]:
+    """How :func:`solve_multistart` calls ``solver``: ``call(**arguments) -> (outputs, stats)``, the
+    outputs as flat arrays of their own and the stats of that call.
+
+    An ``nlpsol`` function is evaluated through its buffers (:func:`ocp.fast_call.buffered`: the same
+    evaluation, without converting its vectors to CasADi matrices and back, milliseconds a call on a
+    50-interval collocation NLP), an argument not given taking the input's default as a plain call
+    does; anything else called as it stands (a stand-in such as
+    :class:`planners.spin_extremal.NewtonFirst`), read through its ``stats()``.
+    """
+    if not isinstance(solver, ca.Function):
+        def plain(**arguments: Any) -> tuple[dict[str, Array], Mapping[str, Any]]:
+            solution = solver(**arguments)
+            outputs = {name: np.asarray(value.full() if isinstance(value, ca.DM) else value, dtype=float).ravel()
+                       for name, value in solution.items()}
+            return outputs, solver.stats()
+
+        return plain
+    function = buffered(solver)
+    names_in = [solver.name_in(i) for i in range(solver.n_in())]
+    defaults = [solver.default_in(i) for i in range(solver.n_in())]
+    names_out = [solver.name_out(i) for i in range(solver.n_out())]
+
+    def call(**arguments: Any) -> tuple[dict[str, Array], Mapping[str, Any]]:
+        for target, name, default in zip(function.inputs, names_in, defaults):
+            value = arguments.get(name)
+            target[:] = default if value is None else np.asarray(value, dtype=float).ravel()
+        function.evaluate()  # raises where a plain call raises (``error_on_fail``)
+        return {name: output.copy() for name, output in zip(names_out, function.outputs)}, function.stats()
+
+    return call
 
 
 def perturbed(center: Array, count: int, seed: int = 0, scales: Sequence[float] = (0.01, 0.05),

@@ -183,9 +183,10 @@ class RadauCollocation(Transcription):
         N = self.intervals
         h = duration / N
         nodes = np.arange(N + 1, dtype=float) * h
-        x_nodes, _, _ = sample(nodes)
         times = ((np.arange(N)[:, None] + self.tau[None, 1:]) * h).ravel()
-        x, u, torque = sample(times)
+        # one call for the nodes and the points (a sample's rows depend on their own times only)
+        x_all, u_all, torque_all = sample(np.concatenate([nodes, times]))
+        x_nodes, x, u, torque = x_all[:N + 1], x_all[N + 1:], u_all[N + 1:], torque_all[N + 1:]
         blocks = [x.reshape(N, -1), u.reshape(N, -1)]
         if problem.uses_slack:
             blocks.append(torque.reshape(N, -1))

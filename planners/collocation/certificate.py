@@ -19,6 +19,7 @@ import casadi as ca
 import numpy as np
 
 from ocp.dynamics.model import AttitudeModel
+from ocp.fast_call import matrices
 from ocp.nlp.certificate import (
     Switching,
     certificate,
@@ -78,7 +79,8 @@ def _control_jacobian(model: AttitudeModel) -> ca.Function:
     """``∂f/∂u (x, u, t, d)`` of the model's dynamics (mapped over the points and kept with the
     model's recent maps by :func:`switching`)."""
     xs, us, ts, ds = ca.SX.sym("x", model.nx), ca.SX.sym("u", model.nu), ca.SX.sym("t"), ca.SX.sym("d", 3)
-    return ca.Function("f_u", [xs, us, ts, ds], [ca.jacobian(model.rhs(xs, us, ts, ds), us)])
+    # dense (its structural zeros explicit): read through buffers (ocp.fast_call.matrices)
+    return ca.Function("f_u", [xs, us, ts, ds], [ca.densify(ca.jacobian(model.rhs(xs, us, ts, ds), us))])
 
 
 def switching(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array, lam_g: Array,
@@ -110,8 +112,8 @@ def switching(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w
     offset = nlp.n_stage_state + nx * d
     low = np.asarray(lbx, dtype=float)[:nz * N].reshape(N, nz)[:, offset:offset + nu * d].reshape(N * d, nu)
     high = np.asarray(ubx, dtype=float)[:nz * N].reshape(N, nz)[:, offset:offset + nu * d].reshape(N * d, nu)
-    f_u = np.asarray(_mapped(model, "switching f_u", x.shape[0], lambda: _control_jacobian(model))(
-        x.T, u.T, t[None, :], np.tile(params[-3:], (x.shape[0], 1)).T))
+    mapped = _mapped(model, "switching f_u dense", x.shape[0], lambda: _control_jacobian(model))
+    f_u = matrices(mapped, x.T, u.T, t[None, :], np.tile(params[-3:], (x.shape[0], 1)).T)[0]
     f_u = f_u.reshape(nx, x.shape[0], nu).transpose(1, 0, 2)  # (points, nx, nu)
     sigma = costate_sign * np.einsum("ki,kij->kj", p, f_u)
     return switching_agreement(u, low, high, sigma)

@@ -36,6 +36,7 @@ import numpy as np
 
 from ocp.dynamics.layout import actuator_blocks
 from ocp.errors import InvalidOption, OptionsError
+from ocp.fast_call import matrices
 from ocp.nlp.solve import (
     INFEASIBLE,
     NLPResult,
@@ -1085,8 +1086,8 @@ class CollocationPlanner(Planner):
             return FailedReference(self.name, f"{solver} did not converge from any start: "
                                    f"{sorted(set(result.statuses))}{hint}", result.status, stats=stats)
         assert result.x is not None  # success implies a point
-        T, states, controls = (v.full() for v in solved.nlp.unpack(result.x, params))
-        T = T.item()
+        T_matrix, states, controls = matrices(solved.nlp.unpack, result.x, params)
+        T = T_matrix.item()
         rows = allocation_constraints(problem.spacecraft)
         scaled = () if rows is None else tuple(block.control for block in actuator_blocks(problem.spacecraft)
                                                if np.any(rows[:, block.control]))

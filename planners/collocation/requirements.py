@@ -18,6 +18,7 @@ interpolated.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import cast
 
 import numpy as np
 
@@ -26,7 +27,7 @@ from ocp.dynamics.layout import actuator_blocks
 from ocp.geometry import PointingConstraint
 from planners.collocation.problem import variable_bounds
 from planners.collocation.reference import CollocationReference
-from planners.problem import ManeuverProblem
+from planners.problem import Array, ManeuverProblem
 
 __all__ = ["DENSE_POINTS", "DenseCheck", "Requirements", "Tightening", "dense_check", "imposed_pointing"]
 
@@ -245,6 +246,20 @@ class DenseCheck:
         return ", ".join(words)
 
 
+def _saturated_within(reference: CollocationReference, columns: slice, limits: Array) -> bool:
+    """Whether the bounds at which ``reference`` saturates its controls ``columns`` keep them within
+    ``limits`` wherever a limit is bounded (finite, positive), by at most :data:`BOUND_TOLERANCE`:
+    every control it gives lies between its lower and upper saturation bound, so its magnitude is at
+    most the larger of theirs, and the dense check cannot find it above the limit by more."""
+    if reference.control_bounds is None:  # read as interpolated: unbounded between the points
+        return False
+    low, high = reference.control_bounds
+    bounded = np.isfinite(limits) & (limits > 0)
+    reach = np.maximum(np.abs(low[columns]), np.abs(high[columns]))[bounded]
+    with np.errstate(invalid="ignore"):  # a NaN bound: not within
+        return bool(float(np.max(reach / limits[bounded])) - 1.0 <= BOUND_TOLERANCE)
+
+
 def dense_check(problem: ManeuverProblem, reference: CollocationReference, requirements: Requirements,
                 points_per_interval: int = DENSE_POINTS) -> DenseCheck:
     """Check a reference between its points against the requirements as stated.
@@ -255,7 +270,11 @@ def dense_check(problem: ManeuverProblem, reference: CollocationReference, requi
     :class:`~planners.collocation.reference.CollocationReference`; the states as interpolated). A pointing
     requirement is broken where its margin (:meth:`~ocp.geometry.PointingConstraint.margins` on the
     reference's normalised attitude) is negative; a bound where it is exceeded by more than
-    :data:`BOUND_TOLERANCE` of it.
+    :data:`BOUND_TOLERANCE` of it. The grid reads only what a check needs: the states for the
+    pointing and rate requirements and the actuators' states, the controls only for a block whose
+    saturation bounds do not already keep them within their limits (the reference gives no control
+    beyond its saturation bounds, so there the check is met without a sample); a problem with
+    nothing else to check is not sampled at all.
 
     Parameters
     ----------
@@ -273,12 +292,29 @@ def dense_check(problem: ManeuverProblem, reference: CollocationReference, requi
     DenseCheck
     """
     t = np.linspace(0.0, reference.duration, points_per_interval * reference.intervals + 1)
-    # the states as the reference samples them (its q normalised, its ω), without the torques and
-    # rates of change that sample() would compute for nothing here
-    x_right, u_right = reference._state_control(t)
-    q, omega = quat.normalize(x_right[:, 0:4]), x_right[:, 4:7]
+    # what each check reads: the actuator checks with a bounded entry (controls, then states, per block)
+    actuators: list[tuple[str, str, slice, Array]] = []
+    if requirements.actuator_margin is not None:
+        _, x_high, _, u_high = variable_bounds(problem, None, requirements.actuator_scale)
+        for block in actuator_blocks(problem.spacecraft):
+            name = f"actuators.{block.actuator.block}"
+            actuators += [(name, "controls", block.control, u_high[block.control]),
+                          (name + ".state", "states", block.state, x_high[7:][block.state])]
+        actuators = [entry for entry in actuators if np.any(np.isfinite(entry[3]) & (entry[3] > 0))]
+        # a control saturated within its limit cannot break it: not sampled (the same verdict)
+        actuators = [entry for entry in actuators
+                     if entry[1] == "states" or not _saturated_within(reference, entry[2], entry[3])]
+    needs_states = bool(requirements.pointing) or requirements.max_rate is not None \
+        or any(kind == "states" for _, kind, _, _ in actuators)
+    needs_controls = any(kind == "controls" for _, kind, _, _ in actuators)
     margins: dict[str, float | None] = {}
     violations: dict[str, float] = {}
+    if not (needs_states or needs_controls):
+        return DenseCheck(margins, violations, t.size)
+    # the states as the reference samples them (its q normalised, its ω; the controls shifted and
+    # saturated only when read), without the torques and rates of change that sample() would compute
+    x_right, u_right = reference._state_control(t) if needs_controls else reference._interpolated(t)
+    q, omega = quat.normalize(x_right[:, 0:4]), x_right[:, 4:7]
     for constraint in requirements.pointing:
         margin = constraint.margins(t, q)
         least = float(np.rad2deg(np.nanmin(margin))) if np.any(np.isfinite(margin)) else None
@@ -289,19 +325,15 @@ def dense_check(problem: ManeuverProblem, reference: CollocationReference, requi
         excess = float(np.max(np.linalg.norm(omega, axis=1))) / requirements.max_rate - 1.0
         if excess > BOUND_TOLERANCE:
             violations["rate"] = excess
-    if requirements.actuator_margin is not None:
-        _, x_high, _, u_high = variable_bounds(problem, None, requirements.actuator_scale)
-        x_left, u_left = reference._state_control(t, left=True)
-        controls = np.maximum(np.abs(u_right), np.abs(u_left))
-        states = np.maximum(np.abs(x_right), np.abs(x_left))
-        for block in actuator_blocks(problem.spacecraft):
-            name = f"actuators.{block.actuator.block}"
-            for label, values, limits in ((name, controls[:, block.control], u_high[block.control]),
-                                          (name + ".state", states[:, 7:][:, block.state], x_high[7:][block.state])):
-                bounded = np.isfinite(limits) & (limits > 0)
-                if not np.any(bounded):
-                    continue
-                excess = float(np.max(values[:, bounded] / limits[bounded])) - 1.0
-                if excess > BOUND_TOLERANCE:
-                    violations[label] = excess
+    if actuators:
+        x_left, u_left = reference._state_control(t, left=True) if needs_controls \
+            else reference._interpolated(t, left=True)
+        values = {"controls": np.maximum(np.abs(u_right), np.abs(u_left)) if needs_controls else None,
+                  "states": np.maximum(np.abs(x_right), np.abs(x_left))[:, 7:]}
+        for label, kind, columns, limits in actuators:
+            bounded = np.isfinite(limits) & (limits > 0)
+            read = cast(Array, values[kind])[:, columns]
+            excess = float(np.max(read[:, bounded] / limits[bounded])) - 1.0
+            if excess > BOUND_TOLERANCE:
+                violations[label] = excess
     return DenseCheck(margins, violations, t.size)

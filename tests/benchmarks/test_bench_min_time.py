@@ -222,6 +222,23 @@ fetched once per solver, their norms and row maxima without SciPy's conversions.
 acados on B&W right after (9 rounds each, wall, load 4.6-4.7): this code 1.77 [1.35..2.11] and 1.76
 [1.40..2.29] (ours 295 and 201 ms, acados 169 and 114 ms), main's between them 1.96 [1.45..2.06] (224
 against 121 ms). Issue 30's 1.0x is not met: the solver calls are most of the plan.
+
+Measured 2026-12-03 11:32 UTC, the rest of the work outside IPOPT cut (docs/performance.rst, issue
+30): the multistart calls ``nlpsol`` through CasADi's buffers (NumPy to ``DM`` and back costs about
+0.1 us a number: 1.5-3 ms a 50-interval call), the dense check samples nothing where controls
+saturated within their limits are the only requirement, the certificate evaluates its derivatives
+once on triplets, a seed samples its reference once. The same optima, certificates, seeds and
+iteration counts bit for bit (B&W, full inertia, XTE, spin; ``iteration_counts.py``'s 41 cases).
+Callgrind, instructions a plan against main's (outside the solvers in brackets): B&W 846 M against
+892 M (79 M against 126 M), full inertia 457 M against 508 M (84 M against 135 M), XTE 1022 M against
+1073 M (88 M against 140 M), spin 813 M against 855 M (70 M against 112 M). CPU
+per plan against main, 21 alternating pairs in two processes (load 4.6-4.9), median [min..max] of
+the pairwise ratios: B&W 0.90 [0.57..1.15] (112.5 against 130.6 ms), full inertia 0.90
+[0.70..1.03], XTE 0.93 [0.83..1.15], spin 0.96 [0.71..1.11]; again at 11:48 (load 3.7-4.1) 0.94,
+0.89, 1.00 and 0.96. Side by side with acados right after
+(9 rounds, wall, load 5.7-7.4): B&W 1.84 [0.97..3.48] and 1.57 [1.33..2.24], main's between them
+2.14 [1.81..3.54]; full inertia 0.67 and 0.60 (main 0.62); spin by default 0.71 and 0.69 (main
+0.70). Issue 30's 1.0x is not met.
 """
 from __future__ import annotations
 
