@@ -373,6 +373,7 @@ def test_a_random_vertex_is_certified_whatever_its_hessian(seed):
     assert check.certified and check.negative_curvatures == 0, check.message
 
 
+@pytest.mark.slow  # about 20 s; the saddle's count against the dense one on 8 intervals: the coarse optima test
 def test_the_full_mesh_saddle_is_not_certified_and_its_count_is_the_dense_one():
     # Bilimoria & Wie on 50 intervals (1908 variables) from the unperturbed eigenaxis seed stops at
     # the eigenaxis saddle 3.5449; its negative curvatures below −δ, counted densely, are the check's.
