@@ -252,6 +252,7 @@ def test_type_checking_imports_and_own_modules_do_not_count():
 
 # --- faces, __all__ and docstrings --------------------------------------------------------------
 
+@cache
 def _all(module: Module) -> list[str] | None:
     for node in ast.parse(module.source).body:
         targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(node, ast.AnnAssign) else []
@@ -260,6 +261,7 @@ def _all(module: Module) -> list[str] | None:
     return None
 
 
+@cache
 def _defined(module: Module) -> set[str]:
     """Names a module's own top-level statements define (not the names it imports)."""
     names: set[str] = set()

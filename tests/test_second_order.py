@@ -373,6 +373,7 @@ def test_a_random_vertex_is_certified_whatever_its_hessian(seed):
     assert check.certified and check.negative_curvatures == 0, check.message
 
 
+@pytest.mark.slow  # about 20 s; the saddle's count against the dense one on 8 intervals: the coarse optima test
 def test_the_full_mesh_saddle_is_not_certified_and_its_count_is_the_dense_one():
     # Bilimoria & Wie on 50 intervals (1908 variables) from the unperturbed eigenaxis seed stops at
     # the eigenaxis saddle 3.5449; its negative curvatures below −δ, counted densely, are the check's.
@@ -475,6 +476,7 @@ def test_a_zero_curvature_direction_stays_degenerate_at_any_objective_scale(c):
     assert zero.curvature_threshold == pytest.approx(1e-6)  # ‖∇²L‖∞ = 0: the tolerance itself
 
 
+@pytest.mark.slow  # about 15 s; the refinement below δ and its message: test_a_tiny_curvature_is_refined_to_its_sign
 def test_the_natural_motion_minimum_energy_optimum_is_certified_below_the_first_threshold():
     # The bench's natural-motion minimum-energy problem (UKube-1, J = [0.0109, 0.05, 0.05] kg m²,
     # 110 s, objective 5.8e-8): ∇²L on the free variables is not small (‖H‖∞ = 2.25, the controls'
@@ -511,5 +513,6 @@ def test_a_tiny_curvature_is_refined_to_its_sign(sign):
     check = second_order_check(solver, np.zeros(2), np.zeros(2), np.zeros(0))
     if sign > 0:
         assert check.certified and 2e-10 <= check.curvature_threshold < 3e-9, check.message
+        assert "1 directions between" in check.message  # y alone lies between ±δ
     else:
         assert not check.certified and check.degenerate and check.curvature_threshold == pytest.approx(2e-6)
