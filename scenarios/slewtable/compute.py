@@ -36,6 +36,7 @@ from scenarios.slewtable.spec import (
     TableCase,
     TableSpec,
     case_scenario,
+    rate_limits,
     table_cases,
     torque_generators,
 )
@@ -236,8 +237,8 @@ def _plural(count: int, word: str, words: str | None = None) -> str:
 
 
 def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: np.ndarray | None = None,
-                meta: dict[str, Any] | None = None, triangles: np.ndarray | None = None
-                ) -> tuple[SlewTimeFit | None, str]:
+                meta: dict[str, Any] | None = None, triangles: np.ndarray | None = None,
+                rates: tuple[np.ndarray, float | None] | None = None) -> tuple[SlewTimeFit | None, str]:
     """Fit a grid's ``ok`` entries; the others are kept as gaps (module docstring).
 
     Parameters
@@ -253,6 +254,9 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
     triangles : numpy.ndarray, shape (t, 3), optional
         The grid's triangles (:func:`scenarios.slewtable.grid.polytope_grid`); None: the convex hull
         of the axes.
+    rates : tuple of (numpy.ndarray, float or None), optional
+        The momentum generators [N m s] and rate bound [rad/s] of the fit's baseline
+        (:func:`rate_limits`); None: no rate cap.
 
     Returns
     -------
@@ -280,8 +284,9 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
     if not ok.any():
         return None, "; ".join([*notes, "no fit: no entry is ok"])
     try:
+        momentum, max_rate = rates if rates is not None else (None, None)
         fit = SlewTimeFit(angles, part.axes, np.where(ok, part.slew_time_s, np.nan), meta, inertia, generators,
-                          triangles, status)
+                          triangles, status, momentum, max_rate)
     except ValueError as error:
         return None, "; ".join([*notes, f"no fit: {error}"])
     slower = int(part.not_best_known.sum())
@@ -491,9 +496,10 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
         for case, record in zip(cases, run(cases)):
             _fill(parts[case.part], case, record, spec.objective)
         inertia, generators = torque_generators(spec.base)
+        rates = rate_limits(spec.base)
         triangles = spec.triangles
         if spec.refine is not None:
-            triangles = _refine(table, run, inertia, generators)
+            triangles = _refine(table, run, inertia, generators, rates)
     finally:
         if store is not None:
             store.close()
@@ -507,7 +513,7 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
     meta["grid"] = spec.grid
     if table.refinement:
         meta["refinement"] = table.refinement
-    table.fit, table.fit_note = fit_entries(parts["table"], inertia, generators, meta, triangles)
+    table.fit, table.fit_note = fit_entries(parts["table"], inertia, generators, meta, triangles, rates)
     if table.fit is not None:
         quality = held_out_errors(table.fit, parts["held_out"], spec.angles_deg)
         if quality["no_value"]:
@@ -549,7 +555,8 @@ class _Runner:
         return [results.records.get(study_case.key) for study_case in study.cases]
 
 
-def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.ndarray) -> np.ndarray:
+def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.ndarray,
+            rates: tuple[np.ndarray, float | None]) -> np.ndarray:
     """Refine the table's axes (module docstring); the table part becomes the refined grid, the
     check points not split become the ``check`` part. Returns the refined triangles."""
     from scenarios.slewtable.fit import _hull
@@ -577,7 +584,7 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
         part = TablePart.empty(axes, spec.angles_deg)
         part.slew_time_s[:] = times
         part.status = [["ok" if np.isfinite(v) else "failed" for v in row] for row in times]
-        fit, _ = fit_entries(part, inertia, generators, None, triangles)
+        fit, _ = fit_entries(part, inertia, generators, None, triangles, rates)
         if fit is None:
             return None
         return lambda e, k: fit.many_axis_angle(np.repeat(e, len(k), axis=0), np.tile(angles[k], len(e))

@@ -1,12 +1,18 @@
 """The slew table's fit: slew time as a smooth function of the eigen-axis and the angle.
 
-Model. Let ``g(e, θ) = T(e, θ) / √(θ s(e))`` (``T`` the table's slew time [s], ``θ`` the slew
-angle [rad], ``e`` the unit eigen-axis in the body frame) with ``s(e) = ‖J e‖_Z``, the gauge of
-``J e`` in the zonotope ``Z`` of body torques the working actuators can give (wheels' and
-torquers' torque bounds; magnetorquers left out): ``1 / s(e)`` is the largest angular acceleration
-about ``e``, and the eigenaxis bang-bang takes ``T = 2 √(θ s(e))``. Divided by that shape the
-times are nearly constant in ``θ``, so ``g`` is what is interpolated (without torque bounds, or with
-fewer than three independent torque directions, ``s = 1``). Over the sphere the times (and ``g``)
+Model. Let ``g(e, θ) = T(e, θ) / b(e, θ)`` (``T`` the table's slew time [s], ``θ`` the slew
+angle [rad], ``e`` the unit eigen-axis in the body frame), ``2 b`` the eigenaxis bang-coast-bang
+time: ``b = √(θ s(e))`` while ``θ m(e)² <= s(e)``, else ``b = (θ m + s / m) / 2``. ``s(e) = ‖J e‖_Z``
+is the gauge of ``J e`` in the zonotope ``Z`` of body torques the working actuators can give
+(wheels' and torquers' torque bounds; magnetorquers left out): ``1 / s(e)`` is the largest angular
+acceleration about ``e``, and the eigenaxis bang-bang takes ``T = 2 √(θ s(e))``. ``1 / m(e)`` is the
+largest rate about ``e``: the smaller of the rate bound and, with wheels alone (total momentum zero
+from rest), the rate whose body momentum ``J e ω`` is on the boundary of the working wheels' momentum
+zonotope, ``m(e) = max(‖J e‖_H, 1 / max_rate)`` (no coast without either, or without torque
+bounds). Divided by it the times are nearly constant in ``θ``, so ``g`` is what is interpolated
+(without torque bounds, or with fewer than three independent torque directions, ``s = 1``); a
+table of exactly the eigenaxis bang-coast-bang times has ``g = 2`` everywhere and is reproduced to
+round-off. Over the sphere the times (and ``g``)
 have kinks where the bounding facet of ``Z`` changes, on great circles; the default grid
 (:func:`scenarios.slewtable.grid.polytope_grid`) puts triangle edges on them. Per axis of the
 table, ``g`` is a monotone-preserving piecewise cubic (PCHIP) in ``θ`` through the table's angles;
@@ -281,17 +287,25 @@ class SlewTimeFit:
         Each entry's status in the table (``ok``, ``infeasible``, ``failed``, ...); None: all
         ``ok``. The fit is NaN in the cells that use an entry that is not ``ok``, ``inf`` where
         every entry used is ``infeasible`` (module docstring).
+    momentum_generators : array_like, shape (m, 3), optional
+        The working wheels' axes times their momentum bounds [N m s], body frame, when nothing else
+        changes the total momentum (for the coast rate of the baseline, module docstring); None or
+        fewer than three independent ones: no momentum cap.
+    max_rate : float, optional
+        The body-rate bound the table's slews keep [rad/s]; None: none.
 
     Raises
     ------
     ValueError
         Shapes that disagree, angles not increasing in (0, π], times of ``ok`` entries not positive
-        and finite, no ``ok`` entry, or axes that do not span the sphere.
+        and finite, no ``ok`` entry, axes that do not span the sphere, or a ``max_rate`` that is
+        not positive and finite.
     """
 
     def __init__(self, angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[str, Any] | None = None,
                  inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
-                 triangles: ArrayLike | None = None, status: ArrayLike | None = None):
+                 triangles: ArrayLike | None = None, status: ArrayLike | None = None,
+                 momentum_generators: ArrayLike | None = None, max_rate: float | None = None):
         from scipy.interpolate import PchipInterpolator
         theta = np.asarray(angles, dtype=float)
         e = np.asarray(axes, dtype=float)
@@ -326,7 +340,18 @@ class SlewTimeFit:
         facets = zonotope_facets(self.generators) if len(self.generators) else np.zeros((0, 3))
         self.facets = facets @ self.inertia if len(facets) else facets  # n/h · (J e) = (n/h J) · e
         self._facets = [tuple(f) for f in self.facets.tolist()]
-        g = t / np.sqrt(theta[None, :] * self.shape(e)[:, None])
+        self.momentum_generators = (np.zeros((0, 3)) if momentum_generators is None
+                                    else np.asarray(momentum_generators, dtype=float).reshape(-1, 3))
+        if max_rate is not None and not (math.isfinite(max_rate) and max_rate > 0):
+            raise ValueError(f"max_rate must be positive and finite [rad/s], got {max_rate!r}")
+        self.max_rate = None if max_rate is None else float(max_rate)
+        momentum = zonotope_facets(self.momentum_generators) if len(self.momentum_generators) else np.zeros((0, 3))
+        # n/h · (J e): the largest rate about e is 1 / max_f |rate_facets_f · e| (no coast without torque facets)
+        self.rate_facets = momentum @ self.inertia if len(momentum) and len(self.facets) else np.zeros((0, 3))
+        self._rate_facets = [tuple(f) for f in self.rate_facets.tolist()]
+        self._inverse_rate = 1.0 / self.max_rate if self.max_rate is not None and len(self.facets) else 0.0
+        self._coasts = bool(self._rate_facets) or self._inverse_rate > 0.0
+        g = t / self.baseline(e[:, None, :], theta[None, :])
         slopes = np.full(g.shape, np.nan)
         for row, good in zip(range(len(g)), ok):  # PCHIP over each run of ok angles, alone
             start = 0
@@ -371,6 +396,33 @@ class SlewTimeFit:
         if not len(self.facets):
             return np.ones(len(e))
         return np.max(np.abs(e @ self.facets.T), axis=1)
+
+    def baseline(self, axes: ArrayLike, angles: ArrayLike) -> np.ndarray:
+        """Half the eigenaxis bang-coast-bang time about unit axes by angles (module docstring).
+
+        Parameters
+        ----------
+        axes : array_like, shape (..., 3)
+            Unit eigen-axes, body frame.
+        angles : array_like
+            Slew angles [rad], >= 0, broadcast against ``axes[..., 0]``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``√(θ s)`` while ``θ m² <= s``, else ``(θ m + s / m) / 2`` [s] (``s = 1``, no coast,
+            without torque bounds): the fit is this times ``g``.
+        """
+        e = np.asarray(axes, dtype=float)
+        theta = np.maximum(np.asarray(angles, dtype=float), 0.0)
+        s = np.max(np.abs(e @ self.facets.T), axis=-1) if len(self.facets) else np.ones(e.shape[:-1])
+        bang = np.sqrt(theta * s)
+        if not self._coasts:
+            return bang
+        m = np.max(np.abs(e @ self.rate_facets.T), axis=-1) if len(self.rate_facets) else np.zeros(e.shape[:-1])
+        m = np.maximum(m, self._inverse_rate)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(theta * m * m > s, 0.5 * (theta * m + s / m), bang)
 
     def axis_angle(self, x: float, y: float, z: float, angle: float) -> float:
         """Slew time about a body axis by an angle (pure Python).
@@ -440,6 +492,19 @@ class SlewTimeFit:
         blend = (w0 * r0 + w1 * r1 + w2 * r2) / s
         if blend != blend:  # noqa: PLR0124  (NaN: an entry that is not ok in the cell; isnan costs a call)
             blend = self._gap(found[0], w0 / s, w1 / s, w2 / s, angle)
+        if self._coasts:  # the eigenaxis slew coasts at 1/m past θ m² = s (baseline)
+            slow = 0.0  # m(e) [s/rad]: 1 / the largest rate about e
+            for a, b, c in self._rate_facets:
+                v = a * x + b * y + c * z
+                if v < 0.0:
+                    v = -v
+                if v > slow:  # noqa: PLR1730
+                    slow = v
+            slow /= math.sqrt(x * x + y * y + z * z)
+            if slow < self._inverse_rate:
+                slow = self._inverse_rate
+            if angle * slow * slow > scale:
+                return blend * 0.5 * (angle * slow + scale / slow)
         return blend * math.sqrt(angle * scale)
 
     def _gap(self, vertices: tuple[int, ...], w0: float, w1: float, w2: float, angle: float) -> float:
@@ -606,7 +671,7 @@ class SlewTimeFit:
             blended[row] = self._gap(tuple(vertices[row].tolist()), w[0], w[1], w[2], float(theta[row]))
         blended[theta > self._top + _ANGLE_SLACK] = np.nan  # no extrapolation past the table's largest angle
         with np.errstate(invalid="ignore"):
-            return np.where(theta > 0.0, blended * np.sqrt(np.maximum(theta, 0.0) * self.shape(e)), 0.0)
+            return np.where(theta > 0.0, blended * self.baseline(e, theta), 0.0)
 
     def slew_time_many(self, q0: ArrayLike, qf: ArrayLike) -> np.ndarray:
         """Slew times of many slews (vectorised :meth:`__call__`).
@@ -665,17 +730,22 @@ class SlewTimeFit:
             ``format``, ``model``, ``angles_rad``, ``axes`` (body frame), ``times_s`` (null where
             the entry is not ok), ``status`` (each entry's), ``g`` (T/√(θ s)) and ``dg_dangle``
             (its PCHIP slopes [1/rad], over each run of ok angles), ``triangles``,
-            ``facets`` (the rows ``a_f`` of ``s(e)`` [s²/rad]),
-            ``inertia`` [kg m²], ``torque_generators`` [N m] and ``meta``.
+            ``facets`` (the rows ``a_f`` of ``s(e)`` [s²/rad]), ``rate_facets`` (the rows ``b_f``
+            of ``m(e)`` [s/rad]), ``inertia`` [kg m²], ``torque_generators`` [N m],
+            ``momentum_generators`` [N m s], ``max_rate`` [rad/s] (null: none) and ``meta``.
         """
         return {"format": FIT_FORMAT,
-                "model": "T(e, θ) = √(θ s(e)) · g(e, θ), s(e) = max_f |facets_f · e|; g: PCHIP in θ per axis, "
-                         "linear (barycentric, gnomonic) over the triangles",
+                "model": "T(e, θ) = b(e, θ) · g(e, θ), b = √(θ s) if θ m² <= s else (θ m + s/m)/2 (half the "
+                         "eigenaxis bang-coast-bang time), s(e) = max_f |facets_f · e|, m(e) = max(max_f "
+                         "|rate_facets_f · e|, 1/max_rate); g: PCHIP in θ per axis, linear (barycentric, gnomonic) "
+                         "over the triangles",
                 "angles_rad": self.angles.tolist(), "axes": self.axes.tolist(), "times_s": _plain(self.times),
                 "status": self.status.tolist(),
                 "g": _plain(self._g), "dg_dangle": _plain(self._dg), "triangles": self.triangles.tolist(),
-                "facets": self.facets.tolist(), "inertia": self.inertia.tolist(),
-                "torque_generators": self.generators.tolist(), "meta": self.meta}
+                "facets": self.facets.tolist(), "rate_facets": self.rate_facets.tolist(),
+                "inertia": self.inertia.tolist(), "torque_generators": self.generators.tolist(),
+                "momentum_generators": self.momentum_generators.tolist(), "max_rate": self.max_rate,
+                "meta": self.meta}
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write :meth:`to_dict` as JSON.
@@ -699,7 +769,8 @@ def _plain(values: np.ndarray) -> list[Any]:
 
 def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[str, Any] | None = None,
               inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
-              triangles: ArrayLike | None = None, status: ArrayLike | None = None) -> SlewTimeFit:
+              triangles: ArrayLike | None = None, status: ArrayLike | None = None,
+              momentum_generators: ArrayLike | None = None, max_rate: float | None = None) -> SlewTimeFit:
     """Fit a slew table (module docstring).
 
     Parameters
@@ -720,13 +791,18 @@ def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[s
         Triangles over the axes; None: their convex hull.
     status : array_like of str, shape (n, k), optional
         Each entry's status; None: all ``ok``.
+    momentum_generators : array_like, shape (m, 3), optional
+        Working wheels' axes times momentum bounds [N m s], body frame (no other momentum sink).
+    max_rate : float, optional
+        Body-rate bound [rad/s].
 
     Returns
     -------
     SlewTimeFit
         The fit.
     """
-    return SlewTimeFit(angles, axes, times, meta, inertia, generators, triangles, status)
+    return SlewTimeFit(angles, axes, times, meta, inertia, generators, triangles, status, momentum_generators,
+                       max_rate)
 
 
 def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
@@ -762,4 +838,5 @@ def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
                          "the fit with its gaps")
     times = np.array(data["times_s"], dtype=float)  # null (an entry not ok) -> NaN
     return SlewTimeFit(data["angles_rad"], data["axes"], times, data.get("meta"), data.get("inertia"),
-                       data.get("torque_generators"), data.get("triangles"), data.get("status"))
+                       data.get("torque_generators"), data.get("triangles"), data.get("status"),
+                       data.get("momentum_generators"), data.get("max_rate"))

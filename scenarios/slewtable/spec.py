@@ -51,7 +51,8 @@ from scenarios.slewtable.grid import (
 )
 from scenarios.slewtable.refine import RefineOptions
 
-__all__ = ["TableCase", "TableSpec", "case_scenario", "parse_table_spec", "table_cases", "torque_generators"]
+__all__ = ["TableCase", "TableSpec", "case_scenario", "parse_table_spec", "rate_limits", "table_cases",
+           "torque_generators"]
 
 
 @dataclass
@@ -158,6 +159,39 @@ def torque_generators(scenario: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]
     if not np.all(np.isfinite(g)):
         g = np.zeros((0, 3))
     return np.asarray(spacecraft.inertia, dtype=float), g
+
+
+def rate_limits(scenario: dict[str, Any]) -> tuple[np.ndarray, float | None]:
+    """What caps the body rate of the fit's baseline, the eigenaxis bang-coast-bang
+    (:meth:`scenarios.slewtable.fit.SlewTimeFit.baseline`).
+
+    Parameters
+    ----------
+    scenario : dict
+        A scenario mapping (plain YAML data).
+
+    Returns
+    -------
+    momentum_generators : numpy.ndarray, shape (m, 3)
+        Each working wheel's axis times its ``max_momentum`` [N m s], body frame: the body's
+        momentum ``J ω`` stays in their zonotope when the wheels alone act (total momentum zero
+        from rest). Empty when another actuator kind acts (torquers, magnetorquers: they change the
+        total momentum) or a wheel's momentum is unbounded.
+    max_rate : float or None
+        The problem's rate bound (``maneuver.max_rate``, else ``requirements.rate.max``:
+        ``ManeuverProblem.rate_bound``) [rad/s]; None without one.
+    """
+    from scenarios.schema.loader import parse_scenario
+    problem = parse_scenario(scenario).problem
+    spacecraft = problem.spacecraft
+    wheels = spacecraft.wheels
+    generators = np.zeros((0, 3))
+    if wheels is not None and all(a is wheels for a in spacecraft.actuators):
+        working = [i for i in range(wheels.count) if i not in wheels.failed]
+        g = np.array([wheels.axes[:, i] * wheels.max_momentum[i] for i in working]).reshape(-1, 3)
+        if np.all(np.isfinite(g)):
+            generators = g
+    return generators, problem.rate_bound(None)
 
 
 def _scenario(path: Path, where: str) -> dict[str, Any]:
