@@ -29,8 +29,8 @@ The environment's torque (gravity gradient, a constant disturbance) is not in th
 model, but the actuators must cancel it: a bound of it along the slew
 (:meth:`~planners.problem.ManeuverProblem.environment_torque_bound`) is kept from every row's bound
 (:attr:`WheelBudget.reserve`), and the momentum it adds to the wheels over the slew, at most
-``(|(A⁺)_i d| + ‖(A⁺)_i‖ g) T`` per working wheel (``d`` the constant disturbance, ``g`` the
-gravity gradient's bound), from every working wheel's momentum bound
+``‖(A⁺)_i‖ (‖d‖ + g) T`` per working wheel (``d`` the constant disturbance, ``g`` the
+gravity gradient's bound: the impulse turns with the body into any wheel), from every working wheel's momentum bound
 (:attr:`WheelBudget.momentum_reserve`): ``T`` the scenario's for ``trapezoidal``, the slew's own
 for ``min_time`` (iterated from no reserve up to the least duration that covers its own slew).
 """
@@ -464,7 +464,8 @@ class WheelBudget:
         actuators must cancel besides the motion's own torque; 0 without one.
     momentum_reserve : (n,) ndarray
         Per working wheel, a bound of the momentum the environment's torque adds to it over the
-        slew, ``(|(A⁺)_i d| + ‖(A⁺)_i‖ g) T`` [N m s] (``T`` the ``horizon``): the wheels absorb
+        slew, ``‖(A⁺)_i‖ (‖d‖ + g) T`` [N m s] (``T`` the ``horizon``; the impulse of a body-fixed
+        ``d`` turns with the body into any wheel): the wheels absorb
         the torque the actuators cancel, so the profile's own momentum keeps within ``h_max`` less
         it; 0 without an environment torque.
     accel, quadratic, linear : (m,) ndarray
@@ -507,10 +508,12 @@ class WheelBudget:
         self.wheel_momentum0 = momentum0
         self.h0 = h0[self.working] + self.pinv @ inertia @ problem.omega0
         # The environment's torque, cancelled by the actuators, goes into the wheels' momentum: at most
-        # (|(A⁺)_i d| + ‖(A⁺)_i‖ g) T over the slew, kept from each working wheel's bound.
+        # ‖(A⁺)_i‖ (‖d‖ + g) T over the slew, kept from each working wheel's bound. Not |(A⁺)_i d| T:
+        # the impulse of a body-fixed d is fixed in inertial space while the body turns, so the body
+        # sees it turn into other wheels (a slew about an axis across d loads a wheel d never acts on).
         self.horizon = problem.duration if horizon is None else float(horizon)
-        self.momentum_reserve = (np.abs(self.pinv @ disturbance)
-                                 + gravity_gradient * np.linalg.norm(self.pinv, axis=1)) * self.horizon
+        self.momentum_reserve = (np.linalg.norm(self.pinv, axis=1)
+                                 * (np.linalg.norm(disturbance) + gravity_gradient) * self.horizon)
         self.h_max = np.zeros(0) if wheels is None else (momentum_fraction * wheels.max_momentum[self.working]
                                                          - self.momentum_reserve)
         inertia_axis = inertia @ axis

@@ -102,3 +102,27 @@ def test_trapezoidal_reserves_the_environments_momentum_over_T(duration, status)
         return
     assert profile_momentum(reference) + environment_reserve(duration) <= CAPACITY
     assert integrated_momentum(slew, reference) <= CAPACITY
+
+
+def test_a_body_fixed_disturbance_across_the_slew_axis_is_reserved_from_every_wheel_it_turns_into():
+    """A constant body-x disturbance, a 90 deg slew about (0, 1, 1) on three orthogonal wheels: the
+    impulse ``∫ R d dt`` is fixed in inertial space, so the body sees it turn into the y and z
+    wheels, which ``d`` never acts on. Oracle: the momentum balance integrated along the reference
+    (the wheels hold ``A⁺ (Rᵀ ∫ R d dt − I ω)``, from rest). A reserve of ``|(A⁺)_i d| T`` (x wheel
+    only) let wheel y reach 1.11 times its bound (found by a review, 2026-12-03)."""
+    wheels = np.eye(3)
+    h_max = 0.0005
+    disturbance = np.array([2e-7, 0.0, 0.0])  # N m, body x
+    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels(wheels, max_torque=0.002, max_momentum=h_max))
+    slew = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), TARGET, 600.0, omegaf=np.zeros(3),
+                           environment=Environment(disturbance_torque=disturbance))
+    reference = PLANNERS["eigenaxis"]({"profile": "min_time"}).plan(slew)
+    assert reference.status == "ok", reference.message
+    t = np.linspace(0.0, reference.duration, 20001)
+    sample = reference.sample(t)
+    inertial = np.array([quat.rotate(q, disturbance) for q in sample.q])
+    impulse = np.concatenate([np.zeros((1, 3)),
+                              np.cumsum(0.5 * np.diff(t)[:, None] * (inertial[1:] + inertial[:-1]), axis=0)])
+    body = np.array([quat.rotate_inverse(q, h) for q, h in zip(sample.q, impulse)])
+    held = (body - sample.omega @ INERTIA) @ np.linalg.pinv(wheels).T
+    assert np.max(np.abs(held)) <= h_max * (1 + 1e-6), np.max(np.abs(held), axis=0)
