@@ -75,3 +75,34 @@ def test_an_object_the_fingerprint_cannot_state_makes_the_model_equal_to_no_othe
     assert _model(same).fingerprint != _model(same).fingerprint
     model = _model(same)
     assert model.fingerprint == model.fingerprint  # a model agrees with itself
+
+
+def test_an_object_the_fingerprint_cannot_state_keys_the_same_while_it_lives() -> None:
+    """The same environment object in two models: equal fingerprints (they build the same
+    functions); and a controller whose options hold a callable keys its law the same on every call,
+    so its closed loop is built once, not per run (a token drawn per call rebuilt it; found by a
+    review, 2026-12-03)."""
+    import dataclasses
+
+    from controllers import CONTROLLERS
+    from ocp import ReactionWheels, Spacecraft
+
+    environment = Environment(orbit=CircularOrbit(altitude=500e3), magnetic_field=_OpaqueField(2e-5))
+    spacecraft = _spacecraft([1.0, 2.0, 2.5])
+    assert AttitudeModel(spacecraft, environment).fingerprint == AttitudeModel(spacecraft, environment).fingerprint
+    assert _model(_OpaqueField(2e-5)).fingerprint != _model(_OpaqueField(2e-5)).fingerprint
+
+    @dataclasses.dataclass(frozen=True)
+    class Scheduled:
+        kp: float = 0.2
+        kd: float = 0.6
+        schedule: Any = _OpaqueField(1.0)  # a plugin law's gain schedule, say
+
+    law = CONTROLLERS["augmented_quaternion_feedback"]({"kp": 0.2, "kd": 0.6})
+    law.reset(Spacecraft(np.diag([3.0, 3.5, 4.0]), wheels=ReactionWheels(np.eye(3), max_torque=0.05)), 1.0)
+    object.__setattr__(law, "options", Scheduled())
+    assert law.symbolic_key() == law.symbolic_key()
+    other = Scheduled(schedule=_OpaqueField(1.0))
+    first = law.symbolic_key()
+    object.__setattr__(law, "options", other)
+    assert law.symbolic_key() != first

@@ -15,7 +15,9 @@ torque on the body, the momentum its states store (``A h_w``) and their rates (`
 from __future__ import annotations
 
 import hashlib
+import threading
 import uuid
+import weakref
 from typing import Any
 
 import casadi as ca
@@ -286,15 +288,45 @@ class AttitudeModel:
         return quat.rotate(x[..., 0:4], body)
 
 
+_TOKENS: dict[int, tuple[weakref.ref, str]] = {}
+"""By ``id``: a live object :func:`_plain` cannot state exactly, and its token."""
+_TOKENS_LOCK = threading.Lock()
+
+
+def _token(value: Any) -> str:
+    """A token of ``value`` equal to no other object's, the same for the object while it lives
+    (its ``id`` is unique while it lives; the entry goes with it); a fresh one on each call for an
+    object that takes no weak reference."""
+    key = id(value)
+
+    def forget(gone: weakref.ref) -> None:
+        with _TOKENS_LOCK:
+            if key in _TOKENS and _TOKENS[key][0] is gone:
+                del _TOKENS[key]
+
+    with _TOKENS_LOCK:
+        found = _TOKENS.get(key)
+        if found is not None and found[0]() is value:
+            return found[1]
+        token = uuid.uuid4().hex
+        try:
+            _TOKENS[key] = (weakref.ref(value, forget), token)
+        except TypeError:  # no weak reference (a builtin, say): a token of this call alone
+            pass
+        return token
+
+
 def _plain(value: Any) -> Any:
     """``value`` as the model's fingerprint states it: :func:`~ocp.cache.exact_key` (exact numbers,
     compared dataclass fields), or, for a value it cannot state exactly (an object of unknown kind),
-    a token drawn afresh on each call, equal to no other: a fingerprint holding one is that model's
-    alone, and shares no built solver with another model rather than share one by accident.
+    a token of that object (:func:`_token`), equal to no other object's: a fingerprint holding one
+    is that object's alone, and shares no built solver with another rather than share one by
+    accident, while repeated keys of the same object agree (a controller's closed loop is built
+    once, not per run).
 
     Also the walker of :meth:`controllers.Controller.symbolic_key`.
     """
     try:
         return exact_key(value)
     except Unkeyable:
-        return ("unkeyable", uuid.uuid4().hex)
+        return ("unkeyable", _token(value))
