@@ -478,7 +478,7 @@ def build_parser() -> argparse.ArgumentParser:
                                help="; ".join(f"{name}: {fmt.description}" for name, fmt in EXPORT_FORMATS.items()))
     export_parser.add_argument("--out", type=directory_argument, help="export directory (default: RUN_DIR-FORMAT beside RUN_DIR)")
     export_parser.add_argument("--option", action="append", metavar="NAME=VALUE",
-                               help="a format option, repeatable (aem: time_system=UTC|TAI|TT|TDB, "
+                               help="a format option, repeatable (aem: time_system=UTC|TAI|TT|TDB|GPS, "
                                     "attitude_type=QUATERNION/ANGVEL|QUATERNION, originator, object_name, object_id)")
     export_parser.set_defaults(handler=command_export)
     list_parser = commands.add_parser("list", help="registered planners and controllers, and the plugins that "

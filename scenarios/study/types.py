@@ -148,8 +148,17 @@ class Study:
                 f"varies {varied}>")
 
 
+RESULTS_FORMAT = 2
+"""What a stored case's results mean, in the store key beside the package version (:func:`case_text`):
+raised when a result a case stores changes its meaning or its columns, so that a resumed study
+recomputes its cases instead of mixing two meanings in one table. 2 (2026-12-03): the settling
+band defaults to ``requirements.final.error_deg``, and the actuator score stores
+``unrealised_torque_allowed``."""
+
+
 def case_key(scenario: dict[str, Any], version: str) -> str:
-    """Store key: a hash of the resolved case (canonical JSON) and the package version.
+    """Store key: a hash of the resolved case (canonical JSON), the package version and
+    :data:`RESULTS_FORMAT`.
 
     Parameters
     ----------
@@ -179,9 +188,10 @@ def case_text(scenario: dict[str, Any], version: str) -> str:
     Returns
     -------
     str
-        ``{"scenario": ..., "version": ...}`` with sorted keys and no spaces.
+        ``{"results": RESULTS_FORMAT, "scenario": ..., "version": ...}`` with sorted keys and no spaces.
     """
-    return json.dumps({"scenario": scenario, "version": version}, sort_keys=True, separators=(",", ":"))
+    return json.dumps({"results": RESULTS_FORMAT, "scenario": scenario, "version": version}, sort_keys=True,
+                      separators=(",", ":"))
 
 
 def _status_counts(study: Study, records: dict[str, dict[str, Any]]) -> dict[str, collections.Counter[str]]:
