@@ -78,8 +78,8 @@ MAX_NAME = 200
 MAX_LABEL = 100
 """Characters of a planner's or controller's label."""
 MAX_DURATION_S = 1.0e8
-"""Longest ``maneuver.duration`` [s] (about three years): planners raise powers of it, which must
-stay finite."""
+"""Longest ``maneuver.duration`` and ``simulation.duration`` [s] (about three years): planners raise
+powers of it, which must stay finite, and an epoch plus the run must be a date."""
 
 
 @dataclass
@@ -409,7 +409,7 @@ SIMULATION = Section((
            "``maneuver.duration``, or for its reference's duration when that is longer (a minimum-time or "
            "rate-limited planner's); a row without a planner for ``maneuver.duration``. After its duration a "
            "reference continues as the torque-free motion of its final state.", unit="s", default=None,
-           positive=True, nullable=True),
+           positive=True, nullable=True, maximum=MAX_DURATION_S),
     vector("initial_attitude_error_deg", "Rotation vector applied to the true initial attitude, body axes.", 3,
            unit="deg", default=[0.0, 0.0, 0.0], magnitude=1e6),
     vector("initial_rate_error", "Added to the true initial body rate, body frame.", 3, unit="rad/s",
