@@ -46,3 +46,21 @@ def test_the_sweep_says_it_when_it_starts_and_runs_the_study(tmp_path, capsys, m
     first = out.splitlines()
     assert first[0].startswith("s2: 2 cases") and first[1].startswith("note: 2 cases is a large study (over 1)")
     assert "2 cases run in" in out
+
+
+def test_the_size_note_never_stops_a_sweep_on_a_scheduler_that_does_not_answer() -> None:
+    """The note asks the cluster for its threads only to size itself: a scheduler that fails to
+    answer gives no count (a fake cluster without ``workers`` once made a sweep an internal error)."""
+    from scenarios.cli.sweep import _cluster_threads
+
+    class Silent:
+        def workers(self) -> int:
+            raise OSError("scheduler gone")
+
+    class Answering:
+        def workers(self) -> int:
+            return 3
+
+    assert _cluster_threads(None) is None
+    assert _cluster_threads(Silent()) is None  # type: ignore[arg-type]
+    assert _cluster_threads(Answering()) == 3  # type: ignore[arg-type]

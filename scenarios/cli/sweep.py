@@ -352,6 +352,17 @@ DRY_RUN_SHOWN = 50
 """Cases ``sweep --dry-run`` lists one per line (the others are counted)."""
 
 
+def _cluster_threads(cluster: DaskCluster | None) -> int | None:
+    """The cluster's worker threads now, for the size note (``None``: no cluster, or it does not
+    answer: a note never stops a sweep)."""
+    if cluster is None:
+        return None
+    try:
+        return cluster.workers()
+    except Exception:  # noqa: BLE001 (the scheduler's answer only sizes a note)
+        return None
+
+
 def _local_workers() -> int:
     """The workers of a local pool by default (one per core available)."""
     from scenarios.study.engine import default_workers
@@ -414,7 +425,7 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
         robustness_tables,
     )
     from scenarios.study.robustness import crashed_counts, robustness_lines
-    from scenarios.study.spec import size_note
+    from scenarios.study.spec import LARGE_STUDY, size_note
     from scenarios.study.store import STORE_NAME, SweepStore, resume_counts
 
     previous = signal.signal(signal.SIGTERM, _terminate)
@@ -434,8 +445,8 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
                   + f", {cluster.address if cluster else 'local process pool'}", flush=True)
             for note in counts.notes():  # stored cases of an earlier version of the study
                 print(note, flush=True)
-            size = size_note(study, args.workers or (cluster.workers() if cluster else None)
-                             or study.execution.workers or _local_workers())
+            size = None if len(study.cases) <= LARGE_STUDY else size_note(
+                study, args.workers or _cluster_threads(cluster) or study.execution.workers or _local_workers())
             if size:
                 print(size, flush=True)
             results = sweep(study, workers=args.workers, store=store, progress=True, cluster=cluster)
