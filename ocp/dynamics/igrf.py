@@ -25,6 +25,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ocp.cache import RecentCache, Unkeyable, exact_key
 from ocp.dynamics.environment import MAGNETIC_FIELDS, FieldModel
 from ocp.dynamics.ephemeris import parse_utc
 from ocp.dynamics.orbits import Orbit
@@ -38,6 +39,9 @@ MAX_NODES = 200_000
 EPOCH_RANGE = (datetime.date(1900, 1, 1), datetime.date(2030, 1, 1))
 """Dates the IGRF-14 coefficients cover (definitive to 2020, the 2025 model and its secular
 variation to 2030)."""
+_INTERPOLANTS = RecentCache(size=16)
+"""Built interpolants (:attr:`IGRFField.interpolant`) keyed by the field's exact value: a scenario
+parsed again, or a study's cases sharing one orbit and epoch, tabulate the field once per thread."""
 
 
 def parse_epoch(epoch: str | datetime.date) -> datetime.datetime:
@@ -282,7 +286,16 @@ class IGRFField(FieldModel):
     @cached_property
     def interpolant(self) -> ca.Function:
         """``casadi.Function`` ``igrf_field(t) -> b``: cubic B-spline through the table, ``t`` [s],
-        ``b`` (3,) [T], inertial axes (built on first use)."""
+        ``b`` (3,) [T], inertial axes (built on first use; fields of equal value share one,
+        a bounded cache per thread)."""
+        try:
+            key = exact_key(self)  # every compared field: orbit, span, epoch, step, angle, rate
+        except Unkeyable:  # an orbit of unknown kind: its own table
+            return self._build_interpolant()
+        return _INTERPOLANTS.get(("igrf_interpolant", key), self._build_interpolant)
+
+    def _build_interpolant(self) -> ca.Function:
+        """A new interpolant through the table (:attr:`interpolant`)."""
         nodes = self.nodes
         values = self.exact(nodes)
         return ca.interpolant("igrf_field", "bspline", [nodes], values.ravel())

@@ -26,18 +26,26 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp import quat
 from ocp import quat_casadi as qc
-from ocp.cache import SolverCache, Unkeyable, exact_key
+from ocp.cache import RecentCache, SolverCache, Unkeyable, exact_key
 from ocp.dynamics.environment import Environment, gravity_gradient_torque
 from ocp.dynamics.layout import actuator_blocks, control_layout
 from ocp.dynamics.spacecraft import Spacecraft
 from ocp.quat_casadi import Expr
+
+_LAZY = ("rhs", "body_torque", "environment_torque", "field_body", "field_rate_inertial")
+"""The model's CasADi functions, built on first use (:meth:`AttitudeModel.__getattr__`)."""
+_BUILT = RecentCache(size=32)
+"""Built functions keyed by the model's fingerprint: models of equal fingerprint share them (a
+scenario parsed again, a study's cases of one spacecraft). One set per thread, as CasADi functions
+are; bounded, for a study sweeping the spacecraft."""
 
 
 class AttitudeModel:
     """Symbolic model of one spacecraft in one environment (see the module docstring for the
     state ``x``, control ``u`` and parameter ``p``, and the dynamics).
 
-    The CasADi functions are built on ``SX`` symbols at construction; all take and return column
+    The CasADi functions are built on ``SX`` symbols on first use (not at construction), and shared
+    by the models of equal :attr:`fingerprint` built in one thread; all take and return column
     vectors, ``t`` in s.
 
     Parameters
@@ -95,7 +103,21 @@ class AttitudeModel:
         self._fingerprint: str | None = None
         self.solver_cache = SolverCache()
         """Solvers built on this model by planners given no cache of their own."""
-        self._build()
+
+    rhs: ca.Function
+    body_torque: ca.Function
+    environment_torque: ca.Function
+    field_body: ca.Function | None
+    field_rate_inertial: ca.Function | None
+
+    def __getattr__(self, name: str) -> Any:
+        """The CasADi functions (:data:`_LAZY`), built on first use: those of an earlier model of
+        equal fingerprint in this thread, else new ones. Any other missing name is an
+        ``AttributeError``."""
+        if name not in _LAZY or "_fingerprint" not in self.__dict__:  # not one, or not constructed
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        self.__dict__.update(_BUILT.get(("attitude_model", self.fingerprint), self._build))
+        return self.__dict__[name]
 
     @property
     def fingerprint(self) -> str:
@@ -246,28 +268,30 @@ class AttitudeModel:
         parts += [block.actuator.state_rate(u[block.control], states[block.state]) for block in stateful]
         return ca.vertcat(*parts)
 
-    def _build(self) -> None:
+    def _build(self) -> dict[str, ca.Function | None]:
+        """The CasADi functions of :data:`_LAZY`, built anew, by name."""
         x = ca.SX.sym("x", self.nx)
         u = ca.SX.sym("u", self.nu)
         t = ca.SX.sym("t")
         p = ca.SX.sym("p", 3)
-        self.rhs = ca.Function("f", [x, u, t, p], [self.dynamics(x, u, t, p)], ["x", "u", "t", "p"], ["xdot"])
-        self.body_torque = ca.Function(
-            "body_torque", [x, u, t], [self.actuator_torque(x, u, t)], ["x", "u", "t"], ["tau"]
-        )
-        self.environment_torque = ca.Function(
-            "environment_torque", [x, t, p], [self.external_torque(x, t, p)], ["x", "t", "p"], ["tau"]
-        )
+        built: dict[str, ca.Function | None] = {
+            "rhs": ca.Function("f", [x, u, t, p], [self.dynamics(x, u, t, p)], ["x", "u", "t", "p"], ["xdot"]),
+            "body_torque": ca.Function(
+                "body_torque", [x, u, t], [self.actuator_torque(x, u, t)], ["x", "u", "t"], ["tau"]),
+            "environment_torque": ca.Function(
+                "environment_torque", [x, t, p], [self.external_torque(x, t, p)], ["x", "t", "p"], ["tau"]),
+            "field_body": None,
+            "field_rate_inertial": None,
+        }
         field_body = self.magnetic_field_body(x[0:4], t)
-        self.field_body: ca.Function | None = None if field_body is None else ca.Function(
-            "field_body", [x, t], [field_body], ["x", "t"], ["b"]
-        )
-        self.field_rate_inertial: ca.Function | None = None
+        if field_body is not None:
+            built["field_body"] = ca.Function("field_body", [x, t], [field_body], ["x", "t"], ["b"])
         env = self.environment
         if field_body is not None and env.magnetic_field is not None and env.orbit is not None:
             field_inertial = env.magnetic_field.field_inertial(env.orbit.position(t), t)
-            self.field_rate_inertial = ca.Function(
+            built["field_rate_inertial"] = ca.Function(
                 "field_rate_inertial", [t], [ca.jacobian(field_inertial, t)], ["t"], ["db"])
+        return built
 
     def inertial_momentum(self, x: ArrayLike) -> NDArray:
         """Total angular momentum of body and wheels, ``R(q)(I ω + A h_w)``, conserved without
