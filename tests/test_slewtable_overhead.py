@@ -22,27 +22,8 @@ from scenarios.runner import run
 from scenarios.schema.loader import parse_scenario
 from scenarios.slewtable.compute import TablePart, _fill
 from scenarios.slewtable.spec import case_scenario, parse_table_spec, table_cases
-
-UNIT_BOX = {
-    "name": "bilimoria-wie",
-    "spacecraft": {"inertia": [1.0, 1.0, 1.0], "wheels": None, "torquers": {"max_torque": 1.0}},
-    "maneuver": {"duration": 10.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
-                 "final": {"q": [0, 1, 0, 0], "omega": [0, 0, 0]}},
-    "planners": [{"name": "collocation"}],
-    "controller": {"name": "augmented_quaternion_feedback"},
-}
-
-KEEP_OUT = {
-    "name": "box-keep-out",
-    "spacecraft": {"inertia": [1.0, 1.0, 1.0], "wheels": None, "torquers": {"max_torque": 1.0},
-                   "sensors": {"camera": {"boresight": [1, 0, 0]}}},
-    "maneuver": {"duration": 20.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
-                 "final": {"q": [0.7071068, 0, 0, 0.7071068], "omega": [0, 0, 0]}},
-    "planners": [{"name": "collocation"}],
-    "controller": {"name": "augmented_quaternion_feedback"},
-    "requirements": {"pointing": {"cam_y": {"sensor": "camera", "keep_out": {"inertial": [0, 1, 0]},
-                                            "angle_deg": 20}}},
-}
+from tests.test_slewtable import UNIT_BOX
+from tests.test_slewtable_gaps import KEEP_OUT
 
 
 def _spec(tmp_path: Path, scenario: dict, axes: list, angles: list):
