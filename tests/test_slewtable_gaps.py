@@ -225,7 +225,9 @@ def test_the_keep_out_table_records_the_impossible_entry_and_the_fit_gives_no_ti
     assert fit is not None and fit.meta["from_identity_only"] is True
     assert "1 entry not ok (1 infeasible)" in table.fit_note
     assert _both(fit, [0, 0, 1], 90.0) == (math.inf, math.inf)
-    for angle in (95.0, 100.0, 110.0):
+    for angle in (95.0, 100.0, 105.0):  # the camera ends 5-15 deg from +y, inside the cone: no slew
+        assert _both(fit, [0, 0, 1], angle) == (math.inf, math.inf)
+    for angle in (112.0, 116.0):  # it ends outside, in the cells around the infeasible entry: no time
         assert all(math.isnan(v) for v in _both(fit, [0, 0, 1], angle))
     assert _both(fit, [0, 0, -1], 90.0)[0] == pytest.approx(part.slew_time_s[1, 0], rel=1e-12)
 

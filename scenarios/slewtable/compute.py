@@ -21,6 +21,7 @@ same engine and store, so an interrupted refinement also resumes where it stoppe
 from __future__ import annotations
 
 import json
+import math
 import statistics
 import time
 import timeit
@@ -41,8 +42,8 @@ from scenarios.slewtable.spec import (
     torque_generators,
 )
 
-__all__ = ["FIT_TARGET", "PART_NAMES", "SlewTable", "TablePart", "compute_table", "eval_time_us", "fit_entries",
-           "held_out_errors", "quality_lines", "slower_than_known"]
+__all__ = ["FIT_TARGET", "PART_NAMES", "SlewTable", "TablePart", "compute_table", "end_cones", "eval_time_us",
+           "fit_entries", "held_out_errors", "quality_lines", "slower_than_known"]
 
 PART_NAMES = ("table", "held_out", "check")
 """The grids of a table: the fitted one, the held-out one, and the refinement's check points that
@@ -174,6 +175,39 @@ def _study(spec: TableSpec, cases: list[TableCase]) -> Any:
                  study_cases, {"table": spec.name}, units=("entry", "entries"))
 
 
+def end_cones(scenario: dict[str, Any]) -> np.ndarray:
+    """The pointing requirements' cones that an entry's target is checked against, for the fit.
+
+    The same check as an entry's own (:func:`scenarios.requirements.scoring.endpoint_violations`):
+    the target at the scenario's duration, or at a window's start when it opens later; a cone whose
+    window has closed by then is left out.
+
+    Parameters
+    ----------
+    scenario : dict
+        One entry's scenario (plain YAML data; its target does not matter).
+
+    Returns
+    -------
+    numpy.ndarray, shape (c, 8)
+        A row per cone: the body boresight, the inertial direction at that time (unit vectors), the
+        cosine of the half-angle there (its growth included) and 1 for a keep-out, 0 for a keep-in
+        (:class:`~scenarios.slewtable.fit.SlewTimeFit`'s ``end_cones``); no rows without pointing
+        requirements.
+    """
+    from scenarios.schema.loader import parse_scenario
+    problem = parse_scenario(scenario).problem
+    rows = []
+    for constraint in problem.pointing:
+        time = max(float(problem.duration), constraint.window[0])
+        if not bool(constraint.in_window([time])[0]):
+            continue
+        direction = constraint.direction([time])[0]
+        rows.append([*constraint.boresight, *direction, math.cos(float(constraint.limit([time])[0])),
+                     1.0 if constraint.keep_out else 0.0])
+    return np.array(rows, dtype=float).reshape(-1, 8)
+
+
 def _proven_infeasible(scenario: dict[str, Any]) -> bool:
     """Whether the entry's start or target attitude already breaks a pointing requirement (then no
     slew can meet it: the run's row is ``failed`` without planning)."""
@@ -238,7 +272,8 @@ def _plural(count: int, word: str, words: str | None = None) -> str:
 
 def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: np.ndarray | None = None,
                 meta: dict[str, Any] | None = None, triangles: np.ndarray | None = None,
-                rates: tuple[np.ndarray, float | None] | None = None) -> tuple[SlewTimeFit | None, str]:
+                rates: tuple[np.ndarray, float | None] | None = None,
+                cones: np.ndarray | None = None) -> tuple[SlewTimeFit | None, str]:
     """Fit a grid's ``ok`` entries; the others are kept as gaps (module docstring).
 
     Parameters
@@ -257,6 +292,8 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
     rates : tuple of (numpy.ndarray, float or None), optional
         The momentum generators [N m s] and rate bound [rad/s] of the fit's baseline
         (:func:`rate_limits`); None: no rate cap.
+    cones : numpy.ndarray, shape (c, 8), optional
+        The pointing requirements' cones at the end of a slew (:func:`end_cones`); None: none.
 
     Returns
     -------
@@ -286,7 +323,7 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
     try:
         momentum, max_rate = rates if rates is not None else (None, None)
         fit = SlewTimeFit(angles, part.axes, np.where(ok, part.slew_time_s, np.nan), meta, inertia, generators,
-                          triangles, status, momentum, max_rate)
+                          triangles, status, momentum, max_rate, cones)
     except ValueError as error:
         return None, "; ".join([*notes, f"no fit: {error}"])
     slower = int(part.not_best_known.sum())
@@ -362,7 +399,10 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart, table_angles_deg: list[fl
         under-estimate, None without one); ``by_angle`` (per held-out angle [deg]: ``kind``,
         ``points``, ``max_over_error``, ``max_under_error``); ``held_out`` (what the set is:
         ``axes``, ``angles_deg``, ``table_angles_deg``, ``midpoint_angles_deg``); ``no_value`` (ok
-        entries where the fit has no time, in a cell around an entry that is not ok: not compared).
+        entries where the fit has no time, in a cell around an entry that is not ok: not compared);
+        ``timed_infeasible`` (``infeasible`` held-out entries where the fit gives a finite time: a
+        time for a slew that cannot be made; any makes ``target_met`` false) and
+        ``worst_timed_infeasible`` (one of them: axis, angle [deg], fitted time [s]; None without).
     """
     fitted = np.rad2deg(fit.angles).tolist()
     table_angles = [float(a) for a in (fitted if table_angles_deg is None else table_angles_deg)]
@@ -376,7 +416,18 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart, table_angles_deg: list[fl
                  "midpoint_angles_deg": [float(a) for a, kind in zip(part.angles_deg, kinds) if kind == "midpoint"]}
     none: dict[str, Any] = {"points": 0, "max_rel_error": None, "max_over_error": None, "max_under_error": None,
                             "rms_rel_error": None, "target": FIT_TARGET, "target_met": None, "worst": None,
-                            "worst_under": None, "by_angle": [], "held_out": described, "no_value": 0}
+                            "worst_under": None, "by_angle": [], "held_out": described, "no_value": 0,
+                            "timed_infeasible": 0, "worst_timed_infeasible": None}
+    impossible = np.array([[status == "infeasible" for status in row] for row in part.status], dtype=bool)
+    if impossible.size and impossible.any():
+        a, b = np.nonzero(impossible)
+        guessed = fit.many_axis_angle(part.axes[a], np.deg2rad(np.asarray(part.angles_deg, dtype=float))[b])
+        timed = np.isfinite(guessed)
+        none["timed_infeasible"] = int(timed.sum())
+        if timed.any():
+            w = int(np.argmax(timed))
+            none["worst_timed_infeasible"] = {"axis": part.axes[a[w]].tolist(), "angle_deg": float(part.angles_deg[b[w]]),
+                                              "fit_s": float(guessed[w])}
     ok = part.ok
     if not ok.any():
         return none
@@ -407,9 +458,11 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart, table_angles_deg: list[fl
     largest = max(over, under)
     return {"points": len(signed), "max_rel_error": largest, "max_over_error": over, "max_under_error": under,
             "rms_rel_error": float(np.sqrt(np.mean(signed ** 2))), "target": FIT_TARGET,
-            "target_met": bool(largest <= FIT_TARGET), "worst": point(int(np.argmax(np.abs(signed)))),
+            "target_met": bool(largest <= FIT_TARGET and not none["timed_infeasible"]),
+            "worst": point(int(np.argmax(np.abs(signed)))),
             "worst_under": point(int(np.argmin(signed))) if under > 0.0 else None, "by_angle": by_angle,
-            "held_out": described, "no_value": none["no_value"]}
+            "held_out": described, "no_value": none["no_value"], "timed_infeasible": none["timed_infeasible"],
+            "worst_timed_infeasible": none["worst_timed_infeasible"]}
 
 
 def quality_lines(quality: dict[str, Any]) -> list[str]:
@@ -427,8 +480,15 @@ def quality_lines(quality: dict[str, Any]) -> list[str]:
         the errors at each held-out angle.
     """
     evaluation = f"evaluation {quality['eval_time_us']:.2f} us CPU per call"
+    timed = quality.get("timed_infeasible") or 0
+    impossible = []
+    if timed:
+        example = quality["worst_timed_infeasible"]
+        impossible.append(f"fit: gives a time for {_plural(timed, 'infeasible held-out entry', 'infeasible held-out entries')}"
+                          f" (a slew that cannot be made; target NOT met), e.g. {example['fit_s']:.4g} s at "
+                          f"{example['angle_deg']:g} deg about [{', '.join(f'{v:.3f}' for v in example['axis'])}]")
     if not quality.get("points"):
-        return [f"fit: no held-out points; {evaluation}"]
+        return [f"fit: no held-out points; {evaluation}", *impossible]
     held = quality["held_out"]
     verdict = "met" if quality["target_met"] else "NOT met"
     degrees = ", ".join(f"{a:g}" for a in held["table_angles_deg"])
@@ -444,7 +504,7 @@ def quality_lines(quality: dict[str, Any]) -> list[str]:
     lines.append("fit: held-out error by angle: " + "; ".join(
         f"{item['angle_deg']:g} deg ({item['kind']}) {_signed(-item['max_under_error'])} to "
         f"{_signed(item['max_over_error'])} %" for item in quality["by_angle"]))
-    return lines
+    return lines + impossible
 
 
 def _signed(fraction: float) -> str:
@@ -497,9 +557,10 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
             _fill(parts[case.part], case, record, spec.objective)
         inertia, generators = torque_generators(spec.base)
         rates = rate_limits(spec.base)
+        cones = end_cones(cases[0].scenario) if cases else None
         triangles = spec.triangles
         if spec.refine is not None:
-            triangles = _refine(table, run, inertia, generators, rates)
+            triangles = _refine(table, run, inertia, generators, rates, cones)
     finally:
         if store is not None:
             store.close()
@@ -513,7 +574,7 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
     meta["grid"] = spec.grid
     if table.refinement:
         meta["refinement"] = table.refinement
-    table.fit, table.fit_note = fit_entries(parts["table"], inertia, generators, meta, triangles, rates)
+    table.fit, table.fit_note = fit_entries(parts["table"], inertia, generators, meta, triangles, rates, cones)
     if table.fit is not None:
         quality = held_out_errors(table.fit, parts["held_out"], spec.angles_deg)
         if quality["no_value"]:
@@ -556,7 +617,7 @@ class _Runner:
 
 
 def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.ndarray,
-            rates: tuple[np.ndarray, float | None]) -> np.ndarray:
+            rates: tuple[np.ndarray, float | None], cones: np.ndarray | None) -> np.ndarray:
     """Refine the table's axes (module docstring); the table part becomes the refined grid, the
     check points not split become the ``check`` part. Returns the refined triangles."""
     from scenarios.slewtable.fit import _hull
@@ -584,7 +645,7 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
         part = TablePart.empty(axes, spec.angles_deg)
         part.slew_time_s[:] = times
         part.status = [["ok" if np.isfinite(v) else "failed" for v in row] for row in times]
-        fit, _ = fit_entries(part, inertia, generators, None, triangles, rates)
+        fit, _ = fit_entries(part, inertia, generators, None, triangles, rates, cones)
         if fit is None:
             return None
         return lambda e, k: fit.many_axis_angle(np.repeat(e, len(k), axis=0), np.tile(angles[k], len(e))

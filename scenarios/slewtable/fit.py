@@ -26,6 +26,13 @@ triangle of axes between two table angles) that has one with a non-zero weight, 
 every entry it uses is ``infeasible`` (at such an entry itself). A table of slews from the identity
 only (``meta.from_identity_only``) refuses any other start attitude.
 
+A slew whose end attitude breaks a pointing requirement of the table's scenario is ``inf`` whatever
+the interpolation gives (``end_cones``: each cone's body boresight, its inertial direction and
+half-angle at the time the table checks its own entries' targets, the scenario's duration): the
+table's entries there are ``infeasible``, but an end attitude inside a cone between the table's
+axes is no entry of the table, and the blend of its neighbours' times would be a time for a slew
+that cannot be made. Between the end points the fit relies on the entries alone.
+
 Evaluation (:meth:`SlewTimeFit.__call__`) is pure Python on precomputed lists (a cube-map lookup
 finds the candidate triangles), since every NumPy call costs about a microsecond;
 :meth:`SlewTimeFit.slew_time_many` is the vectorised form.
@@ -293,6 +300,12 @@ class SlewTimeFit:
         fewer than three independent ones: no momentum cap.
     max_rate : float, optional
         The body-rate bound the table's slews keep [rad/s]; None: none.
+    end_cones : array_like, shape (c, 8), optional
+        The pointing requirements' cones at the end of a slew from the identity, a row each: the
+        body boresight (3, unit), the inertial direction (3, unit), the cosine of the half-angle
+        and 1 for a keep-out (0 for a keep-in) (:func:`scenarios.slewtable.compute.end_cones`).
+        A slew whose end attitude breaks one is ``inf``. None: none (the table has no pointing
+        requirement; a table with them holds slews from the identity only).
 
     Raises
     ------
@@ -305,7 +318,8 @@ class SlewTimeFit:
     def __init__(self, angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[str, Any] | None = None,
                  inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
                  triangles: ArrayLike | None = None, status: ArrayLike | None = None,
-                 momentum_generators: ArrayLike | None = None, max_rate: float | None = None):
+                 momentum_generators: ArrayLike | None = None, max_rate: float | None = None,
+                 end_cones: ArrayLike | None = None):
         from scipy.interpolate import PchipInterpolator
         theta = np.asarray(angles, dtype=float)
         e = np.asarray(axes, dtype=float)
@@ -351,6 +365,12 @@ class SlewTimeFit:
         self._rate_facets = [tuple(f) for f in self.rate_facets.tolist()]
         self._inverse_rate = 1.0 / self.max_rate if self.max_rate is not None and len(self.facets) else 0.0
         self._coasts = bool(self._rate_facets) or self._inverse_rate > 0.0
+        cones = np.zeros((0, 8)) if end_cones is None else np.asarray(end_cones, dtype=float).reshape(-1, 8)
+        if not np.all(np.isfinite(cones)) or not np.allclose(np.linalg.norm(cones[:, :6].reshape(-1, 3), axis=1), 1.0):
+            raise ValueError("end_cones must be finite rows of a unit boresight, a unit direction, the cosine of "
+                             "the half-angle and 1 (keep-out) or 0 (keep-in)")
+        self.end_cones = cones
+        self._cones = [tuple(row) for row in cones.tolist()]
         g = t / self.baseline(e[:, None, :], theta[None, :])
         slopes = np.full(g.shape, np.nan)
         for row, good in zip(range(len(g)), ok):  # PCHIP over each run of ok angles, alone
@@ -442,6 +462,8 @@ class SlewTimeFit:
         """
         if angle <= 0.0:
             return 0.0
+        if self._cones and self._end_breaks(x, y, z, angle):
+            return math.inf
         found = None
         for tri in self._cells[_cell(x, y, z)]:
             m = tri[1]
@@ -507,6 +529,54 @@ class SlewTimeFit:
                 return blend * 0.5 * (angle * slow + scale / slow)
         return blend * math.sqrt(angle * scale)
 
+    def _end_breaks(self, x: float, y: float, z: float, angle: float) -> bool:
+        """Whether the end attitude of the slew from the identity about ``(x, y, z)`` by ``angle``
+        breaks a cone of :attr:`end_cones` (pure Python)."""
+        half = 0.5 * angle
+        k = math.sin(half) / math.sqrt(x * x + y * y + z * z)
+        w, vx, vy, vz = math.cos(half), x * k, y * k, z * k
+        for bx, by, bz, dx, dy, dz, cosine, keep_out in self._cones:
+            # b rotated body to inertial: b + 2 w (v x b) + 2 v x (v x b)
+            cx, cy, cz = vy * bz - vz * by, vz * bx - vx * bz, vx * by - vy * bx
+            ix = bx + 2.0 * (w * cx + vy * cz - vz * cy)
+            iy = by + 2.0 * (w * cy + vz * cx - vx * cz)
+            iz = bz + 2.0 * (w * cz + vx * cy - vy * cx)
+            dot = ix * dx + iy * dy + iz * dz
+            if (dot > cosine) if keep_out else (dot < cosine):
+                return True
+        return False
+
+    def end_breaks_many(self, axes: ArrayLike, angles: ArrayLike) -> np.ndarray:
+        """Whether the end attitudes of slews from the identity break a cone of :attr:`end_cones`.
+
+        Parameters
+        ----------
+        axes : array_like, shape (n, 3)
+            Eigen-axes, body frame (any length > 0).
+        angles : array_like, shape (n,)
+            Slew angles [rad].
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (n,)
+            True where the end attitude's boresight is inside a keep-out cone or outside a keep-in
+            cone (all False without cones).
+        """
+        e = np.atleast_2d(np.asarray(axes, dtype=float))
+        theta = np.atleast_1d(np.asarray(angles, dtype=float))
+        broken = np.zeros(len(e), dtype=bool)
+        if not len(self.end_cones):
+            return broken
+        v = e / np.linalg.norm(e, axis=1, keepdims=True) * np.sin(0.5 * theta)[:, None]
+        w = np.cos(0.5 * theta)[:, None]
+        for row in self.end_cones:
+            b, d, cosine, keep_out = row[:3], row[3:6], row[6], row[7] > 0.5
+            c = np.cross(v, b)
+            inertial = b + 2.0 * (w * c + np.cross(v, c))
+            dot = inertial @ d
+            broken |= (dot > cosine) if keep_out else (dot < cosine)
+        return broken & (theta > 0.0)
+
     def _gap(self, vertices: tuple[int, ...], w0: float, w1: float, w2: float, angle: float) -> float:
         """The blended ``g`` of a cell holding an entry that is not ok (normalised weights): NaN if
         an entry used (non-zero weight) is not ok, inf if every one used is infeasible, else the
@@ -562,7 +632,8 @@ class SlewTimeFit:
         float
             The fitted slew time [s] of the rest-to-rest slew ``q0 -> qf``; NaN where the fit has no
             value (a cell with an entry that is not ``ok``, or an angle past the table's largest),
-            ``inf`` at an ``infeasible`` entry (module docstring).
+            ``inf`` at an ``infeasible`` entry and where the end attitude breaks a pointing
+            requirement (module docstring).
 
         Raises
         ------
@@ -671,7 +742,10 @@ class SlewTimeFit:
             blended[row] = self._gap(tuple(vertices[row].tolist()), w[0], w[1], w[2], float(theta[row]))
         blended[theta > self._top + _ANGLE_SLACK] = np.nan  # no extrapolation past the table's largest angle
         with np.errstate(invalid="ignore"):
-            return np.where(theta > 0.0, blended * self.baseline(e, theta), 0.0)
+            times = np.where(theta > 0.0, blended * self.baseline(e, theta), 0.0)
+        if len(self.end_cones):
+            times[self.end_breaks_many(e, theta)] = np.inf
+        return times
 
     def slew_time_many(self, q0: ArrayLike, qf: ArrayLike) -> np.ndarray:
         """Slew times of many slews (vectorised :meth:`__call__`).
@@ -732,7 +806,9 @@ class SlewTimeFit:
             (its PCHIP slopes [1/rad], over each run of ok angles), ``triangles``,
             ``facets`` (the rows ``a_f`` of ``s(e)`` [s²/rad]), ``rate_facets`` (the rows ``b_f``
             of ``m(e)`` [s/rad]), ``inertia`` [kg m²], ``torque_generators`` [N m],
-            ``momentum_generators`` [N m s], ``max_rate`` [rad/s] (null: none) and ``meta``.
+            ``momentum_generators`` [N m s], ``max_rate`` [rad/s] (null: none), ``end_cones``
+            (boresight, direction, cosine of the half-angle, 1 keep-out / 0 keep-in, a row each)
+            and ``meta``.
         """
         return {"format": FIT_FORMAT,
                 "model": "T(e, θ) = b(e, θ) · g(e, θ), b = √(θ s) if θ m² <= s else (θ m + s/m)/2 (half the "
@@ -745,7 +821,7 @@ class SlewTimeFit:
                 "facets": self.facets.tolist(), "rate_facets": self.rate_facets.tolist(),
                 "inertia": self.inertia.tolist(), "torque_generators": self.generators.tolist(),
                 "momentum_generators": self.momentum_generators.tolist(), "max_rate": self.max_rate,
-                "meta": self.meta}
+                "end_cones": self.end_cones.tolist(), "meta": self.meta}
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write :meth:`to_dict` as JSON.
@@ -770,7 +846,8 @@ def _plain(values: np.ndarray) -> list[Any]:
 def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[str, Any] | None = None,
               inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
               triangles: ArrayLike | None = None, status: ArrayLike | None = None,
-              momentum_generators: ArrayLike | None = None, max_rate: float | None = None) -> SlewTimeFit:
+              momentum_generators: ArrayLike | None = None, max_rate: float | None = None,
+              end_cones: ArrayLike | None = None) -> SlewTimeFit:
     """Fit a slew table (module docstring).
 
     Parameters
@@ -795,6 +872,8 @@ def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[s
         Working wheels' axes times momentum bounds [N m s], body frame (no other momentum sink).
     max_rate : float, optional
         Body-rate bound [rad/s].
+    end_cones : array_like, shape (c, 8), optional
+        The pointing requirements' cones at the end of a slew (:class:`SlewTimeFit`).
 
     Returns
     -------
@@ -802,7 +881,7 @@ def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[s
         The fit.
     """
     return SlewTimeFit(angles, axes, times, meta, inertia, generators, triangles, status, momentum_generators,
-                       max_rate)
+                       max_rate, end_cones)
 
 
 def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
@@ -839,4 +918,4 @@ def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
     times = np.array(data["times_s"], dtype=float)  # null (an entry not ok) -> NaN
     return SlewTimeFit(data["angles_rad"], data["axes"], times, data.get("meta"), data.get("inertia"),
                        data.get("torque_generators"), data.get("triangles"), data.get("status"),
-                       data.get("momentum_generators"), data.get("max_rate"))
+                       data.get("momentum_generators"), data.get("max_rate"), data.get("end_cones"))
