@@ -20,7 +20,13 @@ import pytest
 
 from ocp import quat
 from scenarios.schema.loader import parse_scenario
-from scenarios.slewtable.compute import TablePart, end_cones, fit_entries, held_out_errors, quality_lines
+from scenarios.slewtable.compute import (
+    TablePart,
+    end_cones,
+    fit_entries,
+    held_out_errors,
+    quality_lines,
+)
 from scenarios.slewtable.fit import SlewTimeFit, load_fit
 from scenarios.slewtable.grid import polytope_grid
 
@@ -128,3 +134,19 @@ def test_held_out_errors_count_an_infeasible_entry_the_fit_gives_a_time():
     part.slew_time_s[0, 1] = fit.axis_angle(0.3, 0.5, 0.81, math.pi)
     quality = held_out_errors(fit, part, [90.0, 180.0])
     assert quality["timed_infeasible"] == 0 and quality["target_met"] is True
+
+
+def test_the_error_by_angle_is_the_range_of_the_signed_errors():
+    """A user read "90 deg (table) 0 to +11.4 %" where every error there was +3.3 % or more: the
+    lower end was the largest under-estimate clamped at 0, not the least error."""
+    fit = _table_fit(None)
+    axes = np.array([[0.3, 0.5, 0.81], [0.7, -0.2, 0.4]])
+    part = TablePart.empty(axes, [90.0])
+    part.status = [["ok"], ["ok"]]
+    for i, (axis, over) in enumerate(zip(axes.tolist(), (1.03, 1.11))):
+        part.slew_time_s[i, 0] = fit.axis_angle(*axis, math.radians(90.0)) / over
+    quality = held_out_errors(fit, part, [90.0])
+    quality["eval_time_us"] = 1.0
+    (item,) = quality["by_angle"]
+    assert item["min_error"] == pytest.approx(0.03) and item["max_error"] == pytest.approx(0.11)
+    assert "90 deg (table) +3 to +11 %" in quality_lines(quality)[2]

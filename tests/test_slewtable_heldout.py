@@ -111,4 +111,4 @@ def test_a_fit_within_the_target_says_met_and_has_no_under_estimate():
     quality["eval_time_us"] = 4.0
     said = "\n".join(quality_lines(quality))
     assert "from 0 % (largest under-estimate) to +0.5 % (largest over-estimate)" in said, said
-    assert "target 1 %: met" in said and "120 deg (midpoint) 0 to +0.5 %" in said, said
+    assert "target 1 %: met" in said and "120 deg (midpoint) +0.5 to +0.5 %" in said, said

@@ -397,7 +397,8 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart, table_angles_deg: list[fl
         (``max_rel_error <= target``; None without points); ``worst`` (axis, angle [deg], solved
         and fitted times [s], signed error) and ``worst_under`` (the same at the largest
         under-estimate, None without one); ``by_angle`` (per held-out angle [deg]: ``kind``,
-        ``points``, ``max_over_error``, ``max_under_error``); ``held_out`` (what the set is:
+        ``points``, ``max_over_error``, ``max_under_error``, and ``min_error`` and ``max_error``, the
+        range of the signed errors there); ``held_out`` (what the set is:
         ``axes``, ``angles_deg``, ``table_angles_deg``, ``midpoint_angles_deg``); ``no_value`` (ok
         entries where the fit has no time, in a cell around an entry that is not ok: not compared);
         ``timed_infeasible`` (``infeasible`` held-out entries where the fit gives a finite time: a
@@ -454,7 +455,8 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart, table_angles_deg: list[fl
         if len(here):
             by_angle.append({"angle_deg": float(angle), "kind": kinds[column], "points": len(here),
                              "max_over_error": max(float(here.max()), 0.0),
-                             "max_under_error": max(float(-here.min()), 0.0)})
+                             "max_under_error": max(float(-here.min()), 0.0),
+                             "min_error": float(here.min()), "max_error": float(here.max())})
     largest = max(over, under)
     return {"points": len(signed), "max_rel_error": largest, "max_over_error": over, "max_under_error": under,
             "rms_rel_error": float(np.sqrt(np.mean(signed ** 2))), "target": FIT_TARGET,
@@ -502,8 +504,8 @@ def quality_lines(quality: dict[str, Any]) -> list[str]:
              f"[{', '.join(f'{v:.3f}' for v in worst['axis'])}]); {evaluation}",
              f"fit: held-out points: {held['axes']} axes not in the table, {angles}"]
     lines.append("fit: held-out error by angle: " + "; ".join(
-        f"{item['angle_deg']:g} deg ({item['kind']}) {_signed(-item['max_under_error'])} to "
-        f"{_signed(item['max_over_error'])} %" for item in quality["by_angle"]))
+        f"{item['angle_deg']:g} deg ({item['kind']}) {_signed(item['min_error'])} to "
+        f"{_signed(item['max_error'])} %" for item in quality["by_angle"]))
     return lines + impossible
 
 
