@@ -28,6 +28,7 @@ L1 ``Σ|τ_i|`` (with slacks), plus ``time_weight · T``.
 """
 from __future__ import annotations
 
+import copy
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from typing import Any
@@ -55,16 +56,82 @@ class Transcription(ABC):
     Parameters
     ----------
     intervals : int
-        Number of mesh intervals (equal lengths T / intervals).
+        Number of mesh intervals (equal lengths T / intervals unless ``mesh`` says otherwise).
+    mesh : (intervals + 1,) array_like or None
+        The mesh nodes as fractions of T, increasing from 0 to 1 (a non-uniform mesh: nodes at a
+        bang-bang control's switching times, say); ``None`` (default): uniform.
     """
 
     name: str
+    non_uniform: bool = False
+    """Whether it takes a non-uniform ``mesh`` (:meth:`with_mesh`)."""
     fatrop_seed: bool = False
     """Whether FATROP, not IPOPT, solves its coarse seed of a fixed final time (measured:
     :data:`planners.collocation.strategy.SEED_FATROP`)."""
 
-    def __init__(self, intervals: int) -> None:
+    def __init__(self, intervals: int, mesh: Array | None = None) -> None:
         self.intervals = intervals
+        self.mesh: Array | None = None
+        if mesh is not None:
+            nodes = np.asarray(mesh, dtype=float)
+            if nodes.shape != (intervals + 1,) or nodes[0] != 0.0 or nodes[-1] != 1.0 or np.any(np.diff(nodes) <= 0.0):
+                raise ValueError(f"mesh: expected {intervals + 1} increasing fractions of T from 0 to 1, got {nodes}")
+            nodes.setflags(write=False)
+            self.mesh = nodes
+
+    def with_mesh(self, mesh: Array) -> Transcription:
+        """A copy of this transcription on the mesh ``mesh`` (its number of intervals).
+
+        Parameters
+        ----------
+        mesh : (intervals + 1,) ndarray
+            The nodes as fractions of T, increasing from 0 to 1.
+
+        Returns
+        -------
+        Transcription
+
+        Raises
+        ------
+        ValueError
+            The transcription takes no non-uniform mesh (:attr:`non_uniform`), or ``mesh`` is not one.
+        """
+        if not self.non_uniform:
+            raise ValueError(f"{self.name} takes no non-uniform mesh")
+        copied = copy.copy(self)
+        Transcription.__init__(copied, len(mesh) - 1, mesh)
+        return copied
+
+    @property
+    def nodes(self) -> Array:
+        """The mesh nodes as fractions of T.
+
+        Returns
+        -------
+        (intervals + 1,) ndarray
+            From 0 to 1: :attr:`mesh`, or uniform.
+        """
+        return np.arange(self.intervals + 1) / self.intervals if self.mesh is None else self.mesh
+
+    def fractions(self, k: NDArray[np.int_] | Array, tau: Array) -> Array:
+        """Times as fractions of T of positions ``tau`` in intervals ``k``.
+
+        Parameters
+        ----------
+        k : ndarray of int
+            Interval indices (broadcast with ``tau``).
+        tau : ndarray
+            Positions in the interval, fractions of its length in [0, 1].
+
+        Returns
+        -------
+        ndarray
+            ``t / T``: ``(k + τ) / N`` on a uniform mesh.
+        """
+        if self.mesh is None:
+            return (k + tau) / self.intervals
+        nodes = self.mesh
+        return nodes[k] + tau * (nodes[np.asarray(k) + 1] - nodes[k])
 
     @classmethod
     @abstractmethod
@@ -212,7 +279,7 @@ class Transcription(ABC):
         """
 
     def interval_index(self, duration: float, t: Array, left: bool = False) -> NDArray[np.int_]:
-        """The mesh interval that holds each time (a uniform mesh of :attr:`intervals`).
+        """The mesh interval that holds each time (:attr:`nodes`).
 
         Parameters
         ----------
@@ -230,6 +297,13 @@ class Transcription(ABC):
         (n,) ndarray of int
             Interval indices in ``0 … N − 1``.
         """
+        if self.mesh is not None:  # within 1e-9 of the shortest interval of a node counts as the node
+            s = np.asarray(t, dtype=float) / duration
+            tol = 1e-9 * float(np.min(np.diff(self.mesh)))
+            nodes = self.mesh
+            k = (np.searchsorted(nodes, s - tol, side="left") - 1 if left
+                 else np.searchsorted(nodes, s + tol, side="right") - 1)
+            return np.clip(k, 0, self.intervals - 1)
         s = np.asarray(t, dtype=float) * self.intervals / duration
         k = np.ceil(s - 1e-9).astype(int) - 1 if left else np.floor(s + 1e-9).astype(int)
         return np.clip(k, 0, self.intervals - 1)

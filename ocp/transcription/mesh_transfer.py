@@ -14,7 +14,9 @@ As the mesh is refined the multipliers converge to functions of time, up to a kn
   the quadrature weight times ``h``, so they scale with ``h``.
 
 :func:`transfer_multipliers` resamples entry by entry, linearly in time (constant beyond the ends),
-and rescales by the ratio of the steps. The result is the warm start of a solve on the fine mesh
+and rescales by the ratio of the steps. Either mesh may be non-uniform (its nodes given as
+fractions of T, :attr:`~ocp.transcription.base.Transcription.nodes`): the entries are then placed
+and rescaled by each interval's own step. The result is the warm start of a solve on the fine mesh
 from a coarse-mesh optimum (IPOPT ``warm_start_init_point``): the barrier can then start small.
 """
 from __future__ import annotations
@@ -42,7 +44,30 @@ def _resample(values: Array, positions: Array, source: int, target: int, rows: i
             + frac * np.take_along_axis(values, high, axis=0))
 
 
-def transfer_multipliers(source: Any, target: Any, lam_x: Array, lam_g: Array) -> tuple[Array, Array] | None:
+def _resample_nodes(values: Array, positions: Array, source: Array, target: Array,
+                    rows: int) -> tuple[Array, Array]:
+    """:func:`_resample` between meshes of nodes ``source`` and ``target`` (fractions of T): the
+    values read linearly in time (constant beyond the ends), and per target row the ratio of its
+    interval's step to the source step at its middle. ``values`` has one row per source interval
+    (entry ``e`` at ``t_k + r_e h_k``) or, for the stage states (``rows`` one more than the target's
+    intervals), one per source node."""
+    n_source, n_target = source.size - 1, target.size - 1
+    k_t = np.minimum(np.arange(rows), n_target - 1)
+    k_s = np.arange(values.shape[0])
+    step_t, step_s = np.diff(target), np.diff(source)
+    out = np.empty((rows, values.shape[1]))
+    for e, r in enumerate(positions):
+        if values.shape[0] == n_source + 1:  # at the nodes
+            times_s, times_t = source, target[:rows]
+        else:
+            times_s, times_t = source[k_s] + r * step_s[k_s], target[k_t] + r * step_t[k_t]
+        out[:, e] = np.interp(times_t, times_s, values[:, e])
+    holder = np.clip(np.searchsorted(source, target[k_t] + 0.5 * step_t[k_t], side="right") - 1, 0, n_source - 1)
+    return out, (step_t[k_t] / step_s[holder])[:, None]
+
+
+def transfer_multipliers(source: Any, target: Any, lam_x: Array, lam_g: Array, source_nodes: Array | None = None,
+                         target_nodes: Array | None = None) -> tuple[Array, Array] | None:
     """Bound and constraint multipliers of ``source``'s solution resampled onto ``target``'s mesh.
 
     Parameters
@@ -54,6 +79,9 @@ def transfer_multipliers(source: Any, target: Any, lam_x: Array, lam_g: Array) -
         Bound multipliers at the source's solution.
     lam_g : (len(source.lbg),) ndarray
         Constraint multipliers at the source's solution.
+    source_nodes, target_nodes : (N + 1,) ndarray or None
+        The meshes' nodes as fractions of T when either is non-uniform
+        (:attr:`~ocp.transcription.base.Transcription.nodes`); ``None`` (default): both uniform.
 
     Returns
     -------
@@ -74,19 +102,34 @@ def transfer_multipliers(source: Any, target: Any, lam_x: Array, lam_g: Array) -
     n_initial = len(source.lbg) - n_source * nb - n_terminal
     if lam_x.size != source.n_w or lam_g.size != len(source.lbg) or n_initial < 0:
         return None
-    ratio = n_source / n_target  # h_target / h_source: bounds and inequalities scale with h
+    if source_nodes is None and target_nodes is None:
+        ratio = n_source / n_target  # h_target / h_source: bounds and inequalities scale with h
+
+        def resample(values: Array, positions: Array, rows: int) -> tuple[Array, Array | float]:
+            return _resample(values, positions, n_source, n_target, rows), ratio
+    else:
+        nodes_s = np.arange(n_source + 1) / n_source if source_nodes is None else np.asarray(source_nodes, float)
+        nodes_t = np.arange(n_target + 1) / n_target if target_nodes is None else np.asarray(target_nodes, float)
+        if nodes_s.size != n_source + 1 or nodes_t.size != n_target + 1:
+            return None
+
+        def resample(values: Array, positions: Array, rows: int) -> tuple[Array, Array | float]:
+            return _resample_nodes(values, positions, nodes_s, nodes_t, rows)
     Z = lam_x[:nz * n_source].reshape(n_source, nz)
     S = np.vstack([Z[:, :ns], lam_x[None, nz * n_source:]])
-    S_new = _resample(S, np.zeros(ns), n_source, n_target, n_target + 1) * ratio
-    C_new = _resample(Z[:, ns:], np.asarray(target.layout["c_position"], float), n_source, n_target, n_target) * ratio
+    S_new, step = resample(S, np.zeros(ns), n_target + 1)
+    S_new = S_new * step
+    C_new, step = resample(Z[:, ns:], np.asarray(target.layout["c_position"], float), n_target)
+    C_new = C_new * step
     x_out = np.concatenate([np.hstack([S_new[:-1], C_new]).ravel(), S_new[-1]])
 
     rows = np.concatenate([lam_g[:nb], lam_g[nb + n_initial:nb + n_initial + (n_source - 1) * nb]]).reshape(n_source, nb)
     gap_scaled = np.asarray(target.layout["gap_step_scaled"], bool)
-    gap_new = _resample(rows[:, :ns], np.ones(ns), n_source, n_target, n_target) * np.where(gap_scaled, ratio, 1.0)[None, :]
+    gap_new, step = resample(rows[:, :ns], np.ones(ns), n_target)
+    gap_new = np.where(gap_scaled[None, :], gap_new * step, gap_new)
     equality = np.asarray(target.layout["path_equality"], bool)
-    path_new = _resample(rows[:, ns:], np.asarray(target.layout["path_position"], float), n_source, n_target,
-                         n_target) * np.where(equality, 1.0, ratio)[None, :]
+    path_new, step = resample(rows[:, ns:], np.asarray(target.layout["path_position"], float), n_target)
+    path_new = np.where(equality[None, :], path_new, path_new * step)
     blocks = np.hstack([gap_new, path_new])
     g_out = np.concatenate([blocks[0], lam_g[nb:nb + n_initial], blocks[1:].ravel(), lam_g[len(lam_g) - n_terminal:]])
     return x_out, g_out

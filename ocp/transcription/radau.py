@@ -93,13 +93,17 @@ class RadauCollocation(Transcription):
         Number of mesh intervals.
     degree : int
         Radau points per interval (state polynomials of this degree).
+    mesh : (intervals + 1,) array_like or None
+        The mesh nodes as fractions of T (:class:`~ocp.transcription.base.Transcription`);
+        ``None`` (default): uniform.
     """
 
     name = "collocation"
+    non_uniform = True
     fatrop_seed = True  # see planners.collocation.strategy.SEED_FATROP
 
-    def __init__(self, intervals: int, degree: int = 3) -> None:
-        super().__init__(intervals)
+    def __init__(self, intervals: int, degree: int = 3, mesh: Array | None = None) -> None:
+        super().__init__(intervals, mesh)
         self.degree = degree
         tau = np.append(0.0, ca.collocation_points(degree, "radau"))
         self.tau = tau
@@ -181,9 +185,13 @@ class RadauCollocation(Transcription):
     def stage_guess(self, problem: OptimalControlProblem, sample: Callable[[Array], tuple[Array, Array, Array]],
                     duration: float) -> tuple[Array, Array]:
         N = self.intervals
-        h = duration / N
-        nodes = np.arange(N + 1, dtype=float) * h
-        times = ((np.arange(N)[:, None] + self.tau[None, 1:]) * h).ravel()
+        if self.mesh is None:
+            h = duration / N
+            nodes = np.arange(N + 1, dtype=float) * h
+            times = ((np.arange(N)[:, None] + self.tau[None, 1:]) * h).ravel()
+        else:
+            nodes = self.mesh * duration
+            times = (self.fractions(np.arange(N)[:, None], self.tau[None, 1:]) * duration).ravel()
         # one call for the nodes and the points (a sample's rows depend on their own times only)
         x_all, u_all, torque_all = sample(np.concatenate([nodes, times]))
         x_nodes, x, u, torque = x_all[:N + 1], x_all[N + 1:], u_all[N + 1:], torque_all[N + 1:]
@@ -201,8 +209,11 @@ class RadauCollocation(Transcription):
     def smoothness(self, duration: float) -> tuple[Array, Array]:
         # The state polynomials join continuously at the mesh nodes, their slopes and the controls
         # do not; the dynamics hold at the Radau points inside each interval.
-        nodes = np.arange(1, self.intervals) * duration / self.intervals
         radau = self.tau[1:-1] if self.tau[-1] == 1.0 else self.tau[1:]
+        if self.mesh is not None:
+            inner = (self.fractions(np.arange(self.intervals)[:, None], radau[None, :]) * duration).ravel()
+            return self.mesh[1:-1] * duration, inner
+        nodes = np.arange(1, self.intervals) * duration / self.intervals
         inner = ((np.arange(self.intervals)[:, None] + radau[None, :]) * duration / self.intervals).ravel()
         return nodes, inner
 
@@ -213,7 +224,10 @@ class RadauCollocation(Transcription):
         # extrapolation, while the left limit at a node is the decision variable of the ending
         # interval's point τ_d = 1 (``interval_index``'s ``left``).
         k = self.interval_index(duration, t, left)
-        tau = np.asarray(t, dtype=float) * N / duration - k
+        if self.mesh is None:
+            tau = np.asarray(t, dtype=float) * N / duration - k
+        else:
+            tau = (np.asarray(t, dtype=float) / duration - self.mesh[k]) / (self.mesh[k + 1] - self.mesh[k])
         X = states.reshape(model.nx, N, d + 1)
         U = controls[:model.nu * d, :].reshape(d, model.nu, N).transpose(1, 2, 0)
         x = np.einsum("tik,tk->ti", X[:, k, :].transpose(1, 0, 2), lagrange(self.tau, tau))

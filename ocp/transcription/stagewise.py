@@ -95,10 +95,12 @@ def assemble(transcription: Any, problem: OptimalControlProblem, interval: Inter
     n_par = nx + 4 + 3 + 1 + 3
 
     # one interval on its own variables v = [s_k, c_k, s_{k+1}], k its index
-    v, k, ps = ca.SX.sym("v", nv), ca.SX.sym("k"), ca.SX.sym("p", n_par)
+    mesh = transcription.mesh  # None: uniform (t_k = k T / N); else each interval's start and length, as fractions of T
+    v, k, ps = ca.SX.sym("v", nv), ca.SX.sym("k", 1 if mesh is None else 2), ca.SX.sym("p", n_par)
     s, s_next = v[:ns], v[nz:]
     T_s = s[ns0] if free else ps[nx + 7]
-    following, path, cost = interval.function(s[:ns0], v[ns:nz], k * T_s / N, T_s / N, ps[nx + 8:nx + 11])
+    t0, h = (k * T_s / N, T_s / N) if mesh is None else (k[0] * T_s, k[1] * T_s)
+    following, path, cost = interval.function(s[:ns0], v[ns:nz], t0, h, ps[nx + 8:nx + 11])
     gap = s_next[:ns0] - following
     if free:
         gap = ca.vertcat(gap, s_next[ns0] - s[ns0])  # explicit continuity of T
@@ -128,7 +130,7 @@ def assemble(transcription: Any, problem: OptimalControlProblem, interval: Inter
     s_last = w[nz * N:]
     S = ca.horzcat(Z[:ns, :], s_last)
     V = ca.vertcat(Z, S[:, 1:])
-    K = ca.DM(np.arange(N)).T
+    K = ca.DM(np.arange(N)).T if mesh is None else ca.DM(np.vstack([mesh[:-1], np.diff(mesh)]))
     blocks, costs = block_fn.map(N)(V, K, p)
     initial = transcription.state_of(Z[:ns0, 0]) - p[:nx]
     terminal = ca.vertcat(*transcription.terminal(problem, transcription.state_of(s_last[:ns0]),

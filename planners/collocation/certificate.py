@@ -17,6 +17,7 @@ from typing import Any
 
 import casadi as ca
 import numpy as np
+from numpy.typing import NDArray
 
 from ocp.dynamics.model import AttitudeModel
 from ocp.fast_call import matrices
@@ -72,6 +73,8 @@ def radau_points(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP
     p = -(lam / transcription.quadrature[None, :, None]).reshape(N * d, nx)
     T = stages[0, ns - 1] if nlp.free_time else None
     times = (np.arange(N)[:, None] + transcription.tau[None, 1:]).ravel() / N
+    if transcription.mesh is not None:  # a non-uniform mesh (the planner's switch_refinement)
+        times = transcription.fractions(np.arange(N)[:, None], transcription.tau[None, 1:]).ravel()
     return x, u, p, times if T is None else times * T
 
 
@@ -104,19 +107,38 @@ def switching(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w
     ocp.nlp.certificate.Switching
         Agreement of ``sign(u) = −sign(σ)`` over every control at every Radau point.
     """
-    x, u, p, t = radau_points(transcription, model, nlp, w, lam_g)
-    if not nlp.free_time:
-        t = t * float(params[model.nx + 7])
+    _, u, sigma = switching_functions(transcription, model, nlp, w, lam_g, params, costate_sign)
     N, d, nx, nu = transcription.intervals, transcription.degree, model.nx, model.nu
     nz = nlp.n_stage_state + nlp.n_interval
     offset = nlp.n_stage_state + nx * d
     low = np.asarray(lbx, dtype=float)[:nz * N].reshape(N, nz)[:, offset:offset + nu * d].reshape(N * d, nu)
     high = np.asarray(ubx, dtype=float)[:nz * N].reshape(N, nz)[:, offset:offset + nu * d].reshape(N * d, nu)
+    return switching_agreement(u, low, high, sigma)
+
+
+def switching_functions(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array, lam_g: Array,
+                        params: Array, costate_sign: float = 1.0) -> tuple[Array, Array, Array]:
+    """The switching functions ``σ = ∂H/∂u`` at the Radau points of a collocation solution.
+
+    Parameters
+    ----------
+    transcription, model, nlp, w, lam_g, params, costate_sign
+        As in :func:`switching`.
+
+    Returns
+    -------
+    tuple of ndarray
+        The points' times ``t (N d,)`` [s] (in time order), the controls ``u (N d, nu)`` and
+        ``σ (N d, nu)`` there (see the module docstring).
+    """
+    x, u, p, t = radau_points(transcription, model, nlp, w, lam_g)
+    if not nlp.free_time:
+        t = t * float(params[model.nx + 7])
+    nx, nu = model.nx, model.nu
     mapped = _mapped(model, "switching f_u dense", x.shape[0], lambda: _control_jacobian(model))
     f_u = matrices(mapped, x.T, u.T, t[None, :], np.tile(params[-3:], (x.shape[0], 1)).T)[0]
     f_u = f_u.reshape(nx, x.shape[0], nu).transpose(1, 0, 2)  # (points, nx, nu)
-    sigma = costate_sign * np.einsum("ki,kij->kj", p, f_u)
-    return switching_agreement(u, low, high, sigma)
+    return t, u, costate_sign * np.einsum("ki,kij->kj", p, f_u)
 
 
 def collocation_certificate(result: NLPResult, transcription: Transcription, ocp: OptimalControlProblem, nlp: NLP,
@@ -256,3 +278,41 @@ def start_violations(problem: ManeuverProblem, reference: Reference, bounds: tup
         misses["final rate"] = float(np.max(np.abs(sample.omega[-1] - problem.omegaf)))
     broken.update({name: miss for name, miss in misses.items() if miss > boundary_tolerance})
     return broken
+
+
+def switch_intervals(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array, lbx: Array,
+                     ubx: Array, bound_tolerance: float = 1e-6) -> NDArray[np.bool_]:
+    """The mesh intervals of a collocation solution where a bang-bang control switches.
+
+    An interval holds a switch where one of its controls, at its Radau points, is between its
+    bounds at one point (by more than ``bound_tolerance`` times ``1 + |bound|``) or at different
+    bounds at two: its control polynomial is then no constant at a bound. A switch at a node (the
+    intervals on either side at their own bounds) is in neither.
+
+    Parameters
+    ----------
+    transcription, model, nlp, w
+        As in :func:`radau_points`.
+    lbx, ubx : (n_w,) ndarray
+        The decision vector's bounds (the controls' bounds are read there).
+    bound_tolerance : float
+        A control within this times ``(1 + |bound|)`` of a bound is at it.
+
+    Returns
+    -------
+    (N,) ndarray of bool
+        Per interval, whether it holds a switch.
+    """
+    N, d, nx, nu = transcription.intervals, transcription.degree, model.nx, model.nu
+    nz = nlp.n_stage_state + nlp.n_interval
+    offset = nlp.n_stage_state + nx * d
+
+    def controls(vector: Array) -> Array:
+        return np.asarray(vector, dtype=float)[:nz * N].reshape(N, nz)[:, offset:offset + nu * d].reshape(N, d, nu)
+
+    u, low, high = controls(w), controls(lbx), controls(ubx)
+    at_low = u - low <= bound_tolerance * (1.0 + np.abs(low))
+    at_high = high - u <= bound_tolerance * (1.0 + np.abs(high))
+    between = ~at_low & ~at_high
+    mixed = np.any(at_low, axis=1) & np.any(at_high, axis=1)
+    return np.any(np.any(between, axis=1) | mixed, axis=1)

@@ -338,7 +338,10 @@ class CollocationReference(Reference):
         for block in self.scaled_blocks:
             shifted[block] = False
         tau = (np.arange(IMPULSE_POINTS) + 0.5) / IMPULSE_POINTS
-        t = ((np.arange(N)[:, None] + tau[None, :]) * (self.duration / N)).ravel()
+        if self.transcription.mesh is None:
+            t = ((np.arange(N)[:, None] + tau[None, :]) * (self.duration / N)).ravel()
+        else:
+            t = (self.transcription.fractions(np.arange(N)[:, None], tau[None, :]) * self.duration).ravel()
         p = self._interpolated(t)[1].reshape(N, IMPULSE_POINTS, nu)
         slack = IMPULSE_SLACK * np.maximum(np.abs(np.where(np.isfinite(low), low, 0.0)),
                                            np.abs(np.where(np.isfinite(high), high, 0.0)))

@@ -13,8 +13,10 @@ free); 5 spin-like ones warm-started from ``spin_extremal`` (principal inertia, 
 0.1-0.3 rad/s, 150-250 s); 5 tight minimum-energy ones (T 1.15x a rest-to-rest bang-bang estimate
 about the largest moment: the torque bounds are active; some are infeasible).
 
-Run: ``python tests/benchmarks/iteration_counts.py [--coarse-min-time N] [--coarse-fixed N] [--only a,b]``;
-one JSON line per case (coarse and full-mesh iterations, the coarse solver, objective).
+Run: ``python tests/benchmarks/iteration_counts.py [--coarse-min-time N] [--coarse-fixed N]
+[--switch-refinement N] [--only a,b]``; one JSON line per case (coarse and full-mesh iterations, the
+coarse solver, objective; with ``--switch-refinement`` (the option, on the minimum-time cases) also
+the refined solve's iterations and intervals, counted in ``full``).
 """
 from __future__ import annotations
 
@@ -93,6 +95,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--coarse-min-time", type=int, default=None)
     parser.add_argument("--coarse-fixed", type=int, default=None)
+    parser.add_argument("--switch-refinement", type=int, default=None)
     parser.add_argument("--only", default="")
     args = parser.parse_args()
     only = set(filter(None, args.only.split(",")))
@@ -105,12 +108,16 @@ def main() -> None:
         coarse = args.coarse_min_time if kind == "min_time" else args.coarse_fixed
         if coarse is not None:
             options["coarse_intervals"] = coarse
+        if args.switch_refinement is not None and kind == "min_time":
+            options["switch_refinement"] = args.switch_refinement
         reference = PLANNERS["collocation"](options).plan(problem)
         stats = reference.stats
         print(json.dumps({"name": name, "ok": reference.ok, "coarse": stats.get("coarse", {}).get("iterations", 0),
                           "coarse_solver": stats.get("coarse", {}).get("solver"),
                           "coarse_fatrop": stats.get("coarse_fatrop", {}).get("iterations", 0),
-                          "full": stats.get("iterations"), "objective": stats.get("objective")}), flush=True)
+                          "full": stats.get("iterations"), "objective": stats.get("objective"),
+                          **({"refined": stats["switch_refinement"]} if "switch_refinement" in stats else {})}),
+              flush=True)
 
 
 if __name__ == "__main__":
