@@ -223,6 +223,8 @@ def test_the_keep_out_table_records_the_impossible_entry_and_the_fit_gives_no_ti
     assert part.status[0][0] == "infeasible" and "no reference can meet it" in part.message[0][0]
     fit = table.fit
     assert fit is not None and fit.meta["from_identity_only"] is True
+    # what the times hold for is in the fit: slews from the identity at the epoch, under these requirements
+    assert fit.meta["requirements"] == KEEP_OUT["requirements"] and fit.meta["epoch"] is None
     assert "1 entry not ok (1 infeasible)" in table.fit_note
     assert _both(fit, [0, 0, 1], 90.0) == (math.inf, math.inf)
     for angle in (95.0, 100.0, 105.0):  # the camera ends 5-15 deg from +y, inside the cone: no slew

@@ -573,6 +573,9 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
         return table
     meta = {"scenario": spec.name, "objective": spec.objective,
             "from_identity_only": _inertially_dependent(spec.base)}
+    if meta["from_identity_only"]:  # what the times hold for: slews from the identity at the epoch
+        written = {key: spec.base.get(key) for key in ("epoch", "requirements", "environment")}
+        meta.update(json.loads(json.dumps(written, default=str)))  # YAML's dates as text
     meta["grid"] = spec.grid
     if table.refinement:
         meta["refinement"] = table.refinement

@@ -118,6 +118,11 @@ def write_netcdf(table: SlewTable, path: Path) -> None:
         nc.status_codes = " ".join(f"{i}={s}" for i, s in enumerate(STATUS_CODES))
         if spec.duration is not None:
             nc.duration_s = float(spec.duration)
+        # what makes the times depend on the start attitude and the date (the slews start at the
+        # identity at the epoch): the pointing requirements and the environment, as written
+        nc.epoch = str(spec.base.get("epoch") or "")
+        nc.requirements = json.dumps(spec.base.get("requirements"), sort_keys=True, default=str)
+        nc.environment = json.dumps(spec.base.get("environment"), sort_keys=True, default=str)
         for name, prefix in (("table", ""), ("held_out", "held_out_"), ("check", "check_")):
             part = table.parts.get(name)
             if part is None or (name != "table" and not len(part.axes)):
