@@ -145,6 +145,9 @@ def _simulate(scenario: Scenario, simulator: Simulator, reference: Reference | N
         row.status, row.message = "failed", f"simulation: {error}"
         return
     except Exception as error:
+        interruption = _interruption(error)
+        if interruption is not None:
+            raise interruption from None
         where = law_raised(error)
         if where is None:  # the simulator's own code: an internal error
             raise
@@ -452,11 +455,30 @@ class _NotKept(Exception):
         self.reference = reference
 
 
+def _interruption(error: BaseException) -> BaseException | None:
+    """The interruption (an exception that is not an ``Exception``: a study's
+    :class:`~scenarios.errors.CaseTimeout`, Ctrl-C) that ``error`` carries as its cause or context,
+    if any: a signal handler's exception raised inside a C call (CasADi's) comes back wrapped, as a
+    ``SystemError`` whose cause it is."""
+    seen: set[int] = set()
+    link: BaseException | None = error
+    while link is not None and id(link) not in seen:
+        if not isinstance(link, Exception):
+            return link
+        seen.add(id(link))
+        link = link.__cause__ or link.__context__
+    return None
+
+
 def _plan(planner: Any, name: str, problem: Any) -> Reference:
-    """``planner.plan(problem)``; a planner that raises gives a failed reference naming it."""
+    """``planner.plan(problem)``; a planner that raises gives a failed reference naming it; an
+    interruption wrapped by a C call is raised as itself (:func:`_interruption`)."""
     try:
         return planner.plan(problem)
     except Exception as error:  # noqa: BLE001 (a planner bug must not lose the other rows)
+        interruption = _interruption(error)
+        if interruption is not None:
+            raise interruption from None
         traceback.print_exc()
         return FailedReference(name, f"planner raised {type(error).__name__}: {error}")
 
@@ -547,6 +569,9 @@ def _sampled(reference: Reference, times: np.ndarray) -> ReferenceSample | str:
     try:
         sample = reference.sample(times)
     except Exception as error:  # noqa: BLE001 (a planner bug must not lose the other rows)
+        interruption = _interruption(error)
+        if interruption is not None:
+            raise interruption from None
         # the coast after T starts from the state at T, and raises on a NaN there: find the first within [0, T]
         within = times[times <= reference.duration]
         try:

@@ -75,6 +75,27 @@ def test_a_planner_out_of_time_is_a_timed_out_case_not_a_failed_row(monkeypatch)
     assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0) and signal.getsignal(signal.SIGALRM) == handler
 
 
+def test_an_alarm_a_c_call_wraps_still_ends_the_case_without_a_traceback(monkeypatch, capsys):
+    """CasADi's buffered call returns the alarm's exception wrapped: ``SystemError: <built-in
+    function _function_buffer_eval> returned a result with an exception set``, its cause the
+    ``CaseTimeout``. The runner's planner handler caught that ``SystemError``, printed its traceback
+    (a user saw eight) and went on to the next row until the measured time ended the case."""
+    def wrapped_plan(self, problem):
+        try:
+            time.sleep(5.0)
+        except CaseTimeout as stop:  # what CasADi hands back for the alarm raised inside its call
+            raise SystemError("<built-in function _function_buffer_eval> returned a result with an "
+                              "exception set") from stop
+        raise AssertionError("the case went on past its time limit")
+
+    monkeypatch.setattr(EigenaxisPlanner, "plan", wrapped_plan)
+    result = run_case(payload(0.3))
+    assert result["status"] == "crashed", result
+    assert [row["message"] for row in result["rows"]] == [TIMED_OUT.format(0.3)] * 2
+    assert 0.3 <= result["elapsed_s"] < 2.0, result["elapsed_s"]  # the first row's alarm ended the case
+    assert "Traceback" not in capsys.readouterr().err
+
+
 def test_a_case_that_swallows_the_alarm_and_finishes_late_is_timed_out(monkeypatch):
     """C code can swallow the alarm's exception (CasADi turns an exception in its callbacks into its
     own error): a case that then finishes past its limit is still out of time."""
