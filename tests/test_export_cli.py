@@ -169,3 +169,25 @@ controller: {name: eigenaxis_pd, options: {kp: 0.2, kd: 0.6}}""")
     segment, = read_aem((export / "eigenaxis_pd.closed_loop.aem").read_text()).segments
     q = csv_columns(out / "timeseries" / "eigenaxis_pd.csv", ["q0", "q1", "q2", "q3"])
     assert np.max(np.abs(segment.quaternions() - q)) < 1e-12
+
+
+def test_an_exported_row_the_run_did_not_score_ok_is_named_with_its_reason(tmp_path, capsys):
+    """A user handed an AEM of a row that broke its keep-out to ops with no word on the console
+    (only a COMMENT line in the file said its status)."""
+    strict = SCENARIO + "requirements: {final: {error_deg: 1.0e-9}}\n"  # no closed loop settles to 1e-9 deg
+    out = tmp_path / "run"
+    assert main(["run", str(scenario_file(tmp_path, strict)), "--out", str(out), "--no-plots"]) == 0
+    capsys.readouterr()
+    statuses = {row["label"]: row["status"] for row in json.loads((out / "results.json").read_text())["rows"]}
+    assert statuses == {"smooth": "violated", "fast": "violated"}
+    assert main(["export", str(out), "--format", "aem", "--out", str(tmp_path / "aem")]) == 0
+    said = capsys.readouterr().out
+    for label in statuses:
+        assert f"row {label!r}: exported, but the run scored it violated: " in said and "final" in said, said
+
+
+def test_rows_scored_ok_get_no_such_note(run_directory, tmp_path, capsys):
+    statuses = {row["status"] for row in json.loads((run_directory / "results.json").read_text())["rows"]}
+    assert statuses == {"ok"}
+    assert main(["export", str(run_directory), "--format", "aem", "--out", str(tmp_path / "aem")]) == 0
+    assert "scored it" not in capsys.readouterr().out

@@ -62,6 +62,8 @@ class RunRow:
     rate_jump_times : tuple of float, optional
         When its reference's body rate jumps, as its scores record it (the largest jump's
         ``requirements.reference.actuators.rate_jump_time_s``); empty: none recorded.
+    message : str, optional
+        The row's message in ``results.json`` (why it is not ``ok``, where it is not).
     """
 
     label: str
@@ -71,6 +73,7 @@ class RunRow:
     stem: str
     timeseries: Path | None
     rate_jump_times: tuple[float, ...] = ()
+    message: str = ""
 
     def series(self) -> dict[str, Array]:
         """The row's time series as arrays (blank cells NaN).
@@ -169,7 +172,7 @@ def read_run(directory: str | Path) -> RunRecord:
         name = f"timeseries/{stem}.csv"
         series = path / name if name in manifest["files"] and (path / name).is_file() else None
         rows.append(RunRow(row["label"], row.get("planner"), row.get("controller"), row.get("status", ""), stem,
-                           series, _rate_jump_times(row)))
+                           series, _rate_jump_times(row), str(row.get("message") or "")))
     return RunRecord(path.absolute(), str(data.get("scenario", "")), str(data.get("frame", "")), data.get("epoch"),
                      rows, data.get("provenance") or {})
 
@@ -258,7 +261,8 @@ class ExportReport:
     files : list of str
         The files written there.
     notes : list of str
-        Rows or histories left out, and why.
+        Rows or histories left out, and why; rows exported although the run did not score them
+        ``ok`` (a hand-off of an attitude that breaks a requirement), and why.
     """
 
     directory: Path
@@ -324,6 +328,10 @@ def export_run(run_directory: str | Path, format_name: str, out: str | Path | No
     try:
         notes = export.write(run, staging, options)
         files = commit_outputs(target, staging, kind="export")
+        for row in run.rows:
+            if row.timeseries is not None and row.status != "ok" and any(f.startswith(row.stem + ".") for f in files):
+                why = f": {row.message[:300]}" if row.message else ""
+                notes.append(f"row {row.label!r}: exported, but the run scored it {row.status}{why}")
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return ExportReport(target, files, notes)
