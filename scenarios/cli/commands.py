@@ -2,7 +2,7 @@
 
 Exit status (:mod:`scenarios.cli.status`): 0 when the run completed (a failed planner or a
 violated requirement is a row, not an error), 1 under ``run --strict`` when some row is not ``ok``
-(the results are written all the same), under ``validate --strict`` when a scenario (a study's case) cannot have an ok row or a table is too large, or under ``table --strict`` when some entry is not, 2 for a bad scenario file, a
+(the results are written all the same), under ``validate --strict`` when a scenario (a study's case) cannot have an ok row or has a plausibility warning, or a table is too large, or under ``table --strict`` when some entry is not, 2 for a bad scenario file, a
 plugin that fails to load or takes a registered name (:mod:`scenarios.schema.plugins`), or an output location
 slewbench must not or cannot write to, 1 for an internal error.
 """
@@ -55,6 +55,7 @@ from scenarios.schema.loader import (
     parse_scenario,
     refuse_unmarked_base,
 )
+from scenarios.schema.plausibility import plausibility_warnings
 from scenarios.schema.plugins import PluginError, load_plugins, loaded_plugins, provider
 from scenarios.schema.read import read_yaml
 
@@ -202,8 +203,9 @@ def command_validate(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         ``file``: the scenario, study or slew-table YAML path; ``strict`` (optional): exit 1 when
-        there is a finding: a scenario (a study's case) that cannot have an ok row, or a table
-        that ``table`` refuses without ``--max-entries``.
+        there is a finding: a scenario (a study's case) that cannot have an ok row or has a
+        plausibility warning (:mod:`scenarios.schema.plausibility`), or a table that ``table``
+        refuses without ``--max-entries``.
 
     Returns
     -------
@@ -232,8 +234,12 @@ def command_validate(args: argparse.Namespace) -> int:
           f"({', '.join(label.label for label in labels)})")
     for line in _scenario_details(scenario):
         print("  " + line)
-    findings = _strict_findings(scenario)
-    return _strict_status(args, findings, f"no row can be ok ({len(findings)} note(s) above say every row must fail)")
+    doomed, warned = _doomed_notes(scenario), plausibility_warnings(scenario)
+    for warning in warned:
+        print(f"  warning: {warning}")
+    said = ([f"no row can be ok ({len(doomed)} note(s) above say every row must fail)"] if doomed else []) + \
+        ([f"{len(warned)} plausibility warning(s) above"] if warned else [])
+    return _strict_status(args, [*doomed, *map(str, warned)], "; ".join(said))
 
 
 def _strict_status(args: argparse.Namespace, findings: list[str], said: str) -> int:
@@ -245,8 +251,9 @@ def _strict_status(args: argparse.Namespace, findings: list[str], said: str) -> 
 
 
 def _strict_findings(scenario: Scenario) -> list[str]:
-    """What fails ``validate --strict`` on a scenario: :func:`_doomed_notes`."""
-    return _doomed_notes(scenario)
+    """What fails ``validate --strict`` on a scenario: :func:`_doomed_notes` and the plausibility
+    warnings (:func:`scenarios.schema.plausibility.plausibility_warnings`, each ``warning: ...``)."""
+    return _doomed_notes(scenario) + [f"warning: {warning}" for warning in plausibility_warnings(scenario)]
 
 
 def _leaf_paths(value: Any, prefix: str) -> list[str]:
@@ -337,9 +344,13 @@ def command_run(args: argparse.Namespace) -> int:
     -------
     int
         Exit status: 0, the run completed (failed and violated rows are results, not errors); 1
-        with ``strict`` when some row is not ``ok`` (the results are written first).
+        with ``strict`` when some row is not ``ok`` (the results are written first). Plausibility
+        warnings (:func:`scenarios.schema.plausibility.plausibility_warnings`) go to standard error
+        before planning; they change no status.
     """
     scenario = load(args.file)
+    for warning in plausibility_warnings(scenario):  # not errors: the run goes on
+        print(f"slewbench: warning: {warning}", file=sys.stderr)
     out = Path(args.out) if args.out else default_output_directory(scenario.name)
     exports = getattr(args, "export", None) or []
     for name in exports:  # before planning: an export the run cannot give is refused first
@@ -480,7 +491,8 @@ def build_parser() -> argparse.ArgumentParser:
                f"interrupted sweep or table (run it again to finish). Under run --strict or table --strict, "
                f"{EXIT_NOT_OK} also for a completed run with a row (or table entry) not ok: its files are "
                f"written and stderr says so ('slewbench: --strict: N of M ... not ok'); under validate --strict, "
-               f"{EXIT_NOT_OK} for a scenario (a study's case) whose notes say every row must fail, or a table "
+               f"{EXIT_NOT_OK} for a scenario (a study's case) whose notes say every row must fail or that has a "
+               f"plausibility warning, or a table "
                f"too large for `table` without --max-entries. Plugins: the "
                f"'slewbench.plugins' entry points of installed distributions and the modules or .py files of "
                f"SLEWBENCH_PLUGINS (comma-separated) load at start; one that fails or takes a registered name: "
@@ -504,7 +516,8 @@ def build_parser() -> argparse.ArgumentParser:
     validate_parser.add_argument("file", help="scenario, study or slew-table YAML file (a study has the top-level key 'study', a table 'table')")
     validate_parser.add_argument("--strict", action="store_true",
                                  help=f"exit {EXIT_NOT_OK} when a scenario (a study's case) cannot have an ok row (a note "
-                                      "says every row must fail) or a table has more entries than `table` computes "
+                                      "says every row must fail) or has a plausibility warning (a likely unit "
+                                      "slip), or a table has more entries than `table` computes "
                                       "without --max-entries, after printing the check (for continuous integration)")
     validate_parser.set_defaults(handler=command_validate)
     codegen_parser = commands.add_parser("codegen", help="export the controller law, saturation and reference tables as flight C")
