@@ -154,7 +154,7 @@ def _validate_study(file: str) -> tuple[str, list[str]]:
     for case in study.cases:
         values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
         where = f"case {case.index}" + (f" [{values}]" if values else "")
-        findings += [f"{where}: {line}" for line in _strict_findings(parse_scenario(case.scenario))]
+        findings += [f"{where}: {line}" for line in _strict_findings(parse_scenario(case.scenario, inapplicable_rows=True))]
     return (f"{file}: valid study {study.name!r}: {len(study.cases)} cases ({points} grid point(s) x "
             f"{study.samples} sample(s)), varying {varied}; run it with `slewbench {OTHER_FILES['study']} {file}`",
             findings)
