@@ -3,10 +3,23 @@ closed-loop key leaves the target out: one closed loop serves every target (coun
 with the numbers of a loop built for that target alone; a law that needs a target keeps it in its key."""
 from __future__ import annotations
 
+import casadi as ca
 import numpy as np
+import pytest
 
 from controllers import CONTROLLERS
-from ocp import AttitudeModel, ReactionWheels, SensorNoise, Simulator, Spacecraft, quat
+from controllers.conformance import check_symbolic
+from controllers.errors import ConformanceError
+from controllers.none import NoControl
+from ocp import (
+    AttitudeModel,
+    Command,
+    ReactionWheels,
+    SensorNoise,
+    Simulator,
+    Spacecraft,
+    quat,
+)
 
 X0 = np.r_[quat.IDENTITY, 0.02, -0.01, 0.005, 0, 0, 0]
 NOISE = SensorNoise(1e-3, 1e-4, seed=3)
@@ -48,3 +61,30 @@ def test_the_key_holds_the_target_only_for_a_law_that_needs_one():
     assert not CONTROLLERS["none"].needs_target_attitude
     assert len(keys["none"]) == 1
     assert len(keys["augmented_quaternion_feedback"]) == len(TARGETS)
+
+
+class _BakesTheTarget(NoControl):
+    """A law that says it needs no target but bakes the target's second quaternion component into
+    its wheel torques: its build for one target is wrong for the next."""
+
+    name = "bakes_the_target"
+
+    def _torque(self) -> float:
+        q_f = None if self.target is None else self.target[0]
+        return 0.0 if q_f is None else 1e-3 * float(q_f[1])
+
+    def __call__(self, t, measurement, reference):
+        wheels = self._slices.get("wheels")
+        return Command() if wheels is None else Command(wheel_torque=np.full(wheels.stop - wheels.start, self._torque()))
+
+    def _law(self, t, y, z, r):
+        u = ca.SX.zeros(self._nu)
+        if "wheels" in self._slices:
+            u[self._slices["wheels"]] = self._torque()
+        return u, z
+
+
+def test_conformance_refuses_a_law_that_needs_no_target_but_bakes_one_in():
+    check_symbolic(CONTROLLERS["none"]())  # the none law bakes none in
+    with pytest.raises(ConformanceError, match="the symbolic law gives u"):
+        check_symbolic(_BakesTheTarget())
