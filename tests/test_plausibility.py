@@ -125,3 +125,14 @@ def test_run_prints_them_on_stderr_and_runs(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "slewbench: warning: maneuver.max_rate: 2 rad/s is 115 deg/s" in err, err
     assert (tmp_path / "out" / "results.json").exists()
+
+
+def test_validate_names_the_study_case_whose_value_looks_like_a_slip(tmp_path, capsys):
+    path = tmp_path / "study.yaml"
+    path.write_text(yaml.safe_dump({"study": "altitudes", "scenario": CUBESAT,
+                                    "grid": {"orbit.altitude_km": [500, 500000]}}, sort_keys=False))
+    assert main(["validate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "case 1 [orbit.altitude_km=500000]: warning: orbit.altitude_km: 500000 km" in out, out
+    assert "case 0" not in out
+    assert main(["validate", str(path), "--strict"]) == 1
