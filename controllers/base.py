@@ -41,7 +41,8 @@ class SymbolicLaw:
     function : ``law(t, y, z, r) -> (u, z_next)``, see :class:`Controller` ("Symbolic form").
     state0 : (n_z,) the controller state ``z`` right after ``reset`` (``state_vector()`` then).
     key : hex digest identifying every number the function bakes in (class, options, spacecraft,
-        sample time, target); equal keys mean identical functions (build caches use it).
+        sample time, and the target for a law that needs one); equal keys mean identical functions
+        (build caches use it).
     """
 
     function: ca.Function
@@ -79,7 +80,8 @@ class Controller(Allocation, Configurable, ABC):
       reference without declaring it.
     * ``needs_target_attitude``: in regulation mode the law needs ``maneuver.final.q``. Laws that
       regulate the rate alone (detumbling: ``bdot``, ``tdfc``; ``none``) set it to ``False`` and
-      then accept a free final attitude (``q: null``).
+      then accept a free final attitude (``q: null``); their symbolic form must then not bake the
+      target (``self.target``) in, as :meth:`symbolic_key` leaves it out.
     * ``needs_field_rate``: the law reads ``measurement.field_rate_inertial`` (ḃ_I, T/s), which
       the simulator then provides (only the ideal B-dot does; a real spacecraft cannot).
     * ``planner_error(name, options)`` says why the law cannot track references of that planner
@@ -299,18 +301,24 @@ class Controller(Allocation, Configurable, ABC):
     def symbolic_key(self) -> str:
         """Digest of everything :meth:`_law` bakes in.
 
+        The target is in it only for a law that declares it needs one (``needs_target_attitude``):
+        a law that does not (``none``, the detumbling laws) bakes no target into :meth:`_law` (in
+        regulation mode it gets the target's rows through ``r``, as every law does), so one closed
+        loop serves every target.
+
         Returns
         -------
         str
-            SHA-256 hex digest of the class, options, spacecraft, sample time and target.
+            SHA-256 hex digest of the class, options, spacecraft, sample time and (when the law
+            needs one) target.
         """
         from ocp.dynamics.model import _plain  # the model's fingerprint walker
 
         cache = self._spacecraft()._cache  # the spacecraft is frozen: its description is computed once
         if "description" not in cache:
             cache["description"] = repr(_plain(self.spacecraft))
-        target = None if self.target is None else tuple(None if v is None else _plain(np.asarray(v, dtype=float))
-                                                        for v in self.target)
+        target = None if self.target is None or not self.needs_target_attitude else tuple(
+            None if v is None else _plain(np.asarray(v, dtype=float)) for v in self.target)
         text = repr((type(self).__module__, type(self).__qualname__, _plain(self.options),
                      cache["description"], float(self.sample_time), target))
         return hashlib.sha256(text.encode()).hexdigest()

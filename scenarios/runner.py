@@ -9,7 +9,9 @@ that the initial or target attitude already breaks makes every planner's row ``f
 Then each row's reference and closed loop are scored against every requirement; a row that breaks
 one is ``violated`` (never ``ok``), its message naming the requirement, the scope, the margin and
 the time, and a planner that does not honour a kind of requirement present says so in its message.
-Statuses rank ``failed`` over ``violated`` over ``ok``.
+Statuses rank ``failed`` over ``violated`` over ``ok``. A planner that cannot take a study's case
+(:attr:`~scenarios.schema.loader.Scenario.inapplicable`) gets ``failed`` rows, unplanned, whose
+message is ``not applicable: ...`` with its reason.
 
 References reused (a trade study's worker, which passes ``references``): a row whose planning
 inputs are identical to an earlier case's (:func:`planning_key`: the planner's class, registry name
@@ -282,6 +284,9 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
             note = ""
         else:
             planner_spec = scenario.planners[i]
+            if i in scenario.inapplicable:  # a study's case this planner cannot take: its rows fail, unplanned
+                planned.setdefault(i, (FailedReference(planner_spec.name, f"not applicable: {planner_spec.name} cannot "
+                                                       f"take this case: {scenario.inapplicable[i]}"), None, None))
             if broken_ends:  # no planner can meet them: nothing is planned
                 planned.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends)), None, None))
             if i not in planned:  # planned once, tracked by every controller

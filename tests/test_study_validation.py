@@ -223,7 +223,7 @@ def test_cases_keys_and_recorded_values_match_an_expansion_written_from_the_rule
 def test_the_whole_loader_runs_once_per_combination_of_values_it_must_see(monkeypatch):
     calls = []
     original = spec.parse_scenario
-    monkeypatch.setattr(spec, "parse_scenario", lambda data: calls.append(1) or original(data))
+    monkeypatch.setattr(spec, "parse_scenario", lambda data, **given: calls.append(1) or original(data, **given))
     parse_study({"study": "v", "scenario": copy.deepcopy(BASE), "grid": {"simulation.sensor_noise.seed": list(range(500))}})
     assert len(calls) == 2  # the base, and the first case: every other case differs only by a seed
     calls.clear()

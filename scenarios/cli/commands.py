@@ -2,7 +2,7 @@
 
 Exit status (:mod:`scenarios.cli.status`): 0 when the run completed (a failed planner or a
 violated requirement is a row, not an error), 1 under ``run --strict`` when some row is not ``ok``
-(the results are written all the same), under ``validate --strict`` when a scenario cannot have an ok row, or under ``table --strict`` when some entry is not, 2 for a bad scenario file, a
+(the results are written all the same), under ``validate --strict`` when a scenario (a study's case) cannot have an ok row or has a plausibility warning, or a table is too large, or under ``table --strict`` when some entry is not, 2 for a bad scenario file, a
 plugin that fails to load or takes a registered name (:mod:`scenarios.schema.plugins`), or an output location
 slewbench must not or cannot write to, 1 for an internal error.
 """
@@ -55,6 +55,7 @@ from scenarios.schema.loader import (
     parse_scenario,
     refuse_unmarked_base,
 )
+from scenarios.schema.plausibility import plausibility_warnings
 from scenarios.schema.plugins import PluginError, load_plugins, loaded_plugins, provider
 from scenarios.schema.read import read_yaml
 
@@ -136,19 +137,33 @@ def command_schema(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _validate_study(file: str) -> str:
-    """A study file, every case expanded and checked (its parser imported here: ``run`` needs none)."""
+STRICT_LINES_SHOWN = 10
+"""Lines of a study's per-case findings ``validate`` prints (the others are counted)."""
+
+
+def _validate_study(file: str) -> tuple[str, list[str]]:
+    """A study file, every case expanded and checked as ``sweep`` checks it before running (its
+    parser imported here: ``run`` needs none); the findings are each case's :func:`_strict_findings`,
+    naming the case and its varied values."""
     from scenarios.study.spec import load_study
 
     study = load_study(file)
     points = len({case.point for case in study.cases})
     varied = ", ".join(study.varied_paths) or "nothing"
+    findings = []
+    for case in study.cases:
+        values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
+        where = f"case {case.index}" + (f" [{values}]" if values else "")
+        findings += [f"{where}: {line}" for line in _strict_findings(parse_scenario(case.scenario, inapplicable_rows=True))]
     return (f"{file}: valid study {study.name!r}: {len(study.cases)} cases ({points} grid point(s) x "
-            f"{study.samples} sample(s)), varying {varied}; run it with `slewbench {OTHER_FILES['study']} {file}`")
+            f"{study.samples} sample(s)), varying {varied}; run it with `slewbench {OTHER_FILES['study']} {file}`",
+            findings)
 
 
-def _validate_table(file: str) -> str:
-    """A slew-table file, checked as ``slewbench table`` would before computing."""
+def _validate_table(file: str) -> tuple[str, list[str]]:
+    """A slew-table file, checked as ``slewbench table`` checks it before computing: its spec, and its
+    number of entries against the default ``--max-entries`` (a finding: the limit is an option)."""
+    from scenarios.cli.table import _check_work
     from scenarios.slewtable.spec import parse_table_spec
 
     spec = parse_table_spec(file)
@@ -158,12 +173,19 @@ def _validate_table(file: str) -> str:
                 f"angle{'' if mids == 1 else 's'}" if spec.held_out else ", no held-out grid")
     refine = (f"; refined to a tolerance of {spec.refine.tolerance:g} (at most {spec.refine.max_axes} axes, "
               f"{spec.refine.max_rounds} rounds)" if spec.refine is not None else "; no refinement")
+    findings = []
+    try:  # the table command's own check, with its default limit
+        _check_work(spec, len(spec.axes) * len(spec.angles_deg) + spec.held_out * mids,
+                    argparse.Namespace(max_entries=None, angles=None))
+    except ScenarioError as error:
+        findings.append(f"`slewbench {OTHER_FILES['table']}` refuses it without an option: {error}")
     return (f"{file}: valid slew table {spec.name!r}: {axes} x {len(spec.angles_deg)} angles{held_out}, "
-            f"{spec.objective}{refine}; run it with `slewbench {OTHER_FILES['table']} {file}`")
+            f"{spec.objective}{refine}; run it with `slewbench {OTHER_FILES['table']} {file}`", findings)
 
 
 _OTHER_VALIDATORS = {"study": _validate_study, "table": _validate_table}
-"""How ``validate`` checks each kind of ``scenarios.schema.loader.OTHER_FILES`` (keyed the same)."""
+"""How ``validate`` checks each kind of ``scenarios.schema.loader.OTHER_FILES`` (keyed the same):
+a summary line and the findings that fail ``validate --strict``."""
 _COMMAND_FILES = {"sweep": "study file", "table": "table file"}
 """What a command's file is called in its errors (``error in <kind>:``) where it is not a scenario;
 ``validate`` sets ``file_kind`` on its arguments once it knows."""
@@ -173,27 +195,36 @@ def command_validate(args: argparse.Namespace) -> int:
     """``slewbench validate FILE``: load and check a scenario, a study or a slew-table file, print what would run.
 
     A file whose top level has the key ``study`` is a study (:func:`scenarios.study.spec.load_study`:
-    every case is expanded and checked), one with ``table`` a slew table
-    (:func:`scenarios.slewtable.spec.parse_table_spec`); any other is a scenario.
+    every case is expanded and checked, as ``sweep`` checks it), one with ``table`` a slew table
+    (:func:`scenarios.slewtable.spec.parse_table_spec` and the entry limit, as ``table`` checks it);
+    any other is a scenario.
 
     Parameters
     ----------
     args : argparse.Namespace
         ``file``: the scenario, study or slew-table YAML path; ``strict`` (optional): exit 1 when
-        the scenario cannot have an ok row.
+        there is a finding: a scenario (a study's case) that cannot have an ok row or has a
+        plausibility warning (:mod:`scenarios.schema.plausibility`), or a table that ``table``
+        refuses without ``--max-entries``.
 
     Returns
     -------
     int
-        Exit status: 0; 1 with ``strict`` when a scenario's notes say every row must fail
-        (:func:`_doomed_notes`); a bad file raises ``ScenarioError``, which :func:`main` reports with exit 2.
+        Exit status: 0; 1 with ``strict`` when there is a finding (:func:`_strict_findings`; a
+        study's per case, a table's entry limit), printed in any case; a bad file raises
+        ``ScenarioError``, which :func:`main` reports with exit 2.
     """
     data = read_yaml(args.file)
     for key in OTHER_FILES:  # a study or a slew table: its own check and summary
         if isinstance(data, dict) and key in data:
             args.file_kind = f"{key} file"  # how main() names its errors
-            print(_OTHER_VALIDATORS[key](args.file))
-            return EXIT_OK
+            summary, findings = _OTHER_VALIDATORS[key](args.file)
+            print(summary)
+            for line in findings[:STRICT_LINES_SHOWN]:
+                print("  " + line)
+            if len(findings) > STRICT_LINES_SHOWN:
+                print(f"  ... and {len(findings) - STRICT_LINES_SHOWN} more")
+            return _strict_status(args, findings, f"{len(findings)} finding(s) above")
     refuse_unmarked_base(data, args.file)
     scenario = parse_scenario(data, Path(args.file))
     labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in scenario.controllers])
@@ -203,12 +234,26 @@ def command_validate(args: argparse.Namespace) -> int:
           f"({', '.join(label.label for label in labels)})")
     for line in _scenario_details(scenario):
         print("  " + line)
-    doomed = _doomed_notes(scenario)
-    if getattr(args, "strict", False) and doomed:
-        print(f"slewbench: --strict: no row can be ok ({len(doomed)} note(s) above say every row must fail)",
-              file=sys.stderr)
+    doomed, warned = _doomed_notes(scenario), plausibility_warnings(scenario)
+    for warning in warned:
+        print(f"  warning: {warning}")
+    said = ([f"no row can be ok ({len(doomed)} note(s) above say every row must fail)"] if doomed else []) + \
+        ([f"{len(warned)} plausibility warning(s) above"] if warned else [])
+    return _strict_status(args, [*doomed, *map(str, warned)], "; ".join(said))
+
+
+def _strict_status(args: argparse.Namespace, findings: list[str], said: str) -> int:
+    """``validate``'s exit status: 1 under ``--strict`` when there are findings (``said`` on stderr), else 0."""
+    if getattr(args, "strict", False) and findings:
+        print(f"slewbench: --strict: {said}", file=sys.stderr)
         return EXIT_NOT_OK
     return EXIT_OK
+
+
+def _strict_findings(scenario: Scenario) -> list[str]:
+    """What fails ``validate --strict`` on a scenario: :func:`_doomed_notes` and the plausibility
+    warnings (:func:`scenarios.schema.plausibility.plausibility_warnings`, each ``warning: ...``)."""
+    return _doomed_notes(scenario) + [f"warning: {warning}" for warning in plausibility_warnings(scenario)]
 
 
 def _leaf_paths(value: Any, prefix: str) -> list[str]:
@@ -299,9 +344,13 @@ def command_run(args: argparse.Namespace) -> int:
     -------
     int
         Exit status: 0, the run completed (failed and violated rows are results, not errors); 1
-        with ``strict`` when some row is not ``ok`` (the results are written first).
+        with ``strict`` when some row is not ``ok`` (the results are written first). Plausibility
+        warnings (:func:`scenarios.schema.plausibility.plausibility_warnings`) go to standard error
+        before planning; they change no status.
     """
     scenario = load(args.file)
+    for warning in plausibility_warnings(scenario):  # not errors: the run goes on
+        print(f"slewbench: warning: {warning}", file=sys.stderr)
     out = Path(args.out) if args.out else default_output_directory(scenario.name)
     exports = getattr(args, "export", None) or []
     for name in exports:  # before planning: an export the run cannot give is refused first
@@ -442,7 +491,9 @@ def build_parser() -> argparse.ArgumentParser:
                f"interrupted sweep or table (run it again to finish). Under run --strict or table --strict, "
                f"{EXIT_NOT_OK} also for a completed run with a row (or table entry) not ok: its files are "
                f"written and stderr says so ('slewbench: --strict: N of M ... not ok'); under validate --strict, "
-               f"{EXIT_NOT_OK} for a scenario whose notes say every row must fail. Plugins: the "
+               f"{EXIT_NOT_OK} for a scenario (a study's case) whose notes say every row must fail or that has a "
+               f"plausibility warning, or a table "
+               f"too large for `table` without --max-entries. Plugins: the "
                f"'slewbench.plugins' entry points of installed distributions and the modules or .py files of "
                f"SLEWBENCH_PLUGINS (comma-separated) load at start; one that fails or takes a registered name: "
                f"exit {EXIT_BAD_SCENARIO}")
@@ -464,8 +515,10 @@ def build_parser() -> argparse.ArgumentParser:
     validate_parser = commands.add_parser("validate", help="check a scenario, study or slew-table file; print what would run")
     validate_parser.add_argument("file", help="scenario, study or slew-table YAML file (a study has the top-level key 'study', a table 'table')")
     validate_parser.add_argument("--strict", action="store_true",
-                                 help=f"exit {EXIT_NOT_OK} when a scenario cannot have an ok row (a note says every "
-                                      "row must fail), after printing the check (for continuous integration)")
+                                 help=f"exit {EXIT_NOT_OK} when a scenario (a study's case) cannot have an ok row (a note "
+                                      "says every row must fail) or has a plausibility warning (a likely unit "
+                                      "slip), or a table has more entries than `table` computes "
+                                      "without --max-entries, after printing the check (for continuous integration)")
     validate_parser.set_defaults(handler=command_validate)
     codegen_parser = commands.add_parser("codegen", help="export the controller law, saturation and reference tables as flight C")
     codegen_parser.add_argument("file", help="scenario YAML file")

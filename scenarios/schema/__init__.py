@@ -10,7 +10,8 @@ angle, Euler angles, pointing targets, orbit frames; :mod:`~scenarios.schema.tar
 :class:`~scenarios.schema.loader.Scenario` it builds (:mod:`~scenarios.schema.loader`), how planner
 and controller labels name the rows (:mod:`~scenarios.schema.labels`), the names of the metric
 columns (:mod:`~scenarios.schema.columns`), the checks of a parsed scenario as a whole
-(:mod:`~scenarios.schema.checks`), the study file's keys, value generators and distributions
+(:mod:`~scenarios.schema.checks`), the plausibility warnings on likely unit slips
+(:mod:`~scenarios.schema.plausibility`), the study file's keys, value generators and distributions
 (:mod:`~scenarios.schema.study`), the slew-table file's keys (:mod:`~scenarios.schema.table`), and the
 reference of them all (:mod:`~scenarios.schema.reference`: ``slewbench schema``).
 

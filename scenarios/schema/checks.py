@@ -158,7 +158,8 @@ def rate_bound_notes(problem: ManeuverProblem, simulation: SimulationSpec, max_r
 
 def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
                         controllers: list[ControllerSpec] | ControllerSpec,
-                        simulation: SimulationSpec | None = None) -> None:
+                        simulation: SimulationSpec | None = None,
+                        inapplicable: dict[int, str] | None = None) -> None:
     """What each planner and controller say they cannot take, reported at their YAML entries.
 
     Parameters
@@ -171,6 +172,9 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
         The controllers (one spec is accepted as a list of one), each with its validated law.
     simulation : SimulationSpec or None, optional
         Closed-loop settings; ``None`` skips the sample-time checks.
+    inapplicable : dict or None, optional
+        ``None`` (default): a planner's ``problem_error`` is raised. A dict (a study's case): it
+        receives planner row index -> that reason instead, and the other checks go on.
 
     Raises
     ------
@@ -185,7 +189,9 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
         controllers = [controllers]
     for index, spec in enumerate(planners):
         error = spec.planner.problem_error(problem)
-        if error:
+        if error and inapplicable is not None:
+            inapplicable[index] = error
+        elif error:
             raise ScenarioError(f"planners[{index}]", error)
     for controller in controllers:
         law = controller.controller

@@ -240,6 +240,10 @@ class Scenario:
     truth : TruthPlant or None, optional
         The simulated plant where it differs from the design model (``truth``; built on
         ``problem.model``); ``None`` (default): the design model is the plant.
+    inapplicable : dict, optional
+        Planner row index -> why that planner cannot take the problem (its ``problem_error``): the
+        row fails without planning, naming it (a study's case, parsed with
+        ``inapplicable_rows=True``); empty (default): every planner takes it.
     """
 
     name: str
@@ -253,6 +257,7 @@ class Scenario:
     euler_sequence: str = "321"
     data: dict[str, Any] | None = field(default=None, repr=False, compare=False)
     truth: TruthPlant | None = field(default=None, repr=False, compare=False)
+    inapplicable: dict[int, str] = field(default_factory=dict, compare=False)
 
     @property
     def frame(self) -> str:
@@ -578,7 +583,7 @@ def _parse_simulation(values: dict[str, Any], path: str, sensors: dict[str, Sens
     return spec
 
 
-def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
+def parse_scenario(data: Any, source: Path | None = None, *, inapplicable_rows: bool = False) -> Scenario:
     """Build a :class:`Scenario` from parsed YAML data, checking it as a whole.
 
     Parameters
@@ -587,6 +592,11 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
         The parsed YAML document (a mapping; see :func:`~scenarios.schema.read.read_yaml`).
     source : Path or None, optional
         The file it came from, kept in :attr:`Scenario.source`.
+    inapplicable_rows : bool, optional
+        False (default): a planner that cannot take the problem (``problem_error``) is an error at
+        ``planners[i]``, as ``slewbench run`` refuses it. True (a study's case): it is recorded in
+        :attr:`Scenario.inapplicable` and its rows fail, naming the reason, while the other
+        planners run.
 
     Returns
     -------
@@ -626,9 +636,11 @@ def parse_scenario(data: Any, source: Path | None = None) -> Scenario:
     check_work(problem, simulation)
     check_magnetometer(problem, simulation)
     check_row_labels(planners, controllers)
-    check_compatibility(problem, planners, controllers, simulation)
+    inapplicable: dict[int, str] | None = {} if inapplicable_rows else None
+    check_compatibility(problem, planners, controllers, simulation, inapplicable)
     return Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch,
-                    euler_sequence=plots["euler_sequence"], data=copy.deepcopy(data), truth=truth)
+                    euler_sequence=plots["euler_sequence"], data=copy.deepcopy(data), truth=truth,
+                    inapplicable=inapplicable or {})
 
 
 def _settling_band(simulation: SimulationSpec, requirements: Requirements, given: bool) -> SimulationSpec:

@@ -103,7 +103,7 @@ def rerun_case(results: SweepResults, index: int, progress: Any = None) -> RunRe
     cases = results.study.cases
     if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < len(cases):
         raise ScenarioError("--case", f"expected a case of the study, 0 to {len(cases) - 1}, got {index!r}")
-    return run(parse_scenario(cases[index].scenario), progress=progress)
+    return run(parse_scenario(cases[index].scenario, inapplicable_rows=True), progress=progress)
 
 
 def _same(stored: Any, now: Any) -> bool:

@@ -273,7 +273,8 @@ def _base(root: Node, source: Path | None) -> dict[str, Any]:
     if not isinstance(base, dict):
         raise ScenarioError("scenario", "the base scenario is not a mapping")
     try:
-        parse_scenario(base)  # the loader only reads its data
+        parse_scenario(base, inapplicable_rows=True)  # the loader only reads its data; a planner the base
+        # does not suit may suit other cases (:meth:`_Expansion.refuse_unused_planners`)
     except ScenarioError as error:
         raise ScenarioError(f"scenario: {error.path}", error.message) from None
     return base
@@ -360,6 +361,7 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
                   thresholds=robustness["thresholds"], worst=robustness["worst"])
     expansion = _Expansion(study, axes, dispersions, version or package_version(), progress)
     study.cases = expansion.cases()
+    expansion.refuse_unused_planners()
     _check_summary([(f"summary[{index}]", column) for index, column in enumerate(summary)]
                    + [(f"robustness.thresholds.{column}", column) for column in study.thresholds], expansion.columns)
     return study
@@ -418,6 +420,8 @@ class _Expansion:
         self.total = self.points * study.samples
         self.checked: set[tuple[int, ...]] = set()  # classes of cases the whole loader has passed
         self.columns: dict[str, None] = {}  # requirement columns the cases give, in order
+        self.accepted: set[int] = set()  # planner rows some case's problem suits
+        self.refused: dict[int, tuple[Case, str, str]] = {}  # planner row -> its first refused case, name, reason
         for axis in axes:
             axis.verdicts = [self._verdicts(varied, values) for varied, values in zip(axis.varied, axis.values)]
 
@@ -542,13 +546,28 @@ class _Expansion:
                 raise _case_error(case, error) from None
         if case_class not in self.checked:
             try:
-                scenario = parse_scenario(case.scenario)  # the loader only reads its data
+                scenario = parse_scenario(case.scenario, inapplicable_rows=True)  # the loader only reads its data
             except ScenarioError as error:
                 raise _case_error(case, error) from None
             self.checked.add(case_class)
+            # a class shares the problem (independent keys are not in it): its planners' verdicts hold for all
+            for index, spec in enumerate(scenario.planners):
+                if index in scenario.inapplicable:
+                    self.refused.setdefault(index, (case, spec.name, scenario.inapplicable[index]))
+                else:
+                    self.accepted.add(index)
             # a class of cases shares every key a requirement column depends on (independent keys
             # are initial errors, noise and tolerances), so one parse per class lists them all
             self.columns.update(dict.fromkeys(_requirement_columns(scenario)))
+
+    def refuse_unused_planners(self) -> None:
+        """Refuse a planner row that no case's problem suits (as ``run`` refuses it): a study of its
+        rows would hold nothing but failures. One that suits some cases fails the others' rows."""
+        for index, (case, name, reason) in self.refused.items():
+            if index not in self.accepted:
+                raise ScenarioError(f"scenario: planners[{index}]",
+                                    f"{name} cannot take any of the study's {self.total} case(s) (case {case.index}: "
+                                    f"{reason}); remove it, or vary the study so that some case suits it")
 
 
 def _read(key: Key, value: Any, path: str) -> Any:

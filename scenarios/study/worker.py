@@ -292,7 +292,7 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
                 if not _PLUGINS_LOADED:  # a fork server's worker does not inherit the parent's registries
                     load_plugins()
                     _plugins_loaded()
-                scenario = parse_scenario(data)
+                scenario = parse_scenario(data, inapplicable_rows=True)  # a planner the case does not suit: failed rows
                 results = run(scenario, cache=cache, simulators=simulators, references=references)
                 status, rows = "ok", [row.to_dict() for row in results.rows]
             finally:  # disarmed first: an alarm due now is raised here, inside the outer try

@@ -1,0 +1,210 @@
+"""Plausibility warnings on a validated scenario: values that the schema accepts but that are
+almost certainly a unit slip (kilometres written as metres, degrees per second written as rad/s,
+millinewton metres written as newton metres).
+
+They are warnings, not errors: each names the YAML path, the value as written and the physical
+reason it looks wrong, and suggests the value meant where one follows. ``slewbench validate``
+prints them (``validate --strict`` counts each as a finding: exit 1) and ``slewbench run`` prints
+them on standard error before planning. Each check of :data:`PLAUSIBILITY_CHECKS` has one physical
+reason; a value that passes them all is not thereby right, only not obviously wrong.
+
+There is no check of angles in radians: every angle a scenario gives is in degrees (``_deg``
+keys, ``axis_angle.angle_deg``), whose ranges the schema already bounds; and an inertia that
+violates the triangle inequality is an error of the loader, not a warning.
+
+May import: :mod:`ocp` (the Earth's radius) and the :class:`~scenarios.schema.loader.Scenario`
+it reads (for types only).
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ocp.dynamics.orbits import R_EARTH
+
+if TYPE_CHECKING:
+    from scenarios.schema.loader import Scenario
+
+__all__ = ["LOWEST_ORBIT_KM", "MAX_ANGULAR_ACCELERATION", "MAX_RATE", "MOON_DISTANCE_KM", "PLAUSIBILITY_CHECKS",
+           "Implausible", "plausibility_warnings"]
+
+MOON_DISTANCE_KM = 384_400.0
+"""The Moon's mean distance from the Earth [km]: an orbit reaching beyond it is no Earth orbit the
+two-body (and J2) model describes, the Moon's and the Sun's pull being comparable to the Earth's."""
+LOWEST_ORBIT_KM = 100.0
+"""The Kármán line [km] above the equatorial radius: an orbit whose perigee is lower re-enters
+within hours, so no attitude manoeuvre is planned there."""
+MAX_RATE = 1.0
+"""Body rate [rad/s] (57 deg/s) above which a rate bound binds no slew: agile spacecraft slew at a
+few degrees per second; a bound in deg/s written as rad/s lands above it."""
+MAX_ANGULAR_ACCELERATION = 5.0
+"""Angular acceleration [rad/s²] an actuator's torque gives about the least principal axis above
+which it is no attitude actuator (a full turn from rest in under 1.6 s); a torque in mN m written
+as N m lands above it on any spacecraft of slewbench's examples."""
+
+
+@dataclass(frozen=True)
+class Implausible:
+    """One plausibility warning.
+
+    Parameters
+    ----------
+    path : str
+        The YAML path of the value (``orbit.altitude_km``).
+    value : str
+        The value as written, with its unit (``500000 km``).
+    reason : str
+        Why it looks wrong, and the value probably meant where one follows.
+    """
+
+    path: str
+    value: str
+    reason: str
+
+    def __str__(self) -> str:
+        return f"{self.path}: {self.value} {self.reason}"
+
+
+PlausibilityCheck = Callable[["Scenario"], Iterator[Implausible]]
+
+
+def _number(value: Any) -> float | None:
+    """``value`` as a finite float, or None (absent, null, text, a bool)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        return None
+    return float(value)
+
+
+def _numbers(value: Any) -> list[float] | None:
+    """A number or a list of numbers as floats, or None when it is neither."""
+    one = _number(value)
+    if one is not None:
+        return [one]
+    if isinstance(value, list) and value and all(_number(item) is not None for item in value):
+        return [float(item) for item in value]
+    return None
+
+
+def _mapping(data: Any, *keys: str) -> dict[str, Any]:
+    """``data[keys[0]][keys[1]]...`` when every level is a mapping, else an empty one."""
+    for key in keys:
+        data = data.get(key) if isinstance(data, dict) else None
+    return data if isinstance(data, dict) else {}
+
+
+def _orbit_altitude(scenario: Scenario) -> Iterator[Implausible]:
+    """A circular or Keplerian orbit whose apogee lies beyond the Moon, or whose perigee lies below
+    the Kármán line (a two-line element set, read from its fixed format, is not checked)."""
+    orbit = _mapping(scenario.data, "orbit")
+    radius_km = R_EARTH / 1e3
+    eccentricity = _number(orbit.get("eccentricity")) or 0.0
+    for key, to_radius in (("altitude_km", lambda v: v + radius_km), ("semi_major_axis_km", lambda v: v)):
+        value = _number(orbit.get(key))
+        if value is None:
+            continue
+        apogee = to_radius(value) * (1 + eccentricity) - radius_km
+        perigee = to_radius(value) * (1 - eccentricity) - radius_km
+        height = "altitude" if eccentricity == 0 else "apogee altitude"
+        if apogee > MOON_DISTANCE_KM:
+            meant = value / 1e3
+            guess = (f"; did you mean {meant:g} (metres written as kilometres)?"
+                     if LOWEST_ORBIT_KM <= to_radius(meant) * (1 - eccentricity) - radius_km else "")
+            yield Implausible(f"orbit.{key}", f"{value:g} km",
+                              f"puts the orbit's {height} at {apogee:,.0f} km, beyond the Moon's distance "
+                              f"({MOON_DISTANCE_KM:,.0f} km), where the Earth's two-body orbit no longer holds{guess}")
+        elif perigee < LOWEST_ORBIT_KM:
+            where = "altitude" if eccentricity == 0 else "perigee altitude"
+            yield Implausible(f"orbit.{key}", f"{value:g} km",
+                              f"puts the orbit's {where} at {perigee:,.4g} km, below {LOWEST_ORBIT_KM:g} km (the "
+                              "Kármán line), where the atmosphere ends an orbit within hours; is the value in km?")
+
+
+def _rate_bounds(scenario: Scenario) -> Iterator[Implausible]:
+    """A bound on the body rate above :data:`MAX_RATE` (a bound in deg/s written as rad/s)."""
+    data = scenario.data or {}
+    bounds = [("maneuver.max_rate", _mapping(data, "maneuver").get("max_rate")),
+              ("requirements.rate.max", _mapping(data, "requirements", "rate").get("max")),
+              ("requirements.final.rate", _mapping(data, "requirements", "final").get("rate")),
+              ("simulation.detumble_tolerance", _mapping(data, "simulation").get("detumble_tolerance"))]
+    planners = data.get("planners")
+    for index, planner in enumerate(planners if isinstance(planners, list) else []):
+        bounds.append((f"planners[{index}].options.max_rate", _mapping(planner, "options").get("max_rate")))
+    for path, given in bounds:
+        value = _number(given)
+        if value is not None and value > MAX_RATE:
+            yield Implausible(path, f"{value:g} rad/s",
+                              f"is {math.degrees(value):,.0f} deg/s, above {MAX_RATE:g} rad/s "
+                              f"({math.degrees(MAX_RATE):.0f} deg/s), a bound no attitude slew comes near; did you "
+                              f"mean {math.radians(value):.4g} rad/s ({value:g} deg/s)?")
+
+
+def _boundary_rates(scenario: Scenario) -> Iterator[Implausible]:
+    """A boundary rate (``maneuver.initial.omega``, ``maneuver.final.omega``) above
+    :data:`MAX_RATE` that the actuators could not give or take away within the manoeuvre, even at
+    their peak angular acceleration (the body torque box over the least principal moment): a rate
+    in deg/s written as rad/s. A fast spin the actuators can reach (a spin-up) is left alone."""
+    problem = scenario.problem
+    spacecraft = problem.spacecraft
+    least = float(np.linalg.eigvalsh(spacecraft.inertia)[0])
+    peak = float(np.linalg.norm(spacecraft.body_torque_limit())) / least  # rad/s^2, inf when unlimited
+    reach = peak * problem.duration
+    for where, rate in (("initial", problem.omega0), ("final", problem.omegaf)):
+        if rate is None:
+            continue
+        norm = float(np.linalg.norm(rate))
+        if norm > MAX_RATE and norm > reach:
+            yield Implausible(f"maneuver.{where}.omega", f"{np.asarray(rate).tolist()} rad/s",
+                              f"has ‖ω‖ = {norm:.4g} rad/s ({math.degrees(norm):,.0f} deg/s), above {MAX_RATE:g} "
+                              f"rad/s and more than the actuators can change in maneuver.duration ({peak:.3g} rad/s² at "
+                              f"most about the least principal axis for {problem.duration:g} s: {reach:.3g} rad/s); did "
+                              f"you mean {[round(math.radians(float(w)), 6) for w in rate]} rad/s (deg/s written "
+                              "as rad/s)?")
+
+
+def _torques(scenario: Scenario) -> Iterator[Implausible]:
+    """An actuator torque bound that would turn the spacecraft at more than
+    :data:`MAX_ANGULAR_ACCELERATION` about its least principal axis (mN m written as N m)."""
+    least = float(np.linalg.eigvalsh(scenario.problem.spacecraft.inertia)[0])
+    for path in ("spacecraft.wheels.max_torque", "spacecraft.torquers.max_torque", "truth.wheels.max_torque"):
+        *section, key = path.split(".")
+        values = _numbers(_mapping(scenario.data, *section).get(key))
+        if not values:
+            continue
+        largest = max(values)
+        acceleration = largest / least
+        if acceleration > MAX_ANGULAR_ACCELERATION:
+            shown = f"{largest:g} N m" if len(values) == 1 else f"{values} N m (largest {largest:g})"
+            yield Implausible(path, shown,
+                              f"on a least principal moment of inertia of {least:g} kg m² gives {acceleration:.3g} "
+                              f"rad/s², above {MAX_ANGULAR_ACCELERATION:g} rad/s² (a full turn from rest in "
+                              f"{math.sqrt(4 * math.pi / acceleration):.2g} s); did you mean {largest / 1e3:g} N m "
+                              "(mN m written as N m)?")
+
+
+PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
+    "orbit_altitude": _orbit_altitude,
+    "rate_bounds": _rate_bounds,
+    "boundary_rates": _boundary_rates,
+    "actuator_torques": _torques,
+}
+"""Name -> check: each yields the :class:`Implausible` values of a validated scenario."""
+
+
+def plausibility_warnings(scenario: Scenario) -> list[Implausible]:
+    """Every check of :data:`PLAUSIBILITY_CHECKS` on ``scenario``, in order.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A validated scenario (its ``data``, the YAML as given, names the paths and values).
+
+    Returns
+    -------
+    list of Implausible
+        The warnings; empty when nothing looks like a unit slip.
+    """
+    return [warning for check in PLAUSIBILITY_CHECKS.values() for warning in check(scenario)]

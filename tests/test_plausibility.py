@@ -1,0 +1,138 @@
+"""Plausibility warnings: values the schema accepts that look like a unit slip, each named by its
+YAML path, its value and the physical reason, printed by ``validate`` (a finding under
+``--strict``) and ``run``; none on any shipped scenario or study case."""
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import pytest
+import yaml
+
+from scenarios.cli.commands import main
+from scenarios.schema.loader import OTHER_FILES, load, parse_scenario
+from scenarios.schema.plausibility import plausibility_warnings
+from scenarios.schema.read import read_yaml
+from scenarios.study.spec import load_study
+
+ROOT = Path(__file__).resolve().parents[1]
+CUBESAT = read_yaml(ROOT / "scenarios" / "cubesat_12u_sun_keep_out.yaml")  # 500 km, I_min 0.12 kg m², 3 mN m wheels
+
+
+def shipped() -> list[Path]:
+    return sorted([*(ROOT / "scenarios").glob("*.yaml"), *(ROOT / "scenarios" / "bench").rglob("*.yaml")])
+
+
+@pytest.mark.parametrize("path", shipped(), ids=lambda path: str(path.relative_to(ROOT)))
+def test_no_shipped_scenario_or_study_case_warns(path):
+    data = read_yaml(path)
+    if "study" in data:
+        scenarios = [parse_scenario(case.scenario) for case in load_study(path).cases]
+    elif any(key in data for key in OTHER_FILES) or "maneuver" not in data:
+        pytest.skip("not a scenario or a study (the bench suite)")
+    else:
+        scenarios = [load(path)]
+    assert scenarios
+    for scenario in scenarios:
+        assert plausibility_warnings(scenario) == []
+
+
+def warnings_of(change) -> list[str]:
+    data = copy.deepcopy(CUBESAT)
+    change(data)
+    return [str(warning) for warning in plausibility_warnings(parse_scenario(data))]
+
+
+def test_an_altitude_beyond_the_moon_names_path_value_reason_and_the_value_meant():
+    said = warnings_of(lambda d: d["orbit"].update(altitude_km=500000))
+    assert len(said) == 1, said
+    assert said[0].startswith("orbit.altitude_km: 500000 km ")
+    assert "beyond the Moon's distance (384,400 km)" in said[0] and "did you mean 500 " in said[0], said
+
+
+def test_an_elliptic_orbits_apogee_counts_and_a_perigee_under_100_km_warns():
+    def elliptic(apogee_beyond: bool):
+        def change(d):
+            d["orbit"] = {"type": "keplerian", "semi_major_axis_km": 250000.0 if apogee_beyond else 200000.0,
+                          "eccentricity": 0.6 if apogee_beyond else 0.5}
+        return change
+    beyond = warnings_of(elliptic(True))  # apogee 250,000 x 1.6 - 6,378 = 393,622 km: beyond the Moon
+    assert len(beyond) == 1 and "apogee altitude" in beyond[0] and "Moon" in beyond[0], beyond
+    assert warnings_of(elliptic(False)) == []  # apogee 293,622 km, perigee 93,622 km
+    low = warnings_of(lambda d: d["orbit"].update(altitude_km=80))
+    assert len(low) == 1 and low[0].startswith("orbit.altitude_km: 80 km") and "Kármán" in low[0], low
+    assert warnings_of(lambda d: d["orbit"].update(altitude_km=120)) == []
+
+
+@pytest.mark.parametrize("path", ["maneuver.max_rate", "requirements.rate.max"])
+def test_a_rate_bound_in_degrees_per_second_warns(path):
+    def change(d):
+        section, *inner, key = path.split(".")
+        node = d.setdefault(section, {})
+        for name in inner:
+            node = node.setdefault(name, {})
+        node[key] = 3.0
+    said = warnings_of(change)
+    assert len(said) == 1 and said[0].startswith(f"{path}: 3 rad/s is 172 deg/s"), said
+    assert "did you mean 0.05236 rad/s" in said[0], said
+    loose = 0.9  # just under 1 rad/s: no warning
+    assert warnings_of(lambda d: d["maneuver"].update(max_rate=loose)) == []
+
+
+def test_a_boundary_rate_the_actuators_cannot_reach_warns_and_a_reachable_spin_does_not():
+    said = warnings_of(lambda d: d["maneuver"]["initial"].update(omega=[0.0, 0.0, 3.0]))
+    assert len(said) == 1 and said[0].startswith("maneuver.initial.omega: [0.0, 0.0, 3.0] rad/s"), said
+    assert "0.05236" in said[0], said
+
+    def strong(d):  # 0.3 N m per axis on 0.12 kg m²: 4.3 rad/s² peak, 3 rad/s reached in 60 s
+        d["spacecraft"]["wheels"] = None
+        d["spacecraft"]["torquers"] = {"max_torque": 0.3}
+        d["maneuver"]["initial"]["omega"] = [0.0, 0.0, 3.0]
+    assert warnings_of(strong) == []
+
+
+def test_a_torque_in_millinewton_metres_written_as_newton_metres_warns():
+    said = warnings_of(lambda d: d["spacecraft"]["wheels"].update(max_torque=3))  # 25 rad/s² on 0.12 kg m²
+    assert len(said) == 1 and said[0].startswith("spacecraft.wheels.max_torque: 3 N m"), said
+    assert "25 rad/s²" in said[0] and "did you mean 0.003 N m" in said[0], said
+    assert warnings_of(lambda d: d["spacecraft"]["wheels"].update(max_torque=0.5)) == []  # 4.2 rad/s²
+
+
+def write(tmp_path: Path, data: dict) -> str:
+    path = tmp_path / "slip.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return str(path)
+
+
+def test_validate_prints_them_and_strict_counts_them(tmp_path, capsys):
+    data = copy.deepcopy(CUBESAT)
+    data["orbit"]["altitude_km"] = 500000
+    path = write(tmp_path, data)
+    assert main(["validate", path]) == 0
+    assert "  warning: orbit.altitude_km: 500000 km" in capsys.readouterr().out
+    assert main(["validate", path, "--strict"]) == 1
+    captured = capsys.readouterr()
+    assert "warning: orbit.altitude_km" in captured.out and "--strict: 1 plausibility warning(s)" in captured.err
+    assert main(["validate", write(tmp_path, CUBESAT), "--strict"]) == 0
+    assert "warning" not in capsys.readouterr().out
+
+
+def test_run_prints_them_on_stderr_and_runs(tmp_path, capsys):
+    data = read_yaml(ROOT / "scenarios" / "eigenaxis_demo.yaml")
+    data["planners"] = data["planners"][:1]
+    data["maneuver"]["max_rate"] = 2.0
+    assert main(["run", write(tmp_path, data), "--out", str(tmp_path / "out"), "--no-plots"]) == 0
+    err = capsys.readouterr().err
+    assert "slewbench: warning: maneuver.max_rate: 2 rad/s is 115 deg/s" in err, err
+    assert (tmp_path / "out" / "results.json").exists()
+
+
+def test_validate_names_the_study_case_whose_value_looks_like_a_slip(tmp_path, capsys):
+    path = tmp_path / "study.yaml"
+    path.write_text(yaml.safe_dump({"study": "altitudes", "scenario": CUBESAT,
+                                    "grid": {"orbit.altitude_km": [500, 500000]}}, sort_keys=False))
+    assert main(["validate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "case 1 [orbit.altitude_km=500000]: warning: orbit.altitude_km: 500000 km" in out, out
+    assert "case 0" not in out
+    assert main(["validate", str(path), "--strict"]) == 1
