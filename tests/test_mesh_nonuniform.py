@@ -12,11 +12,13 @@ import numpy as np
 import pytest
 
 import scenarios
+from ocp.errors import OptionsError
 from ocp.nlp.solve import solve_multistart, solver_options
 from ocp.transcription import MultipleShooting, RadauCollocation
 from ocp.transcription.mesh_transfer import transfer_multipliers
 from planners import PLANNERS
 from planners.collocation.reference import seed_sampler
+from planners.collocation.requirements import dense_times
 from tests.test_collocation_mesh_transfer import bounded_single_axis
 
 STRETCHED = np.array([0.0, 0.05, 0.12, 0.2, 0.35, 0.5, 0.7, 0.85, 1.0])  # 8 intervals, lengths 0.05 ... 0.2
@@ -138,10 +140,28 @@ def test_switch_refinement_brings_xte_within_its_tolerance():
     assert certificate["kkt_scaled"] < 1e-6 and certificate["switching"] > 0.9
 
 
-def test_switch_refinement_leaves_minimum_energy_alone():
-    problem = bounded_single_axis()
-    options = {"intervals": 12}
-    plain = PLANNERS["collocation"](options).plan(problem)
-    refined = PLANNERS["collocation"]({**options, "switch_refinement": 4}).plan(problem)
-    assert "switch_refinement" not in refined.stats and refined.intervals == 12
-    assert refined.stats["functional"]["value"] == plain.stats["functional"]["value"]
+@pytest.mark.parametrize(("options", "named"), [
+    ({}, "objective 'min_energy'"),
+    ({"objective": "min_time", "transcription": "multiple_shooting"}, "transcription 'multiple_shooting'"),
+    ({"objective": "min_time", "solver": "fatrop"}, "solver 'fatrop'"),
+    ({"objective": "min_time", "switch_refinement": 1}, "1 piece per interval"),
+])
+def test_switch_refinement_where_it_does_nothing_is_refused_naming_why(options, named):
+    """A reviewer found it accepted and ignored there, without a word in the stats."""
+    with pytest.raises(OptionsError, match="switch_refinement") as raised:
+        PLANNERS["collocation"]({"switch_refinement": 4, **options})
+    assert named in str(raised.value)
+
+
+def test_the_dense_grid_on_a_non_uniform_mesh_has_its_points_per_interval_and_the_nodes():
+    """The dense check spread 20 N points evenly over T: on a refined mesh a split interval got a
+    few points and its nodes none."""
+    mesh = np.array([0.0, 0.1, 0.125, 0.15, 0.175, 0.2, 1.0])
+    reference = SimpleNamespace(duration=8.0, intervals=6, transcription=RadauCollocation(6, mesh=mesh))
+    t = dense_times(reference, 20)
+    assert t.size == 20 * 6 + 1 and t[0] == 0.0 and t[-1] == 8.0 and np.all(np.diff(t) > 0)
+    np.testing.assert_allclose(t[::20], mesh * 8.0, rtol=0, atol=1e-15)  # every node on the grid
+    for k in range(6):  # 20 equal steps inside each interval
+        np.testing.assert_allclose(np.diff(t[20 * k:20 * (k + 1) + 1]), np.diff(mesh)[k] * 8.0 / 20, rtol=1e-12)
+    uniform = SimpleNamespace(duration=8.0, intervals=6, transcription=RadauCollocation(6))
+    np.testing.assert_array_equal(dense_times(uniform, 20), np.linspace(0.0, 8.0, 121))

@@ -13,6 +13,7 @@ eigenaxis bang-bang time of a unit-inertia body with ``|u_i| <= 1`` N m for the 
 from __future__ import annotations
 
 import copy
+import json
 import math
 
 import numpy as np
@@ -127,7 +128,7 @@ def test_held_out_errors_count_an_infeasible_entry_the_fit_gives_a_time():
     quality = held_out_errors(fit, part, [90.0, 180.0])
     assert quality["max_rel_error"] == pytest.approx(0.0, abs=1e-12)  # the ok point is exact ...
     assert quality["timed_infeasible"] == 1 and quality["target_met"] is False  # ... but a time for no slew
-    assert quality["worst_timed_infeasible"]["angle_deg"] == 180.0
+    assert quality["timed_infeasible_example"]["angle_deg"] == 180.0
     quality["eval_time_us"] = 1.0
     assert any("infeasible held-out entry" in line and "NOT met" in line for line in quality_lines(quality))
     part.status = [["ok", "ok"]]
@@ -150,3 +151,24 @@ def test_the_error_by_angle_is_the_range_of_the_signed_errors():
     (item,) = quality["by_angle"]
     assert item["min_error"] == pytest.approx(0.03) and item["max_error"] == pytest.approx(0.11)
     assert "90 deg (table) +3 to +11 %" in quality_lines(quality)[2]
+
+
+def test_an_earlier_fit_without_the_end_check_is_refused(tmp_path):
+    """A reviewer loaded a keep-out fit.json written before the check: it gave 2.5066 s where the
+    fit now gives inf."""
+    data = _table_fit(end_cones(KEEP_OUT)).to_dict()
+    del data["end_cones"]
+    (tmp_path / "fit.json").write_text(json.dumps(data))
+    with pytest.raises(ValueError, match="end attitude"):
+        load_fit(tmp_path)
+    data["meta"]["from_identity_only"] = False  # a table of any start: no cones to check
+    (tmp_path / "fit.json").write_text(json.dumps(data))
+    assert load_fit(tmp_path).end_cones.shape == (0, 8)
+
+
+def test_cones_need_slews_from_the_identity():
+    """The end check takes the slew's rotation for the end attitude, true only from the identity."""
+    fit = _table_fit(None)
+    with pytest.raises(ValueError, match="from_identity_only"):
+        SlewTimeFit(fit.angles, fit.axes, fit.times, {}, np.eye(3), np.eye(3), fit.triangles,
+                    end_cones=end_cones(KEEP_OUT))

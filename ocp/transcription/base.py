@@ -74,7 +74,8 @@ class Transcription(ABC):
         self.mesh: Array | None = None
         if mesh is not None:
             nodes = np.asarray(mesh, dtype=float)
-            if nodes.shape != (intervals + 1,) or nodes[0] != 0.0 or nodes[-1] != 1.0 or np.any(np.diff(nodes) <= 0.0):
+            if (nodes.shape != (intervals + 1,) or not np.all(np.isfinite(nodes)) or nodes[0] != 0.0
+                    or nodes[-1] != 1.0 or not np.all(np.diff(nodes) > 0.0)):
                 raise ValueError(f"mesh: expected {intervals + 1} increasing fractions of T from 0 to 1, got {nodes}")
             nodes.setflags(write=False)
             self.mesh = nodes

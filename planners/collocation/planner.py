@@ -222,8 +222,9 @@ class CollocationOptions:
         converges. A switch inside an interval is a jump the control polynomial cannot follow: the
         final time's error is of the order of those intervals' length (XTE: +8.6e-4 s on 50
         intervals, +3.7e-5 s refined by 4). Skipped when no interval or more than a quarter of them
-        hold a switch (a singular arc, not bang-bang); ``stats["switch_refinement"]`` records it.
-        0 or 1 (default 0): off.
+        hold a switch (a singular arc, not bang-bang), or for a problem with cones, a rate bound or
+        an energy term (``time_regularization``); ``stats["switch_refinement"]`` records it.
+        0 (default): off; another objective, transcription or solver, or 1, is refused.
     """
 
     objective: Literal["min_energy", "min_l1", "min_time", "weighted"] = "min_energy"
@@ -279,6 +280,15 @@ class CollocationOptions:
             raise InvalidOption(error.path, error.message) from None
         if self.time_regularization and self.objective != "min_time":
             raise InvalidOption("time_regularization", f"applies to objective min_time only, not {self.objective!r}")
+        if self.switch_refinement:
+            refusal = (f"objective {self.objective!r}" if self.objective != "min_time" else
+                       f"transcription {self.transcription!r}" if not TRANSCRIPTIONS[self.transcription].non_uniform
+                       else f"solver {self.solver!r}" if self.solver != "ipopt" else
+                       "1 piece per interval" if self.switch_refinement == 1 else None)
+            if refusal is not None:
+                raise InvalidOption("switch_refinement", f"{self.switch_refinement} applies to objective min_time "
+                                                         f"on radau collocation with IPOPT, split in 2 to 16; not "
+                                                         f"to {refusal} (0: off)")
         if self.objective == "weighted" and not (self.energy_weight or self.l1_weight or self.time_weight):
             raise InvalidOption("objective", "weighted needs a positive energy_weight, l1_weight or time_weight")
         l1 = self.objective == "min_l1" or (self.objective == "weighted" and self.l1_weight > 0)
@@ -732,9 +742,14 @@ class CollocationPlanner(Planner):
         stats as ``switch_refinement``)."""
         o = self.options
         result, transcription = solved.result, solved.transcription
-        if (o.switch_refinement < 2 or not ocp.free_time or ocp.energy_weight or ocp.l1_weight or ocp.cones
-                or ocp.max_rate is not None or o.solver != "ipopt" or solved.solver not in (None, "ipopt")
-                or not isinstance(transcription, RadauCollocation) or not result.success or result.x is None):
+        if o.switch_refinement < 2 or not result.success or result.x is None:
+            return solved
+        why = ("an energy or L1 term" if ocp.energy_weight or ocp.l1_weight else "cones" if ocp.cones else
+               "a rate bound" if ocp.max_rate is not None else "not a free final time" if not ocp.free_time else
+               "another solver" if solved.solver not in (None, "ipopt") or o.solver != "ipopt" else
+               "another transcription" if not isinstance(transcription, RadauCollocation) else None)
+        if why is not None:
+            solved.extra["switch_refinement"] = {"pieces": o.switch_refinement, "skipped": why}
             return solved
         lbx, ubx = transcription.bounds(ocp, solved.nlp, *self._variable_bounds(problem), problem.duration)
         held = switch_intervals(transcription, ocp.model, solved.nlp, result.x, lbx, ubx)

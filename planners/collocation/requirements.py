@@ -29,7 +29,7 @@ from planners.collocation.problem import variable_bounds
 from planners.collocation.reference import CollocationReference
 from planners.problem import Array, ManeuverProblem
 
-__all__ = ["DENSE_POINTS", "DenseCheck", "Requirements", "Tightening", "dense_check", "imposed_pointing"]
+__all__ = ["DENSE_POINTS", "DenseCheck", "Requirements", "Tightening", "dense_check", "dense_times", "imposed_pointing"]
 
 DENSE_POINTS = 20
 """Points per mesh interval of the dense check (equally spaced, the nodes included)."""
@@ -260,6 +260,30 @@ def _saturated_within(reference: CollocationReference, columns: slice, limits: A
         return bool(float(np.max(reach / limits[bounded])) - 1.0 <= BOUND_TOLERANCE)
 
 
+def dense_times(reference: CollocationReference, points_per_interval: int = DENSE_POINTS) -> Array:
+    """The dense check's grid: ``points_per_interval`` equally spaced points per mesh interval, the
+    nodes among them, and T.
+
+    Parameters
+    ----------
+    reference : CollocationReference
+        The solution (its duration [s] and its transcription's mesh, uniform or not).
+    points_per_interval : int, optional
+        Points per mesh interval (default :data:`DENSE_POINTS`).
+
+    Returns
+    -------
+    (points_per_interval * intervals + 1,) ndarray
+        Times [s] from 0 to T.
+    """
+    mesh = reference.transcription.mesh
+    if mesh is None:
+        return np.linspace(0.0, reference.duration, points_per_interval * reference.intervals + 1)
+    steps = np.arange(points_per_interval) / points_per_interval  # a non-uniform mesh (switch_refinement)
+    fractions = np.append((mesh[:-1, None] + np.diff(mesh)[:, None] * steps[None, :]).ravel(), 1.0)
+    return np.asarray(fractions * reference.duration, dtype=float)
+
+
 def dense_check(problem: ManeuverProblem, reference: CollocationReference, requirements: Requirements,
                 points_per_interval: int = DENSE_POINTS) -> DenseCheck:
     """Check a reference between its points against the requirements as stated.
@@ -291,7 +315,7 @@ def dense_check(problem: ManeuverProblem, reference: CollocationReference, requi
     -------
     DenseCheck
     """
-    t = np.linspace(0.0, reference.duration, points_per_interval * reference.intervals + 1)
+    t = dense_times(reference, points_per_interval)
     # what each check reads: the actuator checks with a bounded entry (controls, then states, per block)
     actuators: list[tuple[str, str, slice, Array]] = []
     if requirements.actuator_margin is not None:

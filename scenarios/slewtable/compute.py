@@ -403,7 +403,7 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart, table_angles_deg: list[fl
         entries where the fit has no time, in a cell around an entry that is not ok: not compared);
         ``timed_infeasible`` (``infeasible`` held-out entries where the fit gives a finite time: a
         time for a slew that cannot be made; any makes ``target_met`` false) and
-        ``worst_timed_infeasible`` (one of them: axis, angle [deg], fitted time [s]; None without).
+        ``timed_infeasible_example`` (one of them: axis, angle [deg], fitted time [s]; None without).
     """
     fitted = np.rad2deg(fit.angles).tolist()
     table_angles = [float(a) for a in (fitted if table_angles_deg is None else table_angles_deg)]
@@ -418,7 +418,7 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart, table_angles_deg: list[fl
     none: dict[str, Any] = {"points": 0, "max_rel_error": None, "max_over_error": None, "max_under_error": None,
                             "rms_rel_error": None, "target": FIT_TARGET, "target_met": None, "worst": None,
                             "worst_under": None, "by_angle": [], "held_out": described, "no_value": 0,
-                            "timed_infeasible": 0, "worst_timed_infeasible": None}
+                            "timed_infeasible": 0, "timed_infeasible_example": None}
     impossible = np.array([[status == "infeasible" for status in row] for row in part.status], dtype=bool)
     if impossible.size and impossible.any():
         a, b = np.nonzero(impossible)
@@ -427,7 +427,7 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart, table_angles_deg: list[fl
         none["timed_infeasible"] = int(timed.sum())
         if timed.any():
             w = int(np.argmax(timed))
-            none["worst_timed_infeasible"] = {"axis": part.axes[a[w]].tolist(), "angle_deg": float(part.angles_deg[b[w]]),
+            none["timed_infeasible_example"] = {"axis": part.axes[a[w]].tolist(), "angle_deg": float(part.angles_deg[b[w]]),
                                               "fit_s": float(guessed[w])}
     ok = part.ok
     if not ok.any():
@@ -464,7 +464,7 @@ def held_out_errors(fit: SlewTimeFit, part: TablePart, table_angles_deg: list[fl
             "worst": point(int(np.argmax(np.abs(signed)))),
             "worst_under": point(int(np.argmin(signed))) if under > 0.0 else None, "by_angle": by_angle,
             "held_out": described, "no_value": none["no_value"], "timed_infeasible": none["timed_infeasible"],
-            "worst_timed_infeasible": none["worst_timed_infeasible"]}
+            "timed_infeasible_example": none["timed_infeasible_example"]}
 
 
 def quality_lines(quality: dict[str, Any]) -> list[str]:
@@ -485,7 +485,7 @@ def quality_lines(quality: dict[str, Any]) -> list[str]:
     timed = quality.get("timed_infeasible") or 0
     impossible = []
     if timed:
-        example = quality["worst_timed_infeasible"]
+        example = quality["timed_infeasible_example"]
         impossible.append(f"fit: gives a time for {_plural(timed, 'infeasible held-out entry', 'infeasible held-out entries')}"
                           f" (a slew that cannot be made; target NOT met), e.g. {example['fit_s']:.4g} s at "
                           f"{example['angle_deg']:g} deg about [{', '.join(f'{v:.3f}' for v in example['axis'])}]")

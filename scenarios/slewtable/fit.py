@@ -369,6 +369,9 @@ class SlewTimeFit:
         if not np.all(np.isfinite(cones)) or not np.allclose(np.linalg.norm(cones[:, :6].reshape(-1, 3), axis=1), 1.0):
             raise ValueError("end_cones must be finite rows of a unit boresight, a unit direction, the cosine of "
                              "the half-angle and 1 (keep-out) or 0 (keep-in)")
+        if len(cones) and not self._identity_only:
+            raise ValueError("end_cones need meta['from_identity_only'] true: the end check takes the slew's "
+                             "rotation for the end attitude, which it is only from the identity")
         self.end_cones = cones
         self._cones = [tuple(row) for row in cones.tolist()]
         g = t / self.baseline(e[:, None, :], theta[None, :])
@@ -901,7 +904,8 @@ def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
     ------
     ValueError
         The file is not a slew-time fit of this format, or one that filled entries that were not
-        ``ok`` (written before the fit kept them as gaps).
+        ``ok`` (written before the fit kept them as gaps), or one of slews from the identity only
+        without ``end_cones`` (written before the fit checked end attitudes).
     """
     file = Path(path)
     if file.is_dir():
@@ -915,6 +919,10 @@ def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
                          "(or covered axes it left out) with times the table did not find; run `slewbench table` "
                          "again into the same --out (the entries are stored: nothing is solved again) to write "
                          "the fit with its gaps")
+    if "end_cones" not in data and (data.get("meta") or {}).get("from_identity_only"):
+        raise ValueError(f"{file} was written by an earlier slewbench whose fit did not check a slew's end attitude "
+                         "against the pointing requirements (it gave times for slews ending inside a keep-out "
+                         "cone); run `slewbench table` again to write the fit with the check")
     times = np.array(data["times_s"], dtype=float)  # null (an entry not ok) -> NaN
     return SlewTimeFit(data["angles_rad"], data["axes"], times, data.get("meta"), data.get("inertia"),
                        data.get("torque_generators"), data.get("triangles"), data.get("status"),
