@@ -746,9 +746,10 @@ class CollocationPlanner(Planner):
             return solved
         why = ("an energy or L1 term" if ocp.energy_weight or ocp.l1_weight else "cones" if ocp.cones else
                "a rate bound" if ocp.max_rate is not None else "not a free final time" if not ocp.free_time else
-               "another solver" if solved.solver not in (None, "ipopt") or o.solver != "ipopt" else
-               "another transcription" if not isinstance(transcription, RadauCollocation) else None)
-        if why is not None:
+               "another solver" if solved.solver not in (None, "ipopt") or o.solver != "ipopt" else None)
+        if not isinstance(transcription, RadauCollocation):
+            why = "another transcription"
+        if why is not None or not isinstance(transcription, RadauCollocation):
             solved.extra["switch_refinement"] = {"pieces": o.switch_refinement, "skipped": why}
             return solved
         lbx, ubx = transcription.bounds(ocp, solved.nlp, *self._variable_bounds(problem), problem.duration)
