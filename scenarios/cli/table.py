@@ -364,7 +364,8 @@ def add_table_parser(commands: Any) -> None:
                                                      "(at every table angle and the midpoints; 0: none; default 0)")
     parser.add_argument("--tolerance", type=float,
                         help="refine the axes until the fit's misses at the triangles' edge midpoints are at most "
-                             "this fraction of the slew time (e.g. 0.01; default: no refinement)")
+                             "this fraction of the slew time (e.g. 0.01; default: no refinement); samples, not a "
+                             "bound: judge the fit by --held-out")
     parser.add_argument("--check-angles", help="with --tolerance: the table angles [deg] a midpoint is checked at "
                                                "first, comma-separated, or 'all' (default)")
     parser.add_argument("--max-axes", type=int, help="with --tolerance: axes at most (default 2000)")
