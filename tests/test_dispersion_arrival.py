@@ -392,8 +392,8 @@ def _candidates(annotation: Any, default: Any) -> list[Any]:
     args = [a for a in typing.get_args(annotation) if a is not type(None)] or [annotation]
     if isinstance(default, bool):
         return []
-    if isinstance(default, int):
-        return [default + 1, default * 2, default - 1]
+    if isinstance(default, int):  # never the default itself (0 * 2): a value that changes nothing proves nothing
+        return [v for v in (default + 1, default * 2, default - 1, default + 2) if v != default]
     if isinstance(default, float) and math.isfinite(default):
         return [default * 1.25, default * 0.8, default * 2.0, default + 1.0] if default else [0.1, 1.0]
     if isinstance(default, (list, tuple)) and default and all(isinstance(v, (int, float)) for v in default):
