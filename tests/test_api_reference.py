@@ -8,11 +8,14 @@ class. The Sphinx build checks the same through ``warn_unresolved`` (a build war
 """
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import importlib
 import importlib.util
 import inspect
 import re
 import warnings
+from collections.abc import Iterator
 from functools import cache
 from pathlib import Path
 from types import ModuleType
@@ -25,6 +28,16 @@ ROLE = re.compile(r":(func|class|meth|mod|data|exc|attr|obj):`([^`]+)`")
 DIRECTIVE = re.compile(r"^\.\. auto(?:function|class|exception|data|module):: (\S+)", re.MULTILINE)
 
 
+@contextlib.contextmanager
+def pages_lock() -> Iterator[None]:
+    """Hold an exclusive lock on ``docs/conf.py`` (nothing is written to it) while the generated
+    pages are written and read: the test workers of ``pytest -n 2`` each load ``docs/conf.py``, and
+    in a fresh checkout both write the pages, one reading a page the other has just truncated."""
+    with open(DOCS / "conf.py") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)  # released when the file is closed
+        yield
+
+
 @cache
 def conf() -> ModuleType:
     """``docs/conf.py``, loaded (it writes the generated pages); the warning hook it installs is undone."""
@@ -33,7 +46,8 @@ def conf() -> ModuleType:
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     try:
-        spec.loader.exec_module(module)
+        with pages_lock():
+            spec.loader.exec_module(module)
     finally:
         warnings.showwarning = shown
     return module
@@ -42,8 +56,11 @@ def conf() -> ModuleType:
 @cache
 def documented() -> frozenset[str]:
     """Every object path an ``auto*`` directive of the generated API pages documents."""
-    conf().write_api_pages()
-    return frozenset(path for page in (DOCS / "api").glob("*.rst") for path in DIRECTIVE.findall(page.read_text()))
+    module = conf()  # outside the lock, which conf() takes itself
+    with pages_lock():
+        module.write_api_pages()
+        pages = [page.read_text() for page in (DOCS / "api").glob("*.rst")]
+    return frozenset(path for page in pages for path in DIRECTIVE.findall(page))
 
 
 def _resolves(target: str) -> bool:

@@ -88,7 +88,7 @@ def test_the_documentation_has_the_commands_it_is_tested_for():
     readme = _markdown_commands()
     assert any(c.startswith("pip install .") for c in readme)
     assert any(c.startswith("slewbench run scenarios/") for c in readme)
-    assert "pytest" in readme and "pytest -m slow" in readme
+    assert "pytest -n 2" in readme and "pytest -m slow" in readme  # the default run, as CI runs it
     assert sum(language == "python" for source, language, _ in BLOCKS if source == "README.md") >= 2
     assert "python tests/public_api.py" in readme and "mypy" in readme
     assert any(c.startswith("sphinx-build ") for c in readme)
