@@ -136,6 +136,7 @@ def test_switch_refinement_brings_xte_within_its_tolerance():
     assert refined.ok and abs(refined.duration - XTE) < 1e-4, (refined.duration, record)
     assert record["intervals_split"] >= 3 and record["intervals"] == 50 + 3 * record["intervals_split"]
     assert refined.transcription.mesh is not None and refined.intervals == record["intervals"]
+    assert f"refined: {record['intervals_split']} intervals holding a switch split in 4" in refined.message
     certificate = refined.stats["certificate"]
     assert certificate["kkt_scaled"] < 1e-6 and certificate["switching"] > 0.9
 

@@ -1191,6 +1191,10 @@ class CollocationPlanner(Planner):
             agreed = (f", {seeds['agreed']} of {seeds['tried']} seeds agreed there"
                       if "agreed" in seeds and "tried" in seeds else "")
             seeded = f" (seeded by the N={coarse['intervals']} optimum{agreed})"
+        refined = solved.extra.get("switch_refinement")
+        if isinstance(refined, dict) and "to_s" in refined:  # the result is the refined mesh's
+            seeded += (f"; refined: {refined['intervals_split']} intervals holding a switch split in "
+                       f"{refined['pieces']}, T {refined['from_s']:.7g} -> {refined['to_s']:.7g} s")
         reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {solver}): "
                              f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}{seeded}")
         if solved.intervals == o.intervals or transcription.mesh is not None:  # the final mesh: its certificate

@@ -189,9 +189,8 @@ def rate_limits(scenario: dict[str, Any]) -> tuple[np.ndarray, float | None]:
     generators = np.zeros((0, 3))
     if wheels is not None and all(a is wheels for a in spacecraft.actuators):
         working = [i for i in range(wheels.count) if i not in wheels.failed]
-        g = np.array([wheels.axes[:, i] * wheels.max_momentum[i] for i in working]).reshape(-1, 3)
-        if np.all(np.isfinite(g)):
-            generators = g
+        if np.all(np.isfinite(wheels.max_momentum[working])):  # an unbounded wheel: no cap (0 x inf is NaN)
+            generators = np.array([wheels.axes[:, i] * wheels.max_momentum[i] for i in working]).reshape(-1, 3)
     return generators, problem.rate_bound(None)
 
 
