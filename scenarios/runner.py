@@ -58,6 +58,7 @@ from planners import FailedReference, Reference, ReferenceSample
 from planners.conformance import check_boundary
 from planners.errors import ConformanceError
 from planners.reference import JUMP_TOLERANCE
+from scenarios.errors import CaseTimeout
 from scenarios.output.results import Row, RunResults
 from scenarios.requirements.fields import VERDICT
 from scenarios.requirements.scoring import (
@@ -461,18 +462,13 @@ class _NotKept(Exception):
 
 
 def _interruption(error: BaseException) -> BaseException | None:
-    """The interruption (an exception that is not an ``Exception``: a study's
-    :class:`~scenarios.errors.CaseTimeout`, Ctrl-C) that ``error`` carries as its cause or context,
-    if any: a signal handler's exception raised inside a C call (CasADi's) comes back wrapped, as a
-    ``SystemError`` whose cause it is."""
-    seen: set[int] = set()
-    link: BaseException | None = error
-    while link is not None and id(link) not in seen:
-        if not isinstance(link, Exception):
-            return link
-        seen.add(id(link))
-        link = link.__cause__ or link.__context__
-    return None
+    """The signal's exception (a study's :class:`~scenarios.errors.CaseTimeout`, Ctrl-C's
+    ``KeyboardInterrupt``) that ``error`` carries as its direct cause, if any: a signal handler's
+    exception raised inside a C call (CasADi's) comes back wrapped, as a ``SystemError`` whose
+    cause it is. Nothing else: an error raised while handling another exception (its context), or
+    one a planner raises ``from`` a ``GeneratorExit`` or ``SystemExit``, stays the planner's error."""
+    cause = error.__cause__
+    return cause if isinstance(cause, (CaseTimeout, KeyboardInterrupt)) else None
 
 
 def _plan(planner: Any, name: str, problem: Any) -> Reference:

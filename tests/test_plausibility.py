@@ -136,3 +136,19 @@ def test_validate_names_the_study_case_whose_value_looks_like_a_slip(tmp_path, c
     assert "case 1 [orbit.altitude_km=500000]: warning: orbit.altitude_km: 500000 km" in out, out
     assert "case 0" not in out
     assert main(["validate", str(path), "--strict"]) == 1
+
+
+def test_the_moons_distance_is_compared_with_the_distance_from_the_earths_centre():
+    """A reviewer: the apogee's altitude was compared with the Moon's distance from the centre."""
+    def circular(altitude_km):
+        return lambda d: d["orbit"].update(altitude_km=altitude_km)
+    assert warnings_of(circular(384_400 - 6_378.137 - 100)) == []  # 100 km inside the Moon's distance
+    assert len(warnings_of(circular(384_400 - 6_378.137 + 100))) == 1  # 100 km beyond it
+
+
+def test_a_fast_tumble_with_magnetorquers_alone_is_not_judged():
+    """A legitimate detumble of a nanosatellite spinning at 60 deg/s about each axis warned "0 rad/s²":
+    a magnetorquer's torque depends on the field, so there is no bound to judge the rate against."""
+    data = read_yaml(ROOT / "scenarios" / "nano_detumble.yaml")
+    data["maneuver"]["initial"]["omega"] = [0.6, 0.6, 0.6]  # 1.04 rad/s in norm
+    assert plausibility_warnings(parse_scenario(data)) == []

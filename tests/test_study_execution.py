@@ -96,6 +96,54 @@ def test_an_alarm_a_c_call_wraps_still_ends_the_case_without_a_traceback(monkeyp
     assert "Traceback" not in capsys.readouterr().err
 
 
+class _Raising:
+    """A planner whose plan raises what ``make`` returns."""
+
+    def __init__(self, make):
+        self.make = make
+
+    def plan(self, problem):
+        raise self.make()
+
+
+def _from(error, cause):
+    error.__cause__ = cause
+    return error
+
+
+def _in_handler(error, handled):
+    """``error`` raised while ``handled`` was being handled (its context), optionally ``from None``."""
+    def make():
+        try:
+            raise handled
+        except BaseException:  # noqa: BLE001 - the planner handles it, then fails otherwise
+            return error
+    return make
+
+
+@pytest.mark.parametrize("make", [
+    lambda: _from(SystemError("returned a result with an exception set"), CaseTimeout()),
+    lambda: _from(SystemError("returned a result with an exception set"), KeyboardInterrupt()),
+], ids=["time limit", "ctrl-c"])
+def test_a_signal_a_c_call_wraps_is_raised_as_itself(make):
+    with pytest.raises((CaseTimeout, KeyboardInterrupt)):
+        runner._plan(_Raising(make), "wrapped", None)
+
+
+@pytest.mark.parametrize("make", [
+    _in_handler(ValueError("cleanup failed"), GeneratorExit()),
+    _in_handler(ValueError("after a handled Ctrl-C"), KeyboardInterrupt()),
+    lambda: _from(ValueError("a library exited"), SystemExit(3)),
+    lambda: _from(ValueError("wrapped"), GeneratorExit()),
+], ids=["context GeneratorExit", "context KeyboardInterrupt", "cause SystemExit", "cause GeneratorExit"])
+def test_a_planner_error_that_merely_carries_another_exception_is_a_failed_row(make, capsys):
+    """A reviewer crashed ``run`` and ``sweep`` with a planner whose generator cleanup raised a
+    ValueError: its context held a GeneratorExit, which the runner re-raised."""
+    reference = runner._plan(_Raising(make), "carrying", None)
+    assert not reference.ok and "planner raised ValueError" in reference.message
+    capsys.readouterr()
+
+
 def test_a_case_that_swallows_the_alarm_and_finishes_late_is_timed_out(monkeypatch):
     """C code can swallow the alarm's exception (CasADi turns an exception in its callbacks into its
     own error): a case that then finishes past its limit is still out of time."""

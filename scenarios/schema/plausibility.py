@@ -109,13 +109,14 @@ def _orbit_altitude(scenario: Scenario) -> Iterator[Implausible]:
         apogee = to_radius(value) * (1 + eccentricity) - radius_km
         perigee = to_radius(value) * (1 - eccentricity) - radius_km
         height = "altitude" if eccentricity == 0 else "apogee altitude"
-        if apogee > MOON_DISTANCE_KM:
+        if apogee + radius_km > MOON_DISTANCE_KM:  # the Moon's distance is from the Earth's centre
             meant = value / 1e3
             guess = (f"; did you mean {meant:g} (metres written as kilometres)?"
                      if LOWEST_ORBIT_KM <= to_radius(meant) * (1 - eccentricity) - radius_km else "")
             yield Implausible(f"orbit.{key}", f"{value:g} km",
-                              f"puts the orbit's {height} at {apogee:,.0f} km, beyond the Moon's distance "
-                              f"({MOON_DISTANCE_KM:,.0f} km), where the Earth's two-body orbit no longer holds{guess}")
+                              f"puts the orbit's {height} at {apogee:,.0f} km ({apogee + radius_km:,.0f} km from "
+                              f"the Earth's centre), beyond the Moon's distance ({MOON_DISTANCE_KM:,.0f} km), where "
+                              f"the Earth's two-body orbit no longer holds{guess}")
         elif perigee < LOWEST_ORBIT_KM:
             where = "altitude" if eccentricity == 0 else "perigee altitude"
             yield Implausible(f"orbit.{key}", f"{value:g} km",
@@ -146,11 +147,15 @@ def _boundary_rates(scenario: Scenario) -> Iterator[Implausible]:
     """A boundary rate (``maneuver.initial.omega``, ``maneuver.final.omega``) above
     :data:`MAX_RATE` that the actuators could not give or take away within the manoeuvre, even at
     their peak angular acceleration (the body torque box over the least principal moment): a rate
-    in deg/s written as rad/s. A fast spin the actuators can reach (a spin-up) is left alone."""
+    in deg/s written as rad/s. A fast spin the actuators can reach (a spin-up) is left alone, and so
+    is a spacecraft without a stated torque bound (magnetorquers alone: their torque depends on the
+    field)."""
     problem = scenario.problem
     spacecraft = problem.spacecraft
     least = float(np.linalg.eigvalsh(spacecraft.inertia)[0])
     peak = float(np.linalg.norm(spacecraft.body_torque_limit())) / least  # rad/s^2, inf when unlimited
+    if peak == 0.0:  # no torque bound it can state (magnetorquers alone: the field decides): not judged
+        return
     reach = peak * problem.duration
     for where, rate in (("initial", problem.omega0), ("final", problem.omegaf)):
         if rate is None:
