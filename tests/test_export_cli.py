@@ -191,3 +191,29 @@ def test_rows_scored_ok_get_no_such_note(run_directory, tmp_path, capsys):
     assert statuses == {"ok"}
     assert main(["export", str(run_directory), "--format", "aem", "--out", str(tmp_path / "aem")]) == 0
     assert "scored it" not in capsys.readouterr().out
+
+
+def test_the_note_goes_to_the_row_whose_file_it_is_when_stems_share_a_prefix(tmp_path, monkeypatch):
+    """Row file stems hold dots (``k=0``, ``k=0.5``): a file of ``k=0.5`` was taken for ``k=0``'s."""
+    from dataclasses import dataclass
+
+    from scenarios.output import export as export_module
+
+    text = (SCENARIO.replace("label: smooth", "label: k=0").replace("label: fast", "label: k=0.5")
+            + "requirements: {final: {error_deg: 1.0e-9}}\n")  # both rows violated
+    out = tmp_path / "run"
+    assert main(["run", str(scenario_file(tmp_path, text)), "--out", str(out), "--no-plots"]) == 0
+
+    @dataclass(frozen=True)
+    class NoOptions:
+        pass
+
+    def write_one(run, directory, options):  # a format that writes the k=0.5 row only
+        (directory / "k=0.5.waypoints.csv").write_text("t\n0\n")
+        return []
+
+    fake = export_module.ExportFormat("fake", "one row's file", NoOptions, lambda run, options: None, write_one)
+    monkeypatch.setitem(export_module.EXPORT_FORMATS, "fake", fake)
+    report = export_module.export_run(out, "fake", tmp_path / "fake")
+    assert report.files == ["k=0.5.waypoints.csv"]
+    assert [note.split(":")[0] for note in report.notes] == ["row 'k=0.5'"], report.notes

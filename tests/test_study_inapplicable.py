@@ -65,3 +65,19 @@ def test_run_still_refuses_a_scenario_its_planner_cannot_take(tmp_path, capsys):
     assert main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert "planners[0]" in err and REASON in err, err
+
+
+def test_validate_strict_fails_a_case_that_no_listed_planner_can_take(tmp_path, capsys):
+    """A reviewer: with ``spin_extremal`` alone, case 1 fails all its rows, yet ``validate --strict``
+    passed the study."""
+    alone = dict(BASE, planners=[BASE["planners"][0]])
+    path = tmp_path / "study.yaml"
+    path.write_text(yaml.safe_dump({"study": "spin-final-rate", "scenario": alone,
+                                    "grid": {"maneuver.final.omega": [None, [0, 0, 0]]}}, sort_keys=False))
+    assert main(["validate", str(path)]) == 0
+    capsys.readouterr()
+    assert main(["validate", str(path), "--strict"]) == 1
+    said = capsys.readouterr()
+    text = said.out + said.err
+    assert "case 1" in text and "none can take it" in text and REASON in text, text
+    assert "case 0" not in text.split("none can take it")[0].splitlines()[-1], text

@@ -264,9 +264,10 @@ def _leaf_paths(value: Any, prefix: str) -> list[str]:
 
 
 def _doomed_notes(scenario: Scenario) -> list[str]:
-    """``validate``'s notes that every row must fail (``validate --strict`` exits 1 on any): an end
-    point that already breaks a requirement (every planner's row fails before planning), a boundary
-    rate above the rate requirement (every row breaks it).
+    """``validate``'s notes that every row must fail (``validate --strict`` exits 1 on any): a
+    study's case that no listed planner can take, an end point that already breaks a requirement
+    (every planner's row fails before planning), a boundary rate above the rate requirement (every
+    row breaks it).
 
     Parameters
     ----------
@@ -283,6 +284,9 @@ def _doomed_notes(scenario: Scenario) -> list[str]:
 
     requirements = scenario.requirements
     lines = []
+    if scenario.planners and len(scenario.inapplicable) == len(scenario.planners):  # a study's case none can take
+        lines += ["every planner's row fails, none can take it: "
+                  + "; ".join(scenario.inapplicable[i] for i in sorted(scenario.inapplicable))]
     if requirements and scenario.planners:
         lines += [f"every planner's row fails before planning: {broken}"
                   for broken in endpoint_violations(scenario.problem)]

@@ -328,8 +328,11 @@ def export_run(run_directory: str | Path, format_name: str, out: str | Path | No
     try:
         notes = export.write(run, staging, options)
         files = commit_outputs(target, staging, kind="export")
+        # a file is the row's whose stem is the longest to prefix it (stems hold dots: k=0 and k=0.5)
+        owners = {max((r for r in run.rows if f.startswith(r.stem + ".")), key=lambda r: len(r.stem), default=None)
+                  for f in files}
         for row in run.rows:
-            if row.timeseries is not None and row.status != "ok" and any(f.startswith(row.stem + ".") for f in files):
+            if row in owners and row.status != "ok":
                 why = f": {row.message[:300]}" if row.message else ""
                 notes.append(f"row {row.label!r}: exported, but the run scored it {row.status}{why}")
     finally:
