@@ -152,3 +152,16 @@ def test_a_fast_tumble_with_magnetorquers_alone_is_not_judged():
     data = read_yaml(ROOT / "scenarios" / "nano_detumble.yaml")
     data["maneuver"]["initial"]["omega"] = [0.6, 0.6, 0.6]  # 1.04 rad/s in norm
     assert plausibility_warnings(parse_scenario(data)) == []
+
+
+def test_a_rate_beyond_what_wheels_alone_can_store_warns():
+    """A reviewer: 2 rad/s on the 12U CubeSat (2 deg/s meant) was not flagged, though its momentum
+    is many times what the wheels store; the torque check alone let it through."""
+    said = warnings_of(lambda d: d["maneuver"]["initial"].update(omega=[2.0, 0.0, 0.0]))
+    assert len(said) == 1 and said[0].startswith("maneuver.initial.omega: [2.0, 0.0, 0.0] rad/s"), said
+    assert "more than the wheels alone can take" in said[0] and "did you mean [0.034907, 0.0, 0.0]" in said[0], said
+    data = copy.deepcopy(CUBESAT)
+    inertia = parse_scenario(data).problem.spacecraft.inertia
+    wheels = parse_scenario(data).problem.spacecraft.wheels
+    storage = float(sum(wheels.max_momentum))
+    assert float(inertia[0, 0]) * 2.0 > 8 * storage  # the oracle: J_xx ω = 0.5 N m s against the bounds' sum, 0.06

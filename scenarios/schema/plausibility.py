@@ -147,9 +147,10 @@ def _boundary_rates(scenario: Scenario) -> Iterator[Implausible]:
     """A boundary rate (``maneuver.initial.omega``, ``maneuver.final.omega``) above
     :data:`MAX_RATE` that the actuators could not give or take away within the manoeuvre, even at
     their peak angular acceleration (the body torque box over the least principal moment): a rate
-    in deg/s written as rad/s. A fast spin the actuators can reach (a spin-up) is left alone, and so
-    is a spacecraft without a stated torque bound (magnetorquers alone: their torque depends on the
-    field)."""
+    in deg/s written as rad/s; with wheels alone, also one whose momentum ``‖J ω‖`` exceeds what
+    all working wheels store together. A fast spin the actuators can reach (a spin-up) is left
+    alone, and so is a spacecraft without a stated torque bound (magnetorquers alone: their torque
+    depends on the field)."""
     problem = scenario.problem
     spacecraft = problem.spacecraft
     least = float(np.linalg.eigvalsh(spacecraft.inertia)[0])
@@ -157,17 +158,25 @@ def _boundary_rates(scenario: Scenario) -> Iterator[Implausible]:
     if peak == 0.0:  # no torque bound it can state (magnetorquers alone: the field decides): not judged
         return
     reach = peak * problem.duration
+    wheels = spacecraft.wheels
+    storage = math.inf  # wheels alone conserve the total momentum: they hold at most the sum of their bounds
+    if wheels is not None and all(actuator is wheels for actuator in spacecraft.actuators):
+        storage = float(sum(float(wheels.max_momentum[i]) for i in range(wheels.count) if i not in wheels.failed))
     for where, rate in (("initial", problem.omega0), ("final", problem.omegaf)):
         if rate is None:
             continue
         norm = float(np.linalg.norm(rate))
-        if norm > MAX_RATE and norm > reach:
-            yield Implausible(f"maneuver.{where}.omega", f"{np.asarray(rate).tolist()} rad/s",
-                              f"has ‖ω‖ = {norm:.4g} rad/s ({math.degrees(norm):,.0f} deg/s), above {MAX_RATE:g} "
-                              f"rad/s and more than the actuators can change in maneuver.duration ({peak:.3g} rad/s² at "
-                              f"most about the least principal axis for {problem.duration:g} s: {reach:.3g} rad/s); did "
-                              f"you mean {[round(math.radians(float(w)), 6) for w in rate]} rad/s (deg/s written "
-                              "as rad/s)?")
+        momentum = float(np.linalg.norm(spacecraft.inertia @ np.asarray(rate, dtype=float)))
+        if norm <= MAX_RATE or (norm <= reach and momentum <= storage):
+            continue
+        why = (f"more than the actuators can change in maneuver.duration ({peak:.3g} rad/s² at most about the "
+               f"least principal axis for {problem.duration:g} s: {reach:.3g} rad/s)" if norm > reach else
+               f"more than the wheels alone can take (its momentum ‖J ω‖ = {momentum:.3g} N m s against the "
+               f"{storage:.3g} N m s all working wheels store together)")
+        yield Implausible(f"maneuver.{where}.omega", f"{np.asarray(rate).tolist()} rad/s",
+                          f"has ‖ω‖ = {norm:.4g} rad/s ({math.degrees(norm):,.0f} deg/s), above {MAX_RATE:g} "
+                          f"rad/s and {why}; did you mean {[round(math.radians(float(w)), 6) for w in rate]} "
+                          "rad/s (deg/s written as rad/s)?")
 
 
 def _torques(scenario: Scenario) -> Iterator[Implausible]:
