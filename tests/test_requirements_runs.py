@@ -14,6 +14,7 @@ import csv
 import io
 import json
 import math
+import re
 from pathlib import Path
 
 import pytest
@@ -227,3 +228,25 @@ def test_a_closed_loop_window_shorter_than_the_reference_is_said():
                                 "T = 60 s: its closed-loop metrics cover 50 % of the manoeuvre")
     data["simulation"]["duration"] = 60.0  # the whole manoeuvre: nothing to say
     assert "closed loop stops" not in scenarios.run(scenarios.parse_scenario(data)).rows[0].message
+
+
+def test_the_terminal_marks_a_requirement_broken_by_a_field_its_headline_does_not_show():
+    """A tester read ``req.actuators 0.1202`` (well under its limit) on a row violated by an impulsive
+    rate jump: the headline is the peak torque demand, which a jump does not raise. Here the natural
+    motion spins about the principal z axis through the 120° of the slew (no torque at all) and its
+    rate steps to the final rest at the arc's end: the cell must say broken."""
+    data = with_direction([-1, 0, 0])  # the keep-out is never nearer than 120 deg: only the actuators break
+    data["planners"] = [{"name": "natural_motion", "options": {"stop": "step"}}]
+    results = scenarios.run(scenarios.parse_scenario(data))
+    row = results.rows[0]
+    actuators = row.requirements["reference"]["actuators"]
+    arc_s = float(re.search(r"over ([0-9.]+) s, stop 'step'", row.message).group(1))
+    assert row.status == "violated" and "jumps by" in row.message, row.message
+    # the jump is the whole spin rate: 120 deg over the arc's time
+    assert actuators["met"] is False and actuators["rate_jump"] == pytest.approx(2.0 * math.pi / 3.0 / arc_s, rel=1e-6)
+    assert actuators["wheels_torque"] < 0.5 and row.requirements["reference"]["st"]["met"] is True
+    terminal = results.to_terminal().splitlines()
+    line = next(line for line in terminal if line.startswith("req.actuators"))
+    assert line.rstrip().endswith("✗ | -"), line  # its number well under 1, yet broken: marked
+    st = next(line for line in terminal if line.startswith("req.st "))
+    assert "✗" not in st and "(✗: that scope breaks the requirement; the messages below say how)" in terminal

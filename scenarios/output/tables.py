@@ -416,8 +416,21 @@ def _headline(values: Mapping[str, Any] | None) -> tuple[str, Any]:
     return "peak demand / limit", max(ratios) if ratios else None
 
 
+_BROKEN = " ✗"
+"""Appended to a requirement's terminal cell in a scope that breaks it: the headline number alone
+may look harmless where another field breaks the requirement (a reference at 0.12 of its torque
+limit whose rate jumps: an impulse)."""
+
+
+def _requirement_cell(values: Mapping[str, Any] | None) -> str:
+    """One scope's terminal cell of a requirement: its headline number, marked when not met."""
+    cell = text_cell(_headline(values)[1])
+    return cell + _BROKEN if values and values.get("met") is False else cell
+
+
 def _requirement_lines(results: RunResults) -> list[tuple[str, list[str]]]:
-    """One line per requirement for the terminal: its headline number, ``reference | closed loop``."""
+    """One line per requirement for the terminal: its headline number, ``reference | closed loop``,
+    each marked ``✗`` where that scope breaks the requirement."""
     scores = [row.requirements or {} for row in results.rows]
     names: dict[str, None] = {}
     for row in scores:
@@ -427,7 +440,7 @@ def _requirement_lines(results: RunResults) -> list[tuple[str, list[str]]]:
     for name in names:
         words = next((_headline(row.get(scope, {}).get(name))[0] for row in scores for scope, _ in SCOPES
                       if row.get(scope, {}).get(name)), "")
-        cells = [" | ".join(text_cell(_headline(row.get(scope, {}).get(name))[1]) for scope, _ in SCOPES)
+        cells = [" | ".join(_requirement_cell(row.get(scope, {}).get(name)) for scope, _ in SCOPES)
                  for row in scores]
         lines.append((f"req.{name} ({words}; ref | cl)", cells))
     return lines
@@ -549,6 +562,8 @@ def to_terminal(results: RunResults, all_metrics: bool = False) -> str:
     summaries = [(row.label, (row.to_dict().get("certificate") or {}).get("summary")) for row in results.rows]
     messages += [f"{label} certificate: {summary}" for label, summary in summaries if summary]
     note = [f"({len(hidden)} metrics with no value in any row not shown; --all-metrics shows them)"] if hidden else []
+    if any(_BROKEN in cell for name, cells in lines if name.startswith("req.") for cell in cells):
+        note.append(f"({_BROKEN.strip()}: that scope breaks the requirement; the messages below say how)")
     return "\n".join([f"scenario: {results.scenario.name}", header, *body, *note, "", *messages, "",
                       status_line(results)])
 
