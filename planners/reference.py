@@ -166,7 +166,9 @@ class Reference(ABC):
 
     @property
     def ok(self) -> bool:
-        """Whether the planner succeeded (``status == "ok"``)."""
+        """Whether the planner succeeded (``status == "ok"``): on its own terms, not against the
+        scenario's requirements (actuator limits, pointing, rate, final accuracy), which
+        :func:`scenarios.run` scores for every row."""
         return self.status == "ok"
 
     def _summary(self) -> dict[str, str]:

@@ -426,7 +426,9 @@ class ReactionWheels(Actuator):
     Parameters
     ----------
     axes : (3, n) array_like
-        Spin axes, body frame, one column per wheel; normalised on construction.
+        Spin axes, body frame, one column per wheel (the allocation matrix; a scenario file's
+        ``spacecraft.wheels.axes`` lists one row per wheel: pass its transpose); normalised on
+        construction.
     max_torque : float or (n,) array_like, optional
         Motor torque limit per wheel [N m], positive; ``None`` (default): unlimited.
     max_momentum : float or (n,) array_like, optional
