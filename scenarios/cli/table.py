@@ -163,7 +163,8 @@ def command_table(args: argparse.Namespace) -> int:
         for item in refinement["rounds"]:
             print(f"refinement round {item['round']}: {item['checked']} midpoints checked, largest miss "
                   f"{100 * item['max_miss']:.3g} %, {item['missed']} over the tolerance, {item['split']} triangles split "
-                  f"(+{item['graded']} to keep the mesh graded), {item['axes']} axes, {item['solves']} entries solved")
+                  f"({item.get('boundary', 0)} of them across the boundary of the entries without a time; "
+                  f"+{item['graded']} to keep the mesh graded), {item['axes']} axes, {item['solves']} entries solved")
         print(f"refinement: {'reached' if refinement['reached'] else 'NOT reached'} at its check points "
               f"({refinement['stopped']}); {refinement['axes']} axes in the fit, {refinement['check_points']} check "
               "points outside it")

@@ -489,6 +489,12 @@ def quality_lines(quality: dict[str, Any]) -> list[str]:
         impossible.append(f"fit: gives a time for {_plural(timed, 'infeasible held-out entry', 'infeasible held-out entries')}"
                           f" (a slew that cannot be made; target NOT met), e.g. {example['fit_s']:.4g} s at "
                           f"{example['angle_deg']:g} deg about [{', '.join(f'{v:.3f}' for v in example['axis'])}]")
+    unknown = quality.get("no_value") or 0
+    if unknown:  # NaN: the fit does not know (cells beside entries that are not ok), not compared
+        compared = quality.get("points") or 0
+        impossible.append(f"fit: no time at {unknown} of {unknown + compared} ok held-out entries "
+                          f"({100 * unknown / (unknown + compared):.3g} %: cells beside entries that are not ok; NaN, "
+                          "not compared)")
     if not quality.get("points"):
         return [f"fit: no held-out points; {evaluation}", *impossible]
     held = quality["held_out"]
@@ -626,38 +632,48 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
     """Refine the table's axes (module docstring); the table part becomes the refined grid, the
     check points not split become the ``check`` part. Returns the refined triangles."""
     from scenarios.slewtable.fit import _hull
-    from scenarios.slewtable.refine import refine
+    from scenarios.slewtable.grid import held_out_angles
+    from scenarios.slewtable.refine import check_positions, refine
     spec = table.spec
     assert spec.refine is not None
     initial = table.parts["table"]
-    angles = np.deg2rad(spec.angles_deg)
-    entries: dict[tuple[tuple[float, ...], int], tuple[TableCase, dict[str, Any] | None]] = {}
+    entries: dict[tuple[tuple[float, ...], float], tuple[TableCase, dict[str, Any] | None]] = {}
+    between = held_out_angles(spec.angles_deg)  # the table's angles and their midpoints: position p at 2 p
 
-    def solve(axes: np.ndarray, angle_indices: list[int]) -> np.ndarray:
-        cases = [TableCase("table", i, k, axis, spec.angles_deg[k], case_scenario(spec, axis, spec.angles_deg[k]))
-                 for i, axis in enumerate(axes) for k in angle_indices]
-        times = np.full((len(axes), len(angle_indices)), np.nan)
-        for case, record in zip(cases, run(cases)):
-            entries[tuple(case.axis.tolist()), case.angle_index] = (case, record)
-            one = TablePart.empty(np.zeros((1, 3)), spec.angles_deg)
-            _fill(one, TableCase("table", 0, case.angle_index, case.axis, case.angle_deg, case.scenario), record,
-                  spec.objective)
-            if one.ok[0, case.angle_index]:
-                times[case.axis_index, angle_indices.index(case.angle_index)] = one.slew_time_s[0, case.angle_index]
+    def solve(axes: np.ndarray, positions: list[float]) -> np.ndarray:
+        # a table angle is the table's entry (its angle index), a midpoint a check entry (its index in `between`)
+        places = [(i, c, TableCase("table", i, int(p), axis, between[round(2 * p)],
+                                   case_scenario(spec, axis, between[round(2 * p)])) if p == int(p) else
+                   TableCase("check", i, round(2 * p), axis, between[round(2 * p)],
+                             case_scenario(spec, axis, between[round(2 * p)])))
+                  for i, axis in enumerate(axes) for c, p in enumerate(positions)]
+        times = np.full((len(axes), len(positions)), np.nan)
+        for (i, c, case), record in zip(places, run([case for *_, case in places])):
+            entries[tuple(case.axis.tolist()), positions[c]] = (case, record)
+            one = TablePart.empty(np.zeros((1, 3)), [case.angle_deg])
+            _fill(one, TableCase(case.part, 0, 0, case.axis, case.angle_deg, case.scenario), record, spec.objective)
+            if one.ok[0, 0]:
+                times[i, c] = one.slew_time_s[0, 0]
+            elif one.status[0][0] == "infeasible":
+                times[i, c] = np.inf
         return times
 
     def predict(axes: np.ndarray, times: np.ndarray, triangles: np.ndarray) -> Any:
         part = TablePart.empty(axes, spec.angles_deg)
-        part.slew_time_s[:] = times
-        part.status = [["ok" if np.isfinite(v) else "failed" for v in row] for row in times]
+        part.slew_time_s[:] = np.where(np.isfinite(times), times, np.nan)
+        part.status = [["ok" if np.isfinite(v) else ("infeasible" if v == np.inf else "failed") for v in row]
+                       for row in times]
         fit, _ = fit_entries(part, inertia, generators, None, triangles, rates, cones)
         if fit is None:
             return None
-        return lambda e, k: fit.many_axis_angle(np.repeat(e, len(k), axis=0), np.tile(angles[k], len(e))
-                                                ).reshape(len(e), len(k))
+        at = np.deg2rad(between)
+        return lambda e, p: fit.many_axis_angle(np.repeat(e, len(p), axis=0),
+                                                np.tile(at[np.round(2 * np.asarray(p)).astype(int)], len(e))
+                                                ).reshape(len(e), len(p))
 
     triangles = spec.triangles if spec.triangles is not None else _hull(initial.axes)
-    times = np.where(initial.ok, initial.slew_time_s, np.nan)
+    infeasible = np.array([[status == "infeasible" for status in row] for row in initial.status], dtype=bool)
+    times = np.where(initial.ok, initial.slew_time_s, np.where(infeasible.reshape(initial.ok.shape), np.inf, np.nan))
     result = refine(initial.axes, triangles, times, solve, predict, spec.refine)
     refined = TablePart.empty(result.axes, spec.angles_deg)
     n0 = len(initial.axes)
@@ -665,19 +681,21 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
         for k in range(len(spec.angles_deg)):
             if i < n0:  # the initial axes keep their order and entries
                 _copy_entry(initial, i, refined, i, k)
-            elif (found := entries.get((tuple(axis.tolist()), k))) is not None:
+            elif (found := entries.get((tuple(axis.tolist()), float(k)))) is not None:
                 _fill(refined, TableCase("table", i, k, axis, spec.angles_deg[k], found[0].scenario), found[1],
                       spec.objective)
-    checks = TablePart.empty(np.array([c["axis"] for c in result.checks]).reshape(-1, 3), spec.angles_deg)
+    checks = TablePart.empty(np.array([c["axis"] for c in result.checks]).reshape(-1, 3), between)
     for i, axis in enumerate(checks.axes):
-        for k in range(len(spec.angles_deg)):
-            if (found := entries.get((tuple(axis.tolist()), k))) is not None:
-                _fill(checks, TableCase("check", i, k, axis, spec.angles_deg[k], found[0].scenario), found[1],
-                      spec.objective)
+        for c, angle in enumerate(between):
+            if (found := entries.get((tuple(axis.tolist()), c / 2))) is not None:
+                _fill(checks, TableCase("check", i, c, axis, angle, found[0].scenario), found[1], spec.objective)
     table.parts["table"], table.parts["check"] = refined, checks
     table.refinement = {"tolerance": spec.refine.tolerance,
                         "check_angles_deg": [spec.angles_deg[k] for k in (spec.refine.check_angles
                                                                           or range(len(spec.angles_deg)))],
+                        "check_midpoint_angles_deg": [between[round(2 * p)] for p in check_positions(
+                            spec.refine.check_angles or list(range(len(spec.angles_deg))), len(spec.angles_deg))
+                                                      if p != int(p)],
                         "max_axes": spec.refine.max_axes, "max_rounds": spec.refine.max_rounds,
                         "initial_axes": n0, **result.summary()}
     return result.triangles

@@ -23,8 +23,12 @@ above the largest there is no value (NaN), unless the largest is 180°, which co
 
 Entries that are not ``ok`` (``status``) are not interpolated: the fit is NaN in every cell (a
 triangle of axes between two table angles) that has one with a non-zero weight, and ``inf`` where
-every entry it uses is ``infeasible`` (at such an entry itself). A table of slews from the identity
-only (``meta.from_identity_only``) refuses any other start attitude.
+every entry it uses is ``infeasible`` (at such an entry itself). That holds where the slew's end
+clears every pointing requirement too: a keep-out cone is a path constraint, and a slew ending just
+outside it may go around it slower than any ``ok`` corner of the cell, so no value of the corners
+bounds it; the refinement (:mod:`scenarios.slewtable.refine`) splits the triangles across the
+boundary to shrink that region. A table of slews from the identity only
+(``meta.from_identity_only``) refuses any other start attitude.
 
 A slew whose end attitude breaks a pointing requirement of the table's scenario is ``inf`` whatever
 the interpolation gives (``end_cones``: each cone's body boresight, its inertial direction and
