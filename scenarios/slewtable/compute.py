@@ -42,8 +42,9 @@ from scenarios.slewtable.spec import (
     torque_generators,
 )
 
-__all__ = ["FIT_TARGET", "PART_NAMES", "SlewTable", "TablePart", "compute_table", "end_cones", "eval_time_us",
-           "fit_entries", "held_out_errors", "quality_lines", "slower_than_known"]
+__all__ = ["FIT_TARGET", "PART_NAMES", "TIMED_OUT", "UNDERACTUATED_NOTE", "SlewTable", "TablePart", "compute_table",
+           "end_cones", "eval_time_us", "fit_entries", "held_out_errors", "quality_lines", "slower_than_known",
+           "timed_out_message"]
 
 PART_NAMES = ("table", "held_out", "check")
 """The grids of a table: the fitted one, the held-out one, and the refinement's check points that
@@ -68,7 +69,8 @@ class TablePart:
     plan_time_s : numpy.ndarray, shape (n, k)
         The planner's wall time [s] (NaN where none).
     status : list of list of str
-        Each entry's status (``ok``, ``violated``, ``infeasible``, ``failed``, ``crashed``, ``missing``).
+        Each entry's status (``ok``, ``violated``, ``infeasible``, ``failed``, ``timed_out``: the
+        planner ran out of ``case_timeout_s`` without an error, ``crashed``, ``missing``).
     message : list of list of str
         Each entry's message.
     best_known : list of list of (bool or None), optional
@@ -243,6 +245,38 @@ def slower_than_known(row: dict[str, Any]) -> str:
     return note if isinstance(note, str) else ""
 
 
+TIMED_OUT = "timed out after "
+"""How the engine's message of a case that ran out of ``case_timeout_s`` begins
+(:func:`scenarios.study.worker.timed_out_message`): the table's entry is then ``timed_out``."""
+
+
+def timed_out_message(engine_message: str) -> str:
+    """What a ``timed_out`` entry says: the engine's message, and what it means.
+
+    Parameters
+    ----------
+    engine_message : str
+        The engine's ``timed out after <limit> s (case_timeout_s)`` (with ``; worker stopped`` when
+        the driver stopped the worker).
+
+    Returns
+    -------
+    str
+        The message, saying that the planner was still solving (no error, not a crash), that the
+        slew time is unknown and the slew may be possible, and which key gives it more time.
+    """
+    return (f"{engine_message}: the planner was still solving (no error, not a crash); the slew time is unknown "
+            "and the slew may be possible: give it more time (table.execution.case_timeout_s) and run the table "
+            "again into the same --out")
+
+
+UNDERACTUATED_NOTE = ("; the spacecraft has torque about fewer than three independent axes (underactuated): its "
+                      "minimum-time solves take many times longer than a fully actuated one's, and may run to ipopt's "
+                      "iteration limit (failed) given the time; table.planner_options {time_regularization: 0.02} "
+                      "converges more often (the slew-table guide)")
+"""What a ``timed_out`` entry of an underactuated spacecraft adds (:func:`compute_table`)."""
+
+
 def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objective: str) -> None:
     i, k = case.axis_index, case.angle_index
     if record is None or not record.get("rows"):
@@ -252,6 +286,9 @@ def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objec
     if part.status[i][k] == "failed" and _proven_infeasible(case.scenario):
         part.status[i][k] = "infeasible"
     part.message[i][k] = str(row.get("message") or "")
+    if part.status[i][k] == "crashed" and part.message[i][k].startswith(TIMED_OUT):
+        part.status[i][k] = "timed_out"  # ran out of case_timeout_s: no error, the time unknown
+        part.message[i][k] = timed_out_message(part.message[i][k])
     if row.get("plan_time_s") is not None:
         part.plan_time_s[i, k] = float(row["plan_time_s"])
     reference = row.get("reference") or {}
@@ -574,6 +611,12 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
             store.close()
     table.wall_time_s = time.perf_counter() - start
     table.stored, table.rerun = run.stored, run.rerun
+    if len(generators) and np.linalg.matrix_rank(generators, tol=1e-9 * float(np.max(np.abs(generators)))) < 3:
+        for part in table.parts.values():
+            for statuses, messages in zip(part.status, part.message):
+                for k, status in enumerate(statuses):
+                    if status == "timed_out":
+                        messages[k] += UNDERACTUATED_NOTE
     if spec.objective != "min_time":
         table.fit_note = "the fit is of minimum-time tables (this table is min_energy at a fixed duration)"
         return table
