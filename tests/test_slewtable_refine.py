@@ -52,18 +52,23 @@ def smooth_time(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
     return 2.0 * np.sqrt(angles * _shape(axes)) * (1.0 + 0.02 * angles)
 
 
+def _at(positions) -> np.ndarray:
+    """The angles [rad] of angle positions (k: ANGLES[k], k + 0.5: the midpoint of ANGLES[k] and ANGLES[k + 1])."""
+    return np.interp(np.asarray(positions, dtype=float), np.arange(len(ANGLES)), ANGLES)
+
+
 def _solver(function, calls: list[int] | None = None):
-    def solve(axes: np.ndarray, indices: list[int]) -> np.ndarray:
+    def solve(axes: np.ndarray, positions: list[float]) -> np.ndarray:
         if calls is not None:
-            calls.append(len(axes) * len(indices))
-        return function(np.repeat(axes, len(indices), axis=0), np.tile(ANGLES[indices], len(axes))).reshape(
-            len(axes), len(indices))
+            calls.append(len(axes) * len(positions))
+        return function(np.repeat(axes, len(positions), axis=0), np.tile(_at(positions), len(axes))).reshape(
+            len(axes), len(positions))
     return solve
 
 
 def _predict(axes: np.ndarray, times: np.ndarray, triangles: np.ndarray):
     fit = SlewTimeFit(ANGLES, axes, times, inertia=INERTIA, generators=np.eye(3), triangles=triangles)
-    return lambda e, k: fit.many_axis_angle(np.repeat(e, len(k), axis=0), np.tile(ANGLES[k], len(e))).reshape(len(e), len(k))
+    return lambda e, p: fit.many_axis_angle(np.repeat(e, len(p), axis=0), np.tile(_at(p), len(e))).reshape(len(e), len(p))
 
 
 def _grid(n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -121,7 +126,7 @@ def test_a_table_the_fit_represents_is_checked_once_and_not_split():
     result = refine(axes, triangles, times, _solver(smooth_time, calls), _predict, RefineOptions(1e-6))
     assert result.reached and len(result.rounds) == 1
     edges = len(triangles) * 3 // 2
-    assert calls == [edges * 3]  # every edge midpoint, at every angle, once
+    assert calls == [edges * 5]  # every edge midpoint, at every angle and every angle midpoint, once
     assert result.rounds[0]["max_miss"] < 1e-9 and result.rounds[0]["split"] == 0
     assert len(result.axes) == len(axes) and len(result.checks) == edges
     np.testing.assert_array_equal(result.triangles, triangles)
@@ -133,9 +138,10 @@ def test_check_angles_cost_less_and_unsplit_checks_stay_out_of_the_fit():
     result = refine(axes, triangles, times, _solver(bump_time, calls), _predict,
                     RefineOptions(0.002, check_angles=[2], max_rounds=1))
     edges = len(triangles) * 3 // 2
-    assert calls[0] == edges  # checked at 180 deg only
+    assert calls[0] == edges * 2  # checked at 180 deg and at 135 deg, the midpoint of the interval beside it
     assert not result.reached and "rounds" in result.stopped
     assert result.checks and all(np.isnan(c["times"][0]) and np.isfinite(c["times"][2]) for c in result.checks)
+    assert all(np.isnan(c["midpoint_times"][0]) and np.isfinite(c["midpoint_times"][1]) for c in result.checks)
     assert np.all(np.isfinite(result.times))  # split points completed at every angle
     fit_axes = {tuple(a) for a in np.round(result.axes, 12).tolist()}
     assert not {tuple(np.round(c["axis"], 12).tolist()) for c in result.checks} & fit_axes
@@ -244,8 +250,10 @@ def test_command_refines_and_writes_the_refined_table(tmp_path, capsys, analytic
     table_rows = [r for r in rows if r["grid"] == "table"]
     check_rows = [r for r in rows if r["grid"] == "check"]
     assert len(table_rows) == 3 * len(fit.axes)
-    assert check_rows and len(check_rows) == 3 * refinement["check_points"]
-    assert all(r["status"] == "missing" for r in check_rows if float(r["angle_deg"]) != 180.0)
+    assert check_rows and len(check_rows) == 5 * refinement["check_points"]  # the table's angles and midpoints
+    assert refinement["check_midpoint_angles_deg"] == [135.0]  # the midpoint beside the check angle
+    assert all(r["status"] == "missing" for r in check_rows if float(r["angle_deg"]) not in (135.0, 180.0))
+    assert all(r["status"] == "ok" for r in check_rows if float(r["angle_deg"]) in (135.0, 180.0))
     assert sum(r["status"] == "failed" for r in table_rows) == 1
     with netcdf_file(out / "slew_table.nc", "r", mmap=False) as nc:
         assert nc.dimensions["axis"] == len(fit.axes)

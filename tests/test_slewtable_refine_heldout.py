@@ -73,15 +73,17 @@ def test_refinement_to_1_percent_meets_the_target_on_the_held_out_grid_it_never_
     assert initial["worst"]["angle_deg"] >= 150.0  # where the kink is deepest
     solved: list[np.ndarray] = []
 
-    def solve(new: np.ndarray, indices: list[int]) -> np.ndarray:
+    between = held_out_angles(ANGLES_DEG)  # position p is between[2 p]
+
+    def solve(new: np.ndarray, positions: list[float]) -> np.ndarray:
         solved.append(new)
-        return _times(new, ANGLES_DEG)[:, indices]
+        return _times(new, between)[:, [round(2 * p) for p in positions]]
 
     def predict(a: np.ndarray, t: np.ndarray, tri: np.ndarray):
         fit, _ = fit_entries(_part(a, ANGLES_DEG, t), np.eye(3), np.eye(3), None, tri)
-        theta = np.deg2rad(ANGLES_DEG)
-        return lambda e, k: fit.many_axis_angle(np.repeat(e, len(k), axis=0), np.tile(theta[k], len(e))).reshape(
-            len(e), len(k))
+        theta = np.deg2rad(between)
+        return lambda e, p: fit.many_axis_angle(np.repeat(e, len(p), axis=0),
+                                                np.tile(theta[[round(2 * x) for x in p]], len(e))).reshape(len(e), len(p))
 
     result = refine(axes, triangles, _times(axes, ANGLES_DEG), solve, predict, RefineOptions(FIT_TARGET))
     assert result.reached

@@ -4,9 +4,10 @@ Everything that can fail before an entry is computed is checked first (the scena
 and the options: exit 2 naming the YAML path or option; the output directory: exit 2 if it is not
 slewbench's or holds another kind of output; a Dask scheduler). Entries run on the trade-study
 engine and are stored as they finish, so a table interrupted (exit 130) or run again into the same
-``--out`` computes only the entries it lacks. A table whose entries crashed (raised, ran out of
-``case_timeout_s`` or killed their worker) writes its files, then exits 1 (as ``slewbench sweep``)
-saying how many crashed, why, and the command that runs them again. This module imports only the
+``--out`` computes only the entries it lacks. A table whose entries crashed (raised or killed their
+worker) or timed out (the planner still solving when ``case_timeout_s`` ran out: status
+``timed_out``) writes its files, then exits 1 (as ``slewbench sweep``) saying how many, why, and the
+command that runs them again. This module imports only the
 standard library until the command runs.
 """
 from __future__ import annotations
@@ -93,8 +94,8 @@ def command_table(args: argparse.Namespace) -> int:
     -------
     int
         0 when every entry is stored (entries that are not ok included: they are results); 1 when
-        entries crashed (:data:`~scenarios.cli.status.EXIT_CRASHED`: they have no result; the
-        files are written first), or with ``strict`` when an entry of the table or of its held-out
+        entries crashed or timed out (:data:`~scenarios.cli.status.EXIT_CRASHED`: they have no
+        result; the files are written first), or with ``strict`` when an entry of the table or of its held-out
         grid is not ``ok`` (the files are written first); 130 when interrupted.
 
     Raises
@@ -163,7 +164,8 @@ def command_table(args: argparse.Namespace) -> int:
         for item in refinement["rounds"]:
             print(f"refinement round {item['round']}: {item['checked']} midpoints checked, largest miss "
                   f"{100 * item['max_miss']:.3g} %, {item['missed']} over the tolerance, {item['split']} triangles split "
-                  f"(+{item['graded']} to keep the mesh graded), {item['axes']} axes, {item['solves']} entries solved")
+                  f"({item.get('boundary', 0)} of them across the boundary of the entries without a time; "
+                  f"+{item['graded']} to keep the mesh graded), {item['axes']} axes, {item['solves']} entries solved")
         print(f"refinement: {'reached' if refinement['reached'] else 'NOT reached'} at its check points "
               f"({refinement['stopped']}); {refinement['axes']} axes in the fit, {refinement['check_points']} check "
               "points outside it")
@@ -189,6 +191,10 @@ def command_table(args: argparse.Namespace) -> int:
     crashed = crashed_message(table, rerun_command(args, directory))
     if crashed:
         print(crashed, file=sys.stderr)
+    timed_out = timed_out_message(table, spec.case_timeout_s, rerun_command(args, directory))
+    if timed_out:
+        print(timed_out, file=sys.stderr)
+    if crashed or timed_out:
         return EXIT_CRASHED
     return EXIT_NOT_OK if args.strict and not_ok else EXIT_OK
 
@@ -284,6 +290,40 @@ def crashed_message(table: Any, command: str) -> str:
                         command)
 
 
+def timed_out_message(table: Any, limit_s: float, command: str) -> str:
+    """What a table whose entries ran out of their time limit says last (status ``timed_out``: the
+    planner was still solving, no error; the engine runs them again, as crashed ones, when the table
+    is run again into the same directory).
+
+    Parameters
+    ----------
+    table : SlewTable
+        The computed table (every grid).
+    limit_s : float
+        ``table.execution.case_timeout_s`` [s].
+    command : str
+        The command that runs them again (:func:`rerun_command`).
+
+    Returns
+    -------
+    str
+        ``slewbench: N of M entries timed out ...`` with the limit, what it means and how to give
+        them more time; empty when none timed out.
+    """
+    count, total = 0, 0
+    for part in table.parts.values():
+        for statuses in part.status:
+            total += len(statuses)
+            count += sum(status == "timed_out" for status in statuses)
+    if not count:
+        return ""
+    return (f"slewbench: {count} of {_count(total, 'entry', 'entries')} timed out: the planner was still solving "
+            f"when table.execution.case_timeout_s ({limit_s:g} s) ran out (no error, not a crash): they have no "
+            "result (status timed_out in slew_table.csv; the fit has no time around them). Give them more time "
+            "(a larger table.execution.case_timeout_s in the table file) and run again (the entries already stored "
+            f"are kept):\n  {command}")
+
+
 def rerun_command(args: argparse.Namespace, out: Path) -> str:
     """The command that computes a table's missing and crashed entries again: the same file, the
     flags the user gave that set the table's keys (so that it asks for the same entries),
@@ -343,7 +383,7 @@ def add_table_parser(commands: Any) -> None:
         "table", help="slew table: minimum slew time over eigen-axes and angles, CSV, NetCDF and a fast fit "
                       "slew_time(q0, qf)",
         epilog=f"exit status: {EXIT_OK} done (entries that failed or are not ok are results, stored with their "
-               f"status); {EXIT_CRASHED} entries crashed (no result: the files are written, the message says the "
+               f"status); {EXIT_CRASHED} entries crashed or timed out (no result: the files are written, the message says the "
                f"command that runs them again), or under --strict, an entry of the table or its held-out grid not ok; "
                f"{EXIT_BAD_SCENARIO} bad scenario or table file, option, or output location (nothing written); "
                f"{EXIT_INTERRUPTED} interrupted (the finished entries are stored: run it again). The table file's "
@@ -376,5 +416,6 @@ def add_table_parser(commands: Any) -> None:
     parser.add_argument("--no-plots", action="store_true", help="skip agility_envelope.png")
     parser.add_argument("--strict", action="store_true",
                         help=f"exit {EXIT_NOT_OK} when any entry of the table or its held-out grid is not ok (failed, "
-                             "violated, infeasible, crashed), after writing the files (for continuous integration)")
+                             "violated, infeasible, timed_out, crashed), after writing the files (for continuous "
+                             "integration)")
     parser.set_defaults(handler=command_table)

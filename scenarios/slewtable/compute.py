@@ -42,8 +42,9 @@ from scenarios.slewtable.spec import (
     torque_generators,
 )
 
-__all__ = ["FIT_TARGET", "PART_NAMES", "SlewTable", "TablePart", "compute_table", "end_cones", "eval_time_us",
-           "fit_entries", "held_out_errors", "quality_lines", "slower_than_known"]
+__all__ = ["FIT_TARGET", "PART_NAMES", "TIMED_OUT", "UNDERACTUATED_NOTE", "SlewTable", "TablePart", "compute_table",
+           "end_cones", "eval_time_us", "fit_entries", "held_out_errors", "quality_lines", "slower_than_known",
+           "timed_out_message"]
 
 PART_NAMES = ("table", "held_out", "check")
 """The grids of a table: the fitted one, the held-out one, and the refinement's check points that
@@ -68,7 +69,8 @@ class TablePart:
     plan_time_s : numpy.ndarray, shape (n, k)
         The planner's wall time [s] (NaN where none).
     status : list of list of str
-        Each entry's status (``ok``, ``violated``, ``infeasible``, ``failed``, ``crashed``, ``missing``).
+        Each entry's status (``ok``, ``violated``, ``infeasible``, ``failed``, ``timed_out``: the
+        planner ran out of ``case_timeout_s`` without an error, ``crashed``, ``missing``).
     message : list of list of str
         Each entry's message.
     best_known : list of list of (bool or None), optional
@@ -243,6 +245,38 @@ def slower_than_known(row: dict[str, Any]) -> str:
     return note if isinstance(note, str) else ""
 
 
+TIMED_OUT = "timed out after "
+"""How the engine's message of a case that ran out of ``case_timeout_s`` begins
+(:func:`scenarios.study.worker.timed_out_message`): the table's entry is then ``timed_out``."""
+
+
+def timed_out_message(engine_message: str) -> str:
+    """What a ``timed_out`` entry says: the engine's message, and what it means.
+
+    Parameters
+    ----------
+    engine_message : str
+        The engine's ``timed out after <limit> s (case_timeout_s)`` (with ``; worker stopped`` when
+        the driver stopped the worker).
+
+    Returns
+    -------
+    str
+        The message, saying that the planner was still solving (no error, not a crash), that the
+        slew time is unknown and the slew may be possible, and which key gives it more time.
+    """
+    return (f"{engine_message}: the planner was still solving (no error, not a crash); the slew time is unknown "
+            "and the slew may be possible: give it more time (table.execution.case_timeout_s) and run the table "
+            "again into the same --out")
+
+
+UNDERACTUATED_NOTE = ("; the spacecraft has torque about fewer than three independent axes (underactuated): its "
+                      "minimum-time solves take many times longer than a fully actuated one's, and may run to ipopt's "
+                      "iteration limit (failed) given the time; table.planner_options {time_regularization: 0.02} "
+                      "converges more often (the slew-table guide)")
+"""What a ``timed_out`` entry of an underactuated spacecraft adds (:func:`compute_table`)."""
+
+
 def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objective: str) -> None:
     i, k = case.axis_index, case.angle_index
     if record is None or not record.get("rows"):
@@ -252,6 +286,9 @@ def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objec
     if part.status[i][k] == "failed" and _proven_infeasible(case.scenario):
         part.status[i][k] = "infeasible"
     part.message[i][k] = str(row.get("message") or "")
+    if part.status[i][k] == "crashed" and part.message[i][k].startswith(TIMED_OUT):
+        part.status[i][k] = "timed_out"  # ran out of case_timeout_s: no error, the time unknown
+        part.message[i][k] = timed_out_message(part.message[i][k])
     if row.get("plan_time_s") is not None:
         part.plan_time_s[i, k] = float(row["plan_time_s"])
     reference = row.get("reference") or {}
@@ -489,6 +526,12 @@ def quality_lines(quality: dict[str, Any]) -> list[str]:
         impossible.append(f"fit: gives a time for {_plural(timed, 'infeasible held-out entry', 'infeasible held-out entries')}"
                           f" (a slew that cannot be made; target NOT met), e.g. {example['fit_s']:.4g} s at "
                           f"{example['angle_deg']:g} deg about [{', '.join(f'{v:.3f}' for v in example['axis'])}]")
+    unknown = quality.get("no_value") or 0
+    if unknown:  # NaN: the fit does not know (cells beside entries that are not ok), not compared
+        compared = quality.get("points") or 0
+        impossible.append(f"fit: no time at {unknown} of {unknown + compared} ok held-out entries "
+                          f"({100 * unknown / (unknown + compared):.3g} %: cells beside entries that are not ok; NaN, "
+                          "not compared)")
     if not quality.get("points"):
         return [f"fit: no held-out points; {evaluation}", *impossible]
     held = quality["held_out"]
@@ -568,6 +611,12 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
             store.close()
     table.wall_time_s = time.perf_counter() - start
     table.stored, table.rerun = run.stored, run.rerun
+    if len(generators) and np.linalg.matrix_rank(generators, tol=1e-9 * float(np.max(np.abs(generators)))) < 3:
+        for part in table.parts.values():
+            for statuses, messages in zip(part.status, part.message):
+                for k, status in enumerate(statuses):
+                    if status == "timed_out":
+                        messages[k] += UNDERACTUATED_NOTE
     if spec.objective != "min_time":
         table.fit_note = "the fit is of minimum-time tables (this table is min_energy at a fixed duration)"
         return table
@@ -626,38 +675,48 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
     """Refine the table's axes (module docstring); the table part becomes the refined grid, the
     check points not split become the ``check`` part. Returns the refined triangles."""
     from scenarios.slewtable.fit import _hull
-    from scenarios.slewtable.refine import refine
+    from scenarios.slewtable.grid import held_out_angles
+    from scenarios.slewtable.refine import check_positions, refine
     spec = table.spec
     assert spec.refine is not None
     initial = table.parts["table"]
-    angles = np.deg2rad(spec.angles_deg)
-    entries: dict[tuple[tuple[float, ...], int], tuple[TableCase, dict[str, Any] | None]] = {}
+    entries: dict[tuple[tuple[float, ...], float], tuple[TableCase, dict[str, Any] | None]] = {}
+    between = held_out_angles(spec.angles_deg)  # the table's angles and their midpoints: position p at 2 p
 
-    def solve(axes: np.ndarray, angle_indices: list[int]) -> np.ndarray:
-        cases = [TableCase("table", i, k, axis, spec.angles_deg[k], case_scenario(spec, axis, spec.angles_deg[k]))
-                 for i, axis in enumerate(axes) for k in angle_indices]
-        times = np.full((len(axes), len(angle_indices)), np.nan)
-        for case, record in zip(cases, run(cases)):
-            entries[tuple(case.axis.tolist()), case.angle_index] = (case, record)
-            one = TablePart.empty(np.zeros((1, 3)), spec.angles_deg)
-            _fill(one, TableCase("table", 0, case.angle_index, case.axis, case.angle_deg, case.scenario), record,
-                  spec.objective)
-            if one.ok[0, case.angle_index]:
-                times[case.axis_index, angle_indices.index(case.angle_index)] = one.slew_time_s[0, case.angle_index]
+    def solve(axes: np.ndarray, positions: list[float]) -> np.ndarray:
+        # a table angle is the table's entry (its angle index), a midpoint a check entry (its index in `between`)
+        places = [(i, c, TableCase("table", i, int(p), axis, between[round(2 * p)],
+                                   case_scenario(spec, axis, between[round(2 * p)])) if p == int(p) else
+                   TableCase("check", i, round(2 * p), axis, between[round(2 * p)],
+                             case_scenario(spec, axis, between[round(2 * p)])))
+                  for i, axis in enumerate(axes) for c, p in enumerate(positions)]
+        times = np.full((len(axes), len(positions)), np.nan)
+        for (i, c, case), record in zip(places, run([case for *_, case in places])):
+            entries[tuple(case.axis.tolist()), positions[c]] = (case, record)
+            one = TablePart.empty(np.zeros((1, 3)), [case.angle_deg])
+            _fill(one, TableCase(case.part, 0, 0, case.axis, case.angle_deg, case.scenario), record, spec.objective)
+            if one.ok[0, 0]:
+                times[i, c] = one.slew_time_s[0, 0]
+            elif one.status[0][0] == "infeasible":
+                times[i, c] = np.inf
         return times
 
     def predict(axes: np.ndarray, times: np.ndarray, triangles: np.ndarray) -> Any:
         part = TablePart.empty(axes, spec.angles_deg)
-        part.slew_time_s[:] = times
-        part.status = [["ok" if np.isfinite(v) else "failed" for v in row] for row in times]
+        part.slew_time_s[:] = np.where(np.isfinite(times), times, np.nan)
+        part.status = [["ok" if np.isfinite(v) else ("infeasible" if v == np.inf else "failed") for v in row]
+                       for row in times]
         fit, _ = fit_entries(part, inertia, generators, None, triangles, rates, cones)
         if fit is None:
             return None
-        return lambda e, k: fit.many_axis_angle(np.repeat(e, len(k), axis=0), np.tile(angles[k], len(e))
-                                                ).reshape(len(e), len(k))
+        at = np.deg2rad(between)
+        return lambda e, p: fit.many_axis_angle(np.repeat(e, len(p), axis=0),
+                                                np.tile(at[np.round(2 * np.asarray(p)).astype(int)], len(e))
+                                                ).reshape(len(e), len(p))
 
     triangles = spec.triangles if spec.triangles is not None else _hull(initial.axes)
-    times = np.where(initial.ok, initial.slew_time_s, np.nan)
+    infeasible = np.array([[status == "infeasible" for status in row] for row in initial.status], dtype=bool)
+    times = np.where(initial.ok, initial.slew_time_s, np.where(infeasible.reshape(initial.ok.shape), np.inf, np.nan))
     result = refine(initial.axes, triangles, times, solve, predict, spec.refine)
     refined = TablePart.empty(result.axes, spec.angles_deg)
     n0 = len(initial.axes)
@@ -665,19 +724,21 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
         for k in range(len(spec.angles_deg)):
             if i < n0:  # the initial axes keep their order and entries
                 _copy_entry(initial, i, refined, i, k)
-            elif (found := entries.get((tuple(axis.tolist()), k))) is not None:
+            elif (found := entries.get((tuple(axis.tolist()), float(k)))) is not None:
                 _fill(refined, TableCase("table", i, k, axis, spec.angles_deg[k], found[0].scenario), found[1],
                       spec.objective)
-    checks = TablePart.empty(np.array([c["axis"] for c in result.checks]).reshape(-1, 3), spec.angles_deg)
+    checks = TablePart.empty(np.array([c["axis"] for c in result.checks]).reshape(-1, 3), between)
     for i, axis in enumerate(checks.axes):
-        for k in range(len(spec.angles_deg)):
-            if (found := entries.get((tuple(axis.tolist()), k))) is not None:
-                _fill(checks, TableCase("check", i, k, axis, spec.angles_deg[k], found[0].scenario), found[1],
-                      spec.objective)
+        for c, angle in enumerate(between):
+            if (found := entries.get((tuple(axis.tolist()), c / 2))) is not None:
+                _fill(checks, TableCase("check", i, c, axis, angle, found[0].scenario), found[1], spec.objective)
     table.parts["table"], table.parts["check"] = refined, checks
     table.refinement = {"tolerance": spec.refine.tolerance,
                         "check_angles_deg": [spec.angles_deg[k] for k in (spec.refine.check_angles
                                                                           or range(len(spec.angles_deg)))],
+                        "check_midpoint_angles_deg": [between[round(2 * p)] for p in check_positions(
+                            spec.refine.check_angles or list(range(len(spec.angles_deg))), len(spec.angles_deg))
+                                                      if p != int(p)],
                         "max_axes": spec.refine.max_axes, "max_rounds": spec.refine.max_rounds,
                         "initial_axes": n0, **result.summary()}
     return result.triangles

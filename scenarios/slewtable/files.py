@@ -29,9 +29,9 @@ CSV_COLUMNS = ("grid", "axis_x", "axis_y", "axis_z", "angle_deg", "slew_time_s",
 BEST_KNOWN_FILL = -1
 """The fill value of ``best_known`` in ``slew_table.nc``: the question does not apply (no slew time,
 or a ``min_energy`` table)."""
-STATUS_CODES = ("ok", "violated", "failed", "crashed", "missing", "infeasible")
-"""Entry status -> its code in the NetCDF file (the index; ``infeasible`` last, so that the earlier
-codes keep their values)."""
+STATUS_CODES = ("ok", "violated", "failed", "crashed", "missing", "infeasible", "timed_out")
+"""Entry status -> its code in the NetCDF file (the index; the later ones appended, so that the
+earlier codes keep their values)."""
 TABLE_FILES = ("slew_table.csv", "slew_table.nc", "fit.json", "agility_envelope.png")
 """The files a table writes (``fit.json`` only when there is a fit)."""
 

@@ -23,8 +23,12 @@ above the largest there is no value (NaN), unless the largest is 180°, which co
 
 Entries that are not ``ok`` (``status``) are not interpolated: the fit is NaN in every cell (a
 triangle of axes between two table angles) that has one with a non-zero weight, and ``inf`` where
-every entry it uses is ``infeasible`` (at such an entry itself). A table of slews from the identity
-only (``meta.from_identity_only``) refuses any other start attitude.
+every entry it uses is ``infeasible`` (at such an entry itself). That holds where the slew's end
+clears every pointing requirement too: a keep-out cone is a path constraint, and a slew ending just
+outside it may go around it slower than any ``ok`` corner of the cell, so no value of the corners
+bounds it; the refinement (:mod:`scenarios.slewtable.refine`) splits the triangles across the
+boundary to shrink that region. A table of slews from the identity only
+(``meta.from_identity_only``) refuses any other start attitude.
 
 A slew whose end attitude breaks a pointing requirement of the table's scenario is ``inf`` whatever
 the interpolation gives (``end_cones``: each cone's body boresight, its inertial direction and
@@ -37,9 +41,14 @@ Evaluation (:meth:`SlewTimeFit.__call__`) is pure Python on precomputed lists (a
 finds the candidate triangles), since every NumPy call costs about a microsecond;
 :meth:`SlewTimeFit.slew_time_many` is the vectorised form.
 
-Quaternions are scalar first, body to inertial: the slew from ``q0`` to ``qf`` is the rotation
-``dq = q0⁻¹ ⊗ qf`` (Hamilton product), whose axis is in the body frame and whose angle (the short
-way, in [0, π]) is the table's angle.
+Quaternions are scalar first, ``[w, x, y, z]``, body to inertial, unless the fit is made or loaded
+with ``quaternion_order="scalar_last"`` (``[x, y, z, w]``, as ``maneuver.quaternion_order`` of a
+scenario; ``fit.json`` keeps the order as ``quaternion_order``): the slew from ``q0`` to ``qf`` is
+the rotation ``dq = q0⁻¹ ⊗ qf`` (Hamilton product), whose axis is in the body frame and whose angle
+(the short way, in [0, π]) is the table's angle. A unit quaternion in the other order is a unit
+quaternion too, of another rotation: the fit cannot tell, and answers for that rotation. Only a
+table of slews from the identity only can tell: the identity written scalar last, ``[0, 0, 0, 1]``,
+is 180° from it read scalar first, and the refusal says so.
 """
 from __future__ import annotations
 
@@ -54,7 +63,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["FIT_FORMAT", "IDENTITY_TOLERANCE", "UNIT_TOLERANCE", "SlewTimeFit", "fit_table", "load_fit"]
+__all__ = ["FIT_FORMAT", "IDENTITY_TOLERANCE", "QUATERNION_ORDERS", "UNIT_TOLERANCE", "SlewTimeFit", "fit_table",
+           "load_fit"]
 
 FIT_FORMAT = "slewbench-slew-time-fit/1"
 """The ``format`` key of ``fit.json``."""
@@ -226,11 +236,23 @@ identity only (``meta.from_identity_only``: with pointing requirements or enviro
 slew time depends on the start attitude, and the table holds slews from the identity)."""
 
 
-def _identity_error(name: str, q: Any, angle: float) -> ValueError:
+QUATERNION_ORDERS = ("scalar_first", "scalar_last")
+"""The orders a fit takes quaternions in: ``[w, x, y, z]`` (the default) or ``[x, y, z, w]``."""
+
+
+def _identity_error(name: str, q: Any, angle: float, order: str = "scalar_first") -> ValueError:
+    values = [float(v) for v in q]
+    other = values[0] if order == "scalar_last" else values[-1]  # where the other order keeps the scalar
+    hint = ""
+    if abs(other) >= math.sqrt(sum(v * v for v in values)) * math.cos(IDENTITY_TOLERANCE / 2.0):
+        written = "[w, x, y, z]" if order == "scalar_last" else "[x, y, z, w]"
+        hint = (f"; it is the identity written {written}: this fit reads quaternions {order.replace('_', ' ')}, "
+                f"load it with quaternion_order={QUATERNION_ORDERS[order == 'scalar_first']!r} to call it so")
     return ValueError(f"{name} must be the identity attitude (within {IDENTITY_TOLERANCE:g} rad): this fit's "
                       "table holds slews from the identity only (meta.from_identity_only: pointing requirements "
                       "or environment torques make the slew time depend on the start attitude, not only on the "
-                      f"rotation), got {list(q)} ({angle:.6g} rad from the identity)")
+                      f"rotation), got {list(q)} ({angle:.6g} rad from the identity, quaternions read "
+                      f"{order.replace('_', ' ')}){hint}")
 
 
 def _as_list(name: str, value: Any) -> list[float]:
@@ -268,7 +290,9 @@ def _check_unit(q0: Sequence[float], qf: Sequence[float]) -> None:
 class SlewTimeFit:
     """Slew time [s] between two attitudes from a slew table's fit (module docstring).
 
-    Call it as ``fit(q0, qf)`` (pure Python, a few microseconds), or :meth:`slew_time_many` for arrays.
+    Call it as ``fit(q0, qf)`` (pure Python, a few microseconds), or :meth:`slew_time_many` for arrays;
+    quaternions scalar first, ``[w, x, y, z]``, body to inertial (or ``[x, y, z, w]`` with
+    ``quaternion_order="scalar_last"``: :attr:`quaternion_order` says which).
 
     Parameters
     ----------
@@ -306,21 +330,29 @@ class SlewTimeFit:
         and 1 for a keep-out (0 for a keep-in) (:func:`scenarios.slewtable.compute.end_cones`).
         A slew whose end attitude breaks one is ``inf``. None: none (the table has no pointing
         requirement; a table with them holds slews from the identity only).
+    quaternion_order : {"scalar_first", "scalar_last"}, optional
+        The order :meth:`__call__` and :meth:`slew_time_many` read quaternions in: ``[w, x, y, z]``
+        (default) or ``[x, y, z, w]``. A unit quaternion in the other order is another rotation:
+        the fit cannot tell (module docstring).
 
     Raises
     ------
     ValueError
         Shapes that disagree, angles not increasing in (0, π], times of ``ok`` entries not positive
-        and finite, no ``ok`` entry, axes that do not span the sphere, or a ``max_rate`` that is
-        not positive and finite.
+        and finite, no ``ok`` entry, axes that do not span the sphere, a ``max_rate`` that is
+        not positive and finite, or another ``quaternion_order``.
     """
 
     def __init__(self, angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[str, Any] | None = None,
                  inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
                  triangles: ArrayLike | None = None, status: ArrayLike | None = None,
                  momentum_generators: ArrayLike | None = None, max_rate: float | None = None,
-                 end_cones: ArrayLike | None = None):
+                 end_cones: ArrayLike | None = None, quaternion_order: str = "scalar_first"):
         from scipy.interpolate import PchipInterpolator
+        if quaternion_order not in QUATERNION_ORDERS:
+            raise ValueError(f"quaternion_order must be one of {', '.join(QUATERNION_ORDERS)}, got {quaternion_order!r}")
+        self.quaternion_order = quaternion_order
+        self._scalar_last = quaternion_order == "scalar_last"
         theta = np.asarray(angles, dtype=float)
         e = np.asarray(axes, dtype=float)
         t = np.asarray(times, dtype=float)
@@ -626,9 +658,13 @@ class SlewTimeFit:
         Parameters
         ----------
         q0, qf : sequence of 4 floats
-            Attitude quaternions, scalar first, body to inertial (unit; tuples or lists of
-            Python floats are fastest; NumPy arrays, and sequences of NumPy scalars or ints,
-            are converted first).
+            Attitude quaternions, body to inertial, in :attr:`quaternion_order`: scalar first,
+            ``[w, x, y, z]``, unless the fit was made or loaded with ``quaternion_order="scalar_last"``
+            (``[x, y, z, w]``). A quaternion in the other order is read as another rotation: it
+            cannot be told apart (a unit quaternion either way), except a start that must be the
+            identity (``meta.from_identity_only``), whose refusal names the order. Unit; tuples or
+            lists of Python floats are fastest; NumPy arrays, and sequences of NumPy scalars or
+            ints, are converted first.
 
         Returns
         -------
@@ -652,19 +688,28 @@ class SlewTimeFit:
         if type(qf) is not tuple and type(qf) is not list:
             qf = _as_list("qf", qf)
         try:
-            a, b, c, d = q0
-            e, f, g, h = qf
+            if self._scalar_last:  # [x, y, z, w]
+                b, c, d, a = q0
+                f, g, h, e = qf
+            else:
+                a, b, c, d = q0
+                e, f, g, h = qf
             if type(a) is not float or type(e) is not float:  # e.g. NumPy scalars: ~10x a float per operation
                 a, b, c, d = _floats("q0", q0)
                 e, f, g, h = _floats("qf", qf)
+                if self._scalar_last:
+                    a, b, c, d = d, a, b, c
+                    e, f, g, h = h, e, f, g
             n0 = a * a + b * b + c * c + d * d
             n1 = e * e + f * f + g * g + h * h
         except (TypeError, ValueError):
-            raise TypeError(f"q0 and qf must be 4 numbers each (scalar first), got {q0!r} and {qf!r}") from None
+            raise TypeError(f"q0 and qf must be 4 numbers each ({self.quaternion_order.replace('_', ' ')}), "
+                            f"got {q0!r} and {qf!r}") from None
         if not (abs(n0 - 1.0) <= _UNIT_SQUARED and abs(n1 - 1.0) <= _UNIT_SQUARED):  # NaN fails too
             _check_unit(q0, qf)
         if self._identity_only and b * b + c * c + d * d > self._identity_vsq * n0:
-            raise _identity_error("q0", q0, 2.0 * math.atan2(math.sqrt(b * b + c * c + d * d), abs(a)))
+            raise _identity_error("q0", q0, 2.0 * math.atan2(math.sqrt(b * b + c * c + d * d), abs(a)),
+                                  self.quaternion_order)
         # dq = conj(q0) ⊗ qf
         w = a * e + b * f + c * g + d * h
         x = a * f - b * e - c * h + d * g
@@ -756,7 +801,8 @@ class SlewTimeFit:
         Parameters
         ----------
         q0, qf : array_like, shape (n, 4) or (4,)
-            Attitude quaternions, scalar first, body to inertial (broadcast against each other).
+            Attitude quaternions, body to inertial, in :attr:`quaternion_order` (scalar first,
+            ``[w, x, y, z]``, by default), broadcast against each other.
 
         Returns
         -------
@@ -778,7 +824,10 @@ class SlewTimeFit:
                 raise TypeError(f"{name} must be quaternions of 4 numbers (scalar first), got shape {array.shape}")
             arrays.append(array)
         a, b = np.broadcast_arrays(*arrays)
-        for name, quaternions in (("q0", a), ("qf", b)):
+        given, given_f = a, b  # as the caller wrote them (messages)
+        if self._scalar_last:  # [x, y, z, w] -> [w, x, y, z]
+            a, b = a[..., [3, 0, 1, 2]], b[..., [3, 0, 1, 2]]
+        for name, quaternions in (("q0", given), ("qf", given_f)):
             norms = np.linalg.norm(quaternions, axis=-1)
             bad = ~(np.abs(norms - 1.0) <= UNIT_TOLERANCE)
             if np.any(bad):
@@ -791,8 +840,9 @@ class SlewTimeFit:
             if np.any(bad):
                 row = int(np.argmax(bad.ravel()))
                 q = a.reshape(-1, 4)[row]
-                raise _identity_error(f"q0[{row}]", q.tolist(), 2.0 * math.atan2(math.sqrt(float(vector.ravel()[row])),
-                                                                                abs(float(q[0]))))
+                raise _identity_error(f"q0[{row}]", given.reshape(-1, 4)[row].tolist(),
+                                      2.0 * math.atan2(math.sqrt(float(vector.ravel()[row])), abs(float(q[0]))),
+                                      self.quaternion_order)
         axes, angles = relative_axis_angle(a, b)
         return self.many_axis_angle(axes, angles)
 
@@ -810,8 +860,8 @@ class SlewTimeFit:
             ``facets`` (the rows ``a_f`` of ``s(e)`` [s²/rad]), ``rate_facets`` (the rows ``b_f``
             of ``m(e)`` [s/rad]), ``inertia`` [kg m²], ``torque_generators`` [N m],
             ``momentum_generators`` [N m s], ``max_rate`` [rad/s] (null: none), ``end_cones``
-            (boresight, direction, cosine of the half-angle, 1 keep-out / 0 keep-in, a row each)
-            and ``meta``.
+            (boresight, direction, cosine of the half-angle, 1 keep-out / 0 keep-in, a row each),
+            ``quaternion_order`` (the order the fit's call reads quaternions in) and ``meta``.
         """
         return {"format": FIT_FORMAT,
                 "model": "T(e, θ) = b(e, θ) · g(e, θ), b = √(θ s) if θ m² <= s else (θ m + s/m)/2 (half the "
@@ -824,7 +874,7 @@ class SlewTimeFit:
                 "facets": self.facets.tolist(), "rate_facets": self.rate_facets.tolist(),
                 "inertia": self.inertia.tolist(), "torque_generators": self.generators.tolist(),
                 "momentum_generators": self.momentum_generators.tolist(), "max_rate": self.max_rate,
-                "end_cones": self.end_cones.tolist(), "meta": self.meta}
+                "end_cones": self.end_cones.tolist(), "quaternion_order": self.quaternion_order, "meta": self.meta}
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write :meth:`to_dict` as JSON.
@@ -838,7 +888,8 @@ class SlewTimeFit:
 
     def __repr__(self) -> str:
         return (f"<SlewTimeFit: {len(self.axes)} axes x {len(self.angles)} angles "
-                f"({np.rad2deg(self.angles[0]):g}..{np.rad2deg(self.angles[-1]):g} deg)>")
+                f"({np.rad2deg(self.angles[0]):g}..{np.rad2deg(self.angles[-1]):g} deg), quaternions "
+                f"{self.quaternion_order.replace('_', ' ')}>")
 
 
 def _plain(values: np.ndarray) -> list[Any]:
@@ -850,7 +901,7 @@ def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[s
               inertia: ArrayLike | None = None, generators: ArrayLike | None = None,
               triangles: ArrayLike | None = None, status: ArrayLike | None = None,
               momentum_generators: ArrayLike | None = None, max_rate: float | None = None,
-              end_cones: ArrayLike | None = None) -> SlewTimeFit:
+              end_cones: ArrayLike | None = None, quaternion_order: str = "scalar_first") -> SlewTimeFit:
     """Fit a slew table (module docstring).
 
     Parameters
@@ -877,6 +928,8 @@ def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[s
         Body-rate bound [rad/s].
     end_cones : array_like, shape (c, 8), optional
         The pointing requirements' cones at the end of a slew (:class:`SlewTimeFit`).
+    quaternion_order : {"scalar_first", "scalar_last"}, optional
+        The order the fit's call reads quaternions in (:class:`SlewTimeFit`).
 
     Returns
     -------
@@ -884,28 +937,33 @@ def fit_table(angles: ArrayLike, axes: ArrayLike, times: ArrayLike, meta: dict[s
         The fit.
     """
     return SlewTimeFit(angles, axes, times, meta, inertia, generators, triangles, status, momentum_generators,
-                       max_rate, end_cones)
+                       max_rate, end_cones, quaternion_order)
 
 
-def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
+def load_fit(path: str | os.PathLike[str], quaternion_order: str | None = None) -> SlewTimeFit:
     """Read a ``fit.json`` written by ``slewbench table``.
 
     Parameters
     ----------
     path : str or os.PathLike
         The ``fit.json`` file, or the table's output directory holding it.
+    quaternion_order : {"scalar_first", "scalar_last"} or None, optional
+        The order the fit's call reads quaternions in: ``[w, x, y, z]`` or ``[x, y, z, w]``; None:
+        the file's ``quaternion_order`` (``scalar_first`` in a file written without one).
 
     Returns
     -------
     SlewTimeFit
-        The fit; call it as ``fit(q0, qf)`` (quaternions scalar first, body to inertial) [s].
+        The fit; call it as ``fit(q0, qf)`` (quaternions body to inertial, in
+        :attr:`SlewTimeFit.quaternion_order`) [s].
 
     Raises
     ------
     ValueError
         The file is not a slew-time fit of this format, or one that filled entries that were not
         ``ok`` (written before the fit kept them as gaps), or one of slews from the identity only
-        without ``end_cones`` (written before the fit checked end attitudes).
+        without ``end_cones`` (written before the fit checked end attitudes); a quaternion order
+        (given, or the file's) other than ``scalar_first`` or ``scalar_last``.
     """
     file = Path(path)
     if file.is_dir():
@@ -924,6 +982,10 @@ def load_fit(path: str | os.PathLike[str]) -> SlewTimeFit:
                          "against the pointing requirements (it gave times for slews ending inside a keep-out "
                          "cone); run `slewbench table` again to write the fit with the check")
     times = np.array(data["times_s"], dtype=float)  # null (an entry not ok) -> NaN
+    order = quaternion_order if quaternion_order is not None else data.get("quaternion_order", "scalar_first")
+    if order not in QUATERNION_ORDERS:
+        where = "quaternion_order" if quaternion_order is not None else f"{file}'s quaternion_order"
+        raise ValueError(f"{where} must be one of {', '.join(QUATERNION_ORDERS)}, got {order!r}")
     return SlewTimeFit(data["angles_rad"], data["axes"], times, data.get("meta"), data.get("inertia"),
                        data.get("torque_generators"), data.get("triangles"), data.get("status"),
-                       data.get("momentum_generators"), data.get("max_rate"), data.get("end_cones"))
+                       data.get("momentum_generators"), data.get("max_rate"), data.get("end_cones"), order)

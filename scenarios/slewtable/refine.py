@@ -5,23 +5,33 @@ of other axes) are the roots of a forest of spherical triangles (:class:`Triangl
 
 1. *Check.* For every edge of the active triangles (all of them in round 1) whose midpoint is not
    known yet, the midpoint (on the great circle, so that a child never crosses a kink its parent
-   did not) is solved at the *check angles* and the current fit predicts it there; the point's
-   *miss* is the largest ``|predicted / solved - 1|`` over those angles (an entry that is not
-   ``ok``, or where the fit has no value, counts as a miss: the fit cannot vouch for it).
+   did not) is solved at the *check angles* and at the midpoints of the table-angle intervals beside
+   them (:func:`check_positions`: the fit interpolates in angle there, as the held-out grid's
+   midpoints measure), and the current fit predicts it there; the point's *miss* is the largest
+   ``|predicted / solved - 1|`` over those angles. An entry that is not ``ok``, or where the fit
+   has no value, counts as a miss (the fit cannot vouch for it), except a proven-``infeasible``
+   entry where the fit says ``inf`` too (the slew's end attitude breaks a pointing requirement:
+   the fit knows it).
 2. *Split.* An active triangle whose largest edge-midpoint miss is over the tolerance is cut in
    four at its edge midpoints (as is one whose three midpoints are known at every angle already:
-   the data costs nothing more). Neighbours are then cut too until no triangle has an edge
-   subdivided twice or more than one subdivided edge (the mesh stays graded); the fit cuts a
-   triangle with one subdivided edge in two, so that the triangulation is conforming (no vertex
-   inside an edge) and the interpolant continuous.
+   the data costs nothing more), and so is a *boundary* triangle: one whose corners, at a table
+   angle, have both entries with a time and entries without one (the fit has no value in the cells
+   beside that angle wherever the slew's end clears the pointing requirements: cutting it shrinks
+   that region to the cells along the boundary). Neighbours are then cut too until no
+   triangle has an edge subdivided twice or more than one subdivided edge (the mesh stays
+   graded); the fit cuts a triangle with one subdivided edge in two, so that the triangulation is
+   conforming (no vertex inside an edge) and the interpolant continuous.
 3. *Complete.* Every new vertex is solved at the table's other angles.
-4. The next round checks the children of the triangles split for a miss.
+4. The next round checks the children of the triangles split for a miss or on the boundary.
 
-It stops when no check misses (the largest miss is under the tolerance: ``reached``), when no
-triangle is left to check, or when the next round would pass the budget of axes or rounds. A
-check entry of a midpoint that is not split is kept (the table's files list it) but is not in the
-fit. The refinement's checks are not a measure of the final fit's error: they measure the fit
-*before* the round's points were added. The held-out grid does.
+It stops when no check misses (the largest miss is under the tolerance: ``reached``) and no
+boundary triangle was split, when no triangle is left to check, or when the next round would pass
+the budget of axes or rounds (``reached`` then says whether the last round's checks all met the
+tolerance). Only axes are refined: in angle the region without a value stays the interval between
+the table's angles on either side of the boundary (more table angles shrink it). A check entry of a
+midpoint that is not split is kept (the table's files list it) but is not in the fit, and neither
+is a check at an angle midpoint. The refinement's checks are not a measure of the final fit's
+error: they measure the fit *before* the round's points were added. The held-out grid does.
 
 The solves go through a callable (:data:`Solver`): the slew table's runs them on the trade-study
 engine (:func:`scenarios.slewtable.compute.compute_table`); tests give analytic functions.
@@ -36,11 +46,36 @@ import numpy as np
 
 from scenarios.schema.table import TABLE_REFINE
 
-__all__ = ["RefineOptions", "RefineResult", "Solver", "TriangleMesh", "refine"]
+__all__ = ["RefineOptions", "RefineResult", "Solver", "TriangleMesh", "check_positions", "refine"]
 
-Solver = Callable[[np.ndarray, list[int]], np.ndarray]
-"""``solve(axes, angle_indices) -> times``: slew times [s] of unit axes (n, 3) at the table's angles
-of the given indices, shape (n, len(angle_indices)); NaN where an entry is not ``ok``."""
+Solver = Callable[[np.ndarray, list[float]], np.ndarray]
+"""``solve(axes, positions) -> times``: slew times [s] of unit axes (n, 3) at angle *positions*, shape
+(n, len(positions)): position ``k`` (a whole number) is the table's angle ``k``, ``k + 0.5`` the
+midpoint between its angles ``k`` and ``k + 1``; ``inf`` where an entry is proven ``infeasible``, NaN
+where it is otherwise not ``ok``. The fit that ``predict`` returns takes the same positions."""
+
+
+def check_positions(check: list[int], k: int) -> list[float]:
+    """Where a midpoint is checked: the check angles and the midpoints of the table-angle intervals
+    beside them.
+
+    Parameters
+    ----------
+    check : list of int
+        Indices of the table's angles to check at, increasing.
+    k : int
+        How many angles the table has.
+
+    Returns
+    -------
+    list of float
+        Angle positions (:data:`Solver`), increasing: every check index, and ``j + 0.5`` for each
+        interval ``[j, j + 1]`` with a check index at one end (all ``2 k - 1`` for every angle,
+        as :func:`scenarios.slewtable.grid.held_out_angles`).
+    """
+    chosen = set(check)
+    between = {j + 0.5 for j in range(k - 1) if j in chosen or j + 1 in chosen}
+    return sorted({float(c) for c in chosen} | between)
 
 
 def _edge(i: int, j: int) -> tuple[int, int]:
@@ -237,15 +272,19 @@ class RefineResult:
     axes : numpy.ndarray, shape (n, 3)
         The fit's axes: the initial ones first, then the refinement's.
     times : numpy.ndarray, shape (n, k)
-        Their slew times [s] at every angle (NaN where an entry is not ``ok``).
+        Their slew times [s] at every angle (``inf`` where an entry is proven ``infeasible``, NaN
+        where it is otherwise not ``ok``).
     triangles : numpy.ndarray of int, shape (t, 3)
         The conforming triangulation over ``axes``.
     checks : list of dict
-        Each check point not in the fit: ``axis``, ``times`` (NaN where not solved or not ok).
+        Each check point not in the fit: ``axis``, ``times`` at the table's angles and
+        ``midpoint_times`` at the midpoints between them (NaN where not solved or not ok, ``inf``
+        where infeasible).
     rounds : list of dict
         Per round: ``checked`` (points), ``solves``, ``max_miss``, ``missed`` (points over the
-        tolerance), ``split`` (triangles split for a miss), ``graded`` (split to keep the mesh
-        graded), ``axes`` (after the round).
+        tolerance), ``split`` (triangles split for a miss or on the boundary), ``boundary`` (of
+        them, those on the boundary of the entries without a time), ``graded`` (split to keep the
+        mesh graded), ``axes`` (after the round).
     reached : bool
         The last round's checks all met the tolerance.
     stopped : str
@@ -274,7 +313,7 @@ class RefineResult:
 
 
 def refine(axes: Any, triangles: Any, times: Any, solve: Solver, predict: Callable[[np.ndarray, np.ndarray, np.ndarray],
-           Callable[[np.ndarray, list[int]], np.ndarray] | None], options: RefineOptions) -> RefineResult:
+           Callable[[np.ndarray, list[float]], np.ndarray] | None], options: RefineOptions) -> RefineResult:
     """Refine a table's axes until the fit's misses at edge midpoints are under the tolerance
     (module docstring).
 
@@ -285,12 +324,13 @@ def refine(axes: Any, triangles: Any, times: Any, solve: Solver, predict: Callab
     triangles : array_like of int, shape (t, 3)
         Their triangles, covering the sphere once.
     times : array_like, shape (n, k)
-        Their slew times at every table angle [s] (NaN: not ok).
+        Their slew times at every table angle [s] (``inf``: proven infeasible; NaN: otherwise not ok).
     solve : Solver
-        Solves new axes at some of the table's angles.
+        Solves new axes at some angle positions (the table's angles and the midpoints between them).
     predict : callable
-        ``predict(axes, times, triangles)`` -> a fit as ``f(axes, angle_indices) -> times`` (shape
-        (n, len(angle_indices))), or None when no fit can be made from them.
+        ``predict(axes, times, triangles)`` -> a fit as ``f(axes, positions) -> times`` (shape
+        (n, len(positions)), positions as :data:`Solver`'s; ``inf`` where the end attitude breaks a
+        pointing requirement), or None when no fit can be made from them.
     options : RefineOptions
         Tolerance and budget.
 
@@ -315,35 +355,46 @@ def refine(axes: Any, triangles: Any, times: Any, solve: Solver, predict: Callab
         raise ValueError("max_rounds and max_axes must be >= 1")
     mesh = TriangleMesh(axes, triangles)
     rows: dict[int, np.ndarray] = {i: known[i] for i in range(len(known))}  # point -> times (NaN: not solved)
+    between: dict[int, np.ndarray] = {}  # point -> times at the angle midpoints (NaN: not solved)
     complete = set(rows)  # points solved at every angle
+    positions = check_positions(check, k)
+    on_table = [int(p) for p in positions if p == int(p)]
+    midway = [int(p) for p in positions if p != int(p)]  # interval j: the midpoint of angles j, j + 1
     result = RefineResult(np.zeros((0, 3)), np.zeros((0, k)), np.zeros((0, 3), dtype=int))
     active = list(mesh.leaves)
     stopped = f"the budget of {options.max_rounds} rounds"
+    missed = 0
     for number in range(1, options.max_rounds + 1):
         fit = predict(*_fit_data(mesh, rows, complete, k))
         if fit is None:
             stopped = "no fit over the sphere to check against"
             break
         candidates = [e for e in mesh.edges(active) if e not in mesh.mids or mesh.mids[e] not in complete]
-        if not candidates:
+        boundary = {leaf for leaf in active if _mixed(leaf, rows)}
+        if not candidates and not boundary:
             result.reached, stopped = True, "no triangle left to check"
             break
         # 1. check
         points = [mesh.midpoint(*e) for e in candidates]
-        ask = [p for p in points if p not in rows or np.isnan(rows[p][check]).all()]
+        ask = [p for p in points if p not in rows or np.isnan(rows[p][on_table]).all()]
         solves = 0
         if ask:
-            got = solve(np.array([mesh.points[p] for p in ask]), check)
+            got = solve(np.array([mesh.points[p] for p in ask]), positions)
             solves += got.size
             for p, values in zip(ask, got):
                 row = np.full(k, np.nan)
-                row[check] = values
+                row[on_table] = values[[positions.index(float(c)) for c in on_table]]
                 rows[p] = row
-        truth = np.array([rows[p][check] for p in points])
-        estimate = fit(np.array([mesh.points[p] for p in points]), check)
-        with np.errstate(invalid="ignore", divide="ignore"):
+                mid = np.full(k - 1, np.nan)
+                mid[midway] = values[[positions.index(j + 0.5) for j in midway]]
+                between[p] = mid
+        truth = np.array([np.concatenate([rows[p][on_table], between.get(p, np.full(k - 1, np.nan))[midway]])
+                          for p in points]).reshape(len(points), len(positions))
+        estimate = (fit(np.array([mesh.points[p] for p in points]), on_table + [j + 0.5 for j in midway])
+                    if points else np.zeros_like(truth))
+        with np.errstate(invalid="ignore", divide="ignore"):  # the fit knows an impossible entry: inf there
             miss = np.where(np.isfinite(truth) & np.isfinite(estimate), np.abs(estimate / truth - 1.0),
-                            np.inf).max(axis=1)
+                            np.where((truth == np.inf) & (estimate == np.inf), 0.0, np.inf)).max(axis=1)
         by_point = dict(zip(points, miss.tolist()))
         # 2. split
         scores = []
@@ -354,8 +405,8 @@ def refine(axes: Any, triangles: Any, times: Any, solve: Solver, predict: Callab
             mids = [mesh.mids[_edge(p, q)] for p, q in ((i, j), (j, l), (l, i))]
             worst = max(by_point.get(m, 0.0) for m in mids)
             free = all(m in complete for m in mids)
-            if worst > options.tolerance or free:
-                scores.append((worst, leaf, worst > options.tolerance))
+            if worst > options.tolerance or free or leaf in boundary:
+                scores.append((worst, leaf, worst > options.tolerance or leaf in boundary))
         scores.sort(key=lambda item: -item[0])
         before = len(complete)
         missed = sum(1 for value in miss if value > options.tolerance)
@@ -391,8 +442,9 @@ def refine(axes: Any, triangles: Any, times: Any, solve: Solver, predict: Callab
         result.rounds.append({"round": number, "checked": len(points), "solves": int(solves),
                               "max_miss": float(np.max(miss)) if len(miss) else 0.0, "missed": missed,
                               "split": sum(1 for *_, flagged in scores[:len(chosen)] if flagged),
+                              "boundary": sum(1 for _, leaf, _ in scores[:len(chosen)] if leaf in boundary),
                               "graded": len(graded), "axes": len(complete), "new_axes": len(complete) - before})
-        if missed == 0:
+        if missed == 0 and not boundary:
             result.reached, stopped = True, f"every check within the tolerance {options.tolerance:g}"
             break
         if over:
@@ -403,10 +455,24 @@ def refine(axes: Any, triangles: Any, times: Any, solve: Solver, predict: Callab
             stopped = "no triangle left to check"
             break
     result.stopped = stopped
+    result.reached = result.reached or (bool(result.rounds) and missed == 0)
     result.axes, result.times, result.triangles = _fit_data(mesh, rows, complete, k)
-    result.checks = [{"axis": mesh.points[p].tolist(), "times": rows[p].tolist()}
+    result.checks = [{"axis": mesh.points[p].tolist(), "times": rows[p].tolist(),
+                      "midpoint_times": between.get(p, np.full(k - 1, np.nan)).tolist()}
                      for p in sorted(rows) if p not in complete]
     return result
+
+
+def _mixed(leaf: tuple[int, int, int], rows: dict[int, np.ndarray]) -> bool:
+    """Whether a leaf's corners have, at one table angle, both entries with a time and entries
+    without one (not ``ok``): the boundary of the entries without a time crosses it, and cutting it
+    shrinks the cells where the fit has no value (a leaf whose corners all lack a time at an angle,
+    beside one where all have one, is not: cutting it along the axes changes nothing there)."""
+    corners = [rows.get(v) for v in leaf]
+    if any(row is None for row in corners):
+        return False
+    timed = np.isfinite(np.array(corners))  # (3, k)
+    return bool(np.any(timed.any(axis=0) & ~timed.all(axis=0)))
 
 
 def _count_after(mesh: TriangleMesh, complete: set[int], chosen: list[tuple[int, int, int]],
