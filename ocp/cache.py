@@ -52,7 +52,9 @@ def exact_key(value: Any) -> Any:
     (one bit of one float), give different results; a list and a tuple of the same items differ. A
     dataclass is its qualified type and its compared fields (those excluded from equality,
     ``compare=False``, are caches of the others, as ``Spacecraft._cache``); a dict and a set are
-    sorted.
+    sorted. An enum member is its qualified type and its value: an ``IntEnum`` or ``StrEnum``
+    member differs from the int or str it compares equal to, and from another type's member of the
+    same value.
 
     Parameters
     ----------
@@ -73,6 +75,8 @@ def exact_key(value: Any) -> Any:
         decides what then follows (a planning key is then ``None``; a model's fingerprint is then
         its own alone).
     """
+    if isinstance(value, enum.Enum):  # first: an IntEnum or StrEnum member is an int or a str too
+        return ("e", f"{type(value).__module__}.{type(value).__qualname__}", _member_value(value))
     if value is None or isinstance(value, (bool, np.bool_)):
         return None if value is None else ("b", bool(value))
     if isinstance(value, (int, np.integer)):
@@ -81,8 +85,6 @@ def exact_key(value: Any) -> Any:
         return ("f", float(value).hex())
     if isinstance(value, str):
         return ("s", value)
-    if isinstance(value, enum.Enum):
-        return ("e", f"{type(value).__module__}.{type(value).__qualname__}", value.name)
     if isinstance(value, np.ndarray):
         if value.dtype.kind not in "biuf":
             raise Unkeyable(f"an array of dtype {value.dtype}")
@@ -97,6 +99,16 @@ def exact_key(value: Any) -> Any:
     if isinstance(value, (set, frozenset)):
         return ("set", tuple(sorted((exact_key(item) for item in value), key=repr)))
     raise Unkeyable(f"a {type(value).__module__}.{type(value).__qualname__}")
+
+
+def _member_value(member: enum.Enum) -> Any:
+    """An enum member's value as :func:`exact_key` states it; a value it cannot state (an object of
+    unknown kind) by the member's name, as exact within its type (a flag's unnamed combination has
+    an int value)."""
+    try:
+        return exact_key(member.value)
+    except Unkeyable:
+        return ("name", member.name)
 
 
 class _Entries:

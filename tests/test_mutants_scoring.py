@@ -103,7 +103,9 @@ def test_a_target_held_until_a_later_window_is_checked_when_the_window_opens():
     behind = [-1.0, 0.1, 0.0]
     late = PointingRequirement("late", X_AXIS, True, np.deg2rad(30.0), Direction(None, behind), (20.0, None))
     found = endpoint_violations(problem_with(Requirements((late,))))
-    assert len(found) == 1 and "the target attitude already breaks it at 20 s" in found[0], found
+    # named as what it is: the window's start, after the manoeuvre's duration T (not the slew's end)
+    assert len(found) == 1 and ("the target attitude already breaks it at 20 s, when the window opens after "
+                                "maneuver.duration = 10 s (margin") in found[0], found
     early = PointingRequirement("early", X_AXIS, True, np.deg2rad(30.0), Direction(None, behind), (1.0, 5.0))
     assert endpoint_violations(problem_with(Requirements((early,)))) == []
 

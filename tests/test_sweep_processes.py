@@ -1,9 +1,9 @@
 """Trade studies across processes: a real Dask cluster on localhost, and a sweep stopped by
 SIGTERM and by SIGKILL, then resumed, against an uninterrupted run."""
 import contextlib
+import json
 import os
 import signal
-import socket
 import sqlite3
 import subprocess
 import sys
@@ -22,10 +22,18 @@ from tests.test_sweep import BASE, InlineExecutor, comparable
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
+def scheduler_address(scheduler_file: Path, scheduler: subprocess.Popen, timeout_s: float = 60.0) -> str:
+    """The address a Dask scheduler started on port 0 bound (the system chose a free port as it
+    bound, so no other process can take it in between), read back from its ``--scheduler-file``."""
+    start = time.monotonic()
+    while True:
+        with contextlib.suppress(FileNotFoundError, ValueError):  # not written yet, or being written
+            address = json.loads(scheduler_file.read_text())["address"]
+            if address:
+                return address
+        assert scheduler.poll() is None, f"the scheduler exited ({scheduler.returncode}) before binding"
+        assert time.monotonic() - start < timeout_s, "the scheduler wrote no address"
+        time.sleep(0.05)
 
 
 @contextlib.contextmanager
@@ -60,13 +68,15 @@ def write_study(tmp_path, grid, name="study.yaml"):
 def test_dask_cluster_on_localhost_gives_the_local_results(tmp_path):
     pytest.importorskip("distributed")
     from distributed import Client
-    port = free_port()
-    address = f"tcp://127.0.0.1:{port}"
-    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
-    worker = [sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads", "1", "--no-nanny",
-              "--no-dashboard", "--memory-limit", "0", "--host", "127.0.0.1"]
+    scheduler_file = tmp_path / "scheduler.json"  # where the scheduler says the address it bound
+    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
+            "--no-dashboard", "--scheduler-file", str(scheduler_file)]
+    worker = [sys.executable, "-m", "distributed.cli.dask_worker", "--scheduler-file", str(scheduler_file),
+              "--nthreads", "1", "--no-nanny", "--no-dashboard", "--memory-limit", "0", "--host", "127.0.0.1"]
     path = write_study(tmp_path, {"maneuver.final.q": {"axis_angle": {"axis": [0, 1, 0], "angle_deg": [15, 30, 60]}}})
-    with processes(dask + ["--host", "127.0.0.1", "--port", str(port), "--no-dashboard"], worker, worker):
+    with processes(dask, worker, worker) as (scheduler, *_):
+        address = scheduler_address(scheduler_file, scheduler)
+        assert address.startswith("tcp://127.0.0.1:"), address  # a TCP cluster on localhost, as before
         with Client(address, timeout="60s") as client:
             client.wait_for_workers(2, timeout=90)
         assert main(["sweep", str(path), "--out", str(tmp_path / "dask"), "--scheduler", address, "--no-plots"]) == 0

@@ -163,7 +163,7 @@ def _validate_study(file: str) -> tuple[str, list[str]]:
 def _validate_table(file: str) -> tuple[str, list[str]]:
     """A slew-table file, checked as ``slewbench table`` checks it before computing: its spec, and its
     number of entries against the default ``--max-entries`` (a finding: the limit is an option)."""
-    from scenarios.cli.table import _check_work
+    from scenarios.cli.table import check_table_work
     from scenarios.slewtable.spec import parse_table_spec
 
     spec = parse_table_spec(file)
@@ -175,8 +175,7 @@ def _validate_table(file: str) -> tuple[str, list[str]]:
               f"{spec.refine.max_rounds} rounds)" if spec.refine is not None else "; no refinement")
     findings = []
     try:  # the table command's own check, with its default limit
-        _check_work(spec, len(spec.axes) * len(spec.angles_deg) + spec.held_out * mids,
-                    argparse.Namespace(max_entries=None, angles=None))
+        check_table_work(spec, len(spec.axes) * len(spec.angles_deg) + spec.held_out * mids)
     except ScenarioError as error:
         findings.append(f"`slewbench {OTHER_FILES['table']}` refuses it without an option: {error}")
     return (f"{file}: valid slew table {spec.name!r}: {axes} x {len(spec.angles_deg)} angles{held_out}, "

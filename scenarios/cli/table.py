@@ -56,20 +56,40 @@ MAX_ENTRIES = 2000
 at 1 to 90 s of collocation each, 2000 entries are hours on a few cores."""
 
 
-def _check_work(spec: TableSpec, entries: int, args: argparse.Namespace) -> None:
-    """Say how many axes the grid has when it is not the number asked for, and refuse more than
-    ``--max-entries`` (default :data:`MAX_ENTRIES`) entries, naming the count and how to go on."""
+def check_table_work(spec: TableSpec, entries: int, max_entries: int | None = None, angles: str | None = None) -> None:
+    """The work a table would take, checked before anything is computed (by ``slewbench table``,
+    and by ``slewbench validate`` on a table file, with the default limit).
+
+    Says (on standard output) how many axes the grid has when it is not the number asked for, and
+    refuses more than ``max_entries`` entries, naming the count and how to go on.
+
+    Parameters
+    ----------
+    spec : TableSpec
+        The table (its axes, angles and held-out grid).
+    entries : int
+        Its number of entries: axes x angles, plus the held-out grid's.
+    max_entries : int or None, optional
+        ``--max-entries``: the most entries to compute; ``None`` (default): :data:`MAX_ENTRIES`.
+    angles : str or None, optional
+        ``--angles`` as given: a bare count there is explained in the refusal (it is not degrees).
+
+    Raises
+    ------
+    ScenarioError
+        At ``--max-entries``: a limit below 1, or more entries than the limit.
+    """
     if spec.axes_asked is not None and spec.axes_asked != len(spec.axes):
         print(f"{spec.name}: {_count(spec.axes_asked, 'axis', 'axes')} asked for, the {spec.grid} grid has "
               f"{len(spec.axes)}: every vertex and face centre of the torque polytope, its faces subdivided evenly "
               f"(so its counts come in steps); --grid fibonacci gives exactly {spec.axes_asked}", flush=True)
     from scenarios.errors import ScenarioError
-    if args.max_entries is not None and args.max_entries < 1:
-        raise ScenarioError("--max-entries", f"expected a positive number of entries, got {args.max_entries}")
-    limit = MAX_ENTRIES if args.max_entries is None else args.max_entries
+    if max_entries is not None and max_entries < 1:
+        raise ScenarioError("--max-entries", f"expected a positive number of entries, got {max_entries}")
+    limit = MAX_ENTRIES if max_entries is None else max_entries
     if entries <= limit:
         return
-    angles = str(args.angles or "").strip()
+    angles = str(angles or "").strip()
     bare = f"; --angles {angles} means {angles} angles spread from 10 to 180 deg, not {angles} deg (angles in " \
            f"degrees are a comma-separated list, e.g. --angles 30,90)" if angles.isdigit() else ""
     raise ScenarioError("--max-entries", f"{_count(len(spec.axes), 'axis', 'axes')} x "
@@ -124,7 +144,7 @@ def command_table(args: argparse.Namespace) -> int:
         import matplotlib  # noqa: F401  (fail now, not after the entries ran)
     out = Path(args.out) if args.out else default_output_directory(f"table-{spec.name}")
     entries = len(spec.axes) * len(spec.angles_deg) + spec.held_out * len(spec.held_out_angles_deg)
-    _check_work(spec, entries, args)
+    check_table_work(spec, entries, args.max_entries, args.angles)
     # the scheduler first: one that cannot be reached exits 2 with nothing written
     cluster = connect_scheduler(spec.scheduler, "--scheduler" if args.scheduler else "table.execution.scheduler") \
         if spec.scheduler else None

@@ -839,8 +839,10 @@ def score_fields(requirements: Requirements, spacecraft: Spacecraft,
 def endpoint_violations(problem: ManeuverProblem) -> list[str]:
     """Pointing requirements that the manoeuvre's end points already break, before anything is planned.
 
-    The initial attitude is checked at t = 0 and the target at T (or at the window's start when it
-    opens after T: the target is held), each when the window covers that time.
+    The initial attitude is checked at t = 0 and the target at T, the manoeuvre's duration
+    (``maneuver.duration``, the time the target attitude is given for; a minimum-time planner's own
+    slew may end at another time), or at the window's start when it opens after T (the target is
+    held), each when the window covers that time. The sentence names that time as what it is.
 
     Parameters
     ----------
@@ -865,10 +867,21 @@ def endpoint_violations(problem: ManeuverProblem) -> list[str]:
                 # the cone at that time: the angle and its growth (the Earth's apparent radius about the limb)
                 limit = float(np.rad2deg(constraint.limit([time])[0]))
                 grown = f": {constraint.description}" if abs(limit - np.rad2deg(constraint.angle)) > 1e-9 else ""
-                found.append(f"{constraint.name}: the {words} already breaks it at {time:g} s (margin "
-                             f"{np.rad2deg(margin):.3g} deg to the {limit:.4g} deg {kind} cone{grown}); "
+                found.append(f"{constraint.name}: the {words} already breaks it {_end_time(words, time, problem)} "
+                             f"(margin {np.rad2deg(margin):.3g} deg to the {limit:.4g} deg {kind} cone{grown}); "
                              "no reference can meet it")
     return found
+
+
+def _end_time(words: str, time: float, problem: ManeuverProblem) -> str:
+    """When :func:`endpoint_violations` checked an end, in words: ``at 0 s`` for the initial
+    attitude; for the target, the manoeuvre's duration T named as such (``maneuver.duration``, not
+    the end of a slew, which a minimum-time planner chooses itself), or the window's start after it."""
+    if words != "target attitude":
+        return f"at {time:g} s"
+    if time <= problem.duration:
+        return f"at {time:g} s, maneuver.duration"
+    return f"at {time:g} s, when the window opens after maneuver.duration = {problem.duration:g} s"
 
 
 def violations(scores: Mapping[str, Mapping[str, Score]]) -> list[str]:

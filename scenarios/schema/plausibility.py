@@ -29,8 +29,8 @@ from ocp.dynamics.orbits import R_EARTH
 if TYPE_CHECKING:
     from scenarios.schema.loader import Scenario
 
-__all__ = ["LOWEST_ORBIT_KM", "MAX_ANGULAR_ACCELERATION", "MAX_RATE", "MOON_DISTANCE_KM", "PLAUSIBILITY_CHECKS",
-           "Implausible", "plausibility_warnings"]
+__all__ = ["LOWEST_ORBIT_KM", "MAX_ANGULAR_ACCELERATION", "MAX_RATE", "MAX_RATE_TOLERANCE", "MOON_DISTANCE_KM",
+           "PLAUSIBILITY_CHECKS", "Implausible", "plausibility_warnings"]
 
 MOON_DISTANCE_KM = 384_400.0
 """The Moon's mean distance from the Earth [km]: an orbit reaching beyond it is no Earth orbit the
@@ -39,8 +39,18 @@ LOWEST_ORBIT_KM = 100.0
 """The Kármán line [km] above the equatorial radius: an orbit whose perigee is lower re-enters
 within hours, so no attitude manoeuvre is planned there."""
 MAX_RATE = 1.0
-"""Body rate [rad/s] (57 deg/s) above which a rate bound binds no slew: agile spacecraft slew at a
-few degrees per second; a bound in deg/s written as rad/s lands above it."""
+"""Body rate [rad/s] (57 deg/s) at or above which a rate bound binds no slew: agile spacecraft slew
+at a few degrees per second, so a bound of 1 rad/s is as implausible as one above it; a bound in
+deg/s written as rad/s lands at or above it (1 deg/s written as 1 is flagged: the bar is inclusive)."""
+MAX_RATE_TOLERANCE = 0.1
+"""Rate tolerance [rad/s] (5.7 deg/s) at or above which a tolerance on a rate left over
+(``requirements.final.rate``, the rate error after the slew; ``simulation.detumble_tolerance``, the
+rate at which a tumble counts as stopped) decides nothing. A tolerance is a small part of the rates
+a manoeuvre reaches, and the most agile spacecraft slew at a few deg/s (under 0.1 rad/s): at this
+bar a spacecraft still slewing as fast as any does would meet it. The rate bounds' bar (1 rad/s)
+would let a tolerance in deg/s written as rad/s through from 0.1 up to 1 deg/s (the usual final
+rate tolerances and detumble ends); this one flags them, and no shipped scenario comes near it
+(their tolerances are at most 0.01 rad/s)."""
 MAX_ANGULAR_ACCELERATION = 5.0
 """Angular acceleration [rad/s²] an actuator's torque gives about the least principal axis above
 which it is no attitude actuator (a full turn from rest in under 1.6 s); a torque in mN m written
@@ -125,26 +135,40 @@ def _orbit_altitude(scenario: Scenario) -> Iterator[Implausible]:
 
 
 def _rate_bounds(scenario: Scenario) -> Iterator[Implausible]:
-    """A bound on the body rate above :data:`MAX_RATE` (a bound in deg/s written as rad/s)."""
+    """A bound on the body rate at or above :data:`MAX_RATE` (a bound in deg/s written as rad/s)."""
     data = scenario.data or {}
     bounds = [("maneuver.max_rate", _mapping(data, "maneuver").get("max_rate")),
-              ("requirements.rate.max", _mapping(data, "requirements", "rate").get("max")),
-              ("requirements.final.rate", _mapping(data, "requirements", "final").get("rate")),
-              ("simulation.detumble_tolerance", _mapping(data, "simulation").get("detumble_tolerance"))]
+              ("requirements.rate.max", _mapping(data, "requirements", "rate").get("max"))]
     planners = data.get("planners")
     for index, planner in enumerate(planners if isinstance(planners, list) else []):
         bounds.append((f"planners[{index}].options.max_rate", _mapping(planner, "options").get("max_rate")))
-    for path, given in bounds:
-        value = _number(given)
-        if value is not None and value > MAX_RATE:
+    yield from _rates_at_or_above(bounds, MAX_RATE, "a bound no attitude slew comes near")
+
+
+def _rate_tolerances(scenario: Scenario) -> Iterator[Implausible]:
+    """A tolerance on a rate left over at or above :data:`MAX_RATE_TOLERANCE` (a tolerance in deg/s
+    written as rad/s)."""
+    data = scenario.data or {}
+    tolerances = [("requirements.final.rate", _mapping(data, "requirements", "final").get("rate")),
+                  ("simulation.detumble_tolerance", _mapping(data, "simulation").get("detumble_tolerance"))]
+    yield from _rates_at_or_above(tolerances, MAX_RATE_TOLERANCE,
+                                  "a tolerance that a spacecraft still slewing as fast as any does would meet")
+
+
+def _rates_at_or_above(given: list[tuple[str, Any]], bar: float, why: str) -> Iterator[Implausible]:
+    """The rates [rad/s] of ``given`` (YAML path, value as written) at or above ``bar``, each
+    saying ``why`` that is implausible and the value meant if it was written in deg/s."""
+    for path, written in given:
+        value = _number(written)
+        if value is not None and value >= bar:
             yield Implausible(path, f"{value:g} rad/s",
-                              f"is {math.degrees(value):,.0f} deg/s, above {MAX_RATE:g} rad/s "
-                              f"({math.degrees(MAX_RATE):.0f} deg/s), a bound no attitude slew comes near; did you "
-                              f"mean {math.radians(value):.4g} rad/s ({value:g} deg/s)?")
+                              f"is {math.degrees(value):,.{0 if value >= 1 else 1}f} deg/s, at or above {bar:g} rad/s "
+                              f"({math.degrees(bar):.2g} deg/s), {why}; did you mean {math.radians(value):.4g} rad/s "
+                              f"({value:g} deg/s)?")
 
 
 def _boundary_rates(scenario: Scenario) -> Iterator[Implausible]:
-    """A boundary rate (``maneuver.initial.omega``, ``maneuver.final.omega``) above
+    """A boundary rate (``maneuver.initial.omega``, ``maneuver.final.omega``) at or above
     :data:`MAX_RATE` that the actuators could not give or take away within the manoeuvre, even at
     their peak angular acceleration (the body torque box over the least principal moment): a rate
     in deg/s written as rad/s; with wheels alone, also one whose momentum ``‖J ω‖`` exceeds what
@@ -167,14 +191,14 @@ def _boundary_rates(scenario: Scenario) -> Iterator[Implausible]:
             continue
         norm = float(np.linalg.norm(rate))
         momentum = float(np.linalg.norm(spacecraft.inertia @ np.asarray(rate, dtype=float)))
-        if norm <= MAX_RATE or (norm <= reach and momentum <= storage):
+        if norm < MAX_RATE or (norm <= reach and momentum <= storage):
             continue
         why = (f"more than the actuators can change in maneuver.duration ({peak:.3g} rad/s² at most about the "
                f"least principal axis for {problem.duration:g} s: {reach:.3g} rad/s)" if norm > reach else
                f"more than the wheels alone can take (its momentum ‖J ω‖ = {momentum:.3g} N m s against the "
                f"{storage:.3g} N m s all working wheels store together)")
         yield Implausible(f"maneuver.{where}.omega", f"{np.asarray(rate).tolist()} rad/s",
-                          f"has ‖ω‖ = {norm:.4g} rad/s ({math.degrees(norm):,.0f} deg/s), above {MAX_RATE:g} "
+                          f"has ‖ω‖ = {norm:.4g} rad/s ({math.degrees(norm):,.0f} deg/s), at or above {MAX_RATE:g} "
                           f"rad/s and {why}; did you mean {[round(math.radians(float(w)), 6) for w in rate]} "
                           "rad/s (deg/s written as rad/s)?")
 
@@ -202,6 +226,7 @@ def _torques(scenario: Scenario) -> Iterator[Implausible]:
 PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "orbit_altitude": _orbit_altitude,
     "rate_bounds": _rate_bounds,
+    "rate_tolerances": _rate_tolerances,
     "boundary_rates": _boundary_rates,
     "actuator_torques": _torques,
 }
