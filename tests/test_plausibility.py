@@ -6,6 +6,7 @@ from __future__ import annotations
 import copy
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
@@ -165,3 +166,19 @@ def test_a_rate_beyond_what_wheels_alone_can_store_warns():
     wheels = parse_scenario(data).problem.spacecraft.wheels
     storage = float(sum(wheels.max_momentum))
     assert float(inertia[0, 0]) * 2.0 > 8 * storage  # the oracle: J_xx ω = 0.5 N m s against the bounds' sum, 0.06
+
+
+def test_wheels_that_span_only_a_plane_warn_naming_the_missing_direction():
+    """A tester's four wheels in the body xy-plane (no control about z) validated without a word.
+    The oracle: the cross product of two of the in-plane axes is the direction no wheel torques about."""
+    axes = [[1.0, 0.0, 0.0], [0.6, 0.8, 0.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]
+    said = warnings_of(lambda d: d["spacecraft"].update(wheels={**d["spacecraft"]["wheels"], "axes": axes}))
+    normal = np.cross(axes[0], axes[1])
+    assert len(said) == 1 and said[0].startswith(f"spacecraft.wheels.axes: {axes} (4 wheels) span only a plane"), said
+    assert f"the body direction {(normal / np.max(np.abs(normal))).tolist()}" in said[0], said
+    # tilted out of the plane (a pyramid), or two wheels (the underactuated problem), or a failure: no warning
+    pyramid = [[0.8, 0.0, 0.6], [0.0, 0.8, 0.6], [-0.8, 0.0, 0.6], [0.0, -0.8, 0.6]]
+    assert warnings_of(lambda d: d["spacecraft"].update(wheels={**d["spacecraft"]["wheels"], "axes": pyramid})) == []
+    assert warnings_of(lambda d: d["spacecraft"].update(wheels={**d["spacecraft"]["wheels"], "axes": axes[:2]})) == []
+    assert warnings_of(lambda d: d["spacecraft"].update(
+        wheels={**d["spacecraft"]["wheels"], "axes": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "failed": [2]})) == []

@@ -1,6 +1,7 @@
 """Plausibility warnings on a validated scenario: values that the schema accepts but that are
 almost certainly a unit slip (kilometres written as metres, degrees per second written as rad/s,
-millinewton metres written as newton metres).
+millinewton metres written as newton metres), or a layout slip (wheels that cannot torque about
+every axis).
 
 They are warnings, not errors: each names the YAML path, the value as written and the physical
 reason it looks wrong, and suggests the value meant where one follows. ``slewbench validate``
@@ -223,12 +224,36 @@ def _torques(scenario: Scenario) -> Iterator[Implausible]:
                               "(mN m written as N m)?")
 
 
+def _wheel_axes(scenario: Scenario) -> Iterator[Implausible]:
+    """Three or more wheels whose axes span fewer than three directions, with no other actuator:
+    a layout slip (a pyramid's elevation written as 0, an axis repeated), since a spacecraft flies
+    three or more wheels to torque about every axis. Two wheels (the underactuated problem) and
+    failed wheels (a failure studied) are meant, and left alone."""
+    spacecraft = scenario.problem.spacecraft
+    wheels = spacecraft.wheels
+    if wheels is None or wheels.count < 3 or any(actuator is not wheels for actuator in spacecraft.actuators):
+        return
+    _, singular, rows = np.linalg.svd(np.asarray(wheels.axes, dtype=float).T)
+    rank = int(np.sum(singular > 1e-6 * singular[0]))
+    if rank == 3:
+        return
+    missing = rows[-1]  # a body direction no wheel torques about
+    shape = "a plane" if rank == 2 else "one line"
+    written = _mapping(scenario.data, "spacecraft", "wheels").get("axes")
+    yield Implausible("spacecraft.wheels.axes", f"{written} ({wheels.count} wheels)",
+                      f"span only {shape}: no wheel torques about the body direction "
+                      f"{np.round(missing / np.max(np.abs(missing)), 4).tolist()}, and the spacecraft has no other "
+                      "actuator; did you mean a layout spanning three axes (a pyramid's axes tilted out of the "
+                      "plane)? Underactuated control is written with two wheels, or a wheel listed in failed.")
+
+
 PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "orbit_altitude": _orbit_altitude,
     "rate_bounds": _rate_bounds,
     "rate_tolerances": _rate_tolerances,
     "boundary_rates": _boundary_rates,
     "actuator_torques": _torques,
+    "wheel_axes": _wheel_axes,
 }
 """Name -> check: each yields the :class:`Implausible` values of a validated scenario."""
 
