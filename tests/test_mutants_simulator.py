@@ -71,3 +71,10 @@ def test_a_time_varying_torque_is_held_at_the_right_times_against_scipy():
         result = Simulator(model, 10.0, max_step=0.5, python_loop=python_loop).run(CONTROLLERS["none"](), x0, duration)
         assert np.max(quat.error_angle(result.q, truth.y[:4].T)) < 1e-9
         np.testing.assert_allclose(result.omega, truth.y[4:].T, atol=1e-11)
+
+
+def test_no_rk4_sub_step_is_longer_than_max_step():
+    """⌈T_s / max_step⌉ sub-steps, by hand."""
+    model = problem().model
+    for sample_time, max_step, substeps in ((0.1, 0.03, 4), (0.1, 0.05, 2), (0.1, 0.1, 1), (1.0, 0.3, 4), (0.1, 0.2, 1)):
+        assert Simulator(model, sample_time, max_step=max_step).substeps == substeps

@@ -1,11 +1,11 @@
 """Torque-free motion integrated over many chunks (the coast of every reference after T) against
 the invariants of Euler's equations, an integration written here with scipy, and the derivative
-of its own rate by finite differences."""
+of its own rate by finite differences; the elliptic rates of a spin about a principal axis by hand."""
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from ocp import quat
-from planners.torque_free import TorqueFreeMotion
+from planners.torque_free import TorqueFreeMotion, asymmetric_rates
 
 INERTIA = np.array([[0.08, 0.004, -0.006], [0.004, 0.05, 0.002], [-0.006, 0.002, 0.11]])
 Q0 = quat.normalize(np.array([0.6, -0.3, 0.2, 0.7]))
@@ -47,3 +47,14 @@ def test_the_coasts_acceleration_is_the_derivative_of_its_rate():
     _, _, omega_dot = motion(t)
     slope = (motion(t + h)[1] - motion(t - h)[1]) / (2 * h)
     np.testing.assert_allclose(omega_dot, slope, atol=1e-8)
+
+
+def test_a_spin_about_a_principal_axis_is_an_equilibrium():
+    """Euler's equations leave a spin about any principal axis unchanged (about the intermediate one
+    too: it is unstable, not moving)."""
+    moments = np.array([0.02, 0.05, 0.04])
+    t = np.linspace(0.0, 300.0, 7)
+    for axis in range(3):
+        omega0 = np.zeros(3)
+        omega0[axis] = -0.2
+        np.testing.assert_array_equal(asymmetric_rates(t, omega0, moments), np.tile(omega0, (t.size, 1)))
