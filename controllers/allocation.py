@@ -33,7 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 from ocp import AttitudeModel, Command, Measurement, SolverCache, Spacecraft, quat
 from ocp.dynamics.actuator_kinds import Actuator
 from ocp.dynamics.layout import actuator_blocks, control_layout, split_measurement
-from ocp.fast_call import BufferedFunction, as_floats
+from ocp.fast_call import BufferedFunction, as_floats, buffered
 
 Array = NDArray[np.float64]
 
@@ -383,7 +383,8 @@ def demand_limits(spacecraft: Spacecraft) -> dict[str, Array]:
 
 def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: ArrayLike,
                      torque: ArrayLike, state0: ArrayLike | None = None,
-                     jumps: ArrayLike | None = None, torque_after: ArrayLike | None = None) -> dict[str, Demand]:
+                     jumps: ArrayLike | None = None, torque_after: ArrayLike | None = None,
+                     environment: ArrayLike | None = None) -> dict[str, Demand]:
     """What a reference asks of each actuator through a law's own allocation (module docstring).
 
     At each sample the feed-forward torque goes through the law's map (its flags included, except
@@ -450,6 +451,11 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     torque_after : (N, 3) array_like or None, optional
         The feed-forward torque just after each sample [N m], body axes, where it jumps there
         (a reference's end T: zero after it), for the integrated states; ``None``: ``torque``.
+    environment : (N, 3) array_like or None, optional
+        The environment's torque of ``model`` at the samples [N m], body axes, where the caller has
+        it already (``model_rows(model, "environment_torque", ...)`` at the same states, times and
+        the model's default parameters: the scorer's, which ``torque`` is net of); ``None``:
+        evaluated here where the closed form of the momenta needs it.
 
     Returns
     -------
@@ -490,7 +496,7 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
         states = np.zeros((n, n_states))
     elif _conserving(law, blocks, model):
         states = _momentum_by_conservation(law, spacecraft, q, omega, start + kicks[0],
-                                           _environment_impulse(model, t, q, omega))
+                                           _environment_impulse(model, t, q, omega, environment))
     else:
         after = inputs.copy()
         if torque_after is not None:
@@ -520,18 +526,30 @@ and of :func:`model_rows`."""
 
 def _mapped_rows(cache: SolverCache, key: tuple[Hashable, ...], build: Callable[[], ca.Function], *inputs: Array) -> Array:
     """The first output of ``build()`` at each of N samples, by chunks of :data:`_CHUNK` samples
-    through its map (cached under ``key``) and reusable buffers: no map is built per call and no
-    matrix converted to CasADi's (which cost more than the evaluation itself). ``inputs``: (N, k_i)
-    rows, or (1, k_i) for a value shared by every sample. Returns (N, m)."""
+    through its map (cached under ``key``) and its buffers (:func:`ocp.fast_call.buffered`: made
+    once per map and thread): no map is built per call and no matrix converted to CasADi's (which
+    cost more than the evaluation itself); each chunk's rows are written into the input buffers
+    in place, a shared value once. ``inputs``: (N, k_i) rows, or (1, k_i) for a value shared by
+    every sample. Returns (N, m)."""
     n = max((rows.shape[0] for rows in inputs if rows.shape[0] != 1), default=1)
-    mapped = BufferedFunction(cache.get((*key, "rows", _CHUNK), lambda: build().map(_CHUNK)))
+    mapped = buffered(cache.get((*key, "rows", _CHUNK), lambda: build().map(_CHUNK)))
     width = mapped.outputs[0].size // _CHUNK
+    result = mapped.outputs[0].reshape(_CHUNK, width)  # column-major (m, CHUNK): a row per sample
+    buffers = [buffer.reshape(_CHUNK, values.shape[1]) for buffer, values in zip(mapped.inputs, inputs)]
+    per_sample = []
+    for buffer, values in zip(buffers, inputs):
+        if values.shape[0] == 1:
+            buffer[:] = values
+        else:
+            per_sample.append((buffer, values))
     out = np.empty((n, width))
     for first in range(0, n, _CHUNK):  # the last chunk padded with the last sample
-        rows = np.arange(first, first + _CHUNK).clip(max=n - 1)
-        flat = [np.broadcast_to(values, (_CHUNK, values.shape[1])).ravel() if values.shape[0] == 1
-                else values[rows].ravel() for values in inputs]
-        out[first:first + _CHUNK] = mapped(*flat).reshape(_CHUNK, width)[:min(_CHUNK, n - first)]  # a row per sample
+        count = min(_CHUNK, n - first)
+        for buffer, values in per_sample:
+            buffer[:count] = values[first:first + count]
+            buffer[count:] = values[n - 1]
+        mapped.evaluate()
+        out[first:first + count] = result[:count]
     return out
 
 
@@ -587,16 +605,21 @@ def _conserving(law: Allocation, blocks: Sequence[Any], model: AttitudeModel) ->
             and law._working_axes is not None and int(np.linalg.matrix_rank(law._working_axes)) == 3)
 
 
-def _environment_impulse(model: AttitudeModel, t: Array, q: Array, omega: Array) -> Array:
+def _environment_impulse(model: AttitudeModel, t: Array, q: Array, omega: Array,
+                         known: ArrayLike | None = None) -> Array:
     """``∫₀ᵗ R(q) τ_e dt`` [N m s], inertial axes, at each sample: the environment's torque of
     ``model`` (gravity gradient, constant disturbance) along the motion, by the trapezoidal rule;
-    zeros without one."""
+    zeros without one. ``known``: that torque at the samples [N m], body axes, when the caller has
+    it (:func:`reference_demand`'s ``environment``); ``None``: evaluated here."""
     environment = model.environment
     if environment is None or not (environment.gravity_gradient or np.any(environment.disturbance_torque)):
         return np.zeros((t.size, 3))
-    x = np.hstack([q, omega, np.zeros((t.size, model.nx - 7))])
-    torque = model_rows(model, "environment_torque", x, t[:, None],
-                        np.asarray(model.default_parameters, dtype=float).ravel())
+    if known is not None:
+        torque = np.asarray(known, dtype=float).reshape(t.size, 3)
+    else:
+        x = np.hstack([q, omega, np.zeros((t.size, model.nx - 7))])
+        torque = model_rows(model, "environment_torque", x, t[:, None],
+                            np.asarray(model.default_parameters, dtype=float).ravel())
     inertial = quat.rotate(quat.normalize(q), torque)
     steps = 0.5 * (inertial[1:] + inertial[:-1]) * np.diff(t)[:, None]
     return np.vstack([np.zeros((1, 3)), np.cumsum(steps, axis=0)])
