@@ -215,6 +215,12 @@ def _seconds(value: float) -> str:
     return f"{value:.1f}" if value == 0.0 or abs(value) >= 0.1 else f"{value:.2g}"
 
 
+def _on_samples(times: Array, t: Array) -> NDArray[np.bool_]:
+    """Whether each of ``times`` is one of the increasing samples ``t`` (``np.isin``, by a binary search)."""
+    found = np.minimum(t.searchsorted(times), t.size - 1)
+    return t[found] == times
+
+
 def _inserted(t: Array, columns: Sequence[Array], times: Array, values: Sequence[Array]) -> tuple[Array, list[Array]]:
     """``t`` and its columns (rows per time) with the rows of ``values`` at ``times`` inserted, in
     time order: those strictly inside ``t``'s span, on no sample and on no earlier one of ``times``."""
@@ -222,7 +228,7 @@ def _inserted(t: Array, columns: Sequence[Array], times: Array, values: Sequence
     _, first = np.unique(times, return_index=True)
     keep = np.zeros(times.size, bool)
     keep[first] = True
-    keep &= (times > t[0]) & (times < t[-1]) & ~np.isin(times, t)
+    keep &= (times > t[0]) & (times < t[-1]) & ~_on_samples(times, t)
     if not np.any(keep):
         return t, [np.asarray(column, dtype=float) for column in columns]
     merged = np.concatenate([t, times[keep]])
@@ -249,7 +255,7 @@ def _with_edges(problem: ManeuverProblem, t: Array, sample: Any,
     if reference is None or not problem.pointing or t.size < 2:
         return t, q, omega
     edges = np.unique(np.asarray([edge for constraint in problem.pointing for edge in constraint.window], dtype=float))
-    edges = edges[(edges > t[0]) & (edges < t[-1]) & ~np.isin(edges, t)]
+    edges = edges[(edges > t[0]) & (edges < t[-1]) & ~_on_samples(edges, t)]
     sides, at_sides = reference.breakpoint_sides()
     times = np.concatenate([edges, sides])
     if not times.size:
