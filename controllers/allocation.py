@@ -523,33 +523,45 @@ _CHUNK = 512
 """Samples (or sub-steps) per call of the mapped map and the accumulated step of :func:`reference_demand`,
 and of :func:`model_rows`."""
 
+_TAIL = 64
+"""Samples per call of the smaller map that evaluates the rows past the last whole chunk of
+:data:`_CHUNK` (2110 samples: four chunks and one call of 64, not a fifth chunk padded with 450)."""
+
 
 def _mapped_rows(cache: SolverCache, key: tuple[Hashable, ...], build: Callable[[], ca.Function], *inputs: Array) -> Array:
     """The first output of ``build()`` at each of N samples, by chunks of :data:`_CHUNK` samples
-    through its map (cached under ``key``) and its buffers (:func:`ocp.fast_call.buffered`: made
-    once per map and thread): no map is built per call and no matrix converted to CasADi's (which
-    cost more than the evaluation itself); each chunk's rows are written into the input buffers
-    in place, a shared value once. ``inputs``: (N, k_i) rows, or (1, k_i) for a value shared by
-    every sample. Returns (N, m)."""
+    through its map (cached under ``key``), the rows past the last whole chunk by :data:`_TAIL`
+    through a smaller map, and their buffers (:func:`ocp.fast_call.buffered`: made once per map and
+    thread): no map is built per call and no matrix converted to CasADi's (which cost more than the
+    evaluation itself); each call's rows are written into the input buffers in place, a shared value
+    once a map, the last call padded with the last sample. ``inputs``: (N, k_i) rows, or (1, k_i)
+    for a value shared by every sample. Returns (N, m)."""
     n = max((rows.shape[0] for rows in inputs if rows.shape[0] != 1), default=1)
-    mapped = buffered(cache.get((*key, "rows", _CHUNK), lambda: build().map(_CHUNK)))
-    width = mapped.outputs[0].size // _CHUNK
-    result = mapped.outputs[0].reshape(_CHUNK, width)  # column-major (m, CHUNK): a row per sample
-    buffers = [buffer.reshape(_CHUNK, values.shape[1]) for buffer, values in zip(mapped.inputs, inputs)]
-    per_sample = []
-    for buffer, values in zip(buffers, inputs):
-        if values.shape[0] == 1:
-            buffer[:] = values
-        else:
-            per_sample.append((buffer, values))
-    out = np.empty((n, width))
-    for first in range(0, n, _CHUNK):  # the last chunk padded with the last sample
-        count = min(_CHUNK, n - first)
-        for buffer, values in per_sample:
-            buffer[:count] = values[first:first + count]
-            buffer[count:] = values[n - 1]
-        mapped.evaluate()
-        out[first:first + count] = result[:count]
+    out: Array | None = None
+    whole = n - n % _CHUNK
+    for size, begin, end in ((_CHUNK, 0, whole), (_TAIL, whole, n)):
+        if begin == end:
+            continue
+        mapped = buffered(cache.get((*key, "rows", size), lambda: build().map(size)))
+        width = mapped.outputs[0].size // size
+        if out is None:
+            out = np.empty((n, width))
+        result = mapped.outputs[0].reshape(size, width)  # column-major (m, size): a row per sample
+        per_sample = []
+        for buffer, values in zip(mapped.inputs, inputs):
+            rows = buffer.reshape(size, values.shape[1])
+            if values.shape[0] == 1:
+                rows[:] = values
+            else:
+                per_sample.append((rows, values))
+        for first in range(begin, end, size):
+            count = min(size, end - first)
+            for rows, values in per_sample:
+                rows[:count] = values[first:first + count]
+                rows[count:] = values[n - 1]
+            mapped.evaluate()
+            out[first:first + count] = result[:count]
+    assert out is not None  # n >= 1
     return out
 
 
