@@ -568,7 +568,8 @@ def _mapped_rows(cache: SolverCache, key: tuple[Hashable, ...], build: Callable[
 def model_rows(model: AttitudeModel, name: str, *inputs: ArrayLike) -> Array:
     """One of a model's CasADi functions at each of N samples (``environment_torque``,
     ``body_torque``, ``field_body``, ...), as a batch: the function's own expression evaluated by
-    chunks through a cached map (:data:`_CHUNK` samples a call) and reusable buffers.
+    chunks through a cached map (:data:`_CHUNK` samples a call, the rest :data:`_TAIL` a call) and
+    its buffers.
 
     Parameters
     ----------
