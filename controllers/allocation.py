@@ -33,7 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 from ocp import AttitudeModel, Command, Measurement, SolverCache, Spacecraft, quat
 from ocp.dynamics.actuator_kinds import Actuator
 from ocp.dynamics.layout import actuator_blocks, control_layout, split_measurement
-from ocp.fast_call import BufferedFunction, as_floats
+from ocp.fast_call import BufferedFunction, as_floats, buffered
 
 Array = NDArray[np.float64]
 
@@ -383,7 +383,8 @@ def demand_limits(spacecraft: Spacecraft) -> dict[str, Array]:
 
 def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike, q: ArrayLike, omega: ArrayLike,
                      torque: ArrayLike, state0: ArrayLike | None = None,
-                     jumps: ArrayLike | None = None, torque_after: ArrayLike | None = None) -> dict[str, Demand]:
+                     jumps: ArrayLike | None = None, torque_after: ArrayLike | None = None,
+                     environment: ArrayLike | None = None) -> dict[str, Demand]:
     """What a reference asks of each actuator through a law's own allocation (module docstring).
 
     At each sample the feed-forward torque goes through the law's map (its flags included, except
@@ -450,6 +451,11 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
     torque_after : (N, 3) array_like or None, optional
         The feed-forward torque just after each sample [N m], body axes, where it jumps there
         (a reference's end T: zero after it), for the integrated states; ``None``: ``torque``.
+    environment : (N, 3) array_like or None, optional
+        The environment's torque of ``model`` at the samples [N m], body axes, where the caller has
+        it already (``model_rows(model, "environment_torque", ...)`` at the same states, times and
+        the model's default parameters: the scorer's, which ``torque`` is net of); ``None``:
+        evaluated here where the closed form of the momenta needs it.
 
     Returns
     -------
@@ -490,7 +496,7 @@ def reference_demand(allocation: Allocation, model: AttitudeModel, t: ArrayLike,
         states = np.zeros((n, n_states))
     elif _conserving(law, blocks, model):
         states = _momentum_by_conservation(law, spacecraft, q, omega, start + kicks[0],
-                                           _environment_impulse(model, t, q, omega))
+                                           _environment_impulse(model, t, q, omega, environment))
     else:
         after = inputs.copy()
         if torque_after is not None:
@@ -517,28 +523,53 @@ _CHUNK = 512
 """Samples (or sub-steps) per call of the mapped map and the accumulated step of :func:`reference_demand`,
 and of :func:`model_rows`."""
 
+_TAIL = 64
+"""Samples per call of the smaller map that evaluates the rows past the last whole chunk of
+:data:`_CHUNK` (2110 samples: four chunks and one call of 64, not a fifth chunk padded with 450)."""
+
 
 def _mapped_rows(cache: SolverCache, key: tuple[Hashable, ...], build: Callable[[], ca.Function], *inputs: Array) -> Array:
     """The first output of ``build()`` at each of N samples, by chunks of :data:`_CHUNK` samples
-    through its map (cached under ``key``) and reusable buffers: no map is built per call and no
-    matrix converted to CasADi's (which cost more than the evaluation itself). ``inputs``: (N, k_i)
-    rows, or (1, k_i) for a value shared by every sample. Returns (N, m)."""
+    through its map (cached under ``key``), the rows past the last whole chunk by :data:`_TAIL`
+    through a smaller map, and their buffers (:func:`ocp.fast_call.buffered`: made once per map and
+    thread): no map is built per call and no matrix converted to CasADi's (which cost more than the
+    evaluation itself); each call's rows are written into the input buffers in place, a shared value
+    once a map, the last call padded with the last sample. ``inputs``: (N, k_i) rows, or (1, k_i)
+    for a value shared by every sample. Returns (N, m)."""
     n = max((rows.shape[0] for rows in inputs if rows.shape[0] != 1), default=1)
-    mapped = BufferedFunction(cache.get((*key, "rows", _CHUNK), lambda: build().map(_CHUNK)))
-    width = mapped.outputs[0].size // _CHUNK
-    out = np.empty((n, width))
-    for first in range(0, n, _CHUNK):  # the last chunk padded with the last sample
-        rows = np.arange(first, first + _CHUNK).clip(max=n - 1)
-        flat = [np.broadcast_to(values, (_CHUNK, values.shape[1])).ravel() if values.shape[0] == 1
-                else values[rows].ravel() for values in inputs]
-        out[first:first + _CHUNK] = mapped(*flat).reshape(_CHUNK, width)[:min(_CHUNK, n - first)]  # a row per sample
+    out: Array | None = None
+    whole = n - n % _CHUNK
+    for size, begin, end in ((_CHUNK, 0, whole), (_TAIL, whole, n)):
+        if begin == end:
+            continue
+        mapped = buffered(cache.get((*key, "rows", size), lambda: build().map(size)))
+        width = mapped.outputs[0].size // size
+        if out is None:
+            out = np.empty((n, width))
+        result = mapped.outputs[0].reshape(size, width)  # column-major (m, size): a row per sample
+        per_sample = []
+        for buffer, values in zip(mapped.inputs, inputs):
+            rows = buffer.reshape(size, values.shape[1])
+            if values.shape[0] == 1:
+                rows[:] = values
+            else:
+                per_sample.append((rows, values))
+        for first in range(begin, end, size):
+            count = min(size, end - first)
+            for rows, values in per_sample:
+                rows[:count] = values[first:first + count]
+                rows[count:] = values[n - 1]
+            mapped.evaluate()
+            out[first:first + count] = result[:count]
+    assert out is not None  # n >= 1
     return out
 
 
 def model_rows(model: AttitudeModel, name: str, *inputs: ArrayLike) -> Array:
     """One of a model's CasADi functions at each of N samples (``environment_torque``,
     ``body_torque``, ``field_body``, ...), as a batch: the function's own expression evaluated by
-    chunks through a cached map (:data:`_CHUNK` samples a call) and reusable buffers.
+    chunks through a cached map (:data:`_CHUNK` samples a call, the rest :data:`_TAIL` a call) and
+    its buffers.
 
     Parameters
     ----------
@@ -587,16 +618,21 @@ def _conserving(law: Allocation, blocks: Sequence[Any], model: AttitudeModel) ->
             and law._working_axes is not None and int(np.linalg.matrix_rank(law._working_axes)) == 3)
 
 
-def _environment_impulse(model: AttitudeModel, t: Array, q: Array, omega: Array) -> Array:
+def _environment_impulse(model: AttitudeModel, t: Array, q: Array, omega: Array,
+                         known: ArrayLike | None = None) -> Array:
     """``∫₀ᵗ R(q) τ_e dt`` [N m s], inertial axes, at each sample: the environment's torque of
     ``model`` (gravity gradient, constant disturbance) along the motion, by the trapezoidal rule;
-    zeros without one."""
+    zeros without one. ``known``: that torque at the samples [N m], body axes, when the caller has
+    it (:func:`reference_demand`'s ``environment``); ``None``: evaluated here."""
     environment = model.environment
     if environment is None or not (environment.gravity_gradient or np.any(environment.disturbance_torque)):
         return np.zeros((t.size, 3))
-    x = np.hstack([q, omega, np.zeros((t.size, model.nx - 7))])
-    torque = model_rows(model, "environment_torque", x, t[:, None],
-                        np.asarray(model.default_parameters, dtype=float).ravel())
+    if known is not None:
+        torque = np.asarray(known, dtype=float).reshape(t.size, 3)
+    else:
+        x = np.hstack([q, omega, np.zeros((t.size, model.nx - 7))])
+        torque = model_rows(model, "environment_torque", x, t[:, None],
+                            np.asarray(model.default_parameters, dtype=float).ravel())
     inertial = quat.rotate(quat.normalize(q), torque)
     steps = 0.5 * (inertial[1:] + inertial[:-1]) * np.diff(t)[:, None]
     return np.vstack([np.zeros((1, 3)), np.cumsum(steps, axis=0)])

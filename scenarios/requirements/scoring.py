@@ -40,7 +40,8 @@ messages (:func:`violations`, :func:`unhonoured`).
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping, Sequence
+import functools
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -214,6 +215,12 @@ def _seconds(value: float) -> str:
     return f"{value:.1f}" if value == 0.0 or abs(value) >= 0.1 else f"{value:.2g}"
 
 
+def _on_samples(times: Array, t: Array) -> NDArray[np.bool_]:
+    """Whether each of ``times`` is one of the increasing samples ``t`` (``np.isin``, by a binary search)."""
+    found = np.minimum(t.searchsorted(times), t.size - 1)
+    return t[found] == times
+
+
 def _inserted(t: Array, columns: Sequence[Array], times: Array, values: Sequence[Array]) -> tuple[Array, list[Array]]:
     """``t`` and its columns (rows per time) with the rows of ``values`` at ``times`` inserted, in
     time order: those strictly inside ``t``'s span, on no sample and on no earlier one of ``times``."""
@@ -221,7 +228,7 @@ def _inserted(t: Array, columns: Sequence[Array], times: Array, values: Sequence
     _, first = np.unique(times, return_index=True)
     keep = np.zeros(times.size, bool)
     keep[first] = True
-    keep &= (times > t[0]) & (times < t[-1]) & ~np.isin(times, t)
+    keep &= (times > t[0]) & (times < t[-1]) & ~_on_samples(times, t)
     if not np.any(keep):
         return t, [np.asarray(column, dtype=float) for column in columns]
     merged = np.concatenate([t, times[keep]])
@@ -248,7 +255,7 @@ def _with_edges(problem: ManeuverProblem, t: Array, sample: Any,
     if reference is None or not problem.pointing or t.size < 2:
         return t, q, omega
     edges = np.unique(np.asarray([edge for constraint in problem.pointing for edge in constraint.window], dtype=float))
-    edges = edges[(edges > t[0]) & (edges < t[-1]) & ~np.isin(edges, t)]
+    edges = edges[(edges > t[0]) & (edges < t[-1]) & ~_on_samples(edges, t)]
     sides, at_sides = reference.breakpoint_sides()
     times = np.concatenate([edges, sides])
     if not times.size:
@@ -498,12 +505,13 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
                jumps: list[tuple[float, int, Array]] | None = None, unrealised: Array | None = None,
                torque: Array | None = None, plant_limited: Mapping[str, Array] | None = None,
                impulse: Array | None = None, duration: float | None = None,
-               unstarted: Mapping[str, Array] | None = None, start_momentum: float = 0.0) -> Score:
+               unstarted: Callable[[], Mapping[str, Array]] | None = None, start_momentum: float = 0.0) -> Score:
     """The actuator requirement's score of a reference's demand (:func:`score_reference`).
 
     A quantity whose element at the peak (a wheel) is broken only with a declared free start (its
-    peak ratio in ``unstarted``, the demand as if the spacecraft started at the reference's rate,
-    within the allowed) is said to be the free start's:
+    peak ratio in ``unstarted()``, the demand as if the spacecraft started at the reference's rate,
+    within the allowed; asked only for a quantity broken, where the message needs it) is said to be
+    the free start's:
     ``(the free start's momentum, J N m s, takes it there: r x without it)``, ``J``
     the momentum ``‖I (ω_ref(0) − ω₀)‖`` the actuators take up (the wheels, at once where they
     span it and as the body turns where the other actuators remove it, :func:`start_torque`).
@@ -545,9 +553,9 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
             whose = " (the truth model's, below the design's)" if lowered is not None and lowered[element] else ""
             removes = free and name.rsplit("_", 1)[0] not in stores and duration is not None and t[worst] <= duration
             cause = free if removes else ""
-            alone = (unstarted or {}).get(name)
+            alone = unstarted().get(name) if not cause and unstarted is not None else None
             before = None if alone is None or element >= alone.size else float(alone[element])
-            if not cause and before is not None and before <= margin_allowed * (1 + _TOLERANCE):
+            if before is not None and before <= margin_allowed * (1 + _TOLERANCE):
                 cause = (f" (the free start's momentum, {start_momentum:.3g} N m s, takes it there: "
                          f"{before:.3g} x without it)")
             broken.append(f"{name} {shown} x its limit{whose} at {t[worst]:.1f} s{cause}")
@@ -709,18 +717,13 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
                 torque = torque + start
                 after = after + np.where(coasting, 0.0, start)
         demand = reference_demand(allocation, problem.model, demand_t, q, omega, torque,
-                                  problem.wheel_momentum0, jumps=steps, torque_after=after)
-        unstarted: dict[str, Array] = {}  # with a free start, each element's peak ratio as if it started at ω_ref(0)
+                                  problem.wheel_momentum0, jumps=steps, torque_after=after, environment=environment)
+        # with a free start, each element's peak ratio as if it started at ω_ref(0): a second demand, asked
+        # only where a broken quantity's message needs it
+        unstarted: Callable[[], dict[str, Array]] | None = None
         if demand_t.size and np.any(steps[0]) and not any(index == 0 for _, index, _ in jumps):
-            free_steps = steps.copy()
-            free_steps[0] -= omega[0] - np.asarray(problem.omega0, dtype=float)
-            alone = reference_demand(allocation, problem.model, demand_t, q, omega, reference_torque - environment,
-                                     problem.wheel_momentum0, jumps=free_steps,
-                                     torque_after=None if reference is None else
-                                     np.where((demand_t >= reference.duration)[:, None], 0.0, reference_torque)
-                                     - environment)
-            unstarted = {name: np.max(quantity.ratios(), axis=0) for name, quantity in alone.items()
-                         if quantity.limited and quantity.ratios().size and np.all(np.isfinite(quantity.values))}
+            unstarted = functools.cache(functools.partial(_unstarted, allocation, problem, demand_t, q, omega,
+                                                          reference_torque, environment, steps, reference))
         unrealised = unrealised_torque(problem.model, demand_t, q, omega, torque, demand)
         lower: dict[str, Array] = {}  # per quantity, the elements whose plant limit is below the design's
         if plant_limits is not None:
@@ -732,10 +735,26 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         scores["actuators"] = _actuators(requirements.actuators.allowed, demand, demand_t, jumps, unrealised, torque,
                                          lower, impulse, None if reference is None else reference.duration,
                                          unstarted, float(np.linalg.norm(problem.spacecraft.inertia @ steps[0]))
-                                         if unstarted else 0.0)
+                                         if unstarted is not None else 0.0)
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, sample.omega)
     return scores
+
+
+def _unstarted(allocation: Allocation, problem: ManeuverProblem, t: Array, q: Array, omega: Array,
+               reference_torque: Array, environment: Array, steps: Array,
+               reference: Reference | None) -> dict[str, Array]:
+    """Each limited quantity's peak ratio per element as if the spacecraft started at the
+    reference's rate (:func:`score_reference`'s demand without the free start's jump at ``t[0]``)."""
+    free_steps = steps.copy()
+    free_steps[0] -= omega[0] - np.asarray(problem.omega0, dtype=float)
+    alone = reference_demand(allocation, problem.model, t, q, omega, reference_torque - environment,
+                             problem.wheel_momentum0, jumps=free_steps,
+                             torque_after=None if reference is None else
+                             np.where((t >= reference.duration)[:, None], 0.0, reference_torque) - environment,
+                             environment=environment)
+    return {name: np.max(quantity.ratios(), axis=0) for name, quantity in alone.items()
+            if quantity.limited and quantity.ratios().size and np.all(np.isfinite(quantity.values))}
 
 
 def _environment_torque(problem: ManeuverProblem, t: Array, q: Array, omega: Array) -> Array:

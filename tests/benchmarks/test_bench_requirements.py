@@ -21,6 +21,19 @@ the unrealised torque about 2.4 ms (CasADi evaluation through
 ``controllers.allocation.model_rows``), the interpolants about 2.5 ms. The budget (1.25 times the
 largest run seen before the last changes) guards against the search's old cost returning.
 
+Measured on 2026-12-03 (load 4.0-5.6 on 2 cores), against 382b1fd, after the environment's torque
+was evaluated once a reference (the demand's closed form takes the scorer's), the free start's
+second demand asked only where a broken quantity's message needs it, and ``model_rows`` kept its
+buffers and evaluated the rows past the last whole chunk by a smaller map: this benchmark run
+alternately on both (15 pairs a run, wall): +20.8, +22.1, +22.9, +20.7 % (median 21.5 %) against
++35.6, +33.7, +36.0, +33.5 % on 382b1fd (median 34.8 %); CPU, three alternate processes of 15
+pairs each: overhead +22.8, +22.7, +21.4 % against +29.8, +32.7, +34.7 %, the scoring's CPU 44-56 ms
+a run against 62-72 ms; every score, status and message of 15 rows (this scenario and five more)
+bit for bit. The 10 % target is not met: about half of what is left is the pointing searches of
+both scopes (``ocp.geometry.pointing``: per requirement and per row) and their interpolants, then
+the CasADi evaluations along each reference. The budget stays 60 %: single runs reached +42 % at
+this load.
+
 The 12U CubeSat Sun keep-out scenario without its collocation row (the fast planners, where scoring
 weighs most), with three pointing requirements (the star tracker off the Sun and the Moon, an
 antenna off the Earth's limb: moving directions, tabulated), the actuator margin (the demand
