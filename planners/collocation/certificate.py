@@ -364,7 +364,7 @@ def _shooting(model: AttitudeModel, arcs: int, fixed_rate: bool) -> ca.Function:
     arc = step.fold(SHOOTING_STEPS)  # an MX graph of folds: built in milliseconds, unlike its SX expansion
     x0, z, U = ca.MX.sym("x0", model.nx), ca.MX.sym("z", arcs), ca.MX.sym("U", model.nu, arcs)
     disturbance, xf = ca.MX.sym("d", 3), ca.MX.sym("xf", model.nx)
-    state, start = ca.vertcat(x0, 0), 0
+    state, start = ca.vertcat(x0, 0), ca.MX(0)
     for k in range(arcs):
         state = arc(state, ca.repmat(U[:, k], 1, SHOOTING_STEPS), ca.repmat((z[k] - start) / SHOOTING_STEPS, 1,
                     SHOOTING_STEPS), ca.repmat(disturbance, 1, SHOOTING_STEPS))
