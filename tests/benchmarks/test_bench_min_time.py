@@ -233,9 +233,11 @@ against 121 ms). Issue 30's 1.0x is not met: the solver calls are most of the pl
 Measured 2026-12-03 16:34 UTC, switch refinement by default where the estimated error of T exceeds
 1e-4 s (9 rounds, wall, load 4.2-4.5): B&W not refined, 1.76 [1.50..2.49] (ours 259, acados 152 ms);
 XTE refined 0.31 [0.25..0.36] (ours 663 ms, 28.6304443; acados 2241 ms to its 500th SQP iteration),
-unrefined 0.19 [0.12..0.27] (348 ms, 28.6312691). CPU per plan after the build (10 plans, 3 runs):
-XTE 1.6-1.8x unrefined, the full inertia (estimated 1.27e-4 s, refined: 7.6824880 against
-7.6826133) 2.2-2.3x (docs/performance.rst).
+unrefined 0.19 [0.12..0.27] (348 ms, 28.6312691). Again at 16:44 (load 4.4-4.6): B&W 1.81
+[1.12..2.91]; XTE 0.29 [0.23..0.37] (388 against acados's 1320 ms), unrefined 0.17 [0.15..0.23]; the
+full inertia, now refined (its estimated error 1.27e-4 s exceeds 1e-4 s; 7.6824880, 12 IPOPT
+iterations), 1.32 [0.99..1.53] (237 against 177 ms; 0.60-0.83 unrefined before). CPU per plan after
+the build (10 plans, 3 runs): XTE 1.6-1.8x unrefined, the full inertia 2.2-2.3x (docs/performance.rst).
 
 Measured 2026-12-03 11:32 UTC, the rest of the work outside IPOPT cut (docs/performance.rst, issue
 30): the multistart calls ``nlpsol`` through CasADi's buffers (NumPy to ``DM`` and back costs about
