@@ -449,17 +449,27 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
         shooting = _mapped(model, f"switch shooting {arcs} {fixed_rate} {SHOOTING_STEPS}", 1,
                            lambda: _shooting(model, arcs, fixed_rate))
         stationary = 0.0
+        outputs = [np.asarray(m) for m in (shooting(x0, z, U, disturbance, xf) if arcs <= conditions else
+                                           shooting(x0, z, U, disturbance, xf, multiplier))]
+        if not all(np.all(np.isfinite(m)) for m in outputs):  # an arc far too long: the RK4 steps diverged
+            return {"skipped": f"the shooting is not finite ({arcs - 1} switches)"}
         if arcs <= conditions:
-            r, J = (np.asarray(m) for m in shooting(x0, z, U, disturbance, xf))
-            step = np.linalg.lstsq(J, -r.ravel(), rcond=None)[0]
+            r, J = outputs
+            matrix, rhs = J, -r.ravel()
         else:
-            r, J, H = (np.asarray(m) for m in shooting(x0, z, U, disturbance, xf, multiplier))
+            r, J, H = outputs
             gradient = np.zeros(arcs)
             gradient[-1] = 1.0  # of T
             stationary = float(np.max(np.abs(gradient + J.T @ multiplier)))
-            kkt = np.block([[H, J.T], [J, np.zeros((conditions, conditions))]])
-            solution = np.linalg.lstsq(kkt, -np.concatenate([gradient + J.T @ multiplier, r.ravel()]), rcond=None)[0]
-            step, multiplier = solution[:arcs], multiplier + solution[arcs:]
+            matrix = np.block([[H, J.T], [J, np.zeros((conditions, conditions))]])
+            rhs = -np.concatenate([gradient + J.T @ multiplier, r.ravel()])
+        try:
+            solution = np.linalg.lstsq(matrix, rhs, rcond=None)[0]
+        except np.linalg.LinAlgError as error:
+            return {"skipped": f"the shooting's Newton step: {error}"}
+        step = solution[:arcs]
+        if arcs > conditions:
+            multiplier = multiplier + solution[arcs:]
         miss = float(np.max(np.abs(r)))
         z = z + step
         if not np.all(np.isfinite(z)) or np.max(np.abs(z - roots)) > interval:
