@@ -15,10 +15,13 @@ The discretisation error of a bang-bang minimum time (:func:`time_error`): the s
 functions' roots, interpolated between the Radau points, are the switch times of a bang-bang
 control with the solution's switching structure; Newton's method on those times and ``T`` makes
 that control, integrated accurately (RK4, :data:`SHOOTING_STEPS` steps per arc), meet the final
-attitude and rate. Its ``T`` is that of an exact trajectory of the continuous problem, so it is an
-upper bound of the continuous minimum time, and, the optimum being stationary on the feasible
-switch times, within the square of the collocation's switch-time error of it: ``T_N`` minus it is
-the discretisation error of ``T_N``, never more than it (a switch the mesh missed makes it less).
+attitude and rate (with more switches than final conditions, ``T`` minimised on them). Its ``T`` is
+that of a trajectory of the continuous problem (to the RK4 steps' error, 1.6e-6 s on XTE), so it
+bounds the continuous minimum time from above, and, the optimum being stationary on the feasible
+switch times, it is within the square of the collocation's switch-time error of it: ``T_N`` minus
+it is the discretisation error of ``T_N``, not more than it (a switch the mesh missed makes it
+less). A switch or ``T`` moved by more than a mesh interval is another switching structure than the
+mesh resolved: no estimate.
 """
 from __future__ import annotations
 
