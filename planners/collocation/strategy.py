@@ -15,6 +15,11 @@ from planners.problem import Array
 
 AUTO_RESTART = 0.05
 """Relative perturbation of the restarts of ``multistart: auto`` when the final time is free."""
+AUTO_PIECES = 4
+"""Pieces each interval holding a switch is split in by ``switch_refinement: auto`` (where the
+estimated error of T exceeds ``mesh_tolerance``): XTE's 28.6312691 s on 50 intervals becomes
+28.6304443 s (+3.7e-5 s of the published 28.6304077 s, +3.8e-5 s of the switch-time shooting's
+28.6304068 s); 2 pieces leave +1.6e-4 s."""
 AUTO_FIRST = 0.03
 """Relative perturbation of the first start of ``multistart: auto`` when the final time is free: each
 decision variable moves by ``AUTO_FIRST × (|value| + floor)`` (normal noise), the floor half the
