@@ -33,7 +33,7 @@ from scenarios.schema.read import read_yaml
 
 def test_the_index_loads_and_every_problem_is_a_scenario_with_its_planners():
     suite = load_suite()
-    assert suite.version == 2
+    assert suite.version == 3
     assert len(suite.problems) >= 10
     for problem in suite.problems.values():
         scenario = load(problem.file)  # an ordinary scenario: `slewbench run` runs it too
@@ -174,7 +174,7 @@ def test_bench_writes_the_leaderboard_with_the_hand_worked_gap(tmp_path, capsys)
     if peer["value"]:
         assert float(peer["gap_abs"]) == pytest.approx(float(peer["value"]) - 2.42112, abs=1e-12)
     data = json.loads((out / "leaderboard.json").read_text())
-    assert data["suite_version"] == 2 and data["slewbench"] and data["date"].endswith("Z") and data["platform"]
+    assert data["suite_version"] == 3 and data["slewbench"] and data["date"].endswith("Z") and data["platform"]
     assert [problem["name"] for problem in data["problems"]] == ["bilimoria_wie_90"]
     assert len(data["rows"]) == len(rows) == 2
     text = (out / "leaderboard.md").read_text()
