@@ -1050,8 +1050,8 @@ MUTATIONS: list[Mutation] = [
              'return status == "ok" and gap_abs <= problem.tolerance',
              ("tests/test_bench.py::test_a_row_reaches_the_optimum_only_when_ok_and_a_peer_at_the_eigenaxis_saddle_is_noted",
               "tests/test_bench_rows_logic.py")),
-    Mutation("bench-suite-version-1", "scenarios/bench/suite.yaml",
-             "\nversion: 2\n", "\nversion: 1\n", ("tests/test_bench_xte_tolerance.py::test_the_tolerance_is_the_digits_the_optimum_is_known_to",)),
+    Mutation("bench-suite-version-2", "scenarios/bench/suite.yaml",
+             "\nversion: 3\n", "\nversion: 2\n", ("tests/test_bench_xte_tolerance.py::test_the_tolerance_is_the_digits_the_optimum_is_known_to",)),
     Mutation("bench-xte-tolerance-covers-the-default-mesh", "scenarios/bench/suite.yaml",
              "value: 28.6304077\n      tolerance: 1.0e-4", "value: 28.6304077\n      tolerance: 1.0e-3",
              ("tests/test_bench_xte_tolerance.py::test_the_tolerance_is_the_digits_the_optimum_is_known_to",)),
@@ -1225,5 +1225,15 @@ MUTATIONS: list[Mutation] = [
     Mutation("compiled-cc-ignored-when-cc-exists", "ocp/simulation/compiled.py",
              'for candidate in (os.environ.get("CC"), "cc", "gcc"):', 'for candidate in ("cc", "gcc", os.environ.get("CC")):',
              ("tests/test_mutants_compiled.py", "tests/test_closed_loop.py", "tests/test_closed_loop_cache.py")),
+    # --- the estimated discretisation error of a bang-bang minimum time and the default refinement ---
+    Mutation("time-error-auto-refines-at-ten-times-the-tolerance", "planners/collocation/planner.py",
+             'abs(estimate.get("estimate_s", 0.0)) <= o.mesh_tolerance', 'abs(estimate.get("estimate_s", 0.0)) <= 10 * o.mesh_tolerance',
+             ("tests/test_mesh_error.py::test_xte_is_within_its_tolerance_by_default",)),
+    Mutation("time-error-first-arc-at-the-wrong-bound", "planners/collocation/certificate.py",
+             "first = np.where(sigma[0] > 0, low, high)", "first = np.where(sigma[0] < 0, low, high)",
+             ("tests/test_mesh_error.py",)),
+    Mutation("time-error-sign-of-the-estimate", "planners/collocation/certificate.py",
+             'return {"estimate_s": T - float(z[-1]),', 'return {"estimate_s": float(z[-1]) - T,',
+             ("tests/test_mesh_error.py",)),
 ]
 """Every mutation of the check, by area."""
