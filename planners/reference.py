@@ -168,7 +168,7 @@ class Reference(ABC):
     def ok(self) -> bool:
         """Whether the planner succeeded (``status == "ok"``): on its own terms, not against the
         scenario's requirements (actuator limits, pointing, rate, final accuracy), which
-        :func:`scenarios.run` scores for every row."""
+        :func:`scenarios.runner.run` scores for every row."""
         return self.status == "ok"
 
     def _summary(self) -> dict[str, str]:

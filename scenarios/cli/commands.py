@@ -603,6 +603,23 @@ def _names(given: str, path: Path) -> bool:
     return path == directory or directory in path.parents
 
 
+def _tolerant_streams() -> None:
+    """Standard output and error that escape what their encoding cannot show (``\\u2717``)
+    instead of raising: the tables and messages use ✓, ✗, ω, ‖ and °, which a console or a file
+    in a legacy encoding (cp1252) lacks, and a ``UnicodeEncodeError`` there stopped a run before
+    its files were written. Streams already UTF-8, or without ``reconfigure`` (a test's
+    ``StringIO``), are left as they are."""
+    for stream in (sys.stdout, sys.stderr):
+        encoding = (getattr(stream, "encoding", None) or "").lower().replace("_", "-")
+        reconfigure = getattr(stream, "reconfigure", None)
+        if reconfigure is None or encoding in ("utf-8", "utf8") or getattr(stream, "errors", None) != "strict":
+            continue
+        try:
+            reconfigure(errors="backslashreplace")
+        except (ValueError, OSError):  # a stream that cannot change now: left as it is
+            continue
+
+
 def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     """Run the ``slewbench`` command line.
 
@@ -626,6 +643,7 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     """
     parser = build_parser()
     args = parser.parse_args(attached_values(sys.argv[1:] if argv is None else list(argv), parser))
+    _tolerant_streams()
     args.interruption = Interruption()
     args.renderer = renderer
     # Ctrl-C too: CasADi turns a KeyboardInterrupt raised inside IPOPT into a failed solve, and the
