@@ -85,6 +85,9 @@ def test_a_truth_speed_limit_bounds_the_momentum(design):
     scored = row.requirements["reference"]["actuators"]
     assert scored["wheels_momentum"] == pytest.approx(design["wheels_momentum"] * DESIGN_MOMENTUM / stored, rel=1e-9)
     assert row.status == "violated" and "truth model's" in row.message
+    # a tester read only "does not honour the pointing requirement" and wondered why a planner that
+    # honours the actuators broke them: it honours the design's limits
+    assert "the planners plan to the design's, above it" in row.message, row.message
 
 
 def test_the_message_blames_the_truth_only_for_the_wheel_that_broke_its_limit():

@@ -550,7 +550,8 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
             allowed = max(allowed, limit, key=len)
             element = int(np.argmax(ratios[worst])) if ratios.size else 0  # the element at the peak
             lowered = (plant_limited or {}).get(name)
-            whose = " (the truth model's, below the design's)" if lowered is not None and lowered[element] else ""
+            whose = (" (the truth model's; the planners plan to the design's, above it)"
+                     if lowered is not None and lowered[element] else "")
             removes = free and name.rsplit("_", 1)[0] not in stores and duration is not None and t[worst] <= duration
             cause = free if removes else ""
             alone = unstarted().get(name) if not cause and unstarted is not None else None
