@@ -15,12 +15,16 @@ The discretisation error of a bang-bang minimum time (:func:`time_error`): the s
 functions' roots, interpolated between the Radau points, are the switch times of a bang-bang
 control with the solution's switching structure; Newton's method on those times and ``T`` makes
 that control, integrated accurately (RK4, :data:`SHOOTING_STEPS` steps per arc), meet the final
-attitude and rate (with more switches than final conditions, ``T`` minimised on them). Its ``T`` is
+attitude and rate (with more switches than final conditions, ``T`` minimised on them; two switches
+of two controls the minimisation makes cross are tied, their order constraint active). Newton's
+method stops where the miss and the stationarity at the point it returns are below
+:data:`SHOOTING_TOLERANCE`. A σ exactly 0 at a Radau point between a positive and a negative value
+is one root. Its ``T`` is
 that of a trajectory of the continuous problem (to the RK4 steps' error, 1.6e-6 s on XTE), so it
 bounds the continuous minimum time from above, and, the optimum being stationary on the feasible
 switch times, it is within the square of the collocation's switch-time error of it: ``T_N`` minus
-it is the discretisation error of ``T_N``, not more than it (a switch the mesh missed makes it
-less). A switch or ``T`` moved by more than a mesh interval is another switching structure than the
+it is the discretisation error of ``T_N``, not more than it but for the RK4 steps' error (a
+switch the mesh missed makes it less). A switch or ``T`` moved by more than a mesh interval is another switching structure than the
 mesh resolved: no estimate.
 """
 from __future__ import annotations
@@ -51,13 +55,12 @@ SHOOTING_STEPS = 12
 """RK4 steps per arc of :func:`time_error`'s bang-bang shooting: its ``T`` on XTE is 1.6e-6 s from
 that of 80 steps (28.6304068 s), on Bilimoria & Wie 2.6e-8 s, on the full inertia 2e-7 s; 40 steps
 cost 10x the time a call."""
-SHOOTING_TOLERANCE = 1e-3
-"""Largest final attitude (quaternion vector part) and rate [rad/s] miss from which
-:func:`time_error`'s last Newton step is taken: Newton's convergence being quadratic, that step
-leaves about its square, and the estimate is within 3.5e-7 s of the one iterated on to a miss of
-1e-13 (XTE 1.0e-7 s, Bilimoria & Wie 180° 2.9e-7 s, ten of the benchmarks' slews), one call of
-the shooting (1.1 ms) fewer: two on Bilimoria & Wie."""
-SHOOTING_ITERATIONS = 8
+SHOOTING_TOLERANCE = 1e-10
+"""Largest final attitude (quaternion vector part) and rate [rad/s] miss, and stationarity of the
+minimisation of ``T`` (more switches than conditions), at which :func:`time_error` accepts a point
+of its Newton iteration: both are evaluated at the point returned, whose ``T`` is then that of the
+RK4 shooting's exact solution to far below a microsecond."""
+SHOOTING_ITERATIONS = 10
 """Newton iterations of :func:`time_error` before it gives up."""
 
 
@@ -384,6 +387,31 @@ def _shooting(model: AttitudeModel, arcs: int, fixed_rate: bool) -> ca.Function:
                        [r, ca.jacobian(r, z), ca.hessian(ca.dot(multiplier, r), z)[0]])
 
 
+def _switch_times(t: Array, sigma: Array, low: Array, high: Array) -> tuple[Array, NDArray[np.int_], Array]:
+    """The roots of the switching functions ``sigma`` (points, controls) at the times ``t`` [s]:
+    linear between consecutive points of opposite signs; a run of exact zeros between a positive
+    and a negative value is one root, at the run's middle (between two values of one sign, a touch:
+    none). Returns the switch times in time order, the control each switches and the first arc's
+    controls (``low`` where the first nonzero σ is positive: the control minimises ``σ u``)."""
+    times, owners = [], []
+    first = np.where(sigma[0] > 0, low, high)
+    for control in range(sigma.shape[1]):
+        values = sigma[:, control]
+        nonzero = np.flatnonzero(values)
+        if nonzero.size and values[0] == 0:  # σ is 0 at the start: the first nonzero value decides
+            first[control] = low[control] if values[nonzero[0]] > 0 else high[control]
+        for a, b in zip(nonzero[:-1], nonzero[1:]):
+            if values[a] * values[b] > 0:
+                continue
+            if b == a + 1:
+                times.append(t[a] + (t[b] - t[a]) * values[a] / (values[a] - values[b]))
+            else:  # exact zeros in between
+                times.append(0.5 * (t[a + 1] + t[b - 1]))
+            owners.append(control)
+    order = np.argsort(times, kind="stable")
+    return np.asarray(times, dtype=float)[order], np.asarray(owners, dtype=int)[order], first
+
+
 def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array, lbx: Array, ubx: Array,
                params: Array, fixed_rate: bool, functions: tuple[Array, Array, Array]) -> dict[str, Any]:
     """The discretisation error of a bang-bang minimum time: ``T_N`` minus the final time of the
@@ -406,8 +434,10 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
     Returns
     -------
     dict
-        ``estimate_s`` (``T_N − T`` [s]), ``shooting_T_s`` (its ``T``), ``switches`` and
-        ``iterations``; or ``skipped`` saying why not (controls' bounds that vary, no convergence,
+        ``estimate_s`` (``T_N − T`` [s]), ``shooting_T_s`` (its ``T``), ``switches``, ``miss`` (the
+        final attitude and rate miss there), ``stationarity`` (of ``T``'s minimisation; 0 without),
+        ``switch_times_s`` (in time order), ``controls`` (per arc), ``coinciding`` (tied pairs of switches) and
+        ``iterations`` (shooting calls); or ``skipped`` saying why not (controls' bounds that vary, no convergence,
         switches that change order).
     """
     N, d, nx, nu = transcription.intervals, transcription.degree, model.nx, model.nu
@@ -424,16 +454,16 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
     params = np.asarray(params, dtype=float)
     x0, xf = params[:nx], params[nx:nx + 7]
     # the roots of σ, linear between consecutive points, and which control each switches
-    crossing = np.nonzero(sigma[:-1] * sigma[1:] < 0)
-    times = t[crossing[0]] + (t[crossing[0] + 1] - t[crossing[0]]) * sigma[crossing] / (
-        sigma[crossing] - sigma[crossing[0] + 1, crossing[1]])
-    owner = crossing[1]
-    first = np.where(sigma[0] > 0, low, high)
+    times, owner, first = _switch_times(t, sigma, low, high)
     conditions = 6 if fixed_rate else 3
     z, roots = np.append(times, T), np.append(times, T)
+    ident = np.arange(len(times))  # each switch's identity, kept through the removals and sorts
     interval = float(np.max(np.diff(transcription.nodes))) * T  # the longest mesh interval [s]
     disturbance = params[-3:]
     multiplier = np.zeros(conditions)
+    # pairs of switches of two controls that T's minimisation makes coincide (Bilimoria & Wie 45°):
+    # the order constraint between them active, each with its multiplier (>= 0 at a minimum)
+    ties: dict[tuple[int, int], float] = {}
     miss = np.inf
     for iteration in range(1, SHOOTING_ITERATIONS + 1):
         # a switch that Newton's step moved out of the slew is none (a σ root by a node, an arc the
@@ -442,10 +472,17 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
         for control in owner[z[:-1] <= 0]:
             first[control] = low[control] + high[control] - first[control]
         z, owner, roots = np.append(z[:-1][~out], z[-1]), owner[~out], np.append(roots[:-1][~out], roots[-1])
+        ident = ident[~out]
         # the arcs in time order: each switch flips its control between its bounds
         order = np.argsort(z[:-1], kind="stable")
-        z[:-1], owner, roots[:-1] = z[:-1][order], owner[order], roots[:-1][order]
+        z[:-1], owner, roots[:-1], ident = z[:-1][order], owner[order], roots[:-1][order], ident[order]
         arcs = len(z)
+        position = {int(i): k for k, i in enumerate(ident)}
+        ties = {pair: mu for pair, mu in ties.items() if pair[0] in position and pair[1] in position}
+        tie_rows = np.zeros((len(ties), arcs))
+        for row, (earlier, later) in enumerate(ties):  # z_earlier − z_later <= 0, active
+            tie_rows[row, position[earlier]], tie_rows[row, position[later]] = 1.0, -1.0
+        mu = np.array(list(ties.values()), dtype=float)
         U = np.repeat(first[:, None], arcs, axis=1)
         for arc, control in enumerate(owner, start=1):
             U[control, arc:] = low[control] + high[control] - U[control, arc - 1]
@@ -463,24 +500,35 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
             r, J, H = outputs
             gradient = np.zeros(arcs)
             gradient[-1] = 1.0  # of T
-            stationary = float(np.max(np.abs(gradient + J.T @ multiplier)))
-            matrix = np.block([[H, J.T], [J, np.zeros((conditions, conditions))]])
-            rhs = -np.concatenate([gradient + J.T @ multiplier, r.ravel()])
+            residual = gradient + J.T @ multiplier + tie_rows.T @ mu
+            stationary = float(np.max(np.abs(residual)))
+            constraints = np.vstack([J, tie_rows])
+            matrix = np.block([[H, constraints.T], [constraints, np.zeros((len(constraints), len(constraints)))]])
+            rhs = -np.concatenate([residual, r.ravel(), tie_rows @ z])
+        miss = float(np.max(np.abs(r)))
+        if miss < SHOOTING_TOLERANCE and stationary < SHOOTING_TOLERANCE and np.all(mu >= 0):
+            # converged at the point evaluated (its switches in order): the estimate is its T
+            return {"estimate_s": T - float(z[-1]), "shooting_T_s": float(z[-1]), "switches": arcs - 1,
+                    "miss": miss, "stationarity": stationary, "switch_times_s": [float(v) for v in z[:-1]],
+                    "controls": U.T.tolist(), "coinciding": len(ties), "iterations": iteration}
         try:
             solution = np.linalg.lstsq(matrix, rhs, rcond=None)[0]
         except np.linalg.LinAlgError as error:
             return {"skipped": f"the shooting's Newton step: {error}"}
         step = solution[:arcs]
         if arcs > conditions:
-            multiplier = multiplier + solution[arcs:]
-        miss = float(np.max(np.abs(r)))
+            multiplier = multiplier + solution[arcs:arcs + conditions]
+            mu = mu + solution[arcs + conditions:]
+            # a tie whose multiplier is negative is released: T falls with the two switches apart
+            ties = {pair: float(m) for pair, m in zip(ties, mu) if m >= 0}
         z = z + step
         if not np.all(np.isfinite(z)) or np.max(np.abs(z - roots)) > interval:
             return {"skipped": f"the shooting moves a switch or T by more than a mesh interval ({len(z) - 1} "
                                f"switches): another switching structure"}
-        if miss < SHOOTING_TOLERANCE and stationary < SHOOTING_TOLERANCE and not np.any(
-                (z[:-1] <= 0) | (z[:-1] >= z[-1])):
-            # the step from there leaves a miss of about its square
-            return {"estimate_s": T - float(z[-1]), "shooting_T_s": float(z[-1]), "switches": arcs - 1,
-                    "iterations": iteration}
+        if arcs > conditions:  # two switches of two controls the step crosses: tied, from their middle
+            for k in range(arcs - 2):
+                pair = (int(ident[k]), int(ident[k + 1]))
+                if z[k] > z[k + 1] and owner[k] != owner[k + 1] and pair not in ties:
+                    ties[pair] = 0.0
+                    z[k] = z[k + 1] = 0.5 * (z[k] + z[k + 1])
     return {"skipped": f"the shooting does not converge ({len(z) - 1} switches; miss {miss:.1e})"}

@@ -1235,5 +1235,16 @@ MUTATIONS: list[Mutation] = [
     Mutation("time-error-sign-of-the-estimate", "planners/collocation/certificate.py",
              'return {"estimate_s": T - float(z[-1]),', 'return {"estimate_s": float(z[-1]) - T,',
              ("tests/test_mesh_error.py",)),
+    Mutation("time-error-t-not-minimised-on-extra-switches", "planners/collocation/certificate.py",
+             "gradient[-1] = 1.0  # of T", "gradient[-1] = 0.0  # of T",
+             ("tests/test_mesh_error.py",)),
+    Mutation("time-error-no-mesh-interval-guard", "planners/collocation/certificate.py",
+             "if not np.all(np.isfinite(z)) or np.max(np.abs(z - roots)) > interval:",
+             "if not np.all(np.isfinite(z)):",
+             ("tests/test_mesh_error.py",)),
+    Mutation("time-error-switch-at-the-interval-midpoint", "planners/collocation/certificate.py",
+             "times.append(t[a] + (t[b] - t[a]) * values[a] / (values[a] - values[b]))",
+             "times.append(0.5 * (t[a] + t[b]))",
+             ("tests/test_mesh_error.py",)),
 ]
 """Every mutation of the check, by area."""
