@@ -227,7 +227,7 @@ class CollocationOptions:
         intervals, +3.7e-5 s refined by 4). Skipped when no interval or more than a quarter of them
         hold a switch (a singular arc, not bang-bang), or for a problem with cones, a rate bound or
         an energy term (``time_regularization``); ``stats["switch_refinement"]`` records it.
-        ``auto`` (default): split in :data:`~planners.collocation.strategy.AUTO_PIECES` only where
+        ``auto`` (default): split in 4 (:data:`~planners.collocation.strategy.AUTO_PIECES`) only where
         the estimated discretisation error of T (``stats["time_error"]``, see ``mesh_tolerance``)
         exceeds ``mesh_tolerance``, else nothing is done and nothing recorded (under every other
         objective too). The error of T falls as the square of the switching intervals' length (XTE:

@@ -459,13 +459,16 @@ _ENTRY = re.compile(r"^([A-Za-z_]\w*(?:\s*,\s*[A-Za-z_]\w*)*)\s*(?::|$)")
 def _unit(meaning: str, position: int = 0, count: int = 1) -> str:
     """The unit a description gives in brackets (``[rad/s]``), outside parentheses; of several
     options documented together (``a, b : float``), the one at ``position`` of a comma-separated
-    list (``[N m, N m s]``). A bracket with commas otherwise is an interval, not a unit."""
+    list (``[N m, N m s]``). A bracket with commas otherwise is an interval, not a unit, and one
+    that opens on a quote an index (``stats["switch_refinement"]``)."""
     depth, start = 0, -1
     for index, char in enumerate(meaning):
         if start >= 0:
             if char == "]":
                 units = [unit.strip() for unit in meaning[start + 1:index].split(",")]
-                if any(c.isalpha() or c in "°µ" for c in meaning[start + 1:index]):
+                if meaning[start + 1:start + 2] in ("'", '"'):  # an index (stats["switch_refinement"]), no unit
+                    start = -1
+                elif any(c.isalpha() or c in "°µ" for c in meaning[start + 1:index]):
                     if len(units) == 1:
                         return units[0]
                     return units[position] if len(units) == count else ""
