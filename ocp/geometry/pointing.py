@@ -355,15 +355,24 @@ class Searched(tuple[Array, Array]):
         return found
 
 
-def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpec]) -> list[Searched]:
+Together = Callable[[NDArray[np.intp], Array, Array], Array]
+"""Every search's values in one call (:func:`searches_between_samples`): ``together(bounds, times,
+attitudes)``, the points of search ``i`` being ``times[bounds[i]:bounds[i + 1]]`` (``bounds``: one more
+than the searches), each point's value exactly what that search's own ``value`` gives."""
+
+
+def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpec],
+                             together: Together | None = None) -> list[Searched]:
     """Several searches of :func:`search_between_samples` on one motion (a row's pointing
     requirements), each exactly as alone: the same points, the same values.
 
-    Each search's samples and sub-grid are found on its own; its refinement brackets then go
-    through the zooms together with the others' (one array per zoom, each bracket tagged with its
-    search; the least value, the threshold and the :data:`MIN_SEARCHES` deepest brackets counted
-    per search), the attitudes of every zoom's points interpolated in one call: the array
-    operations of the zooms are paid once for all the searches, not once for each.
+    Each search's heads and sub-grid are found on its own, but evaluated together: the heads of
+    every search in one call, then the new points of every sub-grid (their attitudes interpolated
+    in one call) in one more; its refinement brackets then go through the zooms together with the
+    others' (one array per zoom, each bracket tagged with its search; the least value, the
+    threshold and the :data:`MIN_SEARCHES` deepest brackets counted per search), each zoom's points
+    interpolated and evaluated in one call: the array operations of the evaluations and the zooms
+    are paid once for all the searches, not once for each.
 
     Parameters
     ----------
@@ -371,31 +380,57 @@ def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpe
         The motion (its samples' times span the searches).
     searches : sequence of (value, threshold, drift, edges)
         Each as the arguments of :func:`search_between_samples`.
+    together : callable or None, optional
+        ``together(bounds, times, attitudes)``: every search's values in one call, the points of
+        search ``i`` being ``times[bounds[i]:bounds[i + 1]]``, each value exactly that of the
+        search's own ``value`` (:func:`scores_between_samples`: the margins of several constraints);
+        ``None``: each search's ``value`` on its own points.
 
     Returns
     -------
     list of Searched
         Per search, as :func:`search_between_samples` returns.
     """
-    results: list[Searched | None] = [None] * len(searches)
+    count = len(searches)
+    if not count:
+        return []
+    evaluate = _each(searches) if together is None else together
+    # 1. every search's heads (the knots: the samples and its edges), evaluated in one call
+    heads = [_heads(motion, drift, edges) for _, _, drift, edges in searches]
+    at_heads = _split(evaluate, [len(head[3]) for head in heads], np.concatenate([head[0][head[3]] for head in heads]),
+                      np.concatenate([head[1][head[3]] for head in heads]))
+    # 2. every search's sub-grid, its new points evaluated in one call
+    results: list[Searched | None] = [None] * count
+    opened: list[tuple[Array, Array, Array, NDArray[np.bool_], float] | None] = [None] * count
+    for index, ((_, threshold, _, _), head, values) in enumerate(zip(searches, heads, at_heads)):
+        if len(head[0]) < 2 or not np.any(np.isfinite(values)):  # nothing to zoom into
+            results[index] = Searched(head[0][head[3]], values)
+            continue
+        opened[index] = _sub_grid(motion, head, values, threshold)
+    grids = [(np.zeros(0), np.zeros(0, dtype=bool)) if entry is None else (entry[0], entry[3]) for entry in opened]
+    new_t = [grid[new] for grid, new in grids]
+    joined = np.concatenate(new_t)
+    found = _split(evaluate, [len(t) for t in new_t], joined, motion.attitudes(joined)) if joined.size \
+        else [np.zeros(0)] * count
+    active: list[int] = []  # the searches whose sub-grid goes on into the zooms, in order
     missable: list[float] = []
     found_t: list[list[Array]] = []
     found_v: list[list[Array]] = []
-    active: list[int] = []  # the searches whose sub-grid goes on into the zooms, in order
     brackets: list[tuple[Array, Array, Array]] = []
-    for index, (value, threshold, drift, edges) in enumerate(searches):
-        opened = _sub_grid(motion, value, threshold, drift, edges)
-        if len(opened) == 2:
-            results[index] = Searched(*opened)
+    for index, entry in enumerate(opened):
+        if entry is None:
             continue
-        grid, values, rate, longest = opened
+        grid, values, rate, new, longest = entry
+        values[new] = found[index]
         missable.append(longest)
         active.append(index)
         found_t.append([grid])
         found_v.append([values])
         brackets.append((grid, values, rate))
     if active:
-        _zoom(motion, [searches[index] for index in active], brackets, found_t, found_v, missable)
+        # 3. the zooms, every search's brackets together
+        _zoom(motion, evaluate, count, active, [float(searches[index][1]) for index in active], brackets, found_t,
+              found_v, missable)
         for slot, index in enumerate(active):
             if len(found_t[slot]) == 1:
                 results[index] = Searched(found_t[slot][0], found_v[slot][0], missable[slot])
@@ -406,12 +441,33 @@ def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpe
     return [result for result in results if result is not None]
 
 
-def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], threshold: float, drift: float,
-              edges: Sequence[float]) -> tuple[Array, Array] | tuple[Array, Array, Array, float]:
-    """Steps 1 and 2 of :func:`search_between_samples`: the heads, then the sub-grid, its values,
-    the bound's rate on each of its steps and its longest step [s] when the work limit cut it coarser
-    (:data:`MAX_SUB_GRID`; else 0); or the final ``(times, values)`` when nothing is left to zoom
-    into (fewer than two knots, no head inside the value's domain)."""
+def _each(searches: Sequence[SearchSpec]) -> Together:
+    """``together`` of :func:`searches_between_samples` from each search's own ``value``."""
+    def evaluate(bounds: NDArray[np.intp], times: Array, attitudes: Array) -> Array:
+        values = np.empty(len(times))
+        for index, (value, _, _, _) in enumerate(searches):
+            span = slice(int(bounds[index]), int(bounds[index + 1]))
+            if span.start < span.stop:
+                values[span] = np.asarray(value(times[span], attitudes[span]), dtype=np.float64)
+        return values
+    return evaluate
+
+
+def _split(evaluate: Together, sizes: Sequence[int], times: Array, attitudes: Array) -> list[Array]:
+    """Every search's points (``sizes[i]`` of them, in search order in ``times`` and ``attitudes``)
+    evaluated in one call, split per search."""
+    ends = np.cumsum(sizes)
+    return np.split(evaluate(np.concatenate([[0], ends]).astype(np.intp), times, attitudes), ends[:-1])
+
+
+_Heads = tuple[Array, Array, tuple[Array, Array, Array], NDArray[np.intp], NDArray[np.bool_], Array, Array, list[float]]
+"""What step 1 of :func:`search_between_samples` finds (:func:`_heads`)."""
+
+
+def _heads(motion: HermiteMotion, drift: float, edges: Sequence[float]) -> _Heads:
+    """Step 1 of :func:`search_between_samples`: the knots (the samples and the edges inside them),
+    their attitudes, the knots' steps (length, bound, fine steps), the heads' indices and mask, the
+    bound's rate and its integral on each knot step, and the edges inside."""
     t = motion.t
     inner = [float(edge) for edge in edges if t[0] < edge < t[-1]]
     # the samples increase (repeats allowed): np.unique only where an edge is inserted or a time repeats
@@ -421,10 +477,12 @@ def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], thr
     # the samples' attitudes are the samples (normalised); an edge between them is interpolated
     attitudes = motion.unit if count == len(t) else motion.attitudes(knots)
     if count < 2:
-        return knots, np.asarray(value(knots, attitudes), dtype=float)
+        empty = np.zeros(0)
+        return knots, attitudes, (empty, empty, empty), np.arange(count), np.ones(count, dtype=bool), empty, empty, inner
     # the knots' steps, their bound and their fine steps: the motion's own (built once for a row's
     # searches) when the knots are its samples
-    h, bound, fine_steps = motion.sample_steps if own else _knot_steps(motion, knots)
+    steps = motion.sample_steps if own else _knot_steps(motion, knots)
+    h, bound, _ = steps
     speed = bound + drift  # per step between knots
     # the heads of groups of knot steps, evaluated first: every SAMPLE_GROUP-th knot, the edges, and
     # each knot where the bound's sum over the steps passes a multiple of GROUP_REACH
@@ -434,10 +492,15 @@ def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], thr
     head[::SAMPLE_GROUP] = head[-1] = True
     head[1:] |= turned[1:] != turned[:-1]
     head[np.searchsorted(knots, inner)] = True
-    heads = np.flatnonzero(head)
-    at_heads = np.asarray(value(knots[heads], attitudes[heads]), dtype=float)
-    if not np.any(np.isfinite(at_heads)):
-        return knots[heads], at_heads
+    return knots, attitudes, steps, np.flatnonzero(head), head, speed, moved, inner
+
+
+def _sub_grid(motion: HermiteMotion, found: _Heads, at_heads: Array,
+              threshold: float) -> tuple[Array, Array, Array, NDArray[np.bool_], float]:
+    """Step 2 of :func:`search_between_samples` from its heads and their values: the sub-grid, its
+    values (the heads'; the new points, ``new``, to be evaluated), the bound's rate on each of its
+    steps and its longest step [s] when the work limit cut it coarser (:data:`MAX_SUB_GRID`; else 0)."""
+    knots, _, (h, _, fine_steps), heads, head, speed, moved, _ = found
     sizes = np.diff(heads)
     reach = np.add.reduceat(moved, heads[:-1])  # the bound's integral over each group
     with np.errstate(invalid="ignore"):
@@ -463,10 +526,7 @@ def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], thr
     known = np.append(np.repeat(head[:-1], steps) & (offset == 0), True)
     values = np.empty(total + 1)
     values[known] = at_heads
-    new = ~known
-    if np.any(new):
-        values[new] = value(grid[new], motion.attitudes(grid[new]))
-    return grid, values, rate, longest
+    return grid, values, rate, ~known, longest
 
 
 def _knot_steps(motion: HermiteMotion, knots: Array) -> tuple[Array, Array, Array]:
@@ -479,14 +539,16 @@ def _knot_steps(motion: HermiteMotion, knots: Array) -> tuple[Array, Array, Arra
     return h, motion.rate_bound[interval], np.maximum(4, np.ceil(motion.turn_rate[interval] * h / FINE_STEP)).astype(int)
 
 
-def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence[tuple[Array, Array, Array]],
-          found_t: list[list[Array]], found_v: list[list[Array]], missable: list[float]) -> None:
+def _zoom(motion: HermiteMotion, evaluate: Together, searches: int, active: Sequence[int], thresholds: Sequence[float],
+          grids: Sequence[tuple[Array, Array, Array]], found_t: list[list[Array]], found_v: list[list[Array]],
+          missable: list[float]) -> None:
     """Step 3 of :func:`search_between_samples` for several searches at once: the brackets of every
     search in one array (``owner``: the search of each, in order), the least value, the threshold
-    and the :data:`MIN_SEARCHES` deepest brackets per search; the points of each zoom appended to
-    that search's ``found_t`` and ``found_v``. Every search zooms into at most :data:`MAX_SUB_GRID`
-    points a zoom: past that, into its deepest brackets that may hide a crossing only, its
-    ``missable`` raised (in place) to the longest bracket left unsearched."""
+    and the :data:`MIN_SEARCHES` deepest brackets per search; the points of each zoom evaluated in
+    one call (``evaluate`` of ``searches`` searches, of which those zoomed are ``active``) and
+    appended to that search's ``found_t`` and ``found_v``. Every search zooms into at most
+    :data:`MAX_SUB_GRID` points a zoom: past that, into its deepest brackets that may hide a
+    crossing only, its ``missable`` raised (in place) to the longest bracket left unsearched."""
     count = len(grids)
     owner = np.repeat(np.arange(count), [len(grid) - 1 for grid, _, _ in grids])
     low = np.concatenate([grid[:-1] for grid, _, _ in grids])
@@ -494,14 +556,15 @@ def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence
     at_low = np.concatenate([values[:-1] for _, values, _ in grids])
     at_high = np.concatenate([values[1:] for _, values, _ in grids])
     rate = np.concatenate([rate for _, _, rate in grids])
-    thresholds = np.array([float(search[1]) for search in searches])
+    thresholds_of = np.asarray(thresholds, dtype=float)
     smallest = [float(np.nanmin(values)) for _, values, _ in grids]
     near = np.ones(len(low), dtype=bool)  # a candidate for a lower value (else only for a crossing)
     fraction = np.linspace(0.0, 1.0, REFINE_POINTS)[1:-1]
     part = np.arange(REFINE_POINTS - 1)
     inside_count = REFINE_POINTS - 2
+    searched = np.asarray(active, dtype=np.intp)  # each slot's search
     for _ in range(REFINE_LEVELS):
-        threshold = thresholds[owner]
+        threshold = thresholds_of[owner]
         with np.errstate(invalid="ignore"):
             floor = 0.5 * (at_low + at_high) - 0.5 * rate * (high - low)
             hidden = (np.fmin(at_low, at_high) >= threshold) & (floor < threshold)
@@ -527,16 +590,16 @@ def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence
         owner = owner[pick]
         points = low[:, None] + (high - low)[:, None] * fraction
         flat = points.ravel()
-        attitudes = motion.attitudes(flat)  # every search's points in one call
-        inside_values = np.empty(flat.size)
-        bounds = np.searchsorted(owner, np.arange(count + 1)) * inside_count  # each search's points: one run
-        for slot in np.flatnonzero(np.diff(bounds)).tolist():
-            span = slice(bounds[slot], bounds[slot + 1])
-            mine = np.asarray(searches[slot][0](flat[span], attitudes[span]), dtype=np.float64)
-            inside_values[span] = mine
-            found_t[slot].append(flat[span])
-            found_v[slot].append(mine)
-            smallest[slot] = min(smallest[slot], float(np.nanmin(mine)))
+        # every search's points in one call (owner increases: each search's points are one run)
+        bounds = np.searchsorted(searched[owner], np.arange(searches + 1)) * inside_count
+        inside_values = evaluate(bounds, flat, motion.attitudes(flat))
+        for slot, index in enumerate(active):
+            span = slice(int(bounds[index]), int(bounds[index + 1]))
+            if span.start < span.stop:
+                mine = inside_values[span]
+                found_t[slot].append(flat[span])
+                found_v[slot].append(mine)
+                smallest[slot] = min(smallest[slot], float(np.nanmin(mine)))
         inside_values = inside_values.reshape(points.shape)
         ends_t = np.column_stack([low, points, high])
         ends_v = np.column_stack([at_low, inside_values, at_high])
@@ -1052,5 +1115,85 @@ def scores_between_samples(constraints: Sequence[PointingConstraint], t: ArrayLi
         return [constraint.score(t, np.atleast_2d(np.asarray(q, dtype=float))) for constraint in constraints]
     moving = HermiteMotion(t, q, omega) if motion is None else motion
     found = searches_between_samples(moving, [(constraint.margins, 0.0, constraint.drift, constraint.window)
-                                              for constraint in constraints])
+                                              for constraint in constraints], _margins_together(constraints))
     return [constraint._scored(search[0], search[1], search.missable_s) for constraint, search in zip(constraints, found)]
+
+
+def _margins_together(constraints: Sequence[PointingConstraint]) -> Together:
+    """``together`` of :func:`searches_between_samples` for the constraints' margins
+    (:meth:`PointingConstraint.margins`), each constraint at its own points: the moving constraints'
+    in one pass (their tables end to end, each point's lookup into its own; per point the same
+    operations as :meth:`PointingConstraint.margins`, so the same values), a fixed one alone."""
+    moving = [index for index, constraint in enumerate(constraints) if constraint.moving]
+    if len(moving) < 2:
+        return _each([(constraint.margins, 0.0, 0.0, ()) for constraint in constraints])
+    fixed = [index for index in range(len(constraints)) if index not in moving]
+    mine = [constraints[index] for index in moving]
+    last = np.array([len(constraint.times) - 2 for constraint in mine])  # each table's last step
+    offsets = np.concatenate([[0], np.cumsum(last + 2)[:-1]])
+    table_times = np.concatenate([constraint.times for constraint in mine])
+    slopes = [constraint._table_slopes for constraint in mine]
+    rows = np.concatenate([slope[0] for slope in slopes])
+    # the steps' arrays hold one fewer than the rows: padded by one, the rows' offsets serve them
+    inverse_steps = np.concatenate([np.append(slope[1], 0.0) for slope in slopes])
+    differences = np.concatenate([np.vstack([slope[2], np.zeros((1, 4))]) for slope in slopes])
+    angles = np.array([constraint.angle for constraint in mine])
+    keep_in = np.array([not constraint.keep_out for constraint in mine])
+    starts = np.array([constraint.window[0] for constraint in mine])
+    ends = np.array([constraint.window[1] for constraint in mine])
+    forms = [constraint._rotation_form for constraint in mine]
+    alone = [constraints[index].margins for index in fixed]
+
+    def evaluate(bounds: NDArray[np.intp], times: Array, attitudes: Array) -> Array:
+        values = np.empty(len(times))
+        for index, margins in zip(fixed, alone):
+            span = slice(int(bounds[index]), int(bounds[index + 1]))
+            if span.start < span.stop:
+                values[span] = margins(times[span], attitudes[span])
+        sizes = np.array([bounds[index + 1] - bounds[index] for index in moving])
+        if fixed:
+            select: Any = np.concatenate([np.arange(bounds[index], bounds[index + 1]) for index in moving])
+            t, q = times[select], attitudes[select]
+        else:
+            select, t, q = slice(None), times, attitudes
+        count = len(t)
+        row = np.empty(count, dtype=np.intp)
+        product = np.empty((count, 12))
+        start = 0
+        for slot, constraint in enumerate(mine):  # each point's lookup into its own table
+            span = slice(start, start + int(sizes[slot]))
+            start = span.stop
+            if span.start == span.stop:
+                continue
+            found = constraint.times.searchsorted(t[span], side="right")
+            found -= 1
+            np.minimum(np.maximum(found, 0, out=found), last[slot], out=found)
+            found += offsets[slot]
+            row[span] = found
+            product[span] = q[span] @ forms[slot]
+        owner = np.repeat(np.arange(len(mine)), sizes)
+        # from here per point the operations of PointingConstraint._table_at, margins and _angles
+        weight = t - table_times[row]
+        weight *= inverse_steps[row]
+        np.minimum(np.maximum(weight, 0.0, out=weight), 1.0, out=weight)
+        table = differences[row]
+        table *= weight[:, None]
+        table += rows[row]
+        limit = table[:, 3]
+        limit += angles[owner]
+        pointing = np.einsum("mij,mj->mi", product.reshape(count, 3, 4), q)
+        direction = table[:, :3]
+        scale = np.sqrt(np.einsum("ij,ij->i", direction, direction))
+        scale *= np.einsum("ij,ij->i", q, q)
+        cosine = np.einsum("ij,ij->i", pointing, direction)
+        cosine /= scale
+        margin = np.arccos(np.minimum(np.maximum(cosine, -1.0, out=cosine), 1.0, out=cosine), out=cosine)
+        margin -= limit
+        np.negative(margin, out=margin, where=keep_in[owner])
+        within = t >= starts[owner]
+        within &= t <= ends[owner]
+        margin[~within] = np.nan
+        values[select] = margin
+        return values
+
+    return evaluate
