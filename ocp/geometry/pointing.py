@@ -180,7 +180,7 @@ class HermiteMotion:
         s = at - t[k]
         s *= self._inverse_h[k]
         s = s[:, None]
-        c = self._cubic[k]
+        c = self._cubic.take(k, axis=0)  # np.take: the rows of fancy indexing, faster
         # Horner in place: ((c3 s + c2) s + c1) s + c0, the same operations and values, fewer temporaries
         value = c[:, 3] * s
         value += c[:, 2]
@@ -265,7 +265,8 @@ class HermiteMotion:
         return np.where(sound, bound, 1.5 * self.turn_rate)
 
 
-def _may_cross(start: Array, end: Array, reach: Array, threshold: float, smallest: float) -> NDArray[np.bool_]:
+def _may_cross(start: Array, end: Array, reach: Array, threshold: float | Array,
+               smallest: float | Array) -> NDArray[np.bool_]:
     """Which brackets (values at their ends, ``reach``: their rate bound times their length) may go
     from one side of ``threshold`` to the other, or below ``smallest`` (NaN: no)."""
     mean, slack = 0.5 * (start + end), 0.5 * reach
@@ -366,13 +367,14 @@ def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpe
     """Several searches of :func:`search_between_samples` on one motion (a row's pointing
     requirements), each exactly as alone: the same points, the same values.
 
-    Each search's heads and sub-grid are found on its own, but evaluated together: the heads of
+    The searches' heads and sub-grids are found together, each on its own knots (one row of an
+    array per search; the steps' sums per search, as alone) and evaluated together: the heads of
     every search in one call, then the new points of every sub-grid (their attitudes interpolated
-    in one call) in one more; its refinement brackets then go through the zooms together with the
-    others' (one array per zoom, each bracket tagged with its search; the least value, the
-    threshold and the :data:`MIN_SEARCHES` deepest brackets counted per search), each zoom's points
-    interpolated and evaluated in one call: the array operations of the evaluations and the zooms
-    are paid once for all the searches, not once for each.
+    in one call) in one more; the refinement brackets then go through the zooms together (one
+    array per zoom, each bracket tagged with its search; the least value, the threshold and the
+    :data:`MIN_SEARCHES` deepest brackets counted per search), each zoom's points interpolated and
+    evaluated in one call: the array operations are paid once for all the searches, not once for
+    each.
 
     Parameters
     ----------
@@ -395,42 +397,21 @@ def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpe
     if not count:
         return []
     evaluate = _each(searches) if together is None else together
-    # 1. every search's heads (the knots: the samples and its edges), evaluated in one call
-    heads = [_heads(motion, drift, edges) for _, _, drift, edges in searches]
-    at_heads = _split(evaluate, [len(head[3]) for head in heads], np.concatenate([head[0][head[3]] for head in heads]),
-                      np.concatenate([head[1][head[3]] for head in heads]))
-    # 2. every search's sub-grid, its new points evaluated in one call
-    results: list[Searched | None] = [None] * count
-    opened: list[tuple[Array, Array, Array, NDArray[np.bool_], float] | None] = [None] * count
-    for index, ((_, threshold, _, _), head, values) in enumerate(zip(searches, heads, at_heads)):
-        if len(head[0]) < 2 or not np.any(np.isfinite(values)):  # nothing to zoom into
-            results[index] = Searched(head[0][head[3]], values)
-            continue
-        opened[index] = _sub_grid(motion, head, values, threshold)
-    grids = [(np.zeros(0), np.zeros(0, dtype=bool)) if entry is None else (entry[0], entry[3]) for entry in opened]
-    new_t = [grid[new] for grid, new in grids]
-    joined = np.concatenate(new_t)
-    found = _split(evaluate, [len(t) for t in new_t], joined, motion.attitudes(joined)) if joined.size \
-        else [np.zeros(0)] * count
-    active: list[int] = []  # the searches whose sub-grid goes on into the zooms, in order
-    missable: list[float] = []
-    found_t: list[list[Array]] = []
-    found_v: list[list[Array]] = []
-    brackets: list[tuple[Array, Array, Array]] = []
-    for index, entry in enumerate(opened):
-        if entry is None:
-            continue
-        grid, values, rate, new, longest = entry
-        values[new] = found[index]
-        missable.append(longest)
-        active.append(index)
-        found_t.append([grid])
-        found_v.append([values])
-        brackets.append((grid, values, rate))
+    t = motion.t
+    if len(t) < 2:  # no step between knots: the samples alone
+        values = evaluate(np.arange(count + 1, dtype=np.intp) * len(t), np.tile(t, count),
+                          np.tile(motion.unit, (count, 1)))
+        return [Searched(t, values[index * len(t):(index + 1) * len(t)]) for index in range(count)]
+    results, opened = _sub_grids(motion, searches, evaluate)
+    active = sorted(opened)
     if active:
+        grids = [opened[index] for index in active]
+        missable = [longest for _, _, _, longest in grids]
+        found_t: list[list[Array]] = [[grid] for grid, _, _, _ in grids]
+        found_v: list[list[Array]] = [[values] for _, values, _, _ in grids]
         # 3. the zooms, every search's brackets together
-        _zoom(motion, evaluate, count, active, [float(searches[index][1]) for index in active], brackets, found_t,
-              found_v, missable)
+        _zoom(motion, evaluate, count, active, [float(searches[index][1]) for index in active],
+              [(grid, values, rate) for grid, values, rate, _ in grids], found_t, found_v, missable)
         for slot, index in enumerate(active):
             if len(found_t[slot]) == 1:
                 results[index] = Searched(found_t[slot][0], found_v[slot][0], missable[slot])
@@ -453,80 +434,130 @@ def _each(searches: Sequence[SearchSpec]) -> Together:
     return evaluate
 
 
-def _split(evaluate: Together, sizes: Sequence[int], times: Array, attitudes: Array) -> list[Array]:
-    """Every search's points (``sizes[i]`` of them, in search order in ``times`` and ``attitudes``)
-    evaluated in one call, split per search."""
-    ends = np.cumsum(sizes)
-    return np.split(evaluate(np.concatenate([[0], ends]).astype(np.intp), times, attitudes), ends[:-1])
+def _sub_grids(motion: HermiteMotion, searches: Sequence[SearchSpec], evaluate: Together
+               ) -> tuple[list[Searched | None], dict[int, tuple[Array, Array, Array, float]]]:
+    """Steps 1 and 2 of :func:`search_between_samples` for every search at once (``motion`` of
+    two samples or more): per search the final :class:`Searched` when nothing is left to zoom into
+    (no head inside the value's domain), else ``None`` and (by search) its sub-grid, its values,
+    the bound's rate on each of its steps and its longest step [s] when the work limit cut it
+    coarser (:data:`MAX_SUB_GRID`; else 0).
 
-
-_Heads = tuple[Array, Array, tuple[Array, Array, Array], NDArray[np.intp], NDArray[np.bool_], Array, Array, list[float]]
-"""What step 1 of :func:`search_between_samples` finds (:func:`_heads`)."""
-
-
-def _heads(motion: HermiteMotion, drift: float, edges: Sequence[float]) -> _Heads:
-    """Step 1 of :func:`search_between_samples`: the knots (the samples and the edges inside them),
-    their attitudes, the knots' steps (length, bound, fine steps), the heads' indices and mask, the
-    bound's rate and its integral on each knot step, and the edges inside."""
+    One row per search of arrays over the knots (the samples and the search's edges inside them,
+    padded to the longest row), the column of the last knot a step of length 0: every sum runs
+    over one search's own steps in its own order, so each value is that of the search alone."""
     t = motion.t
-    inner = [float(edge) for edge in edges if t[0] < edge < t[-1]]
-    # the samples increase (repeats allowed): np.unique only where an edge is inserted or a time repeats
-    own = not inner and motion.increasing
-    knots = t if own else np.unique(np.concatenate([t, inner]))
-    count = len(knots)
-    # the samples' attitudes are the samples (normalised); an edge between them is interpolated
-    attitudes = motion.unit if count == len(t) else motion.attitudes(knots)
-    if count < 2:
-        empty = np.zeros(0)
-        return knots, attitudes, (empty, empty, empty), np.arange(count), np.ones(count, dtype=bool), empty, empty, inner
-    # the knots' steps, their bound and their fine steps: the motion's own (built once for a row's
-    # searches) when the knots are its samples
-    steps = motion.sample_steps if own else _knot_steps(motion, knots)
-    h, bound, _ = steps
-    speed = bound + drift  # per step between knots
+    count = len(searches)
+    knots_of: list[Array] = []
+    inner_of: list[list[float]] = []
+    for _, _, _, edges in searches:
+        inner = [float(edge) for edge in edges if t[0] < edge < t[-1]]
+        inner_of.append(inner)
+        # the samples increase (repeats allowed): np.unique only where an edge is inserted or a time repeats
+        knots_of.append(t if not inner and motion.increasing else np.unique(np.concatenate([t, inner])))
+    widths = np.array([len(knots) for knots in knots_of])
+    width = int(widths.max())
+    knots = np.empty((count, width))
+    h = np.zeros((count, width))  # the steps between knots; 0 at the last knot and past it
+    bound = np.zeros((count, width))
+    fine_steps = np.ones((count, width), dtype=int)
+    attitudes = np.empty((count, width, 4))
+    for index, row in enumerate(knots_of):
+        size = len(row)
+        knots[index, :size] = row
+        knots[index, size:] = row[-1]
+        # the knots' steps, their bound and their fine steps: the motion's own (built once for a row's
+        # searches) when the knots are its samples
+        own = row is t
+        knot_steps = motion.sample_steps if own else _knot_steps(motion, row)
+        h[index, :size - 1], bound[index, :size - 1], fine_steps[index, :size - 1] = knot_steps
+        # the samples' attitudes are the samples (normalised); an edge between them is interpolated
+        attitudes[index, :size] = motion.unit if size == len(t) else motion.attitudes(row)
+    drift = np.array([float(search[2]) for search in searches])
+    speed = bound + drift[:, None]  # per step between knots
     # the heads of groups of knot steps, evaluated first: every SAMPLE_GROUP-th knot, the edges, and
     # each knot where the bound's sum over the steps passes a multiple of GROUP_REACH
     moved = speed * h  # the bound's integral over each knot step
-    turned = np.concatenate([[0.0], np.cumsum(moved)]) // GROUP_REACH
-    head = np.zeros(count, dtype=bool)
-    head[::SAMPLE_GROUP] = head[-1] = True
-    head[1:] |= turned[1:] != turned[:-1]
-    head[np.searchsorted(knots, inner)] = True
-    return knots, attitudes, steps, np.flatnonzero(head), head, speed, moved, inner
-
-
-def _sub_grid(motion: HermiteMotion, found: _Heads, at_heads: Array,
-              threshold: float) -> tuple[Array, Array, Array, NDArray[np.bool_], float]:
-    """Step 2 of :func:`search_between_samples` from its heads and their values: the sub-grid, its
-    values (the heads'; the new points, ``new``, to be evaluated), the bound's rate on each of its
-    steps and its longest step [s] when the work limit cut it coarser (:data:`MAX_SUB_GRID`; else 0)."""
-    knots, _, (h, _, fine_steps), heads, head, speed, moved, _ = found
-    sizes = np.diff(heads)
-    reach = np.add.reduceat(moved, heads[:-1])  # the bound's integral over each group
+    turned = np.concatenate([np.zeros((count, 1)), np.cumsum(moved[:, :-1], axis=1)], axis=1) // GROUP_REACH
+    column = np.arange(width)
+    head = np.zeros((count, width), dtype=bool)
+    head[:, ::SAMPLE_GROUP] = True
+    head[np.arange(count), widths - 1] = True
+    head[:, 1:] |= turned[:, 1:] != turned[:, :-1]
+    head &= column < widths[:, None]
+    for index, inner in enumerate(inner_of):
+        head[index, np.searchsorted(knots_of[index], inner)] = True
+    flat_head = head.ravel()
+    heads = np.flatnonzero(flat_head)  # into the rows end to end
+    owner = heads // width
+    flat_knots = knots.ravel()
+    head_bounds = np.searchsorted(owner, np.arange(count + 1))
+    at_heads = evaluate(head_bounds, flat_knots[heads], attitudes.reshape(-1, 4)[heads])
+    results: list[Searched | None] = []
+    finite = np.isfinite(at_heads)
+    live = np.zeros(count, dtype=bool)
+    for index in range(count):
+        span = slice(int(head_bounds[index]), int(head_bounds[index + 1]))
+        live[index] = bool(np.any(finite[span]))
+        # no head inside the value's domain: nothing to zoom into
+        results.append(None if live[index] else Searched(flat_knots[heads[span]], at_heads[span]))
+    # the groups between two heads of one search that goes on
+    group = (owner[:-1] == owner[1:]) & live[owner[:-1]]
+    first, after = heads[:-1][group], heads[1:][group]
+    sizes = after - first
+    reach = np.add.reduceat(moved.ravel(), heads[:-1])[group]  # the bound's integral over each group
+    searched = owner[:-1][group]
+    thresholds = np.array([float(search[1]) for search in searches])[searched]
+    smallest = np.fmin.reduceat(at_heads, head_bounds[:-1])[searched]  # each search's least head (NaN: none)
+    start, end = at_heads[:-1][group], at_heads[1:][group]
     with np.errstate(invalid="ignore"):
-        crossing = _may_cross(at_heads[:-1], at_heads[1:], reach, threshold, -np.inf)
-        deeper = _may_cross(at_heads[:-1], at_heads[1:], reach, -np.inf, float(np.nanmin(at_heads)))
+        crossing = _may_cross(start, end, reach, thresholds, -np.inf)
+        deeper = _may_cross(start, end, reach, -np.inf, smallest)
     # a group that may cross the threshold: its knot steps cut into the fine sub-grid; one that may
     # hide a lower value: into at most COARSE_STEPS; the others keep their heads alone (one bracket)
-    cut = np.where(np.repeat(crossing, sizes), fine_steps, np.minimum(COARSE_STEPS, fine_steps))
+    real = np.flatnonzero(((column < widths[:, None] - 1) & live[:, None]).ravel())  # the live searches' steps
+    fine = fine_steps.ravel()[real]
+    cut = np.where(np.repeat(crossing, sizes), fine, np.minimum(COARSE_STEPS, fine))
     opened = np.repeat(crossing | deeper, sizes)
-    steps = np.where(opened, cut, head[:-1])
-    rate = np.where(opened, speed, np.repeat(reach / np.diff(knots[heads]), sizes))  # a group kept whole: its mean
+    steps = np.where(opened, cut, flat_head[real])
+    rate = np.where(opened, speed.ravel()[real], np.repeat(reach / (flat_knots[after] - flat_knots[first]), sizes))
+    # each live search's steps: one run of those arrays
+    step_bounds = np.concatenate([[0], np.cumsum(np.where(live, widths - 1, 0))])
+    flat_h = h.ravel()[real]
+    longest = np.zeros(count)
+    for index in np.flatnonzero(live).tolist():
+        span = slice(int(step_bounds[index]), int(step_bounds[index + 1]))
+        total = int(steps[span].sum())
+        if total > MAX_SUB_GRID:  # the work limit: every opened step coarser in one ratio, at least one step each
+            ratio = (MAX_SUB_GRID - len(steps[span])) / total
+            cut[span] = np.maximum(1, np.floor(cut[span] * ratio)).astype(int)
+            steps[span] = np.where(opened[span], cut[span], flat_head[real[span]])
+            longest[index] = float(np.max(np.where(opened[span], flat_h[span] / cut[span], 0.0)))
+    # each live search's last knot: a step of its own (one point, known: a head), so that the
+    # sub-grids of all searches are built end to end
+    ends = (widths - 1 + np.arange(count) * width)[live]
+    where = np.searchsorted(real, ends)
+    knot_of_step = np.insert(real, where, ends)
+    steps = np.insert(steps, where, 1)
+    divided = np.insert(flat_h / np.maximum(cut, 1), where, 0.0)
+    rate = np.insert(rate, where, 0.0)
     total = int(steps.sum())
-    longest = 0.0
-    if total > MAX_SUB_GRID:  # the work limit: every opened step coarser in one ratio, at least one step each
-        ratio = (MAX_SUB_GRID - len(steps)) / total
-        cut = np.maximum(1, np.floor(cut * ratio)).astype(int)
-        steps = np.where(opened, cut, head[:-1])
-        total = int(steps.sum())
-        longest = float(np.max(np.where(opened, h / cut, 0.0)))
     offset = np.arange(total) - np.repeat(np.cumsum(steps) - steps, steps)
-    grid = np.append(np.repeat(knots[:-1], steps) + np.repeat(h / np.maximum(cut, 1), steps) * offset, knots[-1])
+    grid = np.repeat(flat_knots[knot_of_step], steps) + np.repeat(divided, steps) * offset
     rate = np.repeat(rate, steps)
-    known = np.append(np.repeat(head[:-1], steps) & (offset == 0), True)
-    values = np.empty(total + 1)
-    values[known] = at_heads
-    return grid, values, rate, ~known, longest
+    known = np.repeat(flat_head[knot_of_step], steps) & (offset == 0)
+    values = np.empty(total)
+    values[known] = at_heads[np.repeat(live, np.diff(head_bounds))]
+    new = np.flatnonzero(~known)
+    point_owner = np.repeat(knot_of_step // width, steps)
+    if new.size:
+        values[new] = evaluate(np.searchsorted(point_owner[new], np.arange(count + 1)), grid[new],
+                               motion.attitudes(grid[new]))
+    point_bounds = np.searchsorted(point_owner, np.arange(count + 1))
+    grids: dict[int, tuple[Array, Array, Array, float]] = {}
+    for index in np.flatnonzero(live).tolist():
+        span = slice(int(point_bounds[index]), int(point_bounds[index + 1]))
+        grids[index] = (grid[span], values[span], rate[span.start:span.stop - 1], float(longest[index]))
+    return results, grids
 
 
 def _knot_steps(motion: HermiteMotion, knots: Array) -> tuple[Array, Array, Array]:
@@ -557,9 +588,11 @@ def _zoom(motion: HermiteMotion, evaluate: Together, searches: int, active: Sequ
     at_high = np.concatenate([values[1:] for _, values, _ in grids])
     rate = np.concatenate([rate for _, _, rate in grids])
     thresholds_of = np.asarray(thresholds, dtype=float)
-    smallest = [float(np.nanmin(values)) for _, values, _ in grids]
+    # each search's least value (min ignores NaN: np.nanmin's value, once for all)
+    smallest = np.fmin.reduceat(np.concatenate([values for _, values, _ in grids]),
+                                np.concatenate([[0], np.cumsum([len(values) for _, values, _ in grids])[:-1]])).tolist()
     near = np.ones(len(low), dtype=bool)  # a candidate for a lower value (else only for a crossing)
-    fraction = np.linspace(0.0, 1.0, REFINE_POINTS)[1:-1]
+    fraction = _FRACTION
     part = np.arange(REFINE_POINTS - 1)
     inside_count = REFINE_POINTS - 2
     searched = np.asarray(active, dtype=np.intp)  # each slot's search
@@ -574,7 +607,8 @@ def _zoom(motion: HermiteMotion, evaluate: Together, searches: int, active: Sequ
             first = np.searchsorted(owner[ranked], owner[ranked], side="left")
             lower = ranked[np.arange(ranked.size) - first < MIN_SEARCHES]
         allowed = max(MAX_SUB_GRID // inside_count - MIN_SEARCHES, 0)
-        for slot in np.unique(owner[hidden]).tolist():  # the work limit, per search and zoom
+        for slot in np.unique(owner[hidden]).tolist() if np.count_nonzero(hidden) > allowed else ():  # the work
+            # limit, per search and zoom (none past it when all of them are within)
             may_hide = np.flatnonzero(hidden & (owner == slot))
             if may_hide.size > allowed:
                 dropped = may_hide[np.argsort((floor - threshold)[may_hide], kind="stable")[allowed:]]
@@ -583,7 +617,7 @@ def _zoom(motion: HermiteMotion, evaluate: Together, searches: int, active: Sequ
                 missable[slot] = max(missable[slot], float(np.max(high[dropped] - low[dropped])))
         pick = hidden.copy()
         pick[lower] = True
-        if not np.any(pick):
+        if not pick.any():
             break
         whole = hidden[pick]
         low, high, at_low, at_high, rate = low[pick], high[pick], at_low[pick], at_high[pick], rate[pick]
@@ -593,13 +627,14 @@ def _zoom(motion: HermiteMotion, evaluate: Together, searches: int, active: Sequ
         # every search's points in one call (owner increases: each search's points are one run)
         bounds = np.searchsorted(searched[owner], np.arange(searches + 1)) * inside_count
         inside_values = evaluate(bounds, flat, motion.attitudes(flat))
-        for slot, index in enumerate(active):
-            span = slice(int(bounds[index]), int(bounds[index + 1]))
-            if span.start < span.stop:
-                mine = inside_values[span]
-                found_t[slot].append(flat[span])
-                found_v[slot].append(mine)
-                smallest[slot] = min(smallest[slot], float(np.nanmin(mine)))
+        starts = bounds[searched]
+        zoomed = np.flatnonzero(bounds[searched + 1] > starts)  # the slots with points at this zoom
+        least = np.fmin.reduceat(inside_values, starts[zoomed]).tolist()  # each one's least (NaN: none)
+        for slot, lowest in zip(zoomed.tolist(), least):
+            span = slice(int(starts[slot]), int(bounds[searched[slot] + 1]))
+            found_t[slot].append(flat[span])
+            found_v[slot].append(inside_values[span])
+            smallest[slot] = min(smallest[slot], lowest)
         inside_values = inside_values.reshape(points.shape)
         ends_t = np.column_stack([low, points, high])
         ends_v = np.column_stack([at_low, inside_values, at_high])
@@ -613,6 +648,10 @@ def _zoom(motion: HermiteMotion, evaluate: Together, searches: int, active: Sequ
         rate = np.repeat(rate, REFINE_POINTS - 1)[keep]
         owner = np.repeat(owner, REFINE_POINTS - 1)[keep]
         near = near[keep]
+
+
+_FRACTION = np.linspace(0.0, 1.0, REFINE_POINTS)[1:-1]
+"""Where a zoom's new points lie in each bracket (fractions of it)."""
 
 
 class PointingScore(NamedTuple):
@@ -1150,7 +1189,7 @@ def _margins_together(constraints: Sequence[PointingConstraint]) -> Together:
             span = slice(int(bounds[index]), int(bounds[index + 1]))
             if span.start < span.stop:
                 values[span] = margins(times[span], attitudes[span])
-        sizes = np.array([bounds[index + 1] - bounds[index] for index in moving])
+        sizes = np.diff(bounds)[moving]
         if fixed:
             select: Any = np.concatenate([np.arange(bounds[index], bounds[index + 1]) for index in moving])
             t, q = times[select], attitudes[select]
@@ -1173,12 +1212,12 @@ def _margins_together(constraints: Sequence[PointingConstraint]) -> Together:
             product[span] = q[span] @ forms[slot]
         owner = np.repeat(np.arange(len(mine)), sizes)
         # from here per point the operations of PointingConstraint._table_at, margins and _angles
-        weight = t - table_times[row]
-        weight *= inverse_steps[row]
+        weight = t - table_times.take(row)
+        weight *= inverse_steps.take(row)
         np.minimum(np.maximum(weight, 0.0, out=weight), 1.0, out=weight)
-        table = differences[row]
+        table = differences.take(row, axis=0)
         table *= weight[:, None]
-        table += rows[row]
+        table += rows.take(row, axis=0)
         limit = table[:, 3]
         limit += angles[owner]
         pointing = np.einsum("mij,mj->mi", product.reshape(count, 3, 4), q)
