@@ -477,7 +477,9 @@ def _sub_grids(motion: HermiteMotion, searches: Sequence[SearchSpec], evaluate: 
     # the heads of groups of knot steps, evaluated first: every SAMPLE_GROUP-th knot, the edges, and
     # each knot where the bound's sum over the steps passes a multiple of GROUP_REACH
     moved = speed * h  # the bound's integral over each knot step
-    turned = np.concatenate([np.zeros((count, 1)), np.cumsum(moved[:, :-1], axis=1)], axis=1) // GROUP_REACH
+    turned = np.zeros((count, width))
+    turned[:, 1:] = np.cumsum(moved, axis=1)[:, :-1]  # each row's own running sum (the later columns add 0)
+    turned //= GROUP_REACH
     column = np.arange(width)
     head = np.zeros((count, width), dtype=bool)
     head[:, ::SAMPLE_GROUP] = True
@@ -492,20 +494,20 @@ def _sub_grids(motion: HermiteMotion, searches: Sequence[SearchSpec], evaluate: 
     flat_knots = knots.ravel()
     head_bounds = np.searchsorted(owner, np.arange(count + 1))
     at_heads = evaluate(head_bounds, flat_knots[heads], attitudes.reshape(-1, 4)[heads])
-    results: list[Searched | None] = []
-    finite = np.isfinite(at_heads)
-    live = np.zeros(count, dtype=bool)
-    for index in range(count):
-        span = slice(int(head_bounds[index]), int(head_bounds[index + 1]))
-        live[index] = bool(np.any(finite[span]))
-        # no head inside the value's domain: nothing to zoom into
-        results.append(None if live[index] else Searched(flat_knots[heads[span]], at_heads[span]))
+    live = np.logical_or.reduceat(np.isfinite(at_heads), head_bounds[:-1])  # each search's heads: two or more
+    # a search without a head inside its value's domain: nothing to zoom into
+    results: list[Searched | None] = [
+        None if alive else Searched(flat_knots[heads[start:stop]], at_heads[start:stop])
+        for alive, start, stop in zip(live.tolist(), head_bounds[:-1].tolist(), head_bounds[1:].tolist())]
     # the groups between two heads of one search that goes on
     group = (owner[:-1] == owner[1:]) & live[owner[:-1]]
     first, after = heads[:-1][group], heads[1:][group]
     sizes = after - first
     reach = np.add.reduceat(moved.ravel(), heads[:-1])[group]  # the bound's integral over each group
     searched = owner[:-1][group]
+    # each search's last knot: a step of its own in its last group (one point, known: a head; 0 long
+    # and one step), so that the sub-grids of all searches are built end to end
+    sizes_to_end = sizes + (after == searched * width + widths[searched] - 1)
     thresholds = np.array([float(search[1]) for search in searches])[searched]
     smallest = np.fmin.reduceat(at_heads, head_bounds[:-1])[searched]  # each search's least head (NaN: none)
     start, end = at_heads[:-1][group], at_heads[1:][group]
@@ -514,32 +516,27 @@ def _sub_grids(motion: HermiteMotion, searches: Sequence[SearchSpec], evaluate: 
         deeper = _may_cross(start, end, reach, -np.inf, smallest)
     # a group that may cross the threshold: its knot steps cut into the fine sub-grid; one that may
     # hide a lower value: into at most COARSE_STEPS; the others keep their heads alone (one bracket)
-    real = np.flatnonzero(((column < widths[:, None] - 1) & live[:, None]).ravel())  # the live searches' steps
+    real = np.flatnonzero(((column < widths[:, None]) & live[:, None]).ravel())  # the live searches' steps
     fine = fine_steps.ravel()[real]
-    cut = np.where(np.repeat(crossing, sizes), fine, np.minimum(COARSE_STEPS, fine))
-    opened = np.repeat(crossing | deeper, sizes)
+    cut = np.where(np.repeat(crossing, sizes_to_end), fine, np.minimum(COARSE_STEPS, fine))
+    opened = np.repeat(crossing | deeper, sizes_to_end)
     steps = np.where(opened, cut, flat_head[real])
-    rate = np.where(opened, speed.ravel()[real], np.repeat(reach / (flat_knots[after] - flat_knots[first]), sizes))
-    # each live search's steps: one run of those arrays
-    step_bounds = np.concatenate([[0], np.cumsum(np.where(live, widths - 1, 0))])
+    rate = np.where(opened, speed.ravel()[real],
+                    np.repeat(reach / (flat_knots[after] - flat_knots[first]), sizes_to_end))
+    # each live search's steps: one run of those arrays (its last knot's the last of the run)
+    step_bounds = np.concatenate([[0], np.cumsum(np.where(live, widths, 0))])
     flat_h = h.ravel()[real]
     longest = np.zeros(count)
     for index in np.flatnonzero(live).tolist():
-        span = slice(int(step_bounds[index]), int(step_bounds[index + 1]))
+        span = slice(int(step_bounds[index]), int(step_bounds[index + 1]) - 1)
         total = int(steps[span].sum())
         if total > MAX_SUB_GRID:  # the work limit: every opened step coarser in one ratio, at least one step each
             ratio = (MAX_SUB_GRID - len(steps[span])) / total
             cut[span] = np.maximum(1, np.floor(cut[span] * ratio)).astype(int)
             steps[span] = np.where(opened[span], cut[span], flat_head[real[span]])
             longest[index] = float(np.max(np.where(opened[span], flat_h[span] / cut[span], 0.0)))
-    # each live search's last knot: a step of its own (one point, known: a head), so that the
-    # sub-grids of all searches are built end to end
-    ends = (widths - 1 + np.arange(count) * width)[live]
-    where = np.searchsorted(real, ends)
-    knot_of_step = np.insert(real, where, ends)
-    steps = np.insert(steps, where, 1)
-    divided = np.insert(flat_h / np.maximum(cut, 1), where, 0.0)
-    rate = np.insert(rate, where, 0.0)
+    knot_of_step = real
+    divided = flat_h / np.maximum(cut, 1)
     total = int(steps.sum())
     offset = np.arange(total) - np.repeat(np.cumsum(steps) - steps, steps)
     grid = np.repeat(flat_knots[knot_of_step], steps) + np.repeat(divided, steps) * offset
