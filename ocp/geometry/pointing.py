@@ -180,7 +180,7 @@ class HermiteMotion:
         s = at - t[k]
         s *= self._inverse_h[k]
         s = s[:, None]
-        c = self._cubic[k]
+        c = self._cubic.take(k, axis=0)  # np.take: the rows of fancy indexing, faster
         # Horner in place: ((c3 s + c2) s + c1) s + c0, the same operations and values, fewer temporaries
         value = c[:, 3] * s
         value += c[:, 2]
@@ -265,7 +265,8 @@ class HermiteMotion:
         return np.where(sound, bound, 1.5 * self.turn_rate)
 
 
-def _may_cross(start: Array, end: Array, reach: Array, threshold: float, smallest: float) -> NDArray[np.bool_]:
+def _may_cross(start: Array, end: Array, reach: Array, threshold: float | Array,
+               smallest: float | Array) -> NDArray[np.bool_]:
     """Which brackets (values at their ends, ``reach``: their rate bound times their length) may go
     from one side of ``threshold`` to the other, or below ``smallest`` (NaN: no)."""
     mean, slack = 0.5 * (start + end), 0.5 * reach
@@ -355,15 +356,25 @@ class Searched(tuple[Array, Array]):
         return found
 
 
-def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpec]) -> list[Searched]:
+Together = Callable[[NDArray[np.intp], Array, Array], Array]
+"""Every search's values in one call (:func:`searches_between_samples`): ``together(bounds, times,
+attitudes)``, the points of search ``i`` being ``times[bounds[i]:bounds[i + 1]]`` (``bounds``: one more
+than the searches), each point's value exactly what that search's own ``value`` gives."""
+
+
+def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpec],
+                             together: Together | None = None) -> list[Searched]:
     """Several searches of :func:`search_between_samples` on one motion (a row's pointing
     requirements), each exactly as alone: the same points, the same values.
 
-    Each search's samples and sub-grid are found on its own; its refinement brackets then go
-    through the zooms together with the others' (one array per zoom, each bracket tagged with its
-    search; the least value, the threshold and the :data:`MIN_SEARCHES` deepest brackets counted
-    per search), the attitudes of every zoom's points interpolated in one call: the array
-    operations of the zooms are paid once for all the searches, not once for each.
+    The searches' heads and sub-grids are found together, each on its own knots (one row of an
+    array per search; the steps' sums per search, as alone) and evaluated together: the heads of
+    every search in one call, then the new points of every sub-grid (their attitudes interpolated
+    in one call) in one more; the refinement brackets then go through the zooms together (one
+    array per zoom, each bracket tagged with its search; the least value, the threshold and the
+    :data:`MIN_SEARCHES` deepest brackets counted per search), each zoom's points interpolated and
+    evaluated in one call: the array operations are paid once for all the searches, not once for
+    each.
 
     Parameters
     ----------
@@ -371,31 +382,36 @@ def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpe
         The motion (its samples' times span the searches).
     searches : sequence of (value, threshold, drift, edges)
         Each as the arguments of :func:`search_between_samples`.
+    together : callable or None, optional
+        ``together(bounds, times, attitudes)``: every search's values in one call, the points of
+        search ``i`` being ``times[bounds[i]:bounds[i + 1]]``, each value exactly that of the
+        search's own ``value`` (:func:`scores_between_samples`: the margins of several constraints);
+        ``None``: each search's ``value`` on its own points.
 
     Returns
     -------
     list of Searched
         Per search, as :func:`search_between_samples` returns.
     """
-    results: list[Searched | None] = [None] * len(searches)
-    missable: list[float] = []
-    found_t: list[list[Array]] = []
-    found_v: list[list[Array]] = []
-    active: list[int] = []  # the searches whose sub-grid goes on into the zooms, in order
-    brackets: list[tuple[Array, Array, Array]] = []
-    for index, (value, threshold, drift, edges) in enumerate(searches):
-        opened = _sub_grid(motion, value, threshold, drift, edges)
-        if len(opened) == 2:
-            results[index] = Searched(*opened)
-            continue
-        grid, values, rate, longest = opened
-        missable.append(longest)
-        active.append(index)
-        found_t.append([grid])
-        found_v.append([values])
-        brackets.append((grid, values, rate))
+    count = len(searches)
+    if not count:
+        return []
+    evaluate = _each(searches) if together is None else together
+    t = motion.t
+    if len(t) < 2:  # no step between knots: the samples alone
+        values = evaluate(np.arange(count + 1, dtype=np.intp) * len(t), np.tile(t, count),
+                          np.tile(motion.unit, (count, 1)))
+        return [Searched(t, values[index * len(t):(index + 1) * len(t)]) for index in range(count)]
+    results, opened = _sub_grids(motion, searches, evaluate)
+    active = sorted(opened)
     if active:
-        _zoom(motion, [searches[index] for index in active], brackets, found_t, found_v, missable)
+        grids = [opened[index] for index in active]
+        missable = [longest for _, _, _, longest in grids]
+        found_t: list[list[Array]] = [[grid] for grid, _, _, _ in grids]
+        found_v: list[list[Array]] = [[values] for _, values, _, _ in grids]
+        # 3. the zooms, every search's brackets together
+        _zoom(motion, evaluate, count, active, [float(searches[index][1]) for index in active],
+              [(grid, values, rate) for grid, values, rate, _ in grids], found_t, found_v, missable)
         for slot, index in enumerate(active):
             if len(found_t[slot]) == 1:
                 results[index] = Searched(found_t[slot][0], found_v[slot][0], missable[slot])
@@ -406,67 +422,139 @@ def searches_between_samples(motion: HermiteMotion, searches: Sequence[SearchSpe
     return [result for result in results if result is not None]
 
 
-def _sub_grid(motion: HermiteMotion, value: Callable[[Array, Array], Array], threshold: float, drift: float,
-              edges: Sequence[float]) -> tuple[Array, Array] | tuple[Array, Array, Array, float]:
-    """Steps 1 and 2 of :func:`search_between_samples`: the heads, then the sub-grid, its values,
-    the bound's rate on each of its steps and its longest step [s] when the work limit cut it coarser
-    (:data:`MAX_SUB_GRID`; else 0); or the final ``(times, values)`` when nothing is left to zoom
-    into (fewer than two knots, no head inside the value's domain)."""
+def _each(searches: Sequence[SearchSpec]) -> Together:
+    """``together`` of :func:`searches_between_samples` from each search's own ``value``."""
+    def evaluate(bounds: NDArray[np.intp], times: Array, attitudes: Array) -> Array:
+        values = np.empty(len(times))
+        for index, (value, _, _, _) in enumerate(searches):
+            span = slice(int(bounds[index]), int(bounds[index + 1]))
+            if span.start < span.stop:
+                values[span] = np.asarray(value(times[span], attitudes[span]), dtype=np.float64)
+        return values
+    return evaluate
+
+
+def _sub_grids(motion: HermiteMotion, searches: Sequence[SearchSpec], evaluate: Together
+               ) -> tuple[list[Searched | None], dict[int, tuple[Array, Array, Array, float]]]:
+    """Steps 1 and 2 of :func:`search_between_samples` for every search at once (``motion`` of
+    two samples or more): per search the final :class:`Searched` when nothing is left to zoom into
+    (no head inside the value's domain), else ``None`` and (by search) its sub-grid, its values,
+    the bound's rate on each of its steps and its longest step [s] when the work limit cut it
+    coarser (:data:`MAX_SUB_GRID`; else 0).
+
+    One row per search of arrays over the knots (the samples and the search's edges inside them,
+    padded to the longest row), the column of the last knot a step of length 0: every sum runs
+    over one search's own steps in its own order, so each value is that of the search alone."""
     t = motion.t
-    inner = [float(edge) for edge in edges if t[0] < edge < t[-1]]
-    # the samples increase (repeats allowed): np.unique only where an edge is inserted or a time repeats
-    own = not inner and motion.increasing
-    knots = t if own else np.unique(np.concatenate([t, inner]))
-    count = len(knots)
-    # the samples' attitudes are the samples (normalised); an edge between them is interpolated
-    attitudes = motion.unit if count == len(t) else motion.attitudes(knots)
-    if count < 2:
-        return knots, np.asarray(value(knots, attitudes), dtype=float)
-    # the knots' steps, their bound and their fine steps: the motion's own (built once for a row's
-    # searches) when the knots are its samples
-    h, bound, fine_steps = motion.sample_steps if own else _knot_steps(motion, knots)
-    speed = bound + drift  # per step between knots
+    count = len(searches)
+    knots_of: list[Array] = []
+    inner_of: list[list[float]] = []
+    for _, _, _, edges in searches:
+        inner = [float(edge) for edge in edges if t[0] < edge < t[-1]]
+        inner_of.append(inner)
+        # the samples increase (repeats allowed): np.unique only where an edge is inserted or a time repeats
+        knots_of.append(t if not inner and motion.increasing else np.unique(np.concatenate([t, inner])))
+    widths = np.array([len(knots) for knots in knots_of])
+    width = int(widths.max())
+    knots = np.empty((count, width))
+    h = np.zeros((count, width))  # the steps between knots; 0 at the last knot and past it
+    bound = np.zeros((count, width))
+    fine_steps = np.ones((count, width), dtype=int)
+    attitudes = np.empty((count, width, 4))
+    for index, row in enumerate(knots_of):
+        size = len(row)
+        knots[index, :size] = row
+        knots[index, size:] = row[-1]
+        # the knots' steps, their bound and their fine steps: the motion's own (built once for a row's
+        # searches) when the knots are its samples
+        own = row is t
+        knot_steps = motion.sample_steps if own else _knot_steps(motion, row)
+        h[index, :size - 1], bound[index, :size - 1], fine_steps[index, :size - 1] = knot_steps
+        # the samples' attitudes are the samples (normalised); an edge between them is interpolated
+        attitudes[index, :size] = motion.unit if size == len(t) else motion.attitudes(row)
+    drift = np.array([float(search[2]) for search in searches])
+    speed = bound + drift[:, None]  # per step between knots
     # the heads of groups of knot steps, evaluated first: every SAMPLE_GROUP-th knot, the edges, and
     # each knot where the bound's sum over the steps passes a multiple of GROUP_REACH
     moved = speed * h  # the bound's integral over each knot step
-    turned = np.concatenate([[0.0], np.cumsum(moved)]) // GROUP_REACH
-    head = np.zeros(count, dtype=bool)
-    head[::SAMPLE_GROUP] = head[-1] = True
-    head[1:] |= turned[1:] != turned[:-1]
-    head[np.searchsorted(knots, inner)] = True
-    heads = np.flatnonzero(head)
-    at_heads = np.asarray(value(knots[heads], attitudes[heads]), dtype=float)
-    if not np.any(np.isfinite(at_heads)):
-        return knots[heads], at_heads
-    sizes = np.diff(heads)
-    reach = np.add.reduceat(moved, heads[:-1])  # the bound's integral over each group
+    turned = np.zeros((count, width))
+    turned[:, 1:] = np.cumsum(moved, axis=1)[:, :-1]  # each row's own running sum (the later columns add 0)
+    turned //= GROUP_REACH
+    column = np.arange(width)
+    head = np.zeros((count, width), dtype=bool)
+    head[:, ::SAMPLE_GROUP] = True
+    head[np.arange(count), widths - 1] = True
+    head[:, 1:] |= turned[:, 1:] != turned[:, :-1]
+    head &= column < widths[:, None]
+    for index, inner in enumerate(inner_of):
+        head[index, np.searchsorted(knots_of[index], inner)] = True
+    flat_head = head.ravel()
+    heads = np.flatnonzero(flat_head)  # into the rows end to end
+    owner = heads // width
+    flat_knots = knots.ravel()
+    head_bounds = np.searchsorted(owner, np.arange(count + 1))
+    at_heads = evaluate(head_bounds, flat_knots[heads], attitudes.reshape(-1, 4)[heads])
+    live = np.logical_or.reduceat(np.isfinite(at_heads), head_bounds[:-1])  # each search's heads: two or more
+    # a search without a head inside its value's domain: nothing to zoom into
+    results: list[Searched | None] = [
+        None if alive else Searched(flat_knots[heads[start:stop]], at_heads[start:stop])
+        for alive, start, stop in zip(live.tolist(), head_bounds[:-1].tolist(), head_bounds[1:].tolist())]
+    # the groups between two heads of one search that goes on
+    group = (owner[:-1] == owner[1:]) & live[owner[:-1]]
+    first, after = heads[:-1][group], heads[1:][group]
+    sizes = after - first
+    reach = np.add.reduceat(moved.ravel(), heads[:-1])[group]  # the bound's integral over each group
+    searched = owner[:-1][group]
+    # each search's last knot: a step of its own in its last group (one point, known: a head; 0 long
+    # and one step), so that the sub-grids of all searches are built end to end
+    sizes_to_end = sizes + (after == searched * width + widths[searched] - 1)
+    thresholds = np.array([float(search[1]) for search in searches])[searched]
+    smallest = np.fmin.reduceat(at_heads, head_bounds[:-1])[searched]  # each search's least head (NaN: none)
+    start, end = at_heads[:-1][group], at_heads[1:][group]
     with np.errstate(invalid="ignore"):
-        crossing = _may_cross(at_heads[:-1], at_heads[1:], reach, threshold, -np.inf)
-        deeper = _may_cross(at_heads[:-1], at_heads[1:], reach, -np.inf, float(np.nanmin(at_heads)))
+        crossing = _may_cross(start, end, reach, thresholds, -np.inf)
+        deeper = _may_cross(start, end, reach, -np.inf, smallest)
     # a group that may cross the threshold: its knot steps cut into the fine sub-grid; one that may
     # hide a lower value: into at most COARSE_STEPS; the others keep their heads alone (one bracket)
-    cut = np.where(np.repeat(crossing, sizes), fine_steps, np.minimum(COARSE_STEPS, fine_steps))
-    opened = np.repeat(crossing | deeper, sizes)
-    steps = np.where(opened, cut, head[:-1])
-    rate = np.where(opened, speed, np.repeat(reach / np.diff(knots[heads]), sizes))  # a group kept whole: its mean
+    real = np.flatnonzero(((column < widths[:, None]) & live[:, None]).ravel())  # the live searches' steps
+    fine = fine_steps.ravel()[real]
+    cut = np.where(np.repeat(crossing, sizes_to_end), fine, np.minimum(COARSE_STEPS, fine))
+    opened = np.repeat(crossing | deeper, sizes_to_end)
+    steps = np.where(opened, cut, flat_head[real])
+    rate = np.where(opened, speed.ravel()[real],
+                    np.repeat(reach / (flat_knots[after] - flat_knots[first]), sizes_to_end))
+    # each live search's steps: one run of those arrays (its last knot's the last of the run)
+    step_bounds = np.concatenate([[0], np.cumsum(np.where(live, widths, 0))])
+    flat_h = h.ravel()[real]
+    longest = np.zeros(count)
+    for index in np.flatnonzero(live).tolist():
+        span = slice(int(step_bounds[index]), int(step_bounds[index + 1]) - 1)
+        total = int(steps[span].sum())
+        if total > MAX_SUB_GRID:  # the work limit: every opened step coarser in one ratio, at least one step each
+            ratio = (MAX_SUB_GRID - len(steps[span])) / total
+            cut[span] = np.maximum(1, np.floor(cut[span] * ratio)).astype(int)
+            steps[span] = np.where(opened[span], cut[span], flat_head[real[span]])
+            longest[index] = float(np.max(np.where(opened[span], flat_h[span] / cut[span], 0.0)))
+    knot_of_step = real
+    divided = flat_h / np.maximum(cut, 1)
     total = int(steps.sum())
-    longest = 0.0
-    if total > MAX_SUB_GRID:  # the work limit: every opened step coarser in one ratio, at least one step each
-        ratio = (MAX_SUB_GRID - len(steps)) / total
-        cut = np.maximum(1, np.floor(cut * ratio)).astype(int)
-        steps = np.where(opened, cut, head[:-1])
-        total = int(steps.sum())
-        longest = float(np.max(np.where(opened, h / cut, 0.0)))
     offset = np.arange(total) - np.repeat(np.cumsum(steps) - steps, steps)
-    grid = np.append(np.repeat(knots[:-1], steps) + np.repeat(h / np.maximum(cut, 1), steps) * offset, knots[-1])
+    grid = np.repeat(flat_knots[knot_of_step], steps) + np.repeat(divided, steps) * offset
     rate = np.repeat(rate, steps)
-    known = np.append(np.repeat(head[:-1], steps) & (offset == 0), True)
-    values = np.empty(total + 1)
-    values[known] = at_heads
-    new = ~known
-    if np.any(new):
-        values[new] = value(grid[new], motion.attitudes(grid[new]))
-    return grid, values, rate, longest
+    known = np.repeat(flat_head[knot_of_step], steps) & (offset == 0)
+    values = np.empty(total)
+    values[known] = at_heads[np.repeat(live, np.diff(head_bounds))]
+    new = np.flatnonzero(~known)
+    point_owner = np.repeat(knot_of_step // width, steps)
+    if new.size:
+        values[new] = evaluate(np.searchsorted(point_owner[new], np.arange(count + 1)), grid[new],
+                               motion.attitudes(grid[new]))
+    point_bounds = np.searchsorted(point_owner, np.arange(count + 1))
+    grids: dict[int, tuple[Array, Array, Array, float]] = {}
+    for index in np.flatnonzero(live).tolist():
+        span = slice(int(point_bounds[index]), int(point_bounds[index + 1]))
+        grids[index] = (grid[span], values[span], rate[span.start:span.stop - 1], float(longest[index]))
+    return results, grids
 
 
 def _knot_steps(motion: HermiteMotion, knots: Array) -> tuple[Array, Array, Array]:
@@ -479,14 +567,16 @@ def _knot_steps(motion: HermiteMotion, knots: Array) -> tuple[Array, Array, Arra
     return h, motion.rate_bound[interval], np.maximum(4, np.ceil(motion.turn_rate[interval] * h / FINE_STEP)).astype(int)
 
 
-def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence[tuple[Array, Array, Array]],
-          found_t: list[list[Array]], found_v: list[list[Array]], missable: list[float]) -> None:
+def _zoom(motion: HermiteMotion, evaluate: Together, searches: int, active: Sequence[int], thresholds: Sequence[float],
+          grids: Sequence[tuple[Array, Array, Array]], found_t: list[list[Array]], found_v: list[list[Array]],
+          missable: list[float]) -> None:
     """Step 3 of :func:`search_between_samples` for several searches at once: the brackets of every
     search in one array (``owner``: the search of each, in order), the least value, the threshold
-    and the :data:`MIN_SEARCHES` deepest brackets per search; the points of each zoom appended to
-    that search's ``found_t`` and ``found_v``. Every search zooms into at most :data:`MAX_SUB_GRID`
-    points a zoom: past that, into its deepest brackets that may hide a crossing only, its
-    ``missable`` raised (in place) to the longest bracket left unsearched."""
+    and the :data:`MIN_SEARCHES` deepest brackets per search; the points of each zoom evaluated in
+    one call (``evaluate`` of ``searches`` searches, of which those zoomed are ``active``) and
+    appended to that search's ``found_t`` and ``found_v``. Every search zooms into at most
+    :data:`MAX_SUB_GRID` points a zoom: past that, into its deepest brackets that may hide a
+    crossing only, its ``missable`` raised (in place) to the longest bracket left unsearched."""
     count = len(grids)
     owner = np.repeat(np.arange(count), [len(grid) - 1 for grid, _, _ in grids])
     low = np.concatenate([grid[:-1] for grid, _, _ in grids])
@@ -494,14 +584,17 @@ def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence
     at_low = np.concatenate([values[:-1] for _, values, _ in grids])
     at_high = np.concatenate([values[1:] for _, values, _ in grids])
     rate = np.concatenate([rate for _, _, rate in grids])
-    thresholds = np.array([float(search[1]) for search in searches])
-    smallest = [float(np.nanmin(values)) for _, values, _ in grids]
+    thresholds_of = np.asarray(thresholds, dtype=float)
+    # each search's least value (min ignores NaN: np.nanmin's value, once for all)
+    smallest = np.fmin.reduceat(np.concatenate([values for _, values, _ in grids]),
+                                np.concatenate([[0], np.cumsum([len(values) for _, values, _ in grids])[:-1]])).tolist()
     near = np.ones(len(low), dtype=bool)  # a candidate for a lower value (else only for a crossing)
-    fraction = np.linspace(0.0, 1.0, REFINE_POINTS)[1:-1]
+    fraction = _FRACTION
     part = np.arange(REFINE_POINTS - 1)
     inside_count = REFINE_POINTS - 2
+    searched = np.asarray(active, dtype=np.intp)  # each slot's search
     for _ in range(REFINE_LEVELS):
-        threshold = thresholds[owner]
+        threshold = thresholds_of[owner]
         with np.errstate(invalid="ignore"):
             floor = 0.5 * (at_low + at_high) - 0.5 * rate * (high - low)
             hidden = (np.fmin(at_low, at_high) >= threshold) & (floor < threshold)
@@ -511,7 +604,8 @@ def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence
             first = np.searchsorted(owner[ranked], owner[ranked], side="left")
             lower = ranked[np.arange(ranked.size) - first < MIN_SEARCHES]
         allowed = max(MAX_SUB_GRID // inside_count - MIN_SEARCHES, 0)
-        for slot in np.unique(owner[hidden]).tolist():  # the work limit, per search and zoom
+        for slot in np.unique(owner[hidden]).tolist() if np.count_nonzero(hidden) > allowed else ():  # the work
+            # limit, per search and zoom (none past it when all of them are within)
             may_hide = np.flatnonzero(hidden & (owner == slot))
             if may_hide.size > allowed:
                 dropped = may_hide[np.argsort((floor - threshold)[may_hide], kind="stable")[allowed:]]
@@ -520,23 +614,24 @@ def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence
                 missable[slot] = max(missable[slot], float(np.max(high[dropped] - low[dropped])))
         pick = hidden.copy()
         pick[lower] = True
-        if not np.any(pick):
+        if not pick.any():
             break
         whole = hidden[pick]
         low, high, at_low, at_high, rate = low[pick], high[pick], at_low[pick], at_high[pick], rate[pick]
         owner = owner[pick]
         points = low[:, None] + (high - low)[:, None] * fraction
         flat = points.ravel()
-        attitudes = motion.attitudes(flat)  # every search's points in one call
-        inside_values = np.empty(flat.size)
-        bounds = np.searchsorted(owner, np.arange(count + 1)) * inside_count  # each search's points: one run
-        for slot in np.flatnonzero(np.diff(bounds)).tolist():
-            span = slice(bounds[slot], bounds[slot + 1])
-            mine = np.asarray(searches[slot][0](flat[span], attitudes[span]), dtype=np.float64)
-            inside_values[span] = mine
+        # every search's points in one call (owner increases: each search's points are one run)
+        bounds = np.searchsorted(searched[owner], np.arange(searches + 1)) * inside_count
+        inside_values = evaluate(bounds, flat, motion.attitudes(flat))
+        starts = bounds[searched]
+        zoomed = np.flatnonzero(bounds[searched + 1] > starts)  # the slots with points at this zoom
+        least = np.fmin.reduceat(inside_values, starts[zoomed]).tolist()  # each one's least (NaN: none)
+        for slot, lowest in zip(zoomed.tolist(), least):
+            span = slice(int(starts[slot]), int(bounds[searched[slot] + 1]))
             found_t[slot].append(flat[span])
-            found_v[slot].append(mine)
-            smallest[slot] = min(smallest[slot], float(np.nanmin(mine)))
+            found_v[slot].append(inside_values[span])
+            smallest[slot] = min(smallest[slot], lowest)
         inside_values = inside_values.reshape(points.shape)
         ends_t = np.column_stack([low, points, high])
         ends_v = np.column_stack([at_low, inside_values, at_high])
@@ -550,6 +645,10 @@ def _zoom(motion: HermiteMotion, searches: Sequence[SearchSpec], grids: Sequence
         rate = np.repeat(rate, REFINE_POINTS - 1)[keep]
         owner = np.repeat(owner, REFINE_POINTS - 1)[keep]
         near = near[keep]
+
+
+_FRACTION = np.linspace(0.0, 1.0, REFINE_POINTS)[1:-1]
+"""Where a zoom's new points lie in each bracket (fractions of it)."""
 
 
 class PointingScore(NamedTuple):
@@ -1052,5 +1151,85 @@ def scores_between_samples(constraints: Sequence[PointingConstraint], t: ArrayLi
         return [constraint.score(t, np.atleast_2d(np.asarray(q, dtype=float))) for constraint in constraints]
     moving = HermiteMotion(t, q, omega) if motion is None else motion
     found = searches_between_samples(moving, [(constraint.margins, 0.0, constraint.drift, constraint.window)
-                                              for constraint in constraints])
+                                              for constraint in constraints], _margins_together(constraints))
     return [constraint._scored(search[0], search[1], search.missable_s) for constraint, search in zip(constraints, found)]
+
+
+def _margins_together(constraints: Sequence[PointingConstraint]) -> Together:
+    """``together`` of :func:`searches_between_samples` for the constraints' margins
+    (:meth:`PointingConstraint.margins`), each constraint at its own points: the moving constraints'
+    in one pass (their tables end to end, each point's lookup into its own; per point the same
+    operations as :meth:`PointingConstraint.margins`, so the same values), a fixed one alone."""
+    moving = [index for index, constraint in enumerate(constraints) if constraint.moving]
+    if len(moving) < 2:
+        return _each([(constraint.margins, 0.0, 0.0, ()) for constraint in constraints])
+    fixed = [index for index in range(len(constraints)) if index not in moving]
+    mine = [constraints[index] for index in moving]
+    last = np.array([len(constraint.times) - 2 for constraint in mine])  # each table's last step
+    offsets = np.concatenate([[0], np.cumsum(last + 2)[:-1]])
+    table_times = np.concatenate([constraint.times for constraint in mine])
+    slopes = [constraint._table_slopes for constraint in mine]
+    rows = np.concatenate([slope[0] for slope in slopes])
+    # the steps' arrays hold one fewer than the rows: padded by one, the rows' offsets serve them
+    inverse_steps = np.concatenate([np.append(slope[1], 0.0) for slope in slopes])
+    differences = np.concatenate([np.vstack([slope[2], np.zeros((1, 4))]) for slope in slopes])
+    angles = np.array([constraint.angle for constraint in mine])
+    keep_in = np.array([not constraint.keep_out for constraint in mine])
+    starts = np.array([constraint.window[0] for constraint in mine])
+    ends = np.array([constraint.window[1] for constraint in mine])
+    forms = [constraint._rotation_form for constraint in mine]
+    alone = [constraints[index].margins for index in fixed]
+
+    def evaluate(bounds: NDArray[np.intp], times: Array, attitudes: Array) -> Array:
+        values = np.empty(len(times))
+        for index, margins in zip(fixed, alone):
+            span = slice(int(bounds[index]), int(bounds[index + 1]))
+            if span.start < span.stop:
+                values[span] = margins(times[span], attitudes[span])
+        sizes = np.diff(bounds)[moving]
+        if fixed:
+            select: Any = np.concatenate([np.arange(bounds[index], bounds[index + 1]) for index in moving])
+            t, q = times[select], attitudes[select]
+        else:
+            select, t, q = slice(None), times, attitudes
+        count = len(t)
+        row = np.empty(count, dtype=np.intp)
+        product = np.empty((count, 12))
+        start = 0
+        for slot, constraint in enumerate(mine):  # each point's lookup into its own table
+            span = slice(start, start + int(sizes[slot]))
+            start = span.stop
+            if span.start == span.stop:
+                continue
+            found = constraint.times.searchsorted(t[span], side="right")
+            found -= 1
+            np.minimum(np.maximum(found, 0, out=found), last[slot], out=found)
+            found += offsets[slot]
+            row[span] = found
+            product[span] = q[span] @ forms[slot]
+        owner = np.repeat(np.arange(len(mine)), sizes)
+        # from here per point the operations of PointingConstraint._table_at, margins and _angles
+        weight = t - table_times.take(row)
+        weight *= inverse_steps.take(row)
+        np.minimum(np.maximum(weight, 0.0, out=weight), 1.0, out=weight)
+        table = differences.take(row, axis=0)
+        table *= weight[:, None]
+        table += rows.take(row, axis=0)
+        limit = table[:, 3]
+        limit += angles[owner]
+        pointing = np.einsum("mij,mj->mi", product.reshape(count, 3, 4), q)
+        direction = table[:, :3]
+        scale = np.sqrt(np.einsum("ij,ij->i", direction, direction))
+        scale *= np.einsum("ij,ij->i", q, q)
+        cosine = np.einsum("ij,ij->i", pointing, direction)
+        cosine /= scale
+        margin = np.arccos(np.minimum(np.maximum(cosine, -1.0, out=cosine), 1.0, out=cosine), out=cosine)
+        margin -= limit
+        np.negative(margin, out=margin, where=keep_in[owner])
+        within = t >= starts[owner]
+        within &= t <= ends[owner]
+        margin[~within] = np.nan
+        values[select] = margin
+        return values
+
+    return evaluate
