@@ -182,10 +182,14 @@ def command_table(args: argparse.Namespace) -> int:
     if table.refinement:
         refinement = table.refinement
         for item in refinement["rounds"]:
+            boundary = item.get("boundary", 0)  # said only when some were: a table whose entries all have a time has none
+            across = f"{boundary} of them across the boundary of the entries without a time; " if boundary else ""
+            largest = ("unbounded (a check where the entry or the fit has no time)" if item["max_miss"] is None
+                       else f"{100 * item['max_miss']:.3g} %")
             print(f"refinement round {item['round']}: {item['checked']} midpoints checked, largest miss "
-                  f"{100 * item['max_miss']:.3g} %, {item['missed']} over the tolerance, {item['split']} triangles split "
-                  f"({item.get('boundary', 0)} of them across the boundary of the entries without a time; "
-                  f"+{item['graded']} to keep the mesh graded), {item['axes']} axes, {item['solves']} entries solved")
+                  f"{largest}, {item['missed']} over the tolerance, {item['split']} triangles split "
+                  f"({across}+{item['graded']} to keep the mesh graded), {item['axes']} axes, {item['solves']} entries "
+                  "solved")
         print(f"refinement: {'reached' if refinement['reached'] else 'NOT reached'} at its check points "
               f"({refinement['stopped']}); {refinement['axes']} axes in the fit, {refinement['check_points']} check "
               "points outside it")

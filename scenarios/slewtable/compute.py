@@ -152,7 +152,8 @@ class SlewTable:
         ``eval_time_us`` [µs per call]; empty without a fit.
     refinement : dict
         The refinement's figures (:meth:`scenarios.slewtable.refine.RefineResult.summary`, with
-        ``tolerance``); empty without one.
+        ``tolerance``; a round's ``max_miss`` None where it is unbounded: a check whose entry or
+        fit has no time); empty without one.
     """
 
     spec: TableSpec
@@ -605,7 +606,7 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
         cones = end_cones(cases[0].scenario) if cases else None
         triangles = spec.triangles
         if spec.refine is not None:
-            triangles = _refine(table, run, inertia, generators, rates, cones)
+            triangles = _refine(table, run, inertia, generators, rates, cones, _fit_meta(spec))
     finally:
         if store is not None:
             store.close()
@@ -620,11 +621,7 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
     if spec.objective != "min_time":
         table.fit_note = "the fit is of minimum-time tables (this table is min_energy at a fixed duration)"
         return table
-    meta = {"scenario": spec.name, "objective": spec.objective,
-            "from_identity_only": _inertially_dependent(spec.base)}
-    if meta["from_identity_only"]:  # what the times hold for: slews from the identity at the epoch
-        written = {key: spec.base.get(key) for key in ("epoch", "requirements", "environment")}
-        meta.update(json.loads(json.dumps(written, default=str)))  # YAML's dates as text
+    meta = _fit_meta(spec)
     meta["grid"] = spec.grid
     if table.refinement:
         meta["refinement"] = table.refinement
@@ -640,6 +637,19 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
         table.fit.meta["note"] = table.fit_note
         table.fit_quality = quality
     return table
+
+
+def _fit_meta(spec: TableSpec) -> dict[str, Any]:
+    """What a table's fit keeps of its scenario (the final fit's and the refinement's working fits'):
+    its name and objective, and whether its times hold for slews from the identity only (pointing
+    requirements or environment torques; then with the epoch, requirements and environment they
+    hold for). A fit with end cones needs ``from_identity_only`` (:class:`SlewTimeFit`)."""
+    meta = {"scenario": spec.name, "objective": spec.objective,
+            "from_identity_only": _inertially_dependent(spec.base)}
+    if meta["from_identity_only"]:  # what the times hold for: slews from the identity at the epoch
+        written = {key: spec.base.get(key) for key in ("epoch", "requirements", "environment")}
+        meta.update(json.loads(json.dumps(written, default=str)))  # YAML's dates as text
+    return meta
 
 
 class _Runner:
@@ -671,9 +681,11 @@ class _Runner:
 
 
 def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.ndarray,
-            rates: tuple[np.ndarray, float | None], cones: np.ndarray | None) -> np.ndarray:
+            rates: tuple[np.ndarray, float | None], cones: np.ndarray | None, meta: dict[str, Any]) -> np.ndarray:
     """Refine the table's axes (module docstring); the table part becomes the refined grid, the
-    check points not split become the ``check`` part. Returns the refined triangles."""
+    check points not split become the ``check`` part; its working fits carry ``meta``, the final
+    fit's (:func:`_fit_meta`: with end cones they must hold for slews from the identity only).
+    Returns the refined triangles."""
     from scenarios.slewtable.fit import _hull
     from scenarios.slewtable.grid import held_out_angles
     from scenarios.slewtable.refine import check_positions, refine
@@ -706,7 +718,7 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
         part.slew_time_s[:] = np.where(np.isfinite(times), times, np.nan)
         part.status = [["ok" if np.isfinite(v) else ("infeasible" if v == np.inf else "failed") for v in row]
                        for row in times]
-        fit, _ = fit_entries(part, inertia, generators, None, triangles, rates, cones)
+        fit, _ = fit_entries(part, inertia, generators, meta, triangles, rates, cones)
         if fit is None:
             return None
         at = np.deg2rad(between)
@@ -741,6 +753,9 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
                                                       if p != int(p)],
                         "max_axes": spec.refine.max_axes, "max_rounds": spec.refine.max_rounds,
                         "initial_axes": n0, **result.summary()}
+    for item in table.refinement["rounds"]:  # fit.json is strict JSON: an unbounded miss is null
+        if not math.isfinite(item["max_miss"]):
+            item["max_miss"] = None
     return result.triangles
 
 
