@@ -142,7 +142,10 @@ class SlewTable:
     stored : int
         Entries found already computed in the store (not ``crashed``: those run again).
     rerun : int
-        Entries found ``crashed`` in the store, run again.
+        Entries found ``crashed`` in the store (raised or killed their worker), run again.
+    rerun_timed_out : int
+        Entries found ``timed_out`` in the store (the engine's ``crashed`` of a case that ran out of
+        ``case_timeout_s``), run again.
     fit : SlewTimeFit or None
         The fit (None when it could not be made: :attr:`fit_note` says why).
     fit_note : str
@@ -161,6 +164,7 @@ class SlewTable:
     wall_time_s: float = 0.0
     stored: int = 0
     rerun: int = 0
+    rerun_timed_out: int = 0
     fit: SlewTimeFit | None = None
     fit_note: str = ""
     fit_quality: dict[str, Any] = field(default_factory=dict)
@@ -264,11 +268,11 @@ def timed_out_message(engine_message: str) -> str:
     -------
     str
         The message, saying that the planner was still solving (no error, not a crash), that the
-        slew time is unknown and the slew may be possible, and which key gives it more time.
+        slew time is unknown and the slew may be possible, and which flag or key gives it more time.
     """
     return (f"{engine_message}: the planner was still solving (no error, not a crash); the slew time is unknown "
-            "and the slew may be possible: give it more time (table.execution.case_timeout_s) and run the table "
-            "again into the same --out")
+            "and the slew may be possible: give it more time (slewbench table --case-timeout, or "
+            "table.execution.case_timeout_s in a table file) and run the table again into the same --out")
 
 
 UNDERACTUATED_NOTE = ("; the spacecraft has torque about fewer than three independent axes (underactuated): its "
@@ -276,6 +280,12 @@ UNDERACTUATED_NOTE = ("; the spacecraft has torque about fewer than three indepe
                       "iteration limit (failed) given the time; table.planner_options {time_regularization: 0.02} "
                       "converges more often (the slew-table guide)")
 """What a ``timed_out`` entry of an underactuated spacecraft adds (:func:`compute_table`)."""
+
+
+def _timed_out(record: dict[str, Any]) -> bool:
+    """Whether an engine's ``crashed`` record ran out of ``case_timeout_s`` (the table's ``timed_out``)."""
+    rows = record.get("rows") or [{}]
+    return str(rows[0].get("message") or "").startswith(TIMED_OUT)
 
 
 def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objective: str) -> None:
@@ -287,7 +297,7 @@ def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objec
     if part.status[i][k] == "failed" and _proven_infeasible(case.scenario):
         part.status[i][k] = "infeasible"
     part.message[i][k] = str(row.get("message") or "")
-    if part.status[i][k] == "crashed" and part.message[i][k].startswith(TIMED_OUT):
+    if part.status[i][k] == "crashed" and _timed_out(record):
         part.status[i][k] = "timed_out"  # ran out of case_timeout_s: no error, the time unknown
         part.message[i][k] = timed_out_message(part.message[i][k])
     if row.get("plan_time_s") is not None:
@@ -611,7 +621,7 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
         if store is not None:
             store.close()
     table.wall_time_s = time.perf_counter() - start
-    table.stored, table.rerun = run.stored, run.rerun
+    table.stored, table.rerun, table.rerun_timed_out = run.stored, run.rerun, run.rerun_timed_out
     if len(generators) and np.linalg.matrix_rank(generators, tol=1e-9 * float(np.max(np.abs(generators)))) < 3:
         for part in table.parts.values():
             for statuses, messages in zip(part.status, part.message):
@@ -654,7 +664,8 @@ def _fit_meta(spec: TableSpec) -> dict[str, Any]:
 
 class _Runner:
     """Runs table entries through the trade-study engine (one study per call), counting those found
-    in the store (``stored``) and those found ``crashed`` there, run again (``rerun``)."""
+    in the store (``stored``) and those found ``crashed`` there, run again: ``rerun_timed_out`` those
+    that ran out of ``case_timeout_s`` (the table's ``timed_out``), ``rerun`` the others."""
 
     def __init__(self, spec: TableSpec, store: Any, workers: int | None, cluster: Any, executor: Executor | None,
                  progress: bool):
@@ -662,6 +673,7 @@ class _Runner:
         self.cluster, self.executor, self.progress = cluster, executor, progress
         self.stored = 0
         self.rerun = 0
+        self.rerun_timed_out = 0
         self.entries = 0
 
     def __call__(self, cases: list[TableCase]) -> list[dict[str, Any] | None]:
@@ -673,9 +685,14 @@ class _Runner:
         if self.store is not None:  # a crashed entry is not kept: the engine runs it again
             counts = resume_counts(self.store, {case.key for case in study.cases})
             self.stored += counts.kept
-            self.rerun += counts.crashed
+            if counts.crashed:  # the engine's crashed: the table tells those that timed out apart
+                keys = {case.key for case in study.cases}
+                timed = sum(1 for key, record in self.store.records().items()
+                            if key in keys and record["status"] == "crashed" and _timed_out(record))
+                self.rerun += counts.crashed - timed
+                self.rerun_timed_out += timed
         results = sweep(study, self.executor, workers=self.workers, store=self.store, progress=self.progress,
-                        cluster=self.cluster)
+                        cluster=self.cluster, timeouts_apart=True)  # the table's timed_out entries
         self.entries += len(cases)
         return [results.records.get(study_case.key) for study_case in study.cases]
 
