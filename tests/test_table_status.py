@@ -5,6 +5,10 @@
    result), ending with how many crashed, why, and the command that computes them again; run
    again, it says the crashed entries are run again rather than "already stored". Before: exit 0,
    no word of the crash, and "(2 entries already stored)" on the second run though both ran again.
+   Entries that ran out of time are ``timed_out`` and called timed out wherever the table speaks
+   (the progress line said "(2 crashed)", the second run "2 crashed ones run again"), and the advice
+   gives them more time with ``--case-timeout`` (it named a table file's key to one who gave a
+   scenario alone).
 2. A ``min_time`` entry that ``collocation`` found slower than a feasible slew of the same problem
    (its certificate's ``seed_bound`` note, "not the best known") stays ``ok`` and is fitted, but is
    marked: ``best_known`` false in ``slew_table.csv`` and ``slew_table.nc``, counted in the
