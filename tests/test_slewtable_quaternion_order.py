@@ -92,3 +92,20 @@ def test_the_identity_in_the_other_order_is_named_by_a_table_from_the_identity_o
     # another start is refused without the hint
     with pytest.raises(ValueError, match=r"read scalar first\)$"):
         first(quat.from_axis_angle([1, 0, 0], 0.3).tolist(), qf.tolist())
+
+
+def test_a_bad_quaternion_is_refused_in_the_fits_order(tmp_path):
+    """A ``scalar_last`` fit's refusals of what is not 4 numbers said "(scalar first)"."""
+    _fit({}).save(tmp_path / "fit.json")
+    for order, words, other in (("scalar_last", "scalar last", "scalar first"),
+                                ("scalar_first", "scalar first", "scalar last")):
+        fit = load_fit(tmp_path, quaternion_order=order)
+        unit = [0.0, 0.0, 0.0, 1.0]
+        for call, q0, qf in ((fit, np.array([0, 0, 1.0]), unit),  # an array of 3
+                             (fit, (np.float64(0.0), np.float64(0.0), np.float64(0.0), "1"), unit),  # text
+                             (fit, object(), unit),  # not numbers
+                             (fit.slew_time_many, np.zeros((2, 3)), np.array(unit)),
+                             (fit.slew_time_many, "abcd", np.array(unit))):
+            with pytest.raises(TypeError, match=f"q0 (and qf )?must be .*4 numbers.*\\({words}\\)") as raised:
+                call(q0, qf)
+            assert other not in str(raised.value)

@@ -155,6 +155,7 @@ BAD = {
     "held_out": (-1, -1, "-1"),
     "execution.workers": (0, 0, "0"),
     "execution.scheduler": ("nowhere", "nowhere", "nowhere"),
+    "execution.case_timeout_s": (-1.0, -1.0, "-1"),
     "refine.tolerance": (1.5, 1.5, "1.5"),
     "refine.check_angles_deg": ("ninety", "ninety", "ninety"),
     "refine.max_axes": (0, 0, "0"),

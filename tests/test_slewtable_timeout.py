@@ -59,3 +59,46 @@ def test_an_entry_out_of_time_is_timed_out_and_says_so(tmp_path, capsys):
     assert "slewbench: 2 of 2 entries timed out: the planner was still solving when table.execution." \
            "case_timeout_s (0.5 s) ran out" in said.err, said.err
     assert "entries crashed" not in said.err and "Traceback" not in said.err
+
+
+def test_the_schema_and_the_exit_status_call_an_entry_out_of_time_timed_out():
+    """The schema's ``table.execution.case_timeout_s`` said "its status is then crashed"; EXIT_CRASHED's
+    description named only crashed entries."""
+    from scenarios.cli import status
+    from scenarios.schema.table import TABLE_EXECUTION, TABLE_FLAGS
+    meaning = TABLE_EXECUTION["case_timeout_s"].meaning
+    assert "``timed_out``" in meaning and "crashed" not in meaning, meaning
+    assert TABLE_FLAGS["execution.case_timeout_s"] == "--case-timeout"
+    described = " ".join(_attribute_doc(status, "EXIT_CRASHED").split())
+    assert "timed out (status ``timed_out``" in described and "--case-timeout" in described, described
+
+
+def _attribute_doc(module, name: str) -> str:
+    """The docstring written under a module's constant (``NAME = 1`` then a string)."""
+    import ast
+    import inspect
+    tree = ast.parse(inspect.getsource(module))
+    for node, after in zip(tree.body, tree.body[1:]):
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", "") == name for t in node.targets) \
+                and isinstance(after, ast.Expr) and isinstance(after.value, ast.Constant):
+            return str(after.value.value)
+    return ""
+
+
+def test_a_tables_crash_report_does_not_count_running_out_of_time_as_a_crash():
+    """A table's entries that run out of time are ``timed_out`` (reported apart): its crash report
+    said "crashed (raised, ran out of case_timeout_s or killed their worker)"; a sweep's still does."""
+    import numpy as np
+
+    from scenarios.cli.status import crash_report
+    from scenarios.cli.table import crashed_message
+    from scenarios.slewtable.compute import SlewTable, TablePart
+    part = TablePart.empty(np.eye(3)[:1], [90.0, 180.0])
+    part.status[0] = ["crashed", "timed_out"]
+    part.message[0] = ["worker died (signal 9); 2 attempt(s)", "timed out after 1 s (case_timeout_s): ..."]
+    said = crashed_message(SlewTable(None, {"table": part}), "slewbench table box.yaml")  # type: ignore[arg-type]
+    assert said.startswith("slewbench: 1 of 2 entries crashed (raised or killed their worker): "), said
+    assert "case_timeout_s" not in said and "timed out" not in said
+    sweep = crash_report(["boom"], 3, ("case", "cases"), "cases.csv", "x", "slewbench sweep s.yaml --resume")
+    assert sweep.startswith("slewbench: 1 of 3 cases crashed (raised, ran out of case_timeout_s or killed their "
+                            "worker): "), sweep

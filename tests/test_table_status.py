@@ -5,6 +5,10 @@
    result), ending with how many crashed, why, and the command that computes them again; run
    again, it says the crashed entries are run again rather than "already stored". Before: exit 0,
    no word of the crash, and "(2 entries already stored)" on the second run though both ran again.
+   Entries that ran out of time are ``timed_out`` and called timed out wherever the table speaks
+   (the progress line said "(2 crashed)", the second run "2 crashed ones run again"), and the advice
+   gives them more time with ``--case-timeout`` (it named a table file's key to one who gave a
+   scenario alone).
 2. A ``min_time`` entry that ``collocation`` found slower than a feasible slew of the same problem
    (its certificate's ``seed_bound`` note, "not the best known") stays ``ok`` and is fitted, but is
    marked: ``best_known`` false in ``slew_table.csv`` and ``slew_table.nc``, counted in the
@@ -80,22 +84,43 @@ def test_a_table_whose_entries_crashed_writes_its_files_and_exits_1(tmp_path: Pa
     lines = captured.err.strip().splitlines()
     # off a terminal the engine's progress line comes first (at most every 30 s, and at the end)
     progress = [line for line in lines if line.startswith("table bilimoria-wie: ")]
-    assert progress and progress[-1].startswith("table bilimoria-wie: 2/2 entries done, 2 not ok (2 crashed), "), captured.err
+    # the table calls them timed out everywhere: its progress line too (a sweep's says crashed, as its rows)
+    assert progress and progress[-1].startswith("table bilimoria-wie: 2/2 entries done, 2 not ok (2 timed out), "), \
+        captured.err
     last = lines[lines.index(progress[-1]) + 1:]
     # each entry timed out (by the worker's own alarm, or under load by the driver's clock, which
     # stops the worker): status timed_out, not crashed, and the message says what to do
     assert last[0].startswith("slewbench: 2 of 2 entries timed out: the planner was still solving when "
                               "table.execution.case_timeout_s (0.001 s) ran out"), captured.err
-    command = shlex.join(["slewbench", "table", str(path), "--angles", "90,180", "--out", str(out), "--no-plots"])
+    # the command gives them more time with a flag (twice the limit, to a whole second)
+    assert "Give them more time (--case-timeout, which wins over table.execution.case_timeout_s)" in last[0]
+    command = shlex.join(["slewbench", "table", str(path), "--angles", "90,180", "--case-timeout", "1", "--out",
+                          str(out), "--no-plots"])
     assert last[-1] == f"  {command}" and len(last) == 2, captured.err
+    assert "crashed" not in captured.err.replace("not a crash", ""), captured.err
     assert "Traceback" not in captured.err
     table_rows = rows(out / "slew_table.csv")
     assert [r["status"] for r in table_rows] == ["timed_out", "timed_out"]  # written all the same
     assert all(re.match(r"timed out after 0\.001 s \(case_timeout_s\)(?:; worker stopped)?: the planner was still "
                         r"solving", r["message"]) for r in table_rows), table_rows
-    # run again: the crashed entries are not "already stored", they run again (and crash again)
+    # run again: the timed-out entries are not "already stored", they run again (and time out again)
     assert main(["table", str(path), "--out", str(out), "--no-plots"]) == EXIT_CRASHED
-    assert "(0 entries already stored, 2 crashed ones run again)" in capsys.readouterr().out
+    assert "(0 entries already stored, 2 timed-out ones run again)" in capsys.readouterr().out
+
+
+def test_a_scenario_given_alone_is_told_how_to_give_its_entries_more_time(tmp_path: Path, capsys) -> None:
+    """The advice named a key of a table file, and the command the same scenario file: one who ran
+    ``slewbench table scenario.yaml`` has no table file. The flag holds for both."""
+    scenario = write(tmp_path, "box.yaml", BOX)
+    out = tmp_path / "out"
+    assert main(["table", str(scenario), "--axes", "1", "--grid", "fibonacci", "--angles", "90,180",
+                 "--case-timeout", "0.001", "--workers", "2", "--out", str(out), "--no-plots"]) == EXIT_CRASHED
+    err = capsys.readouterr().err
+    assert "when table.execution.case_timeout_s (0.001 s) ran out" in err, err  # the flag set the limit
+    command = shlex.join(["slewbench", "table", str(scenario), "--axes", "1", "--grid", "fibonacci", "--angles",
+                          "90,180", "--workers", "2", "--case-timeout", "1", "--out", str(out), "--no-plots"])
+    assert err.rstrip().endswith(f"\n  {command}"), err
+    assert "in the table file" not in err
 
 
 # --- 2. entries that are not the best known --------------------------------------------------------

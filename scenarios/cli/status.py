@@ -9,8 +9,8 @@ import argparse
 import re
 
 __all__ = ["CRASH_REASONS_SHOWN", "EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_CRASHED", "EXIT_INTERNAL",
-           "EXIT_INTERRUPTED", "EXIT_NOT_OK", "EXIT_OK", "INTERRUPTED_STATUS", "attached_values", "crash_report",
-           "directory_argument", "interrupted_status"]
+           "EXIT_INTERRUPTED", "EXIT_NOT_OK", "EXIT_OK", "INTERRUPTED_STATUS", "SWEEP_CRASH_CAUSES", "attached_values",
+           "crash_report", "directory_argument", "interrupted_status"]
 
 EXIT_OK = 0
 """The command completed (a run's failed and violated rows, a table's entries that are not ok
@@ -27,9 +27,11 @@ a boundary rate is above the rate bound): for users' continuous integration."""
 EXIT_CRASHED = 1
 """``slewbench sweep``: every case ran and the tables are written, but some cases crashed (raised,
 ran out of ``case_timeout_s`` or killed their worker): they have no result, and ``--resume`` runs
-them again. ``slewbench table`` alike: its files are written, some entries crashed, and the same
-command run again into the same ``--out`` computes them again. A numerical failure is a ``failed``
-row (entry), a result: it does not set this status."""
+them again. ``slewbench table`` alike: its files are written, some entries crashed (raised or killed
+their worker) or timed out (status ``timed_out``: the planner still solving when ``case_timeout_s``
+ran out), and the same command run again into the same ``--out`` computes them again (a timed-out
+one given more time with ``--case-timeout``). A numerical failure is a ``failed`` row (entry), a
+result: it does not set this status."""
 EXIT_BAD_SCENARIO = 2
 """A bad scenario or study file (or key of ``slewbench schema``): nothing was written."""
 EXIT_BAD_OUTPUT = 2
@@ -63,8 +65,12 @@ CRASH_REASONS_SHOWN = 3
 entries (the most frequent first)."""
 
 
+SWEEP_CRASH_CAUSES = "raised, ran out of case_timeout_s or killed their worker"
+"""What makes a case ``crashed`` (a sweep's; a slew table's timed-out entries have their own status)."""
+
+
 def crash_report(reasons: list[str], total: int, noun: tuple[str, str], where: str, consequence: str,
-                 command: str) -> str:
+                 command: str, causes: str = SWEEP_CRASH_CAUSES) -> str:
     """What a command whose cases crashed says last (on standard error): how many, why, and how to
     run them again (:data:`EXIT_CRASHED`).
 
@@ -82,6 +88,10 @@ def crash_report(reasons: list[str], total: int, noun: tuple[str, str], where: s
         What their missing results mean for the outputs.
     command : str
         The command that runs them again.
+    causes : str, optional
+        What makes one crashed, said in brackets: :data:`SWEEP_CRASH_CAUSES` by default; a slew
+        table's ``"raised or killed their worker"`` (its entries that ran out of time are
+        ``timed_out``, reported apart).
 
     Returns
     -------
@@ -99,8 +109,8 @@ def crash_report(reasons: list[str], total: int, noun: tuple[str, str], where: s
     def many(count: int) -> str:
         return f"{count} {noun[0] if count == 1 else noun[1]}"
 
-    lines = [(f"slewbench: {len(reasons)} of {many(total)} crashed (raised, ran out of case_timeout_s or killed "
-              f"their worker): they have no result (status crashed in {where}; {consequence}). Why:")]
+    lines = [(f"slewbench: {len(reasons)} of {many(total)} crashed ({causes}): they have no result (status crashed "
+              f"in {where}; {consequence}). Why:")]
     lines += [f"  {many(count)}: {reason}" for reason, count in ranked[:CRASH_REASONS_SHOWN]]
     if len(ranked) > CRASH_REASONS_SHOWN:
         lines.append(f"  ... and {len(ranked) - CRASH_REASONS_SHOWN} other reason(s) ({where}, status crashed)")

@@ -13,6 +13,7 @@ standard library until the command runs.
 from __future__ import annotations
 
 import argparse
+import math
 import shlex
 import signal
 import sys
@@ -175,17 +176,23 @@ def command_table(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     write_table_files(table, staging, plots=not args.no_plots)
     files = commit_sweep_outputs(directory, staging, kind="table")
-    rerun = f", {_count(table.rerun, 'crashed one')} run again" if table.rerun else ""
+    again = [_count(count, words) for count, words in ((table.rerun, "crashed one"),
+                                                          (table.rerun_timed_out, "timed-out one")) if count]
+    rerun = f", {' and '.join(again)} run again" if again else ""
     print(f"computed in {table.wall_time_s:.1f} s ({table.stored} entries already stored{rerun}); table: "
           f"{entry_counts(table)}; files written in {time.perf_counter() - start:.1f} s: {directory}/ "
           f"({', '.join(sorted(files))})")
     if table.refinement:
         refinement = table.refinement
         for item in refinement["rounds"]:
+            boundary = item.get("boundary", 0)  # said only when some were: a table whose entries all have a time has none
+            across = f"{boundary} of them across the boundary of the entries without a time; " if boundary else ""
+            largest = ("unbounded (a check where the entry or the fit has no time)" if item["max_miss"] is None
+                       else f"{100 * item['max_miss']:.3g} %")
             print(f"refinement round {item['round']}: {item['checked']} midpoints checked, largest miss "
-                  f"{100 * item['max_miss']:.3g} %, {item['missed']} over the tolerance, {item['split']} triangles split "
-                  f"({item.get('boundary', 0)} of them across the boundary of the entries without a time; "
-                  f"+{item['graded']} to keep the mesh graded), {item['axes']} axes, {item['solves']} entries solved")
+                  f"{largest}, {item['missed']} over the tolerance, {item['split']} triangles split "
+                  f"({across}+{item['graded']} to keep the mesh graded), {item['axes']} axes, {item['solves']} entries "
+                  "solved")
         print(f"refinement: {'reached' if refinement['reached'] else 'NOT reached'} at its check points "
               f"({refinement['stopped']}); {refinement['axes']} axes in the fit, {refinement['check_points']} check "
               "points outside it")
@@ -211,7 +218,8 @@ def command_table(args: argparse.Namespace) -> int:
     crashed = crashed_message(table, rerun_command(args, directory))
     if crashed:
         print(crashed, file=sys.stderr)
-    timed_out = timed_out_message(table, spec.case_timeout_s, rerun_command(args, directory))
+    timed_out = timed_out_message(table, spec.case_timeout_s, rerun_command(args, directory, {
+        "--case-timeout": f"{_more_time(spec.case_timeout_s):g}"}))
     if timed_out:
         print(timed_out, file=sys.stderr)
     if crashed or timed_out:
@@ -307,7 +315,14 @@ def crashed_message(table: Any, command: str) -> str:
             total += len(statuses)
             reasons += [message for status, message in zip(statuses, messages) if status == "crashed"]
     return crash_report(reasons, total, ("entry", "entries"), "slew_table.csv", "the fit has no time around them",
-                        command)
+                        command, "raised or killed their worker")
+
+
+def _more_time(limit_s: float) -> float:
+    """The time limit the advice of a table whose entries timed out suggests [s]: twice ``limit_s``
+    (rounded up to a whole second), within the key's bound."""
+    from scenarios.schema.study import MAX_CASE_TIMEOUT_S
+    return float(min(math.ceil(2.0 * limit_s), MAX_CASE_TIMEOUT_S))
 
 
 def timed_out_message(table: Any, limit_s: float, command: str) -> str:
@@ -322,7 +337,8 @@ def timed_out_message(table: Any, limit_s: float, command: str) -> str:
     limit_s : float
         ``table.execution.case_timeout_s`` [s].
     command : str
-        The command that runs them again (:func:`rerun_command`).
+        The command that runs them again with more time (:func:`rerun_command` with a larger
+        ``--case-timeout``: a flag, so that it holds for a scenario given alone as for a table file).
 
     Returns
     -------
@@ -340,11 +356,11 @@ def timed_out_message(table: Any, limit_s: float, command: str) -> str:
     return (f"slewbench: {count} of {_count(total, 'entry', 'entries')} timed out: the planner was still solving "
             f"when table.execution.case_timeout_s ({limit_s:g} s) ran out (no error, not a crash): they have no "
             "result (status timed_out in slew_table.csv; the fit has no time around them). Give them more time "
-            "(a larger table.execution.case_timeout_s in the table file) and run again (the entries already stored "
-            f"are kept):\n  {command}")
+            "(--case-timeout, which wins over table.execution.case_timeout_s) and run again (the entries already "
+            f"stored are kept), e.g. with twice the time:\n  {command}")
 
 
-def rerun_command(args: argparse.Namespace, out: Path) -> str:
+def rerun_command(args: argparse.Namespace, out: Path, changed: dict[str, str] | None = None) -> str:
     """The command that computes a table's missing and crashed entries again: the same file, the
     flags the user gave that set the table's keys (so that it asks for the same entries),
     ``--out`` the table's directory, ``--no-plots`` and ``--strict`` as given, each argument quoted
@@ -356,6 +372,9 @@ def rerun_command(args: argparse.Namespace, out: Path) -> str:
         The parsed ``table`` arguments.
     out : Path
         The table's directory.
+    changed : dict, optional
+        Flags of :data:`~scenarios.schema.table.TABLE_FLAGS` -> the value the command gives them
+        instead of the user's (``{"--case-timeout": "600"}``).
 
     Returns
     -------
@@ -363,9 +382,10 @@ def rerun_command(args: argparse.Namespace, out: Path) -> str:
         ``slewbench table FILE [flags] --out DIR [--no-plots] [--strict]``.
     """
     from scenarios.schema.table import TABLE_FLAGS
+    changed = changed or {}
     words = ["slewbench", "table", str(args.file)]
     for flag in TABLE_FLAGS.values():
-        value = getattr(args, flag[2:].replace("-", "_"), None)
+        value = changed.get(flag, getattr(args, flag[2:].replace("-", "_"), None))
         if value is not None:
             words += [flag, str(value)]
     words += ["--out", str(out)]
@@ -433,6 +453,9 @@ def add_table_parser(commands: Any) -> None:
     parser.add_argument("--out", type=directory_argument, help="output directory (default: results/table-<scenario name>)")
     parser.add_argument("--workers", type=int, help="entries at once (default: one per core)")
     parser.add_argument("--scheduler", help="Dask scheduler address (tcp://host:port) instead of local processes")
+    parser.add_argument("--case-timeout", type=float, metavar="SECONDS",
+                        help="wall time after which an entry's planner is stopped: the entry is then timed_out "
+                             "(default 600)")
     parser.add_argument("--no-plots", action="store_true", help="skip agility_envelope.png")
     parser.add_argument("--strict", action="store_true",
                         help=f"exit {EXIT_NOT_OK} when any entry of the table or its held-out grid is not ok (failed, "

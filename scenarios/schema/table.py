@@ -198,8 +198,10 @@ TABLE_EXECUTION = Section((
                                                       "or ``null``: one per core."),
     dataclasses.replace(EXECUTION["scheduler"], meaning="Address of a Dask scheduler (``tcp://host:8786``) that "
                                                         "computes the entries; ``null``: the local process pool."),
-    dataclasses.replace(EXECUTION["case_timeout_s"], meaning="Wall time after which an entry is stopped: its status "
-                                                             "is then ``crashed``."),
+    dataclasses.replace(EXECUTION["case_timeout_s"], meaning="Wall time after which an entry's planner is stopped: "
+                                                             "its status is then ``timed_out`` (no result; the "
+                                                             "table run again into the same ``--out`` computes it "
+                                                             "again)."),
 ), "How the entries run (the trade-study engine's, as a study's ``execution`` without ``retries``).")
 
 TABLE_REFINE = Section((
@@ -257,7 +259,7 @@ TABLE_FILE = Section((
 TABLE_FLAGS: dict[str, str] = {
     "axes": "--axes", "grid": "--grid", "angles_deg": "--angles", "objective": "--objective",
     "duration": "--duration", "held_out": "--held-out", "execution.workers": "--workers",
-    "execution.scheduler": "--scheduler", "refine.tolerance": "--tolerance", "refine.check_angles_deg": "--check-angles",
+    "execution.scheduler": "--scheduler", "execution.case_timeout_s": "--case-timeout", "refine.tolerance": "--tolerance", "refine.check_angles_deg": "--check-angles",
     "refine.max_axes": "--max-axes", "refine.max_rounds": "--max-rounds"}
 """Key below ``table`` (dotted) -> the ``slewbench table`` flag that sets it (and wins over the file)."""
 

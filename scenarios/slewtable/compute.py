@@ -142,7 +142,10 @@ class SlewTable:
     stored : int
         Entries found already computed in the store (not ``crashed``: those run again).
     rerun : int
-        Entries found ``crashed`` in the store, run again.
+        Entries found ``crashed`` in the store (raised or killed their worker), run again.
+    rerun_timed_out : int
+        Entries found ``timed_out`` in the store (the engine's ``crashed`` of a case that ran out of
+        ``case_timeout_s``), run again.
     fit : SlewTimeFit or None
         The fit (None when it could not be made: :attr:`fit_note` says why).
     fit_note : str
@@ -152,7 +155,8 @@ class SlewTable:
         ``eval_time_us`` [µs per call]; empty without a fit.
     refinement : dict
         The refinement's figures (:meth:`scenarios.slewtable.refine.RefineResult.summary`, with
-        ``tolerance``); empty without one.
+        ``tolerance``; a round's ``max_miss`` None where it is unbounded: a check whose entry or
+        fit has no time); empty without one.
     """
 
     spec: TableSpec
@@ -160,6 +164,7 @@ class SlewTable:
     wall_time_s: float = 0.0
     stored: int = 0
     rerun: int = 0
+    rerun_timed_out: int = 0
     fit: SlewTimeFit | None = None
     fit_note: str = ""
     fit_quality: dict[str, Any] = field(default_factory=dict)
@@ -263,11 +268,11 @@ def timed_out_message(engine_message: str) -> str:
     -------
     str
         The message, saying that the planner was still solving (no error, not a crash), that the
-        slew time is unknown and the slew may be possible, and which key gives it more time.
+        slew time is unknown and the slew may be possible, and which flag or key gives it more time.
     """
     return (f"{engine_message}: the planner was still solving (no error, not a crash); the slew time is unknown "
-            "and the slew may be possible: give it more time (table.execution.case_timeout_s) and run the table "
-            "again into the same --out")
+            "and the slew may be possible: give it more time (slewbench table --case-timeout, or "
+            "table.execution.case_timeout_s in a table file) and run the table again into the same --out")
 
 
 UNDERACTUATED_NOTE = ("; the spacecraft has torque about fewer than three independent axes (underactuated): its "
@@ -275,6 +280,12 @@ UNDERACTUATED_NOTE = ("; the spacecraft has torque about fewer than three indepe
                       "iteration limit (failed) given the time; table.planner_options {time_regularization: 0.02} "
                       "converges more often (the slew-table guide)")
 """What a ``timed_out`` entry of an underactuated spacecraft adds (:func:`compute_table`)."""
+
+
+def _timed_out(record: dict[str, Any]) -> bool:
+    """Whether an engine's ``crashed`` record ran out of ``case_timeout_s`` (the table's ``timed_out``)."""
+    rows = record.get("rows") or [{}]
+    return str(rows[0].get("message") or "").startswith(TIMED_OUT)
 
 
 def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objective: str) -> None:
@@ -286,7 +297,7 @@ def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objec
     if part.status[i][k] == "failed" and _proven_infeasible(case.scenario):
         part.status[i][k] = "infeasible"
     part.message[i][k] = str(row.get("message") or "")
-    if part.status[i][k] == "crashed" and part.message[i][k].startswith(TIMED_OUT):
+    if part.status[i][k] == "crashed" and _timed_out(record):
         part.status[i][k] = "timed_out"  # ran out of case_timeout_s: no error, the time unknown
         part.message[i][k] = timed_out_message(part.message[i][k])
     if row.get("plan_time_s") is not None:
@@ -605,12 +616,12 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
         cones = end_cones(cases[0].scenario) if cases else None
         triangles = spec.triangles
         if spec.refine is not None:
-            triangles = _refine(table, run, inertia, generators, rates, cones)
+            triangles = _refine(table, run, inertia, generators, rates, cones, _fit_meta(spec))
     finally:
         if store is not None:
             store.close()
     table.wall_time_s = time.perf_counter() - start
-    table.stored, table.rerun = run.stored, run.rerun
+    table.stored, table.rerun, table.rerun_timed_out = run.stored, run.rerun, run.rerun_timed_out
     if len(generators) and np.linalg.matrix_rank(generators, tol=1e-9 * float(np.max(np.abs(generators)))) < 3:
         for part in table.parts.values():
             for statuses, messages in zip(part.status, part.message):
@@ -620,11 +631,7 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
     if spec.objective != "min_time":
         table.fit_note = "the fit is of minimum-time tables (this table is min_energy at a fixed duration)"
         return table
-    meta = {"scenario": spec.name, "objective": spec.objective,
-            "from_identity_only": _inertially_dependent(spec.base)}
-    if meta["from_identity_only"]:  # what the times hold for: slews from the identity at the epoch
-        written = {key: spec.base.get(key) for key in ("epoch", "requirements", "environment")}
-        meta.update(json.loads(json.dumps(written, default=str)))  # YAML's dates as text
+    meta = _fit_meta(spec)
     meta["grid"] = spec.grid
     if table.refinement:
         meta["refinement"] = table.refinement
@@ -642,9 +649,23 @@ def compute_table(spec: TableSpec, directory: str | Path | None = None, *, worke
     return table
 
 
+def _fit_meta(spec: TableSpec) -> dict[str, Any]:
+    """What a table's fit keeps of its scenario (the final fit's and the refinement's working fits'):
+    its name and objective, and whether its times hold for slews from the identity only (pointing
+    requirements or environment torques; then with the epoch, requirements and environment they
+    hold for). A fit with end cones needs ``from_identity_only`` (:class:`SlewTimeFit`)."""
+    meta = {"scenario": spec.name, "objective": spec.objective,
+            "from_identity_only": _inertially_dependent(spec.base)}
+    if meta["from_identity_only"]:  # what the times hold for: slews from the identity at the epoch
+        written = {key: spec.base.get(key) for key in ("epoch", "requirements", "environment")}
+        meta.update(json.loads(json.dumps(written, default=str)))  # YAML's dates as text
+    return meta
+
+
 class _Runner:
     """Runs table entries through the trade-study engine (one study per call), counting those found
-    in the store (``stored``) and those found ``crashed`` there, run again (``rerun``)."""
+    in the store (``stored``) and those found ``crashed`` there, run again: ``rerun_timed_out`` those
+    that ran out of ``case_timeout_s`` (the table's ``timed_out``), ``rerun`` the others."""
 
     def __init__(self, spec: TableSpec, store: Any, workers: int | None, cluster: Any, executor: Executor | None,
                  progress: bool):
@@ -652,6 +673,7 @@ class _Runner:
         self.cluster, self.executor, self.progress = cluster, executor, progress
         self.stored = 0
         self.rerun = 0
+        self.rerun_timed_out = 0
         self.entries = 0
 
     def __call__(self, cases: list[TableCase]) -> list[dict[str, Any] | None]:
@@ -663,17 +685,24 @@ class _Runner:
         if self.store is not None:  # a crashed entry is not kept: the engine runs it again
             counts = resume_counts(self.store, {case.key for case in study.cases})
             self.stored += counts.kept
-            self.rerun += counts.crashed
+            if counts.crashed:  # the engine's crashed: the table tells those that timed out apart
+                keys = {case.key for case in study.cases}
+                timed = sum(1 for key, record in self.store.records().items()
+                            if key in keys and record["status"] == "crashed" and _timed_out(record))
+                self.rerun += counts.crashed - timed
+                self.rerun_timed_out += timed
         results = sweep(study, self.executor, workers=self.workers, store=self.store, progress=self.progress,
-                        cluster=self.cluster)
+                        cluster=self.cluster, timeouts_apart=True)  # the table's timed_out entries
         self.entries += len(cases)
         return [results.records.get(study_case.key) for study_case in study.cases]
 
 
 def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.ndarray,
-            rates: tuple[np.ndarray, float | None], cones: np.ndarray | None) -> np.ndarray:
+            rates: tuple[np.ndarray, float | None], cones: np.ndarray | None, meta: dict[str, Any]) -> np.ndarray:
     """Refine the table's axes (module docstring); the table part becomes the refined grid, the
-    check points not split become the ``check`` part. Returns the refined triangles."""
+    check points not split become the ``check`` part; its working fits carry ``meta``, the final
+    fit's (:func:`_fit_meta`: with end cones they must hold for slews from the identity only).
+    Returns the refined triangles."""
     from scenarios.slewtable.fit import _hull
     from scenarios.slewtable.grid import held_out_angles
     from scenarios.slewtable.refine import check_positions, refine
@@ -706,7 +735,7 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
         part.slew_time_s[:] = np.where(np.isfinite(times), times, np.nan)
         part.status = [["ok" if np.isfinite(v) else ("infeasible" if v == np.inf else "failed") for v in row]
                        for row in times]
-        fit, _ = fit_entries(part, inertia, generators, None, triangles, rates, cones)
+        fit, _ = fit_entries(part, inertia, generators, meta, triangles, rates, cones)
         if fit is None:
             return None
         at = np.deg2rad(between)
@@ -741,6 +770,9 @@ def _refine(table: SlewTable, run: _Runner, inertia: np.ndarray, generators: np.
                                                       if p != int(p)],
                         "max_axes": spec.refine.max_axes, "max_rounds": spec.refine.max_rounds,
                         "initial_axes": n0, **result.summary()}
+    for item in table.refinement["rounds"]:  # fit.json is strict JSON: an unbounded miss is null
+        if not math.isfinite(item["max_miss"]):
+            item["max_miss"] = None
     return result.triangles
 
 

@@ -255,23 +255,24 @@ def _identity_error(name: str, q: Any, angle: float, order: str = "scalar_first"
                       f"{order.replace('_', ' ')}){hint}")
 
 
-def _as_list(name: str, value: Any) -> list[float]:
-    """A quaternion argument as a list (NumPy arrays and other sequences), or a ``TypeError``."""
+def _as_list(name: str, value: Any, order: str) -> list[float]:
+    """A quaternion argument as a list (NumPy arrays and other sequences), or a ``TypeError`` naming
+    the fit's quaternion ``order``."""
     try:
         listed = np.asarray(value, dtype=float).tolist()
     except (TypeError, ValueError):
-        raise TypeError(f"{name} must be 4 numbers (scalar first), got {value!r}") from None
+        raise TypeError(f"{name} must be 4 numbers ({order.replace('_', ' ')}), got {value!r}") from None
     if not isinstance(listed, list) or len(listed) != 4:
-        raise TypeError(f"{name} must be 4 numbers (scalar first), got {value!r}")
+        raise TypeError(f"{name} must be 4 numbers ({order.replace('_', ' ')}), got {value!r}")
     return listed
 
 
-def _floats(name: str, q: Sequence[Any]) -> list[float]:
-    """A quaternion's 4 numbers (NumPy scalars, ints) as Python floats, or a ``TypeError`` (text is
-    not a number, though ``float`` reads it)."""
+def _floats(name: str, q: Sequence[Any], order: str) -> list[float]:
+    """A quaternion's 4 numbers (NumPy scalars, ints) as Python floats, or a ``TypeError`` naming the
+    fit's quaternion ``order`` (text is not a number, though ``float`` reads it)."""
     a, b, c, d = q
     if isinstance(a, _TEXT) or isinstance(b, _TEXT) or isinstance(c, _TEXT) or isinstance(d, _TEXT):
-        raise TypeError(f"{name} must be 4 numbers (scalar first), got {q!r}")
+        raise TypeError(f"{name} must be 4 numbers ({order.replace('_', ' ')}), got {q!r}")
     return [float(a), float(b), float(c), float(d)]
 
 
@@ -684,9 +685,9 @@ class SlewTimeFit:
             from the identity only (``meta.from_identity_only``).
         """
         if type(q0) is not tuple and type(q0) is not list:
-            q0 = _as_list("q0", q0)
+            q0 = _as_list("q0", q0, self.quaternion_order)
         if type(qf) is not tuple and type(qf) is not list:
-            qf = _as_list("qf", qf)
+            qf = _as_list("qf", qf, self.quaternion_order)
         try:
             if self._scalar_last:  # [x, y, z, w]
                 b, c, d, a = q0
@@ -695,8 +696,8 @@ class SlewTimeFit:
                 a, b, c, d = q0
                 e, f, g, h = qf
             if type(a) is not float or type(e) is not float:  # e.g. NumPy scalars: ~10x a float per operation
-                a, b, c, d = _floats("q0", q0)
-                e, f, g, h = _floats("qf", qf)
+                a, b, c, d = _floats("q0", q0, self.quaternion_order)
+                e, f, g, h = _floats("qf", qf, self.quaternion_order)
                 if self._scalar_last:
                     a, b, c, d = d, a, b, c
                     e, f, g, h = h, e, f, g
@@ -815,13 +816,14 @@ class SlewTimeFit:
             As :meth:`__call__`, naming the first bad quaternion.
         """
         arrays = []
+        order = self.quaternion_order.replace("_", " ")
         for name, value in (("q0", q0), ("qf", qf)):
             try:
                 array = np.atleast_2d(np.asarray(value, dtype=float))
             except (TypeError, ValueError):
-                raise TypeError(f"{name} must be quaternions of 4 numbers (scalar first), got {value!r}") from None
+                raise TypeError(f"{name} must be quaternions of 4 numbers ({order}), got {value!r}") from None
             if array.shape[-1] != 4:
-                raise TypeError(f"{name} must be quaternions of 4 numbers (scalar first), got shape {array.shape}")
+                raise TypeError(f"{name} must be quaternions of 4 numbers ({order}), got shape {array.shape}")
             arrays.append(array)
         a, b = np.broadcast_arrays(*arrays)
         given, given_f = a, b  # as the caller wrote them (messages)

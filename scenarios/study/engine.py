@@ -64,6 +64,7 @@ from scenarios.study.worker import (
     run_case,
     run_chunk,
     start_local_worker,
+    timed_out_message,
 )
 
 if TYPE_CHECKING:
@@ -425,12 +426,15 @@ class _Progress:
     a plain line, ``NAME: 12/40 cases done, 3 not ok (1 crashed), 2m10s elapsed``, at most every
     :data:`PROGRESS_LINE_S` (also while no case finishes) and once at the end, so that a long
     sweep under continuous integration or ``nohup`` can be told from a hung one. ``units``: what
-    one case and several are called (:attr:`~scenarios.study.types.Study.units`)."""
+    one case and several are called (:attr:`~scenarios.study.types.Study.units`); ``timeouts_apart``:
+    the crashed cases that ran out of ``case_timeout_s`` are said apart, ``(1 crashed, 2 timed
+    out)`` (a slew table's, whose entries then have their own status, ``timed_out``)."""
 
     def __init__(self, name: str, total: int, clock: Callable[[], float] = time.monotonic,
-                 units: tuple[str, str] = ("case", "cases")):
+                 units: tuple[str, str] = ("case", "cases"), timeouts_apart: bool = False):
         self.name, self.total, self.clock, self.units = name, total, clock, units
-        self.done = self.not_ok = self.crashed = 0
+        self.timeouts_apart = timeouts_apart
+        self.done = self.not_ok = self.crashed = self.timed_out = 0
         self.started = self.said = clock()
         self.bar: Any = None
         if sys.stderr.isatty():
@@ -443,14 +447,17 @@ class _Progress:
     def line(self) -> str:
         """What the progress line says now."""
         counts = f", {self.not_ok} not ok" if self.not_ok else ""
-        counts += f" ({self.crashed} crashed)" if self.crashed else ""
+        timed = self.timed_out if self.timeouts_apart else 0
+        kinds = [f"{count} {kind}" for count, kind in ((self.crashed - timed, "crashed"), (timed, "timed out")) if count]
+        counts += f" ({', '.join(kinds)})" if kinds else ""
         return (f"{self.name}: {self.done}/{self.total} {self.units[1]} done{counts}, "
                 f"{_duration(self.clock() - self.started)} elapsed")
 
-    def update(self, done: int, not_ok: int, crashed: int) -> None:
-        """Cases stored: ``done`` more; ``not_ok`` and ``crashed`` cases so far."""
+    def update(self, done: int, not_ok: int, crashed: int, timed_out: int = 0) -> None:
+        """Cases stored: ``done`` more; ``not_ok`` and ``crashed`` cases so far (``timed_out`` of
+        the crashed ones ran out of ``case_timeout_s``)."""
         self.done += done
-        self.not_ok, self.crashed = not_ok, crashed
+        self.not_ok, self.crashed, self.timed_out = not_ok, crashed, timed_out
         if self.bar is not None:
             self.bar.set_postfix(not_ok=not_ok, refresh=False)
             self.bar.update(done)
@@ -477,7 +484,8 @@ class _Engine:
     """The submit / collect loop; see the module docstring for the failure rules."""
 
     def __init__(self, study: Study, executor: Executor | None, workers: int, store: SweepStore | None,
-                 progress: bool, task: Callable[[dict[str, Any]], dict[str, Any]], cluster: Any = None):
+                 progress: bool, task: Callable[[dict[str, Any]], dict[str, Any]], cluster: Any = None,
+                 timeouts_apart: bool = False):
         self.study, self.store, self.task, self.cluster = study, store, task, cluster
         self.owned = executor is None
         self.workers = workers
@@ -514,9 +522,11 @@ class _Engine:
         self.elapsed: collections.deque[float] = collections.deque(maxlen=64)
         self.not_ok = 0
         self.crashed = 0
+        self.timed_out = 0  # of the crashed, those that ran out of case_timeout_s
         self.no_workers_since: float | None = None
         self.next_cluster_check = 0.0
-        self.progress = _Progress(study.name, len(self.cases), units=study.units) if progress else None
+        self.progress = (_Progress(study.name, len(self.cases), units=study.units, timeouts_apart=timeouts_apart)
+                         if progress else None)
 
     # --- submitting ---------------------------------------------------------------------------
 
@@ -575,6 +585,8 @@ class _Engine:
         batch.append((key, status, encode_rows(rows) if text is None else text, elapsed, attempts))
         self.not_ok += any(row["status"] != "ok" for row in rows)
         self.crashed += status == "crashed"
+        self.timed_out += status == "crashed" and bool(rows) and str(rows[0].get("message") or "").startswith(
+            timed_out_message(self.timeout))
 
     def _commit(self, batch: list[tuple[str, str, str, float | None, int]]) -> None:
         """Commit finished cases in one transaction, then report them (a case shown done is stored)."""
@@ -583,7 +595,7 @@ class _Engine:
         if self.store is not None:
             self.store.put_encoded(batch)
         if self.progress is not None:
-            self.progress.update(len(batch), self.not_ok, self.crashed)
+            self.progress.update(len(batch), self.not_ok, self.crashed, self.timed_out)
 
     def _crash(self, key: str, message: str, batch: list) -> None:
         self._record(key, "crashed", crashed_rows(self.cases[key].scenario, message), None, batch)
@@ -995,8 +1007,8 @@ def _check_arguments(study: Any, executor: Any, workers: Any, store: Any, progre
 
 def sweep(study: Study | dict[str, Any] | str | os.PathLike[str], executor: Executor | None = None, *,
           workers: int | None = None, store: SweepStore | None = None, progress: bool = False,
-          task: Callable[[dict[str, Any]], dict[str, Any]] = run_case, cluster: DaskCluster | None = None
-          ) -> SweepResults:
+          task: Callable[[dict[str, Any]], dict[str, Any]] = run_case, cluster: DaskCluster | None = None,
+          timeouts_apart: bool = False) -> SweepResults:
     """Run every case of a trade study.
 
     Parameters
@@ -1025,6 +1037,10 @@ def sweep(study: Study | dict[str, Any] | str | os.PathLike[str], executor: Exec
     cluster : DaskCluster or None, optional
         A Dask cluster already connected (:func:`connect_scheduler`; the command line connects
         before it writes anything); this call does not close it.
+    timeouts_apart : bool, optional
+        The progress says the crashed cases that ran out of ``case_timeout_s`` apart (``2 not ok
+        (1 crashed, 1 timed out)``), for a caller that gives them their own status (a slew
+        table's ``timed_out``); default: all ``crashed``, as their rows are.
 
     Returns
     -------
@@ -1057,7 +1073,7 @@ def sweep(study: Study | dict[str, Any] | str | os.PathLike[str], executor: Exec
             executor = cluster.executor
             workers = workers or max(cluster.workers(), 1)
         workers = workers or study.execution.workers or default_workers()
-        engine = _Engine(study, executor, workers, store, progress, task, cluster)
+        engine = _Engine(study, executor, workers, store, progress, task, cluster, timeouts_apart)
         try:
             engine.run()
         except KeyboardInterrupt:

@@ -1,0 +1,78 @@
+"""``slewbench table`` refines a table with pointing requirements.
+
+The refinement's working fits used to be made without the table's ``meta``: a fit with end cones
+(a keep-out, :func:`scenarios.slewtable.compute.end_cones`) needs ``meta.from_identity_only``, so
+every working fit was refused and the refinement stopped before its first round, "NOT reached at
+its check points (no fit over the sphere to check against)", on every table with pointing
+requirements (a 12U Sun keep-out table, 2026-12-03). Through the command, on a small keep-out
+table whose entries about ``[1, 1, 0]`` at 180 deg are proven infeasible (the camera ends on the
+keep-out's direction): a round is made, it splits triangles across the boundary of the entries
+without a time, and ``fit.json`` (strict JSON) keeps it.
+
+The round's line names the triangles split across that boundary only when there are some: a table
+whose entries all have a time used to say "(0 of them across the boundary ...)" all the same.
+
+Oracle of the infeasible entry: the half-turn about ``[1, 1, 0] / sqrt(2)`` takes the body x axis
+to the y axis, the keep-out's direction (0 deg from it, inside 20 deg).
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from scenarios.cli.commands import main
+from scenarios.slewtable.compute import _Runner
+from tests.test_slewtable import UNIT_BOX
+from tests.test_slewtable_refine import _box_time
+
+BOX = {
+    "name": "box-keep-out",
+    "spacecraft": {"inertia": [1.0, 1.0, 1.0], "wheels": None, "torquers": {"max_torque": 1.0},
+                   "sensors": {"camera": {"boresight": [1, 0, 0]}}},
+    "maneuver": {"duration": 20.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
+                 "final": {"q": [0.7071068, 0, 0, 0.7071068], "omega": [0, 0, 0]}},
+    "planners": [{"name": "collocation"}],
+    "controller": {"name": "augmented_quaternion_feedback"},
+    "requirements": {"pointing": {"cam_y": {"sensor": "camera", "keep_out": {"inertial": [0, 1, 0]},
+                                            "angle_deg": 20}}},
+}
+AXES = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1], [0.7071068, 0.7071068, 0]]
+
+
+def test_a_keep_out_table_is_refined(tmp_path: Path, capsys) -> None:
+    (tmp_path / "box.yaml").write_text(yaml.safe_dump(BOX))
+    table = tmp_path / "table.yaml"
+    table.write_text(yaml.safe_dump({"table": {
+        "scenario": "box.yaml", "axes": AXES, "angles_deg": [60, 180], "planner_options": {"multistart": 0},
+        "execution": {"workers": 2}, "refine": {"tolerance": 0.05, "max_rounds": 1}}}))
+    out = tmp_path / "out"
+    assert main(["table", str(table), "--out", str(out), "--no-plots"]) == 0
+    said = capsys.readouterr().out
+    assert "no fit over the sphere to check against" not in said, said
+    rounds = [line for line in said.splitlines() if line.startswith("refinement round ")]
+    assert len(rounds) == 1 and rounds[0].startswith("refinement round 1: "), said
+    refinement = json.loads((out / "fit.json").read_text())["meta"]["refinement"]
+    assert len(refinement["rounds"]) == 1 and refinement["axes"] > len(AXES)
+    first = refinement["rounds"][0]
+    assert first["checked"] > 0 and first["split"] > 0 and first["boundary"] > 0  # across the infeasible entry
+    assert f"({first['boundary']} of them across the boundary of the entries without a time; " in rounds[0]
+    assert "(the budget of 1 rounds)" in said
+
+
+def test_a_round_without_a_boundary_does_not_mention_it(tmp_path: Path, capsys, monkeypatch) -> None:
+    def run(self, cases):  # every entry ok: the analytic slew time (the engine's solves are the test above's)
+        return [{"rows": [{"status": "ok", "message": "", "plan_time_s": 0.5,
+                           "reference": {"duration_s": _box_time(np.asarray(case.axis), case.angle_deg)}}]}
+                for case in cases]
+
+    monkeypatch.setattr(_Runner, "__call__", run)
+    scenario = tmp_path / "box.yaml"
+    scenario.write_text(yaml.safe_dump(UNIT_BOX))
+    assert main(["table", str(scenario), "--out", str(tmp_path / "out"), "--axes", "14", "--angles", "45,180",
+                 "--tolerance", "0.004", "--max-rounds", "1", "--no-plots"]) == 0
+    rounds = [line for line in capsys.readouterr().out.splitlines() if line.startswith("refinement round ")]
+    assert len(rounds) == 1 and " triangles split (+" in rounds[0], rounds
+    assert "across the boundary" not in rounds[0]
