@@ -150,3 +150,32 @@ def test_the_torque_limit_label_says_it_does_not_bound_the_wheels_reference():
         figure = RowFigure(3 if wheels else 0, True, True, limited=(("torque", True),))
         labels = [line.get_label().replace("\n", " ") for line in figure.panels["torque"].get_lines()]
         assert ("±limit" + WHEELS_TORQUE_NOTE if wheels else "±limit") in labels
+
+
+def test_a_row_figure_names_a_conservative_box_as_such():
+    """A tester saw a pyramid's unsaturated x torque (0.0065 N m) above the dotted "±limit" line
+    (0.0039 N m): the line is the box the wheels give on all axes at once, the largest cube inside
+    the realised set, and along one axis they give more. The legend must say so; the body-axis
+    wheels' line is the whole set and keeps its "±limit"."""
+    from types import SimpleNamespace
+
+    from scenarios.output.plot_data import row_series
+
+    skewed = Spacecraft(np.diag([0.3, 0.32, 0.14]), wheels=ReactionWheels(
+        np.array([[1.0, 0.6, 0.0], [0.0, 0.8, 0.0], [0.0, 0.0, 1.0]]), max_torque=0.004, max_momentum=0.03))
+    body = Spacecraft(np.diag([0.3, 0.32, 0.14]), wheels=ReactionWheels(np.eye(3), max_torque=0.004, max_momentum=0.03))
+    # the oracle: along x the skewed wheels give more than the box's x bound (wheel 2 adds 0.6 of its torque)
+    assert skewed.torque_along([1, 0, 0]) > skewed.body_torque_limit()[0] * (1 + 1e-6)
+    assert body.torque_along([1, 0, 0]) == pytest.approx(body.body_torque_limit()[0], rel=1e-9)
+    t = np.linspace(0.0, 10.0, 11)
+    x = np.hstack([np.tile([1.0, 0, 0, 0], (11, 1)), np.zeros((11, 6))])
+    simulation = SimpleNamespace(t=t, x=x, q=x[:, 0:4], omega=x[:, 4:7], wheel_momentum=x[:, 7:],
+                                 applied_torque=np.zeros((10, 3)), applied_u=np.zeros((10, 3)))
+    row = SimpleNamespace(label="r", planner="eigenaxis", controller="c", simulation=simulation, reference=None)
+    labels = {}
+    for name, spacecraft in (("skewed", skewed), ("body", body)):
+        shape = row_series(row, quat.IDENTITY, spacecraft).shape
+        figure = RowFigure(*shape)
+        labels[name] = " ".join(line.get_label().replace("\n", " ") for line in figure.panels["torque"].get_lines())
+    assert "conservative" in labels["skewed"] and "±box on all axes at once" in labels["skewed"], labels
+    assert "conservative" not in labels["body"] and "±limit" in labels["body"], labels

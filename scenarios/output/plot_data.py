@@ -342,6 +342,10 @@ class RowSeries:
     euler: list[Curve] = field(default_factory=list)
     euler_sequence: str = EULER_SEQUENCE
     knowledge: Curve | None = None
+    torque_box_exact: bool = True
+    """Whether the body-torque limit (``limits["torque"]``) is the whole set the actuators give
+    (``Spacecraft.torque_box_is_exact``); else a conservative box inside it (a skewed wheel array:
+    along one body axis the wheels give more), which the legend says."""
 
     @property
     def shape(self) -> RowShape:
@@ -349,9 +353,11 @@ class RowSeries:
         panel, limit styles, Euler sequence, knowledge error)``, the arguments of
         :class:`scenarios.output.plots.RowFigure`: rows of one shape share a figure. A limit style
         is ``(panel, common)``: ``common`` when every limit of the panel is the same (one black pair
-        of lines), else one pair per curve."""
-        styles = tuple((panel, _common(values)) for panel, values in self.limits.items()
-                       if np.any(np.isfinite(values)))
+        of lines), else one pair per curve; the torque panel's is ``(panel, common, False)`` where
+        its limit is a conservative box (:attr:`torque_box_exact`)."""
+        styles = tuple((panel, _common(values)) if panel != "torque" or self.torque_box_exact
+                       else (panel, _common(values), False)
+                       for panel, values in self.limits.items() if np.any(np.isfinite(values)))
         return (self.n_wheels, self.with_reference, self.with_target, tuple(self.failed), tuple(self.wheel_axis),
                 bool(self.wheel_speed), bool(self.dipole), styles, self.euler_sequence, self.knowledge is not None)
 
@@ -476,6 +482,7 @@ def row_series(row: Any, target_q: Any, spacecraft: Any, euler_sequence: str = E
         # for a skewed wheel array (Spacecraft.torque_box_is_exact); magnetorquers' torque depends on the field.
         # It bounds the solid applied torque; with wheels not the dashed reference (torque_limit_label).
         series.limits["torque"] = _limits(spacecraft.body_torque_limit())
+        series.torque_box_exact = spacecraft.torque_box_is_exact()
     if wheels is not None:
         series.failed, series.wheel_axis = tuple(wheels.failed), wheel_axes(wheels.axes)
         series.wheel_torque = held_curves(sim.applied_u[:, slices["wheels"]])

@@ -292,8 +292,10 @@ class RowFigure:
         A wheel speed panel.
     dipole : bool, optional
         A magnetorquer dipole panel.
-    limited : tuple of (str, bool), optional
-        Panels with limit lines and whether their limits are common (:attr:`RowSeries.shape`).
+    limited : tuple of (str, bool) or (str, bool, bool), optional
+        Panels with limit lines and whether their limits are common, and for the torque panel
+        optionally whether its limit is the whole realised set (``False``: a conservative box,
+        said in the legend) (:attr:`RowSeries.shape`).
     euler_sequence : str, optional
         The Euler angles' sequence (:func:`euler_names`); default
         :data:`scenarios.output.plot_data.EULER_SEQUENCE`.
@@ -304,7 +306,7 @@ class RowFigure:
 
     def __init__(self, n_wheels: int, with_reference: bool, with_target: bool, failed: tuple[int, ...] = (),
                  wheel_axis: tuple[int, ...] = (), wheel_speed: bool = False, dipole: bool = False,
-                 limited: tuple[tuple[str, bool], ...] = (), euler_sequence: str = EULER_SEQUENCE,
+                 limited: tuple[tuple[Any, ...], ...] = (), euler_sequence: str = EULER_SEQUENCE,
                  knowledge: bool = False):
         self.shape: RowShape = (n_wheels, with_reference, with_target, tuple(failed), tuple(wheel_axis),
                                 wheel_speed, dipole, tuple(limited), euler_sequence, knowledge)
@@ -364,7 +366,7 @@ class RowFigure:
         """(panel, curve index or None for a common limit, sign, line)."""
         self.off_scale: dict[str, Any] = {}
         """Per limited panel, the note shown when its limits lie beyond the view (:data:`LIMIT_VIEW_FACTOR`)."""
-        for name, common in limited:
+        for name, common, *exact in limited:
             if name not in panel:
                 continue
             count = {"torque": 3, "dipole": 3}.get(name, n_wheels)
@@ -373,6 +375,8 @@ class RowFigure:
                 color = "k" if index is None else (axis_colors if name in ("torque", "dipole") else colors)[index]
                 for sign in (1.0, -1.0):
                     label = ("±limit" if common else "±limit (per curve)") if sign > 0 and index in (None, 0) else None
+                    if label and name == "torque" and exact and not exact[0]:  # a skewed wheel array's box
+                        label = "±box on all axes at once (conservative: one axis alone gets more)"
                     if label and name == "torque":
                         label = textwrap.fill(torque_limit_label(label, n_wheels > 0), ROW_LEGEND_CHARS)
                     self.limit_lines.append((name, index, sign, line(panel[name], linestyle=":", color=color,
