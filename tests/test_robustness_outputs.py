@@ -336,3 +336,17 @@ def test_the_sweep_prints_each_criterion_and_the_worst_cases(swept):
     worst_cases = pd.read_csv(out / "worst_cases.csv")
     mine = worst_cases[(worst_cases["label"] == "smooth") & (worst_cases["metric"] == "cl.int_u")]["case"]
     assert f"  smooth: worst cl.int_u: case {', '.join(map(str, mine))}" in lines
+
+
+def test_the_sensitivity_map_shows_whole_paths_broken_after_dots():
+    """A tester found the parameter names cut (``…raft.inertia.principal_moments_scale[0]``); two
+    drawn quantities that differ early in their path could not be told apart. The oracle: the
+    lines joined are the path, and each break follows a dot."""
+    from scenarios.study.plots import PATH_LINE_CHARS, _path_lines
+
+    for path in ("truth.spacecraft.inertia.principal_moments_scale[0]", "truth.wheels.friction.coulomb",
+                 "maneuver.duration", "a_key_longer_than_the_line_with_no_dot_at_all_anywhere"):
+        lines = _path_lines(path).split("\n")
+        assert "".join(lines) == path
+        assert all(line.endswith(".") for line in lines[:-1])
+        assert all(len(line) <= PATH_LINE_CHARS or "." not in line[:-1] for line in lines), lines

@@ -63,6 +63,9 @@ MAX_GROUPS = 12
 pooled over the grid points (and the title says so)."""
 MAX_ANNOTATED_CELLS = 64
 """Heat map panels with at most this many cells print each cell's value."""
+PATH_LINE_CHARS = 28
+"""About the longest line of a drawn quantity's YAML path under the sensitivity map (broken after
+its dots, never cut)."""
 FAILED_MARK: dict[str, Any] = {"marker": "x", "linestyle": "none", "markersize": 7, "markeredgewidth": 1.6}
 """How a grid point or case with a failed row is marked (at the bottom of the panel, in the planner's colour)."""
 NEVER_MARK: dict[str, Any] = {"marker": "^", "linestyle": "none", "markersize": 8, "markeredgewidth": 1.2}
@@ -586,6 +589,19 @@ def _box(values: np.ndarray) -> dict[str, Any]:
     return box
 
 
+def _path_lines(path: str, width: int = PATH_LINE_CHARS) -> str:
+    """A YAML path on lines of at most about ``width`` characters, broken after its dots: whole, so
+    that two drawn quantities that differ early in their path stay told apart (a tester read
+    ``…raft.inertia.principal_moments_scale[0]`` for ``truth.spacecraft.inertia....``)."""
+    lines: list[str] = []
+    for part in re.split(r"(?<=\.)", path):
+        if lines and len(lines[-1]) + len(part) <= width:
+            lines[-1] += part
+        else:
+            lines.append(part)
+    return "\n".join(lines)
+
+
 def _sensitivity(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figure]]:
     """The rank correlations of ``sensitivity.csv`` as one heat map per group (at most
     :data:`MAX_GROUPS`): summary metrics down, the drawn quantities
@@ -613,7 +629,7 @@ def _sensitivity(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str
             for (i, j), value in np.ndenumerate(matrix):
                 axis.text(j, i, "–" if math.isnan(value) else f"{value:.2f}", ha="center", va="center", fontsize=7,
                           color="white" if abs(value) > 0.6 else "black")  # NaN > 0.6 is False: black
-        axis.set_xticks(range(len(parameters)), [q if len(q) <= 40 else f"…{q[-39:]}" for q in parameters], rotation=30,
+        axis.set_xticks(range(len(parameters)), [_path_lines(q) for q in parameters], rotation=30,
                         ha="right", fontsize=7)
         axis.set_yticks(range(len(metrics)), metrics, fontsize=7)
         axis.set_title(name, fontsize=9)
