@@ -1225,6 +1225,17 @@ MUTATIONS: list[Mutation] = [
     Mutation("compiled-cc-ignored-when-cc-exists", "ocp/simulation/compiled.py",
              'for candidate in (os.environ.get("CC"), "cc", "gcc"):', 'for candidate in ("cc", "gcc", os.environ.get("CC")):',
              ("tests/test_mutants_compiled.py", "tests/test_closed_loop.py", "tests/test_closed_loop_cache.py")),
+    # --- a tester's findings (stop 50) ---
+    Mutation("terminal-marks-the-met-requirement", "scenarios/output/tables.py",
+             'return cell + _BROKEN if values and values.get("met") is False else cell',
+             'return cell + _BROKEN if values and values.get("met") is True else cell',
+             ("tests/test_requirements_runs.py::test_the_terminal_marks_a_requirement_broken_by_a_field_its_headline_does_not_show",)),
+    Mutation("plausibility-coplanar-wheels-pass-as-spanning", "scenarios/schema/plausibility.py",
+             "    if rank == 3:\n        return", "    if rank >= 2:\n        return",
+             ("tests/test_plausibility.py::test_wheels_that_span_only_a_plane_warn_naming_the_missing_direction",)),
+    Mutation("row-plot-conservative-box-unsaid", "scenarios/output/plot_data.py",
+             "series.torque_box_exact = spacecraft.torque_box_is_exact()", "series.torque_box_exact = True",
+             ("tests/test_torque_box.py::test_a_row_figure_names_a_conservative_box_as_such",)),
     # --- the estimated discretisation error of a bang-bang minimum time and the default refinement ---
     Mutation("time-error-auto-refines-at-ten-times-the-tolerance", "planners/collocation/planner.py",
              'abs(estimate.get("estimate_s", 0.0)) <= o.mesh_tolerance', 'abs(estimate.get("estimate_s", 0.0)) <= 10 * o.mesh_tolerance',
