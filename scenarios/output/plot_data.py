@@ -318,6 +318,10 @@ class RowSeries:
     knowledge : Curve, optional
         The knowledge error [deg]: the angle of the attitude the controller was given from the
         true one (:func:`knowledge_series`), with a star tracker in the loop.
+    torque_box_exact : bool, optional
+        Whether the body-torque limit (``limits["torque"]``) is the whole set the actuators give
+        (``Spacecraft.torque_box_is_exact``; default ``True``); else a conservative box inside it
+        (a skewed wheel array: along one body axis the wheels give more), which the legend says.
     """
 
     n_wheels: int
@@ -343,9 +347,6 @@ class RowSeries:
     euler_sequence: str = EULER_SEQUENCE
     knowledge: Curve | None = None
     torque_box_exact: bool = True
-    """Whether the body-torque limit (``limits["torque"]``) is the whole set the actuators give
-    (``Spacecraft.torque_box_is_exact``); else a conservative box inside it (a skewed wheel array:
-    along one body axis the wheels give more), which the legend says."""
 
     @property
     def shape(self) -> RowShape:
