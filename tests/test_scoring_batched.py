@@ -21,6 +21,7 @@ from controllers import CONTROLLERS
 from controllers.allocation import _CHUNK, model_rows, reference_demand
 from ocp import AttitudeModel, CircularOrbit, Environment, ReactionWheels, Spacecraft
 from scenarios.requirements import scoring
+from tests.test_requirements_free_start_wheels import SPHERE as FREE_START_SPHERE
 
 INERTIA = np.array([[0.25, 0.01, -0.02], [0.01, 0.28, 0.015], [-0.02, 0.015, 0.12]])
 ORBIT = CircularOrbit(altitude=550e3, inclination=np.deg2rad(97.6))
@@ -79,23 +80,8 @@ def test_model_rows_one_call_after_another_is_each_samples_own_call():
             np.testing.assert_array_equal(rows[k], one, err_msg=f"{n} samples, sample {k}")
 
 
-SPHERE = """
-name: free-start-wheels
-spacecraft:
-  inertia: [10.0, 10.0, 10.0]
-  wheels: {axes: [[1, 0, 0], [0, 1, 0], [0, 0, 1]], failed: [0], max_torque: 0.1, max_momentum: MOMENTUM}
-  torquers: {max_torque: 0.005}
-maneuver:
-  duration: 200.0
-  initial: {q: [1, 0, 0, 0], omega: [0.05, 0, 0]}
-  final: {q: [0.7071068, 0, 0, 0.7071068], omega: [0, 0, 0]}
-planners:
-  - {name: eigenaxis, label: smooth, options: {profile: smooth}}
-controller: {name: augmented_quaternion_feedback, options: {kp: 0.5, kd: 3.0}}
-simulation: {sample_time: 0.5, duration: 260.0}
-requirements:
-  actuators: {margin: 0.0}
-"""
+# the free-start sphere of test_requirements_free_start_wheels at 0.05 rad/s, its actuators required
+SPHERE = FREE_START_SPHERE.replace("SPIN", "0.05") + "requirements:\n  actuators: {margin: 0.0}\n"
 
 
 @pytest.mark.parametrize("momentum, demands, named", [(1.0, 1, False), (0.2, 2, True)])

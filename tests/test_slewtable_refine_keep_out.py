@@ -26,19 +26,10 @@ import yaml
 from scenarios.cli.commands import main
 from scenarios.slewtable.compute import _Runner
 from tests.test_slewtable import UNIT_BOX
+from tests.test_slewtable_gaps import KEEP_OUT
 from tests.test_slewtable_refine import _box_time
 
-BOX = {
-    "name": "box-keep-out",
-    "spacecraft": {"inertia": [1.0, 1.0, 1.0], "wheels": None, "torquers": {"max_torque": 1.0},
-                   "sensors": {"camera": {"boresight": [1, 0, 0]}}},
-    "maneuver": {"duration": 20.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
-                 "final": {"q": [0.7071068, 0, 0, 0.7071068], "omega": [0, 0, 0]}},
-    "planners": [{"name": "collocation"}],
-    "controller": {"name": "augmented_quaternion_feedback"},
-    "requirements": {"pointing": {"cam_y": {"sensor": "camera", "keep_out": {"inertial": [0, 1, 0]},
-                                            "angle_deg": 20}}},
-}
+BOX = KEEP_OUT  # the keep-out box of the table report's end-to-end test
 AXES = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1], [0.7071068, 0.7071068, 0]]
 
 
