@@ -667,3 +667,108 @@ def cone_avoiding_sampler(sample: Callable[[Array], tuple[Array, Array, Array]],
         return x, u, torque
 
     return bent
+
+
+BANG_BANG_SUBSTEPS = 4
+"""RK4 steps between consecutive Radau points of :func:`bang_bang_solution`: on 50 intervals its
+final state is within 1.1e-11 (Bilimoria & Wie 180°), 6.8e-12 (full inertia) and 6.4e-11 (XTE) of
+DOP853's at 1e-13 with the same switch times (2 steps: 1.7e-10, 1.1e-10, 1e-9), in under a
+millisecond."""
+
+
+def switch_mesh(switch_times: Array, duration: float, intervals: int) -> Array:
+    """A mesh with a node at every switch of a bang-bang control.
+
+    Parameters
+    ----------
+    switch_times : (m,) ndarray
+        The switch times [s], sorted, inside ``(0, duration)`` (coinciding ones are one node).
+    duration : float
+        T [s].
+    intervals : int
+        Mesh intervals in all (at least one per arc: more where there are more arcs).
+
+    Returns
+    -------
+    (N + 1,) ndarray
+        The nodes as fractions of T, increasing from 0 to 1: each arc divided into equal intervals,
+        their numbers as near the arc's share of ``intervals`` as whole numbers allow (largest
+        remainders).
+    """
+    edges = np.concatenate([[0.0], np.asarray(switch_times, dtype=float) / duration, [1.0]])
+    edges = edges[np.concatenate([[True], np.diff(edges) > 1e-12])]  # coinciding switches: one node
+    edges[-1] = 1.0
+    lengths = np.diff(edges)
+    share = lengths * max(int(intervals), lengths.size)
+    counts = np.maximum(np.floor(share).astype(int), 1)
+    for k in np.argsort(counts - share)[:max(max(int(intervals), lengths.size) - int(counts.sum()), 0)]:
+        counts[k] += 1  # the largest remainders
+    nodes = [edges[0]] + [a + (b - a) * np.arange(1, n + 1) / n for a, b, n in zip(edges[:-1], edges[1:], counts)]
+    mesh = np.concatenate([np.atleast_1d(n) for n in nodes])
+    mesh[-1] = 1.0
+    return mesh
+
+
+def _radau_steps(model: AttitudeModel, tau: Array) -> ca.Function:
+    """``(x0, u, h, d) -> (x(h), [x(τ_0 h) … x(τ_d h)])``: the state of ``x0`` under the constant
+    control ``u`` over one interval of length ``h`` [s], read at its Radau points (RK4,
+    :data:`BANG_BANG_SUBSTEPS` steps between consecutive points; disturbance ``d`` [N m]; the time
+    rides along as the last state)."""
+    xt, u, h, d = ca.SX.sym("xt", model.nx + 1), ca.SX.sym("u", model.nu), ca.SX.sym("h"), ca.SX.sym("d", 3)
+    state, columns = xt, [xt[:-1]]
+    for a, b in zip(tau[:-1], tau[1:]):
+        step = (b - a) * h / BANG_BANG_SUBSTEPS
+        for _ in range(BANG_BANG_SUBSTEPS):
+            x, t = state[:-1], state[-1]
+            k1 = model.rhs(x, u, t, d)
+            k2 = model.rhs(x + step / 2 * k1, u, t + step / 2, d)
+            k3 = model.rhs(x + step / 2 * k2, u, t + step / 2, d)
+            k4 = model.rhs(x + step * k3, u, t + step, d)
+            state = ca.vertcat(x + step / 6 * (k1 + 2 * k2 + 2 * k3 + k4), t + step)
+        columns.append(state[:-1])
+    return ca.Function("radau_steps", [xt, u, h, d], [state, ca.horzcat(*columns)])
+
+
+def bang_bang_solution(model: AttitudeModel, transcription: Transcription, x0: Array, switch_times: Array,
+                       arc_controls: Array, duration: float, disturbance: Array) -> tuple[Array, Array]:
+    """The states and controls of a bang-bang control at a transcription's points, the states
+    integrated (not collocated): a :class:`CollocationReference` of the exact trajectory.
+
+    Parameters
+    ----------
+    model : AttitudeModel
+        The spacecraft model (no actuator states).
+    transcription : Transcription
+        Radau collocation (``tau``, ``degree``) on a mesh with a node at every switch
+        (:func:`switch_mesh`).
+    x0 : (nx,) ndarray
+        The initial state.
+    switch_times : (m,) ndarray
+        The switch times [s], sorted.
+    arc_controls : (m + 1, nu) ndarray
+        The control on each arc.
+    duration : float
+        T [s].
+    disturbance : (3,) ndarray
+        The disturbance torque [N m].
+
+    Returns
+    -------
+    states : (nx, N (d + 1)) ndarray
+        ``[x_k0, x_k1 … x_kd]`` per interval (``unpack``'s layout), from RK4 with
+        :data:`BANG_BANG_SUBSTEPS` steps between consecutive points.
+    controls : (nu d, N) ndarray
+        Each interval's arc control at its ``d`` Radau points.
+    """
+    tau = np.asarray(getattr(transcription, "tau"), dtype=float)
+    N, d = transcription.intervals, tau.size - 1
+    nodes = transcription.nodes * duration
+    middles = 0.5 * (nodes[:-1] + nodes[1:])
+    arc = np.searchsorted(np.asarray(switch_times, dtype=float), middles)  # every switch is a node
+    u = np.asarray(arc_controls, dtype=float)[arc].T  # (nu, N)
+    # kept with the model's maps (_mapped), one per degree and number of intervals
+    maps = model.solver_cache.get(("collocation", "maps"), lambda: RecentCache(MAPS_KEPT))
+    accumulate = maps.get((f"bang-bang radau steps {d} {BANG_BANG_SUBSTEPS}", N),
+                          lambda: _radau_steps(model, tau).mapaccum("accumulate", N, [0], [0]))
+    _, points = accumulate(np.append(x0, 0.0), u, np.diff(nodes)[None, :], np.tile(disturbance[:, None], N))
+    return np.asarray(points), np.tile(u, (d, 1))
