@@ -401,6 +401,8 @@ def summary_line(record: dict[str, Any]) -> str:
         necessary conditions)[, gap to the direct solution ..]"`` for an indirect one.
     """
     verdict, gap = record["verdict"], record.get("costate_gap")
+    if record.get("pontryagin") is not None:  # an exact bang-bang trajectory (switch-time shooting)
+        return f"{verdict}: {record['method']}, " + ", ".join(_bang_bang_parts(record))
     if record.get("method") is not None:  # an indirect solution
         return (f"{verdict}: {record['method']} residual {record['kkt_scaled']:.1g} (Pontryagin's necessary "
                 f"conditions)" + ("" if gap is None else f", gap to the direct solution {gap:.1g}"))
@@ -416,6 +418,31 @@ def summary_line(record: dict[str, Any]) -> str:
         agreed = record.get("seeds_agreed")
         parts.append(f"{agreed if agreed is not None else '?'}/{record['seeds']} seeds")
     return f"{verdict}: " + ", ".join(parts)
+
+
+def _bang_bang_parts(record: dict[str, Any]) -> list[str]:
+    """The summary's parts of a bang-bang trajectory's record (its ``pontryagin`` checks, see
+    :func:`planners.collocation.certificate.bang_bang_certificate`)."""
+    checks = record["pontryagin"]
+    parts = [f"Pontryagin H {checks['hamiltonian']:.1g}", f"switching {100.0 * checks['switching']:.0f}%"]
+    if checks["wrong"] > 0:
+        parts.append(f"{100.0 * checks['wrong']:.0f}% on the wrong side")
+    parts += [f"{name} {checks[name]:.1g}" for name in ("miss", "stationarity") if checks[name] > 1e-8]
+    switches = checks["switches"]
+    why = ("a control inside its bounds" if not checks["bang_bang"] else "coinciding switches"
+           if not checks["simple_switches"] else f"strictness margin {checks['strictness']:.1g}")
+    parts.append(f"{switches} simple switches" if checks["strict"] else
+                 f"{switches} switches, not strictly bang-bang ({why})")
+    if "condition" in checks:
+        parts.append(f"induced SOSC (cond {checks['condition']:.0e})" if checks["second_order"] else
+                     f"induced problem singular (cond {checks['condition']:.0e})")
+    else:
+        parts.append(f"induced {'SOSC' if checks['second_order'] else 'SOSC fails'} "
+                     f"(least eigenvalue {checks['curvature']:.1g})")
+    if record.get("seeds") is not None:
+        agreed = record.get("seeds_agreed")
+        parts.append(f"{agreed if agreed is not None else '?'}/{record['seeds']} seeds")
+    return parts
 
 
 def with_costate_gap(record: dict[str, Any], gap: float) -> dict[str, Any]:

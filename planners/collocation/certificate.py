@@ -29,6 +29,7 @@ mesh resolved: no estimate.
 """
 from __future__ import annotations
 
+from dataclasses import asdict
 from typing import Any
 
 import casadi as ca
@@ -42,6 +43,7 @@ from ocp.nlp.certificate import (
     certificate,
     certify,
     seed_counts,
+    summary_line,
     switching_agreement,
 )
 from ocp.nlp.solve import NLPResult
@@ -532,3 +534,254 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
                     ties[pair] = 0.0
                     z[k] = z[k + 1] = 0.5 * (z[k] + z[k + 1])
     return {"skipped": f"the shooting does not converge ({len(z) - 1} switches; miss {miss:.1e})"}
+
+
+BANG_BANG_MISS = 1e-8
+"""Largest final attitude (quaternion vector part) and rate [rad/s] miss of a trajectory
+:func:`bang_bang_certificate` accepts as feasible: the shooting converges to below 1e-10
+(:data:`SHOOTING_TOLERANCE`), a switch time moved by 1e-6 s misses by about 1e-6."""
+BANG_BANG_STATIONARITY = 1e-5
+"""Largest residual ``‖e_T + Jᵀ ν‖∞`` of the multipliers of :func:`bang_bang_certificate` (with
+more switches than final conditions, the least-squares ``ν``): the measure of
+:data:`BANG_BANG_HAMILTONIAN` (its ``T`` row is ``H(T)``). About 1e-15 at the converged shootings;
+a tie of two switches (Bilimoria & Wie 45°) leaves its order constraint's multiplier there
+(3e-8), and a switch moved by 1e-3 s leaves 1e-3."""
+BANG_BANG_HAMILTONIAN = 1e-5
+"""Largest ``|H(t)| = |1 + pᵀ f|`` along the trajectory (``H`` is already relative: the cost's
+multiplier is 1). With the discrete co-state of the RK4 shooting it is 1e-7 on Bilimoria & Wie
+and 1e-6 on the full inertia and XTE: the RK4 steps' error (:data:`SHOOTING_STEPS`), ten times
+below."""
+BANG_BANG_ZERO = 1e-5
+"""Largest ``|σ_i|`` at a switch of control ``i``, relative to ``max|σ_i|`` over the slew: 3e-7 on
+Bilimoria & Wie, 2e-6 on the full inertia and XTE (the RK4 steps' error: the stationarity in the
+switch time is exact for the steps, see the docstring)."""
+BANG_BANG_SIGN = 1e-3
+"""``|σ_i|`` at most this times ``max|σ_i|`` counts as zero in the sign agreement
+(:func:`~ocp.nlp.certificate.switching_agreement`'s relative tolerance): samples beside a switch."""
+BANG_BANG_STRICT = 1e-2
+"""Least strictness margin of a strictly bang-bang control: ``|σ_i(t)| / max|σ_i|`` divided by
+``min(1, d(t) / T)`` (``d`` the distance to the nearest switch of control ``i``), over the
+samples and, at the switches, ``|σ̇_i| T / max|σ_i|``. A simple zero and a clear sign elsewhere
+give order 1 (0.3 to 3 on Bilimoria & Wie, the full inertia and XTE); a touch of zero between two
+switches or a singular control (the eigenaxis slew's zero torques) gives 0."""
+BANG_BANG_CONDITION = 1e8
+"""Largest condition number of the shooting's Jacobian ``∂r/∂z`` (as many switch times and ``T``
+as conditions or fewer) at which the feasible switch times are an isolated point: 1e1 to 1e3 on
+Bilimoria & Wie, the full inertia and XTE."""
+BANG_BANG_CURVATURE = 1e-6
+"""Least eigenvalue, times ``T``, of the reduced Hessian of ``T + νᵀ r`` on the null space of
+``∂r/∂z`` (more switch times than conditions) that counts as positive definite."""
+BANG_BANG_SAMPLES = 4
+"""Samples of the switching functions inside each RK4 step (cubic Hermite from the steps' ``σ``
+and ``σ̇``), besides the steps' ends."""
+
+
+def _final_miss(model: AttitudeModel, fixed_rate: bool) -> tuple[ca.SX, ca.SX, ca.SX]:
+    """``(x, xf, r)``: the final conditions of :func:`_shooting` as an expression of the final
+    state (the vector part of ``conj(q_f) ⊗ q`` and, with ``fixed_rate``, ``ω − ω_f``)."""
+    x, xf = ca.SX.sym("x", model.nx), ca.SX.sym("xf", model.nx)
+    q, qf = x[:4], xf[:4]
+    vector = qf[0] * q[1:4] - q[0] * qf[1:4] - ca.cross(qf[1:4], q[1:4])
+    return x, xf, ca.vertcat(vector, x[4:7] - xf[4:7]) if fixed_rate else vector
+
+
+def _costate_shooting(model: AttitudeModel, arcs: int, fixed_rate: bool) -> ca.Function:
+    """``(x0, z, U, d, xf, E) -> (r, ∂r/∂z, ∂vec(∂r/∂z)/∂z, X, G)``: the shooting of :func:`_shooting`
+    (the same RK4 steps) with its states ``X (nx, N + 1)`` at the steps' ends (``N`` = ``arcs``
+    :data:`SHOOTING_STEPS`) and ``G = ∂r/∂[x_0, …, x_N] (m, nx (N + 1))``, the sensitivity of
+    the final miss to a jump ``E`` (zero) of the state after each step: ``νᵀ G`` is the discrete
+    co-state (the adjoint of the RK4 steps) of the multipliers ``ν``."""
+    nx = model.nx
+    xt, u, h, d, e = (ca.SX.sym("xt", nx + 1), ca.SX.sym("u", model.nu), ca.SX.sym("h"), ca.SX.sym("d", 3),
+                      ca.SX.sym("e", nx))
+    x, t = xt[:-1], xt[-1]
+    k1 = model.rhs(x, u, t, d)
+    k2 = model.rhs(x + h / 2 * k1, u, t + h / 2, d)
+    k3 = model.rhs(x + h / 2 * k2, u, t + h / 2, d)
+    k4 = model.rhs(x + h * k3, u, t + h, d)
+    step = ca.Function("rk4", [xt, u, h, d, e], [ca.vertcat(x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4) + e, t + h)])
+    arc = step.mapaccum(SHOOTING_STEPS)
+    S = SHOOTING_STEPS
+    x0, z, U = ca.MX.sym("x0", nx), ca.MX.sym("z", arcs), ca.MX.sym("U", model.nu, arcs)
+    disturbance, xf, E = ca.MX.sym("d", 3), ca.MX.sym("xf", nx), ca.MX.sym("E", nx, arcs * S)
+    state, start, columns = ca.vertcat(x0, 0), ca.MX(0), []
+    for k in range(arcs):
+        steps = arc(state, ca.repmat(U[:, k], 1, S), ca.repmat((z[k] - start) / S, 1, S), ca.repmat(disturbance, 1, S),
+                    E[:, k * S:(k + 1) * S])
+        columns.append(steps)
+        state, start = steps[:, -1], z[k]
+    xs, xfs, miss = _final_miss(model, fixed_rate)
+    r = ca.Function("miss", [xs, xfs], [miss])(state[:nx], xf)
+    J = ca.jacobian(r, z)
+    curvature = ca.jacobian(ca.vec(J), z) if arcs > r.numel() else ca.MX(0, 1)
+    X = ca.horzcat(x0, *[c[:nx, :] for c in columns])
+    G = ca.jacobian(r, ca.vertcat(x0, ca.vec(E)))
+    return ca.Function("costate_shooting", [x0, z, U, disturbance, xf, E], [r, J, curvature, X, G])
+
+
+def _node_conditions(model: AttitudeModel) -> ca.Function:
+    """``(x, p, u, d) -> (H − 1, σ, σ̇)`` at one point: ``pᵀ f``, ``σ = (∂f/∂u)ᵀ p`` and its time
+    derivative along ``ẋ = f``, ``ṗ = −(∂f/∂x)ᵀ p``."""
+    x, p, u, d = ca.SX.sym("x", model.nx), ca.SX.sym("p", model.nx), ca.SX.sym("u", model.nu), ca.SX.sym("d", 3)
+    f = model.rhs(x, u, 0, d)
+    sigma = ca.mtimes(ca.jacobian(f, u).T, p)
+    pdot = -ca.mtimes(ca.jacobian(f, x).T, p)
+    sigma_dot = ca.jtimes(sigma, ca.vertcat(x, p), ca.vertcat(f, pdot))
+    return ca.Function("node_conditions", [x, p, u, d], [ca.dot(p, f), sigma, sigma_dot])
+
+
+def _strictness(t: Array, sigma: Array, switches: list[Array], T: float) -> Array:
+    """Per control, the least strictness margin (:data:`BANG_BANG_STRICT`) over the samples ``t``
+    (away from its switches ``switches[i]``) of ``σ (points, controls)``, normalised by ``max|σ_i|``."""
+    margins = np.full(sigma.shape[1], np.inf)
+    for i, times in enumerate(switches):
+        distance = (np.min(np.abs(t[:, None] - times[None, :]), axis=1) if times.size else np.full(t.shape, np.inf))
+        away = distance > 1e-9 * T
+        scale = float(np.max(np.abs(sigma[:, i]), initial=0.0))
+        if scale == 0.0:
+            margins[i] = 0.0
+            continue
+        margins[i] = float(np.min(np.abs(sigma[away, i]) / scale / np.minimum(1.0, distance[away] / T), initial=np.inf))
+    return margins
+
+
+def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbance: Array, switch_times: Array,
+                          controls: Array, T: float, low: Array, high: Array, fixed_rate: bool, *,
+                          seeds: int | None = None, seeds_agreed: int | None = None) -> dict[str, Any]:
+    """The certificate of a bang-bang minimum-time trajectory found by switch-time shooting:
+    Pontryagin's minimum principle along its co-state and the second order of the problem in its
+    switch times (see the module docstring).
+
+    Parameters
+    ----------
+    model : AttitudeModel
+        A rigid body (``nx`` 7: quaternion scalar first, body rate [rad/s]).
+    x0 : (7,) ndarray
+        The initial state.
+    xf : (7,) ndarray
+        The final attitude and rate ``[q_f, ω_f]`` (the rate only with ``fixed_rate``).
+    disturbance : (3,) ndarray
+        Constant disturbance torque [N m], body frame.
+    switch_times : (arcs − 1,) ndarray
+        The switch times [s], in order.
+    controls : (arcs, nu) ndarray
+        The control on each arc.
+    T : float
+        The final time [s].
+    low, high : (nu,) ndarray
+        The controls' bounds.
+    fixed_rate : bool
+        The final rate is fixed (6 final conditions) or free (3).
+    seeds, seeds_agreed : int or None
+        Starts tried and agreeing (shown in the summary).
+
+    Returns
+    -------
+    dict
+        The keys of :func:`ocp.nlp.certificate.certificate` (``kkt_scaled`` and ``kkt_unscaled``
+        the largest first-order residual: final miss, stationarity in ``z``, ``|H|``), ``method``
+        ``"switch-time shooting"`` and ``pontryagin``, the checks: ``miss``, ``stationarity``,
+        ``hamiltonian`` (max ``|H|``), ``switching`` (agreement), ``wrong`` (fraction of samples on
+        the wrong side), ``zero_at_switches`` (max ``|σ_i| / max|σ_i|`` at them), ``strictness``
+        (least margin), ``bang_bang`` (all controls at a bound), ``simple_switches`` (one control
+        per switch), ``switches``, ``condition`` (of ``∂r/∂z``, as many unknowns as conditions or
+        fewer) or ``curvature`` (least reduced-Hessian eigenvalue times ``T``, more), ``first_order``,
+        ``strict``, ``second_order`` (bools).
+    """
+    x0, xf = np.asarray(x0, dtype=float).ravel(), np.asarray(xf, dtype=float).ravel()
+    disturbance = np.asarray(disturbance, dtype=float).ravel()
+    U = np.atleast_2d(np.asarray(controls, dtype=float)).T  # (nu, arcs)
+    low, high = np.asarray(low, dtype=float).ravel(), np.asarray(high, dtype=float).ravel()
+    nx, nu, arcs, S = model.nx, model.nu, U.shape[1], SHOOTING_STEPS
+    z = np.append(np.asarray(switch_times, dtype=float).ravel(), float(T))
+    conditions = 6 if fixed_rate else 3
+    function = model.solver_cache.get(("bang-bang certificate", arcs, fixed_rate, S),
+                                      lambda: _costate_shooting(model, arcs, fixed_rate))
+    r, J, curvature, X, G = (np.asarray(m) for m in function(x0, z, U, disturbance, xf, np.zeros((nx, arcs * S))))
+    r = r.ravel()
+    # the multipliers: e_T + Jᵀ ν = 0 (solved, or in the least-squares sense)
+    gradient = np.zeros(arcs)
+    gradient[-1] = 1.0
+    nu_ = np.linalg.lstsq(J.T, -gradient, rcond=None)[0]
+    stationarity = float(np.max(np.abs(gradient + J.T @ nu_)))
+    singular_values = np.linalg.svd(J, compute_uv=False)
+    checks: dict[str, Any] = {"miss": float(np.max(np.abs(r))), "stationarity": stationarity}
+    if arcs <= conditions:
+        condition = float(singular_values[0] / singular_values[-1]) if singular_values[-1] > 0 else np.inf
+        checks["condition"] = condition
+        second = bool(condition <= BANG_BANG_CONDITION)
+    else:  # the reduced Hessian of T + νᵀ r on the null space of J
+        _, _, vt = np.linalg.svd(J)
+        Z = vt[conditions:].T
+        hessian = np.einsum("i,ijk->jk", nu_, curvature.reshape(arcs, conditions, arcs).transpose(1, 0, 2))
+        least = float(np.min(np.linalg.eigvalsh(Z.T @ (0.5 * (hessian + hessian.T)) @ Z))) * float(T)
+        checks["curvature"] = least
+        second = bool(least > BANG_BANG_CURVATURE)
+    # the co-state at the steps' ends, and H, σ, σ̇ there per arc (an arc's two ends with its control)
+    P = (nu_ @ G).reshape(-1, nx).T  # (nx, N + 1)
+    ends = np.arange(arcs)[:, None] * S + np.arange(S + 1)[None, :]  # (arcs, S + 1) step ends per arc
+    points = ends.size
+    node = _mapped(model, "bang-bang node conditions", points, lambda: _node_conditions(model))
+    pf, sigma, sigma_dot = (np.asarray(m) for m in node(X[:, ends.ravel()], P[:, ends.ravel()],
+                                                       np.repeat(U, S + 1, axis=1), np.tile(disturbance, (points, 1)).T))
+    starts = np.concatenate([[0.0], z[:-1]])
+    times = starts[:, None] + (z - starts)[:, None] * np.arange(S + 1)[None, :] / S  # (arcs, S + 1)
+    hamiltonian = float(np.max(np.abs(1.0 + pf)))
+    # σ sampled inside the steps: cubic Hermite per arc from the ends' σ and σ̇
+    sigma, sigma_dot = sigma.T.reshape(arcs, S + 1, nu), sigma_dot.T.reshape(arcs, S + 1, nu)
+    s = np.arange(BANG_BANG_SAMPLES + 1)[None, :] / (BANG_BANG_SAMPLES + 1)  # (1, samples) in [0, 1)
+    h = ((z - starts) / S)[:, None, None]
+    h00, h10, h01, h11 = 2 * s ** 3 - 3 * s ** 2 + 1, s ** 3 - 2 * s ** 2 + s, -2 * s ** 3 + 3 * s ** 2, s ** 3 - s ** 2
+    a, b, da, db = sigma[:, :-1, None, :], sigma[:, 1:, None, :], sigma_dot[:, :-1, None, :], sigma_dot[:, 1:, None, :]
+    w = [c.ravel()[None, None, :, None] for c in (h00, h10, h01, h11)]
+    dense = w[0] * a + w[1] * h[..., None] * da + w[2] * b + w[3] * h[..., None] * db  # (arcs, S, samples, nu)
+    samples = np.concatenate([dense.reshape(arcs, -1, nu), sigma[:, -1:, :]], axis=1)  # (arcs, S (samples) + 1, nu)
+    sample_times = np.concatenate([(times[:, :-1, None] + h[..., 0, None] * s[None, :, :]).reshape(arcs, -1),
+                                   times[:, -1:]], axis=1)
+    sample_u = np.repeat(U.T[:, None, :], samples.shape[1], axis=1)
+    samples, sample_times, sample_u = samples.reshape(-1, nu), sample_times.ravel(), sample_u.reshape(-1, nu)
+    # per control, σ relative to its largest value (a control whose σ is far below the others':
+    # relative to a thousandth of the largest)
+    largest = np.max(np.abs(samples), axis=0)
+    scale = np.maximum(largest, BANG_BANG_SIGN * float(np.max(largest, initial=0.0)))
+    scale = np.where(scale > 0, scale, 1.0)
+    agreement = switching_agreement(sample_u, low, high, samples / scale, relative_tolerance=BANG_BANG_SIGN)
+    # the switches: which controls each flips, σ_i and σ̇_i there
+    flips = U[:, 1:] != U[:, :-1]  # (nu, arcs − 1)
+    bound = np.all((np.abs(U - low[:, None]) <= 1e-9 * (1 + np.abs(low[:, None])))
+                   | (np.abs(U - high[:, None]) <= 1e-9 * (1 + np.abs(high[:, None]))))
+    simple = bool(np.all(flips.sum(axis=0) == 1) and np.all(np.diff(z) > 1e-9 * float(T)) and z[0] > 0)
+    zero, slope = 0.0, np.inf
+    owned: list[list[float]] = [[] for _ in range(nu)]
+    for k, i in zip(*np.nonzero(flips.T)):
+        value = 0.5 * (sigma[k, -1, i] + sigma[k + 1, 0, i])  # the two arcs' ends at the switch
+        rate = 0.5 * (sigma_dot[k, -1, i] + sigma_dot[k + 1, 0, i])
+        zero = max(zero, abs(value) / scale[i])
+        slope = min(slope, abs(rate) * float(T) / scale[i])
+        owned[i].append(z[k])
+    margins = _strictness(sample_times, samples, [np.asarray(o) for o in owned], float(T))
+    strictness = float(min(slope, float(np.min(margins, initial=np.inf))))
+    first = bool(checks["miss"] <= BANG_BANG_MISS and stationarity <= BANG_BANG_STATIONARITY
+                 and hamiltonian <= BANG_BANG_HAMILTONIAN and zero <= BANG_BANG_ZERO and agreement.wrong == 0.0
+                 and agreement.interior_large == 0.0)
+    strict = bool(bound and simple and strictness >= BANG_BANG_STRICT)
+    checks.update({"hamiltonian": hamiltonian, "switching": agreement.agreement, "wrong": agreement.wrong,
+                   "zero_at_switches": zero, "strictness": strictness, "bang_bang": bool(bound),
+                   "simple_switches": simple, "switches": arcs - 1, "first_order": first, "strict": strict,
+                   "second_order": second})
+    verdict = ("certified" if first and strict and second else "first-order" if first else "not certified")
+    residual = max(checks["miss"], stationarity, hamiltonian)
+    if first and strict and second:
+        text = "strict strong local minimum: strictly bang-bang, the induced problem's SOSC"
+    elif not second:
+        text = "not certified: the induced problem's second order fails"
+    elif not strict:
+        text = "not certified: not strictly bang-bang"
+    else:
+        text = "not checked: Pontryagin's necessary conditions fail"
+    record = {"kkt_scaled": residual, "kkt_unscaled": residual, "second_order": text,
+              "switching": agreement.agreement, "costate_gap": None, "seeds": seeds, "seeds_agreed": seeds_agreed,
+              "verdict": verdict, "method": "switch-time shooting", "summary": "", "kkt": None,
+              "switching_detail": asdict(agreement), "pontryagin": checks}
+    record["summary"] = summary_line(record)
+    return record
