@@ -78,6 +78,8 @@ def test_the_default_minimum_time_is_the_published_one(exact, name):
     assert reference.stats["certificate"]["verdict"] == "certified"
     assert reference.stats["certificate"]["method"] == "switch-time shooting"
     assert "exact bang-bang optimum" in reference.message and "N=8 optimum" in reference.message
+    # from YAML the actuator requirement is on (margin 0): checked between the points, met
+    assert reference.stats["dense_check"]["met"] and reference.stats["dense_check"]["rounds"] == 0
 
 
 def test_bilimoria_and_wie_is_the_mesh_converged_value(exact):

@@ -866,7 +866,7 @@ class CollocationPlanner(Planner):
                 return None
             tightening = Tightening.initial(requirements, float(np.deg2rad(o.cone_margin_deg)),
                                             problem.rate_bound(None, o.rate_margin))
-            stats["dense_check"] = self._dense_stats(requirements, tightening, check, [])
+            reference.stats["dense_check"] = self._dense_stats(requirements, tightening, check, [])
         shooting["used"] = True
         seeds = found.stats.get("seeds") or {}
         agreement = (f", {seeds['agreed']} of {seeds['tried']} seeds agreed there"
