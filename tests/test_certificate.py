@@ -164,7 +164,8 @@ def bilimoria_wie_solution(options):
 def test_costates_from_the_radau_multipliers_make_the_minimum_time_hamiltonian_vanish():
     # Pontryagin: along a minimum-time optimum H = 1 + pᵀ f = 0. With p = −λ / w_j this holds to the
     # discretisation's accuracy; the opposite sign would give H = 2, a missing step factor far more.
-    problem, solved, params, lbx, ubx = bilimoria_wie_solution({"objective": "min_time"})
+    # switch_refinement 0: the 50-interval solve (by default the exact bang-bang optimum replaces it)
+    problem, solved, params, lbx, ubx = bilimoria_wie_solution({"objective": "min_time", "switch_refinement": 0})
     assert float(solved.nlp.unpack(solved.result.x, params)[0]) == pytest.approx(3.2431, abs=2e-4)
     x, u, p, t = radau_points(solved.transcription, problem.model, solved.nlp, solved.result.x, solved.result.lam_g)
     f = np.array([problem.model.rhs(x[k], u[k], t[k], np.zeros(3)).full().ravel() for k in range(t.size)])
@@ -184,7 +185,9 @@ def test_costates_from_the_radau_multipliers_make_the_minimum_time_hamiltonian_v
 
 
 def test_bilimoria_wie_optimum_is_certified_and_the_eigenaxis_saddle_is_not():
-    optimum = PLANNERS["collocation"]({"objective": "min_time"}).plan(bilimoria_wie_problem())
+    # switch_refinement 0: the 50-interval NLP's certificate (by default the exact bang-bang optimum's,
+    # tests/test_collocation_bang_bang.py)
+    optimum = PLANNERS["collocation"]({"objective": "min_time", "switch_refinement": 0}).plan(bilimoria_wie_problem())
     assert optimum.duration == pytest.approx(3.2431, abs=2e-4)
     record = optimum.stats["certificate"]
     assert record["verdict"] == "certified", record
@@ -236,11 +239,12 @@ def test_the_certificate_is_in_a_runs_results(tmp_path):
     assert by_planner["collocation"]["certificate"]["verdict"] == "certified"
     assert by_planner["eigenaxis"]["certificate"] is None
     lines = {line["planner"]: line for line in csv.DictReader((out / "results.csv").open())}
-    assert lines["collocation"]["certificate"].startswith("certified: KKT")
+    # the exact bang-bang optimum's certificate (switch_refinement: auto, tests/test_collocation_bang_bang.py)
+    assert lines["collocation"]["certificate"].startswith("certified: switch-time shooting, Pontryagin H")
     assert lines["collocation"]["certificate_verdict"] == "certified"
     assert float(lines["collocation"]["certificate_kkt_scaled"]) <= 1e-6
     assert lines["eigenaxis"]["certificate"] == ""
-    assert "| certificate | certified: KKT" in (out / "results.md").read_text()
+    assert "| certificate | certified: switch-time shooting" in (out / "results.md").read_text()
 
 
 def test_the_certificate_is_in_a_one_case_studys_cases_csv(tmp_path):

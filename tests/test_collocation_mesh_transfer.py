@@ -138,7 +138,9 @@ def test_the_full_mesh_seed_with_and_without_the_transfer(monkeypatch, transfer)
         monkeypatch.setattr(collocation, name, lambda *args, _f=original, _n=name: used.append(_n) or _f(*args))
     if not transfer:
         monkeypatch.setattr(collocation, "transfer_multipliers", lambda *args: None)
-    reference = PLANNERS["collocation"]({"objective": "min_time", "seed_planners": []}).plan(bilimoria_wie())
+    # switch_refinement 0: the full-mesh solve (by default the exact bang-bang optimum replaces it)
+    reference = PLANNERS["collocation"]({"objective": "min_time", "seed_planners": [], "switch_refinement": 0}).plan(
+        bilimoria_wie())
     assert reference.ok, reference.message
     assert reference.duration == pytest.approx(3.2431, abs=2e-4)
     # the coarse mesh is seeded from the warm start, then the full mesh from the coarse optimum
@@ -375,12 +377,13 @@ def test_the_min_time_transfer_reaches_the_direct_solves_optimum_in_fewer_iterat
 
     problem = ManeuverProblem(Spacecraft([1.0, 1.0, 1.0], torquers=Torquers(1.0)), quat.IDENTITY, np.zeros(3),
                               quat.from_axis_angle([1, 0, 0], np.pi), 10.0, omegaf=np.zeros(3))
-    default = PLANNERS["collocation"]({"objective": "min_time"}).plan(problem)
+    # switch_refinement 0: the transfer (by default the exact bang-bang optimum replaces it)
+    default = PLANNERS["collocation"]({"objective": "min_time", "switch_refinement": 0}).plan(problem)
     direct = PLANNERS["collocation"]({"objective": "min_time", "coarse_intervals": 0}).plan(problem)
     assert default.ok and direct.ok and "coarse" in default.stats, default.message
     assert default.duration == pytest.approx(3.2431, abs=2e-4)
     assert default.stats["objective"] == pytest.approx(direct.stats["objective"], rel=1e-8)
-    monotone = PLANNERS["collocation"]({"objective": "min_time"})
+    monotone = PLANNERS["collocation"]({"objective": "min_time", "switch_refinement": 0})
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(planner_module, "TRANSFER_MIN_TIME_BARRIER", {})
         before = monotone.plan(problem)
