@@ -266,10 +266,15 @@ against 224.1 [211.7..269.9] ms; the full inertia 534.7 [492.2..573.6] against 1
 [116.1..142.7] ms (its refinement solve is gone too); XTE 691.0 [647.3..844.1] against 335.5
 [290.3..370.2] ms. Side by side with acados right after (9 rounds, wall, load 7.8-9.4): B&W 1.32
 [1.03..1.69] (ours 299, acados 220 ms; 1.8-2.0 before), the full inertia 0.34 [0.26..0.44], XTE
-0.16 [0.12..0.17] (to acados's 500th SQP iteration), unrefined XTE 0.18, spin 0.67 and 0.71. What
-is left on B&W (profile): the coarse multistart (2 starts, 63 IPOPT iterations) about three
-quarters of the plan, the shooting (5 calls) and the bang-bang certificate 15-20 ms on a quiet
-machine, the starts and the seed bound the rest. Issue 30's 1.0x is not met on B&W.
+0.16 [0.12..0.17] (to acados's 500th SQP iteration), unrefined XTE 0.18, spin 0.67 and 0.71. Again
+at 19:24 (load 3.4-3.9): before and after 234.9 [186.3..254.5] against 142.6 [119.9..169.5] ms on
+B&W, 301.9 against 53.4 ms on the full inertia, 397.1 against 167.1 ms on XTE; side by side B&W
+1.18 [0.84..2.01] (ours 95.7, acados 81.5 ms), then 1.33 [0.59..2.67] and 1.21 [0.61..2.88]; the
+full inertia 0.27, XTE 0.17, unrefined XTE 0.20. Where B&W's plan goes now (cProfile, 79 ms a plan
+at load 3.4): the coarse multistart 56 ms (2 starts, 63 IPOPT iterations), the exact optimum 13 ms
+(the shooting's 5 calls 7 ms, the bang-bang certificate 3.6 ms, the integrated states 1 ms), the
+starts 7 ms, the seed bound 1.4 ms. Issue 30's 1.0x is not met on B&W: the coarse multistart alone
+is about acados's whole solve.
 """
 from __future__ import annotations
 
