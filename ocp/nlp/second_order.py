@@ -396,10 +396,19 @@ def _inertia(H: _Triplets, A: _Triplets, delta: float, scale: float) -> Callable
     base = K.data[diagonal].copy()
     sparsity, solver, analysed = _linsol(n + m, K.indptr, K.indices)
     rhs, b = _random_rhs(n + m)
+    # K as CasADi's matrix, made at the first count (converting every entry costs as much as the
+    # factorisation); a shift changes only H's diagonal, set in place at the later counts
+    made: list[ca.DM] = []
+    positions = diagonal.tolist()
 
     def count(shift: float) -> int | str:
         K.data[diagonal] = base + shift / scale
-        values = ca.DM(sparsity, K.data.tolist())
+        if made:
+            values = made[0]
+            values.set_nz(ca.DM(K.data[diagonal].tolist()), False, positions)
+        else:
+            values = ca.DM(sparsity, K.data.tolist())
+            made.append(values)
         if not analysed:
             solver.sfact(values)  # the symbolic factorisation (the ordering), once per pattern
             analysed.append(True)
