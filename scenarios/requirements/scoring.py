@@ -27,7 +27,8 @@ and what breaks it in words. The fields (their units, words and definitions are 
   reference's peak torque; a demand or unrealised torque that is not finite (nan, inf) is no
   number met: its field is null, its time the first sample where it is not finite, and the
   requirement broken;
-* ``rate``: ``peak_rate`` [rad/s] (of ``‖ω‖``), ``peak_time_s``, ``ratio`` (over the bound);
+* ``rate``: ``peak_rate`` [rad/s] (of ``‖ω‖``), ``peak_time_s``, ``ratio`` (over the bound); the
+  reference's either side of its breakpoints too (a bang-bang's peak at a switch between samples);
 * ``final`` (closed loop only): ``worst_error_deg`` from ``T + after_s`` to the end, between the
   samples too (:func:`worst_error_between_samples`, on the attitude interpolated as for pointing),
   ``worst_rate_error`` [rad/s] over the samples from then on, and ``from_s``; to ``(q_f, ω_f)``,
@@ -267,14 +268,23 @@ def _with_edges(problem: ManeuverProblem, t: Array, sample: Any,
     return merged, q, omega
 
 
-def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
+def _rate(requirement: RateRequirement, t: Array, omega: Array, reference: Reference | None = None) -> Score:
+    """The rate requirement's score on the samples, and on a reference's sides of its breakpoints
+    (:meth:`planners.Reference.breakpoint_sides`, those within the samples' span): a rate that
+    peaks at a switch between two samples (a bang-bang's, a step stop's) peaks there only."""
     norms = np.linalg.norm(omega, axis=1)
     worst = int(np.argmax(norms))
-    peak = float(norms[worst])
+    peak, when = float(norms[worst]), float(t[worst])
+    if reference is not None and reference.breakpoints.size:
+        sides, at_sides = reference.breakpoint_sides()
+        side_norms = np.where((sides >= t[0]) & (sides <= t[-1]), np.linalg.norm(at_sides.omega, axis=1), -np.inf)
+        side = int(np.argmax(side_norms))
+        if side_norms[side] > peak:  # a side above every sample (on a tie, the sample's time)
+            peak, when = float(side_norms[side]), float(sides[side])
     ratio = peak / requirement.max_rate
-    values: dict[str, float | None] = dict(zip(RATE_FIELDS, (peak, float(t[worst]), ratio)))
+    values: dict[str, float | None] = dict(zip(RATE_FIELDS, (peak, when, ratio)))
     met = ratio <= 1.0 + _TOLERANCE
-    return Score("rate", values, met, "" if met else f"peak rate {peak:.4g} rad/s at {t[worst]:.1f} s, "
+    return Score("rate", values, met, "" if met else f"peak rate {peak:.4g} rad/s at {when:.1f} s, "
                                                      f"{_over(ratio, 1.0)[0]} x the {requirement.max_rate:g} rad/s bound")
 
 
@@ -639,7 +649,7 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
     breakpoints; the actuator requirement at the samples and either side of the breakpoints (where
     the torque or the rate may jump: the demand, integrated with its inputs linear between samples,
     would smear a switch over the interval across it; :meth:`planners.Reference.breakpoint_sides`,
-    sampled once per reference), the rate requirement at the samples.
+    sampled once per reference), the rate requirement at the samples and either side of the breakpoints.
 
     Parameters
     ----------
@@ -738,7 +748,7 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
                                          unstarted, float(np.linalg.norm(problem.spacecraft.inertia @ steps[0]))
                                          if unstarted is not None else 0.0)
     if requirements.rate is not None:
-        scores["rate"] = _rate(requirements.rate, t, sample.omega)
+        scores["rate"] = _rate(requirements.rate, t, sample.omega, reference)
     return scores
 
 
