@@ -541,20 +541,22 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
         if not quantity.limited:
             continue
         ratios = quantity.ratios()
-        unknown = ~np.all(np.isfinite(quantity.values), axis=1)
-        if np.any(unknown):  # a demand that cannot be computed is no demand met
-            first = int(np.argmax(unknown))
+        finite = np.isfinite(quantity.values)
+        if not finite.all():  # a demand that cannot be computed is no demand met
+            first = int(np.argmax(~np.all(finite, axis=1)))
             values[name] = None
             values[f"{name}_time_s"] = float(t[first])
             unscored.append(f"{name} is not finite (nan or inf) from {t[first]:.1f} s: the demand cannot be scored "
                             f"(a reference rate that is not finite, or past the {MAX_SUBSTEPS:,} integration sub-steps "
                             f"the demand may take)")
             continue
-        peaks = np.max(ratios, axis=1) if ratios.size else np.zeros(len(t))
-        worst = int(np.argmax(peaks)) if peaks.size else 0
-        ratio = float(peaks[worst]) if peaks.size else 0.0
+        if ratios.size:  # the peak over every sample and element: the first sample that holds it
+            highest = int(np.argmax(ratios))
+            worst, ratio = highest // ratios.shape[1], float(ratios.flat[highest])
+        else:
+            worst, ratio = 0, 0.0
         values[name] = ratio
-        values[f"{name}_time_s"] = float(t[worst]) if peaks.size else None
+        values[f"{name}_time_s"] = float(t[worst]) if ratios.size or t.size else None
         if ratio > margin_allowed * (1 + _TOLERANCE):
             shown, limit = _over(ratio, margin_allowed)
             allowed = max(allowed, limit, key=len)

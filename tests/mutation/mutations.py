@@ -543,8 +543,8 @@ MUTATIONS: list[Mutation] = [
              "if lowered is not None and lowered[element] else", "if lowered is not None and np.any(lowered) else",
              ("tests/test_truth_actuator_limits.py",)),
     Mutation("actuators-peak-of-the-least-loaded-wheel", "scenarios/requirements/scoring.py",
-             "peaks = np.max(ratios, axis=1) if ratios.size else np.zeros(len(t))",
-             "peaks = np.min(ratios, axis=1) if ratios.size else np.zeros(len(t))",
+             "            highest = int(np.argmax(ratios))\n",
+             "            highest = int(np.argmax(np.where(ratios == ratios.min(axis=1, keepdims=True), ratios, -np.inf)))\n",
              ("tests/test_truth_actuator_limits.py", "tests/test_requirements_actuators.py")),
     # pointing geometry and the final accuracy
     Mutation("pointing-violation-start-not-interpolated", "ocp/geometry/pointing.py",
