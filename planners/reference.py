@@ -286,8 +286,9 @@ class Reference(ABC):
 
         Where ``ω`` or ``ω̇`` may jump, a sample on either side stands for the one-sided limits: the
         requirement scoring reads them for the jumps of the rate
-        (:func:`scenarios.requirements.scoring.rate_jumps`), for the attitude between its samples and
-        for the actuator demand (which it integrates up to each side, never across a switch). They
+        (:func:`scenarios.requirements.scoring.rate_jumps`), for the attitude between its samples, for
+        the actuator demand (which it integrates up to each side, never across a switch) and for the
+        peak rate (a bang-bang's at its switch, between two samples). They
         are sampled once per reference and kept (computed again only if the breakpoints or the
         duration change).
 

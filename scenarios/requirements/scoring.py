@@ -27,7 +27,8 @@ and what breaks it in words. The fields (their units, words and definitions are 
   reference's peak torque; a demand or unrealised torque that is not finite (nan, inf) is no
   number met: its field is null, its time the first sample where it is not finite, and the
   requirement broken;
-* ``rate``: ``peak_rate`` [rad/s] (of ``‖ω‖``), ``peak_time_s``, ``ratio`` (over the bound);
+* ``rate``: ``peak_rate`` [rad/s] (of ``‖ω‖``), ``peak_time_s``, ``ratio`` (over the bound); the
+  reference's either side of its breakpoints too (a bang-bang's peak at a switch between samples);
 * ``final`` (closed loop only): ``worst_error_deg`` from ``T + after_s`` to the end, between the
   samples too (:func:`worst_error_between_samples`, on the attitude interpolated as for pointing),
   ``worst_rate_error`` [rad/s] over the samples from then on, and ``from_s``; to ``(q_f, ω_f)``,
@@ -267,14 +268,23 @@ def _with_edges(problem: ManeuverProblem, t: Array, sample: Any,
     return merged, q, omega
 
 
-def _rate(requirement: RateRequirement, t: Array, omega: Array) -> Score:
+def _rate(requirement: RateRequirement, t: Array, omega: Array, reference: Reference | None = None) -> Score:
+    """The rate requirement's score on the samples, and on a reference's sides of its breakpoints
+    (:meth:`planners.Reference.breakpoint_sides`, those within the samples' span): a rate that
+    peaks at a switch between two samples (a bang-bang's, a step stop's) peaks there only."""
     norms = np.linalg.norm(omega, axis=1)
     worst = int(np.argmax(norms))
-    peak = float(norms[worst])
+    peak, when = float(norms[worst]), float(t[worst])
+    if reference is not None and reference.breakpoints.size:
+        sides, at_sides = reference.breakpoint_sides()
+        side_norms = np.where((sides >= t[0]) & (sides <= t[-1]), np.linalg.norm(at_sides.omega, axis=1), -np.inf)
+        side = int(np.argmax(side_norms))
+        if side_norms[side] > peak:  # a side above every sample (on a tie, the sample's time)
+            peak, when = float(side_norms[side]), float(sides[side])
     ratio = peak / requirement.max_rate
-    values: dict[str, float | None] = dict(zip(RATE_FIELDS, (peak, float(t[worst]), ratio)))
+    values: dict[str, float | None] = dict(zip(RATE_FIELDS, (peak, when, ratio)))
     met = ratio <= 1.0 + _TOLERANCE
-    return Score("rate", values, met, "" if met else f"peak rate {peak:.4g} rad/s at {t[worst]:.1f} s, "
+    return Score("rate", values, met, "" if met else f"peak rate {peak:.4g} rad/s at {when:.1f} s, "
                                                      f"{_over(ratio, 1.0)[0]} x the {requirement.max_rate:g} rad/s bound")
 
 
@@ -531,20 +541,22 @@ def _actuators(margin_allowed: float, demand: Mapping[str, Any], t: Array,
         if not quantity.limited:
             continue
         ratios = quantity.ratios()
-        unknown = ~np.all(np.isfinite(quantity.values), axis=1)
-        if np.any(unknown):  # a demand that cannot be computed is no demand met
-            first = int(np.argmax(unknown))
+        finite = np.isfinite(quantity.values)
+        if not finite.all():  # a demand that cannot be computed is no demand met
+            first = int(np.argmax(~np.all(finite, axis=1)))
             values[name] = None
             values[f"{name}_time_s"] = float(t[first])
             unscored.append(f"{name} is not finite (nan or inf) from {t[first]:.1f} s: the demand cannot be scored "
                             f"(a reference rate that is not finite, or past the {MAX_SUBSTEPS:,} integration sub-steps "
                             f"the demand may take)")
             continue
-        peaks = np.max(ratios, axis=1) if ratios.size else np.zeros(len(t))
-        worst = int(np.argmax(peaks)) if peaks.size else 0
-        ratio = float(peaks[worst]) if peaks.size else 0.0
+        if ratios.size:  # the peak over every sample and element: the first sample that holds it
+            highest = int(np.argmax(ratios))
+            worst, ratio = highest // ratios.shape[1], float(ratios.flat[highest])
+        else:
+            worst, ratio = 0, 0.0
         values[name] = ratio
-        values[f"{name}_time_s"] = float(t[worst]) if peaks.size else None
+        values[f"{name}_time_s"] = float(t[worst]) if ratios.size or t.size else None
         if ratio > margin_allowed * (1 + _TOLERANCE):
             shown, limit = _over(ratio, margin_allowed)
             allowed = max(allowed, limit, key=len)
@@ -639,7 +651,7 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
     breakpoints; the actuator requirement at the samples and either side of the breakpoints (where
     the torque or the rate may jump: the demand, integrated with its inputs linear between samples,
     would smear a switch over the interval across it; :meth:`planners.Reference.breakpoint_sides`,
-    sampled once per reference), the rate requirement at the samples.
+    sampled once per reference), the rate requirement at the samples and either side of the breakpoints.
 
     Parameters
     ----------
@@ -738,7 +750,7 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
                                          unstarted, float(np.linalg.norm(problem.spacecraft.inertia @ steps[0]))
                                          if unstarted is not None else 0.0)
     if requirements.rate is not None:
-        scores["rate"] = _rate(requirements.rate, t, sample.omega)
+        scores["rate"] = _rate(requirements.rate, t, sample.omega, reference)
     return scores
 
 

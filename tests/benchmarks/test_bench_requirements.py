@@ -43,6 +43,15 @@ ratio 0.80); every score, status and message of 13 rows (this scenario and four 
 The 10 % target is not met: the searches do 20 % less work, not the 35-40 % it needs
 (docs/performance.rst: what is left). The budget stays 60 %.
 
+Measured on 2026-12-03 (load 2.9-4.1 on 2 cores), against b417048, after the actuator score found
+each quantity's peak by one argmax (0.74 against 1.44 ms of CPU a run): this benchmark run
+alternately on both (15 pairs a run, wall): median +20.6 % (+12.6..+21.5) against +21.4 %
+(+17.7..+22.8); every score, status and message of 25 rows (five scenarios, four with a rate
+requirement added, and this one) bit for bit. The 10 % target is not met: of the scoring's some
+35 ms of CPU a run, the scorer's own arithmetic is about 3 ms; the rest is the pointing searches
+and their interpolants (23.6 ms), the demand and its unrealised torque (8.4 ms) and the
+environment's torque (4.8 ms, CasADi's virtual machine). The budget stays 60 %.
+
 The 12U CubeSat Sun keep-out scenario without its collocation row (the fast planners, where scoring
 weighs most), with three pointing requirements (the star tracker off the Sun and the Moon, an
 antenna off the Earth's limb: moving directions, tabulated), the actuator margin (the demand
