@@ -129,6 +129,12 @@ def test_an_unchanged_study_resumes_its_missing_cases_only(partial, capsys):
     assert re.search(r"^1 case run in [0-9.]+ s \(1 already stored, 2 in all\); ", said, re.M), said
     with open(out / "cases.csv", newline="") as handle:
         assert sorted(float(row["controller.options.kp"]) for row in csv.DictReader(handle)) == [0.2, 0.2, 0.3, 0.3]
+    with open(out / "summary.csv", newline="") as handle:
+        assert {row["metric"] for row in csv.DictReader(handle)} == {"cl.final_error_deg"}  # the summary asked for
+    # the store records the study as resumed: a redrawn report is the one the resumed sweep wrote
+    written = {name: (out / name).read_text() for name in ("cases.csv", "summary.csv")}
+    assert main(["sweep", "--report", str(out), "--no-plots"]) == 0
+    assert {name: (out / name).read_text() for name in written} == written
 
 
 def test_the_same_base_written_inline_resumes(partial, capsys):
