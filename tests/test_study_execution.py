@@ -1,6 +1,6 @@
 """How a sweep executes its cases: the time limit (however a case spends its time), the crashed
-cases a resumed sweep runs again, the stored cases of a changed study, and a sweep started from an
-unguarded script (which must fail once, never hang)."""
+cases a resumed sweep runs again, the stored cases of another version (left out) and a changed
+study (refused), and a sweep started from an unguarded script (which must fail once, never hang)."""
 import ast
 import contextlib
 import copy
@@ -24,6 +24,7 @@ from scenarios.errors import CaseTimeout
 from scenarios.study.engine import sweep
 from scenarios.study.spec import load_study, parse_study
 from scenarios.study.store import SweepStore, resume_counts
+from scenarios.study.types import case_key
 from scenarios.study.worker import crashed_rows, run_case
 from tests.test_sweep import InlineExecutor
 
@@ -273,22 +274,29 @@ def test_cli_resume_says_what_it_runs_again_and_what_is_not_the_studys(tmp_path,
     with SweepStore(out) as store:
         assert set(store.statuses().values()) == {"ok"} and store.records()[keys[40.0]]["attempts"] == 2
 
-    # a changed study: 30 and 40 s kept, 50 s no more its case (and crashed: it must not be counted)
+    # cases stored by another slewbench version (their keys differ): kept in the store, left out, counted in a note
     with SweepStore(out) as store:
+        store.put(case_key(cases[50.0].scenario, "0.0.1"), "ok", [], 1.0, 1)
         store.put(keys[50.0], "crashed", crashed_rows(cases[50.0].scenario, TIMED_OUT.format(600)), 600.0, 1)
-    path = write_study(tmp_path, {"maneuver.duration": [30.0, 40.0, 60.0, 70.0]})
     assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--no-plots", "--resume"]) == 0
     said = capsys.readouterr().out
-    assert "cli-resume: 4 cases, 2 already stored, local process pool\n" in said, said
-    assert ("note: 1 stored case is not this study's (the study changed?): kept in the store, left out of the "
-            "outputs") in said, said
-    assert "(2 already stored, 4 in all); of the 4 cases stored, 0 crashed and 0 others have a row not ok" in said, said
+    assert "cli-resume: 3 cases, 2 already stored, 1 crashed case run again, local process pool\n" in said, said
+    assert ("note: 1 stored case is not this study's as this slewbench keys them (stored by another version?): kept "
+            "in the store, left out of the outputs") in said, said
+    assert "(2 already stored, 3 in all); of the 3 cases stored, 0 crashed and 0 others have a row not ok" in said, said
     with (out / "cases.csv").open() as stream:
         durations = sorted({float(row["maneuver.duration"]) for row in csv.DictReader(stream)})
-    assert durations == [30.0, 40.0, 60.0, 70.0]
-    # the redrawn report counts this study's cases (the 50 s one is the earlier study's)
+    assert durations == [30.0, 40.0, 50.0]
+    # the redrawn report counts this study's cases (the other version's is not one)
     assert main(["sweep", "--report", str(out), "--no-plots"]) == 0
-    assert "from 4 stored case(s); 0 missing" in capsys.readouterr().out
+    assert "from 3 stored case(s); 0 missing" in capsys.readouterr().out
+
+    # a changed study is refused: the store holds the sweep of the study as it was
+    path = write_study(tmp_path, {"maneuver.duration": [30.0, 40.0, 60.0, 70.0]})
+    assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--no-plots", "--resume"]) == 2
+    error = capsys.readouterr().err
+    assert ("with another definition (3 cases then, 4 now), changed since: grid.maneuver.duration: "
+            "[30.0, 40.0, 50.0] -> [30.0, 40.0, 60.0, 70.0]") in error, error
 
 
 # --- a sweep started by an unguarded script ------------------------------------------------------

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import copy
 import re
+import sqlite3
 
 import yaml
 
 from scenarios.cli.commands import main
+from scenarios.study.spec import load_study
 from tests.test_sweep import BASE
 
 
@@ -38,10 +40,11 @@ def test_a_dry_run_of_a_bad_study_exits_2(tmp_path, capsys):
 
 def test_a_resumed_sweep_counts_what_it_ran(tmp_path, capsys):
     out = tmp_path / "out"
-    study = _study(tmp_path, values=(0.2, 0.3))
+    study = _study(tmp_path, values=(0.2, 0.3, 0.4))
     assert main(["sweep", str(study), "--out", str(out), "--workers", "1", "--no-plots"]) == 0
-    assert re.search(r"^2 cases run in [0-9.]+ s; ", capsys.readouterr().out, re.M)
-    study = _study(tmp_path, values=(0.2, 0.3, 0.4))  # one case more: only it runs on resume
+    assert re.search(r"^3 cases run in [0-9.]+ s; ", capsys.readouterr().out, re.M)
+    with sqlite3.connect(out / "sweep.sqlite") as db:  # one case missing, as an interrupted sweep leaves it
+        db.execute("DELETE FROM cases WHERE key = ?", (load_study(study).cases[2].key,))
     assert main(["sweep", str(study), "--out", str(out), "--workers", "1", "--no-plots", "--resume"]) == 0
     said = capsys.readouterr().out
     assert re.search(r"^1 case run in [0-9.]+ s \(2 already stored, 3 in all\); ", said, re.M), said

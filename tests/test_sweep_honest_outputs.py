@@ -18,7 +18,9 @@ from scenarios.errors import ScenarioError
 from scenarios.output.directory import MARKER
 from scenarios.runner import final_accuracy_note
 from scenarios.study.report import wilson_interval
-from scenarios.study.spec import parse_study
+from scenarios.study.spec import load_study, parse_study
+from scenarios.study.store import SweepStore
+from scenarios.study.worker import crashed_rows
 from tests.test_sweep import BASE
 
 
@@ -62,10 +64,12 @@ def test_cases_that_collapse_to_one_simulation_count_once(tmp_path, capsys):
 def test_a_resumed_sweep_marks_the_directory_incomplete_until_its_tables_are_written(tmp_path, monkeypatch, capsys):
     from scenarios.study import engine
     out = tmp_path / "out"
-    first = write(tmp_path, {"study": "grow", "grid": {"controller.options.kp": [0.2, 0.3]}})
-    assert main(["sweep", str(first), "--out", str(out), "--workers", "1", "--no-plots"]) == 0
-    assert json.loads((out / MARKER).read_text())["complete"] is True
     grown = write(tmp_path, {"study": "grow", "grid": {"controller.options.kp": [0.2, 0.3, 0.4]}})
+    assert main(["sweep", str(grown), "--out", str(out), "--workers", "1", "--no-plots"]) == 0
+    assert json.loads((out / MARKER).read_text())["complete"] is True
+    case = load_study(grown).cases[2]
+    with SweepStore(out) as store:  # as a crashed case is stored: its tables are written, and resume runs it again
+        store.put(case.key, "crashed", crashed_rows(case.scenario, "timed out after 600 s (case_timeout_s)"), 600.0, 1)
     seen = {}
     real_sweep = engine.sweep
 
@@ -76,7 +80,7 @@ def test_a_resumed_sweep_marks_the_directory_incomplete_until_its_tables_are_wri
     monkeypatch.setattr(engine, "sweep", interrupted)
     assert main(["sweep", str(grown), "--out", str(out), "--workers", "1", "--no-plots", "--resume"]) == 130
     assert seen == {"complete": False}  # before any case ran
-    assert json.loads((out / MARKER).read_text())["complete"] is False  # the 2-case tables stay, marked stale
+    assert json.loads((out / MARKER).read_text())["complete"] is False  # the tables of the crash stay, marked stale
     monkeypatch.setattr(engine, "sweep", real_sweep)
     assert main(["sweep", str(grown), "--out", str(out), "--workers", "1", "--no-plots", "--resume"]) == 0
     assert json.loads((out / MARKER).read_text())["complete"] is True

@@ -2,8 +2,9 @@
 
 Everything that can fail before a case runs is checked first, and nothing is written until it
 passes: the study and every case (exit 2), the options, the output directory (exit 2 if it is not
-slewbench's, already holds a sweep and ``--resume`` was not given, or holds a sweep of an earlier
-slewbench, which ``--report`` still redraws), and a Dask scheduler (it must answer as one and have
+slewbench's, already holds a sweep and ``--resume`` was not given, holds another study's sweep
+or one of this study with another definition, :func:`scenarios.study.store.check_resume`, or holds a
+sweep of an earlier slewbench, which ``--report`` still redraws), and a Dask scheduler (it must answer as one and have
 workers). A directory this command created is removed again if the sweep cannot start in it (a
 full disk). An interrupted sweep exits 130 and says how to resume; one whose cases crashed (raised,
 ran out of time or killed their worker) writes its tables, then exits 1 saying how many crashed,
@@ -199,9 +200,10 @@ def _output(args: argparse.Namespace, study: Study) -> Path:
     """The output directory, checked without writing anything."""
     from scenarios.study.store import (
         EARLIER_FORMATS,
+        FORMAT,
         STORE_NAME,
+        check_resume,
         store_format,
-        stored_study_name,
     )
 
     out = Path(args.out) if args.out else default_output_directory(study.name)
@@ -217,12 +219,8 @@ def _output(args: argparse.Namespace, study: Study) -> Path:
     if stored and not args.resume:
         raise OutputError(out, f"already holds a sweep ({STORE_NAME}); pass --resume to continue it, "
                                "--report to redraw it, or choose another --out")
-    if stored:
-        other = stored_study_name(out)
-        if other is not None and other != study.name:  # a store recording no study: nothing to compare
-            raise OutputError(out, f"holds the sweep of study {other!r}, not {study.name!r}: --resume continues the "
-                                   "same study (its `study:` name), whose stored cases it keeps; choose another "
-                                   "--out (nothing was touched)")
+    if stored and earlier == FORMAT:  # another file is refused where the directory is claimed
+        check_resume(out, study)  # the same study, its definition unchanged
     return out
 
 

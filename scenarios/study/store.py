@@ -27,7 +27,7 @@ import stat
 import time
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from ocp.errors import excerpt
 from scenarios.errors import OutputError
@@ -39,6 +39,9 @@ from scenarios.output.directory import (
     write_manifest,
 )
 from scenarios.output.tables import json_safe
+
+if TYPE_CHECKING:
+    from scenarios.study.types import Study
 
 STORE_NAME = "sweep.sqlite"
 FORMAT = "slewbench-sweep-2"
@@ -389,8 +392,9 @@ class ResumeCounts(NamedTuple):
     crashed: int
     """Cases of the study stored ``crashed``: a resumed sweep runs them again, replacing them."""
     other: int
-    """Stored cases that are not the study's (the study file changed since): kept in the store,
-    left out of the results and outputs."""
+    """Stored cases that are not the study's as this slewbench keys them (stored by another
+    version, whose keys differ, or by an edited study before ``--resume`` refused one): kept in the
+    store, left out of the results and outputs."""
 
     def describe(self) -> str:
         """The counts for the line a resumed sweep starts with (empty when nothing is stored).
@@ -412,12 +416,13 @@ class ResumeCounts(NamedTuple):
         -------
         list of str
             One line when there are such cases, for example ``note: 182 stored cases are not this
-            study's (the study changed?): kept in the store, left out of the outputs``; else none.
+            study's as this slewbench keys them (stored by another version?): kept in the store, left
+            out of the outputs``; else none.
         """
         if not self.other:
             return []
-        return [(f"note: {self.other} stored case{'s are' if self.other != 1 else ' is'} not this study's (the study "
-                 "changed?): kept in the store, left out of the outputs")]
+        return [(f"note: {self.other} stored case{'s are' if self.other != 1 else ' is'} not this study's as this "
+                 "slewbench keys them (stored by another version?): kept in the store, left out of the outputs")]
 
 
 def resume_counts(store: SweepStore, keys: Iterable[str]) -> ResumeCounts:
@@ -515,7 +520,7 @@ def commit_sweep_outputs(directory: Path, staging: Path, kind: str = "sweep") ->
 
 def mark_incomplete(directory: Path, kind: str = "sweep") -> None:
     """Mark a claimed sweep directory's outputs incomplete: its tables stop describing the store
-    (a sweep starts or resumes: cases are added, a changed study's stored with it) until
+    (a sweep starts or resumes: cases are added, crashed ones replaced) until
     :func:`commit_sweep_outputs` writes them again and marks them complete.
 
     Parameters
@@ -537,6 +542,112 @@ def mark_incomplete(directory: Path, kind: str = "sweep") -> None:
         write_manifest(directory, manifest["files"], complete=False, kind=kind)
 
 
+DEFINING_KEYS = ("scenario", "grid", "zip", "monte_carlo")
+"""The keys of a study that determine its cases and each case's scenario (``scenario`` as the base
+scenario's content): ``slewbench sweep --resume`` continues a sweep only while they are as its store
+records them (:func:`check_resume`). ``summary``, ``execution`` and ``robustness`` may change: they
+decide how the cases run and what the tables summarise, and the tables are drawn again from the
+store whole."""
+ORDERED_KEYS = ("grid", "zip", "monte_carlo.dispersions")
+"""Mappings of a study whose keys' order is part of its definition (it orders the cases, and with
+them the Monte Carlo seeds and draws)."""
+CUT = "... (cut)"
+"""How :func:`ocp.errors.excerpt` ends a value it cut."""
+SHOWN_CHANGES = 5
+"""Changes of a study's definition named in the message of a refused resume (the others are counted)."""
+
+
+def study_definition(data: dict[str, Any], base: Any) -> dict[str, Any]:
+    """What determines a study's cases (:data:`DEFINING_KEYS`), in the form the store keeps it (JSON).
+
+    Parameters
+    ----------
+    data : dict
+        The study mapping (as given, or as stored: :func:`scenarios.study.report.resolved_study`).
+    base : Any
+        The base scenario mapping (its content, not its file name).
+
+    Returns
+    -------
+    dict
+        ``scenario`` (the base), ``grid`` and ``zip`` (``{}`` when absent), ``monte_carlo``
+        (``None`` when absent), as JSON reads them back (tuples as lists, non-finite numbers null).
+    """
+    defined = {"scenario": base, "grid": data.get("grid") or {}, "zip": data.get("zip") or {},
+               "monte_carlo": data.get("monte_carlo")}
+    return json.loads(json.dumps(json_safe(defined), allow_nan=False, default=str))
+
+
+def definition_changes(before: Any, after: Any, path: str = "") -> list[str]:
+    """The differences between two definitions (:func:`study_definition`), or two parts of them,
+    one line each, naming the path that changed.
+
+    Mappings are compared key by key (and, under :data:`ORDERED_KEYS`, in order), lists entry by
+    entry when their lengths agree (``grid.x[3]: 0.95 -> 0.99``, ``scenario.planners[1].options.w``);
+    lists of other lengths whole, or, when too long to show, by their counts and the values added
+    and removed; any other value whole.
+
+    Parameters
+    ----------
+    before, after : Any
+        The stored definition and the study's now (or parts of them at ``path``).
+    path : str, optional
+        Where they are in the study (``grid``, ``scenario.maneuver``); empty at the top.
+
+    Returns
+    -------
+    list of str
+        ``grid.maneuver.duration: [60.0, 120.0] -> [60.0, 90.0, 120.0]``,
+        ``grid.controller.options.kp: 16 values -> 17, added [0.99]``,
+        ``zip.simulation.sample_time: added ([0.5, 1.0])``, ``scenario.planners[1].options.weight:
+        removed (was 2.0)``, ...; empty when they are equal.
+    """
+    if isinstance(before, dict) and isinstance(after, dict):
+        found = []
+        if path in ORDERED_KEYS and before.keys() == after.keys() and list(before) != list(after):
+            found.append(f"{path}: its keys in another order ({', '.join(map(str, before))} -> "
+                         f"{', '.join(map(str, after))}), which orders the cases")
+        for key in [*before, *(key for key in after if key not in before)]:
+            where = f"{path}.{key}" if path else str(key)
+            if key not in after:
+                found.append(f"{where}: removed (was {excerpt(before[key], 60)})")
+            elif key not in before:
+                found.append(f"{where}: added ({excerpt(after[key], 60)})")
+            else:
+                found += definition_changes(before[key], after[key], where)
+        return found
+    if isinstance(before, list) and isinstance(after, list):
+        if len(before) == len(after):
+            return [change for index, (old, new) in enumerate(zip(before, after))
+                    for change in definition_changes(old, new, f"{path}[{index}]")]
+        old_text, new_text = excerpt(before, 60), excerpt(after, 60)
+        if not old_text.endswith(CUT) and not new_text.endswith(CUT):
+            return [f"{path}: {old_text} -> {new_text}"]
+        added, removed = [v for v in after if v not in before], [v for v in before if v not in after]
+        return [f"{path}: {len(before)} values -> {len(after)}" + (f", added {excerpt(added, 60)}" if added else "")
+                + (f", removed {excerpt(removed, 60)}" if removed else "")]
+    if before == after and type(before) is type(after):
+        return []
+    if before is None or after is None:  # an entry given or dropped (monte_carlo)
+        return [f"{path}: added ({excerpt(after, 60)})" if before is None else f"{path}: removed (was {excerpt(before, 60)})"]
+    return [f"{path}: {excerpt(before, 60)} -> {excerpt(after, 60)}"]
+
+
+def _stored_study(directory: Path) -> tuple[bool, Any]:
+    """Whether ``directory/sweep.sqlite`` could be read, and the study it records (read only; None
+    when it records none, or not as JSON)."""
+    try:
+        with contextlib.closing(sqlite3.connect((Path(directory) / STORE_NAME).absolute().as_uri() + "?mode=ro",
+                                                uri=True, timeout=30.0)) as db:
+            found = db.execute("SELECT value FROM meta WHERE name = 'study'").fetchone()
+    except sqlite3.Error:
+        return False, None
+    try:
+        return True, json.loads(found[0]) if found is not None else None
+    except (TypeError, ValueError):
+        return True, None
+
+
 def stored_study_name(directory: Path) -> str | None:
     """The name (``study:``) of the study whose sweep ``directory`` stores, read without writing.
 
@@ -551,12 +662,64 @@ def stored_study_name(directory: Path) -> str | None:
         The stored study's name; None when the store cannot be read as a sweep store or records no
         named study (the checks that open it then say what is wrong).
     """
-    try:
-        with contextlib.closing(sqlite3.connect((Path(directory) / STORE_NAME).absolute().as_uri() + "?mode=ro",
-                                                uri=True, timeout=30.0)) as db:
-            found = db.execute("SELECT value FROM meta WHERE name = 'study'").fetchone()
-        study = json.loads(found[0]) if found is not None else None
-    except (sqlite3.Error, TypeError, ValueError):
-        return None
+    _, study = _stored_study(directory)
     name = study.get("study") if isinstance(study, dict) else None
     return name if isinstance(name, str) else None
+
+
+def check_resume(directory: Path, study: Study) -> None:
+    """Refuse to resume the sweep stored in ``directory`` with ``study`` unless it is the same study
+    as the store records: the same name, and the same definition (:data:`DEFINING_KEYS`: the base
+    scenario's content, the grid, zip and Monte Carlo entries). Nothing is written.
+
+    A resumed sweep keeps its stored cases; resumed with a changed definition it would put cases of
+    two definitions in one store and stop counting the changed ones, so it is refused, naming what
+    changed. A store that records no study (filled through :func:`scenarios.study.engine.sweep` in
+    code, not by ``slewbench sweep``) cannot be compared, and is refused too.
+
+    Parameters
+    ----------
+    directory : Path
+        The sweep directory, holding a store of this version's format.
+    study : Study
+        The study to resume, as loaded now.
+
+    Raises
+    ------
+    OutputError
+        Another study's sweep, the same study's with another definition (the paths that changed, the
+        case counts, and what to do), or a store that records no study.
+    """
+    readable, stored = _stored_study(directory)
+    if not readable:  # not an SQLite store: claiming the directory says so
+        return
+    source = study.source.name if study.source is not None else "the study"
+    if not isinstance(stored, dict) or not isinstance(stored.get("study"), str):
+        raise OutputError(directory, f"its {STORE_NAME} records no study (it was not written by `slewbench sweep`), so "
+                                     "whether it holds this study's cases cannot be told: --resume continues a sweep "
+                                     "of an unchanged study only; nothing was run or touched. Run the study into a "
+                                     "new directory (another --out)")
+    if stored["study"] != study.name:
+        raise OutputError(directory, f"holds the sweep of study {stored['study']!r}, not {study.name!r}: --resume "
+                                     "continues the same study (its `study:` name), whose stored cases it keeps; "
+                                     "choose another --out (nothing was touched)")
+    before = study_definition(stored, stored.get("scenario"))
+    after = study_definition(study.raw, study.base)
+    changes = [change for key in DEFINING_KEYS if key != "scenario"
+               for change in definition_changes(before[key], after[key], key)]
+    base = study.raw.get("scenario")
+    named = f"base scenario {base}" if isinstance(base, str) else "base scenario (inline)"
+    changes += [f"{named}: {change}" for change in definition_changes(before["scenario"], after["scenario"])]
+    if not changes:
+        return
+    shown = "; ".join(changes[:SHOWN_CHANGES]) + (f"; and {len(changes) - SHOWN_CHANGES} more"
+                                                   if len(changes) > SHOWN_CHANGES else "")
+    resolved = stored.get("resolved")
+    then = resolved.get("cases") if isinstance(resolved, dict) else None
+    counts = f" ({then} cases then, {len(study.cases)} now)" if isinstance(then, int) else ""
+    was = f"{source} and {base} as they were" if isinstance(base, str) else f"{source} as it was"
+    raise OutputError(directory, f"holds the sweep of study {study.name!r} with another definition{counts}, "
+                                 f"changed since: {shown}. --resume continues an unchanged study only (summary, "
+                                 "execution and robustness may change), so that one sweep never holds results of "
+                                 "two definitions; nothing was run or touched. Run the edited study into a new "
+                                 f"directory (another --out), or resume with {was}")
