@@ -77,7 +77,7 @@ def test_the_default_minimum_time_is_the_published_one(exact, name):
     assert shooting["used"] and shooting["from_intervals"] == 8 and shooting["miss"] < 1e-10
     assert reference.stats["certificate"]["verdict"] == "certified"
     assert reference.stats["certificate"]["method"] == "switch-time shooting"
-    assert "exact bang-bang optimum" in reference.message and "N=8 optimum" in reference.message
+    assert "the bang-bang optimum, T = " in reference.message and "RK4" in reference.message and "N=8 optimum" in reference.message
     # from YAML the actuator requirement is on (margin 0): checked between the points, met
     assert reference.stats["dense_check"]["met"] and reference.stats["dense_check"]["rounds"] == 0
 
@@ -135,7 +135,9 @@ def test_without_a_certified_optimum_the_fifty_interval_solve_runs(monkeypatch):
     assert reference.stats["shooting"]["used"] is False
     assert "first-order" in reference.stats["shooting"]["why"]
     assert reference.stats["certificate"]["method"] != "switch-time shooting"
-    assert "exact bang-bang" not in reference.message
+    assert "the bang-bang optimum, T = " not in reference.message
+    # the message says why the full mesh was solved
+    assert "the shooting from the N=8 optimum not used (its certificate: first-order)" in reference.message
 
 
 def test_without_a_converged_shooting_the_fifty_interval_solve_runs(monkeypatch):
@@ -143,6 +145,7 @@ def test_without_a_converged_shooting_the_fifty_interval_solve_runs(monkeypatch)
     reference = plan("bilimoria_wie_180")
     assert reference.ok and reference.intervals == 50 and reference.duration - FINE_BW > 1e-5
     assert reference.stats["shooting"]["used"] is False and "does not converge" in reference.stats["shooting"]["why"]
+    assert "not used (no exact optimum: the shooting does not converge" in reference.message
 
 
 def test_switch_refinement_0_is_the_plain_fifty_interval_answer():
@@ -156,6 +159,6 @@ def test_a_suite_run_scores_the_exact_row_and_shows_its_certificate(tmp_path):
     assert main(["run", "scenarios/bench/problems/bilimoria_wie_180.yaml", "--out", str(out)]) == 0
     rows = {row["label"]: row for row in json.loads((out / "results.json").read_text())["rows"]}
     row = rows["collocation"]
-    assert row["status"] == "ok" and "exact bang-bang optimum" in row["message"]
+    assert row["status"] == "ok" and "the bang-bang optimum, T = " in row["message"]
     assert row["requirements"] and row["reference"]["final_error_deg"] < 1e-3
     assert "switch-time shooting" in json.dumps(row["certificate"]) or "certified" in json.dumps(row["certificate"])

@@ -26,7 +26,7 @@ and the ``seed_planners``, solved by :func:`ocp.nlp.solve.solve_multistart` (its
 stopping); the best converged optimum is kept. With ``multistart: auto`` they are solved on
 ``coarse_intervals`` first and the full mesh once from that optimum and its multipliers (see the
 option). For plain bang-bang minimum time (``switch_refinement: auto``) the full mesh is not solved
-where the switch-time shooting from the coarse optimum reaches the exact bang-bang optimum and
+where the switch-time shooting from the coarse optimum reaches the bang-bang optimum (to its RK4 steps) and
 its certificate (:func:`~planners.collocation.certificate.bang_bang_certificate`) is
 ``certified``: that trajectory is the reference (:meth:`CollocationPlanner._bang_bang`).
 """
@@ -65,6 +65,7 @@ from planners.collocation.allocation import (
     with_allocation,
 )
 from planners.collocation.certificate import (
+    SHOOTING_STEPS,
     bang_bang_certificate,
     collocation_certificate,
     start_violations,
@@ -243,20 +244,23 @@ class CollocationOptions:
         ``mesh_tolerance``, where no estimate could be made (the shooting's reason) or the refinement
         was skipped or did not converge, the record's ``note`` says so and the reference's message
         repeats it (``within_tolerance`` records the refined estimate's verdict): no tolerance is
-        missed silently. Before all this, ``auto`` takes the exact optimum where it can: where the
+        missed silently. Before all this, ``auto`` takes the bang-bang optimum where it can: where the
         estimate applies (see ``mesh_tolerance``) and the coarse mesh was solved first
         (``coarse_intervals``), the switch-time shooting runs from the coarse optimum; where it
         converges, its bang-bang certificate
         (:func:`~planners.collocation.certificate.bang_bang_certificate`) is ``certified`` and the
-        trajectory meets the requirements between its points, the reference is that exact
+        trajectory meets the requirements between its points, the reference is that
         bang-bang trajectory (on ``intervals`` intervals with a node at every switch, its states
         integrated) and nothing is solved on ``intervals`` (Bilimoria & Wie 180°: 3.2430833 s, the
-        50-interval solve's 3.2431108 s; XTE 28.6304052 s against Betts's 28.6304077 s).
+        50-interval solve's 3.2431108 s; XTE 28.6304052 s against Betts's 28.6304077 s). Its T is
+        that of the shooting's RK4 trajectory (12 steps per arc), not of the same switches flown
+        exactly: 1.6e-6 s below it on XTE (28.6304068 s by DOP853), 2e-7 s on the full inertia; the
+        reference's final attitude misses by up to 5e-7 rad there.
         ``stats["shooting"]`` records the shooting from the coarse optimum (``time_error``'s record,
         its ``estimate_s`` the coarse T's error, ``from_intervals``, ``used`` and, where not,
         ``why``), ``stats["certificate"]`` is then the bang-bang certificate and
         ``stats["iterations"]`` the coarse solve's. 0: off (the plain ``intervals`` solve, no
-        shooting); n >= 2: always (never the exact trajectory); another objective, transcription
+        shooting); n >= 2: always (never the shot trajectory); another objective, transcription
         or solver, or 1, is refused.
     mesh_tolerance : float
         With ``switch_refinement: auto``, the estimated discretisation error of a bang-bang minimum
@@ -811,7 +815,7 @@ class CollocationPlanner(Planner):
 
     def _bang_bang(self, problem: ManeuverProblem, ocp: OptimalControlProblem, params: Array, coarse: _Optimum,
                    found: CollocationReference, extra: dict[str, Any]) -> CollocationReference | None:
-        """The exact bang-bang minimum time from the coarse optimum (``switch_refinement: auto``).
+        """The bang-bang minimum time (switch-time shooting) from the coarse optimum (``switch_refinement: auto``).
 
         Where the discretisation error of T can be estimated (:meth:`_time_error`: plain minimum
         time on Radau collocation, a rigid body without cones, rate bound or allocation), the
@@ -871,9 +875,11 @@ class CollocationPlanner(Planner):
         seeds = found.stats.get("seeds") or {}
         agreement = (f", {seeds['agreed']} of {seeds['tried']} seeds agreed there"
                      if "agreed" in seeds and "tried" in seeds else "")
-        reference.message = (f"{o.objective}: the exact bang-bang optimum, T = {T:.8g} s, by switch-time shooting "
+        reference.message = (f"{o.objective}: the bang-bang optimum, T = {T:.8g} s, by switch-time shooting "
                              f"from the N={coarse.intervals} optimum (T = {found.duration:.7g} s{agreement}; "
-                             f"{record['switches']} switches, final miss {record['miss']:.1e}); "
+                             f"{record['switches']} switches; the final miss {record['miss']:.1e} of the shooting's RK4, "
+                             f"{SHOOTING_STEPS} steps per arc: T is that of the RK4 trajectory, within those steps' "
+                             f"error of the same switches flown exactly); "
                              f"{certificate.get('summary', certificate.get('verdict'))}")
         return reference
 
@@ -1379,6 +1385,9 @@ class CollocationPlanner(Planner):
             seeded += f"; estimated discretisation error of T {estimate['estimate_s']:.1e} s"
         if isinstance(refined, dict) and "note" in refined:  # a mesh_tolerance missed or not checked
             seeded += f"; {refined['note']}"
+        shot = solved.extra.get("shooting")
+        if isinstance(shot, dict) and not shot.get("used") and shot.get("why"):  # why the full mesh was solved
+            seeded += f"; the shooting from the N={shot.get('from_intervals')} optimum not used ({shot['why']})"
         reference.message = (f"{o.objective} by {transcription.name} (N={solved.intervals}, {solver}): "
                              f"objective {result.f:.6g}, T = {T:.4g} s, {result.message}{seeded}")
         if solved.intervals == o.intervals or transcription.mesh is not None:  # the final mesh: its certificate
