@@ -138,7 +138,7 @@ def test_verdicts_from_the_evidence():
     assert certificate(small, SecondOrderCheck(True, 0, 1e-6, "curvature above 1e-06"), None)["verdict"] == "certified"
     assert certificate(small, "not checked: big", Switching(0.92, 0.08, 0.0, 0.0, 1e-3))["verdict"] == "first-order"
     record = certificate(small, "strict local minimum", None, seeds=5, seeds_agreed=4)
-    assert record["verdict"] == "certified" and record["summary"] == "certified: KKT 1e-09, SOSC, 4/5 seeds"
+    assert record["verdict"] == "certified" and record["summary"] == "certified: KKT 1e-09, SOSC, 4/5 seeds agreed"
     assert json.loads(json.dumps(record)) == record
 
 
@@ -279,7 +279,7 @@ def test_summary_line_is_rebuilt_with_the_costate_gap_in_its_place():
     from ocp.nlp.certificate import necessary_conditions_certificate, with_costate_gap
     direct = certificate(None, "not checked: no multipliers", seeds=2, seeds_agreed=1)
     updated = with_costate_gap(direct, 4.9e-6)
-    assert updated["summary"] == "not certified: KKT not computed, SOSC not checked, co-state gap 5e-06, 1/2 seeds"
+    assert updated["summary"] == "not certified: KKT not computed, SOSC not checked, co-state gap 5e-06, 1/2 seeds agreed"
     assert direct["costate_gap"] is None and updated["verdict"] == direct["verdict"]  # evidence beside the verdict
     indirect = with_costate_gap(necessary_conditions_certificate(1e-8, "solve_bvp"), 0.25)
     assert indirect["summary"] == ("first-order: solve_bvp residual 1e-08 (Pontryagin's necessary conditions), "
@@ -325,3 +325,42 @@ def test_a_run_cross_checks_the_direct_and_the_costate_optimum_of_one_functional
     rows = {row.label: row for row in run(scenarios.load(path)).rows}
     assert rows["direct"].reference.stats["certificate"]["costate_gap"] is None
     assert rows["indirect"].reference.stats["certificate"]["costate_gap"] is None
+
+
+# --- what the record says of its seeds and its second-order check (report 51 L1) ---
+
+def test_one_start_is_one_seed_not_an_agreement():
+    small = kkt_residuals(small_nlp(lambda x: x[0] ** 2 + x[1] ** 2, lambda x: x[0] + x[1]), [0.5, 0.5], [0.0, 0.0],
+                          [-1.0], lbg=1.0, ubg=1.0)
+    one = certificate(small, "strict local minimum", None, seeds=1, seeds_agreed=1)
+    assert one["summary"].endswith(", SOSC, 1 seed"), one["summary"]
+    assert certificate(small, "strict local minimum", None, seeds=1, seeds_agreed=0)["summary"].endswith(
+        "1 seed, not converged")
+    assert certificate(small, "strict local minimum", None, seeds=2, seeds_agreed=2)["summary"].endswith(
+        "2/2 seeds agreed")
+    assert certificate(small, "strict local minimum", None, seeds=3)["summary"].endswith(", 3 seeds")
+    assert "seed" not in certificate(small, "strict local minimum", None)["summary"]
+
+
+def test_the_record_keeps_the_second_order_checks_numbers():
+    """min x² + y² on x + y = 1 at (1/2, 1/2): H = 2 I on both (free) variables, one active row, so
+    the check certifies at δ = CURVATURE_TOLERANCE × ‖H‖∞ = 2e-6 (the curvature on Z is 2)."""
+    from ocp.nlp.certificate import certify
+    from ocp.nlp.second_order import CURVATURE_TOLERANCE, SecondOrderCheck
+    solver = small_nlp(lambda x: x[0] ** 2 + x[1] ** 2, lambda x: x[0] + x[1])
+    record = certify(solver, np.array([0.5, 0.5]), np.zeros(2), np.array([-1.0]), lbg=1.0, ubg=1.0)
+    assert record["second_order"] == "strict local minimum"
+    detail = record["second_order_detail"]
+    assert detail["certified"] is True and detail["negative_curvatures"] == 0
+    assert detail["curvature_threshold"] == pytest.approx(CURVATURE_TOLERANCE * 2.0, rel=1e-12)
+    assert "on 2 free variables and 1 active rows" in detail["message"], detail
+    # a check not made keeps no made-up numbers (NaN is no JSON), a text keeps none at all
+    small = kkt_residuals(solver, [0.5, 0.5], [0.0, 0.0], [-1.0], lbg=1.0, ubg=1.0)
+    unchecked = certificate(small, SecondOrderCheck(False, -1, float("nan"), "no derivatives"))
+    assert unchecked["second_order_detail"] == {"certified": False, "negative_curvatures": None,
+                                                "curvature_threshold": None, "message": "no derivatives"}
+    saddle = certificate(small, SecondOrderCheck(False, 3, 1e-6, "at most 3 directions"))
+    assert saddle["second_order_detail"]["negative_curvatures"] == 3
+    assert certificate(small, "not checked: no multipliers")["second_order_detail"] is None
+    for made in (record, unchecked):
+        assert json.loads(json.dumps(made, allow_nan=False)) == made

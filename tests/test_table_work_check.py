@@ -57,3 +57,48 @@ def test_the_check_takes_its_limit_and_angles_as_arguments(tmp_path):
     assert "give --max-entries 360" in str(given.value)
     with pytest.raises(ScenarioError, match="expected a positive number of entries, got 0"):
         table_command.check_table_work(spec, entries, max_entries=0)
+
+
+# --- a bare --angles count that reads like degrees (report 51 M3) ---
+
+def test_a_bare_count_that_reads_like_degrees_is_refused_within_the_entry_limit(tmp_path, capsys, monkeypatch):
+    """``--axes 12 --angles 90`` is 12 x 90 = 1080 entries, under the 2000 limit: the user meant the
+    angle 90 deg. Refused before anything is computed or written, naming the count, the work and
+    both ways on; ``--max-entries`` confirms the work."""
+    import scenarios.slewtable.compute as compute
+
+    def computed(*args, **kwargs):
+        raise AssertionError("the table was computed")
+    monkeypatch.setattr(compute, "compute_table", computed)
+    path = table(tmp_path, 12)
+    out = tmp_path / "out"
+    assert 12 * 90 < table_command.MAX_ENTRIES
+    assert main(["table", path, "--angles", "90", "--out", str(out), "--no-plots"]) == 2
+    err = capsys.readouterr().err
+    assert "--angles: 90 is a count: 90 angles" in err and "12 axes x 90 angles = 1080 entries" in err, err
+    assert "not the angle 90 deg" in err and "--angles 60,90,120" in err and "--max-entries 1080" in err, err
+    assert not out.exists()
+
+
+def test_the_count_limit_is_bare_angles_and_max_entries_confirms_the_work(tmp_path, capsys):
+    spec = parse_table_spec(table(tmp_path, 10))  # the check reads the count as given, beside the spec
+    limit = table_command.BARE_ANGLES
+    assert table_command.check_table_work(spec, 10 * limit, angles=str(limit)) is None
+    assert f"--angles {limit} is a count: {limit} angles spread from 10 to 180 deg" in capsys.readouterr().out
+    with pytest.raises(ScenarioError) as over:
+        table_command.check_table_work(spec, 10 * (limit + 1), angles=str(limit + 1))
+    assert over.value.path == "--angles" and f"--max-entries {10 * (limit + 1)}" in over.value.message
+    assert table_command.check_table_work(spec, 900, max_entries=900, angles="90") is None  # confirmed
+    assert "--angles 90 is a count" in capsys.readouterr().out
+    assert table_command.check_table_work(spec, 900, angles="30,90") is None  # a list: degrees, no note
+    assert capsys.readouterr().out == ""
+
+
+def test_a_trailing_comma_makes_a_list_not_a_count():
+    from scenarios.schema.table import angles_from_text
+    assert len(angles_from_text("8")) == 8
+    with pytest.raises(ScenarioError) as one:
+        angles_from_text("90,")  # one angle in degrees: a table needs two
+    assert one.value.path == "--angles" and "at least 2 angles in degrees" in one.value.message
+    assert "got [90.0]" in one.value.message
+    assert angles_from_text("90,180,") == [90.0, 180.0]

@@ -330,6 +330,16 @@ def _second_order_text(check: SecondOrderCheck | str | None) -> str:
     return "not certified: " + check.message
 
 
+def _second_order_detail(check: SecondOrderCheck | str | None) -> dict[str, Any] | None:
+    """The ``second_order_detail`` of the record: the check's numbers (``None`` for a text)."""
+    if not isinstance(check, SecondOrderCheck):
+        return None
+    threshold = float(check.curvature_threshold)
+    return {"certified": bool(check.certified),
+            "negative_curvatures": None if check.negative_curvatures < 0 else int(check.negative_curvatures),
+            "curvature_threshold": threshold if np.isfinite(threshold) else None, "message": check.message}
+
+
 def certificate(kkt: KKTResiduals | None, second_order: SecondOrderCheck | str | None,
                 switching: Switching | None = None, *, costate_gap: float | None = None,
                 seeds: int | None = None, seeds_agreed: int | None = None,
@@ -360,8 +370,13 @@ def certificate(kkt: KKTResiduals | None, second_order: SecondOrderCheck | str |
         ``kkt_scaled``, ``kkt_unscaled``, ``second_order``, ``switching``, ``costate_gap``,
         ``seeds``, ``seeds_agreed``, ``verdict`` (``"certified"`` with the second-order sufficient
         conditions only, ``"first-order, bang-bang"`` with the switching evidence in their place,
-        ``"first-order"`` or ``"not certified"``), ``summary`` (one line) and ``kkt`` (the residuals
-        by kind).
+        ``"first-order"`` or ``"not certified"``), ``summary`` (one line), ``kkt`` (the residuals
+        by kind), ``switching_detail`` (:class:`Switching`'s fractions) and ``second_order_detail``
+        (the check's numbers when ``second_order`` is a :class:`~ocp.nlp.second_order.SecondOrderCheck`:
+        ``certified``, ``negative_curvatures`` (an upper bound on the directions curving below
+        ``−δ``; ``None`` when not checked), ``curvature_threshold`` (the ``δ`` certified at, or
+        checked against; ``None`` when not checked) and ``message`` (the free variables and active
+        rows it was checked on); ``None`` for a text).
     """
     text = _second_order_text(second_order)
     first_order = kkt is not None and kkt.scaled <= kkt_tolerance
@@ -380,7 +395,8 @@ def certificate(kkt: KKTResiduals | None, second_order: SecondOrderCheck | str |
               "costate_gap": costate_gap, "seeds": seeds, "seeds_agreed": seeds_agreed, "verdict": verdict,
               "method": None, "summary": "",
               "kkt": None if kkt is None else asdict(kkt),
-              "switching_detail": None if switching is None else asdict(switching)}
+              "switching_detail": None if switching is None else asdict(switching),
+              "second_order_detail": _second_order_detail(second_order)}
     record["summary"] = summary_line(record)
     return record
 
@@ -396,8 +412,9 @@ def summary_line(record: dict[str, Any]) -> str:
     Returns
     -------
     str
-        ``"<verdict>: KKT ..., SOSC ..., switching ..%, co-state gap .., a/b seeds"`` for a direct
-        solution (the parts it has evidence for); ``"<verdict>: <method> residual ... (Pontryagin's
+        ``"<verdict>: KKT ..., SOSC ..., switching ..%, co-state gap .., 2/2 seeds agreed"`` for a
+        direct solution (the parts it has evidence for; ``1 seed`` when one start was made:
+        ``_seeds_text``); ``"<verdict>: <method> residual ... (Pontryagin's
         necessary conditions)[, gap to the direct solution ..]"`` for an indirect one.
     """
     verdict, gap = record["verdict"], record.get("costate_gap")
@@ -415,9 +432,32 @@ def summary_line(record: dict[str, Any]) -> str:
     if gap is not None:
         parts.append(f"co-state gap {gap:.1g}")
     if record.get("seeds") is not None:
-        agreed = record.get("seeds_agreed")
-        parts.append(f"{agreed if agreed is not None else '?'}/{record['seeds']} seeds")
+        parts.append(_seeds_text(record["seeds"], record.get("seeds_agreed")))
     return f"{verdict}: " + ", ".join(parts)
+
+
+def _seeds_text(tried: int, agreed: int | None) -> str:
+    """What the summary says of the starts: one start is no agreement, several are.
+
+    Parameters
+    ----------
+    tried : int
+        Starts tried (``seeds``).
+    agreed : int or None
+        Starts that reached the optimum (``seeds_agreed``; ``None``: not known).
+
+    Returns
+    -------
+    str
+        ``1 seed`` (one start, which reached the point: nothing to agree with), ``1 seed, not
+        converged``, ``2/2 seeds agreed``, ``1/2 seeds agreed`` (one of two reached the optimum, the
+        other stopped elsewhere), ``3 seeds`` (agreement not known).
+    """
+    if tried == 1:
+        return "1 seed" if agreed != 0 else "1 seed, not converged"
+    if agreed is None:
+        return f"{tried} seeds"
+    return f"{agreed}/{tried} seeds agreed"
 
 
 def _bang_bang_parts(record: dict[str, Any]) -> list[str]:
@@ -440,8 +480,7 @@ def _bang_bang_parts(record: dict[str, Any]) -> list[str]:
         parts.append(f"induced {'SOSC' if checks['second_order'] else 'SOSC fails'} "
                      f"(least eigenvalue {checks['curvature']:.1g})")
     if record.get("seeds") is not None:
-        agreed = record.get("seeds_agreed")
-        parts.append(f"{agreed if agreed is not None else '?'}/{record['seeds']} seeds")
+        parts.append(_seeds_text(record["seeds"], record.get("seeds_agreed")))
     return parts
 
 
@@ -533,6 +572,6 @@ def necessary_conditions_certificate(residual: float, method: str, *, tolerance:
     record = {"kkt_scaled": float(residual), "kkt_unscaled": float(residual),
               "second_order": f"not checked: an indirect solution ({method}), Pontryagin's necessary conditions only",
               "switching": None, "costate_gap": costate_gap, "seeds": None, "seeds_agreed": None, "verdict": verdict,
-              "method": method, "summary": "", "kkt": None, "switching_detail": None}
+              "method": method, "summary": "", "kkt": None, "switching_detail": None, "second_order_detail": None}
     record["summary"] = summary_line(record)
     return record

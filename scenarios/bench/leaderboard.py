@@ -12,7 +12,8 @@ solver iterations (``reference.stats["iterations"]``) and the certificate
 that leaves a boundary condition of the problem free (``Reference.free_boundary``) solves another
 problem: its value is shown, its gap is not; so does a minimum-time row that keeps the scenario's
 duration bound (a fixed-time plan) and a minimum-energy row planned over another duration; a
-minimum-energy row whose rate jumps (an impulse) has no value.
+row whose rate jumps (an impulse, a start the reference declares free included), whose energy is
+not finite, has no value (``-``, null, empty), its note says why.
 """
 from __future__ import annotations
 
@@ -67,7 +68,8 @@ class BenchRow:
         The row's status as the run gives it, its closed loop included (``ok``, ``violated``,
         ``failed``; a peer's ``ok`` or ``failed``).
     value : float or None
-        The objective's value in the problem's unit; ``None`` without a reference.
+        The objective's value in the problem's unit; ``None`` without a reference, and for a
+        reference whose metric is not finite (its rate jumps: an impulse, whose energy is +inf).
     gap_abs : float or None
         ``value − optimum`` in the problem's unit; ``None`` when not comparable.
     gap_rel : float or None
@@ -196,9 +198,13 @@ def _planner_rows(problem: BenchProblem, scenario: Any, results: Any, specs: lis
             message = f"default options (the planner's own objective, not tuned to this problem); {message}"
         free = sorted(getattr(reference, "free_boundary", ()) or ())
         other = _other_problem(problem, scenario, reference, row, timed)
+        infinite = value is not None and not math.isfinite(value)
         if value is not None and other.startswith("impulse"):
             value = gap_abs = gap_rel = None
-        if value is not None and free:
+        elif infinite:  # no value, as a jump the run counts against the plan (other) has none
+            message = f"{_infinite_note(metric, free)}; {message}"
+            value = None
+        if (value is not None or infinite) and free:
             gap_abs = gap_rel = None
             message = f"leaves {', '.join(free)} free: solves another problem, no gap; {message}"
         if other and not (free and not other.startswith("impulse")):
@@ -300,6 +306,16 @@ def _other_problem(problem: BenchProblem, scenario: Any, reference: Any, row: An
             return ("impulse: its rate jumps (no finite torque gives it), so its energy is not finite; no value "
                     "or gap")
     return ""
+
+
+def _infinite_note(metric: str, free: list[str]) -> str:
+    """Why a row whose reference metric is not finite has no value: the metrics count each jump of
+    the rate as an impulse (``int_u2`` +inf, :data:`ocp.metrics.IMPULSE_INFINITE`), a start the
+    reference declares free included (it starts at its own rate, not the problem's)."""
+    where = ("from the problem's initial rate to the rate it starts at (omega0 free)" if "omega0" in free
+             else "")
+    return (f"impulse: its rate jumps{' ' + where if where else ''} (no finite torque gives it), so its {metric} is "
+            "not finite; no value")
 
 
 def _reached(status: str, gap_abs: float | None, problem: BenchProblem) -> bool | None:
@@ -433,7 +449,8 @@ class Leaderboard:
                   "status: the run's, its closed loop included (the bench ranks plans: a tracking controller's "
                   "violation shows there, not in the ✓). Plan time: the second of two plans (a peer's solves), the "
                   "first paying the build and first-call costs; CPU: the process's CPU time (time.process_time), "
-                  "wall: the elapsed time (time.perf_counter), which a loaded machine inflates."), ""]
+                  "wall: the elapsed time (time.perf_counter), which a loaded machine inflates."), "",
+                 VALUE_LEGEND, ""]
         lines += self._summary()
         for problem in self.problems:
             lines += [f"## {problem.name}: {problem.title}", "",
@@ -628,6 +645,17 @@ def _with_tolerance(value: float, tolerance: float) -> str:
     return f"{value:#.{min(max(digits, stated, 1), 17)}g}"
 
 
+VALUE_LEGEND = ("Value: the objective (the reference metric of the problem's objective, the same measure for every "
+                "row); - where there is none: a plan that failed, or a motion whose rate jumps (an impulse, a free "
+                "start included), whose energy is not finite (the note says so). Iterations: what the planner or "
+                "peer reports of its solver (collocation: its NLP solver's iterations; a peer: its solver's), - where "
+                "it reports none (closed forms); methods differ in what one iteration is. Certificate: the evidence "
+                "that a plan is a local optimum of its discretised problem (the verdict, then the KKT residual, SOSC: "
+                "the second-order sufficient conditions, switching: the bang-bang samples on the side of Pontryagin's "
+                "switching function, the co-state gap, and the seeds: 1 seed when one start was made, a/b seeds "
+                "agreed when a of b starts reached the optimum), - where the planner writes none (closed forms, "
+                "peers).")
+"""The legend of the leaderboard's value, iterations and certificate columns, under its header."""
 NOTE_CHARS = 100
 """Longest note in a Markdown table cell: a longer one is cut there and given whole below the table
 (as are the CSV and JSON)."""
@@ -700,7 +728,8 @@ def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Ite
     Returns
     -------
     Leaderboard
-        The rows; peers missing or unable to express a problem are notes.
+        The rows; peers missing, unable to express a problem or not asked on it (the suite's
+        ``peers: {skip: <why>}``) are notes, each with its reason.
 
     Raises
     ------
@@ -741,6 +770,10 @@ def run_bench(suite: Suite, problems: Iterable[str] | None = None, planners: Ite
             finally:
                 restore()
             rows += _planner_rows(problem, scenario, results, specs, cpu)
+        if not problem.peers:  # the index's reason, a note per peer as a peer's own refusal is
+            board.notes += [f"peer {name} not asked on {problem.name}: "
+                            f"{problem.peers_skip or 'the suite does not ask the peers (no reason given)'}"
+                            for name in loaded]
         for name, peer in loaded.items() if problem.peers else ():
             reason = peer.problem_error(scenario.problem, problem.objective)
             if reason is not None:

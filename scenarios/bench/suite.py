@@ -4,7 +4,10 @@
 an ordinary scenario: ``slewbench run`` runs it too), a title, the source of its data, the
 objective, the optimum (the published value or the best known one, its tolerance and where it
 comes from), the eigenaxis comparison value and the planners that apply (the scenario's planner
-rows). The scenario schema is not extended: the metadata lives here.
+rows), and ``peers``: ``true`` (the default: every peer is asked, and one that cannot express the
+problem skips it with its reason as a note) or ``{skip: <why>}`` (no peer is asked; the reason is
+the note of each peer, so that no absence in the leaderboard goes unexplained; a bare ``false`` is
+refused for want of one). The scenario schema is not extended: the metadata lives here.
 """
 from __future__ import annotations
 
@@ -62,9 +65,12 @@ class BenchProblem:
     planners : tuple of str
         The planner registry names that apply (those of the scenario's rows).
     peers : bool
-        Whether the peers are asked to solve it (they skip what they cannot express).
+        Whether the peers are asked to solve it (they skip what they cannot express, each with its
+        reason).
     notes : str
         Anything else a reader must know.
+    peers_skip : str
+        Why the peers are not asked (``peers: {skip: <why>}`` in the index); empty when they are.
     """
 
     name: str
@@ -81,6 +87,7 @@ class BenchProblem:
     planners: tuple[str, ...]
     peers: bool = True
     notes: str = ""
+    peers_skip: str = ""
 
     @property
     def unit(self) -> str:
@@ -100,7 +107,7 @@ class BenchProblem:
                 "tolerance": self.tolerance, "optimum_kind": self.optimum_kind,
                 "optimum_source": self.optimum_source, "eigenaxis": self.eigenaxis,
                 "eigenaxis_source": self.eigenaxis_source, "planners": list(self.planners),
-                "peers": self.peers, "notes": self.notes}
+                "peers": self.peers, "peers_skip": self.peers_skip, "notes": self.notes}
 
 
 @dataclass(frozen=True)
@@ -140,6 +147,19 @@ def _text(entry: dict[str, Any], key: str, where: str) -> str:
     return value.strip()
 
 
+def _peers(entry: dict[str, Any], where: str) -> str:
+    """Why the peers are not asked (``peers: {skip: <why>}``); empty when they are (``peers`` absent
+    or ``true``)."""
+    value = entry.get("peers", True)
+    if value is True:
+        return ""
+    if isinstance(value, dict) and set(value) == {"skip"}:
+        return _text(value, "skip", f"{where}.peers")
+    raise ScenarioError(f"{where}.peers", f"expected true (ask the peers; each skips with a note what it cannot "
+                                         f"express) or {{skip: <why the peers are not asked>}}, got {value!r}: every "
+                                         "absence in the leaderboard needs its reason")
+
+
 def _problem(name: str, entry: Any, folder: Path) -> BenchProblem:
     where = f"problems.{name}"
     if not isinstance(entry, dict):
@@ -162,6 +182,7 @@ def _problem(name: str, entry: Any, folder: Path) -> BenchProblem:
     planners = entry["planners"]
     if not isinstance(planners, list) or not planners or not all(isinstance(p, str) for p in planners):
         raise ScenarioError(f"{where}.planners", f"expected a list of planner names, got {planners!r}")
+    skip = _peers(entry, where)
     file = folder / _text(entry, "file", where)
     if not file.is_file():
         raise ScenarioError(f"{where}.file", f"no scenario file {file.name} beside the index")
@@ -172,7 +193,7 @@ def _problem(name: str, entry: Any, folder: Path) -> BenchProblem:
         optimum_kind=kind, optimum_source=_text(optimum, "source", f"{where}.optimum"),
         eigenaxis=None if eigenaxis.get("value") is None else _number(eigenaxis["value"], f"{where}.eigenaxis.value"),
         eigenaxis_source=_text(eigenaxis, "source", f"{where}.eigenaxis"),
-        planners=tuple(planners), peers=bool(entry.get("peers", True)), notes=str(entry.get("notes", "")).strip())
+        planners=tuple(planners), peers=not skip, notes=str(entry.get("notes", "")).strip(), peers_skip=skip)
 
 
 def load_suite(path: str | Path | None = None) -> Suite:

@@ -57,12 +57,21 @@ MAX_ENTRIES = 2000
 at 1 to 90 s of collocation each, 2000 entries are hours on a few cores."""
 
 
+BARE_ANGLES = 14
+"""Most angles a bare count ``--angles N`` gives without ``--max-entries``: a larger count reads like
+a slew angle in degrees (``--angles 90`` is 90 angles from 10 to 180 deg, not 90 deg: 1080 entries
+on 12 axes), so it is refused before anything runs unless ``--max-entries`` confirms the work (or
+the angles are listed). 14 angles are a step of 13 deg; the default table has 7."""
+
+
 def check_table_work(spec: TableSpec, entries: int, max_entries: int | None = None, angles: str | None = None) -> None:
     """The work a table would take, checked before anything is computed (by ``slewbench table``,
     and by ``slewbench validate`` on a table file, with the default limit).
 
     Says (on standard output) how many axes the grid has when it is not the number asked for, and
-    refuses more than ``max_entries`` entries, naming the count and how to go on.
+    refuses more than ``max_entries`` entries, naming the count and how to go on. A bare count
+    ``--angles N`` is said to be one (on standard output), and one above :data:`BARE_ANGLES`, which
+    reads like an angle in degrees, is refused without ``max_entries`` (given, it confirms the work).
 
     Parameters
     ----------
@@ -73,12 +82,14 @@ def check_table_work(spec: TableSpec, entries: int, max_entries: int | None = No
     max_entries : int or None, optional
         ``--max-entries``: the most entries to compute; ``None`` (default): :data:`MAX_ENTRIES`.
     angles : str or None, optional
-        ``--angles`` as given: a bare count there is explained in the refusal (it is not degrees).
+        ``--angles`` as given: a bare count there is said to be one (it is not degrees), and
+        refused above :data:`BARE_ANGLES` angles without ``max_entries``.
 
     Raises
     ------
     ScenarioError
-        At ``--max-entries``: a limit below 1, or more entries than the limit.
+        At ``--max-entries``: a limit below 1, or more entries than the limit; at ``--angles``: a
+        bare count above :data:`BARE_ANGLES` without ``max_entries``.
     """
     if spec.axes_asked is not None and spec.axes_asked != len(spec.axes):
         print(f"{spec.name}: {_count(spec.axes_asked, 'axis', 'axes')} asked for, the {spec.grid} grid has "
@@ -88,17 +99,32 @@ def check_table_work(spec: TableSpec, entries: int, max_entries: int | None = No
     if max_entries is not None and max_entries < 1:
         raise ScenarioError("--max-entries", f"expected a positive number of entries, got {max_entries}")
     limit = MAX_ENTRIES if max_entries is None else max_entries
-    if entries <= limit:
-        return
     angles = str(angles or "").strip()
+    if entries <= limit:
+        if not angles.isdigit():
+            return
+        count = int(angles)
+        degrees = f", not the angle {count} deg" if count <= 180 else ""
+        if count > BARE_ANGLES and max_entries is None:
+            raise ScenarioError("--angles", f"{count} is a count: {count} angles spread from 10 to 180 deg "
+                                            f"({_work(spec, entries)})"
+                                            f"{degrees}; angles in degrees are a comma-separated list of at least "
+                                            "2 (e.g. --angles 60,90,120; for one slew, slewbench run); to compute "
+                                            f"the {count} angles, confirm the work with --max-entries {entries}")
+        print(f"--angles {count} is a count: {count} angles spread from 10 to 180 deg{degrees} (angles in degrees are "
+              "a comma-separated list, e.g. --angles 30,90)", flush=True)
+        return
     bare = f"; --angles {angles} means {angles} angles spread from 10 to 180 deg, not {angles} deg (angles in " \
            f"degrees are a comma-separated list, e.g. --angles 30,90)" if angles.isdigit() else ""
-    raise ScenarioError("--max-entries", f"{_count(len(spec.axes), 'axis', 'axes')} x "
-                                         f"{_count(len(spec.angles_deg), 'angle')}"
-                        + (f" + the held-out grid's {spec.held_out * len(spec.held_out_angles_deg)}"
-                           if spec.held_out else "")
-                        + f" = {entries} entries, more than {limit} (each a collocation solve: seconds to minutes){bare}; "
-                        f"to compute them all, give --max-entries {entries}")
+    raise ScenarioError("--max-entries", f"{_work(spec, entries)}, more than {limit} (each a collocation solve: "
+                                         f"seconds to minutes){bare}; to compute them all, give --max-entries {entries}")
+
+
+def _work(spec: TableSpec, entries: int) -> str:
+    """``12 axes x 90 angles = 1080 entries``, with the held-out grid's entries when it has one."""
+    return (f"{_count(len(spec.axes), 'axis', 'axes')} x {_count(len(spec.angles_deg), 'angle')}"
+            + (f" + the held-out grid's {spec.held_out * len(spec.held_out_angles_deg)}" if spec.held_out else "")
+            + f" = {entries} entries")
 
 
 def command_table(args: argparse.Namespace) -> int:
@@ -435,7 +461,8 @@ def add_table_parser(commands: Any) -> None:
     parser.add_argument("--grid", help="how the axes are spread: polytope (default: along the actuators' kinks) "
                                        "or fibonacci")
     parser.add_argument("--angles", help="slew angles [deg]: a comma-separated list (e.g. 30,90), or N, a count: "
-                                         "N angles spread from 10 to 180 deg (default 10,30,60,90,120,150,180)")
+                                         "N angles spread from 10 to 180 deg (default 10,30,60,90,120,150,180); "
+                                         f"a count above {BARE_ANGLES} reads like degrees and needs --max-entries")
     parser.add_argument("--max-entries", type=int,
                         help=f"most entries (axes x angles) to compute; more are refused (default {MAX_ENTRIES})")
     parser.add_argument("--objective", help="min_time (default) or min_energy (needs --duration)")

@@ -49,7 +49,8 @@ def _number(value: Any, where: str, what: str) -> float:
 
 
 def angles_from_text(text: str, where: str = "--angles") -> list[float]:
-    """Read ``--angles``: a comma-separated list [deg], or a count (that many from 10 to 180 deg).
+    """Read ``--angles``: a comma-separated list [deg], or a count (that many from 10 to 180 deg):
+    a whole number without a comma (``"90,"`` is a list, of one angle: refused, a table needs two).
 
     Parameters
     ----------
@@ -73,7 +74,7 @@ def angles_from_text(text: str, where: str = "--angles") -> list[float]:
         values = [float(p) for p in parts]
     except ValueError:
         raise ScenarioError(where, f"expected a count or a comma-separated list of angles in degrees, got {text!r}") from None
-    if len(parts) == 1 and parts[0].isdigit():
+    if len(parts) == 1 and parts[0].isdigit() and "," not in str(text):
         count = int(parts[0])
         if count < 2:
             raise ScenarioError(where, f"expected a count of at least 2 angles, got {count}")
@@ -102,7 +103,8 @@ def check_angles(values: Any, where: str) -> list[float]:
         Anything else.
     """
     if not isinstance(values, (list, tuple)) or len(values) < 2:
-        raise ScenarioError(where, f"expected at least 2 angles in degrees, got {values!r}")
+        raise ScenarioError(where, f"expected at least 2 angles in degrees (the table interpolates between them; "
+                                   f"for one slew, slewbench run), got {values!r}")
     angles = sorted(_number(v, where, "angles in degrees") for v in values)
     if angles[0] <= 0.0 or angles[-1] > 180.0:
         raise ScenarioError(where, f"angles must be in (0, 180] degrees, got {values!r}")
