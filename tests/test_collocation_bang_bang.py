@@ -162,3 +162,16 @@ def test_a_suite_run_scores_the_exact_row_and_shows_its_certificate(tmp_path):
     assert row["status"] == "ok" and "the bang-bang optimum, T = " in row["message"]
     assert row["requirements"] and row["reference"]["final_error_deg"] < 1e-3
     assert "switch-time shooting" in json.dumps(row["certificate"]) or "certified" in json.dumps(row["certificate"])
+
+
+def test_the_message_counts_the_coarse_seeds_as_they_were_tried(exact):
+    # the full inertia's coarse multistart tries one seed (nothing to agree with), B&W's two
+    for name in ("full_inertia_150", "bilimoria_wie_180"):
+        seeds = exact[name].stats["seeds"]
+        message = exact[name].message
+        if seeds["tried"] == 1:
+            assert ", from 1 seed;" in message and "of 1 seeds" not in message, message
+        else:
+            assert f", {seeds['agreed']} of {seeds['tried']} seeds agreed there;" in message, message
+    assert exact["full_inertia_150"].stats["seeds"]["tried"] == 1
+    assert exact["bilimoria_wie_180"].stats["seeds"]["tried"] == 2

@@ -873,8 +873,7 @@ class CollocationPlanner(Planner):
             reference.stats["dense_check"] = self._dense_stats(requirements, tightening, check, [])
         shooting["used"] = True
         seeds = found.stats.get("seeds") or {}
-        agreement = (f", {seeds['agreed']} of {seeds['tried']} seeds agreed there"
-                     if "agreed" in seeds and "tried" in seeds else "")
+        agreement = _agreement(seeds)
         reference.message = (f"{o.objective}: the bang-bang optimum, T = {T:.8g} s, by switch-time shooting "
                              f"from the N={coarse.intervals} optimum (T = {found.duration:.7g} s{agreement}; "
                              f"{record['switches']} switches; the final miss {record['miss']:.1e} of the shooting's RK4, "
@@ -1373,8 +1372,7 @@ class CollocationPlanner(Planner):
         seeded = ""
         if isinstance(coarse, dict) and "intervals" in coarse:  # the full mesh solved from the coarse optimum
             seeds = coarse.get("seeds") or {}
-            agreed = (f", {seeds['agreed']} of {seeds['tried']} seeds agreed there"
-                      if "agreed" in seeds and "tried" in seeds else "")
+            agreed = _agreement(seeds)
             seeded = f" (seeded by the N={coarse['intervals']} optimum{agreed})"
         refined = solved.extra.get("switch_refinement")
         if isinstance(refined, dict) and "to_s" in refined:  # the result is the refined mesh's
@@ -1397,3 +1395,13 @@ class CollocationPlanner(Planner):
                                                                      lbx, ubx, solver, reference.stats,
                                                                      solved.switching)
         return reference
+
+
+def _agreement(seeds: dict[str, Any]) -> str:
+    """The coarse multistart's seeds in a reference's message: ``", 2 of 2 seeds agreed there"``,
+    ``", from 1 seed"`` where one was tried (no agreement to speak of), empty without a record."""
+    if "agreed" not in seeds or "tried" not in seeds:
+        return ""
+    if seeds["tried"] == 1:
+        return ", from 1 seed"
+    return f", {seeds['agreed']} of {seeds['tried']} seeds agreed there"
