@@ -5,7 +5,11 @@ reference and the simulation, and which render to JSON, CSV and Markdown (see
 :mod:`scenarios.output.tables`).
 
 Requirements (:mod:`scenarios.requirements`): before anything is planned, a pointing requirement
-that the initial or target attitude already breaks makes every planner's row ``failed``, naming it.
+that the initial or target attitude already breaks (:func:`~scenarios.requirements.scoring.endpoint_violations`)
+makes the planner's row ``failed``, naming it, and a rate requirement that the angle between them
+cannot be turned within T at (:func:`~scenarios.requirements.scoring.rate_violations`) makes it
+``infeasible``; a planner that minimises time (:func:`planners.capabilities.minimises_time`) is
+checked with T as the bound on its slew's time.
 Then each row's reference and closed loop are scored against every requirement; a row that breaks
 one is ``violated`` (never ``ok``), its message naming the requirement, the scope, the margin and
 the time, and a planner that does not honour a kind of requirement present says so in its message.
@@ -55,6 +59,7 @@ from ocp.cache import Unkeyable, exact_key
 from ocp.nlp import with_costate_gap
 from ocp.simulation.simulator import law_raised
 from planners import FailedReference, Reference, ReferenceSample
+from planners.capabilities import minimises_time
 from planners.conformance import check_boundary
 from planners.errors import ConformanceError
 from planners.reference import JUMP_TOLERANCE
@@ -68,6 +73,7 @@ from scenarios.requirements.scoring import (
     endpoint_violations,
     plant_limits,
     rate_jumps,
+    rate_violations,
     reference_times,
     score_closed_loop,
     score_reference,
@@ -274,7 +280,9 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     kept = None if references is None else _Watched(references)
     reused: dict[int, bool] = {}
     scoring = _SCORE_REQUIREMENTS and bool(scenario.requirements)
-    broken_ends = endpoint_violations(scenario.problem) if scoring else []
+    # proven before planning, per planner: a minimum-time planner's slew may end before T (its bound)
+    broken_ends = {i: endpoint_violations(scenario.problem, minimises_time(type(spec.planner), spec.planner.options))
+                   if scoring else [] for i, spec in enumerate(scenario.planners)}
     rows: list[Row] = []
     for label, i, j in labels:
         scores: dict[str, dict[str, Score]] = {}
@@ -288,8 +296,10 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
             if i in scenario.inapplicable:  # a study's case this planner cannot take: its rows fail, unplanned
                 planned.setdefault(i, (FailedReference(planner_spec.name, f"not applicable: {planner_spec.name} cannot "
                                                        f"take this case: {scenario.inapplicable[i]}"), None, None))
-            if broken_ends:  # no planner can meet them: nothing is planned
-                planned.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends)), None, None))
+            if broken_ends[i]:  # proven: no reference can meet them, nothing is planned
+                status = "infeasible" if rate_violations(scenario.problem) else "failed"
+                planned.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends[i]), status),
+                                       None, None))
             if i not in planned:  # planned once, tracked by every controller
                 if kept is not None:
                     kept.reused = False
@@ -301,13 +311,17 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
                       reference, controller=controllers[j].name, plan_reused=reused.get(i, False))
             if reference.ok:
                 _check_physical(row, "reference", row.reference_metrics)
+                if reference.duration > scenario.problem.duration * (1 + 1e-9):  # documented, but said
+                    longer = (f"its slew takes T = {reference.duration:.6g} s, longer than maneuver.duration = "
+                              f"{scenario.problem.duration:g} s (the planner chose its own duration)")
+                    row.message = f"{row.message}; {longer}" if row.message else longer
                 if sampled is not None:
                     scores["reference"] = score_reference(scenario.requirements, scenario.problem, *sampled,
                                                           controllers[j].controller, reference, flown_limits)
                 _simulate(scenario, simulator, reference, row, controllers[j])
             timing = (f"planned in {(row.plan_time_s or 0.0) * 1e3:.1f} ms, "
                       f"simulated in {row.simulate_time_s:.2f} s")
-            note = unhonoured(scenario.requirements, planner_spec.planner) if scoring and not broken_ends else ""
+            note = unhonoured(scenario.requirements, planner_spec.planner) if scoring and not broken_ends[i] else ""
         if scoring and row.simulation is not None:
             end = row.reference.duration if row.reference is not None else scenario.problem.duration
             result = row.simulation

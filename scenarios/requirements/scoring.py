@@ -77,7 +77,7 @@ from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requi
 __all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
            "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
            "endpoint_violations", "plant_limits", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
-           "score_reference", "start_torque", "tracking_loss", "unhonoured", "violations",
+           "rate_violations", "score_reference", "start_torque", "target_slack", "tracking_loss", "unhonoured", "violations",
            "worst_error_between_samples"]
 
 Array = NDArray[np.float64]
@@ -200,6 +200,19 @@ def _pointing(constraint: PointingConstraint, score: PointingScore) -> Score:
     broken = (f"min margin {score.min_margin_deg:.3g} deg at {_seconds(score.min_margin_time_s)} s, "
               f"{_seconds(score.time_in_violation_s)} s {where}")
     return Score(constraint.name, values, False, "; ".join(filter(None, (broken, caveat))))
+
+
+def _after_slew(score: Score, reference: Reference | None) -> Score:
+    """A pointing score of a reference broken only after its slew ends (T = its duration), when
+    the end state is held (or coasts) to the end of the run: said so, with when the cone reaches
+    it, since the slew itself clears the cone (a minimum-time slew ending before
+    ``maneuver.duration``, its target held into a moving cone)."""
+    first = score.values.get("first_violation_s")
+    if score.met or reference is None or first is None or not first > reference.duration * (1 + _TOLERANCE):
+        return score
+    return dataclasses.replace(score, detail=(
+        f"the slew clears it (it ends at T = {reference.duration:.4g} s), but the cone reaches its end state, "
+        f"held after it, at {_seconds(first)} s: {score.detail}"))
 
 
 def _limited(search: str, breach: str, missable_s: float) -> str:
@@ -688,7 +701,8 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
     scores: dict[str, Score] = {}
     if problem.pointing:
         motion = HermiteMotion(*edged)  # one interpolant for the row's pointing requirements
-        scores.update(_pointing_scores(problem.pointing, *edged, motion))
+        pointing = _pointing_scores(problem.pointing, *edged, motion)
+        scores.update({name: _after_slew(score, reference) for name, score in pointing.items()})
     if requirements.actuators is not None and allocation is not None:
         # The demand on the samples and either side of each breakpoint: where the torque (or the
         # rate) may jump, the demand's integration interpolates its inputs linearly between samples
@@ -868,23 +882,41 @@ def score_fields(requirements: Requirements, spacecraft: Spacecraft,
             for scope, fields in (("reference", reference), ("closed_loop", closed_loop))}
 
 
-def endpoint_violations(problem: ManeuverProblem) -> list[str]:
-    """Pointing requirements that the manoeuvre's end points already break, before anything is planned.
+def endpoint_violations(problem: ManeuverProblem, free_time: bool = False) -> list[str]:
+    """Requirements that the manoeuvre's end points already break, before anything is planned.
 
     The initial attitude is checked at t = 0 and the target at T, the manoeuvre's duration
-    (``maneuver.duration``, the time the target attitude is given for; a minimum-time planner's own
-    slew may end at another time), or at the window's start when it opens after T (the target is
-    held), each when the window covers that time. The sentence names that time as what it is.
+    (``maneuver.duration``, the time the target attitude is given for), or at the window's start
+    when it opens after T (the target is held), each when the window covers that time. The sentence
+    names that time as what it is.
+
+    With a free final time (a planner that minimises time,
+    :func:`planners.capabilities.minimises_time`) T only bounds the slew's time: the slew may end
+    at any time up to T. A fixed cone is checked as above (its margin is the same at every time);
+    a moving one (:attr:`~ocp.geometry.pointing.PointingConstraint.moving`) at the target only
+    where that is proven for every time the slew may end: its window covers ``[0, T]`` and the
+    margin at T plus the most it can grow back over T (the constraint's ``drift``, a bound on the
+    margin's rate with the attitude held, times T, :func:`target_slack`) is still negative.
+    Otherwise the slew is planned, and a target held after it into the cone is scored as the row's
+    violation, after planning.
+
+    The rate requirement (``requirements.rate.max``, ω_max) is checked too: the principal angle θ
+    between the initial and the target attitude takes at least ``θ / ω_max`` (the angle changes no
+    faster than ``‖ω‖``), whatever the boundary rates; more than T is refused.
 
     Parameters
     ----------
     problem : ManeuverProblem
         The manoeuvre with its pointing constraints.
+    free_time : bool, optional
+        The row's planner chooses the final time, T its upper bound (default False: the slew ends
+        at T).
 
     Returns
     -------
     list of str
-        One sentence per broken requirement and end (empty when none is broken).
+        One sentence per broken requirement and end, then the rate requirement's (empty when
+        none is broken).
     """
     found = []
     ends: list[tuple[str, Any, float]] = [("initial attitude", problem.q0, 0.0)]
@@ -892,17 +924,96 @@ def endpoint_violations(problem: ManeuverProblem) -> list[str]:
         ends.append(("target attitude", problem.qf, problem.duration))
     for constraint in problem.pointing:
         for words, q, time in ends:
-            time = max(time, constraint.window[0]) if words == "target attitude" else time
+            target = words == "target attitude"
+            time = max(time, constraint.window[0]) if target else time
+            slack = target_slack(constraint, problem.duration, free_time) if target else 0.0
             margin = constraint.margins(np.array([time]), np.asarray(q).reshape(1, 4))[0]
-            if np.isfinite(margin) and margin < 0.0:
-                kind = "keep-out" if constraint.keep_out else "keep-in"
-                # the cone at that time: the angle and its growth (the Earth's apparent radius about the limb)
-                limit = float(np.rad2deg(constraint.limit([time])[0]))
-                grown = f": {constraint.description}" if abs(limit - np.rad2deg(constraint.angle)) > 1e-9 else ""
+            if slack is None or not (np.isfinite(margin) and margin + slack < 0.0):
+                continue
+            kind = "keep-out" if constraint.keep_out else "keep-in"
+            # the cone at that time: the angle and its growth (the Earth's apparent radius about the limb)
+            limit = float(np.rad2deg(constraint.limit([time])[0]))
+            grown = f": {constraint.description}" if abs(limit - np.rad2deg(constraint.angle)) > 1e-9 else ""
+            cone = f"margin {np.rad2deg(margin):.3g} deg to the {limit:.4g} deg {kind} cone{grown}"
+            if slack > 0.0:
+                found.append(f"{constraint.name}: the target attitude breaks it at every time a minimum-time slew "
+                             f"may end, up to maneuver.duration = {problem.duration:g} s ({cone} at "
+                             f"{problem.duration:g} s; the cone moves back by at most {np.rad2deg(slack):.3g} deg "
+                             "before it); no reference can meet it")
+            else:
                 found.append(f"{constraint.name}: the {words} already breaks it {_end_time(words, time, problem)} "
-                             f"(margin {np.rad2deg(margin):.3g} deg to the {limit:.4g} deg {kind} cone{grown}); "
-                             "no reference can meet it")
+                             f"({cone}); no reference can meet it")
+    found += rate_violations(problem)
     return found
+
+
+def target_slack(constraint: PointingConstraint, duration: float, free_time: bool) -> float | None:
+    """How much a pointing constraint's margin at the target, checked at T, may grow back at the
+    earlier times a slew may end (:func:`endpoint_violations`).
+
+    Parameters
+    ----------
+    constraint : PointingConstraint
+        One pointing constraint of the manoeuvre.
+    duration : float
+        The manoeuvre's duration T [s] (``maneuver.duration``).
+    free_time : bool
+        The slew may end at any time up to T (a planner that minimises time).
+
+    Returns
+    -------
+    float or None
+        [rad]: 0 with a fixed final time or a fixed cone (its margin at T is the slew's end's, or
+        the same at every time); for a moving cone with a free final time the most its margin can
+        grow over ``[0, T]`` with the attitude held, ``drift · T``
+        (:attr:`~ocp.geometry.pointing.PointingConstraint.drift`): the target breaks it at every
+        time the slew may end only where its margin at T is below minus that. None: a moving cone
+        whose window does not cover ``[0, T]`` (the slew may end outside it): the target is not
+        checked before planning.
+    """
+    if not (free_time and constraint.moving):
+        return 0.0
+    if constraint.window[0] > 0.0 or constraint.window[1] < duration:
+        return None
+    return float(constraint.drift * duration)
+
+
+def rate_violations(problem: ManeuverProblem) -> list[str]:
+    """The rate requirement that no motion from ``q0`` to ``qf`` within T can meet, before planning
+    (part of :func:`endpoint_violations`; the runner makes such rows ``infeasible``).
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre (its end attitudes, duration T and ``rate_requirement``).
+
+    Returns
+    -------
+    list of str
+        One sentence (θ, ω_max, θ/ω_max and T, with their YAML paths) when ``θ / ω_max > T``,
+        else empty (also without a rate requirement or a target).
+
+    Notes
+    -----
+    The principal angle
+    ``θ`` between them (the shorter way, ±qf) changes no faster than the body turns, ``|dθ/dt| ≤ ‖ω‖``,
+    so a motion with ``‖ω‖ ≤ ω_max`` throughout needs at least ``θ / ω_max``; T bounds the slew
+    (fixed, or the upper bound of a minimum-time slew; a planner that chooses a longer duration of its
+    own, eigenaxis's ``min_time``, is held to it here: a slew that cannot be made within the
+    manoeuvre's duration is not the manoeuvre asked for). Whatever the boundary rates (the bound holds
+    at every time, the ends included). Refused only beyond the scoring's own slack (``_TOLERANCE``).
+    """
+    bound = problem.rate_requirement
+    if bound is None or problem.qf is None:
+        return []
+    theta = 2.0 * float(np.arccos(min(1.0, abs(float(np.dot(problem.q0, problem.qf))))))
+    least = theta / bound
+    if least <= problem.duration * (1.0 + _TOLERANCE):
+        return []
+    return [f"rate: the slew turns {np.rad2deg(theta):.4g} deg (the principal angle from maneuver.initial.q to "
+            f"maneuver.final.q); at ‖ω‖ at most {bound:g} rad/s (requirements.rate.max) it takes at least "
+            f"θ/ω_max = {least:.4g} s, more than the {problem.duration:g} s bound (maneuver.duration); no "
+            "reference within it can meet it"]
 
 
 def _end_time(words: str, time: float, problem: ManeuverProblem) -> str:

@@ -7,8 +7,8 @@ a callable ``slew_time(q0, qf)`` (:mod:`~scenarios.slewtable.fit`), its adaptive
 tolerance (:mod:`~scenarios.slewtable.refine`) and the files (:mod:`~scenarios.slewtable.files`: CSV,
 NetCDF, ``fit.json``, the agility envelope plot).
 
-May import: :mod:`ocp`, :mod:`scenarios.errors`, :mod:`scenarios.requirements`, :mod:`scenarios.schema`,
-:mod:`scenarios.output` and :mod:`scenarios.study`. Its names are imported on first use.
+May import: :mod:`ocp`, :mod:`planners`, :mod:`scenarios.errors`, :mod:`scenarios.requirements`,
+:mod:`scenarios.schema`, :mod:`scenarios.output` and :mod:`scenarios.study`. Its names are imported on first use.
 """
 from __future__ import annotations
 

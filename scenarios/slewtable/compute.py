@@ -7,9 +7,11 @@ given (so a table run again into the same directory computes only the entries it
 whose solve fails, or that breaks a requirement, is kept with its status and message; only the
 ``ok`` entries are interpolated: the fit keeps every axis with its entries' statuses and has no value
 (NaN) in the cells around an entry that is not ``ok`` (``inf`` at an ``infeasible`` one), rather than
-a time the table did not find. An entry whose start or target attitude already breaks a pointing
-requirement (the run's row is ``failed``: "no reference can meet it") is proven impossible: the
-table records it ``infeasible``. A ``min_time`` entry that the planner found slower than a
+a time the table did not find. An entry whose start or target attitude already breaks a
+requirement (the run's row is ``infeasible``: "no reference can meet it") is proven impossible: the
+table records it ``infeasible``. A ``min_time`` entry whose slew meets every requirement, but whose
+target, held after the slew until ``maneuver.duration``, enters a moving cone, is ``ok`` (an entry
+is the slew: its time and feasibility) and its message says when the cone reaches the target. A ``min_time`` entry that the planner found slower than a
 feasible slew of the same problem it knows (its certificate's ``seed_bound`` note: "not the best
 known") stays ``ok`` and is fitted (its time is achieved by its own reference), and is marked
 (:attr:`TablePart.best_known` false; the fit's note counts them).
@@ -187,7 +189,11 @@ def end_cones(scenario: dict[str, Any]) -> np.ndarray:
 
     The same check as an entry's own (:func:`scenarios.requirements.scoring.endpoint_violations`):
     the target at the scenario's duration, or at a window's start when it opens later; a cone whose
-    window has closed by then is left out.
+    window has closed by then is left out. For a ``min_time`` table (T only bounds the slew) a
+    moving cone is narrowed (a keep-out) or widened (a keep-in) by how far it may move back over
+    ``[0, T]`` (:func:`~scenarios.requirements.scoring.target_slack`): inside it the target breaks the
+    cone whenever the slew ends; one whose window does not cover ``[0, T]``, or that nothing
+    breaks at every such time, is left out.
 
     Parameters
     ----------
@@ -202,32 +208,64 @@ def end_cones(scenario: dict[str, Any]) -> np.ndarray:
         (:class:`~scenarios.slewtable.fit.SlewTimeFit`'s ``end_cones``); no rows without pointing
         requirements.
     """
+    from scenarios.requirements.scoring import target_slack
     from scenarios.schema.loader import parse_scenario
-    problem = parse_scenario(scenario).problem
+    parsed = parse_scenario(scenario)
+    problem = parsed.problem
+    free_time = _free_time(parsed)
     rows = []
     for constraint in problem.pointing:
         time = max(float(problem.duration), constraint.window[0])
-        if not bool(constraint.in_window([time])[0]):
+        slack = target_slack(constraint, float(problem.duration), free_time)
+        if not bool(constraint.in_window([time])[0]) or slack is None:
             continue
+        # a minimum-time slew may end before T: a moving cone narrowed by how far it can move back
+        limit = float(constraint.limit([time])[0]) + (-slack if constraint.keep_out else slack)
+        if not 0.0 < limit < math.pi:
+            continue  # no attitude breaks it at every time the slew may end
         direction = constraint.direction([time])[0]
-        rows.append([*constraint.boresight, *direction, math.cos(float(constraint.limit([time])[0])),
-                     1.0 if constraint.keep_out else 0.0])
+        rows.append([*constraint.boresight, *direction, math.cos(limit), 1.0 if constraint.keep_out else 0.0])
     return np.array(rows, dtype=float).reshape(-1, 8)
 
 
 def _proven_infeasible(scenario: dict[str, Any]) -> bool:
-    """Whether the entry's start or target attitude already breaks a pointing requirement (then no
-    slew can meet it: the run's row is ``failed`` without planning)."""
+    """Whether the entry's start or target attitude already breaks a requirement (then no slew can
+    meet it: the run's row is ``infeasible`` without planning; rows stored by a version that
+    called it ``failed`` are read the same), as the run checks it for the entry's planner
+    (a ``min_time`` one: ``maneuver.duration`` bounds the slew's end)."""
     from scenarios.errors import ScenarioError
     from scenarios.requirements.scoring import endpoint_violations
     from scenarios.schema.loader import parse_scenario
     if not scenario:
         return False
     try:
-        problem = parse_scenario(scenario).problem
+        parsed = parse_scenario(scenario)
     except ScenarioError:
         return False
-    return bool(endpoint_violations(problem))
+    return bool(endpoint_violations(parsed.problem, _free_time(parsed)))
+
+
+def _free_time(parsed: Any) -> bool:
+    """Whether the entry's planner minimises time (:func:`planners.capabilities.minimises_time`)."""
+    from planners.capabilities import minimises_time
+    return any(minimises_time(type(spec.planner), spec.planner.options) for spec in parsed.planners)
+
+
+def _broken_after_slew(row: dict[str, Any]) -> bool:
+    """Whether a ``violated`` row breaks only pointing requirements, each first after its slew ends
+    (the target held into a moving cone before ``maneuver.duration``): its reference's scores, and
+    the token closed loop's for those requirements only."""
+    from scenarios.requirements.fields import VERDICT
+    requirements = row.get("requirements") or {}
+    duration = (row.get("reference") or {}).get("duration_s")
+    reference = requirements.get("reference") or {}
+    broken = {name: values for name, values in reference.items() if not values.get(VERDICT, True)}
+    if duration is None or not broken:
+        return False
+    late = all(values.get("first_violation_s") is not None and values["first_violation_s"] > float(duration)
+               for values in broken.values())
+    loop = {name for name, values in (requirements.get("closed_loop") or {}).items() if not values.get(VERDICT, True)}
+    return late and loop <= set(broken)
 
 
 def slower_than_known(row: dict[str, Any]) -> str:
@@ -297,6 +335,8 @@ def _fill(part: TablePart, case: TableCase, record: dict[str, Any] | None, objec
     if part.status[i][k] == "failed" and _proven_infeasible(case.scenario):
         part.status[i][k] = "infeasible"
     part.message[i][k] = str(row.get("message") or "")
+    if part.status[i][k] == "violated" and objective == "min_time" and _broken_after_slew(row):
+        part.status[i][k] = "ok"  # the slew meets them: only its target, held after it, does not (message)
     if part.status[i][k] == "crashed" and _timed_out(record):
         part.status[i][k] = "timed_out"  # ran out of case_timeout_s: no error, the time unknown
         part.message[i][k] = timed_out_message(part.message[i][k])
