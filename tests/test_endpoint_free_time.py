@@ -190,3 +190,17 @@ def test_rate_proof_holds_whatever_the_boundary_rates():
     roomy = copy.deepcopy(data)
     roomy["requirements"]["rate"]["max"] = 0.05
     assert endpoint_violations(scenarios.parse_scenario(roomy).problem) == []
+
+
+def test_validate_names_only_the_rows_the_end_points_doom():
+    """``validate`` proves it per planner as the runner does: the fixed-time row is doomed by the
+    limb at 120 s, the minimum-time row is not (its slew may end before)."""
+    from scenarios.cli.commands import _doomed_notes
+
+    data = sat6u(TARGET, {**EIGENAXIS, "label": "fastest"})
+    data["planners"].append({**SMOOTH, "label": "smooth"})
+    notes = _doomed_notes(scenarios.parse_scenario(data))
+    assert [note.split(": ")[0] for note in notes] == ["the row of smooth fails before planning"], notes
+    assert "st_limb: the target attitude already breaks it at 120 s" in notes[0]
+    alone = _doomed_notes(scenarios.parse_scenario(sat6u(TARGET, {**SMOOTH, "label": "smooth"})))
+    assert [note.split(": ")[0] for note in alone] == ["every planner's row fails before planning"], alone

@@ -278,6 +278,7 @@ def _doomed_notes(scenario: Scenario) -> list[str]:
     list of str
         One line per such finding (empty when a row may succeed).
     """
+    from planners.capabilities import minimises_time
     from scenarios.requirements.scoring import endpoint_violations
     from scenarios.schema.checks import rate_bound_notes
 
@@ -287,8 +288,14 @@ def _doomed_notes(scenario: Scenario) -> list[str]:
         lines += ["every planner's row fails, none can take it: "
                   + "; ".join(scenario.inapplicable[i] for i in sorted(scenario.inapplicable))]
     if requirements and scenario.planners:
-        lines += [f"every planner's row fails before planning: {broken}"
-                  for broken in endpoint_violations(scenario.problem)]
+        # per planner, as the runner proves it: a minimum-time planner's slew may end before T (its bound)
+        broken = {spec.label: endpoint_violations(scenario.problem, minimises_time(type(spec.planner), spec.planner.options))
+                  for spec in scenario.planners}
+        for sentence in dict.fromkeys(sentence for found in broken.values() for sentence in found):
+            rows = [label for label, found in broken.items() if sentence in found]
+            who = ("every planner's row fails" if len(rows) == len(broken)
+                   else f"the rows of {', '.join(rows)} fail" if len(rows) > 1 else f"the row of {rows[0]} fails")
+            lines.append(f"{who} before planning: {sentence}")
     if requirements.rate is not None:  # a boundary rate above the bound: every row breaks it
         lines += rate_bound_notes(scenario.problem, scenario.simulation, requirements.rate.max_rate)
     return lines
