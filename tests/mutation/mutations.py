@@ -686,8 +686,8 @@ MUTATIONS: list[Mutation] = [
              "        if ratio > 1.0 + _TOLERANCE:\n",
              ("tests/test_requirements_actuators.py::test_ratios_and_the_actuator_score",)),
     Mutation("endpoint-target-checked-before-its-window-opens", "scenarios/requirements/scoring.py",
-             'time = max(time, constraint.window[0]) if words == "target attitude" else time',
-             'time = min(time, constraint.window[0]) if words == "target attitude" else time',
+             'time = max(time, constraint.window[0]) if target else time',
+             'time = min(time, constraint.window[0]) if target else time',
              ("tests/test_requirements_scoring.py::test_end_points_that_already_break_a_keep_out_are_named",
               "tests/test_mutants_scoring.py::test_a_target_held_until_a_later_window_is_checked_when_the_window_opens")),
     # the work limit of the search between samples and its zooms
