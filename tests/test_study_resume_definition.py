@@ -190,3 +190,18 @@ def test_definition_changes_name_each_path_and_the_order_of_the_cases():
     assert definition_changes({"kp": many}, {"kp": many[1:]}) == ["kp: 16 values -> 15, removed [0.0]"]
     assert definition_changes({"kp": many}, {"kp": [5.0, *many[2:]]}) == [
         "kp: 16 values -> 15, added [5.0], removed [0.0, 0.1]"]
+
+
+def test_a_dry_run_resume_refuses_what_the_resume_would(partial, capsys):
+    """``--dry-run --resume`` on an edited study: refused like the resume itself, not "checked"."""
+    folder, _, out = partial
+    path = write_study(folder, values=[0.2, 0.35])
+    before = snapshot(out)
+    capsys.readouterr()
+    assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--dry-run", "--resume"]) == 2
+    assert "grid.controller.options.kp[1]: 0.3 -> 0.35" in capsys.readouterr().err
+    assert snapshot(out) == before
+    # unchanged, the dry run lists the cases
+    path = write_study(folder)
+    assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--dry-run", "--resume"]) == 0
+    assert snapshot(out) == before

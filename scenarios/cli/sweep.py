@@ -326,6 +326,8 @@ def command_sweep(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return EXIT_INTERRUPTED
     if args.dry_run:
+        if args.resume:  # what the real resume would refuse, it refuses (nothing is written either way)
+            _output(args, study)
         _list_cases(study, args.workers or study.execution.workers or _local_workers())
         return EXIT_OK
     where = "--scheduler" if scheduler else "execution.scheduler"

@@ -7,9 +7,10 @@ given (so a table run again into the same directory computes only the entries it
 whose solve fails, or that breaks a requirement, is kept with its status and message; only the
 ``ok`` entries are interpolated: the fit keeps every axis with its entries' statuses and has no value
 (NaN) in the cells around an entry that is not ``ok`` (``inf`` at an ``infeasible`` one), rather than
-a time the table did not find. An entry whose start or target attitude already breaks a
-requirement (the run's row is ``infeasible``: "no reference can meet it") is proven impossible: the
-table records it ``infeasible``. A ``min_time`` entry whose slew meets every requirement, but whose
+a time the table did not find. An entry proven impossible before planning (its start or target
+attitude already breaks a pointing requirement, where the run's row is ``failed``, or its angle
+needs longer than ``maneuver.duration`` at the rate bound, where it is ``infeasible``; both say
+"no reference can meet it") is recorded ``infeasible`` by the table. A ``min_time`` entry whose slew meets every requirement, but whose
 target, held after the slew until ``maneuver.duration``, enters a moving cone, is ``ok`` (an entry
 is the slew: its time and feasibility) and its message says when the cone reaches the target. A ``min_time`` entry that the planner found slower than a
 feasible slew of the same problem it knows (its certificate's ``seed_bound`` note: "not the best
@@ -229,10 +230,11 @@ def end_cones(scenario: dict[str, Any]) -> np.ndarray:
 
 
 def _proven_infeasible(scenario: dict[str, Any]) -> bool:
-    """Whether the entry's start or target attitude already breaks a requirement (then no slew can
-    meet it: the run's row is ``infeasible`` without planning; rows stored by a version that
-    called it ``failed`` are read the same), as the run checks it for the entry's planner
-    (a ``min_time`` one: ``maneuver.duration`` bounds the slew's end)."""
+    """Whether the entry is proven impossible before planning (:func:`~scenarios.requirements.scoring.endpoint_violations`:
+    its start or target attitude already breaks a pointing requirement, the run's row ``failed``;
+    or its angle needs longer than ``maneuver.duration`` at the rate bound, the row ``infeasible``),
+    as the run checks it for the entry's planner (a ``min_time`` one: ``maneuver.duration`` bounds
+    the slew's end). The table records either as ``infeasible``."""
     from scenarios.errors import ScenarioError
     from scenarios.requirements.scoring import endpoint_violations
     from scenarios.schema.loader import parse_scenario
