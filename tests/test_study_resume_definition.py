@@ -178,7 +178,9 @@ def test_definition_changes_name_each_path_and_the_order_of_the_cases():
     assert definition_changes(before["monte_carlo"], reordered, "monte_carlo") == [
         "monte_carlo.dispersions: its keys in another order (x, y -> y, x), which orders the cases"]
     assert definition_changes(before["scenario"], after["scenario"]) == [
-        "planners[0].options.w: 1 -> 2", "d: 1.0 -> 1", "e: added (True)"]
+        "planners[0].options.w: 1 -> 2",
+        "d: 1.0 -> 1 (the same value as another type, float -> int: the cases' keys are computed from it as written)",
+        "e: added (True)"]
     assert definition_changes({"s": {"k": 1}}, {"s": {"k": 1, "j": 2}, "t": 3}) == ["s.j: added (2)", "t: added (3)"]
     assert definition_changes({"p": [{"a": 1}]}, {"p": [{"a": 1}, {"a": 2}]}) == [
         "p: [{'a': 1}] -> [{'a': 1}, {'a': 2}]"]
@@ -205,3 +207,14 @@ def test_a_dry_run_resume_refuses_what_the_resume_would(partial, capsys):
     path = write_study(folder)
     assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--dry-run", "--resume"]) == 0
     assert snapshot(out) == before
+
+
+def test_a_number_written_as_another_type_is_named_so(partial, capsys):
+    """60.0 -> 60: equal numbers, but the cases' keys hash the value as written, so the stored cases
+    would not be found; the refusal says that this is all that changed."""
+    folder, _, out = partial
+    base = copy.deepcopy(BASE)
+    assert isinstance(base["maneuver"]["duration"], float) and base["maneuver"]["duration"].is_integer()
+    base["maneuver"]["duration"] = int(base["maneuver"]["duration"])
+    error = refused(write_study(folder, base=base), out, capsys)
+    assert "(the same value as another type, float -> int: the cases' keys are computed from it as written)" in error

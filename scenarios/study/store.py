@@ -630,6 +630,9 @@ def definition_changes(before: Any, after: Any, path: str = "") -> list[str]:
         return []
     if before is None or after is None:  # an entry given or dropped (monte_carlo)
         return [f"{path}: added ({excerpt(after, 60)})" if before is None else f"{path}: removed (was {excerpt(before, 60)})"]
+    if before == after:  # 60.0 -> 60: the value written another way, which keys the cases anew
+        return [f"{path}: {excerpt(before, 60)} -> {excerpt(after, 60)} (the same value as another type, "
+                f"{type(before).__name__} -> {type(after).__name__}: the cases' keys are computed from it as written)"]
     return [f"{path}: {excerpt(before, 60)} -> {excerpt(after, 60)}"]
 
 
