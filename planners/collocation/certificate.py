@@ -36,6 +36,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.model import AttitudeModel
 from ocp.fast_call import matrices
 from ocp.nlp.certificate import (
@@ -364,11 +365,8 @@ def _shooting(model: AttitudeModel, arcs: int, fixed_rate: bool) -> ca.Function:
     With more ``arcs`` than conditions, ``(x0, z, U, d, xf, λ) -> (r, ∂r/∂z, ∇²_z λᵀ r)``."""
     xt, u, h, d = ca.SX.sym("xt", model.nx + 1), ca.SX.sym("u", model.nu), ca.SX.sym("h"), ca.SX.sym("d", 3)
     x, t = xt[:-1], xt[-1]
-    k1 = model.rhs(x, u, t, d)
-    k2 = model.rhs(x + h / 2 * k1, u, t + h / 2, d)
-    k3 = model.rhs(x + h / 2 * k2, u, t + h / 2, d)
-    k4 = model.rhs(x + h * k3, u, t + h, d)
-    step = ca.Function("rk4", [xt, u, h, d], [ca.vertcat(x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4), t + h)])
+    after = rk4_step(lambda state, time: model.rhs(state, u, time, d), x, t, h)
+    step = ca.Function("rk4", [xt, u, h, d], [ca.vertcat(after, t + h)])
     arc = step.fold(SHOOTING_STEPS)  # an MX graph of folds: built in milliseconds, unlike its SX expansion
     x0, z, U = ca.MX.sym("x0", model.nx), ca.MX.sym("z", arcs), ca.MX.sym("U", model.nu, arcs)
     disturbance, xf = ca.MX.sym("d", 3), ca.MX.sym("xf", model.nx)
@@ -595,11 +593,8 @@ def _costate_shooting(model: AttitudeModel, arcs: int, fixed_rate: bool) -> ca.F
     xt, u, h, d, e = (ca.SX.sym("xt", nx + 1), ca.SX.sym("u", model.nu), ca.SX.sym("h"), ca.SX.sym("d", 3),
                       ca.SX.sym("e", nx))
     x, t = xt[:-1], xt[-1]
-    k1 = model.rhs(x, u, t, d)
-    k2 = model.rhs(x + h / 2 * k1, u, t + h / 2, d)
-    k3 = model.rhs(x + h / 2 * k2, u, t + h / 2, d)
-    k4 = model.rhs(x + h * k3, u, t + h, d)
-    step = ca.Function("rk4", [xt, u, h, d, e], [ca.vertcat(x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4) + e, t + h)])
+    after = rk4_step(lambda state, time: model.rhs(state, u, time, d), x, t, h)
+    step = ca.Function("rk4", [xt, u, h, d, e], [ca.vertcat(after + e, t + h)])
     arc = step.mapaccum(SHOOTING_STEPS)
     S = SHOOTING_STEPS
     x0, z, U = ca.MX.sym("x0", nx), ca.MX.sym("z", arcs), ca.MX.sym("U", model.nu, arcs)

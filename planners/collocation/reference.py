@@ -53,6 +53,7 @@ from numpy.typing import NDArray
 
 from ocp import quat
 from ocp.cache import RecentCache
+from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.model import AttitudeModel
 from ocp.geometry import PointingConstraint
 from ocp.transcription.base import Transcription
@@ -720,11 +721,7 @@ def _radau_steps(model: AttitudeModel, tau: Array) -> ca.Function:
         step = (b - a) * h / BANG_BANG_SUBSTEPS
         for _ in range(BANG_BANG_SUBSTEPS):
             x, t = state[:-1], state[-1]
-            k1 = model.rhs(x, u, t, d)
-            k2 = model.rhs(x + step / 2 * k1, u, t + step / 2, d)
-            k3 = model.rhs(x + step / 2 * k2, u, t + step / 2, d)
-            k4 = model.rhs(x + step * k3, u, t + step, d)
-            state = ca.vertcat(x + step / 6 * (k1 + 2 * k2 + 2 * k3 + k4), t + step)
+            state = ca.vertcat(rk4_step(lambda y, time: model.rhs(y, u, time, d), x, t, step), t + step)
         columns.append(state[:-1])
     return ca.Function("radau_steps", [xt, u, h, d], [state, ca.horzcat(*columns)])
 
