@@ -21,6 +21,7 @@ from controllers import CONTROLLERS
 from controllers.allocation import _CHUNK, model_rows, reference_demand
 from ocp import AttitudeModel, CircularOrbit, Environment, ReactionWheels, Spacecraft
 from scenarios.requirements import scoring
+from tests.test_batched_demand import _states as _motion
 from tests.test_requirements_free_start_wheels import SPHERE as FREE_START_SPHERE
 
 INERTIA = np.array([[0.25, 0.01, -0.02], [0.01, 0.28, 0.015], [-0.02, 0.015, 0.12]])
@@ -34,12 +35,6 @@ def _model() -> AttitudeModel:
     return AttitudeModel(spacecraft, Environment(orbit=ORBIT, gravity_gradient=True,
                                                  disturbance_torque=np.array([1e-6, -2e-6, 5e-7])))
 
-
-def _motion(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    t = np.sort(rng.uniform(0.0, 300.0, n))
-    q = rng.normal(size=(n, 4))
-    q /= np.linalg.norm(q, axis=1, keepdims=True)
-    return t, q, rng.normal(0.0, 0.05, (n, 3)), rng.normal(0.0, 2e-3, (n, 3))
 
 
 def test_the_demand_given_the_scorers_environment_torque_is_the_demand_alone():
