@@ -102,3 +102,73 @@ def test_a_trailing_comma_makes_a_list_not_a_count():
     assert one.value.path == "--angles" and "at least 2 angles in degrees" in one.value.message
     assert "got [90.0]" in one.value.message
     assert angles_from_text("90,180,") == [90.0, 180.0]
+
+
+# --- a table file's bare count is checked as the flag's, at its YAML path (report 52) ---
+
+def _counted(folder, angles, axes=12):
+    """A table file of ``axes`` Fibonacci axes whose ``angles_deg`` is ``angles`` as written."""
+    from tests.test_validate_files import BOX, write
+    write(folder, "box.yaml", BOX)
+    return write(folder, "table.yaml", {"table": {"scenario": "box.yaml", "axes": axes, "grid": "fibonacci",
+                                                  "angles_deg": angles}})
+
+
+def test_a_table_files_bare_count_that_reads_like_degrees_is_refused_at_its_yaml_path(tmp_path, capsys, monkeypatch):
+    """``angles_deg: 90`` on 12 axes is 1080 entries, under the 2000 limit: the file meant 90 deg.
+    ``table`` refuses it before computing, naming the YAML path, the count, the work and both ways
+    on; ``validate`` foretells it (a finding); ``--max-entries`` confirms the work."""
+    import scenarios.slewtable.compute as compute
+
+    def computed(*args, **kwargs):
+        raise AssertionError("the table was computed")
+    monkeypatch.setattr(compute, "compute_table", computed)
+    path = _counted(tmp_path, 90)
+    out = tmp_path / "out"
+    assert main(["table", path, "--out", str(out), "--no-plots"]) == 2
+    err = capsys.readouterr().err
+    assert "table.angles_deg: 90 is a count: 90 angles spread from 10 to 180 deg" in err, err
+    assert "12 axes x 90 angles = 1080 entries" in err and "not the angle 90 deg" in err, err
+    assert "angles_deg: [60, 90, 120]" in err and "--max-entries 1080" in err and "Traceback" not in err, err
+    assert not out.exists()
+    assert main(["validate", path, "--strict"]) == 1
+    assert "table.angles_deg: 90 is a count" in capsys.readouterr().out
+    spec = parse_table_spec(path)
+    assert (spec.angles_count, spec.angles_where) == (90, "table.angles_deg")
+    assert table_command.check_table_work(spec, 1080, max_entries=1080) is None  # confirmed
+    assert "table.angles_deg: 90 is a count: 90 angles" in capsys.readouterr().out
+
+
+def test_a_table_files_small_count_is_said_to_be_one_and_a_flag_wins_over_it(tmp_path, capsys):
+    spec = parse_table_spec(_counted(tmp_path, table_command.BARE_ANGLES, axes=4))
+    assert len(spec.angles_deg) == table_command.BARE_ANGLES
+    assert table_command.check_table_work(spec, 4 * table_command.BARE_ANGLES) is None
+    assert f"table.angles_deg: {table_command.BARE_ANGLES} is a count" in capsys.readouterr().out
+    flagged = parse_table_spec(_counted(tmp_path, 90, axes=4), {"angles": "30,90"})  # the flag's list wins
+    assert flagged.angles_count is None and flagged.angles_deg == [30.0, 90.0]
+    assert table_command.check_table_work(flagged, 8) is None and capsys.readouterr().out == ""
+    counted = parse_table_spec(_counted(tmp_path, [30, 90], axes=4), {"angles": "40"})  # the flag's count
+    with pytest.raises(ScenarioError) as flag:
+        table_command.check_table_work(counted, 160)
+    assert flag.value.path == "--angles" and "40 is a count" in flag.value.message
+    listed = parse_table_spec(_counted(tmp_path, [30, 90], axes=4))  # a list: degrees, no note
+    assert listed.angles_count is None and table_command.check_table_work(listed, 8) is None
+    assert capsys.readouterr().out == ""
+
+
+@pytest.mark.parametrize("written", [90.0, 2.0, 1e2])
+def test_a_lone_number_that_is_not_whole_is_neither_a_count_nor_angles(tmp_path, capsys, written):
+    """``angles_deg: 90.0`` is not a count (a whole number) and one angle is not a table: refused
+    at its YAML path, naming the value and both forms."""
+    assert main(["validate", _counted(tmp_path, written)]) == 2
+    err = capsys.readouterr().err
+    assert "table.angles_deg" in err and f"got the lone number {written!r}" in err, err
+    assert "a list of at least 2 angles in degrees" in err and "a count of angles" in err and "Traceback" not in err
+
+
+def test_the_schema_says_a_bare_number_is_a_count_not_degrees():
+    from scenarios.schema.table import TABLE
+    key = TABLE["angles_deg"]
+    # the reference writes the unit after the type: it reads as the list's, the count's said to be a count
+    assert f"{key.type} [{key.unit}]" == "a whole number (a count of angles), or a list of angles [deg]"
+    assert "a whole number ``n``, a count, not an angle" in key.meaning

@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from scenarios.cli.commands import STRICT_LINES_SHOWN, main
-from scenarios.cli.table import MAX_ENTRIES
+from scenarios.cli.table import BARE_ANGLES, MAX_ENTRIES
 from tests.test_validate_files import study, table
 
 PAGE = Path(__file__).resolve().parents[1] / "docs" / "guide" / "requirements.rst"
@@ -58,3 +58,4 @@ def test_the_limits_the_page_states_are_the_codes():
     words = {10: "ten"}
     assert f"the first {words[STRICT_LINES_SHOWN]};" in text
     assert f"without ``--max-entries`` ({MAX_ENTRIES})" in text
+    assert f"reads like an angle in degrees (above {BARE_ANGLES})" in text

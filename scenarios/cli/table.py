@@ -58,10 +58,11 @@ at 1 to 90 s of collocation each, 2000 entries are hours on a few cores."""
 
 
 BARE_ANGLES = 14
-"""Most angles a bare count ``--angles N`` gives without ``--max-entries``: a larger count reads like
-a slew angle in degrees (``--angles 90`` is 90 angles from 10 to 180 deg, not 90 deg: 1080 entries
-on 12 axes), so it is refused before anything runs unless ``--max-entries`` confirms the work (or
-the angles are listed). 14 angles are a step of 13 deg; the default table has 7."""
+"""Most angles a bare count (``--angles N``, or ``angles_deg: N`` in a table file) gives without
+``--max-entries``: a larger count reads like a slew angle in degrees (``--angles 90`` is 90 angles
+from 10 to 180 deg, not 90 deg: 1080 entries on 12 axes), so it is refused before anything runs
+unless ``--max-entries`` confirms the work (or the angles are listed). 14 angles are a step of
+13 deg; the default table has 7."""
 
 
 def check_table_work(spec: TableSpec, entries: int, max_entries: int | None = None, angles: str | None = None) -> None:
@@ -69,53 +70,59 @@ def check_table_work(spec: TableSpec, entries: int, max_entries: int | None = No
     and by ``slewbench validate`` on a table file, with the default limit).
 
     Says (on standard output) how many axes the grid has when it is not the number asked for, and
-    refuses more than ``max_entries`` entries, naming the count and how to go on. A bare count
-    ``--angles N`` is said to be one (on standard output), and one above :data:`BARE_ANGLES`, which
-    reads like an angle in degrees, is refused without ``max_entries`` (given, it confirms the work).
+    refuses more than ``max_entries`` entries, naming the count and how to go on. Angles given as a
+    bare count (``--angles N``, or ``angles_deg: N`` in the table file) are said to be one (on
+    standard output), and a count above :data:`BARE_ANGLES`, which reads like an angle in degrees,
+    is refused without ``max_entries`` (given, it confirms the work), at the flag or YAML path that
+    gave it.
 
     Parameters
     ----------
     spec : TableSpec
-        The table (its axes, angles and held-out grid).
+        The table (its axes, angles and held-out grid; :attr:`~scenarios.slewtable.spec.TableSpec.angles_count`
+        the count its angles were given as, and where).
     entries : int
         Its number of entries: axes x angles, plus the held-out grid's.
     max_entries : int or None, optional
         ``--max-entries``: the most entries to compute; ``None`` (default): :data:`MAX_ENTRIES`.
     angles : str or None, optional
-        ``--angles`` as given: a bare count there is said to be one (it is not degrees), and
-        refused above :data:`BARE_ANGLES` angles without ``max_entries``.
+        ``--angles`` as given (a bare count there is checked at ``--angles``); ``None``: the
+        count the spec records, if any (a flag's or the table file's).
 
     Raises
     ------
     ScenarioError
-        At ``--max-entries``: a limit below 1, or more entries than the limit; at ``--angles``: a
-        bare count above :data:`BARE_ANGLES` without ``max_entries``.
+        At ``--max-entries``: a limit below 1, or more entries than the limit; at ``--angles`` or
+        ``table.angles_deg``: a bare count above :data:`BARE_ANGLES` without ``max_entries``.
     """
     if spec.axes_asked is not None and spec.axes_asked != len(spec.axes):
         print(f"{spec.name}: {_count(spec.axes_asked, 'axis', 'axes')} asked for, the {spec.grid} grid has "
               f"{len(spec.axes)}: every vertex and face centre of the torque polytope, its faces subdivided evenly "
               f"(so its counts come in steps); --grid fibonacci gives exactly {spec.axes_asked}", flush=True)
     from scenarios.errors import ScenarioError
+    from scenarios.schema.table import bare_count
     if max_entries is not None and max_entries < 1:
         raise ScenarioError("--max-entries", f"expected a positive number of entries, got {max_entries}")
     limit = MAX_ENTRIES if max_entries is None else max_entries
-    angles = str(angles or "").strip()
+    count, where = (bare_count(angles), "--angles") if angles is not None else (spec.angles_count, spec.angles_where)
+    flag = where.startswith("--")
+    said = f"{where} {count}" if flag else f"{where}: {count}"  # --angles 90, table.angles_deg: 90
+    listed = ("a comma-separated list", "--angles 60,90,120", "--angles 30,90") if flag else \
+        ("a YAML list", f"{where.rsplit('.', 1)[-1]}: [60, 90, 120]", f"{where.rsplit('.', 1)[-1]}: [30, 90]")
     if entries <= limit:
-        if not angles.isdigit():
+        if count is None:
             return
-        count = int(angles)
         degrees = f", not the angle {count} deg" if count <= 180 else ""
         if count > BARE_ANGLES and max_entries is None:
-            raise ScenarioError("--angles", f"{count} is a count: {count} angles spread from 10 to 180 deg "
-                                            f"({_work(spec, entries)})"
-                                            f"{degrees}; angles in degrees are a comma-separated list of at least "
-                                            "2 (e.g. --angles 60,90,120; for one slew, slewbench run); to compute "
-                                            f"the {count} angles, confirm the work with --max-entries {entries}")
-        print(f"--angles {count} is a count: {count} angles spread from 10 to 180 deg{degrees} (angles in degrees are "
-              "a comma-separated list, e.g. --angles 30,90)", flush=True)
+            raise ScenarioError(where, f"{count} is a count: {count} angles spread from 10 to 180 deg "
+                                       f"({_work(spec, entries)}){degrees}; angles in degrees are {listed[0]} of at "
+                                       f"least 2 (e.g. {listed[1]}; for one slew, slewbench run); to compute the "
+                                       f"{count} angles, confirm the work with --max-entries {entries}")
+        print(f"{said} is a count: {count} angles spread from 10 to 180 deg{degrees} (angles in degrees are "
+              f"{listed[0]}, e.g. {listed[2]})", flush=True)
         return
-    bare = f"; --angles {angles} means {angles} angles spread from 10 to 180 deg, not {angles} deg (angles in " \
-           f"degrees are a comma-separated list, e.g. --angles 30,90)" if angles.isdigit() else ""
+    bare = f"; {said} means {count} angles spread from 10 to 180 deg, not {count} deg (angles in degrees are " \
+           f"{listed[0]}, e.g. {listed[2]})" if count is not None else ""
     raise ScenarioError("--max-entries", f"{_work(spec, entries)}, more than {limit} (each a collocation solve: "
                                          f"seconds to minutes){bare}; to compute them all, give --max-entries {entries}")
 

@@ -28,7 +28,7 @@ from scenarios.schema.node import Node
 from scenarios.schema.study import EXECUTION
 
 __all__ = ["GRIDS", "MAX_AXES", "MAX_REFINE", "OBJECTIVES", "TABLE", "TABLE_EXECUTION", "TABLE_FILE", "TABLE_FLAGS",
-           "TABLE_REFINE", "TableValue", "angles_from_text", "check_angles", "read_table"]
+           "TABLE_REFINE", "TableValue", "angles_from_text", "bare_count", "check_angles", "read_table"]
 
 OBJECTIVES = ("min_time", "min_energy")
 """The objectives a table computes."""
@@ -48,9 +48,34 @@ def _number(value: Any, where: str, what: str) -> float:
     return float(value)
 
 
+def bare_count(value: Any) -> int | None:
+    """The count of angles a bare value of ``table.angles_deg`` or ``--angles`` gives: a whole
+    number alone (an integer, or text of digits alone: ``"90,"`` is a list of one angle in degrees).
+    A count ``n`` is ``n`` angles evenly from 10 to 180 deg, not an angle: whether it is one the
+    user meant is ``slewbench table``'s check (:func:`scenarios.cli.table.check_table_work`).
+
+    Parameters
+    ----------
+    value : Any
+        The value as written: YAML data, or the flag's text.
+
+    Returns
+    -------
+    int or None
+        The count; None for anything else (a list, a number with a decimal point such as ``90.0``,
+        text with a comma, a bool).
+    """
+    if isinstance(value, int) and not isinstance(value, bool):
+        return value
+    if isinstance(value, str) and value.strip().isdigit():
+        return int(value.strip())
+    return None
+
+
 def angles_from_text(text: str, where: str = "--angles") -> list[float]:
     """Read ``--angles``: a comma-separated list [deg], or a count (that many from 10 to 180 deg):
-    a whole number without a comma (``"90,"`` is a list, of one angle: refused, a table needs two).
+    a whole number without a comma (:func:`bare_count`; ``"90,"`` is a list, of one angle: refused,
+    a table needs two).
 
     Parameters
     ----------
@@ -67,18 +92,18 @@ def angles_from_text(text: str, where: str = "--angles") -> list[float]:
     Raises
     ------
     ScenarioError
-        Not numbers, or angles out of range.
+        Not numbers, a count below 2, or angles out of range.
     """
+    count = bare_count(text)
+    if count is not None:
+        if count < 2:
+            raise ScenarioError(where, f"expected a count of at least 2 angles, got {count}")
+        return check_angles(list(np.linspace(10.0, 180.0, count)), where)
     parts = [p.strip() for p in str(text).split(",") if p.strip()]
     try:
         values = [float(p) for p in parts]
     except ValueError:
         raise ScenarioError(where, f"expected a count or a comma-separated list of angles in degrees, got {text!r}") from None
-    if len(parts) == 1 and parts[0].isdigit() and "," not in str(text):
-        count = int(parts[0])
-        if count < 2:
-            raise ScenarioError(where, f"expected a count of at least 2 angles, got {count}")
-        return check_angles(list(np.linspace(10.0, 180.0, count)), where)
     return check_angles(values, where)
 
 
@@ -148,10 +173,16 @@ def _axes(node: Node) -> int | np.ndarray:
 
 
 def _angles(node: Node) -> list[float]:
+    """A list of angles [deg], or a bare count (:func:`bare_count`, as on the command line); a lone
+    number that is not whole (``90.0``) is neither: refused, naming both forms."""
     value = node.value
-    if isinstance(value, int) and not isinstance(value, bool):  # a count, as on the command line
+    if bare_count(value) is not None or isinstance(value, str):
         return angles_from_text(str(value), node.path)
-    return angles_from_text(value, node.path) if isinstance(value, str) else check_angles(value, node.path)
+    if isinstance(value, float):
+        raise node.error(f"expected a list of at least 2 angles in degrees (e.g. [60, 90, 120]; for one slew, "
+                         f"slewbench run) or a whole number, a count of angles (e.g. 8: 8 angles evenly from 10 to "
+                         f"180 deg), got the lone number {value!r}")
+    return check_angles(value, node.path)
 
 
 def _planner_options(node: Node) -> dict[str, Any]:
@@ -231,10 +262,13 @@ TABLE = Section((
            "into triangles, so that none crosses a kink of the slew time (without bounded torques on three "
            "independent axes: the Fibonacci lattice); ``fibonacci``: a Fibonacci lattice. Not used by a list of "
            "axes.", GRIDS, default="polytope"),
-    custom("angles_deg", "The slew angles; a number ``n``: ``n`` angles evenly from 10 to 180 deg. The fit has no "
-           "time above the largest angle unless it is 180 deg.", "list of numbers, or a number", _angles, unit="deg",
+    custom("angles_deg", "The slew angles in degrees, a list; or a whole number ``n``, a count, not an angle: ``n`` "
+           "angles evenly from 10 to 180 deg (``slewbench table`` refuses a count that reads like an angle in "
+           "degrees unless ``--max-entries`` confirms the work: the slew-table guide). A lone number that is not whole (``90.0``) is "
+           "refused. The fit has no time above the largest angle unless it is 180 deg.",
+           "a whole number (a count of angles), or a list of angles", _angles, unit="deg",  # [deg]: the list's
            default=[10.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0],
-           bounds="at least 2, distinct, > 0 and <= 180; a number: >= 2"),
+           bounds="a list: at least 2, distinct, > 0 and <= 180; a count: >= 2"),
     choice("objective", "``min_time``: the shortest slew (the scenario's ``maneuver.duration`` bounds it); "
            "``min_energy``: the least integral of the squared control over ``duration``.", OBJECTIVES,
            default="min_time"),
@@ -278,11 +312,15 @@ class TableValue:
         Its YAML path (``table.refine.tolerance``) or the flag that gave it (``--tolerance``).
     given : bool
         Whether the file or a flag gave it a value (not ``null``).
+    written : object, optional
+        The value as the file or the flag wrote it, before its reader (``90`` where ``value`` is the
+        90 angles that count gives); None when not given.
     """
 
     value: Any
     where: str
     given: bool
+    written: Any = None
 
 
 def read_table(node: Node, flags: Mapping[str, Any] | None = None, *, skip: tuple[str, ...] = (),
@@ -329,11 +367,11 @@ def read_table(node: Node, flags: Mapping[str, Any] | None = None, *, skip: tupl
         flag = TABLE_FLAGS.get(name)
         if flag is not None and flags.get(flag) is not None:
             key.node(node)  # the flag wins; the file's value is not read
-            found[name] = TableValue(_value(key, Node(flags[flag], flag)), flag, True)
+            found[name] = TableValue(_value(key, Node(flags[flag], flag)), flag, True, flags[flag])
         else:
             child = key.node(node)
             given = isinstance(node.value, dict) and node.value.get(key.name) is not None
-            found[name] = TableValue(_value(key, child), child.path, given)
+            found[name] = TableValue(_value(key, child), child.path, given, child.value if given else None)
     node.finish()
     return found
 

@@ -41,6 +41,7 @@ from scenarios.schema.table import (
     TABLE_FILE,
     TABLE_FLAGS,
     TableValue,
+    bare_count,
     read_table,
 )
 from scenarios.slewtable.fit import zonotope_facets
@@ -98,6 +99,11 @@ class TableSpec:
         The number of axes asked for (``axes`` / ``--axes``); a ``polytope`` grid may have more
         (at least its vertices and face centres), a ``fibonacci`` grid has exactly that many; None
         when the axes were listed.
+    angles_count : int or None
+        The count the angles were given as (``angles_deg: 8``, ``--angles 8``: 8 angles from 10 to
+        180 deg, :func:`scenarios.schema.table.bare_count`); None when they were listed (or the default).
+    angles_where : str
+        Where the angles were given: ``table.angles_deg`` or ``--angles`` (for messages).
     """
 
     name: str
@@ -116,6 +122,8 @@ class TableSpec:
     triangles: np.ndarray | None
     refine: RefineOptions | None
     axes_asked: int | None = None
+    angles_count: int | None = None
+    angles_where: str = "table.angles_deg"
 
     @property
     def held_out_axes(self) -> np.ndarray:
@@ -275,7 +283,8 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
     spec = TableSpec(str(base.get("name") or source.stem), base, axes, angles, objective, duration.value, held_out,
                      value("planner_options"), value("execution.workers"), value("execution.scheduler"),
                      value("execution.case_timeout_s"), source, grid, triangles, refine,
-                     values["axes"].value if isinstance(values["axes"].value, int) else None)
+                     values["axes"].value if isinstance(values["axes"].value, int) else None,
+                     bare_count(values["angles_deg"].written), values["angles_deg"].where)
     table_cases(spec)  # the collocation options and the case scenario are checked now
     return spec
 
