@@ -172,8 +172,30 @@ def test_colliding_labels_each_get_their_own_time_series(tmp_path):
                                         {"name": "eigenaxis", "label": "comparison"}])
     out = tmp_path / "out"
     assert main(["run", str(path), "--out", str(out)]) == 0
-    assert len(list((out / "timeseries").glob("*.csv"))) == 3
-    assert len(list(out.glob("*.png"))) == 4  # three rows and comparison.png
+    # readable: the label that is the stem keeps it, the other gets -2; comparison.png is slewbench's
+    assert sorted(p.name for p in (out / "timeseries").glob("*.csv")) == ["a_b-2.csv", "a_b.csv", "comparison-2.csv"]
+    assert sorted(p.name for p in out.glob("*.png")) == ["a_b-2.png", "a_b.png", "comparison-2.png", "comparison.png"]
+
+
+# the stems written out by hand from the rule (docs/outputs.rst, "Distinct rows, distinct files")
+@pytest.mark.parametrize(("labels", "stems"), [
+    (["a/b", "a_b"], ["a_b-2", "a_b"]),  # the label that is the stem keeps it
+    (["a/b", "a b"], ["a_b", "a_b-2"]),  # else the first, in row order
+    (["A", "a", "a"], ["A", "a-2", "a-3"]),  # compared ignoring case
+    (["α", "β"], ["row", "row-2"]),  # nothing usable: row
+    (["comparison", "Sky", "x"], ["comparison-2", "Sky-2", "x"]),  # slewbench's own file is the first
+    (["a/b", "a_b", "a_b-2"], ["a_b-3", "a_b", "a_b-2"]),  # a label that is a suffix keeps its stem
+    (["pd", "k=0.5", "lqr gain", "wheel.2"], ["pd", "k=0.5", "lqr_gain", "wheel.2"]),  # no collision: as sanitised
+])
+def test_colliding_labels_get_a_numeric_suffix_in_row_order(labels, stems):
+    assert row_stems(labels) == stems
+
+
+def test_a_suffix_keeps_a_long_stem_within_the_limit():
+    from scenarios.output.names import MAX_STEM
+    long = "x" * (MAX_STEM + 5)
+    stems = row_stems([long, long + "y"])  # both cut to the same MAX_STEM characters
+    assert stems == ["x" * MAX_STEM, "x" * (MAX_STEM - 2) + "-2"]
 
 
 @pytest.mark.parametrize("make", ["parent_is_file", "too_long", "unwritable"])

@@ -45,9 +45,13 @@ def _digest(text: str) -> str:
 def row_stems(labels: Sequence[str]) -> list[str]:
     """Distinct file stems for row labels (compared case-insensitively, reserved names avoided).
 
-    A label whose sanitised stem is empty, reserved, or shared with another label gets a short hash
-    of the label appended, so ``a/b`` and ``a_b``, ``α`` and ``β``, or ``comparison`` never
-    overwrite each other's files.
+    A label keeps its sanitised stem (:func:`sanitize`) when no other label shares it and it is
+    not one of slewbench's own (:data:`RESERVED`). Labels whose stems collide (``a/b`` and
+    ``a_b``, ``A`` and ``a``, ``α`` and ``β``, both ``row``) are told apart by a numeric suffix in
+    row order: the label that is the stem itself (``a_b``) keeps it, or else the first; the others
+    get ``-2``, ``-3``, ... (``a_b-2``). A reserved stem is taken by slewbench's own file, so its
+    row gets ``-2`` (``comparison-2``). A suffix that another label's stem already is, is skipped,
+    so that every non-colliding label keeps its stem.
 
     Parameters
     ----------
@@ -57,21 +61,38 @@ def row_stems(labels: Sequence[str]) -> list[str]:
     Returns
     -------
     list of str
-        One stem per label, pairwise distinct ignoring case.
+        One stem per label, pairwise distinct ignoring case, each at most :data:`MAX_STEM`
+        characters.
     """
     stems = [sanitize(label) for label in labels]
-    counts: dict[str, int] = {}
-    for stem in stems:
-        counts[stem.lower()] = counts.get(stem.lower(), 0) + 1
-    result, taken = [], set()
-    for index, (label, stem) in enumerate(zip(labels, stems)):
-        if counts[stem.lower()] > 1 or stem.lower() in RESERVED:
-            stem = f"{stem[:MAX_STEM - 9]}-{_digest(label)}"
-        while stem.lower() in taken:  # a hash collision or a label equal to another's suffixed stem
-            stem = f"{stem[:MAX_STEM - 9]}-{_digest(f'{label}#{index}')}"
-        taken.add(stem.lower())
-        result.append(stem)
-    return result
+    groups: dict[str, list[int]] = {}
+    for index, stem in enumerate(stems):
+        groups.setdefault(stem.lower(), []).append(index)
+    result: list[str | None] = [None] * len(stems)
+    taken = set(RESERVED)
+    for key, members in groups.items():  # the stems nothing else claims stay as they are
+        if len(members) == 1 and key not in RESERVED:
+            result[members[0]] = stems[members[0]]
+            taken.add(key)
+    for key, members in groups.items():
+        if result[members[0]] is not None:
+            continue
+        keeper = None if key in RESERVED else next((i for i in members if labels[i] == stems[i]), members[0])
+        number = 2
+        for index in members:
+            if index == keeper:
+                result[index] = stems[index]
+                taken.add(key)
+                continue
+            while True:
+                suffix = f"-{number}"
+                stem = stems[index][:MAX_STEM - len(suffix)].rstrip("._-") + suffix
+                number += 1
+                if stem.lower() not in taken and stem.lower() not in groups:
+                    break
+            result[index] = stem
+            taken.add(stem.lower())
+    return [stem for stem in result if stem is not None]
 
 
 def default_output_directory(name: str, root: str | Path = "results") -> Path:
