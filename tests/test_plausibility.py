@@ -99,6 +99,60 @@ def test_a_torque_in_millinewton_metres_written_as_newton_metres_warns():
     assert warnings_of(lambda d: d["spacecraft"]["wheels"].update(max_torque=0.5)) == []  # 4.2 rad/s²
 
 
+BILIMORIA_WIE = read_yaml(ROOT / "scenarios" / "bench" / "problems" / "bilimoria_wie_180.yaml")
+# unit inertia, 1 N m per body axis (torquers alone), 180 deg about x, rest to rest; windows 10 s and 4 s
+
+
+def slew_warnings(scale: float, change=None) -> list[str]:
+    """The warnings of the Bilimoria-Wie slew with its inertia ``scale`` times as large."""
+    data = copy.deepcopy(BILIMORIA_WIE)
+    data["spacecraft"]["inertia"] = [scale] * 3
+    if change is not None:
+        change(data)
+    return [str(warning) for warning in plausibility_warnings(parse_scenario(data))]
+
+
+def test_an_inertia_far_too_large_for_its_torque_warns_at_ten_times_the_window():
+    """By hand: the torque box (1, 1, 1) N m has the norm √3, so the unit inertia scaled by ``k``
+    turns at √3 / k rad/s² at most, and the 180 deg slew takes at least 2 √(π k / √3) s; the window
+    is maneuver.duration, 10 s (longer than simulation.duration, 4 s), and ten times it is 100 s:
+    k = 1400 gives 100.78 s (warns), k = 1350 gives 98.97 s (does not)."""
+    said = slew_warnings(1400.0)
+    assert len(said) == 1, said
+    assert said[0].startswith("spacecraft.inertia: [1400.0, 1400.0, 1400.0] kg m² (least principal moment 1400 "), said
+    assert "‖τ‖ = 1.73 N m" in said[0] and "180 deg rest-to-rest slew takes at least 101 s" in said[0], said
+    assert "10 times maneuver.duration (10 s)" in said[0] and "is the inertia in kg m²" in said[0], said
+    assert slew_warnings(1350.0) == []
+
+
+def test_the_slews_window_is_the_longer_of_the_manoeuvre_and_the_simulation():
+    def longer(d):
+        d["simulation"]["duration"] = 20.0  # ten times it is 200 s: 2 √(π k / √3) > 200 from k = 5513
+    assert slew_warnings(1400.0, longer) == []
+    said = slew_warnings(5600.0, longer)
+    assert len(said) == 1 and "times simulation.duration (20 s)" in said[0], said
+    assert slew_warnings(5400.0, longer) == []
+
+
+def test_a_cubesat_inertia_in_gram_square_millimetres_warns_and_one_ten_times_off_does_not():
+    def scaled(factor):
+        return lambda d: d["spacecraft"].update(inertia=[v * factor for v in d["spacecraft"]["inertia"]])
+    said = warnings_of(scaled(1e7))
+    assert len(said) == 1 and said[0].startswith("spacecraft.inertia: ") and "every planner's slew fails" in said[0]
+    assert warnings_of(scaled(10.0)) == []
+
+
+def test_a_slew_not_from_rest_to_rest_and_an_unbounded_torque_are_not_judged():
+    def tumbling(d):
+        d["maneuver"]["initial"]["omega"] = [0.0, 0.0, 0.01]
+    assert slew_warnings(1e6, tumbling) == []
+
+    def unbounded(d):
+        d["spacecraft"]["torquers"] = {}  # no max_torque: unbounded (a min-energy plan needs no bound)
+        d["planners"] = [{"name": "collocation", "options": {"objective": "min_energy"}}]
+    assert slew_warnings(1e6, unbounded) == []
+
+
 def write(tmp_path: Path, data: dict) -> str:
     path = tmp_path / "slip.yaml"
     path.write_text(yaml.safe_dump(data, sort_keys=False))
@@ -182,3 +236,11 @@ def test_wheels_that_span_only_a_plane_warn_naming_the_missing_direction():
     assert warnings_of(lambda d: d["spacecraft"].update(wheels={**d["spacecraft"]["wheels"], "axes": axes[:2]})) == []
     assert warnings_of(lambda d: d["spacecraft"].update(
         wheels={**d["spacecraft"]["wheels"], "axes": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "failed": [2]})) == []
+
+
+def test_the_guide_states_the_slow_slew_bar_the_code_uses():
+    import re
+
+    from scenarios.schema.plausibility import SLOW_SLEW_FACTOR
+    text = re.sub(r"\s+", " ", (ROOT / "docs" / "guide" / "scenarios.rst").read_text())
+    assert f"exceeds {SLOW_SLEW_FACTOR:g} times its window" in text

@@ -1,7 +1,7 @@
 """Plausibility warnings on a validated scenario: values that the schema accepts but that are
 almost certainly a unit slip (kilometres written as metres, degrees per second written as rad/s,
-millinewton metres written as newton metres), or a layout slip (wheels that cannot torque about
-every axis).
+millinewton metres written as newton metres, an inertia in g mm² written as kg m²), or a layout
+slip (wheels that cannot torque about every axis).
 
 They are warnings, not errors: each names the YAML path, the value as written and the physical
 reason it looks wrong, and suggests the value meant where one follows. ``slewbench validate``
@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     from scenarios.schema.loader import Scenario
 
 __all__ = ["LOWEST_ORBIT_KM", "MAX_ANGULAR_ACCELERATION", "MAX_RATE", "MAX_RATE_TOLERANCE", "MOON_DISTANCE_KM",
-           "PLAUSIBILITY_CHECKS", "Implausible", "plausibility_warnings"]
+           "PLAUSIBILITY_CHECKS", "SLOW_SLEW_FACTOR", "Implausible", "plausibility_warnings"]
 
 MOON_DISTANCE_KM = 384_400.0
 """The Moon's mean distance from the Earth [km]: an orbit reaching beyond it is no Earth orbit the
@@ -56,6 +56,13 @@ MAX_ANGULAR_ACCELERATION = 5.0
 """Angular acceleration [rad/s²] an actuator's torque gives about the least principal axis above
 which it is no attitude actuator (a full turn from rest in under 1.6 s); a torque in mN m written
 as N m lands above it on any spacecraft of slewbench's examples."""
+SLOW_SLEW_FACTOR = 10.0
+"""How many times its window (``maneuver.duration``, or ``simulation.duration`` when longer) the
+least time a rest-to-rest slew can take at the actuators' peak angular acceleration must exceed to
+warn: an inertia in g mm² or g cm² written as kg m² (1e9 or 1e7 too large), or a torque bound a
+thousand times too small, makes it thousands of times the window; the shipped scenarios' slews
+take at most 0.4 of theirs at that bound. The time goes as the square root of the inertia over the
+torque, so the warning comes from an inertia (or a torque) off by about a hundred or more."""
 
 
 @dataclass(frozen=True)
@@ -224,6 +231,40 @@ def _torques(scenario: Scenario) -> Iterator[Implausible]:
                               "(mN m written as N m)?")
 
 
+def _slew_time(scenario: Scenario) -> Iterator[Implausible]:
+    """A rest-to-rest slew the actuators could not make in :data:`SLOW_SLEW_FACTOR` times its
+    window, even at their peak angular acceleration ``α = ‖τ‖ / λ_min`` (the body torque box's norm
+    over the least principal moment): an inertia far too large for its torque (g mm² written as
+    kg m²), or a torque far too small. From rest to rest, ``‖J ω‖`` grows and falls at most at
+    ``‖τ‖``, so a turn by ``θ`` takes at least the bang-bang time ``2 √(θ / α)``. A slew that does
+    not start and end at rest, one without a final attitude, and a spacecraft without a stated
+    torque bound (magnetorquers alone) or with an unbounded one are left alone."""
+    problem = scenario.problem
+    if problem.qf is None or problem.omegaf is None or np.any(problem.omega0) or np.any(problem.omegaf):
+        return
+    spacecraft = problem.spacecraft
+    least = float(np.linalg.eigvalsh(spacecraft.inertia)[0])
+    torque = float(np.linalg.norm(spacecraft.body_torque_limit()))
+    if not 0.0 < torque < math.inf:
+        return
+    angle = 2.0 * math.acos(min(1.0, abs(float(np.dot(problem.q0, problem.qf)))))
+    shortest = 2.0 * math.sqrt(angle * least / torque)
+    window, where = problem.duration, "maneuver.duration"
+    simulated = _number(_mapping(scenario.data, "simulation").get("duration"))
+    if simulated is not None and simulated > window:
+        window, where = simulated, "simulation.duration"
+    if shortest <= SLOW_SLEW_FACTOR * window:
+        return
+    written = _mapping(scenario.data, "spacecraft").get("inertia")
+    yield Implausible("spacecraft.inertia", f"{written} kg m²",
+                      f"(least principal moment {least:g} kg m²) with the actuators' body torque bound (‖τ‖ = "
+                      f"{torque:.3g} N m) turns the spacecraft at {torque / least:.3g} rad/s² at most, so the "
+                      f"{math.degrees(angle):.4g} deg rest-to-rest slew takes at least {shortest:,.0f} s (the "
+                      f"bang-bang time 2 √(θ / α)), "
+                      f"{shortest / window:,.0f} times {where} ({window:g} s): every planner's slew fails; is the "
+                      "inertia in kg m² (g mm² written as kg m² is 1e9 too large, g cm² 1e7) and the torque in N m?")
+
+
 def _wheel_axes(scenario: Scenario) -> Iterator[Implausible]:
     """Three or more wheels whose axes span fewer than three directions, with no other actuator:
     a layout slip (a pyramid's elevation written as 0, an axis repeated), since a spacecraft flies
@@ -253,6 +294,7 @@ PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "rate_tolerances": _rate_tolerances,
     "boundary_rates": _boundary_rates,
     "actuator_torques": _torques,
+    "slew_time": _slew_time,
     "wheel_axes": _wheel_axes,
 }
 """Name -> check: each yields the :class:`Implausible` values of a validated scenario."""
