@@ -80,7 +80,8 @@ from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requi
 
 __all__ = ["AT_LIMIT", "FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
            "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
-           "closed_loop_wheels", "endpoint_violations", "plant_limits", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
+           "closed_loop_wheels", "endpoint_violations", "plant_limits", "rate_jumps", "reference_times",
+           "score_closed_loop", "score_fields",
            "rate_violations", "score_reference", "start_torque", "target_slack", "tracking_loss", "unhonoured", "violations",
            "worst_error_between_samples"]
 
@@ -874,9 +875,11 @@ def closed_loop_wheels(spacecraft: Spacecraft, t: ArrayLike, omega: ArrayLike, w
     cutting it at ``|Ω| = Ω_max`` (:meth:`~ocp.dynamics.truth.TruthPlant.effective_control`): a
     wheel at its limit is a wheel the loop could not use as the law asked, so reaching the limit is
     the violation, not only passing it (a torque saturation is the law's own design, a metric:
-    ``cl.saturation_fraction``). The limit is the one :func:`score_reference` holds the reference's
-    demand to: the lesser of the design's and the truth's (:func:`plant_limits`), element by
-    element; the closed loop is held to the limit itself, not to ``1 − margin`` (the margin is
+    ``cl.saturation_fraction``). The limits are those :func:`score_reference` holds the reference's
+    demand to: the lesser of the design's and the truth's momentum limit, element by element, and
+    the truth's speed limit, which :func:`plant_limits` turns into the momentum ``J_s Ω_max`` for
+    the reference (its body-rate share ``J_s aᵀω`` left out), scored here on the closed loop's
+    speed itself. The closed loop is held to the limit itself, not to ``1 − margin`` (the margin is
     the reference's, room left for the closed loop).
 
     Parameters
@@ -905,31 +908,21 @@ def closed_loop_wheels(spacecraft: Spacecraft, t: ArrayLike, omega: ArrayLike, w
     """
     t = np.asarray(t, dtype=float).reshape(-1)
     states = np.asarray(wheel_momentum, dtype=float).reshape(t.size, -1)
-    limits = demand_limits(spacecraft)
-    flown = plant_limits(plant) or {}
     values: dict[str, float | None] = {}
     broken: list[str] = []
-    stores = _stored_momenta(spacecraft)
-    for block in actuator_blocks(spacecraft):
-        actuator = block.actuator
-        name = f"{actuator.name}_momentum"
-        if stores.get(name) is not actuator:
-            continue
-        design = np.asarray(limits[name], dtype=float)
-        limit = np.minimum(design, np.asarray(flown.get(name, design), dtype=float))
-        if not np.any(np.isfinite(limit)):
-            continue
-        element = actuator.name.removesuffix("s")
-        lowered = limit < design
+    for name, (block, limit, lowered) in _momentum_limits(spacecraft, plant).items():
+        element = block.actuator.name.removesuffix("s")
         whose = [" (the truth model's; the design's is above it)" if low else "" for low in lowered]
         broken += _peak(name, np.abs(states[:, block.state]), limit, t, values,
                         lambda i, when, h, bound: (f"{element} {i} momentum {h:.4g} N m s "
                                                    f"{_reached(h, bound)} {bound:.4g} N m s limit{whose[i]} "
                                                    f"at {when:.1f} s"))
-    flying = None if plant is None else plant.model.spacecraft
-    speed = None if plant is None else plant.wheel_max_speed
-    wheels = None if flying is None else flying.wheels
-    if flying is not None and speed is not None and wheels is not None and wheels.spin_inertia is not None:
+    speed = _speed_limit(plant)
+    if speed is not None:
+        assert plant is not None
+        flying = plant.model.spacecraft
+        wheels = flying.wheels
+        assert wheels is not None and wheels.spin_inertia is not None  # the truth's speed limit needs them
         where = next(block.state for block in actuator_blocks(flying) if block.actuator is wheels)
         relative = (states[:, where] / np.asarray(wheels.spin_inertia, dtype=float)
                     - np.asarray(omega, dtype=float).reshape(t.size, 3) @ np.asarray(wheels.axes, dtype=float))
@@ -950,14 +943,31 @@ def _reached(value: float, bound: float) -> str:
     return "over its" if value > bound * (1 + _TOLERANCE) else "at its"
 
 
-def _stored_momenta(spacecraft: Spacecraft) -> dict[str, Any]:
-    """The actuators that store momentum (their states' ``momentum_matrix`` is not zero: the wheels)
-    by the name of their states' quantity (:func:`controllers.allocation.demand_limits`,
-    ``wheels_momentum``)."""
+def _momentum_limits(spacecraft: Spacecraft, plant: TruthPlant | None) -> dict[str, tuple[Any, Array, Array]]:
+    """The closed loop's momentum limits (:func:`closed_loop_wheels`): per actuator that stores
+    momentum (its states' ``momentum_matrix`` is not zero: the wheels) with a finite limit, by the
+    name of its states' quantity (``wheels_momentum``, :func:`controllers.allocation.demand_limits`),
+    its block (:func:`ocp.dynamics.layout.actuator_blocks`), the lesser of the design's and the
+    truth's limit per element, and where the truth's is the lesser. The truth's speed limit is not
+    in it (:func:`_speed_limit`: the closed loop's speed is scored itself)."""
     limits = demand_limits(spacecraft)
-    return {f"{block.actuator.name}_momentum": block.actuator for block in actuator_blocks(spacecraft)
-            if block.actuator.state_size and np.any(block.actuator.momentum_matrix())
-            and f"{block.actuator.name}_momentum" in limits}
+    flown = {} if plant is None else demand_limits(plant.model.spacecraft)
+    found = {}
+    for block in actuator_blocks(spacecraft):
+        name = f"{block.actuator.name}_momentum"
+        if not (block.actuator.state_size and np.any(block.actuator.momentum_matrix()) and name in limits):
+            continue
+        design = np.asarray(limits[name], dtype=float)
+        limit = np.minimum(design, np.asarray(flown.get(name, design), dtype=float))
+        if np.any(np.isfinite(limit)):
+            found[name] = (block, limit, limit < design)
+    return found
+
+
+def _speed_limit(plant: TruthPlant | None) -> Array | None:
+    """The truth's wheel speed limit [rad/s] (``truth.wheels.max_speed_rpm``, which needs the wheels'
+    spin inertia); ``None`` without one."""
+    return None if plant is None else plant.wheel_max_speed
 
 
 def _peak(name: str, magnitude: Array, limit: Array, t: Array, values: dict[str, float | None],
@@ -1017,8 +1027,8 @@ def score_fields(requirements: Requirements, spacecraft: Spacecraft,
                    if np.any(np.isfinite(np.minimum(limit, flown.get(name, limit))))]
         reference["actuators"] = (tuple(field for name in limited for field in (name, f"{name}_time_s"))
                                   + JUMP_FIELDS + UNREALISED_FIELDS)
-        stored = [name for name in _stored_momenta(spacecraft) if name in limited]
-        if plant is not None and plant.wheel_max_speed is not None:
+        stored = list(_momentum_limits(spacecraft, plant))
+        if _speed_limit(plant) is not None:
             stored.append("wheels_speed")
         if stored:
             closed_loop["actuators"] = tuple(field for name in stored for field in (name, f"{name}_time_s"))
