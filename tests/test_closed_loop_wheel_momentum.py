@@ -98,6 +98,9 @@ def test_generous_wheels_meet_it(generous):
     worst = np.unravel_index(np.argmax(peak), peak.shape)[0]
     assert score.values["wheels_momentum_time_s"] == row.simulation.t[worst]
     assert not violations({"closed_loop": {"actuators": score}})
+    # the run's row: scored so, and ok
+    assert row.requirements["closed_loop"]["actuators"] == {"met": True, **score.values}
+    assert row.status == "ok", row.message
 
 
 def test_a_closed_loop_at_its_momentum_limit_breaks_it_where_the_reference_meets_it(low):
@@ -114,6 +117,9 @@ def test_a_closed_loop_at_its_momentum_limit_breaks_it_where_the_reference_meets
     assert f"at {score.values['wheels_momentum_time_s']:.1f} s" in score.detail
     (message,) = violations({"closed_loop": scores})
     assert message.startswith("actuators (closed loop): wheel")
+    # the run's row: violated, by the closed loop's wheel alone
+    assert row.status == "violated" and row.message.startswith(message), row.message
+    assert row.requirements["closed_loop"]["actuators"] == {"met": False, **score.values}
     # the reference's demand is within the same limit: the closed loop alone breaks it
     assert row.requirements["reference"]["actuators"]["met"]
     assert row.requirements["reference"]["actuators"]["wheels_momentum"] < 1.0
