@@ -85,7 +85,7 @@ def study(summary: list[str] | None = None, **grid) -> dict:
 @pytest.mark.parametrize(("column", "words"), [
     ("ref.req.st_moon.min_margin_deg", ["'st_moon'", "ref.req.st_sun.min_margin_deg"]),
     ("ref.req.st_sun.min_margin", ["'min_margin'", "min_margin_deg"]),
-    ("cl.req.actuators.wheels_torque", ["closed loop", "ref.req.actuators.wheels_torque"]),
+    ("cl.req.actuators.wheels_torque", ["'wheels_torque'", "cl.req.actuators.wheels_momentum"]),
     ("ref.req.actuators.wheel_torque", ["'wheel_torque'", "wheels_torque"]),
     ("ref.req.rate.peak_rate", ["'rate'"]),
 ])

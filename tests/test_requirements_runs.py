@@ -107,14 +107,16 @@ def test_the_requirement_columns_in_every_table(crossing, tmp_path):
     header = crossing.to_csv().splitlines()[0].split(",")
     req = [c for c in header if ".req." in c]
     pointing = ("met", "min_margin_deg", "time_in_violation_s", "first_violation_s", "min_margin_time_s")
-    # the actuator requirement every scenario carries (margin 0) is scored on the reference only
+    # the actuator requirement every scenario carries (margin 0): the reference's demand, and the closed
+    # loop's wheel momentum
     assert req == ([f"ref.req.st.{field}" for field in pointing]
                    + [f"ref.req.actuators.{field}" for field in ("met", "wheels_torque", "wheels_torque_time_s",
                                                                  "wheels_momentum", "wheels_momentum_time_s",
                                                                  "rate_jump", "rate_jump_time_s",
                                                                  "unrealised_torque", "unrealised_torque_time_s",
                                                                  "unrealised_torque_allowed")]
-                   + [f"cl.req.st.{field}" for field in pointing])
+                   + [f"cl.req.st.{field}" for field in pointing]
+                   + [f"cl.req.actuators.{field}" for field in ("met", "wheels_momentum", "wheels_momentum_time_s")])
     assert header.index(req[0]) > header.index("cl.initial_rate_error")  # after the metric columns
     assert float(lines[0]["ref.req.st.min_margin_deg"]) == scores["reference"]["st"]["min_margin_deg"]
     frame = crossing.to_dataframe()
@@ -164,7 +166,10 @@ def test_the_actuator_rate_and_final_requirements_on_a_run():
     assert reference["actuators"]["wheels_momentum"] == pytest.approx(0.12 * peak / 0.02, rel=1e-3)
     accel = 5.7735 * math.radians(120.0) / 60.0**2
     assert reference["actuators"]["wheels_torque"] == pytest.approx(0.12 * accel / 0.003, rel=1e-3)
-    assert set(closed) == {"rate", "final"} and closed["final"]["from_s"] == 70.0
+    assert set(closed) == {"actuators", "rate", "final"} and closed["final"]["from_s"] == 70.0
+    # the closed loop's z wheel stores about the reference's I_z ω (the loop follows it)
+    assert closed["actuators"]["met"] is True
+    assert closed["actuators"]["wheels_momentum"] == pytest.approx(0.12 * peak / 0.02, rel=1e-2)
     assert closed["rate"]["peak_rate"] == pytest.approx(peak, rel=1e-3)  # the loop follows the reference
     assert closed["final"]["worst_error_deg"] < 0.5 and closed["final"]["worst_rate_error"] < 1e-3
     assert row.status == "ok" and "rate" not in row.message.split(";", 1)[-1]  # the eigenaxis honours the rate
@@ -247,6 +252,7 @@ def test_the_terminal_marks_a_requirement_broken_by_a_field_its_headline_does_no
     assert actuators["wheels_torque"] < 0.5 and row.requirements["reference"]["st"]["met"] is True
     terminal = results.to_terminal().splitlines()
     line = next(line for line in terminal if line.startswith("req.actuators"))
-    assert line.rstrip().endswith("✗ | -"), line  # its number well under 1, yet broken: marked
+    ref, cl = line.rstrip().rsplit("|", 1)  # its number well under 1, yet broken: marked (the closed loop's met)
+    assert ref.rstrip().endswith("✗") and "✗" not in cl, line
     st = next(line for line in terminal if line.startswith("req.st "))
     assert "✗" not in st and "(✗: that scope breaks the requirement; the messages below say how)" in terminal

@@ -39,11 +39,18 @@ def test_a_summary_verdict_names_the_path_and_the_requirements_numbers(column, n
     assert "not a number to summarise" in message and number in message and "given the bound" not in message
 
 
-@pytest.mark.parametrize("column, kind, scope", [("ref.req.final.met", "final", "reference"),
-                                                 ("cl.req.actuators.met", "actuators", "closed loop")])
+@pytest.mark.parametrize("column, kind, scope", [("ref.req.final.met", "final", "reference")])
 def test_a_verdict_of_a_scope_that_never_scores_the_requirement_says_so(column, kind, scope):
-    # a final requirement is scored in the closed loop only, the actuators in the reference only: no
-    # number columns to offer there (the message listed none: "such as " and nothing)
+    # a final requirement is scored in the closed loop only: no number columns to offer in the
+    # reference (the message listed none: "such as " and nothing)
     message = _error(robustness={"thresholds": {column: True}})
     assert f"({kind}) is not scored in the {scope}" in message and "(given the bound True)" in message
     assert not message.rstrip().endswith("such as")
+
+
+def test_the_closed_loops_actuator_verdict_names_its_wheel_momentum():
+    # the closed loop's wheels are scored against their momentum limit: its number columns offered
+    message = _error(robustness={"thresholds": {"cl.req.actuators.met": True}})
+    assert message.startswith("robustness.thresholds.cl.req.actuators.met: 'cl.req.actuators.met' is whether "
+                              "requirement 'actuators' is met in the closed loop"), message
+    assert "cl.req.actuators.<quantity>" in message and "ref.req.actuators" not in message

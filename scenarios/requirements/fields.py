@@ -14,7 +14,8 @@ names of those requirements (a pointing requirement may not take one,
 :data:`~scenarios.requirements.spec.RESERVED_NAMES`); any other name is a pointing requirement's.
 The actuator requirement's fields per actuator quantity (``wheels_torque``, ``wheels_momentum``,
 ``magnetorquers_dipole``, ``torquers_torque``: one per actuator kind's command and its states,
-:func:`controllers.allocation.demand_limits`) are declared once for all quantities, as the patterns
+:func:`controllers.allocation.demand_limits`; in the closed loop ``wheels_momentum`` and, under a
+truth speed limit, ``wheels_speed``) are declared once for all quantities, as the patterns
 ``<quantity>`` and ``<quantity>_time_s``.
 
 Every requirement's score also carries its verdict in that scope, the field :data:`VERDICT`
@@ -109,10 +110,14 @@ _ACTUATORS = (
         "samples; only quantities with a limit; a declared free start's momentum the wheels cannot take is "
         "asked too, as a constant torque over the manoeuvre (:func:`~scenarios.requirements.scoring.start_torque`). "
         "Met at most ``1 − margin``; null when the demand is not "
-        "finite (nan, inf), which breaks the requirement.", ("ref",)),
+        "finite (nan, inf), which breaks the requirement. In the closed loop (``cl.``), the flown wheels' "
+        "own ``wheels_momentum``, ``|h_i|`` over the limit at the samples, and under a truth speed limit "
+        "``wheels_speed``, ``|Ω_i|`` (the speed relative to the body) over ``truth.wheels.max_speed_rpm`` "
+        "(:func:`~scenarios.requirements.scoring.closed_loop_wheels`): the simulator holds a wheel at its "
+        "limit by cutting its motor torque, so reaching 1 breaks the requirement.", ("ref", "cl")),
     RequirementField(
         "actuators", f"{QUANTITY}_time_s", "s", "time of peak {quantity}",
-        "When that peak occurs (the first sample where the demand is not finite, when it is not).", ("ref",)),
+        "When that peak occurs (the first sample where the demand is not finite, when it is not).", ("ref", "cl")),
     RequirementField(
         "actuators", "rate_jump", "rad/s", "rate jump",
         "The largest jump of the reference's body rate (0 without one): across a breakpoint (natural "
@@ -177,7 +182,7 @@ def _verdict(kind: str, scopes: tuple[str, ...]) -> tuple[RequirementField]:
 
 
 REQUIREMENT_FIELDS: tuple[RequirementField, ...] = (
-    _verdict("pointing", ("ref", "cl")) + _POINTING + _verdict("actuators", ("ref",)) + _ACTUATORS
+    _verdict("pointing", ("ref", "cl")) + _POINTING + _verdict("actuators", ("ref", "cl")) + _ACTUATORS
     + _verdict("rate", ("ref", "cl")) + _RATE + _verdict("final", ("cl",)) + _FINAL)
 """Every requirement field, by requirement kind in column order, each kind's verdict (:data:`VERDICT`)
 first (the actuator quantities' fields as the patterns ``<quantity>`` and ``<quantity>_time_s``)."""

@@ -12,7 +12,9 @@ and what breaks it in words. The fields (their units, words and definitions are 
   :meth:`~ocp.geometry.pointing.PointingConstraint.score_between_samples` on the attitude
   interpolated between the samples with the body rates (the reference's own rates; the window's
   edges are points of it, the reference sampled there exactly, the closed loop interpolated);
-* ``actuators`` (reference only): for each actuator quantity with a limit
+* ``actuators``: in the closed loop, its wheels' momentum (and speed, under a truth speed limit)
+  against the same limits, reaching one a violation (:func:`closed_loop_wheels`); in the
+  reference, for each actuator quantity with a limit
   (:func:`controllers.allocation.reference_demand`, through the row's controller's allocation, at
   the samples and either side of each of the reference's breakpoints: the integrated demand never
   interpolates across a switch, and a bang's peak at its end is read there; a declared free start's
@@ -58,6 +60,7 @@ from controllers.allocation import (
     unrealised_torque,
 )
 from ocp import Spacecraft, quat, target_motion
+from ocp.dynamics.layout import actuator_blocks
 from ocp.dynamics.truth import TruthPlant
 from ocp.geometry.pointing import (
     MAX_SUB_GRID,
@@ -68,15 +71,17 @@ from ocp.geometry.pointing import (
     search_between_samples,
 )
 from ocp.metrics import rate_error, turning
+from ocp.simulation.simulator import RPM_PER_RAD_S
 from planners import ManeuverProblem, Planner, Reference
 from planners.base import REQUIREMENT_KINDS
 from planners.reference import BREAKPOINT_INSTANT, JUMP_TOLERANCE
 from scenarios.requirements.fields import VERDICT
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
-__all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
+__all__ = ["AT_LIMIT", "FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
            "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
-           "endpoint_violations", "plant_limits", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
+           "closed_loop_wheels", "endpoint_violations", "plant_limits", "rate_jumps", "reference_times",
+           "score_closed_loop", "score_fields",
            "rate_violations", "score_reference", "start_torque", "target_slack", "tracking_loss", "unhonoured", "violations",
            "worst_error_between_samples"]
 
@@ -116,6 +121,11 @@ momenta integrated from its saturated torques part from its state polynomial's b
 
 _TOLERANCE = 1e-9
 """Relative slack on the ratio and bound checks (rounding, not a margin)."""
+
+AT_LIMIT = 1.0 - 1e-9
+"""A closed-loop actuator state (a wheel's momentum or speed) at this fraction of its limit or more
+is at the limit (:func:`closed_loop_wheels`): the simulator's momentum saturation puts it there to
+rounding (``h + g dt = h_max``), and it is the violation."""
 
 
 def _over(value: float, bound: float) -> tuple[str, str]:
@@ -796,7 +806,8 @@ def _environment_torque(problem: ManeuverProblem, t: Array, q: Array, omega: Arr
 
 
 def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: ArrayLike, q: ArrayLike,
-                      omega: ArrayLike, end_of_manoeuvre: float, reference: Reference | None = None) -> dict[str, Score]:
+                      omega: ArrayLike, end_of_manoeuvre: float, reference: Reference | None = None,
+                      wheel_momentum: ArrayLike | None = None, plant: TruthPlant | None = None) -> dict[str, Score]:
     """Score a closed-loop run against every requirement that applies to it: the rate requirement
     and the final rate error on its samples, the pointing requirements and the final error angle
     between them too (the attitude interpolated with the body rates,
@@ -823,23 +834,164 @@ def score_closed_loop(requirements: Requirements, problem: ManeuverProblem, t: A
         the error and the rate error to the target's motion after ``T``
         (:func:`ocp.metrics.target_motion`: the reference's own coast from ``(q_f, ω_f)``);
         ``None`` (regulation): to ``(q_f, ω_f)``.
+    wheel_momentum : (N, n_w) array_like or None, optional
+        The closed loop's wheel momenta at ``t`` [N m s] (``SimulationResult.wheel_momentum``):
+        with the actuator requirement, scored against the wheels' momentum limits
+        (:func:`closed_loop_wheels`); ``None``: not scored.
+    plant : ocp.dynamics.truth.TruthPlant or None, optional
+        The truth model the closed loop flew (``Scenario.truth``): its limits where lower than the
+        design's (:func:`plant_limits`), and its wheels' speed limit; ``None``: the design's.
 
     Returns
     -------
     dict of str to Score
-        By requirement name: the pointing requirements, then ``rate`` and ``final`` (the actuator
-        requirement is the reference's: the closed loop's actuators saturate).
+        By requirement name: the pointing requirements, then ``actuators`` (the wheels' momentum,
+        with ``wheel_momentum`` and the actuator requirement, on a spacecraft whose wheels have a
+        limit), ``rate`` and ``final``.
     """
     t = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
     omega = np.asarray(omega, dtype=float)
     motion = HermiteMotion(t, q, omega)  # one interpolant for the row's requirements
     scores = _pointing_scores(problem.pointing, t, q, omega, motion)
+    if requirements.actuators is not None and wheel_momentum is not None:
+        wheels = closed_loop_wheels(problem.spacecraft, t, omega, wheel_momentum, plant)
+        if wheels is not None:
+            scores["actuators"] = wheels
     if requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, omega)
     if requirements.final is not None:
         scores["final"] = _final(requirements.final, t, q, omega, problem, end_of_manoeuvre, motion, reference)
     return scores
+
+
+def closed_loop_wheels(spacecraft: Spacecraft, t: ArrayLike, omega: ArrayLike, wheel_momentum: ArrayLike,
+                       plant: TruthPlant | None = None) -> Score | None:
+    """The actuator requirement's score of a closed loop: its momentum-storing actuators (the
+    wheels) against their momentum limits, and against their speed limit under a truth model's.
+
+    The simulator keeps each wheel within its momentum limit by cutting its motor torque
+    (:meth:`~ocp.dynamics.actuator_kinds.ReactionWheels.saturate`), and a truth's speed limit by
+    cutting it at ``|Ω| = Ω_max`` (:meth:`~ocp.dynamics.truth.TruthPlant.effective_control`): a
+    wheel at its limit is a wheel the loop could not use as the law asked, so reaching the limit is
+    the violation, not only passing it (a torque saturation is the law's own design, a metric:
+    ``cl.saturation_fraction``). The limits are those :func:`score_reference` holds the reference's
+    demand to: the lesser of the design's and the truth's momentum limit, element by element, and
+    the truth's speed limit, which :func:`plant_limits` turns into the momentum ``J_s Ω_max`` for
+    the reference (its body-rate share ``J_s aᵀω`` left out), scored here on the closed loop's
+    speed itself. The closed loop is held to the limit itself, not to ``1 − margin`` (the margin is
+    the reference's, room left for the closed loop).
+
+    Parameters
+    ----------
+    spacecraft : ocp.Spacecraft
+        The design's spacecraft (its actuators' limits and state layout).
+    t : (N,) array_like
+        Sample times [s].
+    omega : (N, 3) array_like
+        The closed loop's body rate at ``t`` [rad/s], body axes.
+    wheel_momentum : (N, n_s) array_like
+        The actuators' states at ``t`` (``SimulationResult.wheel_momentum``: the wheel momenta
+        [N m s]).
+    plant : ocp.dynamics.truth.TruthPlant or None, optional
+        The truth model flown; ``None``: the design's.
+
+    Returns
+    -------
+    Score or None
+        ``actuators``: per momentum-storing kind with a limit, ``<kind>_momentum``, the peak of
+        ``|h_i| / limit_i`` over the samples and elements, and ``<kind>_momentum_time_s`` when;
+        under a truth speed limit, ``wheels_speed``, the peak of ``|Ω_i| / Ω_max,i`` (``Ω = h / J_s −
+        aᵀω``, truth axes and spin inertia), and ``wheels_speed_time_s``. Met when every ratio is
+        below 1 (:data:`AT_LIMIT`); the detail names the element, the time and the value. ``None``
+        when no such quantity is limited.
+    """
+    t = np.asarray(t, dtype=float).reshape(-1)
+    states = np.asarray(wheel_momentum, dtype=float).reshape(t.size, -1)
+    values: dict[str, float | None] = {}
+    broken: list[str] = []
+    for name, (block, limit, lowered) in _momentum_limits(spacecraft, plant).items():
+        element = block.actuator.name.removesuffix("s")
+        whose = [" (the truth model's; the design's is above it)" if low else "" for low in lowered]
+        broken += _peak(name, np.abs(states[:, block.state]), limit, t, values,
+                        lambda i, when, h, bound: (f"{element} {i} momentum {h:.4g} N m s "
+                                                   f"{_reached(h, bound)} {bound:.4g} N m s limit{whose[i]} "
+                                                   f"at {when:.1f} s"))
+    speed = _speed_limit(plant)
+    if speed is not None:
+        assert plant is not None
+        flying = plant.model.spacecraft
+        wheels = flying.wheels
+        assert wheels is not None and wheels.spin_inertia is not None  # the truth's speed limit needs them
+        where = next(block.state for block in actuator_blocks(flying) if block.actuator is wheels)
+        relative = (states[:, where] / np.asarray(wheels.spin_inertia, dtype=float)
+                    - np.asarray(omega, dtype=float).reshape(t.size, 3) @ np.asarray(wheels.axes, dtype=float))
+        broken += _peak("wheels_speed", np.abs(relative), np.asarray(speed, dtype=float), t, values,
+                        lambda i, when, w, bound: (f"wheel {i} speed {w * RPM_PER_RAD_S:.4g} rpm "
+                                                   f"{_reached(w, bound)} {bound * RPM_PER_RAD_S:.4g} rpm limit "
+                                                   f"(truth.wheels.max_speed_rpm) at {when:.1f} s"))
+    if not values:
+        return None
+    detail = ", ".join(broken)
+    if detail:
+        detail += " (the simulator holds a wheel at its limit by cutting the motor torque the law asks)"
+    return Score("actuators", values, not broken, detail)
+
+
+def _reached(value: float, bound: float) -> str:
+    """``over its`` a value above its limit (beyond rounding), else ``at its``."""
+    return "over its" if value > bound * (1 + _TOLERANCE) else "at its"
+
+
+def _momentum_limits(spacecraft: Spacecraft, plant: TruthPlant | None) -> dict[str, tuple[Any, Array, Array]]:
+    """The closed loop's momentum limits (:func:`closed_loop_wheels`): per actuator that stores
+    momentum (its states' ``momentum_matrix`` is not zero: the wheels) with a finite limit, by the
+    name of its states' quantity (``wheels_momentum``, :func:`controllers.allocation.demand_limits`),
+    its block (:func:`ocp.dynamics.layout.actuator_blocks`), the lesser of the design's and the
+    truth's limit per element, and where the truth's is the lesser. The truth's speed limit is not
+    in it (:func:`_speed_limit`: the closed loop's speed is scored itself)."""
+    limits = demand_limits(spacecraft)
+    flown = {} if plant is None else demand_limits(plant.model.spacecraft)
+    found = {}
+    for block in actuator_blocks(spacecraft):
+        name = f"{block.actuator.name}_momentum"
+        if not (block.actuator.state_size and np.any(block.actuator.momentum_matrix()) and name in limits):
+            continue
+        design = np.asarray(limits[name], dtype=float)
+        limit = np.minimum(design, np.asarray(flown.get(name, design), dtype=float))
+        if np.any(np.isfinite(limit)):
+            found[name] = (block, limit, limit < design)
+    return found
+
+
+def _speed_limit(plant: TruthPlant | None) -> Array | None:
+    """The truth's wheel speed limit [rad/s] (``truth.wheels.max_speed_rpm``, which needs the wheels'
+    spin inertia); ``None`` without one."""
+    return None if plant is None else plant.wheel_max_speed
+
+
+def _peak(name: str, magnitude: Array, limit: Array, t: Array, values: dict[str, float | None],
+          words: Callable[[int, float, float, float], str]) -> list[str]:
+    """One closed-loop quantity's peak ratio (``|value| / limit`` per sample and element, 0 where
+    unlimited) and its time into ``values`` as ``name`` and ``<name>_time_s``; the sentence of the
+    element at the peak (``words(element, time, value, limit)``) when it reaches :data:`AT_LIMIT`."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratios = np.where(np.isinf(limit), 0.0, magnitude / limit)
+    ratios = np.where(limit == 0.0, np.where(magnitude > 0.0, np.inf, 0.0), ratios)
+    if not np.all(np.isfinite(magnitude)):  # a state that is not finite is no state within its limit
+        first = int(np.argmax(~np.all(np.isfinite(magnitude), axis=1)))
+        values[name], values[f"{name}_time_s"] = None, float(t[first])
+        return [f"{name} is not finite (nan or inf) from {t[first]:.1f} s"]
+    if not ratios.size:
+        values[name], values[f"{name}_time_s"] = 0.0, None
+        return []
+    highest = int(np.argmax(ratios))
+    worst, element = divmod(highest, ratios.shape[1])
+    ratio = float(ratios[worst, element])
+    values[name], values[f"{name}_time_s"] = ratio, float(t[worst])
+    if ratio < AT_LIMIT:
+        return []
+    return [words(element, float(t[worst]), float(magnitude[worst, element]), float(limit[element]))]
 
 
 def score_fields(requirements: Requirements, spacecraft: Spacecraft,
@@ -863,7 +1015,8 @@ def score_fields(requirements: Requirements, spacecraft: Spacecraft,
         Scope (``reference``, ``closed_loop``) -> requirement name -> fields, in column order,
         each requirement's verdict first (:data:`~scenarios.requirements.fields.VERDICT`, as the
         runner stores the scores): pointing and rate in both scopes, ``actuators`` in the
-        reference only, ``final`` in the closed loop only.
+        reference, and in the closed loop where a momentum-storing actuator (the wheels) has a
+        limit (:func:`closed_loop_wheels`), ``final`` in the closed loop only.
     """
     pointing = {requirement.name: POINTING_FIELDS for requirement in requirements.pointing}
     reference: dict[str, tuple[str, ...]] = dict(pointing)
@@ -874,6 +1027,11 @@ def score_fields(requirements: Requirements, spacecraft: Spacecraft,
                    if np.any(np.isfinite(np.minimum(limit, flown.get(name, limit))))]
         reference["actuators"] = (tuple(field for name in limited for field in (name, f"{name}_time_s"))
                                   + JUMP_FIELDS + UNREALISED_FIELDS)
+        stored = list(_momentum_limits(spacecraft, plant))
+        if _speed_limit(plant) is not None:
+            stored.append("wheels_speed")
+        if stored:
+            closed_loop["actuators"] = tuple(field for name in stored for field in (name, f"{name}_time_s"))
     if requirements.rate is not None:
         reference["rate"] = closed_loop["rate"] = RATE_FIELDS
     if requirements.final is not None:
