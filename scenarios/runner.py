@@ -326,7 +326,7 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
             end = row.reference.duration if row.reference is not None else scenario.problem.duration
             result = row.simulation
             scores["closed_loop"] = score_closed_loop(scenario.requirements, scenario.problem, result.t, result.q,
-                                                      result.omega, end, row.reference)
+                                                      result.omega, end, row.reference, result.wheel_momentum, plant)
         if scoring:
             _judge(row, scores, note)
         rows.append(row)
