@@ -65,6 +65,13 @@ of its Newton iteration: both are evaluated at the point returned, whose ``T`` i
 RK4 shooting's exact solution to far below a microsecond."""
 SHOOTING_ITERATIONS = 10
 """Newton iterations of :func:`time_error` before it gives up."""
+SHOOTING_RICHARDSON = 1e-7
+"""Largest RK4 correction of ``T`` (the step from the shooting's optimum to that of the same
+switches flown exactly, by step doubling: :func:`_rk4_error`), relative to ``T``, that
+:func:`time_error` and :func:`bang_bang_certificate` take with :data:`SHOOTING_STEPS` steps per
+arc; above it the steps are doubled (up to :data:`SHOOTING_MAX_STEPS`)."""
+SHOOTING_MAX_STEPS = 96
+"""Most RK4 steps per arc :data:`SHOOTING_RICHARDSON` doubles them to."""
 
 
 def radau_points(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array,
@@ -357,34 +364,68 @@ def switch_intervals(transcription: RadauCollocation, model: AttitudeModel, nlp:
     return np.any(np.any(between, axis=1) | mixed, axis=1)
 
 
-def _shooting(model: AttitudeModel, arcs: int, fixed_rate: bool) -> ca.Function:
-    """``(x0, z, U, d, xf) -> (r, ∂r/∂z)``: the final miss ``r`` of the bang-bang control ``U (nu,
-    arcs)`` from ``x0`` with the switch times and final time ``z = (t_1 … t_{arcs−1}, T)`` [s]
-    (RK4, :data:`SHOOTING_STEPS` steps per arc, disturbance ``d`` [N m]): the vector part of
-    ``conj(q_f) ⊗ q(T)`` and, with ``fixed_rate``, ``ω(T) − ω_f`` [rad/s] (``xf = [q_f, ω_f]``).
-    With more ``arcs`` than conditions, ``(x0, z, U, d, xf, λ) -> (r, ∂r/∂z, ∇²_z λᵀ r)``."""
+def _flight(model: AttitudeModel, arcs: int, fixed_rate: bool, steps: int) -> tuple[list[ca.MX], ca.MX]:
+    """``([x0, z, U, d, xf], r)``: the symbols and the final miss ``r`` of the bang-bang control
+    ``U (nu, arcs)`` from ``x0`` with the switch times and final time ``z = (t_1 … t_{arcs−1}, T)``
+    [s] (RK4, ``steps`` steps per arc, disturbance ``d`` [N m]): the vector part of
+    ``conj(q_f) ⊗ q(T)`` and, with ``fixed_rate``, ``ω(T) − ω_f`` [rad/s] (``xf = [q_f, ω_f]``)."""
     xt, u, h, d = ca.SX.sym("xt", model.nx + 1), ca.SX.sym("u", model.nu), ca.SX.sym("h"), ca.SX.sym("d", 3)
     x, t = xt[:-1], xt[-1]
     after = rk4_step(lambda state, time: model.rhs(state, u, time, d), x, t, h)
     step = ca.Function("rk4", [xt, u, h, d], [ca.vertcat(after, t + h)])
-    arc = step.fold(SHOOTING_STEPS)  # an MX graph of folds: built in milliseconds, unlike its SX expansion
+    arc = step.fold(steps)  # an MX graph of folds: built in milliseconds, unlike its SX expansion
     x0, z, U = ca.MX.sym("x0", model.nx), ca.MX.sym("z", arcs), ca.MX.sym("U", model.nu, arcs)
     disturbance, xf = ca.MX.sym("d", 3), ca.MX.sym("xf", model.nx)
     state, start = ca.vertcat(x0, 0), ca.MX(0)
     for k in range(arcs):
-        state = arc(state, ca.repmat(U[:, k], 1, SHOOTING_STEPS), ca.repmat((z[k] - start) / SHOOTING_STEPS, 1,
-                    SHOOTING_STEPS), ca.repmat(disturbance, 1, SHOOTING_STEPS))
+        state = arc(state, ca.repmat(U[:, k], 1, steps), ca.repmat((z[k] - start) / steps, 1, steps),
+                    ca.repmat(disturbance, 1, steps))
         start = z[k]
-    q, qf = state[:4], xf[:4]
-    vector = qf[0] * q[1:4] - q[0] * qf[1:4] - ca.cross(qf[1:4], q[1:4])  # of conj(q_f) ⊗ q, scalar first
-    r = ca.vertcat(vector, state[4:7] - xf[4:7]) if fixed_rate else vector
+    xs, xfs, miss = _final_miss(model, fixed_rate)
+    return [x0, z, U, disturbance, xf], ca.Function("miss", [xs, xfs], [miss])(state[:model.nx], xf)
+
+
+def _listed(flight: tuple[list[ca.MX], ca.MX]) -> tuple[list[ca.MX], list[ca.MX]]:
+    """:func:`_flight`'s inputs and its miss as the output list of a ``casadi.Function``."""
+    return flight[0], [flight[1]]
+
+
+def _shooting(model: AttitudeModel, arcs: int, fixed_rate: bool, steps: int = SHOOTING_STEPS) -> ca.Function:
+    """``(x0, z, U, d, xf) -> (r, ∂r/∂z)``: the final miss ``r`` of :func:`_flight` (``steps`` RK4
+    steps per arc) and its Jacobian. With more ``arcs`` than conditions, ``(x0, z, U, d, xf, λ) ->
+    (r, ∂r/∂z, ∇²_z λᵀ r)``."""
+    inputs, r = _flight(model, arcs, fixed_rate, steps)
+    z = inputs[1]
     if arcs <= r.numel():
-        return ca.Function("shooting", [x0, z, U, disturbance, xf], [r, ca.jacobian(r, z)])
+        return ca.Function("shooting", inputs, [r, ca.jacobian(r, z)])
     # more switch times than conditions: T is minimised on them, Newton's method on the KKT
     # conditions, whose Hessian of ``λᵀ r`` this gives too
     multiplier = ca.MX.sym("lambda", r.numel())
-    return ca.Function("shooting", [x0, z, U, disturbance, xf, multiplier],
+    return ca.Function("shooting", [*inputs, multiplier],
                        [r, ca.jacobian(r, z), ca.hessian(ca.dot(multiplier, r), z)[0]])
+
+
+def _rk4_error(model: AttitudeModel, x0: Array, z: Array, U: Array, disturbance: Array, xf: Array, fixed_rate: bool,
+               steps: int, r: Array) -> Array:
+    """The error ``e`` of the final miss ``r`` of :func:`_flight` with ``steps`` RK4 steps per arc,
+    ``r`` minus that of the same switches flown exactly, by step doubling: RK4's error falls as
+    the fourth power of the step, so ``r − r_2S = e (1 − 1/16)`` (``r_2S`` with ``2 steps``, the
+    final miss alone)."""
+    arcs = len(z)
+    flown = _mapped(model, f"switch miss {arcs} {fixed_rate} {2 * steps}", 1,
+                    lambda: ca.Function("miss", *_listed(_flight(model, arcs, fixed_rate, 2 * steps))))
+    finer = np.asarray(flown(x0, z, U, disturbance, xf), dtype=float).ravel()
+    return 16.0 / 15.0 * (np.asarray(r, dtype=float).ravel() - finer)
+
+
+def _newton_step(matrix: Array, rhs: Array, row: int, error: Array) -> Array:
+    """The step in ``z`` of the Newton system ``matrix δ = rhs`` of :func:`time_error` (or
+    :func:`bang_bang_certificate`) with the RK4 steps' error ``error`` of the final miss, whose
+    rows start at ``row``, taken off the miss: from the shooting's optimum to that of the same
+    switches flown exactly."""
+    shifted = np.array(rhs, dtype=float)
+    shifted[row:row + len(error)] += error
+    return np.linalg.lstsq(matrix, shifted, rcond=None)[0][:matrix.shape[1] if row == 0 else row]
 
 
 def _switch_times(t: Array, sigma: Array, low: Array, high: Array) -> tuple[Array, NDArray[np.int_], Array]:
@@ -465,7 +506,9 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
     # the order constraint between them active, each with its multiplier (>= 0 at a minimum)
     ties: dict[tuple[int, int], float] = {}
     miss = np.inf
-    for iteration in range(1, SHOOTING_ITERATIONS + 1):
+    steps, iteration, at_steps = SHOOTING_STEPS, 0, 0
+    while at_steps < SHOOTING_ITERATIONS:
+        iteration, at_steps = iteration + 1, at_steps + 1
         # a switch that Newton's step moved out of the slew is none (a σ root by a node, an arc the
         # mesh made up): the control starts or ends at its other bound
         out = (z[:-1] <= 0) | (z[:-1] >= z[-1])
@@ -486,8 +529,8 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
         U = np.repeat(first[:, None], arcs, axis=1)
         for arc, control in enumerate(owner, start=1):
             U[control, arc:] = low[control] + high[control] - U[control, arc - 1]
-        shooting = _mapped(model, f"switch shooting {arcs} {fixed_rate} {SHOOTING_STEPS}", 1,
-                           lambda: _shooting(model, arcs, fixed_rate))
+        shooting = _mapped(model, f"switch shooting {arcs} {fixed_rate} {steps}", 1,
+                           lambda: _shooting(model, arcs, fixed_rate, steps))
         stationary = 0.0
         outputs = [np.asarray(m) for m in (shooting(x0, z, U, disturbance, xf) if arcs <= conditions else
                                            shooting(x0, z, U, disturbance, xf, multiplier))]
@@ -507,10 +550,19 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
             rhs = -np.concatenate([residual, r.ravel(), tie_rows @ z])
         miss = float(np.max(np.abs(r)))
         if miss < SHOOTING_TOLERANCE and stationary < SHOOTING_TOLERANCE and np.all(mu >= 0):
-            # converged at the point evaluated (its switches in order): the estimate is its T
-            return {"estimate_s": T - float(z[-1]), "shooting_T_s": float(z[-1]), "switches": arcs - 1,
-                    "miss": miss, "stationarity": stationary, "switch_times_s": [float(v) for v in z[:-1]],
-                    "controls": U.T.tolist(), "coinciding": len(ties), "iterations": iteration}
+            # converged at the point evaluated (its switches in order): the RK4 steps' error of its
+            # miss by step doubling, and the Newton step to the same switches flown exactly
+            error = _rk4_error(model, x0, z, U, disturbance, xf, fixed_rate, steps, r)
+            exact = z + _newton_step(matrix, rhs, arcs if arcs > conditions else 0, error)
+            if abs(exact[-1] - z[-1]) > SHOOTING_RICHARDSON * z[-1] and steps < SHOOTING_MAX_STEPS:
+                # too far from RK4's asymptotic error to extrapolate it: again with twice the steps
+                z, steps, at_steps = exact, 2 * steps, 0
+                continue
+            return {"estimate_s": T - float(exact[-1]), "shooting_T_s": float(exact[-1]), "switches": arcs - 1,
+                    "miss": miss, "stationarity": stationary, "switch_times_s": [float(v) for v in exact[:-1]],
+                    "controls": U.T.tolist(), "coinciding": len(ties), "iterations": iteration,
+                    "steps_per_arc": steps, "rk4_correction_s": float(exact[-1] - z[-1]),
+                    "rk4_error": float(np.max(np.abs(error)))}
         try:
             solution = np.linalg.lstsq(matrix, rhs, rcond=None)[0]
         except np.linalg.LinAlgError as error:
@@ -575,7 +627,7 @@ and ``σ̇``), besides the steps' ends."""
 
 
 def _final_miss(model: AttitudeModel, fixed_rate: bool) -> tuple[ca.SX, ca.SX, ca.SX]:
-    """``(x, xf, r)``: the final conditions of :func:`_shooting` as an expression of the final
+    """``(x, xf, r)``: the final conditions of :func:`_flight` as an expression of the final
     state (the vector part of ``conj(q_f) ⊗ q`` and, with ``fixed_rate``, ``ω − ω_f``)."""
     x, xf = ca.SX.sym("x", model.nx), ca.SX.sym("xf", model.nx)
     q, qf = x[:4], xf[:4]
@@ -583,10 +635,10 @@ def _final_miss(model: AttitudeModel, fixed_rate: bool) -> tuple[ca.SX, ca.SX, c
     return x, xf, ca.vertcat(vector, x[4:7] - xf[4:7]) if fixed_rate else vector
 
 
-def _costate_shooting(model: AttitudeModel, arcs: int, fixed_rate: bool) -> ca.Function:
+def _costate_shooting(model: AttitudeModel, arcs: int, fixed_rate: bool, steps: int = SHOOTING_STEPS) -> ca.Function:
     """``(x0, z, U, d, xf, E) -> (r, ∂r/∂z, ∂vec(∂r/∂z)/∂z, X, G)``: the shooting of :func:`_shooting`
-    (the same RK4 steps) with its states ``X (nx, N + 1)`` at the steps' ends (``N`` = ``arcs``
-    :data:`SHOOTING_STEPS`) and ``G = ∂r/∂[x_0, …, x_N] (m, nx (N + 1))``, the sensitivity of
+    (the same RK4 steps, ``steps`` per arc) with its states ``X (nx, N + 1)`` at the steps' ends
+    (``N`` = ``arcs steps``) and ``G = ∂r/∂[x_0, …, x_N] (m, nx (N + 1))``, the sensitivity of
     the final miss to a jump ``E`` (zero) of the state after each step: ``νᵀ G`` is the discrete
     co-state (the adjoint of the RK4 steps) of the multipliers ``ν``."""
     nx = model.nx
@@ -595,16 +647,16 @@ def _costate_shooting(model: AttitudeModel, arcs: int, fixed_rate: bool) -> ca.F
     x, t = xt[:-1], xt[-1]
     after = rk4_step(lambda state, time: model.rhs(state, u, time, d), x, t, h)
     step = ca.Function("rk4", [xt, u, h, d, e], [ca.vertcat(after + e, t + h)])
-    arc = step.mapaccum(SHOOTING_STEPS)
-    S = SHOOTING_STEPS
+    arc = step.mapaccum(steps)
+    S = steps
     x0, z, U = ca.MX.sym("x0", nx), ca.MX.sym("z", arcs), ca.MX.sym("U", model.nu, arcs)
     disturbance, xf, E = ca.MX.sym("d", 3), ca.MX.sym("xf", nx), ca.MX.sym("E", nx, arcs * S)
     state, start, columns = ca.vertcat(x0, 0), ca.MX(0), []
     for k in range(arcs):
-        steps = arc(state, ca.repmat(U[:, k], 1, S), ca.repmat((z[k] - start) / S, 1, S), ca.repmat(disturbance, 1, S),
-                    E[:, k * S:(k + 1) * S])
-        columns.append(steps)
-        state, start = steps[:, -1], z[k]
+        ends = arc(state, ca.repmat(U[:, k], 1, S), ca.repmat((z[k] - start) / S, 1, S), ca.repmat(disturbance, 1, S),
+                   E[:, k * S:(k + 1) * S])
+        columns.append(ends)
+        state, start = ends[:, -1], z[k]
     xs, xfs, miss = _final_miss(model, fixed_rate)
     r = ca.Function("miss", [xs, xfs], [miss])(state[:nx], xf)
     J = ca.jacobian(r, z)
@@ -687,20 +739,35 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
     disturbance = np.asarray(disturbance, dtype=float).ravel()
     U = np.atleast_2d(np.asarray(controls, dtype=float)).T  # (nu, arcs)
     low, high = np.asarray(low, dtype=float).ravel(), np.asarray(high, dtype=float).ravel()
-    nx, nu, arcs, S = model.nx, model.nu, U.shape[1], SHOOTING_STEPS
+    nx, nu, arcs = model.nx, model.nu, U.shape[1]
     z = np.append(np.asarray(switch_times, dtype=float).ravel(), float(T))
     conditions = 6 if fixed_rate else 3
-    function = model.solver_cache.get(("bang-bang certificate", arcs, fixed_rate, S),
-                                      lambda: _costate_shooting(model, arcs, fixed_rate))
-    r, J, curvature, X, G = (np.asarray(m) for m in function(x0, z, U, disturbance, xf, np.zeros((nx, arcs * S))))
-    r = r.ravel()
-    # the multipliers: e_T + Jᵀ ν = 0 (solved, or in the least-squares sense)
     gradient = np.zeros(arcs)
     gradient[-1] = 1.0
-    nu_ = np.linalg.lstsq(J.T, -gradient, rcond=None)[0]
+    S = SHOOTING_STEPS
+    while True:  # the RK4 steps per arc as time_error chooses them (SHOOTING_RICHARDSON)
+        function = model.solver_cache.get(("bang-bang certificate", arcs, fixed_rate, S),
+                                          lambda: _costate_shooting(model, arcs, fixed_rate, S))
+        r, J, curvature, X, G = (np.asarray(m) for m in function(x0, z, U, disturbance, xf, np.zeros((nx, arcs * S))))
+        r = r.ravel()
+        # the multipliers: e_T + Jᵀ ν = 0 (solved, or in the least-squares sense)
+        nu_ = np.linalg.lstsq(J.T, -gradient, rcond=None)[0]
+        hessian = np.einsum("i,ijk->jk", nu_, curvature.reshape(arcs, conditions, arcs).transpose(1, 0, 2)) \
+            if arcs > conditions else np.zeros((arcs, arcs))
+        hessian = 0.5 * (hessian + hessian.T)
+        # the RK4 steps' error of the miss, and of T: the Newton step it makes at the steps' optimum
+        error = _rk4_error(model, x0, z, U, disturbance, xf, fixed_rate, S, r)
+        matrix = J if arcs <= conditions else np.block([[hessian, J.T], [J, np.zeros((conditions, conditions))]])
+        time_error_ = abs(float(_newton_step(matrix, np.zeros(len(matrix)), arcs if arcs > conditions else 0, error)[-1]))
+        if time_error_ <= SHOOTING_RICHARDSON * float(T) or S >= SHOOTING_MAX_STEPS:
+            break
+        S *= 2
     stationarity = float(np.max(np.abs(gradient + J.T @ nu_)))
     singular_values = np.linalg.svd(J, compute_uv=False)
-    checks: dict[str, Any] = {"miss": float(np.max(np.abs(r))), "stationarity": stationarity}
+    # the miss of the switches flown exactly (the RK4 steps' error taken off)
+    checks: dict[str, Any] = {"miss": float(np.max(np.abs(r - error))), "stationarity": stationarity,
+                              "steps_per_arc": S, "rk4_error": float(np.max(np.abs(error))),
+                              "rk4_time_error_s": time_error_}
     if arcs <= conditions:
         condition = float(singular_values[0] / singular_values[-1]) if singular_values[-1] > 0 else np.inf
         checks["condition"] = condition
@@ -708,8 +775,7 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
     else:  # the reduced Hessian of T + νᵀ r on the null space of J
         _, _, vt = np.linalg.svd(J)
         Z = vt[conditions:].T
-        hessian = np.einsum("i,ijk->jk", nu_, curvature.reshape(arcs, conditions, arcs).transpose(1, 0, 2))
-        least = float(np.min(np.linalg.eigvalsh(Z.T @ (0.5 * (hessian + hessian.T)) @ Z))) * float(T)
+        least = float(np.min(np.linalg.eigvalsh(Z.T @ hessian @ Z))) * float(T)
         checks["curvature"] = least
         second = bool(least > BANG_BANG_CURVATURE)
     # the co-state at the steps' ends, and H, σ, σ̇ there per arc (an arc's two ends with its control)

@@ -1,0 +1,116 @@
+"""The shot bang-bang minimum time and its certificate (planners.collocation.certificate:
+``time_error``'s switch-time shooting, ``bang_bang_certificate``): the switch times and T are those
+of the continuous problem, not of the shooting's RK4 steps, and the sign test of the switching
+functions refuses a wrong sign between its samples.
+
+Oracle, independent of the code under test: scipy's DOP853 (rtol 1e-13) flying the bang-bang
+control (the dynamics written out in tests/test_collocation_bang_bang.py), and Newton's method on
+the final conditions with those flights (a finite-difference Jacobian): the exact optimum with the
+returned switching structure. Published: Betts 2010, sect. 6.8, XTE 28.6304077 s, 9e-7 s above it.
+"""
+import numpy as np
+import pytest
+
+import planners.collocation.certificate as certificate
+from tests.test_collocation_bang_bang import flown, plan, problem_of
+
+CASES = ("bilimoria_wie_180", "full_inertia_150", "xte_150")
+
+
+def final_miss(problem, times, controls, T):
+    """DOP853's final miss: the vector part of ``conj(q_f) ⊗ q(T)`` and ``ω(T) − ω_f``."""
+    end, _ = flown(problem, times, controls, T)
+    q, qf = end[:4], np.asarray(problem.qf, dtype=float)
+    vector = qf[0] * q[1:] - q[0] * qf[1:] - np.cross(qf[1:], q[1:])
+    return np.concatenate([vector, end[4:7] - np.asarray(problem.omegaf, dtype=float)])
+
+
+def exact_optimum(problem, times, controls, T):
+    """Switch times and T (as many as the final conditions) that DOP853's flight meets them with:
+    Newton's method from the given ones, forward differences of 1e-6 s."""
+    z = np.append(np.asarray(times, dtype=float), float(T))
+    assert len(z) == 6  # the cases here: 5 switches, 6 conditions
+    for _ in range(6):
+        r = final_miss(problem, z[:-1], controls, z[-1])
+        if np.max(np.abs(r)) < 1e-13:
+            break
+        J = np.empty((6, 6))
+        for k in range(6):
+            moved = z.copy()
+            moved[k] += 1e-6
+            J[:, k] = (final_miss(problem, moved[:-1], controls, moved[-1]) - r) / 1e-6
+        z = z - np.linalg.solve(J, r)
+    assert np.max(np.abs(final_miss(problem, z[:-1], controls, z[-1]))) < 1e-12
+    return z
+
+
+@pytest.fixture(scope="module")
+def planned():
+    return {name: plan(name) for name in CASES}
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_the_shot_switch_times_and_T_are_the_exact_optimum(planned, name):
+    # the shooting's RK4 steps (12 per arc) put T 1.6e-6 s below the exact optimum on XTE and
+    # 2e-7 s above it on the full inertia; their error taken off, T within 1e-9 of itself and the
+    # switches within 1e-8 of T (2e-9 on the full inertia, whose RK4 error at 12 steps is the least
+    # asymptotic: 14 times that of 24, not 16)
+    reference = planned[name]
+    shooting = reference.stats["shooting"]
+    times, controls, T = shooting["switch_times_s"], shooting["controls"], reference.duration
+    assert T == shooting["shooting_T_s"] and reference.stats["certificate"]["verdict"] == "certified"
+    exact = exact_optimum(problem_of(name), times, controls, T)
+    assert abs(T - exact[-1]) < 1e-9 * T, (T, exact[-1])
+    assert np.max(np.abs(np.asarray(times) - exact[:-1])) < 1e-8 * T
+    assert shooting["steps_per_arc"] == certificate.SHOOTING_STEPS
+    # the correction is the RK4 steps' error of T: the exact T minus that of the RK4 optimum
+    rk4_T = T - shooting["rk4_correction_s"]
+    assert abs(abs(exact[-1] - rk4_T) - abs(shooting["rk4_correction_s"])) < 0.02 * abs(exact[-1] - rk4_T)
+
+
+def test_xte_is_betts_value_to_its_digits(planned):
+    # Betts's 28.6304077 is 9e-7 s above the exact optimum (28.6304068)
+    assert planned["xte_150"].duration == pytest.approx(28.6304068, abs=1e-7)
+
+
+def certify(name, times, controls, T):
+    problem = problem_of(name)
+    bound = np.broadcast_to(np.asarray(problem.spacecraft.torquers.max_torque, dtype=float), (3,))
+    x0 = np.asarray(problem.initial_state[:7], dtype=float)
+    xf = np.concatenate([problem.qf, problem.omegaf])
+    return certificate.bang_bang_certificate(problem.model, x0, xf, np.zeros(3), np.asarray(times), np.asarray(controls),
+                                             T, -bound, bound, True)
+
+
+def test_the_certificate_measures_the_miss_of_the_exact_flight(planned):
+    # switch times and T 5.7e-8 of T off the exact optimum (XTE's RK4 error of 12 steps per arc)
+    # miss the final state by more than BANG_BANG_MISS flown exactly: not certified, and the
+    # certificate's miss is DOP853's, as at the certified optimum
+    reference = planned["xte_150"]
+    shooting, record = reference.stats["shooting"], reference.stats["certificate"]
+    assert record["verdict"] == "certified" and record["pontryagin"]["miss"] < 1e-12
+    assert record["pontryagin"]["steps_per_arc"] == certificate.SHOOTING_STEPS
+    assert record["pontryagin"]["rk4_time_error_s"] == pytest.approx(abs(shooting["rk4_correction_s"]), rel=0.02)
+    problem = problem_of("xte_150")
+    z = np.append(shooting["switch_times_s"], reference.duration)
+    # flown exactly, the certified optimum misses by 1.4e-10 (its switches 1e-9 s off the exact ones)
+    assert np.max(np.abs(final_miss(problem, z[:-1], shooting["controls"], z[-1]))) < 1e-9
+    moved = z * (1 - 5.7e-8)
+    miss = np.max(np.abs(final_miss(problem, moved[:-1], shooting["controls"], moved[-1])))
+    assert miss > certificate.BANG_BANG_MISS
+    refused = certify("xte_150", moved[:-1], shooting["controls"], moved[-1])
+    assert refused["verdict"] != "certified" and not refused["pontryagin"]["first_order"]
+    assert refused["pontryagin"]["miss"] == pytest.approx(miss, rel=0.02)
+
+
+def test_a_long_rk4_error_doubles_the_steps(monkeypatch):
+    # with a threshold below XTE's correction (5.7e-8 of T) the shooting and the certificate take
+    # 24 steps per arc: the same exact optimum
+    monkeypatch.setattr(certificate, "SHOOTING_RICHARDSON", 1e-8)
+    reference = plan("xte_150")
+    shooting = reference.stats["shooting"]
+    assert shooting["steps_per_arc"] == 2 * certificate.SHOOTING_STEPS
+    assert reference.stats["certificate"]["pontryagin"]["steps_per_arc"] == 2 * certificate.SHOOTING_STEPS
+    assert abs(shooting["rk4_correction_s"]) < 2e-7  # 1.6e-6 / 16
+    exact = exact_optimum(problem_of("xte_150"), shooting["switch_times_s"], shooting["controls"], reference.duration)
+    assert abs(reference.duration - exact[-1]) < 1e-9 * reference.duration
