@@ -114,3 +114,92 @@ def test_a_long_rk4_error_doubles_the_steps(monkeypatch):
     assert abs(shooting["rk4_correction_s"]) < 2e-7  # 1.6e-6 / 16
     exact = exact_optimum(problem_of("xte_150"), shooting["switch_times_s"], shooting["controls"], reference.duration)
     assert abs(reference.duration - exact[-1]) < 1e-9 * reference.duration
+
+
+# the sign test on switching functions given at the RK4 steps' ends: one control, |u| <= 1, at
+# +1 (σ < 0) until its switch at t = 1 and at −1 (σ > 0) after, T = 3, 12 steps per arc
+STEPS, SWITCH, END = 12, 1.0, 3.0
+U = np.array([[1.0, -1.0]])
+LOW, HIGH = np.array([-1.0]), np.array([1.0])
+
+
+def sign_test(values, rates):
+    """``_sign_test`` of σ and σ̇ given per arc as functions of the time (arrays of it)."""
+    times = np.stack([np.linspace(0.0, SWITCH, STEPS + 1), np.linspace(SWITCH, END, STEPS + 1)])
+    sigma = np.stack([values(times[k], k) for k in range(2)])[..., None]
+    sigma_dot = np.stack([rates(times[k], k) for k in range(2)])[..., None]
+    return certificate._sign_test(times, sigma, sigma_dot, U, LOW, HIGH)
+
+
+def test_a_clean_switch_passes_the_sign_test():
+    result = sign_test(lambda t, k: t - SWITCH, lambda t, k: np.ones_like(t))
+    assert result["wrong_sign"] == 0.0 and result["zero"] == 0.0
+    # |σ| / max|σ| over d / T: (d / 2) / (d / 3), and σ̇ T / max|σ| at the switch: 3 / 2
+    assert result["strictness"] == pytest.approx(1.5)
+    assert result["agreement"].wrong == 0.0
+
+
+def test_a_wrong_sign_below_the_agreement_tolerance_near_a_switch_is_refused():
+    # σ −9e-4 of its largest (2) at the first step's end after the switch (1/18 of T after it):
+    # the agreement counts it as zero (BANG_BANG_SIGN) and its strictness margin is 9e-4 / (1/18),
+    # 0.016: the old test passed it
+    def values(t, k):
+        v = t - SWITCH
+        return np.where(np.isclose(t, SWITCH + 2.0 / STEPS), -9e-4 * 2.0, v) if k == 1 else v
+
+    def rates(t, k):
+        return np.where(np.isclose(t, SWITCH + 2.0 / STEPS), 0.0, 1.0) if k == 1 else np.ones_like(t)
+
+    result = sign_test(values, rates)
+    assert result["agreement"].wrong == 0.0  # below BANG_BANG_SIGN: not seen by the agreement
+    assert result["wrong_sign"] == pytest.approx(9e-4, rel=1e-6)
+    assert result["wrong_sign"] > certificate.BANG_BANG_ZERO
+
+
+def test_a_wrong_sign_between_the_samples_is_refused():
+    # on the arc after the switch σ = 1 at the steps' ends but for a dip inside the 7th step:
+    # its ends' slopes -4.05 and 4.05 (per step) make the cubic 1 − 4.05 s (1 − s), −0.0125 at
+    # its middle and positive at every sample (s = 0.4: 0.028)
+    h = (END - SWITCH) / STEPS
+    dip = (SWITCH + 6 * h, SWITCH + 7 * h)
+
+    def values(t, k):
+        return t - SWITCH if k == 0 else np.where(t == SWITCH, 0.0, 1.0)
+
+    def rates(t, k):
+        if k == 0:
+            return np.ones_like(t)
+        rate = np.where(t == SWITCH, 1.0, 0.0)
+        return rate + np.where(np.isclose(t, dip[0]), -4.05 / h, 0.0) + np.where(np.isclose(t, dip[1]), 4.05 / h, 0.0)
+
+    result = sign_test(values, rates)
+    assert result["agreement"].wrong == 0.0
+    largest = 1 + 4.05 * 4 / 27  # the neighbouring steps' cubics 1 + 4.05 s² (1 − s) at s = 2/3
+    assert result["wrong_sign"] == pytest.approx(0.0125 / largest, rel=1e-6)
+    assert result["strictness"] > certificate.BANG_BANG_STRICT  # the samples alone: strict
+
+
+def test_a_switch_crossing_zero_the_wrong_way_is_not_strict():
+    # σ̇ at the switch (both arcs' ends) of the wrong sign, 0.02 of max|σ| / T: the wrong side's
+    # excursions beside it, 1e-6 of max|σ|, are below the co-state's error; the slope's sign
+    # refuses it (its size passed the old test's |σ̇| T / max|σ| >= BANG_BANG_STRICT)
+    slope = -0.02 * 2.0 / END
+
+    def rates(t, k):
+        return np.where(t == SWITCH, slope, 1.0)
+
+    result = sign_test(lambda t, k: t - SWITCH, rates)
+    assert result["wrong_sign"] < certificate.BANG_BANG_ZERO
+    assert result["strictness"] < 0 < certificate.BANG_BANG_STRICT
+
+
+@pytest.mark.parametrize("found, check", [({"wrong_sign": 1e-4}, "first_order"), ({"strictness": -0.5}, "strict")])
+def test_the_certificate_refuses_what_the_sign_test_finds(planned, monkeypatch, found, check):
+    real = certificate._sign_test
+    monkeypatch.setattr(certificate, "_sign_test", lambda *args: {**real(*args), **found})
+    shooting = planned["xte_150"].stats["shooting"]
+    record = certify("xte_150", shooting["switch_times_s"], shooting["controls"], planned["xte_150"].duration)
+    assert record["verdict"] != "certified" and not record["pontryagin"][check]
+    monkeypatch.setattr(certificate, "_sign_test", real)
+    assert certify("xte_150", shooting["switch_times_s"], shooting["controls"],
+                   planned["xte_150"].duration)["verdict"] == "certified"

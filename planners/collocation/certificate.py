@@ -677,19 +677,102 @@ def _node_conditions(model: AttitudeModel) -> ca.Function:
     return ca.Function("node_conditions", [x, p, u, d], [ca.dot(p, f), sigma, sigma_dot])
 
 
-def _strictness(t: Array, sigma: Array, switches: list[Array], T: float) -> Array:
-    """Per control, the least strictness margin (:data:`BANG_BANG_STRICT`) over the samples ``t``
-    (away from its switches ``switches[i]``) of ``σ (points, controls)``, normalised by ``max|σ_i|``."""
-    margins = np.full(sigma.shape[1], np.inf)
-    for i, times in enumerate(switches):
-        distance = (np.min(np.abs(t[:, None] - times[None, :]), axis=1) if times.size else np.full(t.shape, np.inf))
+def _sign_test(times: Array, sigma: Array, sigma_dot: Array, U: Array, low: Array, high: Array) -> dict[str, Any]:
+    """Pontryagin's sign test of :func:`bang_bang_certificate`: ``σ_i`` against the control on
+    each arc, between and at its switches.
+
+    ``σ`` is the cubic Hermite interpolant of its values and rates at the RK4 steps' ends (the
+    step's own accuracy): sampled at the ends and :data:`BANG_BANG_SAMPLES` points inside each
+    step, and read at each step's cubic's extrema, so that no wrong sign between the samples
+    escapes.
+
+    Parameters
+    ----------
+    times : (arcs, S + 1) ndarray
+        The steps' ends per arc [s] (an arc's last is the next one's first: the switch).
+    sigma, sigma_dot : (arcs, S + 1, nu) ndarray
+        ``σ`` and ``σ̇`` there, each arc's with its own control.
+    U : (nu, arcs) ndarray
+        The control on each arc.
+    low, high : (nu,) ndarray
+        The controls' bounds.
+
+    Returns
+    -------
+    dict
+        ``agreement`` (:func:`~ocp.nlp.certificate.switching_agreement` of the samples, ``|σ_i|``
+        relative to ``max|σ_i|`` below :data:`BANG_BANG_SIGN` counted as zero), ``wrong_sign``
+        (the largest ``σ_i`` of the wrong sign for the arc's control, relative to ``max|σ_i|``,
+        over the samples and extrema but at the switches of control ``i``), ``zero`` (the largest
+        ``|σ_i| / max|σ_i|`` at them) and ``strictness`` (:data:`BANG_BANG_STRICT`: the least of
+        the margins over the samples and extrema and, at the switches, ``σ̇_i T / max|σ_i|``
+        signed: negative where ``σ_i`` crosses zero the wrong way).
+    """
+    arcs, ends, nu = sigma.shape
+    S = ends - 1
+    T = float(times[-1, -1])
+    h = ((times[:, -1] - times[:, 0]) / S)[:, None, None]  # (arcs, 1, 1)
+    # inside each step: samples at s in [0, 1) and the cubic's extrema p'(s) = 0 in (0, 1)
+    a, b, da, db = sigma[:, :-1], sigma[:, 1:], h * sigma_dot[:, :-1], h * sigma_dot[:, 1:]  # (arcs, S, nu)
+
+    def cubic(s: Array) -> Array:
+        return ((2 * s ** 3 - 3 * s ** 2 + 1) * a + (s ** 3 - 2 * s ** 2 + s) * da + (-2 * s ** 3 + 3 * s ** 2) * b
+                + (s ** 3 - s ** 2) * db)
+
+    fractions = np.arange(BANG_BANG_SAMPLES + 1) / (BANG_BANG_SAMPLES + 1)
+    samples = np.stack([cubic(np.full(a.shape, f)) for f in fractions], axis=2)  # (arcs, S, samples, nu)
+    sample_times = times[:, :-1, None] + h * fractions[None, None, :]  # (arcs, S, samples)
+    A, B, C = 6 * a + 3 * da - 6 * b + 3 * db, -6 * a - 4 * da + 6 * b - 2 * db, da  # p'(s) = A s² + B s + C
+    with np.errstate(divide="ignore", invalid="ignore"):
+        root = np.sqrt(B ** 2 - 4 * A * C)
+        linear = np.abs(A) <= 1e-12 * (np.abs(B) + np.abs(C))
+        extrema = np.stack([np.where(linear, -C / B, (-B - root) / (2 * A)),
+                            np.where(linear, np.nan, (-B + root) / (2 * A))], axis=2)  # (arcs, S, 2, nu)
+    inside = np.isfinite(extrema) & (extrema > 0) & (extrema < 1)
+    extrema = np.where(inside, extrema, 0.0)  # else the step's start, a sample already
+    extreme_values = np.stack([cubic(extrema[:, :, k]) for k in range(2)], axis=2)
+    extreme_times = times[:, :-1, None, None] + h[..., None] * extrema
+    # per control: every sample and extremum, its time, the arc's control; the arcs' last ends
+    values = np.concatenate([samples.reshape(arcs, -1, nu), extreme_values.reshape(arcs, -1, nu), sigma[:, -1:]], axis=1)
+    every_time = np.concatenate([np.repeat(sample_times.reshape(arcs, -1, 1), nu, axis=2),
+                                 extreme_times.reshape(arcs, -1, nu), np.repeat(times[:, -1:, None], nu, axis=2)],
+                                axis=1)
+    regular = samples.shape[1] * samples.shape[2]
+    plain = np.concatenate([samples.reshape(arcs, -1, nu), sigma[:, -1:]], axis=1).reshape(-1, nu)
+    plain_u = np.repeat(U.T[:, None, :], regular + 1, axis=1).reshape(-1, nu)
+    # per control, σ relative to its largest value (a control whose σ is far below the others':
+    # relative to a thousandth of the largest)
+    largest = np.max(np.abs(values.reshape(-1, nu)), axis=0)
+    scale = np.maximum(largest, BANG_BANG_SIGN * float(np.max(largest, initial=0.0)))
+    scale = np.where(scale > 0, scale, 1.0)
+    agreement = switching_agreement(plain_u, low, high, plain / scale, relative_tolerance=BANG_BANG_SIGN)
+    # the sign σ_i has on an arc: positive at the lower bound (the control minimises σ u)
+    expected = np.where(np.abs(U - low[:, None]) <= 1e-9 * (1 + np.abs(low[:, None])), 1.0, -1.0)  # (nu, arcs)
+    signed = np.repeat(expected.T[:, None, :], values.shape[1], axis=1) * values / scale  # (arcs, points, nu)
+    # the switches: which controls each flips, σ_i and σ̇_i there (the two arcs' ends' mean)
+    flips = U[:, 1:] != U[:, :-1]  # (nu, arcs − 1)
+    zero, slope = 0.0, np.inf
+    owned: list[list[float]] = [[] for _ in range(nu)]
+    for k, i in zip(*np.nonzero(flips.T)):
+        value = 0.5 * (sigma[k, -1, i] + sigma[k + 1, 0, i])
+        rate = 0.5 * (sigma_dot[k, -1, i] + sigma_dot[k + 1, 0, i])
+        zero = max(zero, abs(value) / scale[i])
+        slope = min(slope, expected[i, k + 1] * rate * T / scale[i])  # rising into the next arc's sign
+        owned[i].append(float(times[k, -1]))
+    wrong, margins = 0.0, np.full(nu, np.inf)
+    for i in range(nu):
+        t, v = every_time[..., i].ravel(), signed[..., i].ravel()
+        switches = np.asarray(owned[i])
+        distance = np.min(np.abs(t[:, None] - switches[None, :]), axis=1) if switches.size else np.full(t.shape, np.inf)
         away = distance > 1e-9 * T
-        scale = float(np.max(np.abs(sigma[:, i]), initial=0.0))
-        if scale == 0.0:
+        wrong = max(wrong, float(np.max(-v[away], initial=0.0)))
+        if largest[i] == 0.0:
             margins[i] = 0.0
             continue
-        margins[i] = float(np.min(np.abs(sigma[away, i]) / scale / np.minimum(1.0, distance[away] / T), initial=np.inf))
-    return margins
+        relative = np.abs(values[..., i].ravel()[away]) / largest[i]  # to its own largest
+        margins[i] = float(np.min(relative / np.minimum(1.0, distance[away] / T), initial=np.inf))
+    return {"agreement": agreement, "wrong_sign": wrong, "zero": zero,
+            "strictness": float(min(slope, float(np.min(margins, initial=np.inf))))}
 
 
 def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbance: Array, switch_times: Array,
@@ -788,46 +871,19 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
     starts = np.concatenate([[0.0], z[:-1]])
     times = starts[:, None] + (z - starts)[:, None] * np.arange(S + 1)[None, :] / S  # (arcs, S + 1)
     hamiltonian = float(np.max(np.abs(1.0 + pf)))
-    # σ sampled inside the steps: cubic Hermite per arc from the ends' σ and σ̇
     sigma, sigma_dot = sigma.T.reshape(arcs, S + 1, nu), sigma_dot.T.reshape(arcs, S + 1, nu)
-    s = np.arange(BANG_BANG_SAMPLES + 1)[None, :] / (BANG_BANG_SAMPLES + 1)  # (1, samples) in [0, 1)
-    h = ((z - starts) / S)[:, None, None]
-    h00, h10, h01, h11 = 2 * s ** 3 - 3 * s ** 2 + 1, s ** 3 - 2 * s ** 2 + s, -2 * s ** 3 + 3 * s ** 2, s ** 3 - s ** 2
-    a, b, da, db = sigma[:, :-1, None, :], sigma[:, 1:, None, :], sigma_dot[:, :-1, None, :], sigma_dot[:, 1:, None, :]
-    w = [c.ravel()[None, None, :, None] for c in (h00, h10, h01, h11)]
-    dense = w[0] * a + w[1] * h[..., None] * da + w[2] * b + w[3] * h[..., None] * db  # (arcs, S, samples, nu)
-    samples = np.concatenate([dense.reshape(arcs, -1, nu), sigma[:, -1:, :]], axis=1)  # (arcs, S (samples) + 1, nu)
-    sample_times = np.concatenate([(times[:, :-1, None] + h[..., 0, None] * s[None, :, :]).reshape(arcs, -1),
-                                   times[:, -1:]], axis=1)
-    sample_u = np.repeat(U.T[:, None, :], samples.shape[1], axis=1)
-    samples, sample_times, sample_u = samples.reshape(-1, nu), sample_times.ravel(), sample_u.reshape(-1, nu)
-    # per control, σ relative to its largest value (a control whose σ is far below the others':
-    # relative to a thousandth of the largest)
-    largest = np.max(np.abs(samples), axis=0)
-    scale = np.maximum(largest, BANG_BANG_SIGN * float(np.max(largest, initial=0.0)))
-    scale = np.where(scale > 0, scale, 1.0)
-    agreement = switching_agreement(sample_u, low, high, samples / scale, relative_tolerance=BANG_BANG_SIGN)
-    # the switches: which controls each flips, σ_i and σ̇_i there
+    sign = _sign_test(times, sigma, sigma_dot, U, low, high)
+    agreement, zero, wrong_sign, strictness = sign["agreement"], sign["zero"], sign["wrong_sign"], sign["strictness"]
     flips = U[:, 1:] != U[:, :-1]  # (nu, arcs − 1)
     bound = np.all((np.abs(U - low[:, None]) <= 1e-9 * (1 + np.abs(low[:, None])))
                    | (np.abs(U - high[:, None]) <= 1e-9 * (1 + np.abs(high[:, None]))))
     simple = bool(np.all(flips.sum(axis=0) == 1) and np.all(np.diff(z) > 1e-9 * float(T)) and z[0] > 0)
-    zero, slope = 0.0, np.inf
-    owned: list[list[float]] = [[] for _ in range(nu)]
-    for k, i in zip(*np.nonzero(flips.T)):
-        value = 0.5 * (sigma[k, -1, i] + sigma[k + 1, 0, i])  # the two arcs' ends at the switch
-        rate = 0.5 * (sigma_dot[k, -1, i] + sigma_dot[k + 1, 0, i])
-        zero = max(zero, abs(value) / scale[i])
-        slope = min(slope, abs(rate) * float(T) / scale[i])
-        owned[i].append(z[k])
-    margins = _strictness(sample_times, samples, [np.asarray(o) for o in owned], float(T))
-    strictness = float(min(slope, float(np.min(margins, initial=np.inf))))
     first = bool(checks["miss"] <= BANG_BANG_MISS and stationarity <= BANG_BANG_STATIONARITY
                  and hamiltonian <= BANG_BANG_HAMILTONIAN and zero <= BANG_BANG_ZERO and agreement.wrong == 0.0
-                 and agreement.interior_large == 0.0)
+                 and wrong_sign <= BANG_BANG_ZERO and agreement.interior_large == 0.0)
     strict = bool(bound and simple and strictness >= BANG_BANG_STRICT)
     checks.update({"hamiltonian": hamiltonian, "switching": agreement.agreement, "wrong": agreement.wrong,
-                   "zero_at_switches": zero, "strictness": strictness, "bang_bang": bool(bound),
+                   "zero_at_switches": zero, "wrong_sign": wrong_sign, "strictness": strictness, "bang_bang": bool(bound),
                    "simple_switches": simple, "switches": arcs - 1, "first_order": first, "strict": strict,
                    "second_order": second})
     verdict = ("certified" if first and strict and second else "first-order" if first else "not certified")
