@@ -18,13 +18,16 @@ that control, integrated accurately (RK4, :data:`SHOOTING_STEPS` steps per arc),
 attitude and rate (with more switches than final conditions, ``T`` minimised on them; two switches
 of two controls the minimisation makes cross are tied, their order constraint active). Newton's
 method stops where the miss and the stationarity at the point it returns are below
-:data:`SHOOTING_TOLERANCE`. A σ exactly 0 at a Radau point between a positive and a negative value
-is one root. Its ``T`` is
-that of a trajectory of the continuous problem (to the RK4 steps' error, 1.6e-6 s on XTE), so it
-bounds the continuous minimum time from above, and, the optimum being stationary on the feasible
-switch times, it is within the square of the collocation's switch-time error of it: ``T_N`` minus
-it is the discretisation error of ``T_N``, not more than it but for the RK4 steps' error (a
-switch the mesh missed makes it less). A switch or ``T`` moved by more than a mesh interval is another switching structure than the
+:data:`SHOOTING_TOLERANCE`. There the RK4 steps' error of the final miss, by step doubling
+(:func:`_rk4_error`: twice the steps, the miss alone), gives one more Newton step, to the optimum
+of the same switches flown exactly (Richardson's extrapolation: within 2e-9 s of DOP853's on
+Bilimoria & Wie, the full inertia and XTE, whose RK4 optimum is 1.6e-6 s below); where that step
+moves ``T`` by more than :data:`SHOOTING_RICHARDSON` of it, the steps per arc are doubled and the
+shooting goes on from there. A σ exactly 0 at a Radau point between a positive and a negative
+value is one root. Its ``T`` is that of a trajectory of the continuous problem, so it bounds the
+continuous minimum time from above, and, the optimum being stationary on the feasible switch
+times, it is within the square of the collocation's switch-time error of it: ``T_N`` minus it is
+the discretisation error of ``T_N``, not more than it (a switch the mesh missed makes it less). A switch or ``T`` moved by more than a mesh interval is another switching structure than the
 mesh resolved: no estimate.
 """
 from __future__ import annotations
@@ -55,21 +58,27 @@ from planners.problem import Array, ManeuverProblem
 from planners.reference import Reference
 
 SHOOTING_STEPS = 12
-"""RK4 steps per arc of :func:`time_error`'s bang-bang shooting: its ``T`` on XTE is 1.6e-6 s from
-that of 80 steps (28.6304068 s), on Bilimoria & Wie 2.6e-8 s, on the full inertia 2e-7 s; 40 steps
-cost 10x the time a call."""
+"""RK4 steps per arc of :func:`time_error`'s bang-bang shooting (and :func:`bang_bang_certificate`'s
+co-state), doubled where :data:`SHOOTING_RICHARDSON` asks: the RK4 optimum's ``T`` on XTE is
+1.6e-6 s below the exact one (28.6304068 s), on Bilimoria & Wie 2.6e-8 s, on the full inertia 2e-7 s
+above (taken off by step doubling: :func:`_rk4_error`); 40 steps cost 10x the time a call."""
 SHOOTING_TOLERANCE = 1e-10
 """Largest final attitude (quaternion vector part) and rate [rad/s] miss, and stationarity of the
 minimisation of ``T`` (more switches than conditions), at which :func:`time_error` accepts a point
 of its Newton iteration: both are evaluated at the point returned, whose ``T`` is then that of the
-RK4 shooting's exact solution to far below a microsecond."""
+RK4 shooting's exact solution to far below a microsecond (the RK4 steps' own error is then taken
+off: :data:`SHOOTING_RICHARDSON`)."""
 SHOOTING_ITERATIONS = 10
 """Newton iterations of :func:`time_error` before it gives up."""
 SHOOTING_RICHARDSON = 1e-7
 """Largest RK4 correction of ``T`` (the step from the shooting's optimum to that of the same
 switches flown exactly, by step doubling: :func:`_rk4_error`), relative to ``T``, that
-:func:`time_error` and :func:`bang_bang_certificate` take with :data:`SHOOTING_STEPS` steps per
-arc; above it the steps are doubled (up to :data:`SHOOTING_MAX_STEPS`)."""
+:func:`time_error` and :func:`bang_bang_certificate` take with their steps per arc; above it the
+steps are doubled (up to :data:`SHOOTING_MAX_STEPS`). The correction is Richardson's extrapolation
+of RK4's fourth-order error: from 12 and 24 steps it leaves 4e-11 of ``T`` on XTE (correction
+5.7e-8 of ``T``) and 2e-10 on the full inertia (2.5e-8, its error at 12 steps 14 times that at 24,
+not 16); the switch times within 2e-9 of ``T``. Both are far from the error's asymptote when the
+correction is large: above 1e-7 of ``T``, 24 steps and more."""
 SHOOTING_MAX_STEPS = 96
 """Most RK4 steps per arc :data:`SHOOTING_RICHARDSON` doubles them to."""
 
@@ -475,10 +484,13 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
     Returns
     -------
     dict
-        ``estimate_s`` (``T_N − T`` [s]), ``shooting_T_s`` (its ``T``), ``switches``, ``miss`` (the
-        final attitude and rate miss there), ``stationarity`` (of ``T``'s minimisation; 0 without),
-        ``switch_times_s`` (in time order), ``controls`` (per arc), ``coinciding`` (tied pairs of switches) and
-        ``iterations`` (shooting calls); or ``skipped`` saying why not (controls' bounds that vary, no convergence,
+        ``estimate_s`` (``T_N − T`` [s]), ``shooting_T_s`` (its ``T``: the exact flight's, the RK4
+        steps' error taken off), ``switches``, ``miss`` (the final attitude and rate miss of the RK4
+        shooting at its optimum), ``stationarity`` (of ``T``'s minimisation; 0 without),
+        ``switch_times_s`` (in time order, the exact flight's), ``controls`` (per arc), ``coinciding``
+        (tied pairs of switches), ``iterations`` (shooting calls), ``steps_per_arc`` (RK4),
+        ``rk4_correction_s`` (``T`` minus the RK4 optimum's [s]) and ``rk4_error`` (the steps' error
+        of the final miss there, by step doubling); or ``skipped`` saying why not (controls' bounds that vary, no convergence,
         switches that change order).
     """
     N, d, nx, nu = transcription.intervals, transcription.degree, model.nx, model.nu
@@ -588,8 +600,9 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
 
 BANG_BANG_MISS = 1e-8
 """Largest final attitude (quaternion vector part) and rate [rad/s] miss of a trajectory
-:func:`bang_bang_certificate` accepts as feasible: the shooting converges to below 1e-10
-(:data:`SHOOTING_TOLERANCE`), a switch time moved by 1e-6 s misses by about 1e-6."""
+:func:`bang_bang_certificate` accepts as feasible, flown exactly (its RK4 steps' error taken off:
+:func:`_rk4_error`): 1e-13 at :func:`time_error`'s optimum, 1.4e-10 flown by DOP853 on XTE; a switch
+time moved by 1e-6 s misses by about 1e-6, and XTE's RK4 optimum (1.6e-6 s below) by 1e-7."""
 BANG_BANG_STATIONARITY = 1e-5
 """Largest residual ``‖e_T + Jᵀ ν‖∞`` of the multipliers of :func:`bang_bang_certificate` (with
 more switches than final conditions, the least-squares ``ν``): the measure of
@@ -600,18 +613,23 @@ BANG_BANG_HAMILTONIAN = 1e-5
 """Largest ``|H(t)| = |1 + pᵀ f|`` along the trajectory (``H`` is already relative: the cost's
 multiplier is 1). With the discrete co-state of the RK4 shooting it is 1e-7 on Bilimoria & Wie
 and 1e-6 on the full inertia and XTE: the RK4 steps' error (:data:`SHOOTING_STEPS`), ten times
-below."""
+below (more steps where :data:`SHOOTING_RICHARDSON` asks)."""
 BANG_BANG_ZERO = 1e-5
 """Largest ``|σ_i|`` at a switch of control ``i``, relative to ``max|σ_i|`` over the slew: 3e-7 on
 Bilimoria & Wie, 2e-6 on the full inertia and XTE (the RK4 steps' error: the stationarity in the
-switch time is exact for the steps, see the docstring)."""
+switch time is exact for the steps, see the docstring). Also the largest ``σ_i`` of the wrong sign
+for its arc's control, relative alike, that :func:`bang_bang_certificate` takes for the co-state's
+numerical error (0 on the three): above it Pontryagin's minimum condition fails."""
 BANG_BANG_SIGN = 1e-3
 """``|σ_i|`` at most this times ``max|σ_i|`` counts as zero in the sign agreement
-(:func:`~ocp.nlp.certificate.switching_agreement`'s relative tolerance): samples beside a switch."""
+(:func:`~ocp.nlp.certificate.switching_agreement`'s relative tolerance, the ``switching`` fraction
+recorded): samples beside a switch. A wrong sign below it is still refused
+(:data:`BANG_BANG_ZERO`)."""
 BANG_BANG_STRICT = 1e-2
 """Least strictness margin of a strictly bang-bang control: ``|σ_i(t)| / max|σ_i|`` divided by
 ``min(1, d(t) / T)`` (``d`` the distance to the nearest switch of control ``i``), over the
-samples and, at the switches, ``|σ̇_i| T / max|σ_i|``. A simple zero and a clear sign elsewhere
+samples and the steps' cubics' extrema and, at the switches, ``σ̇_i T / max|σ_i|`` signed (negative
+where ``σ_i`` crosses zero against the next arc's control). A simple zero and a clear sign elsewhere
 give order 1 (0.3 to 3 on Bilimoria & Wie, the full inertia and XTE); a touch of zero between two
 switches or a singular control (the eigenaxis slew's zero torques) gives 0."""
 BANG_BANG_CONDITION = 1e8
@@ -810,10 +828,15 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
     dict
         The keys of :func:`ocp.nlp.certificate.certificate` (``kkt_scaled`` and ``kkt_unscaled``
         the largest first-order residual: final miss, stationarity in ``z``, ``|H|``), ``method``
-        ``"switch-time shooting"`` and ``pontryagin``, the checks: ``miss``, ``stationarity``,
-        ``hamiltonian`` (max ``|H|``), ``switching`` (agreement), ``wrong`` (fraction of samples on
-        the wrong side), ``zero_at_switches`` (max ``|σ_i| / max|σ_i|`` at them), ``strictness``
-        (least margin), ``bang_bang`` (all controls at a bound), ``simple_switches`` (one control
+        ``"switch-time shooting"`` and ``pontryagin``, the checks: ``miss`` (of the switches flown
+        exactly: the RK4 steps' error taken off), ``stationarity``, ``steps_per_arc`` (RK4, as
+        :data:`SHOOTING_RICHARDSON` chooses them), ``rk4_error`` (the steps' error of the final
+        miss, by step doubling), ``rk4_time_error_s`` (the error it makes in ``T`` at the steps'
+        optimum [s]), ``hamiltonian`` (max ``|H|``), ``switching`` (agreement), ``wrong`` (fraction
+        of samples on the wrong side by more than :data:`BANG_BANG_SIGN`), ``zero_at_switches``
+        (max ``|σ_i| / max|σ_i|`` at them), ``wrong_sign`` (the largest ``σ_i`` of the wrong sign,
+        relative alike, over the samples and the steps' cubics' extrema), ``strictness`` (least
+        margin), ``bang_bang`` (all controls at a bound), ``simple_switches`` (one control
         per switch), ``switches``, ``condition`` (of ``∂r/∂z``, as many unknowns as conditions or
         fewer) or ``curvature`` (least reduced-Hessian eigenvalue times ``T``, more), ``first_order``,
         ``strict``, ``second_order`` (bools).
