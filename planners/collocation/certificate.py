@@ -27,8 +27,9 @@ shooting goes on from there. A σ exactly 0 at a Radau point between a positive 
 value is one root. Its ``T`` is that of a trajectory of the continuous problem, so it bounds the
 continuous minimum time from above, and, the optimum being stationary on the feasible switch
 times, it is within the square of the collocation's switch-time error of it: ``T_N`` minus it is
-the discretisation error of ``T_N``, not more than it (a switch the mesh missed makes it less). A switch or ``T`` moved by more than a mesh interval is another switching structure than the
-mesh resolved: no estimate.
+the discretisation error of ``T_N``, not more than it (a switch the mesh missed makes it less). A
+switch or ``T`` moved by more than a mesh interval is another switching structure than the mesh
+resolved: no estimate.
 """
 from __future__ import annotations
 
@@ -490,8 +491,8 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
         ``switch_times_s`` (in time order, the exact flight's), ``controls`` (per arc), ``coinciding``
         (tied pairs of switches), ``iterations`` (shooting calls), ``steps_per_arc`` (RK4),
         ``rk4_correction_s`` (``T`` minus the RK4 optimum's [s]) and ``rk4_error`` (the steps' error
-        of the final miss there, by step doubling); or ``skipped`` saying why not (controls' bounds that vary, no convergence,
-        switches that change order).
+        of the final miss there, by step doubling); or ``skipped`` saying why not (controls' bounds
+        that vary, no convergence, switches that change order).
     """
     N, d, nx, nu = transcription.intervals, transcription.degree, model.nx, model.nu
     t, _, sigma = functions
@@ -613,7 +614,10 @@ BANG_BANG_HAMILTONIAN = 1e-5
 """Largest ``|H(t)| = |1 + pᵀ f|`` along the trajectory (``H`` is already relative: the cost's
 multiplier is 1). With the discrete co-state of the RK4 shooting it is 1e-7 on Bilimoria & Wie
 and 1e-6 on the full inertia and XTE: the RK4 steps' error (:data:`SHOOTING_STEPS`), ten times
-below (more steps where :data:`SHOOTING_RICHARDSON` asks)."""
+below (more steps where :data:`SHOOTING_RICHARDSON` asks). Above it :func:`bang_bang_certificate`
+doubles its steps once (up to :data:`SHOOTING_MAX_STEPS`) before it refuses: a discrete co-state's
+own error falls 16-fold, a trajectory's that is no optimum does not (0.1 s the first time a model
+needs the finer co-state, 10-30 ms a call)."""
 BANG_BANG_ZERO = 1e-5
 """Largest ``|σ_i|`` at a switch of control ``i``, relative to ``max|σ_i|`` over the slew: 3e-7 on
 Bilimoria & Wie, 2e-6 on the full inertia and XTE (the RK4 steps' error: the stationarity in the
@@ -751,7 +755,8 @@ def _sign_test(times: Array, sigma: Array, sigma_dot: Array, U: Array, low: Arra
     extreme_values = np.stack([cubic(extrema[:, :, k]) for k in range(2)], axis=2)
     extreme_times = times[:, :-1, None, None] + h[..., None] * extrema
     # per control: every sample and extremum, its time, the arc's control; the arcs' last ends
-    values = np.concatenate([samples.reshape(arcs, -1, nu), extreme_values.reshape(arcs, -1, nu), sigma[:, -1:]], axis=1)
+    values = np.concatenate([samples.reshape(arcs, -1, nu), extreme_values.reshape(arcs, -1, nu), sigma[:, -1:]],
+                            axis=1)
     every_time = np.concatenate([np.repeat(sample_times.reshape(arcs, -1, 1), nu, axis=2),
                                  extreme_times.reshape(arcs, -1, nu), np.repeat(times[:, -1:, None], nu, axis=2)],
                                 axis=1)
@@ -850,8 +855,8 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
     conditions = 6 if fixed_rate else 3
     gradient = np.zeros(arcs)
     gradient[-1] = 1.0
-    S = SHOOTING_STEPS
-    while True:  # the RK4 steps per arc as time_error chooses them (SHOOTING_RICHARDSON)
+    S, finer = SHOOTING_STEPS, False
+    while True:  # the RK4 steps per arc as time_error chooses them (SHOOTING_RICHARDSON), or more for H
         function = model.solver_cache.get(("bang-bang certificate", arcs, fixed_rate, S),
                                           lambda: _costate_shooting(model, arcs, fixed_rate, S))
         r, J, curvature, X, G = (np.asarray(m) for m in function(x0, z, U, disturbance, xf, np.zeros((nx, arcs * S))))
@@ -864,10 +869,23 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
         # the RK4 steps' error of the miss, and of T: the Newton step it makes at the steps' optimum
         error = _rk4_error(model, x0, z, U, disturbance, xf, fixed_rate, S, r)
         matrix = J if arcs <= conditions else np.block([[hessian, J.T], [J, np.zeros((conditions, conditions))]])
-        time_error_ = abs(float(_newton_step(matrix, np.zeros(len(matrix)), arcs if arcs > conditions else 0, error)[-1]))
-        if time_error_ <= SHOOTING_RICHARDSON * float(T) or S >= SHOOTING_MAX_STEPS:
+        row = arcs if arcs > conditions else 0
+        time_error_ = abs(float(_newton_step(matrix, np.zeros(len(matrix)), row, error)[-1]))
+        if time_error_ > SHOOTING_RICHARDSON * float(T) and S < SHOOTING_MAX_STEPS:
+            S *= 2
+            continue
+        # the co-state at the steps' ends, and H, σ, σ̇ there per arc (an arc's two ends with its control)
+        P = (nu_ @ G).reshape(-1, nx).T  # (nx, N + 1)
+        ends = np.arange(arcs)[:, None] * S + np.arange(S + 1)[None, :]  # (arcs, S + 1) step ends per arc
+        points = ends.size
+        node = _mapped(model, "bang-bang node conditions", points, lambda: _node_conditions(model))
+        pf, sigma, sigma_dot = (np.asarray(m) for m in node(X[:, ends.ravel()], P[:, ends.ravel()],
+                                                           np.repeat(U, S + 1, axis=1),
+                                                           np.tile(disturbance, (points, 1)).T))
+        hamiltonian = float(np.max(np.abs(1.0 + pf)))
+        if hamiltonian <= BANG_BANG_HAMILTONIAN or S >= SHOOTING_MAX_STEPS or finer:
             break
-        S *= 2
+        S, finer = 2 * S, True  # H above its tolerance: once more with twice the steps (their error / 16)
     stationarity = float(np.max(np.abs(gradient + J.T @ nu_)))
     singular_values = np.linalg.svd(J, compute_uv=False)
     # the miss of the switches flown exactly (the RK4 steps' error taken off)
@@ -884,16 +902,8 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
         least = float(np.min(np.linalg.eigvalsh(Z.T @ hessian @ Z))) * float(T)
         checks["curvature"] = least
         second = bool(least > BANG_BANG_CURVATURE)
-    # the co-state at the steps' ends, and H, σ, σ̇ there per arc (an arc's two ends with its control)
-    P = (nu_ @ G).reshape(-1, nx).T  # (nx, N + 1)
-    ends = np.arange(arcs)[:, None] * S + np.arange(S + 1)[None, :]  # (arcs, S + 1) step ends per arc
-    points = ends.size
-    node = _mapped(model, "bang-bang node conditions", points, lambda: _node_conditions(model))
-    pf, sigma, sigma_dot = (np.asarray(m) for m in node(X[:, ends.ravel()], P[:, ends.ravel()],
-                                                       np.repeat(U, S + 1, axis=1), np.tile(disturbance, (points, 1)).T))
     starts = np.concatenate([[0.0], z[:-1]])
     times = starts[:, None] + (z - starts)[:, None] * np.arange(S + 1)[None, :] / S  # (arcs, S + 1)
-    hamiltonian = float(np.max(np.abs(1.0 + pf)))
     sigma, sigma_dot = sigma.T.reshape(arcs, S + 1, nu), sigma_dot.T.reshape(arcs, S + 1, nu)
     sign = _sign_test(times, sigma, sigma_dot, U, low, high)
     agreement, zero, wrong_sign, strictness = sign["agreement"], sign["zero"], sign["wrong_sign"], sign["strictness"]
@@ -906,7 +916,8 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
                  and wrong_sign <= BANG_BANG_ZERO and agreement.interior_large == 0.0)
     strict = bool(bound and simple and strictness >= BANG_BANG_STRICT)
     checks.update({"hamiltonian": hamiltonian, "switching": agreement.agreement, "wrong": agreement.wrong,
-                   "zero_at_switches": zero, "wrong_sign": wrong_sign, "strictness": strictness, "bang_bang": bool(bound),
+                   "zero_at_switches": zero, "wrong_sign": wrong_sign, "strictness": strictness,
+                   "bang_bang": bool(bound),
                    "simple_switches": simple, "switches": arcs - 1, "first_order": first, "strict": strict,
                    "second_order": second})
     verdict = ("certified" if first and strict and second else "first-order" if first else "not certified")
