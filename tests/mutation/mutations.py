@@ -1258,7 +1258,7 @@ MUTATIONS: list[Mutation] = [
              "first = np.where(sigma[0] > 0, low, high)", "first = np.where(sigma[0] < 0, low, high)",
              ("tests/test_mesh_error.py",)),
     Mutation("time-error-sign-of-the-estimate", "planners/collocation/certificate.py",
-             'return {"estimate_s": T - float(z[-1]),', 'return {"estimate_s": float(z[-1]) - T,',
+             'return {"estimate_s": T - float(exact[-1]),', 'return {"estimate_s": float(exact[-1]) - T,',
              ("tests/test_mesh_error.py",)),
     Mutation("time-error-t-not-minimised-on-extra-switches", "planners/collocation/certificate.py",
              "gradient[-1] = 1.0  # of T", "gradient[-1] = 0.0  # of T",
