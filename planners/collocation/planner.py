@@ -877,8 +877,9 @@ class CollocationPlanner(Planner):
         reference.message = (f"{o.objective}: the bang-bang optimum, T = {T:.8g} s, by switch-time shooting "
                              f"from the N={coarse.intervals} optimum (T = {found.duration:.7g} s{agreement}; "
                              f"{record['switches']} switches; the final miss {record['miss']:.1e} of the shooting's RK4, "
-                             f"{SHOOTING_STEPS} steps per arc: T is that of the RK4 trajectory, within those steps' "
-                             f"error of the same switches flown exactly); "
+                             f"{record.get('steps_per_arc', SHOOTING_STEPS)} steps per arc, whose error "
+                             f"({record.get('rk4_correction_s', 0.0):+.1e} s of T, by step doubling) is taken off: T is "
+                             f"that of the same switches flown exactly); "
                              f"{certificate.get('summary', certificate.get('verdict'))}")
         return reference
 
