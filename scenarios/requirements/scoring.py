@@ -76,7 +76,7 @@ from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requi
 
 __all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
            "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
-           "endpoint_violations", "plant_limits", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
+           "endpoint_violations", "late_slew", "plant_limits", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
            "rate_violations", "score_reference", "start_torque", "target_slack", "tracking_loss", "unhonoured", "violations",
            "worst_error_between_samples"]
 
@@ -980,7 +980,8 @@ def target_slack(constraint: PointingConstraint, duration: float, free_time: boo
 
 def rate_violations(problem: ManeuverProblem) -> list[str]:
     """The rate requirement that no motion from ``q0`` to ``qf`` within T can meet, before planning
-    (part of :func:`endpoint_violations`; the runner makes such rows ``infeasible``).
+    (part of :func:`endpoint_violations`; the runner makes such rows ``infeasible``, as every proof
+    of it does).
 
     Parameters
     ----------
@@ -998,10 +999,10 @@ def rate_violations(problem: ManeuverProblem) -> list[str]:
     The principal angle
     ``θ`` between them (the shorter way, ±qf) changes no faster than the body turns, ``|dθ/dt| ≤ ‖ω‖``,
     so a motion with ``‖ω‖ ≤ ω_max`` throughout needs at least ``θ / ω_max``; T bounds the slew
-    (fixed, or the upper bound of a minimum-time slew; a planner that chooses a longer duration of its
-    own, eigenaxis's ``min_time``, is held to it here: a slew that cannot be made within the
-    manoeuvre's duration is not the manoeuvre asked for). Whatever the boundary rates (the bound holds
-    at every time, the ends included). Refused only beyond the scoring's own slack (``_TOLERANCE``).
+    (fixed, or the upper bound of a minimum-time slew: ``maneuver.duration`` is the manoeuvre's time
+    budget for every planner, :func:`late_slew`, which holds a planned reference to it by the same
+    rule). Whatever the boundary rates (the bound holds at every time, the ends included). Refused
+    only beyond the scoring's own slack (``_TOLERANCE``).
     """
     bound = problem.rate_requirement
     if bound is None or problem.qf is None:
@@ -1014,6 +1015,37 @@ def rate_violations(problem: ManeuverProblem) -> list[str]:
             f"maneuver.final.q); at ‖ω‖ at most {bound:g} rad/s (requirements.rate.max) it takes at least "
             f"θ/ω_max = {least:.4g} s, more than the {problem.duration:g} s bound (maneuver.duration); no "
             "reference within it can meet it"]
+
+
+def late_slew(problem: ManeuverProblem, duration: float) -> str:
+    """Why a planned slew that ends after ``maneuver.duration`` is not the manoeuvre asked for.
+
+    ``maneuver.duration`` (T) is the manoeuvre's time budget for every planner: a fixed-time planner
+    plans over it, a minimum-time one ends its slew at or before it (T its upper bound, as
+    :func:`endpoint_violations` and :func:`rate_violations` take it). A planner that chooses a
+    longer duration of its own (``eigenaxis``'s ``min_time``, ``shape_polynomial``'s
+    ``rate_limit``, a minimum-time ``costate_tpbvp``) has found no slew within the budget under its
+    bounds: its row is ``infeasible``, as a bang-coast-bang longer than T is, and as the rate proof
+    makes it before planning.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre (its duration T [s]).
+    duration : float
+        The planned reference's duration [s].
+
+    Returns
+    -------
+    str
+        The sentence (the slew's duration and T, with its YAML path, and what to change) when the
+        slew ends after T beyond the scoring's own slack (``_TOLERANCE``), else empty.
+    """
+    if duration <= problem.duration * (1.0 + _TOLERANCE):
+        return ""
+    return (f"its slew takes {duration:.6g} s, longer than the {problem.duration:g} s bound (maneuver.duration, "
+            "the manoeuvre's time budget for every planner): the planner found no slew within it under its "
+            f"bounds; a maneuver.duration of at least {duration:.6g} s admits this one")
 
 
 def _end_time(words: str, time: float, problem: ManeuverProblem) -> str:
