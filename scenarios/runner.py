@@ -17,7 +17,7 @@ than T is.
 Then each row's reference and closed loop are scored against every requirement; a row that breaks
 one is ``violated`` (never ``ok``), its message naming the requirement, the scope, the margin and
 the time, and a planner that does not honour a kind of requirement present says so in its message.
-Statuses rank ``failed`` over ``violated`` over ``ok``. A planner that cannot take a study's case
+Statuses rank ``failed`` over ``infeasible`` over ``violated`` over ``ok``. A planner that cannot take a study's case
 (:attr:`~scenarios.schema.loader.Scenario.inapplicable`) gets ``failed`` rows, unplanned, whose
 message is ``not applicable: ...`` with its reason.
 

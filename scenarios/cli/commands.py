@@ -288,7 +288,9 @@ def _before_planning(scenario: Scenario) -> list[tuple[str, bool]]:
     ``maneuver.duration`` (:func:`~scenarios.requirements.scoring.endpoint_violations`; the row
     ``infeasible``, nothing planned), said once for the planners it dooms; a study's case a planner
     cannot take (its row ``failed``, unplanned, whatever else; said when no planner can). When every planner's row
-    is doomed, but for reasons that differ by planner, one more line says so: no row can be ok.
+    is doomed, but for reasons that differ by planner, one more line says so, naming each
+    planner's (the requirements, or that it cannot take the case): no row can be ok. A line that
+    dooms only some rows is said, but is no finding of ``validate --strict`` (another row may be ok).
     Then a boundary rate above the rate requirement (every row breaks it).
 
     Parameters
@@ -326,8 +328,10 @@ def _before_planning(scenario: Scenario) -> list[tuple[str, bool]]:
     if scenario.planners and len(doomed) == count and not any(every for _, every in lines):
         # each row doomed, for reasons that differ by planner: none of the lines above says every row
         words = "fails or is infeasible" if scenario.inapplicable else "is infeasible"
-        lines.append((f"every planner's row {words} before planning, each for its reasons above: no row can be ok",
-                      True))
+        reasons = [f"{spec.label}: " + ("cannot take this case" if i in scenario.inapplicable
+                                        else ", ".join(dict.fromkeys(line.split(":")[0] for line in broken[i])))
+                   for i, spec in enumerate(scenario.planners)]
+        lines.append((f"every planner's row {words} before planning ({'; '.join(reasons)}): no row can be ok", True))
     if requirements.rate is not None:  # a boundary rate above the bound: every row breaks it
         lines += [(line, True) for line in rate_bound_notes(scenario.problem, scenario.simulation,
                                                              requirements.rate.max_rate)]
