@@ -74,11 +74,11 @@ from planners.reference import BREAKPOINT_INSTANT, JUMP_TOLERANCE
 from scenarios.requirements.fields import VERDICT
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
-__all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
+__all__ = ["FINAL_FIELDS", "JUMP_FIELDS", "LATE_SLACK", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
            "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
-           "endpoint_violations", "late_slew", "plant_limits", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
-           "rate_violations", "score_reference", "start_torque", "target_slack", "tracking_loss", "unhonoured", "violations",
-           "worst_error_between_samples"]
+           "endpoint_violations", "late_slew", "plant_limits", "rate_jumps", "reference_times", "score_closed_loop",
+           "score_fields", "rate_violations", "score_reference", "start_torque", "target_slack", "tracking_loss",
+           "unhonoured", "violations", "worst_error_between_samples"]
 
 Array = NDArray[np.float64]
 
@@ -116,6 +116,10 @@ momenta integrated from its saturated torques part from its state polynomial's b
 
 _TOLERANCE = 1e-9
 """Relative slack on the ratio and bound checks (rounding, not a margin)."""
+LATE_SLACK = 1e-6
+"""Relative slack of :func:`late_slew` on ``maneuver.duration``: a solver's relaxation of the bound
+on a free final time (IPOPT's ``bound_relax_factor``, 1e-8) and rounding, not a margin (60 µs of a
+60 s budget)."""
 
 
 def _over(value: float, bound: float) -> tuple[str, str]:
@@ -1039,9 +1043,9 @@ def late_slew(problem: ManeuverProblem, duration: float) -> str:
     -------
     str
         The sentence (the slew's duration and T, with its YAML path, and what to change) when the
-        slew ends after T beyond the scoring's own slack (``_TOLERANCE``), else empty.
+        slew ends after T by more than :data:`LATE_SLACK` of T, else empty.
     """
-    if duration <= problem.duration * (1.0 + _TOLERANCE):
+    if duration <= problem.duration * (1.0 + LATE_SLACK):
         return ""
     return (f"its slew takes {duration:.6g} s, longer than the {problem.duration:g} s bound (maneuver.duration, "
             "the manoeuvre's time budget for every planner): the planner found no slew within it under its "
