@@ -47,8 +47,9 @@ class ManeuverProblem:
         (the default refuses it).
     duration : float
         Manoeuvre time T [s], finite and positive (a Python or numpy integer or float, not a bool;
-        stored as a float); minimum-time planners take it as an initial guess
-        or bound and return their own duration.
+        stored as a float): the manoeuvre's time budget. Minimum-time planners return their own
+        duration; ``slewbench``'s runner makes a reference that ends after T ``infeasible``
+        (:func:`scenarios.requirements.scoring.late_slew`).
     omegaf : (3,) array_like or None, optional
         Target body rate [rad/s], body axes. ``None`` (default) leaves the final rate free.
     environment : ocp.Environment, optional

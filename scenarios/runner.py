@@ -5,15 +5,19 @@ reference and the simulation, and which render to JSON, CSV and Markdown (see
 :mod:`scenarios.output.tables`).
 
 Requirements (:mod:`scenarios.requirements`): before anything is planned, a pointing requirement
-that the initial or target attitude already breaks (:func:`~scenarios.requirements.scoring.endpoint_violations`)
-makes the planner's row ``failed``, naming it, and a rate requirement that the angle between them
-cannot be turned within T at (:func:`~scenarios.requirements.scoring.rate_violations`) makes it
-``infeasible``; a planner that minimises time (:func:`planners.capabilities.minimises_time`) is
-checked with T as the bound on its slew's time.
+that the initial or target attitude already breaks (:func:`~scenarios.requirements.scoring.endpoint_violations`),
+or a rate requirement that the angle between them cannot be turned within T at
+(:func:`~scenarios.requirements.scoring.rate_violations`), makes the planner's row ``infeasible``,
+naming it, and nothing is planned: both are proofs that no motion meets the requirements, not a
+numerical failure (``failed``). ``maneuver.duration`` (T) is the manoeuvre's time budget for every
+planner: a planner that minimises time (:func:`planners.capabilities.minimises_time`) is checked
+with T as the bound on its slew's time, and a reference that ends after T (a planner that chose a
+longer duration of its own) is ``infeasible`` too (:func:`plan_row`), as a bang-coast-bang longer
+than T is.
 Then each row's reference and closed loop are scored against every requirement; a row that breaks
 one is ``violated`` (never ``ok``), its message naming the requirement, the scope, the margin and
 the time, and a planner that does not honour a kind of requirement present says so in its message.
-Statuses rank ``failed`` over ``violated`` over ``ok``. A planner that cannot take a study's case
+Statuses rank ``failed`` over ``infeasible`` over ``violated`` over ``ok``. A planner that cannot take a study's case
 (:attr:`~scenarios.schema.loader.Scenario.inapplicable`) gets ``failed`` rows, unplanned, whose
 message is ``not applicable: ...`` with its reason.
 
@@ -71,9 +75,9 @@ from scenarios.requirements.scoring import (
     SCOPE_WORDS,
     Score,
     endpoint_violations,
+    late_slew,
     plant_limits,
     rate_jumps,
-    rate_violations,
     reference_times,
     score_closed_loop,
     score_reference,
@@ -296,9 +300,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
             if i in scenario.inapplicable:  # a study's case this planner cannot take: its rows fail, unplanned
                 planned.setdefault(i, (FailedReference(planner_spec.name, f"not applicable: {planner_spec.name} cannot "
                                                        f"take this case: {scenario.inapplicable[i]}"), None, None))
-            if broken_ends[i]:  # proven: no reference can meet them, nothing is planned
-                status = "infeasible" if rate_violations(scenario.problem) else "failed"
-                planned.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends[i]), status),
+            if broken_ends[i]:  # proven: no motion can meet them (infeasible, not a failure), nothing is planned
+                planned.setdefault(i, (FailedReference(planner_spec.name, "; ".join(broken_ends[i]), "infeasible"),
                                        None, None))
             if i not in planned:  # planned once, tracked by every controller
                 if kept is not None:
@@ -311,10 +314,6 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
                       reference, controller=controllers[j].name, plan_reused=reused.get(i, False))
             if reference.ok:
                 _check_physical(row, "reference", row.reference_metrics)
-                if reference.duration > scenario.problem.duration * (1 + 1e-9):  # documented, but said
-                    longer = (f"its slew takes T = {reference.duration:.6g} s, longer than maneuver.duration = "
-                              f"{scenario.problem.duration:g} s (the planner chose its own duration)")
-                    row.message = f"{row.message}; {longer}" if row.message else longer
                 if sampled is not None:
                     scores["reference"] = score_reference(scenario.requirements, scenario.problem, *sampled,
                                                           controllers[j].controller, reference, flown_limits)
@@ -398,7 +397,9 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
     tuple
         The reference (a failed one, naming the planner, when the planner raises, its reference
         raises or is not finite where it is sampled, or it misses a boundary condition of the
-        manoeuvre that it does not declare free, :func:`planners.conformance.check_boundary`), its
+        manoeuvre that it does not declare free, :func:`planners.conformance.check_boundary`; an
+        ``infeasible`` one, with the planned duration, when it ends after ``maneuver.duration``,
+        the manoeuvre's time budget, :func:`~scenarios.requirements.scoring.late_slew`), its
         metrics (``None`` when failed)
         and, with ``scoring``, its times and sample for the requirements (one sampling serves both:
         the metrics' uniform times come first), else ``None``.
@@ -412,6 +413,11 @@ def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache |
         reference = _kept_or_planned(kept, key, planner, planner_spec.name, scenario.problem)
     if not reference.ok:
         return reference, None, None
+    late = late_slew(scenario.problem, reference.duration)
+    if late:  # maneuver.duration is every planner's time budget: a longer slew is not the manoeuvre asked for
+        failed = FailedReference(planner_spec.name, late, "infeasible", duration=reference.duration, stats=reference.stats)
+        failed.plan_time_s = reference.plan_time_s
+        return failed, None, None
     times = (reference_times(reference.duration, closed_loop_window(scenario, reference), spec.sample_time, REFERENCE_POINTS)
              if scoring else np.linspace(0.0, reference.duration, REFERENCE_POINTS))
     sample = _sampled(reference, times)

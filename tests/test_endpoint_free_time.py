@@ -103,7 +103,7 @@ def test_minimum_time_row_is_planned_and_its_hold_named():
 def test_fixed_time_row_is_still_refused_before_planning():
     scenario = scenarios.parse_scenario(sat6u(TARGET, SMOOTH))
     row = scenarios.run(scenario).rows[0]
-    assert row.status == "failed" and row.plan_time_s == 0.0  # documented: a pointing end point fails the row
+    assert row.status == "infeasible" and row.plan_time_s == 0.0  # documented: a proof before planning, infeasible
     assert row.message.startswith("st_limb: the target attitude already breaks it at 120 s, maneuver.duration")
 
 
@@ -195,12 +195,13 @@ def test_rate_proof_holds_whatever_the_boundary_rates():
 def test_validate_names_only_the_rows_the_end_points_doom():
     """``validate`` proves it per planner as the runner does: the fixed-time row is doomed by the
     limb at 120 s, the minimum-time row is not (its slew may end before)."""
-    from scenarios.cli.commands import _doomed_notes
+    from scenarios.cli.commands import _before_planning, _doomed_notes
 
     data = sat6u(TARGET, {**EIGENAXIS, "label": "fastest"})
     data["planners"].append({**SMOOTH, "label": "smooth"})
-    notes = _doomed_notes(scenarios.parse_scenario(data))
-    assert [note.split(": ")[0] for note in notes] == ["the row of smooth fails before planning"], notes
+    notes = [line for line, _ in _before_planning(scenarios.parse_scenario(data))]
+    assert [note.split(": ")[0] for note in notes] == ["the row of smooth is infeasible before planning"], notes
     assert "st_limb: the target attitude already breaks it at 120 s" in notes[0]
+    assert _doomed_notes(scenarios.parse_scenario(data)) == []  # the minimum-time row may be ok
     alone = _doomed_notes(scenarios.parse_scenario(sat6u(TARGET, {**SMOOTH, "label": "smooth"})))
-    assert [note.split(": ")[0] for note in alone] == ["every planner's row fails before planning"], alone
+    assert [note.split(": ")[0] for note in alone] == ["every planner's row is infeasible before planning"], alone

@@ -306,8 +306,8 @@ def test_validate_without_requirements_says_the_actuator_limits_alone_are_scored
 
 
 def test_validate_says_when_the_end_points_already_break_a_requirement(tmp_path, capsys):
-    """``run`` fails every row before planning when the initial or target attitude breaks a pointing
-    requirement; validate says so at once (the demo starts at identity: body z on inertial z)."""
+    """``run`` makes every row infeasible before planning when the initial or target attitude breaks a
+    pointing requirement; validate says so at once (the demo starts at identity: body z on inertial z)."""
     data = yaml.safe_load(DEMO.read_text())
     data["spacecraft"]["sensors"] = {"camera": {"boresight": [0, 0, 1]}}
     data["requirements"] = {"pointing": {"cam": {"sensor": "camera", "keep_out": {"inertial": [0, 0, 1]},
@@ -316,7 +316,7 @@ def test_validate_says_when_the_end_points_already_break_a_requirement(tmp_path,
     path.write_text(yaml.safe_dump(data))
     assert main(["validate", str(path)]) == 0
     broken = [line for line in capsys.readouterr().out.splitlines()
-              if "every planner's row fails before planning" in line]
+              if "every planner's row is infeasible before planning" in line]
     assert len(broken) == 1 and "cam" in broken[0] and "initial attitude already breaks it" in broken[0]
 
 

@@ -263,10 +263,8 @@ def _leaf_paths(value: Any, prefix: str) -> list[str]:
 
 
 def _doomed_notes(scenario: Scenario) -> list[str]:
-    """``validate``'s notes that every row must fail (``validate --strict`` exits 1 on any): a
-    study's case that no listed planner can take, an end point that already breaks a requirement
-    (every planner's row fails before planning), a boundary rate above the rate requirement (every
-    row breaks it).
+    """``validate``'s notes that every row must fail (``validate --strict`` exits 1 on any): the
+    lines of :func:`_before_planning` that doom every row.
 
     Parameters
     ----------
@@ -278,26 +276,65 @@ def _doomed_notes(scenario: Scenario) -> list[str]:
     list of str
         One line per such finding (empty when a row may succeed).
     """
+    return [line for line, every in _before_planning(scenario) if every]
+
+
+def _before_planning(scenario: Scenario) -> list[tuple[str, bool]]:
+    """What ``validate`` proves of the rows before anything runs, as the runner proves it, each line
+    with whether it dooms every row.
+
+    Per planner (a minimum-time planner's slew may end before T, its bound): an end point that
+    already breaks a pointing requirement, or an angle the rate requirement cannot turn within
+    ``maneuver.duration`` (:func:`~scenarios.requirements.scoring.endpoint_violations`; the row
+    ``infeasible``, nothing planned), said once for the planners it dooms; a study's case a planner
+    cannot take (its row ``failed``, unplanned, whatever else; said when no planner can). When every planner's row
+    is doomed, but for reasons that differ by planner, one more line says so, naming each
+    planner's (the requirements, or that it cannot take the case): no row can be ok. A line that
+    dooms only some rows is said, but is no finding of ``validate --strict`` (another row may be ok).
+    Then a boundary rate above the rate requirement (every row breaks it).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The loaded scenario.
+
+    Returns
+    -------
+    list of (str, bool)
+        Each line and whether it dooms every row.
+    """
     from planners.capabilities import minimises_time
     from scenarios.requirements.scoring import endpoint_violations
     from scenarios.schema.checks import rate_bound_notes
 
     requirements = scenario.requirements
-    lines = []
-    if scenario.planners and len(scenario.inapplicable) == len(scenario.planners):  # a study's case none can take
-        lines += ["every planner's row fails, none can take it: "
-                  + "; ".join(scenario.inapplicable[i] for i in sorted(scenario.inapplicable))]
+    count = len(scenario.planners)
+    lines: list[tuple[str, bool]] = []
+    if scenario.planners and len(scenario.inapplicable) == count:  # a study's case none can take
+        lines.append(("every planner's row fails, none can take it: "
+                      + "; ".join(scenario.inapplicable[i] for i in sorted(scenario.inapplicable)), True))
+    broken: dict[int, list[str]] = {}
     if requirements and scenario.planners:
         # per planner, as the runner proves it: a minimum-time planner's slew may end before T (its bound)
-        broken = {spec.label: endpoint_violations(scenario.problem, minimises_time(type(spec.planner), spec.planner.options))
-                  for spec in scenario.planners}
+        # (a planner that cannot take a study's case fails unplanned, as the runner makes its row)
+        broken = {i: endpoint_violations(scenario.problem, minimises_time(type(spec.planner), spec.planner.options))
+                  for i, spec in enumerate(scenario.planners) if i not in scenario.inapplicable}
         for sentence in dict.fromkeys(sentence for found in broken.values() for sentence in found):
-            rows = [label for label, found in broken.items() if sentence in found]
-            who = ("every planner's row fails" if len(rows) == len(broken)
-                   else f"the rows of {', '.join(rows)} fail" if len(rows) > 1 else f"the row of {rows[0]} fails")
-            lines.append(f"{who} before planning: {sentence}")
+            rows = [scenario.planners[i].label for i, found in broken.items() if sentence in found]
+            who = ("every planner's row is" if len(rows) == count
+                   else f"the rows of {', '.join(rows)} are" if len(rows) > 1 else f"the row of {rows[0]} is")
+            lines.append((f"{who} infeasible before planning: {sentence}", len(rows) == count))
+    doomed = set(scenario.inapplicable) | {i for i, found in broken.items() if found}
+    if scenario.planners and len(doomed) == count and not any(every for _, every in lines):
+        # each row doomed, for reasons that differ by planner: none of the lines above says every row
+        words = "fails or is infeasible" if scenario.inapplicable else "is infeasible"
+        reasons = [f"{spec.label}: " + ("cannot take this case" if i in scenario.inapplicable
+                                        else ", ".join(dict.fromkeys(line.split(":")[0] for line in broken[i])))
+                   for i, spec in enumerate(scenario.planners)]
+        lines.append((f"every planner's row {words} before planning ({'; '.join(reasons)}): no row can be ok", True))
     if requirements.rate is not None:  # a boundary rate above the bound: every row breaks it
-        lines += rate_bound_notes(scenario.problem, scenario.simulation, requirements.rate.max_rate)
+        lines += [(line, True) for line in rate_bound_notes(scenario.problem, scenario.simulation,
+                                                             requirements.rate.max_rate)]
     return lines
 
 
@@ -313,7 +350,7 @@ def _scenario_details(scenario: Scenario) -> list[str]:
     elif not requirements.actuators.stated and scenario.planners:
         lines.append("requirement actuators: the reference's demand at most 100 % of each actuator limit "
                      "(every scenario's, unstated)")
-    lines += _doomed_notes(scenario)
+    lines += [line for line, _ in _before_planning(scenario)]
     truth = (scenario.data or {}).get("truth")
     if scenario.truth is not None and isinstance(truth, dict):
         lines.append("truth (the closed loop's plant differs from the design in): "

@@ -20,7 +20,7 @@ EXIT_INTERNAL = 1
 """An internal error (a bug), or a run interrupted by Ctrl-C or SIGTERM."""
 EXIT_NOT_OK = 1
 """``slewbench run --strict``: the run completed and wrote its results, and some row is not ``ok``
-(``violated`` or ``failed``); ``slewbench table --strict``: the table's files are written, and some
+(``violated``, ``infeasible`` or ``failed``); ``slewbench table --strict``: the table's files are written, and some
 entry of the table or of its held-out grid is not ``ok``; ``slewbench validate --strict``: the
 scenario is valid, but a note says every row must fail (an end point already breaks a requirement,
 a boundary rate is above the rate bound): for users' continuous integration."""

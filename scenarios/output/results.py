@@ -60,9 +60,13 @@ class Row:
         Planner registry name; ``None`` in regulation mode.
     status : str
         ``"ok"``; ``"violated"`` (the reference or the closed loop breaks a requirement of the
-        scenario); ``"failed"`` (a failed planner or simulation, unphysical metrics, or a pointing
-        requirement the end points already break); or, in a trade study, ``"crashed"`` (the case
-        raised, timed out or lost its worker). Ranked crashed, failed > violated > ok.
+        scenario); ``"infeasible"`` (proven that no motion meets the problem: before planning, a
+        pointing requirement the end points already break or a rate requirement that cannot turn
+        the angle within ``maneuver.duration``; or by the planner under its bounds, a slew longer
+        than ``maneuver.duration`` included); ``"failed"`` (a failed planner or simulation, or
+        unphysical metrics); or, in a trade study, ``"crashed"`` (the case raised, timed out or lost
+        its worker). Ranked as :data:`~scenarios.output.tables.ROW_STATUSES`: crashed > failed >
+        infeasible > violated > ok.
     message : str
         Why it failed or what it breaks, and what its planner does not honour (may be empty when ok).
     plan_time_s : float or None

@@ -60,9 +60,11 @@ DataFrame (``<NA>`` where missing)."""
 
 ROW_STATUSES = ("crashed", "failed", "infeasible", "violated", "ok")
 """A row's statuses from the worst, the order tables count and sort them in: ``crashed`` (a trade
-study's case that raised), ``failed`` (the planner or the simulation failed, or the end points
-already break a pointing requirement), ``infeasible`` (the planner found the problem cannot be met
-under its bounds: torque about a failed wheel's axis, a keep-out cone over the target, ...),
+study's case that raised), ``failed`` (the planner or the simulation failed: a numerical failure), ``infeasible`` (proven that
+no motion meets the problem: the planner found it cannot be met under its bounds, torque about a
+failed wheel's axis, a slew longer than ``maneuver.duration``, ...; or, before planning, the end
+points already break a pointing requirement or the rate requirement cannot turn the angle between
+them within ``maneuver.duration``),
 ``violated`` (a requirement broken) and ``ok``."""
 
 CERTIFICATE_COLUMNS = ("certificate", "certificate_verdict", "certificate_kkt_scaled", "certificate_kkt_unscaled")

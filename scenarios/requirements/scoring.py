@@ -78,12 +78,11 @@ from planners.reference import BREAKPOINT_INSTANT, JUMP_TOLERANCE
 from scenarios.requirements.fields import VERDICT
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
-__all__ = ["AT_LIMIT", "FINAL_FIELDS", "JUMP_FIELDS", "POINTING_FIELDS", "RATE_FIELDS", "REFERENCE_POINTS",
-           "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
-           "closed_loop_wheels", "endpoint_violations", "plant_limits", "rate_jumps", "reference_times",
-           "score_closed_loop", "score_fields",
-           "rate_violations", "score_reference", "start_torque", "target_slack", "tracking_loss", "unhonoured", "violations",
-           "worst_error_between_samples"]
+__all__ = ["AT_LIMIT", "FINAL_FIELDS", "JUMP_FIELDS", "LATE_SLACK", "POINTING_FIELDS", "RATE_FIELDS",
+           "REFERENCE_POINTS", "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
+           "closed_loop_wheels", "endpoint_violations", "late_slew", "plant_limits", "rate_jumps", "reference_times",
+           "score_closed_loop", "score_fields", "rate_violations", "score_reference", "start_torque", "target_slack",
+           "tracking_loss", "unhonoured", "violations", "worst_error_between_samples"]
 
 Array = NDArray[np.float64]
 
@@ -121,6 +120,10 @@ momenta integrated from its saturated torques part from its state polynomial's b
 
 _TOLERANCE = 1e-9
 """Relative slack on the ratio and bound checks (rounding, not a margin)."""
+LATE_SLACK = 1e-6
+"""Relative slack of :func:`late_slew` on ``maneuver.duration``: a solver's relaxation of the bound
+on a free final time (IPOPT's ``bound_relax_factor``, 1e-8) and rounding, not a margin (60 µs of a
+60 s budget)."""
 
 AT_LIMIT = 1.0 - 1e-9
 """A closed-loop actuator state (a wheel's momentum or speed) at this fraction of its limit or more
@@ -1138,7 +1141,8 @@ def target_slack(constraint: PointingConstraint, duration: float, free_time: boo
 
 def rate_violations(problem: ManeuverProblem) -> list[str]:
     """The rate requirement that no motion from ``q0`` to ``qf`` within T can meet, before planning
-    (part of :func:`endpoint_violations`; the runner makes such rows ``infeasible``).
+    (part of :func:`endpoint_violations`; the runner makes such rows ``infeasible``, as every proof
+    of it does).
 
     Parameters
     ----------
@@ -1156,10 +1160,10 @@ def rate_violations(problem: ManeuverProblem) -> list[str]:
     The principal angle
     ``θ`` between them (the shorter way, ±qf) changes no faster than the body turns, ``|dθ/dt| ≤ ‖ω‖``,
     so a motion with ``‖ω‖ ≤ ω_max`` throughout needs at least ``θ / ω_max``; T bounds the slew
-    (fixed, or the upper bound of a minimum-time slew; a planner that chooses a longer duration of its
-    own, eigenaxis's ``min_time``, is held to it here: a slew that cannot be made within the
-    manoeuvre's duration is not the manoeuvre asked for). Whatever the boundary rates (the bound holds
-    at every time, the ends included). Refused only beyond the scoring's own slack (``_TOLERANCE``).
+    (fixed, or the upper bound of a minimum-time slew: ``maneuver.duration`` is the manoeuvre's time
+    budget for every planner, :func:`late_slew`, which holds a planned reference to it by the same
+    rule). Whatever the boundary rates (the bound holds at every time, the ends included). Refused
+    only beyond the scoring's own slack (``_TOLERANCE``).
     """
     bound = problem.rate_requirement
     if bound is None or problem.qf is None:
@@ -1172,6 +1176,37 @@ def rate_violations(problem: ManeuverProblem) -> list[str]:
             f"maneuver.final.q); at ‖ω‖ at most {bound:g} rad/s (requirements.rate.max) it takes at least "
             f"θ/ω_max = {least:.4g} s, more than the {problem.duration:g} s bound (maneuver.duration); no "
             "reference within it can meet it"]
+
+
+def late_slew(problem: ManeuverProblem, duration: float) -> str:
+    """Why a planned slew that ends after ``maneuver.duration`` is not the manoeuvre asked for.
+
+    ``maneuver.duration`` (T) is the manoeuvre's time budget for every planner: a fixed-time planner
+    plans over it, a minimum-time one ends its slew at or before it (T its upper bound, as
+    :func:`endpoint_violations` and :func:`rate_violations` take it). A planner that chooses a
+    longer duration of its own (``eigenaxis``'s ``min_time``, ``shape_polynomial``'s
+    ``rate_limit``, a minimum-time ``costate_tpbvp``) has found no slew within the budget under its
+    bounds: its row is ``infeasible``, as a bang-coast-bang longer than T is, and as the rate proof
+    makes it before planning.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre (its duration T [s]).
+    duration : float
+        The planned reference's duration [s].
+
+    Returns
+    -------
+    str
+        The sentence (the slew's duration and T, with its YAML path, and what to change) when the
+        slew ends after T by more than :data:`LATE_SLACK` of T, else empty.
+    """
+    if duration <= problem.duration * (1.0 + LATE_SLACK):
+        return ""
+    return (f"its slew takes {duration:.6g} s, longer than the {problem.duration:g} s bound (maneuver.duration, "
+            "the manoeuvre's time budget for every planner): the planner found no slew within it under its "
+            f"bounds; a maneuver.duration of at least {duration:.6g} s admits this one")
 
 
 def _end_time(words: str, time: float, problem: ManeuverProblem) -> str:

@@ -373,7 +373,8 @@ MANEUVER = Section((
            default="scalar_first"),
     mapping("initial", "The initial state.", INITIAL),
     mapping("final", "The target state.", FINAL),
-    number("duration", "Manoeuvre time T (a planner minimising time may choose its own).", unit="s", positive=True,
+    number("duration", "Manoeuvre time T, the time budget of every planner (a planner minimising time ends its slew "
+           "within it; a slew that takes longer is ``infeasible``).", unit="s", positive=True,
            maximum=MAX_DURATION_S),
     number("max_rate", "Bound on the body-rate norm ‖ω‖, for the planners that take one; ``null``: "
            "``requirements.rate.max`` if given, else none. Given with ``requirements.rate``, it must not exceed "
@@ -411,8 +412,7 @@ SENSOR_NOISE = Section((
 SIMULATION = Section((
     number("sample_time", "Zero-order-hold sample time of the controller.", unit="s", default=1.0, positive=True),
     number("duration", "Closed-loop window of every row. ``null`` (the default): each row runs for "
-           "``maneuver.duration``, or for its reference's duration when that is longer (a minimum-time or "
-           "rate-limited planner's); a row without a planner for ``maneuver.duration``. After its duration a "
+           "``maneuver.duration`` (every planner's slew ends within it), a row without a planner too. After its duration a "
            "reference continues as the torque-free motion of its final state.", unit="s", default=None,
            positive=True, nullable=True, maximum=MAX_DURATION_S),
     vector("initial_attitude_error_deg", "Rotation vector applied to the true initial attitude, body axes.", 3,

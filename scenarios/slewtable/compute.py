@@ -8,9 +8,10 @@ whose solve fails, or that breaks a requirement, is kept with its status and mes
 ``ok`` entries are interpolated: the fit keeps every axis with its entries' statuses and has no value
 (NaN) in the cells around an entry that is not ``ok`` (``inf`` at an ``infeasible`` one), rather than
 a time the table did not find. An entry proven impossible before planning (its start or target
-attitude already breaks a pointing requirement, where the run's row is ``failed``, or its angle
-needs longer than ``maneuver.duration`` at the rate bound, where it is ``infeasible``; both say
-"no reference can meet it") is recorded ``infeasible`` by the table. A ``min_time`` entry whose slew meets every requirement, but whose
+attitude already breaks a pointing requirement, or its angle needs longer than
+``maneuver.duration`` at the rate bound; both say "no reference can meet it") is ``infeasible``, as
+the run's row is (an entry stored ``failed`` for it by an earlier version is recorded
+``infeasible`` too). A ``min_time`` entry whose slew meets every requirement, but whose
 target, held after the slew until ``maneuver.duration``, enters a moving cone, is ``ok`` (an entry
 is the slew: its time and feasibility) and its message says when the cone reaches the target. A ``min_time`` entry that the planner found slower than a
 feasible slew of the same problem it knows (its certificate's ``seed_bound`` note: "not the best
@@ -231,10 +232,11 @@ def end_cones(scenario: dict[str, Any]) -> np.ndarray:
 
 def _proven_infeasible(scenario: dict[str, Any]) -> bool:
     """Whether the entry is proven impossible before planning (:func:`~scenarios.requirements.scoring.endpoint_violations`:
-    its start or target attitude already breaks a pointing requirement, the run's row ``failed``;
-    or its angle needs longer than ``maneuver.duration`` at the rate bound, the row ``infeasible``),
-    as the run checks it for the entry's planner (a ``min_time`` one: ``maneuver.duration`` bounds
-    the slew's end). The table records either as ``infeasible``."""
+    its start or target attitude already breaks a pointing requirement, or its angle needs longer
+    than ``maneuver.duration`` at the rate bound; the run's row ``infeasible``), as the run checks
+    it for the entry's planner (a ``min_time`` one: ``maneuver.duration`` bounds the slew's end).
+    A stored entry that an earlier version ran ``failed`` for a pointing end point is recorded
+    ``infeasible`` by the table (a store keeps its records across versions)."""
     from scenarios.errors import ScenarioError
     from scenarios.requirements.scoring import endpoint_violations
     from scenarios.schema.loader import parse_scenario
