@@ -197,11 +197,13 @@ def test_the_sun_scenario_others_violated_with_their_margins():
     assert json.loads(results.to_json())["epoch"] == "2027-03-20T12:00:00Z"
 
 
-def test_end_points_inside_a_keep_out_fail_every_planner_row_before_planning():
+def test_end_points_inside_a_keep_out_make_every_planner_row_infeasible_before_planning():
+    """A proof before planning that no motion meets the requirement: ``infeasible`` (as the rate
+    proof's), not ``failed`` (a numerical failure)."""
     text = SUN_SCENARIO.read_text().replace("boresight: [0.5, -0.8660254, 0.0]", "boresight: [1, 0, 0]")
     scenario = scenarios.parse_scenario(yaml.safe_load(text))
     results = scenarios.run(scenario)
-    assert [row.status for row in results.rows] == ["failed"] * 4
+    assert [row.status for row in results.rows] == ["infeasible"] * 4
     for row in results.rows:
         assert row.message.startswith("st_sun: the initial attitude already breaks it at 0 s")
         assert row.reference_metrics is None and row.simulation is None and row.plan_time_s == 0.0
