@@ -150,24 +150,11 @@ class HermiteMotion:
         self.slope = quat.kinematics(self.q, self.omega)
         h = np.diff(self.t)
         self._inverse_h = np.divide(1.0, h, out=np.zeros_like(h), where=h > 0.0)  # a repeated time: its sample
+        start, end = h[:, None] * self.slope[:-1], h[:, None] * self.slope[1:]
         q0, q1 = self.q[:-1], self.q[1:]
-        # p(s) = c0 + c1 s + c2 s² + c3 s³ on each interval (K, power, component): the Hermite basis
-        # expanded, c2 = -3 q0 - 2 start + 3 q1 - end and c3 = 2 q0 + start - 2 q1 + end written in
-        # place in that order (the same operations and values, no temporaries stacked)
-        cubic = np.empty((len(h), 4, q0.shape[1]))
-        cubic[:, 0] = q0
-        start = np.multiply(h[:, None], self.slope[:-1], out=cubic[:, 1])
-        end = h[:, None] * self.slope[1:]
-        c2, c3 = cubic[:, 2], cubic[:, 3]
-        np.multiply(q0, -3.0, out=c2)
-        c2 -= 2.0 * start
-        c2 += 3.0 * q1
-        c2 -= end
-        np.multiply(q0, 2.0, out=c3)
-        c3 += start
-        c3 -= 2.0 * q1
-        c3 += end
-        self._cubic = cubic
+        # p(s) = c0 + c1 s + c2 s² + c3 s³ on each interval (K, power, component): the Hermite basis expanded
+        self._cubic = np.stack([q0, start, -3.0 * q0 - 2.0 * start + 3.0 * q1 - end,
+                                2.0 * q0 + start - 2.0 * q1 + end], axis=1)
 
     def attitudes(self, times: ArrayLike) -> Array:
         """The interpolated attitude.
