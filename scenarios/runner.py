@@ -283,6 +283,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
     planned: dict[int, tuple[Reference, dict[str, Any] | None, tuple[Any, Any] | None]] = {}
     kept = None if references is None else _Watched(references)
     reused: dict[int, bool] = {}
+    # per planner: its reference's pointing and rate scores, which no controller changes (scored once)
+    shared_scores: dict[int, dict[str, Score]] = {}
     scoring = _SCORE_REQUIREMENTS and bool(scenario.requirements)
     # proven before planning, per planner: a minimum-time planner's slew may end before T (its bound)
     broken_ends = {i: endpoint_violations(scenario.problem, minimises_time(type(spec.planner), spec.planner.options))
@@ -315,8 +317,15 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
             if reference.ok:
                 _check_physical(row, "reference", row.reference_metrics)
                 if sampled is not None:
-                    scores["reference"] = score_reference(scenario.requirements, scenario.problem, *sampled,
-                                                          controllers[j].controller, reference, flown_limits)
+                    if i not in shared_scores:
+                        shared_scores[i] = score_reference(scenario.requirements, scenario.problem, *sampled, None,
+                                                           reference, flown_limits)
+                    shared = shared_scores[i]
+                    own = score_reference(scenario.requirements, scenario.problem, *sampled,
+                                          controllers[j].controller, reference, flown_limits, shared=False)
+                    # in score_reference's order: the pointing requirements, the actuators, the rate
+                    scores["reference"] = {**{name: score for name, score in shared.items() if name != "rate"}, **own,
+                                           **{name: score for name, score in shared.items() if name == "rate"}}
                 _simulate(scenario, simulator, reference, row, controllers[j])
             timing = (f"planned in {(row.plan_time_s or 0.0) * 1e3:.1f} ms, "
                       f"simulated in {row.simulate_time_s:.2f} s")

@@ -24,7 +24,7 @@ from __future__ import annotations
 import hashlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Any, NamedTuple
 
 import casadi as ca
@@ -256,8 +256,16 @@ class HermiteMotion:
         if len(q) < 2:
             return np.zeros(0)
         c1, c2, c3 = self._cubic[:, 1], self._cubic[:, 2], self._cubic[:, 3]
-        control = np.stack([c1, c1 + c2, c1 + 2.0 * c2 + 3.0 * c3])  # p' as a quadratic Bézier curve
-        slope_high = np.sqrt(np.max(np.einsum("ikj,ikj->ik", control, control), axis=0))
+        # p' as a quadratic Bézier curve: its control points c1, c1 + c2, c1 + 2 c2 + 3 c3, each norm
+        # by its own sum of squares (not stacked: a (3, K, 4) sum costs some times more, same values)
+        middle = c1 + c2
+        last = c2 * 2.0
+        last += c1
+        last += 3.0 * c3
+        slope_high = np.einsum("ij,ij->i", c1, c1)
+        np.maximum(slope_high, np.einsum("ij,ij->i", middle, middle), out=slope_high)
+        np.maximum(slope_high, np.einsum("ij,ij->i", last, last), out=slope_high)
+        np.sqrt(slope_high, out=slope_high)
         ends = np.sqrt(np.einsum("ij,ij->i", q, q))
         low = 0.5 * (ends[:-1] + ends[1:] - slope_high)
         sound = low > DEGENERATE_NORM
@@ -460,7 +468,6 @@ def _sub_grids(motion: HermiteMotion, searches: Sequence[SearchSpec], evaluate: 
     h = np.zeros((count, width))  # the steps between knots; 0 at the last knot and past it
     bound = np.zeros((count, width))
     fine_steps = np.ones((count, width), dtype=int)
-    attitudes = np.empty((count, width, 4))
     for index, row in enumerate(knots_of):
         size = len(row)
         knots[index, :size] = row
@@ -470,8 +477,6 @@ def _sub_grids(motion: HermiteMotion, searches: Sequence[SearchSpec], evaluate: 
         own = row is t
         knot_steps = motion.sample_steps if own else _knot_steps(motion, row)
         h[index, :size - 1], bound[index, :size - 1], fine_steps[index, :size - 1] = knot_steps
-        # the samples' attitudes are the samples (normalised); an edge between them is interpolated
-        attitudes[index, :size] = motion.unit if size == len(t) else motion.attitudes(row)
     drift = np.array([float(search[2]) for search in searches])
     speed = bound + drift[:, None]  # per step between knots
     # the heads of groups of knot steps, evaluated first: every SAMPLE_GROUP-th knot, the edges, and
@@ -487,13 +492,24 @@ def _sub_grids(motion: HermiteMotion, searches: Sequence[SearchSpec], evaluate: 
     head[:, 1:] |= turned[:, 1:] != turned[:, :-1]
     head &= column < widths[:, None]
     for index, inner in enumerate(inner_of):
-        head[index, np.searchsorted(knots_of[index], inner)] = True
+        if inner:
+            head[index, np.searchsorted(knots_of[index], inner)] = True
     flat_head = head.ravel()
     heads = np.flatnonzero(flat_head)  # into the rows end to end
     owner = heads // width
     flat_knots = knots.ravel()
     head_bounds = np.searchsorted(owner, np.arange(count + 1))
-    at_heads = evaluate(head_bounds, flat_knots[heads], attitudes.reshape(-1, 4)[heads])
+    # the heads' attitudes: the samples' (normalised) where a search's knots are the samples, else its
+    # knots interpolated (an edge between samples); the samples normalised row by row, those of the heads alone
+    if all(len(row) == len(t) for row in knots_of):
+        head_attitudes = np.asarray(quat.normalize(motion.q.take(heads - owner * width, axis=0)), dtype=float)
+    else:
+        head_attitudes = np.empty((len(heads), 4))
+        for index, row in enumerate(knots_of):
+            span = slice(int(head_bounds[index]), int(head_bounds[index + 1]))
+            head_attitudes[span] = (motion.unit if len(row) == len(t) else motion.attitudes(row)).take(
+                heads[span] - index * width, axis=0)
+    at_heads = evaluate(head_bounds, flat_knots[heads], head_attitudes)
     live = np.logical_or.reduceat(np.isfinite(at_heads), head_bounds[:-1])  # each search's heads: two or more
     # a search without a head inside its value's domain: nothing to zoom into
     results: list[Searched | None] = [
@@ -685,6 +701,15 @@ class PointingScore(NamedTuple):
         return self.min_margin_deg is None or self.min_margin_deg >= 0.0
 
 
+def _covers(window: tuple[float, float], t: Array) -> bool:
+    """Whether every time of ``t`` lies in ``window`` (inclusive; a NaN time does not; ``t`` empty:
+    no time is left out)."""
+    if not t.size:
+        return True
+    start, end = window
+    return bool(start <= t.min() and (end == np.inf or end >= t.max()))
+
+
 def violation_intervals(t: Array, margin: Array) -> list[tuple[float, float]]:
     """Intervals where a sampled margin is negative, with linearly interpolated ends.
 
@@ -702,6 +727,8 @@ def violation_intervals(t: Array, margin: Array) -> list[tuple[float, float]]:
     """
     t, margin = np.asarray(t, dtype=float), np.asarray(margin, dtype=float)
     bad = margin < 0.0  # NaN compares False
+    if not bad.any():
+        return []
     edges = np.diff(np.concatenate([[0], bad.astype(np.int8), [0]]))
     first, last = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1  # each run of bad samples
     start, end = t[first], t[last]
@@ -979,10 +1006,11 @@ class PointingConstraint:
         margin -= limit
         if not self.keep_out:
             np.negative(margin, out=margin)
-        start, end = self.window
-        inside = t >= start
-        inside &= t <= end
-        margin[~inside] = np.nan
+        if not _covers(self.window, t):
+            start, end = self.window
+            inside = t >= start
+            inside &= t <= end
+            margin[~inside] = np.nan
         return margin
 
     def score(self, t: ArrayLike, q: ArrayLike) -> PointingScore:
@@ -1045,9 +1073,11 @@ class PointingConstraint:
 
     def _scored(self, times: Array, margin: Array, missable_s: float = 0.0) -> PointingScore:
         """The score of the margins at the points searched (:meth:`score_between_samples`)."""
-        if not np.any(np.isfinite(margin)):
+        # np.nanargmin's index (the first least, NaN ignored) in one pass: NaN as +inf
+        filled = np.fmin(margin, np.inf)
+        worst = int(np.argmin(filled))
+        if not np.isfinite(filled[worst]) and not np.any(np.isfinite(margin)):
             return PointingScore(None, 0.0, None, None, missable_s)
-        worst = int(np.nanargmin(margin))
         intervals = violation_intervals(times, margin)
         return PointingScore(float(np.rad2deg(margin[worst])), float(sum(b - a for a, b in intervals)),
                              intervals[0][0] if intervals else None, float(times[worst]), missable_s)
@@ -1156,10 +1186,18 @@ def scores_between_samples(constraints: Sequence[PointingConstraint], t: ArrayLi
 
 
 def _margins_together(constraints: Sequence[PointingConstraint]) -> Together:
+    """:func:`_margins_built` of these constraints."""
+    return _margins_built(tuple(constraints))
+
+
+@lru_cache(maxsize=16)
+def _margins_built(constraints: tuple[PointingConstraint, ...]) -> Together:
     """``together`` of :func:`searches_between_samples` for the constraints' margins
     (:meth:`PointingConstraint.margins`), each constraint at its own points: the moving constraints'
     in one pass (their tables end to end, each point's lookup into its own; per point the same
-    operations as :meth:`PointingConstraint.margins`, so the same values), a fixed one alone."""
+    operations as :meth:`PointingConstraint.margins`, so the same values), a fixed one alone. Kept
+    for the last few sets of constraints (equal constraints have equal margins: a run's rows and
+    scopes share one)."""
     moving = [index for index, constraint in enumerate(constraints) if constraint.moving]
     if len(moving) < 2:
         return _each([(constraint.margins, 0.0, 0.0, ()) for constraint in constraints])
@@ -1175,6 +1213,7 @@ def _margins_together(constraints: Sequence[PointingConstraint]) -> Together:
     differences = np.concatenate([np.vstack([slope[2], np.zeros((1, 4))]) for slope in slopes])
     angles = np.array([constraint.angle for constraint in mine])
     keep_in = np.array([not constraint.keep_out for constraint in mine])
+    any_keep_in = bool(keep_in.any())
     starts = np.array([constraint.window[0] for constraint in mine])
     ends = np.array([constraint.window[1] for constraint in mine])
     forms = [constraint._rotation_form for constraint in mine]
@@ -1225,10 +1264,12 @@ def _margins_together(constraints: Sequence[PointingConstraint]) -> Together:
         cosine /= scale
         margin = np.arccos(np.minimum(np.maximum(cosine, -1.0, out=cosine), 1.0, out=cosine), out=cosine)
         margin -= limit
-        np.negative(margin, out=margin, where=keep_in[owner])
-        within = t >= starts[owner]
-        within &= t <= ends[owner]
-        margin[~within] = np.nan
+        if any_keep_in:
+            np.negative(margin, out=margin, where=keep_in[owner])
+        if not _covers((float(starts.max()), float(ends.min())), t):  # some window may leave out a point
+            within = t >= starts[owner]
+            within &= t <= ends[owner]
+            margin[~within] = np.nan
         values[select] = margin
         return values
 

@@ -668,7 +668,7 @@ def plant_limits(plant: TruthPlant | None) -> dict[str, Array] | None:
 
 def score_reference(requirements: Requirements, problem: ManeuverProblem, times: ArrayLike, sample: Any,
                     allocation: Allocation | None, reference: Reference | None = None,
-                    plant_limits: Mapping[str, Array] | None = None) -> dict[str, Score]:
+                    plant_limits: Mapping[str, Array] | None = None, *, shared: bool = True) -> dict[str, Score]:
     """Score a reference, sampled densely, against every requirement that applies to it.
 
     The pointing requirements are scored between the samples too, as the closed loop's are
@@ -702,6 +702,10 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         (:func:`plant_limits` of the scenario's truth model): each
         quantity is scored against the lesser of the design's limit and the plant's, element by
         element, and the message says where the plant's is the lesser; ``None``: the design's.
+    shared : bool, optional
+        ``True`` (default): every requirement; ``False``: the actuator requirement alone, the one
+        that depends on ``allocation`` (a reference tracked by several controllers: the pointing and
+        rate scores of one call serve them all).
 
     Returns
     -------
@@ -710,9 +714,9 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
         is scored in closed loop only).
     """
     t = np.asarray(times, dtype=float)
-    edged = _with_edges(problem, t, sample, reference)
     scores: dict[str, Score] = {}
-    if problem.pointing:
+    if shared and problem.pointing:
+        edged = _with_edges(problem, t, sample, reference)
         motion = HermiteMotion(*edged)  # one interpolant for the row's pointing requirements
         pointing = _pointing_scores(problem.pointing, *edged, motion)
         scores.update({name: _after_slew(score, reference) for name, score in pointing.items()})
@@ -776,7 +780,7 @@ def score_reference(requirements: Requirements, problem: ManeuverProblem, times:
                                          lower, impulse, None if reference is None else reference.duration,
                                          unstarted, float(np.linalg.norm(problem.spacecraft.inertia @ steps[0]))
                                          if unstarted is not None else 0.0)
-    if requirements.rate is not None:
+    if shared and requirements.rate is not None:
         scores["rate"] = _rate(requirements.rate, t, sample.omega, reference)
     return scores
 

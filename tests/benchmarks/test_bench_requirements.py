@@ -52,6 +52,16 @@ requirement added, and this one) bit for bit. The 10 % target is not met: of the
 and their interpolants (23.6 ms), the demand and its unrealised torque (8.4 ms) and the
 environment's torque (4.8 ms, CasADi's virtual machine). The budget stays 60 %.
 
+Measured on 2026-12-03 (load 1.5-9 on 2 cores), against f0e16c0, after the searches lost some array
+operations (the rate bound's control points not stacked, windows and keep-in flips skipped where
+they change nothing, the heads' samples normalised alone, a score's least margin in one pass) and
+a reference tracked by several controllers had its pointing and rate scores computed once: ten
+alternate processes each (15 pairs a process, CPU), overhead median +19.0 % (+17.3..+22.5) against
++21.7 % (+15.4..+25.2), the scoring's CPU 38.4 against 41.0 ms a run (not resolved); the searches
+alone 0.93 of f0e16c0's (paired, 80 pairs); every score, status and message of 65 rows (the
+scenarios but the studies, this one, and this one tracked by three controllers) bit for bit. The
+10 % target is not met (docs/performance.rst). The budget stays 60 %.
+
 The 12U CubeSat Sun keep-out scenario without its collocation row (the fast planners, where scoring
 weighs most), with three pointing requirements (the star tracker off the Sun and the Moon, an
 antenna off the Earth's limb: moving directions, tabulated), the actuator margin (the demand
