@@ -18,6 +18,9 @@ from ocp.errors import SlewbenchError
 
 __all__ = ["CaseTimeout", "OutputError", "PlausibilityWarning", "ScenarioError", "SweepInterrupted", "WorkersCannotStart"]
 
+ANOTHER_DIRECTORY = "choose another directory (the `directory` argument; --out on the command line)"
+"""The remedy an :class:`OutputError` names for a directory it refuses: in the library's terms (the
+argument of :meth:`~scenarios.output.results.RunResults.write`) and the command line's."""
 MAX_PATH_CHARS = 300
 """Characters of a path shown in an error's text (the attribute keeps it whole)."""
 MAX_MESSAGE_CHARS = 2000
