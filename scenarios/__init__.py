@@ -38,7 +38,12 @@ from typing import TYPE_CHECKING, Any
 from scenarios._faces import lazy_face
 
 if TYPE_CHECKING:  # the names, for type checkers and readers
-    from scenarios.errors import OutputError, PlausibilityWarning, ScenarioError, SweepInterrupted
+    from scenarios.errors import (
+        OutputError,
+        PlausibilityWarning,
+        ScenarioError,
+        SweepInterrupted,
+    )
     from scenarios.output.results import Row, RunResults
     from scenarios.runner import run
     from scenarios.schema.loader import Scenario, load, parse_scenario

@@ -15,15 +15,14 @@ import contextlib
 import copy
 import io
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 
 import scenarios
-from ocp import AttitudeModel, SimulationError, Simulator, Spacecraft, quat
 from controllers import CONTROLLERS
+from ocp import AttitudeModel, SimulationError, Simulator, Spacecraft, quat
 from scenarios.cli.commands import main
 from scenarios.errors import OutputError, PlausibilityWarning, ScenarioError
 from scenarios.output.aem import aem_text
