@@ -89,7 +89,6 @@ def test_load_warns_at_the_callers_line_and_a_study_case_does_not(tmp_path):
     seen = caught(lambda: scenarios.load(path))
     assert [w.message.path for w in seen] == ["spacecraft.wheels.max_torque"]
     assert seen[0].filename == __file__
-    assert caught(lambda: parse_scenario(data, inapplicable_rows=True)) == []  # a study's case: validate lists them
     with warnings.catch_warnings():
         warnings.simplefilter("error", PlausibilityWarning)
         with pytest.raises(PlausibilityWarning, match="did you mean 0.004 N m"):

@@ -15,7 +15,6 @@ import sys
 import threading
 import time
 import traceback
-import warnings
 from pathlib import Path
 from typing import Any
 
@@ -37,7 +36,7 @@ from scenarios.cli.status import (
 )
 from scenarios.cli.sweep import add_sweep_parser
 from scenarios.cli.table import add_table_parser
-from scenarios.errors import OutputError, PlausibilityWarning, ScenarioError
+from scenarios.errors import OutputError, ScenarioError
 from scenarios.output.directory import (
     check_output_directory,
     claim_output_directory,
@@ -664,9 +663,7 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     try:
         try:
             load_plugins()  # the slewbench.plugins entry points and SLEWBENCH_PLUGINS, before any name is read
-            with warnings.catch_warnings():  # validate and run print the plausibility findings themselves
-                warnings.simplefilter("ignore", PlausibilityWarning)
-                return args.handler(args)
+            return args.handler(args)
         except Exception:
             if args.interruption.signalled:  # a Ctrl-C that C code (CasADi) turned into an error: not a bad file, no bug
                 raise KeyboardInterrupt from None

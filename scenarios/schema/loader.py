@@ -614,9 +614,9 @@ def parse_scenario(data: Any, source: Path | None = None, *, inapplicable_rows: 
     Warns
     -----
     PlausibilityWarning
-        One per value that looks like a unit or layout slip (the findings of ``slewbench validate``,
-        :func:`scenarios.schema.plausibility.warn_implausible`); not for a study's case
-        (``inapplicable_rows``), whose findings ``slewbench validate`` lists case by case.
+        One per value that looks like a unit or layout slip (the findings of ``slewbench validate``),
+        when called from outside :mod:`scenarios` (:func:`scenarios.schema.plausibility.warn_implausible`:
+        a study's cases and the command line report them their own way).
     """
     root = Node(data).mapping()
     name = SCENARIO["name"].value(root)
@@ -651,8 +651,7 @@ def parse_scenario(data: Any, source: Path | None = None, *, inapplicable_rows: 
     scenario = Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch,
                         euler_sequence=plots["euler_sequence"], data=copy.deepcopy(root.value), truth=truth,
                         inapplicable=inapplicable or {})
-    if not inapplicable_rows:
-        warn_implausible(scenario)
+    warn_implausible(scenario)  # called from a script: one warning per finding
     return scenario
 
 

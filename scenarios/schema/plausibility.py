@@ -323,23 +323,29 @@ def plausibility_warnings(scenario: Scenario) -> list[Implausible]:
     return [warning for check in PLAUSIBILITY_CHECKS.values() for warning in check(scenario)]
 
 
-def _caller_stacklevel() -> int:
+def _caller_stacklevel() -> int | None:
     """The ``stacklevel`` of :func:`warnings.warn`, called from :func:`warn_implausible`, that names
-    the first caller outside the :mod:`scenarios` package (the user's line, whether it called
-    ``parse_scenario`` or ``load``)."""
+    the caller of the schema (of ``parse_scenario`` or ``load``); ``None`` when that caller is
+    slewbench's own code (a study's case, a slew table's entry, the command line, which report the
+    findings their way or not at all)."""
     level, frame = 2, sys._getframe(2)  # 1: warn_implausible; 2: its caller
-    while frame is not None and str(frame.f_globals.get("__name__", "")).split(".")[0] == "scenarios":
+    while frame is not None and str(frame.f_globals.get("__name__", "")).startswith("scenarios.schema."):
         level, frame = level + 1, frame.f_back  # type: ignore[assignment]
+    if frame is None or str(frame.f_globals.get("__name__", "")).split(".")[0] == "scenarios":
+        return None
     return level
 
 
 def warn_implausible(scenario: Scenario) -> list[Implausible]:
-    """Issue each of :func:`plausibility_warnings` as a :class:`~scenarios.errors.PlausibilityWarning`.
+    """Issue each of :func:`plausibility_warnings` as a :class:`~scenarios.errors.PlausibilityWarning`,
+    when the schema was called from outside :mod:`scenarios` (a user's script or test).
 
     The warning names the YAML path, the value as written and the reason (the text ``slewbench
-    validate`` prints), and points at the first caller outside :mod:`scenarios`. Python shows a
-    warning once per text and line by default; ``warnings.simplefilter("error",
-    PlausibilityWarning)`` makes them errors, ``"ignore"`` silences them.
+    validate`` prints), and points at the line that called ``parse_scenario`` or ``load``. Called
+    from slewbench's own code (a study's cases, a slew table's entries, the command line, which
+    prints the findings itself), it warns of nothing. Python shows a warning once per text and line
+    by default; ``warnings.simplefilter("error", PlausibilityWarning)`` makes them errors,
+    ``"ignore"`` silences them.
 
     Parameters
     ----------
@@ -349,10 +355,12 @@ def warn_implausible(scenario: Scenario) -> list[Implausible]:
     Returns
     -------
     list of Implausible
-        The findings warned about.
+        The findings warned about (empty when called from slewbench's own code).
     """
-    found = plausibility_warnings(scenario)
     level = _caller_stacklevel()
+    if level is None:
+        return []
+    found = plausibility_warnings(scenario)
     for finding in found:
         warnings.warn(PlausibilityWarning(finding.path, finding.value, finding.reason), stacklevel=level)
     return found
