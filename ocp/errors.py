@@ -119,7 +119,17 @@ class ModelError(SlewbenchError, ValueError):
 
 
 class SimulationError(SlewbenchError, RuntimeError):
-    """The integration diverged (non-finite state), e.g. a step far too long for the rates."""
+    """The integration diverged (non-finite state), e.g. a step far too long for the rates.
+
+    A run refused before it starts, for its arguments, raises the subclass
+    :class:`SimulationArgumentError` (also a ``ValueError``).
+    """
+
+
+class SimulationArgumentError(SimulationError, ValueError):
+    """A run refused for its arguments before any step: a ``duration`` over the work limit
+    (``max_samples``) or past a tabulated magnetic field. A ``ValueError``, as every bad argument
+    is, and a :class:`SimulationError`, as the run's work limit has always been reported."""
 
 
 class CompilerUnavailable(SlewbenchError, RuntimeError):

@@ -38,7 +38,12 @@ from typing import TYPE_CHECKING, Any
 from scenarios._faces import lazy_face
 
 if TYPE_CHECKING:  # the names, for type checkers and readers
-    from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
+    from scenarios.errors import (
+        OutputError,
+        PlausibilityWarning,
+        ScenarioError,
+        SweepInterrupted,
+    )
     from scenarios.output.results import Row, RunResults
     from scenarios.runner import run
     from scenarios.schema.loader import Scenario, load, parse_scenario
@@ -51,10 +56,11 @@ _HOMES = {"Scenario": "scenarios.schema.loader", "load": "scenarios.schema.loade
           "Row": "scenarios.output.results", "RunResults": "scenarios.output.results", "run": "scenarios.runner",
           "Study": "scenarios.study.types", "load_study": "scenarios.study.spec", "parse_study": "scenarios.study.spec",
           "SweepInterrupted": "scenarios.errors", "SweepResults": "scenarios.study.engine",
-          "sweep": "scenarios.study.engine", "ScenarioError": "scenarios.errors", "OutputError": "scenarios.errors"}
+          "sweep": "scenarios.study.engine", "ScenarioError": "scenarios.errors", "OutputError": "scenarios.errors",
+          "PlausibilityWarning": "scenarios.errors"}
 
-__all__ = ["OutputError", "Row", "RunResults", "Scenario", "ScenarioError", "Study", "SweepInterrupted", "SweepResults",
-           "load", "load_study", "parse_study", "parse_scenario", "run", "sweep"]
+__all__ = ["OutputError", "PlausibilityWarning", "Row", "RunResults", "Scenario", "ScenarioError", "Study",
+           "SweepInterrupted", "SweepResults", "load", "load_study", "parse_study", "parse_scenario", "run", "sweep"]
 
 _face_getattr, __dir__ = lazy_face(__name__, _HOMES)
 _READERS = frozenset({"load", "parse_scenario", "load_study", "parse_study", "run", "sweep"})

@@ -6,6 +6,8 @@ that location (it is not a :class:`ScenarioError`: the scenario may be right). B
 line with exit status 2. :class:`SweepInterrupted` is a study stopped before every case finished.
 :class:`CaseTimeout`, a case out of time in a sweep's worker, is the one exception here not derived
 from :class:`~ocp.errors.SlewbenchError` (it derives from :class:`BaseException`).
+:class:`PlausibilityWarning` is no error: a warning (:func:`warnings.warn`) on a value that is
+valid but almost certainly a unit or layout slip.
 Imports only :mod:`ocp.errors`.
 """
 from __future__ import annotations
@@ -14,8 +16,11 @@ from pathlib import Path
 
 from ocp.errors import SlewbenchError
 
-__all__ = ["CaseTimeout", "OutputError", "ScenarioError", "SweepInterrupted", "WorkersCannotStart"]
+__all__ = ["CaseTimeout", "OutputError", "PlausibilityWarning", "ScenarioError", "SweepInterrupted", "WorkersCannotStart"]
 
+ANOTHER_DIRECTORY = "choose another directory (the `directory` argument; --out on the command line)"
+"""The remedy an :class:`OutputError` names for a directory it refuses: in the library's terms (the
+argument of :meth:`~scenarios.output.results.RunResults.write`) and the command line's."""
 MAX_PATH_CHARS = 300
 """Characters of a path shown in an error's text (the attribute keeps it whole)."""
 MAX_MESSAGE_CHARS = 2000
@@ -59,6 +64,28 @@ class OutputError(SlewbenchError):
         super().__init__(f"{_bounded(str(path), MAX_PATH_CHARS)}: {_bounded(message, MAX_MESSAGE_CHARS)}")
         self.path = Path(path)
         self.message = message
+
+
+class PlausibilityWarning(UserWarning):
+    """A scenario value the schema accepts that is almost certainly a unit or layout slip (a wheel
+    torque in mN m written as N m, wheels whose axes span a plane), issued with :func:`warnings.warn`
+    once per finding by :func:`scenarios.load` and :func:`scenarios.parse_scenario`
+    (:mod:`scenarios.schema.plausibility` says which checks); ``slewbench validate`` and ``run``
+    print the same findings.
+
+    Parameters
+    ----------
+    path : str
+        The YAML path of the value (``spacecraft.wheels.max_torque``), kept as :attr:`path`.
+    value : str
+        The value as written, with its unit (``4 N m``), kept as :attr:`value`.
+    reason : str
+        Why it looks wrong and, where one follows, the value probably meant; kept as :attr:`reason`.
+    """
+
+    def __init__(self, path: str, value: str, reason: str) -> None:
+        super().__init__(f"{path}: {value} {reason}")
+        self.path, self.value, self.reason = path, value, reason
 
 
 class CaseTimeout(BaseException):

@@ -104,7 +104,7 @@ def test_a_run_of_another_scenario_is_not_replaced(tmp_path, capsys):
     capsys.readouterr()
     assert main(["run", str(other), "--out", str(out), "--no-plots"]) == 2
     captured = capsys.readouterr()
-    assert "'user-a-12u'" in captured.err and "'fast'" in captured.err and "another --out" in captured.err
+    assert "'user-a-12u'" in captured.err and "'fast'" in captured.err and "--out on the command line" in captured.err
     assert "[1/1]" not in captured.out  # refused before planning
     assert snapshot(out) == before
 

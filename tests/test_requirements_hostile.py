@@ -372,7 +372,9 @@ def test_hostile_input_is_exit_2_naming_the_path_and_the_value(case, tmp_path):
     data, path, words = HOSTILE[case]
     status, error = run_cli(tmp_path, data)
     assert status == 2, error
-    assert f"error in scenario: {path}:" in error, error
+    # a file that cannot be read (a duplicate key) is named by its path: validate cannot yet tell its kind
+    kind = tmp_path / "case.yaml" if "duplicate key" in words else "scenario"
+    assert f"error in {kind}: {path}:" in error, error
     for word in words:
         assert word in error, (word, error)
     assert "Traceback" not in error

@@ -39,7 +39,7 @@ from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.layout import actuator_blocks, reference_rows
 from ocp.dynamics.model import AttitudeModel
 from ocp.dynamics.truth import TruthPlant
-from ocp.errors import CompilerUnavailable, SimulationError
+from ocp.errors import CompilerUnavailable, SimulationArgumentError, SimulationError
 from ocp.estimation import (
     BLINDED,
     SENSOR_STATE_SIZE,
@@ -479,7 +479,8 @@ class Simulator:
         Always use the Python loop (the reference implementation), even for symbolic laws.
     max_samples : int, optional
         Most samples one run may take, and most RK4 sub-steps in all: ``SUBSTEPS_PER_SAMPLE`` times
-        this (:data:`SUBSTEPS_PER_SAMPLE`); longer runs are refused with :class:`SimulationError`,
+        this (:data:`SUBSTEPS_PER_SAMPLE`); longer runs are refused with
+        :class:`~ocp.errors.SimulationArgumentError` (a ``ValueError`` and a :class:`SimulationError`),
         not attempted.
     plant : TruthPlant or None, optional
         The truth model to integrate (:mod:`ocp.dynamics.truth`), built on ``model``: the loop
@@ -624,8 +625,10 @@ class Simulator:
         Raises
         ------
         SimulationError
-            When the state becomes non-finite (a non-finite command named as the controller's), or
-            the run exceeds the work limits.
+            When the state becomes non-finite (a non-finite command named as the controller's).
+        SimulationArgumentError
+            A ``duration`` over the work limits (``max_samples``) or past a tabulated magnetic
+            field: a ``ValueError`` and a :class:`SimulationError` both, refused before any step.
         Exception
             Whatever the controller's law raises, unchanged; :func:`law_raised` tells it apart
             and says which controller raised it and when.
@@ -654,7 +657,7 @@ class Simulator:
         duration = float(duration)
         n_samples = max(1, math.ceil(duration / self.sample_time - 1e-9))
         if n_samples > self.max_samples or n_samples * self.substeps > SUBSTEPS_PER_SAMPLE * self.max_samples:
-            raise SimulationError(f"{duration:g} s at {self.sample_time:g} s samples is {n_samples} samples, over the "
+            raise SimulationArgumentError(f"{duration:g} s at {self.sample_time:g} s samples is {n_samples} samples, over the "
                                   f"limit of {self.max_samples} samples or {SUBSTEPS_PER_SAMPLE * self.max_samples} sub-steps in all "
                                   "(simulation.max_samples raises it)")
         times = np.minimum(np.arange(n_samples + 1) * self.sample_time, duration)
@@ -665,7 +668,7 @@ class Simulator:
         field_rng = np.random.default_rng([noise.seed, 1])
         valid_until = getattr(model.environment.magnetic_field, "valid_until", None)
         if valid_until is not None and duration > valid_until + 1e-9:
-            raise SimulationError(f"the magnetic field is tabulated up to t = {valid_until:g} s, the run lasts "
+            raise SimulationArgumentError(f"the magnetic field is tabulated up to t = {valid_until:g} s, the run lasts "
                                   f"{duration:g} s; lengthen environment.magnetic_field.span_s")
         field_rate = self._field_rate_numeric if getattr(controller, "needs_field_rate", False) else None
         try:

@@ -213,7 +213,10 @@ def command_validate(args: argparse.Namespace) -> int:
         study's per case, a table's entry limit), printed in any case; a bad file raises
         ``ScenarioError``, which :func:`main` reports with exit 2.
     """
+    args.file_kind = args.file  # until its kind is known, an error (a duplicate key, no mapping) names the file
     data = read_yaml(args.file)
+    if isinstance(data, dict):
+        args.file_kind = None  # a scenario's, unless a key below says otherwise
     for key in OTHER_FILES:  # a study or a slew table: its own check and summary
         if isinstance(data, dict) and key in data:
             args.file_kind = f"{key} file"  # how main() names its errors

@@ -59,7 +59,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp.dynamics.ephemeris import parse_utc, tdb_julian_date
-from ocp.quat import continuous
+from ocp.quat import continuous, unit_norm_error
 from planners.reference import JUMP_TOLERANCE
 from scenarios.errors import ScenarioError
 
@@ -198,7 +198,9 @@ def aem_text(epoch: datetime.datetime | str | None, t: ArrayLike, q: ArrayLike, 
     t : (N,) array_like
         Sample times [s] from the epoch, increasing, at least two.
     q : (N, 4) array_like
-        Attitude, body to inertial (GCRF), scalar first (slewbench's convention).
+        Attitude, body to inertial (GCRF), scalar first (slewbench's convention); each of unit
+        norm within :data:`ocp.quat.UNIT_NORM_TOLERANCE` (:func:`ocp.quat.unit_norm_error`, the
+        rule of the YAML loader and ``ManeuverProblem``), then normalised.
     omega : (N, 3) array_like, optional
         Body rate [rad/s], body axes: written as ``QUATERNION/ANGVEL`` in deg/s; ``None``:
         ``QUATERNION``.
@@ -229,8 +231,9 @@ def aem_text(epoch: datetime.datetime | str | None, t: ArrayLike, q: ArrayLike, 
     ScenarioError
         Without an epoch (at ``epoch``).
     ValueError
-        Fewer than two samples, times not increasing, shapes that disagree, non-finite values or a
-        segment start outside ``1 .. N-1``.
+        Fewer than two samples, times not increasing, shapes that disagree, non-finite values, a
+        quaternion that is zero or not of unit norm (naming its index and value) or a segment
+        start outside ``1 .. N-1``.
     """
     if epoch is None:
         raise ScenarioError("epoch", "no epoch: the times are not absolute and the inertial frame is not the GCRF; a "
@@ -251,6 +254,10 @@ def aem_text(epoch: datetime.datetime | str | None, t: ArrayLike, q: ArrayLike, 
         attitude_type = "QUATERNION/ANGVEL"
     if not all(np.all(np.isfinite(block)) for block in [t, *columns]):
         raise ValueError("the series holds non-finite values, which an AEM cannot carry (CCSDS 504.0-B-2, 6.8.5)")
+    for index, sample in enumerate(q):  # the library's rule for a quaternion given as input: never normalised quietly
+        problem = unit_norm_error(sample)
+        if problem is not None:
+            raise ValueError(f"q[{index}] = {sample.tolist()}: {problem}")
     if np.any(np.diff(t) <= 0.0):
         raise ValueError("sample times must increase strictly")
     tags = time_tags(epoch, t, time_system)

@@ -31,7 +31,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
-from scenarios.errors import OutputError
+from scenarios.errors import ANOTHER_DIRECTORY, OutputError
 from scenarios.schema.read import read_bounded
 
 __all__ = ["MARKER", "STAGING_PREFIX", "changed_files", "check_output_directory", "claim_output_directory",
@@ -127,7 +127,7 @@ def _refuse_changed(path: str | Path, directory: Path, manifest: dict[str, Any],
     if changed:
         shown = ", ".join(changed[:5]) + (f" and {len(changed) - 5} more" if len(changed) > 5 else "")
         raise OutputError(path, f"holds files changed since slewbench wrote them ({shown}); {done}: move them "
-                                "or choose another --out")
+                                "or " + ANOTHER_DIRECTORY)
 
 
 def written_files(directory: Path) -> set[str]:
@@ -287,7 +287,7 @@ def check_output_directory(path: str | Path, kind: str = "run", expected: Iterab
                 if foreign:
                     shown = ", ".join(foreign[:5]) + (f" and {len(foreign) - 5} more" if len(foreign) > 5 else "")
                     raise OutputError(path, f"holds files slewbench did not write ({shown}) that this {kind} would "
-                                            "write; nothing was touched: move them or choose another --out")
+                                            "write; nothing was touched: move them or " + ANOTHER_DIRECTORY)
             writable = directory
         else:
             writable = next(parent for parent in directory.parents if parent.exists())
@@ -400,7 +400,7 @@ def _commit(directory: Path, staging: Path, kind: str) -> list[str]:
     clashes = [name for name in new if name not in previous and os.path.lexists(directory / name)]
     if clashes:
         raise OutputError(directory, f"holds files slewbench did not write ({', '.join(clashes[:5])}); "
-                                     "nothing was replaced: move them or choose another --out")
+                                     "nothing was replaced: move them or " + ANOTHER_DIRECTORY)
     _refuse_changed(directory, directory, manifest, "nothing was replaced")
     # while moving, a file this commit writes may hold its old content or its new one: both are
     # slewbench's (an interrupted commit leaves every listed file of slewbench's stamped)

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from scenarios.errors import OutputError
+from scenarios.errors import ANOTHER_DIRECTORY, OutputError
 from scenarios.output.directory import (
     check_output_directory,
     claim_output_directory,
@@ -255,7 +255,7 @@ def check_run_directory(directory: str | Path, scenario: str, expected: list[str
     earlier = _written_scenario(target)
     if earlier is not None and earlier != scenario:
         raise OutputError(directory, f"holds the run of scenario {earlier!r}, not {scenario!r}: a run replaces only an "
-                                     "earlier run of its own scenario; choose another --out, or delete that run "
+                                     "earlier run of its own scenario; " + ANOTHER_DIRECTORY + ", or delete that run "
                                      "first (nothing was touched)")
     return target
 

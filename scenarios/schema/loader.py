@@ -62,6 +62,7 @@ from scenarios.schema.model import (
     parse_spacecraft,
 )
 from scenarios.schema.node import Node
+from scenarios.schema.plausibility import warn_implausible
 from scenarios.schema.read import read_yaml
 from scenarios.schema.requirements import (
     REQUIREMENTS,
@@ -589,7 +590,9 @@ def parse_scenario(data: Any, source: Path | None = None, *, inapplicable_rows: 
     Parameters
     ----------
     data : object
-        The parsed YAML document (a mapping; see :func:`~scenarios.schema.read.read_yaml`).
+        The parsed YAML document (a mapping; see :func:`~scenarios.schema.read.read_yaml`), or one
+        built in Python: numpy numbers and arrays and tuples are accepted wherever the YAML takes a
+        number or a list (:func:`scenarios.schema.node.plain_value`).
     source : Path or None, optional
         The file it came from, kept in :attr:`Scenario.source`.
     inapplicable_rows : bool, optional
@@ -607,6 +610,13 @@ def parse_scenario(data: Any, source: Path | None = None, *, inapplicable_rows: 
     ------
     ScenarioError
         Naming the YAML path, the value and what was expected.
+
+    Warns
+    -----
+    PlausibilityWarning
+        One per value that looks like a unit or layout slip (the findings of ``slewbench validate``),
+        when called from outside :mod:`scenarios` (:func:`scenarios.schema.plausibility.warn_implausible`:
+        a study's cases and the command line report them their own way).
     """
     root = Node(data).mapping()
     name = SCENARIO["name"].value(root)
@@ -638,9 +648,11 @@ def parse_scenario(data: Any, source: Path | None = None, *, inapplicable_rows: 
     check_row_labels(planners, controllers)
     inapplicable: dict[int, str] | None = {} if inapplicable_rows else None
     check_compatibility(problem, planners, controllers, simulation, inapplicable)
-    return Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch,
-                    euler_sequence=plots["euler_sequence"], data=copy.deepcopy(data), truth=truth,
-                    inapplicable=inapplicable or {})
+    scenario = Scenario(name, problem, planners, controllers, simulation, source, requirements, epoch,
+                        euler_sequence=plots["euler_sequence"], data=copy.deepcopy(root.value), truth=truth,
+                        inapplicable=inapplicable or {})
+    warn_implausible(scenario)  # called from a script: one warning per finding
+    return scenario
 
 
 def _settling_band(simulation: SimulationSpec, requirements: Requirements, given: bool) -> SimulationSpec:
@@ -688,6 +700,11 @@ def load(path: str | Path) -> Scenario:
     ScenarioError
         The file cannot be read or is not a valid scenario (the message names the YAML path); a
         study or slew-table file names the command that runs it.
+
+    Warns
+    -----
+    PlausibilityWarning
+        One per value that looks like a unit or layout slip, as :func:`parse_scenario`.
     """
     data = read_yaml(path)
     if isinstance(data, dict):

@@ -27,7 +27,7 @@ from ocp import (
 from ocp.dynamics.environment import MAGNETIC_FIELDS, MagneticField
 from ocp.dynamics.ephemeris import parse_utc
 from ocp.dynamics.orbits import ORBITS, TLE_EPOCH_WARN_DAYS, Orbit
-from ocp.errors import InvalidOption
+from ocp.errors import InvalidOption, excerpt
 from ocp.simulation.compiled import notice
 from scenarios.errors import ScenarioError
 from scenarios.requirements.spec import Sensor
@@ -64,7 +64,11 @@ def _limits(node: Node) -> Any:
 def _inertia(node: Node) -> np.ndarray:
     inertia = node.value
     if isinstance(inertia, list) and inertia and all(isinstance(row, list) for row in inertia):
+        if len(inertia) != 3:
+            raise node.error(f"expected a 3x3 matrix (3 rows of 3 numbers), got {len(inertia)} rows")
         return np.array([Node(row, f"{node.path}[{i}]").vector(3) for i, row in enumerate(inertia)])
+    if not isinstance(inertia, list):
+        raise node.error(f"expected a list of 3 numbers or a 3x3 matrix (3 rows of 3 numbers), got {excerpt(inertia)}")
     return node.vector(3)
 
 

@@ -18,7 +18,50 @@ from ocp import quat
 from ocp.errors import excerpt
 from scenarios.errors import ScenarioError
 
-__all__ = ["Node"]
+__all__ = ["Node", "plain_value"]
+
+PLAIN_DEPTH = 64
+"""Deepest nesting :func:`plain_value` converts (a mapping nested deeper, or one holding itself, is
+left as given: the schema refuses it where it reads it)."""
+
+
+def plain_value(value: Any, depth: int = 0) -> Any:
+    """``value`` with numpy numbers and arrays and tuples made the YAML values they stand for.
+
+    A script builds a scenario mapping from numpy (``inertia=np.diag(...)``, ``duration=np.int64(60)``)
+    and tuples; the schema reads what ``yaml.safe_load`` gives (lists, ``int``, ``float``, ``bool``,
+    ``str``, mappings), so they are converted here, once, where a mapping enters it (the top
+    :class:`Node`): a numpy scalar becomes the Python number (``np.bool_`` a bool, still refused
+    where a number is wanted), a numpy array its nested list (``ndarray.tolist()``), a tuple a list.
+    Other values are kept, and refused where read.
+
+    Parameters
+    ----------
+    value : object
+        A parsed YAML value or one built in Python.
+    depth : int, optional
+        Nesting level reached (internal).
+
+    Returns
+    -------
+    object
+        The converted value; ``value`` itself when nothing needed converting.
+    """
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if depth >= PLAIN_DEPTH:
+        return value
+    if isinstance(value, (list, tuple)):
+        items = [plain_value(item, depth + 1) for item in value]
+        return value if isinstance(value, list) and all(a is b for a, b in zip(items, value)) else items
+    if isinstance(value, dict):
+        pairs = {plain_value(key, depth + 1): plain_value(item, depth + 1) for key, item in value.items()}
+        unchanged = len(pairs) == len(value) and all(
+            key in value and value[key] is item for key, item in pairs.items())
+        return value if unchanged else pairs
+    return value
 
 
 def _is_number(value: Any) -> bool:
@@ -39,13 +82,15 @@ class Node:
     Parameters
     ----------
     value : object
-        The parsed YAML value (mapping, list, number, string, bool or ``None``).
+        The parsed YAML value (mapping, list, number, string, bool or ``None``). At the top level
+        (``path`` empty) numpy numbers and arrays and tuples are converted first
+        (:func:`plain_value`), so that a mapping built in Python reads as its YAML would.
     path : str, optional
         Its YAML path (``planners[1].options.weight``); empty for the top level.
     """
 
     def __init__(self, value: Any, path: str = ""):
-        self.value = value
+        self.value = value if path else plain_value(value)
         self.path = path
         self._read: set[str] = set()
 

@@ -6,19 +6,24 @@ slip (wheels that cannot torque about every axis).
 They are warnings, not errors: each names the YAML path, the value as written and the physical
 reason it looks wrong, and suggests the value meant where one follows. ``slewbench validate``
 prints them (``validate --strict`` counts each as a finding: exit 1) and ``slewbench run`` prints
-them on standard error before planning. Each check of :data:`PLAUSIBILITY_CHECKS` has one physical
+them on standard error before planning; from Python, :func:`~scenarios.schema.loader.parse_scenario`
+and :func:`~scenarios.schema.loader.load` issue each as a
+:class:`~scenarios.errors.PlausibilityWarning` (:func:`warn_implausible`). Both paths read the
+same findings, those of :func:`plausibility_warnings`. Each check of :data:`PLAUSIBILITY_CHECKS` has one physical
 reason; a value that passes them all is not thereby right, only not obviously wrong.
 
 There is no check of angles in radians: every angle a scenario gives is in degrees (``_deg``
 keys, ``axis_angle.angle_deg``), whose ranges the schema already bounds; and an inertia that
 violates the triangle inequality is an error of the loader, not a warning.
 
-May import: :mod:`ocp` (the Earth's radius) and the :class:`~scenarios.schema.loader.Scenario`
+May import: :mod:`ocp` (the Earth's radius), :mod:`scenarios.errors` (the warning's class) and the :class:`~scenarios.schema.loader.Scenario`
 it reads (for types only).
 """
 from __future__ import annotations
 
 import math
+import sys
+import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -26,12 +31,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ocp.dynamics.orbits import R_EARTH
+from scenarios.errors import PlausibilityWarning
 
 if TYPE_CHECKING:
     from scenarios.schema.loader import Scenario
 
 __all__ = ["LOWEST_ORBIT_KM", "MAX_ANGULAR_ACCELERATION", "MAX_RATE", "MAX_RATE_TOLERANCE", "MOON_DISTANCE_KM",
-           "PLAUSIBILITY_CHECKS", "SLOW_SLEW_FACTOR", "Implausible", "plausibility_warnings"]
+           "PLAUSIBILITY_CHECKS", "SLOW_SLEW_FACTOR", "Implausible", "plausibility_warnings",
+           "warn_implausible"]
 
 MOON_DISTANCE_KM = 384_400.0
 """The Moon's mean distance from the Earth [km]: an orbit reaching beyond it is no Earth orbit the
@@ -314,3 +321,46 @@ def plausibility_warnings(scenario: Scenario) -> list[Implausible]:
         The warnings; empty when nothing looks like a unit slip.
     """
     return [warning for check in PLAUSIBILITY_CHECKS.values() for warning in check(scenario)]
+
+
+def _caller_stacklevel() -> int | None:
+    """The ``stacklevel`` of :func:`warnings.warn`, called from :func:`warn_implausible`, that names
+    the caller of the schema (of ``parse_scenario`` or ``load``); ``None`` when that caller is
+    slewbench's own code (a study's case, a slew table's entry, the command line, which report the
+    findings their way or not at all)."""
+    level, frame = 2, sys._getframe(2)  # 1: warn_implausible; 2: its caller
+    while frame is not None and str(frame.f_globals.get("__name__", "")).startswith("scenarios.schema."):
+        level, frame = level + 1, frame.f_back  # type: ignore[assignment]
+    if frame is None or str(frame.f_globals.get("__name__", "")).split(".")[0] == "scenarios":
+        return None
+    return level
+
+
+def warn_implausible(scenario: Scenario) -> list[Implausible]:
+    """Issue each of :func:`plausibility_warnings` as a :class:`~scenarios.errors.PlausibilityWarning`,
+    when the schema was called from outside :mod:`scenarios` (a user's script or test).
+
+    The warning names the YAML path, the value as written and the reason (the text ``slewbench
+    validate`` prints), and points at the line that called ``parse_scenario`` or ``load``. Called
+    from slewbench's own code (a study's cases, a slew table's entries, the command line, which
+    prints the findings itself), it warns of nothing. Python shows a warning once per text and line
+    by default; ``warnings.simplefilter("error", PlausibilityWarning)`` makes them errors,
+    ``"ignore"`` silences them.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A validated scenario.
+
+    Returns
+    -------
+    list of Implausible
+        The findings warned about (empty when called from slewbench's own code).
+    """
+    level = _caller_stacklevel()
+    if level is None:
+        return []
+    found = plausibility_warnings(scenario)
+    for finding in found:
+        warnings.warn(PlausibilityWarning(finding.path, finding.value, finding.reason), stacklevel=level)
+    return found

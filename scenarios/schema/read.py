@@ -70,8 +70,8 @@ def _check_tree(root: yaml.Node, source: Path | str) -> None:
                 child = f"{path}.{key}" if path else str(key)
                 if key in seen:
                     first = seen[key].start_mark.line + 1
-                    raise ScenarioError(child, f"duplicate key (lines {first} and {key_node.start_mark.line + 1}); "
-                                               "each key may appear once")
+                    raise ScenarioError(child, f"duplicate key (lines {first} and {key_node.start_mark.line + 1} of "
+                                               f"{source}); each key may appear once")
                 seen[key] = key_node
                 stack.append((value_node, child, depth + 1))
         elif isinstance(node, yaml.SequenceNode):
