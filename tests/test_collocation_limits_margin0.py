@@ -15,7 +15,11 @@ import copy
 import numpy as np
 import pytest
 
-from planners.collocation.requirements import SOLVER_BOUND_RELAXATION, STATE_BACKOFF, imposed_state_bounds
+from planners.collocation.requirements import (
+    SOLVER_BOUND_RELAXATION,
+    STATE_BACKOFF,
+    imposed_state_bounds,
+)
 from scenarios import parse_scenario, run
 
 PYRAMID = np.array([[0.612372, 0.612372, 0.5], [-0.612372, 0.612372, 0.5], [-0.612372, -0.612372, 0.5],
