@@ -3,7 +3,8 @@
 A problem's requirements (:class:`Requirements`: its pointing constraints and the planner's own
 ``keep_out`` / ``keep_in`` cones, the bound on the body-rate norm, the actuator margin) are imposed
 by the NLP at the transcription's points only, and tighter than stated (:class:`Tightening`):
-the cones by ``cone_margin_deg``, a window widened by one mesh interval (:func:`imposed_pointing`).
+the cones by ``cone_margin_deg``, a window widened by one mesh interval (:func:`imposed_pointing`),
+the actuators' states inside the solver's relaxation of their bounds (:func:`imposed_state_bounds`).
 Between the points the interpolated solution may still cut a cone or overshoot a bound, so every
 converged reference is checked on a dense grid (:func:`dense_check`, :data:`DENSE_POINTS` points per
 interval) against the requirements **as stated**; the planner tightens what is broken
