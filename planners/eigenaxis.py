@@ -224,6 +224,17 @@ class BangCoastBangProfile(AngleProfile):
         self.angle = angle
         self.duration = 2 * self.ramp + self.coast
 
+    def rate_words(self) -> str:
+        """The profile's rate for a message: ``coast rate w rad/s`` when it coasts for more than
+        1e-6 of its duration, else ``peak rate w rad/s`` (a triangle, at ``w`` only at its switch; a
+        fixed T's root finding leaves a coast of about 1e-8 of T at the minimum time).
+
+        Returns
+        -------
+        str
+        """
+        return f"{'coast' if self.coast > 1e-6 * self.duration else 'peak'} rate {self.rate_max:.4g} rad/s"
+
     def __call__(self, t: Array) -> tuple[Array, Array, Array]:
         a, w, ramp = self.alpha, self.rate_max, self.ramp
         late = np.maximum(self.duration - t, 0.0)
@@ -905,8 +916,7 @@ class EigenaxisPlanner(Planner):
             words += "; feasible, not proven the minimum time (the torquers change the total momentum)"
         if self.options.profile == "min_time":
             return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,
-                                      f"minimum time {profile.duration:.3f} s, coast rate {profile.rate_max:.4g} "
-                                      f"rad/s ({words})", problem)
+                                      f"minimum time {profile.duration:.3f} s, {profile.rate_words()} ({words})", problem)
         if problem.duration < profile.duration * (1 - 1e-12):
             return FailedReference(self.name, f"T = {problem.duration:g} s is shorter than the fastest bang-coast-bang "
                                    f"this planner verifies, {profile.duration:.4g} s ({words})", "infeasible")
@@ -918,7 +928,7 @@ class EigenaxisPlanner(Planner):
         slower.coast = problem.duration - 2 * slower.ramp
         slower.duration = problem.duration
         return EigenaxisReference(problem.q0, axis, slower, problem.duration, inertia,
-                                  f"bang-coast-bang, coast rate {slower.rate_max:.4g} rad/s (the fastest verified "
+                                  f"bang-coast-bang, {slower.rate_words()} (the fastest verified "
                                   f"profile stretched to T; {words})", problem)
 
     def _bang(self, problem: ManeuverProblem, axis: Array, angle: float, max_rate: float | None,
@@ -976,7 +986,7 @@ class EigenaxisPlanner(Planner):
         if profile_name == "min_time":
             profile = BangCoastBangProfile(angle, acceleration(best_rate), best_rate)
             return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,
-                                      f"minimum time {profile.duration:.3f} s, coast rate {best_rate:.4g} rad/s"
+                                      f"minimum time {profile.duration:.3f} s, {profile.rate_words()}"
                                       f"{momentum_words}{reserve_words}", problem)
         if problem.duration < minimum_time * (1 - 1e-12):
             bounds_words = "the torque bounds"
@@ -997,4 +1007,4 @@ class EigenaxisPlanner(Planner):
         profile.coast = problem.duration - 2 * profile.ramp  # exact T despite root tolerance
         profile.duration = problem.duration
         return EigenaxisReference(problem.q0, axis, profile, problem.duration, inertia,
-                                  f"bang-coast-bang, coast rate {coast_rate:.4g} rad/s{reserve_words}", problem)
+                                  f"bang-coast-bang, {profile.rate_words()}{reserve_words}", problem)

@@ -95,6 +95,7 @@ from planners.collocation.requirements import (
     Tightening,
     dense_check,
     imposed_pointing,
+    imposed_state_bounds,
 )
 from planners.collocation.strategy import (
     AGREE_ATOL,
@@ -537,11 +538,13 @@ class CollocationPlanner(Planner):
     def _variable_bounds(self, problem: ManeuverProblem,
                          tightening: Tightening | None = None) -> tuple[Array, Array, Array, Array]:
         """Per-point bounds of the model state and the actuator controls: the actuators' limits
-        scaled by ``1 − actuator_margin`` and by ``1 − tightening.actuators``."""
+        scaled by ``1 − actuator_margin`` and by ``1 − tightening.actuators``, their states'
+        imposed inside the solver's relaxation (:func:`~planners.collocation.requirements.imposed_state_bounds`)."""
         scale = 1.0 - (problem.actuator_margin or 0.0)
         if tightening is not None:
             scale *= 1.0 - tightening.actuators
-        return variable_bounds(problem, self.options.max_rate, scale)
+        x_low, x_high, u_low, u_high = variable_bounds(problem, self.options.max_rate, scale)
+        return (*imposed_state_bounds(x_low, x_high, problem.initial_state), u_low, u_high)
 
     def _seed_names(self, problem: ManeuverProblem) -> list[str]:
         """The seed planners: the option's list, or with ``seed_planners: auto`` every registered

@@ -3,7 +3,8 @@
 A problem's requirements (:class:`Requirements`: its pointing constraints and the planner's own
 ``keep_out`` / ``keep_in`` cones, the bound on the body-rate norm, the actuator margin) are imposed
 by the NLP at the transcription's points only, and tighter than stated (:class:`Tightening`):
-the cones by ``cone_margin_deg``, a window widened by one mesh interval (:func:`imposed_pointing`).
+the cones by ``cone_margin_deg``, a window widened by one mesh interval (:func:`imposed_pointing`),
+the actuators' states inside the solver's relaxation of their bounds (:func:`imposed_state_bounds`).
 Between the points the interpolated solution may still cut a cone or overshoot a bound, so every
 converged reference is checked on a dense grid (:func:`dense_check`, :data:`DENSE_POINTS` points per
 interval) against the requirements **as stated**; the planner tightens what is broken
@@ -29,7 +30,8 @@ from planners.collocation.problem import variable_bounds
 from planners.collocation.reference import CollocationReference
 from planners.problem import Array, ManeuverProblem
 
-__all__ = ["DENSE_POINTS", "DenseCheck", "Requirements", "Tightening", "dense_check", "dense_times", "imposed_pointing"]
+__all__ = ["DENSE_POINTS", "DenseCheck", "Requirements", "Tightening", "dense_check", "dense_times", "imposed_pointing",
+           "imposed_state_bounds"]
 
 DENSE_POINTS = 20
 """Points per mesh interval of the dense check (equally spaced, the nodes included)."""
@@ -155,8 +157,49 @@ BOUND_STEP = 1e-6
 """Floor of a bound's further tightening after a dense check (fraction of the limit)."""
 BOUND_TOLERANCE = 1e-6
 """A bound (rate norm, actuator limit) counts as broken by the dense check when exceeded by more
-than this fraction of it: the solver meets an inequality to about 1e-8 of its scale, and its
-variable bounds exactly."""
+than this fraction of it: the solver meets an inequality to about 1e-8 of its scale, and the
+actuators' state bounds within them (imposed :data:`STATE_BACKOFF` inside, :func:`imposed_state_bounds`)."""
+SOLVER_BOUND_RELAXATION = 1e-8
+"""How far the solver may leave a variable's bound ``b``, as a fraction of ``max(1, |b|)``: IPOPT's
+``bound_relax_factor`` (its default, which :func:`~ocp.nlp.solve.solver_options` keeps) relaxes
+every bound by that before it solves, and returns a point within the relaxed bounds. On a wheel
+momentum limit of 0.03 N m s that is 1e-8 N m s, 3.3e-7 of the limit: a minimum-time optimum rides
+the limit that far above it, and is scored against the limit itself."""
+STATE_BACKOFF = 2.0 * SOLVER_BOUND_RELAXATION
+"""How far inside an actuator state's bound ``b`` (a wheel momentum limit, ``1 − actuator_margin`` of
+it) the NLP imposes it, as a fraction of ``max(1, |b|)``: twice the solver's relaxation
+(:data:`SOLVER_BOUND_RELAXATION`), so that the solution's states stay within ``b`` with the
+relaxation and rounding (2e-8 N m s below 1 N m s: 6.7e-7 of a 0.03 N m s limit, which moves a
+minimum time by less than that fraction). The controls need none: the reference saturates them at
+the bounds as imposed (:class:`~planners.collocation.reference.CollocationReference`)."""
+
+
+def imposed_state_bounds(low: Array, high: Array, start: Array) -> tuple[Array, Array]:
+    """The model state's per-point bounds as the NLP imposes them: the actuators' states (entries 7
+    on: wheel momenta) :data:`STATE_BACKOFF` inside each finite bound, not past the start's value
+    (a start at its bound keeps the bound); the attitude and rate entries as given.
+
+    Parameters
+    ----------
+    low, high : (nx,) ndarray
+        The state's bounds (:func:`~planners.collocation.problem.variable_bounds`, scaled by the
+        actuator margin and the tightening); ``±inf``: none.
+    start : (nx,) ndarray
+        The state at t = 0 (``ManeuverProblem.initial_state``; only its actuator states are read).
+
+    Returns
+    -------
+    tuple of (nx,) ndarray
+        ``(low, high)``, new arrays.
+    """
+    low, high = np.array(low, dtype=float), np.array(high, dtype=float)
+    states = np.asarray(start, dtype=float)[7:]
+    with np.errstate(invalid="ignore"):  # an infinite bound stays infinite
+        high[7:] = np.where(np.isfinite(high[7:]), np.maximum(high[7:] - STATE_BACKOFF * np.maximum(1.0, np.abs(high[7:])),
+                                                              np.minimum(states, high[7:])), high[7:])
+        low[7:] = np.where(np.isfinite(low[7:]), np.minimum(low[7:] + STATE_BACKOFF * np.maximum(1.0, np.abs(low[7:])),
+                                                            np.maximum(states, low[7:])), low[7:])
+    return low, high
 
 
 def imposed_pointing(requirements: Requirements, tightening: Tightening, interval: float | None,
