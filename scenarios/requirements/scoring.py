@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -1208,9 +1209,21 @@ def late_slew(problem: ManeuverProblem, duration: float) -> str:
     """
     if duration <= problem.duration * (1.0 + LATE_SLACK):
         return ""
-    return (f"its slew takes {duration:.6g} s, longer than the {problem.duration:g} s bound (maneuver.duration, "
-            "the manoeuvre's time budget for every planner): the planner found no slew within it under its "
-            f"bounds; a maneuver.duration of at least {duration:.6g} s admits this one")
+    digits = next(k for k in range(7, 18) if f"{duration:.{k}g}" != f"{problem.duration:.{k}g}")
+    return (f"its slew takes {duration:.{digits}g} s, longer than the {problem.duration:g} s bound "
+            "(maneuver.duration, the manoeuvre's time budget for every planner): the planner found no slew "
+            f"within it under its bounds; a maneuver.duration of at least {_rounded_up(duration)} s admits this one")
+
+
+def _rounded_up(value: float) -> str:
+    """``value`` (> 0) rounded up to the fewest significant digits (3 at least) that stay within
+    1e-3 of it: a duration to suggest, never below the one needed (100.00045 -> ``100.1``)."""
+    for k in range(3, 17):
+        step = 10.0 ** (math.floor(math.log10(value)) - k + 1)
+        up = math.ceil(value / step) * step
+        if up >= value and up - value <= 1e-3 * value:
+            return f"{up:.{max(0, k - 1 - math.floor(math.log10(value)))}f}"
+    return repr(value)
 
 
 def _end_time(words: str, time: float, problem: ManeuverProblem) -> str:
