@@ -959,10 +959,9 @@ def _pareto(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Fig
         extra.append(Line2D([], [], color="0.3", label="a row not ok (violated, failed): on no front", **NOT_OK_MARK))
     _legend(figure, colors, False, extra, style="o", never=[f"{words} (on no front)"] if any_never else [])
     more = f" (the first {len(shown)} of {len(panels)} grid points)" if len(shown) < len(panels) else ""
-    each = (f"each planner at the median of its {study.samples} Monte Carlo samples (bars 5-95 %)" if samples
-            else "each planner")
-    _title(figure, f"{study.name}: {each} and the Pareto front of the planners whose rows are all ok"
-           + (", per grid point" if study.grid_paths else "") + more)
+    each = f"planners at the median of {study.samples} samples (bars 5-95 %)" if samples else "planners"
+    _title(figure, f"{study.name}: {each}, front over those with every row ok"
+           + (" per grid point" if study.grid_paths else "") + more)
     yield "pareto.png", figure
 
 
