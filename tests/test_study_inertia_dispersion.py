@@ -293,3 +293,33 @@ def test_the_small_sample_note_reads_the_same_null_distribution_as_the_p_values(
     assert critical_rho(7) == pytest.approx(0.786, abs=1e-3)
     assert critical_rho(8) == pytest.approx(0.738, abs=1e-3)
     assert critical_rho(10) == pytest.approx(0.648, abs=0.02)
+
+
+MOMENTS = [2.0, 3.0, 4.0]
+
+
+@pytest.mark.parametrize("base_inertia, scale, low", [
+    (TENSOR, {"uniform": [-0.1, 1.1]}, "-0.1"),
+    (MOMENTS, {"uniform": [-0.1, 1.1]}, "-0.1"),
+    (TENSOR, {"uniform": {"low": 0.0, "high": 1.1}}, "0"),
+    (TENSOR, {"uniform": {"low": [[0.9, 0.5, 0.5], [0.5, -0.2, 0.5], [0.5, 0.5, 0.9]], "high": [[1.1] * 3] * 3}},
+     "-0.2"),
+    (MOMENTS, {"uniform": {"low": [0.9, 0.95, -0.3], "high": [1.1, 1.05, 1.1]}}, "-0.3"),
+])
+def test_a_scale_whose_bounds_reach_a_factor_of_0_or_less_is_refused_at_validation(base_inertia, scale, low):
+    # Refused at its entry whatever the draws: one sample, whichever seed, must not pass validation (a
+    # study with a larger `samples` would then fail at the case that draws the factor).
+    base = {**copy.deepcopy(SWEEP_BASE), "truth": {"spacecraft": {"inertia": copy.deepcopy(base_inertia)}}}
+    for seed in range(3):
+        with pytest.raises(ScenarioError, match=f"must be > 0 .*got a low bound of {low} ") as error:
+            study({PATH: {"scale": scale}}, samples=1, seed=seed, base=base)
+        assert error.value.path == f"monte_carlo.dispersions.{PATH}.scale"
+
+
+def test_a_scale_of_three_moments_that_can_break_the_triangle_inequality_is_refused_at_validation():
+    base = {**copy.deepcopy(SWEEP_BASE), "truth": {"spacecraft": {"inertia": MOMENTS}}}
+    with pytest.raises(ScenarioError, match="triangle inequality: moment 2 up to 6 exceeds .* 1 \\+ 3") as error:
+        study({PATH: {"scale": {"uniform": [[0.5, 1, 1], [1, 1, 1.5]]}}}, samples=1, base=base)
+    assert error.value.path == f"monte_carlo.dispersions.{PATH}.scale"
+    # one factor for the three keeps the moments' ratios: any positive bounds are physical
+    assert len(study({PATH: {"scale": {"uniform": [0.1, 3.0]}}}, samples=20, base=base).cases) == 20

@@ -33,17 +33,18 @@ def _significant_digits(text: str) -> int:
 # --- 1. a bad case's values ---------------------------------------------------------------------
 
 def test_a_bad_case_shows_each_varied_vector_whole_and_compact(tmp_path, capsys):
-    """The tester's study: the truth inertia scaled by uniform [-1, 1.1] (some cases negative), a
+    """The tester's study: the truth inertia scaled by a factor that some cases draw negative, a
     grid of slew angles and a dispersed initial error. Before the fix each value was its JSON text
     cut at 40 characters with no closing bracket (``inertia="[-10.43894936196218, -10.17128399370``),
-    so the next path read as part of the vector."""
+    so the next path read as part of the vector. (The tester's uniform [-1, 1.1] is now refused at
+    its entry; a normal factor has no bounds, so a case that draws it negative is refused by case.)"""
     (tmp_path / "eigenaxis_truth.yaml").write_text((REPOSITORY / "scenarios" / "eigenaxis_truth.yaml").read_text())
     study = tmp_path / "bad.yaml"
     study.write_text(yaml.safe_dump({
         "study": "bad-inertia", "scenario": "eigenaxis_truth.yaml",
         "grid": {"maneuver.final.q": {"axis_angle": {"axis": [0, 0, 1], "angle_deg": [30, 90]}}},
         "monte_carlo": {"samples": 5, "seed": 3, "dispersions": {
-            "truth.spacecraft.inertia": {"scale": {"uniform": [-1.0, 1.1]}},
+            "truth.spacecraft.inertia": {"scale": {"normal": {"mean": 0.0, "std": 1.0}}},
             "simulation.initial_attitude_error_deg": {"normal": {"mean": [0, 0, 0], "std": [1, 1, 1]}}}}},
         sort_keys=False))
     assert main(["validate", str(study)]) == 2

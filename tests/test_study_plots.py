@@ -23,7 +23,9 @@ from scenarios.study.plots import (
     PARETO_AXES,
     UNKNOWN_UNIT,
     figures,
+    metric_lines,
     parameter_quantity,
+    pareto_panels,
     write_plots,
 )
 from scenarios.study.spec import parse_study
@@ -146,8 +148,14 @@ def test_the_line_plots_mark_failed_points_and_take_a_log_axis_over_decades():
     marks = [line for line in panel.get_lines() if line.get_marker() == "x"]
     assert len(marks) == 1 and list(marks[0].get_xdata()) == [40.0]  # spin's failed case, at its duration
     assert "failed row (no value)" in [t.get_text() for t in figure.legends[0].get_texts()]
-    smooth = panel.get_lines()[0]  # median over the two sample times of a duration: k = 1, 2 | 3, 4 | 5, 6
-    np.testing.assert_allclose(smooth.get_ydata(), [1.5, 3.5, 5.5])
+    # one line per planner and sample time (never a median over the other grid parameter): smooth's k
+    # at sample time 0.5 s is 1, 3, 5 and at 1 s 2, 4, 6
+    smooth = [line for line in panel.get_lines() if line.get_color() == "C0" and line.get_marker() != "x"]
+    assert [list(line.get_ydata()) for line in smooth] == [[1.0, 3.0, 5.0], [2.0, 4.0, 6.0]]
+    assert smooth[0].get_linestyle() != smooth[1].get_linestyle()
+    assert {"simulation sample time 0.5 s", "simulation sample time 1 s"} <= {
+        t.get_text() for t in figure.legends[0].get_texts()}
+    assert not panel.collections  # one case per line and point: no band
 
 
 def test_each_grid_point_has_its_own_pareto_front():
@@ -163,6 +171,88 @@ def test_each_grid_point_has_its_own_pareto_front():
         expected = sorted(table[(point, label)] for label in ("smooth", "spin"))
         np.testing.assert_allclose(np.c_[front.get_xdata(), front.get_ydata()], expected)
         assert axis.get_xlabel() == "closed-loop ∫‖u‖ dt (N m s)" and axis.get_ylabel() == "closed-loop settling time (s)"
+
+
+def design_study():
+    """Grid: 2 durations x 2 gains (kp), 5 Monte Carlo samples each (a user's slew angle x kp study)."""
+    return study(grid={"maneuver.duration": [30.0, 40.0], "controller.options.kp": [0.1, 0.2]},
+                 monte_carlo={"samples": 5, "seed": 2, "dispersions": {
+                     "simulation.initial_attitude_error_deg": {"normal": {"mean": [0, 0, 0], "std": [1, 1, 1]}}}},
+                 summary=["cl.final_error_deg", "cl.settling_time_s", "cl.int_u"])
+
+
+def sample_of(parsed):
+    return {case.index: case.index % parsed.samples for case in parsed.cases}
+
+
+def test_the_pareto_front_runs_over_design_points_at_their_median_and_never_through_a_row_not_ok():
+    """A user saw each grid point's front drawn through single Monte Carlo samples of both planners,
+    with violated rows on it unmarked. Settling times by hand: smooth 10 + k, spin 4 + k for the
+    samples k = 0..4 (median: 12 and 6), ∫‖u‖ smooth 1 + 0.1 k, spin 3 + 0.1 k (median 1.2, 3.2).
+    At kp 0.2 and duration 40 s spin's sample 4 is violated: spin is then on no front, even though
+    its median dominates nothing less; at kp 0.1, duration 30 s, smooth's sample 0 (the fastest
+    single case of the panel, 0.5 s) is violated too."""
+    parsed = design_study()
+    sample = sample_of(parsed)
+
+    def values(case, label):
+        k = sample[case.index]
+        kp, duration = case.varied["controller.options.kp"], case.varied["maneuver.duration"]
+        settling, effort = (10.0 + k, 1.0 + 0.1 * k) if label == "smooth" else (4.0 + k, 3.0 + 0.1 * k)
+        status = "ok"
+        if label == "spin" and (kp, duration, k) == (0.2, 40.0, 4):
+            status = "violated"
+        if label == "smooth" and (kp, duration, k) == (0.1, 30.0, 0):
+            status, settling, effort = "violated", 0.5, 0.1  # dominates every other case of its panel
+        return status, {"cl.settling_time_s": settling, "cl.int_u": effort, "cl.final_error_deg": 0.01}
+
+    rows = rows_of(parsed, values)
+    panels = pareto_panels(parsed, rows)
+    assert [panel.point for panel in panels] == [
+        {"maneuver.duration": d, "controller.options.kp": kp} for d in (30.0, 40.0) for kp in (0.1, 0.2)]
+    for panel in panels:
+        by_label = {point.label: point for point in panel.points}
+        assert set(by_label) == {"smooth", "spin"} and all(point.rows == 5 for point in panel.points)
+        smooth, spin = by_label["smooth"], by_label["spin"]
+        assert (spin.x, spin.y) == pytest.approx((3.2, 6.0))
+        violated_smooth = panel.point == {"maneuver.duration": 30.0, "controller.options.kp": 0.1}
+        violated_spin = panel.point == {"maneuver.duration": 40.0, "controller.options.kp": 0.2}
+        # smooth's median over its samples: 0.5 takes sample 0's place at the low end, the median stays 12
+        assert (smooth.x, smooth.y) == pytest.approx((1.2, 12.0))
+        assert (smooth.not_ok, spin.not_ok) == (int(violated_smooth), int(violated_spin))
+        ok = [p for p in (smooth, spin) if not p.not_ok]
+        # neither planner dominates the other (smooth: less effort; spin: settles sooner): both on the front when ok
+        np.testing.assert_allclose(sorted(map(tuple, panel.front.tolist())), sorted((p.x, p.y) for p in ok))
+        assert [p.on_front for p in (smooth, spin)] == [not violated_smooth, not violated_spin]
+        # every point of the front is a design point's median, none a single sample
+        medians = {(round(p.x, 9), round(p.y, 9)) for p in panel.points}
+        assert all((round(x, 9), round(y, 9)) in medians for x, y in panel.front.tolist())
+        assert smooth.x_spread[0] <= smooth.x <= smooth.x_spread[1] and spin.y_spread[0] <= 6.0 <= spin.y_spread[1]
+    figure = built(parsed, rows)["pareto.png"]
+    legend = [t.get_text() for t in figure.legends[0].get_texts()]
+    assert "a row not ok (violated, failed): on no front" in legend
+
+
+def test_metric_lines_band_spans_one_design_points_samples_only():
+    """A user's 5-95 % band mixed the other design parameter (kp) with the plant's dispersion. Here
+    the final error is 10 j + k for kp number j (0, 1) and sample k (0..4): each line (planner, kp)
+    has the median 10 j + 2 and a band within [10 j, 10 j + 4]; mixed, the bands would span 0 to 14."""
+    parsed = design_study()
+    sample = sample_of(parsed)
+    rows = rows_of(parsed, lambda case, label: ("ok", {
+        "cl.final_error_deg": 10.0 * [0.1, 0.2].index(case.varied["controller.options.kp"]) + sample[case.index],
+        "cl.settling_time_s": 5.0, "cl.int_u": 1.0}))
+    lines = metric_lines(parsed, rows, "maneuver.duration", "cl.final_error_deg")
+    assert [(line.label, line.others) for line in lines] == [
+        (label, {"controller.options.kp": kp}) for label in ("smooth", "spin") for kp in (0.1, 0.2)]
+    for line in lines:
+        j = [0.1, 0.2].index(line.others["controller.options.kp"])
+        assert line.xs == [30.0, 40.0] and line.median == [10.0 * j + 2] * 2 and not line.failed
+        assert all(10.0 * j <= low < 10.0 * j + 2 < high <= 10.0 * j + 4 for low, high in zip(line.low, line.high))
+    figure = built(parsed, rows)["metrics_vs_maneuver.duration.png"]
+    (panel,) = [a for a in figure.axes if a.get_ylabel() == "closed-loop final error (deg)"]
+    bands = [collection.get_paths()[0].vertices[:, 1] for collection in panel.collections]
+    assert len(bands) == 4 and all(np.ptp(band) <= 4.0 for band in bands)
 
 
 def monte_carlo_study():
@@ -351,10 +441,12 @@ def test_cdfs_box_plots_scatter_and_pareto_count_the_cases_that_never_settled():
     assert marks == {colour[label]: found for label, found in unsettled.items()}
     assert "case never settled" in [t.get_text() for t in figure.legends[0].get_texts()]
 
+    # Pareto: each planner at its median over the samples; spin at 30 s has a median +inf (at the top
+    # edge, on no front), spin at 40 s a failed row (marked, on no front)
     pareto = made["pareto.png"]
     notes = {a.get_title(): [t.get_text() for t in a.texts] for a in pareto.axes if a.get_xlabel()}
-    assert notes == {"maneuver duration 30 s": ["never settled: smooth: 1, spin: 3"],
-                     "maneuver duration 40 s": ["no value: spin: 1"]}
+    assert notes == {"maneuver duration 30 s": ["spin: median never reached (did not settle)"],
+                     "maneuver duration 40 s": ["1/5 not ok"]}
 
 
 def test_a_heat_map_cell_whose_median_never_settled_is_hatched_and_counted():

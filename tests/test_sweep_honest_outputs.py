@@ -118,6 +118,47 @@ def test_ctrl_c_while_the_cases_are_checked_exits_130(tmp_path, monkeypatch, cap
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("where, phase", [("engine.start_forkserver", "while it started"),
+                                          ("command._output", "before its first case")])
+def test_ctrl_c_before_the_first_case_says_where_and_that_nothing_was_written(tmp_path, monkeypatch, capsys, where,
+                                                                              phase):
+    # Before: Ctrl-C between the check and the first case (the plots' import, the output directory's
+    # check) reached main's "results not written or marked incomplete in the output manifest".
+    import scenarios.cli.sweep as command
+    from scenarios.study import engine
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    owner, name = where.split(".")
+    monkeypatch.setattr({"engine": engine, "command": command}[owner], name, interrupted)
+    path = write(tmp_path, {"study": "phases", "grid": {"controller.options.kp": [0.2, 0.3]}})
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 130
+    assert capsys.readouterr().err == f"slewbench: sweep interrupted {phase}; nothing was run or written\n"
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_check_says_how_far_it_is_off_a_terminal_after_1_s_then_every_30_s(capsys):
+    import scenarios.cli.sweep as command
+
+    now = [100.0]
+    show = command._checking("big", clock=lambda: now[0])
+    for elapsed, checked in ((0.4, 10), (0.99, 30), (1.0, 31), (20.0, 500), (30.99, 800), (31.0, 801), (45.0, 900),
+                             (61.0, 1500), (62.5, 2000)):
+        now[0] = 100.0 + elapsed
+        show(checked, 2000)
+    assert capsys.readouterr().err.splitlines() == [
+        "big: checking 2000 cases, 31 checked, 1.0 s elapsed",
+        "big: checking 2000 cases, 801 checked, 31.0 s elapsed",
+        "big: checking 2000 cases, 1500 checked, 61.0 s elapsed",
+        "big: 2000 cases checked in 62.5 s"]
+    show = command._checking("small", clock=lambda: now[0])  # checked within 1 s: nothing said
+    now[0] += 0.9
+    show(5, 10)
+    show(10, 10)
+    assert capsys.readouterr().err == ""
+
+
 def test_ctrl_c_while_connecting_to_a_scheduler_exits_130(tmp_path, monkeypatch, capsys):
     # Before: the KeyboardInterrupt reached main's catch-all for a run and exited 1.
     from scenarios.study import engine

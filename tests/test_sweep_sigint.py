@@ -3,6 +3,7 @@ study's cases were checked, cut into a worker's start, and ignored by the C comp
 started."""
 import contextlib
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -105,6 +106,32 @@ def test_ctrl_c_lost_while_the_cases_are_checked_still_stops_the_sweep(tmp_path,
     assert process.returncode == 130, (stdout, stderr)
     assert stderr.strip() == "slewbench: sweep interrupted while its cases were checked; nothing was run or written"
     assert not (tmp_path / "out").exists()
+
+
+def test_a_long_check_shows_a_line_off_a_terminal_and_ctrl_c_there_says_nothing_was_written(tmp_path):
+    """A study that disperses the inertia is checked case by case, by the whole loader (a user's 180
+    cases: 17 s without a line on a redirected stderr, then "results not written or marked
+    incomplete", with nothing written). Here 4000 cases keep the check going for seconds; stderr is
+    a pipe, not a terminal; Ctrl-C comes once the check's first line is there. ``--dry-run``: a
+    check that never shows its line ends without running anything."""
+    study = tmp_path / "study.yaml"
+    study.write_text(yaml.safe_dump({"study": "checked", "scenario": BASE, "monte_carlo": {
+        "samples": 4000, "seed": 1, "dispersions": {"spacecraft.inertia": {"scale": {"uniform": [0.9, 1.1]}}}}}))
+    process = start(tmp_path, f"""
+        import sys
+        from scenarios.cli.commands import main
+        sys.exit(main(["sweep", "{study}", "--out", "out", "--workers", "1", "--no-plots", "--dry-run"]))
+        """)
+    with session_of(process):
+        line = process.stderr.readline()  # blocks until the line (or the end: no line was shown)
+        os.killpg(process.pid, signal.SIGINT)  # what Ctrl-C does
+        stdout, stderr = process.communicate(timeout=60)
+    assert re.fullmatch(r"study: checking 4000 cases, \d+ checked, \d+\.\d s elapsed\n", line), (line, stderr)
+    checked, elapsed = int(line.split(", ")[1].split()[0]), float(line.split(", ")[2].split()[0])
+    assert 0 < checked < 4000 and 1.0 <= elapsed < 30.0, line  # the first line after 1 s of checking
+    assert process.returncode == 130, (stdout, stderr)
+    assert stderr.strip() == "slewbench: sweep interrupted while its cases were checked; nothing was run or written"
+    assert stdout == "" and not (tmp_path / "out").exists()
 
 
 def test_ctrl_c_while_a_worker_starts_stops_it_silently(tmp_path):

@@ -171,18 +171,32 @@ def _say_removed(out: Path, earlier: set[str]) -> None:
               + ", ".join(removed))
 
 
-def _checking(name: str) -> Any:
-    """A progress callback for the cases' checks: a bar on a terminal, else a line when a large
-    study starts being checked and one when it is done."""
-    started = time.perf_counter()
+CHECKING_LINE_S = 1.0
+"""Off a terminal, how long the cases' check runs before its first progress line [s]: a study checked
+faster says nothing."""
+
+
+def _checking(name: str, clock: Any = time.monotonic) -> Any:
+    """A progress callback for the cases' checks (``progress(checked, total)`` of
+    :func:`scenarios.study.spec.parse_study`): a bar on a terminal; elsewhere a line
+    (``NAME: checking 180 cases, 40 checked, 1.0 s elapsed``) once the check has taken
+    :data:`CHECKING_LINE_S`, then at most every
+    :data:`~scenarios.study.engine.PROGRESS_LINE_S`, and one when it is done if any was said."""
+    from scenarios.study.engine import PROGRESS_LINE_S
+
+    started = clock()
+    terminal = sys.stderr.isatty()
     state: dict[str, Any] = {}
 
     def show(checked: int, total: int) -> None:
-        if not sys.stderr.isatty():
-            if checked < total and not state:
-                state["said"] = print(f"{name}: checking {total} cases ...", file=sys.stderr, flush=True)
-            elif checked >= total and state:
-                print(f"{name}: {total} cases checked in {time.perf_counter() - started:.1f} s", file=sys.stderr,
+        if not terminal:
+            elapsed = clock() - started
+            if checked >= total:
+                if "said" in state:
+                    print(f"{name}: {total} cases checked in {elapsed:.1f} s", file=sys.stderr, flush=True)
+            elif elapsed - state.get("said", CHECKING_LINE_S - PROGRESS_LINE_S) >= PROGRESS_LINE_S:
+                state["said"] = elapsed
+                print(f"{name}: checking {total} cases, {checked} checked, {elapsed:.1f} s elapsed", file=sys.stderr,
                       flush=True)
             return
         if "bar" not in state:
@@ -310,36 +324,36 @@ def command_sweep(args: argparse.Namespace) -> int:
         raise ScenarioError("", "give a study file, or --report DIR")
     if args.workers is not None and not 1 <= args.workers <= 1024:
         raise ScenarioError("--workers", f"expected 1 to 1024, got {args.workers}")
-    scheduler = args.scheduler
-    if not scheduler:
-        start_forkserver()  # local workers' imports run while the study is expanded and checked
-    name = Path(args.file).stem
+    # Ctrl-C (or SIGTERM) before the first case: nothing is run or written, and the message says so
+    # and where the sweep was (also when CasADi turned the KeyboardInterrupt into another error)
+    phase = "while it started"
     try:
         try:
-            study = load_study(args.file, progress=_checking(name))
+            scheduler = args.scheduler
+            if not scheduler:
+                start_forkserver()  # local workers' imports run while the study is expanded and checked
+            phase = "while its cases were checked"
+            study = load_study(args.file, progress=_checking(Path(args.file).stem))
+            _check_interrupted(args)  # one that CasADi swallowed
+            phase = "before its first case"
+            if args.dry_run:
+                if args.resume:  # what the real resume would refuse, it refuses (nothing is written either way)
+                    _output(args, study)
+                _list_cases(study, args.workers or study.execution.workers or _local_workers())
+                return EXIT_OK
+            where = "--scheduler" if scheduler else "execution.scheduler"
+            scheduler = scheduler or study.execution.scheduler
+            if not args.no_plots:
+                import scenarios.study.plots  # noqa: F401  (fail now, not after the cases ran)
+            out = _output(args, study)
+            if scheduler:
+                phase = f"while it connected to the Dask scheduler {scheduler}"
+            cluster: DaskCluster | None = connect_scheduler(scheduler, where) if scheduler else None
         except Exception:
-            _check_interrupted(args)  # a Ctrl-C that CasADi turned into an error while a case was checked
+            _check_interrupted(args)  # a Ctrl-C that CasADi turned into an error
             raise
-        _check_interrupted(args)  # one that CasADi swallowed
-    except KeyboardInterrupt:  # an interrupted sweep exits 130, in its checking phase too
-        print("slewbench: sweep interrupted while its cases were checked; nothing was run or written",
-              file=sys.stderr)
-        return EXIT_INTERRUPTED
-    if args.dry_run:
-        if args.resume:  # what the real resume would refuse, it refuses (nothing is written either way)
-            _output(args, study)
-        _list_cases(study, args.workers or study.execution.workers or _local_workers())
-        return EXIT_OK
-    where = "--scheduler" if scheduler else "execution.scheduler"
-    scheduler = scheduler or study.execution.scheduler
-    if not args.no_plots:
-        import scenarios.study.plots  # noqa: F401  (fail now, not after the cases ran)
-    out = _output(args, study)
-    try:
-        cluster: DaskCluster | None = connect_scheduler(scheduler, where) if scheduler else None
-    except KeyboardInterrupt:  # an interrupted sweep exits 130, while it connects too
-        print(f"slewbench: sweep interrupted while it connected to the Dask scheduler {scheduler}; nothing was run "
-              "or written", file=sys.stderr)
+    except KeyboardInterrupt:  # an interrupted sweep exits 130, before its cases too
+        print(f"slewbench: sweep interrupted {phase}; nothing was run or written", file=sys.stderr)
         return EXIT_INTERRUPTED
     try:
         return _run(args, study, out, cluster)

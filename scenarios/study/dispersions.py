@@ -361,6 +361,31 @@ def _distribution(node: Node, symmetric: bool) -> Draw:
     return draw
 
 
+def _check_moment_factors(node: Node, draw: Draw, moments: np.ndarray | None) -> None:
+    """Refuse a uniform draw of factors on an inertia tensor's moments that can reach a tensor that is
+    not physical: a factor of 0 or less (not positive definite) or, given the principal ``moments``
+    the factors multiply one by one, moments that break the triangle inequality. A normal draw has
+    no bounds: a case that draws such a factor is refused at that case."""
+    if draw.kind != "uniform":
+        return
+    factors_low, factors_high = np.asarray(draw.a, dtype=float), np.asarray(draw.b, dtype=float)
+    if draw.shape == (3, 3):  # element by element: the diagonal's factors must stay > 0
+        factors_low, factors_high = np.diag(factors_low.reshape(3, 3)), np.diag(factors_high.reshape(3, 3))
+    if np.any(~(factors_low > 0)):
+        raise node.error(f"a factor on an inertia tensor's moments (its diagonal) must be > 0 (a positive definite "
+                         f"tensor), got a low bound of {float(np.min(factors_low)):g} in {excerpt(node.value)}; "
+                         f"expected uniform bounds > 0")
+    if moments is None or draw.shape == ():  # one factor for all: the moments keep their ratios
+        return
+    low, high = np.broadcast_to(factors_low, (3,)) * moments, np.broadcast_to(factors_high, (3,)) * moments
+    for k in range(3):  # the worst draw: the other two at their low bounds, this one at its high
+        if low[(k + 1) % 3] + low[(k + 2) % 3] < high[k] * (1 - 1e-12):
+            raise node.error(
+                f"these factors can draw principal moments that violate the triangle inequality: moment {k} "
+                f"up to {high[k]:.6g} exceeds the other two at their lowest, {low[(k + 1) % 3]:.6g} + "
+                f"{low[(k + 2) % 3]:.6g}; narrow the bounds")
+
+
 def _principal(node: Node, base_value: Any, steps: list[Step]) -> Dispersion:
     """The ``principal`` dispersion at ``node`` (the mapping under ``principal``)."""
     if not symmetric_key(steps):
@@ -383,17 +408,8 @@ def _principal(node: Node, base_value: Any, steps: list[Step]) -> Dispersion:
         raise node.error("give moments_scale, axes_deg or both")
     moments, _ = principal_frame(base_value)
     scale = draws.get("moments_scale")
-    if scale is not None and scale.kind == "uniform":
-        low, high = np.broadcast_to(scale.a, (3,)) * moments, np.broadcast_to(scale.b, (3,)) * moments
-        if np.any(low <= 0):
-            raise values["moments_scale"].error(f"a moment factor must be > 0 (a positive definite tensor), got a low "
-                                                f"bound of {float(np.min(scale.a)):g}")
-        for k in range(3):  # the worst draw: the other two at their low bounds, this one at its high
-            if low[(k + 1) % 3] + low[(k + 2) % 3] < high[k] * (1 - 1e-12):
-                raise values["moments_scale"].error(
-                    f"these factors can draw principal moments that violate the triangle inequality: moment {k} "
-                    f"up to {high[k]:.6g} exceeds the other two at their lowest, {low[(k + 1) % 3]:.6g} + "
-                    f"{low[(k + 2) % 3]:.6g}; narrow the bounds")
+    if scale is not None:
+        _check_moment_factors(values["moments_scale"], scale, moments)
     axes = draws.get("axes_deg")
     if axes is not None and axes.kind == "uniform":
         largest = max(float(np.linalg.norm(np.where(corner, axes.b, axes.a)))
@@ -464,6 +480,8 @@ def parse_dispersion(node: Node, base: dict[str, Any], steps: list[Step]) -> Dis
             raise node.error(f"{combine} by a list of 3 numbers would act on the tensor's columns and break its "
                              f"symmetry; give a number (the whole tensor), a symmetric 3x3 matrix (element by element) "
                              f"or {{{PRINCIPAL_NAME}: ...}} (principal moments and axes)")
+        if symmetric and combine == "scale":
+            _check_moment_factors(node, draw, array if array.shape == (3,) else None)
     return Dispersion(draw.kind, combine, {"": draw})
 
 

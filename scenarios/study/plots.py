@@ -4,6 +4,12 @@ parameter (one line per planner, median with the 5-95 % band under Monte Carlo),
 against each dispersed parameter across Monte Carlo samples with the heat map of their rank
 correlations (:mod:`scenarios.study.robustness`), and the Pareto front of each grid point.
 
+A band or an error bar spans the Monte Carlo samples of one design point (a planner at one grid
+point), never several design points: ``metrics_vs_<path>`` draws one line per planner and
+combination of the other grid parameters (:func:`metric_lines`); a Pareto panel's points are the
+planners, each at the median of its samples with 5-95 % error bars, and its front runs over the
+points whose every row is ``ok`` only (:func:`pareto_panels`).
+
 Every axis names its quantity in words with its unit: a metric or requirement column by
 :func:`scenarios.output.plot_data.column_quantity`, a varied scenario path by
 :func:`parameter_quantity` (the schema's unit of the key; the angle in degrees for a grid of
@@ -24,6 +30,7 @@ import math
 import re
 import textwrap
 from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -44,11 +51,16 @@ from scenarios.study.paths import Step, get_path, parse_path
 from scenarios.study.report import COUNTED_STATUSES, counted, metric_values, percentile
 from scenarios.study.types import Study
 
-__all__ = ["DECADES", "INFINITE_WORDS", "PARETO_AXES", "PLOTTED_STATUSES", "RECORDED", "figures", "parameter_quantity",
-           "pareto_front", "spans_decades", "write_plots"]
+__all__ = ["DECADES", "INFINITE_WORDS", "PARETO_AXES", "PARETO_SPREAD", "PARETO_STATISTIC", "PLOTTED_STATUSES", "RECORDED",
+           "DesignPoint", "MetricLine", "ParetoPanel", "figures", "metric_lines", "parameter_quantity", "pareto_front",
+           "pareto_panels", "spans_decades", "write_plots"]
 
 PARETO_AXES = ("cl.int_u", "cl.settling_time_s")
 """The two metrics of the Pareto fronts (both to be minimised)."""
+PARETO_STATISTIC = 50.0
+"""The percentile of its Monte Carlo samples that places a design point on a Pareto panel (the median)."""
+PARETO_SPREAD = (5.0, 95.0)
+"""The percentiles of its Monte Carlo samples that a design point's error bars span."""
 PLOTTED_STATUSES = COUNTED_STATUSES
 """Statuses of the rows whose metrics are drawn: the motion completed (a broken requirement is a result
 and its metrics stand); ``failed``, ``infeasible`` and ``crashed`` rows are marked instead. The
@@ -292,6 +304,169 @@ def _point_text(study: Study, point: dict[str, Any]) -> str:
     return ", ".join(parts)
 
 
+# --- plot data --------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class MetricLine:
+    """One line of ``metrics_vs_<path>.png``: a planner at one combination of the other grid
+    parameters, against the values of ``path``.
+
+    Parameters
+    ----------
+    label : str
+        The planner row's label.
+    others : dict
+        The other grid paths' values, fixed along the line (empty for a one-path grid).
+    xs : list of float
+        The values of the plotted path, increasing.
+    median, low, high : list of float
+        Per x, the median and the 5 and 95 % percentiles of the metric over the Monte Carlo
+        samples there (the summary's statistics; +inf where cases never settled, NaN without a
+        value); ``low`` and ``high`` equal the median with one sample.
+    failed : list of float
+        The xs where a row failed (no value).
+    """
+
+    label: str
+    others: dict[str, Any]
+    xs: list[float]
+    median: list[float]
+    low: list[float]
+    high: list[float]
+    failed: list[float]
+
+
+def metric_lines(study: Study, rows: list[dict[str, Any]], path: str, metric: str) -> list[MetricLine]:
+    """The lines of ``metric`` against the numeric grid path ``path``: one per planner and
+    combination of the other grid paths' values, each x summarised over its Monte Carlo samples
+    only (a band never mixes design parameters with the dispersion).
+
+    Parameters
+    ----------
+    study : Study
+        The study (its grid paths).
+    rows : list of dict
+        The ``cases.csv`` rows.
+    path : str
+        A grid path whose values are numbers.
+    metric : str
+        A summary metric column.
+
+    Returns
+    -------
+    list of MetricLine
+        By planner, then by the other paths' values in the order the rows have them.
+    """
+    others = [other for other in study.grid_paths if other != path]
+    xs = sorted({row[path] for row in rows if isinstance(row.get(path), (int, float))})
+    groups: dict[tuple[str, str], list[dict[str, Any]]] = {}
+    for row in rows:
+        groups.setdefault((row["label"], json.dumps([row.get(other) for other in others])), []).append(row)
+    lines = []
+    for label in _labels(rows):
+        for (mine, key), members in groups.items():
+            if mine != label:
+                continue
+            values = [_values(metric, [r for r in members if r.get(path) == x]) for x in xs]
+            lines.append(MetricLine(
+                label, dict(zip(others, json.loads(key))), list(xs), [_statistic(v, 50.0) for v in values],
+                [_statistic(v, 5.0) for v in values], [_statistic(v, 95.0) for v in values],
+                [x for x in xs if any(_failed(r) for r in members if r.get(path) == x)]))
+    return lines
+
+
+@dataclass(frozen=True)
+class DesignPoint:
+    """One planner at one grid point of a Pareto panel, summarised over its Monte Carlo samples.
+
+    Parameters
+    ----------
+    label : str
+        The planner row's label.
+    x, y : float
+        The :data:`PARETO_STATISTIC` percentile (the median) of :data:`PARETO_AXES` over the
+        samples with a value (y +inf when most never settled; NaN when none has a value).
+    x_spread, y_spread : tuple of float
+        The :data:`PARETO_SPREAD` percentiles (the error bars).
+    rows : int
+        The samples (rows) of the design point.
+    not_ok : int
+        How many of them are not ``ok`` (``violated``, ``failed``, ...): with any, the point is
+        marked and on no front.
+    on_front : bool
+        Whether the point is on its panel's front.
+    """
+
+    label: str
+    x: float
+    y: float
+    x_spread: tuple[float, float]
+    y_spread: tuple[float, float]
+    rows: int
+    not_ok: int
+    on_front: bool
+
+
+@dataclass(frozen=True)
+class ParetoPanel:
+    """One panel of ``pareto.png``: a grid point's design points and their front.
+
+    Parameters
+    ----------
+    point : dict
+        The grid paths' values (empty without a grid).
+    points : list of DesignPoint
+        One per planner, in the rows' order.
+    front : (M, 2) ndarray
+        The front (:func:`pareto_front`) of the points whose rows are all ``ok``, by increasing x.
+    """
+
+    point: dict[str, Any]
+    points: list[DesignPoint]
+    front: np.ndarray
+
+
+def pareto_panels(study: Study, rows: list[dict[str, Any]]) -> list[ParetoPanel]:
+    """The Pareto panels: per grid point, each planner is one design point at the median of its
+    Monte Carlo samples; the front runs over the design points whose every row is ``ok``.
+
+    Parameters
+    ----------
+    study : Study
+        The study (its grid paths).
+    rows : list of dict
+        The ``cases.csv`` rows.
+
+    Returns
+    -------
+    list of ParetoPanel
+        In grid order, the grid points with some design point that has a value.
+    """
+    x_key, y_key = PARETO_AXES
+    by_point: dict[str, list[dict[str, Any]]] = {}
+    for row in rows:
+        by_point.setdefault(json.dumps([row.get(p) for p in study.grid_paths]), []).append(row)
+    panels = []
+    for key, members in by_point.items():
+        points = []
+        for label in _labels(members):
+            mine = [r for r in members if r["label"] == label]
+            xs, ys = _values(x_key, mine), _values(y_key, mine)
+            points.append(DesignPoint(
+                label, _statistic(xs, PARETO_STATISTIC), _statistic(ys, PARETO_STATISTIC),
+                (_statistic(xs, PARETO_SPREAD[0]), _statistic(xs, PARETO_SPREAD[1])),
+                (_statistic(ys, PARETO_SPREAD[0]), _statistic(ys, PARETO_SPREAD[1])),
+                len(mine), sum(r.get("status") != "ok" for r in mine), False))
+        if not any(math.isfinite(p.x) and not math.isnan(p.y) for p in points):
+            continue
+        eligible = np.array([(p.x, p.y) for p in points if not p.not_ok]).reshape(-1, 2)
+        front = pareto_front(eligible)
+        points = [DesignPoint(**{**p.__dict__, "on_front": not p.not_ok and bool(
+            np.any(np.all(front == (p.x, p.y), axis=1)))}) for p in points]
+        panels.append(ParetoPanel(dict(zip(study.grid_paths, json.loads(key))), points, front))
+    return panels
+
+
 # --- figures ----------------------------------------------------------------------------------------
 
 def _grid(count: int, width: float = 5.0, height: float = 3.8) -> tuple[Figure, list[Any]]:
@@ -363,50 +538,61 @@ def _legend(figure: Figure, colors: dict[str, Any], failed: bool, extra: list[An
     figure.legend(handles=handles, loc="outside right upper", fontsize=8)
 
 
+LINE_STYLES: tuple[Any, ...] = ("-", "--", ":", "-.")
+LINE_MARKERS: tuple[Any, ...] = ("o", "s", "^", "D", "v", "P")
+"""How the lines of ``metrics_vs_<path>`` tell the other grid parameters' values apart (a planner by its colour)."""
+
+
 def _lines(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figure]]:
     metrics = _with_values(study, rows)
     axes_1d = _numeric_axes(study, rows)
     if not metrics:
         return
-    spread = study.samples > 1 or len(study.grid_paths) > 1
+    spread = study.samples > 1
     labels = _labels(rows)
     colors = _colors(labels)
     for (path, xs), stem in zip(axes_1d, row_stems([path for path, _ in axes_1d])):
         figure, axes = _grid(len(metrics))
         any_failed = False
         never: list[str] = []
+        combinations: dict[str, int] = {}  # the other grid paths' values -> their style
         for axis, metric in zip(axes, metrics):
             drawn: list[float] = []
             bands = []
-            for label in labels:
-                groups = [[r for r in rows if r["label"] == label and r[path] == x] for x in xs]
-                values = [_values(metric, group) for group in groups]
-                median = [_statistic(v, 50.0) for v in values]
-                axis.plot(xs, median, "o-", color=colors[label], ms=4)  # +inf: no point, a mark at the top
-                drawn += median
-                unsettled = [x for x, value in zip(xs, median) if value == math.inf]
-                _mark_never(axis, unsettled, colors[label])
+            for line in metric_lines(study, rows, path, metric):
+                text = _point_text(study, line.others)
+                style = combinations.setdefault(text, len(combinations))
+                axis.plot(line.xs, line.median, color=colors[line.label], ms=4,  # +inf: no point, a mark at the top
+                          linestyle=LINE_STYLES[style % len(LINE_STYLES)],
+                          marker=LINE_MARKERS[style % len(LINE_MARKERS)])
+                drawn += line.median
+                unsettled = [x for x, value in zip(line.xs, line.median) if value == math.inf]
+                _mark_never(axis, unsettled, colors[line.label])
                 if unsettled:
                     never.append(_infinite_words(metric)[1])
                 if spread:
-                    low, high = [_statistic(v, 5.0) for v in values], [_statistic(v, 95.0) for v in values]
-                    bands.append((colors[label], low, high))
-                    drawn += low + high
-                failed = [x for x, group in zip(xs, groups) if any(_failed(r) for r in group)]
-                _mark_failed(axis, failed, colors[label])
-                any_failed |= bool(failed)
+                    bands.append((colors[line.label], line.xs, line.low, line.high))
+                    drawn += line.low + line.high
+                _mark_failed(axis, line.failed, colors[line.label])
+                any_failed |= bool(line.failed)
             _scale(axis, "x", xs)
             _scale(axis, "y", drawn)
             top = _top_edge(axis, drawn) if math.inf in drawn else math.inf
-            for color, low, high in bands:  # a percentile at +inf: the band reaches the top edge
-                axis.fill_between(xs, np.minimum(low, top), np.minimum(high, top), color=color, alpha=0.15, lw=0)
+            for color, line_xs, low, high in bands:  # a percentile at +inf: the band reaches the top edge
+                axis.fill_between(line_xs, np.minimum(low, top), np.minimum(high, top), color=color, alpha=0.12,
+                                  lw=0)
             axis.set_xlabel(axis_label(*parameter_quantity(study, path)))
             axis.set_ylabel(_metric_label(metric))
             axis.grid(alpha=0.3)
-        _legend(figure, colors, any_failed, never=never)
+        styles = [Line2D([], [], color="0.3", linestyle=LINE_STYLES[k % len(LINE_STYLES)],
+                         marker=LINE_MARKERS[k % len(LINE_MARKERS)], label=text)
+                  for text, k in combinations.items() if text]
+        _legend(figure, colors, any_failed, styles, never=never)
         infinite = "; a case that never settled counts as +inf: ▲ and a band at the top edge" if never else ""
-        _title(figure, f"{study.name}: median over the other parameters and samples (band 5-95 %{infinite})"
-               if spread else study.name)
+        each = "one line per planner and value of the other grid parameters" if len(study.grid_paths) > 1 else ""
+        _title(figure, f"{study.name}: median over the Monte Carlo samples (band 5-95 % of the samples"
+                       f"{infinite}){'; ' + each if each else ''}" if spread else
+               f"{study.name}{': ' + each if each else ''}")
         yield f"metrics_vs_{stem}.png", figure
 
 
@@ -716,55 +902,66 @@ def pareto_front(points: np.ndarray) -> np.ndarray:
     return np.array(front).reshape(-1, 2)
 
 
+NOT_OK_MARK: dict[str, Any] = {"marker": "o", "mfc": "white", "ms": 7, "mew": 1.6, "linestyle": "none"}
+"""How a design point with a row not ok is drawn on a Pareto panel (hollow, in the planner's colour)."""
+
+
 def _pareto(study: Study, rows: list[dict[str, Any]]) -> Iterator[tuple[str, Figure]]:
     x_key, y_key = PARETO_AXES
     labels = _labels(rows)
     colors = _colors(labels)
-    points: dict[str, list[dict[str, Any]]] = {}
-    for row in rows:
-        points.setdefault(json.dumps([row.get(p) for p in study.grid_paths]), []).append(row)
-    drawn = {key: np.c_[_values(x_key, members), _values(y_key, members)] for key, members in points.items()}
-    usable = [(key, members) for key, members in points.items()  # a finite point, or one at the top edge
-              if (np.isfinite(drawn[key][:, 0]) & ~np.isnan(drawn[key][:, 1])).any()]
-    if not usable:
+    panels = pareto_panels(study, rows)
+    if not panels:
         return
-    shown = usable[:MAX_PARETO_PANELS]
+    shown = panels[:MAX_PARETO_PANELS]
     figure, axes = _grid(len(shown), 4.6, 3.6)
-    words = _infinite_words(y_key)[0]
-    any_never = False
-    for axis, (key, members) in zip(axes, shown):
-        notes: dict[str, list[str]] = {"no value": [], words: []}
-        for label in labels:
-            mine = drawn[key][np.array([r["label"] == label for r in members])]
-            axis.plot(mine[:, 0], mine[:, 1], "o", color=colors[label], ms=5 if study.samples == 1 else 3,
-                      alpha=1.0 if study.samples == 1 else 0.5)
-            unsettled = np.isfinite(mine[:, 0]) & np.isinf(mine[:, 1])  # +inf settling time: at the top edge
-            _mark_never(axis, list(mine[unsettled, 0]), colors[label])
-            any_never |= bool(unsettled.any())
-            for text, count in (("no value", int(np.sum(~np.isfinite(mine).all(axis=1) & ~unsettled))),
-                                (words, int(unsettled.sum()))):
-                if count:
-                    notes[text].append(f"{label}: {count}" if study.samples > 1 else label)
-        lines = [f"{text}: " + ", ".join(found) for text, found in notes.items() if found]
-        if lines:  # a row that failed (no point), or one that never settled (at the top edge, on no front)
-            axis.text(0.98, 0.02, "\n".join(lines), transform=axis.transAxes, ha="right", va="bottom", fontsize=7,
-                      color="0.3")
-        every = drawn[key]
-        front = pareto_front(every)
-        axis.step(front[:, 0], front[:, 1], where="post", color="k", lw=1.2)
-        axis.plot(front[:, 0], front[:, 1], "o", mfc="none", mec="k", ms=9)
+    words = _infinite_words(y_key)[1]
+    any_never = any_not_ok = False
+    samples = study.samples > 1
+    for axis, panel in zip(axes, shown):
+        notes: list[str] = []
+        drawn = [point for point in panel.points if not (math.isnan(point.x) or math.isnan(point.y))]
+        notes += [f"{point.label}: no value" for point in panel.points if point not in drawn]
+        every = np.array([(x, y) for p in drawn for x, y in ((p.x, p.y), (p.x_spread[0], p.y_spread[0]),
+                                                              (p.x_spread[1], p.y_spread[1]))]).reshape(-1, 2)
         _scale(axis, "x", every[:, 0])
         _scale(axis, "y", every[:, 1])
+        top = _top_edge(axis, every[:, 1]) if np.isinf(every[:, 1]).any() else math.inf
+        for point in drawn:
+            color = colors[point.label]
+            if point.y == math.inf:  # the median never settled: at the top edge, on no front
+                _mark_never(axis, [point.x], color)
+                any_never = True
+                notes.append(f"{point.label}: {words}")
+                continue
+            style = NOT_OK_MARK if point.not_ok else {"marker": "o", "ms": 6, "linestyle": "none"}
+            spread = ({"xerr": [[point.x - point.x_spread[0]], [point.x_spread[1] - point.x]],
+                       "yerr": [[point.y - point.y_spread[0]], [min(point.y_spread[1], top) - point.y]]}
+                      if samples else {})
+            axis.errorbar([point.x], [point.y], color=color, elinewidth=0.8, capsize=2, **spread, **style)
+            if point.not_ok:
+                any_not_ok = True
+                axis.annotate(f"{point.not_ok}/{point.rows} not ok", (point.x, point.y), textcoords="offset points",
+                              xytext=(5, 4), fontsize=7, color="tab:red")
+        if notes:
+            axis.text(0.98, 0.02, "\n".join(notes), transform=axis.transAxes, ha="right", va="bottom", fontsize=7,
+                      color="0.3")
+        if len(panel.front):
+            axis.step(panel.front[:, 0], panel.front[:, 1], where="post", color="k", lw=1.2)
+            axis.plot(panel.front[:, 0], panel.front[:, 1], "o", mfc="none", mec="k", ms=11)
         axis.set_xlabel(_metric_label(x_key))
         axis.set_ylabel(_metric_label(y_key))
         if study.grid_paths:
-            axis.set_title(_point_text(study, dict(zip(study.grid_paths, json.loads(key)))), fontsize=8)
+            axis.set_title(_point_text(study, panel.point), fontsize=8)
         axis.grid(alpha=0.3)
-    front_handle = Line2D([], [], color="k", marker="o", mfc="none", ms=9, label="Pareto front")
-    _legend(figure, colors, False, [front_handle], style="o", never=[f"case {words} (on no front)"] if any_never else [])
-    more = f" (the first {len(shown)} of {len(usable)} grid points)" if len(shown) < len(usable) else ""
-    _title(figure, f"{study.name}: every case and the Pareto front "
-           + ("of each grid point, all planners together" if study.grid_paths else "of all planners together") + more)
+    extra = [Line2D([], [], color="k", marker="o", mfc="none", ms=11, label="Pareto front (design points all ok)")]
+    if any_not_ok:
+        extra.append(Line2D([], [], color="0.3", label="a row not ok (violated, failed): on no front", **NOT_OK_MARK))
+    _legend(figure, colors, False, extra, style="o", never=[f"{words} (on no front)"] if any_never else [])
+    more = f" (the first {len(shown)} of {len(panels)} grid points)" if len(shown) < len(panels) else ""
+    each = f"planners at the median of {study.samples} samples (bars 5-95 %)" if samples else "planners"
+    _title(figure, f"{study.name}: {each}, front over those with every row ok"
+           + (" per grid point" if study.grid_paths else "") + more)
     yield "pareto.png", figure
 
 

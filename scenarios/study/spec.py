@@ -24,6 +24,7 @@ import json
 import math
 import os
 import shlex
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -62,7 +63,10 @@ from scenarios.study.types import (
 )
 
 PROGRESS_EVERY = 2048
-"""Cases checked between two calls of the ``progress`` callback of :func:`parse_study`."""
+"""Most cases checked between two calls of the ``progress`` callback of :func:`parse_study`."""
+PROGRESS_S = 0.25
+"""Longest time between two calls of the ``progress`` callback of :func:`parse_study` while cases are
+checked (a case checked by the whole loader can take tens of milliseconds) [s]."""
 
 
 @dataclass
@@ -297,7 +301,8 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
         report is redrawn).
     progress : callable or None, optional
         ``progress(checked, total)``, called while the cases are checked (every
-        :data:`PROGRESS_EVERY` cases and at the end).
+        :data:`PROGRESS_EVERY` cases, after the case that ends :data:`PROGRESS_S` since the
+        last call, and at the end).
 
     Returns
     -------
@@ -493,6 +498,7 @@ class _Expansion:
         template = _KeyTemplate.make(study.base, [item for axis in self.axes for item in axis.varied]
                                      + [item for item, _ in self.dispersions], self.version)
         cases = []
+        called = time.monotonic()
         for point in range(self.points):
             positions, rest = [], point
             for length in reversed(radix):  # the last axis varies fastest
@@ -525,8 +531,10 @@ class _Expansion:
                 case.key = case_key(case.scenario, self.version) if template is None else \
                     template.key([value for _, value, _ in case_updates])
                 cases.append(case)
-                if self.progress is not None and (index + 1) % PROGRESS_EVERY == 0:
+                if self.progress is not None and index + 1 < n and (
+                        (index + 1) % PROGRESS_EVERY == 0 or time.monotonic() - called >= PROGRESS_S):
                     self.progress(index + 1, n)
+                    called = time.monotonic()
         if self.progress is not None:
             self.progress(n, n)
         return cases
