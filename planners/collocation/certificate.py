@@ -23,7 +23,13 @@ method stops where the miss and the stationarity at the point it returns are bel
 of the same switches flown exactly (Richardson's extrapolation: within 2e-9 s of DOP853's on
 Bilimoria & Wie, the full inertia and XTE, whose RK4 optimum is 1.6e-6 s below); where that step
 moves ``T`` by more than :data:`SHOOTING_RICHARDSON` of it, the steps per arc are doubled and the
-shooting goes on from there. A σ exactly 0 at a Radau point between a positive and a negative
+shooting goes on from there. With more switches than final conditions, where ``T`` is flat to
+second order along the feasible switch times and the stationarity carries the RK4 Jacobian's own
+error, the shooting converges again with twice the steps and the whole point is extrapolated
+(``z_2S + (z_2S − z_S)/15``, from a pair whose fewer steps' correction of ``T`` is within
+:data:`SHOOTING_RICHARDSON`): a reviewer's six-switch slews had kept switches 2e-7 of ``T`` off with
+the miss's error taken off alone; now within 7e-10 of ``T`` of their DOP853 optimum
+(``tests/test_bang_bang_six_switches.py``). A σ exactly 0 at a Radau point between a positive and a negative
 value is one root. Its ``T`` is that of a trajectory of the continuous problem, so it bounds the
 continuous minimum time from above, and, the optimum being stationary on the feasible switch
 times, it is within the square of the collocation's switch-time error of it: ``T_N`` minus it is
@@ -520,6 +526,8 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
     ties: dict[tuple[int, int], float] = {}
     miss = np.inf
     steps, iteration, at_steps = SHOOTING_STEPS, 0, 0
+    # the converged point before the steps doubled: z, its switches, its steps, its correction asymptotic
+    coarser: tuple[Array, list[int], int, bool] | None = None
     while at_steps < SHOOTING_ITERATIONS:
         iteration, at_steps = iteration + 1, at_steps + 1
         # a switch that Newton's step moved out of the slew is none (a σ root by a node, an arc the
@@ -567,7 +575,22 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
             # miss by step doubling, and the Newton step to the same switches flown exactly
             error = _rk4_error(model, x0, z, U, disturbance, xf, fixed_rate, steps, r)
             exact = z + _newton_step(matrix, rhs, arcs if arcs > conditions else 0, error)
-            if abs(exact[-1] - z[-1]) > SHOOTING_RICHARDSON * z[-1] and steps < SHOOTING_MAX_STEPS:
+            if arcs > conditions and steps < SHOOTING_MAX_STEPS:
+                # More switches than conditions: the stationarity rows carry the RK4 Jacobian's own
+                # error, along the feasible curve where T is flat (a reviewer's 6-switch slews kept
+                # switches 2e-7 of T off with the miss's error taken off alone). Converged again with
+                # twice the steps, the whole point is extrapolated (Richardson, h⁴: 1/15 of the change),
+                # and again with twice those while that moves T by more than SHOOTING_RICHARDSON.
+                # (from a pair of step counts where the fewer's own correction of T, by the miss's
+                # error, is within SHOOTING_RICHARDSON: RK4's asymptotic error)
+                asymptotic = abs(exact[-1] - z[-1]) <= SHOOTING_RICHARDSON * z[-1]
+                if not (coarser is not None and coarser[3] and coarser[1] == [int(i) for i in ident]
+                        and steps == 2 * coarser[2]):
+                    coarser = (z.copy(), [int(i) for i in ident], steps, asymptotic)
+                    steps, at_steps = 2 * steps, 0
+                    continue
+                exact = z + (z - coarser[0]) / 15.0
+            elif abs(exact[-1] - z[-1]) > SHOOTING_RICHARDSON * z[-1] and steps < SHOOTING_MAX_STEPS:
                 # too far from RK4's asymptotic error to extrapolate it: again with twice the steps
                 z, steps, at_steps = exact, 2 * steps, 0
                 continue
