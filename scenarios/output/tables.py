@@ -44,11 +44,16 @@ if TYPE_CHECKING:
 
     from scenarios.output.results import RunResults
 
-__all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTITY_COLUMNS", "ROW_STATUSES", "csv_cell", "csv_text",
+__all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTITY_COLUMNS", "ROW_STATUSES", "RUN_COLUMNS",
+           "csv_cell", "csv_text",
            "data_frame", "flatten_row", "html_table", "is_missing", "json_safe", "numeric_columns",
-           "requirement_columns", "requirement_units", "row_columns", "status_line", "text_cell", "to_csv",
+           "requirement_columns", "requirement_units", "row_columns", "run_rows", "status_line", "text_cell", "to_csv",
            "to_dataframe", "to_json", "to_markdown", "to_terminal"]
 
+RUN_COLUMNS = ("file_stem",)
+"""The columns a run's ``results.csv`` (and :meth:`~scenarios.output.results.RunResults.to_dataframe`)
+has after :func:`row_columns`: ``file_stem``, the stem of the row's files (``timeseries/<file_stem>.csv``,
+``<file_stem>.png``; :func:`~scenarios.output.names.row_stems`). A trade study's ``cases.csv`` has none."""
 IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused")
 """The columns that name a row and say how its reference was had, before its metrics: ``plan_time_s``
 the planner's wall time [s], ``plan_reused`` whether the reference was reused from an earlier case of
@@ -316,9 +321,30 @@ def to_json(results: RunResults) -> str:
     return json.dumps(json_safe(results.to_dict()), indent=2, allow_nan=False, default=str)
 
 
+def run_rows(results: RunResults) -> list[dict[str, Any]]:
+    """A run's rows in their plain form (:meth:`~scenarios.output.results.Row.to_dict`), each with
+    ``file_stem``: the stem of its files in the output directory (``timeseries/<file_stem>.csv``,
+    ``<file_stem>.png``), :func:`~scenarios.output.names.row_stems` of the run's labels.
+
+    Parameters
+    ----------
+    results : RunResults
+        The rows of a scenario run.
+
+    Returns
+    -------
+    list of dict
+        One per row, in order.
+    """
+    from scenarios.output.names import row_stems
+
+    stems = row_stems([row.label for row in results.rows])
+    return [{**row.to_dict(), "file_stem": stem} for row, stem in zip(results.rows, stems)]
+
+
 def to_csv(results: RunResults) -> str:
     """``results.csv``: one line per row, the columns of :func:`row_columns` with the rows'
-    requirement columns.
+    requirement columns, then :data:`RUN_COLUMNS` (the row's file stem).
 
     Parameters
     ----------
@@ -330,8 +356,9 @@ def to_csv(results: RunResults) -> str:
     str
         CSV text; missing and non-finite values are empty cells.
     """
-    rows = [row.to_dict() for row in results.rows]
-    return csv_text(row_columns(requirement_columns(rows)), (flatten_row(row) for row in rows))
+    rows = run_rows(results)
+    return csv_text([*row_columns(requirement_columns(rows)), *RUN_COLUMNS],
+                    ({**flatten_row(row), **{key: row[key] for key in RUN_COLUMNS}} for row in rows))
 
 
 def to_dataframe(results: RunResults) -> pandas.DataFrame:
@@ -346,7 +373,7 @@ def to_dataframe(results: RunResults) -> pandas.DataFrame:
     -------
     pandas.DataFrame
         One line per row, the columns of :func:`row_columns` (with the rows' requirement
-        columns); ``plan_time_s``, the metric and the requirement columns are float, NaN where
+        columns), then :data:`RUN_COLUMNS`; ``plan_time_s``, the metric and the requirement columns are float, NaN where
         missing or non-finite, but the verdicts (``<scope>.req.<name>.met``) and ``plan_reused``:
         pandas' nullable ``boolean``.
 
@@ -355,9 +382,11 @@ def to_dataframe(results: RunResults) -> pandas.DataFrame:
     ImportError
         pandas is not installed.
     """
-    rows = [row.to_dict() for row in results.rows]
+    rows = run_rows(results)
     requirements = requirement_columns(rows)
-    return data_frame(row_columns(requirements), [flatten_row(row) for row in rows], numeric_columns(requirements))
+    return data_frame([*row_columns(requirements), *RUN_COLUMNS],
+                      [{**flatten_row(row), **{key: row[key] for key in RUN_COLUMNS}} for row in rows],
+                      numeric_columns(requirements))
 
 
 def text_cell(value: Any) -> str:
