@@ -47,7 +47,7 @@ if TYPE_CHECKING:
 __all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTITY_COLUMNS", "ROW_STATUSES", "RUN_COLUMNS",
            "csv_cell", "csv_text",
            "data_frame", "flatten_row", "html_table", "is_missing", "json_safe", "numeric_columns",
-           "requirement_columns", "requirement_units", "row_columns", "run_rows", "status_line", "text_cell", "to_csv",
+           "ratio_text", "requirement_columns", "requirement_units", "row_columns", "run_rows", "status_line", "text_cell", "to_csv",
            "to_dataframe", "to_json", "to_markdown", "to_terminal"]
 
 RUN_COLUMNS = ("file_stem",)
@@ -425,8 +425,66 @@ def _metric_lines(results: RunResults, requirements: bool = True,
             lines.append((f"{prefix}.{key}", [text_cell((row[scope] or {}).get(key)) for row in rows]))
     if requirements:
         flat = [flatten_row(row) for row in rows]
-        lines += [(column, [text_cell(line.get(column)) for line in flat]) for column in requirement_columns(rows)]
+        lines += [(column, [_requirement_text(column, line) for line in flat]) for column in requirement_columns(rows)]
     return lines
+
+
+_LIMIT_ROUNDING = 1e-9
+"""How near 1 a ratio to its limit is at the limit, to rounding (the closed loop's
+:data:`~scenarios.requirements.scoring.AT_LIMIT`)."""
+_AT_LIMIT_TEXT = "at limit"
+"""The cell of a ratio at its limit (to :data:`_LIMIT_ROUNDING`) in a scope that breaks the
+requirement: a closed loop's wheel the simulator holds at its limit, where a reference at the same
+ratio may meet it (it is allowed the limit itself)."""
+
+
+def ratio_text(value: Any, broken: bool = False) -> str:
+    """A Markdown or terminal cell of a ratio to a limit or a bound: as :func:`text_cell`, but with
+    as many more digits (12 significant at most) as it takes not to read ``1`` when it is not 1
+    (``0.99998``, not ``1``), and :data:`_AT_LIMIT_TEXT` for a ratio at 1 to rounding in a scope
+    that breaks the requirement, so that a met and a broken value never read alike.
+
+    Parameters
+    ----------
+    value : object
+        The ratio (dimensionless), ``None`` or non-finite when missing.
+    broken : bool, optional
+        Whether the scope breaks the requirement.
+
+    Returns
+    -------
+    str
+        The cell's text (without the broken mark).
+    """
+    text = text_cell(value)
+    if not isinstance(value, float) or is_missing(value) or float(text) != 1.0:
+        return text
+    if broken and abs(value - 1.0) <= _LIMIT_ROUNDING:
+        return _AT_LIMIT_TEXT
+    for digits in range(5, 13):
+        shown = f"{value:.{digits}g}"
+        if float(shown) != 1.0:
+            return shown
+    return text
+
+
+def _is_ratio(column: str) -> bool:
+    """Whether a requirement column holds a dimensionless ratio (a demand over its limit, a peak
+    rate over its bound)."""
+    try:
+        return field_info(column).unit == "–"
+    except KeyError:
+        return False
+
+
+def _requirement_text(column: str, line: Mapping[str, Any]) -> str:
+    """A flat row's cell of a requirement column: a ratio by :func:`ratio_text`, broken where the
+    row's verdict of that scope and requirement is False."""
+    value = line.get(column)
+    if not _is_ratio(column):
+        return text_cell(value)
+    verdict = column.rsplit(".", 1)[0] + ".met"
+    return ratio_text(value, broken=line.get(verdict) is False)
 
 
 _HEADLINES = (("min_margin_deg", "min margin, deg"), ("ratio", "peak rate / bound"),
@@ -453,10 +511,16 @@ may look harmless where another field breaks the requirement (a reference at 0.1
 limit whose rate jumps: an impulse)."""
 
 
+_RATIO_HEADLINES = ("peak rate / bound", "peak demand / limit")
+"""The headlines (:func:`_headline`) that are ratios to a limit or a bound (:func:`ratio_text`)."""
+
+
 def _requirement_cell(values: Mapping[str, Any] | None) -> str:
     """One scope's terminal cell of a requirement: its headline number, marked when not met."""
-    cell = text_cell(_headline(values)[1])
-    return cell + _BROKEN if values and values.get("met") is False else cell
+    words, number = _headline(values)
+    broken = values is not None and values.get("met") is False
+    cell = ratio_text(number, broken) if words in _RATIO_HEADLINES else text_cell(number)
+    return cell + _BROKEN if broken else cell
 
 
 def _requirement_lines(results: RunResults) -> list[tuple[str, list[str]]]:
