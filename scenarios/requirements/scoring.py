@@ -1009,7 +1009,7 @@ def _peak(name: str, magnitude: Array, limit: Array, t: Array, values: dict[str,
     last = int(at.size - 1 - np.argmax(at[::-1]))
     held = float(np.sum(np.diff(t)[at[:-1] & at[1:]]))  # between consecutive samples both at it
     size = ("at its limit, 1 x" if ratio <= 1 + _TOLERANCE
-            else f"{_over(ratio, 1.0)[0]} x its limit at {t[worst]:.1f} s, at or over it")
+            else f"at or over its limit, up to {_over(ratio, 1.0)[0]} x at {t[worst]:.1f} s")
     when = (f"at {t[first]:.1f} s, on that sample only" if first == last
             else f"on {int(np.sum(at))} separate samples from {t[first]:.1f} s to {t[last]:.1f} s" if held == 0.0
             else f"from {t[first]:.1f} s to {t[last]:.1f} s, {held:.3g} s at the limit in all")
