@@ -110,13 +110,22 @@ def test_a_closed_loop_at_its_momentum_limit_breaks_it_where_the_reference_meets
     h = np.abs(_conserved_momenta(row.simulation))
     # the oracle: the closed loop's wheel reaches the limit (the simulator holds it there)
     assert np.max(h) == pytest.approx(LOW, rel=1e-6)
-    wheel = int(np.unravel_index(np.argmax(h), h.shape)[1])
+    held = np.abs(row.simulation.wheel_momentum) >= LOW * (1 - 1e-9)  # the states at the limit, to rounding
+    first = int(np.argmax(held.any(axis=1)))
+    wheel = int(np.argmax(held[first]))  # the first there: earliest, then the lowest index
+    assert h[first, wheel] == pytest.approx(LOW, rel=1e-6)  # the oracle agrees it is there
+    t = row.simulation.t
+    at = np.flatnonzero(held.any(axis=1))
+    spans = [b - a for a, b, ka, kb in zip(t[:-1], t[1:], held.any(axis=1)[:-1], held.any(axis=1)[1:]) if ka and kb]
+    assert at.size > 10 and spans  # held there a while, not touched once
     assert not score.met
     assert score.values["wheels_momentum"] >= AT_LIMIT
-    assert f"wheel {wheel} momentum" in score.detail and f"{LOW:g} N m s limit" in score.detail
-    assert f"at {score.values['wheels_momentum_time_s']:.1f} s" in score.detail
+    assert score.values["wheels_momentum_time_s"] == t[first]
+    assert score.detail.startswith(f"wheels_momentum at its limit, 1 x (wheel {wheel}: {LOW:g} N m s, the first "
+                                   f"there) from {t[first]:.1f} s to {t[at[-1]]:.1f} s, "
+                                   f"{sum(spans):.3g} s at the limit in all"), score.detail
     (message,) = violations({"closed_loop": scores})
-    assert message.startswith("actuators (closed loop): wheel")
+    assert message.startswith("actuators (closed loop): wheels_momentum at its limit")
     # the run's row: violated, by the closed loop's wheel alone
     assert row.status == "violated" and row.message.startswith(message), row.message
     assert row.requirements["closed_loop"]["actuators"] == {"met": False, **score.values}
@@ -144,7 +153,7 @@ def test_a_truth_momentum_limit_above_the_design_s_holds_the_closed_loop_to_the_
     score = closed_loop_wheels(design.problem.spacecraft, sim.t, sim.omega, sim.wheel_momentum, design.truth)
     assert score is not None and not score.met
     assert score.values["wheels_momentum"] == pytest.approx(1 / 0.9, rel=1e-6)
-    assert "over its" in score.detail and "truth model's" not in score.detail
+    assert "at or over its limit, up to 1.11 x" in score.detail and "truth model's" not in score.detail
     lowered = _scenario(2 * peak, {"max_momentum": 0.9 * peak})
     assert plant_limits(lowered.truth)["wheels_momentum"] == pytest.approx(0.9 * peak)
     score = closed_loop_wheels(lowered.problem.spacecraft, sim.t, sim.omega, sim.wheel_momentum, lowered.truth)
@@ -179,3 +188,46 @@ def test_the_declared_fields_are_those_scored(generous, max_momentum, truth):
     assert score is not None
     assert declared["actuators"] == ("met", *score.values)
     assert ("wheels_momentum" in score.values) == (max_momentum is not None)
+
+
+def test_the_wheel_named_is_the_first_at_its_limit_and_the_time_there_is_said():
+    # by hand: wheel 0 at its 0.3 N m s limit from 3 s to 5 s; wheel 2 touches it at 4 s, its
+    # rounding a little higher: the first there (wheel 0, 3 s) is named, not the rounding's peak
+    spacecraft = _scenario(LOW).problem.spacecraft
+    t = np.arange(11.0)
+    h = np.zeros((11, 3))
+    h[:, 0] = h[:, 2] = 0.2
+    h[3:6, 0] = 0.30000000000000004
+    h[4, 2] = 0.3000000000000001
+    score = closed_loop_wheels(spacecraft, t, np.zeros((11, 3)), h)
+    assert not score.met and score.values["wheels_momentum_time_s"] == 3.0
+    assert score.detail.startswith("wheels_momentum at its limit, 1 x (wheel 0: 0.3 N m s, the first there) "
+                                   "from 3.0 s to 5.0 s, 2 s at the limit in all"), score.detail
+    # one sample touching it reads as such, not as a wheel held there
+    h[3:6, 0] = 0.2
+    h[6, 1] = -0.3
+    score = closed_loop_wheels(spacecraft, t, np.zeros((11, 3)), h)
+    assert score.detail.startswith("wheels_momentum at its limit, 1 x (wheel 2: 0.3 N m s, the first there) "
+                                   "on 2 separate samples from 4.0 s to 6.0 s"), score.detail
+    h[4, 2] = 0.2
+    score = closed_loop_wheels(spacecraft, t, np.zeros((11, 3)), h)
+    assert score.detail.startswith("wheels_momentum at its limit, 1 x (wheel 1: 0.3 N m s, the first there) "
+                                   "at 6.0 s, on that sample only"), score.detail
+    # just below the limit: met, and it does not read as 1 where a value at the limit is marked
+    h[4, 2] = h[6, 1] = 0.3 * 0.99998
+    score = closed_loop_wheels(spacecraft, t, np.zeros((11, 3)), h)
+    assert score.met and not score.detail
+
+
+def test_a_met_and_a_broken_ratio_never_read_alike(low):
+    from scenarios.output.results import RunResults
+    from scenarios.output.tables import ratio_text
+    assert ratio_text(0.99998) == "0.99998" and ratio_text(0.99998, broken=True) == "0.99998"
+    assert ratio_text(1.0000000000000002) == "1"  # a reference at its allowed limit: met
+    assert ratio_text(1.0000000000000007, broken=True) == "at limit"  # a closed loop held there: broken
+    assert ratio_text(1.00001, broken=True) == "1.00001" and ratio_text(0.9211) == "0.9211"
+    scenario, row = low  # the closed loop at its limit: the terminal and Markdown say so
+    results = RunResults(scenario, [row])
+    assert "| cl.req.actuators.wheels_momentum | at limit |" in results.to_markdown()
+    (line,) = [line for line in results.to_terminal().splitlines() if line.startswith("req.actuators")]
+    assert line.endswith("| at limit ✗"), line

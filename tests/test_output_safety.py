@@ -185,10 +185,56 @@ def test_colliding_labels_each_get_their_own_time_series(tmp_path):
     (["α", "β"], ["row", "row-2"]),  # nothing usable: row
     (["comparison", "Sky", "x"], ["comparison-2", "Sky-2", "x"]),  # slewbench's own file is the first
     (["a/b", "a_b", "a_b-2"], ["a_b-3", "a_b", "a_b-2"]),  # a label that is a suffix keeps its stem
+    # case variants are one file name: the first label that is its stem exactly keeps it
+    (["a/b", "A_B", "a_b", "a_b-2"], ["a_b-3", "A_B", "a_b-4", "a_b-2"]),
+    (["a/b", "a_b", "A_B"], ["a_b-2", "a_b", "A_B-3"]),
     (["pd", "k=0.5", "lqr gain", "wheel.2"], ["pd", "k=0.5", "lqr_gain", "wheel.2"]),  # no collision: as sanitised
 ])
 def test_colliding_labels_get_a_numeric_suffix_in_row_order(labels, stems):
     assert row_stems(labels) == stems
+
+
+def test_each_rows_file_stem_is_recorded_and_names_its_time_series(tmp_path):
+    import csv
+
+    from scenarios.output.export import read_run
+    labels = ["a/b", "A_B", "a_b", "a_b-2"]
+    path = scenario(tmp_path, planners=[{"name": "eigenaxis", "label": label} for label in labels])
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    expected = {"a/b": "a_b-3", "A_B": "A_B", "a_b": "a_b-4", "a_b-2": "a_b-2"}  # by hand, the rule in the docs
+    rows = json.loads((out / "results.json").read_text())["rows"]
+    assert {row["label"]: row["file_stem"] for row in rows} == expected
+    lines = list(csv.reader((out / "results.csv").read_text().splitlines()))
+    assert lines[0][:7] == ["label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused"]
+    assert lines[0][-1] == "file_stem"  # appended: the columns before it keep their places
+    assert {line[0]: line[-1] for line in lines[1:]} == expected
+    for label, stem in expected.items():  # each file is its row's: the time series of that row's planner
+        assert (out / "timeseries" / f"{stem}.csv").is_file()
+    assert {row.label: row.stem for row in read_run(out).rows} == expected
+
+
+def test_export_reads_the_recorded_stem_and_works_it_out_for_an_older_run(tmp_path):
+    from scenarios.output.export import read_run
+    path = scenario(tmp_path, planners=[{"name": "eigenaxis", "label": "a/b"}, {"name": "eigenaxis", "label": "a_b"}])
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-plots"]) == 0
+    results = out / "results.json"
+    data = json.loads(results.read_text())
+    (out / "timeseries" / "a_b.csv").rename(out / "timeseries" / "kept.csv")
+    manifest = out / MARKER
+    manifest.write_text(manifest.read_text().replace("timeseries/a_b.csv", "timeseries/kept.csv"))
+    data["rows"][1]["file_stem"] = "kept"
+    results.write_text(json.dumps(data))
+    assert [(row.stem, row.timeseries.name if row.timeseries else None) for row in read_run(out).rows] == [
+        ("a_b-2", "a_b-2.csv"), ("kept", "kept.csv")]  # the recorded stem, not the label's
+    for row in data["rows"]:  # a run written before the field: worked out from the labels
+        del row["file_stem"]
+    (out / "timeseries" / "kept.csv").rename(out / "timeseries" / "a_b.csv")
+    manifest.write_text(manifest.read_text().replace("timeseries/kept.csv", "timeseries/a_b.csv"))
+    results.write_text(json.dumps(data))
+    assert [row.stem for row in read_run(out).rows] == ["a_b-2", "a_b"]
+    assert all(row.timeseries is not None for row in read_run(out).rows)
 
 
 def test_a_suffix_keeps_a_long_stem_within_the_limit():

@@ -85,12 +85,12 @@ def test_missing_and_non_finite_values_are_null_in_json_empty_in_csv_and_float_n
     assert [row["reference"] for row in strict_json(results.to_json())["rows"]][0] == {
         **dict.fromkeys(METRIC_KEYS), "int_u2": 2.0, "int_abs_u": [1.0, None, 3.0], "duration_s": 30.0}
     json_rows = strict_json(results.to_json())["rows"]
-    assert set(json_rows[0]) == ROW_KEYS and json_rows[0]["closed_loop"] is None
+    assert set(json_rows[0]) == ROW_KEYS | {"file_stem"} and json_rows[0]["closed_loop"] is None
     assert json_rows[1]["planner"] is None and json_rows[1]["plan_time_s"] is None
 
     text = results.to_csv()
     header = text.splitlines()[0].split(",")
-    assert header == IDENTITY + expected_metric_columns() + CERTIFICATE
+    assert header == IDENTITY + expected_metric_columns() + CERTIFICATE + ["file_stem"]  # a run's: appended
     odd, regulating = read_csv(text)
     assert odd["certificate"] == "" and odd["certificate_kkt_scaled"] == ""  # no reference: no certificate
     assert (odd["ref.int_u2"], odd["ref.int_abs_u_x"], odd["ref.int_abs_u_z"], odd["ref.duration_s"]) == \
@@ -126,7 +126,8 @@ def test_a_runs_results_csv_and_a_sweeps_cases_csv_agree_cell_for_cell(tmp_path)
     assert main(["sweep", str(study), "--out", str(tmp_path / "sweep"), "--workers", "1", "--no-plots"]) == 0
     run_text = (tmp_path / "run" / "results.csv").read_text()
     cases_text = (tmp_path / "sweep" / "cases.csv").read_text()
-    assert cases_text.splitlines()[0] == "case,seed," + run_text.splitlines()[0]
+    # the same columns in the same order; a run's results.csv appends its rows' file stems
+    assert cases_text.splitlines()[0] + ",file_stem" == "case,seed," + run_text.splitlines()[0]
     ran, cased = read_csv(run_text), read_csv(cases_text)
     assert len(ran) == len(cased) == 2
     for run_row, case_row in zip(ran, cased):
@@ -143,7 +144,8 @@ def test_a_runs_results_csv_and_a_sweeps_cases_csv_agree_cell_for_cell(tmp_path)
     direct = scenarios.run(scenarios.load(path)).to_dataframe()
     swept = sweep(scenarios.load_study(study), workers=1).to_dataframe()
     assert list(swept.columns[:2]) == ["case", "seed"]
-    pd.testing.assert_frame_equal(direct.drop(columns="plan_time_s"),
+    assert list(direct["file_stem"]) == ["smooth", "fast"]  # a run's rows' file stems, appended
+    pd.testing.assert_frame_equal(direct.drop(columns=["plan_time_s", "file_stem"]),
                                   swept.drop(columns=["case", "seed", "plan_time_s"]))
 
 

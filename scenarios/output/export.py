@@ -39,7 +39,7 @@ from scenarios.output.directory import (
     new_staging,
     read_manifest,
 )
-from scenarios.output.names import row_stems
+from scenarios.output.names import row_stems, sanitize
 
 __all__ = ["EXPORT_FORMATS", "ExportFormat", "ExportReport", "RunRecord", "RunRow", "default_export_directory",
            "export_run", "read_run"]
@@ -56,7 +56,8 @@ class RunRow:
     label, planner, controller, status : str or None
         As in ``results.json`` (``planner`` ``None`` in regulation mode).
     stem : str
-        The row's file stem (:func:`~scenarios.output.names.row_stems`).
+        The row's file stem: ``results.json``'s ``file_stem``; for a run written before it
+        recorded one, :func:`~scenarios.output.names.row_stems` of the labels.
     timeseries : Path or None
         Its ``timeseries/<stem>.csv``; ``None`` when the row was not simulated.
     rate_jump_times : tuple of float, optional
@@ -168,13 +169,23 @@ def read_run(directory: str | Path) -> RunRecord:
     except (OSError, ValueError, KeyError, TypeError) as error:
         raise ScenarioError(str(path / "results.json"), f"cannot be read as a run's results: {error}") from None
     rows = []
-    for row, stem in zip(data["rows"], row_stems(labels)):
+    for row, stem in zip(data["rows"], _recorded_stems(data["rows"], labels)):
         name = f"timeseries/{stem}.csv"
         series = path / name if name in manifest["files"] and (path / name).is_file() else None
         rows.append(RunRow(row["label"], row.get("planner"), row.get("controller"), row.get("status", ""), stem,
                            series, _rate_jump_times(row), str(row.get("message") or "")))
     return RunRecord(path.absolute(), str(data.get("scenario", "")), str(data.get("frame", "")), data.get("epoch"),
                      rows, data.get("provenance") or {})
+
+
+def _recorded_stems(rows: list[Any], labels: list[str]) -> list[str]:
+    """The rows' file stems as ``results.json`` records them (``file_stem``); for a run written
+    before it did (or a stem that is not one slewbench makes: a path, say), worked out again from
+    the labels (:func:`~scenarios.output.names.row_stems`, the rule that named its files)."""
+    recorded = [row.get("file_stem") if isinstance(row, dict) else None for row in rows]
+    if all(isinstance(stem, str) and stem == sanitize(stem, fallback="") for stem in recorded):
+        return [str(stem) for stem in recorded]
+    return row_stems(labels)
 
 
 def _rate_jump_times(row: Any) -> tuple[float, ...]:

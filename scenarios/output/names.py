@@ -48,10 +48,15 @@ def row_stems(labels: Sequence[str]) -> list[str]:
     A label keeps its sanitised stem (:func:`sanitize`) when no other label shares it and it is
     not one of slewbench's own (:data:`RESERVED`). Labels whose stems collide (``a/b`` and
     ``a_b``, ``A`` and ``a``, ``α`` and ``β``, both ``row``) are told apart by a numeric suffix in
-    row order: the label that is the stem itself (``a_b``) keeps it, or else the first; the others
-    get ``-2``, ``-3``, ... (``a_b-2``). A reserved stem is taken by slewbench's own file, so its
-    row gets ``-2`` (``comparison-2``). A suffix that another label's stem already is, is skipped,
-    so that every non-colliding label keeps its stem.
+    row order: the first label that is its stem exactly (``a_b``, unchanged by :func:`sanitize`)
+    keeps it, or else the first label; the others get ``-2``, ``-3``, ... (``a_b-2``). Labels
+    differing only in case are one file name on a case-insensitive file system, so of ``A_B`` and
+    ``a_b`` (each its stem exactly) the first in row order keeps its stem and the other gets a
+    suffix. A reserved stem is taken by slewbench's own file, so its row gets ``-2``
+    (``comparison-2``). A suffix that another label's stem already is, is skipped, so that every
+    non-colliding label keeps its stem (with ``a/b``, ``a_b`` and ``a_b-2``, ``a/b`` gets
+    ``a_b-3``). A run records each row's stem in ``results.json`` and ``results.csv``
+    (``file_stem``).
 
     Parameters
     ----------

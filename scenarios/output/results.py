@@ -19,6 +19,7 @@ from scenarios.output.tables import (
     ROW_STATUSES,
     html_table,
     is_missing,
+    run_rows,
     status_line,
     text_cell,
 )
@@ -183,8 +184,9 @@ class RunResults:
         -------
         dict
             ``{"scenario": name, "frame": ..., "epoch": ..., "rows": [Row.to_dict(), ...],
-            "provenance": {...}}``: the inertial frame the attitudes are in
-            (:attr:`Scenario.frame <scenarios.schema.loader.Scenario.frame>`: ``GCRF (epoch ...Z)``
+            "provenance": {...}}``, each row with ``file_stem`` too, the stem of its files in
+            the output directory (:func:`~scenarios.output.tables.run_rows`): the inertial frame
+            the attitudes are in (:attr:`Scenario.frame <scenarios.schema.loader.Scenario.frame>`: ``GCRF (epoch ...Z)``
             with an epoch, else ``inertial (no epoch)``), the epoch (UTC, ISO 8601 with ``Z``, or
             ``None``) and what produced the results
             (:func:`~scenarios.output.provenance.run_provenance`: versions, platform, date, seeds
@@ -193,7 +195,7 @@ class RunResults:
         epoch = self.scenario.epoch
         return {"scenario": self.scenario.name, "frame": self.scenario.frame,
                 "epoch": None if epoch is None else epoch.isoformat() + "Z",
-                "rows": [row.to_dict() for row in self.rows],
+                "rows": run_rows(self),
                 "provenance": run_provenance(self.scenario, self.finished)}
 
     def __repr__(self) -> str:

@@ -44,11 +44,16 @@ if TYPE_CHECKING:
 
     from scenarios.output.results import RunResults
 
-__all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTITY_COLUMNS", "ROW_STATUSES", "csv_cell", "csv_text",
+__all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTITY_COLUMNS", "ROW_STATUSES", "RUN_COLUMNS",
+           "csv_cell", "csv_text",
            "data_frame", "flatten_row", "html_table", "is_missing", "json_safe", "numeric_columns",
-           "requirement_columns", "requirement_units", "row_columns", "status_line", "text_cell", "to_csv",
+           "ratio_text", "requirement_columns", "requirement_units", "row_columns", "run_rows", "status_line", "text_cell", "to_csv",
            "to_dataframe", "to_json", "to_markdown", "to_terminal"]
 
+RUN_COLUMNS = ("file_stem",)
+"""The columns a run's ``results.csv`` (and :meth:`~scenarios.output.results.RunResults.to_dataframe`)
+has after :func:`row_columns`: ``file_stem``, the stem of the row's files (``timeseries/<file_stem>.csv``,
+``<file_stem>.png``; :func:`~scenarios.output.names.row_stems`). A trade study's ``cases.csv`` has none."""
 IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused")
 """The columns that name a row and say how its reference was had, before its metrics: ``plan_time_s``
 the planner's wall time [s], ``plan_reused`` whether the reference was reused from an earlier case of
@@ -316,9 +321,30 @@ def to_json(results: RunResults) -> str:
     return json.dumps(json_safe(results.to_dict()), indent=2, allow_nan=False, default=str)
 
 
+def run_rows(results: RunResults) -> list[dict[str, Any]]:
+    """A run's rows in their plain form (:meth:`~scenarios.output.results.Row.to_dict`), each with
+    ``file_stem``: the stem of its files in the output directory (``timeseries/<file_stem>.csv``,
+    ``<file_stem>.png``), :func:`~scenarios.output.names.row_stems` of the run's labels.
+
+    Parameters
+    ----------
+    results : RunResults
+        The rows of a scenario run.
+
+    Returns
+    -------
+    list of dict
+        One per row, in order.
+    """
+    from scenarios.output.names import row_stems
+
+    stems = row_stems([row.label for row in results.rows])
+    return [{**row.to_dict(), "file_stem": stem} for row, stem in zip(results.rows, stems)]
+
+
 def to_csv(results: RunResults) -> str:
     """``results.csv``: one line per row, the columns of :func:`row_columns` with the rows'
-    requirement columns.
+    requirement columns, then :data:`RUN_COLUMNS` (the row's file stem).
 
     Parameters
     ----------
@@ -330,8 +356,9 @@ def to_csv(results: RunResults) -> str:
     str
         CSV text; missing and non-finite values are empty cells.
     """
-    rows = [row.to_dict() for row in results.rows]
-    return csv_text(row_columns(requirement_columns(rows)), (flatten_row(row) for row in rows))
+    rows = run_rows(results)
+    return csv_text([*row_columns(requirement_columns(rows)), *RUN_COLUMNS],
+                    ({**flatten_row(row), **{key: row[key] for key in RUN_COLUMNS}} for row in rows))
 
 
 def to_dataframe(results: RunResults) -> pandas.DataFrame:
@@ -346,7 +373,7 @@ def to_dataframe(results: RunResults) -> pandas.DataFrame:
     -------
     pandas.DataFrame
         One line per row, the columns of :func:`row_columns` (with the rows' requirement
-        columns); ``plan_time_s``, the metric and the requirement columns are float, NaN where
+        columns), then :data:`RUN_COLUMNS`; ``plan_time_s``, the metric and the requirement columns are float, NaN where
         missing or non-finite, but the verdicts (``<scope>.req.<name>.met``) and ``plan_reused``:
         pandas' nullable ``boolean``.
 
@@ -355,9 +382,11 @@ def to_dataframe(results: RunResults) -> pandas.DataFrame:
     ImportError
         pandas is not installed.
     """
-    rows = [row.to_dict() for row in results.rows]
+    rows = run_rows(results)
     requirements = requirement_columns(rows)
-    return data_frame(row_columns(requirements), [flatten_row(row) for row in rows], numeric_columns(requirements))
+    return data_frame([*row_columns(requirements), *RUN_COLUMNS],
+                      [{**flatten_row(row), **{key: row[key] for key in RUN_COLUMNS}} for row in rows],
+                      numeric_columns(requirements))
 
 
 def text_cell(value: Any) -> str:
@@ -396,8 +425,66 @@ def _metric_lines(results: RunResults, requirements: bool = True,
             lines.append((f"{prefix}.{key}", [text_cell((row[scope] or {}).get(key)) for row in rows]))
     if requirements:
         flat = [flatten_row(row) for row in rows]
-        lines += [(column, [text_cell(line.get(column)) for line in flat]) for column in requirement_columns(rows)]
+        lines += [(column, [_requirement_text(column, line) for line in flat]) for column in requirement_columns(rows)]
     return lines
+
+
+_LIMIT_ROUNDING = 1e-9
+"""How near 1 a ratio to its limit is at the limit, to rounding (the closed loop's
+:data:`~scenarios.requirements.scoring.AT_LIMIT`)."""
+_AT_LIMIT_TEXT = "at limit"
+"""The cell of a ratio at its limit (to :data:`_LIMIT_ROUNDING`) in a scope that breaks the
+requirement: a closed loop's wheel the simulator holds at its limit, where a reference at the same
+ratio may meet it (it is allowed the limit itself)."""
+
+
+def ratio_text(value: Any, broken: bool = False) -> str:
+    """A Markdown or terminal cell of a ratio to a limit or a bound: as :func:`text_cell`, but with
+    as many more digits (12 significant at most) as it takes not to read ``1`` when it is not 1
+    (``0.99998``, not ``1``), and :data:`_AT_LIMIT_TEXT` for a ratio at 1 to rounding in a scope
+    that breaks the requirement, so that a met and a broken value never read alike.
+
+    Parameters
+    ----------
+    value : object
+        The ratio (dimensionless), ``None`` or non-finite when missing.
+    broken : bool, optional
+        Whether the scope breaks the requirement.
+
+    Returns
+    -------
+    str
+        The cell's text (without the broken mark).
+    """
+    text = text_cell(value)
+    if not isinstance(value, float) or is_missing(value) or float(text) != 1.0:
+        return text
+    if broken and abs(value - 1.0) <= _LIMIT_ROUNDING:
+        return _AT_LIMIT_TEXT
+    for digits in range(5, 13):
+        shown = f"{value:.{digits}g}"
+        if float(shown) != 1.0:
+            return shown
+    return text
+
+
+def _is_ratio(column: str) -> bool:
+    """Whether a requirement column holds a dimensionless ratio (a demand over its limit, a peak
+    rate over its bound)."""
+    try:
+        return field_info(column).unit == "–"
+    except KeyError:
+        return False
+
+
+def _requirement_text(column: str, line: Mapping[str, Any]) -> str:
+    """A flat row's cell of a requirement column: a ratio by :func:`ratio_text`, broken where the
+    row's verdict of that scope and requirement is False."""
+    value = line.get(column)
+    if not _is_ratio(column):
+        return text_cell(value)
+    verdict = column.rsplit(".", 1)[0] + ".met"
+    return ratio_text(value, broken=line.get(verdict) is False)
 
 
 _HEADLINES = (("min_margin_deg", "min margin, deg"), ("ratio", "peak rate / bound"),
@@ -424,10 +511,16 @@ may look harmless where another field breaks the requirement (a reference at 0.1
 limit whose rate jumps: an impulse)."""
 
 
+_RATIO_HEADLINES = ("peak rate / bound", "peak demand / limit")
+"""The headlines (:func:`_headline`) that are ratios to a limit or a bound (:func:`ratio_text`)."""
+
+
 def _requirement_cell(values: Mapping[str, Any] | None) -> str:
     """One scope's terminal cell of a requirement: its headline number, marked when not met."""
-    cell = text_cell(_headline(values)[1])
-    return cell + _BROKEN if values and values.get("met") is False else cell
+    words, number = _headline(values)
+    broken = values is not None and values.get("met") is False
+    cell = ratio_text(number, broken) if words in _RATIO_HEADLINES else text_cell(number)
+    return cell + _BROKEN if broken else cell
 
 
 def _requirement_lines(results: RunResults) -> list[tuple[str, list[str]]]:

@@ -910,9 +910,14 @@ def closed_loop_wheels(spacecraft: Spacecraft, t: ArrayLike, omega: ArrayLike, w
         ``actuators``: per momentum-storing kind with a limit, ``<kind>_momentum``, the peak of
         ``|h_i| / limit_i`` over the samples and elements, and ``<kind>_momentum_time_s`` when;
         under a truth speed limit, ``wheels_speed``, the peak of ``|Ω_i| / Ω_max,i`` (``Ω = h / J_s −
-        aᵀω``, truth axes and spin inertia), and ``wheels_speed_time_s``. Met when every ratio is
-        below 1 (:data:`AT_LIMIT`); the detail names the element, the time and the value. ``None``
-        when no such quantity is limited.
+        aᵀω``, truth axes and spin inertia), and ``wheels_speed_time_s``: ratios to the limit, as the
+        reference's. Met when every ratio is below 1 (:data:`AT_LIMIT`, a relative tolerance);
+        else the time is the first sample at the limit (the peak's otherwise), and the detail
+        says, in ratios (``x its limit``), which element reached it first (the lowest at that
+        sample) and its limit, when, and for how long an element stays there: ``wheels_momentum at
+        its limit, 1 x (wheel 0: 0.3 N m s, the first there) from 61.5 s to 140.0 s, 78.5 s at the
+        limit in all`` (the time between consecutive samples both at it), ``at 6.5 s, on that
+        sample only`` or ``on 2 separate samples from 4.0 s to 6.0 s``. ``None`` when no such quantity is limited.
     """
     t = np.asarray(t, dtype=float).reshape(-1)
     states = np.asarray(wheel_momentum, dtype=float).reshape(t.size, -1)
@@ -921,10 +926,11 @@ def closed_loop_wheels(spacecraft: Spacecraft, t: ArrayLike, omega: ArrayLike, w
     for name, (block, limit, lowered) in _momentum_limits(spacecraft, plant).items():
         element = block.actuator.name.removesuffix("s")
         whose = [" (the truth model's; the design's is above it)" if low else "" for low in lowered]
-        broken += _peak(name, np.abs(states[:, block.state]), limit, t, values,
-                        lambda i, when, h, bound: (f"{element} {i} momentum {h:.4g} N m s "
-                                                   f"{_reached(h, bound)} {bound:.4g} N m s limit{whose[i]} "
-                                                   f"at {when:.1f} s"))
+
+        def words(i: int, kind: str = element, bound: Array = limit, truth: list[str] = whose) -> str:
+            return f"{kind} {i}: {bound[i]:.4g} N m s{truth[i]}"
+
+        broken += _peak(name, np.abs(states[:, block.state]), limit, t, values, words)
     speed = _speed_limit(plant)
     if speed is not None:
         assert plant is not None
@@ -934,21 +940,15 @@ def closed_loop_wheels(spacecraft: Spacecraft, t: ArrayLike, omega: ArrayLike, w
         where = next(block.state for block in actuator_blocks(flying) if block.actuator is wheels)
         relative = (states[:, where] / np.asarray(wheels.spin_inertia, dtype=float)
                     - np.asarray(omega, dtype=float).reshape(t.size, 3) @ np.asarray(wheels.axes, dtype=float))
-        broken += _peak("wheels_speed", np.abs(relative), np.asarray(speed, dtype=float), t, values,
-                        lambda i, when, w, bound: (f"wheel {i} speed {w * RPM_PER_RAD_S:.4g} rpm "
-                                                   f"{_reached(w, bound)} {bound * RPM_PER_RAD_S:.4g} rpm limit "
-                                                   f"(truth.wheels.max_speed_rpm) at {when:.1f} s"))
+        limits = np.asarray(speed, dtype=float)
+        broken += _peak("wheels_speed", np.abs(relative), limits, t, values,
+                        lambda i: f"wheel {i}: {limits[i] * RPM_PER_RAD_S:.4g} rpm, truth.wheels.max_speed_rpm")
     if not values:
         return None
     detail = ", ".join(broken)
     if detail:
         detail += " (the simulator holds a wheel at its limit by cutting the motor torque the law asks)"
     return Score("actuators", values, not broken, detail)
-
-
-def _reached(value: float, bound: float) -> str:
-    """``over its`` a value above its limit (beyond rounding), else ``at its``."""
-    return "over its" if value > bound * (1 + _TOLERANCE) else "at its"
 
 
 def _momentum_limits(spacecraft: Spacecraft, plant: TruthPlant | None) -> dict[str, tuple[Any, Array, Array]]:
@@ -979,10 +979,13 @@ def _speed_limit(plant: TruthPlant | None) -> Array | None:
 
 
 def _peak(name: str, magnitude: Array, limit: Array, t: Array, values: dict[str, float | None],
-          words: Callable[[int, float, float, float], str]) -> list[str]:
+          words: Callable[[int], str]) -> list[str]:
     """One closed-loop quantity's peak ratio (``|value| / limit`` per sample and element, 0 where
-    unlimited) and its time into ``values`` as ``name`` and ``<name>_time_s``; the sentence of the
-    element at the peak (``words(element, time, value, limit)``) when it reaches :data:`AT_LIMIT`."""
+    unlimited) and its time into ``values`` as ``name`` and ``<name>_time_s``, and its sentence when
+    it reaches the limit (:data:`AT_LIMIT`: a relative tolerance, so that rounding does not pick
+    the sample nor the element): the element that reached it first (the earliest sample at the
+    limit, the lowest element there, ``words(element)`` its limit in words), when, and for how long
+    any element is at or over the limit. ``<name>_time_s`` is then that first time, else the peak's."""
     with np.errstate(divide="ignore", invalid="ignore"):
         ratios = np.where(np.isinf(limit), 0.0, magnitude / limit)
     ratios = np.where(limit == 0.0, np.where(magnitude > 0.0, np.inf, 0.0), ratios)
@@ -994,12 +997,24 @@ def _peak(name: str, magnitude: Array, limit: Array, t: Array, values: dict[str,
         values[name], values[f"{name}_time_s"] = 0.0, None
         return []
     highest = int(np.argmax(ratios))
-    worst, element = divmod(highest, ratios.shape[1])
-    ratio = float(ratios[worst, element])
+    worst, _ = divmod(highest, ratios.shape[1])
+    ratio = float(ratios.flat[highest])
     values[name], values[f"{name}_time_s"] = ratio, float(t[worst])
-    if ratio < AT_LIMIT:
+    reached = ratios >= AT_LIMIT
+    if not reached.any():
         return []
-    return [words(element, float(t[worst]), float(magnitude[worst, element]), float(limit[element]))]
+    at: NDArray[np.bool_] = np.any(reached, axis=1)  # the samples where an element is at (or over) its limit
+    first = int(np.argmax(at))
+    element = int(np.argmax(reached[first]))
+    values[f"{name}_time_s"] = float(t[first])
+    last = int(at.size - 1 - np.argmax(at[::-1]))
+    held = float(np.sum(np.diff(t)[at[:-1] & at[1:]]))  # between consecutive samples both at it
+    size = ("at its limit, 1 x" if ratio <= 1 + _TOLERANCE
+            else f"at or over its limit, up to {_over(ratio, 1.0)[0]} x at {t[worst]:.1f} s")
+    when = (f"at {t[first]:.1f} s, on that sample only" if first == last
+            else f"on {int(np.sum(at))} separate samples from {t[first]:.1f} s to {t[last]:.1f} s" if held == 0.0
+            else f"from {t[first]:.1f} s to {t[last]:.1f} s, {held:.3g} s at the limit in all")
+    return [f"{name} {size} ({words(element)}, the first there) {when}"]
 
 
 def score_fields(requirements: Requirements, spacecraft: Spacecraft,
