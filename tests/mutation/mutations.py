@@ -1230,8 +1230,8 @@ MUTATIONS: list[Mutation] = [
              ("tests/test_mutants_compiled.py", "tests/test_closed_loop.py", "tests/test_closed_loop_cache.py")),
     # --- a tester's findings (stop 50) ---
     Mutation("terminal-marks-the-met-requirement", "scenarios/output/tables.py",
-             'return cell + _BROKEN if values and values.get("met") is False else cell',
-             'return cell + _BROKEN if values and values.get("met") is True else cell',
+             'broken = values is not None and values.get("met") is False',
+             'broken = values is not None and values.get("met") is True',
              ("tests/test_requirements_runs.py::test_the_terminal_marks_a_requirement_broken_by_a_field_its_headline_does_not_show",)),
     Mutation("plausibility-coplanar-wheels-pass-as-spanning", "scenarios/schema/plausibility.py",
              "    if rank == 3:\n        return", "    if rank >= 2:\n        return",
