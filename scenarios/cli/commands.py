@@ -712,7 +712,10 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         # a command-line option's error is named as such, not as the scenario's; a study's as the study's
         kind = "option" if error.path.startswith("--") else getattr(args, "file_kind", None) or \
             _COMMAND_FILES.get(args.command, "scenario")
-        print(f"slewbench: error in {kind}: {error}", file=sys.stderr)
+        text = str(error)
+        # a message that starts with the file it names (a file whose kind is not known yet) names it once
+        print(f"slewbench: error in {text}" if text.startswith(f"{kind}: ") else f"slewbench: error in {kind}: {text}",
+              file=sys.stderr)
         return EXIT_BAD_SCENARIO
     except OutputError as error:
         given = "--report" if getattr(args, "report", None) else "--out" if getattr(args, "out", None) else None
