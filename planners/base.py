@@ -83,6 +83,11 @@ class Planner(Configurable, ABC):
       (``seed_planners: auto``) wherever :meth:`start_error` accepts the problem (by default
       where :meth:`problem_error` does; a planner whose start may leave out a condition the
       method it starts imposes says so there).
+    * ``least_duration(problem)`` says, cheaply and without optimising (a closed form, a small
+      search), the least duration its reference for ``problem`` can take, or ``None`` (the
+      default) when it cannot say: ``slewbench validate`` predicts from it a slew that ends after
+      ``maneuver.duration``, the time budget (the row ``infeasible``,
+      :func:`scenarios.requirements.scoring.late_slew`), before anything is planned.
     * ``honours`` names the scenario requirements (:data:`REQUIREMENT_KINDS`) the planner imposes
       on its references (:meth:`honoured`: with given options): ``"pointing"`` (``problem.pointing``, every window and moving direction
       included), ``"actuators"`` (the actuators' limits tightened by ``problem.actuator_margin``),
@@ -206,6 +211,27 @@ class Planner(Configurable, ABC):
         """
         if problem.qf is None:
             return f"planner {self.name} needs a target attitude (maneuver.final.q)"
+        return None
+
+    def least_duration(self, problem: ManeuverProblem) -> float | None:
+        """The least duration of the reference this planner would plan for ``problem``, said
+        cheaply, without optimising; ``None`` when it cannot say so (the default).
+
+        ``slewbench validate`` compares it with ``maneuver.duration``, every planner's time budget:
+        a planner whose least duration exceeds the budget has an ``infeasible`` row, said before
+        planning. Only a planner that knows its duration in closed form (or by a search of
+        milliseconds) overrides this; a lower bound is enough, a guess is not.
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The problem to plan (:meth:`problem_error` accepts it).
+
+        Returns
+        -------
+        float or None
+            The least duration [s], or ``None``.
+        """
         return None
 
     def start_error(self, problem: ManeuverProblem) -> str | None:

@@ -37,7 +37,7 @@ for ``min_time`` (iterated from no reserve up to the least duration that covers 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Annotated, Any, Literal
 
 import casadi as ca
@@ -672,6 +672,17 @@ def _smallest_cap(*caps: float) -> float:
     return float(np.min(values, initial=np.inf))
 
 
+def _rounded_up(value: float, digits: int = 4) -> str:
+    """``value`` (> 0) rounded up to ``digits`` significant digits: a duration to suggest, never
+    below the one needed (42.0534 -> ``42.06``)."""
+    exponent = int(np.floor(np.log10(value)))
+    step = 10.0 ** (exponent - digits + 1)
+    up = np.ceil(value / step * (1 - 1e-15)) * step
+    if up < value:
+        up += step
+    return f"{up:.{max(0, digits - 1 - exponent)}f}"
+
+
 def _environment_loads_the_wheels(problem: ManeuverProblem, environment: tuple[Array, float]) -> bool:
     """Whether the environment has a torque (``environment``: the constant disturbance and the
     gravity gradient's bound) and a working wheel a momentum bound: then the momentum the
@@ -724,6 +735,46 @@ class EigenaxisPlanner(Planner):
             True for the ``min_time`` profile (the fastest bang-coast-bang about the eigenaxis).
         """
         return getattr(options, "profile", None) == "min_time"
+
+    def least_duration(self, problem: ManeuverProblem) -> float | None:
+        """The least duration of the bang profiles, in closed form (a search of milliseconds with
+        wheels spanning fewer than three axes): ``min_time``'s slew, and the fastest
+        bang-coast-bang under ``trapezoidal``'s bounds (its momentum reserve over T), below which
+        it is ``infeasible`` (:meth:`planners.base.Planner.least_duration`).
+
+        Parameters
+        ----------
+        problem : ManeuverProblem
+            The problem to plan.
+
+        Returns
+        -------
+        float or None
+            The duration [s]; ``None`` for ``smooth`` (planned over T), for a problem the planner
+            refuses and where the fastest profile itself is infeasible (its own reason, said
+            when it is planned).
+        """
+        if self.options.profile == "smooth" or self.problem_error(problem) is not None:
+            return None
+        fastest = type(self)(replace(self.options, profile="min_time"))
+        if self.options.profile == "min_time":
+            reference = fastest.plan(problem)
+        else:  # trapezoidal: the fastest profile under its own budget (the environment's momentum over T)
+            axis, angle = self._axis_angle(problem)
+            if angle < 1e-12:
+                return None
+            max_rate = problem.rate_bound(self.options.max_rate, self.options.rate_margin)
+            reference = fastest._plan_bang(problem, axis, angle, max_rate, problem.duration,
+                                           problem.environment_torque_bound(problem.duration))
+        return float(reference.duration) if reference.ok else None
+
+    @staticmethod
+    def _axis_angle(problem: ManeuverProblem) -> tuple[Array, float]:
+        """The eigenaxis (unit, body axes) and the angle [rad] of the rotation from ``q0`` to ``qf``."""
+        assert problem.qf is not None  # problem_error (the default) refuses a free attitude
+        rotvec = quat.to_rotation_vector(quat.error(problem.qf, problem.q0))
+        angle = float(np.linalg.norm(rotvec))
+        return (rotvec / angle if angle > 1e-12 else np.array([1.0, 0.0, 0.0])), angle
 
     @dataclass(frozen=True)
     class Options:
@@ -802,10 +853,7 @@ class EigenaxisPlanner(Planner):
             else "the problem's: maneuver.max_rate, else requirements.rate.max"
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
-        assert problem.qf is not None  # problem_error (the default) refuses a free attitude
-        rotvec = quat.to_rotation_vector(quat.error(problem.qf, problem.q0))
-        angle = float(np.linalg.norm(rotvec))
-        axis = rotvec / angle if angle > 1e-12 else np.array([1.0, 0.0, 0.0])
+        axis, angle = self._axis_angle(problem)
         inertia = problem.spacecraft.inertia
         max_rate = problem.rate_bound(self.options.max_rate, self.options.rate_margin)
         if self.options.profile == "smooth":
@@ -918,8 +966,8 @@ class EigenaxisPlanner(Planner):
             return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,
                                       f"minimum time {profile.duration:.3f} s, {profile.rate_words()} ({words})", problem)
         if problem.duration < profile.duration * (1 - 1e-12):
-            return FailedReference(self.name, f"T = {problem.duration:g} s is shorter than the fastest bang-coast-bang "
-                                   f"this planner verifies, {profile.duration:.4g} s ({words})", "infeasible")
+            return FailedReference(self.name, self._too_short(problem, profile.duration, f"the fastest bang-coast-bang "
+                                   f"this planner verifies, {profile.duration:.6g} s ({words})"), "infeasible")
         stretch = problem.duration / profile.duration
         slower = BangCoastBangProfile(angle, profile.alpha / stretch**2, profile.rate_max / stretch)
         if max(budget.integrated_ratios(slower)) > 1 + 1e-9:
@@ -930,6 +978,17 @@ class EigenaxisPlanner(Planner):
         return EigenaxisReference(problem.q0, axis, slower, problem.duration, inertia,
                                   f"bang-coast-bang, {slower.rate_words()} (the fastest verified "
                                   f"profile stretched to T; {words})", problem)
+
+    def _too_short(self, problem: ManeuverProblem, least: float, shortest: str) -> str:
+        """Why ``trapezoidal`` cannot plan over ``maneuver.duration`` (T), shorter than ``least`` [s]
+        (``shortest`` says which profile takes it, and under what), and what to change."""
+        fraction = self.options.torque_fraction
+        levers = (f"a torque_fraction above {fraction:g} (planners[].options), " if fraction < 1 else "") + \
+            "larger actuator limits (spacecraft.wheels or spacecraft.torquers: max_torque, max_momentum)"
+        if problem.actuator_margin:
+            levers += " or a smaller requirements.actuators.margin"
+        return (f"maneuver.duration, the manoeuvre's time budget (T = {problem.duration:g} s), is shorter than "
+                f"{shortest}; a maneuver.duration of at least {_rounded_up(least)} s admits it, or {levers}")
 
     def _bang(self, problem: ManeuverProblem, axis: Array, angle: float, max_rate: float | None,
               budget: WheelBudget, profile_name: str) -> Reference:
@@ -994,9 +1053,9 @@ class EigenaxisPlanner(Planner):
                 bounds_words += f" and the rate bound {max_rate:g} rad/s ({self._rate_source(problem)})"
             if momentum_words:
                 bounds_words += " and the wheels' momentum bound"
-            return FailedReference(self.name, f"T = {problem.duration:g} s is shorter than the minimum "
-                                   f"bang-coast-bang time {minimum_time:.4g} s under {bounds_words}, for its slew of "
-                                   f"{np.rad2deg(angle):.4g} deg to the final attitude", "infeasible")
+            return FailedReference(self.name, self._too_short(problem, minimum_time, f"the minimum bang-coast-bang "
+                                   f"time {minimum_time:.6g} s under {bounds_words}, for its slew of "
+                                   f"{np.rad2deg(angle):.4g} deg to the final attitude"), "infeasible")
         # Fixed T: the slowest coast rate w with w (T − w/α(w)) = Θ.
         def covered(w: float) -> float:
             alpha = acceleration(w)

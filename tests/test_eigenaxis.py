@@ -126,7 +126,7 @@ def test_a_duration_too_short_under_the_rate_bound_names_it():
                               max_rate=0.01)
     reference = PLANNERS["eigenaxis"]({"profile": "trapezoidal"}).plan(problem)
     assert reference.status == "infeasible"
-    assert f"time {1.57 / 0.01 + 0.01 * 12.6 / 0.1:.4g} s under the torque bounds and the rate bound 0.01 rad/s " \
+    assert f"time {1.57 / 0.01 + 0.01 * 12.6 / 0.1:.6g} s under the torque bounds and the rate bound 0.01 rad/s " \
            "(the problem's: maneuver.max_rate, else requirements.rate.max)" in reference.message
 
 

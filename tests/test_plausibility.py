@@ -4,6 +4,7 @@ YAML path, its value and the physical reason, printed by ``validate`` (a finding
 from __future__ import annotations
 
 import copy
+import re
 from pathlib import Path
 
 import numpy as np
@@ -121,24 +122,55 @@ def test_an_inertia_far_too_large_for_its_torque_warns_at_ten_times_the_window()
     assert len(said) == 1, said
     assert said[0].startswith("spacecraft.inertia: [1400.0, 1400.0, 1400.0] kg m² (least principal moment 1400 "), said
     assert "‖τ‖ = 1.73 N m" in said[0] and "180 deg rest-to-rest slew takes at least 101 s" in said[0], said
-    assert "10 times maneuver.duration (10 s)" in said[0] and "is the inertia in kg m²" in said[0], said
+    assert "10 times maneuver.duration (10 s, the manoeuvre's time budget)" in said[0] and "is the inertia in kg m²" in said[0], said
     assert slew_warnings(1350.0) == []
 
 
-def test_the_slews_window_is_the_longer_of_the_manoeuvre_and_the_simulation():
+def test_the_slews_window_is_the_budget_not_the_simulation():
+    """maneuver.duration is every planner's time budget: a longer simulation.duration changes
+    nothing (it did: 20 s moved the bar to 200 s, k = 5513)."""
     def longer(d):
-        d["simulation"]["duration"] = 20.0  # ten times it is 200 s: 2 √(π k / √3) > 200 from k = 5513
-    assert slew_warnings(1400.0, longer) == []
-    said = slew_warnings(5600.0, longer)
-    assert len(said) == 1 and "times simulation.duration (20 s)" in said[0], said
-    assert slew_warnings(5400.0, longer) == []
+        d["simulation"]["duration"] = 20.0
+    said = slew_warnings(1400.0, longer)
+    assert len(said) == 1 and "10 times maneuver.duration (10 s, the manoeuvre's time budget)" in said[0], said
+    assert "simulation.duration" not in said[0]
+    assert slew_warnings(1350.0, longer) == []
+
+
+def test_the_slow_slew_warning_says_what_the_rows_become_not_that_they_fail():
+    said = slew_warnings(1400.0)
+    assert "fails" not in said[0], said
+    assert ("no slew within it stays within the actuators' torque bound: a planner that takes its own time ends "
+            "after the budget (its row infeasible)") in said[0], said
+
+
+DEMO = read_yaml(ROOT / "scenarios" / "eigenaxis_demo.yaml")
+
+
+def demo_warnings(scale: float) -> list[str]:
+    data = copy.deepcopy(DEMO)
+    data["spacecraft"]["inertia"] = [v * scale for v in data["spacecraft"]["inertia"]]
+    return [str(warning) for warning in plausibility_warnings(parse_scenario(data))]
+
+
+def test_eigenaxis_demo_warns_from_the_factor_the_guide_states():
+    """By hand: least moment 12.6 kg m², wheels 0.1 N m on the body axes (‖τ‖ = 0.1 √3), 90 deg:
+    2 √(π/2 x 12.6 / 0.1732) = 21.379 s, 0.178 of the 120 s budget; k x the inertia warns when
+    21.379 √k > 1200 s, k > 3150.45. A hundred times (213.8 s) does not."""
+    assert demo_warnings(100.0) == []
+    assert demo_warnings(3150.0) == []
+    said = demo_warnings(3151.0)
+    assert len(said) == 1 and said[0].startswith("spacecraft.inertia: ") and "10 times maneuver.duration (120 s" in said[0]
+    text = re.sub(r"\s+", " ", (ROOT / "docs" / "guide" / "scenarios.rst").read_text())
+    assert "``eigenaxis_demo`` (21.4 s of 120 s) warns from ``k`` = 3,151" in text
+    assert "none warns below ``k`` = 625" in text
 
 
 def test_a_cubesat_inertia_in_gram_square_millimetres_warns_and_one_ten_times_off_does_not():
     def scaled(factor):
         return lambda d: d["spacecraft"].update(inertia=[v * factor for v in d["spacecraft"]["inertia"]])
     said = warnings_of(scaled(1e7))
-    assert len(said) == 1 and said[0].startswith("spacecraft.inertia: ") and "every planner's slew fails" in said[0]
+    assert len(said) == 1 and said[0].startswith("spacecraft.inertia: ") and "its row infeasible" in said[0]
     assert warnings_of(scaled(10.0)) == []
 
 
@@ -239,8 +271,6 @@ def test_wheels_that_span_only_a_plane_warn_naming_the_missing_direction():
 
 
 def test_the_guide_states_the_slow_slew_bar_the_code_uses():
-    import re
-
     from scenarios.schema.plausibility import SLOW_SLEW_FACTOR
     text = re.sub(r"\s+", " ", (ROOT / "docs" / "guide" / "scenarios.rst").read_text())
-    assert f"exceeds {SLOW_SLEW_FACTOR:g} times its window" in text
+    assert f"exceeds {SLOW_SLEW_FACTOR:g} times its time budget (``maneuver.duration``)" in text

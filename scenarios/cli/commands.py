@@ -174,12 +174,18 @@ def _validate_table(file: str) -> tuple[str, list[str]]:
     refine = (f"; refined to a tolerance of {spec.refine.tolerance:g} (at most {spec.refine.max_axes} axes, "
               f"{spec.refine.max_rounds} rounds)" if spec.refine is not None else "; no refinement")
     findings = []
+    entries = len(spec.axes) * len(spec.angles_deg) + spec.held_out * mids
+    command = f"slewbench {OTHER_FILES['table']} {file}"
     try:  # the table command's own check, with its default limit
-        check_table_work(spec, len(spec.axes) * len(spec.angles_deg) + spec.held_out * mids)
+        check_table_work(spec, entries)
     except ScenarioError as error:
         findings.append(f"`slewbench {OTHER_FILES['table']}` refuses it without an option: {error}")
-    return (f"{file}: valid slew table {spec.name!r}: {axes} x {len(spec.angles_deg)} angles{held_out}, "
-            f"{spec.objective}{refine}; run it with `slewbench {OTHER_FILES['table']} {file}`", findings)
+    # what the table command does with the file as it is: runs it, or refuses it (then neither valid nor run-it)
+    verdict, how = (("slew table", f"`{command}` refuses it as it is (below): change the file, or confirm the "
+                                   f"work with `{command} --max-entries {entries}`") if findings
+                    else ("valid slew table", f"run it with `{command}`"))
+    return (f"{file}: {verdict} {spec.name!r}: {axes} x {len(spec.angles_deg)} angles{held_out}, "
+            f"{spec.objective}{refine}; {how}", findings)
 
 
 _OTHER_VALIDATORS = {"study": _validate_study, "table": _validate_table}
@@ -239,7 +245,8 @@ def command_validate(args: argparse.Namespace) -> int:
     doomed, warned = _doomed_notes(scenario), plausibility_warnings(scenario)
     for warning in warned:
         print(f"  warning: {warning}")
-    said = ([f"no row can be ok ({len(doomed)} note(s) above say every row must fail)"] if doomed else []) + \
+    said = ([f"no row can be ok ({len(doomed)} note(s) above say every row is infeasible, fails or breaks a "
+             "requirement)"] if doomed else []) + \
         ([f"{len(warned)} plausibility warning(s) above"] if warned else [])
     return _strict_status(args, [*doomed, *map(str, warned)], "; ".join(said))
 
@@ -266,8 +273,8 @@ def _leaf_paths(value: Any, prefix: str) -> list[str]:
 
 
 def _doomed_notes(scenario: Scenario) -> list[str]:
-    """``validate``'s notes that every row must fail (``validate --strict`` exits 1 on any): the
-    lines of :func:`_before_planning` that doom every row.
+    """``validate``'s notes that no row can be ok (``validate --strict`` exits 1 on any): the
+    lines of :func:`_before_planning` that doom every row (``infeasible``, ``failed`` or ``violated``).
 
     Parameters
     ----------
@@ -307,7 +314,7 @@ def _before_planning(scenario: Scenario) -> list[tuple[str, bool]]:
         Each line and whether it dooms every row.
     """
     from planners.capabilities import minimises_time
-    from scenarios.requirements.scoring import endpoint_violations
+    from scenarios.requirements.scoring import endpoint_violations, late_slew
     from scenarios.schema.checks import rate_bound_notes
 
     requirements = scenario.requirements
@@ -317,11 +324,16 @@ def _before_planning(scenario: Scenario) -> list[tuple[str, bool]]:
         lines.append(("every planner's row fails, none can take it: "
                       + "; ".join(scenario.inapplicable[i] for i in sorted(scenario.inapplicable)), True))
     broken: dict[int, list[str]] = {}
-    if requirements and scenario.planners:
+    for i, spec in enumerate(scenario.planners):
+        if i in scenario.inapplicable:  # a planner that cannot take a study's case fails unplanned, as the runner makes its row
+            continue
         # per planner, as the runner proves it: a minimum-time planner's slew may end before T (its bound)
-        # (a planner that cannot take a study's case fails unplanned, as the runner makes its row)
-        broken = {i: endpoint_violations(scenario.problem, minimises_time(type(spec.planner), spec.planner.options))
-                  for i, spec in enumerate(scenario.planners) if i not in scenario.inapplicable}
+        found = (endpoint_violations(scenario.problem, minimises_time(type(spec.planner), spec.planner.options))
+                 if requirements else [])
+        least = spec.planner.least_duration(scenario.problem)  # a planner that can say its duration cheaply
+        late = late_slew(scenario.problem, least) if least is not None else ""
+        broken[i] = found + ([late] if late else [])
+    if scenario.planners:
         for sentence in dict.fromkeys(sentence for found in broken.values() for sentence in found):
             rows = [scenario.planners[i].label for i, found in broken.items() if sentence in found]
             who = ("every planner's row is" if len(rows) == count
@@ -535,13 +547,13 @@ def build_parser() -> argparse.ArgumentParser:
     """
     parser = argparse.ArgumentParser(
         prog="slewbench", description="Spacecraft attitude manoeuvre planning workbench",
-        epilog=f"exit status: {EXIT_OK} done (failed and violated rows are results); {EXIT_BAD_SCENARIO} bad "
+        epilog=f"exit status: {EXIT_OK} done (failed, infeasible and violated rows are results); {EXIT_BAD_SCENARIO} bad "
                f"scenario, study or table file, or output location (nothing written); {EXIT_INTERNAL} internal "
                f"error (a traceback on stderr) or run interrupted (Ctrl-C, SIGTERM); {EXIT_INTERRUPTED} "
                f"interrupted sweep or table (run it again to finish). Under run --strict or table --strict, "
                f"{EXIT_NOT_OK} also for a completed run with a row (or table entry) not ok: its files are "
                f"written and stderr says so ('slewbench: --strict: N of M ... not ok'); under validate --strict, "
-               f"{EXIT_NOT_OK} for a scenario (a study's case) whose notes say every row must fail or that has a "
+               f"{EXIT_NOT_OK} for a scenario (a study's case) whose notes say no row can be ok or that has a "
                f"plausibility warning, or a table "
                f"too large for `table` without --max-entries. Plugins: the "
                f"'slewbench.plugins' entry points of installed distributions and the modules or .py files of "
@@ -556,7 +568,9 @@ def build_parser() -> argparse.ArgumentParser:
     run_parser.add_argument("--all-metrics", action="store_true",
                             help="show every metric in the table, also those with no value in any row")
     run_parser.add_argument("--strict", action="store_true",
-                            help=f"exit {EXIT_NOT_OK} when any row is not ok (violated or failed), after writing the "
+                            help=f"exit {EXIT_NOT_OK} when any row is not ok (violated: it breaks a requirement; "
+                                 "infeasible: no motion meets the requirements or maneuver.duration, the time budget; "
+                                 "failed: a numerical failure), after writing the "
                                  "results (for continuous integration)")
     run_parser.add_argument("--export", action="append", choices=sorted(EXPORT_FORMATS), metavar="FORMAT",
                             help="also export the rows into <out>-FORMAT/ (formats: "
@@ -566,7 +580,8 @@ def build_parser() -> argparse.ArgumentParser:
     validate_parser.add_argument("file", help="scenario, study or slew-table YAML file (a study has the top-level key 'study', a table 'table')")
     validate_parser.add_argument("--strict", action="store_true",
                                  help=f"exit {EXIT_NOT_OK} when a scenario (a study's case) cannot have an ok row (a note "
-                                      "says every row must fail) or has a plausibility warning (a likely unit "
+                                      "says every row is infeasible, e.g. its slew longer than maneuver.duration, "
+                                      "fails, or breaks a requirement) or has a plausibility warning (a likely unit "
                                       "slip), or a table has more entries than `table` computes "
                                       "without --max-entries, after printing the check (for continuous integration)")
     validate_parser.set_defaults(handler=command_validate)

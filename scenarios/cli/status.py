@@ -22,8 +22,9 @@ EXIT_NOT_OK = 1
 """``slewbench run --strict``: the run completed and wrote its results, and some row is not ``ok``
 (``violated``, ``infeasible`` or ``failed``); ``slewbench table --strict``: the table's files are written, and some
 entry of the table or of its held-out grid is not ``ok``; ``slewbench validate --strict``: the
-scenario is valid, but a note says every row must fail (an end point already breaks a requirement,
-a boundary rate is above the rate bound): for users' continuous integration."""
+scenario is valid, but a note says no row can be ok (an end point already breaks a requirement, a
+slew longer than ``maneuver.duration``: ``infeasible``; a boundary rate above the rate bound:
+``violated``): for users' continuous integration."""
 EXIT_CRASHED = 1
 """``slewbench sweep``: every case ran and the tables are written, but some cases crashed (raised,
 ran out of ``case_timeout_s`` or killed their worker): they have no result, and ``--resume`` runs
