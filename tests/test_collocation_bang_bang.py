@@ -170,8 +170,8 @@ def test_the_message_counts_the_coarse_seeds_as_they_were_tried(exact):
         seeds = exact[name].stats["seeds"]
         message = exact[name].message
         if seeds["tried"] == 1:
-            assert ", from 1 seed;" in message and "of 1 seeds" not in message, message
+            assert ", from 1 seed):" in message and "of 1 seeds" not in message, message
         else:
-            assert f", {seeds['agreed']} of {seeds['tried']} seeds agreed there;" in message, message
+            assert f", {seeds['agreed']} of {seeds['tried']} seeds agreed there):" in message, message
     assert exact["full_inertia_150"].stats["seeds"]["tried"] == 1
     assert exact["bilimoria_wie_180"].stats["seeds"]["tried"] == 2
