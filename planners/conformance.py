@@ -43,7 +43,7 @@ from planners.torque_free import REST_RATE
 __all__ = ["ATTITUDE_TOLERANCE", "CHECKS", "CLOSED_FORM_TOLERANCE", "DETERMINISM_PROBLEMS", "FINITE_SAMPLES",
            "NORM_TOLERANCE", "RATE_TOLERANCE", "RELATIVE_TOLERANCE", "Check", "check_after_end", "check_boundary",
            "check_closed_form", "check_deterministic", "check_dynamics", "check_ends", "check_finite",
-           "check_kinematics", "check_reference", "check_times", "check_vectorised", "closed_form_check_times",
+           "check_kinematics", "check_least_duration", "check_reference", "check_times", "check_vectorised", "closed_form_check_times",
            "declares_closed_form", "declared_ends", "determinism_problem", "finite_check_times", "standard_problems"]
 
 ATTITUDE_TOLERANCE = 2e-5
@@ -790,6 +790,38 @@ def _deterministic(problem: ManeuverProblem, reference: Reference,
     _DETERMINISTIC.add(key)
 
 
+def check_least_duration(problem: ManeuverProblem, reference: Reference,
+                         planner: Planner | type[Planner] | None = None) -> None:
+    """The planner's :meth:`~planners.base.Planner.least_duration` is a lower bound of what it plans:
+    ``slewbench validate`` calls a row ``infeasible`` from it, before planning, so a least duration
+    above the reference's would doom a row the run makes ``ok``.
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The planned problem.
+    reference : Reference
+        The planner's reference for it.
+    planner : Planner, Planner subclass or None, optional
+        The planner that made it (an instance: its options); a class, or ``None`` (the class
+        registered under the reference's name, if any), with its default options.
+
+    Raises
+    ------
+    ConformanceError
+        The least duration exceeds the reference's duration (by more than 1e-9 of it: rounding).
+    """
+    if planner is None:
+        planner = PLANNERS.get(reference.planner)
+        if planner is None:
+            return
+    least = _fresh(planner).least_duration(problem) if isinstance(planner, type) else planner.least_duration(problem)
+    if least is not None and least > reference.duration * (1.0 + 1e-9):  # rounding, no more
+        raise ConformanceError(f"{reference.planner}: least_duration says {least:.9g} s, above the "
+                               f"{reference.duration:.9g} s it plans: validate would call a plannable row "
+                               "infeasible (least_duration must be a lower bound, or None)")
+
+
 CHECKS: dict[str, Check] = {
     "finite": _reference_only(check_finite),
     "boundary": _boundary,
@@ -800,6 +832,7 @@ CHECKS: dict[str, Check] = {
     "after_end": _reference_only(check_after_end),
     "closed_form": _closed_form,
     "deterministic": _deterministic,
+    "least_duration": check_least_duration,
 }
 """Every check, by name, in the order :func:`check_reference` runs them (``finite`` first: a NaN
 would read as another defect in the others): ``check(problem, reference, planner=None)`` raises

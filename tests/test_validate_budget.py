@@ -109,3 +109,25 @@ def test_the_strict_help_names_infeasible_rows():
              for name, parser in commands.choices.items() if name in ("run", "validate")}
     assert "infeasible" in helps["run"] and "violated" in helps["run"] and "failed" in helps["run"], helps
     assert "infeasible" in helps["validate"] and "must fail" not in helps["validate"], helps
+
+
+def test_the_conformance_check_refuses_a_least_duration_above_what_the_planner_plans():
+    """``least_duration`` is an extension point: a planner's least duration above its own plan
+    would make validate doom a row the run makes ok. The check runs over every registered planner
+    (tests/test_planner_conformance.py); here it refuses one that overstates and passes eigenaxis."""
+    from planners.conformance import CHECKS
+    from planners.errors import ConformanceError
+
+    problem = scenarios.parse_scenario(slew(70.0)).problem  # both bang profiles plannable (66.06 s)
+    for profile in ("min_time", "trapezoidal"):
+        planner = PLANNERS["eigenaxis"]({"profile": profile})
+        assert planner.plan(problem).ok
+        CHECKS["least_duration"](problem, planner.plan(problem), planner)
+
+    class Overstating(PLANNERS["eigenaxis"]):  # type: ignore[misc, valid-type]
+        def least_duration(self, problem):
+            return 1.01 * self.plan(problem).duration
+
+    planner = Overstating({"profile": "min_time"})
+    with pytest.raises(ConformanceError, match="least_duration says .* above the .* it plans"):
+        CHECKS["least_duration"](problem, planner.plan(problem), planner)
