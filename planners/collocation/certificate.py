@@ -413,12 +413,12 @@ def _shooting(model: AttitudeModel, arcs: int, fixed_rate: bool, steps: int = SH
     inputs, r = _flight(model, arcs, fixed_rate, steps)
     z = inputs[1]
     if arcs <= r.numel():
-        return ca.Function("shooting", inputs, [r, ca.jacobian(r, z)])
+        return ca.Function("shooting", inputs, [r, ca.densify(ca.jacobian(r, z))])
     # more switch times than conditions: T is minimised on them, Newton's method on the KKT
     # conditions, whose Hessian of ``λᵀ r`` this gives too
     multiplier = ca.MX.sym("lambda", r.numel())
     return ca.Function("shooting", [*inputs, multiplier],
-                       [r, ca.jacobian(r, z), ca.hessian(ca.dot(multiplier, r), z)[0]])
+                       [r, ca.densify(ca.jacobian(r, z)), ca.densify(ca.hessian(ca.dot(multiplier, r), z)[0])])
 
 
 def _rk4_error(model: AttitudeModel, x0: Array, z: Array, U: Array, disturbance: Array, xf: Array, fixed_rate: bool,
@@ -428,9 +428,9 @@ def _rk4_error(model: AttitudeModel, x0: Array, z: Array, U: Array, disturbance:
     the fourth power of the step, so ``r − r_2S = e (1 − 1/16)`` (``r_2S`` with ``2 steps``, the
     final miss alone)."""
     arcs = len(z)
-    flown = _mapped(model, f"switch miss {arcs} {fixed_rate} {2 * steps}", 1,
+    flown = _mapped(model, f"switch miss dense {arcs} {fixed_rate} {2 * steps}", 1,
                     lambda: ca.Function("miss", *_listed(_flight(model, arcs, fixed_rate, 2 * steps))))
-    finer = np.asarray(flown(x0, z, U, disturbance, xf), dtype=float).ravel()
+    finer = matrices(flown, x0, z, U, disturbance, xf)[0].ravel()
     return 16.0 / 15.0 * (np.asarray(r, dtype=float).ravel() - finer)
 
 
@@ -457,16 +457,17 @@ def _switch_times(t: Array, sigma: Array, low: Array, high: Array) -> tuple[Arra
         nonzero = np.flatnonzero(values)
         if nonzero.size and values[0] == 0:  # σ is 0 at the start: the first nonzero value decides
             first[control] = low[control] if values[nonzero[0]] > 0 else high[control]
-        for a, b in zip(nonzero[:-1], nonzero[1:]):
-            if values[a] * values[b] > 0:
-                continue
-            if b == a + 1:
-                times.append(t[a] + (t[b] - t[a]) * values[a] / (values[a] - values[b]))
-            else:  # exact zeros in between
-                times.append(0.5 * (t[a + 1] + t[b - 1]))
-            owners.append(control)
-    order = np.argsort(times, kind="stable")
-    return np.asarray(times, dtype=float)[order], np.asarray(owners, dtype=int)[order], first
+        a, b = nonzero[:-1], nonzero[1:]  # consecutive nonzero values
+        changes = ~(values[a] * values[b] > 0)  # of opposite signs (or NaN)
+        a, b = a[changes], b[changes]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            linear = t[a] + (t[b] - t[a]) * values[a] / (values[a] - values[b])
+        # exact zeros in between: the run's middle
+        times.append(np.where(b == a + 1, linear, 0.5 * (t[a + 1] + t[b - 1])))
+        owners.append(np.full(a.size, control))
+    switches = np.concatenate(times)
+    order = np.argsort(switches, kind="stable")
+    return switches[order], np.concatenate(owners)[order], first
 
 
 def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array, lbx: Array, ubx: Array,
@@ -550,11 +551,11 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
         U = np.repeat(first[:, None], arcs, axis=1)
         for arc, control in enumerate(owner, start=1):
             U[control, arc:] = low[control] + high[control] - U[control, arc - 1]
-        shooting = _mapped(model, f"switch shooting {arcs} {fixed_rate} {steps}", 1,
+        shooting = _mapped(model, f"switch shooting dense {arcs} {fixed_rate} {steps}", 1,
                            lambda: _shooting(model, arcs, fixed_rate, steps))
         stationary = 0.0
-        outputs = [np.asarray(m) for m in (shooting(x0, z, U, disturbance, xf) if arcs <= conditions else
-                                           shooting(x0, z, U, disturbance, xf, multiplier))]
+        outputs = (matrices(shooting, x0, z, U, disturbance, xf) if arcs <= conditions else
+                   matrices(shooting, x0, z, U, disturbance, xf, multiplier))
         if not all(np.all(np.isfinite(m)) for m in outputs):  # an arc far too long: the RK4 steps diverged
             return {"skipped": f"the shooting is not finite ({arcs - 1} switches)"}
         if arcs <= conditions:
@@ -708,7 +709,9 @@ def _costate_shooting(model: AttitudeModel, arcs: int, fixed_rate: bool, steps: 
     curvature = ca.jacobian(ca.vec(J), z) if arcs > r.numel() else ca.MX(0, 1)
     X = ca.horzcat(x0, *[c[:nx, :] for c in columns])
     G = ca.jacobian(r, ca.vertcat(x0, ca.vec(E)))
-    return ca.Function("costate_shooting", [x0, z, U, disturbance, xf, E], [r, J, curvature, X, G])
+    # dense (the structural zeros explicit): read through buffers (ocp.fast_call.matrices)
+    return ca.Function("costate_shooting", [x0, z, U, disturbance, xf, E],
+                       [ca.densify(m) for m in (r, J, curvature, X, G)])
 
 
 def _node_conditions(model: AttitudeModel) -> ca.Function:
@@ -719,7 +722,7 @@ def _node_conditions(model: AttitudeModel) -> ca.Function:
     sigma = ca.mtimes(ca.jacobian(f, u).T, p)
     pdot = -ca.mtimes(ca.jacobian(f, x).T, p)
     sigma_dot = ca.jtimes(sigma, ca.vertcat(x, p), ca.vertcat(f, pdot))
-    return ca.Function("node_conditions", [x, p, u, d], [ca.dot(p, f), sigma, sigma_dot])
+    return ca.Function("node_conditions", [x, p, u, d], [ca.densify(m) for m in (ca.dot(p, f), sigma, sigma_dot)])
 
 
 def _sign_test(times: Array, sigma: Array, sigma_dot: Array, U: Array, low: Array, high: Array) -> dict[str, Any]:
@@ -759,14 +762,6 @@ def _sign_test(times: Array, sigma: Array, sigma_dot: Array, U: Array, low: Arra
     h = ((times[:, -1] - times[:, 0]) / S)[:, None, None]  # (arcs, 1, 1)
     # inside each step: samples at s in [0, 1) and the cubic's extrema p'(s) = 0 in (0, 1)
     a, b, da, db = sigma[:, :-1], sigma[:, 1:], h * sigma_dot[:, :-1], h * sigma_dot[:, 1:]  # (arcs, S, nu)
-
-    def cubic(s: Array) -> Array:
-        return ((2 * s ** 3 - 3 * s ** 2 + 1) * a + (s ** 3 - 2 * s ** 2 + s) * da + (-2 * s ** 3 + 3 * s ** 2) * b
-                + (s ** 3 - s ** 2) * db)
-
-    fractions = np.arange(BANG_BANG_SAMPLES + 1) / (BANG_BANG_SAMPLES + 1)
-    samples = np.stack([cubic(np.full(a.shape, f)) for f in fractions], axis=2)  # (arcs, S, samples, nu)
-    sample_times = times[:, :-1, None] + h * fractions[None, None, :]  # (arcs, S, samples)
     A, B, C = 6 * a + 3 * da - 6 * b + 3 * db, -6 * a - 4 * da + 6 * b - 2 * db, da  # p'(s) = A s² + B s + C
     with np.errstate(divide="ignore", invalid="ignore"):
         root = np.sqrt(B ** 2 - 4 * A * C)
@@ -775,7 +770,15 @@ def _sign_test(times: Array, sigma: Array, sigma_dot: Array, U: Array, low: Arra
                             np.where(linear, np.nan, (-B + root) / (2 * A))], axis=2)  # (arcs, S, 2, nu)
     inside = np.isfinite(extrema) & (extrema > 0) & (extrema < 1)
     extrema = np.where(inside, extrema, 0.0)  # else the step's start, a sample already
-    extreme_values = np.stack([cubic(extrema[:, :, k]) for k in range(2)], axis=2)
+    # the cubic at the samples and the extrema at once: (arcs, S, samples + 2, nu)
+    fractions = np.arange(BANG_BANG_SAMPLES + 1) / (BANG_BANG_SAMPLES + 1)
+    s = np.concatenate([np.broadcast_to(fractions[None, None, :, None], (arcs, S, fractions.size, nu)), extrema],
+                       axis=2)
+    s2, s3 = s ** 2, s ** 3
+    a, b, da, db = a[:, :, None], b[:, :, None], da[:, :, None], db[:, :, None]
+    cubic = ((2 * s3 - 3 * s2 + 1) * a + (s3 - 2 * s2 + s) * da + (-2 * s3 + 3 * s2) * b + (s3 - s2) * db)
+    samples, extreme_values = cubic[:, :, :fractions.size], cubic[:, :, fractions.size:]
+    sample_times = times[:, :-1, None] + h * fractions[None, None, :]  # (arcs, S, samples)
     extreme_times = times[:, :-1, None, None] + h[..., None] * extrema
     # per control: every sample and extremum, its time, the arc's control; the arcs' last ends
     values = np.concatenate([samples.reshape(arcs, -1, nu), extreme_values.reshape(arcs, -1, nu), sigma[:, -1:]],
@@ -794,29 +797,23 @@ def _sign_test(times: Array, sigma: Array, sigma_dot: Array, U: Array, low: Arra
     agreement = switching_agreement(plain_u, low, high, plain / scale, relative_tolerance=BANG_BANG_SIGN)
     # the sign σ_i has on an arc: positive at the lower bound (the control minimises σ u)
     expected = np.where(np.abs(U - low[:, None]) <= 1e-9 * (1 + np.abs(low[:, None])), 1.0, -1.0)  # (nu, arcs)
-    signed = np.repeat(expected.T[:, None, :], values.shape[1], axis=1) * values / scale  # (arcs, points, nu)
+    signed = expected.T[:, None, :] * values / scale  # (arcs, points, nu)
     # the switches: which controls each flips, σ_i and σ̇_i there (the two arcs' ends' mean)
-    flips = U[:, 1:] != U[:, :-1]  # (nu, arcs − 1)
-    zero, slope = 0.0, np.inf
-    owned: list[list[float]] = [[] for _ in range(nu)]
-    for k, i in zip(*np.nonzero(flips.T)):
-        value = 0.5 * (sigma[k, -1, i] + sigma[k + 1, 0, i])
-        rate = 0.5 * (sigma_dot[k, -1, i] + sigma_dot[k + 1, 0, i])
-        zero = max(zero, abs(value) / scale[i])
-        slope = min(slope, expected[i, k + 1] * rate * T / scale[i])  # rising into the next arc's sign
-        owned[i].append(float(times[k, -1]))
-    wrong, margins = 0.0, np.full(nu, np.inf)
-    for i in range(nu):
-        t, v = every_time[..., i].ravel(), signed[..., i].ravel()
-        switches = np.asarray(owned[i])
-        distance = np.min(np.abs(t[:, None] - switches[None, :]), axis=1) if switches.size else np.full(t.shape, np.inf)
-        away = distance > 1e-9 * T
-        wrong = max(wrong, float(np.max(-v[away], initial=0.0)))
-        if largest[i] == 0.0:
-            margins[i] = 0.0
-            continue
-        relative = np.abs(values[..., i].ravel()[away]) / largest[i]  # to its own largest
-        margins[i] = float(np.min(relative / np.minimum(1.0, distance[away] / T), initial=np.inf))
+    k, i = np.nonzero((U[:, 1:] != U[:, :-1]).T)  # (arc before, control) per flip, in time order
+    value = 0.5 * (sigma[k, -1, i] + sigma[k + 1, 0, i])
+    rate = 0.5 * (sigma_dot[k, -1, i] + sigma_dot[k + 1, 0, i])
+    # (Python's max and min over the flips in order, as a loop would take them: the first of equal values)
+    zero = max([0.0, *(np.abs(value) / scale[i])])
+    slope = min([np.inf, *(expected[i, k + 1] * rate * T / scale[i])])  # rising into the next arc's sign
+    # per sample and control, the distance to the nearest switch of that control
+    switch_times = np.where(i[:, None] == np.arange(nu)[None, :], times[k, -1][:, None], np.inf)  # (flips, nu)
+    distance = np.min(np.abs(every_time[..., None, :] - switch_times), axis=2, initial=np.inf)  # (arcs, points, nu)
+    away = distance > 1e-9 * T
+    wrong = float(max([0.0, *np.max(np.where(away, -signed, 0.0), axis=(0, 1), initial=0.0)]))  # per control first
+    with np.errstate(divide="ignore", invalid="ignore"):
+        relative = np.abs(values) / largest / np.minimum(1.0, distance / T)  # to its own largest
+    margins = np.min(np.where(away, relative, np.inf), axis=(0, 1))
+    margins = np.where(largest == 0.0, 0.0, margins)
     return {"agreement": agreement, "wrong_sign": wrong, "zero": zero,
             "strictness": float(min(slope, float(np.min(margins, initial=np.inf))))}
 
@@ -880,9 +877,9 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
     gradient[-1] = 1.0
     S, finer = SHOOTING_STEPS, False
     while True:  # the RK4 steps per arc as time_error chooses them (SHOOTING_RICHARDSON), or more for H
-        function = model.solver_cache.get(("bang-bang certificate", arcs, fixed_rate, S),
+        function = model.solver_cache.get(("bang-bang certificate dense", arcs, fixed_rate, S),
                                           lambda: _costate_shooting(model, arcs, fixed_rate, S))
-        r, J, curvature, X, G = (np.asarray(m) for m in function(x0, z, U, disturbance, xf, np.zeros((nx, arcs * S))))
+        r, J, curvature, X, G = matrices(function, x0, z, U, disturbance, xf, np.zeros((nx, arcs * S)))
         r = r.ravel()
         # the multipliers: e_T + Jᵀ ν = 0 (solved, or in the least-squares sense)
         nu_ = np.linalg.lstsq(J.T, -gradient, rcond=None)[0]
@@ -901,10 +898,9 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
         P = (nu_ @ G).reshape(-1, nx).T  # (nx, N + 1)
         ends = np.arange(arcs)[:, None] * S + np.arange(S + 1)[None, :]  # (arcs, S + 1) step ends per arc
         points = ends.size
-        node = _mapped(model, "bang-bang node conditions", points, lambda: _node_conditions(model))
-        pf, sigma, sigma_dot = (np.asarray(m) for m in node(X[:, ends.ravel()], P[:, ends.ravel()],
-                                                           np.repeat(U, S + 1, axis=1),
-                                                           np.tile(disturbance, (points, 1)).T))
+        node = _mapped(model, "bang-bang node conditions dense", points, lambda: _node_conditions(model))
+        pf, sigma, sigma_dot = matrices(node, X[:, ends.ravel()], P[:, ends.ravel()], np.repeat(U, S + 1, axis=1),
+                                        np.tile(disturbance, (points, 1)).T)
         hamiltonian = float(np.max(np.abs(1.0 + pf)))
         if hamiltonian <= BANG_BANG_HAMILTONIAN or S >= SHOOTING_MAX_STEPS or finer:
             break
