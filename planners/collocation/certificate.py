@@ -729,12 +729,15 @@ def _final_miss(model: AttitudeModel, fixed_rate: bool) -> tuple[ca.SX, ca.SX, c
     return x, xf, ca.vertcat(vector, x[4:7] - xf[4:7]) if fixed_rate else vector
 
 
-def _costate_shooting(model: AttitudeModel, arcs: int, fixed_rate: bool, steps: int = SHOOTING_STEPS) -> ca.Function:
+def _costate_shooting(model: AttitudeModel, arcs: int, fixed_rate: bool, steps: int = SHOOTING_STEPS,
+                      jacobians: bool = True) -> ca.Function:
     """``(x0, z, U, d, xf, E) -> (r, ∂r/∂z, ∂vec(∂r/∂z)/∂z, X, G)``: the shooting of :func:`_shooting`
     (the same RK4 steps, ``steps`` per arc) with its states ``X (nx, N + 1)`` at the steps' ends
     (``N`` = ``arcs steps``) and ``G = ∂r/∂[x_0, …, x_N] (m, nx (N + 1))``, the sensitivity of
     the final miss to a jump ``E`` (zero) of the state after each step: ``νᵀ G`` is the discrete
-    co-state (the adjoint of the RK4 steps) of the multipliers ``ν``."""
+    co-state (the adjoint of the RK4 steps) of the multipliers ``ν``. Without ``jacobians``,
+    ``(x0, z, U, d, xf, E) -> (X, G)`` (``r`` and ``∂r/∂z`` from :func:`_shooting`: the same
+    numbers, the zero jumps adding nothing)."""
     nx = model.nx
     xt, u, h, d, e = (ca.SX.sym("xt", nx + 1), ca.SX.sym("u", model.nu), ca.SX.sym("h"), ca.SX.sym("d", 3),
                       ca.SX.sym("e", nx))
@@ -753,13 +756,14 @@ def _costate_shooting(model: AttitudeModel, arcs: int, fixed_rate: bool, steps: 
         state, start = ends[:, -1], z[k]
     xs, xfs, miss = _final_miss(model, fixed_rate)
     r = ca.Function("miss", [xs, xfs], [miss])(state[:nx], xf)
-    J = ca.jacobian(r, z)
-    curvature = ca.jacobian(ca.vec(J), z) if arcs > r.numel() else ca.MX(0, 1)
     X = ca.horzcat(x0, *[c[:nx, :] for c in columns])
     G = ca.jacobian(r, ca.vertcat(x0, ca.vec(E)))
+    outputs = [X, G]
+    if jacobians:
+        J = ca.jacobian(r, z)
+        outputs = [r, J, ca.jacobian(ca.vec(J), z) if arcs > r.numel() else ca.MX(0, 1), X, G]
     # dense (the structural zeros explicit): read through buffers (ocp.fast_call.matrices)
-    return ca.Function("costate_shooting", [x0, z, U, disturbance, xf, E],
-                       [ca.densify(m) for m in (r, J, curvature, X, G)])
+    return ca.Function("costate_shooting", [x0, z, U, disturbance, xf, E], [ca.densify(m) for m in outputs])
 
 
 def _node_conditions(model: AttitudeModel) -> ca.Function:
@@ -925,9 +929,18 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
     gradient[-1] = 1.0
     S, finer = SHOOTING_STEPS, False
     while True:  # the RK4 steps per arc as time_error chooses them (SHOOTING_RICHARDSON), or more for H
-        function = model.solver_cache.get(("bang-bang certificate dense", arcs, fixed_rate, S),
-                                          lambda: _costate_shooting(model, arcs, fixed_rate, S))
-        r, J, curvature, X, G = _evaluate(function, x0, z, U, disturbance, xf, np.zeros((nx, arcs * S)))
+        if arcs <= conditions:  # r and ∂r/∂z by the shooting's sensitivities (time_error's, kept), X and G alone here
+            shooting = _mapped(model, f"switch shooting dense {arcs} {fixed_rate} {S}", 1,
+                               lambda: _shooting(model, arcs, fixed_rate, S))
+            r, J = _evaluate(shooting, x0, z, U, disturbance, xf)
+            function = model.solver_cache.get(("bang-bang co-state", arcs, fixed_rate, S),
+                                              lambda: _costate_shooting(model, arcs, fixed_rate, S, jacobians=False))
+            X, G = _evaluate(function, x0, z, U, disturbance, xf, np.zeros((nx, arcs * S)))
+            curvature = np.zeros((0, 1))
+        else:
+            function = model.solver_cache.get(("bang-bang certificate dense", arcs, fixed_rate, S),
+                                              lambda: _costate_shooting(model, arcs, fixed_rate, S))
+            r, J, curvature, X, G = _evaluate(function, x0, z, U, disturbance, xf, np.zeros((nx, arcs * S)))
         r = r.ravel()
         # the multipliers: e_T + Jᵀ ν = 0 (solved, or in the least-squares sense)
         nu_ = np.linalg.lstsq(J.T, -gradient, rcond=None)[0]
