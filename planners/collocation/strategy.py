@@ -84,6 +84,31 @@ Neighbouring values do about as well (mu_init 1e-8 to 1e-5, pushes 1e-4 to 1e-2:
 iterations over the three); a multiplier push of 1e-2 does not (34 to 41), nor IPOPT's tiny pushes
 of a same-mesh warm start (1e-9: 20 and 12 on the minimum-time cases)."""
 
+COARSE_MIN_TIME_PERTURBATION = {"ipopt.perturb_inc_fact": 2.5}
+"""IPOPT's inertia-correction option for the cold starts of minimum time (a free final time, no energy or
+L1 term, no cones) on ``coarse_intervals``: the Hessian perturbation δw grows by 2.5 (IPOPT's default
+8) per rejected trial factorization after the first of an iteration. Near the eigenaxis saddle of
+Bilimoria & Wie the coarse iterations need δw > 0 and IPOPT tries several δw per iteration (δw = 0
+first, then its last δw cut by ``perturb_dec_fact``, then grown); growing by 8 overshoots, and the
+larger δw shortens the steps. Measured 2026-12-04 against IPOPT's default (the same optima):
+
+- Bilimoria & Wie's two coarse starts 32 + 19 iterations against 39 + 22, 112 MUMPS numerical
+  factorizations against 128 over the coarse solves of it and the full-inertia case (print level 7);
+  callgrind over the plans of Bilimoria & Wie, the full inertia and the spin paper's case 616 M
+  instructions in IPOPT against 683 M (0.90x; 3: 645 M, 4: 628 M);
+- ``tests/benchmarks/iteration_counts.py``: only Bilimoria & Wie changes (61 coarse iterations
+  against 51; its shot optimum the same, switch times within 1e-15 s); XTE 40 + 28 against 50 + 26,
+  Bilimoria & Wie at 90 deg 37 + 29 against 42 + 28, at 45 deg 37 + 41 against 45 + 51 (1.74709403,
+  the same minimum to 4e-11), at 135 deg 23 + 20 against 22 + 20.
+
+Its neighbours on Bilimoria & Wie (factorizations of the two cases' coarse solves): 2 142, 2.2
+130, 2.7 115, 3 119, 3.5 116, 4 114, 5 121, 20 137. With ``perturb_dec_fact`` 0.2 or 0.25, or
+``first_hessian_perturbation`` 1e-3 or 1e-2, or ``perturb_inc_fact_first`` 50 or 300 besides, no
+better (110 to 133). Rejected because another local minimum follows on mt17 of
+``iteration_counts.py`` (10.22393 against 10.30034), as with any start moved there: ``bound_push`` =
+``bound_frac`` 0.02 to 0.1 (87 factorizations at 0.1) and ``alpha_for_y`` ``min-dual-infeas`` (104).
+``min_refinement_steps`` 0: 679 M against 683 M, the same iterations (not worth a constant)."""
+
 TRANSFER_MAX_INTERVALS = 150
 """Largest full mesh solved from the coarse optimum with its multipliers carried over (IPOPT's
 ``warm_start_init_point``, :data:`TRANSFER_WARM_START`); beyond it the full mesh starts from the
