@@ -141,6 +141,45 @@ STRICT_LINES_SHOWN = 10
 """Lines of a study's per-case findings ``validate`` prints (the others are counted)."""
 
 
+def study_findings(study: Any) -> list[str]:
+    """What ``validate`` finds in a study's cases (``sweep --dry-run`` says the same): each case's
+    :func:`_strict_findings` (rows that cannot be ok, a slew longer than ``maneuver.duration`` by a
+    planner's ``least_duration`` among them, and plausibility warnings), naming the case and its
+    varied values.
+
+    Parameters
+    ----------
+    study : scenarios.study.Study
+        The expanded, checked study.
+
+    Returns
+    -------
+    list of str
+        ``case N [path=value, ...]: <finding>``, in case order; empty when there is none.
+    """
+    findings = []
+    for case in study.cases:
+        values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
+        where = f"case {case.index}" + (f" [{values}]" if values else "")
+        findings += [f"{where}: {line}" for line in _strict_findings(parse_scenario(case.scenario, inapplicable_rows=True))]
+    return findings
+
+
+def print_findings(findings: list[str]) -> None:
+    """Print findings as ``validate`` does: two spaces in, the first :data:`STRICT_LINES_SHOWN`, the
+    others counted (``  ... and 3 more``).
+
+    Parameters
+    ----------
+    findings : list of str
+        The lines (:func:`study_findings`, a table's).
+    """
+    for line in findings[:STRICT_LINES_SHOWN]:
+        print("  " + line)
+    if len(findings) > STRICT_LINES_SHOWN:
+        print(f"  ... and {len(findings) - STRICT_LINES_SHOWN} more")
+
+
 def _validate_study(file: str) -> tuple[str, list[str]]:
     """A study file, every case expanded and checked as ``sweep`` checks it before running (its
     parser imported here: ``run`` needs none); the findings are each case's :func:`_strict_findings`,
@@ -150,11 +189,7 @@ def _validate_study(file: str) -> tuple[str, list[str]]:
     study = load_study(file)
     points = len({case.point for case in study.cases})
     varied = ", ".join(study.varied_paths) or "nothing"
-    findings = []
-    for case in study.cases:
-        values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
-        where = f"case {case.index}" + (f" [{values}]" if values else "")
-        findings += [f"{where}: {line}" for line in _strict_findings(parse_scenario(case.scenario, inapplicable_rows=True))]
+    findings = study_findings(study)
     return (f"{file}: valid study {study.name!r}: {len(study.cases)} cases ({points} grid point(s) x "
             f"{study.samples} sample(s)), varying {varied}; run it with `slewbench {OTHER_FILES['study']} {file}`",
             findings)
@@ -228,10 +263,7 @@ def command_validate(args: argparse.Namespace) -> int:
             args.file_kind = f"{key} file"  # how main() names its errors
             summary, findings = _OTHER_VALIDATORS[key](args.file)
             print(summary)
-            for line in findings[:STRICT_LINES_SHOWN]:
-                print("  " + line)
-            if len(findings) > STRICT_LINES_SHOWN:
-                print(f"  ... and {len(findings) - STRICT_LINES_SHOWN} more")
+            print_findings(findings)
             return _strict_status(args, findings, f"{len(findings)} finding(s) above")
     refuse_unmarked_base(data, args.file)
     scenario = parse_scenario(data, Path(args.file))

@@ -386,7 +386,11 @@ def _local_workers() -> int:
 
 def _list_cases(study: Study, workers: int) -> None:
     """Print what ``sweep`` would run: the checked cases and their varied values (nothing written),
-    and for a large study how to estimate its time (:func:`scenarios.study.spec.size_note`)."""
+    for a large study how to estimate its time (:func:`scenarios.study.spec.size_note`), and what
+    ``validate`` finds in the cases (:func:`scenarios.cli.commands.study_findings`: a case whose
+    rows cannot be ok, such as a slew longer than ``maneuver.duration`` by a planner's
+    ``least_duration``; plausibility warnings)."""
+    from scenarios.cli.commands import print_findings, study_findings
     from scenarios.study.spec import size_note
 
     varied = [*study.grid_paths, *study.mc_paths]
@@ -401,6 +405,11 @@ def _list_cases(study: Study, workers: int) -> None:
               + (f": {values}" if values else ""))
     if len(study.cases) > DRY_RUN_SHOWN:
         print(f"  ... and {len(study.cases) - DRY_RUN_SHOWN} more")
+    findings = study_findings(study)  # what `validate` says of the cases, said the same way
+    if findings:
+        print(f"{len(findings)} finding(s), as `slewbench validate` says them (cases whose rows cannot be ok, "
+              "a slew longer than maneuver.duration among them; plausibility warnings):")
+        print_findings(findings)
 
 
 def resume_command(args: argparse.Namespace, out: Path) -> str:
