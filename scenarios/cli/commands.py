@@ -43,7 +43,7 @@ from scenarios.output.directory import (
     written_files,
 )
 from scenarios.output.export import EXPORT_FORMATS, default_export_directory, export_run
-from scenarios.output.names import default_output_directory
+from scenarios.output.names import default_output_directory, suffix_note
 from scenarios.output.provenance import package_version
 from scenarios.output.writer import check_run_directory, plot_streamer, run_files
 from scenarios.runner import final_accuracy_note, run
@@ -484,6 +484,9 @@ def command_run(args: argparse.Namespace) -> int:
     results.write(out, plots=not args.no_plots, renderer=renderer)
     print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
           f"{'' if args.no_plots else ', PNG plots, report.html'}) in {time.perf_counter() - start:.2f} s")
+    renamed = suffix_note([row.label for row in results.rows], "results.json and results.csv")
+    if renamed:
+        print(renamed)
     removed = sorted(earlier - written_files(out))
     if removed:
         print(f"removed {len(removed)} file(s) of the earlier run in {out}/ that this run did not write: "

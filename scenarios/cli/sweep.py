@@ -31,7 +31,7 @@ from scenarios.cli.status import (
 )
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, claim_output_directory, written_files
-from scenarios.output.names import default_output_directory
+from scenarios.output.names import default_output_directory, suffix_note
 from scenarios.output.provenance import package_version
 from scenarios.output.tables import is_missing
 from scenarios.output.writer import check_run_directory
@@ -148,6 +148,9 @@ def command_case(args: argparse.Namespace) -> int:
     rerun.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
     print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
           f"{'' if args.no_plots else ', PNG plots, report.html'})")
+    renamed = suffix_note([row.label for row in rerun.rows], "results.json and results.csv")
+    if renamed:
+        print(renamed)
     record = results.records.get(case.key)
     if record is None:
         print(f"case {case.index} is not stored in {directory}/ (the sweep did not run it yet): nothing to compare")
@@ -507,6 +510,12 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
           + f"; of the {len(records)} cases stored, {crashed} crashed and {others}; wrote {out}/ ({', '.join(files)})")
     _say_removed(out, earlier)
     rows = results.table()[1]
+    labels: dict[Any, list[str]] = {}
+    for row in rows:  # each case's rows (the same labels in every case, but for a study that varies one)
+        labels.setdefault(row["case"], []).append(row["label"])
+    for renamed in dict.fromkeys(suffix_note(case, "cases.csv") for case in labels.values()):
+        if renamed:
+            print(renamed)
     for said in (collapse_note(study), _final_note(study, rows)):
         if said:
             print(said)

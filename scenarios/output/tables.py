@@ -55,7 +55,9 @@ __all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTI
 RUN_COLUMNS = ("file_stem",)
 """The columns a run's ``results.csv`` (and :meth:`~scenarios.output.results.RunResults.to_dataframe`)
 has after :func:`row_columns`: ``file_stem``, the stem of the row's files (``timeseries/<file_stem>.csv``,
-``<file_stem>.png``; :func:`~scenarios.output.names.row_stems`). A trade study's ``cases.csv`` has none."""
+``<file_stem>.png``; :func:`~scenarios.output.names.row_stems`). A trade study's ``cases.csv`` has it
+last too: the stem of the row's files when its case is re-run in full (``slewbench sweep DIR --case N``,
+:func:`scenarios.study.report.case_table`)."""
 IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused",
                     "needed_duration_s")
 """The columns that name a row and say how its reference was had, before its metrics: ``plan_time_s``

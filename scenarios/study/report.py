@@ -25,8 +25,10 @@ from ocp.metrics import METRIC_INFO
 from scenarios.output.directory import (
     new_staging,
 )
+from scenarios.output.names import row_stems
 from scenarios.output.provenance import environment, package_version, utc_stamp
 from scenarios.output.tables import (
+    RUN_COLUMNS,
     csv_text,
     flatten_row,
     is_missing,
@@ -88,10 +90,14 @@ def case_table(study: Study, records: dict[str, dict[str, Any]]) -> tuple[list[s
     -------
     columns : list of str
         ``case``, ``seed``, the varied paths, then a run's columns
-        (:func:`scenarios.output.tables.row_columns`, with the stored rows' requirement columns).
+        (:func:`scenarios.output.tables.row_columns`, with the stored rows' requirement columns),
+        then :data:`~scenarios.output.tables.RUN_COLUMNS` (``file_stem``).
     rows : list of dict
         One per case and planner (and controller), keyed by column: the stored row flattened by
-        :func:`scenarios.output.tables.flatten_row`.
+        :func:`scenarios.output.tables.flatten_row`, and its ``file_stem``: the stem of its files when
+        the case is re-run in full (``slewbench sweep DIR --case N`` writes
+        ``cases/N/timeseries/<file_stem>.csv``), :func:`~scenarios.output.names.row_stems` of the
+        case's labels, as a run records it.
     """
     table = []
     stored = []
@@ -99,10 +105,11 @@ def case_table(study: Study, records: dict[str, dict[str, Any]]) -> tuple[list[s
         record = records.get(case.key)
         if record is None:
             continue
-        for row in record["rows"]:
+        stems = row_stems([str(row.get("label")) for row in record["rows"]])
+        for row, stem in zip(record["rows"], stems):
             stored.append(row)
-            table.append({"case": case.index, "seed": case.seed, **case.varied, **flatten_row(row)})
-    columns = ["case", "seed", *study.varied_paths, *row_columns(requirement_columns(stored))]
+            table.append({"case": case.index, "seed": case.seed, **case.varied, **flatten_row(row), "file_stem": stem})
+    columns = ["case", "seed", *study.varied_paths, *row_columns(requirement_columns(stored)), *RUN_COLUMNS]
     return columns, table
 
 
