@@ -228,7 +228,8 @@ _OTHER_VALIDATORS = {"study": _validate_study, "table": _validate_table}
 a summary line and the findings that fail ``validate --strict``."""
 _COMMAND_FILES = {"sweep": "study file", "table": "table file"}
 """What a command's file is called in its errors (``error in <kind>:``) where it is not a scenario;
-``validate`` sets ``file_kind`` on its arguments once it knows."""
+``validate`` sets ``file_kind`` on its arguments once it knows. Such an error names the file
+(``error in study file: FILE: execution.scheduler: ...``), where its own text does not."""
 
 
 def command_validate(args: argparse.Namespace) -> int:
@@ -763,6 +764,12 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         kind = "option" if error.path.startswith("--") else getattr(args, "file_kind", None) or \
             _COMMAND_FILES.get(args.command, "scenario")
         text = str(error)
+        given = getattr(args, "file", None)
+        if kind in _COMMAND_FILES.values():  # a study's or a table's error names its file (its YAML path follows)
+            if not given:
+                kind = "the command line"  # no file given: nothing to name
+            elif str(given) not in text:
+                text = f"{given}: {text}"
         # a message that starts with the file it names (a file whose kind is not known yet) names it once
         print(f"slewbench: error in {text}" if text.startswith(f"{kind}: ") else f"slewbench: error in {kind}: {text}",
               file=sys.stderr)
