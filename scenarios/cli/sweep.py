@@ -79,7 +79,7 @@ def command_report(args: argparse.Namespace) -> int:
     out = Path(args.report)
     results, _ = stored_results(out)
     earlier = written_files(out)
-    files = results.write(out, plots=not args.no_plots)
+    files = results.write(out, plots=not args.no_plots, progress=True)
     crashed = sum(record.get("status") == "crashed" for record in results.records.values())
     print(f"redrew {out}/ ({', '.join(files)}) from {len(results.records)} stored case(s)"
           + (f" ({crashed} crashed: no result; `--resume` runs them again)" if crashed else "")
@@ -493,7 +493,7 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
         signal.signal(signal.SIGTERM, previous)
     earlier = written_files(out)
     try:
-        files = results.write(out, plots=not args.no_plots)
+        files = results.write(out, plots=not args.no_plots, progress=True)
     except KeyboardInterrupt:
         print(f"slewbench: sweep interrupted while its tables were written; every case is stored in "
               f"{out / STORE_NAME} and the directory is marked incomplete. Write them with:\n"

@@ -1207,10 +1207,10 @@ def rate_violations(problem: ManeuverProblem) -> list[str]:
     rule). Whatever the boundary rates (the bound holds at every time, the ends included). Refused
     only beyond the scoring's own slack (``_TOLERANCE``).
     """
-    least = rate_least_duration(problem)
-    if least is None or least <= problem.duration * (1.0 + _TOLERANCE):
+    least, bound = rate_least_duration(problem), problem.rate_requirement
+    if least is None or bound is None or least <= problem.duration * (1.0 + _TOLERANCE):
         return []
-    theta, bound = least * problem.rate_requirement, problem.rate_requirement
+    theta = least * bound
     return [f"rate: the slew turns {np.rad2deg(theta):.4g} deg (the principal angle from maneuver.initial.q to "
             f"maneuver.final.q); at ‖ω‖ at most {bound:g} rad/s (requirements.rate.max) it takes at least "
             f"θ/ω_max = {least:.4g} s, more than the {problem.duration:g} s bound (maneuver.duration); no "
