@@ -44,7 +44,7 @@ if TYPE_CHECKING:
 
     from scenarios.output.results import RunResults
 
-__all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTITY_COLUMNS", "REFUSED_CERTIFICATE",
+__all__ = ["BUDGET_COLUMNS", "CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTITY_COLUMNS", "REFUSED_CERTIFICATE",
            "ROW_STATUSES", "RUN_COLUMNS",
            "csv_cell", "csv_text",
            "data_frame", "flatten_row", "html_table", "is_missing", "json_safe", "numeric_columns",
@@ -58,14 +58,16 @@ has after :func:`row_columns`: ``file_stem``, the stem of the row's files (``tim
 ``<file_stem>.png``; :func:`~scenarios.output.names.row_stems`). A trade study's ``cases.csv`` has it
 last too: the stem of the row's files when its case is re-run in full (``slewbench sweep DIR --case N``,
 :func:`scenarios.study.report.case_table`)."""
-IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused",
-                    "needed_duration_s")
+IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused")
 """The columns that name a row and say how its reference was had, before its metrics: ``plan_time_s``
 the planner's wall time [s], ``plan_reused`` whether the reference was reused from an earlier case of
 identical planning inputs (:func:`scenarios.runner.run`'s ``references``; then ``plan_time_s`` is that
-plan's), True or False, missing in the rows of a sweep stored before the column existed;
-``needed_duration_s`` [s], for an ``infeasible`` row whose slew does not fit ``maneuver.duration``, the
-least budget known to be needed (:func:`scenarios.runner.needed_duration`), empty for any other row."""
+plan's), True or False, missing in the rows of a sweep stored before the column existed."""
+BUDGET_COLUMNS = ("needed_duration_s",)
+"""The columns after :data:`IDENTITY_COLUMNS` that say what time budget a row needs: ``needed_duration_s``
+[s], for an ``infeasible`` row whose slew does not fit ``maneuver.duration``, the least budget known to be
+needed (:func:`scenarios.runner.needed_duration`); empty for any other row (and in the rows of a sweep
+stored before the column existed). Shown in a report only where some row has a value, as a metric is."""
 FLAG_COLUMNS = ("plan_reused",)
 """The columns of :data:`IDENTITY_COLUMNS` that hold a bool: pandas' nullable ``boolean`` in a
 DataFrame (``<NA>`` where missing)."""
@@ -157,8 +159,8 @@ def requirement_columns(rows: Iterable[Mapping[str, Any]]) -> list[str]:
 
 
 def row_columns(requirements: Sequence[str] = ()) -> list[str]:
-    """The columns of a flat row: :data:`IDENTITY_COLUMNS`, :func:`metric_columns`,
-    :data:`CERTIFICATE_COLUMNS`, then the requirement columns given.
+    """The columns of a flat row: :data:`IDENTITY_COLUMNS`, :data:`BUDGET_COLUMNS`,
+    :func:`metric_columns`, :data:`CERTIFICATE_COLUMNS`, then the requirement columns given.
 
     Parameters
     ----------
@@ -168,10 +170,10 @@ def row_columns(requirements: Sequence[str] = ()) -> list[str]:
     Returns
     -------
     list of str
-        ``label, planner, controller, status, message, plan_time_s, plan_reused, ref.int_u2, ...,
-        certificate, ..., ref.req...``.
+        ``label, planner, controller, status, message, plan_time_s, plan_reused, needed_duration_s,
+        ref.int_u2, ..., certificate, ..., ref.req...``.
     """
-    return [*IDENTITY_COLUMNS, *metric_columns(), *CERTIFICATE_COLUMNS, *requirements]
+    return [*IDENTITY_COLUMNS, *BUDGET_COLUMNS, *metric_columns(), *CERTIFICATE_COLUMNS, *requirements]
 
 
 def numeric_columns(requirements: Sequence[str] = ()) -> list[str]:
@@ -189,7 +191,7 @@ def numeric_columns(requirements: Sequence[str] = ()) -> list[str]:
         ``plan_time_s``, ``needed_duration_s``, every metric column, the certificate's KKT residuals and the requirement
         columns given but the verdicts (``<scope>.req.<name>.met``: bools).
     """
-    return ["plan_time_s", "needed_duration_s", *metric_columns(), *CERTIFICATE_NUMBERS,
+    return ["plan_time_s", *BUDGET_COLUMNS, *metric_columns(), *CERTIFICATE_NUMBERS,
             *(column for column in requirements if not is_verdict_column(column))]
 
 
@@ -209,7 +211,7 @@ def flatten_row(row: Mapping[str, Any]) -> dict[str, Any]:
         (no reference, not simulated, crashed) is ``None``, other values are as given (the
         writers apply the non-finite rule).
     """
-    flat = {name: row.get(name) for name in IDENTITY_COLUMNS}
+    flat = {name: row.get(name) for name in (*IDENTITY_COLUMNS, *BUDGET_COLUMNS)}
     for scope, prefix in SCOPES:
         metrics = row.get(scope) or {}
         for key in SCORED_METRICS:
