@@ -78,6 +78,8 @@ from scenarios.requirements.scoring import (
     late_slew,
     plant_limits,
     rate_jumps,
+    rate_least_duration,
+    rate_violations,
     reference_times,
     score_closed_loop,
     score_reference,
@@ -313,7 +315,8 @@ def run(scenario: Scenario, progress: Callable[[str], None] | None = None,
             reference, reference_metrics, sampled = planned[i]
             row = Row(label, planner_spec.name, reference.status, reference.message,
                       reference.plan_time_s, None if reference_metrics is None else dict(reference_metrics), None,
-                      reference, controller=controllers[j].name, plan_reused=reused.get(i, False))
+                      reference, controller=controllers[j].name, plan_reused=reused.get(i, False),
+                      needed_duration_s=needed_duration(scenario, planner_spec, reference, broken_ends[i]))
             if reference.ok:
                 _check_physical(row, "reference", row.reference_metrics)
                 if sampled is not None:
@@ -379,6 +382,50 @@ def _cross_check_optima(rows: list[Row]) -> None:
             reference.stats["certificate"] = with_costate_gap(record, abs(value - costate) / abs(costate))
         for reference, record, value in indirect:
             reference.stats["certificate"] = with_costate_gap(record, abs(best_direct - value) / abs(value))
+
+
+def needed_duration(scenario: Scenario, planner_spec: PlannerSpec, reference: Reference,
+                    proven: list[str]) -> float | None:
+    """The least ``maneuver.duration`` known to be needed by an ``infeasible`` row whose slew does
+    not fit its time budget (the row's ``needed_duration_s``).
+
+    The largest of: the refused reference's own duration, when it ends after ``maneuver.duration``
+    (:func:`~scenarios.requirements.scoring.late_slew`; a budget that long admits that slew); the
+    planner's :meth:`~planners.base.Planner.least_duration` when it exceeds the budget (a planner
+    that refuses the slew itself, or is refused before planning); the rate requirement's
+    ``θ / ω_max`` when it exceeds the budget (the proof before planning,
+    :func:`~scenarios.requirements.scoring.rate_violations`). None for any other row, and for a row
+    that an end point already breaking a pointing requirement makes infeasible (no budget admits it).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario.
+    planner_spec : PlannerSpec
+        The row's planner.
+    reference : planners.Reference
+        The row's reference (a refused or failed one for an infeasible row).
+    proven : list of str
+        What was proven before planning (:func:`~scenarios.requirements.scoring.endpoint_violations`
+        of the row's planner), empty when nothing was.
+
+    Returns
+    -------
+    float or None
+        [s], above ``maneuver.duration``; None when the row is not infeasible or no needed duration
+        is known.
+    """
+    problem = scenario.problem
+    if reference.status != "infeasible" or any(line not in rate_violations(problem) for line in proven):
+        return None
+    known = [reference.duration] if late_slew(problem, reference.duration) else []
+    least = planner_spec.planner.least_duration(problem)
+    if least is not None and late_slew(problem, least):
+        known.append(least)
+    rate = rate_least_duration(problem) if proven else None
+    if rate is not None:
+        known.append(rate)
+    return max(known) if known else None
 
 
 def plan_row(scenario: Scenario, planner_spec: PlannerSpec, cache: SolverCache | None,

@@ -54,7 +54,7 @@ def test_run_end_to_end_through_the_console_entry_point(tmp_path):
     assert results["scenario"] == "small" and [r["label"] for r in results["rows"]] == ["smooth", "fast"]
     for row in results["rows"]:
         assert set(row) == {"label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused",
-                            "reference", "closed_loop", "requirements", "certificate", "file_stem"}
+                            "needed_duration_s", "reference", "closed_loop", "requirements", "certificate", "file_stem"}
         assert (out / "timeseries" / f"{row['file_stem']}.csv").is_file()  # its files' stem
         assert row["plan_reused"] is False  # a run plans every row
         assert row["controller"] == "augmented_quaternion_feedback"

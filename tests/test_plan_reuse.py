@@ -194,7 +194,7 @@ def test_a_run_without_reference_reuse_plans_and_says_so(calls):
     assert [row.plan_reused for row in first.rows] == [False, False]
     assert [row.plan_reused for row in again.rows] == [True, True]
     assert [row.to_dict()["plan_reused"] for row in alone.rows] == [False, False]
-    assert "plan_reused,ref." in again.to_csv().splitlines()[0] and ",True," in again.to_csv().splitlines()[1]
+    assert "plan_reused,needed_duration_s,ref." in again.to_csv().splitlines()[0] and ",True," in again.to_csv().splitlines()[1]
 
 
 @pytest.fixture(scope="module")

@@ -84,7 +84,8 @@ def test_a_sweep_stores_the_requirement_columns_and_reports_the_fraction_met(tmp
     assert written[0]["met"] == "2" and written[0]["completed"] == "3"
     assert "## Cases meeting the requirements" in (tmp_path / "out" / "summary.md").read_text()
     cases = (tmp_path / "out" / "cases.csv").read_text().splitlines()[0].split(",")
-    assert cases[-1] == "cl.req.actuators.wheels_momentum_time_s"  # the closed loop's wheels, after its pointing
+    assert cases[-2:] == ["cl.req.actuators.wheels_momentum_time_s", "file_stem"]  # the closed loop's wheels, after
+    # its pointing, then the rows' file stem (as results.csv)
 
 
 def test_crashed_rows_do_not_count_as_completed():

@@ -204,7 +204,7 @@ def test_the_compact_table_hides_exactly_the_lines_without_a_value():
                               "closed_loop": {"cone": {"min_margin_deg": None}}})]
     results = RunResults(scenario, rows)
     full, compact = results.to_terminal(all_metrics=True), results.to_terminal()
-    everything = ["status", "plan_time_s", "certificate"] + [f"{prefix}.{key}" for _, prefix in SCOPES for key in SCORED_METRICS]
+    everything = ["status", "plan_time_s", "needed_duration_s", "certificate"] + [f"{prefix}.{key}" for _, prefix in SCOPES for key in SCORED_METRICS]
     shown = {"status", "plan_time_s", "ref.int_u", "ref.energy_ratio", "cl.final_error_deg", "cl.int_abs_u"}
 
     def names(text):

@@ -428,4 +428,4 @@ def test_a_bad_table_file_is_named_as_one(tmp_path, capsys):
     table = tmp_path / "table.yaml"
     table.write_text("table: {scenario: nowhere.yaml, axes: 6, angles_deg: [30, 90]}\n")
     assert main(["table", str(table), "--out", str(tmp_path / "out")]) == 2
-    assert capsys.readouterr().err.startswith("slewbench: error in table file: table.scenario: ")
+    assert capsys.readouterr().err.startswith(f"slewbench: error in table file: {table}: table.scenario: ")

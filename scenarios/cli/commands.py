@@ -43,7 +43,7 @@ from scenarios.output.directory import (
     written_files,
 )
 from scenarios.output.export import EXPORT_FORMATS, default_export_directory, export_run
-from scenarios.output.names import default_output_directory
+from scenarios.output.names import default_output_directory, suffix_note
 from scenarios.output.provenance import package_version
 from scenarios.output.writer import check_run_directory, plot_streamer, run_files
 from scenarios.runner import final_accuracy_note, run
@@ -141,6 +141,45 @@ STRICT_LINES_SHOWN = 10
 """Lines of a study's per-case findings ``validate`` prints (the others are counted)."""
 
 
+def study_findings(study: Any) -> list[str]:
+    """What ``validate`` finds in a study's cases (``sweep --dry-run`` says the same): each case's
+    :func:`_strict_findings` (rows that cannot be ok, a slew longer than ``maneuver.duration`` by a
+    planner's ``least_duration`` among them, and plausibility warnings), naming the case and its
+    varied values.
+
+    Parameters
+    ----------
+    study : scenarios.study.Study
+        The expanded, checked study.
+
+    Returns
+    -------
+    list of str
+        ``case N [path=value, ...]: <finding>``, in case order; empty when there is none.
+    """
+    findings = []
+    for case in study.cases:
+        values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
+        where = f"case {case.index}" + (f" [{values}]" if values else "")
+        findings += [f"{where}: {line}" for line in _strict_findings(parse_scenario(case.scenario, inapplicable_rows=True))]
+    return findings
+
+
+def print_findings(findings: list[str]) -> None:
+    """Print findings as ``validate`` does: two spaces in, the first :data:`STRICT_LINES_SHOWN`, the
+    others counted (``  ... and 3 more``).
+
+    Parameters
+    ----------
+    findings : list of str
+        The lines (:func:`study_findings`, a table's).
+    """
+    for line in findings[:STRICT_LINES_SHOWN]:
+        print("  " + line)
+    if len(findings) > STRICT_LINES_SHOWN:
+        print(f"  ... and {len(findings) - STRICT_LINES_SHOWN} more")
+
+
 def _validate_study(file: str) -> tuple[str, list[str]]:
     """A study file, every case expanded and checked as ``sweep`` checks it before running (its
     parser imported here: ``run`` needs none); the findings are each case's :func:`_strict_findings`,
@@ -150,11 +189,7 @@ def _validate_study(file: str) -> tuple[str, list[str]]:
     study = load_study(file)
     points = len({case.point for case in study.cases})
     varied = ", ".join(study.varied_paths) or "nothing"
-    findings = []
-    for case in study.cases:
-        values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
-        where = f"case {case.index}" + (f" [{values}]" if values else "")
-        findings += [f"{where}: {line}" for line in _strict_findings(parse_scenario(case.scenario, inapplicable_rows=True))]
+    findings = study_findings(study)
     return (f"{file}: valid study {study.name!r}: {len(study.cases)} cases ({points} grid point(s) x "
             f"{study.samples} sample(s)), varying {varied}; run it with `slewbench {OTHER_FILES['study']} {file}`",
             findings)
@@ -193,7 +228,8 @@ _OTHER_VALIDATORS = {"study": _validate_study, "table": _validate_table}
 a summary line and the findings that fail ``validate --strict``."""
 _COMMAND_FILES = {"sweep": "study file", "table": "table file"}
 """What a command's file is called in its errors (``error in <kind>:``) where it is not a scenario;
-``validate`` sets ``file_kind`` on its arguments once it knows."""
+``validate`` sets ``file_kind`` on its arguments once it knows. Such an error names the file
+(``error in study file: FILE: execution.scheduler: ...``), where its own text does not."""
 
 
 def command_validate(args: argparse.Namespace) -> int:
@@ -228,10 +264,7 @@ def command_validate(args: argparse.Namespace) -> int:
             args.file_kind = f"{key} file"  # how main() names its errors
             summary, findings = _OTHER_VALIDATORS[key](args.file)
             print(summary)
-            for line in findings[:STRICT_LINES_SHOWN]:
-                print("  " + line)
-            if len(findings) > STRICT_LINES_SHOWN:
-                print(f"  ... and {len(findings) - STRICT_LINES_SHOWN} more")
+            print_findings(findings)
             return _strict_status(args, findings, f"{len(findings)} finding(s) above")
     refuse_unmarked_base(data, args.file)
     scenario = parse_scenario(data, Path(args.file))
@@ -452,6 +485,9 @@ def command_run(args: argparse.Namespace) -> int:
     results.write(out, plots=not args.no_plots, renderer=renderer)
     print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
           f"{'' if args.no_plots else ', PNG plots, report.html'}) in {time.perf_counter() - start:.2f} s")
+    renamed = suffix_note([row.label for row in results.rows], "results.json and results.csv")
+    if renamed:
+        print(renamed)
     removed = sorted(earlier - written_files(out))
     if removed:
         print(f"removed {len(removed)} file(s) of the earlier run in {out}/ that this run did not write: "
@@ -728,6 +764,12 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         kind = "option" if error.path.startswith("--") else getattr(args, "file_kind", None) or \
             _COMMAND_FILES.get(args.command, "scenario")
         text = str(error)
+        given = getattr(args, "file", None)
+        if kind in _COMMAND_FILES.values():  # a study's or a table's error names its file (its YAML path follows)
+            if not given:
+                kind = "the command line"  # no file given: nothing to name
+            elif str(given) not in text:
+                text = f"{given}: {text}"
         # a message that starts with the file it names (a file whose kind is not known yet) names it once
         print(f"slewbench: error in {text}" if text.startswith(f"{kind}: ") else f"slewbench: error in {kind}: {text}",
               file=sys.stderr)

@@ -31,7 +31,7 @@ from scenarios.cli.status import (
 )
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, claim_output_directory, written_files
-from scenarios.output.names import default_output_directory
+from scenarios.output.names import default_output_directory, suffix_note
 from scenarios.output.provenance import package_version
 from scenarios.output.tables import is_missing
 from scenarios.output.writer import check_run_directory
@@ -79,7 +79,7 @@ def command_report(args: argparse.Namespace) -> int:
     out = Path(args.report)
     results, _ = stored_results(out)
     earlier = written_files(out)
-    files = results.write(out, plots=not args.no_plots)
+    files = results.write(out, plots=not args.no_plots, progress=True)
     crashed = sum(record.get("status") == "crashed" for record in results.records.values())
     print(f"redrew {out}/ ({', '.join(files)}) from {len(results.records)} stored case(s)"
           + (f" ({crashed} crashed: no result; `--resume` runs them again)" if crashed else "")
@@ -148,6 +148,9 @@ def command_case(args: argparse.Namespace) -> int:
     rerun.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
     print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
           f"{'' if args.no_plots else ', PNG plots, report.html'})")
+    renamed = suffix_note([row.label for row in rerun.rows], "results.json and results.csv")
+    if renamed:
+        print(renamed)
     record = results.records.get(case.key)
     if record is None:
         print(f"case {case.index} is not stored in {directory}/ (the sweep did not run it yet): nothing to compare")
@@ -386,7 +389,11 @@ def _local_workers() -> int:
 
 def _list_cases(study: Study, workers: int) -> None:
     """Print what ``sweep`` would run: the checked cases and their varied values (nothing written),
-    and for a large study how to estimate its time (:func:`scenarios.study.spec.size_note`)."""
+    for a large study how to estimate its time (:func:`scenarios.study.spec.size_note`), and what
+    ``validate`` finds in the cases (:func:`scenarios.cli.commands.study_findings`: a case whose
+    rows cannot be ok, such as a slew longer than ``maneuver.duration`` by a planner's
+    ``least_duration``; plausibility warnings)."""
+    from scenarios.cli.commands import print_findings, study_findings
     from scenarios.study.spec import size_note
 
     varied = [*study.grid_paths, *study.mc_paths]
@@ -401,6 +408,11 @@ def _list_cases(study: Study, workers: int) -> None:
               + (f": {values}" if values else ""))
     if len(study.cases) > DRY_RUN_SHOWN:
         print(f"  ... and {len(study.cases) - DRY_RUN_SHOWN} more")
+    findings = study_findings(study)  # what `validate` says of the cases, said the same way
+    if findings:
+        print(f"{len(findings)} finding(s), as `slewbench validate` says them (cases whose rows cannot be ok, "
+              "a slew longer than maneuver.duration among them; plausibility warnings):")
+        print_findings(findings)
 
 
 def resume_command(args: argparse.Namespace, out: Path) -> str:
@@ -481,7 +493,7 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
         signal.signal(signal.SIGTERM, previous)
     earlier = written_files(out)
     try:
-        files = results.write(out, plots=not args.no_plots)
+        files = results.write(out, plots=not args.no_plots, progress=True)
     except KeyboardInterrupt:
         print(f"slewbench: sweep interrupted while its tables were written; every case is stored in "
               f"{out / STORE_NAME} and the directory is marked incomplete. Write them with:\n"
@@ -498,6 +510,12 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
           + f"; of the {len(records)} cases stored, {crashed} crashed and {others}; wrote {out}/ ({', '.join(files)})")
     _say_removed(out, earlier)
     rows = results.table()[1]
+    labels: dict[Any, list[str]] = {}
+    for row in rows:  # each case's rows (the same labels in every case, but for a study that varies one)
+        labels.setdefault(row["case"], []).append(row["label"])
+    for renamed in dict.fromkeys(suffix_note(case, "cases.csv") for case in labels.values()):
+        if renamed:
+            print(renamed)
     for said in (collapse_note(study), _final_note(study, rows)):
         if said:
             print(said)

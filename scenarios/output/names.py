@@ -100,6 +100,33 @@ def row_stems(labels: Sequence[str]) -> list[str]:
     return [stem for stem in result if stem is not None]
 
 
+def suffix_note(labels: Sequence[str], recorded_in: str) -> str:
+    """The line that says which rows' file stems got a suffix (:func:`row_stems`: a label whose stem
+    another label's, or one of slewbench's own, already is), so that a user looking for
+    ``timeseries/<label>.csv`` finds its file.
+
+    Parameters
+    ----------
+    labels : sequence of str
+        The rows' labels, in order.
+    recorded_in : str
+        Where each row's ``file_stem`` is recorded (``results.json and results.csv``, ``cases.csv``).
+
+    Returns
+    -------
+    str
+        ``note: 1 row's file stem got a suffix, the label's stem being another row's or one of
+        slewbench's own (file_stem in results.json and results.csv): 'a/b' -> a_b-2``; empty when no
+        stem did.
+    """
+    renamed = [(label, stem) for label, stem in zip(labels, row_stems(labels)) if stem != sanitize(label)]
+    if not renamed:
+        return ""
+    count = f"{len(renamed)} row's file stem" if len(renamed) == 1 else f"{len(renamed)} rows' file stems"
+    return (f"note: {count} got a suffix, the label's stem being another row's or one of slewbench's own "
+            f"(file_stem in {recorded_in}): " + ", ".join(f"{label!r} -> {stem}" for label, stem in renamed))
+
+
 def default_output_directory(name: str, root: str | Path = "results") -> Path:
     """``results/<sanitised scenario name>``: always one level under ``root``.
 

@@ -93,6 +93,11 @@ class Row:
         identical planning inputs (a trade study's worker, :func:`scenarios.runner.run`'s
         ``references``); its ``plan_time_s`` is then that earlier plan's. Default False (planned
         for the row, or no planner: regulation mode, a crashed case).
+    needed_duration_s : float or None, optional
+        For an ``infeasible`` row whose slew does not fit ``maneuver.duration`` (its time budget),
+        the least budget known to be needed [s], above it
+        (:func:`scenarios.runner.needed_duration`): the refused reference's own duration, or a
+        lower bound proven before or instead of planning; None (default) for any other row.
     """
 
     label: str
@@ -108,6 +113,7 @@ class Row:
     controller: str | None = None
     requirements: dict[str, dict[str, dict[str, Any]]] | None = None
     plan_reused: bool = False
+    needed_duration_s: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The row's plain, nested form: a ``results.json`` row and a trade study's stored row.
@@ -119,7 +125,7 @@ class Row:
         -------
         dict
             ``label``, ``planner``, ``controller``, ``status``, ``message``, ``plan_time_s``,
-            ``plan_reused``, ``reference`` and ``closed_loop`` (the two metric dicts, or ``None``) and
+            ``plan_reused``, ``needed_duration_s``, ``reference`` and ``closed_loop`` (the two metric dicts, or ``None``) and
             ``requirements`` (the requirement scores by scope, name and field, or ``None``) and
             ``certificate`` (the reference's ``stats["certificate"]``, :mod:`ocp.nlp.certificate`,
             or ``None``: no reference, or a planner that writes none).
@@ -127,7 +133,8 @@ class Row:
         certificate = None if self.reference is None else self.reference.stats.get("certificate")
         return {"label": self.label, "planner": self.planner, "controller": self.controller,
                 "status": self.status, "message": self.message,
-                "plan_time_s": self.plan_time_s, "plan_reused": self.plan_reused, "reference": self.reference_metrics,
+                "plan_time_s": self.plan_time_s, "plan_reused": self.plan_reused,
+                "needed_duration_s": self.needed_duration_s, "reference": self.reference_metrics,
                 "closed_loop": self.closed_loop_metrics, "requirements": self.requirements,
                 "certificate": None if certificate is None else dict(certificate)}
 

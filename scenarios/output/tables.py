@@ -44,21 +44,30 @@ if TYPE_CHECKING:
 
     from scenarios.output.results import RunResults
 
-__all__ = ["CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTITY_COLUMNS", "ROW_STATUSES", "RUN_COLUMNS",
+__all__ = ["BUDGET_COLUMNS", "CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTITY_COLUMNS", "REFUSED_CERTIFICATE",
+           "ROW_STATUSES", "RUN_COLUMNS",
            "csv_cell", "csv_text",
            "data_frame", "flatten_row", "html_table", "is_missing", "json_safe", "numeric_columns",
-           "ratio_text", "requirement_columns", "requirement_units", "row_columns", "run_rows", "status_line", "text_cell", "to_csv",
+           "ratio_text", "refused_certificate", "requirement_columns", "requirement_units", "row_columns", "run_rows",
+           "status_line", "text_cell", "to_csv",
            "to_dataframe", "to_json", "to_markdown", "to_terminal"]
 
 RUN_COLUMNS = ("file_stem",)
 """The columns a run's ``results.csv`` (and :meth:`~scenarios.output.results.RunResults.to_dataframe`)
 has after :func:`row_columns`: ``file_stem``, the stem of the row's files (``timeseries/<file_stem>.csv``,
-``<file_stem>.png``; :func:`~scenarios.output.names.row_stems`). A trade study's ``cases.csv`` has none."""
+``<file_stem>.png``; :func:`~scenarios.output.names.row_stems`). A trade study's ``cases.csv`` has it
+last too: the stem of the row's files when its case is re-run in full (``slewbench sweep DIR --case N``,
+:func:`scenarios.study.report.case_table`)."""
 IDENTITY_COLUMNS = ("label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused")
 """The columns that name a row and say how its reference was had, before its metrics: ``plan_time_s``
 the planner's wall time [s], ``plan_reused`` whether the reference was reused from an earlier case of
 identical planning inputs (:func:`scenarios.runner.run`'s ``references``; then ``plan_time_s`` is that
 plan's), True or False, missing in the rows of a sweep stored before the column existed."""
+BUDGET_COLUMNS = ("needed_duration_s",)
+"""The columns after :data:`IDENTITY_COLUMNS` that say what time budget a row needs: ``needed_duration_s``
+[s], for an ``infeasible`` row whose slew does not fit ``maneuver.duration``, the least budget known to be
+needed (:func:`scenarios.runner.needed_duration`); empty for any other row (and in the rows of a sweep
+stored before the column existed). Shown in a report only where some row has a value, as a metric is."""
 FLAG_COLUMNS = ("plan_reused",)
 """The columns of :data:`IDENTITY_COLUMNS` that hold a bool: pandas' nullable ``boolean`` in a
 DataFrame (``<NA>`` where missing)."""
@@ -80,6 +89,31 @@ CERTIFICATE_NUMBERS = ("certificate_kkt_scaled", "certificate_kkt_unscaled")
 """The certificate columns that hold numbers."""
 _CERTIFICATE_KEYS = ("summary", "verdict", "kkt_scaled", "kkt_unscaled")
 """The certificate's keys behind :data:`CERTIFICATE_COLUMNS`, in order."""
+
+
+REFUSED_CERTIFICATE = "not applicable"
+"""The certificate cell of a row whose reference was refused (:func:`refused_certificate`) in the
+terminal table and ``results.md``: the certificate is of the planner's optimum, not of a motion the row
+tracks."""
+
+
+def refused_certificate(row: Any) -> bool:
+    """Whether a row's certificate is of a reference the row did not use: the planner's optimum that
+    the run refused (a slew that ends after ``maneuver.duration``, ``infeasible``; one that misses its
+    manoeuvre's ends, ``failed``), kept in ``results.json`` and ``results.csv`` as the planner's record.
+
+    Parameters
+    ----------
+    row : scenarios.output.results.Row
+        A run's row.
+
+    Returns
+    -------
+    bool
+        True when the row has a reference that is not ok (the run refused it, or the planner failed).
+    """
+    reference = getattr(row, "reference", None)
+    return reference is not None and not reference.ok
 
 
 def is_missing(value: Any) -> bool:
@@ -125,8 +159,8 @@ def requirement_columns(rows: Iterable[Mapping[str, Any]]) -> list[str]:
 
 
 def row_columns(requirements: Sequence[str] = ()) -> list[str]:
-    """The columns of a flat row: :data:`IDENTITY_COLUMNS`, :func:`metric_columns`,
-    :data:`CERTIFICATE_COLUMNS`, then the requirement columns given.
+    """The columns of a flat row: :data:`IDENTITY_COLUMNS`, :data:`BUDGET_COLUMNS`,
+    :func:`metric_columns`, :data:`CERTIFICATE_COLUMNS`, then the requirement columns given.
 
     Parameters
     ----------
@@ -136,10 +170,10 @@ def row_columns(requirements: Sequence[str] = ()) -> list[str]:
     Returns
     -------
     list of str
-        ``label, planner, controller, status, message, plan_time_s, plan_reused, ref.int_u2, ...,
-        certificate, ..., ref.req...``.
+        ``label, planner, controller, status, message, plan_time_s, plan_reused, needed_duration_s,
+        ref.int_u2, ..., certificate, ..., ref.req...``.
     """
-    return [*IDENTITY_COLUMNS, *metric_columns(), *CERTIFICATE_COLUMNS, *requirements]
+    return [*IDENTITY_COLUMNS, *BUDGET_COLUMNS, *metric_columns(), *CERTIFICATE_COLUMNS, *requirements]
 
 
 def numeric_columns(requirements: Sequence[str] = ()) -> list[str]:
@@ -154,10 +188,10 @@ def numeric_columns(requirements: Sequence[str] = ()) -> list[str]:
     Returns
     -------
     list of str
-        ``plan_time_s``, every metric column, the certificate's KKT residuals and the requirement
+        ``plan_time_s``, ``needed_duration_s``, every metric column, the certificate's KKT residuals and the requirement
         columns given but the verdicts (``<scope>.req.<name>.met``: bools).
     """
-    return ["plan_time_s", *metric_columns(), *CERTIFICATE_NUMBERS,
+    return ["plan_time_s", *BUDGET_COLUMNS, *metric_columns(), *CERTIFICATE_NUMBERS,
             *(column for column in requirements if not is_verdict_column(column))]
 
 
@@ -177,7 +211,7 @@ def flatten_row(row: Mapping[str, Any]) -> dict[str, Any]:
         (no reference, not simulated, crashed) is ``None``, other values are as given (the
         writers apply the non-finite rule).
     """
-    flat = {name: row.get(name) for name in IDENTITY_COLUMNS}
+    flat = {name: row.get(name) for name in (*IDENTITY_COLUMNS, *BUDGET_COLUMNS)}
     for scope, prefix in SCOPES:
         metrics = row.get(scope) or {}
         for key in SCORED_METRICS:
@@ -419,7 +453,10 @@ def _metric_lines(results: RunResults, requirements: bool = True,
     rows = [row.to_dict() for row in results.rows]
     lines = [("status", [row["status"] for row in rows]),
              ("plan_time_s", [text_cell(row["plan_time_s"]) for row in rows]),
-             ("certificate", [text_cell((row.get("certificate") or {}).get(certificate)) for row in rows])]
+             ("needed_duration_s", [text_cell(row["needed_duration_s"]) for row in rows]),
+             ("certificate", [REFUSED_CERTIFICATE if refused_certificate(original) and row.get("certificate")
+                              else text_cell((row.get("certificate") or {}).get(certificate))
+                              for original, row in zip(results.rows, rows)])]
     for scope, prefix in SCOPES:
         for key in SCORED_METRICS:
             lines.append((f"{prefix}.{key}", [text_cell((row[scope] or {}).get(key)) for row in rows]))
@@ -654,8 +691,11 @@ def to_terminal(results: RunResults, all_metrics: bool = False) -> str:
     header = " " * name_width + "  " + "  ".join(label.rjust(w) for label, w in zip(labels, widths))
     body = [name.ljust(name_width) + "  " + "  ".join(c.rjust(w) for c, w in zip(cells, widths)) for name, cells in lines]
     messages = [f"{row.label}: {row.message}" for row in results.rows if row.message]
-    summaries = [(row.label, (row.to_dict().get("certificate") or {}).get("summary")) for row in results.rows]
-    messages += [f"{label} certificate: {summary}" for label, summary in summaries if summary]
+    summaries = [(row, (row.to_dict().get("certificate") or {}).get("summary")) for row in results.rows]
+    messages += [f"{row.label} certificate: " + (f"{REFUSED_CERTIFICATE}, its reference was refused ({row.status}: the "
+                                                 f"message above); the planner's own optimum had {summary}"
+                                                 if refused_certificate(row) else summary)
+                 for row, summary in summaries if summary]
     note = [f"({len(hidden)} metrics with no value in any row not shown; --all-metrics shows them)"] if hidden else []
     if any(_BROKEN in cell for name, cells in lines if name.startswith("req.") for cell in cells):
         note.append(f"({_BROKEN.strip()}: that scope breaks the requirement; the messages below say how)")

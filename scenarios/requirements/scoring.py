@@ -82,7 +82,7 @@ from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requi
 __all__ = ["AT_LIMIT", "FINAL_FIELDS", "JUMP_FIELDS", "LATE_SLACK", "POINTING_FIELDS", "RATE_FIELDS",
            "REFERENCE_POINTS", "SCOPE_WORDS", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
            "closed_loop_wheels", "endpoint_violations", "late_slew", "plant_limits", "rate_jumps", "reference_times",
-           "score_closed_loop", "score_fields", "rate_violations", "score_reference", "start_torque", "target_slack",
+           "score_closed_loop", "score_fields", "rate_least_duration", "rate_violations", "score_reference", "start_torque", "target_slack",
            "tracking_loss", "unhonoured", "violations", "worst_error_between_samples"]
 
 Array = NDArray[np.float64]
@@ -1159,6 +1159,28 @@ def target_slack(constraint: PointingConstraint, duration: float, free_time: boo
     return float(constraint.drift * duration)
 
 
+def rate_least_duration(problem: ManeuverProblem) -> float | None:
+    """The least time the rate requirement lets a slew from ``q0`` to ``qf`` take, ``θ / ω_max``
+    (:func:`rate_violations` refuses a ``maneuver.duration`` below it).
+
+    Parameters
+    ----------
+    problem : ManeuverProblem
+        The manoeuvre (its end attitudes and ``rate_requirement``).
+
+    Returns
+    -------
+    float or None
+        ``θ / ω_max`` [s], ``θ`` the principal angle between the end attitudes [rad] and ``ω_max``
+        the rate requirement [rad/s]; None without a rate requirement or a target attitude.
+    """
+    bound = problem.rate_requirement
+    if bound is None or problem.qf is None:
+        return None
+    theta = 2.0 * float(np.arccos(min(1.0, abs(float(np.dot(problem.q0, problem.qf))))))
+    return theta / bound
+
+
 def rate_violations(problem: ManeuverProblem) -> list[str]:
     """The rate requirement that no motion from ``q0`` to ``qf`` within T can meet, before planning
     (part of :func:`endpoint_violations`; the runner makes such rows ``infeasible``, as every proof
@@ -1185,13 +1207,10 @@ def rate_violations(problem: ManeuverProblem) -> list[str]:
     rule). Whatever the boundary rates (the bound holds at every time, the ends included). Refused
     only beyond the scoring's own slack (``_TOLERANCE``).
     """
-    bound = problem.rate_requirement
-    if bound is None or problem.qf is None:
+    least, bound = rate_least_duration(problem), problem.rate_requirement
+    if least is None or bound is None or least <= problem.duration * (1.0 + _TOLERANCE):
         return []
-    theta = 2.0 * float(np.arccos(min(1.0, abs(float(np.dot(problem.q0, problem.qf))))))
-    least = theta / bound
-    if least <= problem.duration * (1.0 + _TOLERANCE):
-        return []
+    theta = least * bound
     return [f"rate: the slew turns {np.rad2deg(theta):.4g} deg (the principal angle from maneuver.initial.q to "
             f"maneuver.final.q); at ‖ω‖ at most {bound:g} rad/s (requirements.rate.max) it takes at least "
             f"θ/ω_max = {least:.4g} s, more than the {problem.duration:g} s bound (maneuver.duration); no "

@@ -164,7 +164,7 @@ class SweepResults:
         columns, rows = self.table()
         return data_frame(columns, rows, numeric_columns())
 
-    def write(self, directory: str | Path, plots: bool = True) -> list[str]:
+    def write(self, directory: str | Path, plots: bool = True, progress: bool = False) -> list[str]:
         """Write cases.csv, summary.csv, summary.md, study.yaml and plots.
 
         Parameters
@@ -173,6 +173,10 @@ class SweepResults:
             The output directory (claimed for slewbench; only files it listed are replaced).
         plots : bool, optional
             Also draw the PNG figures.
+        progress : bool, optional
+            Show the files written so far on standard error (``slewbench sweep`` does): a bar
+            on a terminal, elsewhere a line at most every 30 s and none for a quick write
+            (:func:`write_progress`). Default False.
 
         Returns
         -------
@@ -182,14 +186,15 @@ class SweepResults:
         Raises
         ------
         TypeError
-            ``directory`` is not a path or ``plots`` not a bool.
+            ``directory`` is not a path, or ``plots`` or ``progress`` not a bool.
         """
         if not isinstance(directory, (str, os.PathLike)):
             raise TypeError(f"directory must be a str or os.PathLike, got {type(directory).__name__}")
-        if not isinstance(plots, bool):
-            raise TypeError(f"plots must be True or False, got {excerpt(plots)}")
+        for name, value in (("plots", plots), ("progress", progress)):
+            if not isinstance(value, bool):
+                raise TypeError(f"{name} must be True or False, got {excerpt(value)}")
         from scenarios.study.report import write_report
-        return write_report(self, Path(directory), plots=plots)
+        return write_report(self, Path(directory), plots=plots, progress=progress)
 
     def __repr__(self) -> str:
         from scenarios.study.types import sweep_repr
@@ -430,7 +435,7 @@ class _Progress:
     the crashed cases that ran out of ``case_timeout_s`` are said apart, ``(1 crashed, 2 timed
     out)`` (a slew table's, whose entries then have their own status, ``timed_out``)."""
 
-    def __init__(self, name: str, total: int, clock: Callable[[], float] = time.monotonic,
+    def __init__(self, name: str, total: int | None, clock: Callable[[], float] = time.monotonic,
                  units: tuple[str, str] = ("case", "cases"), timeouts_apart: bool = False):
         self.name, self.total, self.clock, self.units = name, total, clock, units
         self.timeouts_apart = timeouts_apart
@@ -439,8 +444,9 @@ class _Progress:
         self.bar: Any = None
         if sys.stderr.isatty():
             from tqdm import tqdm
-            self.bar = tqdm(total=total, unit=units[0], desc=name[:40], dynamic_ncols=True, file=sys.stderr,
-                            mininterval=0.5)
+            # without a total, tqdm writes a count and a rate: "7 files [00:02, 3.1 files/s]"
+            self.bar = tqdm(total=total, unit=units[0] if total is not None else f" {units[1]}", desc=name[:40],
+                            dynamic_ncols=True, file=sys.stderr, mininterval=0.5)
             if not (self.bar.ncols or 0) > 0:  # a terminal reporting no size (0 x 0):
                 self.bar.dynamic_ncols, self.bar.ncols, self.bar.nrows = False, 80, None  # tqdm would draw nothing
 
@@ -450,8 +456,8 @@ class _Progress:
         timed = self.timed_out if self.timeouts_apart else 0
         kinds = [f"{count} {kind}" for count, kind in ((self.crashed - timed, "crashed"), (timed, "timed out")) if count]
         counts += f" ({', '.join(kinds)})" if kinds else ""
-        return (f"{self.name}: {self.done}/{self.total} {self.units[1]} done{counts}, "
-                f"{_duration(self.clock() - self.started)} elapsed")
+        done = self.done if self.total is None else f"{self.done}/{self.total}"
+        return f"{self.name}: {done} {self.units[1]} done{counts}, {_duration(self.clock() - self.started)} elapsed"
 
     def update(self, done: int, not_ok: int, crashed: int, timed_out: int = 0) -> None:
         """Cases stored: ``done`` more; ``not_ok`` and ``crashed`` cases so far (``timed_out`` of
@@ -463,21 +469,63 @@ class _Progress:
             self.bar.update(done)
         self.poll()
 
+    def advance(self, done: int = 1) -> None:
+        """Steps done: ``done`` more (a count without statuses: the files :func:`write_progress`
+        counts)."""
+        self.done += done
+        if self.bar is not None:
+            self.bar.update(done)
+        self.poll()
+
     def poll(self) -> None:
         """Off a terminal, say where the sweep is if the last line is :data:`PROGRESS_LINE_S` old."""
         if self.bar is None and self.clock() - self.said >= PROGRESS_LINE_S:
             self._say()
 
     def close(self) -> None:
-        """Close the bar, or say the last line (none for a sweep with nothing to run)."""
+        """Close the bar, or say the last line (none for a sweep with nothing to run; with no total,
+        none unless a line was said before: a quick count stays quiet)."""
         if self.bar is not None:
             self.bar.close()
-        elif self.total:
+        elif self.total if self.total is not None else self.said > self.started:
             self._say()
 
     def _say(self) -> None:
         self.said = self.clock()
         print(self.line(), file=sys.stderr, flush=True)
+
+
+def write_progress(name: str, enabled: bool) -> Any:
+    """The progress of writing a study's tables and figures, as a sweep's (:class:`_Progress`, no
+    total: the figures that apply are known as they are drawn): tqdm's bar on a terminal
+    (``NAME: writing: 7 files ...``); elsewhere a line at most every :data:`PROGRESS_LINE_S`, and
+    one at the end only if one was said (a quick write says nothing).
+
+    Parameters
+    ----------
+    name : str
+        The study's name.
+    enabled : bool
+        Show it; False: a progress that does nothing.
+
+    Returns
+    -------
+    object
+        ``advance(n)`` after each ``n`` files written, ``close()`` at the end.
+    """
+    if not enabled:
+        return _NoProgress()
+    return _Progress(f"{name}: writing", None, units=("file", "files"))
+
+
+class _NoProgress:
+    """:func:`write_progress` when not shown."""
+
+    def advance(self, done: int = 1) -> None:
+        """Nothing."""
+
+    def close(self) -> None:
+        """Nothing."""
 
 
 class _Engine:

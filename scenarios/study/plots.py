@@ -998,7 +998,7 @@ def _save(figure: Figure, directory: Path, name: str) -> str:
     return name
 
 
-def write_plots(study: Study, rows: list[dict[str, Any]], directory: Path) -> list[str]:
+def write_plots(study: Study, rows: list[dict[str, Any]], directory: Path, progress: Any = None) -> list[str]:
     """Every figure that applies to the study (:func:`figures`), as PNG files.
 
     Parameters
@@ -1009,10 +1009,18 @@ def write_plots(study: Study, rows: list[dict[str, Any]], directory: Path) -> li
         The ``cases.csv`` rows (:func:`scenarios.study.report.case_table`).
     directory : Path
         Where the PNG files are written (an existing folder).
+    progress : object, optional
+        Told of each file written, ``progress.advance()``
+        (:func:`scenarios.study.engine.write_progress`); None (default): nothing is.
 
     Returns
     -------
     list of str
         The file names written in ``directory``.
     """
-    return [_save(figure, directory, name) for name, figure in figures(study, rows)]
+    written = []
+    for name, figure in figures(study, rows):
+        written.append(_save(figure, directory, name))
+        if progress is not None:
+            progress.advance()
+    return written

@@ -25,8 +25,10 @@ from ocp.metrics import METRIC_INFO
 from scenarios.output.directory import (
     new_staging,
 )
+from scenarios.output.names import row_stems
 from scenarios.output.provenance import environment, package_version, utc_stamp
 from scenarios.output.tables import (
+    RUN_COLUMNS,
     csv_text,
     flatten_row,
     is_missing,
@@ -88,10 +90,14 @@ def case_table(study: Study, records: dict[str, dict[str, Any]]) -> tuple[list[s
     -------
     columns : list of str
         ``case``, ``seed``, the varied paths, then a run's columns
-        (:func:`scenarios.output.tables.row_columns`, with the stored rows' requirement columns).
+        (:func:`scenarios.output.tables.row_columns`, with the stored rows' requirement columns),
+        then :data:`~scenarios.output.tables.RUN_COLUMNS` (``file_stem``).
     rows : list of dict
         One per case and planner (and controller), keyed by column: the stored row flattened by
-        :func:`scenarios.output.tables.flatten_row`.
+        :func:`scenarios.output.tables.flatten_row`, and its ``file_stem``: the stem of its files when
+        the case is re-run in full (``slewbench sweep DIR --case N`` writes
+        ``cases/N/timeseries/<file_stem>.csv``), :func:`~scenarios.output.names.row_stems` of the
+        case's labels, as a run records it.
     """
     table = []
     stored = []
@@ -99,10 +105,11 @@ def case_table(study: Study, records: dict[str, dict[str, Any]]) -> tuple[list[s
         record = records.get(case.key)
         if record is None:
             continue
-        for row in record["rows"]:
+        stems = row_stems([str(row.get("label")) for row in record["rows"]])
+        for row, stem in zip(record["rows"], stems):
             stored.append(row)
-            table.append({"case": case.index, "seed": case.seed, **case.varied, **flatten_row(row)})
-    columns = ["case", "seed", *study.varied_paths, *row_columns(requirement_columns(stored))]
+            table.append({"case": case.index, "seed": case.seed, **case.varied, **flatten_row(row), "file_stem": stem})
+    columns = ["case", "seed", *study.varied_paths, *row_columns(requirement_columns(stored)), *RUN_COLUMNS]
     return columns, table
 
 
@@ -726,7 +733,7 @@ def robustness_tables(study: Study, rows: list[dict[str, Any]]) -> tuple[Table, 
     return proportion_table(study, rows), sensitivity_table(study, rows), worst_table(study, rows)
 
 
-def write_report(results: SweepResults, directory: str | Path, plots: bool = True) -> list[str]:
+def write_report(results: SweepResults, directory: str | Path, plots: bool = True, progress: bool = False) -> list[str]:
     """Write the study's tables, resolved study and (``plots``) figures and ``report.html`` into ``directory``.
 
     ``directory`` is claimed (created with slewbench's marker, or already carrying it); the files
@@ -741,43 +748,61 @@ def write_report(results: SweepResults, directory: str | Path, plots: bool = Tru
     plots : bool, optional
         Also draw the PNG figures (``plots/``) and write the interactive ``report.html``
         (:mod:`scenarios.study.html`).
+    progress : bool, optional
+        Show the files written so far on standard error as a sweep shows its cases
+        (:func:`scenarios.study.engine.write_progress`: a bar on a terminal, elsewhere a line at most
+        every 30 s). Default False.
 
     Returns
     -------
     list of str
         The file names written (relative to ``directory``).
     """
+    from scenarios.study.engine import write_progress
+
     study = results.study
     directory = claim_sweep_directory(directory)
-    columns, rows = case_table(study, results.records)
-    summary_columns, summary = summary_table(study, rows)
-    summary = shown_infinity(summary)  # +inf (never settled) written "inf", not an empty cell
-    requirements = requirement_table(study, rows)
-    robustness = robustness_tables(study, rows)
-    if robustness is not None:
-        robustness = tuple((names, shown_infinity(table)) for names, table in robustness)  # type: ignore[assignment]
-    markdown = ""
-    if robustness is not None:
-        from scenarios.study.robustness import robustness_markdown
-        markdown = robustness_markdown(study, rows, *robustness)
-    files = {"cases.csv": csv_text(columns, rows), "summary.csv": csv_text(summary_columns, summary),
-             "requirements.csv": csv_text(*requirements),
-             **({} if robustness is None else {name: csv_text(*table) for name, table in zip(ROBUSTNESS_FILES,
-                                                                                             robustness)}),
-             "summary.md": _markdown(study, summary_columns, summary, results.missing, requirements, markdown),
-             "study.yaml": yaml.dump(resolved_study(study), Dumper=_DUMPER, sort_keys=False, width=120)}
-    staging = new_staging(directory)
+    meter = write_progress(study.name, progress)
     try:
-        for name, text in files.items():
-            (staging / name).write_text(text)
-        if plots:
-            from scenarios.study.html import study_report
-            from scenarios.study.plots import write_plots
-            (staging / "plots").mkdir()
-            write_plots(study, rows, staging / "plots")
-            (staging / "report.html").write_text(study_report(study, (columns, rows), (summary_columns, summary),
-                                                              requirements, results.missing, robustness),
-                                                 encoding="utf-8")
-        return commit_sweep_outputs(directory, staging)
+        files: dict[str, str] = {}
+
+        def add(name: str, text: str) -> None:
+            files[name] = text
+            meter.advance()
+
+        columns, rows = case_table(study, results.records)
+        add("cases.csv", csv_text(columns, rows))
+        summary_columns, summary = summary_table(study, rows)
+        summary = shown_infinity(summary)  # +inf (never settled) written "inf", not an empty cell
+        add("summary.csv", csv_text(summary_columns, summary))
+        requirements = requirement_table(study, rows)
+        add("requirements.csv", csv_text(*requirements))
+        robustness = robustness_tables(study, rows)
+        if robustness is not None:
+            robustness = tuple((names, shown_infinity(table)) for names, table in robustness)  # type: ignore[assignment]
+            for name, table in zip(ROBUSTNESS_FILES, robustness):
+                add(name, csv_text(*table))
+        markdown = ""
+        if robustness is not None:
+            from scenarios.study.robustness import robustness_markdown
+            markdown = robustness_markdown(study, rows, *robustness)
+        add("summary.md", _markdown(study, summary_columns, summary, results.missing, requirements, markdown))
+        add("study.yaml", yaml.dump(resolved_study(study), Dumper=_DUMPER, sort_keys=False, width=120))
+        staging = new_staging(directory)
+        try:
+            for name, text in files.items():
+                (staging / name).write_text(text)
+            if plots:
+                from scenarios.study.html import study_report
+                from scenarios.study.plots import write_plots
+                (staging / "plots").mkdir()
+                write_plots(study, rows, staging / "plots", progress=meter)
+                (staging / "report.html").write_text(study_report(study, (columns, rows), (summary_columns, summary),
+                                                                  requirements, results.missing, robustness),
+                                                     encoding="utf-8")
+                meter.advance()
+            return commit_sweep_outputs(directory, staging)
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)
     finally:
-        shutil.rmtree(staging, ignore_errors=True)
+        meter.close()
