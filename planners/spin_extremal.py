@@ -167,6 +167,9 @@ two the start is left to IPOPT."""
 DEGENERATE_ITERATIONS = 3
 """IPOPT's ``degen_iters_max``: perturbed iterations from the start after which it perturbs every
 later one without trying ``δ = 0``."""
+_EYE = np.eye(3)
+_TINY_STEP = 10.0 * np.finfo(float).eps
+"""IPOPT's ``Search_Direction_Becomes_Too_Small``: every step component below this times ``1 + |x_i|``."""
 
 
 def _objective(x: ca.SX, p: ca.SX) -> ca.SX:
@@ -257,16 +260,17 @@ class NewtonFirst:
         """
         return self._stats
 
-    def _evaluate(self, x: Array) -> tuple[float, Array, Array]:
-        f, gradient, hessian = self.derivatives.all_outputs(x)
-        return float(f[0]), gradient.copy(), hessian.reshape(3, 3).copy()
+    def _evaluate(self, x: Array) -> tuple[float, Array, Array, bool]:
+        """J, ∇J, ∇²J at ``x`` (arrays of their own) and whether all of them are finite."""
+        values = np.concatenate(self.derivatives.all_outputs(x))  # one copy of J, ∇J and ∇²J
+        return float(values[0]), values[1:4], values[4:].reshape(3, 3), bool(np.isfinite(values).all())
 
     @staticmethod
-    def _definite(eigenvalues: np.ndarray, shift: float) -> bool | None:
+    def _definite(eigenvalues: list[float], shift: float) -> bool | None:
         """Whether ``∇²J + shift I`` is positive definite as IPOPT's factorisation finds it;
         ``None`` where its rounding would decide."""
         least = eigenvalues[0] + shift
-        largest = max(abs(eigenvalues[-1] + shift), abs(least))
+        largest = max(abs(eigenvalues[2] + shift), abs(least))
         if least > DEFINITE * largest:
             return True
         if least <= SINGULAR * largest:
@@ -275,20 +279,23 @@ class NewtonFirst:
 
     def _newton(self, x: Array) -> tuple[Array, float, int, str] | None:
         """The point, J, the steps and IPOPT's status there; ``None`` where IPOPT would not step so."""
-        f, gradient, hessian = self._evaluate(x)
-        largest = float(np.max(np.abs(gradient)))
+        # Plain floats where NumPy's per-call cost would dominate (3-vectors); the same IEEE
+        # operations, so the same numbers: max |·| is exact, as are the comparisons.
+        f, gradient, hessian, finite = self._evaluate(x)
+        largest = max(map(abs, gradient.tolist()))
         scale = 100.0 / largest if largest > 100.0 else 1.0  # IPOPT's nlp_scaling_max_gradient
         last = 0.0  # IPOPT's delta_x_last
         degenerate: bool | None = None  # IPOPT's hess_degenerate (None: not yet determined)
         perturbed = 0
         for k in range(NEWTON_ITERATIONS + 1):
-            if not (np.isfinite(f) and np.all(np.isfinite(gradient)) and np.all(np.isfinite(hessian))):
+            if not finite:
                 return None
-            if scale * float(np.max(np.abs(gradient))) <= TOLERANCE:
+            if scale * max(map(abs, gradient.tolist())) <= TOLERANCE:
                 return x, f, k, "Solve_Succeeded"
             if k == NEWTON_ITERATIONS:
                 return None
-            eigenvalues = np.linalg.eigvalsh(scale * hessian)  # IPOPT perturbs the scaled problem's Hessian
+            scaled = scale * hessian
+            eigenvalues = np.linalg.eigvalsh(scaled).tolist()  # IPOPT perturbs the scaled problem's Hessian
             shift = 0.0
             if not degenerate:
                 definite = self._definite(eigenvalues, 0.0)
@@ -309,13 +316,13 @@ class NewtonFirst:
                 if degenerate is None:
                     perturbed += 1
                     degenerate = True if perturbed >= DEGENERATE_ITERATIONS else None
-            step = -np.linalg.solve(scale * hessian + shift * np.eye(3), scale * gradient)
-            if not np.all(np.isfinite(step)):
+            step = -np.linalg.solve(scaled + shift * _EYE, scale * gradient)
+            if not np.isfinite(step).all():
                 return None
-            if float(np.max(np.abs(step) / (1.0 + np.abs(x)))) < 10.0 * np.finfo(float).eps:
+            if max(abs(s) / (1.0 + abs(y)) for s, y in zip(step.tolist(), x.tolist())) < _TINY_STEP:
                 return x, f, k, "Search_Direction_Becomes_Too_Small"
             trial = x + step
-            f_trial, gradient_trial, hessian_trial = self._evaluate(trial)
+            f_trial, gradient_trial, hessian_trial, finite = self._evaluate(trial)
             if not f_trial <= f + 1e-8 * float(gradient @ step):  # Armijo refuses the full step (or NaN)
                 return None
             x, f, gradient, hessian = trial, f_trial, gradient_trial, hessian_trial
