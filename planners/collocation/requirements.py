@@ -193,6 +193,8 @@ def imposed_state_bounds(low: Array, high: Array, start: Array) -> tuple[Array, 
         ``(low, high)``, new arrays.
     """
     low, high = np.array(low, dtype=float), np.array(high, dtype=float)
+    if low.size <= 7:  # no actuator state: nothing to back off
+        return low, high
     states = np.asarray(start, dtype=float)[7:]
     with np.errstate(invalid="ignore"):  # an infinite bound stays infinite
         high[7:] = np.where(np.isfinite(high[7:]), np.maximum(high[7:] - STATE_BACKOFF * np.maximum(1.0, np.abs(high[7:])),
