@@ -55,6 +55,7 @@ from ocp import quat
 from ocp.cache import RecentCache
 from ocp.dynamics.integration import rk4_step
 from ocp.dynamics.model import AttitudeModel
+from ocp.fast_call import matrices
 from ocp.geometry import PointingConstraint
 from ocp.transcription.base import Transcription
 from planners.collocation.allocation import allocation_constraints
@@ -405,14 +406,15 @@ class CollocationReference(Reference):
     def _rhs(self, x: Array, u: Array, t: Array) -> Array:
         n = x.shape[0]
         times = np.broadcast_to(t, (n,))
-        return _mapped(self.model, "rhs", n)(x.T, u.T, times, np.tile(self.disturbance[:, None], n)).full().T
+        return matrices(_mapped(self.model, "rhs", n), x.T, u.T, times, np.tile(self.disturbance[:, None], n))[0].T
 
     def _evaluate(self, t: Array) -> ReferenceSample:
         x, u = self._state_control(t)
         n = t.size
         x_dot = self._rhs(x, u, t)
-        actuator = _mapped(self.model, "body_torque", n)(x.T, u.T, t).full().T
-        environment = _mapped(self.model, "environment_torque", n)(x.T, t, np.tile(self.disturbance[:, None], n)).full().T
+        actuator = matrices(_mapped(self.model, "body_torque", n), x.T, u.T, t)[0].T
+        environment = matrices(_mapped(self.model, "environment_torque", n), x.T, t,
+                               np.tile(self.disturbance[:, None], n))[0].T
         omega = x[:, 4:7]
         wheel_momentum = x[:, 7:] @ self.model.spacecraft.wheel_axes.T
         torque = actuator - np.cross(omega, wheel_momentum) + environment
@@ -556,7 +558,7 @@ def solution_sampler(reference: CollocationReference) -> Callable[[Array], tuple
         t = np.clip(np.asarray(times, dtype=float), 0.0, reference.duration)
         x, u = reference._interpolated(t, left=True)  # as solved (IPOPT pushes a seed into its bounds)
         x[:, 0:4] = quat.normalize(x[:, 0:4])  # as Reference.sample does
-        torque = _mapped(model, "body_torque", t.size)(x.T, u.T, t).full().T
+        torque = matrices(_mapped(model, "body_torque", t.size), x.T, u.T, t)[0].T
         return x, u, np.abs(torque)
 
     return sample
@@ -767,5 +769,5 @@ def bang_bang_solution(model: AttitudeModel, transcription: Transcription, x0: A
     maps = model.solver_cache.get(("collocation", "maps"), lambda: RecentCache(MAPS_KEPT))
     accumulate = maps.get((f"bang-bang radau steps {d} {BANG_BANG_SUBSTEPS}", N),
                           lambda: _radau_steps(model, tau).mapaccum("accumulate", N, [0], [0]))
-    _, points = accumulate(np.append(x0, 0.0), u, np.diff(nodes)[None, :], np.tile(disturbance[:, None], N))
-    return np.asarray(points), np.tile(u, (d, 1))
+    _, points = matrices(accumulate, np.append(x0, 0.0), u, np.diff(nodes)[None, :], np.tile(disturbance[:, None], N))
+    return points, np.tile(u, (d, 1))
