@@ -107,8 +107,11 @@ def test_eigenaxis_min_time_keeps_the_gravity_gradient_bound_from_the_accelerati
     if gravity_gradient:  # the user's case: 1.3e-4 of the acceleration kept, said in the message
         assert hand_min_time(gravity_gradient_bound(), 0.0495)[0] == pytest.approx(alpha, rel=1e-8)
         assert "kept for the environment's torque" in reference.message
-    else:  # no environment torque: the acceleration is the one without a reserve, to the last bit
-        assert reference.profile.alpha == alpha and "environment" not in reference.message
+    else:  # no environment torque: the acceleration is the one without a reserve, to a few ulps (the
+        # planner's A⁺ products associate otherwise than the hand's, and OpenBLAS picks its kernels per
+        # CPU: on one machine the last bit differed, 0.014696938456699072 against ...076)
+        assert abs(reference.profile.alpha - alpha) <= 8 * np.spacing(alpha)
+        assert "environment" not in reference.message
 
 
 def test_the_rate_margin_applies_to_the_requirement_only():
