@@ -38,7 +38,7 @@ BASE = {
     "simulation": {"sample_time": 1.0, "duration": 35.0},
 }
 ROW_KEYS = {"label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused", "reference",
-            "closed_loop", "requirements", "certificate"}
+            "closed_loop", "requirements", "certificate", "needed_duration_s"}
 IDENTITY = ["label", "planner", "controller", "status", "message", "plan_time_s", "plan_reused"]
 CERTIFICATE = ["certificate", "certificate_verdict", "certificate_kkt_scaled", "certificate_kkt_unscaled"]
 
@@ -90,7 +90,8 @@ def test_missing_and_non_finite_values_are_null_in_json_empty_in_csv_and_float_n
 
     text = results.to_csv()
     header = text.splitlines()[0].split(",")
-    assert header == IDENTITY + expected_metric_columns() + CERTIFICATE + ["file_stem"]  # a run's: appended
+    # the duration an infeasible row needs after the identity columns; the rows' file stems appended
+    assert header == IDENTITY + ["needed_duration_s"] + expected_metric_columns() + CERTIFICATE + ["file_stem"]
     odd, regulating = read_csv(text)
     assert odd["certificate"] == "" and odd["certificate_kkt_scaled"] == ""  # no reference: no certificate
     assert (odd["ref.int_u2"], odd["ref.int_abs_u_x"], odd["ref.int_abs_u_z"], odd["ref.duration_s"]) == \
@@ -126,8 +127,8 @@ def test_a_runs_results_csv_and_a_sweeps_cases_csv_agree_cell_for_cell(tmp_path)
     assert main(["sweep", str(study), "--out", str(tmp_path / "sweep"), "--workers", "1", "--no-plots"]) == 0
     run_text = (tmp_path / "run" / "results.csv").read_text()
     cases_text = (tmp_path / "sweep" / "cases.csv").read_text()
-    # the same columns in the same order; a run's results.csv appends its rows' file stems
-    assert cases_text.splitlines()[0] + ",file_stem" == "case,seed," + run_text.splitlines()[0]
+    # the same columns in the same order, both ending with the rows' file stems
+    assert cases_text.splitlines()[0] == "case,seed," + run_text.splitlines()[0]
     ran, cased = read_csv(run_text), read_csv(cases_text)
     assert len(ran) == len(cased) == 2
     for run_row, case_row in zip(ran, cased):
@@ -144,9 +145,10 @@ def test_a_runs_results_csv_and_a_sweeps_cases_csv_agree_cell_for_cell(tmp_path)
     direct = scenarios.run(scenarios.load(path)).to_dataframe()
     swept = sweep(scenarios.load_study(study), workers=1).to_dataframe()
     assert list(swept.columns[:2]) == ["case", "seed"]
-    assert list(direct["file_stem"]) == ["smooth", "fast"]  # a run's rows' file stems, appended
+    assert list(direct["file_stem"]) == ["smooth", "fast"]  # the rows' file stems, appended
+    assert list(swept["file_stem"]) == ["smooth", "fast"]  # one case: the stems a --case re-run gives
     pd.testing.assert_frame_equal(direct.drop(columns=["plan_time_s", "file_stem"]),
-                                  swept.drop(columns=["case", "seed", "plan_time_s"]))
+                                  swept.drop(columns=["case", "seed", "plan_time_s", "file_stem"]))
 
 
 def test_a_sweeps_dataframe_holds_nan_not_none_for_a_crashed_case():
