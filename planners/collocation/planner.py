@@ -103,7 +103,7 @@ from planners.collocation.strategy import (
     AUTO_FIRST,
     AUTO_PIECES,
     AUTO_RESTART,
-    COARSE_MIN_TIME_PERTURBATION,
+    COARSE_MIN_TIME_OPTIONS,
     DENSE_ROUNDS,
     POLISH_MU_INIT,
     SEED_BOUND_ATOL,
@@ -497,7 +497,7 @@ class CollocationPlanner(Planner):
         multipliers of a coarse-mesh optimum (``transfer``: :data:`TRANSFER_WARM_START`, with
         :data:`TRANSFER_L1_BARRIER` for an L1 objective without an energy term and
         :data:`TRANSFER_MIN_TIME_BARRIER` for minimum time without cones; the cold starts of minimum time
-        without cones on ``coarse_intervals`` with :data:`COARSE_MIN_TIME_PERTURBATION`). A fixed final
+        without cones on ``coarse_intervals`` with :data:`COARSE_MIN_TIME_OPTIONS`). A fixed final
         time on other than the option's ``intervals`` is the coarse seed: solved to
         :data:`SEED_TOLERANCE` at the least (by FATROP with :data:`SEED_FATROP` where
         :meth:`_seed_solver` chooses it for the ``solver`` option IPOPT; a ``solver: fatrop`` seed
@@ -518,7 +518,7 @@ class CollocationPlanner(Planner):
             extra = {**(extra or {}), **TRANSFER_MIN_TIME_BARRIER}
         if (mode == "cold" and solver == "ipopt" and intervals == o.coarse_intervals and mesh is None
                 and ocp.free_time and not (ocp.energy_weight or ocp.l1_weight or ocp.cones)):
-            extra = {**(extra or {}), **COARSE_MIN_TIME_PERTURBATION}
+            extra = {**(extra or {}), **COARSE_MIN_TIME_OPTIONS}
         if seed_only and solver == "fatrop" and o.solver == "ipopt":  # the IPOPT option's FATROP seed only
             extra = {**(extra or {}), **SEED_FATROP}
         # The extra options in the key: a shared cache also serves planners whose options differ

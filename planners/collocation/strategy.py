@@ -84,13 +84,16 @@ Neighbouring values do about as well (mu_init 1e-8 to 1e-5, pushes 1e-4 to 1e-2:
 iterations over the three); a multiplier push of 1e-2 does not (34 to 41), nor IPOPT's tiny pushes
 of a same-mesh warm start (1e-9: 20 and 12 on the minimum-time cases)."""
 
-COARSE_MIN_TIME_PERTURBATION = {"ipopt.perturb_inc_fact": 2.5}
-"""IPOPT's inertia-correction option for the cold starts of minimum time (a free final time, no energy or
-L1 term, no cones) on ``coarse_intervals``: the Hessian perturbation δw grows by 2.5 (IPOPT's default
-8) per rejected trial factorization after the first of an iteration. Near the eigenaxis saddle of
-Bilimoria & Wie the coarse iterations need δw > 0 and IPOPT tries several δw per iteration (δw = 0
-first, then its last δw cut by ``perturb_dec_fact``, then grown); growing by 8 overshoots, and the
-larger δw shortens the steps. Measured 2026-12-04 against IPOPT's default (the same optima):
+COARSE_MIN_TIME_OPTIONS = {"ipopt.perturb_inc_fact": 2.5, "ipopt.bound_push": 0.1, "ipopt.bound_frac": 0.1}
+"""IPOPT's options for the cold starts of minimum time (a free final time, no energy or L1 term, no
+cones) on ``coarse_intervals``: the inertia correction's growth factor and the initial point's
+distance from the bounds.
+
+``perturb_inc_fact`` 2.5 (IPOPT's default 8): the Hessian perturbation δw grows by 2.5 per rejected
+trial factorization after the first of an iteration. Near the eigenaxis saddle of Bilimoria & Wie
+the coarse iterations need δw > 0 and IPOPT tries several δw per iteration (δw = 0 first, then its
+last δw cut by ``perturb_dec_fact``, then grown); growing by 8 overshoots, and the larger δw
+shortens the steps. Measured 2026-12-04 against IPOPT's default (the same optima):
 
 - Bilimoria & Wie's two coarse starts 32 + 19 iterations against 39 + 22, 112 MUMPS numerical
   factorizations against 128 over the coarse solves of it and the full-inertia case (print level 7);
@@ -104,10 +107,25 @@ larger δw shortens the steps. Measured 2026-12-04 against IPOPT's default (the 
 Its neighbours on Bilimoria & Wie (factorizations of the two cases' coarse solves): 2 142, 2.2
 130, 2.7 115, 3 119, 3.5 116, 4 114, 5 121, 20 137. With ``perturb_dec_fact`` 0.2 or 0.25, or
 ``first_hessian_perturbation`` 1e-3 or 1e-2, or ``perturb_inc_fact_first`` 50 or 300 besides, no
-better (110 to 133). Rejected because another local minimum follows on mt17 of
-``iteration_counts.py`` (10.22393 against 10.30034), as with any start moved there: ``bound_push`` =
-``bound_frac`` 0.02 to 0.1 (87 factorizations at 0.1) and ``alpha_for_y`` ``min-dual-infeas`` (104).
-``min_refinement_steps`` 0: 679 M against 683 M, the same iterations (not worth a constant)."""
+better (110 to 133). ``min_refinement_steps`` 0: 679 M against 683 M, the same iterations (not
+worth a constant).
+
+``bound_push`` = ``bound_frac`` 0.1 (IPOPT's default 0.01) with the growth factor 2.5: the seeds'
+controls, at their bounds on a bang-bang start, are moved 0.1 of the way in, where the barrier's
+first steps no longer fight the bounds. Measured 2026-12-04 against 2.5 alone
+(``iteration_counts.py``, the 23 minimum-time cases; the fixed-time cases do not use it): 919
+coarse iterations against 981 and 600 full-mesh against 641; Bilimoria & Wie 42 against 51 (its
+two seeds still agree); every optimum the same to 1e-11 but mt17's, which reaches the lower of the
+two minima the docs name (10.22393 s against 10.30034 s: the best known, found before only by
+FATROP's coarse solve or 6 coarse intervals). ``slewbench bench`` (collocation only): the same
+optimum on every problem, iterations 46 against 54 on Bilimoria & Wie 180 deg, 48 against 66 at 90
+deg, 9 against 23 at 45 deg, 27 against 117 on the norm-bounded eigenaxis case, 70 against 68 on
+XTE. With 0.05 instead: 944 coarse iterations, mt17 at 10.22393 too. Side by side with acados
+(``test_side_by_side_acados``, 9 rounds, load 0.1-0.6): Bilimoria & Wie 81.9 ms against 95.3 ms
+before, 0.89x acados [0.88..0.92] against 1.03x [1.00..1.07]. (At stop 51, with the growth factor 8,
+the same pushes sent the spin-extremal seed of Bilimoria & Wie to another coarse minimum, 3.28326
+against 3.24349; with 2.5 both seeds end at 3.24349.) ``alpha_for_y`` ``min-dual-infeas`` (104
+factorizations) also reaches mt17's lower minimum; not measured further."""
 
 TRANSFER_MAX_INTERVALS = 150
 """Largest full mesh solved from the coarse optimum with its multipliers carried over (IPOPT's
