@@ -275,6 +275,28 @@ at load 3.4): the coarse multistart 56 ms (2 starts, 63 IPOPT iterations), the e
 (the shooting's 5 calls 7 ms, the bang-bang certificate 3.6 ms, the integrated states 1 ms), the
 starts 7 ms, the seed bound 1.4 ms. Issue 30's 1.0x is not met on B&W: the coarse multistart alone
 is about acados's whole solve.
+
+Measured 2026-12-04 (a new, slower machine: acados takes 92-106 ms on B&W here against 58-81 ms on
+the last; load 0.1-1.2, 9 alternating rounds, wall, median [min..max]). The coarse cold starts of
+minimum time with ``COARSE_MIN_TIME_OPTIONS`` (IPOPT's ``perturb_inc_fact`` 2.5, ``bound_push`` =
+``bound_frac`` 0.1) and the work around the solves cut again (the certificate's shooting Jacobian
+by forward sensitivities, buffered evaluations): B&W 51 then 42 coarse iterations against 61.
+
+==========================  ===================  ===================  =================  ==========
+case (08:21 UTC)            ours [ms]            acados [ms]          ours/acados        iterations
+==========================  ===================  ===================  =================  ==========
+B&W 180° min time           95.3 [92.7..102.1]   106.3 [104.8..107.1] 0.90 [0.88..0.95]  42 / 17 SQP
+full inertia min time       53.9 [50.9..56.5]    194.6 [190.8..197.1] 0.28 [0.26..0.29]  14 / 63 SQP
+XTE (to acados's 500th)     169.7 [163.8..185.3] 1341.7               0.13 [0.12..0.14]  70 / 500
+XTE, switch_refinement 0    241.3                1368.2               0.17 [0.17..0.20]  7 / 500
+spin min energy, default    137.0 [135.6..139.8] 227.9 [225.5..229.1] 0.60 [0.60..0.61]  4 / 146 SQP
+spin, from spin extremal    136.3 [134.6..142.0] 227.0                0.60 [0.58..0.63]  4 / 146 SQP
+==========================  ===================  ===================  =================  ==========
+
+Twenty minutes earlier (load 0.1-0.6): B&W 81.9 ms against 91.9 ms, 0.89 [0.88..0.92]; with the
+growth factor alone (no pushes) 95.3 against 92.6 ms, 1.03 [1.00..1.07]; the spin case 116.9 ms
+against 203.4 ms, 0.57 [0.57..0.59]. Issue 30's 1.0x is met on B&W; the spin case's 100 ms is not
+on this machine (117-137 ms quiet, where acados's own time moved from 155 to 203-228 ms).
 """
 from __future__ import annotations
 
