@@ -142,3 +142,68 @@ def test_min_energy_reaches_the_optimum_the_other_peers_reach():
     result = acados.PEER.solve(problem, "min_energy")
     assert result.status == "ok", result.message
     assert result.objective == pytest.approx(5.849307e-08, rel=1e-6)
+
+
+class _ScriptedWorker:
+    """A stand-in for the acados worker: each build records its options, each solve answers what
+    ``script(options)`` says for the last build's options."""
+
+    def __init__(self, script):
+        self.script, self.builds = script, []
+        self._process = type("P", (), {"poll": staticmethod(lambda: None)})()
+
+    def _ask(self, request):
+        assert request["op"] == "build"
+        self.builds.append(dict(request.get("options", {})))
+        return {"build_s": 1.0}
+
+    def solve(self):
+        status, time_s = self.script(self.builds[-1])
+        return {"objective": 3.2434 if status == "ok" else 9.9, "T": 3.2434, "time_s": time_s, "cpu_s": time_s,
+                "status": status, "iterations": 17}
+
+
+@pytest.mark.parametrize("case", ["capped_faster", "defaults_faster", "capped_only_after_fallback", "none"])
+def test_the_bench_peer_reports_the_faster_converged_qp_setting(case):
+    """Each HPIPM setting of ``QP_SETTINGS`` is built (with the fallback options after a QP failure)
+    and solved; the faster converged solve is the row, every build in the build time, the note names
+    the setting; when none converges the first setting's failure is reported."""
+    capped = {"qp_solver_iter_max": 8, "qp_solver_warm_start": 1}
+    assert list(acados.QP_SETTINGS) == [{}, capped]
+
+    def script(options):
+        is_capped = options.get("qp_solver_iter_max") == 8
+        fallback = options.get("regularize_method") == "MIRROR"
+        if case == "capped_faster":
+            return "ok", 0.05 if is_capped else 0.10
+        if case == "defaults_faster":
+            return "ok", 0.20 if is_capped else 0.09
+        if case == "capped_only_after_fallback":
+            if is_capped:
+                return ("ok", 0.30) if fallback else ("qp_failure", 0.01)
+            return "maxiter", 1.5
+        return ("maxiter" if not is_capped else "qp_failure"), 1.0
+
+    peer = acados.AcadosBenchPeer()
+    worker = peer._worker = _ScriptedWorker(script)
+    result = peer.solve(bilimoria_wie(), "min_time")
+    expected_builds = {"capped_faster": 2, "defaults_faster": 2, "capped_only_after_fallback": 3, "none": 3}[case]
+    assert len(worker.builds) == expected_builds
+    assert result.build_time_s == pytest.approx(float(expected_builds))
+    assert [entry["options"].get("qp_solver_iter_max") for entry in result.extra["tried"]] == [None, 8]
+    if case == "none":
+        assert result.status == "failed" and result.objective is None
+        assert result.message.endswith("acados: maxiter (HPIPM's defaults; none of 2 QP settings converged)")
+        return
+    assert result.status == "ok" and result.objective == pytest.approx(3.2434)
+    chosen = {"capped_faster": 0.05, "defaults_faster": 0.09, "capped_only_after_fallback": 0.30}[case]
+    assert result.solve_time_s == chosen
+    if case == "defaults_faster":
+        assert "qp_solver_iter_max" not in result.extra["options"]
+        assert result.message.endswith("(HPIPM's defaults; the faster of 2 converged QP settings)")
+    else:
+        assert result.extra["options"]["qp_solver_iter_max"] == 8
+        assert ("the only one of 2 QP settings that converged" if case == "capped_only_after_fallback"
+                else "the faster of 2 converged QP settings") in result.message
+    if case == "capped_only_after_fallback":
+        assert result.extra["options"]["regularize_method"] == "MIRROR"

@@ -27,7 +27,8 @@ Two faces: :data:`PEER` follows the peers' contract of :mod:`scenarios.bench.pee
 (``unavailable``, ``problem_error``, ``solve`` returning a ``PeerResult``; its guess is
 ``collocation``'s first start that every peer starts from,
 :func:`~scenarios.bench.peers._shooting.first_start_guess`, and when acados stops at a QP failure
-it builds once more with :data:`FALLBACK_OPTIONS`, both builds counted in the build time); :func:`solve` and
+it builds once more with :data:`FALLBACK_OPTIONS`, both builds counted in the build time; it does so for
+each HPIPM setting of :data:`QP_SETTINGS` and reports the faster converged solve); :func:`solve` and
 :class:`AcadosPeer` are the dict-level calls the side-by-side benchmarks use (one build, many
 timed solves). ``time_s`` is the solve after the build, guess setting and ``reset`` included,
 measured in the worker [s]; ``status`` is ``"ok"`` or acados's flag named; ``iterations`` its SQP
@@ -53,6 +54,14 @@ ACADOS_STATUS = {0: "ok", 1: "nan_detected", 2: "maxiter", 3: "minstep", 4: "qp_
 """acados's return flags, named."""
 SOLVER_OPTIONS: dict[str, Any] = {"regularize_method": "PROJECT", "globalization": "MERIT_BACKTRACKING"}
 """acados options beyond the module docstring's (17 SQP iterations on Bilimoria & Wie 180°)."""
+QP_SETTINGS: tuple[dict[str, Any], ...] = ({}, {"qp_solver_iter_max": 8, "qp_solver_warm_start": 1})
+"""HPIPM settings ``slewbench bench``'s peer tries on every problem (each over :data:`SOLVER_OPTIONS`,
+and over :data:`FALLBACK_OPTIONS` after a QP failure), reporting the faster solve that converges:
+HPIPM's defaults (at most 50 interior-point iterations per QP) and at most 8, warm-started from the
+last QP. Neither is best everywhere (2026-12-04, ``slewbench bench --planners acados``, the second
+against the first): Bilimoria & Wie 180° 59 against 136 ms, the full inertia 45 against 195 ms,
+but 90° 170 against 96 ms and 45° 229 against 192 ms, the same objectives; a user tuning acados
+per problem would keep the faster, so the peer does."""
 FALLBACK_OPTIONS: dict[str, Any] = {"regularize_method": "MIRROR", "levenberg_marquardt": 0.1}
 """Options of the second build after a QP failure: the full-inertia case (150° about [1, 1, 1])
 stops at a QP failure in SQP iteration 2 under :data:`SOLVER_OPTIONS` (and under MIRROR,
@@ -308,7 +317,8 @@ class AcadosBenchPeer:
 
     def solve(self, problem: Any, objective: str) -> Any:
         """Build (again with :data:`FALLBACK_OPTIONS` after a QP failure) and solve from ``collocation``'s
-        first start (:func:`~scenarios.bench.peers._shooting.first_start_guess`).
+        first start (:func:`~scenarios.bench.peers._shooting.first_start_guess`), once per HPIPM
+        setting of :data:`QP_SETTINGS`; the faster converged solve is reported.
 
         Parameters
         ----------
@@ -321,9 +331,10 @@ class AcadosBenchPeer:
         -------
         PeerResult
             The objective reached (``None`` when acados failed), the solve's time in the worker
-            [s], ``"ok"`` or ``"failed"``, the SQP iterations, the start and acados's status, the
-            build time [s]; ``extra``: the options of the reported solve, the final time [s] and the
-            start.
+            [s], ``"ok"`` or ``"failed"``, the SQP iterations, the start and acados's status (and
+            the QP setting reported), the build time [s] (every build); ``extra``: the options of
+            the reported solve, the final time [s], the start and ``tried`` (per setting: its
+            options, status, time [s], SQP iterations and objective).
         """
         import atexit
 
@@ -334,25 +345,39 @@ class AcadosBenchPeer:
             self._worker = AcadosPeer()
             atexit.register(self._worker.close)
         guess = first_start_guess(problem, objective, N)
-        build, answer, options = 0.0, {}, SOLVER_OPTIONS
-        for options in (SOLVER_OPTIONS, FALLBACK_OPTIONS):
-            data = problem_data(problem, objective, N, (guess.states, guess.duration), options)
-            data["u_max"] = np.asarray(torque_bounds(problem), dtype=float).tolist()  # the actuator margin applied
-            try:
-                build += float(self._worker._ask({"op": "build", **data})["build_s"])
-                answer = self._worker.solve()
-            except RuntimeError as error:
-                if self._worker._process.poll() is not None:  # it died: the next problem starts a new one
-                    self._worker.close()
-                    self._worker = None
-                return PeerResult(None, 0.0, "failed", None, f"{guess.start}; {error}", build or None,
-                                  {"start": guess.start})
-            if answer["status"] != "qp_failure":
-                break
+        build = 0.0
+        tried: list[tuple[dict, dict]] = []  # (options, answer) of each setting's last solve
+        for setting in QP_SETTINGS:
+            for base in (SOLVER_OPTIONS, FALLBACK_OPTIONS):
+                options = {**base, **setting}
+                data = problem_data(problem, objective, N, (guess.states, guess.duration), options)
+                data["u_max"] = np.asarray(torque_bounds(problem), dtype=float).tolist()  # the actuator margin applied
+                try:
+                    build += float(self._worker._ask({"op": "build", **data})["build_s"])
+                    answer = self._worker.solve()
+                except RuntimeError as error:
+                    if self._worker._process.poll() is not None:  # it died: the next problem starts a new one
+                        self._worker.close()
+                        self._worker = None
+                    return PeerResult(None, 0.0, "failed", None, f"{guess.start}; {error}", build or None,
+                                      {"start": guess.start})
+                if answer["status"] != "qp_failure":
+                    break
+            tried.append((options, answer))
+        converged = [pair for pair in tried if pair[1]["status"] == "ok"]
+        options, answer = min(converged, key=lambda pair: pair[1]["time_s"]) if converged else tried[0]
         ok = answer["status"] == "ok"
+        setting = {name: value for name, value in options.items() if name.startswith("qp_solver")}
+        which = ", ".join(f"{name} {value}" for name, value in setting.items()) or "HPIPM's defaults"
+        choice = (f"the faster of {len(converged)} converged QP settings" if len(converged) > 1 else
+                  f"the only one of {len(tried)} QP settings that converged" if converged else
+                  f"none of {len(tried)} QP settings converged")
         return PeerResult(answer["objective"] if ok else None, answer["time_s"], "ok" if ok else "failed",
-                          answer["iterations"], f"{guess.start}; acados: {answer['status']}", build,
-                          {"options": dict(options), "T": answer["T"], "start": guess.start}, answer.get("cpu_s"))
+                          answer["iterations"], f"{guess.start}; acados: {answer['status']} ({which}; {choice})", build,
+                          {"options": dict(options), "T": answer["T"], "start": guess.start,
+                           "tried": [{"options": dict(o), "status": a["status"], "time_s": a["time_s"],
+                                      "iterations": a["iterations"], "objective": a["objective"]} for o, a in tried]},
+                          answer.get("cpu_s"))
 
 
 PEER = AcadosBenchPeer()
