@@ -144,66 +144,149 @@ def test_min_energy_reaches_the_optimum_the_other_peers_reach():
     assert result.objective == pytest.approx(5.849307e-08, rel=1e-6)
 
 
+
 class _ScriptedWorker:
-    """A stand-in for the acados worker: each build records its options, each solve answers what
-    ``script(options)`` says for the last build's options."""
+    """A stand-in for the acados worker: each build records its options; each solve answers what
+    ``script(options, solve_number)`` gives for the last build's options (``solve_number`` 1 for the
+    first solve after that build), or raises a ``RuntimeError`` where it gives an exception, as the
+    worker's ``_ask`` does; ``dead`` makes ``poll`` say it exited."""
 
     def __init__(self, script):
-        self.script, self.builds = script, []
-        self._process = type("P", (), {"poll": staticmethod(lambda: None)})()
+        self.script, self.builds, self.solves, self.dead = script, [], 0, False
+        worker = self
+        self._process = type("P", (), {"poll": staticmethod(lambda: 1 if worker.dead else None)})()
+        self.closed = False
 
     def _ask(self, request):
         assert request["op"] == "build"
         self.builds.append(dict(request.get("options", {})))
+        self.solves = 0
+        answer = self.script(self.builds[-1], 0)
+        if isinstance(answer, Exception):
+            raise answer
         return {"build_s": 1.0}
 
     def solve(self):
-        status, time_s = self.script(self.builds[-1])
-        return {"objective": 3.2434 if status == "ok" else 9.9, "T": 3.2434, "time_s": time_s, "cpu_s": time_s,
-                "status": status, "iterations": 17}
+        self.solves += 1
+        answer = self.script(self.builds[-1], self.solves)
+        if isinstance(answer, Exception):
+            raise answer
+        return answer
+
+    def close(self):
+        self.closed = True
 
 
-@pytest.mark.parametrize("case", ["capped_faster", "defaults_faster", "capped_only_after_fallback", "none"])
-def test_the_bench_peer_reports_the_faster_converged_qp_setting(case):
-    """Each HPIPM setting of ``QP_SETTINGS`` is built (with the fallback options after a QP failure)
-    and solved; the faster converged solve is the row, every build in the build time, the note names
-    the setting; when none converges the first setting's failure is reported."""
-    capped = {"qp_solver_iter_max": 8, "qp_solver_warm_start": 1}
-    assert list(acados.QP_SETTINGS) == [{}, capped]
+def _answer(status, objective, time_s, iterations):
+    return {"objective": objective, "T": objective + 1.0, "time_s": time_s, "cpu_s": time_s / 2, "status": status,
+            "iterations": iterations}
 
-    def script(options):
-        is_capped = options.get("qp_solver_iter_max") == 8
+
+CAPPED = {"qp_solver_iter_max": 8, "qp_solver_warm_start": 1}
+
+
+def _script(case):
+    """Per case, what each setting's builds and solves give. The capped setting's answers differ
+    from the defaults' in every field, and a second solve's time from the first's, so that the
+    test sees which solve each reported field comes from."""
+    def script(options, solve):
+        capped = options.get("qp_solver_iter_max") == 8
         fallback = options.get("regularize_method") == "MIRROR"
+        if solve == 0:  # the build
+            if case == "second_build_raises" and capped:
+                return RuntimeError("acados worker: ValueError: bad option")
+            return None
+        time_s = {True: 0.05, False: 0.10}[capped] + (0.001 if solve == 2 else 0.0)
         if case == "capped_faster":
-            return "ok", 0.05 if is_capped else 0.10
+            return _answer("ok", 3.2434 if capped else 3.24340001, time_s, 20 if capped else 16)
         if case == "defaults_faster":
-            return "ok", 0.20 if is_capped else 0.09
+            return _answer("ok", 3.2434 if capped else 3.24340001, 0.20 + 0.001 * solve if capped else time_s,
+                           20 if capped else 16)
+        if case == "lower_objective_slower":  # the capped setting is faster, at a worse optimum
+            return _answer("ok", 3.5449 if capped else 3.2434, time_s, 3 if capped else 16)
         if case == "capped_only_after_fallback":
-            if is_capped:
-                return ("ok", 0.30) if fallback else ("qp_failure", 0.01)
-            return "maxiter", 1.5
-        return ("maxiter" if not is_capped else "qp_failure"), 1.0
+            if capped:
+                return _answer("ok", 3.2434, 0.30 + 0.001 * solve, 64) if fallback else _answer("qp_failure", 9.9, 0.01, 2)
+            return _answer("maxiter", float("nan"), 1.5, 500)
+        if case == "second_build_raises":
+            return _answer("ok", 3.2434, time_s, 16)
+        return _answer("maxiter" if not capped else "qp_failure", float("nan"), 1.0, 500)  # none converges
+    return script
 
+
+@pytest.mark.parametrize("case", ["capped_faster", "defaults_faster", "lower_objective_slower",
+                                  "capped_only_after_fallback", "second_build_raises", "none"])
+def test_the_bench_peer_reports_its_best_qp_setting(case):
+    """Each HPIPM setting of ``QP_SETTINGS`` is built (with the fallback options after a QP failure)
+    and solved; of the converged solves the lowest objective wins, then the faster first solve, and
+    the row reports that setting's second solve (its time, objective, iterations, CPU); every build
+    counts in the build time, the note names the setting and why; a setting whose worker raises is
+    recorded and the others still count; where none converges the first setting's failure is
+    reported; ``extra`` is strict JSON."""
+    import json
+
+    assert list(acados.QP_SETTINGS) == [{}, CAPPED]
     peer = acados.AcadosBenchPeer()
-    worker = peer._worker = _ScriptedWorker(script)
+    worker = peer._worker = _ScriptedWorker(_script(case))
     result = peer.solve(bilimoria_wie(), "min_time")
-    expected_builds = {"capped_faster": 2, "defaults_faster": 2, "capped_only_after_fallback": 3, "none": 3}[case]
-    assert len(worker.builds) == expected_builds
-    assert result.build_time_s == pytest.approx(float(expected_builds))
-    assert [entry["options"].get("qp_solver_iter_max") for entry in result.extra["tried"]] == [None, 8]
+    json.dumps(result.extra, allow_nan=False)
+    builds = {"capped_faster": 2, "defaults_faster": 2, "lower_objective_slower": 2, "capped_only_after_fallback": 3,
+              "second_build_raises": 2, "none": 3}[case]
+    assert len(worker.builds) == builds
+    assert result.build_time_s == pytest.approx(float(builds - (case == "second_build_raises")))
+    tried = result.extra["tried"]
+    assert [entry["options"].get("qp_solver_iter_max") for entry in tried] == [None, 8]
     if case == "none":
         assert result.status == "failed" and result.objective is None
         assert result.message.endswith("acados: maxiter (HPIPM's defaults; none of 2 QP settings converged)")
+        assert [entry["status"] for entry in tried] == ["maxiter", "qp_failure"]
+        assert tried[0]["objective"] is None  # NaN is not JSON
         return
-    assert result.status == "ok" and result.objective == pytest.approx(3.2434)
-    chosen = {"capped_faster": 0.05, "defaults_faster": 0.09, "capped_only_after_fallback": 0.30}[case]
-    assert result.solve_time_s == chosen
-    if case == "defaults_faster":
-        assert "qp_solver_iter_max" not in result.extra["options"]
-        assert result.message.endswith("(HPIPM's defaults; the faster of 2 converged QP settings)")
-    else:
-        assert result.extra["options"]["qp_solver_iter_max"] == 8
-        assert ("the only one of 2 QP settings that converged" if case == "capped_only_after_fallback"
-                else "the faster of 2 converged QP settings") in result.message
+    expected = {  # the reported setting's (objective, time of its second solve, iterations, why)
+        "capped_faster": (3.2434, 0.051, 20, "the faster of 2 converged QP settings"),
+        "defaults_faster": (3.24340001, 0.101, 16, "the faster of 2 converged QP settings"),
+        "lower_objective_slower": (3.2434, 0.101, 16,
+                                   "the lowest objective of 2 converged QP settings (the others 3.5449)"),
+        "capped_only_after_fallback": (3.2434, 0.302, 64, "the only one of 2 QP settings that converged"),
+        "second_build_raises": (3.2434, 0.101, 16, "the only one of 2 QP settings that converged; "
+                                "qp_solver_iter_max 8, qp_solver_warm_start 1: acados worker: ValueError: bad option"),
+    }[case]
+    objective, time_s, iterations, why = expected
+    assert result.status == "ok"
+    assert (result.objective, result.iterations) == (objective, iterations)
+    assert result.solve_time_s == pytest.approx(time_s, rel=1e-12)  # the second solve's: 1 ms off the first's
+    assert result.solve_cpu_s == pytest.approx(time_s / 2, rel=1e-12) and result.extra["T"] == objective + 1.0
+    assert result.message.endswith(f"; {why})")
+    capped_reported = case in ("capped_faster", "capped_only_after_fallback")
+    assert (result.extra["options"].get("qp_solver_iter_max") == 8) == capped_reported
+    assert result.message.split("acados: ok (")[1].startswith(
+        "qp_solver_iter_max 8, qp_solver_warm_start 1;" if capped_reported else "HPIPM's defaults;")
     if case == "capped_only_after_fallback":
         assert result.extra["options"]["regularize_method"] == "MIRROR"
+    if case == "second_build_raises":
+        assert tried[1] == {"options": {**acados.SOLVER_OPTIONS, **CAPPED}, "error": "acados worker: ValueError: bad option"}
+        assert not worker.closed  # alive: not closed
+    else:
+        assert [entry["status"] for entry in tried][1] == "ok"
+        assert tried[0]["choice_time_s"] != tried[0]["time_s"] or case == "capped_only_after_fallback"
+
+
+def test_the_bench_peer_starts_a_new_worker_when_one_dies(monkeypatch):
+    """A worker that dies under the first setting is closed; the second setting runs in a new one,
+    whose converged solve is the row."""
+    dying = _ScriptedWorker(lambda options, solve: None if solve == 0 else RuntimeError("the acados worker ended (exit 1)"))
+
+    def die_on_solve(original=dying.solve):
+        dying.dead = True
+        return original()
+
+    dying.solve = die_on_solve
+    fresh = _ScriptedWorker(lambda options, solve: None if solve == 0 else _answer("ok", 3.2434, 0.05, 20))
+    monkeypatch.setattr(acados, "AcadosPeer", lambda: fresh)
+    peer = acados.AcadosBenchPeer()
+    peer._worker = dying
+    result = peer.solve(bilimoria_wie(), "min_time")
+    assert dying.closed and peer._worker is fresh
+    assert result.status == "ok" and result.objective == 3.2434
+    assert result.message.endswith("(qp_solver_iter_max 8, qp_solver_warm_start 1; the only one of 2 QP settings "
+                                   "that converged; HPIPM's defaults: the acados worker ended (exit 1))")

@@ -123,8 +123,8 @@ deg, 9 against 23 at 45 deg, 27 against 117 on the norm-bounded eigenaxis case, 
 XTE. With 0.05 instead: 944 coarse iterations, mt17 at 10.22393 too. Side by side with acados
 (``test_side_by_side_acados``, 9 rounds, load 0.1-0.6): Bilimoria & Wie 81.9 ms against 95.3 ms
 before, 0.89x acados [0.88..0.92] against 1.03x [1.00..1.07] (acados with HPIPM's default QP
-cap; given the cap 8 and the QP warm start, 1.71x: ``tests/benchmarks/test_bench_min_time.py``). (At stop 51, with the growth factor 8,
-the same pushes sent the spin-extremal seed of Bilimoria & Wie to another coarse minimum, 3.28326
+cap; given the cap 8 and the QP warm start, 1.71x: ``tests/benchmarks/test_bench_min_time.py``).
+(At stop 51, with the growth factor 8, the same pushes sent the spin-extremal seed of Bilimoria & Wie to another coarse minimum, 3.28326
 against 3.24349; with 2.5 both seeds end at 3.24349.) ``alpha_for_y`` ``min-dual-infeas`` (104
 factorizations) also reaches mt17's lower minimum; not measured further."""
 

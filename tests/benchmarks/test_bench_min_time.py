@@ -28,11 +28,12 @@ its lower bound; so do MIRROR, CONVEXIFY, a Levenberg-Marquardt term of 1e-3 and
 iterations), and only ``levenberg_marquardt: 0.1`` with MIRROR converges (7.68339, 63-64 iterations).
 Since 2026-12-04 both min-time cases also cap HPIPM at 8 interior-point iterations per QP and warm
 start it from the last QP (``qp_solver_iter_max: 8``, ``qp_solver_warm_start: 1``), and the full
-inertia keeps PROJECT without a Levenberg-Marquardt term: with HPIPM's default cap of 50 most of
-acados's time went into QPs that ran to that cap (B&W: 77 of 96 ms in the QP solver, 17 SQP
-iterations). Measured that day, medians of 4 solves after the build (acados's own ``time_tot``):
+inertia keeps PROJECT without a Levenberg-Marquardt term: with HPIPM's default cap of 50, most of
+acados's time on B&W went into its QPs (77 of 96 ms, by its own timers), 307 HPIPM iterations over
+its 17 SQP iterations (per QP 7, 19, 23, 17, 50, 9, 9, 50, 8, 10, 45, 9, 11, then 8: two at the cap);
+capped at 8, 151 over 19. Measured that day, medians of 4 solves after the build (acados's own ``time_tot``):
 B&W 104 ms by the old options; caps 5 (500 SQP iterations, no convergence), 8 (46 ms, 19 SQP, with
-the warm start), 10 (50-54 ms), 12 (57-67 ms), 15 (58 ms), 20 (76 ms), 30 (84 ms), all at 3.2433925;
+the warm start), 10 (50-54 ms), 12 (57-67 ms), 15 (58 ms), 20 (76 ms), 30 (84 ms), each at 3.2433925;
 Levenberg-Marquardt 1e-4 or 1e-2 instead of 1e-3 no faster; HPIPM's ``SPEED`` and ``SPEED_ABS``
 modes, ``ROBUST`` with the cap, warm start 2 and ``qp_solver_cond_N`` 1 or 5 stop at a QP failure,
 MIRROR with the cap runs to 500 SQP iterations. The full inertia: 40 ms (14 SQP, 7.6833920) with the

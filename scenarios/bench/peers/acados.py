@@ -28,7 +28,7 @@ Two faces: :data:`PEER` follows the peers' contract of :mod:`scenarios.bench.pee
 ``collocation``'s first start that every peer starts from,
 :func:`~scenarios.bench.peers._shooting.first_start_guess`, and when acados stops at a QP failure
 it builds once more with :data:`FALLBACK_OPTIONS`, both builds counted in the build time; it does so for
-each HPIPM setting of :data:`QP_SETTINGS` and reports the faster converged solve); :func:`solve` and
+each HPIPM setting of :data:`QP_SETTINGS` and reports one, :meth:`AcadosBenchPeer._chosen`); :func:`solve` and
 :class:`AcadosPeer` are the dict-level calls the side-by-side benchmarks use (one build, many
 timed solves). ``time_s`` is the solve after the build, guess setting and ``reset`` included,
 measured in the worker [s]; ``status`` is ``"ok"`` or acados's flag named; ``iterations`` its SQP
@@ -56,12 +56,17 @@ SOLVER_OPTIONS: dict[str, Any] = {"regularize_method": "PROJECT", "globalization
 """acados options beyond the module docstring's (17 SQP iterations on Bilimoria & Wie 180°)."""
 QP_SETTINGS: tuple[dict[str, Any], ...] = ({}, {"qp_solver_iter_max": 8, "qp_solver_warm_start": 1})
 """HPIPM settings ``slewbench bench``'s peer tries on every problem (each over :data:`SOLVER_OPTIONS`,
-and over :data:`FALLBACK_OPTIONS` after a QP failure), reporting the faster solve that converges:
-HPIPM's defaults (at most 50 interior-point iterations per QP) and at most 8, warm-started from the
-last QP. Neither is best everywhere (2026-12-04, ``slewbench bench --planners acados``, the second
-against the first): Bilimoria & Wie 180° 59 against 136 ms, the full inertia 45 against 195 ms,
-but 90° 170 against 96 ms and 45° 229 against 192 ms, the same objectives; a user tuning acados
-per problem would keep the faster, so the peer does."""
+and over :data:`FALLBACK_OPTIONS` after a QP failure): HPIPM's defaults (at most 50 interior-point
+iterations per QP) and at most 8, warm-started from the last QP. Of the converged solves, those
+within :data:`SAME_OBJECTIVE` of the lowest objective compete, the faster by a first solve is
+reported with the time of a second solve. Neither setting is best everywhere (2026-12-04,
+``slewbench bench --planners acados``, the second against the first): Bilimoria & Wie 180° 59
+against 136 ms, the full inertia 45 against 195 ms, but 90° 170 against 96 ms and 45° 229 against
+192 ms, the same objectives; a user tuning acados per problem would keep the faster, so the peer
+does."""
+SAME_OBJECTIVE = 1e-6
+"""Relative difference within which two settings' objectives are the same optimum (the settings
+then compete on time; a lower optimum wins whatever its time)."""
 FALLBACK_OPTIONS: dict[str, Any] = {"regularize_method": "MIRROR", "levenberg_marquardt": 0.1}
 """Options of the second build after a QP failure: the full-inertia case (150° about [1, 1, 1])
 stops at a QP failure in SQP iteration 2 under :data:`SOLVER_OPTIONS` (and under MIRROR,
@@ -317,8 +322,8 @@ class AcadosBenchPeer:
 
     def solve(self, problem: Any, objective: str) -> Any:
         """Build (again with :data:`FALLBACK_OPTIONS` after a QP failure) and solve from ``collocation``'s
-        first start (:func:`~scenarios.bench.peers._shooting.first_start_guess`), once per HPIPM
-        setting of :data:`QP_SETTINGS`; the faster converged solve is reported.
+        first start (:func:`~scenarios.bench.peers._shooting.first_start_guess`) under each HPIPM
+        setting of :data:`QP_SETTINGS`, and report one (:meth:`_chosen`).
 
         Parameters
         ----------
@@ -330,54 +335,109 @@ class AcadosBenchPeer:
         Returns
         -------
         PeerResult
-            The objective reached (``None`` when acados failed), the solve's time in the worker
-            [s], ``"ok"`` or ``"failed"``, the SQP iterations, the start and acados's status (and
-            the QP setting reported), the build time [s] (every build); ``extra``: the options of
+            The objective reached (``None`` when acados failed), the reported solve's time in the
+            worker [s], ``"ok"`` or ``"failed"``, the SQP iterations, the start, acados's status and
+            the QP setting reported, the build time [s] (every build); ``extra``: the options of
             the reported solve, the final time [s], the start and ``tried`` (per setting: its
-            options, status, time [s], SQP iterations and objective).
+            options, status, the choosing and the reported solve's times [s], SQP iterations,
+            objective, or the error that stopped it; ``None`` for a value that is not finite).
+        """
+        from scenarios.bench.peers._shooting import first_start_guess
+        from scenarios.bench.peers.base import PeerResult
+
+        guess = first_start_guess(problem, objective, N)
+        build, tried = 0.0, []
+        for setting in QP_SETTINGS:
+            entry = self._solve_setting(problem, objective, guess, setting)
+            build += entry.pop("build_s")
+            tried.append(entry)
+        record = [{"options": entry["options"], **({"error": entry["error"]} if "error" in entry else {
+            "status": entry["answer"]["status"], "choice_time_s": _finite(entry["first"]["time_s"]),
+            "time_s": _finite(entry["answer"]["time_s"]), "iterations": entry["answer"]["iterations"],
+            "objective": _finite(entry["answer"]["objective"])})} for entry in tried]
+        chosen, choice = self._chosen(tried)
+        if chosen is None:
+            errors = "; ".join(f"{_setting_name(entry['options'])}: {entry['error']}" for entry in tried)
+            return PeerResult(None, 0.0, "failed", None, f"{guess.start}; {errors}", build or None,
+                              {"start": guess.start, "tried": record})
+        options, answer = chosen["options"], chosen["answer"]
+        ok = answer["status"] == "ok"
+        return PeerResult(answer["objective"] if ok else None, answer["time_s"], "ok" if ok else "failed",
+                          answer["iterations"],
+                          f"{guess.start}; acados: {answer['status']} ({_setting_name(options)}; {choice})", build,
+                          {"options": dict(options), "T": _finite(answer["T"]), "start": guess.start, "tried": record},
+                          answer.get("cpu_s"))
+
+    def _solve_setting(self, problem: Any, objective: str, guess: Any, setting: dict[str, Any]) -> dict[str, Any]:
+        """Build and solve under one HPIPM setting (over :data:`FALLBACK_OPTIONS` after a QP failure).
+        A converged solve is solved again: the first chooses among the settings, the second is
+        the one reported, so that the time reported is not the one the choice was made on.
+
+        Returns
+        -------
+        dict
+            ``options``, ``build_s`` [s] and ``first`` and ``answer`` (the worker's answers), or
+            ``error`` where the worker raised (it is closed if it died; the next setting starts another).
         """
         import atexit
 
-        from scenarios.bench.peers._shooting import first_start_guess
-        from scenarios.bench.peers.base import PeerResult, torque_bounds
+        from scenarios.bench.peers.base import torque_bounds
 
-        if self._worker is None:
-            self._worker = AcadosPeer()
-            atexit.register(self._worker.close)
-        guess = first_start_guess(problem, objective, N)
         build = 0.0
-        tried: list[tuple[dict, dict]] = []  # (options, answer) of each setting's last solve
-        for setting in QP_SETTINGS:
+        options: dict[str, Any] = {}
+        try:
             for base in (SOLVER_OPTIONS, FALLBACK_OPTIONS):
                 options = {**base, **setting}
                 data = problem_data(problem, objective, N, (guess.states, guess.duration), options)
                 data["u_max"] = np.asarray(torque_bounds(problem), dtype=float).tolist()  # the actuator margin applied
-                try:
-                    build += float(self._worker._ask({"op": "build", **data})["build_s"])
-                    answer = self._worker.solve()
-                except RuntimeError as error:
-                    if self._worker._process.poll() is not None:  # it died: the next problem starts a new one
-                        self._worker.close()
-                        self._worker = None
-                    return PeerResult(None, 0.0, "failed", None, f"{guess.start}; {error}", build or None,
-                                      {"start": guess.start})
-                if answer["status"] != "qp_failure":
+                if self._worker is None:
+                    self._worker = AcadosPeer()
+                    atexit.register(self._worker.close)
+                worker = self._worker
+                build += float(worker._ask({"op": "build", **data})["build_s"])
+                first = worker.solve()
+                if first["status"] != "qp_failure":
                     break
-            tried.append((options, answer))
-        converged = [pair for pair in tried if pair[1]["status"] == "ok"]
-        options, answer = min(converged, key=lambda pair: pair[1]["time_s"]) if converged else tried[0]
-        ok = answer["status"] == "ok"
-        setting = {name: value for name, value in options.items() if name.startswith("qp_solver")}
-        which = ", ".join(f"{name} {value}" for name, value in setting.items()) or "HPIPM's defaults"
-        choice = (f"the faster of {len(converged)} converged QP settings" if len(converged) > 1 else
-                  f"the only one of {len(tried)} QP settings that converged" if converged else
-                  f"none of {len(tried)} QP settings converged")
-        return PeerResult(answer["objective"] if ok else None, answer["time_s"], "ok" if ok else "failed",
-                          answer["iterations"], f"{guess.start}; acados: {answer['status']} ({which}; {choice})", build,
-                          {"options": dict(options), "T": answer["T"], "start": guess.start,
-                           "tried": [{"options": dict(o), "status": a["status"], "time_s": a["time_s"],
-                                      "iterations": a["iterations"], "objective": a["objective"]} for o, a in tried]},
-                          answer.get("cpu_s"))
+            answer = worker.solve() if first["status"] == "ok" else first
+        except RuntimeError as error:
+            if self._worker is not None and self._worker._process.poll() is not None:  # it died
+                self._worker.close()
+                self._worker = None
+            return {"options": options, "build_s": build, "error": str(error)}
+        return {"options": options, "build_s": build, "first": first, "answer": answer}
+
+    @staticmethod
+    def _chosen(tried: list[dict[str, Any]]) -> tuple[dict[str, Any] | None, str]:
+        """The setting reported, and why: among the converged solves those within
+        :data:`SAME_OBJECTIVE` of the lowest objective, the fastest by its first solve; where none
+        converged, the first setting that answered; ``None`` where every setting raised."""
+        answered = [entry for entry in tried if "answer" in entry]
+        converged = [entry for entry in answered if entry["answer"]["status"] == "ok"]
+        if not converged:
+            return (answered[0] if answered else None), f"none of {len(tried)} QP settings converged"
+        best = min(entry["answer"]["objective"] for entry in converged)
+        same = [entry for entry in converged if entry["answer"]["objective"] <= best + SAME_OBJECTIVE * abs(best)]
+        chosen = min(same, key=lambda entry: entry["first"]["time_s"])
+        others = [f"{_setting_name(entry['options'])}: {entry['error']}" for entry in tried if "error" in entry]
+        if len(converged) == 1:
+            why = f"the only one of {len(tried)} QP settings that converged"
+        elif len(same) == len(converged):
+            why = f"the faster of {len(converged)} converged QP settings"
+        else:
+            worse = ", ".join(f"{entry['answer']['objective']:.8g}" for entry in converged if entry not in same)
+            why = f"the lowest objective of {len(converged)} converged QP settings (the others {worse})"
+        return chosen, why + "".join(f"; {other}" for other in others)
+
+
+def _setting_name(options: dict[str, Any]) -> str:
+    """An HPIPM setting in words: its ``qp_solver`` options, or HPIPM's defaults."""
+    return ", ".join(f"{name} {value}" for name, value in options.items() if name.startswith("qp_solver")) or \
+        "HPIPM's defaults"
+
+
+def _finite(value: Any) -> float | None:
+    """``value`` as a float, ``None`` where it is not finite (JSON has no NaN)."""
+    return float(value) if value is not None and np.isfinite(value) else None
 
 
 PEER = AcadosBenchPeer()
