@@ -1,7 +1,7 @@
 """The exceptions of :mod:`scenarios`, derived from :class:`ocp.errors.SlewbenchError`.
 
 :class:`ScenarioError` is a user's mistake in a scenario or study file (or a library argument), at
-its YAML path; :class:`OutputError` an output location slewbench must not or cannot write to, at
+its YAML path, naming the file where one was read (:func:`in_file`); :class:`OutputError` an output location slewbench must not or cannot write to, at
 that location (it is not a :class:`ScenarioError`: the scenario may be right). Both end the command
 line with exit status 2. :class:`SweepInterrupted` is a study stopped before every case finished.
 :class:`CaseTimeout`, a case out of time in a sweep's worker, is the one exception here not derived
@@ -12,11 +12,13 @@ Imports only :mod:`ocp.errors`.
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from ocp.errors import SlewbenchError
 
-__all__ = ["CaseTimeout", "OutputError", "PlausibilityWarning", "ScenarioError", "SweepInterrupted", "WorkersCannotStart"]
+__all__ = ["CaseTimeout", "OutputError", "PlausibilityWarning", "ScenarioError", "SweepInterrupted", "WorkersCannotStart",
+           "in_file"]
 
 ANOTHER_DIRECTORY = "choose another directory (the `directory` argument; --out on the command line)"
 """The remedy an :class:`OutputError` names for a directory it refuses: in the library's terms (the
@@ -40,13 +42,61 @@ class ScenarioError(SlewbenchError, ValueError):
 
     The error's text shows at most :data:`MAX_PATH_CHARS` of the path and
     :data:`MAX_MESSAGE_CHARS` of the message, whatever a file holds.
+
+    Parameters
+    ----------
+    path : str
+        The YAML path of the wrong value (``maneuver.duration``), kept as :attr:`path`; empty for
+        the file as a whole.
+    message : str
+        What is wrong and what was expected, kept as :attr:`message`.
+    file : str or os.PathLike or None, optional
+        The file read, kept as :attr:`file` (a :class:`~pathlib.Path`, or None for data not read
+        from a file); the text starts with it (``FILE: path: message``) unless the path or message
+        already names it. :func:`in_file` sets it on an error raised while a file is read.
     """
 
-    def __init__(self, path: str, message: str):
+    def __init__(self, path: str, message: str, file: str | os.PathLike[str] | None = None):
         shown = _bounded(message, MAX_MESSAGE_CHARS)
-        super().__init__(f"{_bounded(path, MAX_PATH_CHARS)}: {shown}" if path else shown)
+        text = f"{_bounded(path, MAX_PATH_CHARS)}: {shown}" if path else shown
+        if file is not None and str(Path(file)) not in f"{path}: {message}":
+            text = f"{_bounded(str(Path(file)), MAX_PATH_CHARS)}: {text}"
+        super().__init__(text)
         self.path = path
         self.message = message
+        self.file = None if file is None else Path(file)
+
+
+def in_file(error: ScenarioError, file: str | os.PathLike[str], kind: str = "scenario") -> ScenarioError:
+    """``error``, raised while ``file`` was read, as the error that names the file.
+
+    The one way :func:`scenarios.load`, :func:`scenarios.load_study` and the other readers of a
+    file name it: the result's :attr:`~ScenarioError.file` is ``file`` and its text starts with it
+    (once: not where the error already names it); a YAML path equal to the file is dropped (the
+    file as a whole), and a missing file is a ``<kind> file not found``.
+
+    Parameters
+    ----------
+    error : ScenarioError
+        The error raised while the file was read and checked.
+    file : str or os.PathLike
+        The file.
+    kind : str, optional
+        What the file is (``scenario``, ``study``, ``table``), named when it is not found.
+
+    Returns
+    -------
+    ScenarioError
+        ``error`` itself when it already has a file (one read inside this one names its own) or is
+        a command-line option's (its path starts with ``--``), else a new error with the same path
+        and message.
+    """
+    if error.file is not None or error.path.startswith("--"):
+        return error
+    named, message = Path(file), error.message
+    if not error.path and message == f"scenario file not found: {named}":
+        message = f"{kind} file not found: {named}"
+    return ScenarioError("" if error.path in (str(file), str(named)) else error.path, message, named)
 
 
 class OutputError(SlewbenchError):

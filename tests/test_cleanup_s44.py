@@ -34,7 +34,7 @@ def _run(tmp_path, data, capsys):
 def test_spin_extremal_on_a_fixed_final_rate_refuses_the_scenario_at_its_entry(tmp_path, capsys):
     code, captured, out = _run(tmp_path, REST_TO_REST, capsys)
     assert code == 2, captured
-    assert captured.err.startswith("slewbench: error in scenario: planners[3]: "), captured.err
+    assert captured.err.startswith(f"slewbench: error in scenario: {tmp_path / 'scenario.yaml'}: planners[3]: "), captured.err
     for words in ("the spin extremals cannot meet a fixed final rate", "maneuver.final.omega = [0. 0. 0.]",
                   "set maneuver.final.omega: null"):
         assert words in captured.err, captured.err
@@ -61,8 +61,8 @@ def test_natural_motion_on_a_non_zero_final_rate_is_refused_the_same_way(tmp_pat
     data["maneuver"]["final"]["omega"] = [0.01, 0, 0]
     code, captured, out = _run(tmp_path, data, capsys)
     assert code == 2, captured
-    assert captured.err.startswith("slewbench: error in scenario: planners[0]: natural_motion ends at rest: "
-                                   "maneuver.final.omega must be zero or null"), captured.err
+    assert captured.err.startswith(f"slewbench: error in scenario: {tmp_path / 'scenario.yaml'}: planners[0]: "
+                                   "natural_motion ends at rest: maneuver.final.omega must be zero or null"), captured.err
     assert not out.exists()
 
 

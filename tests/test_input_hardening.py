@@ -106,7 +106,7 @@ def test_bad_values_are_exit_2_naming_the_path(case, tmp_path):
     data, path = CASES[case]
     status, error, seconds = run_cli(tmp_path, yaml.safe_dump(data))
     assert status == 2, error
-    assert f"error in scenario: {path}:" in error, error
+    assert f"error in scenario: {tmp_path / 'case.yaml'}: {path}:" in error, error
     assert "Traceback" not in error and seconds < 10
 
 
@@ -312,7 +312,7 @@ def test_two_wheel_laws_need_zero_momentum_and_end_at_rest(change, path, tmp_pat
     else:
         data["maneuver"]["initial"]["omega"] = [0.01, 0.0, 0.02]
     status, error, _ = run_cli(tmp_path, yaml.safe_dump(data))
-    assert status == 2 and f"error in scenario: {path}:" in error, error
+    assert status == 2 and f"error in scenario: {tmp_path / 'case.yaml'}: {path}:" in error, error
 
 
 def test_combined_row_labels_must_differ(tmp_path):

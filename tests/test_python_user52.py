@@ -196,7 +196,7 @@ def test_a_scenario_files_error_still_says_scenario(tmp_path):
     err = io.StringIO()
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
         assert main(["validate", str(path)]) == 2
-    assert "error in scenario: maneuver.duration:" in err.getvalue(), err.getvalue()
+    assert f"error in scenario: {path}: maneuver.duration:" in err.getvalue(), err.getvalue()
 
 
 def test_a_mapping_that_holds_itself_is_refused_not_a_recursion_error():

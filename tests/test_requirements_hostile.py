@@ -373,7 +373,8 @@ def test_hostile_input_is_exit_2_naming_the_path_and_the_value(case, tmp_path):
     status, error = run_cli(tmp_path, data)
     assert status == 2, error
     # a file that cannot be read (a duplicate key) is named by its path: validate cannot yet tell its kind
-    kind = tmp_path / "case.yaml" if "duplicate key" in words else "scenario"
+    file = tmp_path / "case.yaml"
+    kind = file if "duplicate key" in words else f"scenario: {file}"  # a scenario's names its file after its kind
     assert f"error in {kind}: {path}:" in error, error
     for word in words:
         assert word in error, (word, error)

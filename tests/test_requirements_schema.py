@@ -138,7 +138,7 @@ def test_bad_requirement_input_is_exit_2_naming_the_path(case, tmp_path):
     data, path, words = BAD[case]
     status, error = run_cli(tmp_path, data)
     assert status == 2, error
-    assert f"error in scenario: {path}:" in error, error
+    assert f"error in scenario: {tmp_path / 'case.yaml'}: {path}:" in error, error
     for word in words:
         assert word in error, (word, error)
     assert "Traceback" not in error
@@ -155,11 +155,11 @@ def test_a_field_model_takes_the_scenarios_epoch_or_must_agree_with_it(tmp_path)
     assert scenarios.parse_scenario(same).problem.environment.magnetic_field.epoch == "2027-03-20T13:00:00+01:00"
     differ = changed(epoch=EPOCH, orbit=ORBIT, environment={"magnetic_field": {"model": "igrf", "epoch": "2025-01-01"}})
     status, error = run_cli(tmp_path, differ)
-    assert status == 2 and "error in scenario: environment.magnetic_field.epoch: 2025-01-01T00:00:00 differs" in error
+    assert status == 2 and f"error in scenario: {tmp_path / 'case.yaml'}: environment.magnetic_field.epoch: 2025-01-01T00:00:00 differs" in error
     assert "epoch: 2027-03-20T12:00:00Z" in error
     outside = changed(epoch="2035-01-01T00:00:00Z", orbit=ORBIT, environment={"magnetic_field": igrf})
     status, error = run_cli(tmp_path, outside)
-    assert status == 2 and "error in scenario: epoch: IGRF-14 covers" in error, error
+    assert status == 2 and f"error in scenario: {tmp_path / 'case.yaml'}: epoch: IGRF-14 covers" in error, error
     assert "takes the scenario's epoch" in error
 
 

@@ -77,7 +77,8 @@ def test_a_misspelt_keep_out_is_named_as_the_unknown_key_on_the_command_line(tmp
     data["requirements"]["pointing"]["st_sun"] = {"sensor": "star_tracker", "keepout": "sun", "angle_deg": 30}
     status, _, error = validate(tmp_path, data)
     assert status == 2, error
-    assert "error in scenario: requirements.pointing.st_sun.keepout: unknown key 'keepout'" in error, error
+    assert f"error in scenario: {tmp_path / 'case.yaml'}: requirements.pointing.st_sun.keepout: unknown key 'keepout'" \
+        in error, error
     assert "a misspelling of 'keep_out'?" in error and "exactly one of keep_out and keep_in" in error, error
     assert "Traceback" not in error
 
@@ -146,7 +147,8 @@ def test_every_wheel_failed_without_other_actuators_is_refused_at_the_failed_lis
     data = small(spacecraft__wheels__failed=[0, 1, 2, 3])
     status, _, error = validate(tmp_path, data)
     assert status == 2, error
-    assert "error in scenario: spacecraft.wheels.failed: [0, 1, 2, 3]: every one of the 4 wheels is failed" in error
+    assert f"error in scenario: {tmp_path / 'case.yaml'}: spacecraft.wheels.failed: [0, 1, 2, 3]: every one of the 4 " \
+        "wheels is failed" in error
     assert "controller.name 'augmented_quaternion_feedback' has nothing to steer with" in error, error
     assert "Traceback" not in error
 

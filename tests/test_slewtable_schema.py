@@ -218,7 +218,7 @@ def verdict(path: Path) -> Any:
     try:
         return plain(parse_table_spec(path))
     except ScenarioError as error:
-        return ("error", str(error))
+        return ("error", error.path, error.message)  # the file named aside (the two files' names differ)
 
 
 def test_documented_table_defaults_are_the_defaults_the_table_parser_applies(folder):

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from scenarios.errors import ScenarioError
+from scenarios.errors import ScenarioError, in_file
 from scenarios.schema.read import read_yaml
 
 __all__ = ["OBJECTIVE_METRICS", "OPTIMUM_KINDS", "SUITE_FILE", "BenchProblem", "Suite", "load_suite"]
@@ -212,15 +212,19 @@ def load_suite(path: str | Path | None = None) -> Suite:
     Raises
     ------
     ScenarioError
-        A missing or malformed field, named by its YAML path, or a scenario file that is not there.
+        A missing or malformed field, named by its YAML path, or a scenario file that is not there;
+        its :attr:`~scenarios.errors.ScenarioError.file` is the index, named in its text.
     """
     path = SUITE_FILE if path is None else Path(path)
-    data = read_yaml(path)
-    if not isinstance(data, dict) or not isinstance(data.get("problems"), dict):
-        raise ScenarioError("problems", f"{path.name}: expected a mapping with version and problems")
-    version = data.get("version")
-    if isinstance(version, bool) or not isinstance(version, int) or version < 1:
-        raise ScenarioError("version", f"expected a positive integer, got {version!r}")
-    folder = path.parent / "problems"
-    problems = {str(name): _problem(str(name), entry, folder) for name, entry in data["problems"].items()}
+    try:
+        data = read_yaml(path)
+        if not isinstance(data, dict) or not isinstance(data.get("problems"), dict):
+            raise ScenarioError("problems", "expected a mapping with version and problems")
+        version = data.get("version")
+        if isinstance(version, bool) or not isinstance(version, int) or version < 1:
+            raise ScenarioError("version", f"expected a positive integer, got {version!r}")
+        folder = path.parent / "problems"
+        problems = {str(name): _problem(str(name), entry, folder) for name, entry in data["problems"].items()}
+    except ScenarioError as error:
+        raise in_file(error, path, "suite") from None
     return Suite(version, problems, path)

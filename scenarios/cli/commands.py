@@ -36,7 +36,7 @@ from scenarios.cli.status import (
 )
 from scenarios.cli.sweep import add_sweep_parser
 from scenarios.cli.table import add_table_parser
-from scenarios.errors import OutputError, ScenarioError
+from scenarios.errors import OutputError, ScenarioError, in_file
 from scenarios.output.directory import (
     check_output_directory,
     claim_output_directory,
@@ -266,8 +266,11 @@ def command_validate(args: argparse.Namespace) -> int:
             print(summary)
             print_findings(findings)
             return _strict_status(args, findings, f"{len(findings)} finding(s) above")
-    refuse_unmarked_base(data, args.file)
-    scenario = parse_scenario(data, Path(args.file))
+    try:
+        refuse_unmarked_base(data, args.file)
+        scenario = parse_scenario(data, Path(args.file))
+    except ScenarioError as error:
+        raise in_file(error, args.file) from None
     labels = row_labels([planner.label for planner in scenario.planners], [c.label for c in scenario.controllers])
     controllers = ", ".join(repr(c.name) for c in scenario.controllers)
     print(f"{args.file}: valid scenario {scenario.name!r} with {len(scenario.planners)} planner(s) and "
@@ -768,7 +771,7 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         if kind in _COMMAND_FILES.values():  # a study's or a table's error names its file (its YAML path follows)
             if not given:
                 kind = "the command line"  # no file given: nothing to name
-            elif str(given) not in text:
+            elif error.file is None and str(given) not in text:  # raised after the file was read
                 text = f"{given}: {text}"
         # a message that starts with the file it names (a file whose kind is not known yet) names it once
         print(f"slewbench: error in {text}" if text.startswith(f"{kind}: ") else f"slewbench: error in {kind}: {text}",

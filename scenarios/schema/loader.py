@@ -34,7 +34,7 @@ from ocp.metrics import DEFAULT_SETTLING_TOLERANCE_DEG
 from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem, Planner
 from planners.errors import UnknownNameError
-from scenarios.errors import ScenarioError
+from scenarios.errors import ScenarioError, in_file
 from scenarios.requirements.spec import Requirements, Sensor
 from scenarios.schema.checks import (
     check_compatibility,
@@ -698,22 +698,26 @@ def load(path: str | Path) -> Scenario:
     Raises
     ------
     ScenarioError
-        The file cannot be read or is not a valid scenario (the message names the YAML path); a
-        study or slew-table file names the command that runs it.
+        The file cannot be read or is not a valid scenario: its :attr:`~scenarios.errors.ScenarioError.file`
+        is ``path``, its text names the file and the YAML path (``FILE: name: required key is
+        missing``); a study or slew-table file names the command that runs it.
 
     Warns
     -----
     PlausibilityWarning
         One per value that looks like a unit or layout slip, as :func:`parse_scenario`.
     """
-    data = read_yaml(path)
-    if isinstance(data, dict):
-        for key, command in OTHER_FILES.items():
-            if key in data:
-                raise ScenarioError(key, f"{path} is a {key} file, not a scenario: run it with "
-                                         f"`slewbench {command} {path}`")
-    refuse_unmarked_base(data, path)
-    return parse_scenario(data, Path(path))
+    try:
+        data = read_yaml(path)
+        if isinstance(data, dict):
+            for key, command in OTHER_FILES.items():
+                if key in data:
+                    raise ScenarioError(key, f"{path} is a {key} file, not a scenario: run it with "
+                                             f"`slewbench {command} {path}`")
+        refuse_unmarked_base(data, path)
+        return parse_scenario(data, Path(path))
+    except ScenarioError as error:
+        raise in_file(error, path) from None
 
 
 OTHER_FILES = {"study": "sweep", "table": "table"}

@@ -115,9 +115,9 @@ def parse_yaml_text(text: str, source: Path | str = "<text>") -> Any:
         where = getattr(error, "problem_mark", None)
         line = f" (line {where.line + 1}, column {where.column + 1})" if where else ""
         problem = getattr(error, "problem", None) or error
-        raise ScenarioError("", f"{source} is not valid YAML{line}: {excerpt(str(problem), 200)}") from None
+        raise ScenarioError("", f"{source}: not valid YAML{line}: {excerpt(str(problem), 200)}") from None
     except RecursionError:
-        raise ScenarioError("", f"{source} nests too deeply") from None
+        raise ScenarioError("", f"{source}: nests too deeply") from None
     finally:
         loader.dispose()
 
@@ -195,7 +195,7 @@ def read_yaml(path: str | Path) -> Any:
     try:
         data = read_bounded(path, MAX_FILE_BYTES)  # /dev/zero or a pipe reports no size
         if len(data) > MAX_FILE_BYTES:
-            raise ScenarioError("", f"{path} has more than {MAX_FILE_BYTES} bytes; scenario and study files are "
+            raise ScenarioError("", f"{path}: more than {MAX_FILE_BYTES} bytes; scenario and study files are "
                                     "limited to that")
         text = data.decode("utf-8")
     except FileNotFoundError:

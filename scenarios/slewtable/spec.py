@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from ocp.simulation.simulator import MAX_SUBSTEPS
-from scenarios.errors import ScenarioError
+from scenarios.errors import ScenarioError, in_file
 from scenarios.schema.node import Node
 from scenarios.schema.table import (
     MAX_REFINE,
@@ -241,7 +241,8 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
     Raises
     ------
     ScenarioError
-        A bad file or option, named by its YAML path or option (exit 2 on the command line).
+        A bad file or option, named by its YAML path or option (exit 2 on the command line); its
+        :attr:`~scenarios.errors.ScenarioError.file` is ``file``, named in its text.
     ValueError
         An override that is not a flag of ``TABLE_FLAGS``.
     """
@@ -252,7 +253,14 @@ def parse_table_spec(file: str | Path, overrides: dict[str, Any] | None = None) 
         raise ValueError(f"unknown table override(s) {', '.join(unknown)}; expected flags of TABLE_FLAGS without dashes: "
                          f"{', '.join(flag[2:] for flag in TABLE_FLAGS.values())}")
     path = Path(file)
-    data = read_yaml(path)
+    try:
+        return _table_spec(path, read_yaml(path), flags)
+    except ScenarioError as error:
+        raise in_file(error, path, "table") from None
+
+
+def _table_spec(path: Path, data: Any, flags: dict[str, Any]) -> TableSpec:
+    """:func:`parse_table_spec` of the file at ``path`` read as ``data``, with the overrides ``flags``."""
     if isinstance(data, dict) and "table" in data:
         root = Node(data)
         table = TABLE_FILE["table"].node(root).mapping()

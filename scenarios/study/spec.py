@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from ocp.errors import excerpt
-from scenarios.errors import ScenarioError
+from scenarios.errors import ScenarioError, in_file
 from scenarios.output.provenance import package_version
 from scenarios.requirements.fields import is_requirement_column
 from scenarios.requirements.scoring import score_fields
@@ -268,19 +268,21 @@ def _base(root: Node, source: Path | None) -> dict[str, Any]:
     node = STUDY["scenario"].value(root)
     if isinstance(node.value, str):
         folder = source.parent if source else Path.cwd()
+        where = f"scenario: {folder / node.value}"  # the base scenario's errors name its file too
         try:
             base = read_yaml(folder / node.value)
         except ScenarioError as error:
             raise ScenarioError("scenario", error.message) from None
     else:
+        where = "scenario"
         base = copy.deepcopy(node.mapping().value)
     if not isinstance(base, dict):
-        raise ScenarioError("scenario", "the base scenario is not a mapping")
+        raise ScenarioError(where, "the base scenario is not a mapping")
     try:
         parse_scenario(base, inapplicable_rows=True)  # the loader only reads its data; a planner the base
         # does not suit may suit other cases (:meth:`_Expansion.refuse_unused_planners`)
     except ScenarioError as error:
-        raise ScenarioError(f"scenario: {error.path}", error.message) from None
+        raise ScenarioError(f"{where}: {error.path}" if error.path else where, error.message) from None
     return base
 
 
@@ -724,8 +726,9 @@ def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None
     Raises
     ------
     ScenarioError
-        Naming the study file, the case and the path, for a missing file, a bad entry or a case
-        the scenario loader rejects.
+        Naming the study file (its :attr:`~scenarios.errors.ScenarioError.file`, and first in its
+        text), the case and the path, for a missing file, a bad entry or a case the scenario loader
+        rejects; an error in a base scenario read from its own file names that file too.
     TypeError
         ``path`` is not a path.
     """
@@ -737,8 +740,5 @@ def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None
         _refuse_other_file(data, path)
         return parse_study(data, path, progress=progress)
     except ScenarioError as error:
-        if error.message.startswith(f"scenario file not found: {path}"):
-            raise ScenarioError("", f"study file not found: {path}") from None
-        where = f"{path}: {error.path}" if error.path and error.path != str(path) else str(path)
-        raise ScenarioError(where, error.message) from None
+        raise in_file(error, path, "study") from None
 
