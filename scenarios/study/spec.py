@@ -364,7 +364,7 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
     root.finish()
     _mark_independent(seen)
     study = Study(name, source, base, [v.path for axis in axes for v in axis.varied], [v.path for v, _ in dispersions],
-                  samples, method, seed, summary, execution, raw=copy.deepcopy(data),
+                  samples, method, seed, summary, execution, raw=copy.deepcopy(root.value),
                   thresholds=robustness["thresholds"], worst=robustness["worst"])
     expansion = _Expansion(study, axes, dispersions, version or package_version(), progress)
     study.cases = expansion.cases()

@@ -101,7 +101,10 @@ class Study:
     cases : list of Case
         The expanded cases, in order.
     raw : dict
-        The study mapping as given (for ``study.yaml``).
+        The study mapping as given (for ``study.yaml``), in the plain values YAML gives: dicts, lists,
+        ``str``, ``int``, ``float``, ``bool`` and None; a mapping built in Python has its numpy numbers
+        and arrays and its tuples converted (:func:`scenarios.schema.node.plain_value`), so that it
+        serialises with ``json`` and ``yaml.safe_dump``.
     thresholds : dict
         Metric column -> ``(sense, bound)`` with sense ``at_most`` or ``at_least``
         (``robustness.thresholds``): the robustness table's criteria beside every requirement.
