@@ -95,8 +95,8 @@ from planners.collocation.reference import (
     switch_mesh,
 )
 from planners.collocation.requirements import (
-    BOUND_TOLERANCE,
     DENSE_POINTS,
+    START_TOLERANCE,
     DenseCheck,
     Requirements,
     Tightening,
@@ -1071,7 +1071,7 @@ class CollocationPlanner(Planner):
                 entry["checked"] = "not faster"
                 continue
             broken = start_violations(problem, candidate, bounds, ocp.max_rate, requirements.pointing,
-                                      DENSE_POINTS * o.intervals + 1, BOUND_TOLERANCE, SEED_BOUND_ATOL)
+                                      DENSE_POINTS * o.intervals + 1, START_TOLERANCE, SEED_BOUND_ATOL)
             entry["checked"] = broken if isinstance(broken, str) else ("feasible" if not broken else "infeasible")
             if isinstance(broken, dict) and broken:
                 entry["violations"] = broken
@@ -1192,7 +1192,7 @@ class CollocationPlanner(Planner):
         within: list[tuple[float, str]] = []
         for label, candidate in self._bound_candidates(problem, []):
             broken = start_violations(problem, candidate, bounds, ocp.max_rate, pointing,
-                                      DENSE_POINTS * self.options.intervals + 1, BOUND_TOLERANCE, SEED_BOUND_ATOL)
+                                      DENSE_POINTS * self.options.intervals + 1, START_TOLERANCE, SEED_BOUND_ATOL)
             if broken == {}:
                 (within if candidate.duration <= bound else known).append((float(candidate.duration), label))
         if within:  # a feasible slew fits: the bound is not below the minimum time
