@@ -32,10 +32,21 @@ from planners.reference import (
     Reference,
 )
 
-__all__ = ["REQUIREMENT_KINDS", "Planner"]
+__all__ = ["REQUIREMENT_KINDS", "REQUIREMENT_TOLERANCE", "Planner"]
 
 REQUIREMENT_KINDS: tuple[str, ...] = ("pointing", "actuators", "rate")
 """The requirement kinds a planner may honour (:attr:`Planner.honours`)."""
+
+REQUIREMENT_TOLERANCE = 1e-9
+"""Relative slack on a requirement's bound, rounding and not a margin: a quantity at most
+``(1 + REQUIREMENT_TOLERANCE)`` times its bound (the body-rate norm over the rate requirement, an
+actuator's demand over ``1 − actuator_margin`` of its limit) meets it. One number for the scorer
+(:mod:`scenarios.requirements.scoring`, its ratio and bound checks) and for a planner that honours
+the kind and checks its reference densely (``collocation``'s dense check,
+:data:`planners.collocation.requirements.BOUND_TOLERANCE`): a reference the planner calls within a
+bound is never scored breaking it for the slack alone, nor refused for what the scorer accepts.
+(The two grids still differ: the dense check reads :data:`~planners.collocation.requirements.DENSE_POINTS`
+points per mesh interval, the scorer its own samples.)"""
 
 
 class Planner(Configurable, ABC):

@@ -3,6 +3,12 @@
 Objectives: ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt (slack variables),
 ``min_time`` (free T, the scenario's T is the upper bound), and ``weighted``
 (``energy_weight``, ``l1_weight``, ``time_weight``). τ is the actuators' body torque.
+A ``min_time`` that fails under its bound, where the starts say the bound may be below the minimum
+time and a feasible slew longer than it is known, is solved again with the bound released
+(:meth:`CollocationPlanner._released`): an optimum above the bound makes the reference
+``infeasible``, its duration that optimum's T (the least time this planner finds, a local optimum,
+not a proof that no faster slew exists), as a minimum-time slew of another planner longer than the
+budget is; ``failed`` stays for a solve that does not converge.
 Constraints: actuator bounds (wheel torques, dipoles, torquers), wheel momentum bounds, a body-rate
 bound ``max_rate`` (option, per axis), fixed or free final rate, keep-out / keep-in cones (options),
 and the controllers' allocation on the controls (:mod:`planners.collocation.allocation`): the wheel
@@ -32,6 +38,7 @@ its certificate (:func:`~planners.collocation.certificate.bang_bang_certificate`
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import Annotated, Any, Literal
 
@@ -88,8 +95,8 @@ from planners.collocation.reference import (
     switch_mesh,
 )
 from planners.collocation.requirements import (
-    BOUND_TOLERANCE,
     DENSE_POINTS,
+    START_TOLERANCE,
     DenseCheck,
     Requirements,
     Tightening,
@@ -144,7 +151,9 @@ class CollocationOptions:
     ----------
     objective : str
         ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt, ``min_time`` (free T, the
-        scenario's duration its upper bound) or ``weighted``; τ the actuators' body torque [N m].
+        scenario's duration its upper bound: where none is found within it, ``infeasible`` with
+        the least T found with the bound released, see the module docstring) or ``weighted``; τ
+        the actuators' body torque [N m].
     intervals : int
         Mesh intervals.
     degree : int
@@ -784,7 +793,57 @@ class CollocationPlanner(Planner):
             dropped = [*(coarse.get("seeds_dropped", []) if isinstance(coarse, dict) else []),
                        *reference.stats.get("seeds_dropped", [])]
             reference.stats["seeds"]["skipped"] = failures + dropped
+        if not reference.ok and self.options.objective == "min_time":
+            reference = self._released(problem, reference)
         return reference
+
+    def _released(self, problem: ManeuverProblem, failed: Reference) -> Reference:
+        """A minimum time that failed at its bound, solved again with the bound released.
+
+        Where no start converged under ``maneuver.duration`` (the bound on the free final time), some
+        ended locally infeasible or at the bound, and a feasible slew of the problem longer than the
+        bound is known (:meth:`_time_bound`: ``eigenaxis``'s ``min_time``, checked against the
+        problem's constraints), the same problem is planned again with its bound at that slew's
+        duration ``D`` (a bound that admits a slew; nothing else of the problem changes: with a free
+        final time the pointing windows are imposed over the whole run). Where that converges to
+        ``T* > maneuver.duration``, the reference is ``infeasible``, its ``duration`` ``T*`` and its
+        stats the released optimum's (its certificate, and ``time_bound``: the bound, ``D``, where
+        ``D`` came from, ``T*`` and the statuses at the bound): this planner's least time is
+        longer than the budget, as a minimum-time ``costate_tpbvp`` or ``eigenaxis`` slew longer
+        than it is (:func:`scenarios.requirements.scoring.late_slew`), and the row's
+        ``needed_duration_s`` is ``T*`` (:func:`scenarios.runner.needed_duration`). ``T*`` is a
+        local optimum, whatever its certificate says of it: the least time this planner finds, not a
+        proof that no faster slew exists, and the message says so. Where the released solve does
+        not converge, or converges within the bound, the reference stays ``failed`` (a numerical
+        failure, not a verdict on the budget), its message saying what the released solve did."""
+        record = failed.stats.get("time_bound")
+        if failed.status != "failed" or not isinstance(record, dict) or "feasible_s" not in record:
+            return failed
+        bound, (released, label) = float(problem.duration), (float(record["feasible_s"]), str(record["feasible_from"]))
+        wider = replace(problem, duration=released)
+        starts = self._starts(wider)
+        found = self._plan_from(wider, starts) if starts else FailedReference(self.name, "no start")
+        record = {**record, "released_ok": found.ok, "bounded_status": failed.stats.get("solver_status")}
+        failed.stats["time_bound"] = record
+        if not found.ok:
+            failed.message += (f"; with the bound released to {released:.6g} s ({label}'s feasible slew) it did not "
+                               f"converge either: {found.message}")
+            return failed
+        T = float(found.duration)
+        record["released_T_s"] = T
+        if not T > bound:
+            failed.message += (f"; with the bound released to {released:.6g} s ({label}'s feasible slew) it "
+                               f"converged to T = {T:.8g} s, within the bound: the starts under the bound failed "
+                               f"for another reason (try more starts)")
+            return failed
+        certificate = found.stats.get("certificate")
+        verdict = f", its certificate {certificate.get('verdict')}" if isinstance(certificate, dict) else ""
+        message = (f"{self.options.objective}: no slew found within maneuver.duration = {bound:g} s (the bound on the "
+                   f"free final time): with the bound released to {released:.6g} s ({label}'s feasible slew) this "
+                   f"planner's minimum time is T = {T:.8g} s{verdict}, longer than the bound; a local optimum, the "
+                   f"least time this planner finds, not a proof that no faster slew exists; a maneuver.duration of "
+                   f"{_rounded_up(T)} s admits this slew. Under the bound: {failed.message}")
+        return FailedReference(self.name, message, "infeasible", duration=T, stats={**found.stats, "time_bound": record})
 
     def _plan_from(self, problem: ManeuverProblem, starts: list[Reference]) -> Reference:
         """Plan from the given start references (see the module docstring), then honour the
@@ -1012,7 +1071,7 @@ class CollocationPlanner(Planner):
                 entry["checked"] = "not faster"
                 continue
             broken = start_violations(problem, candidate, bounds, ocp.max_rate, requirements.pointing,
-                                      DENSE_POINTS * o.intervals + 1, BOUND_TOLERANCE, SEED_BOUND_ATOL)
+                                      DENSE_POINTS * o.intervals + 1, START_TOLERANCE, SEED_BOUND_ATOL)
             entry["checked"] = broken if isinstance(broken, str) else ("feasible" if not broken else "infeasible")
             if isinstance(broken, dict) and broken:
                 entry["violations"] = broken
@@ -1104,9 +1163,17 @@ class CollocationPlanner(Planner):
         constraints as :meth:`_seed_bound` checks it, the final time's bound aside: an upper bound
         of the minimum time, so a ``maneuver.duration`` at least that admits a slew). When such a
         slew fits within the bound, that instead: the bound is then not below the minimum time.
-        Else empty."""
+        Else empty. (:meth:`_time_bound` says it, and which slew's duration the bound may be
+        released to.)"""
+        return self._time_bound(problem, ocp, result)[0]
+
+    def _time_bound(self, problem: ManeuverProblem, ocp: OptimalControlProblem,
+                    result: NLPResult) -> tuple[str, tuple[float, str] | None]:
+        """:meth:`_time_bound_note`'s note, and where it says the bound may be below the minimum
+        time and names a feasible slew longer than the bound, that slew's duration [s] and label
+        (what :meth:`_released` releases the bound to); else ``None``."""
         if not ocp.free_time:
-            return ""
+            return "", None
         bound = float(problem.duration)
         infeasible = sum(start.status in INFEASIBLE for start in result.starts)
         plain = not (ocp.energy_weight or ocp.l1_weight)  # the objective is the final time
@@ -1114,7 +1181,7 @@ class CollocationPlanner(Planner):
         at_bound = sum(plain and start.status not in INFEASIBLE and np.isfinite(start.f)
                        and start.f >= weight * bound * (1.0 - 1e-6) for start in result.starts)
         if not infeasible and not at_bound:
-            return ""
+            return "", None
         ended = " and ".join(part for part in (f"{infeasible} ended locally infeasible" if infeasible else "",
                                                f"{at_bound} stopped at T = {bound:g} s" if at_bound else "") if part)
         note = (f"the final time is free and maneuver.duration = {bound:g} s bounds it; of {len(result.starts)} "
@@ -1125,19 +1192,20 @@ class CollocationPlanner(Planner):
         within: list[tuple[float, str]] = []
         for label, candidate in self._bound_candidates(problem, []):
             broken = start_violations(problem, candidate, bounds, ocp.max_rate, pointing,
-                                      DENSE_POINTS * self.options.intervals + 1, BOUND_TOLERANCE, SEED_BOUND_ATOL)
+                                      DENSE_POINTS * self.options.intervals + 1, START_TOLERANCE, SEED_BOUND_ATOL)
             if broken == {}:
                 (within if candidate.duration <= bound else known).append((float(candidate.duration), label))
         if within:  # a feasible slew fits: the bound is not below the minimum time
             duration, label = min(within)
             return (f"the final time is free and maneuver.duration = {bound:g} s bounds it; of {len(result.starts)} "
                     f"starts {ended}, but {label} is a feasible slew of this problem in {duration:.6g} s, within "
-                    f"the bound: the starts failed for another reason")
+                    f"the bound: the starts failed for another reason"), None
         if known:
             duration, label = min(known)
             note += (f"; {label} is a feasible slew of this problem in {duration:.6g} s, so a maneuver.duration "
                      f"of at least that admits one")
-        return note
+            return note, (duration, label)
+        return note, None
 
     @staticmethod
     def _failure_hint(problem: ManeuverProblem, ocp: OptimalControlProblem, statuses: list[str]) -> str:
@@ -1354,9 +1422,13 @@ class CollocationPlanner(Planner):
         stats = result.stats()
         stats.update(solved.extra, transcription=transcription.name, intervals=solved.intervals, solver=solver)
         if not result.success:
-            hint, note = self._failure_hint(problem, ocp, result.statuses), self._time_bound_note(problem, ocp, result)
+            hint, (note, release) = self._failure_hint(problem, ocp, result.statuses), self._time_bound(problem, ocp,
+                                                                                                        result)
             if note:  # first: what the starts' ends say, then what to try
                 hint = f" ({note}; {hint[2:-1]})" if hint else f" ({note})"
+            if release is not None:  # a feasible slew longer than the bound: what _released releases it to
+                stats["time_bound"] = {"bound_s": float(problem.duration), "feasible_s": release[0],
+                                       "feasible_from": release[1]}
             return FailedReference(self.name, f"{solver} did not converge from any start: "
                                    f"{sorted(set(result.statuses))}{hint}", result.status, stats=stats)
         assert result.x is not None  # success implies a point
@@ -1404,6 +1476,13 @@ class CollocationPlanner(Planner):
                                                                      lbx, ubx, solver, reference.stats,
                                                                      solved.switching)
         return reference
+
+
+def _rounded_up(value: float, digits: int = 7) -> str:
+    """``value`` (> 0) rounded up at ``digits`` significant digits: a duration to suggest, never below
+    the one needed (3.24308328 -> ``3.243084``)."""
+    step = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
+    return f"{math.ceil(value / step) * step:.{max(0, digits - 1 - math.floor(math.log10(value)))}f}"
 
 
 def _agreement(seeds: dict[str, Any]) -> str:

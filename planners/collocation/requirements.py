@@ -26,12 +26,13 @@ import numpy as np
 from ocp import quat
 from ocp.dynamics.layout import actuator_blocks
 from ocp.geometry import PointingConstraint
+from planners.base import REQUIREMENT_TOLERANCE
 from planners.collocation.problem import variable_bounds
 from planners.collocation.reference import CollocationReference
 from planners.problem import Array, ManeuverProblem
 
-__all__ = ["DENSE_POINTS", "DenseCheck", "Requirements", "Tightening", "dense_check", "dense_times", "imposed_pointing",
-           "imposed_state_bounds"]
+__all__ = ["BOUND_TOLERANCE", "DENSE_POINTS", "DenseCheck", "Requirements", "START_TOLERANCE", "Tightening", "dense_check",
+           "dense_times", "imposed_pointing", "imposed_state_bounds"]
 
 DENSE_POINTS = 20
 """Points per mesh interval of the dense check (equally spaced, the nodes included)."""
@@ -155,10 +156,21 @@ POINTING_STEP = float(np.deg2rad(1e-3))
 """Floor of a cone's further tightening after a dense check [rad] (1e-3 deg)."""
 BOUND_STEP = 1e-6
 """Floor of a bound's further tightening after a dense check (fraction of the limit)."""
-BOUND_TOLERANCE = 1e-6
+BOUND_TOLERANCE = REQUIREMENT_TOLERANCE
 """A bound (rate norm, actuator limit) counts as broken by the dense check when exceeded by more
-than this fraction of it: the solver meets an inequality to about 1e-8 of its scale, and the
-actuators' state bounds within them (imposed :data:`STATE_BACKOFF` inside, :func:`imposed_state_bounds`)."""
+than this fraction of it: the scorer's slack (:data:`planners.base.REQUIREMENT_TOLERANCE`, 1e-9),
+so that the planner never calls within a bound what a scenario then scores as breaking it. The
+solver meets an inequality only to about 1e-8 of its scale: a bound it rides (a rate requirement
+imposed with ``rate_margin: 0``) can exceed it by that and is then tightened and solved again, as
+any violation is; the actuators' state bounds are imposed :data:`STATE_BACKOFF` inside
+(:func:`imposed_state_bounds`) and the controls saturate at the bounds imposed, so neither needs
+it. (Until 2026-12-04 this was 1e-6: a reference up to 1e-6 above a bound passed the dense check and
+was scored ``violated``.) Not the slack of a start's feasibility (:data:`START_TOLERANCE`)."""
+START_TOLERANCE = 1e-6
+"""How far above a bound a start or candidate slew may go and still count as feasible for the NLP
+(:func:`~planners.collocation.certificate.start_violations`: the minimum time's seed bound and the
+note on a bound below the minimum time): the solver's own scale, about 1e-8, with room for a
+start's rounding. A start is no row: no scenario scores it."""
 SOLVER_BOUND_RELAXATION = 1e-8
 """How far the solver may leave a variable's bound ``b``, as a fraction of ``max(1, |b|)``: IPOPT's
 ``bound_relax_factor`` (its default, which :func:`~ocp.nlp.solve.solver_options` keeps) relaxes

@@ -74,7 +74,7 @@ from ocp.geometry.pointing import (
 from ocp.metrics import rate_error, turning
 from ocp.simulation.simulator import RPM_PER_RAD_S
 from planners import ManeuverProblem, Planner, Reference
-from planners.base import REQUIREMENT_KINDS
+from planners.base import REQUIREMENT_KINDS, REQUIREMENT_TOLERANCE
 from planners.reference import BREAKPOINT_INSTANT, JUMP_TOLERANCE
 from scenarios.requirements.fields import VERDICT
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
@@ -119,8 +119,10 @@ leaves about 1e-16 on a fully actuated spacecraft, and the optimal two-wheel man
 momenta integrated from its saturated torques part from its state polynomial's by that much
 (``scenarios/REPRODUCTION.md``, the saturated controls)."""
 
-_TOLERANCE = 1e-9
-"""Relative slack on the ratio and bound checks (rounding, not a margin)."""
+_TOLERANCE = REQUIREMENT_TOLERANCE
+"""Relative slack on the ratio and bound checks (rounding, not a margin):
+:data:`planners.base.REQUIREMENT_TOLERANCE`, the one that ``collocation``'s dense check allows a
+bound too, so that a reference it calls within a bound is not scored breaking it for the slack."""
 LATE_SLACK = 1e-6
 """Relative slack of :func:`late_slew` on ``maneuver.duration``: a solver's relaxation of the bound
 on a free final time (IPOPT's ``bound_relax_factor``, 1e-8) and rounding, not a margin (60 µs of a
