@@ -130,13 +130,28 @@ class Built:
         return status, np.array(command.u[:self.nu]), np.array(command.u_applied[:self.nu]), command.saturated
 
 
+@pytest.fixture(scope="module")
+def build(tmp_path_factory):
+    """``Built`` of a shipped scenario, generated and compiled once for the module's tests (in the
+    same worker): they only read it, each ``slewbench_step`` call packing the parameters and the
+    state it is given. ``horri_palmer_two_wheels.yaml`` took 44 s a test on a loaded machine."""
+    cache: dict[str, Built] = {}
+
+    def get(name: str) -> Built:
+        if name not in cache:
+            cache[name] = Built(name, tmp_path_factory.mktemp(Path(name).stem) / "c")
+        return cache[name]
+
+    return get
+
+
 @pytest.mark.parametrize("name", ["eigenaxis_demo.yaml", "collocation_min_energy.yaml", "nano_detumble.yaml",
                                   "horri_palmer_two_wheels.yaml"])
-def test_step_equals_the_python_law_then_the_simulators_saturation(name, tmp_path, rng):
+def test_step_equals_the_python_law_then_the_simulators_saturation(name, build, rng):
     """Random measurements (rates and wheel momenta large enough to saturate some samples) on every
     exported table (and regulation): the C command, applied command, flag and controller state equal
     the Python controller followed by ActuatorModel.apply, sample after sample."""
-    built = Built(name, tmp_path / "c")
+    built = build(name)
     scenario = load(SCENARIOS / name)
     problem, spec = scenario.problem, scenario.simulation
     spacecraft = problem.spacecraft
@@ -176,7 +191,7 @@ def test_step_equals_the_python_law_then_the_simulators_saturation(name, tmp_pat
     assert saturated_seen > 0  # the saturation stage was exercised
 
 
-def test_step_can_skip_the_saturation_and_a_law_that_bakes_its_sample_time_refuses_another(tmp_path, rng):
+def test_step_can_skip_the_saturation_and_a_law_that_bakes_its_sample_time_refuses_another(tmp_path, build, rng):
     text = (SCENARIOS / "nano_detumble.yaml").read_text()
     lines = [line for line in text.splitlines() if "name: bdot" not in line]  # TDFC alone: its delay is in samples
     (tmp_path / "tdfc.yaml").write_text("\n".join(lines) + "\n")
@@ -186,7 +201,7 @@ def test_step_can_skip_the_saturation_and_a_law_that_bakes_its_sample_time_refus
     measurement = Measurement(0.0, quat.random_unit(rng), np.full(3, 0.05), np.zeros(0), np.full(3, 2e-5))
     assert built.step(0.0, measurement, built.params(sample_time=2 * built.sample_time), state)[0] == 2  # ESAMPLE
     assert built.step(0.0, measurement, built.params(), state)[0] == 0
-    built = Built("eigenaxis_demo.yaml", tmp_path / "c")
+    built = build("eigenaxis_demo.yaml")
     state = built.init()
     measurement = Measurement(0.0, quat.random_unit(rng), np.full(3, 0.05), np.full(3, 2.0), None)
     params = built.params(saturate=0)
@@ -198,12 +213,12 @@ def test_step_can_skip_the_saturation_and_a_law_that_bakes_its_sample_time_refus
 
 @pytest.mark.parametrize("name", ["eigenaxis_demo.yaml", "collocation_min_energy.yaml",
                                   "nano_natural_vs_eigenaxis.yaml", "vepa_attitude_acquisition.yaml"])
-def test_c_tables_equal_the_python_interpolation_and_state_their_error_honestly(name, tmp_path, rng):
+def test_c_tables_equal_the_python_interpolation_and_state_their_error_honestly(name, build, rng):
     """Every planned row: the C interpolation equals the NumPy one on the same table (at random
     times, at the nodes, beyond the ends); the stated error (seven points per interval) is what the C
     table gives against the continuous reference, recomputed here; at random times the error stays
     below twice the stated figure (the points are h/8 apart; a smooth error peaks at the midpoint)."""
-    built = Built(name, tmp_path / "c")
+    built = build(name)
     scenario = load(SCENARIOS / name)
     planners = {p.label: p for p in scenario.planners}
     assert set(built.interface["tables"]) | set(built.interface.get("skipped", {})) <= set(planners)
@@ -300,7 +315,7 @@ def test_a_row_that_fails_to_plan_is_skipped_with_its_reason(tmp_path, monkeypat
     ("nano_detumble.yaml", {"sample_time", "gain"}),  # B-dot: K_b / T_s from both
     ("horri_palmer_two_wheels.yaml", set()),  # the two-wheel laws compile their numbers in (README says so)
 ])
-def test_parameters_are_inputs_the_law_and_saturation_read(name, law_reads, tmp_path, rng):
+def test_parameters_are_inputs_the_law_and_saturation_read(name, law_reads, build, rng):
     """Other gains, inertia, wheel axes, actuator limits and sample time, set in slewbench_params at
     run time (no regeneration): the C step equals the Python controller built with those options
     and reset for a spacecraft built with those numbers, followed by that spacecraft's
@@ -310,7 +325,7 @@ def test_parameters_are_inputs_the_law_and_saturation_read(name, law_reads, tmp_
     from ocp import Spacecraft
     from ocp.dynamics.actuator_kinds import Magnetorquers, ReactionWheels
 
-    built = Built(name, tmp_path / "c")
+    built = build(name)
     scenario = load(SCENARIOS / name)
     problem = scenario.problem
     law = built.interface["laws"][built.interface["step"]["law"]]
