@@ -16,7 +16,23 @@ class SlewbenchError(Exception):
 
     Catch it to tell slewbench's errors from Python's own; each package's ``errors`` module derives
     its exceptions from it.
+
+    Every one survives :mod:`pickle` (a sweep's worker process or a Dask worker sends an exception
+    back to the sweep) and :func:`copy.copy` with its text, ``args`` and attributes unchanged:
+    it is made again without its ``__init__`` (whose parameters are not its ``args``, the text),
+    from its ``args`` and its attributes.
     """
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return _remade, (type(self), self.args), self.__dict__ or None
+
+
+def _remade(cls: type[BaseException], args: tuple[Any, ...]) -> BaseException:
+    """An exception of class ``cls`` with ``args``, its ``__init__`` not called (the unpickling of a
+    :class:`SlewbenchError`; its attributes are restored after)."""
+    error = cls.__new__(cls, *args)
+    error.args = args
+    return error
 
 
 MAX_REPR = 80

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 from ocp.errors import SlewbenchError
 
@@ -136,6 +137,10 @@ class PlausibilityWarning(UserWarning):
     def __init__(self, path: str, value: str, reason: str) -> None:
         super().__init__(f"{path}: {value} {reason}")
         self.path, self.value, self.reason = path, value, reason
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as its constructor's arguments (not its text): the same text and attributes after."""
+        return type(self), (self.path, self.value, self.reason), self.__dict__
 
 
 class CaseTimeout(BaseException):

@@ -1,0 +1,172 @@
+"""Every exception class of slewbench survives :mod:`pickle` and :mod:`copy` with its class, text,
+``args`` and attributes: a sweep's worker (a local process pool, a Dask worker) sends an exception
+its task raises back to the sweep by pickling it.
+
+The classes are found, not listed: every module of ``ocp``, ``planners``, ``controllers`` and
+``scenarios`` is imported and every subclass of :class:`BaseException` defined there is checked (a
+new exception class is covered without editing this file). Each is built from its constructor's
+signature (a sample value per parameter, from its annotation).
+
+Before the fix (an ``__init__`` whose parameters are not the exception's ``args``), unpickling
+called ``ScenarioError(text)``, a ``TypeError``; in a local sweep whose task raised one, the pool's
+manager thread could not read the result, the pool broke, and the sweep started new pools for the
+same case without end (it hung).
+"""
+from __future__ import annotations
+
+import copy
+import importlib
+import inspect
+import os
+import pickle
+import pkgutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from ocp.errors import SlewbenchError
+from scenarios.errors import ScenarioError
+
+PACKAGES = ("ocp", "planners", "controllers", "scenarios")
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _import_everything() -> None:
+    for name in PACKAGES:
+        package = importlib.import_module(name)
+        for module in pkgutil.walk_packages(package.__path__, f"{name}."):
+            if module.name.rsplit(".", 1)[-1] != "__main__":  # runs the command line
+                importlib.import_module(module.name)
+
+
+def _subclasses(cls: type) -> list[type]:
+    found = []
+    for sub in cls.__subclasses__():
+        found += [sub, *_subclasses(sub)]
+    return found
+
+
+def _ours(cls: type) -> bool:
+    return cls.__module__.split(".")[0] in PACKAGES
+
+
+_import_everything()
+SLEWBENCH_ERRORS = sorted({SlewbenchError, *_subclasses(SlewbenchError)}, key=lambda c: f"{c.__module__}.{c.__qualname__}")
+OTHERS = sorted({cls for cls in _subclasses(BaseException) if _ours(cls) and cls not in SLEWBENCH_ERRORS
+                 # private ones are raised and caught within one call (scenarios.runner._NotKept carries a
+                 # Reference out of a cache's build): never sent to another process
+                 and not cls.__name__.startswith("_")},
+                key=lambda c: f"{c.__module__}.{c.__qualname__}")
+
+
+def _sample(name: str, annotation: str, position: int) -> object:
+    """A value for a constructor parameter, from its annotation (text: ``from __future__ import annotations``)."""
+    if annotation.split("|")[0].strip() == "int":
+        return 7 + 4 * position
+    if annotation.startswith("Iterable"):
+        return ["beta", "alpha"]
+    return f"<{name} {position}>"
+
+
+def instance(cls: type[BaseException]) -> BaseException:
+    """An instance of ``cls``: every parameter of a custom ``__init__`` given a sample value; a
+    message for the others."""
+    if not any("__init__" in vars(base) for base in cls.__mro__ if _ours(base)):
+        return cls("what went wrong, 1.5 N m")
+    parameters = list(inspect.signature(cls.__init__).parameters.values())[1:]
+    assert all(p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) for p in parameters), cls
+    positional = [_sample(p.name, str(p.annotation), at) for at, p in enumerate(parameters)
+                  if p.kind is p.POSITIONAL_OR_KEYWORD]
+    keywords = {p.name: _sample(p.name, str(p.annotation), at) for at, p in enumerate(parameters)
+                if p.kind is p.KEYWORD_ONLY}
+    return cls(*positional, **keywords)
+
+
+def assert_same(copied: BaseException, error: BaseException) -> None:
+    assert type(copied) is type(error)
+    assert str(copied) == str(error)
+    assert repr(copied) == repr(error)
+    assert copied.args == error.args
+    assert vars(copied) == vars(error)
+
+
+def test_the_walk_finds_every_exception_module():
+    names = {f"{cls.__module__}.{cls.__qualname__}" for cls in SLEWBENCH_ERRORS + OTHERS}
+    assert {"scenarios.errors.ScenarioError", "scenarios.errors.OutputError", "ocp.errors.OptionsError",
+            "planners.errors.UnknownNameError", "controllers.errors.ConformanceError",
+            "scenarios.schema.plugins.PluginError", "scenarios.errors.PlausibilityWarning",
+            "scenarios.errors.CaseTimeout"} <= names
+
+
+@pytest.mark.parametrize("cls", SLEWBENCH_ERRORS + OTHERS, ids=lambda c: f"{c.__module__}.{c.__qualname__}")
+@pytest.mark.parametrize("protocol", [0, pickle.DEFAULT_PROTOCOL, pickle.HIGHEST_PROTOCOL])
+def test_every_exception_survives_pickle_with_its_text_and_attributes(cls, protocol):
+    error = instance(cls)
+    error.add_note("a note added on the way")
+    assert_same(pickle.loads(pickle.dumps(error, protocol=protocol)), error)
+
+
+@pytest.mark.parametrize("cls", SLEWBENCH_ERRORS + OTHERS, ids=lambda c: f"{c.__module__}.{c.__qualname__}")
+def test_every_exception_survives_copy_and_deepcopy(cls):
+    error = instance(cls)
+    assert_same(copy.copy(error), error)
+    assert_same(copy.deepcopy(error), error)
+
+
+def test_a_scenario_error_keeps_its_file_and_names_it_once_after_the_round_trip():
+    error = ScenarioError("maneuver.duration", "must be > 0, got -1", "a.yaml")
+    copied = pickle.loads(pickle.dumps(error))
+    assert (copied.path, copied.message, copied.file) == ("maneuver.duration", "must be > 0, got -1", Path("a.yaml"))
+    assert str(copied) == "a.yaml: maneuver.duration: must be > 0, got -1"
+    assert isinstance(copied, ValueError)
+
+
+# --- a study's worker raises -------------------------------------------------------------------
+
+def scenario_error_task(payload):
+    """A sweep's task (imported by the worker processes from this module) that raises a user's mistake."""
+    raise ScenarioError("maneuver.duration", "must be > 0, got -1", "a.yaml")
+
+
+SWEEP_SCRIPT = textwrap.dedent("""
+    from scenarios.study.engine import sweep
+    from scenarios.study.spec import parse_study
+    from tests.test_errors_pickle import scenario_error_task
+    from tests.test_sweep import BASE
+
+    if __name__ == "__main__":
+        results = sweep(parse_study({"study": "raising", "scenario": BASE}), workers=1, task=scenario_error_task)
+        for _, row in results.to_dataframe().iterrows():
+            print(row["status"], "|", row["message"])
+""")
+
+
+def test_a_local_sweep_whose_task_raises_shows_the_error_s_message_and_ends():
+    """In its own process, so that a sweep that never ends (the old failure) is stopped (its workers
+    die with it)."""
+    environment = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
+    completed = subprocess.run([sys.executable, "-c", SWEEP_SCRIPT], cwd=ROOT, env=environment, capture_output=True,
+                               text=True, timeout=120)
+    assert completed.returncode == 0, completed.stderr
+    lines = completed.stdout.splitlines()
+    assert len(lines) == 2  # the two planners' rows of the case
+    for line in lines:
+        status, message = line.split(" | ")
+        assert status == "crashed"
+        assert "ScenarioError: a.yaml: maneuver.duration: must be > 0, got -1" in message
+
+
+def test_a_dask_worker_s_error_reaches_the_client_as_itself():
+    distributed = pytest.importorskip("distributed")
+    import logging
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                           dashboard_address=None, silence_logs=logging.CRITICAL)
+    with cluster, distributed.Client(cluster) as client:
+        error = client.submit(scenario_error_task, {}).exception(timeout=60)
+    assert_same(error, ScenarioError("maneuver.duration", "must be > 0, got -1", "a.yaml"))
