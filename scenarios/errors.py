@@ -83,7 +83,8 @@ def in_file(error: ScenarioError, file: str | os.PathLike[str], kind: str = "sce
     file : str or os.PathLike
         The file.
     kind : str, optional
-        What the file is (``scenario``, ``study``, ``table``), named when it is not found.
+        What the file is (``scenario``, ``study``, ``table``; ``YAML`` where its kind is not known
+        yet), named when it is not found.
 
     Returns
     -------

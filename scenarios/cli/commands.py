@@ -256,7 +256,10 @@ def command_validate(args: argparse.Namespace) -> int:
         ``ScenarioError``, which :func:`main` reports with exit 2.
     """
     args.file_kind = args.file  # until its kind is known, an error (a duplicate key, no mapping) names the file
-    data = read_yaml(args.file)
+    try:
+        data = read_yaml(args.file)
+    except ScenarioError as error:  # a scenario, a study or a table: a YAML file, not found or not readable
+        raise in_file(error, args.file, kind="YAML") from None
     if isinstance(data, dict):
         args.file_kind = None  # a scenario's, unless a key below says otherwise
     for key in OTHER_FILES:  # a study or a slew table: its own check and summary
@@ -773,9 +776,15 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
                 kind = "the command line"  # no file given: nothing to name
             elif error.file is None and str(given) not in text:  # raised after the file was read
                 text = f"{given}: {text}"
-        # a message that starts with the file it names (a file whose kind is not known yet) names it once
-        print(f"slewbench: error in {text}" if text.startswith(f"{kind}: ") else f"slewbench: error in {kind}: {text}",
-              file=sys.stderr)
+        # a file whose kind is not known yet (validate's) is named once: by the message that starts with
+        # it, or by the message that names it elsewhere (``cannot read FILE: it is a directory``)
+        if text.startswith(f"{kind}: "):
+            line = f"error in {text}"
+        elif given and kind == str(given) and kind in text:
+            line = f"error: {text}"
+        else:
+            line = f"error in {kind}: {text}"
+        print(f"slewbench: {line}", file=sys.stderr)
         return EXIT_BAD_SCENARIO
     except OutputError as error:
         given = "--report" if getattr(args, "report", None) else "--out" if getattr(args, "out", None) else None
