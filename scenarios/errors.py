@@ -93,7 +93,7 @@ def in_file(error: ScenarioError, file: str | os.PathLike[str], kind: str = "sce
         a command-line option's (its path starts with ``--``), else a new error with the same path
         and message.
     """
-    if error.file is not None or error.path.startswith("--"):
+    if error.file is not None or (error.path or "").startswith("--"):
         return error
     named, message = Path(file), error.message
     if not error.path and message == f"scenario file not found: {named}":

@@ -767,7 +767,7 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         return EXIT_BAD_SCENARIO
     except ScenarioError as error:
         # a command-line option's error is named as such, not as the scenario's; a study's as the study's
-        kind = "option" if error.path.startswith("--") else getattr(args, "file_kind", None) or \
+        kind = "option" if (error.path or "").startswith("--") else getattr(args, "file_kind", None) or \
             _COMMAND_FILES.get(args.command, "scenario")
         text = str(error)
         given = getattr(args, "file", None)

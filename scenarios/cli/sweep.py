@@ -128,6 +128,9 @@ def command_case(args: argparse.Namespace) -> int:
     if not args.file:
         raise ScenarioError("--case", "give the sweep directory: slewbench sweep DIR --case N")
     directory = Path(args.file)
+    if directory.is_file():  # the study file, as without --case: the sweep is in its output directory
+        raise ScenarioError("--case", f"re-runs a case of a stored sweep: give the sweep's output directory (its "
+                                      f"--out), not the file {args.file}: slewbench sweep DIR --case N")
     results, version = stored_results(directory)
     cases = results.study.cases
     if not 0 <= args.case < len(cases):

@@ -76,6 +76,15 @@ def _is_finite(value: int | float) -> bool:
         return False
 
 
+def _why_not_finite(value: Any) -> str:
+    """Why a number is refused as one (NaN, an infinity, an integer beyond a float), else nothing."""
+    if not _is_number(value) or _is_finite(value):
+        return ""
+    if isinstance(value, int):
+        return " (too large: beyond the range of a float, about 1.8e308)"
+    return " (NaN and infinities are not accepted)"
+
+
 class Node:
     """A YAML value with its path; typed accessors raise :class:`ScenarioError` naming the path.
 
@@ -208,6 +217,9 @@ class Node:
         if isinstance(self.value, dict):
             for key in self.value:
                 if key not in self._read:
+                    if not isinstance(key, str):  # `~: 1`, `1: 2`: YAML read a null or a number, not a name
+                        raise ScenarioError(self.path, f"a key must be a name, got {excerpt(key)} (a YAML null or "
+                                                       f"number); expected one of {sorted(self._read)}")
                     raise ScenarioError(self._child_path(key), f"unknown key; expected one of {sorted(self._read)}")
 
     def items(self) -> Iterator[Node]:
@@ -263,7 +275,7 @@ class Node:
             Not a finite number, or outside the bounds.
         """
         if not _is_number(self.value) or not _is_finite(self.value):
-            raise self.error(f"expected a number, got {excerpt(self.value)}")
+            raise self.error(f"expected a number, got {excerpt(self.value)}{_why_not_finite(self.value)}")
         if positive and not self.value > 0:
             raise self.error(f"expected a positive number, got {excerpt(self.value)}")
         if non_negative and self.value < 0:

@@ -100,7 +100,13 @@ def parse_yaml_text(text: str, source: Path | str = "<text>") -> Any:
         Text that is not YAML, a value YAML cannot build, a duplicate key, nesting deeper than
         :data:`MAX_DEPTH` or alias expansion beyond :data:`MAX_NODES` values.
     """
-    loader = _Loader(text)
+    try:
+        loader = _Loader(text)  # refuses the whole text at once for a character YAML does not allow
+    except yaml.reader.ReaderError as error:  # a NUL or another control character: a binary file?
+        row = text.count("\n", 0, error.position) + 1
+        column = error.position - text.rfind("\n", 0, error.position)
+        raise ScenarioError("", f"{source}: not YAML text (line {row}, column {column}): character "
+                                f"#x{error.character:04x} is not allowed in YAML (a binary file?)") from None
     try:  # composed once, checked, then built from the same nodes
         root = loader.get_single_node()
         if root is None:
