@@ -105,3 +105,20 @@ def test_sweep_case_given_the_study_file_asks_for_the_sweep_directory(tmp_path, 
     line = _one_error_line(capsys)
     assert "--case: re-runs a case of a stored sweep: give the sweep's output directory" in line, line
     assert line.count(str(path)) == 1
+
+
+def test_validate_of_a_huge_torque_bound_prints_no_numpy_warning(tmp_path, capsys):
+    """A 1e300 N m wheel torque: the plausibility check's norm overflowed and numpy's
+    ``RuntimeWarning: overflow encountered in dot`` was printed amid validate's output; the
+    plausibility warning (a unit slip?) is what the user is shown."""
+    import warnings
+    data = copy.deepcopy(BASE)
+    data["spacecraft"]["wheels"]["max_torque"] = 1e300
+    path = tmp_path / "scenario.yaml"
+    path.write_text(yaml.safe_dump(data))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert main(["validate", str(path)]) == 0
+    captured = capsys.readouterr()
+    assert "RuntimeWarning" not in captured.err + captured.out
+    assert "spacecraft.wheels.max_torque: 1e+300 N m" in captured.out

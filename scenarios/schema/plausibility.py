@@ -324,7 +324,9 @@ def plausibility_warnings(scenario: Scenario) -> list[Implausible]:
     list of Implausible
         The warnings; empty when nothing looks like a unit slip.
     """
-    return [warning for check in PLAUSIBILITY_CHECKS.values() for warning in check(scenario)]
+    with np.errstate(over="ignore", invalid="ignore"):  # a bound of 1e300 N m: its norm is inf (as unlimited),
+        # not numpy's RuntimeWarning printed amid the findings
+        return [warning for check in PLAUSIBILITY_CHECKS.values() for warning in check(scenario)]
 
 
 def _caller_stacklevel() -> int | None:
