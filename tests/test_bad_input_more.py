@@ -122,3 +122,18 @@ def test_validate_of_a_huge_torque_bound_prints_no_numpy_warning(tmp_path, capsy
     captured = capsys.readouterr()
     assert "RuntimeWarning" not in captured.err + captured.out
     assert "spacecraft.wheels.max_torque: 1e+300 N m" in captured.out
+
+
+@pytest.mark.parametrize("encoding, byte, line", [("latin-1", "0xe9", 1), ("utf-16", "0xff", 1)])
+@pytest.mark.parametrize("command", ["validate", "run"])
+def test_a_file_not_in_utf8_says_so_and_what_to_do(encoding, byte, line, command, tmp_path, capsys):
+    """Was ``cannot read FILE: 'utf-8' codec can't decode byte 0xe9 in position 7: invalid
+    continuation byte``."""
+    path = tmp_path / "scenario.yaml"
+    rest = yaml.safe_dump({key: value for key, value in BASE.items() if key != "name"})
+    path.write_bytes(f"name: tést\n{rest}".encode(encoding))  # the first non-ASCII byte on line 1
+    assert main([command, str(path), "--out", str(tmp_path / "out")] if command == "run" else [command, str(path)]) == 2
+    message = _one_error_line(capsys)
+    assert message.count(str(path)) == 1, message
+    assert f"not UTF-8 text (byte {byte} on line {line}); save it as UTF-8" in message, message
+    assert "codec" not in message

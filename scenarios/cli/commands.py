@@ -232,6 +232,20 @@ _COMMAND_FILES = {"sweep": "study file", "table": "table file"}
 (``error in study file: FILE: execution.scheduler: ...``), where its own text does not."""
 
 
+def _named_once(error: ScenarioError, file: str) -> ScenarioError:
+    """``validate``'s error for a file it cannot read (:func:`~scenarios.schema.read.read_yaml`'s
+    ``scenario file not found: FILE``, ``cannot read FILE: REASON``) as ``FILE: file not found``,
+    ``FILE: cannot read: REASON``: the file named once, where ``error in`` names the file of a kind
+    not known yet (a scenario, a study or a table); any other error named in the file as it is."""
+    named = Path(file)
+    if error.message == f"scenario file not found: {named}":
+        return ScenarioError("", "file not found", named)
+    unreadable = f"cannot read {named}: "
+    if error.message.startswith(unreadable):
+        return ScenarioError("", f"cannot read: {error.message[len(unreadable):]}", named)
+    return in_file(error, file)
+
+
 def command_validate(args: argparse.Namespace) -> int:
     """``slewbench validate FILE``: load and check a scenario, a study or a slew-table file, print what would run.
 
@@ -258,8 +272,8 @@ def command_validate(args: argparse.Namespace) -> int:
     args.file_kind = args.file  # until its kind is known, an error (a duplicate key, no mapping) names the file
     try:
         data = read_yaml(args.file)
-    except ScenarioError as error:  # a scenario, a study or a table: a YAML file, not found or not readable
-        raise in_file(error, args.file, kind="YAML") from None
+    except ScenarioError as error:  # not found or not readable: main() names the file, once, as where
+        raise _named_once(error, args.file) from None
     if isinstance(data, dict):
         args.file_kind = None  # a scenario's, unless a key below says otherwise
     for key in OTHER_FILES:  # a study or a slew table: its own check and summary

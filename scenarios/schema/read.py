@@ -206,6 +206,10 @@ def read_yaml(path: str | Path) -> Any:
         text = data.decode("utf-8")
     except FileNotFoundError:
         raise ScenarioError("", f"scenario file not found: {path}") from None
+    except UnicodeDecodeError as error:  # Latin-1, UTF-16 ...: not the codec's words, what to do
+        line = data.count(b"\n", 0, error.start) + 1
+        raise ScenarioError("", f"cannot read {path}: not UTF-8 text (byte 0x{data[error.start]:02x} on line {line}); "
+                                "save it as UTF-8") from None
     except (OSError, UnicodeDecodeError) as error:
         reason = error.strerror if isinstance(error, OSError) and error.strerror else error
         raise ScenarioError("", f"cannot read {path}: {reason}") from None
