@@ -236,14 +236,14 @@ def _named_once(error: ScenarioError, file: str) -> ScenarioError:
     """``validate``'s error for a file it cannot read (:func:`~scenarios.schema.read.read_yaml`'s
     ``scenario file not found: FILE``, ``cannot read FILE: REASON``) as ``FILE: file not found``,
     ``FILE: cannot read: REASON``: the file named once, where ``error in`` names the file of a kind
-    not known yet (a scenario, a study or a table); any other error named in the file as it is."""
+    not known yet (a scenario, a study or a table); any other error as it is."""
     named = Path(file)
     if error.message == f"scenario file not found: {named}":
         return ScenarioError("", "file not found", named)
     unreadable = f"cannot read {named}: "
     if error.message.startswith(unreadable):
         return ScenarioError("", f"cannot read: {error.message[len(unreadable):]}", named)
-    return in_file(error, file)
+    return error
 
 
 def command_validate(args: argparse.Namespace) -> int:
@@ -790,15 +790,9 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
                 kind = "the command line"  # no file given: nothing to name
             elif error.file is None and str(given) not in text:  # raised after the file was read
                 text = f"{given}: {text}"
-        # a file whose kind is not known yet (validate's) is named once: by the message that starts with
-        # it, or by the message that names it elsewhere (``cannot read FILE: it is a directory``)
-        if text.startswith(f"{kind}: "):
-            line = f"error in {text}"
-        elif given and kind == str(given) and kind in text:
-            line = f"error: {text}"
-        else:
-            line = f"error in {kind}: {text}"
-        print(f"slewbench: {line}", file=sys.stderr)
+        # a message that starts with the file it names (a file whose kind is not known yet) names it once
+        print(f"slewbench: error in {text}" if text.startswith(f"{kind}: ") else f"slewbench: error in {kind}: {text}",
+              file=sys.stderr)
         return EXIT_BAD_SCENARIO
     except OutputError as error:
         given = "--report" if getattr(args, "report", None) else "--out" if getattr(args, "out", None) else None
