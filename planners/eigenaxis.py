@@ -615,7 +615,8 @@ class WheelBudget:
         phases = [(profile.ramp, profile.alpha), (profile.coast, 0.0), (profile.ramp, -profile.alpha)]
         momentum = self.wheel_momentum0.astype(float)
         rate0 = 0.0
-        torques, momenta = [], []
+        pieces: list[Array] = []
+        stored: list[Array] = []
         for length, accel in phases:
             if length <= 0:
                 continue
@@ -624,16 +625,16 @@ class WheelBudget:
             dt = length / steps
             # The momentum's equation is affine in it, so each step of the classical Runge-Kutta is
             # an affine map h -> Φ_k h + γ_k: built for every step at once, then composed.
-            rates = rate0 + accel * np.arange(steps) * dt
+            rates = rate0 + accel * dt * np.arange(steps, dtype=float)
             phi, gamma = _runge_kutta_maps(self.projector, cross, inertia_axis * accel, spin, rates, accel, dt)
             states = _affine_orbit(phi, gamma, momentum)  # (steps + 1, 3): the momentum at each step's ends
             ends = np.concatenate([[rate0], rates + accel * dt])
-            torques.append(inertia_axis * accel + np.outer(ends**2, spin) + ends[:, None] * (states @ cross.T))
-            momenta.append(states[1:])
+            pieces.append(inertia_axis * accel + np.outer(ends**2, spin) + ends[:, None] * (states @ cross.T))
+            stored.append(states[1:])
             momentum = states[-1]
             rate0 = rate0 + accel * length
-        torques = np.concatenate(torques) if torques else np.zeros((0, 3))
-        momenta = np.concatenate(momenta) if momenta else []
+        torques = np.concatenate(pieces) if pieces else np.zeros((0, 3))
+        momenta = np.concatenate(stored) if stored else np.zeros((0, 3))
         demand = np.abs(torques @ self.rows.T)
         size = np.linalg.norm(self.rows, axis=1) * np.max(np.linalg.norm(torques, axis=1), initial=0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
