@@ -611,41 +611,106 @@ class WheelBudget:
         axis, inertia = self.axis, self.problem.spacecraft.inertia
         inertia_axis = inertia @ axis
         spin = np.cross(axis, inertia_axis)
+        cross = _cross_matrix(axis)  # cross @ w = axis × w
         phases = [(profile.ramp, profile.alpha), (profile.coast, 0.0), (profile.ramp, -profile.alpha)]
-        momentum = self.wheel_momentum0.copy()
-        start, rate0 = 0.0, 0.0
-        torques, momenta = [], []
-
-        def torque(rate: float, accel: float, w: Array) -> Array:
-            return inertia_axis * accel + rate**2 * spin + rate * np.cross(axis, w)
-
+        momentum = self.wheel_momentum0.astype(float)
+        rate0 = 0.0
+        pieces: list[Array] = []
+        stored: list[Array] = []
         for length, accel in phases:
             if length <= 0:
                 continue
             peak_rate = max(abs(rate0), abs(rate0 + accel * length))
             steps = max(8, int(np.ceil(peak_rate * length / step_angle)))
             dt = length / steps
-            torques.append(torque(rate0, accel, momentum))
-            for k in range(steps):
-                r0 = rate0 + accel * k * dt
-                r1, r2 = r0 + 0.5 * accel * dt, r0 + accel * dt
-                k1 = -self.projector @ torque(r0, accel, momentum)
-                k2 = -self.projector @ torque(r1, accel, momentum + 0.5 * dt * k1)
-                k3 = -self.projector @ torque(r1, accel, momentum + 0.5 * dt * k2)
-                k4 = -self.projector @ torque(r2, accel, momentum + dt * k3)
-                momentum = momentum + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-                torques.append(torque(r2, accel, momentum))
-                momenta.append(momentum)
+            # The momentum's equation is affine in it, so each step of the classical Runge-Kutta is
+            # an affine map h -> Φ_k h + γ_k: built for every step at once, then composed.
+            rates = rate0 + accel * dt * np.arange(steps, dtype=float)
+            phi, gamma = _runge_kutta_maps(self.projector, cross, inertia_axis * accel, spin, rates, accel, dt)
+            states = _affine_orbit(phi, gamma, momentum)  # (steps + 1, 3): the momentum at each step's ends
+            ends = np.concatenate([[rate0], rates + accel * dt])
+            pieces.append(inertia_axis * accel + np.outer(ends**2, spin) + ends[:, None] * (states @ cross.T))
+            stored.append(states[1:])
+            momentum = states[-1]
             rate0 = rate0 + accel * length
-            start += length
-        demand = np.abs(np.array(torques) @ self.rows.T)
-        size = np.linalg.norm(self.rows, axis=1) * np.max(np.linalg.norm(torques, axis=1))
+        torques = np.concatenate(pieces) if pieces else np.zeros((0, 3))
+        momenta = np.concatenate(stored) if stored else np.zeros((0, 3))
+        demand = np.abs(torques @ self.rows.T)
+        size = np.linalg.norm(self.rows, axis=1) * np.max(np.linalg.norm(torques, axis=1), initial=0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.where(self.bounds > 0, demand / self.bounds, np.where(demand > 1e-9 * size, np.inf, 0.0))
-        h = self.h0 + (np.array(momenta) - self.wheel_momentum0) @ self.pinv.T if momenta else np.zeros((1, 0))
+        h = self.h0 + (momenta - self.wheel_momentum0) @ self.pinv.T if len(momenta) else np.zeros((1, 0))
         with np.errstate(divide="ignore", invalid="ignore"):  # a bound the reserve takes whole: no momentum fits
             h_ratio = np.where(~np.isfinite(self.h_max), 0.0, np.where(self.h_max > 0, np.abs(h) / self.h_max, np.inf))
         return float(np.max(ratio, initial=0.0)), float(np.max(h_ratio, initial=0.0))
+
+
+def _cross_matrix(vector: Array) -> Array:
+    """The matrix ``S`` with ``S @ w = vector × w``."""
+    x, y, z = (float(value) for value in vector)
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def _runge_kutta_maps(projector: Array, cross: Array, push: Array, spin: Array, rates: Array, accel: float,
+                      dt: float) -> tuple[Array, Array]:
+    """The classical Runge-Kutta steps of ``dh/dt = −P (p + r² s + r S h)``, ``r = r_k + accel t``
+    over ``[0, dt]``, as affine maps ``h -> Φ_k h + γ_k``, one per start rate ``r_k``.
+
+    Parameters
+    ----------
+    projector, cross : (3, 3) ndarray
+        ``P`` and ``S``.
+    push, spin : (3,) ndarray
+        ``p`` and ``s``.
+    rates : (n,) ndarray
+        ``r_k``, the rate at each step's start.
+    accel : float
+        The rate's derivative over the steps.
+    dt : float
+        The step.
+
+    Returns
+    -------
+    phi : (n, 3, 3) ndarray
+    gamma : (n, 3) ndarray
+    """
+    coupling = projector @ cross
+    eye = np.eye(3)
+
+    def slope(rate: Array) -> tuple[Array, Array]:  # f(h) = K h + κ at the rate, per step
+        return -rate[:, None, None] * coupling, -(push + np.outer(rate**2, spin)) @ projector.T
+
+    half, end = rates + 0.5 * accel * dt, rates + accel * dt
+    (a1, c1), (a2, c2), (a4, c4) = slope(rates), slope(half), slope(end)
+    k1, q1 = a1, c1
+    k2, q2 = a2 @ (eye + 0.5 * dt * k1), c2 + 0.5 * dt * np.einsum("nij,nj->ni", a2, q1)
+    k3, q3 = a2 @ (eye + 0.5 * dt * k2), c2 + 0.5 * dt * np.einsum("nij,nj->ni", a2, q2)
+    k4, q4 = a4 @ (eye + dt * k3), c4 + dt * np.einsum("nij,nj->ni", a4, q3)
+    return eye + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4), dt / 6 * (q1 + 2 * q2 + 2 * q3 + q4)
+
+
+def _affine_orbit(phi: Array, gamma: Array, start: Array) -> Array:
+    """``h_0 = start``, ``h_{k+1} = Φ_k h_k + γ_k``: every ``h_k`` (``n + 1`` of them), by composing the
+    maps in ``log2 n`` rounds of batched products (an inclusive scan) instead of ``n`` small ones.
+
+    Parameters
+    ----------
+    phi : (n, 3, 3) ndarray
+    gamma : (n, 3) ndarray
+    start : (3,) ndarray
+
+    Returns
+    -------
+    (n + 1, 3) ndarray
+    """
+    total, offset = phi.copy(), gamma.copy()  # after the scan: the composition of maps 0..k
+    shift = 1
+    while shift < len(total):
+        later_total, later_offset = total[shift:], offset[shift:]
+        offset[shift:] = np.einsum("nij,nj->ni", later_total, offset[:-shift]) + later_offset
+        total[shift:] = later_total @ total[:-shift]
+        shift *= 2
+    return np.concatenate([[start], np.einsum("nij,j->ni", total, start) + offset])
 
 
 def _positive_root(quadratic: float, linear: float, bound: float) -> float:
