@@ -221,10 +221,26 @@ def physical(metrics: dict) -> bool:
     return True
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture,
-                                                                  HealthCheck.too_slow])
+FUZZ = settings(deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+
+
+@pytest.mark.slow
+@settings(FUZZ, max_examples=40)
 @given(mutation=MUTATIONS)
 def test_mutated_scenarios_exit_0_with_physical_metrics_or_2_naming_a_path(mutation, tmp_path_factory):
+    check_mutated_scenario(mutation, tmp_path_factory)
+
+
+@settings(FUZZ, max_examples=12)
+@given(mutation=MUTATIONS)
+def test_mutated_scenarios_exit_0_with_physical_metrics_or_2_naming_a_path_default_run(mutation, tmp_path_factory):
+    """The default run's twin of the 40-example property above: the same mutations, checks and
+    per-case 60 s bound on 12 random examples a run (each accepted one runs three planners and a
+    closed loop, about 1 s); the slow one adds 28 more examples a run, not a different check."""
+    check_mutated_scenario(mutation, tmp_path_factory)
+
+
+def check_mutated_scenario(mutation, tmp_path_factory) -> None:
     folder = tmp_path_factory.mktemp("case")
     data = mutate(BASE, mutation)
     path = folder / "case.yaml"
