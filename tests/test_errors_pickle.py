@@ -131,32 +131,54 @@ def scenario_error_task(payload):
     raise ScenarioError("maneuver.duration", "must be > 0, got -1", "a.yaml")
 
 
+class UsersOwnError(Exception):
+    """A task's own exception that pickles but cannot be rebuilt from its pickle (its constructor
+    takes two arguments, its ``args`` hold one text)."""
+
+    def __init__(self, what, value):
+        super().__init__(f"{what} went wrong at {value}")
+
+
+def users_own_error_task(payload):
+    """A sweep's task that raises an exception slewbench cannot make picklable."""
+    raise UsersOwnError("the user's task", 42)
+
+
 SWEEP_SCRIPT = textwrap.dedent("""
+    import sys
+
     from scenarios.study.engine import sweep
     from scenarios.study.spec import parse_study
-    from tests.test_errors_pickle import scenario_error_task
+    from tests import test_errors_pickle
     from tests.test_sweep import BASE
 
     if __name__ == "__main__":
-        results = sweep(parse_study({"study": "raising", "scenario": BASE}), workers=1, task=scenario_error_task)
+        task = getattr(test_errors_pickle, sys.argv[1])
+        results = sweep(parse_study({"study": "raising", "scenario": BASE}), workers=1, task=task)
         for _, row in results.to_dataframe().iterrows():
             print(row["status"], "|", row["message"])
 """)
 
 
-def test_a_local_sweep_whose_task_raises_shows_the_error_s_message_and_ends():
-    """In its own process, so that a sweep that never ends (the old failure) is stopped (its workers
-    die with it)."""
+@pytest.mark.parametrize("task, expected", [
+    ("scenario_error_task", "ScenarioError: a.yaml: maneuver.duration: must be > 0, got -1"),
+    ("users_own_error_task", "UsersOwnError: the user's task went wrong at 42 (raised by the task; its exception "
+                             "cannot be pickled)"),
+])
+def test_a_local_sweep_whose_task_raises_shows_the_error_s_message_and_ends(task, expected):
+    """In its own process, so that a sweep that never ends (the old failure: the pool's result
+    thread could not rebuild the exception, and a new pool ran the case again without end) is
+    stopped (its workers die with it)."""
     environment = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
-    completed = subprocess.run([sys.executable, "-c", SWEEP_SCRIPT], cwd=ROOT, env=environment, capture_output=True,
-                               text=True, timeout=120)
+    completed = subprocess.run([sys.executable, "-c", SWEEP_SCRIPT, task], cwd=ROOT, env=environment,
+                               capture_output=True, text=True, timeout=120)
     assert completed.returncode == 0, completed.stderr
     lines = completed.stdout.splitlines()
     assert len(lines) == 2  # the two planners' rows of the case
     for line in lines:
         status, message = line.split(" | ")
         assert status == "crashed"
-        assert "ScenarioError: a.yaml: maneuver.duration: must be > 0, got -1" in message
+        assert expected in message
 
 
 def test_a_dask_worker_s_error_reaches_the_client_as_itself():

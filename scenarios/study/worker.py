@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import functools
 import os
+import pickle
 import signal
 import socket
 import threading
@@ -159,10 +160,37 @@ def run_chunk(task: Callable[[dict[str, Any]], dict[str, Any]], payloads: list[d
     """
     results = []
     for payload in payloads:
-        result = dict(tracked_case(task, payload))
+        try:
+            result = dict(tracked_case(task, payload))
+        except Exception as error:
+            raise _portable(error) from None
         result["rows_json"] = encode_rows(result.pop("rows"))  # the store's text, made here in parallel
         results.append(result)
     return results
+
+
+def _portable(error: Exception) -> Exception:
+    """``error`` if it survives pickling, else a :class:`RuntimeError` with its type's name and text.
+
+    An exception leaves a worker process pickled; one that cannot be rebuilt from its pickle (a
+    task's own class whose constructor takes other arguments than its ``args``) breaks a local
+    pool's result thread, and the pool would be started again for the same case without end.
+
+    Parameters
+    ----------
+    error : Exception
+        What a task raised.
+
+    Returns
+    -------
+    Exception
+        ``error`` itself, or a picklable stand-in naming it.
+    """
+    try:
+        pickle.loads(pickle.dumps(error))
+    except Exception:
+        return RuntimeError(f"{type(error).__name__}: {error} (raised by the task; its exception cannot be pickled)")
+    return error
 
 
 _PLUGINS_LOADED = False
