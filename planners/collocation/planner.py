@@ -3,12 +3,15 @@
 Objectives: ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt (slack variables),
 ``min_time`` (free T, the scenario's T is the upper bound), and ``weighted``
 (``energy_weight``, ``l1_weight``, ``time_weight``). τ is the actuators' body torque.
-A ``min_time`` that fails under its bound, where the starts say the bound may be below the minimum
-time and a feasible slew longer than it is known, is solved again with the bound released
-(:meth:`CollocationPlanner._released`): an optimum above the bound makes the reference
-``infeasible``, its duration that optimum's T (the least time this planner finds, a local optimum,
-not a proof that no faster slew exists), as a minimum-time slew of another planner longer than the
-budget is; ``failed`` stays for a solve that does not converge.
+A ``min_time`` (or a ``weighted`` objective with a ``time_weight``) that fails under its bound, where
+the starts say the bound may be below the minimum time and a feasible slew longer than it is known,
+is solved again as a minimum time with the bound released (:meth:`CollocationPlanner._released`):
+an optimum above the bound makes the reference ``infeasible``, its duration that optimum's T (the
+least time this planner finds, a local optimum, not a proof that no faster slew exists), as a
+minimum-time slew of another planner longer than the budget is; ``failed`` stays for a solve that
+does not converge. Where the coarse starts (``coarse_intervals``) fail so, the released solve
+comes before the full mesh, which is solved under the bound only where the released optimum does not
+settle the verdict.
 Constraints: actuator bounds (wheel torques, dipoles, torquers), wheel momentum bounds, a body-rate
 bound ``max_rate`` (option, per axis), fixed or free final rate, keep-out / keep-in cones (options),
 and the controllers' allocation on the controls (:mod:`planners.collocation.allocation`): the wheel
@@ -153,8 +156,9 @@ class CollocationOptions:
     objective : str
         ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt, ``min_time`` (free T, the
         scenario's duration its upper bound: where none is found within it, ``infeasible`` with
-        the least T found with the bound released, see the module docstring) or ``weighted``; τ
-        the actuators' body torque [N m].
+        the least T found with the bound released, see the module docstring) or ``weighted`` (with
+        a ``time_weight``, free T so bounded and decided so, by that least time); τ the actuators'
+        body torque [N m].
     intervals : int
         Mesh intervals.
     degree : int
