@@ -3,12 +3,15 @@
 Objectives: ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt (slack variables),
 ``min_time`` (free T, the scenario's T is the upper bound), and ``weighted``
 (``energy_weight``, ``l1_weight``, ``time_weight``). τ is the actuators' body torque.
-A ``min_time`` that fails under its bound, where the starts say the bound may be below the minimum
-time and a feasible slew longer than it is known, is solved again with the bound released
-(:meth:`CollocationPlanner._released`): an optimum above the bound makes the reference
-``infeasible``, its duration that optimum's T (the least time this planner finds, a local optimum,
-not a proof that no faster slew exists), as a minimum-time slew of another planner longer than the
-budget is; ``failed`` stays for a solve that does not converge.
+A ``min_time`` (or a ``weighted`` objective with a ``time_weight``) that fails under its bound, where
+the starts say the bound may be below the minimum time and a feasible slew longer than it is known,
+is solved again as a minimum time with the bound released (:meth:`CollocationPlanner._released`):
+an optimum above the bound makes the reference ``infeasible``, its duration that optimum's T (the
+least time this planner finds, a local optimum, not a proof that no faster slew exists), as a
+minimum-time slew of another planner longer than the budget is; ``failed`` stays for a solve that
+does not converge. Where the coarse starts (``coarse_intervals``) fail so, the released solve
+comes before the full mesh, which is solved under the bound only where the released optimum does not
+settle the verdict.
 Constraints: actuator bounds (wheel torques, dipoles, torquers), wheel momentum bounds, a body-rate
 bound ``max_rate`` (option, per axis), fixed or free final rate, keep-out / keep-in cones (options),
 and the controllers' allocation on the controls (:mod:`planners.collocation.allocation`): the wheel
@@ -38,6 +41,7 @@ its certificate (:func:`~planners.collocation.certificate.bang_bang_certificate`
 """
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field, replace
 from typing import Annotated, Any, Literal
@@ -152,8 +156,9 @@ class CollocationOptions:
     objective : str
         ``min_energy`` ∫‖τ‖² dt (default), ``min_l1`` ∫Σ|τ_i| dt, ``min_time`` (free T, the
         scenario's duration its upper bound: where none is found within it, ``infeasible`` with
-        the least T found with the bound released, see the module docstring) or ``weighted``; τ
-        the actuators' body torque [N m].
+        the least T found with the bound released, see the module docstring) or ``weighted`` (with
+        a ``time_weight``, free T so bounded and decided so, by that least time); τ the actuators'
+        body torque [N m].
     intervals : int
         Mesh intervals.
     degree : int
@@ -386,6 +391,7 @@ class _Optimum:
     solver: str | None = None  # None: the option's
     switching: tuple | None = None  # switching_functions() of the result, where computed (shared by the certificate)
     exact: CollocationReference | None = None  # the exact bang-bang optimum shot from this coarse one (_bang_bang)
+    deferred: Reference | None = None  # the coarse mesh's failure at the time bound, the full mesh not tried (_optimum)
 
 
 class CollocationPlanner(Planner):
@@ -787,72 +793,111 @@ class CollocationPlanner(Planner):
         if not starts:
             return FailedReference(self.name, f"no start: the warm-start planner {self.options.warm_start!r} failed ("
                                               + "; ".join(failures) + ")")
-        reference = self._plan_from(problem, starts)
-        if isinstance(reference.stats.get("seeds"), dict):  # the seed planners that failed or raised
-            coarse = reference.stats.get("coarse")
-            dropped = [*(coarse.get("seeds_dropped", []) if isinstance(coarse, dict) else []),
-                       *reference.stats.get("seeds_dropped", [])]
-            reference.stats["seeds"]["skipped"] = failures + dropped
-        if not reference.ok and self.options.objective == "min_time":
-            reference = self._released(problem, reference)
-        return reference
+        timed = self.minimises_time(self.options)
+        reference = self._plan_from(problem, starts, defer=timed)
+        if reference.ok or not timed:
+            _skipped(reference, failures)
+            return reference
+        return self._released(problem, reference, starts, failures)
 
-    def _released(self, problem: ManeuverProblem, failed: Reference) -> Reference:
-        """A minimum time that failed at its bound, solved again with the bound released.
+    def _released(self, problem: ManeuverProblem, failed: Reference, starts: list[Reference],
+                  failures: list[str]) -> Reference:
+        """A minimum time (or a ``weighted`` objective with a time term) that failed at its bound,
+        decided by the minimum time with the bound released.
 
         Where no start converged under ``maneuver.duration`` (the bound on the free final time), some
         ended locally infeasible or at the bound, and a feasible slew of the problem longer than the
         bound is known (:meth:`_time_bound`: ``eigenaxis``'s ``min_time``, checked against the
-        problem's constraints), the same problem is planned again with its bound at that slew's
-        duration ``D`` (a bound that admits a slew; nothing else of the problem changes: with a free
-        final time the pointing windows are imposed over the whole run). Where that converges to
+        problem's constraints), the same problem is planned again as a minimum time (``weighted``
+        too: its problem under the bound admits a slew exactly where the least feasible time is
+        within the bound, whatever its weights) with its bound at that slew's duration ``D`` (a
+        bound that admits a slew; nothing else of the problem changes: with a free final time the
+        pointing windows are imposed over the whole run). Where that converges to
         ``T* > maneuver.duration``, the reference is ``infeasible``, its ``duration`` ``T*`` and its
         stats the released optimum's (its certificate, and ``time_bound``: the bound, ``D``, where
-        ``D`` came from, ``T*`` and the statuses at the bound): this planner's least time is
-        longer than the budget, as a minimum-time ``costate_tpbvp`` or ``eigenaxis`` slew longer
-        than it is (:func:`scenarios.requirements.scoring.late_slew`), and the row's
-        ``needed_duration_s`` is ``T*`` (:func:`scenarios.runner.needed_duration`). ``T*`` is a
-        local optimum, whatever its certificate says of it: the least time this planner finds, not a
-        proof that no faster slew exists, and the message says so. Where the released solve does
-        not converge, or converges within the bound, the reference stays ``failed`` (a numerical
-        failure, not a verdict on the budget), its message saying what the released solve did."""
+        ``D`` came from, the mesh the bound was tried on, ``T*`` and the statuses at the bound):
+        this planner's least time is longer than the budget, as a minimum-time ``costate_tpbvp`` or
+        ``eigenaxis`` slew longer than it is (:func:`scenarios.requirements.scoring.late_slew`), and
+        the row's ``needed_duration_s`` is ``T*`` (:func:`scenarios.runner.needed_duration`). ``T*``
+        is a local optimum, whatever its certificate says of it: the least time this planner finds,
+        not a proof that no faster slew exists, and the message says so. Where the released solve
+        does not converge, or converges within the bound, the reference stays ``failed`` (a
+        numerical failure, not a verdict on the budget), its message saying what the released solve
+        did.
+
+        The starts under the bound are the coarse multistart's where it failed so
+        (:meth:`_optimum`'s ``defer``): the full-mesh attempts under the bound (from the starts
+        again, costlier per iteration; Bilimoria & Wie 180° under 3 s: 906 iterations) are made
+        only where the released solve does not settle the verdict (it fails, or its ``T*`` is
+        within the bound: the full mesh may then converge under it, as the coarse one did not), and
+        the reference is theirs as without the deferral."""
         record = failed.stats.get("time_bound")
         if failed.status != "failed" or not isinstance(record, dict) or "feasible_s" not in record:
+            _skipped(failed, failures)
             return failed
         bound, (released, label) = float(problem.duration), (float(record["feasible_s"]), str(record["feasible_from"]))
+        o = self.options
+        timer = self
+        if o.objective != "min_time":  # weighted: the least feasible time is the minimum time's
+            timer = copy.copy(self)
+            timer.options = replace(o, objective="min_time")
         wider = replace(problem, duration=released)
-        starts = self._starts(wider)
-        found = self._plan_from(wider, starts) if starts else FailedReference(self.name, "no start")
+        refused = None if timer is self else timer.problem_error(wider)  # min_time refuses unbounded controls
+        found_starts = [] if refused else timer._starts(wider)
+        found = (timer._plan_from(wider, found_starts) if found_starts
+                 else FailedReference(self.name, refused or "no start"))
+        if record.get("intervals") != o.intervals and not (found.ok and float(found.duration) > bound):
+            # deferred on the coarse mesh: the full mesh under the bound, as it would have been solved
+            failed = self._plan_from(problem, starts, resumed=failed)
+            _skipped(failed, failures)
+            record = failed.stats.get("time_bound")
+            if failed.status != "failed" or not isinstance(record, dict) or "feasible_s" not in record:
+                return failed
+        else:
+            _skipped(failed, failures)
+        minimum = "minimum time" if timer is self else "minimum time (objective min_time)"
+        it = "it" if timer is self else f"its {minimum}"
         record = {**record, "released_ok": found.ok, "bounded_status": failed.stats.get("solver_status")}
+        if timer is not self:
+            record["released_objective"] = "min_time"
         failed.stats["time_bound"] = record
         if not found.ok:
-            failed.message += (f"; with the bound released to {released:.6g} s ({label}'s feasible slew) it did not "
-                               f"converge either: {found.message}")
+            failed.message += (f"; with the bound released to {released:.6g} s ({label}'s feasible slew) {it} "
+                               f"did not converge either: {found.message}")
             return failed
         T = float(found.duration)
         record["released_T_s"] = T
         if not T > bound:
-            failed.message += (f"; with the bound released to {released:.6g} s ({label}'s feasible slew) it "
-                               f"converged to T = {T:.8g} s, within the bound: the starts under the bound failed "
-                               f"for another reason (try more starts)")
+            failed.message += (f"; with the bound released to {released:.6g} s ({label}'s feasible slew) {it} "
+                               f"converged to T = {T:.8g} s, within the bound: the starts under the "
+                               f"bound failed for another reason (try more starts)")
             return failed
         certificate = found.stats.get("certificate")
         verdict = f", its certificate {certificate.get('verdict')}" if isinstance(certificate, dict) else ""
-        message = (f"{self.options.objective}: no slew found within maneuver.duration = {bound:g} s (the bound on the "
+        least = ("" if timer is self else " (the least time of a slew, which the weighted objective's final time "
+                                          "cannot undercut)")
+        mesh = ("" if record.get("intervals") == o.intervals else
+                f" (on the N={record.get('intervals')} coarse mesh; the full mesh is not tried under a bound below "
+                f"the released minimum time)")
+        message = (f"{o.objective}: no slew found within maneuver.duration = {bound:g} s (the bound on the "
                    f"free final time): with the bound released to {released:.6g} s ({label}'s feasible slew) this "
-                   f"planner's minimum time is T = {T:.8g} s{verdict}, longer than the bound; a local optimum, the "
-                   f"least time this planner finds, not a proof that no faster slew exists; a maneuver.duration of "
-                   f"{_rounded_up(T)} s admits this slew. Under the bound: {failed.message}")
+                   f"planner's {minimum} is T = {T:.8g} s{verdict}, longer than the bound{least}; a local optimum, "
+                   f"the least time this planner finds, not a proof that no faster slew exists; a maneuver.duration "
+                   f"of {_rounded_up(T)} s admits this slew. Under the bound{mesh}: {failed.message}")
         return FailedReference(self.name, message, "infeasible", duration=T, stats={**found.stats, "time_bound": record})
 
-    def _plan_from(self, problem: ManeuverProblem, starts: list[Reference]) -> Reference:
+    def _plan_from(self, problem: ManeuverProblem, starts: list[Reference], defer: bool = False,
+                   resumed: Reference | None = None) -> Reference:
         """Plan from the given start references (see the module docstring), then honour the
-        requirements between the points (:meth:`_honoured`)."""
+        requirements between the points (:meth:`_honoured`). ``defer`` and ``resumed``: as in
+        :meth:`_optimum` (a deferred failure is returned as it is)."""
         ocp = self._ocp(problem)
         omegaf = np.zeros(3) if problem.omegaf is None else problem.omegaf
         params = np.concatenate([problem.initial_state, problem.qf, omegaf, [problem.duration],
                                  problem.model.default_parameters])
-        solved = self._optimum(problem, ocp, starts, params, self.options.intervals)
+        solved = self._optimum(problem, ocp, starts, params, self.options.intervals, defer=defer, resumed=resumed)
+        if solved.deferred is not None:  # the coarse mesh failed at the time bound: _released decides
+            return solved.deferred
         if solved.exact is not None:  # the exact bang-bang optimum, its requirements checked (_bang_bang)
             reference: Reference = solved.exact
         else:
@@ -1317,9 +1362,16 @@ class CollocationPlanner(Planner):
         return seeds, alternates, labels + alternate_labels
 
     def _optimum(self, problem: ManeuverProblem, ocp: OptimalControlProblem, starts: list[Reference], params: Array,
-                 intervals: int, solver: str | None = None) -> _Optimum:
+                 intervals: int, solver: str | None = None, defer: bool = False,
+                 resumed: Reference | None = None) -> _Optimum:
         """The best optimum on ``intervals`` from the starts (through the coarse mesh first, see
-        :meth:`_coarse`, when ``intervals`` is the option's); ``solver`` as in :meth:`_nlp`."""
+        :meth:`_coarse`, when ``intervals`` is the option's); ``solver`` as in :meth:`_nlp`.
+
+        ``defer``: where the coarse multistart fails and :meth:`_time_bound` names a feasible slew
+        longer than the bound on the free final time (the bound may be below the minimum time), that
+        failure is returned (``deferred``) without the full-mesh attempts under the bound, for
+        :meth:`_released` to decide; ``resumed``: such a deferred failure, whose full-mesh attempts
+        are made now (the coarse multistart not solved again), as without ``defer``."""
         o = self.options
         coarse_first = intervals == o.intervals and self._coarse(ocp)
         # The layout (bounds, seeds, unpack) is the same in every build: use the one solved first.
@@ -1328,7 +1380,11 @@ class CollocationPlanner(Planner):
         bounds = transcription.bounds(ocp, nlp, *self._variable_bounds(problem), problem.duration)
         result, regularized = None, None
         extra: dict[str, Any] = {}
-        if coarse_first:
+        if coarse_first and resumed is not None:  # the coarse multistart failed (deferred): its stats as then
+            extra["coarse"] = resumed.stats
+            if "seeds" in resumed.stats:
+                extra["seeds"] = resumed.stats["seeds"]
+        elif coarse_first:
             # On a coarse mesh, where an iteration costs a fraction: the escape from stationary
             # points and its confirmation (free T), or the long way from a far seed (fixed T); its
             # optimum (and its multipliers, carried to the full mesh) seeds one solve on the full mesh.
@@ -1342,6 +1398,11 @@ class CollocationPlanner(Planner):
             extra["coarse"] = found.stats
             if "seeds" in found.stats:  # the multistart was the coarse one
                 extra["seeds"] = found.stats["seeds"]
+            record = found.stats.get("time_bound")
+            if defer and not found.ok and isinstance(record, dict) and "feasible_s" in record:
+                # The bound may be below the minimum time (:meth:`_time_bound`): the released solve
+                # first; the full mesh is tried under the bound only where that does not settle it.
+                return replace(coarse, extra=extra, deferred=found)
             if found.ok:
                 assert isinstance(found, CollocationReference)  # found.ok
                 exact = self._bang_bang(problem, ocp, params, coarse, found, extra)
@@ -1428,7 +1489,7 @@ class CollocationPlanner(Planner):
                 hint = f" ({note}; {hint[2:-1]})" if hint else f" ({note})"
             if release is not None:  # a feasible slew longer than the bound: what _released releases it to
                 stats["time_bound"] = {"bound_s": float(problem.duration), "feasible_s": release[0],
-                                       "feasible_from": release[1]}
+                                       "feasible_from": release[1], "intervals": solved.intervals}
             return FailedReference(self.name, f"{solver} did not converge from any start: "
                                    f"{sorted(set(result.statuses))}{hint}", result.status, stats=stats)
         assert result.x is not None  # success implies a point
@@ -1476,6 +1537,16 @@ class CollocationPlanner(Planner):
                                                                      lbx, ubx, solver, reference.stats,
                                                                      solved.switching)
         return reference
+
+
+def _skipped(reference: Reference, failures: list[str]) -> None:
+    """Name in ``reference``'s seed record the seed planners that failed or raised (``failures``)
+    and the starts left out as not finite (``seeds_dropped``, its own or its coarse mesh's)."""
+    if isinstance(reference.stats.get("seeds"), dict):
+        coarse = reference.stats.get("coarse")
+        dropped = [*(coarse.get("seeds_dropped", []) if isinstance(coarse, dict) else []),
+                   *reference.stats.get("seeds_dropped", [])]
+        reference.stats["seeds"]["skipped"] = failures + dropped
 
 
 def _rounded_up(value: float, digits: int = 7) -> str:
