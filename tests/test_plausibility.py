@@ -274,3 +274,32 @@ def test_the_guide_states_the_slow_slew_bar_the_code_uses():
     from scenarios.schema.plausibility import SLOW_SLEW_FACTOR
     text = re.sub(r"\s+", " ", (ROOT / "docs" / "guide" / "scenarios.rst").read_text())
     assert f"exceeds {SLOW_SLEW_FACTOR:g} times its time budget (``maneuver.duration``)" in text
+
+
+@pytest.mark.parametrize("change, path", [
+    (lambda d: d["maneuver"]["initial"].update(omega=[1e261, 0.0, 0.0]), "maneuver.initial.omega"),
+    (lambda d: d.setdefault("maneuver", {}).update(max_rate=1.2e261), "maneuver.max_rate"),
+])
+def test_a_huge_value_is_written_in_exponent_form_not_hundreds_of_digits(change, path):
+    """A rate of 1e261 rad/s was written as 70,114,267,... deg/s (263 digits) in the warning; from
+    1e15 the text gives exponent form. Grouped thousands stay below it (57,296 deg/s above)."""
+    said = warnings_of(change)
+    assert len(said) == 1 and said[0].startswith(path), said
+    assert "e+" in said[0]
+    assert not re.search(r"\d[\d,]{24,}", said[0]), said[0]  # no run of 20-odd digits
+
+
+@pytest.mark.parametrize("orbit", [{"altitude_km": 1e300}, {"type": "keplerian", "semi_major_axis_km": 1e300},
+                                   {"type": "keplerian", "altitude_km": 2e9}])
+def test_an_orbit_beyond_any_earth_orbit_is_refused_at_its_path(orbit):
+    """An altitude of 1e300 km overflowed the orbit's rate (radius³) and ended ``validate`` in an
+    internal error; above MAX_ORBIT_KM the loader names the path and the bound."""
+    from ocp.dynamics.orbits import MAX_ORBIT_KM
+    from scenarios.errors import ScenarioError
+
+    data = copy.deepcopy(CUBESAT)
+    data["orbit"] = orbit
+    with pytest.raises(ScenarioError) as raised:
+        parse_scenario(data)
+    key = "altitude_km" if "altitude_km" in orbit else "semi_major_axis_km"
+    assert f"orbit.{key}" in str(raised.value) and f"{MAX_ORBIT_KM:g}" in str(raised.value), str(raised.value)

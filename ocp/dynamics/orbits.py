@@ -35,13 +35,17 @@ from ocp.errors import InvalidOption, ModelError
 from ocp.options import Range
 from ocp.quat_casadi import Expr
 
-__all__ = ["J2_EARTH", "MU_EARTH", "ORBITS", "R_EARTH", "TLE_EPOCH_REFUSE_DAYS", "TLE_EPOCH_WARN_DAYS",
+__all__ = ["J2_EARTH", "MAX_ORBIT_KM", "MU_EARTH", "ORBITS", "R_EARTH", "TLE_EPOCH_REFUSE_DAYS", "TLE_EPOCH_WARN_DAYS",
            "CircularOrbit", "KeplerianOrbit", "Orbit", "OrbitKind", "TLEOrbit", "kepler_newton_iterations",
            "teme_to_gcrf_matrices"]
 
 MU_EARTH = 3.986004418e14      # m³/s², EGM96 / WGS-84
 R_EARTH = 6378.137e3           # m, WGS-84 equatorial radius
 J2_EARTH = 1.08262668e-3       # EGM96 second zonal harmonic (unnormalised), with R_EARTH
+MAX_ORBIT_KM = 1e9
+"""The largest altitude or semi-major axis an orbit may have [km]: 650 times the radius of the Earth's Hill
+sphere (1.5 million km), far beyond any orbit about the Earth alone; above it the orbit's rate and
+the geometry built on it overflow (a radius³ beyond the largest float from 5.6e99 km)."""
 TLE_EPOCH_WARN_DAYS = 30.0
 """A TLE whose epoch lies more than this many days from the scenario's epoch is used with a warning."""
 TLE_EPOCH_REFUSE_DAYS = 365.0
@@ -281,7 +285,7 @@ class CircularOrbit(OrbitKind):
             Argument of latitude at t = 0, from the ascending node [deg].
         """
 
-        altitude_km: Annotated[float, Range(gt=0.0)]
+        altitude_km: Annotated[float, Range(gt=0.0, le=MAX_ORBIT_KM)]
         inclination_deg: Annotated[float, Range()] = 0.0
         raan_deg: Annotated[float, Range()] = 0.0
         arg_latitude_deg: Annotated[float, Range()] = 0.0
@@ -491,8 +495,8 @@ class KeplerianOrbit(OrbitKind):
             Let the node, the perigee and the mean anomaly drift at J2's first-order secular rates.
         """
 
-        semi_major_axis_km: Annotated[float | None, Range(gt=0.0)] = None
-        altitude_km: Annotated[float | None, Range()] = None
+        semi_major_axis_km: Annotated[float | None, Range(gt=0.0, le=MAX_ORBIT_KM)] = None
+        altitude_km: Annotated[float | None, Range(le=MAX_ORBIT_KM)] = None
         eccentricity: Annotated[float, Range(ge=0.0, lt=1.0)] = 0.0
         inclination_deg: Annotated[float, Range()] = 0.0
         raan_deg: Annotated[float, Range()] = 0.0

@@ -100,6 +100,19 @@ class Implausible:
 PlausibilityCheck = Callable[["Scenario"], Iterator[Implausible]]
 
 
+_GROUPED_BELOW = 1e15
+"""Numbers in a warning's text are written with their thousands grouped below this, in exponent form
+from it."""
+
+
+def _grouped(value: float, decimals: int = 0) -> str:
+    """``value`` with its thousands grouped (``57,296``) below ``_GROUPED_BELOW``, beyond that in
+    exponent form (``7.011e+262``): a user's 1e261 rad/s is no 263-digit number in a warning."""
+    if abs(value) < _GROUPED_BELOW:
+        return f"{value:,.{decimals}f}"
+    return f"{value:.4g}"
+
+
 def _number(value: Any) -> float | None:
     """``value`` as a finite float, or None (absent, null, text, a bool)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
@@ -142,7 +155,7 @@ def _orbit_altitude(scenario: Scenario) -> Iterator[Implausible]:
             guess = (f"; did you mean {meant:g} (metres written as kilometres)?"
                      if LOWEST_ORBIT_KM <= to_radius(meant) * (1 - eccentricity) - radius_km else "")
             yield Implausible(f"orbit.{key}", f"{value:g} km",
-                              f"puts the orbit's {height} at {apogee:,.0f} km ({apogee + radius_km:,.0f} km from "
+                              f"puts the orbit's {height} at {_grouped(apogee)} km ({_grouped(apogee + radius_km)} km from "
                               f"the Earth's centre), beyond the Moon's distance ({MOON_DISTANCE_KM:,.0f} km), where "
                               f"the Earth's two-body orbit no longer holds{guess}")
         elif perigee < LOWEST_ORBIT_KM:
@@ -180,7 +193,7 @@ def _rates_at_or_above(given: list[tuple[str, Any]], bar: float, why: str) -> It
         value = _number(written)
         if value is not None and value >= bar:
             yield Implausible(path, f"{value:g} rad/s",
-                              f"is {math.degrees(value):,.{0 if value >= 1 else 1}f} deg/s, at or above {bar:g} rad/s "
+                              f"is {_grouped(math.degrees(value), 0 if value >= 1 else 1)} deg/s, at or above {bar:g} rad/s "
                               f"({math.degrees(bar):.2g} deg/s), {why}; did you mean {math.radians(value):.4g} rad/s "
                               f"({value:g} deg/s)?")
 
@@ -216,7 +229,7 @@ def _boundary_rates(scenario: Scenario) -> Iterator[Implausible]:
                f"more than the wheels alone can take (its momentum ‖J ω‖ = {momentum:.3g} N m s against the "
                f"{storage:.3g} N m s all working wheels store together)")
         yield Implausible(f"maneuver.{where}.omega", f"{np.asarray(rate).tolist()} rad/s",
-                          f"has ‖ω‖ = {norm:.4g} rad/s ({math.degrees(norm):,.0f} deg/s), at or above {MAX_RATE:g} "
+                          f"has ‖ω‖ = {norm:.4g} rad/s ({_grouped(math.degrees(norm))} deg/s), at or above {MAX_RATE:g} "
                           f"rad/s and {why}; did you mean {[round(math.radians(float(w)), 6) for w in rate]} "
                           "rad/s (deg/s written as rad/s)?")
 
@@ -266,9 +279,9 @@ def _slew_time(scenario: Scenario) -> Iterator[Implausible]:
     yield Implausible("spacecraft.inertia", f"{written} kg m²",
                       f"(least principal moment {least:g} kg m²) with the actuators' body torque bound (‖τ‖ = "
                       f"{torque:.3g} N m) turns the spacecraft at {torque / least:.3g} rad/s² at most, so the "
-                      f"{math.degrees(angle):.4g} deg rest-to-rest slew takes at least {shortest:,.0f} s (the "
+                      f"{math.degrees(angle):.4g} deg rest-to-rest slew takes at least {_grouped(shortest)} s (the "
                       f"bang-bang time 2 √(θ / α)), "
-                      f"{shortest / budget:,.0f} times maneuver.duration ({budget:g} s, the manoeuvre's time budget): "
+                      f"{_grouped(shortest / budget)} times maneuver.duration ({budget:g} s, the manoeuvre's time budget): "
                       "no slew within it stays within the actuators' torque bound: a planner that takes its own "
                       "time ends after the budget (its row infeasible), one planned over it asks more torque than "
                       "the actuators give (its row violated under the actuator requirement, or infeasible where the "
