@@ -154,3 +154,71 @@ def test_a_solve_that_does_not_converge_is_still_failed(duration: float, objecti
     assert row.status == "failed", row.message
     assert row.needed_duration_s is None
     assert "did not converge" in row.message
+
+
+
+FULL_INERTIA_7S = """
+name: full-inertia-budget
+spacecraft: {inertia: [[10, 0.5, 0.2], [0.5, 8, 0.3], [0.2, 0.3, 6]], wheels: none, torquers: {max_torque: 1.0}}
+maneuver:
+  duration: 7.0
+  initial: {q: [1, 0, 0, 0], omega: [0, 0, 0]}
+  final: {q: [0.25881904510252074, 0.5576775358252053, 0.5576775358252053, 0.5576775358252053], omega: [0, 0, 0]}
+planners: [{name: collocation, options: {objective: min_time}}]
+controller: {name: augmented_quaternion_feedback, options: {kp: 2.0, kd: 3.0}}
+simulation: {sample_time: 0.05, duration: 9.0}
+"""
+"""150° about [1, 1, 1] of a full inertia under a 7.0 s budget, below its minimum time (7.68249 s,
+``scenarios/bench/suite.yaml``): its full mesh under the bound costs a fifth of B&W's."""
+
+
+def _counted_with(change) -> tuple:
+    """The row of :data:`FULL_INERTIA_7S` and its solves, ``change(planner, problem, reference)``
+    replacing the released solve's reference (the plan of a problem whose bound is not the 7.0 s
+    budget: the bound released to a feasible slew)."""
+    plan_from = collocation_planner.CollocationPlanner._plan_from
+
+    def patched(self, problem, starts, defer=False, resumed=None):
+        reference = plan_from(self, problem, starts, defer=defer, resumed=resumed)
+        return reference if float(problem.duration) == 7.0 else change(self, problem, reference)
+
+    solves = Solves()
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(collocation_planner, "solve_multistart", solves)
+        patch.setattr(collocation_planner.CollocationPlanner, "_plan_from", patched)
+        row = run(parse_scenario(yaml.safe_load(FULL_INERTIA_7S))).rows[0]
+    return row, solves.records
+
+
+def test_a_released_solve_that_fails_leaves_the_row_failed_after_the_full_mesh_under_the_bound() -> None:
+    """Where the minimum time with the bound released does not converge (here: replaced by a failure),
+    nothing is known of the least time: the row stays failed (a numerical failure, no needed
+    duration), its message says what the released solve did, and the full mesh was tried under the
+    bound after the coarse one, as without the deferral."""
+    from planners.reference import FailedReference
+
+    row, solves = _counted_with(lambda planner, problem, reference: FailedReference(planner.name, "stopped (test)"))
+    assert row.status == "failed", row.message
+    assert row.needed_duration_s is None
+    assert "did not converge either: stopped (test)" in row.message, row.message
+    coarse = min(size for _, size, _ in solves)
+    assert any(bound == 7.0 and size > coarse for bound, size, _ in solves), solves  # the full mesh, under the bound
+    assert row.reference.stats["time_bound"]["released_ok"] is False
+
+
+def test_a_released_optimum_within_the_bound_leaves_the_row_failed_and_says_to_try_more_starts() -> None:
+    """Where the released minimum time converges within the budget (here: its duration replaced by
+    6.9 s < 7.0 s), the starts under the bound failed for another reason than the budget: the full mesh
+    is tried under the bound, and where it fails too the row is failed (not infeasible, no needed
+    duration), its message naming the released time and suggesting more starts."""
+    def shortened(planner, problem, reference):
+        reference.duration = 6.9
+        return reference
+
+    row, solves = _counted_with(shortened)
+    assert row.status == "failed", row.message
+    assert row.needed_duration_s is None
+    assert "converged to T = 6.9 s, within the bound" in row.message and "try more starts" in row.message, row.message
+    coarse = min(size for _, size, _ in solves)
+    assert any(bound == 7.0 and size > coarse for bound, size, _ in solves), solves
+    assert row.reference.stats["time_bound"]["released_T_s"] == 6.9
