@@ -112,15 +112,34 @@ def test_the_verdict_costs_the_coarse_starts_and_the_released_solve_only(short_b
     assert sum(iterations for _, _, iterations in solves) <= 800, solves
 
 
-def test_a_budget_between_the_coarse_and_the_full_mesh_minimum_is_solved_on_the_full_mesh() -> None:
-    """3.2432 s: above the minimum time (3.2431108 s on 50 intervals) but below the coarse mesh's
-    (3.243488 s on 8), whose starts all fail under it: the released optimum lies within the bound, so
-    the full mesh is solved under the bound after all, and the row is ok at its optimum."""
+def test_a_budget_between_the_coarse_and_the_exact_minimum_is_met_by_the_released_optimum() -> None:
+    """3.2432 s: above the minimum time but below the coarse mesh's (3.243488 s on 8 intervals), whose
+    starts all fail under it: the released minimum time (the exact bang-bang optimum, 3.2430833 s)
+    lies within the bound, so it is the bounded problem's optimum too; no solve on the full mesh
+    under the bound is needed (before: 1908-variable solves under the bound, ok at the 50-interval
+    optimum 3.2431108 s)."""
     row, solves = counted(3.2432)
     assert row.status == "ok", row.message
     assert row.reference.duration == pytest.approx(PUBLISHED, abs=1e-4)
     assert row.reference.duration <= 3.2432
-    assert any(bound == 3.2432 and size > min(s for _, s, _ in solves) for bound, size, _ in solves)
+    coarse = min(s for _, s, _ in solves)
+    assert not any(bound == 3.2432 and size > coarse for bound, size, _ in solves), solves
+    record = row.reference.stats["time_bound"]
+    assert record["bound_s"] == 3.2432 and record["released_T_s"] == row.reference.duration
+    assert "is within the bound" in row.message
+
+
+def test_the_suggested_duration_of_an_infeasible_row_admits_a_certified_slew(short_budget_row) -> None:
+    """The duration a too-short budget's row suggests ("a maneuver.duration of 3.243084 s admits this
+    slew": the least time rounded up) is met: the row at that budget is ok, its slew no longer than
+    the budget and certified. Before, the full mesh under the bound (its optimum 3.2431108 s, above
+    the suggestion) stopped at IPOPT's acceptable level at T = 3.243084032 s, over the budget."""
+    suggested = collocation_planner._rounded_up(short_budget_row[0].needed_duration_s)
+    assert f"a maneuver.duration of {suggested} s admits this slew" in short_budget_row[0].message
+    row = run(scenario(float(suggested))).rows[0]
+    assert row.status == "ok", row.message
+    assert row.reference.duration <= float(suggested)
+    assert row.reference.stats["certificate"]["verdict"] == "certified", row.reference.stats["certificate"]
 
 
 def test_a_weighted_objective_with_a_time_term_is_infeasible_below_the_minimum_time() -> None:
@@ -172,7 +191,7 @@ simulation: {sample_time: 0.05, duration: 9.0}
 ``scenarios/bench/suite.yaml``): its full mesh under the bound costs a fifth of B&W's."""
 
 
-def _counted_with(change) -> tuple:
+def _counted_with(change, **options: object) -> tuple:
     """The row of :data:`FULL_INERTIA_7S` and its solves, ``change(planner, problem, reference)``
     replacing the released solve's reference (the plan of a problem whose bound is not the 7.0 s
     budget: the bound released to a feasible slew)."""
@@ -186,7 +205,9 @@ def _counted_with(change) -> tuple:
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(collocation_planner, "solve_multistart", solves)
         patch.setattr(collocation_planner.CollocationPlanner, "_plan_from", patched)
-        row = run(parse_scenario(yaml.safe_load(FULL_INERTIA_7S))).rows[0]
+        data = yaml.safe_load(FULL_INERTIA_7S)
+        data["planners"][0]["options"].update(options)
+        row = run(parse_scenario(data)).rows[0]
     return row, solves.records
 
 
@@ -206,16 +227,17 @@ def test_a_released_solve_that_fails_leaves_the_row_failed_after_the_full_mesh_u
     assert row.reference.stats["time_bound"]["released_ok"] is False
 
 
-def test_a_released_optimum_within_the_bound_leaves_the_row_failed_and_says_to_try_more_starts() -> None:
-    """Where the released minimum time converges within the budget (here: its duration replaced by
-    6.9 s < 7.0 s), the starts under the bound failed for another reason than the budget: the full mesh
-    is tried under the bound, and where it fails too the row is failed (not infeasible, no needed
-    duration), its message naming the released time and suggesting more starts."""
+def test_a_released_optimum_within_the_bound_leaves_a_weighted_row_failed_and_says_to_try_more_starts() -> None:
+    """A weighted objective with a time term, whose released minimum time converges within the budget
+    (here: its duration replaced by 6.9 s < 7.0 s): the weighted starts under the bound failed for
+    another reason than the budget, and the minimum time is not the weighted optimum, so the full
+    mesh is tried under the bound, and where it fails too the row is failed (not infeasible, no
+    needed duration), its message naming the released time and suggesting more starts."""
     def shortened(planner, problem, reference):
         reference.duration = 6.9
         return reference
 
-    row, solves = _counted_with(shortened)
+    row, solves = _counted_with(shortened, objective="weighted", energy_weight=1.0, time_weight=1.0)
     assert row.status == "failed", row.message
     assert row.needed_duration_s is None
     assert "converged to T = 6.9 s, within the bound" in row.message and "try more starts" in row.message, row.message

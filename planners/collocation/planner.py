@@ -820,8 +820,12 @@ class CollocationPlanner(Planner):
         ``eigenaxis`` slew longer than it is (:func:`scenarios.requirements.scoring.late_slew`), and
         the row's ``needed_duration_s`` is ``T*`` (:func:`scenarios.runner.needed_duration`). ``T*``
         is a local optimum, whatever its certificate says of it: the least time this planner finds,
-        not a proof that no faster slew exists, and the message says so. Where the released solve
-        does not converge, or converges within the bound, the reference stays ``failed`` (a
+        not a proof that no faster slew exists, and the message says so. Where a minimum time's
+        released solve converges within the bound, its optimum is the bounded problem's too (the
+        starts under the bound failed on a mesh whose optimum lies above the exact one): it is the
+        reference, ``ok``, its stats' ``time_bound`` saying so. Where the released solve does not
+        converge, or a ``weighted`` objective's minimum time lies within the bound (not its
+        optimum) and its own solves under the bound fail, the reference stays ``failed`` (a
         numerical failure, not a verdict on the budget), its message saying what the released solve
         did.
 
@@ -846,6 +850,18 @@ class CollocationPlanner(Planner):
         found_starts = [] if refused else timer._starts(wider)
         found = (timer._plan_from(wider, found_starts) if found_starts
                  else FailedReference(self.name, refused or "no start"))
+        if found.ok and timer is self and not float(found.duration) > bound:
+            # the released minimum time lies within the bound: it is the bounded problem's optimum too
+            # (the same problem, its final time admitted by both bounds); the discretised optima above it
+            # (coarse mesh, full mesh) are what failed under the bound
+            _skipped(found, failures)
+            found.stats["time_bound"] = {**record, "released_ok": True, "released_T_s": float(found.duration),
+                                         "bounded_status": failed.stats.get("solver_status")}
+            found.message += (f"; the starts under maneuver.duration = {bound:.10g} s failed on the "
+                              f"N={record.get('intervals')} mesh (a mesh's optimum may lie above the exact one): "
+                              f"this optimum, found with the bound released to {released:.6g} s ({label}'s "
+                              f"feasible slew), is within the bound")
+            return found
         if record.get("intervals") != o.intervals and not (found.ok and float(found.duration) > bound):
             # deferred on the coarse mesh: the full mesh under the bound, as it would have been solved
             failed = self._plan_from(problem, starts, resumed=failed)
