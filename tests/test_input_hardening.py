@@ -138,7 +138,7 @@ def test_duplicate_keys_name_both_places(tmp_path):
         controller: {name: none}
         """)
     status, error, _ = run_cli(tmp_path, text)
-    assert status == 2 and "maneuver.duration: duplicate key (lines 4 and 5 of " in error, error
+    assert status == 2 and "maneuver.duration: duplicate key (lines 4 and 5); " in error, error
 
 
 def test_an_alias_bomb_fails_fast_with_a_short_message(tmp_path):

@@ -177,7 +177,7 @@ def test_run_results_write_speaks_of_the_directory_argument(tmp_path):
 
 @pytest.mark.parametrize("text, words", [
     ("study: s\nscenario: base.yaml\ngrid:\n  controller.options.kp: [0.1]\n  controller.options.kp: [0.2]\n",
-     "error in {file}: grid.controller.options.kp: duplicate key (lines 4 and 5 of {file})"),
+     "error in {file}: grid.controller.options.kp: duplicate key (lines 4 and 5); each key may appear once"),
     ("- a\n- b\n", "error in {file}: (top level): expected a mapping, got ['a', 'b']")])
 def test_validate_names_the_file_before_its_kind_is_known(text, words, tmp_path):
     path = tmp_path / "study.yaml"
@@ -186,6 +186,20 @@ def test_validate_names_the_file_before_its_kind_is_known(text, words, tmp_path)
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
         assert main(["validate", str(path)]) == 2
     assert words.format(file=path) in err.getvalue() and "error in scenario" not in err.getvalue(), err.getvalue()
+    assert err.getvalue().count(str(path)) == 1, err.getvalue()  # the file named once
+
+
+@pytest.mark.parametrize("text, words", [
+    ("name: a\nname: b\n", "error in study.yaml: name: duplicate key (lines 1 and 2); each key may appear once"),
+    ("- a\n", "error in study.yaml: (top level): expected a mapping, got ['a']")])
+def test_a_file_given_as_dot_slash_is_named_once(text, words, tmp_path, monkeypatch):
+    """``validate ./FILE``: the error names the file once (Python writes ./FILE as FILE)."""
+    (tmp_path / "study.yaml").write_text(text)
+    monkeypatch.chdir(tmp_path)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        assert main(["validate", "./study.yaml"]) == 2
+    assert words in err.getvalue() and err.getvalue().count("study.yaml") == 1, err.getvalue()
 
 
 def test_a_scenario_files_error_still_says_scenario(tmp_path):

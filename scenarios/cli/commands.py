@@ -790,9 +790,10 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
                 kind = "the command line"  # no file given: nothing to name
             elif error.file is None and str(given) not in text:  # raised after the file was read
                 text = f"{given}: {text}"
-        # a message that starts with the file it names (a file whose kind is not known yet) names it once
-        print(f"slewbench: error in {text}" if text.startswith(f"{kind}: ") else f"slewbench: error in {kind}: {text}",
-              file=sys.stderr)
+        # the given file (./FILE is FILE in the error) where its kind is not known yet: named once
+        named = str(error.file) if given and error.file is not None and error.file == Path(given) else kind
+        print(f"slewbench: error in {text}" if kind == given and text.startswith(f"{named}: ")
+              else f"slewbench: error in {kind}: {text}", file=sys.stderr)
         return EXIT_BAD_SCENARIO
     except OutputError as error:
         given = "--report" if getattr(args, "report", None) else "--out" if getattr(args, "out", None) else None

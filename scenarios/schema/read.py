@@ -69,9 +69,10 @@ def _check_tree(root: yaml.Node, source: Path | str) -> None:
                 key = key_node.value if isinstance(key_node, yaml.ScalarNode) else id(key_node)
                 child = f"{path}.{key}" if path else str(key)
                 if key in seen:
-                    first = seen[key].start_mark.line + 1
-                    raise ScenarioError(child, f"duplicate key (lines {first} and {key_node.start_mark.line + 1} of "
-                                               f"{source}); each key may appear once")
+                    lines = f"lines {seen[key].start_mark.line + 1} and {key_node.start_mark.line + 1}"
+                    if isinstance(source, Path):  # the error names the file once, before the path
+                        raise ScenarioError(child, f"duplicate key ({lines}); each key may appear once", source)
+                    raise ScenarioError(child, f"duplicate key ({lines} of {source}); each key may appear once")
                 seen[key] = key_node
                 stack.append((value_node, child, depth + 1))
         elif isinstance(node, yaml.SequenceNode):
