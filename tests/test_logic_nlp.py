@@ -102,3 +102,20 @@ def test_a_continuation_that_fails_leaves_the_acceptable_point():
                             ("Maximum_Iterations_Exceeded", False, 120.0, [0.3])], agree=1)
     assert len(solver.calls) == 2 and result.success and result.f == 150.0
     assert result.starts[0].status == "Solved_To_Acceptable_Level"
+
+
+@pytest.mark.parametrize("statuses, tried", [
+    (["Maximum_Iterations_Exceeded"], True),  # a stall: the fallback may escape it
+    (["Infeasible_Problem_Detected", "Restoration_Failed"], True),
+    (["Infeasible_Problem_Detected", "Maximum_Iterations_Exceeded"], True),
+    (["Infeasible_Problem_Detected"], False),  # locally infeasible from every start: nothing to escape
+    (["Infeasible_Problem_Detected", "Infeasible_Problem_Detected"], False),
+    (["Solve_Succeeded"], False),  # converged: fallbacks are for when nothing did
+])
+def test_a_fallback_is_tried_only_after_starts_that_stalled(statuses, tried):
+    outcomes = [(s, s == "Solve_Succeeded", 1.0, [0.0 if s == "Solve_Succeeded" else 1.0]) for s in statuses]
+    solver = ScriptedSolver(outcomes + [("Solve_Succeeded", True, 2.0, [0.0])])
+    guesses = [np.array([float(i)]) for i in range(len(statuses))]
+    result = solve_multistart(solver, guesses, lbg=[0.0], ubg=[0.0], agree=0, fallback=[np.array([9.0])])
+    assert len(solver.calls) == len(statuses) + tried
+    assert result.success is (tried or "Solve_Succeeded" in statuses)

@@ -35,7 +35,11 @@ a different start, which is the evidence that more starts would not improve it.
 Fallbacks
 ---------
 ``fallback`` guesses are tried only while no start has converged (e.g. the unperturbed warm start
-after a perturbed copy of it that hit the iteration limit).
+after a perturbed copy of it that hit the iteration limit), and not where every start ended
+``Infeasible_Problem_Detected``: the constraints were found locally infeasible from each, no
+stall for a fallback to escape (a minimum time under a bound below it: Bilimoria & Wie's
+unperturbed eigenaxis start under 3 s ran to the iteration limit, 500 of the verdict's 727
+iterations).
 
 Warm starts with multipliers
 ----------------------------
@@ -391,8 +395,8 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
                 break
             yield guess
         for guess in fallback:
-            if best:
-                break
+            if best or (starts and all(start.status == INFEASIBLE[0] for start in starts)):
+                break  # converged, or every start found the constraints locally infeasible: no stall to escape
             yield guess
         for k in range(max_restarts if restart > 0 and best else 0):
             if second_order and agree:
