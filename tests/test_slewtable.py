@@ -26,6 +26,7 @@ from scenarios.slewtable.files import STATUS_CODES, write_table_files
 from scenarios.slewtable.fit import SlewTimeFit, load_fit, zonotope_facets
 from scenarios.slewtable.grid import fibonacci_axes, offset_axes, polytope_grid
 from scenarios.slewtable.spec import parse_table_spec
+from scenarios.study import engine
 
 BILIMORIA_WIE = 3.2431  # s: unit inertia, |u_i| <= 1 N m, 180 deg about x (J. Guid. Control Dyn. 16(3), 1993)
 
@@ -342,7 +343,10 @@ def test_netcdf_reads_back_with_dimensions_units_and_attributes(tmp_path):
     (["--held-out", "-1"], "--held-out"),
     (["--scheduler", "tcp://127.0.0.1:1"], "--scheduler"),  # nobody listens: nothing is claimed
 ])
-def test_bad_options_exit_2_naming_the_option(tmp_path, capsys, flags, where):
+def test_bad_options_exit_2_naming_the_option(tmp_path, capsys, monkeypatch, flags, where):
+    # a closed port: Dask's connect retries until the handshake timeout (10 s), which only the
+    # connection attempt (as in tests/test_study_errors_name_the_file.py) needs, not its length
+    monkeypatch.setattr(engine, "HANDSHAKE_TIMEOUT_S", 0.5)
     scenario = _write(tmp_path, "box.yaml", UNIT_BOX)
     assert main(["table", str(scenario), "--out", str(tmp_path / "out"), *flags]) == 2
     assert where in capsys.readouterr().err
