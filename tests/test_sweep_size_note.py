@@ -3,10 +3,16 @@ and when the sweep starts; it is never refused (docs/guide/studies.rst).
 
 Oracle: the case count of the grid by hand (1001 Monte Carlo samples of one grid point), the worker time at 1 s a
 case (1001 s = 0.278 h, 0.139 h on 2 workers), and a small study (10 cases) that gets no note.
+
+The dry run checks every case (parse, plan, findings: about 9 ms a case), so the command line's 1001-case dry
+run is marked slow; its default twin runs the same command on 11 cases over a limit of 10 (and 10 cases at it,
+no note) and checks the note of the real limit on the 1001-case study in-process.
 """
 from __future__ import annotations
 
 from pathlib import Path
+
+import pytest
 
 from scenarios.cli import main
 from scenarios.study.spec import LARGE_STUDY, load_study, size_note
@@ -21,6 +27,27 @@ def study_file(tmp_path: Path, cases: int) -> Path:
     return path
 
 
+def test_a_dry_run_over_the_limit_prints_the_count_and_how_to_estimate_its_time(tmp_path, capsys, monkeypatch):
+    import scenarios.study.spec as spec
+    assert LARGE_STUDY == 1000
+    # the real limit: 1001 cases, 1001 s = 0.278 h of worker time, 0.139 h on 2 workers
+    assert size_note(load_study(study_file(tmp_path, 1001)), 2) == (
+        "note: 1001 cases is a large study (over 1000): at 1 s a case that is 0.3 h of worker time, 0.1 h on 2 "
+        f"workers. To estimate it, time one case (slewbench run {BASE} --no-plots prints its plan and simulation "
+        "times) and multiply by 1001 / 2; once cases finish, the progress bar shows the time left.")
+    # the command line's dry run, over a limit of 10 (and at it: no note)
+    monkeypatch.setattr(spec, "LARGE_STUDY", 10)
+    assert main(["sweep", str(study_file(tmp_path, 10)), "--dry-run", "--workers", "2"]) == 0
+    assert "note:" not in capsys.readouterr().out
+    assert main(["sweep", str(study_file(tmp_path, 11)), "--dry-run", "--workers", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "s11: 11 cases, checked; nothing run, nothing written" in out
+    assert "note: 11 cases is a large study (over 10): at 1 s a case that is 0.0 h of worker time, 0.0 h on 2 " \
+           "workers" in out, out
+    assert f"slewbench run {BASE} --no-plots" in out and "multiply by 11 / 2" in out
+
+
+@pytest.mark.slow  # 1001 cases checked one by one: 9 s idle (the twin above runs the same command on 11)
 def test_a_large_dry_run_prints_the_count_and_how_to_estimate_its_time(tmp_path, capsys):
     assert LARGE_STUDY == 1000
     assert main(["sweep", str(study_file(tmp_path, 1001)), "--dry-run", "--workers", "2"]) == 0
