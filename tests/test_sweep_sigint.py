@@ -138,10 +138,11 @@ def test_ctrl_c_while_a_worker_starts_stops_it_silently(tmp_path):
     """A Ctrl-C while the pool waits for a worker that the fork server has not forked yet (it still
     imports) cut the worker's start short: the pool did not know that worker, the server forked it
     later, and it failed on the stopped pool's queues with a traceback (or stayed, waiting). Here a
-    module preloaded last keeps the server importing for 4 s; the sweep is called from Python, whose
-    process goes on after the interrupt."""
+    module preloaded last keeps the server importing for 2.5 s; the sweep is called from Python, whose
+    process goes on after the interrupt (4.5 s: the 2.3 s margin of the earlier 4 s import and 6 s
+    wait, after the import would have ended; the interrupt lands 0.3 s into the import)."""
     (tmp_path / "slow_preload.py").write_text("import pathlib, time\npathlib.Path('importing').touch()\n"
-                                              "time.sleep(4)\npathlib.Path('imported').touch()\n")
+                                              "time.sleep(2.5)\npathlib.Path('imported').touch()\n")
     study = write_study(tmp_path)
     process = start(tmp_path, f"""
         import gc, os, pathlib, sys, time
@@ -155,7 +156,7 @@ def test_ctrl_c_while_a_worker_starts_stops_it_silently(tmp_path):
             print("interrupted", type(stop).__name__, flush=True)
         interrupted = time.monotonic()
         gc.collect()  # the stopped pool's queues and semaphores go
-        time.sleep(6)  # the server would have forked the worker by now
+        time.sleep(4.5)  # the server would have forked the worker by now
         print("imported" if pathlib.Path("imported").exists() else "not imported", flush=True)
         """)
     with session_of(process):
