@@ -35,26 +35,37 @@ def _pixels(path: Path) -> np.ndarray:
     return np.asarray(Image.open(path).convert("RGB"))
 
 
-def test_the_plot_process_draws_what_the_run_process_draws(tmp_path):
+@pytest.fixture(scope="module")
+def demo_jobs(tmp_path_factory) -> Path:
+    """The demo's plot jobs (``plot_jobs`` of its run), pickled once for the tests whose script
+    draws them: the run is not what those tests are about, and each run costs seconds."""
+    import pickle
+
+    import scenarios
+    from scenarios.output.plot_data import plot_jobs
+
+    path = tmp_path_factory.mktemp("demo-jobs") / "jobs.pickle"
+    path.write_bytes(pickle.dumps(plot_jobs(scenarios.run(scenarios.load(DEMO)))))
+    return path
+
+
+def test_the_plot_process_draws_what_the_run_process_draws(tmp_path, demo_jobs):
     """Oracle: the same jobs drawn in process (``draw_jobs``) by the script's own process."""
     done = _python("""
-        import sys
+        import pickle, sys
         from pathlib import Path
         from scenarios.output.renderer import Renderer
         renderer = Renderer.start()
         assert renderer is not None, "no plot process on a one-thread Linux process"
-        import scenarios
-        from scenarios.output.plot_data import plot_jobs
         from scenarios.output.plots import draw_jobs
-        results = scenarios.run(scenarios.load(sys.argv[1]))
-        jobs = plot_jobs(results)
+        jobs = pickle.loads(Path(sys.argv[1]).read_bytes())
         forked, here = Path(sys.argv[2]) / "forked", Path(sys.argv[2]) / "here"
         forked.mkdir(); here.mkdir()
         renderer.draw(jobs, forked)
         renderer.close()
         draw_jobs(jobs, here)
         print(" ".join(name for name, _ in jobs))
-    """, str(DEMO), str(tmp_path))
+    """, str(demo_jobs), str(tmp_path))
     assert done.returncode == 0, done.stderr
     names = done.stdout.split()
     assert sorted(names) == ["bang-coast-bang.png", "comparison.png", "min-time.png", "smooth.png"]
@@ -121,21 +132,21 @@ def test_figures_streamed_during_the_run_are_those_drawn_in_process(tmp_path, sc
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the plot process exists on Linux only")
 @pytest.mark.parametrize("kill_helper", [False, True])
-def test_figures_streamed_faster_than_drawn_are_shared_with_a_helper(tmp_path, kill_helper):
+def test_figures_streamed_faster_than_drawn_are_shared_with_a_helper(tmp_path, kill_helper, demo_jobs):
     """Figures that wait while the idle plot process draws are shared with a fork of it (a helper,
     drawing into memory) without waiting for the run's end; what both drew is written, pixel for
     pixel the figures drawn in process. A helper killed while it draws costs only time: the plot
     process draws its figures itself."""
     done = _python("""
-        import sys, os, signal, time
+        import pickle, sys, os, signal, time
         from pathlib import Path
         from scenarios.output.renderer import Renderer
         renderer = Renderer.start()
-        import scenarios
-        from scenarios.output.plot_data import plot_jobs
         from scenarios.output.plots import draw_jobs
-        jobs = plot_jobs(scenarios.run(scenarios.load(sys.argv[1])))
-        jobs = [(f"{k}-{name}", series) for k in range(4) for name, series in jobs]
+        base = pickle.loads(Path(sys.argv[1]).read_bytes())
+        # two copies of the demo's four figures: eight waiting, enough for the plot process to
+        # share with a helper while it draws the first
+        jobs = [(f"{k}-{name}", series) for k in range(2) for name, series in base]
         for job in jobs:
             renderer.stream(job, None)
         children = Path(f"/proc/{renderer.pid}/task/{renderer.pid}/children")
@@ -150,16 +161,18 @@ def test_figures_streamed_faster_than_drawn_are_shared_with_a_helper(tmp_path, k
         out.mkdir(); here.mkdir()
         renderer.submit([], out, {name for name, _ in jobs})
         renderer.wait()
-        draw_jobs(jobs, here)
+        draw_jobs(base, here)  # the copies share a series: each figure is drawn here once
         print("jobs", " ".join(sorted(name for name, _ in jobs)))
-    """, str(DEMO), str(tmp_path), str(kill_helper))
+    """, str(demo_jobs), str(tmp_path), str(kill_helper))
     assert done.returncode == 0, done.stderr
     helper, jobs = done.stdout.splitlines()
     assert helper == "helper 1"
     names = jobs.split()[1:]
+    assert len(names) == 8
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == names
-    for name in names:
-        np.testing.assert_array_equal(_pixels(tmp_path / "out" / name), _pixels(tmp_path / "here" / name))
+    for name in names:  # "<copy>-<figure>" against the figure drawn here
+        np.testing.assert_array_equal(_pixels(tmp_path / "out" / name),
+                                      _pixels(tmp_path / "here" / name.split("-", 1)[1]))
 
 
 def test_a_plot_process_dying_while_rows_stream_costs_only_time(tmp_path):
@@ -361,18 +374,16 @@ def _gone(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the plot process exists on Linux only")
-def test_an_interrupted_draw_stops_both_plot_processes_before_it_returns(tmp_path):
+def test_an_interrupted_draw_stops_both_plot_processes_before_it_returns(tmp_path, demo_jobs):
     """Ctrl-C or SIGTERM while the plot processes draw: when ``draw`` raises, the plot process and
     its fork are gone (reaped, not left to init) and write nothing more (the caller removes the
     staging folder next)."""
     done = _python("""
-        import os, signal, sys, time
+        import os, pickle, signal, sys, time
         from pathlib import Path
         from scenarios.output.renderer import Renderer
         renderer = Renderer.start()
-        import scenarios
-        from scenarios.output.plot_data import plot_jobs
-        jobs = plot_jobs(scenarios.run(scenarios.load(sys.argv[1])))
+        jobs = pickle.loads(Path(sys.argv[1]).read_bytes())
         jobs = [(f"{k}-{name}", series) for k in range(8) for name, series in jobs]  # a long draw
         directory, forks = Path(sys.argv[2]), []
 
@@ -395,7 +406,7 @@ def test_an_interrupted_draw_stops_both_plot_processes_before_it_returns(tmp_pat
                       if Path(f"/proc/{pid}").exists() else "gone")
             time.sleep(1.0)
             print("written-afterwards", len(set(os.listdir(directory)) - set(written)))
-    """, str(DEMO), str(tmp_path))
+    """, str(demo_jobs), str(tmp_path))
     assert done.returncode == 0, done.stderr
     states = dict(line.split() for line in done.stdout.splitlines())
     assert states.pop("written-afterwards") == "0", done.stdout
@@ -499,7 +510,7 @@ def test_the_second_drawer_is_forked_only_from_a_single_thread(tmp_path, monkeyp
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the plot process exists on Linux only")
 @pytest.mark.parametrize("draw", [True, False])
-def test_the_plot_process_removes_the_temporary_matplotlib_directory(tmp_path, draw):
+def test_the_plot_process_removes_the_temporary_matplotlib_directory(tmp_path, draw, demo_jobs):
     """Where matplotlib's own directory cannot be written (a read-only home in CI or a container),
     it makes a temporary one and removes it at exit: the plot process must too, having drawn or
     having been stopped (``python -m scenarios.cli`` leaves nothing there either)."""
@@ -507,19 +518,20 @@ def test_the_plot_process_removes_the_temporary_matplotlib_directory(tmp_path, d
     scratch.mkdir()
     (tmp_path / "file").write_text("")  # MPLCONFIGDIR below it cannot be made
     done = subprocess.run([sys.executable, "-c", textwrap.dedent("""
-        import sys, time
+        import os, pickle, sys, time
         from pathlib import Path
         from scenarios.output.renderer import Renderer
         renderer = Renderer.start()
-        import scenarios
-        from scenarios.output.plot_data import plot_jobs
-        results = scenarios.run(scenarios.load(sys.argv[1]))
+        jobs = pickle.loads(Path(sys.argv[1]).read_bytes())
         if sys.argv[3] == "True":
-            renderer.draw(plot_jobs(results), Path(sys.argv[2]))
-        else:
-            time.sleep(3.0)  # matplotlib imported, nothing to draw (a bad --out, a failed write)
+            renderer.draw(jobs, Path(sys.argv[2]))
+        else:  # matplotlib imported, nothing to draw (a bad --out, a failed write)
+            deadline = time.monotonic() + 60.0
+            while not any(Path(os.environ["TMPDIR"]).iterdir()) and time.monotonic() < deadline:
+                time.sleep(0.01)  # until the plot process has made matplotlib's temporary directory
+            time.sleep(3.0)
         renderer.close()
-    """), str(DEMO), str(tmp_path), str(draw)], cwd=REPO, capture_output=True, text=True, timeout=300, check=False,
+    """), str(demo_jobs), str(tmp_path), str(draw)], cwd=REPO, capture_output=True, text=True, timeout=300, check=False,
                           env={**os.environ, "PYTHONPATH": str(REPO), "TMPDIR": str(scratch),
                                "MPLCONFIGDIR": str(tmp_path / "file" / "not-a-directory")})
     assert done.returncode == 0, done.stderr
