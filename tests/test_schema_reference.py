@@ -15,6 +15,7 @@ import re
 import subprocess
 import sys
 import textwrap
+from collections.abc import Iterable
 from html import unescape
 from pathlib import Path
 from typing import Annotated, Any, ClassVar
@@ -29,6 +30,7 @@ from controllers import CONTROLLERS
 from ocp import SolverCache, quat
 from ocp.dynamics.environment import MAGNETIC_FIELDS, FieldModel
 from planners import PLANNERS
+from scenarios.cli.commands import main
 from scenarios.errors import ScenarioError
 from scenarios.schema.node import Node
 from scenarios.schema.read import parse_yaml_text
@@ -252,14 +254,19 @@ def yaml_paths(data: Any, prefix: str = "") -> set[str]:
     return paths
 
 
-def scenario_path(path: str) -> str:
-    """A scenario path as the reference writes it: indices as ``[i]``, ``controllers[i]`` as
+def scenario_paths(paths: Iterable[str]) -> set[str]:
+    """Scenario paths as the reference writes them: indices as ``[i]``, ``controllers[i]`` as
     ``controller`` (both take the keys of one controller), a user's name under a key of named
-    entries (``spacecraft.sensors.st``) as ``<name>``."""
-    path = re.sub(r"\[\d+\]", "[i]", path).replace("controllers[i]", "controller")
-    for named in {entry.path.split(".<name>")[0] for entry in entries() if ".<name>" in entry.path}:
-        path = re.sub(rf"^{re.escape(named)}\.[^.]+", f"{named}.<name>", path)
-    return path
+    entries (``spacecraft.sensors.st``) as ``<name>``. (The reference is built once for all of
+    ``paths``: building it takes a tenth of a second.)"""
+    named = {entry.path.split(".<name>")[0] for entry in entries() if ".<name>" in entry.path}
+    written = set()
+    for path in paths:
+        path = re.sub(r"\[\d+\]", "[i]", path).replace("controllers[i]", "controller")
+        for prefix in named:
+            path = re.sub(rf"^{re.escape(prefix)}\.[^.]+", f"{prefix}.<name>", path)
+        written.add(path)
+    return written
 
 
 # --- every key accepted is documented, every documented key accepted ------------------------------
@@ -268,7 +275,7 @@ def test_the_maximal_scenarios_use_every_documented_scenario_key_and_only_docume
     found = set()
     for data in maximal_scenarios():
         scenarios.parse_scenario(copy.deepcopy(data))  # every key in them is accepted
-        found |= {scenario_path(path) for path in yaml_paths(data)}
+        found |= scenario_paths(yaml_paths(data))
     assert found <= documented_paths(), sorted(found - documented_paths())
     section_keys = {entry.path for entry in entries("Scenario file")}
     assert section_keys - found == set(), sorted(section_keys - found)
@@ -299,7 +306,7 @@ def keys_read(monkeypatch):
 def test_every_key_the_scenario_parser_reads_is_documented(keys_read):
     for data in [*maximal_scenarios(), parse_yaml_text(MINIMAL)]:
         scenarios.parse_scenario(data)
-    read = {scenario_path(path) for path in keys_read}
+    read = scenario_paths(keys_read)
     assert read - documented_paths() == set(), sorted(read - documented_paths())
     assert "environment.magnetic_field.span_s" in read and "simulation.sensor_noise.seed" in read
 
@@ -347,10 +354,11 @@ def test_every_value_generator_and_its_arguments_are_documented():
 
 
 def test_every_option_of_every_registered_planner_and_controller_is_documented():
+    every = entries()
     for prefix, registry in (("planners", PLANNERS), ("controller", CONTROLLERS)):
         for name, cls in registry.items():
             fields = {f.name for f in dataclasses.fields(cls.Options)}
-            listed = {entry.key.rsplit(".", 1)[-1] for entry in entries() if entry.key.startswith(f"{prefix}.{name}.")}
+            listed = {entry.key.rsplit(".", 1)[-1] for entry in every if entry.key.startswith(f"{prefix}.{name}.")}
             assert listed == fields, (name, listed ^ fields)
 
 
@@ -441,9 +449,10 @@ def test_documented_study_defaults_are_the_defaults_the_study_parser_applies():
 
 @pytest.mark.parametrize("prefix, registry", [("planners", PLANNERS), ("controller", CONTROLLERS)])
 def test_documented_option_defaults_are_the_defaults_the_options_take(prefix, registry):
+    every = entries()
     for name, cls in registry.items():
         defaults = cls({}).options
-        for entry in entries():
+        for entry in every:
             if entry.key.startswith(f"{prefix}.{name}."):
                 option = entry.key.rsplit(".", 1)[-1]
                 assert cls({option: documented_default(entry)}).options == defaults, (name, option)
@@ -478,12 +487,22 @@ def test_the_rst_page_builds_with_sphinx_without_warnings(tmp_path):
 
 
 def run_schema(*args: str) -> subprocess.CompletedProcess:
+    """``python -m scenarios.cli schema ARGS`` in a new process: its exit status and streams."""
     return subprocess.run([sys.executable, "-m", "scenarios.cli", "schema", *args], capture_output=True, text=True,
                           timeout=300, cwd=ROOT, check=False)
 
 
-def test_slewbench_schema_prints_the_entries_under_a_key():
-    completed = run_schema("maneuver.initial")
+def schema_here(capsys, *args: str) -> subprocess.CompletedProcess:
+    """``slewbench schema ARGS`` through the command line's ``main`` in this process (what it prints
+    does not depend on the process; :func:`run_schema` tests the process's exit status and streams)."""
+    capsys.readouterr()
+    status = main(["schema", *args])
+    out, err = capsys.readouterr()
+    return subprocess.CompletedProcess(["slewbench", "schema", *args], status, out, err)
+
+
+def test_slewbench_schema_prints_the_entries_under_a_key(capsys):
+    completed = run_schema("maneuver.initial")  # through a process: its status and output
     assert completed.returncode == 0, completed.stderr
     paths = [line for line in completed.stdout.splitlines() if line and not line[0].isspace() and "=" not in line
              and not line.startswith(("Scenario file", "The slew"))]
@@ -491,7 +510,7 @@ def test_slewbench_schema_prints_the_entries_under_a_key():
         "maneuver.initial", "maneuver.initial.q", "maneuver.initial.omega", "maneuver.initial.wheel_momentum"]
     assert "maneuver.initial.q.point.secondary.toward" in paths  # the attitude's forms
     assert "list of 3 numbers [rad/s]; default [0.0, 0.0, 0.0]" in completed.stdout
-    collocation = run_schema("planners.collocation.intervals")
+    collocation = schema_here(capsys, "planners.collocation.intervals")
     assert collocation.returncode == 0 and "planners[i].options.intervals" in collocation.stdout
     assert "integer; default 50; >= 1 and <= 2000" in collocation.stdout
 
@@ -522,7 +541,7 @@ def test_schema_keys_select_what_they_name():
         schema_text("seed")
 
 
-def test_every_study_path_the_reference_prints_selects_its_entry():
+def test_every_study_path_the_reference_prints_selects_its_entry(capsys):
     """``slewbench schema`` prints a study entry under its YAML path (``grid.<path>.linspace``,
     ``monte_carlo.samples``): that path, typed back, selects it, as ``study.<key>`` does."""
     printed = [entry.path for entry in entries("Study file")]
@@ -535,23 +554,23 @@ def test_every_study_path_the_reference_prints_selects_its_entry():
     assert "scenario" in schema_text("study.scenario").splitlines()
     assert "Study file" not in schema_text("scenario")
     for key in ("grid.<path>.linspace", "monte_carlo.samples"):
-        completed = run_schema(key)
+        completed = schema_here(capsys, key)
         assert completed.returncode == 0 and key in completed.stdout.splitlines(), completed.stderr
 
 
-def test_slewbench_schema_table_prints_the_slew_table_keys():
+def test_slewbench_schema_table_prints_the_slew_table_keys(capsys):
     """A slew-table file's keys were left out of the reference (a pointer to the guide instead);
     they are in it now, from the declarations ``slewbench table`` reads them by
     (``tests/test_slewtable_schema.py`` compares both)."""
-    completed = run_schema("table")
+    completed = schema_here(capsys, "table")
     assert completed.returncode == 0, completed.stderr
     lines = completed.stdout.splitlines()
     assert {"table.scenario", "table.axes", "table.execution.case_timeout_s", "table.refine.max_rounds"} <= set(lines)
-    refine = run_schema("table.refine")
+    refine = schema_here(capsys, "table.refine")
     assert refine.returncode == 0 and "table.refine.tolerance" in refine.stdout.splitlines()
     assert "table.axes" not in refine.stdout.splitlines()
     assert "number or null; default null; > 0 and < 1" in refine.stdout and "--tolerance" in refine.stdout
-    unknown = run_schema("table.refine.tolerence")
+    unknown = schema_here(capsys, "table.refine.tolerence")
     assert unknown.returncode == 2 and "Traceback" not in unknown.stderr
     assert "close matches: table.refine.tolerance" in unknown.stderr, unknown.stderr
 
