@@ -158,6 +158,8 @@ SWEEP_SCRIPT = textwrap.dedent("""
             results = sweep(parse_study({"study": "raising", "scenario": BASE}), workers=1, task=task)
             for _, row in results.to_dataframe().iterrows():
                 print(name, "|", row["status"], "|", row["message"], flush=True)
+            for record in results.records.values():
+                print(name, "| attempts |", record["attempts"], flush=True)
 """)
 RAISING_TASKS = ("scenario_error_task", "users_own_error_task")
 
@@ -172,25 +174,29 @@ def raising_sweeps() -> tuple[subprocess.CompletedProcess, dict[str, list[tuple[
     rows: dict[str, list[tuple[str, str]]] = {}
     for line in completed.stdout.splitlines():
         name, status, message = line.split(" | ", 2)
-        rows.setdefault(name, []).append((status, message))
+        rows.setdefault(name, []).append((status, message))  # status "attempts": a case's starts
     return completed, rows
 
 
 @pytest.mark.parametrize("task, expected", [
-    ("scenario_error_task", "ScenarioError: a.yaml: maneuver.duration: must be > 0, got -1"),
-    ("users_own_error_task", "UsersOwnError: the user's task went wrong at 42 (raised by the task; its exception "
-                             "cannot be pickled)"),
+    ("scenario_error_task", "its task raised ScenarioError: a.yaml: maneuver.duration: must be > 0, got -1"),
+    ("users_own_error_task", "its task raised UsersOwnError: the user's task went wrong at 42"),
 ])
 def test_a_local_sweep_whose_task_raises_shows_the_error_s_message_and_ends(raising_sweeps, task, expected):
     """In its own process, so that a sweep that never ends (the old failure: the pool's result
     thread could not rebuild the exception, and a new pool ran the case again without end) is
-    stopped (its workers die with it)."""
+    stopped (its workers die with it). What a task raises is its outcome, not a worker's death: the
+    case is crashed with it at once (one attempt), not run again (it said "worker died (...); 2
+    attempt(s)")."""
     completed, rows = raising_sweeps
     assert completed.returncode == 0, completed.stderr
-    assert len(rows[task]) == 2  # the two planners' rows of the case
-    for status, message in rows[task]:
+    cases = [message for status, message in rows[task] if status == "attempts"]
+    assert cases == ["1"], rows[task]
+    planned = [(status, message) for status, message in rows[task] if status != "attempts"]
+    assert len(planned) == 2  # the two planners' rows of the case
+    for status, message in planned:
         assert status == "crashed"
-        assert expected in message
+        assert message.startswith(expected) and "worker died" not in message, message
 
 
 def test_a_dask_worker_s_error_reaches_the_client_as_itself():

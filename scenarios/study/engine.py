@@ -60,6 +60,7 @@ from scenarios.study.worker import (
     PARENT_ENVIRONMENT,
     PRELOAD,
     SLOT_FIELDS,
+    TaskRaised,
     crashed_rows,
     run_case,
     run_chunk,
@@ -683,12 +684,13 @@ class _Engine:
                     for key in entry.keys:
                         self._charge(key, 1, "its process ended abruptly", batch)
                 continue
-            except Exception as error:  # a lost worker on a cluster (dask's KilledWorker, ...)
-                why = excerpt(f"{type(error).__name__}: {error}", 300)
+            except Exception as error:  # the task raised, or a lost worker on a cluster (dask's KilledWorker, ...)
                 if len(entry.keys) > 1:  # a chunk: each of its cases again, one per task
                     self.singles.extend(entry.keys)
+                elif isinstance(error, TaskRaised):  # deterministic: crashed at once, not run again
+                    self._crash(entry.keys[0], f"its task raised {error}", batch)
                 else:
-                    self._charge(entry.keys[0], 1, why, batch)
+                    self._charge(entry.keys[0], 1, excerpt(f"{type(error).__name__}: {error}", 300), batch)
                 continue
             results = outcome if isinstance(outcome, list) else [outcome]
             for key, result in zip(entry.keys, results):

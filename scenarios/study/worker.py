@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import functools
 import os
-import pickle
 import signal
 import socket
 import threading
@@ -163,34 +162,27 @@ def run_chunk(task: Callable[[dict[str, Any]], dict[str, Any]], payloads: list[d
         try:
             result = dict(tracked_case(task, payload))
         except Exception as error:
-            raise _portable(error) from None
+            text = f"{type(error).__name__}: {error}"
+            raise TaskRaised(text if len(text) <= 1000 else f"{text[:1000]}... (cut)") from None
         result["rows_json"] = encode_rows(result.pop("rows"))  # the store's text, made here in parallel
         results.append(result)
     return results
 
 
-def _portable(error: Exception) -> Exception:
-    """``error`` if it survives pickling, else a :class:`RuntimeError` with its type's name and text.
+class TaskRaised(RuntimeError):
+    """What a case's task raised, carried out of the worker as its type's name and text.
 
     An exception leaves a worker process pickled; one that cannot be rebuilt from its pickle (a
-    task's own class whose constructor takes other arguments than its ``args``) breaks a local
-    pool's result thread, and the pool would be started again for the same case without end.
+    task's own class whose constructor takes other arguments than its ``args``) would break a local
+    pool's result thread, and the pool would be started again for the same case without end. This
+    class always pickles, and tells the sweep that the task raised (a deterministic outcome: the
+    case is ``crashed`` at once, not run again as after a worker's death).
 
     Parameters
     ----------
-    error : Exception
-        What a task raised.
-
-    Returns
-    -------
-    Exception
-        ``error`` itself, or a picklable stand-in naming it.
+    text : str
+        ``"TYPE: TEXT"`` of the exception the task raised (cut at 1000 characters).
     """
-    try:
-        pickle.loads(pickle.dumps(error))
-    except Exception:
-        return RuntimeError(f"{type(error).__name__}: {error} (raised by the task; its exception cannot be pickled)")
-    return error
 
 
 _PLUGINS_LOADED = False
