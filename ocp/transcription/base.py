@@ -473,7 +473,7 @@ class Transcription(ABC):
         interval = self.interval(problem)
         ns0, nc = interval.n_state, interval.n_interval
         ns = ns0 + (1 if problem.free_time else 0)
-        stages = assemble(self, problem, interval)
+        stages = assemble(self, problem, interval, expand=solver != "fatrop")  # FATROP takes no derivatives
         zero_gap = np.zeros(ns)
         stage_low = np.concatenate([zero_gap, interval.path_lower])
         stage_high = np.concatenate([zero_gap, interval.path_upper])
