@@ -114,9 +114,23 @@ def test_default_minimum_time_still_reaches_bilimoria_and_wie_with_consistent_se
     assert reference.duration == pytest.approx(3.2431, abs=1e-4)
     seeds = reference.stats["seeds"]
     consistent(seeds)
-    # the perturbed eigenaxis start and the spin extremal's both reach it: they agree (spin_extremal
-    # refuses a fixed final rate as a row, but its start frees it: Planner.start_error)
-    assert seeds["tried"] == seeds["agreed"] == 2
+    # Both the perturbed eigenaxis start and the spin extremal's are tried (spin_extremal refuses a
+    # fixed final rate as a row, but its start frees it: Planner.start_error). Where the spin
+    # extremal's start ends depends on the host: it lies on a basin boundary of the 8-interval mesh,
+    # where rounding in its seed decides. It reached the eigenaxis start's 3.24349 in 20 iterations
+    # (2 of 2 agreed) on hosts up to 2026-12-04, and another local minimum, 3.28326, in 24 on an
+    # AVX-512 host where NumPy dispatches its AVX-512 kernels (the same host with
+    # NPY_DISABLE_CPU_FEATURES="X86_V4 AVX512_ICL AVX512_SPR": 3.24349 again). The row's
+    # optimum is the same either way; the count of agreeing seeds is evidence that says so.
+    assert seeds["tried"] == 2
+    coarse = reference.stats["coarse"]["starts"]
+    assert len(coarse) == 2 and all(start["converged"] for start in coarse)
+    best = min(start["f"] for start in coarse)
+    assert best == pytest.approx(3.243487505, rel=1e-8)  # the 8-interval mesh's optimum
+    agreeing = sum(abs(start["f"] - best) <= 1e-6 * best for start in coarse)
+    assert seeds["agreed"] == agreeing
+    assert all(abs(start["f"] - best) <= 1e-6 * best or start["f"] == pytest.approx(3.283261735, rel=1e-6)
+               for start in coarse)
 
 
 def test_auto_seeds_only_planners_that_accept_the_problem():

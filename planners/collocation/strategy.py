@@ -125,7 +125,8 @@ XTE. With 0.05 instead: 944 coarse iterations, mt17 at 10.22393 too. Side by sid
 before, 0.89x acados [0.88..0.92] against 1.03x [1.00..1.07] (acados with HPIPM's default QP
 cap; given the cap 8 and the QP warm start, 1.71x: ``tests/benchmarks/test_bench_min_time.py``).
 (At stop 51, with the growth factor 8, the same pushes sent the spin-extremal seed of Bilimoria & Wie to another coarse minimum, 3.28326
-against 3.24349; with 2.5 both seeds end at 3.24349.) ``alpha_for_y`` ``min-dual-infeas`` (104
+against 3.24349; with 2.5 both seeds end at 3.24349, except on an AVX-512 host where NumPy's AVX-512 kernels move the
+spin-extremal seed's rounding: 3.28326 there, 2026-12-04, ``tests/test_collocation_seeds.py``.) ``alpha_for_y`` ``min-dual-infeas`` (104
 factorizations) also reaches mt17's lower minimum; not measured further."""
 
 TRANSFER_MAX_INTERVALS = 150
