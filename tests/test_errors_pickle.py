@@ -144,6 +144,11 @@ def users_own_error_task(payload):
     raise UsersOwnError("the user's task", 42)
 
 
+def memory_error_task(payload):
+    """A sweep's task whose worker runs out of memory: the worker's fault, not the case's."""
+    raise MemoryError("cannot allocate 80 GiB")
+
+
 SWEEP_SCRIPT = textwrap.dedent("""
     import sys
 
@@ -161,7 +166,7 @@ SWEEP_SCRIPT = textwrap.dedent("""
             for record in results.records.values():
                 print(name, "| attempts |", record["attempts"], flush=True)
 """)
-RAISING_TASKS = ("scenario_error_task", "users_own_error_task")
+RAISING_TASKS = ("scenario_error_task", "users_own_error_task", "memory_error_task")
 
 
 @pytest.fixture(scope="module")
@@ -197,6 +202,31 @@ def test_a_local_sweep_whose_task_raises_shows_the_error_s_message_and_ends(rais
     for status, message in planned:
         assert status == "crashed"
         assert message.startswith(expected) and "worker died" not in message, message
+
+
+def test_a_task_that_runs_out_of_memory_runs_again_as_after_a_worker_s_death(raising_sweeps):
+    """A ``MemoryError`` (like an ``ImportError`` on one worker of a mixed cluster) says the worker
+    failed the case, not the case itself: it runs again, ``execution.retries`` times (1 by default),
+    before its rows are crashed with what it raised and its attempts (one attempt before, as any
+    exception a task raises)."""
+    completed, rows = raising_sweeps
+    assert completed.returncode == 0, completed.stderr
+    assert [message for status, message in rows["memory_error_task"] if status == "attempts"] == ["2"]
+    planned = [(status, message) for status, message in rows["memory_error_task"] if status != "attempts"]
+    assert len(planned) == 2
+    for status, message in planned:
+        assert status == "crashed"
+        assert message == "its task raised MemoryError: cannot allocate 80 GiB; 2 attempt(s)", message
+
+
+@pytest.mark.parametrize("error, fault", [
+    (MemoryError(), True), (ModuleNotFoundError("No module named 'ppigrf'"), True), (ImportError("x"), True),
+    (OSError(28, "No space left on device"), True), (OSError(24, "Too many open files"), True),
+    (FileNotFoundError(2, "No such file", "igrf.shc"), False), (ValueError("x"), False),
+    (ScenarioError("maneuver.duration", "must be > 0, got -1"), False), (RuntimeError("x"), False)])
+def test_a_worker_fault_is_told_from_the_case_s_own_error(error, fault):
+    from scenarios.study.worker import worker_fault
+    assert worker_fault(error) is fault
 
 
 def test_a_dask_worker_s_error_reaches_the_client_as_itself():

@@ -530,8 +530,8 @@ EXECUTION = Section((
            "text or null", _scheduler, default=None),
     number("case_timeout_s", "Wall time after which a case is stopped and becomes a ``crashed`` row.", unit="s",
            default=600.0, positive=True, maximum=MAX_CASE_TIMEOUT_S),
-    custom("retries", "How many times a case whose worker died is run again.", "integer", _retries, default=1,
-           bounds="0 to 10"),
+    custom("retries", "How many times a case whose worker died, or failed it (out of memory, a module missing), "
+           "is run again.", "integer", _retries, default=1, bounds="0 to 10"),
 ), "How the cases run.")
 
 

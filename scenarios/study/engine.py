@@ -3,7 +3,9 @@
 by address; finished cases go to the crash-safe store as they arrive.
 
 A case that raises or exceeds ``case_timeout_s`` is a ``crashed`` row and the sweep goes on. A
-case whose worker died is retried ``retries`` times (its stored ``attempts`` counts every start).
+case whose worker died is retried ``retries`` times (its stored ``attempts`` counts every start), and
+so is one whose task raised what says the worker failed it
+(:func:`scenarios.study.worker.worker_fault`: out of memory, a module missing on that worker).
 On a local pool each worker writes the case it runs and when it started it into a shared slot
 table (:func:`scenarios.study.worker.tracked_case`), so a worker's death is charged to the case
 that worker was running, never to a case that was only queued; when the pool cannot tell (several
@@ -61,6 +63,7 @@ from scenarios.study.worker import (
     PRELOAD,
     SLOT_FIELDS,
     TaskRaised,
+    WorkerFault,
     crashed_rows,
     run_case,
     run_chunk,
@@ -649,12 +652,13 @@ class _Engine:
     def _crash(self, key: str, message: str, batch: list) -> None:
         self._record(key, "crashed", crashed_rows(self.cases[key].scenario, message), None, batch)
 
-    def _charge(self, key: str, deaths: int, why: str, batch: list) -> None:
-        """Charge ``deaths`` worker deaths to ``key``: crashed past ``retries``, else run again."""
+    def _charge(self, key: str, deaths: int, why: str, batch: list, died: bool = True) -> None:
+        """Charge ``deaths`` worker deaths (``died``) or worker faults (``why`` says which) to
+        ``key``: crashed past ``retries``, else run again."""
         self.deaths[key] += deaths
         self.shared.pop(key, None)
         if self.deaths[key] > self.study.execution.retries:
-            self._crash(key, f"worker died ({why}); {self.starts[key]} attempt(s)", batch)
+            self._crash(key, f"{f'worker died ({why})' if died else why}; {self.starts[key]} attempt(s)", batch)
         else:
             self.pending.appendleft(key)
 
@@ -687,6 +691,8 @@ class _Engine:
             except Exception as error:  # the task raised, or a lost worker on a cluster (dask's KilledWorker, ...)
                 if len(entry.keys) > 1:  # a chunk: each of its cases again, one per task
                     self.singles.extend(entry.keys)
+                elif isinstance(error, WorkerFault):  # the worker failed it (its memory, a module): again
+                    self._charge(entry.keys[0], 1, f"its task raised {error}", batch, died=False)
                 elif isinstance(error, TaskRaised):  # deterministic: crashed at once, not run again
                     self._crash(entry.keys[0], f"its task raised {error}", batch)
                 else:

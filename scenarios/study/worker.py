@@ -16,6 +16,7 @@ with the sweep (:func:`start_local_worker`, :data:`PARENT_ENVIRONMENT`).
 """
 from __future__ import annotations
 
+import errno
 import functools
 import os
 import signal
@@ -163,7 +164,8 @@ def run_chunk(task: Callable[[dict[str, Any]], dict[str, Any]], payloads: list[d
             result = dict(tracked_case(task, payload))
         except Exception as error:
             text = f"{type(error).__name__}: {error}"
-            raise TaskRaised(text if len(text) <= 1000 else f"{text[:1000]}... (cut)") from None
+            text = text if len(text) <= 1000 else f"{text[:1000]}... (cut)"
+            raise (WorkerFault if worker_fault(error) else TaskRaised)(text) from None
         result["rows_json"] = encode_rows(result.pop("rows"))  # the store's text, made here in parallel
         results.append(result)
     return results
@@ -183,6 +185,40 @@ class TaskRaised(RuntimeError):
     text : str
         ``"TYPE: TEXT"`` of the exception the task raised (cut at 1000 characters).
     """
+
+
+class WorkerFault(TaskRaised):
+    """What a case's task raised where the worker, not the case, failed (:func:`worker_fault`): the
+    case runs again, as after a worker's death, up to ``execution.retries`` times.
+
+    Parameters
+    ----------
+    text : str
+        ``"TYPE: TEXT"`` of the exception the task raised (cut at 1000 characters).
+    """
+
+
+RESOURCE_ERRNOS = frozenset({errno.ENOMEM, errno.ENOSPC, errno.EMFILE, errno.ENFILE, errno.EAGAIN})
+"""``OSError`` numbers of a worker's exhausted resources (memory, disk, file handles, processes)."""
+
+
+def worker_fault(error: BaseException) -> bool:
+    """Whether an exception a case's task raised says that its worker failed it rather than the case
+    itself: a ``MemoryError`` (the worker's memory, which another attempt, or another worker, may
+    have), an ``ImportError`` (a module missing on one worker of a mixed cluster) or an ``OSError``
+    of an exhausted resource (:data:`RESOURCE_ERRNOS`). Any other exception is the case's outcome.
+
+    Parameters
+    ----------
+    error : BaseException
+        What the task raised.
+
+    Returns
+    -------
+    bool
+    """
+    return isinstance(error, (MemoryError, ImportError)) or (
+        isinstance(error, OSError) and error.errno in RESOURCE_ERRNOS)
 
 
 _PLUGINS_LOADED = False
