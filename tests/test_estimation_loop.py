@@ -235,3 +235,16 @@ def test_the_star_tracker_has_one_boresight(tmp_path):
     status, error = validate(tmp_path, _with_declared_tracker([1.0, 0.0, 0.0], [0.0, 0.0, 1.0]))
     assert status == 2, error
     assert "simulation.sensors.star_tracker.boresight" in error and "90 deg" in error and "Traceback" not in error
+
+
+def test_python_and_interpreted_loops_agree_on_a_shortened_last_sample(example):
+    """A run that ends 0.4 of a sample after a sample time: the last hold is shorter, and both
+    paths hand the sensors its own length (their state after it, too, agrees)."""
+    scenario, reference = example
+    sensors = scenario.simulation.sensors
+    sample_time = scenario.simulation.sample_time
+    duration = (np.floor(reference.duration / sample_time) + 0.4) * sample_time
+    python = run(scenario, reference, sensors, duration=duration, python_loop=True)
+    interpreted = run(scenario, reference, sensors, duration=duration)
+    assert python.t[-1] - python.t[-2] == pytest.approx(0.4 * sample_time)
+    assert_same(python, interpreted)

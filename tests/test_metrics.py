@@ -107,6 +107,15 @@ def test_star_tracker_blinding_by_hand():
     assert none["star_tracker_blinded_s"] is None and none["star_tracker_blinded_updates"] is None
 
 
+def test_star_tracker_blinded_time_adds_each_blinded_samples_own_length():
+    """Samples 1 s, 1.5 s, 0.5 s, 2 s long, blinded at t_0, t_2 and t_3: 1 + 0.5 + 2 = 3.5 s (not
+    three samples of the first's length, 3 s)."""
+    t = np.array([0.0, 1.0, 2.5, 3.0, 5.0])
+    metrics = compute_metrics(t, np.tile(quat.IDENTITY, (5, 1)), np.zeros((5, 3)), np.zeros((4, 3)), None,
+                              blinded=[True, False, True, True])
+    assert metrics["star_tracker_blinded_s"] == 3.5 and metrics["star_tracker_blinded_updates"] == 3
+
+
 def test_zero_order_hold_integrals(metrics):
     """The integrals of the body torque: HELD less ω × A h_w at the start of each sample; only the
     first sample turns, ω = [0.02, 0, 0] with h_w = [0, 0.1, 0] on body-axis wheels: ω × A h_w =
@@ -146,6 +155,18 @@ def test_tracking_errors(metrics):
     assert metrics["max_error_deg"] == pytest.approx(3.0, rel=1e-9)
 
 
+def test_max_tracking_error_counts_the_last_sample():
+    """Tracking errors 0.5, 1.0, 2.5 deg about y, the largest at the last sample: max 2.5 deg,
+    RMS √((0.25 + 1 + 6.25) / 3) deg."""
+    t = np.array([0.0, 1.0, 2.0])
+    q = np.stack([quat.from_axis_angle(Z, a) for a in (0.0, 0.1, 0.2)])
+    reference = np.stack([quat.product(q[k], quat.from_axis_angle(np.array([0, 1.0, 0]), np.deg2rad(e)))
+                          for k, e in enumerate((0.5, 1.0, 2.5))])
+    metrics = compute_metrics(t, q, np.zeros((3, 3)), np.zeros((2, 3)), None, reference_q=reference)
+    assert metrics["max_error_deg"] == pytest.approx(2.5, rel=1e-9)
+    assert metrics["rms_error_deg"] == pytest.approx(math.sqrt(7.5 / 3), rel=1e-9)
+
+
 def test_body_and_wheel_torques_by_hand():
     """Two wheels on x and y holding momentum: the body torque, of the peak and the integrals, is
     the applied actuator torque less ω × A h_w at the start of each sample, the wheel torque the
@@ -177,6 +198,25 @@ def test_actuator_metrics_and_passed_values(metrics):
     assert metrics["peak_wheel_momentum"] == pytest.approx(0.35)  # |−0.35|
     assert metrics["plan_time_s"] == 0.25 and metrics["duration_s"] == 4.5
     assert metrics["initial_rate_error"] is None  # closed loop: the reference metric
+
+
+class RampRate(Reference):
+    """ω(t) = [0.1 + 0.5 t, 0, 0] on [0, 2] s (the torque does not matter here)."""
+
+    def __init__(self) -> None:
+        super().__init__("hand", 2.0, np.eye(3))
+
+    def _evaluate(self, t: np.ndarray) -> ReferenceSample:
+        omega = np.stack([0.1 + 0.5 * t, np.zeros_like(t), np.zeros_like(t)], axis=-1)
+        zeros = np.zeros((t.size, 3))
+        return ReferenceSample(np.tile(quat.IDENTITY, (t.size, 1)), omega, zeros, zeros)
+
+
+def test_initial_rate_error_is_taken_at_t0():
+    """ω(0) = [0.1, 0, 0] against ω0 = [0.1, 0.03, −0.04]: ‖[0, −0.03, 0.04]‖ = 0.05, whatever the
+    rate does after t = 0 (on 11 samples, ω(0.2 s) = [0.2, 0, 0] would give 0.112)."""
+    metrics = metrics_from_reference(RampRate(), None, None, points=11, initial_omega=np.array([0.1, 0.03, -0.04]))
+    assert metrics["initial_rate_error"] == pytest.approx(0.05, rel=1e-12)
 
 
 class RampTorque(Reference):
@@ -246,3 +286,14 @@ def test_energy_ratio_is_null_for_a_start_at_rest_up_to_rounding(residue, expect
         assert metrics["energy_ratio"] is None
     else:
         assert metrics["energy_ratio"] == pytest.approx(expected, rel=1e-12)  # ω_T²/ω_0² (same axis)
+
+
+def test_energy_ratio_is_null_for_a_rest_to_rest_motion():
+    """Rounding residue 1e-17 rad/s at both ends of a slew that peaks at 0.05 rad/s: the start is at
+    rest against the motion's largest energy, so the ratio is null (E_T / E_0 would divide two
+    rounding errors, here 1.0), whatever the energy at the end."""
+    t = np.linspace(0.0, 4.0, 5)
+    omega = np.array([[1e-17, 0, 0], [0.02, 0, 0], [0.05, 0, 0], [0.02, 0, 0], [1e-17, 0, 0]])
+    metrics = compute_metrics(t, np.tile(quat.IDENTITY, (5, 1)), omega, np.zeros((4, 3)), None,
+                              inertia=np.diag([2.0, 3.0, 4.0]))
+    assert metrics["energy_ratio"] is None

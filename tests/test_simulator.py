@@ -97,6 +97,27 @@ def test_sensor_noise_is_seeded_and_has_the_requested_spread():
     assert np.std(angle_errors) == pytest.approx(np.deg2rad(0.1), rel=0.1)
 
 
+def test_magnetometer_noise_is_independent_of_the_attitude_noise():
+    """The magnetometer draws from its own stream: over 400 samples its errors are uncorrelated with
+    the attitude noise's rotation vectors (each sample correlation within 0.25, five standard
+    deviations of 1/√400), and have the requested spread. Drawn from one seed, the two would repeat
+    the same normals (correlation 1)."""
+    model = saturating_model()
+    x0 = np.r_[quat.IDENTITY, 0.01, 0.0, 0.0, 0, 0, 0]
+
+    def seen(noise):
+        controller = GreedyController()
+        Simulator(model, 1.0).run(controller, x0, 400.0, noise=noise)
+        return controller.seen
+
+    noisy, truth = seen(SensorNoise(attitude_std=1e-3, seed=3, field_std=1e-7)), seen(None)
+    field_errors = np.array([m.field_body - t.field_body for m, t in zip(noisy, truth)])
+    angle_errors = np.array([quat.to_rotation_vector(quat.error(m.q, t.q)) for m, t in zip(noisy, truth)])
+    assert np.std(field_errors) == pytest.approx(1e-7, rel=0.1)
+    correlation = np.corrcoef(field_errors.T, angle_errors.T)[0:3, 3:6]
+    assert np.max(np.abs(correlation)) < 0.25
+
+
 def test_pd_regulation_converges_and_integrators_agree():
     spacecraft = Spacecraft([2.0, 3.0, 4.0], wheels=ReactionWheels.from_body_axes(max_torque=0.5))
     model = AttitudeModel(spacecraft)
