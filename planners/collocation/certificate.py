@@ -88,6 +88,13 @@ not 16); the switch times within 2e-9 of ``T``. Both are far from the error's as
 correction is large: above 1e-7 of ``T``, 24 steps and more."""
 SHOOTING_MAX_STEPS = 96
 """Most RK4 steps per arc :data:`SHOOTING_RICHARDSON` doubles them to."""
+SHOOTING_MAX_SWITCHES = 8
+"""Most switches :func:`time_error` shoots: a solution whose switching functions change sign more
+often is skipped (``skipped``). The minimum times of ``tests/benchmarks/iteration_counts.py`` (rigid
+bodies with torquers) have 4 to 8, the shot ones 5 or 6; with three reaction wheels some slews have
+10 to 14 on the 8-interval mesh, where the shooting neither converged nor certified and its Newton
+iterations over many arcs (a Hessian of the miss in every switch time, built per arc count) took a
+plan from 172 to 1079 ms (2026-12-04)."""
 
 
 def radau_points(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array,
@@ -526,7 +533,8 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
     Parameters
     ----------
     transcription, model, nlp, w
-        As in :func:`radau_points` (a free final time, a rigid body: ``nx`` 7).
+        As in :func:`radau_points` (a free final time; a rigid body, ``nx`` 7, or with reaction wheels,
+        their momenta the states after the rate, free at the end).
     lbx, ubx : (n_w,) ndarray
         The decision vector's bounds (the controls' bounds are read there).
     params : ndarray
@@ -561,9 +569,11 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
     T = float(np.asarray(w, dtype=float)[nlp.n_stage_state - 1])
     # the boundary conditions as given (the solution meets them to the solver's tolerance)
     params = np.asarray(params, dtype=float)
-    x0, xf = params[:nx], params[nx:nx + 7]
+    x0, xf = params[:nx], np.concatenate([params[nx:nx + 7], np.zeros(nx - 7)])  # final wheel momenta free
     # the roots of σ, linear between consecutive points, and which control each switches
     times, owner, first = _switch_times(t, sigma, low, high)
+    if len(times) > SHOOTING_MAX_SWITCHES:
+        return {"skipped": f"{len(times)} switches, more than the shooting takes ({SHOOTING_MAX_SWITCHES})"}
     conditions = 6 if fixed_rate else 3
     z, roots = np.append(times, T), np.append(times, T)
     ident = np.arange(len(times))  # each switch's identity, kept through the removals and sorts
@@ -880,11 +890,13 @@ def bang_bang_certificate(model: AttitudeModel, x0: Array, xf: Array, disturbanc
     Parameters
     ----------
     model : AttitudeModel
-        A rigid body (``nx`` 7: quaternion scalar first, body rate [rad/s]).
-    x0 : (7,) ndarray
+        A rigid body (quaternion scalar first, body rate [rad/s]), with torquers or reaction wheels
+        (their momenta [N m s] the states after the rate, ``nx`` 7 + wheels).
+    x0 : (nx,) ndarray
         The initial state.
-    xf : (7,) ndarray
-        The final attitude and rate ``[q_f, ω_f]`` (the rate only with ``fixed_rate``).
+    xf : (nx,) ndarray
+        The final attitude and rate ``[q_f, ω_f]`` first (the rate only with ``fixed_rate``); the
+        wheel momenta are free at the end (their entries are not read).
     disturbance : (3,) ndarray
         Constant disturbance torque [N m], body frame.
     switch_times : (arcs − 1,) ndarray

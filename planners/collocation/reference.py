@@ -736,7 +736,7 @@ def bang_bang_solution(model: AttitudeModel, transcription: Transcription, x0: A
     Parameters
     ----------
     model : AttitudeModel
-        The spacecraft model (no actuator states).
+        The spacecraft model (torquers, or reaction wheels whose momenta it integrates too).
     transcription : Transcription
         Radau collocation (``tau``, ``degree``) on a mesh with a node at every switch
         (:func:`switch_mesh`).
