@@ -219,6 +219,64 @@ def test_a_task_that_runs_out_of_memory_runs_again_as_after_a_worker_s_death(rai
         assert message == "its task raised MemoryError: cannot allocate 80 GiB; 2 attempt(s)", message
 
 
+def raises_at_sixty_task(payload):
+    """A sweep's task that runs a case, but raises where its duration is 60 s: a MemoryError (the
+    worker's fault) or, in a study named ``deterministic``, a ScenarioError (the case's own)."""
+    from scenarios.study.worker import run_case
+    if payload["scenario"]["maneuver"]["duration"] == 60.0:
+        if payload["scenario"]["name"].startswith("deterministic"):
+            raise ScenarioError("maneuver.duration", "must not be 60", "a.yaml")
+        raise MemoryError("cannot allocate 80 GiB")
+    return run_case(payload)
+
+
+CHUNK_SCRIPT = textwrap.dedent("""
+    import copy
+    import sys
+
+    from scenarios.study.engine import sweep
+    from scenarios.study.spec import parse_study
+    from tests import test_errors_pickle
+    from tests.test_sweep import BASE
+
+    if __name__ == "__main__":
+        for name, retries in (("memory", 0), ("memory", 1), ("deterministic", 1)):
+            scenario = {**copy.deepcopy(BASE), "name": name}
+            study = {"study": name, "scenario": scenario, "execution": {"retries": retries},
+                     "grid": {"maneuver.duration": [30.0 + k for k in range(40)]}}
+            results = sweep(parse_study(study), workers=2, task=test_errors_pickle.raises_at_sixty_task)
+            for record in results.records.values():
+                row = record["rows"][0]
+                print(name, retries, "|", row["status"], "|", record["attempts"], "|", row["message"], flush=True)
+""")
+
+
+def test_a_chunk_s_raising_case_is_charged_alone_and_runs_retries_times():
+    """40 cheap cases go several to a task: the case whose task raised is known by its key, so a
+    worker fault is charged to it alone (run ``retries`` + 1 times in all; a chunk that raised was
+    not counted before, and the case ran twice with ``retries: 0``, 4 times with 1) and the case's
+    own error crashes it at once (it ran again, alone, after its chunk raised)."""
+    environment = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
+    completed = subprocess.run([sys.executable, "-c", CHUNK_SCRIPT], cwd=ROOT, env=environment,
+                               capture_output=True, text=True, timeout=300)
+    assert completed.returncode == 0, completed.stderr
+    runs: dict[tuple[str, str], list[tuple[str, int, str]]] = {}
+    for line in completed.stdout.splitlines():
+        study, status, attempts, message = line.split(" | ", 3)
+        runs.setdefault(tuple(study.split()), []).append((status, int(attempts), message))
+    for (name, retries), expected in ((("memory", "0"), (1, "its task raised MemoryError: cannot allocate 80 GiB; "
+                                                            "1 attempt(s)")),
+                                      (("memory", "1"), (2, "its task raised MemoryError: cannot allocate 80 GiB; "
+                                                            "2 attempt(s)")),
+                                      (("deterministic", "1"), (1, "its task raised ScenarioError: a.yaml: "
+                                                                   "maneuver.duration: must not be 60"))):
+        rows = runs[(name, retries)]
+        assert len(rows) == 40
+        crashed = [(attempts, message) for status, attempts, message in rows if status == "crashed"]
+        assert crashed == [expected], (name, retries, crashed)
+        assert all(status == "ok" for status, _, _ in rows if status != "crashed")
+
+
 @pytest.mark.parametrize("error, fault", [
     (MemoryError(), True), (ModuleNotFoundError("No module named 'ppigrf'"), True), (ImportError("x"), True),
     (OSError(28, "No space left on device"), True), (OSError(24, "Too many open files"), True),

@@ -662,6 +662,14 @@ class _Engine:
         else:
             self.pending.appendleft(key)
 
+    def _raised(self, key: str, error: TaskRaised, batch: list) -> None:
+        """What ``key``'s task raised: a worker fault charged as a death (run again up to
+        ``retries`` times), anything else crashed at once, not run again (deterministic)."""
+        if isinstance(error, WorkerFault):
+            self._charge(key, 1, f"its task raised {error}", batch, died=False)
+        else:
+            self._crash(key, f"its task raised {error}", batch)
+
     def _result(self, key: str, result: dict[str, Any], batch: list) -> None:
         self.worker_builds[result["worker"]] = result["cache_builds"]
         text = result.get("rows_json")
@@ -689,12 +697,19 @@ class _Engine:
                         self._charge(key, 1, "its process ended abruptly", batch)
                 continue
             except Exception as error:  # the task raised, or a lost worker on a cluster (dask's KilledWorker, ...)
-                if len(entry.keys) > 1:  # a chunk: each of its cases again, one per task
+                raised = error.key if isinstance(error, TaskRaised) and error.key in entry.keys else None
+                if len(entry.keys) > 1 and raised is not None:  # a chunk, and whose task raised is known
+                    # the cases it finished before (their results lost with the chunk's) again, one per
+                    # task; those after it were never started
+                    at = entry.keys.index(raised)
+                    for key in entry.keys[at + 1:]:
+                        self.starts[key] -= 1
+                    self.singles.extend(key for key in entry.keys if key != raised)
+                    self._raised(raised, error, batch)
+                elif len(entry.keys) > 1:  # a chunk: each of its cases again, one per task
                     self.singles.extend(entry.keys)
-                elif isinstance(error, WorkerFault):  # the worker failed it (its memory, a module): again
-                    self._charge(entry.keys[0], 1, f"its task raised {error}", batch, died=False)
-                elif isinstance(error, TaskRaised):  # deterministic: crashed at once, not run again
-                    self._crash(entry.keys[0], f"its task raised {error}", batch)
+                elif isinstance(error, TaskRaised):
+                    self._raised(entry.keys[0], error, batch)
                 else:
                     self._charge(entry.keys[0], 1, excerpt(f"{type(error).__name__}: {error}", 300), batch)
                 continue

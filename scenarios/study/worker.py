@@ -165,7 +165,7 @@ def run_chunk(task: Callable[[dict[str, Any]], dict[str, Any]], payloads: list[d
         except Exception as error:
             text = f"{type(error).__name__}: {error}"
             text = text if len(text) <= 1000 else f"{text[:1000]}... (cut)"
-            raise (WorkerFault if worker_fault(error) else TaskRaised)(text) from None
+            raise (WorkerFault if worker_fault(error) else TaskRaised)(text, payload.get("key")) from None
         result["rows_json"] = encode_rows(result.pop("rows"))  # the store's text, made here in parallel
         results.append(result)
     return results
@@ -184,7 +184,16 @@ class TaskRaised(RuntimeError):
     ----------
     text : str
         ``"TYPE: TEXT"`` of the exception the task raised (cut at 1000 characters).
+    key : str or None
+        The key of the case whose task raised (of the several a chunk runs), if known.
     """
+
+    def __init__(self, text: str, key: str | None = None) -> None:
+        super().__init__(text, key)  # both in args: the pickle rebuilds them
+        self.text, self.key = text, key
+
+    def __str__(self) -> str:
+        return self.text
 
 
 class WorkerFault(TaskRaised):
@@ -195,6 +204,8 @@ class WorkerFault(TaskRaised):
     ----------
     text : str
         ``"TYPE: TEXT"`` of the exception the task raised (cut at 1000 characters).
+    key : str or None
+        The key of the case whose task raised, if known.
     """
 
 
