@@ -698,7 +698,8 @@ class _Engine:
                 continue
             except Exception as error:  # the task raised, or a lost worker on a cluster (dask's KilledWorker, ...)
                 raised = error.key if isinstance(error, TaskRaised) and error.key in entry.keys else None
-                if len(entry.keys) > 1 and raised is not None:  # a chunk, and whose task raised is known
+                if len(entry.keys) > 1 and isinstance(error, TaskRaised) and raised is not None:
+                    # a chunk, and whose task raised is known
                     # the cases it finished before (their results lost with the chunk's) again, one per
                     # task; those after it were never started
                     at = entry.keys.index(raised)
