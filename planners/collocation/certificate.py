@@ -88,6 +88,10 @@ not 16); the switch times within 2e-9 of ``T``. Both are far from the error's as
 correction is large: above 1e-7 of ``T``, 24 steps and more."""
 SHOOTING_MAX_STEPS = 96
 """Most RK4 steps per arc :data:`SHOOTING_RICHARDSON` doubles them to."""
+STATE_BOUND_ACTIVE = 1e-6
+"""Relative distance of an actuator state from its bound within which :func:`time_error` counts the
+bound active (and does not shoot: a bang-bang trajectory with that state constraint active is not
+the optimum of the bang-bang problem the shooting solves)."""
 SHOOTING_MAX_SWITCHES = 8
 """Most switches :func:`time_error` shoots: a solution whose switching functions change sign more
 often is skipped (``skipped``). The minimum times of ``tests/benchmarks/iteration_counts.py`` (rigid
@@ -95,6 +99,35 @@ bodies with torquers) have 4 to 8, the shot ones 5 or 6; with three reaction whe
 10 to 14 on the 8-interval mesh, where the shooting neither converged nor certified and its Newton
 iterations over many arcs (a Hessian of the miss in every switch time, built per arc count) took a
 plan from 172 to 1079 ms (2026-12-04)."""
+
+
+def bound_excess(values: Array, low: Array, high: Array) -> float:
+    """The largest excess of ``values (points, n)`` over per-column bounds ``low``, ``high`` (``(n,)``,
+    infinite where unbounded), relative to the larger bound's magnitude (absolute where both are zero:
+    a failed wheel): positive outside, ``-inf`` where no column has a finite bound.
+
+    Parameters
+    ----------
+    values : (points, n) ndarray
+        The values, a row per point.
+    low, high : (n,) ndarray
+        Their bounds.
+
+    Returns
+    -------
+    float
+    """
+    scale = np.maximum(np.abs(low), np.abs(high))
+    scale = np.where(scale > 0, scale, 1.0)
+    with np.errstate(invalid="ignore"):
+        excess = np.maximum(values - high, low - values) / scale  # nan where both bounds are infinite
+    return float(np.max(np.nan_to_num(excess, nan=-np.inf), initial=-np.inf))
+
+
+def final_conditions(params: Array, nx: int) -> Array:
+    """The shooting's ``xf (nx,)``: the final attitude and rate ``[q_f, ω_f]`` of an NLP's parameters
+    (after the initial state), the wheel momenta (free at the end, not read) zero."""
+    return np.concatenate([np.asarray(params, dtype=float)[nx:nx + 7], np.zeros(nx - 7)])
 
 
 def radau_points(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, w: Array,
@@ -322,11 +355,7 @@ def start_violations(problem: ManeuverProblem, reference: Reference, bounds: tup
     broken: dict[str, float] = {}
     x_low, x_high, u_low, u_high = bounds
     for name, values, low, high in (("states", x, x_low, x_high), ("controls", u, u_low, u_high)):
-        scale = np.maximum(np.abs(low), np.abs(high))
-        scale = np.where(scale > 0, scale, 1.0)  # a zero bound (a failed wheel): absolute excess
-        with np.errstate(invalid="ignore"):
-            excess = np.maximum(values - high, low - values) / scale  # nan where both bounds are infinite
-        worst = float(np.max(np.nan_to_num(excess, nan=-np.inf), initial=-np.inf))
+        worst = bound_excess(values, low, high)
         if worst > tolerance:
             broken[name] = worst
     if max_rate is not None:
@@ -555,7 +584,8 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
         (tied pairs of switches), ``iterations`` (shooting calls), ``steps_per_arc`` (RK4),
         ``rk4_correction_s`` (``T`` minus the RK4 optimum's [s]) and ``rk4_error`` (the steps' error
         of the final miss there, by step doubling); or ``skipped`` saying why not (controls' bounds
-        that vary, no convergence, switches that change order).
+        that vary, a control held at one value, a wheel's momentum at its bound, more switches than
+        :data:`SHOOTING_MAX_SWITCHES`, no convergence, switches that change order).
     """
     N, d, nx, nu = transcription.intervals, transcription.degree, model.nx, model.nu
     t, _, sigma = functions
@@ -566,10 +596,17 @@ def time_error(transcription: RadauCollocation, model: AttitudeModel, nlp: NLP, 
     low, high = bounds[0][0], bounds[1][0]
     if not all(np.all(b == b[0]) for b in bounds) or not np.all(np.isfinite(low) & np.isfinite(high)):
         return {"skipped": "control bounds that vary along the slew"}
+    if np.any(low == high):  # its switching function's roots are no switches
+        return {"skipped": "a control held at one value (a failed wheel)"}
+    if nx > 7:  # the wheels' momenta: the shooting knows no bound on them
+        states = [np.asarray(b, dtype=float)[:nz * N].reshape(N, nz)[:, nlp.n_stage_state:offset].reshape(N * d, nx)
+                  for b in (w, lbx, ubx)]
+        if bound_excess(states[0][:, 7:], states[1][0, 7:], states[2][0, 7:]) > -STATE_BOUND_ACTIVE:
+            return {"skipped": "a wheel's momentum at its bound (a state constraint active)"}
     T = float(np.asarray(w, dtype=float)[nlp.n_stage_state - 1])
     # the boundary conditions as given (the solution meets them to the solver's tolerance)
     params = np.asarray(params, dtype=float)
-    x0, xf = params[:nx], np.concatenate([params[nx:nx + 7], np.zeros(nx - 7)])  # final wheel momenta free
+    x0, xf = params[:nx], final_conditions(params, nx)
     # the roots of σ, linear between consecutive points, and which control each switches
     times, owner, first = _switch_times(t, sigma, low, high)
     if len(times) > SHOOTING_MAX_SWITCHES:

@@ -78,7 +78,9 @@ from planners.collocation.allocation import (
 from planners.collocation.certificate import (
     SHOOTING_STEPS,
     bang_bang_certificate,
+    bound_excess,
     collocation_certificate,
+    final_conditions,
     start_violations,
     switch_intervals,
     switching_functions,
@@ -392,21 +394,6 @@ class _Optimum:
     switching: tuple | None = None  # switching_functions() of the result, where computed (shared by the certificate)
     exact: CollocationReference | None = None  # the exact bang-bang optimum shot from this coarse one (_bang_bang)
     deferred: Reference | None = None  # the coarse mesh's failure at the time bound, the full mesh not tried (_optimum)
-
-
-def _state_bound_excess(states: Array, low: Array, high: Array) -> float:
-    """How far the actuator states (rows 7 on of ``states (nx, points)``) leave their bounds
-    ``low``, ``high`` (``(nx,)``, infinite where unbounded), relative to the bound: the largest
-    ``(x − high) / |high|`` or ``(low − x) / |low|`` over the points (0 within them, and without actuator
-    states)."""
-    actuator = np.asarray(states, dtype=float)[7:]
-    worst = 0.0
-    for limits, sign in ((np.asarray(high, dtype=float)[7:], 1.0), (np.asarray(low, dtype=float)[7:], -1.0)):
-        finite = np.isfinite(limits) & (limits != 0)
-        if np.any(finite):
-            over = sign * (actuator[finite] - limits[finite, None]) / np.abs(limits[finite, None])
-            worst = max(worst, float(np.max(over)))
-    return worst
 
 
 class CollocationPlanner(Planner):
@@ -943,12 +930,13 @@ class CollocationPlanner(Planner):
         """The estimated discretisation error of a bang-bang minimum time
         (:func:`~planners.collocation.certificate.time_error`) of a converged ``solved``, kept in its
         extra stats as ``time_error`` (its switching functions in ``solved.switching``); ``None``
-        where it does not apply (not plain minimum time on Radau collocation, cones, a rate bound or
-        the allocation's equalities). Reaction wheels' momenta are states of the shooting, free at
-        the end."""
+        where it does not apply (not plain minimum time on Radau collocation, cones, a rate bound,
+        the allocation's equalities, or actuator states other than reaction wheels' momenta, which are
+        states of the shooting, free at the end)."""
         result, transcription = solved.result, solved.transcription
         if (not ocp.free_time or ocp.energy_weight or ocp.l1_weight or ocp.cones or ocp.max_rate is not None
-                or not isinstance(transcription, RadauCollocation) or result.x is None
+                or not isinstance(transcription, RadauCollocation) or ocp.model.nx != 7 + ocp.model.n_wheels
+                or result.x is None
                 or result.lam_g is None or getattr(transcription, "allocation_rows", None) is not None):
             return None
         lbx, ubx = transcription.bounds(ocp, solved.nlp, *self._variable_bounds(problem), problem.duration)
@@ -993,22 +981,21 @@ class CollocationPlanner(Planner):
         arcs = np.asarray(record["controls"], dtype=float)
         bounds = self._variable_bounds(problem)
         tried, agreed = seed_counts(found.stats)
-        final = np.concatenate([params[nx:nx + 7], np.zeros(nx - 7)])  # [q_f, ω_f]; the wheel momenta free
-        certificate = bang_bang_certificate(model, params[:nx], final, params[-3:], switches, arcs, T,
-                                            bounds[2], bounds[3], ocp.fixed_final_rate, seeds=tried,
-                                            seeds_agreed=agreed)
-        if certificate.get("verdict") != "certified":
-            shooting.update(why=f"its certificate: {certificate.get('verdict')}", certificate=certificate)
-            return None
         transcription = coarse.transcription.with_mesh(switch_mesh(switches, T, o.intervals))
         states, controls = bang_bang_solution(model, transcription, params[:nx], switches, arcs, T, params[-3:])
         # The actuators' states within the bounds the NLP imposes (wheel momenta: linear in time on
         # each arc, ḣ = g, so at their largest at the nodes, which hold every switch): the shooting
         # knows no state bound, and where one is active the optimum is not the bang-bang one.
-        excess = _state_bound_excess(states, bounds[0], bounds[1])
+        excess = bound_excess(states[7:].T, bounds[0][7:], bounds[1][7:])
         if excess > REQUIREMENT_TOLERANCE:
             shooting["why"] = (f"its actuator states leave their bounds (by {excess:.2g} of the largest; a wheel's "
                                f"momentum bound is active at the optimum)")
+            return None
+        certificate = bang_bang_certificate(model, params[:nx], final_conditions(params, nx), params[-3:], switches,
+                                            arcs, T, bounds[2], bounds[3], ocp.fixed_final_rate, seeds=tried,
+                                            seeds_agreed=agreed)
+        if certificate.get("verdict") != "certified":
+            shooting.update(why=f"its certificate: {certificate.get('verdict')}", certificate=certificate)
             return None
         stats: dict[str, Any] = {key: found.stats[key] for key in ("iterations", "solver_status", "solve_time_s")
                                  if key in found.stats}
