@@ -95,7 +95,9 @@ the optimum of the bang-bang problem the shooting solves)."""
 SHOOTING_MAX_SWITCHES = 8
 """Most switches :func:`time_error` shoots: a solution whose switching functions change sign more
 often is skipped (``skipped``). The minimum times of ``tests/benchmarks/iteration_counts.py`` (rigid
-bodies with torquers) have 4 to 8, the shot ones 5 or 6; with three reaction wheels some slews have
+bodies with torquers) have 4 to 10 at the 8-interval optimum, the shot ones 5 or 6 (mt0's 10 were
+not shot before the cap either: a switch moved by more than a mesh interval; its plan the same);
+with three reaction wheels some slews have
 10 to 14 on the 8-interval mesh, where the shooting neither converged nor certified and its Newton
 iterations over many arcs (a Hessian of the miss in every switch time, built per arc count) took a
 plan from 172 to 1079 ms (2026-12-04)."""
