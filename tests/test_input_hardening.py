@@ -96,6 +96,11 @@ CASES = {
                     "simulation.duration"),
     "huge duration": (set_path(BASE, ("maneuver", "duration"), 1e9), "maneuver.duration"),
     "tiny sample time": (set_path(BASE, ("simulation", "sample_time"), 1e-7), "maneuver.duration"),
+    # one sample (or none) for the whole window: ran, violated, with no word on the sample time
+    "sample time longer than the manoeuvre": (set_path(set_path(BASE, ("simulation", "sample_time"), 30.0),
+                                                       ("simulation", "max_step"), 1.0), "simulation.sample_time"),
+    "sample time longer than the window": (set_path(set_path(BASE, ("simulation", "sample_time"), 5.0),
+                                                    ("simulation", "duration"), 1.0), "simulation.sample_time"),
     "zero quaternion": (set_path(BASE, ("maneuver", "initial", "q"), [0, 0, 0, 0]), "maneuver.initial.q"),
     "empty name": (set_path(BASE, ("name",), ""), "name"),
 }

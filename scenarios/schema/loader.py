@@ -411,7 +411,8 @@ SENSOR_NOISE = Section((
 ), "Measurement noise, white and Gaussian.")
 
 SIMULATION = Section((
-    number("sample_time", "Zero-order-hold sample time of the controller.", unit="s", default=1.0, positive=True),
+    number("sample_time", "Zero-order-hold sample time of the controller; at most the closed-loop window "
+           "(``simulation.duration``, else ``maneuver.duration``).", unit="s", default=1.0, positive=True),
     number("duration", "Closed-loop window of every row. ``null`` (the default): each row runs for "
            "``maneuver.duration`` (every planner's slew ends within it), a row without a planner too. After its duration a "
            "reference continues as the torque-free motion of its final state.", unit="s", default=None,
