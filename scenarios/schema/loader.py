@@ -18,6 +18,7 @@ import copy
 import dataclasses
 import datetime
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -702,12 +703,18 @@ def load(path: str | Path) -> Scenario:
         The file cannot be read or is not a valid scenario: its :attr:`~scenarios.errors.ScenarioError.file`
         is ``path``, its text names the file and the YAML path (``FILE: name: required key is
         missing``); a study or slew-table file names the command that runs it.
+    TypeError
+        ``path`` is not a path (a mapping already read goes to :func:`parse_scenario`).
 
     Warns
     -----
     PlausibilityWarning
         One per value that looks like a unit or layout slip, as :func:`parse_scenario`.
     """
+    if not isinstance(path, (str, os.PathLike)):  # as load_study: not pathlib's "expected str, bytes or ..."
+        raise TypeError(f"path must be a str or os.PathLike, got {type(path).__name__}"
+                        + ("; a scenario mapping already read: scenarios.parse_scenario(data)"
+                           if isinstance(path, dict) else ""))
     try:
         data = read_yaml(path)
         if isinstance(data, dict):
