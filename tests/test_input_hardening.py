@@ -146,6 +146,27 @@ def test_duplicate_keys_name_both_places(tmp_path):
     assert status == 2 and "maneuver.duration: duplicate key (lines 4 and 5); " in error, error
 
 
+@pytest.mark.parametrize("written, line, words", [
+    # a zero-padded duration and angle: ran as 32 s and a 37 deg slew, no word
+    ("maneuver: {duration: 040, initial: {q: [1, 0, 0, 0]}, final: {q: {axis_angle: {axis: [0, 0, 1], "
+     "angle_deg: 90}}}}", 3, "maneuver.duration: 040 (line 3) is read by YAML 1.1 as the octal number 32, not 40; "
+     "write 40 (without the leading zero)"),
+    ("maneuver: {duration: 20, initial: {q: [1, 0, 0, 0]}, final: {q: {axis_angle: {axis: [0, 0, 1], "
+     "angle_deg: 045}}}}", 3, "maneuver.final.q.axis_angle.angle_deg: 045 (line 3) is read by YAML 1.1 as the "
+     "octal number 37, not 45"),
+    # minutes:seconds: ran as 80 s
+    ("maneuver: {duration: 1:20, initial: {q: [1, 0, 0, 0]}, final: {q: [1, 0, 0, 0]}}", 3,
+     "maneuver.duration: 1:20 (line 3) is read by YAML 1.1 as the base-60 number 80; write 80 if that is meant"),
+])
+def test_a_number_yaml_reads_as_another_value_is_refused(written, line, words, tmp_path):
+    text = f"name: padded\nspacecraft: {{inertia: [2, 3, 4]}}\n{written}\nplanners: []\ncontroller: {{name: none}}\n"
+    status, error, _ = run_cli(tmp_path, text)
+    assert status == 2 and words in error and "Traceback" not in error, error
+    padded = text.replace("040", "07").replace("045", "07").replace("1:20", "20")  # 07 is 7 either way
+    status, error, _ = run_cli(tmp_path, padded)
+    assert status == 0, error
+
+
 def test_an_alias_bomb_fails_fast_with_a_short_message(tmp_path):
     lines = ['a0: &a0 ["x", "x", "x", "x", "x", "x", "x", "x", "x", "x"]']
     lines += [f"a{i}: &a{i} [*a{i - 1}, *a{i - 1}, *a{i - 1}, *a{i - 1}, *a{i - 1}, *a{i - 1}, *a{i - 1}, *a{i - 1}, "
