@@ -9,6 +9,7 @@ slewbench must not or cannot write to, 1 for an internal error.
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import signal
 import sys
@@ -738,6 +739,18 @@ def _tolerant_streams() -> None:
             continue
 
 
+_STORAGE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS})
+"""``OSError`` numbers of a file system that refuses a write (full, over quota, file too large,
+read-only): an output error, not a bug."""
+
+
+def _internal_error() -> int:
+    """Report the exception being handled as a bug, with its traceback; the exit status."""
+    traceback.print_exc()
+    print("slewbench: internal error (this is a bug; please report it with the scenario file)", file=sys.stderr)
+    return EXIT_INTERNAL
+
+
 def main(argv: list[str] | None = None, renderer: Any = None) -> int:
     """Run the ``slewbench`` command line.
 
@@ -806,10 +819,18 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         return EXIT_OK
     except KeyboardInterrupt:
         return _interrupted(args)
+    except OSError as error:
+        if error.errno not in _STORAGE_ERRORS:
+            return _internal_error()
+        # the file system refused a write (full, over quota, read-only): not a bug, no traceback; every
+        # writer stages its files and commits them last, so what was being written is discarded
+        named = f" {error.filename}" if error.filename else ""
+        print(f"slewbench: output error: cannot write{named}: {error.strerror}; the files being written were "
+              "discarded (an earlier complete output is kept): free space or choose another location, and run "
+              "again", file=sys.stderr)
+        return EXIT_BAD_OUTPUT
     except Exception:  # noqa: BLE001 (the last resort: any bug is reported as one, with its traceback)
-        traceback.print_exc()
-        print("slewbench: internal error (this is a bug; please report it with the scenario file)", file=sys.stderr)
-        return EXIT_INTERNAL
+        return _internal_error()
     finally:
         for signum, handler in (previous or {}).items():
             signal.signal(signum, handler)
