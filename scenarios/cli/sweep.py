@@ -304,7 +304,8 @@ def _open(out: Path, study: Study) -> tuple[Path, SweepStore]:
         raise
     except (OSError, ValueError, sqlite3.Error) as error:  # sqlite3.Error, or a store of another format
         _undo(Path(out).absolute(), missing, empty)
-        raise OutputError(out, f"cannot start the sweep store: {error}; nothing was left behind") from None
+        raise OutputError(out, f"cannot start the sweep store: {getattr(error, 'strerror', None) or error}; nothing "
+                               "was left behind") from None
     return directory, store
 
 
