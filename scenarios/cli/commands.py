@@ -420,6 +420,14 @@ def _scenario_details(scenario: Scenario) -> list[str]:
         lines.append("requirement actuators: the reference's demand at most 100 % of each actuator limit "
                      "(every scenario's, unstated)")
     lines += [line for line, _ in _before_planning(scenario)]
+    window, budget = scenario.simulation.duration, scenario.problem.duration
+    from planners.capabilities import minimises_time
+    # the rows whose slew takes its time budget (a minimum-time one ends sooner): run says so per row, validate did not
+    cut = [spec.label for spec in scenario.planners if not minimises_time(type(spec.planner), spec.planner.options)]
+    if window is not None and window < budget and cut:
+        lines.append(f"note: simulation.duration ({window:g} s) ends before maneuver.duration ({budget:g} s), the "
+                     f"slew of {', '.join(cut)}: the closed loop stops while it is under way, and its closed-loop "
+                     f"metrics (final error, settling) are those at {window:g} s")
     truth = (scenario.data or {}).get("truth")
     if scenario.truth is not None and isinstance(truth, dict):
         lines.append("truth (the closed loop's plant differs from the design in): "
