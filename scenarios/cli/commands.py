@@ -717,8 +717,15 @@ class Interruption:
 def _interrupted(args: argparse.Namespace) -> int:
     """Say that the command was interrupted, in one line; its exit status
     (:func:`~scenarios.cli.status.interrupted_status`)."""
-    print("slewbench: interrupted; results not written or marked incomplete in the output manifest", file=sys.stderr)
-    return interrupted_status(getattr(args, "command", None))
+    command = getattr(args, "command", None)
+    print("slewbench: interrupted; nothing written" if command in _WRITES_NOTHING else  # as the console says it
+          "slewbench: interrupted; results not written or marked incomplete in the output manifest", file=sys.stderr)
+    return interrupted_status(command)
+
+
+_WRITES_NOTHING = frozenset({"validate", "list", "schema"})
+"""Commands that only print: an interruption has no results to speak of (it said 'results not
+written or marked incomplete in the output manifest')."""
 
 
 def _names(given: str, path: Path) -> bool:
