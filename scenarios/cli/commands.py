@@ -478,7 +478,7 @@ def command_run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else default_output_directory(scenario.name)
     exports = getattr(args, "export", None) or []
     for name in exports:  # before planning: an export the run cannot give is refused first
-        _check_run_export(name, scenario.epoch)
+        _check_run_export(name, scenario.epoch, bool(scenario.planners))
     # before planning: a long run is never lost at the end (a user's file among the run's, or another
     # scenario's run, is refused now); every directory is checked before any is claimed
     check_run_directory(out, scenario.name, run_files(scenario, plots=not args.no_plots))
@@ -531,10 +531,15 @@ def command_run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _check_run_export(name: str, epoch: Any) -> None:
-    """Refuse ``run --export NAME`` for an unknown format, or an AEM of a scenario without an epoch."""
+def _check_run_export(name: str, epoch: Any, planned: bool = True) -> None:
+    """Refuse ``run --export NAME`` for an unknown format, an AEM of a scenario without an epoch, or
+    waypoint files of a scenario without planners (``planned`` False: regulation rows only)."""
     if name not in EXPORT_FORMATS:
         raise ScenarioError("--export", f"{name!r} is not an export format; known: {', '.join(EXPORT_FORMATS)}")
+    if name == "basilisk" and not planned:
+        raise ScenarioError("--export", "`--export basilisk` writes each planner row's reference, and the scenario has "
+                                        "no planner (planners: []: regulation rows, without a reference); nothing "
+                                        "would be exported")
     if name == "aem" and epoch is None:
         raise ScenarioError("epoch", "the scenario has no epoch, so its times are not absolute and its inertial "
                                      "frame is not the GCRF; `--export aem` needs both: give the scenario an `epoch` "
