@@ -216,6 +216,11 @@ def test_a_row_that_solves_another_problem_has_no_gap(tmp_path, capsys):
     (["--problems", "no_such_problem"], "--problems: unknown problem 'no_such_problem'"),
     (["--planners", "no_such_planner"], "--planners: unknown planner or peer 'no_such_planner'"),
     (["--planners", "acados", "--no-peers"], "--planners: names only peers (acados) and --no-peers runs none"),
+    # ran the problem twice: two identical leaderboard rows, counted twice in its medians
+    (["--problems", "bilimoria_wie_45", "bilimoria_wie_45", "--planners", "eigenaxis", "--no-peers"],
+     "--problems: 'bilimoria_wie_45' is given 2 times; give each name once"),
+    (["--problems", "bilimoria_wie_45", "--planners", "eigenaxis", "eigenaxis", "--no-peers"],
+     "--planners: 'eigenaxis' is given 2 times; give each name once"),
 ])
 def test_unknown_names_exit_2_before_anything_is_written(tmp_path, capsys, argv, expected):
     out = tmp_path / "board"

@@ -159,6 +159,12 @@ BAD = {
     "an estimator without a gyro": (("sensors", "gyro"), None, "simulation.estimator"),
     "an outage ending before it starts": (("sensors", "star_tracker", "outages_s"), [[60, 50]],
                                           "simulation.sensors.star_tracker.outages_s[0]"),
+    # R = 0 on an axis and Q = 0: P on that axis is 0 after the first update, the next one divides by
+    # zero: the row failed 'final_knowledge_error_deg = nan', naming no key
+    "a silent star tracker axis and a noise-free gyro": (
+        ("sensors",), {"gyro": {"bias_deg_per_h": [1.0, 0, 0]}, "star_tracker": {"noise_arcsec": [5, 5, 0]}},
+        "simulation.sensors.star_tracker.noise_arcsec: [5.0, 5.0, 0.0] is zero about the sensor's z axis and the "
+        "gyro is noise-free"),
     "the attitude noise twice": (("sensor_noise", "attitude_deg"), 0.01, "simulation.sensor_noise.attitude_deg"),
     "an unknown estimator": (("estimator", "type"), "ukf", "simulation.estimator.type"),
     # the example has no magnetic field model: a magnetometer would measure nothing

@@ -111,6 +111,12 @@ def test_export_in_gps_time(run_directory, tmp_path):
     (["--option", "time_system=GLONASS"], "time_system"),
     (["--option", "colour=red"], "NAME one of time_system"),
     (["--option", "attitude_type=EULER_ANGLE"], "attitude_type"),
+    # the last one silently won
+    (["--option", "object_id=2027-012A", "--option", "object_id=2027-013B"],
+     "--option object_id: given twice ('2027-012A', then '2027-013B')"),
+    # a 5014-character OBJECT_NAME line was written (KVN lines are at most 254 characters, 6.6.1)
+    (["--option", "object_name=" + "x" * 241], "--option object_name: 241 characters"),
+    (["--option", "originator=" + "x" * 300], "expected at most 241, so that the ORIGINATOR line keeps to the 254"),
 ])
 def test_bad_options_exit_2_and_write_nothing(run_directory, tmp_path, capsys, argv, fragment):
     out = tmp_path / "bad"

@@ -96,6 +96,11 @@ CASES = {
                     "simulation.duration"),
     "huge duration": (set_path(BASE, ("maneuver", "duration"), 1e9), "maneuver.duration"),
     "tiny sample time": (set_path(BASE, ("simulation", "sample_time"), 1e-7), "maneuver.duration"),
+    # one sample (or none) for the whole window: ran, violated, with no word on the sample time
+    "sample time longer than the manoeuvre": (set_path(set_path(BASE, ("simulation", "sample_time"), 30.0),
+                                                       ("simulation", "max_step"), 1.0), "simulation.sample_time"),
+    "sample time longer than the window": (set_path(set_path(BASE, ("simulation", "sample_time"), 5.0),
+                                                    ("simulation", "duration"), 1.0), "simulation.sample_time"),
     "zero quaternion": (set_path(BASE, ("maneuver", "initial", "q"), [0, 0, 0, 0]), "maneuver.initial.q"),
     "empty name": (set_path(BASE, ("name",), ""), "name"),
 }
@@ -139,6 +144,27 @@ def test_duplicate_keys_name_both_places(tmp_path):
         """)
     status, error, _ = run_cli(tmp_path, text)
     assert status == 2 and "maneuver.duration: duplicate key (lines 4 and 5); " in error, error
+
+
+@pytest.mark.parametrize("written, line, words", [
+    # a zero-padded duration and angle: ran as 32 s and a 37 deg slew, no word
+    ("maneuver: {duration: 040, initial: {q: [1, 0, 0, 0]}, final: {q: {axis_angle: {axis: [0, 0, 1], "
+     "angle_deg: 90}}}}", 3, "maneuver.duration: 040 (line 3) is read by YAML 1.1 as the octal number 32, not 40; "
+     "write 40 (without the leading zero)"),
+    ("maneuver: {duration: 20, initial: {q: [1, 0, 0, 0]}, final: {q: {axis_angle: {axis: [0, 0, 1], "
+     "angle_deg: 045}}}}", 3, "maneuver.final.q.axis_angle.angle_deg: 045 (line 3) is read by YAML 1.1 as the "
+     "octal number 37, not 45"),
+    # minutes:seconds: ran as 80 s
+    ("maneuver: {duration: 1:20, initial: {q: [1, 0, 0, 0]}, final: {q: [1, 0, 0, 0]}}", 3,
+     "maneuver.duration: 1:20 (line 3) is read by YAML 1.1 as the base-60 number 80; write 80 if that is meant"),
+])
+def test_a_number_yaml_reads_as_another_value_is_refused(written, line, words, tmp_path):
+    text = f"name: padded\nspacecraft: {{inertia: [2, 3, 4]}}\n{written}\nplanners: []\ncontroller: {{name: none}}\n"
+    status, error, _ = run_cli(tmp_path, text)
+    assert status == 2 and words in error and "Traceback" not in error, error
+    padded = text.replace("040", "07").replace("045", "07").replace("1:20", "20")  # 07 is 7 either way
+    status, error, _ = run_cli(tmp_path, padded)
+    assert status == 0, error
 
 
 def test_an_alias_bomb_fails_fast_with_a_short_message(tmp_path):

@@ -240,3 +240,16 @@ def test_shape_polynomial_says_how_to_plan_without_a_rate_bound():
     assert "options {'duration': 'scenario'}" in reason
     assert PLANNERS["shape_polynomial"]({"duration": "scenario", "terms": 1}).plan(slew).ok
     assert PLANNERS["shape_polynomial"]({"terms": 1}).plan(problem(omegaf=np.zeros(3), max_rate=0.05)).ok
+
+
+@pytest.mark.parametrize("argument, words", [
+    (None, "path must be a str or os.PathLike, got NoneType$"),
+    ({"name": "x"}, r"got dict; a scenario mapping already read: scenarios.parse_scenario\(data\)"),
+    (b"scenario.yaml", "got bytes"),
+])
+def test_load_names_a_path_that_is_not_one(argument, words):
+    """``scenarios.load`` raised pathlib's 'expected str, bytes or os.PathLike object, not dict'
+    (and, for bytes, 'argument should be a str object ...'); ``load_study`` names the argument."""
+    import scenarios
+    with pytest.raises(TypeError, match=words):
+        scenarios.load(argument)

@@ -471,3 +471,55 @@ def test_an_interrupted_commit_keeps_every_file_stamped(tmp_path, monkeypatch):
     with pytest.raises(OutputError, match=f"changed since slewbench wrote them \\({edited.name}\\)"):
         commit_outputs(out, staging, kind="run")
     assert edited.read_text() == "the user's"
+
+
+@pytest.mark.parametrize("number", ["ENOSPC", "EDQUOT", "EROFS"])
+def test_a_file_system_that_refuses_a_write_is_an_output_error_not_a_bug(number, tmp_path, monkeypatch, capsys):
+    """A full disk while the outputs were staged: a traceback and 'internal error (this is a bug)',
+    exit 1. Now exit 2 naming the cause, no traceback; the earlier complete output is kept."""
+    import errno
+    out = tmp_path / "out"
+    assert main(["run", str(scenario(tmp_path)), "--out", str(out), "--no-plots"]) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    original = Path.write_text
+
+    def full(self, *args, **kwargs):
+        if self.name == "results.md":
+            raise OSError(getattr(errno, number), os.strerror(getattr(errno, number)))
+        return original(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "write_text", full)
+    capsys.readouterr()
+    assert main(["run", str(scenario(tmp_path)), "--out", str(out), "--no-plots"]) == 2
+    error = capsys.readouterr().err
+    assert error.startswith(f"slewbench: output error: cannot write: {os.strerror(getattr(errno, number))}; the "
+                            "files being written were discarded"), error
+    assert "Traceback" not in error and "bug" not in error
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
+    assert not [p for p in out.iterdir() if p.name.startswith(STAGING_PREFIX)]
+
+
+@pytest.mark.parametrize("command", ["table", "sweep"])
+def test_a_full_disk_at_the_store_is_an_output_error(command, tmp_path, monkeypatch, capsys):
+    """SQLite's 'database or disk is full' opening the store: `table` printed a traceback and
+    'internal error (this is a bug ...)'; `sweep` named it with a stray '[Errno 28]'."""
+    import sqlite3
+
+    def full(*args, **kwargs):
+        error = sqlite3.OperationalError("database or disk is full")
+        error.sqlite_errorcode = 13  # SQLITE_FULL
+        raise error
+
+    monkeypatch.setattr("scenarios.study.store.sqlite3.connect", full)
+    path = scenario(tmp_path)
+    if command == "sweep":
+        study = tmp_path / "study.yaml"
+        study.write_text(yaml.safe_dump({"study": "full", "scenario": path.name,
+                                         "grid": {"controller.options.kp": [0.2, 0.3]}}))
+        argv = ["sweep", str(study), "--workers", "1"]
+    else:
+        argv = ["table", str(path), "--axes", "2", "--grid", "fibonacci", "--angles", "30,90"]
+    assert main([*argv, "--out", str(tmp_path / "out"), "--no-plots"]) == 2
+    error = capsys.readouterr().err
+    assert "cannot open the sweep store" in error and "database or disk is full" in error, error
+    assert "Traceback" not in error and "bug" not in error and "[Errno" not in error, error

@@ -81,6 +81,17 @@ def test_a_rate_bound_in_degrees_per_second_warns(path):
     assert warnings_of(lambda d: d["maneuver"].update(max_rate=loose)) == []
 
 
+def test_a_rate_noise_in_degrees_per_second_warns():
+    """``simulation.sensor_noise.rate`` is rad/s (1 sigma): 2 (deg/s meant) fed the controller 115 deg/s
+    of noise with no word; a gyro-class noise (1e-4 rad/s) and one just under 0.1 rad/s pass."""
+    def noise(value):
+        return lambda d: d.setdefault("simulation", {}).update(sensor_noise={"rate": value, "seed": 1})
+    said = warnings_of(noise(2.0))
+    assert len(said) == 1 and said[0].startswith("simulation.sensor_noise.rate: 2 rad/s is 115 deg/s"), said
+    assert "at or above 0.1 rad/s" in said[0] and "did you mean 0.03491 rad/s (2 deg/s)?" in said[0], said
+    assert warnings_of(noise(1e-4)) == [] and warnings_of(noise(0.099)) == []
+
+
 def test_a_boundary_rate_the_actuators_cannot_reach_warns_and_a_reachable_spin_does_not():
     said = warnings_of(lambda d: d["maneuver"]["initial"].update(omega=[0.0, 0.0, 3.0]))
     assert len(said) == 1 and said[0].startswith("maneuver.initial.omega: [0.0, 0.0, 3.0] rad/s"), said

@@ -362,3 +362,28 @@ def test_a_second_thread_waits_for_the_plugins(tmp_path: Path) -> None:
     done = slewbench([], tmp_path, plugins="./slow_cubic.py", code=code)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "['cubic_slew', 'cubic_slew']", done.stdout
+
+
+@pytest.mark.parametrize("entry, kind", [("scenario.yaml", "a file"), ("{tmp}", "a directory"),
+                                         ("./nowhere/plugin", "a path")])
+def test_an_entry_that_is_a_path_but_not_a_py_file_is_named_as_such(entry: str, kind: str,
+                                                                    monkeypatch: pytest.MonkeyPatch,
+                                                                    tmp_path: Path) -> None:
+    """SLEWBENCH_PLUGINS=scenario.yaml was imported as the module name 'scenario.yaml': 'No module
+    named 'scenario'' and the hint to give ./scenario.py; './nowhere/plugin' gave a TypeError about
+    relative imports. A package directory named without a slash is still a module name."""
+    from scenarios.schema import plugins
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "scenario.yaml").write_text(SCENARIO)
+    text = entry.format(tmp=tmp_path)
+    monkeypatch.setenv(plugins.ENVIRONMENT_VARIABLE, text)
+    with pytest.raises(plugins.PluginError) as error:
+        plugins.load_plugins()
+    assert str(error.value) == (f"plugin SLEWBENCH_PLUGINS entry {text} failed to load: ValueError: {text} is {kind}, "
+                                "not a .py file or a module name: give the path of a .py file or a module "
+                                "importable from sys.path (mypackage.plugins)")
+    (tmp_path / "a_package").mkdir()
+    monkeypatch.setenv(plugins.ENVIRONMENT_VARIABLE, "a_package")
+    with pytest.raises(plugins.PluginError, match="module a_package failed to load: ModuleNotFoundError"):
+        plugins.load_plugins()

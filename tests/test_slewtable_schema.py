@@ -320,3 +320,18 @@ def test_strict_exits_0_when_every_entry_is_ok(folder, capsys):
     assert main(["table", str(path), "--out", str(folder / "out"), "--no-plots", "--strict"]) == 0
     captured = capsys.readouterr()
     assert "2 of 2 entries ok" in captured.out and "--strict" not in captured.err
+
+
+def test_a_study_file_given_to_table_is_named_as_a_study_not_as_a_table(folder, capsys):
+    """``table STUDY`` said '... is a study or table file, not a scenario' although ``table`` takes a
+    table file: it names what the file is and the command that runs it, as ``run`` does."""
+    study = write_table(folder, {"study": "s", "scenario": "box.yaml", "grid": {"maneuver.duration": [5, 10]}},
+                        "study.yaml")
+    assert main(["table", str(study), "--out", str(folder / "out")]) == 2
+    error = capsys.readouterr().err
+    assert f"{study} is a study file, not a scenario: run it with `slewbench sweep {study}`" in error, error
+    assert "table file, not" not in error and not (folder / "out").exists()
+    table = write_table(folder, {"table": {"scenario": "study.yaml"}})
+    with pytest.raises(ScenarioError) as error:
+        parse_table_spec(table)
+    assert error.value.path == "table.scenario" and "study.yaml is a study file, not a scenario" in str(error.value)

@@ -72,6 +72,8 @@ def test_an_independent_key_gets_the_loaders_verdict_from_its_reader(base, path,
     set_path(first, steps, good, path)
     if loader_verdict(first) is not None:
         return  # the study is refused at its first case whatever the value
+    if value == good and isinstance(value, bool) == isinstance(good, bool):
+        return  # the same value twice: a repeat, refused as such (test_a_value_given_twice_is_refused)
     second = copy.deepcopy(data)
     set_path(second, steps, copy.deepcopy(value), path)
     expected = loader_verdict(second)
@@ -276,3 +278,22 @@ def test_an_initial_attitude_error_too_large_to_rotate_by_is_refused_by_its_read
     assert error.value.path == "simulation.initial_attitude_error_deg"
     data["simulation"]["initial_attitude_error_deg"] = [0.0, 0.0, 370.0]  # a turn and 10 deg: accepted
     scenarios.parse_scenario(data)
+
+
+@pytest.mark.parametrize("section, entries, words", [
+    ("grid", {"maneuver.duration": [10, 20, 10.0]}, "grid.maneuver.duration: 10.0 is given twice (values [0] and [2])"),
+    ("grid", {"maneuver.final.q": {"axis_angle": {"axis": [1, 1, 1], "angle_deg": [10, 30, 10]}}},
+     "grid.maneuver.final.q: 10.0 is given twice (values [0] and [2])"),
+    ("zip", {"maneuver.duration": [10, 20, 10], "simulation.sample_time": [0.5, 0.5, 0.5]},
+     "zip.simulation.sample_time: (10, 0.5) is given twice (tuple of the zip's values [0] and [2])"),
+])
+def test_a_value_given_twice_is_refused(section, entries, words):
+    """A grid value (a zip's tuple) given twice ran its cases twice and counted them twice in the
+    summaries and robustness tables, without a word; true is not 1, and a zip that repeats one list's
+    value with another's differing is fine."""
+    data = copy.deepcopy(BASES[0])
+    with pytest.raises(ScenarioError) as error:
+        parse_study({"study": "v", "scenario": data, section: entries})
+    assert str(error.value).startswith(words) and "count twice in the summaries" in str(error.value), error.value
+    parse_study({"study": "v", "scenario": data, "zip": {"maneuver.duration": [10, 20, 10],
+                                                           "simulation.sample_time": [0.5, 0.5, 0.25]}})

@@ -66,3 +66,21 @@ def test_a_report_redrawn_without_plots_names_the_pictures_it_removed(tmp_path, 
     assert not [p for p in out.rglob("*") if p.suffix in (".png", ".html")]
     assert main(["sweep", "--report", str(out), "--no-plots"]) == 0  # nothing more to remove: nothing said
     assert "removed" not in capsys.readouterr().out
+
+
+def test_report_refuses_the_options_it_would_ignore(tmp_path, capsys):
+    """``sweep --report DIR`` redraws DIR in place: beside it, --dry-run ('write nothing'), --out,
+    a study file, --resume, --workers or --scheduler asked for what it does not do, and were
+    ignored (the --dry-run and --out runs rewrote DIR's files): exit 2, DIR untouched."""
+    out = tmp_path / "out"
+    study = _study(tmp_path, values=(0.2, 0.3))
+    assert main(["sweep", str(study), "--out", str(out), "--workers", "1", "--no-plots"]) == 0
+    before = {p: p.stat().st_mtime_ns for p in out.rglob("*")}
+    for extra, named in (([str(study)], "a study file"), (["--dry-run"], "--dry-run"),
+                         (["--out", str(tmp_path / "other")], "--out"), (["--resume"], "--resume"),
+                         (["--workers", "1"], "--workers"), (["--scheduler", "tcp://127.0.0.1:1"], "--scheduler")):
+        capsys.readouterr()
+        assert main(["sweep", "--report", str(out), "--no-plots", *extra]) == 2, extra
+        error = capsys.readouterr().err
+        assert error.startswith("slewbench: error in option: --report: ") and f"does not take {named}" in error, error
+    assert {p: p.stat().st_mtime_ns for p in out.rglob("*")} == before and not (tmp_path / "other").exists()

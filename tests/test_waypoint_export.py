@@ -201,3 +201,32 @@ def test_export_of_a_run_directory_is_each_reference_at_the_controllers_samples(
     assert main(["export", str(out), "--format", "basilisk", "--out", str(tmp_path / "bad"),
                  "--option", "delimiter=."]) == 2
     assert not (tmp_path / "bad").exists()
+
+
+def test_a_run_without_a_planner_row_is_refused_not_exported_as_an_empty_settings_file(tmp_path: Path,
+                                                                                      capsys: pytest.CaptureFixture
+                                                                                      ) -> None:
+    """``planners: []`` (regulation rows, no reference): ``export --format basilisk`` wrote an empty
+    ``waypoints.json`` ({}) and said 'wrote DIR/: waypoints.json', exit 0; ``run --export basilisk``
+    ran and did the same. Now both exit 2 before writing, saying why."""
+    import yaml
+
+    from scenarios.cli.commands import main
+
+    data = yaml.safe_load((Path(__file__).resolve().parents[1] / "scenarios" / "eigenaxis_demo.yaml").read_text())
+    data["planners"] = []
+    data["simulation"]["duration"] = 20.0
+    scenario = tmp_path / "regulation.yaml"
+    scenario.write_text(yaml.safe_dump(data))
+    out = tmp_path / "run"
+    assert main(["run", str(scenario), "--out", str(out), "--no-plots", "--export", "basilisk"]) == 2
+    assert "`--export basilisk` writes each planner row's reference, and the scenario has no planner" \
+        in capsys.readouterr().err
+    assert not out.exists() and not (tmp_path / "run-basilisk").exists()
+    assert main(["run", str(scenario), "--out", str(out), "--no-plots"]) == 0
+    capsys.readouterr()
+    assert main(["export", str(out), "--format", "basilisk", "--out", str(tmp_path / "b")]) == 2
+    error = capsys.readouterr().err
+    assert (f"--format basilisk: the run in {out} has no simulated planner row ('augmented_quaternion_feedback': "
+            "regulation, no reference): a waypoint file holds a planner's reference; nothing to export") in error, error
+    assert not (tmp_path / "b").exists()

@@ -53,6 +53,10 @@ def command_bench(args: argparse.Namespace) -> int:
     unknown = [name for name in problems if name not in suite.problems]
     if unknown:
         raise ScenarioError("--problems", str(UnknownNameError("problem", unknown[0], suite.problems)))
+    for flag, names in (("--problems", args.problems or []), ("--planners", args.planners or [])):
+        twice = sorted({name for name in names if names.count(name) > 1})
+        if twice:  # a problem named twice ran twice: two identical rows in the leaderboard and its medians
+            raise ScenarioError(flag, f"{twice[0]!r} is given {names.count(twice[0])} times; give each name once")
     peers = [] if args.no_peers else list(PEERS)
     planners = None
     if args.planners:

@@ -9,6 +9,7 @@ slewbench must not or cannot write to, 1 for an internal error.
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import signal
 import sys
@@ -419,6 +420,14 @@ def _scenario_details(scenario: Scenario) -> list[str]:
         lines.append("requirement actuators: the reference's demand at most 100 % of each actuator limit "
                      "(every scenario's, unstated)")
     lines += [line for line, _ in _before_planning(scenario)]
+    window, budget = scenario.simulation.duration, scenario.problem.duration
+    from planners.capabilities import minimises_time
+    # the rows whose slew takes its time budget (a minimum-time one ends sooner): run says so per row, validate did not
+    cut = [spec.label for spec in scenario.planners if not minimises_time(type(spec.planner), spec.planner.options)]
+    if window is not None and window < budget and cut:
+        lines.append(f"note: simulation.duration ({window:g} s) ends before maneuver.duration ({budget:g} s), the "
+                     f"slew of {', '.join(cut)}: the closed loop stops while it is under way, and its closed-loop "
+                     f"metrics (final error, settling) are those at {window:g} s")
     truth = (scenario.data or {}).get("truth")
     if scenario.truth is not None and isinstance(truth, dict):
         lines.append("truth (the closed loop's plant differs from the design in): "
@@ -469,7 +478,7 @@ def command_run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else default_output_directory(scenario.name)
     exports = getattr(args, "export", None) or []
     for name in exports:  # before planning: an export the run cannot give is refused first
-        _check_run_export(name, scenario.epoch)
+        _check_run_export(name, scenario.epoch, bool(scenario.planners))
     # before planning: a long run is never lost at the end (a user's file among the run's, or another
     # scenario's run, is refused now); every directory is checked before any is claimed
     check_run_directory(out, scenario.name, run_files(scenario, plots=not args.no_plots))
@@ -522,10 +531,15 @@ def command_run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _check_run_export(name: str, epoch: Any) -> None:
-    """Refuse ``run --export NAME`` for an unknown format, or an AEM of a scenario without an epoch."""
+def _check_run_export(name: str, epoch: Any, planned: bool = True) -> None:
+    """Refuse ``run --export NAME`` for an unknown format, an AEM of a scenario without an epoch, or
+    waypoint files of a scenario without planners (``planned`` False: regulation rows only)."""
     if name not in EXPORT_FORMATS:
         raise ScenarioError("--export", f"{name!r} is not an export format; known: {', '.join(EXPORT_FORMATS)}")
+    if name == "basilisk" and not planned:
+        raise ScenarioError("--export", "`--export basilisk` writes each planner row's reference, and the scenario has "
+                                        "no planner (planners: []: regulation rows, without a reference); nothing "
+                                        "would be exported")
     if name == "aem" and epoch is None:
         raise ScenarioError("epoch", "the scenario has no epoch, so its times are not absolute and its inertial "
                                      "frame is not the GCRF; `--export aem` needs both: give the scenario an `epoch` "
@@ -708,8 +722,15 @@ class Interruption:
 def _interrupted(args: argparse.Namespace) -> int:
     """Say that the command was interrupted, in one line; its exit status
     (:func:`~scenarios.cli.status.interrupted_status`)."""
-    print("slewbench: interrupted; results not written or marked incomplete in the output manifest", file=sys.stderr)
-    return interrupted_status(getattr(args, "command", None))
+    command = getattr(args, "command", None)
+    print("slewbench: interrupted; nothing written" if command in _WRITES_NOTHING else  # as the console says it
+          "slewbench: interrupted; results not written or marked incomplete in the output manifest", file=sys.stderr)
+    return interrupted_status(command)
+
+
+_WRITES_NOTHING = frozenset({"validate", "list", "schema"})
+"""Commands that only print: an interruption has no results to speak of (it said 'results not
+written or marked incomplete in the output manifest')."""
 
 
 def _names(given: str, path: Path) -> bool:
@@ -736,6 +757,18 @@ def _tolerant_streams() -> None:
             reconfigure(errors="backslashreplace")
         except (ValueError, OSError):  # a stream that cannot change now: left as it is
             continue
+
+
+_STORAGE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS})
+"""``OSError`` numbers of a file system that refuses a write (full, over quota, file too large,
+read-only): an output error, not a bug."""
+
+
+def _internal_error() -> int:
+    """Report the exception being handled as a bug, with its traceback; the exit status."""
+    traceback.print_exc()
+    print("slewbench: internal error (this is a bug; please report it with the scenario file)", file=sys.stderr)
+    return EXIT_INTERNAL
 
 
 def main(argv: list[str] | None = None, renderer: Any = None) -> int:
@@ -806,10 +839,18 @@ def main(argv: list[str] | None = None, renderer: Any = None) -> int:
         return EXIT_OK
     except KeyboardInterrupt:
         return _interrupted(args)
+    except OSError as error:
+        if error.errno not in _STORAGE_ERRORS:
+            return _internal_error()
+        # the file system refused a write (full, over quota, read-only): not a bug, no traceback; every
+        # writer stages its files and commits them last, so what was being written is discarded
+        named = f" {error.filename}" if error.filename else ""
+        print(f"slewbench: output error: cannot write{named}: {error.strerror}; the files being written were "
+              "discarded (an earlier complete output is kept): free space or choose another location, and run "
+              "again", file=sys.stderr)
+        return EXIT_BAD_OUTPUT
     except Exception:  # noqa: BLE001 (the last resort: any bug is reported as one, with its traceback)
-        traceback.print_exc()
-        print("slewbench: internal error (this is a bug; please report it with the scenario file)", file=sys.stderr)
-        return EXIT_INTERNAL
+        return _internal_error()
     finally:
         for signum, handler in (previous or {}).items():
             signal.signal(signum, handler)

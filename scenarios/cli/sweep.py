@@ -70,12 +70,25 @@ def command_report(args: argparse.Namespace) -> int:
 
     Raises
     ------
+    ScenarioError
+        Given with a study file, ``--dry-run``, ``--resume``, ``--out``, ``--workers`` or
+        ``--scheduler`` (exit 2; nothing written).
     OutputError
         The directory holds no slewbench sweep (a sweep of an earlier slewbench whose store is
         still readable is redrawn), or its store is damaged.
     """
     from scenarios.study.rerun import stored_results
 
+    # each of these asks for something --report does not do (it redraws DIR in place, running nothing):
+    # ignored, a --dry-run rewrote DIR's files and an --out's were written into DIR instead
+    clashing = [name for name, given in (("a study file", args.file), ("--dry-run", args.dry_run),
+                                         ("--resume", args.resume), ("--out", args.out),
+                                         ("--workers", args.workers is not None),
+                                         ("--scheduler", args.scheduler)) if given]
+    if clashing:
+        raise ScenarioError("--report", f"redraws the tables and plots of the stored sweep {args.report} in place "
+                                        f"from its store, running nothing; it does not take {clashing[0]}"
+                                        + (f" ({args.file})" if clashing[0] == "a study file" else ""))
     out = Path(args.report)
     results, _ = stored_results(out)
     earlier = written_files(out)
@@ -291,7 +304,8 @@ def _open(out: Path, study: Study) -> tuple[Path, SweepStore]:
         raise
     except (OSError, ValueError, sqlite3.Error) as error:  # sqlite3.Error, or a store of another format
         _undo(Path(out).absolute(), missing, empty)
-        raise OutputError(out, f"cannot start the sweep store: {error}; nothing was left behind") from None
+        raise OutputError(out, f"cannot start the sweep store: {getattr(error, 'strerror', None) or error}; nothing "
+                               "was left behind") from None
     return directory, store
 
 

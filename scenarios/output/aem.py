@@ -170,6 +170,15 @@ def _kvn_text(text: str) -> str:
     return ascii_text.upper() or "UNKNOWN"
 
 
+KVN_LINE = 254
+"""Longest line of a KVN message [characters], line ends not counted (CCSDS 504.0-B-2)."""
+
+
+def _excerpt(text: str, size: int = 40) -> str:
+    """``text`` as a repr, cut to about ``size`` characters."""
+    return repr(text) if len(text) <= size else f"{text[:size]!r}..."
+
+
 def _comment(text: str) -> list[str]:
     """``COMMENT`` lines for ``text`` (printable ASCII, at most 254 characters a line)."""
     lines = []
@@ -573,6 +582,12 @@ def check_aem_export(run: RunRecord, options: AemOptions) -> None:
     if options.attitude_type not in ATTITUDE_TYPES:
         raise ScenarioError("--option attitude_type",
                             f"{options.attitude_type!r} is not one of {', '.join(ATTITUDE_TYPES)}")
+    for name, keyword in (("originator", "ORIGINATOR"), ("object_name", "OBJECT_NAME"), ("object_id", "OBJECT_ID")):
+        text, room = getattr(options, name), KVN_LINE - len(f"{keyword} = ")
+        if len(text) > room:  # the line would break the KVN limit: a message other readers refuse
+            raise ScenarioError(f"--option {name}", f"{len(text)} characters ({_excerpt(text)}): expected at most "
+                                                    f"{room}, so that the {keyword} line keeps to the {KVN_LINE} "
+                                                    "characters of a KVN line")
     if run.epoch is None:
         raise ScenarioError("epoch", f"the run in {run.directory} has no epoch (results.json \"epoch\": null), so its "
                                      "times are not absolute and its inertial frame is not the GCRF; a CCSDS AEM "

@@ -212,7 +212,8 @@ def check_waypoint_export(run: RunRecord, options: BasiliskOptions) -> None:
     Raises
     ------
     ScenarioError
-        An attitude type or delimiter the format does not take (at ``--option NAME``).
+        An attitude type or delimiter the format does not take (at ``--option NAME``), or a run
+        without a simulated planner row (at ``--format basilisk``: nothing to export).
     """
     if options.attitude_type not in ATTITUDE_TYPES:
         raise ScenarioError("--option attitude_type",
@@ -220,6 +221,13 @@ def check_waypoint_export(run: RunRecord, options: BasiliskOptions) -> None:
     if len(options.delimiter) != 1 or options.delimiter.isspace() or options.delimiter in "0123456789+-.eE":
         raise ScenarioError("--option delimiter", f"{options.delimiter!r} is not one character that cannot occur in "
                                                   "a number")
+    if not any(row.planner is not None and row.timeseries is not None for row in run.rows):
+        # it wrote an empty waypoints.json and said 'wrote DIR/: waypoints.json', exit 0
+        raise ScenarioError("--format basilisk", f"the run in {run.directory} has no simulated planner row ("
+                            + ", ".join(f"{row.label!r}: " + ("regulation, no reference" if row.planner is None
+                                                              else f"not simulated, {row.status}")
+                                        for row in run.rows[:5])
+                            + "): a waypoint file holds a planner's reference; nothing to export")
 
 
 def write_waypoint_files(run: RunRecord, directory: Path, options: BasiliskOptions) -> list[str]:

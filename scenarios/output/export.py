@@ -238,7 +238,8 @@ class ExportFormat:
         Raises
         ------
         ScenarioError
-            A text without ``=`` or a name the format does not have (the names are listed).
+            A text without ``=``, a name the format does not have (the names are listed) or one
+        given twice.
         """
         names = [item.name for item in dataclasses.fields(self.options)]
         values: dict[str, str] = {}
@@ -247,6 +248,9 @@ class ExportFormat:
             if not equals or name.strip() not in names:
                 raise ScenarioError(f"--option {pair}", f"expected NAME=VALUE with NAME one of {', '.join(names)} "
                                                         f"(the {self.name} export's options)")
+            if name.strip() in values:  # the last one silently won
+                raise ScenarioError(f"--option {name.strip()}", f"given twice ({values[name.strip()]!r}, then "
+                                                                f"{value.strip()!r}); give each option once")
             values[name.strip()] = value.strip()
         return self.options(**values)
 

@@ -80,13 +80,17 @@ def check_work(problem: ManeuverProblem, simulation: SimulationSpec) -> None:
     Raises
     ------
     ScenarioError
-        At ``simulation.duration`` or ``maneuver.duration`` (too many samples) or
-        ``simulation.max_step`` (too many RK4 sub-steps).
+        At ``simulation.sample_time`` (longer than the window), ``simulation.duration`` or
+        ``maneuver.duration`` (too many samples) or ``simulation.max_step`` (too many RK4 sub-steps).
     """
     window = simulation.duration or problem.duration
     samples = math.ceil(window / simulation.sample_time - 1e-9)
     substeps = 1 if simulation.integrator != "rk4" else math.ceil(simulation.sample_time / simulation.max_step - 1e-9)
     where = "simulation.duration" if simulation.duration else "maneuver.duration"
+    if simulation.sample_time > window:  # the law would act once (at t = 0) over the whole window, if at all
+        raise ScenarioError("simulation.sample_time", f"{simulation.sample_time:g} s is longer than the closed-loop "
+                            f"window ({where}, {window:g} s): the controller would hold its first command over "
+                            f"the whole run; expected a sample time of at most {window:g} s (a fraction of it)")
     if samples > simulation.max_samples:
         raise ScenarioError(where, f"{window:g} s at a {simulation.sample_time:g} s sample time is {samples} samples, "
                                    f"over the limit of {simulation.max_samples}; raise simulation.max_samples "

@@ -98,7 +98,8 @@ def _exclusions(node: Node) -> dict[str, Any]:
 
 STAR_TRACKER = Section((
     custom("noise_arcsec", "Standard deviation of the attitude error about the sensor's x, y (cross-boresight) "
-           "and z (boresight) axes.", "list of 3 numbers", _non_negative_vector, unit="arcsec"),
+           "and z (boresight) axes; with an estimator, a zero needs some gyro noise (a filter certain of an axis "
+           "divides by zero at its next update).", "list of 3 numbers", _non_negative_vector, unit="arcsec"),
     number("rate_hz", "Updates per second; ``null``: every sample.", unit="Hz", default=None, positive=True,
            nullable=True),
     custom("outages_s", "Windows ``[t0, t1]`` without updates.", "list of [t0, t1]", _outages, unit="s", default=[]),
@@ -218,6 +219,15 @@ def parse_sensor_suite(sensors: dict[str, Any] | None, estimator: dict[str, Any]
             raise ScenarioError(f"{path}.estimator", f"the {estimator['type']} needs "
                                 f"{' and '.join(f'{path}.sensors.{m}' for m in missing)}; declare "
                                 f"{'it' if len(missing) == 1 else 'them'} or remove the estimator")
+        silent = [] if tracker is None else [int(i) for i in np.flatnonzero(np.asarray(tracker.noise) == 0.0)]
+        if silent and gyro is not None and tracker is not None and gyro.arw == 0.0 and gyro.rrw == 0.0:  # the filter's knowledge came out NaN, the row failed
+            raise ScenarioError(f"{path}.sensors.star_tracker.noise_arcsec",
+                                f"{[float(f'{v:g}') for v in np.asarray(tracker.noise) / ARCSEC]} is zero about the sensor's "
+                                f"{', '.join('xyz'[i] for i in silent)} ax{'is' if len(silent) == 1 else 'es'} and the gyro is noise-free "
+                                f"({path}.sensors.gyro.arw_deg_per_sqrt_h and rrw_deg_per_h_per_sqrt_h 0): the "
+                                f"{estimator['type']} would be certain of that axis after its first update and divide "
+                                "by zero at the next; expected a positive noise on every axis, or some gyro noise "
+                                f"(remove {path}.estimator for a measurement taken as the state)")
         mekf = Mekf(attitude_sigma=math.radians(estimator["initial_attitude_sigma_deg"]),
                     bias_sigma=estimator["initial_bias_sigma_deg_per_h"] * DEG_PER_H)
     if gyro is None and tracker is None and magnetometer is None:

@@ -18,6 +18,7 @@ import copy
 import dataclasses
 import datetime
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -411,7 +412,8 @@ SENSOR_NOISE = Section((
 ), "Measurement noise, white and Gaussian.")
 
 SIMULATION = Section((
-    number("sample_time", "Zero-order-hold sample time of the controller.", unit="s", default=1.0, positive=True),
+    number("sample_time", "Zero-order-hold sample time of the controller; at most the closed-loop window "
+           "(``simulation.duration``, else ``maneuver.duration``).", unit="s", default=1.0, positive=True),
     number("duration", "Closed-loop window of every row. ``null`` (the default): each row runs for "
            "``maneuver.duration`` (every planner's slew ends within it), a row without a planner too. After its duration a "
            "reference continues as the torque-free motion of its final state.", unit="s", default=None,
@@ -701,12 +703,18 @@ def load(path: str | Path) -> Scenario:
         The file cannot be read or is not a valid scenario: its :attr:`~scenarios.errors.ScenarioError.file`
         is ``path``, its text names the file and the YAML path (``FILE: name: required key is
         missing``); a study or slew-table file names the command that runs it.
+    TypeError
+        ``path`` is not a path (a mapping already read goes to :func:`parse_scenario`).
 
     Warns
     -----
     PlausibilityWarning
         One per value that looks like a unit or layout slip, as :func:`parse_scenario`.
     """
+    if not isinstance(path, (str, os.PathLike)):  # as load_study: not pathlib's "expected str, bytes or ..."
+        raise TypeError(f"path must be a str or os.PathLike, got {type(path).__name__}"
+                        + ("; a scenario mapping already read: scenarios.parse_scenario(data)"
+                           if isinstance(path, dict) else ""))
     try:
         data = read_yaml(path)
         if isinstance(data, dict):

@@ -186,6 +186,14 @@ def _rate_tolerances(scenario: Scenario) -> Iterator[Implausible]:
                                   "a tolerance that a spacecraft still slewing as fast as any does would meet")
 
 
+def _rate_noise(scenario: Scenario) -> Iterator[Implausible]:
+    """A rate measurement noise (``simulation.sensor_noise.rate``, 1 sigma per axis) at or above
+    :data:`MAX_RATE_TOLERANCE` (a noise in deg/s written as rad/s)."""
+    noise = _mapping(scenario.data or {}, "simulation", "sensor_noise").get("rate")
+    yield from _rates_at_or_above([("simulation.sensor_noise.rate", noise)], MAX_RATE_TOLERANCE,
+                                  "a noise that hides the rate of a spacecraft slewing as fast as any does")
+
+
 def _rates_at_or_above(given: list[tuple[str, Any]], bar: float, why: str) -> Iterator[Implausible]:
     """The rates [rad/s] of ``given`` (YAML path, value as written) at or above ``bar``, each
     saying ``why`` that is implausible and the value meant if it was written in deg/s."""
@@ -316,6 +324,7 @@ PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "orbit_altitude": _orbit_altitude,
     "rate_bounds": _rate_bounds,
     "rate_tolerances": _rate_tolerances,
+    "rate_noise": _rate_noise,
     "boundary_rates": _boundary_rates,
     "actuator_torques": _torques,
     "slew_time": _slew_time,

@@ -162,10 +162,21 @@ def _pending() -> list[tuple[str, str, Callable[[], Any]]]:
         if text.endswith(".py"):
             found.append((f"{ENVIRONMENT_VARIABLE} {text}", f"{ENVIRONMENT_VARIABLE} file {text}",
                           functools.partial(_import_file, text)))
+        elif "/" in text or os.sep in text or Path(text).is_file():  # imported as a module name, it was told
+            # "No module named 'small'" and to give ./small.py (small.yaml), or a relative-import TypeError
+            found.append((f"{ENVIRONMENT_VARIABLE} {text}", f"{ENVIRONMENT_VARIABLE} entry {text}",
+                          functools.partial(_not_a_plugin, text)))
         else:
             found.append((f"{ENVIRONMENT_VARIABLE} {text}", f"{ENVIRONMENT_VARIABLE} module {text}",
                           functools.partial(importlib.import_module, text)))
     return [item for item in found if item[0] not in _LOADED]
+
+
+def _not_a_plugin(text: str) -> None:
+    """Refuse a ``SLEWBENCH_PLUGINS`` entry that is a path but not a ``.py`` file."""
+    kind = "a directory" if Path(text).is_dir() else "a file" if Path(text).exists() else "a path"
+    raise ValueError(f"{text} is {kind}, not a .py file or a module name: give the path of a .py file "
+                     f"or a module importable from sys.path (mypackage.plugins)")
 
 
 def _import_hint(label: str, error: BaseException) -> str:

@@ -1,6 +1,7 @@
 """Reading scenario and study YAML safely: bounded size, depth and alias expansion, duplicate keys
-refused, dates kept as text, and exponent numbers such as ``6e5`` read as floats (YAML 1.1 reads
-them as strings). Errors are :class:`ScenarioError` naming the YAML path.
+refused, dates kept as text, exponent numbers such as ``6e5`` read as floats (YAML 1.1 reads
+them as strings), and numbers YAML 1.1 reads otherwise than written (``045``: octal 37; ``1:20``:
+base 60) refused. Errors are :class:`ScenarioError` naming the YAML path.
 
 Values that name their path are :mod:`scenarios.schema.node`'s :class:`~scenarios.schema.node.Node`,
 which wraps a value parsed here.
@@ -77,6 +78,36 @@ def _check_tree(root: yaml.Node, source: Path | str) -> None:
                 stack.append((value_node, child, depth + 1))
         elif isinstance(node, yaml.SequenceNode):
             stack.extend((item, f"{path}[{index}]", depth + 1) for index, item in enumerate(node.value))
+        elif isinstance(node, yaml.ScalarNode) and node.style is None:
+            _check_number(node, path, source)
+
+
+_OCTAL = re.compile(r"^[-+]?0[0-7_]+$")
+"""A plain integer with a leading zero, which YAML 1.1 (PyYAML) reads as octal: ``045`` is 37."""
+
+
+def _check_number(node: yaml.ScalarNode, path: str, source: Path | str) -> None:
+    """Refuse a plain number that YAML 1.1 reads as another value than its digits say: a leading zero
+    (``045``: octal, 37) or colons (``1:20``: base 60, 80). Zero-padded angles and durations were
+    read silently as other values (YAML 1.2 reads ``045`` as 45 and ``1:20`` as text)."""
+    tag, text = node.tag, node.value
+    if tag == "tag:yaml.org,2002:int" and _OCTAL.match(text):
+        decimal: int | None = int(text.replace("_", ""))  # the digits read in base 10
+        how, meant = "the octal number", f"{decimal} (without the leading zero)"
+    elif tag in ("tag:yaml.org,2002:int", "tag:yaml.org,2002:float") and ":" in text:
+        decimal, how, meant = None, "the base-60 number", ""
+    else:
+        return
+    value = yaml.SafeLoader(text).get_single_data()  # the number YAML 1.1 makes of it
+    if value == decimal:  # 07, 00: the same either way
+        return
+    where = f"line {node.start_mark.line + 1}" + ("" if isinstance(source, Path) else f" of {source}")
+    message = (f"{text} ({where}) is read by YAML 1.1 as {how} {value:g}"
+               + (f", not {decimal}; write {meant}" if meant else f"; write {value:g} if that is meant")
+               + ", or quote it if text is meant")
+    if isinstance(source, Path):  # the error names the file once, before the path
+        raise ScenarioError(_short(path) or "(top level)", message, source)
+    raise ScenarioError(_short(path) or "(top level)", message)
 
 
 def parse_yaml_text(text: str, source: Path | str = "<text>") -> Any:

@@ -211,8 +211,11 @@ def _scenario(path: Path, where: str) -> dict[str, Any]:
         raise ScenarioError(where, error.message.replace(str(path), str(path.resolve()))) from None
     if not isinstance(data, dict):
         raise ScenarioError(where, f"{path} is not a scenario (a mapping)")
-    if "study" in data or "table" in data:
-        raise ScenarioError(where, f"{path} is a study or table file, not a scenario")
+    if "study" in data or "table" in data:  # which one: "a study or table file" read as if tables were refused
+        kind, command = ("table", "table") if "table" in data else ("study", "sweep")
+        raise ScenarioError(where, f"{path} is a {kind} file, not a scenario: "
+                                   + (f"run it with `slewbench {command} {path}`" if where == str(path) else
+                                      "table.scenario names the scenario file the table is made for"))
     try:
         parse_scenario(data)
     except ScenarioError as error:  # the scenario's YAML path, in the scenario's file

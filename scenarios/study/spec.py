@@ -250,6 +250,7 @@ def _axes(root: Node, base: dict[str, Any], seen: list[_Varied]) -> list[_Axis]:
             _register(varied, seen)
             values, recorded = grid_values(entry, base)
             if section == "grid":
+                _refuse_repeats(entry, list(recorded))
                 axes.append(_Axis([varied], [values], [recorded], len(values)))
                 continue
             if zipped is None:
@@ -260,7 +261,23 @@ def _axes(root: Node, base: dict[str, Any], seen: list[_Varied]) -> list[_Axis]:
             zipped.varied.append(varied)
             zipped.values.append(values)
             zipped.recorded.append(recorded)
+            if len(zipped.recorded) == len(node.value):  # the last zip entry: repeated tuples of them all
+                _refuse_repeats(entry, list(zip(*zipped.recorded)), "zip")
     return axes
+
+
+def _refuse_repeats(entry: Node, recorded: list[Any], section: str = "grid") -> None:
+    """Refuse a value (a zip's tuple of values) given twice in one axis: the same cases ran twice,
+    and the summaries and robustness tables counted them twice, without a word."""
+    first: dict[Any, int] = {}
+    for index, value in enumerate(recorded):
+        key = tuple((type(item) is bool, item) for item in value) if isinstance(value, tuple) else \
+            (type(value) is bool, value)  # true is not 1 (nor 1.0, which is 1)
+        if key in first:
+            what = "values" if section == "grid" else "tuple of the zip's values"
+            raise entry.error(f"{value!r} is given twice ({what} [{first[key]}] and [{index}]): its cases would run "
+                              "twice and count twice in the summaries; give each once")
+        first[key] = index
 
 
 def _base(root: Node, source: Path | None) -> dict[str, Any]:

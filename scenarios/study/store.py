@@ -20,6 +20,7 @@ ever replacing it (a sweep's directory, or a slew table's: ``kind="table"``).
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
 import sqlite3
@@ -187,7 +188,10 @@ class SweepStore:
             with contextlib.suppress(Exception):
                 self._db.close()
             if isinstance(error, sqlite3.OperationalError):
-                raise OSError(f"cannot open the sweep store {self.path}: {error}") from None
+                failure = OSError(f"cannot open the sweep store {self.path}: {error}")
+                if getattr(error, "sqlite_errorcode", None) == getattr(sqlite3, "SQLITE_FULL", 13):  # a full disk, not a bug
+                    failure.errno, failure.strerror = errno.ENOSPC, str(failure)
+                raise failure from None
             raise ValueError(f"{self.path} is not a sweep store: {error}") from None
         self._read_rows: Callable[[list[dict[str, Any]]], list[dict[str, Any]]] = list
         if stored is None:
