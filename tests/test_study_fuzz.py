@@ -124,8 +124,11 @@ def check(mutation, folder):
         assert (out / "cases.csv").is_file() and (out / "sweep.sqlite").is_file(), mutation
 
 
-@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture,
-                                                                 HealthCheck.too_slow])
+# Derandomised: the default run draws the same 6 mutations every time (a random draw such as
+# maneuver.final.omega = [-33994, 0, 0] runs both its cases to the 60 s case timeout, past LIMIT_S:
+# a CI run must not pass or fail by the draw); the slow test below draws 500 at random.
+@settings(max_examples=6, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(mutation=MUTATIONS)
 def test_mutated_studies_exit_0_or_2_naming_a_path(mutation, tmp_path_factory):
     check(mutation, tmp_path_factory.mktemp("study"))
