@@ -127,8 +127,21 @@ def bound_excess(values: Array, low: Array, high: Array) -> float:
 
 
 def final_conditions(params: Array, nx: int) -> Array:
-    """The shooting's ``xf (nx,)``: the final attitude and rate ``[q_f, ω_f]`` of an NLP's parameters
-    (after the initial state), the wheel momenta (free at the end, not read) zero."""
+    """The shooting's final state ``xf``: the final attitude and rate of an NLP's parameters, the
+    wheel momenta (free at the end, not read) zero.
+
+    Parameters
+    ----------
+    params : ndarray
+        The NLP's parameters: the initial state (``nx``), then ``[q_f, ω_f]`` (7), ...
+    nx : int
+        The model's state size (7, plus one per reaction wheel).
+
+    Returns
+    -------
+    (nx,) ndarray
+        ``[q_f, ω_f, 0 …]``.
+    """
     return np.concatenate([np.asarray(params, dtype=float)[nx:nx + 7], np.zeros(nx - 7)])
 
 
