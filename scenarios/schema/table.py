@@ -92,14 +92,21 @@ def angles_from_text(text: str, where: str = "--angles") -> list[float]:
     Raises
     ------
     ScenarioError
-        Not numbers, a count below 2, or angles out of range.
+        Not numbers, an empty item (``30,,90``; one trailing comma is allowed), a count below 2,
+        or angles out of range.
     """
     count = bare_count(text)
     if count is not None:
         if count < 2:
             raise ScenarioError(where, f"expected a count of at least 2 angles, got {count}")
         return check_angles(list(np.linspace(10.0, 180.0, count)), where)
-    parts = [p.strip() for p in str(text).split(",") if p.strip()]
+    parts = [p.strip() for p in str(text).split(",")]
+    if len(parts) > 1 and not parts[-1]:
+        parts.pop()  # one trailing comma: "90,180," is the list [90, 180]
+    for i, part in enumerate(parts, start=1):
+        if not part:
+            raise ScenarioError(where, f"item {i} of {text!r} is empty: expected a comma-separated list of angles "
+                                       "in degrees, one number between each pair of commas (e.g. 30,60,90)")
     try:
         values = [float(p) for p in parts]
     except ValueError:
