@@ -337,6 +337,8 @@ def test_netcdf_reads_back_with_dimensions_units_and_attributes(tmp_path):
     (["--angles", "-10,90"], "(0, 180] degrees, got [-10.0, 90.0]"),  # checked, not read as an option
     (["--check-angles", "-5,30", "--tolerance", "0.01"], "--check-angles"),  # a list: argparse read it as an option
     (["--axes", "many"], "--axes"),
+    (["--axes", "[[1,0,0]]"], "--axes: expected a whole number of axes from 1 to 10000 (e.g. --axes 40; to give "
+                              "the axes themselves, list them at table.axes in a table file), got '[[1,0,0]]'"),
     (["--axes", "-1"], "--axes: expected a number of axes from 1 to 10000, got -1"),  # as the YAML form says
     (["--duration", "5"], "--duration"),
     (["--objective", "min_energy"], "--duration"),

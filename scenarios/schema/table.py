@@ -160,6 +160,9 @@ def _axes(node: Node) -> int | np.ndarray:
         if not 1 <= value <= MAX_AXES:
             raise node.error(f"expected a number of axes from 1 to {MAX_AXES}, got {value}")
         return value
+    if where.startswith("--"):  # the flag takes a count only: the axes themselves are for the table file
+        raise node.error(f"expected a whole number of axes from 1 to {MAX_AXES} (e.g. --axes 40; to give the "
+                         f"axes themselves, list them at table.axes in a table file), got {value!r}")
     if not isinstance(value, (list, tuple)) or not value:
         raise node.error(f"expected a number of axes or a list of [x, y, z] axes, got {value!r}")
     axes: list[np.ndarray] = []
