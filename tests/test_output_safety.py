@@ -406,6 +406,28 @@ def test_an_empty_output_directory_is_refused_not_replaced_by_the_default(argv, 
     assert list(tmp_path.iterdir()) == []  # no results/ made
 
 
+@pytest.mark.parametrize("argv", [
+    ["run", "scenarios/eigenaxis_demo.yaml", "--out"],
+    ["bench", "--problems", "bilimoria_wie_45", "--out"],
+    ["sweep", "scenarios/study_spin_monte_carlo.yaml", "--out"],
+    ["sweep", "--report"],
+    ["table", "scenarios/eigenaxis_demo.yaml", "--out"],
+    ["codegen", "scenarios/eigenaxis_demo.yaml", "--out"],
+    ["export", "results/none", "--format", "aem", "--out"],
+])
+def test_a_dash_output_directory_is_refused_not_made(argv, tmp_path, monkeypatch, capsys):
+    """``--out -`` (a dash usually means standard output) made a directory named ``-``."""
+    root = Path(__file__).resolve().parents[1]
+    monkeypatch.chdir(tmp_path)
+    argv = [str(root / a) if a.startswith("scenarios/") else a for a in argv]
+    with pytest.raises(SystemExit) as stop:
+        main([*argv, "-"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert f"{argv[-1]}: '-' is not standard output here: slewbench writes a directory of files" in err
+    assert list(tmp_path.iterdir()) == []  # no directory '-', no results/
+
+
 def test_a_file_changed_since_slewbench_wrote_it_is_not_replaced(tmp_path, capsys):
     """A user saved their own figure over a run's output, with the same name; the rerun replaced it
     (the manifest knew names only). Its stamp (size, mtime) now says it is no longer slewbench's."""

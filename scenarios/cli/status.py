@@ -122,7 +122,8 @@ def crash_report(reasons: list[str], total: int, noun: tuple[str, str], where: s
 def directory_argument(text: str) -> str:
     """An output directory given on the command line (``argparse`` ``type``): refuses an empty one.
 
-    ``--out ""`` used to fall back to the default ``results/<name>`` without a word.
+    ``--out ""`` used to fall back to the default ``results/<name>`` without a word; ``--out -``
+    (a dash usually means standard output) made a directory named ``-``.
 
     Parameters
     ----------
@@ -137,10 +138,13 @@ def directory_argument(text: str) -> str:
     Raises
     ------
     argparse.ArgumentTypeError
-        For an empty or blank path (argparse exits 2 with the option's name).
+        For an empty or blank path, or ``-`` (argparse exits 2 with the option's name).
     """
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path: give the output directory")
+    if text.strip() == "-":
+        raise argparse.ArgumentTypeError("'-' is not standard output here: slewbench writes a directory of files, "
+                                         "give its path (./- for a directory named '-')")
     return text
 
 
