@@ -278,7 +278,7 @@ class CircularOrbit(OrbitKind):
             Height of the circular orbit above the equatorial radius (6378.137 km) [km], positive
             (an orbit under the surface is an error, as a Keplerian orbit's perigee there is).
         inclination_deg : float
-            Inclination of the orbit plane to the equator [deg].
+            Inclination of the orbit plane to the equator [deg], in [0, 180] (above 90: retrograde).
         raan_deg : float
             Right ascension of the ascending node [deg].
         arg_latitude_deg : float
@@ -286,7 +286,7 @@ class CircularOrbit(OrbitKind):
         """
 
         altitude_km: Annotated[float, Range(gt=0.0, le=MAX_ORBIT_KM)]
-        inclination_deg: Annotated[float, Range()] = 0.0
+        inclination_deg: Annotated[float, Range(ge=0.0, le=180.0)] = 0.0
         raan_deg: Annotated[float, Range()] = 0.0
         arg_latitude_deg: Annotated[float, Range()] = 0.0
 
@@ -482,7 +482,7 @@ class KeplerianOrbit(OrbitKind):
         eccentricity : float
             Eccentricity, in [0, 1); the perigee a (1 − e) must clear the equatorial radius.
         inclination_deg : float
-            Inclination to the GCRF equator [deg].
+            Inclination to the GCRF equator [deg], in [0, 180] (above 90: retrograde).
         raan_deg : float
             Right ascension of the ascending node at t = 0 [deg].
         arg_perigee_deg : float
@@ -498,7 +498,7 @@ class KeplerianOrbit(OrbitKind):
         semi_major_axis_km: Annotated[float | None, Range(gt=0.0, le=MAX_ORBIT_KM)] = None
         altitude_km: Annotated[float | None, Range(le=MAX_ORBIT_KM)] = None
         eccentricity: Annotated[float, Range(ge=0.0, lt=1.0)] = 0.0
-        inclination_deg: Annotated[float, Range()] = 0.0
+        inclination_deg: Annotated[float, Range(ge=0.0, le=180.0)] = 0.0
         raan_deg: Annotated[float, Range()] = 0.0
         arg_perigee_deg: Annotated[float, Range()] = 0.0
         mean_anomaly_deg: Annotated[float | None, Range()] = None

@@ -624,8 +624,9 @@ def _option_key(name: str, annotation: Any, bounds: Range | None, default: Any, 
     kind = base[0] if len(base) == 1 else None
     if kind is float:
         bounds = bounds or Range()
-        if bounds.gt in (None, 0.0) and bounds.ge in (None, 0.0) and bounds.lt is None and bounds.finite:
-            # the scenario's own number checks (and their messages)
+        closed = bounds.ge is not None and bounds.le is not None  # a range such as [0, 180]: named whole
+        if bounds.gt in (None, 0.0) and bounds.ge in (None, 0.0) and bounds.lt is None and bounds.finite and not closed:
+            # the scenario's own number checks (and their messages, which name the side crossed)
             return number(name, meaning, unit=unit, default=default, positive=bounds.gt == 0.0,
                           non_negative=bounds.ge == 0.0, maximum=bounds.le, nullable=optional)
         declared = bounds
