@@ -360,6 +360,7 @@ def compute_metrics(
     t = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
     torque = np.asarray(torque, dtype=float)
+    _check_samples(t, q, omega, torque)
     norms = np.linalg.norm(torque, axis=1)
     error_to_target = None if target_q is None else np.rad2deg(quat.error_angle(q, target_q))
     settling = settling_time(t, error_to_target, settling_tolerance_deg)
@@ -527,6 +528,22 @@ def rate_error(q: ArrayLike, omega: ArrayLike, target_q: ArrayLike | None, targe
         target = quat.rotate_inverse(quat.error(np.atleast_2d(np.asarray(q, dtype=float)), target_q,
                                                 shortest=False), target)
     return np.asarray(np.linalg.norm(omega - target, axis=-1))
+
+
+def _check_samples(t: NDArray, q: NDArray, omega: ArrayLike, torque: NDArray) -> None:
+    """ValueError naming the argument of :func:`compute_metrics` whose shape does not fit the
+    times ``t`` (N+1 samples), instead of a NumPy broadcasting error deep in an integral."""
+    if t.ndim != 1 or t.size < 1:
+        raise ValueError(f"compute_metrics: t must be (N+1,) sample times, got shape {t.shape}")
+    n = t.size - 1
+    rates = np.shape(omega)
+    for name, shape, expected in (("q", q.shape, [(n + 1, 4)]), ("omega", rates, [(n + 1, 3)]),
+                                  ("torque", torque.shape, [(n, 3), (n + 1, 3)])):
+        if shape not in expected:
+            said = " or ".join(str(s) for s in expected)
+            raise ValueError(f"compute_metrics: {name} must have shape {said} for the {n + 1} sample times t"
+                             f"{' (held over each interval, or sampled at t)' if name == 'torque' else ''}, "
+                             f"got shape {shape}")
 
 
 def _check_targets(function: str, target_q: Any, target_omega: Any) -> None:

@@ -204,6 +204,28 @@ def test_metric_functions_name_a_wrong_target():
     assert metrics_from_reference(reference, slew.qf, slew.omegaf)["final_error_deg"] == pytest.approx(0.0, abs=1e-9)
 
 
+def test_compute_metrics_names_a_torque_of_the_wrong_length():
+    """A torque with neither N nor N+1 rows for N+1 sample times ended in a NumPy broadcasting error."""
+    from ocp import compute_metrics
+    t = np.linspace(0.0, 10.0, 11)
+    q = np.tile(quat.IDENTITY, (11, 1))
+    omega = np.zeros((11, 3))
+    with pytest.raises(ValueError, match=re.escape("compute_metrics: torque must have shape (10, 3) or (11, 3) for "
+                                                   "the 11 sample times t (held over each interval, or sampled at "
+                                                   "t), got shape (7, 3)")):
+        compute_metrics(t, q, omega, np.zeros((7, 3)), quat.IDENTITY)
+    with pytest.raises(ValueError, match=re.escape("torque must have shape (10, 3) or (11, 3) for the 11 sample "
+                                                   "times t (held over each interval, or sampled at t), got shape "
+                                                   "(10, 2)")):
+        compute_metrics(t, q, omega, np.zeros((10, 2)), quat.IDENTITY)  # silently two axes before
+    with pytest.raises(ValueError, match=re.escape("compute_metrics: omega must have shape (11, 3) for the 11 "
+                                                   "sample times t, got shape (10, 3)")):
+        compute_metrics(t, q, omega[:-1], np.zeros((10, 3)), quat.IDENTITY)
+    # What it takes still works: 1 N m about x held for 10 s.
+    torque = np.tile([1.0, 0.0, 0.0], (10, 1))
+    assert compute_metrics(t, q, omega, torque, quat.IDENTITY)["int_u2"] == pytest.approx(10.0, rel=1e-12)
+
+
 def test_a_non_finite_inertia_is_called_non_finite():
     with pytest.raises(ModelError, match=r"inertia: the inertia must be finite, got \[\[nan, 0.0, 0.0\]"):
         Spacecraft([np.nan, 1.0, 1.0])
