@@ -281,6 +281,26 @@ def test_wheels_that_span_only_a_plane_warn_naming_the_missing_direction():
         wheels={**d["spacecraft"]["wheels"], "axes": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "failed": [2]})) == []
 
 
+def test_a_disturbance_torque_the_actuators_cannot_counter_warns():
+    """A constant disturbance of 4 N m written for 4 mN m validated without a word, though no
+    controller can hold an attitude against it. The oracle: the CubeSat's wheels lie along the
+    body axes at 3 mN m each, so along x they give 3 mN m, and along the diagonal 3 mN m per axis
+    (‖·‖ = 5.2 mN m): 4 mN m about x is beyond them, [2, 2, 2] mN m (‖·‖ = 3.46 mN m) is not."""
+    def disturbance(torque):
+        return lambda d: d["environment"].update(disturbance_torque=torque)
+    said = warnings_of(disturbance([0.004, 0.0, 0.0]))
+    assert len(said) == 1 and said[0].startswith("environment.disturbance_torque: [0.004, 0.0, 0.0] N m has "
+                                                 "‖τ_d‖ = 0.004 N m, more than the actuators give against it "
+                                                 "(0.003 N m along −τ_d"), said
+    assert "did you mean [4e-06, 0.0, 0.0] N m (mN m written as N m)?" in said[0], said
+    assert warnings_of(disturbance([0.0, -4.0, 0.0]))[0].startswith("environment.disturbance_torque: [0.0, -4.0, 0.0]")
+    assert warnings_of(disturbance([0.002, 0.002, 0.002])) == []  # a norm above 3 mN m the wheels still counter
+    assert warnings_of(disturbance([1e-5, 0.0, 0.0])) == []
+    data = read_yaml(ROOT / "scenarios" / "nano_detumble.yaml")  # magnetorquers alone: the field decides
+    data["environment"]["disturbance_torque"] = [1.0, 0.0, 0.0]
+    assert plausibility_warnings(parse_scenario(data)) == []
+
+
 def test_the_guide_states_the_slow_slew_bar_the_code_uses():
     from scenarios.schema.plausibility import SLOW_SLEW_FACTOR
     text = re.sub(r"\s+", " ", (ROOT / "docs" / "guide" / "scenarios.rst").read_text())

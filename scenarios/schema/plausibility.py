@@ -297,6 +297,32 @@ def _slew_time(scenario: Scenario) -> Iterator[Implausible]:
                       "inertia in kg m² (g mm² written as kg m² is 1e9 too large, g cm² 1e7) and the torque in N m?")
 
 
+def _disturbance(scenario: Scenario) -> Iterator[Implausible]:
+    """A constant disturbance torque (``environment.disturbance_torque``) larger than the actuators
+    give against it: the largest torque along ``−τ_d`` within the wheels' and torquers'
+    ``max_torque``, through the controllers' allocation (:meth:`~ocp.Spacecraft.torque_along`).
+    No controller then holds an attitude, so every run drifts away; a torque in mN m or µN m
+    written as N m lands there. A spacecraft that gives no stated torque against it (magnetorquers
+    alone: the field decides; failed wheels that leave that direction bare) or an unbounded one is
+    left alone."""
+    written = _mapping(scenario.data, "environment").get("disturbance_torque")
+    values = _numbers(written)
+    if values is None or len(values) != 3:
+        return
+    torque = np.array(values)
+    norm = float(np.linalg.norm(torque))
+    if not 0.0 < norm < math.inf:
+        return
+    counter = scenario.problem.spacecraft.torque_along(-torque)
+    if not 0.0 < counter < norm:  # 0: no stated bound that way; inf: unlimited; or the actuators hold it
+        return
+    yield Implausible("environment.disturbance_torque", f"{values} N m",
+                      f"has ‖τ_d‖ = {norm:.3g} N m, more than the actuators give against it ({counter:.3g} N m "
+                      "along −τ_d within the wheels' and torquers' max_torque): no controller holds an attitude, "
+                      f"so every run drifts away; did you mean {[round(v / 1e3, 9) for v in values]} N m (mN m written "
+                      "as N m)?")
+
+
 def _wheel_axes(scenario: Scenario) -> Iterator[Implausible]:
     """Three or more wheels whose axes span fewer than three directions, with no other actuator:
     a layout slip (a pyramid's elevation written as 0, an axis repeated), since a spacecraft flies
@@ -328,6 +354,7 @@ PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "boundary_rates": _boundary_rates,
     "actuator_torques": _torques,
     "slew_time": _slew_time,
+    "disturbance": _disturbance,
     "wheel_axes": _wheel_axes,
 }
 """Name -> check: each yields the :class:`Implausible` values of a validated scenario."""
