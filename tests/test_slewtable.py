@@ -336,6 +336,8 @@ def test_netcdf_reads_back_with_dimensions_units_and_attributes(tmp_path):
     (["--angles", ",30,90"], "--angles: item 1 of ',30,90' is empty"),
     (["--angles", "-10,90"], "(0, 180] degrees, got [-10.0, 90.0]"),  # checked, not read as an option
     (["--check-angles", "-5,30", "--tolerance", "0.01"], "--check-angles"),  # a list: argparse read it as an option
+    (["--check-angles", "30,,90", "--tolerance", "0.01", "--max-entries", "1"],  # 1: no table computed before
+     "--check-angles: item 2 of '30,,90' is empty"),
     (["--axes", "many"], "--axes"),
     (["--axes", "[[1,0,0]]"], "--axes: expected a whole number of axes from 1 to 10000 (e.g. --axes 40; to give "
                               "the axes themselves, list them at table.axes in a table file), got '[[1,0,0]]'"),

@@ -100,18 +100,25 @@ def angles_from_text(text: str, where: str = "--angles") -> list[float]:
         if count < 2:
             raise ScenarioError(where, f"expected a count of at least 2 angles, got {count}")
         return check_angles(list(np.linspace(10.0, 180.0, count)), where)
-    parts = [p.strip() for p in str(text).split(",")]
-    if len(parts) > 1 and not parts[-1]:
-        parts.pop()  # one trailing comma: "90,180," is the list [90, 180]
-    for i, part in enumerate(parts, start=1):
-        if not part:
-            raise ScenarioError(where, f"item {i} of {text!r} is empty: expected a comma-separated list of angles "
-                                       "in degrees, one number between each pair of commas (e.g. 30,60,90)")
+    parts = _comma_items(str(text), where)
     try:
         values = [float(p) for p in parts]
     except ValueError:
         raise ScenarioError(where, f"expected a count or a comma-separated list of angles in degrees, got {text!r}") from None
     return check_angles(values, where)
+
+
+def _comma_items(text: str, where: str) -> list[str]:
+    """The items of a comma-separated list of angles, stripped; one trailing comma is allowed
+    (``"90,180,"`` is two items), an empty item elsewhere (``"30,,90"``) is refused at ``where``."""
+    parts = [p.strip() for p in text.split(",")]
+    if len(parts) > 1 and not parts[-1]:
+        parts.pop()
+    for i, part in enumerate(parts, start=1):
+        if not part:
+            raise ScenarioError(where, f"item {i} of {text!r} is empty: expected a comma-separated list of angles "
+                                       "in degrees, one number between each pair of commas (e.g. 30,60,90)")
+    return parts
 
 
 def check_angles(values: Any, where: str) -> list[float]:
@@ -218,8 +225,9 @@ def _check_angles(node: Node) -> list[float] | None:
     if value is None or value == "all":
         return None
     if isinstance(value, str):
+        items = _comma_items(value, node.path)
         try:
-            value = [float(p) for p in value.split(",") if p.strip()]
+            value = [float(p) for p in items]
         except ValueError:
             raise node.error(f"expected 'all' or table angles in degrees, got {node.value!r}") from None
     if not isinstance(value, (list, tuple)) or not value:
