@@ -167,7 +167,8 @@ def _axes(node: Node) -> int | np.ndarray:
         if not 1 <= value <= MAX_AXES:
             raise node.error(f"expected a number of axes from 1 to {MAX_AXES}, got {value}")
         return value
-    if where.startswith("--"):  # the flag takes a count only: the axes themselves are for the table file
+    if where.startswith("--") and isinstance(value, str):  # the flag's text takes a count only: the axes
+        # themselves are for the table file (a Python override at "--axes" may still give them as a list)
         raise node.error(f"expected a whole number of axes from 1 to {MAX_AXES} (e.g. --axes 40; to give the "
                          f"axes themselves, list them at table.axes in a table file), got {value!r}")
     if not isinstance(value, (list, tuple)) or not value:
