@@ -7,6 +7,7 @@ duration that is a whole number of samples up to rounding takes that many, the s
 is integrated and saturated over its own length, the initial quaternion is normalised, and a run of
 exactly ``max_samples`` samples is allowed."""
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -64,9 +65,10 @@ def test_the_attitude_noise_turns_by_the_drawn_rotation_vector():
     assert abs(np.mean(angles**2) / (3 * sigma**2) - 1) < 0.1  # chi-square with 12000 dof: about 1.3 %
 
 
-def test_a_time_varying_torque_is_held_at_the_right_times_against_scipy():
-    """Gravity gradient along a circular orbit, no control: the run (both paths, 20 RK4 sub-steps a
-    sample) is the model's own equations integrated by scipy's DOP853 from t = 0."""
+def gravity_gradient_drift() -> tuple[AttitudeModel, np.ndarray, float, Any]:
+    """``(model, x0, duration, truth)``: a full-inertia body drifting under gravity gradient along a
+    circular orbit, uncontrolled, and the model's own equations integrated by scipy's DOP853 from
+    t = 0 (``truth.y`` every 10 s)."""
     spacecraft = Spacecraft([[0.9, 0.05, 0.0], [0.05, 0.4, 0.02], [0.0, 0.02, 0.6]], torquers=Torquers(1.0))
     model = AttitudeModel(spacecraft, Environment(CircularOrbit(500e3, 0.9), gravity_gradient=True))
     x0 = np.r_[quat.normalize(np.array([0.8, 0.3, -0.2, 0.4])), 2e-3, -1e-3, 5e-4]
@@ -74,6 +76,13 @@ def test_a_time_varying_torque_is_held_at_the_right_times_against_scipy():
     u, p = np.zeros(model.nu), np.zeros(3)
     truth = solve_ivp(lambda t, x: model.rhs(x, u, t, p).full().ravel(), (0.0, duration), x0, method="DOP853",
                       rtol=1e-12, atol=1e-14, t_eval=np.arange(0.0, duration + 1.0, 10.0))
+    return model, x0, duration, truth
+
+
+def test_a_time_varying_torque_is_held_at_the_right_times_against_scipy():
+    """Gravity gradient along a circular orbit, no control: the run (both paths, 20 RK4 sub-steps a
+    sample) is the model's own equations integrated by scipy's DOP853 from t = 0."""
+    model, x0, duration, truth = gravity_gradient_drift()
     for python_loop in (True, False):
         result = Simulator(model, 10.0, max_step=0.5, python_loop=python_loop).run(CONTROLLERS["none"](), x0, duration)
         assert np.max(quat.error_angle(result.q, truth.y[:4].T)) < 1e-9
@@ -90,13 +99,7 @@ def test_no_rk4_sub_step_is_longer_than_max_step():
 def test_cvodes_integrates_a_time_varying_torque_at_the_right_times_against_scipy():
     """As above with CVODES, which integrates each hold on a normalised time s in [0, 1]: the
     environment must be evaluated at t_k + s T_s, not t_k + s (10 s samples, so that the two part)."""
-    spacecraft = Spacecraft([[0.9, 0.05, 0.0], [0.05, 0.4, 0.02], [0.0, 0.02, 0.6]], torquers=Torquers(1.0))
-    model = AttitudeModel(spacecraft, Environment(CircularOrbit(500e3, 0.9), gravity_gradient=True))
-    x0 = np.r_[quat.normalize(np.array([0.8, 0.3, -0.2, 0.4])), 2e-3, -1e-3, 5e-4]
-    duration = 600.0
-    u, p = np.zeros(model.nu), np.zeros(3)
-    truth = solve_ivp(lambda t, x: model.rhs(x, u, t, p).full().ravel(), (0.0, duration), x0, method="DOP853",
-                      rtol=1e-12, atol=1e-14, t_eval=np.arange(0.0, duration + 1.0, 10.0))
+    model, x0, duration, truth = gravity_gradient_drift()
     result = Simulator(model, 10.0, integrator="cvodes", rtol=1e-12, atol=1e-14).run(CONTROLLERS["none"](), x0, duration)
     assert np.max(quat.error_angle(result.q, truth.y[:4].T)) < 1e-8  # 2.5e-10 rad; evaluated at t_k + s: 8e-4
     np.testing.assert_allclose(result.omega, truth.y[4:].T, atol=1e-10)

@@ -385,7 +385,7 @@ def test_codegen_output_never_replaces_a_runs_results(tmp_path, capsys):
     assert snapshot(out) == before
 
 
-@pytest.mark.parametrize("argv", [
+OUTPUT_OPTIONS = [
     ["run", "scenarios/eigenaxis_demo.yaml", "--out"],
     ["bench", "--problems", "bilimoria_wie_45", "--out"],
     ["sweep", "scenarios/study_spin_monte_carlo.yaml", "--out"],
@@ -393,39 +393,33 @@ def test_codegen_output_never_replaces_a_runs_results(tmp_path, capsys):
     ["table", "scenarios/eigenaxis_demo.yaml", "--out"],
     ["codegen", "scenarios/eigenaxis_demo.yaml", "--out"],
     ["export", "results/none", "--format", "aem", "--out"],
-])
+]
+"""Every command's output-directory option, before its value."""
+
+
+def _refused_output(argv: list[str], value: str, tmp_path: Path, monkeypatch, capsys) -> str:
+    """Run ``argv`` + ``value`` in an empty ``tmp_path``: exit 2, nothing made there; its stderr."""
+    root = Path(__file__).resolve().parents[1]
+    monkeypatch.chdir(tmp_path)
+    argv = [str(root / a) if a.startswith("scenarios/") else a for a in argv]
+    with pytest.raises(SystemExit) as stop:
+        main([*argv, value])
+    assert stop.value.code == 2
+    assert list(tmp_path.iterdir()) == []  # no results/, no directory named after the value
+    return capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv", OUTPUT_OPTIONS)
 def test_an_empty_output_directory_is_refused_not_replaced_by_the_default(argv, tmp_path, monkeypatch, capsys):
     """``--out ""`` wrote into results/<name> without a word."""
-    root = Path(__file__).resolve().parents[1]
-    monkeypatch.chdir(tmp_path)
-    argv = [str(root / a) if a.startswith("scenarios/") else a for a in argv]
-    with pytest.raises(SystemExit) as stop:
-        main([*argv, ""])
-    assert stop.value.code == 2
-    assert "an empty path: give the output directory" in capsys.readouterr().err
-    assert list(tmp_path.iterdir()) == []  # no results/ made
+    assert "an empty path: give the output directory" in _refused_output(argv, "", tmp_path, monkeypatch, capsys)
 
 
-@pytest.mark.parametrize("argv", [
-    ["run", "scenarios/eigenaxis_demo.yaml", "--out"],
-    ["bench", "--problems", "bilimoria_wie_45", "--out"],
-    ["sweep", "scenarios/study_spin_monte_carlo.yaml", "--out"],
-    ["sweep", "--report"],
-    ["table", "scenarios/eigenaxis_demo.yaml", "--out"],
-    ["codegen", "scenarios/eigenaxis_demo.yaml", "--out"],
-    ["export", "results/none", "--format", "aem", "--out"],
-])
+@pytest.mark.parametrize("argv", OUTPUT_OPTIONS)
 def test_a_dash_output_directory_is_refused_not_made(argv, tmp_path, monkeypatch, capsys):
     """``--out -`` (a dash usually means standard output) made a directory named ``-``."""
-    root = Path(__file__).resolve().parents[1]
-    monkeypatch.chdir(tmp_path)
-    argv = [str(root / a) if a.startswith("scenarios/") else a for a in argv]
-    with pytest.raises(SystemExit) as stop:
-        main([*argv, "-"])
-    assert stop.value.code == 2
-    err = capsys.readouterr().err
+    err = _refused_output(argv, "-", tmp_path, monkeypatch, capsys)
     assert f"{argv[-1]}: '-' is not standard output here: slewbench writes a directory of files" in err
-    assert list(tmp_path.iterdir()) == []  # no directory '-', no results/
 
 
 def test_a_file_changed_since_slewbench_wrote_it_is_not_replaced(tmp_path, capsys):
