@@ -382,3 +382,22 @@ def test_a_long_tdfc_delay_runs_in_the_python_loop_instead_of_exhausting_memory(
     assert status == 0 and seconds < 30, error
     rows = json.loads((tmp_path / "out" / "results.json").read_text())["rows"]
     assert rows[0]["status"] == "ok" and rows[0]["closed_loop"]["final_rate"] > 0
+
+
+@pytest.mark.parametrize("end", ["initial", "final"])
+def test_a_body_rate_beyond_any_spacecraft_is_refused_at_its_path(end, tmp_path, capsys):
+    """``maneuver.initial.omega: [1e23, 0, 0]`` only warned; eigenaxis's quintic then returned an
+    ``ok`` reference ending at -2e8 rad/s and the run never ended (its torque-free coast). Entries
+    beyond MAX_BODY_RATE (1e3 rad/s) are refused; 999 rad/s is accepted (with the warning)."""
+    from scenarios.cli.commands import main
+    from scenarios.schema.loader import MAX_BODY_RATE
+    accepted = [(0.999 * MAX_BODY_RATE, 0)] if end == "initial" else []  # the planners here end at rest
+    for value, status in [(1e23, 2), (1.0001 * MAX_BODY_RATE, 2), *accepted]:
+        data = copy.deepcopy(BASE)
+        data["maneuver"][end]["omega"] = [value, 0.0, 0.0]
+        path = tmp_path / f"{end}_{value:g}.yaml"
+        path.write_text(yaml.safe_dump(data))
+        assert main(["validate", str(path)]) == status, value
+        err = capsys.readouterr().err
+        if status == 2:
+            assert f"maneuver.{end}.omega: expected entries within ±1000, got [{value}" in err, err

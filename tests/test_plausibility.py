@@ -308,7 +308,8 @@ def test_the_guide_states_the_slow_slew_bar_the_code_uses():
 
 
 @pytest.mark.parametrize("change, path", [
-    (lambda d: d["maneuver"]["initial"].update(omega=[1e261, 0.0, 0.0]), "maneuver.initial.omega"),
+    (lambda d: d.setdefault("simulation", {}).setdefault("sensor_noise", {}).update(rate=1e261),
+     "simulation.sensor_noise.rate"),
     (lambda d: d.setdefault("maneuver", {}).update(max_rate=1.2e261), "maneuver.max_rate"),
 ])
 def test_a_huge_value_is_written_in_exponent_form_not_hundreds_of_digits(change, path):

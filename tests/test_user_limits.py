@@ -220,7 +220,7 @@ name: huge-rate
 spacecraft: {inertia: [10.0, 10.0, 10.0], wheels: {max_torque: 0.1, max_momentum: 2.0}}
 maneuver:
   duration: 20.0
-  initial: {q: [1, 0, 0, 0], omega: [1000000.0, 0, 0]}
+  initial: {q: [1, 0, 0, 0], omega: [999.0, 0, 0]}
   final: {q: [0.7071068, 0, 0, 0.7071068], omega: [0, 0, 0]}
 planners: [{name: eigenaxis, options: {profile: smooth}}]
 controller: {name: augmented_quaternion_feedback, options: {kp: 0.5, kd: 3.0}}
@@ -230,7 +230,8 @@ requirements: {final: {after_s: 5, error_deg: 0.1, rate: 0.001}}
 
 
 def test_a_unit_mix_up_rate_runs_and_its_final_error_search_says_it_was_limited(tmp_path) -> None:
-    """A user's 1e6 rad/s initial rate (a unit mix-up) crashed the run (128 GiB). It runs; the final
+    """A user's 1e6 rad/s initial rate (a unit mix-up) crashed the run (128 GiB); the loader now refuses
+    rates beyond 1e3 rad/s, and at 999 rad/s the same work limit is met. It runs; the final
     requirement is broken (the body cannot stop such a spin: its error and rate are far off) and
     the row says that the error's search between samples reached its work limit."""
     from scenarios.runner import run

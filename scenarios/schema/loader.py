@@ -82,6 +82,13 @@ MAX_LABEL = 100
 MAX_DURATION_S = 1.0e8
 """Longest ``maneuver.duration`` and ``simulation.duration`` [s] (about three years): planners raise
 powers of it, which must stay finite, and an epoch plus the run must be a date."""
+MAX_BODY_RATE = 1.0e3
+"""Largest entry [rad/s] of ``maneuver.initial.omega`` and ``maneuver.final.omega``: about 9,500 rpm,
+beyond any spacecraft body (fast spinners turn at a few rad/s; rates from 1 rad/s already warn,
+:mod:`scenarios.schema.plausibility`). Above it the planners' arithmetic breaks down: from 1e23 rad/s
+``eigenaxis``'s quintic returned ``ok`` ending at -2e8 rad/s and the torque-free coast after it
+never ended."""
+
 
 
 @dataclass
@@ -357,7 +364,8 @@ INITIAL = Section((
     attitude_key("q", "Initial attitude, body to inertial: a quaternion (scalar first unless ``quaternion_order: "
                  "scalar_last``), or a mapping of one form (``axis_angle``, ``euler``, ``point`` ...; the user guide's "
                  "page on manoeuvres); its instant is t = 0."),
-    vector("omega", "Initial body rate, body frame.", 3, unit="rad/s", default=[0.0, 0.0, 0.0]),
+    vector("omega", "Initial body rate, body frame.", 3, unit="rad/s", default=[0.0, 0.0, 0.0],
+           magnitude=MAX_BODY_RATE),
     custom("wheel_momentum", "Initial spin momentum of each wheel; ``null``: zero.",
            "list of numbers (one per wheel) or null", None, unit="N m s", default=None),
 ), "The state at t = 0.")
@@ -366,7 +374,8 @@ FINAL = Section((
     attitude_key("q", "Target attitude, written as ``initial.q`` is (its instant is ``duration``; ``frame: initial`` "
                  "is relative to the initial attitude); ``null``: free (rate acquisition; the attitude metrics are "
                  "then null). Only laws that need no target attitude accept it without planners.", nullable=True),
-    vector("omega", "Target body rate, body frame; ``null``: free.", 3, unit="rad/s", default=None, nullable=True),
+    vector("omega", "Target body rate, body frame; ``null``: free.", 3, unit="rad/s", default=None, nullable=True,
+           magnitude=MAX_BODY_RATE),
 ), "The state at t = ``duration``.")
 
 MANEUVER = Section((
