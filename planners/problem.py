@@ -18,7 +18,13 @@ Array = NDArray[np.float64]
 
 RADIUS_STEP = 5.0
 """Largest spacing [s] of the orbit's samples in :meth:`ManeuverProblem.environment_torque_bound`."""
-
+MAX_BODY_RATE = 1.0e3
+"""Largest entry [rad/s] of a boundary body rate (``omega0``, ``omegaf``; ``maneuver.initial.omega``
+and ``maneuver.final.omega`` of a scenario): about 9,500 rpm, beyond any spacecraft body (fast
+spinners turn at a few rad/s; rates from 1 rad/s already warn in a scenario,
+:mod:`scenarios.schema.plausibility`). Above it the planners' arithmetic breaks down: from 1e23 rad/s
+``eigenaxis``'s quintic returned ``ok`` ending at -2e8 rad/s and the torque-free coast after it
+never ended."""
 
 
 @dataclass(frozen=True)
@@ -40,7 +46,8 @@ class ManeuverProblem:
         Initial attitude quaternion, scalar first, body to inertial: unit norm within 1e-3
         (``ocp.quat.unit_norm_error``), normalised here.
     omega0 : (3,) array_like
-        Initial body rate [rad/s], body axes.
+        Initial body rate [rad/s], body axes: finite, each entry within ±:data:`MAX_BODY_RATE`
+        (1000 rad/s).
     qf : (4,) array_like or None
         Target attitude, scalar first, body to inertial: unit norm within 1e-3, normalised here. ``None`` leaves the final
         attitude free, which only suits planners that accept it in :meth:`Planner.problem_error`
@@ -51,7 +58,8 @@ class ManeuverProblem:
         duration; ``slewbench``'s runner makes a reference that ends after T ``infeasible``
         (:func:`scenarios.requirements.scoring.late_slew`).
     omegaf : (3,) array_like or None, optional
-        Target body rate [rad/s], body axes. ``None`` (default) leaves the final rate free.
+        Target body rate [rad/s], body axes, each entry within ±:data:`MAX_BODY_RATE`. ``None``
+        (default) leaves the final rate free.
     environment : ocp.Environment, optional
         Orbit and environment torques (gravity gradient, constant disturbance, magnetic field); the
         default has none.
@@ -100,9 +108,9 @@ class ManeuverProblem:
         object.__setattr__(self, "q0", _quaternion("q0", self.q0))
         if self.qf is not None:
             object.__setattr__(self, "qf", _quaternion("qf", self.qf))
-        object.__setattr__(self, "omega0", _vector("omega0", self.omega0, 3))
+        object.__setattr__(self, "omega0", _rate("omega0", self.omega0))
         if self.omegaf is not None:
-            object.__setattr__(self, "omegaf", _vector("omegaf", self.omegaf, 3))
+            object.__setattr__(self, "omegaf", _rate("omegaf", self.omegaf))
         momentum = np.zeros(self.spacecraft.n_wheels) if self.wheel_momentum0 is None else self.wheel_momentum0
         object.__setattr__(self, "wheel_momentum0", _vector("wheel_momentum0", momentum, self.spacecraft.n_wheels))
         if not is_real(self.duration) or not np.isfinite(self.duration) or not self.duration > 0:
@@ -285,6 +293,18 @@ def _vector(name: str, value: ArrayLike, size: int) -> Array:
         raise ValueError(f"{name} must be {size} finite numbers, got shape {array.shape}: {array.tolist()}")
     array.setflags(write=False)
     return array
+
+
+def _rate(name: str, value: ArrayLike) -> Array:
+    """A body rate from ``value`` (3 finite numbers, each within ±:data:`MAX_BODY_RATE`), or a
+    ``ValueError`` naming ``name``, the value and the bound."""
+    rate = _vector(name, value, 3)
+    beyond = np.abs(rate) > MAX_BODY_RATE
+    if np.any(beyond):
+        raise ValueError(f"{name} must be a body rate [rad/s] with each entry within ±{MAX_BODY_RATE:g} rad/s "
+                         f"(MAX_BODY_RATE, about 9,500 rpm, beyond any spacecraft body), got {rate.tolist()} "
+                         f"(entry {int(np.argmax(beyond))})")
+    return rate
 
 
 def _quaternion(name: str, value: ArrayLike) -> Array:

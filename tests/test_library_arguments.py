@@ -49,6 +49,23 @@ def test_maneuver_problem_checks_its_arguments(changes, words):
         problem(**changes)
 
 
+@pytest.mark.parametrize("changes, named", [
+    ({"omega0": [1e23, 0, 0]}, r"omega0 .*within ±1000 rad/s .*got \[1e\+23, 0\.0, 0\.0\] \(entry 0\)"),
+    ({"omega0": [0, 0, -1000.5]}, r"omega0 .*within ±1000 rad/s .*got \[0\.0, 0\.0, -1000\.5\] \(entry 2\)"),
+    ({"omegaf": [0, 1001, 0]}, r"omegaf .*within ±1000 rad/s .*got \[0\.0, 1001\.0, 0\.0\] \(entry 1\)"),
+])
+def test_maneuver_problem_bounds_its_rates_as_the_yaml_path_does(changes, named):
+    """From [1e23, 0, 0] eigenaxis returned an ok reference ending at -2e8 rad/s: the library now
+    refuses what maneuver.initial.omega / maneuver.final.omega refuse, with the same bound."""
+    from planners.problem import MAX_BODY_RATE
+    from scenarios.schema.loader import MAX_BODY_RATE as YAML_BOUND
+    assert MAX_BODY_RATE == YAML_BOUND == 1e3
+    with pytest.raises(ValueError, match=named):
+        problem(**changes)
+    at_bound = problem(omega0=[-1e3, 0, 1e3], omegaf=[0, 1e3, 0])  # the bound itself is accepted
+    assert at_bound.omega0.tolist() == [-1e3, 0.0, 1e3] and at_bound.omegaf.tolist() == [0.0, 1e3, 0.0]
+
+
 def test_maneuver_problem_checks_types():
     with pytest.raises(TypeError, match="spacecraft must be an ocp.Spacecraft"):
         problem(spacecraft=[2.0, 3.0, 4.0])

@@ -35,6 +35,7 @@ from ocp.metrics import DEFAULT_SETTLING_TOLERANCE_DEG
 from ocp.simulation.simulator import MAX_SAMPLES, MAX_SUBSTEPS
 from planners import PLANNERS, ManeuverProblem, Planner
 from planners.errors import UnknownNameError
+from planners.problem import MAX_BODY_RATE
 from scenarios.errors import ScenarioError, in_file
 from scenarios.requirements.spec import Requirements, Sensor
 from scenarios.schema.checks import (
@@ -82,13 +83,8 @@ MAX_LABEL = 100
 MAX_DURATION_S = 1.0e8
 """Longest ``maneuver.duration`` and ``simulation.duration`` [s] (about three years): planners raise
 powers of it, which must stay finite, and an epoch plus the run must be a date."""
-MAX_BODY_RATE = 1.0e3
-"""Largest entry [rad/s] of ``maneuver.initial.omega`` and ``maneuver.final.omega``: about 9,500 rpm,
-beyond any spacecraft body (fast spinners turn at a few rad/s; rates from 1 rad/s already warn,
-:mod:`scenarios.schema.plausibility`). Above it the planners' arithmetic breaks down: from 1e23 rad/s
-``eigenaxis``'s quintic returned ``ok`` ending at -2e8 rad/s and the torque-free coast after it
-never ended."""
-
+# MAX_BODY_RATE (planners.problem): the bound on maneuver.initial.omega and maneuver.final.omega entries,
+# ManeuverProblem's own on omega0 and omegaf
 
 
 @dataclass
