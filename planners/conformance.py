@@ -49,7 +49,10 @@ __all__ = ["ATTITUDE_TOLERANCE", "CHECKS", "CLOSED_FORM_TOLERANCE", "DETERMINISM
 ATTITUDE_TOLERANCE = 2e-5
 """rad: boundary attitudes (about 1e-3 deg, what the shooting planners guarantee)."""
 RATE_TOLERANCE = 1e-7
-"""rad/s: boundary rates, plus ``RELATIVE_TOLERANCE`` times the reference's peak rate."""
+"""rad/s: boundary rates, plus ``RELATIVE_TOLERANCE`` times the problem's rate scale (the largest of
+``‖ω0‖``, ``‖ωf‖`` and the slew angle over the reference's duration, :func:`check_boundary`), not
+the reference's own peak rate: a reference whose rate runs away mid-slew does not widen its own
+tolerance at the ends."""
 RELATIVE_TOLERANCE = 1e-5
 """Finite-difference checks, relative to the scale of the compared quantity."""
 NORM_TOLERANCE = 1e-6
@@ -208,6 +211,12 @@ def check_boundary(problem: ManeuverProblem, reference: Reference) -> None:
     (a breakpoint at 0: its sample at 0 is then the right limit, the step an impulse the scoring
     counts).
 
+    Tolerances: :data:`ATTITUDE_TOLERANCE` (2e-5 rad) on the attitudes; on the rates
+    :data:`RATE_TOLERANCE` + :data:`RELATIVE_TOLERANCE` times the problem's rate scale, the largest
+    of ``‖ω0‖``, ``‖ωf‖`` (when fixed) and ``θ / T`` (the slew angle from ``q0`` to ``qf`` over the
+    reference's duration: the mean rate of any motion between them), never the reference's own
+    rates (a reference peaking at 1e4 rad/s mid-slew would otherwise pass ends 0.1 rad/s off).
+
     Parameters
     ----------
     problem : ManeuverProblem
@@ -222,8 +231,7 @@ def check_boundary(problem: ManeuverProblem, reference: Reference) -> None:
     """
     T = reference.duration
     start, end = reference.sample(0.0), reference.sample(T)
-    peak = float(np.max(np.linalg.norm(reference.omega(np.linspace(0.0, T, 201)), axis=1)))
-    rate_tolerance = RATE_TOLERANCE + RELATIVE_TOLERANCE * peak
+    rate_tolerance = RATE_TOLERANCE + RELATIVE_TOLERANCE * _rate_scale(problem, T)
     checks = [("q0", "q(0)", start.q, problem.q0, True), ("omega0", "ω(0)", start.omega, problem.omega0, False),
               ("qf", f"q(T = {T:g} s)", end.q, problem.qf, True),
               ("omegaf", f"ω(T = {T:g} s)", end.omega, problem.omegaf, False)]
@@ -242,6 +250,16 @@ def check_boundary(problem: ManeuverProblem, reference: Reference) -> None:
                 f"{reference.planner}: {label} = {np.round(value, 6).tolist()} but the problem asks "
                 f"{condition} = {np.round(wanted, 6).tolist()} (error {error:.3g} {unit} > {tolerance:.2g}); "
                 + _fix_free(condition))
+
+
+def _rate_scale(problem: ManeuverProblem, duration: float) -> float:
+    """The problem's rate scale [rad/s] for :func:`check_boundary`: the largest of ``‖ω0‖``,
+    ``‖ωf‖`` (when fixed) and the slew angle over ``duration`` (0 without a target attitude)."""
+    angle = 0.0 if problem.qf is None else float(quat.error_angle(problem.qf, problem.q0))
+    rates = [float(np.linalg.norm(problem.omega0)), angle / duration]
+    if problem.omegaf is not None:
+        rates.append(float(np.linalg.norm(problem.omegaf)))
+    return max(rates)
 
 
 def check_ends(reference: Reference) -> None:

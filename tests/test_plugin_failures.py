@@ -35,6 +35,10 @@ from scenarios.schema.reference import summary_line
 
 T = 60.0
 """The manoeuvre's duration [s]."""
+RUNAWAY = 1e4
+"""The ``runaway`` defect's peak rate across the slew axis [rad/s], at T/2."""
+RUNAWAY_END = 0.05
+"""The ``runaway`` defect's rate at T [rad/s] (the manoeuvre asks rest)."""
 
 
 class _CubicReference(Reference):
@@ -54,6 +58,13 @@ class _CubicReference(Reference):
         theta = scale * self.angle * (3 * s**2 - 2 * s**3)
         omega = (scale * self.angle * (6 * s - 6 * s**2) / self.duration)[:, None] * self.axis
         omega_dot = (scale * self.angle * (6 - 12 * s) / self.duration**2)[:, None] * self.axis
+        if self.defect == "runaway":  # q reaches qf, but ω peaks at RUNAWAY mid-slew and ends RUNAWAY_END off rest
+            across = np.cross(self.axis, [1.0, 0.0, 0.0] if abs(self.axis[0]) < 0.9 else [0.0, 1.0, 0.0])
+            across /= np.linalg.norm(across)
+            extra = RUNAWAY * np.sin(np.pi * s) ** 2 + RUNAWAY_END * s**3
+            extra_dot = (RUNAWAY * np.pi * np.sin(2 * np.pi * s) + 3 * RUNAWAY_END * s**2) / self.duration
+            omega = omega + extra[:, None] * across
+            omega_dot = omega_dot + extra_dot[:, None] * across
         q = quat.product(self.q0, quat.from_axis_angle(self.axis, theta))
         torque = inverse_dynamics_torque(self.inertia, omega, omega_dot)
         if self.defect == "nan_late":  # q is NaN after T/2, so at T too (the coast after T starts there)
@@ -72,7 +83,7 @@ class _CubicPlanner(Planner):
 
     @dataclass(frozen=True)
     class Options:
-        defect: Literal["none", "nan_late", "nan_mid", "raise", "short"] = "none"
+        defect: Literal["none", "nan_late", "nan_mid", "raise", "short", "runaway"] = "none"
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
         return _CubicReference(problem, self.options.defect)
@@ -208,6 +219,29 @@ def test_a_law_whose_reset_raises_or_that_returns_no_command_fails_its_rows_only
     assert rows["cubic / array"]["message"].startswith(
         "simulation: test_pd raised TypeError at t = 0 s: the law returned ndarray, not an ocp.Command")
     assert rows["cubic / reset"]["status"] == rows["cubic / array"]["status"] == "failed"
+
+
+def test_a_reference_whose_rate_runs_away_does_not_widen_its_own_end_tolerance(registered: None,
+                                                                              tmp_path: Path) -> None:
+    # The "runaway" reference reaches qf but ends 0.05 rad/s (2.9 deg/s) off the rest asked, after a
+    # 1e4 rad/s excursion mid-slew. The rate tolerance scaled with the reference's own peak (1e-7 +
+    # 1e-5 * 1e4 = 0.1 rad/s) and passed it: an ok row. Scaled with the problem (by hand: the 90 deg
+    # slew over 60 s, pi/2 / 60 = 0.0262 rad/s, so 1e-7 + 1e-5 * 0.0262 = 3.6e-7 rad/s) it fails.
+    from scenarios.runner import plan_row
+    from scenarios.schema.loader import load
+    scenario = load(_scenario(tmp_path, planners="""\
+  - {name: test_cubic, label: good}
+  - {name: test_cubic, label: runaway, options: {defect: runaway}}""", controllers="""\
+  - {name: test_pd, label: pd}"""))
+    planned = scenario.planners[1].planner.plan(scenario.problem)
+    peak = float(np.max(np.linalg.norm(planned.omega(np.linspace(0.0, T, 201)), axis=1)))
+    assert peak > 0.99 * RUNAWAY  # the excursion the old tolerance scaled with
+    good, runaway = (plan_row(scenario, spec, None)[0] for spec in scenario.planners)
+    assert good.ok
+    assert runaway.status == "failed", runaway.message
+    tolerance = 1e-7 + 1e-5 * (np.pi / 2) / T
+    assert f"(error {RUNAWAY_END:.3g} rad/s > {tolerance:.2g})" in runaway.message, runaway.message
+    assert runaway.message.startswith("test_cubic: ω(T = 60 s) = ") and "does not perform the manoeuvre" in runaway.message
 
 
 def test_a_law_that_raises_or_returns_nan_fails_its_rows_only(registered: None, tmp_path: Path,
