@@ -92,6 +92,50 @@ def test_a_rate_noise_in_degrees_per_second_warns():
     assert warnings_of(noise(1e-4)) == [] and warnings_of(noise(0.099)) == []
 
 
+def _rate_error(error, max_torque=None):
+    def change(d):
+        d.setdefault("simulation", {})["initial_rate_error"] = error
+        if max_torque is not None:
+            d["spacecraft"]["wheels"]["max_torque"] = max_torque
+    return change
+
+
+def test_an_initial_rate_error_in_degrees_per_second_warns():
+    """``simulation.initial_rate_error`` is rad/s: 5 (deg/s meant) started every closed loop at
+    286 deg/s with no word, while a rate noise of 2 warned. The oracle: 5 deg/s = 0.0872665 rad/s."""
+    said = warnings_of(_rate_error([0, 5, 0]))
+    assert len(said) == 1, said
+    assert said[0].startswith("simulation.initial_rate_error: [0.0, 5.0, 0.0] rad/s has ‖δω‖ = 5 rad/s "
+                              "(286.5 deg/s), at or above 0.1 rad/s"), said
+    assert "did you mean [0.0, 0.087266, 0.0] rad/s (deg/s written as rad/s)?" in said[0], said
+    # the CubeSat's wheels take out 3.03 rad/s in the 70 s window: just under the bar, and the
+    # shipped scenarios' 0.002 rad/s, pass
+    assert warnings_of(_rate_error([0.099, 0, 0])) == [] and warnings_of(_rate_error([0.0, 0.002, -0.002])) == []
+
+
+def test_an_initial_rate_error_the_actuators_cannot_remove_in_the_window_warns():
+    """Below the 0.1 rad/s bar, an error larger than the actuators can take out within the
+    closed-loop window. The oracle, by hand: 10 µN m per body axis on the least moment 0.12 kg m²
+    give at most ‖(1, 1, 1)‖ 1e-5 / 0.12 = 1.443e-4 rad/s², 0.0101 rad/s over simulation.duration (70 s)."""
+    reach = np.sqrt(3) * 1e-5 / 0.12 * 70.0
+    said = warnings_of(_rate_error([0.05, 0, 0], max_torque=1e-5))
+    assert len(said) == 1 and said[0].startswith("simulation.initial_rate_error: [0.05, 0.0, 0.0] rad/s"), said
+    assert f"within the closed-loop window (0.000144 rad/s² at most about the least principal axis for 70 s: " \
+           f"{reach:.3g} rad/s), so no row's closed loop removes it" in said[0], said
+    assert "did you mean" not in said[0], said  # no unit slip below the bar
+    assert warnings_of(_rate_error([0.0, 0.95 * reach, 0.0], max_torque=1e-5)) == []
+    assert len(warnings_of(_rate_error([0.0, 1.05 * reach, 0.0], max_torque=1e-5))) == 1
+
+
+def test_an_initial_rate_error_with_magnetorquers_alone_is_judged_by_the_bar_only():
+    data = read_yaml(ROOT / "scenarios" / "nano_detumble.yaml")  # no stated torque bound: the field decides
+    data.setdefault("simulation", {})["initial_rate_error"] = [0.05, 0.0, 0.0]
+    assert plausibility_warnings(parse_scenario(data)) == []
+    data["simulation"]["initial_rate_error"] = [0.0, 0.0, -0.2]
+    said = [str(w) for w in plausibility_warnings(parse_scenario(data))]
+    assert len(said) == 1 and "at or above 0.1 rad/s" in said[0] and "closed-loop window" not in said[0], said
+
+
 def test_a_boundary_rate_the_actuators_cannot_reach_warns_and_a_reachable_spin_does_not():
     said = warnings_of(lambda d: d["maneuver"]["initial"].update(omega=[0.0, 0.0, 3.0]))
     assert len(said) == 1 and said[0].startswith("maneuver.initial.omega: [0.0, 0.0, 3.0] rad/s"), said

@@ -206,6 +206,14 @@ def _rates_at_or_above(given: list[tuple[str, Any]], bar: float, why: str) -> It
                               f"({value:g} deg/s)?")
 
 
+def _peak_acceleration(scenario: Scenario) -> float:
+    """The actuators' peak angular acceleration [rad/s²]: the body torque box's norm over the least
+    principal moment (``inf`` when unlimited, 0 without a stated bound: magnetorquers alone)."""
+    spacecraft = scenario.problem.spacecraft
+    least = float(np.linalg.eigvalsh(spacecraft.inertia)[0])
+    return float(np.linalg.norm(spacecraft.body_torque_limit())) / least
+
+
 def _boundary_rates(scenario: Scenario) -> Iterator[Implausible]:
     """A boundary rate (``maneuver.initial.omega``, ``maneuver.final.omega``) at or above
     :data:`MAX_RATE` that the actuators could not give or take away within the manoeuvre, even at
@@ -216,8 +224,7 @@ def _boundary_rates(scenario: Scenario) -> Iterator[Implausible]:
     depends on the field)."""
     problem = scenario.problem
     spacecraft = problem.spacecraft
-    least = float(np.linalg.eigvalsh(spacecraft.inertia)[0])
-    peak = float(np.linalg.norm(spacecraft.body_torque_limit())) / least  # rad/s^2, inf when unlimited
+    peak = _peak_acceleration(scenario)  # rad/s^2, inf when unlimited
     if peak == 0.0:  # no torque bound it can state (magnetorquers alone: the field decides): not judged
         return
     reach = peak * problem.duration
@@ -240,6 +247,45 @@ def _boundary_rates(scenario: Scenario) -> Iterator[Implausible]:
                           f"has ‖ω‖ = {norm:.4g} rad/s ({_grouped(math.degrees(norm))} deg/s), at or above {MAX_RATE:g} "
                           f"rad/s and {why}; did you mean {[round(math.radians(float(w)), 6) for w in rate]} "
                           "rad/s (deg/s written as rad/s)?")
+
+
+def _rate_error(scenario: Scenario) -> Iterator[Implausible]:
+    """An initial rate error (``simulation.initial_rate_error``, added to the closed loop's true
+    initial rate) at or above :data:`MAX_RATE_TOLERANCE`, or more than the actuators can take out
+    within the closed-loop window (``simulation.duration``, else ``maneuver.duration``) even at
+    their peak angular acceleration (the body torque box over the least principal moment). An error
+    of the rate the closed loop starts from is a small part of the rates a manoeuvre reaches (a
+    rate knowledge error, a handoff's residual; the shipped scenarios' are 0.002 rad/s); at
+    0.1 rad/s it exceeds what the most agile spacecraft slew at (a rate in deg/s written as rad/s),
+    and one the actuators cannot remove within the window leaves every row's closed loop still
+    tumbling at its end, whatever the controller. A spacecraft without a stated torque bound
+    (magnetorquers alone) is judged by the first bar only."""
+    error = np.asarray(scenario.simulation.initial_rate_error, dtype=float)
+    norm = float(np.linalg.norm(error))
+    if not norm > 0.0:
+        return
+    peak = _peak_acceleration(scenario)
+    window = scenario.simulation.duration or scenario.problem.duration
+    reach = peak * window
+    slip = norm >= MAX_RATE_TOLERANCE
+    beyond = peak > 0.0 and norm > reach
+    if not (slip or beyond):
+        return
+    why = []
+    if slip:
+        why.append(f"at or above {MAX_RATE_TOLERANCE:g} rad/s ({math.degrees(MAX_RATE_TOLERANCE):.2g} deg/s): an error "
+                   "of the rate the closed loop starts from as large as the rates the most agile spacecraft slew at")
+    if beyond:
+        why.append(f"more than the actuators can take out within the closed-loop window ({peak:.3g} rad/s² at most "
+                   f"about the least principal axis for {window:g} s: {reach:.3g} rad/s), so no row's closed loop "
+                   "removes it")
+    written = _numbers(_mapping(scenario.data, "simulation").get("initial_rate_error"))
+    shown = written if written is not None and len(written) == 3 else error.tolist()
+    meant = (f"; did you mean {[round(math.radians(v), 6) for v in shown]} rad/s (deg/s written as rad/s)?"
+             if slip else "; is the error meant, or the torque bound too small?")
+    yield Implausible("simulation.initial_rate_error", f"{shown} rad/s",
+                      f"has ‖δω‖ = {norm:.4g} rad/s ({_grouped(math.degrees(norm), 1)} deg/s), {' and '.join(why)}"
+                      f"{meant}")
 
 
 def _torques(scenario: Scenario) -> Iterator[Implausible]:
@@ -352,6 +398,7 @@ PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "rate_tolerances": _rate_tolerances,
     "rate_noise": _rate_noise,
     "boundary_rates": _boundary_rates,
+    "initial_rate_error": _rate_error,
     "actuator_torques": _torques,
     "slew_time": _slew_time,
     "disturbance": _disturbance,
