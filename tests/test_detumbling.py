@@ -264,3 +264,16 @@ def test_tdfc_mean_power_over_a_hold_and_its_sampled_stability_limit():
         energy = kinetic_energy(result.omega)
         ratios[rate] = energy[-1] / energy[0]
     assert ratios[1.0] < 1.0 < ratios[1.1], ratios
+
+
+@pytest.mark.parametrize("name", ["bdot", "tdfc"])
+def test_a_magnetic_law_refuses_a_model_without_magnetorquers_or_without_a_field(name):
+    """The magnetometer-only laws need both (their documented requirement): each missing piece is
+    named by its YAML key; with both the law runs."""
+    from controllers import CONTROLLERS
+    law = CONTROLLERS[name]()
+    with_torquers = Spacecraft(UKUBE_INERTIA, magnetorquers=Magnetorquers(0.1))
+    field = Environment(ORBIT, magnetic_field=TiltedDipole())
+    assert law.environment_error(with_torquers, field) is None
+    assert "environment.magnetic_field" in law.environment_error(with_torquers, Environment(ORBIT))
+    assert "spacecraft.magnetorquers" in law.environment_error(Spacecraft(UKUBE_INERTIA), field)

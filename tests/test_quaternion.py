@@ -86,3 +86,22 @@ def test_kinematics_about_a_fixed_axis_matches_axis_angle():
     q_t = quat.from_axis_angle(axis, rate * t)
     np.testing.assert_allclose(quat.kinematics(q_t, rate * axis),
                                0.5 * rate * np.r_[-np.sin(rate * t / 2), np.cos(rate * t / 2) * axis], atol=1e-15)
+
+
+def test_rotation_vector_series_branch_matches_the_half_angle_closed_form():
+    """Below θ² = 1e-8 the CasADi exponential map takes its series branch: its value must still be
+    ``[cos(θ/2), sin(θ/2) e]`` to rounding, and its second derivatives at zero those of the closed
+    form (∂²q0/∂v² = −I/4, ∂²q_v/∂v² = 0 at v = 0), as the NLP's Hessian reads them."""
+    import casadi as ca
+
+    from ocp.quat_casadi import from_rotation_vector
+    axis = np.array([2.0, -1.0, 2.0]) / 3.0
+    for angle in (3e-5, 1e-5, 1e-7):  # θ² from 9e-10 down: all in the series branch
+        expected = np.r_[np.cos(angle / 2), np.sin(angle / 2) * axis]
+        np.testing.assert_allclose(casadi_value("from_rotation_vector", angle * axis), expected, rtol=0, atol=1e-16)
+    v = ca.SX.sym("v", 3)
+    q = from_rotation_vector(v)
+    hessian = ca.Function("h", [v], [ca.hessian(q[0], v)[0]])
+    np.testing.assert_allclose(np.array(hessian(np.zeros(3))), -0.25 * np.eye(3), atol=1e-15)
+    jacobian = ca.Function("j", [v], [ca.jacobian(q[1:4], v)])
+    np.testing.assert_allclose(np.array(jacobian(np.zeros(3))), 0.5 * np.eye(3), atol=1e-15)

@@ -309,3 +309,18 @@ def test_scenario_rejects_a_spacecraft_the_laws_cannot_control(change, path):
     with pytest.raises(ScenarioError, match="spacecraft") as error:
         scenarios.parse_scenario(data)
     assert error.value.path == path
+
+
+def test_min_norm_lyapunov_gradient_is_eq_26_27_with_gamma_and_sigma():
+    """``L_gV = [(ω1 − ω_γσ1)/I1, (ω2 − ω_γσ2)/I2]`` with eq. 27's rates written out by hand,
+    ``ω_γσ1 = −γ q1 + σ q2 q3 / D``, ``ω_γσ2 = −γ q2 − σ q1 q3 / D``, ``D = q1² + q2²`` (unsaturated):
+    V's own gains γ, σ, not the benchmark's k, g (UoSAT-12, wheel 3 failed: the control frame is the body's)."""
+    gamma, sigma = 0.013, 0.05
+    law = MinNorm({"gamma": gamma, "sigma": sigma, "k": 0.02, "g": 0.08, "a1": None, "a2": None})
+    law.reset(two_wheel_spacecraft(failed=2), 1.0, (quat.IDENTITY, np.zeros(3)))
+    q0, q1, q2, q3 = quat.normalize([0.8, 0.3, -0.2, 0.4])
+    w1, w2, w3 = 0.01, -0.02, 0.003
+    d = q1**2 + q2**2
+    rates = (-gamma * q1 + sigma * q2 * q3 / d, -gamma * q2 - sigma * q1 * q3 / d)
+    expected = ((w1 - rates[0]) / UOSAT12[0], (w2 - rates[1]) / UOSAT12[1])
+    np.testing.assert_allclose(law.lgv((q0, q1, q2, q3, w1, w2, w3)), expected, rtol=1e-13)
