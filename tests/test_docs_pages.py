@@ -203,3 +203,126 @@ def test_the_wheels_of_a_scenario_file_are_as_the_library_guide_says(wheels, cou
         assert np.array_equal(model.spacecraft.wheels.axes, np.eye(3))
         assert np.all(np.isinf(model.spacecraft.wheels.max_torque)) and np.all(np.isinf(model.spacecraft.wheels.max_momentum))
     assert Spacecraft([2.0, 3.0, 4.0]).wheels is None  # the library's default: no wheels
+
+
+# --- README.md and docs/guide/scenarios.rst: the closed-loop defaults -----------------------------
+
+def _number(text: str) -> float:
+    return float(text.replace(",", ""))
+
+
+def test_the_closed_loop_defaults_the_readme_and_the_guide_state_are_the_schemas():
+    from ocp.metrics import DEFAULT_SETTLING_TOLERANCE_DEG
+    from scenarios.schema.loader import SIMULATION
+
+    readme = " ".join(section((ROOT / "README.md").read_text(), "**Other simulation defaults.**",
+                              "- **Spacecraft").split())
+    stated = {"sample_time": re.search(r"`sample_time` ([\d.]+) s", readme),
+              "max_step": re.search(r"at most ([\d.]+) s \(`max_step`\)", readme),
+              "max_samples": re.search(r"at most ([\d,]+) samples \(`max_samples`\)", readme)}
+    assert all(stated.values()), readme
+    assert {key: _number(match.group(1)) for key, match in stated.items()} == \
+        {key: SIMULATION[key].default for key in stated}
+    # The settling tolerance has no fixed default (null): the final-error requirement's bound when
+    # the scenario states one, else the metric's 0.5 deg.
+    assert SIMULATION["settling_tolerance_deg"].default is None
+    settling = re.search(r"`settling_tolerance_deg` ([\d.]+) \(or `requirements\.final\.error_deg` when the "
+                         r"scenario states it\)", readme)
+    assert settling and _number(settling.group(1)) == DEFAULT_SETTLING_TOLERANCE_DEG, readme
+    guide = " ".join(section((DOCS / "guide" / "scenarios.rst").read_text(), "The other closed-loop defaults",
+                             "Keys added").split())
+    sample = re.search(r"``sample_time`` ([\d.]+) s", guide)
+    step = re.search(r"``max_step`` ([\d.]+) s", guide)
+    assert sample and step, guide
+    assert (_number(sample.group(1)), _number(step.group(1))) == \
+        (SIMULATION["sample_time"].default, SIMULATION["max_step"].default)
+
+
+# --- docs/guide/scenarios.rst: the exit statuses ---------------------------------------------------
+
+def test_the_exit_status_table_names_every_command_an_interrupt_ends_with_130():
+    from scenarios.cli.status import EXIT_INTERRUPTED, INTERRUPTED_STATUS
+
+    table = section((DOCS / "guide" / "scenarios.rst").read_text(), "Exit status\n", "The closed-loop window")
+    row = " ".join(section(table, f"\n{EXIT_INTERRUPTED} ", "\n=====").split())
+    commands = {command for command, status in INTERRUPTED_STATUS.items() if status == EXIT_INTERRUPTED}
+    assert commands == {"sweep", "table"}
+    assert "a sweep interrupted" in row and "``table``" in row, row
+
+
+# --- docs/guide/slew_table.rst: the NetCDF file ------------------------------------------------------
+
+def test_the_netcdf_attributes_and_variables_the_slew_table_page_lists_are_the_files(tmp_path):
+    from scipy.io import netcdf_file
+
+    from scenarios.slewtable.files import write_table_files
+    from tests.test_table_status import synthetic_table
+
+    write_table_files(synthetic_table(tmp_path), tmp_path, plots=False)
+    with netcdf_file(tmp_path / "slew_table.nc", "r", mmap=False) as nc:
+        written = set(nc._attributes)
+        variables = set(nc.variables)
+    item = " ".join(section((DOCS / "guide" / "slew_table.rst").read_text(), "``slew_table.nc``\n",
+                            "``fit.json``\n").split())
+    attributes = set(re.findall(r"``(\w+)``", item[item.index("Global attributes:"):]))
+    attributes -= {"CF-1.8"}
+    conditional = {"duration_s"}  # written for a table of a fixed duration only
+    assert written <= attributes and attributes - written <= conditional, (sorted(written), sorted(attributes))
+    listed = set(re.findall(r"``(\w+)``", item[item.index("variables"):item.index("Global attributes:")]))
+    table_variables = {name for name in variables if not name.startswith(("held_out_", "check_"))}
+    assert table_variables <= listed, sorted(table_variables - listed)
+
+
+# --- docs/guide/bench.rst: the problems of the suite ------------------------------------------------
+
+def test_the_bench_pages_problem_table_is_the_suites_index():
+    suite = read_yaml(ROOT / "scenarios" / "bench" / "suite.yaml")
+    text = (DOCS / "guide" / "bench.rst").read_text()
+    assert f"(``version: {suite['version']}``" in text
+    rows = list_table_rows(section(text, "The problems of version", "The command\n"))
+    assert rows[0] == ["name", "objective", "optimum", "source"]
+    assert f"The problems of version {suite['version']}" in text
+    named: list[str] = []
+    kinds = {"published": "published", "best_known": "best known", "closed_form": "closed form"}
+    for names, objective, optimum, _ in rows[1:]:
+        row_names = re.findall(r"``(\w+)``", names)
+        values = [float(value) for value in re.findall(r"(?<![\w.])(\d+\.\d+(?:e-?\d+)?)(?: s)?", optimum)]
+        for k, name in enumerate(row_names):
+            problem = suite["problems"][name]
+            assert objective == problem["objective"], name
+            assert kinds[problem["optimum"]["kind"]] in optimum, (name, optimum)
+            if values:  # a closed form may be stated as its formula
+                assert values[k] == pytest.approx(problem["optimum"]["value"], rel=0, abs=1e-12), (name, optimum)
+            if "±" in optimum:
+                assert float(re.search(r"± (\S+) s", optimum).group(1)) == problem["optimum"]["tolerance"], name
+        named += row_names
+    assert named == list(suite["problems"])
+
+
+# --- docs/guide/detumbling.rst: the IGRF table's default window ------------------------------------
+
+IGRF = """
+name: igrf-window
+spacecraft: {inertia: [2.0, 3.0, 4.0], torquers: {max_torque: 0.1}, wheels: none}
+orbit: {altitude_km: 600, inclination_deg: 97.79}
+environment: {magnetic_field: {model: igrf, epoch: 2025-01-01}}
+maneuver: {duration: 120.0, initial: {q: [1, 0, 0, 0], omega: [0, 0, 0]}, final: {q: [0, 0, 0, 1], omega: [0, 0, 0]}}
+PLANNERS
+controller: {name: eigenaxis_pd}
+simulation: {sample_time: 1.0SIMULATION}
+"""
+
+
+@pytest.mark.parametrize(("planners", "duration", "span"), [
+    ("planners: [{name: eigenaxis}]", None, 2 * 120.0 + 60.0),    # twice the manoeuvre, the longer
+    ("planners: [{name: eigenaxis}]", 140.0, 2 * 120.0 + 60.0),
+    ("planners: [{name: eigenaxis}]", 400.0, 400.0 + 60.0),        # the closed-loop window, the longer
+    ("planners: []", None, 120.0 + 60.0),                          # no planner: the closed-loop window
+    ("planners: []", 400.0, 400.0 + 60.0)])
+def test_the_igrf_tables_default_window_is_as_the_detumbling_page_says(planners, duration, span):
+    text = " ".join((DOCS / "guide" / "detumbling.rst").read_text().split())
+    assert ("By default the closed-loop window or, when there are planners, twice the manoeuvre's duration if "
+            "that is longer, plus 60 s") in text
+    extra = "" if duration is None else f", duration: {duration}"
+    data = parse_yaml_text(IGRF.replace("PLANNERS", planners).replace("SIMULATION", extra))
+    assert scenarios.parse_scenario(data).problem.environment.magnetic_field.span == span

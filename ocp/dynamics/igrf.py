@@ -175,8 +175,9 @@ class IGRFField(FieldModel):
             Spacing of the table's nodes [s] (cubic B-spline between them; at 1000 s the spline
             misses the field by 42 %).
         span_s : float or None
-            Tabulated window [s]; ``null``: the closed-loop window (twice the manoeuvre's duration
-            when there are planners) plus 60 s. A run beyond it is a failed row naming this key.
+            Tabulated window [s]; ``null``: the closed-loop window or, when there are planners,
+            twice the manoeuvre's duration if that is longer, plus 60 s. A run beyond it is a failed
+            row naming this key.
         greenwich_angle_deg : float or None
             Angle of the Earth-fixed x axis from the inertial x axis at t = 0 [deg]; ``null``: the
             Greenwich mean sidereal time of the epoch.
