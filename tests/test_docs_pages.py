@@ -250,6 +250,26 @@ def test_the_exit_status_table_names_every_command_an_interrupt_ends_with_130():
     assert "a sweep interrupted" in row and "``table``" in row, row
 
 
+
+# --- docs/guide/slew_table.rst: a bare count that reads like degrees ---------------------------------
+
+def test_the_slew_table_pages_bare_count_example_is_what_the_command_prints(tmp_path, capsys):
+    """The page's ``--axes 12 ... --angles 90`` example, run on ``collocation_min_time.yaml`` (the
+    page's first example scenario): it exits 2 and prints the message the page quotes, word for
+    word (with the default polytope grid, 12 axes are 14, so the page must say ``--grid fibonacci``)."""
+    from scenarios.cli import main
+
+    text = " ".join((DOCS / "guide" / "slew_table.rst").read_text().split())
+    found = re.search(r"confirms the work: ``(--axes [^`]+)`` exits 2 with ``([^`]+)``", text)
+    assert found, "the example moved: update this test"
+    arguments, quoted = found.group(1).split(), found.group(2)
+    out = tmp_path / "out"
+    status = main(["table", str(ROOT / "scenarios" / "collocation_min_time.yaml"), *arguments, "--out", str(out),
+                   "--no-plots"])
+    err = " ".join(capsys.readouterr().err.split())
+    assert status == 2 and quoted in err, (arguments, quoted, err)
+    assert not out.exists()
+
 # --- docs/guide/slew_table.rst: the NetCDF file ------------------------------------------------------
 
 def test_the_netcdf_attributes_and_variables_the_slew_table_page_lists_are_the_files(tmp_path):
