@@ -37,6 +37,7 @@ from scenarios.output.tables import is_missing
 from scenarios.output.writer import check_run_directory
 
 if TYPE_CHECKING:  # the trade-study machinery is imported by the handlers: `slewbench run` does not load it
+    from scenarios.cli.commands import StudyFindings
     from scenarios.study.engine import DaskCluster
     from scenarios.study.store import SweepStore
     from scenarios.study.types import Study
@@ -353,13 +354,17 @@ def command_sweep(args: argparse.Namespace) -> int:
             if not scheduler:
                 start_forkserver()  # local workers' imports run while the study is expanded and checked
             phase = "while its cases were checked"
-            study = load_study(args.file, progress=_checking(Path(args.file).stem))
+            found = None
+            if args.dry_run:  # the cases' findings, from the loader's parse where the check parsed the case
+                from scenarios.cli.commands import StudyFindings
+                found = StudyFindings()
+            study = load_study(args.file, progress=_checking(Path(args.file).stem), parsed=found)
             _check_interrupted(args)  # one that CasADi swallowed
             phase = "before its first case"
             if args.dry_run:
                 if args.resume:  # what the real resume would refuse, it refuses (nothing is written either way)
                     _output(args, study)
-                _list_cases(study, args.workers or study.execution.workers or _local_workers())
+                _list_cases(study, args.workers or study.execution.workers or _local_workers(), found)
                 return EXIT_OK
             where = "--scheduler" if scheduler else "execution.scheduler"
             scheduler = scheduler or study.execution.scheduler
@@ -404,7 +409,7 @@ def _local_workers() -> int:
     return default_workers()
 
 
-def _list_cases(study: Study, workers: int) -> None:
+def _list_cases(study: Study, workers: int, found: StudyFindings | None = None) -> None:
     """Print what ``sweep`` would run: the checked cases and their varied values (nothing written),
     for a large study how to estimate its time (:func:`scenarios.study.spec.size_note`), and what
     ``validate`` finds in the cases (:func:`scenarios.cli.commands.study_findings`: a case whose
@@ -425,7 +430,7 @@ def _list_cases(study: Study, workers: int) -> None:
               + (f": {values}" if values else ""))
     if len(study.cases) > DRY_RUN_SHOWN:
         print(f"  ... and {len(study.cases) - DRY_RUN_SHOWN} more")
-    findings = study_findings(study)  # what `validate` says of the cases, said the same way
+    findings = study_findings(study, found)  # what `validate` says of the cases, said the same way
     if findings:
         print(f"{len(findings)} finding(s), as `slewbench validate` says them (cases whose rows cannot be ok, "
               "a slew longer than maneuver.duration among them; plausibility warnings):")
