@@ -28,6 +28,7 @@ from scenarios.cli.status import (
     EXIT_OK,
     crash_report,
     directory_argument,
+    workers_note,
 )
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, claim_output_directory, written_files
@@ -364,7 +365,8 @@ def command_sweep(args: argparse.Namespace) -> int:
             if args.dry_run:
                 if args.resume:  # what the real resume would refuse, it refuses (nothing is written either way)
                     _output(args, study)
-                _list_cases(study, args.workers or study.execution.workers or _local_workers(), found)
+                _list_cases(study, args.workers or study.execution.workers or _local_workers(), found,
+                            local=not (scheduler or study.execution.scheduler), option=_workers_option(args))
                 return EXIT_OK
             where = "--scheduler" if scheduler else "execution.scheduler"
             scheduler = scheduler or study.execution.scheduler
@@ -409,7 +411,20 @@ def _local_workers() -> int:
     return default_workers()
 
 
-def _list_cases(study: Study, workers: int, found: StudyFindings | None = None) -> None:
+def _workers_option(args: argparse.Namespace) -> str:
+    """Where the number of workers was given: ``--workers``, else the study's ``execution.workers``."""
+    return "--workers" if args.workers is not None else "execution.workers"
+
+
+def _say_workers(workers: int | None, option: str) -> None:
+    """Print :func:`~scenarios.cli.status.workers_note` for a local pool of ``workers``."""
+    note = workers_note(workers, _local_workers(), option, "cases")
+    if note:
+        print(note, flush=True)
+
+
+def _list_cases(study: Study, workers: int, found: StudyFindings | None = None, local: bool = True,
+                option: str = "--workers") -> None:
     """Print what ``sweep`` would run: the checked cases and their varied values (nothing written),
     for a large study how to estimate its time (:func:`scenarios.study.spec.size_note`), and what
     ``validate`` finds in the cases (:func:`scenarios.cli.commands.study_findings`: a case whose
@@ -424,6 +439,8 @@ def _list_cases(study: Study, workers: int, found: StudyFindings | None = None) 
     note = size_note(study, workers)
     if note:
         print(note)
+    if local:
+        _say_workers(workers, option)
     for case in study.cases[:DRY_RUN_SHOWN]:
         values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
         print(f"  case {case.index} (grid point {case.point}, seed {case.seed}, key {case.key[:12]})"
@@ -497,6 +514,8 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
                 study, args.workers or _cluster_threads(cluster) or study.execution.workers or _local_workers())
             if size:
                 print(size, flush=True)
+            if cluster is None:
+                _say_workers(args.workers or study.execution.workers, _workers_option(args))
             results = sweep(study, workers=args.workers, store=store, progress=True, cluster=cluster)
         _check_interrupted(args)  # a Ctrl-C lost on the way: the sweep's tables are not written
     except (SweepInterrupted, KeyboardInterrupt) as stop:  # KeyboardInterrupt: before the sweep took over
