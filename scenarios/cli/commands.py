@@ -18,6 +18,7 @@ import sys
 import threading
 import time
 import traceback
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -142,9 +143,12 @@ def command_schema(args: argparse.Namespace) -> int:
 
 STRICT_LINES_SHOWN = 10
 """Lines of a study's per-case findings ``validate`` prints (the others are counted)."""
+FINDINGS_PROGRESS_EVERY = 256
+"""Cases between two calls of the ``progress`` callback of :func:`study_findings`."""
 
 
-def study_findings(study: Any, found: StudyFindings | None = None) -> list[str]:
+def study_findings(study: Any, found: StudyFindings | None = None,
+                   progress: Callable[[int, int], None] | None = None) -> list[str]:
     """What ``validate`` finds in a study's cases (``sweep --dry-run`` says the same): each case's
     :func:`_strict_findings` (rows that cannot be ok, a slew longer than ``maneuver.duration`` by a
     planner's ``least_duration`` among them, and plausibility warnings), naming the case and its
@@ -158,13 +162,15 @@ def study_findings(study: Any, found: StudyFindings | None = None) -> list[str]:
         The findings gathered while the study was checked (given to
         :func:`~scenarios.study.spec.load_study` as ``parsed``): its cases are not parsed again.
         None: every case is parsed here.
+    progress : callable or None, optional
+        ``progress(judged, total)``, called every :data:`FINDINGS_PROGRESS_EVERY` cases and at the end.
 
     Returns
     -------
     list of str
         ``case N [path=value, ...]: <finding>``, in case order; empty when there is none.
     """
-    return (found or StudyFindings()).lines(study)
+    return (found or StudyFindings()).lines(study, progress)
 
 
 class StudyFindings:
@@ -211,13 +217,15 @@ class StudyFindings:
             self._found[case.index] = found
         return found
 
-    def lines(self, study: Any) -> list[str]:
+    def lines(self, study: Any, progress: Callable[[int, int], None] | None = None) -> list[str]:
         """Every case's findings, naming the case and its varied values (:func:`study_findings`).
 
         Parameters
         ----------
         study : scenarios.study.Study
             The expanded, checked study.
+        progress : callable or None, optional
+            As :func:`study_findings`.
 
         Returns
         -------
@@ -225,13 +233,16 @@ class StudyFindings:
             ``case N [path=value, ...]: <finding>``, in case order.
         """
         findings = []
-        for case in study.cases:
+        total = len(study.cases)
+        for number, case in enumerate(study.cases, 1):
             found = (self._found.get(case.index, []) if case.index in self._done
                      else self._keep(case, parse_scenario(case.scenario, inapplicable_rows=True)))
             if found:
                 values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
                 where = f"case {case.index}" + (f" [{values}]" if values else "")
                 findings += [f"{where}: {line}" for line in found]
+            if progress is not None and (number % FINDINGS_PROGRESS_EVERY == 0 or number == total):
+                progress(number, total)
         return findings
 
 

@@ -197,12 +197,13 @@ CHECKING_LINE_S = 1.0
 faster says nothing."""
 
 
-def _checking(name: str, clock: Any = time.monotonic) -> Any:
+def _checking(name: str, clock: Any = time.monotonic, doing: str = "checking", done: str = "checked") -> Any:
     """A progress callback for the cases' checks (``progress(checked, total)`` of
     :func:`scenarios.study.spec.parse_study`): a bar on a terminal; elsewhere a line
     (``NAME: checking 180 cases, 40 checked, 1.0 s elapsed``) once the check has taken
     :data:`CHECKING_LINE_S`, then at most every
-    :data:`~scenarios.study.engine.PROGRESS_LINE_S`, and one when it is done if any was said."""
+    :data:`~scenarios.study.engine.PROGRESS_LINE_S`, and one when it is done if any was said.
+    ``doing`` and ``done`` word another pass over the cases (the dry run's findings: ``judging``)."""
     from scenarios.study.engine import PROGRESS_LINE_S
 
     started = clock()
@@ -214,15 +215,15 @@ def _checking(name: str, clock: Any = time.monotonic) -> Any:
             elapsed = clock() - started
             if checked >= total:
                 if "said" in state:
-                    print(f"{name}: {total} cases checked in {elapsed:.1f} s", file=sys.stderr, flush=True)
+                    print(f"{name}: {total} cases {done} in {elapsed:.1f} s", file=sys.stderr, flush=True)
             elif elapsed - state.get("said", CHECKING_LINE_S - PROGRESS_LINE_S) >= PROGRESS_LINE_S:
                 state["said"] = elapsed
-                print(f"{name}: checking {total} cases, {checked} checked, {elapsed:.1f} s elapsed", file=sys.stderr,
+                print(f"{name}: {doing} {total} cases, {checked} {done}, {elapsed:.1f} s elapsed", file=sys.stderr,
                       flush=True)
             return
         if "bar" not in state:
             from tqdm import tqdm
-            state["bar"] = tqdm(total=total, unit="case", desc=f"checking {name[:30]}", file=sys.stderr, leave=False,
+            state["bar"] = tqdm(total=total, unit="case", desc=f"{doing} {name[:30]}", file=sys.stderr, leave=False,
                                 mininterval=0.5)
         state["bar"].update(checked - state["bar"].n)
         if checked >= total:
@@ -366,7 +367,8 @@ def command_sweep(args: argparse.Namespace) -> int:
                 if args.resume:  # what the real resume would refuse, it refuses (nothing is written either way)
                     _output(args, study)
                 _list_cases(study, args.workers or study.execution.workers or _local_workers(), found,
-                            local=not (scheduler or study.execution.scheduler), option=_workers_option(args))
+                            local=not (scheduler or study.execution.scheduler), option=_workers_option(args),
+                            name=Path(args.file).stem)
                 return EXIT_OK
             where = "--scheduler" if scheduler else "execution.scheduler"
             scheduler = scheduler or study.execution.scheduler
@@ -424,7 +426,7 @@ def _say_workers(workers: int | None, option: str) -> None:
 
 
 def _list_cases(study: Study, workers: int, found: StudyFindings | None = None, local: bool = True,
-                option: str = "--workers") -> None:
+                option: str = "--workers", name: str | None = None) -> None:
     """Print what ``sweep`` would run: the checked cases and their varied values (nothing written),
     for a large study how to estimate its time (:func:`scenarios.study.spec.size_note`), and what
     ``validate`` finds in the cases (:func:`scenarios.cli.commands.study_findings`: a case whose
@@ -447,7 +449,8 @@ def _list_cases(study: Study, workers: int, found: StudyFindings | None = None, 
               + (f": {values}" if values else ""))
     if len(study.cases) > DRY_RUN_SHOWN:
         print(f"  ... and {len(study.cases) - DRY_RUN_SHOWN} more")
-    findings = study_findings(study, found)  # what `validate` says of the cases, said the same way
+    # what `validate` says of the cases, said the same way (a large study's take a while: said as its check is)
+    findings = study_findings(study, found, _checking(name or study.name, doing="judging", done="judged"))
     if findings:
         print(f"{len(findings)} finding(s), as `slewbench validate` says them (cases whose rows cannot be ok, "
               "a slew longer than maneuver.duration among them; plausibility warnings):")
