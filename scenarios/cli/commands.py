@@ -10,12 +10,15 @@ from __future__ import annotations
 
 import argparse
 import errno
+import functools
+import json
 import os
 import signal
 import sys
 import threading
 import time
 import traceback
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -140,9 +143,12 @@ def command_schema(args: argparse.Namespace) -> int:
 
 STRICT_LINES_SHOWN = 10
 """Lines of a study's per-case findings ``validate`` prints (the others are counted)."""
+FINDINGS_PROGRESS_EVERY = 256
+"""Cases between two calls of the ``progress`` callback of :func:`study_findings`."""
 
 
-def study_findings(study: Any) -> list[str]:
+def study_findings(study: Any, found: StudyFindings | None = None,
+                   progress: Callable[[int, int], None] | None = None) -> list[str]:
     """What ``validate`` finds in a study's cases (``sweep --dry-run`` says the same): each case's
     :func:`_strict_findings` (rows that cannot be ok, a slew longer than ``maneuver.duration`` by a
     planner's ``least_duration`` among them, and plausibility warnings), naming the case and its
@@ -152,18 +158,130 @@ def study_findings(study: Any) -> list[str]:
     ----------
     study : scenarios.study.Study
         The expanded, checked study.
+    found : StudyFindings or None, optional
+        The findings gathered while the study was checked (given to
+        :func:`~scenarios.study.spec.load_study` as ``parsed``): its cases are not parsed again.
+        None: every case is parsed here.
+    progress : callable or None, optional
+        ``progress(judged, total)``, called every :data:`FINDINGS_PROGRESS_EVERY` cases and at the end.
 
     Returns
     -------
     list of str
         ``case N [path=value, ...]: <finding>``, in case order; empty when there is none.
     """
-    findings = []
-    for case in study.cases:
-        values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
-        where = f"case {case.index}" + (f" [{values}]" if values else "")
-        findings += [f"{where}: {line}" for line in _strict_findings(parse_scenario(case.scenario, inapplicable_rows=True))]
-    return findings
+    return (found or StudyFindings()).lines(study, progress)
+
+
+class StudyFindings:
+    """:func:`_strict_findings` of a study's cases, each case parsed by the loader once.
+
+    Given to :func:`~scenarios.study.spec.load_study` as ``parsed``, it is called with each case
+    the loader parsed while the study was checked, and keeps its findings; :meth:`lines` parses the
+    others (cases checked by the verdict of an earlier case of their class). The lines that read
+    only the problem, the planners and the requirements (:func:`_planning_lines`: a planner's
+    ``least_duration`` plans the slew) are computed once for all cases whose scenarios differ only
+    in :data:`~scenarios.schema.study.INDEPENDENT_KEYS`, which the loader reads into
+    ``scenario.simulation`` alone (the same rule that lets the study check them by their own
+    readers); the rest (:func:`_rate_lines`, the plausibility warnings) per case.
+    """
+
+    def __init__(self) -> None:
+        self._found: dict[int, list[str]] = {}  # case index -> its findings (a case without any is absent)
+        self._done: set[int] = set()
+        self._planning: dict[str, list[str]] = {}  # a scenario without its independent keys -> _planning_lines
+
+    def __call__(self, case: Any, scenario: Scenario) -> None:
+        """Keep the findings of ``case``, parsed by the loader into ``scenario``.
+
+        Parameters
+        ----------
+        case : scenarios.study.Case
+            The case.
+        scenario : Scenario
+            ``parse_scenario(case.scenario, inapplicable_rows=True)``.
+        """
+        self._keep(case, scenario)
+
+    def _keep(self, case: Any, scenario: Scenario) -> list[str]:
+        shared = _shared_text(case.scenario)
+        planning = self._planning.get(shared) if shared is not None else None
+        if planning is None:
+            planning = [line for line, every in _planning_lines(scenario) if every]
+            if shared is not None:
+                self._planning[shared] = planning
+        found = (planning + [line for line, every in _rate_lines(scenario) if every]
+                 + [f"warning: {warning}" for warning in plausibility_warnings(scenario)])
+        self._done.add(case.index)
+        if found:
+            self._found[case.index] = found
+        return found
+
+    def lines(self, study: Any, progress: Callable[[int, int], None] | None = None) -> list[str]:
+        """Every case's findings, naming the case and its varied values (:func:`study_findings`).
+
+        Parameters
+        ----------
+        study : scenarios.study.Study
+            The expanded, checked study.
+        progress : callable or None, optional
+            As :func:`study_findings`.
+
+        Returns
+        -------
+        list of str
+            ``case N [path=value, ...]: <finding>``, in case order.
+        """
+        findings = []
+        total = len(study.cases)
+        for number, case in enumerate(study.cases, 1):
+            found = (self._found.get(case.index, []) if case.index in self._done
+                     else self._keep(case, parse_scenario(case.scenario, inapplicable_rows=True)))
+            if found:
+                values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
+                where = f"case {case.index}" + (f" [{values}]" if values else "")
+                findings += [f"{where}: {line}" for line in found]
+            if progress is not None and (number % FINDINGS_PROGRESS_EVERY == 0 or number == total):
+                progress(number, total)
+        return findings
+
+
+@functools.cache
+def _independent_tree() -> dict[str, Any]:
+    """:data:`~scenarios.schema.study.INDEPENDENT_KEYS` as nested mappings (a leaf: None)."""
+    from scenarios.schema.study import INDEPENDENT_KEYS
+
+    tree: dict[str, Any] = {}
+    for path in INDEPENDENT_KEYS:
+        *parents, last = path.split(".")
+        node = tree
+        for part in parents:
+            node = node.setdefault(part, {})
+        node[last] = None
+    return tree
+
+
+def _shared_text(scenario: dict[str, Any]) -> str | None:
+    """A scenario mapping without its :data:`~scenarios.schema.study.INDEPENDENT_KEYS`, as JSON text
+    (equal texts: equal scenarios but for those keys); None for data JSON does not hold exactly
+    (then nothing is shared)."""
+    def strip(data: Any, tree: dict[str, Any]) -> Any:
+        if isinstance(data, list):
+            return [strip(item, {}) for item in data]
+        if not isinstance(data, dict):
+            return data
+        if not all(isinstance(key, str) for key in data):  # JSON would write 1 and "1" alike
+            raise TypeError("a key that is not text")
+        return {key: strip(value, tree[key]) if isinstance(tree.get(key), dict) else value
+                for key, value in data.items() if not (key in tree and tree[key] is None)}
+
+    def refuse(value: Any) -> Any:
+        raise TypeError(type(value).__name__)
+
+    try:
+        return json.dumps(strip(scenario, _independent_tree()), default=refuse, allow_nan=True)
+    except (TypeError, ValueError):
+        return None
 
 
 def print_findings(findings: list[str]) -> None:
@@ -187,10 +305,11 @@ def _validate_study(file: str) -> tuple[str, list[str]]:
     naming the case and its varied values."""
     from scenarios.study.spec import load_study
 
-    study = load_study(file)
+    found = StudyFindings()  # each case's findings, from the loader's parse where the check parsed it
+    study = load_study(file, parsed=found)
     points = len({case.point for case in study.cases})
     varied = ", ".join(study.varied_paths) or "nothing"
-    findings = study_findings(study)
+    findings = study_findings(study, found)
     return (f"{file}: valid study {study.name!r}: {len(study.cases)} cases ({points} grid point(s) x "
             f"{study.samples} sample(s)), varying {varied}; run it with `slewbench {OTHER_FILES['study']} {file}`",
             findings)
@@ -367,9 +486,27 @@ def _before_planning(scenario: Scenario) -> list[tuple[str, bool]]:
     list of (str, bool)
         Each line and whether it dooms every row.
     """
+    return _planning_lines(scenario) + _rate_lines(scenario)
+
+
+def _rate_lines(scenario: Scenario) -> list[tuple[str, bool]]:
+    """The lines of :func:`_before_planning` that read ``scenario.simulation`` (a boundary rate, or
+    the closed loop's true initial rate, above the rate requirement: each dooms every row)."""
+    from scenarios.schema.checks import rate_bound_notes
+
+    rate = scenario.requirements.rate
+    if rate is None:
+        return []
+    return [(line, True) for line in rate_bound_notes(scenario.problem, scenario.simulation, rate.max_rate)]
+
+
+def _planning_lines(scenario: Scenario) -> list[tuple[str, bool]]:
+    """The lines of :func:`_before_planning` that read only the problem, the planners and the
+    requirements (not ``scenario.simulation``, not ``scenario.data``): the same for every case of
+    a study that differs only in :data:`~scenarios.schema.study.INDEPENDENT_KEYS`
+    (:class:`StudyFindings` computes them once for such cases)."""
     from planners.capabilities import minimises_time
     from scenarios.requirements.scoring import endpoint_violations, late_slew
-    from scenarios.schema.checks import rate_bound_notes
 
     requirements = scenario.requirements
     count = len(scenario.planners)
@@ -401,9 +538,6 @@ def _before_planning(scenario: Scenario) -> list[tuple[str, bool]]:
                                         else ", ".join(dict.fromkeys(line.split(":")[0] for line in broken[i])))
                    for i, spec in enumerate(scenario.planners)]
         lines.append((f"every planner's row {words} before planning ({'; '.join(reasons)}): no row can be ok", True))
-    if requirements.rate is not None:  # a boundary rate above the bound: every row breaks it
-        lines += [(line, True) for line in rate_bound_notes(scenario.problem, scenario.simulation,
-                                                             requirements.rate.max_rate)]
     return lines
 
 

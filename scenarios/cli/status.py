@@ -10,7 +10,7 @@ import re
 
 __all__ = ["CRASH_REASONS_SHOWN", "EXIT_BAD_OUTPUT", "EXIT_BAD_SCENARIO", "EXIT_CRASHED", "EXIT_INTERNAL",
            "EXIT_INTERRUPTED", "EXIT_NOT_OK", "EXIT_OK", "INTERRUPTED_STATUS", "SWEEP_CRASH_CAUSES", "attached_values",
-           "crash_report", "directory_argument", "interrupted_status"]
+           "crash_report", "directory_argument", "interrupted_status", "workers_note"]
 
 EXIT_OK = 0
 """The command completed (a run's failed and violated rows, a table's entries that are not ok
@@ -196,3 +196,30 @@ def _valued_options(parser: argparse.ArgumentParser) -> set[str]:
         elif action.nargs != 0:
             found.update(option for option in action.option_strings if option.startswith("--"))
     return found
+
+
+def workers_note(workers: int | None, cores: int, option: str, units: str) -> str | None:
+    """The note of a command given more local workers than cores: not an error, but each of its
+    cases then shares a core, runs slower, and its plan and simulation times are inflated.
+
+    Parameters
+    ----------
+    workers : int or None
+        The workers asked for (None: the default, one per core).
+    cores : int
+        The cores this process may run on (its CPU affinity, where the system says it).
+    option : str
+        Where the number was given (``--workers``, ``execution.workers``).
+    units : str
+        What the workers run, plural (``cases``, ``entries``).
+
+    Returns
+    -------
+    str or None
+        ``note: --workers 8 is more than the 2 cores ...``; None when ``workers`` is at most ``cores``.
+    """
+    if workers is None or workers <= cores:
+        return None
+    return (f"note: {option} {workers} is more than the {cores} core{'s' if cores != 1 else ''} this process may "
+            f"run on: the {units} share them, so each runs slower and its plan and simulation times in the tables "
+            "are inflated")

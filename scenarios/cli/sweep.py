@@ -28,6 +28,7 @@ from scenarios.cli.status import (
     EXIT_OK,
     crash_report,
     directory_argument,
+    workers_note,
 )
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import MARKER, claim_output_directory, written_files
@@ -37,6 +38,7 @@ from scenarios.output.tables import is_missing
 from scenarios.output.writer import check_run_directory
 
 if TYPE_CHECKING:  # the trade-study machinery is imported by the handlers: `slewbench run` does not load it
+    from scenarios.cli.commands import StudyFindings
     from scenarios.study.engine import DaskCluster
     from scenarios.study.store import SweepStore
     from scenarios.study.types import Study
@@ -195,12 +197,13 @@ CHECKING_LINE_S = 1.0
 faster says nothing."""
 
 
-def _checking(name: str, clock: Any = time.monotonic) -> Any:
+def _checking(name: str, clock: Any = time.monotonic, doing: str = "checking", done: str = "checked") -> Any:
     """A progress callback for the cases' checks (``progress(checked, total)`` of
     :func:`scenarios.study.spec.parse_study`): a bar on a terminal; elsewhere a line
     (``NAME: checking 180 cases, 40 checked, 1.0 s elapsed``) once the check has taken
     :data:`CHECKING_LINE_S`, then at most every
-    :data:`~scenarios.study.engine.PROGRESS_LINE_S`, and one when it is done if any was said."""
+    :data:`~scenarios.study.engine.PROGRESS_LINE_S`, and one when it is done if any was said.
+    ``doing`` and ``done`` word another pass over the cases (the dry run's findings: ``judging``)."""
     from scenarios.study.engine import PROGRESS_LINE_S
 
     started = clock()
@@ -212,15 +215,15 @@ def _checking(name: str, clock: Any = time.monotonic) -> Any:
             elapsed = clock() - started
             if checked >= total:
                 if "said" in state:
-                    print(f"{name}: {total} cases checked in {elapsed:.1f} s", file=sys.stderr, flush=True)
+                    print(f"{name}: {total} cases {done} in {elapsed:.1f} s", file=sys.stderr, flush=True)
             elif elapsed - state.get("said", CHECKING_LINE_S - PROGRESS_LINE_S) >= PROGRESS_LINE_S:
                 state["said"] = elapsed
-                print(f"{name}: checking {total} cases, {checked} checked, {elapsed:.1f} s elapsed", file=sys.stderr,
+                print(f"{name}: {doing} {total} cases, {checked} {done}, {elapsed:.1f} s elapsed", file=sys.stderr,
                       flush=True)
             return
         if "bar" not in state:
             from tqdm import tqdm
-            state["bar"] = tqdm(total=total, unit="case", desc=f"checking {name[:30]}", file=sys.stderr, leave=False,
+            state["bar"] = tqdm(total=total, unit="case", desc=f"{doing} {name[:30]}", file=sys.stderr, leave=False,
                                 mininterval=0.5)
         state["bar"].update(checked - state["bar"].n)
         if checked >= total:
@@ -353,13 +356,19 @@ def command_sweep(args: argparse.Namespace) -> int:
             if not scheduler:
                 start_forkserver()  # local workers' imports run while the study is expanded and checked
             phase = "while its cases were checked"
-            study = load_study(args.file, progress=_checking(Path(args.file).stem))
+            found = None
+            if args.dry_run:  # the cases' findings, from the loader's parse where the check parsed the case
+                from scenarios.cli.commands import StudyFindings
+                found = StudyFindings()
+            study = load_study(args.file, progress=_checking(Path(args.file).stem), parsed=found)
             _check_interrupted(args)  # one that CasADi swallowed
             phase = "before its first case"
             if args.dry_run:
                 if args.resume:  # what the real resume would refuse, it refuses (nothing is written either way)
                     _output(args, study)
-                _list_cases(study, args.workers or study.execution.workers or _local_workers())
+                _list_cases(study, args.workers or study.execution.workers or _local_workers(), found,
+                            local=not (scheduler or study.execution.scheduler), option=_workers_option(args),
+                            name=Path(args.file).stem)
                 return EXIT_OK
             where = "--scheduler" if scheduler else "execution.scheduler"
             scheduler = scheduler or study.execution.scheduler
@@ -404,7 +413,20 @@ def _local_workers() -> int:
     return default_workers()
 
 
-def _list_cases(study: Study, workers: int) -> None:
+def _workers_option(args: argparse.Namespace) -> str:
+    """Where the number of workers was given: ``--workers``, else the study's ``execution.workers``."""
+    return "--workers" if args.workers is not None else "execution.workers"
+
+
+def _say_workers(workers: int | None, option: str) -> None:
+    """Print :func:`~scenarios.cli.status.workers_note` for a local pool of ``workers``."""
+    note = workers_note(workers, _local_workers(), option, "cases")
+    if note:
+        print(note, flush=True)
+
+
+def _list_cases(study: Study, workers: int, found: StudyFindings | None = None, local: bool = True,
+                option: str = "--workers", name: str | None = None) -> None:
     """Print what ``sweep`` would run: the checked cases and their varied values (nothing written),
     for a large study how to estimate its time (:func:`scenarios.study.spec.size_note`), and what
     ``validate`` finds in the cases (:func:`scenarios.cli.commands.study_findings`: a case whose
@@ -419,13 +441,16 @@ def _list_cases(study: Study, workers: int) -> None:
     note = size_note(study, workers)
     if note:
         print(note)
+    if local:
+        _say_workers(workers, option)
     for case in study.cases[:DRY_RUN_SHOWN]:
         values = ", ".join(f"{path}={value}" for path, value in case.varied.items())
         print(f"  case {case.index} (grid point {case.point}, seed {case.seed}, key {case.key[:12]})"
               + (f": {values}" if values else ""))
     if len(study.cases) > DRY_RUN_SHOWN:
         print(f"  ... and {len(study.cases) - DRY_RUN_SHOWN} more")
-    findings = study_findings(study)  # what `validate` says of the cases, said the same way
+    # what `validate` says of the cases, said the same way (a large study's take a while: said as its check is)
+    findings = study_findings(study, found, _checking(name or study.name, doing="judging", done="judged"))
     if findings:
         print(f"{len(findings)} finding(s), as `slewbench validate` says them (cases whose rows cannot be ok, "
               "a slew longer than maneuver.duration among them; plausibility warnings):")
@@ -492,6 +517,8 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
                 study, args.workers or _cluster_threads(cluster) or study.execution.workers or _local_workers())
             if size:
                 print(size, flush=True)
+            if cluster is None:
+                _say_workers(args.workers or study.execution.workers, _workers_option(args))
             results = sweep(study, workers=args.workers, store=store, progress=True, cluster=cluster)
         _check_interrupted(args)  # a Ctrl-C lost on the way: the sweep's tables are not written
     except (SweepInterrupted, KeyboardInterrupt) as stop:  # KeyboardInterrupt: before the sweep took over

@@ -29,6 +29,7 @@ from scenarios.cli.status import (
     EXIT_OK,
     crash_report,
     directory_argument,
+    workers_note,
 )
 
 if TYPE_CHECKING:
@@ -166,7 +167,11 @@ def command_table(args: argparse.Namespace) -> int:
     from scenarios.slewtable.compute import compute_table, quality_lines
     from scenarios.slewtable.files import write_table_files
     from scenarios.slewtable.spec import parse_table_spec
-    from scenarios.study.engine import connect_scheduler, start_forkserver
+    from scenarios.study.engine import (
+        connect_scheduler,
+        default_workers,
+        start_forkserver,
+    )
     from scenarios.study.store import claim_sweep_directory, commit_sweep_outputs
 
     if not args.scheduler:
@@ -194,6 +199,10 @@ def command_table(args: argparse.Namespace) -> int:
           + f" = {entries} entries, {spec.objective}, {cluster.address if cluster else 'local process pool'}"
           + (f"; then refined to a tolerance of {spec.refine.tolerance:g} (at most {spec.refine.max_axes} axes, "
              f"{spec.refine.max_rounds} rounds)" if spec.refine else ""), flush=True)
+    note = None if cluster else workers_note(spec.workers, default_workers(),  # --workers is in spec.workers
+                                             "--workers" if args.workers is not None else "table.execution.workers", "entries")
+    if note:
+        print(note, flush=True)
     previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         table = compute_table(spec, directory, workers=args.workers, cluster=cluster, progress=True)

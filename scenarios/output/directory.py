@@ -6,6 +6,8 @@ The rules (:doc:`/outputs`, "What slewbench writes, and what it never touches"):
   files slewbench wrote there and whether the set is complete. A directory is claimed only when it
   does not exist yet, is empty, or already carries the marker; anything else (a regular file, a
   user's directory, the working directory) is refused with a :class:`OutputError` and left untouched.
+* No output directory is made inside another (:func:`enclosing_output`): a path below a folder
+  that carries the marker is refused, but for a sweep's case re-runs (:data:`HOSTS`).
 * Inside a marked directory slewbench replaces or removes only files its manifest lists; a file a
   user put there is never touched, and a result name that would land on such a file is an error.
   The manifest also keeps each committed file's size and content digest (``stamps``): a listed
@@ -34,13 +36,17 @@ from typing import Any
 from scenarios.errors import ANOTHER_DIRECTORY, OutputError
 from scenarios.schema.read import read_bounded
 
-__all__ = ["MARKER", "STAGING_PREFIX", "changed_files", "check_output_directory", "claim_output_directory",
-           "commit_outputs", "new_staging", "read_manifest", "write_manifest", "written_files"]
+__all__ = ["HOSTS", "MARKER", "STAGING_PREFIX", "changed_files", "check_output_directory", "claim_output_directory",
+           "commit_outputs", "enclosing_output", "new_staging", "read_manifest", "write_manifest", "written_files"]
 
 MARKER = ".slewbench-output.json"
 STAGING_PREFIX = ".slewbench-staging-"
 MAX_MANIFEST_BYTES = 16 * 1024 * 1024
 """Largest marker read (bytes); a larger one is not slewbench's."""
+HOSTS = {"sweep": "cases"}
+"""Kind of output -> the folder of such a directory that holds other outputs (a sweep's case
+re-runs, ``sweep DIR --case N``: ``DIR/cases/N``). No other output directory is made inside one of
+slewbench's (:func:`enclosing_output`)."""
 
 
 def read_manifest(directory: Path) -> dict[str, Any] | None:
@@ -241,6 +247,38 @@ def write_manifest(directory: Path, files: Iterable[str], complete: bool, kind: 
     os.replace(temporary, directory / MARKER)
 
 
+def enclosing_output(directory: Path) -> tuple[Path, str] | None:
+    """The slewbench output directory that ``directory`` lies inside, if any: the nearest folder
+    above it that carries the marker, with its kind, unless ``directory`` is in the folder that
+    kind holds other outputs in (:data:`HOSTS`).
+
+    An output directory inside another one would be presented as part of it (an export inside the
+    run it was made from, which a re-run of that run does not renew), and the other directory's
+    files and the inner one's would be one folder's: slewbench writes each into a folder of its own.
+
+    Parameters
+    ----------
+    directory : Path
+        An absolute path (need not exist).
+
+    Returns
+    -------
+    (Path, str) or None
+        The enclosing output directory and its kind (``run``, ``sweep``, ...); None when there is
+        none, or when ``directory`` is in its host folder.
+    """
+    for parent in directory.parents:
+        manifest = read_manifest(parent)
+        if manifest is None:
+            continue
+        kind = str(manifest.get("kind", "run"))
+        host = HOSTS.get(kind)
+        if host is not None and directory.is_relative_to(parent / host) and directory != parent / host:
+            return None
+        return parent, kind
+    return None
+
+
 def check_output_directory(path: str | Path, kind: str = "run", expected: Iterable[str] = ()) -> Path:
     """Every check :func:`claim_output_directory` makes, writing nothing: a command that writes into
     more than one directory (``run --export``) checks each before it claims any, so that a refusal
@@ -268,6 +306,12 @@ def check_output_directory(path: str | Path, kind: str = "run", expected: Iterab
     """
     directory = Path(path).expanduser().absolute()
     try:
+        enclosing = enclosing_output(directory)
+        if enclosing is not None:
+            raise OutputError(path, f"is inside {enclosing[0]}, a slewbench {enclosing[1]} output directory (it "
+                                    f"carries {MARKER}); slewbench writes the {kind} output into a directory of "
+                                    f"its own, not inside another output: choose a directory outside "
+                                    f"{enclosing[0]} (--out on the command line), nothing was touched")
         if directory.is_symlink() or (directory.exists() and not directory.is_dir()):
             raise OutputError(path, "exists and is not a directory; slewbench writes only into a new, "
                                     "empty or slewbench-made directory")
@@ -333,7 +377,8 @@ def claim_output_directory(path: str | Path, kind: str = "run", expected: Iterab
     Raises
     ------
     OutputError
-        For a regular file, a non-empty directory without the marker, a parent that is a file,
+        For a path inside another slewbench output directory (:func:`enclosing_output`), a
+        regular file, a non-empty directory without the marker, a parent that is a file,
         a name too long for the file system, a location that cannot be written, or an
         ``expected`` file that slewbench did not write.
     """

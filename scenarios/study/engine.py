@@ -2,7 +2,9 @@
 ``concurrent.futures.Executor`` (a Dask client's ``get_executor()``, for one), or a Dask cluster
 by address; finished cases go to the crash-safe store as they arrive.
 
-A case that raises or exceeds ``case_timeout_s`` is a ``crashed`` row and the sweep goes on. A
+A case that raises or exceeds ``case_timeout_s`` is a ``crashed`` row and the sweep goes on; on
+any executor a task runs in :func:`scenarios.study.worker.run_chunk`, so that what it raised comes
+back as a :class:`~scenarios.study.worker.TaskRaised`, told apart from a lost worker. A
 case whose worker died is retried ``retries`` times (its stored ``attempts`` counts every start), and
 so is one whose task raised what says the worker failed it
 (:func:`scenarios.study.worker.worker_fault`: out of memory, a module missing on that worker).
@@ -588,11 +590,9 @@ class _Engine:
 
     def _submit(self, keys: list[str]) -> None:
         now = time.monotonic()
-        future: Future[Any]
-        if self.chunked:
-            future = self.executor.submit(run_chunk, self.task, [self._payload(key) for key in keys])
-        else:
-            future = self.executor.submit(self.task, self._payload(keys[0]))
+        # a chunk of one case on a caller's executor too: what its task raises comes back as TaskRaised (a
+        # worker fault as WorkerFault), told apart from a worker's death (and always rebuilt from its pickle)
+        future: Future[Any] = self.executor.submit(run_chunk, self.task, [self._payload(key) for key in keys])
         for key in keys:
             self.starts[key] += 1  # taken back for a case a broken pool never started (_requeue)
         self.in_flight[future] = _Batch(keys, now)
@@ -696,7 +696,7 @@ class _Engine:
                     for key in entry.keys:
                         self._charge(key, 1, "its process ended abruptly", batch)
                 continue
-            except Exception as error:  # the task raised, or a lost worker on a cluster (dask's KilledWorker, ...)
+            except Exception as error:  # TaskRaised, or a lost worker (dask's KilledWorker, an executor's own failure)
                 raised = error.key if isinstance(error, TaskRaised) and error.key in entry.keys else None
                 if len(entry.keys) > 1 and isinstance(error, TaskRaised) and raised is not None:
                     # a chunk, and whose task raised is known

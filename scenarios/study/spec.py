@@ -304,7 +304,8 @@ def _base(root: Node, source: Path | None) -> dict[str, Any]:
 
 
 def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version: str | None = None,
-                progress: Callable[[int, int], None] | None = None) -> Study:
+                progress: Callable[[int, int], None] | None = None,
+                parsed: Callable[[Case, Scenario], None] | None = None) -> Study:
     """Parse a study (YAML data), expand its cases and check every one (see the module docstring).
 
     Parameters
@@ -322,6 +323,12 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
         ``progress(checked, total)``, called while the cases are checked (every
         :data:`PROGRESS_EVERY` cases, after the case that ends :data:`PROGRESS_S` since the
         last call, and at the end).
+    parsed : callable or None, optional
+        ``parsed(case, scenario)``, called with each case the whole scenario loader checked
+        (``scenario``: what :func:`~scenarios.schema.loader.parse_scenario` built from it, with
+        ``inapplicable_rows``), once it passed; a case checked by the verdict of an earlier case of
+        its class is not given (see the module docstring). ``slewbench validate`` and ``sweep
+        --dry-run`` take the cases' findings from it rather than parse those cases again.
 
     Returns
     -------
@@ -335,7 +342,7 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
         Naming the study entry (or the case and the scenario path), for a bad study or a case the
         scenario loader rejects.
     TypeError
-        ``source``, ``version`` or ``progress`` of the wrong type.
+        ``source``, ``version``, ``progress`` or ``parsed`` of the wrong type.
     """
     if source is not None and not isinstance(source, (str, os.PathLike)):
         raise TypeError(f"source must be a path or None, got {type(source).__name__}")
@@ -343,6 +350,8 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
         raise TypeError(f"version must be a str or None, got {type(version).__name__}")
     if progress is not None and not callable(progress):
         raise TypeError(f"progress must be callable or None, got {type(progress).__name__}")
+    if parsed is not None and not callable(parsed):
+        raise TypeError(f"parsed must be callable or None, got {type(parsed).__name__}")
     source = None if source is None else Path(source)
     root = Node(data).mapping()
     name = STUDY["study"].value(root)
@@ -383,7 +392,7 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
     study = Study(name, source, base, [v.path for axis in axes for v in axis.varied], [v.path for v, _ in dispersions],
                   samples, method, seed, summary, execution, raw=copy.deepcopy(root.value),
                   thresholds=robustness["thresholds"], worst=robustness["worst"])
-    expansion = _Expansion(study, axes, dispersions, version or package_version(), progress)
+    expansion = _Expansion(study, axes, dispersions, version or package_version(), progress, parsed)
     study.cases = expansion.cases()
     expansion.refuse_unused_planners()
     _check_summary([(f"summary[{index}]", column) for index, column in enumerate(summary)]
@@ -437,9 +446,9 @@ class _Expansion:
     """The cases of a study, built and checked in order (see the module docstring)."""
 
     def __init__(self, study: Study, axes: list[_Axis], dispersions: list[tuple[_Varied, Dispersion]], version: str,
-                 progress: Callable[[int, int], None] | None):
+                 progress: Callable[[int, int], None] | None, parsed: Callable[[Case, Scenario], None] | None = None):
         self.study, self.axes, self.dispersions, self.version = study, axes, dispersions, version
-        self.progress = progress
+        self.progress, self.parsed = progress, parsed
         self.points = math.prod(axis.length for axis in axes)
         self.total = self.points * study.samples
         self.checked: set[tuple[int, ...]] = set()  # classes of cases the whole loader has passed
@@ -577,6 +586,8 @@ class _Expansion:
             except ScenarioError as error:
                 raise _case_error(case, error) from None
             self.checked.add(case_class)
+            if self.parsed is not None:
+                self.parsed(case, scenario)
             # a class shares the problem (independent keys are not in it): its planners' verdicts hold for all
             for index, spec in enumerate(scenario.planners):
                 if index in scenario.inapplicable:
@@ -725,7 +736,8 @@ def size_note(study: Study, workers: int) -> str | None:
             f"{workers}; once cases finish, the progress bar shows the time left.")
 
 
-def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None] | None = None) -> Study:
+def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None] | None = None,
+               parsed: Callable[[Case, Scenario], None] | None = None) -> Study:
     """Read, expand and check a study file.
 
     Parameters
@@ -733,6 +745,8 @@ def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None
     path : str or os.PathLike
         The study YAML file.
     progress : callable or None, optional
+        As :func:`parse_study`.
+    parsed : callable or None, optional
         As :func:`parse_study`.
 
     Returns
@@ -755,7 +769,7 @@ def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None
     try:
         data = read_yaml(path)
         _refuse_other_file(data, path)
-        return parse_study(data, path, progress=progress)
+        return parse_study(data, path, progress=progress, parsed=parsed)
     except ScenarioError as error:
         raise in_file(error, path, "study") from None
 
