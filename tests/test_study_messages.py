@@ -204,3 +204,40 @@ def test_the_summary_shows_a_group_whose_every_case_crashed(tmp_path, monkeypatc
                                                        line)], said
         assert [line for line in lines if re.fullmatch(rf"  30(\.0)?, {label}: every requirement [0-9]/3 = .*",
                                                        line)], said
+
+
+# --- 4. a dispersed quaternion ------------------------------------------------------------------
+
+def _quaternion_study(tmp_path: Path, path: str, std: float) -> Path:
+    """The eigenaxis demo with its ``path`` quaternion offset by a normal draw of ``std`` per number."""
+    study = {"study": "dispersed-quaternion", "scenario": str(REPOSITORY / "scenarios" / "eigenaxis_demo.yaml"),
+             "monte_carlo": {"samples": 20, "seed": 1,
+                             "dispersions": {path: {"offset": {"normal": {"mean": [0, 0, 0, 0], "std": [std] * 4}}}}}}
+    file = tmp_path / "study.yaml"
+    file.write_text(yaml.safe_dump(study))
+    return file
+
+
+def test_a_dispersed_quaternion_off_the_unit_sphere_is_one_error_at_its_entry(tmp_path, capsys):
+    """Four numbers drawn independently leave the unit sphere: one error at the dispersion's entry,
+    counting the cases (norms computed here with NumPy from the same draws: std 0.05 per number moves
+    the norm by about 0.05, far beyond 1e-3) and naming the forms that disperse a rotation. Before,
+    the first such case stopped the check with the loader's advice to normalise that case's
+    quaternion, which nothing in a study can do."""
+    for path in ("maneuver.final.q", "maneuver.initial.q"):
+        status = main(["sweep", str(_quaternion_study(tmp_path, path, 0.05)), "--dry-run"])
+        err = " ".join(capsys.readouterr().err.split())
+        assert status == 2, err
+        found = re.search(rf"monte_carlo\.dispersions\.{re.escape(path)}: (\d+) of 20 cases draw a quaternion whose "
+                          r"norm is not within 0\.001 of 1", err)
+        assert found and int(found.group(1)) >= 15, err
+        assert "normalise it" not in err and "case 1 [" not in err, err
+        assert f"{path}.axis_angle.angle_deg" in err and f"{path}.axis_angle.axis" in err, err
+        assert ("simulation.initial_attitude_error_deg" in err) == (path == "maneuver.initial.q"), err
+
+
+def test_a_dispersed_quaternion_within_the_norm_tolerance_is_still_taken(tmp_path, capsys):
+    """Draws whose norms stay within 1e-3 of 1 (std 1e-4 per number) are quaternions as written ones
+    are: normalised by the loader, the dry run passes."""
+    assert main(["sweep", str(_quaternion_study(tmp_path, "maneuver.final.q", 1e-4)), "--dry-run"]) == 0, \
+        capsys.readouterr().err

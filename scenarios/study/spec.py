@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from ocp.errors import excerpt
+from ocp.quat import UNIT_NORM_TOLERANCE
 from scenarios.errors import ScenarioError, in_file
 from scenarios.output.provenance import package_version
 from scenarios.requirements.fields import is_requirement_column
@@ -442,6 +443,38 @@ def _mark_independent(seen: list[_Varied]) -> None:
         varied.independent = None if overlaps else independent_key(varied.steps)
 
 
+QUATERNION_PATHS = ("maneuver.initial.q", "maneuver.final.q")
+"""The scenario paths that hold an attitude quaternion written as four numbers: a dispersion of one
+draws its four numbers independently (:func:`_refuse_drawn_quaternions`)."""
+
+
+def _refuse_drawn_quaternions(varied: _Varied, values: np.ndarray) -> None:
+    """One error for the whole dispersion, at its study entry, when a dispersion of a quaternion
+    (:data:`QUATERNION_PATHS`, four numbers) draws any case whose norm is not within
+    ``ocp.quat.UNIT_NORM_TOLERANCE`` of 1, rather than the scenario loader's per-case advice to
+    normalise a quaternion, which a study's user cannot act on: the draws are the study's. Such a
+    draw is not normalised either: four numbers drawn independently and normalised are not a
+    distribution of rotations anyone asked for (draws within the tolerance are, as a written
+    quaternion is, by the loader)."""
+    if varied.path not in QUATERNION_PATHS or values.shape[1] != 4:
+        return
+    norms = np.linalg.norm(values, axis=1)
+    off = np.flatnonzero(np.abs(norms - 1.0) > UNIT_NORM_TOLERANCE)
+    if not off.size:
+        return
+    first = int(off[0])
+    start = ("; for the closed loop's start about the planned attitude, simulation.initial_attitude_error_deg "
+             "(a rotation vector [deg], body axes)" if varied.path == "maneuver.initial.q" else "")
+    raise ScenarioError(varied.entry, f"{off.size} of {len(values)} cases draw a quaternion whose norm is not within "
+                                      f"{UNIT_NORM_TOLERANCE:g} of 1 (case {first}: norm {norms[first]:.6g}): the four "
+                                      "numbers of a quaternion do not disperse independently (normalised, such draws "
+                                      "would be a distribution of rotations nobody asked for); "
+                                      f"disperse a rotation instead: write {varied.path} in the axis_angle form "
+                                      f"({varied.path}: {{axis_angle: {{axis: [x, y, z], angle_deg: a}}}}) and "
+                                      f"disperse {varied.path}.axis_angle.angle_deg and "
+                                      f"{varied.path}.axis_angle.axis{start}")
+
+
 class _Expansion:
     """The cases of a study, built and checked in order (see the module docstring)."""
 
@@ -507,6 +540,7 @@ class _Expansion:
                     raise ScenarioError(varied.entry, f"case {bad} draws a value that is not finite "
                                                       f"({excerpt(values[bad].tolist())}); the distribution's "
                                                       "parameters are too large")
+                _refuse_drawn_quaternions(varied, values.reshape(n, -1))
                 columns.append(values.tolist())
             else:
                 columns.append(values)
