@@ -104,6 +104,36 @@ def test_a_dispersion_of_an_independent_key_is_refused_at_the_first_case_the_loa
         parse_study(data)
 
 
+
+def _two_wheel_regulation():
+    """Horri & Palmer's two-wheel spacecraft (z wheel failed) regulated to the identity from it by
+    the zero-momentum law: a law defined for attitude errors with q1² + q2² ≠ 0."""
+    base = read_yaml(ROOT / "scenarios" / "horri_palmer_two_wheels.yaml")
+    base["planners"] = []
+    base["maneuver"]["initial"]["q"] = [0, 0, 0, 1]
+    base["controllers"] = base["controllers"][:1]
+    return base
+
+
+def test_an_initial_error_a_two_wheel_law_cannot_start_from_is_refused_at_its_case():
+    """The two-wheel laws check the start as simulated, initial errors applied: the initial errors
+    are not independent of the scenario there. The oracle: the whole loader on each case alone
+    refuses the second (30 deg about the unactuated z axis) and takes the first. Before, the study
+    checked the class once, on the first case, and passed the second."""
+    errors = [[5.0, 5.0, 0.0], [0.0, 0.0, 30.0], [0.0, 0.0, 20.0]]
+    verdicts = []
+    for error in errors:
+        case = _two_wheel_regulation()
+        case["simulation"]["initial_attitude_error_deg"] = error
+        verdicts.append(loader_verdict(case))
+    assert verdicts == [None, "maneuver.initial.q", "maneuver.initial.q"], verdicts
+    data = {"study": "v", "scenario": _two_wheel_regulation(), "grid": {"simulation.initial_attitude_error_deg": errors}}
+    with pytest.raises(ScenarioError, match=r"^case 1 \[simulation\.initial_attitude_error_deg=\[0\.0, 0\.0, 30\.0\]\]: "
+                                            r"maneuver\.initial\.q: controller singular_zero_momentum"):
+        parse_study(data)
+    data["grid"]["simulation.initial_attitude_error_deg"] = [errors[0], [6.0, 4.0, 0.0]]
+    assert len(parse_study(data).cases) == 2  # a study whose every case the loader takes still passes
+
 def reference_cases(study_mapping, version):
     """The cases as the study's documentation defines them, one deep copy each (no shared parts)."""
     data = copy.deepcopy(study_mapping)

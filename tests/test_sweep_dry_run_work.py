@@ -87,11 +87,14 @@ def test_the_findings_are_each_case_judged_on_its_own(tmp_path):
     found = StudyFindings()
     assert study_findings(load_study(mixed(tmp_path), parsed=found), found) == expected
     assert study_findings(study) == expected  # without the check's parses
-    # every part is there: the late 180 deg grid point (4 cases), the noise (6), the rate error (6)
+    # every part is there: the late 180 deg grid point (4 cases), the noise (6), the rate error (6:
+    # the rate requirement's finding and the plausibility warning of a 0.5 rad/s error, each)
     said = [line.split("]: ", 1)[1] for line in expected]
     assert sum("infeasible before planning" in line for line in said) == 4
     assert sum(line.startswith("warning: simulation.sensor_noise.rate") for line in said) == 6
-    assert sum("simulation.initial_rate_error" in line for line in said) == 6
+    assert sum(line.startswith("every row's closed loop breaks the rate requirement: simulation.initial_rate_error")
+               for line in said) == 6
+    assert sum(line.startswith("warning: simulation.initial_rate_error") for line in said) == 6
 
 
 def test_a_dry_run_parses_each_case_once(tmp_path, parses, plans, capsys):

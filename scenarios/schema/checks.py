@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from controllers import Controller
 from ocp.simulation.simulator import SUBSTEPS_PER_SAMPLE
 from planners import ManeuverProblem
 from scenarios.errors import ScenarioError
@@ -158,6 +159,27 @@ def rate_bound_notes(problem: ManeuverProblem, simulation: SimulationSpec, max_r
                      f"{simulation.initial_rate_error.tolist()} starts it at ‖ω‖ = {true_rate:.4g} rad/s "
                      f"(maneuver.initial.omega plus the error), above {max_rate:g} rad/s (the key is in rad/s)")
     return notes
+
+
+def reads_the_simulated_start(controllers: list[ControllerSpec]) -> bool:
+    """Whether :func:`check_compatibility` reads the start as simulated (the planned start with
+    ``simulation.initial_attitude_error_deg`` and ``simulation.initial_rate_error`` applied): it does
+    for a law defined on part of the attitudes, one that overrides
+    :meth:`controllers.Controller.initial_attitude_error` (the two-wheel laws). Those two keys are
+    then not independent of the rest of the scenario (:data:`scenarios.schema.study.INDEPENDENT_KEYS`),
+    and a study checks every case of such a scenario with the whole loader.
+
+    Parameters
+    ----------
+    controllers : list of ControllerSpec
+        The scenario's controllers, each with its validated law.
+
+    Returns
+    -------
+    bool
+    """
+    return any(type(spec.controller).initial_attitude_error is not Controller.initial_attitude_error
+               for spec in controllers)
 
 
 def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],

@@ -665,7 +665,10 @@ is its verdict on the key's value alone (the key's own reader) and on the rest o
 A study checks the values it gives these keys with their readers, and runs the whole loader once
 per combination of its other values (:mod:`scenarios.study.spec`). Add a key here only when
 nothing but its reader, and the run itself, reads it; ``tests/test_study_validation.py`` compares
-both verdicts."""
+both verdicts. One exception, decided per scenario: a controller whose law is defined on part of
+the attitudes (the two-wheel laws) checks the start as simulated, initial errors applied
+(:func:`scenarios.schema.checks.reads_the_simulated_start`), and a study parses every case of such a
+scenario whole."""
 
 
 def declared_key(steps: Sequence[Step]) -> Key | None:

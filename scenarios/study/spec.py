@@ -38,6 +38,7 @@ from scenarios.errors import ScenarioError, in_file
 from scenarios.output.provenance import package_version
 from scenarios.requirements.fields import is_requirement_column
 from scenarios.requirements.scoring import score_fields
+from scenarios.schema.checks import reads_the_simulated_start
 from scenarios.schema.columns import REQUIREMENT_MARK, SCOPES
 from scenarios.schema.keys import Key
 from scenarios.schema.loader import OTHER_FILES, Scenario, parse_scenario
@@ -485,6 +486,9 @@ class _Expansion:
         self.points = math.prod(axis.length for axis in axes)
         self.total = self.points * study.samples
         self.checked: set[tuple[int, ...]] = set()  # classes of cases the whole loader has passed
+        # classes whose controllers read the simulated start (reads_the_simulated_start): every case of
+        # theirs goes through the whole loader, their initial errors not independent of the scenario
+        self.start_read: set[tuple[int, ...]] = set()
         self.columns: dict[str, None] = {}  # requirement columns the cases give, in order
         self.accepted: set[int] = set()  # planner rows some case's problem suits
         self.refused: dict[int, tuple[Case, str, str]] = {}  # planner row -> its first refused case, name, reason
@@ -614,12 +618,14 @@ class _Expansion:
                 _read(item.independent, value, item.path)  # type: ignore[arg-type]
             except ScenarioError as error:
                 raise _case_error(case, error) from None
-        if case_class not in self.checked:
+        if case_class not in self.checked or case_class in self.start_read:
             try:
                 scenario = parse_scenario(case.scenario, inapplicable_rows=True)  # the loader only reads its data
             except ScenarioError as error:
                 raise _case_error(case, error) from None
             self.checked.add(case_class)
+            if reads_the_simulated_start(scenario.controllers):
+                self.start_read.add(case_class)
             if self.parsed is not None:
                 self.parsed(case, scenario)
             # a class shares the problem (independent keys are not in it): its planners' verdicts hold for all
