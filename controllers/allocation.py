@@ -612,9 +612,11 @@ states of the samples after them are nan (not computed), never an under-resolved
 
 def _conserving(law: Allocation, blocks: Sequence[Any], model: AttitudeModel) -> bool:
     """Whether the total angular momentum changes along the reference by the environment's impulse
-    alone: the wheels are the only actuators (a torquer's or magnetorquer's share of the torque is
-    external) and their working axes span three (they take every torque)."""
-    return ([block.actuator.block for block in blocks] == ["wheels"]
+    alone: the working wheels span three axes, so they take every torque, and they are the only
+    actuators with states. The allocation then asks any other actuator nothing (torquers and
+    magnetorquers beside them take the residual ``(1 − A A⁺) τ``, zero; a kind without a
+    ``residual_rank`` is never commanded), so no torque of theirs is external to the balance."""
+    return (all(block.actuator.state_size == 0 for block in blocks if block.actuator.block != "wheels")
             and law._working_axes is not None and int(np.linalg.matrix_rank(law._working_axes)) == 3)
 
 

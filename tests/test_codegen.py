@@ -111,3 +111,20 @@ def test_every_controller_of_a_list_is_exported(tmp_path, rng):
             expected = controller.command_vector(controller(t, measurement, None))
             np.testing.assert_allclose(u, expected, rtol=0, atol=1e-12 * max(1.0, np.abs(expected).max()))
             np.testing.assert_allclose(z, controller.state_vector(), rtol=0, atol=1e-12)
+
+
+def test_the_estimator_the_c_does_not_hold_is_said_on_the_command_line_readme_and_interface(tmp_path, capsys):
+    """spin_repoint_estimator.yaml flies a gyro, a star tracker and an MEKF between the plant and
+    the law; the C holds the law and the saturation only, so codegen says the estimator is not
+    generated (a flight engineer must supply the attitude and rate); eigenaxis_demo.yaml, whose law
+    read the noisy state itself, has no such note."""
+    out = tmp_path / "c"
+    assert main(["codegen", str(SCENARIOS / "spin_repoint_estimator.yaml"), "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "note: simulation.estimator (an MEKF, with the gyro, star tracker) is not generated" in printed
+    assert "Not generated: simulation.estimator" in (out / "README.md").read_text()
+    assert json.loads((out / "interface.json").read_text())["not_generated"][0].startswith("simulation.estimator")
+    plain = tmp_path / "plain"
+    assert main(["codegen", str(SCENARIOS / "eigenaxis_demo.yaml"), "--out", str(plain)]) == 0
+    assert "not generated" not in capsys.readouterr().out
+    assert json.loads((plain / "interface.json").read_text())["not_generated"] == []

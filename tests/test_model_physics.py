@@ -223,6 +223,16 @@ def test_invalid_inertia_is_rejected_with_a_clear_message(inertia, message):
     assert info.value.field == "inertia"
 
 
+def test_an_asymmetric_inertia_names_the_mismatched_product_and_its_values():
+    """A product of inertia typed with opposite signs (a sign-convention slip) is named by its
+    elements and their values, not only "must be symmetric"."""
+    with pytest.raises(ModelError) as info:
+        Spacecraft([[3.1, 0.06, 0.04], [-0.06, 2.7, -0.03], [0.04, -0.03, 2.2]])
+    assert "[0][1] = 0.06 but [1][0] = -0.06" in info.value.message
+    with pytest.raises(ModelError, match="non-zero, got"):
+        Spacecraft(np.zeros((3, 3)))
+
+
 def test_two_wheel_satellite_is_expressible():
     spacecraft = Spacecraft([1.0, 1.2, 1.4], wheels=ReactionWheels(np.eye(3)[:, :2], max_torque=0.01))
     assert spacecraft.n_wheels == 2

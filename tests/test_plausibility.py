@@ -379,3 +379,21 @@ def test_an_orbit_beyond_any_earth_orbit_is_refused_at_its_path(orbit):
         parse_scenario(data)
     key = "altitude_km" if "altitude_km" in orbit else "semi_major_axis_km"
     assert f"orbit.{key}" in str(raised.value) and f"{MAX_ORBIT_KM:g}" in str(raised.value), str(raised.value)
+
+
+def test_a_star_tracker_noise_in_radians_written_as_arcsec_warns_with_the_arcsec_meant():
+    """5, 5 and 41 arcsec written in radians (2.4e-5, 2.4e-5, 2e-4): 206,264.8 arcsec to the radian
+    by hand gives 4.95, 4.95 and 41.25 arcsec."""
+    def tracker(noise):
+        def change(d):
+            d.setdefault("simulation", {})["sensors"] = {
+                "gyro": {"arw_deg_per_sqrt_h": 0.15},
+                "star_tracker": {"noise_arcsec": noise, "rate_hz": 1.0}}
+        return change
+    said = warnings_of(tracker([2.4e-5, 2.4e-5, 2e-4]))
+    assert len(said) == 1, said
+    assert said[0].startswith("simulation.sensors.star_tracker.noise_arcsec: [2.4e-05, 2.4e-05, 0.0002] arcsec ")
+    assert "did you mean [4.95, 4.95, 41.25] arcsec" in said[0], said
+    assert warnings_of(tracker([5, 5, 40])) == []       # a small satellite's tracker
+    assert warnings_of(tracker([0.1, 0.1, 0.5])) == []  # the most precise
+    assert warnings_of(tracker([0, 0, 0])) == []        # a perfect sensor, meant

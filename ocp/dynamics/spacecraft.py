@@ -95,8 +95,17 @@ class Spacecraft:
         if not np.all(np.isfinite(inertia)):
             raise ModelError("inertia", f"the inertia must be finite, got {inertia.tolist()}")
         scale = np.max(np.abs(inertia))
-        if scale == 0 or np.max(np.abs(inertia - inertia.T)) > 1e-9 * scale:
-            raise ModelError("inertia", "the inertia matrix must be symmetric and non-zero")
+        if scale == 0:
+            raise ModelError("inertia", f"the inertia matrix must be non-zero, got {inertia.tolist()}")
+        mismatch = np.abs(inertia - inertia.T)
+        if np.max(mismatch) > 1e-9 * scale:
+            i, j = sorted(np.unravel_index(int(np.argmax(mismatch)), mismatch.shape))
+            raise ModelError(
+                "inertia",
+                f"the inertia matrix must be symmetric, got [{i}][{j}] = {inertia[i, j]:g} but [{j}][{i}] = "
+                f"{inertia[j, i]:g} in {inertia.tolist()}; a product of inertia appears twice with the same "
+                "value and sign",
+            )
         moments = np.linalg.eigvalsh(inertia)
         if moments[0] <= 0:
             raise ModelError("inertia", f"the inertia matrix must be positive definite (eigenvalues {moments.tolist()})")

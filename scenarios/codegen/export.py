@@ -91,6 +91,8 @@ class CodegenReport:
         The row whose table ``SLEWBENCH_PARAMS_DEFAULT`` tracks (``None``: regulation).
     default_reason : str, optional
         Why that row (or regulation), in words.
+    notes : list of str, optional
+        What of the scenario the C does not hold (:func:`not_generated`: its sensors and estimator).
     """
 
     directory: Path
@@ -101,6 +103,7 @@ class CodegenReport:
     violations: dict[str, list[str]] = field(default_factory=dict)
     default: str | None = None
     default_reason: str = ""
+    notes: list[str] = field(default_factory=list)
 
     def summary(self) -> list[str]:
         """What ``slewbench codegen`` prints: the files, the functions, each table's error (naming
@@ -119,7 +122,37 @@ class CodegenReport:
                   for label, broken in self.violations.items()]
         lines += [f"  no C reference for row {label!r}: {reason}" for label, reason in self.skipped.items()]
         lines.append(f"default reference (SLEWBENCH_PARAMS_DEFAULT): {self.default_reason}")
+        lines += [f"note: {note}" for note in self.notes]
         return lines
+
+
+def not_generated(scenario: Scenario) -> list[str]:
+    """What of ``scenario``'s closed loop the generated C does not hold, one sentence each: its
+    sensor models and its estimator (``simulation.sensors``, ``simulation.estimator``), which the
+    simulation put between the plant and the law, while ``slewbench_step`` takes the measurement
+    as given.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario exported.
+
+    Returns
+    -------
+    list of str
+        Empty when the simulation fed the law the (noisy) state itself.
+    """
+    suite = scenario.simulation.sensors
+    if suite is None:
+        return []
+    named = [name for name, part in (("gyro", suite.gyro), ("star tracker", suite.star_tracker),
+                                     ("magnetometer", suite.magnetometer)) if part is not None]
+    if suite.estimator is not None:
+        return [f"simulation.estimator (an MEKF, with the {', '.join(named)}) is not generated: slewbench_step's "
+                "measurement is the attitude and rate your own estimator gives (in the simulation the law read "
+                "the MEKF's attitude and the gyro's rate less its bias estimate)"]
+    return [f"simulation.sensors ({', '.join(named)}) are models of the simulation, not generated: "
+            "slewbench_step's measurement is what your sensors give"]
 
 
 def c_identifier(text: str) -> str:
@@ -315,7 +348,9 @@ def _readme(scenario: Scenario, stem: str, law: str, tables: dict[str, tuple[str
              "scaled). `command.u` is the law's command, `command.u_applied` what the actuators apply. "
              "It uses static work arrays sized from the generated `_work` functions (checked by "
              "`slewbench_init`), no allocation, and is not re-entrant."), "",
-             "`example.c` is a worked use.", "", "## Parameters (`slewbench_params`)", "",
+             "`example.c` is a worked use.", "",
+             *[line for note in not_generated(scenario) for line in (f"Not generated: {note}.", "")],
+             "## Parameters (`slewbench_params`)", "",
              ("The numbers the generated functions read as inputs (matrices row-major in the struct); the "
              "defaults (`SLEWBENCH_PARAMS_DEFAULT`) are the scenario's. Numbers a law does not read through "
              "its parameters are compiled into it: change them by regenerating."), "",
@@ -441,7 +476,7 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
         laws.append(controller)
     directory = claim_output_directory(out, kind="codegen")
     stem = f"slewbench_{c_identifier(scenario.name)}"
-    report = CodegenReport(directory)
+    report = CodegenReport(directory, notes=not_generated(scenario))
     functions: list[ca.Function] = []
     taken: set[str] = {"slewbench_saturate", "slewbench_segment"}
     spacecraft = problem.spacecraft
@@ -561,6 +596,7 @@ def generate(scenario: Scenario, out: str | Path, tolerance: TableTolerance | No
               "BAKES_SAMPLE_TIME": "0" if "sample_time" in law_reads[step_law] else "1",
               "TRACKS": "1" if tracks else "0"}
     interface["skipped"] = dict(report.skipped)
+    interface["not_generated"] = list(report.notes)
     interface["step"] = {"law": step_law, "saturation": "slewbench_saturate", "segment": "slewbench_segment",
                          "default_reference": default_reference, "default_row": report.default,
                          "default_reason": report.default_reason, "target": target.tolist()}

@@ -13,7 +13,8 @@ same findings, those of :func:`plausibility_warnings`. Each check of :data:`PLAU
 reason; a value that passes them all is not thereby right, only not obviously wrong.
 
 There is no check of angles in radians: every angle a scenario gives is in degrees (``_deg``
-keys, ``axis_angle.angle_deg``), whose ranges the schema already bounds; and an inertia that
+keys, ``axis_angle.angle_deg``), whose ranges the schema already bounds, except a star tracker's
+noise in arcsec, which has no upper bound and whose value in radians lies far below any sensor's; and an inertia that
 violates the triangle inequality is an error of the loader, not a warning.
 
 May import: :mod:`ocp` (the Earth's radius), :mod:`scenarios.errors` (the warning's class) and the :class:`~scenarios.schema.loader.Scenario`
@@ -36,8 +37,8 @@ from scenarios.errors import PlausibilityWarning
 if TYPE_CHECKING:
     from scenarios.schema.loader import Scenario
 
-__all__ = ["LOWEST_ORBIT_KM", "MAX_ANGULAR_ACCELERATION", "MAX_RATE", "MAX_RATE_TOLERANCE", "MOON_DISTANCE_KM",
-           "PLAUSIBILITY_CHECKS", "SLOW_SLEW_FACTOR", "Implausible", "plausibility_warnings",
+__all__ = ["LOWEST_ORBIT_KM", "MAX_ANGULAR_ACCELERATION", "MAX_RATE", "MAX_RATE_TOLERANCE",
+           "MIN_STAR_TRACKER_NOISE_ARCSEC", "MOON_DISTANCE_KM", "PLAUSIBILITY_CHECKS", "SLOW_SLEW_FACTOR", "Implausible", "plausibility_warnings",
            "warn_implausible"]
 
 MOON_DISTANCE_KM = 384_400.0
@@ -73,6 +74,13 @@ share of its budget (at that bound) exceeds this factor: ``k > (10 / share)²``.
 scenarios' slews take at most 0.4 of their budgets, so none warns with an inertia less than 625
 times too large; ``eigenaxis_demo``'s, 21.4 s of 120 s (0.18), warns from 3,151 times: an inertia
 a hundred times too large warns only where the slew already takes more than its whole budget."""
+
+MIN_STAR_TRACKER_NOISE_ARCSEC = 0.05
+"""Star-tracker noise [arcsec, 1 sigma] below which every axis of ``noise_arcsec`` is no star
+tracker's: the most precise flown reach about 0.1 arcsec across the boresight, a small satellite's
+1 to 10 arcsec (and several times that about the boresight). A noise in radians written as arcsec
+(5 arcsec = 2.4e-5 rad) lands thousands of times below it; zero (a perfect sensor, meant) does not
+warn."""
 
 
 @dataclass(frozen=True)
@@ -392,6 +400,20 @@ def _wheel_axes(scenario: Scenario) -> Iterator[Implausible]:
                       "plane)? Underactuated control is written with two wheels, or a wheel listed in failed.")
 
 
+def _star_tracker_noise(scenario: Scenario) -> Iterator[Implausible]:
+    """A star tracker's noise (``simulation.sensors.star_tracker.noise_arcsec``) whose largest axis
+    is positive and below :data:`MIN_STAR_TRACKER_NOISE_ARCSEC` (radians written as arcsec)."""
+    written = _mapping(scenario.data or {}, "simulation", "sensors", "star_tracker").get("noise_arcsec")
+    values = _numbers(written)
+    if values is None or not 0.0 < max(values) < MIN_STAR_TRACKER_NOISE_ARCSEC:
+        return
+    meant = [float(f"{math.degrees(value) * 3600.0:.4g}") for value in values]
+    yield Implausible("simulation.sensors.star_tracker.noise_arcsec", f"{written} arcsec",
+                      f"is at most {max(values):.3g} arcsec (1 sigma), below "
+                      f"{MIN_STAR_TRACKER_NOISE_ARCSEC:g} arcsec on every axis, where no star tracker is (the most "
+                      f"precise reach about 0.1 arcsec); did you mean {meant} arcsec (radians written as arcsec)?")
+
+
 PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "orbit_altitude": _orbit_altitude,
     "rate_bounds": _rate_bounds,
@@ -403,6 +425,7 @@ PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "slew_time": _slew_time,
     "disturbance": _disturbance,
     "wheel_axes": _wheel_axes,
+    "star_tracker_noise": _star_tracker_noise,
 }
 """Name -> check: each yields the :class:`Implausible` values of a validated scenario."""
 
