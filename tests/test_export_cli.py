@@ -192,6 +192,29 @@ def test_an_exported_row_the_run_did_not_score_ok_is_named_with_its_reason(tmp_p
         assert f"row {label!r}: exported, but the run scored it violated: " in said and "final" in said, said
 
 
+
+def test_the_reason_in_the_note_is_cut_between_words_and_says_so(tmp_path, capsys, monkeypatch):
+    """A reason longer than the note's limit is cut between words and ends in `` ...``: cut inside a
+    token, ``over 0.05 deg`` read ``over 0.0`` (a user's basilisk export; the limit is lowered here
+    so that the run's own messages are cut)."""
+    import scenarios.output.export as export
+
+    monkeypatch.setattr(export, "NOTE_MESSAGE_CHARS", 60)
+    strict = SCENARIO + "requirements: {final: {error_deg: 1.0e-9}}\n"
+    out = tmp_path / "run"
+    assert main(["run", str(scenario_file(tmp_path, strict)), "--out", str(out), "--no-plots"]) == 0
+    messages = {row["label"]: row["message"] for row in json.loads((out / "results.json").read_text())["rows"]}
+    capsys.readouterr()
+    assert main(["export", str(out), "--format", "aem", "--out", str(tmp_path / "aem")]) == 0
+    said = capsys.readouterr().out
+    for label, message in messages.items():
+        flat = " ".join(message.split())
+        assert len(flat) > 60, flat
+        reason = said.split(f"row {label!r}: exported, but the run scored it violated: ", 1)[1].splitlines()[0]
+        assert reason.endswith(" ...") and len(reason) <= 60, reason
+        kept = reason.removesuffix(" ...")
+        assert flat.startswith(kept) and flat[len(kept)] == " ", (kept, flat)  # whole words only
+
 def test_rows_scored_ok_get_no_such_note(run_directory, tmp_path, capsys):
     statuses = {row["status"] for row in json.loads((run_directory / "results.json").read_text())["rows"]}
     assert statuses == {"ok"}

@@ -18,6 +18,7 @@ import csv
 import dataclasses
 import json
 import shutil
+import textwrap
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,6 +46,9 @@ __all__ = ["EXPORT_FORMATS", "ExportFormat", "ExportReport", "RunRecord", "RunRo
            "export_run", "read_run"]
 
 Array = NDArray[np.float64]
+NOTE_MESSAGE_CHARS = 300
+"""Characters of a row's message at most in an export's note on a row the run did not score ``ok``
+(cut between words, ``...`` marking the cut)."""
 
 
 @dataclass(frozen=True)
@@ -348,7 +352,8 @@ def export_run(run_directory: str | Path, format_name: str, out: str | Path | No
                   for f in files}
         for row in run.rows:
             if row in owners and row.status != "ok":
-                why = f": {row.message[:300]}" if row.message else ""
+                # cut between words, visibly: a cut inside a number would state another number
+                why = f": {textwrap.shorten(row.message, NOTE_MESSAGE_CHARS, placeholder=' ...')}" if row.message else ""
                 notes.append(f"row {row.label!r}: exported, but the run scored it {row.status}{why}")
     finally:
         shutil.rmtree(staging, ignore_errors=True)
