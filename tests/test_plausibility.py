@@ -397,3 +397,35 @@ def test_a_star_tracker_noise_in_radians_written_as_arcsec_warns_with_the_arcsec
     assert warnings_of(tracker([5, 5, 40])) == []       # a small satellite's tracker
     assert warnings_of(tracker([0.1, 0.1, 0.5])) == []  # the most precise
     assert warnings_of(tracker([0, 0, 0])) == []        # a perfect sensor, meant
+
+
+def test_a_sun_or_moon_cone_in_radians_written_as_degrees_warns_with_the_degrees_meant():
+    """35 deg written in radians is 0.6109 (35 pi / 180 by hand), and 0.6109 rad is 35.0 deg back:
+    a cone about the Sun that small (the disc is 0.27 deg in radius) protects nothing; so for the
+    Moon, and a star tracker's exclusion about either. 1 deg and more, 0 (no cone) and a small
+    cone about the Earth's limb are not judged."""
+    def cone(body, angle):
+        def change(d):
+            d.setdefault("requirements", {})["pointing"] = {
+                "st": {"sensor": "star_tracker", "keep_out": body, "angle_deg": angle}}
+        return change
+    said = warnings_of(cone("sun", 0.6109))
+    assert len(said) == 1, said
+    assert said[0].startswith("requirements.pointing.st.angle_deg: 0.6109 deg "), said
+    assert "about the Sun" in said[0] and "did you mean 35 deg (radians written as degrees)" in said[0], said
+    moon = warnings_of(cone("moon", 0.17453))  # 10 pi / 180
+    assert len(moon) == 1 and "about the Moon" in moon[0] and "did you mean 10 deg" in moon[0], moon
+    for body, angle in (("sun", 30), ("sun", 1.0), ("moon", 5), ("earth_limb", 0.5)):
+        assert warnings_of(cone(body, angle)) == [], (body, angle)
+
+    def exclusion(angles):
+        def change(d):
+            d.setdefault("simulation", {})["sensors"] = {
+                "gyro": {"arw_deg_per_sqrt_h": 0.15},
+                "star_tracker": {"noise_arcsec": [6, 6, 40], "rate_hz": 1.0, "exclusion_deg": angles}}
+        return change
+    tracker = warnings_of(exclusion({"sun": 0.5236, "moon": 10}))
+    assert len(tracker) == 1 and tracker[0].startswith("simulation.sensors.star_tracker.exclusion_deg.sun: 0.5236 deg"), \
+        tracker
+    assert "did you mean 30 deg" in tracker[0], tracker
+    assert warnings_of(exclusion({"sun": 30, "moon": 10, "earth_limb": 0.5})) == []

@@ -12,9 +12,10 @@ and :func:`~scenarios.schema.loader.load` issue each as a
 same findings, those of :func:`plausibility_warnings`. Each check of :data:`PLAUSIBILITY_CHECKS` has one physical
 reason; a value that passes them all is not thereby right, only not obviously wrong.
 
-There is no check of angles in radians: every angle a scenario gives is in degrees (``_deg``
-keys, ``axis_angle.angle_deg``), whose ranges the schema already bounds, except a star tracker's
-noise in arcsec, which has no upper bound and whose value in radians lies far below any sensor's; and an inertia that
+Angles are in degrees (``_deg`` keys, ``axis_angle.angle_deg``), whose ranges the schema already
+bounds; two have a range where a value in radians lands and no physical one does: a star tracker's
+noise in arcsec (no upper bound, and radians lie far below any sensor's) and a keep-out cone about
+the Sun or the Moon (below 1 deg it protects nothing, and 35 deg in radians is 0.61). An inertia that
 violates the triangle inequality is an error of the loader, not a warning.
 
 May import: :mod:`ocp` (the Earth's radius), :mod:`scenarios.errors` (the warning's class) and the :class:`~scenarios.schema.loader.Scenario`
@@ -38,9 +39,13 @@ if TYPE_CHECKING:
     from scenarios.schema.loader import Scenario
 
 __all__ = ["LOWEST_ORBIT_KM", "MAX_ANGULAR_ACCELERATION", "MAX_RATE", "MAX_RATE_TOLERANCE",
-           "MIN_STAR_TRACKER_NOISE_ARCSEC", "MOON_DISTANCE_KM", "PLAUSIBILITY_CHECKS", "SLOW_SLEW_FACTOR", "Implausible", "plausibility_warnings",
+           "MIN_BRIGHT_BODY_CONE_DEG", "MIN_STAR_TRACKER_NOISE_ARCSEC", "MOON_DISTANCE_KM", "PLAUSIBILITY_CHECKS", "SLOW_SLEW_FACTOR", "Implausible", "plausibility_warnings",
            "warn_implausible"]
 
+MIN_BRIGHT_BODY_CONE_DEG = 1.0
+"""Half-angle [deg] of a keep-out cone about the Sun or the Moon below which it reads as radians
+written as degrees: the bodies' discs are about 0.27 deg in radius and the sensors they blind keep
+tens of degrees off them (35 deg written as 0.61 lands here; a cone of 1 deg or more is not judged)."""
 MOON_DISTANCE_KM = 384_400.0
 """The Moon's mean distance from the Earth [km]: an orbit reaching beyond it is no Earth orbit the
 two-body (and J2) model describes, the Moon's and the Sun's pull being comparable to the Earth's."""
@@ -414,6 +419,35 @@ def _star_tracker_noise(scenario: Scenario) -> Iterator[Implausible]:
                       f"precise reach about 0.1 arcsec); did you mean {meant} arcsec (radians written as arcsec)?")
 
 
+
+BRIGHT_BODIES = {"sun": "Sun", "moon": "Moon"}
+"""The keep-out targets (``keep_out``, ``exclusion_deg`` keys) :func:`_bright_body_cones` judges, and their names."""
+
+
+def _bright_body_cones(scenario: Scenario) -> Iterator[Implausible]:
+    """A keep-out cone about the Sun or the Moon (``requirements.pointing.<name>`` with ``keep_out:
+    sun`` or ``moon``, a star tracker's ``exclusion_deg.sun`` or ``.moon``) with a half-angle above 0
+    and below :data:`MIN_BRIGHT_BODY_CONE_DEG` (radians written as degrees): the bodies' own discs
+    are 0.27 deg in radius, and a sensor the Sun or the Moon blinds needs tens of degrees (star
+    trackers 25-45 deg off the Sun, 10-25 deg off the Moon), so such a cone protects nothing."""
+    data = scenario.data or {}
+    given: list[tuple[str, str, Any]] = []  # (path, body, the angle as written)
+    for name, entry in _mapping(data, "requirements", "pointing").items():
+        if isinstance(entry, dict) and isinstance(entry.get("keep_out"), str) and entry["keep_out"] in BRIGHT_BODIES:
+            given.append((f"requirements.pointing.{name}.angle_deg", entry["keep_out"], entry.get("angle_deg")))
+    for body, angle in _mapping(data, "simulation", "sensors", "star_tracker", "exclusion_deg").items():
+        if isinstance(body, str) and body in BRIGHT_BODIES:
+            given.append((f"simulation.sensors.star_tracker.exclusion_deg.{body}", body, angle))
+    for path, body, written in given:
+        value = _number(written)
+        if value is None or not 0.0 < value < MIN_BRIGHT_BODY_CONE_DEG:
+            continue
+        yield Implausible(path, f"{written} deg",
+                          f"is a cone of {value:g} deg about the {BRIGHT_BODIES[body]}, below "
+                          f"{MIN_BRIGHT_BODY_CONE_DEG:g} deg, where it protects nothing (the disc itself is 0.27 deg in "
+                          f"radius; a sensor it blinds needs tens of degrees); did you mean "
+                          f"{math.degrees(value):.4g} deg (radians written as degrees)?")
+
 PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "orbit_altitude": _orbit_altitude,
     "rate_bounds": _rate_bounds,
@@ -426,6 +460,7 @@ PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "disturbance": _disturbance,
     "wheel_axes": _wheel_axes,
     "star_tracker_noise": _star_tracker_noise,
+    "bright_body_cones": _bright_body_cones,
 }
 """Name -> check: each yields the :class:`Implausible` values of a validated scenario."""
 
