@@ -46,7 +46,10 @@ def test_a_study_case_that_cannot_pass_fails_validate_strict_naming_the_case(tmp
     assert "case 0" not in out
     assert main(["validate", path, "--strict"]) == 1
     captured = capsys.readouterr()
-    assert "case 1 [" in captured.out and "--strict: 1 finding(s) above" in captured.err, captured
+    # case 1's two findings: the rate requirement it cannot meet, and 0.2 rad/s as an initial rate
+    # error, at or above the 0.1 rad/s plausibility bar (deg/s written as rad/s?)
+    assert "case 1 [" in captured.out and "--strict: 2 finding(s) above" in captured.err, captured
+    assert "warning: simulation.initial_rate_error" in captured.out, captured
 
 
 def test_a_study_whose_cases_may_pass_exits_0_under_strict(tmp_path, capsys):
