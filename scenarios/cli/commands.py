@@ -303,16 +303,17 @@ def _validate_study(file: str) -> tuple[str, list[str]]:
     """A study file, every case expanded and checked as ``sweep`` checks it before running (its
     parser imported here: ``run`` needs none); the findings are each case's :func:`_strict_findings`,
     naming the case and its varied values."""
-    from scenarios.study.spec import load_study
+    from scenarios.study.spec import load_study, noise_note
 
     found = StudyFindings()  # each case's findings, from the loader's parse where the check parsed it
     study = load_study(file, parsed=found)
     points = len({case.point for case in study.cases})
     varied = ", ".join(study.varied_paths) or "nothing"
     findings = study_findings(study, found)
+    note = noise_note(study)
     return (f"{file}: valid study {study.name!r}: {len(study.cases)} cases ({points} grid point(s) x "
-            f"{study.samples} sample(s)), varying {varied}; run it with `slewbench {OTHER_FILES['study']} {file}`",
-            findings)
+            f"{study.samples} sample(s)), varying {varied}; run it with `slewbench {OTHER_FILES['study']} {file}`"
+            + (f"\n{note}" if note else ""), findings)
 
 
 def _validate_table(file: str) -> tuple[str, list[str]]:

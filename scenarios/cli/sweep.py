@@ -433,14 +433,14 @@ def _list_cases(study: Study, workers: int, found: StudyFindings | None = None, 
     rows cannot be ok, such as a slew longer than ``maneuver.duration`` by a planner's
     ``least_duration``; plausibility warnings)."""
     from scenarios.cli.commands import print_findings, study_findings
-    from scenarios.study.spec import size_note
+    from scenarios.study.spec import noise_note, size_note
 
     varied = [*study.grid_paths, *study.mc_paths]
     print(f"{study.name}: {len(study.cases)} cases, checked; nothing run, nothing written"
           + (f"; varying {', '.join(varied)}" if varied else ""))
-    note = size_note(study, workers)
-    if note:
-        print(note)
+    for note in (size_note(study, workers), noise_note(study)):
+        if note:
+            print(note)
     if local:
         _say_workers(workers, option)
     for case in study.cases[:DRY_RUN_SHOWN]:
@@ -493,7 +493,7 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
         robustness_tables,
     )
     from scenarios.study.robustness import crashed_counts, robustness_lines
-    from scenarios.study.spec import LARGE_STUDY, size_note
+    from scenarios.study.spec import LARGE_STUDY, noise_note, size_note
     from scenarios.study.store import STORE_NAME, SweepStore, resume_counts
 
     previous = signal.signal(signal.SIGTERM, _terminate)
@@ -515,8 +515,9 @@ def _run(args: argparse.Namespace, study: Study, out: Path, cluster: DaskCluster
                 print(note, flush=True)
             size = None if len(study.cases) <= LARGE_STUDY else size_note(
                 study, args.workers or _cluster_threads(cluster) or study.execution.workers or _local_workers())
-            if size:
-                print(size, flush=True)
+            for said in (size, noise_note(study)):
+                if said:
+                    print(said, flush=True)
             if cluster is None:
                 _say_workers(args.workers or study.execution.workers, _workers_option(args))
             results = sweep(study, workers=args.workers, store=store, progress=True, cluster=cluster)

@@ -744,6 +744,50 @@ LARGE_STUDY = 1000
 (:func:`size_note`); a study of any size up to :data:`~scenarios.schema.study.MAX_CASES` runs."""
 
 
+NOISE_SEED_PATH = "simulation.sensor_noise.seed"
+"""The scenario path of the seed of every sensor's noise (:func:`noise_note`)."""
+
+
+def _noisy(scenario: Any) -> bool:
+    """Whether a case's scenario mapping measures with noise: a ``simulation.sensor_noise`` standard
+    deviation above 0, or ``simulation.sensors`` (a gyro, a star tracker) given."""
+    simulation = scenario.get("simulation") if isinstance(scenario, dict) else None
+    if not isinstance(simulation, dict):
+        return False
+    noise = simulation.get("sensor_noise")
+    stds = [noise.get(key) for key in ("attitude_deg", "rate", "magnetic_field")] if isinstance(noise, dict) else []
+    return (any(isinstance(v, (int, float)) and not isinstance(v, bool) and v > 0 for v in stds)
+            or simulation.get("sensors") not in (None, "none"))
+
+
+def noise_note(study: Study) -> str | None:
+    """A Monte Carlo study whose samples measure with noise but share its seed
+    (:data:`NOISE_SEED_PATH` varied by no entry): each grid point's samples then see one and the
+    same noise history, so their spread holds none of the noise's. A note, never a refusal: common
+    noise may be meant (to isolate a plant dispersion's effect).
+
+    Parameters
+    ----------
+    study : Study
+        The study.
+
+    Returns
+    -------
+    str or None
+        ``note: ...`` naming the fix, or ``None`` (one sample per grid point, no noise, or a varied seed).
+    """
+    if study.samples <= 1 or not study.cases:
+        return None
+    steps = NOISE_SEED_PATH.split(".")
+    if any(path.split(".")[:len(steps)] == steps[:len(path.split("."))] for path in study.grid_paths + study.mc_paths):
+        return None  # the seed (or a mapping that holds it) is varied
+    if not any(_noisy(case.scenario) for case in study.cases):
+        return None
+    return (f"note: the {study.samples} Monte Carlo samples of each grid point share one sensor-noise history "
+            f"({NOISE_SEED_PATH} is the same in every case), so their spread holds none of the noise's (as meant "
+            f"when the noise is held fixed to isolate what the dispersions do); to draw the noise per case, add "
+            f"'{NOISE_SEED_PATH}: case_seed' to monte_carlo.dispersions")
+
 def size_note(study: Study, workers: int) -> str | None:
     """What to know of a large study before it runs: its case count, the worker time at 1 s a case
     and how to time one of its cases. Never a refusal.
