@@ -185,3 +185,17 @@ def test_the_collocation_rate_margin_lengthens_the_minimum_time_by_at_most_the_m
     # coasting at 0.99 w instead of w lengthens Θ/w by 1/0.99 at most
     assert exact.duration < tight.duration <= exact.duration / 0.99
     assert dataclasses.replace(slew, rate_requirement=None).rate_bound(None, 0.01) == 0.05
+
+
+def test_the_gravity_gradient_bound_covers_the_perigee_of_an_orbit_started_at_apogee():
+    """Documented: the bound holds over at least one orbital period whatever the duration asked, so a 10 s
+    window from apogee is bounded at the perigee radius a (1 − e): 3 μ / r_p³ (I_max − I_min) / 2 by hand."""
+    from ocp.dynamics.orbits import KeplerianOrbit
+    a, e = 7500e3, 0.1
+    orbit = KeplerianOrbit(a, eccentricity=e, inclination=0.5, mean_anomaly=np.pi, mu=MU)
+    spacecraft = Spacecraft(INERTIA, wheels=ReactionWheels(PYRAMID, max_torque=0.002, max_momentum=0.018))
+    slew = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), TARGET, 10.0, omegaf=np.zeros(3),
+                           environment=Environment(orbit=orbit, gravity_gradient=True))
+    _, bound = slew.environment_torque_bound(10.0)
+    hand = 3.0 * MU / (a * (1 - e)) ** 3 * (0.28 - 0.12) / 2.0
+    assert hand <= bound <= hand * 1.001

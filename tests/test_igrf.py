@@ -126,3 +126,39 @@ def test_run_beyond_the_table_is_a_failed_row(tmp_path):
     (tmp_path / "short.yaml").write_text(textwrap.dedent(text))
     results = scenarios.run(scenarios.load(tmp_path / "short.yaml"))
     assert all(row.status == "failed" and "span_s" in row.message for row in results.rows)
+
+
+def test_the_greenwich_angle_option_is_in_degrees(tmp_path):
+    """``greenwich_angle_deg: 90`` puts the Earth-fixed x axis on the inertial y axis at t = 0: the field is
+    ppigrf's along the orbit with the Earth turned from π/2 rad (docs: the option is in degrees)."""
+    text = SCENARIO.replace("{model: igrf, epoch: 2025-01-01}",
+                            "{model: igrf, epoch: 2025-01-01, greenwich_angle_deg: 90, span_s: 200}")
+    (tmp_path / "turned.yaml").write_text(textwrap.dedent(text))
+    field = scenarios.load(tmp_path / "turned.yaml").problem.environment.magnetic_field
+    times = field.nodes[:5]
+    expected = package_field(times, 600e3, np.deg2rad(97.79), 0.0, 0.0, np.pi / 2)
+    got = np.array([field.interpolant(t).full().ravel() for t in times])
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("epoch, refused", [("1900-01-01", False), ("2029-12-31", False), ("1899-12-31", True),
+                                            ("2030-01-01", True)])
+def test_the_epoch_range_is_1900_to_the_end_of_2029(epoch, refused):
+    """IGRF-14's coefficients (the 2025 model's secular variation) end at 2030.0: 2030-01-01 is refused."""
+    from ocp.dynamics.igrf import parse_epoch
+    from ocp.errors import ModelError
+    if refused:
+        with pytest.raises(ModelError, match="IGRF-14 covers"):
+            parse_epoch(epoch)
+    else:
+        assert parse_epoch(epoch) == datetime.datetime.fromisoformat(epoch)
+
+
+@pytest.mark.parametrize("span, step", [(100.0, 30.0), (300.0, 30.0), (7000.0, 7.0), (1000.0, 120.0)])
+def test_the_table_covers_its_span_with_the_least_whole_steps(span, step):
+    """The nodes are 0, step, 2 step, ... up to the first one at or after the span (at least four): the
+    window asked for is covered and no more than a step beyond (ceil(span / step) steps, by hand)."""
+    field = IGRFField(CircularOrbit(600e3, 1.0), span=span, step=step)
+    steps = max(3, int(np.ceil(span / step - 1e-12)))
+    np.testing.assert_allclose(field.nodes, step * np.arange(steps + 1), rtol=0, atol=1e-9)
+    assert span <= field.valid_until < span + step

@@ -166,3 +166,35 @@ def test_the_dense_grid_on_a_non_uniform_mesh_has_its_points_per_interval_and_th
         np.testing.assert_allclose(np.diff(t[20 * k:20 * (k + 1) + 1]), np.diff(mesh)[k] * 8.0 / 20, rtol=1e-12)
     uniform = SimpleNamespace(duration=8.0, intervals=6, transcription=RadauCollocation(6))
     np.testing.assert_array_equal(dense_times(uniform, 20), np.linspace(0.0, 8.0, 121))
+
+
+def test_the_uniform_nlp_puts_each_interval_at_its_own_time():
+    """A time-dependent problem (a cone switched on over [20, 40] s of 60 s, a gravity gradient along the
+    orbit): the NLP of the uniform mesh and of the same mesh given as nodes (times k T / N against the
+    nodes' fractions times T) give the same constraints and objective at a random point."""
+    import casadi as ca
+
+    from ocp import CircularOrbit, Environment, Spacecraft, Torquers, quat
+    from ocp.geometry import PointingConstraint
+    from ocp.transcription.stagewise import assemble
+    from planners import ManeuverProblem
+
+    windowed = PointingConstraint("keep_in", [0, 0, 1], False, np.deg2rad(60.0), directions=[[0, 0, 1]],
+                                  window=(20.0, 40.0))
+    spacecraft = Spacecraft([[10, 0.5, 0.2], [0.5, 8, 0.3], [0.2, 0.3, 6]], torquers=Torquers(0.05))
+    environment = Environment(CircularOrbit(300e3, 0.9), gravity_gradient=True)
+    problem = ManeuverProblem(spacecraft, quat.IDENTITY, np.zeros(3), quat.from_axis_angle([0, 0, 1], 1.0), 60.0,
+                              omegaf=np.zeros(3), pointing=(windowed,), environment=environment)
+    ocp = PLANNERS["collocation"]({"intervals": 6})._ocp(problem)
+    values = []
+    rng = np.random.default_rng(5)
+    for method in (RadauCollocation(6), RadauCollocation(6, mesh=np.arange(7) / 6)):
+        stages = assemble(method, ocp, method.interval(ocp))
+        if not values:
+            w = rng.normal(size=stages.w.numel())
+        p = np.concatenate([problem.initial_state, problem.qf, np.zeros(3), [60.0], np.zeros(3)])
+        values.append([v.full().ravel() for v in ca.Function("fg", [stages.w, stages.p], [stages.f, stages.g])(w, p)])
+    (f_uniform, g_uniform), (f_nodes, g_nodes) = values
+    np.testing.assert_allclose(g_uniform, g_nodes, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(f_uniform, f_nodes, rtol=1e-12)
+    assert np.sum(g_uniform == -1.0) > 0  # the window switches the cone off somewhere

@@ -182,3 +182,32 @@ def test_good_requirements_build_the_problem_the_planners_get():
     tighter = changed(requirements__rate={"max": 0.05}, maneuver__max_rate=0.04)
     assert scenarios.parse_scenario(tighter).problem.max_rate == 0.04  # the planning bound, no looser
     assert scenarios.parse_scenario(changed(requirements=None)).problem.pointing == ()
+
+
+@pytest.mark.parametrize("name", ["actuators", "rate", "final"])
+def test_a_pointing_requirement_may_not_take_a_reserved_name(name):
+    """The names ``actuators``, ``rate`` and ``final`` name the other requirements' result columns
+    (``ref.req.<name>.<field>``): a pointing requirement called so is refused, naming it."""
+    from scenarios.requirements.spec import (
+        Direction,
+        PointingRequirement,
+        Requirements,
+        Sensor,
+    )
+    cone = PointingRequirement(name, Sensor("st", [0, 0, 1]), True, 0.5, Direction(None, [1, 0, 0]))
+    with pytest.raises(ValueError, match=name):
+        Requirements(pointing=(cone,))
+    assert Requirements(pointing=(PointingRequirement("sun", cone.sensor, True, 0.5, cone.direction),)).names == ("sun",)
+
+
+def test_a_sensors_boresight_and_a_fixed_direction_are_made_unit():
+    """[0, 6, 8] becomes [0, 0.6, 0.8] (norm 10, by hand); the cone's angle at the identity attitude from
+    inertial z is then acos(0.8)."""
+    from ocp.geometry.directions import Geometry
+    from scenarios.requirements.spec import Direction, PointingRequirement, Sensor
+    sensor = Sensor("st", [0.0, 6.0, 8.0])
+    np.testing.assert_allclose(sensor.boresight, [0.0, 0.6, 0.8], rtol=1e-15)
+    direction = Direction(None, [0.0, 0.0, 5.0])
+    np.testing.assert_allclose(direction.vector, [0.0, 0.0, 1.0], rtol=1e-15)
+    constraint = PointingRequirement("sun", sensor, True, 0.3, direction).constraint(Geometry(None, None), 10.0)
+    assert float(constraint.angles([0.0], [[1.0, 0.0, 0.0, 0.0]])[0]) == pytest.approx(np.arccos(0.8), abs=1e-12)

@@ -168,3 +168,22 @@ def test_a_refinement_checks_the_angles_between_the_tables():
     nearest = float(np.max(np.maximum(0.0, 1.0 - np.arccos(np.clip(checked @ CENTRE, -1.0, 1.0)) / 0.4)))
     assert result.rounds[0]["max_miss"] == pytest.approx(1.0 / (1.0 - 0.04 * nearest) - 1.0, rel=1e-9)
     assert result.rounds[0]["max_miss"] > 0.01
+
+
+def test_an_angle_without_a_time_anywhere_is_no_boundary():
+    """Documented: a triangle is on the boundary when its corners have, at one angle, entries with a time
+    and entries without; one whose corners all lack a time there (here every axis at the last angle:
+    proven infeasible) beside angles where all have one is not. With a fit exact everywhere (inf where the
+    entry is), nothing misses and nothing is on the boundary: round 1 splits nothing and the tolerance is
+    reached on the initial 14 axes."""
+    def times(axes, positions):
+        angles = np.interp(positions, [0, 1, 2], [0.5, 1.5, 3.0])
+        values = 2.0 * np.sqrt(np.outer(np.max(np.abs(np.atleast_2d(axes)), axis=1), angles))
+        values[:, np.asarray(positions, dtype=float) > 1.0] = np.inf
+        return values
+
+    axes, triangles = polytope_grid(np.eye(3), 14)
+    result = refine(axes, triangles, times(axes, [0, 1, 2]), times, lambda a, t, tri: times,
+                    RefineOptions(0.01, max_rounds=3))
+    assert result.reached and len(result.axes) == len(axes)
+    assert result.rounds[0]["split"] == 0 and result.rounds[0]["boundary"] == 0

@@ -49,3 +49,23 @@ def test_the_fit_along_a_table_axis_is_scipys_pchip_of_the_scaled_times():
         scalar = [fit.axis_angle(*axis.tolist(), float(a)) for a in between]
         np.testing.assert_allclose(scalar, expected, rtol=1e-12)
         np.testing.assert_allclose(fit.many_axis_angle(np.tile(axis, (len(between), 1)), between), expected, rtol=1e-12)
+
+
+def test_a_failed_wheel_gives_the_grid_no_torque_generator():
+    """Documented: the grid's shape is the *working* actuators' torque generators. Four pyramid wheels
+    of 0.02, 0.03, 0.04, 0.05 N m with the second failed, plus torquers of [0.001, 0.002, 0.003] N m:
+    the generators are three wheel axes times their bounds and the torquer axes, by hand."""
+    from scenarios.slewtable.spec import torque_generators
+    pyramid = np.array([[1, 1, 1], [-1, 1, 1], [-1, -1, 1], [1, -1, 1]]) / np.sqrt(3.0)
+    scenario = {"name": "failed", "spacecraft": {
+        "inertia": [1.0, 2.0, 3.0],
+        "wheels": {"axes": pyramid.tolist(), "max_torque": [0.02, 0.03, 0.04, 0.05], "max_momentum": 1.0,
+                   "failed": [1]},
+        "torquers": {"max_torque": [0.001, 0.002, 0.003]}},
+        "maneuver": {"duration": 60.0, "initial": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]},
+                     "final": {"q": [1, 0, 0, 0], "omega": [0, 0, 0]}},
+        "planners": [], "controller": {"name": "none"}}
+    inertia, generators = torque_generators(scenario)
+    np.testing.assert_allclose(inertia, np.diag([1.0, 2.0, 3.0]))
+    expected = [pyramid[0] * 0.02, pyramid[2] * 0.04, pyramid[3] * 0.05, [0.001, 0, 0], [0, 0.002, 0], [0, 0, 0.003]]
+    np.testing.assert_allclose(generators, expected, rtol=1e-12, atol=1e-15)

@@ -308,3 +308,38 @@ def test_bad_refine_section_exits_2_naming_the_yaml_path(tmp_path, capsys, refin
     spec.write_text(yaml.safe_dump({"table": {"scenario": "box.yaml", "angles_deg": [90, 180], "refine": refine_section}}))
     assert main(["table", str(spec), "--out", str(tmp_path / "out")]) == 2
     assert where in capsys.readouterr().err
+
+
+def test_a_budget_of_exactly_the_axes_a_round_needs_lets_it_finish():
+    """max_axes is the refined table's axes *at most*: a round that ends on C axes without a budget (and
+    grades nothing) is admitted whole by a budget of C, and one of C - 1 stops the refinement (grading may
+    still complete the round's last cut)."""
+    axes, triangles, times = _initial(bump_time, 14)
+    free = refine(axes, triangles, times, _solver(bump_time), _predict, RefineOptions(0.005, max_rounds=1, max_axes=10**4))
+    count = len(free.axes)
+    assert free.rounds[0]["graded"] == 0 and count > len(axes)
+    exact = refine(axes, triangles, times, _solver(bump_time), _predict, RefineOptions(0.005, max_rounds=1, max_axes=count))
+    assert len(exact.axes) == count and "axes" not in exact.stopped
+    np.testing.assert_array_equal(exact.axes, free.axes)
+    short = refine(axes, triangles, times, _solver(bump_time), _predict,
+                   RefineOptions(0.005, max_rounds=1, max_axes=count - 1))
+    assert short.rounds[0]["split"] < free.rounds[0]["split"] and f"{count - 1} axes" in short.stopped
+
+
+@pytest.mark.parametrize("check, refused", [([90.0], False), ([180.02], False), ([90.06], True), ([45.0], True)])
+def test_check_angles_must_be_table_angles_within_005_deg(tmp_path, check, refused):
+    """Read without computing anything: a check angle is one of the table's angles (to 0.05 deg, the
+    documented rounding allowance) or the spec is refused naming table.refine.check_angles_deg and it."""
+    from scenarios.errors import ScenarioError
+    from scenarios.slewtable.spec import parse_table_spec
+    (tmp_path / "box.yaml").write_text(yaml.safe_dump(UNIT_BOX))
+    table = {"table": {"scenario": "box.yaml", "axes": 14, "angles_deg": [90.0, 180.0],
+                       "refine": {"tolerance": 0.01, "check_angles_deg": check}}}
+    (tmp_path / "table.yaml").write_text(yaml.safe_dump(table))
+    if refused:
+        with pytest.raises(ScenarioError) as error:
+            parse_table_spec(tmp_path / "table.yaml")
+        assert error.value.path == "table.refine.check_angles_deg" and f"{check[0]:g}" in error.value.message
+    else:
+        spec = parse_table_spec(tmp_path / "table.yaml")
+        assert spec.refine is not None and spec.refine.check_angles == [0 if check[0] < 135 else 1]
