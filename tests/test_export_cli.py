@@ -246,3 +246,16 @@ def test_the_note_goes_to_the_row_whose_file_it_is_when_stems_share_a_prefix(tmp
     report = export_module.export_run(out, "fake", tmp_path / "fake")
     assert report.files == ["k=0.5.waypoints.csv"]
     assert [note.split(":")[0] for note in report.notes] == ["row 'k=0.5'"], report.notes
+
+
+def test_a_reason_whose_first_word_is_longer_than_the_room_is_cut_at_the_room():
+    """A word longer than the note's room (a long path) leaves no whole word to keep: the reason is
+    cut at the room's end, not dropped (``textwrap.shorten`` gave ``...`` alone); a reason that fits
+    is kept whole, on one line. Lengths by hand: 300 characters at most, 296 of them the text."""
+    from scenarios.output.export import NOTE_MESSAGE_CHARS, _cut
+
+    assert NOTE_MESSAGE_CHARS == 300
+    assert _cut("x" * 400 + " tail") == "x" * 296 + " ..."
+    path = "reference failed: /" + "a" * 320
+    assert _cut(path) == path[:296] + " ..."
+    assert _cut("final (closed loop):\n error 0.439 deg") == "final (closed loop): error 0.439 deg"

@@ -15,6 +15,7 @@ import yaml
 from scenarios import runner
 from scenarios.cli.commands import main
 from scenarios.errors import ScenarioError
+from scenarios.schema.read import read_yaml
 from scenarios.study import engine
 from scenarios.study.spec import _case_error
 from scenarios.study.types import Case
@@ -209,8 +210,13 @@ def test_the_summary_shows_a_group_whose_every_case_crashed(tmp_path, monkeypatc
 # --- 4. a dispersed quaternion ------------------------------------------------------------------
 
 def _quaternion_study(tmp_path: Path, path: str, std: float) -> Path:
-    """The eigenaxis demo with its ``path`` quaternion offset by a normal draw of ``std`` per number."""
-    study = {"study": "dispersed-quaternion", "scenario": str(REPOSITORY / "scenarios" / "eigenaxis_demo.yaml"),
+    """The eigenaxis demo with its ``path`` quaternion offset by a normal draw of ``std`` per number
+    (a path ending in ``.quaternion``: the attitude written in the mapping form first)."""
+    scenario = read_yaml(REPOSITORY / "scenarios" / "eigenaxis_demo.yaml")
+    if path.endswith(".quaternion"):
+        end = path.split(".")[1]
+        scenario["maneuver"][end]["q"] = {"quaternion": scenario["maneuver"][end]["q"]}
+    study = {"study": "dispersed-quaternion", "scenario": scenario,
              "monte_carlo": {"samples": 20, "seed": 1,
                              "dispersions": {path: {"offset": {"normal": {"mean": [0, 0, 0, 0], "std": [std] * 4}}}}}}
     file = tmp_path / "study.yaml"
@@ -224,7 +230,7 @@ def test_a_dispersed_quaternion_off_the_unit_sphere_is_one_error_at_its_entry(tm
     the norm by about 0.05, far beyond 1e-3) and naming the forms that disperse a rotation. Before,
     the first such case stopped the check with the loader's advice to normalise that case's
     quaternion, which nothing in a study can do."""
-    for path in ("maneuver.final.q", "maneuver.initial.q"):
+    for path in ("maneuver.final.q", "maneuver.initial.q", "maneuver.final.q.quaternion"):
         status = main(["sweep", str(_quaternion_study(tmp_path, path, 0.05)), "--dry-run"])
         err = " ".join(capsys.readouterr().err.split())
         assert status == 2, err
@@ -232,8 +238,9 @@ def test_a_dispersed_quaternion_off_the_unit_sphere_is_one_error_at_its_entry(tm
                           r"norm is not within 0\.001 of 1", err)
         assert found and int(found.group(1)) >= 15, err
         assert "normalise it" not in err and "case 1 [" not in err, err
-        assert f"{path}.axis_angle.angle_deg" in err and f"{path}.axis_angle.axis" in err, err
-        assert ("simulation.initial_attitude_error_deg" in err) == (path == "maneuver.initial.q"), err
+        attitude = path.removesuffix(".quaternion")
+        assert f"{attitude}.axis_angle.angle_deg" in err and f"{attitude}.axis_angle.axis" in err, err
+        assert ("simulation.initial_attitude_error_deg" in err) == (attitude == "maneuver.initial.q"), err
 
 
 def test_a_dispersed_quaternion_within_the_norm_tolerance_is_still_taken(tmp_path, capsys):

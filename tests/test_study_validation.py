@@ -115,6 +115,24 @@ def _two_wheel_regulation():
     return base
 
 
+def test_a_two_wheel_start_out_of_the_laws_domain_is_refused_at_the_key_that_put_it_there():
+    """30 deg about the unactuated z axis (q = [cos 15, 0, 0, sin 15] deg, scalar last in this file)
+    from rest is outside the laws' domain: written as the planned start, maneuver.initial.q is
+    named; reached from a planned start at the target by simulation.initial_attitude_error_deg,
+    that key is named with its value (it named maneuver.initial.q and advised the very key)."""
+    half = np.deg2rad(15.0)
+    planned = _two_wheel_regulation()
+    planned["maneuver"]["initial"]["q"] = [0.0, 0.0, float(np.sin(half)), float(np.cos(half))]
+    with pytest.raises(ScenarioError) as written:
+        scenarios.parse_scenario(planned)
+    assert written.value.path == "maneuver.initial.q", written.value
+    simulated = _two_wheel_regulation()
+    simulated["simulation"]["initial_attitude_error_deg"] = [0.0, 0.0, 30.0]
+    with pytest.raises(ScenarioError) as error:
+        scenarios.parse_scenario(simulated)
+    assert error.value.path == "simulation.initial_attitude_error_deg", error.value
+    assert "[0.0, 0.0, 30.0] deg takes the start as simulated" in str(error.value), error.value
+
 def test_an_initial_error_a_two_wheel_law_cannot_start_from_is_refused_at_its_case():
     """The two-wheel laws check the start as simulated, initial errors applied: the initial errors
     are not independent of the scenario there. The oracle: the whole loader on each case alone
@@ -126,10 +144,12 @@ def test_an_initial_error_a_two_wheel_law_cannot_start_from_is_refused_at_its_ca
         case = _two_wheel_regulation()
         case["simulation"]["initial_attitude_error_deg"] = error
         verdicts.append(loader_verdict(case))
-    assert verdicts == [None, "maneuver.initial.q", "maneuver.initial.q"], verdicts
+    assert verdicts == [None, "simulation.initial_attitude_error_deg", "simulation.initial_attitude_error_deg"], verdicts
     data = {"study": "v", "scenario": _two_wheel_regulation(), "grid": {"simulation.initial_attitude_error_deg": errors}}
     with pytest.raises(ScenarioError, match=r"^case 1 \[simulation\.initial_attitude_error_deg=\[0\.0, 0\.0, 30\.0\]\]: "
-                                            r"maneuver\.initial\.q: controller singular_zero_momentum"):
+                                            r"simulation\.initial_attitude_error_deg \(set by simulation\.initial_attitude_error_deg\): "
+                                            r"\[0\.0, 0\.0, 30\.0\] deg takes the start as simulated .* "
+                                            r"controller singular_zero_momentum"):
         parse_study(data)
     data["grid"]["simulation.initial_attitude_error_deg"] = [errors[0], [6.0, 4.0, 0.0]]
     assert len(parse_study(data).cases) == 2  # a study whose every case the loader takes still passes

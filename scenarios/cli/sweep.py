@@ -31,7 +31,12 @@ from scenarios.cli.status import (
     workers_note,
 )
 from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
-from scenarios.output.directory import MARKER, claim_output_directory, written_files
+from scenarios.output.directory import (
+    HOSTS,
+    MARKER,
+    claim_output_directory,
+    written_files,
+)
 from scenarios.output.names import default_output_directory, suffix_note
 from scenarios.output.provenance import package_version
 from scenarios.output.tables import is_missing
@@ -103,9 +108,10 @@ def command_report(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-CASE_FOLDER = "cases"
+CASE_FOLDER = HOSTS["sweep"]
 """The folder of a sweep directory that ``sweep DIR --case N`` writes case ``N`` into by default
-(``DIR/cases/N``)."""
+(``DIR/cases/N``): the one a sweep's directory hosts other outputs in
+(:data:`scenarios.output.directory.HOSTS`)."""
 
 
 def command_case(args: argparse.Namespace) -> int:

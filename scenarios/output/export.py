@@ -18,7 +18,6 @@ import csv
 import dataclasses
 import json
 import shutil
-import textwrap
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -50,6 +49,18 @@ NOTE_MESSAGE_CHARS = 300
 """Characters of a row's message at most in an export's note on a row the run did not score ``ok``
 (cut between words, ``...`` marking the cut)."""
 
+
+
+def _cut(message: str) -> str:
+    """``message`` on one line, at most :data:`NOTE_MESSAGE_CHARS` characters: cut between words,
+    visibly (a cut inside a number would state another number), or, where a word longer than the
+    room leaves nothing whole (a long path), at the room's end; ``...`` marks a cut."""
+    flat = " ".join(message.split())
+    if len(flat) <= NOTE_MESSAGE_CHARS:
+        return flat
+    room = NOTE_MESSAGE_CHARS - len(" ...")
+    words = flat[:room + 1].rsplit(" ", 1)[0] if " " in flat[:room + 1] else ""
+    return (words if len(words) >= room // 2 else flat[:room]) + " ..."
 
 @dataclass(frozen=True)
 class RunRow:
@@ -352,8 +363,7 @@ def export_run(run_directory: str | Path, format_name: str, out: str | Path | No
                   for f in files}
         for row in run.rows:
             if row in owners and row.status != "ok":
-                # cut between words, visibly: a cut inside a number would state another number
-                why = f": {textwrap.shorten(row.message, NOTE_MESSAGE_CHARS, placeholder=' ...')}" if row.message else ""
+                why = f": {_cut(row.message)}" if row.message else ""
                 notes.append(f"row {row.label!r}: exported, but the run scored it {row.status}{why}")
     finally:
         shutil.rmtree(staging, ignore_errors=True)

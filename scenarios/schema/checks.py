@@ -207,7 +207,8 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
     ScenarioError
         At ``planners[i]`` (``problem_error``), ``<controller path>.name`` (environment, planner or
         reference needed), ``spacecraft.wheels.failed`` (a law that steers the attitude on a
-        spacecraft without a working actuator), ``maneuver.<key>`` (initial or final state),
+        spacecraft without a working actuator), ``maneuver.<key>`` (initial or final state; ``simulation.initial_attitude_error_deg`` where the planned
+        start is in a law's domain and the simulated one is not),
         ``<controller path>.options.<option>`` (sample time) or ``maneuver.final.q`` (a target
         attitude needed in regulation mode).
     """
@@ -233,6 +234,14 @@ def check_compatibility(problem: ManeuverProblem, planners: list[PlannerSpec],
         if not state:  # a law defined on part of the attitudes, from the start as simulated
             start = problem.initial_state if simulation is None else simulation.true_initial_state(problem)
             state = law.initial_attitude_error(problem.spacecraft, start[:4], start[4:7], problem.qf)
+        if state and state[0] == "initial.q" and simulation is not None \
+                and not law.initial_attitude_error(problem.spacecraft, problem.q0, problem.omega0, problem.qf):
+            # the planned start is in the law's domain: the simulated start's errors take it out
+            given = np.round(np.rad2deg(simulation.initial_attitude_error), 6).tolist()
+            raise ScenarioError("simulation.initial_attitude_error_deg",
+                                f"{given} deg takes the start as simulated (maneuver.initial.q turned by it, "
+                                f"maneuver.initial.omega plus simulation.initial_rate_error) out of the domain of "
+                                f"{controller.path}: {state[1]} ({controller.path} is {controller.name!r})")
         if state:
             raise ScenarioError(f"maneuver.{state[0]}", f"{state[1]} ({controller.path} is {controller.name!r})")
         if simulation is not None:

@@ -445,8 +445,9 @@ def _mark_independent(seen: list[_Varied]) -> None:
 
 
 QUATERNION_PATHS = ("maneuver.initial.q", "maneuver.final.q")
-"""The scenario paths that hold an attitude quaternion written as four numbers: a dispersion of one
-draws its four numbers independently (:func:`_refuse_drawn_quaternions`)."""
+"""The scenario paths of the attitudes, whose quaternion form (four numbers, at the path itself or
+in the mapping form at ``<path>.quaternion``) a dispersion would draw number by number
+(:func:`_refuse_drawn_quaternions`)."""
 
 
 def _refuse_drawn_quaternions(varied: _Varied, values: np.ndarray) -> None:
@@ -457,7 +458,8 @@ def _refuse_drawn_quaternions(varied: _Varied, values: np.ndarray) -> None:
     draw is not normalised either: four numbers drawn independently and normalised are not a
     distribution of rotations anyone asked for (draws within the tolerance are, as a written
     quaternion is, by the loader)."""
-    if varied.path not in QUATERNION_PATHS or values.shape[1] != 4:
+    attitude = varied.path.removesuffix(".quaternion")
+    if attitude not in QUATERNION_PATHS or values.shape[1] != 4:
         return
     norms = np.linalg.norm(values, axis=1)
     off = np.flatnonzero(np.abs(norms - 1.0) > UNIT_NORM_TOLERANCE)
@@ -465,15 +467,15 @@ def _refuse_drawn_quaternions(varied: _Varied, values: np.ndarray) -> None:
         return
     first = int(off[0])
     start = ("; for the closed loop's start about the planned attitude, simulation.initial_attitude_error_deg "
-             "(a rotation vector [deg], body axes)" if varied.path == "maneuver.initial.q" else "")
+             "(a rotation vector [deg], body axes)" if attitude == "maneuver.initial.q" else "")
     raise ScenarioError(varied.entry, f"{off.size} of {len(values)} cases draw a quaternion whose norm is not within "
                                       f"{UNIT_NORM_TOLERANCE:g} of 1 (case {first}: norm {norms[first]:.6g}): the four "
                                       "numbers of a quaternion do not disperse independently (normalised, such draws "
                                       "would be a distribution of rotations nobody asked for); "
-                                      f"disperse a rotation instead: write {varied.path} in the axis_angle form "
-                                      f"({varied.path}: {{axis_angle: {{axis: [x, y, z], angle_deg: a}}}}) and "
-                                      f"disperse {varied.path}.axis_angle.angle_deg and "
-                                      f"{varied.path}.axis_angle.axis{start}")
+                                      f"disperse a rotation instead: write {attitude} in the axis_angle form "
+                                      f"({attitude}: {{axis_angle: {{axis: [x, y, z], angle_deg: a}}}}) and "
+                                      f"disperse {attitude}.axis_angle.angle_deg and "
+                                      f"{attitude}.axis_angle.axis{start}")
 
 
 class _Expansion:
