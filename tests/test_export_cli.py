@@ -139,6 +139,50 @@ def test_a_run_without_epoch_is_refused_naming_epoch(tmp_path, capsys):
     assert not out.with_name("plain-aem").exists()
 
 
+def test_an_interrupted_run_is_refused_and_nothing_is_exported(run_directory, tmp_path, capsys):
+    """A run whose manifest says it is incomplete (interrupted while committing) holds files of two
+    runs or half a run: exporting it would present them as complete."""
+    import shutil
+    copy = tmp_path / "interrupted"
+    shutil.copytree(run_directory, copy)
+    marker = copy / ".slewbench-output.json"
+    manifest = json.loads(marker.read_text())
+    assert manifest["complete"] is True
+    marker.write_text(json.dumps({**manifest, "complete": False}))
+    assert main(["export", str(copy), "--format", "aem", "--out", str(tmp_path / "aem")]) == 2
+    assert "incomplete" in capsys.readouterr().err
+    assert not (tmp_path / "aem").exists()
+
+
+def test_a_recorded_stem_that_is_not_a_file_stem_is_worked_out_again_from_the_label(run_directory, tmp_path):
+    """A ``file_stem`` in results.json that slewbench would not make (a path, say: an edited or foreign
+    file) is not trusted: the stems come from the labels, the rule that named the run's files, so
+    both rows are still exported under their own names."""
+    import shutil
+
+    from scenarios.output.export import export_run
+    copy = tmp_path / "edited"
+    shutil.copytree(run_directory, copy)
+    data = json.loads((copy / "results.json").read_text())
+    assert [row["file_stem"] for row in data["rows"]] == ["smooth", "fast"]
+    data["rows"][0]["file_stem"] = "../smooth"
+    (copy / "results.json").write_text(json.dumps(data))
+    report = export_run(copy, "aem", tmp_path / "aem")
+    assert sorted(report.files) == ["fast.closed_loop.aem", "fast.reference.aem", "smooth.closed_loop.aem",
+                                    "smooth.reference.aem"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["aem", "edited"]  # nothing written beside
+
+
+def test_results_json_records_the_epoch_in_utc_with_z(run_directory):
+    """The epoch as the scenario wrote it (2027-03-20T12:00:00Z), ISO 8601 with the UTC designator Z
+    (docs: results.json's epoch), so a reader does not take it for local time."""
+    import datetime
+    data = json.loads((run_directory / "results.json").read_text())
+    assert data["epoch"] == "2027-03-20T12:00:00Z"
+    parsed = datetime.datetime.fromisoformat(data["epoch"].replace("Z", "+00:00"))
+    assert parsed == datetime.datetime(2027, 3, 20, 12, tzinfo=datetime.timezone.utc)
+
+
 def test_a_missing_or_foreign_directory_exits_2(tmp_path, capsys):
     assert main(["export", str(tmp_path / "nowhere"), "--format", "aem"]) == 2
     assert "is not a directory" in capsys.readouterr().err

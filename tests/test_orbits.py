@@ -409,6 +409,11 @@ def test_a_tle_a_month_and_more_away_is_used_with_a_warning(tmp_path):
     assert "warning: orbit: the TLE's epoch lies 41.3 days" in error
     status, error = run_cli(tmp_path, with_orbit(TLE_ORBIT, epoch="2020-01-01T00:00:00Z"))
     assert status == 0 and "warning" not in error, error
+    # as far before the TLE's epoch (day 343.69339541 of 2019) as after it: 2019-10-29 is day 302.0,
+    # 41.69 days before (by hand); SGP4's error grows both ways
+    status, error = run_cli(tmp_path, with_orbit(TLE_ORBIT, epoch="2019-10-29T00:00:00Z"))
+    assert status == 0, error
+    assert "warning: orbit: the TLE's epoch lies 41.7 days" in error
 
 
 @pytest.mark.parametrize("kind", ["earth", "earth_limb", "velocity"])

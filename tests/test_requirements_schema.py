@@ -107,6 +107,11 @@ BAD = {
                         "requirements.pointing.st.window", ["[30, 10]"]),
     "window negative start": (changed(requirements__pointing__st=pointing(window=[-1, None])),
                               "requirements.pointing.st.window[0]", ["non-negative"]),
+    # a window of no length: the run is [0, 60] s (maneuver.duration), so none of it is left at 60 s
+    "window starting at the run's end": (changed(requirements__pointing__st=pointing(window=[60, None])),
+                                         "requirements.pointing.st.window", ["starts at 60 s", "end at 60 s"]),
+    "window of no length": (changed(requirements__pointing__st=pointing(window=[10, 10])),
+                            "requirements.pointing.st.window", ["[10, 10]", "after its start"]),
     "window of one number": (changed(requirements__pointing__st=pointing(window=[10])),
                              "requirements.pointing.st.window", ["[start_s, end_s or null]"]),
     "reserved name": (changed(requirements__pointing={"rate": pointing()}), "requirements.pointing.rate",

@@ -531,6 +531,9 @@ def test_schema_keys_select_what_they_name():
     assert re.findall(r"^planners\[i\]\.options\.\w+$", selected, re.MULTILINE) == \
         ["planners[i].options.torque_fraction"] * having
     assert "controller.options.gain" in schema_text("controllers.bdot")
+    # a key selects itself and what lies under it, not a longer name it begins (warm_start_options)
+    warm = schema_text("planners.collocation.warm_start")
+    assert re.findall(r"^planners\[i\]\.options\.\w+$", warm, re.MULTILINE) == ["planners[i].options.warm_start"]
     # a registered controller without options is a part of its own (it was "not a key", its close match itself)
     assert schema_text("controller.none").startswith("Controller options: none") and "it has none" in schema_text("controller.none")
     assert "execution.retries" in schema_text("study.execution") and "maneuver" not in schema_text("study.execution")

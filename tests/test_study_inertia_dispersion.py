@@ -191,6 +191,22 @@ def test_principal_moment_factors_scale_the_eigenvalues():
         np.testing.assert_allclose(np.abs(_ordered_axes(tensor)[1]), np.abs(base_axes), atol=1e-12)
 
 
+def test_a_principal_factor_scales_the_moment_about_the_axis_nearest_its_body_axis():
+    """``moments_scale[k]`` scales the principal moment whose axis is nearest body axis ``k`` (docs),
+    whatever order ``eigh`` lists the moments in: with the largest moment about x (4 > 3 > 2, eigh's
+    last), a factor of 1.1 on moment 0 scales that eigenpair's value alone and keeps every axis."""
+    base = [[4.0, 0.05, 0.0], [0.05, 2.0, 0.02], [0.0, 0.02, 3.0]]
+    parsed = study({PATH: {"principal": {"moments_scale": {"uniform": [[1.1, 1.0, 1.0], [1.1, 1.0, 1.0]]}}}},
+                   samples=2, base={**copy.deepcopy(SWEEP_BASE), "truth": {"spacecraft": {"inertia": base}}})
+    moments, axes = np.linalg.eigh(np.array(base))
+    nearest_x = int(np.argmax(np.abs(axes[0])))
+    assert nearest_x == 2 and moments[2] > 3.9  # the largest, listed last
+    for tensor in tensors(parsed):
+        for k in range(3):
+            factor = 1.1 if k == nearest_x else 1.0
+            np.testing.assert_allclose(tensor @ axes[:, k], factor * moments[k] * axes[:, k], atol=1e-12)
+
+
 def test_principal_bounds_that_reach_a_tensor_that_is_not_physical_are_refused_at_validation():
     with pytest.raises(ScenarioError, match="triangle inequality") as error:
         study({PATH: {"principal": {"moments_scale": {"uniform": [[1, 1, 0.5], [1, 1, 2.0]]}}}}, samples=2)
@@ -199,6 +215,9 @@ def test_principal_bounds_that_reach_a_tensor_that_is_not_physical_are_refused_a
         study({PATH: {"principal": {"moments_scale": {"uniform": [0.0, 1.1]}}}}, samples=2)
     with pytest.raises(ScenarioError, match="beyond 180 deg"):
         study({PATH: {"principal": {"axes_deg": {"uniform": [[-120] * 3, [120] * 3]}}}}, samples=2)
+    # the farthest corner of the box may be its low one: |(-120, -120, -120)| = 120 sqrt(3) = 207.846 deg
+    with pytest.raises(ScenarioError, match="207.846 deg, beyond 180 deg"):
+        study({PATH: {"principal": {"axes_deg": {"uniform": [[-120] * 3, [0] * 3]}}}}, samples=2)
     with pytest.raises(ScenarioError, match="principal disperses an inertia tensor"):
         study({"spacecraft.wheels.max_torque": {"principal": {"moments_scale": {"uniform": [0.9, 1.1]}}}}, samples=2)
 
