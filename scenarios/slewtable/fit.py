@@ -813,11 +813,15 @@ class SlewTimeFit:
         Raises
         ------
         TypeError, ValueError
-            As :meth:`__call__`, naming the first bad quaternion.
+            As :meth:`__call__`, naming the first bad quaternion; a ``ValueError`` for ``q0`` and
+            ``qf`` whose numbers of quaternions differ (neither being one).
         """
         arrays = []
         order = self.quaternion_order.replace("_", " ")
         for name, value in (("q0", q0), ("qf", qf)):
+            # text is not a number, though NumPy reads it as one (``__call__`` refuses it too)
+            if value is None or np.asarray(value).dtype.kind in "US":
+                raise TypeError(f"{name} must be quaternions of 4 numbers ({order}), got {value!r}")
             try:
                 array = np.atleast_2d(np.asarray(value, dtype=float))
             except (TypeError, ValueError):
@@ -825,7 +829,11 @@ class SlewTimeFit:
             if array.shape[-1] != 4:
                 raise TypeError(f"{name} must be quaternions of 4 numbers ({order}), got shape {array.shape}")
             arrays.append(array)
-        a, b = np.broadcast_arrays(*arrays)
+        try:
+            a, b = np.broadcast_arrays(*arrays)
+        except ValueError:
+            raise ValueError(f"q0 and qf must hold as many quaternions (or one of them one), got shapes "
+                             f"{arrays[0].shape} and {arrays[1].shape}") from None
         given, given_f = a, b  # as the caller wrote them (messages)
         if self._scalar_last:  # [x, y, z, w] -> [w, x, y, z]
             a, b = a[..., [3, 0, 1, 2]], b[..., [3, 0, 1, 2]]

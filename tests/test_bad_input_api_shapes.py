@@ -1,0 +1,69 @@
+"""Public functions given arguments of the wrong kind: text for numbers, ``None``, arrays of the
+wrong shape. Each is refused with an error naming the argument and what was expected, as the
+scalar form of the same call already does, never a NumPy error or an answer computed from text."""
+import numpy as np
+import pytest
+
+from ocp import quat
+from scenarios.slewtable.fit import SlewTimeFit
+
+IDENTITY = [1.0, 0.0, 0.0, 0.0]
+QUARTER_X = [np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0]
+
+
+@pytest.fixture(scope="module")
+def fit():
+    """A fit on the six body axes at 90 and 180 deg: unit inertia, unit torque bounds, the
+    eigenaxis bang-bang times 2 sqrt(theta) (closed form)."""
+    axes = np.vstack([np.eye(3), -np.eye(3)])
+    angles = np.array([np.pi / 2, np.pi])
+    return SlewTimeFit(angles, axes, np.tile(2.0 * np.sqrt(angles), (6, 1)), inertia=np.eye(3),
+                       generators=np.eye(3))
+
+
+def test_the_fit_answers_the_well_formed_calls(fit):
+    assert fit(IDENTITY, QUARTER_X) == pytest.approx(2.0 * np.sqrt(np.pi / 2), rel=1e-9)
+    assert fit.slew_time_many([IDENTITY] * 2, [QUARTER_X] * 2) == pytest.approx([2.0 * np.sqrt(np.pi / 2)] * 2, rel=1e-9)
+
+
+def test_slew_time_many_refuses_text_as_the_scalar_call_does(fit):
+    # the scalar call refused ["1", "0", "0", "0"]; the vectorised one answered 2.5066 s for it
+    with pytest.raises(TypeError, match="q0 and qf must be 4 numbers"):
+        fit(["1", "0", "0", "0"], QUARTER_X)
+    with pytest.raises(TypeError, match=r"q0 must be quaternions of 4 numbers \(scalar first\), got array\(\[\['1'"):
+        fit.slew_time_many(np.array([["1", "0", "0", "0"]]), [QUARTER_X])
+    with pytest.raises(TypeError, match="qf must be quaternions of 4 numbers"):
+        fit.slew_time_many([IDENTITY], "0.7071,0.7071,0,0")
+
+
+def test_slew_time_many_names_none(fit):
+    # was "got shape (1, 1)": None read as a NaN
+    with pytest.raises(TypeError, match="q0 must be quaternions of 4 numbers .*, got None"):
+        fit.slew_time_many(None, [QUARTER_X])
+
+
+def test_slew_time_many_names_q0_and_qf_of_different_lengths(fit):
+    # was NumPy's "shape mismatch: objects cannot be broadcast to a single shape. Mismatch is between arg 0 ..."
+    with pytest.raises(ValueError, match=r"q0 and qf must hold as many quaternions .*got shapes \(3, 4\) and \(2, 4\)"):
+        fit.slew_time_many([IDENTITY] * 3, [QUARTER_X] * 2)
+    # one against many still broadcasts
+    assert fit.slew_time_many(IDENTITY, [QUARTER_X] * 3).shape == (3,)
+
+
+@pytest.mark.parametrize("q", [[1.0, 0.0, 0.0], np.eye(3), None, 1.0, "1000"])
+def test_to_euler_refuses_what_is_not_quaternions_naming_q(q):
+    # [1, 0, 0] raised IndexError from inside the formula; "1000" and None a NumPy error
+    with pytest.raises(ValueError, match=r"q must be quaternions of 4 numbers"):
+        quat.to_euler(q)
+
+
+def test_to_euler_still_takes_stacks_of_quaternions():
+    # 90 deg about z: yaw pi/2, pitch and roll 0 (3-2-1, closed form)
+    angles = quat.to_euler(np.array([[np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4)]] * 2))
+    assert angles == pytest.approx(np.array([[np.pi / 2, 0.0, 0.0]] * 2), abs=1e-12)
+
+
+def test_from_axis_angle_names_the_axis_for_text():
+    # was NumPy's "could not convert string to float: 'xyz'"
+    with pytest.raises(ValueError, match="axis must be 3 numbers"):
+        quat.from_axis_angle("xyz", 1.0)
