@@ -117,6 +117,11 @@ def test_export_in_gps_time(run_directory, tmp_path):
     # a 5014-character OBJECT_NAME line was written (KVN lines are at most 254 characters, 6.6.1)
     (["--option", "object_name=" + "x" * 241], "--option object_name: 241 characters"),
     (["--option", "originator=" + "x" * 300], "expected at most 241, so that the ORIGINATOR line keeps to the 254"),
+    # written as OBJECT_NAME = A_B, ORIGINATOR = __ _ and ORIGINATOR = UNKNOWN: other names than the ones given
+    (["--option", "object_name=a\nb"], "--option object_name: 'a\\nb' has characters a KVN line cannot carry ('\\n')"),
+    (["--option", "originator=ÄÖ é"], "--option originator: 'ÄÖ é' has characters a KVN line cannot carry"),
+    (["--option", "originator="], "--option originator: '' is empty"),
+    (["--option", "object_id= "], "--option object_id: '' is empty"),
 ])
 def test_bad_options_exit_2_and_write_nothing(run_directory, tmp_path, capsys, argv, fragment):
     out = tmp_path / "bad"
