@@ -3,6 +3,7 @@ back independently (the run's own time series CSV, parsed here, and ``ccsds-ndm-
 installed), and the command line's refusals (exit status 2, nothing written)."""
 import csv
 import json
+import shutil
 import textwrap
 
 import numpy as np
@@ -251,3 +252,65 @@ def test_the_note_goes_to_the_row_whose_file_it_is_when_stems_share_a_prefix(tmp
     report = export_module.export_run(out, "fake", tmp_path / "fake")
     assert report.files == ["k=0.5.waypoints.csv"]
     assert [note.split(":")[0] for note in report.notes] == ["row 'k=0.5'"], report.notes
+
+
+def _damage_copy(run_directory, tmp_path, damage):
+    run = tmp_path / "run"
+    shutil.copytree(run_directory, run)
+    damage(run)
+    return run
+
+
+def _cut_series(run):  # a time series cut short: it was exported as a complete 3-sample AEM
+    path = run / "timeseries" / "smooth.csv"
+    path.write_text("".join(path.read_text().splitlines(keepends=True)[:4]))
+
+
+def _text_in_series(run):  # was an internal error (ValueError: could not convert string to float), exit 1
+    path = run / "timeseries" / "smooth.csv"
+    lines = path.read_text().splitlines(keepends=True)
+    lines[5] = "abc" + lines[5][lines[5].index(","):]
+    path.write_text("".join(lines))
+
+
+def _edited_epoch(run):  # was exit 0 with every row "not exported" and an empty export directory
+    path = run / "results.json"
+    data = json.loads(path.read_text())
+    data["epoch"] = "2027-13-40T00:00:00Z"
+    path.write_text(json.dumps(data))
+
+
+@pytest.mark.parametrize("damage, fragment", [
+    # was exit 0: row 'smooth' skipped as "not simulated (ok)", the other rows exported
+    (lambda run: (run / "timeseries" / "smooth.csv").unlink(), "removed since slewbench wrote them: timeseries/smooth.csv"),
+    (lambda run: shutil.rmtree(run / "timeseries"), "removed since slewbench wrote them: timeseries/fast.csv, "
+                                                    "timeseries/smooth.csv"),
+    (_cut_series, "changed since slewbench wrote them: timeseries/smooth.csv"),
+    (_text_in_series, "changed since slewbench wrote them: timeseries/smooth.csv"),
+    (_edited_epoch, "changed since slewbench wrote them: results.json"),
+])
+def test_a_run_directory_edited_or_half_deleted_is_refused_and_nothing_written(run_directory, tmp_path, capsys,
+                                                                               damage, fragment):
+    run = _damage_copy(run_directory, tmp_path, damage)
+    out = tmp_path / "export"
+    assert main(["export", str(run), "--format", "aem", "--out", str(out)]) == 2
+    assert fragment in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_a_run_with_its_results_md_removed_still_exports(run_directory, tmp_path):
+    # results.md is not read by an export: its loss changes nothing the export hands off
+    run = _damage_copy(run_directory, tmp_path, lambda run: (run / "results.md").unlink())
+    assert main(["export", str(run), "--format", "aem", "--out", str(tmp_path / "export")]) == 0
+
+
+def test_text_in_a_series_of_a_run_without_stamps_is_named_not_an_internal_error(run_directory, tmp_path, capsys):
+    # a run written before the manifest kept stamps cannot tell an edit: the bad cell is named
+    run = _damage_copy(run_directory, tmp_path, _text_in_series)
+    marker = run / ".slewbench-output.json"
+    manifest = json.loads(marker.read_text())
+    manifest["stamps"] = {}
+    marker.write_text(json.dumps(manifest))
+    assert main(["export", str(run), "--format", "aem", "--out", str(tmp_path / "export")]) == 2
+    assert "smooth.csv: cannot be read as the time series of row 'smooth': could not convert string to float: 'abc'" \
+        in capsys.readouterr().err
