@@ -4,7 +4,9 @@ scalar form of the same call already does, never a NumPy error or an answer comp
 import numpy as np
 import pytest
 
-from ocp import quat
+from ocp import ReactionWheels, Spacecraft, quat
+from ocp.errors import ModelError
+from planners import ManeuverProblem
 from scenarios.slewtable.fit import SlewTimeFit
 
 IDENTITY = [1.0, 0.0, 0.0, 0.0]
@@ -67,3 +69,28 @@ def test_from_axis_angle_names_the_axis_for_text():
     # was NumPy's "could not convert string to float: 'xyz'"
     with pytest.raises(ValueError, match="axis must be 3 numbers"):
         quat.from_axis_angle("xyz", 1.0)
+
+
+@pytest.mark.parametrize("build, fragment", [
+    # each was accepted: NumPy reads "2" as the number 2
+    (lambda: Spacecraft(["1", "2", "2"]), "inertia: expected 3 principal moments or a 3x3 matrix of numbers, got ['1'"),
+    (lambda: ReactionWheels(np.array([["1", "0", "0"], ["0", "1", "0"], ["0", "0", "1"]])),
+     "axes: expected a 3 x n matrix of wheel axes (numbers), got"),
+    (lambda: ReactionWheels.from_body_axes(max_torque="0.1"), "max_torque: expected a number or 3 numbers, got '0.1'"),
+])
+def test_the_model_refuses_text_for_numbers(build, fragment):
+    with pytest.raises(ModelError) as caught:
+        build()
+    assert fragment in str(caught.value)
+
+
+@pytest.mark.parametrize("argument, value, fragment", [
+    ("q0", ["1", "0", "0", "0"], "q0 must be 4 numbers, got ['1', '0', '0', '0']"),  # was accepted
+    ("omega0", "000", "omega0 must be 3 numbers, got '000'"),  # was "got shape (): 0.0"
+    ("q0", None, "q0 must be 4 numbers, got None"),  # was "got shape (): nan"
+])
+def test_a_problem_refuses_text_and_none_for_its_vectors(argument, value, fragment):
+    arguments = {"q0": IDENTITY, "omega0": np.zeros(3), "qf": QUARTER_X, "duration": 10.0, argument: value}
+    with pytest.raises(ValueError) as caught:
+        ManeuverProblem(Spacecraft([1.0, 1.0, 1.0]), **arguments)
+    assert fragment in str(caught.value)
