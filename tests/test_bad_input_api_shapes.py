@@ -94,3 +94,18 @@ def test_a_problem_refuses_text_and_none_for_its_vectors(argument, value, fragme
     with pytest.raises(ValueError) as caught:
         ManeuverProblem(Spacecraft([1.0, 1.0, 1.0]), **arguments)
     assert fragment in str(caught.value)
+
+
+@pytest.mark.parametrize("t, fragment", [
+    ("1.0", "got '1.0'"),  # was sampled at 1 s
+    (None, "got None"),  # was "reference times must be finite [s]; got [nan]"
+])
+def test_a_reference_refuses_times_that_are_not_numbers(t, fragment):
+    from planners import PLANNERS
+    problem = ManeuverProblem(Spacecraft([1.0, 1.0, 1.0]), q0=IDENTITY, omega0=np.zeros(3), qf=QUARTER_X,
+                              duration=10.0, omegaf=np.zeros(3))
+    reference = PLANNERS["eigenaxis"]({"profile": "smooth"}).plan(problem)
+    assert reference.sample(10.0).q == pytest.approx(QUARTER_X, abs=1e-9)  # ends at qf
+    with pytest.raises(TypeError, match="reference times must be numbers") as caught:
+        reference.sample(t)
+    assert fragment in str(caught.value)
