@@ -109,3 +109,23 @@ def test_a_reference_refuses_times_that_are_not_numbers(t, fragment):
     with pytest.raises(TypeError, match="reference times must be numbers") as caught:
         reference.sample(t)
     assert fragment in str(caught.value)
+
+
+@pytest.mark.parametrize("target_q, fragment", [
+    ([0.0, 0.0, 0.0, 0.0], "target_q must be a unit quaternion"),  # scored final_error_deg 0.0
+    ([1.4142, 0.0, 1.4142, 0.0], "target_q must be a unit quaternion"),  # 2 qf: as qf, a slip unseen
+    (["0.7071", "0", "0.7071", "0"], "target_q must be 4 numbers"),  # read as numbers
+])
+def test_the_metrics_refuse_a_target_that_is_no_attitude(target_q, fragment):
+    from ocp import metrics_from_reference
+    from planners import PLANNERS
+    qf = [np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0]  # 90 deg about y
+    problem = ManeuverProblem(Spacecraft([1.0, 1.0, 1.0]), q0=IDENTITY, omega0=np.zeros(3), qf=qf,
+                              duration=10.0, omegaf=np.zeros(3))
+    reference = PLANNERS["eigenaxis"]({"profile": "smooth"}).plan(problem)
+    # the reference ends at qf: 0 deg from it, 90 deg from the identity (closed form)
+    assert metrics_from_reference(reference, qf)["final_error_deg"] == pytest.approx(0.0, abs=1e-9)
+    assert metrics_from_reference(reference, IDENTITY)["final_error_deg"] == pytest.approx(90.0, abs=1e-9)
+    with pytest.raises((TypeError, ValueError)) as caught:
+        metrics_from_reference(reference, target_q)
+    assert fragment in str(caught.value)
