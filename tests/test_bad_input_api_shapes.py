@@ -129,3 +129,34 @@ def test_the_metrics_refuse_a_target_that_is_no_attitude(target_q, fragment):
     with pytest.raises((TypeError, ValueError)) as caught:
         metrics_from_reference(reference, target_q)
     assert fragment in str(caught.value)
+
+
+def _fit_file(tmp_path, fit, edit):
+    import json
+    data = fit.to_dict()
+    edit(data)
+    path = tmp_path / "fit.json"
+    path.write_text(json.dumps(data) if isinstance(data, dict) else data)
+    return path
+
+
+@pytest.mark.parametrize("edit, fragment", [
+    (lambda data: data.pop("axes"), "is not a complete slew-time fit: no 'axes'"),  # was KeyError: 'axes'
+    (lambda data: data.update(angles_rad=["a", "b"]), "whose parameters cannot be read (could not convert"),
+])
+def test_load_fit_names_the_file_of_an_edited_fit(tmp_path, fit, edit, fragment):
+    from scenarios.slewtable import load_fit
+    path = _fit_file(tmp_path, fit, edit)
+    with pytest.raises(ValueError) as caught:
+        load_fit(path)
+    assert str(caught.value).startswith(str(path)) and fragment in str(caught.value)
+
+
+def test_load_fit_names_a_file_that_is_not_json(tmp_path, fit):
+    from scenarios.slewtable import load_fit
+    path = tmp_path / "fit.json"
+    path.write_text('{"format": "slewbench-slew-')  # cut short: was a bare JSONDecodeError
+    with pytest.raises(ValueError, match="fit.json is not a slewbench slew-time fit: not JSON"):
+        load_fit(path)
+    good = _fit_file(tmp_path, fit, lambda data: None)  # the same fit written whole loads and answers
+    assert load_fit(good)(IDENTITY, QUARTER_X) == pytest.approx(2.0 * np.sqrt(np.pi / 2), rel=1e-9)
