@@ -160,3 +160,32 @@ def test_load_fit_names_a_file_that_is_not_json(tmp_path, fit):
         load_fit(path)
     good = _fit_file(tmp_path, fit, lambda data: None)  # the same fit written whole loads and answers
     assert load_fit(good)(IDENTITY, QUARTER_X) == pytest.approx(2.0 * np.sqrt(np.pi / 2), rel=1e-9)
+
+
+@pytest.fixture(scope="module")
+def run_results():
+    import scenarios
+    data = {"name": "write check", "spacecraft": {"inertia": [1.0, 1.0, 1.0], "wheels": None,
+                                                  "torquers": {"max_torque": 1.0}},
+            "maneuver": {"duration": 5.0, "initial": {"q": IDENTITY, "omega": [0, 0, 0]},
+                         "final": {"q": QUARTER_X, "omega": [0, 0, 0]}},
+            "planners": [{"name": "eigenaxis"}], "controller": {"name": "augmented_quaternion_feedback"},
+            "simulation": {"sample_time": 0.1, "duration": 6.0}}
+    return scenarios.run(scenarios.parse_scenario(data))
+
+
+@pytest.mark.parametrize("arguments, fragment", [
+    ({"directory": None}, "directory must be a str or os.PathLike, got NoneType"),  # was pathlib's TypeError
+    ({"directory": 3}, "directory must be a str or os.PathLike, got int"),
+])
+def test_run_results_write_names_a_directory_that_is_no_path(run_results, arguments, fragment):
+    with pytest.raises(TypeError) as caught:
+        run_results.write(**arguments)
+    assert fragment in str(caught.value)
+
+
+def test_run_results_write_refuses_plots_that_is_not_a_bool(run_results, tmp_path):
+    # plots="no" drew the figures ("no" is truthy), as a sweep's write already refuses
+    with pytest.raises(TypeError, match="plots must be True or False, got 'no'"):
+        run_results.write(tmp_path / "out", plots="no")
+    assert not (tmp_path / "out").exists()
