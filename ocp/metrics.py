@@ -557,12 +557,16 @@ def _check_targets(function: str, target_q: Any, target_omega: Any) -> None:
             raise TypeError(f"{function}: {name} must be {size} numbers ({what}) or None, got {type(value).__name__}"
                             + (" (pass problem.qf and problem.omegaf)" if hasattr(value, "qf") else ""))
         try:
+            if np.asarray(value).dtype.kind in "US":  # text, though NumPy reads "1" as a number
+                raise TypeError(name)
             array = np.asarray(value, dtype=float)
         except (TypeError, ValueError):
             raise TypeError(f"{function}: {name} must be {size} numbers ({what}) or None, got {value!r:.80}") from None
         if array.shape != (size,) or not np.all(np.isfinite(array)):
             raise ValueError(f"{function}: {name} must be {size} finite numbers ({what}) or None, got shape "
                              f"{array.shape}: {array.tolist()}")
+        if size == 4 and (reason := quat.unit_norm_error(array)) is not None:  # [0, 0, 0, 0] scored 0 deg
+            raise ValueError(f"{function}: {name} must be a unit quaternion ({what}): {reason}; got {array.tolist()}")
 
 
 def metrics_from_simulation(

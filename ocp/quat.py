@@ -297,7 +297,10 @@ def from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> Array:
     ValueError
         If ``axis`` is not a (..., 3) array of finite, non-zero vectors.
     """
-    axis = np.asarray(axis, dtype=float)
+    try:
+        axis = np.asarray(axis, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"axis must be 3 numbers (a (..., 3) array), got {axis!r}") from None
     if axis.ndim == 0 or axis.shape[-1] != 3:
         raise ValueError(f"axis must have 3 components, got shape {axis.shape}")
     length = np.linalg.norm(axis, axis=-1, keepdims=True)
@@ -515,10 +518,11 @@ def to_euler(q: ArrayLike, sequence: str = "321") -> Array:
     Raises
     ------
     ValueError
-        A sequence that is not three body axes with no two consecutive ones equal.
+        A sequence that is not three body axes with no two consecutive ones equal, or ``q`` that
+        is not a (..., 4) array of numbers.
     """
     first, middle, last = sequence_axes(sequence)
-    q = np.asarray(q, dtype=float)
+    q = _quaternions("q", q)
     # Written for the extrinsic sequence (i, j, k): the intrinsic (first, middle, last) is the
     # extrinsic (last, middle, first), its angles in reverse order.
     i, j, k = last, middle, first
@@ -585,6 +589,17 @@ def from_euler(angles: ArrayLike, sequence: str = "321") -> Array:
     for index, axis in enumerate(axes):
         q = product(q, from_axis_angle(np.eye(3)[axis], angles[..., index]))
     return np.where(q[..., :1] < 0.0, -q, q)
+
+
+def _quaternions(name: str, q: ArrayLike) -> Array:
+    """``q`` as a float (..., 4) array, or a ``ValueError`` naming ``name`` (text is no number)."""
+    try:
+        array = np.asarray(q, dtype=float) if np.asarray(q).dtype.kind not in "US" else None
+    except (TypeError, ValueError):
+        array = None
+    if array is None or array.ndim == 0 or array.shape[-1] != 4:
+        raise ValueError(f"{name} must be quaternions of 4 numbers (a (..., 4) array, scalar first), got {q!r}")
+    return array
 
 
 def _wrap(angles: Array) -> Array:

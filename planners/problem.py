@@ -286,6 +286,8 @@ def bound_keys(actuators: list) -> str:
 def _vector(name: str, value: ArrayLike, size: int) -> Array:
     """``value`` as a finite float vector of ``size`` entries, or a ``ValueError`` naming ``name``."""
     try:
+        if value is None or np.asarray(value).dtype.kind in "US":  # None reads as NaN, text "1" as a number
+            raise TypeError(name)
         array = np.array(value, dtype=float)  # a private copy: the caller's array is not kept
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be {size} numbers, got {value!r}") from None

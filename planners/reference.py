@@ -256,11 +256,15 @@ class Reference(ABC):
         ------
         ValueError
             If a time is not finite (NaN or infinite).
+        TypeError
+            If ``t`` is not numbers (``None``, text).
         TypeError, ValueError
             If :meth:`_evaluate` breaks the contract (not a ``ReferenceSample``, wrong shapes).
         RuntimeError
             If the reference is a :class:`FailedReference`.
         """
+        if t is None or np.asarray(t).dtype.kind in "USO":  # None reads as NaN, text "1.0" as a number
+            raise TypeError(f"reference times must be numbers [s] (a float or an array of floats), got {t!r}")
         times = np.atleast_1d(np.asarray(t, dtype=float))
         if times.ndim != 1:
             times = times.ravel()

@@ -3,6 +3,7 @@ back independently (the run's own time series CSV, parsed here, and ``ccsds-ndm-
 installed), and the command line's refusals (exit status 2, nothing written)."""
 import csv
 import json
+import shutil
 import textwrap
 
 import numpy as np
@@ -117,6 +118,11 @@ def test_export_in_gps_time(run_directory, tmp_path):
     # a 5014-character OBJECT_NAME line was written (KVN lines are at most 254 characters, 6.6.1)
     (["--option", "object_name=" + "x" * 241], "--option object_name: 241 characters"),
     (["--option", "originator=" + "x" * 300], "expected at most 241, so that the ORIGINATOR line keeps to the 254"),
+    # written as OBJECT_NAME = A_B, ORIGINATOR = __ _ and ORIGINATOR = UNKNOWN: other names than the ones given
+    (["--option", "object_name=a\nb"], "--option object_name: 'a\\nb' has characters a KVN line cannot carry ('\\n')"),
+    (["--option", "originator=ÄÖ é"], "--option originator: 'ÄÖ é' has characters a KVN line cannot carry"),
+    (["--option", "originator="], "--option originator: '' is empty"),
+    (["--option", "object_id= "], "--option object_id: '' is empty"),
 ])
 def test_bad_options_exit_2_and_write_nothing(run_directory, tmp_path, capsys, argv, fragment):
     out = tmp_path / "bad"
@@ -161,12 +167,14 @@ def test_a_recorded_stem_that_is_not_a_file_stem_is_worked_out_again_from_the_la
     import shutil
 
     from scenarios.output.export import export_run
+    from tests.test_output_safety import restamp
     copy = tmp_path / "edited"
     shutil.copytree(run_directory, copy)
     data = json.loads((copy / "results.json").read_text())
     assert [row["file_stem"] for row in data["rows"]] == ["smooth", "fast"]
     data["rows"][0]["file_stem"] = "../smooth"
     (copy / "results.json").write_text(json.dumps(data))
+    restamp(copy)  # stamped as its writer left it (an edit since is refused before any stem is read)
     report = export_run(copy, "aem", tmp_path / "aem")
     assert sorted(report.files) == ["fast.closed_loop.aem", "fast.reference.aem", "smooth.closed_loop.aem",
                                     "smooth.reference.aem"]
@@ -303,3 +311,65 @@ def test_a_reason_whose_first_word_is_longer_than_the_room_is_cut_at_the_room():
     path = "reference failed: /" + "a" * 320
     assert _cut(path) == path[:296] + " ..."
     assert _cut("final (closed loop):\n error 0.439 deg") == "final (closed loop): error 0.439 deg"
+
+
+def _damage_copy(run_directory, tmp_path, damage):
+    run = tmp_path / "run"
+    shutil.copytree(run_directory, run)
+    damage(run)
+    return run
+
+
+def _cut_series(run):  # a time series cut short: it was exported as a complete 3-sample AEM
+    path = run / "timeseries" / "smooth.csv"
+    path.write_text("".join(path.read_text().splitlines(keepends=True)[:4]))
+
+
+def _text_in_series(run):  # was an internal error (ValueError: could not convert string to float), exit 1
+    path = run / "timeseries" / "smooth.csv"
+    lines = path.read_text().splitlines(keepends=True)
+    lines[5] = "abc" + lines[5][lines[5].index(","):]
+    path.write_text("".join(lines))
+
+
+def _edited_epoch(run):  # was exit 0 with every row "not exported" and an empty export directory
+    path = run / "results.json"
+    data = json.loads(path.read_text())
+    data["epoch"] = "2027-13-40T00:00:00Z"
+    path.write_text(json.dumps(data))
+
+
+@pytest.mark.parametrize("damage, fragment", [
+    # was exit 0: row 'smooth' skipped as "not simulated (ok)", the other rows exported
+    (lambda run: (run / "timeseries" / "smooth.csv").unlink(), "removed since slewbench wrote them: timeseries/smooth.csv"),
+    (lambda run: shutil.rmtree(run / "timeseries"), "removed since slewbench wrote them: timeseries/fast.csv, "
+                                                    "timeseries/smooth.csv"),
+    (_cut_series, "changed since slewbench wrote them: timeseries/smooth.csv"),
+    (_text_in_series, "changed since slewbench wrote them: timeseries/smooth.csv"),
+    (_edited_epoch, "changed since slewbench wrote them: results.json"),
+])
+def test_a_run_directory_edited_or_half_deleted_is_refused_and_nothing_written(run_directory, tmp_path, capsys,
+                                                                               damage, fragment):
+    run = _damage_copy(run_directory, tmp_path, damage)
+    out = tmp_path / "export"
+    assert main(["export", str(run), "--format", "aem", "--out", str(out)]) == 2
+    assert fragment in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_a_run_with_its_results_md_removed_still_exports(run_directory, tmp_path):
+    # results.md is not read by an export: its loss changes nothing the export hands off
+    run = _damage_copy(run_directory, tmp_path, lambda run: (run / "results.md").unlink())
+    assert main(["export", str(run), "--format", "aem", "--out", str(tmp_path / "export")]) == 0
+
+
+def test_text_in_a_series_of_a_run_without_stamps_is_named_not_an_internal_error(run_directory, tmp_path, capsys):
+    # a run written before the manifest kept stamps cannot tell an edit: the bad cell is named
+    run = _damage_copy(run_directory, tmp_path, _text_in_series)
+    marker = run / ".slewbench-output.json"
+    manifest = json.loads(marker.read_text())
+    manifest["stamps"] = {}
+    marker.write_text(json.dumps(manifest))
+    assert main(["export", str(run), "--format", "aem", "--out", str(tmp_path / "export")]) == 2
+    assert "smooth.csv: cannot be read as the time series of row 'smooth': could not convert string to float: 'abc'" \
+        in capsys.readouterr().err

@@ -55,6 +55,8 @@ def _limit_vector(value: ArrayLike | None, size: int, field_name: str) -> Array:
     """Per-element positive limit; ``None`` means unlimited (inf). A read-only copy."""
     if value is None:
         return _frozen(np.full(size, np.inf))
+    if np.asarray(value).dtype.kind in "US":  # text, though NumPy reads "0.1" as a number
+        raise ModelError(field_name, f"expected a number or {size} numbers, got {value!r}")
     array = np.broadcast_to(np.asarray(value, dtype=float), (size,)).copy() if np.ndim(value) == 0 \
         else np.array(value, dtype=float)
     if array.shape != (size,):
@@ -465,6 +467,8 @@ class ReactionWheels(Actuator):
         self.__post_init__()
 
     def __post_init__(self) -> None:
+        if np.asarray(self.axes).dtype.kind in "US":  # text, though NumPy reads "1" as a number
+            raise ModelError("axes", f"expected a 3 x n matrix of wheel axes (numbers), got {self.axes!r}")
         axes = np.asarray(self.axes, dtype=float)
         if axes.ndim != 2 or axes.shape[0] != 3 or axes.shape[1] < 1:
             raise ModelError("axes", f"expected a 3 x n matrix of wheel axes, got shape {axes.shape}")

@@ -85,9 +85,12 @@ class Spacecraft:
 
     def __post_init__(self) -> None:
         try:
+            if np.asarray(self.inertia).dtype.kind in "US":  # text, though NumPy reads "1" as a number
+                raise TypeError("inertia")
             inertia = np.array(self.inertia, dtype=float)  # a private copy: the caller's array is not kept
         except (TypeError, ValueError):
-            raise ModelError("inertia", "expected 3 principal moments or a 3x3 matrix of numbers") from None
+            raise ModelError("inertia", f"expected 3 principal moments or a 3x3 matrix of numbers, "
+                                        f"got {self.inertia!r}") from None
         if inertia.shape == (3,):
             inertia = np.diag(inertia)
         if inertia.shape != (3, 3):

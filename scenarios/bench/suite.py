@@ -182,6 +182,12 @@ def _problem(name: str, entry: Any, folder: Path) -> BenchProblem:
     planners = entry["planners"]
     if not isinstance(planners, list) or not planners or not all(isinstance(p, str) for p in planners):
         raise ScenarioError(f"{where}.planners", f"expected a list of planner names, got {planners!r}")
+    # the registry, with its plugins, when a suite is read
+    from planners import PLANNERS
+    from planners.errors import UnknownNameError
+    for index, planner in enumerate(planners):
+        if planner not in PLANNERS:  # metadata of the leaderboard: a typo would be published as a planner
+            raise ScenarioError(f"{where}.planners[{index}]", str(UnknownNameError("planner", planner, PLANNERS)))
     skip = _peers(entry, where)
     file = folder / _text(entry, "file", where)
     if not file.is_file():

@@ -574,7 +574,9 @@ def check_aem_export(run: RunRecord, options: AemOptions) -> None:
     Raises
     ------
     ScenarioError
-        An option that is not a valid value (at ``--option NAME``), or a run without an epoch
+        An option that is not a valid value (at ``--option NAME``: a time system or attitude type
+        not listed, a name too long for its KVN line, with characters outside printable ASCII, or
+        an empty originator or object ID), or a run without an epoch
         (at ``epoch``).
     """
     if options.time_system not in TIME_SYSTEMS:
@@ -584,6 +586,14 @@ def check_aem_export(run: RunRecord, options: AemOptions) -> None:
                             f"{options.attitude_type!r} is not one of {', '.join(ATTITUDE_TYPES)}")
     for name, keyword in (("originator", "ORIGINATOR"), ("object_name", "OBJECT_NAME"), ("object_id", "OBJECT_ID")):
         text, room = getattr(options, name), KVN_LINE - len(f"{keyword} = ")
+        unwritable = sorted({c for c in text if not 32 <= ord(c) < 127})
+        if unwritable:  # written as "_": the message would carry another name than the one given
+            raise ScenarioError(f"--option {name}", f"{text!r} has characters a KVN line cannot carry "
+                                                    f"({', '.join(repr(c) for c in unwritable)}): expected "
+                                                    "printable ASCII (letters, digits, spaces, punctuation)")
+        if name != "object_name" and not text.strip():  # written UNKNOWN: not the value given
+            raise ScenarioError(f"--option {name}", f"{text!r} is empty: expected the {keyword} value "
+                                                    f"(leave the option out for its default, {getattr(AemOptions, name)})")
         if len(text) > room:  # the line would break the KVN limit: a message other readers refuse
             raise ScenarioError(f"--option {name}", f"{len(text)} characters ({_excerpt(text)}): expected at most "
                                                     f"{room}, so that the {keyword} line keeps to the {KVN_LINE} "

@@ -34,6 +34,7 @@ from scenarios.output.basilisk import (
     write_waypoint_files,
 )
 from scenarios.output.directory import (
+    changed_files,
     claim_output_directory,
     commit_outputs,
     new_staging,
@@ -104,12 +105,23 @@ class RunRow:
         """
         if self.timeseries is None:
             raise ValueError(f"row {self.label!r} has no time series")
-        with self.timeseries.open(newline="") as handle:
-            reader = csv.reader(handle)
-            header = next(reader)
-            table = np.array([[float(cell) if cell else np.nan for cell in line] for line in reader], dtype=float)
-        table = table.reshape(-1, len(header))
-        column = {name: index for index, name in enumerate(header)}
+        try:
+            with self.timeseries.open(newline="") as handle:
+                reader = csv.reader(handle)
+                header = next(reader)
+                table = np.array([[float(cell) if cell else np.nan for cell in line] for line in reader],
+                                 dtype=float)
+            table = table.reshape(-1, len(header))
+            column = {name: index for index, name in enumerate(header)}
+            missing = [name for name in ("t", "q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z", "ref_q0",
+                                         "ref_q1", "ref_q2", "ref_q3", "ref_omega_x", "ref_omega_y", "ref_omega_z")
+                       if name not in column]
+        except (OSError, ValueError, StopIteration) as error:  # a run written before stamps, edited since
+            raise ScenarioError(str(self.timeseries), f"cannot be read as the time series of row {self.label!r}: "
+                                                      f"{error or 'empty file'}") from None
+        if missing:
+            raise ScenarioError(str(self.timeseries), f"cannot be read as the time series of row {self.label!r}: "
+                                                      f"no column {', '.join(missing)}")
 
         def block(*names: str) -> Array:
             return table[:, [column[name] for name in names]]
@@ -165,8 +177,9 @@ def read_run(directory: str | Path) -> RunRecord:
     Raises
     ------
     ScenarioError
-        Not a directory, not a complete slewbench run, or an unreadable ``results.json``
-        (at the directory).
+        Not a directory, not a complete slewbench run, ``results.json`` or a time series that
+        the run listed but is gone or has changed since (its recorded size and digest), or an
+        unreadable ``results.json`` (at the directory).
     """
     path = Path(directory).expanduser()
     if not path.is_dir():
@@ -178,6 +191,14 @@ def read_run(directory: str | Path) -> RunRecord:
                                             "results.json); give a run's output directory")
     if not manifest.get("complete"):
         raise ScenarioError(str(directory), "holds an incomplete run (interrupted while writing); run it again")
+    read = [name for name in manifest["files"] if name == "results.json" or name.startswith("timeseries/")]
+    missing = [name for name in read if not (path / name).is_file()]
+    changed = [name for name in changed_files(path, manifest) if name in read and name not in missing]
+    if missing or changed:  # an export of them would hand off numbers the run did not write, or drop a row
+        said = "; ".join(f"{what} since slewbench wrote them: {_some(names)}"
+                         for what, names in (("removed", missing), ("changed", changed)) if names)
+        raise ScenarioError(str(directory), f"holds a run whose files were {said}; an export reads them as the "
+                                            "run's: run the scenario again (or restore the files)")
     try:
         data = json.loads((path / "results.json").read_text())
         labels = [row["label"] for row in data["rows"]]
@@ -191,6 +212,11 @@ def read_run(directory: str | Path) -> RunRecord:
                            series, _rate_jump_times(row), str(row.get("message") or "")))
     return RunRecord(path.absolute(), str(data.get("scenario", "")), str(data.get("frame", "")), data.get("epoch"),
                      rows, data.get("provenance") or {})
+
+
+def _some(names: list[str], shown: int = 5) -> str:
+    """The first ``shown`` names, comma-separated, and how many more."""
+    return ", ".join(names[:shown]) + (f" and {len(names) - shown} more" if len(names) > shown else "")
 
 
 def _recorded_stems(rows: list[Any], labels: list[str]) -> list[str]:

@@ -9,11 +9,13 @@ columns) is derived from :meth:`Row.to_dict` by :func:`scenarios.output.tables.f
 from __future__ import annotations
 
 import datetime
+import os
 import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ocp.errors import excerpt
 from scenarios.output.provenance import run_provenance
 from scenarios.output.tables import (
     ROW_STATUSES,
@@ -295,7 +297,19 @@ class RunResults:
             Also write the PNG figures.
         renderer : scenarios.output.renderer.Renderer, optional
             A plot process to draw them (``None``: drawn in this process).
+
+        Raises
+        ------
+        TypeError
+            ``directory`` is not a path, or ``plots`` not a bool (as
+            :meth:`scenarios.study.engine.SweepResults.write`).
+        scenarios.output.directory.OutputError
+            The directory is not slewbench's to write (:doc:`/outputs`).
         """
+        if not isinstance(directory, (str, os.PathLike)):
+            raise TypeError(f"directory must be a str or os.PathLike, got {type(directory).__name__}")
+        if not isinstance(plots, bool):  # plots="no" drew them
+            raise TypeError(f"plots must be True or False, got {excerpt(plots)}")
         from scenarios.output.writer import write_results
         write_results(self, directory, plots=plots, renderer=renderer)
 

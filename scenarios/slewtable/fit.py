@@ -813,11 +813,15 @@ class SlewTimeFit:
         Raises
         ------
         TypeError, ValueError
-            As :meth:`__call__`, naming the first bad quaternion.
+            As :meth:`__call__`, naming the first bad quaternion; a ``ValueError`` for ``q0`` and
+            ``qf`` whose numbers of quaternions differ (neither being one).
         """
         arrays = []
         order = self.quaternion_order.replace("_", " ")
         for name, value in (("q0", q0), ("qf", qf)):
+            # text is not a number, though NumPy reads it as one (``__call__`` refuses it too)
+            if value is None or np.asarray(value).dtype.kind in "US":
+                raise TypeError(f"{name} must be quaternions of 4 numbers ({order}), got {value!r}")
             try:
                 array = np.atleast_2d(np.asarray(value, dtype=float))
             except (TypeError, ValueError):
@@ -825,7 +829,11 @@ class SlewTimeFit:
             if array.shape[-1] != 4:
                 raise TypeError(f"{name} must be quaternions of 4 numbers ({order}), got shape {array.shape}")
             arrays.append(array)
-        a, b = np.broadcast_arrays(*arrays)
+        try:
+            a, b = np.broadcast_arrays(*arrays)
+        except ValueError:
+            raise ValueError(f"q0 and qf must hold as many quaternions (or one of them one), got shapes "
+                             f"{arrays[0].shape} and {arrays[1].shape}") from None
         given, given_f = a, b  # as the caller wrote them (messages)
         if self._scalar_last:  # [x, y, z, w] -> [w, x, y, z]
             a, b = a[..., [3, 0, 1, 2]], b[..., [3, 0, 1, 2]]
@@ -965,12 +973,16 @@ def load_fit(path: str | os.PathLike[str], quaternion_order: str | None = None) 
         The file is not a slew-time fit of this format, or one that filled entries that were not
         ``ok`` (written before the fit kept them as gaps), or one of slews from the identity only
         without ``end_cones`` (written before the fit checked end attitudes); a quaternion order
-        (given, or the file's) other than ``scalar_first`` or ``scalar_last``.
+        (given, or the file's) other than ``scalar_first`` or ``scalar_last``; a file that is not
+        JSON, or whose parameters are missing or unreadable (an edited file); each names the file.
     """
     file = Path(path)
     if file.is_dir():
         file = file / "fit.json"
-    data = json.loads(file.read_text())
+    try:
+        data = json.loads(file.read_text())
+    except json.JSONDecodeError as error:  # a file cut short, or another file given
+        raise ValueError(f"{file} is not a slewbench slew-time fit: not JSON ({error})") from None
     if not isinstance(data, dict) or data.get("format") != FIT_FORMAT:
         raise ValueError(f"{file} is not a slewbench slew-time fit ({FIT_FORMAT!r} expected)")
     note = str((data.get("meta") or {}).get("note", ""))
@@ -983,11 +995,18 @@ def load_fit(path: str | os.PathLike[str], quaternion_order: str | None = None) 
         raise ValueError(f"{file} was written by an earlier slewbench whose fit did not check a slew's end attitude "
                          "against the pointing requirements (it gave times for slews ending inside a keep-out "
                          "cone); run `slewbench table` again to write the fit with the check")
-    times = np.array(data["times_s"], dtype=float)  # null (an entry not ok) -> NaN
     order = quaternion_order if quaternion_order is not None else data.get("quaternion_order", "scalar_first")
     if order not in QUATERNION_ORDERS:
         where = "quaternion_order" if quaternion_order is not None else f"{file}'s quaternion_order"
         raise ValueError(f"{where} must be one of {', '.join(QUATERNION_ORDERS)}, got {order!r}")
-    return SlewTimeFit(data["angles_rad"], data["axes"], times, data.get("meta"), data.get("inertia"),
-                       data.get("torque_generators"), data.get("triangles"), data.get("status"),
-                       data.get("momentum_generators"), data.get("max_rate"), data.get("end_cones"), order)
+    try:
+        times = np.array(data["times_s"], dtype=float)  # null (an entry not ok) -> NaN
+        return SlewTimeFit(data["angles_rad"], data["axes"], times, data.get("meta"), data.get("inertia"),
+                           data.get("torque_generators"), data.get("triangles"), data.get("status"),
+                           data.get("momentum_generators"), data.get("max_rate"), data.get("end_cones"), order)
+    except KeyError as error:  # an edited file: its parameters are not the fit's
+        raise ValueError(f"{file} is not a complete slew-time fit: no {error.args[0]!r}; run `slewbench table` "
+                         "again into the table's --out to write it") from None
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{file} holds a slew-time fit whose parameters cannot be read ({error}); run `slewbench "
+                         "table` again into the table's --out to write it") from None
