@@ -382,6 +382,23 @@ or the full inertia (1.11-1.20x). B&W's spin-extremal coarse start ends at anoth
 here (3.28326, 24 iterations: NumPy's AVX-512 kernels move its seed's rounding;
 ``tests/test_collocation_seeds.py``), the row's optimum the same; its two coarse starts take 46
 iterations (22 + 24) against 42 on the last host.
+
+Measured 2026-12-05 01:52 UTC, the same host in a slower phase (acados on B&W 23.4 ms against 19.7),
+load 0.4, 9 alternating rounds, ours/acados median [min..max]: B&W 1.95 [1.66..2.01] (45.8 against
+23.4 ms), full inertia 1.28 [1.22..1.41] (23.3 against 18.1 ms), the spin case 0.73 [0.71..0.76]
+(71.9 ms, at 0.018548). The planner is the previous day's (CPU per full-inertia plan alternating
+with it: 20.5-21.3 against 20.5-22.3 ms). Where the full inertia's plan goes (CPU, stage timers
+over 30 plans, 22.9 ms in all): the one coarse IPOPT start 11 ms (14 iterations), its second-order
+check 1.6, the switch-time shooting 2.9 and its certificate 2.6 (CasADi's interpreted evaluations
+of the RK4 flights, 156k SX instructions per shooting call: bound by the arithmetic; their SX
+expansion is 15-42 % faster per call, 0.7 ms a plan, for about 180 ms more build per switch count),
+eigenaxis's min_time bound candidate 1.4, the seeds 0.9, the rest about 2. B&W (about 47 ms CPU):
+the two coarse starts 34 ms; ``perf`` over 100 plans: MUMPS and its BLAS 39 %, Python 21 %, IPOPT
+10 %, libc 9 %, CasADi's SX evaluation 9 %. Coarse tolerances of 1e-8 or 1e-6 instead of 1e-10 move
+B&W's spin-extremal start to another point and add a third start (48-50 against 46 ms) and a second
+start on the full inertia (28.5 against 20.5 ms). The gap on B&W is the two coarse IPOPT solves that
+item 5's seeds require, at 0.6-0.8 ms an iteration on a 312-variable NLP: what remains is a cheaper
+step than IPOPT with MUMPS (the condensed Riccati route measured above), not the Python around it.
 """
 from __future__ import annotations
 
