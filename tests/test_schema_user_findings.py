@@ -193,3 +193,25 @@ def test_validate_notes_an_initial_rate_error_in_deg_per_s(tmp_path):
     status, out, error = validate(tmp_path, small(simulation__initial_rate_error=[1, 0, 0]))
     assert status == 0, error
     assert "  every row's closed loop breaks the rate requirement: simulation.initial_rate_error [1.0, 0.0, 0.0]" in out
+
+
+# --- an unknown key beside a missing required one ---------------------------------------------------
+
+@pytest.mark.parametrize(("edit", "unknown", "missing"), [
+    # a TLE or apsides given to the circular orbit: said only that altitude_km is missing
+    (lambda d: d.__setitem__("orbit", {"tle": "1 25544U 98067A"}), "orbit.tle", "orbit.altitude_km"),
+    (lambda d: d.__setitem__("orbit", {"perigee_km": 800, "apogee_km": 500}), "orbit.perigee_km", "orbit.altitude_km"),
+    # a keep-out direction under a key its mapping form does not have (a Section's read)
+    (lambda d: d["requirements"]["pointing"]["st_sun"].__setitem__("keep_out", {"body": [1, 0, 0]}),
+     "requirements.pointing.st_sun.keep_out.body", "requirements.pointing.st_sun.keep_out.inertial"),
+])
+def test_an_unknown_key_beside_a_missing_required_one_is_named_first(tmp_path, capsys, edit, unknown, missing):
+    """The key the user wrote is the mistake to see: the error is at it, and says the missing one."""
+    data = read_yaml(Path(__file__).resolve().parents[1] / "scenarios" / "cubesat_12u_sun_keep_out.yaml")
+    edit(data)
+    path = tmp_path / "case.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))  # the first unknown key as written
+    assert main(["validate", str(path)]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert f": {unknown}: unknown key; expected one of [" in err, err
+    assert f"({missing}: required key is missing)" in err, err

@@ -20,7 +20,7 @@ import inspect
 import re
 import types
 import typing
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal, Union
 
@@ -29,10 +29,12 @@ import numpy as np
 from ocp import quat
 from ocp.errors import excerpt
 from ocp.options import Range, numeric_leaves, option_fields
+from scenarios.errors import ScenarioError
 from scenarios.schema.node import Node
 
 __all__ = ["QUATERNION_BOUNDS", "REQUIRED", "Described", "Key", "OptionEntry", "Section", "boolean", "choice", "custom",
-           "integer", "mapping", "number", "option_entries", "option_keys", "quaternion", "text", "vector"]
+           "integer", "mapping", "number", "option_entries", "option_keys", "quaternion", "read_mapping", "text",
+           "vector"]
 
 
 class _Required:
@@ -197,10 +199,52 @@ class Section:
         ScenarioError
             ``node`` is not a mapping, a value is wrong, or an unknown key is present.
         """
-        node.mapping()
-        values = {key.name: key.value(node) for key in self.keys}
-        node.finish()
-        return values
+        return read_mapping(node, self.keys)
+
+
+def read_mapping(node: Node, keys: Sequence[Key]) -> dict[str, Any]:
+    """Every key of ``keys`` from the mapping ``node`` by :meth:`Key.value`, then reject the keys
+    not read (:meth:`Node.finish`).
+
+    A required key missing beside a key the mapping gives and nothing reads (``orbit: {tle: ...}``,
+    not a form of orbit) is reported at that unknown key, the missing one said too: the unknown key
+    is the mistake to see first, and the required key's error alone never named it (one that looks
+    like a misspelling of the missing key is named in that key's error, :meth:`Node.get`).
+
+    Parameters
+    ----------
+    node : Node
+        The mapping.
+    keys : sequence of Key
+        Its keys (others read before, such as a ``type`` that chose them, are accepted too).
+
+    Returns
+    -------
+    dict
+        Key name -> value.
+
+    Raises
+    ------
+    ScenarioError
+        ``node`` is not a mapping, a value is wrong, a required key is missing, or an unknown key
+        is present.
+    """
+    node.mapping()
+    try:
+        values = {key.name: key.value(node) for key in keys}
+    except ScenarioError as error:
+        names = {key.name for key in keys}
+        missing = {node.path + "." + name if node.path else name for name in names}
+        unknown = [k for k in node.value if isinstance(k, str) and k not in names and k not in node.read_keys]
+        # (a misspelling of the missing key is named by its error already: "'altitud_km' is given")
+        if (error.path in missing and error.message.startswith("required key is missing") and unknown
+                and "a misspelling of" not in error.message):
+            where = f"{node.path}.{unknown[0]}" if node.path else unknown[0]
+            raise ScenarioError(where, f"unknown key; expected one of {sorted(names | node.read_keys)} "
+                                       f"({error.path}: {error.message})") from None
+        raise
+    node.finish()
+    return values
 
 
 # --- keys of each kind: a reader built on Node's checks and the words that describe it ---------

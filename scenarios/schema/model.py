@@ -38,6 +38,7 @@ from scenarios.schema.keys import (
     custom,
     mapping,
     option_keys,
+    read_mapping,
     vector,
 )
 from scenarios.schema.node import Node
@@ -205,8 +206,7 @@ def parse_orbit(node: Node, epoch: datetime.datetime | None = None) -> Orbit | N
         return None
     node.mapping()
     kind = ORBITS[ORBIT["type"].value(node)]
-    values = {key.name: key.value(node) for key in option_keys(kind.Options)}
-    node.finish()
+    values = read_mapping(node, option_keys(kind.Options))
     try:
         options = kind.Options(**values)
     except InvalidOption as error:  # a relation between options (Options.__post_init__)
@@ -265,8 +265,7 @@ def parse_magnetic_field(node: Node, orbit: Orbit | None,
         node.mapping()
         model = MAGNETIC_FIELDS[MAGNETIC_FIELD["model"].value(node)]
         given_epoch = "epoch" in node
-        values = {key.name: key.value(node) for key in option_keys(model.Options)}
-        node.finish()
+        values = read_mapping(node, option_keys(model.Options))
         try:
             options = model.Options(**values)
         except InvalidOption as error:  # a relation between options (Options.__post_init__)

@@ -118,6 +118,11 @@ class Node:
         """
         return ScenarioError(self.path or "(top level)", message)
 
+    @property
+    def read_keys(self) -> frozenset[str]:
+        """The keys of this mapping read so far (by :meth:`get`, a missing required one included)."""
+        return frozenset(self._read)
+
     def _child_path(self, key: str | int) -> str:
         if isinstance(key, int):
             return f"{self.path}[{key}]"
