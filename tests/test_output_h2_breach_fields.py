@@ -11,8 +11,10 @@ from __future__ import annotations
 import copy
 import csv
 import io
+from pathlib import Path
 
 import pytest
+import yaml
 
 import scenarios
 from scenarios.output.tables import _LIMIT_ROUNDING, _requirement_cell, breaking_fields
@@ -22,6 +24,8 @@ from scenarios.requirements.spec import (
     Requirements,
 )
 from tests.test_requirements_runs import with_direction
+
+ROOT = Path(__file__).resolve().parents[1]
 
 MARGIN = Requirements(actuators=ActuatorRequirement(margin=0.1), final=FinalRequirement(after_s=5.0, error_deg=0.1,
                                                                                          rate=1e-3))
@@ -96,3 +100,17 @@ def test_a_run_whose_reference_jumps_names_the_jump_as_its_tables_show_it():
     assert record["ref.req.actuators.met"] == "False" and float(record["ref.req.actuators.rate_jump"]) > 0.0
     assert float(record["ref.req.actuators.wheels_momentum"]) < 0.9
     assert "| ref.req.actuators.rate_jump | " in results.to_markdown()
+
+
+def test_a_breach_its_number_shows_gets_no_field_and_no_field_note():
+    # the eigenaxis slew through the sun keep-out: broken by its min margin, the number shown
+    data = yaml.safe_load((ROOT / "scenarios" / "cubesat_12u_sun_keep_out.yaml").read_text())
+    data["planners"] = [{"name": "eigenaxis"}]
+    results = scenarios.run(scenarios.parse_scenario(data))
+    terminal = results.to_terminal().splitlines()
+    (line,) = [line for line in terminal if line.startswith("req.st_sun")]
+    ref, cl = line.split("ref | cl)", 1)[1].rsplit("|", 1)
+    assert ref.strip().endswith("✗") and cl.strip().endswith("✗"), line  # the mark alone, no field
+    assert results.rows[0].requirements["reference"]["st_sun"]["min_margin_deg"] < 0
+    assert "(✗: that scope breaks the requirement; the messages below say how)" in terminal
+    assert not any(text.startswith("(✗ FIELD") for text in terminal)

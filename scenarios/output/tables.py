@@ -802,7 +802,8 @@ def to_terminal(results: RunResults, all_metrics: bool = False) -> str:
     note = [f"({len(hidden)} metrics with no value in any row not shown; --all-metrics shows them)"] if hidden else []
     if any(_BROKEN in cell for name, cells in lines if name.startswith("req.") for cell in cells):
         note.append(f"({_BROKEN.strip()}: that scope breaks the requirement; the messages below say how)")
-    if any(_BROKEN + " " in cell for name, cells in lines if name.startswith("req.") for cell in cells):
+    if any(part.partition(_BROKEN)[2].strip() for name, cells in lines if name.startswith("req.") for cell in cells
+           for part in cell.split(" | ")):  # a field named after a scope's mark
         note.append(f"({_BROKEN.strip()} FIELD: the field that breaks it where the number shown does not, as in "
                     "results.md and results.csv, <scope>.req.<name>.FIELD)")
     return "\n".join([f"scenario: {results.scenario.name}", header, *body, *note, "", *messages, "",
