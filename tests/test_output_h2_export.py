@@ -98,3 +98,24 @@ def test_a_failure_while_writing_removes_what_this_export_made_and_only_that(run
     assert {p.name: p.read_bytes() for p in earlier.iterdir()} == before  # the earlier export, untouched
     assert json.loads((earlier / MARKER).read_text())["complete"]
     assert sorted(p.name for p in above.iterdir()) == ["keep"]  # the user's folder above stays
+
+
+def test_a_run_write_that_fails_leaves_no_new_directory_and_an_earlier_run_as_it_was(tmp_path, monkeypatch):
+    # before: RunResults.write interrupted (or out of space) left its new directory marked incomplete
+    import scenarios
+    from scenarios.output import writer
+    results = scenarios.run(scenarios.load(scenario_file(tmp_path)))
+    earlier = tmp_path / "earlier"
+    results.write(earlier, plots=False)
+    before = {p.relative_to(earlier): p.read_bytes() for p in earlier.rglob("*") if p.is_file()}
+
+    def fail(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(writer, "write_timeseries", fail)
+    for out in (tmp_path / "new" / "run", earlier):
+        with pytest.raises(KeyboardInterrupt):
+            results.write(out, plots=False)
+    assert not (tmp_path / "new").exists()
+    assert {p.relative_to(earlier): p.read_bytes() for p in earlier.rglob("*") if p.is_file()} == before
+    assert json.loads((earlier / MARKER).read_text())["complete"]
