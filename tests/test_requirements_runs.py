@@ -255,6 +255,6 @@ def test_the_terminal_marks_a_requirement_broken_by_a_field_its_headline_does_no
     terminal = results.to_terminal().splitlines()
     line = next(line for line in terminal if line.startswith("req.actuators"))
     ref, cl = line.rstrip().rsplit("|", 1)  # its number well under 1, yet broken: marked (the closed loop's met)
-    assert ref.rstrip().endswith("✗") and "✗" not in cl, line
+    assert ref.rstrip().endswith("✗ rate_jump") and "✗" not in cl, line  # the field that breaks it
     st = next(line for line in terminal if line.startswith("req.st "))
     assert "✗" not in st and "(✗: that scope breaks the requirement; the messages below say how)" in terminal

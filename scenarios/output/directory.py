@@ -37,7 +37,7 @@ from scenarios.errors import ANOTHER_DIRECTORY, OutputError
 from scenarios.schema.read import read_bounded
 
 __all__ = ["HOSTS", "MARKER", "STAGING_PREFIX", "changed_files", "check_output_directory", "claim_output_directory",
-           "commit_outputs", "enclosing_output", "new_staging", "read_manifest", "write_manifest", "written_files"]
+           "claimed_output_directory", "commit_outputs", "enclosing_output", "new_staging", "read_manifest", "write_manifest", "written_files"]
 
 MARKER = ".slewbench-output.json"
 STAGING_PREFIX = ".slewbench-staging-"
@@ -398,6 +398,69 @@ def claim_output_directory(path: str | Path, kind: str = "run", expected: Iterab
     except OSError as error:
         raise OutputError(path, f"cannot be written: {error.strerror or error}") from None
     return directory
+
+
+@contextlib.contextmanager
+def claimed_output_directory(path: str | Path, kind: str = "run", expected: Iterable[str] = ()) -> Iterator[Path]:
+    """:func:`claim_output_directory`, withdrawn when the body raises before anything was committed
+    there: a command refused half-way leaves no output directory marked incomplete behind.
+
+    Only what the claim itself made is removed: the marker it wrote into a new or empty directory,
+    and the folders it created (while they hold nothing else). A directory that already carried
+    the marker (an earlier output, or one claimed ahead by the same command) is left as it was, and
+    so is one whose manifest lists files (a commit happened).
+
+    Parameters
+    ----------
+    path : str or Path
+        The output directory.
+    kind : str, optional
+        What writes there, as :func:`claim_output_directory`.
+    expected : iterable of str, optional
+        As :func:`claim_output_directory`.
+
+    Yields
+    ------
+    Path
+        The absolute, claimed directory.
+
+    Raises
+    ------
+    OutputError
+        As :func:`claim_output_directory`.
+    """
+    directory = Path(path).expanduser().absolute()
+    missing = [folder for folder in (directory, *directory.parents) if not os.path.lexists(folder)]
+    made = missing[-1] if missing else None  # the outermost folder the claim creates
+    marks = made is None and directory.is_dir() and read_manifest(directory) is None
+    directory = claim_output_directory(path, kind, expected)
+    try:
+        yield directory
+    except BaseException:
+        if made is not None or marks:
+            _withdraw(directory, made)
+        raise
+
+
+def _withdraw(directory: Path, made: Path | None) -> None:
+    """Remove the marker of a claim that committed nothing, then the empty folders from
+    ``directory`` up to ``made`` (the outermost one the claim created; ``None``: none)."""
+    manifest = read_manifest(directory)
+    if manifest is None or manifest["files"] or manifest.get("complete"):
+        return
+    with contextlib.suppress(OSError):
+        (directory / MARKER).unlink()
+    if made is None:
+        return
+    for folder in (directory, *directory.parents):
+        if not folder.is_relative_to(made):
+            return
+        try:
+            folder.rmdir()  # only an empty folder: anything else someone put there stays
+        except OSError:
+            return
+        if folder == made:
+            return
 
 
 def _relative_files(root: Path) -> list[str]:

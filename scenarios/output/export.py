@@ -35,7 +35,7 @@ from scenarios.output.basilisk import (
 )
 from scenarios.output.directory import (
     changed_files,
-    claim_output_directory,
+    claimed_output_directory,
     commit_outputs,
     new_staging,
     read_manifest,
@@ -102,6 +102,12 @@ class RunRow:
             ``omega`` (N, 3) body rate [rad/s, body]; ``ref_q``, ``ref_omega`` and ``ref_omega_dot``
             [rad/s², reference body axes] the reference's (NaN without a reference, and
             ``ref_omega_dot`` NaN in a run written before slewbench recorded it).
+
+        Raises
+        ------
+        ScenarioError
+            A file that cannot be read as a time series (a cell that is not a number, a column
+            missing, times that are not finite and strictly increasing), at the file.
         """
         if self.timeseries is None:
             raise ValueError(f"row {self.label!r} has no time series")
@@ -122,6 +128,10 @@ class RunRow:
         if missing:
             raise ScenarioError(str(self.timeseries), f"cannot be read as the time series of row {self.label!r}: "
                                                       f"no column {', '.join(missing)}")
+        t = table[:, column["t"]]
+        if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0.0):  # a simulation's samples always increase
+            raise ScenarioError(str(self.timeseries), f"cannot be read as the time series of row {self.label!r}: "
+                                                      "its times t are not finite and strictly increasing")
 
         def block(*names: str) -> Array:
             return table[:, [column[name] for name in names]]
@@ -178,8 +188,9 @@ def read_run(directory: str | Path) -> RunRecord:
     ------
     ScenarioError
         Not a directory, not a complete slewbench run, ``results.json`` or a time series that
-        the run listed but is gone or has changed since (its recorded size and digest), or an
-        unreadable ``results.json`` (at the directory).
+        the run listed but is gone or has changed since (its recorded size and digest), an
+        unreadable ``results.json`` (at the directory), or, in a run written before stamps, a time
+        series that cannot be read (:meth:`RunRow.series`, at the file).
     """
     path = Path(directory).expanduser()
     if not path.is_dir():
@@ -210,6 +221,10 @@ def read_run(directory: str | Path) -> RunRecord:
         series = path / name if name in manifest["files"] and (path / name).is_file() else None
         rows.append(RunRow(row["label"], row.get("planner"), row.get("controller"), row.get("status", ""), stem,
                            series, _rate_jump_times(row), str(row.get("message") or "")))
+        if series is not None and name not in manifest["stamps"]:
+            # a run written before stamps cannot tell an edit: its series is read now, so that one
+            # that cannot be read is refused before an export writes anything
+            rows[-1].series()
     return RunRecord(path.absolute(), str(data.get("scenario", "")), str(data.get("frame", "")), data.get("epoch"),
                      rows, data.get("provenance") or {})
 
@@ -368,7 +383,8 @@ def export_run(run_directory: str | Path, format_name: str, out: str | Path | No
     ------
     ScenarioError
         An unknown format, a directory that is not a finished run, or a run the format cannot
-        take (an AEM without an epoch). Nothing is written then.
+        take (an AEM without an epoch). Nothing is written then; a failure while writing
+        removes the export directory this call created (or the marker it put in an empty one).
     OutputError
         ``out`` is not slewbench's to write (:func:`~scenarios.output.directory.claim_output_directory`).
     """
@@ -378,19 +394,21 @@ def export_run(run_directory: str | Path, format_name: str, out: str | Path | No
     run = read_run(run_directory)
     options = export.options() if options is None else options
     export.check(run, options)
-    target = claim_output_directory(out if out is not None else default_export_directory(run.directory, format_name),
-                                    kind="export")
-    staging = new_staging(target)
-    try:
-        notes = export.write(run, staging, options)
-        files = commit_outputs(target, staging, kind="export")
-        # a file is the row's whose stem is the longest to prefix it (stems hold dots: k=0 and k=0.5)
-        owners = {max((r for r in run.rows if f.startswith(r.stem + ".")), key=lambda r: len(r.stem), default=None)
-                  for f in files}
-        for row in run.rows:
-            if row in owners and row.status != "ok":
-                why = f": {_cut(row.message)}" if row.message else ""
-                notes.append(f"row {row.label!r}: exported, but the run scored it {row.status}{why}")
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+    # a failure before the commit (an interruption, a full disk) withdraws the claim: no export
+    # directory marked incomplete is left behind, and nothing this export did not make is removed
+    with claimed_output_directory(out if out is not None else default_export_directory(run.directory, format_name),
+                                  kind="export") as target:
+        staging = new_staging(target)
+        try:
+            notes = export.write(run, staging, options)
+            files = commit_outputs(target, staging, kind="export")
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)
+    # a file is the row's whose stem is the longest to prefix it (stems hold dots: k=0 and k=0.5)
+    owners = {max((r for r in run.rows if f.startswith(r.stem + ".")), key=lambda r: len(r.stem), default=None)
+              for f in files}
+    for row in run.rows:
+        if row in owners and row.status != "ok":
+            why = f": {_cut(row.message)}" if row.message else ""
+            notes.append(f"row {row.label!r}: exported, but the run scored it {row.status}{why}")
     return ExportReport(target, files, notes)

@@ -22,7 +22,7 @@ import html
 import io
 import json
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from scenarios.requirements.fields import (
@@ -43,9 +43,10 @@ if TYPE_CHECKING:
     import pandas
 
     from scenarios.output.results import RunResults
+    from scenarios.requirements.spec import Requirements
 
 __all__ = ["BUDGET_COLUMNS", "CERTIFICATE_COLUMNS", "CERTIFICATE_NUMBERS", "FLAG_COLUMNS", "IDENTITY_COLUMNS", "REFUSED_CERTIFICATE",
-           "ROW_STATUSES", "RUN_COLUMNS",
+           "ROW_STATUSES", "RUN_COLUMNS", "breaking_fields",
            "csv_cell", "csv_text",
            "data_frame", "flatten_row", "html_table", "is_missing", "json_safe", "numeric_columns",
            "ratio_text", "refused_certificate", "requirement_columns", "requirement_units", "row_columns", "run_rows",
@@ -530,16 +531,106 @@ _HEADLINES = (("min_margin_deg", "min margin, deg"), ("ratio", "peak rate / boun
 actuators, which have none of these: the largest demand over its limit)."""
 
 
-def _headline(values: Mapping[str, Any] | None) -> tuple[str, Any]:
-    """(what the number is, the number) of one requirement's score."""
+def _demand_ratios(values: Mapping[str, Any]) -> dict[str, Any]:
+    """An actuator score's demand ratios by quantity (by their declared unit), ``None`` where not
+    finite."""
+    return {key: value for key, value in values.items()
+            if key != "met" and field_info(f"actuators.{key}").unit == "–"}
+
+
+def _headline_field(values: Mapping[str, Any] | None) -> tuple[str, str | None]:
+    """(what the number is, the field that gives it) of one requirement's score: the actuators'
+    is the quantity with the largest finite ratio (``None`` when none is finite)."""
     if not values:
         return "", None
     for key, words in _HEADLINES:
         if key in values:
-            return words, values[key]
-    ratios = [value for key, value in values.items()  # the demand ratios, by their declared unit
-              if value is not None and field_info(f"actuators.{key}").unit == "–"]
-    return "peak demand / limit", max(ratios) if ratios else None
+            return words, key
+    ratios = {key: value for key, value in _demand_ratios(values).items() if value is not None}
+    return "peak demand / limit", max(ratios, key=ratios.__getitem__) if ratios else None
+
+
+def _headline(values: Mapping[str, Any] | None) -> tuple[str, Any]:
+    """(what the number is, the number) of one requirement's score."""
+    words, key = _headline_field(values)
+    return words, None if key is None or values is None else values[key]
+
+
+def _over(value: Any, bound: float | None) -> bool:
+    """Whether a recorded value exceeds a bound beyond rounding (:data:`_LIMIT_ROUNDING`, the
+    scoring's :data:`~planners.base.REQUIREMENT_TOLERANCE`)."""
+    return bound is not None and isinstance(value, (int, float)) and value > bound * (1.0 + _LIMIT_ROUNDING)
+
+
+def _actuator_breaches(scope: str, values: Mapping[str, Any], requirements: Requirements | None) -> list[str]:
+    """The fields of an actuator score that break it (:func:`scenarios.requirements.scoring.score_reference`,
+    :func:`~scenarios.requirements.scoring.closed_loop_wheels`): a rate jump (any), an unrealised
+    torque over its allowed, a demand that is not finite, a ratio over the allowed (the
+    reference's ``1 − margin``, the closed loop's limit)."""
+    breaches = [key for key, value in _demand_ratios(values).items()
+                if value is None and values.get(f"{key}_time_s") is not None]
+    if isinstance(values.get("rate_jump"), (int, float)) and values["rate_jump"] > 0.0:  # only jumps are recorded
+        breaches.append("rate_jump")
+    if values.get("unrealised_torque") is None and values.get("unrealised_torque_time_s") is not None:
+        breaches.append("unrealised_torque")
+    elif _over(values.get("unrealised_torque"), values.get("unrealised_torque_allowed")):
+        breaches.append("unrealised_torque")
+    if scope == "closed_loop":
+        allowed = 1.0 - _LIMIT_ROUNDING  # the closed loop breaks at its limit (scoring.AT_LIMIT)
+        over = [key for key, value in _demand_ratios(values).items() if value is not None and value >= allowed]
+    else:
+        bound = requirements.actuators.allowed if requirements is not None and requirements.actuators else None
+        over = [key for key, value in _demand_ratios(values).items() if _over(value, bound)]
+    return over + breaches
+
+
+def _final_breaches(scope: str, values: Mapping[str, Any], requirements: Requirements | None) -> list[str]:
+    """The fields of a final score that break it: the error or the rate error over its bound."""
+    final = requirements.final if requirements is not None else None
+    if final is None:
+        return []
+    return [key for key, bound in (("worst_error_deg", final.error_deg), ("worst_rate_error", final.rate))
+            if _over(values.get(key), bound)]
+
+
+_BREACHES: dict[str, Callable[[str, Mapping[str, Any], Requirements | None], list[str]]] = {
+    "actuators": _actuator_breaches, "final": _final_breaches}
+"""Requirement name -> the fields of its score that break it, where the score has fields other
+than its headline's that may (the pointing requirements and ``rate`` break by their headline
+alone)."""
+
+
+def breaking_fields(name: str, scope: str, values: Mapping[str, Any] | None,
+                    requirements: Requirements | None = None) -> list[str]:
+    """The fields of one scope's score of a requirement that break it, by the numbers recorded
+    (``results.json``'s, ``results.csv``'s columns ``<scope>.req.<name>.<field>``).
+
+    Parameters
+    ----------
+    name : str
+        The requirement's name (a pointing requirement's, ``actuators``, ``rate``, ``final``).
+    scope : str
+        ``reference`` or ``closed_loop``.
+    values : mapping or None
+        The score's fields (the verdict ``met`` among them).
+    requirements : Requirements, optional
+        The scenario's requirements, for the bounds the fields are held to (``1 − margin``, the
+        final error's and rate's); without them, only the breaches the fields show themselves (a
+        rate jump, an unrealised torque over its allowed, a number not finite).
+
+    Returns
+    -------
+    list of str
+        Field names, in column order of their kind (the demand ratios, then ``rate_jump``,
+        ``unrealised_torque``); where the score is not met and no field shows why, its headline
+        field (the number the terminal shows); empty when met.
+    """
+    if not values or values.get("met") is not False:
+        return []
+    rule = _BREACHES.get(name)
+    found = [] if rule is None else rule(scope, values, requirements)
+    headline = _headline_field(values)[1]
+    return found or ([headline] if headline is not None else [])
 
 
 _BROKEN = " ✗"
@@ -552,18 +643,29 @@ _RATIO_HEADLINES = ("peak rate / bound", "peak demand / limit")
 """The headlines (:func:`_headline`) that are ratios to a limit or a bound (:func:`ratio_text`)."""
 
 
-def _requirement_cell(values: Mapping[str, Any] | None) -> str:
-    """One scope's terminal cell of a requirement: its headline number, marked when not met."""
+def _requirement_cell(name: str, scope: str, values: Mapping[str, Any] | None,
+                      requirements: Requirements | None = None) -> str:
+    """One scope's terminal cell of a requirement: its headline number, marked when not met, and
+    the fields that break it where the headline's is not the one (``0.2513 ✗ rate_jump``: a small
+    demand ratio on a reference whose rate jumps), a field with no number said ``not finite``."""
     words, number = _headline(values)
     broken = values is not None and values.get("met") is False
     cell = ratio_text(number, broken) if words in _RATIO_HEADLINES else text_cell(number)
-    return cell + _BROKEN if broken else cell
+    if not broken:
+        return cell
+    assert values is not None
+    fields = breaking_fields(name, scope, values, requirements)
+    shown = [] if fields == [_headline_field(values)[1]] else fields
+    said = [f"{key} not finite" if values.get(key) is None else key for key in shown]
+    return cell + _BROKEN + (" " + ", ".join(said) if said else "")
 
 
 def _requirement_lines(results: RunResults) -> list[tuple[str, list[str]]]:
     """One line per requirement for the terminal: its headline number, ``reference | closed loop``,
-    each marked ``✗`` where that scope breaks the requirement."""
+    each marked ``✗`` where that scope breaks the requirement (with the fields that break it where
+    the number shown is not the one, :func:`breaking_fields`)."""
     scores = [row.requirements or {} for row in results.rows]
+    requirements = getattr(results.scenario, "requirements", None)
     names: dict[str, None] = {}
     for row in scores:
         for scope, _ in SCOPES:
@@ -572,7 +674,8 @@ def _requirement_lines(results: RunResults) -> list[tuple[str, list[str]]]:
     for name in names:
         words = next((_headline(row.get(scope, {}).get(name))[0] for row in scores for scope, _ in SCOPES
                       if row.get(scope, {}).get(name)), "")
-        cells = [" | ".join(_requirement_cell(row.get(scope, {}).get(name)) for scope, _ in SCOPES)
+        cells = [" | ".join(_requirement_cell(name, scope, row.get(scope, {}).get(name), requirements)
+                            for scope, _ in SCOPES)
                  for row in scores]
         lines.append((f"req.{name} ({words}; ref | cl)", cells))
     return lines
@@ -699,6 +802,10 @@ def to_terminal(results: RunResults, all_metrics: bool = False) -> str:
     note = [f"({len(hidden)} metrics with no value in any row not shown; --all-metrics shows them)"] if hidden else []
     if any(_BROKEN in cell for name, cells in lines if name.startswith("req.") for cell in cells):
         note.append(f"({_BROKEN.strip()}: that scope breaks the requirement; the messages below say how)")
+    if any(part.partition(_BROKEN)[2].strip() for name, cells in lines if name.startswith("req.") for cell in cells
+           for part in cell.split(" | ")):  # a field named after a scope's mark
+        note.append(f"({_BROKEN.strip()} FIELD: the field that breaks it where the number shown does not, as in "
+                    "results.md and results.csv, <scope>.req.<name>.FIELD)")
     return "\n".join([f"scenario: {results.scenario.name}", header, *body, *note, "", *messages, "",
                       status_line(results)])
 

@@ -17,7 +17,7 @@ import numpy as np
 from scenarios.errors import ANOTHER_DIRECTORY, OutputError
 from scenarios.output.directory import (
     check_output_directory,
-    claim_output_directory,
+    claimed_output_directory,
     commit_outputs,
     new_staging,
     read_manifest,
@@ -265,8 +265,10 @@ def write_results(results: RunResults, directory: str | Path, plots: bool = True
     into ``directory``.
 
     The directory is checked (:func:`check_run_directory`: a directory holding the run of another
-    scenario is refused) and claimed first (:func:`claim_output_directory`); the files are staged
-    inside it and committed together (:func:`commit_outputs`).
+    scenario is refused) and claimed first (:func:`~scenarios.output.directory.claimed_output_directory`); the files are staged
+    inside it and committed together (:func:`commit_outputs`). A failure or an interruption before
+    the commit leaves no new directory behind (the claim is withdrawn: only what it made is
+    removed), and an earlier run there as it was.
 
     Parameters
     ----------
@@ -292,21 +294,23 @@ def write_results(results: RunResults, directory: str | Path, plots: bool = True
         The directory is not slewbench's to write, or holds the run of another scenario.
     """
     check_run_directory(directory, results.scenario.name)
-    target = claim_output_directory(directory)
-    staging = new_staging(target)
-    try:
-        (staging / "results.json").write_text(to_json(results))
-        (staging / "results.csv").write_text(to_csv(results))
-        (staging / "results.md").write_text(to_markdown(results))
-        series = staging / "timeseries"
-        series.mkdir()
-        stems = row_stems([row.label for row in results.rows])
-        for row, stem in zip(results.rows, stems):
-            if row.simulation is not None:
-                write_timeseries(row, series / f"{stem}.csv")
-        if plots:
-            _write_plots(results, staging, stems, renderer)
-        commit_outputs(target, staging, kind="run")
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+    # a failure or an interruption before the commit withdraws the claim: a directory this call made
+    # (or the marker it put in an empty one) is removed, an earlier run there stays as it was
+    with claimed_output_directory(directory) as target:
+        staging = new_staging(target)
+        try:
+            (staging / "results.json").write_text(to_json(results))
+            (staging / "results.csv").write_text(to_csv(results))
+            (staging / "results.md").write_text(to_markdown(results))
+            series = staging / "timeseries"
+            series.mkdir()
+            stems = row_stems([row.label for row in results.rows])
+            for row, stem in zip(results.rows, stems):
+                if row.simulation is not None:
+                    write_timeseries(row, series / f"{stem}.csv")
+            if plots:
+                _write_plots(results, staging, stems, renderer)
+            commit_outputs(target, staging, kind="run")
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)
     return target
