@@ -9,6 +9,7 @@ slewbench must not or cannot write to, 1 for an internal error.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import errno
 import functools
 import json
@@ -43,7 +44,7 @@ from scenarios.cli.table import add_table_parser
 from scenarios.errors import OutputError, ScenarioError, in_file
 from scenarios.output.directory import (
     check_output_directory,
-    claim_output_directory,
+    claimed_output_directory,
     written_files,
 )
 from scenarios.output.export import EXPORT_FORMATS, default_export_directory, export_run
@@ -623,9 +624,15 @@ def command_run(args: argparse.Namespace) -> int:
         except OutputError as error:
             raise OutputError(error.path, f"{error.message} (`--export {name}` writes beside the run, into "
                                           f"<out>-{name}: move that directory or choose another --out)") from None
-    claim_output_directory(out)
-    for name in exports:
-        claim_output_directory(default_export_directory(out, name), kind="export")
+    with contextlib.ExitStack() as claims:  # an interrupted or failed run withdraws the claims it committed nothing to
+        claims.enter_context(claimed_output_directory(out))
+        for name in exports:
+            claims.enter_context(claimed_output_directory(default_export_directory(out, name), kind="export"))
+        return _run_claimed(args, scenario, out, exports)
+
+
+def _run_claimed(args: argparse.Namespace, scenario: Any, out: Path, exports: list[str]) -> int:
+    """:func:`command_run` once its output directories are claimed: plan, simulate, write, export."""
     start = time.perf_counter()
     interruption = getattr(args, "interruption", None) or Interruption()
 

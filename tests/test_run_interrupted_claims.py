@@ -1,0 +1,43 @@
+"""``slewbench run`` interrupted (or failing) before it wrote its results leaves no output directory
+behind that it made, and withdraws only its own claim where the directory was there before:
+the run's and its ``--export`` directories, each checked on disk."""
+import json
+
+import pytest
+
+from scenarios.cli import commands
+from scenarios.cli.commands import main
+from scenarios.cli.status import interrupted_status
+from scenarios.output.directory import MARKER
+from tests.test_export_cli import scenario_file
+
+
+def _interrupt(*args, **kwargs):
+    raise KeyboardInterrupt  # what Ctrl-C raises in the planning
+
+
+@pytest.mark.parametrize("exports", [[], ["aem"]], ids=["run", "run-export"])
+def test_an_interrupted_run_leaves_no_new_directory(tmp_path, monkeypatch, exports):
+    # before: each claimed directory stayed, holding only a manifest marked incomplete
+    monkeypatch.setattr(commands, "run", _interrupt)
+    out = tmp_path / "new" / "run"
+    argv = ["run", str(scenario_file(tmp_path)), "--out", str(out), "--no-plots"]
+    for name in exports:
+        argv += ["--export", name]
+    assert main(argv) == interrupted_status("run")
+    assert not (tmp_path / "new").exists()
+
+
+def test_an_interrupted_run_keeps_the_users_empty_folder_and_an_earlier_run(tmp_path, monkeypatch):
+    scenario = scenario_file(tmp_path)
+    earlier = tmp_path / "earlier"
+    assert main(["run", str(scenario), "--out", str(earlier), "--no-plots"]) == 0
+    before = {p.relative_to(earlier): p.read_bytes() for p in earlier.rglob("*") if p.is_file()}
+    empty = tmp_path / "mine"
+    empty.mkdir()
+    monkeypatch.setattr(commands, "run", _interrupt)
+    for out in (earlier, empty):
+        assert main(["run", str(scenario), "--out", str(out), "--no-plots"]) == interrupted_status("run")
+    assert empty.is_dir() and not any(empty.iterdir())  # the folder stays, without the claim's marker
+    assert {p.relative_to(earlier): p.read_bytes() for p in earlier.rglob("*") if p.is_file()} == before
+    assert json.loads((earlier / MARKER).read_text())["complete"]
