@@ -797,10 +797,15 @@ class CollocationPlanner(Planner):
                                               + "; ".join(failures) + ")")
         timed = self.minimises_time(self.options)
         reference = self._plan_from(problem, starts, defer=timed)
-        if reference.ok or not timed:
+        if not (reference.ok or not timed):
+            reference = self._released(problem, reference, starts, failures)
+        else:
             _skipped(reference, failures)
-            return reference
-        return self._released(problem, reference, starts, failures)
+        warm = self.options.warm_start
+        unused = [failure[len(warm) + 2:] for failure in failures if failure.startswith(f"{warm}: ")]
+        if unused:  # the start the user named did not plan: the row says so, not only the stats
+            reference.message += f"; the warm start {warm!r} was not used ({unused[0]})"
+        return reference
 
     def _released(self, problem: ManeuverProblem, failed: Reference, starts: list[Reference],
                   failures: list[str]) -> Reference:
