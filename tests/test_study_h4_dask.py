@@ -1,0 +1,145 @@
+"""A Dask scheduler address that cannot be a scheduler is refused fast and said plainly, and a sweep
+stopped on Dask leaves no traceback in the log.
+
+* A closed port is refused in well under :data:`HANDSHAKE_TIMEOUT_S` (Dask's own connect retries a
+  refused connection until its timeout: 10 s before), saying the connection was refused; a host
+  name that does not resolve likewise, naming it.
+* A listener that speaks another protocol (an SSH banner: Dask reads its first 8 bytes as a frame
+  length of exabytes) is "not Dask's protocol", not ``MemoryError: Unable to allocate 3 EiB``.
+* ``slewbench sweep --scheduler`` with a closed port exits 2 before it checks the study's cases
+  (which takes seconds for a study that disperses the inertia).
+* Cancelling the futures of :attr:`DaskCluster.executor` while their tasks finish (what an
+  interrupted sweep does) logs nothing: Dask's ``client.get_executor()`` set the result of a task
+  that finished meanwhile on the cancelled future, and tornado logged ``InvalidStateError`` with
+  its traceback into the sweep's output (seen on ``timeout -s INT 20 slewbench sweep ... --scheduler``).
+"""
+from __future__ import annotations
+
+import logging
+import socket
+import threading
+import time
+
+import pytest
+
+from scenarios.errors import ScenarioError
+from scenarios.study.engine import HANDSHAKE_TIMEOUT_S, DaskCluster, connect_scheduler
+
+
+def _closed_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def test_a_closed_port_is_refused_at_once():
+    port = _closed_port()
+    start = time.monotonic()
+    with pytest.raises(ScenarioError) as raised:
+        connect_scheduler(f"tcp://127.0.0.1:{port}", "--scheduler")
+    elapsed = time.monotonic() - start
+    assert elapsed < 3.0 < HANDSHAKE_TIMEOUT_S, elapsed
+    message = str(raised.value)
+    assert message.startswith("--scheduler: ")
+    assert f"tcp://127.0.0.1:{port}" in message and "refused" in message
+
+
+def test_a_host_that_does_not_resolve_is_refused_at_once_by_name():
+    start = time.monotonic()
+    with pytest.raises(ScenarioError) as raised:
+        connect_scheduler("tcp://no-such-host.invalid:8786", "execution.scheduler")
+    assert time.monotonic() - start < 3.0
+    message = str(raised.value)
+    assert message.startswith("execution.scheduler: ") and "'no-such-host.invalid'" in message
+    assert "resolve" in message
+
+
+@pytest.fixture
+def banner_server():
+    """A listener that greets every connection with an SSH banner and keeps it open."""
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(4)
+    kept: list[socket.socket] = []
+
+    def serve() -> None:
+        while True:
+            try:
+                conn, _ = server.accept()
+            except OSError:
+                return
+            conn.sendall(b"SSH-2.0-OpenSSH_9.6\r\n")
+            kept.append(conn)
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    yield server.getsockname()[1]
+    server.close()
+    for conn in kept:
+        conn.close()
+
+
+def test_another_protocol_is_said_to_be_one_not_a_memory_error(banner_server):
+    with pytest.raises(ScenarioError) as raised:
+        connect_scheduler(f"tcp://127.0.0.1:{banner_server}", "--scheduler")
+    message = str(raised.value)
+    assert "MemoryError" not in message and "EiB" not in message, message
+    assert "not in Dask's protocol" in message and f"tcp://127.0.0.1:{banner_server}" in message
+
+
+def test_sweep_with_a_closed_scheduler_exits_2_before_checking_the_cases(tmp_path, monkeypatch, capsys):
+    from scenarios.cli.commands import main
+    from scenarios.study import spec
+
+    def load_study(*args, **kwargs):
+        raise AssertionError("the cases were checked before the scheduler")
+
+    monkeypatch.setattr(spec, "load_study", load_study)
+    port = _closed_port()
+    status = main(["sweep", "scenarios/study_truth_inertia_monte_carlo.yaml", "--out", str(tmp_path / "sw"),
+                   "--scheduler", f"tcp://127.0.0.1:{port}"])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert f"--scheduler: no Dask scheduler at tcp://127.0.0.1:{port}: nothing listens there" in err
+    assert "Traceback" not in err
+    assert not (tmp_path / "sw").exists()
+
+
+def _quick(x: int) -> int:
+    time.sleep(0.001)
+    return x
+
+
+def test_cancelling_a_clusters_futures_while_tasks_finish_logs_nothing(caplog):
+    distributed = pytest.importorskip("distributed")
+    errors: list[logging.LogRecord] = []
+
+    class Keep(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            if record.levelno >= logging.ERROR:
+                errors.append(record)
+
+    handler = Keep()
+    loggers = [logging.getLogger(name) for name in ("tornado.application", "distributed.client", "asyncio")]
+    for logger in loggers:
+        logger.addHandler(handler)
+    try:
+        with (distributed.LocalCluster(processes=False, n_workers=1, threads_per_worker=2, worker_dashboard_address=None,
+                                       dashboard_address=None) as cluster,
+              distributed.Client(cluster) as client, DaskCluster(cluster.scheduler_address, client) as dask):
+            for trial in range(5):
+                executor = dask.executor
+                futures = [executor.submit(_quick, 1000 * trial + i) for i in range(300)]
+                time.sleep(0.05)
+                for future in futures:
+                    future.cancel()
+                time.sleep(0.1)
+            # the executor still gives results (and what a task raised)
+            assert [f.result(timeout=10) for f in [dask.executor.submit(_quick, i) for i in range(3)]] == [0, 1, 2]
+            with pytest.raises(ZeroDivisionError):
+                dask.executor.submit(divmod, 1, 0).result(timeout=10)
+            time.sleep(0.2)
+    finally:
+        for logger in loggers:
+            logger.removeHandler(handler)
+    assert not errors, [record.getMessage()[:200] for record in errors]
