@@ -143,3 +143,44 @@ def test_cancelling_a_clusters_futures_while_tasks_finish_logs_nothing(caplog):
         for logger in loggers:
             logger.removeHandler(handler)
     assert not errors, [record.getMessage()[:200] for record in errors]
+
+
+def _slow_case(payload):
+    """A case's rows after 0.3 s (the sweep's main loop checks its cluster meanwhile)."""
+    from scenarios.study.worker import run_case
+
+    time.sleep(0.3)
+    return run_case(payload)
+
+
+def test_a_sweep_on_a_cluster_never_waits_for_the_scheduler_in_its_main_thread(monkeypatch):
+    """The worker count the sweep needs (at its start, and every second to notice a cluster without
+    workers) is asked in a thread of its own: a Ctrl-C that lands in the main thread while it waits
+    in ``distributed.utils.sync`` made tornado log ``NameError: cannot access free variable
+    'future'`` with its traceback (1 of 3 interrupted runs of a 500-case study)."""
+    distributed = pytest.importorskip("distributed")
+    import copy
+
+    from scenarios.study.engine import sweep
+    from tests.test_sweep import BASE
+
+    asked_in: list[str] = []
+    counted = DaskCluster.workers
+
+    def workers(self):
+        asked_in.append(threading.current_thread().name)
+        return counted(self)
+
+    monkeypatch.setattr(DaskCluster, "workers", workers)
+    study = {"study": "h4-watch", "scenario": copy.deepcopy(BASE),
+             "grid": {"maneuver.final.q": [[0.9238795, 0.3826834, 0, 0], [0.7071068, 0.7071068, 0, 0],
+                                           [0.9659258, 0.258819, 0, 0], [0.8660254, 0.5, 0, 0]]}}
+    with (distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp",
+                                   host="127.0.0.1", dashboard_address=None,
+                                   worker_dashboard_address=None) as cluster,
+          connect_scheduler(cluster.scheduler_address) as dask):
+        asked_in.clear()  # connect_scheduler's own checks are before any case
+        results = sweep(study, cluster=dask, task=_slow_case)
+    assert len(results.to_dataframe()) >= 4
+    assert asked_in, "the worker count was never asked"
+    assert threading.main_thread().name not in asked_in, asked_in

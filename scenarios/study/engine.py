@@ -841,7 +841,7 @@ class _Engine:
         if self.cluster is None or now < self.next_cluster_check:
             return
         self.next_cluster_check = now + 1.0
-        if self.cluster.workers() > 0:
+        if self.cluster.workers() > 0:  # the watch's last count (_WorkerWatch)
             self.no_workers_since = None
             return
         self.no_workers_since = self.no_workers_since or now
@@ -881,6 +881,62 @@ class _Engine:
 
 class _ClusterLost(Exception):
     """The Dask cluster stayed without workers."""
+
+
+class _WorkerWatch:
+    """A Dask cluster's worker threads, counted about every second in a thread of its own, so that
+    the sweep's main thread never waits in a call to the cluster while it runs: a Ctrl-C that
+    lands in the main thread while it waits for the scheduler's answer (``distributed.utils.sync``)
+    makes Dask cancel a future it has not made yet, and tornado logs a ``NameError`` with its
+    traceback into the output of the interrupted sweep.
+
+    Parameters
+    ----------
+    cluster : DaskCluster
+        The cluster to watch.
+    """
+
+    def __init__(self, cluster: DaskCluster):
+        self.cluster = cluster
+        self.counted = threading.Event()
+        self.stopped = threading.Event()
+        self.value = 0
+        self.error: Exception | None = None
+        self.thread = threading.Thread(target=self._watch, name="slewbench-dask-workers", daemon=True)
+        self.thread.start()
+
+    def _watch(self) -> None:
+        while not self.stopped.is_set():
+            try:
+                self.value = self.cluster.workers()
+            except Exception as error:  # noqa: BLE001 (given to the main thread, which raises it)
+                self.error = error
+                self.counted.set()
+                return
+            self.counted.set()
+            self.stopped.wait(1.0)
+
+    def workers(self) -> int:
+        """The last count (waiting for the first one).
+
+        Returns
+        -------
+        int
+            The cluster's worker threads.
+
+        Raises
+        ------
+        Exception
+            What the count raised (a scheduler gone).
+        """
+        self.counted.wait()
+        if self.error is not None:
+            raise self.error
+        return self.value
+
+    def close(self) -> None:
+        """Stop counting (a count under way ends on its own)."""
+        self.stopped.set()
 
 
 def default_workers() -> int:
@@ -1254,12 +1310,13 @@ def sweep(study: Study | dict[str, Any] | str | os.PathLike[str], executor: Exec
     own = None
     if executor is None and cluster is None and study.execution.scheduler:
         cluster = own = connect_scheduler(study.execution.scheduler)
+    watch = _WorkerWatch(cluster) if cluster is not None else None
     try:
-        if executor is None and cluster is not None:
-            executor = cluster.executor
-            workers = workers or max(cluster.workers(), 1)
+        if executor is None and watch is not None:
+            executor = cluster.executor  # type: ignore[union-attr]
+            workers = workers or max(watch.workers(), 1)
         workers = workers or study.execution.workers or default_workers()
-        engine = _Engine(study, executor, workers, store, progress, task, cluster, timeouts_apart)
+        engine = _Engine(study, executor, workers, store, progress, task, watch, timeouts_apart)
         try:
             engine.run()
         except KeyboardInterrupt:
@@ -1269,6 +1326,8 @@ def sweep(study: Study | dict[str, Any] | str | os.PathLike[str], executor: Exec
             results = SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)
             raise SweepInterrupted(results.missing, len(study.cases), str(lost)) from None
     finally:
+        if watch is not None:
+            watch.close()
         if own is not None:
             own.close()
     return SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)
