@@ -184,3 +184,65 @@ def test_a_sweep_on_a_cluster_never_waits_for_the_scheduler_in_its_main_thread(m
     assert len(results.to_dataframe()) >= 4
     assert asked_in, "the worker count was never asked"
     assert threading.main_thread().name not in asked_in, asked_in
+
+
+def test_cancelling_after_the_client_closed_logs_nothing():
+    """A sweep whose scheduler went away cancels its futures on a closed client: that raised
+    ``ClosedClientError`` in the future's callback, and ``concurrent.futures`` logged "exception
+    calling callback" with two tracebacks per future."""
+    distributed = pytest.importorskip("distributed")
+    errors: list[str] = []
+
+    class Keep(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            if record.levelno >= logging.ERROR:
+                errors.append(record.getMessage())
+
+    handler = Keep()
+    logger = logging.getLogger("concurrent.futures")
+    logger.addHandler(handler)
+    try:
+        with distributed.LocalCluster(processes=False, n_workers=1, threads_per_worker=1, dashboard_address=None,
+                                      worker_dashboard_address=None) as cluster:
+            with distributed.Client(cluster) as client:
+                dask = DaskCluster(cluster.scheduler_address, client)
+                futures = [dask.executor.submit(time.sleep, 0.5) for _ in range(3)]
+                # the state Dask leaves a client in when it could not reconnect (_reconnect: "closing
+                # client"), with tasks submitted while it tried still pending
+                client.status = "closed"
+                try:
+                    for future in futures:
+                        future.cancel()
+                finally:
+                    client.status = "running"
+    finally:
+        logger.removeHandler(handler)
+    assert not errors, errors
+
+
+def test_a_sweep_whose_client_closed_stops_at_once_saying_so():
+    """A client that could not reconnect to its scheduler closes itself (Dask: 10 s); the sweep then
+    stops like an interrupted one at once, saying the scheduler went away, where it waited 60 s more
+    for workers and said "no workers"."""
+    distributed = pytest.importorskip("distributed")
+    import copy
+
+    from scenarios.errors import SweepInterrupted
+    from scenarios.study.engine import sweep
+    from tests.test_sweep import BASE
+
+    study = {"study": "h4-gone", "scenario": copy.deepcopy(BASE),
+             "grid": {"maneuver.final.q": [[0.9238795, 0.3826834, 0, 0], [0.7071068, 0.7071068, 0, 0],
+                                           [0.9659258, 0.258819, 0, 0], [0.8660254, 0.5, 0, 0]]}}
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp",
+                                  host="127.0.0.1", dashboard_address=None,
+                                  worker_dashboard_address=None) as cluster:
+        dask = connect_scheduler(cluster.scheduler_address)
+        closer = threading.Timer(0.5, dask.client.close)
+        closer.start()
+        start = time.monotonic()
+        with pytest.raises(SweepInterrupted) as raised:
+            sweep(study, cluster=dask, task=_slow_case)
+        closer.join()
+    assert time.monotonic() - start < 5.0
+    assert "client" in raised.value.reason and cluster.scheduler_address in raised.value.reason, raised.value.reason

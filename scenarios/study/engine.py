@@ -926,10 +926,14 @@ class _WorkerWatch:
 
         Raises
         ------
+        _ClusterLost
+            The client closed (it could not reconnect to its scheduler).
         Exception
-            What the count raised (a scheduler gone).
+            What the count raised.
         """
         self.counted.wait()
+        if self.cluster.client.status == "closed":
+            raise _ClusterLost(_client_closed(self.cluster.address))
         if self.error is not None:
             raise self.error
         return self.value
@@ -1045,20 +1049,31 @@ class _ClusterExecutor(Executor):
     the output of every interrupted sweep. Here a task's outcome goes to its future unless that
     future was cancelled, and cancelling the future cancels the task on the cluster."""
 
-    def __init__(self, client: Any):
-        self.client = client
+    def __init__(self, client: Any, address: str = ""):
+        self.client, self.address = client, address
 
     def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future[Any]:
+        if self.client.status == "closed":
+            raise _ClusterLost(_client_closed(self.address))
         task = self.client.submit(fn, *args, **kwargs)
         future: Future[Any] = Future()
 
         def cancel_task(done: Future[Any]) -> None:
-            if done.cancelled() and task.status == "pending":
-                task.cancel()
+            # a closed client's tasks went with it (Dask raises ClosedClientError: the callback's
+            # traceback would be logged into the sweep's output)
+            if done.cancelled() and task.status == "pending" and self.client.status == "running":
+                with contextlib.suppress(Exception):  # closed meanwhile: as above
+                    task.cancel()
 
         future.add_done_callback(cancel_task)
         task.add_done_callback(lambda task: _settle(future, task))
         return future
+
+
+def _client_closed(address: str) -> str:
+    """Why a sweep stops whose Dask client closed."""
+    return (f"lost the Dask scheduler at {address}: its client could not reconnect and closed; "
+            f"restart the scheduler (and its workers) there")
 
 
 def _settle(future: Future[Any], task: Any) -> None:
@@ -1106,7 +1121,7 @@ class DaskCluster:
     def executor(self) -> Executor:
         """The client's tasks as a ``concurrent.futures`` executor (as ``client.get_executor()``,
         without Dask's log noise when its futures are cancelled)."""
-        return _ClusterExecutor(self.client)
+        return _ClusterExecutor(self.client, self.address)
 
     def workers(self) -> int:
         """Worker threads the scheduler knows now.
