@@ -100,7 +100,7 @@ def test_sweep_with_a_closed_scheduler_exits_2_before_checking_the_cases(tmp_pat
                    "--scheduler", f"tcp://127.0.0.1:{port}"])
     err = capsys.readouterr().err
     assert status == 2, err
-    assert f"--scheduler: no Dask scheduler at tcp://127.0.0.1:{port}: nothing listens there" in err
+    assert f"--scheduler: no Dask scheduler answered at tcp://127.0.0.1:{port}: nothing listens there" in err
     assert "Traceback" not in err
     assert not (tmp_path / "sw").exists()
 

@@ -962,19 +962,20 @@ def _reach(address: str, where: str) -> None:
     from distributed.comm.addressing import parse_address, parse_host_port
 
     host, port = parse_host_port(parse_address(address)[1])
+    none = f"no Dask scheduler answered at {address}"
     try:
         socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
     except socket.gaierror as error:
-        raise ScenarioError(where, f"no Dask scheduler at {address}: its host {excerpt(host)} does not resolve "
+        raise ScenarioError(where, f"{none}: its host {excerpt(host)} does not resolve "
                                    f"({error.strerror or error}); is the name right?") from None
     except ConnectionRefusedError:
-        raise ScenarioError(where, f"no Dask scheduler at {address}: nothing listens there (connection "
-                                   f"refused); is one running there, on that port?") from None
+        raise ScenarioError(where, f"{none}: nothing listens there (connection refused); is one running "
+                                   f"there, on that port?") from None
     except TimeoutError:
-        raise ScenarioError(where, f"no Dask scheduler at {address}: no connection within {CONNECT_TIMEOUT_S:g} "
-                                   f"s (the host is down or unreachable, or a firewall drops it)") from None
+        raise ScenarioError(where, f"{none}: no connection within {CONNECT_TIMEOUT_S:g} s (the host is down "
+                                   f"or unreachable, or a firewall drops it)") from None
     except OSError as error:
-        raise ScenarioError(where, f"no Dask scheduler at {address}: cannot connect "
+        raise ScenarioError(where, f"{none}: cannot connect "
                                    f"({excerpt(error.strerror or str(error), 200)})") from None
 
 
