@@ -342,7 +342,7 @@ def command_sweep(args: argparse.Namespace) -> int:
         An output directory slewbench must not or cannot write to (exit 2; nothing written), or a
         store that cannot be written while the sweep runs (the cases stored so far are kept).
     """
-    from scenarios.study.engine import connect_scheduler, start_forkserver
+    from scenarios.study.engine import connect_scheduler, reachable, start_forkserver
     from scenarios.study.spec import load_study
 
     if args.case is not None:
@@ -361,6 +361,9 @@ def command_sweep(args: argparse.Namespace) -> int:
             scheduler = args.scheduler
             if not scheduler:
                 start_forkserver()  # local workers' imports run while the study is expanded and checked
+            elif not args.dry_run:  # a closed port is refused now, not after the cases are checked
+                phase = f"while it connected to the Dask scheduler {scheduler}"
+                reachable(scheduler, "--scheduler")
             phase = "while its cases were checked"
             found = None
             if args.dry_run:  # the cases' findings, from the loader's parse where the check parsed the case

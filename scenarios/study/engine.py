@@ -16,8 +16,9 @@ alone is charged that death and the one it shared. A case's time limit counts fr
 its worker. The local workers fork from a server that dies with the sweep, and they die with it
 (:data:`scenarios.study.worker.PARENT_ENVIRONMENT`): a sweep killed outright leaves no process.
 
-On Dask, :func:`connect_scheduler` checks that the address answers as a Dask scheduler within
-:data:`HANDSHAKE_TIMEOUT_S` and that it has workers (waiting at most :data:`WORKER_WAIT_S`) before
+On Dask, :func:`connect_scheduler` checks that the address accepts a connection within
+:data:`CONNECT_TIMEOUT_S`, answers as a Dask scheduler within :data:`HANDSHAKE_TIMEOUT_S` and
+that it has workers (waiting at most :data:`WORKER_WAIT_S`) before
 anything is written; cases go in chunks sized from the cases' run times (about
 :data:`CHUNK_TARGET_S` each), and a sweep whose cluster stays without workers for
 :data:`WORKER_WAIT_S` stops as if interrupted (resume it later).
@@ -45,6 +46,7 @@ from concurrent.futures import (
     FIRST_COMPLETED,
     Executor,
     Future,
+    InvalidStateError,
     ProcessPoolExecutor,
     wait,
 )
@@ -81,6 +83,13 @@ MANAGER_JOIN_S = 10.0  # the longest a killed local pool's manager thread is wai
 _TIMEOUT_GRACE = 1.25  # the driver gives up on a case at this multiple of case_timeout_s (+ 5 s)
 HANDSHAKE_TIMEOUT_S = 10.0
 """How long a Dask scheduler's address has to answer as a Dask scheduler [s]."""
+CONNECT_TIMEOUT_S = 2.0
+"""How long a Dask scheduler's host has to accept a TCP connection [s], checked before the
+handshake: a closed port or a host name that does not resolve is refused at once (Dask's own
+connect retries a refused connection until :data:`HANDSHAKE_TIMEOUT_S`), a host that does not
+answer after this (down, unreachable, or a firewall that drops the connection). A host that is up
+accepts a connection in a round trip, whatever its scheduler is doing (the kernel accepts it); 2 s
+leaves room for one lost first packet, sent again after 1 s."""
 WORKER_WAIT_S = 60.0
 """How long a sweep waits for a Dask cluster without workers: before it starts (then it is refused,
 nothing written) and while it runs (then it stops like an interrupted sweep) [s]."""
@@ -543,7 +552,8 @@ class _Engine:
         self.study, self.store, self.task, self.cluster = study, store, task, cluster
         self.owned = executor is None
         self.workers = workers
-        self.dask = not self.owned and type(executor).__module__.startswith("distributed")
+        self.dask = not self.owned and (isinstance(executor, _ClusterExecutor)
+                                        or type(executor).__module__.startswith("distributed"))
         self.chunked = self.owned or self.dask
         # a local pool gets one chunk ahead of its workers, so that none idles while the driver stores a
         # result; Dask two chunks per worker; other executors one case per worker
@@ -831,7 +841,7 @@ class _Engine:
         if self.cluster is None or now < self.next_cluster_check:
             return
         self.next_cluster_check = now + 1.0
-        if self.cluster.workers() > 0:
+        if self.cluster.workers() > 0:  # the watch's last count (_WorkerWatch)
             self.no_workers_since = None
             return
         self.no_workers_since = self.no_workers_since or now
@@ -873,6 +883,66 @@ class _ClusterLost(Exception):
     """The Dask cluster stayed without workers."""
 
 
+class _WorkerWatch:
+    """A Dask cluster's worker threads, counted about every second in a thread of its own, so that
+    the sweep's main thread never waits in a call to the cluster while it runs: a Ctrl-C that
+    lands in the main thread while it waits for the scheduler's answer (``distributed.utils.sync``)
+    makes Dask cancel a future it has not made yet, and tornado logs a ``NameError`` with its
+    traceback into the output of the interrupted sweep.
+
+    Parameters
+    ----------
+    cluster : DaskCluster
+        The cluster to watch.
+    """
+
+    def __init__(self, cluster: DaskCluster):
+        self.cluster = cluster
+        self.counted = threading.Event()
+        self.stopped = threading.Event()
+        self.value = 0
+        self.error: Exception | None = None
+        self.thread = threading.Thread(target=self._watch, name="slewbench-dask-workers", daemon=True)
+        self.thread.start()
+
+    def _watch(self) -> None:
+        while not self.stopped.is_set():
+            try:
+                self.value = self.cluster.workers()
+            except Exception as error:  # noqa: BLE001 (given to the main thread, which raises it)
+                self.error = error
+                self.counted.set()
+                return
+            self.counted.set()
+            self.stopped.wait(1.0)
+
+    def workers(self) -> int:
+        """The last count (waiting for the first one).
+
+        Returns
+        -------
+        int
+            The cluster's worker threads.
+
+        Raises
+        ------
+        _ClusterLost
+            The client closed (it could not reconnect to its scheduler).
+        Exception
+            What the count raised.
+        """
+        self.counted.wait()
+        if self.cluster.client.status == "closed":
+            raise _ClusterLost(_client_closed(self.cluster.address))
+        if self.error is not None:
+            raise self.error
+        return self.value
+
+    def close(self) -> None:
+        """Stop counting (a count under way ends on its own)."""
+        self.stopped.set()
+
+
 def default_workers() -> int:
     """One worker per core available to this process.
 
@@ -882,6 +952,63 @@ def default_workers() -> int:
         The number of cores this process may run on (at least 1).
     """
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+def _reach(address: str, where: str) -> None:
+    """Open and close a TCP connection to the scheduler's host and port within
+    :data:`CONNECT_TIMEOUT_S`, or raise a :class:`ScenarioError` at ``where`` saying why not."""
+    import socket
+
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    host, port = parse_host_port(parse_address(address)[1])
+    none = f"no Dask scheduler answered at {address}"
+    try:
+        socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
+    except socket.gaierror as error:
+        raise ScenarioError(where, f"{none}: its host {excerpt(host)} does not resolve "
+                                   f"({error.strerror or error}); is the name right?") from None
+    except ConnectionRefusedError:
+        raise ScenarioError(where, f"{none}: nothing listens there (connection refused); is one running "
+                                   f"there, on that port?") from None
+    except TimeoutError:
+        raise ScenarioError(where, f"{none}: no connection within {CONNECT_TIMEOUT_S:g} s (the host is down "
+                                   f"or unreachable, or a firewall drops it)") from None
+    except OSError as error:
+        raise ScenarioError(where, f"{none}: cannot connect "
+                                   f"({excerpt(error.strerror or str(error), 200)})") from None
+
+
+def reachable(address: str, where: str = "execution.scheduler") -> str:
+    """Check that a Dask scheduler's address is well formed and that its host accepts a TCP
+    connection there within :data:`CONNECT_TIMEOUT_S`: the quick part of :func:`connect_scheduler`,
+    to refuse a closed port before a study's cases are checked.
+
+    Parameters
+    ----------
+    address : str
+        ``[scheme://]host:port`` (:func:`scenarios.schema.study.scheduler_address`).
+    where : str, optional
+        Where the address was given, for messages.
+
+    Returns
+    -------
+    str
+        The address with its scheme.
+
+    Raises
+    ------
+    ScenarioError
+        At ``where``: a malformed address, a host that does not resolve, a closed port, a host
+        that does not answer.
+    """
+    address = scheduler_address(address, where)
+    try:
+        import distributed  # noqa: F401
+    except ImportError:
+        raise ScenarioError(where, "a Dask scheduler needs the distributed package (pip install distributed)") from None
+    _reach(address, where)
+    return address
 
 
 def _identity(address: str, timeout_s: float) -> dict[str, Any]:
@@ -915,6 +1042,61 @@ def _drop(record: logging.LogRecord) -> bool:
     return False
 
 
+class _ClusterExecutor(Executor):
+    """A Dask client's tasks as ``concurrent.futures`` futures, as ``client.get_executor()`` gives
+    them, but quiet when they are cancelled: Dask's executor sets the outcome of a task that
+    finished (or was cancelled) while its future was being cancelled on that cancelled future, and
+    tornado logs the ``InvalidStateError`` (or ``FutureCancelledError``) with its traceback, into
+    the output of every interrupted sweep. Here a task's outcome goes to its future unless that
+    future was cancelled, and cancelling the future cancels the task on the cluster."""
+
+    def __init__(self, client: Any, address: str = ""):
+        self.client, self.address = client, address
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future[Any]:
+        if self.client.status == "closed":
+            raise _ClusterLost(_client_closed(self.address))
+        task = self.client.submit(fn, *args, **kwargs)
+        future: Future[Any] = Future()
+
+        def cancel_task(done: Future[Any]) -> None:
+            # a closed client's tasks went with it (Dask raises ClosedClientError: the callback's
+            # traceback would be logged into the sweep's output)
+            if done.cancelled() and task.status == "pending" and self.client.status == "running":
+                with contextlib.suppress(Exception):  # closed meanwhile: as above
+                    task.cancel()
+
+        future.add_done_callback(cancel_task)
+        task.add_done_callback(lambda task: _settle(future, task))
+        return future
+
+
+def _client_closed(address: str) -> str:
+    """Why a sweep stops whose Dask client closed."""
+    return (f"lost the Dask scheduler at {address}: its client could not reconnect and closed; "
+            f"restart the scheduler (and its workers) there")
+
+
+def _settle(future: Future[Any], task: Any) -> None:
+    """Give a finished Dask task's outcome to its future (in Dask's callback thread); a future that
+    was cancelled meanwhile keeps nothing."""
+    if future.cancelled():
+        return
+    try:
+        if task.status == "cancelled":
+            if future.cancel():
+                future.set_running_or_notify_cancel()  # wakes a wait() on it
+            return
+        try:
+            value = task.result()
+        except BaseException as error:  # noqa: BLE001 (what the task raised, or the cluster's failure)
+            future.set_exception(error)
+        else:
+            future.set_result(value)
+    except InvalidStateError:  # cancelled while the outcome was fetched: nobody waits for it
+        pass
+
+
 @dataclass
 class DaskCluster:
     """A Dask cluster the sweep connected to (:func:`connect_scheduler`), and a context manager
@@ -938,8 +1120,9 @@ class DaskCluster:
 
     @property
     def executor(self) -> Executor:
-        """The client's ``concurrent.futures`` executor."""
-        return self.client.get_executor()
+        """The client's tasks as a ``concurrent.futures`` executor (as ``client.get_executor()``,
+        without Dask's log noise when its futures are cancelled)."""
+        return _ClusterExecutor(self.client, self.address)
 
     def workers(self) -> int:
         """Worker threads the scheduler knows now.
@@ -977,8 +1160,9 @@ class DaskCluster:
 
 
 def connect_scheduler(address: str, where: str = "execution.scheduler", wait_s: float | None = None) -> DaskCluster:
-    """Connect to a Dask scheduler, or refuse at once: a malformed address, an address that does not
-    answer as a Dask scheduler within :data:`HANDSHAKE_TIMEOUT_S` (a web server, a closed port),
+    """Connect to a Dask scheduler, or refuse at once: a malformed address, a host that does not
+    resolve or accept a connection within :data:`CONNECT_TIMEOUT_S` (a closed port), an address
+    that does not answer as a Dask scheduler within :data:`HANDSHAKE_TIMEOUT_S` (a web server),
     or a scheduler without workers after ``wait_s``.
 
     Parameters
@@ -1000,18 +1184,20 @@ def connect_scheduler(address: str, where: str = "execution.scheduler", wait_s: 
     ScenarioError
         At ``where``, saying what is wrong (exit status 2 on the command line; nothing written).
     """
-    address = scheduler_address(address, where)
+    import distributed
+
+    address = reachable(address, where)
     wait_s = WORKER_WAIT_S if wait_s is None else wait_s
-    try:
-        import distributed
-    except ImportError:
-        raise ScenarioError(where, "a Dask scheduler needs the distributed package (pip install distributed)") from None
     try:
         identity = _identity(address, HANDSHAKE_TIMEOUT_S)
     except (TimeoutError, OSError) as error:
         why = "no answer" if isinstance(error, TimeoutError) or "Timed out" in str(error) else excerpt(str(error), 200)
         raise ScenarioError(where, f"no Dask scheduler answered at {address} within {HANDSHAKE_TIMEOUT_S:g} s "
-                                   f"({why}); is one running there?") from None
+                                   f"({why}; something accepts connections there); is it the scheduler's port "
+                                   f"(8786 by default; not its dashboard's)?") from None
+    except MemoryError:  # Dask read another protocol's first bytes as the length of a frame
+        raise ScenarioError(where, f"{address} answered, but not in Dask's protocol (another service listens "
+                                   f"there); is it the scheduler's port (8786 by default)?") from None
     except Exception as error:  # anything that is not Dask's protocol
         raise ScenarioError(where, f"{address} did not answer as a Dask scheduler "
                                    f"({type(error).__name__}: {excerpt(str(error), 200)})") from None
@@ -1140,12 +1326,13 @@ def sweep(study: Study | dict[str, Any] | str | os.PathLike[str], executor: Exec
     own = None
     if executor is None and cluster is None and study.execution.scheduler:
         cluster = own = connect_scheduler(study.execution.scheduler)
+    watch = _WorkerWatch(cluster) if cluster is not None else None
     try:
-        if executor is None and cluster is not None:
-            executor = cluster.executor
-            workers = workers or max(cluster.workers(), 1)
+        if executor is None and watch is not None:
+            executor = cluster.executor  # type: ignore[union-attr]
+            workers = workers or max(watch.workers(), 1)
         workers = workers or study.execution.workers or default_workers()
-        engine = _Engine(study, executor, workers, store, progress, task, cluster, timeouts_apart)
+        engine = _Engine(study, executor, workers, store, progress, task, watch, timeouts_apart)
         try:
             engine.run()
         except KeyboardInterrupt:
@@ -1155,6 +1342,8 @@ def sweep(study: Study | dict[str, Any] | str | os.PathLike[str], executor: Exec
             results = SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)
             raise SweepInterrupted(results.missing, len(study.cases), str(lost)) from None
     finally:
+        if watch is not None:
+            watch.close()
         if own is not None:
             own.close()
     return SweepResults(study, engine.records, engine.worker_builds, engine.cpu_s, engine.worker_cpu_s)
