@@ -425,8 +425,9 @@ SIMULATION = Section((
            positive=True, nullable=True, maximum=MAX_DURATION_S),
     vector("initial_attitude_error_deg", "Rotation vector applied to the true initial attitude, body axes.", 3,
            unit="deg", default=[0.0, 0.0, 0.0], magnitude=1e6),
-    vector("initial_rate_error", "Added to the true initial body rate, body frame.", 3, unit="rad/s",
-           default=[0.0, 0.0, 0.0]),
+    vector("initial_rate_error", "Added to the true initial body rate, body frame (each entry within "
+           f"±{MAX_BODY_RATE:g}, ``maneuver.initial.omega``'s bound).", 3, unit="rad/s", default=[0.0, 0.0, 0.0],
+           magnitude=MAX_BODY_RATE),
     mapping("sensor_noise", "Measurement noise.", SENSOR_NOISE, default={}),
     mapping("sensors", "Sensor models (gyro, star tracker, magnetometer); absent or ``null``: the measurement is "
             "``sensor_noise``'s.", SENSORS, default=None, null="none"),

@@ -44,7 +44,7 @@ from scenarios.schema.keys import (
 from scenarios.schema.node import Node
 from scenarios.schema.requirements import SENSOR, parse_sensors
 
-__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "ORBIT", "SPACECRAFT", "TORQUERS", "WHEELS",
+__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "MAX_INERTIA", "MIN_INERTIA", "ORBIT", "SPACECRAFT", "TORQUERS", "WHEELS",
            "parse_environment", "parse_magnetic_field", "parse_orbit", "parse_spacecraft"]
 
 
@@ -62,15 +62,38 @@ def _limits(node: Node) -> Any:
     return None if node.is_null() else node.vector(allow_scalar=True)
 
 
+MAX_INERTIA = 1.0e12
+"""Largest entry [kg m²] of ``spacecraft.inertia`` (and ``truth.spacecraft.inertia``): ten thousand
+times the International Space Station's (about 1e8 kg m²). Far beyond it the planners' arithmetic
+overflows (1e300 printed NumPy's overflow warning and a bound of 150 digits); an inertia merely too
+large for its torque (g mm² written as kg m², 1e9 too large) warns (``slew_time``)."""
+MIN_INERTIA = 1.0e-9
+"""Least principal moment [kg m²] of ``spacecraft.inertia`` (and ``truth.spacecraft.inertia``): a
+gram at a millimetre, a hundred times below the smallest spacecraft flown (chip-sats of a few grams
+over a few centimetres, about 1e-7 kg m²). Far below it a run hung (1e-250 kg m²: the torque-free
+coast after a bang-coast-bang slew never ended); a positive moment above it too small for its torque
+warns (``actuator_torques``), and one of 0 or below is the spacecraft's error (positive definite)."""
+
+
 def _inertia(node: Node) -> np.ndarray:
     inertia = node.value
     if isinstance(inertia, list) and inertia and all(isinstance(row, list) for row in inertia):
         if len(inertia) != 3:
             raise node.error(f"expected a 3x3 matrix (3 rows of 3 numbers), got {len(inertia)} rows")
-        return np.array([Node(row, f"{node.path}[{i}]").vector(3) for i, row in enumerate(inertia)])
-    if not isinstance(inertia, list):
+        values = np.array([Node(row, f"{node.path}[{i}]").vector(3) for i, row in enumerate(inertia)])
+    elif not isinstance(inertia, list):
         raise node.error(f"expected a list of 3 numbers or a 3x3 matrix (3 rows of 3 numbers), got {excerpt(inertia)}")
-    return node.vector(3)
+    else:
+        values = node.vector(3)
+    if np.any(np.abs(values) > MAX_INERTIA):
+        raise node.error(f"expected entries within ±{MAX_INERTIA:g} kg m² (ten thousand times the International Space "
+                         f"Station's), got {values.tolist()}")
+    matrix = np.diag(values) if values.ndim == 1 else values
+    least = float(np.linalg.eigvalsh((matrix + matrix.T) / 2.0)[0])
+    if 0.0 < least < MIN_INERTIA:
+        raise node.error(f"expected a least principal moment of at least {MIN_INERTIA:g} kg m² (a gram at a millimetre; "
+                         f"the smallest spacecraft have about 1e-7), got {least:.4g} kg m² for {values.tolist()}")
+    return values
 
 
 def _axes(node: Node) -> np.ndarray:
@@ -105,7 +128,8 @@ TORQUERS = Section((
 SPACECRAFT = Section((
     custom("inertia", "Principal moments (3 numbers) or the 3x3 inertia matrix about the centre of mass, body "
            "frame; positive definite, the moments meeting the triangle inequality.",
-           "list of 3 numbers or 3x3 matrix", _inertia, unit="kg m²"),
+           "list of 3 numbers or 3x3 matrix", _inertia, unit="kg m²",
+           bounds=f"each entry within ±{MAX_INERTIA:g}; the least principal moment at least {MIN_INERTIA:g}"),
     mapping("wheels", "Reaction wheels (default: three wheels on the body axes without bounds).", WHEELS,
             default={}, null="none"),
     mapping("magnetorquers", "Magnetorquers.", MAGNETORQUERS, default=None, null="none"),

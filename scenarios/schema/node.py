@@ -441,12 +441,19 @@ class Node:
             (the message shows the value, its norm and the normalised quaternion to write).
         """
         q = self.vector(4)
-        problem = quat.unit_norm_error(q)
+        scale = float(np.max(np.abs(q)))
+        unit = q / scale if scale > 0.0 else q  # the direction, whose norm cannot overflow (entries of 1e300 did,
+        # with NumPy's RuntimeWarning printed before the error and "must be finite" said of finite entries)
+        if scale > 2.0:  # an entry beyond 2: no unit quaternion, whatever the tolerance
+            norm = scale * float(np.linalg.norm(unit))
+            shown = f"{norm:.6g}" if math.isfinite(norm) else "beyond a float's range"
+            problem: str | None = f"a quaternion must have unit norm (got norm {shown})"
+        else:
+            problem = quat.unit_norm_error(q)
         if problem is not None:
             hint = ""
-            norm = float(np.linalg.norm(q))
-            if np.isfinite(norm) and norm > 0.0:
-                hint = (f"; normalise it (q / ‖q‖ = {[round(float(v), 7) for v in q / norm]}) if it is the "
-                        "attitude you mean, or check it for a typo")
+            if scale > 0.0:
+                hint = (f"; normalise it (q / ‖q‖ = {[round(float(v), 7) for v in unit / np.linalg.norm(unit)]}) if "
+                        "it is the attitude you mean, or check it for a typo")
             raise self.error(f"{problem} for {excerpt(self.value)}{hint}")
         return q / float(np.linalg.norm(q))

@@ -1,0 +1,75 @@
+"""Hostile numbers in a scenario: each a one-line error naming the YAML path, the value and what is
+expected, with nothing printed before it (NumPy's overflow warnings) and no hang.
+
+- a quaternion with entries of 1e300: its norm overflowed (NumPy's RuntimeWarning, then "must be
+  finite" said of finite entries);
+- ``simulation.initial_rate_error`` of 1e300 rad/s: accepted (its norm inf in a warning);
+- an inertia of 1e300 kg m²: accepted with NumPy's overflow warning and a 150-digit bound; one of
+  1e-250 kg m²: ``slewbench run`` hung in the torque-free coast of a bang-coast-bang row.
+"""
+from __future__ import annotations
+
+import copy
+import warnings
+from pathlib import Path
+
+import pytest
+
+from scenarios.errors import ScenarioError
+from scenarios.schema.loader import parse_scenario
+from scenarios.schema.read import read_yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+DEMO = read_yaml(ROOT / "scenarios" / "eigenaxis_demo.yaml")
+TRUTH = read_yaml(ROOT / "scenarios" / "eigenaxis_truth.yaml")
+
+
+def refused(base: dict, path: str, value) -> str:
+    data = copy.deepcopy(base)
+    node = data
+    *parents, key = path.split(".")
+    for name in parents:
+        node = node.setdefault(name, {})
+    node[key] = value
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # nothing may warn on the way to the error
+        with pytest.raises(ScenarioError) as raised:
+            parse_scenario(data)
+    assert raised.value.path == path, raised.value
+    return raised.value.message
+
+
+@pytest.mark.parametrize("q, norm", [([1e300, 1e300, 0, 0], "1.41421e+300"), ([1e200, 0, 0, 0], "1e+200"),
+                                     ([1.7e308] * 4, "beyond a float's range")])
+def test_a_quaternion_whose_norm_overflows_says_its_norm_and_the_unit_one(q, norm):
+    message = refused(DEMO, "maneuver.initial.q", q)
+    assert message.startswith(f"a quaternion must have unit norm (got norm {norm}) for "), message
+    assert "q / ‖q‖ = [" in message, message
+
+
+def test_an_initial_rate_error_beyond_any_body_rate_is_refused():
+    message = refused(DEMO, "simulation.initial_rate_error", [1e300, 0, 0])
+    assert message == "expected entries within ±1000, got [1e+300, 0.0, 0.0]", message
+
+
+@pytest.mark.parametrize("inertia, said", [
+    ([1e300, 1e300, 1e300], "expected entries within ±1e+12 kg m²"),
+    ([[1e13, 0, 0], [0, 1e13, 0], [0, 0, 1e13]], "expected entries within ±1e+12 kg m²"),
+    ([1e-250, 1e-250, 1e-250], "expected a least principal moment of at least 1e-09 kg m²"),
+    ([[1.0, 0, 0], [0, 1.0, 0.999999999999], [0, 0.999999999999, 1.0]], "got 1e-12 kg m²"),  # 1 - 0.999999999999
+])
+def test_an_inertia_beyond_any_spacecraft_is_refused_at_its_path(inertia, said):
+    assert said in refused(DEMO, "spacecraft.inertia", inertia)
+
+
+def test_the_truths_inertia_has_the_same_bounds():
+    assert "at least 1e-09 kg m²" in refused(TRUTH, "truth.spacecraft.inertia", [1e-250, 1e-250, 1e-250])
+
+
+def test_the_bounds_leave_real_spacecraft_alone():
+    for inertia in ([1e8, 1e8, 1.2e8], [2e-7, 3e-7, 4e-7]):  # the ISS's order; a chip-sat's
+        data = copy.deepcopy(DEMO)
+        data["spacecraft"]["inertia"] = inertia
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the torque bound warns on these; only acceptance is judged
+            parse_scenario(data)
