@@ -73,3 +73,34 @@ def test_the_bounds_leave_real_spacecraft_alone():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the torque bound warns on these; only acceptance is judged
             parse_scenario(data)
+
+
+def test_an_integer_beyond_pythons_digit_limit_names_its_path(tmp_path):
+    """5,000 digits: Python's int() refuses text beyond 4,300 digits, and the message said only 'a
+    value cannot be read: Exceeds the limit ... use sys.set_int_max_str_digits()'."""
+    from scenarios.schema.read import read_yaml as read
+    path = tmp_path / "big.yaml"
+    path.write_text("name: big\nmaneuver:\n  duration: " + "9" * 5000 + "\n")
+    with pytest.raises(ScenarioError) as raised:
+        read(path)
+    assert raised.value.path == "maneuver.duration" and raised.value.file == path, raised.value
+    assert "(5000 characters, line 3) is an integer beyond any number" in raised.value.message, raised.value
+    assert "set_int_max_str_digits" not in str(raised.value)
+
+
+def test_a_long_written_out_list_is_not_called_an_alias_bomb(tmp_path, monkeypatch):
+    from scenarios.schema import read as reader
+    from scenarios.schema.read import read_yaml as read
+    monkeypatch.setattr(reader, "MAX_NODES", 1000)  # the limit's logic at a size that parses fast
+    path = tmp_path / "long.yaml"
+    path.write_text("grid:\n  maneuver.duration: [" + ", ".join(["1"] * 1010) + "]\n")
+    with pytest.raises(ScenarioError) as raised:
+        read(path)
+    assert raised.value.file == path and raised.value.path.startswith("grid.maneuver.duration["), raised.value
+    assert "holds more than 1000 values" in raised.value.message and "alias" not in raised.value.message
+    bomb = tmp_path / "bomb.yaml"  # nine aliases of nine, three levels deep: 9**4 values from a few lines
+    bomb.write_text("a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+        f"{b}: &{b} [{', '.join([f'*{a}'] * 9)}]\n" for a, b in zip("abc", "bcd")))
+    with pytest.raises(ScenarioError) as raised:
+        read(bomb)
+    assert "alias bomb" in raised.value.message and raised.value.file == bomb, raised.value
