@@ -90,3 +90,59 @@ def test_gyro_and_estimator_values_that_overflow_are_errors_naming_path_and_valu
         parse_scenario(scenario(path, value))
     message = str(raised.value)
     assert message.startswith(path) and "1e+300" in message and ("<=" in message or "at most" in message), message
+
+
+NANO = read_yaml(ROOT / "scenarios" / "nano_detumble_noisy.yaml")  # a magnetic field, sensor_noise.magnetic_field 1e-5 T
+DEMO = read_yaml(ROOT / "scenarios" / "eigenaxis_demo.yaml")
+
+
+def said_on(base: dict, path: str, value) -> list[str]:
+    data = copy.deepcopy(base)
+    node = data
+    *parents, key = path.split(".")
+    for name in parents:
+        node = node.setdefault(name, {})
+    node[key] = value
+    return [str(warning) for warning in plausibility_warnings(parse_scenario(data))]
+
+
+def refused_on(base: dict, path: str, value) -> str:
+    data = copy.deepcopy(base)
+    node = data
+    *parents, key = path.split(".")
+    for name in parents:
+        node = node.setdefault(name, {})
+    node[key] = value
+    with pytest.raises(ScenarioError) as raised:
+        parse_scenario(data)
+    assert raised.value.path == path, raised.value
+    return raised.value.message
+
+
+def test_a_magnetometer_noise_beyond_the_field_warns_and_one_beyond_a_tesla_is_an_error_reading_it_in_nt():
+    """The Earth's field is at most 6.5e-5 T: 1e-3 T of noise warns; 5 (5 nT written as T) and 1e300
+    T (accepted: a 27 s B-dot run on noise alone) are errors, 5 nT being 5e-9 T."""
+    path = "simulation.sensor_noise.magnetic_field"
+    warned = said_on(NANO, path, 1e-3)
+    assert len(warned) == 1 and warned[0].startswith(f"{path}: 0.001 T is up to 0.001 T, above 0.0001 T"), warned
+    assert said_on(NANO, path, 5e-8) == []  # 50 nT
+    assert refused_on(NANO, path, 5).endswith("if it is in nT, write 5e-09"), refused_on(NANO, path, 5)
+    assert refused_on(NANO, path, 1e300).startswith("1e+300 T is beyond 1 T")
+    sensors = copy.deepcopy(NANO)
+    sensors["simulation"]["sensor_noise"]["magnetic_field"] = 0.0
+    for key, value, meant in (("noise_T", 7, "7e-09"), ("bias_T", [100, 0, 0], "[1e-07, 0.0, 0.0]")):
+        data = copy.deepcopy(sensors)
+        data["simulation"]["sensors"] = {"magnetometer": {key: value}}
+        with pytest.raises(ScenarioError) as raised:
+            parse_scenario(data)
+        assert raised.value.path == f"simulation.sensors.magnetometer.{key}", raised.value
+        assert raised.value.message.endswith(f"if it is in nT, write {meant}"), raised.value
+
+
+def test_an_attitude_noise_coarser_than_any_sensor_warns_and_one_beyond_half_a_turn_is_an_error():
+    path = "simulation.sensor_noise.attitude_deg"
+    warned = said_on(DEMO, path, 20)
+    assert len(warned) == 1 and warned[0].startswith(f"{path}: 20 deg is above 10 deg"), warned
+    assert said_on(DEMO, path, 2.0) == []  # a Sun sensor's
+    assert refused_on(DEMO, path, 1e300) == "expected a number <= 180, got 1e+300"
+

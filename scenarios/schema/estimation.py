@@ -50,6 +50,11 @@ MAX_GYRO_BIAS_DEG_PER_H = MAX_BODY_RATE / DEG_PER_H
 """Largest gyro bias per axis, and initial bias standard deviation of the estimator [deg/h] (2.1e8):
 ``MAX_BODY_RATE`` (1e3 rad/s), the largest body rate slewbench accepts (a bias of 1e300 deg/h made
 the knowledge error NaN, an initial sigma of 1e300 a traceback)."""
+MAX_MAGNETIC_NOISE_T = 1.0
+"""Largest magnetometer noise and bias per axis [T] (``sensor_noise.magnetic_field``,
+``sensors.magnetometer.noise_T`` and ``bias_T``): a tesla, 15,000 times the strongest field at the
+Earth's surface (6.5e-5 T); 1e300 T was accepted (a B-dot run of 27 s on noise alone). A noise above
+the field itself warns (:data:`~scenarios.schema.plausibility.MAX_MAGNETIC_NOISE_T`)."""
 BORESIGHT_AGREEMENT_DEG = 0.01
 """``simulation.sensors.star_tracker.boresight`` given beside ``spacecraft.sensors.star_tracker`` must be
 within this angle of it [deg] (the same direction, up to numbers written to four digits)."""
@@ -64,6 +69,48 @@ def _non_negative_vector(node: Node) -> np.ndarray:
 
 def _vector3(node: Node) -> np.ndarray:
     return node.vector(3)
+
+
+def _tesla_beyond(values: np.ndarray) -> str:
+    """Why a magnetometer value beyond :data:`MAX_MAGNETIC_NOISE_T` is refused, and the value it
+    would be in nT written as T, where that is a magnetometer's (at most 1e-4 T)."""
+    shown = f"{float(values):g}" if values.ndim == 0 else str(values.tolist())
+    meant = [float(f"{v * 1e-9:g}") for v in np.atleast_1d(values)]
+    guess = (f"; if it is in nT, write {meant[0] if values.ndim == 0 else meant}"
+             if np.max(np.abs(values)) * 1e-9 <= 1e-4 else "")
+    return (f"{shown} T is beyond {MAX_MAGNETIC_NOISE_T:g} T, 15,000 times the Earth's field (at most 6.5e-5 T; "
+            f"magnetometers' noise is nT){guess}")
+
+
+def magnetic_noise(node: Node) -> float:
+    """A magnetometer noise [T]: a non-negative number of at most :data:`MAX_MAGNETIC_NOISE_T`.
+
+    Parameters
+    ----------
+    node : Node
+        ``simulation.sensor_noise.magnetic_field`` or ``simulation.sensors.magnetometer.noise_T``.
+
+    Returns
+    -------
+    float
+        The noise [T].
+
+    Raises
+    ------
+    ScenarioError
+        Not a non-negative number, or beyond the bound (the message reads it in nT too).
+    """
+    value = node.number(non_negative=True)
+    if value > MAX_MAGNETIC_NOISE_T:
+        raise node.error(_tesla_beyond(np.asarray(value)))
+    return value
+
+
+def _magnetometer_bias(node: Node) -> np.ndarray:
+    values = node.vector(3)
+    if np.any(np.abs(values) > MAX_MAGNETIC_NOISE_T):
+        raise node.error(_tesla_beyond(values))
+    return values
 
 
 def _gyro_bias(node: Node) -> np.ndarray:
@@ -161,9 +208,10 @@ STAR_TRACKER = Section((
 ), "A star tracker; it replaces ``sensor_noise.attitude_deg``.")
 
 MAGNETOMETER = Section((
-    number("noise_T", "Standard deviation of the white noise per body axis.", unit="T", default=0.0,
-           non_negative=True),
-    custom("bias_T", "Constant bias, body axes.", "list of 3 numbers", _vector3, unit="T", default=[0.0, 0.0, 0.0]),
+    custom("noise_T", f"Standard deviation of the white noise per body axis (at most {MAX_MAGNETIC_NOISE_T:g}).",
+           "number", magnetic_noise, unit="T", default=0.0, bounds=f">= 0 and <= {MAX_MAGNETIC_NOISE_T:g}"),
+    custom("bias_T", f"Constant bias, body axes (each at most {MAX_MAGNETIC_NOISE_T:g}).", "list of 3 numbers",
+           _magnetometer_bias, unit="T", default=[0.0, 0.0, 0.0]),
 ), "A magnetometer; it replaces ``sensor_noise.magnetic_field``.")
 
 SENSORS = Section((

@@ -39,7 +39,8 @@ if TYPE_CHECKING:
     from scenarios.schema.loader import Scenario
 
 __all__ = ["LOWEST_ORBIT_KM", "MAX_ANGULAR_ACCELERATION", "MAX_RATE", "MAX_RATE_TOLERANCE",
-           "MAX_GYRO_ARW_DEG_PER_SQRT_H", "MAX_STAR_TRACKER_NOISE_ARCSEC", "MAX_STAR_TRACKER_RATE_HZ",
+           "MAX_ATTITUDE_NOISE_DEG", "MAX_GYRO_ARW_DEG_PER_SQRT_H", "MAX_MAGNETIC_NOISE_T",
+           "MAX_STAR_TRACKER_NOISE_ARCSEC", "MAX_STAR_TRACKER_RATE_HZ",
            "MIN_BRIGHT_BODY_CONE_DEG", "MIN_STAR_TRACKER_NOISE_ARCSEC", "MOON_DISTANCE_KM", "PLAUSIBILITY_CHECKS", "SLOW_SLEW_FACTOR", "Implausible", "plausibility_warnings",
            "warn_implausible"]
 
@@ -101,6 +102,17 @@ their detector for tens to hundreds of milliseconds per frame and update at 1 to
 above the controller's sample rate (``1 / simulation.sample_time``) warns too: the simulation gives
 at most one update per sample, so it acts as ``null`` (every sample). Beyond 1e7 Hz the schema
 refuses it (:data:`~scenarios.schema.estimation.STAR_TRACKER_RATE_LIMIT_HZ`)."""
+MAX_ATTITUDE_NOISE_DEG = 10.0
+"""Attitude measurement noise [deg, 1 sigma] (``simulation.sensor_noise.attitude_deg``) above which no
+attitude sensor is that coarse: Sun sensors and magnetometer-based attitude give 0.5 to 5 deg, star
+trackers arcseconds. Beyond 180 deg the schema refuses it."""
+MAX_MAGNETIC_NOISE_T = 1.0e-4
+"""Magnetometer noise or bias [T] (``simulation.sensor_noise.magnetic_field``,
+``simulation.sensors.magnetometer.noise_T`` and the largest entry of ``bias_T``) above which the
+error exceeds the field it measures: the Earth's is at most 6.5e-5 T at its surface and 1e-5 to
+5e-5 T in low orbit; magnetometers' noise is nT (1e-9 T). A value in nT written as T (1e9 too
+large) is mostly beyond 1 T, an error of the schema that says so
+(:data:`~scenarios.schema.estimation.MAX_MAGNETIC_NOISE_T`)."""
 MAX_GYRO_ARW_DEG_PER_SQRT_H = math.degrees(MAX_RATE_TOLERANCE) * 60.0
 """Gyro angle random walk [deg/√h] (344) at or above which the gyro's white rate noise over one
 second has a standard deviation of :data:`MAX_RATE_TOLERANCE` (0.1 rad/s, 5.7 deg/s), as large as
@@ -489,6 +501,34 @@ def _gyro_noise(scenario: Scenario) -> Iterator[Implausible]:
                       "(navigation) to a few (MEMS) deg/√h")
 
 
+def _attitude_noise(scenario: Scenario) -> Iterator[Implausible]:
+    """An attitude measurement noise (``simulation.sensor_noise.attitude_deg``) above
+    :data:`MAX_ATTITUDE_NOISE_DEG`."""
+    noise = _number(_mapping(scenario.data or {}, "simulation", "sensor_noise").get("attitude_deg"))
+    if noise is None or not noise > MAX_ATTITUDE_NOISE_DEG:
+        return
+    yield Implausible("simulation.sensor_noise.attitude_deg", f"{noise:g} deg",
+                      f"is above {MAX_ATTITUDE_NOISE_DEG:g} deg (1 sigma per axis), coarser than any attitude sensor: "
+                      "plausible: arcseconds (a star tracker) to a few degrees (Sun sensors, magnetometers)")
+
+
+def _magnetic_noise(scenario: Scenario) -> Iterator[Implausible]:
+    """A magnetometer noise or bias above :data:`MAX_MAGNETIC_NOISE_T` (nT written as T)."""
+    data = scenario.data or {}
+    magnetometer = _mapping(data, "simulation", "sensors", "magnetometer")
+    given = [("simulation.sensor_noise.magnetic_field", _mapping(data, "simulation", "sensor_noise").get("magnetic_field")),
+             ("simulation.sensors.magnetometer.noise_T", magnetometer.get("noise_T")),
+             ("simulation.sensors.magnetometer.bias_T", magnetometer.get("bias_T"))]
+    for path, written in given:
+        values = _numbers(written)
+        if values is None or not max(abs(v) for v in values) > MAX_MAGNETIC_NOISE_T:
+            continue
+        largest = max(abs(v) for v in values)
+        yield Implausible(path, f"{written} T",
+                          f"is up to {largest:g} T, above {MAX_MAGNETIC_NOISE_T:g} T, more than the Earth's field it "
+                          "measures (at most 6.5e-5 T); plausible: a few nT (1e-9 T) to a few hundred nT")
+
+
 BRIGHT_BODIES = {"sun": "Sun", "moon": "Moon"}
 """The keep-out targets (``keep_out``, ``exclusion_deg`` keys) :func:`_bright_body_cones` judges, and their names."""
 
@@ -532,6 +572,8 @@ PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "star_tracker_coarse": _star_tracker_coarse,
     "star_tracker_rate": _star_tracker_rate,
     "gyro_noise": _gyro_noise,
+    "attitude_noise": _attitude_noise,
+    "magnetic_noise": _magnetic_noise,
     "bright_body_cones": _bright_body_cones,
 }
 """Name -> check: each yields the :class:`Implausible` values of a validated scenario."""
