@@ -90,3 +90,16 @@ def test_a_table_without_a_fit_says_no_fit_once_with_its_reason():
     fit, note = fit_entries(three)
     assert fit is None and no_fit_line(note).count("no fit") == 1, note
     assert no_fit_line(note).startswith("no fit over the sphere: 3 axes"), no_fit_line(note)
+
+
+def test_a_huge_axis_is_its_direction(tmp_path):
+    """[1e300, 1e300, 0]: its norm overflowed (NumPy's RuntimeWarning), the axis came out zero and the
+    table refused 'maneuver.final.q: a quaternion must have unit norm', a quaternion no one wrote."""
+    import warnings
+
+    from scenarios.slewtable.spec import parse_table_spec
+    file = table_file(tmp_path, {"axes": [[1e300, 1e300, 0], [0, 0, 2]], "angles_deg": [30, 90]})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        spec = parse_table_spec(file)
+    np.testing.assert_allclose(spec.axes, [[0.5 ** 0.5, 0.5 ** 0.5, 0.0], [0.0, 0.0, 1.0]], rtol=1e-15)

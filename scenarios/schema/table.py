@@ -206,10 +206,11 @@ def _axes(node: Node) -> int | np.ndarray:
         if not isinstance(item, (list, tuple)) or len(item) != 3:
             raise ScenarioError(f"{where}[{i}]", f"expected 3 numbers (a body axis), got {item!r}")
         vector = np.array([_number(v, f"{where}[{i}]", "3 numbers (a body axis)") for v in item])
-        size = float(np.linalg.norm(vector))
-        if size == 0.0:
+        largest = float(np.max(np.abs(vector)))
+        if largest == 0.0:
             raise ScenarioError(f"{where}[{i}]", "a zero vector has no direction")
-        unit = vector / size
+        direction = vector / largest  # its norm cannot overflow ([1e300, 1e300, 0]: inf, then a zero axis and
+        unit = direction / float(np.linalg.norm(direction))  # an error about a quaternion no one wrote)
         for j, other in enumerate(axes):
             if np.linalg.norm(unit - other) <= 1e-9:
                 raise ScenarioError(f"{where}[{i}]", f"repeats the direction of {where}[{j}] ({value[j]!r}): "
