@@ -104,3 +104,24 @@ def test_a_long_written_out_list_is_not_called_an_alias_bomb(tmp_path, monkeypat
     with pytest.raises(ScenarioError) as raised:
         read(bomb)
     assert "alias bomb" in raised.value.message and raised.value.file == bomb, raised.value
+
+
+@pytest.mark.parametrize("form, path", [
+    ({"axis_angle": {"axis": [0, 0, 1], "angle_deg": 1e300}}, "maneuver.final.q.axis_angle.angle_deg"),
+    ({"euler": {"angles_deg": [1e300, 0, 0], "sequence": "321"}}, "maneuver.final.q.euler.angles_deg"),
+])
+def test_an_attitude_angle_beyond_a_turn_is_refused(form, path):
+    """1e300 deg was accepted: cos and sin of it are rounding noise, an attitude no one wrote (the
+    plausibility checks say the schema bounds every angle)."""
+    data = copy.deepcopy(DEMO)
+    data["maneuver"]["final"]["q"] = form
+    with pytest.raises(ScenarioError) as raised:
+        parse_scenario(data)
+    assert raised.value.path == path and "360" in raised.value.message and "1e+300" in raised.value.message
+
+
+def test_an_attitude_angle_of_a_turn_or_less_is_kept():
+    for angle in (-360.0, 270.0):
+        data = copy.deepcopy(DEMO)
+        data["maneuver"]["final"]["q"] = {"axis_angle": {"axis": [0, 0, 1], "angle_deg": angle}}
+        parse_scenario(data)
