@@ -125,3 +125,10 @@ def test_an_attitude_angle_of_a_turn_or_less_is_kept():
         data = copy.deepcopy(DEMO)
         data["maneuver"]["final"]["q"] = {"axis_angle": {"axis": [0, 0, 1], "angle_deg": angle}}
         parse_scenario(data)
+
+
+def test_a_disturbance_torque_beyond_any_spacecrafts_is_refused():
+    """1e300 N m was valid without a warning (its norm inf, read as unlimited) and NumPy's overflow
+    warnings were printed."""
+    assert refused(DEMO, "environment.disturbance_torque", [1e300, 0, 0]) == \
+        "expected entries within ±1e+06, got [1e+300, 0.0, 0.0]"

@@ -44,7 +44,8 @@ from scenarios.schema.keys import (
 from scenarios.schema.node import Node
 from scenarios.schema.requirements import SENSOR, parse_sensors
 
-__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "MAX_INERTIA", "MIN_INERTIA", "ORBIT", "SPACECRAFT", "TORQUERS", "WHEELS",
+__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "MAX_DISTURBANCE", "MAX_INERTIA",
+           "MIN_INERTIA", "ORBIT", "SPACECRAFT", "TORQUERS", "WHEELS",
            "parse_environment", "parse_magnetic_field", "parse_orbit", "parse_spacecraft"]
 
 
@@ -67,6 +68,12 @@ MAX_INERTIA = 1.0e12
 times the International Space Station's (about 1e8 kg m²). Far beyond it the planners' arithmetic
 overflows (1e300 printed NumPy's overflow warning and a bound of 150 digits); an inertia merely too
 large for its torque (g mm² written as kg m², 1e9 too large) warns (``slew_time``)."""
+MAX_DISTURBANCE = 1.0e6
+"""Largest entry [N m] of ``environment.disturbance_torque``: a million times the largest disturbance
+torques on any spacecraft (the ISS's gravity-gradient and aerodynamic torques, of the order of N m;
+small satellites' are µN m to mN m). 1e300 N m was accepted without a warning (its norm overflowed
+to inf, which the plausibility check reads as unlimited) and printed NumPy's overflow warnings; a
+torque merely larger than the actuators give against it warns (``disturbance``)."""
 MIN_INERTIA = 1.0e-9
 """Least principal moment [kg m²] of ``spacecraft.inertia`` (and ``truth.spacecraft.inertia``): a
 gram at a millimetre, a hundred times below the smallest spacecraft flown (chip-sats of a few grams
@@ -156,7 +163,8 @@ ENVIRONMENT = Section((
     custom("magnetic_field", "The geomagnetic field: a model name (its default options), ``none``, or "
            "``{model: <name>, <option>: <value>, ...}``; needs ``orbit``.", "text, mapping or null", None,
            default=None, section=MAGNETIC_FIELD, choices=MAGNETIC_FIELDS),
-    vector("disturbance_torque", "Constant disturbance torque, body frame.", 3, unit="N m", default=[0.0, 0.0, 0.0]),
+    vector("disturbance_torque", f"Constant disturbance torque, body frame (each entry within ±{MAX_DISTURBANCE:g}).", 3,
+           unit="N m", default=[0.0, 0.0, 0.0], magnitude=MAX_DISTURBANCE),
 ), "What acts on the spacecraft besides its actuators (absent or ``null``: nothing).")
 
 
