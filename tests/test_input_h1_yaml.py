@@ -132,3 +132,14 @@ def test_a_disturbance_torque_beyond_any_spacecrafts_is_refused():
     warnings were printed."""
     assert refused(DEMO, "environment.disturbance_torque", [1e300, 0, 0]) == \
         "expected entries within ±1e+06, got [1e+300, 0.0, 0.0]"
+
+
+def test_a_yaml_boolean_where_a_number_is_expected_says_where_it_came_from():
+    """``duration: yes`` read as True: the message said 'got True' of a file that says yes."""
+    data = copy.deepcopy(DEMO)
+    data["maneuver"]["duration"] = yaml_boolean = True  # what YAML makes of an unquoted yes
+    with pytest.raises(ScenarioError) as raised:
+        parse_scenario(data)
+    assert raised.value.path == "maneuver.duration" and yaml_boolean
+    assert raised.value.message == ("expected a number, got True (a YAML boolean: unquoted yes, no, on, off, true and "
+                                    "false are read as one)"), raised.value

@@ -76,6 +76,11 @@ def _is_finite(value: int | float) -> bool:
         return False
 
 
+_YAML_BOOLEAN = " (a YAML boolean: unquoted yes, no, on, off, true and false are read as one)"
+"""Said of a boolean where a number is expected: ``duration: yes`` reads as ``True``, which the
+message showed without saying where it came from."""
+
+
 def _why_not_finite(value: Any) -> str:
     """Why a number is refused as one (NaN, an infinity, an integer beyond a float), else nothing."""
     if not _is_number(value) or _is_finite(value):
@@ -280,7 +285,8 @@ class Node:
             Not a finite number, or outside the bounds.
         """
         if not _is_number(self.value) or not _is_finite(self.value):
-            raise self.error(f"expected a number, got {excerpt(self.value)}{_why_not_finite(self.value)}")
+            raise self.error(f"expected a number, got {excerpt(self.value)}{_why_not_finite(self.value)}"
+                             + (_YAML_BOOLEAN if isinstance(self.value, bool) else ""))
         if positive and not self.value > 0:
             raise self.error(f"expected a positive number, got {excerpt(self.value)}")
         if non_negative and self.value < 0:
