@@ -41,8 +41,7 @@ def test_a_scenario_error_names_the_file_and_the_yaml_path(command, tmp_path, ca
     path.write_text(BAD)
     status, err = _cli(command, path, tmp_path, capsys)
     assert status == 2, err
-    kind = "table file" if command == "table" else "scenario"
-    assert err == f"slewbench: error in {kind}: {path}: name: required key is missing\n", err
+    assert err == f"slewbench: error in scenario: {path}: name: required key is missing\n", err  # table too: a scenario
     assert not (tmp_path / "out").exists()
 
 

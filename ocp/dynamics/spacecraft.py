@@ -20,6 +20,7 @@ from ocp.dynamics.actuator_kinds import (
     Torquers,
 )
 from ocp.errors import ModelError
+from ocp.options import is_real
 
 __all__ = ["Spacecraft"]
 
@@ -59,7 +60,8 @@ class Spacecraft:
     ------
     ModelError
         For an unknown actuator kind, an actuator of the wrong type or an inertia that is not a
-        valid rigid body's.
+        valid rigid body's, or not real numbers (booleans, complex numbers, text and dates are
+        refused, not converted). :class:`~ocp.errors.ModelError` is a ``ValueError``.
     """
 
     inertia: Array
@@ -84,13 +86,7 @@ class Spacecraft:
         self.__post_init__()
 
     def __post_init__(self) -> None:
-        try:
-            if np.asarray(self.inertia).dtype.kind in "US":  # text, though NumPy reads "1" as a number
-                raise TypeError("inertia")
-            inertia = np.array(self.inertia, dtype=float)  # a private copy: the caller's array is not kept
-        except (TypeError, ValueError):
-            raise ModelError("inertia", f"expected 3 principal moments or a 3x3 matrix of numbers, "
-                                        f"got {self.inertia!r}") from None
+        inertia = _real_array(self.inertia)  # a private copy: the caller's array is not kept
         if inertia.shape == (3,):
             inertia = np.diag(inertia)
         if inertia.shape != (3, 3):
@@ -334,6 +330,36 @@ class Spacecraft:
         demand[demand <= 1e-12 * np.linalg.norm(matrix, axis=1)] = 0.0  # rounding of exact zeros
         used = demand > 0
         return float(np.min(bound[used] / demand[used], initial=np.inf))
+
+
+_REAL_KINDS = "iuf"
+"""NumPy dtype kinds of real numbers (signed and unsigned integers, floats); booleans (``b``), complex
+numbers (``c``), text (``U``, ``S``), dates and durations (``M``, ``m``) are refused, and an object
+array is judged entry by entry."""
+_KIND_NAMES = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "bytes", "M": "dates",
+               "m": "durations", "V": "raw records"}
+
+
+def _real_array(value: Any) -> Array:
+    """``value`` (the inertia as given) as a new float array, or a :class:`~ocp.errors.ModelError`
+    naming it when it holds anything but real numbers: NumPy would read ``True`` as 1, ``"2"`` in
+    an object array as 2, and ``1+0j`` as 1 with only a ``ComplexWarning``."""
+    expected = "expected 3 principal moments or a 3x3 matrix of numbers"  # real ones, in kg m^2
+    try:
+        array = value if isinstance(value, np.ndarray) else np.array(value, dtype=object)
+    except (TypeError, ValueError):  # a ragged nesting
+        raise ModelError("inertia", f"{expected}, got {value!r:.200}") from None
+    if array.dtype.kind == "O":
+        if array.size == 0:
+            raise ModelError("inertia", f"{expected}, got {value!r:.200}: no numbers")
+        odd = [item for item in array.ravel().tolist() if not is_real(item)]
+        if odd:
+            raise ModelError("inertia", f"{expected}, got {value!r:.200}: {odd[0]!r:.60} ({type(odd[0]).__name__}) "
+                                        "is no real number (moments of inertia are real, in kg m^2)")
+    elif array.dtype.kind not in _REAL_KINDS:
+        raise ModelError("inertia", f"{expected}, got {value!r:.200}: an array of "
+                                    f"{_KIND_NAMES.get(array.dtype.kind, array.dtype.name)} (dtype {array.dtype})")
+    return np.array(array, dtype=float)
 
 
 def _significant(matrix: Array) -> NDArray[np.bool_]:

@@ -33,6 +33,7 @@ from scenarios.cli.status import (
 )
 
 if TYPE_CHECKING:
+    from scenarios.errors import ScenarioError
     from scenarios.slewtable.spec import TableSpec
 
 
@@ -135,6 +136,27 @@ def _work(spec: TableSpec, entries: int) -> str:
             + f" = {entries} entries")
 
 
+def _file_kind(file: str, error: ScenarioError) -> tuple[str, ScenarioError]:
+    """What ``slewbench table``'s file is, for :func:`~scenarios.cli.commands.main`'s ``error in
+    <kind>:`` of ``error``: ``table file`` (top-level ``table``), ``study file`` (``study``,
+    refused) or ``scenario``; the file itself where it cannot be read as a mapping (a duplicate
+    key), as ``validate`` names it; a ``table file`` where there is no file (``table file not
+    found``). Returns the kind and the error to raise."""
+    from scenarios.cli.commands import _named_once
+    from scenarios.errors import ScenarioError
+    from scenarios.schema.loader import OTHER_FILES
+    from scenarios.schema.read import read_yaml
+    if not Path(file).is_file():  # not found, or a directory: a table file in the command's terms
+        return "table file", error
+    try:
+        data = read_yaml(file)
+    except ScenarioError as unread:  # a duplicate key, a syntax error, no permission: named by the file, as
+        return file, _named_once(unread, file)  # validate names it (its kind is not known)
+    if not isinstance(data, dict):
+        return file, error
+    return next((f"{key} file" for key in OTHER_FILES if key in data), "scenario"), error
+
+
 def command_table(args: argparse.Namespace) -> int:
     """Compute the table of ``args.file`` into ``args.out`` and print its fit's quality.
 
@@ -160,7 +182,7 @@ def command_table(args: argparse.Namespace) -> int:
     OutputError
         An output directory slewbench must not write to (exit 2; nothing written).
     """
-    from scenarios.errors import SweepInterrupted
+    from scenarios.errors import ScenarioError, SweepInterrupted
     from scenarios.output.directory import new_staging
     from scenarios.output.names import default_output_directory
     from scenarios.schema.table import TABLE_FLAGS
@@ -178,7 +200,11 @@ def command_table(args: argparse.Namespace) -> int:
         start_forkserver()
     # every flag of the table's keys (the key's reader checks its value, naming the flag)
     overrides = {flag[2:]: getattr(args, flag[2:].replace("-", "_")) for flag in TABLE_FLAGS.values()}
-    spec = parse_table_spec(args.file, overrides)
+    try:
+        spec = parse_table_spec(args.file, overrides)
+    except ScenarioError as error:
+        args.file_kind, named = _file_kind(args.file, error)  # how main() names it: the file's kind, not "table file"
+        raise named from None
     if not args.no_plots:
         import matplotlib  # noqa: F401  (fail now, not after the entries ran)
     out = Path(args.out) if args.out else default_output_directory(f"table-{spec.name}")
@@ -239,7 +265,7 @@ def command_table(args: argparse.Namespace) -> int:
               f"({refinement['stopped']}); {refinement['axes']} axes in the fit, {refinement['check_points']} check "
               "points outside it")
     if table.fit is None:
-        print(f"no fit: {table.fit_note}")
+        print(no_fit_line(table.fit_note))
     else:
         quality = table.fit_quality
         lines = quality_lines(quality)
@@ -267,6 +293,32 @@ def command_table(args: argparse.Namespace) -> int:
     if crashed or timed_out:
         return EXIT_CRASHED
     return EXIT_NOT_OK if args.strict and not_ok else EXIT_OK
+
+
+def no_fit_line(note: str) -> str:
+    """The line that says why a table has no fit, from its ``fit_note``: the reason once.
+
+    The note lists the entries not ok before the reason (``N entries not ok (...): the fit gives
+    NaN in the cells around them ...; no fit: no entry is ok``): with no fit, the entry counts
+    line says those, and the cells the note speaks of are not there. ``slewbench table`` printed
+    ``no fit: <note>``, so "no fit" two or three times and a fit's cells that do not exist.
+
+    Parameters
+    ----------
+    note : str
+        :attr:`~scenarios.slewtable.compute.SlewTable.fit_note` of a table without a fit.
+
+    Returns
+    -------
+    str
+        ``no fit: <reason>`` (``no fit over the sphere: <reason>`` where that is the reason).
+    """
+    start = note.find("no fit")
+    if start < 0:  # a reason of its own (a min_energy table is not fitted)
+        return f"no fit: {note}"
+    reason = note[start:]
+    head, rest = reason[:len("no fit")], reason[len("no fit"):]
+    return head + rest.replace(": no fit over the sphere", ", so none over the sphere").replace("no fit: ", "")
 
 
 def refinement_verdict(refinement: dict[str, Any], quality: dict[str, Any]) -> str:

@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike
 
 from ocp.estimation import Exclusion, Gyro, Magnetometer, Mekf, SensorSuite, StarTracker
 from ocp.geometry.directions import DIRECTIONS, Geometry
+from planners.problem import MAX_BODY_RATE
 from scenarios.errors import ScenarioError
 from scenarios.schema.keys import Section, choice, custom, mapping, number
 from scenarios.schema.node import Node
@@ -26,6 +27,34 @@ ARCSEC = math.pi / 180.0 / 3600.0
 """One arcsecond in rad."""
 SQRT_HOUR = 60.0
 """√(1 h) in √s."""
+STAR_TRACKER_NOISE_LIMIT_ARCSEC = 648_000.0
+"""Largest star-tracker noise [arcsec, 1 sigma] per axis: 180 deg, half a turn. A rotation-vector
+error whose standard deviation exceeds a half turn is no attitude measurement at all (the rotation
+vector wraps at pi rad), and from about 1e83 arcsec the estimator's covariance overflows (its
+knowledge error came out NaN). Plausible values, a thousand times below, warn from
+:data:`~scenarios.schema.plausibility.MAX_STAR_TRACKER_NOISE_ARCSEC`."""
+STAR_TRACKER_RATE_LIMIT_HZ = 1.0e7
+"""Largest star-tracker update rate [Hz]. The updates fall where the count ``floor(t rate)`` advances,
+and over the longest run slewbench allows (``MAX_DURATION_S``, 1e8 s) ``t rate`` then stays below
+2**53, where a float counts every integer; far beyond it the count overflows (from 1.8e308 / t Hz)
+and the tracker silently stops updating. Real trackers update at 1 to 30 Hz; rates above the
+controller's sample rate or a kHz warn (:mod:`scenarios.schema.plausibility`)."""
+MAX_GYRO_ARW_DEG_PER_SQRT_H = math.degrees(MAX_BODY_RATE) * SQRT_HOUR
+"""Largest gyro angle random walk [deg/√h] (3.4e6): a white rate noise whose one-second standard
+deviation is ``MAX_BODY_RATE`` (1e3 rad/s, the largest body rate slewbench accepts) measures no rate;
+from about 1e150 the estimator's process noise overflowed (a traceback)."""
+MAX_GYRO_RRW_DEG_PER_H_PER_SQRT_H = MAX_BODY_RATE / DEG_PER_H * SQRT_HOUR
+"""Largest gyro rate random walk [deg/h/√h] (1.2e13): a bias whose one-second drift has the standard
+deviation ``MAX_BODY_RATE`` (1e3 rad/s); beyond it the estimator's process noise overflows likewise."""
+MAX_GYRO_BIAS_DEG_PER_H = MAX_BODY_RATE / DEG_PER_H
+"""Largest gyro bias per axis, and initial bias standard deviation of the estimator [deg/h] (2.1e8):
+``MAX_BODY_RATE`` (1e3 rad/s), the largest body rate slewbench accepts (a bias of 1e300 deg/h made
+the knowledge error NaN, an initial sigma of 1e300 a traceback)."""
+MAX_MAGNETIC_NOISE_T = 1.0
+"""Largest magnetometer noise and bias per axis [T] (``sensor_noise.magnetic_field``,
+``sensors.magnetometer.noise_T`` and ``bias_T``): a tesla, 15,000 times the strongest field at the
+Earth's surface (6.5e-5 T); 1e300 T was accepted (a B-dot run of 27 s on noise alone). A noise above
+the field itself warns (:data:`~scenarios.schema.plausibility.MAX_MAGNETIC_NOISE_T`)."""
 BORESIGHT_AGREEMENT_DEG = 0.01
 """``simulation.sensors.star_tracker.boresight`` given beside ``spacecraft.sensors.star_tracker`` must be
 within this angle of it [deg] (the same direction, up to numbers written to four digits)."""
@@ -40,6 +69,65 @@ def _non_negative_vector(node: Node) -> np.ndarray:
 
 def _vector3(node: Node) -> np.ndarray:
     return node.vector(3)
+
+
+def _tesla_beyond(values: np.ndarray) -> str:
+    """Why a magnetometer value beyond :data:`MAX_MAGNETIC_NOISE_T` is refused, and the value it
+    would be in nT written as T, where that is a magnetometer's (at most 1e-4 T)."""
+    shown = f"{float(values):g}" if values.ndim == 0 else str(values.tolist())
+    meant = [float(f"{v * 1e-9:g}") for v in np.atleast_1d(values)]
+    guess = (f"; if it is in nT, write {meant[0] if values.ndim == 0 else meant}"
+             if np.max(np.abs(values)) * 1e-9 <= 1e-4 else "")
+    return (f"{shown} T is beyond {MAX_MAGNETIC_NOISE_T:g} T, 15,000 times the Earth's field (at most 6.5e-5 T; "
+            f"magnetometers' noise is nT){guess}")
+
+
+def magnetic_noise(node: Node) -> float:
+    """A magnetometer noise [T]: a non-negative number of at most :data:`MAX_MAGNETIC_NOISE_T`.
+
+    Parameters
+    ----------
+    node : Node
+        ``simulation.sensor_noise.magnetic_field`` or ``simulation.sensors.magnetometer.noise_T``.
+
+    Returns
+    -------
+    float
+        The noise [T].
+
+    Raises
+    ------
+    ScenarioError
+        Not a non-negative number, or beyond the bound (the message reads it in nT too).
+    """
+    value = node.number(non_negative=True)
+    if value > MAX_MAGNETIC_NOISE_T:
+        raise node.error(_tesla_beyond(np.asarray(value)))
+    return value
+
+
+def _magnetometer_bias(node: Node) -> np.ndarray:
+    values = node.vector(3)
+    if np.any(np.abs(values) > MAX_MAGNETIC_NOISE_T):
+        raise node.error(_tesla_beyond(values))
+    return values
+
+
+def _gyro_bias(node: Node) -> np.ndarray:
+    values = node.vector(3)
+    if np.any(np.abs(values) > MAX_GYRO_BIAS_DEG_PER_H):
+        raise node.error(f"expected 3 numbers of magnitude at most {MAX_GYRO_BIAS_DEG_PER_H:.4g} deg/h (1e3 rad/s, the "
+                         f"largest body rate slewbench accepts; gyro biases are below 1,000 deg/h), got {values.tolist()}")
+    return values
+
+
+def _star_tracker_noise(node: Node) -> np.ndarray:
+    values = _non_negative_vector(node)
+    if np.any(values > STAR_TRACKER_NOISE_LIMIT_ARCSEC):
+        raise node.error(f"expected 3 non-negative numbers of at most {STAR_TRACKER_NOISE_LIMIT_ARCSEC:,.0f} arcsec (180 deg: "
+                         f"a noise beyond half a turn measures no attitude; star trackers give 0.1 to 100 arcsec), "
+                         f"got {values.tolist()}")
+    return values
 
 
 def _boresight(node: Node) -> np.ndarray | None:
@@ -62,12 +150,14 @@ def _outages(node: Node) -> tuple[tuple[float, float], ...]:
 
 
 GYRO = Section((
-    number("arw_deg_per_sqrt_h", "Angle random walk ``σ_v``: the white rate noise density.", unit="deg/√h",
-           default=0.0, non_negative=True),
-    number("rrw_deg_per_h_per_sqrt_h", "Rate random walk ``σ_u``: the density of the bias's white derivative.",
-           unit="deg/h/√h", default=0.0, non_negative=True),
-    custom("bias_deg_per_h", "The bias at t = 0, body axes.", "list of 3 numbers", _vector3, unit="deg/h",
-           default=[0.0, 0.0, 0.0]),
+    number("arw_deg_per_sqrt_h", "Angle random walk ``σ_v``: the white rate noise density (at most "
+           f"{MAX_GYRO_ARW_DEG_PER_SQRT_H:.4g}: a one-second noise of 1e3 rad/s).", unit="deg/√h",
+           default=0.0, non_negative=True, maximum=MAX_GYRO_ARW_DEG_PER_SQRT_H),
+    number("rrw_deg_per_h_per_sqrt_h", "Rate random walk ``σ_u``: the density of the bias's white derivative "
+           f"(at most {MAX_GYRO_RRW_DEG_PER_H_PER_SQRT_H:.4g}: a one-second drift of 1e3 rad/s).",
+           unit="deg/h/√h", default=0.0, non_negative=True, maximum=MAX_GYRO_RRW_DEG_PER_H_PER_SQRT_H),
+    custom("bias_deg_per_h", f"The bias at t = 0, body axes (each at most {MAX_GYRO_BIAS_DEG_PER_H:.4g}: 1e3 rad/s).",
+           "list of 3 numbers", _gyro_bias, unit="deg/h", default=[0.0, 0.0, 0.0]),
 ), "A rate gyro (Farrenkopf's model: angle and rate random walk, bias); it replaces ``sensor_noise.rate``.")
 
 BRIGHT_BODIES = ("sun", "moon", "earth_limb")
@@ -99,9 +189,10 @@ def _exclusions(node: Node) -> dict[str, Any]:
 STAR_TRACKER = Section((
     custom("noise_arcsec", "Standard deviation of the attitude error about the sensor's x, y (cross-boresight) "
            "and z (boresight) axes; with an estimator, a zero needs some gyro noise (a filter certain of an axis "
-           "divides by zero at its next update).", "list of 3 numbers", _non_negative_vector, unit="arcsec"),
-    number("rate_hz", "Updates per second; ``null``: every sample.", unit="Hz", default=None, positive=True,
-           nullable=True),
+           "divides by zero at its next update); each at most 648,000 (180 deg).", "list of 3 numbers",
+           _star_tracker_noise, unit="arcsec"),
+    number("rate_hz", f"Updates per second (at most {STAR_TRACKER_RATE_LIMIT_HZ:g}; one a sample at most); ``null``: every "
+           "sample.", unit="Hz", default=None, positive=True, nullable=True, maximum=STAR_TRACKER_RATE_LIMIT_HZ),
     custom("outages_s", "Windows ``[t0, t1]`` without updates.", "list of [t0, t1]", _outages, unit="s", default=[]),
     custom("boresight", "The sensor's z axis in body axes (its x and y: the body's, turned by the shortest "
            "rotation taking body z there). Absent or ``null``: the boresight of ``spacecraft.sensors.star_tracker`` "
@@ -117,9 +208,10 @@ STAR_TRACKER = Section((
 ), "A star tracker; it replaces ``sensor_noise.attitude_deg``.")
 
 MAGNETOMETER = Section((
-    number("noise_T", "Standard deviation of the white noise per body axis.", unit="T", default=0.0,
-           non_negative=True),
-    custom("bias_T", "Constant bias, body axes.", "list of 3 numbers", _vector3, unit="T", default=[0.0, 0.0, 0.0]),
+    custom("noise_T", f"Standard deviation of the white noise per body axis (at most {MAX_MAGNETIC_NOISE_T:g}).",
+           "number", magnetic_noise, unit="T", default=0.0, bounds=f">= 0 and <= {MAX_MAGNETIC_NOISE_T:g}"),
+    custom("bias_T", f"Constant bias, body axes (each at most {MAX_MAGNETIC_NOISE_T:g}).", "list of 3 numbers",
+           _magnetometer_bias, unit="T", default=[0.0, 0.0, 0.0]),
 ), "A magnetometer; it replaces ``sensor_noise.magnetic_field``.")
 
 SENSORS = Section((
@@ -136,7 +228,8 @@ ESTIMATOR = Section((
     number("initial_attitude_sigma_deg", "Initial attitude standard deviation per axis (the estimate starts "
            "off by a draw from it).", unit="deg", positive=True, maximum=180.0),
     number("initial_bias_sigma_deg_per_h", "Initial gyro-bias standard deviation per axis (the estimate starts "
-           "at zero).", unit="deg/h", positive=True),
+           f"at zero; at most {MAX_GYRO_BIAS_DEG_PER_H:.4g}: 1e3 rad/s).", unit="deg/h", positive=True,
+           maximum=MAX_GYRO_BIAS_DEG_PER_H),
 ), "The attitude estimator in the loop: the controller gets its attitude and the gyro's rate less its bias "
    "estimate. It needs ``sensors.gyro`` and ``sensors.star_tracker``.")
 

@@ -44,7 +44,13 @@ from scenarios.schema.checks import (
     check_row_labels,
     check_work,
 )
-from scenarios.schema.estimation import ESTIMATOR, SENSORS, parse_sensor_suite
+from scenarios.schema.estimation import (
+    ESTIMATOR,
+    MAX_MAGNETIC_NOISE_T,
+    SENSORS,
+    magnetic_noise,
+    parse_sensor_suite,
+)
 from scenarios.schema.keys import (
     Described,
     Section,
@@ -406,14 +412,15 @@ CONTROLLER = Section((
 ), "A tracking or regulating controller and its options.")
 
 SENSOR_NOISE = Section((
-    number("attitude_deg", "Standard deviation of the attitude measurement error per axis.", unit="deg",
-           default=0.0, non_negative=True),
+    number("attitude_deg", "Standard deviation of the attitude measurement error per axis (at most 180: a noise "
+           "beyond half a turn measures no attitude).", unit="deg", default=0.0, non_negative=True, maximum=180.0),
     number("rate", "Standard deviation of the rate measurement error per axis.", unit="rad/s", default=0.0,
            non_negative=True),
     integer("seed", "Seed of the noise (the magnetometer's on a stream of its own).", default=0, minimum=0,
             maximum=2**63 - 1),
-    number("magnetic_field", "Standard deviation of the magnetometer error per body axis, white per sample.",
-           unit="T", default=0.0, non_negative=True),
+    custom("magnetic_field", "Standard deviation of the magnetometer error per body axis, white per sample (at most "
+           f"{MAX_MAGNETIC_NOISE_T:g}).", "number", magnetic_noise, unit="T", default=0.0,
+           bounds=f">= 0 and <= {MAX_MAGNETIC_NOISE_T:g}"),
 ), "Measurement noise, white and Gaussian.")
 
 SIMULATION = Section((
@@ -425,8 +432,9 @@ SIMULATION = Section((
            positive=True, nullable=True, maximum=MAX_DURATION_S),
     vector("initial_attitude_error_deg", "Rotation vector applied to the true initial attitude, body axes.", 3,
            unit="deg", default=[0.0, 0.0, 0.0], magnitude=1e6),
-    vector("initial_rate_error", "Added to the true initial body rate, body frame.", 3, unit="rad/s",
-           default=[0.0, 0.0, 0.0]),
+    vector("initial_rate_error", "Added to the true initial body rate, body frame (each entry within "
+           f"±{MAX_BODY_RATE:g}, ``maneuver.initial.omega``'s bound).", 3, unit="rad/s", default=[0.0, 0.0, 0.0],
+           magnitude=MAX_BODY_RATE),
     mapping("sensor_noise", "Measurement noise.", SENSOR_NOISE, default={}),
     mapping("sensors", "Sensor models (gyro, star tracker, magnetometer); absent or ``null``: the measurement is "
             "``sensor_noise``'s.", SENSORS, default=None, null="none"),

@@ -44,7 +44,8 @@ from scenarios.schema.keys import (
 from scenarios.schema.node import Node
 from scenarios.schema.requirements import SENSOR, parse_sensors
 
-__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "ORBIT", "SPACECRAFT", "TORQUERS", "WHEELS",
+__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "MAX_DISTURBANCE", "MAX_INERTIA",
+           "MIN_INERTIA", "ORBIT", "SPACECRAFT", "TORQUERS", "WHEELS",
            "parse_environment", "parse_magnetic_field", "parse_orbit", "parse_spacecraft"]
 
 
@@ -62,15 +63,44 @@ def _limits(node: Node) -> Any:
     return None if node.is_null() else node.vector(allow_scalar=True)
 
 
+MAX_INERTIA = 1.0e12
+"""Largest entry [kg m²] of ``spacecraft.inertia`` (and ``truth.spacecraft.inertia``): ten thousand
+times the International Space Station's (about 1e8 kg m²). Far beyond it the planners' arithmetic
+overflows (1e300 printed NumPy's overflow warning and a bound of 150 digits); an inertia merely too
+large for its torque (g mm² written as kg m², 1e9 too large) warns (``slew_time``)."""
+MAX_DISTURBANCE = 1.0e6
+"""Largest entry [N m] of ``environment.disturbance_torque``: a million times the largest disturbance
+torques on any spacecraft (the ISS's gravity-gradient and aerodynamic torques, of the order of N m;
+small satellites' are µN m to mN m). 1e300 N m was accepted without a warning (its norm overflowed
+to inf, which the plausibility check reads as unlimited) and printed NumPy's overflow warnings; a
+torque merely larger than the actuators give against it warns (``disturbance``)."""
+MIN_INERTIA = 1.0e-9
+"""Least principal moment [kg m²] of ``spacecraft.inertia`` (and ``truth.spacecraft.inertia``): a
+gram at a millimetre, a hundred times below the smallest spacecraft flown (chip-sats of a few grams
+over a few centimetres, about 1e-7 kg m²). Far below it a run hung (1e-250 kg m²: the torque-free
+coast after a bang-coast-bang slew never ended); a positive moment above it too small for its torque
+warns (``actuator_torques``), and one of 0 or below is the spacecraft's error (positive definite)."""
+
+
 def _inertia(node: Node) -> np.ndarray:
     inertia = node.value
     if isinstance(inertia, list) and inertia and all(isinstance(row, list) for row in inertia):
         if len(inertia) != 3:
             raise node.error(f"expected a 3x3 matrix (3 rows of 3 numbers), got {len(inertia)} rows")
-        return np.array([Node(row, f"{node.path}[{i}]").vector(3) for i, row in enumerate(inertia)])
-    if not isinstance(inertia, list):
+        values = np.array([Node(row, f"{node.path}[{i}]").vector(3) for i, row in enumerate(inertia)])
+    elif not isinstance(inertia, list):
         raise node.error(f"expected a list of 3 numbers or a 3x3 matrix (3 rows of 3 numbers), got {excerpt(inertia)}")
-    return node.vector(3)
+    else:
+        values = node.vector(3)
+    if np.any(np.abs(values) > MAX_INERTIA):
+        raise node.error(f"expected entries within ±{MAX_INERTIA:g} kg m² (ten thousand times the International Space "
+                         f"Station's), got {values.tolist()}")
+    matrix = np.diag(values) if values.ndim == 1 else values
+    least = float(np.linalg.eigvalsh((matrix + matrix.T) / 2.0)[0])
+    if 0.0 < least < MIN_INERTIA:
+        raise node.error(f"expected a least principal moment of at least {MIN_INERTIA:g} kg m² (a gram at a millimetre; "
+                         f"the smallest spacecraft have about 1e-7), got {least:.4g} kg m² for {values.tolist()}")
+    return values
 
 
 def _axes(node: Node) -> np.ndarray:
@@ -105,7 +135,8 @@ TORQUERS = Section((
 SPACECRAFT = Section((
     custom("inertia", "Principal moments (3 numbers) or the 3x3 inertia matrix about the centre of mass, body "
            "frame; positive definite, the moments meeting the triangle inequality.",
-           "list of 3 numbers or 3x3 matrix", _inertia, unit="kg m²"),
+           "list of 3 numbers or 3x3 matrix", _inertia, unit="kg m²",
+           bounds=f"each entry within ±{MAX_INERTIA:g}; the least principal moment at least {MIN_INERTIA:g}"),
     mapping("wheels", "Reaction wheels (default: three wheels on the body axes without bounds).", WHEELS,
             default={}, null="none"),
     mapping("magnetorquers", "Magnetorquers.", MAGNETORQUERS, default=None, null="none"),
@@ -132,7 +163,8 @@ ENVIRONMENT = Section((
     custom("magnetic_field", "The geomagnetic field: a model name (its default options), ``none``, or "
            "``{model: <name>, <option>: <value>, ...}``; needs ``orbit``.", "text, mapping or null", None,
            default=None, section=MAGNETIC_FIELD, choices=MAGNETIC_FIELDS),
-    vector("disturbance_torque", "Constant disturbance torque, body frame.", 3, unit="N m", default=[0.0, 0.0, 0.0]),
+    vector("disturbance_torque", f"Constant disturbance torque, body frame (each entry within ±{MAX_DISTURBANCE:g}).", 3,
+           unit="N m", default=[0.0, 0.0, 0.0], magnitude=MAX_DISTURBANCE),
 ), "What acts on the spacecraft besides its actuators (absent or ``null``: nothing).")
 
 

@@ -76,6 +76,11 @@ def _is_finite(value: int | float) -> bool:
         return False
 
 
+_YAML_BOOLEAN = " (a YAML boolean: unquoted yes, no, on, off, true and false are read as one)"
+"""Said of a boolean where a number is expected: ``duration: yes`` reads as ``True``, which the
+message showed without saying where it came from."""
+
+
 def _why_not_finite(value: Any) -> str:
     """Why a number is refused as one (NaN, an infinity, an integer beyond a float), else nothing."""
     if not _is_number(value) or _is_finite(value):
@@ -280,7 +285,8 @@ class Node:
             Not a finite number, or outside the bounds.
         """
         if not _is_number(self.value) or not _is_finite(self.value):
-            raise self.error(f"expected a number, got {excerpt(self.value)}{_why_not_finite(self.value)}")
+            raise self.error(f"expected a number, got {excerpt(self.value)}{_why_not_finite(self.value)}"
+                             + (_YAML_BOOLEAN if isinstance(self.value, bool) else ""))
         if positive and not self.value > 0:
             raise self.error(f"expected a positive number, got {excerpt(self.value)}")
         if non_negative and self.value < 0:
@@ -441,12 +447,19 @@ class Node:
             (the message shows the value, its norm and the normalised quaternion to write).
         """
         q = self.vector(4)
-        problem = quat.unit_norm_error(q)
+        scale = float(np.max(np.abs(q)))
+        unit = q / scale if scale > 0.0 else q  # the direction, whose norm cannot overflow (entries of 1e300 did,
+        # with NumPy's RuntimeWarning printed before the error and "must be finite" said of finite entries)
+        if scale > 2.0:  # an entry beyond 2: no unit quaternion, whatever the tolerance
+            norm = scale * float(np.linalg.norm(unit))
+            shown = f"{norm:.6g}" if math.isfinite(norm) else "beyond a float's range"
+            problem: str | None = f"a quaternion must have unit norm (got norm {shown})"
+        else:
+            problem = quat.unit_norm_error(q)
         if problem is not None:
             hint = ""
-            norm = float(np.linalg.norm(q))
-            if np.isfinite(norm) and norm > 0.0:
-                hint = (f"; normalise it (q / ‖q‖ = {[round(float(v), 7) for v in q / norm]}) if it is the "
-                        "attitude you mean, or check it for a typo")
+            if scale > 0.0:
+                hint = (f"; normalise it (q / ‖q‖ = {[round(float(v), 7) for v in unit / np.linalg.norm(unit)]}) if "
+                        "it is the attitude you mean, or check it for a typo")
             raise self.error(f"{problem} for {excerpt(self.value)}{hint}")
         return q / float(np.linalg.norm(q))

@@ -39,6 +39,8 @@ if TYPE_CHECKING:
     from scenarios.schema.loader import Scenario
 
 __all__ = ["LOWEST_ORBIT_KM", "MAX_ANGULAR_ACCELERATION", "MAX_RATE", "MAX_RATE_TOLERANCE",
+           "MAX_ATTITUDE_NOISE_DEG", "MAX_GYRO_ARW_DEG_PER_SQRT_H", "MAX_MAGNETIC_NOISE_T",
+           "MAX_STAR_TRACKER_NOISE_ARCSEC", "MAX_STAR_TRACKER_RATE_HZ",
            "MIN_BRIGHT_BODY_CONE_DEG", "MIN_STAR_TRACKER_NOISE_ARCSEC", "MOON_DISTANCE_KM", "PLAUSIBILITY_CHECKS", "SLOW_SLEW_FACTOR", "Implausible", "plausibility_warnings",
            "warn_implausible"]
 
@@ -86,6 +88,37 @@ tracker's: the most precise flown reach about 0.1 arcsec across the boresight, a
 1 to 10 arcsec (and several times that about the boresight). A noise in radians written as arcsec
 (5 arcsec = 2.4e-5 rad) lands thousands of times below it; zero (a perfect sensor, meant) does not
 warn."""
+
+MAX_STAR_TRACKER_NOISE_ARCSEC = 3600.0
+"""Star-tracker noise [arcsec, 1 sigma] above which an axis of ``noise_arcsec`` is no star tracker's:
+one degree. The coarsest (nanosatellite) trackers reach tens of arcsec across the boresight and a
+few hundred about it; a degree is a Sun sensor's accuracy, and trackers' fields of view are only 8
+to 25 deg, so a noise of degrees would put the stars out of the frame the sensor matches. Beyond
+180 deg (648,000 arcsec) the schema refuses it
+(:data:`~scenarios.schema.estimation.STAR_TRACKER_NOISE_LIMIT_ARCSEC`)."""
+MAX_STAR_TRACKER_RATE_HZ = 1000.0
+"""Star-tracker update rate [Hz] above which ``rate_hz`` is no star tracker's: a kHz. Trackers expose
+their detector for tens to hundreds of milliseconds per frame and update at 1 to 30 Hz. A rate
+above the controller's sample rate (``1 / simulation.sample_time``) warns too: the simulation gives
+at most one update per sample, so it acts as ``null`` (every sample). Beyond 1e7 Hz the schema
+refuses it (:data:`~scenarios.schema.estimation.STAR_TRACKER_RATE_LIMIT_HZ`)."""
+MAX_ATTITUDE_NOISE_DEG = 10.0
+"""Attitude measurement noise [deg, 1 sigma] (``simulation.sensor_noise.attitude_deg``) above which no
+attitude sensor is that coarse: Sun sensors and magnetometer-based attitude give 0.5 to 5 deg, star
+trackers arcseconds. Beyond 180 deg the schema refuses it."""
+MAX_MAGNETIC_NOISE_T = 1.0e-4
+"""Magnetometer noise or bias [T] (``simulation.sensor_noise.magnetic_field``,
+``simulation.sensors.magnetometer.noise_T`` and the largest entry of ``bias_T``) above which the
+error exceeds the field it measures: the Earth's is at most 6.5e-5 T at its surface and 1e-5 to
+5e-5 T in low orbit; magnetometers' noise is nT (1e-9 T). A value in nT written as T (1e9 too
+large) is mostly beyond 1 T, an error of the schema that says so
+(:data:`~scenarios.schema.estimation.MAX_MAGNETIC_NOISE_T`)."""
+MAX_GYRO_ARW_DEG_PER_SQRT_H = math.degrees(MAX_RATE_TOLERANCE) * 60.0
+"""Gyro angle random walk [deg/√h] (344) at or above which the gyro's white rate noise over one
+second has a standard deviation of :data:`MAX_RATE_TOLERANCE` (0.1 rad/s, 5.7 deg/s), as large as
+the rates the most agile spacecraft slew at: the bar of ``simulation.sensor_noise.rate``, the
+noise of the rate measured without a gyro model. Navigation gyros have 0.001 to 0.01 deg/√h,
+MEMS gyros 0.1 to a few deg/√h."""
 
 
 @dataclass(frozen=True)
@@ -420,6 +453,82 @@ def _star_tracker_noise(scenario: Scenario) -> Iterator[Implausible]:
 
 
 
+def _star_tracker_coarse(scenario: Scenario) -> Iterator[Implausible]:
+    """A star tracker's noise (``simulation.sensors.star_tracker.noise_arcsec``) whose largest axis
+    is above :data:`MAX_STAR_TRACKER_NOISE_ARCSEC` (a degree: no star tracker)."""
+    written = _mapping(scenario.data or {}, "simulation", "sensors", "star_tracker").get("noise_arcsec")
+    values = _numbers(written)
+    if values is None or not max(values) > MAX_STAR_TRACKER_NOISE_ARCSEC:
+        return
+    yield Implausible("simulation.sensors.star_tracker.noise_arcsec", f"{written} arcsec",
+                      f"is up to {_grouped(max(values))} arcsec ({max(values) / 3600.0:.4g} deg, 1 sigma), above "
+                      f"{MAX_STAR_TRACKER_NOISE_ARCSEC:,.0f} arcsec (1 deg), where no star tracker is: plausible "
+                      "noises are 0.1 to 100 arcsec across the boresight and up to a few hundred about it")
+
+
+def _star_tracker_rate(scenario: Scenario) -> Iterator[Implausible]:
+    """A star tracker's update rate (``simulation.sensors.star_tracker.rate_hz``) above
+    :data:`MAX_STAR_TRACKER_RATE_HZ` (no star tracker) or above the controller's sample rate (it
+    updates at every sample, as ``null`` does)."""
+    rate = _number(_mapping(scenario.data or {}, "simulation", "sensors", "star_tracker").get("rate_hz"))
+    sample_time = scenario.simulation.sample_time
+    if rate is None:
+        return
+    sampled = rate * sample_time > 1.0 + 1e-9  # more than one update per sample asked
+    fast = rate > MAX_STAR_TRACKER_RATE_HZ
+    if not (sampled or fast):
+        return
+    why = []
+    if fast:
+        why.append(f"above {MAX_STAR_TRACKER_RATE_HZ:,.0f} Hz, where no star tracker is (they update at 1 to 30 Hz)")
+    if sampled:
+        why.append(f"above the controller's sample rate ({1.0 / sample_time:.4g} Hz: simulation.sample_time "
+                   f"{sample_time:g} s), so it gives one update a sample, as null (every sample) does")
+    yield Implausible("simulation.sensors.star_tracker.rate_hz", f"{_grouped(rate, 0 if rate >= 1 else 3)} Hz",
+                      f"is {' and '.join(why)}; plausible: 1 to 30 Hz, at most 1 / sample_time")
+
+
+def _gyro_noise(scenario: Scenario) -> Iterator[Implausible]:
+    """A gyro's angle random walk (``simulation.sensors.gyro.arw_deg_per_sqrt_h``) at or above
+    :data:`MAX_GYRO_ARW_DEG_PER_SQRT_H` (a one-second rate noise of 0.1 rad/s)."""
+    arw = _number(_mapping(scenario.data or {}, "simulation", "sensors", "gyro").get("arw_deg_per_sqrt_h"))
+    if arw is None or arw < MAX_GYRO_ARW_DEG_PER_SQRT_H:
+        return
+    yield Implausible("simulation.sensors.gyro.arw_deg_per_sqrt_h", f"{_grouped(arw, 0 if arw >= 1 else 3)} deg/√h",
+                      f"is a white rate noise of {math.radians(arw) / 60.0:.4g} rad/s over one second, at or above "
+                      f"{MAX_GYRO_ARW_DEG_PER_SQRT_H:.0f} deg/√h ({MAX_RATE_TOLERANCE:g} rad/s over one second), "
+                      "a noise that hides the rate of a spacecraft slewing as fast as any does; plausible: 0.001 "
+                      "(navigation) to a few (MEMS) deg/√h")
+
+
+def _attitude_noise(scenario: Scenario) -> Iterator[Implausible]:
+    """An attitude measurement noise (``simulation.sensor_noise.attitude_deg``) above
+    :data:`MAX_ATTITUDE_NOISE_DEG`."""
+    noise = _number(_mapping(scenario.data or {}, "simulation", "sensor_noise").get("attitude_deg"))
+    if noise is None or not noise > MAX_ATTITUDE_NOISE_DEG:
+        return
+    yield Implausible("simulation.sensor_noise.attitude_deg", f"{noise:g} deg",
+                      f"is above {MAX_ATTITUDE_NOISE_DEG:g} deg (1 sigma per axis), coarser than any attitude sensor: "
+                      "plausible: arcseconds (a star tracker) to a few degrees (Sun sensors, magnetometers)")
+
+
+def _magnetic_noise(scenario: Scenario) -> Iterator[Implausible]:
+    """A magnetometer noise or bias above :data:`MAX_MAGNETIC_NOISE_T` (nT written as T)."""
+    data = scenario.data or {}
+    magnetometer = _mapping(data, "simulation", "sensors", "magnetometer")
+    given = [("simulation.sensor_noise.magnetic_field", _mapping(data, "simulation", "sensor_noise").get("magnetic_field")),
+             ("simulation.sensors.magnetometer.noise_T", magnetometer.get("noise_T")),
+             ("simulation.sensors.magnetometer.bias_T", magnetometer.get("bias_T"))]
+    for path, written in given:
+        values = _numbers(written)
+        if values is None or not max(abs(v) for v in values) > MAX_MAGNETIC_NOISE_T:
+            continue
+        largest = max(abs(v) for v in values)
+        yield Implausible(path, f"{written} T",
+                          f"is up to {largest:g} T, above {MAX_MAGNETIC_NOISE_T:g} T, more than the Earth's field it "
+                          "measures (at most 6.5e-5 T); plausible: a few nT (1e-9 T) to a few hundred nT")
+
+
 BRIGHT_BODIES = {"sun": "Sun", "moon": "Moon"}
 """The keep-out targets (``keep_out``, ``exclusion_deg`` keys) :func:`_bright_body_cones` judges, and their names."""
 
@@ -460,6 +569,11 @@ PLAUSIBILITY_CHECKS: dict[str, PlausibilityCheck] = {
     "disturbance": _disturbance,
     "wheel_axes": _wheel_axes,
     "star_tracker_noise": _star_tracker_noise,
+    "star_tracker_coarse": _star_tracker_coarse,
+    "star_tracker_rate": _star_tracker_rate,
+    "gyro_noise": _gyro_noise,
+    "attitude_noise": _attitude_noise,
+    "magnetic_noise": _magnetic_noise,
     "bright_body_cones": _bright_body_cones,
 }
 """Name -> check: each yields the :class:`Implausible` values of a validated scenario."""

@@ -54,16 +54,26 @@ def _check_tree(root: yaml.Node, source: Path | str) -> None:
     :data:`MAX_DEPTH` (a recursive alias nests forever) and alias expansion beyond
     :data:`MAX_NODES`, walking the composed node graph without building Python objects."""
     count = 0
+    distinct: set[int] = set()  # the values written (an alias repeats one)
     stack: list[tuple[yaml.Node, str, int]] = [(root, "", 0)]
     while stack:
         node, path, depth = stack.pop()
         count += 1
+        distinct.add(id(node))
         if depth > MAX_DEPTH:
             raise ScenarioError(_short(path), f"{source} nests deeper than {MAX_DEPTH} levels; "
                                                    "is an alias used inside itself?")
         if count > MAX_NODES:
-            raise ScenarioError(_short(path) or "(top level)", f"{source} expands to more than {MAX_NODES} values "
-                                                                    "(aliases count at every use); is it an alias bomb?")
+            if len(distinct) < count:  # aliases repeat values: an alias bomb, most likely
+                message = (f"expands to more than {MAX_NODES} values (aliases count at every use); is it an "
+                           "alias bomb?")
+            else:  # written out: a list far longer than any scenario's or study's (a study varies at most
+                # 10,000 values per path; the message said "alias bomb" of a file without an alias)
+                message = (f"holds more than {MAX_NODES} values, far more than any scenario or study (a study "
+                           "varies at most 10,000 values per path); is a list generated too long?")
+            if isinstance(source, Path):  # the error names the file once, before the path
+                raise ScenarioError(_short(path) or "(top level)", message, source)
+            raise ScenarioError(_short(path) or "(top level)", f"{source} {message}")
         if isinstance(node, yaml.MappingNode):
             seen: dict[Any, yaml.Node] = {}
             for key_node, value_node in node.value:
@@ -82,6 +92,10 @@ def _check_tree(root: yaml.Node, source: Path | str) -> None:
             _check_number(node, path, source)
 
 
+_MAX_INT_DIGITS = 4000
+"""Longest plain integer read [characters]: below Python's limit on converting text to an integer
+(4,300 digits), far beyond a float's 309; a longer one is refused at its path (a schema reader
+says why a shorter one beyond a float is not a number)."""
 _OCTAL = re.compile(r"^[-+]?0[0-7_]+$")
 """A plain integer with a leading zero, which YAML 1.1 (PyYAML) reads as octal: ``045`` is 37."""
 
@@ -91,6 +105,14 @@ def _check_number(node: yaml.ScalarNode, path: str, source: Path | str) -> None:
     (``045``: octal, 37) or colons (``1:20``: base 60, 80). Zero-padded angles and durations were
     read silently as other values (YAML 1.2 reads ``045`` as 45 and ``1:20`` as text)."""
     tag, text = node.tag, node.value
+    if tag == "tag:yaml.org,2002:int" and len(text) > _MAX_INT_DIGITS:  # Python refuses to read it: the error
+        # named no path and suggested sys.set_int_max_str_digits()
+        where = f"line {node.start_mark.line + 1}" + ("" if isinstance(source, Path) else f" of {source}")
+        message = (f"{text[:20]}... ({len(text)} characters, {where}) is an integer beyond any number slewbench "
+                   "reads (a float reaches about 1.8e308, 309 digits); expected a number")
+        if isinstance(source, Path):
+            raise ScenarioError(_short(path) or "(top level)", message, source)
+        raise ScenarioError(_short(path) or "(top level)", message)
     if tag == "tag:yaml.org,2002:int" and _OCTAL.match(text):
         decimal: int | None = int(text.replace("_", ""))  # the digits read in base 10
         how, meant = "the octal number", f"{decimal} (without the leading zero)"

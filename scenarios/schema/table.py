@@ -27,7 +27,7 @@ from scenarios.schema.keys import Key, Section, choice, custom, integer, number
 from scenarios.schema.node import Node
 from scenarios.schema.study import EXECUTION
 
-__all__ = ["GRIDS", "MAX_AXES", "MAX_REFINE", "OBJECTIVES", "TABLE", "TABLE_EXECUTION", "TABLE_FILE", "TABLE_FLAGS",
+__all__ = ["GRIDS", "MAX_ANGLES", "MAX_AXES", "MAX_REFINE", "OBJECTIVES", "TABLE", "TABLE_EXECUTION", "TABLE_FILE", "TABLE_FLAGS",
            "TABLE_REFINE", "TableValue", "angles_from_text", "bare_count", "check_angles", "read_table"]
 
 OBJECTIVES = ("min_time", "min_energy")
@@ -38,14 +38,36 @@ GRIDS = ("polytope", "fibonacci")
 or a Fibonacci lattice (:func:`scenarios.slewtable.grid.fibonacci_axes`)."""
 MAX_AXES = 10000
 """Most axes of a table's grid, and of its held-out grid."""
+MAX_ANGLES = 10000
+"""Most angles of a table, listed or counted (``--angles N``): as many as :data:`MAX_AXES` (a count of
+1e11 asked NumPy for 745 GiB before the entries were counted against ``--max-entries``)."""
 MAX_REFINE = 100000
 """Largest ``table.refine.max_axes`` and ``table.refine.max_rounds``."""
 
 
 def _number(value: Any, where: str, what: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ScenarioError(where, f"expected {what}, got {value!r}")
+    """``value`` as a float, or an error at ``where`` saying it is no number, or not finite (NaN, an
+    infinity, an integer beyond a float's range), and that ``what`` was expected."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ScenarioError(where, f"expected {what}, got {value!r:.80}")
+    try:
+        finite = math.isfinite(value)
+    except OverflowError:  # an integer beyond a float's range
+        finite = False
+    if not finite:
+        said = (f"{str(value)[:20]}... ({len(str(value))} digits) is beyond a float's range (about 1.8e308)"
+                if isinstance(value, int) else f"{value!r} is not finite")
+        raise ScenarioError(where, f"{said}; expected {what}")
     return float(value)
+
+
+def _item_number(values: Any, index: int, where: str, what: str) -> float:
+    """:func:`_number` of ``values[index]``, its error at ``where`` (the key or the flag, as every
+    other error of it) saying which item (``item 1: nan is not finite; ...``)."""
+    try:
+        return _number(values[index], where, what)
+    except ScenarioError as error:
+        raise ScenarioError(where, f"item {index + 1}: {error.message}") from None
 
 
 def bare_count(value: Any) -> int | None:
@@ -97,8 +119,9 @@ def angles_from_text(text: str, where: str = "--angles") -> list[float]:
     """
     count = bare_count(text)
     if count is not None:
-        if count < 2:
-            raise ScenarioError(where, f"expected a count of at least 2 angles, got {count}")
+        if not 2 <= count <= MAX_ANGLES:
+            raise ScenarioError(where, f"expected a count of 2 to {MAX_ANGLES} angles, got "
+                                       f"{count if count < 10**20 else f'{str(count)[:20]}... ({len(str(count))} digits)'}")
         return check_angles(list(np.linspace(10.0, 180.0, count)), where)
     parts = _comma_items(str(text), where)
     try:
@@ -144,12 +167,17 @@ def check_angles(values: Any, where: str) -> list[float]:
     if not isinstance(values, (list, tuple)) or len(values) < 2:
         raise ScenarioError(where, f"expected at least 2 angles in degrees (the table interpolates between them; "
                                    f"for one slew, slewbench run), got {values!r}")
-    angles = sorted(_number(v, where, "angles in degrees") for v in values)
-    if angles[0] <= 0.0 or angles[-1] > 180.0:
-        raise ScenarioError(where, f"angles must be in (0, 180] degrees, got {values!r}")
-    if len(set(angles)) != len(angles):
-        raise ScenarioError(where, f"angles must be distinct, got {values!r}")
-    return angles
+    if len(values) > MAX_ANGLES:
+        raise ScenarioError(where, f"expected at most {MAX_ANGLES} angles, got {len(values)}")
+    numbers = [_item_number(values, i, where, "an angle in degrees, in (0, 180]") for i in range(len(values))]
+    for i, angle in enumerate(numbers):
+        if not 0.0 < angle <= 180.0:
+            raise ScenarioError(where, f"item {i + 1}: {angle:g} is outside (0, 180]: expected a slew angle in "
+                                       "degrees above 0 and at most 180")
+        if angle in numbers[:i]:
+            raise ScenarioError(where, f"item {i + 1}: {angle:g} repeats item {numbers.index(angle) + 1}: "
+                                       "expected distinct angles")
+    return sorted(numbers)
 
 
 # --- the readers: one value each, at its YAML path or flag -----------------------------------------
@@ -178,10 +206,11 @@ def _axes(node: Node) -> int | np.ndarray:
         if not isinstance(item, (list, tuple)) or len(item) != 3:
             raise ScenarioError(f"{where}[{i}]", f"expected 3 numbers (a body axis), got {item!r}")
         vector = np.array([_number(v, f"{where}[{i}]", "3 numbers (a body axis)") for v in item])
-        size = float(np.linalg.norm(vector))
-        if size == 0.0:
+        largest = float(np.max(np.abs(vector)))
+        if largest == 0.0:
             raise ScenarioError(f"{where}[{i}]", "a zero vector has no direction")
-        unit = vector / size
+        direction = vector / largest  # its norm cannot overflow ([1e300, 1e300, 0]: inf, then a zero axis and
+        unit = direction / float(np.linalg.norm(direction))  # an error about a quaternion no one wrote)
         for j, other in enumerate(axes):
             if np.linalg.norm(unit - other) <= 1e-9:
                 raise ScenarioError(f"{where}[{i}]", f"repeats the direction of {where}[{j}] ({value[j]!r}): "
@@ -287,7 +316,7 @@ TABLE = Section((
            "refused. The fit has no time above the largest angle unless it is 180 deg.",
            "a whole number (a count of angles), or a list of angles", _angles, unit="deg",  # [deg]: the list's
            default=[10.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0],
-           bounds="a list: at least 2, distinct, > 0 and <= 180; a count: >= 2"),
+           bounds=f"a list: 2 to {MAX_ANGLES}, distinct, > 0 and <= 180; a count: 2 to {MAX_ANGLES}"),
     choice("objective", "``min_time``: the shortest slew (the scenario's ``maneuver.duration`` bounds it); "
            "``min_energy``: the least integral of the squared control over ``duration``.", OBJECTIVES,
            default="min_time"),

@@ -231,11 +231,13 @@ def _sequence(node: Node) -> str:
 AXIS_ANGLE = Section((
     custom("axis", "Rotation axis (any length but zero), in the axes of ``frame``.", "list of 3 numbers",
            rotation_axis),
-    number("angle_deg", "Rotation angle, right-handed about ``axis``.", unit="deg"),
+    number("angle_deg", "Rotation angle, right-handed about ``axis`` (within ±360: a turn; 1e300 gave an "
+           "attitude of rounding noise).", unit="deg", minimum=-360.0, maximum=360.0),
 ), "The rotation by ``angle_deg`` about ``axis``, from ``frame`` to the body.")
 
 EULER = Section((
-    vector("angles_deg", "The three angles, in the order of ``sequence``.", 3, unit="deg"),
+    vector("angles_deg", "The three angles, in the order of ``sequence`` (each within ±360: a turn).", 3, unit="deg",
+           magnitude=360.0),
     custom("sequence", "The body axes rotated about, in order, from ``frame`` to the body: ``\"321\"`` (yaw, "
            "pitch, roll), ``\"313\"`` ... (1, 2, 3 or x, y, z; no two consecutive ones equal).", "text", _sequence,
            default="321"),

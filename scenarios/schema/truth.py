@@ -82,7 +82,7 @@ TRUTH_SPACECRAFT = Section((
     custom("inertia", "The true inertia about the centre of mass: principal moments (3 numbers) or the full 3x3 "
            "tensor with its products of inertia, body frame (positive definite, the moments meeting the triangle "
            "inequality); ``null``: the design's ``spacecraft.inertia``.", "list of 3 numbers, 3x3 matrix or null",
-           _inertia, unit="kg m²", default=None),
+           _inertia, unit="kg m²", default=None, bounds=SPACECRAFT["inertia"].bounds),
 ), "The true rigid body.")
 
 TRUTH_FRICTION = Section((

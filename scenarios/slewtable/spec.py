@@ -208,14 +208,18 @@ def _scenario(path: Path, where: str) -> dict[str, Any]:
     try:
         data = read_yaml(path)
     except ScenarioError as error:  # the path as resolved (relative to the table file), not as written
-        raise ScenarioError(where, error.message.replace(str(path), str(path.resolve()))) from None
+        message = error.message.replace(str(path), str(path.resolve()))
+        if error.file is not None:  # an error in the file (a duplicate key): the file and the YAML path in it
+            message = f"{path.resolve()}: {f'{error.path}: ' if error.path else ''}{message}"
+        raise ScenarioError(where, message) from None
     if not isinstance(data, dict):
         raise ScenarioError(where, f"{path} is not a scenario (a mapping)")
     if "study" in data or "table" in data:  # which one: "a study or table file" read as if tables were refused
         kind, command = ("table", "table") if "table" in data else ("study", "sweep")
         raise ScenarioError(where, f"{path} is a {kind} file, not a scenario: "
-                                   + (f"run it with `slewbench {command} {path}`" if where == str(path) else
-                                      "table.scenario names the scenario file the table is made for"))
+                                   + (f"run it with `slewbench {command} {path}` (slewbench table expects a scenario "
+                                      "file or a table file, top-level key 'table')" if where == str(path)
+                                      else "table.scenario names the scenario file the table is made for"))
     try:
         parse_scenario(data)
     except ScenarioError as error:  # the scenario's YAML path, in the scenario's file
