@@ -41,3 +41,25 @@ def test_an_interrupted_run_keeps_the_users_empty_folder_and_an_earlier_run(tmp_
     assert empty.is_dir() and not any(empty.iterdir())  # the folder stays, without the claim's marker
     assert {p.relative_to(earlier): p.read_bytes() for p in earlier.rglob("*") if p.is_file()} == before
     assert json.loads((earlier / MARKER).read_text())["complete"]
+
+
+def test_a_withdrawn_claim_keeps_the_marker_of_another_run_writing_there(tmp_path):
+    # two runs into the same new folder: the first (which made it) is interrupted while the
+    # second is writing; before, the first removed the marker and the second's commit failed
+    # ("lost its .slewbench-output.json while running")
+    from scenarios.output.directory import (
+        claim_output_directory,
+        claimed_output_directory,
+        commit_outputs,
+        new_staging,
+    )
+
+    out = tmp_path / "X"
+    with pytest.raises(KeyboardInterrupt):
+        with claimed_output_directory(out):
+            other = claim_output_directory(out)  # the second run's claim: the marker is there
+            staging = new_staging(other)
+            (staging / "results.json").write_text("{}")
+            raise KeyboardInterrupt
+    assert commit_outputs(other, staging, kind="run") == ["results.json"]
+    assert json.loads((out / MARKER).read_text())["complete"]

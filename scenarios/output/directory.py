@@ -444,12 +444,21 @@ def claimed_output_directory(path: str | Path, kind: str = "run", expected: Iter
 
 def _withdraw(directory: Path, made: Path | None) -> None:
     """Remove the marker of a claim that committed nothing, then the empty folders from
-    ``directory`` up to ``made`` (the outermost one the claim created; ``None``: none)."""
-    manifest = read_manifest(directory)
-    if manifest is None or manifest["files"] or manifest.get("complete"):
+    ``directory`` up to ``made`` (the outermost one the claim created; ``None``: none).
+
+    Another run that claimed the same directory meanwhile and is writing there (a staging folder
+    of a live process) keeps the marker: its commit needs it."""
+    try:
+        with _locked(directory):  # as a commit: none moves files in while the marker goes
+            manifest = read_manifest(directory)
+            if manifest is None or manifest["files"] or manifest.get("complete"):
+                return
+            if any(leftover.is_dir() and not _abandoned(leftover)
+                   for leftover in directory.glob(f"{STAGING_PREFIX}*")):
+                return
+            (directory / MARKER).unlink()
+    except OSError:
         return
-    with contextlib.suppress(OSError):
-        (directory / MARKER).unlink()
     if made is None:
         return
     for folder in (directory, *directory.parents):
