@@ -63,3 +63,25 @@ def test_a_withdrawn_claim_keeps_the_marker_of_another_run_writing_there(tmp_pat
             raise KeyboardInterrupt
     assert commit_outputs(other, staging, kind="run") == ["results.json"]
     assert json.loads((out / MARKER).read_text())["complete"]
+
+
+def test_an_interrupted_run_keeps_the_empty_folders_above_those_it_made(tmp_path, monkeypatch):
+    # the withdrawal stops at the outermost folder the claim created: a user's empty folder above
+    # it stays (a withdrawal that went on up would remove it)
+    monkeypatch.setattr(commands, "run", _interrupt)
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    argv = ["run", str(scenario_file(tmp_path)), "--out", str(mine / "new" / "run"), "--no-plots"]
+    assert main(argv) == interrupted_status("run")
+    assert mine.is_dir() and not any(mine.iterdir())
+
+
+def test_an_export_interrupted_after_the_run_committed_keeps_the_run(tmp_path, monkeypatch):
+    # the run's claim is not withdrawn once its files are committed: its marker stays, complete
+    monkeypatch.setattr(commands, "export_run", _interrupt)
+    out = tmp_path / "new"
+    argv = ["run", str(scenario_file(tmp_path)), "--out", str(out), "--no-plots", "--export", "aem"]
+    assert main(argv) == interrupted_status("run")
+    manifest = json.loads((out / MARKER).read_text())
+    assert manifest["complete"] and "results.json" in manifest["files"] and (out / "results.json").is_file()
+    assert not (tmp_path / "new-aem").exists()
