@@ -85,3 +85,15 @@ def test_an_export_interrupted_after_the_run_committed_keeps_the_run(tmp_path, m
     manifest = json.loads((out / MARKER).read_text())
     assert manifest["complete"] and "results.json" in manifest["files"] and (out / "results.json").is_file()
     assert not (tmp_path / "new-aem").exists()
+
+
+def test_an_interrupted_run_through_a_missing_folder_and_dotdot_keeps_the_users_folder(tmp_path, monkeypatch):
+    # --out new/../mine/run: 'new' is missing, so 'new/..' and 'new/../mine' do not exist as
+    # written, but 'mine' does (the user's, empty); before, the withdrawal took it for a folder
+    # the claim made and removed it
+    monkeypatch.setattr(commands, "run", _interrupt)
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    argv = ["run", str(scenario_file(tmp_path)), "--out", str(tmp_path / "new" / ".." / "mine" / "run"), "--no-plots"]
+    assert main(argv) == interrupted_status("run")
+    assert mine.is_dir() and not any(mine.iterdir())

@@ -430,7 +430,10 @@ def claimed_output_directory(path: str | Path, kind: str = "run", expected: Iter
         As :func:`claim_output_directory`.
     """
     directory = Path(path).expanduser().absolute()
-    missing = [folder for folder in (directory, *directory.parents) if not os.path.lexists(folder)]
+    # the folders as the claim's mkdir meets them: symbolic links and '..' resolved, so that
+    # 'new/../mine' (no such path as written while 'new' is missing) is the user's 'mine'
+    real = Path(os.path.realpath(directory))
+    missing = [folder for folder in (real, *real.parents) if not os.path.lexists(folder)]
     made = missing[-1] if missing else None  # the outermost folder the claim creates
     marks = made is None and directory.is_dir() and read_manifest(directory) is None
     directory = claim_output_directory(path, kind, expected)
@@ -438,7 +441,7 @@ def claimed_output_directory(path: str | Path, kind: str = "run", expected: Iter
         yield directory
     except BaseException:
         if made is not None or marks:
-            _withdraw(directory, made)
+            _withdraw(real, made)
         raise
 
 

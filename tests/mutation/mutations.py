@@ -192,6 +192,11 @@ MUTATIONS: list[Mutation] = [
              "            if any(leftover.is_dir() and not _abandoned(leftover)",
              "            if False and any(leftover.is_dir() and not _abandoned(leftover)",
              ("tests/test_run_interrupted_claims.py::test_a_withdrawn_claim_keeps_the_marker_of_another_run_writing_there",)),
+    Mutation("output-withdrawal-reads-dotdot-as-written", "scenarios/output/directory.py",
+             "missing = [folder for folder in (real, *real.parents) if not os.path.lexists(folder)]",
+             "missing = [folder for folder in (directory, *directory.parents) if not os.path.lexists(folder)]",
+             ("tests/test_run_interrupted_claims.py::"
+              "test_an_interrupted_run_through_a_missing_folder_and_dotdot_keeps_the_users_folder",)),
     Mutation("terminal-closed-loop-at-limit-unnamed", "scenarios/output/tables.py",
              "value is not None and value >= allowed]", "value is not None and value > 1.0]",
              ("tests/test_output_h2_breach_fields.py::test_a_closed_loop_names_every_quantity_at_its_limit",)),
