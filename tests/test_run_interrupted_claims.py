@@ -97,3 +97,21 @@ def test_an_interrupted_run_through_a_missing_folder_and_dotdot_keeps_the_users_
     argv = ["run", str(scenario_file(tmp_path)), "--out", str(tmp_path / "new" / ".." / "mine" / "run"), "--no-plots"]
     assert main(argv) == interrupted_status("run")
     assert mine.is_dir() and not any(mine.iterdir())
+
+
+def test_an_interrupted_case_rerun_leaves_no_folder_in_the_sweep(tmp_path, monkeypatch, capsys):
+    # sweep DIR --case N claims DIR/cases/N as a run does; before, an interrupted re-run left it
+    # (and DIR/cases) holding only a manifest marked incomplete
+    import yaml
+
+    from scenarios.study import rerun
+    from tests.test_verdict_rules import slew
+
+    study = tmp_path / "study.yaml"
+    study.write_text(yaml.safe_dump({"study": "budget", "scenario": slew(80.0, "trapezoidal"),
+                                     "grid": {"maneuver.duration": [80.0]}}, sort_keys=False))
+    out = tmp_path / "out"
+    assert main(["sweep", str(study), "--out", str(out), "--no-plots", "--workers", "1"]) == 0, capsys.readouterr()
+    monkeypatch.setattr(rerun, "rerun_case", _interrupt)
+    assert main(["sweep", str(out), "--case", "0", "--no-plots"]) == interrupted_status("sweep")
+    assert not (out / "cases").exists()
