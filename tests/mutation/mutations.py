@@ -197,6 +197,9 @@ MUTATIONS: list[Mutation] = [
              "missing = [folder for folder in (directory, *directory.parents) if not os.path.lexists(folder)]",
              ("tests/test_run_interrupted_claims.py::"
               "test_an_interrupted_run_through_a_missing_folder_and_dotdot_keeps_the_users_folder",)),
+    Mutation("study-cluster-dropped-task-charged", "scenarios/study/engine.py",
+             "            if future.cancelled():\n                # the sweep pops", "            if False:\n                # the sweep pops",
+             ("tests/test_study_h4_dask.py::test_a_task_the_cluster_dropped_is_run_again_not_stored_crashed",)),
     Mutation("terminal-closed-loop-at-limit-unnamed", "scenarios/output/tables.py",
              "value is not None and value >= allowed]", "value is not None and value > 1.0]",
              ("tests/test_output_h2_breach_fields.py::test_a_closed_loop_names_every_quantity_at_its_limit",)),
