@@ -82,6 +82,18 @@ def test_a_closed_loop_at_its_limit_reads_as_before():
     assert _requirement_cell("actuators", "closed_loop", values, MARGIN) == "at limit ✗"
 
 
+def test_a_closed_loop_names_every_quantity_at_its_limit():
+    # the scoring's rule: a closed-loop state at AT_LIMIT of its limit or more is at it (a ratio
+    # held there to rounding, 1 - 1e-12, too): both quantities break it, so both are named
+    from scenarios.requirements.scoring import AT_LIMIT
+
+    values = {"met": False, "wheels_momentum": 1.0, "wheels_momentum_time_s": 6.5,
+              "wheels_speed": AT_LIMIT, "wheels_speed_time_s": 7.0}
+    assert breaking_fields("actuators", "closed_loop", values, MARGIN) == ["wheels_momentum", "wheels_speed"]
+    values["wheels_speed"] = 0.5  # below: the momentum alone
+    assert breaking_fields("actuators", "closed_loop", values, MARGIN) == ["wheels_momentum"]
+
+
 def test_a_pointing_requirement_breaks_by_its_margin_alone():
     values = {"met": False, "min_margin_deg": -0.19, "time_in_violation_s": 3.2}
     assert breaking_fields("st", "reference", values, MARGIN) == ["min_margin_deg"]

@@ -246,3 +246,44 @@ def test_a_sweep_whose_client_closed_stops_at_once_saying_so():
         closer.join()
     assert time.monotonic() - start < 5.0
     assert "client" in raised.value.reason and cluster.scheduler_address in raised.value.reason, raised.value.reason
+
+
+class _DropsItsFirstTask:
+    """An executor whose first task is dropped as a Dask client that lost its scheduler drops its
+    tasks (the future cancelled, not by the sweep: ``_settle``); the others run at once."""
+
+    def __init__(self):
+        self.dropped = False
+
+    def submit(self, fn, /, *args, **kwargs):
+        from concurrent.futures import Future
+
+        future = Future()
+        if not self.dropped:
+            self.dropped = True
+            future.cancel()
+            future.set_running_or_notify_cancel()
+        else:
+            future.set_result(fn(*args, **kwargs))
+        return future
+
+
+def test_a_task_the_cluster_dropped_is_run_again_not_stored_crashed(tmp_path):
+    # before: the cancelled future's CancelledError was charged as a worker death, and with
+    # retries 0 the case was stored crashed ("worker died ('CancelledError: ')"), never run again
+    # on a resume; seen with a Dask client closed while single-case tasks were in flight
+    import copy
+    from concurrent.futures import Executor
+
+    from scenarios.study.engine import sweep
+    from scenarios.study.store import SweepStore
+    from tests.test_sweep import BASE
+
+    class Dropping(_DropsItsFirstTask, Executor):
+        pass
+
+    study = {"study": "dropped", "scenario": copy.deepcopy(BASE), "execution": {"retries": 0},
+             "grid": {"maneuver.duration": [30.0, 40.0]}}
+    results = sweep(study, executor=Dropping(), workers=1, store=SweepStore(tmp_path))
+    table = results.to_dataframe()
+    assert sorted(set(table["case"])) == [0, 1] and set(table["status"]) == {"ok"}, table[["case", "status"]]

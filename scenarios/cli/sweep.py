@@ -34,7 +34,7 @@ from scenarios.errors import OutputError, ScenarioError, SweepInterrupted
 from scenarios.output.directory import (
     HOSTS,
     MARKER,
-    claim_output_directory,
+    claimed_output_directory,
     written_files,
 )
 from scenarios.output.names import default_output_directory, suffix_note
@@ -160,18 +160,18 @@ def command_case(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else directory / CASE_FOLDER / str(args.case)
     # before running: a long case is never lost at the end (a directory holding another scenario's run is refused)
     check_run_directory(out, str(case.scenario.get("name", "")))
-    claim_output_directory(out)
-    varied = ", ".join(f"{path}={value}" for path, value in case.varied.items())
-    print(f"{results.study.name}: case {case.index} (grid point {case.point}, seed {case.seed})"
-          + (f": {varied}" if varied else ""), flush=True)
-    if version != package_version():
-        print(f"note: the sweep was stored by slewbench {version}; this is {package_version()}", flush=True)
-    rerun = rerun_case(results, args.case, progress=lambda line: print(line, flush=True))
-    print()
-    print(rerun.to_terminal())
-    rerun.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
-    print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
-          f"{'' if args.no_plots else ', PNG plots, report.html'})")
+    with claimed_output_directory(out):  # an interrupted or failing re-run withdraws the claim, as a run's
+        varied = ", ".join(f"{path}={value}" for path, value in case.varied.items())
+        print(f"{results.study.name}: case {case.index} (grid point {case.point}, seed {case.seed})"
+              + (f": {varied}" if varied else ""), flush=True)
+        if version != package_version():
+            print(f"note: the sweep was stored by slewbench {version}; this is {package_version()}", flush=True)
+        rerun = rerun_case(results, args.case, progress=lambda line: print(line, flush=True))
+        print()
+        print(rerun.to_terminal())
+        rerun.write(out, plots=not args.no_plots, renderer=getattr(args, "renderer", None))
+        print(f"\nwrote {out}/ (results.json, results.csv, results.md, timeseries/"
+              f"{'' if args.no_plots else ', PNG plots, report.html'})")
     renamed = suffix_note([row.label for row in rerun.rows], "results.json and results.csv")
     if renamed:
         print(renamed)

@@ -430,7 +430,10 @@ def claimed_output_directory(path: str | Path, kind: str = "run", expected: Iter
         As :func:`claim_output_directory`.
     """
     directory = Path(path).expanduser().absolute()
-    missing = [folder for folder in (directory, *directory.parents) if not os.path.lexists(folder)]
+    # the folders as the claim's mkdir meets them: symbolic links and '..' resolved, so that
+    # 'new/../mine' (no such path as written while 'new' is missing) is the user's 'mine'
+    real = Path(os.path.realpath(directory))
+    missing = [folder for folder in (real, *real.parents) if not os.path.lexists(folder)]
     made = missing[-1] if missing else None  # the outermost folder the claim creates
     marks = made is None and directory.is_dir() and read_manifest(directory) is None
     directory = claim_output_directory(path, kind, expected)
@@ -438,18 +441,27 @@ def claimed_output_directory(path: str | Path, kind: str = "run", expected: Iter
         yield directory
     except BaseException:
         if made is not None or marks:
-            _withdraw(directory, made)
+            _withdraw(real, made)
         raise
 
 
 def _withdraw(directory: Path, made: Path | None) -> None:
     """Remove the marker of a claim that committed nothing, then the empty folders from
-    ``directory`` up to ``made`` (the outermost one the claim created; ``None``: none)."""
-    manifest = read_manifest(directory)
-    if manifest is None or manifest["files"] or manifest.get("complete"):
+    ``directory`` up to ``made`` (the outermost one the claim created; ``None``: none).
+
+    Another run that claimed the same directory meanwhile and is writing there (a staging folder
+    of a live process) keeps the marker: its commit needs it."""
+    try:
+        with _locked(directory):  # as a commit: none moves files in while the marker goes
+            manifest = read_manifest(directory)
+            if manifest is None or manifest["files"] or manifest.get("complete"):
+                return
+            if any(leftover.is_dir() and not _abandoned(leftover)
+                   for leftover in directory.glob(f"{STAGING_PREFIX}*")):
+                return
+            (directory / MARKER).unlink()
+    except OSError:
         return
-    with contextlib.suppress(OSError):
-        (directory / MARKER).unlink()
     if made is None:
         return
     for folder in (directory, *directory.parents):

@@ -696,6 +696,13 @@ class _Engine:
         broken = False
         for future in done:
             entry = self.in_flight.pop(future)
+            if future.cancelled():
+                # the sweep pops the futures it cancels first: this one the cluster dropped (a Dask
+                # client that lost its scheduler, _settle): no worker died, its cases go back uncharged
+                for key in entry.keys:
+                    self.starts[key] -= 1
+                self.pending.extendleft(sorted(entry.keys, key=lambda key: -self.cases[key].index))
+                continue
             try:
                 outcome = future.result()
             except BrokenProcessPool:
