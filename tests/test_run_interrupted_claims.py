@@ -115,3 +115,30 @@ def test_an_interrupted_case_rerun_leaves_no_folder_in_the_sweep(tmp_path, monke
     monkeypatch.setattr(rerun, "rerun_case", _interrupt)
     assert main(["sweep", str(out), "--case", "0", "--no-plots"]) == interrupted_status("sweep")
     assert not (out / "cases").exists()
+
+
+def test_dot_dot_through_a_missing_folder_is_checked_as_the_folder_it_names(tmp_path, capsys):
+    # before: 'zz/../mine' (zz missing) was taken for a new path: a non-empty 'mine' gave "cannot be
+    # written: File exists" after 'zz' had been created, and 'zz' stayed
+    scenario = scenario_file(tmp_path)
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("the user's")
+    assert main(["run", str(scenario), "--out", str(tmp_path / "zz" / ".." / "mine"), "--no-plots"]) == 2
+    assert "did not create" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mine", "scenario.yaml"]
+    assert [p.name for p in mine.iterdir()] == ["notes.txt"]
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert main(["run", str(scenario), "--out", str(tmp_path / "zz" / ".." / "empty"), "--no-plots"]) == 0
+    assert (empty / "results.json").is_file() and not (tmp_path / "zz").exists()
+
+
+def test_a_symbolic_link_as_out_is_named_as_a_link(tmp_path, capsys):
+    target = tmp_path / "real"
+    target.mkdir()
+    (tmp_path / "link").symlink_to(target)
+    assert main(["run", str(scenario_file(tmp_path)), "--out", str(tmp_path / "link"), "--no-plots"]) == 2
+    err = capsys.readouterr().err
+    assert "is a symbolic link" in err and str(target) in err  # it said "exists and is not a directory"
+    assert not any(target.iterdir())

@@ -279,6 +279,19 @@ def enclosing_output(directory: Path) -> tuple[Path, str] | None:
     return None
 
 
+def _output_path(path: str | Path) -> Path:
+    """``path`` as an absolute path with its ``..`` resolved as the file system meets them (through
+    the folders and links that exist, lexically past a missing one, as ``mkdir -p`` goes), its last
+    component kept as written (a link there is refused, not followed): ``new/../mine`` is the
+    existing ``mine``, checked as such, not a new path whose creation fails half-way."""
+    directory = Path(path).expanduser().absolute()
+    if ".." not in directory.parts:
+        return directory
+    if directory.name in ("", ".."):
+        return Path(os.path.realpath(directory))
+    return Path(os.path.realpath(directory.parent)) / directory.name
+
+
 def check_output_directory(path: str | Path, kind: str = "run", expected: Iterable[str] = ()) -> Path:
     """Every check :func:`claim_output_directory` makes, writing nothing: a command that writes into
     more than one directory (``run --export``) checks each before it claims any, so that a refusal
@@ -304,7 +317,7 @@ def check_output_directory(path: str | Path, kind: str = "run", expected: Iterab
         As :func:`claim_output_directory`; a location the process has no write permission for too
         (the claim's probe file finds what the permissions do not show).
     """
-    directory = Path(path).expanduser().absolute()
+    directory = _output_path(path)
     try:
         enclosing = enclosing_output(directory)
         if enclosing is not None:
@@ -312,7 +325,11 @@ def check_output_directory(path: str | Path, kind: str = "run", expected: Iterab
                                     f"carries {MARKER}); slewbench writes the {kind} output into a directory of "
                                     f"its own, not inside another output: choose a directory outside "
                                     f"{enclosing[0]} (--out on the command line), nothing was touched")
-        if directory.is_symlink() or (directory.exists() and not directory.is_dir()):
+        if directory.is_symlink():
+            raise OutputError(path, f"is a symbolic link (to {os.path.realpath(directory)}); slewbench writes only "
+                                    "into a directory itself, not through a link: give the directory's own path "
+                                    "or another one, nothing was touched")
+        if directory.exists() and not directory.is_dir():
             raise OutputError(path, "exists and is not a directory; slewbench writes only into a new, "
                                     "empty or slewbench-made directory")
         if directory.is_dir():
@@ -429,7 +446,7 @@ def claimed_output_directory(path: str | Path, kind: str = "run", expected: Iter
     OutputError
         As :func:`claim_output_directory`.
     """
-    directory = Path(path).expanduser().absolute()
+    directory = _output_path(path)
     # the folders as the claim's mkdir meets them: symbolic links and '..' resolved, so that
     # 'new/../mine' (no such path as written while 'new' is missing) is the user's 'mine'
     real = Path(os.path.realpath(directory))
