@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp import AttitudeModel, Environment, Spacecraft, quat
 from ocp.geometry import PointingConstraint
-from ocp.options import is_real
+from ocp.options import is_real, real_array
 
 Array = NDArray[np.float64]
 
@@ -284,13 +284,12 @@ def bound_keys(actuators: list) -> str:
 
 
 def _vector(name: str, value: ArrayLike, size: int) -> Array:
-    """``value`` as a finite float vector of ``size`` entries, or a ``ValueError`` naming ``name``."""
+    """``value`` as a finite float vector of ``size`` entries, or a ``ValueError`` naming ``name``
+    (:func:`~ocp.options.real_array`: ``None``, text, booleans and complex numbers are refused)."""
     try:
-        if value is None or np.asarray(value).dtype.kind in "US":  # None reads as NaN, text "1" as a number
-            raise TypeError(name)
-        array = np.array(value, dtype=float)  # a private copy: the caller's array is not kept
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be {size} numbers, got {value!r}") from None
+        array = real_array(value)  # a private copy: the caller's array is not kept
+    except ValueError as reason:
+        raise ValueError(f"{name} must be {size} numbers, got {value!r:.200}: {reason}") from None
     if array.shape != (size,) or not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must be {size} finite numbers, got shape {array.shape}: {array.tolist()}")
     array.setflags(write=False)
