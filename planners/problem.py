@@ -111,6 +111,9 @@ class ManeuverProblem:
         object.__setattr__(self, "omega0", _rate("omega0", self.omega0))
         if self.omegaf is not None:
             object.__setattr__(self, "omegaf", _rate("omegaf", self.omegaf))
+        if self.spacecraft.n_wheels == 0 and self.wheel_momentum0 is not None and np.size(self.wheel_momentum0) != 0:
+            raise ValueError(f"wheel_momentum0 must be None (or empty) for a spacecraft without wheels, got "
+                             f"{self.wheel_momentum0!r:.80}")
         momentum = np.zeros(self.spacecraft.n_wheels) if self.wheel_momentum0 is None else self.wheel_momentum0
         object.__setattr__(self, "wheel_momentum0", _vector("wheel_momentum0", momentum, self.spacecraft.n_wheels))
         if not is_real(self.duration) or not np.isfinite(self.duration) or not self.duration > 0:

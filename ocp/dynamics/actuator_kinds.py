@@ -523,8 +523,17 @@ class ReactionWheels(Actuator):
         -------
         ReactionWheels
             Wheels with ``axes = eye(3)[:, :n_axes]``.
+
+        Raises
+        ------
+        ModelError
+            For an ``n_axes`` that is not an integer from 1 to 3 (``4`` gave three wheels, ``"3"`` a
+            slicing ``TypeError``).
         """
-        return cls(axes=np.eye(3)[:, :n_axes], **limits)
+        if not isinstance(n_axes, numbers.Integral) or isinstance(n_axes, bool) or not 1 <= n_axes <= 3:
+            raise ModelError("n_axes", f"expected 1, 2 or 3 wheels along the body axes, got {n_axes!r:.60} "
+                                       f"({type(n_axes).__name__}); ReactionWheels(axes) takes any others")
+        return cls(axes=np.eye(3)[:, :int(n_axes)], **limits)
 
     @property
     def count(self) -> int:
