@@ -199,7 +199,19 @@ class ManeuverProblem:
         float or None
             The smallest of the option, ``max_rate`` and ``(1 − margin)`` times the requirement
             [rad/s]; ``None`` without any.
+
+        Raises
+        ------
+        ValueError
+            For an option that is not a finite positive number or ``None``, or a margin outside
+            [0, 1) (booleans and text are refused).
         """
+        if option is not None and not (is_real(option) and np.isfinite(option) and option > 0):
+            raise ValueError(f"rate_bound: option must be a finite positive rate [rad/s] or None, got {option!r:.60} "
+                             f"({type(option).__name__})")
+        if not (is_real(margin) and 0.0 <= margin < 1.0):
+            raise ValueError(f"rate_bound: margin must be a fraction in [0, 1), got {margin!r:.60} "
+                             f"({type(margin).__name__})")
         required = None if self.rate_requirement is None else self.rate_requirement * (1.0 - margin)
         bounds = [bound for bound in (option, self.max_rate, required) if bound is not None]
         return min(bounds) if bounds else None
@@ -230,7 +242,15 @@ class ManeuverProblem:
             The constant disturbance torque [N m], body axes (zeros without one).
         gravity_gradient : float
             Bound on the gravity gradient's norm [N m] (0 without it).
+
+        Raises
+        ------
+        ValueError
+            For a ``duration`` that is not a finite number >= 0 (a boolean or text).
         """
+        if not (is_real(duration) and np.isfinite(duration) and duration >= 0):
+            raise ValueError(f"environment_torque_bound: duration must be a finite time >= 0 [s], got "
+                             f"{duration!r:.60} ({type(duration).__name__})")
         environment = self.environment
         disturbance = np.array(environment.disturbance_torque, dtype=float)
         orbit = environment.orbit

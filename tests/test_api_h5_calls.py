@@ -65,3 +65,32 @@ def test_torque_free_motion_refuses_a_time_beyond_its_span_instead_of_extrapolat
     assert MAX_COAST_CHUNKS * motion.chunk > 1e6  # a million seconds of coast remain reachable
     with pytest.raises(ValueError, match=r"times must be finite"):
         motion([np.inf])
+
+
+def _plain_problem() -> ManeuverProblem:
+    return ManeuverProblem(Spacecraft([1, 2, 2.5]), [1, 0, 0, 0], [0, 0, 0], [0, 1, 0, 0], 10.0, max_rate=0.5,
+                           rate_requirement=1.0)
+
+
+@pytest.mark.parametrize("option, margin, words", [
+    ("0.1", 0.0, r"option must be a finite positive rate \[rad/s\] or None, got '0.1' \(str\)"),
+    (-1.0, 0.0, r"option must be a finite positive rate .*got -1.0 \(float\)"),  # was -1.0, a negative bound
+    (True, 0.0, r"option .*got True \(bool\)"),
+    (None, 1.0, r"margin must be a fraction in \[0, 1\), got 1.0"),  # was a bound of 0 rad/s
+    (None, "0.1", r"margin must be a fraction in \[0, 1\), got '0.1' \(str\)"),  # was a TypeError from inside
+])
+def test_rate_bound_refuses_bad_arguments(option, margin, words):
+    with pytest.raises(ValueError, match="rate_bound: " + words):
+        _plain_problem().rate_bound(option, margin)
+
+
+def test_rate_bound_is_the_smallest_bound():
+    problem = _plain_problem()  # max_rate 0.5, requirement 1.0
+    assert problem.rate_bound(None) == 0.5 and problem.rate_bound(0.2) == 0.2
+    assert problem.rate_bound(None, 0.6) == pytest.approx(0.4)
+
+
+@pytest.mark.parametrize("duration", ["1", True, -1.0, np.nan])
+def test_environment_torque_bound_refuses_a_bad_duration(duration):
+    with pytest.raises(ValueError, match=r"environment_torque_bound: duration must be a finite time >= 0 \[s\], got"):
+        _plain_problem().environment_torque_bound(duration)
