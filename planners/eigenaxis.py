@@ -930,17 +930,18 @@ class EigenaxisPlanner(Planner):
             else "the problem's: maneuver.max_rate, else requirements.rate.max"
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
-        # An overflow (a torque bound of 1e300 N m over a moment of 1e-9 kg m^2) is a failed
-        # reference that says so, not NumPy's warning and an "ok" reference of NaN duration.
+        # An overflow (a torque bound of 1e300 N m over a moment of 1e-9 kg m^2, T = 1e300 s) is a
+        # failed reference that says so, not NumPy's warning and an "ok" reference of NaN duration.
         try:
             with np.errstate(over="raise", invalid="raise"):
                 return self._plan_profile(problem)
         except (OverflowError, FloatingPointError) as failure:
             moments = np.linalg.eigvalsh(problem.spacecraft.inertia)
-            return FailedReference(self.name, f"the {self.options.profile} profile's arithmetic overflows ({failure}) "
-                                   f"for principal moments {[float(f'{m:.6g}') for m in moments]} kg m^2 under the "
-                                   f"actuator limits ({bound_keys(list(problem.spacecraft.actuators))}): "
-                                   "their ratio is far beyond any spacecraft's", "infeasible")
+            return FailedReference(self.name, f"numerical failure: {type(failure).__name__}: {failure} in the "
+                                   f"{self.options.profile} profile (duration {problem.duration:g} s, principal moments "
+                                   f"{[float(f'{m:.6g}') for m in moments]} kg m^2, actuator limits "
+                                   f"{bound_keys(list(problem.spacecraft.actuators))}): values far beyond any "
+                                   "spacecraft's overflow its arithmetic")
 
     def _plan_profile(self, problem: ManeuverProblem) -> Reference:
         axis, angle = self._axis_angle(problem)
