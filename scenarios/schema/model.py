@@ -45,8 +45,8 @@ from scenarios.schema.keys import (
 from scenarios.schema.node import Node
 from scenarios.schema.requirements import SENSOR, parse_sensors
 
-__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "MAX_DISTURBANCE", "MAX_INERTIA",
-           "MIN_INERTIA", "ORBIT", "SPACECRAFT", "TORQUERS", "WHEELS",
+__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "MAX_DISTURBANCE", "ORBIT", "SPACECRAFT", "TORQUERS",
+           "WHEELS",
            "parse_environment", "parse_magnetic_field", "parse_orbit", "parse_spacecraft"]
 
 
