@@ -28,6 +28,9 @@ import typing
 from dataclasses import dataclass
 from typing import Annotated, Any, ClassVar, Literal, Mapping, TypeVar, Union
 
+import numpy as np
+from numpy.typing import NDArray
+
 from ocp.errors import InvalidOption, OptionsError, excerpt
 
 T = TypeVar("T")
@@ -105,6 +108,57 @@ def is_real(value: object) -> bool:
     bool
     """
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+_REAL_KINDS = "iuf"
+"""NumPy dtype kinds of real numbers (signed and unsigned integers, floats); booleans (``b``), complex
+numbers (``c``), text (``U``, ``S``), dates and durations (``M``, ``m``) are refused, and an object
+array is judged entry by entry (:func:`is_real`)."""
+_KIND_NAMES = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "bytes", "M": "dates",
+               "m": "durations", "V": "raw records"}
+
+
+def real_array(value: object) -> NDArray[np.float64]:
+    """``value`` (a number or a nesting of numbers, as given to the library) as a new float array,
+    when it holds real numbers only: the one check of the library's numeric inputs (inertia,
+    actuator limits, sensors, boundary conditions). NumPy alone would read ``True`` as 1, ``"2"`` in
+    an object array as 2 and ``1+0j`` as 1 (with only a ``ComplexWarning``). Shape and finiteness are
+    the caller's checks (its message names its field and what it expects).
+
+    Parameters
+    ----------
+    value : object
+        A number, a (nested) sequence of numbers or an ndarray.
+
+    Returns
+    -------
+    ndarray of float
+        A copy, of the shape of ``value`` (the caller's array is not kept).
+
+    Raises
+    ------
+    ValueError
+        Naming the first entry that is no real number and its type (a bool, complex number, text,
+        ``None``, date ...), the array's kind, or a ragged nesting; the message is the reason alone,
+        for the caller to prefix with its field and what it expects.
+    """
+    try:
+        array = value if isinstance(value, np.ndarray) else np.array(value, dtype=object)
+    except (TypeError, ValueError):  # a ragged nesting
+        raise ValueError("a ragged nesting (rows of different lengths)") from None
+    if array.dtype.kind == "O":
+        if array.size == 0:
+            raise ValueError("no numbers")
+        odd = [item for item in array.ravel().tolist() if not is_real(item)]
+        if odd:
+            raise ValueError(f"{odd[0]!r:.60} ({type(odd[0]).__name__}) is no real number")
+    elif array.dtype.kind not in _REAL_KINDS:
+        raise ValueError(f"an array of {_KIND_NAMES.get(array.dtype.kind, array.dtype.name)} (dtype {array.dtype}), "
+                         "not of real numbers")
+    try:
+        return np.array(array, dtype=float)
+    except OverflowError:  # a Python integer beyond the floats (10**400)
+        raise ValueError("a number beyond the floats' range (about 1.8e308)") from None
 
 
 def _split(annotation: Any) -> tuple[Any, Range | None]:

@@ -298,6 +298,7 @@ def _unbounded_about_the_axis(problem: ManeuverProblem) -> list[Any]:
     spacecraft = problem.spacecraft
     rows, limits = spacecraft.allocation_rows()
     torque = spacecraft.inertia @ (rotvec / angle)
+    torque = torque / np.max(np.abs(torque))  # its direction only: the norm of 1e300 kg m^2's overflows
     loaded = np.abs(rows @ torque) > 1e-12 * np.linalg.norm(rows, axis=1) * np.linalg.norm(torque)
     if not np.any(loaded) or np.any(np.isfinite(limits[loaded])):
         return []
@@ -739,13 +740,24 @@ def _smallest_cap(*caps: float) -> float:
 
 def _rounded_up(value: float, digits: int = 4) -> str:
     """``value`` (> 0) rounded up to ``digits`` significant digits: a duration to suggest, never
-    below the one needed (42.0534 -> ``42.06``)."""
+    below the one needed (42.0534 -> ``42.06``); from a billion up or below 1e-4, in powers of ten
+    (``1.122e+151``, not 152 digits)."""
+    if not (np.isfinite(value) and value > 0):
+        return f"{value:.{digits}g}"
     exponent = int(np.floor(np.log10(value)))
     step = 10.0 ** (exponent - digits + 1)
     up = np.ceil(value / step * (1 - 1e-15)) * step
     if up < value:
         up += step
+    if not -4 <= exponent < 9:
+        return f"{up:.{digits - 1}e}"
     return f"{up:.{max(0, digits - 1 - exponent)}f}"
+
+
+def _seconds(value: float) -> str:
+    """A duration [s] for a message: to the millisecond from 1 ms to a billion seconds, else in powers
+    of ten (``1.121e-09``, ``3.545e+156``; not ``0.000`` or 157 digits)."""
+    return f"{value:.3f}" if 1e-3 <= value < 1e9 else f"{value:.4g}"
 
 
 def _environment_loads_the_wheels(problem: ManeuverProblem, environment: tuple[Array, float]) -> bool:
@@ -918,6 +930,20 @@ class EigenaxisPlanner(Planner):
             else "the problem's: maneuver.max_rate, else requirements.rate.max"
 
     def _plan(self, problem: ManeuverProblem) -> Reference:
+        # An overflow (a torque bound of 1e300 N m over a moment of 1e-9 kg m^2, T = 1e300 s) is a
+        # failed reference that says so, not NumPy's warning and an "ok" reference of NaN duration.
+        try:
+            with np.errstate(over="raise", invalid="raise"):
+                return self._plan_profile(problem)
+        except (OverflowError, FloatingPointError) as failure:
+            moments = np.linalg.eigvalsh(problem.spacecraft.inertia)
+            return FailedReference(self.name, f"numerical failure: {type(failure).__name__}: {failure} in the "
+                                   f"{self.options.profile} profile (duration {problem.duration:g} s, principal moments "
+                                   f"{[float(f'{m:.6g}') for m in moments]} kg m^2, actuator limits "
+                                   f"{bound_keys(list(problem.spacecraft.actuators))}): values far beyond any "
+                                   "spacecraft's overflow its arithmetic")
+
+    def _plan_profile(self, problem: ManeuverProblem) -> Reference:
         axis, angle = self._axis_angle(problem)
         inertia = problem.spacecraft.inertia
         max_rate = problem.rate_bound(self.options.max_rate, self.options.rate_margin)
@@ -1029,7 +1055,7 @@ class EigenaxisPlanner(Planner):
             words += "; feasible, not proven the minimum time (the torquers change the total momentum)"
         if self.options.profile == "min_time":
             return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,
-                                      f"minimum time {profile.duration:.3f} s, {profile.rate_words()} ({words})", problem)
+                                      f"minimum time {_seconds(profile.duration)} s, {profile.rate_words()} ({words})", problem)
         if problem.duration < profile.duration * (1 - 1e-12):
             return FailedReference(self.name, self._too_short(problem, profile.duration, f"the fastest bang-coast-bang "
                                    f"this planner verifies, {profile.duration:.6g} s ({words})"), "infeasible")
@@ -1110,7 +1136,7 @@ class EigenaxisPlanner(Planner):
         if profile_name == "min_time":
             profile = BangCoastBangProfile(angle, acceleration(best_rate), best_rate)
             return EigenaxisReference(problem.q0, axis, profile, profile.duration, inertia,
-                                      f"minimum time {profile.duration:.3f} s, {profile.rate_words()}"
+                                      f"minimum time {_seconds(profile.duration)} s, {profile.rate_words()}"
                                       f"{momentum_words}{reserve_words}", problem)
         if problem.duration < minimum_time * (1 - 1e-12):
             bounds_words = "the torque bounds"

@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp import AttitudeModel, Environment, Spacecraft, quat
 from ocp.geometry import PointingConstraint
-from ocp.options import is_real
+from ocp.options import is_real, real_array
 
 Array = NDArray[np.float64]
 
@@ -111,6 +111,9 @@ class ManeuverProblem:
         object.__setattr__(self, "omega0", _rate("omega0", self.omega0))
         if self.omegaf is not None:
             object.__setattr__(self, "omegaf", _rate("omegaf", self.omegaf))
+        if self.spacecraft.n_wheels == 0 and self.wheel_momentum0 is not None and np.size(self.wheel_momentum0) != 0:
+            raise ValueError(f"wheel_momentum0 must be None (or empty) for a spacecraft without wheels, got "
+                             f"{self.wheel_momentum0!r:.80}")
         momentum = np.zeros(self.spacecraft.n_wheels) if self.wheel_momentum0 is None else self.wheel_momentum0
         object.__setattr__(self, "wheel_momentum0", _vector("wheel_momentum0", momentum, self.spacecraft.n_wheels))
         if not is_real(self.duration) or not np.isfinite(self.duration) or not self.duration > 0:
@@ -196,7 +199,19 @@ class ManeuverProblem:
         float or None
             The smallest of the option, ``max_rate`` and ``(1 − margin)`` times the requirement
             [rad/s]; ``None`` without any.
+
+        Raises
+        ------
+        ValueError
+            For an option that is not a finite positive number or ``None``, or a margin outside
+            [0, 1) (booleans and text are refused).
         """
+        if option is not None and not (is_real(option) and np.isfinite(option) and option > 0):
+            raise ValueError(f"rate_bound: option must be a finite positive rate [rad/s] or None, got {option!r:.60} "
+                             f"({type(option).__name__})")
+        if not (is_real(margin) and 0.0 <= margin < 1.0):
+            raise ValueError(f"rate_bound: margin must be a fraction in [0, 1), got {margin!r:.60} "
+                             f"({type(margin).__name__})")
         required = None if self.rate_requirement is None else self.rate_requirement * (1.0 - margin)
         bounds = [bound for bound in (option, self.max_rate, required) if bound is not None]
         return min(bounds) if bounds else None
@@ -227,7 +242,15 @@ class ManeuverProblem:
             The constant disturbance torque [N m], body axes (zeros without one).
         gravity_gradient : float
             Bound on the gravity gradient's norm [N m] (0 without it).
+
+        Raises
+        ------
+        ValueError
+            For a ``duration`` that is not a finite number >= 0 (a boolean or text).
         """
+        if not (is_real(duration) and np.isfinite(duration) and duration >= 0):
+            raise ValueError(f"environment_torque_bound: duration must be a finite time >= 0 [s], got "
+                             f"{duration!r:.60} ({type(duration).__name__})")
         environment = self.environment
         disturbance = np.array(environment.disturbance_torque, dtype=float)
         orbit = environment.orbit
@@ -284,13 +307,12 @@ def bound_keys(actuators: list) -> str:
 
 
 def _vector(name: str, value: ArrayLike, size: int) -> Array:
-    """``value`` as a finite float vector of ``size`` entries, or a ``ValueError`` naming ``name``."""
+    """``value`` as a finite float vector of ``size`` entries, or a ``ValueError`` naming ``name``
+    (:func:`~ocp.options.real_array`: ``None``, text, booleans and complex numbers are refused)."""
     try:
-        if value is None or np.asarray(value).dtype.kind in "US":  # None reads as NaN, text "1" as a number
-            raise TypeError(name)
-        array = np.array(value, dtype=float)  # a private copy: the caller's array is not kept
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be {size} numbers, got {value!r}") from None
+        array = real_array(value)  # a private copy: the caller's array is not kept
+    except ValueError as reason:
+        raise ValueError(f"{name} must be {size} numbers, got {value!r:.200}: {reason}") from None
     if array.shape != (size,) or not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must be {size} finite numbers, got shape {array.shape}: {array.tolist()}")
     array.setflags(write=False)

@@ -18,10 +18,29 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp import quat
 from ocp.dynamics.spin_closed_form import extremal_quaternion
+from ocp.options import is_real, real_array
+from planners.problem import MAX_BODY_RATE
 
 Array = NDArray[np.float64]
 REST_RATE = 1e-15
 """rad/s: a final rate at or below this is rounding residue; the torque-free coast is then rest."""
+MAX_COAST_CHUNKS = 10**6
+"""Chunks of integration (each about a quarter turn at the initial rate, 1 s to 1e4 s) a
+:class:`TorqueFreeMotion` evaluates at most; a later time is refused (about 6 ms a chunk: a
+million is 1.5 h of integration)."""
+
+
+def _finite(name: str, value: ArrayLike, shape: tuple[int, ...]) -> Array:
+    """``value`` as a finite float array of ``shape`` (:func:`~ocp.options.real_array`), or a
+    ``ValueError`` naming ``name``."""
+    try:
+        array = real_array(value)
+    except ValueError as reason:
+        raise ValueError(f"TorqueFreeMotion: {name} must be real numbers, got {value!r:.120}: {reason}") from None
+    if array.shape != shape or not np.all(np.isfinite(array)):
+        raise ValueError(f"TorqueFreeMotion: {name} must be finite numbers of shape {shape}, got shape {array.shape}: "
+                         f"{array.tolist()!r:.120}")
+    return array
 
 
 class TorqueFreeMotion:
@@ -36,19 +55,36 @@ class TorqueFreeMotion:
     q_start : (4,) array_like
         Attitude quaternion at ``start``, scalar first, body to inertial (normalised here).
     omega_start : (3,) array_like
-        Body rate at ``start`` [rad/s], body axes.
+        Body rate at ``start`` [rad/s], body axes, each entry within
+        ±:data:`~planners.problem.MAX_BODY_RATE`.
     inertia : (3, 3) array_like
         Body inertia [kg m^2], body axes.
     start : float
         Time of the initial state [s].
+
+    Raises
+    ------
+    ValueError
+        For values that are not finite real numbers of the shapes above, a zero quaternion or an
+        inertia that is not positive definite.
     """
 
     def __init__(self, q_start: ArrayLike, omega_start: ArrayLike, inertia: ArrayLike, start: float) -> None:
-        self.q_start = quat.normalize(np.asarray(q_start, dtype=float))
-        self.omega_start = np.asarray(omega_start, dtype=float)
-        self.inertia = np.asarray(inertia, dtype=float)
+        self.q_start = quat.normalize(_finite("q_start", q_start, (4,)))
+        self.omega_start = _finite("omega_start", omega_start, (3,))
+        self.inertia = _finite("inertia", inertia, (3, 3))
+        moments = np.linalg.eigvalsh((self.inertia + self.inertia.T) / 2)
+        if not moments[0] > 0:
+            raise ValueError(f"TorqueFreeMotion: inertia must be positive definite [kg m^2], got principal moments "
+                             f"{moments.tolist()}")
         self.inverse = np.linalg.inv(self.inertia)
+        if not (is_real(start) and np.isfinite(start)):
+            raise ValueError(f"TorqueFreeMotion: start must be a finite time [s], got {start!r:.60} "
+                             f"({type(start).__name__})")
         self.start = float(start)
+        if np.any(np.abs(self.omega_start) > MAX_BODY_RATE):
+            raise ValueError(f"TorqueFreeMotion: omega_start must be within ±{MAX_BODY_RATE:g} rad/s (MAX_BODY_RATE) "
+                             f"per axis, got {self.omega_start.tolist()}")
         rate = float(np.linalg.norm(self.omega_start))
         # A rest-to-rest profile ends at rest up to rounding (~1e-17 rad/s: a degree in 10⁸
         # years); at or below REST_RATE the coast is rest, and scipy.integrate (0.5 s) is not imported.
@@ -83,7 +119,8 @@ class TorqueFreeMotion:
         Parameters
         ----------
         t : (N,) array_like
-            Times [s], at or after ``start`` (earlier times give the state at ``start``).
+            Times [s], at or after ``start`` (earlier times give the state at ``start``), finite and
+            within :data:`MAX_COAST_CHUNKS` chunks of it.
 
         Returns
         -------
@@ -97,8 +134,15 @@ class TorqueFreeMotion:
         t = np.asarray(t, dtype=float)
         if self.at_rest:
             return np.tile(self.q_start, (t.size, 1)), np.zeros((t.size, 3)), np.zeros((t.size, 3))
+        if not np.all(np.isfinite(t)):
+            raise ValueError(f"TorqueFreeMotion: times must be finite [s], got {t.ravel()[~np.isfinite(t.ravel())][:3].tolist()}")
         elapsed = np.maximum(t - self.start, 0.0)
-        index = np.minimum((elapsed / self.chunk).astype(int), 10**6)
+        span = MAX_COAST_CHUNKS * self.chunk
+        if np.any(elapsed >= span):  # was extrapolated from the last chunk's polynomial: no motion at all
+            raise ValueError(f"TorqueFreeMotion: t = {float(np.max(t)):.6g} s is {float(np.max(elapsed)):.6g} s after the "
+                             f"start of the coast, beyond the {span:.6g} s it integrates (MAX_COAST_CHUNKS = "
+                             f"{MAX_COAST_CHUNKS:g} steps of {self.chunk:.4g} s)")
+        index = (elapsed / self.chunk).astype(int)
         y = np.empty((t.size, 7))
         for k in np.unique(index):
             mask = index == k

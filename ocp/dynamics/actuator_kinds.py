@@ -16,6 +16,7 @@ saturation, the layouts, the collocation bounds and the closed loop iterate over
 from __future__ import annotations
 
 import functools
+import numbers
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -26,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ocp.errors import ModelError
+from ocp.options import real_array
 
 Array = NDArray[np.float64]
 Expr = Any
@@ -52,13 +54,17 @@ def casadi_number(value: Any) -> Any:
 
 
 def _limit_vector(value: ArrayLike | None, size: int, field_name: str) -> Array:
-    """Per-element positive limit; ``None`` means unlimited (inf). A read-only copy."""
+    """Per-element positive limit; ``None`` means unlimited (inf). A read-only copy; a
+    :class:`~ocp.errors.ModelError` naming the field, the value and its type for anything but real
+    numbers (:func:`~ocp.options.real_array`: ``True``, ``1+0j``, ``"0.1"``)."""
     if value is None:
         return _frozen(np.full(size, np.inf))
-    if np.asarray(value).dtype.kind in "US":  # text, though NumPy reads "0.1" as a number
-        raise ModelError(field_name, f"expected a number or {size} numbers, got {value!r}")
-    array = np.broadcast_to(np.asarray(value, dtype=float), (size,)).copy() if np.ndim(value) == 0 \
-        else np.array(value, dtype=float)
+    try:
+        array = real_array(value)
+    except ValueError as reason:
+        raise ModelError(field_name, f"expected a number or {size} numbers, got {value!r:.200}: {reason}") from None
+    if array.ndim == 0:
+        array = np.full(size, float(array))
     if array.shape != (size,):
         raise ModelError(field_name, f"expected a scalar or {size} values, got shape {array.shape}")
     if np.any(~(array > 0)):
@@ -467,21 +473,34 @@ class ReactionWheels(Actuator):
         self.__post_init__()
 
     def __post_init__(self) -> None:
-        if np.asarray(self.axes).dtype.kind in "US":  # text, though NumPy reads "1" as a number
-            raise ModelError("axes", f"expected a 3 x n matrix of wheel axes (numbers), got {self.axes!r}")
-        axes = np.asarray(self.axes, dtype=float)
+        try:
+            axes = real_array(self.axes)
+        except ValueError as reason:
+            raise ModelError("axes", f"expected a 3 x n matrix of wheel axes (numbers), got {self.axes!r:.200}: "
+                                     f"{reason}") from None
         if axes.ndim != 2 or axes.shape[0] != 3 or axes.shape[1] < 1:
             raise ModelError("axes", f"expected a 3 x n matrix of wheel axes, got shape {axes.shape}")
-        norms = np.linalg.norm(axes, axis=0)
-        if np.any(norms < 1e-9):
+        if not np.all(np.isfinite(axes)):
+            raise ModelError("axes", f"expected finite wheel axes, got {axes.tolist()}")
+        scale = np.max(np.abs(axes), axis=0)  # scaled first: the norm of [1e300, 1e300, 0] overflows
+        if np.any(scale * np.linalg.norm(axes / np.where(scale > 0, scale, 1.0), axis=0) < 1e-9):
             raise ModelError("axes", "a wheel axis is the zero vector")
         n = axes.shape[1]
-        object.__setattr__(self, "axes", _frozen(axes / norms))
+        axes = axes / scale
+        object.__setattr__(self, "axes", _frozen(axes / np.linalg.norm(axes, axis=0)))
         object.__setattr__(self, "max_torque", _limit_vector(self.max_torque, n, "max_torque"))
         object.__setattr__(self, "max_momentum", _limit_vector(self.max_momentum, n, "max_momentum"))
         if self.spin_inertia is not None:
             object.__setattr__(self, "spin_inertia", _limit_vector(self.spin_inertia, n, "spin_inertia"))
-        failed = tuple(int(i) for i in self.failed)
+        try:
+            listed = list(self.failed)
+        except TypeError:
+            raise ModelError("failed", f"expected a list of wheel indices, got {self.failed!r:.80}") from None
+        odd = [i for i in listed if not isinstance(i, numbers.Integral) or isinstance(i, bool)]
+        if odd:
+            raise ModelError("failed", f"expected wheel indices (integers), got {odd[0]!r:.60} ({type(odd[0]).__name__}) "
+                                       f"in {listed!r:.120}")
+        failed = tuple(int(i) for i in listed)
         if any(i < 0 or i >= n for i in failed):
             raise ModelError("failed", f"failed wheel indices must be in 0..{n - 1}, got {list(failed)}")
         if len(set(failed)) != len(failed):
@@ -504,8 +523,17 @@ class ReactionWheels(Actuator):
         -------
         ReactionWheels
             Wheels with ``axes = eye(3)[:, :n_axes]``.
+
+        Raises
+        ------
+        ModelError
+            For an ``n_axes`` that is not an integer from 1 to 3 (``4`` gave three wheels, ``"3"`` a
+            slicing ``TypeError``).
         """
-        return cls(axes=np.eye(3)[:, :n_axes], **limits)
+        if not isinstance(n_axes, numbers.Integral) or isinstance(n_axes, bool) or not 1 <= n_axes <= 3:
+            raise ModelError("n_axes", f"expected 1, 2 or 3 wheels along the body axes, got {n_axes!r:.60} "
+                                       f"({type(n_axes).__name__}); ReactionWheels(axes) takes any others")
+        return cls(axes=np.eye(3)[:, :int(n_axes)], **limits)
 
     @property
     def count(self) -> int:

@@ -20,9 +20,21 @@ from ocp.dynamics.actuator_kinds import (
     Torquers,
 )
 from ocp.errors import ModelError
-from ocp.options import is_real
+from ocp.options import real_array
 
-__all__ = ["Spacecraft"]
+__all__ = ["MAX_INERTIA", "MIN_INERTIA", "Spacecraft"]
+
+MAX_INERTIA = 1.0e12
+"""Largest entry [kg m²] of a spacecraft's inertia (the library's and ``spacecraft.inertia``'s
+bound): ten thousand times the International Space Station's (about 1e8 kg m²). Far beyond it the
+planners' arithmetic overflows (1e300 printed NumPy's overflow warning and a bound of 150 digits);
+an inertia merely too large for its torque (g mm² written as kg m², 1e9 too large) warns (``slew_time``)."""
+
+MIN_INERTIA = 1.0e-9
+"""Least principal moment [kg m²] of a spacecraft (the library's and ``spacecraft.inertia``'s bound):
+a gram at a millimetre, a hundred times below the smallest spacecraft flown (chip-sats of a few grams
+over a few centimetres, about 1e-7 kg m²). Far below it a run hung (1e-250 kg m²: the torque-free
+coast after a bang-coast-bang slew never ended); one of 0 or below is not positive definite."""
 
 Array = NDArray[np.float64]
 _Instance = TypeVar("_Instance", bound=Actuator)
@@ -38,8 +50,9 @@ class Spacecraft:
     ----------
     inertia : (3,) or (3, 3) array_like
         Principal moments, or the full inertia matrix, about the centre of mass [kg m^2], body
-        frame. It must be symmetric positive definite and its principal moments must satisfy the
-        triangle inequalities (``I_i + I_j >= I_k``).
+        frame. It must be symmetric positive definite, its entries within :data:`MAX_INERTIA`
+        (1e12 kg m^2), its least principal moment at least :data:`MIN_INERTIA` (1e-9 kg m^2), and its principal moments must satisfy the triangle
+        inequalities (``I_i + I_j >= I_k``).
     wheels : ReactionWheels or None, optional
         Reaction wheels (default none).
     magnetorquers : Magnetorquers or None, optional
@@ -94,6 +107,9 @@ class Spacecraft:
         if not np.all(np.isfinite(inertia)):
             raise ModelError("inertia", f"the inertia must be finite, got {inertia.tolist()}")
         scale = np.max(np.abs(inertia))
+        if scale > MAX_INERTIA:
+            raise ModelError("inertia", f"expected entries within ±{MAX_INERTIA:g} kg m^2 (MAX_INERTIA, ten thousand "
+                                        f"times the International Space Station's), got {inertia.tolist()!r:.200}")
         if scale == 0:
             raise ModelError("inertia", f"the inertia matrix must be non-zero, got {inertia.tolist()}")
         mismatch = np.abs(inertia - inertia.T)
@@ -108,6 +124,10 @@ class Spacecraft:
         moments = np.linalg.eigvalsh(inertia)
         if moments[0] <= 0:
             raise ModelError("inertia", f"the inertia matrix must be positive definite (eigenvalues {moments.tolist()})")
+        if moments[0] < MIN_INERTIA:
+            raise ModelError("inertia", f"the least principal moment must be at least {MIN_INERTIA:g} kg m^2 (MIN_INERTIA, "
+                                        f"a gram at a millimetre), got {moments[0]:.6g} (principal moments "
+                                        f"{[float(f'{m:.6g}') for m in moments]})")
         if moments[0] + moments[1] < moments[2] * (1 - 1e-12):
             raise ModelError(
                 "inertia",
@@ -332,34 +352,14 @@ class Spacecraft:
         return float(np.min(bound[used] / demand[used], initial=np.inf))
 
 
-_REAL_KINDS = "iuf"
-"""NumPy dtype kinds of real numbers (signed and unsigned integers, floats); booleans (``b``), complex
-numbers (``c``), text (``U``, ``S``), dates and durations (``M``, ``m``) are refused, and an object
-array is judged entry by entry."""
-_KIND_NAMES = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "bytes", "M": "dates",
-               "m": "durations", "V": "raw records"}
-
-
 def _real_array(value: Any) -> Array:
-    """``value`` (the inertia as given) as a new float array, or a :class:`~ocp.errors.ModelError`
-    naming it when it holds anything but real numbers: NumPy would read ``True`` as 1, ``"2"`` in
-    an object array as 2, and ``1+0j`` as 1 with only a ``ComplexWarning``."""
-    expected = "expected 3 principal moments or a 3x3 matrix of numbers"  # real ones, in kg m^2
+    """``value`` (the inertia as given) as a new float array (:func:`~ocp.options.real_array`), or a
+    :class:`~ocp.errors.ModelError` naming it when it holds anything but real numbers."""
     try:
-        array = value if isinstance(value, np.ndarray) else np.array(value, dtype=object)
-    except (TypeError, ValueError):  # a ragged nesting
-        raise ModelError("inertia", f"{expected}, got {value!r:.200}") from None
-    if array.dtype.kind == "O":
-        if array.size == 0:
-            raise ModelError("inertia", f"{expected}, got {value!r:.200}: no numbers")
-        odd = [item for item in array.ravel().tolist() if not is_real(item)]
-        if odd:
-            raise ModelError("inertia", f"{expected}, got {value!r:.200}: {odd[0]!r:.60} ({type(odd[0]).__name__}) "
-                                        "is no real number (moments of inertia are real, in kg m^2)")
-    elif array.dtype.kind not in _REAL_KINDS:
-        raise ModelError("inertia", f"{expected}, got {value!r:.200}: an array of "
-                                    f"{_KIND_NAMES.get(array.dtype.kind, array.dtype.name)} (dtype {array.dtype})")
-    return np.array(array, dtype=float)
+        return real_array(value)
+    except ValueError as reason:
+        raise ModelError("inertia", f"expected 3 principal moments or a 3x3 matrix of numbers, got {value!r:.200}: "
+                                    f"{reason} (moments of inertia are real, in kg m^2)") from None
 
 
 def _significant(matrix: Array) -> NDArray[np.bool_]:

@@ -25,15 +25,28 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ocp.options import is_real
+from ocp.options import is_real, real_array
 
 Array = NDArray[np.float64]
 
+STAR_TRACKER_RATE_LIMIT_HZ = 1.0e7
+"""Largest star-tracker update rate [Hz] (:class:`StarTracker`'s and ``rate_hz``'s bound). The
+updates fall where the count ``floor(t rate)`` advances, and over the longest run slewbench allows
+(``MAX_DURATION_S``, 1e8 s) ``t rate`` then stays below 2**53, where a float counts every integer;
+far beyond it the count overflows (from 1.8e308 / t Hz) and the tracker silently stops updating.
+Real trackers update at 1 to 30 Hz; rates above the controller's sample rate or a kHz warn
+(:mod:`scenarios.schema.plausibility`)."""
+
 
 def _vector(name: str, value: Any, non_negative: bool = False) -> Array:
-    array = np.asarray(value, dtype=float)
+    """``value`` as 3 finite real numbers (:func:`~ocp.options.real_array`), or a ``ValueError``
+    naming ``name``, the value and what is wrong."""
+    try:
+        array = real_array(value)
+    except ValueError as reason:
+        raise ValueError(f"{name} must be 3 finite numbers, got {value!r:.200}: {reason}") from None
     if array.shape != (3,) or not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be 3 finite numbers, got {value!r}")
+        raise ValueError(f"{name} must be 3 finite numbers, got {value!r:.200}")
     if non_negative and np.any(array < 0):
         raise ValueError(f"{name} must be non-negative, got {array.tolist()}")
     return array
@@ -202,8 +215,9 @@ class StarTracker:
         Standard deviation of the measured rotation vector per sensor axis [rad]: about the
         sensor's x and y axes (cross-boresight) and about its z axis, the boresight.
     rate : float or None, optional
-        Updates per second [Hz]; ``None``: every sample. An update falls on a sample when the
-        count ``floor(t rate)`` has advanced since the previous sample (and on the first sample).
+        Updates per second [Hz], at most :data:`STAR_TRACKER_RATE_LIMIT_HZ` (1e7); ``None``: every
+        sample. An update falls on a sample when the count ``floor(t rate)`` has advanced since the
+        previous sample (and on the first sample).
     outages : tuple of (float, float), optional
         Windows ``[t0, t1)`` [s] without updates, whatever the attitude (for blinding by a body at a
         known attitude, ``exclusions`` follows the attitude).
@@ -238,7 +252,12 @@ class StarTracker:
         object.__setattr__(self, "exclusions", exclusions)
         if self.rate is not None:
             if not is_real(self.rate) or not math.isfinite(self.rate) or not self.rate > 0:
-                raise ValueError(f"rate must be a finite positive number of Hz or None, got {self.rate!r}")
+                raise ValueError(f"rate must be a finite positive number of Hz or None, got {self.rate!r:.80} "
+                                 f"({type(self.rate).__name__})")
+            if self.rate > STAR_TRACKER_RATE_LIMIT_HZ:
+                raise ValueError(f"rate must be at most {STAR_TRACKER_RATE_LIMIT_HZ:g} Hz (STAR_TRACKER_RATE_LIMIT_HZ; "
+                                 f"beyond it the update count overflows and the tracker stops updating; None: every "
+                                 f"sample), got {self.rate:g}")
             object.__setattr__(self, "rate", float(self.rate))
         windows = _windows(self.outages)
         for a, b in windows:

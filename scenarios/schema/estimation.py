@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ocp.estimation import Exclusion, Gyro, Magnetometer, Mekf, SensorSuite, StarTracker
+from ocp.estimation.sensors import STAR_TRACKER_RATE_LIMIT_HZ
 from ocp.geometry.directions import DIRECTIONS, Geometry
 from planners.problem import MAX_BODY_RATE
 from scenarios.errors import ScenarioError
@@ -33,12 +34,6 @@ error whose standard deviation exceeds a half turn is no attitude measurement at
 vector wraps at pi rad), and from about 1e83 arcsec the estimator's covariance overflows (its
 knowledge error came out NaN). Plausible values, a thousand times below, warn from
 :data:`~scenarios.schema.plausibility.MAX_STAR_TRACKER_NOISE_ARCSEC`."""
-STAR_TRACKER_RATE_LIMIT_HZ = 1.0e7
-"""Largest star-tracker update rate [Hz]. The updates fall where the count ``floor(t rate)`` advances,
-and over the longest run slewbench allows (``MAX_DURATION_S``, 1e8 s) ``t rate`` then stays below
-2**53, where a float counts every integer; far beyond it the count overflows (from 1.8e308 / t Hz)
-and the tracker silently stops updating. Real trackers update at 1 to 30 Hz; rates above the
-controller's sample rate or a kHz warn (:mod:`scenarios.schema.plausibility`)."""
 MAX_GYRO_ARW_DEG_PER_SQRT_H = math.degrees(MAX_BODY_RATE) * SQRT_HOUR
 """Largest gyro angle random walk [deg/√h] (3.4e6): a white rate noise whose one-second standard
 deviation is ``MAX_BODY_RATE`` (1e3 rad/s, the largest body rate slewbench accepts) measures no rate;

@@ -27,6 +27,7 @@ from ocp import (
 from ocp.dynamics.environment import MAGNETIC_FIELDS, MagneticField
 from ocp.dynamics.ephemeris import parse_utc
 from ocp.dynamics.orbits import ORBITS, TLE_EPOCH_WARN_DAYS, Orbit
+from ocp.dynamics.spacecraft import MAX_INERTIA, MIN_INERTIA
 from ocp.errors import InvalidOption, excerpt
 from ocp.simulation.compiled import notice
 from scenarios.errors import ScenarioError
@@ -44,8 +45,8 @@ from scenarios.schema.keys import (
 from scenarios.schema.node import Node
 from scenarios.schema.requirements import SENSOR, parse_sensors
 
-__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "MAX_DISTURBANCE", "MAX_INERTIA",
-           "MIN_INERTIA", "ORBIT", "SPACECRAFT", "TORQUERS", "WHEELS",
+__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "MAX_DISTURBANCE", "ORBIT", "SPACECRAFT", "TORQUERS",
+           "WHEELS",
            "parse_environment", "parse_magnetic_field", "parse_orbit", "parse_spacecraft"]
 
 
@@ -63,25 +64,12 @@ def _limits(node: Node) -> Any:
     return None if node.is_null() else node.vector(allow_scalar=True)
 
 
-MAX_INERTIA = 1.0e12
-"""Largest entry [kg m²] of ``spacecraft.inertia`` (and ``truth.spacecraft.inertia``): ten thousand
-times the International Space Station's (about 1e8 kg m²). Far beyond it the planners' arithmetic
-overflows (1e300 printed NumPy's overflow warning and a bound of 150 digits); an inertia merely too
-large for its torque (g mm² written as kg m², 1e9 too large) warns (``slew_time``)."""
 MAX_DISTURBANCE = 1.0e6
 """Largest entry [N m] of ``environment.disturbance_torque``: a million times the largest disturbance
 torques on any spacecraft (the ISS's gravity-gradient and aerodynamic torques, of the order of N m;
 small satellites' are µN m to mN m). 1e300 N m was accepted without a warning (its norm overflowed
 to inf, which the plausibility check reads as unlimited) and printed NumPy's overflow warnings; a
 torque merely larger than the actuators give against it warns (``disturbance``)."""
-MIN_INERTIA = 1.0e-9
-"""Least principal moment [kg m²] of ``spacecraft.inertia`` (and ``truth.spacecraft.inertia``): a
-gram at a millimetre, a hundred times below the smallest spacecraft flown (chip-sats of a few grams
-over a few centimetres, about 1e-7 kg m²). Far below it a run hung (1e-250 kg m²: the torque-free
-coast after a bang-coast-bang slew never ended); a positive moment above it too small for its torque
-warns (``actuator_torques``), and one of 0 or below is the spacecraft's error (positive definite)."""
-
-
 def _inertia(node: Node) -> np.ndarray:
     inertia = node.value
     if isinstance(inertia, list) and inertia and all(isinstance(row, list) for row in inertia):

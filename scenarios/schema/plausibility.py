@@ -101,7 +101,7 @@ MAX_STAR_TRACKER_RATE_HZ = 1000.0
 their detector for tens to hundreds of milliseconds per frame and update at 1 to 30 Hz. A rate
 above the controller's sample rate (``1 / simulation.sample_time``) warns too: the simulation gives
 at most one update per sample, so it acts as ``null`` (every sample). Beyond 1e7 Hz the schema
-refuses it (:data:`~scenarios.schema.estimation.STAR_TRACKER_RATE_LIMIT_HZ`)."""
+refuses it (:data:`~ocp.estimation.sensors.STAR_TRACKER_RATE_LIMIT_HZ`)."""
 MAX_ATTITUDE_NOISE_DEG = 10.0
 """Attitude measurement noise [deg, 1 sigma] (``simulation.sensor_noise.attitude_deg``) above which no
 attitude sensor is that coarse: Sun sensors and magnetometer-based attitude give 0.5 to 5 deg, star
