@@ -334,7 +334,7 @@ def test_netcdf_reads_back_with_dimensions_units_and_attributes(tmp_path):
     (["--angles", "ten"], "--angles"),
     (["--angles", "30,,90"], "--angles: item 2 of '30,,90' is empty"),  # not dropped: a typo for 30,60,90?
     (["--angles", ",30,90"], "--angles: item 1 of ',30,90' is empty"),
-    (["--angles", "-10,90"], "(0, 180] degrees, got [-10.0, 90.0]"),  # checked, not read as an option
+    (["--angles", "-10,90"], "--angles: item 1: -10 is outside (0, 180]"),  # checked, not read as an option
     (["--check-angles", "-5,30", "--tolerance", "0.01"], "--check-angles"),  # a list: argparse read it as an option
     (["--check-angles", "30,,90", "--tolerance", "0.01", "--max-entries", "1"],  # 1: no table computed before
      "--check-angles: item 2 of '30,,90' is empty"),
