@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from ocp import quat_casadi as qc
 from ocp.dynamics.orbits import MU_EARTH, Orbit
 from ocp.errors import ModelError
-from ocp.options import Range
+from ocp.options import Range, real_array
 from ocp.quat_casadi import Expr
 
 EARTH_RATE = 7.2921159e-5      # rad/s, sidereal rotation rate
@@ -280,6 +280,14 @@ def gravity_gradient_torque(q: Expr, position: Expr, inertia: NDArray, mu: float
     return 3 * mu / r**5 * ca.cross(r_body, ca.mtimes(ca.DM(inertia), r_body))
 
 
+MAX_DISTURBANCE = 1.0e6
+"""Largest entry [N m] of ``Environment.disturbance_torque`` (and the scenario's
+``environment.disturbance_torque``): a million times the largest disturbance torques on any spacecraft (the ISS's gravity-gradient and aerodynamic torques, of the order of N m;
+small satellites' are µN m to mN m). 1e300 N m was accepted without a warning (its norm overflowed
+to inf, which the plausibility check reads as unlimited) and printed NumPy's overflow warnings; a
+torque merely larger than the actuators give against it warns (``disturbance``)."""
+
+
 @dataclass(frozen=True)
 class Environment:
     """What acts on the spacecraft besides its actuators.
@@ -311,9 +319,16 @@ class Environment:
     disturbance_torque: NDArray = field(default_factory=lambda: np.zeros(3))
 
     def __post_init__(self) -> None:
-        disturbance = np.asarray(self.disturbance_torque, dtype=float)
+        try:
+            disturbance = real_array(self.disturbance_torque)
+        except ValueError as reason:
+            raise ModelError("disturbance_torque", f"expected 3 numbers [N m], got {self.disturbance_torque!r:.200}: "
+                                                   f"{reason}") from None
         if disturbance.shape != (3,):
             raise ModelError("disturbance_torque", f"expected 3 values, got shape {disturbance.shape}")
+        if not np.all(np.abs(disturbance) <= MAX_DISTURBANCE):  # NaN too
+            raise ModelError("disturbance_torque", f"expected finite entries within ±{MAX_DISTURBANCE:g} N m, got "
+                                                   f"{disturbance.tolist()}")
         object.__setattr__(self, "disturbance_torque", disturbance)
         if self.orbit is None and self.gravity_gradient:
             raise ModelError("gravity_gradient", "gravity gradient needs an orbit")

@@ -24,7 +24,7 @@ from ocp import (
     Spacecraft,
     Torquers,
 )
-from ocp.dynamics.environment import MAGNETIC_FIELDS, MagneticField
+from ocp.dynamics.environment import MAGNETIC_FIELDS, MAX_DISTURBANCE, MagneticField
 from ocp.dynamics.ephemeris import parse_utc
 from ocp.dynamics.orbits import ORBITS, TLE_EPOCH_WARN_DAYS, Orbit
 from ocp.dynamics.spacecraft import MAX_INERTIA, MIN_INERTIA
@@ -45,7 +45,7 @@ from scenarios.schema.keys import (
 from scenarios.schema.node import Node
 from scenarios.schema.requirements import SENSOR, parse_sensors
 
-__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "MAX_DISTURBANCE", "ORBIT", "SPACECRAFT", "TORQUERS",
+__all__ = ["ENVIRONMENT", "MAGNETIC_FIELD", "MAGNETORQUERS", "ORBIT", "SPACECRAFT", "TORQUERS",
            "WHEELS",
            "parse_environment", "parse_magnetic_field", "parse_orbit", "parse_spacecraft"]
 
@@ -64,12 +64,6 @@ def _limits(node: Node) -> Any:
     return None if node.is_null() else node.vector(allow_scalar=True)
 
 
-MAX_DISTURBANCE = 1.0e6
-"""Largest entry [N m] of ``environment.disturbance_torque``: a million times the largest disturbance
-torques on any spacecraft (the ISS's gravity-gradient and aerodynamic torques, of the order of N m;
-small satellites' are µN m to mN m). 1e300 N m was accepted without a warning (its norm overflowed
-to inf, which the plausibility check reads as unlimited) and printed NumPy's overflow warnings; a
-torque merely larger than the actuators give against it warns (``disturbance``)."""
 def _inertia(node: Node) -> np.ndarray:
     inertia = node.value
     if isinstance(inertia, list) and inertia and all(isinstance(row, list) for row in inertia):
