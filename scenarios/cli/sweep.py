@@ -369,7 +369,15 @@ def command_sweep(args: argparse.Namespace) -> int:
             if args.dry_run:  # the cases' findings, from the loader's parse where the check parsed the case
                 from scenarios.cli.commands import StudyFindings
                 found = StudyFindings()
-            study = load_study(args.file, progress=_checking(Path(args.file).stem), parsed=found)
+            def early_scheduler(execution: Any) -> None:  # execution.scheduler: refused before the cases too
+                nonlocal phase
+                if execution.scheduler and not scheduler and not args.dry_run:
+                    phase = f"while it connected to the Dask scheduler {execution.scheduler}"
+                    reachable(execution.scheduler, "execution.scheduler")
+                    phase = "while its cases were checked"
+
+            study = load_study(args.file, progress=_checking(Path(args.file).stem), parsed=found,
+                               execution_read=early_scheduler)
             _check_interrupted(args)  # one that CasADi swallowed
             phase = "before its first case"
             if args.dry_run:

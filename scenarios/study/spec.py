@@ -307,7 +307,8 @@ def _base(root: Node, source: Path | None) -> dict[str, Any]:
 
 def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version: str | None = None,
                 progress: Callable[[int, int], None] | None = None,
-                parsed: Callable[[Case, Scenario], None] | None = None) -> Study:
+                parsed: Callable[[Case, Scenario], None] | None = None,
+                execution_read: Callable[[Execution], None] | None = None) -> Study:
     """Parse a study (YAML data), expand its cases and check every one (see the module docstring).
 
     Parameters
@@ -331,6 +332,11 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
         ``inapplicable_rows``), once it passed; a case checked by the verdict of an earlier case of
         its class is not given (see the module docstring). ``slewbench validate`` and ``sweep
         --dry-run`` take the cases' findings from it rather than parse those cases again.
+    execution_read : callable or None, optional
+        ``execution_read(execution)``, called with the study's ``execution`` section once the
+        study's own keys are read and before any case is built or checked (``slewbench sweep``
+        checks ``execution.scheduler`` there: a closed port is refused before a long check of
+        the cases); what it raises is raised.
 
     Returns
     -------
@@ -354,6 +360,8 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
         raise TypeError(f"progress must be callable or None, got {type(progress).__name__}")
     if parsed is not None and not callable(parsed):
         raise TypeError(f"parsed must be callable or None, got {type(parsed).__name__}")
+    if execution_read is not None and not callable(execution_read):
+        raise TypeError(f"execution_read must be callable or None, got {type(execution_read).__name__}")
     source = None if source is None else Path(source)
     root = Node(data).mapping()
     name = STUDY["study"].value(root)
@@ -390,6 +398,8 @@ def parse_study(data: Any, source: str | os.PathLike[str] | None = None, version
     robustness = STUDY["robustness"].value(root)
     STUDY["resolved"].value(root)  # written into study.yaml for the record (version, case seeds)
     root.finish()
+    if execution_read is not None:
+        execution_read(execution)
     _mark_independent(seen)
     study = Study(name, source, base, [v.path for axis in axes for v in axis.varied], [v.path for v, _ in dispersions],
                   samples, method, seed, summary, execution, raw=copy.deepcopy(root.value),
@@ -823,7 +833,8 @@ def size_note(study: Study, workers: int) -> str | None:
 
 
 def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None] | None = None,
-               parsed: Callable[[Case, Scenario], None] | None = None) -> Study:
+               parsed: Callable[[Case, Scenario], None] | None = None,
+               execution_read: Callable[[Execution], None] | None = None) -> Study:
     """Read, expand and check a study file.
 
     Parameters
@@ -833,6 +844,8 @@ def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None
     progress : callable or None, optional
         As :func:`parse_study`.
     parsed : callable or None, optional
+        As :func:`parse_study`.
+    execution_read : callable or None, optional
         As :func:`parse_study`.
 
     Returns
@@ -855,7 +868,7 @@ def load_study(path: str | os.PathLike[str], progress: Callable[[int, int], None
     try:
         data = read_yaml(path)
         _refuse_other_file(data, path)
-        return parse_study(data, path, progress=progress, parsed=parsed)
+        return parse_study(data, path, progress=progress, parsed=parsed, execution_read=execution_read)
     except ScenarioError as error:
         raise in_file(error, path, "study") from None
 
