@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ocp.dynamics.ephemeris import parse_utc
 from ocp.errors import InvalidOption, ModelError
-from ocp.options import Range
+from ocp.options import Range, is_real
 from ocp.quat_casadi import Expr
 
 __all__ = ["J2_EARTH", "MAX_ORBIT_KM", "MU_EARTH", "ORBITS", "R_EARTH", "TLE_EPOCH_REFUSE_DAYS", "TLE_EPOCH_WARN_DAYS",
@@ -236,6 +236,15 @@ class OrbitKind(Orbit):
         return ""
 
 
+def _real_fields(orbit: Any, names: tuple[str, ...]) -> None:
+    """Refuse an orbit element that is no finite real number (``True`` read as 1 m or 1 rad, a
+    text, NaN): a :class:`~ocp.errors.ModelError` naming the element, its value and its type."""
+    for name in names:
+        value = getattr(orbit, name)
+        if not (is_real(value) and np.isfinite(value)):
+            raise ModelError(name, f"expected a finite real number, got {value!r:.100} ({type(value).__name__})")
+
+
 @dataclass(frozen=True)
 class CircularOrbit(OrbitKind):
     """Circular Keplerian orbit, fixed in the inertial (ECI) frame.
@@ -310,6 +319,7 @@ class CircularOrbit(OrbitKind):
                    raan=np.deg2rad(options.raan_deg), arg_latitude=np.deg2rad(options.arg_latitude_deg))
 
     def __post_init__(self) -> None:
+        _real_fields(self, ("altitude", "inclination", "raan", "arg_latitude", "mu"))
         if not self.altitude > -R_EARTH * 0.99:
             raise ModelError("altitude", f"the orbit radius must be positive, got altitude {self.altitude} m")
 
@@ -549,6 +559,8 @@ class KeplerianOrbit(OrbitKind):
             raise ModelError(a_key if error.field == "semi_major_axis" else error.field, error.message) from None
 
     def __post_init__(self) -> None:
+        _real_fields(self, ("semi_major_axis", "eccentricity", "inclination", "raan", "arg_perigee", "mean_anomaly",
+                            "mu"))
         if not (0.0 <= self.eccentricity < 1.0):
             raise ModelError("eccentricity", f"expected an elliptic orbit, 0 <= e < 1, got {self.eccentricity!r}")
         if not (np.isfinite(self.semi_major_axis) and self.semi_major_axis > 0):
