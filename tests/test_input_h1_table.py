@@ -85,6 +85,7 @@ def test_a_table_without_a_fit_says_no_fit_once_with_its_reason():
     fit, note = fit_entries(part)
     assert fit is None
     assert no_fit_line(note) == "no fit: no entry is ok", note
+    assert "8 entries not ok (8 infeasible)" in note and "the fit gives" not in note, note  # there is no fit
     three = TablePart(axes[:3], [30.0, 60.0], np.ones((3, 2)), np.ones((3, 2)), np.zeros((3, 2)),
                       [["ok"] * 2 for _ in range(3)], [[""] * 2 for _ in range(3)])
     fit, note = fit_entries(three)

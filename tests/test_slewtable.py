@@ -274,7 +274,7 @@ def test_fit_entries_keeps_entries_that_are_not_ok_as_gaps():
     part.slew_time_s[1, 2] = np.nan
     refit, note = fit_entries(part, INERTIA, np.eye(3))
     assert refit is not None and len(refit.axes) == len(fit.axes)
-    assert "8 entries not ok (0 infeasible)" in note
+    assert "8 entries not ok (0 infeasible): the fit gives NaN in the cells around them" in note
     assert np.isnan(refit.axis_angle(*fit.axes[0], fit.angles[3]))
     assert np.isnan(refit.axis_angle(*fit.axes[1], 0.5 * (fit.angles[1] + fit.angles[2])))
     far = -fit.axes[0]  # the cells there use neither axis 0 nor axis 1

@@ -401,12 +401,11 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
     ok = part.ok
     status = [[s if good else ("missing" if s == "ok" else s) for s, good in zip(row, flags)]
               for row, flags in zip(part.status, ok.tolist())]  # "ok" without a finite time is not ok
-    notes = []
+    notes = []  # without a fit, what is not ok is said alone: there is no fit to give NaN around it
     bad = int((~ok).sum())
     if bad:
         infeasible = sum(s == "infeasible" for row in status for s in row)
-        notes.append(f"{_plural(bad, 'entry', 'entries')} not ok ({infeasible} infeasible): the fit gives NaN in the "
-                     f"cells around {'it' if bad == 1 else 'them'} (inf at an infeasible one), not a time")
+        notes.append(f"{_plural(bad, 'entry', 'entries')} not ok ({infeasible} infeasible)")
     if len(part.axes) < 4:
         return None, "; ".join([*notes, (f"no fit over the sphere: {_plural(len(part.axes), 'axis', 'axes')} "
                                          "(4 or more spanning the sphere needed)")])
@@ -418,6 +417,9 @@ def fit_entries(part: TablePart, inertia: np.ndarray | None = None, generators: 
                           triangles, status, momentum, max_rate, cones)
     except ValueError as error:
         return None, "; ".join([*notes, f"no fit: {error}"])
+    if bad:
+        notes[0] += (f": the fit gives NaN in the cells around {'it' if bad == 1 else 'them'} (inf at an infeasible "
+                     "one), not a time")
     slower = int(part.not_best_known.sum())
     if slower:
         notes.append(f"{_plural(slower, 'fitted entry', 'fitted entries')} slower than a feasible slew the planner "
