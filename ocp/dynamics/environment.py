@@ -282,8 +282,9 @@ def gravity_gradient_torque(q: Expr, position: Expr, inertia: NDArray, mu: float
 
 MAX_DISTURBANCE = 1.0e6
 """Largest entry [N m] of ``Environment.disturbance_torque`` (and the scenario's
-``environment.disturbance_torque``): a million times the largest disturbance torques on any spacecraft (the ISS's gravity-gradient and aerodynamic torques, of the order of N m;
-small satellites' are µN m to mN m). 1e300 N m was accepted without a warning (its norm overflowed
+``environment.disturbance_torque``): a million times the largest disturbance torques on any
+spacecraft (the ISS's gravity-gradient and aerodynamic torques, of the order of N m; small
+satellites' are µN m to mN m). 1e300 N m was accepted without a warning (its norm overflowed
 to inf, which the plausibility check reads as unlimited) and printed NumPy's overflow warnings; a
 torque merely larger than the actuators give against it warns (``disturbance``)."""
 

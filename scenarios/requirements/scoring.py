@@ -80,9 +80,10 @@ from scenarios.requirements.fields import VERDICT
 from scenarios.requirements.spec import FinalRequirement, RateRequirement, Requirements
 
 __all__ = ["AT_LIMIT", "FINAL_FIELDS", "JUMP_FIELDS", "LATE_SLACK", "POINTING_FIELDS", "RATE_FIELDS",
-           "REFERENCE_POINTS", "SCOPE_WORDS", "TURN_PER_SAMPLE_RAD", "UNREALISED_FIELDS", "UNREALISED_FLOOR", "UNREALISED_TOLERANCE", "Score",
-           "closed_loop_wheels", "coarse_samples", "endpoint_violations", "late_slew", "plant_limits", "rate_jumps", "reference_times",
-           "score_closed_loop", "score_fields", "rate_least_duration", "rate_violations", "score_reference", "start_torque", "target_slack",
+           "REFERENCE_POINTS", "SCOPE_WORDS", "TURN_PER_SAMPLE_RAD", "UNREALISED_FIELDS", "UNREALISED_FLOOR",
+           "UNREALISED_TOLERANCE", "Score", "closed_loop_wheels", "coarse_samples", "endpoint_violations",
+           "late_slew", "plant_limits", "rate_jumps", "reference_times", "score_closed_loop", "score_fields",
+           "rate_least_duration", "rate_violations", "score_reference", "start_torque", "target_slack",
            "tracking_loss", "unhonoured", "violations", "worst_error_between_samples"]
 
 Array = NDArray[np.float64]
