@@ -7,7 +7,8 @@ subpackages it names:
 * top-level modules: :mod:`~ocp.errors` (the exceptions and their base :class:`SlewbenchError`),
   :mod:`~ocp.options` (typed options), :mod:`~ocp.quat` and :mod:`~ocp.quat_casadi` (quaternion
   algebra), :mod:`~ocp.cache` (solver caches), :mod:`~ocp.fast_call` (low-overhead calls of CasADi
-  functions), :mod:`~ocp.metrics` (the common score);
+  functions), :mod:`~ocp.native` (the C compiler and the cache of its builds), :mod:`~ocp.metrics`
+  (the common score);
 * :mod:`ocp.dynamics`: the spacecraft, its actuators, orbits and environment, the assembled model;
 * :mod:`ocp.geometry`: pointing constraints and the directions they are measured from (the Sun,
   the Moon, the Earth, the orbital velocity; imports :mod:`ocp.dynamics`);

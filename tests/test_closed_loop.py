@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import ocp.simulation.compiled
+import ocp.native
 from controllers import CONTROLLERS
 from ocp import (
     AttitudeModel,
@@ -98,13 +98,13 @@ def test_compiled_loop_equals_the_python_loop_and_is_cached(tmp_path, monkeypatc
     libraries = list((tmp_path / "slewbench").glob("*.so"))
     assert len(libraries) == 1
     # The same law and model again: loaded from the cache, the compiler is not run.
-    monkeypatch.setattr(ocp.simulation.compiled.subprocess, "run", lambda *a, **k: pytest.fail("rebuilt a cached build"))
+    monkeypatch.setattr(ocp.native.subprocess, "run", lambda *a, **k: pytest.fail("rebuilt a cached build"))
     assert_same(python, small_loop(compile=True))
 
 
 def test_without_a_compiler_the_loop_runs_interpreted_with_a_one_line_notice(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
-    monkeypatch.setattr(ocp.simulation.compiled, "find_compiler", lambda: None)
+    monkeypatch.setattr(ocp.native, "find_compiler", lambda: None)
     result = small_loop(compile=True)
     assert result.path == "interpreted"
     notice = capsys.readouterr().err

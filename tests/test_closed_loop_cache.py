@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-import ocp.simulation.compiled
+import ocp.native
 from controllers import CONTROLLERS
 from ocp import AttitudeModel, ReactionWheels, SensorNoise, Simulator, Spacecraft, quat
 from ocp.dynamics.truth import Truth, TruthPlant
@@ -163,7 +163,7 @@ def test_the_cache_pickles_empty_after_a_run():
 def test_a_failed_compile_is_not_kept(tmp_path, monkeypatch, capsys):
     """Without a compiler each run says so and runs interpreted: the failure is not cached."""
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
-    monkeypatch.setattr(ocp.simulation.compiled, "find_compiler", lambda: None)
+    monkeypatch.setattr(ocp.native, "find_compiler", lambda: None)
     model = _model()
     for _ in range(2):
         assert _run(model, compile=True).path == "interpreted"

@@ -30,7 +30,8 @@ PACKAGES = ("ocp", "planners", "controllers", "scenarios")
 
 GROUPS: dict[str, tuple[str, ...]] = {
     # ocp: the top-level modules, then the subpackages
-    "ocp": ("ocp.errors", "ocp.options", "ocp.quat", "ocp.quat_casadi", "ocp.cache", "ocp.fast_call", "ocp.metrics"),
+    "ocp": ("ocp.errors", "ocp.options", "ocp.quat", "ocp.quat_casadi", "ocp.cache", "ocp.fast_call", "ocp.native",
+            "ocp.metrics"),
     "ocp.dynamics": ("ocp.dynamics",),
     "ocp.geometry": ("ocp.geometry",),
     "ocp.estimation": ("ocp.estimation",),

@@ -1,9 +1,9 @@
-"""The compiler of the compiled closed loop: ``$CC`` when it is set and found, before ``cc``."""
+"""The compiler of the native builds (the compiled closed loop, the sparse LDLᵀ): ``$CC`` when it is set and found, before ``cc``."""
 import shutil
 
 import pytest
 
-from ocp.simulation.compiled import find_compiler
+from ocp.native import find_compiler
 
 
 def test_cc_from_the_environment_comes_first(monkeypatch):

@@ -108,8 +108,8 @@ MUTATIONS: list[Mutation] = [
              ("tests/test_two_wheel.py::test_min_norm_at_every_sample",),
              equivalent="at s = 0 the projection's scale s / ‖L_gV‖² is 0: the same zero torque"),
     # --- compiled loop and code generation --------------------------------------------------------
-    Mutation("compiled-key-without-source", "ocp/simulation/compiled.py",
-             '"\\n".join([text, compiler, *CFLAGS, version])', '"\\n".join([name, compiler, *CFLAGS, version])',
+    Mutation("compiled-key-without-source", "ocp/native.py",
+             '"\\n".join([source, compiler, *flags, version])', '"\\n".join([name, compiler, *flags, version])',
              (L + "codegen.py::test_cache_key_changes_with_the_generated_source",)),
     Mutation("codegen-y-z-swapped", "scenarios/codegen/export.py",
              '"y": law.function.nnz_in(1), "z": law.function.nnz_in(2)',
@@ -1229,7 +1229,7 @@ MUTATIONS: list[Mutation] = [
     Mutation("closed-loop-star-tracker-reads-the-measured-attitude", "ocp/simulation/closed_loop.py",
              "x[0:4] if sensors.star_tracker is not None else q,", "q,", ("tests/test_estimation_filter.py", "tests/test_estimation_loop.py"),
              equivalent="with a star tracker the attitude noise is refused (simulator._with_sensors): q is x[0:4]"),
-    Mutation("compiled-cache-ignores-xdg", "ocp/simulation/compiled.py",
+    Mutation("compiled-cache-ignores-xdg", "ocp/native.py",
              'base = os.environ.get("XDG_CACHE_HOME") or', "base = None or",
              ("tests/test_closed_loop.py", "tests/test_closed_loop_cache.py")),
     Mutation("mekf-q-cross-term-sign", "ocp/estimation/mekf.py",
@@ -1294,7 +1294,7 @@ MUTATIONS: list[Mutation] = [
              "if np.count_nonzero(np.abs(omega0) > 1e-15 * np.max(np.abs(omega0), initial=0.0)) <= 1:",
              "if np.count_nonzero(np.abs(omega0) > 1e-15 * np.max(np.abs(omega0), initial=0.0)) < 1:",
              ("tests/test_mutants_torque_free.py", "tests/test_natural_motion.py", "tests/test_model_physics.py")),
-    Mutation("compiled-cc-ignored-when-cc-exists", "ocp/simulation/compiled.py",
+    Mutation("compiled-cc-ignored-when-cc-exists", "ocp/native.py",
              'for candidate in (os.environ.get("CC"), "cc", "gcc"):', 'for candidate in ("cc", "gcc", os.environ.get("CC")):',
              ("tests/test_mutants_compiled.py", "tests/test_closed_loop.py", "tests/test_closed_loop_cache.py")),
     # --- a tester's findings (stop 50) ---
