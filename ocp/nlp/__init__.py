@@ -4,7 +4,10 @@ What lives here: solver options, the status policy, multistart with warm starts 
 objects (:mod:`~ocp.nlp.solve`); the second-order sufficient conditions at a converged point
 (:mod:`~ocp.nlp.second_order`); the certificate of a converged point, its KKT residuals unscaled and
 in the solver's scaling, the second-order check and Pontryagin's switching agreement in one record
-(:mod:`~ocp.nlp.certificate`).
+(:mod:`~ocp.nlp.certificate`); IPOPT's interior point on a compiled sparse LDLᵀ for small
+equality-constrained NLPs with bounds, called as an ``nlpsol`` is (:mod:`~ocp.nlp.interior_point`),
+and that factorisation with its inertia (:mod:`~ocp.nlp.sparse_ldl`, a C kernel compiled at first
+use).
 
 May import: CasADi, NumPy, SciPy and the top-level modules of :mod:`ocp`; it knows
 nothing of attitude, models or transcriptions.
@@ -21,6 +24,7 @@ from ocp.nlp.certificate import (
                                  switching_agreement,
                                  with_costate_gap,
 )
+from ocp.nlp.interior_point import InteriorPoint
 from ocp.nlp.second_order import SecondOrderCheck, second_order_check
 from ocp.nlp.solve import (
                            NLPResult,
@@ -33,10 +37,10 @@ from ocp.nlp.solve import (
                            warm_start_options,
 )
 
-__all__ = ["KKTResiduals", "NLPResult", "SecondOrderCheck", "StartResult", "Switching", "certificate", "certify",
-           "converged", "kkt_residuals", "necessary_conditions_certificate", "perturbed", "second_order_check", "seed_counts", "solve_multistart",
-           "solver_options", "status_name", "summary_line", "switching_agreement", "warm_start_options",
-           "with_costate_gap"]
+__all__ = ["InteriorPoint", "KKTResiduals", "NLPResult", "SecondOrderCheck", "StartResult", "Switching",
+           "certificate", "certify", "converged", "kkt_residuals", "necessary_conditions_certificate",
+           "perturbed", "second_order_check", "seed_counts", "solve_multistart", "solver_options", "status_name",
+           "summary_line", "switching_agreement", "warm_start_options", "with_costate_gap"]
 
 
 def __dir__() -> list[str]:

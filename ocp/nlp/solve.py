@@ -104,6 +104,10 @@ class StartResult:
         Largest constraint violation at that point (constraint units).
     converged : bool
         Whether the module's status policy accepts the start.
+    solver : str
+        The solver that reached that point: the ``nlpsol`` plugin (``"ipopt"``, ``"fatrop"``), or
+        what a stand-in's ``stats()`` names (``"interior_point"``: :mod:`ocp.nlp.interior_point`; it
+        names ``"ipopt"`` where it handed the start over).
     """
 
     status: str
@@ -112,6 +116,7 @@ class StartResult:
     time_s: float
     violation: float
     converged: bool
+    solver: str = ""
 
 
 @dataclass
@@ -332,7 +337,9 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
     Parameters
     ----------
     solver : casadi.Function
-        A ``casadi.nlpsol`` function.
+        A ``casadi.nlpsol`` function, or a stand-in called as one whose ``nlpsol`` attribute is the
+        function whose derivatives describe the NLP (:class:`ocp.nlp.interior_point.InteriorPoint`,
+        :class:`planners.spin_extremal.NewtonFirst` takes none: no second-order check there).
     guesses : iterable of ndarray
         Initial decision vectors (clipped into ``[lbx, ubx]``); may be a lazy iterable.
     p, lbx, ubx, lbg, ubg : array_like or None
@@ -385,6 +392,11 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
     objectives: list[float] = []
     begin = time.perf_counter()
     call = _caller(solver)
+    # a stand-in for an nlpsol function (:class:`ocp.nlp.interior_point.InteriorPoint`) names the one
+    # whose derivatives describe its NLP
+    derivatives: ca.Function = getattr(solver, "nlpsol", solver)
+    default_name = (derivatives.class_name().removesuffix("Interface").lower() if isinstance(derivatives, ca.Function)
+                    else type(solver).__name__)
 
     def agreeing() -> int:
         return sum(abs(value - best_f) <= atol + rtol * abs(best_f) for value in objectives)
@@ -402,7 +414,7 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
             if second_order and agree:
                 assert best_index is not None  # set with best
                 if best_index not in checks:
-                    checks[best_index] = second_order_check(solver, best["x"], best["lam_x"], best["lam_g"],
+                    checks[best_index] = second_order_check(derivatives, best["x"], best["lam_x"], best["lam_g"],
                                                             p=p, lbx=low, ubx=high, lbg=g_low, ubg=g_high)
                 # the certificate counts as one more start agreeing on the best point
                 if checks[best_index].certified and agreeing() + 1 >= agree:
@@ -419,6 +431,7 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
         ok = bool(np.isfinite(f)) and converged(status, bool(stats.get("success", False)), excess,
                                                  feasibility_tolerance)
         iterations = int(stats.get("iter_count", 0))
+        name = str(stats.get("solver", default_name))
         if ok and status in ACCEPTABLE:  # stopped at the acceptable level: continued once
             again, stats = call(x0=solution["x"], **{**args, "lam_x0": solution["lam_x"], "lam_g0": solution["lam_g"]})
             iterations += int(stats.get("iter_count", 0))
@@ -428,7 +441,7 @@ def solve_multistart(solver: ca.Function, guesses: Iterable[Array], *, p: Any = 
                                                   excess_again, feasibility_tolerance):
                 solution, status, g, excess, f = again, status_name(stats), g_again, excess_again, f_again
         elapsed = time.perf_counter() - tic
-        starts.append(StartResult(status, f, iterations, elapsed, excess, ok))
+        starts.append(StartResult(status, f, iterations, elapsed, excess, ok, name))
         if not ok:
             continue
         objectives.append(f)

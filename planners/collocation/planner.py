@@ -52,6 +52,7 @@ from ocp.dynamics.layout import actuator_blocks
 from ocp.errors import InvalidOption, OptionsError
 from ocp.fast_call import matrices
 from ocp.nlp.certificate import seed_counts
+from ocp.nlp.interior_point import for_nlpsol
 from ocp.nlp.solve import (
     INFEASIBLE,
     NLPResult,
@@ -116,6 +117,7 @@ from planners.collocation.strategy import (
     AUTO_FIRST,
     AUTO_PIECES,
     AUTO_RESTART,
+    COARSE_INTERIOR_POINT,
     COARSE_MIN_TIME_OPTIONS,
     DENSE_ROUNDS,
     POLISH_MU_INIT,
@@ -533,8 +535,7 @@ class CollocationPlanner(Planner):
             extra = {**(extra or {}), **TRANSFER_L1_BARRIER}
         elif mode == "transfer" and ocp.free_time and not (ocp.energy_weight or ocp.l1_weight or ocp.cones):
             extra = {**(extra or {}), **TRANSFER_MIN_TIME_BARRIER}
-        if (mode == "cold" and solver == "ipopt" and intervals == o.coarse_intervals and mesh is None
-                and ocp.free_time and not (ocp.energy_weight or ocp.l1_weight or ocp.cones)):
+        if mode == "cold" and mesh is None and self._coarse_min_time(ocp, intervals, solver):
             extra = {**(extra or {}), **COARSE_MIN_TIME_OPTIONS}
         if seed_only and solver == "fatrop" and o.solver == "ipopt":  # the IPOPT option's FATROP seed only
             extra = {**(extra or {}), **SEED_FATROP}
@@ -557,6 +558,13 @@ class CollocationPlanner(Planner):
 
         # The model's numbers are baked into the graph: a shared cache needs them in the key.
         return self.solver_cache(problem).get(("collocation", problem.model.fingerprint, key), build)
+
+    def _coarse_min_time(self, ocp: OptimalControlProblem, intervals: int, solver: str) -> bool:
+        """Whether a solve on ``intervals`` by ``solver`` is a cold start of minimum time on the coarse
+        mesh that :data:`COARSE_MIN_TIME_OPTIONS` tune (a free final time, no energy or L1 term, no
+        cones; IPOPT)."""
+        return (solver == "ipopt" and intervals == self.options.coarse_intervals and ocp.free_time
+                and not (ocp.energy_weight or ocp.l1_weight or ocp.cones))
 
     def _variable_bounds(self, problem: ManeuverProblem,
                          tightening: Tightening | None = None) -> tuple[Array, Array, Array, Array]:
@@ -733,7 +741,12 @@ class CollocationPlanner(Planner):
         agree = 1 if near_optimum else o.agree
         lbx, ubx = bounds
         if not o.time_regularization:
-            result = solve_multistart(nlp.solver, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
+            solving: Any = nlp.solver  # the nlpsol, or its stand-in (solve_multistart takes either)
+            if (not near_optimum and self._coarse_min_time(ocp, intervals, o.solver if solver is None else solver)
+                    and np.array_equal(nlp.lbg, nlp.ubg)):
+                # IPOPT's iterates on a compiled factorisation (COARSE_INTERIOR_POINT), IPOPT where unavailable
+                solving = for_nlpsol(nlp.solver, o.tolerance, COARSE_INTERIOR_POINT, o.max_iterations) or nlp.solver
+            result = solve_multistart(solving, guesses, p=params, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg,
                                       agree=agree, restart=restart, fallback=fallback, second_order=restart > 0,
                                       rtol=AGREE_RTOL, atol=AGREE_ATOL)
             return result, {} if near_optimum else {"seeds": seed_record(result, len(guesses), names)}, None

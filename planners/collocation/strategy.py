@@ -129,6 +129,17 @@ against 3.24349; with 2.5 both seeds end at 3.24349, except on an AVX-512 host w
 spin-extremal seed's rounding: 3.28326 there, 2026-12-04, ``tests/test_collocation_seeds.py``.) ``alpha_for_y`` ``min-dual-infeas`` (104
 factorizations) also reaches mt17's lower minimum; not measured further."""
 
+COARSE_INTERIOR_POINT = {key.removeprefix("ipopt."): value for key, value in COARSE_MIN_TIME_OPTIONS.items()}
+"""The options (IPOPT's names) of the compiled interior point (:mod:`ocp.nlp.interior_point`) that solves
+the cold starts of minimum time on ``coarse_intervals`` where the compiled factorisation is
+available: :data:`COARSE_MIN_TIME_OPTIONS`, the same iterates as IPOPT under them. It takes IPOPT's
+iterates (Bilimoria & Wie's two coarse starts: 23 + 24 iterations against IPOPT's 22 + 24, the same
+optima) in about a third of IPOPT's time (0.28-0.39x a start on Bilimoria & Wie, the full inertia and
+XTE, 2026-12-05, ``tests/benchmarks/test_bench_interior_point.py``); a start it cannot finish (it has
+no restoration phase) is IPOPT's from its beginning: one start of the minimum-time cases of
+``tests/benchmarks/iteration_counts.py`` (mt11) and one of the 32 coarse starts of 30 random
+minimum-time slews on torquers and wheels, 2026-12-05; every optimum the same as IPOPT's, to 5e-12."""
+
 TRANSFER_MAX_INTERVALS = 150
 """Largest full mesh solved from the coarse optimum with its multipliers carried over (IPOPT's
 ``warm_start_init_point``, :data:`TRANSFER_WARM_START`); beyond it the full mesh starts from the

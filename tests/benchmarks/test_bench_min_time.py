@@ -399,6 +399,12 @@ B&W's spin-extremal start to another point and add a third start (48-50 against 
 start on the full inertia (28.5 against 20.5 ms). The gap on B&W is the two coarse IPOPT solves that
 item 5's seeds require, at 0.6-0.8 ms an iteration on a 312-variable NLP: what remains is a cheaper
 step than IPOPT with MUMPS (the condensed Riccati route measured above), not the Python around it.
+
+That cheaper step, later on 2026-12-05: IPOPT's algorithm over a compiled LDLᵀ for the coarse
+minimum-time starts (:mod:`ocp.nlp.interior_point`; each start 0.28-0.39x IPOPT's time,
+``test_bench_interior_point.py``). Side by side (9 rounds, wall, load 0.6-0.7): B&W **0.93x
+[0.90..0.96]** (20.8 against 22.5 ms, 47 coarse iterations), the full inertia 0.83x [0.78..0.91] (14.6
+against 17.7 ms), XTE 0.06x, the spin case 0.71x at 70 ms.
 """
 from __future__ import annotations
 
