@@ -301,3 +301,29 @@ def test_bounds_beyond_1e19_are_no_bounds_as_in_ipopt():
     huge = solver(x0=x0, p=params, lbx=np.where(np.isinf(lbx), -1e20, lbx), ubx=np.where(np.isinf(ubx), 1e20, ubx),
                   lbg=target, ubg=target)
     assert solver.stats()["iter_count"] == iterations and np.array_equal(huge["x"], plain["x"])
+
+
+def test_each_thread_has_its_own_stand_in_and_concurrent_solves_agree():
+    """The stand-in's buffers serve one solve at a time: threads sharing an nlpsol (a shared solver
+    cache) each get their own, and solving at once gives each its own answer."""
+    import threading
+
+    nlp, lbx, ubx, target, params = random_nlp(5)
+    ipopt = ca.nlpsol("s", "ipopt", nlp, solver_options("ipopt", 1e-10))
+    x0 = np.clip(np.zeros(nlp["x"].numel()), lbx, ubx)
+    expected = for_nlpsol(ipopt, 1e-10)(x0=x0, p=params, lbx=lbx, ubx=ubx, lbg=target, ubg=target)["x"].copy()
+    found, instances = [], []
+
+    def solve():
+        solver = for_nlpsol(ipopt, 1e-10)
+        instances.append(solver)
+        for _ in range(20):
+            found.append(solver(x0=x0, p=params, lbx=lbx, ubx=ubx, lbg=target, ubg=target)["x"].copy())
+
+    threads = [threading.Thread(target=solve) for _ in range(3)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert len({id(instance) for instance in instances}) == 3
+    assert all(np.array_equal(x, expected) for x in found)

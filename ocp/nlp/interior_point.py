@@ -76,6 +76,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import math
+import threading
 import time
 import weakref
 from pathlib import Path
@@ -592,12 +593,15 @@ def available() -> tuple[bool, str]:
     return ok, note
 
 
-_BUILT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_PER_THREAD = threading.local()
+"""Per thread: ``.built``, a weak table of each ``nlpsol``'s :class:`InteriorPoint` instances
+(:func:`for_nlpsol`): an instance evaluates into buffers of its own, one solve at a time."""
 
 
 def for_nlpsol(nlpsol: ca.Function, tolerance: float, options: dict[str, float] | None = None,
                    max_iterations: int = 3000) -> InteriorPoint | None:
-    """The :class:`InteriorPoint` of ``nlpsol`` with these settings, built once while ``nlpsol`` lives;
+    """The :class:`InteriorPoint` of ``nlpsol`` with these settings, built once per thread while
+    ``nlpsol`` lives (its buffers serve one solve at a time, as :func:`ocp.fast_call.buffered`'s do);
     ``None`` where the compiled factorisation is not available (the caller keeps ``nlpsol``).
 
     Parameters
@@ -618,7 +622,10 @@ def for_nlpsol(nlpsol: ca.Function, tolerance: float, options: dict[str, float] 
     if not available()[0]:
         return None
     key = (float(tolerance), tuple(sorted((options or {}).items())), int(max_iterations))
-    table = _BUILT.setdefault(nlpsol, {})
+    built: weakref.WeakKeyDictionary | None = getattr(_PER_THREAD, "built", None)
+    if built is None:
+        built = _PER_THREAD.built = weakref.WeakKeyDictionary()
+    table = built.setdefault(nlpsol, {})
     found = table.get(key)
     if found is None:
         # over a handle of its own to the same function: the entry must not keep its key alive
