@@ -98,11 +98,10 @@ def _solved_alone(seed):
     return solver.stats()["solver"] == "interior_point"
 
 
-def coarse_bilimoria_wie():
-    """The coarse (8-interval) minimum-time NLP of Bilimoria & Wie's 180° slew and its first start,
-    as collocation's multistart solves it."""
+def coarse_starts(problem):
+    """``problem``'s minimum-time plan by collocation and each coarse start the interior point got:
+    ``(reference, [(solver, arguments), ...])`` (also the benchmark's, test_bench_interior_point.py)."""
     from planners import PLANNERS
-    from tests.benchmarks.test_bench_min_time import bilimoria_wie
 
     captured = []
     original = ip_module.InteriorPoint.__call__
@@ -113,10 +112,18 @@ def coarse_bilimoria_wie():
 
     ip_module.InteriorPoint.__call__ = spy
     try:
-        reference = PLANNERS["collocation"]({"objective": "min_time"}).plan(bilimoria_wie())
+        reference = PLANNERS["collocation"]({"objective": "min_time"}).plan(problem)
     finally:
         ip_module.InteriorPoint.__call__ = original
     return reference, captured
+
+
+def coarse_bilimoria_wie():
+    """The coarse (8-interval) minimum-time starts of Bilimoria & Wie's 180° slew, as collocation's
+    multistart solves them, and the plan."""
+    from tests.benchmarks.test_bench_min_time import bilimoria_wie
+
+    return coarse_starts(bilimoria_wie())
 
 
 def test_the_coarse_minimum_time_starts_take_ipopts_iterates():

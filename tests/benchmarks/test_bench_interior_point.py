@@ -32,31 +32,16 @@ import time
 import numpy as np
 import pytest
 
-import ocp.nlp.interior_point as ip_module
 from ocp.fast_call import buffered
 from ocp.nlp.sparse_ldl import available
 from planners import PLANNERS
 from tests.benchmarks.test_bench_min_time import bilimoria_wie, full_inertia, xte
+from tests.test_interior_point import coarse_starts
 
 ROUNDS = int(os.environ.get("SLEWBENCH_ROUNDS", "9"))
 CASES = {"bilimoria_wie": bilimoria_wie, "full_inertia": full_inertia, "xte": xte}
 
 
-def coarse_starts(problem):
-    """The interior point and the arguments of each coarse start of ``problem``'s plan."""
-    captured = []
-    original = ip_module.InteriorPoint.__call__
-
-    def spy(self, **arguments):
-        captured.append((self, arguments))
-        return original(self, **arguments)
-
-    ip_module.InteriorPoint.__call__ = spy
-    try:
-        PLANNERS["collocation"]({"objective": "min_time"}).plan(problem)
-    finally:
-        ip_module.InteriorPoint.__call__ = original
-    return captured
 
 
 def _ipopt(solver, arguments):
@@ -79,7 +64,7 @@ def _spread(values):
 @pytest.mark.skipif(not available()[0], reason=available()[1])
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_side_by_side_ipopt(case):
-    starts = coarse_starts(CASES[case]())
+    _, starts = coarse_starts(CASES[case]())
     assert starts, "no coarse start reached the interior point"
     for index, (solver, arguments) in enumerate(starts):
         ours, theirs = [], []
